@@ -1,0 +1,60 @@
+# stereovision: one front door for build, demo, test, lint and bench.  `make help` lists targets.
+SHELL := /bin/bash
+VENV ?= .venv
+PY := $(VENV)/bin/python
+PIP := $(PY) -m pip
+STAMP := $(VENV)/.deps-stamp
+BUILD_STAMP := $(VENV)/.build-stamp
+RUST_SRC := $(shell find rust -name '*.rs' -o -name Cargo.toml) Cargo.toml pyproject.toml
+PY_SRC := $(shell find python -type f -not -name '*.so' -not -path '*/__pycache__/*')
+
+.PHONY: help setup build demo test test-rust test-py lint fmt bench clean
+
+help:  ## list targets
+	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
+
+$(STAMP): pyproject.toml requirements-dev.txt
+	test -x $(PY) || python3 -m venv $(VENV)
+	$(PIP) install -q --upgrade pip
+	$(PIP) install -q -r requirements-dev.txt
+	touch $@
+
+setup: $(STAMP)  ## create .venv with the build and test tools
+
+$(BUILD_STAMP): $(STAMP) $(RUST_SRC) $(PY_SRC)
+	$(PY) -m maturin build --release --quiet -o target/wheels
+	$(PIP) install -q --force-reinstall --no-deps $$(ls -t target/wheels/stereovision_rs-*.whl | head -1)
+	$(PIP) install -q $$(ls -t target/wheels/stereovision_rs-*.whl | head -1)
+	touch $@
+
+build: $(BUILD_STAMP)  ## build the Rust extension (release) and install the package into .venv
+
+demo: build  ## run the demo on the bundled scene (no camera, no network)
+	$(VENV)/bin/stereovision demo -o demo_output
+
+test-rust:  ## cargo test of the pure-Rust core
+	cargo test --quiet
+
+lint: $(STAMP)  ## cargo fmt/clippy, ruff, mypy
+	cargo fmt --all -- --check
+	cargo clippy --workspace --all-targets --quiet -- -D warnings
+	$(VENV)/bin/ruff check python tests benches
+	$(VENV)/bin/ruff format --check python tests benches
+	$(VENV)/bin/mypy
+
+test-py: build  ## pytest (parity, API, CLI, accuracy)
+	$(PY) -m pytest -q
+
+test: build test-rust lint test-py  ## everything CI runs
+
+fmt:  ## format Rust and Python in place
+	cargo fmt --all
+	$(VENV)/bin/ruff format python tests benches
+	$(VENV)/bin/ruff check --fix python tests benches
+
+bench: build  ## criterion benches of the kernels, then the Python benches against OpenCV
+	cargo bench
+	$(PY) benches/bench_vs_opencv.py
+
+clean:  ## remove build products (keeps .venv)
+	rm -rf target $(BUILD_STAMP) demo_output

@@ -1,0 +1,96 @@
+//! A minimal owned single-channel `f32` image, row-major.
+
+use crate::error::{CoreError, Result};
+
+/// Grey image, row-major, `data[y * width + x]`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    pub width: usize,
+    pub height: usize,
+    pub data: Vec<f32>,
+}
+
+impl Image {
+    /// Wraps a buffer after checking its size; rejects empty and non-finite images.
+    pub fn new(width: usize, height: usize, data: Vec<f32>) -> Result<Self> {
+        if width == 0 || height == 0 {
+            return Err(CoreError::EmptyImage { width, height });
+        }
+        let expected = width
+            .checked_mul(height)
+            .ok_or_else(|| CoreError::param("shape", "width * height overflows"))?;
+        if data.len() != expected {
+            return Err(CoreError::BufferSize {
+                got: data.len(),
+                expected,
+                width,
+                height,
+            });
+        }
+        let count = data.iter().filter(|v| !v.is_finite()).count();
+        if count > 0 {
+            return Err(CoreError::NonFinite { count });
+        }
+        Ok(Image {
+            width,
+            height,
+            data,
+        })
+    }
+
+    /// An image filled with one value.
+    pub fn filled(width: usize, height: usize, value: f32) -> Self {
+        Image {
+            width,
+            height,
+            data: vec![value; width * height],
+        }
+    }
+
+    /// Value at `(x, y)`; the caller guarantees bounds.
+    #[inline]
+    pub fn at(&self, x: usize, y: usize) -> f32 {
+        self.data[y * self.width + x]
+    }
+
+    /// `(width, height)`.
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+}
+
+/// Checks that a stereo pair has the same, non-empty size.
+pub fn check_pair(left: &Image, right: &Image) -> Result<()> {
+    if left.size() != right.size() {
+        return Err(CoreError::SizeMismatch {
+            left: left.size(),
+            right: right.size(),
+        });
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_bad_buffers() {
+        assert!(matches!(
+            Image::new(0, 3, vec![]),
+            Err(CoreError::EmptyImage { .. })
+        ));
+        assert!(matches!(
+            Image::new(2, 2, vec![0.0; 3]),
+            Err(CoreError::BufferSize { got: 3, expected: 4, .. })
+        ));
+        assert!(matches!(
+            Image::new(2, 1, vec![0.0, f32::NAN]),
+            Err(CoreError::NonFinite { count: 1 })
+        ));
+        let a = Image::filled(2, 2, 0.5);
+        let b = Image::filled(3, 2, 0.5);
+        assert!(matches!(check_pair(&a, &b), Err(CoreError::SizeMismatch { .. })));
+        assert_eq!(Image::new(2, 1, vec![0.25, 0.5]).unwrap().at(1, 0), 0.5);
+    }
+}

@@ -1,0 +1,18 @@
+//! Pure-Rust core of `stereovision`: the hot kernels of the pipeline, with no Python in sight.
+//!
+//! Layout mirrors the pipeline (see `docs/architecture.md`):
+//! * [`image`]: a minimal owned grey image and validation of inputs;
+//! * [`error`]: the one error type every kernel returns (mapped to Python exceptions by `rust/py`);
+//! * [`matching`]: the correspondence channels (`gabor` today; `mcgm`, `hopfield`, `fusion` later).
+//!
+//! Conventions (algorithms.md section 0): images are `f32` in `[0, 1]`, row-major `(H, W)`;
+//! `x` = column, `y` = row; disparity `d = x_left - x_right`, stored at left-image pixels,
+//! `NaN` = no estimate.
+
+pub mod error;
+pub mod image;
+pub mod matching;
+pub mod parallel;
+
+pub use error::{CoreError, Result};
+pub use image::Image;

@@ -1,0 +1,3 @@
+//! Correspondence channels. Each submodule is one matcher of the paper (algorithms.md A-D).
+
+pub mod gabor;

@@ -1,0 +1,25 @@
+//! NumPy <-> core image conversion.
+
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use stereovision_core::Image;
+
+/// Copies a 2-D float32 array into a core [`Image`] (validated: non-empty, finite).
+pub fn image_from_numpy(arr: &PyReadonlyArray2<'_, f32>, what: &str) -> PyResult<Image> {
+    let view = arr.as_array();
+    let (h, w) = view.dim();
+    let data: Vec<f32> = match view.as_slice() {
+        Some(s) => s.to_vec(),
+        None => view.iter().copied().collect(),
+    };
+    Image::new(w, h, data).map_err(|e| PyValueError::new_err(format!("{what}: {e}")))
+}
+
+/// Moves a core [`Image`] into a new NumPy array without copying.
+pub fn image_to_numpy<'py>(py: Python<'py>, img: Image) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let arr = Array2::from_shape_vec((img.height, img.width), img.data)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(arr.into_pyarray(py))
+}

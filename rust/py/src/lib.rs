@@ -1,0 +1,18 @@
+//! `stereovision._core`: the thin PyO3 layer over `stereovision-core`.
+//!
+//! Each file wraps one core module with the same function names; arrays come in as read-only
+//! NumPy views, the GIL is released around every kernel, and core errors become Python exceptions
+//! (`errors.rs`). No algorithm lives here.
+
+use pyo3::prelude::*;
+
+mod convert;
+mod errors;
+mod gabor;
+
+#[pymodule(gil_used = false)]
+fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    m.add_function(wrap_pyfunction!(gabor::gabor_disparity, m)?)?;
+    Ok(())
+}
