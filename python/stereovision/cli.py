@@ -1,0 +1,348 @@
+"""Command line: ``stereovision demo | depth | eval``.
+
+Errors print one line on stderr and exit with status 2 (never a traceback); every output file is
+written atomically after all computation succeeded, so an error never destroys earlier outputs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import tempfile
+import time
+from collections.abc import Sequence
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+EXIT_ERROR = 2
+EXIT_INTERRUPTED = 130
+
+
+class CliError(Exception):
+    """A user-facing error: printed as one line, exit status 2."""
+
+
+# ----------------------------------------------------------------------------- output helpers
+
+
+def _atomic_write_bytes(path: Path, data: bytes) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def colorize(values: np.ndarray, *, lo: float | None = None, hi: float | None = None) -> np.ndarray:
+    """Colour-map a float map (TURBO, NaN black) robustly scaled to its 1st-99th percentiles.
+
+    Parameters
+    ----------
+    values : ndarray, float (H, W)
+    lo, hi : float, optional
+        Value range mapped to the ends of the colour map (default: 1st and 99th percentiles).
+
+    Returns
+    -------
+    ndarray, uint8 (H, W, 3)
+        BGR image.
+    """
+    finite = np.isfinite(values)
+    out = np.zeros((*values.shape, 3), np.uint8)
+    if not finite.any():
+        return out
+    v = values[finite]
+    lo = float(np.percentile(v, 1)) if lo is None else lo
+    hi = float(np.percentile(v, 99)) if hi is None else hi
+    scale = 255.0 / max(hi - lo, 1e-9)
+    u8 = np.clip((np.nan_to_num(values, nan=lo) - lo) * scale, 0, 255).astype(np.uint8)
+    out = cv2.applyColorMap(u8, cv2.COLORMAP_TURBO)
+    out[~finite] = 0
+    return out
+
+
+def _png_bytes(img: np.ndarray) -> bytes:
+    ok, buf = cv2.imencode(".png", img)
+    if not ok:
+        raise CliError("could not encode a PNG image")
+    return buf.tobytes()
+
+
+def _npy_bytes(arr: np.ndarray) -> bytes:
+    import io as _io
+
+    bio = _io.BytesIO()
+    np.save(bio, arr)
+    return bio.getvalue()
+
+
+def write_depth_outputs(result: Any, out_dir: Path) -> dict[str, Path]:
+    """Write disparity.png, disparity.pfm, depth.png, depth.npy and cloud.ply into ``out_dir``.
+
+    Everything is encoded in memory first, then each file is replaced atomically.
+    """
+    from stereovision.io import write_pfm, write_ply
+
+    files: dict[str, bytes] = {"disparity.png": _png_bytes(colorize(result.disparity, lo=0.0))}
+    if result.depth is not None:
+        # Near = warm: colour the inverse depth so the map reads like the disparity.
+        inv = np.where(np.isfinite(result.depth), 1.0 / result.depth, np.nan)
+        files["depth.png"] = _png_bytes(colorize(inv))
+        files["depth.npy"] = _npy_bytes(result.depth.astype(np.float32))
+    out_dir.mkdir(parents=True, exist_ok=True)
+    written: dict[str, Path] = {}
+    for name, data in files.items():
+        _atomic_write_bytes(out_dir / name, data)
+        written[name] = out_dir / name
+    written["disparity.pfm"] = Path(write_pfm(out_dir / "disparity.pfm", result.disparity))
+    if result.depth is not None:
+        written["cloud.ply"] = Path(write_ply(out_dir / "cloud.ply", result.points, result.colors))
+    return written
+
+
+# ----------------------------------------------------------------------------- commands
+
+
+def _load_calibration(path: str | None) -> Any:
+    if path is None:
+        return None
+    from stereovision.calibration import Calibration
+
+    return Calibration.from_file(path)
+
+
+def _progress(enabled: bool = True) -> Any:
+    from tqdm import tqdm
+
+    return tqdm(disable=not enabled or not sys.stderr.isatty(), file=sys.stderr, leave=False)
+
+
+def cmd_depth(args: argparse.Namespace) -> int:
+    """``stereovision depth LEFT RIGHT -o DIR``."""
+    from stereovision.depth import depth_map
+    from stereovision.io import imread
+
+    left = imread(args.left)
+    right = imread(args.right)
+    calib = _load_calibration(args.calib)
+    res = depth_map(
+        left,
+        right,
+        calib,
+        method=args.method,
+        max_disparity=args.max_disparity,
+        fill=args.fill,
+    )
+    written = write_depth_outputs(res, Path(args.output))
+    print(
+        f"{args.method}: max_disparity {res.max_disparity} px, density {100 * res.density:.1f} %,"
+        f" {len(res.points)} points, {sum(res.timings.values()):.2f} s"
+    )
+    for name, path in written.items():
+        print(f"  {name:14s} {path}")
+    return 0
+
+
+def _demo_scene_dir() -> Path:
+    return Path(str(resources.files("stereovision") / "data" / "cones"))
+
+
+def cmd_demo(args: argparse.Namespace) -> int:
+    """``stereovision demo``: the bundled Middlebury scene, end to end, with an evaluation line."""
+    from stereovision.depth import depth_map
+    from stereovision.evaluate import dense_metrics, depth_metrics, gt_depth
+    from stereovision.io import load_scene
+
+    scene_dir = _demo_scene_dir()
+    scene = load_scene(scene_dir)
+    print(f"demo scene: Middlebury 2003 'Cones' ({scene_dir})")
+    print("  (c) Scharstein & Szeliski, CVPR 2003; calibration nominal, see its README.md")
+    res = depth_map(
+        scene.left, scene.right, scene.calib, method=args.method, max_disparity=scene.max_disparity
+    )
+    out_dir = Path(args.output)
+    written = write_depth_outputs(res, out_dir)
+    raw = dense_metrics(res.disparity, scene.gt)
+    from stereovision.baselines import row_fill
+
+    filled = dense_metrics(row_fill(res.disparity), scene.gt)
+    print(
+        f"{args.method} on cones (max_disparity {res.max_disparity}): "
+        f"bad-2.0 {filled.bad[2.0]:.1f} % with row fill, {raw.bad[2.0]:.1f} % unfilled "
+        f"(density {raw.density:.1f} %, avgerr {raw.avgerr:.2f} px), "
+        f"{sum(res.timings.values()):.2f} s"
+    )
+    if res.depth is not None and scene.calib is not None:
+        dm = depth_metrics(res.depth, gt_depth(scene.gt, scene.calib))
+        print(
+            f"  depth vs GT: median |dZ|/Z {dm.median_rel:.2f} %, off by >5 % {dm.share_off_5:.1f} %"
+            f" over {dm.n} pixels; {len(res.points)} points in the cloud"
+        )
+    print(f"outputs in {out_dir.resolve()}:")
+    for name, path in written.items():
+        print(f"  {name:14s} {path}")
+    return 0
+
+
+def _eval_scene(scene: Any, method: str, with_opencv: bool) -> dict[str, Any]:
+    from stereovision import baselines
+    from stereovision.depth import depth_map
+    from stereovision.evaluate import dense_metrics, depth_metrics, gt_depth, table1_report
+
+    md = scene.max_disparity
+    t = time.perf_counter()
+    calib = scene.calib if scene.calib is not None and scene.calib.rectified else None
+    res = depth_map(scene.left, scene.right, calib, method=method, max_disparity=md)
+    t_ours = time.perf_counter() - t
+    row: dict[str, Any] = {"scene": scene.name, "max_disparity": md, "method": method}
+    row["ours"] = dense_metrics(res.disparity, scene.gt).as_dict()
+    row["ours+fill"] = dense_metrics(baselines.row_fill(res.disparity), scene.gt).as_dict()
+    row["ours_ms"] = 1000 * t_ours
+    sgbm = None
+    if with_opencv:
+        t = time.perf_counter()
+        bm = baselines.opencv_bm(scene.left, scene.right, md)
+        row["bm_ms"] = 1000 * (time.perf_counter() - t)
+        t = time.perf_counter()
+        sgbm = baselines.opencv_sgbm(scene.left, scene.right, md)
+        row["sgbm_ms"] = 1000 * (time.perf_counter() - t)
+        row["bm"] = dense_metrics(bm, scene.gt).as_dict()
+        row["sgbm"] = dense_metrics(sgbm, scene.gt).as_dict()
+        row["sgbm+fill"] = dense_metrics(baselines.row_fill(sgbm), scene.gt).as_dict()
+    if calib is not None and res.depth is not None:
+        zgt = gt_depth(scene.gt, calib)
+        row["depth"] = depth_metrics(res.depth, zgt).as_dict()
+        if sgbm is not None:
+            row["sgbm_depth"] = depth_metrics(calib.depth_from_disparity(sgbm), zgt).as_dict()
+        rep = table1_report(res.depth, zgt, n_points=10, seed=0)
+        row["table1"] = rep.as_dict()
+        row["_table1_text"] = rep.format()
+    return row
+
+
+def _fmt_dense(m: dict[str, Any]) -> str:
+    return f"{m['bad_2.0']:6.1f} {m['bad_1.0']:6.1f} {m['density']:6.1f}"
+
+
+def cmd_eval(args: argparse.Namespace) -> int:
+    """``stereovision eval SCENE_DIR...``: evaluation.md metrics, ours beside OpenCV."""
+    from tqdm import tqdm
+
+    from stereovision.io import find_scenes, load_scene
+
+    dirs: list[Path] = []
+    for d in args.scenes:
+        p = Path(d)
+        if not p.exists():
+            raise FileNotFoundError(f"scene folder not found: {d}")
+        found = find_scenes(p)
+        if not found:
+            raise CliError(f"no scene (left.png + right.png) under {d}")
+        dirs.extend(found)
+    rows = []
+    header = (
+        f"{'scene':38s} {'D':>4s} | {'ours':^20s} | {'ours+fill':^20s} |"
+        f" {'StereoBM':^20s} | {'SGBM-3WAY':^20s} | {'SGBM+fill':^20s}"
+    )
+    sub = f"{'':38s} {'':>4s} |" + " bad-2  bad-1  dens |" * 5
+    if not args.json:
+        print(header)
+        print(sub)
+    for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=args.json or len(dirs) < 2):
+        scene = load_scene(d)
+        if scene.gt is None:
+            raise CliError(f"{d}: no ground truth (gt_disp.pfm) to evaluate against")
+        row = _eval_scene(scene, args.method, not args.no_opencv)
+        rows.append(row)
+        if args.json:
+            print(json.dumps({k: v for k, v in row.items() if not k.startswith("_")}))
+            continue
+        cells = [_fmt_dense(row["ours"]), _fmt_dense(row["ours+fill"])]
+        for key in ("bm", "sgbm", "sgbm+fill"):
+            cells.append(_fmt_dense(row[key]) if key in row else " " * 20)
+        tqdm.write(f"{row['scene']:38s} {row['max_disparity']:4d} | " + " | ".join(cells))
+    if args.json or not rows:
+        return 0
+    mean = {
+        k: float(np.mean([r[k]["bad_2.0"] for r in rows])) for k in ("ours", "ours+fill", "bm", "sgbm")
+        if all(k in r for r in rows)
+    }
+    print("mean bad-2.0: " + ", ".join(f"{k} {v:.1f} %" for k, v in mean.items()))
+    for r in rows:
+        if "depth" in r:
+            dm = r["depth"]
+            line = (
+                f"{r['scene']}: depth over our {dm['n']} pixels: median |dZ|/Z {dm['median_rel']:.2f} %,"
+                f" off >5 % {dm['share_off_5']:.1f} %"
+            )
+            if "sgbm_depth" in r:
+                s = r["sgbm_depth"]
+                line += (
+                    f"; SGBM-3WAY over {s['n']}: {s['median_rel']:.2f} %, {s['share_off_5']:.1f} %"
+                )
+            print(line)
+            print(r["_table1_text"])
+    return 0
+
+
+# ----------------------------------------------------------------------------- entry point
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the ``stereovision`` command."""
+    from stereovision.depth import METHODS
+
+    p = argparse.ArgumentParser(prog="stereovision", description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="command", required=True)
+
+    d = sub.add_parser("demo", help="run the pipeline on the bundled Middlebury scene")
+    d.add_argument("-o", "--output", default="demo_output", help="output folder")
+    d.add_argument("--method", default="gabor", choices=METHODS)
+    d.set_defaults(func=cmd_demo)
+
+    d = sub.add_parser("depth", help="disparity, depth and point cloud of one pair")
+    d.add_argument("left")
+    d.add_argument("right")
+    d.add_argument("--calib", help="YAML/JSON calibration, Middlebury calib.txt or KITTI calib")
+    d.add_argument("--max-disparity", type=int, default=None, help="default: from the images")
+    d.add_argument("--method", default="gabor", choices=METHODS)
+    d.add_argument("--fill", action="store_true", help="fill holes (reference row fill)")
+    d.add_argument("-o", "--output", required=True, help="output folder")
+    d.set_defaults(func=cmd_depth)
+
+    d = sub.add_parser("eval", help="evaluate against ground truth, OpenCV beside")
+    d.add_argument("scenes", nargs="+", help="scene folders (or folders containing scenes)")
+    d.add_argument("--method", default="gabor", choices=METHODS)
+    d.add_argument("--json", action="store_true", help="one JSON object per scene on stdout")
+    d.add_argument("--no-opencv", action="store_true", help="skip the OpenCV references")
+    d.set_defaults(func=cmd_eval)
+    return p
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the exit status (0 ok, 2 error, 130 interrupted)."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args))
+    except KeyboardInterrupt:
+        print("stereovision: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except (CliError, ValueError, OSError, RuntimeError) as exc:
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        print(f"stereovision: error: {msg}", file=sys.stderr)
+        return EXIT_ERROR
+
+
+if __name__ == "__main__":
+    sys.exit(main())

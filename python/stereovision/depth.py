@@ -1,0 +1,299 @@
+"""The main entry point: a stereo pair (and its calibration) in, a metric depth map out.
+
+``depth_map`` runs one matcher on the rectified pair, then triangulates with the rectified shortcut
+(algorithms.md E.3): ``Z = f * B / (d + doffs)``, in metres.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from stereovision._validate import as_bgr_uint8, as_gray_float, check_pair
+from stereovision.calibration import Calibration
+
+__all__ = ["METHODS", "DepthResult", "depth_map", "estimate_max_disparity"]
+
+#: Matchers ``depth_map`` knows, by name.
+METHODS = ("gabor",)
+
+# Automatic disparity range: ORB matches on the epipolar band, a high percentile with margin.
+_AUTO_DY_TOL = 2.0  # px: rectified pairs keep matches within a couple of rows
+_AUTO_PERCENTILE = 99.0  # robust "largest" disparity: ignore the top 1 % (mismatches)
+_AUTO_MARGIN = 1.15  # headroom above the observed largest disparity
+_AUTO_MIN_MATCHES = 12  # fewer than this and the estimate is noise: fall back
+_AUTO_FALLBACK_FRACTION = 1 / 8  # of the width, when the pair has too few features
+_DISPARITY_STEP = 16  # ranges are multiples of 16, like the evaluation protocol's
+
+
+def _round_up(value: float, step: int = _DISPARITY_STEP) -> int:
+    return int(max(step, int(np.ceil(value / step)) * step))
+
+
+def estimate_max_disparity(left: npt.ArrayLike, right: npt.ArrayLike) -> int:
+    """Choose a disparity search range from the pair itself.
+
+    ORB features are matched between the images (Hamming distance, mutual best match); matches
+    more than 2 rows apart or with negative disparity are discarded, and the range is 1.15 x the
+    99th percentile of the remaining disparities, rounded up to a multiple of 16 and clamped to
+    [16, width / 2]. A pair with too few features (fewer than 12 matches) falls back to width / 8.
+
+    Parameters
+    ----------
+    left, right : ndarray
+        Rectified images, grey or BGR, any dtype accepted by :func:`depth_map`.
+
+    Returns
+    -------
+    int
+        Largest disparity to search, in pixels (a multiple of 16).
+    """
+    gl = (as_gray_float(left, "left") * 255).astype(np.uint8)
+    gr = (as_gray_float(right, "right") * 255).astype(np.uint8)
+    check_pair(gl, gr)
+    width = gl.shape[1]
+    upper = _round_up(width / 2)
+    fallback = min(upper, _round_up(width * _AUTO_FALLBACK_FRACTION))
+    orb = cv2.ORB_create(nfeatures=4000)
+    kl, dl = orb.detectAndCompute(gl, None)
+    kr, dr = orb.detectAndCompute(gr, None)
+    if dl is None or dr is None or len(kl) < _AUTO_MIN_MATCHES or len(kr) < _AUTO_MIN_MATCHES:
+        return fallback
+    matches = cv2.BFMatcher(cv2.NORM_HAMMING, crossCheck=True).match(dl, dr)
+    pl = np.array([kl[m.queryIdx].pt for m in matches], dtype=np.float64).reshape(-1, 2)
+    pr = np.array([kr[m.trainIdx].pt for m in matches], dtype=np.float64).reshape(-1, 2)
+    d = pl[:, 0] - pr[:, 0]
+    keep = (np.abs(pl[:, 1] - pr[:, 1]) <= _AUTO_DY_TOL) & (d >= 0)
+    if int(keep.sum()) < _AUTO_MIN_MATCHES:
+        return fallback
+    top = float(np.percentile(d[keep], _AUTO_PERCENTILE))
+    return int(min(upper, _round_up(top * _AUTO_MARGIN)))
+
+
+@dataclass
+class DepthResult:
+    """Output of :func:`depth_map`.
+
+    Attributes
+    ----------
+    disparity : ndarray, float32 (H, W)
+        ``x_left - x_right`` in pixels at left rectified pixels; NaN = no estimate.
+    confidence : ndarray, float32 (H, W)
+        Matcher confidence in [0, 1]; 0 where there is no estimate.
+    depth : ndarray, float32 (H, W) or None
+        Depth ``Z`` along the optical axis in metres (NaN where none); None without calibration.
+    points : ndarray, float32 (N, 3)
+        3-D points in metres in the left rectified camera frame (X right, Y down, Z forward), one
+        per pixel with a depth, in row-major pixel order. Empty without calibration.
+    colors : ndarray, uint8 (N, 3)
+        RGB colour of each point, from the left image.
+    pixels : ndarray, int32 (N, 2)
+        ``(x, y)`` pixel of each point.
+    method : str
+        Matcher used.
+    max_disparity : int
+        Disparity range searched, ``[min_disparity, max_disparity]``.
+    calibration : Calibration or None
+        Calibration of the rectified pair the depth was computed with.
+    timings : dict
+        Seconds spent per stage.
+    """
+
+    disparity: npt.NDArray[np.float32]
+    confidence: npt.NDArray[np.float32]
+    depth: npt.NDArray[np.float32] | None
+    points: npt.NDArray[np.float32]
+    colors: npt.NDArray[np.uint8]
+    pixels: npt.NDArray[np.int32]
+    method: str
+    max_disparity: int
+    min_disparity: float = 0.0
+    calibration: Calibration | None = None
+    left_rectified: npt.NDArray[np.uint8] | None = field(default=None, repr=False)
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def valid(self) -> npt.NDArray[np.bool_]:
+        """Boolean (H, W) mask of pixels with a disparity estimate."""
+        return np.isfinite(self.disparity)
+
+    @property
+    def density(self) -> float:
+        """Fraction of pixels with a disparity estimate."""
+        return float(self.valid.mean())
+
+    def to_ply(self, path: str | Path) -> Path:
+        """Write the coloured point cloud as a binary PLY (metres), atomically.
+
+        Raises
+        ------
+        ValueError
+            If the result has no calibration (no metric points to write).
+        """
+        from stereovision.io import write_ply
+
+        if self.depth is None:
+            raise ValueError("no point cloud: depth_map was called without a calibration")
+        return Path(write_ply(path, self.points, self.colors))
+
+
+def _run_matcher(
+    method: str, left: np.ndarray, right: np.ndarray, d_min: float, d_max: float, params: dict
+) -> tuple[np.ndarray, np.ndarray]:
+    if method == "gabor":
+        from stereovision.matching.gabor import gabor_disparity
+
+        res = gabor_disparity(left, right, max_disparity=d_max, min_disparity=d_min, **params)
+        return res.disparity, res.confidence
+    raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
+
+
+def depth_map(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    calib: Calibration | None = None,
+    *,
+    method: str = "gabor",
+    max_disparity: int | None = None,
+    min_disparity: float = 0.0,
+    fill: bool = False,
+    progress: Callable[[str], None] | None = None,
+    **params: Any,
+) -> DepthResult:
+    """Disparity, metric depth and a coloured point cloud from a stereo pair.
+
+    Parameters
+    ----------
+    left, right : ndarray
+        The two images, (H, W) grey or (H, W, 3) BGR as ``cv2.imread`` gives, uint8, uint16 or
+        float in [0, 1]. Raw camera images when ``calib`` is an unrectified rig calibration
+        (they are rectified first); already rectified images otherwise.
+    calib : Calibration, optional
+        Rig calibration. Without it only disparity is computed (``depth`` is None).
+    method : {"gabor"}
+        Matcher (algorithms.md section A for "gabor").
+    max_disparity : int, optional
+        Largest disparity searched, in pixels. None chooses it from the images
+        (:func:`estimate_max_disparity`: ORB matches, 1.15 x their 99th percentile, multiple of 16).
+    min_disparity : float
+        Smallest disparity searched (default 0).
+    fill : bool
+        Fill holes with the reference row rule (evaluation.md: each hole takes the smaller of the
+        nearest valid disparities left and right of it). Off by default: a pixel the matcher is not
+        sure of stays NaN. Filled pixels keep confidence 0 and get no depth or 3-D point.
+    progress : callable, optional
+        Called with a stage name as the pipeline advances.
+    **params
+        Passed to the matcher (see :func:`stereovision.matching.gabor.gabor_disparity`).
+
+    Returns
+    -------
+    DepthResult
+
+    Raises
+    ------
+    ValueError
+        Bad images (shape, dtype, empty, NaN, mismatched sizes), a bad range or unknown method.
+
+    Examples
+    --------
+    >>> import numpy as np, stereovision as sv
+    >>> rng = np.random.default_rng(0)
+    >>> left = rng.random((64, 96), dtype=np.float32)
+    >>> right = np.roll(left, -4, axis=1)  # everything 4 px closer on the right image
+    >>> res = sv.depth_map(left, right, max_disparity=16)
+    >>> bool(abs(np.nanmedian(res.disparity) - 4.0) < 0.1)
+    True
+    """
+    t0 = time.perf_counter()
+    timings: dict[str, float] = {}
+
+    def stage(name: str) -> None:
+        nonlocal t0
+        now = time.perf_counter()
+        timings[name] = now - t0
+        t0 = now
+        if progress is not None:
+            progress(name)
+
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
+    left_bgr = as_bgr_uint8(left, "left")
+    right_bgr = as_bgr_uint8(right, "right")
+    check_pair(left_bgr, right_bgr)
+    if calib is not None:
+        if not isinstance(calib, Calibration):
+            raise ValueError(f"calib must be a stereovision.Calibration, got {type(calib).__name__}")
+        h, w = left_bgr.shape[:2]
+        if tuple(calib.image_size) != (w, h):
+            raise ValueError(
+                f"calibration is for {calib.image_size[0]}x{calib.image_size[1]} images, "
+                f"got {w}x{h}"
+            )
+        if not calib.rectified:
+            left_bgr, right_bgr = calib.rectify(left_bgr, right_bgr)
+            calib = calib.rectified_calibration()
+            left = left_bgr
+            right = right_bgr
+    stage("rectify")
+    gl = as_gray_float(left, "left")
+    gr = as_gray_float(right, "right")
+    if max_disparity is None:
+        max_disparity = estimate_max_disparity(gl, gr)
+    if not np.isfinite(min_disparity) or not np.isfinite(max_disparity):
+        raise ValueError("min_disparity and max_disparity must be finite")
+    if max_disparity <= min_disparity:
+        raise ValueError(
+            f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"
+        )
+    if max_disparity - min_disparity >= gl.shape[1]:
+        raise ValueError(
+            f"disparity range {max_disparity - min_disparity} is not smaller than the image "
+            f"width {gl.shape[1]}"
+        )
+    stage("prepare")
+    disp, conf = _run_matcher(method, gl, gr, float(min_disparity), float(max_disparity), params)
+    disp = np.ascontiguousarray(disp, dtype=np.float32)
+    conf = np.ascontiguousarray(conf, dtype=np.float32)
+    measured = np.isfinite(disp)
+    conf = np.where(measured, conf, np.float32(0)).astype(np.float32)
+    stage("match")
+    if fill:
+        from stereovision.baselines import row_fill
+
+        disp = row_fill(disp).astype(np.float32)
+    depth = None
+    points = np.zeros((0, 3), np.float32)
+    colors = np.zeros((0, 3), np.uint8)
+    pixels = np.zeros((0, 2), np.int32)
+    if calib is not None:
+        # Depth only where the matcher measured: filled pixels are guesses, not measurements.
+        depth = calib.depth_from_disparity(np.where(measured, disp, np.nan)).astype(np.float32)
+        xyz = calib.reproject(np.where(measured, disp, np.nan)).astype(np.float32)
+        ok = np.isfinite(depth) & (depth > 0)
+        ys, xs = np.nonzero(ok)
+        points = np.ascontiguousarray(xyz[ys, xs], dtype=np.float32)
+        colors = np.ascontiguousarray(left_bgr[ys, xs, ::-1], dtype=np.uint8)
+        pixels = np.stack([xs, ys], axis=1).astype(np.int32)
+        stage("triangulate")
+    return DepthResult(
+        disparity=disp,
+        confidence=conf,
+        depth=depth,
+        points=points,
+        colors=colors,
+        pixels=pixels,
+        method=method,
+        max_disparity=int(max_disparity),
+        min_disparity=float(min_disparity),
+        calibration=calib,
+        left_rectified=left_bgr,
+        timings=timings,
+    )
