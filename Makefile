@@ -8,10 +8,25 @@ BUILD_STAMP := $(VENV)/.build-stamp
 RUST_SRC := $(shell find rust -name '*.rs' -o -name Cargo.toml) Cargo.toml pyproject.toml
 PY_SRC := $(shell find python -type f -not -name '*.so' -not -path '*/__pycache__/*')
 
-.PHONY: help setup build demo test test-rust test-py lint fmt bench clean
+.PHONY: help system-deps setup build demo test test-rust test-py lint fmt bench clean
 
 help:  ## list targets
 	@grep -E '^[a-z-]+:.*## ' $(MAKEFILE_LIST) | awk -F':.*## ' '{printf "  %-10s %s\n", $$1, $$2}'
+
+SYS_STAMP := $(VENV)/.sys-stamp
+
+# Headless Chromium for the browser tests (report and GUI pages). Debian's package: never a
+# browser download. Skipped with a warning where apt is unavailable (tests then skip, not fail).
+$(SYS_STAMP):
+	@mkdir -p $(VENV)
+	@if command -v chromium >/dev/null 2>&1; then echo "chromium: present"; \
+	elif command -v apt-get >/dev/null 2>&1 && [ "$$(id -u)" = 0 ]; then \
+	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) \
+	  || echo "warning: could not install chromium; browser tests will be skipped"; \
+	else echo "warning: chromium missing and apt-get unavailable; browser tests will be skipped"; fi
+	@touch $@
+
+system-deps: $(SYS_STAMP)  ## install Debian packages the tests use (chromium)
 
 $(STAMP): pyproject.toml requirements-dev.txt
 	test -x $(PY) || python3 -m venv $(VENV)
@@ -45,7 +60,7 @@ lint: $(STAMP)  ## cargo fmt/clippy, ruff, mypy
 test-py: build  ## pytest (parity, API, CLI, accuracy)
 	$(PY) -m pytest -q
 
-test: build test-rust lint test-py  ## everything CI runs
+test: build system-deps test-rust lint test-py  ## everything CI runs
 
 fmt:  ## format Rust and Python in place
 	cargo fmt --all

@@ -1,0 +1,101 @@
+"""The command line: outputs, exit codes, one-line errors, nothing lost on failure."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from stereovision.cli import main
+from stereovision.io import read_pfm, read_ply
+
+SV = [sys.executable, "-m", "stereovision.cli"]
+
+
+def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
+    out = tmp_path / "demo"
+    proc = subprocess.run([*SV, "demo", "-o", str(out)], capture_output=True, text=True, check=False)
+    assert proc.returncode == 0, proc.stderr
+    assert "bad-2.0" in proc.stdout and "density" in proc.stdout
+    for name in ("disparity.png", "depth.png", "disparity.pfm", "depth.npy", "cloud.ply"):
+        assert (out / name).stat().st_size > 0, name
+    disp = read_pfm(out / "disparity.pfm")
+    assert disp.shape == (375, 450)
+    assert np.isfinite(disp).mean() > 0.5
+    img = cv2.imread(str(out / "disparity.png"))
+    assert img is not None and img.shape == (375, 450, 3) and img.std() > 10
+    pts, _ = read_ply(out / "cloud.ply")
+    assert len(pts) > 10000
+
+
+def test_depth_command_on_metric_scene(tmp_path: Path, data_dir: Path) -> None:
+    scene = data_dir / "eth3d" / "terrace"
+    out = tmp_path / "o"
+    rc = main(
+        [
+            "depth",
+            str(scene / "left.png"),
+            str(scene / "right.png"),
+            "--calib",
+            str(scene / "calib.txt"),
+            "--max-disparity",
+            "32",
+            "-o",
+            str(out),
+        ]
+    )
+    assert rc == 0
+    depth = np.load(out / "depth.npy")
+    assert depth.shape == (434, 713) and depth.dtype == np.float32
+    assert 1.0 < float(np.nanmedian(depth)) < 30.0  # metres
+
+
+def test_errors_are_one_line_and_keep_earlier_outputs(tmp_path: Path, data_dir: Path) -> None:
+    out = tmp_path / "o"
+    out.mkdir()
+    keep = out / "disparity.png"
+    keep.write_bytes(b"earlier result")
+    scene = data_dir / "middlebury2001" / "tsukuba"
+    cases = [
+        ["depth", str(tmp_path / "missing.png"), str(scene / "right.png"), "-o", str(out)],
+        ["depth", str(scene / "left.png"), str(data_dir / "eth3d" / "terrace" / "right.png"),
+         "-o", str(out)],
+        ["depth", str(scene / "left.png"), str(scene / "right.png"), "--calib",
+         str(scene / "SOURCE"), "-o", str(out)],
+        ["eval", str(tmp_path / "nowhere")],
+    ]
+    for argv in cases:
+        proc = subprocess.run([*SV, *argv], capture_output=True, text=True, check=False)
+        assert proc.returncode == 2, (argv, proc.stdout, proc.stderr)
+        lines = proc.stderr.strip().splitlines()
+        assert len(lines) == 1 and lines[0].startswith("stereovision: error:"), proc.stderr
+        assert "Traceback" not in proc.stderr
+    assert keep.read_bytes() == b"earlier result"
+
+
+def test_eval_json_one_object_per_scene(data_dir: Path) -> None:
+    import json
+
+    proc = subprocess.run(
+        [*SV, "eval", str(data_dir / "middlebury2001" / "tsukuba"), "--json"],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stderr
+    rows = [json.loads(line) for line in proc.stdout.splitlines() if line.strip()]
+    assert len(rows) == 1
+    row = rows[0]
+    assert row["scene"].endswith("tsukuba") and row["max_disparity"] == 16
+    # Gabor (+ reference fill) beats StereoBM on Tsukuba, same run.
+    assert row["ours+fill"]["bad_2.0"] < row["bm"]["bad_2.0"]
+
+
+@pytest.mark.parametrize("argv", [["depth"], ["bogus"], []])
+def test_usage_errors_exit_nonzero(argv: list[str]) -> None:
+    proc = subprocess.run([*SV, *argv], capture_output=True, text=True, check=False)
+    assert proc.returncode == 2

@@ -1,0 +1,145 @@
+"""depth_map end to end: values, units, frames, bad input."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stereovision as sv
+from stereovision.calibration import Calibration
+from stereovision.io import load_scene, read_ply
+
+
+def _texture(h: int, w: int, seed: int = 0) -> np.ndarray:
+    """Band-limited random texture in [0, 1] (smooth enough for sub-pixel shifts)."""
+    rng = np.random.default_rng(seed)
+    spec = np.fft.fft2(rng.standard_normal((h, w)))
+    fy = np.fft.fftfreq(h)[:, None]
+    fx = np.fft.fftfreq(w)[None, :]
+    spec *= np.exp(-((fx**2 + fy**2) / (2 * 0.12**2)))
+    img = np.real(np.fft.ifft2(spec))
+    img = (img - img.min()) / (img.max() - img.min())
+    return img.astype(np.float32)
+
+
+def _shift(img: np.ndarray, d: float) -> np.ndarray:
+    """right(x) = left(x + d): a fronto-parallel plane at disparity d (Fourier shift)."""
+    w = img.shape[1]
+    fx = np.fft.fftfreq(w)[None, :]
+    out = np.real(np.fft.ifft(np.fft.fft(img, axis=1) * np.exp(2j * np.pi * fx * d), axis=1))
+    return out.astype(np.float32)
+
+
+def _rect_calib(w: int, h: int, f: float = 500.0, baseline_mm: float = 100.0) -> Calibration:
+    k = np.array([[f, 0, (w - 1) / 2], [0, f, (h - 1) / 2], [0, 0, 1]], np.float64)
+    return Calibration(
+        K1=k,
+        D1=np.zeros(5),
+        K2=k.copy(),
+        D2=np.zeros(5),
+        R=np.eye(3),
+        T=np.array([-baseline_mm, 0.0, 0.0]),
+        image_size=(w, h),
+        unit="mm",
+        rectified=True,
+    )
+
+
+def test_plane_gives_metric_depth_and_points() -> None:
+    h, w, d = 96, 160, 6.5
+    left = _texture(h, w)
+    right = _shift(left, d)
+    calib = _rect_calib(w, h)
+    res = sv.depth_map(left, right, calib, max_disparity=16)
+    core = res.disparity[10:-10, 20:-20]
+    assert np.isfinite(core).mean() > 0.9
+    assert abs(float(np.nanmedian(core)) - d) < 0.1
+    z_expected = 500.0 * 0.1 / d  # metres
+    assert res.depth is not None
+    assert abs(float(np.nanmedian(res.depth)) - z_expected) / z_expected < 0.02
+    # Points: left rectified camera frame, metres, X right, Y down, Z forward.
+    assert res.points.dtype == np.float32 and res.points.shape[1] == 3
+    assert len(res.points) == len(res.colors) == len(res.pixels) == int(np.isfinite(res.depth).sum())
+    x, y = res.pixels[0]
+    p = res.points[0]
+    assert p[2] == pytest.approx(res.depth[y, x], rel=1e-5)
+    assert p[0] == pytest.approx((x - (w - 1) / 2) * p[2] / 500.0, rel=1e-4, abs=1e-6)
+    assert p[1] == pytest.approx((y - (h - 1) / 2) * p[2] / 500.0, rel=1e-4, abs=1e-6)
+
+
+def test_without_calibration_no_depth() -> None:
+    left = _texture(64, 96, seed=1)
+    res = sv.depth_map(left, _shift(left, 3.0), max_disparity=16)
+    assert res.depth is None and res.points.shape == (0, 3)
+    with pytest.raises(ValueError, match="calibration"):
+        res.to_ply("unused.ply")
+
+
+def test_textureless_pair_gives_nan_not_error() -> None:
+    flat = np.full((48, 64), 0.5, np.float32)
+    res = sv.depth_map(flat, flat, max_disparity=16)
+    assert np.isnan(res.disparity).all()
+    assert (res.confidence == 0).all()
+
+
+def test_fill_flag_fills_but_keeps_depth_measured_only() -> None:
+    left = _texture(64, 128, seed=2)
+    right = _shift(left, 4.0)
+    left[:, 60:70] = 0.5  # a textureless stripe: holes there
+    right[:, 56:66] = 0.5
+    calib = _rect_calib(128, 64)
+    raw = sv.depth_map(left, right, calib, max_disparity=16)
+    filled = sv.depth_map(left, right, calib, max_disparity=16, fill=True)
+    assert np.isfinite(filled.disparity).sum() >= np.isfinite(raw.disparity).sum()
+    assert filled.depth is not None and raw.depth is not None
+    np.testing.assert_array_equal(np.isfinite(filled.depth), np.isfinite(raw.depth))
+
+
+def test_auto_max_disparity_on_real_scene(data_dir: Path) -> None:
+    scene = load_scene(data_dir / "middlebury2003" / "cones")
+    md = sv.estimate_max_disparity(scene.left, scene.right)
+    gt_max = float(np.nanmax(scene.gt))
+    # Covers the true range, and not absurdly more than it.
+    assert gt_max <= md <= 2 * gt_max + 16
+    assert md % 16 == 0
+
+
+def test_real_scene_ply_round_trip(tmp_path: Path, data_dir: Path) -> None:
+    scene = load_scene(data_dir / "eth3d" / "terrace")
+    assert scene.calib is not None
+    res = sv.depth_map(scene.left, scene.right, scene.calib, max_disparity=scene.max_disparity)
+    path = res.to_ply(tmp_path / "cloud.ply")
+    pts, cols = read_ply(path)
+    np.testing.assert_array_equal(pts, res.points)
+    np.testing.assert_array_equal(cols, res.colors)
+    # Terrace is an outdoor scene a few metres away: metres, not millimetres.
+    assert 1.0 < float(np.median(pts[:, 2])) < 30.0
+
+
+@pytest.mark.parametrize(
+    ("left", "right", "match"),
+    [
+        (np.zeros((10, 12)), np.zeros((10, 13)), "differ|mismatch|shape"),
+        (np.zeros((0, 12)), np.zeros((0, 12)), "empty"),
+        (np.zeros((10, 12, 2)), np.zeros((10, 12, 2)), "channel"),
+        (np.full((10, 12), np.nan, np.float32), np.zeros((10, 12), np.float32), "NaN|finite"),
+        (np.zeros((10, 12), complex), np.zeros((10, 12), complex), "dtype"),
+    ],
+)
+def test_bad_images_raise_value_error(left: np.ndarray, right: np.ndarray, match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        sv.depth_map(left, right, max_disparity=8)
+
+
+def test_bad_arguments_raise_value_error() -> None:
+    img = _texture(32, 48)
+    with pytest.raises(ValueError, match="method"):
+        sv.depth_map(img, img, method="nope", max_disparity=8)
+    with pytest.raises(ValueError, match="max_disparity"):
+        sv.depth_map(img, img, max_disparity=0)
+    with pytest.raises(ValueError, match="width"):
+        sv.depth_map(img, img, max_disparity=64)
+    with pytest.raises(ValueError, match="calibration is for"):
+        sv.depth_map(img, img, _rect_calib(100, 50), max_disparity=8)
