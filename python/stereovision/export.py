@@ -1,0 +1,418 @@
+"""Export a depth result: coloured PLY (cloud or mesh), organised PCD, ``.npz`` bundle.
+
+Conventions shared with pyvista, Open3D, MeshLab and PCL:
+
+- PLY: ``binary_little_endian 1.0``; vertex ``float x, y, z`` + ``uchar red, green, blue``; mesh
+  faces as ``list uchar int vertex_indices``. Metres, left rectified camera frame (X right, Y down,
+  Z forward).
+- PCD (PCL 0.7): ``FIELDS x y z rgb``, ``rgb`` packed into a float (``r << 16 | g << 8 | b``, as
+  ``pcl::PointXYZRGB`` writes it); the cloud keeps the image layout (``WIDTH`` = image width,
+  ``HEIGHT`` = image height, row-major), pixels without depth are NaN points (``is_dense`` false).
+- NPZ: ``depth``, ``confidence``, ``disparity`` (H, W float32, NaN = none), ``K`` (3x3),
+  ``baseline`` (metres), ``doffs`` (pixels), ``image_size`` (W, H), ``method``, ``max_disparity``.
+
+Every writer replaces its file atomically (:func:`stereovision.io.atomic_write`).
+"""
+
+from __future__ import annotations
+
+import io as _io
+import os
+import zipfile
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+from stereovision.io import atomic_write, read_ply, write_ply
+
+if TYPE_CHECKING:
+    import pyvista as pv
+
+    from stereovision.depth import DepthResult
+
+__all__ = [
+    "EXPORT_FORMATS",
+    "export_result",
+    "load_cloud",
+    "organised_points",
+    "read_npz",
+    "read_pcd",
+    "write_cloud_ply",
+    "write_mesh_ply",
+    "write_npz",
+    "write_pcd",
+]
+
+PathLike = str | os.PathLike[str]
+
+#: Formats :func:`export_result` writes, with their file names.
+EXPORT_FORMATS = {"ply": "cloud.ply", "pcd": "cloud.pcd", "npz": "depth.npz"}
+
+_PCD_MAGIC = (b"# .PCD", b"VERSION")
+_PLY_MAGIC = b"ply"
+_ZIP_MAGIC = b"PK\x03\x04"
+
+
+def _require_metric(result: DepthResult) -> None:
+    if result.depth is None or result.calibration is None:
+        raise ValueError("no point cloud: depth_map was called without a calibration")
+
+
+def organised_points(
+    result: DepthResult,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8]]:
+    """Image-shaped points and colours of ``result`` (NaN points where there is no depth).
+
+    Returns
+    -------
+    points : ndarray, float32 (H, W, 3)
+        Metres, left rectified camera frame; NaN where the pixel has no 3-D point.
+    colors : ndarray, uint8 (H, W, 3)
+        RGB of the left rectified image (zeros if the result does not carry it).
+    """
+    _require_metric(result)
+    h, w = result.disparity.shape[:2]
+    pts = np.full((h, w, 3), np.nan, dtype=np.float32)
+    xs, ys = result.pixels[:, 0], result.pixels[:, 1]
+    pts[ys, xs] = result.points
+    if result.left_rectified is not None:
+        cols = np.ascontiguousarray(result.left_rectified[..., ::-1], dtype=np.uint8)
+    else:
+        cols = np.zeros((h, w, 3), np.uint8)
+        cols[ys, xs] = result.colors
+    return pts, cols
+
+
+# ----------------------------------------------------------------------------- PLY
+
+
+def write_cloud_ply(path: PathLike, result: DepthResult) -> Path:
+    """Coloured point cloud of ``result`` as binary PLY (see the module conventions).
+
+    Raises
+    ------
+    ValueError
+        If the result has no calibration (no metric points).
+    """
+    _require_metric(result)
+    write_ply(path, result.points, result.colors)
+    return Path(path)
+
+
+def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
+    """Triangle mesh with per-vertex colours as binary PLY (MeshLab / Open3D / pyvista readable).
+
+    Parameters
+    ----------
+    path : path
+    mesh : pyvista.PolyData
+        E.g. :func:`stereovision.render.surface_mesh`; triangles only; colours from point data
+        ``"RGB"`` when present.
+
+    Raises
+    ------
+    ValueError
+        If the mesh has non-triangle faces.
+    """
+    pts = np.asarray(mesh.points, dtype=np.float32)
+    faces = np.asarray(mesh.faces, dtype=np.int64)
+    if faces.size % 4 or (faces.size and (faces.reshape(-1, 4)[:, 0] != 3).any()):
+        raise ValueError("write_mesh_ply: only triangle meshes are supported")
+    tris = faces.reshape(-1, 4)[:, 1:].astype("<i4")
+    has_rgb = "RGB" in mesh.point_data
+    vfields: list[tuple[str, str]] = [("x", "<f4"), ("y", "<f4"), ("z", "<f4")]
+    header = [
+        "ply",
+        "format binary_little_endian 1.0",
+        "comment stereovision surface mesh (metres, X right, Y down, Z forward)",
+        f"element vertex {len(pts)}",
+        "property float x",
+        "property float y",
+        "property float z",
+    ]
+    if has_rgb:
+        vfields += [("red", "u1"), ("green", "u1"), ("blue", "u1")]
+        header += ["property uchar red", "property uchar green", "property uchar blue"]
+    header += [f"element face {len(tris)}", "property list uchar int vertex_indices", "end_header"]
+    vert = np.empty(len(pts), dtype=np.dtype(vfields))
+    vert["x"], vert["y"], vert["z"] = pts[:, 0], pts[:, 1], pts[:, 2]
+    if has_rgb:
+        rgb = np.asarray(mesh.point_data["RGB"], dtype=np.uint8)
+        vert["red"], vert["green"], vert["blue"] = rgb[:, 0], rgb[:, 1], rgb[:, 2]
+    face = np.empty(len(tris), dtype=np.dtype([("n", "u1"), ("i", "<i4", (3,))]))
+    face["n"] = 3
+    face["i"] = tris
+    with atomic_write(path) as fh:
+        fh.write(("\n".join(header) + "\n").encode("ascii"))
+        fh.write(vert.tobytes())
+        fh.write(face.tobytes())
+    return Path(path)
+
+
+# ----------------------------------------------------------------------------- PCD
+
+
+def _pack_rgb(colors: npt.NDArray[np.uint8]) -> npt.NDArray[np.float32]:
+    c = colors.reshape(-1, 3).astype(np.uint32)
+    packed = (c[:, 0] << 16) | (c[:, 1] << 8) | c[:, 2]
+    return packed.astype("<u4").view("<f4")
+
+
+def _unpack_rgb(packed: npt.NDArray[np.float32]) -> npt.NDArray[np.uint8]:
+    u = np.ascontiguousarray(packed, dtype="<f4").view("<u4")
+    return np.stack([(u >> 16) & 255, (u >> 8) & 255, u & 255], axis=-1).astype(np.uint8)
+
+
+def write_pcd(path: PathLike, result: DepthResult) -> Path:
+    """Organised binary PCD (``WIDTH`` x ``HEIGHT`` = image size, NaN where no depth).
+
+    Raises
+    ------
+    ValueError
+        If the result has no calibration.
+    """
+    pts, cols = organised_points(result)
+    h, w = pts.shape[:2]
+    rec = np.empty(
+        h * w, dtype=np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("rgb", "<f4")])
+    )
+    flat = pts.reshape(-1, 3)
+    rec["x"], rec["y"], rec["z"] = flat[:, 0], flat[:, 1], flat[:, 2]
+    rec["rgb"] = _pack_rgb(cols)
+    header = (
+        "# .PCD v0.7 - Point Cloud Data file format (stereovision, metres, X right Y down Z fwd)\n"
+        "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+        f"WIDTH {w}\nHEIGHT {h}\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {h * w}\nDATA binary\n"
+    )
+    with atomic_write(path) as fh:
+        fh.write(header.encode("ascii"))
+        fh.write(rec.tobytes())
+    return Path(path)
+
+
+def read_pcd(
+    path: PathLike,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]:
+    """Read a PCD file with ``x y z`` (float) and optional packed ``rgb`` (ascii or binary data).
+
+    Returns
+    -------
+    points : ndarray, float32 (HEIGHT, WIDTH, 3)
+        Organised layout as stored (``HEIGHT`` 1 for an unorganised cloud); NaN kept.
+    colors : ndarray, uint8 (HEIGHT, WIDTH, 3) or None
+
+    Raises
+    ------
+    FileNotFoundError
+        Missing file.
+    ValueError
+        Not a PCD file, unsupported fields / compression, truncated data.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"PCD file not found: {p}")
+    raw = p.read_bytes()
+    if not raw.startswith(_PCD_MAGIC):
+        raise ValueError(f"not a PCD file: {p}")
+    meta: dict[str, list[str]] = {}
+    pos = 0
+    while True:
+        nl = raw.find(b"\n", pos)
+        if nl < 0:
+            raise ValueError(f"not a PCD file (header not terminated): {p}")
+        line = raw[pos:nl].decode("ascii", errors="replace").strip()
+        pos = nl + 1
+        if not line or line.startswith("#"):
+            continue
+        key, *vals = line.split()
+        meta[key.upper()] = vals
+        if key.upper() == "DATA":
+            break
+    try:
+        names = meta["FIELDS"]
+        sizes = [int(s) for s in meta["SIZE"]]
+        types = meta["TYPE"]
+        counts = [int(c) for c in meta.get("COUNT", ["1"] * len(names))]
+        width, height = int(meta["WIDTH"][0]), int(meta["HEIGHT"][0])
+        mode = meta["DATA"][0]
+    except (KeyError, IndexError, ValueError):
+        raise ValueError(f"PCD file {p}: incomplete header") from None
+    if not {"x", "y", "z"} <= set(names):
+        raise ValueError(f"PCD file {p}: fields {names}, expected x y z")
+    kinds = {"F": "f", "U": "u", "I": "i"}
+    dtype = np.dtype(
+        [
+            (n, f"<{kinds[t]}{s}", (c,)) if c > 1 else (n, f"<{kinds[t]}{s}")
+            for n, s, t, c in zip(names, sizes, types, counts, strict=True)
+        ]
+    )
+    n = width * height
+    if mode == "binary":
+        if len(raw) - pos < n * dtype.itemsize:
+            raise ValueError(f"truncated PCD file {p}: expected {n} points")
+        rec = np.frombuffer(raw, dtype=dtype, count=n, offset=pos)
+    elif mode == "ascii":
+        table = np.loadtxt(_io.BytesIO(raw[pos:]), dtype=np.float64, ndmin=2)
+        if table.shape[0] != n:
+            raise ValueError(f"PCD file {p}: expected {n} points, got {table.shape[0]}")
+        rec = np.empty(n, dtype=dtype)
+        for i, name in enumerate(names):
+            col = table[:, i]
+            rec[name] = col.astype(np.uint32).view(np.float32) if name == "rgb" else col
+    else:
+        raise ValueError(f"PCD file {p}: unsupported DATA {mode!r} (ascii or binary)")
+    pts = np.stack([rec["x"], rec["y"], rec["z"]], axis=-1).astype(np.float32)
+    cols = _unpack_rgb(np.asarray(rec["rgb"])) if "rgb" in names else None
+    shape = (height, width)
+    return pts.reshape(*shape, 3), None if cols is None else cols.reshape(*shape, 3)
+
+
+# ----------------------------------------------------------------------------- NPZ
+
+
+def write_npz(path: PathLike, result: DepthResult) -> Path:
+    """Bundle depth, confidence, disparity and the intrinsics into a compressed ``.npz``.
+
+    Without calibration ``depth`` is all NaN and ``K`` / ``baseline`` / ``doffs`` are NaN.
+    """
+    h, w = result.disparity.shape[:2]
+    calib = result.calibration
+    k = np.full((3, 3), np.nan)
+    baseline = doffs = float("nan")
+    if calib is not None:
+        k = np.asarray(calib.K1, dtype=np.float64)
+        baseline = float(calib.baseline_m)
+        doffs = float(calib.doffs_px)
+    depth = result.depth if result.depth is not None else np.full((h, w), np.nan, np.float32)
+    bio = _io.BytesIO()
+    np.savez_compressed(
+        bio,
+        depth=depth.astype(np.float32),
+        confidence=result.confidence.astype(np.float32),
+        disparity=result.disparity.astype(np.float32),
+        K=k,
+        baseline=np.float64(baseline),
+        doffs=np.float64(doffs),
+        image_size=np.array([w, h], dtype=np.int64),
+        method=np.array(result.method),
+        max_disparity=np.int64(result.max_disparity),
+    )
+    with atomic_write(path) as fh:
+        fh.write(bio.getvalue())
+    return Path(path)
+
+
+def read_npz(path: PathLike) -> dict[str, Any]:
+    """Read a bundle written by :func:`write_npz` into a dict of arrays (scalars as Python values).
+
+    Raises
+    ------
+    ValueError
+        If the file is not an ``.npz`` bundle with ``depth`` and ``K``.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"npz file not found: {p}")
+    try:
+        with np.load(p, allow_pickle=False) as z:
+            data = {k: z[k] for k in z.files}
+    except (zipfile.BadZipFile, ValueError, OSError):
+        raise ValueError(f"not an .npz bundle: {p}") from None
+    if "depth" not in data or "K" not in data:
+        raise ValueError(f"{p}: not a stereovision depth bundle (needs depth and K)")
+    for key, value in list(data.items()):
+        if value.ndim == 0:
+            data[key] = value.item()
+    return data
+
+
+def _points_from_bundle(data: dict[str, Any]) -> npt.NDArray[np.float32]:
+    depth = np.asarray(data["depth"], dtype=np.float64)
+    k = np.asarray(data["K"], dtype=np.float64)
+    h, w = depth.shape
+    ys, xs = np.mgrid[0:h, 0:w]
+    x = (xs - k[0, 2]) * depth / k[0, 0]
+    y = (ys - k[1, 2]) * depth / k[1, 1]
+    return np.stack([x, y, depth], axis=-1).astype(np.float32)
+
+
+# ----------------------------------------------------------------------------- any cloud
+
+
+def load_cloud(
+    path: PathLike,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]:
+    """Read a point cloud from PLY, PCD or an ``.npz`` bundle (chosen by content, not by name).
+
+    Returns
+    -------
+    points : ndarray, float32 (N, 3)
+        Finite points only.
+    colors : ndarray, uint8 (N, 3) or None
+
+    Raises
+    ------
+    FileNotFoundError
+        Missing file.
+    ValueError
+        Not a PLY / PCD / NPZ file (``"not a PLY file: ..."`` for a ``.ply`` that is not one), or
+        a cloud without any finite point (``"empty point cloud: ..."``).
+    """
+    p = Path(path)
+    if not p.exists():
+        raise FileNotFoundError(f"point cloud file not found: {p}")
+    if not p.is_file():
+        raise ValueError(f"not a file: {p}")
+    with open(p, "rb") as fh:
+        head = fh.read(8)
+    cols: npt.NDArray[np.uint8] | None
+    if head.startswith(_PLY_MAGIC):
+        pts, cols = read_ply(p)
+    elif head.startswith(_PCD_MAGIC):
+        pts, cols = read_pcd(p)
+    elif head.startswith(_ZIP_MAGIC):
+        pts, cols = _points_from_bundle(read_npz(p)), None
+    elif p.suffix.lower() == ".ply":
+        raise ValueError(f"not a PLY file: {p}")
+    else:
+        raise ValueError(f"not a point cloud file (PLY, PCD or NPZ): {p}")
+    pts = pts.reshape(-1, 3)
+    keep = np.isfinite(pts).all(axis=1)
+    if not keep.any():
+        raise ValueError(f"empty point cloud: {p} has no finite 3-D point")
+    cols = None if cols is None else cols.reshape(-1, 3)[keep]
+    return np.ascontiguousarray(pts[keep]), cols
+
+
+def export_result(
+    result: DepthResult,
+    out_dir: PathLike,
+    formats: tuple[str, ...] = tuple(EXPORT_FORMATS),
+) -> dict[str, Path]:
+    """Write the result in the chosen formats (``"ply"``, ``"pcd"``, ``"npz"``) into ``out_dir``.
+
+    Returns
+    -------
+    dict
+        File name -> path written.
+
+    Raises
+    ------
+    ValueError
+        Unknown format, or PLY / PCD asked for a result without calibration.
+    """
+    unknown = set(formats) - set(EXPORT_FORMATS)
+    if unknown:
+        raise ValueError(
+            f"unknown export format(s) {sorted(unknown)}: expected {list(EXPORT_FORMATS)}"
+        )
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    writers = {"ply": write_cloud_ply, "pcd": write_pcd, "npz": write_npz}
+    written: dict[str, Path] = {}
+    for fmt in formats:
+        name = EXPORT_FORMATS[fmt]
+        written[name] = writers[fmt](out / name, result)
+    return written

@@ -1,0 +1,680 @@
+"""3-D views of a depth result: textured surface, coloured point cloud, the paper's camera controls.
+
+Frames and units follow the package convention (architecture.md): metres, left rectified camera
+frame, X right, Y down, Z forward. The virtual camera starts at the left camera's pose and is moved
+with the paper's six controls (:class:`CameraControls`): ``roll``, ``pitch``, ``yaw`` in degrees and
+``forward``, ``up``, ``right`` in metres. With all controls at zero and the calibration's
+intrinsics, a render of the textured surface reproduces the left rectified image.
+
+Rotation convention (all about the camera's own position, axes of the left camera frame)::
+
+    R = R_y(yaw) @ R_x(pitch) @ R_z(roll)
+    yaw   > 0: the camera turns right   (forward axis Z moves towards +X)
+    pitch > 0: the camera looks up      (forward axis Z moves towards -Y)
+    roll  > 0: the camera's right side goes down (+X moves towards +Y; clockwise from behind)
+
+Translations are expressed in the (fixed) left camera frame, so the six sliders commute:
+the camera sits at ``(right, -up, forward)``.
+
+Everything renders offscreen (``pyvista.Plotter(off_screen=True)``); no display is needed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+if TYPE_CHECKING:
+    import pyvista as pv
+
+    from stereovision.depth import DepthResult
+
+__all__ = [
+    "BACKGROUND",
+    "DEFAULT_FOV_DEG",
+    "MAX_RELATIVE_DEPTH_JUMP",
+    "CameraControls",
+    "apply_camera",
+    "camera_pose",
+    "orbit_controls",
+    "point_cloud",
+    "pose_from_camera",
+    "render_outputs",
+    "render_view",
+    "surface_mesh",
+]
+
+#: A triangle is dropped when its largest vertex depth exceeds its smallest by more than this
+#: fraction: neighbouring pixels on one surface differ by a few per cent at most (a 0.5 px
+#: disparity error at 20 px is 2.5 %), while an occlusion edge jumps by tens of per cent.
+MAX_RELATIVE_DEPTH_JUMP = 0.08
+
+#: Vertical field of view used when there are no intrinsics (a bare PLY file), degrees.
+DEFAULT_FOV_DEG = 60.0
+
+#: Background of every render (RGB, 0-255): dark grey, so black texture pixels stay visible.
+BACKGROUND = (32, 32, 36)
+
+#: Point size (screen pixels) of rendered point clouds.
+POINT_SIZE = 2.0
+
+#: Default render.png view: orbit around the scene's median depth point by these angles (deg).
+RENDER_YAW_DEG = -25.0
+RENDER_PITCH_DEG = -15.0
+
+#: Largest render side (pixels) of render.png; bigger images are scaled down.
+RENDER_MAX_SIDE = 1024
+
+#: The camera looks at a point this far ahead when there is no scene depth to use (metres).
+_DEFAULT_FOCAL_DISTANCE = 1.0
+
+
+# ----------------------------------------------------------------------------- camera controls
+
+
+@dataclass(frozen=True)
+class CameraControls:
+    """The paper's six camera controls, relative to the left rectified camera's pose.
+
+    Attributes
+    ----------
+    roll, pitch, yaw : float
+        Rotations in degrees (see the module docstring for the axes and signs).
+    forward, up, right : float
+        Translations in metres along the left camera's forward (+Z), up (-Y) and right (+X) axes.
+    """
+
+    roll: float = 0.0
+    pitch: float = 0.0
+    yaw: float = 0.0
+    forward: float = 0.0
+    up: float = 0.0
+    right: float = 0.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if not isinstance(value, (int, float)) or not math.isfinite(value):
+                raise ValueError(f"camera control {f.name} must be a finite number, got {value!r}")
+
+    def pose(self) -> npt.NDArray[np.float64]:
+        """4x4 camera-to-left-camera pose of these controls (see :func:`camera_pose`)."""
+        return camera_pose(
+            roll=self.roll,
+            pitch=self.pitch,
+            yaw=self.yaw,
+            forward=self.forward,
+            up=self.up,
+            right=self.right,
+        )
+
+
+def _rot_x(deg: float) -> npt.NDArray[np.float64]:
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def _rot_y(deg: float) -> npt.NDArray[np.float64]:
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def _rot_z(deg: float) -> npt.NDArray[np.float64]:
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def camera_pose(
+    roll: float = 0.0,
+    pitch: float = 0.0,
+    yaw: float = 0.0,
+    forward: float = 0.0,
+    up: float = 0.0,
+    right: float = 0.0,
+) -> npt.NDArray[np.float64]:
+    """Pose of the virtual camera driven by the paper's controls.
+
+    Parameters
+    ----------
+    roll, pitch, yaw : float
+        Degrees. ``R = R_y(yaw) @ R_x(pitch) @ R_z(roll)`` about the camera's position, axes of the
+        left camera frame (yaw > 0 turns right, pitch > 0 looks up, roll > 0 lowers the right side).
+    forward, up, right : float
+        Metres along +Z, -Y and +X of the left camera frame.
+
+    Returns
+    -------
+    ndarray, float64 (4, 4)
+        Camera-to-left-camera transform ``[[R, t], [0, 1]]``: the columns of ``R`` are the virtual
+        camera's X (right), Y (down) and Z (forward) axes in the left camera frame, and
+        ``t = (right, -up, forward)`` is its position. All zeros give the identity.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> T = camera_pose(yaw=90.0)
+    >>> np.allclose(T[:3, 2], [1, 0, 0])  # looking along the old +X (turned right)
+    True
+    """
+    rot = _rot_y(yaw) @ _rot_x(pitch) @ _rot_z(roll)
+    pose = np.eye(4)
+    pose[:3, :3] = rot
+    pose[:3, 3] = [right, -up, forward]
+    return pose
+
+
+def orbit_controls(yaw: float, pitch: float, center_depth: float) -> CameraControls:
+    """Controls that look at the point ``(0, 0, center_depth)`` from a rotated position.
+
+    The camera turns by ``yaw`` / ``pitch`` and moves so that the point straight ahead of the left
+    camera at ``center_depth`` metres stays in the centre of the view, at the same distance.
+
+    Parameters
+    ----------
+    yaw, pitch : float
+        Degrees, as in :func:`camera_pose`.
+    center_depth : float
+        Distance of the orbit centre in metres (> 0), e.g. the median depth of the scene.
+
+    Returns
+    -------
+    CameraControls
+    """
+    if not math.isfinite(center_depth) or center_depth <= 0:
+        raise ValueError(f"center_depth must be a positive distance, got {center_depth}")
+    rot = camera_pose(yaw=yaw, pitch=pitch)[:3, :3]
+    center = np.array([0.0, 0.0, center_depth])
+    position = center - center_depth * rot[:, 2]
+    return CameraControls(
+        pitch=pitch,
+        yaw=yaw,
+        forward=float(position[2]),
+        up=float(-position[1]),
+        right=float(position[0]),
+    )
+
+
+@dataclass(frozen=True)
+class Intrinsics:
+    """Pinhole intrinsics of the rendered view (pixels), origin at the top-left pixel's centre."""
+
+    f: float
+    cx: float
+    cy: float
+    width: int
+    height: int
+
+    @classmethod
+    def from_result(cls, result: DepthResult) -> Intrinsics | None:
+        """Intrinsics of the rectified left camera of ``result``, or None without calibration."""
+        calib = result.calibration
+        if calib is None:
+            return None
+        k = np.asarray(calib.K1, dtype=np.float64)
+        h, w = result.disparity.shape[:2]
+        return cls(float(k[0, 0]), float(k[0, 2]), float(k[1, 2]), int(w), int(h))
+
+    def scaled(self, factor: float) -> Intrinsics:
+        """The same camera for an image scaled by ``factor`` (pixel centres kept consistent)."""
+        return Intrinsics(
+            self.f * factor,
+            (self.cx + 0.5) * factor - 0.5,
+            (self.cy + 0.5) * factor - 0.5,
+            max(1, round(self.width * factor)),
+            max(1, round(self.height * factor)),
+        )
+
+
+def apply_camera(
+    plotter: pv.Plotter,
+    controls: CameraControls,
+    *,
+    intrinsics: Intrinsics | None = None,
+    focal_distance: float = _DEFAULT_FOCAL_DISTANCE,
+) -> None:
+    """Place ``plotter``'s camera at the pose of ``controls``.
+
+    Parameters
+    ----------
+    plotter : pyvista.Plotter
+    controls : CameraControls
+    intrinsics : Intrinsics, optional
+        With intrinsics the view angle is ``2 atan(H / 2f)`` and the window centre is shifted to the
+        principal point, so a zero-control render lines up with the left image pixel for pixel
+        (when the window is ``width x height``). Without, a :data:`DEFAULT_FOV_DEG` view.
+    focal_distance : float
+        Distance of the focal point ahead of the camera (metres): the centre of mouse rotations.
+    """
+    pose = controls.pose()
+    rot, pos = pose[:3, :3], pose[:3, 3]
+    cam = plotter.camera
+    cam.position = tuple(pos)
+    cam.focal_point = tuple(pos + focal_distance * rot[:, 2])
+    cam.up = tuple(-rot[:, 1])
+    if intrinsics is not None:
+        cam.view_angle = math.degrees(2 * math.atan(intrinsics.height / (2 * intrinsics.f)))
+        # VTK shifts the image by the window centre: a principal point right of / below the
+        # image centre needs the opposite shift (measured: tests/test_render.py projection test).
+        wx = 1 - 2 * (intrinsics.cx + 0.5) / intrinsics.width
+        wy = 2 * (intrinsics.cy + 0.5) / intrinsics.height - 1
+        cam.SetWindowCenter(wx, wy)
+    else:
+        cam.view_angle = DEFAULT_FOV_DEG
+        cam.SetWindowCenter(0.0, 0.0)
+    plotter.reset_camera_clipping_range()
+    plotter.camera_set = True  # keep this camera: the first render must not reset it to the bounds
+
+
+def pose_from_camera(camera: Any) -> npt.NDArray[np.float64]:
+    """4x4 pose (same layout as :func:`camera_pose`) read back from a pyvista/VTK camera.
+
+    Parameters
+    ----------
+    camera : pyvista.Camera
+        Its position, focal point and view-up are used (view-up orthogonalised).
+
+    Returns
+    -------
+    ndarray, float64 (4, 4)
+    """
+    pos = np.asarray(camera.position, dtype=np.float64)
+    z = np.asarray(camera.focal_point, dtype=np.float64) - pos
+    z /= np.linalg.norm(z)
+    up = np.asarray(camera.up, dtype=np.float64)
+    up = up - np.dot(up, z) * z
+    y = -up / np.linalg.norm(up)
+    x = np.cross(y, z)
+    pose = np.eye(4)
+    pose[:3, 0], pose[:3, 1], pose[:3, 2], pose[:3, 3] = x, y, z, pos
+    return pose
+
+
+# ----------------------------------------------------------------------------- geometry
+
+
+def _pv() -> Any:
+    import pyvista as pv
+
+    return pv
+
+
+def _check_result(result: DepthResult) -> None:
+    if result.depth is None or result.calibration is None:
+        raise ValueError("no 3-D points: the depth result has no calibration")
+    if len(result.points) == 0:
+        raise ValueError("empty point cloud: the matcher found no depth in this pair")
+
+
+def surface_mesh(
+    result: DepthResult,
+    *,
+    step: int = 1,
+    max_jump: float = MAX_RELATIVE_DEPTH_JUMP,
+) -> pv.PolyData:
+    """Textured triangle mesh of the depth map, one vertex per (sub-sampled) pixel with a depth.
+
+    Neighbouring pixels ``(x, y), (x+s, y), (x, y+s), (x+s, y+s)`` form two triangles; a triangle
+    is kept only if its three pixels have a depth and ``max(Z) / min(Z) - 1 <= max_jump`` (no
+    triangle spans a depth discontinuity or a hole).
+
+    Parameters
+    ----------
+    result : DepthResult
+        A result computed with a calibration (metric points).
+    step : int
+        Pixel stride of the vertex grid (1 = every pixel; 2 = a quarter of the vertices).
+    max_jump : float
+        Relative depth jump above which a triangle is dropped (default
+        :data:`MAX_RELATIVE_DEPTH_JUMP`).
+
+    Returns
+    -------
+    pyvista.PolyData
+        Vertices in metres (left rectified frame), triangles, texture coordinates, point data
+        ``"RGB"`` (uint8 colours) and the texture (rectified left image, RGB) in
+        ``mesh.field_data["texture_rgb"]`` (use :func:`texture_of`).
+
+    Raises
+    ------
+    ValueError
+        Without calibration, with no points, or with a bad ``step`` / ``max_jump``.
+    """
+    pv = _pv()
+    _check_result(result)
+    if not isinstance(step, (int, np.integer)) or step < 1:
+        raise ValueError(f"step must be a positive integer, got {step!r}")
+    if not max_jump > 0:
+        raise ValueError(f"max_jump must be positive, got {max_jump}")
+    h, w = result.disparity.shape[:2]
+    xs, ys = result.pixels[:, 0], result.pixels[:, 1]
+    on_grid = (xs % step == 0) & (ys % step == 0)
+    sel = np.nonzero(on_grid)[0]
+    gh, gw = (h + step - 1) // step, (w + step - 1) // step
+    index = np.full((gh, gw), -1, dtype=np.int64)
+    index[ys[sel] // step, xs[sel] // step] = np.arange(len(sel))
+    pts = result.points[sel].astype(np.float32)
+    z = pts[:, 2].astype(np.float64)
+    a, b = index[:-1, :-1].ravel(), index[:-1, 1:].ravel()
+    c, d = index[1:, :-1].ravel(), index[1:, 1:].ravel()
+    tris = np.concatenate([np.stack([a, c, b], 1), np.stack([b, c, d], 1)])
+    tris = tris[(tris >= 0).all(axis=1)]
+    if len(tris):
+        zt = z[tris]
+        tris = tris[zt.max(axis=1) <= zt.min(axis=1) * (1 + max_jump)]
+    faces = np.hstack([np.full((len(tris), 1), 3, np.int64), tris]).ravel()
+    mesh = pv.PolyData(pts, faces=faces) if len(tris) else pv.PolyData(pts)
+    u = (xs[sel] + 0.5) / w
+    v = 1.0 - (ys[sel] + 0.5) / h
+    mesh.active_texture_coordinates = np.stack([u, v], axis=1).astype(np.float32)
+    mesh.point_data["RGB"] = result.colors[sel]
+    if result.left_rectified is not None:
+        rgb = np.ascontiguousarray(result.left_rectified[..., ::-1])
+        mesh.field_data["texture_rgb"] = rgb.reshape(-1, 3)
+        mesh.field_data["texture_shape"] = np.array(rgb.shape[:2], dtype=np.int64)
+    return mesh
+
+
+def texture_of(mesh: pv.PolyData) -> pv.Texture | None:
+    """The texture stored by :func:`surface_mesh` (None when the result had no left image)."""
+    if "texture_rgb" not in mesh.field_data:
+        return None
+    pv = _pv()
+    h, w = (int(v) for v in mesh.field_data["texture_shape"])
+    rgb = np.asarray(mesh.field_data["texture_rgb"], dtype=np.uint8).reshape(h, w, 3)
+    return pv.Texture(rgb)
+
+
+def point_cloud(points: npt.ArrayLike, colors: npt.ArrayLike | None = None) -> pv.PolyData:
+    """Coloured point cloud as pyvista vertices.
+
+    Parameters
+    ----------
+    points : array_like, (N, 3)
+        Metres; non-finite rows are dropped.
+    colors : array_like, uint8 (N, 3), optional
+        RGB per point (stored as point data ``"RGB"``).
+
+    Returns
+    -------
+    pyvista.PolyData
+
+    Raises
+    ------
+    ValueError
+        Wrong shapes, or no finite point ("empty point cloud").
+    """
+    pv = _pv()
+    pts = np.asarray(points, dtype=np.float32)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise ValueError(f"points: expected shape (N, 3), got {pts.shape}")
+    keep = np.isfinite(pts).all(axis=1)
+    if not keep.any():
+        raise ValueError("empty point cloud: no finite 3-D point to show")
+    cloud = pv.PolyData(pts[keep])
+    if colors is not None:
+        cols = np.asarray(colors)
+        if cols.shape != pts.shape or cols.dtype != np.uint8:
+            raise ValueError(
+                f"colors: expected uint8 shape {pts.shape}, got {cols.dtype} {cols.shape}"
+            )
+        cloud.point_data["RGB"] = cols[keep]
+    return cloud
+
+
+# ----------------------------------------------------------------------------- rendering
+
+
+def make_plotter(size: tuple[int, int], *, off_screen: bool = True) -> pv.Plotter:
+    """A plotter of ``size = (width, height)`` pixels with the package background."""
+    pv = _pv()
+    plotter = pv.Plotter(off_screen=off_screen, window_size=list(size))
+    plotter.set_background([c / 255 for c in BACKGROUND])
+    return plotter
+
+
+def add_geometry(plotter: pv.Plotter, geometry: pv.PolyData) -> Any:
+    """Add a surface mesh (textured, unlit) or a point cloud (RGB points) to ``plotter``."""
+    texture = texture_of(geometry) if geometry.n_cells and geometry.n_faces else None
+    has_rgb = "RGB" in geometry.point_data
+    if geometry.n_faces:
+        if texture is not None:
+            return plotter.add_mesh(geometry, texture=texture, lighting=False, name="scene")
+        return plotter.add_mesh(
+            geometry, scalars="RGB" if has_rgb else None, rgb=has_rgb, lighting=False, name="scene"
+        )
+    return plotter.add_mesh(
+        geometry,
+        scalars="RGB" if has_rgb else None,
+        rgb=has_rgb,
+        point_size=POINT_SIZE,
+        style="points",
+        lighting=False,
+        name="scene",
+    )
+
+
+def median_depth(geometry: pv.PolyData) -> float:
+    """Median Z of the geometry's points (metres), or the default focal distance if unusable."""
+    z = np.asarray(geometry.points)[:, 2] if geometry.n_points else np.zeros(0)
+    z = z[np.isfinite(z) & (z > 0)]
+    return float(np.median(z)) if z.size else _DEFAULT_FOCAL_DISTANCE
+
+
+def render_view(
+    geometry: pv.PolyData,
+    controls: CameraControls | None = None,
+    *,
+    intrinsics: Intrinsics | None = None,
+    size: tuple[int, int] | None = None,
+) -> npt.NDArray[np.uint8]:
+    """Render ``geometry`` offscreen from the camera of ``controls``.
+
+    Parameters
+    ----------
+    geometry : pyvista.PolyData
+        From :func:`surface_mesh` or :func:`point_cloud`.
+    controls : CameraControls, optional
+        Default: the left camera's pose.
+    intrinsics : Intrinsics, optional
+        Camera model (e.g. :meth:`Intrinsics.from_result`); the render size defaults to its image
+        size. Without intrinsics a :data:`DEFAULT_FOV_DEG` view of ``size`` (default 800x600).
+    size : (int, int), optional
+        ``(width, height)`` of the picture; with intrinsics they are scaled to fit it.
+
+    Returns
+    -------
+    ndarray, uint8 (height, width, 3)
+        RGB screenshot.
+    """
+    controls = controls or CameraControls()
+    if intrinsics is not None:
+        if size is not None:
+            intrinsics = intrinsics.scaled(size[0] / intrinsics.width)
+        size = (intrinsics.width, intrinsics.height)
+    size = size or (800, 600)
+    plotter = make_plotter(size)
+    try:
+        add_geometry(plotter, geometry)
+        apply_camera(
+            plotter, controls, intrinsics=intrinsics, focal_distance=median_depth(geometry)
+        )
+        img = plotter.screenshot(return_img=True)
+    finally:
+        plotter.close()
+    return np.ascontiguousarray(img[..., :3], dtype=np.uint8)
+
+
+def is_blank(image: npt.NDArray[np.uint8], *, min_fraction: float = 0.01) -> bool:
+    """True when fewer than ``min_fraction`` of the pixels differ from the render background."""
+    bg = np.asarray(BACKGROUND, dtype=np.int16)
+    differs = np.abs(image[..., :3].astype(np.int16) - bg).max(axis=-1) > 8
+    return bool(differs.mean() < min_fraction)
+
+
+def render_result(
+    result: DepthResult,
+    controls: CameraControls | None = None,
+    *,
+    max_side: int = RENDER_MAX_SIDE,
+) -> npt.NDArray[np.uint8]:
+    """Textured surface of ``result`` seen through its own intrinsics, scaled to ``max_side``.
+
+    ``controls`` default to an orbit of :data:`RENDER_YAW_DEG` / :data:`RENDER_PITCH_DEG` around
+    the scene's median depth (a 3-D impression rather than the left image itself).
+    """
+    mesh = surface_mesh(result)
+    intr = Intrinsics.from_result(result)
+    assert intr is not None  # _check_result in surface_mesh
+    scale = min(1.0, max_side / max(intr.width, intr.height))
+    if controls is None:
+        controls = orbit_controls(RENDER_YAW_DEG, RENDER_PITCH_DEG, median_depth(mesh))
+    return render_view(mesh, controls, intrinsics=intr.scaled(scale))
+
+
+def render_outputs(result: DepthResult, out_dir: str | os.PathLike[str]) -> dict[str, Path]:
+    """Write ``render.png``, an offscreen 3-D view of the textured surface, into ``out_dir``.
+
+    Meant for ``stereovision depth``: results without calibration or without any 3-D point have
+    nothing to render and write nothing.
+
+    Parameters
+    ----------
+    result : DepthResult
+    out_dir : path
+        Output folder (created if missing). The file is replaced atomically.
+
+    Returns
+    -------
+    dict
+        ``{"render.png": path}``, or ``{}`` when there is nothing to render.
+    """
+    import cv2
+
+    from stereovision.io import atomic_write
+
+    if result.depth is None or result.calibration is None or len(result.points) == 0:
+        return {}
+    img = render_result(result)
+    ok, buf = cv2.imencode(".png", img[..., ::-1])
+    if not ok:
+        raise OSError("could not encode render.png")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / "render.png"
+    with atomic_write(path) as fh:
+        fh.write(buf.tobytes())
+    return {"render.png": path}
+
+
+# ----------------------------------------------------------------------------- `stereovision view`
+
+
+def _has_display() -> bool:
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+
+
+def load_view_source(path: str | os.PathLike[str]) -> tuple[pv.PolyData, Intrinsics | None]:
+    """Geometry to show for ``stereovision view``: a cloud file, an output folder or a scene.
+
+    Parameters
+    ----------
+    path : path
+        A ``.ply`` / ``.pcd`` / ``.npz`` file (see :func:`stereovision.export.load_cloud`); a
+        folder with ``cloud.ply`` (``stereovision depth`` output); or a scene folder with
+        ``left.png``, ``right.png`` and ``calib.txt`` (depth is computed and the textured surface
+        shown).
+
+    Returns
+    -------
+    geometry : pyvista.PolyData
+    intrinsics : Intrinsics or None
+
+    Raises
+    ------
+    FileNotFoundError, ValueError
+        Missing path, not a point cloud file, an empty cloud, a folder with nothing to show.
+    """
+    from stereovision.export import load_cloud
+
+    p = Path(path)
+    if not p.exists():
+        raise FileNotFoundError(f"no such file or folder: {p}")
+    if p.is_dir():
+        if (p / "cloud.ply").is_file():
+            p = p / "cloud.ply"
+        elif (p / "left.png").is_file() and (p / "right.png").is_file():
+            from stereovision.depth import depth_map
+            from stereovision.io import load_scene
+
+            scene = load_scene(p)
+            if scene.calib is None:
+                raise ValueError(f"scene {p} has no calib.txt: no metric 3-D points to show")
+            result = depth_map(
+                scene.left, scene.right, scene.calib, max_disparity=scene.max_disparity
+            )
+            return surface_mesh(result), Intrinsics.from_result(result)
+        else:
+            raise FileNotFoundError(
+                f"{p}: no cloud.ply and no scene (left.png + right.png) in this folder"
+            )
+    points, colors = load_cloud(p)
+    return point_cloud(points, colors), None
+
+
+def cmd_view(args: argparse.Namespace) -> int:
+    """``stereovision view FILE.ply|DIR [--roll ...] [-o shot.png]``."""
+    import cv2
+
+    controls = CameraControls(
+        roll=args.roll,
+        pitch=args.pitch,
+        yaw=args.yaw,
+        forward=args.forward,
+        up=args.up,
+        right=args.right,
+    )
+    geometry, intr = load_view_source(args.source)
+    if args.output is None and _has_display():
+        plotter = make_plotter((1024, 768), off_screen=False)
+        add_geometry(plotter, geometry)
+        apply_camera(plotter, controls, intrinsics=None, focal_distance=median_depth(geometry))
+        plotter.show()
+        return 0
+    out = Path(args.output or "view.png")
+    img = render_view(geometry, controls, intrinsics=intr)
+    ok, buf = cv2.imencode(".png", img[..., ::-1])
+    if not ok:
+        raise OSError(f"could not encode {out}")
+    from stereovision.io import atomic_write
+
+    if not out.parent.exists():
+        raise FileNotFoundError(f"output folder does not exist: {out.parent}")
+    with atomic_write(out) as fh:
+        fh.write(buf.tobytes())
+    print(f"{geometry.n_points} points, {geometry.n_cells} cells -> {out}", file=sys.stdout)
+    return 0
+
+
+def add_cli(subparsers: Any) -> None:
+    """Register ``stereovision view`` on the CLI's sub-parsers."""
+    p = subparsers.add_parser(
+        "view",
+        help="show a point cloud / depth output (window, or a screenshot without a display)",
+    )
+    p.add_argument("source", help="cloud.ply / .pcd / .npz, a `depth` output folder or a scene")
+    for name, unit in (("roll", "deg"), ("pitch", "deg"), ("yaw", "deg")):
+        p.add_argument(f"--{name}", type=float, default=0.0, help=f"camera {name} ({unit})")
+    for name in ("forward", "up", "right"):
+        p.add_argument(f"--{name}", type=float, default=0.0, help=f"move the camera {name} (m)")
+    p.add_argument(
+        "-o", "--output", default=None, help="screenshot PNG (default view.png without a display)"
+    )
+    p.set_defaults(func=cmd_view)

@@ -1,0 +1,303 @@
+"""Rendering: camera controls (numerically), projection, textured surface, render.png, `view`."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+import synthetic_scene as syn
+
+pv = pytest.importorskip("pyvista")
+
+from stereovision import render  # noqa: E402
+from stereovision.render import CameraControls, camera_pose  # noqa: E402
+
+pv.OFF_SCREEN = True
+
+#: Controls exercised by the pose tests: each axis alone, then all together.
+CONTROL_CASES = [
+    CameraControls(),
+    CameraControls(yaw=30.0),
+    CameraControls(pitch=-20.0),
+    CameraControls(roll=15.0),
+    CameraControls(forward=1.5),
+    CameraControls(up=0.4),
+    CameraControls(right=-0.7),
+    CameraControls(roll=10.0, pitch=-12.0, yaw=25.0, forward=0.5, up=0.2, right=0.3),
+]
+
+
+def _rz(deg: float) -> np.ndarray:
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+
+
+def _ry(deg: float) -> np.ndarray:
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return np.array([[c, 0, s], [0, 1.0, 0], [-s, 0, c]])
+
+
+def _rx(deg: float) -> np.ndarray:
+    c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+    return np.array([[1.0, 0, 0], [0, c, -s], [0, s, c]])
+
+
+@pytest.fixture(scope="module")
+def result():
+    return syn.depth_result()
+
+
+@pytest.fixture(scope="module")
+def mesh(result):
+    return render.surface_mesh(result)
+
+
+def _project(points: np.ndarray, controls: CameraControls) -> np.ndarray:
+    """Pixel (x, y) of left-camera-frame points seen by the virtual camera with the rig's K."""
+    pose = controls.pose()
+    cam = (points - pose[:3, 3]) @ pose[:3, :3]  # world -> camera: R^T (p - t)
+    return np.stack(
+        [syn.F * cam[:, 0] / cam[:, 2] + syn.CX, syn.F * cam[:, 1] / cam[:, 2] + syn.CY], 1
+    )
+
+
+# ----------------------------------------------------------------------------- camera_pose
+
+
+def test_camera_pose_axes_and_signs():
+    assert np.array_equal(camera_pose(), np.eye(4))
+    np.testing.assert_allclose(camera_pose(yaw=90)[:3, 2], [1, 0, 0], atol=1e-12)  # turns right
+    np.testing.assert_allclose(camera_pose(pitch=90)[:3, 2], [0, -1, 0], atol=1e-12)  # looks up
+    np.testing.assert_allclose(camera_pose(roll=90)[:3, 0], [0, 1, 0], atol=1e-12)  # right down
+    np.testing.assert_allclose(camera_pose(forward=2, up=0.5, right=-1)[:3, 3], [-1, -0.5, 2])
+
+
+def test_camera_pose_composition_order():
+    pose = camera_pose(roll=11, pitch=-23, yaw=37, forward=1, up=2, right=3)
+    np.testing.assert_allclose(pose[:3, :3], _ry(37) @ _rx(-23) @ _rz(11), atol=1e-12)
+    np.testing.assert_allclose(pose[:3, :3] @ pose[:3, :3].T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(pose[:3, :3]) == pytest.approx(1.0)
+    np.testing.assert_allclose(pose[3], [0, 0, 0, 1])
+
+
+def test_bad_controls_rejected():
+    with pytest.raises(ValueError, match="yaw"):
+        CameraControls(yaw=float("nan"))
+    with pytest.raises(ValueError, match="center_depth"):
+        render.orbit_controls(10, 10, 0.0)
+
+
+def test_orbit_keeps_centre_ahead_at_same_distance():
+    c = render.orbit_controls(yaw=-25, pitch=-15, center_depth=4.0)
+    pose = c.pose()
+    centre = np.array([0, 0, 4.0])
+    np.testing.assert_allclose(pose[:3, 3] + 4.0 * pose[:3, 2], centre, atol=1e-12)
+    assert np.linalg.norm(pose[:3, 3]) > 0.5  # it did move
+
+
+# ----------------------------------------------------------------------------- pyvista camera
+
+
+@pytest.mark.parametrize("controls", CONTROL_CASES, ids=lambda c: repr(c)[15:-1] or "zero")
+def test_pyvista_camera_follows_controls(mesh, controls):
+    expected = controls.pose()
+    plotter = render.make_plotter((80, 60))
+    try:
+        render.add_geometry(plotter, mesh)
+        render.apply_camera(plotter, controls, focal_distance=3.0)
+        plotter.screenshot(return_img=True)  # the first render must not move the camera
+        cam = plotter.camera
+        np.testing.assert_allclose(cam.position, expected[:3, 3], atol=1e-9)
+        np.testing.assert_allclose(
+            cam.focal_point, expected[:3, 3] + 3.0 * expected[:3, 2], atol=1e-9
+        )
+        np.testing.assert_allclose(cam.up, -expected[:3, 1], atol=1e-9)
+        np.testing.assert_allclose(render.pose_from_camera(cam), expected, atol=1e-9)
+    finally:
+        plotter.close()
+
+
+@pytest.mark.parametrize(
+    "controls",
+    [CameraControls(), CameraControls(roll=8, pitch=-6, yaw=12, forward=0.6, up=0.1, right=-0.3)],
+    ids=["zero", "moved"],
+)
+def test_render_projects_points_with_intrinsics(controls):
+    pts = np.array([[0.0, 0.0, 4.0], [0.8, 0.5, 4.0], [-0.9, -0.6, 5.0], [0.3, -0.4, 3.0]])
+    plotter = render.make_plotter((syn.W, syn.H))
+    try:
+        for p in pts:
+            plotter.add_mesh(
+                pv.PolyData(p[None].astype(np.float32)),
+                color="white",
+                point_size=3,
+                style="points",
+                lighting=False,
+            )
+        intr = render.Intrinsics(syn.F, syn.CX, syn.CY, syn.W, syn.H)
+        render.apply_camera(plotter, controls, intrinsics=intr, focal_distance=4.0)
+        img = plotter.screenshot(return_img=True)
+    finally:
+        plotter.close()
+    expected = _project(pts, controls)
+    lit = img[..., 0] > 200
+    for ex, ey in expected:
+        y0, x0 = round(ey), round(ex)
+        win = lit[y0 - 4 : y0 + 5, x0 - 4 : x0 + 5]
+        assert win.any(), f"no point drawn near ({ex:.1f}, {ey:.1f})"
+        wy, wx = np.nonzero(win)
+        assert abs(wx.mean() + x0 - 4 - ex) < 1.0
+        assert abs(wy.mean() + y0 - 4 - ey) < 1.0
+    assert lit.sum() <= 4 * 16  # nothing else drawn
+
+
+# ----------------------------------------------------------------------------- surface mesh
+
+
+def _oracle_triangle_count(z: np.ndarray, jump: float) -> int:
+    """Plain loop: triangles of the pixel grid whose 3 depths exist and differ by <= jump."""
+    n = 0
+    h, w = z.shape
+    for r in range(h - 1):
+        for c in range(w - 1):
+            for tri in (((r, c), (r + 1, c), (r, c + 1)), ((r, c + 1), (r + 1, c), (r + 1, c + 1))):
+                zs = [z[p] for p in tri]
+                if all(np.isfinite(zs)) and max(zs) <= min(zs) * (1 + jump):
+                    n += 1
+    return n
+
+
+def test_surface_mesh_skips_holes_and_discontinuities(result, mesh):
+    assert mesh.n_points == len(result.points) == syn.W * syn.H - 100
+    tris = np.asarray(mesh.faces).reshape(-1, 4)
+    assert (tris[:, 0] == 3).all()
+    z = np.asarray(mesh.points)[tris[:, 1:], 2]
+    assert (z.max(axis=1) <= z.min(axis=1) * (1 + render.MAX_RELATIVE_DEPTH_JUMP)).all()
+    # No triangle spans the wall (4 m) and the box (2 m).
+    assert set(np.unique(z)) == {syn.BOX_Z, syn.WALL_Z}
+    assert len(tris) == _oracle_triangle_count(result.depth, render.MAX_RELATIVE_DEPTH_JUMP)
+    # Texture coordinates map each vertex to its own pixel centre.
+    tc = np.asarray(mesh.active_texture_coordinates)
+    px = result.pixels
+    np.testing.assert_allclose(tc[:, 0], (px[:, 0] + 0.5) / syn.W, atol=1e-6)
+    np.testing.assert_allclose(tc[:, 1], 1 - (px[:, 1] + 0.5) / syn.H, atol=1e-6)
+
+
+def test_surface_mesh_step_subsamples(result):
+    coarse = render.surface_mesh(result, step=2)
+    assert coarse.n_points == int(((result.pixels % 2) == 0).all(axis=1).sum())
+    assert 0 < coarse.n_cells < render.surface_mesh(result).n_cells / 3
+
+
+def test_surface_mesh_errors(result):
+    from dataclasses import replace
+
+    with pytest.raises(ValueError, match="step"):
+        render.surface_mesh(result, step=0)
+    empty = replace(
+        result,
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+    )
+    with pytest.raises(ValueError, match="empty point cloud"):
+        render.surface_mesh(empty)
+    with pytest.raises(ValueError, match="calibration"):
+        render.surface_mesh(replace(result, depth=None, calibration=None))
+
+
+def test_zero_pose_render_reproduces_left_image(result, mesh):
+    img = render.render_view(mesh, intrinsics=render.Intrinsics.from_result(result))
+    assert img.shape == (syn.H, syn.W, 3)
+    left = result.left_rectified[..., ::-1].astype(np.float64)
+    covered = ~np.isclose(img, render.BACKGROUND, atol=8).all(axis=-1)
+    assert covered.mean() > 0.9  # everything but the hole and the box outline
+    err = np.abs(img - left)[covered].mean()
+    err_shifted = np.abs(img - np.roll(left, 2, axis=1))[covered].mean()
+    assert err < 12.0
+    assert err < 0.5 * err_shifted
+
+
+def test_render_outputs_and_rotated_view_differ(result, tmp_path):
+    written = render.render_outputs(result, tmp_path)
+    assert set(written) == {"render.png"}
+    png = cv2.imread(str(written["render.png"]))[..., ::-1]
+    assert png.shape == (syn.H, syn.W, 3)
+    assert not render.is_blank(png, min_fraction=0.3)
+    other = render.render_result(result, render.orbit_controls(30.0, 10.0, 3.0))
+    assert not render.is_blank(other, min_fraction=0.3)
+    diff = np.abs(png.astype(np.int16) - other.astype(np.int16)).max(axis=-1) > 30
+    assert diff.mean() > 0.2
+
+
+def test_render_outputs_nothing_without_points(result, tmp_path):
+    from dataclasses import replace
+
+    assert render.render_outputs(replace(result, depth=None, calibration=None), tmp_path) == {}
+    assert not (tmp_path / "render.png").exists()
+
+
+def test_point_cloud_render_not_blank():
+    rng = np.random.default_rng(1)
+    pts = rng.uniform([-1, -1, 3], [1, 1, 5], (2000, 3)).astype(np.float32)
+    cols = rng.integers(50, 255, (2000, 3)).astype(np.uint8)
+    img = render.render_view(render.point_cloud(pts, cols), size=(160, 120))
+    assert not render.is_blank(img)
+    with pytest.raises(ValueError, match="empty point cloud"):
+        render.point_cloud(np.full((5, 3), np.nan))
+
+
+# ----------------------------------------------------------------------------- `view`
+
+
+def _view_args(source: Path, out: Path | None, **controls: float) -> argparse.Namespace:
+    parser = argparse.ArgumentParser()
+    render.add_cli(parser.add_subparsers())
+    argv = ["view", str(source)] + (["-o", str(out)] if out else [])
+    for k, v in controls.items():
+        argv += [f"--{k}", str(v)]
+    return parser.parse_args(argv)
+
+
+def test_view_writes_screenshot(result, tmp_path, capsys):
+    from stereovision.export import write_cloud_ply
+
+    write_cloud_ply(tmp_path / "cloud.ply", result)
+    shot = tmp_path / "shot.png"
+    args = _view_args(tmp_path, shot, yaw=5.0, forward=0.5)
+    assert args.func(args) == 0
+    img = cv2.imread(str(shot))
+    assert img is not None and not render.is_blank(img[..., ::-1])
+    assert f"{len(result.points)} points" in capsys.readouterr().out
+
+
+def test_view_bad_inputs_clear_errors(tmp_path):
+    fake = tmp_path / "fake.ply"
+    fake.write_text("this is not a point cloud\n")
+    with pytest.raises(ValueError, match="not a PLY file"):
+        render.load_view_source(fake)
+    from stereovision.io import write_ply
+
+    write_ply(tmp_path / "empty.ply", np.zeros((0, 3), np.float32))
+    with pytest.raises(ValueError, match="empty point cloud"):
+        render.load_view_source(tmp_path / "empty.ply")
+    with pytest.raises(FileNotFoundError, match="no such file"):
+        render.load_view_source(tmp_path / "missing.ply")
+    (tmp_path / "emptydir").mkdir()
+    with pytest.raises(FileNotFoundError, match=r"no cloud\.ply"):
+        render.load_view_source(tmp_path / "emptydir")
+
+
+def test_view_via_cli_main(tmp_path, capsys):
+    from stereovision import cli
+
+    if "view" not in cli.build_parser().format_help():
+        pytest.skip("`view` not wired into stereovision.cli yet (render.add_cli)")
+    fake = tmp_path / "fake.ply"
+    fake.write_bytes(b"\x00\x01garbage")
+    assert cli.main(["view", str(fake), "-o", str(tmp_path / "x.png")]) == 2
+    assert "stereovision: error: not a PLY file" in capsys.readouterr().err
