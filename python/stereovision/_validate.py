@@ -1,0 +1,307 @@
+"""Input checks shared by every entry point (images, pairs, dtypes, calibration numbers).
+
+Every public function of the package validates its inputs here, at the top, so that a bad input
+fails with one :class:`ValueError` that names the argument, what was received and what was
+expected -- never with an obscure error from deep inside NumPy, OpenCV or the Rust kernels.
+
+Image conventions (algorithms.md section 0): images are ``(H, W)`` ``float32`` grey levels in
+``[0, 1]``; colour input is OpenCV's channel order (BGR or BGRA) and is converted with the usual
+luma weights.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "LUMA_WEIGHTS_BGR",
+    "as_bgr_uint8",
+    "as_gray_float",
+    "as_gray_uint8",
+    "as_image_array",
+    "check_pair",
+    "positive_finite",
+]
+
+#: ITU-R BT.601 luma weights in OpenCV's B, G, R channel order (the weights ``cv2.cvtColor``
+#: uses for ``COLOR_BGR2GRAY``), applied here in floating point without intermediate rounding.
+LUMA_WEIGHTS_BGR: tuple[float, float, float] = (0.114, 0.587, 0.299)
+
+#: Full-scale values of the accepted integer image dtypes.
+_INT_FULL_SCALE: dict[np.dtype[Any], float] = {
+    np.dtype(np.uint8): 255.0,
+    np.dtype(np.uint16): 65535.0,
+}
+
+_EXPECTED = "uint8, uint16 or floating point in [0, 1]"
+
+
+def _describe(arr: np.ndarray) -> str:
+    return f"shape {arr.shape} dtype {arr.dtype}"
+
+
+def as_image_array(img: object, name: str = "image") -> np.ndarray:
+    """Convert ``img`` to a NumPy image array and check its shape and dtype (no value checks).
+
+    Parameters
+    ----------
+    img : array_like
+        Grey ``(H, W)`` or colour ``(H, W, C)`` image with ``C`` in 1, 3 (BGR), 4 (BGRA).
+    name : str
+        Argument name used in error messages.
+
+    Returns
+    -------
+    numpy.ndarray
+        The image as an array (no copy when ``img`` already is one), shape ``(H, W)`` or
+        ``(H, W, C)``, dtype ``uint8``, ``uint16`` or floating point.
+
+    Raises
+    ------
+    ValueError
+        If ``img`` is not array-like, has the wrong number of dimensions or channels, is empty,
+        or has an unsupported dtype (bool, signed integer, complex, object, strings, ...).
+    """
+    if img is None:
+        raise ValueError(f"{name}: expected an image array (H, W) or (H, W, 3), got None")
+    try:
+        arr = np.asarray(img)
+    except (ValueError, TypeError) as exc:  # ragged nested sequences and the like
+        raise ValueError(
+            f"{name}: expected an image array (H, W) or (H, W, 3), got {type(img).__name__} "
+            f"that NumPy cannot convert ({exc})"
+        ) from None
+    if arr.dtype == object or arr.dtype.kind in "USV":
+        raise ValueError(
+            f"{name}: expected a numeric image array, got {type(img).__name__} "
+            f"converting to dtype {arr.dtype}"
+        )
+    if arr.ndim not in (2, 3):
+        raise ValueError(
+            f"{name}: expected a grey (H, W) or colour (H, W, C) image, got {arr.ndim} "
+            f"dimension(s) with shape {arr.shape}"
+        )
+    if arr.ndim == 3 and arr.shape[2] not in (1, 3, 4):
+        raise ValueError(
+            f"{name}: expected 1, 3 (BGR) or 4 (BGRA) channels, got {arr.shape[2]} "
+            f"(shape {arr.shape})"
+        )
+    if arr.size == 0:
+        raise ValueError(f"{name}: image is empty (shape {arr.shape})")
+    if arr.dtype not in _INT_FULL_SCALE and arr.dtype.kind != "f":
+        raise ValueError(f"{name}: unsupported dtype {arr.dtype}; expected {_EXPECTED}")
+    return arr
+
+
+def _to_unit_float(arr: np.ndarray, name: str) -> npt.NDArray[np.float32]:
+    """Scale a validated image array to float32 in [0, 1] (channels untouched)."""
+    if arr.dtype in _INT_FULL_SCALE:
+        return arr.astype(np.float32) * np.float32(1.0 / _INT_FULL_SCALE[arr.dtype])
+    out = arr.astype(np.float32)
+    if not np.isfinite(out).all():
+        n_bad = int(np.count_nonzero(~np.isfinite(out)))
+        raise ValueError(
+            f"{name}: float image contains {n_bad} NaN/inf value(s); expected finite grey levels "
+            "in [0, 1]"
+        )
+    lo, hi = float(out.min()), float(out.max())
+    if lo < 0.0 or hi > 1.0:
+        # Rescaling by the maximum would give the two images of a pair different scales, so a
+        # float image outside [0, 1] is an error rather than a guess.
+        raise ValueError(
+            f"{name}: float image values must lie in [0, 1], got range [{lo:g}, {hi:g}] "
+            "(divide 8-bit data by 255, or pass the uint8 array itself)"
+        )
+    return out
+
+
+def as_gray_float(img: object, name: str = "left") -> npt.NDArray[np.float32]:
+    """Return ``img`` as a C-contiguous grey ``(H, W)`` ``float32`` image in ``[0, 1]``.
+
+    Scaling: ``uint8`` is divided by 255, ``uint16`` by 65535. Floating point images must already
+    be finite and lie in ``[0, 1]`` (they are not rescaled: rescaling by the maximum would put the
+    two images of a pair on different scales). Colour images (BGR or BGRA, OpenCV order) are
+    converted with the BT.601 luma weights :data:`LUMA_WEIGHTS_BGR` in floating point; alpha is
+    ignored.
+
+    Parameters
+    ----------
+    img : array_like
+        ``(H, W)``, ``(H, W, 1)``, ``(H, W, 3)`` BGR or ``(H, W, 4)`` BGRA image of dtype
+        ``uint8``, ``uint16``, ``float16``, ``float32`` or ``float64``.
+    name : str
+        Argument name used in error messages.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` ``float32`` array with values in ``[0, 1]`` (always a new array).
+
+    Raises
+    ------
+    ValueError
+        If ``img`` is not an image array, has the wrong number of dimensions or channels, is
+        empty, has an unsupported dtype (bool, signed integer, complex, object), or is a float
+        image with NaN/inf or values outside ``[0, 1]``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> as_gray_float(np.array([[0, 255]], dtype=np.uint8))
+    array([[0., 1.]], dtype=float32)
+    """
+    arr = as_image_array(img, name)
+    out = _to_unit_float(arr, name)
+    if out.ndim == 3:
+        if out.shape[2] == 1:
+            out = out[:, :, 0]
+        else:
+            b, g, r = LUMA_WEIGHTS_BGR
+            gray = (
+                np.float32(b) * out[:, :, 0]
+                + np.float32(g) * out[:, :, 1]
+                + np.float32(r) * out[:, :, 2]
+            )
+            # The weights sum to 1 up to float rounding; keep the documented range exact.
+            out = np.clip(gray, 0.0, 1.0)
+    return np.ascontiguousarray(out, dtype=np.float32)
+
+
+def as_bgr_uint8(img: object, name: str = "image") -> npt.NDArray[np.uint8]:
+    """Return ``img`` as a C-contiguous ``(H, W, 3)`` ``uint8`` BGR image (for OpenCV).
+
+    ``uint8`` BGR input is returned as is (no copy when already contiguous). Grey input is
+    replicated to three channels; BGRA drops alpha; ``uint16`` is divided by 257 and floats in
+    ``[0, 1]`` multiplied by 255, both rounded to nearest.
+
+    Parameters
+    ----------
+    img : array_like
+        Image accepted by :func:`as_gray_float`.
+    name : str
+        Argument name used in error messages.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W, 3)`` ``uint8``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`as_gray_float`.
+    """
+    arr = as_image_array(img, name)
+    if arr.dtype != np.uint8:
+        arr = np.rint(_to_unit_float(arr, name) * np.float32(255.0)).astype(np.uint8)
+    if arr.ndim == 2:
+        arr = arr[:, :, None]
+    if arr.shape[2] == 1:
+        arr = np.repeat(arr, 3, axis=2)
+    elif arr.shape[2] == 4:
+        arr = arr[:, :, :3]
+    return np.ascontiguousarray(arr)
+
+
+def as_gray_uint8(img: object, name: str = "image") -> npt.NDArray[np.uint8]:
+    """Return ``img`` as a C-contiguous ``(H, W)`` ``uint8`` grey image (for OpenCV).
+
+    Colour input goes through :func:`as_bgr_uint8` and ``cv2.cvtColor(..., COLOR_BGR2GRAY)``,
+    i.e. exactly what OpenCV users get from an 8-bit BGR image.
+
+    Parameters
+    ----------
+    img : array_like
+        Image accepted by :func:`as_gray_float`.
+    name : str
+        Argument name used in error messages.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` ``uint8``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`as_gray_float`.
+    """
+    import cv2
+
+    arr = as_image_array(img, name)
+    if arr.ndim == 2 or arr.shape[2] == 1:
+        if arr.dtype != np.uint8:
+            arr = np.rint(_to_unit_float(arr, name) * np.float32(255.0)).astype(np.uint8)
+        return np.ascontiguousarray(arr.reshape(arr.shape[:2]))
+    return np.asarray(cv2.cvtColor(as_bgr_uint8(arr, name), cv2.COLOR_BGR2GRAY), dtype=np.uint8)
+
+
+def check_pair(
+    left: object, right: object
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+    """Validate a stereo pair and return it as grey ``float32`` images in ``[0, 1]``.
+
+    Parameters
+    ----------
+    left, right : array_like
+        Images accepted by :func:`as_gray_float`, of identical shape (same height, width and
+        channel count).
+
+    Returns
+    -------
+    tuple of numpy.ndarray
+        ``(left, right)``, each ``(H, W)`` ``float32`` in ``[0, 1]``.
+
+    Raises
+    ------
+    ValueError
+        If either image is invalid (the message names ``left`` or ``right``) or if their shapes
+        differ (the message gives both shapes).
+    """
+    larr = as_image_array(left, "left")
+    rarr = as_image_array(right, "right")
+    if larr.shape != rarr.shape:
+        raise ValueError(
+            f"left and right images must have the same shape, got left {larr.shape} and "
+            f"right {rarr.shape}"
+        )
+    return as_gray_float(larr, "left"), as_gray_float(rarr, "right")
+
+
+def positive_finite(value: object, name: str) -> float:
+    """Return ``value`` as a Python float, checking that it is finite and strictly positive.
+
+    Parameters
+    ----------
+    value : float-like
+        A real scalar (Python or NumPy number, or a size-1 array).
+    name : str
+        Field or argument name used in the error message.
+
+    Returns
+    -------
+    float
+
+    Raises
+    ------
+    ValueError
+        If ``value`` is not a real number, is NaN/inf, or is ``<= 0``.
+    """
+    if isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name}: expected a positive finite number, got bool {value!r}")
+    try:
+        arr = np.asarray(value)
+        if arr.size != 1 or arr.dtype.kind not in "iuf":
+            raise TypeError
+        out = float(arr.reshape(()))
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"{name}: expected a positive finite number, got {type(value).__name__} {value!r}"
+        ) from None
+    if not math.isfinite(out) or out <= 0.0:
+        raise ValueError(f"{name}: expected a positive finite number, got {out!r}")
+    return out

@@ -1,0 +1,208 @@
+"""OpenCV reference matchers and the reference hole fill, exactly as evaluation.md defines them.
+
+Every accuracy or speed figure of the project is reported beside these references:
+
+* :func:`opencv_bm` -- ``cv2.StereoBM_create(D16, 15)`` on the grey pair;
+* :func:`opencv_sgbm` -- ``cv2.StereoSGBM_create`` in ``SGBM_3WAY`` mode on the BGR pair with the
+  configuration of evaluation.md "Speed";
+* :func:`row_fill` -- the "filled reference" rule (a hole takes the smaller of the nearest valid
+  disparities to its left and right in its row).
+
+Outputs follow the project's convention: ``float32`` disparity in pixels, ``d = x_left - x_right``
+at left-image pixels, NaN for "no estimate" (OpenCV's 16x fixed point divided by 16, negative
+values turned into NaN).
+"""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from stereovision._validate import as_bgr_uint8, as_gray_uint8, as_image_array
+
+__all__ = [
+    "BM_BLOCK_SIZE",
+    "SGBM_BLOCK_SIZE",
+    "opencv_bm",
+    "opencv_sgbm",
+    "round_up16",
+    "row_fill",
+]
+
+#: OpenCV disparities are fixed point with 4 fractional bits.
+_OPENCV_DISP_SCALE = 16.0
+#: evaluation.md "Speed": ``cv2.StereoBM_create(D16, 15)``.
+BM_BLOCK_SIZE = 15
+#: evaluation.md "Speed": SGBM-3WAY block size; P1/P2 are ``8*3*5^2`` and ``32*3*5^2``.
+SGBM_BLOCK_SIZE = 5
+_SGBM_CHANNELS = 3
+_SGBM_P1 = 8 * _SGBM_CHANNELS * SGBM_BLOCK_SIZE**2
+_SGBM_P2 = 32 * _SGBM_CHANNELS * SGBM_BLOCK_SIZE**2
+_SGBM_DISP12_MAX_DIFF = 1
+_SGBM_UNIQUENESS = 10
+_SGBM_SPECKLE_WINDOW = 100
+_SGBM_SPECKLE_RANGE = 2
+
+
+def round_up16(n: float) -> int:
+    """Round a disparity range up to a positive multiple of 16 (OpenCV's requirement).
+
+    Parameters
+    ----------
+    n : float
+        Disparity range in pixels (finite, ``>= 0``).
+
+    Returns
+    -------
+    int
+        Smallest multiple of 16 that is ``>= n``, and at least 16.
+
+    Raises
+    ------
+    ValueError
+        If ``n`` is negative, NaN or infinite.
+
+    Examples
+    --------
+    >>> round_up16(15.4), round_up16(16), round_up16(16.5), round_up16(0)
+    (16, 16, 32, 16)
+    """
+    x = float(n)
+    if not math.isfinite(x) or x < 0:
+        raise ValueError(f"disparity range must be finite and >= 0, got {n!r}")
+    return max(16, 16 * math.ceil(x / 16.0))
+
+
+def _check_pair_shapes(left: np.ndarray, right: np.ndarray) -> None:
+    if left.shape[:2] != right.shape[:2]:
+        raise ValueError(
+            f"left and right images must have the same size, got left {left.shape} and "
+            f"right {right.shape}"
+        )
+
+
+def _from_opencv(raw: np.ndarray) -> npt.NDArray[np.float32]:
+    disp = raw.astype(np.float32) / np.float32(_OPENCV_DISP_SCALE)
+    disp[disp < 0] = np.nan
+    return disp
+
+
+def opencv_bm(left: object, right: object, max_disparity: float) -> npt.NDArray[np.float32]:
+    """OpenCV block matching reference: ``cv2.StereoBM_create(D16, 15)`` on the grey pair.
+
+    Parameters
+    ----------
+    left, right : array_like
+        Rectified pair, grey ``(H, W)`` or BGR ``(H, W, 3)`` (``uint8``, ``uint16`` or float in
+        ``[0, 1]``); colour is converted with ``cv2.cvtColor(BGR2GRAY)`` on 8-bit data.
+    max_disparity : float
+        Largest disparity searched, in pixels; rounded up to a multiple of 16 (``D16``).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` ``float32`` disparity in pixels, NaN where BM reports none.
+
+    Raises
+    ------
+    ValueError
+        On invalid images, mismatched sizes or a negative/non-finite ``max_disparity``.
+    """
+    la, ra = as_image_array(left, "left"), as_image_array(right, "right")
+    _check_pair_shapes(la, ra)
+    num = round_up16(max_disparity)
+    matcher = cv2.StereoBM.create(numDisparities=num, blockSize=BM_BLOCK_SIZE)
+    raw = matcher.compute(as_gray_uint8(la, "left"), as_gray_uint8(ra, "right"))
+    return _from_opencv(raw)
+
+
+def opencv_sgbm(left: object, right: object, max_disparity: float) -> npt.NDArray[np.float32]:
+    """OpenCV SGBM-3WAY reference with evaluation.md's configuration, on the BGR pair.
+
+    ``minDisparity=0, numDisparities=D16, blockSize=5, P1=8*3*25, P2=32*3*25, disp12MaxDiff=1,
+    uniquenessRatio=10, speckleWindowSize=100, speckleRange=2, mode=STEREO_SGBM_MODE_SGBM_3WAY``.
+
+    Parameters
+    ----------
+    left, right : array_like
+        Rectified pair, BGR ``(H, W, 3)`` or grey ``(H, W)`` (replicated to three channels);
+        ``uint8``, ``uint16`` or float in ``[0, 1]``.
+    max_disparity : float
+        Largest disparity searched, in pixels; rounded up to a multiple of 16 (``D16``).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` ``float32`` disparity in pixels, NaN where SGBM reports none.
+
+    Raises
+    ------
+    ValueError
+        On invalid images, mismatched sizes or a negative/non-finite ``max_disparity``.
+    """
+    la, ra = as_image_array(left, "left"), as_image_array(right, "right")
+    _check_pair_shapes(la, ra)
+    num = round_up16(max_disparity)
+    matcher = cv2.StereoSGBM.create(
+        minDisparity=0,
+        numDisparities=num,
+        blockSize=SGBM_BLOCK_SIZE,
+        P1=_SGBM_P1,
+        P2=_SGBM_P2,
+        disp12MaxDiff=_SGBM_DISP12_MAX_DIFF,
+        uniquenessRatio=_SGBM_UNIQUENESS,
+        speckleWindowSize=_SGBM_SPECKLE_WINDOW,
+        speckleRange=_SGBM_SPECKLE_RANGE,
+        mode=cv2.STEREO_SGBM_MODE_SGBM_3WAY,
+    )
+    raw = matcher.compute(as_bgr_uint8(la, "left"), as_bgr_uint8(ra, "right"))
+    return _from_opencv(raw)
+
+
+def row_fill(disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
+    """The reference hole fill of evaluation.md (vectorised, no per-pixel Python loop).
+
+    Along each row, a hole (NaN) takes the smaller (background) of the nearest valid disparity
+    to its left and the nearest valid disparity to its right; with a valid value on one side
+    only it takes that one; a row with no valid value stays NaN.
+
+    Parameters
+    ----------
+    disp : array_like
+        ``(H, W)`` disparity, NaN (or any non-finite value) = hole.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` ``float32``, a new array; valid input values are unchanged.
+
+    Raises
+    ------
+    ValueError
+        If ``disp`` is not a 2-D real array.
+
+    Examples
+    --------
+    >>> row_fill(np.array([[np.nan, 3, np.nan, np.nan, 1, np.nan]]))
+    array([[3., 3., 1., 1., 1., 1.]], dtype=float32)
+    """
+    d = np.asarray(disp)
+    if d.ndim != 2 or d.dtype.kind not in "iuf":
+        raise ValueError(f"disp: expected a real (H, W) array, got shape {d.shape} dtype {d.dtype}")
+    d = d.astype(np.float32)
+    h, w = d.shape
+    if d.size == 0:
+        return d
+    valid = np.isfinite(d)
+    cols = np.broadcast_to(np.arange(w), (h, w))
+    # Index of the nearest valid pixel at or to the left (-1: none) and at or to the right (w).
+    left_idx = np.maximum.accumulate(np.where(valid, cols, -1), axis=1)
+    right_idx = np.minimum.accumulate(np.where(valid, cols, w)[:, ::-1], axis=1)[:, ::-1]
+    rows = np.arange(h)[:, None]
+    left_val = np.where(left_idx >= 0, d[rows, np.clip(left_idx, 0, w - 1)], np.nan)
+    right_val = np.where(right_idx < w, d[rows, np.clip(right_idx, 0, w - 1)], np.nan)
+    filled = np.fmin(left_val, right_val).astype(np.float32)  # fmin ignores a missing side
+    return np.where(valid, d, filled).astype(np.float32)

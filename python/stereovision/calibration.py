@@ -1,0 +1,802 @@
+"""Stereo calibration: the :class:`Calibration` record, its file formats, rectification and depth.
+
+Conventions (OpenCV's, same as Bouguet's toolbox and ``cv2.stereoCalibrate``):
+
+* pixel ``(x, y)`` = (column, row), origin at the centre of the top-left pixel;
+* ``X_R = R @ X_L + T`` maps a point from left-camera to right-camera coordinates, so a standard
+  left/right rig has ``T ~ (-B, 0, 0)`` with ``B`` the baseline;
+* distortion coefficients in OpenCV's order ``(k1, k2, p1, p2[, k3[, k4, k5, k6[, s1..s4[, tx,
+  ty]]]])``;
+* lengths (``T``, baseline) are in the calibration's ``unit``; depths and points returned by
+  :meth:`Calibration.depth_from_disparity` and :meth:`Calibration.reproject` are in metres.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from stereovision._validate import as_image_array
+
+__all__ = [
+    "DISTORTION_LENGTHS",
+    "UNIT_TO_METRES",
+    "Calibration",
+    "parse_kitti_calib",
+    "parse_middlebury_calib",
+]
+
+PathLike = str | os.PathLike[str]
+F64 = npt.NDArray[np.float64]
+
+#: Length units a calibration may use, with their size in metres.
+UNIT_TO_METRES: dict[str, float] = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "ft": 0.3048, "in": 0.0254}
+#: Distortion vector lengths OpenCV accepts.
+DISTORTION_LENGTHS: tuple[int, ...] = (4, 5, 8, 12, 14)
+#: Tolerance of the rotation check on R (orthonormality and det = +1).
+ROTATION_TOL = 1e-6
+#: Relative tolerance for "equal" numbers of the two cameras of a rectified calibration.
+RECTIFIED_REL_TOL = 1e-6
+#: Middlebury prints doffs and principal points with 3 decimals: allowed mismatch (px).
+DOFFS_TOL_PX = 2e-3
+#: Format tag written into saved files.
+_FORMAT_TAG = "stereovision-calibration"
+_FORMAT_VERSION = 1
+
+
+def _as_float_array(value: object, name: str, shapes: tuple[tuple[int, ...], ...]) -> F64:
+    try:
+        arr = np.array(value, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a real array, got {type(value).__name__}") from None
+    for shape in shapes:
+        if arr.shape == shape:
+            break
+    else:
+        # Accept row/column vectors as produced by OpenCV (1, n) / (n, 1).
+        if len(shapes[0]) == 1 and arr.ndim == 2 and 1 in arr.shape:
+            arr = arr.ravel()
+        if not any(arr.shape == s for s in shapes):
+            raise ValueError(
+                f"{name}: expected shape {' or '.join(map(str, shapes))}, got {arr.shape}"
+            )
+    if not np.isfinite(arr).all():
+        raise ValueError(f"{name}: contains NaN or inf: {arr.tolist()}")
+    arr.setflags(write=False)
+    return arr
+
+
+def _check_camera_matrix(K: F64, name: str) -> None:
+    fx, fy = K[0, 0], K[1, 1]
+    if not (fx > 0 and fy > 0):
+        raise ValueError(f"{name}: focal lengths must be positive, got fx={fx!r}, fy={fy!r}")
+    if K[1, 0] != 0 or not np.allclose(K[2], (0.0, 0.0, 1.0), rtol=0, atol=1e-12):
+        raise ValueError(
+            f"{name}: expected a camera matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]], got "
+            f"{K.tolist()}"
+        )
+
+
+def _close(a: float, b: float, rel: float = RECTIFIED_REL_TOL) -> bool:
+    return abs(a - b) <= rel * max(abs(a), abs(b), 1.0)
+
+
+@dataclass(eq=False)
+class Calibration:
+    """Intrinsics and extrinsics of a stereo pair (OpenCV conventions, see module docstring).
+
+    Parameters
+    ----------
+    K1, K2 : array_like
+        ``(3, 3)`` camera matrices of the left and right camera (pixels).
+    D1, D2 : array_like
+        ``(n,)`` distortion coefficients, ``n`` in 4, 5, 8, 12, 14 (``(1, n)`` is accepted).
+    R : array_like
+        ``(3, 3)`` rotation from left- to right-camera coordinates.
+    T : array_like
+        ``(3,)`` translation in ``unit``: ``X_R = R @ X_L + T``.
+    image_size : tuple of int
+        ``(width, height)`` in pixels.
+    unit : str
+        Length unit of ``T``: ``"m"``, ``"mm"``, ``"cm"``, ``"ft"`` or ``"in"``.
+    rectified : bool
+        True when the images are already rectified (Middlebury, KITTI): then ``R = I``,
+        ``T = (-B, 0, 0)``, no distortion, equal focal lengths and rows.
+    doffs : float, optional
+        Rectified only: ``cx_right - cx_left`` in pixels (Middlebury's ``doffs``); derived from
+        ``K1``/``K2`` when omitted, checked against them when given.
+
+    Raises
+    ------
+    ValueError
+        Naming the field: wrong shape, NaN/inf, non-positive focal length, ``R`` not a rotation,
+        zero baseline, non-positive image size, unknown unit, or a rectified calibration whose
+        numbers are not those of a rectified pair.
+    """
+
+    K1: F64
+    D1: F64
+    K2: F64
+    D2: F64
+    R: F64
+    T: F64
+    image_size: tuple[int, int]
+    unit: str = "m"
+    rectified: bool = False
+    doffs: float | None = None
+    _cache: dict[Any, Any] = field(default_factory=dict, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.K1 = _as_float_array(self.K1, "K1", ((3, 3),))
+        self.K2 = _as_float_array(self.K2, "K2", ((3, 3),))
+        dist_shapes = tuple((n,) for n in DISTORTION_LENGTHS)
+        self.D1 = _as_float_array(self.D1, "D1", dist_shapes)
+        self.D2 = _as_float_array(self.D2, "D2", dist_shapes)
+        self.R = _as_float_array(self.R, "R", ((3, 3),))
+        self.T = _as_float_array(self.T, "T", ((3,),))
+        _check_camera_matrix(self.K1, "K1")
+        _check_camera_matrix(self.K2, "K2")
+        err = float(np.abs(self.R @ self.R.T - np.eye(3)).max())
+        det = float(np.linalg.det(self.R))
+        if err > ROTATION_TOL or abs(det - 1.0) > ROTATION_TOL:
+            raise ValueError(
+                f"R: not a rotation matrix (|R R^T - I| = {err:.3g}, det = {det:.6g}; "
+                f"tolerance {ROTATION_TOL})"
+            )
+        if not float(np.linalg.norm(self.T)) > 0:
+            raise ValueError(f"T: zero baseline (T = {self.T.tolist()})")
+        self.image_size = self._check_size(self.image_size)
+        if self.unit not in UNIT_TO_METRES:
+            raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {self.unit!r}")
+        if not isinstance(self.rectified, (bool, np.bool_)):
+            raise ValueError(f"rectified: expected a bool, got {self.rectified!r}")
+        self.rectified = bool(self.rectified)
+        if self.doffs is not None:
+            d = float(self.doffs)
+            if not math.isfinite(d):
+                raise ValueError(f"doffs: expected a finite number of pixels, got {self.doffs!r}")
+            if not self.rectified:
+                raise ValueError("doffs: only applies to a rectified calibration")
+            self.doffs = d
+        if self.rectified:
+            self._check_rectified()
+
+    @staticmethod
+    def _check_size(size: object) -> tuple[int, int]:
+        if not isinstance(size, (tuple, list, np.ndarray)) or len(size) != 2:
+            raise ValueError(f"image_size: expected (width, height), got {size!r}")
+        out: list[int] = []
+        for v in size:
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)) or v <= 0:
+                raise ValueError(
+                    f"image_size: expected positive integers (width, height), got {size!r}"
+                )
+            out.append(int(v))
+        return out[0], out[1]
+
+    def _check_rectified(self) -> None:
+        if np.abs(self.R - np.eye(3)).max() > ROTATION_TOL:
+            raise ValueError(f"R: a rectified calibration needs R = I, got {self.R.tolist()}")
+        b = float(np.linalg.norm(self.T))
+        if abs(self.T[1]) > RECTIFIED_REL_TOL * b or abs(self.T[2]) > RECTIFIED_REL_TOL * b:
+            raise ValueError(
+                f"T: a rectified calibration needs T = (-B, 0, 0), got {self.T.tolist()}"
+            )
+        if self.T[0] >= 0:
+            raise ValueError(
+                f"T: T[0] must be negative (right camera to the right of the left one) for "
+                f"a rectified pair, got {self.T.tolist()}"
+            )
+        for name, d in (("D1", self.D1), ("D2", self.D2)):
+            if np.any(d != 0):
+                raise ValueError(f"{name}: a rectified calibration has no distortion, got {d}")
+        for i, j, what in ((0, 0, "fx"), (1, 1, "fy"), (1, 2, "cy")):
+            if not _close(self.K1[i, j], self.K2[i, j]):
+                raise ValueError(
+                    f"K2: {what} = {self.K2[i, j]!r} differs from K1's {self.K1[i, j]!r}; a "
+                    "rectified pair shares focal length and image rows"
+                )
+        if self.doffs is not None:
+            expected = self.K2[0, 2] - self.K1[0, 2]
+            if abs(self.doffs - expected) > DOFFS_TOL_PX:
+                raise ValueError(
+                    f"doffs: {self.doffs!r} differs from cx2 - cx1 = {expected!r} (K2, K1)"
+                )
+
+    # ----------------------------------------------------------------------------- equality
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Calibration):
+            return NotImplemented
+        arrays = ("K1", "D1", "K2", "D2", "R", "T")
+        return (
+            all(np.array_equal(getattr(self, a), getattr(other, a)) for a in arrays)
+            and self.image_size == other.image_size
+            and self.unit == other.unit
+            and self.rectified == other.rectified
+            and self.doffs == other.doffs
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    # --------------------------------------------------------------------------- properties
+
+    @property
+    def to_metres_factor(self) -> float:
+        """Size of one calibration ``unit`` in metres (``0.001`` for ``"mm"``)."""
+        return UNIT_TO_METRES[self.unit]
+
+    @property
+    def baseline(self) -> float:
+        """Baseline ``|T|`` in the calibration's unit."""
+        return float(np.linalg.norm(self.T))
+
+    @property
+    def baseline_m(self) -> float:
+        """Baseline ``|T|`` in metres."""
+        return self.baseline * self.to_metres_factor
+
+    @property
+    def doffs_px(self) -> float:
+        """Rectified: ``cx_right - cx_left`` (px), the given ``doffs`` or derived from K1/K2."""
+        cal = self if self.rectified else self.rectified_calibration()
+        if cal.doffs is not None:
+            return cal.doffs
+        return float(cal.K2[0, 2] - cal.K1[0, 2])
+
+    @property
+    def focal_px(self) -> float:
+        """Focal length (px) of the rectified pair (``K1[0, 0]``, or ``P1[0, 0]`` after
+        ``cv2.stereoRectify`` with ``alpha=0`` for an unrectified calibration)."""
+        cal = self if self.rectified else self.rectified_calibration()
+        return float(cal.K1[0, 0])
+
+    @property
+    def Q(self) -> F64:
+        """``(4, 4)`` disparity-to-depth matrix (OpenCV convention, the calibration's unit).
+
+        For a rectified calibration it is built from K1, K2 and T with ``doffs`` handled::
+
+            [[1, 0, 0, -cx], [0, 1, 0, -cy], [0, 0, 0, f], [0, 0, 1/B, doffs/B]]
+
+        so that ``cv2.reprojectImageTo3D(disp, Q)`` gives ``Z = f B / (d + doffs)``; otherwise
+        it is ``cv2.stereoRectify``'s ``Q`` (``alpha=0``, ``CALIB_ZERO_DISPARITY``).
+        """
+        if not self.rectified:
+            q: F64 = self._stereo_rectify(0.0)[4].copy()
+            return q
+        f = float(self.K1[0, 0])
+        tx = float(self.T[0])  # = -B
+        cx, cy = float(self.K1[0, 2]), float(self.K1[1, 2])
+        return np.array(
+            [
+                [1.0, 0.0, 0.0, -cx],
+                [0.0, 1.0, 0.0, -cy],
+                [0.0, 0.0, 0.0, f],
+                [0.0, 0.0, -1.0 / tx, -self.doffs_px / tx],
+            ]
+        )
+
+    # ---------------------------------------------------------------------------- rectifying
+
+    def _stereo_rectify(self, alpha: float) -> tuple[F64, F64, F64, F64, F64]:
+        key = ("stereoRectify", float(alpha))
+        if key not in self._cache:
+            r1, r2, p1, p2, q, _, _ = cv2.stereoRectify(
+                self.K1,
+                self.D1,
+                self.K2,
+                self.D2,
+                self.image_size,
+                self.R,
+                self.T,
+                flags=cv2.CALIB_ZERO_DISPARITY,
+                alpha=float(alpha),
+            )
+            self._cache[key] = (r1, r2, p1, p2, q)
+        out: tuple[F64, F64, F64, F64, F64] = self._cache[key]
+        return out
+
+    def _maps(self, alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        key = ("maps", float(alpha))
+        if key not in self._cache:
+            r1, r2, p1, p2, _ = self._stereo_rectify(alpha)
+            m1x, m1y = cv2.initUndistortRectifyMap(
+                self.K1, self.D1, r1, p1, self.image_size, cv2.CV_32FC1
+            )
+            m2x, m2y = cv2.initUndistortRectifyMap(
+                self.K2, self.D2, r2, p2, self.image_size, cv2.CV_32FC1
+            )
+            self._cache[key] = (m1x, m1y, m2x, m2y)
+        out: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = self._cache[key]
+        return out
+
+    def rectify(
+        self, left: npt.ArrayLike, right: npt.ArrayLike, alpha: float = 0.0
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Rectify a raw pair so that epipolar lines are image rows.
+
+        For a ``rectified`` calibration the inputs are returned unchanged (same objects, same
+        pixel frame, no warping). Otherwise ``cv2.stereoRectify`` (``CALIB_ZERO_DISPARITY``),
+        ``cv2.initUndistortRectifyMap`` and ``cv2.remap`` (bilinear) are applied; the maps are
+        cached per ``alpha``. Use :meth:`rectified_calibration` with the same ``alpha`` for the
+        geometry of the result.
+
+        Parameters
+        ----------
+        left, right : array_like
+            Images of size ``image_size`` (grey or colour, any dtype OpenCV remaps).
+        alpha : float
+            ``cv2.stereoRectify`` free scaling: 0 keeps only valid pixels, 1 keeps all pixels.
+
+        Returns
+        -------
+        tuple of numpy.ndarray
+            ``(left_rectified, right_rectified)``, same shapes and dtypes as the inputs.
+
+        Raises
+        ------
+        ValueError
+            If an image is not an image array or its size differs from ``image_size``, or
+            ``alpha`` is outside ``[0, 1]``.
+        """
+        la = as_image_array(left, "left")
+        ra = as_image_array(right, "right")
+        w, h = self.image_size
+        for name, a in (("left", la), ("right", ra)):
+            if a.shape[:2] != (h, w):
+                raise ValueError(
+                    f"{name}: image is {a.shape[1]}x{a.shape[0]}, calibration image_size is {w}x{h}"
+                )
+        if self.rectified:
+            return la, ra
+        if not 0.0 <= alpha <= 1.0:
+            raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
+        m1x, m1y, m2x, m2y = self._maps(alpha)
+        lr = cv2.remap(la, m1x, m1y, cv2.INTER_LINEAR)
+        rr = cv2.remap(ra, m2x, m2y, cv2.INTER_LINEAR)
+        return lr, rr
+
+    def rectified_calibration(self, alpha: float = 0.0) -> Calibration:
+        """Calibration of the pair produced by :meth:`rectify` with the same ``alpha``.
+
+        ``K1``/``K2`` are ``P1[:, :3]``/``P2[:, :3]`` of ``cv2.stereoRectify``, no distortion,
+        ``R = I``, ``T = (P2[0, 3] / P2[0, 0], 0, 0) = (-B, 0, 0)``, ``rectified=True``. A
+        rectified calibration returns itself.
+
+        Raises
+        ------
+        ValueError
+            For a vertical rig (OpenCV rectifies it to columns, which this package does not
+            handle) or a right camera to the left of the left one.
+        """
+        if self.rectified:
+            return self
+        key = ("rectified_calibration", float(alpha))
+        if key not in self._cache:
+            _, _, p1, p2, _ = self._stereo_rectify(alpha)
+            if abs(p2[1, 3]) > abs(p2[0, 3]):
+                raise ValueError(
+                    "R, T: the rig is vertical (stereoRectify produced a vertical baseline); "
+                    "only horizontal rigs are supported"
+                )
+            self._cache[key] = Calibration(
+                K1=p1[:, :3],
+                D1=np.zeros(5),
+                K2=p2[:, :3],
+                D2=np.zeros(5),
+                R=np.eye(3),
+                T=np.array([p2[0, 3] / p2[0, 0], 0.0, 0.0]),
+                image_size=self.image_size,
+                unit=self.unit,
+                rectified=True,
+            )
+        cal: Calibration = self._cache[key]
+        return cal
+
+    # ------------------------------------------------------------------------------- depth
+
+    def depth_from_disparity(self, disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
+        """Depth in metres from a rectified-frame disparity map (algorithms.md E.3).
+
+        ``Z = f B / (d + doffs)`` scaled to metres; ``d <= -doffs`` or NaN gives NaN. See
+        :func:`stereovision.triangulation.depth_from_disparity`.
+        """
+        from stereovision.triangulation import depth_from_disparity
+
+        return depth_from_disparity(disp, self)
+
+    def reproject(self, disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
+        """``(H, W, 3)`` points in metres (left rectified frame: X right, Y down, Z forward).
+
+        See :func:`stereovision.triangulation.reproject`.
+        """
+        from stereovision.triangulation import reproject
+
+        return reproject(disp, self)
+
+    # ------------------------------------------------------------------------------ saving
+
+    def _to_record(self) -> dict[str, Any]:
+        rec: dict[str, Any] = {
+            "format": _FORMAT_TAG,
+            "version": _FORMAT_VERSION,
+            "K1": self.K1,
+            "D1": self.D1,
+            "K2": self.K2,
+            "D2": self.D2,
+            "R": self.R,
+            "T": self.T,
+            "image_width": self.image_size[0],
+            "image_height": self.image_size[1],
+            "unit": self.unit,
+            "rectified": int(self.rectified),
+        }
+        if self.doffs is not None:
+            rec["doffs"] = self.doffs
+        return rec
+
+    def save(self, path: PathLike) -> None:
+        """Write the calibration atomically.
+
+        ``.yaml``/``.yml``/``.xml`` are written with ``cv2.FileStorage`` (readable by OpenCV in
+        any language: matrices ``K1 D1 K2 D2 R T``, ``image_width``, ``image_height``, ``unit``,
+        ``rectified``, ``doffs``); ``.json`` holds the same fields as nested lists. Both round
+        trip every float64 bit-identically.
+
+        Raises
+        ------
+        ValueError
+            For another file extension.
+        FileNotFoundError
+            If the directory does not exist.
+        """
+        from stereovision.io import atomic_write
+
+        p = Path(path)
+        suffix = p.suffix.lower()
+        rec = self._to_record()
+        if suffix in (".yaml", ".yml", ".xml"):
+            fmt = cv2.FILE_STORAGE_FORMAT_XML if suffix == ".xml" else cv2.FILE_STORAGE_FORMAT_YAML
+            fs = cv2.FileStorage("", cv2.FILE_STORAGE_WRITE | cv2.FILE_STORAGE_MEMORY | fmt)
+            for key, value in rec.items():
+                if isinstance(value, np.ndarray):
+                    fs.write(
+                        key,
+                        value.reshape(-1, 1)
+                        if key == "T"
+                        else value.reshape(1, -1)
+                        if key in ("D1", "D2")
+                        else value,
+                    )
+                else:
+                    fs.write(key, value)
+            text = fs.releaseAndGetString()
+        elif suffix == ".json":
+            text = json.dumps(
+                {k: v.tolist() if isinstance(v, np.ndarray) else v for k, v in rec.items()},
+                indent=2,
+            )
+        else:
+            raise ValueError(
+                f"cannot save a calibration as {p.name!r}: use .yaml, .yml, .xml or .json"
+            )
+        with atomic_write(p, "w") as fh:
+            fh.write(text)
+
+    @classmethod
+    def _from_mapping(cls, get: Any, source: str) -> Calibration:
+        def need(key: str, *aliases: str) -> Any:
+            for k in (key, *aliases):
+                v = get(k)
+                if v is not None:
+                    return v
+            raise ValueError(f"calibration file {source} lacks field {key!r}")
+
+        width = need("image_width")
+        height = need("image_height")
+        doffs = get("doffs")
+        return cls(
+            K1=need("K1", "M1"),
+            D1=need("D1"),
+            K2=need("K2", "M2"),
+            D2=need("D2"),
+            R=need("R"),
+            T=need("T"),
+            image_size=(int(width), int(height)),
+            unit=str(need("unit")),
+            rectified=bool(int(get("rectified") or 0)),
+            doffs=None if doffs is None else float(doffs),
+        )
+
+    @classmethod
+    def _from_filestorage_text(cls, text: str, source: str) -> Calibration:
+        fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
+        if not fs.isOpened():
+            raise ValueError(f"cannot parse {source} as OpenCV YAML/XML")
+
+        def get(key: str) -> Any:
+            node = fs.getNode(key)
+            if node.isNone():
+                return None
+            if node.isString():
+                return node.string()
+            if node.isInt():
+                return int(node.real())
+            if node.isReal():
+                return node.real()
+            mat = node.mat()
+            return None if mat is None else np.asarray(mat, dtype=np.float64)
+
+        try:
+            return cls._from_mapping(get, source)
+        finally:
+            fs.release()
+
+    @classmethod
+    def _from_json_text(cls, text: str, source: str) -> Calibration:
+        try:
+            obj = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise ValueError(f"cannot parse {source} as JSON: {exc}") from None
+        if not isinstance(obj, dict):
+            raise ValueError(f"{source}: expected a JSON object, got {type(obj).__name__}")
+        return cls._from_mapping(obj.get, source)
+
+    @staticmethod
+    def _read_text(path: PathLike) -> tuple[Path, str]:
+        p = Path(path)
+        if not p.exists():
+            raise FileNotFoundError(f"calibration file not found: {p}")
+        if not p.is_file():
+            raise ValueError(f"calibration path is not a file: {p}")
+        try:
+            return p, p.read_text(encoding="utf-8")
+        except UnicodeDecodeError:
+            raise ValueError(f"not a text calibration file: {p}") from None
+
+    @classmethod
+    def load(cls, path: PathLike) -> Calibration:
+        """Read a calibration written by :meth:`save` (OpenCV YAML/XML or JSON).
+
+        The format is recognised from the content. ``M1``/``M2`` (OpenCV's ``stereo_calib``
+        sample names) are accepted for ``K1``/``K2``.
+
+        Raises
+        ------
+        FileNotFoundError
+            If ``path`` does not exist.
+        ValueError
+            If the file is not such a calibration, lacks a field (named), or holds invalid
+            values (see :class:`Calibration`).
+        """
+        p, text = cls._read_text(path)
+        head = text.lstrip()
+        if head.startswith("%YAML") or head.startswith("<?xml") or head.startswith("<opencv"):
+            return cls._from_filestorage_text(text, str(p))
+        if head.startswith("{"):
+            return cls._from_json_text(text, str(p))
+        raise ValueError(f"not a stereovision calibration file (OpenCV YAML/XML or JSON): {p}")
+
+    @classmethod
+    def from_file(cls, path: PathLike, image_size: tuple[int, int] | None = None) -> Calibration:
+        """Read any supported calibration, detecting the format from the content.
+
+        OpenCV YAML/XML and JSON (:meth:`load`), Middlebury ``calib.txt``
+        (:meth:`from_middlebury`), KITTI ``calib_cam_to_cam`` / object calibration
+        (:meth:`from_kitti`; ``image_size`` is passed on).
+
+        Raises
+        ------
+        FileNotFoundError
+            If ``path`` does not exist.
+        ValueError
+            If the format is not recognised or the content is invalid.
+        """
+        p, text = cls._read_text(path)
+        head = text.lstrip()
+        if head.startswith(("%YAML", "<?xml", "<opencv", "{")):
+            return cls.load(p)
+        if re.search(r"^\s*cam0\s*=", text, re.MULTILINE):
+            return cls.from_middlebury(p)
+        if re.search(r"^\s*(P_rect_02|P2)\s*:", text, re.MULTILINE):
+            return cls.from_kitti(p, image_size=image_size)
+        raise ValueError(
+            f"unrecognised calibration format in {p}: expected OpenCV YAML/XML, JSON, "
+            "Middlebury calib.txt or KITTI calibration"
+        )
+
+    # ------------------------------------------------------------------ dataset formats
+
+    @classmethod
+    def from_middlebury(cls, calib_txt: PathLike) -> Calibration:
+        """Rectified calibration from a Middlebury ``calib.txt``.
+
+        ``cam0``/``cam1`` give K1/K2, ``baseline`` (mm) gives ``T = (-baseline, 0, 0)``,
+        ``doffs`` is kept, ``width``/``height`` give ``image_size``; unit ``"mm"``,
+        ``R = I``, no distortion, ``rectified=True``.
+
+        Raises
+        ------
+        FileNotFoundError
+            If the file does not exist.
+        ValueError
+            If a key is missing (named) or a value is invalid.
+        """
+        p, _ = cls._read_text(calib_txt)
+        v = parse_middlebury_calib(p)
+        for key in ("cam0", "cam1", "baseline", "width", "height"):
+            if key not in v:
+                raise ValueError(f"Middlebury calibration {p} lacks {key!r}")
+        return cls(
+            K1=v["cam0"],
+            D1=np.zeros(5),
+            K2=v["cam1"],
+            D2=np.zeros(5),
+            R=np.eye(3),
+            T=np.array([-float(v["baseline"]), 0.0, 0.0]),
+            image_size=(int(v["width"]), int(v["height"])),
+            unit="mm",
+            rectified=True,
+            doffs=float(v["doffs"]) if "doffs" in v else None,
+        )
+
+    @classmethod
+    def from_kitti(
+        cls, calib_file: PathLike, image_size: tuple[int, int] | None = None
+    ) -> Calibration:
+        """Rectified calibration of KITTI's colour pair (cameras 2 and 3), metres.
+
+        Reads ``P_rect_02``/``P_rect_03`` (raw ``calib_cam_to_cam.txt``, also when each matrix
+        spans several lines) or ``P2``/``P3`` (object/odometry format). ``K = P[:, :3]``,
+        baseline ``B = (P2[0, 3] - P3[0, 3]) / f``, ``T = (-B, 0, 0)``, ``R = I``. The small
+        vertical and depth offsets of the rectified colour cameras in ``P[1:, 3]`` (a few
+        millimetres) are ignored.
+
+        The image size comes from ``S_rect_02``, else from ``image_size``, else from a
+        ``left.png``/``image_2.png`` next to the file.
+
+        Raises
+        ------
+        FileNotFoundError
+            If the file does not exist.
+        ValueError
+            If the projection matrices or the image size are missing.
+        """
+        p, _ = cls._read_text(calib_file)
+        v = parse_kitti_calib(p)
+        for k2, k3 in (("P_rect_02", "P_rect_03"), ("P2", "P3")):
+            if k2 in v and k3 in v:
+                break
+        else:
+            raise ValueError(f"KITTI calibration {p} lacks P_rect_02/P_rect_03 (or P2/P3)")
+        mats = []
+        for key in (k2, k3):
+            if v[key].size != 12:
+                raise ValueError(f"KITTI calibration {p}: {key} has {v[key].size} values, not 12")
+            mats.append(v[key].reshape(3, 4))
+        p2, p3 = mats
+        f = float(p2[0, 0])
+        if not f > 0:
+            raise ValueError(f"KITTI calibration {p}: {k2} focal length {f!r} is not positive")
+        size: tuple[int, int] | None = None
+        if "S_rect_02" in v and v["S_rect_02"].size == 2:
+            size = (int(np.rint(v["S_rect_02"][0])), int(np.rint(v["S_rect_02"][1])))
+        elif image_size is not None:
+            size = image_size
+        else:
+            for name in ("left.png", "image_2.png"):
+                img = p.parent / name
+                if img.is_file():
+                    hdr = cv2.imread(str(img), cv2.IMREAD_UNCHANGED)
+                    if hdr is not None:
+                        size = (int(hdr.shape[1]), int(hdr.shape[0]))
+                        break
+        if size is None:
+            raise ValueError(
+                f"image_size: KITTI calibration {p} has no S_rect_02 and no image next to it; "
+                "pass image_size=(width, height)"
+            )
+        return cls(
+            K1=p2[:, :3],
+            D1=np.zeros(5),
+            K2=p3[:, :3],
+            D2=np.zeros(5),
+            R=np.eye(3),
+            T=np.array([-(p2[0, 3] - p3[0, 3]) / f, 0.0, 0.0]),
+            image_size=size,
+            unit="m",
+            rectified=True,
+        )
+
+
+_MB_LINE = re.compile(r"^\s*([A-Za-z_]\w*)\s*=\s*(.*?)\s*$")
+
+
+def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
+    """Parse a Middlebury ``calib.txt`` into a dict.
+
+    ``cam0``/``cam1`` (``[f 0 cx; 0 f cy; 0 0 1]``) become ``(3, 3)`` float64 arrays; every
+    other ``key=number`` line (``doffs``, ``baseline``, ``width``, ``height``, ``ndisp``,
+    ``vmin``, ...) a float.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    ValueError
+        If a line is not ``key=value`` or a value does not parse.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"Middlebury calibration not found: {p}")
+    out: dict[str, Any] = {}
+    for n, line in enumerate(p.read_text(encoding="utf-8", errors="replace").splitlines(), 1):
+        if not line.strip():
+            continue
+        m = _MB_LINE.match(line)
+        if m is None:
+            raise ValueError(f"{p}:{n}: expected key=value, got {line!r}")
+        key, val = m.group(1), m.group(2)
+        try:
+            if val.startswith("["):
+                rows = [r.split() for r in val.strip("[]").split(";")]
+                mat = np.array(rows, dtype=np.float64)
+                if mat.shape != (3, 3):
+                    raise ValueError(f"shape {mat.shape}")
+                out[key] = mat
+            else:
+                out[key] = float(val)
+        except ValueError as exc:
+            raise ValueError(f"{p}:{n}: cannot parse {key}={val!r} ({exc})") from None
+    return out
+
+
+_KITTI_KEY = re.compile(r"^([A-Za-z_][\w]*):$")
+
+
+def parse_kitti_calib(path: PathLike) -> dict[str, F64]:
+    """Parse a KITTI calibration file into ``{key: float64 values}``.
+
+    Handles ``key: v1 v2 ...`` on one line and values continued over following lines; keys whose
+    values are not all numbers (``calib_time``) are skipped, as is free text before the first key.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    """
+    p = Path(path)
+    if not p.is_file():
+        raise FileNotFoundError(f"KITTI calibration not found: {p}")
+    text = p.read_text(encoding="utf-8", errors="replace")
+    out: dict[str, F64] = {}
+    key: str | None = None
+    values: list[str] = []
+
+    def flush() -> None:
+        if key is None:
+            return
+        try:
+            out[key] = np.array([float(t) for t in values], dtype=np.float64)
+        except ValueError:
+            pass
+
+    for tok in re.sub(r":", ": ", text).split():
+        m = _KITTI_KEY.match(tok)
+        if m is not None:
+            flush()
+            key, values = m.group(1), []
+        elif key is not None:
+            values.append(tok)
+    flush()
+    return out

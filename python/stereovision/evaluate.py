@@ -1,0 +1,539 @@
+"""Accuracy metrics exactly as evaluation.md defines them.
+
+* :func:`dense_metrics` -- Middlebury-style bad-t (holes counted as errors), density, avgerr, rms;
+* :func:`depth_metrics` -- metric depth: median ``|dZ|/Z``, share off by more than 5 %, RMSE as a
+  percentage of the mean depth;
+* :func:`table1_report` -- the paper's Table-1 test (per-point distances, average error, RMSE,
+  RMSE %), in metres and feet;
+* :func:`sparse_metrics` -- precision of sparse matches, count and 4x4 grid coverage.
+
+Missing values: a disparity estimate is missing when it is not finite (NaN); an OpenCV ``0`` is a
+valid estimate. A GT disparity is unknown when it is not finite. Depths (estimated or GT) are
+missing when not finite or ``<= 0``. All percentages are in ``[0, 100]``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+if TYPE_CHECKING:
+    from stereovision.calibration import Calibration
+
+__all__ = [
+    "DEFAULT_THRESHOLDS",
+    "DenseMetrics",
+    "DepthMetrics",
+    "SparseMetrics",
+    "Table1Report",
+    "dense_metrics",
+    "depth_metrics",
+    "gt_depth",
+    "sparse_metrics",
+    "table1_report",
+]
+
+#: evaluation.md: bad-t thresholds in pixels; bad-2.0 is the headline figure.
+DEFAULT_THRESHOLDS: tuple[float, ...] = (0.5, 1.0, 2.0, 4.0)
+#: evaluation.md: a depth is "off" when its relative error exceeds 5 %.
+DEPTH_OFF_FRACTION = 0.05
+#: evaluation.md: sparse precision thresholds (px); precision@1 is the headline.
+SPARSE_THRESHOLDS: tuple[float, ...] = (0.5, 1.0, 2.0)
+#: evaluation.md: spread of sparse matches over a 4 x 4 grid of the image.
+COVERAGE_GRID = 4
+
+_FT_PER_M = 1.0 / 0.3048
+_TO_METRES = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "ft": 0.3048, "in": 0.0254}
+
+
+def _real_2d(a: object, name: str) -> npt.NDArray[np.float64]:
+    arr = np.asarray(a)
+    if arr.ndim != 2 or arr.dtype.kind not in "iuf":
+        raise ValueError(
+            f"{name}: expected a real (H, W) array, got shape {arr.shape} dtype {arr.dtype}"
+        )
+    return arr.astype(np.float64)
+
+
+def _same_shape(a: np.ndarray, b: np.ndarray, na: str, nb: str) -> None:
+    if a.shape != b.shape:
+        raise ValueError(f"{na} and {nb} must have the same shape, got {a.shape} and {b.shape}")
+
+
+def _unit_factor(unit: str) -> float:
+    try:
+        return _TO_METRES[unit]
+    except KeyError:
+        raise ValueError(f"unit: expected one of {sorted(_TO_METRES)}, got {unit!r}") from None
+
+
+def _pct(num: float, den: float) -> float:
+    return 100.0 * num / den if den else math.nan
+
+
+# ---------------------------------------------------------------------------------------- dense
+
+
+@dataclass(frozen=True)
+class DenseMetrics:
+    """Dense disparity metrics over the pixels with known GT (evaluation.md).
+
+    Attributes
+    ----------
+    bad : dict of float to float
+        ``{t: percentage}`` of GT pixels whose estimate is missing or off by more than ``t`` px.
+    density : float
+        Percentage of GT pixels that have an estimate.
+    avgerr, rms : float
+        Mean and RMS absolute error (px) over pixels with both (NaN if there are none).
+    n_gt : int
+        Number of pixels with known GT.
+    n_both : int
+        Number of pixels with both GT and an estimate.
+    """
+
+    bad: dict[float, float]
+    density: float
+    avgerr: float
+    rms: float
+    n_gt: int
+    n_both: int
+
+    def as_dict(self) -> dict[str, float | int]:
+        """Flat dict: ``bad-0.5``, ``bad-1.0``, ..., ``density``, ``avgerr``, ``rms``, counts."""
+        out: dict[str, float | int] = {f"bad-{t:.1f}": v for t, v in self.bad.items()}
+        out.update(
+            density=self.density,
+            avgerr=self.avgerr,
+            rms=self.rms,
+            n_gt=self.n_gt,
+            n_both=self.n_both,
+        )
+        return out
+
+
+def dense_metrics(
+    disp: npt.ArrayLike,
+    gt: npt.ArrayLike,
+    thresholds: tuple[float, ...] = DEFAULT_THRESHOLDS,
+    mask: npt.ArrayLike | None = None,
+) -> DenseMetrics:
+    """Middlebury-style dense metrics, holes counted as errors.
+
+    Parameters
+    ----------
+    disp : array_like
+        ``(H, W)`` estimated disparity (px), NaN = no estimate.
+    gt : array_like
+        ``(H, W)`` GT disparity (px), non-finite = unknown.
+    thresholds : tuple of float
+        bad-t thresholds in px.
+    mask : array_like of bool, optional
+        ``(H, W)``; restrict the evaluation to these pixels (e.g. non-occluded).
+
+    Returns
+    -------
+    DenseMetrics
+
+    Raises
+    ------
+    ValueError
+        On non-2-D input, mismatched shapes or non-positive thresholds.
+
+    Examples
+    --------
+    >>> m = dense_metrics(np.array([[1.0, np.nan, 5.0]]), np.array([[1.5, 2.0, 2.0]]))
+    >>> m.bad[1.0], round(m.density, 2), m.avgerr
+    (66.66666666666667, 66.67, 1.75)
+    """
+    d = _real_2d(disp, "disp")
+    g = _real_2d(gt, "gt")
+    _same_shape(d, g, "disp", "gt")
+    if any(not (t > 0 and math.isfinite(t)) for t in thresholds):
+        raise ValueError(f"thresholds must be positive and finite, got {thresholds}")
+    known = np.isfinite(g)
+    if mask is not None:
+        m = np.asarray(mask, dtype=bool)
+        _same_shape(m, g, "mask", "gt")
+        known &= m
+    n_gt = int(known.sum())
+    est = np.isfinite(d) & known
+    err = np.abs(d[est] - g[est])
+    n_both = int(est.sum())
+    bad = {float(t): _pct(n_gt - int(np.count_nonzero(err <= t)), n_gt) for t in thresholds}
+    return DenseMetrics(
+        bad=bad,
+        density=_pct(n_both, n_gt),
+        avgerr=float(err.mean()) if n_both else math.nan,
+        rms=float(np.sqrt(np.mean(err**2))) if n_both else math.nan,
+        n_gt=n_gt,
+        n_both=n_both,
+    )
+
+
+# ---------------------------------------------------------------------------------------- depth
+
+
+@dataclass(frozen=True)
+class DepthMetrics:
+    """Metric depth accuracy over pixels where both depths exist (evaluation.md).
+
+    Attributes
+    ----------
+    median_rel_err : float
+        Median of ``|Z_est - Z_gt| / Z_gt``, percent.
+    share_off_5pct : float
+        Percentage of those pixels with relative error above 5 %.
+    rmse_pct : float
+        RMSE of ``Z_est - Z_gt`` as a percentage of the mean GT depth.
+    rmse : float
+        The RMSE itself, in the depth maps' unit.
+    n : int
+        Number of pixels with both depths.
+    density : float
+        ``n`` as a percentage of all pixels.
+    """
+
+    median_rel_err: float
+    share_off_5pct: float
+    rmse_pct: float
+    rmse: float
+    n: int
+    density: float
+
+    def as_dict(self) -> dict[str, float | int]:
+        """The fields as a flat dict."""
+        return asdict(self)
+
+
+def _depth_valid(z: np.ndarray) -> npt.NDArray[np.bool_]:
+    with np.errstate(invalid="ignore"):
+        return np.isfinite(z) & (z > 0)
+
+
+def depth_metrics(depth_est: npt.ArrayLike, depth_gt: npt.ArrayLike) -> DepthMetrics:
+    """Median relative error, share off by > 5 % and RMSE % over pixels with both depths.
+
+    Parameters
+    ----------
+    depth_est, depth_gt : array_like
+        Same-shape depth maps in the same unit; non-finite or ``<= 0`` = missing.
+
+    Returns
+    -------
+    DepthMetrics
+        NaN figures and ``n = 0`` when no pixel has both.
+
+    Raises
+    ------
+    ValueError
+        On mismatched shapes or non-real input.
+    """
+    e = np.asarray(depth_est)
+    g = np.asarray(depth_gt)
+    if e.dtype.kind not in "iuf" or g.dtype.kind not in "iuf":
+        raise ValueError(f"depth maps must be real arrays, got {e.dtype} and {g.dtype}")
+    _same_shape(e, g, "depth_est", "depth_gt")
+    e = e.astype(np.float64)
+    g = g.astype(np.float64)
+    both = _depth_valid(e) & _depth_valid(g)
+    n = int(both.sum())
+    if n == 0:
+        return DepthMetrics(math.nan, math.nan, math.nan, math.nan, 0, 0.0)
+    diff = e[both] - g[both]
+    rel = np.abs(diff) / g[both]
+    rmse = float(np.sqrt(np.mean(diff**2)))
+    return DepthMetrics(
+        median_rel_err=100.0 * float(np.median(rel)),
+        share_off_5pct=_pct(int(np.count_nonzero(rel > DEPTH_OFF_FRACTION)), n),
+        rmse_pct=100.0 * rmse / float(np.mean(g[both])),
+        rmse=rmse,
+        n=n,
+        density=_pct(n, e.size),
+    )
+
+
+def gt_depth(gt_disp: npt.ArrayLike, calib: Calibration) -> npt.NDArray[np.float32]:
+    """GT depth in metres from a GT disparity map and a rectified calibration.
+
+    ``Z = f * B / (d + doffs)`` (algorithms.md E.3); unknown or ``d <= -doffs`` gives NaN.
+
+    Parameters
+    ----------
+    gt_disp : array_like
+        ``(H, W)`` GT disparity in pixels (non-finite = unknown).
+    calib : Calibration
+        Calibration of the (rectified) pair.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` ``float32`` depth in metres, NaN where unknown.
+    """
+    from stereovision.triangulation import depth_from_disparity
+
+    return depth_from_disparity(gt_disp, calib)
+
+
+# -------------------------------------------------------------------------------------- Table 1
+
+
+@dataclass(frozen=True)
+class Table1Report:
+    """The paper's Table-1 test: triangulated vs GT distances at N points (metres).
+
+    Attributes
+    ----------
+    x, y : numpy.ndarray
+        ``(N,)`` ``int64`` pixel columns and rows of the points.
+    estimated, ground_truth : numpy.ndarray
+        ``(N,)`` ``float64`` distances in metres.
+    mean_error : float
+        Mean signed error ``estimated - ground_truth`` (m).
+    mean_abs_error : float
+        Mean absolute error (m).
+    rmse : float
+        Root-mean-square error (m).
+    rmse_pct : float
+        RMSE as a percentage of the mean GT distance.
+    mean_distance : float
+        Mean GT distance (m).
+    """
+
+    x: npt.NDArray[np.int64]
+    y: npt.NDArray[np.int64]
+    estimated: npt.NDArray[np.float64]
+    ground_truth: npt.NDArray[np.float64]
+    mean_error: float
+    mean_abs_error: float
+    rmse: float
+    rmse_pct: float
+    mean_distance: float
+    n_points: int = field(init=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "n_points", len(self.x))
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready dict: summary figures in metres and feet plus the per-point rows."""
+        return {
+            "n_points": self.n_points,
+            "mean_error_m": self.mean_error,
+            "mean_abs_error_m": self.mean_abs_error,
+            "rmse_m": self.rmse,
+            "rmse_pct": self.rmse_pct,
+            "mean_distance_m": self.mean_distance,
+            "mean_error_ft": self.mean_error * _FT_PER_M,
+            "rmse_ft": self.rmse * _FT_PER_M,
+            "mean_distance_ft": self.mean_distance * _FT_PER_M,
+            "points": [
+                {
+                    "x": int(x),
+                    "y": int(y),
+                    "estimated_m": float(e),
+                    "ground_truth_m": float(g),
+                    "error_m": float(e - g),
+                }
+                for x, y, e, g in zip(
+                    self.x, self.y, self.estimated, self.ground_truth, strict=True
+                )
+            ],
+        }
+
+    def format(self) -> str:
+        """Plain-text table (per point, then the summary), in metres and feet."""
+        head = (
+            f"{'#':>3} {'x':>5} {'y':>5} {'est m':>9} {'GT m':>9} {'err m':>8} "
+            f"{'est ft':>9} {'GT ft':>9} {'err ft':>8}"
+        )
+        lines = ["Table-1 test: triangulated vs ground-truth distance", head, "-" * len(head)]
+        for i, (x, y, e, g) in enumerate(
+            zip(self.x, self.y, self.estimated, self.ground_truth, strict=True), start=1
+        ):
+            lines.append(
+                f"{i:>3} {x:>5} {y:>5} {e:>9.3f} {g:>9.3f} {e - g:>+8.3f} "
+                f"{e * _FT_PER_M:>9.3f} {g * _FT_PER_M:>9.3f} {(e - g) * _FT_PER_M:>+8.3f}"
+            )
+        lines += [
+            "-" * len(head),
+            f"points: {self.n_points}   mean distance: {self.mean_distance:.3f} m "
+            f"({self.mean_distance * _FT_PER_M:.3f} ft)",
+            f"average error: {self.mean_error:+.3f} m ({self.mean_error * _FT_PER_M:+.3f} ft)   "
+            f"mean |error|: {self.mean_abs_error:.3f} m "
+            f"({self.mean_abs_error * _FT_PER_M:.3f} ft)",
+            f"RMSE: {self.rmse:.3f} m ({self.rmse * _FT_PER_M:.3f} ft) = "
+            f"{self.rmse_pct:.2f} % of the mean distance",
+        ]
+        return "\n".join(lines)
+
+
+def table1_report(
+    depth_est: npt.ArrayLike,
+    depth_gt: npt.ArrayLike,
+    n_points: int = 10,
+    seed: int = 0,
+    points: npt.ArrayLike | None = None,
+    unit: str = "m",
+) -> Table1Report:
+    """The paper's Table-1 test on a distance map against a GT distance map.
+
+    Works for any per-pixel distance (depth ``Z`` or range): ``N`` random pixels where both
+    exist (drawn without replacement with ``numpy.random.default_rng(seed)``, listed in
+    row-major order) or the given ``points``.
+
+    Parameters
+    ----------
+    depth_est, depth_gt : array_like
+        ``(H, W)`` distances in ``unit``; non-finite or ``<= 0`` = missing.
+    n_points : int
+        Number of random points (all valid pixels if fewer exist). Ignored with ``points``.
+    seed : int
+        Seed of the random draw.
+    points : array_like, optional
+        ``(N, 2)`` integer ``(x, y)`` pixels to use instead of a random draw; each must lie in
+        the image and have both distances.
+    unit : str
+        Unit of the input maps: ``"m"``, ``"mm"``, ``"cm"``, ``"ft"`` or ``"in"``. The report is
+        in metres (and feet in :meth:`Table1Report.format`).
+
+    Returns
+    -------
+    Table1Report
+
+    Raises
+    ------
+    ValueError
+        On mismatched shapes, ``n_points < 1``, no pixel with both distances, or a given point
+        outside the image or without both distances.
+    """
+    e = _real_2d(depth_est, "depth_est")
+    g = _real_2d(depth_gt, "depth_gt")
+    _same_shape(e, g, "depth_est", "depth_gt")
+    factor = _unit_factor(unit)
+    both = _depth_valid(e) & _depth_valid(g)
+    if points is None:
+        if n_points < 1:
+            raise ValueError(f"n_points must be >= 1, got {n_points}")
+        flat = np.flatnonzero(both)
+        if flat.size == 0:
+            raise ValueError("no pixel has both an estimated and a ground-truth distance")
+        rng = np.random.default_rng(seed)
+        pick = np.sort(rng.choice(flat, size=min(n_points, flat.size), replace=False))
+        ys, xs = np.unravel_index(pick, e.shape)
+    else:
+        pts = np.asarray(points)
+        if pts.ndim != 2 or pts.shape[1] != 2 or pts.shape[0] == 0 or pts.dtype.kind not in "iu":
+            raise ValueError(
+                f"points: expected a non-empty integer (N, 2) array of (x, y), got shape "
+                f"{pts.shape} dtype {pts.dtype}"
+            )
+        xs, ys = pts[:, 0], pts[:, 1]
+        h, w = e.shape
+        inside = (xs >= 0) & (xs < w) & (ys >= 0) & (ys < h)
+        if not inside.all():
+            raise ValueError(f"points: {pts[~inside].tolist()} lie outside the {w}x{h} image")
+        missing = ~both[ys, xs]
+        if missing.any():
+            raise ValueError(f"points: {pts[missing].tolist()} lack an estimated or GT distance")
+    est = e[ys, xs] * factor
+    ref = g[ys, xs] * factor
+    err = est - ref
+    rmse = float(np.sqrt(np.mean(err**2)))
+    mean_d = float(np.mean(ref))
+    return Table1Report(
+        x=np.asarray(xs, dtype=np.int64),
+        y=np.asarray(ys, dtype=np.int64),
+        estimated=est,
+        ground_truth=ref,
+        mean_error=float(np.mean(err)),
+        mean_abs_error=float(np.mean(np.abs(err))),
+        rmse=rmse,
+        rmse_pct=100.0 * rmse / mean_d,
+        mean_distance=mean_d,
+    )
+
+
+# --------------------------------------------------------------------------------------- sparse
+
+
+@dataclass(frozen=True)
+class SparseMetrics:
+    """Sparse match metrics over the matches whose GT is known (evaluation.md).
+
+    Attributes
+    ----------
+    precision : dict of float to float
+        ``{t: percentage}`` of matches with GT whose ``|(xl - xr) - gt| <= t`` (t = 0.5, 1, 2).
+    count : int
+        Number of matches with known GT.
+    n_matches : int
+        Number of matches given.
+    coverage : int
+        Number of cells of a 4 x 4 grid over the image holding at least one match with GT
+        (0 to 16).
+    """
+
+    precision: dict[float, float]
+    count: int
+    n_matches: int
+    coverage: int
+
+    def as_dict(self) -> dict[str, float | int]:
+        """Flat dict: ``precision@0.5``, ``precision@1.0``, ``precision@2.0``, counts."""
+        out: dict[str, float | int] = {f"precision@{t:.1f}": v for t, v in self.precision.items()}
+        out.update(count=self.count, n_matches=self.n_matches, coverage=self.coverage)
+        return out
+
+
+def sparse_metrics(
+    xl: npt.ArrayLike, yl: npt.ArrayLike, xr: npt.ArrayLike, gt: npt.ArrayLike
+) -> SparseMetrics:
+    """Precision@0.5/1/2, count and 4x4 grid coverage of sparse matches ``(xl, yl) -> xr``.
+
+    The GT is looked up at the rounded ``(xl, yl)`` (round half to even); matches outside the
+    image or on unknown GT are not counted.
+
+    Parameters
+    ----------
+    xl, yl, xr : array_like
+        ``(N,)`` left-image coordinates (px) and the matched right-image column.
+    gt : array_like
+        ``(H, W)`` GT disparity of the left image, non-finite = unknown.
+
+    Returns
+    -------
+    SparseMetrics
+        Precision is NaN when no match has GT.
+
+    Raises
+    ------
+    ValueError
+        If ``xl``, ``yl``, ``xr`` are not 1-D of equal length or ``gt`` is not 2-D.
+    """
+    g = _real_2d(gt, "gt")
+    arrs = [np.asarray(a, dtype=np.float64) for a in (xl, yl, xr)]
+    if any(a.ndim != 1 for a in arrs) or len({a.shape for a in arrs}) != 1:
+        raise ValueError(
+            f"xl, yl, xr: expected 1-D arrays of equal length, got shapes {[a.shape for a in arrs]}"
+        )
+    x, y, x2 = arrs
+    h, w = g.shape
+    with np.errstate(invalid="ignore"):
+        xi = np.rint(x)
+        yi = np.rint(y)
+        inside = np.isfinite(x2) & (xi >= 0) & (xi < w) & (yi >= 0) & (yi < h)
+    xi = np.where(inside, xi, 0).astype(np.int64)
+    yi = np.where(inside, yi, 0).astype(np.int64)
+    gv = np.where(inside, g[yi, xi], np.nan)
+    has_gt = np.isfinite(gv)
+    count = int(has_gt.sum())
+    err = np.abs((x - x2)[has_gt] - gv[has_gt])
+    precision = {t: _pct(int(np.count_nonzero(err <= t)), count) for t in SPARSE_THRESHOLDS}
+    cell_x = np.minimum(xi[has_gt] * COVERAGE_GRID // w, COVERAGE_GRID - 1)
+    cell_y = np.minimum(yi[has_gt] * COVERAGE_GRID // h, COVERAGE_GRID - 1)
+    coverage = len(set(zip(cell_y.tolist(), cell_x.tolist(), strict=True)))
+    return SparseMetrics(precision=precision, count=count, n_matches=len(x), coverage=coverage)

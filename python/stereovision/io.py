@@ -1,0 +1,582 @@
+"""Reading and writing images, PFM disparity maps, PLY point clouds and evaluation scenes.
+
+Every writer in this module writes atomically: the data goes to a temporary file in the
+destination directory which then replaces the destination with :func:`os.replace`, so a reader
+never sees a half-written file and an interrupted write leaves the previous file intact.
+
+Scene layout (evaluation.md)::
+
+    <scene>/left.png  right.png   rectified pair, 8-bit
+    <scene>/gt_disp.pfm           GT disparity of the left image (pixels, +inf = unknown)
+    <scene>/calib.txt             Middlebury-style calibration (optional)
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+from typing import IO, TYPE_CHECKING, Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from stereovision.baselines import round_up16
+
+if TYPE_CHECKING:
+    from stereovision.calibration import Calibration
+
+__all__ = [
+    "MAX_DISPARITY_MARGIN",
+    "Scene",
+    "atomic_write",
+    "find_scenes",
+    "imread",
+    "load_scene",
+    "read_pfm",
+    "read_ply",
+    "scene_max_disparity",
+    "write_pfm",
+    "write_ply",
+]
+
+PathLike = str | os.PathLike[str]
+
+#: evaluation.md: every method searches ``1.1 x`` the largest finite GT disparity, rounded up to
+#: a multiple of 16 (so OpenCV's matchers accept it).
+MAX_DISPARITY_MARGIN = 1.1
+
+#: Fallback search range without GT or calibration: a quarter of the image width.
+_WIDTH_FRACTION = 4
+
+
+@contextmanager
+def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
+    """Open a temporary file next to ``path``; on success it atomically replaces ``path``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Destination file. Its directory must exist.
+    mode : str
+        ``"wb"`` (default) or ``"w"`` (text, UTF-8).
+
+    Yields
+    ------
+    file object
+        The open temporary file. If the ``with`` body raises, the temporary file is removed and
+        ``path`` is left untouched.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the destination directory does not exist.
+    """
+    dest = Path(path)
+    directory = dest.parent if str(dest.parent) else Path(".")
+    if not directory.is_dir():
+        raise FileNotFoundError(f"cannot write {dest}: directory {directory} does not exist")
+    fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=directory)
+    try:
+        encoding = None if "b" in mode else "utf-8"
+        with os.fdopen(fd, mode, encoding=encoding) as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, dest)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def _describe(a: np.ndarray) -> str:
+    return f"shape {a.shape} dtype {a.dtype}"
+
+
+def _existing_file(path: PathLike, what: str) -> Path:
+    p = Path(path)
+    if not p.exists():
+        raise FileNotFoundError(f"{what} not found: {p}")
+    if not p.is_file():
+        raise ValueError(f"{what} is not a regular file: {p}")
+    return p
+
+
+# --------------------------------------------------------------------------------------- images
+
+
+def imread(path: PathLike, gray: bool = False) -> npt.NDArray[np.uint8]:
+    """Read an image file as OpenCV does (8-bit, BGR channel order).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Image file (any format OpenCV decodes: PNG, JPEG, ...).
+    gray : bool
+        Return a grey ``(H, W)`` image instead of BGR ``(H, W, 3)``, converted with
+        ``cv2.cvtColor(COLOR_BGR2GRAY)`` (BT.601 luma).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``uint8``, ``(H, W, 3)`` BGR or ``(H, W)`` grey.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    ValueError
+        If the file cannot be decoded as an image.
+    """
+    p = _existing_file(path, "image file")
+    # imdecode from bytes: works for non-ASCII paths, and fails loudly instead of returning None.
+    data = np.fromfile(p, dtype=np.uint8)
+    img = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
+    if img is None:
+        raise ValueError(f"cannot decode {p} as an image")
+    if gray:
+        # Same conversion as everywhere else in the package (cv2.cvtColor, BT.601), not the
+        # codec's own (libpng's differs by one grey level on some pixels).
+        img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    return np.asarray(img, dtype=np.uint8)
+
+
+# ------------------------------------------------------------------------------------------ PFM
+
+_PFM_HEADER = re.compile(rb"^(P[Ff])\s+(\d+)\s+(\d+)\s+([-+]?[0-9.]+(?:[eE][-+]?\d+)?)\s")
+
+
+def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
+    """Read a PFM file (Middlebury convention) into a top-down ``float32`` array.
+
+    PFM stores rows bottom-up; a negative scale means little-endian data, a positive one
+    big-endian. Both endiannesses, grey (``Pf``) and colour (``PF``) files are read. Values are
+    returned as stored (``inf`` stays ``inf``; see :func:`load_scene` for the GT convention).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        PFM file.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` (``Pf``) or ``(H, W, 3)`` (``PF``) native-endian ``float32``, row 0 = top.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    ValueError
+        If the header is not a PFM header or the data is truncated.
+    """
+    p = _existing_file(path, "PFM file")
+    raw = p.read_bytes()
+    m = _PFM_HEADER.match(raw[:256])
+    if m is None:
+        raise ValueError(f"not a PFM file (bad header): {p}")
+    channels = 3 if m.group(1) == b"PF" else 1
+    width, height = int(m.group(2)), int(m.group(3))
+    scale = float(m.group(4))
+    if width <= 0 or height <= 0 or scale == 0.0 or not math.isfinite(scale):
+        raise ValueError(
+            f"bad PFM header in {p}: width {width}, height {height}, scale {scale} "
+            "(expected positive sizes and a non-zero scale)"
+        )
+    dtype = np.dtype("<f4") if scale < 0 else np.dtype(">f4")
+    count = width * height * channels
+    start = m.end()
+    nbytes = len(raw) - start
+    if nbytes < count * 4:
+        raise ValueError(
+            f"truncated PFM file {p}: expected {count * 4} data bytes for {width}x{height}x"
+            f"{channels}, got {nbytes}"
+        )
+    data = np.frombuffer(raw, dtype=dtype, count=count, offset=start)
+    shape = (height, width, 3) if channels == 3 else (height, width)
+    arr = data.reshape(shape)[::-1]
+    return np.ascontiguousarray(arr, dtype=np.float32)
+
+
+def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) -> None:
+    """Write a ``float32`` array as a PFM file (bottom-up rows, scale magnitude 1), atomically.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Destination file.
+    arr : array_like
+        ``(H, W)`` (written as ``Pf``) or ``(H, W, 3)`` (``PF``) real array, cast to
+        ``float32``. NaN and inf are written as they are, bit for bit.
+    little_endian : bool
+        Byte order of the data (scale ``-1`` when True, ``+1`` otherwise).
+
+    Raises
+    ------
+    ValueError
+        If ``arr`` has the wrong shape or a non-real dtype.
+    """
+    a = np.asarray(arr)
+    if a.dtype.kind not in "iuf" or a.size == 0:
+        raise ValueError(f"arr: expected a non-empty real array, got {_describe(a)}")
+    if not (a.ndim == 2 or (a.ndim == 3 and a.shape[2] == 3)):
+        raise ValueError(f"arr: expected shape (H, W) or (H, W, 3), got {a.shape}")
+    height, width = a.shape[:2]
+    magic = b"PF" if a.ndim == 3 else b"Pf"
+    dtype = np.dtype("<f4") if little_endian else np.dtype(">f4")
+    body = np.ascontiguousarray(a[::-1], dtype=dtype).tobytes()
+    scale = b"-1.0" if little_endian else b"1.0"
+    header = magic + b"\n" + f"{width} {height}".encode() + b"\n" + scale + b"\n"
+    with atomic_write(path) as fh:
+        fh.write(header)
+        fh.write(body)
+
+
+# ------------------------------------------------------------------------------------------ PLY
+
+_PLY_TYPES: dict[str, str] = {
+    "char": "i1",
+    "int8": "i1",
+    "uchar": "u1",
+    "uint8": "u1",
+    "short": "i2",
+    "int16": "i2",
+    "ushort": "u2",
+    "uint16": "u2",
+    "int": "i4",
+    "int32": "i4",
+    "uint": "u4",
+    "uint32": "u4",
+    "float": "f4",
+    "float32": "f4",
+    "double": "f8",
+    "float64": "f8",
+}
+
+
+def write_ply(
+    path: PathLike,
+    points: npt.ArrayLike,
+    colors: npt.ArrayLike | None = None,
+    drop_invalid: bool = True,
+) -> int:
+    """Write a point cloud as a binary little-endian PLY file, atomically.
+
+    Vertex properties: ``float x, y, z`` and, with colours, ``uchar red, green, blue``.
+
+    Parameters
+    ----------
+    points : array_like
+        ``(N, 3)`` (or ``(H, W, 3)``, flattened row-major) coordinates, cast to ``float32``;
+        the project's frame is the left rectified camera, metres, X right, Y down, Z forward.
+    colors : array_like, optional
+        ``uint8`` colours in **RGB** order, same leading shape as ``points`` (flip OpenCV's BGR
+        with ``img[..., ::-1]``).
+    drop_invalid : bool
+        Skip points with a non-finite coordinate (NaN = no depth). When False they are written.
+
+    Returns
+    -------
+    int
+        Number of vertices written.
+
+    Raises
+    ------
+    ValueError
+        If ``points`` is not ``(..., 3)`` real, or ``colors`` does not match it or is not
+        ``uint8``.
+    """
+    pts = np.asarray(points)
+    if pts.dtype.kind not in "iuf" or pts.ndim < 2 or pts.shape[-1] != 3:
+        raise ValueError(f"points: expected a real (N, 3) array, got {_describe(pts)}")
+    pts = pts.reshape(-1, 3).astype(np.float32)
+    cols: np.ndarray | None = None
+    if colors is not None:
+        cols = np.asarray(colors)
+        if cols.dtype != np.uint8:
+            raise ValueError(f"colors: expected dtype uint8, got {cols.dtype}")
+        if cols.ndim < 2 or cols.shape[-1] != 3 or cols.size != pts.size:
+            raise ValueError(
+                f"colors: expected shape {np.asarray(points).shape} (RGB per point), "
+                f"got {cols.shape}"
+            )
+        cols = cols.reshape(-1, 3)
+    if drop_invalid:
+        keep = np.isfinite(pts).all(axis=1)
+        pts = pts[keep]
+        if cols is not None:
+            cols = cols[keep]
+    fields: list[tuple[str, str]] = [("x", "<f4"), ("y", "<f4"), ("z", "<f4")]
+    if cols is not None:
+        fields += [("red", "u1"), ("green", "u1"), ("blue", "u1")]
+    rec = np.empty(len(pts), dtype=np.dtype(fields))
+    rec["x"], rec["y"], rec["z"] = pts[:, 0], pts[:, 1], pts[:, 2]
+    lines = [
+        "ply",
+        "format binary_little_endian 1.0",
+        "comment stereovision point cloud",
+        f"element vertex {len(pts)}",
+        "property float x",
+        "property float y",
+        "property float z",
+    ]
+    if cols is not None:
+        rec["red"], rec["green"], rec["blue"] = cols[:, 0], cols[:, 1], cols[:, 2]
+        lines += ["property uchar red", "property uchar green", "property uchar blue"]
+    lines.append("end_header")
+    with atomic_write(path) as fh:
+        fh.write(("\n".join(lines) + "\n").encode("ascii"))
+        fh.write(rec.tobytes())
+    return len(pts)
+
+
+def read_ply(
+    path: PathLike,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]:
+    """Read a binary PLY point cloud with ``x, y, z`` and optional ``red, green, blue``.
+
+    Reads the files :func:`write_ply` writes and other binary (little- or big-endian) PLY files
+    whose first element is ``vertex`` with scalar properties (further elements are ignored).
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        PLY file.
+
+    Returns
+    -------
+    points : numpy.ndarray
+        ``(N, 3)`` ``float32``.
+    colors : numpy.ndarray or None
+        ``(N, 3)`` ``uint8`` RGB, or None if the file has no colour properties.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    ValueError
+        ``"not a PLY file"`` for anything else; ASCII PLY, missing ``x/y/z`` or truncated data
+        are also reported as ValueError.
+    """
+    p = _existing_file(path, "PLY file")
+    raw = p.read_bytes()
+    end = raw.find(b"end_header")
+    if not raw.startswith(b"ply") or end < 0:
+        raise ValueError(f"not a PLY file: {p}")
+    nl = raw.find(b"\n", end)
+    if nl < 0:
+        raise ValueError(f"not a PLY file (header not terminated): {p}")
+    try:
+        header = raw[:end].decode("ascii").splitlines()
+    except UnicodeDecodeError:
+        raise ValueError(f"not a PLY file (non-ASCII header): {p}") from None
+    order = ""
+    count = -1
+    props: list[tuple[str, str]] = []
+    in_vertex = False
+    for line in header[1:]:
+        tok = line.split()
+        if not tok or tok[0] in ("comment", "obj_info"):
+            continue
+        if tok[0] == "format":
+            fmt = tok[1] if len(tok) > 1 else ""
+            if fmt == "binary_little_endian":
+                order = "<"
+            elif fmt == "binary_big_endian":
+                order = ">"
+            else:
+                raise ValueError(f"unsupported PLY format {fmt!r} in {p} (binary only)")
+        elif tok[0] == "element":
+            if count >= 0 and in_vertex:
+                in_vertex = False
+                break
+            in_vertex = len(tok) == 3 and tok[1] == "vertex"
+            if not in_vertex:
+                raise ValueError(f"PLY file {p}: first element is {tok[1:2]}, expected vertex")
+            count = int(tok[2])
+        elif tok[0] == "property" and in_vertex:
+            if len(tok) != 3 or tok[1] not in _PLY_TYPES:
+                raise ValueError(f"PLY file {p}: unsupported vertex property {line!r}")
+            props.append((tok[2], tok[1]))
+    if not order or count < 0:
+        raise ValueError(f"not a PLY file (no format or vertex element): {p}")
+    names = [n for n, _ in props]
+    if not {"x", "y", "z"} <= set(names):
+        raise ValueError(f"PLY file {p}: vertex has properties {names}, expected x, y, z")
+    dtype = np.dtype([(n, order + _PLY_TYPES[t]) for n, t in props])
+    start = nl + 1
+    if len(raw) - start < count * dtype.itemsize:
+        raise ValueError(
+            f"truncated PLY file {p}: expected {count} vertices of {dtype.itemsize} bytes"
+        )
+    rec = np.frombuffer(raw, dtype=dtype, count=count, offset=start)
+    pts = np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float32)
+    cols: npt.NDArray[np.uint8] | None = None
+    if {"red", "green", "blue"} <= set(names):
+        cols = np.stack([rec["red"], rec["green"], rec["blue"]], axis=1).astype(np.uint8)
+    return pts, cols
+
+
+# --------------------------------------------------------------------------------------- scenes
+
+
+@dataclass(eq=False)
+class Scene:
+    """One evaluation scene of ``../shared/data`` (evaluation.md "Data layout").
+
+    Attributes
+    ----------
+    name : str
+        ``"<family>/<scene>"``, e.g. ``"middlebury2001/tsukuba"``.
+    left, right : numpy.ndarray
+        The rectified pair as read: ``(H, W, 3)`` ``uint8`` BGR.
+    gt : numpy.ndarray or None
+        ``(H, W)`` ``float32`` GT disparity of the left image in pixels, NaN where unknown
+        (the files' ``+inf``); None when the scene has no ``gt_disp.pfm``.
+    calib : Calibration or None
+        From ``calib.txt`` (Middlebury format, unit mm) when present.
+    max_disparity : int
+        Disparity search range for every method (multiple of 16): ``1.1 x`` the largest finite
+        GT disparity rounded up; without GT the calibration's ``ndisp`` rounded up, else a
+        quarter of the width rounded up.
+    path : pathlib.Path
+        The scene directory.
+    """
+
+    name: str
+    left: npt.NDArray[np.uint8]
+    right: npt.NDArray[np.uint8]
+    gt: npt.NDArray[np.float32] | None
+    calib: Calibration | None
+    max_disparity: int
+    path: Path
+
+    def __repr__(self) -> str:
+        h, w = self.left.shape[:2]
+        return (
+            f"Scene({self.name!r}, {w}x{h}, max_disparity={self.max_disparity}, "
+            f"gt={'yes' if self.gt is not None else 'no'}, "
+            f"calib={'yes' if self.calib is not None else 'no'})"
+        )
+
+
+def scene_max_disparity(
+    gt: npt.NDArray[np.floating[Any]] | None,
+    width: int,
+    ndisp: float | None = None,
+) -> int:
+    """Disparity search range of a scene (evaluation.md rule), a multiple of 16.
+
+    Parameters
+    ----------
+    gt : numpy.ndarray or None
+        GT disparity (pixels; non-finite = unknown).
+    width : int
+        Image width in pixels (fallback).
+    ndisp : float, optional
+        ``ndisp`` of a Middlebury ``calib.txt`` (fallback).
+
+    Returns
+    -------
+    int
+        ``round_up16(1.1 * max finite GT)``; without usable GT ``round_up16(ndisp)``, else
+        ``round_up16(width // 4)``.
+    """
+    if gt is not None:
+        finite = gt[np.isfinite(gt)]
+        if finite.size and float(finite.max()) > 0:
+            return round_up16(MAX_DISPARITY_MARGIN * float(finite.max()))
+    if ndisp is not None and ndisp > 0:
+        return round_up16(ndisp)
+    return round_up16(width // _WIDTH_FRACTION)
+
+
+def load_scene(directory: PathLike) -> Scene:
+    """Load one scene directory (``left.png``, ``right.png``, optional GT and ``calib.txt``).
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        Scene directory.
+
+    Returns
+    -------
+    Scene
+
+    Raises
+    ------
+    FileNotFoundError
+        If the directory, ``left.png`` or ``right.png`` is missing.
+    ValueError
+        If an image cannot be decoded, the pair sizes differ, or the GT size differs from the
+        left image.
+    """
+    from stereovision.calibration import Calibration, parse_middlebury_calib
+
+    d = Path(directory)
+    if not d.is_dir():
+        raise FileNotFoundError(f"scene directory not found: {d}")
+    left = imread(d / "left.png")
+    right = imread(d / "right.png")
+    if left.shape != right.shape:
+        raise ValueError(
+            f"scene {d}: left.png {left.shape} and right.png {right.shape} differ in size"
+        )
+    gt: npt.NDArray[np.float32] | None = None
+    gt_path = d / "gt_disp.pfm"
+    if gt_path.exists():
+        gt = read_pfm(gt_path)
+        if gt.shape != left.shape[:2]:
+            raise ValueError(
+                f"scene {d}: gt_disp.pfm has shape {gt.shape}, left.png {left.shape[:2]}"
+            )
+        gt[~np.isfinite(gt)] = np.nan
+    calib: Calibration | None = None
+    ndisp: float | None = None
+    calib_path = d / "calib.txt"
+    if calib_path.exists():
+        calib = Calibration.from_middlebury(calib_path)
+        ndisp = parse_middlebury_calib(calib_path).get("ndisp")
+    return Scene(
+        name=f"{d.parent.name}/{d.name}",
+        left=left,
+        right=right,
+        gt=gt,
+        calib=calib,
+        max_disparity=scene_max_disparity(gt, left.shape[1], ndisp),
+        path=d,
+    )
+
+
+def find_scenes(root: PathLike) -> list[Path]:
+    """Scene directories under ``root`` (any depth) that contain ``left.png`` and ``right.png``.
+
+    Parameters
+    ----------
+    root : str or os.PathLike
+        Directory to search, e.g. ``../shared/data``.
+
+    Returns
+    -------
+    list of pathlib.Path
+        Sorted scene directories (``root`` itself if it is a scene).
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``root`` is not a directory.
+    """
+    r = Path(root)
+    if not r.is_dir():
+        raise FileNotFoundError(f"scene root not found: {r}")
+    found = {p.parent for p in r.rglob("left.png") if (p.parent / "right.png").is_file()}
+    return sorted(found)

@@ -1,0 +1,329 @@
+"""Stereo triangulation: Bouguet's midpoint method and the rectified shortcut (algorithms.md E).
+
+* :func:`triangulate` -- unrectified pixel correspondences to 3-D points (E.2): normalise and
+  undistort each point by fixed-point iteration, intersect the two rays in the least-squares
+  sense, take the midpoint of the closest points.
+* :func:`depth_from_disparity` / :func:`reproject` -- rectified disparity to depth / points
+  (E.3): ``Z = f B / (d + doffs)``, ``X = (x - cx) Z / f``, ``Y = (y - cy) Z / fy``.
+
+Frames: points are in the left camera frame (rectified left camera for the shortcut), X right,
+Y down, Z forward; ``X_R = R X_L + T``. Output lengths are in metres unless ``unit`` says
+otherwise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from stereovision.calibration import UNIT_TO_METRES, Calibration
+
+__all__ = [
+    "PARALLEL_SIN2_TOL",
+    "UNDISTORT_MAX_ITER",
+    "UNDISTORT_TOL",
+    "TriangulationResult",
+    "depth_from_disparity",
+    "reproject",
+    "triangulate",
+    "undistort_normalized",
+]
+
+#: Fixed-point undistortion stops when the update is below this (normalised image units,
+#: algorithms.md E.2: ``< 1e-12``).
+UNDISTORT_TOL = 1e-12
+#: Iteration cap of the undistortion; points still moving after it are flagged (the toolbox
+#: runs 20 fixed rounds; strong distortion near the corners needs more or diverges).
+UNDISTORT_MAX_ITER = 100
+#: Rays whose squared sine of their angle is below this are treated as parallel (angle below
+#: 1e-6 rad: at a 0.1 m baseline that is beyond 100 km).
+PARALLEL_SIN2_TOL = 1e-12
+
+F64 = npt.NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class TriangulationResult:
+    """3-D points of :func:`triangulate`.
+
+    Attributes
+    ----------
+    XL : numpy.ndarray
+        ``(N, 3)`` ``float64`` points in the left camera frame, NaN where invalid.
+    XR : numpy.ndarray
+        ``(N, 3)`` ``float64`` the same points in the right camera frame (``R XL + T``).
+    valid : numpy.ndarray
+        ``(N,)`` bool: False for parallel rays, undistortion that did not converge, or a point
+        behind either camera.
+    unit : str
+        Length unit of ``XL`` and ``XR``.
+    """
+
+    XL: F64
+    XR: F64
+    valid: npt.NDArray[np.bool_]
+    unit: str = "m"
+
+
+def _unit_scale(calib: Calibration, unit: str) -> float:
+    if unit not in UNIT_TO_METRES:
+        raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+    return calib.to_metres_factor / UNIT_TO_METRES[unit]
+
+
+def _points(x: npt.ArrayLike, name: str) -> F64:
+    a = np.asarray(x)
+    if a.dtype.kind not in "iuf" or a.ndim != 2 or a.shape[1] != 2:
+        hint = " (transpose a (2, N) array)" if a.ndim == 2 and a.shape[0] == 2 else ""
+        raise ValueError(
+            f"{name}: expected an (N, 2) real array of (x, y) pixels, got shape {a.shape} "
+            f"dtype {a.dtype}{hint}"
+        )
+    return a.astype(np.float64)
+
+
+def undistort_normalized(
+    pts: npt.ArrayLike,
+    K: npt.ArrayLike,
+    D: npt.ArrayLike,
+    max_iter: int = UNDISTORT_MAX_ITER,
+    tol: float = UNDISTORT_TOL,
+) -> tuple[F64, npt.NDArray[np.bool_]]:
+    """Normalised, undistorted image coordinates of pixel points (algorithms.md E.2 step 1).
+
+    Removes ``K`` (including skew) and inverts OpenCV's distortion model (radial with the
+    rational terms ``k4..k6``, tangential ``p1, p2``, thin prism ``s1..s4``) by the fixed-point
+    iteration ``x <- (x_d - delta(x)) / radial(x)`` started at ``x = x_d``, stopping when the
+    update is below ``tol``.
+
+    Parameters
+    ----------
+    pts : array_like
+        ``(N, 2)`` pixel coordinates ``(x, y)``.
+    K : array_like
+        ``(3, 3)`` camera matrix.
+    D : array_like
+        ``(n,)`` OpenCV distortion coefficients (``n`` in 4, 5, 8, 12, 14; the tilt terms of
+        the 14-coefficient model must be zero).
+    max_iter : int
+        Iteration cap.
+    tol : float
+        Convergence threshold on the update (normalised units).
+
+    Returns
+    -------
+    xy : numpy.ndarray
+        ``(N, 2)`` ``float64`` normalised coordinates (ray ``(x, y, 1)``), NaN where not
+        converged.
+    converged : numpy.ndarray
+        ``(N,)`` bool.
+
+    Raises
+    ------
+    ValueError
+        On a bad shape or non-zero tilt coefficients.
+    """
+    p = _points(pts, "pts")
+    Km = np.asarray(K, dtype=np.float64)
+    d = np.zeros(14)
+    dist = np.asarray(D, dtype=np.float64).ravel()
+    if dist.size not in (0, 4, 5, 8, 12, 14):
+        raise ValueError(f"D: expected 4, 5, 8, 12 or 14 coefficients, got {dist.size}")
+    d[: dist.size] = dist
+    if d[12] != 0 or d[13] != 0:
+        raise ValueError(
+            f"D: the tilted-sensor terms (tx, ty) = {d[12:].tolist()} are not supported"
+        )
+    k1, k2, p1, p2, k3, k4, k5, k6, s1, s2, s3, s4 = d[:12]
+    fx, fy, cx, cy, skew = Km[0, 0], Km[1, 1], Km[0, 2], Km[1, 2], Km[0, 1]
+    yd = (p[:, 1] - cy) / fy
+    xd = (p[:, 0] - cx - skew * yd) / fx
+    x, y = xd.copy(), yd.copy()
+    if not np.any(d):
+        return np.stack([x, y], axis=1), np.isfinite(x) & np.isfinite(y)
+    converged = np.zeros(len(x), dtype=bool)
+    active = np.isfinite(x) & np.isfinite(y)
+    with np.errstate(all="ignore"):
+        for _ in range(max_iter):
+            if not active.any():
+                break
+            xa, ya = x[active], y[active]
+            r2 = xa * xa + ya * ya
+            r4 = r2 * r2
+            radial = (1 + r2 * (k1 + r2 * (k2 + r2 * k3))) / (1 + r2 * (k4 + r2 * (k5 + r2 * k6)))
+            dx = 2 * p1 * xa * ya + p2 * (r2 + 2 * xa * xa) + s1 * r2 + s2 * r4
+            dy = p1 * (r2 + 2 * ya * ya) + 2 * p2 * xa * ya + s3 * r2 + s4 * r4
+            xn = (xd[active] - dx) / radial
+            yn = (yd[active] - dy) / radial
+            step = np.hypot(xn - xa, yn - ya)
+            x[active], y[active] = xn, yn
+            done = step < tol
+            idx = np.flatnonzero(active)
+            converged[idx[done]] = True
+            active[idx[done | ~np.isfinite(step)]] = False
+    x[~converged] = np.nan
+    y[~converged] = np.nan
+    return np.stack([x, y], axis=1), converged
+
+
+def triangulate(
+    xl: npt.ArrayLike,
+    xr: npt.ArrayLike,
+    calib: Calibration,
+    unit: str = "m",
+    max_iter: int = UNDISTORT_MAX_ITER,
+    tol: float = UNDISTORT_TOL,
+) -> TriangulationResult:
+    """Triangulate unrectified pixel correspondences with Bouguet's midpoint method (E.2).
+
+    Each point is normalised and undistorted (:func:`undistort_normalized`) into a ray
+    ``x = (x, y, 1)``. With ``u = R xL`` the depths along both optical axes minimise
+    ``|ZR xR - ZL u - T|^2``::
+
+        D  = (u.u)(xR.xR) - (u.xR)^2
+        ZL = ((u.xR)(xR.T) - (xR.xR)(u.T)) / D
+        ZR = ((u.u)(xR.T) - (u.T)(u.xR)) / D
+
+    and the point is the midpoint of ``ZL xL`` and ``R^T (ZR xR - T)``; ``XR = R XL + T``.
+
+    Parameters
+    ----------
+    xl, xr : array_like
+        ``(N, 2)`` pixel coordinates ``(x, y)`` of corresponding points in the raw (unrectified,
+        distorted) left and right images.
+    calib : Calibration
+        Stereo calibration (``rectified`` ones work too: their distortion is zero).
+    unit : str
+        Output length unit: ``"m"`` (default), ``"ft"``, ``"mm"``, ``"cm"`` or ``"in"``.
+    max_iter, tol : int, float
+        Undistortion iteration cap and convergence threshold.
+
+    Returns
+    -------
+    TriangulationResult
+        ``XL``, ``XR`` ``(N, 3)`` and ``valid`` ``(N,)``; invalid points (parallel rays, no
+        undistortion convergence, negative depth in either camera) are NaN.
+
+    Raises
+    ------
+    ValueError
+        If ``xl``/``xr`` are not ``(N, 2)`` of equal length or ``unit`` is unknown.
+    """
+    pl = _points(xl, "xl")
+    pr = _points(xr, "xr")
+    if pl.shape != pr.shape:
+        raise ValueError(f"xl and xr must have the same shape, got {pl.shape} and {pr.shape}")
+    scale = _unit_scale(calib, unit)
+    nl, okl = undistort_normalized(pl, calib.K1, calib.D1, max_iter, tol)
+    nr, okr = undistort_normalized(pr, calib.K2, calib.D2, max_iter, tol)
+    n = len(pl)
+    ray_l = np.column_stack([nl, np.ones(n)])
+    ray_r = np.column_stack([nr, np.ones(n)])
+    R, T = calib.R, calib.T
+    u = ray_l @ R.T
+    uu = np.einsum("ij,ij->i", u, u)
+    rr = np.einsum("ij,ij->i", ray_r, ray_r)
+    ur = np.einsum("ij,ij->i", u, ray_r)
+    ut = u @ T
+    rt = ray_r @ T
+    delta = uu * rr - ur * ur
+    with np.errstate(all="ignore"):
+        not_parallel = delta > PARALLEL_SIN2_TOL * uu * rr
+        zl = (ur * rt - rr * ut) / delta
+        zr = (uu * rt - ut * ur) / delta
+        p1 = zl[:, None] * ray_l
+        p2 = (zr[:, None] * ray_r - T) @ R  # R^T (ZR xR - T), row-wise
+        XL = 0.5 * (p1 + p2)
+        XR = XL @ R.T + T
+        valid = okl & okr & not_parallel & (zl > 0) & (zr > 0) & (XL[:, 2] > 0) & (XR[:, 2] > 0)
+    XL[~valid] = np.nan
+    XR[~valid] = np.nan
+    return TriangulationResult(XL=XL * scale, XR=XR * scale, valid=valid, unit=unit)
+
+
+def _disparity(disparity: npt.ArrayLike) -> F64:
+    d = np.asarray(disparity)
+    if d.ndim != 2 or d.dtype.kind not in "iuf":
+        raise ValueError(
+            f"disparity: expected a real (H, W) array, got shape {d.shape} dtype {d.dtype}"
+        )
+    return d.astype(np.float64)
+
+
+def depth_from_disparity(
+    disparity: npt.ArrayLike, calib: Calibration, unit: str = "m"
+) -> npt.NDArray[np.float32]:
+    """Depth from a rectified disparity map (algorithms.md E.3).
+
+    ``Z = f B / (d + doffs)``, with ``f`` the rectified focal length (px), ``B`` the baseline
+    and ``doffs = cx_right - cx_left``; ``d + doffs <= 0`` and non-finite ``d`` give NaN. For an
+    unrectified calibration the disparity must be in the frame of
+    :meth:`Calibration.rectify` (``alpha=0``) and :meth:`Calibration.rectified_calibration` is
+    used.
+
+    Parameters
+    ----------
+    disparity : array_like
+        ``(H, W)`` disparity ``x_left - x_right`` in pixels, NaN = none.
+    calib : Calibration
+        Calibration of the pair.
+    unit : str
+        Output unit, metres by default.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` ``float32`` depth, NaN where invalid.
+
+    Raises
+    ------
+    ValueError
+        If ``disparity`` is not a real 2-D array or ``unit`` is unknown.
+    """
+    d = _disparity(disparity)
+    cal = calib if calib.rectified else calib.rectified_calibration()
+    scale = _unit_scale(cal, unit)
+    denom = d + cal.doffs_px
+    with np.errstate(all="ignore"):
+        z = cal.focal_px * cal.baseline * scale / denom
+    z[~(np.isfinite(denom) & (denom > 0))] = np.nan
+    return z.astype(np.float32)
+
+
+def reproject(
+    disparity: npt.ArrayLike, calib: Calibration, unit: str = "m"
+) -> npt.NDArray[np.float32]:
+    """3-D points of every pixel of a rectified disparity map (algorithms.md E.3).
+
+    ``Z`` as :func:`depth_from_disparity`, ``X = (x - cx) Z / fx``, ``Y = (y - cy) Z / fy``
+    with ``(x, y)`` the pixel column and row (left rectified camera frame: X right, Y down,
+    Z forward). Equals ``cv2.reprojectImageTo3D(disparity, calib.Q)`` times
+    ``calib.to_metres_factor`` where valid.
+
+    Parameters
+    ----------
+    disparity : array_like
+        ``(H, W)`` disparity in pixels, NaN = none.
+    calib : Calibration
+        Calibration of the pair.
+    unit : str
+        Output unit, metres by default.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W, 3)`` ``float32``, NaN where the depth is invalid.
+    """
+    z = depth_from_disparity(disparity, calib, unit).astype(np.float64)
+    cal = calib if calib.rectified else calib.rectified_calibration()
+    h, w = z.shape
+    fx, fy, cx, cy = cal.K1[0, 0], cal.K1[1, 1], cal.K1[0, 2], cal.K1[1, 2]
+    xs = (np.arange(w, dtype=np.float64) - cx) / fx
+    ys = (np.arange(h, dtype=np.float64) - cy) / fy
+    out = np.empty((h, w, 3), dtype=np.float32)
+    out[:, :, 0] = xs[None, :] * z
+    out[:, :, 1] = ys[:, None] * z
+    out[:, :, 2] = z
+    return out

@@ -1,0 +1,155 @@
+"""Tests of the OpenCV references and the reference row fill (evaluation.md)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
+from stereovision.baselines import opencv_bm, opencv_sgbm, round_up16, row_fill
+from stereovision.evaluate import dense_metrics
+from stereovision.io import load_scene
+
+NAN = np.nan
+
+
+def test_round_up16() -> None:
+    assert [round_up16(n) for n in (0, 1, 15.4, 16, 16.0001, 32, 101.2 * 1.1)] == [
+        16,
+        16,
+        16,
+        16,
+        32,
+        32,
+        112,
+    ]
+    for bad in (-1, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match="disparity range"):
+            round_up16(bad)
+
+
+def test_row_fill_hand_made() -> None:
+    d = np.array(
+        [
+            [NAN, 3, NAN, NAN, 1, NAN],  # leading/trailing holes take their one side
+            [5, NAN, 2, NAN, NAN, 7],  # inner holes take the smaller side
+            [NAN, NAN, NAN, NAN, NAN, NAN],  # empty row stays empty
+            [1, 2, 3, 4, 5, 6],  # no holes: unchanged
+        ],
+        dtype=np.float32,
+    )
+    expected = np.array(
+        [
+            [3, 3, 1, 1, 1, 1],
+            [5, 2, 2, 2, 2, 7],
+            [NAN] * 6,
+            [1, 2, 3, 4, 5, 6],
+        ],
+        dtype=np.float32,
+    )
+    got = row_fill(d)
+    assert got.dtype == np.float32
+    np.testing.assert_array_equal(got, expected)
+    assert np.isnan(d[0, 0])  # input untouched
+
+
+def _row_fill_loop(d: np.ndarray) -> np.ndarray:
+    """Plain per-pixel reference of the rule (the oracle of the vectorised version)."""
+    out = d.astype(np.float32).copy()
+    for r in range(d.shape[0]):
+        row = d[r]
+        valid = np.flatnonzero(np.isfinite(row))
+        for c in range(d.shape[1]):
+            if np.isfinite(row[c]) or valid.size == 0:
+                continue
+            left = valid[valid < c]
+            right = valid[valid > c]
+            cands = ([row[left[-1]]] if left.size else []) + ([row[right[0]]] if right.size else [])
+            out[r, c] = min(cands)
+    return out
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    hnp.arrays(
+        np.float32,
+        hnp.array_shapes(min_dims=2, max_dims=2, min_side=1, max_side=9),
+        elements=st.one_of(st.just(np.nan), st.floats(0, 100, width=32)),
+    )
+)
+def test_row_fill_matches_loop(d: np.ndarray) -> None:
+    np.testing.assert_array_equal(row_fill(d), _row_fill_loop(d))
+
+
+def test_row_fill_rejects_bad_input() -> None:
+    with pytest.raises(ValueError, match="disp"):
+        row_fill(np.zeros(5))
+
+
+def _shifted_pair(shift: int) -> tuple[np.ndarray, np.ndarray]:
+    """Random texture with left(x) = right(x - shift): disparity ``x_l - x_r = shift``."""
+    rng = np.random.default_rng(3)
+    tex = rng.integers(0, 256, (60, 160 + shift), dtype=np.uint8)
+    tex = cv2.GaussianBlur(tex, (3, 3), 0)
+    left = tex[:, :-shift]
+    right = tex[:, shift:]
+    return np.ascontiguousarray(left), np.ascontiguousarray(right)
+
+
+@pytest.mark.parametrize("fn", [opencv_bm, opencv_sgbm])
+def test_references_recover_a_known_shift(fn) -> None:
+    left, right = _shifted_pair(7)
+    d = fn(left, right, 16)
+    assert d.dtype == np.float32 and d.shape == left.shape
+    # interior, away from the borders the matchers cannot handle
+    inner = d[10:-10, 40:-10]
+    ok = np.isfinite(inner)
+    assert ok.mean() > 0.9
+    assert np.median(inner[ok]) == pytest.approx(7.0, abs=0.1)
+    assert np.isnan(d[:, :5]).all()  # no match possible at the left border -> NaN, not -1
+
+
+def test_references_accept_gray_bgr_and_float() -> None:
+    left, right = _shifted_pair(5)
+    bgr_l, bgr_r = cv2.cvtColor(left, cv2.COLOR_GRAY2BGR), cv2.cvtColor(right, cv2.COLOR_GRAY2BGR)
+    for fn in (opencv_bm, opencv_sgbm):
+        a = fn(left, right, 16)
+        b = fn(bgr_l, bgr_r, 16)
+        c = fn(left / 255.0, right / 255.0, 16)
+        np.testing.assert_array_equal(a, b)
+        np.testing.assert_array_equal(a, c)
+
+
+def test_references_equal_raw_opencv_over_16() -> None:
+    left, right = _shifted_pair(4)
+    raw = cv2.StereoBM.create(32, 15).compute(left, right)
+    expected = raw.astype(np.float32) / 16
+    expected[raw < 0] = np.nan
+    np.testing.assert_array_equal(opencv_bm(left, right, 20), expected)  # 20 -> D16 = 32
+
+
+def test_references_reject_mismatched_pair() -> None:
+    with pytest.raises(ValueError, match=r"left \(10, 20\) and right \(10, 21\)"):
+        opencv_sgbm(np.zeros((10, 20), np.uint8), np.zeros((10, 21), np.uint8), 16)
+    with pytest.raises(ValueError, match="disparity range"):
+        opencv_bm(np.zeros((10, 20), np.uint8), np.zeros((10, 20), np.uint8), -3)
+
+
+def test_sgbm_tsukuba_reference_figures(data_dir: Path) -> None:
+    """evaluation.md table: SGBM-3WAY bad-2 5.3 %, bad-1 6.4 %, density 98 %, + fill 4.2 %;
+    BM bad-2 12.7 %."""
+    s = load_scene(data_dir / "middlebury2001" / "tsukuba")
+    assert s.gt is not None
+    m = dense_metrics(opencv_sgbm(s.left, s.right, s.max_disparity), s.gt)
+    assert m.bad[2.0] == pytest.approx(5.3, abs=0.5)
+    assert m.bad[1.0] == pytest.approx(6.4, abs=0.5)
+    assert m.density == pytest.approx(98.0, abs=0.5)
+    filled = dense_metrics(row_fill(opencv_sgbm(s.left, s.right, s.max_disparity)), s.gt)
+    assert filled.bad[2.0] == pytest.approx(4.2, abs=0.5)
+    assert filled.density == 100.0
+    bm = dense_metrics(opencv_bm(s.left, s.right, s.max_disparity), s.gt)
+    assert bm.bad[2.0] == pytest.approx(12.7, abs=0.5)

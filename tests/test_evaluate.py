@@ -1,0 +1,245 @@
+"""Tests of stereovision.evaluate on hand-made arrays with hand-computed answers, and on real
+scenes against the reference figures of evaluation.md."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+from stereovision.baselines import opencv_sgbm
+from stereovision.calibration import Calibration
+from stereovision.evaluate import (
+    dense_metrics,
+    depth_metrics,
+    gt_depth,
+    sparse_metrics,
+    table1_report,
+)
+from stereovision.io import load_scene
+
+NAN = np.nan
+INF = np.inf
+
+
+# ---------------------------------------------------------------------------------------- dense
+
+
+def test_dense_metrics_hand_computed() -> None:
+    gt = np.array([[10.0, 10.0, 10.0, 10.0], [10.0, INF, NAN, 10.0]])
+    disp = np.array([[10.2, 10.8, 11.5, 13.0], [NAN, 5.0, 5.0, 0.0]])
+    # known GT: 6 pixels; estimates there: errors 0.2, 0.8, 1.5, 3.0, (hole), 10.0
+    m = dense_metrics(disp, gt)
+    assert m.n_gt == 6 and m.n_both == 5
+    assert m.density == pytest.approx(100 * 5 / 6)
+    # bad-t counts the hole: errors > t or missing
+    assert m.bad[0.5] == pytest.approx(100 * 5 / 6)  # 0.8, 1.5, 3, 10, hole
+    assert m.bad[1.0] == pytest.approx(100 * 4 / 6)  # 1.5, 3, 10, hole
+    assert m.bad[2.0] == pytest.approx(100 * 3 / 6)  # 3, 10, hole
+    assert m.bad[4.0] == pytest.approx(100 * 2 / 6)  # 10, hole
+    errs = np.array([0.2, 0.8, 1.5, 3.0, 10.0])
+    assert m.avgerr == pytest.approx(errs.mean())
+    assert m.rms == pytest.approx(math.sqrt(np.mean(errs**2)))
+    d = m.as_dict()
+    assert d["bad-2.0"] == m.bad[2.0] and d["density"] == m.density and d["n_gt"] == 6
+    assert set(d) == {"bad-0.5", "bad-1.0", "bad-2.0", "bad-4.0", "density", "avgerr", "rms"} | {
+        "n_gt",
+        "n_both",
+    }
+
+
+def test_dense_metrics_boundary_and_mask() -> None:
+    gt = np.array([[4.0, 4.0]])
+    # exactly t is not bad (bad means "more than t")
+    assert dense_metrics(np.array([[6.0, 5.0]]), gt).bad[2.0] == 0.0
+    m = dense_metrics(np.array([[6.0, NAN]]), gt, mask=np.array([[True, False]]))
+    assert m.n_gt == 1 and m.density == 100.0 and m.bad[1.0] == 100.0
+
+
+def test_dense_metrics_empty_and_errors() -> None:
+    m = dense_metrics(np.full((2, 2), NAN), np.full((2, 2), NAN))
+    assert m.n_gt == 0 and math.isnan(m.bad[2.0]) and math.isnan(m.avgerr)
+    m = dense_metrics(np.full((2, 2), NAN), np.ones((2, 2)))
+    assert m.bad[0.5] == 100.0 and m.density == 0.0 and math.isnan(m.rms)
+    with pytest.raises(ValueError, match=r"same shape.*\(2, 2\).*\(2, 3\)"):
+        dense_metrics(np.ones((2, 2)), np.ones((2, 3)))
+    with pytest.raises(ValueError, match="disp"):
+        dense_metrics(np.ones(4), np.ones(4))
+    with pytest.raises(ValueError, match="thresholds"):
+        dense_metrics(np.ones((2, 2)), np.ones((2, 2)), thresholds=(0.0,))
+
+
+# ---------------------------------------------------------------------------------------- depth
+
+
+def test_depth_metrics_hand_computed() -> None:
+    gt = np.array([[10.0, 10.0, 20.0, 20.0], [NAN, 5.0, -1.0, 0.0]])
+    est = np.array([[10.1, 11.0, 19.0, 20.0], [3.0, NAN, 5.0, 5.0]])
+    # both valid: (10.1|10) (11|10) (19|20) (20|20); rel errs 1 %, 10 %, 5 %, 0 %
+    m = depth_metrics(est, gt)
+    assert m.n == 4
+    assert m.density == pytest.approx(50.0)
+    assert m.median_rel_err == pytest.approx(3.0)  # median of 0, 1, 5, 10
+    assert m.share_off_5pct == pytest.approx(25.0)  # only 10 % (5 % is not "more than")
+    diff = np.array([0.1, 1.0, -1.0, 0.0])
+    rmse = math.sqrt(np.mean(diff**2))
+    assert m.rmse == pytest.approx(rmse)
+    assert m.rmse_pct == pytest.approx(100 * rmse / 15.0)
+    assert m.as_dict()["n"] == 4
+
+
+def test_depth_metrics_no_overlap() -> None:
+    m = depth_metrics(np.full((2, 2), NAN), np.ones((2, 2)))
+    assert m.n == 0 and math.isnan(m.median_rel_err)
+    with pytest.raises(ValueError, match="depth_est and depth_gt"):
+        depth_metrics(np.ones((2, 2)), np.ones((3, 2)))
+
+
+def _rect_calib(f: float = 500.0, b_mm: float = 100.0, doffs: float = 0.0) -> Calibration:
+    K1 = np.array([[f, 0, 100.0], [0, f, 50.0], [0, 0, 1]])
+    K2 = K1.copy()
+    K2[0, 2] += doffs
+    return Calibration(
+        K1=K1,
+        D1=np.zeros(5),
+        K2=K2,
+        D2=np.zeros(5),
+        R=np.eye(3),
+        T=np.array([-b_mm, 0, 0]),
+        image_size=(200, 100),
+        unit="mm",
+        rectified=True,
+        doffs=doffs,
+    )
+
+
+def test_gt_depth_metres() -> None:
+    cal = _rect_calib(f=500.0, b_mm=100.0, doffs=10.0)
+    z = gt_depth(np.array([[40.0, NAN, -10.0, -20.0, 90.0]]), cal)
+    # Z = f B / (d + doffs) = 500 * 0.1 m / 50 = 1 m ; d <= -doffs -> NaN
+    np.testing.assert_allclose(z[0, [0, 4]], [1.0, 0.5], rtol=1e-7)
+    assert np.isnan(z[0, 1:4]).all()
+    assert z.dtype == np.float32
+
+
+# -------------------------------------------------------------------------------------- Table 1
+
+
+def test_table1_given_points_hand_computed() -> None:
+    est = np.array([[2.0, 3.1, 9.0], [4.0, 5.0, NAN]])
+    gt = np.array([[2.1, 3.0, 9.0], [4.0, 5.0, 1.0]])
+    r = table1_report(est, gt, points=np.array([[0, 0], [1, 0], [0, 1]]))
+    np.testing.assert_array_equal(r.x, [0, 1, 0])
+    np.testing.assert_array_equal(r.y, [0, 0, 1])
+    np.testing.assert_allclose(r.estimated, [2.0, 3.1, 4.0])
+    err = np.array([-0.1, 0.1, 0.0])
+    assert r.mean_error == pytest.approx(0.0, abs=1e-12)
+    assert r.mean_abs_error == pytest.approx(0.2 / 3)
+    assert r.rmse == pytest.approx(math.sqrt(np.mean(err**2)))
+    assert r.mean_distance == pytest.approx(3.0333333333)
+    assert r.rmse_pct == pytest.approx(100 * r.rmse / (9.1 / 3))
+    d = r.as_dict()
+    json.dumps(d)  # JSON-ready
+    assert d["rmse_ft"] == pytest.approx(r.rmse / 0.3048)
+    assert d["points"][1] == {
+        "x": 1,
+        "y": 0,
+        "estimated_m": 3.1,
+        "ground_truth_m": 3.0,
+        "error_m": pytest.approx(0.1),
+    }
+    text = r.format()
+    assert "RMSE: 0.082 m (0.268 ft)" in text  # sqrt(0.02/3) = 0.0816 m = 0.2679 ft
+    assert "est ft" in text and len(text.splitlines()) == 3 + 3 + 4
+
+
+def test_table1_units_and_random_draw() -> None:
+    rng = np.random.default_rng(5)
+    gt = rng.uniform(1000, 3000, (20, 30))  # millimetres
+    est = gt * 1.02
+    est[::2] = NAN
+    r = table1_report(est, gt, n_points=7, seed=3, unit="mm")
+    assert r.n_points == 7
+    assert (r.y % 2 == 1).all()  # only pixels where both exist
+    assert len(set(zip(r.x.tolist(), r.y.tolist(), strict=True))) == 7
+    np.testing.assert_allclose(r.estimated, gt[r.y, r.x] * 1.02e-3)
+    assert r.rmse_pct == pytest.approx(
+        100 * math.sqrt(np.mean((0.02 * r.ground_truth) ** 2)) / r.ground_truth.mean()
+    )
+    again = table1_report(est, gt, n_points=7, seed=3, unit="mm")
+    np.testing.assert_array_equal(again.x, r.x)  # seeded
+    assert table1_report(est, gt, n_points=10_000, unit="mm").n_points == 300
+
+
+def test_table1_errors() -> None:
+    ones = np.ones((3, 3))
+    with pytest.raises(ValueError, match="no pixel"):
+        table1_report(np.full((3, 3), NAN), ones)
+    with pytest.raises(ValueError, match="outside"):
+        table1_report(ones, ones, points=np.array([[3, 0]]))
+    with pytest.raises(ValueError, match="lack"):
+        table1_report(np.where(np.eye(3) > 0, NAN, 1.0), ones, points=np.array([[1, 1]]))
+    with pytest.raises(ValueError, match="unit"):
+        table1_report(ones, ones, unit="parsec")
+    with pytest.raises(ValueError, match="n_points"):
+        table1_report(ones, ones, n_points=0)
+
+
+# --------------------------------------------------------------------------------------- sparse
+
+
+def test_sparse_metrics_hand_computed() -> None:
+    gt = np.full((8, 8), NAN)
+    gt[0, 0] = 3.0
+    gt[0, 7] = 3.0
+    gt[7, 7] = 3.0
+    gt[4, 4] = 2.0
+    xl = np.array([0.2, 6.6, 7.0, 4.0, 3.0, 20.0])
+    yl = np.array([0.4, 0.0, 7.0, 4.0, 3.0, 1.0])
+    xr = np.array([-2.6, 3.0, 2.0, 1.0, 0.0, 0.0])
+    # match 0: rounds to (0,0), dx=2.8 -> err 0.2 ; match 1: (7,0) dx=3.6 -> err 0.6
+    # match 2: (7,7) dx=5 -> err 2 ; match 3: (4,4) dx=3 -> err 1 ; 4: no GT ; 5: outside
+    m = sparse_metrics(xl, yl, xr, gt)
+    assert m.count == 4 and m.n_matches == 6
+    assert m.precision[0.5] == pytest.approx(25.0)
+    assert m.precision[1.0] == pytest.approx(75.0)
+    assert m.precision[2.0] == pytest.approx(100.0)
+    assert m.coverage == 4  # cells (0,0), (0,3), (3,3), (2,2) of the 4x4 grid
+    assert m.as_dict()["precision@1.0"] == pytest.approx(75.0)
+
+
+def test_sparse_metrics_errors_and_empty() -> None:
+    m = sparse_metrics([], [], [], np.ones((4, 4)))
+    assert m.count == 0 and math.isnan(m.precision[1.0]) and m.coverage == 0
+    with pytest.raises(ValueError, match="equal length"):
+        sparse_metrics([1.0], [1.0, 2.0], [0.0], np.ones((4, 4)))
+
+
+# ---------------------------------------------------------------------------------- real scenes
+
+
+def test_sgbm_tsukuba_dense_reference(data_dir: Path) -> None:
+    """evaluation.md: SGBM-3WAY on tsukuba, bad-2 5.3 %, density 98 %."""
+    s = load_scene(data_dir / "middlebury2001" / "tsukuba")
+    assert s.gt is not None
+    m = dense_metrics(opencv_sgbm(s.left, s.right, s.max_disparity), s.gt)
+    assert m.bad[2.0] == pytest.approx(5.3, abs=0.5)
+    assert m.density == pytest.approx(98.0, abs=0.5)
+    assert m.n_gt == 288 * 384 - 22896
+
+
+def test_sgbm_terrace_depth_reference(data_dir: Path) -> None:
+    """evaluation.md "Metric depth": terrace 2.18 % / 17.5 % / 6.1 % / density 50 %."""
+    s = load_scene(data_dir / "eth3d" / "terrace")
+    assert s.gt is not None and s.calib is not None
+    disp = opencv_sgbm(s.left, s.right, s.max_disparity)
+    m = depth_metrics(s.calib.depth_from_disparity(disp), gt_depth(s.gt, s.calib))
+    assert m.median_rel_err == pytest.approx(2.18, abs=0.05)
+    assert m.share_off_5pct == pytest.approx(17.5, abs=0.3)
+    assert m.rmse_pct == pytest.approx(6.1, abs=0.3)
+    assert m.density == pytest.approx(50.0, abs=1.0)
+    # terrace: Z = 711.499 px * 0.0599432 m / d -> a few metres
+    r = table1_report(s.calib.depth_from_disparity(disp), gt_depth(s.gt, s.calib), n_points=5)
+    assert 1.0 < r.mean_distance < 20.0

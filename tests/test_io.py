@@ -1,0 +1,284 @@
+"""Tests of stereovision.io: images, PFM, PLY, scenes (values asserted)."""
+
+from __future__ import annotations
+
+import os
+import struct
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
+from stereovision.calibration import Calibration
+from stereovision.io import (
+    atomic_write,
+    find_scenes,
+    imread,
+    load_scene,
+    read_pfm,
+    read_ply,
+    scene_max_disparity,
+    write_pfm,
+    write_ply,
+)
+
+# evaluation.md "Reference figures": max_disparity per scene.
+TABLE_MAX_DISPARITY = {
+    "eth3d/playground": 32,
+    "eth3d/terrace": 32,
+    "kitti2015/000005_10": 112,
+    "middeval3/teddyH": 128,
+    "middlebury2001/tsukuba": 16,
+    "middlebury2001/venus": 32,
+    "middlebury2003/cones": 64,
+    "middlebury2003/teddy": 64,
+    "middlebury2005/art": 96,
+    "middlebury2005/books": 96,
+    "middlebury2005/dolls": 96,
+    "middlebury2005/laundry": 96,
+    "middlebury2005/moebius": 80,
+    "middlebury2005/reindeer": 80,
+    "middlebury2006/cloth3": 96,
+    "middlebury2006/wood2": 128,
+    "tartanair/oldtown_easy_p000_001116": 48,
+}
+
+
+# ------------------------------------------------------------------------------------- imread
+
+
+def test_imread_colour_and_gray(tmp_path: Path) -> None:
+    img = np.zeros((4, 5, 3), np.uint8)
+    img[1, 2] = (10, 20, 30)  # B, G, R
+    path = tmp_path / "a.png"
+    assert cv2.imwrite(str(path), img)
+    got = imread(path)
+    assert got.dtype == np.uint8 and got.shape == (4, 5, 3)
+    np.testing.assert_array_equal(got, img)
+    gray = imread(path, gray=True)
+    assert gray.shape == (4, 5)
+    # BT.601: 0.114 B + 0.587 G + 0.299 R = 1.14 + 11.74 + 8.97 = 21.85 -> 22
+    assert gray[1, 2] == 22
+
+
+def test_imread_missing(tmp_path: Path) -> None:
+    with pytest.raises(FileNotFoundError, match=r"nope\.png"):
+        imread(tmp_path / "nope.png")
+
+
+def test_imread_garbage(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.png"
+    bad.write_bytes(b"this is not an image")
+    with pytest.raises(ValueError, match="cannot decode"):
+        imread(bad)
+    empty = tmp_path / "empty.png"
+    empty.write_bytes(b"")
+    with pytest.raises(ValueError, match="cannot decode"):
+        imread(empty)
+
+
+# ---------------------------------------------------------------------------------------- PFM
+
+
+def _pfm_bytes(arr: np.ndarray, little: bool) -> bytes:
+    """Independent PFM encoder (bottom-up rows) used as the oracle."""
+    magic = b"PF" if arr.ndim == 3 else b"Pf"
+    h, w = arr.shape[:2]
+    dt = "<f4" if little else ">f4"
+    scale = b"-1.0" if little else b"1.0"
+    return magic + f"\n{w} {h}\n".encode() + scale + b"\n" + arr[::-1].astype(dt).tobytes()
+
+
+def test_read_pfm_orientation_and_endianness(tmp_path: Path) -> None:
+    arr = np.arange(6, dtype=np.float32).reshape(2, 3)  # row 0 = top = [0, 1, 2]
+    for little in (True, False):
+        p = tmp_path / f"x{little}.pfm"
+        p.write_bytes(_pfm_bytes(arr, little))
+        got = read_pfm(p)
+        assert got.dtype == np.float32 and got.dtype.isnative
+        np.testing.assert_array_equal(got, arr)
+    # the first stored row is the bottom one
+    raw = (tmp_path / "xTrue.pfm").read_bytes()
+    assert struct.unpack("<f", raw[-12:-8])[0] == 0.0  # last stored row = top row [0, 1, 2]
+
+
+def test_pfm_colour_round_trip(tmp_path: Path) -> None:
+    arr = np.random.default_rng(1).standard_normal((3, 4, 3)).astype(np.float32)
+    write_pfm(tmp_path / "c.pfm", arr, little_endian=False)
+    assert (tmp_path / "c.pfm").read_bytes().startswith(b"PF\n4 3\n1.0\n")
+    np.testing.assert_array_equal(read_pfm(tmp_path / "c.pfm"), arr)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    arr=hnp.arrays(
+        np.float32,
+        hnp.array_shapes(min_dims=2, max_dims=2, min_side=1, max_side=7),
+        elements=st.floats(width=32, allow_nan=True, allow_infinity=True),
+    ),
+    little=st.booleans(),
+)
+def test_pfm_round_trip_bit_exact(tmp_path_factory: pytest.TempPathFactory, arr, little) -> None:
+    p = tmp_path_factory.mktemp("pfm") / "r.pfm"
+    write_pfm(p, arr, little_endian=little)
+    got = read_pfm(p)
+    assert got.shape == arr.shape
+    assert got.tobytes() == arr.astype(np.float32).tobytes()  # NaN/inf bits included
+
+
+def test_pfm_errors(tmp_path: Path) -> None:
+    with pytest.raises(FileNotFoundError):
+        read_pfm(tmp_path / "none.pfm")
+    (tmp_path / "bad.pfm").write_bytes(b"P5\n2 2\n255\n....")
+    with pytest.raises(ValueError, match="not a PFM"):
+        read_pfm(tmp_path / "bad.pfm")
+    (tmp_path / "short.pfm").write_bytes(b"Pf\n4 4\n-1.0\n" + b"\0" * 12)
+    with pytest.raises(ValueError, match="truncated"):
+        read_pfm(tmp_path / "short.pfm")
+    with pytest.raises(ValueError, match=r"\(H, W\)"):
+        write_pfm(tmp_path / "w.pfm", np.zeros((2, 2, 2), np.float32))
+
+
+def test_read_shared_gt(data_dir: Path) -> None:
+    gt = read_pfm(data_dir / "middlebury2001" / "tsukuba" / "gt_disp.pfm")
+    assert gt.shape == (288, 384)
+    finite = gt[np.isfinite(gt)]
+    assert finite.max() == 14.0
+    assert np.count_nonzero(np.isinf(gt)) == 22896
+
+
+# ------------------------------------------------------------------------------------- atomic
+
+
+def test_atomic_write_leaves_old_file_on_error(tmp_path: Path) -> None:
+    dest = tmp_path / "f.bin"
+    dest.write_bytes(b"old")
+    with pytest.raises(RuntimeError), atomic_write(dest) as fh:
+        fh.write(b"new")
+        raise RuntimeError("boom")
+    assert dest.read_bytes() == b"old"
+    assert os.listdir(tmp_path) == ["f.bin"]  # no temporary file left behind
+    with atomic_write(dest) as fh:
+        fh.write(b"new")
+    assert dest.read_bytes() == b"new"
+    with pytest.raises(FileNotFoundError, match="does not exist"):
+        write_pfm(tmp_path / "missing_dir" / "x.pfm", np.zeros((1, 1), np.float32))
+
+
+# ---------------------------------------------------------------------------------------- PLY
+
+
+def test_ply_round_trip_with_colours(tmp_path: Path) -> None:
+    rng = np.random.default_rng(0)
+    pts = rng.standard_normal((50, 3)).astype(np.float32)
+    cols = rng.integers(0, 256, (50, 3), dtype=np.uint8)
+    pts[7] = np.nan
+    n = write_ply(tmp_path / "c.ply", pts, cols)
+    assert n == 49
+    raw = (tmp_path / "c.ply").read_bytes()
+    header, body = raw.split(b"end_header\n")
+    assert b"format binary_little_endian 1.0" in header
+    assert b"element vertex 49" in header
+    assert b"property uchar red" in header
+    assert len(body) == 49 * (3 * 4 + 3)
+    got_p, got_c = read_ply(tmp_path / "c.ply")
+    keep = np.arange(50) != 7
+    np.testing.assert_array_equal(got_p, pts[keep])
+    assert got_c is not None
+    np.testing.assert_array_equal(got_c, cols[keep])
+    # first vertex, decoded by hand
+    x, y, z, r, g, b = struct.unpack("<fffBBB", body[:15])
+    assert (x, y, z) == tuple(pts[0].tolist()) and (r, g, b) == tuple(cols[0].tolist())
+
+
+def test_ply_without_colours_and_image_shaped(tmp_path: Path) -> None:
+    pts = np.arange(2 * 3 * 3, dtype=np.float64).reshape(2, 3, 3)
+    assert write_ply(tmp_path / "p.ply", pts) == 6
+    got, cols = read_ply(tmp_path / "p.ply")
+    assert cols is None
+    np.testing.assert_array_equal(got, pts.reshape(-1, 3).astype(np.float32))
+    assert write_ply(tmp_path / "k.ply", np.full((2, 3), np.nan), drop_invalid=False) == 2
+
+
+def test_ply_errors(tmp_path: Path) -> None:
+    (tmp_path / "g.ply").write_bytes(b"\x00\x01garbage")
+    with pytest.raises(ValueError, match="not a PLY file"):
+        read_ply(tmp_path / "g.ply")
+    with pytest.raises(FileNotFoundError):
+        read_ply(tmp_path / "none.ply")
+    with pytest.raises(ValueError, match="points"):
+        write_ply(tmp_path / "x.ply", np.zeros((4, 2)))
+    with pytest.raises(ValueError, match="colors"):
+        write_ply(tmp_path / "x.ply", np.zeros((4, 3)), np.zeros((4, 3), np.float32))
+    with pytest.raises(ValueError, match="colors"):
+        write_ply(tmp_path / "x.ply", np.zeros((4, 3)), np.zeros((3, 3), np.uint8))
+    assert not (tmp_path / "x.ply").exists()
+
+
+# ------------------------------------------------------------------------------------- scenes
+
+
+def test_scene_max_disparity_rule() -> None:
+    gt = np.array([[np.nan, 14.0], [np.inf, 3.0]], np.float32)
+    gt[1, 0] = np.nan
+    assert scene_max_disparity(gt, width=100) == 16  # 1.1 * 14 = 15.4 -> 16
+    assert scene_max_disparity(np.array([[14.6]]), width=100) == 32  # 16.06 -> 32
+    assert scene_max_disparity(None, width=100, ndisp=70) == 80
+    assert scene_max_disparity(None, width=100) == 32  # 100 // 4 = 25 -> 32
+    assert scene_max_disparity(np.full((2, 2), np.nan), width=320) == 80
+
+
+def test_find_scenes(data_dir: Path) -> None:
+    scenes = find_scenes(data_dir)
+    names = [f"{p.parent.name}/{p.name}" for p in scenes]
+    assert names == sorted(names)
+    assert set(TABLE_MAX_DISPARITY) <= set(names)
+    assert all((p / "left.png").is_file() and (p / "right.png").is_file() for p in scenes)
+    assert "opencv_uncalibrated/books" not in names  # .jpg pair, not a scene
+    with pytest.raises(FileNotFoundError):
+        find_scenes(data_dir / "nope")
+
+
+def test_load_scene_tsukuba(data_dir: Path) -> None:
+    s = load_scene(data_dir / "middlebury2001" / "tsukuba")
+    assert s.name == "middlebury2001/tsukuba"
+    assert s.left.shape == (288, 384, 3) and s.left.dtype == np.uint8
+    assert s.gt is not None and s.gt.dtype == np.float32
+    assert not np.isinf(s.gt).any()
+    assert np.isnan(s.gt).sum() == 22896  # the file's +inf became NaN
+    assert s.calib is None
+    assert s.max_disparity == 16
+
+
+def test_load_scene_with_calib(data_dir: Path) -> None:
+    s = load_scene(data_dir / "eth3d" / "terrace")
+    assert isinstance(s.calib, Calibration)
+    assert s.calib.unit == "mm" and s.calib.baseline == pytest.approx(59.9432)
+    assert s.calib.image_size == (713, 434)
+
+
+def test_max_disparity_matches_evaluation_table(data_dir: Path) -> None:
+    for name, expected in TABLE_MAX_DISPARITY.items():
+        assert load_scene(data_dir / name).max_disparity == expected, name
+
+
+def test_load_scene_errors(tmp_path: Path) -> None:
+    with pytest.raises(FileNotFoundError):
+        load_scene(tmp_path / "none")
+    with pytest.raises(FileNotFoundError, match=r"left\.png"):
+        load_scene(tmp_path)
+    img = np.zeros((4, 6, 3), np.uint8)
+    cv2.imwrite(str(tmp_path / "left.png"), img)
+    cv2.imwrite(str(tmp_path / "right.png"), img[:, :5])
+    with pytest.raises(ValueError, match="differ in size"):
+        load_scene(tmp_path)
+    cv2.imwrite(str(tmp_path / "right.png"), img)
+    write_pfm(tmp_path / "gt_disp.pfm", np.zeros((3, 6), np.float32))
+    with pytest.raises(ValueError, match=r"gt_disp\.pfm"):
+        load_scene(tmp_path)
+    (tmp_path / "gt_disp.pfm").unlink()
+    s = load_scene(tmp_path)
+    assert s.gt is None and s.max_disparity == 16
