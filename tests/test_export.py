@@ -1,0 +1,136 @@
+"""Exports: coloured PLY (pyvista-readable), organised PCD, NPZ bundle, and their errors."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+import synthetic_scene as syn
+from stereovision import export
+
+
+@pytest.fixture(scope="module")
+def result():
+    return syn.depth_result()
+
+
+def test_cloud_ply_read_by_pyvista(result, tmp_path):
+    pv = pytest.importorskip("pyvista")
+    path = export.write_cloud_ply(tmp_path / "cloud.ply", result)
+    cloud = pv.read(path)
+    assert cloud.n_points == len(result.points) == syn.W * syn.H - 100
+    np.testing.assert_array_equal(np.asarray(cloud.points), result.points)
+    np.testing.assert_array_equal(np.asarray(cloud.point_data["RGB"]), result.colors)
+    header = path.read_bytes()[:200]
+    assert b"format binary_little_endian 1.0" in header
+    assert b"property uchar red" in header
+
+
+def test_mesh_ply_read_by_pyvista(result, tmp_path):
+    pv = pytest.importorskip("pyvista")
+    from stereovision.render import surface_mesh
+
+    mesh = surface_mesh(result, step=2)
+    path = export.write_mesh_ply(tmp_path / "mesh.ply", mesh)
+    back = pv.read(path)
+    assert back.n_points == mesh.n_points
+    assert back.n_cells == mesh.n_cells > 0
+    np.testing.assert_array_equal(np.asarray(back.faces), np.asarray(mesh.faces))
+    np.testing.assert_array_equal(np.asarray(back.point_data["RGB"]), mesh.point_data["RGB"])
+
+
+def test_open3d_reads_ply_and_pcd(result, tmp_path):
+    o3d = pytest.importorskip("open3d")
+    ply = o3d.io.read_point_cloud(str(export.write_cloud_ply(tmp_path / "c.ply", result)))
+    assert len(ply.points) == len(result.points)
+    pcd = o3d.io.read_point_cloud(str(export.write_pcd(tmp_path / "c.pcd", result)))
+    assert np.isfinite(np.asarray(pcd.points)).all(axis=1).sum() == len(result.points)
+
+
+def test_pcd_keeps_image_layout(result, tmp_path):
+    path = export.write_pcd(tmp_path / "cloud.pcd", result)
+    head = path.read_bytes()[:400].decode("ascii", errors="replace")
+    assert f"WIDTH {syn.W}\n" in head
+    assert f"HEIGHT {syn.H}\n" in head
+    assert f"POINTS {syn.W * syn.H}\n" in head
+    pts, cols = export.read_pcd(path)
+    assert pts.shape == (syn.H, syn.W, 3)
+    assert np.isnan(pts[syn.HOLE]).all()  # missing points stay NaN at their pixel
+    assert pts[60, 80, 2] == pytest.approx(syn.BOX_Z)  # box centre
+    assert pts[5, 150, 2] == pytest.approx(syn.WALL_Z)
+    x, y = result.pixels[:, 0], result.pixels[:, 1]
+    np.testing.assert_array_equal(pts[y, x], result.points)
+    np.testing.assert_array_equal(cols, result.left_rectified[..., ::-1])
+
+
+def test_pcd_rgb_is_packed_like_pcl():
+    packed = export._pack_rgb(np.array([[255, 0, 0], [0, 128, 1]], np.uint8))
+    assert packed.view("<u4").tolist() == [0xFF0000, 0x008001]
+    np.testing.assert_array_equal(export._unpack_rgb(packed), [[255, 0, 0], [0, 128, 1]])
+
+
+def test_npz_bundle(result, tmp_path):
+    data = export.read_npz(export.write_npz(tmp_path / "d.npz", result))
+    np.testing.assert_array_equal(data["depth"], result.depth)
+    np.testing.assert_array_equal(data["confidence"], result.confidence)
+    np.testing.assert_array_equal(data["disparity"], result.disparity)
+    np.testing.assert_allclose(data["K"], [[syn.F, 0, syn.CX], [0, syn.F, syn.CY], [0, 0, 1]])
+    assert data["baseline"] == pytest.approx(syn.B)
+    assert data["doffs"] == 0.0
+    assert data["image_size"].tolist() == [syn.W, syn.H]
+    assert data["method"] == "gabor"
+    # The bundle alone rebuilds the cloud.
+    pts, cols = export.load_cloud(tmp_path / "d.npz")
+    assert cols is None
+    np.testing.assert_allclose(pts, result.points, rtol=1e-6, atol=1e-6)
+
+
+def test_export_result_writes_all(result, tmp_path):
+    written = export.export_result(result, tmp_path / "out")
+    assert set(written) == {"cloud.ply", "cloud.pcd", "depth.npz"}
+    assert all(p.is_file() and p.stat().st_size > 0 for p in written.values())
+    for name in ("cloud.ply", "cloud.pcd"):
+        pts, _ = export.load_cloud(written[name])
+        assert len(pts) == len(result.points)
+    with pytest.raises(ValueError, match="unknown export format"):
+        export.export_result(result, tmp_path, ("obj",))
+
+
+def test_no_calibration_no_cloud(result, tmp_path):
+    bare = replace(result, depth=None, calibration=None)
+    with pytest.raises(ValueError, match="without a calibration"):
+        export.write_cloud_ply(tmp_path / "c.ply", bare)
+    with pytest.raises(ValueError, match="without a calibration"):
+        export.write_pcd(tmp_path / "c.pcd", bare)
+    data = export.read_npz(export.write_npz(tmp_path / "d.npz", bare))
+    assert np.isnan(data["depth"]).all() and np.isnan(data["K"]).all()
+
+
+def test_load_cloud_errors(tmp_path):
+    fake = tmp_path / "fake.ply"
+    fake.write_bytes(b"\x89PNG not a ply")
+    with pytest.raises(ValueError, match="not a PLY file"):
+        export.load_cloud(fake)
+    other = tmp_path / "notes.txt"
+    other.write_text("hello")
+    with pytest.raises(ValueError, match=r"not a point cloud file \(PLY, PCD or NPZ\)"):
+        export.load_cloud(other)
+    with pytest.raises(FileNotFoundError, match="not found"):
+        export.load_cloud(tmp_path / "missing.ply")
+    from stereovision.io import write_ply
+
+    write_ply(tmp_path / "nan.ply", np.full((4, 3), np.nan, np.float32), drop_invalid=False)
+    with pytest.raises(ValueError, match="empty point cloud"):
+        export.load_cloud(tmp_path / "nan.ply")
+    trunc = tmp_path / "t.pcd"
+    trunc.write_bytes(
+        b"# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+        b"WIDTH 10\nHEIGHT 1\nPOINTS 10\nDATA binary\n" + b"\0" * 12
+    )
+    with pytest.raises(ValueError, match="truncated PCD"):
+        export.load_cloud(trunc)
+    bad_npz = tmp_path / "b.npz"
+    np.savez(bad_npz, foo=np.zeros(3))
+    with pytest.raises(ValueError, match="not a stereovision depth bundle"):
+        export.load_cloud(bad_npz)
