@@ -26,15 +26,52 @@ where
         });
 }
 
+/// Like [`for_each_row`] for two buffers of the same shape written together (`f(y, row_a, row_b)`).
+pub fn for_each_row2<A, B, F>(a: &mut [A], b: &mut [B], width: usize, f: F)
+where
+    A: Send,
+    B: Send,
+    F: Fn(usize, &mut [A], &mut [B]) + Sync,
+{
+    if width == 0 {
+        return;
+    }
+    let n = width * ROWS_PER_TASK;
+    a.par_chunks_mut(n)
+        .zip(b.par_chunks_mut(n))
+        .enumerate()
+        .for_each(|(band, (ca, cb))| {
+            for (i, (ra, rb)) in ca.chunks_mut(width).zip(cb.chunks_mut(width)).enumerate() {
+                f(band * ROWS_PER_TASK + i, ra, rb);
+            }
+        });
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
     fn visits_every_row_once() {
         let w = 3;
         let mut buf = vec![0usize; w * 37];
-        super::for_each_row(&mut buf, w, |y, row| row.iter_mut().for_each(|v| *v += y + 1));
+        super::for_each_row(&mut buf, w, |y, row| {
+            row.iter_mut().for_each(|v| *v += y + 1)
+        });
         for (y, row) in buf.chunks(w).enumerate() {
             assert!(row.iter().all(|&v| v == y + 1));
         }
+        let mut a = vec![0usize; w * 37];
+        let mut b = vec![0usize; w * 37];
+        super::for_each_row2(&mut a, &mut b, w, |y, ra, rb| {
+            ra.iter_mut().for_each(|v| *v = y);
+            rb.iter_mut().for_each(|v| *v = 2 * y);
+        });
+        assert!(a
+            .chunks(w)
+            .enumerate()
+            .all(|(y, r)| r.iter().all(|&v| v == y)));
+        assert!(b
+            .chunks(w)
+            .enumerate()
+            .all(|(y, r)| r.iter().all(|&v| v == 2 * y)));
     }
 }

@@ -2,27 +2,215 @@
 
 use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
-use stereovision_core::matching::gabor::{gabor_disparity as core_gabor, GaborParams};
+use stereovision_core::matching::gabor::{
+    gabor_disparity as core_gabor, gabor_newton_step as core_step, gabor_responses as core_resp,
+    post::lr_check, GaborParams,
+};
+use stereovision_core::Image;
 
 use crate::convert::{image_from_numpy, image_to_numpy};
 use crate::errors::guard;
 
+type Pair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>);
+
+/// Builds the core parameters from the keyword arguments (defaults mirror `GaborParams::default`).
+#[allow(clippy::too_many_arguments)]
+fn params(
+    d_min: f32,
+    d_max: f32,
+    freq: f32,
+    orientations_deg: Vec<f32>,
+    bandwidth_oct: f32,
+    aspect: f32,
+    n_levels: Option<usize>,
+    iters_per_level: usize,
+    amp_rel_thresh: f32,
+    stability_tau: f32,
+    conf_min: f32,
+    research_radius: usize,
+    search_pool_radius: usize,
+    lr_check: bool,
+    lr_tol: f32,
+    speckle_size: usize,
+    speckle_range: f32,
+) -> GaborParams {
+    GaborParams {
+        d_min,
+        d_max,
+        freq,
+        orientations_deg,
+        bandwidth_oct,
+        aspect,
+        n_levels,
+        iters_per_level,
+        amp_rel_thresh,
+        stability_tau,
+        conf_min,
+        research_radius,
+        search_pool_radius,
+        lr_check,
+        lr_tol,
+        speckle_size,
+        speckle_range,
+    }
+}
+
+fn to_image(w: usize, h: usize, data: Vec<f32>) -> Image {
+    Image {
+        width: w,
+        height: h,
+        data,
+    }
+}
+
 /// Dense Gabor phase disparity. Returns `(disparity, confidence)`, float32 (H, W).
 #[pyfunction]
-#[pyo3(signature = (left, right, d_min, d_max))]
+#[pyo3(signature = (
+    left, right, d_min, d_max, *, freq=0.25, orientations_deg=None, bandwidth_oct=1.0, aspect=1.0,
+    n_levels=None, iters_per_level=2, amp_rel_thresh=0.02, stability_tau=1.25, conf_min=0.15,
+    research_radius=2, search_pool_radius=2, lr_check=true, lr_tol=1.0, speckle_size=0,
+    speckle_range=1.0
+))]
+#[allow(clippy::too_many_arguments)]
 pub fn gabor_disparity<'py>(
     py: Python<'py>,
     left: PyReadonlyArray2<'py, f32>,
     right: PyReadonlyArray2<'py, f32>,
     d_min: f32,
     d_max: f32,
-) -> PyResult<(Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>)> {
+    freq: f32,
+    orientations_deg: Option<Vec<f32>>,
+    bandwidth_oct: f32,
+    aspect: f32,
+    n_levels: Option<usize>,
+    iters_per_level: usize,
+    amp_rel_thresh: f32,
+    stability_tau: f32,
+    conf_min: f32,
+    research_radius: usize,
+    search_pool_radius: usize,
+    lr_check: bool,
+    lr_tol: f32,
+    speckle_size: usize,
+    speckle_range: f32,
+) -> PyResult<Pair<'py>> {
     let l = image_from_numpy(&left, "left")?;
     let r = image_from_numpy(&right, "right")?;
-    let params = GaborParams { d_min, d_max };
-    let out = py.detach(|| guard("gabor_disparity", || core_gabor(&l, &r, &params)))?;
+    let p = params(
+        d_min,
+        d_max,
+        freq,
+        orientations_deg.unwrap_or_else(|| GaborParams::default().orientations_deg),
+        bandwidth_oct,
+        aspect,
+        n_levels,
+        iters_per_level,
+        amp_rel_thresh,
+        stability_tau,
+        conf_min,
+        research_radius,
+        search_pool_radius,
+        lr_check,
+        lr_tol,
+        speckle_size,
+        speckle_range,
+    );
+    let out = py.detach(|| guard("gabor_disparity", || core_gabor(&l, &r, &p)))?;
     Ok((
         image_to_numpy(py, out.disparity)?,
         image_to_numpy(py, out.confidence)?,
     ))
+}
+
+/// Complex response `y = h * img` of one zero-DC Gabor channel, as `(re, im)` float32 (H, W).
+#[pyfunction]
+#[pyo3(signature = (img, freq=0.25, theta_deg=0.0, bandwidth_oct=1.0, aspect=1.0))]
+pub fn gabor_responses<'py>(
+    py: Python<'py>,
+    img: PyReadonlyArray2<'py, f32>,
+    freq: f32,
+    theta_deg: f32,
+    bandwidth_oct: f32,
+    aspect: f32,
+) -> PyResult<Pair<'py>> {
+    let im = image_from_numpy(&img, "img")?;
+    let (w, h) = im.size();
+    let (re, imag) = py.detach(|| {
+        guard("gabor_responses", || {
+            core_resp(&im, freq, theta_deg, bandwidth_oct, aspect)
+        })
+    })?;
+    Ok((
+        image_to_numpy(py, to_image(w, h, re))?,
+        image_to_numpy(py, to_image(w, h, imag))?,
+    ))
+}
+
+/// One raw Newton step at full resolution for a given disparity map: `(delta, conf)` before
+/// smoothing (parity tests of the phase-difference / local-frequency / confidence stage).
+#[pyfunction]
+#[pyo3(signature = (
+    left, right, disp, *, freq=0.25, orientations_deg=None, bandwidth_oct=1.0, aspect=1.0,
+    amp_rel_thresh=0.02, stability_tau=1.25
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn gabor_newton_step<'py>(
+    py: Python<'py>,
+    left: PyReadonlyArray2<'py, f32>,
+    right: PyReadonlyArray2<'py, f32>,
+    disp: PyReadonlyArray2<'py, f32>,
+    freq: f32,
+    orientations_deg: Option<Vec<f32>>,
+    bandwidth_oct: f32,
+    aspect: f32,
+    amp_rel_thresh: f32,
+    stability_tau: f32,
+) -> PyResult<Pair<'py>> {
+    let l = image_from_numpy(&left, "left")?;
+    let r = image_from_numpy(&right, "right")?;
+    let d = image_from_numpy(&disp, "disp")?;
+    let (w, h) = l.size();
+    let p = GaborParams {
+        freq,
+        orientations_deg: orientations_deg
+            .unwrap_or_else(|| GaborParams::default().orientations_deg),
+        bandwidth_oct,
+        aspect,
+        amp_rel_thresh,
+        stability_tau,
+        ..GaborParams::default()
+    };
+    let (delta, conf) = py.detach(|| guard("gabor_newton_step", || core_step(&l, &r, &d, &p)))?;
+    Ok((
+        image_to_numpy(py, to_image(w, h, delta))?,
+        image_to_numpy(py, to_image(w, h, conf))?,
+    ))
+}
+
+/// Left-right consistency mask: `True` where `|d_l(x) - d_r(round(x - d_l(x)))| <= tol`.
+#[pyfunction]
+#[pyo3(signature = (disp_left, disp_right, tol=1.0))]
+pub fn gabor_lr_check<'py>(
+    py: Python<'py>,
+    disp_left: PyReadonlyArray2<'py, f32>,
+    disp_right: PyReadonlyArray2<'py, f32>,
+    tol: f32,
+) -> PyResult<Bound<'py, PyArray2<bool>>> {
+    // NaN is allowed here (it means "no estimate"), so no Image validation of finiteness.
+    let a = disp_left.as_array();
+    let b = disp_right.as_array();
+    if a.dim() != b.dim() {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "disp_left {:?} and disp_right {:?} differ in shape",
+            a.dim(),
+            b.dim()
+        )));
+    }
+    let (h, w) = a.dim();
+    let dl: Vec<f32> = a.iter().copied().collect();
+    let dr: Vec<f32> = b.iter().copied().collect();
+    let ok = py.detach(|| lr_check(&dl, &dr, w, h, tol));
+    let arr = numpy::ndarray::Array2::from_shape_vec((h, w), ok)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+    Ok(numpy::IntoPyArray::into_pyarray(arr, py))
 }

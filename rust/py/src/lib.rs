@@ -14,5 +14,8 @@ mod gabor;
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add_function(wrap_pyfunction!(gabor::gabor_disparity, m)?)?;
+    m.add_function(wrap_pyfunction!(gabor::gabor_responses, m)?)?;
+    m.add_function(wrap_pyfunction!(gabor::gabor_newton_step, m)?)?;
+    m.add_function(wrap_pyfunction!(gabor::gabor_lr_check, m)?)?;
     Ok(())
 }

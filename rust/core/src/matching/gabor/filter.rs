@@ -1,0 +1,363 @@
+//! Quadrature Gabor filter bank: separable complex kernels, zero-DC correction, reflect borders.
+//!
+//! The kernel of one channel is `h(x, y) = g(x) g(y) exp(j (kx x + ky y)) - c g(x) g(y)` with
+//! normalised 1-D Gaussians `g`, and `c = sum of the carrier-modulated kernel` (Morlet correction,
+//! algorithms.md A.1) so `sum h = 0` exactly on the truncated discrete kernel. Because the carrier
+//! factors into an x-part and a y-part, `h * I = hx *_x (hy *_y I) - c (G * I)`: a complex row pass
+//! (shared by +-theta, which have the same `kx`), a complex column pass per channel, and one real
+//! Gaussian `G * I` shared by every channel. True convolution (not correlation) fixes the phase
+//! sign: for `I = cos(w x)` the response phase grows as `+w x`.
+
+use crate::error::{CoreError, Result};
+use crate::parallel::for_each_row;
+use std::f32::consts::PI;
+
+/// Half-amplitude half-width factor of a Gaussian spectrum: `a = sqrt(ln 2 / 2) / (pi sigma)`.
+const HALF_WIDTH_FACTOR: f64 = 0.187_390_5; // sqrt(ln(2)/2)/pi
+/// Kernel truncation in standard deviations (the Gaussian is 0.011 of its peak there).
+pub const TRUNCATE_SIGMAS: f32 = 3.0;
+
+/// `sigma` (px) of the spatial envelope giving a radial bandwidth of `bandwidth_oct` octaves at
+/// centre frequency `freq` (cycles/px): `sigma = a0 (2^b + 1) / ((2^b - 1) F)`.
+pub fn sigma_from_bandwidth(freq: f32, bandwidth_oct: f32) -> f32 {
+    let b = 2f64.powf(bandwidth_oct as f64);
+    (HALF_WIDTH_FACTOR * (b + 1.0) / ((b - 1.0) * freq as f64)) as f32
+}
+
+/// Truncation radius of a Gaussian of std `sigma`.
+pub fn radius_for(sigma: f32) -> usize {
+    (TRUNCATE_SIGMAS * sigma).ceil().max(1.0) as usize
+}
+
+/// Normalised (sum 1) sampled Gaussian of std `sigma`, taps `-r..=r`.
+pub fn gaussian_taps(sigma: f32, r: usize) -> Vec<f32> {
+    let s = sigma as f64;
+    let raw: Vec<f64> = (-(r as isize)..=r as isize)
+        .map(|t| (-((t * t) as f64) / (2.0 * s * s)).exp())
+        .collect();
+    let sum: f64 = raw.iter().sum();
+    raw.iter().map(|v| (v / sum) as f32).collect()
+}
+
+/// One channel of the bank (one orientation at one centre frequency).
+#[derive(Debug, Clone)]
+pub struct Channel {
+    /// Orientation of the frequency vector from the x-axis (degrees).
+    pub theta_deg: f32,
+    /// Angular carrier frequency along x and y (rad/px).
+    pub kx: f32,
+    pub ky: f32,
+    /// Envelope standard deviations (px): `sigma_x = aspect * sigma`, `sigma_y = sigma`.
+    pub sigma_x: f32,
+    pub sigma_y: f32,
+    /// Real Gaussian taps along x and y (sum 1).
+    pub gx: Vec<f32>,
+    pub gy: Vec<f32>,
+    /// Complex taps `g(t) exp(j k t)` along x and y, as (re, im), index `t + r`.
+    pub hx: Vec<[f32; 2]>,
+    pub hy: Vec<[f32; 2]>,
+    /// Zero-DC coefficient `c = sum_t hx(t) * sum_t hy(t)` (complex).
+    pub dc: [f32; 2],
+}
+
+impl Channel {
+    /// Builds the channel `(freq, theta_deg)` with radial bandwidth `bandwidth_oct` and envelope
+    /// aspect ratio `aspect` (`sigma_x / sigma_y`).
+    pub fn new(freq: f32, theta_deg: f32, bandwidth_oct: f32, aspect: f32) -> Result<Self> {
+        if !(freq.is_finite() && freq > 0.0 && freq < 0.5) {
+            return Err(CoreError::param(
+                "freq",
+                format!("must be in (0, 0.5) cycles/px, got {freq}"),
+            ));
+        }
+        if !(bandwidth_oct.is_finite() && bandwidth_oct > 0.05 && bandwidth_oct <= 4.0) {
+            return Err(CoreError::param(
+                "bandwidth_oct",
+                format!("must be in (0.05, 4] octaves, got {bandwidth_oct}"),
+            ));
+        }
+        if !(aspect.is_finite() && aspect > 0.1 && aspect <= 10.0) {
+            return Err(CoreError::param(
+                "aspect",
+                format!("must be in (0.1, 10], got {aspect}"),
+            ));
+        }
+        if !(theta_deg.is_finite() && theta_deg.abs() < 90.0) {
+            return Err(CoreError::param(
+                "orientations_deg",
+                format!("each must be in (-90, 90) degrees (needs a horizontal carrier), got {theta_deg}"),
+            ));
+        }
+        let sigma = sigma_from_bandwidth(freq, bandwidth_oct);
+        let (sigma_x, sigma_y) = (aspect * sigma, sigma);
+        let th = (theta_deg as f64).to_radians();
+        let k = 2.0 * std::f64::consts::PI * freq as f64;
+        let (kx, ky) = (k * th.cos(), k * th.sin());
+        let gx = gaussian_taps(sigma_x, radius_for(sigma_x));
+        let gy = gaussian_taps(sigma_y, radius_for(sigma_y));
+        let modulate = |g: &[f32], kk: f64| -> Vec<[f32; 2]> {
+            let r = (g.len() / 2) as f64;
+            g.iter()
+                .enumerate()
+                .map(|(i, &v)| {
+                    let t = i as f64 - r;
+                    [
+                        (v as f64 * (kk * t).cos()) as f32,
+                        (v as f64 * (kk * t).sin()) as f32,
+                    ]
+                })
+                .collect()
+        };
+        let hx = modulate(&gx, kx);
+        let hy = modulate(&gy, ky);
+        let sum = |h: &[[f32; 2]]| {
+            h.iter()
+                .fold([0f64; 2], |a, v| [a[0] + v[0] as f64, a[1] + v[1] as f64])
+        };
+        let (sx, sy) = (sum(&hx), sum(&hy));
+        let dc = [
+            (sx[0] * sy[0] - sx[1] * sy[1]) as f32,
+            (sx[0] * sy[1] + sx[1] * sy[0]) as f32,
+        ];
+        Ok(Channel {
+            theta_deg,
+            kx: kx as f32,
+            ky: ky as f32,
+            sigma_x,
+            sigma_y,
+            gx,
+            gy,
+            hx,
+            hy,
+            dc,
+        })
+    }
+
+    /// Nominal horizontal carrier (rad/px), > 0.
+    pub fn k0x(&self) -> f32 {
+        self.kx
+    }
+}
+
+/// Mirror index (reflect-101, OpenCV's default border / scipy "mirror"): `-1 -> 1`, `n -> n - 2`.
+#[inline]
+pub fn mirror(i: isize, n: usize) -> usize {
+    if n == 1 {
+        return 0;
+    }
+    let p = 2 * (n as isize - 1);
+    let mut m = i.rem_euclid(p);
+    if m >= n as isize {
+        m = p - m;
+    }
+    m as usize
+}
+
+/// Real separable convolution with reflect-101 borders (symmetric taps, so conv = correlation).
+pub fn blur_real(src: &[f32], w: usize, h: usize, gx: &[f32], gy: &[f32]) -> Vec<f32> {
+    let rx = gx.len() / 2;
+    let ry = gy.len() / 2;
+    let mut tmp = vec![0f32; w * h];
+    for_each_row(&mut tmp, w, |y, out| {
+        let row = &src[y * w..(y + 1) * w];
+        let pad: Vec<f32> = (0..w + 2 * rx)
+            .map(|i| row[mirror(i as isize - rx as isize, w)])
+            .collect();
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for (k, &g) in gx.iter().enumerate() {
+            let seg = &pad[k..k + w];
+            for (o, &p) in out.iter_mut().zip(seg) {
+                *o += g * p;
+            }
+        }
+    });
+    let mut dst = vec![0f32; w * h];
+    for_each_row(&mut dst, w, |y, out| {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for (k, &g) in gy.iter().enumerate() {
+            let yy = mirror(y as isize + k as isize - ry as isize, h);
+            let seg = &tmp[yy * w..(yy + 1) * w];
+            for (o, &p) in out.iter_mut().zip(seg) {
+                *o += g * p;
+            }
+        }
+    });
+    dst
+}
+
+/// Complex responses `y = h * I` of one image for every channel, as planar (re, im) planes,
+/// plus the shared low-pass `L = G * I` (Gaussian of the first channel; all channels share it).
+pub struct Responses {
+    pub w: usize,
+    pub h: usize,
+    /// `re[c]`, `im[c]`: planes of channel `c`.
+    pub re: Vec<Vec<f32>>,
+    pub im: Vec<Vec<f32>>,
+    pub lowpass: Vec<f32>,
+}
+
+/// Filters `img` (`w` x `h`, row-major) with every channel. All channels must share the same
+/// envelope (same frequency, bandwidth and aspect), which the bank guarantees.
+pub fn filter_bank(img: &[f32], w: usize, h: usize, chans: &[Channel]) -> Responses {
+    let lowpass = match chans.first() {
+        Some(c) => blur_real(img, w, h, &c.gx, &c.gy),
+        None => vec![0.0; w * h],
+    };
+    // Row passes are shared by channels with identical x taps (+-theta).
+    let mut groups: Vec<(Vec<[f32; 2]>, Vec<f32>, Vec<f32>)> = Vec::new();
+    let mut group_of = Vec::with_capacity(chans.len());
+    for c in chans {
+        if let Some(g) = groups.iter().position(|(hx, _, _)| *hx == c.hx) {
+            group_of.push(g);
+        } else {
+            let (re, im) = row_pass(img, w, h, &c.hx);
+            groups.push((c.hx.clone(), re, im));
+            group_of.push(groups.len() - 1);
+        }
+    }
+    let mut re_out = Vec::with_capacity(chans.len());
+    let mut im_out = Vec::with_capacity(chans.len());
+    for (c, &g) in chans.iter().zip(&group_of) {
+        let (_, hre, him) = &groups[g];
+        let (mut re, mut im) = col_pass(hre, him, w, h, &c.hy);
+        // Zero-DC correction: y = a - c L.
+        let [cr, ci] = c.dc;
+        for ((r, i), &l) in re.iter_mut().zip(im.iter_mut()).zip(&lowpass) {
+            *r -= cr * l;
+            *i -= ci * l;
+        }
+        re_out.push(re);
+        im_out.push(im);
+    }
+    Responses {
+        w,
+        h,
+        re: re_out,
+        im: im_out,
+        lowpass,
+    }
+}
+
+/// Complex row pass of a real image: `H(x) = sum_t hx(t) I(x - t)`.
+fn row_pass(img: &[f32], w: usize, h: usize, hx: &[[f32; 2]]) -> (Vec<f32>, Vec<f32>) {
+    let r = hx.len() / 2;
+    let mut re = vec![0f32; w * h];
+    let mut im = vec![0f32; w * h];
+    crate::parallel::for_each_row2(&mut re, &mut im, w, |y, ore, oim| {
+        let row = &img[y * w..(y + 1) * w];
+        // pad[i] = I(i - r); output x needs I(x - t) = pad[x + r - t] = pad[x + 2r - k], k = t + r.
+        let pad: Vec<f32> = (0..w + 2 * r)
+            .map(|i| row[mirror(i as isize - r as isize, w)])
+            .collect();
+        ore.iter_mut().for_each(|v| *v = 0.0);
+        oim.iter_mut().for_each(|v| *v = 0.0);
+        for (k, &[hr, hi]) in hx.iter().enumerate() {
+            let seg = &pad[2 * r - k..2 * r - k + w];
+            for ((a, b), &p) in ore.iter_mut().zip(oim.iter_mut()).zip(seg) {
+                *a += hr * p;
+                *b += hi * p;
+            }
+        }
+    });
+    (re, im)
+}
+
+/// Complex column pass: `a(y) = sum_s hy(s) H(y - s)`.
+fn col_pass(hre: &[f32], him: &[f32], w: usize, h: usize, hy: &[[f32; 2]]) -> (Vec<f32>, Vec<f32>) {
+    let r = hy.len() / 2;
+    let real_taps = hy.iter().all(|t| t[1] == 0.0);
+    let mut re = vec![0f32; w * h];
+    let mut im = vec![0f32; w * h];
+    crate::parallel::for_each_row2(&mut re, &mut im, w, |y, ore, oim| {
+        ore.iter_mut().for_each(|v| *v = 0.0);
+        oim.iter_mut().for_each(|v| *v = 0.0);
+        for (k, &[gr, gi]) in hy.iter().enumerate() {
+            // tap s = k - r reads row y - s
+            let yy = mirror(y as isize - (k as isize - r as isize), h);
+            let sr = &hre[yy * w..(yy + 1) * w];
+            let si = &him[yy * w..(yy + 1) * w];
+            if real_taps {
+                for ((a, b), (&pr, &pi)) in
+                    ore.iter_mut().zip(oim.iter_mut()).zip(sr.iter().zip(si))
+                {
+                    *a += gr * pr;
+                    *b += gr * pi;
+                }
+            } else {
+                for ((a, b), (&pr, &pi)) in
+                    ore.iter_mut().zip(oim.iter_mut()).zip(sr.iter().zip(si))
+                {
+                    *a += gr * pr - gi * pi;
+                    *b += gr * pi + gi * pr;
+                }
+            }
+        }
+    });
+    (re, im)
+}
+
+/// Gaussian pyramid level: blur with `sigma = 1` and keep even pixels (`ceil(n / 2)`).
+pub fn pyr_down(img: &[f32], w: usize, h: usize) -> (Vec<f32>, usize, usize) {
+    let g = gaussian_taps(PYR_SIGMA, radius_for(PYR_SIGMA));
+    let b = blur_real(img, w, h, &g, &g);
+    let (w2, h2) = (w.div_ceil(2), h.div_ceil(2));
+    let mut out = vec![0f32; w2 * h2];
+    for_each_row(&mut out, w2, |y, row| {
+        let src = &b[(2 * y) * w..(2 * y + 1) * w];
+        for (x, v) in row.iter_mut().enumerate() {
+            *v = src[2 * x];
+        }
+    });
+    (out, w2, h2)
+}
+
+/// Anti-alias blur of the pyramid (algorithms.md A.5 step 1).
+pub const PYR_SIGMA: f32 = 1.0;
+
+/// Nominal angular frequency `2 pi F` (rad/px).
+pub fn angular(freq: f32) -> f32 {
+    2.0 * PI * freq
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kernel_is_zero_dc() {
+        for th in [0.0, 30.0, -30.0, 60.0, -60.0] {
+            let c = Channel::new(0.25, th, 1.0, 1.0).unwrap();
+            // Response to a constant image must vanish.
+            let img = vec![0.7f32; 40 * 30];
+            let r = filter_bank(&img, 40, 30, std::slice::from_ref(&c));
+            let m = r.re[0]
+                .iter()
+                .chain(&r.im[0])
+                .fold(0f32, |a, v| a.max(v.abs()));
+            assert!(m < 1e-6, "theta {th}: max |y| = {m}");
+            assert!(c.dc[0].abs() < 0.01 && c.dc[1].abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn phase_grows_with_x_for_a_tuned_sinusoid() {
+        let (w, h) = (64, 8);
+        let k = angular(0.25);
+        let img: Vec<f32> = (0..w * h)
+            .map(|i| 0.5 + 0.3 * (k * (i % w) as f32).cos())
+            .collect();
+        let c = Channel::new(0.25, 0.0, 1.0, 1.0).unwrap();
+        let r = filter_bank(&img, w, h, std::slice::from_ref(&c));
+        let p = |x: usize| r.im[0][4 * w + x].atan2(r.re[0][4 * w + x]);
+        let step = (p(31) - p(30) + 3.0 * PI) % (2.0 * PI) - PI;
+        assert!((step - k).abs() < 1e-3, "phase step {step}");
+    }
+
+    #[test]
+    fn mirror_index() {
+        assert_eq!(mirror(-1, 5), 1);
+        assert_eq!(mirror(5, 5), 3);
+        assert_eq!(mirror(-7, 5), 1);
+        assert_eq!(mirror(3, 1), 0);
+    }
+}

@@ -1,0 +1,427 @@
+//! Gabor-wavelet phase disparity (algorithms.md A.5 with the A.9 fixes).
+//!
+//! Pipeline per direction (left reference; the right reference is the same code on the mirrored,
+//! swapped pair):
+//! 1. Gaussian pyramids; every level filtered ONCE per image with a quadrature bank (`filter`).
+//! 2. Top level: position-shift search of the normalised binocular energy over the scaled range.
+//! 3. Every finer level: up-sample, +-`research_radius` px position-shift re-search, then
+//!    `iters_per_level` Newton steps (phase difference / local frequency, WLS over orientations,
+//!    normalised-convolution smoothing, separable 5x5 median).
+//! 4. Confidence = max over levels of the smoothed confidence; left-right check; speckle removal.
+//!
+//! Right responses are never recomputed for a warp: the smooth baseband is shifted (`level`).
+
+mod fastmath;
+pub mod filter;
+pub mod level;
+pub mod post;
+
+use crate::error::{CoreError, Result};
+use crate::image::{check_pair, Image};
+use filter::Channel;
+use level::{chan_consts, energy_terms, level_data, newton_step, LevelData};
+
+/// Parameters of the Gabor channel (defaults: algorithms.md A.3 with the A.9 fixes).
+#[derive(Debug, Clone, PartialEq)]
+pub struct GaborParams {
+    /// Smallest disparity searched (px).
+    pub d_min: f32,
+    /// Largest disparity searched (px).
+    pub d_max: f32,
+    /// Carrier frequency at every pyramid level (cycles/px).
+    pub freq: f32,
+    /// Orientations of the frequency vector from the x-axis (degrees, each in (-90, 90), <= 8).
+    pub orientations_deg: Vec<f32>,
+    /// Radial bandwidth (octaves); sets the envelope sigma.
+    pub bandwidth_oct: f32,
+    /// Envelope aspect ratio `sigma_x / sigma_y` (the paper's lambda).
+    pub aspect: f32,
+    /// Pyramid depth; `None` = automatic (A.3 rule).
+    pub n_levels: Option<usize>,
+    /// Newton iterations per level.
+    pub iters_per_level: usize,
+    /// Amplitude threshold relative to the 95th percentile of the channel's amplitude.
+    pub amp_rel_thresh: f32,
+    /// Fleet-Jepson stability threshold (in units of 1/sigma_x).
+    pub stability_tau: f32,
+    /// Minimum smoothed confidence to update / report a pixel.
+    pub conf_min: f32,
+    /// Position-shift re-search radius at each level below the top (px at that level).
+    pub research_radius: usize,
+    /// Half-size of the box over which the search energy is pooled (px at that level).
+    pub search_pool_radius: usize,
+    /// Left-right consistency check.
+    pub lr_check: bool,
+    /// Left-right tolerance (px).
+    pub lr_tol: f32,
+    /// Speckle removal: regions smaller than this many pixels are dropped (0 = off).
+    pub speckle_size: usize,
+    /// Speckle removal: neighbouring pixels within this many px belong to one region.
+    pub speckle_range: f32,
+}
+
+/// Default orientations: 0, +-30, +-60 degrees (A.9: five orientations beat three).
+pub const DEFAULT_ORIENTATIONS: [f32; 5] = [0.0, 30.0, -30.0, 60.0, -60.0];
+
+impl Default for GaborParams {
+    fn default() -> Self {
+        GaborParams {
+            d_min: 0.0,
+            d_max: 64.0,
+            freq: 0.25,
+            orientations_deg: DEFAULT_ORIENTATIONS.to_vec(),
+            bandwidth_oct: 1.0,
+            aspect: 1.0,
+            n_levels: None,
+            iters_per_level: 2,
+            // A.9: 0.1 passes only 26-57 % of correctly matched pixels.
+            amp_rel_thresh: 0.02,
+            stability_tau: 1.25,
+            conf_min: 0.15,
+            research_radius: 2,
+            search_pool_radius: 2,
+            lr_check: true,
+            lr_tol: 1.0,
+            speckle_size: 0,
+            speckle_range: 1.0,
+        }
+    }
+}
+
+/// Maximum pyramid depth accepted.
+const MAX_LEVELS: usize = 10;
+/// The automatic pyramid stops before the top level gets narrower than this (px).
+const MIN_TOP_WIDTH: usize = 32;
+/// ... or lower than this (px).
+const MIN_TOP_HEIGHT: usize = 16;
+
+impl GaborParams {
+    /// Checks every parameter; errors are [`CoreError::InvalidParameter`].
+    pub fn validate(&self) -> Result<()> {
+        let fin = |name: &'static str, v: f32| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(CoreError::param(name, format!("must be finite, got {v}")))
+            }
+        };
+        fin("d_min", self.d_min)?;
+        fin("d_max", self.d_max)?;
+        if self.d_max <= self.d_min {
+            return Err(CoreError::param(
+                "d_max",
+                format!("must be > d_min ({}), got {}", self.d_min, self.d_max),
+            ));
+        }
+        if self.orientations_deg.is_empty() || self.orientations_deg.len() > 8 {
+            return Err(CoreError::param(
+                "orientations_deg",
+                format!(
+                    "needs 1 to 8 orientations, got {}",
+                    self.orientations_deg.len()
+                ),
+            ));
+        }
+        // Channel::new validates freq, bandwidth, aspect and each orientation.
+        if let Some(n) = self.n_levels {
+            if n == 0 || n > MAX_LEVELS {
+                return Err(CoreError::param(
+                    "n_levels",
+                    format!("must be in 1..={MAX_LEVELS}, got {n}"),
+                ));
+            }
+        }
+        if self.iters_per_level > 20 {
+            return Err(CoreError::param("iters_per_level", "must be <= 20"));
+        }
+        let unit = |name: &'static str, v: f32| {
+            if v.is_finite() && (0.0..=1.0).contains(&v) {
+                Ok(())
+            } else {
+                Err(CoreError::param(
+                    name,
+                    format!("must be in [0, 1], got {v}"),
+                ))
+            }
+        };
+        unit("amp_rel_thresh", self.amp_rel_thresh)?;
+        unit("conf_min", self.conf_min)?;
+        if !(self.stability_tau.is_finite() && self.stability_tau > 0.0) {
+            return Err(CoreError::param("stability_tau", "must be finite and > 0"));
+        }
+        if self.research_radius > 16 || self.search_pool_radius > 16 {
+            return Err(CoreError::param(
+                "research_radius",
+                "radii must be <= 16 px",
+            ));
+        }
+        if !(self.lr_tol.is_finite() && self.lr_tol >= 0.0) {
+            return Err(CoreError::param("lr_tol", "must be finite and >= 0"));
+        }
+        if !(self.speckle_range.is_finite() && self.speckle_range >= 0.0) {
+            return Err(CoreError::param("speckle_range", "must be finite and >= 0"));
+        }
+        Ok(())
+    }
+
+    /// The filter bank (one channel per orientation).
+    pub fn channels(&self) -> Result<Vec<Channel>> {
+        self.orientations_deg
+            .iter()
+            .map(|&t| Channel::new(self.freq, t, self.bandwidth_oct, self.aspect))
+            .collect()
+    }
+
+    /// Pyramid depth for a `w` x `h` image: the smallest `L` whose top level's half-wavelength
+    /// capture range covers half the disparity range (A.3), capped by the top-level size.
+    pub fn levels_for(&self, w: usize, h: usize) -> usize {
+        if let Some(n) = self.n_levels {
+            return n;
+        }
+        let half_range = 0.5 * (self.d_max - self.d_min);
+        let mut l = 1;
+        while l < MAX_LEVELS && (0.5 / self.freq) * 2f32.powi(l as i32 - 1) < half_range {
+            let (tw, th) = (w >> l, h >> l);
+            if tw < MIN_TOP_WIDTH || th < MIN_TOP_HEIGHT {
+                break;
+            }
+            l += 1;
+        }
+        l
+    }
+}
+
+/// Output of the Gabor channel: disparity (`NaN` = no estimate) and confidence in `[0, 1]`.
+#[derive(Debug, Clone)]
+pub struct GaborOutput {
+    pub disparity: Image,
+    pub confidence: Image,
+}
+
+/// Raw result of one direction: disparity (every pixel) and max-over-levels confidence.
+struct Direction {
+    disp: Vec<f32>,
+    conf: Vec<f32>,
+}
+
+/// Dense phase-based disparity of a rectified pair.
+///
+/// `left`, `right`: grey `f32` images in `[0, 1]` of the same size. Returns the disparity
+/// `x_left - x_right` at left pixels (`NaN` where not confident or inconsistent) and the
+/// confidence (0 where `NaN`). A textureless pair gives an all-`NaN` map, not an error.
+pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Result<GaborOutput> {
+    check_pair(left, right)?;
+    params.validate()?;
+    let chans = params.channels()?;
+    let (w, h) = left.size();
+    let (fwd, bwd) = if params.lr_check {
+        let fl = post::flip_x(&right.data, w, h);
+        let fr = post::flip_x(&left.data, w, h);
+        let (a, b) = rayon::join(
+            || one_direction(&left.data, &right.data, w, h, params, &chans),
+            || one_direction(&fl, &fr, w, h, params, &chans),
+        );
+        (a, Some(b))
+    } else {
+        (
+            one_direction(&left.data, &right.data, w, h, params, &chans),
+            None,
+        )
+    };
+    let mut disp = fwd.disp;
+    let mut conf = fwd.conf;
+    let lr_ok = bwd.map(|b| {
+        let dr = post::flip_x(&b.disp, w, h);
+        post::lr_check(&disp, &dr, w, h, params.lr_tol)
+    });
+    for i in 0..w * h {
+        let x = (i % w) as f32;
+        let s = x - disp[i];
+        let valid = conf[i] >= params.conf_min
+            && s >= 0.0
+            && s <= (w - 1) as f32
+            && lr_ok.as_ref().is_none_or(|v| v[i]);
+        if !valid {
+            disp[i] = f32::NAN;
+        }
+    }
+    post::remove_speckles(&mut disp, w, h, params.speckle_size, params.speckle_range);
+    for (c, d) in conf.iter_mut().zip(&disp) {
+        *c = if d.is_finite() {
+            c.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+    }
+    Ok(GaborOutput {
+        disparity: Image {
+            width: w,
+            height: h,
+            data: disp,
+        },
+        confidence: Image {
+            width: w,
+            height: h,
+            data: conf,
+        },
+    })
+}
+
+/// Coarse-to-fine estimate with `l` as reference.
+fn one_direction(
+    l: &[f32],
+    r: &[f32],
+    w: usize,
+    h: usize,
+    p: &GaborParams,
+    chans: &[Channel],
+) -> Direction {
+    let n_levels = p.levels_for(w, h);
+    let mut pyr: Vec<(Vec<f32>, Vec<f32>, usize, usize)> = vec![(l.to_vec(), r.to_vec(), w, h)];
+    for _ in 1..n_levels {
+        let Some((pl, pr, pw, ph)) = pyr.last() else {
+            break;
+        };
+        if *pw < 2 || *ph < 2 {
+            break;
+        }
+        let (nl, nw, nh) = filter::pyr_down(pl, *pw, *ph);
+        let (nr, _, _) = filter::pyr_down(pr, *pw, *ph);
+        pyr.push((nl, nr, nw, nh));
+    }
+    let tau = p.stability_tau;
+    let sigma_s = chans.first().map_or(1.0, |c| c.sigma_x);
+    let mut state: Option<(Vec<f32>, Vec<f32>, usize, usize)> = None;
+    let timing = std::env::var_os("SV_GABOR_TIMING").is_some();
+    let mut t0 = std::time::Instant::now();
+    let mut lap = |what: &str, lvl: usize| {
+        if timing {
+            eprintln!(
+                "  L{lvl} {what}: {:.1} ms",
+                t0.elapsed().as_secs_f64() * 1e3
+            );
+            t0 = std::time::Instant::now();
+        }
+    };
+    lap("pyramid", 0);
+    for (lvl, (il, ir, lw, lh)) in pyr.iter().enumerate().rev() {
+        let (lw, lh) = (*lw, *lh);
+        let scale = 0.5f32.powi(lvl as i32);
+        let (lo, hi) = (p.d_min * scale - 1.0, p.d_max * scale + 1.0);
+        let (ld, rd) = rayon::join(
+            || level_data(il, lw, lh, chans, tau, false),
+            || level_data(ir, lw, lh, chans, tau, true),
+        );
+        let cc = chan_consts(chans, &ld, &rd, p.amp_rel_thresh);
+        lap("filter", lvl);
+        let (mut disp, mut conf_max) = match state.take() {
+            None => {
+                let init = vec![p.d_min * scale; lw * lh];
+                let n = ((p.d_max - p.d_min) * scale).ceil().max(0.0) as usize;
+                let offs: Vec<f32> = (0..=n).map(|k| k as f32).collect();
+                (
+                    search(&ld, &rd, &cc, &init, &offs, p.search_pool_radius),
+                    vec![0.0; lw * lh],
+                )
+            }
+            Some((d, c, sw, sh)) => {
+                let d = post::upsample(&d, sw, sh, lw, lh, 2.0);
+                let c = post::upsample(&c, sw, sh, lw, lh, 1.0);
+                let rr = p.research_radius as i32;
+                let d = if rr > 0 {
+                    let offs: Vec<f32> = (-rr..=rr).map(|k| k as f32).collect();
+                    search(&ld, &rd, &cc, &d, &offs, p.search_pool_radius)
+                } else {
+                    d
+                };
+                (d, c)
+            }
+        };
+        disp.iter_mut().for_each(|d| *d = d.clamp(lo, hi));
+        lap("search", lvl);
+        for _ in 0..p.iters_per_level {
+            let (delta, c) = newton_step(&ld, &rd, &cc, &disp);
+            lap("newton", lvl);
+            let (dbar, cbar) = post::normalized_conv(&delta, &c, lw, lh, sigma_s);
+            post::apply_update(&mut disp, &dbar, &cbar, p.conf_min, lo, hi, lw);
+            lap("nc", lvl);
+            disp = post::median5(&disp, lw, lh);
+            post::max_into(&mut conf_max, &cbar);
+            lap("median", lvl);
+        }
+        state = Some((disp, conf_max, lw, lh));
+    }
+    match state {
+        Some((disp, conf, _, _)) => Direction { disp, conf },
+        None => Direction {
+            disp: vec![f32::NAN; w * h],
+            conf: vec![0.0; w * h],
+        },
+    }
+}
+
+/// Position-shift search: for each pixel, the offset in `offs` (added to `base`) maximising the
+/// box-pooled normalised energy `sum 2 Re(y_l conj y_r) / sum (|y_l|^2 + |y_r|^2)` (A.9: the
+/// raw energy favours high-contrast positions). Ties keep the first offset.
+fn search(
+    l: &LevelData,
+    r: &LevelData,
+    cc: &[level::ChanConst],
+    base: &[f32],
+    offs: &[f32],
+    pool: usize,
+) -> Vec<f32> {
+    let (w, h) = (l.w, l.h);
+    let mut best = vec![f32::NEG_INFINITY; w * h];
+    let mut out = base.to_vec();
+    for &o in offs {
+        let (num, den) = energy_terms(l, r, cc, base, o);
+        let num = post::box_sum(&num, w, h, pool);
+        let den = post::box_sum(&den, w, h, pool);
+        for i in 0..w * h {
+            let e = if den[i] > 0.0 { num[i] / den[i] } else { 0.0 };
+            if e > best[i] {
+                best[i] = e;
+                out[i] = base[i] + o;
+            }
+        }
+    }
+    out
+}
+
+/// Filter-bank responses of one image for one channel (debugging and parity tests):
+/// the complex response `y = h * I` as `(re, im)` planes, row-major `(h, w)`.
+pub fn gabor_responses(
+    img: &Image,
+    freq: f32,
+    theta_deg: f32,
+    bandwidth_oct: f32,
+    aspect: f32,
+) -> Result<(Vec<f32>, Vec<f32>)> {
+    let c = Channel::new(freq, theta_deg, bandwidth_oct, aspect)?;
+    let r = filter::filter_bank(&img.data, img.width, img.height, std::slice::from_ref(&c));
+    let (mut re, mut im) = (r.re, r.im);
+    Ok((re.pop().unwrap_or_default(), im.pop().unwrap_or_default()))
+}
+
+/// One raw Newton step at the full resolution for a given disparity map (parity tests): returns
+/// the per-pixel WLS update `delta` and mean channel confidence `c`, before any smoothing.
+pub fn gabor_newton_step(
+    left: &Image,
+    right: &Image,
+    disp: &Image,
+    params: &GaborParams,
+) -> Result<(Vec<f32>, Vec<f32>)> {
+    check_pair(left, right)?;
+    check_pair(left, disp)?;
+    params.validate()?;
+    let chans = params.channels()?;
+    let (w, h) = left.size();
+    let ld = level_data(&left.data, w, h, &chans, params.stability_tau, false);
+    let rd = level_data(&right.data, w, h, &chans, params.stability_tau, true);
+    let cc = chan_consts(&chans, &ld, &rd, params.amp_rel_thresh);
+    Ok(newton_step(&ld, &rd, &cc, &disp.data))
+}
+
+#[cfg(test)]
+mod tests;

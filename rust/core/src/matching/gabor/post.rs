@@ -1,0 +1,228 @@
+//! Image-domain helpers of the matcher: normalised convolution, median, up-sampling, LR check.
+
+use super::filter::{blur_real, gaussian_taps, radius_for};
+use crate::parallel::for_each_row;
+
+/// Normalised-convolution smoothing (A.5 step 3h): `cbar = G * c`, `dbar = G * (c d) / cbar`.
+pub fn normalized_conv(
+    delta: &[f32],
+    conf: &[f32],
+    w: usize,
+    h: usize,
+    sigma: f32,
+) -> (Vec<f32>, Vec<f32>) {
+    let g = gaussian_taps(sigma, radius_for(sigma));
+    let cd: Vec<f32> = delta.iter().zip(conf).map(|(d, c)| d * c).collect();
+    let cbar = blur_real(conf, w, h, &g, &g);
+    let num = blur_real(&cd, w, h, &g, &g);
+    let dbar = num
+        .iter()
+        .zip(&cbar)
+        .map(|(n, c)| if *c > NC_EPS { n / c } else { 0.0 })
+        .collect();
+    (dbar, cbar)
+}
+
+/// Denominator floor of the normalised convolution (A.5 step 3h).
+const NC_EPS: f32 = 1e-6;
+
+#[inline(always)]
+fn cas(a: &mut f32, b: &mut f32) {
+    let (lo, hi) = (a.min(*b), a.max(*b));
+    *a = lo;
+    *b = hi;
+}
+
+/// Median of five (branch-free compare-and-swap network).
+#[inline(always)]
+fn med5(mut a: f32, mut b: f32, mut c: f32, mut d: f32, mut e: f32) -> f32 {
+    cas(&mut a, &mut b);
+    cas(&mut d, &mut e);
+    cas(&mut a, &mut d);
+    cas(&mut b, &mut e);
+    cas(&mut b, &mut c);
+    cas(&mut c, &mut d);
+    cas(&mut b, &mut c);
+    c
+}
+
+/// Separable 5x5 median (5x1 median of the 1x5 medians), clamped borders. Cheaper than the exact
+/// 5x5 median (two 5-networks instead of a 25-sort) with the same job here: removing isolated
+/// disparity outliers after each Newton step.
+pub fn median5(src: &[f32], w: usize, h: usize) -> Vec<f32> {
+    let mut tmp = vec![0f32; w * h];
+    for_each_row(&mut tmp, w, |y, row| {
+        let s = &src[y * w..(y + 1) * w];
+        for (x, v) in row.iter_mut().enumerate() {
+            let at = |dx: isize| s[(x as isize + dx).clamp(0, w as isize - 1) as usize];
+            *v = med5(at(-2), at(-1), at(0), at(1), at(2));
+        }
+    });
+    let mut out = vec![0f32; w * h];
+    for_each_row(&mut out, w, |y, row| {
+        let r = |dy: isize| {
+            let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
+            &tmp[yy * w..(yy + 1) * w]
+        };
+        let (a, b, c, d, e) = (r(-2), r(-1), r(0), r(1), r(2));
+        for (x, v) in row.iter_mut().enumerate() {
+            *v = med5(a[x], b[x], c[x], d[x], e[x]);
+        }
+    });
+    out
+}
+
+/// Bilinear sample of `src` (`w` x `h`) at `(x, y)`, clamped to the image.
+#[inline]
+fn bilinear(src: &[f32], w: usize, h: usize, x: f32, y: f32) -> f32 {
+    let x = x.clamp(0.0, (w - 1) as f32);
+    let y = y.clamp(0.0, (h - 1) as f32);
+    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
+    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
+    let (tx, ty) = (x - x0 as f32, y - y0 as f32);
+    let a = src[y0 * w + x0] + tx * (src[y0 * w + x1] - src[y0 * w + x0]);
+    let b = src[y1 * w + x0] + tx * (src[y1 * w + x1] - src[y1 * w + x0]);
+    a + ty * (b - a)
+}
+
+/// Up-samples a coarse map to `(w, h)` (pixel `x` at the fine level is `x / 2` at the coarse one),
+/// multiplying values by `scale` (2 for disparities, 1 for confidences).
+pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f32) -> Vec<f32> {
+    let mut out = vec![0f32; w * h];
+    for_each_row(&mut out, w, |y, row| {
+        for (x, v) in row.iter_mut().enumerate() {
+            *v = scale * bilinear(src, sw, sh, x as f32 * 0.5, y as f32 * 0.5);
+        }
+    });
+    out
+}
+
+/// Box sum over a `(2r+1)^2` window with clamped borders, computed per output row (no running
+/// sums across rows, so bands are independent and results thread-count invariant).
+pub fn box_sum(src: &[f32], w: usize, h: usize, r: usize) -> Vec<f32> {
+    let mut tmp = vec![0f32; w * h];
+    for_each_row(&mut tmp, w, |y, row| {
+        row.iter_mut().for_each(|v| *v = 0.0);
+        for dy in -(r as isize)..=r as isize {
+            let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
+            for (v, s) in row.iter_mut().zip(&src[yy * w..(yy + 1) * w]) {
+                *v += s;
+            }
+        }
+    });
+    let mut out = vec![0f32; w * h];
+    for_each_row(&mut out, w, |y, row| {
+        let s = &tmp[y * w..(y + 1) * w];
+        for (x, v) in row.iter_mut().enumerate() {
+            let mut a = 0.0;
+            for dx in -(r as isize)..=r as isize {
+                a += s[(x as isize + dx).clamp(0, w as isize - 1) as usize];
+            }
+            *v = a;
+        }
+    });
+    out
+}
+
+/// Left-right consistency (A.5 step 5): left pixel `x` keeps its value only if the right map at
+/// `round(x - d)` agrees within `tol` px. `dr` is on the right grid, in `x_L - x_R` convention.
+pub fn lr_check(dl: &[f32], dr: &[f32], w: usize, h: usize, tol: f32) -> Vec<bool> {
+    let mut ok = vec![false; w * h];
+    for_each_row(&mut ok, w, |y, row| {
+        for (x, v) in row.iter_mut().enumerate() {
+            let d = dl[y * w + x];
+            let xr = (x as f32 - d).round();
+            *v = d.is_finite()
+                && xr >= 0.0
+                && xr <= (w - 1) as f32
+                && (d - dr[y * w + xr as usize]).abs() <= tol;
+        }
+    });
+    ok
+}
+
+/// Mirrors a row-major image left-right.
+pub fn flip_x(src: &[f32], w: usize, h: usize) -> Vec<f32> {
+    let mut out = vec![0f32; w * h];
+    for_each_row(&mut out, w, |y, row| {
+        for (x, v) in row.iter_mut().enumerate() {
+            *v = src[y * w + (w - 1 - x)];
+        }
+    });
+    out
+}
+
+/// Removes 4-connected regions of valid pixels smaller than `min_size` whose neighbours differ by
+/// at most `max_diff` px (OpenCV's `filterSpeckles` rule). Sequential flood fill; the result is
+/// deterministic. NaN marks invalid pixels.
+pub fn remove_speckles(disp: &mut [f32], w: usize, h: usize, min_size: usize, max_diff: f32) {
+    if min_size == 0 {
+        return;
+    }
+    let mut label = vec![0u32; w * h];
+    let mut next = 1u32;
+    let mut stack = Vec::new();
+    let mut region = Vec::new();
+    for start in 0..w * h {
+        if label[start] != 0 || !disp[start].is_finite() {
+            continue;
+        }
+        region.clear();
+        stack.push(start);
+        label[start] = next;
+        while let Some(p) = stack.pop() {
+            region.push(p);
+            let (x, y) = (p % w, p / w);
+            let dp = disp[p];
+            let mut visit = |q: usize| {
+                if label[q] == 0 && disp[q].is_finite() && (disp[q] - dp).abs() <= max_diff {
+                    label[q] = next;
+                    stack.push(q);
+                }
+            };
+            if x > 0 {
+                visit(p - 1);
+            }
+            if x + 1 < w {
+                visit(p + 1);
+            }
+            if y > 0 {
+                visit(p - w);
+            }
+            if y + 1 < h {
+                visit(p + w);
+            }
+        }
+        if region.len() < min_size {
+            for &p in &region {
+                disp[p] = f32::NAN;
+            }
+        }
+        next += 1;
+    }
+}
+
+/// Sets `out[i] = max(out[i], other[i])`.
+pub fn max_into(out: &mut [f32], other: &[f32]) {
+    out.iter_mut().zip(other).for_each(|(a, b)| *a = a.max(*b));
+}
+
+/// Applies `disp += dbar` where `cbar >= conf_min`, clamping to `[lo, hi]`.
+pub fn apply_update(
+    disp: &mut [f32],
+    dbar: &[f32],
+    cbar: &[f32],
+    conf_min: f32,
+    lo: f32,
+    hi: f32,
+    w: usize,
+) {
+    for_each_row(disp, w, |y, row| {
+        for (x, d) in row.iter_mut().enumerate() {
+            let i = y * w + x;
+            if cbar[i] >= conf_min {
+                *d = (*d + dbar[i]).clamp(lo, hi);
+            }
+        }
+    });
+}

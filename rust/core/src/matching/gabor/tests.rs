@@ -1,0 +1,142 @@
+use super::*;
+
+/// Band-limited random texture (sum of sinusoids) sampled at `x + shift`: an exact sub-pixel shift.
+fn texture(w: usize, h: usize, shift: f32, seed: u64) -> Image {
+    let mut s = seed;
+    let mut rnd = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 33) as f32) / (1u64 << 31) as f32
+    };
+    let comps: Vec<(f32, f32, f32, f32)> = (0..60)
+        .map(|_| {
+            let f = 0.03 + 0.3 * rnd();
+            let th = std::f32::consts::PI * (rnd() - 0.5);
+            (
+                f * th.cos(),
+                f * th.sin(),
+                2.0 * std::f32::consts::PI * rnd(),
+                0.5 + rnd(),
+            )
+        })
+        .collect();
+    let norm: f32 = comps.iter().map(|c| c.3).sum();
+    let data = (0..w * h)
+        .map(|i| {
+            let (x, y) = ((i % w) as f32 + shift, (i / w) as f32);
+            let v: f32 = comps
+                .iter()
+                .map(|&(u, v, p, a)| a * (2.0 * std::f32::consts::PI * (u * x + v * y) + p).cos())
+                .sum();
+            0.5 + 0.4 * v / norm * 3.0
+        })
+        .map(|v: f32| v.clamp(0.0, 1.0))
+        .collect();
+    Image::new(w, h, data).unwrap()
+}
+
+fn median_of_finite(v: &[f32]) -> (f32, usize) {
+    let mut f: Vec<f32> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    f.sort_by(|a, b| a.total_cmp(b));
+    (f.get(f.len() / 2).copied().unwrap_or(f32::NAN), f.len())
+}
+
+#[test]
+fn recovers_sign_and_magnitude_of_a_subpixel_shift() {
+    for &d in &[2.3f32, 0.6, 7.75] {
+        let left = texture(96, 64, 0.0, 7);
+        // right(x) = left(x + d)
+        let right = texture(96, 64, d, 7);
+        let p = GaborParams {
+            d_min: 0.0,
+            d_max: 16.0,
+            ..GaborParams::default()
+        };
+        let out = gabor_disparity(&left, &right, &p).unwrap();
+        let (med, n) = median_of_finite(&out.disparity.data);
+        assert!(n > 96 * 64 / 2, "density too low: {n}");
+        assert!((med - d).abs() < 0.05, "d = {d}, median = {med}");
+    }
+}
+
+#[test]
+fn negative_range_is_supported() {
+    let left = texture(96, 64, 0.0, 3);
+    let right = texture(96, 64, -3.4, 3);
+    let p = GaborParams {
+        d_min: -8.0,
+        d_max: 8.0,
+        ..GaborParams::default()
+    };
+    let out = gabor_disparity(&left, &right, &p).unwrap();
+    let (med, _) = median_of_finite(&out.disparity.data);
+    assert!((med + 3.4).abs() < 0.05, "median = {med}");
+}
+
+#[test]
+fn textureless_pair_gives_all_nan() {
+    let a = Image::filled(64, 48, 0.5);
+    let out = gabor_disparity(&a, &a, &GaborParams::default()).unwrap();
+    assert!(out.disparity.data.iter().all(|v| v.is_nan()));
+    assert!(out.confidence.data.iter().all(|&v| v == 0.0));
+}
+
+#[test]
+fn bad_parameters_are_errors() {
+    let a = Image::filled(16, 16, 0.5);
+    let bad = [
+        GaborParams {
+            d_max: 0.0,
+            ..GaborParams::default()
+        },
+        GaborParams {
+            d_min: f32::NAN,
+            ..GaborParams::default()
+        },
+        GaborParams {
+            freq: 0.7,
+            ..GaborParams::default()
+        },
+        GaborParams {
+            orientations_deg: vec![],
+            ..GaborParams::default()
+        },
+        GaborParams {
+            orientations_deg: vec![90.0],
+            ..GaborParams::default()
+        },
+        GaborParams {
+            n_levels: Some(0),
+            ..GaborParams::default()
+        },
+        GaborParams {
+            conf_min: 2.0,
+            ..GaborParams::default()
+        },
+    ];
+    for p in bad {
+        assert!(
+            matches!(
+                gabor_disparity(&a, &a, &p),
+                Err(CoreError::InvalidParameter { .. })
+            ),
+            "{p:?}"
+        );
+    }
+    let b = Image::filled(17, 16, 0.5);
+    assert!(matches!(
+        gabor_disparity(&a, &b, &GaborParams::default()),
+        Err(CoreError::SizeMismatch { .. })
+    ));
+}
+
+#[test]
+fn tiny_images_do_not_panic() {
+    for (w, h) in [(1, 1), (2, 1), (1, 5), (3, 3), (9, 2)] {
+        let a = texture(w, h, 0.0, 1);
+        let b = texture(w, h, 0.5, 1);
+        let out = gabor_disparity(&a, &b, &GaborParams::default()).unwrap();
+        assert_eq!(out.disparity.data.len(), w * h);
+    }
+}
