@@ -100,7 +100,8 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
 def _to_unit_float(arr: np.ndarray, name: str) -> npt.NDArray[np.float32]:
     """Scale a validated image array to float32 in [0, 1] (channels untouched)."""
     if arr.dtype in _INT_FULL_SCALE:
-        return arr.astype(np.float32) * np.float32(1.0 / _INT_FULL_SCALE[arr.dtype])
+        # divide (not multiply by the reciprocal) so that full scale maps to exactly 1.0
+        return arr.astype(np.float32) / np.float32(_INT_FULL_SCALE[arr.dtype])
     out = arr.astype(np.float32)
     if not np.isfinite(out).all():
         n_bad = int(np.count_nonzero(~np.isfinite(out)))

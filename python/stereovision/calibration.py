@@ -206,7 +206,7 @@ class Calibration:
                     "rectified pair shares focal length and image rows"
                 )
         if self.doffs is not None:
-            expected = self.K2[0, 2] - self.K1[0, 2]
+            expected = float(self.K2[0, 2] - self.K1[0, 2])
             if abs(self.doffs - expected) > DOFFS_TOL_PX:
                 raise ValueError(
                     f"doffs: {self.doffs!r} differs from cx2 - cx1 = {expected!r} (K2, K1)"
@@ -298,7 +298,7 @@ class Calibration:
                 self.D2,
                 self.image_size,
                 self.R,
-                self.T,
+                self.T.reshape(3, 1),
                 flags=cv2.CALIB_ZERO_DISPARITY,
                 alpha=float(alpha),
             )

@@ -1,0 +1,420 @@
+"""Tests of stereovision.calibration: validation, file round trips, dataset parsers, Q, rectify."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from stereovision.calibration import Calibration, parse_kitti_calib, parse_middlebury_calib
+
+SIZE = (320, 240)
+
+
+def raw_calib(**overrides: object) -> Calibration:
+    """An unrectified, distorted synthetic rig: 12 cm baseline, slight toe-in, metres."""
+    fields: dict[str, object] = {
+        "K1": np.array([[300.0, 0.0, 161.3], [0.0, 302.0, 118.7], [0.0, 0.0, 1.0]]),
+        "D1": np.array([-0.12, 0.05, 0.001, -0.0005, -0.01]),
+        "K2": np.array([[305.0, 0.0, 158.2], [0.0, 306.5, 121.4], [0.0, 0.0, 1.0]]),
+        "D2": np.array([-0.10, 0.03, -0.0008, 0.0007, 0.0]),
+        "R": cv2.Rodrigues(np.array([0.01, -0.03, 0.004]))[0],
+        "T": np.array([-0.12, 0.002, 0.003]),
+        "image_size": SIZE,
+        "unit": "m",
+    }
+    fields.update(overrides)
+    return Calibration(**fields)  # type: ignore[arg-type]
+
+
+def rect_calib(**overrides: object) -> Calibration:
+    K = np.array([[500.0, 0.0, 160.0], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]])
+    fields: dict[str, object] = {
+        "K1": K,
+        "D1": np.zeros(5),
+        "K2": K,
+        "D2": np.zeros(5),
+        "R": np.eye(3),
+        "T": np.array([-100.0, 0.0, 0.0]),
+        "image_size": SIZE,
+        "unit": "mm",
+        "rectified": True,
+    }
+    fields.update(overrides)
+    return Calibration(**fields)  # type: ignore[arg-type]
+
+
+# ----------------------------------------------------------------------------------- validation
+
+
+def test_valid_calibration_properties() -> None:
+    c = raw_calib()
+    assert c.K1.dtype == np.float64 and c.T.shape == (3,)
+    assert not c.K1.flags.writeable  # cached maps cannot go stale
+    assert c.baseline == pytest.approx(np.sqrt(0.12**2 + 0.002**2 + 0.003**2))
+    assert c.baseline_m == c.baseline and c.to_metres_factor == 1.0
+    r = rect_calib()
+    assert r.baseline == 100.0 and r.baseline_m == pytest.approx(0.1)
+    assert r.to_metres_factor == 1e-3 and r.focal_px == 500.0 and r.doffs_px == 0.0
+    assert rect_calib(unit="ft").baseline_m == pytest.approx(30.48)
+    # OpenCV-shaped inputs: (1, 5) distortion and (3, 1) translation
+    c2 = raw_calib(D1=np.zeros((1, 5)), T=np.array([[-0.12], [0.0], [0.0]]))
+    assert c2.D1.shape == (5,) and c2.T.shape == (3,)
+    for n in (4, 8, 12, 14):
+        assert raw_calib(D2=np.zeros(n)).D2.shape == (n,)
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("K1", np.full((3, 3), np.nan), "K1: contains NaN"),
+        ("K2", np.diag([0.0, 300.0, 1.0]), "K2: focal lengths must be positive"),
+        ("K1", np.diag([-300.0, 300.0, 1.0]), "K1: focal lengths must be positive"),
+        ("K1", np.eye(2), r"K1: expected shape \(3, 3\)"),
+        ("K1", np.array([[300.0, 0, 160], [0, 300, 120], [0, 0, 2]]), "K1: expected a camera"),
+        ("D1", np.zeros(6), r"D1: expected shape \(4,\) or \(5,\)"),
+        ("D2", np.array([np.inf, 0, 0, 0, 0]), "D2: contains NaN or inf"),
+        ("R", 2 * np.eye(3), "R: not a rotation"),
+        ("R", np.diag([1.0, 1.0, -1.0]), r"R: not a rotation.*det = -1"),
+        ("R", np.eye(3) + 1e-4, "R: not a rotation"),
+        ("T", np.zeros(3), "T: zero baseline"),
+        ("T", np.array([np.nan, 0, 0]), "T: contains NaN"),
+        ("T", np.zeros(2), r"T: expected shape \(3,\)"),
+        ("image_size", (0, 240), "image_size: expected positive integers"),
+        ("image_size", (320.5, 240), "image_size: expected positive integers"),
+        ("image_size", 320, r"image_size: expected \(width, height\)"),
+        ("unit", "furlong", "unit: expected one of"),
+        ("rectified", "yes", "rectified: expected a bool"),
+        ("doffs", 3.0, "doffs: only applies to a rectified"),
+    ],
+)
+def test_bad_values_name_the_field(field: str, value: object, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        raw_calib(**{field: value})
+
+
+@pytest.mark.parametrize(
+    ("overrides", "message"),
+    [
+        ({"R": cv2.Rodrigues(np.array([0.0, 0.01, 0.0]))[0]}, "R: a rectified calibration"),
+        ({"T": np.array([-100.0, 1.0, 0.0])}, r"T: a rectified calibration needs T = \(-B"),
+        ({"T": np.array([100.0, 0.0, 0.0])}, "T: T\\[0\\] must be negative"),
+        ({"D1": np.array([0.1, 0, 0, 0, 0])}, "D1: a rectified calibration has no distortion"),
+        ({"K2": np.array([[510.0, 0, 160], [0, 500, 120], [0, 0, 1]])}, "K2: fx"),
+        ({"doffs": 4.0}, r"doffs: 4.0 differs from cx2 - cx1 = 0.0"),
+        ({"doffs": float("nan")}, "doffs: expected a finite number"),
+    ],
+)
+def test_bad_rectified_values(overrides: dict[str, object], message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        rect_calib(**overrides)
+
+
+def test_doffs_derived_from_principal_points() -> None:
+    K2 = np.array([[500.0, 0.0, 170.5], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]])
+    assert rect_calib(K2=K2).doffs_px == 10.5
+    assert rect_calib(K2=K2, doffs=10.5).doffs_px == 10.5
+
+
+def test_equality() -> None:
+    assert raw_calib() == raw_calib()
+    assert raw_calib() != raw_calib(unit="mm")
+    assert raw_calib() != raw_calib(T=np.array([-0.13, 0.0, 0.0]))
+
+
+# ---------------------------------------------------------------------------------- round trips
+
+
+def _bits_equal(a: Calibration, b: Calibration) -> None:
+    for name in ("K1", "D1", "K2", "D2", "R", "T"):
+        x, y = getattr(a, name), getattr(b, name)
+        assert x.shape == y.shape and x.dtype == y.dtype == np.float64, name
+        assert x.tobytes() == y.tobytes(), name  # bit-identical float64
+    assert (a.image_size, a.unit, a.rectified, a.doffs) == (
+        b.image_size,
+        b.unit,
+        b.rectified,
+        b.doffs,
+    )
+    assert a == b
+
+
+@pytest.mark.parametrize("suffix", [".yaml", ".yml", ".xml", ".json"])
+@pytest.mark.parametrize("make", [raw_calib, lambda: rect_calib(doffs=0.0, unit="in")])
+def test_save_load_round_trip_bit_identical(tmp_path: Path, suffix: str, make) -> None:
+    rng = np.random.default_rng(7)
+    c = make()
+    if not c.rectified:  # awkward float64 values that do not print short
+        c = raw_calib(D1=rng.standard_normal(8) * 1e-3, T=np.array([-0.1 / 3, 1e-17, np.pi * 1e-3]))
+    path = tmp_path / f"calib{suffix}"
+    c.save(path)
+    for loaded in (Calibration.load(path), Calibration.from_file(path)):
+        _bits_equal(c, loaded)
+    assert [p.name for p in tmp_path.iterdir()] == [path.name]  # atomic: no temp file left
+
+
+def test_yaml_readable_by_opencv(tmp_path: Path) -> None:
+    c = raw_calib()
+    c.save(tmp_path / "c.yaml")
+    text = (tmp_path / "c.yaml").read_text()
+    assert text.startswith("%YAML")
+    fs = cv2.FileStorage(str(tmp_path / "c.yaml"), cv2.FILE_STORAGE_READ)
+    assert fs.isOpened()
+    np.testing.assert_array_equal(fs.getNode("K1").mat(), c.K1)
+    np.testing.assert_array_equal(fs.getNode("R").mat(), c.R)
+    np.testing.assert_array_equal(fs.getNode("T").mat().ravel(), c.T)
+    np.testing.assert_array_equal(fs.getNode("D2").mat().ravel(), c.D2)
+    assert fs.getNode("unit").string() == "m"
+    assert int(fs.getNode("image_width").real()) == 320
+    assert int(fs.getNode("rectified").real()) == 0
+    fs.release()
+
+
+def test_json_content(tmp_path: Path) -> None:
+    rect_calib(doffs=0.0).save(tmp_path / "c.json")
+    obj = json.loads((tmp_path / "c.json").read_text())
+    assert obj["K1"][0] == [500.0, 0.0, 160.0]
+    assert obj["T"] == [-100.0, 0.0, 0.0]
+    assert (obj["unit"], obj["rectified"], obj["doffs"]) == ("mm", 1, 0.0)
+    assert (obj["image_width"], obj["image_height"]) == SIZE
+
+
+def test_load_errors(tmp_path: Path) -> None:
+    missing = tmp_path / "none.yaml"
+    for fn in (Calibration.load, Calibration.from_file, Calibration.from_middlebury):
+        with pytest.raises(FileNotFoundError, match=r"calibration file not found.*none\.yaml"):
+            fn(missing)
+    with pytest.raises(FileNotFoundError):
+        Calibration.from_kitti(missing)
+    (tmp_path / "g.txt").write_text("hello world\n")
+    with pytest.raises(ValueError, match="unrecognised calibration format"):
+        Calibration.from_file(tmp_path / "g.txt")
+    with pytest.raises(ValueError, match="not a stereovision calibration"):
+        Calibration.load(tmp_path / "g.txt")
+    (tmp_path / "b.bin").write_bytes(b"\xff\xfe\x00\x81")
+    with pytest.raises(ValueError, match="not a text calibration"):
+        Calibration.from_file(tmp_path / "b.bin")
+    rec = json.loads(json.dumps({"K1": np.eye(3).tolist()}))
+    (tmp_path / "partial.json").write_text(json.dumps(rec))
+    with pytest.raises(ValueError, match="lacks field 'image_width'"):
+        Calibration.load(tmp_path / "partial.json")
+    (tmp_path / "broken.json").write_text("{not json")
+    with pytest.raises(ValueError, match="cannot parse"):
+        Calibration.load(tmp_path / "broken.json")
+    with pytest.raises(ValueError, match=r"use \.yaml, \.yml, \.xml or \.json"):
+        raw_calib().save(tmp_path / "c.txt")
+    # invalid values inside a well-formed file are reported by field
+    raw_calib().save(tmp_path / "c.json")
+    obj = json.loads((tmp_path / "c.json").read_text())
+    obj["K1"][0][0] = -1.0
+    (tmp_path / "c.json").write_text(json.dumps(obj))
+    with pytest.raises(ValueError, match="K1: focal lengths must be positive"):
+        Calibration.load(tmp_path / "c.json")
+
+
+# --------------------------------------------------------------------------------- Middlebury
+
+
+def test_from_middlebury_terrace(data_dir: Path) -> None:
+    path = data_dir / "eth3d" / "terrace" / "calib.txt"
+    c = Calibration.from_middlebury(path)
+    np.testing.assert_array_equal(c.K1, [[711.499, 0, 376.135], [0, 711.499, 227.447], [0, 0, 1]])
+    np.testing.assert_array_equal(c.K2, c.K1)
+    np.testing.assert_array_equal(c.T, [-59.9432, 0, 0])
+    np.testing.assert_array_equal(c.R, np.eye(3))
+    assert (c.unit, c.rectified, c.doffs, c.image_size) == ("mm", True, 0.0, (713, 434))
+    assert c.baseline_m == pytest.approx(0.0599432)
+    assert c.focal_px == 711.499
+    assert Calibration.from_file(path) == c
+    v = parse_middlebury_calib(path)
+    assert v["ndisp"] == 713.0 and v["baseline"] == 59.9432
+
+
+def test_from_middlebury_with_doffs(tmp_path: Path) -> None:
+    # Middlebury 2014 style: different principal points, doffs = cx1 - cx0
+    (tmp_path / "calib.txt").write_text(
+        "cam0=[3997.684 0 1176.728; 0 3997.684 1011.728; 0 0 1]\n"
+        "cam1=[3997.684 0 1307.839; 0 3997.684 1011.728; 0 0 1]\n"
+        "doffs=131.111\nbaseline=193.001\nwidth=2964\nheight=1988\nndisp=280\nisint=0\n"
+        "vmin=31\nvmax=257\ndyavg=0.918\ndymax=1.516\n"
+    )
+    c = Calibration.from_middlebury(tmp_path / "calib.txt")
+    assert c.doffs == 131.111 and c.doffs_px == 131.111
+    assert c.Q[3, 3] == pytest.approx(131.111 / 193.001)
+    (tmp_path / "bad.txt").write_text("cam0=[1 0 0; 0 1 0]\n")
+    with pytest.raises(ValueError, match="cannot parse cam0"):
+        Calibration.from_middlebury(tmp_path / "bad.txt")
+    (tmp_path / "partial.txt").write_text("cam0=[1 0 0; 0 1 0; 0 0 1]\nbaseline=1\n")
+    with pytest.raises(ValueError, match="lacks 'cam1'"):
+        Calibration.from_middlebury(tmp_path / "partial.txt")
+
+
+# -------------------------------------------------------------------------------------- KITTI
+
+
+def test_from_kitti_shared_file(data_dir: Path) -> None:
+    path = data_dir / "kitti2015" / "000005_10" / "calib_kitti.txt"
+    c = Calibration.from_kitti(path)
+    np.testing.assert_array_equal(
+        c.K1, [[721.5377, 0, 609.5593], [0, 721.5377, 172.854], [0, 0, 1]]
+    )
+    expected_b = (4.485728e01 - -3.395242e02) / 7.215377e02  # (P2[0,3] - P3[0,3]) / f
+    assert c.T[0] == pytest.approx(-expected_b, rel=1e-12)
+    assert c.baseline_m == pytest.approx(0.5327254, abs=1e-7)
+    assert (c.unit, c.rectified, c.image_size) == ("m", True, (1242, 375))  # from left.png
+    # agrees with the Middlebury-style calib.txt of the same scene (532.725 mm)
+    mb = Calibration.from_middlebury(path.parent / "calib.txt")
+    assert c.baseline_m == pytest.approx(mb.baseline_m, abs=1e-6)
+    assert Calibration.from_file(path) == c
+    assert parse_kitti_calib(path)["T_03"][0] == -4.731050e-01
+
+
+def test_from_kitti_raw_and_object_formats(tmp_path: Path) -> None:
+    p2 = "7.2e+02 0 6.1e+02 4.5e+01 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    p3 = "7.2e+02 0 6.1e+02 -3.6e+02 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    (tmp_path / "calib_cam_to_cam.txt").write_text(
+        f"calib_time: 09-Jan-2012 13:57:47\ncorner_dist: 9.950000e-02\n"
+        f"S_rect_02: 1.242000e+03 3.750000e+02\nP_rect_02: {p2}\nP_rect_03: {p3}\n"
+    )
+    c = Calibration.from_file(tmp_path / "calib_cam_to_cam.txt")
+    assert c.image_size == (1242, 375)
+    assert c.baseline == pytest.approx(405.0 / 720.0)
+    (tmp_path / "000000.txt").write_text(f"P0: {p2}\nP1: {p3}\nP2: {p2}\nP3: {p3}\n")
+    with pytest.raises(ValueError, match="image_size"):
+        Calibration.from_kitti(tmp_path / "000000.txt")
+    c2 = Calibration.from_kitti(tmp_path / "000000.txt", image_size=(1242, 375))
+    assert c2 == c
+    (tmp_path / "short.txt").write_text("P2: 1 2 3\nP3: 1 2 3\n")
+    with pytest.raises(ValueError, match="P2 has 3 values"):
+        Calibration.from_kitti(tmp_path / "short.txt", image_size=(10, 10))
+    (tmp_path / "none.txt").write_text("P0: 1 2 3\n")
+    with pytest.raises(ValueError, match="lacks P_rect_02"):
+        Calibration.from_kitti(tmp_path / "none.txt", image_size=(10, 10))
+
+
+# ------------------------------------------------------------------------------------ Q, rectify
+
+
+def test_q_rectified_formula() -> None:
+    c = rect_calib(K2=np.array([[500.0, 0, 168.0], [0, 500.0, 120.0], [0, 0, 1]]))
+    Q = c.Q
+    np.testing.assert_array_equal(
+        Q,
+        [[1, 0, 0, -160], [0, 1, 0, -120], [0, 0, 0, 500], [0, 0, 1 / 100, 8 / 100]],
+    )
+    # a pixel with d = 42: Z = f B / (d + doffs) = 500 * 100 / 50 = 1000 mm
+    X = Q @ np.array([170.0, 130.0, 42.0, 1.0])
+    np.testing.assert_allclose(X[:3] / X[3], [20.0, 20.0, 1000.0])
+
+
+def test_q_unrectified_is_stereo_rectify_q() -> None:
+    c = raw_calib()
+    q = cv2.stereoRectify(
+        c.K1,
+        c.D1,
+        c.K2,
+        c.D2,
+        SIZE,
+        c.R,
+        c.T.reshape(3, 1),
+        flags=cv2.CALIB_ZERO_DISPARITY,
+        alpha=0,
+    )[4]
+    np.testing.assert_array_equal(c.Q, q)
+    rc = c.rectified_calibration()
+    assert rc.rectified and rc.unit == "m" and rc.image_size == SIZE
+    assert rc.baseline == pytest.approx(c.baseline, rel=1e-9)  # rectification keeps |T|
+    assert rc.doffs_px == pytest.approx(0.0, abs=1e-9)  # CALIB_ZERO_DISPARITY
+    np.testing.assert_allclose(rc.Q, q, rtol=1e-12, atol=1e-12)
+    assert c.focal_px == rc.K1[0, 0]
+    assert c.rectified_calibration() is rc  # cached
+
+
+def test_rectify_rectified_is_identity() -> None:
+    c = rect_calib()
+    left = np.zeros((240, 320, 3), np.uint8)
+    right = np.ones((240, 320), np.float32)
+    out_l, out_r = c.rectify(left, right)
+    assert out_l is left and out_r is right
+    with pytest.raises(
+        ValueError, match="left: image is 100x240, calibration image_size is 320x240"
+    ):
+        c.rectify(np.zeros((240, 100)), right)
+
+
+def _render_blobs(points_px: np.ndarray, size: tuple[int, int], sigma: float = 1.2) -> np.ndarray:
+    w, h = size
+    yy, xx = np.mgrid[0:h, 0:w].astype(np.float64)
+    img = np.zeros((h, w))
+    for x, y in points_px:
+        img += np.exp(-((xx - x) ** 2 + (yy - y) ** 2) / (2 * sigma**2))
+    return np.clip(img, 0, 1).astype(np.float32)
+
+
+def _centroid(img: np.ndarray, x: float, y: float, r: int = 4) -> tuple[float, float]:
+    x0, y0 = round(x), round(y)
+    win = img[y0 - r : y0 + r + 1, x0 - r : x0 + r + 1].astype(np.float64)
+    yy, xx = np.mgrid[y0 - r : y0 + r + 1, x0 - r : x0 + r + 1]
+    return float((win * xx).sum() / win.sum()), float((win * yy).sum() / win.sum())
+
+
+def test_rectify_raw_pair_rows_and_depth() -> None:
+    """Blobs projected through the distorted raw cameras land on equal rows after rectify(),
+    at the disparity f B / Z of rectified_calibration()."""
+    c = raw_calib()
+    gx, gy = np.meshgrid(np.linspace(-0.35, 0.35, 5), np.linspace(-0.25, 0.25, 4))
+    Z = 1.5 + 0.5 * (np.arange(gx.size) % 3)
+    pts = np.column_stack([gx.ravel() * Z, gy.ravel() * Z, Z])
+    pl = cv2.projectPoints(pts, np.zeros(3), np.zeros(3), c.K1, c.D1)[0].reshape(-1, 2)
+    pr = cv2.projectPoints(pts, cv2.Rodrigues(c.R)[0], c.T, c.K2, c.D2)[0].reshape(-1, 2)
+    left, right = _render_blobs(pl, SIZE), _render_blobs(pr, SIZE)
+    rl, rr = c.rectify(left, right)
+    assert rl.shape == left.shape and rl.dtype == np.float32
+    assert len([k for k in c._cache if k[0] == "maps"]) == 1
+    rc = c.rectified_calibration()
+    r1, r2, p1, p2, _ = c._stereo_rectify(0.0)
+    el = cv2.undistortPoints(pl.reshape(-1, 1, 2), c.K1, c.D1, R=r1, P=p1).reshape(-1, 2)
+    er = cv2.undistortPoints(pr.reshape(-1, 1, 2), c.K2, c.D2, R=r2, P=p2).reshape(-1, 2)
+    depth_rect = (pts @ r1.T)[:, 2]  # Z in the rectified left frame
+    for i in range(len(pts)):
+        xl, yl = _centroid(rl, *el[i])
+        xr, yr = _centroid(rr, *er[i])
+        assert abs(yl - yr) < 0.15, i  # same row
+        assert xl == pytest.approx(el[i, 0], abs=0.15) and yl == pytest.approx(el[i, 1], abs=0.15)
+        d = xl - xr
+        expected = rc.focal_px * rc.baseline / depth_rect[i]
+        assert d == pytest.approx(expected, abs=0.25), i
+        z = rc.depth_from_disparity(np.array([[d]]))[0, 0]
+        assert z == pytest.approx(depth_rect[i], rel=0.01)
+    rl2, _ = c.rectify(left, right)
+    np.testing.assert_array_equal(rl, rl2)
+    with pytest.raises(ValueError, match="alpha"):
+        c.rectify(left, right, alpha=2.0)
+
+
+def test_stereopi_reference_calibration(data_dir: Path) -> None:
+    """The StereoPi tutorial's cv2.stereoCalibrate output loads (unit cm) and our convention
+    X_R = R X_L + T reproduces its rectification rotations."""
+    ref = data_dir / "stereopi_rig" / "reference_calib_result"
+    c = Calibration(
+        K1=np.load(ref / "cam_mats_left.npy"),
+        D1=np.load(ref / "dist_coefs_left.npy"),
+        K2=np.load(ref / "cam_mats_right.npy"),
+        D2=np.load(ref / "dist_coefs_right.npy"),
+        R=np.load(ref / "rot_mat.npy"),
+        T=np.load(ref / "trans_vec.npy"),
+        image_size=(320, 240),
+        unit="cm",
+    )
+    assert c.baseline_m == pytest.approx(0.05396, abs=1e-5)
+    r1, r2, *_ = c._stereo_rectify(0.0)
+    # 2.4e-4 apart (another OpenCV version); R transposed or inverted rigs are 0.009 to 0.04 off
+    np.testing.assert_allclose(r1, np.load(ref / "rect_trans_left.npy"), atol=1e-3)
+    np.testing.assert_allclose(r2, np.load(ref / "rect_trans_right.npy"), atol=1e-3)
+    # their P2[0, 3] = f * Tx = -1295.248 (alpha -1): same sign and size as ours
+    rc = c.rectified_calibration(alpha=-1)
+    assert rc.K2[0, 0] * rc.T[0] == pytest.approx(
+        np.load(ref / "proj_mats_right.npy")[0, 3], abs=0.05
+    )

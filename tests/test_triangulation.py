@@ -1,0 +1,257 @@
+"""Tests of stereovision.triangulation (algorithms.md E): synthetic round trips with distortion,
+OpenCV oracles (undistortPoints, triangulatePoints, reprojectImageTo3D), degenerate cases."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+from stereovision.baselines import opencv_sgbm
+from stereovision.calibration import Calibration
+from stereovision.io import load_scene
+from stereovision.triangulation import (
+    depth_from_disparity,
+    reproject,
+    triangulate,
+    undistort_normalized,
+)
+
+SIZE = (640, 480)
+
+
+def raw_calib(unit: str = "m", scale: float = 1.0, D1=None, D2=None) -> Calibration:
+    """Unrectified rig with distortion, skew-free, 15 cm baseline, slight toe-in."""
+    return Calibration(
+        K1=np.array([[600.0, 0.0, 321.5], [0.0, 603.0, 238.2], [0.0, 0.0, 1.0]]),
+        D1=np.array([-0.21, 0.09, 0.0012, -0.0007, -0.02]) if D1 is None else D1,
+        K2=np.array([[610.0, 0.0, 316.1], [0.0, 611.5, 243.9], [0.0, 0.0, 1.0]]),
+        D2=np.array([-0.18, 0.05, -0.0009, 0.0011, 0.01]) if D2 is None else D2,
+        R=cv2.Rodrigues(np.array([0.008, -0.04, 0.005]))[0],
+        T=np.array([-0.15, 0.003, 0.004]) * scale,
+        image_size=SIZE,
+        unit=unit,
+    )
+
+
+def rect_calib(doffs: float = 0.0) -> Calibration:
+    K1 = np.array([[700.0, 0.0, 330.0], [0.0, 700.0, 240.0], [0.0, 0.0, 1.0]])
+    K2 = K1.copy()
+    K2[0, 2] += doffs
+    return Calibration(
+        K1=K1,
+        D1=np.zeros(5),
+        K2=K2,
+        D2=np.zeros(5),
+        R=np.eye(3),
+        T=np.array([-120.0, 0.0, 0.0]),
+        image_size=SIZE,
+        unit="mm",
+        rectified=True,
+        doffs=doffs,
+    )
+
+
+def scene_points(n: int = 200, seed: int = 0) -> np.ndarray:
+    """Points in front of the rig, inside both fields of view (metres)."""
+    rng = np.random.default_rng(seed)
+    z = rng.uniform(0.8, 6.0, n)
+    x = rng.uniform(-0.35, 0.35, n) * z
+    y = rng.uniform(-0.28, 0.28, n) * z
+    return np.column_stack([x, y, z])
+
+
+def project(calib: Calibration, pts_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    s = 1.0 / calib.to_metres_factor  # points in the calibration's unit
+    pl = cv2.projectPoints(pts_m * s, np.zeros(3), np.zeros(3), calib.K1, calib.D1)[0]
+    rvec = cv2.Rodrigues(calib.R)[0]
+    pr = cv2.projectPoints(pts_m * s, rvec, calib.T, calib.K2, calib.D2)[0]
+    return pl.reshape(-1, 2), pr.reshape(-1, 2)
+
+
+# ---------------------------------------------------------------------------------- undistortion
+
+
+@pytest.mark.parametrize(
+    "D",
+    [
+        np.array([-0.21, 0.09, 0.0012, -0.0007, -0.02]),  # Bouguet's 5
+        np.array([-0.21, 0.09, 0.0012, -0.0007]),  # 4
+        np.array([0.3, -0.1, 0.001, 0.002, 0.01, 0.25, -0.05, 0.02]),  # rational
+        np.array([-0.2, 0.05, 0.001, 0.0, 0.0, 0.0, 0.0, 0.0, 0.002, -0.001, 0.001, 0.0005]),
+        np.array([-0.2, 0.05, 0.001, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+    ],
+)
+def test_undistort_matches_opencv(D: np.ndarray) -> None:
+    K = np.array([[600.0, 0.0, 321.5], [0.0, 603.0, 238.2], [0.0, 0.0, 1.0]])
+    rng = np.random.default_rng(1)
+    px = np.column_stack([rng.uniform(0, 640, 300), rng.uniform(0, 480, 300)])
+    ours, ok = undistort_normalized(px, K, D)
+    assert ok.all()
+    crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 200, 1e-15)
+    ref = cv2.undistortPoints(px.reshape(-1, 1, 2), K, D, criteria=crit).reshape(-1, 2)
+    np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-9)
+    # and it inverts the forward model: re-distorting gives the pixels back
+    back = cv2.projectPoints(
+        np.column_stack([ours, np.ones(len(ours))]), np.zeros(3), np.zeros(3), K, D
+    )[0].reshape(-1, 2)
+    np.testing.assert_allclose(back, px, rtol=0, atol=1e-7)
+
+
+def test_undistort_skew() -> None:
+    K = np.array([[500.0, 2.0, 300.0], [0.0, 510.0, 200.0], [0.0, 0.0, 1.0]])
+    xy = np.array([[0.1, -0.2], [0.3, 0.05]])
+    px = (np.column_stack([xy, np.ones(2)]) @ K.T)[:, :2]
+    got, ok = undistort_normalized(px, K, np.zeros(5))
+    assert ok.all()
+    np.testing.assert_allclose(got, xy, atol=1e-14)
+
+
+def test_undistort_flags_non_convergence() -> None:
+    # barrel k1=-0.5, k2=0.1: r_d(r) peaks at 0.6 (r = 1), so r_d > 0.6 has no preimage
+    K = np.array([[300.0, 0.0, 160.0], [0.0, 300.0, 120.0], [0.0, 0.0, 1.0]])
+    D = np.array([-0.5, 0.1, 0.0, 0.0, 0.0])
+    px = np.array([[160.0 + 300 * 0.65, 120.0], [160.0 + 300 * 0.3, 120.0]])
+    xy, ok = undistort_normalized(px, K, D)
+    assert ok.tolist() == [False, True]
+    assert np.isnan(xy[0]).all() and np.isfinite(xy[1]).all()
+    with pytest.raises(ValueError, match="tilted-sensor"):
+        undistort_normalized(px, K, np.r_[np.zeros(12), 0.01, 0.0])
+
+
+# ---------------------------------------------------------------------------------- triangulate
+
+
+def test_round_trip_with_distortion() -> None:
+    c = raw_calib()
+    pts = scene_points()
+    xl, xr = project(c, pts)
+    res = triangulate(xl, xr, c)
+    assert res.valid.all() and res.unit == "m"
+    assert res.XL.shape == (200, 3) and res.XL.dtype == np.float64
+    np.testing.assert_allclose(res.XL, pts, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(res.XR, pts @ c.R.T + c.T, rtol=1e-9, atol=1e-9)
+
+
+def test_units_metres_by_default_and_feet() -> None:
+    pts = scene_points(20, seed=2)
+    c_mm = raw_calib(unit="mm", scale=1000.0)  # same rig, T in millimetres
+    xl, xr = project(c_mm, pts)
+    np.testing.assert_allclose(triangulate(xl, xr, c_mm).XL, pts, rtol=1e-9)
+    ft = triangulate(xl, xr, c_mm, unit="ft")
+    assert ft.unit == "ft"
+    np.testing.assert_allclose(ft.XL, pts / 0.3048, rtol=1e-9)
+    with pytest.raises(ValueError, match="unit"):
+        triangulate(xl, xr, c_mm, unit="yard")
+
+
+def test_agrees_with_cv2_triangulate_points() -> None:
+    c = raw_calib()
+    pts = scene_points(100, seed=3)
+    xl, xr = project(c, pts)
+    ours = triangulate(xl, xr, c).XL
+    nl, _ = undistort_normalized(xl, c.K1, c.D1)
+    nr, _ = undistort_normalized(xr, c.K2, c.D2)
+    ul = (np.column_stack([nl, np.ones(len(nl))]) @ c.K1.T)[:, :2]  # undistorted pixels
+    ur = (np.column_stack([nr, np.ones(len(nr))]) @ c.K2.T)[:, :2]
+    P1 = c.K1 @ np.hstack([np.eye(3), np.zeros((3, 1))])
+    P2 = c.K2 @ np.hstack([c.R, c.T.reshape(3, 1)])
+    h = cv2.triangulatePoints(P1, P2, ul.T.copy(), ur.T.copy())
+    ref = (h[:3] / h[3]).T
+    np.testing.assert_allclose(ours, ref, rtol=1e-6)
+
+
+def test_degenerate_points_are_invalid() -> None:
+    c = rect_calib()
+    xl = np.array([[400.0, 250.0], [400.0, 250.0], [400.0, 250.0], [np.nan, 1.0]])
+    xr = np.array([[400.0, 250.0], [410.0, 250.0], [380.0, 250.0], [1.0, 1.0]])
+    # parallel rays (d = 0), negative disparity (behind), a good one, NaN input
+    res = triangulate(xl, xr, c)
+    assert res.valid.tolist() == [False, False, True, False]
+    assert np.isnan(res.XL[[0, 1, 3]]).all() and np.isnan(res.XR[[0, 1, 3]]).all()
+    # Z = f B / d = 700 * 0.12 m / 20 = 4.2 m
+    np.testing.assert_allclose(res.XL[2], [70 * 4.2 / 700, 10 * 4.2 / 700, 4.2], rtol=1e-12)
+
+
+def test_non_converged_undistortion_is_invalid() -> None:
+    c = raw_calib(D1=np.array([-0.5, 0.1, 0.0, 0.0, 0.0]))
+    xl = np.array([[321.5 + 600 * 0.65, 238.2], [321.5 + 600 * 0.1, 238.2]])
+    xr = xl - [30.0, 0.0]
+    res = triangulate(xl, xr, c)
+    assert res.valid.tolist() == [False, True]
+
+
+def test_triangulate_input_errors() -> None:
+    c = rect_calib()
+    with pytest.raises(ValueError, match=r"xl: expected an \(N, 2\).*transpose"):
+        triangulate(np.zeros((2, 5)), np.zeros((2, 5)), c)
+    with pytest.raises(ValueError, match=r"xl and xr must have the same shape"):
+        triangulate(np.zeros((4, 2)), np.zeros((3, 2)), c)
+
+
+def test_rectified_triangulation_equals_shortcut() -> None:
+    c = rect_calib(doffs=6.0)
+    rng = np.random.default_rng(4)
+    x, y, d = rng.uniform(0, 640, 50), rng.uniform(0, 480, 50), rng.uniform(1, 90, 50)
+    # x_R = x_L - d in the right image's own pixels (its cx is larger by doffs)
+    res = triangulate(np.column_stack([x, y]), np.column_stack([x - d, y]), c)
+    z = depth_from_disparity(d[None, :], c)[0]
+    assert res.valid.all()
+    np.testing.assert_allclose(res.XL[:, 2], z, rtol=1e-6)
+    # ignoring doffs would be visibly wrong: Z = f B / d
+    assert not np.allclose(res.XL[:, 2], 700 * 0.12 / d, rtol=1e-3)
+
+
+# ---------------------------------------------------------------------------- rectified shortcut
+
+
+def test_depth_from_disparity_hand_computed() -> None:
+    c = rect_calib(doffs=6.0)
+    d = np.array([[34.0, -6.0, -10.0, np.nan, 0.0, np.inf]])
+    z = depth_from_disparity(d, c)
+    assert z.dtype == np.float32 and z.shape == d.shape
+    # 700 px * 0.12 m / (34 + 6) = 2.1 m ; d = 0 -> 700 * 0.12 / 6 = 14 m
+    np.testing.assert_allclose(z[0, [0, 4]], [2.1, 14.0], rtol=1e-6)
+    assert np.isnan(z[0, [1, 2, 3, 5]]).all()
+    np.testing.assert_allclose(depth_from_disparity(d, c, unit="mm")[0, 0], 2100.0, rtol=1e-6)
+    np.testing.assert_array_equal(c.depth_from_disparity(d), z)
+    with pytest.raises(ValueError, match="disparity"):
+        depth_from_disparity(np.zeros(3), c)
+
+
+@pytest.mark.parametrize("doffs", [0.0, 12.5])
+def test_reproject_equals_opencv(doffs: float) -> None:
+    c = rect_calib(doffs=doffs)
+    rng = np.random.default_rng(5)
+    disp = rng.uniform(-20.0, 100.0, (48, 64)).astype(np.float32)
+    disp[::7, ::5] = np.nan
+    ours = reproject(disp, c)
+    ref = cv2.reprojectImageTo3D(np.nan_to_num(disp, nan=-1e6), c.Q) * c.to_metres_factor
+    valid = np.isfinite(disp) & (disp + doffs > 0)
+    assert ours.shape == (48, 64, 3) and ours.dtype == np.float32
+    np.testing.assert_allclose(ours[valid], ref[valid], rtol=2e-5, atol=1e-6)
+    assert np.isnan(ours[~valid]).all()
+    np.testing.assert_allclose(ours[..., 2][valid], depth_from_disparity(disp, c)[valid], rtol=1e-6)
+
+
+def test_unrectified_calibration_uses_rectified_geometry() -> None:
+    c = raw_calib()
+    rc = c.rectified_calibration()
+    disp = np.array([[10.0, 50.0]])
+    np.testing.assert_array_equal(depth_from_disparity(disp, c), depth_from_disparity(disp, rc))
+    ref = cv2.reprojectImageTo3D(disp.astype(np.float32), c.Q)
+    np.testing.assert_allclose(reproject(disp, c), ref, rtol=1e-5)
+
+
+def test_terrace_shortcut_equals_opencv(data_dir: Path) -> None:
+    s = load_scene(data_dir / "eth3d" / "terrace")
+    assert s.calib is not None
+    disp = opencv_sgbm(s.left, s.right, s.max_disparity)
+    pts = s.calib.reproject(disp)
+    ref = cv2.reprojectImageTo3D(np.nan_to_num(disp, nan=-1.0), s.calib.Q) / 1000.0
+    valid = np.isfinite(disp) & (disp > 0)
+    np.testing.assert_allclose(pts[valid], ref[valid], rtol=1e-5, atol=1e-6)
+    # 711.499 px * 0.0599432 m / 10 px = 4.265 m
+    z = s.calib.depth_from_disparity(np.array([[10.0]]))
+    assert z[0, 0] == pytest.approx(711.499 * 0.0599432 / 10, rel=1e-6)

@@ -1,0 +1,193 @@
+"""Tests of the shared input validators (property tests: valid inputs convert, invalid ones raise
+ValueError and never another exception type)."""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
+from stereovision._validate import (
+    as_bgr_uint8,
+    as_gray_float,
+    as_gray_uint8,
+    check_pair,
+    positive_finite,
+)
+
+SIDES = {"min_side": 1, "max_side": 6}
+
+
+@st.composite
+def valid_images(draw: st.DrawFn) -> np.ndarray:
+    """Any accepted image: (H, W) or (H, W, C), C in 1/3/4; uint8, uint16 or float in [0, 1]."""
+    dtype = draw(st.sampled_from([np.uint8, np.uint16, np.float16, np.float32, np.float64]))
+    h, w = draw(st.integers(1, 6)), draw(st.integers(1, 6))
+    shape = draw(st.sampled_from([(h, w), (h, w, 1), (h, w, 3), (h, w, 4)]))
+    if np.dtype(dtype).kind == "f":
+        width = 8 * np.dtype(dtype).itemsize
+        elements = st.floats(0.0, 1.0, width=width)
+    else:
+        elements = st.integers(0, int(np.iinfo(dtype).max))
+    return draw(hnp.arrays(dtype, shape, elements=elements))
+
+
+def _expected_gray(img: np.ndarray) -> np.ndarray:
+    scale = {np.dtype(np.uint8): 255.0, np.dtype(np.uint16): 65535.0}.get(img.dtype, 1.0)
+    f = img.astype(np.float64) / scale
+    if f.ndim == 3:
+        f = (
+            f[:, :, 0]
+            if f.shape[2] == 1
+            else f[..., 0] * 0.114 + f[..., 1] * 0.587 + f[..., 2] * 0.299
+        )
+    return f
+
+
+@settings(max_examples=200, deadline=None)
+@given(valid_images())
+def test_valid_images_convert_into_unit_range(img: np.ndarray) -> None:
+    out = as_gray_float(img)
+    assert out.dtype == np.float32
+    assert out.shape == img.shape[:2]
+    assert out.flags.c_contiguous
+    assert np.all((out >= 0) & (out <= 1))
+    np.testing.assert_allclose(out, _expected_gray(img), rtol=0, atol=2e-6)
+    assert not np.shares_memory(out, img)
+
+
+@settings(max_examples=100, deadline=None)
+@given(valid_images())
+def test_valid_images_convert_to_bgr_uint8(img: np.ndarray) -> None:
+    bgr = as_bgr_uint8(img)
+    assert bgr.dtype == np.uint8 and bgr.shape == (*img.shape[:2], 3)
+    gray = as_gray_uint8(img)
+    assert gray.dtype == np.uint8 and gray.shape == img.shape[:2]
+    # 8-bit round trip within one grey level of the float conversion
+    assert np.abs(gray.astype(np.float64) / 255 - as_gray_float(img)).max() <= 1 / 255 + 1e-6
+
+
+def _bad_dtype_arrays() -> st.SearchStrategy[np.ndarray]:
+    dtypes = st.sampled_from(
+        [np.bool_, np.int8, np.int16, np.int32, np.int64, np.uint32, np.uint64, np.complex64]
+    )
+    return dtypes.flatmap(
+        lambda dt: hnp.arrays(dt, hnp.array_shapes(min_dims=2, max_dims=3, **SIDES))
+    )
+
+
+def _bad_shape_arrays() -> st.SearchStrategy[np.ndarray]:
+    shapes = st.one_of(
+        hnp.array_shapes(min_dims=0, max_dims=1, min_side=0, max_side=5),
+        hnp.array_shapes(min_dims=4, max_dims=5, min_side=1, max_side=3),
+        st.tuples(st.integers(1, 4), st.integers(1, 4), st.sampled_from([0, 2, 5, 6])),
+        st.tuples(st.integers(0, 3), st.integers(0, 3)).filter(lambda s: 0 in s),
+    )
+    return shapes.flatmap(lambda s: hnp.arrays(np.uint8, s))
+
+
+def _bad_float_arrays() -> st.SearchStrategy[np.ndarray]:
+    # at least one NaN/inf or out-of-[0, 1] value
+    bad = st.sampled_from([np.nan, np.inf, -np.inf, -0.5, 1.5, 255.0])
+    return st.tuples(
+        hnp.arrays(
+            np.float32,
+            st.tuples(st.integers(1, 4), st.integers(1, 4)),
+            elements=st.floats(0, 1, width=32),
+        ),
+        bad,
+        st.integers(0, 15),
+    ).map(lambda t: _poke(*t))
+
+
+def _poke(a: np.ndarray, value: float, i: int) -> np.ndarray:
+    a = a.copy()
+    a.flat[i % a.size] = value
+    return a
+
+
+junk = st.one_of(
+    st.none(),
+    st.integers(),
+    st.floats(),
+    st.text(max_size=5),
+    st.lists(st.lists(st.integers(0, 255), max_size=3), max_size=3),  # ragged or int64
+    st.dictionaries(st.text(max_size=2), st.integers(), max_size=2),
+    st.just(object()),
+    st.just(np.array([[object(), object()]])),
+    st.just(np.array([["a", "b"]])),
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.one_of(_bad_dtype_arrays(), _bad_shape_arrays(), _bad_float_arrays(), junk))
+def test_invalid_inputs_raise_value_error_only(bad: object) -> None:
+    for fn in (as_gray_float, as_bgr_uint8, as_gray_uint8):
+        with pytest.raises(ValueError):
+            fn(bad)
+
+
+def test_messages_name_argument_and_values() -> None:
+    with pytest.raises(ValueError, match=r"right: unsupported dtype bool"):
+        as_gray_float(np.zeros((2, 2), bool), name="right")
+    with pytest.raises(
+        ValueError, match=r"left: expected 1, 3 \(BGR\) or 4 \(BGRA\) channels, got 2 "
+    ):
+        as_gray_float(np.zeros((2, 2, 2), np.uint8))
+    with pytest.raises(ValueError, match=r"got 1 dimension\(s\) with shape \(5,\)"):
+        as_gray_float(np.zeros(5, np.uint8))
+    with pytest.raises(ValueError, match=r"left: image is empty \(shape \(0, 3\)\)"):
+        as_gray_float(np.zeros((0, 3), np.uint8))
+    with pytest.raises(ValueError, match=r"contains 1 NaN/inf"):
+        as_gray_float(np.array([[0.5, np.nan]]))
+    with pytest.raises(ValueError, match=r"range \[0, 255\].*divide 8-bit data by 255"):
+        as_gray_float(np.array([[0.0, 255.0]]))
+    with pytest.raises(ValueError, match="got None"):
+        as_gray_float(None)
+    with pytest.raises(ValueError, match="complex64"):
+        as_gray_float(np.zeros((2, 2), np.complex64))
+
+
+def test_exact_values() -> None:
+    np.testing.assert_array_equal(
+        as_gray_float(np.array([[0, 51, 255]], np.uint8)), np.float32([[0, 0.2, 1]])
+    )
+    assert as_gray_float(np.array([[65535]], np.uint16))[0, 0] == 1.0
+    bgr = np.zeros((1, 1, 3), np.uint8)
+    bgr[0, 0] = (255, 0, 0)  # pure blue -> 0.114
+    assert as_gray_float(bgr)[0, 0] == pytest.approx(0.114, abs=1e-7)
+    bgra = np.concatenate([bgr, np.full((1, 1, 1), 7, np.uint8)], axis=2)
+    assert as_gray_float(bgra)[0, 0] == as_gray_float(bgr)[0, 0]  # alpha ignored
+    # uint8 BGR goes to OpenCV untouched; grey is what cv2.cvtColor gives
+    img = np.random.default_rng(0).integers(0, 256, (5, 7, 3), dtype=np.uint8)
+    assert as_bgr_uint8(img) is img
+    np.testing.assert_array_equal(as_gray_uint8(img), cv2.cvtColor(img, cv2.COLOR_BGR2GRAY))
+    np.testing.assert_array_equal(as_bgr_uint8(np.float32([[0.0, 1.0]]))[0, 1], [255, 255, 255])
+    assert as_bgr_uint8(np.array([[257 * 10]], np.uint16))[0, 0, 0] == 10
+
+
+def test_check_pair() -> None:
+    a = np.zeros((4, 5), np.uint8)
+    left, right = check_pair(a, a + 255)
+    assert left.dtype == np.float32 and left.max() == 0 and right.min() == 1
+    with pytest.raises(ValueError, match=r"left \(4, 5\) and right \(4, 6\)"):
+        check_pair(a, np.zeros((4, 6), np.uint8))
+    with pytest.raises(ValueError, match=r"left \(4, 5\) and right \(4, 5, 3\)"):
+        check_pair(a, np.zeros((4, 5, 3), np.uint8))
+    with pytest.raises(ValueError, match=r"^right: unsupported dtype"):
+        check_pair(a, a.astype(bool))
+
+
+@pytest.mark.parametrize("value", [1, 2.5, np.float32(3), np.array([4.0]), np.int64(7)])
+def test_positive_finite_accepts(value: object) -> None:
+    assert positive_finite(value, "f") == float(np.asarray(value).ravel()[0])
+
+
+@pytest.mark.parametrize(
+    "value", [0, -1.0, np.nan, np.inf, "3", None, True, [1.0, 2.0], 1 + 2j, np.array([])]
+)
+def test_positive_finite_rejects(value: object) -> None:
+    with pytest.raises(ValueError, match=r"^baseline: expected a positive finite number"):
+        positive_finite(value, "baseline")
