@@ -107,7 +107,7 @@ def test_read_pfm_orientation_and_endianness(tmp_path: Path) -> None:
 
 def test_pfm_colour_round_trip(tmp_path: Path) -> None:
     arr = np.random.default_rng(1).standard_normal((3, 4, 3)).astype(np.float32)
-    write_pfm(tmp_path / "c.pfm", arr, little_endian=False)
+    assert write_pfm(tmp_path / "c.pfm", arr, little_endian=False) == tmp_path / "c.pfm"
     assert (tmp_path / "c.pfm").read_bytes().startswith(b"PF\n4 3\n1.0\n")
     np.testing.assert_array_equal(read_pfm(tmp_path / "c.pfm"), arr)
 
@@ -176,8 +176,7 @@ def test_ply_round_trip_with_colours(tmp_path: Path) -> None:
     pts = rng.standard_normal((50, 3)).astype(np.float32)
     cols = rng.integers(0, 256, (50, 3), dtype=np.uint8)
     pts[7] = np.nan
-    n = write_ply(tmp_path / "c.ply", pts, cols)
-    assert n == 49
+    assert write_ply(tmp_path / "c.ply", pts, cols) == tmp_path / "c.ply"
     raw = (tmp_path / "c.ply").read_bytes()
     header, body = raw.split(b"end_header\n")
     assert b"format binary_little_endian 1.0" in header
@@ -196,11 +195,13 @@ def test_ply_round_trip_with_colours(tmp_path: Path) -> None:
 
 def test_ply_without_colours_and_image_shaped(tmp_path: Path) -> None:
     pts = np.arange(2 * 3 * 3, dtype=np.float64).reshape(2, 3, 3)
-    assert write_ply(tmp_path / "p.ply", pts) == 6
+    write_ply(tmp_path / "p.ply", pts)
     got, cols = read_ply(tmp_path / "p.ply")
     assert cols is None
     np.testing.assert_array_equal(got, pts.reshape(-1, 3).astype(np.float32))
-    assert write_ply(tmp_path / "k.ply", np.full((2, 3), np.nan), drop_invalid=False) == 2
+    write_ply(tmp_path / "k.ply", np.full((2, 3), np.nan), drop_invalid=False)
+    kept, _ = read_ply(tmp_path / "k.ply")
+    assert kept.shape == (2, 3) and np.isnan(kept).all()
 
 
 def test_ply_errors(tmp_path: Path) -> None:

@@ -104,8 +104,8 @@ class DenseMetrics:
     n_both: int
 
     def as_dict(self) -> dict[str, float | int]:
-        """Flat dict: ``bad-0.5``, ``bad-1.0``, ..., ``density``, ``avgerr``, ``rms``, counts."""
-        out: dict[str, float | int] = {f"bad-{t:.1f}": v for t, v in self.bad.items()}
+        """Flat dict: ``bad_0.5``, ``bad_1.0``, ..., ``density``, ``avgerr``, ``rms``, counts."""
+        out: dict[str, float | int] = {f"bad_{t:.1f}": v for t, v in self.bad.items()}
         out.update(
             density=self.density,
             avgerr=self.avgerr,
@@ -184,9 +184,9 @@ class DepthMetrics:
 
     Attributes
     ----------
-    median_rel_err : float
+    median_rel : float
         Median of ``|Z_est - Z_gt| / Z_gt``, percent.
-    share_off_5pct : float
+    share_off_5 : float
         Percentage of those pixels with relative error above 5 %.
     rmse_pct : float
         RMSE of ``Z_est - Z_gt`` as a percentage of the mean GT depth.
@@ -198,8 +198,8 @@ class DepthMetrics:
         ``n`` as a percentage of all pixels.
     """
 
-    median_rel_err: float
-    share_off_5pct: float
+    median_rel: float
+    share_off_5: float
     rmse_pct: float
     rmse: float
     n: int
@@ -248,8 +248,8 @@ def depth_metrics(depth_est: npt.ArrayLike, depth_gt: npt.ArrayLike) -> DepthMet
     rel = np.abs(diff) / g[both]
     rmse = float(np.sqrt(np.mean(diff**2)))
     return DepthMetrics(
-        median_rel_err=100.0 * float(np.median(rel)),
-        share_off_5pct=_pct(int(np.count_nonzero(rel > DEPTH_OFF_FRACTION)), n),
+        median_rel=100.0 * float(np.median(rel)),
+        share_off_5=_pct(int(np.count_nonzero(rel > DEPTH_OFF_FRACTION)), n),
         rmse_pct=100.0 * rmse / float(np.mean(g[both])),
         rmse=rmse,
         n=n,

@@ -207,7 +207,7 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     return np.ascontiguousarray(arr, dtype=np.float32)
 
 
-def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) -> None:
+def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) -> Path:
     """Write a ``float32`` array as a PFM file (bottom-up rows, scale magnitude 1), atomically.
 
     Parameters
@@ -219,6 +219,11 @@ def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) ->
         ``float32``. NaN and inf are written as they are, bit for bit.
     little_endian : bool
         Byte order of the data (scale ``-1`` when True, ``+1`` otherwise).
+
+    Returns
+    -------
+    pathlib.Path
+        The file written.
 
     Raises
     ------
@@ -239,6 +244,7 @@ def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) ->
     with atomic_write(path) as fh:
         fh.write(header)
         fh.write(body)
+    return Path(path)
 
 
 # ------------------------------------------------------------------------------------------ PLY
@@ -268,7 +274,7 @@ def write_ply(
     points: npt.ArrayLike,
     colors: npt.ArrayLike | None = None,
     drop_invalid: bool = True,
-) -> int:
+) -> Path:
     """Write a point cloud as a binary little-endian PLY file, atomically.
 
     Vertex properties: ``float x, y, z`` and, with colours, ``uchar red, green, blue``.
@@ -286,8 +292,8 @@ def write_ply(
 
     Returns
     -------
-    int
-        Number of vertices written.
+    pathlib.Path
+        The file written (its ``element vertex`` count is the number of points kept).
 
     Raises
     ------
@@ -336,7 +342,7 @@ def write_ply(
     with atomic_write(path) as fh:
         fh.write(("\n".join(lines) + "\n").encode("ascii"))
         fh.write(rec.tobytes())
-    return len(pts)
+    return Path(path)
 
 
 def read_ply(
