@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -116,6 +117,17 @@ def test_doffs_derived_from_principal_points() -> None:
     K2 = np.array([[500.0, 0.0, 170.5], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]])
     assert rect_calib(K2=K2).doffs_px == 10.5
     assert rect_calib(K2=K2, doffs=10.5).doffs_px == 10.5
+
+
+def test_frozen_and_replace_revalidates() -> None:
+    c = raw_calib()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        c.unit = "mm"  # type: ignore[misc]
+    with pytest.raises(ValueError, match="read-only"):
+        c.T[0] = 5.0
+    assert dataclasses.replace(c, unit="mm").baseline_m == pytest.approx(c.baseline / 1000)
+    with pytest.raises(ValueError, match="T: zero baseline"):
+        dataclasses.replace(c, T=np.zeros(3))
 
 
 def test_equality() -> None:
@@ -246,6 +258,11 @@ def test_from_middlebury_with_doffs(tmp_path: Path) -> None:
     (tmp_path / "bad.txt").write_text("cam0=[1 0 0; 0 1 0]\n")
     with pytest.raises(ValueError, match="cannot parse cam0"):
         Calibration.from_middlebury(tmp_path / "bad.txt")
+    (tmp_path / "neg.txt").write_text(
+        "cam0=[1 0 0; 0 1 0; 0 0 1]\ncam1=[1 0 0; 0 1 0; 0 0 1]\nbaseline=-5\nwidth=4\nheight=3\n"
+    )
+    with pytest.raises(ValueError, match=r"baseline in .*neg\.txt: expected a positive finite"):
+        Calibration.from_middlebury(tmp_path / "neg.txt")
     (tmp_path / "partial.txt").write_text("cam0=[1 0 0; 0 1 0; 0 0 1]\nbaseline=1\n")
     with pytest.raises(ValueError, match="lacks 'cam1'"):
         Calibration.from_middlebury(tmp_path / "partial.txt")

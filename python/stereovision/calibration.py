@@ -25,7 +25,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_image_array
+from stereovision._validate import as_image_array, positive_finite
 
 __all__ = [
     "DISTORTION_LENGTHS",
@@ -90,7 +90,7 @@ def _close(a: float, b: float, rel: float = RECTIFIED_REL_TOL) -> bool:
     return abs(a - b) <= rel * max(abs(a), abs(b), 1.0)
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, frozen=True)
 class Calibration:
     """Intrinsics and extrinsics of a stereo pair (OpenCV conventions, see module docstring).
 
@@ -115,6 +115,11 @@ class Calibration:
         Rectified only: ``cx_right - cx_left`` in pixels (Middlebury's ``doffs``); derived from
         ``K1``/``K2`` when omitted, checked against them when given.
 
+    Notes
+    -----
+    Instances are immutable (frozen, read-only arrays) so that cached rectification maps never
+    go stale; use :func:`dataclasses.replace` to derive a modified, re-validated copy.
+
     Raises
     ------
     ValueError
@@ -136,13 +141,13 @@ class Calibration:
     _cache: dict[Any, Any] = field(default_factory=dict, init=False, repr=False)
 
     def __post_init__(self) -> None:
-        self.K1 = _as_float_array(self.K1, "K1", ((3, 3),))
-        self.K2 = _as_float_array(self.K2, "K2", ((3, 3),))
+        object.__setattr__(self, "K1", _as_float_array(self.K1, "K1", ((3, 3),)))
+        object.__setattr__(self, "K2", _as_float_array(self.K2, "K2", ((3, 3),)))
         dist_shapes = tuple((n,) for n in DISTORTION_LENGTHS)
-        self.D1 = _as_float_array(self.D1, "D1", dist_shapes)
-        self.D2 = _as_float_array(self.D2, "D2", dist_shapes)
-        self.R = _as_float_array(self.R, "R", ((3, 3),))
-        self.T = _as_float_array(self.T, "T", ((3,),))
+        object.__setattr__(self, "D1", _as_float_array(self.D1, "D1", dist_shapes))
+        object.__setattr__(self, "D2", _as_float_array(self.D2, "D2", dist_shapes))
+        object.__setattr__(self, "R", _as_float_array(self.R, "R", ((3, 3),)))
+        object.__setattr__(self, "T", _as_float_array(self.T, "T", ((3,),)))
         _check_camera_matrix(self.K1, "K1")
         _check_camera_matrix(self.K2, "K2")
         err = float(np.abs(self.R @ self.R.T - np.eye(3)).max())
@@ -154,19 +159,19 @@ class Calibration:
             )
         if not float(np.linalg.norm(self.T)) > 0:
             raise ValueError(f"T: zero baseline (T = {self.T.tolist()})")
-        self.image_size = self._check_size(self.image_size)
+        object.__setattr__(self, "image_size", self._check_size(self.image_size))
         if self.unit not in UNIT_TO_METRES:
             raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {self.unit!r}")
         if not isinstance(self.rectified, (bool, np.bool_)):
             raise ValueError(f"rectified: expected a bool, got {self.rectified!r}")
-        self.rectified = bool(self.rectified)
+        object.__setattr__(self, "rectified", bool(self.rectified))
         if self.doffs is not None:
             d = float(self.doffs)
             if not math.isfinite(d):
                 raise ValueError(f"doffs: expected a finite number of pixels, got {self.doffs!r}")
             if not self.rectified:
                 raise ValueError("doffs: only applies to a rectified calibration")
-            self.doffs = d
+            object.__setattr__(self, "doffs", d)
         if self.rectified:
             self._check_rectified()
 
@@ -643,7 +648,7 @@ class Calibration:
             K2=v["cam1"],
             D2=np.zeros(5),
             R=np.eye(3),
-            T=np.array([-float(v["baseline"]), 0.0, 0.0]),
+            T=np.array([-positive_finite(v["baseline"], f"baseline in {p}"), 0.0, 0.0]),
             image_size=(int(v["width"]), int(v["height"])),
             unit="mm",
             rectified=True,
@@ -688,6 +693,7 @@ class Calibration:
         f = float(p2[0, 0])
         if not f > 0:
             raise ValueError(f"KITTI calibration {p}: {k2} focal length {f!r} is not positive")
+        baseline = (p2[0, 3] - p3[0, 3]) / f
         size: tuple[int, int] | None = None
         if "S_rect_02" in v and v["S_rect_02"].size == 2:
             size = (int(np.rint(v["S_rect_02"][0])), int(np.rint(v["S_rect_02"][1])))
@@ -712,7 +718,9 @@ class Calibration:
             K2=p3[:, :3],
             D2=np.zeros(5),
             R=np.eye(3),
-            T=np.array([-(p2[0, 3] - p3[0, 3]) / f, 0.0, 0.0]),
+            T=np.array(
+                [-positive_finite(baseline, f"baseline (P2[0, 3] - P3[0, 3]) / f in {p}"), 0, 0]
+            ),
             image_size=size,
             unit="m",
             rectified=True,
