@@ -144,6 +144,8 @@ def test_messages_name_argument_and_values() -> None:
         as_gray_float(np.array([[0.5, np.nan]]))
     with pytest.raises(ValueError, match=r"range \[0, 255\].*divide 8-bit data by 255"):
         as_gray_float(np.array([[0.0, 255.0]]))
+    with pytest.raises(ValueError, match=r"range \[0, 1e\+300\]"):
+        as_gray_float(np.array([[0.0, 1e300]]))  # not reported as inf after a float32 cast
     with pytest.raises(ValueError, match="got None"):
         as_gray_float(None)
     with pytest.raises(ValueError, match="complex64"):

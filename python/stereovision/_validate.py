@@ -102,14 +102,13 @@ def _to_unit_float(arr: np.ndarray, name: str) -> npt.NDArray[np.float32]:
     if arr.dtype in _INT_FULL_SCALE:
         # divide (not multiply by the reciprocal) so that full scale maps to exactly 1.0
         return arr.astype(np.float32) / np.float32(_INT_FULL_SCALE[arr.dtype])
-    out = arr.astype(np.float32)
-    if not np.isfinite(out).all():
-        n_bad = int(np.count_nonzero(~np.isfinite(out)))
+    if not np.isfinite(arr).all():
+        n_bad = int(np.count_nonzero(~np.isfinite(arr)))
         raise ValueError(
             f"{name}: float image contains {n_bad} NaN/inf value(s); expected finite grey levels "
             "in [0, 1]"
         )
-    lo, hi = float(out.min()), float(out.max())
+    lo, hi = float(arr.min()), float(arr.max())
     if lo < 0.0 or hi > 1.0:
         # Rescaling by the maximum would give the two images of a pair different scales, so a
         # float image outside [0, 1] is an error rather than a guess.
@@ -117,7 +116,7 @@ def _to_unit_float(arr: np.ndarray, name: str) -> npt.NDArray[np.float32]:
             f"{name}: float image values must lie in [0, 1], got range [{lo:g}, {hi:g}] "
             "(divide 8-bit data by 255, or pass the uint8 array itself)"
         )
-    return out
+    return arr.astype(np.float32)
 
 
 def as_gray_float(img: object, name: str = "left") -> npt.NDArray[np.float32]:
