@@ -18,7 +18,9 @@ SV = [sys.executable, "-m", "stereovision.cli"]
 
 def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
     out = tmp_path / "demo"
-    proc = subprocess.run([*SV, "demo", "-o", str(out)], capture_output=True, text=True, check=False)
+    proc = subprocess.run(
+        [*SV, "demo", "-o", str(out)], capture_output=True, text=True, check=False
+    )
     assert proc.returncode == 0, proc.stderr
     assert "bad-2.0" in proc.stdout and "density" in proc.stdout
     for name in ("disparity.png", "depth.png", "disparity.pfm", "depth.npy", "cloud.ply"):
@@ -62,10 +64,22 @@ def test_errors_are_one_line_and_keep_earlier_outputs(tmp_path: Path, data_dir: 
     scene = data_dir / "middlebury2001" / "tsukuba"
     cases = [
         ["depth", str(tmp_path / "missing.png"), str(scene / "right.png"), "-o", str(out)],
-        ["depth", str(scene / "left.png"), str(data_dir / "eth3d" / "terrace" / "right.png"),
-         "-o", str(out)],
-        ["depth", str(scene / "left.png"), str(scene / "right.png"), "--calib",
-         str(scene / "SOURCE"), "-o", str(out)],
+        [
+            "depth",
+            str(scene / "left.png"),
+            str(data_dir / "eth3d" / "terrace" / "right.png"),
+            "-o",
+            str(out),
+        ],
+        [
+            "depth",
+            str(scene / "left.png"),
+            str(scene / "right.png"),
+            "--calib",
+            str(scene / "SOURCE"),
+            "-o",
+            str(out),
+        ],
         ["eval", str(tmp_path / "nowhere")],
     ]
     for argv in cases:

@@ -29,7 +29,7 @@ def _shift(img: np.ndarray, d: float) -> np.ndarray:
     w = img.shape[1]
     fx = np.fft.fftfreq(w)[None, :]
     out = np.real(np.fft.ifft(np.fft.fft(img, axis=1) * np.exp(2j * np.pi * fx * d), axis=1))
-    return out.astype(np.float32)
+    return np.clip(out, 0.0, 1.0).astype(np.float32)
 
 
 def _rect_calib(w: int, h: int, f: float = 500.0, baseline_mm: float = 100.0) -> Calibration:
@@ -61,7 +61,9 @@ def test_plane_gives_metric_depth_and_points() -> None:
     assert abs(float(np.nanmedian(res.depth)) - z_expected) / z_expected < 0.02
     # Points: left rectified camera frame, metres, X right, Y down, Z forward.
     assert res.points.dtype == np.float32 and res.points.shape[1] == 3
-    assert len(res.points) == len(res.colors) == len(res.pixels) == int(np.isfinite(res.depth).sum())
+    assert (
+        len(res.points) == len(res.colors) == len(res.pixels) == int(np.isfinite(res.depth).sum())
+    )
     x, y = res.pixels[0]
     p = res.points[0]
     assert p[2] == pytest.approx(res.depth[y, x], rel=1e-5)

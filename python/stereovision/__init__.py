@@ -1,9 +1,29 @@
 """stereovision: binocular depth perception for robots.
 
-Two cameras in; calibrated, rectified pairs, correspondences, metric depth maps and point clouds out.
+Two cameras in; calibrated, rectified pairs, correspondences, metric depth maps and point
+clouds out.
 The hot kernels are Rust (``stereovision._core``); this package owns the API.
+
+>>> import stereovision as sv
+>>> calib = sv.Calibration.from_file("calib.txt")            # doctest: +SKIP
+>>> result = sv.depth_map(left, right, calib)                 # doctest: +SKIP
+>>> result.depth, result.points, result.to_ply("cloud.ply")   # doctest: +SKIP
 """
 
+from stereovision import evaluate, io
 from stereovision._core import __version__
+from stereovision.calibration import Calibration
+from stereovision.depth import DepthResult, depth_map, estimate_max_disparity
+from stereovision.triangulation import depth_from_disparity, triangulate
 
-__all__ = ["__version__"]
+__all__ = [
+    "Calibration",
+    "DepthResult",
+    "__version__",
+    "depth_from_disparity",
+    "depth_map",
+    "estimate_max_disparity",
+    "evaluate",
+    "io",
+    "triangulate",
+]

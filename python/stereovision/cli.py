@@ -8,9 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
-import tempfile
 import time
 from collections.abc import Sequence
 from importlib import resources
@@ -32,15 +30,11 @@ class CliError(Exception):
 
 
 def _atomic_write_bytes(path: Path, data: bytes) -> None:
+    from stereovision.io import atomic_write
+
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_write(path, "wb") as fh:
+        fh.write(data)
 
 
 def colorize(values: np.ndarray, *, lo: float | None = None, hi: float | None = None) -> np.ndarray:
@@ -185,8 +179,9 @@ def cmd_demo(args: argparse.Namespace) -> int:
     if res.depth is not None and scene.calib is not None:
         dm = depth_metrics(res.depth, gt_depth(scene.gt, scene.calib))
         print(
-            f"  depth vs GT: median |dZ|/Z {dm.median_rel:.2f} %, off by >5 % {dm.share_off_5:.1f} %"
-            f" over {dm.n} pixels; {len(res.points)} points in the cloud"
+            f"  depth vs GT: median |dZ|/Z {dm.median_rel:.2f} %,"
+            f" off by >5 % {dm.share_off_5:.1f} % over {dm.n} pixels;"
+            f" {len(res.points)} points in the cloud"
         )
     print(f"outputs in {out_dir.resolve()}:")
     for name, path in written.items():
@@ -274,7 +269,8 @@ def cmd_eval(args: argparse.Namespace) -> int:
     if args.json or not rows:
         return 0
     mean = {
-        k: float(np.mean([r[k]["bad_2.0"] for r in rows])) for k in ("ours", "ours+fill", "bm", "sgbm")
+        k: float(np.mean([r[k]["bad_2.0"] for r in rows]))
+        for k in ("ours", "ours+fill", "bm", "sgbm")
         if all(k in r for r in rows)
     }
     print("mean bad-2.0: " + ", ".join(f"{k} {v:.1f} %" for k, v in mean.items()))
@@ -282,8 +278,8 @@ def cmd_eval(args: argparse.Namespace) -> int:
         if "depth" in r:
             dm = r["depth"]
             line = (
-                f"{r['scene']}: depth over our {dm['n']} pixels: median |dZ|/Z {dm['median_rel']:.2f} %,"
-                f" off >5 % {dm['share_off_5']:.1f} %"
+                f"{r['scene']}: depth over our {dm['n']} pixels:"
+                f" median |dZ|/Z {dm['median_rel']:.2f} %, off >5 % {dm['share_off_5']:.1f} %"
             )
             if "sgbm_depth" in r:
                 s = r["sgbm_depth"]

@@ -230,7 +230,9 @@ def depth_map(
     check_pair(left_bgr, right_bgr)
     if calib is not None:
         if not isinstance(calib, Calibration):
-            raise ValueError(f"calib must be a stereovision.Calibration, got {type(calib).__name__}")
+            raise ValueError(
+                f"calib must be a stereovision.Calibration, got {type(calib).__name__}"
+            )
         h, w = left_bgr.shape[:2]
         if tuple(calib.image_size) != (w, h):
             raise ValueError(
