@@ -10,6 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
+
 from stereovision.baselines import opencv_bm, opencv_sgbm, round_up16, row_fill
 from stereovision.evaluate import dense_metrics
 from stereovision.io import load_scene
@@ -153,3 +154,43 @@ def test_sgbm_tsukuba_reference_figures(data_dir: Path) -> None:
     assert filled.density == 100.0
     bm = dense_metrics(opencv_bm(s.left, s.right, s.max_disparity), s.gt)
     assert bm.bad[2.0] == pytest.approx(12.7, abs=0.5)
+
+
+# evaluation.md "Reference figures": scene -> (BM bad-2, SGBM bad-1, SGBM bad-2, SGBM density,
+# SGBM + fill bad-2), all in percent, printed to 0.1 (density to 1).
+REFERENCE_TABLE = {
+    "eth3d/playground": (17.3, 9.4, 7.8, 93, 3.3),
+    "eth3d/terrace": (21.2, 14.9, 10.7, 95, 8.5),
+    "kitti2015/000005_10": (60.6, 43.5, 29.5, 80, 21.2),
+    "middeval3/teddyH": (36.8, 28.1, 25.3, 80, 18.2),
+    "middlebury2001/tsukuba": (12.7, 6.4, 5.3, 98, 4.2),
+    "middlebury2001/venus": (20.2, 11.0, 9.9, 92, 1.8),
+    "middlebury2003/cones": (30.7, 22.7, 21.6, 82, 11.2),
+    "middlebury2003/teddy": (35.6, 27.0, 24.4, 81, 15.0),
+    "middlebury2005/art": (53.3, 40.8, 39.2, 69, 25.2),
+    "middlebury2005/books": (40.4, 30.0, 26.4, 78, 12.3),
+    "middlebury2005/dolls": (39.8, 30.7, 27.9, 77, 14.1),
+    "middlebury2005/laundry": (52.2, 38.6, 35.1, 75, 27.4),
+    "middlebury2005/moebius": (39.4, 30.2, 27.9, 78, 13.0),
+    "middlebury2005/reindeer": (49.4, 33.0, 32.1, 75, 14.4),
+    "middlebury2006/cloth3": (24.7, 18.5, 17.8, 84, 10.0),
+    "middlebury2006/wood2": (36.5, 22.0, 21.7, 79, 2.4),
+    "tartanair/oldtown_easy_p000_001116": (32.4, 23.3, 19.7, 89, 10.2),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(REFERENCE_TABLE))
+def test_reference_table_reproduced(data_dir: Path, name: str) -> None:
+    """Every accuracy figure of evaluation.md's reference table, to its printed precision."""
+    bm_b2, b1, b2, density, fill_b2 = REFERENCE_TABLE[name]
+    s = load_scene(data_dir / name)
+    assert s.gt is not None
+    sgbm = opencv_sgbm(s.left, s.right, s.max_disparity)
+    m = dense_metrics(sgbm, s.gt)
+    assert m.bad[1.0] == pytest.approx(b1, abs=0.051)
+    assert m.bad[2.0] == pytest.approx(b2, abs=0.051)
+    assert m.density == pytest.approx(density, abs=0.51)
+    assert dense_metrics(row_fill(sgbm), s.gt).bad[2.0] == pytest.approx(fill_b2, abs=0.051)
+    bm = dense_metrics(opencv_bm(s.left, s.right, s.max_disparity), s.gt)
+    assert bm.bad[2.0] == pytest.approx(bm_b2, abs=0.051)
