@@ -9,6 +9,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+
 from stereovision.calibration import Calibration, parse_kitti_calib, parse_middlebury_calib
 
 SIZE = (320, 240)

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from stereovision.baselines import opencv_sgbm
 from stereovision.calibration import Calibration
 from stereovision.evaluate import (

@@ -12,6 +12,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
+
 from stereovision.calibration import Calibration
 from stereovision.io import (
     atomic_write,
@@ -164,6 +165,9 @@ def test_atomic_write_leaves_old_file_on_error(tmp_path: Path) -> None:
     with atomic_write(dest) as fh:
         fh.write(b"new")
     assert dest.read_bytes() == b"new"
+    umask = os.umask(0)
+    os.umask(umask)
+    assert dest.stat().st_mode & 0o777 == 0o666 & ~umask  # not mkstemp's private 0o600
     with pytest.raises(FileNotFoundError, match="does not exist"):
         write_pfm(tmp_path / "missing_dir" / "x.pfm", np.zeros((1, 1), np.float32))
 

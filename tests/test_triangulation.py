@@ -8,6 +8,7 @@ from pathlib import Path
 import cv2
 import numpy as np
 import pytest
+
 from stereovision.baselines import opencv_sgbm
 from stereovision.calibration import Calibration
 from stereovision.io import load_scene

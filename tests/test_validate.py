@@ -9,6 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
+
 from stereovision._validate import (
     as_bgr_uint8,
     as_gray_float,
