@@ -162,7 +162,7 @@ def test_save_load_round_trip_bit_identical(tmp_path: Path, suffix: str, make) -
     if not c.rectified:  # awkward float64 values that do not print short
         c = raw_calib(D1=rng.standard_normal(8) * 1e-3, T=np.array([-0.1 / 3, 1e-17, np.pi * 1e-3]))
     path = tmp_path / f"calib{suffix}"
-    c.save(path)
+    assert c.save(path) == path
     for loaded in (Calibration.load(path), Calibration.from_file(path)):
         _bits_equal(c, loaded)
     assert [p.name for p in tmp_path.iterdir()] == [path.name]  # atomic: no temp file left

@@ -450,8 +450,8 @@ class Calibration:
             rec["doffs"] = self.doffs
         return rec
 
-    def save(self, path: PathLike) -> None:
-        """Write the calibration atomically.
+    def save(self, path: PathLike) -> Path:
+        """Write the calibration atomically and return the path written.
 
         ``.yaml``/``.yml``/``.xml`` are written with ``cv2.FileStorage`` (readable by OpenCV in
         any language: matrices ``K1 D1 K2 D2 R T``, ``image_width``, ``image_height``, ``unit``,
@@ -497,6 +497,7 @@ class Calibration:
             )
         with atomic_write(p, "w") as fh:
             fh.write(text)
+        return p
 
     @classmethod
     def _from_mapping(cls, get: Any, source: str) -> Calibration:
