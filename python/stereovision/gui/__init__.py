@@ -1,0 +1,131 @@
+"""``stereovision gui``: the paper's three windows (acquisition, stereo output, 3-D view).
+
+A local trame web app, because robots are often headless and watched from another machine::
+
+    stereovision gui                                  # bundled demo scene
+    stereovision gui --left 0 --right 1 --calib rig.yaml
+    stereovision gui --left l.avi --right r.avi --calib calib.txt --data ~/scenes
+
+It listens on 127.0.0.1 unless ``--host`` says otherwise. Files chosen on the page can only come
+from the bundled demo data and the folders given with ``--data``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+__all__ = ["DEFAULT_HOST", "DEFAULT_PORT", "add_cli", "build_app", "cmd_gui", "main"]
+
+#: Loopback only by default: exposing the robot's cameras is an explicit decision (--host).
+DEFAULT_HOST = "127.0.0.1"
+DEFAULT_PORT = 8080
+
+
+def bundled_data_dir() -> Path:
+    """Folder of the bundled demo data (``stereovision/data``)."""
+    return Path(str(resources.files("stereovision") / "data"))
+
+
+def build_app(args: argparse.Namespace) -> Any:
+    """Validate the arguments, open the sources and build the app (without starting the server).
+
+    Raises
+    ------
+    ValueError, FileNotFoundError, OSError
+        ``--left`` without ``--right`` (or the reverse), a missing data folder or calibration, a
+        camera that cannot be opened.
+    """
+    from stereovision.gui.sources import AllowedFolders, open_stereo_source
+
+    if (args.left is None) != (args.right is None):
+        raise ValueError("give both --left and --right camera sources, or neither")
+    if not 0 <= args.port <= 65535:
+        raise ValueError(f"--port must be in 0..65535, got {args.port}")
+    folders = AllowedFolders([bundled_data_dir(), *(args.data or [])])
+    calib = None
+    if args.calib is not None:
+        from stereovision.calibration import Calibration
+
+        calib = Calibration.from_file(args.calib)
+    source = None
+    if args.left is not None:
+        source = open_stereo_source(args.left, args.right)
+    from trame.app import get_server
+
+    from stereovision.gui.app import StereoApp
+
+    server = get_server("stereovision-gui", client_type="vue3")
+    server.state.trame__title = "stereovision"
+    names = (str(args.left or ""), str(args.right or ""))
+    return StereoApp(
+        server,
+        folders,
+        bundled_data_dir() / "cones",
+        source=source,
+        calib=calib,
+        source_names=names,
+    )
+
+
+def cmd_gui(args: argparse.Namespace) -> int:
+    """``stereovision gui``: build the app and serve it until interrupted."""
+    app = build_app(args)
+    url = f"http://{args.host}:{args.port}/"
+    print(f"stereovision gui on {url} (Ctrl+C to stop)", flush=True)
+    argv, sys.argv = sys.argv, sys.argv[:1]  # trame parses sys.argv itself: give it nothing
+    try:
+        app.server.start(
+            port=args.port,
+            host=args.host,
+            open_browser=not args.no_browser,
+            show_connection_info=False,
+            timeout=0,
+        )
+    finally:
+        sys.argv = argv
+        if app.source is not None:
+            app.source.close()
+    return 0
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    """The ``gui`` options."""
+    p.add_argument("--left", help="left camera: device index, video file or image pattern")
+    p.add_argument("--right", help="right camera: device index, video file or image pattern")
+    p.add_argument("--calib", help="calibration of the camera pair (YAML/JSON, calib.txt, KITTI)")
+    p.add_argument(
+        "--data",
+        action="append",
+        metavar="DIR",
+        help="folder the page may open files from (repeatable; the demo data is always allowed)",
+    )
+    p.add_argument("--port", type=int, default=DEFAULT_PORT, help=f"default {DEFAULT_PORT}")
+    p.add_argument("--host", default=DEFAULT_HOST, help=f"listen address (default {DEFAULT_HOST})")
+    p.add_argument("--no-browser", action="store_true", help="do not open a browser")
+
+
+def add_cli(subparsers: Any) -> None:
+    """Register ``stereovision gui`` on the CLI's sub-parsers."""
+    p = subparsers.add_parser("gui", help="three-panel stereo GUI in the browser (trame)")
+    add_arguments(p)
+    p.set_defaults(func=cmd_gui)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """``python -m stereovision.gui``: as ``stereovision gui`` (errors: one line, exit 2)."""
+    p = argparse.ArgumentParser(prog="stereovision gui", description=__doc__.splitlines()[0])
+    add_arguments(p)
+    args = p.parse_args(argv)
+    try:
+        return cmd_gui(args)
+    except KeyboardInterrupt:
+        return 130
+    except (ValueError, OSError, RuntimeError) as exc:
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        print(f"stereovision: error: {msg}", file=sys.stderr)
+        return 2

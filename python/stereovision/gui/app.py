@@ -1,0 +1,885 @@
+"""The three-panel stereo GUI as a local web app (trame + pyvista, rendered on the server).
+
+Panels (the paper's three windows):
+
+1. **Acquisition**: the left and right images, the source (bundled demo scene, a scene folder,
+   a pair of image files, or live camera sources), the processing resolution, and a capture button
+   that grabs a new pair from the cameras.
+2. **Stereo output**: the disparity map and the colour depth map side by side, the method
+   selector and, for sparse methods, the matches drawn between the two images.
+3. **3-D view**: the textured depth surface (or a loaded point cloud) with the roll / pitch / yaw
+   and forward / up / right controls, and the mouse.
+
+Depth is computed in a worker thread; the page shows a progress bar and stays responsive. VTK
+renders on the server (offscreen) and streams images to the page, so no GPU or display is needed
+on the robot. Errors (a file that is not a point cloud, a camera that does not open, a path
+outside the allowed folders) appear in an alert and leave the page usable.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import base64
+import concurrent.futures
+import logging
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from stereovision.gui.sources import (
+    CLOUD_SUFFIXES,
+    IMAGE_SUFFIXES,
+    AllowedFolders,
+    StereoSource,
+    open_stereo_source,
+    parse_source,
+    scale_pair,
+    scaled_calibration,
+)
+
+__all__ = ["EXTRA_METHODS", "RESOLUTIONS", "StereoApp", "compute_view"]
+
+log = logging.getLogger(__name__)
+
+#: Processing widths offered by the resolution control ("full" keeps the input size).
+RESOLUTIONS = ("full", "640", "320")
+
+#: OpenCV references offered beside the package's matchers (evaluation.md baselines).
+EXTRA_METHODS = ("opencv-sgbm", "opencv-bm")
+
+#: Methods whose output is sparse: their matches are drawn on the image pair.
+SPARSE_METHODS = frozenset({"mcgm", "hopfield"})
+
+#: A result with fewer valid pixels than this fraction is treated as sparse (matches drawn).
+SPARSE_DENSITY = 0.2
+
+#: At most this many matches are drawn (evenly sampled), so the drawing stays readable.
+MAX_DRAWN_MATCHES = 150
+
+#: Images sent to the page are at most this wide (JPEG), to keep the websocket light.
+DISPLAY_WIDTH = 480
+JPEG_QUALITY = 85
+
+#: The 3-D surface uses every ``step``-th pixel so that it has at most this many vertices.
+MAX_MESH_VERTICES = 120_000
+
+#: Progress (per cent) reached at each stage reported by ``depth_map``.
+_STAGE_PROGRESS = {"rectify": 10, "prepare": 20, "match": 80, "triangulate": 90}
+
+#: Camera slider ranges: degrees for the rotations, metres for the translations.
+ANGLE_RANGE = 90.0
+TRANSLATION_RANGE = 5.0
+
+_CONTROL_NAMES = ("roll", "pitch", "yaw", "forward", "up", "right")
+
+
+def _data_url(image: npt.NDArray[np.uint8], width: int = DISPLAY_WIDTH) -> str:
+    """A BGR image as a JPEG ``data:`` URL, scaled down to ``width`` pixels."""
+    if image.shape[1] > width:
+        h = max(1, round(image.shape[0] * width / image.shape[1]))
+        image = cv2.resize(image, (width, h), interpolation=cv2.INTER_AREA)
+    ok, buf = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY])
+    if not ok:
+        raise OSError("could not encode an image for the page")
+    return "data:image/jpeg;base64," + base64.b64encode(buf.tobytes()).decode("ascii")
+
+
+def draw_matches(
+    left: npt.NDArray[np.uint8],
+    right: npt.NDArray[np.uint8],
+    disparity: npt.NDArray[np.float32],
+    max_matches: int = MAX_DRAWN_MATCHES,
+) -> npt.NDArray[np.uint8]:
+    """The pair side by side with lines from each matched left pixel to ``x - d`` on the right.
+
+    Parameters
+    ----------
+    left, right : ndarray, uint8 (H, W, 3)
+        BGR rectified pair.
+    disparity : ndarray, float32 (H, W)
+        NaN where there is no match.
+    max_matches : int
+        Evenly sampled subset drawn.
+
+    Returns
+    -------
+    ndarray, uint8 (H, 2W, 3)
+    """
+    w = disparity.shape[1]
+    canvas = np.hstack([left, right]).copy()
+    ys, xs = np.nonzero(np.isfinite(disparity))
+    if len(xs) == 0:
+        return canvas
+    pick = np.linspace(0, len(xs) - 1, min(max_matches, len(xs))).astype(int)
+    for i in pick:
+        x, y = int(xs[i]), int(ys[i])
+        xr = round(x - float(disparity[y, x])) + w
+        hue = int(179 * i / max(1, len(xs)))
+        colour = cv2.cvtColor(np.uint8([[[hue, 255, 255]]]), cv2.COLOR_HSV2BGR)[0, 0]
+        c = tuple(int(v) for v in colour)
+        cv2.line(canvas, (x, y), (xr, y), c, 1, cv2.LINE_AA)
+        cv2.circle(canvas, (x, y), 2, c, -1)
+        cv2.circle(canvas, (xr, y), 2, c, -1)
+    return canvas
+
+
+@dataclass
+class ViewData:
+    """Everything the page shows for one computed pair (built in the worker thread)."""
+
+    result: Any
+    left_url: str
+    right_url: str
+    disparity_url: str
+    depth_url: str
+    matches_url: str
+    mesh: Any
+    intrinsics: Any
+    stats: str
+    message_3d: str
+
+
+def _opencv_result(method: str, left: np.ndarray, right: np.ndarray, calib: Any, d_max: int) -> Any:
+    """A ``DepthResult`` from an OpenCV reference matcher (for comparison in the GUI)."""
+    from stereovision import baselines
+    from stereovision.depth import DepthResult
+
+    if calib is not None and not calib.rectified:
+        left, right = calib.rectify(left, right)
+        calib = calib.rectified_calibration()
+    fn = baselines.opencv_sgbm if method == "opencv-sgbm" else baselines.opencv_bm
+    disp = np.ascontiguousarray(fn(left, right, d_max), dtype=np.float32)
+    valid = np.isfinite(disp)
+    depth = None
+    points = np.zeros((0, 3), np.float32)
+    colors = np.zeros((0, 3), np.uint8)
+    pixels = np.zeros((0, 2), np.int32)
+    if calib is not None:
+        depth = calib.depth_from_disparity(disp).astype(np.float32)
+        xyz = calib.reproject(disp)
+        ok = np.isfinite(depth) & (depth > 0)
+        ys, xs = np.nonzero(ok)
+        points = np.ascontiguousarray(xyz[ys, xs], dtype=np.float32)
+        colors = np.ascontiguousarray(left[ys, xs, ::-1], dtype=np.uint8)
+        pixels = np.stack([xs, ys], axis=1).astype(np.int32)
+    return DepthResult(
+        disparity=disp,
+        confidence=valid.astype(np.float32),
+        depth=depth,
+        points=points,
+        colors=colors,
+        pixels=pixels,
+        method=method,
+        max_disparity=int(d_max),
+        calibration=calib,
+        left_rectified=np.ascontiguousarray(left),
+    )
+
+
+def compute_view(
+    left: npt.NDArray[np.uint8],
+    right: npt.NDArray[np.uint8],
+    calib: Any,
+    method: str,
+    *,
+    width: int | None = None,
+    max_disparity: int | None = None,
+    progress: Any = None,
+) -> ViewData:
+    """Depth of one pair and every picture the page shows of it (runs in the worker thread).
+
+    Parameters
+    ----------
+    left, right : ndarray, uint8 (H, W, 3)
+        BGR pair.
+    calib : Calibration or None
+        For the input size; scaled with the images.
+    method : str
+        A name of ``stereovision.depth.METHODS`` or :data:`EXTRA_METHODS`.
+    width : int, optional
+        Processing width (images scaled down to it).
+    max_disparity : int, optional
+        At the input size; scaled with the images (None: chosen from the images).
+    progress : callable, optional
+        Called with ``(percent, text)``.
+
+    Raises
+    ------
+    ValueError
+        Unknown method, calibration for another image size, bad images.
+    """
+    from stereovision.cli import colorize
+    from stereovision.depth import METHODS, depth_map, estimate_max_disparity
+    from stereovision.render import Intrinsics, surface_mesh
+
+    def report(pct: int, text: str) -> None:
+        if progress is not None:
+            progress(pct, text)
+
+    if method not in METHODS and method not in EXTRA_METHODS:
+        raise ValueError(f"unknown method {method!r}")
+    if calib is not None and tuple(calib.image_size) != (left.shape[1], left.shape[0]):
+        w, h = calib.image_size
+        raise ValueError(
+            f"calibration is for {w}x{h} images, the cameras give {left.shape[1]}x{left.shape[0]}"
+        )
+    left_s, right_s, s = scale_pair(left, right, width)
+    calib_s = scaled_calibration(calib, s, (left_s.shape[1], left_s.shape[0]))
+    d_max = None if max_disparity is None else max(16, math.ceil(max_disparity * s / 16) * 16)
+    t0 = time.perf_counter()
+    report(5, f"{method}: matching {left_s.shape[1]}x{left_s.shape[0]}")
+    if method in EXTRA_METHODS:
+        d = d_max or estimate_max_disparity(left_s, right_s)
+        result = _opencv_result(method, left_s, right_s, calib_s, d)
+    else:
+
+        def stage(name: str) -> None:
+            report(_STAGE_PROGRESS.get(name, 50), f"{method}: {name} done")
+
+        result = depth_map(
+            left_s, right_s, calib_s, method=method, max_disparity=d_max, progress=stage
+        )
+    elapsed = time.perf_counter() - t0
+    report(92, "drawing")
+    shown_left = result.left_rectified if result.left_rectified is not None else left_s
+    disparity_url = _data_url(colorize(result.disparity, lo=0.0))
+    depth_img = np.zeros_like(shown_left)
+    if result.depth is not None:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = np.where(np.isfinite(result.depth), 1.0 / result.depth, np.nan)
+        depth_img = colorize(inv)
+    matches_url = ""
+    if method in SPARSE_METHODS or result.density < SPARSE_DENSITY:
+        matches_url = _data_url(draw_matches(left_s, right_s, result.disparity), 2 * DISPLAY_WIDTH)
+    mesh = None
+    intr = None
+    message_3d = ""
+    if result.depth is None:
+        message_3d = "No calibration: give --calib to see the scene in 3-D."
+    elif len(result.points) == 0:
+        message_3d = "Empty point cloud: the matcher found no depth in this pair."
+    else:
+        report(95, "building the 3-D surface")
+        step = max(1, math.ceil(math.sqrt(len(result.points) / MAX_MESH_VERTICES)))
+        mesh = surface_mesh(result, step=step)
+        intr = Intrinsics.from_result(result)
+    stats = (
+        f"{method} · {left_s.shape[1]}×{left_s.shape[0]} · disparities 0–{result.max_disparity}"
+        f" px · density {100 * result.density:.0f} % · {elapsed:.2f} s"
+    )
+    if result.depth is not None and len(result.points):
+        stats += f" · median depth {float(np.median(result.points[:, 2])):.2f} m"
+    return ViewData(
+        result=result,
+        left_url=_data_url(shown_left),
+        right_url=_data_url(right_s),
+        disparity_url=disparity_url,
+        depth_url=_data_url(depth_img),
+        matches_url=matches_url,
+        mesh=mesh,
+        intrinsics=intr,
+        stats=stats,
+        message_3d=message_3d,
+    )
+
+
+class StereoApp:
+    """The trame application: state, controllers, layout and the worker thread.
+
+    Parameters
+    ----------
+    server : trame server
+        From ``trame.app.get_server(client_type="vue3")``.
+    folders : AllowedFolders
+        Where files chosen on the page may come from.
+    demo_scene : Path
+        Scene shown when no camera source is given.
+    source : StereoSource, optional
+        Opened live / video camera pair (``--left`` / ``--right``).
+    calib : Calibration, optional
+        Calibration of the camera pair (``--calib``).
+    """
+
+    def __init__(
+        self,
+        server: Any,
+        folders: AllowedFolders,
+        demo_scene: Path,
+        source: StereoSource | None = None,
+        calib: Any = None,
+        source_names: tuple[str, str] = ("", ""),
+    ) -> None:
+        import pyvista as pv
+
+        from stereovision.depth import METHODS
+        from stereovision.render import make_plotter
+
+        pv.OFF_SCREEN = True
+        self.server = server
+        self.state = server.state
+        self.ctrl = server.controller
+        self.folders = folders
+        self.demo_scene = demo_scene
+        self.source = source
+        self.source_calib = calib
+        self.pair: tuple[np.ndarray, np.ndarray] | None = None
+        self.calib: Any = None
+        self.max_disparity: int | None = None
+        self.view: ViewData | None = None
+        self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1)
+        self._generation = 0
+        self._lock: asyncio.Lock | None = None
+        self.plotter = make_plotter((640, 480))
+        self._remote_view: Any = None
+
+        st = self.state
+        st.methods = [*METHODS, *EXTRA_METHODS]
+        st.method = METHODS[0]
+        st.resolutions = list(RESOLUTIONS)
+        st.resolution = RESOLUTIONS[0]
+        st.busy = False
+        st.progress = 0
+        st.status = "starting"
+        st.error = ""
+        st.computations = 0
+        st.captures = 0
+        st.img_left = st.img_right = st.img_disparity = st.img_depth = st.img_matches = ""
+        st.stats = ""
+        st.message_3d = ""
+        st.source_label = ""
+        st.cam_left, st.cam_right = source_names
+        st.live = source is not None
+        st.scene = ""
+        st.scenes = []
+        st.cloud_path = ""
+        st.clouds = []
+        st.left_file = st.right_file = ""
+        st.images = []
+        st.view_mode = "surface"
+        for name in _CONTROL_NAMES:
+            st[name] = 0.0
+        self._refresh_file_lists()
+        self._build_ui()
+        st.change(*_CONTROL_NAMES)(self._on_controls)
+        st.change("method", "resolution")(self._on_method)
+        st.change("view_mode")(self._on_view_mode)
+        st.change("scene")(self._on_scene)
+        self.ctrl.on_server_ready.add(self._on_ready)
+
+    # ------------------------------------------------------------------------- helpers
+
+    def _refresh_file_lists(self) -> None:
+        f = self.folders
+        self.state.scenes = [{"title": f.label(p), "value": str(p)} for p in f.scenes()]
+        self.state.clouds = [
+            {"title": f.label(p), "value": str(p)} for p in f.files(CLOUD_SUFFIXES)
+        ]
+        self.state.images = [
+            {"title": f.label(p), "value": str(p)} for p in f.files(IMAGE_SUFFIXES)
+        ]
+
+    def _fail(self, exc: BaseException) -> None:
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        log.info("gui error: %s", msg)
+        with self.state:
+            self.state.error = msg
+            self.state.busy = False
+            self.state.status = "error"
+
+    def _spawn(self, coro: Any) -> None:
+        from trame.app import asynchronous
+
+        asynchronous.create_task(coro)
+
+    # ------------------------------------------------------------------------- sources
+
+    def _load_scene(self, path: str | Path) -> None:
+        from stereovision.io import load_scene
+
+        scene_dir = self.folders.resolve(path) if Path(path) != self.demo_scene else Path(path)
+        scene = load_scene(scene_dir)
+        self.pair = (scene.left, scene.right)
+        self.calib = scene.calib
+        self.max_disparity = scene.max_disparity
+        self.state.source_label = f"scene {self.folders.label(scene_dir)}"
+
+    def _grab(self) -> None:
+        if self.source is None:
+            raise OSError("no camera open: give --left/--right or open cameras below")
+        left, right = self.source.read()
+        if left.shape != right.shape:
+            raise ValueError(f"the cameras give different sizes: {left.shape} and {right.shape}")
+        self.pair = (left, right)
+        self.calib = self.source_calib
+        self.max_disparity = None
+        self.state.source_label = f"cameras {self.state.cam_left} / {self.state.cam_right}"
+
+    def _camera_source(self, text: str) -> int | str:
+        src = parse_source(text)
+        if isinstance(src, str):
+            return str(self.folders.resolve(src))  # files only from the allowed folders
+        return src
+
+    # ------------------------------------------------------------------------- controllers
+
+    def _on_ready(self, **_: Any) -> None:
+        self._lock = asyncio.Lock()
+        try:
+            if self.source is not None:
+                self._grab()
+            else:
+                self._load_scene(self.demo_scene)
+        except (ValueError, OSError, RuntimeError) as exc:
+            self._fail(exc)
+            return
+        self._spawn(self.recompute())
+
+    def _on_method(self, **_: Any) -> None:
+        if self.pair is not None:
+            self._spawn(self.recompute())
+
+    def _on_scene(self, scene: str = "", **_: Any) -> None:
+        if not scene:
+            return
+        try:
+            self._load_scene(scene)
+        except (ValueError, OSError, RuntimeError) as exc:
+            self._fail(exc)
+            return
+        self._spawn(self.recompute())
+
+    def capture(self) -> None:
+        """Grab a new pair from the cameras and recompute."""
+        try:
+            self._grab()
+            self.state.captures += 1
+        except (ValueError, OSError, RuntimeError) as exc:
+            self._fail(exc)
+            return
+        self._spawn(self.recompute())
+
+    def open_cameras(self) -> None:
+        """Open the camera sources typed on the page (device index or allowed file)."""
+        try:
+            left = self._camera_source(self.state.cam_left)
+            right = self._camera_source(self.state.cam_right)
+            source = open_stereo_source(left, right)
+        except (ValueError, OSError, RuntimeError) as exc:
+            self._fail(exc)
+            return
+        if self.source is not None:
+            self.source.close()
+        self.source = source
+        self.state.live = True
+        self.state.error = ""
+        self.capture()
+
+    def load_files(self) -> None:
+        """Use the chosen left / right image files (calibration: ``--calib`` if its size fits)."""
+        from stereovision.io import imread
+
+        try:
+            left = imread(self.folders.resolve(self.state.left_file))
+            right = imread(self.folders.resolve(self.state.right_file))
+            if left.shape != right.shape:
+                raise ValueError(f"left {left.shape} and right {right.shape} differ in size")
+        except (ValueError, OSError) as exc:
+            self._fail(exc)
+            return
+        self.pair = (left, right)
+        c = self.source_calib
+        fits = c is not None and tuple(c.image_size) == (left.shape[1], left.shape[0])
+        self.calib = c if fits else None
+        self.max_disparity = None
+        self.state.source_label = "files"
+        self._spawn(self.recompute())
+
+    def open_cloud(self) -> None:
+        """Show a point-cloud file (PLY / PCD / NPZ) from the allowed folders in the 3-D view."""
+        from stereovision.export import load_cloud
+        from stereovision.render import point_cloud
+
+        try:
+            path = self.folders.resolve(self.state.cloud_path)
+            pts, cols = load_cloud(path)
+            cloud = point_cloud(pts, cols)
+        except (ValueError, OSError) as exc:
+            self._fail(exc)
+            return
+        self._show_geometry(cloud, None)
+        with self.state:
+            self.state.error = ""
+            self.state.message_3d = f"{self.folders.label(path)}: {cloud.n_points} points"
+
+    def reset_camera(self) -> None:
+        """Back to the left camera's pose (all six controls at zero)."""
+        with self.state:
+            for name in _CONTROL_NAMES:
+                self.state[name] = 0.0
+        self._apply_camera()
+
+    # ------------------------------------------------------------------------- worker
+
+    async def recompute(self) -> None:
+        """Compute the current pair in the worker thread; the newest request wins."""
+        if self.pair is None or self._lock is None:
+            return
+        self._generation += 1
+        gen = self._generation
+        async with self._lock:
+            if gen != self._generation:
+                return  # a newer request is queued behind us
+            loop = asyncio.get_running_loop()
+            left, right = self.pair
+            calib, d_max = self.calib, self.max_disparity
+            method = self.state.method
+            res = self.state.resolution
+            width = None if res == "full" else int(res)
+            with self.state:
+                self.state.busy = True
+                self.state.progress = 1
+                self.state.status = f"computing ({method})"
+
+            def progress(pct: int, text: str) -> None:
+                loop.call_soon_threadsafe(self._set_progress, pct, text)
+
+            try:
+                view = await loop.run_in_executor(
+                    self._executor,
+                    lambda: compute_view(
+                        left,
+                        right,
+                        calib,
+                        method,
+                        width=width,
+                        max_disparity=d_max,
+                        progress=progress,
+                    ),
+                )
+            except (ValueError, OSError, RuntimeError) as exc:
+                self._fail(exc)
+                return
+            self._publish(view)
+
+    def _set_progress(self, pct: int, text: str) -> None:
+        with self.state:
+            self.state.progress = pct
+            self.state.status = text
+
+    def _publish(self, view: ViewData) -> None:
+        self.view = view
+        if view.mesh is not None:
+            self._show_geometry(view.mesh, view.intrinsics)
+        else:
+            self.plotter.remove_actor("scene")
+            self._update_view()
+        with self.state:
+            st = self.state
+            st.img_left, st.img_right = view.left_url, view.right_url
+            st.img_disparity, st.img_depth = view.disparity_url, view.depth_url
+            st.img_matches = view.matches_url
+            st.stats = view.stats
+            st.message_3d = view.message_3d
+            st.progress = 100
+            st.busy = False
+            st.status = "ready"
+            st.error = ""
+            st.computations += 1
+
+    # ------------------------------------------------------------------------- 3-D view
+
+    def _geometry_for_mode(self) -> Any:
+        from stereovision.render import point_cloud
+
+        v = self.view
+        if v is None or v.mesh is None:
+            return None
+        if self.state.view_mode == "points":
+            return point_cloud(v.result.points, v.result.colors)
+        return v.mesh
+
+    def _show_geometry(self, geometry: Any, intrinsics: Any) -> None:
+        from stereovision.render import add_geometry, median_depth
+
+        self._intrinsics = intrinsics
+        self._focal = median_depth(geometry)
+        add_geometry(self.plotter, geometry)
+        self._apply_camera()
+
+    def _apply_camera(self) -> None:
+        from stereovision.render import CameraControls, apply_camera
+
+        try:
+            controls = CameraControls(**{n: float(self.state[n]) for n in _CONTROL_NAMES})
+        except (TypeError, ValueError) as exc:
+            self._fail(exc)
+            return
+        apply_camera(
+            self.plotter,
+            controls,
+            intrinsics=getattr(self, "_intrinsics", None),
+            focal_distance=getattr(self, "_focal", 1.0),
+        )
+        self._update_view()
+
+    def _update_view(self) -> None:
+        if self._remote_view is not None:
+            self._remote_view.update()
+
+    def _on_controls(self, **_: Any) -> None:
+        self._apply_camera()
+
+    def _on_view_mode(self, **_: Any) -> None:
+        geometry = self._geometry_for_mode()
+        if geometry is not None:
+            self._show_geometry(geometry, self.view.intrinsics if self.view else None)
+
+    # ------------------------------------------------------------------------- layout
+
+    def _build_ui(self) -> None:
+        from trame.ui.vuetify3 import SinglePageLayout
+        from trame.widgets import html
+        from trame.widgets import vuetify3 as v3
+        from trame_pyvista.ui import plotter_ui
+
+        ctrl = self.ctrl
+        ctrl.capture = self.capture
+        ctrl.open_cameras = self.open_cameras
+        ctrl.load_files = self.load_files
+        ctrl.open_cloud = self.open_cloud
+        ctrl.reset_camera = self.reset_camera
+        img_style = "width: 100%; display: block; background: #222; min-height: 60px;"
+
+        with SinglePageLayout(self.server, full_height=True) as layout:
+            layout.title.set_text("stereovision")
+            with layout.toolbar:
+                v3.VSpacer()
+                html.Span("{{ status }}", id="status", classes="text-body-2 mr-4")
+                html.Span("{{ computations }}", id="computations", style="display: none")
+                v3.VProgressLinear(
+                    model_value=("progress",),
+                    active=("busy",),
+                    indeterminate=("busy && progress < 20",),
+                    absolute=True,
+                    location="bottom",
+                    color="primary",
+                    id="progress",
+                )
+            with layout.content:
+                with v3.VContainer(fluid=True, classes="pa-2"):
+                    v3.VAlert(
+                        "{{ error }}",
+                        v_if="error",
+                        type="error",
+                        closable=True,
+                        density="compact",
+                        classes="mb-2",
+                        id="error-alert",
+                        click_close="error = ''",
+                    )
+                    with v3.VRow(dense=True):
+                        with v3.VCol(cols=12, md=4):
+                            self._panel_acquisition(v3, html, img_style)
+                        with v3.VCol(cols=12, md=4):
+                            self._panel_stereo(v3, html, img_style)
+                        with v3.VCol(cols=12, md=4):
+                            with v3.VCard(id="panel-3d", classes="fill-height"):
+                                v3.VCardTitle("3 · 3-D view")
+                                with v3.VCardText():
+                                    with html.Div(
+                                        id="view-3d", style="height: 360px; position: relative;"
+                                    ):
+                                        self._remote_view = plotter_ui(
+                                            self.plotter,
+                                            mode="server",
+                                            add_menu=False,
+                                            server=self.server,
+                                        )
+                                    html.Div(
+                                        "{{ message_3d }}",
+                                        v_if="message_3d",
+                                        id="message-3d",
+                                        classes="text-caption mt-1",
+                                    )
+                                    self._camera_controls(v3, html)
+
+    def _panel_acquisition(self, v3: Any, html: Any, img_style: str) -> None:
+        with v3.VCard(id="panel-acquisition", classes="fill-height"):
+            v3.VCardTitle("1 · Acquisition")
+            with v3.VCardText():
+                html.Div("{{ source_label }}", id="source-label", classes="text-caption mb-1")
+                with v3.VRow(dense=True):
+                    with v3.VCol(cols=6):
+                        html.Div("left", classes="text-caption")
+                        html.Img(id="img-left", src=("img_left",), style=img_style)
+                    with v3.VCol(cols=6):
+                        html.Div("right", classes="text-caption")
+                        html.Img(id="img-right", src=("img_right",), style=img_style)
+                with v3.VRow(dense=True, classes="mt-2", align="center"):
+                    with v3.VCol(cols=6):
+                        v3.VBtn(
+                            "Capture",
+                            id="capture-btn",
+                            color="primary",
+                            block=True,
+                            click=self.ctrl.capture,
+                            disabled=("!live",),
+                            prepend_icon="mdi-camera",
+                        )
+                    with v3.VCol(cols=6):
+                        html.Div("resolution", classes="text-caption")
+                        with v3.VBtnToggle(
+                            v_model=("resolution",),
+                            mandatory=True,
+                            density="compact",
+                            divided=True,
+                            variant="outlined",
+                            id="resolution-toggle",
+                        ):
+                            for r in RESOLUTIONS:
+                                v3.VBtn(r, value=r, id=f"resolution-{r}", size="small")
+                v3.VSelect(
+                    label="Scene folder",
+                    v_model=("scene",),
+                    items=("scenes",),
+                    density="compact",
+                    hide_details=True,
+                    classes="mt-3",
+                    id="scene-select",
+                )
+                with v3.VRow(dense=True, classes="mt-1"):
+                    with v3.VCol(cols=5):
+                        v3.VCombobox(
+                            label="Left image",
+                            v_model=("left_file",),
+                            items=("images",),
+                            item_title="title",
+                            item_value="value",
+                            return_object=False,
+                            density="compact",
+                            hide_details=True,
+                            id="left-file",
+                        )
+                    with v3.VCol(cols=5):
+                        v3.VCombobox(
+                            label="Right image",
+                            v_model=("right_file",),
+                            items=("images",),
+                            item_title="title",
+                            item_value="value",
+                            return_object=False,
+                            density="compact",
+                            hide_details=True,
+                            id="right-file",
+                        )
+                    with v3.VCol(cols=2):
+                        v3.VBtn("Load", click=self.ctrl.load_files, id="load-files", block=True)
+                with v3.VRow(dense=True, classes="mt-1"):
+                    with v3.VCol(cols=5):
+                        v3.VTextField(
+                            label="Left camera",
+                            v_model=("cam_left",),
+                            density="compact",
+                            hide_details=True,
+                            id="cam-left",
+                        )
+                    with v3.VCol(cols=5):
+                        v3.VTextField(
+                            label="Right camera",
+                            v_model=("cam_right",),
+                            density="compact",
+                            hide_details=True,
+                            id="cam-right",
+                        )
+                    with v3.VCol(cols=2):
+                        v3.VBtn("Open", click=self.ctrl.open_cameras, id="cam-open", block=True)
+
+    def _panel_stereo(self, v3: Any, html: Any, img_style: str) -> None:
+        with v3.VCard(id="panel-stereo", classes="fill-height"):
+            v3.VCardTitle("2 · Stereo output")
+            with v3.VCardText():
+                with v3.VBtnToggle(
+                    v_model=("method",),
+                    mandatory=True,
+                    density="compact",
+                    divided=True,
+                    variant="outlined",
+                    id="method-toggle",
+                    classes="flex-wrap",
+                ):
+                    for m in self.state.methods:
+                        v3.VBtn(m, value=m, id=f"method-{m}", size="small")
+                with v3.VRow(dense=True, classes="mt-2"):
+                    with v3.VCol(cols=6):
+                        html.Div("disparity", classes="text-caption")
+                        html.Img(id="img-disparity", src=("img_disparity",), style=img_style)
+                    with v3.VCol(cols=6):
+                        html.Div("depth (near = warm)", classes="text-caption")
+                        html.Img(id="img-depth", src=("img_depth",), style=img_style)
+                with html.Div(v_if="img_matches", classes="mt-2"):
+                    html.Div("matches", classes="text-caption")
+                    html.Img(id="img-matches", src=("img_matches",), style=img_style)
+                html.Div("{{ stats }}", id="stats", classes="text-caption mt-2")
+
+    def _camera_controls(self, v3: Any, html: Any) -> None:
+        with v3.VRow(dense=True, classes="mt-2", align="center"):
+            with v3.VCol(cols=8):
+                with v3.VBtnToggle(
+                    v_model=("view_mode",),
+                    mandatory=True,
+                    density="compact",
+                    divided=True,
+                    variant="outlined",
+                    id="view-mode",
+                ):
+                    v3.VBtn("surface", value="surface", size="small")
+                    v3.VBtn("points", value="points", size="small")
+            with v3.VCol(cols=4):
+                v3.VBtn(
+                    "Reset",
+                    click=self.ctrl.reset_camera,
+                    size="small",
+                    id="reset-camera",
+                    block=True,
+                )
+        sliders = [
+            ("roll", "roll (°)", ANGLE_RANGE, 1.0),
+            ("pitch", "pitch (°)", ANGLE_RANGE, 1.0),
+            ("yaw", "yaw (°)", ANGLE_RANGE, 1.0),
+            ("forward", "forward (m)", TRANSLATION_RANGE, 0.05),
+            ("up", "up (m)", TRANSLATION_RANGE, 0.05),
+            ("right", "right (m)", TRANSLATION_RANGE, 0.05),
+        ]
+        for name, label, rng, step in sliders:
+            with html.Div(id=f"slider-{name}"):
+                v3.VSlider(
+                    v_model=(name,),
+                    label=label,
+                    min=-rng,
+                    max=rng,
+                    step=step,
+                    density="compact",
+                    hide_details=True,
+                    thumb_label=True,
+                )
+        with v3.VRow(dense=True, classes="mt-1"):
+            with v3.VCol(cols=9):
+                v3.VCombobox(
+                    label="Point cloud file (PLY / PCD / NPZ)",
+                    v_model=("cloud_path",),
+                    items=("clouds",),
+                    item_title="title",
+                    item_value="value",
+                    return_object=False,
+                    density="compact",
+                    hide_details=True,
+                    id="cloud-path",
+                )
+            with v3.VCol(cols=3):
+                v3.VBtn("Show", click=self.ctrl.open_cloud, id="cloud-open", block=True)

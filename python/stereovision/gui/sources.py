@@ -1,0 +1,317 @@
+"""What the GUI reads: camera pairs (live, video, image sequences) and files from allowed folders.
+
+Two safety rules of the GUI live here:
+
+- :class:`AllowedFolders`: a path coming from the page is accepted only if, with every symbolic
+  link and ``..`` resolved, it lies inside one of the folders named on the command line.
+- Camera sources typed on the page are device indices, or files inside those folders.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Any, Protocol
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "CLOUD_SUFFIXES",
+    "IMAGE_SUFFIXES",
+    "MAX_LISTED",
+    "AllowedFolders",
+    "StereoSource",
+    "VideoPair",
+    "open_stereo_source",
+    "parse_source",
+]
+
+#: File types offered by the page.
+IMAGE_SUFFIXES = frozenset({".png", ".jpg", ".jpeg", ".bmp", ".ppm", ".pgm", ".tif", ".tiff"})
+CLOUD_SUFFIXES = frozenset({".ply", ".pcd", ".npz"})
+VIDEO_SUFFIXES = frozenset({".avi", ".mp4", ".mkv", ".mov", ".webm"})
+
+#: At most this many files / scenes are listed per kind (a huge folder must not stall the page).
+MAX_LISTED = 500
+
+
+class AllowedFolders:
+    """The folders the page may read files from, and the check that keeps it inside them.
+
+    Parameters
+    ----------
+    roots : iterable of path
+        Folders named on the command line (plus the bundled demo data). Each must exist.
+
+    Raises
+    ------
+    FileNotFoundError
+        If a root is not an existing folder.
+    """
+
+    def __init__(self, roots: Iterable[str | os.PathLike[str]]) -> None:
+        resolved: list[Path] = []
+        for r in roots:
+            p = Path(r).expanduser()
+            if not p.is_dir():
+                raise FileNotFoundError(f"data folder not found: {r}")
+            rp = p.resolve()
+            if rp not in resolved:
+                resolved.append(rp)
+        self.roots: tuple[Path, ...] = tuple(resolved)
+
+    def resolve(self, path: str | os.PathLike[str]) -> Path:
+        """The real path of ``path`` if it lies inside an allowed folder.
+
+        Relative paths are taken relative to the first root. Symbolic links and ``..`` are
+        resolved before the check, so neither can lead outside.
+
+        Raises
+        ------
+        ValueError
+            If the resolved path is outside every allowed folder (or empty).
+        FileNotFoundError
+            If it is inside but does not exist.
+        """
+        text = os.fspath(path)
+        if not text or "\x00" in text:
+            raise ValueError("empty or invalid path")
+        p = Path(text).expanduser()
+        if not p.is_absolute():
+            if not self.roots:
+                raise ValueError(f"path outside the allowed folders: {text}")
+            p = self.roots[0] / p
+        real = p.resolve()
+        if not any(real == r or real.is_relative_to(r) for r in self.roots):
+            raise ValueError(f"path outside the allowed folders: {text}")
+        if not real.exists():
+            raise FileNotFoundError(f"no such file: {text}")
+        return real
+
+    def contains(self, path: str | os.PathLike[str]) -> bool:
+        """True if :meth:`resolve` accepts ``path``."""
+        try:
+            self.resolve(path)
+        except (ValueError, OSError):
+            return False
+        return True
+
+    def _walk(self, suffixes: frozenset[str]) -> list[Path]:
+        found: list[Path] = []
+        for root in self.roots:
+            for dirpath, dirnames, filenames in os.walk(root):
+                dirnames[:] = sorted(d for d in dirnames if not d.startswith("."))
+                for name in sorted(filenames):
+                    if Path(name).suffix.lower() in suffixes:
+                        p = Path(dirpath) / name
+                        if self.contains(p):  # a symlink may point outside
+                            found.append(p)
+                            if len(found) >= MAX_LISTED:
+                                return found
+        return found
+
+    def files(self, suffixes: frozenset[str]) -> list[Path]:
+        """Files with one of ``suffixes`` under the roots (sorted, at most :data:`MAX_LISTED`)."""
+        return self._walk(suffixes)
+
+    def scenes(self) -> list[Path]:
+        """Scene folders (``left.png`` + ``right.png``) under the roots."""
+        return sorted(
+            {p.parent for p in self._walk(frozenset({".png"})) if p.name == "left.png"}
+            & {p.parent for p in self._walk(frozenset({".png"})) if p.name == "right.png"}
+        )
+
+    def label(self, path: Path) -> str:
+        """Short display name: ``<root name>/<relative path>``."""
+        for r in self.roots:
+            if path == r or path.is_relative_to(r):
+                rel = path.relative_to(r)
+                return f"{r.name}/{rel}" if str(rel) != "." else r.name
+        return path.name
+
+
+# ----------------------------------------------------------------------------- camera pairs
+
+
+class StereoSource(Protocol):
+    """A pair of synchronised image sources."""
+
+    def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
+        """Grab a new (left, right) BGR pair."""
+        ...
+
+    def close(self) -> None:
+        """Release the devices / files."""
+        ...
+
+
+def parse_source(text: str | int) -> int | str:
+    """A camera source: an integer device index, or a video file / image-sequence pattern."""
+    if isinstance(text, int):
+        return text
+    s = str(text).strip()
+    if not s:
+        raise ValueError("empty camera source")
+    return int(s) if s.isdigit() else s
+
+
+class VideoPair:
+    """Two :class:`cv2.VideoCapture` sources read together (fallback when ``stereovision.capture``
+    is not available).
+
+    Video files and image sequences start again from their first frame when they end, so a
+    recorded pair behaves like a camera that never stops.
+
+    Parameters
+    ----------
+    left, right : int or str
+        Device index, video file, or image-sequence pattern (``"img_%03d.png"``).
+    size : (int, int), optional
+        Requested ``(width, height)`` for devices.
+
+    Raises
+    ------
+    FileNotFoundError
+        A file source that does not exist.
+    OSError
+        A source OpenCV cannot open (``"cannot open camera ..."``) or that gives no frame.
+    """
+
+    def __init__(
+        self, left: int | str, right: int | str, size: tuple[int, int] | None = None
+    ) -> None:
+        self._caps: list[cv2.VideoCapture] = []
+        self._files = []
+        try:
+            for side, src in (("left", left), ("right", right)):
+                src = parse_source(src)
+                is_file = isinstance(src, str)
+                if is_file and "%" not in str(src) and not Path(str(src)).exists():
+                    raise FileNotFoundError(f"{side} camera source not found: {src}")
+                cap = cv2.VideoCapture(src)
+                if not cap.isOpened():
+                    cap.release()
+                    raise OSError(f"cannot open camera {src!r} ({side})")
+                if size is not None and not is_file:
+                    cap.set(cv2.CAP_PROP_FRAME_WIDTH, size[0])
+                    cap.set(cv2.CAP_PROP_FRAME_HEIGHT, size[1])
+                self._caps.append(cap)
+                self._files.append(is_file)
+        except BaseException:
+            self.close()
+            raise
+        self.sources = (left, right)
+
+    def _grab(self, i: int) -> npt.NDArray[np.uint8]:
+        cap = self._caps[i]
+        ok, frame = cap.read()
+        if not ok and self._files[i]:
+            cap.set(cv2.CAP_PROP_POS_FRAMES, 0)
+            ok, frame = cap.read()
+        if not ok or frame is None:
+            raise OSError(f"camera {self.sources[i]!r} gave no frame")
+        if frame.ndim == 2:
+            frame = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)
+        return np.ascontiguousarray(frame, dtype=np.uint8)
+
+    def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
+        """Grab both, then decode both (keeps the pair as close in time as OpenCV allows)."""
+        if not self._caps:
+            raise OSError("camera pair is closed")
+        return self._grab(0), self._grab(1)
+
+    def close(self) -> None:
+        """Release both captures."""
+        for cap in self._caps:
+            cap.release()
+        self._caps = []
+
+
+class _CaptureAdapter:
+    """Wraps ``stereovision.capture.StereoCamera`` into :class:`StereoSource`."""
+
+    def __init__(self, camera: Any) -> None:
+        self._camera = camera
+
+    def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
+        got = self._camera.read()
+        if isinstance(got, tuple) and len(got) == 2:
+            left, right = got
+        elif isinstance(got, tuple) and len(got) == 3 and isinstance(got[0], bool):
+            ok, left, right = got
+            if not ok:
+                raise OSError("camera pair gave no frame")
+        else:
+            left, right = got.left, got.right
+        return np.asarray(left), np.asarray(right)
+
+    def close(self) -> None:
+        for name in ("close", "release"):
+            fn = getattr(self._camera, name, None)
+            if callable(fn):
+                fn()
+                return
+
+
+def open_stereo_source(
+    left: int | str, right: int | str, size: tuple[int, int] | None = None
+) -> StereoSource:
+    """Open a camera pair: ``stereovision.capture.StereoCamera`` if available, else OpenCV.
+
+    Parameters
+    ----------
+    left, right : int or str
+        Device index, video file or image-sequence pattern.
+    size : (int, int), optional
+        Requested ``(width, height)``.
+
+    Raises
+    ------
+    FileNotFoundError, OSError, ValueError
+        A source that does not exist or cannot be opened.
+    """
+    left, right = parse_source(left), parse_source(right)
+    try:
+        from stereovision.capture import StereoCamera
+    except ImportError:
+        return VideoPair(left, right, size)
+    return _CaptureAdapter(StereoCamera(left, right, size=size))
+
+
+def scale_pair(
+    left: npt.NDArray[np.uint8], right: npt.NDArray[np.uint8], width: int | None
+) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8], float]:
+    """Resize both images to ``width`` pixels wide (never up); returns the scale factor too."""
+    w = left.shape[1]
+    if width is None or width >= w:
+        return left, right, 1.0
+    s = width / w
+    size = (width, max(1, round(left.shape[0] * s)))
+    return (
+        cv2.resize(left, size, interpolation=cv2.INTER_AREA),
+        cv2.resize(right, size, interpolation=cv2.INTER_AREA),
+        s,
+    )
+
+
+def scaled_calibration(calib: Any, factor: float, size: Sequence[int]) -> Any:
+    """``calib`` for images scaled by ``factor`` to ``size = (width, height)`` (K, doffs scaled)."""
+    if calib is None or factor == 1.0:
+        return calib
+    from dataclasses import replace
+
+    def k(m: np.ndarray) -> np.ndarray:
+        out = np.array(m, dtype=np.float64)
+        out[0, 0] *= factor
+        out[1, 1] *= factor
+        out[0, 2] = (out[0, 2] + 0.5) * factor - 0.5
+        out[1, 2] = (out[1, 2] + 0.5) * factor - 0.5
+        return out
+
+    doffs = None if calib.doffs is None else calib.doffs * factor
+    return replace(
+        calib, K1=k(calib.K1), K2=k(calib.K2), image_size=(int(size[0]), int(size[1])), doffs=doffs
+    )

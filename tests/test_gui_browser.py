@@ -1,0 +1,404 @@
+"""The GUI: path-escape protection and sources (plain tests), then the page in headless chromium.
+
+The browser tests start ``python -m stereovision.gui`` in a subprocess on a free port with two
+small generated video files as the camera sources, drive the page with Playwright, and save
+screenshots to ``$SV_SCREENSHOT_DIR`` (default ``target/gui-screenshots``). They are skipped when
+chromium or playwright is missing.
+"""
+
+from __future__ import annotations
+
+import argparse
+import base64
+import os
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+import synthetic_scene as syn
+
+from stereovision.gui import sources
+from stereovision.gui.sources import AllowedFolders
+
+REPO = Path(__file__).resolve().parents[1]
+CONES = REPO / "python" / "stereovision" / "data" / "cones"
+CHROMIUM = Path("/usr/bin/chromium")
+CHROMIUM_ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--no-first-run",
+    "--disable-component-update",
+    "--disable-sync",
+]
+SCREENSHOT_DIR = Path(os.environ.get("SV_SCREENSHOT_DIR", REPO / "target" / "gui-screenshots"))
+
+#: Generated camera videos: this many frames, each rolled down by this many rows (both cameras
+#: alike, so rows stay aligned and every capture shows a visibly different pair).
+VIDEO_FRAMES = 3
+VIDEO_ROLL = 25
+
+#: Yaw applied with the keyboard in the 3-D test (degrees) and the mean change it must cause.
+YAW_STEPS = 20
+VIEW_CHANGE = 5.0
+
+#: Upper bounds (ms) for page conditions; waits return as soon as the condition holds.
+STARTUP_TIMEOUT_S = 60
+PAGE_TIMEOUT_MS = 60_000
+
+
+# ----------------------------------------------------------------------------- allowed folders
+
+
+@pytest.fixture
+def tree(tmp_path):
+    """data/ (allowed) with a file, a sub-folder and a symlink out; secret/ beside it."""
+    data = tmp_path / "data"
+    (data / "sub").mkdir(parents=True)
+    (data / "sub" / "a.ply").write_text("x")
+    (data / "img.png").write_bytes(b"png")
+    secret = tmp_path / "secret"
+    secret.mkdir()
+    (secret / "key.ply").write_text("secret")
+    (data / "link.ply").symlink_to(secret / "key.ply")
+    (data / "linkdir").symlink_to(secret)
+    (tmp_path / "data2").mkdir()
+    (tmp_path / "data2" / "b.ply").write_text("y")
+    return data, secret
+
+
+def test_allowed_folders_accept_inside(tree):
+    data, _ = tree
+    folders = AllowedFolders([data])
+    assert folders.resolve(data / "sub" / "a.ply") == (data / "sub" / "a.ply").resolve()
+    assert folders.resolve("sub/a.ply") == (data / "sub" / "a.ply").resolve()  # relative to root
+    assert folders.resolve(data / "sub" / ".." / "img.png") == (data / "img.png").resolve()
+
+
+@pytest.mark.parametrize(
+    "path",
+    [
+        "../secret/key.ply",
+        "sub/../../secret/key.ply",
+        "link.ply",  # symlink to a file outside
+        "linkdir/key.ply",  # symlinked folder outside
+        "/etc/passwd",
+        "../data2/b.ply",  # a sibling whose name starts like the root
+        "",
+    ],
+)
+def test_allowed_folders_reject_escapes(tree, path):
+    data, _ = tree
+    with pytest.raises(ValueError, match=r"outside the allowed folders|empty"):
+        AllowedFolders([data]).resolve(path)
+
+
+def test_allowed_folders_listing_and_errors(tree):
+    data, _ = tree
+    folders = AllowedFolders([data])
+    listed = folders.files(sources.CLOUD_SUFFIXES)
+    assert listed == [(data / "sub" / "a.ply").resolve()] or listed == [data / "sub" / "a.ply"]
+    with pytest.raises(FileNotFoundError, match="no such file"):
+        folders.resolve("sub/missing.ply")
+    with pytest.raises(FileNotFoundError, match="data folder not found"):
+        AllowedFolders([data / "nope"])
+
+
+# ----------------------------------------------------------------------------- sources
+
+
+def _write_video(path: Path, image: np.ndarray, frames: int = VIDEO_FRAMES) -> Path:
+    h, w = image.shape[:2]
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 5, (w, h))
+    assert writer.isOpened(), "OpenCV cannot write MJPG video here"
+    for k in range(frames):
+        writer.write(np.roll(image, VIDEO_ROLL * k, axis=0))
+    writer.release()
+    return path
+
+
+def test_video_pair_reads_frames_and_rewinds(tmp_path):
+    img = syn.left_image()
+    lv = _write_video(tmp_path / "l.avi", img)
+    rv = _write_video(tmp_path / "r.avi", img[:, ::-1].copy())
+    pair = sources.VideoPair(str(lv), str(rv))
+    try:
+        frames = [pair.read() for _ in range(VIDEO_FRAMES + 1)]
+    finally:
+        pair.close()
+    assert frames[0][0].shape == img.shape
+    # Consecutive frames differ (rolled), and after the last frame the video starts again.
+    assert np.abs(frames[0][0].astype(int) - frames[1][0]).mean() > 10
+    assert np.abs(frames[0][0].astype(int) - frames[VIDEO_FRAMES][0]).mean() < 3
+
+
+def test_missing_cameras_clear_errors(tmp_path):
+    with pytest.raises(FileNotFoundError, match="left camera source not found"):
+        sources.VideoPair(str(tmp_path / "none.avi"), str(tmp_path / "none2.avi"))
+    with pytest.raises(OSError, match="cannot open camera 9"):
+        sources.VideoPair(9, 10)
+    with pytest.raises(ValueError, match="empty camera source"):
+        sources.parse_source(" ")
+
+
+def test_gui_cli_errors_exit_2(tmp_path, capsys):
+    from stereovision.gui import main
+
+    assert main(["--left", "0", "--port", "0"]) == 2
+    assert "give both --left and --right" in capsys.readouterr().err
+    assert main(["--left", str(tmp_path / "x.avi"), "--right", str(tmp_path / "y.avi")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("stereovision: error: ") and "not found" in err
+    assert main(["--data", str(tmp_path / "nope")]) == 2
+    assert "data folder not found" in capsys.readouterr().err
+
+
+def test_add_cli_registers_gui():
+    from stereovision.gui import DEFAULT_HOST, add_cli
+
+    parser = argparse.ArgumentParser()
+    add_cli(parser.add_subparsers())
+    args = parser.parse_args(["gui", "--left", "0", "--right", "1", "--no-browser"])
+    assert (args.left, args.right, args.host, args.no_browser) == ("0", "1", DEFAULT_HOST, True)
+    assert DEFAULT_HOST == "127.0.0.1"
+
+
+def test_scaled_calibration_and_compute_view():
+    from stereovision.gui.app import compute_view, draw_matches
+
+    calib = syn.calibration()
+    half = sources.scaled_calibration(calib, 0.5, (syn.W // 2, syn.H // 2))
+    assert half.K1[0, 0] == pytest.approx(syn.F / 2)
+    assert half.K1[0, 2] == pytest.approx((syn.CX + 0.5) / 2 - 0.5)
+    assert half.image_size == (syn.W // 2, syn.H // 2)
+    res = syn.depth_result()
+    right = np.roll(res.left_rectified, -4, axis=1)
+    view = compute_view(res.left_rectified, right, calib, "opencv-sgbm", max_disparity=16)
+    assert view.left_url.startswith("data:image/jpeg;base64,")
+    assert view.disparity_url.startswith("data:image/jpeg;base64,")
+    assert view.result.method == "opencv-sgbm"
+    with pytest.raises(ValueError, match="unknown method"):
+        compute_view(res.left_rectified, right, calib, "nope")
+    small = sources.scale_pair(res.left_rectified, right, 80)[0]
+    with pytest.raises(ValueError, match="calibration is for 160x120"):
+        compute_view(small, small, calib, "opencv-sgbm")
+    sparse = np.full(res.disparity.shape, np.nan, np.float32)
+    sparse[60, 100] = 10.0
+    canvas = draw_matches(res.left_rectified, right, sparse)
+    assert canvas.shape == (syn.H, 2 * syn.W, 3)
+    assert (canvas[60, 100] != np.hstack([res.left_rectified, right])[60, 100]).any()
+
+
+# ----------------------------------------------------------------------------- browser
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return int(s.getsockname()[1])
+
+
+def _wait_port(port: int, proc: subprocess.Popen, deadline_s: float) -> None:
+    end = time.monotonic() + deadline_s
+    while time.monotonic() < end:
+        if proc.poll() is not None:
+            raise RuntimeError(
+                f"gui server exited early:\n{proc.stdout.read() if proc.stdout else ''}"
+            )
+        with socket.socket() as s:
+            if s.connect_ex(("127.0.0.1", port)) == 0:
+                return
+        time.sleep(0.1)  # polling a condition, not a fixed delay
+    raise TimeoutError(f"gui server did not listen on {port} within {deadline_s} s")
+
+
+def _decode(data_url: str) -> np.ndarray:
+    raw = base64.b64decode(data_url.split(",", 1)[1])
+    img = cv2.imdecode(np.frombuffer(raw, np.uint8), cv2.IMREAD_COLOR)
+    assert img is not None
+    return img.astype(np.int16)
+
+
+@pytest.fixture(scope="module")
+def gui_data(tmp_path_factory):
+    """Folder with the two camera videos (from the cones pair) and two bad point-cloud files."""
+    d = tmp_path_factory.mktemp("gui_data")
+    # Video encoders want even sizes: drop the last row of the 450x375 pair (K is unchanged).
+    left = cv2.imread(str(CONES / "left.png"))
+    even_h = left.shape[0] // 2 * 2
+    _write_video(d / "left.avi", left[:even_h])
+    _write_video(d / "right.avi", cv2.imread(str(CONES / "right.png"))[:even_h])
+    calib = (CONES / "calib.txt").read_text()
+    (d / "calib.txt").write_text(calib.replace(f"height={left.shape[0]}", f"height={even_h}"))
+    (d / "fake.ply").write_text("this is not a point cloud\n")
+    from stereovision.io import write_ply
+
+    write_ply(d / "empty.ply", np.zeros((0, 3), np.float32))
+    return d
+
+
+@pytest.fixture(scope="module")
+def page(gui_data):
+    pw = pytest.importorskip("playwright.sync_api")
+    if not CHROMIUM.exists():
+        pytest.skip("chromium not installed (apt-get install -y chromium)")
+    port = _free_port()
+    cmd = [
+        sys.executable, "-m", "stereovision.gui",
+        "--left", str(gui_data / "left.avi"), "--right", str(gui_data / "right.avi"),
+        "--calib", str(gui_data / "calib.txt"), "--data", str(gui_data),
+        "--port", str(port), "--no-browser",
+    ]  # fmt: skip
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        _wait_port(port, proc, STARTUP_TIMEOUT_S)
+        with pw.sync_playwright() as p:
+            browser = p.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
+            pg = browser.new_page(viewport={"width": 1500, "height": 950})
+            pg.set_default_timeout(PAGE_TIMEOUT_MS)
+            pg.goto(f"http://127.0.0.1:{port}/")
+            yield pg
+            browser.close()
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+
+
+def _computations(pg) -> int:
+    return int(pg.inner_text("#computations") or 0)
+
+
+def _wait_computations(pg, n: int) -> None:
+    pg.wait_for_function(
+        f"Number(document.querySelector('#computations')?.textContent) >= {n}"
+        " && document.querySelector('#status')?.textContent.trim() === 'ready'"
+    )
+
+
+def _src(pg, sel: str) -> str:
+    return pg.get_attribute(sel, "src") or ""
+
+
+def _shot(pg, name: str, selector: str | None = None) -> Path:
+    SCREENSHOT_DIR.mkdir(parents=True, exist_ok=True)
+    path = SCREENSHOT_DIR / name
+    (pg.locator(selector) if selector else pg).screenshot(path=str(path))
+    return path
+
+
+def _view_image(pg) -> np.ndarray:
+    path = _shot(pg, "view-3d.png", "#view-3d")
+    img = cv2.imread(str(path))
+    assert img is not None
+    return img.astype(np.int16)
+
+
+def _wait_error(pg, text: str) -> str:
+    pg.wait_for_function(
+        "document.querySelector('#error-alert')?.textContent.includes(" + repr(text) + ")"
+    )
+    return pg.inner_text("#error-alert")
+
+
+def test_page_has_three_panels_and_images(page):
+    for panel in ("#panel-acquisition", "#panel-stereo", "#panel-3d"):
+        page.wait_for_selector(panel, state="visible")
+    _wait_computations(page, 1)
+    for sel in ("#img-left", "#img-right", "#img-disparity", "#img-depth"):
+        assert _src(page, sel).startswith("data:image/jpeg;base64,")
+    assert "1 · Acquisition" in page.inner_text("#panel-acquisition")
+    assert "2 · Stereo output" in page.inner_text("#panel-stereo")
+    assert "3 · 3-D view" in page.inner_text("#panel-3d")
+    assert "median depth" in page.inner_text("#stats")
+    _shot(page, "gui-start.png")
+
+
+def test_capture_changes_images(page):
+    _wait_computations(page, 1)
+    n = _computations(page)
+    before_l, before_r = _src(page, "#img-left"), _src(page, "#img-right")
+    page.click("#capture-btn")
+    _wait_computations(page, n + 1)
+    after_l, after_r = _src(page, "#img-left"), _src(page, "#img-right")
+    assert after_l != before_l and after_r != before_r
+    assert np.abs(_decode(after_l) - _decode(before_l)).mean() > 10  # a new frame, not noise
+
+
+def test_method_switch_updates_disparity(page):
+    from stereovision.depth import METHODS
+
+    other = METHODS[1] if len(METHODS) > 1 else "opencv-sgbm"
+    _wait_computations(page, 1)
+    n = _computations(page)
+    before = _src(page, "#img-disparity")
+    page.click(f"#method-{other}")
+    _wait_computations(page, n + 1)
+    assert page.inner_text("#stats").startswith(other)
+    after = _src(page, "#img-disparity")
+    assert after != before
+    assert np.abs(_decode(after) - _decode(before)).mean() > 3
+    _shot(page, "gui-method.png")
+
+
+def test_3d_view_not_blank_and_follows_sliders(page):
+    _wait_computations(page, 1)
+    page.wait_for_selector("#view-3d canvas", state="attached")
+    page.wait_for_function(
+        "[...document.querySelectorAll('#view-3d img')].some(i => i.src && i.naturalWidth > 0)"
+    )
+    first = _view_image(page)
+    assert first.std() > 20  # a textured scene, not a flat canvas
+    from stereovision.render import BACKGROUND
+
+    bgr_background = np.array(BACKGROUND[::-1])
+    scene = np.abs(first - bgr_background).max(axis=-1) > 10
+    assert scene.mean() > 0.5  # the textured surface fills most of the view
+    thumb = "#slider-yaw [role=slider]"
+    page.focus(thumb)
+    for _ in range(YAW_STEPS):
+        page.keyboard.press("ArrowRight")  # one degree per key, as a user would
+    page.wait_for_function(
+        f"document.querySelector('{thumb}').getAttribute('aria-valuenow') === '{YAW_STEPS}'"
+    )
+    # The server renders the turned camera and streams the frame: poll until it has arrived.
+    deadline = time.monotonic() + PAGE_TIMEOUT_MS / 1000
+    change = 0.0
+    while time.monotonic() < deadline and change <= VIEW_CHANGE:
+        change = float(np.abs(_view_image(page) - first).mean())
+    assert change > VIEW_CHANGE
+    _shot(page, "gui-3d.png")
+
+
+def test_bad_inputs_show_errors_and_page_stays_usable(page, gui_data):
+    _wait_computations(page, 1)
+    cases = [
+        (str(gui_data / "fake.ply"), "not a PLY file"),
+        (str(gui_data / "empty.ply"), "empty point cloud"),
+        (str(gui_data / ".." / ".." / "etc" / "passwd"), "outside the allowed folders"),
+        ("/etc/passwd", "outside the allowed folders"),
+    ]
+    for path, message in cases:
+        page.fill("#cloud-path", path)
+        page.click("#cloud-open")
+        assert message in _wait_error(page, message)
+        page.click("#error-alert button")  # dismiss
+        page.wait_for_selector("#error-alert", state="detached")
+    page.fill("#cam-left", "7")
+    page.fill("#cam-right", "8")
+    page.click("#cam-open")
+    assert "cannot open camera" in _wait_error(page, "camera")
+    _shot(page, "gui-error.png")
+    # Still usable: the previous cameras capture a new pair, the error goes away.
+    n = _computations(page)
+    page.click("#capture-btn")
+    _wait_computations(page, n + 1)
+    page.wait_for_selector("#error-alert", state="detached")
