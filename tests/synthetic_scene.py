@@ -8,6 +8,7 @@ a rectified rig with focal ``F`` px and baseline ``B`` m.
 from __future__ import annotations
 
 import numpy as np
+
 from stereovision.calibration import Calibration
 from stereovision.depth import DepthResult
 

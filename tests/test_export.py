@@ -7,6 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 import synthetic_scene as syn
+
 from stereovision import export
 
 

@@ -67,8 +67,8 @@ BACKGROUND = (32, 32, 36)
 POINT_SIZE = 2.0
 
 #: Default render.png view: orbit around the scene's median depth point by these angles (deg).
-RENDER_YAW_DEG = -25.0
-RENDER_PITCH_DEG = -15.0
+RENDER_YAW_DEG = -12.0
+RENDER_PITCH_DEG = -8.0
 
 #: Largest render side (pixels) of render.png; bigger images are scaled down.
 RENDER_MAX_SIDE = 1024
