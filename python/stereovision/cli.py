@@ -253,10 +253,14 @@ def cmd_eval(args: argparse.Namespace) -> int:
     if not args.json:
         print(header)
         print(sub)
-    for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=args.json or len(dirs) < 2):
+    quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
+    for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
         scene = load_scene(d)
         if scene.gt is None:
-            raise CliError(f"{d}: no ground truth (gt_disp.pfm) to evaluate against")
+            if len(dirs) == 1:
+                raise CliError(f"{d}: no ground truth (gt_disp.pfm) to evaluate against")
+            tqdm.write(f"skipped {d}: no ground truth (gt_disp.pfm)", file=sys.stderr)
+            continue
         row = _eval_scene(scene, args.method, not args.no_opencv)
         rows.append(row)
         if args.json:
