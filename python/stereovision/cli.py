@@ -342,6 +342,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         print(f"stereovision: error: {msg}", file=sys.stderr)
         return EXIT_ERROR
+    except Exception as exc:  # a bug of ours: still one line, never a traceback
+        msg = str(exc).splitlines()[0] if str(exc) else ""
+        print(
+            f"stereovision: error: internal {type(exc).__name__}: {msg} (please report this)",
+            file=sys.stderr,
+        )
+        return EXIT_ERROR
 
 
 if __name__ == "__main__":
