@@ -194,6 +194,47 @@ def test_scaled_calibration_and_compute_view():
     assert (canvas[60, 100] != np.hstack([res.left_rectified, right])[60, 100]).any()
 
 
+def test_app_controllers_report_errors_and_compute(tmp_path):
+    """The page's controllers in-process (no browser): errors land in ``state.error``."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import StereoApp
+
+    app = StereoApp(
+        get_server("test-controllers", client_type="vue3"),
+        AllowedFolders([bundled_data_dir()]),
+        bundled_data_dir() / "cones",
+    )
+    app.state.left_file, app.state.right_file = "/etc/passwd", "cones/right.png"
+    app.load_files()
+    assert app.state.error == "path outside the allowed folders: /etc/passwd"
+    app.state.cloud_path = "cones/left.png"
+    app.open_cloud()
+    assert app.state.error.startswith("not a point cloud file")
+    app.capture()
+    assert app.state.error.startswith("no camera open")
+    app._on_scene(scene="../../../../etc")
+    assert app.state.error == "path outside the allowed folders: ../../../../etc"
+    assert [s["title"] for s in app.state.scenes] == ["data/cones"]
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app.state.method = "opencv-bm"
+        app.state.left_file, app.state.right_file = "cones/left.png", "cones/right.png"
+        app.load_files()  # no --calib: disparity only, the 3-D panel says why it is empty
+        await app.recompute()
+
+    asyncio.run(run())
+    assert app.state.error == ""
+    assert app.state.computations == 1
+    assert app.state.stats.startswith("opencv-bm · 450×375")
+    assert "No calibration" in app.state.message_3d
+
+
 # ----------------------------------------------------------------------------- browser
 
 

@@ -292,6 +292,14 @@ def test_view_bad_inputs_clear_errors(tmp_path):
         render.load_view_source(tmp_path / "emptydir")
 
 
+def test_view_scene_folder_shows_textured_surface():
+    from stereovision.gui import bundled_data_dir
+
+    geometry, intr = render.load_view_source(bundled_data_dir() / "cones")
+    assert intr is not None and (intr.width, intr.height) == (450, 375)
+    assert geometry.n_cells > 100_000 and render.texture_of(geometry) is not None
+
+
 def test_view_via_cli_main(tmp_path, capsys):
     from stereovision import cli
 

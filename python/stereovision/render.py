@@ -509,7 +509,9 @@ def render_view(
         img = plotter.screenshot(return_img=True)
     finally:
         plotter.close()
-    return np.ascontiguousarray(img[..., :3], dtype=np.uint8)
+    if img is None:
+        raise RuntimeError("the offscreen render returned no image")
+    return np.ascontiguousarray(np.asarray(img)[..., :3], dtype=np.uint8)
 
 
 def is_blank(image: npt.NDArray[np.uint8], *, min_fraction: float = 0.01) -> bool:

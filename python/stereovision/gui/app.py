@@ -81,10 +81,11 @@ _CONTROL_NAMES = ("roll", "pitch", "yaw", "forward", "up", "right")
 
 def _data_url(image: npt.NDArray[np.uint8], width: int = DISPLAY_WIDTH) -> str:
     """A BGR image as a JPEG ``data:`` URL, scaled down to ``width`` pixels."""
+    shown: Any = image
     if image.shape[1] > width:
         h = max(1, round(image.shape[0] * width / image.shape[1]))
-        image = cv2.resize(image, (width, h), interpolation=cv2.INTER_AREA)
-    ok, buf = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY])
+        shown = cv2.resize(image, (width, h), interpolation=cv2.INTER_AREA)
+    ok, buf = cv2.imencode(".jpg", shown, [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY])
     if not ok:
         raise OSError("could not encode an image for the page")
     return "data:image/jpeg;base64," + base64.b64encode(buf.tobytes()).decode("ascii")
@@ -121,7 +122,8 @@ def draw_matches(
         x, y = int(xs[i]), int(ys[i])
         xr = round(x - float(disparity[y, x])) + w
         hue = int(179 * i / max(1, len(xs)))
-        colour = cv2.cvtColor(np.uint8([[[hue, 255, 255]]]), cv2.COLOR_HSV2BGR)[0, 0]
+        hsv = np.array([[[hue, 255, 255]]], dtype=np.uint8)
+        colour = np.asarray(cv2.cvtColor(hsv, cv2.COLOR_HSV2BGR))[0, 0]
         c = tuple(int(v) for v in colour)
         cv2.line(canvas, (x, y), (xr, y), c, 1, cv2.LINE_AA)
         cv2.circle(canvas, (x, y), 2, c, -1)
@@ -577,7 +579,9 @@ class StereoApp:
         if view.mesh is not None:
             self._show_geometry(view.mesh, view.intrinsics)
         else:
-            self.plotter.remove_actor("scene")
+            actor = self.plotter.actors.get("scene")
+            if actor is not None:
+                self.plotter.renderer.remove_actor(actor)
             self._update_view()
         with self.state:
             st = self.state

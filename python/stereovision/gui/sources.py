@@ -291,8 +291,8 @@ def scale_pair(
     s = width / w
     size = (width, max(1, round(left.shape[0] * s)))
     return (
-        cv2.resize(left, size, interpolation=cv2.INTER_AREA),
-        cv2.resize(right, size, interpolation=cv2.INTER_AREA),
+        np.asarray(cv2.resize(left, size, interpolation=cv2.INTER_AREA), dtype=np.uint8),
+        np.asarray(cv2.resize(right, size, interpolation=cv2.INTER_AREA), dtype=np.uint8),
         s,
     )
 
