@@ -1,0 +1,400 @@
+"""Stereo calibration from chessboards: accuracy on OpenCV's sample pairs, a synthetic rig with
+known geometry, outliers and rejected pairs, report files, errors and the CLI."""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import pytest
+import yaml
+
+from stereovision import calibrate as calmod
+from stereovision.calibrate import (
+    CalibrationReport,
+    add_cli,
+    board_object_points,
+    board_pose_params,
+    calibrate,
+    find_corners,
+    parse_pattern,
+    render_chessboard,
+)
+from stereovision.calibration import Calibration
+
+DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "chessboard"
+CHESSBOARD_IDS = ("01", "02", "03", "04", "05", "06", "07", "08", "09", "11", "12", "13", "14")
+
+#: Acceptance figures of issue 6 on OpenCV's sample pairs (its stereo_calib pipeline: 0.448 px
+#: RMS and 0.122 px mean |dy|).
+MAX_STEREO_RMS = 0.30
+MAX_MEAN_DY = 0.11
+#: Synthetic rig: focal length and baseline recovered within 0.5 %.
+MAX_REL_ERROR = 0.005
+
+# The synthetic rig (pixels, metres).
+SYN_SIZE = (640, 480)
+SYN_PATTERN = (9, 6)
+SYN_SQUARE = 0.03
+SYN_K1 = np.array([[700.0, 0, 321.5], [0, 702.0, 238.7], [0, 0, 1]])
+SYN_D1 = np.array([-0.12, 0.05, 0.0005, -0.0003, 0.0])
+SYN_K2 = np.array([[690.0, 0, 317.2], [0, 691.0, 242.1], [0, 0, 1]])
+SYN_D2 = np.array([-0.10, 0.03, -0.0004, 0.0002, 0.0])
+SYN_R = cv2.Rodrigues(np.array([0.004, -0.02, 0.003]))[0]
+SYN_T = np.array([-0.06, 0.0008, -0.0012])
+SYN_GOOD_PAIRS = 12
+#: The outlier pair's right board is rendered 8 mm off where the rig geometry puts it.
+SYN_OUTLIER_SHIFT = np.array([0.008, 0.0, 0.0])
+
+
+def _chessboard_paths() -> tuple[list[Path], list[Path]]:
+    if not DATA.is_dir():
+        pytest.skip(f"chessboard data not found at {DATA}")
+    return (
+        [DATA / f"left{i}.jpg" for i in CHESSBOARD_IDS],
+        [DATA / f"right{i}.jpg" for i in CHESSBOARD_IDS],
+    )
+
+
+@pytest.fixture(scope="module")
+def chessboard() -> tuple[Calibration, CalibrationReport]:
+    left, right = _chessboard_paths()
+    return calibrate(left, right, pattern=(9, 6), square_size=1.0)
+
+
+def _visible(p: np.ndarray, margin: float = 15.0) -> bool:
+    p = p.reshape(-1, 2)
+    w, h = SYN_SIZE
+    return bool(p.min() > margin and p[:, 0].max() < w - margin and p[:, 1].max() < h - margin)
+
+
+def _synthetic_pairs() -> tuple[list[np.ndarray], list[np.ndarray], list[str]]:
+    """12 good pairs, one with a blank left image, one whose right view is 8 mm off."""
+    rng = np.random.default_rng(7)
+    obj = board_object_points(SYN_PATTERN, SYN_SQUARE).astype(np.float64)
+    centre = np.array([4 * SYN_SQUARE, 2.5 * SYN_SQUARE, 0.0])
+    left: list[np.ndarray] = []
+    right: list[np.ndarray] = []
+    while len(left) < SYN_GOOD_PAIRS + 1:
+        rv = np.array([rng.uniform(-0.6, 0.6), rng.uniform(-0.6, 0.6), rng.uniform(-0.4, 0.4)])
+        z = rng.uniform(0.35, 0.7)
+        target = np.array(
+            [rng.uniform(-0.12, 0.12) * z / 0.5, rng.uniform(-0.08, 0.08) * z / 0.5, z]
+        )
+        rb = cv2.Rodrigues(rv)[0]
+        tv = target - rb @ centre
+        rv2 = cv2.Rodrigues(SYN_R @ rb)[0]
+        tv2 = SYN_R @ tv + SYN_T
+        if len(left) == SYN_GOOD_PAIRS:
+            tv2 = tv2 + SYN_OUTLIER_SHIFT
+        p1 = cv2.projectPoints(obj, rv, tv, SYN_K1, SYN_D1)[0]
+        p2 = cv2.projectPoints(obj, rv2, tv2, SYN_K2, SYN_D2)[0]
+        if not (_visible(p1) and _visible(p2)):
+            continue
+        kw: dict[str, Any] = {
+            "pattern": SYN_PATTERN,
+            "square_size": SYN_SQUARE,
+            "image_size": SYN_SIZE,
+        }
+        left.append(render_chessboard(SYN_K1, SYN_D1, rv, tv, **kw))
+        right.append(render_chessboard(SYN_K2, SYN_D2, rv2, tv2, **kw))
+    outlier_right = right.pop()
+    outlier_left = left.pop()
+    blank = np.full((SYN_SIZE[1], SYN_SIZE[0]), 128, np.uint8)
+    names = [f"good{i:02d}" for i in range(SYN_GOOD_PAIRS)] + ["blank", "shifted"]
+    return [*left, blank, outlier_left], [*right, right[0], outlier_right], names
+
+
+@pytest.fixture(scope="module")
+def synthetic() -> tuple[list[np.ndarray], list[np.ndarray], list[str]]:
+    return _synthetic_pairs()
+
+
+_CORNER_CACHE: dict[Any, Any] = {}
+
+
+def _cached_find_corners(image: Any, pattern: tuple[int, int] = (9, 6)) -> Any:
+    """find_corners memoised by image content (a later call on the same image is free)."""
+    arr = np.ascontiguousarray(image)
+    key = (hashlib.sha1(arr.tobytes()).hexdigest(), arr.shape, tuple(pattern))
+    if key not in _CORNER_CACHE:
+        _CORNER_CACHE[key] = find_corners(arr, pattern)
+    c = _CORNER_CACHE[key]
+    return None if c is None else c.copy()
+
+
+@pytest.fixture
+def cached_corners(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(calmod, "find_corners", _cached_find_corners)
+
+
+@pytest.fixture(scope="module")
+def synthetic_dropped(
+    synthetic: tuple[list[np.ndarray], list[np.ndarray], list[str]],
+) -> tuple[Calibration, CalibrationReport]:
+    left, right, names = synthetic
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(calmod, "find_corners", _cached_find_corners)
+        return calibrate(
+            left,
+            right,
+            pattern=SYN_PATTERN,
+            square_size=SYN_SQUARE,
+            drop_outliers=True,
+            names=names,
+        )
+
+
+# ------------------------------------------------------------------ OpenCV's sample pairs
+
+
+def test_chessboard_all_pairs_used_and_rms(
+    chessboard: tuple[Calibration, CalibrationReport],
+) -> None:
+    cal, rep = chessboard
+    print("\n" + rep.summary())
+    assert rep.used_pairs == [f"left{i}.jpg" for i in CHESSBOARD_IDS]
+    assert rep.rejected_pairs == {}
+    assert rep.rms <= MAX_STEREO_RMS
+    assert rep.rms_left <= MAX_STEREO_RMS and rep.rms_right <= MAX_STEREO_RMS
+    assert set(rep.per_pair_errors) == set(rep.used_pairs)
+    assert max(rep.per_pair_errors.values()) < 2 * rep.rms
+    # The report's own (corner-based) epipolar check and the square measured by triangulation.
+    assert rep.epipolar_mean_dy <= MAX_MEAN_DY
+    assert abs(rep.square_size_measured - 1.0) < 0.005
+    assert 0.3 < rep.coverage_left < 0.8 and 0.3 < rep.coverage_right < 0.8
+    # OpenCV's sample rig: about 3.3 squares of baseline, right camera to the right.
+    assert cal.T[0] == pytest.approx(-3.33, abs=0.05)
+    assert cal.K1[0, 0] == pytest.approx(535, abs=10)
+    assert cal.image_size == (640, 480)
+
+
+def test_chessboard_independent_rectification_dy(
+    chessboard: tuple[Calibration, CalibrationReport],
+) -> None:
+    """cv2.stereoRectify on the returned K, D, R, T; corners found again by
+    findChessboardCornersSB (accuracy flag) in the rectified images; mean |dy| <= 0.11 px."""
+    cal, _ = chessboard
+    left, right = _chessboard_paths()
+    size = cal.image_size
+    R1, R2, P1, P2, _, _, _ = cv2.stereoRectify(
+        cal.K1, cal.D1, cal.K2, cal.D2, size, cal.R, cal.T.reshape(3, 1), alpha=0
+    )
+    m1 = cv2.initUndistortRectifyMap(cal.K1, cal.D1, R1, P1, size, cv2.CV_32FC1)
+    m2 = cv2.initUndistortRectifyMap(cal.K2, cal.D2, R2, P2, size, cv2.CV_32FC1)
+    flags = cv2.CALIB_CB_ACCURACY | cv2.CALIB_CB_NORMALIZE_IMAGE
+    dys = []
+    for lp, rp in zip(left, right, strict=True):
+        lr = cv2.remap(cv2.imread(str(lp), cv2.IMREAD_GRAYSCALE), *m1, cv2.INTER_LINEAR)
+        rr = cv2.remap(cv2.imread(str(rp), cv2.IMREAD_GRAYSCALE), *m2, cv2.INTER_LINEAR)
+        ok1, c1 = cv2.findChessboardCornersSB(lr, (9, 6), flags=flags)
+        ok2, c2 = cv2.findChessboardCornersSB(rr, (9, 6), flags=flags)
+        assert ok1 and ok2, f"board lost after rectification in {lp.name}"
+        c1, c2 = c1.reshape(-1, 2), c2.reshape(-1, 2)
+        # Same corner order in both images: of the two grid orientations, take the one whose
+        # layout matches the left one (decided by position, not by dy).
+        centred = c1 - c1.mean(0)
+        c2 = min((c2, c2[::-1]), key=lambda c: float(np.sum((c - c.mean(0) - centred) ** 2)))
+        dys.append(np.abs(c1[:, 1] - c2[:, 1]))
+    dy = np.concatenate(dys)
+    print(f"\nindependent rectification: mean |dy| {dy.mean():.4f} px, max {dy.max():.3f} px")
+    assert dy.mean() <= MAX_MEAN_DY
+
+
+def test_saved_calibration_loads_back_identical(
+    chessboard: tuple[Calibration, CalibrationReport], tmp_path: Path
+) -> None:
+    cal, _ = chessboard
+    for name in ("rig.yaml", "rig.json"):
+        cal.save(tmp_path / name)
+        back = Calibration.load(tmp_path / name)
+        assert back == cal
+        for k in ("K1", "D1", "K2", "D2", "R", "T"):
+            assert np.array_equal(getattr(back, k), getattr(cal, k))
+    fs = cv2.FileStorage(str(tmp_path / "rig.yaml"), cv2.FILE_STORAGE_READ)
+    assert np.array_equal(fs.getNode("K1").mat(), cal.K1)
+    fs.release()
+
+
+def test_report_files(chessboard: tuple[Calibration, CalibrationReport], tmp_path: Path) -> None:
+    _, rep = chessboard
+    paths = rep.write(tmp_path / "report")
+    page = paths["html"].read_text()
+    assert page.count('src="data:image/png;base64,') == 4
+    assert "http://" not in page and "https://" not in page  # self-contained
+    assert f"{rep.rms:.3f} px" in page
+    for fmt, load in (("yaml", yaml.safe_load), ("json", json.loads)):
+        data = load(paths[fmt].read_text())
+        assert data["rms"] == pytest.approx(rep.rms)
+        assert data["used_pairs"] == rep.used_pairs
+        assert data["pattern"] == [9, 6]
+        assert np.allclose(data["calibration"]["K1"], rep._calibration.K1)
+    # Every embedded picture decodes.
+    import base64
+    import re
+
+    for b64 in re.findall(r'src="data:image/png;base64,([^"]+)"', page):
+        img = cv2.imdecode(np.frombuffer(base64.b64decode(b64), np.uint8), cv2.IMREAD_COLOR)
+        assert img is not None and img.shape[1] > 100
+    with pytest.raises(ValueError, match=r"\.txt"):
+        rep.save(tmp_path / "report.txt")
+
+
+# --------------------------------------------------------------------------- synthetic rig
+
+
+def test_synthetic_rig_recovered(
+    synthetic_dropped: tuple[Calibration, CalibrationReport],
+) -> None:
+    cal, rep = synthetic_dropped
+    print("\n" + rep.summary())
+    f_err = [cal.K1[0, 0] / SYN_K1[0, 0] - 1, cal.K2[0, 0] / SYN_K2[0, 0] - 1]
+    fy_err = [cal.K1[1, 1] / SYN_K1[1, 1] - 1, cal.K2[1, 1] / SYN_K2[1, 1] - 1]
+    b_err = np.linalg.norm(cal.T) / np.linalg.norm(SYN_T) - 1
+    print(
+        f"focal errors {np.round(100 * np.array(f_err), 4)} %, baseline error {100 * b_err:.4f} %"
+    )
+    assert max(map(abs, f_err + fy_err)) < MAX_REL_ERROR
+    assert abs(b_err) < MAX_REL_ERROR
+    assert np.allclose(cal.T, SYN_T, atol=5e-4)
+    rvec = cv2.Rodrigues(cal.R @ SYN_R.T)[0]
+    assert np.degrees(np.linalg.norm(rvec)) < 0.1
+    assert cal.K1[0, 2] == pytest.approx(SYN_K1[0, 2], abs=1.5)
+    assert rep.rms < 0.15
+    assert rep.square_size_measured == pytest.approx(SYN_SQUARE, rel=1e-3)
+
+
+def test_synthetic_rejected_and_outlier_dropped(
+    synthetic_dropped: tuple[Calibration, CalibrationReport],
+) -> None:
+    _, rep = synthetic_dropped
+    assert rep.rejected_pairs["blank"] == "board not found in left"
+    assert rep.rejected_pairs["shifted"].startswith("outlier: error ")
+    assert rep.outlier_pairs == ["shifted"]
+    assert rep.used_pairs == [f"good{i:02d}" for i in range(SYN_GOOD_PAIRS)]
+
+
+def test_outlier_reported_but_kept_without_drop(
+    synthetic: tuple[list[np.ndarray], list[np.ndarray], list[str]],
+    synthetic_dropped: tuple[Calibration, CalibrationReport],
+    cached_corners: None,
+) -> None:
+    left, right, names = synthetic
+    _, rep = calibrate(left, right, pattern=SYN_PATTERN, square_size=SYN_SQUARE, names=names)
+    assert rep.outlier_pairs == ["shifted"]
+    assert "shifted" in rep.used_pairs and "shifted" not in rep.rejected_pairs
+    assert list(rep.rejected_pairs) == ["blank"]
+    med = float(np.median(list(rep.per_pair_errors.values())))
+    assert rep.per_pair_errors["shifted"] > calmod.OUTLIER_FACTOR * med
+    # Keeping the outlier makes the solution worse than with it dropped.
+    assert rep.rms > 2 * synthetic_dropped[1].rms
+    assert "outlier kept" in rep.summary()
+
+
+def test_find_corners_matches_projection() -> None:
+    rv, tv = np.array([0.3, -0.2, 0.1]), np.array([-0.12, -0.07, 0.5])
+    img = render_chessboard(
+        SYN_K1, SYN_D1, rv, tv, pattern=SYN_PATTERN, square_size=SYN_SQUARE, image_size=SYN_SIZE
+    )
+    corners = find_corners(img, SYN_PATTERN)
+    assert corners is not None and corners.shape == (54, 2)
+    truth = cv2.projectPoints(
+        board_object_points(SYN_PATTERN, SYN_SQUARE).astype(np.float64), rv, tv, SYN_K1, SYN_D1
+    )[0].reshape(-1, 2)
+    if np.linalg.norm(corners[0] - truth[0]) > np.linalg.norm(corners[0] - truth[-1]):
+        truth = truth[::-1]
+    err = np.linalg.norm(corners - truth, axis=1)
+    assert np.sqrt(np.mean(err**2)) < 0.15 and err.max() < 0.4
+    assert find_corners(np.full((240, 320), 100, np.uint8), SYN_PATTERN) is None
+    x, y, size, skew = board_pose_params(corners, SYN_PATTERN, SYN_SIZE)
+    assert 0 < x < 1 and 0 < y < 1 and 0.1 < size < 0.8 and 0 <= skew <= 1
+
+
+# ------------------------------------------------------------------------------ errors, CLI
+
+
+def test_input_errors(tmp_path: Path) -> None:
+    left, right = _chessboard_paths()
+    missing = tmp_path / "nope.png"
+    with pytest.raises(FileNotFoundError, match=r"nope\.png"):
+        calibrate([left[0], missing], right[:2], square_size=1.0)
+    junk = tmp_path / "junk.png"
+    junk.write_bytes(b"not an image")
+    with pytest.raises(ValueError, match=r"junk\.png"):
+        calibrate([junk], [right[0]], square_size=1.0)
+    with pytest.raises(ValueError, match="differ in length"):
+        calibrate(left[:2], right[:3], square_size=1.0)
+    with pytest.raises(ValueError, match="square_size"):
+        calibrate(left[:2], right[:2], square_size=-1.0)
+    with pytest.raises(ValueError, match="unit"):
+        calibrate(left[:2], right[:2], square_size=1.0, unit="parsec")
+    with pytest.raises(ValueError, match="distortion"):
+        calibrate(left[:2], right[:2], square_size=1.0, distortion="fisheye")
+    small = np.zeros((240, 320), np.uint8)
+    with pytest.raises(ValueError, match="320x240"):
+        calibrate([left[0], small], [right[0], small], square_size=1.0)
+    blank = np.full((120, 160), 128, np.uint8)
+    with pytest.raises(ValueError, match="only 0 of 3 pairs"):
+        calibrate([blank] * 3, [blank] * 3, square_size=1.0)
+    for bad in ("9", "9x", "axb", "1x6", "9x6x2"):
+        with pytest.raises(ValueError, match="pattern"):
+            parse_pattern(bad)
+    assert parse_pattern("7X5") == (7, 5)
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="stereovision")
+    sub = parser.add_subparsers(dest="command", required=True)
+    add_cli(sub)
+    return parser
+
+
+def test_cli_end_to_end(
+    synthetic: tuple[list[np.ndarray], list[np.ndarray], list[str]],
+    synthetic_dropped: tuple[Calibration, CalibrationReport],
+    cached_corners: None,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    left, right, _ = synthetic
+    for i, (a, b) in enumerate(zip(left, right, strict=True)):
+        cv2.imwrite(str(tmp_path / f"L{i:02d}.png"), a)
+        cv2.imwrite(str(tmp_path / f"R{i:02d}.png"), b)
+    out = tmp_path / "rig.yaml"
+    args = _parser().parse_args(
+        ["calibrate", "--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "R*.png"),
+         "--pattern", "9x6", "--square", str(SYN_SQUARE), "-o", str(out), "--drop-outliers",
+         "--report", str(tmp_path / "rep")]
+    )  # fmt: skip
+    assert args.func(args) == 0
+    text = capsys.readouterr().out
+    assert "12/14 pairs used" in text and "rejected L12.png: board not found in left" in text
+    assert "rejected L13.png: outlier" in text
+    cal = Calibration.load(out)
+    ref = synthetic_dropped[0]
+    assert np.allclose(cal.K1, ref.K1, rtol=1e-9) and np.allclose(cal.T, ref.T, rtol=1e-9)
+    assert (tmp_path / "rep" / "report.html").is_file()
+    assert (tmp_path / "rep" / "report.json").is_file()
+
+    def run(*argv: str) -> int:
+        a = _parser().parse_args(["calibrate", *argv])
+        return int(a.func(a))
+
+    base = ["--pattern", "9x6", "--square", "0.03"]
+    with pytest.raises(FileNotFoundError, match="no file matches"):
+        run("--left", str(tmp_path / "X*.png"), "--right", str(tmp_path / "R*.png"), *base,
+            "-o", str(out))  # fmt: skip
+    with pytest.raises(ValueError, match="matches 14 files but --right matches 1"):
+        run("--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "R00.png"), *base,
+            "-o", str(out))  # fmt: skip
+    with pytest.raises(ValueError, match=r"\.yaml"):
+        run("--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "R*.png"), *base,
+            "-o", str(tmp_path / "rig.txt"))  # fmt: skip
+    with pytest.raises(ValueError, match="pattern"):
+        run("--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "R*.png"),
+            "--pattern", "nine", "--square", "1", "-o", str(out))  # fmt: skip
