@@ -1,4 +1,4 @@
-"""Command line: ``stereovision demo | depth | eval``.
+"""Command line: ``stereovision demo | depth | eval | calibrate | view | gui``.
 
 Errors print one line on stderr and exit with status 2 (never a traceback); every output file is
 written atomically after all computation succeeded, so an error never destroys earlier outputs.
@@ -138,6 +138,9 @@ def cmd_depth(args: argparse.Namespace) -> int:
         fill=args.fill,
     )
     written = write_depth_outputs(res, Path(args.output))
+    from stereovision.render import render_outputs
+
+    written.update(render_outputs(res, Path(args.output)))
     print(
         f"{args.method}: max_disparity {res.max_disparity} px, density {100 * res.density:.1f} %,"
         f" {len(res.points)} points, {sum(res.timings.values()):.2f} s"
@@ -166,6 +169,9 @@ def cmd_demo(args: argparse.Namespace) -> int:
     )
     out_dir = Path(args.output)
     written = write_depth_outputs(res, out_dir)
+    from stereovision.render import render_outputs
+
+    written.update(render_outputs(res, out_dir))
     raw = dense_metrics(res.disparity, scene.gt)
     from stereovision.baselines import row_fill
 
@@ -326,6 +332,13 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--json", action="store_true", help="one JSON object per scene on stdout")
     d.add_argument("--no-opencv", action="store_true", help="skip the OpenCV references")
     d.set_defaults(func=cmd_eval)
+
+    # Commands owned by their pipeline stage's module.
+    from stereovision import calibrate, gui, render
+
+    calibrate.add_cli(sub)
+    render.add_cli(sub)
+    gui.add_cli(sub)
     return p
 
 
