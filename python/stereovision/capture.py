@@ -1,0 +1,665 @@
+"""Two-camera capture: synchronised pairs, atomic saving, chessboard auto-capture.
+
+A source is anything :class:`cv2.VideoCapture` opens -- a device index (``0``), a video file
+(``left.avi``) or an image-sequence pattern (``frames/left_%03d.png``) -- so everything here is
+testable without cameras. A pair is taken the way OpenCV recommends for multi-camera rigs: *grab*
+both cameras first (cheap, latches the frames), then *retrieve* (decode) both, and each grab is
+timestamped so the left/right skew can be measured and reported.
+
+Saved pairs are numbered ``left_0001.png`` / ``right_0001.png``; each file is encoded in memory,
+written to a temporary file in the destination directory and renamed over its final name with
+:func:`os.replace`, so a reader never sees a half-written image. The right image of a pair is
+written last: a pair is complete when its right image exists.
+
+In chessboard mode (:class:`ChessboardCollector`) a pair is saved only when both cameras see the
+board and its pose -- ``(x, y, size, skew)`` as in ROS's ``camera_calibration`` -- differs enough
+from every pair saved so far; the coverage of each of the four parameters is printed as it grows.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import re
+import statistics
+import time
+import warnings
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from stereovision.calibrate import (
+    POSE_PARAM_NAMES,
+    POSE_PARAM_RANGES,
+    board_pose_params,
+    parse_pattern,
+)
+
+__all__ = [
+    "MIN_POSE_DISTANCE",
+    "CaptureResult",
+    "ChessboardCollector",
+    "SourceError",
+    "StereoCamera",
+    "StereoFrame",
+    "add_cli",
+    "capture",
+    "parse_size",
+    "parse_source",
+    "save_pair",
+]
+
+PathLike = str | os.PathLike[str]
+Source = int | str | os.PathLike[str] | Any
+
+#: ROS camera_calibration's "good sample" rule: a new view is kept when the sum of absolute
+#: differences of its (x, y, size, skew) to every kept view is above 0.2.
+MIN_POSE_DISTANCE = 0.2
+#: Live detection runs on frames scaled down to at most this width (ROS does the same): the
+#: classic detector with FAST_CHECK answers in a few ms at VGA, and the pose parameters are
+#: relative, so the scale does not change them.
+DETECT_MAX_WIDTH = 640
+#: Flags of the live detector: adaptive threshold and normalisation for uneven light; FAST_CHECK
+#: rejects board-less frames quickly.
+LIVE_DETECT_FLAGS = (
+    cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE | cv2.CALIB_CB_FAST_CHECK
+)
+#: Width of each coverage bar in the progress line (characters).
+PROGRESS_BAR_WIDTH = 10
+#: File name pattern of saved pairs (index from 1; 4 digits sort well up to 9999 pairs).
+PAIR_NAME = "{side}_{index:04d}{ext}"
+_PAIR_RE = re.compile(r"^(left|right)_(\d+)\.[A-Za-z0-9]+$")
+
+
+class SourceError(OSError):
+    """A camera or video source failed to open or stopped delivering frames."""
+
+
+# --------------------------------------------------------------------------------- parsing
+
+
+def parse_source(text: str | int) -> int | str:
+    """A device index for an all-digit string (``"0"`` -> ``0``), else the text (file/pattern)."""
+    if isinstance(text, int):
+        return text
+    return int(text) if text.strip().isdigit() else text
+
+
+def parse_size(text: str | tuple[int, int] | None) -> tuple[int, int] | None:
+    """Parse ``"1280x720"`` to ``(1280, 720)``.
+
+    Raises
+    ------
+    ValueError
+        If the text is not two positive integers separated by ``x``.
+    """
+    if text is None:
+        return None
+    if isinstance(text, str):
+        m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
+        vals = (int(m.group(1)), int(m.group(2))) if m else (0, 0)
+    else:
+        vals = (int(text[0]), int(text[1])) if len(text) == 2 else (0, 0)
+    if min(vals) <= 0:
+        raise ValueError(f"size: expected WIDTHxHEIGHT with positive integers, got {text!r}")
+    return vals
+
+
+# ---------------------------------------------------------------------------------- camera
+
+
+@dataclass
+class StereoFrame:
+    """One synchronised pair.
+
+    Attributes
+    ----------
+    left, right : numpy.ndarray
+        The frames (BGR ``uint8``, resized to the camera's output size if needed).
+    t_left, t_right : float
+        Host time (``time.monotonic()``, seconds) at which each grab returned.
+    index : int
+        0-based pair counter of the camera.
+    pos_left_ms, pos_right_ms : float
+        The sources' own timestamps (``CAP_PROP_POS_MSEC``; a video file's media time).
+    """
+
+    left: np.ndarray
+    right: np.ndarray
+    t_left: float
+    t_right: float
+    index: int
+    pos_left_ms: float = math.nan
+    pos_right_ms: float = math.nan
+
+    @property
+    def skew_ms(self) -> float:
+        """``|t_left - t_right|`` in milliseconds: how far apart the two grabs were."""
+        return abs(self.t_left - self.t_right) * 1000.0
+
+
+def _describe_source(src: Source) -> str:
+    if isinstance(src, int):
+        return f"camera {src}"
+    if isinstance(src, (str, os.PathLike)):
+        return repr(os.fspath(src))
+    return type(src).__name__
+
+
+class StereoCamera:
+    """Two video sources read as synchronised pairs.
+
+    Parameters
+    ----------
+    left, right : int, str, os.PathLike or VideoCapture-like
+        Device index, video file, image-sequence pattern (``frames/left_%03d.png``), or an object
+        with the ``cv2.VideoCapture`` methods ``isOpened grab retrieve get set release``.
+    size : tuple of int, optional
+        Requested ``(width, height)``, asked of the sources with ``CAP_PROP_FRAME_WIDTH`` /
+        ``CAP_PROP_FRAME_HEIGHT``. Frames that come in another size (a file cannot be asked) are
+        resized to it, with one :class:`UserWarning` per camera. Default: the left source's size.
+    fps : float, optional
+        Requested frame rate (``CAP_PROP_FPS``); what the source reports is in
+        :attr:`delivered_fps`.
+
+    Attributes
+    ----------
+    size : tuple of int
+        Output size of both frames (known after the first pair when not requested).
+    delivered_size : dict of str to tuple of int
+        What each source actually delivered (``{"left": (w, h), "right": (w, h)}``), updated
+        from the frames themselves.
+    delivered_fps : dict of str to float
+        ``CAP_PROP_FPS`` of each source after the request (0 when unknown).
+    skews_ms : list of float
+        Grab skew of every pair read.
+
+    Raises
+    ------
+    FileNotFoundError
+        If a source is a file path (not a pattern) that does not exist.
+    SourceError
+        If a source cannot be opened (the message names it).
+    ValueError
+        If ``size`` or ``fps`` is invalid.
+    """
+
+    def __init__(
+        self,
+        left: Source,
+        right: Source,
+        *,
+        size: tuple[int, int] | str | None = None,
+        fps: float | None = None,
+    ) -> None:
+        self.sources = {"left": left, "right": right}
+        self.requested_size = parse_size(size)
+        if fps is not None and not (math.isfinite(fps) and fps > 0):
+            raise ValueError(f"fps: expected a positive number, got {fps!r}")
+        self.size: tuple[int, int] | None = self.requested_size
+        self.delivered_size: dict[str, tuple[int, int]] = {}
+        self.delivered_fps: dict[str, float] = {}
+        self.skews_ms: list[float] = []
+        self.count = 0
+        self._warned: set[str] = set()
+        self._caps: dict[str, Any] = {}
+        try:
+            for side, src in self.sources.items():
+                self._caps[side] = self._open(side, src, fps)
+        except BaseException:
+            self.close()
+            raise
+
+    def _open(self, side: str, src: Source, fps: float | None) -> Any:
+        if isinstance(src, (str, os.PathLike)):
+            path = os.fspath(src)
+            if "%" not in path and "://" not in path and not os.path.exists(path):
+                raise FileNotFoundError(f"{side} source not found: {path}")
+            cap: Any = cv2.VideoCapture(path)
+        elif isinstance(src, (int, np.integer)):
+            cap = cv2.VideoCapture(int(src))
+        else:
+            cap = src
+        if not cap.isOpened():
+            cap.release()
+            raise SourceError(f"cannot open {side} source {_describe_source(src)}")
+        if self.requested_size is not None:
+            cap.set(cv2.CAP_PROP_FRAME_WIDTH, self.requested_size[0])
+            cap.set(cv2.CAP_PROP_FRAME_HEIGHT, self.requested_size[1])
+        if fps is not None:
+            cap.set(cv2.CAP_PROP_FPS, float(fps))
+        self.delivered_fps[side] = float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
+        w, h = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
+        if w > 0 and h > 0:
+            self.delivered_size[side] = (w, h)
+        return cap
+
+    # -- reading
+
+    def _fail(self, side: str, what: str) -> SourceError:
+        return SourceError(
+            f"{side} source {_describe_source(self.sources[side])} {what} after {self.count} "
+            "pairs (disconnected or end of stream)"
+        )
+
+    def _fit(self, side: str, frame: np.ndarray) -> np.ndarray:
+        if frame.ndim == 2:
+            frame = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)
+        h, w = frame.shape[:2]
+        self.delivered_size[side] = (w, h)
+        if self.size is None:
+            self.size = (w, h)
+        if (w, h) == self.size:
+            return frame
+        if side not in self._warned:
+            self._warned.add(side)
+            warnings.warn(
+                f"{side} source {_describe_source(self.sources[side])} delivers {w}x{h}, not "
+                f"{self.size[0]}x{self.size[1]}: its frames are resized",
+                UserWarning,
+                stacklevel=3,
+            )
+        interp = cv2.INTER_AREA if w > self.size[0] else cv2.INTER_LINEAR
+        return np.asarray(cv2.resize(frame, self.size, interpolation=interp))
+
+    def read(self) -> StereoFrame:
+        """Grab both sources, then retrieve both; return the timestamped pair.
+
+        Raises
+        ------
+        SourceError
+            If a source delivers no frame (device unplugged, end of a file or sequence); the
+            message names the source and the number of pairs read before.
+        """
+        caps = self._caps
+        if len(caps) != 2:
+            raise SourceError("the stereo camera is closed")
+        ok_l = caps["left"].grab()
+        t_l = time.monotonic()
+        ok_r = caps["right"].grab()
+        t_r = time.monotonic()
+        for side, ok in (("left", ok_l), ("right", ok_r)):
+            if not ok:
+                raise self._fail(side, "delivered no frame")
+        frames = {}
+        for side in ("left", "right"):
+            ok, img = caps[side].retrieve()
+            if not ok or img is None:
+                raise self._fail(side, "could not decode a frame")
+            frames[side] = self._fit(side, img)
+        frame = StereoFrame(
+            left=frames["left"],
+            right=frames["right"],
+            t_left=t_l,
+            t_right=t_r,
+            index=self.count,
+            pos_left_ms=float(caps["left"].get(cv2.CAP_PROP_POS_MSEC)),
+            pos_right_ms=float(caps["right"].get(cv2.CAP_PROP_POS_MSEC)),
+        )
+        self.count += 1
+        self.skews_ms.append(frame.skew_ms)
+        return frame
+
+    def frames(self, *, stop_at_end: bool = True) -> Iterator[StereoFrame]:
+        """Iterate over pairs; the end of a source ends the iteration when ``stop_at_end``."""
+        while True:
+            try:
+                frame = self.read()
+            except SourceError:
+                if stop_at_end:
+                    return
+                raise
+            yield frame
+
+    def skew_report(self) -> dict[str, float]:
+        """Grab skew over the pairs read: ``n``, ``mean_ms``, ``median_ms``, ``max_ms``."""
+        s = self.skews_ms
+        if not s:
+            return {"n": 0, "mean_ms": math.nan, "median_ms": math.nan, "max_ms": math.nan}
+        return {
+            "n": len(s),
+            "mean_ms": float(statistics.fmean(s)),
+            "median_ms": float(statistics.median(s)),
+            "max_ms": float(max(s)),
+        }
+
+    def describe(self) -> str:
+        """One line: requested vs delivered size and fps of each source."""
+        parts = []
+        for side in ("left", "right"):
+            d = self.delivered_size.get(side)
+            got = f"{d[0]}x{d[1]}" if d else "?"
+            parts.append(
+                f"{side} {_describe_source(self.sources[side])}: {got} "
+                f"@ {self.delivered_fps.get(side, 0.0):g} fps"
+            )
+        req = self.requested_size
+        asked = f"asked {req[0]}x{req[1]}" if req else "native size"
+        return f"{asked}; " + "; ".join(parts)
+
+    def close(self) -> None:
+        """Release both sources (idempotent)."""
+        for cap in self._caps.values():
+            try:
+                cap.release()
+            except Exception:  # releasing is best effort
+                pass
+        self._caps = {}
+
+    def __enter__(self) -> StereoCamera:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+# ---------------------------------------------------------------------------------- saving
+
+
+def _atomic_write_bytes(path: Path, data: bytes) -> None:
+    from stereovision.io import atomic_write
+
+    with atomic_write(path, "wb") as fh:
+        fh.write(data)
+
+
+def next_pair_index(directory: PathLike) -> int:
+    """1 + the largest pair index already in ``directory`` (1 when none)."""
+    d = Path(directory)
+    if not d.is_dir():
+        return 1
+    found = [int(m.group(2)) for p in d.iterdir() if (m := _PAIR_RE.match(p.name))]
+    return max(found, default=0) + 1
+
+
+def save_pair(
+    directory: PathLike,
+    index: int,
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    *,
+    ext: str = ".png",
+) -> tuple[Path, Path]:
+    """Save a pair atomically as ``left_NNNN.ext`` and ``right_NNNN.ext``.
+
+    Both images are encoded in memory first; each is then written to a temporary file in
+    ``directory`` and renamed over its final name (``os.replace``), left first, right last.
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        Destination (created if missing).
+    index : int
+        Pair number (``>= 0``).
+    left, right : array_like
+        ``uint8`` images (grey or BGR).
+    ext : str
+        Image format by extension (``.png`` lossless by default).
+
+    Returns
+    -------
+    tuple of pathlib.Path
+        The two final paths.
+
+    Raises
+    ------
+    ValueError
+        If an image cannot be encoded in that format.
+    OSError
+        If writing fails (no partial file is left behind).
+    """
+    d = Path(directory)
+    d.mkdir(parents=True, exist_ok=True)
+    data = []
+    for side, img in (("left", left), ("right", right)):
+        ok, buf = cv2.imencode(ext, np.asarray(img))
+        if not ok:
+            raise ValueError(f"cannot encode the {side} image as {ext}")
+        data.append(buf.tobytes())
+    paths = tuple(d / PAIR_NAME.format(side=s, index=index, ext=ext) for s in ("left", "right"))
+    for p, b in zip(paths, data, strict=True):
+        _atomic_write_bytes(p, b)
+    return paths[0], paths[1]
+
+
+# -------------------------------------------------------------------------- chessboard mode
+
+
+def detect_board_live(image: np.ndarray, pattern: tuple[int, int]) -> np.ndarray | None:
+    """Fast board detection for a live stream (scaled to <= :data:`DETECT_MAX_WIDTH`).
+
+    Returns
+    -------
+    numpy.ndarray or None
+        ``(cols * rows, 2)`` corners in full-resolution pixels (about 1 px accurate: for choosing
+        views, not for calibrating), or None.
+    """
+    gray = np.asarray(image if image.ndim == 2 else cv2.cvtColor(image, cv2.COLOR_BGR2GRAY))
+    scale = min(1.0, DETECT_MAX_WIDTH / gray.shape[1])
+    small = gray
+    if scale < 1.0:
+        dsize = (round(gray.shape[1] * scale), round(gray.shape[0] * scale))
+        small = np.asarray(cv2.resize(gray, dsize, interpolation=cv2.INTER_AREA))
+    ok, corners = cv2.findChessboardCorners(small, pattern, flags=LIVE_DETECT_FLAGS)
+    if not ok:
+        return None
+    c = np.asarray(corners, np.float64).reshape(-1, 2) / scale
+    if c[0].sum() > c[-1].sum():  # same orientation rule as calibrate.find_corners
+        c = c[::-1].copy()
+    return c
+
+
+@dataclass
+class Decision:
+    """What :meth:`ChessboardCollector.consider` decided for one pair."""
+
+    save: bool
+    reason: str
+    params: tuple[float, float, float, float] | None = None
+
+
+@dataclass
+class ChessboardCollector:
+    """Choose pairs for calibration: both boards found, pose new enough (ROS's rule).
+
+    Parameters
+    ----------
+    pattern : tuple of int
+        ``(cols, rows)`` inner corners.
+    min_distance : float
+        A pair is kept when ``sum(|p - q|)`` over ``(x, y, size, skew)`` is above this for every
+        kept pair ``q`` (:data:`MIN_POSE_DISTANCE`).
+    """
+
+    pattern: tuple[int, int]
+    min_distance: float = MIN_POSE_DISTANCE
+    kept: list[tuple[float, float, float, float]] = field(default_factory=list)
+
+    def consider(self, frame: StereoFrame) -> Decision:
+        """Decide whether ``frame`` is worth saving; a kept pose is remembered."""
+        cl = detect_board_live(frame.left, self.pattern)
+        if cl is None:
+            return Decision(False, "no board in left")
+        if detect_board_live(frame.right, self.pattern) is None:
+            return Decision(False, "no board in right")
+        h, w = frame.left.shape[:2]
+        p = board_pose_params(cl, self.pattern, (w, h))
+        if self.kept:
+            nearest = min(sum(abs(a - b) for a, b in zip(p, q, strict=True)) for q in self.kept)
+            if nearest <= self.min_distance:
+                return Decision(False, f"pose too close to a saved one ({nearest:.3f})", p)
+        self.kept.append(p)
+        return Decision(True, "new pose", p)
+
+    def progress(self) -> dict[str, float]:
+        """Coverage of each parameter in [0, 1]: span of the kept values / ROS's target span."""
+        out = {}
+        for k, (name, span) in enumerate(zip(POSE_PARAM_NAMES, POSE_PARAM_RANGES, strict=True)):
+            vals = [p[k] for p in self.kept]
+            out[name] = min(1.0, (max(vals) - min(vals)) / span) if vals else 0.0
+        return out
+
+    def format_progress(self) -> str:
+        """``x [#####-----]  50%  y [...] ...`` as ROS's calibrator shows it."""
+        parts = []
+        for name, v in self.progress().items():
+            n = round(v * PROGRESS_BAR_WIDTH)
+            bar = "#" * n + "-" * (PROGRESS_BAR_WIDTH - n)
+            parts.append(f"{name} [{bar}] {100 * v:3.0f}%")
+        return "  ".join(parts)
+
+
+# ---------------------------------------------------------------------------------- capture
+
+
+@dataclass
+class CaptureResult:
+    """What :func:`capture` did."""
+
+    saved: list[tuple[Path, Path]]
+    frames_read: int
+    skew: dict[str, float]
+    coverage: dict[str, float] | None = None
+    ended: str = "count reached"
+
+
+def capture(
+    camera: StereoCamera,
+    directory: PathLike,
+    *,
+    count: int | None = None,
+    chessboard: tuple[int, int] | str | None = None,
+    min_distance: float = MIN_POSE_DISTANCE,
+    every: int = 1,
+    ext: str = ".png",
+    log: Callable[[str], None] | None = None,
+) -> CaptureResult:
+    """Save pairs from ``camera`` into ``directory`` until ``count`` are saved.
+
+    Parameters
+    ----------
+    camera : StereoCamera
+    directory : str or os.PathLike
+        Created if missing; numbering continues after pairs already there (none is overwritten).
+    count : int, optional
+        Pairs to save. Without it, capture runs until a source ends (normal for files).
+    chessboard : tuple of int or str, optional
+        Pattern (``(9, 6)`` or ``"9x6"``): save only pairs with the board in both images and a
+        new pose (:class:`ChessboardCollector`).
+    min_distance : float
+        Pose distance of the chessboard mode.
+    every : int
+        Without ``chessboard``: save every ``every``-th pair.
+    ext : str
+        Image format of the saved files.
+    log : callable, optional
+        Receives one line per saved pair (with coverage in chessboard mode).
+
+    Returns
+    -------
+    CaptureResult
+
+    Raises
+    ------
+    SourceError
+        If a source fails or ends before ``count`` pairs were saved; the pairs saved so far stay
+        on disk, and the message says how many.
+    ValueError
+        For an invalid ``count``, ``every`` or pattern.
+    """
+    if count is not None and count <= 0:
+        raise ValueError(f"count: expected a positive number of pairs, got {count!r}")
+    if every <= 0:
+        raise ValueError(f"every: expected a positive integer, got {every!r}")
+    collector = ChessboardCollector(parse_pattern(chessboard), min_distance) if chessboard else None
+    out = Path(directory)
+    out.mkdir(parents=True, exist_ok=True)
+    index = next_pair_index(out)
+    saved: list[tuple[Path, Path]] = []
+    ended = "count reached"
+    while count is None or len(saved) < count:
+        try:
+            frame = camera.read()
+        except SourceError as exc:
+            if count is None:
+                ended = "end of stream"
+                break
+            raise SourceError(
+                f"{exc}; {len(saved)} of {count} pairs were saved in {out} and are kept"
+            ) from exc
+        if collector is not None:
+            decision = collector.consider(frame)
+            if not decision.save:
+                continue
+        elif frame.index % every:
+            continue
+        paths = save_pair(out, index, frame.left, frame.right, ext=ext)
+        saved.append(paths)
+        index += 1
+        if log is not None:
+            line = f"saved {paths[0].name} {paths[1].name} (skew {frame.skew_ms:.2f} ms)"
+            if collector is not None:
+                line += "  " + collector.format_progress()
+            log(line)
+    return CaptureResult(
+        saved=saved,
+        frames_read=camera.count,
+        skew=camera.skew_report(),
+        coverage=None if collector is None else collector.progress(),
+        ended=ended,
+    )
+
+
+# -------------------------------------------------------------------------------------- CLI
+
+
+def cmd_capture(args: argparse.Namespace) -> int:
+    """``stereovision capture --left 0 --right 1 --size 1280x720 -o pairs/``."""
+    pattern = parse_pattern(args.chessboard) if args.chessboard else None
+    if args.count is not None and args.count <= 0:
+        raise ValueError(f"--count: expected a positive number, got {args.count}")
+    cam = StereoCamera(
+        parse_source(args.left),
+        parse_source(args.right),
+        size=parse_size(args.size),
+        fps=args.fps,
+    )
+    try:
+        print(cam.describe())
+        result = capture(
+            cam, args.output, count=args.count, chessboard=pattern, every=args.every, log=print
+        )
+    finally:
+        cam.close()
+    sk = result.skew
+    print(
+        f"{len(result.saved)} pairs saved in {args.output} ({result.ended}); "
+        f"{result.frames_read} pairs read; delivered {cam.describe()}; "
+        f"skew mean {sk['mean_ms']:.2f} ms, max {sk['max_ms']:.2f} ms"
+    )
+    return 0
+
+
+def add_cli(subparsers: Any) -> None:
+    """Register the ``capture`` subcommand on an ``argparse`` subparsers object."""
+    p = subparsers.add_parser(
+        "capture",
+        help="capture stereo pairs from two cameras (or videos / image sequences)",
+        description="Save synchronised pairs; with --chessboard, only pairs with the board in "
+        "both views and a new pose.",
+    )
+    p.add_argument("--left", required=True, help="device index, video file or pattern (%%03d)")
+    p.add_argument("--right", required=True, help="device index, video file or pattern")
+    p.add_argument("--size", help="requested size WIDTHxHEIGHT (frames are resized if needed)")
+    p.add_argument("--fps", type=float, help="requested frame rate")
+    p.add_argument("-o", "--output", required=True, help="output directory")
+    p.add_argument("--count", type=int, help="pairs to save (default: until a source ends)")
+    p.add_argument("--chessboard", metavar="COLSxROWS", help="auto-capture distinct board poses")
+    p.add_argument("--every", type=int, default=1, help="without --chessboard: save every Nth")
+    p.set_defaults(func=cmd_capture)
