@@ -35,6 +35,9 @@ DEFAULTS: dict[str, object] = {
     "search_pool_radius": 2,
     "lr_check": True,
     "lr_tol": 1.0,
+    "lr_coarse_levels": 0,
+    "iters_finest": 2,
+    "research_finest": True,
     "speckle_size": 0,
     "speckle_range": 1.0,
 }

@@ -33,15 +33,24 @@ where
     B: Send,
     F: Fn(usize, &mut [A], &mut [B]) + Sync,
 {
-    if width == 0 {
+    for_each_row_pair(a, width, b, width, f)
+}
+
+/// Two buffers with the same number of rows but different row lengths (`wa`, `wb`).
+pub fn for_each_row_pair<A, B, F>(a: &mut [A], wa: usize, b: &mut [B], wb: usize, f: F)
+where
+    A: Send,
+    B: Send,
+    F: Fn(usize, &mut [A], &mut [B]) + Sync,
+{
+    if wa == 0 || wb == 0 {
         return;
     }
-    let n = width * ROWS_PER_TASK;
-    a.par_chunks_mut(n)
-        .zip(b.par_chunks_mut(n))
+    a.par_chunks_mut(wa * ROWS_PER_TASK)
+        .zip(b.par_chunks_mut(wb * ROWS_PER_TASK))
         .enumerate()
         .for_each(|(band, (ca, cb))| {
-            for (i, (ra, rb)) in ca.chunks_mut(width).zip(cb.chunks_mut(width)).enumerate() {
+            for (i, (ra, rb)) in ca.chunks_mut(wa).zip(cb.chunks_mut(wb)).enumerate() {
                 f(band * ROWS_PER_TASK + i, ra, rb);
             }
         });

@@ -31,6 +31,9 @@ fn params(
     search_pool_radius: usize,
     lr_check: bool,
     lr_tol: f32,
+    lr_coarse_levels: usize,
+    iters_finest: usize,
+    research_finest: bool,
     speckle_size: usize,
     speckle_range: f32,
 ) -> GaborParams {
@@ -50,6 +53,9 @@ fn params(
         search_pool_radius,
         lr_check,
         lr_tol,
+        lr_coarse_levels,
+        iters_finest,
+        research_finest,
         speckle_size,
         speckle_range,
     }
@@ -68,8 +74,8 @@ fn to_image(w: usize, h: usize, data: Vec<f32>) -> Image {
 #[pyo3(signature = (
     left, right, d_min, d_max, *, freq=0.25, orientations_deg=None, bandwidth_oct=1.0, aspect=1.0,
     n_levels=None, iters_per_level=2, amp_rel_thresh=0.02, stability_tau=1.25, conf_min=0.15,
-    research_radius=2, search_pool_radius=2, lr_check=true, lr_tol=1.0, speckle_size=0,
-    speckle_range=1.0
+    research_radius=2, search_pool_radius=2, lr_check=true, lr_tol=1.0, lr_coarse_levels=0,
+    iters_finest=2, research_finest=true, speckle_size=0, speckle_range=1.0
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn gabor_disparity<'py>(
@@ -91,6 +97,9 @@ pub fn gabor_disparity<'py>(
     search_pool_radius: usize,
     lr_check: bool,
     lr_tol: f32,
+    lr_coarse_levels: usize,
+    iters_finest: usize,
+    research_finest: bool,
     speckle_size: usize,
     speckle_range: f32,
 ) -> PyResult<Pair<'py>> {
@@ -112,6 +121,9 @@ pub fn gabor_disparity<'py>(
         search_pool_radius,
         lr_check,
         lr_tol,
+        lr_coarse_levels,
+        iters_finest,
+        research_finest,
         speckle_size,
         speckle_range,
     );

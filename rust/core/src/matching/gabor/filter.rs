@@ -9,6 +9,7 @@
 //! sign: for `I = cos(w x)` the response phase grows as `+w x`.
 
 use crate::error::{CoreError, Result};
+use super::simd::simd_fn;
 use crate::parallel::for_each_row;
 use std::f32::consts::PI;
 
@@ -155,34 +156,44 @@ pub fn mirror(i: isize, n: usize) -> usize {
 
 /// Real separable convolution with reflect-101 borders (symmetric taps, so conv = correlation).
 pub fn blur_real(src: &[f32], w: usize, h: usize, gx: &[f32], gy: &[f32]) -> Vec<f32> {
-    let rx = gx.len() / 2;
-    let ry = gy.len() / 2;
     let mut tmp = vec![0f32; w * h];
     for_each_row(&mut tmp, w, |y, out| {
-        let row = &src[y * w..(y + 1) * w];
-        let pad: Vec<f32> = (0..w + 2 * rx)
-            .map(|i| row[mirror(i as isize - rx as isize, w)])
-            .collect();
-        out.iter_mut().for_each(|v| *v = 0.0);
-        for (k, &g) in gx.iter().enumerate() {
-            let seg = &pad[k..k + w];
-            for (o, &p) in out.iter_mut().zip(seg) {
-                *o += g * p;
-            }
-        }
+        real_row_pass(&src[y * w..(y + 1) * w], gx, out)
     });
     let mut dst = vec![0f32; w * h];
-    for_each_row(&mut dst, w, |y, out| {
+    for_each_row(&mut dst, w, |y, out| real_col_pass(&tmp, w, h, y, gy, out));
+    dst
+}
+
+simd_fn! {
+    /// `out(x) = sum_k g[k] row(mirror(x + k - r))`.
+    fn real_row_pass(row: &[f32], g: &[f32], out: &mut [f32]) {
+        let w = row.len();
+        let r = g.len() / 2;
+        let pad: Vec<f32> = (0..w + 2 * r)
+            .map(|i| row[mirror(i as isize - r as isize, w)])
+            .collect();
         out.iter_mut().for_each(|v| *v = 0.0);
-        for (k, &g) in gy.iter().enumerate() {
-            let yy = mirror(y as isize + k as isize - ry as isize, h);
-            let seg = &tmp[yy * w..(yy + 1) * w];
-            for (o, &p) in out.iter_mut().zip(seg) {
-                *o += g * p;
+        for (k, &gk) in g.iter().enumerate() {
+            for (o, &p) in out.iter_mut().zip(&pad[k..k + w]) {
+                *o += gk * p;
             }
         }
-    });
-    dst
+    }
+}
+
+simd_fn! {
+    /// Column pass of a real separable blur for output row `y`.
+    fn real_col_pass(src: &[f32], w: usize, h: usize, y: usize, g: &[f32], out: &mut [f32]) {
+        let r = g.len() / 2;
+        out.iter_mut().for_each(|v| *v = 0.0);
+        for (k, &gk) in g.iter().enumerate() {
+            let yy = mirror(y as isize + k as isize - r as isize, h);
+            for (o, &p) in out.iter_mut().zip(&src[yy * w..(yy + 1) * w]) {
+                *o += gk * p;
+            }
+        }
+    }
 }
 
 /// Complex responses `y = h * I` of one image for every channel, as planar (re, im) planes,
@@ -219,7 +230,11 @@ pub fn filter_bank(img: &[f32], w: usize, h: usize, chans: &[Channel]) -> Respon
     let mut im_out = Vec::with_capacity(chans.len());
     for (c, &g) in chans.iter().zip(&group_of) {
         let (_, hre, him) = &groups[g];
-        let (mut re, mut im) = col_pass(hre, him, w, h, &c.hy);
+        let mut re = vec![0f32; w * h];
+        let mut im = vec![0f32; w * h];
+        crate::parallel::for_each_row2(&mut re, &mut im, w, |y, ore, oim| {
+            complex_col_pass(hre, him, w, h, y, &c.hy, ore, oim)
+        });
         // Zero-DC correction: y = a - c L.
         let [cr, ci] = c.dc;
         for ((r, i), &l) in re.iter_mut().zip(im.iter_mut()).zip(&lowpass) {
@@ -239,13 +254,21 @@ pub fn filter_bank(img: &[f32], w: usize, h: usize, chans: &[Channel]) -> Respon
 }
 
 /// Complex row pass of a real image: `H(x) = sum_t hx(t) I(x - t)`.
-fn row_pass(img: &[f32], w: usize, h: usize, hx: &[[f32; 2]]) -> (Vec<f32>, Vec<f32>) {
-    let r = hx.len() / 2;
+pub fn row_pass(img: &[f32], w: usize, h: usize, hx: &[[f32; 2]]) -> (Vec<f32>, Vec<f32>) {
     let mut re = vec![0f32; w * h];
     let mut im = vec![0f32; w * h];
     crate::parallel::for_each_row2(&mut re, &mut im, w, |y, ore, oim| {
-        let row = &img[y * w..(y + 1) * w];
-        // pad[i] = I(i - r); output x needs I(x - t) = pad[x + r - t] = pad[x + 2r - k], k = t + r.
+        complex_row_pass(&img[y * w..(y + 1) * w], hx, ore, oim)
+    });
+    (re, im)
+}
+
+simd_fn! {
+    /// One row of [`row_pass`].
+    fn complex_row_pass(row: &[f32], hx: &[[f32; 2]], ore: &mut [f32], oim: &mut [f32]) {
+        let w = row.len();
+        let r = hx.len() / 2;
+        // pad[i] = I(i - r); output x needs I(x - t) = pad[x + 2r - k], with k = t + r.
         let pad: Vec<f32> = (0..w + 2 * r)
             .map(|i| row[mirror(i as isize - r as isize, w)])
             .collect();
@@ -258,17 +281,23 @@ fn row_pass(img: &[f32], w: usize, h: usize, hx: &[[f32; 2]]) -> (Vec<f32>, Vec<
                 *b += hi * p;
             }
         }
-    });
-    (re, im)
+    }
 }
 
-/// Complex column pass: `a(y) = sum_s hy(s) H(y - s)`.
-fn col_pass(hre: &[f32], him: &[f32], w: usize, h: usize, hy: &[[f32; 2]]) -> (Vec<f32>, Vec<f32>) {
-    let r = hy.len() / 2;
-    let real_taps = hy.iter().all(|t| t[1] == 0.0);
-    let mut re = vec![0f32; w * h];
-    let mut im = vec![0f32; w * h];
-    crate::parallel::for_each_row2(&mut re, &mut im, w, |y, ore, oim| {
+simd_fn! {
+    /// Complex column pass for output row `y`: `a(y) = sum_s hy(s) H(y - s)`.
+    pub fn complex_col_pass(
+        hre: &[f32],
+        him: &[f32],
+        w: usize,
+        h: usize,
+        y: usize,
+        hy: &[[f32; 2]],
+        ore: &mut [f32],
+        oim: &mut [f32],
+    ) {
+        let r = hy.len() / 2;
+        let real_taps = hy.iter().all(|t| t[1] == 0.0);
         ore.iter_mut().for_each(|v| *v = 0.0);
         oim.iter_mut().for_each(|v| *v = 0.0);
         for (k, &[gr, gi]) in hy.iter().enumerate() {
@@ -277,23 +306,18 @@ fn col_pass(hre: &[f32], him: &[f32], w: usize, h: usize, hy: &[[f32; 2]]) -> (V
             let sr = &hre[yy * w..(yy + 1) * w];
             let si = &him[yy * w..(yy + 1) * w];
             if real_taps {
-                for ((a, b), (&pr, &pi)) in
-                    ore.iter_mut().zip(oim.iter_mut()).zip(sr.iter().zip(si))
-                {
+                for ((a, b), (&pr, &pi)) in ore.iter_mut().zip(oim.iter_mut()).zip(sr.iter().zip(si)) {
                     *a += gr * pr;
                     *b += gr * pi;
                 }
             } else {
-                for ((a, b), (&pr, &pi)) in
-                    ore.iter_mut().zip(oim.iter_mut()).zip(sr.iter().zip(si))
-                {
+                for ((a, b), (&pr, &pi)) in ore.iter_mut().zip(oim.iter_mut()).zip(sr.iter().zip(si)) {
                     *a += gr * pr - gi * pi;
                     *b += gr * pi + gi * pr;
                 }
             }
         }
-    });
-    (re, im)
+    }
 }
 
 /// Gaussian pyramid level: blur with `sigma = 1` and keep even pixels (`ceil(n / 2)`).

@@ -2,38 +2,53 @@
 //!
 //! Position-shift receptive fields (Chen & Qian 2004): each pyramid level is filtered once per
 //! image. The right responses are stored as the smooth *baseband* `b = exp(-j k.x) (y + c L)`
-//! (the carrier removed), so shifting them by the current disparity is a cheap linear
-//! interpolation followed by an exact carrier phase `exp(-j kx D)`; a Newton iteration never
-//! re-filters a warped image and its work is pointwise.
+//! (the carrier removed; `y + c L` is the response before the zero-DC term), so shifting them by
+//! the current disparity is a linear interpolation followed by the exact carrier phase
+//! `exp(-j kx D)`; a Newton iteration never re-filters a warped image and its work is pointwise.
+//!
+//! Row kernels run in two passes: a scalar gather of the interpolated right data, then plain
+//! vectorisable arithmetic over the row (`simd_fn!` adds an AVX2+FMA build chosen at run time).
 
-use super::fastmath::{atan2, sincos};
-use super::filter::{filter_bank, Channel, Responses};
-use crate::parallel::{for_each_row, for_each_row2};
+use super::fastmath::{atan2, floor_fast, ln, round_fast, sincos};
+use super::filter::{blur_real, complex_col_pass, row_pass, Channel};
+use super::simd::simd_fn;
+use crate::parallel::{for_each_row, for_each_row2, for_each_row_pair};
 
 /// A response below this amplitude is numerical noise (a constant image gives ~1e-7; one grey
 /// level of texture, 1/255, gives ~1e-3), so its phase is never used whatever the percentile says.
 pub const AMP_ABS_FLOOR: f32 = 1e-4;
-/// Fraction of pixels sampled (every n-th) for the amplitude percentile; deterministic.
+/// Every n-th pixel enters the amplitude percentile (deterministic subsample, 3x cheaper).
 const PERCENTILE_STRIDE: usize = 3;
 /// Percentile of the amplitude distribution the relative threshold refers to (A.3).
 const AMP_PERCENTILE: f32 = 0.95;
 /// A local frequency below this fraction of the tuning is a singularity (A.5 step 4e).
 pub const MIN_FREQ_RATIO: f32 = 0.5;
+/// Guards `ln(0)` in the amplitude log-derivative.
+const LN_EPS: f32 = 1e-30;
 
 /// Filtered data of one image at one level, laid out for the pointwise kernels.
 pub struct LevelData {
     pub w: usize,
     pub h: usize,
-    /// Per channel, per pixel: `[re, im, f_re, f_im]` where `(re, im)` is the demodulated response
-    /// `beta = exp(-j k.x) y` (left) or the baseband `b = exp(-j k.x) (y + c L)` (right), and
-    /// `f = y(x+1) conj y(x) + y(x) conj y(x-1)` the local-frequency phasor.
-    pub chan: Vec<Vec<[f32; 4]>>,
-    /// Shared low-pass `L = G * I` (right image only uses it, for the zero-DC term).
+    /// Per channel, "row-planar": image row `y` holds four sub-rows `re, im, f_re, f_im` at
+    /// `(4 y + k) w`, where `(re, im)` is the demodulated response `beta = exp(-j k.x) y` (left) or
+    /// the baseband `b = exp(-j k.x) (y + c L)` (right), and `f = y(x+1) conj y(x) + y(x) conj
+    /// y(x-1)` the local-frequency phasor. Planar rows keep the arithmetic loops vectorisable.
+    pub chan: Vec<Vec<f32>>,
+    /// Shared low-pass `L = G * I` (the right image uses it for the zero-DC term).
     pub lowpass: Vec<f32>,
     /// Bit `c` set where channel `c` passes the stability test.
     pub stable: Vec<u8>,
-    /// `|y|` samples for the percentile, per channel.
-    pub amp_samples: Vec<Vec<f32>>,
+    /// `|y|^2` samples for the percentile, per channel.
+    pub amp2_samples: Vec<Vec<f32>>,
+    /// Per channel: carrier phasors `exp(-j kx x)` (re, im) per column and `exp(-j ky y)` per row.
+    pub colph: Vec<(Vec<f32>, Vec<f32>)>,
+    pub rowph: Vec<(Vec<f32>, Vec<f32>)>,
+    /// Zero-DC responses packed per pixel, `[re_0, im_0, re_1, im_1, ...]` (`2 n_chan` floats),
+    /// for the integer-shift energy search (one contiguous read per candidate).
+    pub ypack: Vec<f32>,
+    /// `sum_c |y_c|^2` per pixel.
+    pub energy: Vec<f32>,
 }
 
 /// Per-channel constants used by the kernels.
@@ -44,82 +59,217 @@ pub struct ChanConst {
     pub dc: [f32; 2],
     /// Squared amplitude threshold of this channel at this level.
     pub thr2: f32,
+    /// Index of this channel's `kx` in the list of distinct `kx` (shared carrier rotations).
+    pub kx_slot: usize,
+}
+
+fn phasors(k: f32, n: usize) -> (Vec<f32>, Vec<f32>) {
+    // f64 so that exp(-j k x) stays exact to f32 precision even at x ~ 4000.
+    (0..n)
+        .map(|i| {
+            let a = -(k as f64) * i as f64;
+            (a.cos() as f32, a.sin() as f32)
+        })
+        .unzip()
 }
 
 /// Builds the level data of one image. `right` selects the baseband layout.
-pub fn level_data(
-    img: &[f32],
-    w: usize,
-    h: usize,
-    chans: &[Channel],
-    tau: f32,
-    right: bool,
-) -> LevelData {
-    let r: Responses = filter_bank(img, w, h, chans);
-    let mut data = Vec::with_capacity(chans.len());
+pub fn level_data(img: &[f32], w: usize, h: usize, chans: &[Channel], tau: f32, right: bool) -> LevelData {
+    let t0 = std::time::Instant::now();
+    let timing = std::env::var_os("SV_GABOR_TIMING").is_some();
+    let lowpass = match chans.first() {
+        Some(c) => blur_real(img, w, h, &c.gx, &c.gy),
+        None => vec![0.0; w * h],
+    };
+    // Row passes are shared by channels with identical x taps (+-theta).
+    let mut groups: Vec<(&[[f32; 2]], Vec<f32>, Vec<f32>)> = Vec::new();
+    let mut group_of = Vec::with_capacity(chans.len());
+    for c in chans {
+        if let Some(g) = groups.iter().position(|(hx, _, _)| *hx == c.hx.as_slice()) {
+            group_of.push(g);
+        } else {
+            let (re, im) = row_pass(img, w, h, &c.hx);
+            groups.push((&c.hx, re, im));
+            group_of.push(groups.len() - 1);
+        }
+    }
+    if timing {
+        eprintln!("    rowpass {:.1}", t0.elapsed().as_secs_f64() * 1e3);
+    }
+    let mut chan = Vec::with_capacity(chans.len());
     let mut stable = vec![0u8; w * h];
-    let mut amp_samples = Vec::with_capacity(chans.len());
-    for (ci, c) in chans.iter().enumerate() {
-        let (re, im) = (&r.re[ci], &r.im[ci]);
-        let mut out = vec![[0f32; 4]; w * h];
-        let (cr, cim) = (c.dc[0], c.dc[1]);
-        let (kx, ky) = (c.kx, c.ky);
-        let lp = &r.lowpass;
-        for_each_row(&mut out, w, |y, row| {
-            let o = y * w;
-            for (x, v) in row.iter_mut().enumerate() {
-                let i = o + x;
-                let (yr, yi) = (re[i], im[i]);
-                // Local-frequency phasor (central pair of products, clamped at the borders).
-                let (il, ir) = (o + x.saturating_sub(1), o + (x + 1).min(w - 1));
-                let (ar, ai) = (re[ir] * yr + im[ir] * yi, im[ir] * yr - re[ir] * yi);
-                let (br, bi) = (yr * re[il] + yi * im[il], yi * re[il] - yr * im[il]);
-                let (s, cth) = sincos(-(kx * x as f32 + ky * y as f32));
-                // Demodulate: left uses y itself, right adds back c L so the result is smooth.
-                let (pr, pi) = if right {
-                    (yr + cr * lp[i], yi + cim * lp[i])
-                } else {
-                    (yr, yi)
-                };
-                *v = [pr * cth - pi * s, pr * s + pi * cth, ar + br, ai + bi];
-            }
+    let mut amp2_samples = Vec::with_capacity(chans.len());
+    let mut colph = Vec::with_capacity(chans.len());
+    let mut rowph = Vec::with_capacity(chans.len());
+    let mut amp2 = vec![0f32; w * h];
+    let nc = chans.len();
+    let mut ypack = vec![0f32; 2 * nc * w * h];
+    let mut energy = vec![0f32; w * h];
+    for (ci, (c, &g)) in chans.iter().zip(&group_of).enumerate() {
+        let (_, hre, him) = &groups[g];
+        let cph = phasors(c.kx, w);
+        let rph = phasors(c.ky, h);
+        let mut out = vec![0f32; 4 * w * h];
+        for_each_row_pair(&mut out, 4 * w, &mut amp2, w, |y, orow, arow| {
+            build_row(
+                hre, him, w, h, y, &c.hy, c.dc, &lowpass, &cph.0, &cph.1, rph.0[y], rph.1[y], right,
+                orow, arow,
+            )
+        });
+        // y = a - c L is recomputed here from the stored data only for the packed copy.
+        for_each_row_pair(&mut ypack, 2 * nc * w, &mut energy, w, |y, prow, erow| {
+            pack_row(&out[4 * y * w..4 * (y + 1) * w], &lowpass[y * w..(y + 1) * w], &amp2[y * w..(y + 1) * w], &cph, rph.0[y], rph.1[y], c.dc, right, ci, nc, prow, erow)
         });
         // Stability (A.5 step 4e with the A.9 correction): Im psi = mean phase increment,
         // Re psi = central difference of ln rho; |psi - j k0| <= tau / sigma_x, Im psi >= k0 / 2.
         let lim2 = (tau / c.sigma_x).powi(2);
-        let k0 = c.kx;
         let bit = 1u8 << ci;
-        for_each_row(&mut stable, w, |y, row| {
-            let o = y * w;
-            if w < 3 {
-                return;
-            }
-            for x in 1..w - 1 {
-                let f = out[o + x];
-                let im_psi = atan2(f[3], f[2]);
-                let l2 = |j: usize| (re[j] * re[j] + im[j] * im[j] + 1e-30).ln();
-                let re_psi = 0.25 * (l2(o + x + 1) - l2(o + x - 1));
-                let dk = im_psi - k0;
-                if re_psi * re_psi + dk * dk <= lim2 && im_psi >= MIN_FREQ_RATIO * k0 {
-                    row[x] |= bit;
-                }
-            }
+        for_each_row(&mut stable, w, |y, srow| {
+            let o = 4 * y * w;
+            let (fr, fi) = (&out[o + 2 * w..o + 3 * w], &out[o + 3 * w..o + 4 * w]);
+            stability_row(fr, fi, &amp2[y * w..(y + 1) * w], c.kx, lim2, bit, srow)
         });
-        amp_samples.push(
-            (0..w * h)
-                .step_by(PERCENTILE_STRIDE)
-                .map(|i| (re[i] * re[i] + im[i] * im[i]).sqrt())
-                .collect(),
-        );
-        data.push(out);
+        if timing {
+            eprintln!("    chan {ci} {:.1}", t0.elapsed().as_secs_f64() * 1e3);
+        }
+        amp2_samples.push(amp2.iter().step_by(PERCENTILE_STRIDE).copied().collect());
+        chan.push(out);
+        colph.push(cph);
+        rowph.push(rph);
     }
     LevelData {
         w,
         h,
-        chan: data,
-        lowpass: r.lowpass,
+        chan,
+        lowpass,
         stable,
-        amp_samples,
+        amp2_samples,
+        colph,
+        rowph,
+        ypack,
+        energy,
+    }
+}
+
+simd_fn! {
+    /// Re-modulates one row of channel `ci` back to `y` and stores it in the packed layout.
+    fn pack_row(
+        orow: &[f32],
+        lp: &[f32],
+        a2: &[f32],
+        cph: &(Vec<f32>, Vec<f32>),
+        rre: f32,
+        rim: f32,
+        dc: [f32; 2],
+        right: bool,
+        ci: usize,
+        nc: usize,
+        prow: &mut [f32],
+        erow: &mut [f32],
+    ) {
+        let w = lp.len();
+        let (br, bi) = (&orow[..w], &orow[w..2 * w]);
+        let (cre, cim) = (&cph.0[..w], &cph.1[..w]);
+        for x in 0..w {
+            // exp(+j k.(x, y)) = conj(colph[x] rowph[y])
+            let qr = cre[x] * rre - cim[x] * rim;
+            let qi = -(cre[x] * rim + cim[x] * rre);
+            let (mut yr, mut yi) = (br[x] * qr - bi[x] * qi, br[x] * qi + bi[x] * qr);
+            if right {
+                yr -= dc[0] * lp[x];
+                yi -= dc[1] * lp[x];
+            }
+            prow[(x * nc + ci) * 2] = yr;
+            prow[(x * nc + ci) * 2 + 1] = yi;
+            erow[x] += a2[x];
+        }
+    }
+}
+
+simd_fn! {
+    /// One output row of a channel: column pass, zero-DC term, `|y|^2`, demodulation, local
+    /// frequency phasor.
+    fn build_row(
+        hre: &[f32],
+        him: &[f32],
+        w: usize,
+        h: usize,
+        y: usize,
+        hy: &[[f32; 2]],
+        dc: [f32; 2],
+        lowpass: &[f32],
+        cre: &[f32],
+        cim: &[f32],
+        rre: f32,
+        rim: f32,
+        right: bool,
+        orow: &mut [f32],
+        arow: &mut [f32],
+    ) {
+        let mut ar = vec![0f32; w];
+        let mut ai = vec![0f32; w];
+        complex_col_pass(hre, him, w, h, y, hy, &mut ar, &mut ai);
+        let lp = &lowpass[y * w..(y + 1) * w];
+        let mut yr = vec![0f32; w];
+        let mut yi = vec![0f32; w];
+        for x in 0..w {
+            // Zero-DC: y = a - c L (a = response of the uncorrected kernel).
+            yr[x] = ar[x] - dc[0] * lp[x];
+            yi[x] = ai[x] - dc[1] * lp[x];
+            arow[x] = yr[x] * yr[x] + yi[x] * yi[x];
+        }
+        // The left keeps the zero-DC response, the right the smooth uncorrected one.
+        let (pr, pi) = if right { (&ar[..w], &ai[..w]) } else { (&yr[..w], &yi[..w]) };
+        let (cre, cim) = (&cre[..w], &cim[..w]);
+        let (ore, rest) = orow.split_at_mut(w);
+        let (oim, rest) = rest.split_at_mut(w);
+        let (ofr, ofi) = rest.split_at_mut(w);
+        let (ofr, ofi) = (&mut ofr[..w], &mut ofi[..w]);
+        for x in 0..w {
+            // exp(-j k.(x, y)) = colph[x] * rowph[y]
+            let qr = cre[x] * rre - cim[x] * rim;
+            let qi = cre[x] * rim + cim[x] * rre;
+            ore[x] = pr[x] * qr - pi[x] * qi;
+            oim[x] = pr[x] * qi + pi[x] * qr;
+        }
+        // f = y(x+1) conj y(x) + y(x) conj y(x-1), borders clamped.
+        let f = |x: usize, xl: usize, xr: usize| {
+            (
+                yr[xr] * yr[x] + yi[xr] * yi[x] + yr[x] * yr[xl] + yi[x] * yi[xl],
+                yi[xr] * yr[x] - yr[xr] * yi[x] + yi[x] * yr[xl] - yr[x] * yi[xl],
+            )
+        };
+        (ofr[0], ofi[0]) = f(0, 0, 1.min(w - 1));
+        (ofr[w - 1], ofi[w - 1]) = f(w - 1, w.saturating_sub(2), w - 1);
+        if w > 2 {
+            let (yr0, yr1, yr2) = (&yr[..w - 2], &yr[1..w - 1], &yr[2..w]);
+            let (yi0, yi1, yi2) = (&yi[..w - 2], &yi[1..w - 1], &yi[2..w]);
+            let (fr, fi) = (&mut ofr[1..w - 1], &mut ofi[1..w - 1]);
+            for x in 0..w - 2 {
+                fr[x] = yr2[x] * yr1[x] + yi2[x] * yi1[x] + yr1[x] * yr0[x] + yi1[x] * yi0[x];
+                fi[x] = yi2[x] * yr1[x] - yr2[x] * yi1[x] + yi1[x] * yr0[x] - yr1[x] * yi0[x];
+            }
+        }
+    }
+}
+
+simd_fn! {
+    /// Stability bits of one channel for one row (borders are never stable).
+    fn stability_row(fr: &[f32], fi: &[f32], arow: &[f32], k0: f32, lim2: f32, bit: u8, srow: &mut [u8]) {
+        let w = fr.len();
+        if w < 3 || fi.len() != w || arow.len() != w || srow.len() != w {
+            return;
+        }
+        let n = w - 2;
+        let (fr, fi, a0, a2) = (&fr[1..w - 1], &fi[1..w - 1], &arow[..n], &arow[2..]);
+        let s = &mut srow[1..w - 1];
+        for x in 0..n {
+            let im_psi = atan2(fi[x], fr[x]);
+            let re_psi = 0.25 * (ln(a2[x] + LN_EPS) - ln(a0[x] + LN_EPS));
+            let dk = im_psi - k0;
+            let ok = (re_psi * re_psi + dk * dk <= lim2) & (im_psi >= MIN_FREQ_RATIO * k0);
+            s[x] |= if ok { bit } else { 0 };
+        }
     }
 }
 
@@ -135,153 +285,249 @@ pub fn percentile(v: &[f32], q: f32) -> f32 {
 }
 
 /// Channel constants with the amplitude thresholds `amp_rel * P95(|y|)` over both images.
-pub fn chan_consts(
-    chans: &[Channel],
-    l: &LevelData,
-    r: &LevelData,
-    amp_rel: f32,
-) -> Vec<ChanConst> {
+pub fn chan_consts(chans: &[Channel], l: &LevelData, r: &LevelData, amp_rel: f32) -> Vec<ChanConst> {
+    let mut slots: Vec<f32> = Vec::new();
     chans
         .iter()
         .enumerate()
         .map(|(ci, c)| {
-            let mut s = l.amp_samples[ci].clone();
-            s.extend_from_slice(&r.amp_samples[ci]);
-            let thr = (amp_rel * percentile(&s, AMP_PERCENTILE)).max(AMP_ABS_FLOOR);
+            let mut s = l.amp2_samples[ci].clone();
+            s.extend_from_slice(&r.amp2_samples[ci]);
+            let thr = (amp_rel * percentile(&s, AMP_PERCENTILE).sqrt()).max(AMP_ABS_FLOOR);
+            let kx_slot = match slots.iter().position(|&k| k == c.kx) {
+                Some(p) => p,
+                None => {
+                    slots.push(c.kx);
+                    slots.len() - 1
+                }
+            };
             ChanConst {
                 kx: c.kx,
                 ky: c.ky,
                 dc: c.dc,
                 thr2: thr * thr,
+                kx_slot,
             }
         })
         .collect()
 }
 
-/// The right response of channel `c` at sub-pixel position `s` of row `y`, demodulated by the
-/// LEFT pixel's carrier: returns `exp(-j k.(x, y)) y_r(s, y)` with `d = x - s`, plus the
-/// interpolated local-frequency phasor. `None` outside the image.
-#[inline(always)]
-fn shifted(
-    r: &LevelData,
-    cc: &ChanConst,
-    ci: usize,
-    y: usize,
-    x: usize,
-    d: f32,
-) -> Option<([f32; 2], [f32; 2])> {
-    let w = r.w;
-    let s = x as f32 - d;
-    if !(s >= 0.0 && s <= (w - 1) as f32) {
-        return None;
+/// Distinct `kx` values of the channels, in slot order.
+pub fn kx_slots(cc: &[ChanConst]) -> Vec<f32> {
+    let mut v: Vec<f32> = Vec::new();
+    for c in cc {
+        if c.kx_slot == v.len() {
+            v.push(c.kx);
+        }
     }
-    let i0 = (s.floor() as usize).min(w.saturating_sub(2));
-    let i1 = (i0 + 1).min(w - 1);
-    let t = s - i0 as f32;
-    let o = y * w;
-    let (a, b) = (r.chan[ci][o + i0], r.chan[ci][o + i1]);
-    let lerp = |p: f32, q: f32| p + t * (q - p);
-    let (br, bi) = (lerp(a[0], b[0]), lerp(a[1], b[1]));
-    let (fr, fi) = (lerp(a[2], b[2]), lerp(a[3], b[3]));
-    let lp = lerp(r.lowpass[o + i0], r.lowpass[o + i1]);
-    // exp(-j k.x) y_r(s) = exp(-j kx d) b(s) - c L(s) exp(-j k.x).
-    let (sn, cs) = sincos(cc.kx * d);
-    let (sp, cp) = sincos(-(cc.kx * x as f32 + cc.ky * y as f32));
-    let (wr, wi) = (br * cs + bi * sn, bi * cs - br * sn);
-    let (dr, di) = (cc.dc[0] * lp, cc.dc[1] * lp);
-    let (er, ei) = (dr * cp - di * sp, dr * sp + di * cp);
-    Some(([wr - er, wi - ei], [fr, fi]))
+    v
 }
 
-/// One Newton step at every pixel: per-channel phase difference, local frequency, confidence,
-/// weighted least squares over channels. Returns `(delta, c)` with `c` the mean channel
-/// confidence in [0, 1] and `delta` clamped to half a carrier wavelength.
-pub fn newton_step(
+/// Row-level preparation shared by the kernels: sub-pixel positions, validity, stability,
+/// interpolated low-pass and the carrier rotations `exp(-j kx d)` per distinct `kx`.
+struct RowPrep {
+    i0: Vec<usize>,
+    i1: Vec<usize>,
+    t: Vec<f32>,
+    stab: Vec<u8>,
+    lp: Vec<f32>,
+    sn: Vec<Vec<f32>>,
+    cs: Vec<Vec<f32>>,
+}
+
+#[inline(always)]
+fn prep_row(l: &LevelData, r: &LevelData, slots: &[f32], y: usize, drow: &[f32], off: f32) -> RowPrep {
+    let w = l.w;
+    let o = y * w;
+    let last = (w - 1) as f32;
+    let mut p = RowPrep {
+        i0: vec![0; w],
+        i1: vec![0; w],
+        t: vec![0.0; w],
+        stab: vec![0; w],
+        lp: vec![0.0; w],
+        sn: vec![vec![0.0; w]; slots.len()],
+        cs: vec![vec![0.0; w]; slots.len()],
+    };
+    for x in 0..w {
+        let d = drow[x] + off;
+        let s = x as f32 - d;
+        let valid = s >= 0.0 && s <= last;
+        let sc = s.clamp(0.0, last);
+        let i0 = (floor_fast(sc) as usize).min(w.saturating_sub(2));
+        let i1 = (i0 + 1).min(w - 1);
+        let t = sc - i0 as f32;
+        let near = (round_fast(sc) as usize).min(w - 1);
+        p.i0[x] = i0;
+        p.i1[x] = i1;
+        p.t[x] = t;
+        // Validity is folded into the stability byte: an out-of-image shift has no stable channel.
+        p.stab[x] = if valid { l.stable[o + x] & r.stable[o + near] } else { 0 };
+        let (a, b) = (r.lowpass[o + i0], r.lowpass[o + i1]);
+        p.lp[x] = a + t * (b - a);
+    }
+    for (k, &kx) in slots.iter().enumerate() {
+        for x in 0..w {
+            let (s, c) = sincos(kx * (drow[x] + off));
+            p.sn[k][x] = s;
+            p.cs[k][x] = c;
+        }
+    }
+    p
+}
+
+/// Fills `(bwr, bwi)` with the shifted right response of channel `ci`, demodulated by the left
+/// pixel's carrier: `exp(-j k.(x, y)) y_r(x - d, y) = exp(-j kx d) b(x - d) - c L(x - d) exp(-j k.(x, y))`.
+#[inline(always)]
+fn shifted_row(
     l: &LevelData,
     r: &LevelData,
-    cc: &[ChanConst],
-    disp: &[f32],
-) -> (Vec<f32>, Vec<f32>) {
+    c: &ChanConst,
+    ci: usize,
+    y: usize,
+    p: &RowPrep,
+    bwr: &mut [f32],
+    bwi: &mut [f32],
+    gfr: &mut [f32],
+    gfi: &mut [f32],
+) {
+    let w = l.w;
+    let o = 4 * y * w;
+    let rc = &r.chan[ci];
+    let (rre, rim) = (&rc[o..o + w], &rc[o + w..o + 2 * w]);
+    let (rfr, rfi) = (&rc[o + 2 * w..o + 3 * w], &rc[o + 3 * w..o + 4 * w]);
+    // Scalar gather + linear interpolation of the smooth baseband and frequency phasor.
+    for x in 0..w {
+        let (i0, i1, t) = (p.i0[x], p.i1[x], p.t[x]);
+        bwr[x] = rre[i0] + t * (rre[i1] - rre[i0]);
+        bwi[x] = rim[i0] + t * (rim[i1] - rim[i0]);
+        gfr[x] = rfr[i0] + t * (rfr[i1] - rfr[i0]);
+        gfi[x] = rfi[i0] + t * (rfi[i1] - rfi[i0]);
+    }
+    let (cre, cim) = (&l.colph[ci].0[..w], &l.colph[ci].1[..w]);
+    let (rre, rim) = (l.rowph[ci].0[y], l.rowph[ci].1[y]);
+    let (sn, cs) = (&p.sn[c.kx_slot][..w], &p.cs[c.kx_slot][..w]);
+    let lp = &p.lp[..w];
+    let (bwr, bwi) = (&mut bwr[..w], &mut bwi[..w]);
+    for x in 0..w {
+        let (br, bi) = (bwr[x], bwi[x]);
+        let (wr, wi) = (br * cs[x] + bi * sn[x], bi * cs[x] - br * sn[x]);
+        let qr = cre[x] * rre - cim[x] * rim;
+        let qi = cre[x] * rim + cim[x] * rre;
+        let (dr, di) = (c.dc[0] * lp[x], c.dc[1] * lp[x]);
+        bwr[x] = wr - (dr * qr - di * qi);
+        bwi[x] = wi - (dr * qi + di * qr);
+    }
+}
+
+simd_fn! {
+    /// One Newton row: per-channel phase difference, local frequency, confidence, WLS over channels.
+    fn newton_row(
+        l: &LevelData,
+        r: &LevelData,
+        cc: &[ChanConst],
+        slots: &[f32],
+        y: usize,
+        drow: &[f32],
+        max_delta: f32,
+        dout: &mut [f32],
+        cout: &mut [f32],
+    ) {
+        let w = l.w;
+        let p = prep_row(l, r, slots, y, drow, 0.0);
+        let (mut num, mut den, mut csum) = (vec![0f32; w], vec![0f32; w], vec![0f32; w]);
+        let (mut bwr, mut bwi, mut gfr, mut gfi) =
+            (vec![0f32; w], vec![0f32; w], vec![0f32; w], vec![0f32; w]);
+        for (ci, c) in cc.iter().enumerate() {
+            shifted_row(l, r, c, ci, y, &p, &mut bwr, &mut bwi, &mut gfr, &mut gfi);
+            let o = 4 * y * w;
+            let lc = &l.chan[ci];
+            let (lre, lim) = (&lc[o..o + w], &lc[o + w..o + 2 * w]);
+            let (lfr, lfi) = (&lc[o + 2 * w..o + 3 * w], &lc[o + 3 * w..o + 4 * w]);
+            let kmin = MIN_FREQ_RATIO * c.kx;
+            let (bwr, bwi, gfr, gfi) = (&bwr[..w], &bwi[..w], &gfr[..w], &gfi[..w]);
+            let stab = &p.stab[..w];
+            let (num, den, csum) = (&mut num[..w], &mut den[..w], &mut csum[..w]);
+            let bit = 1u8 << ci;
+            for x in 0..w {
+                let bl = [lre[x], lim[x], lfr[x], lfi[x]];
+                let (zr, zi) = (bwr[x] * bl[0] + bwi[x] * bl[1], bwi[x] * bl[0] - bwr[x] * bl[1]);
+                let pl = bl[0] * bl[0] + bl[1] * bl[1];
+                let pw = bwr[x] * bwr[x] + bwi[x] * bwi[x];
+                let k = atan2(bl[3] + gfi[x], bl[2] + gfr[x]);
+                let ok = (stab[x] & bit != 0) & (pl.min(pw) >= c.thr2) & (k >= kmin);
+                let m = 2.0 * (zr * zr + zi * zi).sqrt() / (pl + pw);
+                let m = if ok { m } else { 0.0 };
+                let dphi = atan2(zi, zr);
+                num[x] += m * k * dphi;
+                den[x] += m * k * k;
+                csum[x] += m;
+            }
+        }
+        let inv_n = 1.0 / cc.len().max(1) as f32;
+        for x in 0..w {
+            let d = if den[x] > 0.0 { num[x] / den[x] } else { 0.0 };
+            dout[x] = d.clamp(-max_delta, max_delta);
+            cout[x] = csum[x] * inv_n;
+        }
+    }
+}
+
+/// One Newton step at every pixel. Returns `(delta, c)`: the WLS phase update (clamped to half
+/// the shortest carrier wavelength) and the mean channel confidence in [0, 1].
+pub fn newton_step(l: &LevelData, r: &LevelData, cc: &[ChanConst], disp: &[f32]) -> (Vec<f32>, Vec<f32>) {
     let (w, h) = (l.w, l.h);
     let mut delta = vec![0f32; w * h];
     let mut conf = vec![0f32; w * h];
-    let n = cc.len().max(1) as f32;
+    let slots = kx_slots(cc);
     let max_delta = cc
         .iter()
         .map(|c| std::f32::consts::PI / c.kx)
         .fold(f32::INFINITY, f32::min);
     for_each_row2(&mut delta, &mut conf, w, |y, drow, crow| {
-        for x in 0..w {
-            let i = y * w + x;
-            let d = disp[i];
-            let s = x as f32 - d;
-            if !(s >= 0.0 && s <= (w - 1) as f32) {
-                drow[x] = 0.0;
-                crow[x] = 0.0;
-                continue;
-            }
-            let near = (s.round() as usize).min(w - 1);
-            let stab = l.stable[i] & r.stable[y * w + near];
-            let (mut num, mut den, mut csum) = (0f32, 0f32, 0f32);
-            for (ci, c) in cc.iter().enumerate() {
-                let Some((bw, fr)) = shifted(r, c, ci, y, x, d) else {
-                    continue;
-                };
-                let bl = l.chan[ci][i];
-                let (zr, zi) = (bw[0] * bl[0] + bw[1] * bl[1], bw[1] * bl[0] - bw[0] * bl[1]);
-                let pl = bl[0] * bl[0] + bl[1] * bl[1];
-                let pw = bw[0] * bw[0] + bw[1] * bw[1];
-                let k = atan2(bl[3] + fr[1], bl[2] + fr[0]);
-                let ok =
-                    (stab >> ci) & 1 == 1 && pl.min(pw) >= c.thr2 && k >= MIN_FREQ_RATIO * c.kx;
-                if !ok {
-                    continue;
-                }
-                let m = 2.0 * (zr * zr + zi * zi).sqrt() / (pl + pw);
-                let dphi = atan2(zi, zr);
-                num += m * k * dphi;
-                den += m * k * k;
-                csum += m;
-            }
-            drow[x] = if den > 0.0 {
-                (num / den).clamp(-max_delta, max_delta)
-            } else {
-                0.0
-            };
-            crow[x] = csum / n;
-        }
+        newton_row(l, r, cc, &slots, y, &disp[y * w..(y + 1) * w], max_delta, drow, crow)
     });
     (delta, conf)
 }
 
-/// Normalised binocular energy terms for a shift `d + off` at every pixel:
+simd_fn! {
+    /// One row of [`energy_terms`] at integer shifts `round(d + off)`.
+    fn energy_row(l: &LevelData, r: &LevelData, y: usize, drow: &[f32], off: f32, nout: &mut [f32], dout: &mut [f32]) {
+        let w = l.w;
+        let m = l.ypack.len() / (l.w * l.h).max(1);
+        let o = y * w;
+        let lp = &l.ypack[o * m..(o + w) * m];
+        let rp = &r.ypack[o * m..(o + w) * m];
+        let (le, re) = (&l.energy[o..o + w], &r.energy[o..o + w]);
+        for x in 0..w {
+            let s = round_fast(x as f32 - (drow[x] + off));
+            if !(s >= 0.0 && s <= (w - 1) as f32) {
+                nout[x] = 0.0;
+                dout[x] = 0.0;
+                continue;
+            }
+            let si = s as usize;
+            let (a, b) = (&lp[x * m..(x + 1) * m], &rp[si * m..(si + 1) * m]);
+            let mut acc = 0.0;
+            for k in 0..m {
+                acc += a[k] * b[k];
+            }
+            nout[x] = 2.0 * acc;
+            dout[x] = le[x] + re[si];
+        }
+    }
+}
+
+/// Normalised binocular energy terms for the integer shift `round(d + off)` at every pixel:
 /// `num = sum_c 2 Re(y_l conj y_r)`, `den = sum_c |y_l|^2 + |y_r|^2` (zero outside the image).
-pub fn energy_terms(
-    l: &LevelData,
-    r: &LevelData,
-    cc: &[ChanConst],
-    disp: &[f32],
-    off: f32,
-) -> (Vec<f32>, Vec<f32>) {
+/// Integer shifts: the candidates are 1 px apart and pooled over a box, so interpolation buys
+/// nothing here; the Newton steps refine to sub-pixel.
+pub fn energy_terms(l: &LevelData, r: &LevelData, disp: &[f32], off: f32) -> (Vec<f32>, Vec<f32>) {
     let (w, h) = (l.w, l.h);
     let mut num = vec![0f32; w * h];
     let mut den = vec![0f32; w * h];
     for_each_row2(&mut num, &mut den, w, |y, nrow, drow| {
-        for x in 0..w {
-            let i = y * w + x;
-            let d = disp[i] + off;
-            let (mut a, mut b) = (0f32, 0f32);
-            for (ci, c) in cc.iter().enumerate() {
-                let Some((bw, _)) = shifted(r, c, ci, y, x, d) else {
-                    break;
-                };
-                let bl = l.chan[ci][i];
-                a += 2.0 * (bw[0] * bl[0] + bw[1] * bl[1]);
-                b += bw[0] * bw[0] + bw[1] * bw[1] + bl[0] * bl[0] + bl[1] * bl[1];
-            }
-            nrow[x] = a;
-            drow[x] = b;
-        }
+        energy_row(l, r, y, &disp[y * w..(y + 1) * w], off, nrow, drow)
     });
     (num, den)
 }

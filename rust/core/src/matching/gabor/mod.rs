@@ -12,6 +12,7 @@
 //! Right responses are never recomputed for a warp: the smooth baseband is shifted (`level`).
 
 mod fastmath;
+mod simd;
 pub mod filter;
 pub mod level;
 pub mod post;
@@ -54,6 +55,13 @@ pub struct GaborParams {
     pub lr_check: bool,
     /// Left-right tolerance (px).
     pub lr_tol: f32,
+    /// The right-reference run of the left-right check stops this many levels above full
+    /// resolution (its map is up-sampled); 0 = full resolution.
+    pub lr_coarse_levels: usize,
+    /// Newton iterations at full resolution (the finest level dominates the run time).
+    pub iters_finest: usize,
+    /// Position-shift re-search at full resolution too.
+    pub research_finest: bool,
     /// Speckle removal: regions smaller than this many pixels are dropped (0 = off).
     pub speckle_size: usize,
     /// Speckle removal: neighbouring pixels within this many px belong to one region.
@@ -82,6 +90,9 @@ impl Default for GaborParams {
             search_pool_radius: 2,
             lr_check: true,
             lr_tol: 1.0,
+            lr_coarse_levels: 0,
+            iters_finest: 2,
+            research_finest: true,
             speckle_size: 0,
             speckle_range: 1.0,
         }
@@ -131,8 +142,11 @@ impl GaborParams {
                 ));
             }
         }
-        if self.iters_per_level > 20 {
-            return Err(CoreError::param("iters_per_level", "must be <= 20"));
+        if self.iters_per_level > 20 || self.iters_finest > 20 {
+            return Err(CoreError::param("iters_per_level", "iterations must be <= 20"));
+        }
+        if self.lr_coarse_levels > 4 {
+            return Err(CoreError::param("lr_coarse_levels", "must be <= 4"));
         }
         let unit = |name: &'static str, v: f32| {
             if v.is_finite() && (0.0..=1.0).contains(&v) {
@@ -218,13 +232,13 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
         let fl = post::flip_x(&right.data, w, h);
         let fr = post::flip_x(&left.data, w, h);
         let (a, b) = rayon::join(
-            || one_direction(&left.data, &right.data, w, h, params, &chans),
-            || one_direction(&fl, &fr, w, h, params, &chans),
+            || one_direction(&left.data, &right.data, w, h, params, &chans, 0),
+            || one_direction(&fl, &fr, w, h, params, &chans, params.lr_coarse_levels),
         );
         (a, Some(b))
     } else {
         (
-            one_direction(&left.data, &right.data, w, h, params, &chans),
+            one_direction(&left.data, &right.data, w, h, params, &chans, 0),
             None,
         )
     };
@@ -267,7 +281,7 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
     })
 }
 
-/// Coarse-to-fine estimate with `l` as reference.
+/// Coarse-to-fine estimate with `l` as reference, stopping at level `finest` (then up-sampled).
 fn one_direction(
     l: &[f32],
     r: &[f32],
@@ -275,8 +289,9 @@ fn one_direction(
     h: usize,
     p: &GaborParams,
     chans: &[Channel],
+    finest: usize,
 ) -> Direction {
-    let n_levels = p.levels_for(w, h);
+    let n_levels = p.levels_for(w, h).max(finest + 1);
     let mut pyr: Vec<(Vec<f32>, Vec<f32>, usize, usize)> = vec![(l.to_vec(), r.to_vec(), w, h)];
     for _ in 1..n_levels {
         let Some((pl, pr, pw, ph)) = pyr.last() else {
@@ -305,6 +320,9 @@ fn one_direction(
     };
     lap("pyramid", 0);
     for (lvl, (il, ir, lw, lh)) in pyr.iter().enumerate().rev() {
+        if lvl < finest {
+            break;
+        }
         let (lw, lh) = (*lw, *lh);
         let scale = 0.5f32.powi(lvl as i32);
         let (lo, hi) = (p.d_min * scale - 1.0, p.d_max * scale + 1.0);
@@ -320,7 +338,7 @@ fn one_direction(
                 let n = ((p.d_max - p.d_min) * scale).ceil().max(0.0) as usize;
                 let offs: Vec<f32> = (0..=n).map(|k| k as f32).collect();
                 (
-                    search(&ld, &rd, &cc, &init, &offs, p.search_pool_radius),
+                    search(&ld, &rd, &init, &offs, p.search_pool_radius),
                     vec![0.0; lw * lh],
                 )
             }
@@ -328,9 +346,9 @@ fn one_direction(
                 let d = post::upsample(&d, sw, sh, lw, lh, 2.0);
                 let c = post::upsample(&c, sw, sh, lw, lh, 1.0);
                 let rr = p.research_radius as i32;
-                let d = if rr > 0 {
+                let d = if rr > 0 && (lvl > 0 || p.research_finest) {
                     let offs: Vec<f32> = (-rr..=rr).map(|k| k as f32).collect();
-                    search(&ld, &rd, &cc, &d, &offs, p.search_pool_radius)
+                    search(&ld, &rd, &d, &offs, p.search_pool_radius)
                 } else {
                     d
                 };
@@ -339,7 +357,8 @@ fn one_direction(
         };
         disp.iter_mut().for_each(|d| *d = d.clamp(lo, hi));
         lap("search", lvl);
-        for _ in 0..p.iters_per_level {
+        let iters = if lvl == 0 { p.iters_finest } else { p.iters_per_level };
+        for _ in 0..iters {
             let (delta, c) = newton_step(&ld, &rd, &cc, &disp);
             lap("newton", lvl);
             let (dbar, cbar) = post::normalized_conv(&delta, &c, lw, lh, sigma_s);
@@ -352,7 +371,16 @@ fn one_direction(
         state = Some((disp, conf_max, lw, lh));
     }
     match state {
-        Some((disp, conf, _, _)) => Direction { disp, conf },
+        Some((mut disp, mut conf, mut sw, mut sh)) => {
+            // Up-sample a map that stopped above full resolution, level by level.
+            for lvl in (0..finest).rev() {
+                let (_, _, lw, lh) = pyr[lvl];
+                disp = post::upsample(&disp, sw, sh, lw, lh, 2.0);
+                conf = post::upsample(&conf, sw, sh, lw, lh, 1.0);
+                (sw, sh) = (lw, lh);
+            }
+            Direction { disp, conf }
+        }
         None => Direction {
             disp: vec![f32::NAN; w * h],
             conf: vec![0.0; w * h],
@@ -366,7 +394,6 @@ fn one_direction(
 fn search(
     l: &LevelData,
     r: &LevelData,
-    cc: &[level::ChanConst],
     base: &[f32],
     offs: &[f32],
     pool: usize,
@@ -375,7 +402,7 @@ fn search(
     let mut best = vec![f32::NEG_INFINITY; w * h];
     let mut out = base.to_vec();
     for &o in offs {
-        let (num, den) = energy_terms(l, r, cc, base, o);
+        let (num, den) = energy_terms(l, r, base, o);
         let num = post::box_sum(&num, w, h, pool);
         let den = post::box_sum(&den, w, h, pool);
         for i in 0..w * h {

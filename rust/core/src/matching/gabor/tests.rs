@@ -140,3 +140,21 @@ fn tiny_images_do_not_panic() {
         assert_eq!(out.disparity.data.len(), w * h);
     }
 }
+
+/// Manual timing probe: `SV_GABOR_TIMING=1 cargo test --release -- --ignored --nocapture probe`.
+#[test]
+#[ignore]
+fn probe_timing() {
+    let left = texture(450, 375, 0.0, 5);
+    let right = texture(450, 375, 9.5, 5);
+    let p = GaborParams {
+        d_max: 64.0,
+        lr_check: false,
+        ..GaborParams::default()
+    };
+    for _ in 0..3 {
+        let t = std::time::Instant::now();
+        let _ = gabor_disparity(&left, &right, &p).unwrap();
+        eprintln!("total {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
+    }
+}

@@ -1,0 +1,242 @@
+"""Gabor phase-disparity channel: parity with the NumPy reference, sign/magnitude, edge cases.
+
+Tolerances are chosen to be ~100x above float32 round-off yet far below what a sign flip, a
+conjugated phase or a one-pixel shift produces (each of those is asserted to FAIL them).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from stereovision import _core
+from stereovision.matching.gabor import GaborResult, gabor_disparity, gabor_responses
+from tests.reference import gabor_ref as ref
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+
+#: Relative tolerance of the filter-bank responses (max |diff| / max |y|).
+RESP_RTOL = 1e-4
+#: Newton-step parity: |delta| difference (px) and confidence difference, on 99.5 % of pixels.
+STEP_ATOL_PX = 2e-3
+STEP_ATOL_CONF = 1e-3
+STEP_SHARE = 0.995
+#: One-level pipeline parity: disparity difference (px) on pixels valid in both, share of them,
+#: and agreement of the validity masks.
+PIPE_ATOL_PX = 0.02
+PIPE_SHARE = 0.99
+PIPE_MASK_AGREE = 0.99
+
+
+def _grey(scene: str, crop: tuple[slice, slice] | None = None) -> tuple[np.ndarray, np.ndarray]:
+    cv2 = pytest.importorskip("cv2")
+    d = DATA / scene
+    if not (d / "left.png").exists():
+        pytest.skip(f"shared data not found: {d}")
+    left = cv2.imread(str(d / "left.png"), cv2.IMREAD_GRAYSCALE).astype(np.float32) / 255
+    right = cv2.imread(str(d / "right.png"), cv2.IMREAD_GRAYSCALE).astype(np.float32) / 255
+    if crop is not None:
+        left, right = left[crop], right[crop]
+    return np.ascontiguousarray(left), np.ascontiguousarray(right)
+
+
+def _texture(h: int, w: int, shift: float, seed: int) -> np.ndarray:
+    """Random band-limited texture, circularly Fourier-shifted: ``out(x) = base(x + shift)``."""
+    rng = np.random.default_rng(seed)
+    base = rng.standard_normal((h, w))
+    fx = np.fft.fftfreq(w)[None, :]
+    fy = np.fft.fftfreq(h)[:, None]
+    spec = np.fft.fft2(base) * np.exp(-((fx**2 + fy**2) / (2 * 0.15**2)))
+    img = np.real(np.fft.ifft2(spec * np.exp(2j * np.pi * fx * shift)))
+    return (0.5 + 0.15 * img / img.std()).clip(0, 1).astype(np.float32)
+
+
+def _rel_err(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.max(np.abs(a - b)) / np.max(np.abs(b)))
+
+
+# --- filter bank ------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("scene", ["middlebury2001/tsukuba", "middlebury2003/cones"])
+@pytest.mark.parametrize("theta", [0.0, 30.0, -60.0])
+def test_responses_match_reference(scene: str, theta: float) -> None:
+    left, _ = _grey(scene)
+    ours = gabor_responses(left, 0.25, theta)
+    want = ref.responses(left, ref.channel(0.25, theta))
+    assert ours.shape == left.shape and ours.dtype == np.complex64
+    assert _rel_err(ours, want) < RESP_RTOL
+    # The tolerance catches a one-pixel shift, a transposed carrier sign (conjugate) and the
+    # correlation/convolution confusion (mirrored kernel = conjugate for a symmetric envelope).
+    assert _rel_err(np.roll(ours, 1, axis=1), want) > 100 * RESP_RTOL
+    assert _rel_err(np.roll(ours, 1, axis=0), want) > 100 * RESP_RTOL
+    assert _rel_err(np.conj(ours), want) > 100 * RESP_RTOL
+
+
+def test_kernel_is_zero_dc() -> None:
+    for theta in ref.ORIENTATIONS:
+        ch = ref.channel(0.25, theta)
+        kernel = np.outer(ch.hy, ch.hx) - ch.dc * np.outer(ch.gy, ch.gx)
+        assert abs(kernel.sum()) < 1e-7  # float32 taps; |sum h| before the correction ~2e-3
+        y = gabor_responses(np.full((40, 50), 0.73, np.float32), 0.25, theta)
+        assert np.max(np.abs(y)) < 1e-6
+
+
+# --- one level's phase-difference / local-frequency / confidence step ------------------------
+
+
+def _step_case(shift_px: float = 0.0) -> tuple[np.ndarray, ...]:
+    left, right = _grey("middlebury2001/tsukuba")
+    gt = ref_disp_tsukuba(left.shape)
+    disp = (gt + shift_px).astype(np.float32)
+    d_ours, c_ours = _core.gabor_newton_step(left, right, disp)
+    chans = [ref.channel(0.25, t) for t in ref.ORIENTATIONS]
+    lv, rv = ref.level_data(left, chans), ref.level_data(right, chans)
+    thr2 = ref.thresholds2(lv, rv, 0.02)
+    d_ref, c_ref = ref.newton_step(lv, rv, chans, thr2, gt.astype(np.float64))
+    return d_ours, c_ours, d_ref, c_ref
+
+
+def ref_disp_tsukuba(shape: tuple[int, int]) -> np.ndarray:
+    """A smooth, non-trivial disparity field (sub-pixel, varying in x and y) for the step test."""
+    h, w = shape
+    y, x = np.mgrid[0:h, 0:w]
+    return (6.0 + 3.0 * np.sin(x / 37.0) + 2.0 * np.cos(y / 23.0) + 0.37).astype(np.float32)
+
+
+def test_newton_step_matches_reference() -> None:
+    d_ours, c_ours, d_ref, c_ref = _step_case()
+    both = (c_ours > 0) & (c_ref > 0)
+    assert both.mean() > 0.3, "too few confident pixels to compare"
+    assert np.mean(np.abs(d_ours - d_ref)[both] <= STEP_ATOL_PX) >= STEP_SHARE
+    assert np.mean(np.abs(c_ours - c_ref) <= STEP_ATOL_CONF) >= STEP_SHARE
+    # A sign flip of the update fails the tolerance...
+    assert np.mean(np.abs(-d_ours - d_ref)[both] <= STEP_ATOL_PX) < 0.5
+
+
+def test_newton_step_detects_one_pixel_offset() -> None:
+    # ... and so does evaluating our step at a disparity off by one pixel.
+    d_ours, c_ours, _, _ = _step_case(shift_px=1.0)
+    _, _, d_ref, c_ref = _step_case()
+    both = (c_ours > 0) & (c_ref > 0)
+    assert np.mean(np.abs(d_ours - d_ref)[both] <= STEP_ATOL_PX) < 0.5
+
+
+def test_lr_check_matches_reference() -> None:
+    rng = np.random.default_rng(3)
+    dl = rng.uniform(0, 8, (30, 40)).astype(np.float32)
+    dr = (dl + rng.normal(0, 0.8, dl.shape)).astype(np.float32)
+    dl[0, :5] = np.nan
+    ours = _core.gabor_lr_check(dl, dr, 1.0)
+    want = ref.lr_check(dl.astype(np.float64), dr.astype(np.float64), 1.0)
+    assert ours.dtype == np.bool_
+    assert np.array_equal(ours, want)
+    assert 0.2 < ours.mean() < 0.95
+
+
+def test_one_level_pipeline_matches_reference() -> None:
+    crop = (slice(60, 180), slice(40, 240))
+    left, right = _grey("middlebury2001/tsukuba", crop)
+    ours = gabor_disparity(
+        left, right, max_disparity=16, n_levels=1, lr_check=False, speckle_size=0
+    ).disparity
+    want, _ = ref.disparity_one_level(left, right, 0.0, 16.0)
+    vo, vr = np.isfinite(ours), np.isfinite(want)
+    assert np.mean(vo == vr) >= PIPE_MASK_AGREE
+    both = vo & vr
+    assert both.mean() > 0.5
+    assert np.mean(np.abs(ours - want)[both] <= PIPE_ATOL_PX) >= PIPE_SHARE
+    assert np.mean(np.abs(ours - (want + 1.0))[both] <= PIPE_ATOL_PX) < 0.1
+
+
+# --- behaviour ----------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("d", [-4.6, -1.3, 0.35, 2.7, 4.95])
+def test_recovers_subpixel_shift(d: float) -> None:
+    left = _texture(96, 128, 0.0, seed=11)
+    right = _texture(96, 128, d, seed=11)  # right(x) = left(x + d)
+    res = gabor_disparity(left, right, min_disparity=-8.0, max_disparity=8.0)
+    inner = res.disparity[8:-8, 16:-16]
+    assert np.isfinite(inner).mean() > 0.8
+    assert abs(float(np.nanmedian(inner)) - d) < 0.05
+
+
+def test_constant_pair_gives_all_nan() -> None:
+    img = np.full((48, 64), 0.4, np.float32)
+    res = gabor_disparity(img, img, max_disparity=16)
+    assert isinstance(res, GaborResult)
+    assert res.disparity.dtype == np.float32 and res.confidence.dtype == np.float32
+    assert np.isnan(res.disparity).all()
+    assert (res.confidence == 0).all()
+
+
+def test_output_contract_on_real_pair() -> None:
+    left, right = _grey("middlebury2003/cones")
+    res = gabor_disparity(left, right, max_disparity=64)
+    d, c = res.disparity, res.confidence
+    assert d.shape == left.shape and c.shape == left.shape
+    fin = np.isfinite(d)
+    assert 0.6 < fin.mean() < 1.0
+    assert np.all((c >= 0) & (c <= 1))
+    assert np.all(c[~fin] == 0) and np.all(c[fin] > 0)
+    assert np.nanmin(d) >= -1.0 and np.nanmax(d) <= 65.0
+
+
+def test_invalid_inputs_raise_value_error() -> None:
+    a = np.zeros((10, 12), np.float32)
+    with pytest.raises(ValueError):
+        gabor_disparity(np.zeros((10, 12, 3), np.float32), a, max_disparity=8)
+    with pytest.raises(ValueError):
+        gabor_disparity(a, np.zeros((10, 13), np.float32), max_disparity=8)
+    with pytest.raises(ValueError):
+        gabor_disparity(a, a, max_disparity=0.0)
+    with pytest.raises(ValueError):
+        gabor_disparity(a, a, max_disparity=float("nan"))
+    with pytest.raises(ValueError):
+        gabor_disparity(a, a, max_disparity=8, freq=0.9)
+    with pytest.raises(ValueError):
+        gabor_disparity(a, a, max_disparity=8, no_such_param=1)
+    bad = a.copy()
+    bad[0, 0] = np.nan
+    with pytest.raises(ValueError):
+        gabor_disparity(bad, a, max_disparity=8)
+
+
+# --- determinism ----------------------------------------------------------------------------------
+
+_HASH_SCRIPT = """
+import hashlib, sys, numpy as np
+from stereovision.matching.gabor import gabor_disparity
+rng = np.random.default_rng(5)
+from scipy import ndimage
+base = ndimage.gaussian_filter(rng.random((120, 160)), 1.2).astype(np.float32)
+left = base[:, 6:]
+right = base[:, :-6]
+r = gabor_disparity(np.ascontiguousarray(left), np.ascontiguousarray(right), max_disparity=16)
+print(hashlib.sha256(r.disparity.tobytes() + r.confidence.tobytes()).hexdigest())
+"""
+
+
+def test_bit_identical_runs_and_thread_counts() -> None:
+    left, right = _grey("middlebury2001/tsukuba")
+    a = gabor_disparity(left, right, max_disparity=16)
+    b = gabor_disparity(left, right, max_disparity=16)
+    assert a.disparity.tobytes() == b.disparity.tobytes()
+    assert a.confidence.tobytes() == b.confidence.tobytes()
+    digests = []
+    for n in ("1", "2"):
+        env = {**os.environ, "RAYON_NUM_THREADS": n}
+        out = subprocess.run(
+            [sys.executable, "-c", _HASH_SCRIPT], env=env, capture_output=True, text=True,
+            check=True,
+        )
+        digests.append(out.stdout.strip())
+    assert digests[0] == digests[1]
+    assert len(digests[0]) == len(hashlib.sha256().hexdigest())
