@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import base64
 import os
+import re
 import socket
 import subprocess
 import sys
@@ -44,7 +45,8 @@ VIDEO_FRAMES = 3
 VIDEO_ROLL = 25
 
 #: Yaw applied with the keyboard in the 3-D test (degrees) and the mean change it must cause.
-YAW_STEPS = 20
+YAW_STEPS = 15
+RIGHT_STEPS = 20  # 0.05 m each: 1 m to the left
 VIEW_CHANGE = 5.0
 
 #: Upper bounds (ms) for page conditions; waits return as soon as the condition holds.
@@ -388,6 +390,9 @@ def test_method_switch_updates_disparity(page):
     assert after != before
     assert np.abs(_decode(after) - _decode(before)).mean() > 3
     _shot(page, "gui-method.png")
+    page.click(f"#method-{METHODS[0]}")  # and back
+    _wait_computations(page, n + 2)
+    assert page.inner_text("#stats").startswith(METHODS[0])
 
 
 def test_3d_view_not_blank_and_follows_sliders(page):
@@ -403,13 +408,19 @@ def test_3d_view_not_blank_and_follows_sliders(page):
     bgr_background = np.array(BACKGROUND[::-1])
     scene = np.abs(first - bgr_background).max(axis=-1) > 10
     assert scene.mean() > 0.5  # the textured surface fills most of the view
-    thumb = "#slider-yaw [role=slider]"
-    page.focus(thumb)
-    for _ in range(YAW_STEPS):
-        page.keyboard.press("ArrowRight")  # one degree per key, as a user would
-    page.wait_for_function(
-        f"document.querySelector('{thumb}').getAttribute('aria-valuenow') === '{YAW_STEPS}'"
-    )
+    # Turn right and step left, as a user would with the keyboard (one step per key press):
+    # roughly an orbit around the scene, which shows its relief.
+    for name, key, steps, value in (
+        ("yaw", "ArrowRight", YAW_STEPS, str(YAW_STEPS)),
+        ("right", "ArrowLeft", RIGHT_STEPS, f"-{RIGHT_STEPS * 0.05:g}"),
+    ):
+        thumb = f"#slider-{name} [role=slider]"
+        page.focus(thumb)
+        for _ in range(steps):
+            page.keyboard.press(key)
+        page.wait_for_function(
+            f"document.querySelector('{thumb}').getAttribute('aria-valuenow') === '{value}'"
+        )
     # The server renders the turned camera and streams the frame: poll until it has arrived.
     deadline = time.monotonic() + PAGE_TIMEOUT_MS / 1000
     change = 0.0
@@ -436,10 +447,25 @@ def test_bad_inputs_show_errors_and_page_stays_usable(page, gui_data):
     page.fill("#cam-left", "7")
     page.fill("#cam-right", "8")
     page.click("#cam-open")
-    assert "cannot open camera" in _wait_error(page, "camera")
+    assert re.search(r"cannot open .*camera.* 7|cannot open camera 7", _wait_error(page, "7"))
     _shot(page, "gui-error.png")
     # Still usable: the previous cameras capture a new pair, the error goes away.
     n = _computations(page)
     page.click("#capture-btn")
     _wait_computations(page, n + 1)
     page.wait_for_selector("#error-alert", state="detached")
+
+
+def test_open_stereo_source_loops_video_files(tmp_path):
+    img = syn.left_image()
+    lv = _write_video(tmp_path / "l.avi", img)
+    rv = _write_video(tmp_path / "r.avi", img)
+    src = sources.open_stereo_source(str(lv), str(rv))
+    try:
+        frames = [src.read()[0] for _ in range(2 * VIDEO_FRAMES + 1)]
+    finally:
+        src.close()
+    assert all(f.shape == img.shape for f in frames)
+    assert np.abs(frames[0].astype(int) - frames[VIDEO_FRAMES]).mean() < 3  # started again
+    with pytest.raises(OSError, match="7"):
+        sources.open_stereo_source(7, 8)

@@ -234,6 +234,21 @@ def test_render_outputs_and_rotated_view_differ(result, tmp_path):
     assert diff.mean() > 0.2
 
 
+def test_far_outliers_do_not_clip_the_scene(result):
+    from dataclasses import replace
+
+    pts = result.points.copy()
+    pts[-5:] *= 2000.0  # a few near-zero disparities: points kilometres away
+    far = replace(result, points=pts)
+    near, far_clip = render.robust_clipping_range(pts, [0, 0, 0])
+    assert near == pytest.approx(render.NEAR_FACTOR * syn.BOX_Z, rel=0.01)
+    p995 = np.percentile(np.linalg.norm(pts, axis=1), 99.5)
+    assert far_clip == pytest.approx(max(10 * near, render.FAR_FACTOR * p995))
+    assert far_clip < 20.0  # the kilometre outliers are ignored
+    img = render.render_result(far)
+    assert not render.is_blank(img, min_fraction=0.8)
+
+
 def test_render_outputs_nothing_without_points(result, tmp_path):
     from dataclasses import replace
 

@@ -73,6 +73,15 @@ RENDER_PITCH_DEG = -8.0
 #: Largest render side (pixels) of render.png; bigger images are scaled down.
 RENDER_MAX_SIDE = 1024
 
+#: Clipping range from the scene's point distances: robust percentiles with margins, so
+#: outliers (near-zero disparities give depths of kilometres) cannot clip the whole scene away.
+CLIP_LOW_PERCENTILE = 0.5
+CLIP_HIGH_PERCENTILE = 99.5
+NEAR_FACTOR = 0.5
+FAR_FACTOR = 2.0
+MIN_NEAR = 0.01  # metres
+CLIP_SAMPLE = 20_000  # points used to estimate the range
+
 #: The camera looks at a point this far ahead when there is no scene depth to use (metres).
 _DEFAULT_FOCAL_DISTANCE = 1.0
 
@@ -239,6 +248,7 @@ def apply_camera(
     *,
     intrinsics: Intrinsics | None = None,
     focal_distance: float = _DEFAULT_FOCAL_DISTANCE,
+    points: npt.ArrayLike | None = None,
 ) -> None:
     """Place ``plotter``'s camera at the pose of ``controls``.
 
@@ -252,6 +262,10 @@ def apply_camera(
         (when the window is ``width x height``). Without, a :data:`DEFAULT_FOV_DEG` view.
     focal_distance : float
         Distance of the focal point ahead of the camera (metres): the centre of mouse rotations.
+    points : array_like (N, 3), optional
+        The scene's points: the clipping range is set from robust percentiles of their distances
+        (:func:`robust_clipping_range`), so a few absurdly far points (a disparity of 0.01 px is
+        80 km away) cannot push the near plane beyond the scene. Without, VTK's automatic range.
     """
     pose = controls.pose()
     rot, pos = pose[:3, :3], pose[:3, 3]
@@ -269,8 +283,58 @@ def apply_camera(
     else:
         cam.view_angle = DEFAULT_FOV_DEG
         cam.SetWindowCenter(0.0, 0.0)
-    plotter.reset_camera_clipping_range()
+    if points is not None:
+        cam.clipping_range = robust_clipping_range(points, pos)
+    else:
+        plotter.reset_camera_clipping_range()
     plotter.camera_set = True  # keep this camera: the first render must not reset it to the bounds
+
+
+def robust_clipping_range(points: npt.ArrayLike, position: npt.ArrayLike) -> tuple[float, float]:
+    """Near and far clipping distances covering the bulk of ``points`` seen from ``position``.
+
+    ``near = NEAR_FACTOR x`` the :data:`CLIP_LOW_PERCENTILE` distance (at least
+    :data:`MIN_NEAR`), ``far = FAR_FACTOR x`` the :data:`CLIP_HIGH_PERCENTILE` distance; at most
+    :data:`CLIP_SAMPLE` evenly spaced points are used.
+
+    Returns
+    -------
+    (float, float)
+        ``(near, far)`` in metres, ``0 < near < far``.
+    """
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if len(pts) > CLIP_SAMPLE:
+        pts = pts[np.linspace(0, len(pts) - 1, CLIP_SAMPLE).astype(np.int64)]
+    dist = np.linalg.norm(pts - np.asarray(position, dtype=np.float64), axis=1)
+    dist = dist[np.isfinite(dist)]
+    if dist.size == 0:
+        return MIN_NEAR, 1000.0 * MIN_NEAR
+    near = max(MIN_NEAR, NEAR_FACTOR * float(np.percentile(dist, CLIP_LOW_PERCENTILE)))
+    far = max(near * 10, FAR_FACTOR * float(np.percentile(dist, CLIP_HIGH_PERCENTILE)))
+    return near, far
+
+
+def keep_robust_clipping(plotter: pv.Plotter, points: npt.ArrayLike) -> int:
+    """Re-apply :func:`robust_clipping_range` at the start of every render of ``plotter``.
+
+    Mouse interaction lets VTK reset the clipping range from the bounds of everything shown, which
+    a few far outliers can ruin; this observer puts the robust range back before each frame.
+
+    Returns
+    -------
+    int
+        Observer tag (``plotter.renderer.RemoveObserver(tag)`` removes it).
+    """
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    if len(pts) > CLIP_SAMPLE:
+        pts = pts[np.linspace(0, len(pts) - 1, CLIP_SAMPLE).astype(np.int64)]
+    renderer = plotter.renderer
+
+    def on_start(_obj: Any, _event: str) -> None:
+        cam = renderer.GetActiveCamera()
+        cam.SetClippingRange(*robust_clipping_range(pts, cam.GetPosition()))
+
+    return int(renderer.AddObserver("StartEvent", on_start))
 
 
 def pose_from_camera(camera: Any) -> npt.NDArray[np.float64]:
@@ -504,7 +568,11 @@ def render_view(
     try:
         add_geometry(plotter, geometry)
         apply_camera(
-            plotter, controls, intrinsics=intrinsics, focal_distance=median_depth(geometry)
+            plotter,
+            controls,
+            intrinsics=intrinsics,
+            focal_distance=median_depth(geometry),
+            points=geometry.points,
         )
         img = plotter.screenshot(return_img=True)
     finally:
@@ -647,7 +715,12 @@ def cmd_view(args: argparse.Namespace) -> int:
     if args.output is None and _has_display():
         plotter = make_plotter((1024, 768), off_screen=False)
         add_geometry(plotter, geometry)
-        apply_camera(plotter, controls, intrinsics=None, focal_distance=median_depth(geometry))
+        apply_camera(
+            plotter,
+            controls,
+            focal_distance=median_depth(geometry),
+            points=geometry.points,
+        )
         plotter.show()
         return 0
     out = Path(args.output or "view.png")

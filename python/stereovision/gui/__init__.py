@@ -24,6 +24,7 @@ __all__ = ["DEFAULT_HOST", "DEFAULT_PORT", "add_cli", "build_app", "cmd_gui", "m
 #: Loopback only by default: exposing the robot's cameras is an explicit decision (--host).
 DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 8080
+LOOPBACK_HOSTS = frozenset({"127.0.0.1", "localhost", "::1"})
 
 
 def bundled_data_dir() -> Path:
@@ -77,6 +78,11 @@ def cmd_gui(args: argparse.Namespace) -> int:
     app = build_app(args)
     url = f"http://{args.host}:{args.port}/"
     print(f"stereovision gui on {url} (Ctrl+C to stop)", flush=True)
+    if args.host not in LOOPBACK_HOSTS:
+        print(
+            f"note: listening on {args.host}: anyone who can reach this address sees the cameras",
+            file=sys.stderr,
+        )
     argv, sys.argv = sys.argv, sys.argv[:1]  # trame parses sys.argv itself: give it nothing
     try:
         app.server.start(

@@ -339,6 +339,7 @@ class StereoApp:
         self._lock: asyncio.Lock | None = None
         self.plotter = make_plotter((640, 480))
         self._remote_view: Any = None
+        self._clip_tag: int | None = None
 
         st = self.state
         st.methods = [*METHODS, *EXTRA_METHODS]
@@ -424,9 +425,13 @@ class StereoApp:
 
     def _camera_source(self, text: str) -> int | str:
         src = parse_source(text)
-        if isinstance(src, str):
-            return str(self.folders.resolve(src))  # files only from the allowed folders
-        return src
+        if not isinstance(src, str):
+            return src
+        # Files only from the allowed folders; an image-sequence pattern by its folder.
+        p = Path(src)
+        if "%" in p.name:
+            return str(self.folders.resolve(p.parent) / p.name)
+        return str(self.folders.resolve(src))
 
     # ------------------------------------------------------------------------- controllers
 
@@ -609,11 +614,14 @@ class StereoApp:
         return v.mesh
 
     def _show_geometry(self, geometry: Any, intrinsics: Any) -> None:
-        from stereovision.render import add_geometry, median_depth
+        from stereovision.render import add_geometry, keep_robust_clipping, median_depth
 
         self._intrinsics = intrinsics
         self._focal = median_depth(geometry)
         add_geometry(self.plotter, geometry)
+        if self._clip_tag is not None:
+            self.plotter.renderer.RemoveObserver(self._clip_tag)
+        self._clip_tag = keep_robust_clipping(self.plotter, geometry.points)
         self._apply_camera()
 
     def _apply_camera(self) -> None:
@@ -662,6 +670,7 @@ class StereoApp:
 
         with SinglePageLayout(self.server, full_height=True) as layout:
             layout.title.set_text("stereovision")
+            layout.icon.hide()  # no navigation drawer in this app
             with layout.toolbar:
                 v3.VSpacer()
                 html.Span("{{ status }}", id="status", classes="text-body-2 mr-4")

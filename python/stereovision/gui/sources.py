@@ -231,12 +231,28 @@ class VideoPair:
 
 
 class _CaptureAdapter:
-    """Wraps ``stereovision.capture.StereoCamera`` into :class:`StereoSource`."""
+    """Wraps ``stereovision.capture.StereoCamera`` into :class:`StereoSource`.
 
-    def __init__(self, camera: Any) -> None:
-        self._camera = camera
+    When both sources are files (videos, image sequences) and one ends, the pair is opened again
+    from the start, like :class:`VideoPair`.
+    """
+
+    def __init__(self, factory: Any, files: bool) -> None:
+        self._factory = factory
+        self._files = files
+        self._camera = factory()
 
     def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
+        try:
+            return self._read()
+        except OSError:
+            if not self._files:
+                raise
+            self.close()
+            self._camera = self._factory()
+            return self._read()
+
+    def _read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
         got = self._camera.read()
         if isinstance(got, tuple) and len(got) == 2:
             left, right = got
@@ -278,7 +294,8 @@ def open_stereo_source(
         from stereovision.capture import StereoCamera
     except ImportError:
         return VideoPair(left, right, size)
-    return _CaptureAdapter(StereoCamera(left, right, size=size))
+    files = isinstance(left, str) and isinstance(right, str)
+    return _CaptureAdapter(lambda: StereoCamera(left, right, size=size), files)
 
 
 def scale_pair(
