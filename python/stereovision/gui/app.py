@@ -421,7 +421,8 @@ class StereoApp:
         self.pair = (left, right)
         self.calib = self.source_calib
         self.max_disparity = None
-        self.state.source_label = f"cameras {self.state.cam_left} / {self.state.cam_right}"
+        names = (Path(str(n)).name or str(n) for n in (self.state.cam_left, self.state.cam_right))
+        self.state.source_label = "cameras " + " / ".join(names)
 
     def _camera_source(self, text: str) -> int | str:
         src = parse_source(text)
