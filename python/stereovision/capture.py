@@ -418,7 +418,10 @@ def save_pair(
     d.mkdir(parents=True, exist_ok=True)
     data = []
     for side, img in (("left", left), ("right", right)):
-        ok, buf = cv2.imencode(ext, np.asarray(img))
+        try:
+            ok, buf = cv2.imencode(ext, np.asarray(img))
+        except cv2.error:
+            ok = False
         if not ok:
             raise ValueError(f"cannot encode the {side} image as {ext}")
         data.append(buf.tobytes())

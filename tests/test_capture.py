@@ -1,0 +1,465 @@
+"""Two-camera capture, end to end with video files and image sequences as sources."""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import os
+import threading
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import pytest
+
+from stereovision import capture as capmod
+from stereovision.calibrate import board_pose_params, render_chessboard
+from stereovision.capture import (
+    ChessboardCollector,
+    SourceError,
+    StereoCamera,
+    add_cli,
+    capture,
+    detect_board_live,
+    next_pair_index,
+    parse_size,
+    parse_source,
+    save_pair,
+)
+
+#: Frame numbers are written as a row of black/white blocks (robust to MJPG) at the top left.
+CODE_BITS = 10
+CODE_BLOCK = 12
+SMALL = (320, 240)
+BOARD_SIZE = (640, 480)
+FPS = 10.0
+
+# A rig for the chessboard videos (metres).
+K = np.array([[600.0, 0, 320], [0, 600.0, 240], [0, 0, 1]])
+D = np.zeros(5)
+RIG_R = np.eye(3)
+RIG_T = np.array([-0.06, 0.0, 0.0])
+SQUARE = 0.03
+
+
+def _stamp(img: np.ndarray, n: int) -> np.ndarray:
+    """Write ``n`` as CODE_BITS blocks (white = 1) plus a readable number."""
+    for b in range(CODE_BITS):
+        v = 255 if (n >> b) & 1 else 0
+        x = 2 + b * CODE_BLOCK
+        img[2 : 2 + CODE_BLOCK, x : x + CODE_BLOCK] = v
+    cv2.putText(
+        img, str(n), (4, 2 * CODE_BLOCK + 22), cv2.FONT_HERSHEY_SIMPLEX, 0.8, (0, 0, 255), 2
+    )
+    return img
+
+
+def _read_stamp(img: np.ndarray) -> int:
+    gray = img if img.ndim == 2 else cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+    n = 0
+    for b in range(CODE_BITS):
+        x = 2 + b * CODE_BLOCK
+        block = gray[4:CODE_BLOCK, x + 2 : x + CODE_BLOCK - 2]
+        n |= int(block.mean() > 128) << b
+    return n
+
+
+def _numbered(n: int, size: tuple[int, int] = SMALL, shade: int = 90) -> np.ndarray:
+    w, h = size
+    img = np.full((h, w, 3), shade, np.uint8)
+    return _stamp(img, n)
+
+
+def _write_video(path: Path, frames: list[np.ndarray], fps: float = FPS) -> Path:
+    h, w = frames[0].shape[:2]
+    vw = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), fps, (w, h))
+    assert vw.isOpened()
+    for f in frames:
+        vw.write(f)
+    vw.release()
+    return path
+
+
+def _write_sequence(directory: Path, side: str, frames: list[np.ndarray]) -> str:
+    directory.mkdir(parents=True, exist_ok=True)
+    for i, f in enumerate(frames):
+        cv2.imwrite(str(directory / f"{side}_{i:03d}.png"), f)
+    return str(directory / f"{side}_%03d.png")
+
+
+def _videos(
+    tmp: Path, n_left: int, n_right: int, size: tuple[int, int] = SMALL
+) -> tuple[Path, Path]:
+    left = _write_video(tmp / "left.avi", [_numbered(i, size) for i in range(n_left)])
+    right = _write_video(tmp / "right.avi", [_numbered(i, size, 160) for i in range(n_right)])
+    return left, right
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="stereovision")
+    sub = parser.add_subparsers(dest="command", required=True)
+    add_cli(sub)
+    return parser
+
+
+# ------------------------------------------------------------------------------- sources
+
+
+def test_video_files_count_order_and_skew(tmp_path: Path) -> None:
+    left, right = _videos(tmp_path, 12, 12)
+    with StereoCamera(left, right) as cam:
+        frames = list(cam.frames())
+        report = cam.skew_report()
+        assert cam.size == SMALL and cam.delivered_size == {"left": SMALL, "right": SMALL}
+        assert cam.delivered_fps == {"left": FPS, "right": FPS}
+    assert len(frames) == 12
+    assert [_read_stamp(f.left) for f in frames] == list(range(12))
+    assert [_read_stamp(f.right) for f in frames] == list(range(12))
+    assert [f.index for f in frames] == list(range(12))
+    # Media timestamps: 100 ms apart at 10 fps, equal left and right.
+    assert [f.pos_left_ms for f in frames] == pytest.approx([100.0 * i for i in range(12)])
+    assert [f.pos_right_ms for f in frames] == pytest.approx([f.pos_left_ms for f in frames])
+    # Host timestamps: left grabbed first, then right, pairs in time order.
+    assert all(f.t_right >= f.t_left for f in frames)
+    assert all(b.t_left >= a.t_right for a, b in itertools.pairwise(frames))
+    assert report["n"] == 12
+    assert report["max_ms"] == pytest.approx(max(f.skew_ms for f in frames))
+    assert 0.0 <= report["mean_ms"] <= report["max_ms"] < 250.0
+
+
+def test_image_sequence_source_and_capture(tmp_path: Path) -> None:
+    lpat = _write_sequence(tmp_path / "frames", "left", [_numbered(i) for i in range(7)])
+    rpat = _write_sequence(
+        tmp_path / "frames", "right", [_numbered(i, shade=160) for i in range(7)]
+    )
+    lines: list[str] = []
+    with StereoCamera(lpat, rpat) as cam:
+        result = capture(cam, tmp_path / "pairs", count=5, log=lines.append)
+    assert len(result.saved) == 5 and result.frames_read == 5 and result.ended == "count reached"
+    assert [p[0].name for p in result.saved] == [f"left_{i:04d}.png" for i in range(1, 6)]
+    assert [p[1].name for p in result.saved] == [f"right_{i:04d}.png" for i in range(1, 6)]
+    for k, (lp, rp) in enumerate(result.saved):
+        a, b = cv2.imread(str(lp)), cv2.imread(str(rp))
+        assert _read_stamp(a) == _read_stamp(b) == k
+        assert np.array_equal(a, _numbered(k))  # PNG in, PNG out: lossless
+    assert len(lines) == 5 and "skew" in lines[0]
+    assert result.skew["n"] == 5
+
+
+class _FakeCap:
+    """A VideoCapture stand-in that logs calls into a shared list."""
+
+    def __init__(self, name: str, log: list[str], frames: int = 3, opened: bool = True) -> None:
+        self.name, self.log, self.left, self.opened = name, log, frames, opened
+        self.released = 0
+
+    def isOpened(self) -> bool:
+        return self.opened
+
+    def grab(self) -> bool:
+        self.log.append(f"{self.name}.grab")
+        self.left -= 1
+        return self.left >= 0
+
+    def retrieve(self) -> tuple[bool, np.ndarray]:
+        self.log.append(f"{self.name}.retrieve")
+        return True, _numbered(0)
+
+    def get(self, prop: int) -> float:
+        return {cv2.CAP_PROP_FRAME_WIDTH: SMALL[0], cv2.CAP_PROP_FRAME_HEIGHT: SMALL[1]}.get(
+            prop, 0.0
+        )
+
+    def set(self, prop: int, value: float) -> bool:
+        self.log.append(f"{self.name}.set")
+        return False
+
+    def release(self) -> None:
+        self.released += 1
+
+
+def test_grab_both_then_retrieve_both() -> None:
+    log: list[str] = []
+    cam = StereoCamera(_FakeCap("L", log), _FakeCap("R", log))
+    cam.read()
+    assert log == ["L.grab", "R.grab", "L.retrieve", "R.retrieve"]
+    cam.close()
+
+
+def test_resolution_request_and_resize_warning(tmp_path: Path) -> None:
+    left, right = _videos(tmp_path, 3, 3, size=(160, 120))
+    with pytest.warns(UserWarning, match=r"delivers 160x120, not 320x240") as rec:
+        with StereoCamera(left, right, size=(320, 240), fps=30) as cam:
+            frame = cam.read()
+            cam.read()
+            assert cam.delivered_size == {"left": (160, 120), "right": (160, 120)}
+            assert "asked 320x240" in cam.describe() and "160x120" in cam.describe()
+    assert len(rec) == 2  # one warning per camera, not per frame
+    assert frame.left.shape == (240, 320, 3) and frame.right.shape == (240, 320, 3)
+    assert _read_stamp(frame.left) == 0
+    # Asking for the size a source gives: no warning, no resize.
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with StereoCamera(left, right, size="160x120") as cam:
+            assert cam.read().left.shape == (120, 160, 3)
+    assert parse_size("1280x720") == (1280, 720)
+    for bad in ("big", "0x5", "12x"):
+        with pytest.raises(ValueError, match="WIDTHxHEIGHT"):
+            parse_size(bad)
+    assert parse_source("0") == 0 and parse_source("a.avi") == "a.avi"
+
+
+def test_open_failures_name_the_source(tmp_path: Path) -> None:
+    left, _ = _videos(tmp_path, 2, 2)
+    with pytest.raises(FileNotFoundError, match=r"right source not found: .*missing\.avi"):
+        StereoCamera(left, tmp_path / "missing.avi")
+    pattern = str(tmp_path / "none_%03d.png")
+    with pytest.raises(SourceError, match=r"cannot open left source .*none_%03d\.png"):
+        StereoCamera(pattern, left)
+    log: list[str] = []
+    good = _FakeCap("L", log)
+    with pytest.raises(SourceError, match="cannot open right source _FakeCap"):
+        StereoCamera(good, _FakeCap("R", log, opened=False))
+    assert good.released == 1  # the camera opened first is released
+    with pytest.raises(ValueError, match="fps"):
+        StereoCamera(left, left, fps=-1)
+    assert issubclass(SourceError, OSError)
+
+
+def test_disconnect_mid_run_keeps_saved_pairs(tmp_path: Path) -> None:
+    left, right = _videos(tmp_path, 10, 4)
+    out = tmp_path / "pairs"
+    with StereoCamera(left, right) as cam:
+        with pytest.raises(SourceError, match=r"right source .*right\.avi.* after 4 pairs") as ei:
+            capture(cam, out, count=8)
+    assert "4 of 8 pairs were saved" in str(ei.value)
+    names = sorted(p.name for p in out.iterdir())
+    assert names == [f"{s}_{i:04d}.png" for s in ("left", "right") for i in range(1, 5)]
+    for i in range(1, 5):
+        assert _read_stamp(cv2.imread(str(out / f"left_{i:04d}.png"))) == i - 1
+    # Without --count the end of a source ends the capture normally; numbering continues.
+    with StereoCamera(left, right) as cam:
+        result = capture(cam, out, every=2)
+    assert result.ended == "end of stream" and result.frames_read == 4
+    assert [p[0].name for p in result.saved] == ["left_0005.png", "left_0006.png"]
+    assert [_read_stamp(cv2.imread(str(p[0]))) for p in result.saved] == [0, 2]
+
+
+# -------------------------------------------------------------------------------- saving
+
+
+def test_atomic_pair_writes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    out = tmp_path / "pairs"
+    img = _numbered(7, (640, 480))
+    real_replace = os.replace
+    seen: list[tuple[str, str]] = []
+
+    def checked_replace(src: Any, dst: Any) -> None:
+        src, dst = Path(src), Path(dst)
+        assert src.parent == dst.parent  # same directory: a rename, never a copy
+        assert src.name.startswith(".") and src.name.endswith(".tmp")
+        assert not dst.exists()  # the final name appears only complete
+        assert cv2.imread(str(src)) is not None  # temp file complete before the rename
+        seen.append((src.name, dst.name))
+        real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", checked_replace)
+    lp, rp = save_pair(out, 1, img, img)
+    assert [d for _, d in seen] == ["left_0001.png", "right_0001.png"]  # right last
+    assert np.array_equal(cv2.imread(str(lp)), img) and np.array_equal(cv2.imread(str(rp)), img)
+    monkeypatch.setattr(os, "replace", real_replace)
+
+    # A write failing half-way leaves no partial or temporary file.
+    calls = {"n": 0}
+    real_fsync = os.fsync
+
+    def failing_fsync(fd: int) -> None:
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise OSError("disk full")
+        real_fsync(fd)
+
+    monkeypatch.setattr(os, "fsync", failing_fsync)
+    with pytest.raises(OSError, match="disk full"):
+        save_pair(out, 2, img, img)
+    monkeypatch.setattr(os, "fsync", real_fsync)
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["left_0001.png", "left_0002.png", "right_0001.png"]
+    assert next_pair_index(out) == 3
+    with pytest.raises(ValueError, match="encode"):
+        save_pair(out, 3, img, img, ext=".nope")
+
+
+def test_no_partial_file_visible_to_a_concurrent_reader(tmp_path: Path) -> None:
+    out = tmp_path / "pairs"
+    out.mkdir()
+    img = _numbered(3, (640, 480))
+    stop = threading.Event()
+    bad: list[str] = []
+    checked = {"n": 0}
+
+    def reader() -> None:
+        while not stop.is_set():
+            for p in out.glob("*.png"):
+                data = p.read_bytes()
+                decoded = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
+                checked["n"] += 1
+                if decoded is None or decoded.shape != img.shape:
+                    bad.append(p.name)
+
+    t = threading.Thread(target=reader)
+    t.start()
+    try:
+        for i in range(1, 21):
+            save_pair(out, i, img, img)
+    finally:
+        stop.set()
+        t.join()
+    assert bad == [] and checked["n"] > 0
+    assert len(list(out.iterdir())) == 40
+
+
+# ---------------------------------------------------------------------------- chessboard
+
+
+def _board(pose: tuple[np.ndarray, np.ndarray] | None, n: int, right: bool) -> np.ndarray:
+    if pose is None:
+        img = np.full((BOARD_SIZE[1], BOARD_SIZE[0]), 60, np.uint8)
+    else:
+        rv, tv = pose
+        if right:
+            rv = cv2.Rodrigues(RIG_R @ cv2.Rodrigues(rv)[0])[0].ravel()
+            tv = RIG_R @ tv + RIG_T
+        img = render_chessboard(
+            K, D, rv, tv, pattern=(9, 6), square_size=SQUARE, image_size=BOARD_SIZE
+        )
+    return _stamp(cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), n)
+
+
+def _pose(
+    dx: float, dy: float, z: float, tilt: tuple[float, float] = (0.0, 0.0)
+) -> tuple[np.ndarray, np.ndarray]:
+    rv = np.array([tilt[0], tilt[1], 0.0])
+    rb = cv2.Rodrigues(rv)[0]
+    centre = np.array([4 * SQUARE, 2.5 * SQUARE, 0.0])
+    return rv, np.array([dx + 0.03, dy, z]) - rb @ centre
+
+
+#: Distinct test poses are at least this much further apart than the threshold.
+POSE_MARGIN = 0.05
+POSE_A = _pose(0.0, 0.0, 0.55)
+POSE_B = _pose(0.1, 0.06, 0.55)
+POSE_C = _pose(0.02, 0.0, 0.5, tilt=(0.5, 0.5))
+POSE_D = _pose(-0.1, -0.07, 0.6)
+#: Frames of the auto-capture video: repeats of A, B, C; D seen by the left camera only; a
+#: board-less frame. Only frames 0 (A), 3 (B) and 6 (C) are new poses seen by both cameras.
+SEQUENCE: list[tuple[Any, Any]] = [
+    (POSE_A, POSE_A), (POSE_A, POSE_A), (POSE_A, POSE_A), (POSE_B, POSE_B), (POSE_B, POSE_B),
+    (POSE_A, POSE_A), (POSE_C, POSE_C), (POSE_C, POSE_C), (POSE_D, None), (None, None),
+    (POSE_A, POSE_A),
+]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def board_videos(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    d = tmp_path_factory.mktemp("boards")
+    left = _write_video(d / "left.avi", [_board(a, i, False) for i, (a, _) in enumerate(SEQUENCE)])
+    right = _write_video(d / "right.avi", [_board(b, i, True) for i, (_, b) in enumerate(SEQUENCE)])
+    return left, right
+
+
+def test_test_poses_are_distinct_enough() -> None:
+    """The video's design: A, B, C, D seen whole by both cameras (the stamp included), pairwise
+    further apart than the ROS threshold."""
+    params = []
+    for pose in (POSE_A, POSE_B, POSE_C, POSE_D):
+        c = detect_board_live(_board(pose, 0, False), (9, 6))
+        assert c is not None and detect_board_live(_board(pose, 0, True), (9, 6)) is not None
+        params.append(board_pose_params(c, (9, 6), BOARD_SIZE))
+    for i in range(4):
+        for j in range(i):
+            dist = sum(abs(a - b) for a, b in zip(params[i], params[j], strict=True))
+            assert dist > capmod.MIN_POSE_DISTANCE + POSE_MARGIN
+
+
+def test_chessboard_autocapture_saves_distinct_poses_only(
+    board_videos: tuple[Path, Path], tmp_path: Path
+) -> None:
+    lines: list[str] = []
+    with StereoCamera(*board_videos) as cam:
+        result = capture(cam, tmp_path / "cb", chessboard="9x6", log=lines.append)
+    assert result.frames_read == len(SEQUENCE) and result.ended == "end of stream"
+    stamps = [_read_stamp(cv2.imread(str(p[0]))) for p in result.saved]
+    assert stamps == [0, 3, 6]
+    assert [_read_stamp(cv2.imread(str(p[1]))) for p in result.saved] == [0, 3, 6]
+    assert len(lines) == 3 and all("x [" in s and "skew [" in s for s in lines)
+    assert result.coverage is not None
+    assert result.coverage["x"] > 0.2 and result.coverage["skew"] > 0.3
+    # With a count the capture stops as soon as it is reached ...
+    with StereoCamera(*board_videos) as cam:
+        res2 = capture(cam, tmp_path / "cb2", chessboard=(9, 6), count=2)
+    assert [_read_stamp(cv2.imread(str(p[0]))) for p in res2.saved] == [0, 3]
+    assert res2.frames_read == 4
+    # ... and a stream ending before it is an error that keeps the saved pairs.
+    with StereoCamera(*board_videos) as cam:
+        with pytest.raises(SourceError, match="3 of 5 pairs were saved"):
+            capture(cam, tmp_path / "cb3", chessboard=(9, 6), count=5)
+    assert len(list((tmp_path / "cb3").glob("*.png"))) == 6
+
+
+def test_collector_decisions() -> None:
+    col = ChessboardCollector((9, 6))
+    frames = [_board(POSE_A, 0, False), _board(POSE_A, 1, False), _board(None, 2, False)]
+    mk = capmod.StereoFrame
+    d1 = col.consider(mk(frames[0], frames[0], 0.0, 0.0, 0))
+    d2 = col.consider(mk(frames[1], frames[1], 0.0, 0.0, 1))
+    d3 = col.consider(mk(frames[2], frames[0], 0.0, 0.0, 2))
+    d4 = col.consider(mk(frames[0], frames[2], 0.0, 0.0, 3))
+    assert (d1.save, d1.reason) == (True, "new pose")
+    assert not d2.save and d2.reason.startswith("pose too close")
+    assert (d3.save, d3.reason) == (False, "no board in left")
+    assert (d4.save, d4.reason) == (False, "no board in right")
+    assert col.progress() == {"x": 0.0, "y": 0.0, "size": 0.0, "skew": 0.0}
+
+
+# ---------------------------------------------------------------------------------- CLI
+
+
+def test_cli_capture(
+    board_videos: tuple[Path, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    left, right = _videos(tmp_path, 6, 6)
+    out = tmp_path / "pairs"
+    args = _parser().parse_args(
+        ["capture", "--left", str(left), "--right", str(right), "--size", "320x240",
+         "--count", "3", "-o", str(out)]
+    )  # fmt: skip
+    assert args.func(args) == 0
+    text = capsys.readouterr().out
+    assert "3 pairs saved" in text and "skew mean" in text and "320x240" in text
+    assert len(list(out.glob("left_*.png"))) == 3
+    args = _parser().parse_args(
+        ["capture", "--left", str(board_videos[0]), "--right", str(board_videos[1]),
+         "--chessboard", "9x6", "-o", str(tmp_path / "cb")]
+    )  # fmt: skip
+    assert args.func(args) == 0
+    text = capsys.readouterr().out
+    assert text.count("saved left_") == 3 and "size [" in text
+
+    def run(*argv: str) -> int:
+        a = _parser().parse_args(["capture", *argv])
+        return int(a.func(a))
+
+    with pytest.raises(FileNotFoundError, match="left source not found"):
+        run("--left", str(tmp_path / "x.avi"), "--right", str(right), "-o", str(out))
+    with pytest.raises(ValueError, match="WIDTHxHEIGHT"):
+        run("--left", str(left), "--right", str(right), "--size", "big", "-o", str(out))
+    with pytest.raises(ValueError, match="count"):
+        run("--left", str(left), "--right", str(right), "--count", "0", "-o", str(out))
+    with pytest.raises(ValueError, match="pattern"):
+        run("--left", str(left), "--right", str(right), "--chessboard", "9", "-o", str(out))
+    with pytest.raises(SourceError, match="after 6 pairs"):
+        run("--left", str(left), "--right", str(right), "--count", "9", "-o", str(out))
