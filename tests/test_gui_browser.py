@@ -395,6 +395,17 @@ def test_method_switch_updates_disparity(page):
     assert page.inner_text("#stats").startswith(METHODS[0])
 
 
+def test_resolution_control_rescales(page):
+    _wait_computations(page, 1)
+    n = _computations(page)
+    page.click("#resolution-320")
+    _wait_computations(page, n + 1)
+    assert " · 320×" in page.inner_text("#stats")
+    page.click("#resolution-full")
+    _wait_computations(page, n + 2)
+    assert " · 450×" in page.inner_text("#stats")
+
+
 def test_3d_view_not_blank_and_follows_sliders(page):
     _wait_computations(page, 1)
     page.wait_for_selector("#view-3d canvas", state="attached")
