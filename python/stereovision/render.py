@@ -367,6 +367,12 @@ def pose_from_camera(camera: Any) -> npt.NDArray[np.float64]:
 def _pv() -> Any:
     import pyvista as pv
 
+    if not _has_display():
+        # Without X, VTK tries the X window first and logs "bad X server connection" before it
+        # falls back to offscreen rendering: harmless, but it reads like an error in CLI output.
+        import vtk
+
+        vtk.vtkLogger.SetStderrVerbosity(vtk.vtkLogger.VERBOSITY_ERROR)
     return pv
 
 
