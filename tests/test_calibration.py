@@ -436,3 +436,22 @@ def test_stereopi_reference_calibration(data_dir: Path) -> None:
     assert rc.K2[0, 0] * rc.T[0] == pytest.approx(
         np.load(ref / "proj_mats_right.npy")[0, 3], abs=0.05
     )
+
+
+def test_valid_roi_depends_on_alpha() -> None:
+    c = raw_calib()
+    (_, _, w0, h0), roi_r0 = c.valid_roi(0.0)
+    (x1, y1, w1, h1), _ = c.valid_roi(1.0)
+    # alpha = 0 zooms so (nearly) every rectified pixel is valid; alpha = 1 keeps every source
+    # pixel, so the all-valid rectangle shrinks inside black borders.
+    assert w0 * h0 > 0.9 * SIZE[0] * SIZE[1]
+    assert w1 * h1 < w0 * h0
+    assert 0 <= x1 and 0 <= y1 and x1 + w1 <= SIZE[0] and y1 + h1 <= SIZE[1]
+    # The rectangle really is valid: remapped pixels of an all-white image are white inside it.
+    white = np.full((SIZE[1], SIZE[0]), 255, np.uint8)
+    rl, _ = c.rectify(white, white, alpha=1.0)
+    assert rl[y1 + 1 : y1 + h1 - 1, x1 + 1 : x1 + w1 - 1].min() > 200
+    assert rect_calib().valid_roi() == ((0, 0, *SIZE), (0, 0, *SIZE))
+    assert len(roi_r0) == 4
+    with pytest.raises(ValueError, match="alpha"):
+        c.valid_roi(-0.5)

@@ -296,7 +296,7 @@ class Calibration:
     def _stereo_rectify(self, alpha: float) -> tuple[F64, F64, F64, F64, F64]:
         key = ("stereoRectify", float(alpha))
         if key not in self._cache:
-            r1, r2, p1, p2, q, _, _ = cv2.stereoRectify(
+            r1, r2, p1, p2, q, roi1, roi2 = cv2.stereoRectify(
                 self.K1,
                 self.D1,
                 self.K2,
@@ -308,8 +308,39 @@ class Calibration:
                 alpha=float(alpha),
             )
             self._cache[key] = (r1, r2, p1, p2, q)
+            self._cache[("roi", float(alpha))] = (tuple(roi1), tuple(roi2))
         out: tuple[F64, F64, F64, F64, F64] = self._cache[key]
         return out
+
+    def valid_roi(
+        self, alpha: float = 0.0
+    ) -> tuple[tuple[int, int, int, int], tuple[int, int, int, int]]:
+        """Rectangles ``(x, y, width, height)`` of all-valid pixels in the rectified images.
+
+        With ``alpha=0`` they cover (nearly) the whole image; with ``alpha=1`` every source pixel
+        is kept and the black borders lie outside them. A ``rectified`` calibration has the full
+        image as its ROI.
+
+        Parameters
+        ----------
+        alpha : float
+            Free scaling of :meth:`rectify`, in ``[0, 1]``.
+
+        Returns
+        -------
+        tuple
+            ``(roi_left, roi_right)``.
+        """
+        w, h = self.image_size
+        if self.rectified:
+            return (0, 0, w, h), (0, 0, w, h)
+        if not 0.0 <= alpha <= 1.0:
+            raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
+        self._stereo_rectify(alpha)
+        rois: tuple[tuple[int, int, int, int], tuple[int, int, int, int]] = self._cache[
+            ("roi", float(alpha))
+        ]
+        return rois
 
     def _maps(self, alpha: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         key = ("maps", float(alpha))
