@@ -104,8 +104,15 @@ def cv_to_float(raw: np.ndarray) -> np.ndarray:
 def sgbm(lb: np.ndarray, rb: np.ndarray, dmax: int) -> np.ndarray:
     d16 = (dmax + 15) // 16 * 16
     s = cv2.StereoSGBM_create(
-        minDisparity=0, numDisparities=d16, blockSize=5, P1=8 * 3 * 25, P2=32 * 3 * 25,
-        disp12MaxDiff=1, uniquenessRatio=10, speckleWindowSize=100, speckleRange=2,
+        minDisparity=0,
+        numDisparities=d16,
+        blockSize=5,
+        P1=8 * 3 * 25,
+        P2=32 * 3 * 25,
+        disp12MaxDiff=1,
+        uniquenessRatio=10,
+        speckleWindowSize=100,
+        speckleRange=2,
         mode=cv2.STEREO_SGBM_MODE_SGBM_3WAY,
     )
     return cv_to_float(s.compute(lb, rb))
@@ -171,7 +178,13 @@ def main() -> None:
         print(
             f"{name:38s} {b_fill:6.1f} {b_unf:6.1f} {dens:5.1f} {row.get('bm', np.nan):6.1f} "
             f"{row.get('sgbm', np.nan):6.1f} {ms:6.0f}"
-            + ("  BEATS-BM" if row.get("bm", 1e9) > b_fill else "  LOSES-TO-BM" if "bm" in row else "")
+            + (
+                "  BEATS-BM"
+                if row.get("bm", 1e9) > b_fill
+                else "  LOSES-TO-BM"
+                if "bm" in row
+                else ""
+            )
         )
     mean = {k: float(np.mean([r[k] for r in rows])) for k in ("fill", "unf", "dens", "ms")}
     line = f"{'MEAN':38s} {mean['fill']:6.1f} {mean['unf']:6.1f} {mean['dens']:5.1f}"

@@ -1,13 +1,70 @@
 """Typed stub of the Rust extension ``stereovision._core`` (see rust/py/src)."""
 
+from collections.abc import Sequence
+
 import numpy as np
 import numpy.typing as npt
 
 __version__: str
+
+# --- Gabor phase-disparity channel (rust/py/src/gabor.rs) ---------------------------------------
 
 def gabor_disparity(
     left: npt.NDArray[np.float32],
     right: npt.NDArray[np.float32],
     d_min: float,
     d_max: float,
-) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
+    *,
+    freq: float = 0.25,
+    orientations_deg: Sequence[float] | None = None,
+    bandwidth_oct: float = 1.5,
+    aspect: float = 1.0,
+    n_levels: int | None = None,
+    iters_per_level: int = 2,
+    amp_rel_thresh: float = 0.02,
+    stability_tau: float = 1.25,
+    smooth_sigma: float | None = None,
+    conf_min: float = 0.15,
+    research_radius: int = 2,
+    search_pool_radius: int = 2,
+    lr_check: bool = True,
+    lr_tol: float = 1.0,
+    lr_coarse_levels: int = 0,
+    iters_finest: int = 1,
+    research_finest: bool = True,
+    orientations_finest: int = 5,
+    lr_light: bool = False,
+    speckle_size: int = 100,
+    speckle_range: float = 1.0,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+    """Dense Gabor phase disparity; ``(disparity, confidence)`` float32 (H, W), NaN = none."""
+
+def gabor_responses(
+    img: npt.NDArray[np.float32],
+    freq: float = 0.25,
+    theta_deg: float = 0.0,
+    bandwidth_oct: float = 1.5,
+    aspect: float = 1.0,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+    """Zero-DC complex response of one channel as ``(re, im)`` float32 (H, W)."""
+
+def gabor_newton_step(
+    left: npt.NDArray[np.float32],
+    right: npt.NDArray[np.float32],
+    disp: npt.NDArray[np.float32],
+    *,
+    freq: float = 0.25,
+    orientations_deg: Sequence[float] | None = None,
+    bandwidth_oct: float = 1.5,
+    aspect: float = 1.0,
+    amp_rel_thresh: float = 0.02,
+    stability_tau: float = 1.25,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+    """One raw full-resolution Newton step at ``disp``: ``(delta, conf)`` before smoothing."""
+
+def gabor_lr_check(
+    disp_left: npt.NDArray[np.float32],
+    disp_right: npt.NDArray[np.float32],
+    tol: float = 1.0,
+) -> npt.NDArray[np.bool_]:
+    """Left-right consistency mask (``disp_right`` on the right-image grid)."""

@@ -26,6 +26,7 @@ AMP_PERCENTILE = 0.95
 PERCENTILE_STRIDE = 3
 MIN_FREQ_RATIO = 0.5
 ORIENTATIONS = (0.0, 30.0, -30.0, 60.0, -60.0)
+BANDWIDTH_OCT = 1.5
 
 
 def sigma_from_bandwidth(freq: float, bandwidth_oct: float) -> float:
@@ -57,7 +58,10 @@ class Channel:
 
 
 def channel(
-    freq: float = 0.25, theta_deg: float = 0.0, bandwidth_oct: float = 1.0, aspect: float = 1.0
+    freq: float = 0.25,
+    theta_deg: float = 0.0,
+    bandwidth_oct: float = BANDWIDTH_OCT,
+    aspect: float = 1.0,
 ) -> Channel:
     """Build the channel like ``Channel::new`` (taps rounded to float32 as in Rust)."""
     sigma = np.float32(sigma_from_bandwidth(freq, bandwidth_oct))
@@ -147,8 +151,12 @@ def thresholds2(lv: Level, rv: Level, amp_rel: float) -> list[float]:
     """Squared amplitude thresholds ``(amp_rel * P95 |y|)^2`` over both images, per channel."""
     out = []
     for yl, yr in zip(lv.y, rv.y, strict=True):
-        s = np.concatenate([np.abs(yl.ravel()[::PERCENTILE_STRIDE]) ** 2,
-                            np.abs(yr.ravel()[::PERCENTILE_STRIDE]) ** 2])
+        s = np.concatenate(
+            [
+                np.abs(yl.ravel()[::PERCENTILE_STRIDE]) ** 2,
+                np.abs(yr.ravel()[::PERCENTILE_STRIDE]) ** 2,
+            ]
+        )
         k = min(round(AMP_PERCENTILE * (s.size - 1)), s.size - 1)
         p95 = np.partition(s, k)[k]
         thr = max(amp_rel * math.sqrt(p95), AMP_ABS_FLOOR)
@@ -277,7 +285,7 @@ def disparity_one_level(
     d_min: float,
     d_max: float,
     *,
-    iters: int = 2,
+    iters: int = 1,  # iters_finest: with n_levels=1 the only level is the finest
     amp_rel: float = 0.02,
     tau: float = 1.25,
     conf_min: float = 0.15,

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -24,21 +25,24 @@ __all__ = ["DEFAULTS", "GaborResult", "gabor_disparity", "gabor_responses"]
 DEFAULTS: dict[str, object] = {
     "freq": 0.25,
     "orientations_deg": (0.0, 30.0, -30.0, 60.0, -60.0),
-    "bandwidth_oct": 1.0,
+    "bandwidth_oct": 1.5,
     "aspect": 1.0,
     "n_levels": None,
     "iters_per_level": 2,
     "amp_rel_thresh": 0.02,
     "stability_tau": 1.25,
+    "smooth_sigma": None,
     "conf_min": 0.15,
     "research_radius": 2,
     "search_pool_radius": 2,
     "lr_check": True,
     "lr_tol": 1.0,
     "lr_coarse_levels": 0,
-    "iters_finest": 2,
+    "iters_finest": 1,
     "research_finest": True,
-    "speckle_size": 0,
+    "orientations_finest": 5,
+    "lr_light": False,
+    "speckle_size": 100,
     "speckle_range": 1.0,
 }
 
@@ -119,7 +123,7 @@ def gabor_disparity(
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
         if not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
             raise ValueError(f"{name} must be a finite number, got {v!r}")
-    kw = {**DEFAULTS, **params}
+    kw: dict[str, Any] = {**DEFAULTS, **params}
     orient = kw["orientations_deg"]
     if not isinstance(orient, Sequence) and not isinstance(orient, np.ndarray):
         raise ValueError(f"orientations_deg must be a sequence of degrees, got {orient!r}")
@@ -132,7 +136,7 @@ def gabor_responses(
     img: npt.ArrayLike,
     freq: float = 0.25,
     theta_deg: float = 0.0,
-    bandwidth_oct: float = 1.0,
+    bandwidth_oct: float = 1.5,
     aspect: float = 1.0,
 ) -> npt.NDArray[np.complex64]:
     """Complex response of one zero-DC Gabor channel (debugging and parity tests).

@@ -26,6 +26,7 @@ fn params(
     iters_per_level: usize,
     amp_rel_thresh: f32,
     stability_tau: f32,
+    smooth_sigma: Option<f32>,
     conf_min: f32,
     research_radius: usize,
     search_pool_radius: usize,
@@ -34,6 +35,8 @@ fn params(
     lr_coarse_levels: usize,
     iters_finest: usize,
     research_finest: bool,
+    orientations_finest: usize,
+    lr_light: bool,
     speckle_size: usize,
     speckle_range: f32,
 ) -> GaborParams {
@@ -48,6 +51,7 @@ fn params(
         iters_per_level,
         amp_rel_thresh,
         stability_tau,
+        smooth_sigma,
         conf_min,
         research_radius,
         search_pool_radius,
@@ -56,6 +60,8 @@ fn params(
         lr_coarse_levels,
         iters_finest,
         research_finest,
+        orientations_finest,
+        lr_light,
         speckle_size,
         speckle_range,
     }
@@ -72,10 +78,12 @@ fn to_image(w: usize, h: usize, data: Vec<f32>) -> Image {
 /// Dense Gabor phase disparity. Returns `(disparity, confidence)`, float32 (H, W).
 #[pyfunction]
 #[pyo3(signature = (
-    left, right, d_min, d_max, *, freq=0.25, orientations_deg=None, bandwidth_oct=1.0, aspect=1.0,
-    n_levels=None, iters_per_level=2, amp_rel_thresh=0.02, stability_tau=1.25, conf_min=0.15,
+    left, right, d_min, d_max, *, freq=0.25, orientations_deg=None, bandwidth_oct=1.5, aspect=1.0,
+    n_levels=None, iters_per_level=2, amp_rel_thresh=0.02, stability_tau=1.25, smooth_sigma=None,
+    conf_min=0.15,
     research_radius=2, search_pool_radius=2, lr_check=true, lr_tol=1.0, lr_coarse_levels=0,
-    iters_finest=2, research_finest=true, speckle_size=0, speckle_range=1.0
+    iters_finest=1, research_finest=true, orientations_finest=5, lr_light=false, speckle_size=100,
+    speckle_range=1.0
 ))]
 #[allow(clippy::too_many_arguments)]
 pub fn gabor_disparity<'py>(
@@ -92,6 +100,7 @@ pub fn gabor_disparity<'py>(
     iters_per_level: usize,
     amp_rel_thresh: f32,
     stability_tau: f32,
+    smooth_sigma: Option<f32>,
     conf_min: f32,
     research_radius: usize,
     search_pool_radius: usize,
@@ -100,6 +109,8 @@ pub fn gabor_disparity<'py>(
     lr_coarse_levels: usize,
     iters_finest: usize,
     research_finest: bool,
+    orientations_finest: usize,
+    lr_light: bool,
     speckle_size: usize,
     speckle_range: f32,
 ) -> PyResult<Pair<'py>> {
@@ -116,6 +127,7 @@ pub fn gabor_disparity<'py>(
         iters_per_level,
         amp_rel_thresh,
         stability_tau,
+        smooth_sigma,
         conf_min,
         research_radius,
         search_pool_radius,
@@ -124,6 +136,8 @@ pub fn gabor_disparity<'py>(
         lr_coarse_levels,
         iters_finest,
         research_finest,
+        orientations_finest,
+        lr_light,
         speckle_size,
         speckle_range,
     );
@@ -136,7 +150,7 @@ pub fn gabor_disparity<'py>(
 
 /// Complex response `y = h * img` of one zero-DC Gabor channel, as `(re, im)` float32 (H, W).
 #[pyfunction]
-#[pyo3(signature = (img, freq=0.25, theta_deg=0.0, bandwidth_oct=1.0, aspect=1.0))]
+#[pyo3(signature = (img, freq=0.25, theta_deg=0.0, bandwidth_oct=1.5, aspect=1.0))]
 pub fn gabor_responses<'py>(
     py: Python<'py>,
     img: PyReadonlyArray2<'py, f32>,
@@ -162,7 +176,7 @@ pub fn gabor_responses<'py>(
 /// smoothing (parity tests of the phase-difference / local-frequency / confidence stage).
 #[pyfunction]
 #[pyo3(signature = (
-    left, right, disp, *, freq=0.25, orientations_deg=None, bandwidth_oct=1.0, aspect=1.0,
+    left, right, disp, *, freq=0.25, orientations_deg=None, bandwidth_oct=1.5, aspect=1.0,
     amp_rel_thresh=0.02, stability_tau=1.25
 ))]
 #[allow(clippy::too_many_arguments)]

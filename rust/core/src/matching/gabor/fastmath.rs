@@ -56,11 +56,10 @@ pub fn atan2(y: f32, x: f32) -> f32 {
 pub fn sincos(x: f32) -> (f32, f32) {
     // Reduce to r in [-pi/4, pi/4] and a quadrant q (Cody-Waite split of pi/2).
     let q = round_fast(x * FRAC_2_PI);
-    let r = (x - q * 1.570_312_5) - q * 4.838_267_9e-4;
+    let r = (x - q * 1.570_312_5) - q * 4.838_268e-4;
     let r2 = r * r;
     let s = r * (1.0 + r2 * (-0.166_666_55 + r2 * (0.008_332_161 + r2 * -0.000_195_152_96)));
-    let c = 1.0
-        + r2 * (-0.5 + r2 * (0.041_666_42 + r2 * (-0.001_388_676_4 + r2 * 2.443_315_7e-5)));
+    let c = 1.0 + r2 * (-0.5 + r2 * (0.041_666_42 + r2 * (-0.001_388_676_4 + r2 * 2.443_315_7e-5)));
     let qi = q as i32;
     let swap = qi & 1 != 0;
     let (a, b) = if swap { (c, s) } else { (s, c) };
@@ -116,7 +115,10 @@ mod tests {
     fn ln_and_rounding_match_std() {
         for i in 1..5000 {
             let x = i as f32 * 0.37e-3 * (i as f32).powf(1.7);
-            assert!((super::ln(x) - x.ln()).abs() < 2e-6 * x.ln().abs().max(1.0), "ln {x}");
+            assert!(
+                (super::ln(x) - x.ln()).abs() < 2e-6 * x.ln().abs().max(1.0),
+                "ln {x}"
+            );
         }
         for v in [-2.5f32, -1.2, -0.5, 0.0, 0.49, 0.5, 1.5, 3.7, 1e5 + 0.3] {
             assert_eq!(super::floor_fast(v), v.floor(), "floor {v}");

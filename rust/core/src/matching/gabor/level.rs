@@ -9,6 +9,10 @@
 //! Row kernels run in two passes: a scalar gather of the interpolated right data, then plain
 //! vectorisable arithmetic over the row (`simd_fn!` adds an AVX2+FMA build chosen at run time).
 
+// Row kernels index several equally long rows in lockstep; index loops are the clearest form
+// and the one LLVM vectorises once the slices are re-bounded to the row length.
+#![allow(clippy::needless_range_loop)]
+
 use super::fastmath::{atan2, floor_fast, ln, round_fast, sincos};
 use super::filter::{blur_real, complex_col_pass, row_pass, Channel};
 use super::simd::simd_fn;
@@ -51,6 +55,9 @@ pub struct LevelData {
     pub energy: Vec<f32>,
 }
 
+/// A shared complex row pass: the x taps and the (re, im) planes they produced.
+type RowGroup<'a> = (&'a [[f32; 2]], Vec<f32>, Vec<f32>);
+
 /// Per-channel constants used by the kernels.
 #[derive(Debug, Clone)]
 pub struct ChanConst {
@@ -74,7 +81,14 @@ fn phasors(k: f32, n: usize) -> (Vec<f32>, Vec<f32>) {
 }
 
 /// Builds the level data of one image. `right` selects the baseband layout.
-pub fn level_data(img: &[f32], w: usize, h: usize, chans: &[Channel], tau: f32, right: bool) -> LevelData {
+pub fn level_data(
+    img: &[f32],
+    w: usize,
+    h: usize,
+    chans: &[Channel],
+    tau: f32,
+    right: bool,
+) -> LevelData {
     let t0 = std::time::Instant::now();
     let timing = std::env::var_os("SV_GABOR_TIMING").is_some();
     let lowpass = match chans.first() {
@@ -82,7 +96,7 @@ pub fn level_data(img: &[f32], w: usize, h: usize, chans: &[Channel], tau: f32, 
         None => vec![0.0; w * h],
     };
     // Row passes are shared by channels with identical x taps (+-theta).
-    let mut groups: Vec<(&[[f32; 2]], Vec<f32>, Vec<f32>)> = Vec::new();
+    let mut groups: Vec<RowGroup<'_>> = Vec::new();
     let mut group_of = Vec::with_capacity(chans.len());
     for c in chans {
         if let Some(g) = groups.iter().position(|(hx, _, _)| *hx == c.hx.as_slice()) {
@@ -112,13 +126,26 @@ pub fn level_data(img: &[f32], w: usize, h: usize, chans: &[Channel], tau: f32, 
         let mut out = vec![0f32; 4 * w * h];
         for_each_row_pair(&mut out, 4 * w, &mut amp2, w, |y, orow, arow| {
             build_row(
-                hre, him, w, h, y, &c.hy, c.dc, &lowpass, &cph.0, &cph.1, rph.0[y], rph.1[y], right,
-                orow, arow,
+                hre, him, w, h, y, &c.hy, c.dc, &lowpass, &cph.0, &cph.1, rph.0[y], rph.1[y],
+                right, orow, arow,
             )
         });
         // y = a - c L is recomputed here from the stored data only for the packed copy.
         for_each_row_pair(&mut ypack, 2 * nc * w, &mut energy, w, |y, prow, erow| {
-            pack_row(&out[4 * y * w..4 * (y + 1) * w], &lowpass[y * w..(y + 1) * w], &amp2[y * w..(y + 1) * w], &cph, rph.0[y], rph.1[y], c.dc, right, ci, nc, prow, erow)
+            pack_row(
+                &out[4 * y * w..4 * (y + 1) * w],
+                &lowpass[y * w..(y + 1) * w],
+                &amp2[y * w..(y + 1) * w],
+                &cph,
+                rph.0[y],
+                rph.1[y],
+                c.dc,
+                right,
+                ci,
+                nc,
+                prow,
+                erow,
+            )
         });
         // Stability (A.5 step 4e with the A.9 correction): Im psi = mean phase increment,
         // Re psi = central difference of ln rho; |psi - j k0| <= tau / sigma_x, Im psi >= k0 / 2.
@@ -285,7 +312,12 @@ pub fn percentile(v: &[f32], q: f32) -> f32 {
 }
 
 /// Channel constants with the amplitude thresholds `amp_rel * P95(|y|)` over both images.
-pub fn chan_consts(chans: &[Channel], l: &LevelData, r: &LevelData, amp_rel: f32) -> Vec<ChanConst> {
+pub fn chan_consts(
+    chans: &[Channel],
+    l: &LevelData,
+    r: &LevelData,
+    amp_rel: f32,
+) -> Vec<ChanConst> {
     let mut slots: Vec<f32> = Vec::new();
     chans
         .iter()
@@ -336,7 +368,14 @@ struct RowPrep {
 }
 
 #[inline(always)]
-fn prep_row(l: &LevelData, r: &LevelData, slots: &[f32], y: usize, drow: &[f32], off: f32) -> RowPrep {
+fn prep_row(
+    l: &LevelData,
+    r: &LevelData,
+    slots: &[f32],
+    y: usize,
+    drow: &[f32],
+    off: f32,
+) -> RowPrep {
     let w = l.w;
     let o = y * w;
     let last = (w - 1) as f32;
@@ -362,7 +401,11 @@ fn prep_row(l: &LevelData, r: &LevelData, slots: &[f32], y: usize, drow: &[f32],
         p.i1[x] = i1;
         p.t[x] = t;
         // Validity is folded into the stability byte: an out-of-image shift has no stable channel.
-        p.stab[x] = if valid { l.stable[o + x] & r.stable[o + near] } else { 0 };
+        p.stab[x] = if valid {
+            l.stable[o + x] & r.stable[o + near]
+        } else {
+            0
+        };
         let (a, b) = (r.lowpass[o + i0], r.lowpass[o + i1]);
         p.lp[x] = a + t * (b - a);
     }
@@ -379,6 +422,7 @@ fn prep_row(l: &LevelData, r: &LevelData, slots: &[f32], y: usize, drow: &[f32],
 /// Fills `(bwr, bwi)` with the shifted right response of channel `ci`, demodulated by the left
 /// pixel's carrier: `exp(-j k.(x, y)) y_r(x - d, y) = exp(-j kx d) b(x - d) - c L(x - d) exp(-j k.(x, y))`.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn shifted_row(
     l: &LevelData,
     r: &LevelData,
@@ -475,7 +519,12 @@ simd_fn! {
 
 /// One Newton step at every pixel. Returns `(delta, c)`: the WLS phase update (clamped to half
 /// the shortest carrier wavelength) and the mean channel confidence in [0, 1].
-pub fn newton_step(l: &LevelData, r: &LevelData, cc: &[ChanConst], disp: &[f32]) -> (Vec<f32>, Vec<f32>) {
+pub fn newton_step(
+    l: &LevelData,
+    r: &LevelData,
+    cc: &[ChanConst],
+    disp: &[f32],
+) -> (Vec<f32>, Vec<f32>) {
     let (w, h) = (l.w, l.h);
     let mut delta = vec![0f32; w * h];
     let mut conf = vec![0f32; w * h];
@@ -485,7 +534,17 @@ pub fn newton_step(l: &LevelData, r: &LevelData, cc: &[ChanConst], disp: &[f32])
         .map(|c| std::f32::consts::PI / c.kx)
         .fold(f32::INFINITY, f32::min);
     for_each_row2(&mut delta, &mut conf, w, |y, drow, crow| {
-        newton_row(l, r, cc, &slots, y, &disp[y * w..(y + 1) * w], max_delta, drow, crow)
+        newton_row(
+            l,
+            r,
+            cc,
+            &slots,
+            y,
+            &disp[y * w..(y + 1) * w],
+            max_delta,
+            drow,
+            crow,
+        )
     });
     (delta, conf)
 }

@@ -145,10 +145,10 @@ fn tiny_images_do_not_panic() {
 #[test]
 #[ignore]
 fn probe_timing() {
-    let left = texture(450, 375, 0.0, 5);
-    let right = texture(450, 375, 9.5, 5);
+    let left = texture(626, 555, 0.0, 5);
+    let right = texture(626, 555, 9.5, 5);
     let p = GaborParams {
-        d_max: 64.0,
+        d_max: 96.0,
         lr_check: false,
         ..GaborParams::default()
     };
