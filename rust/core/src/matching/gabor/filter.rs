@@ -158,6 +158,17 @@ pub fn mirror(i: isize, n: usize) -> usize {
     m as usize
 }
 
+/// `row` extended by `r` mirrored (reflect-101) samples on each side. Only the borders go
+/// through [`mirror`] (an integer division): per-pixel mirroring dominated the row passes.
+fn mirror_pad(row: &[f32], r: usize) -> Vec<f32> {
+    let w = row.len();
+    let mut pad = Vec::with_capacity(w + 2 * r);
+    pad.extend((0..r).map(|i| row[mirror(i as isize - r as isize, w)]));
+    pad.extend_from_slice(row);
+    pad.extend((0..r).map(|i| row[mirror((w + i) as isize, w)]));
+    pad
+}
+
 /// Real separable convolution with reflect-101 borders (symmetric taps, so conv = correlation).
 pub fn blur_real(src: &[f32], w: usize, h: usize, gx: &[f32], gy: &[f32]) -> Vec<f32> {
     let mut tmp = vec![0f32; w * h];
@@ -174,9 +185,7 @@ simd_fn! {
     fn real_row_pass(row: &[f32], g: &[f32], out: &mut [f32]) {
         let w = row.len();
         let r = g.len() / 2;
-        let pad: Vec<f32> = (0..w + 2 * r)
-            .map(|i| row[mirror(i as isize - r as isize, w)])
-            .collect();
+        let pad = mirror_pad(row, r);
         out.iter_mut().for_each(|v| *v = 0.0);
         for (k, &gk) in g.iter().enumerate() {
             for (o, &p) in out.iter_mut().zip(&pad[k..k + w]) {
@@ -276,9 +285,7 @@ simd_fn! {
         let w = row.len();
         let r = hx.len() / 2;
         // pad[i] = I(i - r); output x needs I(x - t) = pad[x + 2r - k], with k = t + r.
-        let pad: Vec<f32> = (0..w + 2 * r)
-            .map(|i| row[mirror(i as isize - r as isize, w)])
-            .collect();
+        let pad = mirror_pad(row, r);
         ore.iter_mut().for_each(|v| *v = 0.0);
         oim.iter_mut().for_each(|v| *v = 0.0);
         for (k, &[hr, hi]) in hx.iter().enumerate() {
