@@ -17,7 +17,9 @@ pub enum CoreError {
         height: usize,
     },
     /// The two images of a pair differ in size.
-    #[error("left and right images differ in size: left {left:?}, right {right:?} (width, height)")]
+    #[error(
+        "left and right images differ in size: left {left:?}, right {right:?} (width, height)"
+    )]
     SizeMismatch {
         left: (usize, usize),
         right: (usize, usize),

@@ -82,7 +82,11 @@ mod tests {
         ));
         assert!(matches!(
             Image::new(2, 2, vec![0.0; 3]),
-            Err(CoreError::BufferSize { got: 3, expected: 4, .. })
+            Err(CoreError::BufferSize {
+                got: 3,
+                expected: 4,
+                ..
+            })
         ));
         assert!(matches!(
             Image::new(2, 1, vec![0.0, f32::NAN]),
@@ -90,7 +94,10 @@ mod tests {
         ));
         let a = Image::filled(2, 2, 0.5);
         let b = Image::filled(3, 2, 0.5);
-        assert!(matches!(check_pair(&a, &b), Err(CoreError::SizeMismatch { .. })));
+        assert!(matches!(
+            check_pair(&a, &b),
+            Err(CoreError::SizeMismatch { .. })
+        ));
         assert_eq!(Image::new(2, 1, vec![0.25, 0.5]).unwrap().at(1, 0), 0.5);
     }
 }
