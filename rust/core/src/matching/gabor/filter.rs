@@ -12,6 +12,7 @@
 // and the one LLVM vectorises once the slices are re-bounded to the row length.
 #![allow(clippy::needless_range_loop)]
 
+use super::pool::Buf;
 use super::simd::simd_fn;
 use crate::error::{CoreError, Result};
 use crate::parallel::for_each_row;
@@ -170,12 +171,12 @@ fn mirror_pad(row: &[f32], r: usize) -> Vec<f32> {
 }
 
 /// Real separable convolution with reflect-101 borders (symmetric taps, so conv = correlation).
-pub fn blur_real(src: &[f32], w: usize, h: usize, gx: &[f32], gy: &[f32]) -> Vec<f32> {
-    let mut tmp = vec![0f32; w * h];
+pub fn blur_real(src: &[f32], w: usize, h: usize, gx: &[f32], gy: &[f32]) -> Buf {
+    let mut tmp = Buf::zeroed(w * h);
     for_each_row(&mut tmp, w, |y, out| {
         real_row_pass(&src[y * w..(y + 1) * w], gx, out)
     });
-    let mut dst = vec![0f32; w * h];
+    let mut dst = Buf::zeroed(w * h);
     for_each_row(&mut dst, w, |y, out| real_col_pass(&tmp, w, h, y, gy, out));
     dst
 }
@@ -210,7 +211,7 @@ simd_fn! {
 }
 
 /// A shared complex row pass: x taps and the (re, im) planes they produced.
-type OwnedRowGroup = (Vec<[f32; 2]>, Vec<f32>, Vec<f32>);
+type OwnedRowGroup = (Vec<[f32; 2]>, Buf, Buf);
 
 /// Complex responses `y = h * I` of one image for every channel, as planar (re, im) planes,
 /// plus the shared low-pass `L = G * I` (Gaussian of the first channel; all channels share it).
@@ -227,7 +228,7 @@ pub struct Responses {
 /// envelope (same frequency, bandwidth and aspect), which the bank guarantees.
 pub fn filter_bank(img: &[f32], w: usize, h: usize, chans: &[Channel]) -> Responses {
     let lowpass = match chans.first() {
-        Some(c) => blur_real(img, w, h, &c.gx, &c.gy),
+        Some(c) => blur_real(img, w, h, &c.gx, &c.gy).into_vec(),
         None => vec![0.0; w * h],
     };
     // Row passes are shared by channels with identical x taps (+-theta).
@@ -270,9 +271,9 @@ pub fn filter_bank(img: &[f32], w: usize, h: usize, chans: &[Channel]) -> Respon
 }
 
 /// Complex row pass of a real image: `H(x) = sum_t hx(t) I(x - t)`.
-pub fn row_pass(img: &[f32], w: usize, h: usize, hx: &[[f32; 2]]) -> (Vec<f32>, Vec<f32>) {
-    let mut re = vec![0f32; w * h];
-    let mut im = vec![0f32; w * h];
+pub fn row_pass(img: &[f32], w: usize, h: usize, hx: &[[f32; 2]]) -> (Buf, Buf) {
+    let mut re = Buf::zeroed(w * h);
+    let mut im = Buf::zeroed(w * h);
     crate::parallel::for_each_row2(&mut re, &mut im, w, |y, ore, oim| {
         complex_row_pass(&img[y * w..(y + 1) * w], hx, ore, oim)
     });

@@ -15,6 +15,7 @@
 
 use super::fastmath::{atan2, floor_fast, ln, round_fast, sincos};
 use super::filter::{blur_real, complex_col_pass, row_pass, Channel};
+use super::pool::Buf;
 use super::simd::simd_fn;
 use crate::parallel::{for_each_row, for_each_row2, for_each_row_pair};
 
@@ -38,9 +39,9 @@ pub struct LevelData {
     /// `(4 y + k) w`, where `(re, im)` is the demodulated response `beta = exp(-j k.x) y` (left) or
     /// the baseband `b = exp(-j k.x) (y + c L)` (right), and `f = y(x+1) conj y(x) + y(x) conj
     /// y(x-1)` the local-frequency phasor. Planar rows keep the arithmetic loops vectorisable.
-    pub chan: Vec<Vec<f32>>,
+    pub chan: Vec<Buf>,
     /// Shared low-pass `L = G * I` (the right image uses it for the zero-DC term).
-    pub lowpass: Vec<f32>,
+    pub lowpass: Buf,
     /// Bit `c` set where channel `c` passes the stability test.
     pub stable: Vec<u8>,
     /// `|y|^2` samples for the percentile, per channel.
@@ -50,13 +51,13 @@ pub struct LevelData {
     pub rowph: Vec<(Vec<f32>, Vec<f32>)>,
     /// Zero-DC responses packed per pixel, `[re_0, im_0, re_1, im_1, ...]` (`2 n_chan` floats),
     /// for the integer-shift energy search (one contiguous read per candidate).
-    pub ypack: Vec<f32>,
+    pub ypack: Buf,
     /// `sum_c |y_c|^2` per pixel.
-    pub energy: Vec<f32>,
+    pub energy: Buf,
 }
 
 /// A shared complex row pass: the x taps and the (re, im) planes they produced.
-type RowGroup<'a> = (&'a [[f32; 2]], Vec<f32>, Vec<f32>);
+type RowGroup<'a> = (&'a [[f32; 2]], Buf, Buf);
 
 /// Per-channel constants used by the kernels.
 #[derive(Debug, Clone)]
@@ -93,7 +94,7 @@ pub fn level_data(
     let timing = std::env::var_os("SV_GABOR_TIMING").is_some();
     let lowpass = match chans.first() {
         Some(c) => blur_real(img, w, h, &c.gx, &c.gy),
-        None => vec![0.0; w * h],
+        None => Buf::zeroed(w * h),
     };
     // Row passes are shared by channels with identical x taps (+-theta).
     let mut groups: Vec<RowGroup<'_>> = Vec::new();
@@ -115,15 +116,15 @@ pub fn level_data(
     let mut amp2_samples = Vec::with_capacity(chans.len());
     let mut colph = Vec::with_capacity(chans.len());
     let mut rowph = Vec::with_capacity(chans.len());
-    let mut amp2 = vec![0f32; w * h];
+    let mut amp2 = Buf::zeroed(w * h);
     let nc = chans.len();
-    let mut ypack = vec![0f32; 2 * nc * w * h];
-    let mut energy = vec![0f32; w * h];
+    let mut ypack = Buf::zeroed(2 * nc * w * h);
+    let mut energy = Buf::zeroed(w * h);
     for (ci, (c, &g)) in chans.iter().zip(&group_of).enumerate() {
         let (_, hre, him) = &groups[g];
         let cph = phasors(c.kx, w);
         let rph = phasors(c.ky, h);
-        let mut out = vec![0f32; 4 * w * h];
+        let mut out = Buf::zeroed(4 * w * h);
         for_each_row_pair(&mut out, 4 * w, &mut amp2, w, |y, orow, arow| {
             build_row(
                 hre, him, w, h, y, &c.hy, c.dc, &lowpass, &cph.0, &cph.1, rph.0[y], rph.1[y],
@@ -519,15 +520,10 @@ simd_fn! {
 
 /// One Newton step at every pixel. Returns `(delta, c)`: the WLS phase update (clamped to half
 /// the shortest carrier wavelength) and the mean channel confidence in [0, 1].
-pub fn newton_step(
-    l: &LevelData,
-    r: &LevelData,
-    cc: &[ChanConst],
-    disp: &[f32],
-) -> (Vec<f32>, Vec<f32>) {
+pub fn newton_step(l: &LevelData, r: &LevelData, cc: &[ChanConst], disp: &[f32]) -> (Buf, Buf) {
     let (w, h) = (l.w, l.h);
-    let mut delta = vec![0f32; w * h];
-    let mut conf = vec![0f32; w * h];
+    let mut delta = Buf::zeroed(w * h);
+    let mut conf = Buf::zeroed(w * h);
     let slots = kx_slots(cc);
     let max_delta = cc
         .iter()
@@ -581,10 +577,10 @@ simd_fn! {
 /// `num = sum_c 2 Re(y_l conj y_r)`, `den = sum_c |y_l|^2 + |y_r|^2` (zero outside the image).
 /// Integer shifts: the candidates are 1 px apart and pooled over a box, so interpolation buys
 /// nothing here; the Newton steps refine to sub-pixel.
-pub fn energy_terms(l: &LevelData, r: &LevelData, disp: &[f32], off: f32) -> (Vec<f32>, Vec<f32>) {
+pub fn energy_terms(l: &LevelData, r: &LevelData, disp: &[f32], off: f32) -> (Buf, Buf) {
     let (w, h) = (l.w, l.h);
-    let mut num = vec![0f32; w * h];
-    let mut den = vec![0f32; w * h];
+    let mut num = Buf::zeroed(w * h);
+    let mut den = Buf::zeroed(w * h);
     for_each_row2(&mut num, &mut den, w, |y, nrow, drow| {
         energy_row(l, r, y, &disp[y * w..(y + 1) * w], off, nrow, drow)
     });

@@ -14,6 +14,7 @@
 mod fastmath;
 pub mod filter;
 pub mod level;
+pub mod pool;
 pub mod post;
 mod simd;
 
@@ -21,6 +22,7 @@ use crate::error::{CoreError, Result};
 use crate::image::{check_pair, Image};
 use filter::Channel;
 use level::{chan_consts, energy_terms, level_data, newton_step, LevelData};
+use pool::Buf;
 
 /// Parameters of the Gabor channel (defaults: algorithms.md A.3 with the A.9 fixes).
 #[derive(Debug, Clone, PartialEq)]
@@ -248,8 +250,8 @@ pub struct GaborOutput {
 
 /// Raw result of one direction: disparity (every pixel) and max-over-levels confidence.
 struct Direction {
-    disp: Vec<f32>,
-    conf: Vec<f32>,
+    disp: Buf,
+    conf: Buf,
 }
 
 /// Dense phase-based disparity of a rectified pair.
@@ -286,8 +288,8 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
             None,
         )
     };
-    let mut disp = fwd.disp;
-    let mut conf = fwd.conf;
+    let mut disp = fwd.disp.into_vec();
+    let mut conf = fwd.conf.into_vec();
     let lr_ok = bwd.map(|b| {
         let dr = post::flip_x(&b.disp, w, h);
         post::lr_check(&disp, &dr, w, h, params.lr_tol)
@@ -352,7 +354,7 @@ fn one_direction(
     let sigma_s = p
         .smooth_sigma
         .unwrap_or_else(|| all_chans.first().map_or(1.0, |c| c.sigma_x));
-    let mut state: Option<(Vec<f32>, Vec<f32>, usize, usize)> = None;
+    let mut state: Option<(Buf, Buf, usize, usize)> = None;
     let timing = std::env::var_os("SV_GABOR_TIMING").is_some();
     let mut t0 = std::time::Instant::now();
     let mut lap = |what: &str, lvl: usize| {
@@ -385,12 +387,13 @@ fn one_direction(
         lap("filter", lvl);
         let (mut disp, mut conf_max) = match state.take() {
             None => {
-                let init = vec![p.d_min * scale; lw * lh];
+                let mut init = Buf::zeroed(lw * lh);
+                init.iter_mut().for_each(|v| *v = p.d_min * scale);
                 let n = ((p.d_max - p.d_min) * scale).ceil().max(0.0) as usize;
                 let offs: Vec<f32> = (0..=n).map(|k| k as f32).collect();
                 (
                     search(&ld, &rd, &init, &offs, p.search_pool_radius),
-                    vec![0.0; lw * lh],
+                    Buf::zeroed(lw * lh),
                 )
             }
             Some((d, c, sw, sh)) => {
@@ -436,20 +439,25 @@ fn one_direction(
             }
             Direction { disp, conf }
         }
-        None => Direction {
-            disp: vec![f32::NAN; w * h],
-            conf: vec![0.0; w * h],
-        },
+        None => {
+            let mut disp = Buf::zeroed(w * h);
+            disp.iter_mut().for_each(|v| *v = f32::NAN);
+            Direction {
+                disp,
+                conf: Buf::zeroed(w * h),
+            }
+        }
     }
 }
 
 /// Position-shift search: for each pixel, the offset in `offs` (added to `base`) maximising the
 /// box-pooled normalised energy `sum 2 Re(y_l conj y_r) / sum (|y_l|^2 + |y_r|^2)` (A.9: the
 /// raw energy favours high-contrast positions). Ties keep the first offset.
-fn search(l: &LevelData, r: &LevelData, base: &[f32], offs: &[f32], pool: usize) -> Vec<f32> {
+fn search(l: &LevelData, r: &LevelData, base: &[f32], offs: &[f32], pool: usize) -> Buf {
     let (w, h) = (l.w, l.h);
-    let mut best = vec![f32::NEG_INFINITY; w * h];
-    let mut out = base.to_vec();
+    let mut best = Buf::zeroed(w * h);
+    best.iter_mut().for_each(|v| *v = f32::NEG_INFINITY);
+    let mut out = Buf::from_slice(base);
     for &o in offs {
         let (num, den) = energy_terms(l, r, base, o);
         let num = post::box_sum(&num, w, h, pool);
@@ -496,7 +504,8 @@ pub fn gabor_newton_step(
     let ld = level_data(&left.data, w, h, &chans, params.stability_tau, false);
     let rd = level_data(&right.data, w, h, &chans, params.stability_tau, true);
     let cc = chan_consts(&chans, &ld, &rd, params.amp_rel_thresh);
-    Ok(newton_step(&ld, &rd, &cc, &disp.data))
+    let (delta, conf) = newton_step(&ld, &rd, &cc, &disp.data);
+    Ok((delta.into_vec(), conf.into_vec()))
 }
 
 #[cfg(test)]

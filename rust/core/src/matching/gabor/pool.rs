@@ -1,0 +1,113 @@
+//! A small process-wide pool of `f32` buffers, so that repeated calls (video frames) and the
+//! many same-sized planes inside one call reuse memory instead of mapping fresh pages.
+//!
+//! Measured on cloth3 (626x555, 2 cores): fresh multi-megabyte `Vec`s are `mmap`ed and
+//! unmapped by glibc on every use; the page faults cost ~20 % of the CPU time and serialise
+//! the two threads on the kernel's memory-map lock (-36 % wall time when memory is retained).
+//! Buffers come back zero-filled, so results are identical with or without the pool.
+
+use std::ops::{Deref, DerefMut};
+use std::sync::Mutex;
+
+/// Buffers smaller than this (in f32) are not worth pooling (malloc serves them from its heap).
+const MIN_POOLED: usize = 16 * 1024;
+/// Upper bound of the memory the pool keeps between uses (bytes): enough for the working set of
+/// a 0.4 Mpx pair, bounded so an idle process does not hold more than this.
+pub const POOL_MAX_BYTES: usize = 256 << 20;
+
+static POOL: Mutex<Vec<Vec<f32>>> = Mutex::new(Vec::new());
+
+fn lock() -> std::sync::MutexGuard<'static, Vec<Vec<f32>>> {
+    // A panic while holding the lock cannot leave the list inconsistent (push/remove only).
+    POOL.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// A zero-initialised `f32` buffer that returns its memory to the pool when dropped.
+#[derive(Debug, Default)]
+pub struct Buf {
+    v: Vec<f32>,
+}
+
+impl Buf {
+    /// `n` zeros, reusing the smallest pooled buffer that is large enough.
+    pub fn zeroed(n: usize) -> Buf {
+        if n >= MIN_POOLED {
+            let taken = {
+                let mut p = lock();
+                let best = p
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, b)| b.capacity() >= n)
+                    .min_by_key(|(_, b)| b.capacity())
+                    .map(|(i, _)| i);
+                best.map(|i| p.swap_remove(i))
+            };
+            if let Some(mut v) = taken {
+                v.clear();
+                v.resize(n, 0.0);
+                return Buf { v };
+            }
+        }
+        Buf { v: vec![0.0; n] }
+    }
+
+    /// A pooled copy of `src`.
+    pub fn from_slice(src: &[f32]) -> Buf {
+        let mut b = Buf::zeroed(src.len());
+        b.copy_from_slice(src);
+        b
+    }
+
+    /// Takes the buffer out of the pool's custody (it will be freed normally).
+    pub fn into_vec(mut self) -> Vec<f32> {
+        std::mem::take(&mut self.v)
+    }
+}
+
+impl Deref for Buf {
+    type Target = [f32];
+    fn deref(&self) -> &[f32] {
+        &self.v
+    }
+}
+
+impl DerefMut for Buf {
+    fn deref_mut(&mut self) -> &mut [f32] {
+        &mut self.v
+    }
+}
+
+impl Drop for Buf {
+    fn drop(&mut self) {
+        let v = std::mem::take(&mut self.v);
+        if v.capacity() < MIN_POOLED {
+            return;
+        }
+        let mut p = lock();
+        p.push(v);
+        // Keep the total under the cap, dropping the oldest buffers first.
+        let mut total: usize = p.iter().map(|b| b.capacity() * 4).sum();
+        while total > POOL_MAX_BYTES && !p.is_empty() {
+            let old = p.remove(0);
+            total -= old.capacity() * 4;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Buf;
+
+    #[test]
+    fn reused_buffers_are_zeroed() {
+        let n = 100_000;
+        {
+            let mut a = Buf::zeroed(n);
+            a.iter_mut().for_each(|v| *v = 3.0);
+        }
+        let b = Buf::zeroed(n - 10);
+        assert_eq!(b.len(), n - 10);
+        assert!(b.iter().all(|&v| v == 0.0));
+        assert_eq!(Buf::from_slice(&[1.0, 2.0]).into_vec(), vec![1.0, 2.0]);
+    }
+}
