@@ -90,8 +90,6 @@ pub fn level_data(
     tau: f32,
     right: bool,
 ) -> LevelData {
-    let t0 = std::time::Instant::now();
-    let timing = std::env::var_os("SV_GABOR_TIMING").is_some();
     let lowpass = match chans.first() {
         Some(c) => blur_real(img, w, h, &c.gx, &c.gy),
         None => Buf::zeroed(w * h),
@@ -107,9 +105,6 @@ pub fn level_data(
             groups.push((&c.hx, re, im));
             group_of.push(groups.len() - 1);
         }
-    }
-    if timing {
-        eprintln!("    rowpass {:.1}", t0.elapsed().as_secs_f64() * 1e3);
     }
     let mut chan = Vec::with_capacity(chans.len());
     let mut stable = vec![0u8; w * h];
@@ -157,9 +152,6 @@ pub fn level_data(
             let (fr, fi) = (&out[o + 2 * w..o + 3 * w], &out[o + 3 * w..o + 4 * w]);
             stability_row(fr, fi, &amp2[y * w..(y + 1) * w], c.kx, lim2, bit, srow)
         });
-        if timing {
-            eprintln!("    chan {ci} {:.1}", t0.elapsed().as_secs_f64() * 1e3);
-        }
         amp2_samples.push(amp2.iter().step_by(PERCENTILE_STRIDE).copied().collect());
         chan.push(out);
         colph.push(cph);

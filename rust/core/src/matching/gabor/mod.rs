@@ -10,6 +10,9 @@
 //! 4. Confidence = max over levels of the smoothed confidence; left-right check; speckle removal.
 //!
 //! Right responses are never recomputed for a warp: the smooth baseband is shifted (`level`).
+//!
+//! Profiling aid: with the environment variable `SV_GABOR_TIMING` set, per-level stage times are
+//! printed to stderr.
 
 mod fastmath;
 pub mod filter;
