@@ -32,7 +32,7 @@ def gabor_disparity(
     lr_coarse_levels: int = 0,
     iters_finest: int = 1,
     research_finest: bool = True,
-    orientations_finest: int = 5,
+    orientations_finest: int = 3,
     lr_light: bool = False,
     speckle_size: int = 100,
     speckle_range: float = 1.0,

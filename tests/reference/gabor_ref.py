@@ -27,6 +27,8 @@ PERCENTILE_STRIDE = 3
 MIN_FREQ_RATIO = 0.5
 ORIENTATIONS = (0.0, 30.0, -30.0, 60.0, -60.0)
 BANDWIDTH_OCT = 1.5
+#: Orientations used at full resolution (the first ones of ``ORIENTATIONS``).
+ORIENTATIONS_FINEST = 3
 
 
 def sigma_from_bandwidth(freq: float, bandwidth_oct: float) -> float:
@@ -292,7 +294,8 @@ def disparity_one_level(
     pool: int = 2,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Whole pipeline at one level (``n_levels=1``, no LR check, no speckle removal)."""
-    chans = [channel(0.25, t) for t in ORIENTATIONS]
+    # With one level, that level is the finest: it uses the full-resolution orientations.
+    chans = [channel(0.25, t) for t in ORIENTATIONS[:ORIENTATIONS_FINEST]]
     lv, rv = level_data(left, chans, tau), level_data(right, chans, tau)
     thr2 = thresholds2(lv, rv, amp_rel)
     h, w = left.shape

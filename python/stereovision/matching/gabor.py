@@ -40,7 +40,7 @@ DEFAULTS: dict[str, object] = {
     "lr_coarse_levels": 0,
     "iters_finest": 1,
     "research_finest": True,
-    "orientations_finest": 5,
+    "orientations_finest": 3,
     "lr_light": False,
     "speckle_size": 100,
     "speckle_range": 1.0,

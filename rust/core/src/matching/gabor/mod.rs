@@ -110,7 +110,10 @@ impl Default for GaborParams {
             // A second full-resolution step changed no figure of the evaluation (17 scenes).
             iters_finest: 1,
             research_finest: true,
-            orientations_finest: 5,
+            // Full resolution with 0 and +-30 degrees only: 25-30 % faster for +0.3 points of
+            // mean bad-2 (the +-60 degree channels matter at the coarse levels, where they help
+            // lock onto the right disparity).
+            orientations_finest: LIGHT_ORIENTATIONS,
             // The full right-reference run keeps 6 points more density than the light one.
             lr_light: false,
             // Same rule as the SGBM reference (100 px, 1 px step): -1.2 points of mean bad-2.
