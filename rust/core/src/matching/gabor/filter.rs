@@ -172,11 +172,11 @@ fn mirror_pad(row: &[f32], r: usize) -> Vec<f32> {
 
 /// Real separable convolution with reflect-101 borders (symmetric taps, so conv = correlation).
 pub fn blur_real(src: &[f32], w: usize, h: usize, gx: &[f32], gy: &[f32]) -> Buf {
-    let mut tmp = Buf::zeroed(w * h);
+    let mut tmp = Buf::scratch(w * h);
     for_each_row(&mut tmp, w, |y, out| {
         real_row_pass(&src[y * w..(y + 1) * w], gx, out)
     });
-    let mut dst = Buf::zeroed(w * h);
+    let mut dst = Buf::scratch(w * h);
     for_each_row(&mut dst, w, |y, out| real_col_pass(&tmp, w, h, y, gy, out));
     dst
 }
@@ -272,8 +272,8 @@ pub fn filter_bank(img: &[f32], w: usize, h: usize, chans: &[Channel]) -> Respon
 
 /// Complex row pass of a real image: `H(x) = sum_t hx(t) I(x - t)`.
 pub fn row_pass(img: &[f32], w: usize, h: usize, hx: &[[f32; 2]]) -> (Buf, Buf) {
-    let mut re = Buf::zeroed(w * h);
-    let mut im = Buf::zeroed(w * h);
+    let mut re = Buf::scratch(w * h);
+    let mut im = Buf::scratch(w * h);
     crate::parallel::for_each_row2(&mut re, &mut im, w, |y, ore, oim| {
         complex_row_pass(&img[y * w..(y + 1) * w], hx, ore, oim)
     });

@@ -31,14 +31,18 @@ pub const MIN_FREQ_RATIO: f32 = 0.5;
 /// Guards `ln(0)` in the amplitude log-derivative.
 const LN_EPS: f32 = 1e-30;
 
+/// Sub-rows stored per image row and channel (see [`LevelData::chan`]).
+pub const SUBROWS: usize = 6;
+
 /// Filtered data of one image at one level, laid out for the pointwise kernels.
 pub struct LevelData {
     pub w: usize,
     pub h: usize,
-    /// Per channel, "row-planar": image row `y` holds four sub-rows `re, im, f_re, f_im` at
-    /// `(4 y + k) w`, where `(re, im)` is the demodulated response `beta = exp(-j k.x) y` (left) or
-    /// the baseband `b = exp(-j k.x) (y + c L)` (right), and `f = y(x+1) conj y(x) + y(x) conj
-    /// y(x-1)` the local-frequency phasor. Planar rows keep the arithmetic loops vectorisable.
+    /// Per channel, "row-planar": image row `y` holds [`SUBROWS`] sub-rows `re, im, f_re, f_im,
+    /// y_re, y_im` at `(SUBROWS y + k) w`, where `(re, im)` is the demodulated response
+    /// `beta = exp(-j k.x) y` (left) or the baseband `b = exp(-j k.x) (y + c L)` (right),
+    /// `f = y(x+1) conj y(x) + y(x) conj y(x-1)` the local-frequency phasor and `y` the zero-DC
+    /// response itself (for the integer-shift search). Planar rows keep the loops vectorisable.
     pub chan: Vec<Buf>,
     /// Shared low-pass `L = G * I` (the right image uses it for the zero-DC term).
     pub lowpass: Buf,
@@ -49,9 +53,6 @@ pub struct LevelData {
     /// Per channel: carrier phasors `exp(-j kx x)` (re, im) per column and `exp(-j ky y)` per row.
     pub colph: Vec<(Vec<f32>, Vec<f32>)>,
     pub rowph: Vec<(Vec<f32>, Vec<f32>)>,
-    /// Zero-DC responses packed per pixel, `[re_0, im_0, re_1, im_1, ...]` (`2 n_chan` floats),
-    /// for the integer-shift energy search (one contiguous read per candidate).
-    pub ypack: Buf,
     /// `sum_c |y_c|^2` per pixel.
     pub energy: Buf,
 }
@@ -111,44 +112,30 @@ pub fn level_data(
     let mut amp2_samples = Vec::with_capacity(chans.len());
     let mut colph = Vec::with_capacity(chans.len());
     let mut rowph = Vec::with_capacity(chans.len());
-    let mut amp2 = Buf::zeroed(w * h);
-    let nc = chans.len();
-    let mut ypack = Buf::zeroed(2 * nc * w * h);
+    let mut amp2 = Buf::scratch(w * h);
     let mut energy = Buf::zeroed(w * h);
     for (ci, (c, &g)) in chans.iter().zip(&group_of).enumerate() {
         let (_, hre, him) = &groups[g];
         let cph = phasors(c.kx, w);
         let rph = phasors(c.ky, h);
-        let mut out = Buf::zeroed(4 * w * h);
-        for_each_row_pair(&mut out, 4 * w, &mut amp2, w, |y, orow, arow| {
+        let mut out = Buf::scratch(SUBROWS * w * h);
+        for_each_row_pair(&mut out, SUBROWS * w, &mut amp2, w, |y, orow, arow| {
             build_row(
                 hre, him, w, h, y, &c.hy, c.dc, &lowpass, &cph.0, &cph.1, rph.0[y], rph.1[y],
                 right, orow, arow,
             )
         });
-        // y = a - c L is recomputed here from the stored data only for the packed copy.
-        for_each_row_pair(&mut ypack, 2 * nc * w, &mut energy, w, |y, prow, erow| {
-            pack_row(
-                &out[4 * y * w..4 * (y + 1) * w],
-                &lowpass[y * w..(y + 1) * w],
-                &amp2[y * w..(y + 1) * w],
-                &cph,
-                rph.0[y],
-                rph.1[y],
-                c.dc,
-                right,
-                ci,
-                nc,
-                prow,
-                erow,
-            )
+        for_each_row(&mut energy, w, |y, erow| {
+            for (e, a) in erow.iter_mut().zip(&amp2[y * w..(y + 1) * w]) {
+                *e += a;
+            }
         });
         // Stability (A.5 step 4e with the A.9 correction): Im psi = mean phase increment,
         // Re psi = central difference of ln rho; |psi - j k0| <= tau / sigma_x, Im psi >= k0 / 2.
         let lim2 = (tau / c.sigma_x).powi(2);
         let bit = 1u8 << ci;
         for_each_row(&mut stable, w, |y, srow| {
-            let o = 4 * y * w;
+            let o = SUBROWS * y * w;
             let (fr, fi) = (&out[o + 2 * w..o + 3 * w], &out[o + 3 * w..o + 4 * w]);
             stability_row(fr, fi, &amp2[y * w..(y + 1) * w], c.kx, lim2, bit, srow)
         });
@@ -166,43 +153,7 @@ pub fn level_data(
         amp2_samples,
         colph,
         rowph,
-        ypack,
         energy,
-    }
-}
-
-simd_fn! {
-    /// Re-modulates one row of channel `ci` back to `y` and stores it in the packed layout.
-    fn pack_row(
-        orow: &[f32],
-        lp: &[f32],
-        a2: &[f32],
-        cph: &(Vec<f32>, Vec<f32>),
-        rre: f32,
-        rim: f32,
-        dc: [f32; 2],
-        right: bool,
-        ci: usize,
-        nc: usize,
-        prow: &mut [f32],
-        erow: &mut [f32],
-    ) {
-        let w = lp.len();
-        let (br, bi) = (&orow[..w], &orow[w..2 * w]);
-        let (cre, cim) = (&cph.0[..w], &cph.1[..w]);
-        for x in 0..w {
-            // exp(+j k.(x, y)) = conj(colph[x] rowph[y])
-            let qr = cre[x] * rre - cim[x] * rim;
-            let qi = -(cre[x] * rim + cim[x] * rre);
-            let (mut yr, mut yi) = (br[x] * qr - bi[x] * qi, br[x] * qi + bi[x] * qr);
-            if right {
-                yr -= dc[0] * lp[x];
-                yi -= dc[1] * lp[x];
-            }
-            prow[(x * nc + ci) * 2] = yr;
-            prow[(x * nc + ci) * 2 + 1] = yi;
-            erow[x] += a2[x];
-        }
     }
 }
 
@@ -243,7 +194,11 @@ simd_fn! {
         let (cre, cim) = (&cre[..w], &cim[..w]);
         let (ore, rest) = orow.split_at_mut(w);
         let (oim, rest) = rest.split_at_mut(w);
-        let (ofr, ofi) = rest.split_at_mut(w);
+        let (ofr, rest) = rest.split_at_mut(w);
+        let (ofi, rest) = rest.split_at_mut(w);
+        let (oyr, oyi) = rest.split_at_mut(w);
+        oyr[..w].copy_from_slice(&yr[..w]);
+        oyi[..w].copy_from_slice(&yi[..w]);
         let (ofr, ofi) = (&mut ofr[..w], &mut ofi[..w]);
         for x in 0..w {
             // exp(-j k.(x, y)) = colph[x] * rowph[y]
@@ -429,7 +384,7 @@ fn shifted_row(
     gfi: &mut [f32],
 ) {
     let w = l.w;
-    let o = 4 * y * w;
+    let o = SUBROWS * y * w;
     let rc = &r.chan[ci];
     let (rre, rim) = (&rc[o..o + w], &rc[o + w..o + 2 * w]);
     let (rfr, rfi) = (&rc[o + 2 * w..o + 3 * w], &rc[o + 3 * w..o + 4 * w]);
@@ -477,7 +432,7 @@ simd_fn! {
             (vec![0f32; w], vec![0f32; w], vec![0f32; w], vec![0f32; w]);
         for (ci, c) in cc.iter().enumerate() {
             shifted_row(l, r, c, ci, y, &p, &mut bwr, &mut bwi, &mut gfr, &mut gfi);
-            let o = 4 * y * w;
+            let o = SUBROWS * y * w;
             let lc = &l.chan[ci];
             let (lre, lim) = (&lc[o..o + w], &lc[o + w..o + 2 * w]);
             let (lfr, lfi) = (&lc[o + 2 * w..o + 3 * w], &lc[o + 3 * w..o + 4 * w]);
@@ -514,8 +469,8 @@ simd_fn! {
 /// the shortest carrier wavelength) and the mean channel confidence in [0, 1].
 pub fn newton_step(l: &LevelData, r: &LevelData, cc: &[ChanConst], disp: &[f32]) -> (Buf, Buf) {
     let (w, h) = (l.w, l.h);
-    let mut delta = Buf::zeroed(w * h);
-    let mut conf = Buf::zeroed(w * h);
+    let mut delta = Buf::scratch(w * h);
+    let mut conf = Buf::scratch(w * h);
     let slots = kx_slots(cc);
     let max_delta = cc
         .iter()
@@ -538,29 +493,36 @@ pub fn newton_step(l: &LevelData, r: &LevelData, cc: &[ChanConst], disp: &[f32])
 }
 
 simd_fn! {
-    /// One row of [`energy_terms`] at integer shifts `round(d + off)`.
+    /// One row of [`energy_terms`] at integer shifts `round(d + off)`: channel-outer loops over
+    /// the row (independent gathers, no per-pixel dependency chain).
     fn energy_row(l: &LevelData, r: &LevelData, y: usize, drow: &[f32], off: f32, nout: &mut [f32], dout: &mut [f32]) {
         let w = l.w;
-        let m = l.ypack.len() / (l.w * l.h).max(1);
         let o = y * w;
-        let lp = &l.ypack[o * m..(o + w) * m];
-        let rp = &r.ypack[o * m..(o + w) * m];
-        let (le, re) = (&l.energy[o..o + w], &r.energy[o..o + w]);
+        let last = (w - 1) as f32;
+        let mut si = vec![0usize; w];
+        let mut valid = vec![false; w];
         for x in 0..w {
             let s = round_fast(x as f32 - (drow[x] + off));
-            if !(s >= 0.0 && s <= (w - 1) as f32) {
-                nout[x] = 0.0;
-                dout[x] = 0.0;
-                continue;
+            let v = s >= 0.0 && s <= last;
+            valid[x] = v;
+            si[x] = if v { s as usize } else { 0 };
+        }
+        let (nout, dout) = (&mut nout[..w], &mut dout[..w]);
+        nout.iter_mut().for_each(|v| *v = 0.0);
+        let ro = SUBROWS * y * w;
+        for (lc, rc) in l.chan.iter().zip(&r.chan) {
+            let (lre, lim) = (&lc[ro + 4 * w..ro + 5 * w], &lc[ro + 5 * w..ro + 6 * w]);
+            let (rre, rim) = (&rc[ro + 4 * w..ro + 5 * w], &rc[ro + 5 * w..ro + 6 * w]);
+            for x in 0..w {
+                let j = si[x];
+                nout[x] += lre[x] * rre[j] + lim[x] * rim[j];
             }
-            let si = s as usize;
-            let (a, b) = (&lp[x * m..(x + 1) * m], &rp[si * m..(si + 1) * m]);
-            let mut acc = 0.0;
-            for k in 0..m {
-                acc += a[k] * b[k];
-            }
-            nout[x] = 2.0 * acc;
-            dout[x] = le[x] + re[si];
+        }
+        let (le, re) = (&l.energy[o..o + w], &r.energy[o..o + w]);
+        for x in 0..w {
+            let v = valid[x];
+            nout[x] = if v { 2.0 * nout[x] } else { 0.0 };
+            dout[x] = if v { le[x] + re[si[x]] } else { 0.0 };
         }
     }
 }
@@ -571,8 +533,8 @@ simd_fn! {
 /// nothing here; the Newton steps refine to sub-pixel.
 pub fn energy_terms(l: &LevelData, r: &LevelData, disp: &[f32], off: f32) -> (Buf, Buf) {
     let (w, h) = (l.w, l.h);
-    let mut num = Buf::zeroed(w * h);
-    let mut den = Buf::zeroed(w * h);
+    let mut num = Buf::scratch(w * h);
+    let mut den = Buf::scratch(w * h);
     for_each_row2(&mut num, &mut den, w, |y, nrow, drow| {
         energy_row(l, r, y, &disp[y * w..(y + 1) * w], off, nrow, drow)
     });

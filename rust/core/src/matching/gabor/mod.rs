@@ -393,7 +393,7 @@ fn one_direction(
         lap("filter", lvl);
         let (mut disp, mut conf_max) = match state.take() {
             None => {
-                let mut init = Buf::zeroed(lw * lh);
+                let mut init = Buf::scratch(lw * lh);
                 init.iter_mut().for_each(|v| *v = p.d_min * scale);
                 let n = ((p.d_max - p.d_min) * scale).ceil().max(0.0) as usize;
                 let offs: Vec<f32> = (0..=n).map(|k| k as f32).collect();
@@ -461,7 +461,7 @@ fn one_direction(
 /// raw energy favours high-contrast positions). Ties keep the first offset.
 fn search(l: &LevelData, r: &LevelData, base: &[f32], offs: &[f32], pool: usize) -> Buf {
     let (w, h) = (l.w, l.h);
-    let mut best = Buf::zeroed(w * h);
+    let mut best = Buf::scratch(w * h);
     best.iter_mut().for_each(|v| *v = f32::NEG_INFINITY);
     let mut out = Buf::from_slice(base);
     for &o in offs {

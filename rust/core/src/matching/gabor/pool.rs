@@ -31,6 +31,14 @@ pub struct Buf {
 impl Buf {
     /// `n` zeros, reusing the smallest pooled buffer that is large enough.
     pub fn zeroed(n: usize) -> Buf {
+        let mut b = Buf::scratch(n);
+        b.iter_mut().for_each(|v| *v = 0.0);
+        b
+    }
+
+    /// `n` values with unspecified (but initialised) contents, for outputs the caller overwrites
+    /// entirely: skips the zero fill of a reused buffer.
+    pub fn scratch(n: usize) -> Buf {
         if n >= MIN_POOLED {
             let taken = {
                 let mut p = lock();
@@ -43,7 +51,7 @@ impl Buf {
                 best.map(|i| p.swap_remove(i))
             };
             if let Some(mut v) = taken {
-                v.clear();
+                v.truncate(n);
                 v.resize(n, 0.0);
                 return Buf { v };
             }
@@ -53,7 +61,7 @@ impl Buf {
 
     /// A pooled copy of `src`.
     pub fn from_slice(src: &[f32]) -> Buf {
-        let mut b = Buf::zeroed(src.len());
+        let mut b = Buf::scratch(src.len());
         b.copy_from_slice(src);
         b
     }
@@ -108,6 +116,8 @@ mod tests {
         let b = Buf::zeroed(n - 10);
         assert_eq!(b.len(), n - 10);
         assert!(b.iter().all(|&v| v == 0.0));
+        drop(b);
+        assert_eq!(Buf::scratch(n + 5).len(), n + 5);
         assert_eq!(Buf::from_slice(&[1.0, 2.0]).into_vec(), vec![1.0, 2.0]);
     }
 }

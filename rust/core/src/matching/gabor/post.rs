@@ -12,7 +12,7 @@ use crate::parallel::for_each_row;
 /// Normalised-convolution smoothing (A.5 step 3h): `cbar = G * c`, `dbar = G * (c d) / cbar`.
 pub fn normalized_conv(delta: &[f32], conf: &[f32], w: usize, h: usize, sigma: f32) -> (Buf, Buf) {
     let g = gaussian_taps(sigma, radius_for(sigma));
-    let mut cd = Buf::zeroed(w * h);
+    let mut cd = Buf::scratch(w * h);
     cd.iter_mut()
         .zip(delta.iter().zip(conf))
         .for_each(|(o, (d, c))| *o = d * c);
@@ -51,7 +51,7 @@ fn med5(mut a: f32, mut b: f32, mut c: f32, mut d: f32, mut e: f32) -> f32 {
 /// 5x5 median (two 5-networks instead of a 25-sort) with the same job here: removing isolated
 /// disparity outliers after each Newton step.
 pub fn median5(src: &[f32], w: usize, h: usize) -> Buf {
-    let mut tmp = Buf::zeroed(w * h);
+    let mut tmp = Buf::scratch(w * h);
     for_each_row(&mut tmp, w, |y, row| {
         let s = &src[y * w..(y + 1) * w];
         for (x, v) in row.iter_mut().enumerate() {
@@ -59,7 +59,7 @@ pub fn median5(src: &[f32], w: usize, h: usize) -> Buf {
             *v = med5(at(-2), at(-1), at(0), at(1), at(2));
         }
     });
-    let mut out = Buf::zeroed(w * h);
+    let mut out = Buf::scratch(w * h);
     for_each_row(&mut out, w, |y, row| {
         let r = |dy: isize| {
             let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
@@ -89,7 +89,7 @@ fn bilinear(src: &[f32], w: usize, h: usize, x: f32, y: f32) -> f32 {
 /// Up-samples a coarse map to `(w, h)` (pixel `x` at the fine level is `x / 2` at the coarse one),
 /// multiplying values by `scale` (2 for disparities, 1 for confidences).
 pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f32) -> Buf {
-    let mut out = Buf::zeroed(w * h);
+    let mut out = Buf::scratch(w * h);
     for_each_row(&mut out, w, |y, row| {
         for (x, v) in row.iter_mut().enumerate() {
             *v = scale * bilinear(src, sw, sh, x as f32 * 0.5, y as f32 * 0.5);
@@ -101,7 +101,7 @@ pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f3
 /// Box sum over a `(2r+1)^2` window with clamped borders, computed per output row (no running
 /// sums across rows, so bands are independent and results thread-count invariant).
 pub fn box_sum(src: &[f32], w: usize, h: usize, r: usize) -> Buf {
-    let mut out = Buf::zeroed(w * h);
+    let mut out = Buf::scratch(w * h);
     for_each_row(&mut out, w, |y, row| box_row(src, w, h, r, y, row));
     out
 }
