@@ -33,6 +33,7 @@ def gabor_disparity(
     iters_finest: int = 1,
     research_finest: bool = True,
     orientations_finest: int = 3,
+    fine_levels: int = 1,
     lr_light: bool = False,
     speckle_size: int = 100,
     speckle_range: float = 1.0,

@@ -41,6 +41,7 @@ DEFAULTS: dict[str, object] = {
     "iters_finest": 1,
     "research_finest": True,
     "orientations_finest": 3,
+    "fine_levels": 1,
     "lr_light": False,
     "speckle_size": 100,
     "speckle_range": 1.0,

@@ -36,6 +36,7 @@ fn params(
     iters_finest: usize,
     research_finest: bool,
     orientations_finest: usize,
+    fine_levels: usize,
     lr_light: bool,
     speckle_size: usize,
     speckle_range: f32,
@@ -61,6 +62,7 @@ fn params(
         iters_finest,
         research_finest,
         orientations_finest,
+        fine_levels,
         lr_light,
         speckle_size,
         speckle_range,
@@ -82,7 +84,7 @@ fn to_image(w: usize, h: usize, data: Vec<f32>) -> Image {
     n_levels=None, iters_per_level=2, amp_rel_thresh=0.02, stability_tau=1.25, smooth_sigma=None,
     conf_min=0.15,
     research_radius=2, search_pool_radius=2, lr_check=true, lr_tol=1.0, lr_coarse_levels=0,
-    iters_finest=1, research_finest=true, orientations_finest=3, lr_light=false, speckle_size=100,
+    iters_finest=1, research_finest=true, orientations_finest=3, fine_levels=1, lr_light=false, speckle_size=100,
     speckle_range=1.0
 ))]
 #[allow(clippy::too_many_arguments)]
@@ -110,6 +112,7 @@ pub fn gabor_disparity<'py>(
     iters_finest: usize,
     research_finest: bool,
     orientations_finest: usize,
+    fine_levels: usize,
     lr_light: bool,
     speckle_size: usize,
     speckle_range: f32,
@@ -137,6 +140,7 @@ pub fn gabor_disparity<'py>(
         iters_finest,
         research_finest,
         orientations_finest,
+        fine_levels,
         lr_light,
         speckle_size,
         speckle_range,

@@ -69,8 +69,11 @@ pub struct GaborParams {
     pub iters_finest: usize,
     /// Position-shift re-search at full resolution too.
     pub research_finest: bool,
-    /// Number of orientations (the first ones of `orientations_deg`) used at full resolution.
+    /// Number of orientations (the first ones of `orientations_deg`) used at the finest
+    /// `fine_levels` levels.
     pub orientations_finest: usize,
+    /// How many of the finest levels use `orientations_finest` orientations.
+    pub fine_levels: usize,
     /// The right-reference run of the LR check uses a light full-resolution level (at most
     /// [`LIGHT_ORIENTATIONS`] orientations, one Newton step, no re-search): it only has to agree
     /// within `lr_tol`, and it costs as much as the main run otherwise.
@@ -114,6 +117,7 @@ impl Default for GaborParams {
             // mean bad-2 (the +-60 degree channels matter at the coarse levels, where they help
             // lock onto the right disparity).
             orientations_finest: LIGHT_ORIENTATIONS,
+            fine_levels: 1,
             // The full right-reference run keeps 6 points more density than the light one.
             lr_light: false,
             // Same rule as the SGBM reference (100 px, 1 px step): -1.2 points of mean bad-2.
@@ -378,7 +382,7 @@ fn one_direction(
             break;
         }
         let (lw, lh) = (*lw, *lh);
-        let chans = if lvl == 0 {
+        let chans = if lvl < p.fine_levels {
             &all_chans[..p.orientations_finest.min(all_chans.len())]
         } else {
             all_chans
