@@ -1,0 +1,546 @@
+//! Hopfield-network stereo matching of interest points (algorithms.md C, with the C.10 changes).
+//!
+//! Pipeline:
+//! 1. Moravec interest points of the left image ([`interest`]: squares, 3x3 NMS, 0.1 % of max).
+//! 2. Candidates per left point ([`CandidateMode`]): 7x7 ZNCC peaks along the epipolar row
+//!    (default, C.10), or the right image's interest points in the epipolar band (the paper's
+//!    point-to-point network, kept as a high-precision option). ZNCC `>= s_min`, best `k_cand`.
+//! 3. The sparse binary Hopfield network ([`network`]) over the candidates: compatibility in the
+//!    40x40 window, uniqueness on both sides, similarity input; asynchronous seeded sweeps until a
+//!    sweep without a flip.
+//! 4. Disambiguation of points left with several active candidates (C.5: local median of the
+//!    vertical disparity of single matches, tie-break on similarity, both sides).
+//! 5. Depth-edge filters (C.10): the four half-windows agree within +-1 px, centre grey-level
+//!    check, at least 8 agreeing neighbour matches; parabola sub-pixel refinement.
+//!
+//! [`best_match`] runs the same pipeline without the network (best ZNCC candidate per point):
+//! the reference the network has to beat.
+
+pub mod interest;
+pub mod network;
+pub mod zncc;
+
+#[cfg(test)]
+mod tests;
+
+use std::collections::HashMap;
+
+use rayon::prelude::*;
+
+use crate::error::{CoreError, Result};
+use crate::image::{check_pair, Image};
+pub use interest::{interest_points, moravec, InterestParams, InterestPoint};
+pub use network::{build_weights, run_dynamics, Csr, Dynamics, EnergyWeights, Neuron};
+use zncc::{zncc_curves, Curves, RightStats, FULL, N_REGIONS, SIM_RADIUS};
+
+/// Where the right candidates of a left point come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CandidateMode {
+    /// ZNCC peaks along the epipolar row (C.10: contains the true match far more often).
+    Row,
+    /// Right-image interest points in the epipolar band (the paper's network).
+    Points,
+}
+
+/// Parameters of the Hopfield channel (defaults: algorithms.md C.3 with the C.10 changes).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HopfieldParams {
+    /// Smallest disparity searched (px).
+    pub d_min: usize,
+    /// Largest disparity searched (px).
+    pub d_max: usize,
+    pub interest: InterestParams,
+    pub candidates: CandidateMode,
+    /// Epipolar band `|y_l - y_r|` for [`CandidateMode::Points`] (px, C.3).
+    pub dy_window: usize,
+    /// Minimum ZNCC of a candidate (the real gate of the network, C.10).
+    pub s_min: f32,
+    /// Candidates kept per left point (C.3; C.10: never binds).
+    pub k_cand: usize,
+    pub weights: EnergyWeights,
+    /// Neurons with `S >= s_init` start on (C.4 "preset possible matches").
+    pub s_init: f32,
+    /// Upper bound on asynchronous sweeps.
+    pub max_sweeps: usize,
+    /// Seed of the update order.
+    pub seed: u64,
+    /// Disambiguation tolerance on the vertical disparity (px, C.5).
+    pub tau_y: f32,
+    /// Depth-edge test (half-windows, centre check, neighbour agreement; C.10).
+    pub edge_test: bool,
+    /// Half-window disparities must agree with the match within this many px (C.10: 1).
+    pub edge_tol: usize,
+    /// Centre grey-level difference allowed between the matched pixels (C.10: 0.05).
+    pub centre_tol: f32,
+    /// Agreeing neighbour matches required in the 40x40 window (C.10: 8).
+    pub min_agree: usize,
+    /// Neighbour matches agree when their disparities differ by at most this (px).
+    pub agree_tol: i32,
+    /// Parabola sub-pixel refinement of the final matches.
+    pub subpixel: bool,
+}
+
+impl Default for HopfieldParams {
+    fn default() -> Self {
+        HopfieldParams {
+            d_min: 0,
+            d_max: 64,
+            interest: InterestParams::default(),
+            candidates: CandidateMode::Row,
+            dy_window: 2,
+            s_min: DEFAULT_S_MIN,
+            k_cand: 8,
+            weights: EnergyWeights::default(),
+            s_init: 0.8,
+            max_sweeps: 100,
+            seed: 0,
+            tau_y: 1.0,
+            edge_test: true,
+            edge_tol: 1,
+            centre_tol: 0.05,
+            min_agree: 8,
+            agree_tol: 1,
+            subpixel: true,
+        }
+    }
+}
+
+/// Default minimum candidate ZNCC.
+pub const DEFAULT_S_MIN: f32 = 0.8;
+
+/// One final match.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Match {
+    pub xl: f32,
+    pub yl: f32,
+    pub xr: f32,
+    pub yr: f32,
+    /// ZNCC of the 7x7 windows at the integer match.
+    pub score: f32,
+}
+
+/// Result of [`hopfield_match`] / [`best_match`], with the network's statistics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HopfieldOutput {
+    pub matches: Vec<Match>,
+    /// Energy of the initial state, then after every sweep (empty for [`best_match`]).
+    pub energy_trace: Vec<f64>,
+    pub n_points: usize,
+    pub n_neurons: usize,
+    pub n_weights: usize,
+    pub sweeps: usize,
+    pub converged: bool,
+    /// Matches chosen before the depth-edge filters.
+    pub n_selected: usize,
+}
+
+fn validate(left: &Image, right: &Image, p: &HopfieldParams) -> Result<()> {
+    check_pair(left, right)?;
+    if p.d_max < p.d_min {
+        return Err(CoreError::param(
+            "max_disparity",
+            format!("must be >= min_disparity ({}), got {}", p.d_min, p.d_max),
+        ));
+    }
+    if !(p.interest.rel_threshold.is_finite() && (0.0..=1.0).contains(&p.interest.rel_threshold)) {
+        return Err(CoreError::param("rel_threshold", "must lie in [0, 1]"));
+    }
+    if p.interest.nms_half == 0 {
+        return Err(CoreError::param("nms_half", "must be >= 1"));
+    }
+    for (name, v) in [("s_min", p.s_min), ("s_init", p.s_init)] {
+        if !v.is_finite() || !(-1.0..=1.0).contains(&v) {
+            return Err(CoreError::param(
+                name,
+                format!("must lie in [-1, 1], got {v}"),
+            ));
+        }
+    }
+    if p.k_cand == 0 {
+        return Err(CoreError::param("k_cand", "must be >= 1"));
+    }
+    if p.max_sweeps == 0 {
+        return Err(CoreError::param("max_sweeps", "must be >= 1"));
+    }
+    let w = &p.weights;
+    for (name, v) in [
+        ("A", w.a),
+        ("B", w.b),
+        ("D", w.d),
+        ("theta", w.theta),
+        ("compat_theta", w.compat_theta),
+        ("compat_slope", w.compat_slope),
+        ("tau_y", p.tau_y),
+        ("centre_tol", p.centre_tol),
+    ] {
+        if !v.is_finite() {
+            return Err(CoreError::param(name, format!("must be finite, got {v}")));
+        }
+    }
+    if w.nbr_half < 1 {
+        return Err(CoreError::param("nbr_half", "must be >= 1"));
+    }
+    Ok(())
+}
+
+/// Rows of the right image holding right interest points (points mode).
+fn right_rows(right: &Image, p: &HopfieldParams) -> HashMap<usize, Vec<usize>> {
+    let mut rows: HashMap<usize, Vec<usize>> = HashMap::new();
+    if p.candidates == CandidateMode::Points {
+        for rp in interest_points(right, &p.interest) {
+            rows.entry(rp.y as usize).or_default().push(rp.x as usize);
+        }
+    }
+    rows
+}
+
+/// First index of the maximum of `c[lo..=hi]` (None when the curve is all zeros: undefined).
+fn argmax(c: &[f32], lo: usize, hi: usize) -> Option<usize> {
+    let mut best: Option<(f32, usize)> = None;
+    for (d, &v) in c.iter().enumerate().take(hi + 1).skip(lo) {
+        if best.is_none_or(|b| v > b.0) {
+            best = Some((v, d));
+        }
+    }
+    best.filter(|b| b.0 > 0.0).map(|b| b.1)
+}
+
+/// Parabola vertex offset through `(d-1, a), (d, b), (d+1, c)`, clamped to +-0.5.
+fn parabola(a: f32, b: f32, c: f32) -> f32 {
+    let den = a - 2.0 * b + c;
+    if den >= 0.0 {
+        return 0.0;
+    }
+    (0.5 * (a - c) / den).clamp(-0.5, 0.5)
+}
+
+/// Candidate neurons of every left point, grouped by point (point order, then best ZNCC first),
+/// with their depth-edge verdict and sub-pixel offset.
+fn candidates(
+    left: &Image,
+    right: &Image,
+    pts: &[InterestPoint],
+    p: &HopfieldParams,
+) -> Vec<Neuron> {
+    let stats = RightStats::new(right);
+    let (w, h) = right.size();
+    let rows = right_rows(right, p);
+    let per_point: Vec<Vec<Neuron>> = pts
+        .par_iter()
+        .enumerate()
+        .map_init(Curves::default, |cv, (i, pt)| {
+            let (x, y) = (pt.x as usize, pt.y as usize);
+            let d_hi = p.d_max.min(x.saturating_sub(SIM_RADIUS));
+            if x < SIM_RADIUS || x + SIM_RADIUS >= w || d_hi < p.d_min {
+                return Vec::new();
+            }
+            let mut out: Vec<Neuron> = Vec::new();
+            let row_list: Vec<usize> = match p.candidates {
+                CandidateMode::Row => vec![y],
+                CandidateMode::Points => {
+                    let lo = y.saturating_sub(p.dy_window).max(SIM_RADIUS);
+                    let hi = (y + p.dy_window).min(h.saturating_sub(SIM_RADIUS + 1));
+                    (lo..=hi).filter(|yr| rows.contains_key(yr)).collect()
+                }
+            };
+            for yr in row_list {
+                zncc_curves(left, right, &stats, x, y, yr, d_hi, cv);
+                let full = &cv.curve[FULL];
+                let halves: Vec<Option<usize>> = (1..N_REGIONS)
+                    .map(|k| argmax(&cv.curve[k], p.d_min, d_hi))
+                    .collect();
+                let mut ds: Vec<usize> = Vec::new();
+                match p.candidates {
+                    CandidateMode::Row => {
+                        for d in p.d_min..=d_hi {
+                            let c = full[d];
+                            let ok_lo = d == p.d_min || c >= full[d - 1];
+                            let ok_hi = d == d_hi || c > full[d + 1];
+                            if c >= p.s_min && ok_lo && ok_hi {
+                                ds.push(d);
+                            }
+                        }
+                    }
+                    CandidateMode::Points => {
+                        for &xr in rows.get(&yr).map(|v| v.as_slice()).unwrap_or(&[]) {
+                            if xr <= x
+                                && (p.d_min..=d_hi).contains(&(x - xr))
+                                && full[x - xr] >= p.s_min
+                            {
+                                ds.push(x - xr);
+                            }
+                        }
+                    }
+                }
+                for d in ds {
+                    let xr = x - d;
+                    let halves_ok = halves
+                        .iter()
+                        .all(|hd| hd.is_some_and(|hd| hd.abs_diff(d) <= p.edge_tol));
+                    let centre_ok = (left.at(x, y) - right.at(xr, yr)).abs() <= p.centre_tol;
+                    let sub = if p.subpixel && d >= 1 && d < d_hi {
+                        parabola(full[d - 1], full[d], full[d + 1])
+                    } else {
+                        0.0
+                    };
+                    out.push(Neuron {
+                        point: i as u32,
+                        xl: x as i32,
+                        yl: y as i32,
+                        xr: xr as i32,
+                        yr: yr as i32,
+                        sim: full[d],
+                        edge_ok: halves_ok && centre_ok,
+                        sub,
+                    });
+                }
+            }
+            out.sort_by(|a, b| {
+                b.sim
+                    .total_cmp(&a.sim)
+                    .then(a.xr.cmp(&b.xr))
+                    .then(a.yr.cmp(&b.yr))
+            });
+            out.truncate(p.k_cand);
+            out
+        })
+        .collect();
+    per_point.into_iter().flatten().collect()
+}
+
+fn median(v: &mut [f32]) -> f32 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f32::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// C.5 disambiguation: indices of the kept active neurons (at most one per left point and one
+/// per right pixel).
+fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usize> {
+    let active: Vec<usize> = (0..neurons.len()).filter(|&a| state[a] == 1).collect();
+    let mut by_point: HashMap<u32, Vec<usize>> = HashMap::new();
+    for &a in &active {
+        by_point.entry(neurons[a].point).or_default().push(a);
+    }
+    let singles: Vec<usize> = active
+        .iter()
+        .copied()
+        .filter(|a| {
+            by_point
+                .get(&neurons[*a].point)
+                .is_some_and(|l| l.len() == 1)
+        })
+        .collect();
+    let mut all_dy: Vec<f32> = singles.iter().map(|&a| neurons[a].dy() as f32).collect();
+    let global = median(&mut all_dy);
+    let half = p.weights.nbr_half;
+    let local_ref = |a: usize| -> f32 {
+        let n = &neurons[a];
+        let mut v: Vec<f32> = singles
+            .iter()
+            .filter(|&&s| {
+                (neurons[s].xl - n.xl).abs() <= half && (neurons[s].yl - n.yl).abs() <= half
+            })
+            .map(|&s| neurons[s].dy() as f32)
+            .collect();
+        if v.is_empty() {
+            global
+        } else {
+            median(&mut v)
+        }
+    };
+    let pick = |group: &[usize]| -> Option<usize> {
+        let mut best: Option<(f32, f32, usize)> = None;
+        for &a in group {
+            let dev = (neurons[a].dy() as f32 - local_ref(a)).abs();
+            let key = (dev, -neurons[a].sim, a);
+            if best.is_none_or(|b| (key.0, key.1, key.2) < (b.0, b.1, b.2)) {
+                best = Some(key);
+            }
+        }
+        best.filter(|b| b.0 <= p.tau_y).map(|b| b.2)
+    };
+    let mut kept: Vec<usize> = Vec::new();
+    let mut points: Vec<&u32> = by_point.keys().collect();
+    points.sort_unstable();
+    for pt in points {
+        let group = &by_point[pt];
+        if group.len() == 1 {
+            kept.push(group[0]);
+        } else if let Some(a) = pick(group) {
+            kept.push(a);
+        }
+    }
+    // The same rule on the right side.
+    let mut by_right: HashMap<(i32, i32), Vec<usize>> = HashMap::new();
+    for &a in &kept {
+        by_right
+            .entry((neurons[a].xr, neurons[a].yr))
+            .or_default()
+            .push(a);
+    }
+    let mut out: Vec<usize> = kept
+        .iter()
+        .copied()
+        .filter(|&a| {
+            let group = &by_right[&(neurons[a].xr, neurons[a].yr)];
+            group.len() == 1 || pick(group) == Some(a)
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
+
+/// Depth-edge filters and sub-pixel refinement of the selected neurons.
+fn finish(
+    left: &Image,
+    right: &Image,
+    neurons: &[Neuron],
+    chosen: &[usize],
+    p: &HopfieldParams,
+) -> Vec<Match> {
+    let _ = (left, right);
+    // Stage 1: the per-candidate depth-edge verdict (computed with the ZNCC curves).
+    let stage1: Vec<Option<(usize, f32)>> = chosen
+        .iter()
+        .map(|&a| {
+            let n = &neurons[a];
+            (!p.edge_test || n.edge_ok).then_some((a, n.dx() as f32 + n.sub))
+        })
+        .collect();
+    let survivors: Vec<(usize, f32)> = stage1.into_iter().flatten().collect();
+    // Stage 2: neighbour agreement among the survivors (uniform grid, cell = window half-size).
+    let half = p.weights.nbr_half;
+    let mut grid: HashMap<(i32, i32), Vec<usize>> = HashMap::new();
+    for (s, &(a, _)) in survivors.iter().enumerate() {
+        let n = &neurons[a];
+        grid.entry((n.xl.div_euclid(half), n.yl.div_euclid(half)))
+            .or_default()
+            .push(s);
+    }
+    survivors
+        .par_iter()
+        .enumerate()
+        .filter(|&(s, &(a, _))| {
+            if !p.edge_test {
+                return true;
+            }
+            let n = &neurons[a];
+            let (cx, cy) = (n.xl.div_euclid(half), n.yl.div_euclid(half));
+            let mut agree = 0usize;
+            for gy in cy - 1..=cy + 1 {
+                for gx in cx - 1..=cx + 1 {
+                    let Some(list) = grid.get(&(gx, gy)) else {
+                        continue;
+                    };
+                    for &t in list {
+                        let m = &neurons[survivors[t].0];
+                        if t != s
+                            && (m.xl - n.xl).abs() <= half
+                            && (m.yl - n.yl).abs() <= half
+                            && (m.dx() - n.dx()).abs() <= p.agree_tol
+                        {
+                            agree += 1;
+                        }
+                    }
+                }
+            }
+            agree >= p.min_agree
+        })
+        .map(|(_, &(a, dsub))| {
+            let n = &neurons[a];
+            Match {
+                xl: n.xl as f32,
+                yl: n.yl as f32,
+                xr: n.xl as f32 - dsub,
+                yr: n.yr as f32,
+                score: n.sim,
+            }
+        })
+        .collect()
+}
+
+/// Interest points and candidate neurons (exposed for tests and the reference comparison).
+pub fn candidate_neurons(
+    left: &Image,
+    right: &Image,
+    p: &HopfieldParams,
+) -> Result<(Vec<InterestPoint>, Vec<Neuron>)> {
+    validate(left, right, p)?;
+    let pts = interest_points(left, &p.interest);
+    let neurons = candidates(left, right, &pts, p);
+    Ok((pts, neurons))
+}
+
+/// The Hopfield channel: interest points matched by energy minimisation (see the module docs).
+pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result<HopfieldOutput> {
+    let t0 = std::time::Instant::now();
+    let (pts, neurons) = candidate_neurons(left, right, p)?;
+    let t1 = std::time::Instant::now();
+    let csr = build_weights(&neurons, &p.weights);
+    let t2 = std::time::Instant::now();
+    let input: Vec<f64> = neurons
+        .iter()
+        .map(|n| (p.weights.d * n.sim - p.weights.theta) as f64)
+        .collect();
+    let init: Vec<u8> = neurons
+        .iter()
+        .map(|n| u8::from(n.sim >= p.s_init))
+        .collect();
+    let dynamics = run_dynamics(&csr, &input, &init, p.seed, p.max_sweeps);
+    let t3 = std::time::Instant::now();
+    let chosen = disambiguate(&neurons, &dynamics.state, p);
+    let t4 = std::time::Instant::now();
+    let matches = finish(left, right, &neurons, &chosen, p);
+    let t5 = std::time::Instant::now();
+    if std::env::var("HOP_TIMING").is_ok() {
+        eprintln!(
+            "cand {:?} weights {:?} dyn {:?} dis {:?} finish {:?}",
+            t1 - t0,
+            t2 - t1,
+            t3 - t2,
+            t4 - t3,
+            t5 - t4
+        );
+    }
+    Ok(HopfieldOutput {
+        matches,
+        energy_trace: dynamics.energy_trace,
+        n_points: pts.len(),
+        n_neurons: neurons.len(),
+        n_weights: csr.nnz(),
+        sweeps: dynamics.sweeps,
+        converged: dynamics.converged,
+        n_selected: chosen.len(),
+    })
+}
+
+/// The best-match reference: same points, candidates and filters, no network (the best ZNCC
+/// candidate of every point).
+pub fn best_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result<HopfieldOutput> {
+    let (pts, neurons) = candidate_neurons(left, right, p)?;
+    let mut chosen = Vec::new();
+    for (a, n) in neurons.iter().enumerate() {
+        if a == 0 || neurons[a - 1].point != n.point {
+            chosen.push(a); // candidates are sorted best first within a point
+        }
+    }
+    let matches = finish(left, right, &neurons, &chosen, p);
+    Ok(HopfieldOutput {
+        matches,
+        energy_trace: Vec::new(),
+        n_points: pts.len(),
+        n_neurons: neurons.len(),
+        n_weights: 0,
+        sweeps: 0,
+        converged: true,
+        n_selected: chosen.len(),
+    })
+}
