@@ -64,7 +64,9 @@ class Matches:
         names = ("xl", "yl", "xr", "yr", "score")
         arrs = [_f32_1d(getattr(self, n), n) for n in names]
         if len({a.shape for a in arrs}) != 1:
-            raise ValueError(f"xl, yl, xr, yr, score must have one length, got {[len(a) for a in arrs]}")
+            raise ValueError(
+                f"xl, yl, xr, yr, score must have one length, got {[len(a) for a in arrs]}"
+            )
         for n, a in zip(names, arrs, strict=True):
             object.__setattr__(self, n, a)
         h, w = (int(v) for v in self.image_shape)
@@ -89,12 +91,12 @@ class Matches:
 
     @property
     def dispx(self) -> F32:
-        """``(H, W)`` float32 map of ``x_left - x_right`` at the matched left pixels, NaN elsewhere."""
+        """``(H, W)`` float32 ``x_left - x_right`` at the matched left pixels, NaN elsewhere."""
         return self._raster(self.xl - self.xr)
 
     @property
     def dispy(self) -> F32:
-        """``(H, W)`` float32 map of ``y_left - y_right`` at the matched left pixels, NaN elsewhere."""
+        """``(H, W)`` float32 ``y_left - y_right`` at the matched left pixels, NaN elsewhere."""
         return self._raster(self.yl - self.yr)
 
     def to_array(self) -> F32:

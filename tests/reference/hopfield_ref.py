@@ -141,9 +141,7 @@ def _parabola(a: float, b: float, c: float) -> float:
     return float(np.clip(0.5 * (a - c) / den, -0.5, 0.5))
 
 
-def candidates(
-    left: np.ndarray, right: np.ndarray, d_min: int, d_max: int, p: dict
-) -> list[dict]:
+def candidates(left: np.ndarray, right: np.ndarray, d_min: int, d_max: int, p: dict) -> list[dict]:
     """Row-mode candidate neurons, grouped by point, best ZNCC first."""
     xy, _ = interest_points(left, p["rel_threshold"], p["nms_half"])
     w = left.shape[1]
@@ -162,15 +160,27 @@ def candidates(
             ok_hi = d == d_hi or c > full[d + 1]
             if c >= p["s_min"] and ok_lo and ok_hi:
                 halves_ok = all(hd is not None and abs(hd - d) <= p["edge_tol"] for hd in halves)
-                centre_ok = abs(float(left[y, x]) - float(right[y, x - d])) <= p["centre_tol"]
+                lw = left[y - 3 : y + 4, x - 3 : x + 4].astype(np.float64)
+                rw = right[y - 3 : y + 4, x - d - 3 : x - d + 4].astype(np.float64)
+                lc = float(left[y, x]) - lw.mean()
+                rc = float(right[y, x - d]) - rw.mean()
+                centre_ok = abs(lc - rc) <= p["centre_tol"]
                 sub = (
                     _parabola(full[d - 1], full[d], full[d + 1])
                     if p["subpixel"] and 1 <= d < d_hi
                     else 0.0
                 )
                 cands.append(
-                    {"point": i, "xl": x, "yl": y, "xr": x - d, "yr": y, "sim": float(c),
-                     "edge_ok": halves_ok and centre_ok, "sub": sub}
+                    {
+                        "point": i,
+                        "xl": x,
+                        "yl": y,
+                        "xr": x - d,
+                        "yr": y,
+                        "sim": float(c),
+                        "edge_ok": halves_ok and centre_ok,
+                        "sub": sub,
+                    }
                 )
         cands.sort(key=lambda n: (-n["sim"], n["xr"]))
         out.extend(cands[: p["k_cand"]])
@@ -192,7 +202,8 @@ def build_weights(neurons: list[dict], p: dict) -> list[list[tuple[int, float]]]
         members.setdefault(n["point"], []).append(a)
     nbrs = {
         q: [
-            r for r in points
+            r
+            for r in points
             if r != q and abs(pxy[r][0] - pxy[q][0]) <= half and abs(pxy[r][1] - pxy[q][1]) <= half
         ]
         for q in points
@@ -215,7 +226,9 @@ def build_weights(neurons: list[dict], p: dict) -> list[list[tuple[int, float]]]
                     continue
                 ex = (na["xl"] - na["xr"]) - (nb["xl"] - nb["xr"])
                 ey = (na["yl"] - na["yr"]) - (nb["yl"] - nb["yr"])
-                c = np.float32(_compat(np.sqrt(ex * ex + ey * ey), p["compat_theta"], p["compat_slope"]))
+                c = np.float32(
+                    _compat(np.sqrt(ex * ex + ey * ey), p["compat_theta"], p["compat_slope"])
+                )
                 row.append((b, float(np.float32(norm) * c)))
         rows.append(row)
     return rows
@@ -235,7 +248,10 @@ def splitmix_shuffle(order: list[int], state: int) -> int:
 
 
 def run_dynamics(
-    rows: list[list[tuple[int, float]]], inp: np.ndarray, init: np.ndarray, seed: int,
+    rows: list[list[tuple[int, float]]],
+    inp: np.ndarray,
+    init: np.ndarray,
+    seed: int,
     max_sweeps: int,
 ) -> tuple[np.ndarray, list[float]]:
     """Asynchronous threshold dynamics; returns the final state and the energy trace."""
@@ -281,7 +297,8 @@ def _finish(neurons: list[dict], chosen: list[int], p: dict) -> np.ndarray:
         n = neurons[a]
         d = n["xl"] - n["xr"]
         agree = sum(
-            1 for b in surv
+            1
+            for b in surv
             if b != a
             and abs(neurons[b]["xl"] - n["xl"]) <= half
             and abs(neurons[b]["yl"] - n["yl"]) <= half

@@ -277,7 +277,12 @@ fn candidates(
                     let halves_ok = halves
                         .iter()
                         .all(|hd| hd.is_some_and(|hd| hd.abs_diff(d) <= p.edge_tol));
-                    let centre_ok = (left.at(x, y) - right.at(xr, yr)).abs() <= p.centre_tol;
+                    // Centre check on window-mean-free grey levels: insensitive to the exposure
+                    // offset between the cameras (ETH3D, KITTI), still catches a centre pixel
+                    // that belongs to the other surface.
+                    let lc = left.at(x, y) - cv.left_mean;
+                    let rc = right.at(xr, yr) - stats.mean(xr, yr);
+                    let centre_ok = (lc - rc).abs() <= p.centre_tol;
                     let sub = if p.subpixel && d >= 1 && d < d_hi {
                         parabola(full[d - 1], full[d], full[d + 1])
                     } else {

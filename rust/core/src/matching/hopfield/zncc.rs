@@ -59,6 +59,11 @@ pub struct RightStats {
 }
 
 impl RightStats {
+    /// Mean of the right 7x7 window centred at `(x, y)` (0 where it does not fit).
+    pub fn mean(&self, x: usize, y: usize) -> f32 {
+        self.sum[FULL][y * self.width + x] / region_n(FULL) as f32
+    }
+
     pub fn new(img: &Image) -> Self {
         let (w, h) = img.size();
         let w1 = w + 1;
@@ -128,6 +133,8 @@ pub struct Curves {
     part: Vec<f32>,
     /// `curve[k][d]`: ZNCC of region `k` at disparity `d = 0..=d_hi` (0 = undefined).
     pub curve: [Vec<f32>; N_REGIONS],
+    /// Mean of the left 7x7 window.
+    pub left_mean: f32,
 }
 
 /// ZNCC curves of the five regions around left `(x, y)` against right `(x - d, yr)`,
@@ -179,6 +186,7 @@ pub fn zncc_curves(
         };
     }
     let c = mu[FULL];
+    out.left_mean = c as f32;
     // Partial sums part[(row * 3 + group) * len + j], j = x_r - (x - d_hi).
     out.part.clear();
     out.part.resize(SIDE * 3 * len, 0.0);
