@@ -1,7 +1,7 @@
 """NumPy reference of the Hopfield channel (rust/core/src/matching/hopfield), written for clarity.
 
 * :func:`moravec` / :func:`interest_points` -- bit-exact oracle of the interest operator (same
-  float64 summation order as the Rust kernel: horizontal 5-sums left to right, then vertical);
+  float32 summation order as the Rust kernel: horizontal 5-sums left to right, then vertical);
 * :func:`zncc_curve` -- direct float64 ZNCC of a region along a row;
 * :func:`candidates` -- ZNCC peaks, depth-edge verdicts, parabola offsets (row mode);
 * :func:`build_weights`, :func:`run_dynamics` -- the network, with the same SplitMix64 order;
@@ -61,7 +61,7 @@ def _box5(s: np.ndarray) -> np.ndarray:
 
 def moravec(img: np.ndarray) -> np.ndarray:
     """Moravec interest map ``min(S_h, S_v, S_d, S_a)`` (float32), 0 within 3 px of the border."""
-    a = img.astype(np.float64)
+    a = img.astype(np.float32)
     h, w = a.shape
     out = np.zeros((h, w), dtype=np.float32)
     if w < 2 * BORDER + 1 or h < 2 * BORDER + 1:

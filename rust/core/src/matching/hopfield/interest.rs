@@ -1,9 +1,11 @@
 //! Moravec interest operator with the squares put back (algorithms.md C.1, densities of C.10).
 //!
 //! `M(x, y) = min(S_h, S_v, S_d, S_a)` where each `S` is the 5x5 window sum of squared differences
-//! of adjacent pixels in one direction. Sums are taken in `f64` in a fixed order (horizontal pass
-//! left to right, then vertical pass top to bottom) so the NumPy reference reproduces every value
-//! bit for bit; `M` is returned as `f32`.
+//! of adjacent pixels in one direction. Everything is `f32` in a fixed order (squared difference,
+//! horizontal 5-sum left to right, then vertical 5-sum top to bottom: no running sums), so the
+//! NumPy reference reproduces every value bit for bit.
+
+use rayon::prelude::*;
 
 use crate::image::Image;
 
@@ -41,49 +43,52 @@ pub struct InterestPoint {
     pub value: f32,
 }
 
-/// Squared difference image for the step `(sx, sy)` (with `sy` in -1..=1), `f64`, same size as
-/// the image; entries whose partner pixel falls outside are 0 (never read inside the valid area).
-fn sq_diff(img: &Image, sx: usize, sy: isize) -> Vec<f64> {
+/// Sum of the 5x5 window of squared differences for the step `(sx, sy)` (`sy` in -1..=1), at
+/// every pixel at least [`BORDER`] from the edge (0 elsewhere). Per row: squared differences,
+/// horizontal 5-sums (left to right), then vertical 5-sums (top to bottom), all `f32`.
+fn direction_sum(img: &Image, sx: usize, sy: isize) -> Vec<f32> {
     let (w, h) = img.size();
-    let mut out = vec![0.0f64; w * h];
-    for y in 0..h {
+    let r = MORAVEC_HALF;
+    let n = w - 2 * r; // horizontal sums exist for x in r..w-r
+                       // hs[y * w + x]: horizontal 5-sum of the squared differences of row y (rows whose partner
+                       // row exists; x in r..w-r-sx so the partner column exists for every term).
+    let mut hs = vec![0.0f32; w * h];
+    hs.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
         let yy = y as isize + sy;
         if yy < 0 || yy >= h as isize {
-            continue;
+            return;
         }
-        let yy = yy as usize;
-        for x in 0..w.saturating_sub(sx) {
-            let d = img.at(x, y) as f64 - img.at(x + sx, yy) as f64;
-            out[y * w + x] = d * d;
-        }
-    }
-    out
-}
-
-/// 5x5 window sum at every valid pixel (horizontal pass then vertical, both in increasing order).
-fn box5(sq: &[f64], w: usize, h: usize) -> Vec<f64> {
-    let r = MORAVEC_HALF;
-    let mut hs = vec![0.0f64; w * h];
-    for y in 0..h {
-        for x in r..w.saturating_sub(r) {
-            let row = &sq[y * w..(y + 1) * w];
-            let mut acc = row[x - r];
-            for &v in &row[x - r + 1..=x + r] {
-                acc += v;
+        let a = &img.data[y * w..(y + 1) * w];
+        let b = &img.data[yy as usize * w..(yy as usize + 1) * w];
+        let sq: Vec<f32> = (0..w - sx)
+            .map(|x| {
+                let d = a[x] - b[x + sx];
+                d * d
+            })
+            .collect();
+        let m = n.saturating_sub(sx).min(sq.len().saturating_sub(2 * r));
+        let dst = &mut out[r..r + m];
+        dst.copy_from_slice(&sq[0..m]);
+        for k in 1..=2 * r {
+            for (o, &v) in dst.iter_mut().zip(&sq[k..k + m]) {
+                *o += v;
             }
-            hs[y * w + x] = acc;
         }
-    }
-    let mut out = vec![0.0f64; w * h];
-    for y in r..h.saturating_sub(r) {
-        for x in 0..w {
-            let mut acc = hs[(y - r) * w + x];
-            for v in (y - r + 1)..=(y + r) {
-                acc += hs[v * w + x];
+    });
+    let mut out = vec![0.0f32; w * h];
+    out.par_chunks_mut(w)
+        .enumerate()
+        .skip(BORDER)
+        .take(h - 2 * BORDER)
+        .for_each(|(y, row)| {
+            row.copy_from_slice(&hs[(y - r) * w..(y - r + 1) * w]);
+            for k in 1..=2 * r {
+                let src = &hs[(y - r + k) * w..(y - r + k + 1) * w];
+                for (o, &v) in row.iter_mut().zip(src) {
+                    *o += v;
+                }
             }
-            out[y * w + x] = acc;
-        }
-    }
+        });
     out
 }
 
@@ -96,17 +101,20 @@ pub fn moravec(img: &Image) -> Vec<f32> {
     }
     // Horizontal, vertical, 45 degrees (down-right) and 135 degrees (up-right).
     let dirs: [(usize, isize); 4] = [(1, 0), (0, 1), (1, 1), (1, -1)];
-    let sums: Vec<Vec<f64>> = dirs
+    let sums: Vec<Vec<f32>> = dirs
         .iter()
-        .map(|&(sx, sy)| box5(&sq_diff(img, sx, sy), w, h))
+        .map(|&(sx, sy)| direction_sum(img, sx, sy))
         .collect();
-    for y in BORDER..h - BORDER {
-        for x in BORDER..w - BORDER {
-            let i = y * w + x;
-            let m = sums[0][i].min(sums[1][i]).min(sums[2][i]).min(sums[3][i]);
-            out[i] = m as f32;
-        }
-    }
+    out.par_chunks_mut(w)
+        .enumerate()
+        .skip(BORDER)
+        .take(h - 2 * BORDER)
+        .for_each(|(y, row)| {
+            for x in BORDER..w - BORDER {
+                let i = y * w + x;
+                row[x] = sums[0][i].min(sums[1][i]).min(sums[2][i]).min(sums[3][i]);
+            }
+        });
     out
 }
 

@@ -7,7 +7,6 @@
 //! random order, net inputs maintained incrementally, until a sweep without a flip.
 
 use rayon::prelude::*;
-use std::collections::HashMap;
 
 /// One neuron: left point index, right position and disparity vector `(x_l - x_r, y_l - y_r)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -95,7 +94,64 @@ impl Csr {
     }
 }
 
-/// Builds the CSR weights. `neurons` must be grouped by `point` in increasing order.
+/// Uniform grid over the left points (cell = the compatibility half-window), counting-sorted.
+struct PointGrid {
+    cell: i32,
+    gw: i32,
+    gh: i32,
+    start: Vec<usize>,
+    items: Vec<u32>,
+}
+
+impl PointGrid {
+    fn new(pxy: &[(i32, i32)], cell: i32) -> Self {
+        let gw = pxy.iter().map(|p| p.0 / cell).max().unwrap_or(0) + 1;
+        let gh = pxy.iter().map(|p| p.1 / cell).max().unwrap_or(0) + 1;
+        let idx = |p: &(i32, i32)| ((p.1 / cell) * gw + p.0 / cell) as usize;
+        let mut start = vec![0usize; (gw * gh) as usize + 1];
+        for p in pxy {
+            start[idx(p) + 1] += 1;
+        }
+        for i in 1..start.len() {
+            start[i] += start[i - 1];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u32; pxy.len()];
+        for (k, p) in pxy.iter().enumerate() {
+            let c = idx(p);
+            items[fill[c]] = k as u32;
+            fill[c] += 1;
+        }
+        PointGrid {
+            cell,
+            gw,
+            gh,
+            start,
+            items,
+        }
+    }
+
+    /// Calls `f(q)` for every point `q != p` with `|dx| <= half` and `|dy| <= half`.
+    fn for_each_near(&self, pxy: &[(i32, i32)], p: usize, half: i32, mut f: impl FnMut(usize)) {
+        let (x, y) = pxy[p];
+        let (cx, cy) = (x / self.cell, y / self.cell);
+        for gy in (cy - 1).max(0)..=(cy + 1).min(self.gh - 1) {
+            for gx in (cx - 1).max(0)..=(cx + 1).min(self.gw - 1) {
+                let c = (gy * self.gw + gx) as usize;
+                for &q in &self.items[self.start[c]..self.start[c + 1]] {
+                    let q = q as usize;
+                    let (qx, qy) = pxy[q];
+                    if q != p && (qx - x).abs() <= half && (qy - y).abs() <= half {
+                        f(q);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Builds the CSR weights. `neurons` must be grouped by `point` in increasing order and have
+/// non-negative coordinates.
 pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
     let m = neurons.len();
     if m == 0 {
@@ -113,56 +169,43 @@ pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
     }
     let n_pts = starts.len();
     starts.push(m);
-    // Compact point index of every neuron (neurons[a].point indexes all interest points).
-    let mut compact = vec![0usize; m];
-    for p in 0..n_pts {
-        compact[starts[p]..starts[p + 1]].fill(p);
-    }
     let pxy: Vec<(i32, i32)> = (0..n_pts)
-        .map(|p| (neurons[starts[p]].xl, neurons[starts[p]].yl))
+        .map(|p| (neurons[starts[p]].xl.max(0), neurons[starts[p]].yl.max(0)))
         .collect();
-    // Uniform grid of cell = nbr_half px over the left points.
-    let cell = w.nbr_half.max(1);
-    let mut grid: HashMap<(i32, i32), Vec<u32>> = HashMap::new();
-    for (p, &(x, y)) in pxy.iter().enumerate() {
-        grid.entry((x.div_euclid(cell), y.div_euclid(cell)))
-            .or_default()
-            .push(p as u32);
-    }
-    let within = |p: usize, q: usize| {
-        (pxy[p].0 - pxy[q].0).abs() <= w.nbr_half && (pxy[p].1 - pxy[q].1).abs() <= w.nbr_half
-    };
-    let neighbours = |p: usize| -> Vec<u32> {
-        let (cx, cy) = (pxy[p].0.div_euclid(cell), pxy[p].1.div_euclid(cell));
-        let mut out = Vec::new();
-        for gy in cy - 1..=cy + 1 {
-            for gx in cx - 1..=cx + 1 {
-                if let Some(list) = grid.get(&(gx, gy)) {
-                    out.extend(
-                        list.iter()
-                            .copied()
-                            .filter(|&q| q as usize != p && within(p, q as usize)),
-                    );
-                }
+    let half = w.nbr_half.max(1);
+    let grid = PointGrid::new(&pxy, half);
+    // n_i: left points (with candidates) in i's window.
+    let n_count: Vec<f32> = (0..n_pts)
+        .into_par_iter()
+        .map(|p| {
+            let mut n = 0usize;
+            grid.for_each_near(&pxy, p, half, |_| n += 1);
+            n as f32
+        })
+        .collect();
+    // Neurons sharing a right pixel (column inhibition), wherever their left points are:
+    // neuron indices sorted by right pixel, and each neuron's group range in that order.
+    let mut by_right: Vec<u32> = (0..m as u32).collect();
+    let key = |a: u32| (neurons[a as usize].yr, neurons[a as usize].xr);
+    by_right.sort_unstable_by_key(|&a| (key(a), a));
+    let mut group = vec![(0usize, 0usize); m];
+    let mut g0 = 0;
+    for k in 1..=m {
+        if k == m || key(by_right[k]) != key(by_right[g0]) {
+            for &a in &by_right[g0..k] {
+                group[a as usize] = (g0, k);
             }
+            g0 = k;
         }
-        out.sort_unstable();
-        out
-    };
-    let nbrs: Vec<Vec<u32>> = (0..n_pts).into_par_iter().map(neighbours).collect();
-    let n_count: Vec<f32> = nbrs.iter().map(|v| v.len() as f32).collect();
-    // Neurons sharing a right pixel (column inhibition), wherever their left points are.
-    let mut by_right: HashMap<(i32, i32), Vec<u32>> = HashMap::new();
-    for (a, nr) in neurons.iter().enumerate() {
-        by_right.entry((nr.xr, nr.yr)).or_default().push(a as u32);
     }
     // Compatibility lookup over the integer squared disparity-vector difference.
-    let max_dx = neurons.iter().map(|n| n.dx()).max().unwrap_or(0)
-        - neurons.iter().map(|n| n.dx()).min().unwrap_or(0);
-    let max_dy = neurons.iter().map(|n| n.dy()).max().unwrap_or(0)
-        - neurons.iter().map(|n| n.dy()).min().unwrap_or(0);
-    let q_max = (max_dx as usize).pow(2) + (max_dy as usize).pow(2);
-    let lut: Vec<f32> = (0..=q_max)
+    let span = |f: fn(&Neuron) -> i32| {
+        let lo = neurons.iter().map(f).min().unwrap_or(0);
+        let hi = neurons.iter().map(f).max().unwrap_or(0);
+        (hi - lo) as usize
+    };
+    let (max_dx, max_dy) = (span(Neuron::dx), span(Neuron::dy));
+    let lut: Vec<f32> = (0..=max_dx * max_dx + max_dy * max_dy)
         .map(|q| {
             compat(
                 (q as f64).sqrt(),
@@ -171,54 +214,64 @@ pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
             ) as f32
         })
         .collect();
-    let rows: Vec<Vec<(u32, f32)>> = (0..m)
+    // Rows of every neuron of a point, built together (one allocation per point).
+    let blocks: Vec<(Vec<usize>, Vec<u32>, Vec<f32>)> = (0..n_pts)
         .into_par_iter()
-        .map(|a| {
-            let na = &neurons[a];
-            let p = compact[a];
-            let mut row: Vec<(u32, f32)> = Vec::new();
-            // Same left point: uniqueness (row) inhibition.
-            for b in starts[p]..starts[p + 1] {
-                if b != a {
-                    row.push((b as u32, -w.b));
+        .map(|p| {
+            let mut near: Vec<usize> = Vec::new();
+            grid.for_each_near(&pxy, p, half, |q| near.push(q));
+            let mut lens = Vec::new();
+            let mut idx = Vec::new();
+            let mut val = Vec::new();
+            for a in starts[p]..starts[p + 1] {
+                let before = idx.len();
+                let na = &neurons[a];
+                // Same left point: uniqueness (row) inhibition.
+                for b in starts[p]..starts[p + 1] {
+                    if b != a {
+                        idx.push(b as u32);
+                        val.push(-w.b);
+                    }
                 }
-            }
-            // Same right pixel, other left point: uniqueness (column) inhibition.
-            if let Some(list) = by_right.get(&(na.xr, na.yr)) {
-                for &b in list {
+                // Same right pixel, other left point: uniqueness (column) inhibition.
+                let (gs, ge) = group[a];
+                for &b in &by_right[gs..ge] {
                     if neurons[b as usize].point != na.point {
-                        row.push((b, -w.b));
+                        idx.push(b);
+                        val.push(-w.b);
                     }
                 }
-            }
-            // Compatibility with the candidates of the other points in the 40x40 window.
-            for &q in &nbrs[p] {
-                let norm = w.a / n_count[p].max(n_count[q as usize]).max(1.0);
-                let (qs, qe) = (starts[q as usize], starts[q as usize + 1]);
-                for (b, nb) in neurons.iter().enumerate().take(qe).skip(qs) {
-                    if nb.xr == na.xr && nb.yr == na.yr {
-                        continue; // already inhibited above; compatibility needs l != k
+                // Compatibility with the candidates of the other points in the 40x40 window.
+                for &q in &near {
+                    let norm = w.a / n_count[p].max(n_count[q]).max(1.0);
+                    let (qs, qe) = (starts[q], starts[q + 1]);
+                    for (b, nb) in neurons.iter().enumerate().take(qe).skip(qs) {
+                        if nb.xr == na.xr && nb.yr == na.yr {
+                            continue; // inhibited above; compatibility needs l != k
+                        }
+                        let ex = (na.dx() - nb.dx()).unsigned_abs() as usize;
+                        let ey = (na.dy() - nb.dy()).unsigned_abs() as usize;
+                        idx.push(b as u32);
+                        val.push(norm * lut[ex * ex + ey * ey]);
                     }
-                    let ex = (na.dx() - nb.dx()).unsigned_abs() as usize;
-                    let ey = (na.dy() - nb.dy()).unsigned_abs() as usize;
-                    row.push((b as u32, norm * lut[ex * ex + ey * ey]));
                 }
+                lens.push(idx.len() - before);
             }
-            row.sort_unstable_by_key(|e| e.0);
-            row
+            (lens, idx, val)
         })
         .collect();
+    let nnz: usize = blocks.iter().map(|b| b.1.len()).sum();
     let mut indptr = Vec::with_capacity(m + 1);
     indptr.push(0usize);
-    let nnz: usize = rows.iter().map(|r| r.len()).sum();
     let mut indices = Vec::with_capacity(nnz);
     let mut data = Vec::with_capacity(nnz);
-    for r in rows {
-        for (b, v) in r {
-            indices.push(b);
-            data.push(v);
+    for (lens, idx, val) in blocks {
+        for l in lens {
+            let last = *indptr.last().unwrap_or(&0);
+            indptr.push(last + l);
         }
-        indptr.push(indices.len());
+        indices.extend_from_slice(&idx);
+        data.extend_from_slice(&val);
     }
     Csr {
         indptr,
