@@ -110,9 +110,9 @@ pub fn moravec(img: &Image) -> Vec<f32> {
         .skip(BORDER)
         .take(h - 2 * BORDER)
         .for_each(|(y, row)| {
-            for x in BORDER..w - BORDER {
+            for (x, v) in row.iter_mut().enumerate().take(w - BORDER).skip(BORDER) {
                 let i = y * w + x;
-                row[x] = sums[0][i].min(sums[1][i]).min(sums[2][i]).min(sums[3][i]);
+                *v = sums[0][i].min(sums[1][i]).min(sums[2][i]).min(sums[3][i]);
             }
         });
     out
