@@ -36,6 +36,7 @@ DEFAULTS = {
     "seed": 0,
     "edge_test": True,
     "edge_tol": 1,
+    "edge_margin": 0.0,
     "centre_tol": 0.05,
     "min_agree": 8,
     "agree_tol": 1,
@@ -152,14 +153,18 @@ def candidates(left: np.ndarray, right: np.ndarray, d_min: int, d_max: int, p: d
             continue
         curves = [zncc_curve(left, right, k, x, y, y, d_hi) for k in range(5)]
         full = curves[0]
-        halves = [_argmax(c, d_min, d_hi) for c in curves[1:]]
+        best = [_argmax(c, d_min, d_hi) for c in curves[1:]]
         cands = []
         for d in range(d_min, d_hi + 1):
             c = full[d]
             ok_lo = d == d_min or c >= full[d - 1]
             ok_hi = d == d_hi or c > full[d + 1]
             if c >= p["s_min"] and ok_lo and ok_hi:
-                halves_ok = all(hd is not None and abs(hd - d) <= p["edge_tol"] for hd in halves)
+                lo, hi = max(d - p["edge_tol"], d_min), min(d + p["edge_tol"], d_hi)
+                halves_ok = all(
+                    b is not None and c[lo : hi + 1].max() >= c[b] - p["edge_margin"]
+                    for b, c in zip(best, curves[1:], strict=True)
+                )
                 lw = left[y - 3 : y + 4, x - 3 : x + 4].astype(np.float64)
                 rw = right[y - 3 : y + 4, x - d - 3 : x - d + 4].astype(np.float64)
                 lc = float(left[y, x]) - lw.mean()

@@ -70,6 +70,9 @@ pub struct HopfieldParams {
     pub edge_test: bool,
     /// Half-window disparities must agree with the match within this many px (C.10: 1).
     pub edge_tol: usize,
+    /// Half-window ZNCC at the match may fall this far below the half's best (0 = the match
+    /// must be each half's best disparity, C.10's literal test).
+    pub edge_margin: f32,
     /// Centre grey-level difference allowed between the matched pixels (C.10: 0.05).
     pub centre_tol: f32,
     /// Agreeing neighbour matches required in the 40x40 window (C.10: 8).
@@ -97,6 +100,7 @@ impl Default for HopfieldParams {
             tau_y: 1.0,
             edge_test: true,
             edge_tol: 1,
+            edge_margin: 0.0,
             centre_tol: 0.05,
             min_agree: 8,
             agree_tol: 1,
@@ -246,8 +250,9 @@ fn candidates(
             for yr in row_list {
                 zncc_curves(left, right, &stats, x, y, yr, d_hi, cv);
                 let full = &cv.curve[FULL];
-                let halves: Vec<Option<usize>> = (1..N_REGIONS)
-                    .map(|k| argmax(&cv.curve[k], p.d_min, d_hi))
+                // Best ZNCC of every half-window over the range (None: undefined / textureless).
+                let halves: Vec<Option<f32>> = (1..N_REGIONS)
+                    .map(|k| argmax(&cv.curve[k], p.d_min, d_hi).map(|a| cv.curve[k][a]))
                     .collect();
                 let mut ds: Vec<usize> = Vec::new();
                 match p.candidates {
@@ -274,9 +279,18 @@ fn candidates(
                 }
                 for d in ds {
                     let xr = x - d;
-                    let halves_ok = halves
-                        .iter()
-                        .all(|hd| hd.is_some_and(|hd| hd.abs_diff(d) <= p.edge_tol));
+                    // Each half-window must find this disparity (within edge_tol px) as good as
+                    // its best anywhere in the range, up to edge_margin: a half lying on another
+                    // surface prefers that surface's disparity by far more, while a periodic
+                    // texture's equal peaks (laundry's basket) stay acceptable.
+                    let lo = d.saturating_sub(p.edge_tol).max(p.d_min);
+                    let hi = (d + p.edge_tol).min(d_hi);
+                    let halves_ok = halves.iter().enumerate().all(|(k, best)| {
+                        best.is_some_and(|best| {
+                            let c = &cv.curve[k + 1][lo..=hi];
+                            c.iter().copied().fold(f32::MIN, f32::max) >= best - p.edge_margin
+                        })
+                    });
                     // Centre check on window-mean-free grey levels: insensitive to the exposure
                     // offset between the cameras (ETH3D, KITTI), still catches a centre pixel
                     // that belongs to the other surface.
