@@ -500,11 +500,8 @@ pub fn candidate_neurons(
 
 /// The Hopfield channel: interest points matched by energy minimisation (see the module docs).
 pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result<HopfieldOutput> {
-    let t0 = std::time::Instant::now();
     let (pts, neurons) = candidate_neurons(left, right, p)?;
-    let t1 = std::time::Instant::now();
     let csr = build_weights(&neurons, &p.weights);
-    let t2 = std::time::Instant::now();
     let input: Vec<f64> = neurons
         .iter()
         .map(|n| (p.weights.d * n.sim - p.weights.theta) as f64)
@@ -514,21 +511,8 @@ pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result
         .map(|n| u8::from(n.sim >= p.s_init))
         .collect();
     let dynamics = run_dynamics(&csr, &input, &init, p.seed, p.max_sweeps);
-    let t3 = std::time::Instant::now();
     let chosen = disambiguate(&neurons, &dynamics.state, p);
-    let t4 = std::time::Instant::now();
     let matches = finish(left, right, &neurons, &chosen, p);
-    let t5 = std::time::Instant::now();
-    if std::env::var("HOP_TIMING").is_ok() {
-        eprintln!(
-            "cand {:?} weights {:?} dyn {:?} dis {:?} finish {:?}",
-            t1 - t0,
-            t2 - t1,
-            t3 - t2,
-            t4 - t3,
-            t5 - t4
-        );
-    }
     Ok(HopfieldOutput {
         matches,
         energy_trace: dynamics.energy_trace,
