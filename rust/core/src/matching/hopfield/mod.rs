@@ -343,23 +343,28 @@ fn median(v: &mut [f32]) -> f32 {
 /// C.5 disambiguation: indices of the kept active neurons (at most one per left point and one
 /// per right pixel).
 fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usize> {
-    let active: Vec<usize> = (0..neurons.len()).filter(|&a| state[a] == 1).collect();
-    let mut by_point: HashMap<u32, Vec<usize>> = HashMap::new();
-    for &a in &active {
-        by_point.entry(neurons[a].point).or_default().push(a);
+    // Active neurons per left point (neurons are grouped by point): singles kept as they are.
+    let m = neurons.len();
+    let mut singles: Vec<usize> = Vec::new();
+    let mut ambiguous: Vec<Vec<usize>> = Vec::new();
+    let mut a = 0;
+    while a < m {
+        let mut e = a;
+        while e < m && neurons[e].point == neurons[a].point {
+            e += 1;
+        }
+        let n_on = (a..e).filter(|&b| state[b] == 1).count();
+        if n_on == 1 {
+            singles.extend((a..e).filter(|&b| state[b] == 1));
+        } else if n_on > 1 {
+            ambiguous.push((a..e).filter(|&b| state[b] == 1).collect());
+        }
+        a = e;
     }
-    let singles: Vec<usize> = active
-        .iter()
-        .copied()
-        .filter(|a| {
-            by_point
-                .get(&neurons[*a].point)
-                .is_some_and(|l| l.len() == 1)
-        })
-        .collect();
-    let mut all_dy: Vec<f32> = singles.iter().map(|&a| neurons[a].dy() as f32).collect();
+    let mut all_dy: Vec<f32> = singles.iter().map(|&s| neurons[s].dy() as f32).collect();
     let global = median(&mut all_dy);
     let half = p.weights.nbr_half;
+    // Reference vertical disparity: median over the single matches in the 40x40 window.
     let local_ref = |a: usize| -> f32 {
         let n = &neurons[a];
         let mut v: Vec<f32> = singles
@@ -375,44 +380,40 @@ fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usi
             median(&mut v)
         }
     };
+    // Closest to the reference, then higher similarity, then lower index; None if too far.
     let pick = |group: &[usize]| -> Option<usize> {
         let mut best: Option<(f32, f32, usize)> = None;
         for &a in group {
-            let dev = (neurons[a].dy() as f32 - local_ref(a)).abs();
-            let key = (dev, -neurons[a].sim, a);
+            let key = (
+                (neurons[a].dy() as f32 - local_ref(a)).abs(),
+                -neurons[a].sim,
+                a,
+            );
             if best.is_none_or(|b| (key.0, key.1, key.2) < (b.0, b.1, b.2)) {
                 best = Some(key);
             }
         }
         best.filter(|b| b.0 <= p.tau_y).map(|b| b.2)
     };
-    let mut kept: Vec<usize> = Vec::new();
-    let mut points: Vec<&u32> = by_point.keys().collect();
-    points.sort_unstable();
-    for pt in points {
-        let group = &by_point[pt];
-        if group.len() == 1 {
-            kept.push(group[0]);
-        } else if let Some(a) = pick(group) {
-            kept.push(a);
+    let mut kept = singles.clone();
+    kept.extend(ambiguous.iter().filter_map(|g| pick(g)));
+    // The same rule on the right side (neurons sharing a right pixel).
+    kept.sort_unstable_by_key(|&a| (neurons[a].yr, neurons[a].xr, a));
+    let mut out: Vec<usize> = Vec::with_capacity(kept.len());
+    let mut i = 0;
+    while i < kept.len() {
+        let key = (neurons[kept[i]].yr, neurons[kept[i]].xr);
+        let mut j = i;
+        while j < kept.len() && (neurons[kept[j]].yr, neurons[kept[j]].xr) == key {
+            j += 1;
         }
+        if j - i == 1 {
+            out.push(kept[i]);
+        } else if let Some(a) = pick(&kept[i..j]) {
+            out.push(a);
+        }
+        i = j;
     }
-    // The same rule on the right side.
-    let mut by_right: HashMap<(i32, i32), Vec<usize>> = HashMap::new();
-    for &a in &kept {
-        by_right
-            .entry((neurons[a].xr, neurons[a].yr))
-            .or_default()
-            .push(a);
-    }
-    let mut out: Vec<usize> = kept
-        .iter()
-        .copied()
-        .filter(|&a| {
-            let group = &by_right[&(neurons[a].xr, neurons[a].yr)];
-            group.len() == 1 || pick(group) == Some(a)
-        })
-        .collect();
     out.sort_unstable();
     out
 }
@@ -436,14 +437,12 @@ fn finish(
         .collect();
     let survivors: Vec<(usize, f32)> = stage1.into_iter().flatten().collect();
     // Stage 2: neighbour agreement among the survivors (uniform grid, cell = window half-size).
-    let half = p.weights.nbr_half;
-    let mut grid: HashMap<(i32, i32), Vec<usize>> = HashMap::new();
-    for (s, &(a, _)) in survivors.iter().enumerate() {
-        let n = &neurons[a];
-        grid.entry((n.xl.div_euclid(half), n.yl.div_euclid(half)))
-            .or_default()
-            .push(s);
-    }
+    let half = p.weights.nbr_half.max(1);
+    let sxy: Vec<(i32, i32)> = survivors
+        .iter()
+        .map(|&(a, _)| (neurons[a].xl.max(0), neurons[a].yl.max(0)))
+        .collect();
+    let grid = network::PointGrid::new(&sxy, half);
     survivors
         .par_iter()
         .enumerate()
@@ -451,26 +450,13 @@ fn finish(
             if !p.edge_test {
                 return true;
             }
-            let n = &neurons[a];
-            let (cx, cy) = (n.xl.div_euclid(half), n.yl.div_euclid(half));
+            let d = neurons[a].dx();
             let mut agree = 0usize;
-            for gy in cy - 1..=cy + 1 {
-                for gx in cx - 1..=cx + 1 {
-                    let Some(list) = grid.get(&(gx, gy)) else {
-                        continue;
-                    };
-                    for &t in list {
-                        let m = &neurons[survivors[t].0];
-                        if t != s
-                            && (m.xl - n.xl).abs() <= half
-                            && (m.yl - n.yl).abs() <= half
-                            && (m.dx() - n.dx()).abs() <= p.agree_tol
-                        {
-                            agree += 1;
-                        }
-                    }
+            grid.for_each_near(&sxy, s, half, |t| {
+                if (neurons[survivors[t].0].dx() - d).abs() <= p.agree_tol {
+                    agree += 1;
                 }
-            }
+            });
             agree >= p.min_agree
         })
         .map(|(_, &(a, dsub))| {

@@ -95,7 +95,7 @@ impl Csr {
 }
 
 /// Uniform grid over the left points (cell = the compatibility half-window), counting-sorted.
-struct PointGrid {
+pub(crate) struct PointGrid {
     cell: i32,
     gw: i32,
     gh: i32,
@@ -104,7 +104,7 @@ struct PointGrid {
 }
 
 impl PointGrid {
-    fn new(pxy: &[(i32, i32)], cell: i32) -> Self {
+    pub(crate) fn new(pxy: &[(i32, i32)], cell: i32) -> Self {
         let gw = pxy.iter().map(|p| p.0 / cell).max().unwrap_or(0) + 1;
         let gh = pxy.iter().map(|p| p.1 / cell).max().unwrap_or(0) + 1;
         let idx = |p: &(i32, i32)| ((p.1 / cell) * gw + p.0 / cell) as usize;
@@ -132,7 +132,13 @@ impl PointGrid {
     }
 
     /// Calls `f(q)` for every point `q != p` with `|dx| <= half` and `|dy| <= half`.
-    fn for_each_near(&self, pxy: &[(i32, i32)], p: usize, half: i32, mut f: impl FnMut(usize)) {
+    pub(crate) fn for_each_near(
+        &self,
+        pxy: &[(i32, i32)],
+        p: usize,
+        half: i32,
+        mut f: impl FnMut(usize),
+    ) {
         let (x, y) = pxy[p];
         let (cx, cy) = (x / self.cell, y / self.cell);
         for gy in (cy - 1).max(0)..=(cy + 1).min(self.gh - 1) {
@@ -174,15 +180,16 @@ pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
         .collect();
     let half = w.nbr_half.max(1);
     let grid = PointGrid::new(&pxy, half);
-    // n_i: left points (with candidates) in i's window.
-    let n_count: Vec<f32> = (0..n_pts)
+    // Neighbour lists (left points with candidates in the 40x40 window) and n_i = their count.
+    let near: Vec<Vec<u32>> = (0..n_pts)
         .into_par_iter()
         .map(|p| {
-            let mut n = 0usize;
-            grid.for_each_near(&pxy, p, half, |_| n += 1);
-            n as f32
+            let mut v = Vec::with_capacity(64);
+            grid.for_each_near(&pxy, p, half, |q| v.push(q as u32));
+            v
         })
         .collect();
+    let n_count: Vec<f32> = near.iter().map(|v| v.len() as f32).collect();
     // Neurons sharing a right pixel (column inhibition), wherever their left points are:
     // neuron indices sorted by right pixel, and each neuron's group range in that order.
     let mut by_right: Vec<u32> = (0..m as u32).collect();
@@ -218,11 +225,16 @@ pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
     let blocks: Vec<(Vec<usize>, Vec<u32>, Vec<f32>)> = (0..n_pts)
         .into_par_iter()
         .map(|p| {
-            let mut near: Vec<usize> = Vec::new();
-            grid.for_each_near(&pxy, p, half, |q| near.push(q));
-            let mut lens = Vec::new();
-            let mut idx = Vec::new();
-            let mut val = Vec::new();
+            let n_here = starts[p + 1] - starts[p];
+            let cap: usize = near[p]
+                .iter()
+                .map(|&q| starts[q as usize + 1] - starts[q as usize])
+                .sum::<usize>()
+                * n_here
+                + n_here * (n_here + 2);
+            let mut lens = Vec::with_capacity(n_here);
+            let mut idx = Vec::with_capacity(cap);
+            let mut val = Vec::with_capacity(cap);
             for a in starts[p]..starts[p + 1] {
                 let before = idx.len();
                 let na = &neurons[a];
@@ -242,7 +254,8 @@ pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
                     }
                 }
                 // Compatibility with the candidates of the other points in the 40x40 window.
-                for &q in &near {
+                for &q in &near[p] {
+                    let q = q as usize;
                     let norm = w.a / n_count[p].max(n_count[q]).max(1.0);
                     let (qs, qe) = (starts[q], starts[q + 1]);
                     for (b, nb) in neurons.iter().enumerate().take(qe).skip(qs) {

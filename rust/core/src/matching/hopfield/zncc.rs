@@ -131,6 +131,7 @@ impl RightStats {
 #[derive(Debug, Clone, Default)]
 pub struct Curves {
     part: Vec<f32>,
+    acc: Vec<f32>,
     /// `curve[k][d]`: ZNCC of region `k` at disparity `d = 0..=d_hi` (0 = undefined).
     pub curve: [Vec<f32>; N_REGIONS],
     /// Mean of the left 7x7 window.
@@ -216,7 +217,9 @@ pub fn zncc_curves(
         }
         let (x0, x1, y0, y1) = REGIONS[k];
         let (g0, g1) = (group(x0), group(x1));
-        let mut acc = vec![0.0f32; len];
+        let acc = &mut out.acc;
+        acc.clear();
+        acc.resize(len, 0.0);
         for r in (y0 + R) as usize..=(y1 + R) as usize {
             for g in g0..=g1 {
                 let src = &out.part[(r * 3 + g) * len..(r * 3 + g + 1) * len];
