@@ -18,6 +18,7 @@
 
 pub mod interest;
 pub mod network;
+mod simd;
 pub mod zncc;
 
 #[cfg(test)]

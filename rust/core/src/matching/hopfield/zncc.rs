@@ -10,6 +10,7 @@
 
 use rayon::prelude::*;
 
+use super::simd::simd_fn;
 use crate::image::Image;
 
 /// Similarity window half-size (7x7, C.10).
@@ -138,10 +139,10 @@ pub struct Curves {
     pub left_mean: f32,
 }
 
+simd_fn! {
 /// ZNCC curves of the five regions around left `(x, y)` against right `(x - d, yr)`,
 /// `d = 0..=d_hi`. The caller guarantees `SIM_RADIUS <= x - d_hi`, `x + SIM_RADIUS < W` and
 /// that rows `y` and `yr` are at least `SIM_RADIUS` from the top and bottom.
-#[allow(clippy::too_many_arguments)]
 pub fn zncc_curves(
     left: &Image,
     right: &Image,
@@ -236,4 +237,5 @@ pub fn zncc_curves(
             curve[d_hi - j] = (a - shift * s) * iv * inv_l;
         }
     }
+}
 }
