@@ -37,6 +37,7 @@ DEFAULTS = {
     "edge_test": True,
     "edge_tol": 1,
     "edge_margin": 0.0,
+    "edge_penalty": 0.0,
     "centre_tol": 0.05,
     "min_agree": 8,
     "agree_tol": 1,
@@ -324,7 +325,14 @@ def hopfield_match(
     neurons = candidates(left, right, d_min, d_max, p)
     rows = build_weights(neurons, p)
     inp = np.array(
-        [float(np.float32(p["D"]) * np.float32(n["sim"]) - np.float32(p["theta"])) for n in neurons]
+        [
+            float(
+                np.float32(p["D"]) * np.float32(n["sim"])
+                - np.float32(p["theta"])
+                - np.float32(p["edge_penalty"] if p["edge_test"] and not n["edge_ok"] else 0.0)
+            )
+            for n in neurons
+        ]
     )
     init = np.array([n["sim"] >= p["s_init"] for n in neurons], dtype=np.int8)
     v, trace = run_dynamics(rows, inp, init, int(p["seed"]), int(p["max_sweeps"]))

@@ -55,6 +55,7 @@ DEFAULTS: dict[str, Any] = {
     "edge_test": True,  # C.10 depth-edge test
     "edge_tol": 1,  # half-window disparities agree within +-1 px (C.10)
     "edge_margin": 0.0,  # half-window ZNCC slack vs its best (0 = C.10's literal test)
+    "edge_penalty": 0.0,  # input penalty of edge-test failures in the network (0 = test after)
     "centre_tol": 0.05,  # centre grey-level difference (C.10)
     "min_agree": 8,  # agreeing neighbour matches in the 40x40 window (C.10)
     "agree_tol": 1,  # neighbours agree within +-1 px
@@ -189,8 +190,9 @@ def hopfield_match(
         ``candidates`` (``"row"`` or ``"points"``), ``dy_window`` (px), ``s_min``, ``k_cand``,
         ``A``, ``B``, ``D``, ``theta``, ``nbr_half`` (px), ``compat_theta`` (px),
         ``compat_slope`` (1/px), ``s_init``, ``max_sweeps``, ``seed``, ``tau_y`` (px),
-        ``edge_test``, ``edge_tol`` (px), ``edge_margin`` (ZNCC), ``centre_tol`` (grey levels in [0, 1]),
-        ``min_agree``, ``agree_tol`` (px), ``subpixel``.
+        ``edge_test``, ``edge_tol`` (px), ``edge_margin`` (ZNCC), ``edge_penalty``,
+        ``centre_tol`` (window-mean-free grey levels in [0, 1]), ``min_agree``, ``agree_tol``
+        (px), ``subpixel``.
 
     Returns
     -------

@@ -30,7 +30,8 @@ fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
     Ok(())
 }
 
-const KEYS: [&str; 28] = [
+const KEYS: [&str; 29] = [
+    "edge_penalty",
     "edge_margin",
     "min_disparity",
     "max_disparity",
@@ -104,6 +105,7 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
     get(d, "edge_test", &mut p.edge_test)?;
     get(d, "edge_tol", &mut p.edge_tol)?;
     get(d, "edge_margin", &mut p.edge_margin)?;
+    get(d, "edge_penalty", &mut p.edge_penalty)?;
     get(d, "centre_tol", &mut p.centre_tol)?;
     get(d, "min_agree", &mut p.min_agree)?;
     get(d, "agree_tol", &mut p.agree_tol)?;

@@ -74,6 +74,9 @@ pub struct HopfieldParams {
     /// Half-window ZNCC at the match may fall this far below the half's best (0 = the match
     /// must be each half's best disparity, C.10's literal test).
     pub edge_margin: f32,
+    /// Input penalty of neurons failing the depth-edge test (0 = the network ignores the test,
+    /// which is then applied after the dynamics only).
+    pub edge_penalty: f32,
     /// Centre grey-level difference allowed between the matched pixels (C.10: 0.05).
     pub centre_tol: f32,
     /// Agreeing neighbour matches required in the 40x40 window (C.10: 8).
@@ -102,6 +105,7 @@ impl Default for HopfieldParams {
             edge_test: true,
             edge_tol: 1,
             edge_margin: 0.0,
+            edge_penalty: 0.0,
             centre_tol: 0.05,
             min_agree: 8,
             agree_tol: 1,
@@ -491,7 +495,14 @@ pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result
     let csr = build_weights(&neurons, &p.weights);
     let input: Vec<f64> = neurons
         .iter()
-        .map(|n| (p.weights.d * n.sim - p.weights.theta) as f64)
+        .map(|n| {
+            let penalty = if p.edge_test && !n.edge_ok {
+                p.edge_penalty
+            } else {
+                0.0
+            };
+            (p.weights.d * n.sim - p.weights.theta - penalty) as f64
+        })
         .collect();
     let init: Vec<u8> = neurons
         .iter()
