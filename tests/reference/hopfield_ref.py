@@ -41,6 +41,8 @@ DEFAULTS = {
     "centre_tol": 0.05,
     "min_agree": 8,
     "agree_tol": 1,
+    "agree_share": 0.8,
+    "min_agree_sparse": 2,
     "subpixel": True,
 }
 
@@ -302,15 +304,22 @@ def _finish(neurons: list[dict], chosen: list[int], p: dict) -> np.ndarray:
     for a in surv:
         n = neurons[a]
         d = n["xl"] - n["xr"]
-        agree = sum(
-            1
+        near = [
+            b
             for b in surv
             if b != a
             and abs(neurons[b]["xl"] - n["xl"]) <= half
             and abs(neurons[b]["yl"] - n["yl"]) <= half
-            and abs((neurons[b]["xl"] - neurons[b]["xr"]) - d) <= p["agree_tol"]
+        ]
+        agree = sum(
+            1 for b in near if abs((neurons[b]["xl"] - neurons[b]["xr"]) - d) <= p["agree_tol"]
         )
-        if p["edge_test"] and agree < p["min_agree"]:
+        sparse_ok = (
+            p["agree_share"] > 0
+            and agree >= p["min_agree_sparse"]
+            and agree >= np.float32(p["agree_share"]) * np.float32(len(near))
+        )
+        if p["edge_test"] and agree < p["min_agree"] and not sparse_ok:
             continue
         out.append([n["xl"], n["yl"], n["xl"] - (d + n["sub"]), n["yr"], n["sim"]])
     return np.array(out, dtype=np.float32).reshape(-1, 5)

@@ -59,6 +59,8 @@ DEFAULTS: dict[str, Any] = {
     "centre_tol": 0.05,  # centre grey-level difference (C.10)
     "min_agree": 8,  # agreeing neighbour matches in the 40x40 window (C.10)
     "agree_tol": 1,  # neighbours agree within +-1 px
+    "agree_share": 0.8,  # sparse areas: this share of the (< 8) neighbour matches agrees ...
+    "min_agree_sparse": 2,  # ... with at least 2 agreeing (0 share = C.10's rule only)
     "subpixel": True,  # parabola refinement
 }
 
@@ -192,7 +194,7 @@ def hopfield_match(
         ``compat_slope`` (1/px), ``s_init``, ``max_sweeps``, ``seed``, ``tau_y`` (px),
         ``edge_test``, ``edge_tol`` (px), ``edge_margin`` (ZNCC), ``edge_penalty``,
         ``centre_tol`` (window-mean-free grey levels in [0, 1]), ``min_agree``, ``agree_tol``
-        (px), ``subpixel``.
+        (px), ``agree_share``, ``min_agree_sparse``, ``subpixel``.
 
     Returns
     -------

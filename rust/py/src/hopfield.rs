@@ -30,7 +30,9 @@ fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
     Ok(())
 }
 
-const KEYS: [&str; 29] = [
+const KEYS: [&str; 31] = [
+    "agree_share",
+    "min_agree_sparse",
     "edge_penalty",
     "edge_margin",
     "min_disparity",
@@ -109,6 +111,8 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
     get(d, "centre_tol", &mut p.centre_tol)?;
     get(d, "min_agree", &mut p.min_agree)?;
     get(d, "agree_tol", &mut p.agree_tol)?;
+    get(d, "agree_share", &mut p.agree_share)?;
+    get(d, "min_agree_sparse", &mut p.min_agree_sparse)?;
     get(d, "subpixel", &mut p.subpixel)?;
     Ok(p)
 }

@@ -81,6 +81,12 @@ pub struct HopfieldParams {
     pub centre_tol: f32,
     /// Agreeing neighbour matches required in the 40x40 window (C.10: 8).
     pub min_agree: usize,
+    /// Sparse-area alternative to `min_agree`: this share of the neighbour matches agrees
+    /// (0 = off, C.10's rule only). 0.8: weakly textured areas (wood2's plank, laundry's
+    /// basket, playground's left edge) have fewer than 8 matched neighbours in the window.
+    pub agree_share: f32,
+    /// ... with at least this many agreeing neighbours (2: one neighbour could agree by chance).
+    pub min_agree_sparse: usize,
     /// Neighbour matches agree when their disparities differ by at most this (px).
     pub agree_tol: i32,
     /// Parabola sub-pixel refinement of the final matches.
@@ -109,6 +115,8 @@ impl Default for HopfieldParams {
             centre_tol: 0.05,
             min_agree: 8,
             agree_tol: 1,
+            agree_share: 0.8,
+            min_agree_sparse: 2,
             subpixel: true,
         }
     }
@@ -456,13 +464,19 @@ fn finish(
                 return true;
             }
             let d = neurons[a].dx();
-            let mut agree = 0usize;
+            let (mut agree, mut near) = (0usize, 0usize);
             grid.for_each_near(&sxy, s, half, |t| {
+                near += 1;
                 if (neurons[survivors[t].0].dx() - d).abs() <= p.agree_tol {
                     agree += 1;
                 }
             });
+            // Dense areas: at least min_agree agreeing neighbours (C.10). Sparse areas (weak
+            // texture) optionally: a large share of the few neighbours, at least min_agree_sparse.
             agree >= p.min_agree
+                || (p.agree_share > 0.0
+                    && agree >= p.min_agree_sparse
+                    && agree as f32 >= p.agree_share * near as f32)
         })
         .map(|(_, &(a, dsub))| {
             let n = &neurons[a];
