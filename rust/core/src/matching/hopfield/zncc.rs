@@ -51,80 +51,92 @@ fn group(dx: isize) -> usize {
 }
 
 /// Right-image window sums and inverse zero-mean norms for every region and pixel (0 where the
-/// window does not fit or is textureless).
+/// window does not fit or is textureless). Layout `(H, 2 * N_REGIONS, W)`: per image row, the
+/// five sum rows then the five inverse-norm rows, so one region's values along a row are
+/// contiguous. Built row-parallel with direct (not running) `f64` sums: vertical 7/3-row sums,
+/// then horizontal 7/3-column sums.
 #[derive(Debug, Clone)]
 pub struct RightStats {
     width: usize,
-    sum: [Vec<f32>; N_REGIONS],
-    inv_norm: [Vec<f32>; N_REGIONS],
+    buf: Vec<f32>,
 }
 
 impl RightStats {
-    /// Mean of the right 7x7 window centred at `(x, y)` (0 where it does not fit).
-    pub fn mean(&self, x: usize, y: usize) -> f32 {
-        self.sum[FULL][y * self.width + x] / region_n(FULL) as f32
-    }
-
     pub fn new(img: &Image) -> Self {
         let (w, h) = img.size();
-        let w1 = w + 1;
-        let mut s = vec![0.0f64; w1 * (h + 1)];
-        let mut s2 = vec![0.0f64; w1 * (h + 1)];
-        for y in 0..h {
-            let (mut rs, mut rs2) = (0.0f64, 0.0f64);
-            for x in 0..w {
-                let v = img.at(x, y) as f64;
-                rs += v;
-                rs2 += v * v;
-                s[(y + 1) * w1 + x + 1] = s[y * w1 + x + 1] + rs;
-                s2[(y + 1) * w1 + x + 1] = s2[y * w1 + x + 1] + rs2;
-            }
+        let stride = 2 * N_REGIONS * w;
+        let mut buf = vec![0.0f32; stride * h];
+        if w < SIDE || h < SIDE {
+            return RightStats { width: w, buf };
         }
-        let box_sum = |a: &[f64], xa: usize, xb: usize, ya: usize, yb: usize| {
-            a[yb * w1 + xb] - a[ya * w1 + xb] - a[yb * w1 + xa] + a[ya * w1 + xa]
-        };
-        let per_region = |k: usize| -> (Vec<f32>, Vec<f32>) {
-            let (x0, x1, y0, y1) = REGIONS[k];
-            let n = region_n(k) as f64;
-            let min_n2 = n * MIN_WINDOW_STD * MIN_WINDOW_STD;
-            let mut sum = vec![0.0f32; w * h];
-            let mut inv = vec![0.0f32; w * h];
-            if w < SIDE || h < SIDE {
-                return (sum, inv);
-            }
-            sum.par_chunks_mut(w)
-                .zip(inv.par_chunks_mut(w))
-                .enumerate()
-                .skip(SIM_RADIUS)
-                .take(h - 2 * SIM_RADIUS)
-                .for_each(|(y, (srow, irow))| {
+        buf.par_chunks_mut(stride)
+            .enumerate()
+            .skip(SIM_RADIUS)
+            .take(h - 2 * SIM_RADIUS)
+            .for_each(|(y, chunk)| {
+                // Vertical sums (value, square) over rows -3..=3, -3..=-1 and 1..=3.
+                let mut vs = [vec![0.0f64; w], vec![0.0f64; w], vec![0.0f64; w]];
+                let mut vq = [vec![0.0f64; w], vec![0.0f64; w], vec![0.0f64; w]];
+                for dy in -R..=R {
+                    let row = &img.data[(y as isize + dy) as usize * w..][..w];
+                    let slots: &[usize] = match dy {
+                        d if d < 0 => &[0, 1],
+                        0 => &[0],
+                        _ => &[0, 2],
+                    };
+                    for &k in slots {
+                        for ((s, q), &v) in vs[k].iter_mut().zip(vq[k].iter_mut()).zip(row) {
+                            let v = v as f64;
+                            *s += v;
+                            *q += v * v;
+                        }
+                    }
+                }
+                let (sums, invs) = chunk.split_at_mut(N_REGIONS * w);
+                for k in 0..N_REGIONS {
+                    let (x0, x1, _, _) = REGIONS[k];
+                    let slot = match k {
+                        HALF_TOP => 1,
+                        HALF_BOTTOM => 2,
+                        _ => 0,
+                    };
+                    let n = region_n(k) as f64;
+                    let min_n2 = n * MIN_WINDOW_STD * MIN_WINDOW_STD;
+                    let srow = &mut sums[k * w..(k + 1) * w];
+                    let irow = &mut invs[k * w..(k + 1) * w];
                     for x in SIM_RADIUS..w - SIM_RADIUS {
                         let xa = (x as isize + x0) as usize;
-                        let xb = (x as isize + x1) as usize + 1;
-                        let ya = (y as isize + y0) as usize;
-                        let yb = (y as isize + y1) as usize + 1;
-                        let sm = box_sum(&s, xa, xb, ya, yb);
-                        let n2 = box_sum(&s2, xa, xb, ya, yb) - sm * sm / n;
+                        let xb = (x as isize + x1) as usize;
+                        let sm: f64 = vs[slot][xa..=xb].iter().sum();
+                        let sq: f64 = vq[slot][xa..=xb].iter().sum();
+                        let n2 = sq - sm * sm / n;
                         srow[x] = sm as f32;
                         if n2 >= min_n2 {
                             irow[x] = (1.0 / n2.sqrt()) as f32;
                         }
                     }
-                });
-            (sum, inv)
-        };
-        let parts: Vec<(Vec<f32>, Vec<f32>)> = (0..N_REGIONS).map(per_region).collect();
-        let mut sum: [Vec<f32>; N_REGIONS] = Default::default();
-        let mut inv_norm: [Vec<f32>; N_REGIONS] = Default::default();
-        for (k, (a, b)) in parts.into_iter().enumerate() {
-            sum[k] = a;
-            inv_norm[k] = b;
-        }
-        RightStats {
-            width: w,
-            sum,
-            inv_norm,
-        }
+                }
+            });
+        RightStats { width: w, buf }
+    }
+
+    /// Window sums of region `k` along row `y`.
+    #[inline]
+    fn sums(&self, k: usize, y: usize) -> &[f32] {
+        let o = (y * 2 * N_REGIONS + k) * self.width;
+        &self.buf[o..o + self.width]
+    }
+
+    /// Inverse zero-mean norms of region `k` along row `y` (0 = undefined).
+    #[inline]
+    fn inv_norms(&self, k: usize, y: usize) -> &[f32] {
+        let o = (y * 2 * N_REGIONS + N_REGIONS + k) * self.width;
+        &self.buf[o..o + self.width]
+    }
+
+    /// Mean of the right 7x7 window centred at `(x, y)` (0 where it does not fit).
+    pub fn mean(&self, x: usize, y: usize) -> f32 {
+        self.sums(FULL, y)[x] / region_n(FULL) as f32
     }
 }
 
@@ -208,7 +220,6 @@ pub fn zncc_curves(
             }
         }
     }
-    let row_base = yr * stats.width + xr_lo;
     for k in 0..N_REGIONS {
         let curve = &mut out.curve[k];
         curve.clear();
@@ -231,8 +242,8 @@ pub fn zncc_curves(
         }
         let shift = (mu[k] - c) as f32;
         let inv_l = (1.0 / lnorm[k]) as f32;
-        let sums = &stats.sum[k][row_base..row_base + len];
-        let invs = &stats.inv_norm[k][row_base..row_base + len];
+        let sums = &stats.sums(k, yr)[xr_lo..xr_lo + len];
+        let invs = &stats.inv_norms(k, yr)[xr_lo..xr_lo + len];
         for (j, ((&a, &s), &iv)) in acc.iter().zip(sums).zip(invs).enumerate() {
             curve[d_hi - j] = (a - shift * s) * iv * inv_l;
         }
