@@ -14,7 +14,11 @@ def gabor_disparity(
     d_max: float,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]: ...
 def hopfield_interest(
-    img: npt.NDArray[np.float32], rel_threshold: float = ..., nms_half: int = ...
+    img: npt.NDArray[np.float32],
+    rel_threshold: float = ...,
+    nms_half: int = ...,
+    tile: int = ...,
+    floor_rel: float = ...,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.int32], npt.NDArray[np.float32]]: ...
 def hopfield_match(
     left: npt.NDArray[np.float32], right: npt.NDArray[np.float32], params: dict[str, Any]

@@ -22,6 +22,8 @@ REGIONS = [(-3, 3, -3, 3), (-3, -1, -3, 3), (1, 3, -3, 3), (-3, 3, -3, -1), (-3,
 DEFAULTS = {
     "rel_threshold": 1e-3,
     "nms_half": 1,
+    "tile": 64,
+    "floor_rel": 1e-4,
     "s_min": 0.8,
     "k_cand": 8,
     "A": 3.0,
@@ -84,7 +86,11 @@ def moravec(img: np.ndarray) -> np.ndarray:
 
 
 def interest_points(
-    img: np.ndarray, rel_threshold: float = 1e-3, nms_half: int = 1
+    img: np.ndarray,
+    rel_threshold: float = 1e-3,
+    nms_half: int = 1,
+    tile: int = 64,
+    floor_rel: float = 1e-4,
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(xy (N, 2) int, values (N,) float32)`` in raster order."""
     m = moravec(img)
@@ -92,7 +98,13 @@ def interest_points(
     mx = np.float32(m.max())
     if mx <= 0:
         return np.zeros((0, 2), np.int64), np.zeros(0, np.float32)
-    thr = mx * np.float32(rel_threshold)
+    t = tile if tile > 0 else max(h, w)
+    ty, tx = -(-h // t), -(-w // t)
+    pad = np.zeros((ty * t, tx * t), np.float32)
+    pad[:h, :w] = m
+    tmax = pad.reshape(ty, t, tx, t).max(axis=(1, 3))
+    local = np.repeat(np.repeat(tmax, t, axis=0), t, axis=1)[:h, :w]
+    thr = np.maximum(local * np.float32(rel_threshold), mx * np.float32(floor_rel))
     r = nms_half
     pad = np.pad(m, r, constant_values=-np.inf)
     keep = (m > 0) & (m >= thr)
@@ -147,7 +159,7 @@ def _parabola(a: float, b: float, c: float) -> float:
 
 def candidates(left: np.ndarray, right: np.ndarray, d_min: int, d_max: int, p: dict) -> list[dict]:
     """Row-mode candidate neurons, grouped by point, best ZNCC first."""
-    xy, _ = interest_points(left, p["rel_threshold"], p["nms_half"])
+    xy, _ = interest_points(left, p["rel_threshold"], p["nms_half"], p["tile"], p["floor_rel"])
     w = left.shape[1]
     out = []
     for i, (x, y) in enumerate(xy.tolist()):

@@ -37,6 +37,8 @@ __all__ = [
 DEFAULTS: dict[str, Any] = {
     "rel_threshold": 1e-3,  # interest threshold, fraction of max(M) (C.10: 0.1 %)
     "nms_half": 1,  # 3x3 non-maximum suppression (C.10)
+    "tile": 64,  # threshold relative to the max of each 64x64 tile (spread; 0 = whole image)
+    "floor_rel": 1e-4,  # ... but never below 0.01 % of the image's max (flat areas stay empty)
     "candidates": "row",  # "row": ZNCC peaks along the row (C.10); "points": right interest points
     "dy_window": 2,  # epipolar band for "points" (px, C.3)
     "s_min": 0.8,  # minimum candidate ZNCC (the real gate, C.10)
@@ -88,14 +90,20 @@ class InterestPoints:
 
 
 def interest_points(
-    image: npt.ArrayLike, *, rel_threshold: float = 1e-3, nms_half: int = 1
+    image: npt.ArrayLike,
+    *,
+    rel_threshold: float = 1e-3,
+    nms_half: int = 1,
+    tile: int = 64,
+    floor_rel: float = 1e-4,
 ) -> InterestPoints:
     """Moravec interest points (algorithms.md C.1 with the squares, C.10 densities).
 
     ``M(x, y) = min(S_h, S_v, S_d, S_a)``, each ``S`` the 5x5 window sum of squared differences
     of adjacent pixels in one direction; kept where ``M`` is a local maximum of its
     ``(2 nms_half + 1)^2`` neighbourhood (ties go to the earlier pixel in raster order), ``M > 0``
-    and ``M >= rel_threshold * max(M)``.
+    and ``M >= max(rel_threshold * max_tile(M), floor_rel * max(M))`` where ``max_tile`` is the
+    largest ``M`` of the ``tile x tile`` block holding the pixel.
 
     Parameters
     ----------
@@ -105,6 +113,10 @@ def interest_points(
         Threshold as a fraction of the largest interest value, in ``[0, 1]``.
     nms_half : int
         Half-size of the non-maximum suppression neighbourhood (>= 1).
+    tile : int
+        Block size (px) of the relative threshold (0 = the whole image).
+    floor_rel : float
+        Lowest threshold, as a fraction of the image's largest interest value, in ``[0, 1]``.
 
     Returns
     -------
@@ -116,11 +128,16 @@ def interest_points(
         Bad image (shape, dtype, empty, NaN) or parameters out of range.
     """
     img = as_gray_float(image, "image")
-    if not (0.0 <= float(rel_threshold) <= 1.0):
-        raise ValueError(f"rel_threshold must lie in [0, 1], got {rel_threshold!r}")
+    for name, v in (("rel_threshold", rel_threshold), ("floor_rel", floor_rel)):
+        if not (0.0 <= float(v) <= 1.0):
+            raise ValueError(f"{name} must lie in [0, 1], got {v!r}")
     if int(nms_half) < 1:
         raise ValueError(f"nms_half must be >= 1, got {nms_half!r}")
-    resp, xy, vals = _core.hopfield_interest(img, float(rel_threshold), int(nms_half))
+    if int(tile) < 0:
+        raise ValueError(f"tile must be >= 0, got {tile!r}")
+    resp, xy, vals = _core.hopfield_interest(
+        img, float(rel_threshold), int(nms_half), int(tile), float(floor_rel)
+    )
     return InterestPoints(xy=xy.astype(np.float32), values=vals, response=resp)
 
 
@@ -189,6 +206,7 @@ def hopfield_match(
         Smallest disparity searched (px, default 0).
     **params
         Overrides of :data:`DEFAULTS` (each documented there): ``rel_threshold``, ``nms_half``,
+        ``tile`` (px), ``floor_rel``,
         ``candidates`` (``"row"`` or ``"points"``), ``dy_window`` (px), ``s_min``, ``k_cand``,
         ``A``, ``B``, ``D``, ``theta``, ``nbr_half`` (px), ``compat_theta`` (px),
         ``compat_slope`` (1/px), ``s_init``, ``max_sweeps``, ``seed``, ``tau_y`` (px),

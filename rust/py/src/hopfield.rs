@@ -30,7 +30,9 @@ fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
     Ok(())
 }
 
-const KEYS: [&str; 31] = [
+const KEYS: [&str; 33] = [
+    "tile",
+    "floor_rel",
     "agree_share",
     "min_agree_sparse",
     "edge_penalty",
@@ -79,6 +81,8 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
     get(d, "max_disparity", &mut p.d_max)?;
     get(d, "rel_threshold", &mut p.interest.rel_threshold)?;
     get(d, "nms_half", &mut p.interest.nms_half)?;
+    get(d, "tile", &mut p.interest.tile)?;
+    get(d, "floor_rel", &mut p.interest.floor_rel)?;
     let mut mode = String::from("row");
     get(d, "candidates", &mut mode)?;
     p.candidates = match mode.as_str() {
@@ -119,28 +123,33 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
 
 /// Moravec map and interest points: `(M (H, W) float32, xy (N, 2) int32, values (N,) float32)`.
 #[pyfunction]
-#[pyo3(signature = (img, rel_threshold=1e-3, nms_half=1))]
+#[pyo3(signature = (img, rel_threshold=1e-3, nms_half=1, tile=64, floor_rel=1e-4))]
 #[allow(clippy::type_complexity)]
 pub fn hopfield_interest<'py>(
     py: Python<'py>,
     img: PyReadonlyArray2<'py, f32>,
     rel_threshold: f32,
     nms_half: usize,
+    tile: usize,
+    floor_rel: f32,
 ) -> PyResult<(
     Bound<'py, PyArray2<f32>>,
     Bound<'py, PyArray2<i32>>,
     Bound<'py, PyArray1<f32>>,
 )> {
     let im = image_from_numpy(&img, "image")?;
-    if !(rel_threshold.is_finite() && (0.0..=1.0).contains(&rel_threshold)) || nms_half == 0 {
+    let unit = |v: f32| v.is_finite() && (0.0..=1.0).contains(&v);
+    if !unit(rel_threshold) || !unit(floor_rel) || nms_half == 0 {
         return Err(PyValueError::new_err(
-            "rel_threshold must lie in [0, 1] and nms_half be >= 1",
+            "rel_threshold and floor_rel must lie in [0, 1] and nms_half be >= 1",
         ));
     }
     let (w, h) = im.size();
     let p = stereovision_core::matching::hopfield::InterestParams {
         rel_threshold,
         nms_half,
+        tile,
+        floor_rel,
     };
     let (m, pts) = py.detach(|| {
         guard("hopfield_interest", || {

@@ -24,6 +24,14 @@ pub struct InterestParams {
     /// Half-size of the non-maximum suppression neighbourhood (C.10: 1 = 3x3; 5x5 sets the
     /// count far too low).
     pub nms_half: usize,
+    /// The threshold is `rel_threshold` times the largest `M` of the `tile x tile` block holding
+    /// the pixel (0 = of the whole image, C.10). 64 px (a few 40x40 compatibility windows)
+    /// keeps weakly textured areas represented (C.3 "per grid cell for spread"): wood2's plank
+    /// and laundry's basket get points, so the 4x4 coverage reaches 16/16.
+    pub tile: usize,
+    /// ... but never below `floor_rel` times the image's largest `M` (1e-4: truly flat areas,
+    /// sensor noise only, stay empty).
+    pub floor_rel: f32,
 }
 
 impl Default for InterestParams {
@@ -31,6 +39,8 @@ impl Default for InterestParams {
         InterestParams {
             rel_threshold: 1e-3,
             nms_half: 1,
+            tile: 64,
+            floor_rel: 1e-4,
         }
     }
 }
@@ -120,7 +130,8 @@ pub fn moravec(img: &Image) -> Vec<f32> {
 
 /// Interest points of `img`: local maxima of [`moravec`] over a `(2 nms_half + 1)^2`
 /// neighbourhood (strictly greater than neighbours earlier in raster order, at least as large as
-/// later ones), with `M > 0` and `M >= rel_threshold * max(M)`; raster order.
+/// later ones), with `M > 0` and `M >= max(rel_threshold * max_tile(M), floor_rel * max(M))`;
+/// raster order.
 pub fn interest_points(img: &Image, p: &InterestParams) -> Vec<InterestPoint> {
     let m = moravec(img);
     let (w, h) = img.size();
@@ -130,16 +141,29 @@ pub fn interest_points(img: &Image, p: &InterestParams) -> Vec<InterestPoint> {
 /// Selection step of [`interest_points`] on a precomputed map.
 pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<InterestPoint> {
     let max = m.iter().copied().fold(0.0f32, f32::max);
-    let thr = max * p.rel_threshold;
     let r = p.nms_half as isize;
     let mut out = Vec::new();
     if max <= 0.0 {
         return out;
     }
+    // Largest M per tile (a single tile covering the image when `tile == 0`).
+    let tile = if p.tile == 0 { w.max(h) } else { p.tile };
+    let tiles_x = w.div_ceil(tile);
+    let mut tile_max = vec![0.0f32; tiles_x * h.div_ceil(tile)];
+    for (y, row) in m.chunks(w).enumerate() {
+        for (x, &v) in row.iter().enumerate() {
+            let t = (y / tile) * tiles_x + x / tile;
+            tile_max[t] = tile_max[t].max(v);
+        }
+    }
+    let floor = max * p.floor_rel;
+    let thr_at = |x: usize, y: usize| {
+        (tile_max[(y / tile) * tiles_x + x / tile] * p.rel_threshold).max(floor)
+    };
     for y in BORDER..h.saturating_sub(BORDER) {
         'px: for x in BORDER..w.saturating_sub(BORDER) {
             let v = m[y * w + x];
-            if v <= 0.0 || v < thr {
+            if v <= 0.0 || v < thr_at(x, y) {
                 continue;
             }
             for dy in -r..=r {

@@ -162,6 +162,9 @@ fn validate(left: &Image, right: &Image, p: &HopfieldParams) -> Result<()> {
     if !(p.interest.rel_threshold.is_finite() && (0.0..=1.0).contains(&p.interest.rel_threshold)) {
         return Err(CoreError::param("rel_threshold", "must lie in [0, 1]"));
     }
+    if !(p.interest.floor_rel.is_finite() && (0.0..=1.0).contains(&p.interest.floor_rel)) {
+        return Err(CoreError::param("floor_rel", "must lie in [0, 1]"));
+    }
     if p.interest.nms_half == 0 {
         return Err(CoreError::param("nms_half", "must be >= 1"));
     }
