@@ -70,6 +70,7 @@ fmt:  ## format Rust and Python in place
 bench: build  ## criterion benches of the kernels, then the Python benches against OpenCV
 	cargo bench
 	$(PY) benches/bench_vs_opencv.py
+	$(PY) benches/bench_hopfield.py
 
 clean:  ## remove build products (keeps .venv)
 	rm -rf target $(BUILD_STAMP) demo_output

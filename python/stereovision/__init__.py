@@ -14,16 +14,20 @@ from stereovision import evaluate, io
 from stereovision._core import __version__
 from stereovision.calibration import Calibration
 from stereovision.depth import DepthResult, depth_map, estimate_max_disparity
+from stereovision.match import match
+from stereovision.matches import Matches
 from stereovision.triangulation import depth_from_disparity, triangulate
 
 __all__ = [
     "Calibration",
     "DepthResult",
+    "Matches",
     "__version__",
     "depth_from_disparity",
     "depth_map",
     "estimate_max_disparity",
     "evaluate",
     "io",
+    "match",
     "triangulate",
 ]

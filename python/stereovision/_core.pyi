@@ -1,6 +1,7 @@
 """Typed stub of the Rust extension ``stereovision._core`` (see rust/py/src)."""
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -69,3 +70,19 @@ def gabor_lr_check(
     tol: float = 1.0,
 ) -> npt.NDArray[np.bool_]:
     """Left-right consistency mask (``disp_right`` on the right-image grid)."""
+
+# --- Hopfield network channel (rust/py/src/hopfield.rs) ------------------------------------------
+
+def hopfield_interest(
+    img: npt.NDArray[np.float32],
+    rel_threshold: float = ...,
+    nms_half: int = ...,
+    tile: int = ...,
+    floor_rel: float = ...,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.int32], npt.NDArray[np.float32]]: ...
+def hopfield_match(
+    left: npt.NDArray[np.float32], right: npt.NDArray[np.float32], params: dict[str, Any]
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float64], dict[str, Any]]: ...
+def hopfield_candidates(
+    left: npt.NDArray[np.float32], right: npt.NDArray[np.float32], params: dict[str, Any]
+) -> npt.NDArray[np.float32]: ...

@@ -9,6 +9,7 @@ use pyo3::prelude::*;
 mod convert;
 mod errors;
 mod gabor;
+mod hopfield;
 
 #[pymodule(gil_used = false)]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -17,5 +18,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gabor::gabor_responses, m)?)?;
     m.add_function(wrap_pyfunction!(gabor::gabor_newton_step, m)?)?;
     m.add_function(wrap_pyfunction!(gabor::gabor_lr_check, m)?)?;
+    m.add_function(wrap_pyfunction!(hopfield::hopfield_interest, m)?)?;
+    m.add_function(wrap_pyfunction!(hopfield::hopfield_match, m)?)?;
+    m.add_function(wrap_pyfunction!(hopfield::hopfield_candidates, m)?)?;
     Ok(())
 }

@@ -1,3 +1,4 @@
 //! Correspondence channels. Each submodule is one matcher of the paper (algorithms.md A-D).
 
 pub mod gabor;
+pub mod hopfield;

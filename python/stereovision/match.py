@@ -1,0 +1,81 @@
+"""``stereovision.match``: sparse correspondences of a stereo pair (feature-based channels)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy.typing as npt
+
+from stereovision._validate import as_bgr_uint8, check_pair
+from stereovision.calibration import Calibration
+from stereovision.depth import estimate_max_disparity
+from stereovision.matches import Matches
+from stereovision.matching import hopfield as _hopfield
+
+__all__ = ["METHODS", "match"]
+
+#: Matchers of :func:`match`: the Hopfield network (algorithms.md C) and its best-match
+#: reference without the network.
+METHODS = ("hopfield", "best")
+
+
+def match(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    calib: Calibration | None = None,
+    *,
+    method: str = "hopfield",
+    max_disparity: int | None = None,
+    **params: Any,
+) -> Matches:
+    """Match interest points between the two images of a stereo pair.
+
+    Parameters
+    ----------
+    left, right : array_like
+        ``(H, W)`` grey or ``(H, W, 3)`` BGR images (uint8, uint16 or float in ``[0, 1]``), same
+        shape. Rectified, unless ``calib`` is an unrectified rig calibration (the pair is then
+        rectified first and the matches are in rectified coordinates).
+    calib : Calibration, optional
+        Rig calibration of the pair.
+    method : {"hopfield", "best"}
+        ``"hopfield"``: the network (:func:`stereovision.matching.hopfield.hopfield_match`);
+        ``"best"``: the best-match reference without the network.
+    max_disparity : int, optional
+        Largest disparity searched (px). None estimates it from the pair
+        (:func:`stereovision.estimate_max_disparity`).
+    **params
+        Matcher parameters (:data:`stereovision.matching.hopfield.DEFAULTS`), plus
+        ``min_disparity``.
+
+    Returns
+    -------
+    Matches
+
+    Raises
+    ------
+    ValueError
+        Bad images (shape, dtype, empty, NaN, mismatched sizes), a calibration for another image
+        size, an unknown method or parameter.
+    """
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
+    gl, gr = check_pair(left, right)
+    if calib is not None:
+        if not isinstance(calib, Calibration):
+            raise ValueError(
+                f"calib must be a stereovision.Calibration, got {type(calib).__name__}"
+            )
+        h, w = gl.shape
+        if tuple(calib.image_size) != (w, h):
+            raise ValueError(
+                f"calibration is for {calib.image_size[0]}x{calib.image_size[1]} images, "
+                f"got {w}x{h}"
+            )
+        if not calib.rectified:
+            lb, rb = calib.rectify(as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right"))
+            gl, gr = check_pair(lb, rb)
+    if max_disparity is None:
+        max_disparity = estimate_max_disparity(gl, gr)
+    run = _hopfield.hopfield_match if method == "hopfield" else _hopfield.best_match
+    return run(gl, gr, max_disparity=max_disparity, **params)

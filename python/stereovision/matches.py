@@ -1,0 +1,117 @@
+"""Sparse correspondences: the result type of the feature-based channels (``stereovision.match``).
+
+Conventions (algorithms.md section 0): ``x`` = column, ``y`` = row, origin at the centre of the
+top-left pixel; disparity ``dx = x_left - x_right`` (>= 0 for a standard rig), ``dy = y_left -
+y_right`` (about 0 on rectified pairs), stored at the rounded left-image positions.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from stereovision.io import atomic_write
+
+__all__ = ["Matches"]
+
+F32 = npt.NDArray[np.float32]
+
+
+def _f32_1d(a: npt.ArrayLike, name: str) -> F32:
+    arr = np.ascontiguousarray(a, dtype=np.float32)
+    if arr.ndim != 1:
+        raise ValueError(f"{name}: expected a 1-D array, got shape {arr.shape}")
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class Matches:
+    """Point correspondences between a left and a right image.
+
+    Attributes
+    ----------
+    xl, yl : numpy.ndarray
+        ``(N,)`` float32 left-image positions (px).
+    xr, yr : numpy.ndarray
+        ``(N,)`` float32 matched right-image positions (px; ``xr`` sub-pixel).
+    score : numpy.ndarray
+        ``(N,)`` float32 match similarity (7x7 ZNCC, in ``[-1, 1]``).
+    image_shape : tuple of int
+        ``(H, W)`` of the left image (size of :attr:`dispx` / :attr:`dispy`).
+    energy_trace : numpy.ndarray
+        ``(n_sweeps + 1,)`` float64 network energy: initial state, then after every sweep (empty
+        for matchers without a network).
+    stats : dict
+        Counters of the run (points, neurons, weights, sweeps, converged, ...).
+    """
+
+    xl: F32
+    yl: F32
+    xr: F32
+    yr: F32
+    score: F32
+    image_shape: tuple[int, int]
+    energy_trace: npt.NDArray[np.float64] = field(
+        default_factory=lambda: np.zeros(0, dtype=np.float64)
+    )
+    stats: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        names = ("xl", "yl", "xr", "yr", "score")
+        arrs = [_f32_1d(getattr(self, n), n) for n in names]
+        if len({a.shape for a in arrs}) != 1:
+            raise ValueError(
+                f"xl, yl, xr, yr, score must have one length, got {[len(a) for a in arrs]}"
+            )
+        for n, a in zip(names, arrs, strict=True):
+            object.__setattr__(self, n, a)
+        h, w = (int(v) for v in self.image_shape)
+        if h <= 0 or w <= 0:
+            raise ValueError(f"image_shape must be positive (H, W), got {self.image_shape}")
+        object.__setattr__(self, "image_shape", (h, w))
+        object.__setattr__(
+            self, "energy_trace", np.asarray(self.energy_trace, dtype=np.float64).reshape(-1)
+        )
+
+    def __len__(self) -> int:
+        return int(self.xl.shape[0])
+
+    def _raster(self, values: F32) -> F32:
+        h, w = self.image_shape
+        out = np.full((h, w), np.nan, dtype=np.float32)
+        xi = np.rint(self.xl).astype(np.int64)
+        yi = np.rint(self.yl).astype(np.int64)
+        ok = (xi >= 0) & (xi < w) & (yi >= 0) & (yi < h)
+        out[yi[ok], xi[ok]] = values[ok]
+        return out
+
+    @property
+    def dispx(self) -> F32:
+        """``(H, W)`` float32 ``x_left - x_right`` at the matched left pixels, NaN elsewhere."""
+        return self._raster(self.xl - self.xr)
+
+    @property
+    def dispy(self) -> F32:
+        """``(H, W)`` float32 ``y_left - y_right`` at the matched left pixels, NaN elsewhere."""
+        return self._raster(self.yl - self.yr)
+
+    def to_array(self) -> F32:
+        """``(N, 4)`` float32 array of ``[x, y, x', y']`` (left then right position) per match."""
+        return np.stack([self.xl, self.yl, self.xr, self.yr], axis=1).astype(np.float32)
+
+    def save_csv(self, path: str | os.PathLike[str]) -> None:
+        """Write ``x_left,y_left,x_right,y_right,score`` rows (header first), atomically.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Destination; its directory must exist. The file is replaced only once fully written.
+        """
+        with atomic_write(path, "w") as fh:
+            fh.write("x_left,y_left,x_right,y_right,score\n")
+            for row in zip(self.xl, self.yl, self.xr, self.yr, self.score, strict=True):
+                fh.write(",".join(f"{float(v):.4f}" for v in row) + "\n")

@@ -1,0 +1,268 @@
+"""Hopfield-network channel (algorithms.md C with the C.10 changes), a thin wrapper of Rust.
+
+The kernel lives in ``rust/core/src/matching/hopfield``: Moravec interest points (squared
+differences, 3x3 non-maximum suppression, 0.1 % of the maximum), right candidates as 7x7 ZNCC
+peaks along the epipolar row (or the right image's interest points), a sparse binary Hopfield
+network over the candidate pairs (compatibility in the 40x40 window, uniqueness on both sides,
+similarity input) with asynchronous seeded sweeps until a sweep without a flip, C.5
+disambiguation, the C.10 depth-edge test and parabola sub-pixel refinement.
+
+:func:`best_match` is the same pipeline without the network (the best ZNCC candidate of every
+point): the reference the network is measured against.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from stereovision import _core
+from stereovision._validate import as_gray_float, check_pair
+from stereovision.matches import Matches
+
+__all__ = [
+    "DEFAULTS",
+    "InterestPoints",
+    "best_match",
+    "hopfield_candidates",
+    "hopfield_match",
+    "interest_points",
+    "moravec",
+]
+
+#: Default parameters (mirror ``HopfieldParams::default`` in Rust; algorithms.md C.3 + C.10).
+DEFAULTS: dict[str, Any] = {
+    "rel_threshold": 1e-3,  # interest threshold, fraction of max(M) (C.10: 0.1 %)
+    "nms_half": 1,  # 3x3 non-maximum suppression (C.10)
+    "tile": 64,  # threshold relative to the max of each 64x64 tile (spread; 0 = whole image)
+    "floor_rel": 1e-4,  # ... but never below 0.01 % of the image's max (flat areas stay empty)
+    "candidates": "row",  # "row": ZNCC peaks along the row (C.10); "points": right interest points
+    "dy_window": 2,  # epipolar band for "points" (px, C.3)
+    "s_min": 0.8,  # minimum candidate ZNCC (the real gate, C.10)
+    "k_cand": 8,  # candidates per left point (C.3)
+    "A": 3.0,  # compatibility weight (C.10)
+    "B": 1.5,  # uniqueness inhibition (C.3)
+    "D": 1.0,  # similarity weight (C.3)
+    "theta": 0.6,  # input offset (C.10)
+    "nbr_half": 20,  # compatibility window half-size: the paper's 40x40 (px)
+    "compat_theta": 2.0,  # disparity difference where compatibility crosses 0 (px, C.3)
+    "compat_slope": 2.0,  # steepness of the compatibility sigmoid (1/px, C.3)
+    "s_init": 0.8,  # neurons with ZNCC >= s_init start on (C.4)
+    "max_sweeps": 100,  # bound on asynchronous sweeps
+    "seed": 0,  # update-order seed
+    "tau_y": 1.0,  # disambiguation tolerance (px, C.5)
+    "edge_test": True,  # C.10 depth-edge test
+    "edge_tol": 1,  # half-window disparities agree within +-1 px (C.10)
+    "edge_margin": 0.0,  # half-window ZNCC slack vs its best (0 = C.10's literal test)
+    "edge_penalty": 0.0,  # input penalty of edge-test failures in the network (0 = test after)
+    "centre_tol": 0.05,  # centre grey-level difference (C.10)
+    "min_agree": 8,  # agreeing neighbour matches in the 40x40 window (C.10)
+    "agree_tol": 1,  # neighbours agree within +-1 px
+    "agree_share": 0.8,  # sparse areas: this share of the (< 8) neighbour matches agrees ...
+    "min_agree_sparse": 2,  # ... with at least 2 agreeing (0 share = C.10's rule only)
+    "subpixel": True,  # parabola refinement
+}
+
+
+@dataclass(frozen=True)
+class InterestPoints:
+    """Moravec interest points of one image.
+
+    Attributes
+    ----------
+    xy : numpy.ndarray
+        ``(N, 2)`` float32 ``(x, y)`` pixel positions, raster order.
+    values : numpy.ndarray
+        ``(N,)`` float32 interest values ``M`` (sums of squared grey-level differences).
+    response : numpy.ndarray
+        ``(H, W)`` float32 interest map ``M`` (0 within 3 px of the border).
+    """
+
+    xy: npt.NDArray[np.float32]
+    values: npt.NDArray[np.float32]
+    response: npt.NDArray[np.float32]
+
+    def __len__(self) -> int:
+        return int(self.xy.shape[0])
+
+
+def interest_points(
+    image: npt.ArrayLike,
+    *,
+    rel_threshold: float = 1e-3,
+    nms_half: int = 1,
+    tile: int = 64,
+    floor_rel: float = 1e-4,
+) -> InterestPoints:
+    """Moravec interest points (algorithms.md C.1 with the squares, C.10 densities).
+
+    ``M(x, y) = min(S_h, S_v, S_d, S_a)``, each ``S`` the 5x5 window sum of squared differences
+    of adjacent pixels in one direction; kept where ``M`` is a local maximum of its
+    ``(2 nms_half + 1)^2`` neighbourhood (ties go to the earlier pixel in raster order), ``M > 0``
+    and ``M >= max(rel_threshold * max_tile(M), floor_rel * max(M))`` where ``max_tile`` is the
+    largest ``M`` of the ``tile x tile`` block holding the pixel.
+
+    Parameters
+    ----------
+    image : array_like
+        ``(H, W)`` grey or ``(H, W, 3)`` BGR image, uint8, uint16 or float in ``[0, 1]``.
+    rel_threshold : float
+        Threshold as a fraction of the largest interest value, in ``[0, 1]``.
+    nms_half : int
+        Half-size of the non-maximum suppression neighbourhood (>= 1).
+    tile : int
+        Block size (px) of the relative threshold (0 = the whole image).
+    floor_rel : float
+        Lowest threshold, as a fraction of the image's largest interest value, in ``[0, 1]``.
+
+    Returns
+    -------
+    InterestPoints
+
+    Raises
+    ------
+    ValueError
+        Bad image (shape, dtype, empty, NaN) or parameters out of range.
+    """
+    img = as_gray_float(image, "image")
+    for name, v in (("rel_threshold", rel_threshold), ("floor_rel", floor_rel)):
+        if not (0.0 <= float(v) <= 1.0):
+            raise ValueError(f"{name} must lie in [0, 1], got {v!r}")
+    if int(nms_half) < 1:
+        raise ValueError(f"nms_half must be >= 1, got {nms_half!r}")
+    if int(tile) < 0:
+        raise ValueError(f"tile must be >= 0, got {tile!r}")
+    resp, xy, vals = _core.hopfield_interest(
+        img, float(rel_threshold), int(nms_half), int(tile), float(floor_rel)
+    )
+    return InterestPoints(xy=xy.astype(np.float32), values=vals, response=resp)
+
+
+def moravec(image: npt.ArrayLike) -> npt.NDArray[np.float32]:
+    """The Moravec interest map ``M`` of :func:`interest_points`, ``(H, W)`` float32."""
+    return interest_points(image).response
+
+
+def _params(max_disparity: int, min_disparity: int, params: dict[str, Any]) -> dict[str, Any]:
+    unknown = set(params) - set(DEFAULTS)
+    if unknown:
+        raise ValueError(f"unknown Hopfield parameter(s): {sorted(unknown)}")
+    for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+            if isinstance(v, (float, np.floating)) and np.isfinite(v) and v >= 0:
+                continue
+            raise ValueError(f"{name} must be a non-negative number of pixels, got {v!r}")
+    lo, hi = int(np.floor(min_disparity)), int(np.ceil(max_disparity))
+    if hi < lo:
+        raise ValueError(f"max_disparity ({max_disparity}) must be >= min_disparity ({lo})")
+    return {**DEFAULTS, **params, "min_disparity": lo, "max_disparity": hi}
+
+
+def _run(
+    method: str,
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    max_disparity: int,
+    min_disparity: int,
+    params: dict[str, Any],
+) -> Matches:
+    gl, gr = check_pair(left, right)
+    kw = _params(max_disparity, min_disparity, params)
+    kw["method"] = method
+    m, trace, stats = _core.hopfield_match(gl, gr, kw)
+    return Matches(
+        xl=m[:, 0],
+        yl=m[:, 1],
+        xr=m[:, 2],
+        yr=m[:, 3],
+        score=m[:, 4],
+        image_shape=(gl.shape[0], gl.shape[1]),
+        energy_trace=trace,
+        stats=dict(stats),
+    )
+
+
+def hopfield_match(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    *,
+    max_disparity: int,
+    min_disparity: int = 0,
+    **params: Any,
+) -> Matches:
+    """Match interest points of a rectified pair with the Hopfield network.
+
+    Parameters
+    ----------
+    left, right : array_like
+        Rectified pair, ``(H, W)`` grey or ``(H, W, 3)`` BGR, uint8, uint16 or float in
+        ``[0, 1]``, same shape.
+    max_disparity : int
+        Largest disparity searched (px).
+    min_disparity : int, optional
+        Smallest disparity searched (px, default 0).
+    **params
+        Overrides of :data:`DEFAULTS` (each documented there): ``rel_threshold``, ``nms_half``,
+        ``tile`` (px), ``floor_rel``,
+        ``candidates`` (``"row"`` or ``"points"``), ``dy_window`` (px), ``s_min``, ``k_cand``,
+        ``A``, ``B``, ``D``, ``theta``, ``nbr_half`` (px), ``compat_theta`` (px),
+        ``compat_slope`` (1/px), ``s_init``, ``max_sweeps``, ``seed``, ``tau_y`` (px),
+        ``edge_test``, ``edge_tol`` (px), ``edge_margin`` (ZNCC), ``edge_penalty``,
+        ``centre_tol`` (window-mean-free grey levels in [0, 1]), ``min_agree``, ``agree_tol``
+        (px), ``agree_share``, ``min_agree_sparse``, ``subpixel``.
+
+    Returns
+    -------
+    Matches
+        With ``energy_trace`` (initial energy, then one value per sweep) and ``stats``
+        (``n_points``, ``n_neurons``, ``n_weights``, ``sweeps``, ``converged``, ``n_selected``).
+
+    Raises
+    ------
+    ValueError
+        Bad images (shape, dtype, empty, NaN, mismatched sizes), an unknown parameter or a value
+        out of range.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> rng = np.random.default_rng(0)
+    >>> left = rng.random((60, 80), dtype=np.float32)
+    >>> right = np.roll(left, -5, axis=1)
+    >>> m = hopfield_match(left, right, max_disparity=16, min_agree=0)
+    >>> bool(np.all(np.abs((m.xl - m.xr) - 5) < 0.5)) and len(m) > 100
+    True
+    """
+    return _run("hopfield", left, right, max_disparity, min_disparity, params)
+
+
+def best_match(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    *,
+    max_disparity: int,
+    min_disparity: int = 0,
+    **params: Any,
+) -> Matches:
+    """The reference without the network: best ZNCC candidate per point, same points and filters.
+
+    Parameters and return value as :func:`hopfield_match` (the network parameters are ignored;
+    ``energy_trace`` is empty).
+    """
+    return _run("best", left, right, max_disparity, min_disparity, params)
+
+
+def hopfield_candidates(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    *,
+    max_disparity: int,
+    min_disparity: int = 0,
+    **params: Any,
+) -> npt.NDArray[np.float32]:
+    """Candidate neurons ``(M, 6)`` float32 ``[point, xl, yl, xr, yr, zncc]`` (parity tests)."""
+    gl, gr = check_pair(left, right)
+    return _core.hopfield_candidates(gl, gr, _params(max_disparity, min_disparity, params))

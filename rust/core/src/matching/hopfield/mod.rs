@@ -1,0 +1,564 @@
+//! Hopfield-network stereo matching of interest points (algorithms.md C, with the C.10 changes).
+//!
+//! Pipeline:
+//! 1. Moravec interest points of the left image ([`interest`]: squares, 3x3 NMS, 0.1 % of max).
+//! 2. Candidates per left point ([`CandidateMode`]): 7x7 ZNCC peaks along the epipolar row
+//!    (default, C.10), or the right image's interest points in the epipolar band (the paper's
+//!    point-to-point network, kept as a high-precision option). ZNCC `>= s_min`, best `k_cand`.
+//! 3. The sparse binary Hopfield network ([`network`]) over the candidates: compatibility in the
+//!    40x40 window, uniqueness on both sides, similarity input; asynchronous seeded sweeps until a
+//!    sweep without a flip.
+//! 4. Disambiguation of points left with several active candidates (C.5: local median of the
+//!    vertical disparity of single matches, tie-break on similarity, both sides).
+//! 5. Depth-edge filters (C.10): the four half-windows agree within +-1 px, centre grey-level
+//!    check, at least 8 agreeing neighbour matches; parabola sub-pixel refinement.
+//!
+//! [`best_match`] runs the same pipeline without the network (best ZNCC candidate per point):
+//! the reference the network has to beat.
+
+pub mod interest;
+pub mod network;
+mod simd;
+pub mod zncc;
+
+#[cfg(test)]
+mod tests;
+
+use std::collections::HashMap;
+
+use rayon::prelude::*;
+
+use crate::error::{CoreError, Result};
+use crate::image::{check_pair, Image};
+pub use interest::{interest_points, moravec, InterestParams, InterestPoint};
+pub use network::{build_weights, run_dynamics, Csr, Dynamics, EnergyWeights, Neuron};
+use zncc::{zncc_curves, Curves, RightStats, FULL, N_REGIONS, SIM_RADIUS};
+
+/// Where the right candidates of a left point come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CandidateMode {
+    /// ZNCC peaks along the epipolar row (C.10: contains the true match far more often).
+    Row,
+    /// Right-image interest points in the epipolar band (the paper's network).
+    Points,
+}
+
+/// Parameters of the Hopfield channel (defaults: algorithms.md C.3 with the C.10 changes).
+#[derive(Debug, Clone, PartialEq)]
+pub struct HopfieldParams {
+    /// Smallest disparity searched (px).
+    pub d_min: usize,
+    /// Largest disparity searched (px).
+    pub d_max: usize,
+    pub interest: InterestParams,
+    pub candidates: CandidateMode,
+    /// Epipolar band `|y_l - y_r|` for [`CandidateMode::Points`] (px, C.3).
+    pub dy_window: usize,
+    /// Minimum ZNCC of a candidate (the real gate of the network, C.10).
+    pub s_min: f32,
+    /// Candidates kept per left point (C.3; C.10: never binds).
+    pub k_cand: usize,
+    pub weights: EnergyWeights,
+    /// Neurons with `S >= s_init` start on (C.4 "preset possible matches").
+    pub s_init: f32,
+    /// Upper bound on asynchronous sweeps.
+    pub max_sweeps: usize,
+    /// Seed of the update order.
+    pub seed: u64,
+    /// Disambiguation tolerance on the vertical disparity (px, C.5).
+    pub tau_y: f32,
+    /// Depth-edge test (half-windows, centre check, neighbour agreement; C.10).
+    pub edge_test: bool,
+    /// Half-window disparities must agree with the match within this many px (C.10: 1).
+    pub edge_tol: usize,
+    /// Half-window ZNCC at the match may fall this far below the half's best (0 = the match
+    /// must be each half's best disparity, C.10's literal test).
+    pub edge_margin: f32,
+    /// Input penalty of neurons failing the depth-edge test (0 = the network ignores the test,
+    /// which is then applied after the dynamics only).
+    pub edge_penalty: f32,
+    /// Centre grey-level difference allowed between the matched pixels (C.10: 0.05).
+    pub centre_tol: f32,
+    /// Agreeing neighbour matches required in the 40x40 window (C.10: 8).
+    pub min_agree: usize,
+    /// Sparse-area alternative to `min_agree`: this share of the neighbour matches agrees
+    /// (0 = off, C.10's rule only). 0.8: weakly textured areas (wood2's plank, laundry's
+    /// basket, playground's left edge) have fewer than 8 matched neighbours in the window.
+    pub agree_share: f32,
+    /// ... with at least this many agreeing neighbours (2: one neighbour could agree by chance).
+    pub min_agree_sparse: usize,
+    /// Neighbour matches agree when their disparities differ by at most this (px).
+    pub agree_tol: i32,
+    /// Parabola sub-pixel refinement of the final matches.
+    pub subpixel: bool,
+}
+
+impl Default for HopfieldParams {
+    fn default() -> Self {
+        HopfieldParams {
+            d_min: 0,
+            d_max: 64,
+            interest: InterestParams::default(),
+            candidates: CandidateMode::Row,
+            dy_window: 2,
+            s_min: DEFAULT_S_MIN,
+            k_cand: 8,
+            weights: EnergyWeights::default(),
+            s_init: 0.8,
+            max_sweeps: 100,
+            seed: 0,
+            tau_y: 1.0,
+            edge_test: true,
+            edge_tol: 1,
+            edge_margin: 0.0,
+            edge_penalty: 0.0,
+            centre_tol: 0.05,
+            min_agree: 8,
+            agree_tol: 1,
+            agree_share: 0.8,
+            min_agree_sparse: 2,
+            subpixel: true,
+        }
+    }
+}
+
+/// Default minimum candidate ZNCC.
+pub const DEFAULT_S_MIN: f32 = 0.8;
+
+/// One final match.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Match {
+    pub xl: f32,
+    pub yl: f32,
+    pub xr: f32,
+    pub yr: f32,
+    /// ZNCC of the 7x7 windows at the integer match.
+    pub score: f32,
+}
+
+/// Result of [`hopfield_match`] / [`best_match`], with the network's statistics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HopfieldOutput {
+    pub matches: Vec<Match>,
+    /// Energy of the initial state, then after every sweep (empty for [`best_match`]).
+    pub energy_trace: Vec<f64>,
+    pub n_points: usize,
+    pub n_neurons: usize,
+    pub n_weights: usize,
+    pub sweeps: usize,
+    pub converged: bool,
+    /// Matches chosen before the depth-edge filters.
+    pub n_selected: usize,
+}
+
+fn validate(left: &Image, right: &Image, p: &HopfieldParams) -> Result<()> {
+    check_pair(left, right)?;
+    if p.d_max < p.d_min {
+        return Err(CoreError::param(
+            "max_disparity",
+            format!("must be >= min_disparity ({}), got {}", p.d_min, p.d_max),
+        ));
+    }
+    if !(p.interest.rel_threshold.is_finite() && (0.0..=1.0).contains(&p.interest.rel_threshold)) {
+        return Err(CoreError::param("rel_threshold", "must lie in [0, 1]"));
+    }
+    if !(p.interest.floor_rel.is_finite() && (0.0..=1.0).contains(&p.interest.floor_rel)) {
+        return Err(CoreError::param("floor_rel", "must lie in [0, 1]"));
+    }
+    if p.interest.nms_half == 0 {
+        return Err(CoreError::param("nms_half", "must be >= 1"));
+    }
+    for (name, v) in [("s_min", p.s_min), ("s_init", p.s_init)] {
+        if !v.is_finite() || !(-1.0..=1.0).contains(&v) {
+            return Err(CoreError::param(
+                name,
+                format!("must lie in [-1, 1], got {v}"),
+            ));
+        }
+    }
+    if p.k_cand == 0 {
+        return Err(CoreError::param("k_cand", "must be >= 1"));
+    }
+    if p.max_sweeps == 0 {
+        return Err(CoreError::param("max_sweeps", "must be >= 1"));
+    }
+    let w = &p.weights;
+    for (name, v) in [
+        ("A", w.a),
+        ("B", w.b),
+        ("D", w.d),
+        ("theta", w.theta),
+        ("compat_theta", w.compat_theta),
+        ("compat_slope", w.compat_slope),
+        ("tau_y", p.tau_y),
+        ("centre_tol", p.centre_tol),
+    ] {
+        if !v.is_finite() {
+            return Err(CoreError::param(name, format!("must be finite, got {v}")));
+        }
+    }
+    if w.nbr_half < 1 {
+        return Err(CoreError::param("nbr_half", "must be >= 1"));
+    }
+    Ok(())
+}
+
+/// Rows of the right image holding right interest points (points mode).
+fn right_rows(right: &Image, p: &HopfieldParams) -> HashMap<usize, Vec<usize>> {
+    let mut rows: HashMap<usize, Vec<usize>> = HashMap::new();
+    if p.candidates == CandidateMode::Points {
+        for rp in interest_points(right, &p.interest) {
+            rows.entry(rp.y as usize).or_default().push(rp.x as usize);
+        }
+    }
+    rows
+}
+
+/// First index of the maximum of `c[lo..=hi]` (None when the curve is all zeros: undefined).
+fn argmax(c: &[f32], lo: usize, hi: usize) -> Option<usize> {
+    let mut best: Option<(f32, usize)> = None;
+    for (d, &v) in c.iter().enumerate().take(hi + 1).skip(lo) {
+        if best.is_none_or(|b| v > b.0) {
+            best = Some((v, d));
+        }
+    }
+    best.filter(|b| b.0 > 0.0).map(|b| b.1)
+}
+
+/// Parabola vertex offset through `(d-1, a), (d, b), (d+1, c)`, clamped to +-0.5.
+fn parabola(a: f32, b: f32, c: f32) -> f32 {
+    let den = a - 2.0 * b + c;
+    if den >= 0.0 {
+        return 0.0;
+    }
+    (0.5 * (a - c) / den).clamp(-0.5, 0.5)
+}
+
+/// Candidate neurons of every left point, grouped by point (point order, then best ZNCC first),
+/// with their depth-edge verdict and sub-pixel offset.
+fn candidates(
+    left: &Image,
+    right: &Image,
+    pts: &[InterestPoint],
+    p: &HopfieldParams,
+) -> Vec<Neuron> {
+    let stats = RightStats::new(right);
+    let (w, h) = right.size();
+    let rows = right_rows(right, p);
+    let per_point: Vec<Vec<Neuron>> = pts
+        .par_iter()
+        .enumerate()
+        .map_init(Curves::default, |cv, (i, pt)| {
+            let (x, y) = (pt.x as usize, pt.y as usize);
+            let d_hi = p.d_max.min(x.saturating_sub(SIM_RADIUS));
+            if x < SIM_RADIUS || x + SIM_RADIUS >= w || d_hi < p.d_min {
+                return Vec::new();
+            }
+            let mut out: Vec<Neuron> = Vec::new();
+            let row_list: Vec<usize> = match p.candidates {
+                CandidateMode::Row => vec![y],
+                CandidateMode::Points => {
+                    let lo = y.saturating_sub(p.dy_window).max(SIM_RADIUS);
+                    let hi = (y + p.dy_window).min(h.saturating_sub(SIM_RADIUS + 1));
+                    (lo..=hi).filter(|yr| rows.contains_key(yr)).collect()
+                }
+            };
+            for yr in row_list {
+                zncc_curves(left, right, &stats, x, y, yr, d_hi, cv);
+                let full = &cv.curve[FULL];
+                // Best ZNCC of every half-window over the range (None: undefined / textureless).
+                let halves: Vec<Option<f32>> = (1..N_REGIONS)
+                    .map(|k| argmax(&cv.curve[k], p.d_min, d_hi).map(|a| cv.curve[k][a]))
+                    .collect();
+                let mut ds: Vec<usize> = Vec::new();
+                match p.candidates {
+                    CandidateMode::Row => {
+                        for d in p.d_min..=d_hi {
+                            let c = full[d];
+                            let ok_lo = d == p.d_min || c >= full[d - 1];
+                            let ok_hi = d == d_hi || c > full[d + 1];
+                            if c >= p.s_min && ok_lo && ok_hi {
+                                ds.push(d);
+                            }
+                        }
+                    }
+                    CandidateMode::Points => {
+                        for &xr in rows.get(&yr).map(|v| v.as_slice()).unwrap_or(&[]) {
+                            if xr <= x
+                                && (p.d_min..=d_hi).contains(&(x - xr))
+                                && full[x - xr] >= p.s_min
+                            {
+                                ds.push(x - xr);
+                            }
+                        }
+                    }
+                }
+                for d in ds {
+                    let xr = x - d;
+                    // Each half-window must find this disparity (within edge_tol px) as good as
+                    // its best anywhere in the range, up to edge_margin: a half lying on another
+                    // surface prefers that surface's disparity by far more, while a periodic
+                    // texture's equal peaks (laundry's basket) stay acceptable.
+                    let lo = d.saturating_sub(p.edge_tol).max(p.d_min);
+                    let hi = (d + p.edge_tol).min(d_hi);
+                    let halves_ok = halves.iter().enumerate().all(|(k, best)| {
+                        best.is_some_and(|best| {
+                            let c = &cv.curve[k + 1][lo..=hi];
+                            c.iter().copied().fold(f32::MIN, f32::max) >= best - p.edge_margin
+                        })
+                    });
+                    // Centre check on window-mean-free grey levels: insensitive to the exposure
+                    // offset between the cameras (ETH3D, KITTI), still catches a centre pixel
+                    // that belongs to the other surface.
+                    let lc = left.at(x, y) - cv.left_mean;
+                    let rc = right.at(xr, yr) - stats.mean(xr, yr);
+                    let centre_ok = (lc - rc).abs() <= p.centre_tol;
+                    let sub = if p.subpixel && d >= 1 && d < d_hi {
+                        parabola(full[d - 1], full[d], full[d + 1])
+                    } else {
+                        0.0
+                    };
+                    out.push(Neuron {
+                        point: i as u32,
+                        xl: x as i32,
+                        yl: y as i32,
+                        xr: xr as i32,
+                        yr: yr as i32,
+                        sim: full[d],
+                        edge_ok: halves_ok && centre_ok,
+                        sub,
+                    });
+                }
+            }
+            out.sort_by(|a, b| {
+                b.sim
+                    .total_cmp(&a.sim)
+                    .then(a.xr.cmp(&b.xr))
+                    .then(a.yr.cmp(&b.yr))
+            });
+            out.truncate(p.k_cand);
+            out
+        })
+        .collect();
+    per_point.into_iter().flatten().collect()
+}
+
+fn median(v: &mut [f32]) -> f32 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    v.sort_by(f32::total_cmp);
+    let n = v.len();
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+/// C.5 disambiguation: indices of the kept active neurons (at most one per left point and one
+/// per right pixel).
+fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usize> {
+    // Active neurons per left point (neurons are grouped by point): singles kept as they are.
+    let m = neurons.len();
+    let mut singles: Vec<usize> = Vec::new();
+    let mut ambiguous: Vec<Vec<usize>> = Vec::new();
+    let mut a = 0;
+    while a < m {
+        let mut e = a;
+        while e < m && neurons[e].point == neurons[a].point {
+            e += 1;
+        }
+        let n_on = (a..e).filter(|&b| state[b] == 1).count();
+        if n_on == 1 {
+            singles.extend((a..e).filter(|&b| state[b] == 1));
+        } else if n_on > 1 {
+            ambiguous.push((a..e).filter(|&b| state[b] == 1).collect());
+        }
+        a = e;
+    }
+    let mut all_dy: Vec<f32> = singles.iter().map(|&s| neurons[s].dy() as f32).collect();
+    let global = median(&mut all_dy);
+    let half = p.weights.nbr_half;
+    // Reference vertical disparity: median over the single matches in the 40x40 window.
+    let local_ref = |a: usize| -> f32 {
+        let n = &neurons[a];
+        let mut v: Vec<f32> = singles
+            .iter()
+            .filter(|&&s| {
+                (neurons[s].xl - n.xl).abs() <= half && (neurons[s].yl - n.yl).abs() <= half
+            })
+            .map(|&s| neurons[s].dy() as f32)
+            .collect();
+        if v.is_empty() {
+            global
+        } else {
+            median(&mut v)
+        }
+    };
+    // Closest to the reference, then higher similarity, then lower index; None if too far.
+    let pick = |group: &[usize]| -> Option<usize> {
+        let mut best: Option<(f32, f32, usize)> = None;
+        for &a in group {
+            let key = (
+                (neurons[a].dy() as f32 - local_ref(a)).abs(),
+                -neurons[a].sim,
+                a,
+            );
+            if best.is_none_or(|b| (key.0, key.1, key.2) < (b.0, b.1, b.2)) {
+                best = Some(key);
+            }
+        }
+        best.filter(|b| b.0 <= p.tau_y).map(|b| b.2)
+    };
+    let mut kept = singles.clone();
+    kept.extend(ambiguous.iter().filter_map(|g| pick(g)));
+    // The same rule on the right side (neurons sharing a right pixel).
+    kept.sort_unstable_by_key(|&a| (neurons[a].yr, neurons[a].xr, a));
+    let mut out: Vec<usize> = Vec::with_capacity(kept.len());
+    let mut i = 0;
+    while i < kept.len() {
+        let key = (neurons[kept[i]].yr, neurons[kept[i]].xr);
+        let mut j = i;
+        while j < kept.len() && (neurons[kept[j]].yr, neurons[kept[j]].xr) == key {
+            j += 1;
+        }
+        if j - i == 1 {
+            out.push(kept[i]);
+        } else if let Some(a) = pick(&kept[i..j]) {
+            out.push(a);
+        }
+        i = j;
+    }
+    out.sort_unstable();
+    out
+}
+
+/// Depth-edge filters and sub-pixel refinement of the selected neurons.
+fn finish(
+    left: &Image,
+    right: &Image,
+    neurons: &[Neuron],
+    chosen: &[usize],
+    p: &HopfieldParams,
+) -> Vec<Match> {
+    let _ = (left, right);
+    // Stage 1: the per-candidate depth-edge verdict (computed with the ZNCC curves).
+    let stage1: Vec<Option<(usize, f32)>> = chosen
+        .iter()
+        .map(|&a| {
+            let n = &neurons[a];
+            (!p.edge_test || n.edge_ok).then_some((a, n.dx() as f32 + n.sub))
+        })
+        .collect();
+    let survivors: Vec<(usize, f32)> = stage1.into_iter().flatten().collect();
+    // Stage 2: neighbour agreement among the survivors (uniform grid, cell = window half-size).
+    let half = p.weights.nbr_half.max(1);
+    let sxy: Vec<(i32, i32)> = survivors
+        .iter()
+        .map(|&(a, _)| (neurons[a].xl.max(0), neurons[a].yl.max(0)))
+        .collect();
+    let grid = network::PointGrid::new(&sxy, half);
+    survivors
+        .par_iter()
+        .enumerate()
+        .filter(|&(s, &(a, _))| {
+            if !p.edge_test {
+                return true;
+            }
+            let d = neurons[a].dx();
+            let (mut agree, mut near) = (0usize, 0usize);
+            grid.for_each_near(&sxy, s, half, |t| {
+                near += 1;
+                if (neurons[survivors[t].0].dx() - d).abs() <= p.agree_tol {
+                    agree += 1;
+                }
+            });
+            // Dense areas: at least min_agree agreeing neighbours (C.10). Sparse areas (weak
+            // texture) optionally: a large share of the few neighbours, at least min_agree_sparse.
+            agree >= p.min_agree
+                || (p.agree_share > 0.0
+                    && agree >= p.min_agree_sparse
+                    && agree as f32 >= p.agree_share * near as f32)
+        })
+        .map(|(_, &(a, dsub))| {
+            let n = &neurons[a];
+            Match {
+                xl: n.xl as f32,
+                yl: n.yl as f32,
+                xr: n.xl as f32 - dsub,
+                yr: n.yr as f32,
+                score: n.sim,
+            }
+        })
+        .collect()
+}
+
+/// Interest points and candidate neurons (exposed for tests and the reference comparison).
+pub fn candidate_neurons(
+    left: &Image,
+    right: &Image,
+    p: &HopfieldParams,
+) -> Result<(Vec<InterestPoint>, Vec<Neuron>)> {
+    validate(left, right, p)?;
+    let pts = interest_points(left, &p.interest);
+    let neurons = candidates(left, right, &pts, p);
+    Ok((pts, neurons))
+}
+
+/// The Hopfield channel: interest points matched by energy minimisation (see the module docs).
+pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result<HopfieldOutput> {
+    let (pts, neurons) = candidate_neurons(left, right, p)?;
+    let csr = build_weights(&neurons, &p.weights);
+    let input: Vec<f64> = neurons
+        .iter()
+        .map(|n| {
+            let penalty = if p.edge_test && !n.edge_ok {
+                p.edge_penalty
+            } else {
+                0.0
+            };
+            (p.weights.d * n.sim - p.weights.theta - penalty) as f64
+        })
+        .collect();
+    let init: Vec<u8> = neurons
+        .iter()
+        .map(|n| u8::from(n.sim >= p.s_init))
+        .collect();
+    let dynamics = run_dynamics(&csr, &input, &init, p.seed, p.max_sweeps);
+    let chosen = disambiguate(&neurons, &dynamics.state, p);
+    let matches = finish(left, right, &neurons, &chosen, p);
+    Ok(HopfieldOutput {
+        matches,
+        energy_trace: dynamics.energy_trace,
+        n_points: pts.len(),
+        n_neurons: neurons.len(),
+        n_weights: csr.nnz(),
+        sweeps: dynamics.sweeps,
+        converged: dynamics.converged,
+        n_selected: chosen.len(),
+    })
+}
+
+/// The best-match reference: same points, candidates and filters, no network (the best ZNCC
+/// candidate of every point).
+pub fn best_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result<HopfieldOutput> {
+    let (pts, neurons) = candidate_neurons(left, right, p)?;
+    let mut chosen = Vec::new();
+    for (a, n) in neurons.iter().enumerate() {
+        if a == 0 || neurons[a - 1].point != n.point {
+            chosen.push(a); // candidates are sorted best first within a point
+        }
+    }
+    let matches = finish(left, right, &neurons, &chosen, p);
+    Ok(HopfieldOutput {
+        matches,
+        energy_trace: Vec::new(),
+        n_points: pts.len(),
+        n_neurons: neurons.len(),
+        n_weights: 0,
+        sweeps: 0,
+        converged: true,
+        n_selected: chosen.len(),
+    })
+}

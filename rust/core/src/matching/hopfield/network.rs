@@ -1,0 +1,398 @@
+//! The sparse binary Hopfield network over candidate pairs (algorithms.md C.4, C.6).
+//!
+//! Weights `T_ab = A * C~_ab - B [same left point] - B [same right pixel]` (zero diagonal,
+//! symmetric by construction: every entry is a symmetric function of the pair), inputs
+//! `I_a = D * S_a - theta`. The CSR rows are built independently per neuron (rayon) from a
+//! uniform grid of the left points. Dynamics: asynchronous binary threshold updates in a seeded
+//! random order, net inputs maintained incrementally, until a sweep without a flip.
+
+use rayon::prelude::*;
+
+/// One neuron: left point index, right position and disparity vector `(x_l - x_r, y_l - y_r)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Neuron {
+    pub point: u32,
+    pub xl: i32,
+    pub yl: i32,
+    pub xr: i32,
+    pub yr: i32,
+    pub sim: f32,
+    /// Passed the depth-edge test (four half-windows agree, centre grey-level check).
+    pub edge_ok: bool,
+    /// Parabola sub-pixel offset of the disparity (px, in [-0.5, 0.5]).
+    pub sub: f32,
+}
+
+impl Neuron {
+    #[inline]
+    pub fn dx(&self) -> i32 {
+        self.xl - self.xr
+    }
+    #[inline]
+    pub fn dy(&self) -> i32 {
+        self.yl - self.yr
+    }
+}
+
+/// Weights of the energy (C.4 with the C.10 defaults).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EnergyWeights {
+    /// Compatibility weight `A` (C.10: 3; 1 is less precise than no network).
+    pub a: f32,
+    /// Uniqueness inhibition `B` (C.3: 1.5).
+    pub b: f32,
+    /// Similarity weight `D` (C.3: 1).
+    pub d: f32,
+    /// Input offset `theta` (C.10: 0.6): a neuron needs `D S > theta` or support to switch on.
+    pub theta: f32,
+    /// Compatibility neighbourhood half-size (px): the paper's 40x40 window.
+    pub nbr_half: i32,
+    /// Disparity difference (px) at which compatibility crosses 0 (C.3).
+    pub compat_theta: f32,
+    /// Steepness of the compatibility sigmoid (1/px, C.3).
+    pub compat_slope: f32,
+}
+
+impl Default for EnergyWeights {
+    fn default() -> Self {
+        EnergyWeights {
+            a: 3.0,
+            b: 1.5,
+            d: 1.0,
+            theta: 0.6,
+            nbr_half: 20,
+            compat_theta: 2.0,
+            compat_slope: 2.0,
+        }
+    }
+}
+
+/// `C(dist) = 2 / (1 + exp(slope (dist - theta))) - 1`, in `(-1, 1)`.
+pub fn compat(dist: f64, theta: f64, slope: f64) -> f64 {
+    2.0 / (1.0 + (slope * (dist - theta)).exp()) - 1.0
+}
+
+/// Symmetric sparse weight matrix in CSR form.
+#[derive(Debug, Clone, Default)]
+pub struct Csr {
+    pub indptr: Vec<usize>,
+    pub indices: Vec<u32>,
+    pub data: Vec<f32>,
+}
+
+impl Csr {
+    pub fn n(&self) -> usize {
+        self.indptr.len().saturating_sub(1)
+    }
+    pub fn nnz(&self) -> usize {
+        self.indices.len()
+    }
+    #[inline]
+    pub fn row(&self, a: usize) -> (&[u32], &[f32]) {
+        let (s, e) = (self.indptr[a], self.indptr[a + 1]);
+        (&self.indices[s..e], &self.data[s..e])
+    }
+}
+
+/// Uniform grid over the left points (cell = the compatibility half-window), counting-sorted.
+pub(crate) struct PointGrid {
+    cell: i32,
+    gw: i32,
+    gh: i32,
+    start: Vec<usize>,
+    items: Vec<u32>,
+}
+
+impl PointGrid {
+    pub(crate) fn new(pxy: &[(i32, i32)], cell: i32) -> Self {
+        let gw = pxy.iter().map(|p| p.0 / cell).max().unwrap_or(0) + 1;
+        let gh = pxy.iter().map(|p| p.1 / cell).max().unwrap_or(0) + 1;
+        let idx = |p: &(i32, i32)| ((p.1 / cell) * gw + p.0 / cell) as usize;
+        let mut start = vec![0usize; (gw * gh) as usize + 1];
+        for p in pxy {
+            start[idx(p) + 1] += 1;
+        }
+        for i in 1..start.len() {
+            start[i] += start[i - 1];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u32; pxy.len()];
+        for (k, p) in pxy.iter().enumerate() {
+            let c = idx(p);
+            items[fill[c]] = k as u32;
+            fill[c] += 1;
+        }
+        PointGrid {
+            cell,
+            gw,
+            gh,
+            start,
+            items,
+        }
+    }
+
+    /// Calls `f(q)` for every point `q != p` with `|dx| <= half` and `|dy| <= half`.
+    pub(crate) fn for_each_near(
+        &self,
+        pxy: &[(i32, i32)],
+        p: usize,
+        half: i32,
+        mut f: impl FnMut(usize),
+    ) {
+        let (x, y) = pxy[p];
+        let (cx, cy) = (x / self.cell, y / self.cell);
+        for gy in (cy - 1).max(0)..=(cy + 1).min(self.gh - 1) {
+            for gx in (cx - 1).max(0)..=(cx + 1).min(self.gw - 1) {
+                let c = (gy * self.gw + gx) as usize;
+                for &q in &self.items[self.start[c]..self.start[c + 1]] {
+                    let q = q as usize;
+                    let (qx, qy) = pxy[q];
+                    if q != p && (qx - x).abs() <= half && (qy - y).abs() <= half {
+                        f(q);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Builds the CSR weights. `neurons` must be grouped by `point` in increasing order and have
+/// non-negative coordinates.
+pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
+    let m = neurons.len();
+    if m == 0 {
+        return Csr {
+            indptr: vec![0],
+            ..Csr::default()
+        };
+    }
+    // Points and their neuron ranges.
+    let mut starts: Vec<usize> = Vec::new();
+    for (a, nr) in neurons.iter().enumerate() {
+        if a == 0 || nr.point != neurons[a - 1].point {
+            starts.push(a);
+        }
+    }
+    let n_pts = starts.len();
+    starts.push(m);
+    let pxy: Vec<(i32, i32)> = (0..n_pts)
+        .map(|p| (neurons[starts[p]].xl.max(0), neurons[starts[p]].yl.max(0)))
+        .collect();
+    let half = w.nbr_half.max(1);
+    let grid = PointGrid::new(&pxy, half);
+    // Neighbour lists (left points with candidates in the 40x40 window) and n_i = their count.
+    let near: Vec<Vec<u32>> = (0..n_pts)
+        .into_par_iter()
+        .map(|p| {
+            let mut v = Vec::with_capacity(64);
+            grid.for_each_near(&pxy, p, half, |q| v.push(q as u32));
+            v
+        })
+        .collect();
+    let n_count: Vec<f32> = near.iter().map(|v| v.len() as f32).collect();
+    // Neurons sharing a right pixel (column inhibition), wherever their left points are:
+    // neuron indices sorted by right pixel, and each neuron's group range in that order.
+    let mut by_right: Vec<u32> = (0..m as u32).collect();
+    let key = |a: u32| (neurons[a as usize].yr, neurons[a as usize].xr);
+    by_right.sort_unstable_by_key(|&a| (key(a), a));
+    let mut group = vec![(0usize, 0usize); m];
+    let mut g0 = 0;
+    for k in 1..=m {
+        if k == m || key(by_right[k]) != key(by_right[g0]) {
+            for &a in &by_right[g0..k] {
+                group[a as usize] = (g0, k);
+            }
+            g0 = k;
+        }
+    }
+    // Compatibility lookup over the integer squared disparity-vector difference.
+    let span = |f: fn(&Neuron) -> i32| {
+        let lo = neurons.iter().map(f).min().unwrap_or(0);
+        let hi = neurons.iter().map(f).max().unwrap_or(0);
+        (hi - lo) as usize
+    };
+    let (max_dx, max_dy) = (span(Neuron::dx), span(Neuron::dy));
+    let lut: Vec<f32> = (0..=max_dx * max_dx + max_dy * max_dy)
+        .map(|q| {
+            compat(
+                (q as f64).sqrt(),
+                w.compat_theta as f64,
+                w.compat_slope as f64,
+            ) as f32
+        })
+        .collect();
+    // Rows of every neuron of a point, built together (one allocation per point).
+    let blocks: Vec<(Vec<usize>, Vec<u32>, Vec<f32>)> = (0..n_pts)
+        .into_par_iter()
+        .map(|p| {
+            let n_here = starts[p + 1] - starts[p];
+            let cap: usize = near[p]
+                .iter()
+                .map(|&q| starts[q as usize + 1] - starts[q as usize])
+                .sum::<usize>()
+                * n_here
+                + n_here * (n_here + 2);
+            let mut lens = Vec::with_capacity(n_here);
+            let mut idx = Vec::with_capacity(cap);
+            let mut val = Vec::with_capacity(cap);
+            for a in starts[p]..starts[p + 1] {
+                let before = idx.len();
+                let na = &neurons[a];
+                // Same left point: uniqueness (row) inhibition.
+                for b in starts[p]..starts[p + 1] {
+                    if b != a {
+                        idx.push(b as u32);
+                        val.push(-w.b);
+                    }
+                }
+                // Same right pixel, other left point: uniqueness (column) inhibition.
+                let (gs, ge) = group[a];
+                for &b in &by_right[gs..ge] {
+                    if neurons[b as usize].point != na.point {
+                        idx.push(b);
+                        val.push(-w.b);
+                    }
+                }
+                // Compatibility with the candidates of the other points in the 40x40 window.
+                for &q in &near[p] {
+                    let q = q as usize;
+                    let norm = w.a / n_count[p].max(n_count[q]).max(1.0);
+                    let (qs, qe) = (starts[q], starts[q + 1]);
+                    for (b, nb) in neurons.iter().enumerate().take(qe).skip(qs) {
+                        if nb.xr == na.xr && nb.yr == na.yr {
+                            continue; // inhibited above; compatibility needs l != k
+                        }
+                        let ex = (na.dx() - nb.dx()).unsigned_abs() as usize;
+                        let ey = (na.dy() - nb.dy()).unsigned_abs() as usize;
+                        idx.push(b as u32);
+                        val.push(norm * lut[ex * ex + ey * ey]);
+                    }
+                }
+                lens.push(idx.len() - before);
+            }
+            (lens, idx, val)
+        })
+        .collect();
+    let nnz: usize = blocks.iter().map(|b| b.1.len()).sum();
+    let mut indptr = Vec::with_capacity(m + 1);
+    indptr.push(0usize);
+    let mut indices = Vec::with_capacity(nnz);
+    let mut data = Vec::with_capacity(nnz);
+    for (lens, idx, val) in blocks {
+        for l in lens {
+            let last = *indptr.last().unwrap_or(&0);
+            indptr.push(last + l);
+        }
+        indices.extend_from_slice(&idx);
+        data.extend_from_slice(&val);
+    }
+    Csr {
+        indptr,
+        indices,
+        data,
+    }
+}
+
+/// SplitMix64: a tiny, well-mixed generator (mirrored exactly by the NumPy reference).
+#[derive(Debug, Clone)]
+pub struct SplitMix64(u64);
+
+impl SplitMix64 {
+    pub fn new(seed: u64) -> Self {
+        SplitMix64(seed)
+    }
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Fisher-Yates shuffle (`j = next % (i + 1)` for `i = n-1 .. 1`).
+    pub fn shuffle(&mut self, v: &mut [u32]) {
+        for i in (1..v.len()).rev() {
+            let j = (self.next_u64() % (i as u64 + 1)) as usize;
+            v.swap(i, j);
+        }
+    }
+}
+
+/// Final state of the dynamics.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dynamics {
+    /// Neuron states (0/1).
+    pub state: Vec<u8>,
+    /// Energy of the initial state, then after every sweep.
+    pub energy_trace: Vec<f64>,
+    /// Sweeps run (the last one without a flip when `converged`).
+    pub sweeps: usize,
+    pub converged: bool,
+}
+
+/// Energy `E = -1/2 V^T T V - I^T V` from the net inputs `u = T V + I`.
+fn energy(state: &[u8], u: &[f64], input: &[f64]) -> f64 {
+    state
+        .iter()
+        .zip(u.iter().zip(input))
+        .filter(|(&v, _)| v == 1)
+        .map(|(_, (&ua, &ia))| -(0.5 * (ua - ia) + ia))
+        .sum()
+}
+
+/// Runs the asynchronous dynamics from `init` until a sweep without a flip (or `max_sweeps`).
+pub fn run_dynamics(
+    csr: &Csr,
+    input: &[f64],
+    init: &[u8],
+    seed: u64,
+    max_sweeps: usize,
+) -> Dynamics {
+    let m = csr.n();
+    let mut state = init.to_vec();
+    let mut u = input.to_vec();
+    for (a, &on) in init.iter().enumerate().take(m) {
+        if on == 1 {
+            let (idx, val) = csr.row(a);
+            for (&b, &t) in idx.iter().zip(val) {
+                u[b as usize] += t as f64;
+            }
+        }
+    }
+    let mut trace = vec![energy(&state, &u, input)];
+    let mut rng = SplitMix64::new(seed);
+    let mut order: Vec<u32> = (0..m as u32).collect();
+    let mut sweeps = 0;
+    let mut converged = m == 0;
+    while !converged && sweeps < max_sweeps {
+        rng.shuffle(&mut order);
+        let mut flips = 0usize;
+        for &a in &order {
+            let a = a as usize;
+            let new = if u[a] > 0.0 {
+                1
+            } else if u[a] < 0.0 {
+                0
+            } else {
+                state[a]
+            };
+            if new != state[a] {
+                state[a] = new;
+                flips += 1;
+                let sign = if new == 1 { 1.0 } else { -1.0 };
+                let (idx, val) = csr.row(a);
+                for (&b, &t) in idx.iter().zip(val) {
+                    u[b as usize] += sign * t as f64;
+                }
+            }
+        }
+        sweeps += 1;
+        trace.push(energy(&state, &u, input));
+        converged = flips == 0;
+    }
+    Dynamics {
+        state,
+        energy_trace: trace,
+        sweeps,
+        converged,
+    }
+}

@@ -1,0 +1,29 @@
+//! Runtime CPU-feature dispatch for the hot ZNCC kernel (same scheme as `gabor::simd`, kept
+//! local so the two channels stay independent): the body is compiled for baseline x86-64 and
+//! inside a `#[target_feature(enable = "avx2,fma")]` wrapper chosen at run time. No `mul_add` is
+//! used and LLVM does not contract or reorder f32 arithmetic, so both give identical results.
+
+/// Defines `fn name(args) -> ret` whose body is compiled for the baseline and for AVX2+FMA.
+macro_rules! simd_fn {
+    ($(#[$m:meta])* $vis:vis fn $name:ident($($a:ident: $t:ty),* $(,)?) $(-> $ret:ty)? $body:block) => {
+        $(#[$m])*
+        #[allow(clippy::too_many_arguments)]
+        $vis fn $name($($a: $t),*) $(-> $ret)? {
+            #[inline(always)]
+            #[allow(clippy::too_many_arguments)]
+            fn imp($($a: $t),*) $(-> $ret)? $body
+            #[cfg(target_arch = "x86_64")]
+            {
+                #[target_feature(enable = "avx2,fma")]
+                #[allow(clippy::too_many_arguments)]
+                unsafe fn avx2($($a: $t),*) $(-> $ret)? { imp($($a),*) }
+                if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+                    // SAFETY: the running CPU supports every feature enabled on `avx2`.
+                    return unsafe { avx2($($a),*) };
+                }
+            }
+            imp($($a),*)
+        }
+    };
+}
+pub(crate) use simd_fn;

@@ -1,0 +1,270 @@
+//! Binding of `stereovision_core::matching::hopfield`.
+//!
+//! The many tuning parameters travel as one `params` dict (keys = the Python names, documented in
+//! `stereovision.matching.hopfield.DEFAULTS`); unknown keys and wrong types are `ValueError`s.
+
+use numpy::ndarray::{Array1, Array2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use stereovision_core::matching::hopfield::{
+    best_match as core_best, candidate_neurons, hopfield_match as core_match,
+    interest::select_points, moravec, CandidateMode, HopfieldOutput, HopfieldParams,
+};
+
+use crate::convert::{image_from_numpy, image_to_numpy};
+use crate::errors::guard;
+
+fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
+    d: &Bound<'py, PyDict>,
+    key: &str,
+    slot: &mut T,
+) -> PyResult<()> {
+    if let Some(v) = d.get_item(key)? {
+        *slot = v.extract::<T>().map_err(|e| {
+            let e: PyErr = e.into();
+            PyValueError::new_err(format!("parameter `{key}`: {e}"))
+        })?;
+    }
+    Ok(())
+}
+
+const KEYS: [&str; 33] = [
+    "tile",
+    "floor_rel",
+    "agree_share",
+    "min_agree_sparse",
+    "edge_penalty",
+    "edge_margin",
+    "min_disparity",
+    "max_disparity",
+    "rel_threshold",
+    "nms_half",
+    "candidates",
+    "dy_window",
+    "s_min",
+    "k_cand",
+    "A",
+    "B",
+    "D",
+    "theta",
+    "nbr_half",
+    "compat_theta",
+    "compat_slope",
+    "s_init",
+    "max_sweeps",
+    "seed",
+    "tau_y",
+    "edge_test",
+    "edge_tol",
+    "centre_tol",
+    "min_agree",
+    "agree_tol",
+    "subpixel",
+    "method",
+    "energy",
+];
+
+/// Core parameters from the `params` dict (missing keys keep the core defaults).
+fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
+    for k in d.keys() {
+        let k: String = k.extract()?;
+        if !KEYS.contains(&k.as_str()) {
+            return Err(PyValueError::new_err(format!(
+                "unknown Hopfield parameter `{k}`"
+            )));
+        }
+    }
+    let mut p = HopfieldParams::default();
+    get(d, "min_disparity", &mut p.d_min)?;
+    get(d, "max_disparity", &mut p.d_max)?;
+    get(d, "rel_threshold", &mut p.interest.rel_threshold)?;
+    get(d, "nms_half", &mut p.interest.nms_half)?;
+    get(d, "tile", &mut p.interest.tile)?;
+    get(d, "floor_rel", &mut p.interest.floor_rel)?;
+    let mut mode = String::from("row");
+    get(d, "candidates", &mut mode)?;
+    p.candidates = match mode.as_str() {
+        "row" => CandidateMode::Row,
+        "points" => CandidateMode::Points,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "candidates must be 'row' or 'points', got {other:?}"
+            )))
+        }
+    };
+    get(d, "dy_window", &mut p.dy_window)?;
+    get(d, "s_min", &mut p.s_min)?;
+    get(d, "k_cand", &mut p.k_cand)?;
+    get(d, "A", &mut p.weights.a)?;
+    get(d, "B", &mut p.weights.b)?;
+    get(d, "D", &mut p.weights.d)?;
+    get(d, "theta", &mut p.weights.theta)?;
+    get(d, "nbr_half", &mut p.weights.nbr_half)?;
+    get(d, "compat_theta", &mut p.weights.compat_theta)?;
+    get(d, "compat_slope", &mut p.weights.compat_slope)?;
+    get(d, "s_init", &mut p.s_init)?;
+    get(d, "max_sweeps", &mut p.max_sweeps)?;
+    get(d, "seed", &mut p.seed)?;
+    get(d, "tau_y", &mut p.tau_y)?;
+    get(d, "edge_test", &mut p.edge_test)?;
+    get(d, "edge_tol", &mut p.edge_tol)?;
+    get(d, "edge_margin", &mut p.edge_margin)?;
+    get(d, "edge_penalty", &mut p.edge_penalty)?;
+    get(d, "centre_tol", &mut p.centre_tol)?;
+    get(d, "min_agree", &mut p.min_agree)?;
+    get(d, "agree_tol", &mut p.agree_tol)?;
+    get(d, "agree_share", &mut p.agree_share)?;
+    get(d, "min_agree_sparse", &mut p.min_agree_sparse)?;
+    get(d, "subpixel", &mut p.subpixel)?;
+    Ok(p)
+}
+
+/// Moravec map and interest points: `(M (H, W) float32, xy (N, 2) int32, values (N,) float32)`.
+#[pyfunction]
+#[pyo3(signature = (img, rel_threshold=1e-3, nms_half=1, tile=64, floor_rel=1e-4))]
+#[allow(clippy::type_complexity)]
+pub fn hopfield_interest<'py>(
+    py: Python<'py>,
+    img: PyReadonlyArray2<'py, f32>,
+    rel_threshold: f32,
+    nms_half: usize,
+    tile: usize,
+    floor_rel: f32,
+) -> PyResult<(
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray2<i32>>,
+    Bound<'py, PyArray1<f32>>,
+)> {
+    let im = image_from_numpy(&img, "image")?;
+    let unit = |v: f32| v.is_finite() && (0.0..=1.0).contains(&v);
+    if !unit(rel_threshold) || !unit(floor_rel) || nms_half == 0 {
+        return Err(PyValueError::new_err(
+            "rel_threshold and floor_rel must lie in [0, 1] and nms_half be >= 1",
+        ));
+    }
+    let (w, h) = im.size();
+    let p = stereovision_core::matching::hopfield::InterestParams {
+        rel_threshold,
+        nms_half,
+        tile,
+        floor_rel,
+    };
+    let (m, pts) = py.detach(|| {
+        guard("hopfield_interest", || {
+            let m = moravec(&im);
+            let pts = select_points(&m, w, h, &p);
+            Ok((m, pts))
+        })
+    })?;
+    let xy: Vec<i32> = pts.iter().flat_map(|q| [q.x as i32, q.y as i32]).collect();
+    let vals: Vec<f32> = pts.iter().map(|q| q.value).collect();
+    let xy = Array2::from_shape_vec((pts.len(), 2), xy)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let mimg = stereovision_core::Image {
+        width: w,
+        height: h,
+        data: m,
+    };
+    Ok((
+        image_to_numpy(py, mimg)?,
+        xy.into_pyarray(py),
+        Array1::from_vec(vals).into_pyarray(py),
+    ))
+}
+
+type MatchOut<'py> = (
+    Bound<'py, PyArray2<f32>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyDict>,
+);
+
+fn output<'py>(py: Python<'py>, out: HopfieldOutput) -> PyResult<MatchOut<'py>> {
+    let n = out.matches.len();
+    let flat: Vec<f32> = out
+        .matches
+        .iter()
+        .flat_map(|m| [m.xl, m.yl, m.xr, m.yr, m.score])
+        .collect();
+    let arr =
+        Array2::from_shape_vec((n, 5), flat).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let stats = PyDict::new(py);
+    stats.set_item("n_points", out.n_points)?;
+    stats.set_item("n_neurons", out.n_neurons)?;
+    stats.set_item("n_weights", out.n_weights)?;
+    stats.set_item("sweeps", out.sweeps)?;
+    stats.set_item("converged", out.converged)?;
+    stats.set_item("n_selected", out.n_selected)?;
+    Ok((
+        arr.into_pyarray(py),
+        Array1::from_vec(out.energy_trace).into_pyarray(py),
+        stats,
+    ))
+}
+
+/// Hopfield matching (`method="hopfield"`) or the best-match reference (`method="best"`).
+/// Returns `(matches (N, 5) float32 [xl, yl, xr, yr, score], energy_trace float64, stats dict)`.
+#[pyfunction]
+#[pyo3(signature = (left, right, params))]
+pub fn hopfield_match<'py>(
+    py: Python<'py>,
+    left: PyReadonlyArray2<'py, f32>,
+    right: PyReadonlyArray2<'py, f32>,
+    params: &Bound<'py, PyDict>,
+) -> PyResult<MatchOut<'py>> {
+    let l = image_from_numpy(&left, "left")?;
+    let r = image_from_numpy(&right, "right")?;
+    let p = self::params(params)?;
+    let mut method = String::from("hopfield");
+    get(params, "method", &mut method)?;
+    let mut energy = String::from("recommended");
+    get(params, "energy", &mut energy)?;
+    if energy != "recommended" {
+        return Err(PyValueError::new_err(format!(
+            "energy must be 'recommended', got {energy:?}"
+        )));
+    }
+    let out = match method.as_str() {
+        "hopfield" => py.detach(|| guard("hopfield_match", || core_match(&l, &r, &p)))?,
+        "best" => py.detach(|| guard("hopfield_match", || core_best(&l, &r, &p)))?,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "method must be 'hopfield' or 'best', got {other:?}"
+            )))
+        }
+    };
+    output(py, out)
+}
+
+/// Candidate neurons: `(N, 6) float32 [point, xl, yl, xr, yr, zncc]` (parity tests).
+#[pyfunction]
+#[pyo3(signature = (left, right, params))]
+pub fn hopfield_candidates<'py>(
+    py: Python<'py>,
+    left: PyReadonlyArray2<'py, f32>,
+    right: PyReadonlyArray2<'py, f32>,
+    params: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let l = image_from_numpy(&left, "left")?;
+    let r = image_from_numpy(&right, "right")?;
+    let p = self::params(params)?;
+    let (_, neurons) =
+        py.detach(|| guard("hopfield_candidates", || candidate_neurons(&l, &r, &p)))?;
+    let flat: Vec<f32> = neurons
+        .iter()
+        .flat_map(|n| {
+            [
+                n.point as f32,
+                n.xl as f32,
+                n.yl as f32,
+                n.xr as f32,
+                n.yr as f32,
+                n.sim,
+            ]
+        })
+        .collect();
+    let arr = Array2::from_shape_vec((neurons.len(), 6), flat)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(arr.into_pyarray(py))
+}
