@@ -162,6 +162,8 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
     scene_dir = _demo_scene_dir()
     scene = load_scene(scene_dir)
+    if scene.gt is None:
+        raise CliError(f"the bundled demo scene in {scene_dir} lacks its ground truth")
     print(f"demo scene: Middlebury 2003 'Cones' ({scene_dir})")
     print("  (c) Scharstein & Szeliski, CVPR 2003; calibration nominal, see its README.md")
     res = depth_map(

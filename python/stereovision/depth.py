@@ -61,7 +61,7 @@ def estimate_max_disparity(left: npt.ArrayLike, right: npt.ArrayLike) -> int:
     width = gl.shape[1]
     upper = _round_up(width / 2)
     fallback = min(upper, _round_up(width * _AUTO_FALLBACK_FRACTION))
-    orb = cv2.ORB_create(nfeatures=4000)
+    orb = cv2.ORB_create(nfeatures=4000)  # type: ignore[attr-defined]
     kl, dl = orb.detectAndCompute(gl, None)
     kr, dr = orb.detectAndCompute(gr, None)
     if dl is None or dr is None or len(kl) < _AUTO_MIN_MATCHES or len(kr) < _AUTO_MIN_MATCHES:
