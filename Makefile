@@ -69,7 +69,7 @@ fmt:  ## format Rust and Python in place
 
 bench: build  ## criterion benches of the kernels, then the Python benches against OpenCV
 	cargo bench
-	$(PY) benches/bench_vs_opencv.py
+	$(PY) benches/bench_gabor_vs_sgbm.py
 	$(PY) benches/bench_hopfield.py
 
 clean:  ## remove build products (keeps .venv)
