@@ -13,6 +13,7 @@ pub mod error;
 pub mod image;
 pub mod matching;
 pub mod parallel;
+pub(crate) mod simd;
 
 pub use error::{CoreError, Result};
 pub use image::Image;

@@ -13,9 +13,9 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::pool::Buf;
-use super::simd::simd_fn;
 use crate::error::{CoreError, Result};
 use crate::parallel::for_each_row;
+use crate::simd::simd_fn;
 use std::f32::consts::PI;
 
 /// Half-amplitude half-width factor of a Gaussian spectrum: `a = sqrt(ln 2 / 2) / (pi sigma)`.

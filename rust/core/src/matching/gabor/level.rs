@@ -16,8 +16,8 @@
 use super::fastmath::{atan2, floor_fast, ln, round_fast, sincos};
 use super::filter::{blur_real, complex_col_pass, row_pass, Channel};
 use super::pool::Buf;
-use super::simd::simd_fn;
 use crate::parallel::{for_each_row, for_each_row2, for_each_row_pair};
+use crate::simd::simd_fn;
 
 /// A response below this amplitude is numerical noise (a constant image gives ~1e-7; one grey
 /// level of texture, 1/255, gives ~1e-3), so its phase is never used whatever the percentile says.

@@ -19,7 +19,6 @@ pub mod filter;
 pub mod level;
 pub mod pool;
 pub mod post;
-mod simd;
 
 use crate::error::{CoreError, Result};
 use crate::image::{check_pair, Image};

@@ -6,8 +6,8 @@
 
 use super::filter::{blur_real, gaussian_taps, radius_for};
 use super::pool::Buf;
-use super::simd::simd_fn;
 use crate::parallel::for_each_row;
+use crate::simd::simd_fn;
 
 /// Normalised-convolution smoothing (A.5 step 3h): `cbar = G * c`, `dbar = G * (c d) / cbar`.
 pub fn normalized_conv(delta: &[f32], conf: &[f32], w: usize, h: usize, sigma: f32) -> (Buf, Buf) {

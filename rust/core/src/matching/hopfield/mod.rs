@@ -18,7 +18,6 @@
 
 pub mod interest;
 pub mod network;
-mod simd;
 pub mod zncc;
 
 #[cfg(test)]

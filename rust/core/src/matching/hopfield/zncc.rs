@@ -10,8 +10,8 @@
 
 use rayon::prelude::*;
 
-use super::simd::simd_fn;
 use crate::image::Image;
+use crate::simd::simd_fn;
 
 /// Similarity window half-size (7x7, C.10).
 pub const SIM_RADIUS: usize = 3;

@@ -1,4 +1,4 @@
-//! Runtime CPU-feature dispatch for the hot row kernels.
+//! Runtime CPU-feature dispatch for the hot row kernels of every channel.
 //!
 //! The wheel targets baseline x86-64 (SSE2); the row kernels are written as plain f32 loops the
 //! compiler vectorises, and `simd_fn!` compiles each one twice: as is, and inside a
