@@ -291,6 +291,23 @@ def compute_view(
     )
 
 
+def _file_picker(label: str, model: str, items: str, element_id: str) -> None:
+    """A combobox choosing one of the allowed files (``items`` holds ``{title, value}`` dicts)."""
+    from trame.widgets import vuetify3 as v3
+
+    v3.VCombobox(
+        label=label,
+        v_model=(model,),
+        items=(items,),
+        item_title="title",
+        item_value="value",
+        return_object=False,
+        density="compact",
+        hide_details=True,
+        id=element_id,
+    )
+
+
 class StereoApp:
     """The trame application: state, controllers, layout and the worker thread.
 
@@ -769,29 +786,9 @@ class StereoApp:
                 )
                 with v3.VRow(dense=True, classes="mt-1"):
                     with v3.VCol(cols=5):
-                        v3.VCombobox(
-                            label="Left image",
-                            v_model=("left_file",),
-                            items=("images",),
-                            item_title="title",
-                            item_value="value",
-                            return_object=False,
-                            density="compact",
-                            hide_details=True,
-                            id="left-file",
-                        )
+                        _file_picker("Left image", "left_file", "images", "left-file")
                     with v3.VCol(cols=5):
-                        v3.VCombobox(
-                            label="Right image",
-                            v_model=("right_file",),
-                            items=("images",),
-                            item_title="title",
-                            item_value="value",
-                            return_object=False,
-                            density="compact",
-                            hide_details=True,
-                            id="right-file",
-                        )
+                        _file_picker("Right image", "right_file", "images", "right-file")
                     with v3.VCol(cols=2):
                         v3.VBtn("Load", click=self.ctrl.load_files, id="load-files", block=True)
                 with v3.VRow(dense=True, classes="mt-1"):
@@ -884,16 +881,7 @@ class StereoApp:
                 )
         with v3.VRow(dense=True, classes="mt-1"):
             with v3.VCol(cols=9):
-                v3.VCombobox(
-                    label="Point cloud file (PLY / PCD / NPZ)",
-                    v_model=("cloud_path",),
-                    items=("clouds",),
-                    item_title="title",
-                    item_value="value",
-                    return_object=False,
-                    density="compact",
-                    hide_details=True,
-                    id="cloud-path",
-                )
+                label = "Point cloud file (PLY / PCD / NPZ)"
+                _file_picker(label, "cloud_path", "clouds", "cloud-path")
             with v3.VCol(cols=3):
                 v3.VBtn("Show", click=self.ctrl.open_cloud, id="cloud-open", block=True)
