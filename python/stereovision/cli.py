@@ -1,4 +1,4 @@
-"""Command line: ``stereovision demo | depth | eval | capture | calibrate | view | gui``.
+"""Command line: ``stereovision demo | depth | eval | capture | stream | calibrate | view | gui``.
 
 Errors print one line on stderr and exit with status 2 (never a traceback); every output file is
 written atomically after all computation succeeded, so an error never destroys earlier outputs.
@@ -121,26 +121,64 @@ def _progress(enabled: bool = True) -> Any:
     return tqdm(disable=not enabled or not sys.stderr.isatty(), file=sys.stderr, leave=False)
 
 
+def depth_outputs(
+    left: np.ndarray,
+    right: np.ndarray,
+    calib: Any,
+    out_dir: Path,
+    *,
+    method: str | None = None,
+    max_disparity: int | None = None,
+    fill: bool = False,
+) -> tuple[Any, dict[str, Path]]:
+    """What ``stereovision depth`` computes and writes for one pair (``batch`` writes the same).
+
+    Parameters
+    ----------
+    left, right : ndarray
+        The pair as read (BGR ``uint8``); raw when ``calib`` is an unrectified rig calibration.
+    calib : Calibration or None
+        Without it only the disparity outputs are written.
+    out_dir : pathlib.Path
+        Output folder (created if missing); every file is replaced atomically.
+    method : str, optional
+        Matcher; None = :func:`stereovision.depth.depth_map`'s default.
+    max_disparity : int, optional
+        None = estimated from the pair.
+    fill : bool
+        Reference row fill of the holes.
+
+    Returns
+    -------
+    tuple
+        ``(DepthResult, {file name: path})``.
+    """
+    from stereovision.depth import depth_map
+    from stereovision.render import render_outputs
+
+    kw: dict[str, Any] = {} if method is None else {"method": method}
+    res = depth_map(left, right, calib, max_disparity=max_disparity, fill=fill, **kw)
+    written = write_depth_outputs(res, out_dir)
+    written.update(render_outputs(res, out_dir))
+    return res, written
+
+
 def cmd_depth(args: argparse.Namespace) -> int:
     """``stereovision depth LEFT RIGHT -o DIR``."""
-    from stereovision.depth import depth_map
     from stereovision.io import imread
 
     left = imread(args.left)
     right = imread(args.right)
     calib = _load_calibration(args.calib)
-    res = depth_map(
+    res, written = depth_outputs(
         left,
         right,
         calib,
+        Path(args.output),
         method=args.method,
         max_disparity=args.max_disparity,
         fill=args.fill,
     )
-    written = write_depth_outputs(res, Path(args.output))
-    from stereovision.render import render_outputs
-
-    written.update(render_outputs(res, Path(args.output)))
     print(
         f"{args.method}: max_disparity {res.max_disparity} px, density {100 * res.density:.1f} %,"
         f" {len(res.points)} points, {sum(res.timings.values()):.2f} s"
@@ -336,9 +374,10 @@ def build_parser() -> argparse.ArgumentParser:
     d.set_defaults(func=cmd_eval)
 
     # Commands owned by their pipeline stage's module.
-    from stereovision import calibrate, capture, gui, render
+    from stereovision import calibrate, capture, gui, render, stream
 
     capture.add_cli(sub)
+    stream.add_cli(sub)
     calibrate.add_cli(sub)
     render.add_cli(sub)
     gui.add_cli(sub)

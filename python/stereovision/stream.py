@@ -1,0 +1,639 @@
+"""Live depth from two cameras: grab, rectify, match, report (``stereovision stream``).
+
+Two stages run at once (the machine this targets has two cores): a *producer* thread grabs the
+next pair from the :class:`~stereovision.capture.StereoCamera` and rectifies it into a bounded
+queue while the main thread computes the depth of the current one. The Rust kernels release the
+GIL, so the producer's decoding and remapping overlap the matching instead of adding to it.
+
+Every second a report is emitted: frames per second over that second, the mean time of each stage
+(``grab``, ``rectify``, ``prepare``, ``match``, ``triangulate``), the mean latency from the start
+of a pair's grab to its depth, the time the matcher waited for the producer, and the left/right
+grab skew. ``--json`` prints each report as one JSON object on stdout, then a final summary object
+(``"summary": true``).
+
+The result is shown by serving it over HTTP (OpenCV's own windows are not part of the headless
+OpenCV build the package depends on): ``http://HOST:PORT/`` is a page with the live left image and
+colour-mapped disparity side by side, ``/stream.mjpg`` the MJPEG stream itself (any browser or
+``ffplay`` plays it) and ``/frame.jpg`` the latest frame. Frames are encoded only while a client
+asks for them. ``--no-display`` turns the server off (headless robots).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import queue
+import statistics
+import sys
+import threading
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+from typing import Any
+
+import cv2
+import numpy as np
+
+from stereovision.calibration import Calibration
+from stereovision.capture import SourceError, StereoCamera, parse_size, parse_source
+
+__all__ = [
+    "STAGES",
+    "FrameServer",
+    "StreamReport",
+    "add_cli",
+    "cmd_stream",
+    "run_stream",
+]
+
+#: Stages timed for every pair, in pipeline order.
+STAGES = ("grab", "rectify", "prepare", "match", "triangulate")
+#: Pairs grabbed ahead of the one being matched. One is enough to hide the grab and rectify
+#: behind the matching; more would only age a live camera's frames.
+QUEUE_SIZE = 1
+#: Seconds between two reports.
+REPORT_PERIOD = 1.0
+#: JPEG quality of the served frames.
+JPEG_QUALITY = 80
+DEFAULT_PORT = 8765
+
+_END = object()  # the producer's end-of-stream marker
+
+
+@dataclass
+class _Pair:
+    """A grabbed (and rectified) pair on its way to the matcher."""
+
+    left: np.ndarray
+    right: np.ndarray
+    index: int
+    t_start: float  # perf_counter at the start of the grab
+    grab_s: float
+    rectify_s: float
+    skew_ms: float
+
+
+@dataclass
+class _Done:
+    """Per-pair figures of a finished pair."""
+
+    stages: dict[str, float]
+    latency_s: float
+    wait_s: float
+    skew_ms: float
+    density: float
+
+
+@dataclass
+class StreamReport:
+    """Aggregate figures of a run of :func:`run_stream`.
+
+    Attributes
+    ----------
+    frames : int
+        Pairs processed.
+    seconds : float
+        Wall time from the first grab to the last depth map.
+    fps : float
+        ``frames / seconds``.
+    stage_ms : dict of str to float
+        Median time of each stage of :data:`STAGES` per pair, in milliseconds.
+    latency_ms : float
+        Median time from the start of a pair's grab to its depth map.
+    wait_ms : float
+        Median time the matcher waited for the next pair (0 when the producer keeps up).
+    skew_ms : dict of str to float
+        ``mean`` and ``max`` left/right grab skew.
+    max_disparity : int
+        Disparity range searched.
+    pipelined : bool
+        Whether grab/rectify ran in the producer thread.
+    ended : str
+        ``"frames"`` (the ``frames`` limit), ``"end of stream"`` or ``"interrupted"``.
+    """
+
+    frames: int
+    seconds: float
+    fps: float
+    stage_ms: dict[str, float]
+    latency_ms: float
+    wait_ms: float
+    skew_ms: dict[str, float]
+    max_disparity: int
+    pipelined: bool
+    ended: str
+    density: float = math.nan
+    reports: list[dict[str, Any]] = field(default_factory=list, repr=False)
+
+    def as_dict(self) -> dict[str, Any]:
+        """The JSON summary object (``"summary": true``)."""
+        return {
+            "summary": True,
+            "frames": self.frames,
+            "seconds": round(self.seconds, 4),
+            "fps": round(self.fps, 3),
+            "stage_ms": {k: round(v, 3) for k, v in self.stage_ms.items()},
+            "latency_ms": round(self.latency_ms, 3),
+            "wait_ms": round(self.wait_ms, 3),
+            "skew_ms": {k: round(v, 4) for k, v in self.skew_ms.items()},
+            "density": round(self.density, 4),
+            "max_disparity": self.max_disparity,
+            "pipelined": self.pipelined,
+            "ended": self.ended,
+        }
+
+
+# ------------------------------------------------------------------------------------ serving
+
+
+def _compose(left: np.ndarray, disparity: np.ndarray, max_disparity: float) -> np.ndarray:
+    """Left image and colour-mapped disparity (fixed 0..max_disparity scale, NaN black)."""
+    finite = np.isfinite(disparity)
+    u8 = np.clip(np.nan_to_num(disparity, nan=0.0) * (255.0 / max(max_disparity, 1.0)), 0, 255)
+    colour = cv2.applyColorMap(u8.astype(np.uint8), cv2.COLORMAP_TURBO)
+    colour[~finite] = 0
+    return np.hstack([left, colour])
+
+
+class FrameServer:
+    """A tiny MJPEG-over-HTTP view of the latest result.
+
+    ``GET /`` returns a page showing the stream, ``/stream.mjpg`` the multipart MJPEG stream,
+    ``/frame.jpg`` the latest frame as one JPEG (503 before the first one).
+
+    Parameters
+    ----------
+    host : str
+        Address to listen on (``127.0.0.1`` by default: robots are often on shared networks).
+    port : int
+        TCP port; 0 picks a free one (see :attr:`port`).
+
+    Raises
+    ------
+    OSError
+        If the address cannot be bound (port in use, ...).
+    """
+
+    def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
+        self._cond = threading.Condition()
+        self._latest: tuple[np.ndarray, np.ndarray, float] | None = None
+        self._seq = 0
+        self._closed = False
+        self._host = host
+        server = self
+
+        class Handler(BaseHTTPRequestHandler):
+            def log_message(self, format: str, *args: Any) -> None:  # quiet
+                return
+
+            def do_GET(self) -> None:
+                path = self.path.split("?", 1)[0]
+                if path == "/":
+                    body = (
+                        b"<!doctype html><title>stereovision stream</title>"
+                        b'<body style="margin:0;background:#111">'
+                        b'<img src="/stream.mjpg" style="width:100%"></body>'
+                    )
+                    self._send(200, "text/html; charset=utf-8", body)
+                elif path == "/frame.jpg":
+                    jpg = server.latest_jpeg()
+                    if jpg is None:
+                        self._send(503, "text/plain", b"no frame yet\n")
+                    else:
+                        self._send(200, "image/jpeg", jpg)
+                elif path == "/stream.mjpg":
+                    self._stream()
+                else:
+                    self._send(404, "text/plain", b"not found\n")
+
+            def _send(self, code: int, ctype: str, body: bytes) -> None:
+                self.send_response(code)
+                self.send_header("Content-Type", ctype)
+                self.send_header("Content-Length", str(len(body)))
+                self.send_header("Cache-Control", "no-store")
+                self.end_headers()
+                self.wfile.write(body)
+
+            def _stream(self) -> None:
+                self.send_response(200)
+                self.send_header("Content-Type", "multipart/x-mixed-replace; boundary=frame")
+                self.send_header("Cache-Control", "no-store")
+                self.end_headers()
+                seen = -1
+                try:
+                    while True:
+                        jpg, seen = server.wait_jpeg(seen, timeout=1.0)
+                        if jpg is None:
+                            if server.closed:
+                                return
+                            continue
+                        self.wfile.write(
+                            b"--frame\r\nContent-Type: image/jpeg\r\n"
+                            + f"Content-Length: {len(jpg)}\r\n\r\n".encode()
+                            + jpg
+                            + b"\r\n"
+                        )
+                except (BrokenPipeError, ConnectionResetError):
+                    return
+
+        self._httpd = ThreadingHTTPServer((host, port), Handler)
+        self._httpd.daemon_threads = True
+        self._thread = threading.Thread(
+            target=self._httpd.serve_forever, name="stereovision-serve", daemon=True
+        )
+        self._thread.start()
+
+    @property
+    def port(self) -> int:
+        """The TCP port listened on."""
+        return int(self._httpd.server_address[1])
+
+    @property
+    def url(self) -> str:
+        """``http://host:port/``."""
+        return f"http://{self._host}:{self.port}/"
+
+    @property
+    def closed(self) -> bool:
+        """True after :meth:`close`."""
+        return self._closed
+
+    def update(self, left: np.ndarray, disparity: np.ndarray, max_disparity: float) -> None:
+        """Publish a result (kept by reference: encoded only when a client asks)."""
+        with self._cond:
+            self._latest = (left, disparity, float(max_disparity))
+            self._seq += 1
+            self._cond.notify_all()
+
+    def _encode(self, item: tuple[np.ndarray, np.ndarray, float]) -> bytes:
+        img = _compose(*item)
+        ok, buf = cv2.imencode(".jpg", img, [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY])
+        if not ok:
+            raise OSError("could not encode a JPEG frame")
+        return bytes(buf.tobytes())
+
+    def latest_jpeg(self) -> bytes | None:
+        """The latest frame as JPEG bytes, None before the first :meth:`update`."""
+        with self._cond:
+            item = self._latest
+        return None if item is None else self._encode(item)
+
+    def wait_jpeg(self, seen: int, timeout: float) -> tuple[bytes | None, int]:
+        """Wait for a frame newer than ``seen``; ``(jpeg or None on timeout, its number)``."""
+        with self._cond:
+            if self._seq == seen or self._latest is None:
+                self._cond.wait(timeout)
+            if self._seq == seen or self._latest is None:
+                return None, seen
+            item, seq = self._latest, self._seq
+        return self._encode(item), seq
+
+    def close(self) -> None:
+        """Stop serving (idempotent)."""
+        if self._closed:
+            return
+        self._closed = True
+        with self._cond:
+            self._cond.notify_all()
+        self._httpd.shutdown()
+        self._httpd.server_close()
+
+
+# ----------------------------------------------------------------------------------- pipeline
+
+
+def _pairs(camera: StereoCamera, calib: Calibration | None, frames: int | None) -> Iterator[_Pair]:
+    """Grab (and rectify, for a raw rig calibration) pairs until the end or ``frames`` pairs."""
+    n = 0
+    while frames is None or n < frames:
+        t0 = time.perf_counter()
+        try:
+            fr = camera.read()
+        except SourceError:
+            if camera.count == 0:
+                raise
+            return
+        t1 = time.perf_counter()
+        left, right = fr.left, fr.right
+        if calib is not None and not calib.rectified:
+            left, right = calib.rectify(left, right)
+        t2 = time.perf_counter()
+        yield _Pair(left, right, fr.index, t0, t1 - t0, t2 - t1, fr.skew_ms)
+        n += 1
+
+
+class _Producer(threading.Thread):
+    """Runs :func:`_pairs` ahead of the matcher; errors travel through the queue too.
+
+    A pair is grabbed only when a slot is free (at most :data:`QUEUE_SIZE` pairs ahead of the
+    one being matched), so a live camera's pair is fresh when the matcher takes it rather than
+    aged in a queue.
+    """
+
+    def __init__(self, source: Iterator[_Pair], q: queue.Queue[Any]) -> None:
+        super().__init__(name="stereovision-grab", daemon=True)
+        self._source = source
+        self._q = q
+        self.slots = threading.Semaphore(QUEUE_SIZE)
+        self.stop = threading.Event()
+
+    def _acquire(self) -> bool:
+        while not self.stop.is_set():
+            if self.slots.acquire(timeout=0.1):
+                return True
+        return False
+
+    def run(self) -> None:
+        try:
+            while self._acquire():
+                pair = next(self._source, None)
+                if pair is None:
+                    break
+                self._q.put(pair)
+        except BaseException as exc:  # handed to the consumer, which re-raises it
+            self._q.put(exc)
+            return
+        self._q.put(_END)
+
+
+def _mean(values: list[float]) -> float:
+    return float(statistics.fmean(values)) if values else math.nan
+
+
+def _window_report(
+    done: list[_Done], t_window: float, total: int, elapsed: float, md: int, pipelined: bool
+) -> dict[str, Any]:
+    return {
+        "t": round(elapsed, 3),
+        "frames": len(done),
+        "total_frames": total,
+        "fps": round(len(done) / t_window, 3) if t_window > 0 else 0.0,
+        "stage_ms": {k: round(1e3 * _mean([d.stages[k] for d in done]), 3) for k in STAGES},
+        "latency_ms": round(1e3 * _mean([d.latency_s for d in done]), 3),
+        "wait_ms": round(1e3 * _mean([d.wait_s for d in done]), 3),
+        "skew_ms": {
+            "mean": round(_mean([d.skew_ms for d in done]), 4),
+            "max": round(max((d.skew_ms for d in done), default=math.nan), 4),
+        },
+        "density": round(_mean([d.density for d in done]), 4),
+        "max_disparity": md,
+        "pipelined": pipelined,
+    }
+
+
+def run_stream(
+    camera: StereoCamera,
+    calib: Calibration | None = None,
+    *,
+    method: str | None = None,
+    max_disparity: int | None = None,
+    frames: int | None = None,
+    pipelined: bool = True,
+    on_report: Callable[[dict[str, Any]], None] | None = None,
+    on_result: Callable[[np.ndarray, Any], None] | None = None,
+    report_period: float = REPORT_PERIOD,
+) -> StreamReport:
+    """Depth maps from a stereo camera until it ends, ``frames`` pairs, or Ctrl-C.
+
+    Parameters
+    ----------
+    camera : StereoCamera
+        The two sources (devices, video files or image sequences).
+    calib : Calibration, optional
+        Rig calibration of the camera's output size. A raw rig calibration is applied by the
+        producer (rectification); a rectified one (Middlebury, KITTI) is used as is. Without one,
+        only disparity is computed.
+    method : str, optional
+        Matcher; None = :func:`stereovision.depth.depth_map`'s default.
+    max_disparity : int, optional
+        Disparity range. None estimates it once, from the first pair.
+    frames : int, optional
+        Stop after this many pairs.
+    pipelined : bool
+        Grab and rectify in a producer thread while the main thread matches (default).
+    on_report : callable, optional
+        Called with each per-second report (a JSON-ready dict, see the module doc).
+    on_result : callable, optional
+        Called with ``(left_rectified_bgr, DepthResult)`` of every pair.
+    report_period : float
+        Seconds between reports.
+
+    Returns
+    -------
+    StreamReport
+
+    Raises
+    ------
+    SourceError
+        If a source delivers no first frame.
+    ValueError
+        If ``frames`` is not positive, or the calibration does not fit the frames.
+    """
+    from stereovision.depth import depth_map, estimate_max_disparity
+
+    if frames is not None and frames <= 0:
+        raise ValueError(f"frames: expected a positive number, got {frames}")
+    if max_disparity is not None and max_disparity <= 0:
+        raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
+    rect_calib = None
+    if calib is not None:
+        rect_calib = calib if calib.rectified else calib.rectified_calibration()
+    kw: dict[str, Any] = {} if method is None else {"method": method}
+    source = _pairs(camera, calib, frames)
+    producer: _Producer | None = None
+    q: queue.Queue[Any] = queue.Queue()
+    if pipelined:
+        producer = _Producer(source, q)
+        producer.start()
+
+    def next_pair() -> _Pair | None:
+        if producer is None:
+            return next(source, None)
+        item = q.get()
+        producer.slots.release()
+        if item is _END:
+            return None
+        if isinstance(item, BaseException):
+            raise item
+        return item  # type: ignore[no-any-return]
+
+    all_done: list[_Done] = []
+    window: list[_Done] = []
+    reports: list[dict[str, Any]] = []
+    md = max_disparity
+    ended = "end of stream"
+    t_begin = time.perf_counter()
+    t_window = t_begin
+    t_last = t_begin
+    try:
+        while True:
+            t_wait = time.perf_counter()
+            pair = next_pair()
+            if pair is None:
+                break
+            t_got = time.perf_counter()
+            if md is None:
+                md = estimate_max_disparity(pair.left, pair.right)
+            res = depth_map(pair.left, pair.right, rect_calib, max_disparity=md, **kw)
+            t_last = time.perf_counter()
+            tm = res.timings
+            stages = {
+                "grab": pair.grab_s,
+                "rectify": pair.rectify_s,
+                # depth_map's own "rectify" is only input conversion for a rectified pair
+                "prepare": tm.get("rectify", 0.0) + tm.get("prepare", 0.0),
+                "match": tm.get("match", 0.0),
+                "triangulate": tm.get("triangulate", 0.0),
+            }
+            d = _Done(
+                stages=stages,
+                latency_s=t_last - pair.t_start,
+                wait_s=t_got - t_wait,
+                skew_ms=pair.skew_ms,
+                density=res.density,
+            )
+            all_done.append(d)
+            window.append(d)
+            if on_result is not None:
+                on_result(pair.left, res)
+            if t_last - t_window >= report_period:
+                rep = _window_report(
+                    window, t_last - t_window, len(all_done), t_last - t_begin, md, pipelined
+                )
+                reports.append(rep)
+                if on_report is not None:
+                    on_report(rep)
+                window = []
+                t_window = t_last
+        if frames is not None and len(all_done) >= frames:
+            ended = "frames"
+    except KeyboardInterrupt:
+        ended = "interrupted"
+    finally:
+        if producer is not None:
+            producer.stop.set()
+            producer.join(timeout=5.0)
+    if window:  # the last, partial second
+        rep = _window_report(
+            window, t_last - t_window, len(all_done), t_last - t_begin, md or 0, pipelined
+        )
+        reports.append(rep)
+        if on_report is not None:
+            on_report(rep)
+    n = len(all_done)
+    seconds = t_last - t_begin
+    skews = [d.skew_ms for d in all_done]
+    return StreamReport(
+        frames=n,
+        seconds=seconds,
+        fps=n / seconds if seconds > 0 else 0.0,
+        stage_ms={
+            k: 1e3 * statistics.median([d.stages[k] for d in all_done]) if n else math.nan
+            for k in STAGES
+        },
+        latency_ms=1e3 * statistics.median([d.latency_s for d in all_done]) if n else math.nan,
+        wait_ms=1e3 * statistics.median([d.wait_s for d in all_done]) if n else math.nan,
+        skew_ms={"mean": _mean(skews), "max": max(skews, default=math.nan)},
+        max_disparity=int(md or 0),
+        pipelined=pipelined,
+        ended=ended,
+        density=_mean([d.density for d in all_done]),
+        reports=reports,
+    )
+
+
+# ---------------------------------------------------------------------------------------- CLI
+
+
+def _format_report(rep: dict[str, Any]) -> str:
+    st = rep["stage_ms"]
+    stages = " ".join(f"{k} {st[k]:.1f}" for k in STAGES)
+    return (
+        f"{rep['fps']:5.1f} fps | {stages} ms | latency {rep['latency_ms']:.0f} ms,"
+        f" waited {rep['wait_ms']:.1f} ms | skew {rep['skew_ms']['mean']:.2f} ms"
+        f" | density {100 * rep['density']:.0f} %"
+    )
+
+
+def cmd_stream(args: argparse.Namespace) -> int:
+    """``stereovision stream --left SRC --right SRC``."""
+    calib = Calibration.from_file(args.calib) if args.calib else None
+    out = sys.stdout
+    log = sys.stderr
+    server: FrameServer | None = None
+    size = parse_size(args.size)
+    cam = StereoCamera(parse_source(args.left), parse_source(args.right), size=size)
+    try:
+        on_result = None
+        if not args.no_display:
+            server = FrameServer(args.host, args.serve)
+            print(f"serving the live view on {server.url}", file=log, flush=True)
+            srv = server
+
+            def on_result(left: np.ndarray, res: Any) -> None:
+                srv.update(left, res.disparity, float(res.max_disparity))
+
+        def on_report(rep: dict[str, Any]) -> None:
+            if args.json:
+                print(json.dumps(rep), file=out, flush=True)
+            else:
+                print(_format_report(rep), file=out, flush=True)
+
+        report = run_stream(
+            cam,
+            calib,
+            method=args.method,
+            max_disparity=args.max_disparity,
+            frames=args.frames,
+            pipelined=not args.no_pipeline,
+            on_report=on_report,
+            on_result=on_result,
+        )
+    finally:
+        cam.close()
+        if server is not None:
+            server.close()
+    summary = report.as_dict()
+    if args.json:
+        print(json.dumps(summary), file=out, flush=True)
+    else:
+        st = report.stage_ms
+        print(
+            f"{report.frames} pairs in {report.seconds:.2f} s ({report.ended}): "
+            f"{report.fps:.1f} fps; median per pair "
+            + ", ".join(f"{k} {st[k]:.1f}" for k in STAGES)
+            + f" ms; latency {report.latency_ms:.0f} ms; skew mean"
+            f" {report.skew_ms['mean']:.2f} ms, max {report.skew_ms['max']:.2f} ms;"
+            f" max_disparity {report.max_disparity}",
+            file=out,
+        )
+    return 0
+
+
+def add_cli(subparsers: Any) -> None:
+    """Register ``stereovision stream`` on the CLI's sub-parsers."""
+    from stereovision.depth import METHODS
+
+    p = subparsers.add_parser(
+        "stream",
+        help="live depth from two cameras (or videos), with fps and per-stage latency",
+        description="Grab synchronised pairs, rectify, compute depth, serve the live view "
+        "over HTTP (MJPEG) and report fps, stage times and skew every second.",
+    )
+    p.add_argument("--left", required=True, help="device index, video file or pattern (%%03d)")
+    p.add_argument("--right", required=True, help="device index, video file or pattern")
+    p.add_argument("--calib", help="calibration of the rig (YAML/JSON, Middlebury, KITTI)")
+    p.add_argument("--size", help="requested size WIDTHxHEIGHT (frames are resized if needed)")
+    p.add_argument("--max-disparity", type=int, help="default: estimated from the first pair")
+    p.add_argument("--method", choices=METHODS, help="matcher (default: depth_map's)")
+    p.add_argument("--frames", type=int, help="stop after N pairs (default: until a source ends)")
+    p.add_argument("--no-display", action="store_true", help="headless: do not serve the view")
+    p.add_argument("--serve", type=int, default=DEFAULT_PORT, metavar="PORT", help="view port")
+    p.add_argument("--host", default="127.0.0.1", help="view address (default 127.0.0.1)")
+    p.add_argument("--json", action="store_true", help="one JSON object per second on stdout")
+    p.add_argument(
+        "--no-pipeline", action="store_true", help="grab, rectify and match in one thread"
+    )
+    p.set_defaults(func=cmd_stream)

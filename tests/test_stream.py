@@ -1,0 +1,193 @@
+"""``stereovision stream``: live depth from two 640x480 MJPG videos of a real scene."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import urllib.error
+import urllib.request
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from stereovision.calibration import Calibration
+from stereovision.capture import StereoCamera
+from stereovision.cli import main
+from stereovision.depth import depth_map
+from stereovision.stream import STAGES, FrameServer, run_stream
+
+SCENE = "tartanair/oldtown_easy_p000_001116"  # 640x480, metric rectified calibration
+N_FRAMES = 6
+FPS = 30.0
+
+
+@pytest.fixture(scope="module")
+def videos(data_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+    """Two MJPG videos of the scene (each frame shifted down by 0..2 rows) and its calib.txt."""
+    scene = data_dir / SCENE
+    out = tmp_path_factory.mktemp("stream")
+    paths: dict[str, Path] = {}
+    for side in ("left", "right"):
+        img = cv2.imread(str(scene / f"{side}.png"))
+        assert img.shape == (480, 640, 3)
+        path = out / f"{side}.avi"
+        vw = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), FPS, (640, 480))
+        assert vw.isOpened()
+        for i in range(N_FRAMES):
+            vw.write(np.roll(img, i % 3, axis=0))
+        vw.release()
+        paths[side] = path
+    paths["calib"] = Path(shutil.copy(scene / "calib.txt", out / "calib.txt"))
+    return paths
+
+
+def _json_lines(text: str) -> list[dict]:
+    lines = [ln for ln in text.splitlines() if ln.strip()]
+    return [json.loads(ln) for ln in lines]
+
+
+def test_stream_json_reports(videos: dict[str, Path], capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--calib", str(videos["calib"]), "--max-disparity", "64", "--no-display", "--json"]
+    assert main(argv) == 0
+    objs = _json_lines(capsys.readouterr().out)  # every stdout line is one JSON object
+    reports, summary = objs[:-1], objs[-1]
+    assert reports and all("summary" not in r for r in reports)
+    # Every pair is in exactly one per-second report; the counts add up.
+    assert sum(r["frames"] for r in reports) == N_FRAMES
+    assert [r["total_frames"] for r in reports] == list(np.cumsum([r["frames"] for r in reports]))
+    assert [r["t"] for r in reports] == sorted(r["t"] for r in reports)
+    for r in reports:
+        assert r["fps"] > 0
+        assert set(r["stage_ms"]) == set(STAGES)
+        for k in ("grab", "prepare", "match", "triangulate"):
+            assert r["stage_ms"][k] > 0, k
+        assert r["stage_ms"]["rectify"] >= 0  # rectified calibration: nothing to remap
+        # A pair's latency covers at least its own grab and matching.
+        assert r["latency_ms"] >= r["stage_ms"]["match"] + r["stage_ms"]["grab"] - 1e-6
+        assert 0 <= r["skew_ms"]["mean"] <= r["skew_ms"]["max"] < 1000
+        assert r["max_disparity"] == 64
+        assert r["pipelined"] is True
+        assert 0.6 < r["density"] <= 1.0  # a real scene: the matcher measures most pixels
+    assert summary["summary"] is True
+    assert summary["frames"] == N_FRAMES
+    assert summary["ended"] == "end of stream"
+    assert summary["fps"] == pytest.approx(N_FRAMES / summary["seconds"], rel=1e-2)
+    assert summary["stage_ms"]["match"] > 0
+
+
+def test_stream_results_are_the_frames_depth(videos: dict[str, Path]) -> None:
+    """Pipelined, each result is depth_map of its own pair (no mix-up between frames)."""
+    calib = Calibration.from_file(videos["calib"])
+    got: list[tuple[np.ndarray, np.ndarray]] = []
+    with StereoCamera(str(videos["left"]), str(videos["right"])) as cam:
+        rep = run_stream(
+            cam,
+            calib,
+            max_disparity=64,
+            frames=4,
+            on_result=lambda left, res: got.append((left.copy(), res.disparity)),
+        )
+    assert rep.frames == 4 and rep.ended == "frames"
+    assert len(got) == 4
+    caps = [cv2.VideoCapture(str(videos[s])) for s in ("left", "right")]
+    try:
+        for left, disp in got:
+            lf, rf = caps[0].read()[1], caps[1].read()[1]
+            np.testing.assert_array_equal(left, lf)
+            ref = depth_map(lf, rf, calib, max_disparity=64).disparity
+            np.testing.assert_array_equal(disp, ref)
+    finally:
+        for c in caps:
+            c.release()
+    # Frames 0, 1, 2 are shifted by 0, 1, 2 rows: their disparity maps differ.
+    assert not np.array_equal(got[0][1], got[1][1])
+
+
+def test_stream_unpipelined_with_raw_rig(
+    videos: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A raw (unrectified) rig calibration: the rectify stage does work; --frames stops early."""
+    k = np.array([[320.0, 0, 320], [0, 320.0, 240], [0, 0, 1]])
+    rvec = np.array([0.0, 0.01, 0.0])
+    rig = Calibration(
+        K1=k,
+        D1=np.zeros(5),
+        K2=k,
+        D2=np.zeros(5),
+        R=cv2.Rodrigues(rvec)[0],
+        T=np.array([-0.25, 0.0, 0.0]),
+        image_size=(640, 480),
+        unit="m",
+    )
+    calib_path = rig.save(tmp_path / "rig.yaml")
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--calib", str(calib_path), "--max-disparity", "64", "--no-display", "--json"]
+    argv += ["--frames", "3", "--no-pipeline"]
+    assert main(argv) == 0
+    objs = _json_lines(capsys.readouterr().out)
+    summary = objs[-1]
+    assert summary["frames"] == 3 and summary["ended"] == "frames"
+    assert summary["pipelined"] is False
+    assert summary["stage_ms"]["rectify"] > 0
+    assert sum(r["frames"] for r in objs[:-1]) == 3
+
+
+def test_stream_estimates_range_and_prints_text(
+    videos: dict[str, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--frames", "2", "--no-display"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out.strip().splitlines()
+    assert "fps" in out[0] and "match" in out[0]
+    assert out[-1].startswith("2 pairs in ")
+    # No calibration: disparity only; the range came from the first pair (multiple of 16).
+    md = int(out[-1].rsplit("max_disparity ", 1)[1])
+    assert md % 16 == 0 and 16 <= md <= 320
+
+
+def test_stream_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    rc = main(["stream", "--left", str(tmp_path / "nope.avi"), "--right", "x.avi", "--no-display"])
+    assert rc == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "not found" in err[0] and "nope.avi" in err[0]
+
+
+def _get(url: str) -> tuple[int, str, bytes]:
+    try:
+        with urllib.request.urlopen(url, timeout=5) as r:
+            return r.status, r.headers["Content-Type"], r.read()
+    except urllib.error.HTTPError as e:
+        return e.code, e.headers["Content-Type"], e.read()
+
+
+def test_frame_server_serves_left_and_disparity() -> None:
+    srv = FrameServer("127.0.0.1", 0)
+    try:
+        base = srv.url
+        assert _get(base + "frame.jpg")[0] == 503
+        status, ctype, body = _get(base)
+        assert status == 200 and "text/html" in ctype and b"/stream.mjpg" in body
+        left = np.full((48, 64, 3), (30, 120, 200), np.uint8)
+        disp = np.full((48, 64), 16.0, np.float32)
+        disp[:, :32] = np.nan
+        srv.update(left, disp, 64.0)
+        status, ctype, body = _get(base + "frame.jpg")
+        assert status == 200 and ctype == "image/jpeg"
+        img = cv2.imdecode(np.frombuffer(body, np.uint8), cv2.IMREAD_COLOR)
+        assert img.shape == (48, 128, 3)
+        assert np.abs(img[8:40, 8:56].astype(int) - (30, 120, 200)).max() < 12  # left image
+        assert img[8:40, 72:88].max() < 12  # NaN disparity is black
+        expected = cv2.applyColorMap(np.array([[64]], np.uint8), cv2.COLORMAP_TURBO)[0, 0]
+        assert np.abs(img[8:40, 104:120].astype(int) - expected).max() < 16  # 16 / 64 of TURBO
+        # The MJPEG stream delivers the same frame as a multipart part.
+        with urllib.request.urlopen(base + "stream.mjpg", timeout=5) as r:
+            assert r.headers["Content-Type"].startswith("multipart/x-mixed-replace")
+            head = r.read(200)
+        assert head.startswith(b"--frame\r\nContent-Type: image/jpeg\r\n")
+        assert _get(base + "nope")[0] == 404
+    finally:
+        srv.close()
