@@ -1,4 +1,4 @@
-"""Command line: ``stereovision demo | depth | eval | capture | stream | calibrate | view | gui``.
+"""Command line: ``stereovision demo|depth|eval|capture|stream|batch|bench|calibrate|view|gui``.
 
 Errors print one line on stderr and exit with status 2 (never a traceback); every output file is
 written atomically after all computation succeeded, so an error never destroys earlier outputs.
@@ -374,10 +374,11 @@ def build_parser() -> argparse.ArgumentParser:
     d.set_defaults(func=cmd_eval)
 
     # Commands owned by their pipeline stage's module.
-    from stereovision import calibrate, capture, gui, render, stream
+    from stereovision import batch, calibrate, capture, gui, render, stream
 
     capture.add_cli(sub)
     stream.add_cli(sub)
+    batch.add_cli(sub)
     calibrate.add_cli(sub)
     render.add_cli(sub)
     gui.add_cli(sub)

@@ -1,0 +1,725 @@
+"""Depth for every pair of a folder tree, on Dask distributed (``stereovision batch``).
+
+Each pair found under the input (:func:`find_pairs`) becomes one Dask task that computes what
+``stereovision depth`` writes for it (:func:`stereovision.cli.depth_outputs`): the task receives the
+image bytes and returns the output files' bytes, so workers need neither the input nor the output
+folder -- a multi-node cluster works without a shared filesystem. The client (this process) writes
+each finished pair into ``OUT/<name>/`` atomically (a hidden temporary folder renamed into place)
+and records it in ``OUT/summary.json`` (itself replaced atomically after every pair).
+
+A re-run skips the pairs the summary records as done whose inputs (size, modification time) and
+options are unchanged and whose folder still exists, without starting a cluster when nothing is
+left to do. A pair that fails (an unreadable image, sizes that differ, ...) is recorded with its
+error and the others go on; a re-run tries it again once its files (or the options) change, or
+with ``retry_failed``. Ctrl-C cancels what is running and
+keeps everything already written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as _dt
+import json
+import os
+import re
+import shutil
+import socket
+import sys
+import tempfile
+import time
+import uuid
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+__all__ = [
+    "IMAGE_EXTS",
+    "SUMMARY_NAME",
+    "BatchResult",
+    "PairJob",
+    "add_cli",
+    "cmd_batch",
+    "find_pairs",
+    "process_pair",
+    "run_batch",
+]
+
+#: File name of the run record in the output folder.
+SUMMARY_NAME = "summary.json"
+#: Image files considered for left/right pairs.
+IMAGE_EXTS = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".ppm", ".pgm", ".webp")
+#: Tasks in flight per worker: enough to keep each busy while the client writes results, few
+#: enough that the client does not read the whole input into memory up front.
+IN_FLIGHT_PER_WORKER = 2
+#: Seconds to wait for an existing scheduler.
+CONNECT_TIMEOUT = "10s"
+_SUMMARY_VERSION = 1
+_LEFT_RE = re.compile(r"left", re.IGNORECASE)
+_SCENE_CALIB = "calib.txt"
+
+
+@dataclass(frozen=True)
+class PairJob:
+    """One pair to process.
+
+    Attributes
+    ----------
+    name : str
+        Output sub-folder (POSIX path relative to the output folder).
+    left, right : pathlib.Path
+        The images.
+    calib : pathlib.Path or None
+        Calibration file of the pair.
+    """
+
+    name: str
+    left: Path
+    right: Path
+    calib: Path | None = None
+
+
+def _last_left(stem: str) -> re.Match[str] | None:
+    found = list(_LEFT_RE.finditer(stem))
+    return found[-1] if found else None
+
+
+def _right_of(left: Path) -> Path | None:
+    """The ``right`` counterpart of a file whose stem contains ``left`` (its case kept)."""
+    m = _last_left(left.stem)
+    if m is None:
+        return None
+    word = m.group(0)
+    right = "RIGHT" if word.isupper() else "Right" if word[0].isupper() else "right"
+    stem = left.stem[: m.start()] + right + left.stem[m.end() :]
+    return left.with_name(stem + left.suffix)
+
+
+def find_pairs(
+    root: str | os.PathLike[str], calib: str | os.PathLike[str] | None = None
+) -> list[PairJob]:
+    """Every pair under ``root``: scene folders and ``...left...`` / ``...right...`` image files.
+
+    * A folder holding ``left.png`` and ``right.png`` (evaluation.md's scene layout) is one pair,
+      named by its path relative to ``root`` (``root``'s own name when ``root`` is the scene);
+      its ``calib.txt`` is used when present.
+    * Any other image whose name contains ``left`` (``left_0001.png`` as ``stereovision capture``
+      saves them, ``cam_left.jpg``, ``0001_Left.png``) pairs with the file named with ``right``
+      in its place; the pair is named by its folder and the file name without ``left`` (and
+      separators around it), e.g. ``seq/0001``. Files without a counterpart are ignored.
+
+    Parameters
+    ----------
+    root : path
+        Folder to search (any depth).
+    calib : path, optional
+        Calibration for every pair (overrides the scenes' ``calib.txt``).
+
+    Returns
+    -------
+    list of PairJob
+        Sorted by name; names are unique (a numeric suffix resolves clashes).
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``root`` (or ``calib``) does not exist.
+    NotADirectoryError
+        If ``root`` is not a folder.
+    """
+    r = Path(root)
+    if not r.exists():
+        raise FileNotFoundError(f"input folder not found: {r}")
+    if not r.is_dir():
+        raise NotADirectoryError(f"input is not a folder: {r}")
+    cal = Path(calib) if calib is not None else None
+    if cal is not None and not cal.is_file():
+        raise FileNotFoundError(f"calibration file not found: {cal}")
+    found: list[PairJob] = []
+    for d, _dirs, files in os.walk(r):
+        dirs = sorted(_dirs)
+        _dirs[:] = [x for x in dirs if not x.startswith(".")]
+        here = Path(d)
+        rel = here.relative_to(r).as_posix()
+        names = set(files)
+        if "left.png" in names and "right.png" in names:
+            scene_cal = here / _SCENE_CALIB if _SCENE_CALIB in names else None
+            found.append(
+                PairJob(
+                    rel if rel != "." else r.resolve().name,
+                    here / "left.png",
+                    here / "right.png",
+                    cal if cal is not None else scene_cal,
+                )
+            )
+        for f in sorted(files):
+            p = here / f
+            if p.suffix.lower() not in IMAGE_EXTS or f == "left.png" or f.startswith("."):
+                continue
+            rp = _right_of(p)
+            if rp is None or rp.name not in names:
+                continue
+            m = _last_left(p.stem)
+            assert m is not None
+            before, after = p.stem[: m.start()].rstrip("_-. "), p.stem[m.end() :].lstrip("_-. ")
+            short = "_".join(x for x in (before, after) if x)
+            if not short:  # "left.jpg": named by its folder, like a scene
+                short = rel if rel != "." else r.resolve().name
+                found.append(PairJob(short, p, rp, cal))
+                continue
+            found.append(PairJob(short if rel == "." else f"{rel}/{short}", p, rp, cal))
+    found.sort(key=lambda j: j.name)
+    seen: dict[str, int] = {}
+    unique: list[PairJob] = []
+    for j in found:
+        n = seen.get(j.name, 0)
+        seen[j.name] = n + 1
+        unique.append(j if n == 0 else PairJob(f"{j.name}~{n + 1}", j.left, j.right, j.calib))
+    return unique
+
+
+# ------------------------------------------------------------------------------- the worker
+
+
+def _decode(name: str, data: bytes) -> Any:
+    import cv2
+    import numpy as np
+
+    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR) if data else None
+    if img is None:
+        raise ValueError(f"cannot decode {name} as an image")
+    return img
+
+
+def process_pair(task: dict[str, Any]) -> dict[str, Any]:
+    """Compute one pair's ``stereovision depth`` outputs (runs on a Dask worker).
+
+    Parameters
+    ----------
+    task : dict
+        ``name``; ``left`` and ``right``: ``(file name, bytes)``; ``calib``: ``(file name,
+        bytes)`` or None; ``method`` (None = default), ``max_disparity`` (None = estimated),
+        ``fill``.
+
+    Returns
+    -------
+    dict
+        ``files`` ({output file name: bytes}), ``max_disparity``, ``density``, ``points``,
+        ``seconds`` (compute time), ``worker`` (host:pid).
+
+    Raises
+    ------
+    ValueError
+        An image that cannot be decoded, a pair of different sizes, a calibration for another
+        size, ... (as ``stereovision depth`` reports them).
+    """
+    from stereovision.calibration import Calibration
+    from stereovision.cli import depth_outputs
+
+    t0 = time.perf_counter()
+    left = _decode(task["left"][0], task["left"][1])
+    right = _decode(task["right"][0], task["right"][1])
+    with tempfile.TemporaryDirectory(prefix="stereovision-batch-") as tmp:
+        calib = None
+        if task.get("calib") is not None:
+            cname, cdata = task["calib"]
+            cpath = Path(tmp) / Path(cname).name
+            cpath.write_bytes(cdata)
+            calib = Calibration.from_file(cpath)
+        out = Path(tmp) / "out"
+        res, written = depth_outputs(
+            left,
+            right,
+            calib,
+            out,
+            method=task.get("method"),
+            max_disparity=task.get("max_disparity"),
+            fill=bool(task.get("fill", False)),
+        )
+        files = {name: Path(p).read_bytes() for name, p in written.items()}
+    return {
+        "files": files,
+        "max_disparity": int(res.max_disparity),
+        "density": float(res.density),
+        "points": len(res.points),
+        "seconds": time.perf_counter() - t0,
+        "worker": f"{socket.gethostname()}:{os.getpid()}",
+    }
+
+
+# ------------------------------------------------------------------------------- the client
+
+
+def _now() -> str:
+    return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
+
+
+def _fingerprint(job: PairJob) -> dict[str, Any]:
+    fp: dict[str, Any] = {}
+    for key, p in (("left", job.left), ("right", job.right), ("calib", job.calib)):
+        if p is None:
+            continue
+        st = p.stat()
+        fp[key] = [st.st_size, st.st_mtime_ns]
+    return fp
+
+
+def _commit_pair(out: Path, name: str, files: dict[str, bytes]) -> Path:
+    """Write a pair's files into ``out/name`` as a whole: temporary folder, then rename."""
+    dest = out / name
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    tmp = dest.parent / f".{dest.name}.partial-{uuid.uuid4().hex[:8]}"
+    tmp.mkdir()
+    try:
+        for fname, data in files.items():
+            with open(tmp / fname, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+        old = None
+        if dest.exists():
+            old = dest.parent / f".{dest.name}.old-{uuid.uuid4().hex[:8]}"
+            os.replace(dest, old)
+        os.replace(tmp, dest)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return dest
+
+
+def _error_line(exc: BaseException) -> str:
+    msg = str(exc).splitlines()[0] if str(exc) else ""
+    return f"{type(exc).__name__}: {msg}" if msg else type(exc).__name__
+
+
+@dataclass
+class BatchResult:
+    """What one :func:`run_batch` did.
+
+    Attributes
+    ----------
+    processed, skipped, failed : list of str
+        Pair names, by outcome in this run (``skipped``: done before).
+    failed_before : list of str
+        Pairs skipped because they failed before on the same inputs and options.
+    pending : list of str
+        Pairs not finished (interrupted run).
+    seconds : float
+        Wall time of the run.
+    summary_path : pathlib.Path
+        ``OUT/summary.json``.
+    interrupted : bool
+        The run was stopped by Ctrl-C.
+    """
+
+    processed: list[str]
+    skipped: list[str]
+    failed: list[str]
+    pending: list[str]
+    seconds: float
+    summary_path: Path
+    interrupted: bool = False
+    failed_before: list[str] = field(default_factory=list)
+
+
+class _Summary:
+    """``OUT/summary.json``: one entry per pair, rewritten atomically after every change."""
+
+    def __init__(self, out: Path) -> None:
+        self.path = out / SUMMARY_NAME
+        self.data: dict[str, Any] = {"version": _SUMMARY_VERSION, "pairs": {}}
+        if self.path.is_file():
+            try:
+                old = json.loads(self.path.read_text(encoding="utf-8"))
+            except (OSError, ValueError):
+                old = None  # unreadable: start afresh (the outputs are simply redone)
+            if isinstance(old, dict) and isinstance(old.get("pairs"), dict):
+                self.data = old
+
+    @property
+    def pairs(self) -> dict[str, Any]:
+        return self.data["pairs"]  # type: ignore[no-any-return]
+
+    def save(self) -> None:
+        from stereovision.io import atomic_write
+
+        pairs = self.pairs.values()
+        self.data["counts"] = {
+            s: sum(1 for p in pairs if p.get("status") == s) for s in ("done", "failed", "pending")
+        }
+        with atomic_write(self.path, "w") as fh:
+            json.dump(self.data, fh, indent=1, sort_keys=False)
+            fh.write("\n")
+
+
+def _unchanged(entry: dict[str, Any] | None, fp: dict[str, Any], opts: dict[str, Any]) -> bool:
+    return entry is not None and entry.get("fingerprint") == fp and entry.get("options") == opts
+
+
+def _skip(
+    entry: dict[str, Any] | None,
+    fp: dict[str, Any],
+    opts: dict[str, Any],
+    out: Path,
+    name: str,
+    retry_failed: bool,
+) -> bool:
+    """Done with the same inputs and options (and its folder is there), or failed on them."""
+    if entry is None or not _unchanged(entry, fp, opts):
+        return False
+    if entry.get("status") == "done":
+        return (out / name / "disparity.pfm").is_file()
+    return entry.get("status") == "failed" and not retry_failed
+
+
+def _start_client(scheduler: str | None, workers: int) -> tuple[Any, Any, str]:
+    try:
+        import logging
+
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise RuntimeError(
+            "batch needs Dask distributed: pip install 'stereovision-rs[batch]'"
+        ) from None
+    if scheduler is not None:
+        try:
+            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
+        except (OSError, TimeoutError) as exc:
+            raise OSError(
+                f"cannot reach the Dask scheduler at {scheduler}: {_error_line(exc)}"
+            ) from None
+        return client, None, scheduler
+    # One worker process per core by default, each kernel with its share of the cores, so the
+    # workers do not oversubscribe the machine.
+    threads = str(max(1, (os.cpu_count() or 1) // workers))
+    env = {"RAYON_NUM_THREADS": threads, "OMP_NUM_THREADS": threads, "OPENCV_LOG_LEVEL": "ERROR"}
+    cluster = LocalCluster(
+        n_workers=workers,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        silence_logs=logging.CRITICAL,  # failures are reported per pair
+        env=env,
+    )
+    client = Client(cluster)
+    return client, cluster, f"LocalCluster({workers} worker processes)"
+
+
+def _task(job: PairJob, opts: dict[str, Any]) -> dict[str, Any]:
+    return {
+        "name": job.name,
+        "left": (str(job.left), job.left.read_bytes()),
+        "right": (str(job.right), job.right.read_bytes()),
+        "calib": None if job.calib is None else (job.calib.name, job.calib.read_bytes()),
+        **opts,
+    }
+
+
+def run_batch(
+    input_dir: str | os.PathLike[str],
+    output_dir: str | os.PathLike[str],
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    method: str | None = None,
+    max_disparity: int | None = None,
+    fill: bool = False,
+    calib: str | os.PathLike[str] | None = None,
+    retry_failed: bool = False,
+    log: Callable[[str], None] | None = None,
+    progress: bool = True,
+) -> BatchResult:
+    """Process every pair under ``input_dir`` into ``output_dir`` on Dask (see the module doc).
+
+    Parameters
+    ----------
+    input_dir, output_dir : path
+        Input tree and output folder (created if missing).
+    workers : int, optional
+        Worker processes of the LocalCluster (default: the number of cores). Ignored with
+        ``scheduler``.
+    scheduler : str, optional
+        Address of an existing Dask scheduler (``tcp://host:8786``).
+    method : str, optional
+        Matcher; None = ``depth_map``'s default.
+    max_disparity : int, optional
+        Disparity range for every pair; None = estimated per pair.
+    fill : bool
+        Reference row fill of the holes.
+    calib : path, optional
+        Calibration for every pair (else each scene's ``calib.txt``).
+    retry_failed : bool
+        Also redo the pairs that failed before on the same inputs (by default a failed pair is
+        redone only once its files or the options change).
+    log : callable, optional
+        Receives one line per failed pair.
+    progress : bool
+        Show a progress bar on a terminal.
+
+    Returns
+    -------
+    BatchResult
+
+    Raises
+    ------
+    FileNotFoundError, NotADirectoryError
+        A missing input folder or calibration file.
+    ValueError
+        Bad ``workers`` / ``max_disparity``, or no pair under the input.
+    OSError
+        The scheduler cannot be reached.
+    KeyboardInterrupt
+        After recording what was finished (Ctrl-C).
+    """
+    if workers is not None and workers <= 0:
+        raise ValueError(f"workers: expected a positive number, got {workers}")
+    if max_disparity is not None and max_disparity <= 0:
+        raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
+    t0 = time.perf_counter()
+    jobs = find_pairs(input_dir, calib)
+    if not jobs:
+        raise ValueError(
+            f"no pair under {input_dir} (scene folders with left.png + right.png, or "
+            "files named ...left... / ...right...)"
+        )
+    out = Path(output_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    summary = _Summary(out)
+    opts = {"method": method, "max_disparity": max_disparity, "fill": fill}
+    summary.data.update(
+        input=str(Path(input_dir).resolve()),
+        output=str(out.resolve()),
+    )
+    todo: list[PairJob] = []
+    skipped: list[str] = []
+    failed_before: list[str] = []
+    for job in jobs:
+        fp = _fingerprint(job)
+        entry = summary.pairs.get(job.name)
+        if _skip(entry, fp, opts, out, job.name, retry_failed):
+            assert entry is not None
+            entry["this_run"] = "skipped"
+            (skipped if entry["status"] == "done" else failed_before).append(job.name)
+            continue
+        summary.pairs[job.name] = {
+            "status": "pending",
+            "left": str(job.left),
+            "right": str(job.right),
+            "calib": None if job.calib is None else str(job.calib),
+            "options": opts,
+            "fingerprint": fp,
+        }
+        todo.append(job)
+    n_workers = workers or os.cpu_count() or 1
+    run: dict[str, Any] = {
+        "started": _now(),
+        "scheduler": None,
+        "pairs": len(jobs),
+        "processed": 0,
+        "skipped": len(skipped),
+        "skipped_failed": len(failed_before),
+        "failed": 0,
+        "interrupted": False,
+    }
+    summary.data["run"] = run
+    summary.save()
+    processed: list[str] = []
+    failed: list[str] = []
+    interrupted = False
+    if todo:
+        processed, failed, interrupted = _run_jobs(
+            todo, opts, out, summary, run, scheduler, n_workers, log, progress
+        )
+    seconds = time.perf_counter() - t0
+    run.update(finished=_now(), seconds=round(seconds, 3), interrupted=interrupted)
+    summary.save()
+    pending = [j.name for j in todo if j.name not in processed and j.name not in failed]
+    result = BatchResult(
+        processed,
+        skipped,
+        failed,
+        pending,
+        seconds,
+        summary.path,
+        interrupted=interrupted,
+        failed_before=failed_before,
+    )
+    if interrupted:
+        raise KeyboardInterrupt
+    return result
+
+
+def _run_jobs(
+    todo: list[PairJob],
+    opts: dict[str, Any],
+    out: Path,
+    summary: _Summary,
+    run: dict[str, Any],
+    scheduler: str | None,
+    n_workers: int,
+    log: Callable[[str], None] | None,
+    progress: bool,
+) -> tuple[list[str], list[str], bool]:
+    from tqdm import tqdm
+
+    processed: list[str] = []
+    failed: list[str] = []
+    client, cluster, desc = _start_client(scheduler, n_workers)
+    run["scheduler"] = desc
+    bar = tqdm(
+        total=len(todo),
+        desc="pairs",
+        unit="pair",
+        file=sys.stderr,
+        disable=not progress or not sys.stderr.isatty(),
+    )
+    futures: dict[Any, PairJob] = {}
+    interrupted = False
+    try:
+        from distributed import as_completed
+
+        n_live = len(client.scheduler_info().get("workers", {})) or n_workers
+        limit = max(1, IN_FLIGHT_PER_WORKER * n_live)
+        queue: Iterator[PairJob] = iter(todo)
+        ac = as_completed()
+
+        def submit_next() -> bool:
+            job = next(queue, None)
+            if job is None:
+                return False
+            try:
+                task = _task(job, opts)
+            except OSError as exc:  # unreadable input: a failed pair, not a failed run
+                record_failure(job, exc)
+                return True
+            fut = client.submit(process_pair, task, key=f"stereovision-{uuid.uuid4().hex}")
+            futures[fut] = job
+            ac.add(fut)
+            return True
+
+        def record_failure(job: PairJob, exc: BaseException) -> None:
+            entry = summary.pairs[job.name]
+            entry.update(
+                status="failed", error=_error_line(exc), finished=_now(), this_run="failed"
+            )
+            failed.append(job.name)
+            run["failed"] = len(failed)
+            summary.save()
+            bar.update(1)
+            if log is not None:
+                log(f"failed {job.name}: {entry['error']}")
+
+        while len(futures) < limit and submit_next():
+            pass
+        for fut in ac:
+            job = futures.pop(fut)
+            exc = fut.exception()
+            if exc is not None:
+                record_failure(job, exc)
+            else:
+                res = fut.result()
+                _commit_pair(out, job.name, res["files"])
+                entry = summary.pairs[job.name]
+                entry.update(
+                    status="done",
+                    outputs=sorted(res["files"]),
+                    max_disparity=res["max_disparity"],
+                    density=round(res["density"], 4),
+                    points=res["points"],
+                    seconds=round(res["seconds"], 3),
+                    worker=res["worker"],
+                    finished=_now(),
+                    this_run="processed",
+                )
+                entry.pop("error", None)
+                processed.append(job.name)
+                run["processed"] = len(processed)
+                summary.save()
+                bar.update(1)
+            fut.release()
+            while len(futures) < limit and submit_next():
+                pass
+    except KeyboardInterrupt:
+        interrupted = True
+        for fut in list(futures):
+            fut.cancel()
+    finally:
+        bar.close()
+        try:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+        except Exception:  # shutting down is best effort; the results are already written
+            pass
+    return processed, failed, interrupted
+
+
+# ---------------------------------------------------------------------------------------- CLI
+
+
+def cmd_batch(args: argparse.Namespace) -> int:
+    """``stereovision batch INPUT -o OUT``: exit status 0, or 1 when a pair has no outputs."""
+
+    def log(line: str) -> None:
+        from tqdm import tqdm
+
+        tqdm.write(line, file=sys.stderr)
+
+    try:
+        res = run_batch(
+            args.input,
+            args.output,
+            workers=args.workers,
+            scheduler=args.scheduler,
+            method=args.method,
+            max_disparity=args.max_disparity,
+            fill=args.fill,
+            calib=args.calib,
+            retry_failed=args.retry_failed,
+            log=log,
+        )
+    except KeyboardInterrupt:
+        print(
+            f"interrupted: finished pairs are in {args.output} and recorded in "
+            f"{Path(args.output) / SUMMARY_NAME}; run again to continue",
+            file=sys.stderr,
+        )
+        raise
+    again = (
+        f", {len(res.failed_before)} skipped (failed before; --retry-failed redoes them)"
+        if res.failed_before
+        else ""
+    )
+    print(
+        f"{len(res.processed)} processed, {len(res.skipped)} skipped (done before){again}, "
+        f"{len(res.failed)} failed in {res.seconds:.1f} s; summary: {res.summary_path}"
+    )
+    return 1 if res.failed or res.failed_before else 0
+
+
+def add_cli(subparsers: Any) -> None:
+    """Register ``stereovision batch`` on the CLI's sub-parsers."""
+    from stereovision.depth import METHODS
+
+    p = subparsers.add_parser(
+        "batch",
+        help="depth outputs of every pair under a folder, on Dask (local or a cluster)",
+        description="Process every scene folder (left.png + right.png) or ...left.../...right... "
+        "image pair under INPUT into OUT/<name>/ (the files `stereovision depth` writes), "
+        "recorded in OUT/summary.json; a re-run skips finished pairs. Exit status 1 when a pair "
+        "failed (its error is in the summary), 2 on errors.",
+    )
+    p.add_argument("input", help="folder with scene folders or left/right image pairs")
+    p.add_argument("-o", "--output", required=True, help="output folder")
+    p.add_argument("--workers", type=int, help="LocalCluster worker processes (default: cores)")
+    p.add_argument("--scheduler", metavar="ADDRESS", help="existing Dask scheduler, tcp://...")
+    p.add_argument("--method", choices=METHODS, help="matcher (default: depth_map's)")
+    p.add_argument("--max-disparity", type=int, help="for every pair (default: per pair)")
+    p.add_argument("--calib", help="calibration for every pair (default: each scene's calib.txt)")
+    p.add_argument("--fill", action="store_true", help="fill holes (reference row fill)")
+    p.add_argument(
+        "--retry-failed", action="store_true", help="redo pairs that failed on unchanged inputs"
+    )
+    p.set_defaults(func=cmd_batch)

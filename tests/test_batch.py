@@ -1,0 +1,237 @@
+"""``stereovision batch`` on a real 2-worker Dask LocalCluster: outputs, re-run, failures."""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import cv2
+import distributed
+import numpy as np
+import pytest
+
+from stereovision.batch import SUMMARY_NAME, PairJob, find_pairs
+from stereovision.calibration import Calibration
+from stereovision.cli import main
+from stereovision.depth import depth_map
+from stereovision.io import imread, read_pfm, read_ply
+
+SCALE = 0.5  # half-size copies keep the cluster run short
+DISPARITY_FILES = {"disparity.png", "disparity.pfm"}
+DEPTH_FILES = DISPARITY_FILES | {"depth.png", "depth.npy", "cloud.ply", "render.png"}
+
+
+def _half(src: Path, dst: Path) -> None:
+    dst.mkdir(parents=True)
+    for side in ("left", "right"):
+        img = cv2.imread(str(src / f"{side}.png"))
+        small = cv2.resize(img, None, fx=SCALE, fy=SCALE, interpolation=cv2.INTER_AREA)
+        cv2.imwrite(str(dst / f"{side}.png"), small)
+
+
+def _half_calib(src: Path, dst: Path, size: tuple[int, int]) -> None:
+    """A Middlebury calib.txt for the half-size images (focal, centre and doffs halved)."""
+    cal = Calibration.from_file(src)
+    f, cx, cy = (SCALE * cal.K1[0, 0], SCALE * cal.K1[0, 2], SCALE * cal.K1[1, 2])
+    cam = f"[{f} 0 {cx}; 0 {f} {cy}; 0 0 1]"
+    dst.write_text(
+        f"cam0={cam}\ncam1={cam}\ndoffs={SCALE * cal.doffs_px}\nbaseline={cal.baseline}\n"
+        f"width={size[0]}\nheight={size[1]}\nndisp=128\n"
+    )
+
+
+@pytest.fixture
+def scenes(data_dir: Path, tmp_path: Path) -> Path:
+    """Three half-size scenes (one with a metric calibration) and a pair with a corrupt image."""
+    root = tmp_path / "in"
+    for name in ("middlebury2001/tsukuba", "middlebury2001/venus", "eth3d/terrace"):
+        _half(data_dir / name, root / name)
+    terrace = root / "eth3d/terrace"
+    h, w = cv2.imread(str(terrace / "left.png")).shape[:2]
+    _half_calib(data_dir / "eth3d/terrace/calib.txt", terrace / "calib.txt", (w, h))
+    seq = root / "seq"
+    seq.mkdir()
+    shutil.copy(root / "middlebury2001/tsukuba/left.png", seq / "left_0001.png")
+    good = (root / "middlebury2001/tsukuba/right.png").read_bytes()
+    (seq / "right_0001.png").write_bytes(good[: len(good) // 3])  # truncated: cannot decode
+    return root
+
+
+def _summary(out: Path) -> dict:
+    return json.loads((out / SUMMARY_NAME).read_text())
+
+
+def _tree(out: Path) -> dict[str, float]:
+    return {
+        p.relative_to(out).as_posix(): p.stat().st_mtime_ns
+        for p in out.rglob("*")
+        if p.is_file() and p.name != SUMMARY_NAME
+    }
+
+
+def test_batch_runs_skips_and_records_failures(scenes: Path, tmp_path: Path) -> None:
+    out = tmp_path / "out"
+    t = time.perf_counter()
+    rc = main(["batch", str(scenes), "-o", str(out), "--workers", "2"])
+    first = time.perf_counter() - t
+    assert rc == 1  # one pair failed; the others completed
+    s = _summary(out)
+    pairs = s["pairs"]
+    done = ["eth3d/terrace", "middlebury2001/tsukuba", "middlebury2001/venus"]
+    assert sorted(pairs) == [*done, "seq/0001"]
+    assert s["counts"] == {"done": 3, "failed": 1, "pending": 0}
+    assert s["run"]["processed"] == 3 and s["run"]["failed"] == 1 and s["run"]["skipped"] == 0
+    assert s["run"]["scheduler"] == "LocalCluster(2 worker processes)"
+    bad = pairs["seq/0001"]
+    assert bad["status"] == "failed" and "cannot decode" in bad["error"]
+    assert "right_0001.png" in bad["error"] and not (out / "seq" / "0001").exists()
+    for name in done:
+        entry = pairs[name]
+        assert entry["status"] == "done" and entry["this_run"] == "processed"
+        expected = DEPTH_FILES if name == "eth3d/terrace" else DISPARITY_FILES
+        assert set(entry["outputs"]) == expected
+        assert {p.name for p in (out / name).iterdir()} == expected
+        # The worker's disparity is what depth_map gives on the same pair, bit for bit.
+        left, right = imread(scenes / name / "left.png"), imread(scenes / name / "right.png")
+        calib = None
+        if name == "eth3d/terrace":
+            calib = Calibration.from_file(scenes / name / "calib.txt")
+        ref = depth_map(left, right, calib)
+        np.testing.assert_array_equal(read_pfm(out / name / "disparity.pfm"), ref.disparity)
+        assert entry["max_disparity"] == ref.max_disparity
+        assert entry["density"] == pytest.approx(ref.density, abs=1e-4)
+        if calib is not None:
+            assert ref.depth is not None
+            np.testing.assert_array_equal(np.load(out / name / "depth.npy"), ref.depth)
+    assert len(read_ply(out / "eth3d/terrace/cloud.ply")[0]) == pairs["eth3d/terrace"]["points"]
+    assert not [p for p in out.rglob(".*")]  # no temporary folder left behind
+
+    # Second run: everything is skipped, nothing rewritten, no cluster started.
+    before = _tree(out)
+    t = time.perf_counter()
+    rc = main(["batch", str(scenes), "-o", str(out), "--workers", "2"])
+    second = time.perf_counter() - t
+    assert rc == 1  # the corrupt pair still has no outputs
+    s = _summary(out)
+    assert s["run"]["processed"] == 0 and s["run"]["skipped"] == 3
+    assert s["run"]["skipped_failed"] == 1 and s["run"]["scheduler"] is None
+    assert all(p["this_run"] == "skipped" for p in s["pairs"].values())
+    assert _tree(out) == before
+    assert second < min(10.0, first / 2)
+
+    # The image is repaired: the next run, on an existing scheduler, redoes that pair only.
+    shutil.copy(scenes / "middlebury2001/tsukuba/right.png", scenes / "seq/right_0001.png")
+    with (
+        distributed.LocalCluster(
+            n_workers=2,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.CRITICAL,
+        ) as cluster,
+    ):
+        rc = main(["batch", str(scenes), "-o", str(out), "--scheduler", cluster.scheduler_address])
+    assert rc == 0
+    s = _summary(out)
+    assert s["run"]["scheduler"] == cluster.scheduler_address
+    assert s["run"]["processed"] == 1 and s["run"]["skipped"] == 3
+    entry = s["pairs"]["seq/0001"]
+    assert entry["status"] == "done" and "error" not in entry
+    np.testing.assert_array_equal(
+        read_pfm(out / "seq/0001/disparity.pfm"),
+        read_pfm(out / "middlebury2001/tsukuba/disparity.pfm"),
+    )
+    assert s["counts"] == {"done": 4, "failed": 0, "pending": 0}
+
+
+def test_find_pairs_names(tmp_path: Path) -> None:
+    img = np.zeros((8, 8, 3), np.uint8)
+    files = [
+        "a/scene1/left.png",
+        "a/scene1/right.png",
+        "a/scene1/calib.txt",
+        "caps/left_0001.png",
+        "caps/right_0001.png",
+        "caps/left_0002.png",  # no right image: ignored
+        "cams/000_Left.jpg",
+        "cams/000_Right.jpg",
+        "cams/.left_hidden.png",
+        "cams/.right_hidden.png",
+    ]
+    for f in files:
+        p = tmp_path / f
+        p.parent.mkdir(parents=True, exist_ok=True)
+        if p.suffix == ".txt":
+            p.write_text("x")
+        else:
+            cv2.imwrite(str(p), img)
+    jobs = find_pairs(tmp_path)
+    assert [j.name for j in jobs] == ["a/scene1", "cams/000", "caps/0001"]
+    assert jobs[0] == PairJob(
+        "a/scene1",
+        tmp_path / "a/scene1/left.png",
+        tmp_path / "a/scene1/right.png",
+        tmp_path / "a/scene1/calib.txt",
+    )
+    assert jobs[1].right == tmp_path / "cams/000_Right.jpg"
+    assert jobs[2].right == tmp_path / "caps/right_0001.png" and jobs[2].calib is None
+    # A scene folder given itself is named after the folder; --calib applies to every pair.
+    (tmp_path / "rig.yaml").write_text("x")
+    solo = find_pairs(tmp_path / "a/scene1", calib=tmp_path / "rig.yaml")
+    assert [(j.name, j.calib) for j in solo] == [("scene1", tmp_path / "rig.yaml")]
+
+
+def test_batch_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["batch", str(tmp_path / "missing"), "-o", str(tmp_path / "o")]) == 2
+    assert main(["batch", str(tmp_path), "-o", str(tmp_path / "o")]) == 2
+    assert main(["batch", str(tmp_path), "-o", str(tmp_path / "o"), "--workers", "0"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 3
+    assert "not found" in err[0] and "no pair under" in err[1] and "workers" in err[2]
+
+
+def test_batch_ctrl_c_keeps_finished_pairs(data_dir: Path, tmp_path: Path) -> None:
+    """SIGINT in the middle: exit 130, finished pairs written and recorded, a re-run continues."""
+    root = tmp_path / "in"
+    for i in range(12):
+        _half(data_dir / "middlebury2001/tsukuba", root / f"s{i:02d}")
+    out = tmp_path / "out"
+    cmd = [sys.executable, "-m", "stereovision.cli", "batch", str(root), "-o", str(out)]
+    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
+    proc = subprocess.Popen([*cmd, "--workers", "1"], env=env, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            try:
+                if _summary(out)["counts"]["done"] >= 2:
+                    break
+            except (OSError, ValueError, KeyError):
+                pass
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    s = _summary(out)
+    done = sorted(n for n, p in s["pairs"].items() if p["status"] == "done")
+    assert len(done) >= 2
+    for n in done:
+        assert {p.name for p in (out / n).iterdir()} == DISPARITY_FILES
+        assert read_pfm(out / n / "disparity.pfm").shape == (144, 192)
+    if len(done) < 12:  # interrupted before the end (the usual case)
+        assert proc.returncode == 130 and "interrupted" in err
+        assert s["run"]["interrupted"] is True
+        assert s["counts"]["pending"] == 12 - len(done)
+    assert not [p for p in out.rglob(".*")]
+    # The re-run (in-process) does only what was left.
+    assert main([*cmd[3:], "--workers", "1"]) == 0
+    s = _summary(out)
+    assert s["run"]["skipped"] == len(done) and s["run"]["processed"] == 12 - len(done)
