@@ -374,11 +374,12 @@ def build_parser() -> argparse.ArgumentParser:
     d.set_defaults(func=cmd_eval)
 
     # Commands owned by their pipeline stage's module.
-    from stereovision import batch, calibrate, capture, gui, render, stream
+    from stereovision import batch, bench, calibrate, capture, gui, render, stream
 
     capture.add_cli(sub)
     stream.add_cli(sub)
     batch.add_cli(sub)
+    bench.add_cli(sub)
     calibrate.add_cli(sub)
     render.add_cli(sub)
     gui.add_cli(sub)

@@ -1,0 +1,268 @@
+"""Speed and accuracy of every method beside OpenCV, on the same pairs in the same run.
+
+``stereovision bench [SCENE_DIR...]`` (evaluation.md "Speed"): for each scene, every case runs once
+as a warm-up, then all cases run in turn (A, B, C, ... A, B, C, ...) ``runs`` times and the median
+time of each is reported with its ratio to OpenCV StereoSGBM 3-way's, beside its accuracy
+(evaluation.md's metrics against the scene's ground truth when it has one). The cases:
+
+* each dense method of :data:`stereovision.depth.METHODS`, the matcher alone on the grey float
+  pair (converted once, outside the timing, as OpenCV's is loaded once);
+* ``pipeline``: :func:`stereovision.depth_map` with the default method from the BGR pair and
+  the scene's calibration: input checks, conversion, matching, triangulation and point cloud;
+* each sparse method of :data:`stereovision.match.METHODS` (precision@1 and count instead of
+  bad-2.0 and density);
+* ``StereoBM`` and ``SGBM-3WAY``: :mod:`stereovision.baselines`, evaluation.md's configuration.
+
+All use every core (OpenCV's and rayon's default thread pools). A table is printed, then one JSON
+object per case (``--json``: only those).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+__all__ = ["BenchCase", "add_cli", "bench_scene", "cmd_bench", "format_table"]
+
+#: Timed runs per case (after one warm-up), evaluation.md's minimum.
+DEFAULT_RUNS = 5
+REFERENCE = "SGBM-3WAY"
+
+
+@dataclass
+class BenchCase:
+    """Figures of one case on one scene.
+
+    Attributes
+    ----------
+    scene : str
+    case : str
+        Method name, ``pipeline``, ``StereoBM`` or ``SGBM-3WAY``.
+    kind : str
+        ``method`` (dense matcher alone), ``pipeline``, ``sparse`` or ``opencv``.
+    ms : float
+        Median time of the timed runs, milliseconds.
+    ratio : float
+        ``ms`` / SGBM-3WAY's ``ms`` in the same run (< 1 = faster than SGBM).
+    accuracy : dict
+        Dense: ``bad_2.0`` (holes counted), ``bad_2.0_filled`` (after the reference row fill),
+        ``density`` (percent). Sparse: ``precision@1.0``, ``count``. Empty without GT.
+    """
+
+    scene: str
+    case: str
+    kind: str
+    width: int
+    height: int
+    max_disparity: int
+    runs: int
+    ms: float
+    ratio: float
+    accuracy: dict[str, float]
+
+    def as_dict(self) -> dict[str, Any]:
+        """The JSON object of the case."""
+        return {
+            "bench": "vs_opencv",
+            "scene": self.scene,
+            "case": self.case,
+            "kind": self.kind,
+            "width": self.width,
+            "height": self.height,
+            "max_disparity": self.max_disparity,
+            "runs": self.runs,
+            "ms": round(self.ms, 3),
+            "ratio_sgbm": round(self.ratio, 4),
+            **{k: round(v, 3) for k, v in self.accuracy.items()},
+        }
+
+
+def _dense_accuracy(disp: np.ndarray, gt: np.ndarray | None) -> dict[str, float]:
+    from stereovision.baselines import row_fill
+    from stereovision.evaluate import dense_metrics
+
+    if gt is None:
+        return {}
+    raw = dense_metrics(disp, gt)
+    filled = dense_metrics(row_fill(disp), gt)
+    return {"bad_2.0": raw.bad[2.0], "bad_2.0_filled": filled.bad[2.0], "density": raw.density}
+
+
+def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
+    """Time and score every case on one scene (see the module doc).
+
+    Parameters
+    ----------
+    scene : stereovision.io.Scene
+        The pair, its GT (optional) and calibration (optional); ``max_disparity`` is the range
+        every case searches (evaluation.md).
+    runs : int
+        Timed runs per case (>= 1), after one warm-up.
+
+    Returns
+    -------
+    list of BenchCase
+        In the order: dense methods, pipeline, sparse methods, StereoBM, SGBM-3WAY.
+
+    Raises
+    ------
+    ValueError
+        If ``runs`` < 1.
+    """
+    from stereovision import baselines
+    from stereovision._validate import as_gray_float
+    from stereovision.depth import METHODS, _run_matcher, depth_map
+    from stereovision.evaluate import sparse_metrics
+    from stereovision.match import METHODS as SPARSE_METHODS
+    from stereovision.match import match
+
+    if runs < 1:
+        raise ValueError(f"runs: expected at least 1, got {runs}")
+    left, right, gt, md = scene.left, scene.right, scene.gt, int(scene.max_disparity)
+    calib = scene.calib if scene.calib is not None and scene.calib.rectified else None
+    gl, gr = as_gray_float(left, "left"), as_gray_float(right, "right")
+    outputs: dict[str, Any] = {}
+
+    def dense(m: str) -> Callable[[], Any]:
+        return lambda: _run_matcher(m, gl, gr, 0.0, float(md), {})[0]
+
+    def sparse(m: str) -> Callable[[], Any]:
+        return lambda: match(left, right, method=m, max_disparity=md)
+
+    def keep(name: str, fn: Callable[[], Any]) -> Callable[[], None]:
+        def run() -> None:
+            outputs[name] = fn()
+
+        return run
+
+    cases: list[tuple[str, str, Callable[[], None]]] = [
+        (m, "method", keep(m, dense(m))) for m in METHODS
+    ]
+    pipeline = lambda: depth_map(left, right, calib, max_disparity=md).disparity  # noqa: E731
+    cases.append(("pipeline", "pipeline", keep("pipeline", pipeline)))
+    cases += [(m, "sparse", keep(m, sparse(m))) for m in SPARSE_METHODS]
+    bm = lambda: baselines.opencv_bm(left, right, md)  # noqa: E731
+    sgbm = lambda: baselines.opencv_sgbm(left, right, md)  # noqa: E731
+    cases += [("StereoBM", "opencv", keep("StereoBM", bm))]
+    cases += [(REFERENCE, "opencv", keep(REFERENCE, sgbm))]
+    for _, _, fn in cases:  # warm-up: first-call allocations, thread pools, caches
+        fn()
+    times: dict[str, list[float]] = {name: [] for name, _, _ in cases}
+    for _ in range(runs):
+        for name, _, fn in cases:
+            t = time.perf_counter()
+            fn()
+            times[name].append(time.perf_counter() - t)
+    med = {k: 1e3 * statistics.median(v) for k, v in times.items()}
+    h, w = gl.shape
+    result = []
+    for name, kind, _ in cases:
+        out = outputs[name]
+        if kind == "sparse":
+            acc: dict[str, float] = {}
+            if gt is not None:
+                sm = sparse_metrics(out.xl, out.yl, out.xr, gt)
+                acc = {"precision@1.0": sm.precision[1.0], "count": float(sm.count)}
+        else:
+            acc = _dense_accuracy(out, gt)
+        result.append(
+            BenchCase(
+                scene.name, name, kind, w, h, md, runs, med[name], med[name] / med[REFERENCE], acc
+            )
+        )
+    return result
+
+
+def _fmt(v: float | None, spec: str) -> str:
+    return format(v, spec) if v is not None and math.isfinite(v) else "-"
+
+
+def format_table(cases: Sequence[BenchCase]) -> str:
+    """A text table: one row per case, scenes separated by their header."""
+    lines = [
+        f"{'scene':34s} {'size':>9s} {'D':>4s} {'case':10s} {'ms':>8s} {'x SGBM':>7s}"
+        f" {'bad-2':>6s} {'+fill':>6s} {'dens':>6s} {'p@1':>6s} {'count':>6s}"
+    ]
+    last = None
+    for c in cases:
+        head = (
+            f"{c.scene:34s} {c.width:4d}x{c.height:<4d} {c.max_disparity:4d}"
+            if c.scene != last
+            else " " * 49
+        )
+        last = c.scene
+        a = c.accuracy
+        lines.append(
+            f"{head} {c.case:10s} {c.ms:8.1f} {c.ratio:7.2f}"
+            f" {_fmt(a.get('bad_2.0'), '6.1f'):>6s} {_fmt(a.get('bad_2.0_filled'), '6.1f'):>6s}"
+            f" {_fmt(a.get('density'), '6.1f'):>6s} {_fmt(a.get('precision@1.0'), '6.1f'):>6s}"
+            f" {_fmt(a.get('count'), '6.0f'):>6s}"
+        )
+    return "\n".join(lines)
+
+
+# ---------------------------------------------------------------------------------------- CLI
+
+
+def _scene_dirs(paths: Sequence[str]) -> list[Path]:
+    from stereovision.io import find_scenes
+
+    if not paths:
+        return [Path(str(resources.files("stereovision") / "data" / "cones"))]
+    dirs: list[Path] = []
+    for d in paths:
+        found = find_scenes(d)  # FileNotFoundError for a missing folder
+        if not found:
+            raise ValueError(f"no scene (left.png + right.png) under {d}")
+        dirs.extend(found)
+    return dirs
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    """``stereovision bench [SCENE_DIR...]``."""
+    from tqdm import tqdm
+
+    from stereovision.io import load_scene
+
+    if args.runs < 1:
+        raise ValueError(f"--runs: expected at least 1, got {args.runs}")
+    dirs = _scene_dirs(args.scenes)
+    all_cases: list[BenchCase] = []
+    quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
+    for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
+        cases = bench_scene(load_scene(d), runs=args.runs)
+        all_cases.extend(cases)
+        if args.json:
+            for c in cases:
+                print(json.dumps(c.as_dict()), flush=True)
+    if not args.json:
+        print(format_table(all_cases))
+        for c in all_cases:
+            print(json.dumps(c.as_dict()))
+    return 0
+
+
+def add_cli(subparsers: Any) -> None:
+    """Register ``stereovision bench`` on the CLI's sub-parsers."""
+    p = subparsers.add_parser(
+        "bench",
+        help="time and accuracy of every method beside OpenCV StereoBM / SGBM-3WAY",
+        description="Each method, the whole pipeline and OpenCV's StereoBM and SGBM-3WAY on the "
+        "same pairs in the same run (interleaved, median of --runs after a warm-up): a table, "
+        "then one JSON line per case. Default scene: the bundled Middlebury Cones.",
+    )
+    p.add_argument("scenes", nargs="*", help="scene folders (or folders containing scenes)")
+    p.add_argument("--runs", type=int, default=DEFAULT_RUNS, help="timed runs per case")
+    p.add_argument("--json", action="store_true", help="only the JSON lines")
+    p.set_defaults(func=cmd_bench)

@@ -1,0 +1,76 @@
+"""``stereovision bench``: every method beside OpenCV on the same pair, same run (evaluation.md)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from stereovision import baselines
+from stereovision.bench import bench_scene, format_table
+from stereovision.cli import main
+from stereovision.depth import METHODS
+from stereovision.evaluate import dense_metrics
+from stereovision.io import load_scene
+from stereovision.match import METHODS as SPARSE_METHODS
+
+SCENE = "middlebury2001/tsukuba"  # the smallest GT scene: 384x288, max_disparity 16
+
+
+def test_bench_scene_cases_and_figures(data_dir: Path) -> None:
+    scene = load_scene(data_dir / SCENE)
+    cases = bench_scene(scene, runs=1)
+    names = [c.case for c in cases]
+    assert names == [*METHODS, "pipeline", *SPARSE_METHODS, "StereoBM", "SGBM-3WAY"]
+    by = {c.case: c for c in cases}
+    assert by["SGBM-3WAY"].ratio == pytest.approx(1.0)
+    for c in cases:
+        assert c.ms > 0 and c.ratio == pytest.approx(c.ms / by["SGBM-3WAY"].ms)
+        assert (c.width, c.height, c.max_disparity) == (384, 288, 16)
+    # The OpenCV figures are evaluation.md's (tsukuba: BM 12.7 %, SGBM-3WAY 5.3 % bad-2.0).
+    assert by["StereoBM"].accuracy["bad_2.0"] == pytest.approx(12.7, abs=0.3)
+    assert by["SGBM-3WAY"].accuracy["bad_2.0"] == pytest.approx(5.3, abs=0.3)
+    # Ours is scored by the same metric code as a direct evaluation.
+    sgbm = baselines.opencv_sgbm(scene.left, scene.right, 16)
+    assert by["SGBM-3WAY"].accuracy["density"] == pytest.approx(
+        dense_metrics(sgbm, scene.gt).density
+    )
+    for m in SPARSE_METHODS:
+        acc = by[m].accuracy
+        assert acc["precision@1.0"] > 90 and acc["count"] > 100
+    # issue 2's bar: ours after the reference row fill beats StereoBM (README: 8.2 vs 12.7 %).
+    assert by["pipeline"].accuracy["bad_2.0_filled"] < by["StereoBM"].accuracy["bad_2.0"]
+    table = format_table(cases)
+    assert table.count("\n") == len(cases) and "SGBM-3WAY" in table
+
+
+def test_bench_cli_json_lines(data_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["bench", "--runs", "1", "--json", str(data_dir / SCENE)]) == 0
+    lines = [json.loads(ln) for ln in capsys.readouterr().out.splitlines() if ln.strip()]
+    assert [ln["case"] for ln in lines][-2:] == ["StereoBM", "SGBM-3WAY"]
+    assert all(ln["bench"] == "vs_opencv" and ln["scene"].endswith("tsukuba") for ln in lines)
+    assert {"ms", "ratio_sgbm", "max_disparity"} <= set(lines[0])
+
+
+@pytest.mark.parametrize(
+    ("argv", "needle"),
+    [
+        (["bench", "--runs", "0"], "--runs"),
+        (["bench", "/no/such/folder"], "not found"),
+    ],
+)
+def test_bench_cli_errors_one_line(
+    argv: list[str], needle: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and needle in err and err.startswith("stereovision: error:")
+
+
+def test_bench_cli_folder_without_scenes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    (tmp_path / "empty").mkdir()
+    assert main(["bench", str(tmp_path / "empty")]) == 2
+    assert "no scene" in capsys.readouterr().err
