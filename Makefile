@@ -69,8 +69,10 @@ fmt:  ## format Rust and Python in place
 
 bench: build  ## criterion benches of the kernels, then the Python benches against OpenCV
 	cargo bench
+	$(VENV)/bin/stereovision bench ../shared/data
 	$(PY) benches/bench_gabor_vs_sgbm.py
 	$(PY) benches/bench_hopfield.py
+	$(PY) benches/bench_scaling.py
 
 clean:  ## remove build products (keeps .venv)
 	rm -rf target $(BUILD_STAMP) demo_output
