@@ -1,0 +1,273 @@
+"""Triple-channel agreement: the paper's "valid members" (algorithms.md D, vote mode by default).
+
+The dense Gabor channel (A), the graph-matching curves (B) and the Hopfield points (C) each give a
+disparity at some left pixels. A pixel where a sparse channel measured something is a
+*candidate*; there the available values are collected -- A at the pixel (when its confidence
+passes ``a_conf_min``), each sparse channel's nearest measurement within ``r_spatial`` (D.2: a
+corner almost never sits exactly on a zero-crossing pixel) -- and the largest subset whose members
+agree pairwise within ``tau_dx`` / ``tau_dy`` is kept when it has at least ``min_agree`` members
+(``"vote"``), or only when every channel is present and agrees (``"intersection"``, the paper's
+rule with tolerances).
+The fused value is the weighted mean of the agreeing subset (weights: A's confidence, 1 for the
+sparse channels).
+
+This is orchestration over the channels' outputs (NumPy, O(HW) shifts plus O(|P|) work); the
+channels themselves are the Rust kernels.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from stereovision.matches import Matches
+
+__all__ = ["CHANNEL_BITS", "DEFAULTS", "FusionResult", "fuse"]
+
+F32 = npt.NDArray[np.float32]
+
+#: Bit of each channel in :attr:`FusionResult.sources` (algorithms.md D.1: 1 = A, 2 = B, 4 = C).
+CHANNEL_BITS: dict[str, int] = {"gabor": 1, "mcgm": 2, "hopfield": 4}
+
+#: algorithms.md D.3 defaults.
+DEFAULTS = {
+    "mode": "vote",
+    "r_spatial": 1.5,  # px: a sparse value this close counts as present (3x3 at 1.5)
+    "tau_dx": 1.0,  # px: two channels agree on x-disparity within this
+    "tau_dy": 1.0,  # px: ... and on y-disparity
+    "a_conf_min": 0.15,  # Gabor confidence needed to take part
+    "min_agree": 2,  # vote mode: at least two channels must agree
+}
+
+
+@dataclass(frozen=True, eq=False)
+class FusionResult:
+    """The valid members of the channels' agreement.
+
+    Attributes
+    ----------
+    matches : Matches
+        One correspondence per valid member: ``(xl, yl)`` the left pixel (integer positions),
+        ``xr = xl - dispx``, ``yr = yl - dispy``; ``score`` = the fraction of the available
+        channels that agree.
+    count, sources : numpy.ndarray
+        ``(N,)`` uint8 per member: how many channels agree, and which (:data:`CHANNEL_BITS`).
+    dispx, dispy : numpy.ndarray
+        ``(H, W)`` float32 fused disparities at the members, NaN elsewhere.
+    count_map, sources_map : numpy.ndarray
+        ``(H, W)`` uint8 rasters of ``count`` and ``sources`` (0 off the members).
+    channels : tuple of str
+        The channels that took part, in bit order.
+    """
+
+    matches: Matches
+    count: npt.NDArray[np.uint8]
+    sources: npt.NDArray[np.uint8]
+    dispx: F32
+    dispy: F32
+    count_map: npt.NDArray[np.uint8]
+    sources_map: npt.NDArray[np.uint8]
+    channels: tuple[str, ...]
+
+    def __len__(self) -> int:
+        return len(self.matches)
+
+
+def _radius_offsets(r: float) -> list[tuple[int, int]]:
+    """Integer offsets ``(dy, dx)`` within ``r``, nearest first (ties in a fixed order)."""
+    k = int(np.floor(r))
+    offs = [
+        (dy, dx) for dy in range(-k, k + 1) for dx in range(-k, k + 1) if dy * dy + dx * dx <= r * r
+    ]
+    return sorted(offs, key=lambda o: (o[0] ** 2 + o[1] ** 2, o[0], o[1]))
+
+
+def _nearest_within(dx: F32, dy: F32, r: float) -> tuple[F32, F32]:
+    """Each pixel takes the nearest measured ``(dx, dy)`` within ``r`` px (NaN if none)."""
+    h, w = dx.shape
+    out_x = np.full((h, w), np.nan, np.float32)
+    out_y = np.full((h, w), np.nan, np.float32)
+    for oy, ox in _radius_offsets(r):
+        # target[y, x] <- source[y + oy, x + ox] where the target is still empty
+        ys, yt = slice(max(oy, 0), h + min(oy, 0)), slice(max(-oy, 0), h + min(-oy, 0))
+        xs, xt = slice(max(ox, 0), w + min(ox, 0)), slice(max(-ox, 0), w + min(-ox, 0))
+        src_x, src_y = dx[ys, xs], dy[ys, xs]
+        take = np.isnan(out_x[yt, xt]) & np.isfinite(src_x)
+        out_x[yt, xt] = np.where(take, src_x, out_x[yt, xt])
+        out_y[yt, xt] = np.where(take, src_y, out_y[yt, xt])
+    return out_x, out_y
+
+
+def _check_map(a: npt.ArrayLike, name: str, shape: tuple[int, int] | None) -> F32:
+    arr = np.asarray(a, dtype=np.float32)
+    if arr.ndim != 2:
+        raise ValueError(f"{name}: expected an (H, W) map, got shape {arr.shape}")
+    if shape is not None and arr.shape != shape:
+        raise ValueError(f"{name}: shape {arr.shape} differs from the others' {shape}")
+    return arr
+
+
+def fuse(
+    gabor: tuple[npt.ArrayLike, npt.ArrayLike] | None,
+    sparse: Mapping[str, Matches],
+    *,
+    mode: str = "vote",
+    r_spatial: float = 1.5,
+    tau_dx: float = 1.0,
+    tau_dy: float = 1.0,
+    a_conf_min: float = 0.15,
+    min_agree: int = 2,
+) -> FusionResult:
+    """Valid members of the channels' agreement (algorithms.md D.4).
+
+    Parameters
+    ----------
+    gabor : (dispx, conf) or None
+        The dense channel: ``(H, W)`` float32 disparity (NaN = none) and confidence in ``[0, 1]``.
+        Its vertical disparity is taken as 0 (rectified pairs).
+    sparse : mapping of str to Matches
+        The sparse channels by name (``"mcgm"``, ``"hopfield"``), each on the same image size.
+    mode : {"vote", "intersection"}
+        ``"vote"``: the largest pairwise-agreeing subset with at least ``min_agree`` members
+        (ties: the smaller x spread); ``"intersection"``: every channel present and agreeing.
+    r_spatial : float
+        A sparse channel's measurement within this distance (px) of a candidate counts there.
+    tau_dx, tau_dy : float
+        Agreement tolerances (px) on x- and y-disparity.
+    a_conf_min : float
+        Minimum Gabor confidence for its value to take part.
+    min_agree : int
+        Vote mode: smallest agreeing subset that makes a valid member (>= 2).
+
+    Returns
+    -------
+    FusionResult
+
+    Raises
+    ------
+    ValueError
+        No sparse channel, an unknown channel name, maps of different sizes, a bad mode or a
+        non-positive tolerance.
+    """
+    if mode not in ("vote", "intersection"):
+        raise ValueError(f"mode: expected 'vote' or 'intersection', got {mode!r}")
+    if not sparse:
+        raise ValueError("fuse needs at least one sparse channel (mcgm or hopfield)")
+    for name in sparse:
+        if name not in CHANNEL_BITS or name == "gabor":
+            raise ValueError(f"unknown sparse channel {name!r}: expected mcgm or hopfield")
+    for pname, v in (("r_spatial", r_spatial), ("tau_dx", tau_dx), ("tau_dy", tau_dy)):
+        if not np.isfinite(v) or v <= 0:
+            raise ValueError(f"{pname}: expected a positive number, got {v}")
+    if min_agree < 2:
+        raise ValueError(f"min_agree: expected at least 2, got {min_agree}")
+
+    names: list[str] = []
+    maps_x: list[F32] = []
+    maps_y: list[F32] = []
+    weights: list[F32] = []
+    shape: tuple[int, int] | None = None
+    if gabor is not None:
+        gx = _check_map(gabor[0], "gabor dispx", None)
+        gc = _check_map(gabor[1], "gabor conf", gx.shape)
+        shape = (int(gx.shape[0]), int(gx.shape[1]))
+        ok = np.isfinite(gx) & (gc >= a_conf_min)
+        names.append("gabor")
+        maps_x.append(np.where(ok, gx, np.nan).astype(np.float32))
+        maps_y.append(np.where(ok, 0.0, np.nan).astype(np.float32))
+        weights.append(np.where(ok, gc, 0.0).astype(np.float32))
+    measured = None
+    for name in sorted(sparse, key=CHANNEL_BITS.__getitem__):
+        m = sparse[name]
+        if shape is None:
+            shape = m.image_shape
+        elif m.image_shape != shape:
+            raise ValueError(
+                f"{name}: image shape {m.image_shape} differs from the others' {shape}"
+            )
+        dx, dy = m.dispx, m.dispy
+        here = np.isfinite(dx)
+        measured = here if measured is None else measured | here
+        nx, ny = _nearest_within(dx, dy, r_spatial)
+        names.append(name)
+        maps_x.append(nx)
+        maps_y.append(ny)
+        weights.append(np.ones_like(nx))
+    assert shape is not None and measured is not None
+
+    # Candidates: the sparse channels' own pixels (D.4 step 3), in row-major order.
+    yy, xx = np.nonzero(measured)
+    n_ch = len(names)
+    vx = np.stack([mx[yy, xx] for mx in maps_x])  # (n_ch, P)
+    vy = np.stack([my[yy, xx] for my in maps_y])
+    vw = np.stack([mw[yy, xx] for mw in weights])
+    present = np.isfinite(vx)
+
+    best = np.zeros(len(yy), np.int64)  # chosen subset mask (bits over channel positions)
+    best_size = np.zeros(len(yy), np.int64)
+    best_spread = np.full(len(yy), np.inf)
+    sizes = [n_ch] if mode == "intersection" else range(n_ch, min_agree - 1, -1)
+    for size in sizes:
+        for subset in itertools.combinations(range(n_ch), size):
+            ok = np.all(present[list(subset)], axis=0)
+            for i, j in itertools.combinations(subset, 2):
+                with np.errstate(invalid="ignore"):
+                    ok &= (np.abs(vx[i] - vx[j]) <= tau_dx) & (np.abs(vy[i] - vy[j]) <= tau_dy)
+            sub = vx[list(subset)]
+            spread = np.where(ok, np.nanmax(sub, axis=0) - np.nanmin(sub, axis=0), np.inf)
+            better = ok & ((size > best_size) | ((size == best_size) & (spread < best_spread)))
+            best = np.where(better, sum(1 << k for k in subset), best)
+            best_size = np.where(better, size, best_size)
+            best_spread = np.where(better, spread, best_spread)
+
+    keep = best_size > 0
+    chosen = ((best[None, :] >> np.arange(n_ch)[:, None]) & 1).astype(bool) & keep[None, :]
+    w = np.where(chosen, vw, 0.0)
+    wsum = w.sum(axis=0)
+    # A member whose only weight is a zero-confidence Gabor value cannot happen (a_conf_min > 0
+    # or the sparse weights are 1), but guard the division anyway.
+    wsum = np.where(wsum > 0, wsum, 1.0)
+    fx = (np.where(chosen, vx, 0.0) * w).sum(axis=0) / wsum
+    fy = (np.where(chosen, vy, 0.0) * w).sum(axis=0) / wsum
+    bits = np.array([CHANNEL_BITS[n] for n in names], np.uint8)
+    sources = (chosen * bits[:, None]).sum(axis=0).astype(np.uint8)
+    count = chosen.sum(axis=0).astype(np.uint8)
+    avail = present.sum(axis=0)
+
+    sel = np.nonzero(keep)[0]
+    xl = xx[sel].astype(np.float32)
+    yl = yy[sel].astype(np.float32)
+    dxs = fx[sel].astype(np.float32)
+    dys = fy[sel].astype(np.float32)
+    score = (count[sel] / np.maximum(avail[sel], 1)).astype(np.float32)
+    matches = Matches(
+        xl=xl,
+        yl=yl,
+        xr=xl - dxs,
+        yr=yl - dys,
+        score=score,
+        image_shape=shape,
+        stats={"candidates": len(yy), "members": len(sel), "channels": list(names)},
+    )
+    h, w_ = shape
+    dispx = np.full((h, w_), np.nan, np.float32)
+    dispy = np.full((h, w_), np.nan, np.float32)
+    cmap = np.zeros((h, w_), np.uint8)
+    smap = np.zeros((h, w_), np.uint8)
+    ys, xs = yy[sel], xx[sel]
+    dispx[ys, xs], dispy[ys, xs] = dxs, dys
+    cmap[ys, xs], smap[ys, xs] = count[sel], sources[sel]
+    return FusionResult(
+        matches=matches,
+        count=count[sel],
+        sources=sources[sel],
+        dispx=dispx,
+        dispy=dispy,
+        count_map=cmap,
+        sources_map=smap,
+        channels=tuple(names),
+    )
