@@ -1,0 +1,93 @@
+"""Valid members of the channels' agreement vs each sparse channel alone, on every GT scene.
+
+For each scene: the Gabor map, the sparse channels of :data:`stereovision.match.METHODS` that are
+channels of the fusion (``mcgm``, ``hopfield``), and their valid members (:func:`fuse`, vote mode,
+algorithms.md D.3 defaults). Printed per scene: precision@1 (@2 on KITTI, whose LiDAR GT sits
+about 0.4 px off), count with GT and 4x4 coverage of the members and of each channel, and each
+channel's *count at the members' precision*: the most matches it keeps, taken in decreasing
+score, while its precision stays at or above the members' (the issue's "more of them than either
+sparse channel alone would give at that precision"). One JSON line per scene.
+
+Usage: ``python benches/bench_fusion.py [SCENE ...]`` (default: every GT scene of shared/data)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import numpy as np
+
+from stereovision._validate import as_gray_float
+from stereovision.evaluate import sparse_metrics
+from stereovision.io import find_scenes, load_scene
+from stereovision.match import METHODS, match
+from stereovision.matching.fusion import CHANNEL_BITS, fuse
+from stereovision.matching.gabor import gabor_disparity
+
+DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+SPARSE = [m for m in METHODS if m in CHANNEL_BITS]
+
+
+def count_at_precision(m, gt: np.ndarray, target: float, tol: float) -> int:
+    """Largest top-by-score prefix of ``m`` whose precision@tol (with GT) is >= target %."""
+    h, w = gt.shape
+    xi, yi = np.rint(m.xl).astype(int), np.rint(m.yl).astype(int)
+    ok = (xi >= 0) & (xi < w) & (yi >= 0) & (yi < h)
+    g = np.full(len(m.xl), np.nan)
+    g[ok] = gt[yi[ok], xi[ok]]
+    has = np.isfinite(g)
+    order = np.argsort(-m.score[has], kind="stable")
+    good = (np.abs((m.xl - m.xr)[has] - g[has]) <= tol)[order]
+    prec = 100 * np.cumsum(good) / np.arange(1, len(good) + 1)
+    idx = np.nonzero(prec >= target - 1e-9)[0]
+    return int(idx[-1] + 1) if len(idx) else 0
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("scenes", nargs="*", help="scene folders (default: every GT scene)")
+    args = ap.parse_args()
+    dirs = [Path(s) for s in args.scenes] or find_scenes(DATA)
+    print(f"channels: gabor + {' + '.join(SPARSE)}")
+    for d in dirs:
+        sc = load_scene(d)
+        if sc.gt is None:
+            continue
+        tol = 2.0 if "kitti" in str(d) else 1.0
+        md = int(sc.max_disparity)
+        gl, gr = as_gray_float(sc.left, "left"), as_gray_float(sc.right, "right")
+        g = gabor_disparity(gl, gr, max_disparity=md)
+        chans = {m: match(sc.left, sc.right, method=m, max_disparity=md) for m in SPARSE}
+        res = fuse((g.disparity, g.confidence), chans)
+        fm = sparse_metrics(res.matches.xl, res.matches.yl, res.matches.xr, sc.gt)
+        row = {
+            "bench": "fusion",
+            "scene": sc.name,
+            "tol": tol,
+            "members": {
+                "precision": round(fm.precision[tol], 2),
+                "count": fm.count,
+                "coverage": fm.coverage,
+                "three_agree": int((res.count == 3).sum()),
+            },
+        }
+        line = f"{sc.name:36s} @{tol:.0f} members {fm.precision[tol]:6.2f} % {fm.count:6d}"
+        line += f" {fm.coverage:2d}/16"
+        for name, m in chans.items():
+            cm = sparse_metrics(m.xl, m.yl, m.xr, sc.gt)
+            at = count_at_precision(m, sc.gt, fm.precision[tol], tol)
+            row[name] = {
+                "precision": round(cm.precision[tol], 2),
+                "count": cm.count,
+                "coverage": cm.coverage,
+                "count_at_members_precision": at,
+            }
+            line += f" | {name} {cm.precision[tol]:6.2f} % {cm.count:6d} (at members' p: {at:6d})"
+        print(line, flush=True)
+        print(json.dumps(row), flush=True)
+
+
+if __name__ == "__main__":
+    main()
