@@ -71,10 +71,38 @@ def test_plane_gives_metric_depth_and_points() -> None:
     assert p[1] == pytest.approx((y - (h - 1) / 2) * p[2] / 500.0, rel=1e-4, abs=1e-6)
 
 
+def test_depth_sigma_formula_on_a_plane() -> None:
+    """sigma_Z = Z^2 sigma_d / (f B), sigma_d from the confidence (f 500 px, B 0.1 m)."""
+    h, w, d = 96, 160, 6.5
+    left = _texture(h, w)
+    res = sv.depth_map(left, _shift(left, d), _rect_calib(w, h), max_disparity=16)
+    assert res.depth is not None and res.depth_sigma is not None
+    ok = np.isfinite(res.depth)
+    assert np.array_equal(ok, np.isfinite(res.depth_sigma))
+    expected = res.depth**2 * sv.depth.disparity_sigma(res.confidence) / (500.0 * 0.1)
+    np.testing.assert_allclose(res.depth_sigma[ok], expected[ok], rtol=1e-4)
+    # The prediction is monotone in confidence: 0.6 px at 0, 0.2 px at 1.
+    np.testing.assert_allclose(sv.depth.disparity_sigma([0.0, 0.5, 1.0, 2.0]), [0.6, 0.4, 0.2, 0.2])
+
+
+def test_depth_sigma_predicts_the_error_on_a_metric_scene(data_dir: Path) -> None:
+    """On ETH3D terrace the error in units of sigma_Z is about standard normal in its core."""
+    scene = load_scene(data_dir / "eth3d" / "terrace")
+    res = sv.depth_map(scene.left, scene.right, scene.calib, max_disparity=32)
+    assert res.depth is not None and res.depth_sigma is not None
+    z_gt = scene.calib.depth_from_disparity(scene.gt)
+    ok = np.isfinite(res.depth) & np.isfinite(z_gt)
+    t = np.abs(res.depth[ok] - z_gt[ok]) / res.depth_sigma[ok]
+    # Measured: median 0.71 (standard normal: 0.67), 64 % within 1 sigma, 88 % within 2.
+    assert 0.55 < float(np.median(t)) < 0.9
+    assert 0.55 < float(np.mean(t <= 1)) < 0.75
+    assert float(np.mean(t <= 2)) > 0.8
+
+
 def test_without_calibration_no_depth() -> None:
     left = _texture(64, 96, seed=1)
     res = sv.depth_map(left, _shift(left, 3.0), max_disparity=16)
-    assert res.depth is None and res.points.shape == (0, 3)
+    assert res.depth is None and res.depth_sigma is None and res.points.shape == (0, 3)
     with pytest.raises(ValueError, match="calibration"):
         res.to_ply("unused.ply")
 
