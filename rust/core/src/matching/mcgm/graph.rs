@@ -65,19 +65,29 @@ pub fn candidates(
         .par_iter()
         .enumerate()
         .map_init(
-            || (Vec::<u32>::new(), Vec::<u32>::new()),
-            |(acc, near), (ia, a)| {
+            || {
+                (
+                    Vec::<u32>::new(),
+                    Vec::<u32>::new(),
+                    vec![u32::MAX; right.len()],
+                )
+            },
+            |(acc, near, stamp), (ia, a)| {
                 let Some((lo, hi)) = window[ia] else {
                     return Vec::new();
                 };
+                // Right segments on the rows of A, each once (stamped with A's id: no sort).
                 near.clear();
                 let y0 = (a.y_min - p.dy_band).max(0);
                 let y1 = (a.y_max + p.dy_band).min(h as i32 - 1);
                 for y in y0..=y1 {
-                    near.extend_from_slice(&rows[y as usize]);
+                    for &b in &rows[y as usize] {
+                        if stamp[b as usize] != ia as u32 {
+                            stamp[b as usize] = ia as u32;
+                            near.push(b);
+                        }
+                    }
                 }
-                near.sort_unstable();
-                near.dedup();
                 let ext_a = a.y_max - a.y_min + 1;
                 let mut out: Vec<Candidate> = Vec::new();
                 for &ib in near.iter() {

@@ -357,14 +357,66 @@ pub fn image_curves(img: &Image, p: &McgmParams) -> Result<Vec<ChannelCurves>> {
         .collect())
 }
 
-/// Offsets `(dx, dy)` with `dx^2 + dy^2 <= r^2`, nearest first (ties: row, then column).
-fn disc_offsets(r: i32) -> Vec<(i32, i32)> {
-    let mut v: Vec<(i32, i32)> = (-r..=r)
-        .flat_map(|dy| (-r..=r).map(move |dx| (dx, dy)))
-        .filter(|&(dx, dy)| dx * dx + dy * dy <= r * r)
-        .collect();
-    v.sort_by_key(|&(dx, dy)| (dx * dx + dy * dy, dy, dx));
-    v
+/// Fixed neighbour order of the prior spreading (ties go to the first filled neighbour).
+const SPREAD_ORDER: [(i32, i32); 8] = [
+    (0, -1),
+    (-1, 0),
+    (1, 0),
+    (0, 1),
+    (-1, -1),
+    (1, -1),
+    (-1, 1),
+    (1, 1),
+];
+
+/// Nearest-valid fill of a NaN map up to `radius` px in chessboard distance (B.4.11's
+/// distance-limited spread): `radius` synchronous 8-neighbour dilations, each new pixel taking
+/// the value of its first valid neighbour in [`SPREAD_ORDER`] from the previous step.
+pub fn spread_prior(map: &[f32], w: usize, h: usize, radius: i32) -> Vec<f32> {
+    let mut cur = map.to_vec();
+    let mut front: Vec<usize> = (0..w * h).filter(|&i| cur[i].is_finite()).collect();
+    let mut seen = vec![false; w * h];
+    for _ in 0..radius {
+        let mut next: Vec<usize> = Vec::new();
+        for &i in &front {
+            let (x, y) = ((i % w) as i32, (i / w) as i32);
+            for &(dx, dy) in &SPREAD_ORDER {
+                let (nx, ny) = (x + dx, y + dy);
+                if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
+                    continue;
+                }
+                let q = ny as usize * w + nx as usize;
+                if !cur[q].is_finite() && !seen[q] {
+                    seen[q] = true;
+                    next.push(q);
+                }
+            }
+        }
+        // Values from the previous step only (synchronous update).
+        let vals: Vec<f32> = next
+            .iter()
+            .map(|&q| {
+                let (x, y) = ((q % w) as i32, (q / w) as i32);
+                SPREAD_ORDER
+                    .iter()
+                    .filter_map(|&(dx, dy)| {
+                        let (nx, ny) = (x + dx, y + dy);
+                        (nx >= 0 && ny >= 0 && nx < w as i32 && ny < h as i32)
+                            .then(|| cur[ny as usize * w + nx as usize])
+                    })
+                    .find(|v| v.is_finite())
+                    .unwrap_or(f32::NAN)
+            })
+            .collect();
+        for (&q, v) in next.iter().zip(vals) {
+            cur[q] = v;
+        }
+        if next.is_empty() {
+            break;
+        }
+        front = next;
+    }
+    cur
 }
 
 /// Median (lower of the two middle values for even counts: a value that exists).
@@ -376,16 +428,13 @@ fn median_lower(v: &mut [f32]) -> Option<f32> {
     Some(v[(v.len() - 1) / 2])
 }
 
-/// Disparity windows of the left segments of a channel from the prior map (full-resolution
-/// disparities, NaN = none): the median over the segment's pixels of the nearest prior value
-/// within `radius` px, `+- width` channel px around it; the full range without a prior.
-#[allow(clippy::too_many_arguments)]
+/// Disparity windows of the left segments of a channel from the spread prior map
+/// (full-resolution disparities, NaN = none): the median of the prior over the segment's pixels,
+/// `+- width` channel px around it; the full range without a prior.
 fn windows(
     cc: &ChannelCurves,
     prior: Option<&[f32]>,
     fw: usize,
-    fh: usize,
-    radius: i32,
     width: f32,
     lo_c: i32,
     hi_c: i32,
@@ -394,9 +443,9 @@ fn windows(
     let Some(prior) = prior else {
         return vec![full; cc.curves.segments.len()];
     };
-    let offs = disc_offsets(radius);
     let s = cc.scale as f32;
     let w = cc.width;
+    let fh = prior.len() / fw.max(1);
     cc.curves
         .segments
         .par_iter()
@@ -405,18 +454,11 @@ fn windows(
             for &i in &seg.pixels {
                 let (x, y) = ((i as usize % w) as f32, (i as usize / w) as f32);
                 // Channel pixel centre in full-resolution coordinates.
-                let fx = (s * x + 0.5 * (s - 1.0)).round() as i32;
-                let fy = (s * y + 0.5 * (s - 1.0)).round() as i32;
-                for &(dx, dy) in &offs {
-                    let (qx, qy) = (fx + dx, fy + dy);
-                    if qx < 0 || qy < 0 || qx >= fw as i32 || qy >= fh as i32 {
-                        continue;
-                    }
-                    let v = prior[qy as usize * fw + qx as usize];
-                    if v.is_finite() {
-                        vals.push(v / s);
-                        break;
-                    }
+                let fx = ((s * x + 0.5 * (s - 1.0)).round() as usize).min(fw - 1);
+                let fy = ((s * y + 0.5 * (s - 1.0)).round() as usize).min(fh - 1);
+                let v = prior[fy * fw + fx];
+                if v.is_finite() {
+                    vals.push(v / s);
                 }
             }
             match median_lower(&mut vals) {
@@ -566,19 +608,33 @@ pub fn edge_filters(
         .collect();
     let n_sides = keep.iter().filter(|&&k| k).count();
     if f.disc {
-        // Raster of the survivors' disparities (several per pixel are possible: keep a list).
-        let mut grid: Vec<Vec<u32>> = vec![Vec::new(); w * h];
+        // Survivors bucketed by rounded left pixel (counting sort: several per pixel possible).
         let pos = |m: &Match| -> Option<(i32, i32)> {
             let (x, y) = (m.xl.round() as i32, m.yl.round() as i32);
             (x >= 0 && y >= 0 && x < w as i32 && y < h as i32).then_some((x, y))
         };
-        for (i, m) in matches.iter().enumerate() {
-            if keep[i] {
-                if let Some((x, y)) = pos(m) {
-                    grid[y as usize * w + x as usize].push(i as u32);
-                }
+        let cell: Vec<Option<usize>> = matches
+            .iter()
+            .zip(&keep)
+            .map(|(m, &k)| if k { pos(m) } else { None })
+            .map(|o| o.map(|(x, y)| y as usize * w + x as usize))
+            .collect();
+        let mut start = vec![0u32; w * h + 1];
+        for c in cell.iter().flatten() {
+            start[c + 1] += 1;
+        }
+        for i in 1..start.len() {
+            start[i] += start[i - 1];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u32; start[w * h] as usize];
+        for (i, c) in cell.iter().enumerate() {
+            if let Some(c) = *c {
+                items[fill[c] as usize] = i as u32;
+                fill[c] += 1;
             }
         }
+        let bucket = |c: usize| &items[start[c] as usize..start[c + 1] as usize];
         let drop: Vec<bool> = matches
             .par_iter()
             .enumerate()
@@ -592,7 +648,7 @@ pub fn edge_filters(
                 let d = m.xl - m.xr;
                 for yy in (y - f.disc_dy).max(0)..=(y + f.disc_dy).min(h as i32 - 1) {
                     for xx in (x - f.disc_dx).max(0)..=(x + f.disc_dx).min(w as i32 - 1) {
-                        for &j in &grid[yy as usize * w + xx as usize] {
+                        for &j in bucket(yy as usize * w + xx as usize) {
                             let o = &matches[j as usize];
                             if j as usize != i && ((o.xl - o.xr) - d).abs() > f.disc_tol {
                                 return true;
@@ -628,12 +684,11 @@ pub fn mcgm_match(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
         } else {
             0
         };
+        let spread = prior.as_deref().map(|m| spread_prior(m, fw, fh, radius));
         let win = windows(
             l,
-            prior.as_deref(),
+            spread.as_deref(),
             fw,
-            fh,
-            radius,
             p.prior_width_sigmas * l.sigma,
             lo_c,
             hi_c,

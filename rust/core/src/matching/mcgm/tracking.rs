@@ -57,10 +57,10 @@ pub struct Curves {
     pub t_low: f32,
 }
 
-/// `a - b` wrapped to `(-pi, pi]`.
+/// A difference of two angles in `[0, 2 pi)` wrapped to `(-pi, pi]` (no `fmod`: hot loop).
 #[inline]
 pub fn wrap_angle(d: f64) -> f64 {
-    let mut d = d % TAU;
+    let mut d = d;
     if d > PI {
         d -= TAU;
     } else if d <= -PI {
@@ -76,9 +76,8 @@ pub fn high_threshold(zc: &ZeroCrossings, q: f32) -> f32 {
     if s.is_empty() {
         return 0.0;
     }
-    s.sort_by(f32::total_cmp);
-    let k = ((q as f64) * (s.len() - 1) as f64).floor() as usize;
-    s[k.min(s.len() - 1)]
+    let k = (((q as f64) * (s.len() - 1) as f64).floor() as usize).min(s.len() - 1);
+    *s.select_nth_unstable_by(k, f32::total_cmp).1
 }
 
 fn tangent(theta: f32) -> (f64, f64) {
@@ -99,18 +98,28 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
         .filter(|&i| cand[i] && zc.strength[i] >= t_high)
         .map(|i| i as u32)
         .collect();
-    seeds.sort_by(|&a, &b| {
+    seeds.sort_unstable_by(|&a, &b| {
         zc.strength[b as usize]
             .total_cmp(&zc.strength[a as usize])
             .then(a.cmp(&b))
     });
     let max_turn = (p.max_turn_deg as f64).to_radians();
+    // Unit tangents of the candidates, computed once (the walk visits each pixel's 8 neighbours).
+    let tan: Vec<(f64, f64)> = (0..n)
+        .map(|i| {
+            if cand[i] {
+                tangent(zc.theta[i])
+            } else {
+                (0.0, 0.0)
+            }
+        })
+        .collect();
     let mut visited = vec![false; n];
     let mut labels = vec![-1i32; n];
     let mut segments = Vec::new();
     let grow = |start: usize, sign: f64, visited: &mut Vec<bool>, out: &mut Vec<u32>| {
         let mut cur = start;
-        let (tx, ty) = tangent(zc.theta[start]);
+        let (tx, ty) = tan[start];
         let mut dir = (sign * tx, sign * ty);
         loop {
             let (cx, cy) = ((cur % w) as i32, (cur / w) as i32);
@@ -143,7 +152,7 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
             };
             visited[q] = true;
             out.push(q as u32);
-            let (tx, ty) = tangent(zc.theta[q]);
+            let (tx, ty) = tan[q];
             let sgn = if tx * dx as f64 + ty * dy as f64 >= 0.0 {
                 1.0
             } else {

@@ -1,7 +1,7 @@
 //! Zero crossings of the LoG response, one pixel thick, with sub-pixel x, strength and
 //! orientation (algorithms.md B.4 steps 2-3, B.8's reading for vertical-only marks).
 
-use std::f64::consts::TAU;
+use std::f32::consts::TAU;
 
 /// Mark bit: the pixel holds a crossing found by the horizontal scan (along x).
 pub const ZC_H: u8 = 1;
@@ -99,8 +99,8 @@ pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
         let gx = 0.5 * (l[i + 1] - l[i - 1]);
         let gy = 0.5 * (l[i + w] - l[i - w]);
         strength[i] = (gx * gx + gy * gy).sqrt();
-        let t = (gy as f64).atan2(gx as f64);
-        theta[i] = (if t < 0.0 { t + TAU } else { t }) as f32 % std::f32::consts::TAU;
+        let t = gy.atan2(gx);
+        theta[i] = if t < 0.0 { (t + TAU) % TAU } else { t };
         if mark[i] & ZC_H == 0 {
             // Vertical-only mark: x from the horizontal crossing next to it, else a Newton step.
             let left = x as f32 - 1.0 + l[i - 1] / (l[i - 1] - l[i]);
