@@ -71,6 +71,9 @@ DEFAULTS: dict[str, Any] = {
     "sides_width": 4,  # half-window columns (B.8: 4 x 7)
     "sides_height": 7,  # half-window rows
     "sides_gap": 1,  # columns between the edge and each half-window (B.8)
+    "sides_best": True,  # ... and no other disparity (> 1 px away) fits a half-window better
+    "sides_best_margin": 0.005,  # ... by more than this MAD
+    "sides_mean_free": True,  # half-window means removed first (exposure offsets, ETH3D)
     "disc": True,  # B.8 discontinuity filter
     "disc_dx": 6,  # +- columns (B.8)
     "disc_dy": 2,  # +- rows (B.8)
@@ -283,7 +286,13 @@ def mcgm_match(
 
 
 def edge_filters(
-    left: npt.ArrayLike, right: npt.ArrayLike, matches: npt.ArrayLike, **params: Any
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    matches: npt.ArrayLike,
+    *,
+    max_disparity: float,
+    min_disparity: float = 0,
+    **params: Any,
 ) -> npt.NDArray[np.bool_]:
     """B.8's occlusion filters (both-sides check, discontinuity filter) on any matches.
 
@@ -293,9 +302,12 @@ def edge_filters(
         The rectified pair the matches come from.
     matches : array_like
         ``(N, 4)`` ``[xl, yl, xr, yr]``.
+    max_disparity, min_disparity : float
+        The searched range (the ``sides_best`` test looks for better disparities in it).
     **params
-        ``sides``, ``sides_mad``, ``sides_width``, ``sides_height``, ``sides_gap``, ``disc``,
-        ``disc_dx``, ``disc_dy``, ``disc_tol`` (:data:`DEFAULTS`).
+        ``sides``, ``sides_mad``, ``sides_width``, ``sides_height``, ``sides_gap``,
+        ``sides_best``, ``sides_best_margin``, ``disc``, ``disc_dx``, ``disc_dy``, ``disc_tol``
+        (:data:`DEFAULTS`).
 
     Returns
     -------
@@ -311,7 +323,7 @@ def edge_filters(
     arr = np.ascontiguousarray(matches, dtype=np.float32)
     if arr.ndim != 2 or arr.shape[1] != 4:
         raise ValueError(f"matches: expected shape (N, 4), got {arr.shape}")
-    return _core.mcgm_filter(gl, gr, arr, _params(0, 0, params))
+    return _core.mcgm_filter(gl, gr, arr, _params(max_disparity, min_disparity, params))
 
 
 #: ZNCC window half-size of the reference (7x7, as the Hopfield channel's candidates).
@@ -434,7 +446,14 @@ def zncc_reference(
     yl = ys.astype(np.float32)
     xr = (xl - disp).astype(np.float32)
     arr = np.stack([xl, yl, xr, yl], axis=1)
-    keep = edge_filters(gl, gr, arr, **{k: v for k, v in params.items() if k in _FILTER_KEYS})
+    keep = edge_filters(
+        gl,
+        gr,
+        arr,
+        max_disparity=hi,
+        min_disparity=lo,
+        **{k: v for k, v in params.items() if k in _FILTER_KEYS},
+    )
     return Matches(
         xl=xl[keep],
         yl=yl[keep],
@@ -452,6 +471,9 @@ _FILTER_KEYS = (
     "sides_width",
     "sides_height",
     "sides_gap",
+    "sides_best",
+    "sides_best_margin",
+    "sides_mean_free",
     "disc",
     "disc_dx",
     "disc_dy",

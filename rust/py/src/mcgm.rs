@@ -31,7 +31,7 @@ fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
     Ok(())
 }
 
-const KEYS: [&str; 38] = [
+const KEYS: [&str; 41] = [
     "min_disparity",
     "max_disparity",
     "sigmas",
@@ -66,6 +66,9 @@ const KEYS: [&str; 38] = [
     "sides_width",
     "sides_height",
     "sides_gap",
+    "sides_best",
+    "sides_best_margin",
+    "sides_mean_free",
     "disc",
     "disc_dx",
     "disc_dy",
@@ -117,6 +120,9 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<McgmParams> {
     get(d, "sides_width", &mut p.filters.sides_width)?;
     get(d, "sides_height", &mut p.filters.sides_height)?;
     get(d, "sides_gap", &mut p.filters.sides_gap)?;
+    get(d, "sides_best", &mut p.filters.sides_best)?;
+    get(d, "sides_best_margin", &mut p.filters.sides_best_margin)?;
+    get(d, "sides_mean_free", &mut p.filters.sides_mean_free)?;
     get(d, "disc", &mut p.filters.disc)?;
     get(d, "disc_dx", &mut p.filters.disc_dx)?;
     get(d, "disc_dy", &mut p.filters.disc_dy)?;
@@ -376,6 +382,10 @@ pub fn mcgm_filter<'py>(
             channel: 0,
         })
         .collect();
-    let (keep, _) = py.detach(|| guard("mcgm_filter", || edge_filters(&l, &r, &ms, &p.filters)))?;
+    let (keep, _) = py.detach(|| {
+        guard("mcgm_filter", || {
+            edge_filters(&l, &r, &ms, &p.filters, (p.d_min as i32, p.d_max as i32))
+        })
+    })?;
     Ok(Array1::from_vec(keep).into_pyarray(py))
 }

@@ -82,6 +82,13 @@ pub struct FilterParams {
     pub sides_height: i32,
     /// Columns skipped between the edge pixel and each half-window (B.8: 1).
     pub sides_gap: i32,
+    /// Each half-window must also match at least as well at the match's disparity as at any
+    /// other disparity of the range more than 1 px away, up to `sides_best_margin` (MAD): the
+    /// relative form catches low-contrast background an absolute threshold lets through.
+    pub sides_best: bool,
+    pub sides_best_margin: f32,
+    /// Remove each half-window pair's mean difference before the MAD (exposure offsets).
+    pub sides_mean_free: bool,
     /// Discontinuity filter on / off.
     pub disc: bool,
     /// Neighbourhood of the discontinuity filter (+- columns, +- rows; B.8: 6, 2).
@@ -99,6 +106,9 @@ impl Default for FilterParams {
             sides_width: 4,
             sides_height: 7,
             sides_gap: 1,
+            sides_best: true,
+            sides_best_margin: 0.005,
+            sides_mean_free: true,
             disc: true,
             disc_dx: 6,
             disc_dy: 2,
@@ -546,9 +556,49 @@ fn sample(img: &Image, x: f32, y: usize) -> f32 {
     row[x0] + f * (row[x1] - row[x0])
 }
 
+/// Mean absolute difference of one half-window (columns `xi + side * (inner..=outer)`, rows
+/// `yl +- hh`) against the right image shifted by `d` (linear interpolation along x). With
+/// `mean_free` the two windows' mean grey levels are removed first: insensitive to an exposure
+/// offset between the cameras (ETH3D), still sensitive to different content.
+#[allow(clippy::too_many_arguments)]
+fn half_mad(
+    left: &Image,
+    right: &Image,
+    xi: i32,
+    yl: i32,
+    yr: i32,
+    d: f32,
+    side: i32,
+    (inner, outer, hh): (i32, i32, i32),
+    mean_free: bool,
+) -> f32 {
+    let n = ((outer - inner + 1) * (2 * hh + 1)) as f32;
+    let mut offset = 0.0f32;
+    if mean_free {
+        for dy in -hh..=hh {
+            let (ly, ry) = ((yl + dy) as usize, (yr + dy) as usize);
+            for k in inner..=outer {
+                let x = xi + side * k;
+                offset += left.at(x as usize, ly) - sample(right, x as f32 - d, ry);
+            }
+        }
+        offset /= n;
+    }
+    let mut sad = 0.0f32;
+    for dy in -hh..=hh {
+        let (ly, ry) = ((yl + dy) as usize, (yr + dy) as usize);
+        for k in inner..=outer {
+            let x = xi + side * k;
+            sad += (left.at(x as usize, ly) - sample(right, x as f32 - d, ry) - offset).abs();
+        }
+    }
+    sad / n
+}
+
 /// Both-sides check of one match: the half-windows left and right of the edge agree between
-/// the images (mean absolute grey difference <= `sides_mad` on both sides).
-fn sides_ok(left: &Image, right: &Image, m: &Match, f: &FilterParams) -> bool {
+/// the images (mean absolute grey difference <= `sides_mad` on both sides) and, with
+/// `sides_best`, neither half-window prefers another disparity of `range` (> 1 px away).
+fn sides_ok(left: &Image, right: &Image, m: &Match, f: &FilterParams, range: (i32, i32)) -> bool {
     let (w, h) = (left.width as i32, left.height as i32);
     let xi = m.xl.round() as i32;
     let (yl, yr) = (m.yl.round() as i32, m.yr.round() as i32);
@@ -562,23 +612,34 @@ fn sides_ok(left: &Image, right: &Image, m: &Match, f: &FilterParams) -> bool {
     if xi - outer < 0 || xi + outer >= w {
         return false;
     }
-    if (xi - outer) as f32 - d < 0.0 || (xi + outer) as f32 - d > (w - 1) as f32 {
+    let fits =
+        |dd: f32| (xi - outer) as f32 - dd >= 0.0 && (xi + outer) as f32 - dd <= (w - 1) as f32;
+    if !fits(d) {
         return false;
     }
-    let n = (f.sides_width * (2 * hh + 1)) as f32;
+    let geom = (inner, outer, hh);
     for side in [-1i32, 1] {
-        let mut sad = 0.0f32;
-        for dy in -hh..=hh {
-            let (ly, ry) = ((yl + dy) as usize, (yr + dy) as usize);
-            for k in inner..=outer {
-                let x = xi + side * k;
-                let a = left.at(x as usize, ly);
-                let b = sample(right, x as f32 - d, ry);
-                sad += (a - b).abs();
-            }
-        }
-        if sad / n > f.sides_mad {
+        let here = half_mad(left, right, xi, yl, yr, d, side, geom, f.sides_mean_free);
+        if here > f.sides_mad {
             return false;
+        }
+        if f.sides_best {
+            // Integer steps keep the interpolation weights: a fair comparison with `here`.
+            let (k0, k1) = (
+                (range.0 as f32 - d).ceil() as i32,
+                (range.1 as f32 - d).floor() as i32,
+            );
+            for k in k0..=k1 {
+                let dd = d + k as f32;
+                if k.abs() > 1
+                    && fits(dd)
+                    && half_mad(left, right, xi, yl, yr, dd, side, geom, f.sides_mean_free)
+                        + f.sides_best_margin
+                        < here
+                {
+                    return false;
+                }
+            }
         }
     }
     true
@@ -587,12 +648,14 @@ fn sides_ok(left: &Image, right: &Image, m: &Match, f: &FilterParams) -> bool {
 /// B.8's two occlusion-boundary filters on a match list (also applied to the ZNCC reference):
 /// the both-sides check, then the discontinuity filter among its survivors (drop a match if
 /// another one within `+- disc_dx` columns and `+- disc_dy` rows differs by more than
-/// `disc_tol` px). Returns the kept flags and the count after the first filter.
+/// `disc_tol` px). `range` is the searched disparity range (`sides_best`). Returns the kept
+/// flags and the count after the first filter.
 pub fn edge_filters(
     left: &Image,
     right: &Image,
     matches: &[Match],
     f: &FilterParams,
+    range: (i32, i32),
 ) -> Result<(Vec<bool>, usize)> {
     check_pair(left, right)?;
     let (w, h) = left.size();
@@ -603,7 +666,7 @@ pub fn edge_filters(
                 && m.xr.is_finite()
                 && m.yl.is_finite()
                 && m.yr.is_finite()
-                && (!f.sides || sides_ok(left, right, m, f))
+                && (!f.sides || sides_ok(left, right, m, f, range))
         })
         .collect();
     let n_sides = keep.iter().filter(|&&k| k).count();
@@ -769,7 +832,13 @@ pub fn mcgm_match(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
             taken[row + x] = true;
         }
     }
-    let (keep, n_sides) = edge_filters(left, right, &combined, &p.filters)?;
+    let (keep, n_sides) = edge_filters(
+        left,
+        right,
+        &combined,
+        &p.filters,
+        (p.d_min as i32, p.d_max as i32),
+    )?;
     let n_combined = combined.len();
     let matches = combined
         .into_iter()
