@@ -72,7 +72,7 @@ DEFAULTS: dict[str, Any] = {
     "sides_height": 7,  # half-window rows
     "sides_gap": 1,  # columns between the edge and each half-window (B.8)
     "sides_best": True,  # ... and no other disparity (> 1 px away) fits a half-window better
-    "sides_best_margin": 0.005,  # ... by more than this MAD
+    "sides_best_margin": 0.0,  # ... by more than this MAD (0: the literal test, as C.10)
     "sides_mean_free": True,  # half-window means removed first (exposure offsets, ETH3D)
     "disc": True,  # B.8 discontinuity filter
     "disc_dx": 6,  # +- columns (B.8)

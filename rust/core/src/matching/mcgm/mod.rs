@@ -107,7 +107,7 @@ impl Default for FilterParams {
             sides_height: 7,
             sides_gap: 1,
             sides_best: true,
-            sides_best_margin: 0.005,
+            sides_best_margin: 0.0,
             sides_mean_free: true,
             disc: true,
             disc_dx: 6,
