@@ -1,4 +1,4 @@
-"""Multi-Channel Graph Matching channel (algorithms.md B with the B.8 changes), a thin wrapper of Rust.
+"""Multi-Channel Graph Matching channel (algorithms.md B + B.8), a thin wrapper of Rust.
 
 The kernel lives in ``rust/core/src/matching/mcgm``: per LoG channel (sigma 4, 2, 1 px, coarse to
 fine; sigma 4 on the 2x-decimated image, used as a prior only) zero crossings one pixel thick
@@ -426,9 +426,7 @@ def zncc_reference(
     ks = np.arange(nd)[:, None]
     xl_back = xr_i[None, :] + ks + lo
     valid = (xl_back >= 0) & (xl_back < w)
-    back = np.where(
-        valid, vol[ks, ys[None, :], np.clip(xl_back, 0, w - 1)], -np.inf
-    )  # (nd, N)
+    back = np.where(valid, vol[ks, ys[None, :], np.clip(xl_back, 0, w - 1)], -np.inf)  # (nd, N)
     rbest = np.argmax(back, axis=0)
     ok &= np.abs(rbest - best) <= ZNCC_LR_TOL
     # Parabola sub-pixel refinement (interior disparities only).
@@ -436,10 +434,12 @@ def zncc_reference(
     bm = np.clip(best - 1, 0, nd - 1)
     bp = np.clip(best + 1, 0, nd - 1)
     c0, c1, c2 = curve[bm, idx], bval, curve[bp, idx]
-    den = c0 - 2.0 * c1 + c2
-    interior = (best > 0) & (best < nd - 1) & np.isfinite(c0) & np.isfinite(c2) & (den < 0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        off = np.where(interior, np.clip(0.5 * (c0 - c2) / np.where(interior, den, -1.0), -0.5, 0.5), 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):  # -inf where the ZNCC is undefined
+        den = c0 - 2.0 * c1 + c2
+        interior = (best > 0) & (best < nd - 1) & np.isfinite(c0) & np.isfinite(c2) & (den < 0)
+        off = np.where(
+            interior, np.clip(0.5 * (c0 - c2) / np.where(interior, den, -1.0), -0.5, 0.5), 0.0
+        )
     disp = (best + lo + off).astype(np.float32)
     xs, ys, disp, bval = xs[ok], ys[ok], disp[ok], bval[ok]
     xl = xs.astype(np.float32)

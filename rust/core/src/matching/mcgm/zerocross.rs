@@ -7,6 +7,11 @@ use std::f32::consts::TAU;
 pub const ZC_H: u8 = 1;
 /// Mark bit: the pixel holds a crossing found by the vertical scan (along y).
 pub const ZC_V: u8 = 2;
+/// Crossings with `|grad L|` below this are dropped: in flat areas the sign of `L` is float
+/// rounding noise (gradients ~1e-7), while one 8-bit grey step already gives ~1e-4. Without the
+/// floor, thousands of phantom crossings would set the strength percentile (`t_high`) and make
+/// the marks depend on the summation order of the filter.
+pub const MIN_STRENGTH: f32 = 1e-5;
 /// Largest Newton step `-L / L_x` accepted for a vertical-only mark (px): further than one pixel
 /// the linear model of `L` is not trusted and the pixel centre is kept.
 const MAX_NEWTON_STEP: f32 = 1.0;
@@ -98,7 +103,13 @@ pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
         let (x, y) = (i % w, i / w);
         let gx = 0.5 * (l[i + 1] - l[i - 1]);
         let gy = 0.5 * (l[i + w] - l[i - w]);
-        strength[i] = (gx * gx + gy * gy).sqrt();
+        let st = (gx * gx + gy * gy).sqrt();
+        if st < MIN_STRENGTH {
+            mark[i] = 0;
+            xsub[i] = f32::NAN;
+            continue;
+        }
+        strength[i] = st;
         let t = gy.atan2(gx);
         theta[i] = if t < 0.0 { (t + TAU) % TAU } else { t };
         if mark[i] & ZC_H == 0 {
