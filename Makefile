@@ -71,6 +71,7 @@ bench: build  ## criterion benches of the kernels, then the Python benches again
 	cargo bench
 	$(PY) benches/bench_gabor_vs_sgbm.py
 	$(PY) benches/bench_hopfield.py
+	$(PY) benches/bench_mcgm.py
 
 clean:  ## remove build products (keeps .venv)
 	rm -rf target $(BUILD_STAMP) demo_output
