@@ -567,6 +567,47 @@ def _half_mads(
     return (sad / n).astype(np.float32)
 
 
+def _other_better(
+    l: np.ndarray,
+    r: np.ndarray,
+    xi: int,
+    yl: int,
+    yr: int,
+    d: np.float32,
+    side: int,
+    geom: tuple[int, int, int],
+    p: dict[str, Any],
+    ks: tuple[int, int],
+    here: np.float32,
+) -> bool:
+    """A half-window fits better at ``d + k`` (integer ``|k| > 1``, same interpolation weights)."""
+    inner, outer, hh = geom
+    w = r.shape[1]
+    cols = xi + side * np.arange(inner, outer + 1)
+    pos = cols.astype(np.float32) - d
+    b = np.floor(pos).astype(np.int64)
+    fr = (pos - b.astype(np.float32)).astype(np.float32)
+    k_hi = min(ks[1], int(b.min()))
+    k_lo = max(ks[0], int(b.max()) + 2 - w)
+    kk = np.array([k for k in range(k_hi, k_lo - 1, -1) if abs(k) > 1], np.int64)
+    if len(kk) == 0:
+        return False
+    dys = np.repeat(np.arange(-hh, hh + 1), len(cols))
+    cc = np.tile(np.arange(len(cols)), 2 * hh + 1)
+    lv = l[yl + dys, cols[cc]].astype(np.float32)[:, None]
+    idx = b[cc][:, None] - kk[None, :]
+    ry = (yr + dys)[:, None]
+    a = r[ry, idx]
+    v = a + fr[cc][:, None] * (r[ry, idx + 1] - a)
+    diff = (lv - v).astype(np.float32)  # (n, K), raster order of the window
+    n = np.float32(diff.shape[0])
+    off = np.zeros(len(kk), np.float32)
+    if p["sides_mean_free"]:
+        off = np.cumsum(diff, axis=0, dtype=np.float32)[-1] / n
+    sad = np.cumsum(np.abs(diff - off[None, :]), axis=0, dtype=np.float32)[-1]
+    return bool(np.any(sad / n + np.float32(p["sides_best_margin"]) < here))
+
+
 def sides_ok(
     l: np.ndarray, r: np.ndarray, m: np.ndarray, p: dict[str, Any], rng: tuple[int, int]
 ) -> bool:
@@ -599,13 +640,8 @@ def sides_ok(
         if p["sides_best"]:
             k0 = math.ceil(np.float32(rng[0]) - d)
             k1 = math.floor(np.float32(rng[1]) - d)
-            ks = np.arange(k0, k1 + 1)
-            dds = (d + ks.astype(np.float32)).astype(np.float32)
-            sel = (np.abs(ks) > 1) & fits(dds)
-            if sel.any():
-                o = _half_mads(l, r, xi, yl_i, yr_i, dds[sel], side, geom, p["sides_mean_free"])
-                if np.any(o + np.float32(p["sides_best_margin"]) < here):
-                    return False
+            if _other_better(l, r, xi, yl_i, yr_i, d, side, geom, p, (k0, k1), here):
+                return False
     return True
 
 

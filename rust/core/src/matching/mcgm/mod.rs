@@ -595,6 +595,87 @@ fn half_mad(
     sad / n
 }
 
+/// Whether a half-window matches better (mean absolute difference + `sides_best_margin` below
+/// `here`) at another disparity `d + k`, `k` integer in `ks` with `|k| > 1`. Integer steps keep
+/// the interpolation weights of `d` (right samples `r[b - k] + f (r[b - k + 1] - r[b - k])`
+/// with `b = floor(x - d)`, `f = x - d - b`), so every `k` is compared fairly with `here`; the
+/// differences are laid out with `k` innermost (contiguous, vectorised) and summed in the
+/// window's raster order.
+#[allow(clippy::too_many_arguments)]
+fn other_disparity_better(
+    left: &Image,
+    right: &Image,
+    xi: i32,
+    yl: i32,
+    yr: i32,
+    d: f32,
+    side: i32,
+    (inner, outer, hh): (i32, i32, i32),
+    f: &FilterParams,
+    ks: (i32, i32),
+    here: f32,
+) -> bool {
+    let w = right.width as i32;
+    // Window columns and their interpolation bases.
+    let cols: Vec<i32> = (inner..=outer).map(|k| xi + side * k).collect();
+    let base: Vec<(i32, f32)> = cols
+        .iter()
+        .map(|&x| {
+            let pos = x as f32 - d;
+            let b = pos.floor();
+            (b as i32, pos - b)
+        })
+        .collect();
+    let b_min = base.iter().map(|b| b.0).min().unwrap_or(0);
+    let b_max = base.iter().map(|b| b.0).max().unwrap_or(0);
+    // Every sample r[b - k], r[b - k + 1] must lie inside the row.
+    let k_hi = ks.1.min(b_min);
+    let k_lo = ks.0.max(b_max + 2 - w);
+    // k descending: the right samples of one window pixel are then ascending in memory.
+    let kk: Vec<i32> = (k_lo..=k_hi).rev().filter(|k| k.abs() > 1).collect();
+    if kk.is_empty() {
+        return false;
+    }
+    let nk = kk.len();
+    let n_el = cols.len() * (2 * hh + 1) as usize;
+    let mut diffs = vec![0.0f32; n_el * nk];
+    let mut off = vec![0.0f32; nk];
+    let mut e = 0;
+    for dy in -hh..=hh {
+        let lrow = &left.data[(yl + dy) as usize * left.width..][..left.width];
+        let rrow = &right.data[(yr + dy) as usize * right.width..][..right.width];
+        for (c, &x) in cols.iter().enumerate() {
+            let lv = lrow[x as usize];
+            let (b, fr) = base[c];
+            let out = &mut diffs[e * nk..(e + 1) * nk];
+            for (o, &k) in out.iter_mut().zip(&kk) {
+                let i = (b - k) as usize;
+                let a = rrow[i];
+                *o = lv - (a + fr * (rrow[i + 1] - a));
+            }
+            if f.sides_mean_free {
+                for (s, &o) in off.iter_mut().zip(out.iter()) {
+                    *s += o;
+                }
+            }
+            e += 1;
+        }
+    }
+    let n = n_el as f32;
+    if f.sides_mean_free {
+        for s in off.iter_mut() {
+            *s /= n;
+        }
+    }
+    let mut sad = vec![0.0f32; nk];
+    for e in 0..n_el {
+        for ((s, &o), &m) in sad.iter_mut().zip(&diffs[e * nk..(e + 1) * nk]).zip(&off) {
+            *s += (o - m).abs();
+        }
+    }
+    sad.iter().any(|&s| s / n + f.sides_best_margin < here)
+}
+
 /// Both-sides check of one match: the half-windows left and right of the edge agree between
 /// the images (mean absolute grey difference <= `sides_mad` on both sides) and, with
 /// `sides_best`, neither half-window prefers another disparity of `range` (> 1 px away).
@@ -624,21 +705,12 @@ fn sides_ok(left: &Image, right: &Image, m: &Match, f: &FilterParams, range: (i3
             return false;
         }
         if f.sides_best {
-            // Integer steps keep the interpolation weights: a fair comparison with `here`.
             let (k0, k1) = (
                 (range.0 as f32 - d).ceil() as i32,
                 (range.1 as f32 - d).floor() as i32,
             );
-            for k in k0..=k1 {
-                let dd = d + k as f32;
-                if k.abs() > 1
-                    && fits(dd)
-                    && half_mad(left, right, xi, yl, yr, dd, side, geom, f.sides_mean_free)
-                        + f.sides_best_margin
-                        < here
-                {
-                    return false;
-                }
+            if other_disparity_better(left, right, xi, yl, yr, d, side, geom, f, (k0, k1), here) {
+                return false;
             }
         }
     }
