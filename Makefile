@@ -72,6 +72,8 @@ bench: build  ## criterion benches of the kernels, then the Python benches again
 	$(VENV)/bin/stereovision bench ../shared/data
 	$(PY) benches/bench_gabor_vs_sgbm.py
 	$(PY) benches/bench_hopfield.py
+	$(PY) benches/bench_mcgm.py
+	$(PY) benches/bench_fusion.py
 	$(PY) benches/bench_scaling.py
 
 clean:  ## remove build products (keeps .venv)

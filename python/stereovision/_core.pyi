@@ -86,3 +86,24 @@ def hopfield_match(
 def hopfield_candidates(
     left: npt.NDArray[np.float32], right: npt.NDArray[np.float32], params: dict[str, Any]
 ) -> npt.NDArray[np.float32]: ...
+
+# --- Multi-channel graph matching (rust/py/src/mcgm.rs) -----------------------------------------
+
+def mcgm_log(img: npt.NDArray[np.float32], sigma: float) -> npt.NDArray[np.float32]:
+    """Separable zero-mean scale-normalised LoG, ``(H, W)`` float32."""
+
+def mcgm_curves(img: npt.NDArray[np.float32], params: dict[str, Any]) -> list[dict[str, Any]]:
+    """Per channel: LoG, zero-crossing maps, labels, segments and R-tables (see ChannelCurves)."""
+
+def mcgm_match(
+    left: npt.NDArray[np.float32], right: npt.NDArray[np.float32], params: dict[str, Any]
+) -> tuple[npt.NDArray[np.float32], dict[str, Any], list[dict[str, Any]]]:
+    """``(matches (N, 6) [xl, yl, xr, yr, score, channel], stats, per-channel debug dicts)``."""
+
+def mcgm_filter(
+    left: npt.NDArray[np.float32],
+    right: npt.NDArray[np.float32],
+    matches: npt.NDArray[np.float32],
+    params: dict[str, Any],
+) -> npt.NDArray[np.bool_]:
+    """B.8 occlusion filters on ``(N, 4)`` matches: kept flags."""

@@ -11,12 +11,13 @@ from stereovision.calibration import Calibration
 from stereovision.depth import estimate_max_disparity
 from stereovision.matches import Matches
 from stereovision.matching import hopfield as _hopfield
+from stereovision.matching import mcgm as _mcgm
 
 __all__ = ["METHODS", "match"]
 
 #: Matchers of :func:`match`: the Hopfield network (algorithms.md C) and its best-match
-#: reference without the network.
-METHODS = ("hopfield", "best")
+#: reference without the network; multi-channel graph matching of zero-crossing curves (B).
+METHODS = ("hopfield", "best", "mcgm")
 
 
 def match(
@@ -38,15 +39,16 @@ def match(
         rectified first and the matches are in rectified coordinates).
     calib : Calibration, optional
         Rig calibration of the pair.
-    method : {"hopfield", "best"}
+    method : {"hopfield", "best", "mcgm"}
         ``"hopfield"``: the network (:func:`stereovision.matching.hopfield.hopfield_match`);
-        ``"best"``: the best-match reference without the network.
+        ``"best"``: the best-match reference without the network; ``"mcgm"``: multi-channel
+        graph matching of LoG zero-crossing curves (:func:`stereovision.matching.mcgm.mcgm_match`).
     max_disparity : int, optional
         Largest disparity searched (px). None estimates it from the pair
         (:func:`stereovision.estimate_max_disparity`).
     **params
-        Matcher parameters (:data:`stereovision.matching.hopfield.DEFAULTS`), plus
-        ``min_disparity``.
+        Matcher parameters (:data:`stereovision.matching.hopfield.DEFAULTS` or
+        :data:`stereovision.matching.mcgm.DEFAULTS`), plus ``min_disparity``.
 
     Returns
     -------
@@ -77,5 +79,7 @@ def match(
             gl, gr = check_pair(lb, rb)
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
+    if method == "mcgm":
+        return _mcgm.mcgm_match(gl, gr, max_disparity=max_disparity, **params)
     run = _hopfield.hopfield_match if method == "hopfield" else _hopfield.best_match
     return run(gl, gr, max_disparity=max_disparity, **params)

@@ -10,6 +10,7 @@ mod convert;
 mod errors;
 mod gabor;
 mod hopfield;
+mod mcgm;
 
 #[pymodule(gil_used = false)]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -21,5 +22,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(hopfield::hopfield_interest, m)?)?;
     m.add_function(wrap_pyfunction!(hopfield::hopfield_match, m)?)?;
     m.add_function(wrap_pyfunction!(hopfield::hopfield_candidates, m)?)?;
+    m.add_function(wrap_pyfunction!(mcgm::mcgm_log, m)?)?;
+    m.add_function(wrap_pyfunction!(mcgm::mcgm_curves, m)?)?;
+    m.add_function(wrap_pyfunction!(mcgm::mcgm_match, m)?)?;
+    m.add_function(wrap_pyfunction!(mcgm::mcgm_filter, m)?)?;
     Ok(())
 }

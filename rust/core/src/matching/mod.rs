@@ -2,3 +2,4 @@
 
 pub mod gabor;
 pub mod hopfield;
+pub mod mcgm;

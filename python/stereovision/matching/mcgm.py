@@ -1,0 +1,481 @@
+"""Multi-Channel Graph Matching channel (algorithms.md B + B.8), a thin wrapper of Rust.
+
+The kernel lives in ``rust/core/src/matching/mcgm``: per LoG channel (sigma 4, 2, 1 px, coarse to
+fine; sigma 4 on the 2x-decimated image, used as a prior only) zero crossings one pixel thick
+with sub-pixel x, hysteresis curve tracking into labelled segments, an R-table per segment and
+Generalized-Hough voting over the disparity window (narrowed by the coarser channels), a k-NN
+graph of segment centroids and tolerant association-graph matching with the Hopfield network of
+module C, then per-pixel disparities along the matched curves (sub-pixel at both ends) and B.8's
+occlusion filters (both-sides check, discontinuity filter).
+
+:func:`curves` gives the intermediate outputs of one image (LoG, zero crossings, labelled
+curves, segments, R-tables); :func:`mcgm_match` with ``debug=True`` adds the candidate pairs,
+the network state and the segment graph of every channel. :func:`zncc_reference` is the plain
+reference the channel is measured against (ZNCC winner along the row on the same zero-crossing
+pixels, left-right check, the same filters).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from stereovision import _core
+from stereovision._validate import as_gray_float, check_pair
+from stereovision.matches import Matches
+
+__all__ = [
+    "DEFAULTS",
+    "ChannelCurves",
+    "curves",
+    "edge_filters",
+    "log_filter",
+    "mcgm_match",
+    "zncc_reference",
+]
+
+#: Default parameters (mirror ``McgmParams::default`` in Rust; algorithms.md B.2 + B.8).
+DEFAULTS: dict[str, Any] = {
+    "sigmas": [4.0, 2.0, 1.0],  # LoG channels, coarse to fine (px, B.2)
+    "half_res_sigma": 4.0,  # channels this coarse run on the 2x-decimated image, prior only
+    "high_quantile": 0.5,  # t_high = this quantile of crossing strengths (B.8: 50th percentile)
+    "low_ratio": 0.4,  # t_low = 0.4 t_high (B.2)
+    "max_turn_deg": 60.0,  # normal change allowed between curve pixels (B.8: 60, paper 18)
+    "min_len": 8,  # shortest segment (px) ...
+    "min_len_sigmas": 4.0,  # ... or 4 sigma if longer (B.2)
+    "seg_theta_tol_deg": 30.0,  # mean-orientation difference of candidate segments (B.2)
+    "dy_band": 1,  # epipolar band (rows; B.8: t_y in {-1, 0, 1} for 1.5 px)
+    "n_theta_bins": 36,  # R-table orientation bins over [0, 2 pi) (B.2)
+    "vote_bin_tol": 1,  # +- bins when indexing the R-table (B.2)
+    "ght_min_score": 0.5,  # GHT peak / max(|A|, |A'|) (B.8: 0.5)
+    "k_cand": 6,  # candidates per left segment (B.2)
+    "knn": 6,  # neighbours in the segment graph (B.4.9)
+    "r_graph": 60.0,  # longest graph edge (px, B.2)
+    "A": 1.0,  # compatibility weight (B.2 / C.4)
+    "B": 1.5,  # uniqueness inhibition
+    "D": 1.0,  # GHT-score weight
+    "theta": 0.3,  # input offset
+    "dg_0": 0.5,  # disparity-gradient limit of the compatibility (B.2)
+    "dg_slope": 10.0,  # steepness of the compatibility sigmoid (B.2)
+    "max_sweeps": 100,  # bound on network sweeps
+    "seed": 0,  # update-order seed
+    "horiz_skip_deg": 20.0,  # no per-pixel disparity where the tangent is this near horizontal
+    "prior_radius_sigmas": 4.0,  # coarse prior spread radius, in coarse sigmas (B.4.11)
+    "prior_width_sigmas": 2.0 * float(np.sqrt(2.0)),  # window around the prior, fine sigmas
+    "fill_radius": 1,  # coarser matches only where no finer one within +- 1 column
+    "sides": True,  # B.8 both-sides check
+    "sides_mad": 0.04,  # mean absolute grey difference per half-window (B.8)
+    "sides_width": 4,  # half-window columns (B.8: 4 x 7)
+    "sides_height": 7,  # half-window rows
+    "sides_gap": 1,  # columns between the edge and each half-window (B.8)
+    "sides_best": True,  # ... and no other disparity (> 1 px away) fits a half-window better
+    "sides_best_margin": 0.0,  # ... by more than this MAD (0: the literal test, as C.10)
+    "sides_mean_free": True,  # half-window means removed first (exposure offsets, ETH3D)
+    "disc": True,  # B.8 discontinuity filter
+    "disc_dx": 6,  # +- columns (B.8)
+    "disc_dy": 2,  # +- rows (B.8)
+    "disc_tol": 1.0,  # largest disparity difference to a neighbour (px, B.8)
+}
+
+
+@dataclass(frozen=True)
+class ChannelCurves:
+    """Intermediate outputs of one LoG channel of one image.
+
+    Attributes
+    ----------
+    sigma : float
+        LoG sigma in the channel's own pixels (half the nominal sigma when ``scale == 2``).
+    scale : int
+        1 = full resolution, 2 = the 2x2-mean-decimated image (pixel ``(i, j)`` centred at
+        full-resolution ``(2i + 0.5, 2j + 0.5)``).
+    log : numpy.ndarray
+        ``(h, w)`` float32 LoG response.
+    mark : numpy.ndarray
+        ``(h, w)`` uint8 zero-crossing bits: 1 = horizontal scan, 2 = vertical scan.
+    xsub, strength, theta : numpy.ndarray
+        ``(h, w)`` float32 sub-pixel x of the crossing (NaN elsewhere), ``|grad L|`` and the
+        normal direction in ``[0, 2 pi)`` at marked pixels.
+    labels : numpy.ndarray
+        ``(h, w)`` int32 segment id per pixel, -1 = none.
+    seg_offsets : numpy.ndarray
+        ``(n + 1,)`` int64: segment ``k`` owns ``seg_pixels[seg_offsets[k]:seg_offsets[k+1]]``.
+    seg_pixels : numpy.ndarray
+        ``(N, 2)`` int32 ``(x, y)`` ordered along each curve.
+    centroids : numpy.ndarray
+        ``(n, 2)`` float32 segment centroids.
+    mean_theta : numpy.ndarray
+        ``(n,)`` float32 circular mean normal direction.
+    rtable_offsets : numpy.ndarray
+        ``(n, K + 1)`` int32 bin offsets of each segment's R-table (into its own entries).
+    rtable_vecs : numpy.ndarray
+        ``(N, 2)`` float32 R-table vectors ``c - p``, per segment, grouped by bin.
+    t_high, t_low : float
+        Hysteresis thresholds used.
+    """
+
+    sigma: float
+    scale: int
+    log: npt.NDArray[np.float32]
+    mark: npt.NDArray[np.uint8]
+    xsub: npt.NDArray[np.float32]
+    strength: npt.NDArray[np.float32]
+    theta: npt.NDArray[np.float32]
+    labels: npt.NDArray[np.int32]
+    seg_offsets: npt.NDArray[np.int64]
+    seg_pixels: npt.NDArray[np.int32]
+    centroids: npt.NDArray[np.float32]
+    mean_theta: npt.NDArray[np.float32]
+    rtable_offsets: npt.NDArray[np.int32]
+    rtable_vecs: npt.NDArray[np.float32]
+    t_high: float
+    t_low: float
+
+    @property
+    def n_segments(self) -> int:
+        """Number of segments."""
+        return int(self.centroids.shape[0])
+
+    def segment(self, k: int) -> npt.NDArray[np.int32]:
+        """``(n_k, 2)`` int32 ``(x, y)`` pixels of segment ``k``, in curve order."""
+        return self.seg_pixels[self.seg_offsets[k] : self.seg_offsets[k + 1]]
+
+
+def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:
+    unknown = set(params) - set(DEFAULTS)
+    if unknown:
+        raise ValueError(f"unknown MCGM parameter(s): {sorted(unknown)}")
+    for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
+        if (
+            isinstance(v, bool)
+            or not isinstance(v, (int, float, np.integer, np.floating))
+            or not np.isfinite(v)
+            or v < 0
+        ):
+            raise ValueError(f"{name} must be a non-negative number of pixels, got {v!r}")
+    lo, hi = int(np.floor(min_disparity)), int(np.ceil(max_disparity))
+    if hi < lo:
+        raise ValueError(f"max_disparity ({max_disparity}) must be >= min_disparity ({lo})")
+    kw = {**DEFAULTS, **params, "min_disparity": lo, "max_disparity": hi}
+    kw["sigmas"] = [float(s) for s in np.atleast_1d(np.asarray(kw["sigmas"], dtype=np.float64))]
+    return kw
+
+
+def log_filter(image: npt.ArrayLike, sigma: float) -> npt.NDArray[np.float32]:
+    """Separable zero-mean scale-normalised LoG ``sigma^2 lap(G)`` (B.3), ``(H, W)`` float32.
+
+    Parameters
+    ----------
+    image : array_like
+        ``(H, W)`` grey or ``(H, W, 3)`` BGR image, uint8, uint16 or float in ``[0, 1]``.
+    sigma : float
+        Gaussian standard deviation (px), in ``[0.3, 64]``.
+
+    Returns
+    -------
+    numpy.ndarray
+        The response (reflect-101 borders).
+
+    Raises
+    ------
+    ValueError
+        Bad image or sigma.
+    """
+    return _core.mcgm_log(as_gray_float(image, "image"), float(sigma))
+
+
+def curves(image: npt.ArrayLike, **params: Any) -> list[ChannelCurves]:
+    """Zero crossings, labelled curves, segments and R-tables of every channel of one image.
+
+    Parameters
+    ----------
+    image : array_like
+        ``(H, W)`` grey or ``(H, W, 3)`` BGR image, uint8, uint16 or float in ``[0, 1]``.
+    **params
+        Overrides of :data:`DEFAULTS` (``sigmas``, ``half_res_sigma``, the tracking and R-table
+        parameters).
+
+    Returns
+    -------
+    list of ChannelCurves
+        One per sigma, coarse to fine.
+
+    Raises
+    ------
+    ValueError
+        Bad image, an unknown parameter or a value out of range.
+    """
+    img = as_gray_float(image, "image")
+    out = []
+    for d in _core.mcgm_curves(img, _params(0, 0, params)):
+        out.append(ChannelCurves(**d))
+    return out
+
+
+def mcgm_match(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    *,
+    max_disparity: float,
+    min_disparity: float = 0,
+    debug: bool = False,
+    **params: Any,
+) -> Matches:
+    """Match zero-crossing curves of a rectified pair (the MCGM channel).
+
+    Parameters
+    ----------
+    left, right : array_like
+        Rectified pair, ``(H, W)`` grey or ``(H, W, 3)`` BGR, uint8, uint16 or float in
+        ``[0, 1]``, same shape.
+    max_disparity : float
+        Largest disparity searched (px).
+    min_disparity : float, optional
+        Smallest disparity searched (px, default 0).
+    debug : bool, optional
+        Also return, in ``stats["channels"]``, one dict per channel with the candidate pairs
+        (``candidates``: ``(M, 5)`` float32 ``[left_id, right_id, score, tx, ty]``), the network
+        state, the chosen pairs, the left segment graph (``edges``), the disparity windows and
+        the channel's own per-pixel matches ``(P, 6)``.
+    **params
+        Overrides of :data:`DEFAULTS` (each documented there).
+
+    Returns
+    -------
+    Matches
+        Per-pixel correspondences: ``xl`` / ``xr`` the sub-pixel crossings, ``yl == yr`` the row,
+        ``score`` the GHT score of the matched segment pair; ``stats`` has the counters
+        (``n_candidates``, ``n_pairs``, ``n_combined``, ``n_sides``, ``n_matches``) and
+        ``channel`` (``(N,)`` int index into ``sigmas`` of each match).
+
+    Raises
+    ------
+    ValueError
+        Bad images (shape, dtype, empty, NaN, mismatched sizes), an unknown parameter or a value
+        out of range.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> yy, xx = np.mgrid[0:80, 0:120].astype(np.float32)
+    >>> def scene(s):
+    ...     return (0.5 + 0.4 * np.sin((xx + s) / 5.0) * np.cos(yy / 7.0)).astype(np.float32)
+    >>> m = mcgm_match(scene(0.0), scene(3.4), max_disparity=8)
+    >>> bool(np.median(m.xl - m.xr) - 3.4 < 0.05) and len(m) > 100
+    True
+    """
+    gl, gr = check_pair(left, right)
+    kw = _params(max_disparity, min_disparity, params)
+    m, stats, chans = _core.mcgm_match(gl, gr, kw)
+    st: dict[str, Any] = dict(stats)
+    st["channel"] = m[:, 5].astype(np.int64)
+    if debug:
+        st["channels"] = [dict(c) for c in chans]
+    return Matches(
+        xl=m[:, 0],
+        yl=m[:, 1],
+        xr=m[:, 2],
+        yr=m[:, 3],
+        score=m[:, 4],
+        image_shape=(gl.shape[0], gl.shape[1]),
+        stats=st,
+    )
+
+
+def edge_filters(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    matches: npt.ArrayLike,
+    *,
+    max_disparity: float,
+    min_disparity: float = 0,
+    **params: Any,
+) -> npt.NDArray[np.bool_]:
+    """B.8's occlusion filters (both-sides check, discontinuity filter) on any matches.
+
+    Parameters
+    ----------
+    left, right : array_like
+        The rectified pair the matches come from.
+    matches : array_like
+        ``(N, 4)`` ``[xl, yl, xr, yr]``.
+    max_disparity, min_disparity : float
+        The searched range (the ``sides_best`` test looks for better disparities in it).
+    **params
+        ``sides``, ``sides_mad``, ``sides_width``, ``sides_height``, ``sides_gap``,
+        ``sides_best``, ``sides_best_margin``, ``disc``, ``disc_dx``, ``disc_dy``, ``disc_tol``
+        (:data:`DEFAULTS`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(N,)`` bool, True = kept.
+
+    Raises
+    ------
+    ValueError
+        Bad images, a matches array not of shape ``(N, 4)``, an unknown parameter.
+    """
+    gl, gr = check_pair(left, right)
+    arr = np.ascontiguousarray(matches, dtype=np.float32)
+    if arr.ndim != 2 or arr.shape[1] != 4:
+        raise ValueError(f"matches: expected shape (N, 4), got {arr.shape}")
+    return _core.mcgm_filter(gl, gr, arr, _params(max_disparity, min_disparity, params))
+
+
+#: ZNCC window half-size of the reference (7x7, as the Hopfield channel's candidates).
+ZNCC_RADIUS = 3
+#: Left-right check tolerance of the reference (px).
+ZNCC_LR_TOL = 1
+#: Windows flatter than this grey-level std have no defined ZNCC.
+ZNCC_MIN_STD = 1e-3
+
+
+def _box(a: npt.NDArray[np.float64], r: int) -> npt.NDArray[np.float64]:
+    """``(2r+1)^2`` window sums at every pixel (zero-padded integral image)."""
+    c = np.pad(a, ((r + 1, r), (r + 1, r))).cumsum(0).cumsum(1)
+    k = 2 * r + 1
+    return c[k:, k:] - c[:-k, k:] - c[k:, :-k] + c[:-k, :-k]
+
+
+def zncc_reference(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    *,
+    max_disparity: float,
+    min_disparity: float = 0,
+    pixels: npt.ArrayLike | None = None,
+    **params: Any,
+) -> Matches:
+    """Plain reference: best 7x7 ZNCC along the row at the channel's zero-crossing pixels.
+
+    At every left pixel on a tracked full-resolution curve (the pixels the channel can match,
+    or ``pixels``), the disparity with the highest ZNCC over the range, parabola sub-pixel
+    refinement, a left-right check (the right pixel's best match returns within 1 px), then the
+    same B.8 filters as the channel (:func:`edge_filters`).
+
+    Parameters
+    ----------
+    left, right : array_like
+        Rectified pair (as :func:`mcgm_match`).
+    max_disparity, min_disparity : float
+        Disparity range (px).
+    pixels : array_like, optional
+        ``(N, 2)`` integer ``(x, y)`` left pixels; default: every pixel of a full-resolution
+        channel's segments, tangent at least ``horiz_skip_deg`` from horizontal.
+    **params
+        :data:`DEFAULTS` overrides (curves and filters).
+
+    Returns
+    -------
+    Matches
+        ``score`` = the ZNCC.
+    """
+    gl, gr = check_pair(left, right)
+    kw = _params(max_disparity, min_disparity, params)
+    h, w = gl.shape
+    if pixels is None:
+        mask = np.zeros((h, w), dtype=bool)
+        min_cos = np.sin(np.deg2rad(kw["horiz_skip_deg"]))
+        for c in curves(gl, **params):
+            if c.scale == 1:
+                on = (c.labels >= 0) & (np.abs(np.cos(c.theta)) >= min_cos)
+                mask |= on
+        ys, xs = np.nonzero(mask)
+    else:
+        p = np.asarray(pixels, dtype=np.int64).reshape(-1, 2)
+        xs, ys = p[:, 0], p[:, 1]
+    lo, hi = kw["min_disparity"], kw["max_disparity"]
+    r = ZNCC_RADIUS
+    n_win = float((2 * r + 1) ** 2)
+    a = gl.astype(np.float64)
+    b = gr.astype(np.float64)
+    ma, mb = _box(a, r) / n_win, _box(b, r) / n_win
+    va = np.maximum(_box(a * a, r) / n_win - ma * ma, 0.0)
+    vb = np.maximum(_box(b * b, r) / n_win - mb * mb, 0.0)
+    sa, sb = np.sqrt(va), np.sqrt(vb)
+    nd = hi - lo + 1
+    # scores[d][y, x]: ZNCC of left (x, y) with right (x - d, y); -inf where undefined.
+    vol = np.full((nd, h, w), -np.inf, dtype=np.float32)
+    for k, d in enumerate(range(lo, hi + 1)):
+        if d >= w:
+            break
+        prod = np.zeros((h, w))
+        prod[:, d:] = a[:, d:] * b[:, : w - d]
+        cov = np.zeros((h, w))
+        cov[:, d:] = _box(prod, r)[:, d:] / n_win - ma[:, d:] * mb[:, : w - d]
+        den = np.zeros((h, w))
+        den[:, d:] = sa[:, d:] * sb[:, : w - d]
+        ok = np.zeros((h, w), dtype=bool)
+        ok[:, d:] = (sa[:, d:] > ZNCC_MIN_STD) & (sb[:, : w - d] > ZNCC_MIN_STD)
+        ok[:, : d + r] = False
+        with np.errstate(invalid="ignore", divide="ignore"):
+            z = np.where(ok, cov / np.where(ok, den, 1.0), -np.inf)
+        vol[k] = z
+    inside = (xs >= r) & (xs < w - r) & (ys >= r) & (ys < h - r)
+    xs, ys = xs[inside], ys[inside]
+    curve = vol[:, ys, xs]  # (nd, N)
+    best = np.argmax(curve, axis=0)
+    bval = curve[best, np.arange(len(xs))]
+    ok = np.isfinite(bval)
+    # Left-right check: the right pixel's best left match over the same range.
+    xr_i = xs - (best + lo)
+    ks = np.arange(nd)[:, None]
+    xl_back = xr_i[None, :] + ks + lo
+    valid = (xl_back >= 0) & (xl_back < w)
+    back = np.where(valid, vol[ks, ys[None, :], np.clip(xl_back, 0, w - 1)], -np.inf)  # (nd, N)
+    rbest = np.argmax(back, axis=0)
+    ok &= np.abs(rbest - best) <= ZNCC_LR_TOL
+    # Parabola sub-pixel refinement (interior disparities only).
+    idx = np.arange(len(xs))
+    bm = np.clip(best - 1, 0, nd - 1)
+    bp = np.clip(best + 1, 0, nd - 1)
+    c0, c1, c2 = curve[bm, idx], bval, curve[bp, idx]
+    with np.errstate(invalid="ignore", divide="ignore"):  # -inf where the ZNCC is undefined
+        den = c0 - 2.0 * c1 + c2
+        interior = (best > 0) & (best < nd - 1) & np.isfinite(c0) & np.isfinite(c2) & (den < 0)
+        off = np.where(
+            interior, np.clip(0.5 * (c0 - c2) / np.where(interior, den, -1.0), -0.5, 0.5), 0.0
+        )
+    disp = (best + lo + off).astype(np.float32)
+    xs, ys, disp, bval = xs[ok], ys[ok], disp[ok], bval[ok]
+    xl = xs.astype(np.float32)
+    yl = ys.astype(np.float32)
+    xr = (xl - disp).astype(np.float32)
+    arr = np.stack([xl, yl, xr, yl], axis=1)
+    keep = edge_filters(
+        gl,
+        gr,
+        arr,
+        max_disparity=hi,
+        min_disparity=lo,
+        **{k: v for k, v in params.items() if k in _FILTER_KEYS},
+    )
+    return Matches(
+        xl=xl[keep],
+        yl=yl[keep],
+        xr=xr[keep],
+        yr=yl[keep],
+        score=bval[keep].astype(np.float32),
+        image_shape=(h, w),
+        stats={"n_pixels": int(inside.sum()), "n_lr": int(ok.sum()), "n_matches": int(keep.sum())},
+    )
+
+
+_FILTER_KEYS = (
+    "sides",
+    "sides_mad",
+    "sides_width",
+    "sides_height",
+    "sides_gap",
+    "sides_best",
+    "sides_best_margin",
+    "sides_mean_free",
+    "disc",
+    "disc_dx",
+    "disc_dy",
+    "disc_tol",
+)

@@ -1,0 +1,344 @@
+//! Candidate segment pairs, the segment adjacency graph and the association-graph matching
+//! (algorithms.md B.4 steps 7, 9, 10, with B.8's readings).
+//!
+//! Adjacency: each left segment's `k` nearest centroids within `r_graph` px (the k-NN
+//! alternative B.4.9 allows), symmetrised. Association graph: nodes = candidate pairs
+//! `a = (A, A')`; `a` and `b = (B, B')` are joined when `(A, B)` are adjacent and `A' != B'`, with
+//! the disparity-gradient compatibility `C_ab = 2 / (1 + exp(slope (g - g0))) - 1`,
+//! `g = |t_a - t_b| / |c_A - c_B|`, weighted `A_w C_ab / sqrt(deg A deg B)` (B.8: normalised by
+//! the degree; the geometric mean keeps the matrix symmetric); candidates sharing `A` or `A'`
+//! inhibit each other with `-B`. The Hopfield network of module C
+//! ([`crate::matching::hopfield::run_dynamics`]) minimises the energy; a segment left with
+//! two active pairs keeps the one with the highest net input (B.8).
+
+use rayon::prelude::*;
+
+use super::rtable::{ght_vote, RTable};
+use super::tracking::{wrap_angle, Segment};
+use crate::matching::hopfield::{run_dynamics, Csr};
+
+/// One candidate segment pair with its GHT evidence.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Candidate {
+    pub left: u32,
+    pub right: u32,
+    pub score: f32,
+    /// Translation `t = p - q` (left minus right, px): `tx` is the segment disparity.
+    pub tx: f32,
+    pub ty: f32,
+}
+
+/// Gates and GHT settings of the candidate search.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CandParams {
+    pub seg_theta_tol_deg: f32,
+    /// Epipolar band (rows): y-ranges are widened by this and GHT rows are `-dy..=dy`.
+    pub dy_band: i32,
+    pub n_bins: usize,
+    pub vote_bin_tol: usize,
+    pub ght_min_score: f32,
+    pub k_cand: usize,
+}
+
+/// Candidates of every left segment (grouped by left id, best score first). `window[A]` is the
+/// integer disparity window `[lo, hi]` of segment `A` (None: no candidates).
+#[allow(clippy::too_many_arguments)]
+pub fn candidates(
+    left: &[Segment],
+    rtables: &[RTable],
+    right: &[Segment],
+    theta_r: &[f32],
+    w: usize,
+    h: usize,
+    window: &[Option<(i32, i32)>],
+    p: &CandParams,
+) -> Vec<Candidate> {
+    // Row buckets of the right segments (each listed on every row it spans).
+    let mut rows: Vec<Vec<u32>> = vec![Vec::new(); h];
+    for (id, s) in right.iter().enumerate() {
+        for y in s.y_min.max(0)..=s.y_max.min(h as i32 - 1) {
+            rows[y as usize].push(id as u32);
+        }
+    }
+    let tol = (p.seg_theta_tol_deg as f64).to_radians();
+    let per: Vec<Vec<Candidate>> = left
+        .par_iter()
+        .enumerate()
+        .map_init(
+            || {
+                (
+                    Vec::<u32>::new(),
+                    Vec::<u32>::new(),
+                    vec![u32::MAX; right.len()],
+                )
+            },
+            |(acc, near, stamp), (ia, a)| {
+                let Some((lo, hi)) = window[ia] else {
+                    return Vec::new();
+                };
+                // Right segments on the rows of A, each once (stamped with A's id: no sort).
+                near.clear();
+                let y0 = (a.y_min - p.dy_band).max(0);
+                let y1 = (a.y_max + p.dy_band).min(h as i32 - 1);
+                for y in y0..=y1 {
+                    for &b in &rows[y as usize] {
+                        if stamp[b as usize] != ia as u32 {
+                            stamp[b as usize] = ia as u32;
+                            near.push(b);
+                        }
+                    }
+                }
+                let ext_a = a.y_max - a.y_min + 1;
+                let mut out: Vec<Candidate> = Vec::new();
+                for &ib in near.iter() {
+                    let b = &right[ib as usize];
+                    if wrap_angle(a.mean_theta as f64 - b.mean_theta as f64).abs() >= tol {
+                        continue;
+                    }
+                    let ov =
+                        (a.y_max + p.dy_band).min(b.y_max) - (a.y_min - p.dy_band).max(b.y_min) + 1;
+                    let ext_b = b.y_max - b.y_min + 1;
+                    if (ov as f32) < 0.5 * ext_a.min(ext_b) as f32 {
+                        continue;
+                    }
+                    let slack = 0.5 * (a.x_max - a.x_min + 1).max(b.x_max - b.x_min + 1) as f32;
+                    let dc = a.centroid.0 - b.centroid.0;
+                    if dc < lo as f32 - slack || dc > hi as f32 + slack {
+                        continue;
+                    }
+                    let Some(g) = ght_vote(
+                        &rtables[ia],
+                        a.pixels.len(),
+                        &b.pixels,
+                        theta_r,
+                        w,
+                        lo,
+                        hi,
+                        p.dy_band,
+                        p.n_bins,
+                        p.vote_bin_tol,
+                        acc,
+                    ) else {
+                        continue;
+                    };
+                    if g.score >= p.ght_min_score {
+                        out.push(Candidate {
+                            left: ia as u32,
+                            right: ib,
+                            score: g.score,
+                            tx: g.tx,
+                            ty: g.ty,
+                        });
+                    }
+                }
+                out.sort_by(|x, y| y.score.total_cmp(&x.score).then(x.right.cmp(&y.right)));
+                out.truncate(p.k_cand);
+                out
+            },
+        )
+        .collect();
+    per.into_iter().flatten().collect()
+}
+
+/// Symmetrised k-nearest-neighbour adjacency of segment centroids within `r_max` px (sorted
+/// lists; ties by id). Uniform grid of cell `r_max`.
+pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Vec<Vec<u32>> {
+    let n = segs.len();
+    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); n];
+    if n == 0 || k == 0 {
+        return adj;
+    }
+    let cell = r_max.max(1.0);
+    let key = |s: &Segment| {
+        (
+            (s.centroid.0 / cell).floor() as i64,
+            (s.centroid.1 / cell).floor() as i64,
+        )
+    };
+    let mut grid: std::collections::HashMap<(i64, i64), Vec<u32>> = Default::default();
+    for (i, s) in segs.iter().enumerate() {
+        grid.entry(key(s)).or_default().push(i as u32);
+    }
+    let nearest: Vec<Vec<u32>> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let (cx, cy) = key(&segs[i]);
+            let (x, y) = segs[i].centroid;
+            let mut d: Vec<(f32, u32)> = Vec::new();
+            for gy in cy - 1..=cy + 1 {
+                for gx in cx - 1..=cx + 1 {
+                    for &j in grid.get(&(gx, gy)).map(|v| v.as_slice()).unwrap_or(&[]) {
+                        if j as usize == i {
+                            continue;
+                        }
+                        let (u, v) = segs[j as usize].centroid;
+                        let dd = ((u - x) * (u - x) + (v - y) * (v - y)).sqrt();
+                        if dd <= r_max {
+                            d.push((dd, j));
+                        }
+                    }
+                }
+            }
+            d.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            d.truncate(k);
+            d.into_iter().map(|(_, j)| j).collect()
+        })
+        .collect();
+    for (i, nb) in nearest.iter().enumerate() {
+        for &j in nb {
+            adj[i].push(j);
+            adj[j as usize].push(i as u32);
+        }
+    }
+    for a in adj.iter_mut() {
+        a.sort_unstable();
+        a.dedup();
+    }
+    adj
+}
+
+/// Solver weights (B.2: the module C defaults `A = 1, B = 1.5, D = 1, theta = 0.3`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverParams {
+    pub a: f32,
+    pub b: f32,
+    pub d: f32,
+    pub theta: f32,
+    pub dg_0: f32,
+    pub dg_slope: f32,
+    pub max_sweeps: usize,
+    pub seed: u64,
+}
+
+/// Result of the association-graph matching.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solution {
+    /// Indices of the chosen candidates (at most one per left and per right segment).
+    pub chosen: Vec<usize>,
+    /// Final binary state of every candidate.
+    pub state: Vec<u8>,
+    pub n_weights: usize,
+    pub sweeps: usize,
+    pub converged: bool,
+}
+
+/// Builds the association graph's weights (CSR, symmetric, zero diagonal).
+pub fn association_weights(
+    cands: &[Candidate],
+    left: &[Segment],
+    adj: &[Vec<u32>],
+    n_right: usize,
+    p: &SolverParams,
+) -> Csr {
+    let n_left = left.len();
+    // Candidates per left segment (contiguous) and per right segment.
+    let mut by_left: Vec<Vec<u32>> = vec![Vec::new(); n_left];
+    let mut by_right: Vec<Vec<u32>> = vec![Vec::new(); n_right];
+    for (i, c) in cands.iter().enumerate() {
+        by_left[c.left as usize].push(i as u32);
+        by_right[c.right as usize].push(i as u32);
+    }
+    let rows: Vec<Vec<(u32, f32)>> = cands
+        .par_iter()
+        .enumerate()
+        .map(|(ia, ca)| {
+            let mut row: Vec<(u32, f32)> = Vec::new();
+            for &ib in by_left[ca.left as usize]
+                .iter()
+                .chain(&by_right[ca.right as usize])
+            {
+                if ib as usize != ia {
+                    row.push((ib, -p.b));
+                }
+            }
+            let sa = &left[ca.left as usize];
+            let deg_a = adj[ca.left as usize].len() as f32;
+            for &nb in &adj[ca.left as usize] {
+                let sb = &left[nb as usize];
+                let dist = ((sa.centroid.0 - sb.centroid.0).powi(2)
+                    + (sa.centroid.1 - sb.centroid.1).powi(2))
+                .sqrt()
+                .max(1.0);
+                let deg_b = adj[nb as usize].len() as f32;
+                let norm = p.a / (deg_a * deg_b).sqrt();
+                for &ib in &by_left[nb as usize] {
+                    let cb = &cands[ib as usize];
+                    if cb.right == ca.right {
+                        continue; // already inhibited
+                    }
+                    let g = ((ca.tx - cb.tx).powi(2) + (ca.ty - cb.ty).powi(2)).sqrt() / dist;
+                    let c = 2.0 / (1.0 + (p.dg_slope * (g - p.dg_0)).exp()) - 1.0;
+                    row.push((ib, norm * c));
+                }
+            }
+            // A pair sharing both segments cannot occur (one candidate per (A, A')); sharing
+            // A and A' twice (same left and same right) would be the same candidate.
+            row.sort_by_key(|e| e.0);
+            row.dedup_by_key(|e| e.0);
+            row
+        })
+        .collect();
+    let mut csr = Csr::default();
+    csr.indptr.push(0);
+    for r in rows {
+        for (j, v) in r {
+            csr.indices.push(j);
+            csr.data.push(v);
+        }
+        csr.indptr.push(csr.indices.len());
+    }
+    csr
+}
+
+/// Runs the network and resolves double activations by the highest net input.
+pub fn solve(cands: &[Candidate], csr: &Csr, n_left: usize, p: &SolverParams) -> Solution {
+    let m = cands.len();
+    let input: Vec<f64> = cands
+        .iter()
+        .map(|c| (p.d * c.score - p.theta) as f64)
+        .collect();
+    // Preset: the best candidate of every left segment on (candidates are best first).
+    let init: Vec<u8> = (0..m)
+        .map(|i| u8::from(i == 0 || cands[i - 1].left != cands[i].left))
+        .collect();
+    let dynamics = run_dynamics(csr, &input, &init, p.seed, p.max_sweeps);
+    let state = dynamics.state;
+    let mut net = input.clone();
+    for (a, &on) in state.iter().enumerate() {
+        if on == 1 {
+            let (idx, val) = csr.row(a);
+            for (&b, &t) in idx.iter().zip(val) {
+                net[b as usize] += t as f64;
+            }
+        }
+    }
+    let better = |a: usize, b: usize| net[a] > net[b] || (net[a] == net[b] && a < b);
+    let mut best_left: Vec<Option<usize>> = vec![None; n_left];
+    for a in (0..m).filter(|&a| state[a] == 1) {
+        let slot = &mut best_left[cands[a].left as usize];
+        if slot.is_none_or(|b| better(a, b)) {
+            *slot = Some(a);
+        }
+    }
+    let n_right = cands
+        .iter()
+        .map(|c| c.right as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut best_right: Vec<Option<usize>> = vec![None; n_right];
+    for a in best_left.iter().flatten().copied() {
+        let slot = &mut best_right[cands[a].right as usize];
+        if slot.is_none_or(|b| better(a, b)) {
+            *slot = Some(a);
+        }
+    }
+    let mut chosen: Vec<usize> = best_right.into_iter().flatten().collect();
+    chosen.sort_unstable();
+    Solution {
+        chosen,
+        state,
+        n_weights: csr.nnz(),
+        sweeps: dynamics.sweeps,
+        converged: dynamics.converged,
+    }
+}

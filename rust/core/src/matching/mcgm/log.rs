@@ -1,0 +1,155 @@
+//! Separable, scale-normalised, zero-mean Laplacian of Gaussian (algorithms.md B.3).
+//!
+//! `K = sigma^2 lap(G) = a(x) g(y) + g(x) a(y)` with `g(t) = exp(-t^2 / 2 sigma^2)` and
+//! `a(t) = (t^2 / sigma^2 - 1) g(t) / (2 pi sigma^2)`. The 1-D `a` is made exactly zero-mean on the
+//! truncated support (`a <- a - g sum(a) / sum(g)`), so `sum K = sum(a) sum(g) * 2 = 0`: a flat
+//! bright area gives no response and no spurious zero crossing. Borders reflect without repeating
+//! the edge pixel (OpenCV's BORDER_REFLECT_101). Two row passes (`g`, `a`) and one column pass
+//! that sums both products: four 1-D convolutions instead of a `(2r+1)^2` kernel.
+
+// Row kernels index equally long rows in lockstep; index loops are the form LLVM vectorises.
+#![allow(clippy::needless_range_loop)]
+
+use crate::image::Image;
+use crate::parallel::for_each_row;
+use crate::simd::simd_fn;
+
+/// Kernel truncation in standard deviations (B.2: radius `ceil(4 sigma)`).
+pub const TRUNCATE_SIGMAS: f64 = 4.0;
+
+/// Truncation radius of the LoG of std `sigma`.
+pub fn radius_for(sigma: f32) -> usize {
+    (TRUNCATE_SIGMAS * sigma as f64).ceil().max(1.0) as usize
+}
+
+/// The two 1-D kernels `(g, a)` (taps `-r..=r`), `a` zero-mean on its support.
+pub fn log_kernels(sigma: f32) -> (Vec<f32>, Vec<f32>) {
+    let r = radius_for(sigma) as isize;
+    let s2 = (sigma as f64) * (sigma as f64);
+    let g: Vec<f64> = (-r..=r)
+        .map(|t| (-((t * t) as f64) / (2.0 * s2)).exp())
+        .collect();
+    let norm = 1.0 / (2.0 * std::f64::consts::PI * s2);
+    let mut a: Vec<f64> = (-r..=r)
+        .zip(&g)
+        .map(|(t, gv)| norm * ((t * t) as f64 / s2 - 1.0) * gv)
+        .collect();
+    let (sa, sg): (f64, f64) = (a.iter().sum(), g.iter().sum());
+    for (av, gv) in a.iter_mut().zip(&g) {
+        *av -= gv * sa / sg;
+    }
+    (
+        g.iter().map(|&v| v as f32).collect(),
+        a.iter().map(|&v| v as f32).collect(),
+    )
+}
+
+/// Reflect-101 index of `i` in `0..n` (folds repeatedly for kernels wider than the image).
+#[inline]
+pub fn reflect(mut i: isize, n: usize) -> usize {
+    if n == 1 {
+        return 0;
+    }
+    let n = n as isize;
+    loop {
+        if i < 0 {
+            i = -i;
+        } else if i >= n {
+            i = 2 * (n - 1) - i;
+        } else {
+            return i as usize;
+        }
+    }
+}
+
+simd_fn! {
+    /// `og[x] = sum_j g[j] p[x + j]`, `oa[x] = sum_j a[j] p[x + j]` over a padded row (symmetric
+    /// kernels: centre tap, then pairs), for `x` in `0..og.len()`.
+    fn row_pass(p: &[f32], g: &[f32], a: &[f32], og: &mut [f32], oa: &mut [f32]) {
+        let w = og.len();
+        let r = g.len() / 2;
+        let oa = &mut oa[..w];
+        let c = &p[r..r + w];
+        for x in 0..w {
+            og[x] = g[r] * c[x];
+            oa[x] = a[r] * c[x];
+        }
+        for j in 1..=r {
+            let lo = &p[r - j..r - j + w];
+            let hi = &p[r + j..r + j + w];
+            let (gj, aj) = (g[r + j], a[r + j]);
+            for x in 0..w {
+                let s = lo[x] + hi[x];
+                og[x] += gj * s;
+                oa[x] += aj * s;
+            }
+        }
+    }
+}
+
+simd_fn! {
+    /// `out += k * (lo + hi)` (one symmetric tap pair of the column pass).
+    fn col_tap(out: &mut [f32], k: f32, lo: &[f32], hi: &[f32]) {
+        let w = out.len();
+        let (lo, hi) = (&lo[..w], &hi[..w]);
+        for x in 0..w {
+            out[x] += k * (lo[x] + hi[x]);
+        }
+    }
+}
+
+/// `L = I (*) K_sigma` (float32, same size as the image).
+pub fn log_filter(img: &Image, sigma: f32) -> Vec<f32> {
+    let (w, h) = img.size();
+    let (g, a) = log_kernels(sigma);
+    let r = g.len() / 2;
+    // Row passes: hg = I *_x g, ha = I *_x a.
+    let mut hg = vec![0.0f32; w * h];
+    let mut ha = vec![0.0f32; w * h];
+    crate::parallel::for_each_row2(&mut hg, &mut ha, w, |y, og, oa| {
+        let src = &img.data[y * w..(y + 1) * w];
+        let p: Vec<f32> = (-(r as isize)..(w + r) as isize)
+            .map(|i| src[reflect(i, w)])
+            .collect();
+        row_pass(&p, &g, &a, og, oa);
+    });
+    // Column pass: L = ha *_y g + hg *_y a.
+    let mut out = vec![0.0f32; w * h];
+    for_each_row(&mut out, w, |y, o| {
+        let rows = |i: isize| {
+            let yy = reflect(i, h);
+            yy * w..(yy + 1) * w
+        };
+        for x in 0..w {
+            o[x] = g[r] * ha[y * w + x] + a[r] * hg[y * w + x];
+        }
+        for j in 1..=r {
+            let (ylo, yhi) = (y as isize - j as isize, y as isize + j as isize);
+            col_tap(o, g[r + j], &ha[rows(ylo)], &ha[rows(yhi)]);
+            col_tap(o, a[r + j], &hg[rows(ylo)], &hg[rows(yhi)]);
+        }
+    });
+    out
+}
+
+/// 2x2 mean decimation (floor of odd sizes; at least 1x1): pixel `(i, j)` of the result is the
+/// mean of full-resolution pixels `(2i..2i+1, 2j..2j+1)`, centred at `(2i + 0.5, 2j + 0.5)`.
+pub fn decimate2(img: &Image) -> Image {
+    let (w, h) = img.size();
+    let (w2, h2) = ((w / 2).max(1), (h / 2).max(1));
+    let mut data = vec![0.0f32; w2 * h2];
+    for_each_row(&mut data, w2, |y, o| {
+        let y0 = (2 * y).min(h - 1);
+        let y1 = (2 * y + 1).min(h - 1);
+        for (x, v) in o.iter_mut().enumerate() {
+            let x0 = (2 * x).min(w - 1);
+            let x1 = (2 * x + 1).min(w - 1);
+            *v = 0.25 * (img.at(x0, y0) + img.at(x1, y0) + img.at(x0, y1) + img.at(x1, y1));
+        }
+    });
+    Image {
+        width: w2,
+        height: h2,
+        data,
+    }
+}

@@ -1,0 +1,926 @@
+//! Multi-Channel Graph Matching (algorithms.md B, with the B.8 changes).
+//!
+//! Per channel `sigma` (coarse to fine) and per image:
+//! 1. [`log`]: separable scale-normalised zero-mean LoG; channels with `sigma >= half_res_sigma`
+//!    run on the 2x-decimated image (`sigma / 2` there) and serve as priors only (B.8: the
+//!    coarsest channel is the least precise).
+//! 2. [`zerocross`]: one-pixel-thick zero crossings, sub-pixel x, strength, normal direction.
+//! 3. [`tracking`]: hysteresis tracking into labelled segments.
+//! 4. [`rtable`]: R-table per left segment; GHT votes score candidate pairs over the disparity
+//!    window (narrowed by the coarser channels' prior, B.4.11).
+//! 5. [`graph`]: k-NN segment graph, association graph, the Hopfield network of module C.
+//! 6. Per-pixel disparities along the matched curves with sub-pixel x at both ends (B.4.12).
+//!
+//! The output is the finest channel's matches, coarser full-resolution channels filling rows
+//! the finer ones left empty, then B.8's two occlusion filters ([`edge_filters`]): the
+//! both-sides check and the discontinuity filter.
+
+pub mod graph;
+pub mod log;
+pub mod rtable;
+pub mod tracking;
+pub mod zerocross;
+
+#[cfg(test)]
+mod tests;
+
+use rayon::prelude::*;
+
+use crate::error::{CoreError, Result};
+use crate::image::{check_pair, Image};
+use graph::{
+    association_weights, candidates, knn_graph, solve, CandParams, Candidate, SolverParams,
+};
+use rtable::{build_rtable, RTable};
+use tracking::{track, Curves, TrackParams};
+use zerocross::{zero_crossings, ZeroCrossings};
+
+/// Marr-Poggio channel width `w = 2 sqrt(2) sigma` in units of sigma (B.3, B.4.11).
+pub const CHANNEL_WIDTH_SIGMAS: f32 = 2.0 * std::f32::consts::SQRT_2;
+
+/// Parameters of the MCGM channel (defaults: algorithms.md B.2 with the B.8 changes).
+#[derive(Debug, Clone, PartialEq)]
+pub struct McgmParams {
+    /// Smallest disparity searched (px).
+    pub d_min: usize,
+    /// Largest disparity searched (px).
+    pub d_max: usize,
+    /// LoG channels, coarse to fine (px, B.2: 4, 2, 1).
+    pub sigmas: Vec<f32>,
+    /// Channels with `sigma >= half_res_sigma` run at half resolution and are priors only.
+    pub half_res_sigma: f32,
+    pub track: TrackParams,
+    /// Shortest kept segment: `max(min_len, min_len_sigmas * sigma)` pixels of the channel.
+    pub min_len_sigmas: f32,
+    pub cand: CandParams,
+    /// Neighbours per segment in the adjacency graph (B.4.9: k-NN, k = 6).
+    pub knn: usize,
+    /// Longest adjacency edge (px, B.2: 60).
+    pub r_graph: f32,
+    pub solver: SolverParams,
+    /// Curve pixels whose tangent is within this angle of horizontal get no disparity (deg).
+    pub horiz_skip_deg: f32,
+    /// Prior fill radius in sigmas of the next coarser channel (B.4.11: 4).
+    pub prior_radius_sigmas: f32,
+    /// Prior window half-width in sigmas of the channel (B.4.11: `2 sqrt 2`).
+    pub prior_width_sigmas: f32,
+    /// A coarser channel's match is dropped where a finer one lies within this many columns on
+    /// the same row (px).
+    pub fill_radius: i32,
+    pub filters: FilterParams,
+}
+
+/// B.8's occlusion-boundary filters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FilterParams {
+    /// Both-sides check on / off.
+    pub sides: bool,
+    /// Largest mean absolute grey difference of each half-window (grey in [0, 1]; B.8: 0.04).
+    pub sides_mad: f32,
+    /// Half-window width (columns) and height (rows) (B.8: 4 x 7).
+    pub sides_width: i32,
+    pub sides_height: i32,
+    /// Columns skipped between the edge pixel and each half-window (B.8: 1).
+    pub sides_gap: i32,
+    /// Each half-window must also match at least as well at the match's disparity as at any
+    /// other disparity of the range more than 1 px away, up to `sides_best_margin` (MAD): the
+    /// relative form catches low-contrast background an absolute threshold lets through.
+    pub sides_best: bool,
+    pub sides_best_margin: f32,
+    /// Remove each half-window pair's mean difference before the MAD (exposure offsets).
+    pub sides_mean_free: bool,
+    /// Discontinuity filter on / off.
+    pub disc: bool,
+    /// Neighbourhood of the discontinuity filter (+- columns, +- rows; B.8: 6, 2).
+    pub disc_dx: i32,
+    pub disc_dy: i32,
+    /// Largest disparity difference to a neighbour (px, B.8: 1).
+    pub disc_tol: f32,
+}
+
+impl Default for FilterParams {
+    fn default() -> Self {
+        FilterParams {
+            sides: true,
+            sides_mad: 0.04,
+            sides_width: 4,
+            sides_height: 7,
+            sides_gap: 1,
+            sides_best: true,
+            sides_best_margin: 0.0,
+            sides_mean_free: true,
+            disc: true,
+            disc_dx: 6,
+            disc_dy: 2,
+            disc_tol: 1.0,
+        }
+    }
+}
+
+impl Default for McgmParams {
+    fn default() -> Self {
+        McgmParams {
+            d_min: 0,
+            d_max: 64,
+            sigmas: vec![4.0, 2.0, 1.0],
+            half_res_sigma: 4.0,
+            track: TrackParams {
+                high_quantile: 0.5,
+                low_ratio: 0.4,
+                max_turn_deg: 60.0,
+                min_len: 8,
+            },
+            min_len_sigmas: 4.0,
+            cand: CandParams {
+                seg_theta_tol_deg: 30.0,
+                dy_band: 1,
+                n_bins: 36,
+                vote_bin_tol: 1,
+                ght_min_score: 0.5,
+                k_cand: 6,
+            },
+            knn: 6,
+            r_graph: 60.0,
+            solver: SolverParams {
+                a: 1.0,
+                b: 1.5,
+                d: 1.0,
+                theta: 0.3,
+                dg_0: 0.5,
+                dg_slope: 10.0,
+                max_sweeps: 100,
+                seed: 0,
+            },
+            horiz_skip_deg: 20.0,
+            prior_radius_sigmas: 4.0,
+            prior_width_sigmas: CHANNEL_WIDTH_SIGMAS,
+            fill_radius: 1,
+            filters: FilterParams::default(),
+        }
+    }
+}
+
+/// One per-pixel correspondence (full-resolution coordinates).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Match {
+    /// Sub-pixel x of the left crossing and its row.
+    pub xl: f32,
+    pub yl: f32,
+    /// Sub-pixel x of the right crossing and its row.
+    pub xr: f32,
+    pub yr: f32,
+    /// GHT score of the matched segment pair.
+    pub score: f32,
+    /// Index of the channel in `sigmas`.
+    pub channel: u8,
+}
+
+/// Zero crossings, curves and R-tables of one image in one channel.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelCurves {
+    /// `sigma` in the channel's own pixels (half the nominal value at half resolution).
+    pub sigma: f32,
+    /// 1 (full resolution) or 2 (decimated).
+    pub scale: usize,
+    pub width: usize,
+    pub height: usize,
+    pub log: Vec<f32>,
+    pub zc: ZeroCrossings,
+    pub curves: Curves,
+    pub rtables: Vec<RTable>,
+}
+
+/// What one channel matched (for debugging and the GUI).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelResult {
+    pub sigma: f32,
+    pub scale: usize,
+    pub n_left: usize,
+    pub n_right: usize,
+    /// Disparity window per left segment (channel pixels), None = no candidates possible.
+    pub windows: Vec<Option<(i32, i32)>>,
+    pub candidates: Vec<Candidate>,
+    /// Final network state of every candidate.
+    pub state: Vec<u8>,
+    /// Chosen candidate indices.
+    pub chosen: Vec<usize>,
+    /// Undirected adjacency edges of the left graph `(i, j)`, `i < j`.
+    pub edges: Vec<(u32, u32)>,
+    pub n_weights: usize,
+    pub sweeps: usize,
+    pub converged: bool,
+    /// Per-pixel matches of this channel before combination and filters.
+    pub matches: Vec<Match>,
+}
+
+/// Result of [`mcgm_match`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct McgmOutput {
+    pub matches: Vec<Match>,
+    pub channels: Vec<ChannelResult>,
+    /// Matches after the channel combination, before the filters.
+    pub n_combined: usize,
+    /// ... after the both-sides check.
+    pub n_sides: usize,
+}
+
+fn validate_params(p: &McgmParams) -> Result<()> {
+    if p.d_max < p.d_min {
+        return Err(CoreError::param(
+            "max_disparity",
+            format!("must be >= min_disparity ({}), got {}", p.d_min, p.d_max),
+        ));
+    }
+    if p.sigmas.is_empty() {
+        return Err(CoreError::param("sigmas", "needs at least one channel"));
+    }
+    for &s in &p.sigmas {
+        if !(s.is_finite() && (0.3..=64.0).contains(&s)) {
+            return Err(CoreError::param(
+                "sigmas",
+                format!("each sigma must lie in [0.3, 64] px, got {s}"),
+            ));
+        }
+    }
+    let unit = |v: f32| v.is_finite() && (0.0..=1.0).contains(&v);
+    if !unit(p.track.high_quantile) {
+        return Err(CoreError::param("high_quantile", "must lie in [0, 1]"));
+    }
+    if !unit(p.track.low_ratio) {
+        return Err(CoreError::param("low_ratio", "must lie in [0, 1]"));
+    }
+    if !(p.track.max_turn_deg.is_finite() && p.track.max_turn_deg > 0.0) {
+        return Err(CoreError::param("max_turn_deg", "must be > 0"));
+    }
+    if p.cand.n_bins < 3 || 2 * p.cand.vote_bin_tol + 1 > p.cand.n_bins {
+        return Err(CoreError::param(
+            "n_theta_bins",
+            "needs >= 3 bins and 2 * vote_bin_tol + 1 <= n_theta_bins",
+        ));
+    }
+    if p.cand.k_cand == 0 {
+        return Err(CoreError::param("k_cand", "must be >= 1"));
+    }
+    if p.cand.dy_band < 0 {
+        return Err(CoreError::param("dy_band", "must be >= 0"));
+    }
+    if p.solver.max_sweeps == 0 {
+        return Err(CoreError::param("max_sweeps", "must be >= 1"));
+    }
+    for (name, v) in [
+        ("half_res_sigma", p.half_res_sigma),
+        ("min_len_sigmas", p.min_len_sigmas),
+        ("seg_theta_tol_deg", p.cand.seg_theta_tol_deg),
+        ("ght_min_score", p.cand.ght_min_score),
+        ("r_graph", p.r_graph),
+        ("A", p.solver.a),
+        ("B", p.solver.b),
+        ("D", p.solver.d),
+        ("theta", p.solver.theta),
+        ("dg_0", p.solver.dg_0),
+        ("dg_slope", p.solver.dg_slope),
+        ("horiz_skip_deg", p.horiz_skip_deg),
+        ("prior_radius_sigmas", p.prior_radius_sigmas),
+        ("prior_width_sigmas", p.prior_width_sigmas),
+        ("sides_mad", p.filters.sides_mad),
+        ("disc_tol", p.filters.disc_tol),
+    ] {
+        if !v.is_finite() || v < 0.0 {
+            return Err(CoreError::param(
+                name,
+                format!("must be finite and >= 0, got {v}"),
+            ));
+        }
+    }
+    let f = &p.filters;
+    if f.sides_width < 1 || f.sides_height < 1 || f.sides_gap < 0 || f.disc_dx < 0 || f.disc_dy < 0
+    {
+        return Err(CoreError::param(
+            "filters",
+            "sides_width, sides_height >= 1; sides_gap, disc_dx, disc_dy >= 0",
+        ));
+    }
+    if p.fill_radius < 0 {
+        return Err(CoreError::param("fill_radius", "must be >= 0"));
+    }
+    Ok(())
+}
+
+/// `(sigma in the channel's pixels, scale)` of nominal channel `sigma`.
+fn channel_geometry(sigma: f32, p: &McgmParams) -> (f32, usize) {
+    if sigma >= p.half_res_sigma {
+        (sigma / 2.0, 2)
+    } else {
+        (sigma, 1)
+    }
+}
+
+/// LoG, zero crossings, curves and R-tables of `img` (already at the channel's resolution).
+pub fn channel_curves(img: &Image, sigma: f32, scale: usize, p: &McgmParams) -> ChannelCurves {
+    let (w, h) = img.size();
+    let log = log::log_filter(img, sigma);
+    let zc = zero_crossings(&log, w, h);
+    let tp = TrackParams {
+        min_len: p
+            .track
+            .min_len
+            .max((p.min_len_sigmas * sigma).ceil() as usize),
+        ..p.track
+    };
+    let curves = track(&zc, &tp);
+    let rtables = curves
+        .segments
+        .iter()
+        .map(|s| build_rtable(s, &zc.theta, w, p.cand.n_bins))
+        .collect();
+    ChannelCurves {
+        sigma,
+        scale,
+        width: w,
+        height: h,
+        log,
+        zc,
+        curves,
+        rtables,
+    }
+}
+
+/// Curves of every channel of one image (the debugging / GUI view of `curves(image)`).
+pub fn image_curves(img: &Image, p: &McgmParams) -> Result<Vec<ChannelCurves>> {
+    validate_params(p)?;
+    let half = p
+        .sigmas
+        .iter()
+        .any(|&s| s >= p.half_res_sigma)
+        .then(|| log::decimate2(img));
+    Ok(p.sigmas
+        .par_iter()
+        .map(|&s| {
+            let (sig, scale) = channel_geometry(s, p);
+            let src = if scale == 2 {
+                half.as_ref().unwrap_or(img)
+            } else {
+                img
+            };
+            channel_curves(src, sig, scale, p)
+        })
+        .collect())
+}
+
+/// Fixed neighbour order of the prior spreading (ties go to the first filled neighbour).
+const SPREAD_ORDER: [(i32, i32); 8] = [
+    (0, -1),
+    (-1, 0),
+    (1, 0),
+    (0, 1),
+    (-1, -1),
+    (1, -1),
+    (-1, 1),
+    (1, 1),
+];
+
+/// Nearest-valid fill of a NaN map up to `radius` px in chessboard distance (B.4.11's
+/// distance-limited spread): `radius` synchronous 8-neighbour dilations, each new pixel taking
+/// the value of its first valid neighbour in [`SPREAD_ORDER`] from the previous step.
+pub fn spread_prior(map: &[f32], w: usize, h: usize, radius: i32) -> Vec<f32> {
+    let mut cur = map.to_vec();
+    let mut front: Vec<usize> = (0..w * h).filter(|&i| cur[i].is_finite()).collect();
+    let mut seen = vec![false; w * h];
+    for _ in 0..radius {
+        let mut next: Vec<usize> = Vec::new();
+        for &i in &front {
+            let (x, y) = ((i % w) as i32, (i / w) as i32);
+            for &(dx, dy) in &SPREAD_ORDER {
+                let (nx, ny) = (x + dx, y + dy);
+                if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
+                    continue;
+                }
+                let q = ny as usize * w + nx as usize;
+                if !cur[q].is_finite() && !seen[q] {
+                    seen[q] = true;
+                    next.push(q);
+                }
+            }
+        }
+        // Values from the previous step only (synchronous update).
+        let vals: Vec<f32> = next
+            .iter()
+            .map(|&q| {
+                let (x, y) = ((q % w) as i32, (q / w) as i32);
+                SPREAD_ORDER
+                    .iter()
+                    .filter_map(|&(dx, dy)| {
+                        let (nx, ny) = (x + dx, y + dy);
+                        (nx >= 0 && ny >= 0 && nx < w as i32 && ny < h as i32)
+                            .then(|| cur[ny as usize * w + nx as usize])
+                    })
+                    .find(|v| v.is_finite())
+                    .unwrap_or(f32::NAN)
+            })
+            .collect();
+        for (&q, v) in next.iter().zip(vals) {
+            cur[q] = v;
+        }
+        if next.is_empty() {
+            break;
+        }
+        front = next;
+    }
+    cur
+}
+
+/// Median (lower of the two middle values for even counts: a value that exists).
+fn median_lower(v: &mut [f32]) -> Option<f32> {
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f32::total_cmp);
+    Some(v[(v.len() - 1) / 2])
+}
+
+/// Disparity windows of the left segments of a channel from the spread prior map
+/// (full-resolution disparities, NaN = none): the median of the prior over the segment's pixels,
+/// `+- width` channel px around it; the full range without a prior.
+fn windows(
+    cc: &ChannelCurves,
+    prior: Option<&[f32]>,
+    fw: usize,
+    width: f32,
+    lo_c: i32,
+    hi_c: i32,
+) -> Vec<Option<(i32, i32)>> {
+    let full = Some((lo_c, hi_c)).filter(|w| w.0 <= w.1);
+    let Some(prior) = prior else {
+        return vec![full; cc.curves.segments.len()];
+    };
+    let s = cc.scale as f32;
+    let w = cc.width;
+    let fh = prior.len() / fw.max(1);
+    cc.curves
+        .segments
+        .par_iter()
+        .map(|seg| {
+            let mut vals: Vec<f32> = Vec::with_capacity(seg.pixels.len());
+            for &i in &seg.pixels {
+                let (x, y) = ((i as usize % w) as f32, (i as usize / w) as f32);
+                // Channel pixel centre in full-resolution coordinates.
+                let fx = ((s * x + 0.5 * (s - 1.0)).round() as usize).min(fw - 1);
+                let fy = ((s * y + 0.5 * (s - 1.0)).round() as usize).min(fh - 1);
+                let v = prior[fy * fw + fx];
+                if v.is_finite() {
+                    vals.push(v / s);
+                }
+            }
+            match median_lower(&mut vals) {
+                None => full,
+                Some(d) => {
+                    let lo = ((d - width).floor() as i32).max(lo_c);
+                    let hi = ((d + width).ceil() as i32).min(hi_c);
+                    (lo <= hi).then_some((lo, hi))
+                }
+            }
+        })
+        .collect()
+}
+
+/// Per-pixel correspondences along the chosen pairs (B.4.12), in full-resolution coordinates.
+fn decompose(
+    l: &ChannelCurves,
+    r: &ChannelCurves,
+    cands: &[Candidate],
+    chosen: &[usize],
+    horiz_skip_deg: f32,
+    channel: u8,
+) -> Vec<Match> {
+    let (w, h) = (l.width, l.height);
+    let min_cos = (horiz_skip_deg as f64).to_radians().sin();
+    let half = 0.5 * CHANNEL_WIDTH_SIGMAS * l.sigma;
+    let s = l.scale as f32;
+    let to_full = |v: f32| s * v + 0.5 * (s - 1.0);
+    let per: Vec<Vec<Match>> = chosen
+        .par_iter()
+        .map(|&ci| {
+            let c = &cands[ci];
+            let seg = &l.curves.segments[c.left as usize];
+            let mut out = Vec::new();
+            for &i in &seg.pixels {
+                let i = i as usize;
+                if (l.zc.theta[i] as f64).cos().abs() < min_cos {
+                    continue; // near-horizontal tangent: x-disparity ill-defined
+                }
+                let (x, y) = (i % w, i / w);
+                let xp = l.zc.xsub[i];
+                let target = xp - c.tx;
+                let yq = y as i32; // rectified input: the same row (B.4.12)
+                if yq < 0 || yq >= h as i32 {
+                    continue;
+                }
+                let x0 = ((target - half).floor() as i32).max(0);
+                let x1 = ((target + half).ceil() as i32).min(w as i32 - 1);
+                let mut best: Option<(f32, usize)> = None;
+                for xq in x0..=x1 {
+                    let q = yq as usize * w + xq as usize;
+                    if r.curves.labels[q] != c.right as i32 {
+                        continue;
+                    }
+                    let dist = (r.zc.xsub[q] - target).abs();
+                    if dist <= half && best.is_none_or(|b| dist < b.0) {
+                        best = Some((dist, q));
+                    }
+                }
+                let _ = x;
+                if let Some((_, q)) = best {
+                    out.push(Match {
+                        xl: to_full(xp),
+                        yl: to_full(y as f32),
+                        xr: to_full(r.zc.xsub[q]),
+                        yr: to_full(yq as f32),
+                        score: c.score,
+                        channel,
+                    });
+                }
+            }
+            out
+        })
+        .collect();
+    per.into_iter().flatten().collect()
+}
+
+/// Linear interpolation of row `y` of `img` at column `x` (caller keeps `0 <= x <= w - 1`).
+#[inline]
+fn sample(img: &Image, x: f32, y: usize) -> f32 {
+    let x0 = (x.floor() as usize).min(img.width - 1);
+    let x1 = (x0 + 1).min(img.width - 1);
+    let f = x - x0 as f32;
+    let row = &img.data[y * img.width..(y + 1) * img.width];
+    row[x0] + f * (row[x1] - row[x0])
+}
+
+/// Mean absolute difference of one half-window (columns `xi + side * (inner..=outer)`, rows
+/// `yl +- hh`) against the right image shifted by `d` (linear interpolation along x). With
+/// `mean_free` the two windows' mean grey levels are removed first: insensitive to an exposure
+/// offset between the cameras (ETH3D), still sensitive to different content.
+#[allow(clippy::too_many_arguments)]
+fn half_mad(
+    left: &Image,
+    right: &Image,
+    xi: i32,
+    yl: i32,
+    yr: i32,
+    d: f32,
+    side: i32,
+    (inner, outer, hh): (i32, i32, i32),
+    mean_free: bool,
+) -> f32 {
+    let n = ((outer - inner + 1) * (2 * hh + 1)) as f32;
+    let mut offset = 0.0f32;
+    if mean_free {
+        for dy in -hh..=hh {
+            let (ly, ry) = ((yl + dy) as usize, (yr + dy) as usize);
+            for k in inner..=outer {
+                let x = xi + side * k;
+                offset += left.at(x as usize, ly) - sample(right, x as f32 - d, ry);
+            }
+        }
+        offset /= n;
+    }
+    let mut sad = 0.0f32;
+    for dy in -hh..=hh {
+        let (ly, ry) = ((yl + dy) as usize, (yr + dy) as usize);
+        for k in inner..=outer {
+            let x = xi + side * k;
+            sad += (left.at(x as usize, ly) - sample(right, x as f32 - d, ry) - offset).abs();
+        }
+    }
+    sad / n
+}
+
+/// Whether a half-window matches better (mean absolute difference + `sides_best_margin` below
+/// `here`) at another disparity `d + k`, `k` integer in `ks` with `|k| > 1`. Integer steps keep
+/// the interpolation weights of `d` (right samples `r[b - k] + f (r[b - k + 1] - r[b - k])`
+/// with `b = floor(x - d)`, `f = x - d - b`), so every `k` is compared fairly with `here`; the
+/// differences are laid out with `k` innermost (contiguous, vectorised) and summed in the
+/// window's raster order.
+#[allow(clippy::too_many_arguments)]
+fn other_disparity_better(
+    left: &Image,
+    right: &Image,
+    xi: i32,
+    yl: i32,
+    yr: i32,
+    d: f32,
+    side: i32,
+    (inner, outer, hh): (i32, i32, i32),
+    f: &FilterParams,
+    ks: (i32, i32),
+    here: f32,
+) -> bool {
+    let w = right.width as i32;
+    // Window columns and their interpolation bases.
+    let cols: Vec<i32> = (inner..=outer).map(|k| xi + side * k).collect();
+    let base: Vec<(i32, f32)> = cols
+        .iter()
+        .map(|&x| {
+            let pos = x as f32 - d;
+            let b = pos.floor();
+            (b as i32, pos - b)
+        })
+        .collect();
+    let b_min = base.iter().map(|b| b.0).min().unwrap_or(0);
+    let b_max = base.iter().map(|b| b.0).max().unwrap_or(0);
+    // Every sample r[b - k], r[b - k + 1] must lie inside the row.
+    let k_hi = ks.1.min(b_min);
+    let k_lo = ks.0.max(b_max + 2 - w);
+    // k descending: the right samples of one window pixel are then ascending in memory.
+    let kk: Vec<i32> = (k_lo..=k_hi).rev().filter(|k| k.abs() > 1).collect();
+    if kk.is_empty() {
+        return false;
+    }
+    let nk = kk.len();
+    let n_el = cols.len() * (2 * hh + 1) as usize;
+    let mut diffs = vec![0.0f32; n_el * nk];
+    let mut off = vec![0.0f32; nk];
+    let mut e = 0;
+    for dy in -hh..=hh {
+        let lrow = &left.data[(yl + dy) as usize * left.width..][..left.width];
+        let rrow = &right.data[(yr + dy) as usize * right.width..][..right.width];
+        for (c, &x) in cols.iter().enumerate() {
+            let lv = lrow[x as usize];
+            let (b, fr) = base[c];
+            let out = &mut diffs[e * nk..(e + 1) * nk];
+            for (o, &k) in out.iter_mut().zip(&kk) {
+                let i = (b - k) as usize;
+                let a = rrow[i];
+                *o = lv - (a + fr * (rrow[i + 1] - a));
+            }
+            if f.sides_mean_free {
+                for (s, &o) in off.iter_mut().zip(out.iter()) {
+                    *s += o;
+                }
+            }
+            e += 1;
+        }
+    }
+    let n = n_el as f32;
+    if f.sides_mean_free {
+        for s in off.iter_mut() {
+            *s /= n;
+        }
+    }
+    let mut sad = vec![0.0f32; nk];
+    for e in 0..n_el {
+        for ((s, &o), &m) in sad.iter_mut().zip(&diffs[e * nk..(e + 1) * nk]).zip(&off) {
+            *s += (o - m).abs();
+        }
+    }
+    sad.iter().any(|&s| s / n + f.sides_best_margin < here)
+}
+
+/// Both-sides check of one match: the half-windows left and right of the edge agree between
+/// the images (mean absolute grey difference <= `sides_mad` on both sides) and, with
+/// `sides_best`, neither half-window prefers another disparity of `range` (> 1 px away).
+fn sides_ok(left: &Image, right: &Image, m: &Match, f: &FilterParams, range: (i32, i32)) -> bool {
+    let (w, h) = (left.width as i32, left.height as i32);
+    let xi = m.xl.round() as i32;
+    let (yl, yr) = (m.yl.round() as i32, m.yr.round() as i32);
+    let d = m.xl - m.xr;
+    let hh = f.sides_height / 2;
+    if yl - hh < 0 || yr - hh < 0 || yl + hh >= h || yr + hh >= h {
+        return false;
+    }
+    let inner = f.sides_gap + 1;
+    let outer = f.sides_gap + f.sides_width;
+    if xi - outer < 0 || xi + outer >= w {
+        return false;
+    }
+    let fits =
+        |dd: f32| (xi - outer) as f32 - dd >= 0.0 && (xi + outer) as f32 - dd <= (w - 1) as f32;
+    if !fits(d) {
+        return false;
+    }
+    let geom = (inner, outer, hh);
+    for side in [-1i32, 1] {
+        let here = half_mad(left, right, xi, yl, yr, d, side, geom, f.sides_mean_free);
+        if here > f.sides_mad {
+            return false;
+        }
+        if f.sides_best {
+            let (k0, k1) = (
+                (range.0 as f32 - d).ceil() as i32,
+                (range.1 as f32 - d).floor() as i32,
+            );
+            if other_disparity_better(left, right, xi, yl, yr, d, side, geom, f, (k0, k1), here) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+/// B.8's two occlusion-boundary filters on a match list (also applied to the ZNCC reference):
+/// the both-sides check, then the discontinuity filter among its survivors (drop a match if
+/// another one within `+- disc_dx` columns and `+- disc_dy` rows differs by more than
+/// `disc_tol` px). `range` is the searched disparity range (`sides_best`). Returns the kept
+/// flags and the count after the first filter.
+pub fn edge_filters(
+    left: &Image,
+    right: &Image,
+    matches: &[Match],
+    f: &FilterParams,
+    range: (i32, i32),
+) -> Result<(Vec<bool>, usize)> {
+    check_pair(left, right)?;
+    let (w, h) = left.size();
+    let mut keep: Vec<bool> = matches
+        .par_iter()
+        .map(|m| {
+            m.xl.is_finite()
+                && m.xr.is_finite()
+                && m.yl.is_finite()
+                && m.yr.is_finite()
+                && (!f.sides || sides_ok(left, right, m, f, range))
+        })
+        .collect();
+    let n_sides = keep.iter().filter(|&&k| k).count();
+    if f.disc {
+        // Survivors bucketed by rounded left pixel (counting sort: several per pixel possible).
+        let pos = |m: &Match| -> Option<(i32, i32)> {
+            let (x, y) = (m.xl.round() as i32, m.yl.round() as i32);
+            (x >= 0 && y >= 0 && x < w as i32 && y < h as i32).then_some((x, y))
+        };
+        let cell: Vec<Option<usize>> = matches
+            .iter()
+            .zip(&keep)
+            .map(|(m, &k)| if k { pos(m) } else { None })
+            .map(|o| o.map(|(x, y)| y as usize * w + x as usize))
+            .collect();
+        let mut start = vec![0u32; w * h + 1];
+        for c in cell.iter().flatten() {
+            start[c + 1] += 1;
+        }
+        for i in 1..start.len() {
+            start[i] += start[i - 1];
+        }
+        let mut fill = start.clone();
+        let mut items = vec![0u32; start[w * h] as usize];
+        for (i, c) in cell.iter().enumerate() {
+            if let Some(c) = *c {
+                items[fill[c] as usize] = i as u32;
+                fill[c] += 1;
+            }
+        }
+        let bucket = |c: usize| &items[start[c] as usize..start[c + 1] as usize];
+        let drop: Vec<bool> = matches
+            .par_iter()
+            .enumerate()
+            .map(|(i, m)| {
+                if !keep[i] {
+                    return false;
+                }
+                let Some((x, y)) = pos(m) else {
+                    return true;
+                };
+                let d = m.xl - m.xr;
+                for yy in (y - f.disc_dy).max(0)..=(y + f.disc_dy).min(h as i32 - 1) {
+                    for xx in (x - f.disc_dx).max(0)..=(x + f.disc_dx).min(w as i32 - 1) {
+                        for &j in bucket(yy as usize * w + xx as usize) {
+                            let o = &matches[j as usize];
+                            if j as usize != i && ((o.xl - o.xr) - d).abs() > f.disc_tol {
+                                return true;
+                            }
+                        }
+                    }
+                }
+                false
+            })
+            .collect();
+        for (k, d) in keep.iter_mut().zip(drop) {
+            *k &= !d;
+        }
+    }
+    Ok((keep, n_sides))
+}
+
+/// The MCGM channel end to end (see the module docs).
+pub fn mcgm_match(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOutput> {
+    check_pair(left, right)?;
+    validate_params(p)?;
+    let (fw, fh) = left.size();
+    let (cl, cr) = rayon::join(|| image_curves(left, p), || image_curves(right, p));
+    let (cl, cr) = (cl?, cr?);
+    let mut prior: Option<Vec<f32>> = None;
+    let mut channels: Vec<ChannelResult> = Vec::with_capacity(p.sigmas.len());
+    for (ci, (l, r)) in cl.iter().zip(&cr).enumerate() {
+        let s = l.scale as f32;
+        let lo_c = (p.d_min as f32 / s).floor() as i32;
+        let hi_c = (p.d_max as f32 / s).ceil() as i32;
+        let radius = if ci > 0 {
+            (p.prior_radius_sigmas * p.sigmas[ci - 1]).ceil() as i32
+        } else {
+            0
+        };
+        let spread = prior.as_deref().map(|m| spread_prior(m, fw, fh, radius));
+        let win = windows(
+            l,
+            spread.as_deref(),
+            fw,
+            p.prior_width_sigmas * l.sigma,
+            lo_c,
+            hi_c,
+        );
+        let cands = candidates(
+            &l.curves.segments,
+            &l.rtables,
+            &r.curves.segments,
+            &r.zc.theta,
+            l.width,
+            l.height,
+            &win,
+            &p.cand,
+        );
+        let adj = knn_graph(&l.curves.segments, p.knn, p.r_graph / s);
+        let csr = association_weights(
+            &cands,
+            &l.curves.segments,
+            &adj,
+            r.curves.segments.len(),
+            &p.solver,
+        );
+        let sol = solve(&cands, &csr, l.curves.segments.len(), &p.solver);
+        let matches = decompose(l, r, &cands, &sol.chosen, p.horiz_skip_deg, ci as u8);
+        // Prior for the finer channels: this channel's disparities over the coarser ones'.
+        let map = prior.get_or_insert_with(|| vec![f32::NAN; fw * fh]);
+        for m in &matches {
+            let (x, y) = (m.xl.round() as i64, m.yl.round() as i64);
+            if x >= 0 && y >= 0 && (x as usize) < fw && (y as usize) < fh {
+                map[y as usize * fw + x as usize] = m.xl - m.xr;
+            }
+        }
+        let edges = adj
+            .iter()
+            .enumerate()
+            .flat_map(|(i, nb)| {
+                nb.iter()
+                    .filter(move |&&j| (j as usize) > i)
+                    .map(move |&j| (i as u32, j))
+            })
+            .collect();
+        channels.push(ChannelResult {
+            sigma: l.sigma,
+            scale: l.scale,
+            n_left: l.curves.segments.len(),
+            n_right: r.curves.segments.len(),
+            windows: win,
+            candidates: cands,
+            state: sol.state,
+            chosen: sol.chosen,
+            edges,
+            n_weights: sol.n_weights,
+            sweeps: sol.sweeps,
+            converged: sol.converged,
+            matches,
+        });
+    }
+    // Combination: finest full-resolution channel first; coarser ones fill empty places.
+    let mut taken = vec![false; fw * fh];
+    let mut combined: Vec<Match> = Vec::new();
+    for ch in channels.iter().rev().filter(|c| c.scale == 1) {
+        let mut mine: Vec<(usize, usize)> = Vec::new();
+        for m in &ch.matches {
+            let (x, y) = (m.xl.round() as i32, m.yl.round() as i32);
+            if x < 0 || y < 0 || x >= fw as i32 || y >= fh as i32 {
+                continue;
+            }
+            let row = y as usize * fw;
+            let x0 = (x - p.fill_radius).max(0) as usize;
+            let x1 = (x + p.fill_radius).min(fw as i32 - 1) as usize;
+            if (x0..=x1).any(|xx| taken[row + xx]) {
+                continue;
+            }
+            combined.push(*m);
+            mine.push((row, x as usize));
+        }
+        for (row, x) in mine {
+            taken[row + x] = true;
+        }
+    }
+    let (keep, n_sides) = edge_filters(
+        left,
+        right,
+        &combined,
+        &p.filters,
+        (p.d_min as i32, p.d_max as i32),
+    )?;
+    let n_combined = combined.len();
+    let matches = combined
+        .into_iter()
+        .zip(keep)
+        .filter_map(|(m, k)| k.then_some(m))
+        .collect();
+    Ok(McgmOutput {
+        matches,
+        channels,
+        n_combined,
+        n_sides,
+    })
+}

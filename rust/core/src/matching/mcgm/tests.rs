@@ -1,0 +1,207 @@
+//! Unit tests of the MCGM channel: kernel properties, one-pixel-thick crossings, tracking of a
+//! synthetic contour, GHT of a translated contour, and the sign and magnitude of a known
+//! sub-pixel shift end to end.
+
+use super::log::{log_filter, log_kernels};
+use super::rtable::{build_rtable, ght_vote};
+use super::tracking::track;
+use super::zerocross::{zero_crossings, ZC_H};
+use super::*;
+
+/// Smooth blob texture evaluated at `x + shift`: `right = blobs(shift)` gives `x_l - x_r = shift`.
+fn blobs(w: usize, h: usize, shift: f32) -> Image {
+    let mut s: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut next = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 40) as f32) / (1u64 << 24) as f32
+    };
+    let n = (w * h) / 150;
+    let blobs: Vec<(f32, f32, f32, f32)> = (0..n)
+        .map(|_| {
+            (
+                next() * (w as f32 + 40.0) - 20.0,
+                next() * h as f32,
+                2.0 + 4.0 * next(),
+                next() - 0.5,
+            )
+        })
+        .collect();
+    let mut data = vec![0.5f32; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let xs = x as f32 + shift;
+            let mut v = 0.5;
+            for &(cx, cy, r, a) in &blobs {
+                let d2 = (xs - cx).powi(2) + (y as f32 - cy).powi(2);
+                if d2 < 16.0 * r * r {
+                    v += 0.5 * a * (-d2 / (2.0 * r * r)).exp();
+                }
+            }
+            data[y * w + x] = v.clamp(0.0, 1.0);
+        }
+    }
+    Image::new(w, h, data).expect("valid image")
+}
+
+#[test]
+fn log_kernel_sums_to_zero_and_flat_images_give_nothing() {
+    for sigma in [1.0f32, 2.0, 4.0] {
+        let (g, a) = log_kernels(sigma);
+        let (sg, sa): (f64, f64) = (
+            g.iter().map(|&v| v as f64).sum(),
+            a.iter().map(|&v| v as f64).sum(),
+        );
+        assert!(
+            (2.0 * sa * sg).abs() < 1e-6,
+            "sigma {sigma}: sum K = {}",
+            2.0 * sa * sg
+        );
+        assert_eq!(g.len(), 2 * (4.0 * sigma).ceil() as usize + 1);
+    }
+    let flat = Image::filled(40, 30, 0.8);
+    let l = log_filter(&flat, 2.0);
+    assert!(l.iter().all(|v| v.abs() < 1e-5));
+    let out = mcgm_match(&flat, &flat, &McgmParams::default()).expect("valid input");
+    assert!(out.matches.is_empty());
+}
+
+#[test]
+fn step_edge_gives_one_pixel_thick_crossing_at_the_edge() {
+    // Vertical step between columns 19 and 20: the crossing lies at x = 19.5.
+    let (w, h) = (40, 20);
+    let data: Vec<f32> = (0..w * h)
+        .map(|i| if i % w >= 20 { 0.8 } else { 0.2 })
+        .collect();
+    let img = Image::new(w, h, data).expect("valid image");
+    let l = log_filter(&img, 1.0);
+    let zc = zero_crossings(&l, w, h);
+    let smax = zc.strength.iter().copied().fold(0.0f32, f32::max);
+    for y in 2..h - 2 {
+        // The truncated kernel's far tails add crossings of negligible strength.
+        let xs: Vec<usize> = (0..w)
+            .filter(|&x| zc.mark[y * w + x] & ZC_H != 0 && zc.strength[y * w + x] > 0.1 * smax)
+            .collect();
+        assert_eq!(xs.len(), 1, "row {y}: {xs:?}");
+        let i = y * w + xs[0];
+        assert!((zc.xsub[i] - 19.5).abs() < 1e-3, "xsub {}", zc.xsub[i]);
+        // Dark to light along +x: the LoG goes from + to - so its gradient points to -x.
+        assert!((zc.theta[i] - std::f32::consts::PI).abs() < 1e-3);
+    }
+    let curves = track(
+        &zc,
+        &tracking::TrackParams {
+            min_len: 8,
+            ..McgmParams::default().track
+        },
+    );
+    // Interior rows only are marked; one straight segment covers them all.
+    let long: Vec<_> = curves
+        .segments
+        .iter()
+        .filter(|s| s.x_min == s.x_max)
+        .collect();
+    assert!(long
+        .iter()
+        .any(|s| s.pixels.len() == h - 2 && (19..=20).contains(&s.x_min)));
+}
+
+#[test]
+fn ght_of_a_translated_contour_scores_one_at_the_translation() {
+    let (w, h) = (120, 80);
+    let l = blobs(w, h, 0.0);
+    let p = McgmParams::default();
+    let cl = channel_curves(&l, 2.0, 1, &p);
+    // The right contour is the left one moved by (-7, 0): its pixels q = p - (7, 0).
+    let seg = cl
+        .curves
+        .segments
+        .iter()
+        .find(|s| s.pixels.len() >= 20 && s.x_min > 10)
+        .expect("a long segment");
+    let rt = build_rtable(seg, &cl.zc.theta, w, p.cand.n_bins);
+    let moved: Vec<u32> = seg.pixels.iter().map(|&i| i - 7).collect();
+    let mut theta = cl.zc.theta.clone();
+    for (&i, &j) in seg.pixels.iter().zip(&moved) {
+        theta[j as usize] = cl.zc.theta[i as usize];
+    }
+    let mut acc = Vec::new();
+    let g = ght_vote(
+        &rt,
+        seg.pixels.len(),
+        &moved,
+        &theta,
+        w,
+        0,
+        20,
+        1,
+        36,
+        1,
+        &mut acc,
+    )
+    .expect("votes");
+    assert_eq!(g.score, 1.0);
+    assert_eq!(g.peak as usize, seg.pixels.len());
+    // The 3x3 centroid is pulled a little by coincidental votes of other pixel pairs.
+    assert!((g.tx - 7.0).abs() < 0.5 && g.ty.abs() < 0.5, "{g:?}");
+    let _ = h;
+}
+
+#[test]
+fn known_subpixel_shift_sign_and_magnitude() {
+    for d in [2.3f32, 5.6] {
+        let l = blobs(200, 150, 0.0);
+        let r = blobs(200, 150, d); // right(x) = left(x + d): x_l - x_r = +d
+        let p = McgmParams {
+            d_max: 16,
+            ..McgmParams::default()
+        };
+        let out = mcgm_match(&l, &r, &p).expect("valid input");
+        assert!(out.matches.len() > 300, "{} matches", out.matches.len());
+        let mut disp: Vec<f32> = out.matches.iter().map(|m| m.xl - m.xr).collect();
+        disp.sort_by(f32::total_cmp);
+        let med = disp[disp.len() / 2];
+        assert!((med - d).abs() < 0.05, "d {d}: median {med}");
+        let good = disp.iter().filter(|&&v| (v - d).abs() < 0.25).count();
+        assert!(good as f32 > 0.95 * disp.len() as f32);
+        assert!(out.matches.iter().all(|m| m.yl == m.yr));
+    }
+}
+
+#[test]
+fn bad_parameters_are_errors_not_panics() {
+    let img = blobs(40, 30, 0.0);
+    let bad = [
+        McgmParams {
+            d_min: 5,
+            d_max: 2,
+            ..McgmParams::default()
+        },
+        McgmParams {
+            sigmas: vec![],
+            ..McgmParams::default()
+        },
+        McgmParams {
+            sigmas: vec![f32::NAN],
+            ..McgmParams::default()
+        },
+    ];
+    for p in bad {
+        assert!(matches!(
+            mcgm_match(&img, &img, &p),
+            Err(CoreError::InvalidParameter { .. })
+        ));
+    }
+    let other = blobs(41, 30, 0.0);
+    assert!(matches!(
+        mcgm_match(&img, &other, &McgmParams::default()),
+        Err(CoreError::SizeMismatch { .. })
+    ));
+    // Tiny images: no crossings, no matches, no panic.
+    let tiny = Image::filled(2, 2, 0.3);
+    assert!(mcgm_match(&tiny, &tiny, &McgmParams::default())
+        .expect("valid")
+        .matches
+        .is_empty());
+}

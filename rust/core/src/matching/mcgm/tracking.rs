@@ -1,0 +1,221 @@
+//! Hysteresis curve tracking of zero crossings into labelled segments (algorithms.md B.4 steps
+//! 4-5 with B.8's readings: `t_high` a percentile of the strengths, steps only into the forward
+//! half-plane, the tangent sign that agrees with the previous step).
+
+use std::f64::consts::{PI, TAU};
+
+use super::zerocross::ZeroCrossings;
+
+/// 8-neighbour offsets in the fixed scan order that breaks exact ties.
+const NEIGHBOURS: [(i32, i32); 8] = [
+    (-1, -1),
+    (0, -1),
+    (1, -1),
+    (-1, 0),
+    (1, 0),
+    (-1, 1),
+    (0, 1),
+    (1, 1),
+];
+
+/// Tracking thresholds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrackParams {
+    /// Seed threshold as a quantile of the marked pixels' strengths (B.8: 0.5).
+    pub high_quantile: f32,
+    /// Continuation threshold as a fraction of the seed threshold (B.2: 0.4).
+    pub low_ratio: f32,
+    /// Largest change of the normal direction between consecutive pixels (degrees; B.8: 60).
+    pub max_turn_deg: f32,
+    /// Shortest kept segment (pixels).
+    pub min_len: usize,
+}
+
+/// One tracked curve segment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Segment {
+    /// Pixel indices `y * w + x`, ordered along the curve.
+    pub pixels: Vec<u32>,
+    /// Mean of the integer pixel positions `(x, y)`.
+    pub centroid: (f32, f32),
+    pub x_min: i32,
+    pub x_max: i32,
+    pub y_min: i32,
+    pub y_max: i32,
+    /// Circular mean of the normal directions, `[0, 2 pi)`.
+    pub mean_theta: f32,
+}
+
+/// Segments and the label map of one image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Curves {
+    pub segments: Vec<Segment>,
+    /// Segment id per pixel, -1 = none.
+    pub labels: Vec<i32>,
+    /// The thresholds used (`t_high`, `t_low`).
+    pub t_high: f32,
+    pub t_low: f32,
+}
+
+/// A difference of two angles in `[0, 2 pi)` wrapped to `(-pi, pi]` (no `fmod`: hot loop).
+#[inline]
+pub fn wrap_angle(d: f64) -> f64 {
+    let mut d = d;
+    if d > PI {
+        d -= TAU;
+    } else if d <= -PI {
+        d += TAU;
+    }
+    d
+}
+
+/// Seed threshold: the `q` quantile ("lower": sorted value at `floor(q (n - 1))`) of the
+/// strengths of marked pixels; 0 when nothing is marked.
+pub fn high_threshold(zc: &ZeroCrossings, q: f32) -> f32 {
+    let mut s: Vec<f32> = zc.marked().map(|i| zc.strength[i]).collect();
+    if s.is_empty() {
+        return 0.0;
+    }
+    let k = (((q as f64) * (s.len() - 1) as f64).floor() as usize).min(s.len() - 1);
+    *s.select_nth_unstable_by(k, f32::total_cmp).1
+}
+
+fn tangent(theta: f32) -> (f64, f64) {
+    let t = theta as f64;
+    (-t.sin(), t.cos())
+}
+
+/// Tracks the crossings into segments.
+pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
+    let (w, h) = (zc.width, zc.height);
+    let n = w * h;
+    let t_high = high_threshold(zc, p.high_quantile);
+    let t_low = p.low_ratio * t_high;
+    let cand: Vec<bool> = (0..n)
+        .map(|i| zc.mark[i] != 0 && zc.strength[i] >= t_low && zc.strength[i] > 0.0)
+        .collect();
+    let mut seeds: Vec<u32> = (0..n)
+        .filter(|&i| cand[i] && zc.strength[i] >= t_high)
+        .map(|i| i as u32)
+        .collect();
+    seeds.sort_unstable_by(|&a, &b| {
+        zc.strength[b as usize]
+            .total_cmp(&zc.strength[a as usize])
+            .then(a.cmp(&b))
+    });
+    let max_turn = (p.max_turn_deg as f64).to_radians();
+    // Unit tangents of the candidates, computed once (the walk visits each pixel's 8 neighbours).
+    let tan: Vec<(f64, f64)> = (0..n)
+        .map(|i| {
+            if cand[i] {
+                tangent(zc.theta[i])
+            } else {
+                (0.0, 0.0)
+            }
+        })
+        .collect();
+    let mut visited = vec![false; n];
+    let mut labels = vec![-1i32; n];
+    let mut segments = Vec::new();
+    let grow = |start: usize, sign: f64, visited: &mut Vec<bool>, out: &mut Vec<u32>| {
+        let mut cur = start;
+        let (tx, ty) = tan[start];
+        let mut dir = (sign * tx, sign * ty);
+        loop {
+            let (cx, cy) = ((cur % w) as i32, (cur / w) as i32);
+            let tc = zc.theta[cur] as f64;
+            let mut best: Option<(f64, f32, usize, (i32, i32))> = None;
+            for &(dx, dy) in &NEIGHBOURS {
+                let (nx, ny) = (cx + dx, cy + dy);
+                if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
+                    continue;
+                }
+                let q = ny as usize * w + nx as usize;
+                if !cand[q] || visited[q] {
+                    continue;
+                }
+                if wrap_angle(zc.theta[q] as f64 - tc).abs() >= max_turn {
+                    continue;
+                }
+                let len = ((dx * dx + dy * dy) as f64).sqrt();
+                let dot = (dx as f64 * dir.0 + dy as f64 * dir.1) / len;
+                if dot <= 0.0 {
+                    continue; // forward half-plane only
+                }
+                let s = zc.strength[q];
+                if best.is_none_or(|b| dot > b.0 || (dot == b.0 && s > b.1)) {
+                    best = Some((dot, s, q, (dx, dy)));
+                }
+            }
+            let Some((_, _, q, (dx, dy))) = best else {
+                break;
+            };
+            visited[q] = true;
+            out.push(q as u32);
+            let (tx, ty) = tan[q];
+            let sgn = if tx * dx as f64 + ty * dy as f64 >= 0.0 {
+                1.0
+            } else {
+                -1.0
+            };
+            dir = (sgn * tx, sgn * ty);
+            cur = q;
+        }
+    };
+    for &s in &seeds {
+        let s = s as usize;
+        if visited[s] {
+            continue;
+        }
+        visited[s] = true;
+        let mut fwd = Vec::new();
+        let mut bwd = Vec::new();
+        grow(s, 1.0, &mut visited, &mut fwd);
+        grow(s, -1.0, &mut visited, &mut bwd);
+        if 1 + fwd.len() + bwd.len() < p.min_len {
+            continue;
+        }
+        let mut pixels: Vec<u32> = bwd.into_iter().rev().collect();
+        pixels.push(s as u32);
+        pixels.extend(fwd);
+        let id = segments.len() as i32;
+        segments.push(make_segment(zc, pixels, &mut labels, id));
+    }
+    Curves {
+        segments,
+        labels,
+        t_high,
+        t_low,
+    }
+}
+
+fn make_segment(zc: &ZeroCrossings, pixels: Vec<u32>, labels: &mut [i32], id: i32) -> Segment {
+    let w = zc.width;
+    let (mut sx, mut sy, mut sc, mut ss) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut x_min, mut x_max, mut y_min, mut y_max) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
+    for &i in &pixels {
+        let i = i as usize;
+        labels[i] = id;
+        let (x, y) = ((i % w) as i32, (i / w) as i32);
+        sx += x as f64;
+        sy += y as f64;
+        let t = zc.theta[i] as f64;
+        sc += t.cos();
+        ss += t.sin();
+        x_min = x_min.min(x);
+        x_max = x_max.max(x);
+        y_min = y_min.min(y);
+        y_max = y_max.max(y);
+    }
+    let k = pixels.len() as f64;
+    let m = ss.atan2(sc);
+    Segment {
+        centroid: ((sx / k) as f32, (sy / k) as f32),
+        x_min,
+        x_max,
+        y_min,
+        y_max,
+        mean_theta: (if m < 0.0 { m + TAU } else { m }) as f32 % std::f32::consts::TAU,
+        pixels,
+    }
+}

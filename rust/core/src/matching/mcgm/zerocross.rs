@@ -1,0 +1,139 @@
+//! Zero crossings of the LoG response, one pixel thick, with sub-pixel x, strength and
+//! orientation (algorithms.md B.4 steps 2-3, B.8's reading for vertical-only marks).
+
+use std::f32::consts::TAU;
+
+/// Mark bit: the pixel holds a crossing found by the horizontal scan (along x).
+pub const ZC_H: u8 = 1;
+/// Mark bit: the pixel holds a crossing found by the vertical scan (along y).
+pub const ZC_V: u8 = 2;
+/// Crossings with `|grad L|` below this are dropped: in flat areas the sign of `L` is float
+/// rounding noise (gradients ~1e-7), while one 8-bit grey step already gives ~1e-4. Without the
+/// floor, thousands of phantom crossings would set the strength percentile (`t_high`) and make
+/// the marks depend on the summation order of the filter.
+pub const MIN_STRENGTH: f32 = 1e-5;
+/// Largest Newton step `-L / L_x` accepted for a vertical-only mark (px): further than one pixel
+/// the linear model of `L` is not trusted and the pixel centre is kept.
+const MAX_NEWTON_STEP: f32 = 1.0;
+
+/// Zero-crossing maps of one LoG response (row-major, `w * h`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ZeroCrossings {
+    pub width: usize,
+    pub height: usize,
+    /// `ZC_H | ZC_V` bits, 0 = no crossing.
+    pub mark: Vec<u8>,
+    /// Sub-pixel x of the crossing (absolute column), NaN where unmarked.
+    pub xsub: Vec<f32>,
+    /// `|grad L|` by central differences at marked pixels, 0 elsewhere.
+    pub strength: Vec<f32>,
+    /// Normal direction `atan2(L_y, L_x)` in `[0, 2 pi)` at marked pixels (polarity kept), 0 else.
+    pub theta: Vec<f32>,
+}
+
+impl ZeroCrossings {
+    /// Indices of the marked pixels, raster order.
+    pub fn marked(&self) -> impl Iterator<Item = usize> + '_ {
+        self.mark
+            .iter()
+            .enumerate()
+            .filter(|(_, &m)| m != 0)
+            .map(|(i, _)| i)
+    }
+}
+
+/// Finds the crossings of `l` (`w x h`). Only interior pixels (1 px from the border) are marked,
+/// so the central differences are always defined.
+pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
+    let n = w * h;
+    let mut mark = vec![0u8; n];
+    let mut xsub = vec![f32::NAN; n];
+    let inside = |x: usize, y: usize| x >= 1 && y >= 1 && x + 1 < w && y + 1 < h;
+    // Horizontal scan: the crossing between p and p + (1, 0) is marked on the pixel with the
+    // smaller |L| (ties: p); a pixel with L = 0 exactly is marked if its neighbours differ in sign.
+    for y in 1..h.saturating_sub(1) {
+        let row = &l[y * w..(y + 1) * w];
+        for x in 0..w.saturating_sub(1) {
+            let (a, b) = (row[x], row[x + 1]);
+            let (px, pos) = if a * b < 0.0 {
+                let px = if a.abs() <= b.abs() { x } else { x + 1 };
+                (px, x as f32 + a / (a - b))
+            } else if a == 0.0 && x >= 1 && row[x - 1] * b < 0.0 {
+                (x, x as f32)
+            } else {
+                continue;
+            };
+            if !inside(px, y) {
+                continue;
+            }
+            let i = y * w + px;
+            // Two crossings on one pixel (both neighbours): keep the nearer one.
+            if mark[i] & ZC_H == 0 || (pos - px as f32).abs() < (xsub[i] - px as f32).abs() {
+                xsub[i] = pos;
+            }
+            mark[i] |= ZC_H;
+        }
+    }
+    // Vertical scan: the same rule along y.
+    for y in 0..h.saturating_sub(1) {
+        for x in 1..w.saturating_sub(1) {
+            let (a, b) = (l[y * w + x], l[(y + 1) * w + x]);
+            let py = if a * b < 0.0 {
+                if a.abs() <= b.abs() {
+                    y
+                } else {
+                    y + 1
+                }
+            } else if a == 0.0 && y >= 1 && l[(y - 1) * w + x] * b < 0.0 {
+                y
+            } else {
+                continue;
+            };
+            if inside(x, py) {
+                mark[py * w + x] |= ZC_V;
+            }
+        }
+    }
+    let mut strength = vec![0.0f32; n];
+    let mut theta = vec![0.0f32; n];
+    for i in 0..n {
+        if mark[i] == 0 {
+            continue;
+        }
+        let (x, y) = (i % w, i / w);
+        let gx = 0.5 * (l[i + 1] - l[i - 1]);
+        let gy = 0.5 * (l[i + w] - l[i - w]);
+        let st = (gx * gx + gy * gy).sqrt();
+        if st < MIN_STRENGTH {
+            mark[i] = 0;
+            xsub[i] = f32::NAN;
+            continue;
+        }
+        strength[i] = st;
+        let t = gy.atan2(gx);
+        theta[i] = if t < 0.0 { (t + TAU) % TAU } else { t };
+        if mark[i] & ZC_H == 0 {
+            // Vertical-only mark: x from the horizontal crossing next to it, else a Newton step.
+            let left = x as f32 - 1.0 + l[i - 1] / (l[i - 1] - l[i]);
+            let right = x as f32 + l[i] / (l[i] - l[i + 1]);
+            xsub[i] = if l[i - 1] * l[i] < 0.0 {
+                left
+            } else if l[i] * l[i + 1] < 0.0 {
+                right
+            } else if gx != 0.0 && (l[i] / gx).abs() <= MAX_NEWTON_STEP {
+                x as f32 - l[i] / gx
+            } else {
+                x as f32
+            };
+        }
+        let _ = y;
+    }
+    ZeroCrossings {
+        width: w,
+        height: h,
+        mark,
+        xsub,
+        strength,
+        theta,
+    }
+}
