@@ -16,8 +16,9 @@ from stereovision.matching import mcgm as _mcgm
 __all__ = ["METHODS", "match"]
 
 #: Matchers of :func:`match`: the Hopfield network (algorithms.md C) and its best-match
-#: reference without the network; multi-channel graph matching of zero-crossing curves (B).
-METHODS = ("hopfield", "best", "mcgm")
+#: reference without the network; multi-channel graph matching of zero-crossing curves (B);
+#: the valid members of the three channels' agreement (D).
+METHODS = ("hopfield", "best", "mcgm", "fused")
 
 
 def match(
@@ -39,16 +40,20 @@ def match(
         rectified first and the matches are in rectified coordinates).
     calib : Calibration, optional
         Rig calibration of the pair.
-    method : {"hopfield", "best", "mcgm"}
+    method : {"hopfield", "best", "mcgm", "fused"}
         ``"hopfield"``: the network (:func:`stereovision.matching.hopfield.hopfield_match`);
         ``"best"``: the best-match reference without the network; ``"mcgm"``: multi-channel
-        graph matching of LoG zero-crossing curves (:func:`stereovision.matching.mcgm.mcgm_match`).
+        graph matching of LoG zero-crossing curves (:func:`stereovision.matching.mcgm.mcgm_match`);
+        ``"fused"``: the valid members where Gabor, MCGM and Hopfield agree
+        (:func:`stereovision.matching.fusion.fuse_pair`; its ``count`` and ``sources`` per
+        member are in ``stats``).
     max_disparity : int, optional
         Largest disparity searched (px). None estimates it from the pair
         (:func:`stereovision.estimate_max_disparity`).
     **params
-        Matcher parameters (:data:`stereovision.matching.hopfield.DEFAULTS` or
-        :data:`stereovision.matching.mcgm.DEFAULTS`), plus ``min_disparity``.
+        Matcher parameters (:data:`stereovision.matching.hopfield.DEFAULTS`,
+        :data:`stereovision.matching.mcgm.DEFAULTS`, or for ``"fused"`` those of
+        :data:`stereovision.matching.fusion.DEFAULTS`), plus ``min_disparity``.
 
     Returns
     -------
@@ -81,5 +86,11 @@ def match(
         max_disparity = estimate_max_disparity(gl, gr)
     if method == "mcgm":
         return _mcgm.mcgm_match(gl, gr, max_disparity=max_disparity, **params)
+    if method == "fused":
+        from stereovision.matching.fusion import fuse_pair
+
+        res = fuse_pair(gl, gr, max_disparity=max_disparity, **params)
+        res.matches.stats.update(count=res.count, sources=res.sources)
+        return res.matches
     run = _hopfield.hopfield_match if method == "hopfield" else _hopfield.best_match
     return run(gl, gr, max_disparity=max_disparity, **params)

@@ -18,15 +18,17 @@ channels themselves are the Rust kernels.
 from __future__ import annotations
 
 import itertools
+import time
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from stereovision.matches import Matches
 
-__all__ = ["CHANNEL_BITS", "DEFAULTS", "FusionResult", "fuse"]
+__all__ = ["CHANNEL_BITS", "DEFAULTS", "FusionResult", "fuse", "fuse_pair"]
 
 F32 = npt.NDArray[np.float32]
 
@@ -217,8 +219,8 @@ def fuse(
             for i, j in itertools.combinations(subset, 2):
                 with np.errstate(invalid="ignore"):
                     ok &= (np.abs(vx[i] - vx[j]) <= tau_dx) & (np.abs(vy[i] - vy[j]) <= tau_dy)
-            sub = vx[list(subset)]
-            spread = np.where(ok, np.nanmax(sub, axis=0) - np.nanmin(sub, axis=0), np.inf)
+            sub = np.where(ok[None, :], vx[list(subset)], 0.0)  # no NaN where it counts
+            spread = np.where(ok, sub.max(axis=0) - sub.min(axis=0), np.inf)
             better = ok & ((size > best_size) | ((size == best_size) & (spread < best_spread)))
             best = np.where(better, sum(1 << k for k in subset), best)
             best_size = np.where(better, size, best_size)
@@ -271,3 +273,71 @@ def fuse(
         sources_map=smap,
         channels=tuple(names),
     )
+
+
+def fuse_pair(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    *,
+    max_disparity: float,
+    min_disparity: float = 0.0,
+    channels: tuple[str, ...] = ("gabor", "mcgm", "hopfield"),
+    **params: Any,
+) -> FusionResult:
+    """Run the channels on a rectified pair and fuse them (:func:`fuse`).
+
+    Parameters
+    ----------
+    left, right : array_like
+        Rectified pair, ``(H, W)`` grey float32 in ``[0, 1]`` (or anything
+        :func:`stereovision._validate.as_gray_float` takes), same shape.
+    max_disparity, min_disparity : float
+        Disparity range every channel searches (px).
+    channels : tuple of str
+        Which channels take part: ``"gabor"`` and at least one of ``"mcgm"``, ``"hopfield"``.
+    **params
+        :func:`fuse`'s options (:data:`DEFAULTS`).
+
+    Returns
+    -------
+    FusionResult
+        ``matches.stats`` also holds each channel's match count and seconds.
+
+    Raises
+    ------
+    ValueError
+        Bad images, an unknown channel or option.
+    """
+    from stereovision._validate import as_gray_float, check_pair
+    from stereovision.matching.gabor import gabor_disparity
+    from stereovision.matching.hopfield import hopfield_match
+    from stereovision.matching.mcgm import mcgm_match
+
+    unknown = sorted(set(params) - set(DEFAULTS))
+    if unknown:
+        raise ValueError(f"unknown fusion option(s) {unknown}: expected {sorted(DEFAULTS)}")
+    bad = sorted(set(channels) - set(CHANNEL_BITS))
+    if bad:
+        raise ValueError(f"unknown channel(s) {bad}: expected {sorted(CHANNEL_BITS)}")
+    gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
+    rng: dict[str, Any] = {"max_disparity": max_disparity, "min_disparity": min_disparity}
+    seconds: dict[str, float] = {}
+    dense = None
+    sparse: dict[str, Matches] = {}
+    t = time.perf_counter()
+    if "gabor" in channels:
+        g = gabor_disparity(gl, gr, **rng)
+        dense = (g.disparity, g.confidence)
+        seconds["gabor"] = time.perf_counter() - t
+    for name, run in (("mcgm", mcgm_match), ("hopfield", hopfield_match)):
+        if name in channels:
+            t = time.perf_counter()
+            sparse[name] = run(gl, gr, **rng)
+            seconds[name] = time.perf_counter() - t
+    t = time.perf_counter()
+    res = fuse(dense, sparse, **params)
+    seconds["fuse"] = time.perf_counter() - t
+    res.matches.stats.update(
+        channel_matches={k: len(v) for k, v in sparse.items()}, seconds=seconds
+    )
+    return res
