@@ -22,7 +22,7 @@ from stereovision.calibration import Calibration
 __all__ = ["METHODS", "DepthResult", "depth_map", "disparity_sigma", "estimate_max_disparity"]
 
 #: Matchers ``depth_map`` knows, by name.
-METHODS = ("gabor",)
+METHODS = ("gabor", "fused")
 
 # Automatic disparity range: ORB matches on the epipolar band, a high percentile with margin.
 _AUTO_DY_TOL = 2.0  # px: rectified pairs keep matches within a couple of rows
@@ -116,6 +116,11 @@ class DepthResult:
         One-sigma depth uncertainty in metres where ``depth`` is known (NaN elsewhere; None
         without a calibration): ``sigma_Z = Z^2 sigma_d / (f B)`` with ``sigma_d`` the disparity
         uncertainty predicted from the confidence (:func:`disparity_sigma`).
+    channels : dict or None
+        With ``return_channels=True``: each channel's own output by name (``"gabor"``: a
+        :class:`~stereovision.matching.gabor.GaborResult`; with ``method="fused"`` also
+        ``"mcgm"`` and ``"hopfield"`` :class:`~stereovision.Matches` and ``"members"``, the
+        :class:`~stereovision.matching.fusion.FusionResult` with ``count`` and ``sources``).
     """
 
     disparity: npt.NDArray[np.float32]
@@ -131,6 +136,7 @@ class DepthResult:
     left_rectified: npt.NDArray[np.uint8] | None = field(default=None, repr=False)
     timings: dict[str, float] = field(default_factory=dict)
     depth_sigma: npt.NDArray[np.float32] | None = None
+    channels: dict[str, Any] | None = field(default=None, repr=False)
 
     @property
     def valid(self) -> npt.NDArray[np.bool_]:
@@ -178,13 +184,31 @@ def disparity_sigma(confidence: npt.ArrayLike) -> npt.NDArray[np.float32]:
 
 
 def _run_matcher(
-    method: str, left: np.ndarray, right: np.ndarray, d_min: float, d_max: float, params: dict
+    method: str,
+    left: np.ndarray,
+    right: np.ndarray,
+    d_min: float,
+    d_max: float,
+    params: dict,
+    channels: dict[str, Any] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     if method == "gabor":
         from stereovision.matching.gabor import gabor_disparity
 
         res = gabor_disparity(left, right, max_disparity=d_max, min_disparity=d_min, **params)
+        if channels is not None:
+            channels["gabor"] = res
         return res.disparity, res.confidence
+    if method == "fused":
+        from stereovision.matching import fusion
+
+        dense_kw = {k: params.pop(k) for k in list(params) if k in fusion.DENSE_DEFAULTS}
+        fr = fusion.fuse_pair(left, right, max_disparity=d_max, min_disparity=d_min, **params)
+        g = fr.channel_outputs["gabor"]
+        disp, conf = fusion.fused_dense(g.disparity, g.confidence, fr.dispx, **dense_kw)
+        if channels is not None:
+            channels.update(fr.channel_outputs, members=fr)
+        return disp, conf
     raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
 
 
@@ -197,6 +221,7 @@ def depth_map(
     max_disparity: int | None = None,
     min_disparity: float = 0.0,
     fill: bool = False,
+    return_channels: bool = False,
     progress: Callable[[str], None] | None = None,
     **params: Any,
 ) -> DepthResult:
@@ -210,8 +235,11 @@ def depth_map(
         (they are rectified first); already rectified images otherwise.
     calib : Calibration, optional
         Rig calibration. Without it only disparity is computed (``depth`` is None).
-    method : {"gabor"}
-        Matcher (algorithms.md section A for "gabor").
+    method : {"gabor", "fused"}
+        ``"gabor"``: the dense Gabor phase channel (algorithms.md A); ``"fused"``: the Gabor
+        map corrected and completed by the valid members where the Gabor, graph-matching and
+        Hopfield channels agree (algorithms.md D; :func:`stereovision.matching.fusion.fused_dense`;
+        about the three channels' time together).
     max_disparity : int, optional
         Largest disparity searched, in pixels. None chooses it from the images
         (:func:`estimate_max_disparity`: ORB matches, 1.15 x their 99th percentile, multiple of 16).
@@ -221,6 +249,8 @@ def depth_map(
         Fill holes with the reference row rule (evaluation.md: each hole takes the smaller of the
         nearest valid disparities left and right of it). Off by default: a pixel the matcher is not
         sure of stays NaN. Filled pixels keep confidence 0 and get no depth or 3-D point.
+    return_channels : bool
+        Keep each channel's own output in :attr:`DepthResult.channels`.
     progress : callable, optional
         Called with a stage name as the pipeline advances.
     **params
@@ -294,7 +324,10 @@ def depth_map(
             f"width {gl.shape[1]}"
         )
     stage("prepare")
-    disp, conf = _run_matcher(method, gl, gr, float(min_disparity), float(max_disparity), params)
+    channels: dict[str, Any] | None = {} if return_channels else None
+    disp, conf = _run_matcher(
+        method, gl, gr, float(min_disparity), float(max_disparity), dict(params), channels
+    )
     disp = np.ascontiguousarray(disp, dtype=np.float32)
     conf = np.ascontiguousarray(conf, dtype=np.float32)
     measured = np.isfinite(disp)
@@ -339,4 +372,5 @@ def depth_map(
         left_rectified=left_bgr,
         timings=timings,
         depth_sigma=depth_sigma,
+        channels=channels,
     )

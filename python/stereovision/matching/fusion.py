@@ -20,7 +20,7 @@ from __future__ import annotations
 import itertools
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -28,7 +28,15 @@ import numpy.typing as npt
 
 from stereovision.matches import Matches
 
-__all__ = ["CHANNEL_BITS", "DEFAULTS", "FusionResult", "fuse", "fuse_pair"]
+__all__ = [
+    "CHANNEL_BITS",
+    "DEFAULTS",
+    "DENSE_DEFAULTS",
+    "FusionResult",
+    "fuse",
+    "fuse_pair",
+    "fused_dense",
+]
 
 F32 = npt.NDArray[np.float32]
 
@@ -64,6 +72,9 @@ class FusionResult:
         ``(H, W)`` uint8 rasters of ``count`` and ``sources`` (0 off the members).
     channels : tuple of str
         The channels that took part, in bit order.
+    channel_outputs : dict
+        What each channel returned, by name (:func:`fuse_pair` fills it: ``"gabor"`` a
+        :class:`~stereovision.matching.gabor.GaborResult`, the sparse ones :class:`Matches`).
     """
 
     matches: Matches
@@ -74,6 +85,7 @@ class FusionResult:
     count_map: npt.NDArray[np.uint8]
     sources_map: npt.NDArray[np.uint8]
     channels: tuple[str, ...]
+    channel_outputs: dict[str, Any] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return len(self.matches)
@@ -325,9 +337,11 @@ def fuse_pair(
     dense = None
     sparse: dict[str, Matches] = {}
     t = time.perf_counter()
+    outputs: dict[str, Any] = {}
     if "gabor" in channels:
         g = gabor_disparity(gl, gr, **rng)
         dense = (g.disparity, g.confidence)
+        outputs["gabor"] = g
         seconds["gabor"] = time.perf_counter() - t
     for name, run in (("mcgm", mcgm_match), ("hopfield", hopfield_match)):
         if name in channels:
@@ -337,7 +351,101 @@ def fuse_pair(
     t = time.perf_counter()
     res = fuse(dense, sparse, **params)
     seconds["fuse"] = time.perf_counter() - t
+    res.channel_outputs.update(outputs, **sparse)
     res.matches.stats.update(
         channel_matches={k: len(v) for k, v in sparse.items()}, seconds=seconds
     )
     return res
+
+
+#: Dense completion defaults (measured on the 17 GT scenes with the Gabor + MCGM + Hopfield
+#: members: filled bad-2.0 15.9 -> 14.5 % mean, lower on every scene than Gabor alone; a 25 px
+#: radius starts to hurt books/laundry, 1.5 px is too strict for Gabor's sub-pixel spread).
+DENSE_DEFAULTS = {
+    "radius": 15.0,  # px: a member this close can veto the Gabor value
+    "tau": 2.0,  # px: ... when they differ by more than this (the bad-2 bar)
+    "fill_radius": 3.0,  # px: holes this close to a member take its value
+    "fill_confidence": 0.25,  # confidence of such anchor-filled pixels
+}
+
+
+def _nearest_member(members: F32) -> tuple[F32, F32]:
+    """Value of the nearest member and the distance to it, for every pixel.
+
+    OpenCV's ``distanceTransformWithLabels`` with ``DIST_LABEL_PIXEL`` labels the zero pixels
+    (here: the members) 1, 2, ... in row-major order; label 0 never occurs when a member exists.
+    """
+    import cv2
+
+    inv = (~np.isfinite(members)).astype(np.uint8)
+    dist, lab = cv2.distanceTransformWithLabels(
+        inv, cv2.DIST_L2, cv2.DIST_MASK_5, labelType=cv2.DIST_LABEL_PIXEL
+    )
+    ys, xs = np.nonzero(inv == 0)
+    values = np.concatenate([np.array([np.nan], np.float32), members[ys, xs]])
+    return values[lab].astype(np.float32), dist.astype(np.float32)
+
+
+def fused_dense(
+    disparity: npt.ArrayLike,
+    confidence: npt.ArrayLike,
+    members: npt.ArrayLike,
+    *,
+    radius: float = 15.0,
+    tau: float = 2.0,
+    fill_radius: float = 3.0,
+    fill_confidence: float = 0.25,
+) -> tuple[F32, F32]:
+    """The dense map built on the valid members: Gabor corrected and completed by the anchors.
+
+    1. Members replace the Gabor value at their pixels (they agree with it within the fusion's
+       tolerance where Gabor took part, and are more precise: two or three channels averaged).
+    2. A Gabor pixel whose nearest member (within ``radius``) differs by more than ``tau`` is
+       dropped: a region locked to a wrong phase cycle, or a fattened foreground edge.
+    3. A hole within ``fill_radius`` of a member takes the member's value (confidence
+       ``fill_confidence``); other holes stay NaN.
+
+    Parameters
+    ----------
+    disparity, confidence : array_like
+        ``(H, W)`` Gabor disparity (NaN = none) and confidence.
+    members : array_like
+        ``(H, W)`` members' disparity (:attr:`FusionResult.dispx`), NaN elsewhere.
+    radius, tau, fill_radius, fill_confidence : float
+        See above (:data:`DENSE_DEFAULTS`).
+
+    Returns
+    -------
+    disparity, confidence : numpy.ndarray
+        ``(H, W)`` float32; members have confidence 1.
+
+    Raises
+    ------
+    ValueError
+        Maps of different shapes, or a non-positive radius / tolerance.
+    """
+    d = _check_map(disparity, "disparity", None)
+    shape = (int(d.shape[0]), int(d.shape[1]))
+    c = _check_map(confidence, "confidence", shape)
+    a = _check_map(members, "members", shape)
+    for name, v in (("radius", radius), ("tau", tau), ("fill_radius", fill_radius)):
+        if not np.isfinite(v) or v < 0:
+            raise ValueError(f"{name}: expected a non-negative number, got {v}")
+    if not 0 <= fill_confidence <= 1:
+        raise ValueError(f"fill_confidence: expected a value in [0, 1], got {fill_confidence}")
+    out = d.copy()
+    conf = np.where(np.isfinite(d), c, 0.0).astype(np.float32)
+    has = np.isfinite(a)
+    if not has.any():
+        return out, conf
+    near, dist = _nearest_member(a)
+    with np.errstate(invalid="ignore"):
+        veto = (dist <= radius) & np.isfinite(out) & (np.abs(out - near) > tau)
+    out[veto] = np.nan
+    conf[veto] = 0.0
+    out[has] = a[has]
+    conf[has] = 1.0
+    hole = ~np.isfinite(out) & (dist <= fill_radius)
+    out[hole] = near[hole]
+    conf[hole] = fill_confidence
+    return out, conf
