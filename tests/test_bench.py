@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from stereovision import baselines
-from stereovision.bench import bench_scene, format_table
+from stereovision.bench import bench_scene, format_table, sparse_name
 from stereovision.cli import main
 from stereovision.depth import METHODS
 from stereovision.evaluate import dense_metrics
@@ -22,7 +22,9 @@ def test_bench_scene_cases_and_figures(data_dir: Path) -> None:
     scene = load_scene(data_dir / SCENE)
     cases = bench_scene(scene, runs=1)
     names = [c.case for c in cases]
-    assert names == [*METHODS, "pipeline", *SPARSE_METHODS, "StereoBM", "SGBM-3WAY"]
+    sparse = [sparse_name(m) for m in SPARSE_METHODS]
+    assert names == [*METHODS, "pipeline", *sparse, "StereoBM", "SGBM-3WAY"]
+    assert "fused-sparse" in sparse and len(set(names)) == len(names)
     by = {c.case: c for c in cases}
     assert by["SGBM-3WAY"].ratio == pytest.approx(1.0)
     for c in cases:
@@ -36,7 +38,7 @@ def test_bench_scene_cases_and_figures(data_dir: Path) -> None:
     assert by["SGBM-3WAY"].accuracy["density"] == pytest.approx(
         dense_metrics(sgbm, scene.gt).density
     )
-    for m in SPARSE_METHODS:
+    for m in sparse:
         acc = by[m].accuracy
         assert acc["precision@1.0"] > 90 and acc["count"] > 100
     # issue 2's bar: ours after the reference row fill beats StereoBM (README: 8.2 vs 12.7 %).

@@ -234,7 +234,7 @@ def process_pair(task: dict[str, Any]) -> dict[str, Any]:
             out,
             method=task.get("method"),
             max_disparity=task.get("max_disparity"),
-            fill=bool(task.get("fill", False)),
+            fill=task.get("fill"),
         )
         files = {name: Path(p).read_bytes() for name, p in written.items()}
     return {
@@ -425,7 +425,7 @@ def run_batch(
     scheduler: str | None = None,
     method: str | None = None,
     max_disparity: int | None = None,
-    fill: bool = False,
+    fill: bool | None = None,
     calib: str | os.PathLike[str] | None = None,
     retry_failed: bool = False,
     log: Callable[[str], None] | None = None,
@@ -446,8 +446,8 @@ def run_batch(
         Matcher; None = ``depth_map``'s default.
     max_disparity : int, optional
         Disparity range for every pair; None = estimated per pair.
-    fill : bool
-        Reference row fill of the holes.
+    fill : bool, optional
+        Reference row fill of the holes; None = the method's default (:func:`depth_map`).
     calib : path, optional
         Calibration for every pair (else each scene's ``calib.txt``).
     retry_failed : bool
@@ -718,7 +718,12 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--method", choices=METHODS, help="matcher (default: depth_map's)")
     p.add_argument("--max-disparity", type=int, help="for every pair (default: per pair)")
     p.add_argument("--calib", help="calibration for every pair (default: each scene's calib.txt)")
-    p.add_argument("--fill", action="store_true", help="fill holes (reference row fill)")
+    p.add_argument(
+        "--fill", action="store_const", const=True, help="fill holes (reference row fill)"
+    )
+    p.add_argument(
+        "--no-fill", dest="fill", action="store_const", const=False, help="leave holes NaN"
+    )
     p.add_argument(
         "--retry-failed", action="store_true", help="redo pairs that failed on unchanged inputs"
     )

@@ -33,7 +33,7 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["BenchCase", "add_cli", "bench_scene", "cmd_bench", "format_table"]
+__all__ = ["BenchCase", "add_cli", "bench_scene", "cmd_bench", "format_table", "sparse_name"]
 
 #: Timed runs per case (after one warm-up), evaluation.md's minimum.
 DEFAULT_RUNS = 5
@@ -99,6 +99,13 @@ def _dense_accuracy(disp: np.ndarray, gt: np.ndarray | None) -> dict[str, float]
     return {"bad_2.0": raw.bad[2.0], "bad_2.0_filled": filled.bad[2.0], "density": raw.density}
 
 
+def sparse_name(method: str) -> str:
+    """Case name of a sparse method (``fused`` is also a dense method: ``fused-sparse``)."""
+    from stereovision.depth import METHODS
+
+    return f"{method}-sparse" if method in METHODS else method
+
+
 def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
     """Time and score every case on one scene (see the module doc).
 
@@ -151,7 +158,7 @@ def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
     ]
     pipeline = lambda: depth_map(left, right, calib, max_disparity=md).disparity  # noqa: E731
     cases.append(("pipeline", "pipeline", keep("pipeline", pipeline)))
-    cases += [(m, "sparse", keep(m, sparse(m))) for m in SPARSE_METHODS]
+    cases += [(sparse_name(m), "sparse", keep(sparse_name(m), sparse(m))) for m in SPARSE_METHODS]
     bm = lambda: baselines.opencv_bm(left, right, md)  # noqa: E731
     sgbm = lambda: baselines.opencv_sgbm(left, right, md)  # noqa: E731
     cases += [("StereoBM", "opencv", keep("StereoBM", bm))]

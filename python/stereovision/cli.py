@@ -129,7 +129,7 @@ def depth_outputs(
     *,
     method: str | None = None,
     max_disparity: int | None = None,
-    fill: bool = False,
+    fill: bool | None = None,
 ) -> tuple[Any, dict[str, Path]]:
     """What ``stereovision depth`` computes and writes for one pair (``batch`` writes the same).
 
@@ -145,8 +145,8 @@ def depth_outputs(
         Matcher; None = :func:`stereovision.depth.depth_map`'s default.
     max_disparity : int, optional
         None = estimated from the pair.
-    fill : bool
-        Reference row fill of the holes.
+    fill : bool, optional
+        Reference row fill of the holes; None = the method's default (:func:`depth_map`).
 
     Returns
     -------
@@ -387,7 +387,12 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--calib", help="YAML/JSON calibration, Middlebury calib.txt or KITTI calib")
     d.add_argument("--max-disparity", type=int, default=None, help="default: from the images")
     d.add_argument("--method", default="gabor", choices=METHODS)
-    d.add_argument("--fill", action="store_true", help="fill holes (reference row fill)")
+    d.add_argument(
+        "--fill", action="store_const", const=True, help="fill holes (default: the method's)"
+    )
+    d.add_argument(
+        "--no-fill", dest="fill", action="store_const", const=False, help="leave holes NaN"
+    )
     d.add_argument("-o", "--output", required=True, help="output folder")
     d.set_defaults(func=cmd_depth)
 

@@ -23,6 +23,8 @@ __all__ = ["METHODS", "DepthResult", "depth_map", "disparity_sigma", "estimate_m
 
 #: Matchers ``depth_map`` knows, by name.
 METHODS = ("gabor", "fused")
+#: Methods whose output is dense by default (holes filled, ``fill=None``).
+_DENSE_METHODS = ("fused",)
 
 # Automatic disparity range: ORB matches on the epipolar band, a high percentile with margin.
 _AUTO_DY_TOL = 2.0  # px: rectified pairs keep matches within a couple of rows
@@ -220,7 +222,7 @@ def depth_map(
     method: str = "gabor",
     max_disparity: int | None = None,
     min_disparity: float = 0.0,
-    fill: bool = False,
+    fill: bool | None = None,
     return_channels: bool = False,
     progress: Callable[[str], None] | None = None,
     **params: Any,
@@ -245,10 +247,12 @@ def depth_map(
         (:func:`estimate_max_disparity`: ORB matches, 1.15 x their 99th percentile, multiple of 16).
     min_disparity : float
         Smallest disparity searched (default 0).
-    fill : bool
+    fill : bool, optional
         Fill holes with the reference row rule (evaluation.md: each hole takes the smaller of the
-        nearest valid disparities left and right of it). Off by default: a pixel the matcher is not
-        sure of stays NaN. Filled pixels keep confidence 0 and get no depth or 3-D point.
+        nearest valid disparities left and right of it, i.e. the background, which is what an
+        occluded pixel shows). None (default) = the method's own choice: ``"fused"`` returns a
+        dense map (filled), ``"gabor"`` leaves a pixel it is not sure of NaN. Filled pixels keep
+        confidence 0 and get no depth or 3-D point.
     return_channels : bool
         Keep each channel's own output in :attr:`DepthResult.channels`.
     progress : callable, optional
@@ -333,6 +337,8 @@ def depth_map(
     measured = np.isfinite(disp)
     conf = np.where(measured, conf, np.float32(0)).astype(np.float32)
     stage("match")
+    if fill is None:
+        fill = method in _DENSE_METHODS
     if fill:
         from stereovision.baselines import row_fill
 
