@@ -881,8 +881,10 @@ pub fn mcgm_match(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
     let mut channels: Vec<ChannelResult> = Vec::with_capacity(p.sigmas.len());
     for (ci, (l, r)) in cl.iter().zip(&cr).enumerate() {
         let s = l.scale as f32;
-        let lo_c = (p.d_min as f32 / s).floor() as i32;
-        let hi_c = (p.d_max as f32 / s).ceil() as i32;
+        // No disparity reaches past the image width: a huge max_disparity must not size the
+        // GHT accumulators.
+        let lo_c = (p.d_min.min(fw) as f32 / s).floor() as i32;
+        let hi_c = (p.d_max.min(fw) as f32 / s).ceil() as i32;
         let radius = if ci > 0 {
             (p.prior_radius_sigmas * p.sigmas[ci - 1]).ceil() as i32
         } else {
@@ -978,7 +980,7 @@ pub fn mcgm_match(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
         right,
         &combined,
         &p.filters,
-        (p.d_min as i32, p.d_max as i32),
+        (p.d_min.min(fw) as i32, p.d_max.min(fw) as i32),
     )?;
     let n_combined = combined.len();
     let matches = combined
