@@ -213,6 +213,12 @@ def test_image_without_edges_gives_zero_matches() -> None:
     assert len(sv.match(ramp, ramp, method="mcgm", max_disparity=16)) == 0
     tiny = np.random.default_rng(0).random((3, 3), dtype=np.float32)
     assert len(mcgm.mcgm_match(tiny, tiny, max_disparity=2)) == 0
+    # A range far beyond the image width is clipped to it (no giant accumulators).
+    left = _blobs(60, 80, 0.0, seed=1)
+    right = _blobs(60, 80, 3.0, seed=1)
+    wide = mcgm.mcgm_match(left, right, max_disparity=10**9)
+    assert len(wide) > 0 and np.all(np.abs((wide.xl - wide.xr) - 3.0) < 1.0)
+    assert len(mcgm.zncc_reference(left, right, max_disparity=10**9)) > 0
 
 
 # --- bad input ---

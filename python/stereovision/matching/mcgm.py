@@ -388,7 +388,8 @@ def zncc_reference(
     else:
         p = np.asarray(pixels, dtype=np.int64).reshape(-1, 2)
         xs, ys = p[:, 0], p[:, 1]
-    lo, hi = kw["min_disparity"], kw["max_disparity"]
+    # No disparity reaches past the image: keeps the (D, H, W) score volume bounded.
+    lo, hi = min(kw["min_disparity"], w - 1), min(kw["max_disparity"], w - 1)
     r = ZNCC_RADIUS
     n_win = float((2 * r + 1) ** 2)
     a = gl.astype(np.float64)

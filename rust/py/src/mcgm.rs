@@ -384,7 +384,13 @@ pub fn mcgm_filter<'py>(
         .collect();
     let (keep, _) = py.detach(|| {
         guard("mcgm_filter", || {
-            edge_filters(&l, &r, &ms, &p.filters, (p.d_min as i32, p.d_max as i32))
+            edge_filters(
+                &l,
+                &r,
+                &ms,
+                &p.filters,
+                (p.d_min.min(l.width) as i32, p.d_max.min(l.width) as i32),
+            )
         })
     })?;
     Ok(Array1::from_vec(keep).into_pyarray(py))

@@ -28,6 +28,7 @@ use rayon::prelude::*;
 
 use crate::error::{CoreError, Result};
 use crate::image::{check_pair, Image};
+use crate::simd::simd_fn;
 use graph::{
     association_weights, candidates, knn_graph, solve, CandParams, Candidate, SolverParams,
 };
@@ -293,11 +294,16 @@ fn validate_params(p: &McgmParams) -> Result<()> {
         }
     }
     let f = &p.filters;
-    if f.sides_width < 1 || f.sides_height < 1 || f.sides_gap < 0 || f.disc_dx < 0 || f.disc_dy < 0
+    if f.sides_width < 1
+        || f.sides_width as usize > MAX_SIDES_WIDTH
+        || f.sides_height < 1
+        || f.sides_gap < 0
+        || f.disc_dx < 0
+        || f.disc_dy < 0
     {
         return Err(CoreError::param(
             "filters",
-            "sides_width, sides_height >= 1; sides_gap, disc_dx, disc_dy >= 0",
+            "sides_width in 1..=16, sides_height >= 1; sides_gap, disc_dx, disc_dy >= 0",
         ));
     }
     if p.fill_radius < 0 {
@@ -614,72 +620,122 @@ fn other_disparity_better(
     f: &FilterParams,
     ks: (i32, i32),
     here: f32,
+    scratch: &mut SidesScratch,
 ) -> bool {
     let w = right.width as i32;
+    let n_cols = (outer - inner + 1) as usize;
     // Window columns and their interpolation bases.
-    let cols: Vec<i32> = (inner..=outer).map(|k| xi + side * k).collect();
-    let base: Vec<(i32, f32)> = cols
-        .iter()
-        .map(|&x| {
-            let pos = x as f32 - d;
-            let b = pos.floor();
-            (b as i32, pos - b)
-        })
-        .collect();
-    let b_min = base.iter().map(|b| b.0).min().unwrap_or(0);
-    let b_max = base.iter().map(|b| b.0).max().unwrap_or(0);
+    let mut base = [(0i32, 0.0f32); MAX_SIDES_WIDTH];
+    let (mut b_min, mut b_max) = (i32::MAX, i32::MIN);
+    for (c, k) in (inner..=outer).enumerate() {
+        let pos = (xi + side * k) as f32 - d;
+        let b = pos.floor();
+        base[c] = (b as i32, pos - b);
+        b_min = b_min.min(b as i32);
+        b_max = b_max.max(b as i32);
+    }
     // Every sample r[b - k], r[b - k + 1] must lie inside the row.
     let k_hi = ks.1.min(b_min);
     let k_lo = ks.0.max(b_max + 2 - w);
-    // k descending: the right samples of one window pixel are then ascending in memory.
-    let kk: Vec<i32> = (k_lo..=k_hi).rev().filter(|k| k.abs() > 1).collect();
-    if kk.is_empty() {
+    if k_hi < k_lo || (k_lo >= -1 && k_hi <= 1) {
         return false;
     }
-    let nk = kk.len();
-    let n_el = cols.len() * (2 * hh + 1) as usize;
-    let mut diffs = vec![0.0f32; n_el * nk];
-    let mut off = vec![0.0f32; nk];
+    // j = k_hi - k: the right samples of one window pixel are contiguous and ascending in j.
+    let nk = (k_hi - k_lo + 1) as usize;
+    let n_el = n_cols * (2 * hh + 1) as usize;
+    let SidesScratch { diffs, off, sad } = scratch;
+    diffs.clear();
+    diffs.resize(n_el * nk, 0.0);
+    off.clear();
+    off.resize(nk, 0.0);
+    sad.clear();
+    sad.resize(nk, 0.0);
     let mut e = 0;
     for dy in -hh..=hh {
         let lrow = &left.data[(yl + dy) as usize * left.width..][..left.width];
         let rrow = &right.data[(yr + dy) as usize * right.width..][..right.width];
-        for (c, &x) in cols.iter().enumerate() {
-            let lv = lrow[x as usize];
+        for (c, k) in (inner..=outer).enumerate() {
+            let lv = lrow[(xi + side * k) as usize];
             let (b, fr) = base[c];
+            let start = (b - k_hi) as usize;
             let out = &mut diffs[e * nk..(e + 1) * nk];
-            for (o, &k) in out.iter_mut().zip(&kk) {
-                let i = (b - k) as usize;
-                let a = rrow[i];
-                *o = lv - (a + fr * (rrow[i + 1] - a));
-            }
+            diff_row(
+                out,
+                &rrow[start..start + nk],
+                &rrow[start + 1..start + nk + 1],
+                lv,
+                fr,
+            );
             if f.sides_mean_free {
-                for (s, &o) in off.iter_mut().zip(out.iter()) {
-                    *s += o;
-                }
+                add_row(off, out);
             }
             e += 1;
         }
     }
     let n = n_el as f32;
     if f.sides_mean_free {
-        for s in off.iter_mut() {
-            *s /= n;
+        for v in off.iter_mut() {
+            *v /= n;
         }
     }
-    let mut sad = vec![0.0f32; nk];
     for e in 0..n_el {
-        for ((s, &o), &m) in sad.iter_mut().zip(&diffs[e * nk..(e + 1) * nk]).zip(&off) {
-            *s += (o - m).abs();
+        abs_dev_row(sad, &diffs[e * nk..(e + 1) * nk], off);
+    }
+    (0..nk).any(|j| {
+        let k = k_hi - j as i32;
+        k.abs() > 1 && sad[j] / n + f.sides_best_margin < here
+    })
+}
+
+simd_fn! {
+    /// `out[j] = lv - (a[j] + fr (b[j] - a[j]))`: left value minus the interpolated right one.
+    fn diff_row(out: &mut [f32], a: &[f32], b: &[f32], lv: f32, fr: f32) {
+        for ((o, &x0), &x1) in out.iter_mut().zip(a).zip(b) {
+            *o = lv - (x0 + fr * (x1 - x0));
         }
     }
-    sad.iter().any(|&s| s / n + f.sides_best_margin < here)
 }
+
+simd_fn! {
+    /// `acc[j] += v[j]`.
+    fn add_row(acc: &mut [f32], v: &[f32]) {
+        for (s, &x) in acc.iter_mut().zip(v) {
+            *s += x;
+        }
+    }
+}
+
+simd_fn! {
+    /// `acc[j] += |v[j] - m[j]|`.
+    fn abs_dev_row(acc: &mut [f32], v: &[f32], m: &[f32]) {
+        for ((s, &x), &y) in acc.iter_mut().zip(v).zip(m) {
+            *s += (x - y).abs();
+        }
+    }
+}
+
+/// Per-thread buffers of [`other_disparity_better`] (no allocation per match).
+#[derive(Default)]
+struct SidesScratch {
+    diffs: Vec<f32>,
+    off: Vec<f32>,
+    sad: Vec<f32>,
+}
+
+/// Widest half-window of the both-sides check (columns; validated).
+const MAX_SIDES_WIDTH: usize = 16;
 
 /// Both-sides check of one match: the half-windows left and right of the edge agree between
 /// the images (mean absolute grey difference <= `sides_mad` on both sides) and, with
 /// `sides_best`, neither half-window prefers another disparity of `range` (> 1 px away).
-fn sides_ok(left: &Image, right: &Image, m: &Match, f: &FilterParams, range: (i32, i32)) -> bool {
+fn sides_ok(
+    left: &Image,
+    right: &Image,
+    m: &Match,
+    f: &FilterParams,
+    range: (i32, i32),
+    scratch: &mut SidesScratch,
+) -> bool {
     let (w, h) = (left.width as i32, left.height as i32);
     let xi = m.xl.round() as i32;
     let (yl, yr) = (m.yl.round() as i32, m.yr.round() as i32);
@@ -709,7 +765,20 @@ fn sides_ok(left: &Image, right: &Image, m: &Match, f: &FilterParams, range: (i3
                 (range.0 as f32 - d).ceil() as i32,
                 (range.1 as f32 - d).floor() as i32,
             );
-            if other_disparity_better(left, right, xi, yl, yr, d, side, geom, f, (k0, k1), here) {
+            if other_disparity_better(
+                left,
+                right,
+                xi,
+                yl,
+                yr,
+                d,
+                side,
+                geom,
+                f,
+                (k0, k1),
+                here,
+                scratch,
+            ) {
                 return false;
             }
         }
@@ -733,12 +802,12 @@ pub fn edge_filters(
     let (w, h) = left.size();
     let mut keep: Vec<bool> = matches
         .par_iter()
-        .map(|m| {
+        .map_init(SidesScratch::default, |scratch, m| {
             m.xl.is_finite()
                 && m.xr.is_finite()
                 && m.yl.is_finite()
                 && m.yr.is_finite()
-                && (!f.sides || sides_ok(left, right, m, f, range))
+                && (!f.sides || sides_ok(left, right, m, f, range, scratch))
         })
         .collect();
     let n_sides = keep.iter().filter(|&&k| k).count();
@@ -812,8 +881,10 @@ pub fn mcgm_match(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
     let mut channels: Vec<ChannelResult> = Vec::with_capacity(p.sigmas.len());
     for (ci, (l, r)) in cl.iter().zip(&cr).enumerate() {
         let s = l.scale as f32;
-        let lo_c = (p.d_min as f32 / s).floor() as i32;
-        let hi_c = (p.d_max as f32 / s).ceil() as i32;
+        // No disparity reaches past the image width: a huge max_disparity must not size the
+        // GHT accumulators.
+        let lo_c = (p.d_min.min(fw) as f32 / s).floor() as i32;
+        let hi_c = (p.d_max.min(fw) as f32 / s).ceil() as i32;
         let radius = if ci > 0 {
             (p.prior_radius_sigmas * p.sigmas[ci - 1]).ceil() as i32
         } else {
@@ -909,7 +980,7 @@ pub fn mcgm_match(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
         right,
         &combined,
         &p.filters,
-        (p.d_min as i32, p.d_max as i32),
+        (p.d_min.min(fw) as i32, p.d_max.min(fw) as i32),
     )?;
     let n_combined = combined.len();
     let matches = combined

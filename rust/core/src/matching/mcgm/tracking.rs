@@ -91,35 +91,32 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
     let n = w * h;
     let t_high = high_threshold(zc, p.high_quantile);
     let t_low = p.low_ratio * t_high;
-    let cand: Vec<bool> = (0..n)
-        .map(|i| zc.mark[i] != 0 && zc.strength[i] >= t_low && zc.strength[i] > 0.0)
-        .collect();
-    let mut seeds: Vec<u32> = (0..n)
-        .filter(|&i| cand[i] && zc.strength[i] >= t_high)
-        .map(|i| i as u32)
-        .collect();
+    // Per pixel: FREE = unvisited candidate (marked, s >= t_low), TAKEN = on a curve (or a seed
+    // already used), 0 = not a candidate. One byte array instead of three passes over the image.
+    const FREE: u8 = 1;
+    const TAKEN: u8 = 2;
+    let mut state = vec![0u8; n];
+    let mut seeds: Vec<u32> = Vec::new();
+    for i in zc.marked() {
+        let s = zc.strength[i];
+        if s >= t_low && s > 0.0 {
+            state[i] = FREE;
+            if s >= t_high {
+                seeds.push(i as u32);
+            }
+        }
+    }
     seeds.sort_unstable_by(|&a, &b| {
         zc.strength[b as usize]
             .total_cmp(&zc.strength[a as usize])
             .then(a.cmp(&b))
     });
     let max_turn = (p.max_turn_deg as f64).to_radians();
-    // Unit tangents of the candidates, computed once (the walk visits each pixel's 8 neighbours).
-    let tan: Vec<(f64, f64)> = (0..n)
-        .map(|i| {
-            if cand[i] {
-                tangent(zc.theta[i])
-            } else {
-                (0.0, 0.0)
-            }
-        })
-        .collect();
-    let mut visited = vec![false; n];
     let mut labels = vec![-1i32; n];
     let mut segments = Vec::new();
-    let grow = |start: usize, sign: f64, visited: &mut Vec<bool>, out: &mut Vec<u32>| {
+    let grow = |start: usize, sign: f64, state: &mut Vec<u8>, out: &mut Vec<u32>| {
         let mut cur = start;
-        let (tx, ty) = tan[start];
+        let (tx, ty) = tangent(zc.theta[start]);
         let mut dir = (sign * tx, sign * ty);
         loop {
             let (cx, cy) = ((cur % w) as i32, (cur / w) as i32);
@@ -131,13 +128,17 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
                     continue;
                 }
                 let q = ny as usize * w + nx as usize;
-                if !cand[q] || visited[q] {
+                if state[q] != FREE {
                     continue;
                 }
                 if wrap_angle(zc.theta[q] as f64 - tc).abs() >= max_turn {
                     continue;
                 }
-                let len = ((dx * dx + dy * dy) as f64).sqrt();
+                let len = if dx != 0 && dy != 0 {
+                    std::f64::consts::SQRT_2
+                } else {
+                    1.0
+                };
                 let dot = (dx as f64 * dir.0 + dy as f64 * dir.1) / len;
                 if dot <= 0.0 {
                     continue; // forward half-plane only
@@ -150,9 +151,9 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
             let Some((_, _, q, (dx, dy))) = best else {
                 break;
             };
-            visited[q] = true;
+            state[q] = TAKEN;
             out.push(q as u32);
-            let (tx, ty) = tan[q];
+            let (tx, ty) = tangent(zc.theta[q]);
             let sgn = if tx * dx as f64 + ty * dy as f64 >= 0.0 {
                 1.0
             } else {
@@ -164,14 +165,14 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
     };
     for &s in &seeds {
         let s = s as usize;
-        if visited[s] {
+        if state[s] != FREE {
             continue;
         }
-        visited[s] = true;
+        state[s] = TAKEN;
         let mut fwd = Vec::new();
         let mut bwd = Vec::new();
-        grow(s, 1.0, &mut visited, &mut fwd);
-        grow(s, -1.0, &mut visited, &mut bwd);
+        grow(s, 1.0, &mut state, &mut fwd);
+        grow(s, -1.0, &mut state, &mut bwd);
         if 1 + fwd.len() + bwd.len() < p.min_len {
             continue;
         }
