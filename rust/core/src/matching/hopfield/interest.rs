@@ -72,8 +72,11 @@ fn hsum_row(a: &[f32], b: &[f32], sx: usize, sq: &mut Vec<f32>, out: &mut [f32])
     if w < 2 * r + 1 + sx {
         return;
     }
-    sq.clear();
-    sq.extend(a[..w - sx].iter().zip(&b[sx..]).map(|(&p, &q)| (p - q) * (p - q)));
+    sq.resize(w - sx, 0.0);
+    for ((o, &p), &q) in sq.iter_mut().zip(a).zip(&b[sx..]) {
+        let d = p - q;
+        *o = d * d;
+    }
     let m = w - 2 * r - sx;
     let dst = &mut out[r..r + m];
     dst.copy_from_slice(&sq[..m]);
@@ -122,31 +125,34 @@ pub fn moravec(img: &Image) -> Vec<f32> {
     inner
         .par_chunks_mut(ROWS_PER_TASK * w)
         .enumerate()
-        .for_each(|(t, band)| {
-            let y0 = BORDER + t * ROWS_PER_TASK;
-            let n = band.len() / w;
-            // Horizontal sums of rows y0-2 .. y0+n+1 for each direction.
-            let n_hs = n + 2 * r;
-            let mut hs = vec![0.0f32; 4 * n_hs * w];
-            let mut sq = Vec::with_capacity(w);
-            for (d, &(sx, sy)) in DIRS.iter().enumerate() {
-                for i in 0..n_hs {
-                    let y = y0 + i - r;
-                    let yy = (y as isize + sy) as usize; // in 0..h: y in 1..h-1, |sy| <= 1
-                    let dst = &mut hs[(d * n_hs + i) * w..(d * n_hs + i + 1) * w];
-                    hsum_row(row(y), row(yy), sx, &mut sq, dst);
+        .for_each_init(
+            || (Vec::new(), Vec::new(), vec![0.0f32; w]),
+            |(hs, sq, acc), (t, band)| {
+                let y0 = BORDER + t * ROWS_PER_TASK;
+                let n = band.len() / w;
+                // Horizontal sums of rows y0-2 .. y0+n+1 for each direction.
+                let n_hs = n + 2 * r;
+                hs.resize(4 * n_hs * w, 0.0); // every value is overwritten by hsum_row
+                for (d, &(sx, sy)) in DIRS.iter().enumerate() {
+                    for i in 0..n_hs {
+                        let y = y0 + i - r;
+                        let yy = (y as isize + sy) as usize; // in 0..h: y in 1..h-1, |sy| <= 1
+                        let dst = &mut hs[(d * n_hs + i) * w..(d * n_hs + i + 1) * w];
+                        hsum_row(row(y), row(yy), sx, sq, dst);
+                    }
                 }
-            }
-            let mut acc = vec![0.0f32; w];
-            for (i, orow) in band.chunks_mut(w).enumerate() {
-                let rows: [[&[f32]; 2 * MORAVEC_HALF + 1]; 4] = std::array::from_fn(|d| {
-                    std::array::from_fn(|k| &hs[(d * n_hs + i + k) * w..(d * n_hs + i + k + 1) * w])
-                });
-                min_row(&rows, &mut acc, orow);
-                orow[..BORDER].fill(0.0);
-                orow[w - BORDER..].fill(0.0);
-            }
-        });
+                for (i, orow) in band.chunks_mut(w).enumerate() {
+                    let rows: [[&[f32]; 2 * MORAVEC_HALF + 1]; 4] = std::array::from_fn(|d| {
+                        std::array::from_fn(|k| {
+                            &hs[(d * n_hs + i + k) * w..(d * n_hs + i + k + 1) * w]
+                        })
+                    });
+                    min_row(&rows, acc, orow);
+                    orow[..BORDER].fill(0.0);
+                    orow[w - BORDER..].fill(0.0);
+                }
+            },
+        );
     out
 }
 

@@ -404,17 +404,19 @@ fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usi
     }
     let mut all_dy: Vec<f32> = singles.iter().map(|&s| neurons[s].dy() as f32).collect();
     let global = median(&mut all_dy);
-    let half = p.weights.nbr_half;
+    let half = p.weights.nbr_half.max(1);
+    let sxy: Vec<(i32, i32)> = singles
+        .iter()
+        .map(|&s| (neurons[s].xl.max(0), neurons[s].yl.max(0)))
+        .collect();
+    let grid = network::PointGrid::new(&sxy, half);
     // Reference vertical disparity: median over the single matches in the 40x40 window.
     let local_ref = |a: usize| -> f32 {
         let n = &neurons[a];
-        let mut v: Vec<f32> = singles
-            .iter()
-            .filter(|&&s| {
-                (neurons[s].xl - n.xl).abs() <= half && (neurons[s].yl - n.yl).abs() <= half
-            })
-            .map(|&s| neurons[s].dy() as f32)
-            .collect();
+        let mut v: Vec<f32> = Vec::new();
+        grid.for_each_in_window((n.xl.max(0), n.yl.max(0)), half, |k| {
+            v.push(neurons[singles[k]].dy() as f32)
+        });
         if v.is_empty() {
             global
         } else {
@@ -484,6 +486,12 @@ fn finish(
         .map(|&(a, _)| (neurons[a].xl.max(0), neurons[a].yl.max(0)))
         .collect();
     let grid = network::PointGrid::new(&sxy, half);
+    // Survivor disparities in grid order.
+    let sd: Vec<i32> = grid
+        .items
+        .iter()
+        .map(|&t| neurons[survivors[t as usize].0].dx())
+        .collect();
     survivors
         .par_iter()
         .enumerate()
@@ -492,15 +500,24 @@ fn finish(
                 return true;
             }
             let d = neurons[a].dx();
+            let (x, y) = sxy[s];
             let (mut agree, mut near) = (0usize, 0usize);
-            grid.for_each_near(&sxy, s, half, |t| {
-                near += 1;
-                if (neurons[survivors[t].0].dx() - d).abs() <= p.agree_tol {
-                    agree += 1;
+            // Branch-free count over the 3x3 cells (the survivor itself is excluded below).
+            for (r0, r1) in grid.ranges(x, y) {
+                let cells = grid.xs[r0..r1]
+                    .iter()
+                    .zip(&grid.ys[r0..r1])
+                    .zip(&sd[r0..r1]);
+                for ((&qx, &qy), &qd) in cells {
+                    let inside = (qx - x).abs() <= half && (qy - y).abs() <= half;
+                    near += usize::from(inside);
+                    agree += usize::from(inside && (qd - d).abs() <= p.agree_tol);
                 }
-            });
-            // Dense areas: at least min_agree agreeing neighbours (C.10). Sparse areas (weak
-            // texture) optionally: a large share of the few neighbours, at least min_agree_sparse.
+            }
+            near -= 1;
+            agree -= usize::from(p.agree_tol >= 0); // the survivor itself
+                                                    // Dense areas: at least min_agree agreeing neighbours (C.10). Sparse areas (weak
+                                                    // texture) optionally: a large share of the few neighbours, at least min_agree_sparse.
             agree >= p.min_agree
                 || (p.agree_share > 0.0
                     && agree >= p.min_agree_sparse
