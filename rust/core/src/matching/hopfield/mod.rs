@@ -222,9 +222,9 @@ fn parabola(a: f32, b: f32, c: f32) -> f32 {
     (0.5 * (a - c) / den).clamp(-0.5, 0.5)
 }
 
-/// Left points per parallel work item: enough to amortise the scheduling, small enough for an
-/// even split of the rows over the threads.
-const POINTS_PER_TASK: usize = 64;
+/// Image rows per parallel task of the candidate search: its right-image statistics are
+/// computed for these rows only (small enough for an even split over the threads).
+const ROWS_PER_TASK: usize = 8;
 
 /// Scratch of [`point_candidates`], reused across the points of a thread.
 #[derive(Default)]
@@ -351,19 +351,37 @@ fn candidates(
     pts: &[InterestPoint],
     p: &HopfieldParams,
 ) -> Vec<Neuron> {
-    let stats = RightStats::new(right);
     let rows = right_rows(right, p);
-    let per_task: Vec<Vec<Neuron>> = pts
-        .par_chunks(POINTS_PER_TASK)
-        .enumerate()
-        .map_init(CandScratch::default, |sc, (t, chunk)| {
-            let mut out = Vec::with_capacity(2 * chunk.len());
-            for (k, pt) in chunk.iter().enumerate() {
-                let i = t * POINTS_PER_TASK + k;
-                point_candidates(left, right, &stats, &rows, p, i, pt, sc, &mut out);
-            }
-            out
-        })
+    // Tasks: bands of image rows, each with its own right-image statistics (the rows its
+    // points search, +- dy_window in points mode).
+    let band_of = |pt: &InterestPoint| pt.y as usize / ROWS_PER_TASK;
+    let mut tasks: Vec<(usize, usize)> = Vec::new(); // point index ranges, raster order
+    let mut s0 = 0;
+    for i in 1..=pts.len() {
+        if i == pts.len() || band_of(&pts[i]) != band_of(&pts[s0]) {
+            tasks.push((s0, i));
+            s0 = i;
+        }
+    }
+    let reach = match p.candidates {
+        CandidateMode::Row => 0,
+        CandidateMode::Points => p.dy_window,
+    };
+    let per_task: Vec<Vec<Neuron>> = tasks
+        .par_iter()
+        .map_init(
+            || (CandScratch::default(), RightStats::default()),
+            |(sc, stats), &(i0, i1)| {
+                let y_lo = pts[i0].y as usize;
+                let y_hi = pts[i1 - 1].y as usize + 1;
+                stats.fill_band(right, y_lo.saturating_sub(reach), y_hi + reach);
+                let mut out = Vec::with_capacity(2 * (i1 - i0));
+                for (i, pt) in pts.iter().enumerate().take(i1).skip(i0) {
+                    point_candidates(left, right, stats, &rows, p, i, pt, sc, &mut out);
+                }
+                out
+            },
+        )
         .collect();
     per_task.concat()
 }

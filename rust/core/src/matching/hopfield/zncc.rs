@@ -73,22 +73,27 @@ fn regions_of<T: Copy + std::ops::Add<Output = T>>(c: &[[T; 3]; 3]) -> [T; N_REG
     [full, left, right, top, bottom]
 }
 
-/// Right-image window sums and inverse zero-mean norms for every region and pixel (0 where the
-/// window does not fit or is textureless). Layout `(H, 2 * N_REGIONS, W + LANES)`: per image
-/// row, the five sum rows then the five inverse-norm rows, so one region's values along a row
-/// are contiguous; each row is padded by one block of zeros so that a block of lanes never
-/// reads past it. Built row-parallel from `f64` band sums (vertical 3-row sums, then
-/// horizontal 3-column sums; no running sums, so no drift along a row).
-#[derive(Debug, Clone)]
+/// Right-image window sums and inverse zero-mean norms for every region and pixel of a band of
+/// rows `y0..y0 + rows` (0 where the window does not fit or is textureless). Layout
+/// `(rows, 2 * N_REGIONS, W + LANES)`: per image row, the five sum rows then the five
+/// inverse-norm rows, so one region's values along a row are contiguous; each row is padded by
+/// one block of zeros so that a block of lanes never reads past it. Built from `f64` band sums
+/// (vertical 3-row sums, then horizontal 3-column sums; no running sums, so no drift along a
+/// row). The matcher fills one small band per task ([`RightStats::fill_band`]) instead of the
+/// whole image: far less memory to touch.
+#[derive(Debug, Clone, Default)]
 pub struct RightStats {
     stride: usize,
+    y0: usize,
+    rows: usize,
     buf: Vec<f32>,
+    scratch: StatsScratch,
 }
 
 /// Scratch of [`stats_row`] (`f64`, one image row each): vertical sums of the top band (rows
 /// -3..=-1), the bottom band (1..=3) and all seven rows, for values (`v[0..3]`) and squares
 /// (`v[3..6]`); `h[i][x] = v[i][x] + v[i][x + 1] + v[i][x + 2]`.
-#[derive(Default)]
+#[derive(Debug, Clone, Default)]
 struct StatsScratch {
     v: [Vec<f64>; 6],
     h: [Vec<f64>; 6],
@@ -108,6 +113,15 @@ fn sum3(out: &mut [f64], a: &[f32], b: &[f32], c: &[f32], square: bool) {
     for (((o, &a), &b), &c) in out.iter_mut().zip(a).zip(b).zip(c) {
         *o = f(a) + f(b) + f(c);
     }
+}
+
+/// Statistics of image row `y` (`SIM_RADIUS <= y < H - SIM_RADIUS`) into `chunk`
+/// (`2 * N_REGIONS * stride` values).
+fn fill_row(img: &Image, y: usize, stride: usize, s: &mut StatsScratch, chunk: &mut [f32]) {
+    let w = img.width;
+    let rows: [&[f32]; SIDE] = std::array::from_fn(|r| &img.data[(y + r - SIM_RADIUS) * w..][..w]);
+    let (sums, invs) = chunk.split_at_mut(N_REGIONS * stride);
+    stats_row(&rows, s, stride, sums, invs);
 }
 
 simd_fn! {
@@ -180,38 +194,70 @@ fn stats_row(rows: &[&[f32]; SIDE], s: &mut StatsScratch, stride: usize, sums: &
 }
 
 impl RightStats {
+    /// Statistics of every row of `img` (row-parallel).
     pub fn new(img: &Image) -> Self {
         let (w, h) = img.size();
         let stride = w + LANES;
         let row_len = 2 * N_REGIONS * stride;
         let mut buf = vec![0.0f32; row_len * h];
-        if w < SIDE || h < SIDE {
-            return RightStats { stride, buf };
+        if w >= SIDE && h >= SIDE {
+            buf.par_chunks_mut(row_len)
+                .enumerate()
+                .skip(SIM_RADIUS)
+                .take(h - 2 * SIM_RADIUS)
+                .for_each_init(StatsScratch::default, |s, (y, chunk)| {
+                    fill_row(img, y, stride, s, chunk);
+                });
         }
-        buf.par_chunks_mut(row_len)
-            .enumerate()
-            .skip(SIM_RADIUS)
-            .take(h - 2 * SIM_RADIUS)
-            .for_each_init(StatsScratch::default, |s, (y, chunk)| {
-                let rows: [&[f32]; SIDE] =
-                    std::array::from_fn(|r| &img.data[(y + r - SIM_RADIUS) * w..][..w]);
-                let (sums, invs) = chunk.split_at_mut(N_REGIONS * stride);
-                stats_row(&rows, s, stride, sums, invs);
-            });
-        RightStats { stride, buf }
+        RightStats {
+            stride,
+            y0: 0,
+            rows: h,
+            buf,
+            scratch: StatsScratch::default(),
+        }
+    }
+
+    /// Recomputes `self` for the rows `y_lo..y_hi` of `img` only (reusing its buffers).
+    pub fn fill_band(&mut self, img: &Image, y_lo: usize, y_hi: usize) {
+        let (w, h) = img.size();
+        let y_hi = y_hi.min(h);
+        let y_lo = y_lo.min(y_hi);
+        self.stride = w + LANES;
+        self.y0 = y_lo;
+        self.rows = y_hi - y_lo;
+        let row_len = 2 * N_REGIONS * self.stride;
+        self.buf.clear();
+        self.buf.resize(row_len * self.rows, 0.0);
+        if w < SIDE || h < SIDE {
+            return;
+        }
+        let lo = y_lo.max(SIM_RADIUS);
+        let hi = y_hi.min(h - SIM_RADIUS);
+        for y in lo..hi {
+            let o = (y - y_lo) * row_len;
+            fill_row(
+                img,
+                y,
+                self.stride,
+                &mut self.scratch,
+                &mut self.buf[o..o + row_len],
+            );
+        }
     }
 
     /// Window sums of region `k` along row `y` (`W + LANES` values, zero past the image).
     #[inline]
     fn sums(&self, k: usize, y: usize) -> &[f32] {
-        let o = (y * 2 * N_REGIONS + k) * self.stride;
+        debug_assert!((self.y0..self.y0 + self.rows).contains(&y));
+        let o = ((y - self.y0) * 2 * N_REGIONS + k) * self.stride;
         &self.buf[o..o + self.stride]
     }
 
     /// Inverse zero-mean norms of region `k` along row `y` (0 = undefined).
     #[inline]
     fn inv_norms(&self, k: usize, y: usize) -> &[f32] {
-        let o = (y * 2 * N_REGIONS + N_REGIONS + k) * self.stride;
+        let o = ((y - self.y0) * 2 * N_REGIONS + N_REGIONS + k) * self.stride;
         &self.buf[o..o + self.stride]
     }
 
