@@ -94,10 +94,14 @@ impl Csr {
     }
 }
 
-/// Uniform grid over the left points (cell = the compatibility half-window), counting-sorted:
-/// `items` lists the point indices cell by cell (raster order of the cells, point order within
-/// a cell) with their coordinates beside them, so the three cells of one grid row around a
-/// point form ONE contiguous range.
+/// Cells per window half-size of [`PointGrid`]: cells of `ceil(half / 2)` px, so a window
+/// query scans 5x5 cells (50x50 px for the 41x41 window: 67 % of the scanned points are
+/// inside, against 47 % with cells of `half`).
+const GRID_SUB: i32 = 2;
+
+/// Uniform grid over the left points, counting-sorted: `items` lists the point indices cell by
+/// cell (raster order of the cells, point order within a cell) with their coordinates beside
+/// them, so the cells of one grid row around a point form ONE contiguous range.
 pub(crate) struct PointGrid {
     cell: i32,
     gw: i32,
@@ -109,7 +113,9 @@ pub(crate) struct PointGrid {
 }
 
 impl PointGrid {
-    pub(crate) fn new(pxy: &[(i32, i32)], cell: i32) -> Self {
+    /// Grid for window queries of half-size `half` (>= 1).
+    pub(crate) fn new(pxy: &[(i32, i32)], half: i32) -> Self {
+        let cell = (half.max(1) + GRID_SUB - 1) / GRID_SUB;
         let gw = pxy.iter().map(|p| p.0 / cell).max().unwrap_or(0) + 1;
         let gh = pxy.iter().map(|p| p.1 / cell).max().unwrap_or(0) + 1;
         let idx = |p: &(i32, i32)| ((p.1 / cell) * gw + p.0 / cell) as usize;
@@ -140,14 +146,14 @@ impl PointGrid {
         }
     }
 
-    /// The (up to three, possibly empty) ranges of `items` positions covering the 3x3 cells
-    /// around `(x, y)`, in cell raster order.
+    /// The (possibly empty) ranges of `items` positions covering the cells within
+    /// `GRID_SUB` cells of `(x, y)`'s cell, one per grid row, in cell raster order.
     #[inline]
-    pub(crate) fn ranges(&self, x: i32, y: i32) -> [(usize, usize); 3] {
+    pub(crate) fn ranges(&self, x: i32, y: i32) -> [(usize, usize); 2 * GRID_SUB as usize + 1] {
         let (cx, cy) = (x / self.cell, y / self.cell);
-        let (gx0, gx1) = ((cx - 1).max(0), (cx + 1).min(self.gw - 1));
+        let (gx0, gx1) = ((cx - GRID_SUB).max(0), (cx + GRID_SUB).min(self.gw - 1));
         std::array::from_fn(|k| {
-            let gy = cy - 1 + k as i32;
+            let gy = cy - GRID_SUB + k as i32;
             if gy < 0 || gy >= self.gh || gx0 > gx1 {
                 return (0, 0);
             }
@@ -160,7 +166,7 @@ impl PointGrid {
     }
 
     /// Calls `f(q)` for every point `q` within `half` of `(x, y)` in both coordinates
-    /// (`half <= cell`), in cell order.
+    /// (`half` at most the grid's), in cell order.
     pub(crate) fn for_each_in_window(
         &self,
         (x, y): (i32, i32),
