@@ -8,6 +8,7 @@
 use rayon::prelude::*;
 
 use crate::image::Image;
+use crate::simd::simd_fn;
 
 /// Half-size of the Moravec window (5x5, the paper's size).
 pub const MORAVEC_HALF: usize = 2;
@@ -53,78 +54,105 @@ pub struct InterestPoint {
     pub value: f32,
 }
 
-/// Sum of the 5x5 window of squared differences for the step `(sx, sy)` (`sy` in -1..=1), at
-/// every pixel at least [`BORDER`] from the edge (0 elsewhere). Per row: squared differences,
-/// horizontal 5-sums (left to right), then vertical 5-sums (top to bottom), all `f32`.
-fn direction_sum(img: &Image, sx: usize, sy: isize) -> Vec<f32> {
-    let (w, h) = img.size();
+/// Output rows per parallel task of [`moravec`]: each task recomputes the `2 * MORAVEC_HALF`
+/// rows of horizontal sums it shares with its neighbours (12 % extra at 32 rows).
+const ROWS_PER_TASK: usize = 32;
+
+/// The four steps `(sx, sy)`: horizontal, vertical, 45 degrees (down-right), 135 (up-right).
+const DIRS: [(usize, isize); 4] = [(1, 0), (0, 1), (1, 1), (1, -1)];
+
+simd_fn! {
+/// Horizontal 5-sums of the squared differences between row `a` and row `b` shifted by `sx`:
+/// `out[x] = sq[x-2] + sq[x-1] + sq[x] + sq[x+1] + sq[x+2]` (left to right, `f32`) for
+/// `x in 2..w-2-sx`, 0 elsewhere; `sq` is scratch.
+fn hsum_row(a: &[f32], b: &[f32], sx: usize, sq: &mut Vec<f32>, out: &mut [f32]) {
+    let w = a.len();
     let r = MORAVEC_HALF;
-    let n = w - 2 * r; // horizontal sums exist for x in r..w-r
-                       // hs[y * w + x]: horizontal 5-sum of the squared differences of row y (rows whose partner
-                       // row exists; x in r..w-r-sx so the partner column exists for every term).
-    let mut hs = vec![0.0f32; w * h];
-    hs.par_chunks_mut(w).enumerate().for_each(|(y, out)| {
-        let yy = y as isize + sy;
-        if yy < 0 || yy >= h as isize {
-            return;
+    out.fill(0.0);
+    if w < 2 * r + 1 + sx {
+        return;
+    }
+    sq.resize(w - sx, 0.0);
+    for ((o, &p), &q) in sq.iter_mut().zip(a).zip(&b[sx..]) {
+        let d = p - q;
+        *o = d * d;
+    }
+    let m = w - 2 * r - sx;
+    let dst = &mut out[r..r + m];
+    dst.copy_from_slice(&sq[..m]);
+    for k in 1..=2 * r {
+        for (o, &v) in dst.iter_mut().zip(&sq[k..k + m]) {
+            *o += v;
         }
-        let a = &img.data[y * w..(y + 1) * w];
-        let b = &img.data[yy as usize * w..(yy as usize + 1) * w];
-        let sq: Vec<f32> = (0..w - sx)
-            .map(|x| {
-                let d = a[x] - b[x + sx];
-                d * d
-            })
-            .collect();
-        let m = n.saturating_sub(sx).min(sq.len().saturating_sub(2 * r));
-        let dst = &mut out[r..r + m];
-        dst.copy_from_slice(&sq[0..m]);
-        for k in 1..=2 * r {
-            for (o, &v) in dst.iter_mut().zip(&sq[k..k + m]) {
+    }
+}
+}
+
+simd_fn! {
+/// One row of `M`: per direction the vertical 5-sum of its horizontal sums (top to bottom),
+/// then the minimum over the four directions. `hs[dir]` holds the five rows `y-2..=y+2`.
+fn min_row(hs: &[[&[f32]; 2 * MORAVEC_HALF + 1]; 4], acc: &mut [f32], out: &mut [f32]) {
+    for (d, rows) in hs.iter().enumerate() {
+        acc.copy_from_slice(rows[0]);
+        for row in &rows[1..] {
+            for (o, &v) in acc.iter_mut().zip(row.iter()) {
                 *o += v;
             }
         }
-    });
-    let mut out = vec![0.0f32; w * h];
-    out.par_chunks_mut(w)
-        .enumerate()
-        .skip(BORDER)
-        .take(h - 2 * BORDER)
-        .for_each(|(y, row)| {
-            row.copy_from_slice(&hs[(y - r) * w..(y - r + 1) * w]);
-            for k in 1..=2 * r {
-                let src = &hs[(y - r + k) * w..(y - r + k + 1) * w];
-                for (o, &v) in row.iter_mut().zip(src) {
-                    *o += v;
-                }
+        if d == 0 {
+            out.copy_from_slice(acc);
+        } else {
+            for (o, &v) in out.iter_mut().zip(acc.iter()) {
+                *o = o.min(v);
             }
-        });
-    out
+        }
+    }
+}
 }
 
 /// The Moravec interest map `M` (f32, row-major `(H, W)`); 0 within [`BORDER`] px of the edge.
+/// Row bands in parallel; every value is computed in the fixed order of the module docs, so the
+/// map does not depend on the thread count.
 pub fn moravec(img: &Image) -> Vec<f32> {
     let (w, h) = img.size();
     let mut out = vec![0.0f32; w * h];
     if w < 2 * BORDER + 1 || h < 2 * BORDER + 1 {
         return out;
     }
-    // Horizontal, vertical, 45 degrees (down-right) and 135 degrees (up-right).
-    let dirs: [(usize, isize); 4] = [(1, 0), (0, 1), (1, 1), (1, -1)];
-    let sums: Vec<Vec<f32>> = dirs
-        .iter()
-        .map(|&(sx, sy)| direction_sum(img, sx, sy))
-        .collect();
-    out.par_chunks_mut(w)
+    let r = MORAVEC_HALF;
+    let row = |y: usize| &img.data[y * w..(y + 1) * w];
+    let inner = &mut out[BORDER * w..(h - BORDER) * w];
+    inner
+        .par_chunks_mut(ROWS_PER_TASK * w)
         .enumerate()
-        .skip(BORDER)
-        .take(h - 2 * BORDER)
-        .for_each(|(y, row)| {
-            for (x, v) in row.iter_mut().enumerate().take(w - BORDER).skip(BORDER) {
-                let i = y * w + x;
-                *v = sums[0][i].min(sums[1][i]).min(sums[2][i]).min(sums[3][i]);
-            }
-        });
+        .for_each_init(
+            || (Vec::new(), Vec::new(), vec![0.0f32; w]),
+            |(hs, sq, acc), (t, band)| {
+                let y0 = BORDER + t * ROWS_PER_TASK;
+                let n = band.len() / w;
+                // Horizontal sums of rows y0-2 .. y0+n+1 for each direction.
+                let n_hs = n + 2 * r;
+                hs.resize(4 * n_hs * w, 0.0); // every value is overwritten by hsum_row
+                for (d, &(sx, sy)) in DIRS.iter().enumerate() {
+                    for i in 0..n_hs {
+                        let y = y0 + i - r;
+                        let yy = (y as isize + sy) as usize; // in 0..h: y in 1..h-1, |sy| <= 1
+                        let dst = &mut hs[(d * n_hs + i) * w..(d * n_hs + i + 1) * w];
+                        hsum_row(row(y), row(yy), sx, sq, dst);
+                    }
+                }
+                for (i, orow) in band.chunks_mut(w).enumerate() {
+                    let rows: [[&[f32]; 2 * MORAVEC_HALF + 1]; 4] = std::array::from_fn(|d| {
+                        std::array::from_fn(|k| {
+                            &hs[(d * n_hs + i + k) * w..(d * n_hs + i + k + 1) * w]
+                        })
+                    });
+                    min_row(&rows, acc, orow);
+                    orow[..BORDER].fill(0.0);
+                    orow[w - BORDER..].fill(0.0);
+                }
+            },
+        );
     out
 }
 
@@ -138,56 +166,67 @@ pub fn interest_points(img: &Image, p: &InterestParams) -> Vec<InterestPoint> {
     select_points(&m, w, h, p)
 }
 
-/// Selection step of [`interest_points`] on a precomputed map.
+/// Selection step of [`interest_points`] on a precomputed map (rows in parallel, raster order).
 pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<InterestPoint> {
     let max = m.iter().copied().fold(0.0f32, f32::max);
-    let r = p.nms_half as isize;
-    let mut out = Vec::new();
-    if max <= 0.0 {
-        return out;
+    if max <= 0.0 || w == 0 {
+        return Vec::new();
     }
     // Largest M per tile (a single tile covering the image when `tile == 0`).
     let tile = if p.tile == 0 { w.max(h) } else { p.tile };
     let tiles_x = w.div_ceil(tile);
-    let mut tile_max = vec![0.0f32; tiles_x * h.div_ceil(tile)];
-    for (y, row) in m.chunks(w).enumerate() {
-        for (x, &v) in row.iter().enumerate() {
-            let t = (y / tile) * tiles_x + x / tile;
-            tile_max[t] = tile_max[t].max(v);
-        }
-    }
-    let floor = max * p.floor_rel;
-    let thr_at = |x: usize, y: usize| {
-        (tile_max[(y / tile) * tiles_x + x / tile] * p.rel_threshold).max(floor)
-    };
-    for y in BORDER..h.saturating_sub(BORDER) {
-        'px: for x in BORDER..w.saturating_sub(BORDER) {
-            let v = m[y * w + x];
-            if v <= 0.0 || v < thr_at(x, y) {
-                continue;
+    let tile_max: Vec<f32> = m
+        .par_chunks(tile * w)
+        .flat_map_iter(|band| {
+            let mut tm = vec![0.0f32; tiles_x];
+            for row in band.chunks(w) {
+                for (t, seg) in row.chunks(tile).enumerate() {
+                    tm[t] = seg.iter().copied().fold(tm[t], f32::max);
+                }
             }
-            for dy in -r..=r {
-                for dx in -r..=r {
-                    if dx == 0 && dy == 0 {
-                        continue;
-                    }
-                    let (xx, yy) = (x as isize + dx, y as isize + dy);
-                    if xx < 0 || yy < 0 || xx >= w as isize || yy >= h as isize {
-                        continue;
-                    }
-                    let n = m[yy as usize * w + xx as usize];
-                    let earlier = dy < 0 || (dy == 0 && dx < 0);
-                    if n > v || (earlier && n == v) {
-                        continue 'px;
+            tm
+        })
+        .collect();
+    let floor = max * p.floor_rel;
+    let r = p.nms_half;
+    // Is `v` (at x, y) above its later and strictly above its earlier neighbours?
+    let is_peak = |x: usize, y: usize, v: f32| -> bool {
+        let (x0, x1) = (x.saturating_sub(r), (x + r).min(w - 1));
+        for yy in y.saturating_sub(r)..=(y + r).min(h - 1) {
+            let nrow = &m[yy * w..(yy + 1) * w];
+            for (xx, &n) in nrow.iter().enumerate().take(x1 + 1).skip(x0) {
+                let earlier = yy < y || (yy == y && xx < x);
+                if n > v || (earlier && n == v) {
+                    return false;
+                }
+            }
+        }
+        true
+    };
+    (BORDER..h.saturating_sub(BORDER))
+        .into_par_iter()
+        .flat_map_iter(|y| {
+            let row = &m[y * w..(y + 1) * w];
+            let tiles = &tile_max[(y / tile) * tiles_x..(y / tile + 1) * tiles_x];
+            let mut out = Vec::new();
+            for (t, &tm) in tiles.iter().enumerate() {
+                let thr = (tm * p.rel_threshold).max(floor);
+                let xs = (t * tile).max(BORDER)..((t + 1) * tile).min(w.saturating_sub(BORDER));
+                for x in xs {
+                    let v = row[x];
+                    // Strictly greater than the neighbours earlier in raster order, at least
+                    // as large as the later ones (deterministic ties); the centre compares
+                    // equal to itself and is neither.
+                    if v > 0.0 && v >= thr && is_peak(x, y, v) {
+                        out.push(InterestPoint {
+                            x: x as u32,
+                            y: y as u32,
+                            value: v,
+                        });
                     }
                 }
             }
-            out.push(InterestPoint {
-                x: x as u32,
-                y: y as u32,
-                value: v,
-            });
-        }
-    }
-    out
+            out
+        })
+        .collect()
 }

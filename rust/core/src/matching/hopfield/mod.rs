@@ -31,7 +31,7 @@ use crate::error::{CoreError, Result};
 use crate::image::{check_pair, Image};
 pub use interest::{interest_points, moravec, InterestParams, InterestPoint};
 pub use network::{build_weights, run_dynamics, Csr, Dynamics, EnergyWeights, Neuron};
-use zncc::{zncc_curves, Curves, RightStats, FULL, N_REGIONS, SIM_RADIUS};
+use zncc::{max_of, zncc_curves, Curves, RightStats, FULL, N_REGIONS, SIM_RADIUS};
 
 /// Where the right candidates of a left point come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -213,17 +213,6 @@ fn right_rows(right: &Image, p: &HopfieldParams) -> HashMap<usize, Vec<usize>> {
     rows
 }
 
-/// First index of the maximum of `c[lo..=hi]` (None when the curve is all zeros: undefined).
-fn argmax(c: &[f32], lo: usize, hi: usize) -> Option<usize> {
-    let mut best: Option<(f32, usize)> = None;
-    for (d, &v) in c.iter().enumerate().take(hi + 1).skip(lo) {
-        if best.is_none_or(|b| v > b.0) {
-            best = Some((v, d));
-        }
-    }
-    best.filter(|b| b.0 > 0.0).map(|b| b.1)
-}
-
 /// Parabola vertex offset through `(d-1, a), (d, b), (d+1, c)`, clamped to +-0.5.
 fn parabola(a: f32, b: f32, c: f32) -> f32 {
     let den = a - 2.0 * b + c;
@@ -233,113 +222,168 @@ fn parabola(a: f32, b: f32, c: f32) -> f32 {
     (0.5 * (a - c) / den).clamp(-0.5, 0.5)
 }
 
+/// Image rows per parallel task of the candidate search: its right-image statistics are
+/// computed for these rows only (small enough for an even split over the threads).
+const ROWS_PER_TASK: usize = 8;
+
+/// Scratch of [`point_candidates`], reused across the points of a thread.
+#[derive(Default)]
+struct CandScratch {
+    curves: Curves,
+    ds: Vec<usize>,
+    found: Vec<Neuron>,
+}
+
+/// The candidate neurons of left point `i` appended to `out` (best ZNCC first, at most
+/// `k_cand`), with their depth-edge verdict and sub-pixel offset.
+#[allow(clippy::too_many_arguments)]
+fn point_candidates(
+    left: &Image,
+    right: &Image,
+    stats: &RightStats,
+    rows: &HashMap<usize, Vec<usize>>,
+    p: &HopfieldParams,
+    i: usize,
+    pt: &InterestPoint,
+    sc: &mut CandScratch,
+    out: &mut Vec<Neuron>,
+) {
+    let (w, h) = right.size();
+    let (x, y) = (pt.x as usize, pt.y as usize);
+    let d_hi = p.d_max.min(x.saturating_sub(SIM_RADIUS));
+    if x < SIM_RADIUS || x + SIM_RADIUS >= w || d_hi < p.d_min {
+        return;
+    }
+    let (lo_row, hi_row) = match p.candidates {
+        CandidateMode::Row => (y, y),
+        CandidateMode::Points => (
+            y.saturating_sub(p.dy_window).max(SIM_RADIUS),
+            (y + p.dy_window).min(h.saturating_sub(SIM_RADIUS + 1)),
+        ),
+    };
+    sc.found.clear();
+    for yr in lo_row..=hi_row {
+        let right_xs = rows.get(&yr).map(|v| v.as_slice()).unwrap_or(&[]);
+        if p.candidates == CandidateMode::Points && right_xs.is_empty() {
+            continue;
+        }
+        zncc_curves(left, right, stats, x, y, yr, d_hi, &mut sc.curves);
+        let cv = &sc.curves;
+        let full = &cv.curve[FULL];
+        // No disparity reaches s_min: no candidate (most rejected points end here).
+        if max_of(&full[p.d_min..=d_hi]) < p.s_min {
+            continue;
+        }
+        // Best ZNCC of every half-window over the range (None: undefined / textureless).
+        let halves: [Option<f32>; N_REGIONS - 1] = std::array::from_fn(|k| {
+            Some(max_of(&cv.curve[k + 1][p.d_min..=d_hi])).filter(|&b| b > 0.0)
+        });
+        sc.ds.clear();
+        match p.candidates {
+            CandidateMode::Row => {
+                for d in p.d_min..=d_hi {
+                    let c = full[d];
+                    if c >= p.s_min
+                        && (d == p.d_min || c >= full[d - 1])
+                        && (d == d_hi || c > full[d + 1])
+                    {
+                        sc.ds.push(d);
+                    }
+                }
+            }
+            CandidateMode::Points => {
+                for &xr in right_xs {
+                    if xr <= x && (p.d_min..=d_hi).contains(&(x - xr)) && full[x - xr] >= p.s_min {
+                        sc.ds.push(x - xr);
+                    }
+                }
+            }
+        }
+        for &d in &sc.ds {
+            let xr = x - d;
+            // Each half-window must find this disparity (within edge_tol px) as good as
+            // its best anywhere in the range, up to edge_margin: a half lying on another
+            // surface prefers that surface's disparity by far more, while a periodic
+            // texture's equal peaks (laundry's basket) stay acceptable.
+            let lo = d.saturating_sub(p.edge_tol).max(p.d_min);
+            let hi = (d + p.edge_tol).min(d_hi);
+            let halves_ok = halves.iter().enumerate().all(|(k, best)| {
+                best.is_some_and(|best| max_of(&cv.curve[k + 1][lo..=hi]) >= best - p.edge_margin)
+            });
+            // Centre check on window-mean-free grey levels: insensitive to the exposure
+            // offset between the cameras (ETH3D, KITTI), still catches a centre pixel
+            // that belongs to the other surface.
+            let lc = left.at(x, y) - cv.left_mean;
+            let rc = right.at(xr, yr) - stats.mean(xr, yr);
+            let centre_ok = (lc - rc).abs() <= p.centre_tol;
+            let sub = if p.subpixel && d >= 1 && d < d_hi {
+                parabola(full[d - 1], full[d], full[d + 1])
+            } else {
+                0.0
+            };
+            sc.found.push(Neuron {
+                point: i as u32,
+                xl: x as i32,
+                yl: y as i32,
+                xr: xr as i32,
+                yr: yr as i32,
+                sim: full[d],
+                edge_ok: halves_ok && centre_ok,
+                sub,
+            });
+        }
+    }
+    sc.found.sort_by(|a, b| {
+        b.sim
+            .total_cmp(&a.sim)
+            .then(a.xr.cmp(&b.xr))
+            .then(a.yr.cmp(&b.yr))
+    });
+    out.extend(sc.found.iter().take(p.k_cand));
+}
+
 /// Candidate neurons of every left point, grouped by point (point order, then best ZNCC first),
-/// with their depth-edge verdict and sub-pixel offset.
+/// with their depth-edge verdict and sub-pixel offset. Points are processed in fixed chunks
+/// whose outputs are concatenated in order: the result does not depend on the thread count.
 fn candidates(
     left: &Image,
     right: &Image,
     pts: &[InterestPoint],
     p: &HopfieldParams,
 ) -> Vec<Neuron> {
-    let stats = RightStats::new(right);
-    let (w, h) = right.size();
     let rows = right_rows(right, p);
-    let per_point: Vec<Vec<Neuron>> = pts
+    // Tasks: bands of image rows, each with its own right-image statistics (the rows its
+    // points search, +- dy_window in points mode).
+    let band_of = |pt: &InterestPoint| pt.y as usize / ROWS_PER_TASK;
+    let mut tasks: Vec<(usize, usize)> = Vec::new(); // point index ranges, raster order
+    let mut s0 = 0;
+    for i in 1..=pts.len() {
+        if i == pts.len() || band_of(&pts[i]) != band_of(&pts[s0]) {
+            tasks.push((s0, i));
+            s0 = i;
+        }
+    }
+    let reach = match p.candidates {
+        CandidateMode::Row => 0,
+        CandidateMode::Points => p.dy_window,
+    };
+    let per_task: Vec<Vec<Neuron>> = tasks
         .par_iter()
-        .enumerate()
-        .map_init(Curves::default, |cv, (i, pt)| {
-            let (x, y) = (pt.x as usize, pt.y as usize);
-            let d_hi = p.d_max.min(x.saturating_sub(SIM_RADIUS));
-            if x < SIM_RADIUS || x + SIM_RADIUS >= w || d_hi < p.d_min {
-                return Vec::new();
-            }
-            let mut out: Vec<Neuron> = Vec::new();
-            let row_list: Vec<usize> = match p.candidates {
-                CandidateMode::Row => vec![y],
-                CandidateMode::Points => {
-                    let lo = y.saturating_sub(p.dy_window).max(SIM_RADIUS);
-                    let hi = (y + p.dy_window).min(h.saturating_sub(SIM_RADIUS + 1));
-                    (lo..=hi).filter(|yr| rows.contains_key(yr)).collect()
+        .map_init(
+            || (CandScratch::default(), RightStats::default()),
+            |(sc, stats), &(i0, i1)| {
+                let y_lo = pts[i0].y as usize;
+                let y_hi = pts[i1 - 1].y as usize + 1;
+                stats.fill_band(right, y_lo.saturating_sub(reach), y_hi + reach);
+                let mut out = Vec::with_capacity(2 * (i1 - i0));
+                for (i, pt) in pts.iter().enumerate().take(i1).skip(i0) {
+                    point_candidates(left, right, stats, &rows, p, i, pt, sc, &mut out);
                 }
-            };
-            for yr in row_list {
-                zncc_curves(left, right, &stats, x, y, yr, d_hi, cv);
-                let full = &cv.curve[FULL];
-                // Best ZNCC of every half-window over the range (None: undefined / textureless).
-                let halves: Vec<Option<f32>> = (1..N_REGIONS)
-                    .map(|k| argmax(&cv.curve[k], p.d_min, d_hi).map(|a| cv.curve[k][a]))
-                    .collect();
-                let mut ds: Vec<usize> = Vec::new();
-                match p.candidates {
-                    CandidateMode::Row => {
-                        for d in p.d_min..=d_hi {
-                            let c = full[d];
-                            let ok_lo = d == p.d_min || c >= full[d - 1];
-                            let ok_hi = d == d_hi || c > full[d + 1];
-                            if c >= p.s_min && ok_lo && ok_hi {
-                                ds.push(d);
-                            }
-                        }
-                    }
-                    CandidateMode::Points => {
-                        for &xr in rows.get(&yr).map(|v| v.as_slice()).unwrap_or(&[]) {
-                            if xr <= x
-                                && (p.d_min..=d_hi).contains(&(x - xr))
-                                && full[x - xr] >= p.s_min
-                            {
-                                ds.push(x - xr);
-                            }
-                        }
-                    }
-                }
-                for d in ds {
-                    let xr = x - d;
-                    // Each half-window must find this disparity (within edge_tol px) as good as
-                    // its best anywhere in the range, up to edge_margin: a half lying on another
-                    // surface prefers that surface's disparity by far more, while a periodic
-                    // texture's equal peaks (laundry's basket) stay acceptable.
-                    let lo = d.saturating_sub(p.edge_tol).max(p.d_min);
-                    let hi = (d + p.edge_tol).min(d_hi);
-                    let halves_ok = halves.iter().enumerate().all(|(k, best)| {
-                        best.is_some_and(|best| {
-                            let c = &cv.curve[k + 1][lo..=hi];
-                            c.iter().copied().fold(f32::MIN, f32::max) >= best - p.edge_margin
-                        })
-                    });
-                    // Centre check on window-mean-free grey levels: insensitive to the exposure
-                    // offset between the cameras (ETH3D, KITTI), still catches a centre pixel
-                    // that belongs to the other surface.
-                    let lc = left.at(x, y) - cv.left_mean;
-                    let rc = right.at(xr, yr) - stats.mean(xr, yr);
-                    let centre_ok = (lc - rc).abs() <= p.centre_tol;
-                    let sub = if p.subpixel && d >= 1 && d < d_hi {
-                        parabola(full[d - 1], full[d], full[d + 1])
-                    } else {
-                        0.0
-                    };
-                    out.push(Neuron {
-                        point: i as u32,
-                        xl: x as i32,
-                        yl: y as i32,
-                        xr: xr as i32,
-                        yr: yr as i32,
-                        sim: full[d],
-                        edge_ok: halves_ok && centre_ok,
-                        sub,
-                    });
-                }
-            }
-            out.sort_by(|a, b| {
-                b.sim
-                    .total_cmp(&a.sim)
-                    .then(a.xr.cmp(&b.xr))
-                    .then(a.yr.cmp(&b.yr))
-            });
-            out.truncate(p.k_cand);
-            out
-        })
+                out
+            },
+        )
         .collect();
-    per_point.into_iter().flatten().collect()
+    per_task.concat()
 }
 
 fn median(v: &mut [f32]) -> f32 {
@@ -378,17 +422,19 @@ fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usi
     }
     let mut all_dy: Vec<f32> = singles.iter().map(|&s| neurons[s].dy() as f32).collect();
     let global = median(&mut all_dy);
-    let half = p.weights.nbr_half;
+    let half = p.weights.nbr_half.max(1);
+    let sxy: Vec<(i32, i32)> = singles
+        .iter()
+        .map(|&s| (neurons[s].xl.max(0), neurons[s].yl.max(0)))
+        .collect();
+    let grid = network::PointGrid::new(&sxy, half);
     // Reference vertical disparity: median over the single matches in the 40x40 window.
     let local_ref = |a: usize| -> f32 {
         let n = &neurons[a];
-        let mut v: Vec<f32> = singles
-            .iter()
-            .filter(|&&s| {
-                (neurons[s].xl - n.xl).abs() <= half && (neurons[s].yl - n.yl).abs() <= half
-            })
-            .map(|&s| neurons[s].dy() as f32)
-            .collect();
+        let mut v: Vec<f32> = Vec::new();
+        grid.for_each_in_window((n.xl.max(0), n.yl.max(0)), half, |k| {
+            v.push(neurons[singles[k]].dy() as f32)
+        });
         if v.is_empty() {
             global
         } else {
@@ -458,6 +504,12 @@ fn finish(
         .map(|&(a, _)| (neurons[a].xl.max(0), neurons[a].yl.max(0)))
         .collect();
     let grid = network::PointGrid::new(&sxy, half);
+    // Survivor disparities in grid order.
+    let sd: Vec<i32> = grid
+        .items
+        .iter()
+        .map(|&t| neurons[survivors[t as usize].0].dx())
+        .collect();
     survivors
         .par_iter()
         .enumerate()
@@ -466,15 +518,24 @@ fn finish(
                 return true;
             }
             let d = neurons[a].dx();
+            let (x, y) = sxy[s];
             let (mut agree, mut near) = (0usize, 0usize);
-            grid.for_each_near(&sxy, s, half, |t| {
-                near += 1;
-                if (neurons[survivors[t].0].dx() - d).abs() <= p.agree_tol {
-                    agree += 1;
+            // Branch-free count over the 3x3 cells (the survivor itself is excluded below).
+            for (r0, r1) in grid.ranges(x, y) {
+                let cells = grid.xs[r0..r1]
+                    .iter()
+                    .zip(&grid.ys[r0..r1])
+                    .zip(&sd[r0..r1]);
+                for ((&qx, &qy), &qd) in cells {
+                    let inside = (qx - x).abs() <= half && (qy - y).abs() <= half;
+                    near += usize::from(inside);
+                    agree += usize::from(inside && (qd - d).abs() <= p.agree_tol);
                 }
-            });
-            // Dense areas: at least min_agree agreeing neighbours (C.10). Sparse areas (weak
-            // texture) optionally: a large share of the few neighbours, at least min_agree_sparse.
+            }
+            near -= 1;
+            agree -= usize::from(p.agree_tol >= 0); // the survivor itself
+                                                    // Dense areas: at least min_agree agreeing neighbours (C.10). Sparse areas (weak
+                                                    // texture) optionally: a large share of the few neighbours, at least min_agree_sparse.
             agree >= p.min_agree
                 || (p.agree_share > 0.0
                     && agree >= p.min_agree_sparse
