@@ -19,12 +19,14 @@ pub mod filter;
 pub mod level;
 pub mod pool;
 pub mod post;
+pub mod search;
 
 use crate::error::{CoreError, Result};
 use crate::image::{check_pair, Image};
 use filter::Channel;
-use level::{chan_consts, energy_terms, level_data, newton_step, LevelData};
+use level::{chan_consts, level_data, newton_step};
 use pool::Buf;
+use search::search;
 
 /// Parameters of the Gabor channel (defaults: algorithms.md A.3 with the A.9 fixes).
 #[derive(Debug, Clone, PartialEq)]
@@ -457,29 +459,6 @@ fn one_direction(
             }
         }
     }
-}
-
-/// Position-shift search: for each pixel, the offset in `offs` (added to `base`) maximising the
-/// box-pooled normalised energy `sum 2 Re(y_l conj y_r) / sum (|y_l|^2 + |y_r|^2)` (A.9: the
-/// raw energy favours high-contrast positions). Ties keep the first offset.
-fn search(l: &LevelData, r: &LevelData, base: &[f32], offs: &[f32], pool: usize) -> Buf {
-    let (w, h) = (l.w, l.h);
-    let mut best = Buf::scratch(w * h);
-    best.iter_mut().for_each(|v| *v = f32::NEG_INFINITY);
-    let mut out = Buf::from_slice(base);
-    for &o in offs {
-        let (num, den) = energy_terms(l, r, base, o);
-        let num = post::box_sum(&num, w, h, pool);
-        let den = post::box_sum(&den, w, h, pool);
-        for i in 0..w * h {
-            let e = if den[i] > 0.0 { num[i] / den[i] } else { 0.0 };
-            if e > best[i] {
-                best[i] = e;
-                out[i] = base[i] + o;
-            }
-        }
-    }
-    out
 }
 
 /// Filter-bank responses of one image for one channel (debugging and parity tests):

@@ -7,7 +7,6 @@
 use super::filter::{blur_real, gaussian_taps, radius_for};
 use super::pool::Buf;
 use crate::parallel::for_each_row;
-use crate::simd::simd_fn;
 
 /// Normalised-convolution smoothing (A.5 step 3h): `cbar = G * c`, `dbar = G * (c d) / cbar`.
 pub fn normalized_conv(delta: &[f32], conf: &[f32], w: usize, h: usize, sigma: f32) -> (Buf, Buf) {
@@ -96,38 +95,6 @@ pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f3
         }
     });
     out
-}
-
-/// Box sum over a `(2r+1)^2` window with clamped borders, computed per output row (no running
-/// sums across rows, so bands are independent and results thread-count invariant).
-pub fn box_sum(src: &[f32], w: usize, h: usize, r: usize) -> Buf {
-    let mut out = Buf::scratch(w * h);
-    for_each_row(&mut out, w, |y, row| box_row(src, w, h, r, y, row));
-    out
-}
-
-simd_fn! {
-    /// One output row of [`box_sum`]: vertical sum into a padded row, then horizontal sum.
-    fn box_row(src: &[f32], w: usize, h: usize, r: usize, y: usize, row: &mut [f32]) {
-        let mut col = vec![0f32; w + 2 * r];
-        for dy in -(r as isize)..=r as isize {
-            let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
-            let c = &mut col[r..r + w];
-            for (v, s) in c.iter_mut().zip(&src[yy * w..(yy + 1) * w]) {
-                *v += s;
-            }
-        }
-        for i in 0..r {
-            col[i] = col[r];
-            col[r + w + i] = col[r + w - 1];
-        }
-        row.iter_mut().for_each(|v| *v = 0.0);
-        for k in 0..=2 * r {
-            for (v, s) in row.iter_mut().zip(&col[k..k + w]) {
-                *v += s;
-            }
-        }
-    }
 }
 
 /// Left-right consistency (A.5 step 5): left pixel `x` keeps its value only if the right map at
