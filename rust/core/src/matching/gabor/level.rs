@@ -15,6 +15,7 @@
 
 use super::fastmath::{atan2, floor_fast, ln, round_fast, sincos};
 use super::filter::{blur_real, complex_col_pass, row_pass, Channel};
+use super::gather::gather;
 use super::pool::Buf;
 use crate::parallel::{for_each_row, for_each_row2, for_each_row_pair};
 use crate::simd::simd_fn;
@@ -183,6 +184,7 @@ simd_fn! {
         let lp = &lowpass[y * w..(y + 1) * w];
         let mut yr = vec![0f32; w];
         let mut yi = vec![0f32; w];
+        let arow = &mut arow[..w];
         for x in 0..w {
             // Zero-DC: y = a - c L (a = response of the uncorrected kernel).
             yr[x] = ar[x] - dc[0] * lp[x];
@@ -306,8 +308,8 @@ pub fn kx_slots(cc: &[ChanConst]) -> Vec<f32> {
 /// Row-level preparation shared by the kernels: sub-pixel positions, validity, stability,
 /// interpolated low-pass and the carrier rotations `exp(-j kx d)` per distinct `kx`.
 struct RowPrep {
-    i0: Vec<usize>,
-    i1: Vec<usize>,
+    i0: Vec<u32>,
+    i1: Vec<u32>,
     t: Vec<f32>,
     stab: Vec<u8>,
     lp: Vec<f32>,
@@ -345,8 +347,8 @@ fn prep_row(
         let i1 = (i0 + 1).min(w - 1);
         let t = sc - i0 as f32;
         let near = (round_fast(sc) as usize).min(w - 1);
-        p.i0[x] = i0;
-        p.i1[x] = i1;
+        p.i0[x] = i0 as u32;
+        p.i1[x] = i1 as u32;
         p.t[x] = t;
         // Validity is folded into the stability byte: an out-of-image shift has no stable channel.
         p.stab[x] = if valid {
@@ -354,8 +356,13 @@ fn prep_row(
         } else {
             0
         };
-        let (a, b) = (r.lowpass[o + i0], r.lowpass[o + i1]);
-        p.lp[x] = a + t * (b - a);
+    }
+    let rlp = &r.lowpass[o..o + w];
+    let (mut a, mut b) = (vec![0f32; w], vec![0f32; w]);
+    gather(rlp, &p.i0, &mut a);
+    gather(rlp, &p.i1, &mut b);
+    for x in 0..w {
+        p.lp[x] = a[x] + p.t[x] * (b[x] - a[x]);
     }
     for (k, &kx) in slots.iter().enumerate() {
         for x in 0..w {
@@ -382,19 +389,29 @@ fn shifted_row(
     bwi: &mut [f32],
     gfr: &mut [f32],
     gfi: &mut [f32],
+    g0: &mut [f32],
+    g1: &mut [f32],
 ) {
     let w = l.w;
     let o = SUBROWS * y * w;
     let rc = &r.chan[ci];
     let (rre, rim) = (&rc[o..o + w], &rc[o + w..o + 2 * w]);
     let (rfr, rfi) = (&rc[o + 2 * w..o + 3 * w], &rc[o + 3 * w..o + 4 * w]);
-    // Scalar gather + linear interpolation of the smooth baseband and frequency phasor.
-    for x in 0..w {
-        let (i0, i1, t) = (p.i0[x], p.i1[x], p.t[x]);
-        bwr[x] = rre[i0] + t * (rre[i1] - rre[i0]);
-        bwi[x] = rim[i0] + t * (rim[i1] - rim[i0]);
-        gfr[x] = rfr[i0] + t * (rfr[i1] - rfr[i0]);
-        gfi[x] = rfi[i0] + t * (rfi[i1] - rfi[i0]);
+    // Gather + linear interpolation of the smooth baseband and frequency phasor.
+    let (a, b) = (&mut g0[..w], &mut g1[..w]);
+    let t = &p.t[..w];
+    for (src, dst) in [
+        (rre, &mut *bwr),
+        (rim, &mut *bwi),
+        (rfr, &mut *gfr),
+        (rfi, &mut *gfi),
+    ] {
+        gather(src, &p.i0, a);
+        gather(src, &p.i1, b);
+        let dst = &mut dst[..w];
+        for x in 0..w {
+            dst[x] = a[x] + t[x] * (b[x] - a[x]);
+        }
     }
     let (cre, cim) = (&l.colph[ci].0[..w], &l.colph[ci].1[..w]);
     let (rre, rim) = (l.rowph[ci].0[y], l.rowph[ci].1[y]);
@@ -430,8 +447,9 @@ simd_fn! {
         let (mut num, mut den, mut csum) = (vec![0f32; w], vec![0f32; w], vec![0f32; w]);
         let (mut bwr, mut bwi, mut gfr, mut gfi) =
             (vec![0f32; w], vec![0f32; w], vec![0f32; w], vec![0f32; w]);
+        let (mut g0, mut g1) = (vec![0f32; w], vec![0f32; w]);
         for (ci, c) in cc.iter().enumerate() {
-            shifted_row(l, r, c, ci, y, &p, &mut bwr, &mut bwi, &mut gfr, &mut gfi);
+            shifted_row(l, r, c, ci, y, &p, &mut bwr, &mut bwi, &mut gfr, &mut gfi, &mut g0, &mut g1);
             let o = SUBROWS * y * w;
             let lc = &l.chan[ci];
             let (lre, lim) = (&lc[o..o + w], &lc[o + w..o + 2 * w]);

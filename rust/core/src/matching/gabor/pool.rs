@@ -59,10 +59,7 @@ impl Buf {
                 return Buf { v, n };
             }
         }
-        Buf {
-            v: vec![0.0; n],
-            n,
-        }
+        Buf { v: vec![0.0; n], n }
     }
 
     /// A pooled copy of `src`.

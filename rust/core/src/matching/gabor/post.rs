@@ -7,6 +7,7 @@
 use super::filter::{blur_real, gaussian_taps, radius_for};
 use super::pool::Buf;
 use crate::parallel::for_each_row;
+use crate::simd::simd_fn;
 
 /// Normalised-convolution smoothing (A.5 step 3h): `cbar = G * c`, `dbar = G * (c d) / cbar`.
 pub fn normalized_conv(delta: &[f32], conf: &[f32], w: usize, h: usize, sigma: f32) -> (Buf, Buf) {
@@ -72,29 +73,59 @@ pub fn median5(src: &[f32], w: usize, h: usize) -> Buf {
     out
 }
 
-/// Bilinear sample of `src` (`w` x `h`) at `(x, y)`, clamped to the image.
-#[inline]
-fn bilinear(src: &[f32], w: usize, h: usize, x: f32, y: f32) -> f32 {
-    let x = x.clamp(0.0, (w - 1) as f32);
-    let y = y.clamp(0.0, (h - 1) as f32);
-    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
-    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
-    let (tx, ty) = (x - x0 as f32, y - y0 as f32);
-    let a = src[y0 * w + x0] + tx * (src[y0 * w + x1] - src[y0 * w + x0]);
-    let b = src[y1 * w + x0] + tx * (src[y1 * w + x1] - src[y1 * w + x0]);
-    a + ty * (b - a)
-}
-
 /// Up-samples a coarse map to `(w, h)` (pixel `x` at the fine level is `x / 2` at the coarse one),
-/// multiplying values by `scale` (2 for disparities, 1 for confidences).
+/// multiplying values by `scale` (2 for disparities, 1 for confidences). Bilinear, clamped to the
+/// coarse image: fine pixels fall on coarse samples or half-way between two, so each output row
+/// blends two x-interpolated coarse rows with the weights 0 or 1/2 (no per-pixel `floor`).
 pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f32) -> Buf {
     let mut out = Buf::scratch(w * h);
+    if sw == 0 || sh == 0 {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        return out;
+    }
+    // Per fine column: the two coarse columns and the weight of the second.
+    let cols: Vec<(usize, usize, f32)> = (0..w)
+        .map(|x| {
+            let x0 = (x / 2).min(sw - 1);
+            let x1 = (x0 + 1).min(sw - 1);
+            let t = if x % 2 == 1 && x / 2 < sw - 1 {
+                0.5
+            } else {
+                0.0
+            };
+            (x0, x1, t)
+        })
+        .collect();
     for_each_row(&mut out, w, |y, row| {
-        for (x, v) in row.iter_mut().enumerate() {
-            *v = scale * bilinear(src, sw, sh, x as f32 * 0.5, y as f32 * 0.5);
-        }
+        let y0 = (y / 2).min(sh - 1);
+        let y1 = (y0 + 1).min(sh - 1);
+        let ty = if y % 2 == 1 && y / 2 < sh - 1 {
+            0.5
+        } else {
+            0.0
+        };
+        upsample_row(
+            &src[y0 * sw..(y0 + 1) * sw],
+            &src[y1 * sw..(y1 + 1) * sw],
+            &cols,
+            ty,
+            scale,
+            row,
+        )
     });
     out
+}
+
+simd_fn! {
+    /// One output row of [`upsample`]: `scale (a + ty (b - a))` with `a`, `b` the x-interpolated
+    /// coarse rows `s0`, `s1`.
+    fn upsample_row(s0: &[f32], s1: &[f32], cols: &[(usize, usize, f32)], ty: f32, scale: f32, row: &mut [f32]) {
+        for (v, &(x0, x1, tx)) in row.iter_mut().zip(cols) {
+            let a = s0[x0] + tx * (s0[x1] - s0[x0]);
+            let b = s1[x0] + tx * (s1[x1] - s1[x0]);
+            *v = scale * (a + ty * (b - a));
+        }
+    }
 }
 
 /// Left-right consistency (A.5 step 5): left pixel `x` keeps its value only if the right map at

@@ -1,4 +1,4 @@
-//! Position-shift search (A.5 step 2 at the top level, the A.9 +-2 px re-search below it).
+//! Position-shift search (A.5 step 2 at the top level, the A.9 re-search below it).
 //!
 //! For each pixel, the candidate `base + o` (`o` in `offs`) maximising the box-pooled normalised
 //! binocular energy `sum 2 Re(y_l conj y_r) / sum (|y_l|^2 + |y_r|^2)` over a `(2p+1)^2` box
@@ -14,7 +14,8 @@
 // and the one LLVM vectorises once the slices are re-bounded to the row length.
 #![allow(clippy::needless_range_loop)]
 
-use super::fastmath::round_fast;
+use super::fastmath::floor_fast;
+use super::gather::gather;
 use super::level::{LevelData, SUBROWS};
 use super::pool::Buf;
 use crate::simd::simd_fn;
@@ -29,6 +30,28 @@ pub fn search(l: &LevelData, r: &LevelData, base: &[f32], offs: &[f32], pool: us
     let (w, h) = (l.w, l.h);
     let mut out = Buf::from_slice(base);
     if w == 0 || h == 0 || offs.is_empty() {
+        return out;
+    }
+    if pool == 0 {
+        out.par_chunks_mut(w * SEARCH_BAND)
+            .enumerate()
+            .for_each(|(band, chunk)| {
+                let mut sc = Scratch::new(w, 0);
+                let mut best = vec![0f32; w];
+                for (i, orow) in chunk.chunks_mut(w).enumerate() {
+                    let y = band * SEARCH_BAND + i;
+                    direct_row(
+                        l,
+                        r,
+                        y,
+                        &base[y * w..(y + 1) * w],
+                        offs,
+                        &mut sc,
+                        &mut best,
+                        orow,
+                    );
+                }
+            });
         return out;
     }
     let ring = 2 * pool + 1;
@@ -96,8 +119,13 @@ pub fn search(l: &LevelData, r: &LevelData, base: &[f32], offs: &[f32], pool: us
 
 /// Row buffers of one band.
 struct Scratch {
-    si: Vec<usize>,
+    si: Vec<u32>,
     valid: Vec<bool>,
+    /// `floor(x - d + 0.5)`: the shifted position at offset 0 (unpooled search).
+    j0: Vec<i32>,
+    /// Gathered right samples (re, im).
+    gr: Vec<f32>,
+    gi: Vec<f32>,
     num: Vec<f32>,
     den: Vec<f32>,
     /// A row padded by `p` clamped samples on each side (the x pooling).
@@ -110,6 +138,9 @@ impl Scratch {
         Scratch {
             si: vec![0; w],
             valid: vec![false; w],
+            j0: vec![0; w],
+            gr: vec![0.0; w],
+            gi: vec![0.0; w],
             num: vec![0.0; w],
             den: vec![0.0; w],
             pad: vec![0.0; w + 2 * p],
@@ -136,7 +167,7 @@ fn pool_x(v: &[f32], pad: &mut [f32], p: usize, out: &mut [f32]) {
 }
 
 simd_fn! {
-    /// Energy terms of row `y` at the integer shifts `round(d + off)`, pooled along x into
+    /// Energy terms of row `y` at the integer shifts `floor(x - d + 0.5) - off`, pooled along x into
     /// `(hn, hd)`: `num = sum_c 2 Re(y_l conj y_r)`, `den = sum_c |y_l|^2 + |y_r|^2`, both zero
     /// where the shifted position leaves the image. Integer shifts: the candidates are 1 px apart
     /// and pooled over a box, so interpolation buys nothing; the Newton steps refine to sub-pixel.
@@ -155,29 +186,29 @@ simd_fn! {
         let last = (w - 1) as f32;
         let (si, valid) = (&mut sc.si[..w], &mut sc.valid[..w]);
         for x in 0..w {
-            let s = round_fast(x as f32 - (drow[x] + off));
+            let s = floor_fast(x as f32 - drow[x] + 0.5) - off;
             let v = s >= 0.0 && s <= last;
             valid[x] = v;
-            si[x] = if v { s as usize } else { 0 };
+            si[x] = if v { s as u32 } else { 0 };
         }
         let (num, den) = (&mut sc.num[..w], &mut sc.den[..w]);
+        let (gr, gi) = (&mut sc.gr[..w], &mut sc.gi[..w]);
         num.iter_mut().for_each(|v| *v = 0.0);
         let ro = SUBROWS * y * w;
         for (lc, rc) in l.chan.iter().zip(&r.chan) {
             let (lre, lim) = (&lc[ro + 4 * w..ro + 5 * w], &lc[ro + 5 * w..ro + 6 * w]);
-            let (rre, rim) = (&rc[ro + 4 * w..ro + 5 * w], &rc[ro + 5 * w..ro + 6 * w]);
+            gather(&rc[ro + 4 * w..ro + 5 * w], si, gr);
+            gather(&rc[ro + 5 * w..ro + 6 * w], si, gi);
             for x in 0..w {
-                // `min` is a no-op (si < w) that lets the compiler drop the bounds checks.
-                let j = si[x].min(w - 1);
-                num[x] += lre[x] * rre[j] + lim[x] * rim[j];
+                num[x] += lre[x] * gr[x] + lim[x] * gi[x];
             }
         }
-        let (le, re) = (&l.energy[o..o + w], &r.energy[o..o + w]);
+        gather(&r.energy[o..o + w], si, gr);
+        let le = &l.energy[o..o + w];
         for x in 0..w {
             let v = valid[x];
-            let j = si[x].min(w - 1);
             num[x] = if v { 2.0 * num[x] } else { 0.0 };
-            den[x] = if v { le[x] + re[j] } else { 0.0 };
+            den[x] = if v { le[x] + gr[x] } else { 0.0 };
         }
         pool_x(num, &mut sc.pad, sc.p, hn);
         pool_x(den, &mut sc.pad, sc.p, hd);
@@ -219,6 +250,61 @@ simd_fn! {
             let better = e > best[x];
             best[x] = if better { e } else { best[x] };
             out[x] = if better { base[x] + off } else { out[x] };
+        }
+    }
+}
+
+simd_fn! {
+    /// One output row of the unpooled search (`p = 0`): every offset evaluated per pixel, no
+    /// ring and no pooling pass. Same terms and tie rule as the pooled path.
+    fn direct_row(
+        l: &LevelData,
+        r: &LevelData,
+        y: usize,
+        drow: &[f32],
+        offs: &[f32],
+        sc: &mut Scratch,
+        best: &mut [f32],
+        out: &mut [f32],
+    ) {
+        let w = l.w;
+        let o = y * w;
+        let ro = SUBROWS * y * w;
+        let (drow, best, out) = (&drow[..w], &mut best[..w], &mut out[..w]);
+        let (si, valid, j0) = (&mut sc.si[..w], &mut sc.valid[..w], &mut sc.j0[..w]);
+        let (num, gr, gi) = (&mut sc.num[..w], &mut sc.gr[..w], &mut sc.gi[..w]);
+        for x in 0..w {
+            j0[x] = floor_fast(x as f32 - drow[x] + 0.5) as i32;
+        }
+        best.iter_mut().for_each(|b| *b = f32::NEG_INFINITY);
+        let le = &l.energy[o..o + w];
+        for &off in offs {
+            let oi = off as i32;
+            for x in 0..w {
+                let j = j0[x] - oi;
+                let v = j >= 0 && j < w as i32;
+                valid[x] = v;
+                si[x] = if v { j as u32 } else { 0 };
+            }
+            num.iter_mut().for_each(|v| *v = 0.0);
+            for (lc, rc) in l.chan.iter().zip(&r.chan) {
+                let (lre, lim) = (&lc[ro + 4 * w..ro + 5 * w], &lc[ro + 5 * w..ro + 6 * w]);
+                gather(&rc[ro + 4 * w..ro + 5 * w], si, gr);
+                gather(&rc[ro + 5 * w..ro + 6 * w], si, gi);
+                for x in 0..w {
+                    num[x] += lre[x] * gr[x] + lim[x] * gi[x];
+                }
+            }
+            gather(&r.energy[o..o + w], si, gr);
+            for x in 0..w {
+                let v = valid[x];
+                let n = if v { 2.0 * num[x] } else { 0.0 };
+                let d = if v { le[x] + gr[x] } else { 0.0 };
+                let e = if d > 0.0 { n / d } else { 0.0 };
+                let better = e > best[x];
+                best[x] = if better { e } else { best[x] };
+                out[x] = if better { drow[x] + off } else { out[x] };
+            }
         }
     }
 }
