@@ -17,8 +17,9 @@ use super::fastmath::{atan2, floor_fast, ln, round_fast, sincos};
 use super::filter::{blur_real, complex_col_pass, row_pass, Channel};
 use super::gather::gather;
 use super::pool::Buf;
-use crate::parallel::{for_each_row, for_each_row2, for_each_row_pair};
+use crate::parallel::{for_each_row, for_each_row_pair, ROWS_PER_TASK};
 use crate::simd::simd_fn;
+use rayon::prelude::*;
 
 /// A response below this amplitude is numerical noise (a constant image gives ~1e-7; one grey
 /// level of texture, 1/255, gives ~1e-3), so its phase is never used whatever the percentile says.
@@ -315,8 +316,58 @@ struct RowPrep {
     lp: Vec<f32>,
     sn: Vec<Vec<f32>>,
     cs: Vec<Vec<f32>>,
+    /// Gathered low-pass samples at `i0`, `i1`.
+    a: Vec<f32>,
+    b: Vec<f32>,
 }
 
+impl RowPrep {
+    fn new(w: usize, n_slots: usize) -> Self {
+        RowPrep {
+            i0: vec![0; w],
+            i1: vec![0; w],
+            t: vec![0.0; w],
+            stab: vec![0; w],
+            lp: vec![0.0; w],
+            sn: vec![vec![0.0; w]; n_slots],
+            cs: vec![vec![0.0; w]; n_slots],
+            a: vec![0.0; w],
+            b: vec![0.0; w],
+        }
+    }
+}
+
+/// Row work buffers of the Newton step (reused across the rows of a band).
+struct RowWork {
+    num: Vec<f32>,
+    den: Vec<f32>,
+    csum: Vec<f32>,
+    bwr: Vec<f32>,
+    bwi: Vec<f32>,
+    gfr: Vec<f32>,
+    gfi: Vec<f32>,
+    g0: Vec<f32>,
+    g1: Vec<f32>,
+}
+
+impl RowWork {
+    fn new(w: usize) -> Self {
+        let z = || vec![0f32; w];
+        RowWork {
+            num: z(),
+            den: z(),
+            csum: z(),
+            bwr: z(),
+            bwi: z(),
+            gfr: z(),
+            gfi: z(),
+            g0: z(),
+            g1: z(),
+        }
+    }
+}
+
+/// Fills `p` for row `y` at the disparities `drow + off` (every entry is overwritten).
 #[inline(always)]
 fn prep_row(
     l: &LevelData,
@@ -325,19 +376,11 @@ fn prep_row(
     y: usize,
     drow: &[f32],
     off: f32,
-) -> RowPrep {
+    p: &mut RowPrep,
+) {
     let w = l.w;
     let o = y * w;
     let last = (w - 1) as f32;
-    let mut p = RowPrep {
-        i0: vec![0; w],
-        i1: vec![0; w],
-        t: vec![0.0; w],
-        stab: vec![0; w],
-        lp: vec![0.0; w],
-        sn: vec![vec![0.0; w]; slots.len()],
-        cs: vec![vec![0.0; w]; slots.len()],
-    };
     for x in 0..w {
         let d = drow[x] + off;
         let s = x as f32 - d;
@@ -358,20 +401,20 @@ fn prep_row(
         };
     }
     let rlp = &r.lowpass[o..o + w];
-    let (mut a, mut b) = (vec![0f32; w], vec![0f32; w]);
-    gather(rlp, &p.i0, &mut a);
-    gather(rlp, &p.i1, &mut b);
+    gather(rlp, &p.i0, &mut p.a);
+    gather(rlp, &p.i1, &mut p.b);
+    let (a, b, t, lp) = (&p.a[..w], &p.b[..w], &p.t[..w], &mut p.lp[..w]);
     for x in 0..w {
-        p.lp[x] = a[x] + p.t[x] * (b[x] - a[x]);
+        lp[x] = a[x] + t[x] * (b[x] - a[x]);
     }
     for (k, &kx) in slots.iter().enumerate() {
+        let (sn, cs) = (&mut p.sn[k][..w], &mut p.cs[k][..w]);
         for x in 0..w {
             let (s, c) = sincos(kx * (drow[x] + off));
-            p.sn[k][x] = s;
-            p.cs[k][x] = c;
+            sn[x] = s;
+            cs[x] = c;
         }
     }
-    p
 }
 
 /// Fills `(bwr, bwi)` with the shifted right response of channel `ci`, demodulated by the left
@@ -439,17 +482,19 @@ simd_fn! {
         y: usize,
         drow: &[f32],
         max_delta: f32,
+        p: &mut RowPrep,
+        wk: &mut RowWork,
         dout: &mut [f32],
         cout: &mut [f32],
     ) {
         let w = l.w;
-        let p = prep_row(l, r, slots, y, drow, 0.0);
-        let (mut num, mut den, mut csum) = (vec![0f32; w], vec![0f32; w], vec![0f32; w]);
-        let (mut bwr, mut bwi, mut gfr, mut gfi) =
-            (vec![0f32; w], vec![0f32; w], vec![0f32; w], vec![0f32; w]);
-        let (mut g0, mut g1) = (vec![0f32; w], vec![0f32; w]);
+        prep_row(l, r, slots, y, drow, 0.0, p);
+        let RowWork { num, den, csum, bwr, bwi, gfr, gfi, g0, g1 } = wk;
+        for v in [&mut *num, &mut *den, &mut *csum] {
+            v.iter_mut().for_each(|v| *v = 0.0);
+        }
         for (ci, c) in cc.iter().enumerate() {
-            shifted_row(l, r, c, ci, y, &p, &mut bwr, &mut bwi, &mut gfr, &mut gfi, &mut g0, &mut g1);
+            shifted_row(l, r, c, ci, y, p, bwr, bwi, gfr, gfi, g0, g1);
             let o = SUBROWS * y * w;
             let lc = &l.chan[ci];
             let (lre, lim) = (&lc[o..o + w], &lc[o + w..o + 2 * w]);
@@ -494,18 +539,29 @@ pub fn newton_step(l: &LevelData, r: &LevelData, cc: &[ChanConst], disp: &[f32])
         .iter()
         .map(|c| std::f32::consts::PI / c.kx)
         .fold(f32::INFINITY, f32::min);
-    for_each_row2(&mut delta, &mut conf, w, |y, drow, crow| {
-        newton_row(
-            l,
-            r,
-            cc,
-            &slots,
-            y,
-            &disp[y * w..(y + 1) * w],
-            max_delta,
-            drow,
-            crow,
-        )
-    });
+    let n_slots = slots.len();
+    delta
+        .par_chunks_mut(w * ROWS_PER_TASK)
+        .zip(conf.par_chunks_mut(w * ROWS_PER_TASK))
+        .enumerate()
+        .for_each(|(band, (dband, cband))| {
+            let (mut p, mut wk) = (RowPrep::new(w, n_slots), RowWork::new(w));
+            for (i, (drow, crow)) in dband.chunks_mut(w).zip(cband.chunks_mut(w)).enumerate() {
+                let y = band * ROWS_PER_TASK + i;
+                newton_row(
+                    l,
+                    r,
+                    cc,
+                    &slots,
+                    y,
+                    &disp[y * w..(y + 1) * w],
+                    max_delta,
+                    &mut p,
+                    &mut wk,
+                    drow,
+                    crow,
+                )
+            }
+        });
     (delta, conf)
 }
