@@ -37,20 +37,31 @@ fn gather_scalar(src: &[f32], idx: &[u32], out: &mut [f32], from: usize) {
 #[target_feature(enable = "avx2")]
 unsafe fn gather_avx2(src: &[f32], idx: &[u32], out: &mut [f32]) {
     use std::arch::x86_64::{
-        __m256i, _mm256_i32gather_ps, _mm256_loadu_si256, _mm256_min_epu32, _mm256_set1_epi32,
-        _mm256_storeu_ps,
+        __m256i, _mm256_add_epi32, _mm256_castsi256_ps, _mm256_cmpeq_epi32, _mm256_i32gather_ps,
+        _mm256_loadu_ps, _mm256_loadu_si256, _mm256_min_epu32, _mm256_movemask_ps,
+        _mm256_set1_epi32, _mm256_setr_epi32, _mm256_storeu_ps,
     };
     const LANES: usize = 8;
     let n = out.len().min(idx.len());
     let maxi = _mm256_set1_epi32((src.len() - 1) as i32);
+    let ramp = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     let mut x = 0;
     while x + LANES <= n {
         // SAFETY: x + 8 <= n bounds both the 8-lane load of `idx` and the store to `out`; the
         // clamped indices are <= src.len() - 1 (non-negative as i32), so every lane reads `src`.
+        // A run of 8 consecutive clamped indices i..i+7 (smooth disparities: most chunks) is read
+        // with one plain load, in bounds because i + 7 is itself a clamped index.
         unsafe {
             let iv = _mm256_loadu_si256(idx.as_ptr().add(x) as *const __m256i);
             let iv = _mm256_min_epu32(iv, maxi);
-            let v = _mm256_i32gather_ps::<4>(src.as_ptr(), iv);
+            let first = (*idx.get_unchecked(x) as usize).min(src.len() - 1);
+            let run = _mm256_add_epi32(_mm256_set1_epi32(first as i32), ramp);
+            let same = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(iv, run)));
+            let v = if same == 0xff {
+                _mm256_loadu_ps(src.as_ptr().add(first))
+            } else {
+                _mm256_i32gather_ps::<4>(src.as_ptr(), iv)
+            };
             _mm256_storeu_ps(out.as_mut_ptr().add(x), v);
         }
         x += LANES;
@@ -63,8 +74,11 @@ mod tests {
     #[test]
     fn gathers_and_clamps() {
         let src: Vec<f32> = (0..37).map(|i| i as f32 * 0.5).collect();
-        let idx: Vec<u32> = (0..29).map(|i| (i * 7 % 41) as u32).collect();
-        let mut out = vec![0f32; 29];
+        // Scattered, consecutive (the plain-load path) and clamped runs.
+        let scattered = (0..29).map(|i| (i * 7 % 41) as u32);
+        let runs = (0..24).map(|i| 3 + i as u32).chain((0..16).map(|i| 30 + i as u32));
+        let idx: Vec<u32> = scattered.chain(runs).collect();
+        let mut out = vec![0f32; idx.len()];
         super::gather(&src, &idx, &mut out);
         for (o, &i) in out.iter().zip(&idx) {
             assert_eq!(*o, src[(i as usize).min(36)]);
