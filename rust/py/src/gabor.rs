@@ -83,7 +83,7 @@ fn to_image(w: usize, h: usize, data: Vec<f32>) -> Image {
     left, right, d_min, d_max, *, freq=0.25, orientations_deg=None, bandwidth_oct=1.5, aspect=1.0,
     n_levels=None, iters_per_level=1, amp_rel_thresh=0.02, stability_tau=1.25, smooth_sigma=None,
     conf_min=0.15,
-    research_radius=3, search_pool_radius=0, lr_check=true, lr_tol=1.0, lr_coarse_levels=0,
+    research_radius=3, search_pool_radius=0, lr_check=true, lr_tol=1.5, lr_coarse_levels=1,
     iters_finest=1, research_finest=true, orientations_finest=1, fine_levels=1, lr_light=false, speckle_size=100,
     speckle_range=1.0
 ))]

@@ -76,7 +76,9 @@ mod tests {
         let src: Vec<f32> = (0..37).map(|i| i as f32 * 0.5).collect();
         // Scattered, consecutive (the plain-load path) and clamped runs.
         let scattered = (0..29).map(|i| (i * 7 % 41) as u32);
-        let runs = (0..24).map(|i| 3 + i as u32).chain((0..16).map(|i| 30 + i as u32));
+        let runs = (0..24)
+            .map(|i| 3 + i as u32)
+            .chain((0..16).map(|i| 30 + i as u32));
         let idx: Vec<u32> = scattered.chain(runs).collect();
         let mut out = vec![0f32; idx.len()];
         super::gather(&src, &idx, &mut out);

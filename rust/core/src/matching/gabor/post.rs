@@ -53,11 +53,7 @@ fn med5(mut a: f32, mut b: f32, mut c: f32, mut d: f32, mut e: f32) -> f32 {
 pub fn median5(src: &[f32], w: usize, h: usize) -> Buf {
     let mut tmp = Buf::scratch(w * h);
     for_each_row(&mut tmp, w, |y, row| {
-        let s = &src[y * w..(y + 1) * w];
-        for (x, v) in row.iter_mut().enumerate() {
-            let at = |dx: isize| s[(x as isize + dx).clamp(0, w as isize - 1) as usize];
-            *v = med5(at(-2), at(-1), at(0), at(1), at(2));
-        }
+        median5_h(&src[y * w..(y + 1) * w], row)
     });
     let mut out = Buf::scratch(w * h);
     for_each_row(&mut out, w, |y, row| {
@@ -65,12 +61,42 @@ pub fn median5(src: &[f32], w: usize, h: usize) -> Buf {
             let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
             &tmp[yy * w..(yy + 1) * w]
         };
-        let (a, b, c, d, e) = (r(-2), r(-1), r(0), r(1), r(2));
-        for (x, v) in row.iter_mut().enumerate() {
-            *v = med5(a[x], b[x], c[x], d[x], e[x]);
-        }
+        median5_v([r(-2), r(-1), r(0), r(1), r(2)], row)
     });
     out
+}
+
+/// Radius of the median window (5 taps).
+const MED_R: usize = 2;
+
+simd_fn! {
+    /// 1x5 median of one row, clamped borders (a padded copy keeps the loop branch-free).
+    fn median5_h(s: &[f32], row: &mut [f32]) {
+        let w = s.len();
+        let mut pad = vec![0f32; w + 2 * MED_R];
+        pad[MED_R..MED_R + w].copy_from_slice(s);
+        for i in 0..MED_R {
+            pad[i] = s[0];
+            pad[MED_R + w + i] = s[w - 1];
+        }
+        let (a, b, c, d, e) = (&pad[..w], &pad[1..w + 1], &pad[2..w + 2], &pad[3..w + 3], &pad[4..w + 4]);
+        let row = &mut row[..w];
+        for x in 0..w {
+            row[x] = med5(a[x], b[x], c[x], d[x], e[x]);
+        }
+    }
+}
+
+simd_fn! {
+    /// 5x1 median of five rows.
+    fn median5_v(rows: [&[f32]; 5], row: &mut [f32]) {
+        let w = row.len();
+        let [a, b, c, d, e] = rows;
+        let (a, b, c, d, e) = (&a[..w], &b[..w], &c[..w], &d[..w], &e[..w]);
+        for x in 0..w {
+            row[x] = med5(a[x], b[x], c[x], d[x], e[x]);
+        }
+    }
 }
 
 /// Up-samples a coarse map to `(w, h)` (pixel `x` at the fine level is `x / 2` at the coarse one),
@@ -83,19 +109,6 @@ pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f3
         out.iter_mut().for_each(|v| *v = 0.0);
         return out;
     }
-    // Per fine column: the two coarse columns and the weight of the second.
-    let cols: Vec<(usize, usize, f32)> = (0..w)
-        .map(|x| {
-            let x0 = (x / 2).min(sw - 1);
-            let x1 = (x0 + 1).min(sw - 1);
-            let t = if x % 2 == 1 && x / 2 < sw - 1 {
-                0.5
-            } else {
-                0.0
-            };
-            (x0, x1, t)
-        })
-        .collect();
     for_each_row(&mut out, w, |y, row| {
         let y0 = (y / 2).min(sh - 1);
         let y1 = (y0 + 1).min(sh - 1);
@@ -107,7 +120,6 @@ pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f3
         upsample_row(
             &src[y0 * sw..(y0 + 1) * sw],
             &src[y1 * sw..(y1 + 1) * sw],
-            &cols,
             ty,
             scale,
             row,
@@ -117,13 +129,29 @@ pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f3
 }
 
 simd_fn! {
-    /// One output row of [`upsample`]: `scale (a + ty (b - a))` with `a`, `b` the x-interpolated
-    /// coarse rows `s0`, `s1`.
-    fn upsample_row(s0: &[f32], s1: &[f32], cols: &[(usize, usize, f32)], ty: f32, scale: f32, row: &mut [f32]) {
-        for (v, &(x0, x1, tx)) in row.iter_mut().zip(cols) {
-            let a = s0[x0] + tx * (s0[x1] - s0[x0]);
-            let b = s1[x0] + tx * (s1[x1] - s1[x0]);
-            *v = scale * (a + ty * (b - a));
+    /// One output row of [`upsample`]: `scale (a + ty (b - a))` with `a`, `b` the coarse rows
+    /// `s0`, `s1` interpolated along x (`v + tx (next - v)`, `tx` 0 at even fine columns and 1/2
+    /// at odd ones, 0 past the last coarse column), built per coarse column and interleaved.
+    fn upsample_row(s0: &[f32], s1: &[f32], ty: f32, scale: f32, row: &mut [f32]) {
+        let (sw, w) = (s0.len(), row.len());
+        let half: Vec<f32> = (0..sw).map(|k| if k + 1 < sw { 0.5 } else { 0.0 }).collect();
+        let interp = |s: &[f32]| -> Vec<f32> {
+            let s = &s[..sw];
+            // Columns past 2 sw (not produced by the pyramid) clamp to the last coarse column.
+            let last = s[sw - 1];
+            let mut fine = vec![last + 0.0 * (last - last); (2 * sw).max(w)];
+            let next = |k: usize| s[(k + 1).min(sw - 1)];
+            for k in 0..sw {
+                let (v, n) = (s[k], next(k));
+                fine[2 * k] = v + 0.0 * (n - v);
+                fine[2 * k + 1] = v + half[k] * (n - v);
+            }
+            fine
+        };
+        let (a, b) = (interp(s0), interp(s1));
+        let (a, b, row) = (&a[..w], &b[..w], &mut row[..w]);
+        for x in 0..w {
+            row[x] = scale * (a[x] + ty * (b[x] - a[x]));
         }
     }
 }
