@@ -139,7 +139,7 @@ simd_fn! {
             let s = &s[..sw];
             // Columns past 2 sw (not produced by the pyramid) clamp to the last coarse column.
             let last = s[sw - 1];
-            let mut fine = vec![last + 0.0 * (last - last); (2 * sw).max(w)];
+            let mut fine = vec![last; (2 * sw).max(w)];
             let next = |k: usize| s[(k + 1).min(sw - 1)];
             for k in 0..sw {
                 let (v, n) = (s[k], next(k));
