@@ -179,12 +179,15 @@ simd_fn! {
         orow: &mut [f32],
         arow: &mut [f32],
     ) {
-        let mut ar = vec![0f32; w];
-        let mut ai = vec![0f32; w];
-        complex_col_pass(hre, him, w, h, y, hy, &mut ar, &mut ai);
+        ROW_SCRATCH.with_borrow_mut(|buf| {
+        // Every entry of the four rows is written before it is read.
+        buf.resize(4 * w, 0.0);
+        let (ar, rest) = buf.split_at_mut(w);
+        let (ai, rest) = rest.split_at_mut(w);
+        let (yr, yi) = rest.split_at_mut(w);
+        let (yi, ar, ai, yr) = (&mut yi[..w], &mut ar[..w], &mut ai[..w], &mut yr[..w]);
+        complex_col_pass(hre, him, w, h, y, hy, ar, ai);
         let lp = &lowpass[y * w..(y + 1) * w];
-        let mut yr = vec![0f32; w];
-        let mut yi = vec![0f32; w];
         let arow = &mut arow[..w];
         for x in 0..w {
             // Zero-DC: y = a - c L (a = response of the uncorrected kernel).
@@ -228,7 +231,14 @@ simd_fn! {
                 fi[x] = yi2[x] * yr1[x] - yr2[x] * yi1[x] + yi1[x] * yr0[x] - yr1[x] * yi0[x];
             }
         }
+        });
     }
+}
+
+thread_local! {
+    /// Per-thread row buffers of [`build_row`] (a fresh allocation per row and channel was a
+    /// visible share of the filtering time).
+    static ROW_SCRATCH: std::cell::RefCell<Vec<f32>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 simd_fn! {
@@ -238,12 +248,14 @@ simd_fn! {
         if w < 3 || fi.len() != w || arow.len() != w || srow.len() != w {
             return;
         }
+        // ln rho^2 once per pixel (each is used by both neighbours).
+        let lr: Vec<f32> = arow.iter().map(|&a| ln(a + LN_EPS)).collect();
         let n = w - 2;
-        let (fr, fi, a0, a2) = (&fr[1..w - 1], &fi[1..w - 1], &arow[..n], &arow[2..]);
+        let (fr, fi, l0, l2) = (&fr[1..w - 1], &fi[1..w - 1], &lr[..n], &lr[2..]);
         let s = &mut srow[1..w - 1];
         for x in 0..n {
             let im_psi = atan2(fi[x], fr[x]);
-            let re_psi = 0.25 * (ln(a2[x] + LN_EPS) - ln(a0[x] + LN_EPS));
+            let re_psi = 0.25 * (l2[x] - l0[x]);
             let dk = im_psi - k0;
             let ok = (re_psi * re_psi + dk * dk <= lim2) & (im_psi >= MIN_FREQ_RATIO * k0);
             s[x] |= if ok { bit } else { 0 };

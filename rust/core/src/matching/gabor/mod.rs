@@ -319,17 +319,17 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
         let dr = post::flip_x(&b.disp, w, h);
         post::lr_check(&disp, &dr, w, h, params.lr_tol)
     });
-    for i in 0..w * h {
-        let x = (i % w) as f32;
-        let s = x - disp[i];
-        let valid = conf[i] >= params.conf_min
-            && s >= 0.0
-            && s <= (w - 1) as f32
-            && lr_ok.as_ref().is_none_or(|v| v[i]);
-        if !valid {
-            disp[i] = f32::NAN;
+    let last = (w - 1) as f32;
+    crate::parallel::for_each_row2(&mut disp, &mut conf, w, |y, drow, crow| {
+        let lr = lr_ok.as_ref().map(|v| &v[y * w..(y + 1) * w]);
+        for (x, (d, c)) in drow.iter_mut().zip(crow.iter()).enumerate() {
+            let s = x as f32 - *d;
+            let valid = *c >= params.conf_min && s >= 0.0 && s <= last && lr.is_none_or(|v| v[x]);
+            if !valid {
+                *d = f32::NAN;
+            }
         }
-    }
+    });
     post::remove_speckles(&mut disp, w, h, params.speckle_size, params.speckle_range);
     for (c, d) in conf.iter_mut().zip(&disp) {
         *c = if d.is_finite() {

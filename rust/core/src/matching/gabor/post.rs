@@ -131,27 +131,29 @@ pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f3
 simd_fn! {
     /// One output row of [`upsample`]: `scale (a + ty (b - a))` with `a`, `b` the coarse rows
     /// `s0`, `s1` interpolated along x (`v + tx (next - v)`, `tx` 0 at even fine columns and 1/2
-    /// at odd ones, 0 past the last coarse column), built per coarse column and interleaved.
+    /// at odd ones, 0 past the last coarse column). Fine columns `2k`, `2k + 1` come from coarse
+    /// column `k`.
     fn upsample_row(s0: &[f32], s1: &[f32], ty: f32, scale: f32, row: &mut [f32]) {
         let (sw, w) = (s0.len(), row.len());
-        let half: Vec<f32> = (0..sw).map(|k| if k + 1 < sw { 0.5 } else { 0.0 }).collect();
-        let interp = |s: &[f32]| -> Vec<f32> {
-            let s = &s[..sw];
-            // Columns past 2 sw (not produced by the pyramid) clamp to the last coarse column.
-            let last = s[sw - 1];
-            let mut fine = vec![last; (2 * sw).max(w)];
-            let next = |k: usize| s[(k + 1).min(sw - 1)];
-            for k in 0..sw {
-                let (v, n) = (s[k], next(k));
-                fine[2 * k] = v + 0.0 * (n - v);
-                fine[2 * k + 1] = v + half[k] * (n - v);
-            }
-            fine
-        };
-        let (a, b) = (interp(s0), interp(s1));
-        let (a, b, row) = (&a[..w], &b[..w], &mut row[..w]);
-        for x in 0..w {
-            row[x] = scale * (a[x] + ty * (b[x] - a[x]));
+        if sw == 0 || s1.len() != sw {
+            return;
+        }
+        let at = |a: f32, b: f32| scale * (a + ty * (b - a));
+        let pairs = (w / 2).min(sw - 1);
+        let (s0n, s1n) = (&s0[1..], &s1[1..]);
+        for (k, px) in row[..2 * pairs].chunks_exact_mut(2).enumerate() {
+            let (v0, n0, v1, n1) = (s0[k], s0n[k], s1[k], s1n[k]);
+            px[0] = at(v0 + 0.0 * (n0 - v0), v1 + 0.0 * (n1 - v1));
+            px[1] = at(v0 + 0.5 * (n0 - v0), v1 + 0.5 * (n1 - v1));
+        }
+        // Columns from 2 (sw - 1) on read the last coarse column (its "next" is itself).
+        let (v0, v1) = (s0[sw - 1], s1[sw - 1]);
+        for (x, v) in row.iter_mut().enumerate().skip(2 * pairs) {
+            let k = (x / 2).min(sw - 1);
+            let (a, b) = if k < sw - 1 { (s0[k], s1[k]) } else { (v0, v1) };
+            let (na, nb) = if k < sw - 1 { (s0[k + 1], s1[k + 1]) } else { (v0, v1) };
+            let t = if x % 2 == 1 && k < sw - 1 { 0.5 } else { 0.0 };
+            *v = at(a + t * (na - a), b + t * (nb - b));
         }
     }
 }
