@@ -265,12 +265,16 @@ simd_fn! {
 
 /// Deterministic percentile (`q` in [0, 1]) of a sample (nearest rank).
 pub fn percentile(v: &[f32], q: f32) -> f32 {
+    percentile_in_place(&mut v.to_vec(), q)
+}
+
+/// [`percentile`] that reorders `v` instead of copying it.
+fn percentile_in_place(v: &mut [f32], q: f32) -> f32 {
     if v.is_empty() {
         return 0.0;
     }
-    let mut s = v.to_vec();
-    let k = ((q * (s.len() - 1) as f32).round() as usize).min(s.len() - 1);
-    let (_, m, _) = s.select_nth_unstable_by(k, |a, b| a.total_cmp(b));
+    let k = ((q * (v.len() - 1) as f32).round() as usize).min(v.len() - 1);
+    let (_, m, _) = v.select_nth_unstable_by(k, |a, b| a.total_cmp(b));
     *m
 }
 
@@ -281,14 +285,21 @@ pub fn chan_consts(
     r: &LevelData,
     amp_rel: f32,
 ) -> Vec<ChanConst> {
+    // One selection per channel, run in parallel (each is sequential and O(samples)).
+    let thr: Vec<f32> = (0..chans.len())
+        .into_par_iter()
+        .map(|ci| {
+            let mut s = Vec::with_capacity(l.amp2_samples[ci].len() + r.amp2_samples[ci].len());
+            s.extend_from_slice(&l.amp2_samples[ci]);
+            s.extend_from_slice(&r.amp2_samples[ci]);
+            (amp_rel * percentile_in_place(&mut s, AMP_PERCENTILE).sqrt()).max(AMP_ABS_FLOOR)
+        })
+        .collect();
     let mut slots: Vec<f32> = Vec::new();
     chans
         .iter()
-        .enumerate()
-        .map(|(ci, c)| {
-            let mut s = l.amp2_samples[ci].clone();
-            s.extend_from_slice(&r.amp2_samples[ci]);
-            let thr = (amp_rel * percentile(&s, AMP_PERCENTILE).sqrt()).max(AMP_ABS_FLOOR);
+        .zip(thr)
+        .map(|(c, thr)| {
             let kx_slot = match slots.iter().position(|&k| k == c.kx) {
                 Some(p) => p,
                 None => {
