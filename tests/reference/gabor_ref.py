@@ -25,10 +25,10 @@ AMP_ABS_FLOOR = 1e-4
 AMP_PERCENTILE = 0.95
 PERCENTILE_STRIDE = 3
 MIN_FREQ_RATIO = 0.5
-ORIENTATIONS = (0.0, 30.0, -30.0, 60.0, -60.0)
+ORIENTATIONS = (0.0, 60.0, -60.0)
 BANDWIDTH_OCT = 1.5
 #: Orientations used at full resolution (the first ones of ``ORIENTATIONS``).
-ORIENTATIONS_FINEST = 3
+ORIENTATIONS_FINEST = 1
 
 
 def sigma_from_bandwidth(freq: float, bandwidth_oct: float) -> float:
@@ -291,7 +291,7 @@ def disparity_one_level(
     amp_rel: float = 0.02,
     tau: float = 1.25,
     conf_min: float = 0.15,
-    pool: int = 2,
+    pool: int = 0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Whole pipeline at one level (``n_levels=1``, no LR check, no speckle removal)."""
     # With one level, that level is the finest: it uses the full-resolution orientations.

@@ -1,10 +1,11 @@
 """Gabor phase-disparity channel (algorithms.md A.5 with the A.9 fixes), a thin wrapper of Rust.
 
 The kernel lives in ``rust/core/src/matching/gabor``: a multi-scale quadrature Gabor bank
-(five orientations, zero-DC kernels), coarse-to-fine phase-difference disparity with
-position-shifted right responses, local frequency, amplitude / stability confidence,
-normalised-convolution smoothing, a 5x5 median per Newton step, a +-2 px position-shift re-search
-per level, a left-right check and speckle removal. Pixels that are not confident are ``NaN``.
+(0 and +-60 degrees, zero-DC kernels; the 0 degree channel alone at full resolution),
+coarse-to-fine phase-difference disparity with position-shifted right responses, local
+frequency, amplitude / stability confidence, normalised-convolution smoothing, a 5x5 median per
+Newton step, a +-3 px position-shift re-search per level, a left-right check and speckle
+removal. Pixels that are not confident are ``NaN``.
 """
 
 from __future__ import annotations
@@ -24,23 +25,23 @@ __all__ = ["DEFAULTS", "GaborResult", "gabor_disparity", "gabor_responses"]
 #: Default parameters of :func:`gabor_disparity` (mirrors ``GaborParams::default`` in Rust).
 DEFAULTS: dict[str, object] = {
     "freq": 0.25,
-    "orientations_deg": (0.0, 30.0, -30.0, 60.0, -60.0),
+    "orientations_deg": (0.0, 60.0, -60.0),
     "bandwidth_oct": 1.5,
     "aspect": 1.0,
     "n_levels": None,
-    "iters_per_level": 2,
+    "iters_per_level": 1,
     "amp_rel_thresh": 0.02,
     "stability_tau": 1.25,
     "smooth_sigma": None,
     "conf_min": 0.15,
-    "research_radius": 2,
-    "search_pool_radius": 2,
+    "research_radius": 3,
+    "search_pool_radius": 0,
     "lr_check": True,
-    "lr_tol": 1.0,
-    "lr_coarse_levels": 0,
+    "lr_tol": 1.5,
+    "lr_coarse_levels": 1,
     "iters_finest": 1,
     "research_finest": True,
-    "orientations_finest": 3,
+    "orientations_finest": 1,
     "fine_levels": 1,
     "lr_light": False,
     "speckle_size": 100,

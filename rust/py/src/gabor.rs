@@ -81,10 +81,10 @@ fn to_image(w: usize, h: usize, data: Vec<f32>) -> Image {
 #[pyfunction]
 #[pyo3(signature = (
     left, right, d_min, d_max, *, freq=0.25, orientations_deg=None, bandwidth_oct=1.5, aspect=1.0,
-    n_levels=None, iters_per_level=2, amp_rel_thresh=0.02, stability_tau=1.25, smooth_sigma=None,
+    n_levels=None, iters_per_level=1, amp_rel_thresh=0.02, stability_tau=1.25, smooth_sigma=None,
     conf_min=0.15,
-    research_radius=2, search_pool_radius=2, lr_check=true, lr_tol=1.0, lr_coarse_levels=0,
-    iters_finest=1, research_finest=true, orientations_finest=3, fine_levels=1, lr_light=false, speckle_size=100,
+    research_radius=3, search_pool_radius=0, lr_check=true, lr_tol=1.5, lr_coarse_levels=1,
+    iters_finest=1, research_finest=true, orientations_finest=1, fine_levels=1, lr_light=false, speckle_size=100,
     speckle_range=1.0
 ))]
 #[allow(clippy::too_many_arguments)]

@@ -55,16 +55,19 @@ pub fn atan2(y: f32, x: f32) -> f32 {
 #[inline(always)]
 pub fn sincos(x: f32) -> (f32, f32) {
     // Reduce to r in [-pi/4, pi/4] and a quadrant q (Cody-Waite split of pi/2).
-    let q = round_fast(x * FRAC_2_PI);
+    let t = x * FRAC_2_PI + ROUND_MAGIC;
+    let q = t - ROUND_MAGIC;
+    // The low mantissa bits of `t` hold `q` modulo 2^22 (two's complement): the quadrant
+    // without a float-to-int conversion, which kept this loop from vectorising.
+    let qi = t.to_bits();
     let r = (x - q * 1.570_312_5) - q * 4.838_268e-4;
     let r2 = r * r;
     let s = r * (1.0 + r2 * (-0.166_666_55 + r2 * (0.008_332_161 + r2 * -0.000_195_152_96)));
     let c = 1.0 + r2 * (-0.5 + r2 * (0.041_666_42 + r2 * (-0.001_388_676_4 + r2 * 2.443_315_7e-5)));
-    let qi = q as i32;
     let swap = qi & 1 != 0;
     let (a, b) = if swap { (c, s) } else { (s, c) };
     let a = if qi & 2 != 0 { -a } else { a };
-    let b = if (qi + 1) & 2 != 0 { -b } else { b };
+    let b = if qi.wrapping_add(1) & 2 != 0 { -b } else { b };
     (a, b)
 }
 

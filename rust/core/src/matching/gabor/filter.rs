@@ -187,9 +187,15 @@ simd_fn! {
         let w = row.len();
         let r = g.len() / 2;
         let pad = mirror_pad(row, r);
-        out.iter_mut().for_each(|v| *v = 0.0);
-        for (k, &gk) in g.iter().enumerate() {
-            for (o, &p) in out.iter_mut().zip(&pad[k..k + w]) {
+        // The first tap initialises the sum (0 + a == a: no separate zero fill).
+        let Some((&g0, rest)) = g.split_first() else {
+            return;
+        };
+        for (o, &p) in out.iter_mut().zip(&pad[..w]) {
+            *o = g0 * p;
+        }
+        for (k, &gk) in rest.iter().enumerate() {
+            for (o, &p) in out.iter_mut().zip(&pad[k + 1..k + 1 + w]) {
                 *o += gk * p;
             }
         }
@@ -200,11 +206,18 @@ simd_fn! {
     /// Column pass of a real separable blur for output row `y`.
     fn real_col_pass(src: &[f32], w: usize, h: usize, y: usize, g: &[f32], out: &mut [f32]) {
         let r = g.len() / 2;
-        out.iter_mut().for_each(|v| *v = 0.0);
         for (k, &gk) in g.iter().enumerate() {
             let yy = mirror(y as isize + k as isize - r as isize, h);
-            for (o, &p) in out.iter_mut().zip(&src[yy * w..(yy + 1) * w]) {
-                *o += gk * p;
+            let s = &src[yy * w..(yy + 1) * w];
+            if k == 0 {
+                // The first tap initialises the sum (no separate zero fill).
+                for (o, &p) in out.iter_mut().zip(s) {
+                    *o = gk * p;
+                }
+            } else {
+                for (o, &p) in out.iter_mut().zip(s) {
+                    *o += gk * p;
+                }
             }
         }
     }

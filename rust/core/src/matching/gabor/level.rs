@@ -15,9 +15,11 @@
 
 use super::fastmath::{atan2, floor_fast, ln, round_fast, sincos};
 use super::filter::{blur_real, complex_col_pass, row_pass, Channel};
+use super::gather::gather;
 use super::pool::Buf;
-use crate::parallel::{for_each_row, for_each_row2, for_each_row_pair};
+use crate::parallel::{for_each_row, for_each_row_pair, ROWS_PER_TASK};
 use crate::simd::simd_fn;
+use rayon::prelude::*;
 
 /// A response below this amplitude is numerical noise (a constant image gives ~1e-7; one grey
 /// level of texture, 1/255, gives ~1e-3), so its phase is never used whatever the percentile says.
@@ -177,12 +179,16 @@ simd_fn! {
         orow: &mut [f32],
         arow: &mut [f32],
     ) {
-        let mut ar = vec![0f32; w];
-        let mut ai = vec![0f32; w];
-        complex_col_pass(hre, him, w, h, y, hy, &mut ar, &mut ai);
+        ROW_SCRATCH.with_borrow_mut(|buf| {
+        // Every entry of the four rows is written before it is read.
+        buf.resize(4 * w, 0.0);
+        let (ar, rest) = buf.split_at_mut(w);
+        let (ai, rest) = rest.split_at_mut(w);
+        let (yr, yi) = rest.split_at_mut(w);
+        let (yi, ar, ai, yr) = (&mut yi[..w], &mut ar[..w], &mut ai[..w], &mut yr[..w]);
+        complex_col_pass(hre, him, w, h, y, hy, ar, ai);
         let lp = &lowpass[y * w..(y + 1) * w];
-        let mut yr = vec![0f32; w];
-        let mut yi = vec![0f32; w];
+        let arow = &mut arow[..w];
         for x in 0..w {
             // Zero-DC: y = a - c L (a = response of the uncorrected kernel).
             yr[x] = ar[x] - dc[0] * lp[x];
@@ -225,7 +231,14 @@ simd_fn! {
                 fi[x] = yi2[x] * yr1[x] - yr2[x] * yi1[x] + yi1[x] * yr0[x] - yr1[x] * yi0[x];
             }
         }
+        });
     }
+}
+
+thread_local! {
+    /// Per-thread row buffers of [`build_row`] (a fresh allocation per row and channel was a
+    /// visible share of the filtering time).
+    static ROW_SCRATCH: std::cell::RefCell<Vec<f32>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 simd_fn! {
@@ -235,12 +248,14 @@ simd_fn! {
         if w < 3 || fi.len() != w || arow.len() != w || srow.len() != w {
             return;
         }
+        // ln rho^2 once per pixel (each is used by both neighbours).
+        let lr: Vec<f32> = arow.iter().map(|&a| ln(a + LN_EPS)).collect();
         let n = w - 2;
-        let (fr, fi, a0, a2) = (&fr[1..w - 1], &fi[1..w - 1], &arow[..n], &arow[2..]);
+        let (fr, fi, l0, l2) = (&fr[1..w - 1], &fi[1..w - 1], &lr[..n], &lr[2..]);
         let s = &mut srow[1..w - 1];
         for x in 0..n {
             let im_psi = atan2(fi[x], fr[x]);
-            let re_psi = 0.25 * (ln(a2[x] + LN_EPS) - ln(a0[x] + LN_EPS));
+            let re_psi = 0.25 * (l2[x] - l0[x]);
             let dk = im_psi - k0;
             let ok = (re_psi * re_psi + dk * dk <= lim2) & (im_psi >= MIN_FREQ_RATIO * k0);
             s[x] |= if ok { bit } else { 0 };
@@ -250,12 +265,16 @@ simd_fn! {
 
 /// Deterministic percentile (`q` in [0, 1]) of a sample (nearest rank).
 pub fn percentile(v: &[f32], q: f32) -> f32 {
+    percentile_in_place(&mut v.to_vec(), q)
+}
+
+/// [`percentile`] that reorders `v` instead of copying it.
+fn percentile_in_place(v: &mut [f32], q: f32) -> f32 {
     if v.is_empty() {
         return 0.0;
     }
-    let mut s = v.to_vec();
-    let k = ((q * (s.len() - 1) as f32).round() as usize).min(s.len() - 1);
-    let (_, m, _) = s.select_nth_unstable_by(k, |a, b| a.total_cmp(b));
+    let k = ((q * (v.len() - 1) as f32).round() as usize).min(v.len() - 1);
+    let (_, m, _) = v.select_nth_unstable_by(k, |a, b| a.total_cmp(b));
     *m
 }
 
@@ -266,14 +285,21 @@ pub fn chan_consts(
     r: &LevelData,
     amp_rel: f32,
 ) -> Vec<ChanConst> {
+    // One selection per channel, run in parallel (each is sequential and O(samples)).
+    let thr: Vec<f32> = (0..chans.len())
+        .into_par_iter()
+        .map(|ci| {
+            let mut s = Vec::with_capacity(l.amp2_samples[ci].len() + r.amp2_samples[ci].len());
+            s.extend_from_slice(&l.amp2_samples[ci]);
+            s.extend_from_slice(&r.amp2_samples[ci]);
+            (amp_rel * percentile_in_place(&mut s, AMP_PERCENTILE).sqrt()).max(AMP_ABS_FLOOR)
+        })
+        .collect();
     let mut slots: Vec<f32> = Vec::new();
     chans
         .iter()
-        .enumerate()
-        .map(|(ci, c)| {
-            let mut s = l.amp2_samples[ci].clone();
-            s.extend_from_slice(&r.amp2_samples[ci]);
-            let thr = (amp_rel * percentile(&s, AMP_PERCENTILE).sqrt()).max(AMP_ABS_FLOOR);
+        .zip(thr)
+        .map(|(c, thr)| {
             let kx_slot = match slots.iter().position(|&k| k == c.kx) {
                 Some(p) => p,
                 None => {
@@ -306,15 +332,65 @@ pub fn kx_slots(cc: &[ChanConst]) -> Vec<f32> {
 /// Row-level preparation shared by the kernels: sub-pixel positions, validity, stability,
 /// interpolated low-pass and the carrier rotations `exp(-j kx d)` per distinct `kx`.
 struct RowPrep {
-    i0: Vec<usize>,
-    i1: Vec<usize>,
+    i0: Vec<u32>,
+    i1: Vec<u32>,
     t: Vec<f32>,
     stab: Vec<u8>,
     lp: Vec<f32>,
     sn: Vec<Vec<f32>>,
     cs: Vec<Vec<f32>>,
+    /// Gathered low-pass samples at `i0`, `i1`.
+    a: Vec<f32>,
+    b: Vec<f32>,
 }
 
+impl RowPrep {
+    fn new(w: usize, n_slots: usize) -> Self {
+        RowPrep {
+            i0: vec![0; w],
+            i1: vec![0; w],
+            t: vec![0.0; w],
+            stab: vec![0; w],
+            lp: vec![0.0; w],
+            sn: vec![vec![0.0; w]; n_slots],
+            cs: vec![vec![0.0; w]; n_slots],
+            a: vec![0.0; w],
+            b: vec![0.0; w],
+        }
+    }
+}
+
+/// Row work buffers of the Newton step (reused across the rows of a band).
+struct RowWork {
+    num: Vec<f32>,
+    den: Vec<f32>,
+    csum: Vec<f32>,
+    bwr: Vec<f32>,
+    bwi: Vec<f32>,
+    gfr: Vec<f32>,
+    gfi: Vec<f32>,
+    g0: Vec<f32>,
+    g1: Vec<f32>,
+}
+
+impl RowWork {
+    fn new(w: usize) -> Self {
+        let z = || vec![0f32; w];
+        RowWork {
+            num: z(),
+            den: z(),
+            csum: z(),
+            bwr: z(),
+            bwi: z(),
+            gfr: z(),
+            gfi: z(),
+            g0: z(),
+            g1: z(),
+        }
+    }
+}
+
+/// Fills `p` for row `y` at the disparities `drow + off` (every entry is overwritten).
 #[inline(always)]
 fn prep_row(
     l: &LevelData,
@@ -323,19 +399,11 @@ fn prep_row(
     y: usize,
     drow: &[f32],
     off: f32,
-) -> RowPrep {
+    p: &mut RowPrep,
+) {
     let w = l.w;
     let o = y * w;
     let last = (w - 1) as f32;
-    let mut p = RowPrep {
-        i0: vec![0; w],
-        i1: vec![0; w],
-        t: vec![0.0; w],
-        stab: vec![0; w],
-        lp: vec![0.0; w],
-        sn: vec![vec![0.0; w]; slots.len()],
-        cs: vec![vec![0.0; w]; slots.len()],
-    };
     for x in 0..w {
         let d = drow[x] + off;
         let s = x as f32 - d;
@@ -345,8 +413,8 @@ fn prep_row(
         let i1 = (i0 + 1).min(w - 1);
         let t = sc - i0 as f32;
         let near = (round_fast(sc) as usize).min(w - 1);
-        p.i0[x] = i0;
-        p.i1[x] = i1;
+        p.i0[x] = i0 as u32;
+        p.i1[x] = i1 as u32;
         p.t[x] = t;
         // Validity is folded into the stability byte: an out-of-image shift has no stable channel.
         p.stab[x] = if valid {
@@ -354,17 +422,22 @@ fn prep_row(
         } else {
             0
         };
-        let (a, b) = (r.lowpass[o + i0], r.lowpass[o + i1]);
-        p.lp[x] = a + t * (b - a);
+    }
+    let rlp = &r.lowpass[o..o + w];
+    gather(rlp, &p.i0, &mut p.a);
+    gather(rlp, &p.i1, &mut p.b);
+    let (a, b, t, lp) = (&p.a[..w], &p.b[..w], &p.t[..w], &mut p.lp[..w]);
+    for x in 0..w {
+        lp[x] = a[x] + t[x] * (b[x] - a[x]);
     }
     for (k, &kx) in slots.iter().enumerate() {
+        let (sn, cs) = (&mut p.sn[k][..w], &mut p.cs[k][..w]);
         for x in 0..w {
             let (s, c) = sincos(kx * (drow[x] + off));
-            p.sn[k][x] = s;
-            p.cs[k][x] = c;
+            sn[x] = s;
+            cs[x] = c;
         }
     }
-    p
 }
 
 /// Fills `(bwr, bwi)` with the shifted right response of channel `ci`, demodulated by the left
@@ -382,19 +455,29 @@ fn shifted_row(
     bwi: &mut [f32],
     gfr: &mut [f32],
     gfi: &mut [f32],
+    g0: &mut [f32],
+    g1: &mut [f32],
 ) {
     let w = l.w;
     let o = SUBROWS * y * w;
     let rc = &r.chan[ci];
     let (rre, rim) = (&rc[o..o + w], &rc[o + w..o + 2 * w]);
     let (rfr, rfi) = (&rc[o + 2 * w..o + 3 * w], &rc[o + 3 * w..o + 4 * w]);
-    // Scalar gather + linear interpolation of the smooth baseband and frequency phasor.
-    for x in 0..w {
-        let (i0, i1, t) = (p.i0[x], p.i1[x], p.t[x]);
-        bwr[x] = rre[i0] + t * (rre[i1] - rre[i0]);
-        bwi[x] = rim[i0] + t * (rim[i1] - rim[i0]);
-        gfr[x] = rfr[i0] + t * (rfr[i1] - rfr[i0]);
-        gfi[x] = rfi[i0] + t * (rfi[i1] - rfi[i0]);
+    // Gather + linear interpolation of the smooth baseband and frequency phasor.
+    let (a, b) = (&mut g0[..w], &mut g1[..w]);
+    let t = &p.t[..w];
+    for (src, dst) in [
+        (rre, &mut *bwr),
+        (rim, &mut *bwi),
+        (rfr, &mut *gfr),
+        (rfi, &mut *gfi),
+    ] {
+        gather(src, &p.i0, a);
+        gather(src, &p.i1, b);
+        let dst = &mut dst[..w];
+        for x in 0..w {
+            dst[x] = a[x] + t[x] * (b[x] - a[x]);
+        }
     }
     let (cre, cim) = (&l.colph[ci].0[..w], &l.colph[ci].1[..w]);
     let (rre, rim) = (l.rowph[ci].0[y], l.rowph[ci].1[y]);
@@ -422,16 +505,19 @@ simd_fn! {
         y: usize,
         drow: &[f32],
         max_delta: f32,
+        p: &mut RowPrep,
+        wk: &mut RowWork,
         dout: &mut [f32],
         cout: &mut [f32],
     ) {
         let w = l.w;
-        let p = prep_row(l, r, slots, y, drow, 0.0);
-        let (mut num, mut den, mut csum) = (vec![0f32; w], vec![0f32; w], vec![0f32; w]);
-        let (mut bwr, mut bwi, mut gfr, mut gfi) =
-            (vec![0f32; w], vec![0f32; w], vec![0f32; w], vec![0f32; w]);
+        prep_row(l, r, slots, y, drow, 0.0, p);
+        let RowWork { num, den, csum, bwr, bwi, gfr, gfi, g0, g1 } = wk;
+        for v in [&mut *num, &mut *den, &mut *csum] {
+            v.iter_mut().for_each(|v| *v = 0.0);
+        }
         for (ci, c) in cc.iter().enumerate() {
-            shifted_row(l, r, c, ci, y, &p, &mut bwr, &mut bwi, &mut gfr, &mut gfi);
+            shifted_row(l, r, c, ci, y, p, bwr, bwi, gfr, gfi, g0, g1);
             let o = SUBROWS * y * w;
             let lc = &l.chan[ci];
             let (lre, lim) = (&lc[o..o + w], &lc[o + w..o + 2 * w]);
@@ -476,67 +562,29 @@ pub fn newton_step(l: &LevelData, r: &LevelData, cc: &[ChanConst], disp: &[f32])
         .iter()
         .map(|c| std::f32::consts::PI / c.kx)
         .fold(f32::INFINITY, f32::min);
-    for_each_row2(&mut delta, &mut conf, w, |y, drow, crow| {
-        newton_row(
-            l,
-            r,
-            cc,
-            &slots,
-            y,
-            &disp[y * w..(y + 1) * w],
-            max_delta,
-            drow,
-            crow,
-        )
-    });
-    (delta, conf)
-}
-
-simd_fn! {
-    /// One row of [`energy_terms`] at integer shifts `round(d + off)`: channel-outer loops over
-    /// the row (independent gathers, no per-pixel dependency chain).
-    fn energy_row(l: &LevelData, r: &LevelData, y: usize, drow: &[f32], off: f32, nout: &mut [f32], dout: &mut [f32]) {
-        let w = l.w;
-        let o = y * w;
-        let last = (w - 1) as f32;
-        let mut si = vec![0usize; w];
-        let mut valid = vec![false; w];
-        for x in 0..w {
-            let s = round_fast(x as f32 - (drow[x] + off));
-            let v = s >= 0.0 && s <= last;
-            valid[x] = v;
-            si[x] = if v { s as usize } else { 0 };
-        }
-        let (nout, dout) = (&mut nout[..w], &mut dout[..w]);
-        nout.iter_mut().for_each(|v| *v = 0.0);
-        let ro = SUBROWS * y * w;
-        for (lc, rc) in l.chan.iter().zip(&r.chan) {
-            let (lre, lim) = (&lc[ro + 4 * w..ro + 5 * w], &lc[ro + 5 * w..ro + 6 * w]);
-            let (rre, rim) = (&rc[ro + 4 * w..ro + 5 * w], &rc[ro + 5 * w..ro + 6 * w]);
-            for x in 0..w {
-                let j = si[x];
-                nout[x] += lre[x] * rre[j] + lim[x] * rim[j];
+    let n_slots = slots.len();
+    delta
+        .par_chunks_mut(w * ROWS_PER_TASK)
+        .zip(conf.par_chunks_mut(w * ROWS_PER_TASK))
+        .enumerate()
+        .for_each(|(band, (dband, cband))| {
+            let (mut p, mut wk) = (RowPrep::new(w, n_slots), RowWork::new(w));
+            for (i, (drow, crow)) in dband.chunks_mut(w).zip(cband.chunks_mut(w)).enumerate() {
+                let y = band * ROWS_PER_TASK + i;
+                newton_row(
+                    l,
+                    r,
+                    cc,
+                    &slots,
+                    y,
+                    &disp[y * w..(y + 1) * w],
+                    max_delta,
+                    &mut p,
+                    &mut wk,
+                    drow,
+                    crow,
+                )
             }
-        }
-        let (le, re) = (&l.energy[o..o + w], &r.energy[o..o + w]);
-        for x in 0..w {
-            let v = valid[x];
-            nout[x] = if v { 2.0 * nout[x] } else { 0.0 };
-            dout[x] = if v { le[x] + re[si[x]] } else { 0.0 };
-        }
-    }
-}
-
-/// Normalised binocular energy terms for the integer shift `round(d + off)` at every pixel:
-/// `num = sum_c 2 Re(y_l conj y_r)`, `den = sum_c |y_l|^2 + |y_r|^2` (zero outside the image).
-/// Integer shifts: the candidates are 1 px apart and pooled over a box, so interpolation buys
-/// nothing here; the Newton steps refine to sub-pixel.
-pub fn energy_terms(l: &LevelData, r: &LevelData, disp: &[f32], off: f32) -> (Buf, Buf) {
-    let (w, h) = (l.w, l.h);
-    let mut num = Buf::scratch(w * h);
-    let mut den = Buf::scratch(w * h);
-    for_each_row2(&mut num, &mut den, w, |y, nrow, drow| {
-        energy_row(l, r, y, &disp[y * w..(y + 1) * w], off, nrow, drow)
-    });
-    (num, den)
+        });
+    (delta, conf)
 }

@@ -23,9 +23,14 @@ fn lock() -> std::sync::MutexGuard<'static, Vec<Vec<f32>>> {
 }
 
 /// A zero-initialised `f32` buffer that returns its memory to the pool when dropped.
+///
+/// The vector keeps its full (initialised) length while pooled; `n` is the logical length. So a
+/// reused buffer needs no fill for [`Buf::scratch`] (refilling the tail of a shorter vector was
+/// a visible share of the run time).
 #[derive(Debug, Default)]
 pub struct Buf {
     v: Vec<f32>,
+    n: usize,
 }
 
 impl Buf {
@@ -45,18 +50,16 @@ impl Buf {
                 let best = p
                     .iter()
                     .enumerate()
-                    .filter(|(_, b)| b.capacity() >= n)
-                    .min_by_key(|(_, b)| b.capacity())
+                    .filter(|(_, b)| b.len() >= n)
+                    .min_by_key(|(_, b)| b.len())
                     .map(|(i, _)| i);
                 best.map(|i| p.swap_remove(i))
             };
-            if let Some(mut v) = taken {
-                v.truncate(n);
-                v.resize(n, 0.0);
-                return Buf { v };
+            if let Some(v) = taken {
+                return Buf { v, n };
             }
         }
-        Buf { v: vec![0.0; n] }
+        Buf { v: vec![0.0; n], n }
     }
 
     /// A pooled copy of `src`.
@@ -68,27 +71,29 @@ impl Buf {
 
     /// Takes the buffer out of the pool's custody (it will be freed normally).
     pub fn into_vec(mut self) -> Vec<f32> {
-        std::mem::take(&mut self.v)
+        let mut v = std::mem::take(&mut self.v);
+        v.truncate(self.n);
+        v
     }
 }
 
 impl Deref for Buf {
     type Target = [f32];
     fn deref(&self) -> &[f32] {
-        &self.v
+        &self.v[..self.n]
     }
 }
 
 impl DerefMut for Buf {
     fn deref_mut(&mut self) -> &mut [f32] {
-        &mut self.v
+        &mut self.v[..self.n]
     }
 }
 
 impl Drop for Buf {
     fn drop(&mut self) {
         let v = std::mem::take(&mut self.v);
-        if v.capacity() < MIN_POOLED {
+        if v.len() < MIN_POOLED {
             return;
         }
         let mut p = lock();

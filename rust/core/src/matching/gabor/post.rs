@@ -53,11 +53,7 @@ fn med5(mut a: f32, mut b: f32, mut c: f32, mut d: f32, mut e: f32) -> f32 {
 pub fn median5(src: &[f32], w: usize, h: usize) -> Buf {
     let mut tmp = Buf::scratch(w * h);
     for_each_row(&mut tmp, w, |y, row| {
-        let s = &src[y * w..(y + 1) * w];
-        for (x, v) in row.iter_mut().enumerate() {
-            let at = |dx: isize| s[(x as isize + dx).clamp(0, w as isize - 1) as usize];
-            *v = med5(at(-2), at(-1), at(0), at(1), at(2));
-        }
+        median5_h(&src[y * w..(y + 1) * w], row)
     });
     let mut out = Buf::scratch(w * h);
     for_each_row(&mut out, w, |y, row| {
@@ -65,67 +61,99 @@ pub fn median5(src: &[f32], w: usize, h: usize) -> Buf {
             let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
             &tmp[yy * w..(yy + 1) * w]
         };
-        let (a, b, c, d, e) = (r(-2), r(-1), r(0), r(1), r(2));
-        for (x, v) in row.iter_mut().enumerate() {
-            *v = med5(a[x], b[x], c[x], d[x], e[x]);
-        }
+        median5_v([r(-2), r(-1), r(0), r(1), r(2)], row)
     });
     out
 }
 
-/// Bilinear sample of `src` (`w` x `h`) at `(x, y)`, clamped to the image.
-#[inline]
-fn bilinear(src: &[f32], w: usize, h: usize, x: f32, y: f32) -> f32 {
-    let x = x.clamp(0.0, (w - 1) as f32);
-    let y = y.clamp(0.0, (h - 1) as f32);
-    let (x0, y0) = (x.floor() as usize, y.floor() as usize);
-    let (x1, y1) = ((x0 + 1).min(w - 1), (y0 + 1).min(h - 1));
-    let (tx, ty) = (x - x0 as f32, y - y0 as f32);
-    let a = src[y0 * w + x0] + tx * (src[y0 * w + x1] - src[y0 * w + x0]);
-    let b = src[y1 * w + x0] + tx * (src[y1 * w + x1] - src[y1 * w + x0]);
-    a + ty * (b - a)
+/// Radius of the median window (5 taps).
+const MED_R: usize = 2;
+
+simd_fn! {
+    /// 1x5 median of one row, clamped borders (a padded copy keeps the loop branch-free).
+    fn median5_h(s: &[f32], row: &mut [f32]) {
+        let w = s.len();
+        let mut pad = vec![0f32; w + 2 * MED_R];
+        pad[MED_R..MED_R + w].copy_from_slice(s);
+        for i in 0..MED_R {
+            pad[i] = s[0];
+            pad[MED_R + w + i] = s[w - 1];
+        }
+        let (a, b, c, d, e) = (&pad[..w], &pad[1..w + 1], &pad[2..w + 2], &pad[3..w + 3], &pad[4..w + 4]);
+        let row = &mut row[..w];
+        for x in 0..w {
+            row[x] = med5(a[x], b[x], c[x], d[x], e[x]);
+        }
+    }
+}
+
+simd_fn! {
+    /// 5x1 median of five rows.
+    fn median5_v(rows: [&[f32]; 5], row: &mut [f32]) {
+        let w = row.len();
+        let [a, b, c, d, e] = rows;
+        let (a, b, c, d, e) = (&a[..w], &b[..w], &c[..w], &d[..w], &e[..w]);
+        for x in 0..w {
+            row[x] = med5(a[x], b[x], c[x], d[x], e[x]);
+        }
+    }
 }
 
 /// Up-samples a coarse map to `(w, h)` (pixel `x` at the fine level is `x / 2` at the coarse one),
-/// multiplying values by `scale` (2 for disparities, 1 for confidences).
+/// multiplying values by `scale` (2 for disparities, 1 for confidences). Bilinear, clamped to the
+/// coarse image: fine pixels fall on coarse samples or half-way between two, so each output row
+/// blends two x-interpolated coarse rows with the weights 0 or 1/2 (no per-pixel `floor`).
 pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f32) -> Buf {
     let mut out = Buf::scratch(w * h);
+    if sw == 0 || sh == 0 {
+        out.iter_mut().for_each(|v| *v = 0.0);
+        return out;
+    }
     for_each_row(&mut out, w, |y, row| {
-        for (x, v) in row.iter_mut().enumerate() {
-            *v = scale * bilinear(src, sw, sh, x as f32 * 0.5, y as f32 * 0.5);
-        }
+        let y0 = (y / 2).min(sh - 1);
+        let y1 = (y0 + 1).min(sh - 1);
+        let ty = if y % 2 == 1 && y / 2 < sh - 1 {
+            0.5
+        } else {
+            0.0
+        };
+        upsample_row(
+            &src[y0 * sw..(y0 + 1) * sw],
+            &src[y1 * sw..(y1 + 1) * sw],
+            ty,
+            scale,
+            row,
+        )
     });
-    out
-}
-
-/// Box sum over a `(2r+1)^2` window with clamped borders, computed per output row (no running
-/// sums across rows, so bands are independent and results thread-count invariant).
-pub fn box_sum(src: &[f32], w: usize, h: usize, r: usize) -> Buf {
-    let mut out = Buf::scratch(w * h);
-    for_each_row(&mut out, w, |y, row| box_row(src, w, h, r, y, row));
     out
 }
 
 simd_fn! {
-    /// One output row of [`box_sum`]: vertical sum into a padded row, then horizontal sum.
-    fn box_row(src: &[f32], w: usize, h: usize, r: usize, y: usize, row: &mut [f32]) {
-        let mut col = vec![0f32; w + 2 * r];
-        for dy in -(r as isize)..=r as isize {
-            let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
-            let c = &mut col[r..r + w];
-            for (v, s) in c.iter_mut().zip(&src[yy * w..(yy + 1) * w]) {
-                *v += s;
-            }
+    /// One output row of [`upsample`]: `scale (a + ty (b - a))` with `a`, `b` the coarse rows
+    /// `s0`, `s1` interpolated along x (`v + tx (next - v)`, `tx` 0 at even fine columns and 1/2
+    /// at odd ones, 0 past the last coarse column). Fine columns `2k`, `2k + 1` come from coarse
+    /// column `k`.
+    fn upsample_row(s0: &[f32], s1: &[f32], ty: f32, scale: f32, row: &mut [f32]) {
+        let (sw, w) = (s0.len(), row.len());
+        if sw == 0 || s1.len() != sw {
+            return;
         }
-        for i in 0..r {
-            col[i] = col[r];
-            col[r + w + i] = col[r + w - 1];
+        let at = |a: f32, b: f32| scale * (a + ty * (b - a));
+        let pairs = (w / 2).min(sw - 1);
+        let (s0n, s1n) = (&s0[1..], &s1[1..]);
+        for (k, px) in row[..2 * pairs].chunks_exact_mut(2).enumerate() {
+            let (v0, n0, v1, n1) = (s0[k], s0n[k], s1[k], s1n[k]);
+            px[0] = at(v0 + 0.0 * (n0 - v0), v1 + 0.0 * (n1 - v1));
+            px[1] = at(v0 + 0.5 * (n0 - v0), v1 + 0.5 * (n1 - v1));
         }
-        row.iter_mut().for_each(|v| *v = 0.0);
-        for k in 0..=2 * r {
-            for (v, s) in row.iter_mut().zip(&col[k..k + w]) {
-                *v += s;
-            }
+        // Columns from 2 (sw - 1) on read the last coarse column (its "next" is itself).
+        let (v0, v1) = (s0[sw - 1], s1[sw - 1]);
+        for (x, v) in row.iter_mut().enumerate().skip(2 * pairs) {
+            let k = (x / 2).min(sw - 1);
+            let (a, b) = if k < sw - 1 { (s0[k], s1[k]) } else { (v0, v1) };
+            let (na, nb) = if k < sw - 1 { (s0[k + 1], s1[k + 1]) } else { (v0, v1) };
+            let t = if x % 2 == 1 && k < sw - 1 { 0.5 } else { 0.0 };
+            *v = at(a + t * (na - a), b + t * (nb - b));
         }
     }
 }

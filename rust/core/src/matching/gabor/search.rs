@@ -1,0 +1,310 @@
+//! Position-shift search (A.5 step 2 at the top level, the A.9 re-search below it).
+//!
+//! For each pixel, the candidate `base + o` (`o` in `offs`) maximising the box-pooled normalised
+//! binocular energy `sum 2 Re(y_l conj y_r) / sum (|y_l|^2 + |y_r|^2)` over a `(2p+1)^2` box
+//! (A.9: the raw energy favours high-contrast positions). Ties keep the first offset.
+//!
+//! Fused per band of rows: every offset's energy row is computed while the band's filter data is
+//! in cache, pooled along x at once and along y from a ring of `2p+1` rows. (Full-image planes per
+//! offset streamed the level data from memory once per offset: the search was memory-bound and
+//! cost more than the filtering.) The pooled sums are formed in a fixed order per output pixel,
+//! so the result does not depend on the band split or the thread count.
+
+// Row kernels index several equally long rows in lockstep; index loops are the clearest form
+// and the one LLVM vectorises once the slices are re-bounded to the row length.
+#![allow(clippy::needless_range_loop)]
+
+use super::fastmath::floor_fast;
+use super::gather::gather;
+use super::level::{LevelData, SUBROWS};
+use super::pool::Buf;
+use crate::simd::simd_fn;
+use rayon::prelude::*;
+
+/// Output rows per task: the `2p` halo rows are recomputed by each band, so bands are longer
+/// than the other kernels' (`p = 2`: 12 % extra energy rows at 32 rows, 25 % at 16).
+const SEARCH_BAND: usize = 32;
+
+/// Per-pixel argmax of the pooled normalised energy over `base + offs` (see the module docs).
+pub fn search(l: &LevelData, r: &LevelData, base: &[f32], offs: &[f32], pool: usize) -> Buf {
+    let (w, h) = (l.w, l.h);
+    let mut out = Buf::from_slice(base);
+    if w == 0 || h == 0 || offs.is_empty() {
+        return out;
+    }
+    if pool == 0 {
+        out.par_chunks_mut(w * SEARCH_BAND)
+            .enumerate()
+            .for_each(|(band, chunk)| {
+                let mut sc = Scratch::new(w, 0);
+                let mut best = vec![0f32; w];
+                for (i, orow) in chunk.chunks_mut(w).enumerate() {
+                    let y = band * SEARCH_BAND + i;
+                    direct_row(
+                        l,
+                        r,
+                        y,
+                        &base[y * w..(y + 1) * w],
+                        offs,
+                        &mut sc,
+                        &mut best,
+                        orow,
+                    );
+                }
+            });
+        return out;
+    }
+    let ring = 2 * pool + 1;
+    let k = offs.len();
+    out.par_chunks_mut(w * SEARCH_BAND)
+        .enumerate()
+        .for_each(|(band, chunk)| {
+            let y0 = band * SEARCH_BAND;
+            let y1 = y0 + chunk.len() / w;
+            // Ring of x-pooled rows: offset `oi`, row `yy` at ((oi * ring + yy % ring) * w).
+            let mut rn = vec![0f32; k * ring * w];
+            let mut rd = vec![0f32; k * ring * w];
+            let mut best = vec![f32::NEG_INFINITY; w];
+            let mut sc = Scratch::new(w, pool);
+            for yy in y0.saturating_sub(pool)..(y1 + pool).min(h) {
+                let drow = &base[yy * w..(yy + 1) * w];
+                for (oi, &o) in offs.iter().enumerate() {
+                    let at = (oi * ring + yy % ring) * w;
+                    energy_row(
+                        l,
+                        r,
+                        yy,
+                        drow,
+                        o,
+                        &mut sc,
+                        &mut rn[at..at + w],
+                        &mut rd[at..at + w],
+                    );
+                }
+                // Output rows whose last needed (clamped) row is `yy`.
+                let ys = if yy == h - 1 {
+                    yy.saturating_sub(pool)..h
+                } else if yy >= pool {
+                    yy - pool..yy - pool + 1
+                } else {
+                    continue;
+                };
+                for y in ys.filter(|y| (y0..y1).contains(y)) {
+                    let rows: Vec<usize> = (-(pool as isize)..=pool as isize)
+                        .map(|dy| (y as isize + dy).clamp(0, h as isize - 1) as usize % ring)
+                        .collect();
+                    best.iter_mut().for_each(|b| *b = f32::NEG_INFINITY);
+                    let orow = &mut chunk[(y - y0) * w..(y - y0 + 1) * w];
+                    let brow = &base[y * w..(y + 1) * w];
+                    for (oi, &o) in offs.iter().enumerate() {
+                        let at = oi * ring * w;
+                        pick_row(
+                            &rn[at..at + ring * w],
+                            &rd[at..at + ring * w],
+                            &rows,
+                            w,
+                            brow,
+                            o,
+                            &mut sc.num,
+                            &mut sc.den,
+                            &mut best,
+                            orow,
+                        );
+                    }
+                }
+            }
+        });
+    out
+}
+
+/// Row buffers of one band.
+struct Scratch {
+    si: Vec<u32>,
+    valid: Vec<bool>,
+    /// `floor(x - d + 0.5)`: the shifted position at offset 0 (unpooled search).
+    j0: Vec<i32>,
+    /// Gathered right samples (re, im).
+    gr: Vec<f32>,
+    gi: Vec<f32>,
+    num: Vec<f32>,
+    den: Vec<f32>,
+    /// A row padded by `p` clamped samples on each side (the x pooling).
+    pad: Vec<f32>,
+    p: usize,
+}
+
+impl Scratch {
+    fn new(w: usize, p: usize) -> Self {
+        Scratch {
+            si: vec![0; w],
+            valid: vec![false; w],
+            j0: vec![0; w],
+            gr: vec![0.0; w],
+            gi: vec![0.0; w],
+            num: vec![0.0; w],
+            den: vec![0.0; w],
+            pad: vec![0.0; w + 2 * p],
+            p,
+        }
+    }
+}
+
+/// `out(x) = sum_{k=-p..p} v(clamp(x + k))`, summed in `k` order.
+#[inline(always)]
+fn pool_x(v: &[f32], pad: &mut [f32], p: usize, out: &mut [f32]) {
+    let w = v.len();
+    pad[p..p + w].copy_from_slice(v);
+    for i in 0..p {
+        pad[i] = v[0];
+        pad[p + w + i] = v[w - 1];
+    }
+    out[..w].copy_from_slice(&pad[..w]);
+    for k in 1..=2 * p {
+        for (o, s) in out[..w].iter_mut().zip(&pad[k..k + w]) {
+            *o += s;
+        }
+    }
+}
+
+simd_fn! {
+    /// Energy terms of row `y` at the integer shifts `floor(x - d + 0.5) - off`, pooled along x into
+    /// `(hn, hd)`: `num = sum_c 2 Re(y_l conj y_r)`, `den = sum_c |y_l|^2 + |y_r|^2`, both zero
+    /// where the shifted position leaves the image. Integer shifts: the candidates are 1 px apart
+    /// and pooled over a box, so interpolation buys nothing; the Newton steps refine to sub-pixel.
+    fn energy_row(
+        l: &LevelData,
+        r: &LevelData,
+        y: usize,
+        drow: &[f32],
+        off: f32,
+        sc: &mut Scratch,
+        hn: &mut [f32],
+        hd: &mut [f32],
+    ) {
+        let w = l.w;
+        let o = y * w;
+        let last = (w - 1) as f32;
+        let (si, valid) = (&mut sc.si[..w], &mut sc.valid[..w]);
+        for x in 0..w {
+            let s = floor_fast(x as f32 - drow[x] + 0.5) - off;
+            let v = s >= 0.0 && s <= last;
+            valid[x] = v;
+            si[x] = if v { s as u32 } else { 0 };
+        }
+        let (num, den) = (&mut sc.num[..w], &mut sc.den[..w]);
+        let (gr, gi) = (&mut sc.gr[..w], &mut sc.gi[..w]);
+        num.iter_mut().for_each(|v| *v = 0.0);
+        let ro = SUBROWS * y * w;
+        for (lc, rc) in l.chan.iter().zip(&r.chan) {
+            let (lre, lim) = (&lc[ro + 4 * w..ro + 5 * w], &lc[ro + 5 * w..ro + 6 * w]);
+            gather(&rc[ro + 4 * w..ro + 5 * w], si, gr);
+            gather(&rc[ro + 5 * w..ro + 6 * w], si, gi);
+            for x in 0..w {
+                num[x] += lre[x] * gr[x] + lim[x] * gi[x];
+            }
+        }
+        gather(&r.energy[o..o + w], si, gr);
+        let le = &l.energy[o..o + w];
+        for x in 0..w {
+            let v = valid[x];
+            num[x] = if v { 2.0 * num[x] } else { 0.0 };
+            den[x] = if v { le[x] + gr[x] } else { 0.0 };
+        }
+        pool_x(num, &mut sc.pad, sc.p, hn);
+        pool_x(den, &mut sc.pad, sc.p, hd);
+    }
+}
+
+simd_fn! {
+    /// One candidate for one output row: y-pools the ring rows `rows` (in order), and keeps
+    /// `base + off` where its normalised energy beats `best`.
+    fn pick_row(
+        rn: &[f32],
+        rd: &[f32],
+        rows: &[usize],
+        w: usize,
+        base: &[f32],
+        off: f32,
+        num: &mut [f32],
+        den: &mut [f32],
+        best: &mut [f32],
+        out: &mut [f32],
+    ) {
+        let (num, den) = (&mut num[..w], &mut den[..w]);
+        let Some((&first, rest)) = rows.split_first() else {
+            return;
+        };
+        num.copy_from_slice(&rn[first * w..(first + 1) * w]);
+        den.copy_from_slice(&rd[first * w..(first + 1) * w]);
+        for &s in rest {
+            for (a, b) in num.iter_mut().zip(&rn[s * w..(s + 1) * w]) {
+                *a += b;
+            }
+            for (a, b) in den.iter_mut().zip(&rd[s * w..(s + 1) * w]) {
+                *a += b;
+            }
+        }
+        let (base, best, out) = (&base[..w], &mut best[..w], &mut out[..w]);
+        for x in 0..w {
+            let e = if den[x] > 0.0 { num[x] / den[x] } else { 0.0 };
+            let better = e > best[x];
+            best[x] = if better { e } else { best[x] };
+            out[x] = if better { base[x] + off } else { out[x] };
+        }
+    }
+}
+
+simd_fn! {
+    /// One output row of the unpooled search (`p = 0`): every offset evaluated per pixel, no
+    /// ring and no pooling pass. Same terms and tie rule as the pooled path.
+    fn direct_row(
+        l: &LevelData,
+        r: &LevelData,
+        y: usize,
+        drow: &[f32],
+        offs: &[f32],
+        sc: &mut Scratch,
+        best: &mut [f32],
+        out: &mut [f32],
+    ) {
+        let w = l.w;
+        let o = y * w;
+        let ro = SUBROWS * y * w;
+        let (drow, best, out) = (&drow[..w], &mut best[..w], &mut out[..w]);
+        let (si, valid, j0) = (&mut sc.si[..w], &mut sc.valid[..w], &mut sc.j0[..w]);
+        let (num, gr, gi) = (&mut sc.num[..w], &mut sc.gr[..w], &mut sc.gi[..w]);
+        for x in 0..w {
+            j0[x] = floor_fast(x as f32 - drow[x] + 0.5) as i32;
+        }
+        best.iter_mut().for_each(|b| *b = f32::NEG_INFINITY);
+        let le = &l.energy[o..o + w];
+        for &off in offs {
+            let oi = off as i32;
+            for x in 0..w {
+                let j = j0[x] - oi;
+                let v = j >= 0 && j < w as i32;
+                valid[x] = v;
+                si[x] = if v { j as u32 } else { 0 };
+            }
+            num.iter_mut().for_each(|v| *v = 0.0);
+            for (lc, rc) in l.chan.iter().zip(&r.chan) {
+                let (lre, lim) = (&lc[ro + 4 * w..ro + 5 * w], &lc[ro + 5 * w..ro + 6 * w]);
+                gather(&rc[ro + 4 * w..ro + 5 * w], si, gr);
+                gather(&rc[ro + 5 * w..ro + 6 * w], si, gi);
+                for x in 0..w {
+                    num[x] += lre[x] * gr[x] + lim[x] * gi[x];
+                }
+            }
+            gather(&r.energy[o..o + w], si, gr);
+            for x in 0..w {
+                let v = valid[x];
+                let n = if v { 2.0 * num[x] } else { 0.0 };
+                let d = if v { le[x] + gr[x] } else { 0.0 };
+                let e = if d > 0.0 { n / d } else { 0.0 };
+                let better = e > best[x];
+                best[x] = if better { e } else { best[x] };
+                out[x] = if better { drow[x] + off } else { out[x] };
+            }
+        }
+    }
+}
