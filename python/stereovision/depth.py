@@ -36,10 +36,10 @@ _DISPARITY_STEP = 16  # ranges are multiples of 16, like the evaluation protocol
 
 # Disparity uncertainty from the matcher's confidence: sigma_d = _SIGMA_D0 + _SIGMA_D_SLOPE * conf
 # (px). A line through the robust spread (1.4826 x median |error|) of the Gabor channel per
-# confidence bin over the 17 GT scenes (3.0 M pixels): 0.56 px at confidence 0.1, 0.41 at 0.55,
-# 0.24 at 0.85. It is the spread of the correctly locked pixels, not of gross outliers.
-_SIGMA_D0 = 0.60
-_SIGMA_D_SLOPE = -0.40
+# confidence bin over the 17 GT scenes (2.8 M pixels): 0.65 px at confidence 0.1, 0.47 at 0.55,
+# 0.23 at 0.95. It is the spread of the correctly locked pixels, not of gross outliers.
+_SIGMA_D0 = 0.74
+_SIGMA_D_SLOPE = -0.52
 _SIGMA_D_MIN = 0.2
 
 
@@ -168,7 +168,7 @@ class DepthResult:
 def disparity_sigma(confidence: npt.ArrayLike) -> npt.NDArray[np.float32]:
     """Predicted one-sigma disparity error (px) of a pixel from its matcher confidence.
 
-    ``sigma_d = 0.60 - 0.40 * conf``, at least 0.2 px: a line through the robust error spread
+    ``sigma_d = 0.74 - 0.52 * conf``, at least 0.2 px: a line through the robust error spread
     of the Gabor channel per confidence bin, measured on the 17 shared GT scenes.
 
     Parameters
