@@ -59,7 +59,7 @@ fn bench_filter_bank(c: &mut Criterion) {
         Ok(ch) => ch,
         Err(e) => panic!("default channels are valid: {e}"),
     };
-    let mut g = c.benchmark_group("gabor_filter_bank_5_orient");
+    let mut g = c.benchmark_group("gabor_filter_bank");
     g.sample_size(10).measurement_time(Duration::from_secs(3));
     for (w, h) in SIZES {
         let img = texture(w, h, 0.0);

@@ -179,8 +179,9 @@ simd_fn! {
         orow: &mut [f32],
         arow: &mut [f32],
     ) {
-        ROW_SCRATCH.with_borrow_mut(|buf| {
-        // Every entry of the four rows is written before it is read.
+        // Taken out of the thread-local, not borrowed in a closure: a closure would be compiled
+        // outside this AVX2 function. Every entry of the four rows is written before it is read.
+        let mut buf = ROW_SCRATCH.take();
         buf.resize(4 * w, 0.0);
         let (ar, rest) = buf.split_at_mut(w);
         let (ai, rest) = rest.split_at_mut(w);
@@ -231,7 +232,7 @@ simd_fn! {
                 fi[x] = yi2[x] * yr1[x] - yr2[x] * yi1[x] + yi1[x] * yr0[x] - yr1[x] * yi0[x];
             }
         }
-        });
+        ROW_SCRATCH.set(buf);
     }
 }
 
@@ -249,7 +250,11 @@ simd_fn! {
             return;
         }
         // ln rho^2 once per pixel (each is used by both neighbours).
-        let lr: Vec<f32> = arow.iter().map(|&a| ln(a + LN_EPS)).collect();
+        // (An index loop, not an iterator chain, so it is compiled inside this AVX2 function.)
+        let mut lr = vec![0f32; w];
+        for x in 0..w {
+            lr[x] = ln(arow[x] + LN_EPS);
+        }
         let n = w - 2;
         let (fr, fi, l0, l2) = (&fr[1..w - 1], &fi[1..w - 1], &lr[..n], &lr[2..]);
         let s = &mut srow[1..w - 1];

@@ -193,46 +193,53 @@ pub fn remove_speckles(disp: &mut [f32], w: usize, h: usize, min_size: usize, ma
     if min_size == 0 {
         return;
     }
-    let mut label = vec![0u32; w * h];
-    let mut next = 1u32;
-    let mut stack = Vec::new();
-    let mut region = Vec::new();
-    for start in 0..w * h {
-        if label[start] != 0 || !disp[start].is_finite() {
-            continue;
-        }
-        region.clear();
-        stack.push(start);
-        label[start] = next;
-        while let Some(p) = stack.pop() {
-            region.push(p);
-            let (x, y) = (p % w, p / w);
-            let dp = disp[p];
-            let mut visit = |q: usize| {
-                if label[q] == 0 && disp[q].is_finite() && (disp[q] - dp).abs() <= max_diff {
-                    label[q] = next;
-                    stack.push(q);
+    // Coordinates travel with the pixels (no division per visited pixel), and a region's pixel
+    // list is kept only while it could still be too small to survive.
+    let mut seen = vec![false; w * h];
+    let mut stack: Vec<(usize, usize)> = Vec::new();
+    let mut region = Vec::with_capacity(min_size);
+    for sy in 0..h {
+        for sx in 0..w {
+            let start = sy * w + sx;
+            if seen[start] || !disp[start].is_finite() {
+                continue;
+            }
+            region.clear();
+            let mut size = 0usize;
+            stack.push((sx, sy));
+            seen[start] = true;
+            while let Some((x, y)) = stack.pop() {
+                let p = y * w + x;
+                size += 1;
+                if region.len() < min_size {
+                    region.push(p);
                 }
-            };
-            if x > 0 {
-                visit(p - 1);
+                let dp = disp[p];
+                let mut visit = |q: usize, qx: usize, qy: usize| {
+                    if !seen[q] && disp[q].is_finite() && (disp[q] - dp).abs() <= max_diff {
+                        seen[q] = true;
+                        stack.push((qx, qy));
+                    }
+                };
+                if x > 0 {
+                    visit(p - 1, x - 1, y);
+                }
+                if x + 1 < w {
+                    visit(p + 1, x + 1, y);
+                }
+                if y > 0 {
+                    visit(p - w, x, y - 1);
+                }
+                if y + 1 < h {
+                    visit(p + w, x, y + 1);
+                }
             }
-            if x + 1 < w {
-                visit(p + 1);
-            }
-            if y > 0 {
-                visit(p - w);
-            }
-            if y + 1 < h {
-                visit(p + w);
+            if size < min_size {
+                for &p in &region {
+                    disp[p] = f32::NAN;
+                }
             }
         }
-        if region.len() < min_size {
-            for &p in &region {
-                disp[p] = f32::NAN;
-            }
-        }
-        next += 1;
     }
 }
 

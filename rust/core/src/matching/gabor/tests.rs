@@ -158,3 +158,26 @@ fn probe_timing() {
         eprintln!("total {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
     }
 }
+
+#[test]
+fn speckle_removal_drops_only_small_regions() {
+    // 12 x 8 map: a 12 x 6 plane at 5.0 (72 px), a 2 x 2 blob at 9.0 inside a NaN band, and a
+    // ramp row whose 1 px steps stay one region.
+    let (w, h) = (12, 8);
+    let mut d = vec![5.0f32; w * h];
+    for x in 0..w {
+        d[6 * w + x] = f32::NAN;
+        d[7 * w + x] = x as f32;
+    }
+    for (x, y) in [(3, 2), (4, 2), (3, 3), (4, 3)] {
+        d[y * w + x] = 9.0;
+    }
+    post::remove_speckles(&mut d, w, h, 10, 1.0);
+    assert!(
+        d[2 * w + 3].is_nan() && d[3 * w + 4].is_nan(),
+        "4 px blob removed"
+    );
+    assert_eq!(d[0], 5.0, "68 px plane kept");
+    assert!(d[7 * w..].iter().all(|v| v.is_finite()), "12 px ramp kept");
+    assert!(d[6 * w..7 * w].iter().all(|v| v.is_nan()));
+}
