@@ -1,5 +1,6 @@
-//! Criterion benches of the Hopfield channel: the interest operator, the candidate search (row
-//! ZNCC), the weight construction, the network sweeps and the whole matcher, at three image sizes (synthetic textured pairs with a known 6 px shift, so the
+//! Criterion benches of the Hopfield channel: the interest operator, the candidate search
+//! (interest points + row ZNCC), the weight construction, the network sweeps and the whole
+//! matcher, at three image sizes (synthetic textured pairs with a known 6 px shift, so the
 //! benches need no data files). Throughput is pixels per second.
 use std::time::Duration;
 
