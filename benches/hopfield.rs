@@ -1,5 +1,6 @@
-//! Criterion benches of the Hopfield channel: the interest operator, the network sweeps and the
-//! whole matcher, at three image sizes (synthetic textured pairs with a known 6 px shift, so the
+//! Criterion benches of the Hopfield channel: the interest operator, the candidate search
+//! (interest points + row ZNCC), the weight construction, the network sweeps and the whole
+//! matcher, at three image sizes (synthetic textured pairs with a known 6 px shift, so the
 //! benches need no data files). Throughput is pixels per second.
 use std::time::Duration;
 
@@ -78,6 +79,11 @@ fn bench(c: &mut Criterion) {
         g.bench_with_input(BenchmarkId::new("interest_points", &id), &l, |b, l| {
             b.iter(|| interest_points(l, &InterestParams::default()))
         });
+        g.bench_with_input(
+            BenchmarkId::new("candidates", &id),
+            &(&l, &r),
+            |b, (l, r)| b.iter(|| candidate_neurons(l, r, &p).expect("valid input")),
+        );
         let (_, neurons) = candidate_neurons(&l, &r, &p).expect("valid input");
         let csr = build_weights(&neurons, &p.weights);
         let input: Vec<f64> = neurons

@@ -203,6 +203,26 @@ pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<I
         }
         true
     };
+    // The 3x3 case (C.10's default) without loops or branches: BORDER >= 1 keeps every
+    // neighbour inside the image.
+    let peak = |x: usize, y: usize, v: f32| -> bool {
+        if r != 1 {
+            return is_peak(x, y, v);
+        }
+        let (up, mid, dn) = (
+            &m[(y - 1) * w..y * w],
+            &m[y * w..(y + 1) * w],
+            &m[(y + 1) * w..(y + 2) * w],
+        );
+        (v > up[x - 1])
+            & (v > up[x])
+            & (v > up[x + 1])
+            & (v > mid[x - 1])
+            & (v >= mid[x + 1])
+            & (v >= dn[x - 1])
+            & (v >= dn[x])
+            & (v >= dn[x + 1])
+    };
     (BORDER..h.saturating_sub(BORDER))
         .into_par_iter()
         .flat_map_iter(|y| {
@@ -217,7 +237,7 @@ pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<I
                     // Strictly greater than the neighbours earlier in raster order, at least
                     // as large as the later ones (deterministic ties); the centre compares
                     // equal to itself and is neither.
-                    if v > 0.0 && v >= thr && is_peak(x, y, v) {
+                    if v > 0.0 && v >= thr && peak(x, y, v) {
                         out.push(InterestPoint {
                             x: x as u32,
                             y: y as u32,

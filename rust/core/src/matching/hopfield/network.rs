@@ -241,7 +241,13 @@ pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
         })
         .collect();
     let near: Vec<Vec<u32>> = near_parts.into_iter().flatten().collect();
-    let n_count: Vec<f32> = near.iter().map(|v| v.len() as f32).collect();
+    // A / max(n_p, n_q, 1) = min(A / max(n_p, 1), A / max(n_q, 1)) exactly: division rounds
+    // monotonically (max for a negative A). One division per point instead of per pair.
+    let a_over_n: Vec<f32> = near
+        .iter()
+        .map(|v| w.a / (v.len() as f32).max(1.0))
+        .collect();
+    let a_pos = w.a >= 0.0;
     // Neurons sharing a right pixel (column inhibition), wherever their left points are:
     // neuron indices sorted by right pixel, and each neuron's group range in that order.
     let mut by_right: Vec<u32> = (0..m as u32).collect();
@@ -361,7 +367,8 @@ pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
                 let (ka, dxa, dya) = (rkey[a], dxs[a], dys[a]);
                 for &q in &near[p] {
                     let q = q as usize;
-                    let norm = w.a / n_count[p].max(n_count[q]).max(1.0);
+                    let (np, nq) = (a_over_n[p], a_over_n[q]);
+                    let norm = if (np < nq) == a_pos { np } else { nq };
                     for b in starts[q]..starts[q + 1] {
                         if rkey[b] != ka {
                             let ex = (dxa - dxs[b]).unsigned_abs() as usize;

@@ -154,3 +154,57 @@ fn moravec_corner_and_edges() {
         .iter()
         .any(|p| p.x.abs_diff(15) <= 2 && p.y.abs_diff(15) <= 2));
 }
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    let (l, r) = shifted_pair(300, 200, 9);
+    let p = params(32);
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("thread pool")
+            .install(|| {
+                let out = hopfield_match(&l, &r, &p).expect("valid input");
+                let (_, neurons) = candidate_neurons(&l, &r, &p).expect("valid input");
+                let csr = build_weights(&neurons, &p.weights);
+                (
+                    out,
+                    csr.indptr,
+                    csr.indices,
+                    csr.data,
+                    interest_points(&l, &p.interest),
+                )
+            })
+    };
+    let (a, b) = (run(1), run(3));
+    assert!(a.0.matches.len() > 500, "{} matches", a.0.matches.len());
+    assert_eq!(a.0, b.0);
+    assert_eq!((a.1, a.2, a.3), (b.1, b.2, b.3));
+    assert_eq!(a.4, b.4);
+}
+
+#[test]
+fn csr_rows_hold_every_pair_of_the_window_once() {
+    // Brute force over all neuron pairs: the entries build_weights must store.
+    let (l, r) = shifted_pair(120, 90, 5);
+    let p = params(16);
+    let (_, neurons) = candidate_neurons(&l, &r, &p).expect("valid input");
+    let csr = build_weights(&neurons, &p.weights);
+    let half = p.weights.nbr_half;
+    for (a, na) in neurons.iter().enumerate() {
+        let (idx, _) = csr.row(a);
+        let mut got: Vec<u32> = idx.to_vec();
+        got.sort_unstable();
+        let want: Vec<u32> = (0..neurons.len() as u32)
+            .filter(|&b| {
+                let nb = &neurons[b as usize];
+                let same_point = nb.point == na.point;
+                let same_right = (nb.xr, nb.yr) == (na.xr, na.yr);
+                let near = (nb.xl - na.xl).abs() <= half && (nb.yl - na.yl).abs() <= half;
+                b as usize != a && (same_point || same_right || near)
+            })
+            .collect();
+        assert_eq!(got, want, "row {a}");
+    }
+}

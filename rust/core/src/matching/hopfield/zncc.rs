@@ -517,3 +517,65 @@ impl std::ops::Add for Lanes {
         Lanes(std::array::from_fn(|l| self.0[l] + o.0[l]))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn avx2_and_portable_blocks_are_bit_identical() {
+        if !has_avx2() {
+            return; // nothing to compare on this CPU
+        }
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for _ in 0..50 {
+            let t: [[f32; SIDE]; SIDE] =
+                std::array::from_fn(|_| std::array::from_fn(|_| next() - 0.5));
+            let data: Vec<Vec<f32>> = (0..SIDE)
+                .map(|_| (0..WIN).map(|_| next()).collect())
+                .collect();
+            let rows: [&[f32]; SIDE] = std::array::from_fn(|r| data[r].as_slice());
+            let st_data: Vec<Vec<f32>> = (0..2 * N_REGIONS)
+                .map(|_| (0..LANES).map(|_| next()).collect())
+                .collect();
+            let st: [[&[f32]; N_REGIONS]; 2] = std::array::from_fn(|i| {
+                std::array::from_fn(|k| st_data[i * N_REGIONS + k].as_slice())
+            });
+            let norm = Norm {
+                shift: std::array::from_fn(|_| next() - 0.5),
+                inv_l: std::array::from_fn(|_| next() + 0.5),
+            };
+            let a = block_zncc(true, &t, &rows, &st, &norm);
+            let b = block_zncc(false, &t, &rows, &st, &norm);
+            for k in 0..N_REGIONS {
+                for l in 0..LANES {
+                    assert_eq!(a[k][l].to_bits(), b[k][l].to_bits(), "region {k} lane {l}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn band_statistics_equal_the_whole_image_ones() {
+        let (w, h) = (40, 30);
+        let data: Vec<f32> = (0..w * h)
+            .map(|i| ((i * 7919) % 251) as f32 / 250.0)
+            .collect();
+        let img = Image::new(w, h, data).expect("valid");
+        let full = RightStats::new(&img);
+        let mut band = RightStats::default();
+        band.fill_band(&img, 9, 17);
+        for y in 9..17 {
+            for k in 0..N_REGIONS {
+                assert_eq!(full.sums(k, y), band.sums(k, y));
+                assert_eq!(full.inv_norms(k, y), band.inv_norms(k, y));
+            }
+        }
+    }
+}
