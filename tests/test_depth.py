@@ -101,6 +101,16 @@ def test_depth_sigma_predicts_the_error_on_a_metric_scene(data_dir: Path) -> Non
     assert float(np.mean(t <= 2)) > 0.8
 
 
+def test_points_equal_reproject_on_a_metric_scene(data_dir: Path) -> None:
+    """The cloud is Calibration.reproject (cv2.reprojectImageTo3D's maths) at the valid pixels."""
+    scene = load_scene(data_dir / "eth3d" / "terrace")
+    res = sv.depth_map(scene.left, scene.right, scene.calib, max_disparity=32)
+    xyz = scene.calib.reproject(np.where(res.confidence > 0, res.disparity, np.nan))
+    xs, ys = res.pixels[:, 0], res.pixels[:, 1]
+    assert len(res.points) > 100000
+    np.testing.assert_allclose(res.points, xyz[ys, xs], rtol=1e-6, atol=1e-7)
+
+
 def test_without_calibration_no_depth() -> None:
     left = _texture(64, 96, seed=1)
     res = sv.depth_map(left, _shift(left, 3.0), max_disparity=16)

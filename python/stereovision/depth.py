@@ -351,7 +351,6 @@ def depth_map(
     if calib is not None:
         # Depth only where the matcher measured: filled pixels are guesses, not measurements.
         depth = calib.depth_from_disparity(np.where(measured, disp, np.nan)).astype(np.float32)
-        xyz = calib.reproject(np.where(measured, disp, np.nan)).astype(np.float32)
         ok = np.isfinite(depth) & (depth > 0)
         # dZ/dd = -f B / (d + doffs)^2 = -Z^2 / (f B) = -Z / (d + doffs); calib is rectified here.
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -360,7 +359,13 @@ def depth_map(
             )
         depth_sigma[~ok] = np.nan
         ys, xs = np.nonzero(ok)
-        points = np.ascontiguousarray(xyz[ys, xs], dtype=np.float32)
+        # calib.reproject's formula, on the valid pixels only (no (H, W, 3) image: live rates).
+        k = calib.K1
+        z = depth[ys, xs].astype(np.float64)
+        points = np.empty((len(z), 3), np.float32)
+        points[:, 0] = (xs - k[0, 2]) / k[0, 0] * z
+        points[:, 1] = (ys - k[1, 2]) / k[1, 1] * z
+        points[:, 2] = z
         colors = np.ascontiguousarray(left_bgr[ys, xs, ::-1], dtype=np.uint8)
         pixels = np.stack([xs, ys], axis=1).astype(np.int32)
         stage("triangulate")
