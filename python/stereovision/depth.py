@@ -294,7 +294,13 @@ def depth_map(
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
     left_bgr = as_bgr_uint8(left, "left")
     right_bgr = as_bgr_uint8(right, "right")
-    check_pair(left_bgr, right_bgr)
+    # Each image is validated by as_bgr_uint8; the pair check without check_pair's grey
+    # conversions (the grey pair is made once, below).
+    if left_bgr.shape != right_bgr.shape:
+        raise ValueError(
+            f"left and right images must have the same shape, got left {left_bgr.shape} and "
+            f"right {right_bgr.shape}"
+        )
     if calib is not None:
         if not isinstance(calib, Calibration):
             raise ValueError(
@@ -358,16 +364,20 @@ def depth_map(
                 np.float32
             )
         depth_sigma[~ok] = np.nan
-        ys, xs = np.nonzero(ok)
+        # Flat indices, divmod and take: about twice as fast as nonzero + fancy indexing (VGA).
+        idx = np.flatnonzero(ok)
+        ys, xs = np.divmod(idx, ok.shape[1])
         # calib.reproject's formula, on the valid pixels only (no (H, W, 3) image: live rates).
         k = calib.K1
-        z = depth[ys, xs].astype(np.float64)
+        z = depth.ravel()[idx].astype(np.float64)
         points = np.empty((len(z), 3), np.float32)
         points[:, 0] = (xs - k[0, 2]) / k[0, 0] * z
         points[:, 1] = (ys - k[1, 2]) / k[1, 1] * z
         points[:, 2] = z
-        colors = np.ascontiguousarray(left_bgr[ys, xs, ::-1], dtype=np.uint8)
-        pixels = np.stack([xs, ys], axis=1).astype(np.int32)
+        colors = np.take(left_bgr.reshape(-1, 3)[:, ::-1], idx, axis=0)  # uint8 BGR -> RGB
+        pixels = np.empty((len(idx), 2), np.int32)
+        pixels[:, 0] = xs
+        pixels[:, 1] = ys
         stage("triangulate")
     return DepthResult(
         disparity=disp,
