@@ -198,7 +198,7 @@ def _fmt(v: float | None, spec: str) -> str:
 def format_table(cases: Sequence[BenchCase]) -> str:
     """A text table: one row per case, scenes separated by their header."""
     lines = [
-        f"{'scene':34s} {'size':>9s} {'D':>4s} {'case':10s} {'ms':>8s} {'x SGBM':>7s}"
+        f"{'scene':34s} {'size':>9s} {'D':>4s} {'case':12s} {'ms':>8s} {'x SGBM':>7s}"
         f" {'bad-2':>6s} {'+fill':>6s} {'dens':>6s} {'p@1':>6s} {'count':>6s}"
     ]
     last = None
@@ -211,7 +211,7 @@ def format_table(cases: Sequence[BenchCase]) -> str:
         last = c.scene
         a = c.accuracy
         lines.append(
-            f"{head} {c.case:10s} {c.ms:8.1f} {c.ratio:7.2f}"
+            f"{head} {c.case:12s} {c.ms:8.1f} {c.ratio:7.2f}"
             f" {_fmt(a.get('bad_2.0'), '6.1f'):>6s} {_fmt(a.get('bad_2.0_filled'), '6.1f'):>6s}"
             f" {_fmt(a.get('density'), '6.1f'):>6s} {_fmt(a.get('precision@1.0'), '6.1f'):>6s}"
             f" {_fmt(a.get('count'), '6.0f'):>6s}"
