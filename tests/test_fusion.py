@@ -219,3 +219,29 @@ def test_depth_map_fused_beats_gabor_on_a_scene(data_dir: Path) -> None:
     np.testing.assert_array_equal(fused.disparity[m], members.dispx[m])
     assert np.all(fused.confidence[m] == 1.0)
     assert gabor.channels is None
+
+
+def test_fused_is_bit_identical_across_thread_counts(data_dir: Path) -> None:
+    """Issue 5: same inputs, same bits, with 1 or 2 rayon threads (dense map and members)."""
+    import os
+    import subprocess
+    import sys
+
+    script = (
+        "import hashlib, stereovision as sv\n"
+        "from stereovision.io import load_scene\n"
+        f"sc = load_scene({str(data_dir / 'middlebury2001' / 'tsukuba')!r})\n"
+        "r = sv.depth_map(sc.left, sc.right, method='fused', max_disparity=16)\n"
+        "m = sv.match(sc.left, sc.right, method='fused', max_disparity=16)\n"
+        "h = hashlib.sha1(r.disparity.tobytes() + r.confidence.tobytes())\n"
+        "h.update(m.to_array().tobytes())\n"
+        "print(h.hexdigest(), len(m))\n"
+    )
+    outs = []
+    for threads in ("1", "2"):
+        env = dict(os.environ, RAYON_NUM_THREADS=threads)
+        proc = subprocess.run(
+            [sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True
+        )
+        outs.append(proc.stdout.split())
+    assert outs[0] == outs[1] and int(outs[0][1]) > 1000
