@@ -17,32 +17,16 @@ import argparse
 import json
 from pathlib import Path
 
-import numpy as np
+from _common import DATA
 
 from stereovision._validate import as_gray_float
-from stereovision.evaluate import sparse_metrics
+from stereovision.evaluate import count_at_precision, sparse_metrics
 from stereovision.io import find_scenes, load_scene
 from stereovision.match import METHODS, match
 from stereovision.matching.fusion import CHANNEL_BITS, fuse
 from stereovision.matching.gabor import gabor_disparity
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 SPARSE = [m for m in METHODS if m in CHANNEL_BITS]
-
-
-def count_at_precision(m, gt: np.ndarray, target: float, tol: float) -> int:
-    """Largest top-by-score prefix of ``m`` whose precision@tol (with GT) is >= target %."""
-    h, w = gt.shape
-    xi, yi = np.rint(m.xl).astype(int), np.rint(m.yl).astype(int)
-    ok = (xi >= 0) & (xi < w) & (yi >= 0) & (yi < h)
-    g = np.full(len(m.xl), np.nan)
-    g[ok] = gt[yi[ok], xi[ok]]
-    has = np.isfinite(g)
-    order = np.argsort(-m.score[has], kind="stable")
-    good = (np.abs((m.xl - m.xr)[has] - g[has]) <= tol)[order]
-    prec = 100 * np.cumsum(good) / np.arange(1, len(good) + 1)
-    idx = np.nonzero(prec >= target - 1e-9)[0]
-    return int(idx[-1] + 1) if len(idx) else 0
 
 
 def main() -> None:
@@ -77,7 +61,7 @@ def main() -> None:
         line += f" {fm.coverage:2d}/16"
         for name, m in chans.items():
             cm = sparse_metrics(m.xl, m.yl, m.xr, sc.gt)
-            at = count_at_precision(m, sc.gt, fm.precision[tol], tol)
+            at = count_at_precision(m.xl, m.yl, m.xr, m.score, sc.gt, fm.precision[tol], tol)
             row[name] = {
                 "precision": round(cm.precision[tol], 2),
                 "count": cm.count,

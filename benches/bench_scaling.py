@@ -22,12 +22,10 @@ from __future__ import annotations
 import argparse
 import inspect
 import json
-import statistics
-import time
 from pathlib import Path
 
 import cv2
-import numpy as np
+from _common import interleaved_ms
 
 from stereovision import baselines, depth_map
 
@@ -37,28 +35,6 @@ SIZES = {"VGA": (640, 480), "720p": (1280, 720), "1080p": (1920, 1080)}
 SIZE_SWEEP_D = 64
 D_SWEEP = (32, 64, 128, 192)
 DEFAULT_METHOD = inspect.signature(depth_map).parameters["method"].default
-
-
-def _time_pair(left: np.ndarray, right: np.ndarray, d: int, runs: int) -> tuple[float, float]:
-    """Median ms of ours and of SGBM-3WAY, interleaved after one warm-up each."""
-
-    def ours() -> None:
-        depth_map(left, right, None, max_disparity=d)
-
-    def sgbm() -> None:
-        baselines.opencv_sgbm(left, right, d)
-
-    ours()
-    sgbm()
-    t_ours, t_sgbm = [], []
-    for _ in range(runs):
-        t = time.perf_counter()
-        ours()
-        t_ours.append(time.perf_counter() - t)
-        t = time.perf_counter()
-        sgbm()
-        t_sgbm.append(time.perf_counter() - t)
-    return 1e3 * statistics.median(t_ours), 1e3 * statistics.median(t_sgbm)
 
 
 def _plot(rows: list[dict], path: Path) -> None:
@@ -117,7 +93,13 @@ def main() -> None:
     for sweep, label, (w, h), d in cases:
         left = cv2.resize(left0, (w, h), interpolation=cv2.INTER_CUBIC)
         right = cv2.resize(right0, (w, h), interpolation=cv2.INTER_CUBIC)
-        ours, sgbm = _time_pair(left, right, d, args.runs)
+        ours, sgbm = interleaved_ms(
+            (
+                lambda left=left, right=right, d=d: depth_map(left, right, None, max_disparity=d),
+                lambda left=left, right=right, d=d: baselines.opencv_sgbm(left, right, d),
+            ),
+            args.runs,
+        )
         row = {
             "bench": "scaling",
             "sweep": sweep,

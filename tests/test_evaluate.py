@@ -13,6 +13,7 @@ import pytest
 from stereovision.baselines import opencv_sgbm
 from stereovision.calibration import Calibration
 from stereovision.evaluate import (
+    count_at_precision,
     dense_metrics,
     depth_metrics,
     gt_depth,
@@ -244,3 +245,23 @@ def test_sgbm_terrace_depth_reference(data_dir: Path) -> None:
     # terrace: Z = 711.499 px * 0.0599432 m / d -> a few metres
     r = table1_report(s.calib.depth_from_disparity(disp), gt_depth(s.gt, s.calib), n_points=5)
     assert 1.0 < r.mean_distance < 20.0
+
+
+def test_count_at_precision_hand_computed() -> None:
+    gt = np.full((4, 6), np.nan)
+    gt[1, :] = 5.0
+    # Scores rank: a (right), b (wrong by 3), c (right), d (no GT), e (right).
+    xl = np.array([1, 2, 3, 4, 5], float)
+    yl = np.array([1, 1, 1, 3, 1], float)
+    xr = xl - np.array([5.0, 8.0, 5.4, 5.0, 4.2])
+    score = np.array([0.9, 0.8, 0.7, 0.95, 0.1])
+    # Prefix precisions over matches with GT: a 100, a b 50, a b c 66.7, a b c e 75.
+    assert count_at_precision(xl, yl, xr, score, gt, 100.0) == 1
+    assert count_at_precision(xl, yl, xr, score, gt, 70.0) == 4
+    assert count_at_precision(xl, yl, xr, score, gt, 60.0) == 4
+    assert count_at_precision(xl, yl, xr, score, gt, 76.0) == 1
+    # A looser tolerance counts b as right: all four at 100 %.
+    assert count_at_precision(xl, yl, xr, score, gt, 100.0, tol=3.0) == 4
+    assert count_at_precision(xl[:0], yl[:0], xr[:0], score[:0], gt, 50.0) == 0
+    with pytest.raises(ValueError, match="equal length"):
+        count_at_precision(xl, yl, xr, score[:2], gt, 50.0)

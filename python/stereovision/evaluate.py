@@ -30,6 +30,7 @@ __all__ = [
     "DepthMetrics",
     "SparseMetrics",
     "Table1Report",
+    "count_at_precision",
     "dense_metrics",
     "depth_metrics",
     "gt_depth",
@@ -537,3 +538,61 @@ def sparse_metrics(
     cell_y = np.minimum(yi[has_gt] * COVERAGE_GRID // h, COVERAGE_GRID - 1)
     coverage = len(set(zip(cell_y.tolist(), cell_x.tolist(), strict=True)))
     return SparseMetrics(precision=precision, count=count, n_matches=len(x), coverage=coverage)
+
+
+def count_at_precision(
+    xl: npt.ArrayLike,
+    yl: npt.ArrayLike,
+    xr: npt.ArrayLike,
+    score: npt.ArrayLike,
+    gt: npt.ArrayLike,
+    target: float,
+    tol: float = 1.0,
+) -> int:
+    """How many matches with GT a matcher keeps at a given precision, taken best score first.
+
+    The matches are ranked by decreasing ``score`` (stable) and cut to the longest prefix whose
+    precision@``tol`` over its matches with GT is still >= ``target`` percent; the count with
+    GT of that prefix is returned (0 if none qualifies). It compares two matchers at equal
+    precision ("more matches than the other would give at that precision").
+
+    Parameters
+    ----------
+    xl, yl, xr, score : array_like
+        ``(N,)`` left positions, matched right column and the matcher's score.
+    gt : array_like
+        ``(H, W)`` GT disparity of the left image, non-finite = unknown (looked up as in
+        :func:`sparse_metrics`).
+    target : float
+        Precision to hold, percent.
+    tol : float
+        Error bound of the precision (px).
+
+    Returns
+    -------
+    int
+
+    Raises
+    ------
+    ValueError
+        As :func:`sparse_metrics`, or if ``score`` has another length.
+    """
+    g = _real_2d(gt, "gt")
+    x, y, x2, s = (np.asarray(a, dtype=np.float64) for a in (xl, yl, xr, score))
+    if any(a.ndim != 1 for a in (x, y, x2, s)) or len({a.shape for a in (x, y, x2, s)}) != 1:
+        raise ValueError(
+            "xl, yl, xr, score: expected 1-D arrays of equal length, got shapes "
+            f"{[a.shape for a in (x, y, x2, s)]}"
+        )
+    h, w = g.shape
+    with np.errstate(invalid="ignore"):
+        xi, yi = np.rint(x), np.rint(y)
+        inside = np.isfinite(x2) & (xi >= 0) & (xi < w) & (yi >= 0) & (yi < h)
+    gv = np.full(len(x), np.nan)
+    gv[inside] = g[yi[inside].astype(np.int64), xi[inside].astype(np.int64)]
+    has = np.isfinite(gv)
+    order = np.argsort(-s[has], kind="stable")
+    good = (np.abs((x - x2)[has] - gv[has]) <= tol)[order]
+    prec = 100.0 * np.cumsum(good) / np.arange(1, len(good) + 1)
+    ok = np.nonzero(prec >= target - 1e-9)[0]
+    return int(ok[-1] + 1) if len(ok) else 0
