@@ -11,6 +11,7 @@ mod errors;
 mod gabor;
 mod hopfield;
 mod mcgm;
+mod params;
 
 #[pymodule(gil_used = false)]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -16,20 +16,7 @@ use stereovision_core::Image;
 
 use crate::convert::{image_from_numpy, image_to_numpy};
 use crate::errors::guard;
-
-fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
-    d: &Bound<'py, PyDict>,
-    key: &str,
-    slot: &mut T,
-) -> PyResult<()> {
-    if let Some(v) = d.get_item(key)? {
-        *slot = v.extract::<T>().map_err(|e| {
-            let e: PyErr = e.into();
-            PyValueError::new_err(format!("parameter `{key}`: {e}"))
-        })?;
-    }
-    Ok(())
-}
+use crate::params::{check_keys, get};
 
 const KEYS: [&str; 41] = [
     "min_disparity",
@@ -77,14 +64,7 @@ const KEYS: [&str; 41] = [
 
 /// Core parameters from the `params` dict (missing keys keep the core defaults).
 fn params(d: &Bound<'_, PyDict>) -> PyResult<McgmParams> {
-    for k in d.keys() {
-        let k: String = k.extract()?;
-        if !KEYS.contains(&k.as_str()) {
-            return Err(PyValueError::new_err(format!(
-                "unknown MCGM parameter `{k}`"
-            )));
-        }
-    }
+    check_keys(d, &KEYS, "MCGM")?;
     let mut p = McgmParams::default();
     get(d, "min_disparity", &mut p.d_min)?;
     get(d, "max_disparity", &mut p.d_max)?;

@@ -1,0 +1,33 @@
+//! Tuning parameters passed as one Python dict (keys = the Python names).
+
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// Every key of `d` must be one of `known`; `what` names the channel in the error.
+pub fn check_keys(d: &Bound<'_, PyDict>, known: &[&str], what: &str) -> PyResult<()> {
+    for k in d.keys() {
+        let k: String = k.extract()?;
+        if !known.contains(&k.as_str()) {
+            return Err(PyValueError::new_err(format!(
+                "unknown {what} parameter `{k}`"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Overwrites `slot` with `d[key]` when present; a wrong type is a `ValueError` naming the key.
+pub fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
+    d: &Bound<'py, PyDict>,
+    key: &str,
+    slot: &mut T,
+) -> PyResult<()> {
+    if let Some(v) = d.get_item(key)? {
+        *slot = v.extract::<T>().map_err(|e| {
+            let e: PyErr = e.into();
+            PyValueError::new_err(format!("parameter `{key}`: {e}"))
+        })?;
+    }
+    Ok(())
+}
