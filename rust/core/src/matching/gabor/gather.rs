@@ -2,7 +2,9 @@
 //!
 //! The position-shift kernels read the right image at a per-pixel position; as plain indexed
 //! loads these loops stayed scalar and dominated the search and the Newton step. With AVX2 they
-//! use the hardware gather, 8 lanes at a time. Loads are exact, so both paths give identical
+//! run 8 lanes at a time: a chunk whose indices fit in one 8-wide window (most of them: the
+//! disparity changes slowly along a row) is a plain load and a permutation, the rest use the
+//! hardware gather. Loads are exact, so both paths give identical
 //! results. Indices are clamped to the row (`min(idx, len - 1)`): callers pass in-range indices,
 //! the clamp only makes an out-of-range one impossible to turn into an out-of-bounds read.
 
@@ -37,28 +39,33 @@ fn gather_scalar(src: &[f32], idx: &[u32], out: &mut [f32], from: usize) {
 #[target_feature(enable = "avx2")]
 unsafe fn gather_avx2(src: &[f32], idx: &[u32], out: &mut [f32]) {
     use std::arch::x86_64::{
-        __m256i, _mm256_add_epi32, _mm256_castsi256_ps, _mm256_cmpeq_epi32, _mm256_i32gather_ps,
-        _mm256_loadu_ps, _mm256_loadu_si256, _mm256_min_epu32, _mm256_movemask_ps,
-        _mm256_set1_epi32, _mm256_setr_epi32, _mm256_storeu_ps,
+        __m256i, _mm256_castsi256_ps, _mm256_cmpeq_epi32, _mm256_i32gather_ps, _mm256_loadu_ps,
+        _mm256_loadu_si256, _mm256_max_epu32, _mm256_min_epu32, _mm256_movemask_ps,
+        _mm256_permutevar8x32_ps, _mm256_set1_epi32, _mm256_storeu_ps, _mm256_sub_epi32,
     };
     const LANES: usize = 8;
     let n = out.len().min(idx.len());
-    let maxi = _mm256_set1_epi32((src.len() - 1) as i32);
-    let ramp = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    let len = src.len();
+    let maxi = _mm256_set1_epi32((len - 1) as i32);
+    let seven = _mm256_set1_epi32(7);
     let mut x = 0;
     while x + LANES <= n {
         // SAFETY: x + 8 <= n bounds both the 8-lane load of `idx` and the store to `out`; the
         // clamped indices are <= src.len() - 1 (non-negative as i32), so every lane reads `src`.
-        // A run of 8 consecutive clamped indices i..i+7 (smooth disparities: most chunks) is read
-        // with one plain load, in bounds because i + 7 is itself a clamped index.
+        // When the 8 clamped indices lie in first..=first + 7 (smooth disparities: most chunks,
+        // the in-order run included) and first + 8 <= len, the chunk is one plain load of
+        // src[first..first + 8] and an in-register permutation: the hardware gather is several
+        // times slower (microcoded on AMD).
         unsafe {
             let iv = _mm256_loadu_si256(idx.as_ptr().add(x) as *const __m256i);
             let iv = _mm256_min_epu32(iv, maxi);
-            let first = (*idx.get_unchecked(x) as usize).min(src.len() - 1);
-            let run = _mm256_add_epi32(_mm256_set1_epi32(first as i32), ramp);
-            let same = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(iv, run)));
-            let v = if same == 0xff {
-                _mm256_loadu_ps(src.as_ptr().add(first))
+            let first = (*idx.get_unchecked(x) as usize).min(len - 1);
+            // Lanes below `first` wrap to huge unsigned values and fail the <= 7 test.
+            let rel = _mm256_sub_epi32(iv, _mm256_set1_epi32(first as i32));
+            let near = _mm256_cmpeq_epi32(_mm256_max_epu32(rel, seven), seven);
+            let v = if _mm256_movemask_ps(_mm256_castsi256_ps(near)) == 0xff && first + LANES <= len
+            {
+                _mm256_permutevar8x32_ps(_mm256_loadu_ps(src.as_ptr().add(first)), rel)
             } else {
                 _mm256_i32gather_ps::<4>(src.as_ptr(), iv)
             };
@@ -79,11 +86,17 @@ mod tests {
         let runs = (0..24)
             .map(|i| 3 + i as u32)
             .chain((0..16).map(|i| 30 + i as u32));
-        let idx: Vec<u32> = scattered.chain(runs).collect();
-        let mut out = vec![0f32; idx.len()];
-        super::gather(&src, &idx, &mut out);
-        for (o, &i) in out.iter().zip(&idx) {
-            assert_eq!(*o, src[(i as usize).min(36)]);
+        // Chunks within an 8-wide window (permuted loads), one running past the end of `src`.
+        let windows = [3u32, 3, 5, 4, 9, 10, 6, 8, 31, 33, 36, 36, 35, 30, 29, 36];
+        let all: Vec<u32> = scattered.chain(runs).chain(windows).collect();
+        // Every alignment of the patterns to the 8-lane chunks.
+        for skip in 0..8 {
+            let idx = &all[skip..];
+            let mut out = vec![0f32; idx.len()];
+            super::gather(&src, idx, &mut out);
+            for (o, &i) in out.iter().zip(idx) {
+                assert_eq!(*o, src[(i as usize).min(36)]);
+            }
         }
     }
 }

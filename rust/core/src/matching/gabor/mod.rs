@@ -11,8 +11,9 @@
 //!
 //! Right responses are never recomputed for a warp: the smooth baseband is shifted (`level`).
 //!
-//! Profiling aid: with the environment variable `SV_GABOR_TIMING` set, per-level stage times are
-//! printed to stderr.
+//! Profiling aid: with the environment variable `SV_GABOR_TIMING` set, per-level stage times
+//! (per direction) and the wall-clock time at the end of each post-processing stage are printed
+//! to stderr.
 
 mod fastmath;
 pub mod filter;
@@ -289,6 +290,13 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
     params.validate()?;
     let chans = params.channels()?;
     let (w, h) = left.size();
+    let timing = std::env::var_os("SV_GABOR_TIMING").is_some();
+    let t_all = std::time::Instant::now();
+    let wall = |what: &str| {
+        if timing {
+            eprintln!("wall {what}: {:.1} ms", t_all.elapsed().as_secs_f64() * 1e3);
+        }
+    };
     let (fwd, bwd) = if params.lr_check {
         let fl = post::flip_x(&right.data, w, h);
         let fr = post::flip_x(&left.data, w, h);
@@ -313,6 +321,7 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
             None,
         )
     };
+    wall("directions");
     let mut disp = fwd.disp.into_vec();
     let mut conf = fwd.conf.into_vec();
     let lr_ok = bwd.map(|b| {
@@ -330,7 +339,9 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
             }
         }
     });
+    wall("lr check");
     post::remove_speckles(&mut disp, w, h, params.speckle_size, params.speckle_range);
+    wall("speckles");
     for (c, d) in conf.iter_mut().zip(&disp) {
         *c = if d.is_finite() {
             c.clamp(0.0, 1.0)
@@ -338,6 +349,7 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
             0.0
         };
     }
+    wall("done");
     Ok(GaborOutput {
         disparity: Image {
             width: w,

@@ -120,7 +120,8 @@ pub fn search(l: &LevelData, r: &LevelData, base: &[f32], offs: &[f32], pool: us
 /// Row buffers of one band.
 struct Scratch {
     si: Vec<u32>,
-    valid: Vec<bool>,
+    /// 1 where the shifted position is inside the image, else 0 (a float mask, see `direct_row`).
+    valid: Vec<f32>,
     /// `floor(x - d + 0.5)`: the shifted position at offset 0 (unpooled search).
     j0: Vec<i32>,
     /// Gathered right samples (re, im).
@@ -137,7 +138,7 @@ impl Scratch {
     fn new(w: usize, p: usize) -> Self {
         Scratch {
             si: vec![0; w],
-            valid: vec![false; w],
+            valid: vec![0.0; w],
             j0: vec![0; w],
             gr: vec![0.0; w],
             gi: vec![0.0; w],
@@ -188,7 +189,7 @@ simd_fn! {
         for x in 0..w {
             let s = floor_fast(x as f32 - drow[x] + 0.5) - off;
             let v = s >= 0.0 && s <= last;
-            valid[x] = v;
+            valid[x] = if v { 1.0 } else { 0.0 };
             si[x] = if v { s as u32 } else { 0 };
         }
         let (num, den) = (&mut sc.num[..w], &mut sc.den[..w]);
@@ -206,9 +207,10 @@ simd_fn! {
         gather(&r.energy[o..o + w], si, gr);
         let le = &l.energy[o..o + w];
         for x in 0..w {
+            // Products with the 0/1 mask, not selects (see `direct_row`).
             let v = valid[x];
-            num[x] = if v { 2.0 * num[x] } else { 0.0 };
-            den[x] = if v { le[x] + gr[x] } else { 0.0 };
+            num[x] = 2.0 * num[x] * v;
+            den[x] = (le[x] + gr[x]) * v;
         }
         pool_x(num, &mut sc.pad, sc.p, hn);
         pool_x(den, &mut sc.pad, sc.p, hd);
@@ -246,10 +248,11 @@ simd_fn! {
         }
         let (base, best, out) = (&base[..w], &mut best[..w], &mut out[..w]);
         for x in 0..w {
+            // Unconditional loads and stores (no VMASKMOVPS, see `direct_row`).
             let e = if den[x] > 0.0 { num[x] / den[x] } else { 0.0 };
-            let better = e > best[x];
-            best[x] = if better { e } else { best[x] };
-            out[x] = if better { base[x] + off } else { out[x] };
+            let (b, cand, cur) = (best[x], base[x] + off, out[x]);
+            best[x] = b.max(e);
+            out[x] = if e > b { cand } else { cur };
         }
     }
 }
@@ -283,7 +286,7 @@ simd_fn! {
             for x in 0..w {
                 let j = j0[x] - oi;
                 let v = j >= 0 && j < w as i32;
-                valid[x] = v;
+                valid[x] = if v { 1.0 } else { 0.0 };
                 si[x] = if v { j as u32 } else { 0 };
             }
             num.iter_mut().for_each(|v| *v = 0.0);
@@ -297,13 +300,18 @@ simd_fn! {
             }
             gather(&r.energy[o..o + w], si, gr);
             for x in 0..w {
+                // No load or store under a condition: LLVM turns those into VMASKMOVPS, which is
+                // microcoded on AMD (the masked loads and the masked store of `best` were a large
+                // share of the search on Zen 3). The gathered terms are finite, so a product with
+                // the 0/1 mask is exact, and it cannot be folded back into a masked load.
                 let v = valid[x];
-                let n = if v { 2.0 * num[x] } else { 0.0 };
-                let d = if v { le[x] + gr[x] } else { 0.0 };
+                let n = 2.0 * num[x] * v;
+                let d = (le[x] + gr[x]) * v;
                 let e = if d > 0.0 { n / d } else { 0.0 };
-                let better = e > best[x];
-                best[x] = if better { e } else { best[x] };
-                out[x] = if better { drow[x] + off } else { out[x] };
+                let (b, cand, cur) = (best[x], drow[x] + off, out[x]);
+                let better = e > b;
+                best[x] = b.max(e);
+                out[x] = if better { cand } else { cur };
             }
         }
     }
