@@ -109,6 +109,12 @@ def test_points_equal_reproject_on_a_metric_scene(data_dir: Path) -> None:
     xs, ys = res.pixels[:, 0], res.pixels[:, 1]
     assert len(res.points) > 100000
     np.testing.assert_allclose(res.points, xyz[ys, xs], rtol=1e-6, atol=1e-7)
+    # Depth is depth_from_disparity's at the measured pixels; colours are the left pixel's RGB.
+    z = scene.calib.depth_from_disparity(np.where(res.confidence > 0, res.disparity, np.nan))
+    assert res.depth is not None
+    np.testing.assert_allclose(res.depth, z, rtol=1e-6, equal_nan=True)
+    assert res.left_rectified is not None
+    np.testing.assert_array_equal(res.colors, res.left_rectified[ys, xs][:, ::-1])
 
 
 def test_without_calibration_no_depth() -> None:
@@ -185,3 +191,22 @@ def test_bad_arguments_raise_value_error() -> None:
         sv.depth_map(img, img, max_disparity=64)
     with pytest.raises(ValueError, match="calibration is for"):
         sv.depth_map(img, img, _rect_calib(100, 50), max_disparity=8)
+
+
+def test_cloud_false_keeps_depth_and_to_ply_writes_the_full_cloud(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """depth_map(cloud=False) (live use) has the same depth and no per-frame cloud; to_ply
+    still writes every point."""
+    from stereovision.io import read_ply
+
+    scene = load_scene(data_dir / "eth3d" / "terrace")
+    full = sv.depth_map(scene.left, scene.right, scene.calib, max_disparity=32)
+    lean = sv.depth_map(scene.left, scene.right, scene.calib, max_disparity=32, cloud=False)
+    assert full.depth is not None and lean.depth is not None
+    np.testing.assert_array_equal(lean.depth, full.depth)
+    assert lean.points.shape == (0, 3) and lean.colors.shape == (0, 3)
+    pts, cols = read_ply(lean.to_ply(tmp_path / "lean.ply"))
+    assert len(full.points) > 100000
+    np.testing.assert_array_equal(pts, full.points)
+    np.testing.assert_array_equal(cols, full.colors)

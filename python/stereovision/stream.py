@@ -416,7 +416,8 @@ def run_stream(
     on_report : callable, optional
         Called with each per-second report (a JSON-ready dict, see the module doc).
     on_result : callable, optional
-        Called with ``(left_rectified_bgr, DepthResult)`` of every pair.
+        Called with ``(left_rectified_bgr, DepthResult)`` of every pair. The result is computed
+        with ``cloud=False``: its ``points`` are empty, its ``to_ply`` writes the full cloud.
     report_period : float
         Seconds between reports.
 
@@ -476,7 +477,8 @@ def run_stream(
             t_got = time.perf_counter()
             if md is None:
                 md = estimate_max_disparity(pair.left, pair.right)
-            res = depth_map(pair.left, pair.right, rect_calib, max_disparity=md, **kw)
+            # No point cloud per frame: the live view shows disparity and depth.
+            res = depth_map(pair.left, pair.right, rect_calib, max_disparity=md, cloud=False, **kw)
             t_last = time.perf_counter()
             tm = res.timings
             stages = {
