@@ -76,6 +76,90 @@ unsafe fn gather_avx2(src: &[f32], idx: &[u32], out: &mut [f32]) {
     gather_scalar(src, idx, out, x);
 }
 
+/// `out[x] = a + t[x] (b - a)` with `a = src[i]`, `b = src[i + 1]`, `i = min(idx[x], len - 2)`
+/// (`b = a` for a one-sample row): the gather and linear interpolation of a row at sub-pixel
+/// positions in one pass, the index work shared by both samples. Same float operations as
+/// two [`gather`]s and the interpolation loop, so the same results.
+#[inline]
+pub fn gather_lerp(src: &[f32], idx: &[u32], t: &[f32], out: &mut [f32]) {
+    if src.is_empty() {
+        return;
+    }
+    #[cfg(target_arch = "x86_64")]
+    {
+        if src.len() >= 2 && src.len() <= i32::MAX as usize && std::is_x86_feature_detected!("avx2")
+        {
+            // SAFETY: AVX2 is available (checked above), 2 <= src.len() and src.len() - 1 fits in
+            // an i32.
+            unsafe { gather_lerp_avx2(src, idx, t, out) };
+            return;
+        }
+    }
+    gather_lerp_scalar(src, idx, t, out, 0);
+}
+
+#[inline(always)]
+fn gather_lerp_scalar(src: &[f32], idx: &[u32], t: &[f32], out: &mut [f32], from: usize) {
+    let last = src.len() - 1;
+    let top = src.len().saturating_sub(2);
+    for ((o, &i), &t) in out.iter_mut().zip(idx).zip(t).skip(from) {
+        let i = (i as usize).min(top);
+        let (a, b) = (src[i], src[(i + 1).min(last)]);
+        *o = a + t * (b - a);
+    }
+}
+
+/// # Safety
+/// The CPU must support AVX2, `src.len()` must be in `2..=i32::MAX`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn gather_lerp_avx2(src: &[f32], idx: &[u32], t: &[f32], out: &mut [f32]) {
+    use std::arch::x86_64::{
+        __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_castsi256_ps, _mm256_cmpeq_epi32,
+        _mm256_i32gather_ps, _mm256_loadu_ps, _mm256_loadu_si256, _mm256_max_epu32,
+        _mm256_min_epu32, _mm256_movemask_ps, _mm256_mul_ps, _mm256_permutevar8x32_ps,
+        _mm256_set1_epi32, _mm256_storeu_ps, _mm256_sub_epi32, _mm256_sub_ps,
+    };
+    const LANES: usize = 8;
+    let n = out.len().min(idx.len()).min(t.len());
+    let len = src.len();
+    let top = len - 2;
+    let maxi = _mm256_set1_epi32(top as i32);
+    let one = _mm256_set1_epi32(1);
+    let seven = _mm256_set1_epi32(7);
+    let mut x = 0;
+    while x + LANES <= n {
+        // SAFETY: x + 8 <= n bounds the 8-lane loads of `idx` and `t` and the store to `out`;
+        // clamped indices are <= len - 2, so i and i + 1 are in `src`. The window path reads
+        // src[first..first + 9], in bounds by the test first + 9 <= len (see `gather_avx2`).
+        unsafe {
+            let iv = _mm256_loadu_si256(idx.as_ptr().add(x) as *const __m256i);
+            let iv = _mm256_min_epu32(iv, maxi);
+            let first = (*idx.get_unchecked(x) as usize).min(top);
+            let rel = _mm256_sub_epi32(iv, _mm256_set1_epi32(first as i32));
+            let near = _mm256_cmpeq_epi32(_mm256_max_epu32(rel, seven), seven);
+            let (a, b) =
+                if _mm256_movemask_ps(_mm256_castsi256_ps(near)) == 0xff && first + LANES < len {
+                    let p = src.as_ptr().add(first);
+                    (
+                        _mm256_permutevar8x32_ps(_mm256_loadu_ps(p), rel),
+                        _mm256_permutevar8x32_ps(_mm256_loadu_ps(p.add(1)), rel),
+                    )
+                } else {
+                    (
+                        _mm256_i32gather_ps::<4>(src.as_ptr(), iv),
+                        _mm256_i32gather_ps::<4>(src.as_ptr(), _mm256_add_epi32(iv, one)),
+                    )
+                };
+            let tv = _mm256_loadu_ps(t.as_ptr().add(x));
+            let v = _mm256_add_ps(a, _mm256_mul_ps(tv, _mm256_sub_ps(b, a)));
+            _mm256_storeu_ps(out.as_mut_ptr().add(x), v);
+        }
+        x += LANES;
+    }
+    gather_lerp_scalar(src, idx, t, out, x);
+}
+
 #[cfg(test)]
 mod tests {
     #[test]
@@ -98,5 +182,33 @@ mod tests {
                 assert_eq!(*o, src[(i as usize).min(36)]);
             }
         }
+    }
+
+    #[test]
+    fn gather_lerp_equals_two_gathers_and_the_interpolation() {
+        let src: Vec<f32> = (0..41)
+            .map(|i| ((i * 37) % 23) as f32 * 0.25 - 1.0)
+            .collect();
+        let scattered = (0..29).map(|i| (i * 7 % 45) as u32);
+        let runs = (0..24)
+            .map(|i| 3 + i as u32)
+            .chain((0..16).map(|i| 30 + i as u32));
+        let windows = [3u32, 3, 5, 4, 9, 10, 6, 8, 31, 33, 39, 39, 38, 30, 29, 40];
+        let all: Vec<u32> = scattered.chain(runs).chain(windows).collect();
+        let t: Vec<f32> = (0..all.len()).map(|i| (i % 9) as f32 / 8.0).collect();
+        for skip in 0..8 {
+            let (idx, tt) = (&all[skip..], &t[skip..]);
+            let mut out = vec![0f32; idx.len()];
+            super::gather_lerp(&src, idx, tt, &mut out);
+            for ((o, &i), &t) in out.iter().zip(idx).zip(tt) {
+                let i = (i as usize).min(39);
+                let (a, b) = (src[i], src[i + 1]);
+                assert_eq!(o.to_bits(), (a + t * (b - a)).to_bits(), "index {i}");
+            }
+        }
+        // A one-sample row interpolates between the sample and itself.
+        let mut out = [0f32; 9];
+        super::gather_lerp(&[2.5], &[0; 9], &[0.5; 9], &mut out);
+        assert!(out.iter().all(|&v| v == 2.5));
     }
 }

@@ -15,7 +15,7 @@
 
 use super::fastmath::{atan2, floor_fast, ln, round_fast, sincos};
 use super::filter::{blur_real, complex_col_pass, row_pass, Channel};
-use super::gather::gather;
+use super::gather::gather_lerp;
 use super::pool::Buf;
 use crate::parallel::{for_each_row, for_each_row_pair, ROWS_PER_TASK};
 use crate::simd::simd_fn;
@@ -338,7 +338,6 @@ pub fn kx_slots(cc: &[ChanConst]) -> Vec<f32> {
 /// interpolated low-pass and the carrier rotations `exp(-j kx d)` per distinct `kx`.
 struct RowPrep {
     i0: Vec<u32>,
-    i1: Vec<u32>,
     t: Vec<f32>,
     /// `round(x - d)` clamped to the row, and 1 where `x - d` is inside it.
     near: Vec<u32>,
@@ -347,16 +346,12 @@ struct RowPrep {
     lp: Vec<f32>,
     sn: Vec<Vec<f32>>,
     cs: Vec<Vec<f32>>,
-    /// Gathered low-pass samples at `i0`, `i1`.
-    a: Vec<f32>,
-    b: Vec<f32>,
 }
 
 impl RowPrep {
     fn new(w: usize, n_slots: usize) -> Self {
         RowPrep {
             i0: vec![0; w],
-            i1: vec![0; w],
             t: vec![0.0; w],
             near: vec![0; w],
             valid: vec![0; w],
@@ -364,8 +359,6 @@ impl RowPrep {
             lp: vec![0.0; w],
             sn: vec![vec![0.0; w]; n_slots],
             cs: vec![vec![0.0; w]; n_slots],
-            a: vec![0.0; w],
-            b: vec![0.0; w],
         }
     }
 }
@@ -379,8 +372,6 @@ struct RowWork {
     bwi: Vec<f32>,
     gfr: Vec<f32>,
     gfi: Vec<f32>,
-    g0: Vec<f32>,
-    g1: Vec<f32>,
 }
 
 impl RowWork {
@@ -394,8 +385,6 @@ impl RowWork {
             bwi: z(),
             gfr: z(),
             gfi: z(),
-            g0: z(),
-            g1: z(),
         }
     }
 }
@@ -414,13 +403,12 @@ fn prep_row(
     let w = l.w;
     let o = y * w;
     let last = (w - 1) as f32;
-    let (i0max, i1max) = (w.saturating_sub(2) as f32, last);
+    let i0max = w.saturating_sub(2) as f32;
     // Index arithmetic in f32 and one conversion per value, so this loop vectorises (with
     // `usize` casts and `min` it stayed scalar, a fifth of the Newton row). Same values: the
     // indices are integers below 2^24, exact in f32.
-    let (pi0, pi1, pt, pnear, pv) = (
+    let (pi0, pt, pnear, pv) = (
         &mut p.i0[..w],
-        &mut p.i1[..w],
         &mut p.t[..w],
         &mut p.near[..w],
         &mut p.valid[..w],
@@ -433,7 +421,6 @@ fn prep_row(
         let sc = s.max(0.0).min(last);
         let i0 = floor_fast(sc).min(i0max);
         pi0[x] = i0 as i32 as u32;
-        pi1[x] = (i0 + 1.0).min(i1max) as i32 as u32;
         pt[x] = sc - i0;
         pnear[x] = round_fast(sc).min(last) as i32 as u32;
     }
@@ -443,13 +430,7 @@ fn prep_row(
         let rn = rs[(pnear[x] as usize).min(w - 1)];
         p.stab[x] = (ls[x] & rn) * pv[x];
     }
-    let rlp = &r.lowpass[o..o + w];
-    gather(rlp, &p.i0, &mut p.a);
-    gather(rlp, &p.i1, &mut p.b);
-    let (a, b, t, lp) = (&p.a[..w], &p.b[..w], &p.t[..w], &mut p.lp[..w]);
-    for x in 0..w {
-        lp[x] = a[x] + t[x] * (b[x] - a[x]);
-    }
+    gather_lerp(&r.lowpass[o..o + w], &p.i0, &p.t, &mut p.lp);
     for (k, &kx) in slots.iter().enumerate() {
         let (sn, cs) = (&mut p.sn[k][..w], &mut p.cs[k][..w]);
         for x in 0..w {
@@ -475,8 +456,6 @@ fn shifted_row(
     bwi: &mut [f32],
     gfr: &mut [f32],
     gfi: &mut [f32],
-    g0: &mut [f32],
-    g1: &mut [f32],
 ) {
     let w = l.w;
     let o = SUBROWS * y * w;
@@ -484,20 +463,13 @@ fn shifted_row(
     let (rre, rim) = (&rc[o..o + w], &rc[o + w..o + 2 * w]);
     let (rfr, rfi) = (&rc[o + 2 * w..o + 3 * w], &rc[o + 3 * w..o + 4 * w]);
     // Gather + linear interpolation of the smooth baseband and frequency phasor.
-    let (a, b) = (&mut g0[..w], &mut g1[..w]);
-    let t = &p.t[..w];
     for (src, dst) in [
         (rre, &mut *bwr),
         (rim, &mut *bwi),
         (rfr, &mut *gfr),
         (rfi, &mut *gfi),
     ] {
-        gather(src, &p.i0, a);
-        gather(src, &p.i1, b);
-        let dst = &mut dst[..w];
-        for x in 0..w {
-            dst[x] = a[x] + t[x] * (b[x] - a[x]);
-        }
+        gather_lerp(src, &p.i0, &p.t, dst);
     }
     let (cre, cim) = (&l.colph[ci].0[..w], &l.colph[ci].1[..w]);
     let (rre, rim) = (l.rowph[ci].0[y], l.rowph[ci].1[y]);
@@ -532,12 +504,12 @@ simd_fn! {
     ) {
         let w = l.w;
         prep_row(l, r, slots, y, drow, 0.0, p);
-        let RowWork { num, den, csum, bwr, bwi, gfr, gfi, g0, g1 } = wk;
+        let RowWork { num, den, csum, bwr, bwi, gfr, gfi } = wk;
         for v in [&mut *num, &mut *den, &mut *csum] {
             v.iter_mut().for_each(|v| *v = 0.0);
         }
         for (ci, c) in cc.iter().enumerate() {
-            shifted_row(l, r, c, ci, y, p, bwr, bwi, gfr, gfi, g0, g1);
+            shifted_row(l, r, c, ci, y, p, bwr, bwi, gfr, gfi);
             let o = SUBROWS * y * w;
             let lc = &l.chan[ci];
             let (lre, lim) = (&lc[o..o + w], &lc[o + w..o + 2 * w]);
