@@ -2,9 +2,9 @@
 //!
 //! The position-shift kernels read the right image at a per-pixel position; as plain indexed
 //! loads these loops stayed scalar and dominated the search and the Newton step. With AVX2 they
-//! run 8 lanes at a time: a chunk whose indices fit in one 8-wide window (most of them: the
-//! disparity changes slowly along a row) is a plain load and a permutation, the rest use the
-//! hardware gather. Loads are exact, so both paths give identical
+//! run 8 lanes at a time: a chunk whose indices lie within 16 of their minimum (nearly all of
+//! them: the disparity changes slowly along a row) is one or two plain loads and in-register
+//! permutations, the rest use the hardware gather. Loads are exact, so both paths give identical
 //! results. Indices are clamped to the row (`min(idx, len - 1)`): callers pass in-range indices,
 //! the clamp only makes an out-of-range one impossible to turn into an out-of-bounds read.
 
@@ -33,39 +33,94 @@ fn gather_scalar(src: &[f32], idx: &[u32], out: &mut [f32], from: usize) {
     }
 }
 
+/// AVX2 building blocks shared with the fused search kernel.
+#[cfg(target_arch = "x86_64")]
+pub(crate) mod win {
+    use std::arch::x86_64::*;
+
+    /// Spread of 8 indices above their minimum that one window load covers.
+    pub const NARROW: i32 = 7;
+    /// ... and two loads.
+    pub const WIDE: i32 = 15;
+
+    /// `(min, idx - min, max - min)` of 8 non-negative indices.
+    ///
+    /// # Safety
+    /// AVX2.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub unsafe fn window(iv: __m256i) -> (i32, __m256i, i32) {
+        let lo = _mm256_min_epi32(iv, _mm256_permute2x128_si256::<1>(iv, iv));
+        let lo = _mm256_min_epi32(lo, _mm256_shuffle_epi32::<0b01_00_11_10>(lo));
+        let lo = _mm256_min_epi32(lo, _mm256_shuffle_epi32::<0b10_11_00_01>(lo));
+        let hi = _mm256_max_epi32(iv, _mm256_permute2x128_si256::<1>(iv, iv));
+        let hi = _mm256_max_epi32(hi, _mm256_shuffle_epi32::<0b01_00_11_10>(hi));
+        let hi = _mm256_max_epi32(hi, _mm256_shuffle_epi32::<0b10_11_00_01>(hi));
+        let (m, x) = (_mm256_cvtsi256_si32(lo), _mm256_cvtsi256_si32(hi));
+        (m, _mm256_sub_epi32(iv, _mm256_set1_epi32(m)), x - m)
+    }
+
+    /// `p[rel]` for 8 offsets `rel` in `0..=spread` (`spread <= WIDE`): one load and a
+    /// permutation, or two and a blend.
+    ///
+    /// # Safety
+    /// AVX2; `p[0..8]` readable, and `p[0..16]` when `spread > NARROW`.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    pub unsafe fn load(p: *const f32, rel: __m256i, spread: i32) -> __m256 {
+        // SAFETY: the caller guarantees the reads (see above).
+        unsafe {
+            let lo = _mm256_permutevar8x32_ps(_mm256_loadu_ps(p), rel);
+            if spread <= NARROW {
+                return lo;
+            }
+            // permutevar uses the low 3 bits of each lane, so `rel` indexes the second load too.
+            let hi = _mm256_permutevar8x32_ps(_mm256_loadu_ps(p.add(8)), rel);
+            let upper = _mm256_cmpgt_epi32(rel, _mm256_set1_epi32(NARROW));
+            _mm256_blendv_ps(lo, hi, _mm256_castsi256_ps(upper))
+        }
+    }
+
+    /// Floats a window load of `spread` reads past its start.
+    #[inline]
+    pub fn reach(spread: i32) -> usize {
+        if spread <= NARROW {
+            8
+        } else {
+            16
+        }
+    }
+}
+
 /// # Safety
 /// The CPU must support AVX2, `src` must be non-empty with `src.len() - 1 <= i32::MAX`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn gather_avx2(src: &[f32], idx: &[u32], out: &mut [f32]) {
     use std::arch::x86_64::{
-        __m256i, _mm256_castsi256_ps, _mm256_cmpeq_epi32, _mm256_i32gather_ps, _mm256_loadu_ps,
-        _mm256_loadu_si256, _mm256_max_epu32, _mm256_min_epu32, _mm256_movemask_ps,
-        _mm256_permutevar8x32_ps, _mm256_set1_epi32, _mm256_storeu_ps, _mm256_sub_epi32,
+        __m256i, _mm256_i32gather_ps, _mm256_loadu_si256, _mm256_min_epu32, _mm256_set1_epi32,
+        _mm256_storeu_ps,
     };
     const LANES: usize = 8;
     let n = out.len().min(idx.len());
     let len = src.len();
     let maxi = _mm256_set1_epi32((len - 1) as i32);
-    let seven = _mm256_set1_epi32(7);
     let mut x = 0;
     while x + LANES <= n {
         // SAFETY: x + 8 <= n bounds both the 8-lane load of `idx` and the store to `out`; the
         // clamped indices are <= src.len() - 1 (non-negative as i32), so every lane reads `src`.
-        // When the 8 clamped indices lie in first..=first + 7 (smooth disparities: most chunks,
-        // the in-order run included) and first + 8 <= len, the chunk is one plain load of
-        // src[first..first + 8] and an in-register permutation: the hardware gather is several
-        // times slower (microcoded on AMD).
+        // When the 8 clamped indices lie within 16 of their minimum `m` (smooth disparities:
+        // nearly every chunk) and the window m..m + reach fits in `src`, the chunk is one or two
+        // plain loads and in-register permutations: the hardware gather is several times slower
+        // (microcoded on AMD).
         unsafe {
-            let iv = _mm256_loadu_si256(idx.as_ptr().add(x) as *const __m256i);
-            let iv = _mm256_min_epu32(iv, maxi);
-            let first = (*idx.get_unchecked(x) as usize).min(len - 1);
-            // Lanes below `first` wrap to huge unsigned values and fail the <= 7 test.
-            let rel = _mm256_sub_epi32(iv, _mm256_set1_epi32(first as i32));
-            let near = _mm256_cmpeq_epi32(_mm256_max_epu32(rel, seven), seven);
-            let v = if _mm256_movemask_ps(_mm256_castsi256_ps(near)) == 0xff && first + LANES <= len
-            {
-                _mm256_permutevar8x32_ps(_mm256_loadu_ps(src.as_ptr().add(first)), rel)
+            let iv = _mm256_min_epu32(
+                _mm256_loadu_si256(idx.as_ptr().add(x) as *const __m256i),
+                maxi,
+            );
+            let (m, rel, spread) = win::window(iv);
+            let v = if spread <= win::WIDE && m as usize + win::reach(spread) <= len {
+                win::load(src.as_ptr().add(m as usize), rel, spread)
             } else {
                 _mm256_i32gather_ps::<4>(src.as_ptr(), iv)
             };
@@ -115,10 +170,9 @@ fn gather_lerp_scalar(src: &[f32], idx: &[u32], t: &[f32], out: &mut [f32], from
 #[target_feature(enable = "avx2")]
 unsafe fn gather_lerp_avx2(src: &[f32], idx: &[u32], t: &[f32], out: &mut [f32]) {
     use std::arch::x86_64::{
-        __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_castsi256_ps, _mm256_cmpeq_epi32,
-        _mm256_i32gather_ps, _mm256_loadu_ps, _mm256_loadu_si256, _mm256_max_epu32,
-        _mm256_min_epu32, _mm256_movemask_ps, _mm256_mul_ps, _mm256_permutevar8x32_ps,
-        _mm256_set1_epi32, _mm256_storeu_ps, _mm256_sub_epi32, _mm256_sub_ps,
+        __m256i, _mm256_add_epi32, _mm256_add_ps, _mm256_i32gather_ps, _mm256_loadu_ps,
+        _mm256_loadu_si256, _mm256_min_epu32, _mm256_mul_ps, _mm256_set1_epi32, _mm256_storeu_ps,
+        _mm256_sub_ps,
     };
     const LANES: usize = 8;
     let n = out.len().min(idx.len()).min(t.len());
@@ -126,31 +180,26 @@ unsafe fn gather_lerp_avx2(src: &[f32], idx: &[u32], t: &[f32], out: &mut [f32])
     let top = len - 2;
     let maxi = _mm256_set1_epi32(top as i32);
     let one = _mm256_set1_epi32(1);
-    let seven = _mm256_set1_epi32(7);
     let mut x = 0;
     while x + LANES <= n {
         // SAFETY: x + 8 <= n bounds the 8-lane loads of `idx` and `t` and the store to `out`;
-        // clamped indices are <= len - 2, so i and i + 1 are in `src`. The window path reads
-        // src[first..first + 9], in bounds by the test first + 9 <= len (see `gather_avx2`).
+        // clamped indices are <= len - 2, so i and i + 1 are in `src`. The window loads read
+        // src[m..m + reach + 1], in bounds by the test (see `gather_avx2`).
         unsafe {
-            let iv = _mm256_loadu_si256(idx.as_ptr().add(x) as *const __m256i);
-            let iv = _mm256_min_epu32(iv, maxi);
-            let first = (*idx.get_unchecked(x) as usize).min(top);
-            let rel = _mm256_sub_epi32(iv, _mm256_set1_epi32(first as i32));
-            let near = _mm256_cmpeq_epi32(_mm256_max_epu32(rel, seven), seven);
-            let (a, b) =
-                if _mm256_movemask_ps(_mm256_castsi256_ps(near)) == 0xff && first + LANES < len {
-                    let p = src.as_ptr().add(first);
-                    (
-                        _mm256_permutevar8x32_ps(_mm256_loadu_ps(p), rel),
-                        _mm256_permutevar8x32_ps(_mm256_loadu_ps(p.add(1)), rel),
-                    )
-                } else {
-                    (
-                        _mm256_i32gather_ps::<4>(src.as_ptr(), iv),
-                        _mm256_i32gather_ps::<4>(src.as_ptr(), _mm256_add_epi32(iv, one)),
-                    )
-                };
+            let iv = _mm256_min_epu32(
+                _mm256_loadu_si256(idx.as_ptr().add(x) as *const __m256i),
+                maxi,
+            );
+            let (m, rel, spread) = win::window(iv);
+            let (a, b) = if spread <= win::WIDE && m as usize + win::reach(spread) < len {
+                let p = src.as_ptr().add(m as usize);
+                (win::load(p, rel, spread), win::load(p.add(1), rel, spread))
+            } else {
+                (
+                    _mm256_i32gather_ps::<4>(src.as_ptr(), iv),
+                    _mm256_i32gather_ps::<4>(src.as_ptr(), _mm256_add_epi32(iv, one)),
+                )
+            };
             let tv = _mm256_loadu_ps(t.as_ptr().add(x));
             let v = _mm256_add_ps(a, _mm256_mul_ps(tv, _mm256_sub_ps(b, a)));
             _mm256_storeu_ps(out.as_mut_ptr().add(x), v);
@@ -172,7 +221,13 @@ mod tests {
             .chain((0..16).map(|i| 30 + i as u32));
         // Chunks within an 8-wide window (permuted loads), one running past the end of `src`.
         let windows = [3u32, 3, 5, 4, 9, 10, 6, 8, 31, 33, 36, 36, 35, 30, 29, 36];
-        let all: Vec<u32> = scattered.chain(runs).chain(windows).collect();
+        // Two-load windows (spread 8..=15, also descending and ending at the last sample) and
+        // one that would read past the end (the gather fallback).
+        let wide = [
+            10u32, 20, 12, 25, 11, 13, 24, 10, 30, 28, 27, 25, 24, 22, 21, 19, 25, 36, 30, 22, 26,
+            33, 29, 21, 27, 36, 30, 29, 28, 33, 35, 36,
+        ];
+        let all: Vec<u32> = scattered.chain(runs).chain(windows).chain(wide).collect();
         // Every alignment of the patterns to the 8-lane chunks.
         for skip in 0..8 {
             let idx = &all[skip..];
@@ -194,7 +249,11 @@ mod tests {
             .map(|i| 3 + i as u32)
             .chain((0..16).map(|i| 30 + i as u32));
         let windows = [3u32, 3, 5, 4, 9, 10, 6, 8, 31, 33, 39, 39, 38, 30, 29, 40];
-        let all: Vec<u32> = scattered.chain(runs).chain(windows).collect();
+        let wide = [
+            10u32, 20, 12, 25, 11, 13, 24, 10, 30, 28, 27, 25, 24, 22, 21, 19, 25, 39, 30, 24, 26,
+            33, 29, 24, 27, 39, 30, 29, 28, 33, 35, 39,
+        ];
+        let all: Vec<u32> = scattered.chain(runs).chain(windows).chain(wide).collect();
         let t: Vec<f32> = (0..all.len()).map(|i| (i % 9) as f32 / 8.0).collect();
         for skip in 0..8 {
             let (idx, tt) = (&all[skip..], &t[skip..]);

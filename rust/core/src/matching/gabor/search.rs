@@ -27,6 +27,18 @@ const SEARCH_BAND: usize = 32;
 
 /// Per-pixel argmax of the pooled normalised energy over `base + offs` (see the module docs).
 pub fn search(l: &LevelData, r: &LevelData, base: &[f32], offs: &[f32], pool: usize) -> Buf {
+    search_impl(l, r, base, offs, pool, true)
+}
+
+/// [`search`], with the fused AVX2 row kernel allowed or not (tests compare the two).
+pub(crate) fn search_impl(
+    l: &LevelData,
+    r: &LevelData,
+    base: &[f32],
+    offs: &[f32],
+    pool: usize,
+    allow_fused: bool,
+) -> Buf {
     let (w, h) = (l.w, l.h);
     let mut out = Buf::from_slice(base);
     if w == 0 || h == 0 || offs.is_empty() {
@@ -38,8 +50,24 @@ pub fn search(l: &LevelData, r: &LevelData, base: &[f32], offs: &[f32], pool: us
             .for_each(|(band, chunk)| {
                 let mut sc = Scratch::new(w, 0);
                 let mut best = vec![0f32; w];
+                let fused = allow_fused && consecutive(offs) && avx2::available();
                 for (i, orow) in chunk.chunks_mut(w).enumerate() {
                     let y = band * SEARCH_BAND + i;
+                    if fused {
+                        // SAFETY: AVX2 is available and `offs` are consecutive integers.
+                        unsafe {
+                            avx2::direct_row(
+                                l,
+                                r,
+                                y,
+                                &base[y * w..(y + 1) * w],
+                                offs,
+                                &mut sc.j0,
+                                orow,
+                            )
+                        };
+                        continue;
+                    }
                     direct_row(
                         l,
                         r,
@@ -313,6 +341,206 @@ simd_fn! {
                 best[x] = b.max(e);
                 out[x] = if better { cand } else { cur };
             }
+        }
+    }
+}
+
+/// True when `offs` are consecutive integers in increasing order (the re-search and the top-level
+/// search both are): the fused AVX2 row kernel relies on it.
+fn consecutive(offs: &[f32]) -> bool {
+    offs.iter().all(|o| o.fract() == 0.0 && o.abs() < 65536.0)
+        && offs.windows(2).all(|p| p[1] - p[0] == 1.0)
+}
+
+/// The unpooled search row fused over offsets in registers (AVX2).
+///
+/// [`direct_row`] makes, per offset, a pass of index work, one gather per channel plane and a
+/// pass of energy arithmetic, through row buffers. Here each 8-pixel chunk is done for every
+/// offset at once: the candidates of offset `o` sit at `j0 - o`, so when the chunk's `j0` lie
+/// within 16 of their minimum (smooth disparities: nearly all chunks) every offset is one or two
+/// loads per plane and the same in-register permutation, and the running best stays in
+/// registers. The float
+/// operations are those of [`direct_row`] in the same order, so the output is the same bit for
+/// bit (tested).
+mod avx2 {
+    use super::{LevelData, SUBROWS};
+    #[cfg(target_arch = "x86_64")]
+    use crate::matching::gabor::gather::win;
+    #[cfg(target_arch = "x86_64")]
+    use std::arch::x86_64::*;
+
+    pub fn available() -> bool {
+        #[cfg(target_arch = "x86_64")]
+        {
+            std::is_x86_feature_detected!("avx2")
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            false
+        }
+    }
+
+    /// # Safety
+    /// The CPU must support AVX2 ([`available`]); `offs` must be consecutive integers.
+    #[cfg(not(target_arch = "x86_64"))]
+    pub unsafe fn direct_row(
+        _l: &LevelData,
+        _r: &LevelData,
+        _y: usize,
+        _drow: &[f32],
+        _offs: &[f32],
+        _j0: &mut [i32],
+        _out: &mut [f32],
+    ) {
+        unreachable!("AVX2 kernel called without AVX2")
+    }
+
+    /// 8 samples of `src`: `src[base + rel]` from a window load (`window`: the caller checked
+    /// `0 <= base`, `base + reach(spread) <= src.len()`, `rel` in `0..=spread`), else a gather
+    /// at `idx` (in `0..src.len()`).
+    ///
+    /// # Safety
+    /// AVX2, and the bounds above.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    #[inline]
+    unsafe fn load(
+        src: &[f32],
+        base: i32,
+        rel: __m256i,
+        spread: i32,
+        idx: __m256i,
+        window: bool,
+    ) -> __m256 {
+        // SAFETY: see the function's contract.
+        unsafe {
+            if window {
+                win::load(src.as_ptr().add(base as usize), rel, spread)
+            } else {
+                _mm256_i32gather_ps::<4>(src.as_ptr(), idx)
+            }
+        }
+    }
+
+    /// # Safety
+    /// The CPU must support AVX2 ([`available`]); `offs` must be consecutive integers.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    pub unsafe fn direct_row(
+        l: &LevelData,
+        r: &LevelData,
+        y: usize,
+        drow: &[f32],
+        offs: &[f32],
+        j0: &mut [i32],
+        out: &mut [f32],
+    ) {
+        const LANES: usize = 8;
+        let w = l.w;
+        let (o, ro) = (y * w, SUBROWS * y * w);
+        let (drow, out, j0) = (&drow[..w], &mut out[..w], &mut j0[..w]);
+        for x in 0..w {
+            j0[x] = super::floor_fast(x as f32 - drow[x] + 0.5) as i32;
+        }
+        let nch = l.chan.len();
+        // Per channel: the left (re, im) rows and the right (re, im) rows of row y.
+        let lrows: Vec<(&[f32], &[f32])> = l
+            .chan
+            .iter()
+            .map(|c| (&c[ro + 4 * w..ro + 5 * w], &c[ro + 5 * w..ro + 6 * w]))
+            .collect();
+        let rrows: Vec<(&[f32], &[f32])> = r
+            .chan
+            .iter()
+            .map(|c| (&c[ro + 4 * w..ro + 5 * w], &c[ro + 5 * w..ro + 6 * w]))
+            .collect();
+        let (le, re) = (&l.energy[o..o + w], &r.energy[o..o + w]);
+        let o0 = offs[0] as i32;
+        let wi = w as i32;
+        let zero = _mm256_setzero_ps();
+        let two = _mm256_set1_ps(2.0);
+        let one = _mm256_set1_ps(1.0);
+        let lastv = _mm256_set1_epi32(wi - 1);
+        let mut x = 0;
+        while x + LANES <= w {
+            // SAFETY (whole block): x + 8 <= w bounds every 8-lane load and store at x of the
+            // row slices (all of length w). Window loads at `base` are made only when
+            // 0 <= base and base + 8 <= w; gathers use indices clamped to 0..=w-1.
+            unsafe {
+                let jv = _mm256_loadu_si256(j0.as_ptr().add(x) as *const __m256i);
+                let (first, rel, spread) = win::window(jv);
+                let (window, reach) = (spread <= win::WIDE, win::reach(spread) as i32);
+                let dv = _mm256_loadu_ps(drow.as_ptr().add(x));
+                let mut cur = _mm256_loadu_ps(out.as_ptr().add(x));
+                let mut best = _mm256_set1_ps(f32::NEG_INFINITY);
+                let lev = _mm256_loadu_ps(le.as_ptr().add(x));
+                for (k, &off) in offs.iter().enumerate() {
+                    let oi = o0 + k as i32;
+                    let base = first - oi;
+                    let in_window = window && base >= 0 && base + reach <= wi;
+                    // Shifted positions, their validity (0 <= j < w) and clamped indices.
+                    let j = _mm256_sub_epi32(jv, _mm256_set1_epi32(oi));
+                    let (v, idx) = if in_window {
+                        (one, j)
+                    } else {
+                        let inside = _mm256_andnot_si256(
+                            _mm256_cmpgt_epi32(_mm256_setzero_si256(), j),
+                            _mm256_cmpgt_epi32(_mm256_set1_epi32(wi), j),
+                        );
+                        let idx = _mm256_and_si256(_mm256_min_epi32(j, lastv), inside);
+                        (_mm256_and_ps(_mm256_castsi256_ps(inside), one), idx)
+                    };
+                    let mut num = zero;
+                    for c in 0..nch {
+                        let (lre, lim) = *lrows.get_unchecked(c);
+                        let (rre, rim) = *rrows.get_unchecked(c);
+                        let gr = load(rre, base, rel, spread, idx, in_window);
+                        let gi = load(rim, base, rel, spread, idx, in_window);
+                        let p = _mm256_add_ps(
+                            _mm256_mul_ps(_mm256_loadu_ps(lre.as_ptr().add(x)), gr),
+                            _mm256_mul_ps(_mm256_loadu_ps(lim.as_ptr().add(x)), gi),
+                        );
+                        num = _mm256_add_ps(num, p);
+                    }
+                    let ge = load(re, base, rel, spread, idx, in_window);
+                    let n = _mm256_mul_ps(_mm256_mul_ps(two, num), v);
+                    let d = _mm256_mul_ps(_mm256_add_ps(lev, ge), v);
+                    let e =
+                        _mm256_and_ps(_mm256_div_ps(n, d), _mm256_cmp_ps::<_CMP_GT_OQ>(d, zero));
+                    let better = _mm256_cmp_ps::<_CMP_GT_OQ>(e, best);
+                    best = _mm256_max_ps(best, e);
+                    let cand = _mm256_add_ps(dv, _mm256_set1_ps(off));
+                    cur = _mm256_blendv_ps(cur, cand, better);
+                }
+                _mm256_storeu_ps(out.as_mut_ptr().add(x), cur);
+            }
+            x += LANES;
+        }
+        // The tail (< 8 pixels), with the scalar operations of `direct_row`.
+        for x in x..w {
+            let mut best = f32::NEG_INFINITY;
+            let mut cur = out[x];
+            for (k, &off) in offs.iter().enumerate() {
+                let j = j0[x] - (o0 + k as i32);
+                let valid = j >= 0 && j < wi;
+                let v = if valid { 1.0 } else { 0.0 };
+                let jj = if valid { j as usize } else { 0 };
+                let mut num = 0.0;
+                for c in 0..nch {
+                    let (lre, lim) = lrows[c];
+                    let (rre, rim) = rrows[c];
+                    num += lre[x] * rre[jj] + lim[x] * rim[jj];
+                }
+                let n = 2.0 * num * v;
+                let d = (le[x] + re[jj]) * v;
+                let e = if d > 0.0 { n / d } else { 0.0 };
+                let better = e > best;
+                best = best.max(e);
+                if better {
+                    cur = drow[x] + off;
+                }
+            }
+            out[x] = cur;
         }
     }
 }
