@@ -159,15 +159,21 @@ pub fn mirror(i: isize, n: usize) -> usize {
     m as usize
 }
 
-/// `row` extended by `r` mirrored (reflect-101) samples on each side. Only the borders go
-/// through [`mirror`] (an integer division): per-pixel mirroring dominated the row passes.
-fn mirror_pad(row: &[f32], r: usize) -> Vec<f32> {
+/// `row` extended by `r` mirrored (reflect-101) samples on each side, written into `pad` (a
+/// reused per-thread buffer: an allocation per row was a visible share of the row passes). Only
+/// the borders go through [`mirror`] (an integer division): per-pixel mirroring dominated.
+fn mirror_pad_into(row: &[f32], r: usize, pad: &mut Vec<f32>) {
     let w = row.len();
-    let mut pad = Vec::with_capacity(w + 2 * r);
+    pad.clear();
     pad.extend((0..r).map(|i| row[mirror(i as isize - r as isize, w)]));
     pad.extend_from_slice(row);
     pad.extend((0..r).map(|i| row[mirror((w + i) as isize, w)]));
-    pad
+}
+
+thread_local! {
+    /// Per-thread padded row of the row passes (taken and put back, so that the AVX2 function
+    /// bodies do not run inside a closure compiled without AVX2).
+    static PAD_SCRATCH: std::cell::RefCell<Vec<f32>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Real separable convolution with reflect-101 borders (symmetric taps, so conv = correlation).
@@ -186,11 +192,12 @@ simd_fn! {
     fn real_row_pass(row: &[f32], g: &[f32], out: &mut [f32]) {
         let w = row.len();
         let r = g.len() / 2;
-        let pad = mirror_pad(row, r);
-        // The first tap initialises the sum (0 + a == a: no separate zero fill).
         let Some((&g0, rest)) = g.split_first() else {
             return;
         };
+        let mut pad = PAD_SCRATCH.take();
+        mirror_pad_into(row, r, &mut pad);
+        // The first tap initialises the sum (0 + a == a: no separate zero fill).
         for (o, &p) in out.iter_mut().zip(&pad[..w]) {
             *o = g0 * p;
         }
@@ -199,6 +206,7 @@ simd_fn! {
                 *o += gk * p;
             }
         }
+        PAD_SCRATCH.set(pad);
     }
 }
 
@@ -299,7 +307,8 @@ simd_fn! {
         let w = row.len();
         let r = hx.len() / 2;
         // pad[i] = I(i - r); output x needs I(x - t) = pad[x + 2r - k], with k = t + r.
-        let pad = mirror_pad(row, r);
+        let mut pad = PAD_SCRATCH.take();
+        mirror_pad_into(row, r, &mut pad);
         ore.iter_mut().for_each(|v| *v = 0.0);
         oim.iter_mut().for_each(|v| *v = 0.0);
         for (k, &[hr, hi]) in hx.iter().enumerate() {
@@ -309,6 +318,7 @@ simd_fn! {
                 *b += hi * p;
             }
         }
+        PAD_SCRATCH.set(pad);
     }
 }
 

@@ -180,14 +180,19 @@ simd_fn! {
         arow: &mut [f32],
     ) {
         // Taken out of the thread-local, not borrowed in a closure: a closure would be compiled
-        // outside this AVX2 function. Every entry of the four rows is written before it is read.
+        // outside this AVX2 function. Every entry of the two rows is written before it is read.
         let mut buf = ROW_SCRATCH.take();
-        buf.resize(4 * w, 0.0);
-        let (ar, rest) = buf.split_at_mut(w);
-        let (ai, rest) = rest.split_at_mut(w);
-        let (yr, yi) = rest.split_at_mut(w);
-        let (yi, ar, ai, yr) = (&mut yi[..w], &mut ar[..w], &mut ai[..w], &mut yr[..w]);
+        buf.resize(2 * w, 0.0);
+        let (ar, ai) = buf.split_at_mut(w);
+        let (ar, ai) = (&mut ar[..w], &mut ai[..w]);
         complex_col_pass(hre, him, w, h, y, hy, ar, ai);
+        // The zero-DC response goes straight into its sub-rows (no scratch row and copy).
+        let (ore, rest) = orow.split_at_mut(w);
+        let (oim, rest) = rest.split_at_mut(w);
+        let (ofr, rest) = rest.split_at_mut(w);
+        let (ofi, rest) = rest.split_at_mut(w);
+        let (yr, yi) = rest.split_at_mut(w);
+        let (yr, yi) = (&mut yr[..w], &mut yi[..w]);
         let lp = &lowpass[y * w..(y + 1) * w];
         let arow = &mut arow[..w];
         for x in 0..w {
@@ -196,16 +201,11 @@ simd_fn! {
             yi[x] = ai[x] - dc[1] * lp[x];
             arow[x] = yr[x] * yr[x] + yi[x] * yi[x];
         }
+        let (yr, yi) = (&yr[..w], &yi[..w]);
         // The left keeps the zero-DC response, the right the smooth uncorrected one.
-        let (pr, pi) = if right { (&ar[..w], &ai[..w]) } else { (&yr[..w], &yi[..w]) };
+        let (pr, pi) = if right { (&ar[..w], &ai[..w]) } else { (yr, yi) };
         let (cre, cim) = (&cre[..w], &cim[..w]);
-        let (ore, rest) = orow.split_at_mut(w);
-        let (oim, rest) = rest.split_at_mut(w);
-        let (ofr, rest) = rest.split_at_mut(w);
-        let (ofi, rest) = rest.split_at_mut(w);
-        let (oyr, oyi) = rest.split_at_mut(w);
-        oyr[..w].copy_from_slice(&yr[..w]);
-        oyi[..w].copy_from_slice(&yi[..w]);
+        let (ore, oim) = (&mut ore[..w], &mut oim[..w]);
         let (ofr, ofi) = (&mut ofr[..w], &mut ofi[..w]);
         for x in 0..w {
             // exp(-j k.(x, y)) = colph[x] * rowph[y]

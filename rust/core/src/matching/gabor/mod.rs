@@ -29,6 +29,7 @@ use filter::Channel;
 use level::{chan_consts, level_data, newton_step};
 use pool::Buf;
 use search::search;
+use std::borrow::Cow;
 
 /// Parameters of the Gabor channel (defaults: algorithms.md A.3 with the A.9 fixes).
 #[derive(Debug, Clone, PartialEq)]
@@ -375,7 +376,9 @@ fn one_direction(
     finest: usize,
 ) -> Direction {
     let n_levels = p.levels_for(w, h).max(finest + 1);
-    let mut pyr: Vec<(Vec<f32>, Vec<f32>, usize, usize)> = vec![(l.to_vec(), r.to_vec(), w, h)];
+    // Level 0 borrows the input images (no full-resolution copies).
+    let mut pyr: Vec<(Cow<'_, [f32]>, Cow<'_, [f32]>, usize, usize)> =
+        vec![(Cow::Borrowed(l), Cow::Borrowed(r), w, h)];
     for _ in 1..n_levels {
         let Some((pl, pr, pw, ph)) = pyr.last() else {
             break;
@@ -385,7 +388,7 @@ fn one_direction(
         }
         let (nl, nw, nh) = filter::pyr_down(pl, *pw, *ph);
         let (nr, _, _) = filter::pyr_down(pr, *pw, *ph);
-        pyr.push((nl, nr, nw, nh));
+        pyr.push((Cow::Owned(nl), Cow::Owned(nr), nw, nh));
     }
     let tau = p.stability_tau;
     let sigma_s = p
