@@ -365,6 +365,9 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
     })
 }
 
+/// One pyramid level: left and right images and their size.
+type PyrLevel<'a> = (Cow<'a, [f32]>, Cow<'a, [f32]>, usize, usize);
+
 /// Coarse-to-fine estimate with `l` as reference, stopping at level `finest` (then up-sampled).
 fn one_direction(
     l: &[f32],
@@ -377,8 +380,7 @@ fn one_direction(
 ) -> Direction {
     let n_levels = p.levels_for(w, h).max(finest + 1);
     // Level 0 borrows the input images (no full-resolution copies).
-    let mut pyr: Vec<(Cow<'_, [f32]>, Cow<'_, [f32]>, usize, usize)> =
-        vec![(Cow::Borrowed(l), Cow::Borrowed(r), w, h)];
+    let mut pyr: Vec<PyrLevel<'_>> = vec![(Cow::Borrowed(l), Cow::Borrowed(r), w, h)];
     for _ in 1..n_levels {
         let Some((pl, pr, pw, ph)) = pyr.last() else {
             break;
