@@ -197,14 +197,29 @@ simd_fn! {
         };
         let mut pad = PAD_SCRATCH.take();
         mirror_pad_into(row, r, &mut pad);
-        // The first tap initialises the sum (0 + a == a: no separate zero fill).
-        for (o, &p) in out.iter_mut().zip(&pad[..w]) {
-            *o = g0 * p;
-        }
-        for (k, &gk) in rest.iter().enumerate() {
-            for (o, &p) in out.iter_mut().zip(&pad[k + 1..k + 1 + w]) {
-                *o += gk * p;
+        // Register-blocked: each chunk of CHUNK outputs sums every tap in registers, in tap order
+        // (the first tap initialises the sum), then is stored once.
+        let n = w / CHUNK * CHUNK;
+        for x0 in (0..n).step_by(CHUNK) {
+            let mut acc = [0f32; CHUNK];
+            let p0 = &pad[x0..x0 + CHUNK];
+            for i in 0..CHUNK {
+                acc[i] = g0 * p0[i];
             }
+            for (k, &gk) in rest.iter().enumerate() {
+                let pk = &pad[x0 + k + 1..x0 + k + 1 + CHUNK];
+                for i in 0..CHUNK {
+                    acc[i] += gk * pk[i];
+                }
+            }
+            out[x0..x0 + CHUNK].copy_from_slice(&acc);
+        }
+        for x in n..w {
+            let mut a = g0 * pad[x];
+            for (k, &gk) in rest.iter().enumerate() {
+                a += gk * pad[x + k + 1];
+            }
+            out[x] = a;
         }
         PAD_SCRATCH.set(pad);
     }
@@ -214,22 +229,44 @@ simd_fn! {
     /// Column pass of a real separable blur for output row `y`.
     fn real_col_pass(src: &[f32], w: usize, h: usize, y: usize, g: &[f32], out: &mut [f32]) {
         let r = g.len() / 2;
-        for (k, &gk) in g.iter().enumerate() {
+        let Some((&g0, rest)) = g.split_first() else {
+            return;
+        };
+        let row = |k: usize| {
             let yy = mirror(y as isize + k as isize - r as isize, h);
-            let s = &src[yy * w..(yy + 1) * w];
-            if k == 0 {
-                // The first tap initialises the sum (no separate zero fill).
-                for (o, &p) in out.iter_mut().zip(s) {
-                    *o = gk * p;
-                }
-            } else {
-                for (o, &p) in out.iter_mut().zip(s) {
-                    *o += gk * p;
+            &src[yy * w..(yy + 1) * w]
+        };
+        let s0 = row(0);
+        let rows: Vec<&[f32]> = (1..g.len()).map(row).collect();
+        let out = &mut out[..w];
+        // Register-blocked, taps summed in order (the first initialises the sum).
+        let n = w / CHUNK * CHUNK;
+        for x0 in (0..n).step_by(CHUNK) {
+            let mut acc = [0f32; CHUNK];
+            let p0 = &s0[x0..x0 + CHUNK];
+            for i in 0..CHUNK {
+                acc[i] = g0 * p0[i];
+            }
+            for (&gk, sk) in rest.iter().zip(&rows) {
+                let pk = &sk[x0..x0 + CHUNK];
+                for i in 0..CHUNK {
+                    acc[i] += gk * pk[i];
                 }
             }
+            out[x0..x0 + CHUNK].copy_from_slice(&acc);
+        }
+        for x in n..w {
+            let mut a = g0 * s0[x];
+            for (&gk, sk) in rest.iter().zip(&rows) {
+                a += gk * sk[x];
+            }
+            out[x] = a;
         }
     }
 }
+
+/// Outputs per register block of the separable passes (two AVX2 registers per plane).
+const CHUNK: usize = 16;
 
 /// A shared complex row pass: x taps and the (re, im) planes they produced.
 type OwnedRowGroup = (Vec<[f32; 2]>, Buf, Buf);
@@ -309,14 +346,30 @@ simd_fn! {
         // pad[i] = I(i - r); output x needs I(x - t) = pad[x + 2r - k], with k = t + r.
         let mut pad = PAD_SCRATCH.take();
         mirror_pad_into(row, r, &mut pad);
-        ore.iter_mut().for_each(|v| *v = 0.0);
-        oim.iter_mut().for_each(|v| *v = 0.0);
-        for (k, &[hr, hi]) in hx.iter().enumerate() {
-            let seg = &pad[2 * r - k..2 * r - k + w];
-            for ((a, b), &p) in ore.iter_mut().zip(oim.iter_mut()).zip(seg) {
-                *a += hr * p;
-                *b += hi * p;
+        let (ore, oim) = (&mut ore[..w], &mut oim[..w]);
+        // Register-blocked; the sums start at 0 and add the taps in order.
+        let n = w / CHUNK * CHUNK;
+        for x0 in (0..n).step_by(CHUNK) {
+            let (mut ar, mut ai) = ([0f32; CHUNK], [0f32; CHUNK]);
+            for (k, &[hr, hi]) in hx.iter().enumerate() {
+                let seg = &pad[2 * r - k + x0..2 * r - k + x0 + CHUNK];
+                for i in 0..CHUNK {
+                    ar[i] += hr * seg[i];
+                    ai[i] += hi * seg[i];
+                }
             }
+            ore[x0..x0 + CHUNK].copy_from_slice(&ar);
+            oim[x0..x0 + CHUNK].copy_from_slice(&ai);
+        }
+        for x in n..w {
+            let (mut a, mut b) = (0f32, 0f32);
+            for (k, &[hr, hi]) in hx.iter().enumerate() {
+                let p = pad[2 * r - k + x];
+                a += hr * p;
+                b += hi * p;
+            }
+            ore[x] = a;
+            oim[x] = b;
         }
         PAD_SCRATCH.set(pad);
     }
@@ -336,24 +389,48 @@ simd_fn! {
     ) {
         let r = hy.len() / 2;
         let real_taps = hy.iter().all(|t| t[1] == 0.0);
-        ore.iter_mut().for_each(|v| *v = 0.0);
-        oim.iter_mut().for_each(|v| *v = 0.0);
-        for (k, &[gr, gi]) in hy.iter().enumerate() {
-            // tap s = k - r reads row y - s
-            let yy = mirror(y as isize - (k as isize - r as isize), h);
-            let sr = &hre[yy * w..(yy + 1) * w];
-            let si = &him[yy * w..(yy + 1) * w];
-            if real_taps {
-                for ((a, b), (&pr, &pi)) in ore.iter_mut().zip(oim.iter_mut()).zip(sr.iter().zip(si)) {
-                    *a += gr * pr;
-                    *b += gr * pi;
-                }
-            } else {
-                for ((a, b), (&pr, &pi)) in ore.iter_mut().zip(oim.iter_mut()).zip(sr.iter().zip(si)) {
-                    *a += gr * pr - gi * pi;
-                    *b += gr * pi + gi * pr;
+        // tap s = k - r reads row y - s
+        let rows: Vec<(&[f32], &[f32])> = (0..hy.len())
+            .map(|k| {
+                let yy = mirror(y as isize - (k as isize - r as isize), h);
+                (&hre[yy * w..(yy + 1) * w], &him[yy * w..(yy + 1) * w])
+            })
+            .collect();
+        let (ore, oim) = (&mut ore[..w], &mut oim[..w]);
+        // Register-blocked; the sums start at 0 and add the taps in order.
+        let n = w / CHUNK * CHUNK;
+        for x0 in (0..n).step_by(CHUNK) {
+            let (mut a, mut b) = ([0f32; CHUNK], [0f32; CHUNK]);
+            for (&[gr, gi], &(sr, si)) in hy.iter().zip(&rows) {
+                let (sr, si) = (&sr[x0..x0 + CHUNK], &si[x0..x0 + CHUNK]);
+                if real_taps {
+                    for i in 0..CHUNK {
+                        a[i] += gr * sr[i];
+                        b[i] += gr * si[i];
+                    }
+                } else {
+                    for i in 0..CHUNK {
+                        a[i] += gr * sr[i] - gi * si[i];
+                        b[i] += gr * si[i] + gi * sr[i];
+                    }
                 }
             }
+            ore[x0..x0 + CHUNK].copy_from_slice(&a);
+            oim[x0..x0 + CHUNK].copy_from_slice(&b);
+        }
+        for x in n..w {
+            let (mut a, mut b) = (0f32, 0f32);
+            for (&[gr, gi], &(sr, si)) in hy.iter().zip(&rows) {
+                if real_taps {
+                    a += gr * sr[x];
+                    b += gr * si[x];
+                } else {
+                    a += gr * sr[x] - gi * si[x];
+                    b += gr * si[x] + gi * sr[x];
+                }
+            }
+            ore[x] = a;
+            oim[x] = b;
         }
     }
 }
