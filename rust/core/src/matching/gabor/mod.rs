@@ -325,31 +325,25 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
     wall("directions");
     let mut disp = fwd.disp.into_vec();
     let mut conf = fwd.conf.into_vec();
-    let lr_ok = bwd.map(|b| {
-        let dr = post::flip_x(&b.disp, w, h);
-        post::lr_check(&disp, &dr, w, h, params.lr_tol)
-    });
-    let last = (w - 1) as f32;
+    // Validity, with the left-right check (post::lr_check's rule) read straight from the
+    // mirrored right-reference map: no flipped copy, no mask image.
+    let bwd = bwd.as_ref();
     crate::parallel::for_each_row2(&mut disp, &mut conf, w, |y, drow, crow| {
-        let lr = lr_ok.as_ref().map(|v| &v[y * w..(y + 1) * w]);
-        for (x, (d, c)) in drow.iter_mut().zip(crow.iter()).enumerate() {
-            let s = x as f32 - *d;
-            let valid = *c >= params.conf_min && s >= 0.0 && s <= last && lr.is_none_or(|v| v[x]);
-            if !valid {
-                *d = f32::NAN;
-            }
-        }
+        let brow = bwd.map_or(&[][..], |b| &b.disp[y * w..(y + 1) * w]);
+        post::validity_row(drow, crow, brow, params.conf_min, params.lr_tol)
     });
     wall("lr check");
     post::remove_speckles(&mut disp, w, h, params.speckle_size, params.speckle_range);
     wall("speckles");
-    for (c, d) in conf.iter_mut().zip(&disp) {
-        *c = if d.is_finite() {
-            c.clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-    }
+    crate::parallel::for_each_row(&mut conf, w, |y, crow| {
+        for (c, d) in crow.iter_mut().zip(&disp[y * w..(y + 1) * w]) {
+            *c = if d.is_finite() {
+                c.clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+        }
+    });
     wall("done");
     Ok(GaborOutput {
         disparity: Image {

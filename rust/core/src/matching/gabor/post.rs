@@ -175,6 +175,36 @@ pub fn lr_check(dl: &[f32], dr: &[f32], w: usize, h: usize, tol: f32) -> Vec<boo
     ok
 }
 
+simd_fn! {
+    /// Final validity of one row: a pixel keeps its disparity if its confidence reaches
+    /// `conf_min`, its match `x - d` is inside the row and, when `brow` (the right-reference
+    /// run's row, mirrored: right pixel `xr` at `brow[w - 1 - xr]`) is not empty, the right map
+    /// agrees within `tol` ([`lr_check`]'s rule). Others become NaN. In an AVX2 function so that
+    /// `round` is an instruction, not a libm call per pixel.
+    pub fn validity_row(drow: &mut [f32], crow: &[f32], brow: &[f32], conf_min: f32, tol: f32) {
+        let w = drow.len();
+        if w == 0 || crow.len() != w || !(brow.is_empty() || brow.len() == w) {
+            return;
+        }
+        let last = (w - 1) as f32;
+        let check = !brow.is_empty();
+        let crow = &crow[..w];
+        for x in 0..w {
+            let d = drow[x];
+            let s = x as f32 - d;
+            // Branch-free: the right map is read at the clamped position, the range test decides.
+            let xr = s.round();
+            let inside = d.is_finite() & (xr >= 0.0) & (xr <= last);
+            let lr = !check || {
+                let i = xr.max(0.0).min(last) as usize;
+                inside & ((d - brow[w - 1 - i]).abs() <= tol)
+            };
+            let valid = (crow[x] >= conf_min) & (s >= 0.0) & (s <= last) & lr;
+            drow[x] = if valid { d } else { f32::NAN };
+        }
+    }
+}
+
 /// Mirrors a row-major image left-right.
 pub fn flip_x(src: &[f32], w: usize, h: usize) -> Vec<f32> {
     let mut out = vec![0f32; w * h];
