@@ -270,3 +270,41 @@ fn fused_search_row_equals_the_generic_one() {
         }
     }
 }
+
+#[test]
+fn validity_row_applies_the_lr_check_rule() {
+    // Random left/right maps (NaN, out-of-row matches, near and far agreement): the fused row
+    // pass must keep exactly the pixels that lr_check, the confidence and the range test keep.
+    let (w, h) = (53usize, 7usize);
+    let mut seed = 99u64;
+    let mut rnd = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 33) as f32) / (1u64 << 31) as f32
+    };
+    let mut dl: Vec<f32> = (0..w * h).map(|_| -3.0 + 20.0 * rnd()).collect();
+    dl[5] = f32::NAN;
+    dl[17] = 60.0;
+    let dr: Vec<f32> = (0..w * h).map(|i| dl[i] + 3.0 * (rnd() - 0.5)).collect();
+    let conf: Vec<f32> = (0..w * h).map(|_| rnd()).collect();
+    let ok = post::lr_check(&dl, &dr, w, h, 1.0);
+    let mirrored = post::flip_x(&dr, w, h);
+    let mut kept = 0;
+    for y in 0..h {
+        let row = y * w..(y + 1) * w;
+        let mut d = dl[row.clone()].to_vec();
+        post::validity_row(&mut d, &conf[row.clone()], &mirrored[row.clone()], 0.3, 1.0);
+        for x in 0..w {
+            let i = y * w + x;
+            let s = x as f32 - dl[i];
+            let want = ok[i] && conf[i] >= 0.3 && s >= 0.0 && s <= (w - 1) as f32;
+            assert_eq!(d[x].is_finite(), want, "pixel ({x}, {y})");
+            if want {
+                assert_eq!(d[x], dl[i]);
+                kept += 1;
+            }
+        }
+    }
+    assert!(kept > 20 && kept < w * h / 2, "{kept} kept");
+}
