@@ -445,7 +445,9 @@ fn one_direction(
                 (d, c)
             }
         };
-        disp.iter_mut().for_each(|d| *d = d.clamp(lo, hi));
+        crate::parallel::for_each_row(&mut disp, lw, |_, row| {
+            row.iter_mut().for_each(|d| *d = d.clamp(lo, hi))
+        });
         lap("search", lvl);
         let iters = if lvl == 0 {
             p.iters_finest

@@ -12,15 +12,21 @@ use crate::simd::simd_fn;
 /// Normalised-convolution smoothing (A.5 step 3h): `cbar = G * c`, `dbar = G * (c d) / cbar`.
 pub fn normalized_conv(delta: &[f32], conf: &[f32], w: usize, h: usize, sigma: f32) -> (Buf, Buf) {
     let g = gaussian_taps(sigma, radius_for(sigma));
+    // The pointwise passes run in row bands too (serial, they idled the other core).
     let mut cd = Buf::scratch(w * h);
-    cd.iter_mut()
-        .zip(delta.iter().zip(conf))
-        .for_each(|(o, (d, c))| *o = d * c);
+    for_each_row(&mut cd, w, |y, row| {
+        let (d, c) = (&delta[y * w..(y + 1) * w], &conf[y * w..(y + 1) * w]);
+        for ((o, d), c) in row.iter_mut().zip(d).zip(c) {
+            *o = d * c;
+        }
+    });
     let cbar = blur_real(conf, w, h, &g, &g);
     let mut dbar = blur_real(&cd, w, h, &g, &g);
-    dbar.iter_mut()
-        .zip(cbar.iter())
-        .for_each(|(n, c)| *n = if *c > NC_EPS { *n / c } else { 0.0 });
+    for_each_row(&mut dbar, w, |y, row| {
+        for (n, c) in row.iter_mut().zip(&cbar[y * w..(y + 1) * w]) {
+            *n = if *c > NC_EPS { *n / c } else { 0.0 };
+        }
+    });
     (dbar, cbar)
 }
 
@@ -391,9 +397,13 @@ pub fn remove_speckles_flood(disp: &mut [f32], w: usize, h: usize, min_size: usi
     }
 }
 
-/// Sets `out[i] = max(out[i], other[i])`.
+/// Sets `out[i] = max(out[i], other[i])` (in parallel chunks).
 pub fn max_into(out: &mut [f32], other: &[f32]) {
-    out.iter_mut().zip(other).for_each(|(a, b)| *a = a.max(*b));
+    use rayon::prelude::*;
+    const CH: usize = 1 << 14;
+    out.par_chunks_mut(CH)
+        .zip(other.par_chunks(CH))
+        .for_each(|(a, b)| a.iter_mut().zip(b).for_each(|(a, b)| *a = a.max(*b)));
 }
 
 /// Applies `disp += dbar` where `cbar >= conf_min`, clamping to `[lo, hi]`.
