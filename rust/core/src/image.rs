@@ -59,6 +59,60 @@ impl Image {
     }
 }
 
+/// A borrowed grey image (row-major), e.g. a NumPy array's buffer: kernels that only read their
+/// input take one instead of a copy.
+#[derive(Debug, Clone, Copy)]
+pub struct ImageView<'a> {
+    pub width: usize,
+    pub height: usize,
+    pub data: &'a [f32],
+}
+
+impl<'a> ImageView<'a> {
+    /// Wraps a buffer after the checks of [`Image::new`] (size, non-empty, finite values).
+    pub fn new(width: usize, height: usize, data: &'a [f32]) -> Result<Self> {
+        if width == 0 || height == 0 {
+            return Err(CoreError::EmptyImage { width, height });
+        }
+        let expected = width
+            .checked_mul(height)
+            .ok_or_else(|| CoreError::param("shape", "width * height overflows"))?;
+        if data.len() != expected {
+            return Err(CoreError::BufferSize {
+                got: data.len(),
+                expected,
+                width,
+                height,
+            });
+        }
+        let count = data.iter().filter(|v| !v.is_finite()).count();
+        if count > 0 {
+            return Err(CoreError::NonFinite { count });
+        }
+        Ok(ImageView {
+            width,
+            height,
+            data,
+        })
+    }
+
+    /// `(width, height)`.
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+}
+
+impl Image {
+    /// A borrowed view (already checked: an `Image` is valid by construction).
+    pub fn view(&self) -> ImageView<'_> {
+        ImageView {
+            width: self.width,
+            height: self.height,
+            data: &self.data,
+        }
+    }
+}
+
 /// Checks that a stereo pair has the same, non-empty size.
 pub fn check_pair(left: &Image, right: &Image) -> Result<()> {
     if left.size() != right.size() {

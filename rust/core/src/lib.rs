@@ -16,4 +16,4 @@ pub mod parallel;
 pub(crate) mod simd;
 
 pub use error::{CoreError, Result};
-pub use image::Image;
+pub use image::{Image, ImageView};

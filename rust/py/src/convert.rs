@@ -4,7 +4,7 @@ use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use stereovision_core::Image;
+use stereovision_core::{Image, ImageView};
 
 /// Copies a 2-D float32 array into a core [`Image`] (validated: non-empty, finite).
 pub fn image_from_numpy(arr: &PyReadonlyArray2<'_, f32>, what: &str) -> PyResult<Image> {
@@ -15,6 +15,37 @@ pub fn image_from_numpy(arr: &PyReadonlyArray2<'_, f32>, what: &str) -> PyResult
         None => view.iter().copied().collect(),
     };
     Image::new(w, h, data).map_err(|e| PyValueError::new_err(format!("{what}: {e}")))
+}
+
+/// A validated grey image from a 2-D float32 array: the array's own buffer when it is
+/// C-contiguous (no copy: the Python wrappers make it so), else a copy.
+pub enum GreyInput<'a> {
+    View(ImageView<'a>),
+    Owned(Image),
+}
+
+impl GreyInput<'_> {
+    /// The image, borrowed.
+    pub fn view(&self) -> ImageView<'_> {
+        match self {
+            GreyInput::View(v) => *v,
+            GreyInput::Owned(i) => i.view(),
+        }
+    }
+}
+
+/// [`image_from_numpy`] without the copy when the array is C-contiguous.
+pub fn grey_from_numpy<'a>(
+    arr: &'a PyReadonlyArray2<'_, f32>,
+    what: &str,
+) -> PyResult<GreyInput<'a>> {
+    let (h, w) = arr.as_array().dim();
+    match arr.as_slice() {
+        Ok(s) => ImageView::new(w, h, s)
+            .map(GreyInput::View)
+            .map_err(|e| PyValueError::new_err(format!("{what}: {e}"))),
+        Err(_) => image_from_numpy(arr, what).map(GreyInput::Owned),
+    }
 }
 
 /// Moves a core [`Image`] into a new NumPy array without copying.

@@ -3,12 +3,12 @@
 use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use stereovision_core::matching::gabor::{
-    gabor_disparity as core_gabor, gabor_newton_step as core_step, gabor_responses as core_resp,
-    post::lr_check, GaborParams,
+    gabor_disparity_view as core_gabor, gabor_newton_step as core_step,
+    gabor_responses as core_resp, post::lr_check, GaborParams,
 };
 use stereovision_core::Image;
 
-use crate::convert::{image_from_numpy, image_to_numpy};
+use crate::convert::{grey_from_numpy, image_from_numpy, image_to_numpy};
 use crate::errors::guard;
 
 type Pair<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>);
@@ -117,8 +117,12 @@ pub fn gabor_disparity<'py>(
     speckle_size: usize,
     speckle_range: f32,
 ) -> PyResult<Pair<'py>> {
-    let l = image_from_numpy(&left, "left")?;
-    let r = image_from_numpy(&right, "right")?;
+    // The NumPy buffers themselves (no copy of the pair); read-only borrows held across the call.
+    let (lg, rg) = (
+        grey_from_numpy(&left, "left")?,
+        grey_from_numpy(&right, "right")?,
+    );
+    let (l, r) = (lg.view(), rg.view());
     let p = params(
         d_min,
         d_max,
@@ -145,7 +149,7 @@ pub fn gabor_disparity<'py>(
         speckle_size,
         speckle_range,
     );
-    let out = py.detach(|| guard("gabor_disparity", || core_gabor(&l, &r, &p)))?;
+    let out = py.detach(|| guard("gabor_disparity", || core_gabor(l, r, &p)))?;
     Ok((
         image_to_numpy(py, out.disparity)?,
         image_to_numpy(py, out.confidence)?,

@@ -24,7 +24,7 @@ pub mod post;
 pub mod search;
 
 use crate::error::{CoreError, Result};
-use crate::image::{check_pair, Image};
+use crate::image::{check_pair, Image, ImageView};
 use filter::Channel;
 use level::{chan_consts, level_data, newton_step};
 use pool::Buf;
@@ -287,7 +287,21 @@ struct Direction {
 /// `x_left - x_right` at left pixels (`NaN` where not confident or inconsistent) and the
 /// confidence (0 where `NaN`). A textureless pair gives an all-`NaN` map, not an error.
 pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Result<GaborOutput> {
-    check_pair(left, right)?;
+    gabor_disparity_view(left.view(), right.view(), params)
+}
+
+/// [`gabor_disparity`] on borrowed images (the Python binding passes the NumPy buffers).
+pub fn gabor_disparity_view(
+    left: ImageView<'_>,
+    right: ImageView<'_>,
+    params: &GaborParams,
+) -> Result<GaborOutput> {
+    if left.size() != right.size() {
+        return Err(CoreError::SizeMismatch {
+            left: left.size(),
+            right: right.size(),
+        });
+    }
     params.validate()?;
     let chans = params.channels()?;
     let (w, h) = left.size();
@@ -299,8 +313,8 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
         }
     };
     let (fwd, bwd) = if params.lr_check {
-        let fl = post::flip_x(&right.data, w, h);
-        let fr = post::flip_x(&left.data, w, h);
+        let fl = post::flip_x(right.data, w, h);
+        let fr = post::flip_x(left.data, w, h);
         let back = if params.lr_light {
             GaborParams {
                 orientations_finest: params.orientations_finest.min(LIGHT_ORIENTATIONS),
@@ -312,13 +326,13 @@ pub fn gabor_disparity(left: &Image, right: &Image, params: &GaborParams) -> Res
             params.clone()
         };
         let (a, b) = rayon::join(
-            || one_direction(&left.data, &right.data, w, h, params, &chans, 0),
+            || one_direction(left.data, right.data, w, h, params, &chans, 0),
             || one_direction(&fl, &fr, w, h, &back, &chans, params.lr_coarse_levels),
         );
         (a, Some(b))
     } else {
         (
-            one_direction(&left.data, &right.data, w, h, params, &chans, 0),
+            one_direction(left.data, right.data, w, h, params, &chans, 0),
             None,
         )
     };
