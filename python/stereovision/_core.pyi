@@ -107,3 +107,16 @@ def mcgm_filter(
     params: dict[str, Any],
 ) -> npt.NDArray[np.bool_]:
     """B.8 occlusion filters on ``(N, 4)`` matches: kept flags."""
+
+# --- Triangulation (rust/py/src/triangulation.rs) ------------------------------------------------
+
+def depth_rectified(
+    disp: npt.NDArray[np.float32],
+    conf: npt.NDArray[np.float32],
+    fb: float,
+    doffs: float,
+    s0: float,
+    slope: float,
+    s_min: float,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+    """``(Z, sigma_Z)``: ``fb / (d + doffs)``, ``Z max(s0 + slope clip(c), s_min) / (d+doffs)``."""

@@ -241,30 +241,29 @@ def _pixel_grids(
 
 
 def _depth_rectified(
-    disp: npt.NDArray[np.float32],
-    measured: npt.NDArray[np.bool_],
+    measured_disp: npt.NDArray[np.float32],
     conf: npt.NDArray[np.float32],
     calib: Calibration,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
-    """Depth in metres and its one-sigma uncertainty at the measured pixels of a rectified pair.
+    """Depth in metres and its one-sigma uncertainty of a rectified pair's measured disparity.
 
     ``Z = f B / (d + doffs)`` (:func:`stereovision.triangulation.depth_from_disparity`) in
-    float32 on the pixels that have one; NaN elsewhere. Filled pixels are guesses, not
-    measurements: depth only where ``measured``.
+    float32 where ``measured_disp`` has a value (NaN = not measured: filled pixels are guesses,
+    not measurements, and get no depth); ``sigma_Z = Z sigma_d / (d + doffs)``
+    (:func:`disparity_sigma`). One parallel Rust pass; ``tests/reference/depth_ref.py`` is the
+    same maths in NumPy.
     """
-    h, w = disp.shape
-    fb = np.float32(calib.focal_px * calib.baseline_m)
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        denom = disp + np.float32(calib.doffs_px)
-        ok = measured & (denom > 0)
-        depth = np.full((h, w), np.nan, np.float32)
-        np.divide(fb, denom, out=depth, where=ok)
-        ok &= np.isfinite(depth)
-        depth[~ok] = np.nan
-        # dZ/dd = -f B / (d + doffs)^2 = -Z / (d + doffs)
-        depth_sigma = np.full((h, w), np.nan, np.float32)
-        np.divide(depth * disparity_sigma(conf), denom, out=depth_sigma, where=ok)
-    return depth, depth_sigma
+    from stereovision import _core
+
+    return _core.depth_rectified(
+        np.ascontiguousarray(measured_disp, dtype=np.float32),
+        np.ascontiguousarray(conf, dtype=np.float32),
+        calib.focal_px * calib.baseline_m,
+        calib.doffs_px,
+        _SIGMA_D0,
+        _SIGMA_D_SLOPE,
+        _SIGMA_D_MIN,
+    )
 
 
 def _cloud(
@@ -428,6 +427,7 @@ def depth_map(
     stage("match")
     if fill is None:
         fill = method in _DENSE_METHODS
+    measured_disp = disp  # NaN where not measured; the fill below makes a new array
     if fill:
         from stereovision.baselines import row_fill
 
@@ -438,7 +438,7 @@ def depth_map(
     colors = np.zeros((0, 3), np.uint8)
     pixels = np.zeros((0, 2), np.int32)
     if calib is not None:
-        depth, depth_sigma = _depth_rectified(disp, measured, conf, calib)
+        depth, depth_sigma = _depth_rectified(measured_disp, conf, calib)
         if cloud:
             points, colors, pixels = _cloud(depth, calib, left_bgr)
         stage("triangulate")

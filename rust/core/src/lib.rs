@@ -14,6 +14,7 @@ pub mod image;
 pub mod matching;
 pub mod parallel;
 pub(crate) mod simd;
+pub mod triangulation;
 
 pub use error::{CoreError, Result};
 pub use image::{Image, ImageView};

@@ -12,6 +12,7 @@ mod gabor;
 mod hopfield;
 mod mcgm;
 mod params;
+mod triangulation;
 
 #[pymodule(gil_used = false)]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -27,5 +28,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mcgm::mcgm_curves, m)?)?;
     m.add_function(wrap_pyfunction!(mcgm::mcgm_match, m)?)?;
     m.add_function(wrap_pyfunction!(mcgm::mcgm_filter, m)?)?;
+    m.add_function(wrap_pyfunction!(triangulation::depth_rectified, m)?)?;
     Ok(())
 }

@@ -1,0 +1,53 @@
+//! Binding of `stereovision_core::triangulation`.
+
+use numpy::PyReadonlyArray2;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use stereovision_core::triangulation::{depth_rectified as core_depth, SigmaModel};
+
+use crate::convert::image_to_numpy;
+use crate::errors::guard;
+use stereovision_core::Image;
+
+type Pair<'py> = (
+    Bound<'py, numpy::PyArray2<f32>>,
+    Bound<'py, numpy::PyArray2<f32>>,
+);
+
+/// Depth and its one-sigma uncertainty from a rectified disparity map (NaN = no disparity).
+#[pyfunction]
+#[pyo3(signature = (disp, conf, fb, doffs, s0, slope, s_min))]
+#[allow(clippy::too_many_arguments)]
+pub fn depth_rectified<'py>(
+    py: Python<'py>,
+    disp: PyReadonlyArray2<'py, f32>,
+    conf: PyReadonlyArray2<'py, f32>,
+    fb: f32,
+    doffs: f32,
+    s0: f32,
+    slope: f32,
+    s_min: f32,
+) -> PyResult<Pair<'py>> {
+    let (h, w) = disp.as_array().dim();
+    if conf.as_array().dim() != (h, w) {
+        return Err(PyValueError::new_err(format!(
+            "confidence shape {:?} differs from disparity shape {:?}",
+            conf.as_array().dim(),
+            (h, w)
+        )));
+    }
+    let d = disp
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("disp must be C-contiguous"))?;
+    let c = conf
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("conf must be C-contiguous"))?;
+    let m = SigmaModel { s0, slope, s_min };
+    let (z, s) = py.detach(|| guard("depth_rectified", || core_depth(d, c, w, h, fb, doffs, m)))?;
+    let img = |data| Image {
+        width: w,
+        height: h,
+        data,
+    };
+    Ok((image_to_numpy(py, img(z))?, image_to_numpy(py, img(s))?))
+}
