@@ -308,3 +308,42 @@ fn validity_row_applies_the_lr_check_rule() {
     }
     assert!(kept > 20 && kept < w * h / 2, "{kept} kept");
 }
+
+#[test]
+fn percentile_of_two_equals_the_plain_selection() {
+    // Squared amplitudes over many octaves, exact zeros, ties, and uneven halves: the
+    // histogram selection must return the very element the plain selection returns.
+    let mut seed = 7u64;
+    let mut rnd = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((seed >> 33) as f32) / (1u64 << 31) as f32
+    };
+    for &(na, nb) in &[
+        (1000usize, 3000usize),
+        (1, 0),
+        (0, 5),
+        (20000, 7),
+        (333, 333),
+    ] {
+        let mut v = |n: usize| -> Vec<f32> {
+            (0..n)
+                .map(|i| match i % 13 {
+                    0 => 0.0,
+                    1 => 0.25,
+                    _ => (rnd() * 30.0 - 20.0).exp2(),
+                })
+                .collect()
+        };
+        let (a, b) = (v(na), v(nb));
+        for q in [0.0f32, 0.05, 0.5, 0.95, 1.0] {
+            let mut all: Vec<f32> = a.iter().chain(&b).copied().collect();
+            let want = level::percentile(&all, q);
+            let got = level::percentile_of_two(&a, &b, q);
+            assert_eq!(got.to_bits(), want.to_bits(), "{na}+{nb} at q {q}");
+            all.clear();
+        }
+    }
+    assert_eq!(level::percentile_of_two(&[], &[], 0.95), 0.0);
+}
