@@ -13,24 +13,7 @@ pub struct Image {
 impl Image {
     /// Wraps a buffer after checking its size; rejects empty and non-finite images.
     pub fn new(width: usize, height: usize, data: Vec<f32>) -> Result<Self> {
-        if width == 0 || height == 0 {
-            return Err(CoreError::EmptyImage { width, height });
-        }
-        let expected = width
-            .checked_mul(height)
-            .ok_or_else(|| CoreError::param("shape", "width * height overflows"))?;
-        if data.len() != expected {
-            return Err(CoreError::BufferSize {
-                got: data.len(),
-                expected,
-                width,
-                height,
-            });
-        }
-        let count = data.iter().filter(|v| !v.is_finite()).count();
-        if count > 0 {
-            return Err(CoreError::NonFinite { count });
-        }
+        ImageView::new(width, height, &data)?;
         Ok(Image {
             width,
             height,
@@ -69,7 +52,8 @@ pub struct ImageView<'a> {
 }
 
 impl<'a> ImageView<'a> {
-    /// Wraps a buffer after the checks of [`Image::new`] (size, non-empty, finite values).
+    /// Wraps a buffer after checking its size; rejects empty and non-finite images (the checks
+    /// of [`Image::new`] too).
     pub fn new(width: usize, height: usize, data: &'a [f32]) -> Result<Self> {
         if width == 0 || height == 0 {
             return Err(CoreError::EmptyImage { width, height });

@@ -195,6 +195,32 @@ fn pool_x(v: &[f32], pad: &mut [f32], p: usize, out: &mut [f32]) {
     }
 }
 
+/// `num = sum_c Re(y_l conj y_r)` over the channels at the right positions `si` of row `y`
+/// (`gr`, `gi`: scratch rows). Inlined into the AVX2 row kernels that call it.
+#[inline(always)]
+fn channel_dot(
+    l: &LevelData,
+    r: &LevelData,
+    y: usize,
+    si: &[u32],
+    num: &mut [f32],
+    gr: &mut [f32],
+    gi: &mut [f32],
+) {
+    let w = l.w;
+    let ro = SUBROWS * y * w;
+    let (num, gr, gi) = (&mut num[..w], &mut gr[..w], &mut gi[..w]);
+    num.iter_mut().for_each(|v| *v = 0.0);
+    for (lc, rc) in l.chan.iter().zip(&r.chan) {
+        let (lre, lim) = (&lc[ro + 4 * w..ro + 5 * w], &lc[ro + 5 * w..ro + 6 * w]);
+        gather(&rc[ro + 4 * w..ro + 5 * w], si, gr);
+        gather(&rc[ro + 5 * w..ro + 6 * w], si, gi);
+        for x in 0..w {
+            num[x] += lre[x] * gr[x] + lim[x] * gi[x];
+        }
+    }
+}
+
 simd_fn! {
     /// Energy terms of row `y` at the integer shifts `floor(x - d + 0.5) - off`, pooled along x into
     /// `(hn, hd)`: `num = sum_c 2 Re(y_l conj y_r)`, `den = sum_c |y_l|^2 + |y_r|^2`, both zero
@@ -222,16 +248,7 @@ simd_fn! {
         }
         let (num, den) = (&mut sc.num[..w], &mut sc.den[..w]);
         let (gr, gi) = (&mut sc.gr[..w], &mut sc.gi[..w]);
-        num.iter_mut().for_each(|v| *v = 0.0);
-        let ro = SUBROWS * y * w;
-        for (lc, rc) in l.chan.iter().zip(&r.chan) {
-            let (lre, lim) = (&lc[ro + 4 * w..ro + 5 * w], &lc[ro + 5 * w..ro + 6 * w]);
-            gather(&rc[ro + 4 * w..ro + 5 * w], si, gr);
-            gather(&rc[ro + 5 * w..ro + 6 * w], si, gi);
-            for x in 0..w {
-                num[x] += lre[x] * gr[x] + lim[x] * gi[x];
-            }
-        }
+        channel_dot(l, r, y, si, num, gr, gi);
         gather(&r.energy[o..o + w], si, gr);
         let le = &l.energy[o..o + w];
         for x in 0..w {
@@ -300,7 +317,6 @@ simd_fn! {
     ) {
         let w = l.w;
         let o = y * w;
-        let ro = SUBROWS * y * w;
         let (drow, best, out) = (&drow[..w], &mut best[..w], &mut out[..w]);
         let (si, valid, j0) = (&mut sc.si[..w], &mut sc.valid[..w], &mut sc.j0[..w]);
         let (num, gr, gi) = (&mut sc.num[..w], &mut sc.gr[..w], &mut sc.gi[..w]);
@@ -317,15 +333,7 @@ simd_fn! {
                 valid[x] = if v { 1.0 } else { 0.0 };
                 si[x] = if v { j as u32 } else { 0 };
             }
-            num.iter_mut().for_each(|v| *v = 0.0);
-            for (lc, rc) in l.chan.iter().zip(&r.chan) {
-                let (lre, lim) = (&lc[ro + 4 * w..ro + 5 * w], &lc[ro + 5 * w..ro + 6 * w]);
-                gather(&rc[ro + 4 * w..ro + 5 * w], si, gr);
-                gather(&rc[ro + 5 * w..ro + 6 * w], si, gi);
-                for x in 0..w {
-                    num[x] += lre[x] * gr[x] + lim[x] * gi[x];
-                }
-            }
+            channel_dot(l, r, y, si, num, gr, gi);
             gather(&r.energy[o..o + w], si, gr);
             for x in 0..w {
                 // No load or store under a condition: LLVM turns those into VMASKMOVPS, which is
