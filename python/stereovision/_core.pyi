@@ -120,3 +120,22 @@ def depth_rectified(
     s_min: float,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
     """``(Z, sigma_Z)``: ``fb / (d + doffs)``, ``Z max(s0 + slope clip(c), s_min) / (d+doffs)``."""
+
+def refine_disparity(
+    left: npt.NDArray[np.float32],
+    right: npt.NDArray[np.float32],
+    disp: npt.NDArray[np.float32],
+    conf: npt.NDArray[np.float32],
+    d_min: float,
+    d_max: float,
+    base_sigma: float,
+    win_sigma: float,
+    win_radius: int,
+    search: int,
+    step: float,
+    fill_step: float,
+    var_floor: float,
+    fills: list[tuple[float, float]],
+    fill_confidence: float,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32], int]:
+    """``(disparity, confidence, n_filled)``: ZNCC sub-pixel refinement and validated fill."""

@@ -130,6 +130,7 @@ def depth_outputs(
     method: str | None = None,
     max_disparity: int | None = None,
     fill: bool | None = None,
+    refine: bool | None = None,
 ) -> tuple[Any, dict[str, Path]]:
     """What ``stereovision depth`` computes and writes for one pair (``batch`` writes the same).
 
@@ -147,6 +148,8 @@ def depth_outputs(
         None = estimated from the pair.
     fill : bool, optional
         Reference row fill of the holes; None = the method's default (:func:`depth_map`).
+    refine : bool, optional
+        Sub-pixel refinement; None = the method's default (:func:`depth_map`).
 
     Returns
     -------
@@ -157,7 +160,7 @@ def depth_outputs(
     from stereovision.render import render_outputs
 
     kw: dict[str, Any] = {} if method is None else {"method": method}
-    res = depth_map(left, right, calib, max_disparity=max_disparity, fill=fill, **kw)
+    res = depth_map(left, right, calib, max_disparity=max_disparity, fill=fill, refine=refine, **kw)
     written = write_depth_outputs(res, out_dir)
     written.update(render_outputs(res, out_dir))
     return res, written
@@ -178,6 +181,7 @@ def cmd_depth(args: argparse.Namespace) -> int:
         method=args.method,
         max_disparity=args.max_disparity,
         fill=args.fill,
+        refine=args.refine,
     )
     print(
         f"{args.method}: max_disparity {res.max_disparity} px, density {100 * res.density:.1f} %,"
@@ -392,6 +396,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     d.add_argument(
         "--no-fill", dest="fill", action="store_const", const=False, help="leave holes NaN"
+    )
+    d.add_argument(
+        "--no-refine",
+        dest="refine",
+        action="store_const",
+        const=False,
+        help="skip the sub-pixel refinement (default: the method's)",
     )
     d.add_argument("-o", "--output", required=True, help="output folder")
     d.set_defaults(func=cmd_depth)

@@ -1,7 +1,8 @@
 """The main entry point: a stereo pair (and its calibration) in, a metric depth map out.
 
-``depth_map`` runs one matcher on the rectified pair, then triangulates with the rectified shortcut
-(algorithms.md E.3): ``Z = f * B / (d + doffs)``, in metres.
+``depth_map`` runs one matcher on the rectified pair, refines its disparity to sub-pixel precision
+(:mod:`stereovision.refine`), then triangulates with the rectified shortcut (algorithms.md E.3):
+``Z = f * B / (d + doffs)``, in metres.
 """
 
 from __future__ import annotations
@@ -301,6 +302,7 @@ def depth_map(
     max_disparity: int | None = None,
     min_disparity: float = 0.0,
     fill: bool | None = None,
+    refine: bool | None = None,
     return_channels: bool = False,
     cloud: bool = True,
     progress: Callable[[str], None] | None = None,
@@ -332,6 +334,14 @@ def depth_map(
         occluded pixel shows). None (default) = the method's own choice: ``"fused"`` returns a
         dense map (filled), ``"gabor"`` leaves a pixel it is not sure of NaN. Filled pixels keep
         confidence 0 and get no depth or 3-D point.
+    refine : bool, optional
+        Re-measure the matcher's disparity to sub-pixel precision by a correlation that follows
+        the surface, drop pixels where the correlation disagrees, and fill holes next to
+        measured pixels where it peaks clearly (:func:`stereovision.refine.refine_disparity`;
+        filled pixels are measurements with confidence 0.25 and get a depth). None (default)
+        = the method's own choice: on for ``"gabor"`` (the depth figures it brings are in
+        docs/refine.md), off for ``"fused"``, whose output is already completed. It costs
+        about the matcher's time again; live use can pass False.
     return_channels : bool
         Keep each channel's own output in :attr:`DepthResult.channels`.
     cloud : bool
@@ -426,6 +436,16 @@ def depth_map(
     measured = np.isfinite(disp)
     conf = np.where(measured, conf, np.float32(0)).astype(np.float32)
     stage("match")
+    if refine is None:
+        refine = method not in _DENSE_METHODS
+    if refine:
+        from stereovision.refine import refine_disparity
+
+        ref = refine_disparity(
+            gl, gr, disp, conf, min_disparity=min_disparity, max_disparity=max_disparity
+        )
+        disp, conf = ref.disparity, ref.confidence
+        stage("refine")
     if fill is None:
         fill = method in _DENSE_METHODS
     measured_disp = disp  # NaN where not measured; the fill below makes a new array

@@ -391,6 +391,7 @@ def run_stream(
     max_disparity: int | None = None,
     frames: int | None = None,
     pipelined: bool = True,
+    refine: bool = False,
     on_report: Callable[[dict[str, Any]], None] | None = None,
     on_result: Callable[[np.ndarray, Any], None] | None = None,
     report_period: float = REPORT_PERIOD,
@@ -413,6 +414,10 @@ def run_stream(
         Stop after this many pairs.
     pipelined : bool
         Grab and rectify in a producer thread while the main thread matches (default).
+    refine : bool
+        Sub-pixel refinement of every frame (:func:`stereovision.refine.refine_disparity`).
+        Off by default: it about doubles the matching time, and a live view wants the rate;
+        turn it on for measurements.
     on_report : callable, optional
         Called with each per-second report (a JSON-ready dict, see the module doc).
     on_result : callable, optional
@@ -441,7 +446,9 @@ def run_stream(
     rect_calib = None
     if calib is not None:
         rect_calib = calib if calib.rectified else calib.rectified_calibration()
-    kw: dict[str, Any] = {} if method is None else {"method": method}
+    kw: dict[str, Any] = {"refine": refine}
+    if method is not None:
+        kw["method"] = method
     source = _pairs(camera, calib, frames)
     producer: _Producer | None = None
     q: queue.Queue[Any] = queue.Queue()
@@ -486,7 +493,7 @@ def run_stream(
                 "rectify": pair.rectify_s,
                 # depth_map's own "rectify" is only input conversion for a rectified pair
                 "prepare": tm.get("rectify", 0.0) + tm.get("prepare", 0.0),
-                "match": tm.get("match", 0.0),
+                "match": tm.get("match", 0.0) + tm.get("refine", 0.0),
                 "triangulate": tm.get("triangulate", 0.0),
             }
             d = _Done(
@@ -590,6 +597,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             max_disparity=args.max_disparity,
             frames=args.frames,
             pipelined=not args.no_pipeline,
+            refine=args.refine,
             on_report=on_report,
             on_result=on_result,
         )
@@ -631,6 +639,9 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--max-disparity", type=int, help="default: estimated from the first pair")
     p.add_argument("--method", choices=METHODS, help="matcher (default: depth_map's)")
     p.add_argument("--frames", type=int, help="stop after N pairs (default: until a source ends)")
+    p.add_argument(
+        "--refine", action="store_true", help="sub-pixel refinement per frame (about 2x the time)"
+    )
     p.add_argument("--no-display", action="store_true", help="headless: do not serve the view")
     p.add_argument("--serve", type=int, default=DEFAULT_PORT, metavar="PORT", help="view port")
     p.add_argument("--host", default="127.0.0.1", help="view address (default 127.0.0.1)")

@@ -3,7 +3,9 @@
 //! Layout mirrors the pipeline (see `docs/architecture.md`):
 //! * [`image`]: a minimal owned grey image and validation of inputs;
 //! * [`error`]: the one error type every kernel returns (mapped to Python exceptions by `rust/py`);
-//! * [`matching`]: the correspondence channels (`gabor` today; `mcgm`, `hopfield`, `fusion` later).
+//! * [`matching`]: the correspondence channels (`gabor`, `mcgm`, `hopfield`);
+//! * [`refine`]: sub-pixel refinement and validated completion of a disparity map;
+//! * [`triangulation`]: depth and its uncertainty from a rectified disparity map.
 //!
 //! Conventions (algorithms.md section 0): images are `f32` in `[0, 1]`, row-major `(H, W)`;
 //! `x` = column, `y` = row; disparity `d = x_left - x_right`, stored at left-image pixels,
@@ -13,6 +15,7 @@ pub mod error;
 pub mod image;
 pub mod matching;
 pub mod parallel;
+pub mod refine;
 pub(crate) mod simd;
 pub mod triangulation;
 

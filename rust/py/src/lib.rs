@@ -12,6 +12,7 @@ mod gabor;
 mod hopfield;
 mod mcgm;
 mod params;
+mod refine;
 mod triangulation;
 
 #[pymodule(gil_used = false)]
@@ -29,5 +30,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mcgm::mcgm_match, m)?)?;
     m.add_function(wrap_pyfunction!(mcgm::mcgm_filter, m)?)?;
     m.add_function(wrap_pyfunction!(triangulation::depth_rectified, m)?)?;
+    m.add_function(wrap_pyfunction!(refine::refine_disparity, m)?)?;
     Ok(())
 }

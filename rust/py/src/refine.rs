@@ -1,0 +1,85 @@
+//! Binding of `stereovision_core::refine`.
+
+use numpy::{PyArray2, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use stereovision_core::refine::{refine_disparity as core_refine, FillPass, RefineParams};
+use stereovision_core::Image;
+
+use crate::convert::{grey_from_numpy, image_to_numpy};
+use crate::errors::guard;
+
+type Refined<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>, usize);
+
+/// Refined disparity, its confidence and the number of filled pixels (module docs of the core).
+#[pyfunction]
+#[pyo3(signature = (left, right, disp, conf, d_min, d_max, base_sigma, win_sigma, win_radius,
+                    search, step, fill_step, var_floor, fills, fill_confidence))]
+#[allow(clippy::too_many_arguments)]
+pub fn refine_disparity<'py>(
+    py: Python<'py>,
+    left: PyReadonlyArray2<'py, f32>,
+    right: PyReadonlyArray2<'py, f32>,
+    disp: PyReadonlyArray2<'py, f32>,
+    conf: PyReadonlyArray2<'py, f32>,
+    d_min: f32,
+    d_max: f32,
+    base_sigma: f32,
+    win_sigma: f32,
+    win_radius: usize,
+    search: usize,
+    step: f32,
+    fill_step: f32,
+    var_floor: f32,
+    fills: Vec<(f32, f32)>,
+    fill_confidence: f32,
+) -> PyResult<Refined<'py>> {
+    let l = grey_from_numpy(&left, "left")?;
+    let r = grey_from_numpy(&right, "right")?;
+    let (w, h) = (l.view().width, l.view().height);
+    for (name, a) in [("disparity", &disp), ("confidence", &conf)] {
+        if a.as_array().dim() != (h, w) {
+            return Err(PyValueError::new_err(format!(
+                "{name} shape {:?} differs from the image shape {:?}",
+                a.as_array().dim(),
+                (h, w)
+            )));
+        }
+    }
+    let d = disp
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("disparity must be C-contiguous"))?;
+    let c = conf
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("confidence must be C-contiguous"))?;
+    let p = RefineParams {
+        base_sigma,
+        win_sigma,
+        win_radius,
+        search,
+        step,
+        fill_step,
+        var_floor,
+        fills: fills
+            .into_iter()
+            .map(|(sigma, min_score)| FillPass { sigma, min_score })
+            .collect(),
+        fill_confidence,
+    };
+    let (lv, rv) = (l.view(), r.view());
+    let (out, oc, filled) = py.detach(|| {
+        guard("refine_disparity", || {
+            core_refine(lv, rv, d, c, d_min, d_max, &p)
+        })
+    })?;
+    let img = |data| Image {
+        width: w,
+        height: h,
+        data,
+    };
+    Ok((
+        image_to_numpy(py, img(out))?,
+        image_to_numpy(py, img(oc))?,
+        filled,
+    ))
+}
