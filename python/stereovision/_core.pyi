@@ -133,6 +133,7 @@ def refine_disparity(
     win_radius: int,
     search: int,
     step: float,
+    fill_search: int,
     fill_step: float,
     var_floor: float,
     fills: list[tuple[float, float]],

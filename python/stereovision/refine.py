@@ -36,6 +36,7 @@ DEFAULTS: dict[str, object] = {
     "win_radius": 9,
     "search": 2,
     "step": 0.5,
+    "fill_search": 2,
     "fill_step": 1.0,
     "var_floor": 1e-6,
     "fills": ((16.0, 0.3), (16.0, 0.3)),
@@ -106,8 +107,8 @@ def refine_disparity(
         Values outside this range become NaN.
     **params
         Overrides of :data:`DEFAULTS`: ``base_sigma`` (px), ``win_sigma`` (px), ``win_radius``
-        (px), ``search`` (shifts each side), ``step`` (px between shifts), ``fill_step`` (the
-        same for the fill passes), ``var_floor``, ``fills`` (a sequence of
+        (px), ``search`` (shifts each side), ``step`` (px between shifts), ``fill_search`` and
+        ``fill_step`` (the same for the fill passes), ``var_floor``, ``fills`` (a sequence of
         ``(sigma_px, min_score)``; empty = no fill), ``fill_confidence``.
 
     Returns
@@ -140,7 +141,7 @@ def refine_disparity(
             f"fills must be a sequence of (sigma, min_score), got {fills_raw!r}"
         ) from exc
     f = {k: _number(kw[k], k) for k in _FLOAT_KEYS}
-    i = {k: _number(kw[k], k, whole=True) for k in ("win_radius", "search")}
+    i = {k: _number(kw[k], k, whole=True) for k in ("win_radius", "search", "fill_search")}
     d, c, n = _core.refine_disparity(
         lft,
         rgt,
@@ -153,6 +154,7 @@ def refine_disparity(
         int(i["win_radius"]),
         int(i["search"]),
         f["step"],
+        int(i["fill_search"]),
         f["fill_step"],
         f["var_floor"],
         fills,

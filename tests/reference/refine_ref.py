@@ -127,6 +127,7 @@ def refine_disparity(
     win_radius: int = 9,
     search: int = 2,
     step: float = 0.5,
+    fill_search: int = 2,
     fill_step: float = 1.0,
     var_floor: float = 1e-6,
     fills: tuple[tuple[float, float], ...] = ((16.0, 0.3), (16.0, 0.3)),
@@ -138,23 +139,21 @@ def refine_disparity(
     d = np.asarray(disp, np.float64)
     cf = np.clip(np.asarray(conf, np.float64), 0.0, 1.0)
     taps = gaussian_taps(win_sigma, win_radius)
-    shifts = np.arange(-search, search + 1)
-    c0 = search
 
-    def stack(base: F64, step: float) -> F64:
-        return np.stack(
-            [zncc_shift(lf, rf, base, float(k * step), taps, var_floor) for k in shifts]
-        )
+    def stack(base: F64, search: int, step: float) -> F64:
+        ks = np.arange(-search, search + 1)
+        return np.stack([zncc_shift(lf, rf, base, float(k * step), taps, var_floor) for k in ks])
 
-    def peaks(z: F64) -> tuple[npt.NDArray[np.int64], F64, npt.NDArray[np.bool_]]:
+    def peaks(z: F64, c0: int) -> tuple[npt.NDArray[np.int64], F64, npt.NDArray[np.bool_]]:
         finite = np.all(np.isfinite(z), axis=0)
         k = np.argmax(np.where(np.isfinite(z), z, -np.inf), axis=0)
         zk = np.take_along_axis(z, k[None], 0)[0]
         return k, zk, finite & (k >= c0 - 1) & (k <= c0 + 1)
 
     base = nc_smooth(d, base_sigma)
-    z = stack(base, step)
-    _, _, ok = peaks(z)
+    c0 = search
+    z = stack(base, search, step)
+    _, _, ok = peaks(z, c0)
     off, curved = _parabola(z[c0 - 1], z[c0], z[c0 + 1])
     v = base + step * off
     keep = np.isfinite(d) & ok & curved & (v >= d_min) & (v <= d_max)
@@ -163,12 +162,13 @@ def refine_disparity(
     filled = 0
     for sigma, min_score in fills:
         base = nc_smooth(out, sigma)
-        z = stack(base, fill_step)
-        k, zk, ok = peaks(z)
-        kc = np.clip(k, 1, len(shifts) - 2)
+        z = stack(base, fill_search, fill_step)
+        k, zk, ok = peaks(z, fill_search)
+        ok &= (k >= 1) & (k <= 2 * fill_search - 1)  # a vertex needs both neighbours
+        kc = np.clip(k, 1, 2 * fill_search - 1)
         za, zb, zc = (np.take_along_axis(z, j[None], 0)[0] for j in (kc - 1, kc, kc + 1))
         off, curved = _parabola(za, zb, zc)
-        v = base + fill_step * (kc - c0 + off)
+        v = base + fill_step * (kc - fill_search + off)
         new = ~np.isfinite(out) & ok & (zk >= min_score) & curved & (v >= d_min) & (v <= d_max)
         out = np.where(new, v, out)
         oconf = np.where(new, fill_confidence, oconf)

@@ -41,14 +41,15 @@ pub struct RefineParams {
     /// Gaussian correlation window: sigma and radius (px).
     pub win_sigma: f32,
     pub win_radius: usize,
-    /// Shifts searched on each side of the warped estimate, `step` px apart.
+    /// Shifts searched on each side of the warped estimate when re-measuring, `step` px apart.
     pub search: usize,
     /// Spacing of the searched shifts when re-measuring (px). Half a pixel: a parabola through
     /// correlations a whole pixel apart is biased towards whole pixels by up to 0.05 px (pixel
     /// locking); half a pixel apart, by under 0.01 px.
     pub step: f32,
-    /// Spacing of the shifts of the fill passes (px): a whole pixel, so a fill reaches
-    /// `search` px either side of its smoothed start.
+    /// Shifts on each side, and their spacing (px), of the fill passes: a whole pixel apart,
+    /// two each side, so a fill reaches 2 px either side of its smoothed start.
+    pub fill_search: usize,
     pub fill_step: f32,
     /// Window variance below which a pixel has no texture to correlate (grey levels in [0, 1]).
     pub var_floor: f32,
@@ -66,6 +67,7 @@ impl Default for RefineParams {
             win_radius: 9,
             search: 2,
             step: 0.5,
+            fill_search: 2,
             fill_step: 1.0,
             var_floor: 1e-6,
             fills: vec![
@@ -100,11 +102,13 @@ impl RefineParams {
                 format!("must be in 1..=64, got {}", self.win_radius),
             ));
         }
-        if self.search == 0 || self.search > 16 {
-            return Err(CoreError::param(
-                "search",
-                format!("must be in 1..=16, got {}", self.search),
-            ));
+        for (name, v) in [("search", self.search), ("fill_search", self.fill_search)] {
+            if v == 0 || v > 16 {
+                return Err(CoreError::param(
+                    name,
+                    format!("must be in 1..=16, got {v}"),
+                ));
+            }
         }
         if !(0.0..=1.0).contains(&self.fill_confidence) {
             return Err(CoreError::param(
@@ -442,8 +446,8 @@ fn left_stats(l: &[f32], r: &[f32], w: usize, h: usize, taps: &[f32]) -> LeftSta
 }
 
 /// Rows per band of the fused correlation pass (the window's rows above and below are
-/// recomputed per band: 18 of 64 at the default radius).
-const BAND: usize = 64;
+/// recomputed per band: 18 of 128 at the default radius).
+const BAND: usize = 128;
 
 /// Per-thread buffers of [`zncc_band`], reused from band to band (fresh multi-megabyte
 /// allocations per band cost as much in page faults as the arithmetic).
@@ -482,7 +486,7 @@ fn zncc_band(
     r: &[f32],
     base: &[f32],
     p: &RefineParams,
-    step: f32,
+    (search, step): (usize, f32),
     taps: &[f32],
     w: usize,
     h: usize,
@@ -493,11 +497,11 @@ fn zncc_band(
     let ya = y0.saturating_sub(rad);
     let yb = (y1 + rad).min(h);
     let nr = yb - ya;
-    let n_s = 2 * p.search + 1;
+    let n_s = 2 * search + 1;
     let band_len = (y1 - y0) * w;
     sized(&mut sc.z, n_s * band_len);
     for k in 0..n_s {
-        let s = (k as f32 - p.search as f32) * step;
+        let s = (k as f32 - search as f32) * step;
         let h1 = sized(&mut sc.h1, nr * w);
         let h2 = sized(&mut sc.h2, nr * w);
         let h12 = sized(&mut sc.h12, nr * w);
@@ -588,7 +592,7 @@ fn stage<T, D>(
     r: &[f32],
     base: &[f32],
     p: &RefineParams,
-    step: f32,
+    shifts: (usize, f32),
     taps: &[f32],
     w: usize,
     h: usize,
@@ -600,7 +604,7 @@ fn stage<T, D>(
     D: Fn(usize, &[f32]) -> Option<f32> + Sync,
 {
     use rayon::prelude::*;
-    let n_s = 2 * p.search + 1;
+    let n_s = 2 * shifts.0 + 1;
     out.par_chunks_mut(w * BAND).enumerate().for_each_init(
         || (Scratch::default(), vec![0f32; n_s]),
         |(sc, zb), (bi, chunk)| {
@@ -609,7 +613,7 @@ fn stage<T, D>(
             if !(y0 * w..y1 * w).any(&todo) {
                 return;
             }
-            zncc_band(sc, ls, r, base, p, step, taps, w, h, y0, y1);
+            zncc_band(sc, ls, r, base, p, shifts, taps, w, h, y0, y1);
             let band_len = (y1 - y0) * w;
             for (j, o) in chunk.iter_mut().enumerate().take(band_len) {
                 let i = y0 * w + j;
@@ -669,6 +673,7 @@ pub fn refine_disparity(
     let taps = gaussian_taps(p.win_sigma, p.win_radius);
     let ls = left_stats(left.data, right.data, w, h, &taps);
     let c0 = p.search;
+    let fc = p.fill_search;
     let in_range = |v: f32| v >= d_min && v <= d_max;
 
     // Stage 1: re-measure every pixel with a value; NaN where the correlation disagrees.
@@ -679,7 +684,7 @@ pub fn refine_disparity(
         right.data,
         &base,
         p,
-        p.step,
+        (p.search, p.step),
         &taps,
         w,
         h,
@@ -716,7 +721,7 @@ pub fn refine_disparity(
             right.data,
             &base,
             p,
-            p.fill_step,
+            (p.fill_search, p.fill_step),
             &taps,
             w,
             h,
@@ -724,11 +729,13 @@ pub fn refine_disparity(
             |i| !before[i].is_finite() && base[i].is_finite(),
             |i, z| {
                 let (k, zk) = peak(z)?;
-                if k + 1 < c0 || k > c0 + 1 || zk < f.min_score {
+                // Within one shift of the start, and not at either end (a vertex needs both
+                // neighbours; with search = 1 the ends are one shift away).
+                if k + 1 < fc || k > fc + 1 || k == 0 || k + 1 == z.len() || zk < f.min_score {
                     return None;
                 }
                 let off = parabola_offset(z[k - 1], z[k], z[k + 1])?;
-                let v = base[i] + p.fill_step * (k as f32 - c0 as f32 + off);
+                let v = base[i] + p.fill_step * (k as f32 - fc as f32 + off);
                 in_range(v).then_some(v)
             },
         );
@@ -828,6 +835,20 @@ mod tests {
         let short = vec![0f32; 3];
         assert!(refine_disparity(v, v, &short, &a, 0.0, 4.0, &RefineParams::default()).is_err());
         assert!(refine_disparity(v, v, &a, &a, 4.0, 4.0, &RefineParams::default()).is_err());
+        // The smallest search (one shift each side) is valid, not a panic.
+        let (l, r, d) = slanted_pair(48, 32);
+        let (lv, rv) = (
+            ImageView::new(48, 32, &l).unwrap(),
+            ImageView::new(48, 32, &r).unwrap(),
+        );
+        let mut holes = d.clone();
+        holes[16 * 48 + 20..16 * 48 + 30].fill(f32::NAN);
+        let p = RefineParams {
+            search: 1,
+            ..Default::default()
+        };
+        let ones = vec![1f32; 48 * 32];
+        assert!(refine_disparity(lv, rv, &holes, &ones, 0.0, 16.0, &p).is_ok());
     }
 
     #[test]

@@ -14,7 +14,7 @@ type Refined<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>, usize
 /// Refined disparity, its confidence and the number of filled pixels (module docs of the core).
 #[pyfunction]
 #[pyo3(signature = (left, right, disp, conf, d_min, d_max, base_sigma, win_sigma, win_radius,
-                    search, step, fill_step, var_floor, fills, fill_confidence))]
+                    search, step, fill_search, fill_step, var_floor, fills, fill_confidence))]
 #[allow(clippy::too_many_arguments)]
 pub fn refine_disparity<'py>(
     py: Python<'py>,
@@ -29,6 +29,7 @@ pub fn refine_disparity<'py>(
     win_radius: usize,
     search: usize,
     step: f32,
+    fill_search: usize,
     fill_step: f32,
     var_floor: f32,
     fills: Vec<(f32, f32)>,
@@ -58,6 +59,7 @@ pub fn refine_disparity<'py>(
         win_radius,
         search,
         step,
+        fill_search,
         fill_step,
         var_floor,
         fills: fills
