@@ -12,6 +12,7 @@ fn bench_depth(c: &mut Criterion) {
         s0: 0.74,
         slope: -0.52,
         s_min: 0.2,
+        s_fill: 0.67,
     };
     let mut g = c.benchmark_group("depth_rectified");
     g.sample_size(20).measurement_time(Duration::from_secs(3));

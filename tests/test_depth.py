@@ -75,29 +75,61 @@ def test_depth_sigma_formula_on_a_plane() -> None:
     """sigma_Z = Z^2 sigma_d / (f B), sigma_d from the confidence (f 500 px, B 0.1 m)."""
     h, w, d = 96, 160, 6.5
     left = _texture(h, w)
-    res = sv.depth_map(left, _shift(left, d), _rect_calib(w, h), max_disparity=16)
-    assert res.depth is not None and res.depth_sigma is not None
-    ok = np.isfinite(res.depth)
-    assert np.array_equal(ok, np.isfinite(res.depth_sigma))
-    expected = res.depth**2 * sv.depth.disparity_sigma(res.confidence) / (500.0 * 0.1)
-    np.testing.assert_allclose(res.depth_sigma[ok], expected[ok], rtol=1e-4)
-    # The prediction is monotone in confidence: 0.74 px at 0, 0.22 px at 1.
+    right = _shift(left, d)
+    raw = sv.depth_map(left, right, _rect_calib(w, h), max_disparity=16, refine=False)
+    res = sv.depth_map(left, right, _rect_calib(w, h), max_disparity=16)
+    for r, refined in ((raw, False), (res, True)):
+        assert r.depth is not None and r.depth_sigma is not None
+        ok = np.isfinite(r.depth)
+        assert np.array_equal(ok, np.isfinite(r.depth_sigma))
+        filled = np.isnan(raw.disparity) & np.isfinite(r.disparity)
+        sd = sv.depth.disparity_sigma(r.confidence, refined=refined, filled=filled)
+        expected = r.depth**2 * sd / (500.0 * 0.1)
+        np.testing.assert_allclose(r.depth_sigma[ok], expected[ok], rtol=1e-4)
+    # The prediction is monotone in confidence: raw 0.74 px at 0, 0.22 px at 1; refined 0.405
+    # at 0, 0.184 at 1; filled pixels 0.67 px.
     np.testing.assert_allclose(
-        sv.depth.disparity_sigma([0.0, 0.5, 1.0, 2.0]), [0.74, 0.48, 0.22, 0.22], rtol=1e-6
+        sv.depth.disparity_sigma([0.0, 0.5, 1.0, 2.0], refined=False),
+        [0.74, 0.48, 0.22, 0.22],
+        rtol=1e-6,
+    )
+    np.testing.assert_allclose(
+        sv.depth.disparity_sigma([0.0, 1.0, 0.5], filled=[False, False, True]),
+        [0.405, 0.184, 0.67],
+        rtol=1e-5,
     )
 
 
-def test_depth_sigma_predicts_the_error_on_a_metric_scene(data_dir: Path) -> None:
-    """On ETH3D terrace the error in units of sigma_Z is about standard normal in its core."""
-    scene = load_scene(data_dir / "eth3d" / "terrace")
-    res = sv.depth_map(scene.left, scene.right, scene.calib, max_disparity=32)
-    assert res.depth is not None and res.depth_sigma is not None
-    z_gt = scene.calib.depth_from_disparity(scene.gt)
-    ok = np.isfinite(res.depth) & np.isfinite(z_gt)
-    t = np.abs(res.depth[ok] - z_gt[ok]) / res.depth_sigma[ok]
-    # Measured: median 0.74 (standard normal: 0.67), 62 % within 1 sigma, 87 % within 2.
-    assert 0.55 < float(np.median(t)) < 0.9
-    assert 0.55 < float(np.mean(t <= 1)) < 0.75
+@pytest.mark.parametrize("refine", [True, False])
+def test_depth_sigma_predicts_the_error(data_dir: Path, refine: bool) -> None:
+    """The error in units of the predicted sigma is about standard normal in its core.
+
+    Pooled over terrace, playground, cones and tsukuba (the model is a line fitted on all 17
+    GT scenes; per scene the median of |t| runs from 0.31 on venus to 1.76 on KITTI, whose
+    LiDAR GT is itself ~0.4 px off). Measured, refined (default): median |t| 0.61, 69 % within
+    1 sigma, 88 % within 2; all 17 scenes pooled: 0.68, 64 %, 83 % (standard normal: 0.67,
+    68 %, 95 %). As the channel comes (refine=False), its own line: 0.64, 67 %, 88 %.
+    """
+    ts = []
+    for name in (
+        "eth3d/terrace",
+        "eth3d/playground",
+        "middlebury2003/cones",
+        "middlebury2001/tsukuba",
+    ):
+        scene = load_scene(data_dir / name)
+        md = scene.max_disparity
+        res = sv.depth_map(scene.left, scene.right, max_disparity=md, refine=refine)
+        filled = None
+        if refine:
+            raw = sv.depth_map(scene.left, scene.right, max_disparity=md, refine=False)
+            filled = np.isnan(raw.disparity) & np.isfinite(res.disparity)
+        sd = sv.depth.disparity_sigma(res.confidence, refined=refine, filled=filled)
+        ok = np.isfinite(res.disparity) & np.isfinite(scene.gt)
+        ts.append(np.abs(res.disparity[ok] - scene.gt[ok]) / sd[ok])
+    t = np.concatenate(ts)
+    assert 0.5 < float(np.median(t)) < 0.85
+    assert 0.6 < float(np.mean(t <= 1)) < 0.8
     assert float(np.mean(t <= 2)) > 0.8
 
 

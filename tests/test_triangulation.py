@@ -266,7 +266,7 @@ def test_depth_kernel_matches_numpy_reference_on_a_real_scene(data_dir: Path) ->
     """
     import stereovision as sv
     from stereovision import _core
-    from stereovision.depth import _SIGMA_D0, _SIGMA_D_MIN, _SIGMA_D_SLOPE
+    from stereovision.depth import _SIGMA_FILLED, _SIGMA_REFINED
     from tests.reference import depth_ref
 
     scene = load_scene(data_dir / "eth3d" / "terrace")
@@ -274,15 +274,21 @@ def test_depth_kernel_matches_numpy_reference_on_a_real_scene(data_dir: Path) ->
     cal = scene.calib
     disp = res.disparity.copy()
     disp[:5, :] = -cal.doffs_px - 1.0  # behind the camera: NaN
-    args = (cal.focal_px * cal.baseline_m, cal.doffs_px, _SIGMA_D0, _SIGMA_D_SLOPE, _SIGMA_D_MIN)
-    z, s = _core.depth_rectified(disp, res.confidence, *args)
-    zr, sr = depth_ref.depth_rectified(disp, res.confidence, *args)
+    args = (cal.focal_px * cal.baseline_m, cal.doffs_px, *_SIGMA_REFINED, _SIGMA_FILLED)
+    conf = res.confidence.copy()
+    conf[100:120] = -1.0  # the mark of a filled pixel
+    z, s = _core.depth_rectified(disp, conf, *args)
+    zr, sr = depth_ref.depth_rectified(disp, conf, *args)
     assert int(np.isfinite(zr).sum()) > 100000
     assert np.array_equal(np.isnan(z), np.isnan(zr)) and np.array_equal(np.isnan(s), np.isnan(sr))
     assert np.isnan(z[:5]).all()
     np.testing.assert_allclose(z, zr, rtol=2.4e-7, equal_nan=True)
     np.testing.assert_allclose(s, sr, rtol=2.4e-7, equal_nan=True)
+    ok = np.isfinite(s[100:120])
+    np.testing.assert_allclose(
+        s[100:120][ok], (z * _SIGMA_FILLED / (disp + cal.doffs_px))[100:120][ok], rtol=1e-6
+    )
     with pytest.raises(ValueError, match="fb"):
-        _core.depth_rectified(disp, res.confidence, 0.0, *args[1:])
+        _core.depth_rectified(disp, conf, 0.0, *args[1:])
     with pytest.raises(ValueError, match="shape"):
-        _core.depth_rectified(disp, res.confidence[:, 1:].copy(), *args)
+        _core.depth_rectified(disp, conf[:, 1:].copy(), *args)

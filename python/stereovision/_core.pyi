@@ -118,8 +118,10 @@ def depth_rectified(
     s0: float,
     slope: float,
     s_min: float,
+    s_fill: float,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
-    """``(Z, sigma_Z)``: ``fb / (d + doffs)``, ``Z max(s0 + slope clip(c), s_min) / (d+doffs)``."""
+    """``(Z, sigma_Z)``: ``fb / (d + doffs)``, ``Z max(s0 + slope clip(c), s_min) / (d+doffs)``
+    (``Z s_fill / (d + doffs)`` where ``c < 0``)."""
 
 def refine_disparity(
     left: npt.NDArray[np.float32],

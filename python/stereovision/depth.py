@@ -36,13 +36,17 @@ _AUTO_MIN_MATCHES = 12  # fewer than this and the estimate is noise: fall back
 _AUTO_FALLBACK_FRACTION = 1 / 8  # of the width, when the pair has too few features
 _DISPARITY_STEP = 16  # ranges are multiples of 16, like the evaluation protocol's
 
-# Disparity uncertainty from the matcher's confidence: sigma_d = _SIGMA_D0 + _SIGMA_D_SLOPE * conf
-# (px). A line through the robust spread (1.4826 x median |error|) of the Gabor channel per
-# confidence bin over the 17 GT scenes (2.8 M pixels): 0.65 px at confidence 0.1, 0.47 at 0.55,
-# 0.23 at 0.95. It is the spread of the correctly locked pixels, not of gross outliers.
-_SIGMA_D0 = 0.74
-_SIGMA_D_SLOPE = -0.52
-_SIGMA_D_MIN = 0.2
+# Disparity uncertainty from the matcher's confidence: sigma_d = max(s0 + slope * conf, s_min)
+# (px), a line through the robust spread (1.4826 x median |error|) per confidence bin over the 17
+# GT scenes. It is the spread of the correctly locked pixels, not of gross outliers.
+# The Gabor channel as it comes (refine=False; 2.8 M pixels): 0.65 px at confidence 0.1, 0.47 at
+# 0.55, 0.23 at 0.95.
+_SIGMA_RAW = (0.74, -0.52, 0.2)
+# After the refinement (the default; 3.1 M pixels): 0.34 px at confidence 0.18, 0.30 at 0.52,
+# 0.20 at 0.86; the pixels it filled (14 % of them) spread by 0.67 px, whatever their neighbours'
+# confidence.
+_SIGMA_REFINED = (0.405, -0.221, 0.18)
+_SIGMA_FILLED = 0.67
 
 
 def _round_up(value: float, step: int = _DISPARITY_STEP) -> int:
@@ -172,24 +176,37 @@ class DepthResult:
         return Path(write_ply(path, points, colors))
 
 
-def disparity_sigma(confidence: npt.ArrayLike) -> npt.NDArray[np.float32]:
+def disparity_sigma(
+    confidence: npt.ArrayLike, *, refined: bool = True, filled: npt.ArrayLike | None = None
+) -> npt.NDArray[np.float32]:
     """Predicted one-sigma disparity error (px) of a pixel from its matcher confidence.
 
-    ``sigma_d = 0.74 - 0.52 * conf``, at least 0.2 px: a line through the robust error spread
-    of the Gabor channel per confidence bin, measured on the 17 shared GT scenes.
+    ``sigma_d = max(s0 + slope * conf, s_min)``: a line through the robust error spread per
+    confidence bin, measured on the 17 shared GT scenes; ``0.405 - 0.221 conf`` (at least
+    0.18 px) for the refined map :func:`depth_map` gives by default, ``0.74 - 0.52 conf`` (at
+    least 0.2 px) for the Gabor channel as it comes (``refine=False``). Pixels the refinement
+    filled have a spread of their own: 0.67 px.
 
     Parameters
     ----------
     confidence : array_like
         Confidence in ``[0, 1]`` (values outside are clipped).
+    refined : bool
+        Whether the map was refined (:mod:`stereovision.refine`).
+    filled : array_like of bool, optional
+        Pixels the refinement filled (same shape as ``confidence``).
 
     Returns
     -------
     numpy.ndarray
         float32 array of the same shape, pixels.
     """
+    s0, slope, s_min = _SIGMA_REFINED if refined else _SIGMA_RAW
     c = np.clip(np.asarray(confidence, dtype=np.float32), 0.0, 1.0)
-    return np.maximum(_SIGMA_D0 + _SIGMA_D_SLOPE * c, _SIGMA_D_MIN).astype(np.float32)
+    out = np.maximum(np.float32(s0) + np.float32(slope) * c, np.float32(s_min))
+    if filled is not None:
+        out = np.where(np.asarray(filled, bool), np.float32(_SIGMA_FILLED), out)
+    return np.asarray(out, np.float32)
 
 
 def _run_matcher(
@@ -246,6 +263,8 @@ def _depth_rectified(
     measured_disp: npt.NDArray[np.float32],
     conf: npt.NDArray[np.float32],
     calib: Calibration,
+    refined: bool,
+    filled: npt.NDArray[np.bool_] | None,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
     """Depth in metres and its one-sigma uncertainty of a rectified pair's measured disparity.
 
@@ -253,18 +272,24 @@ def _depth_rectified(
     float32 where ``measured_disp`` has a value (NaN = not measured: filled pixels are guesses,
     not measurements, and get no depth); ``sigma_Z = Z sigma_d / (d + doffs)``
     (:func:`disparity_sigma`). One parallel Rust pass; ``tests/reference/depth_ref.py`` is the
-    same maths in NumPy.
+    same maths in NumPy. Pixels the refinement filled are passed with confidence -1, the
+    kernel's mark for ``s_fill``.
     """
     from stereovision import _core
 
+    s0, slope, s_min = _SIGMA_REFINED if refined else _SIGMA_RAW
+    c = np.ascontiguousarray(conf, dtype=np.float32)
+    if filled is not None and filled.any():
+        c = np.where(filled, np.float32(-1), c)
     return _core.depth_rectified(
         np.ascontiguousarray(measured_disp, dtype=np.float32),
-        np.ascontiguousarray(conf, dtype=np.float32),
+        c,
         calib.focal_px * calib.baseline_m,
         calib.doffs_px,
-        _SIGMA_D0,
-        _SIGMA_D_SLOPE,
-        _SIGMA_D_MIN,
+        s0,
+        slope,
+        s_min,
+        _SIGMA_FILLED,
     )
 
 
@@ -438,12 +463,14 @@ def depth_map(
     stage("match")
     if refine is None:
         refine = method not in _DENSE_METHODS
+    filled: npt.NDArray[np.bool_] | None = None
     if refine:
         from stereovision.refine import refine_disparity
 
         ref = refine_disparity(
             gl, gr, disp, conf, min_disparity=min_disparity, max_disparity=max_disparity
         )
+        filled = ~measured & np.isfinite(ref.disparity)
         disp, conf = ref.disparity, ref.confidence
         stage("refine")
     if fill is None:
@@ -459,7 +486,9 @@ def depth_map(
     colors = np.zeros((0, 3), np.uint8)
     pixels = np.zeros((0, 2), np.int32)
     if calib is not None:
-        depth, depth_sigma = _depth_rectified(measured_disp, conf, calib)
+        depth, depth_sigma = _depth_rectified(
+            measured_disp, conf, calib, bool(refine), filled
+        )
         if cloud:
             points, colors, pixels = _cloud(depth, calib, left_bgr)
         stage("triangulate")

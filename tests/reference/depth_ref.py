@@ -1,7 +1,8 @@
 """NumPy reference of the rectified depth kernel (rust/core/src/triangulation.rs).
 
 ``Z = f B / (d + doffs)`` and ``sigma_Z = Z sigma_d / (d + doffs)`` with
-``sigma_d = max(s0 + slope * clip(conf, 0, 1), s_min)``, in float32, NaN where the disparity is
+``sigma_d = max(s0 + slope * clip(conf, 0, 1), s_min)`` (``s_fill`` where ``conf < 0``: a pixel
+the refinement filled), in float32, NaN where the disparity is
 NaN, ``d + doffs <= 0`` or the depth is not finite: the same operations in the same order.
 """
 
@@ -19,6 +20,7 @@ def depth_rectified(
     s0: float,
     slope: float,
     s_min: float,
+    s_fill: float,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
     """``(depth, sigma)`` float32 arrays of ``disp``'s shape."""
     d = np.asarray(disp, np.float32)
@@ -26,7 +28,9 @@ def depth_rectified(
         denom = d + np.float32(doffs)
         z = np.float32(fb) / denom
         ok = (denom > 0) & np.isfinite(z)
-        c = np.clip(np.asarray(conf, np.float32), np.float32(0), np.float32(1))
+        raw = np.asarray(conf, np.float32)
+        c = np.clip(raw, np.float32(0), np.float32(1))
         sd = np.maximum(np.float32(s0) + np.float32(slope) * c, np.float32(s_min))
+        sd = np.where(raw < 0, np.float32(s_fill), sd)
         s = z * sd / denom
     return np.where(ok, z, np.float32(np.nan)), np.where(ok, s, np.float32(np.nan))

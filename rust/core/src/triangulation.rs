@@ -2,19 +2,22 @@
 //!
 //! `Z = f B / (d + doffs)`, and `sigma_Z = Z sigma_d / (d + doffs)` (`dZ/dd = -Z / (d + doffs)`)
 //! with `sigma_d = max(s0 + slope * clamp(conf, 0, 1), s_min)` predicted from the matcher's
-//! confidence. One parallel pass in f32: the NumPy form (`tests/reference/depth_ref.py`, the same
+//! confidence, or `s_fill` where the confidence is negative (a pixel the refinement filled: its
+//! error spread is its own, not on the line). One parallel pass in f32: the NumPy form (`tests/reference/depth_ref.py`, the same
 //! operations in the same order) allocates and walks half a dozen full-size temporaries, a tenth
 //! of a live frame at VGA.
 
 use crate::error::{CoreError, Result};
 use crate::parallel::for_each_row2;
 
-/// Disparity uncertainty model `sigma_d(conf) = max(s0 + slope * clamp(conf, 0, 1), s_min)` (px).
+/// Disparity uncertainty model (px): `sigma_d(conf) = max(s0 + slope * clamp(conf, 0, 1), s_min)`
+/// for `conf >= 0`, `s_fill` for a negative `conf` (a filled pixel).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SigmaModel {
     pub s0: f32,
     pub slope: f32,
     pub s_min: f32,
+    pub s_fill: f32,
 }
 
 /// `(depth, sigma)` of a `w` x `h` rectified disparity map: `fb = f B` (px times the output
@@ -61,7 +64,11 @@ pub fn depth_rectified(
             let denom = d[x] + doffs;
             let z = fb / denom;
             let ok = denom > 0.0 && z.is_finite();
-            let sd = (sigma.s0 + sigma.slope * c[x].clamp(0.0, 1.0)).max(sigma.s_min);
+            let sd = if c[x] < 0.0 {
+                sigma.s_fill
+            } else {
+                (sigma.s0 + sigma.slope * c[x].clamp(0.0, 1.0)).max(sigma.s_min)
+            };
             zrow[x] = if ok { z } else { f32::NAN };
             srow[x] = if ok { z * sd / denom } else { f32::NAN };
         }
@@ -77,14 +84,15 @@ mod tests {
         s0: 0.74,
         slope: -0.52,
         s_min: 0.2,
+        s_fill: 0.9,
     };
 
     #[test]
     fn depth_and_sigma_on_a_few_pixels() {
         // f B = 50 (500 px, 0.1 m), doffs 2 px.
-        let disp = [8.0, f32::NAN, -2.0, -5.0, 3.0, 48.0];
-        let conf = [1.0, 1.0, 0.5, 0.5, 0.0, 2.0];
-        let (z, s) = depth_rectified(&disp, &conf, 3, 2, 50.0, 2.0, M).unwrap();
+        let disp = [8.0, f32::NAN, -2.0, -5.0, 3.0, 48.0, 8.0, 8.0];
+        let conf = [1.0, 1.0, 0.5, 0.5, 0.0, 2.0, -1.0, 0.5];
+        let (z, s) = depth_rectified(&disp, &conf, 4, 2, 50.0, 2.0, M).unwrap();
         assert_eq!(z[0], 5.0);
         assert!((s[0] - 5.0 * 0.22 / 10.0).abs() < 1e-7);
         assert!(z[1].is_nan() && z[2].is_nan() && z[3].is_nan());
@@ -98,6 +106,8 @@ mod tests {
             (s[5] - 1.0 * 0.22 / 50.0).abs() < 1e-7,
             "confidence clamped to 1"
         );
+        assert!((s[6] - 5.0 * 0.9 / 10.0).abs() < 1e-7, "negative: a fill");
+        assert!((s[7] - 5.0 * 0.48 / 10.0).abs() < 1e-7);
     }
 
     #[test]

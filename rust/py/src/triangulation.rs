@@ -14,9 +14,10 @@ type Pair<'py> = (
     Bound<'py, numpy::PyArray2<f32>>,
 );
 
-/// Depth and its one-sigma uncertainty from a rectified disparity map (NaN = no disparity).
+/// Depth and its one-sigma uncertainty from a rectified disparity map (NaN = no disparity; a
+/// negative confidence marks a filled pixel, whose disparity sigma is `s_fill`).
 #[pyfunction]
-#[pyo3(signature = (disp, conf, fb, doffs, s0, slope, s_min))]
+#[pyo3(signature = (disp, conf, fb, doffs, s0, slope, s_min, s_fill))]
 #[allow(clippy::too_many_arguments)]
 pub fn depth_rectified<'py>(
     py: Python<'py>,
@@ -27,6 +28,7 @@ pub fn depth_rectified<'py>(
     s0: f32,
     slope: f32,
     s_min: f32,
+    s_fill: f32,
 ) -> PyResult<Pair<'py>> {
     let (h, w) = disp.as_array().dim();
     if conf.as_array().dim() != (h, w) {
@@ -42,7 +44,12 @@ pub fn depth_rectified<'py>(
     let c = conf
         .as_slice()
         .map_err(|_| PyValueError::new_err("conf must be C-contiguous"))?;
-    let m = SigmaModel { s0, slope, s_min };
+    let m = SigmaModel {
+        s0,
+        slope,
+        s_min,
+        s_fill,
+    };
     let (z, s) = py.detach(|| guard("depth_rectified", || core_depth(d, c, w, h, fb, doffs, m)))?;
     let img = |data| Image {
         width: w,
