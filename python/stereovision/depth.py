@@ -486,9 +486,7 @@ def depth_map(
     colors = np.zeros((0, 3), np.uint8)
     pixels = np.zeros((0, 2), np.int32)
     if calib is not None:
-        depth, depth_sigma = _depth_rectified(
-            measured_disp, conf, calib, bool(refine), filled
-        )
+        depth, depth_sigma = _depth_rectified(measured_disp, conf, calib, bool(refine), filled)
         if cloud:
             points, colors, pixels = _cloud(depth, calib, left_bgr)
         stage("triangulate")
