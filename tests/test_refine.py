@@ -98,8 +98,8 @@ def test_depth_map_metric_depth_beats_sgbm(data_dir: Path, scene_name: str) -> N
     reports, median |dZ|/Z and the share off by > 5 % are no worse than SGBM-3WAY's, with at
     least 90 % of SGBM's GT coverage.
 
-    Measured (ours / SGBM; coverage ratio): playground 2.72 / 2.82 %, 26.6 / 29.8 %, 1.02;
-    terrace 1.34 / 2.18 %, 12.6 / 17.5 %, 1.00; kitti 1.69 / 1.79 %, 16.7 / 18.2 %, 0.92.
+    Measured (ours / SGBM; coverage ratio): playground 2.68 / 2.82 %, 25.7 / 29.8 %, 1.01;
+    terrace 1.34 / 2.18 %, 11.9 / 17.5 %, 1.00; kitti 1.67 / 1.79 %, 16.6 / 18.2 %, 0.91.
     """
     scene = load_scene(data_dir / scene_name)
     assert scene.calib is not None and scene.gt is not None
