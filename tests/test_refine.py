@@ -52,7 +52,8 @@ def _within(c: tuple[float, float, float]) -> bool:
     return c[0] <= 1e-3 and c[1] <= 1e-4 and c[2] <= 1e-2
 
 
-def test_parity_with_numpy_reference_on_a_real_image(data_dir: Path) -> None:
+@pytest.mark.parametrize("plane", [True, False])
+def test_parity_with_numpy_reference_on_a_real_image(data_dir: Path, plane: bool) -> None:
     """Rust (float32) vs the float64 NumPy reference on a real crop.
 
     Measured: validity differs at 5 of 38400 pixels; the difference has a median of 4e-5 px
@@ -61,8 +62,8 @@ def test_parity_with_numpy_reference_on_a_real_image(data_dir: Path) -> None:
     mirrored pair or a window one tap wider.
     """
     left, right, disp, conf, dmax = _crop_inputs(data_dir)
-    out = refine_disparity(left, right, disp, conf, max_disparity=dmax)
-    ref = refine_ref.refine_disparity(left, right, disp, conf, 0.0, dmax)
+    out = refine_disparity(left, right, disp, conf, max_disparity=dmax, fill_plane=plane)
+    ref = refine_ref.refine_disparity(left, right, disp, conf, 0.0, dmax, fill_plane=plane)
     c = _compare(ref, out)
     assert _within(c), c
     assert out.n_filled == ref[2] or abs(out.n_filled - ref[2]) <= 0.001 * disp.size
@@ -71,6 +72,8 @@ def test_parity_with_numpy_reference_on_a_real_image(data_dir: Path) -> None:
     assert np.mean(np.abs(out.confidence - ref[1]) > 1e-6) <= 1e-3
     assert np.isfinite(out.disparity).mean() > 0.7  # measured 0.76 (the Gabor input: 0.66)
 
+    if not plane:
+        return
     # The same tolerance catches an off-by-one or sign error.
     wrong = [
         refine_ref.refine_disparity(left, np.roll(right, 1, axis=1), disp, conf, 0.0, dmax),
@@ -151,6 +154,23 @@ def test_recovers_a_subpixel_shift_of_a_real_image(data_dir: Path) -> None:
     assert median_error(step=1.0) > 0.03  # what the half-pixel step is for
 
 
+def test_fill_plane_and_residual_test(data_dir: Path) -> None:
+    """Fills start from the local plane; a residual limit keeps them off depth edges."""
+    left, right, disp, conf, dmax = _crop_inputs(data_dir)
+    free = refine_disparity(left, right, disp, conf, max_disparity=dmax)
+    strict = refine_disparity(left, right, disp, conf, max_disparity=dmax, fill_max_residual=0.5)
+    assert 0 < strict.n_filled < free.n_filled
+    both = np.isfinite(strict.disparity)
+    np.testing.assert_array_equal(strict.disparity[both], free.disparity[both])
+    # The plane fit itself: exact on a slanted plane with holes, flat-mean fallback on a line.
+    yy, xx = np.mgrid[0:30, 0:40]
+    plane = 3.0 + 0.25 * xx - 0.4 * yy
+    holes = np.where((xx * 7 + yy) % 5 == 0, np.nan, plane)
+    a, rms = refine_ref.nc_plane(holes, 4.0)
+    np.testing.assert_allclose(a, plane, atol=1e-9)
+    assert float(np.nanmax(rms)) < 1e-6
+
+
 def test_constant_pair_gives_nan_not_error() -> None:
     flat = np.full((40, 60), 0.5, np.float32)
     res = refine_disparity(flat, flat, np.full(flat.shape, 3.0, np.float32), max_disparity=16)
@@ -169,6 +189,7 @@ def test_constant_pair_gives_nan_not_error() -> None:
         ({"nope": 1}, "unknown"),
         ({"win_radius": 2.5}, "whole number"),
         ({"fill_confidence": 2.0}, "fill_confidence"),
+        ({"fill_max_residual": 0.0}, "fill_max_residual"),
     ],
 )
 def test_bad_parameters_raise(kwargs: dict, match: str) -> None:

@@ -140,5 +140,7 @@ def refine_disparity(
     var_floor: float,
     fills: list[tuple[float, float]],
     fill_confidence: float,
+    fill_plane: bool,
+    fill_max_residual: float,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32], int]:
     """``(disparity, confidence, n_filled)``: ZNCC sub-pixel refinement and validated fill."""

@@ -39,8 +39,10 @@ DEFAULTS: dict[str, object] = {
     "fill_search": 2,
     "fill_step": 1.0,
     "var_floor": 1e-6,
-    "fills": ((16.0, 0.3), (16.0, 0.3)),
+    "fills": ((16.0, 0.3),),
     "fill_confidence": 0.25,
+    "fill_plane": True,
+    "fill_max_residual": float("inf"),
 }
 
 
@@ -64,7 +66,15 @@ class RefineResult:
     n_filled: int
 
 
-_FLOAT_KEYS = ("base_sigma", "win_sigma", "step", "fill_step", "var_floor", "fill_confidence")
+_FLOAT_KEYS = (
+    "base_sigma",
+    "win_sigma",
+    "step",
+    "fill_step",
+    "var_floor",
+    "fill_confidence",
+    "fill_max_residual",
+)
 
 
 def _number(v: object, name: str, whole: bool = False) -> float:
@@ -159,5 +169,7 @@ def refine_disparity(
         f["var_floor"],
         fills,
         f["fill_confidence"],
+        bool(kw["fill_plane"]),
+        f["fill_max_residual"],
     )
     return RefineResult(disparity=d, confidence=c, n_filled=int(n))

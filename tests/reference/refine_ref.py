@@ -67,6 +67,44 @@ def nc_smooth(d: npt.ArrayLike, sigma: float) -> F64:
         return np.where(den > 0.5, num / den, np.nan)
 
 
+def nc_plane(d: npt.ArrayLike, sigma: float) -> tuple[F64, F64]:
+    """Local weighted least-squares plane ``a + b dx + c dy`` (three-box kernel): ``(a, rms)``.
+
+    ``rms`` is the weighted RMS residual of the values about the plane; a flat plane (the mean)
+    where the positions do not fix one; NaN where no value is within reach.
+    """
+    dd = np.asarray(d, np.float64)
+    h, w = dd.shape
+    m = np.isfinite(dd)
+    v = np.where(m, dd, 0.0)
+    u = np.arange(w, dtype=np.float64)[None, :] - (w - 1) / 2.0
+    t = np.arange(h, dtype=np.float64)[:, None] - (h - 1) / 2.0
+    u, t = np.broadcast_to(u, dd.shape), np.broadcast_to(t, dd.shape)
+    b = box3_radius(sigma)
+    mf = m.astype(np.float64)
+    s = [box3(mf * q, b) for q in (1.0, u, t, u * u, u * t, t * t, v, u * v, t * v, v * v)]
+    m0 = s[0]
+    mu, mv = s[1] - u * m0, s[2] - t * m0
+    muu = s[3] - 2 * u * s[1] + u * u * m0
+    muv = s[4] - u * s[2] - t * s[1] + u * t * m0
+    mvv = s[5] - 2 * t * s[2] + t * t * m0
+    md, mud, mvd, mdd = s[6], s[7] - u * s[6], s[8] - t * s[6], s[9]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        det = m0 * (muu * mvv - muv**2) - mu * (mu * mvv - muv * mv) + mv * (mu * muv - muu * mv)
+        full = det > 1e-9 * m0 * np.maximum(muu * mvv, 1e-300)
+        dets = np.where(full, det, 1.0)
+        a = md * (muu * mvv - muv**2) - mu * (mud * mvv - muv * mvd) + mv * (mud * muv - muu * mvd)
+        bb = m0 * (mud * mvv - muv * mvd) - md * (mu * mvv - muv * mv) + mv * (mu * mvd - mud * mv)
+        c = m0 * (muu * mvd - mud * muv) - mu * (mu * mvd - mud * mv) + md * (mu * muv - muu * mv)
+        a, bb, c = a / dets, bb / dets, c / dets
+        flat = md / m0
+        plane = np.where(full, a, flat)
+        fit = np.where(full, a * md + bb * mud + c * mvd, flat * md)
+        rms = np.sqrt(np.maximum((mdd - fit) / m0, 0.0))
+    ok = m0 > 0.5
+    return np.where(ok, plane, np.nan), np.where(ok, rms, np.nan)
+
+
 def cubic_warp(right: F64, t: F64) -> F64:
     """Catmull-Rom samples of each row of ``right`` at the real columns ``t`` (clamped)."""
     h, w = right.shape
@@ -130,8 +168,10 @@ def refine_disparity(
     fill_search: int = 2,
     fill_step: float = 1.0,
     var_floor: float = 1e-6,
-    fills: tuple[tuple[float, float], ...] = ((16.0, 0.3), (16.0, 0.3)),
+    fills: tuple[tuple[float, float], ...] = ((16.0, 0.3),),
     fill_confidence: float = 0.25,
+    fill_plane: bool = True,
+    fill_max_residual: float = np.inf,
 ) -> tuple[F64, F64, int]:
     """``(disparity, confidence, n_filled)`` as ``refine_disparity`` in Rust."""
     lf = np.asarray(left, np.float64)
@@ -161,7 +201,11 @@ def refine_disparity(
     oconf = np.where(keep, cf, 0.0)
     filled = 0
     for sigma, min_score in fills:
-        base = nc_smooth(out, sigma)
+        if fill_plane:
+            base, resid = nc_plane(out, sigma)
+            base = np.where(resid < fill_max_residual, base, np.nan)
+        else:
+            base = nc_smooth(out, sigma)
         z = stack(base, fill_search, fill_step)
         k, zk, ok = peaks(z, fill_search)
         ok &= (k >= 1) & (k <= 2 * fill_search - 1)  # a vertex needs both neighbours

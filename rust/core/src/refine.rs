@@ -57,6 +57,11 @@ pub struct RefineParams {
     pub fills: Vec<FillPass>,
     /// Confidence given to a filled pixel (its input confidence is 0).
     pub fill_confidence: f32,
+    /// A fill starts from the local plane fit of the map so far ([`nc_plane`]) rather than its
+    /// local mean, and only where the values around it lie within this RMS distance of that
+    /// plane (px; infinite = no test): one surface, not a depth edge or foliage.
+    pub fill_plane: bool,
+    pub fill_max_residual: f32,
 }
 
 impl Default for RefineParams {
@@ -70,14 +75,13 @@ impl Default for RefineParams {
             fill_search: 2,
             fill_step: 1.0,
             var_floor: 1e-6,
-            fills: vec![
-                FillPass {
-                    sigma: 16.0,
-                    min_score: 0.3,
-                };
-                2
-            ],
+            fills: vec![FillPass {
+                sigma: 16.0,
+                min_score: 0.3,
+            }],
             fill_confidence: 0.25,
+            fill_plane: true,
+            fill_max_residual: f32::INFINITY,
         }
     }
 }
@@ -109,6 +113,15 @@ impl RefineParams {
                     format!("must be in 1..=16, got {v}"),
                 ));
             }
+        }
+        if self.fill_max_residual.is_nan() || self.fill_max_residual <= 0.0 {
+            return Err(CoreError::param(
+                "fill_max_residual",
+                format!(
+                    "must be > 0 (inf = no test), got {}",
+                    self.fill_max_residual
+                ),
+            ));
         }
         if !(0.0..=1.0).contains(&self.fill_confidence) {
             return Err(CoreError::param(
@@ -145,57 +158,85 @@ pub fn box3_radius(sigma: f32) -> usize {
         .max(1.0) as usize
 }
 
+/// A sample type of the box sums: `f32` maps, `f64` moments (running sums are always f64).
+pub trait BoxSample: Copy + Default + Send + Sync {
+    fn to64(self) -> f64;
+    fn from64(v: f64) -> Self;
+}
+
+impl BoxSample for f32 {
+    #[inline]
+    fn to64(self) -> f64 {
+        self as f64
+    }
+    #[inline]
+    fn from64(v: f64) -> Self {
+        v as f32
+    }
+}
+
+impl BoxSample for f64 {
+    #[inline]
+    fn to64(self) -> f64 {
+        self
+    }
+    #[inline]
+    fn from64(v: f64) -> Self {
+        v
+    }
+}
+
 /// Box sum of half-width `b` along a row with zero padding, by a running sum (O(1) a pixel).
-fn box_row(src: &[f32], dst: &mut [f32], b: usize) {
+fn box_row<T: BoxSample>(src: &[T], dst: &mut [T], b: usize) {
     let n = src.len();
     let mut acc = 0f64; // f64: the running sum must not drift along a long row
     for v in src.iter().take(b.min(n)) {
-        acc += *v as f64;
+        acc += v.to64();
     }
     for x in 0..n {
         if x + b < n {
-            acc += src[x + b] as f64;
+            acc += src[x + b].to64();
         }
         if x > b {
-            acc -= src[x - b - 1] as f64;
+            acc -= src[x - b - 1].to64();
         }
-        dst[x] = acc as f32;
+        dst[x] = T::from64(acc);
     }
 }
 
 /// Box sum of half-width `b` down the columns (zero padding): a running sum per column, whole
 /// rows at a time (vectorised over x).
-fn box_cols(src: &[f32], dst: &mut [f32], w: usize, h: usize, b: usize) {
+fn box_cols<T: BoxSample>(src: &[T], dst: &mut [T], w: usize, h: usize, b: usize) {
     let mut acc = vec![0f64; w];
     let row = |y: usize| &src[y * w..(y + 1) * w];
     for y in 0..b.min(h) {
         for (a, &v) in acc.iter_mut().zip(row(y)) {
-            *a += v as f64;
+            *a += v.to64();
         }
     }
     for y in 0..h {
         if y + b < h {
             for (a, &v) in acc.iter_mut().zip(row(y + b)) {
-                *a += v as f64;
+                *a += v.to64();
             }
         }
         if y > b {
             for (a, &v) in acc.iter_mut().zip(row(y - b - 1)) {
-                *a -= v as f64;
+                *a -= v.to64();
             }
         }
         for (d, &a) in dst[y * w..(y + 1) * w].iter_mut().zip(&acc) {
-            *d = a as f32;
+            *d = T::from64(a);
         }
     }
 }
 
 /// Three box passes of half-width `b` along x, then three along y (zero padding): a
 /// Gaussian-like smoothing whose cost does not grow with its width.
-pub fn box3_zero(a: &[f32], w: usize, h: usize, b: usize) -> Vec<f32> {
+pub fn box3_zero<T: BoxSample>(a: &[T], w: usize, h: usize, b: usize) -> Vec<T> {
     let mut rows = a.to_vec();
     for_each_row(&mut rows, w, |_, row| {
-        let mut tmp = vec![0f32; row.len()];
+        let mut tmp = vec![T::default(); row.len()];
         for _ in 0..3 {
             box_row(row, &mut tmp, b);
             row.copy_from_slice(&tmp);
@@ -203,18 +244,18 @@ pub fn box3_zero(a: &[f32], w: usize, h: usize, b: usize) -> Vec<f32> {
     });
     // Columns in parallel strips of 64 (each strip's running sums are independent).
     const STRIP: usize = 64;
-    let mut out = vec![0f32; w * h];
+    let mut out = vec![T::default(); w * h];
     let strips: Vec<usize> = (0..w).step_by(STRIP).collect();
-    let done: Vec<(usize, Vec<f32>)> = {
+    let done: Vec<(usize, Vec<T>)> = {
         use rayon::prelude::*;
         strips
             .par_iter()
             .map(|&x0| {
                 let sw = STRIP.min(w - x0);
-                let mut cur: Vec<f32> = (0..h)
+                let mut cur: Vec<T> = (0..h)
                     .flat_map(|y| rows[y * w + x0..y * w + x0 + sw].iter().copied())
                     .collect();
-                let mut tmp = vec![0f32; sw * h];
+                let mut tmp = vec![T::default(); sw * h];
                 for _ in 0..3 {
                     box_cols(&cur, &mut tmp, sw, h, b);
                     std::mem::swap(&mut cur, &mut tmp);
@@ -230,6 +271,87 @@ pub fn box3_zero(a: &[f32], w: usize, h: usize, b: usize) -> Vec<f32> {
         }
     }
     out
+}
+
+/// Local plane fit of a map with holes (first-order normalised convolution with the three-box
+/// kernel of [`box3_radius`]): at each pixel, the weighted least-squares plane
+/// `d = a + b dx + c dy` through the values around it. Returns the plane's value `a` there and
+/// the weighted RMS residual of the values about the plane (px): how far the neighbourhood is
+/// from one surface (a slanted road fits; a depth edge or foliage does not). Where the
+/// neighbourhood's positions do not fix a plane (fewer than three, or all on a line) the plane
+/// is flat (the mean). NaN where no value lies within reach. Moments in f64, about the image
+/// centre.
+pub fn nc_plane(d: &[f32], w: usize, h: usize, sigma: f32) -> (Vec<f32>, Vec<f32>) {
+    let b = box3_radius(sigma);
+    let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
+    let n = w * h;
+    // m, m u, m v, m u^2, m u v, m v^2, m d, m u d, m v d, m d^2
+    let mut maps: Vec<Vec<f64>> = vec![vec![0f64; n]; 10];
+    for (i, &v) in d.iter().enumerate() {
+        if !v.is_finite() {
+            continue;
+        }
+        let (u, vv, dd) = ((i % w) as f64 - cx, (i / w) as f64 - cy, v as f64);
+        for (k, val) in [
+            1.0,
+            u,
+            vv,
+            u * u,
+            u * vv,
+            vv * vv,
+            dd,
+            u * dd,
+            vv * dd,
+            dd * dd,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            maps[k][i] = val;
+        }
+    }
+    let s: Vec<Vec<f64>> = maps.iter().map(|m| box3_zero(m, w, h, b)).collect();
+    let mut plane = vec![f32::NAN; n];
+    let mut resid = vec![f32::NAN; n];
+    for i in 0..n {
+        let m0 = s[0][i];
+        if m0 <= 0.5 {
+            continue;
+        }
+        let (up, vp) = ((i % w) as f64 - cx, (i / w) as f64 - cy);
+        // Moments about the pixel itself.
+        let mu = s[1][i] - up * m0;
+        let mv = s[2][i] - vp * m0;
+        let muu = s[3][i] - 2.0 * up * s[1][i] + up * up * m0;
+        let muv = s[4][i] - up * s[2][i] - vp * s[1][i] + up * vp * m0;
+        let mvv = s[5][i] - 2.0 * vp * s[2][i] + vp * vp * m0;
+        let md = s[6][i];
+        let mud = s[7][i] - up * md;
+        let mvd = s[8][i] - vp * md;
+        let mdd = s[9][i];
+        // Solve [m0 mu mv; mu muu muv; mv muv mvv] (a b c) = (md mud mvd) by Cramer's rule.
+        let det =
+            m0 * (muu * mvv - muv * muv) - mu * (mu * mvv - muv * mv) + mv * (mu * muv - muu * mv);
+        let scale = m0 * (muu * mvv).max(1e-300);
+        let (a, fit) = if det > 1e-9 * scale {
+            let a = (md * (muu * mvv - muv * muv) - mu * (mud * mvv - muv * mvd)
+                + mv * (mud * muv - muu * mvd))
+                / det;
+            let bb = (m0 * (mud * mvv - muv * mvd) - md * (mu * mvv - muv * mv)
+                + mv * (mu * mvd - mud * mv))
+                / det;
+            let c = (m0 * (muu * mvd - mud * muv) - mu * (mu * mvd - mud * mv)
+                + md * (mu * muv - muu * mv))
+                / det;
+            (a, a * md + bb * mud + c * mvd)
+        } else {
+            let a = md / m0;
+            (a, a * md)
+        };
+        plane[i] = a as f32;
+        resid[i] = ((mdd - fit) / m0).max(0.0).sqrt() as f32;
+    }
+    (plane, resid)
 }
 
 /// Normalised-convolution smoothing of a map with holes (NaN): `K*(v m) / K*m` with the
@@ -714,7 +836,12 @@ pub fn refine_disparity(
     // Fill passes: holes near measured pixels, accepted on a clear correlation peak.
     let mut filled = 0usize;
     for f in &p.fills {
-        let base = nc_smooth(&out, w, h, f.sigma);
+        let (base, resid) = if p.fill_plane {
+            nc_plane(&out, w, h, f.sigma)
+        } else {
+            (nc_smooth(&out, w, h, f.sigma), Vec::new())
+        };
+        let planar = |i: usize| !p.fill_plane || resid[i] < p.fill_max_residual;
         let before = out.clone();
         stage(
             &ls,
@@ -726,7 +853,7 @@ pub fn refine_disparity(
             w,
             h,
             &mut out,
-            |i| !before[i].is_finite() && base[i].is_finite(),
+            |i| !before[i].is_finite() && base[i].is_finite() && planar(i),
             |i, z| {
                 let (k, zk) = peak(z)?;
                 // Within one shift of the start, and not at either end (a vertex needs both
@@ -849,6 +976,33 @@ mod tests {
         };
         let ones = vec![1f32; 48 * 32];
         assert!(refine_disparity(lv, rv, &holes, &ones, 0.0, 16.0, &p).is_ok());
+    }
+
+    #[test]
+    fn plane_fit_is_exact_on_a_slanted_plane_with_holes() {
+        let (w, h) = (40, 30);
+        let mut d: Vec<f32> = (0..w * h)
+            .map(|i| 3.0 + 0.25 * (i % w) as f32 - 0.4 * (i / w) as f32)
+            .collect();
+        for i in (0..w * h).filter(|i| (i * 7) % 5 == 0) {
+            d[i] = f32::NAN;
+        }
+        let (plane, resid) = nc_plane(&d, w, h, 4.0);
+        for i in 0..w * h {
+            let exact = 3.0 + 0.25 * (i % w) as f32 - 0.4 * (i / w) as f32;
+            assert!(
+                (plane[i] - exact).abs() < 1e-3,
+                "{i}: {} vs {exact}",
+                plane[i]
+            );
+            assert!(resid[i] < 1e-2, "{i}: residual {}", resid[i]);
+        }
+        // A step is not a plane: the residual says so at the edge.
+        let step: Vec<f32> = (0..w * h)
+            .map(|i| if i % w < 20 { 5.0 } else { 15.0 })
+            .collect();
+        let (_, r) = nc_plane(&step, w, h, 4.0);
+        assert!(r[15 * w + 20] > 2.0 && r[15 * w + 2] < 1e-3);
     }
 
     #[test]

@@ -14,7 +14,7 @@ type Refined<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>, usize
 /// Refined disparity, its confidence and the number of filled pixels (module docs of the core).
 #[pyfunction]
 #[pyo3(signature = (left, right, disp, conf, d_min, d_max, base_sigma, win_sigma, win_radius,
-                    search, step, fill_search, fill_step, var_floor, fills, fill_confidence))]
+                    search, step, fill_search, fill_step, var_floor, fills, fill_confidence, fill_plane, fill_max_residual))]
 #[allow(clippy::too_many_arguments)]
 pub fn refine_disparity<'py>(
     py: Python<'py>,
@@ -34,6 +34,8 @@ pub fn refine_disparity<'py>(
     var_floor: f32,
     fills: Vec<(f32, f32)>,
     fill_confidence: f32,
+    fill_plane: bool,
+    fill_max_residual: f32,
 ) -> PyResult<Refined<'py>> {
     let l = grey_from_numpy(&left, "left")?;
     let r = grey_from_numpy(&right, "right")?;
@@ -67,6 +69,8 @@ pub fn refine_disparity<'py>(
             .map(|(sigma, min_score)| FillPass { sigma, min_score })
             .collect(),
         fill_confidence,
+        fill_plane,
+        fill_max_residual,
     };
     let (lv, rv) = (l.view(), r.view());
     let (out, oc, filled) = py.detach(|| {
