@@ -43,10 +43,10 @@ _DISPARITY_STEP = 16  # ranges are multiples of 16, like the evaluation protocol
 # 0.55, 0.23 at 0.95.
 _SIGMA_RAW = (0.74, -0.52, 0.2)
 # After the refinement (the default; 3.1 M pixels): 0.34 px at confidence 0.18, 0.30 at 0.52,
-# 0.20 at 0.86; the pixels it filled (14 % of them) spread by 0.67 px, whatever their neighbours'
+# 0.20 at 0.86; the pixels it filled (13 % of them) spread by 0.63 px, whatever their neighbours'
 # confidence.
 _SIGMA_REFINED = (0.405, -0.221, 0.18)
-_SIGMA_FILLED = 0.67
+_SIGMA_FILLED = 0.63
 
 
 def _round_up(value: float, step: int = _DISPARITY_STEP) -> int:
@@ -185,7 +185,7 @@ def disparity_sigma(
     confidence bin, measured on the 17 shared GT scenes; ``0.405 - 0.221 conf`` (at least
     0.18 px) for the refined map :func:`depth_map` gives by default, ``0.74 - 0.52 conf`` (at
     least 0.2 px) for the Gabor channel as it comes (``refine=False``). Pixels the refinement
-    filled have a spread of their own: 0.67 px.
+    filled have a spread of their own: 0.63 px.
 
     Parameters
     ----------

@@ -282,76 +282,97 @@ pub fn box3_zero<T: BoxSample>(a: &[T], w: usize, h: usize, b: usize) -> Vec<T> 
 /// is flat (the mean). NaN where no value lies within reach. Moments in f64, about the image
 /// centre.
 pub fn nc_plane(d: &[f32], w: usize, h: usize, sigma: f32) -> (Vec<f32>, Vec<f32>) {
+    use rayon::prelude::*;
     let b = box3_radius(sigma);
     let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
     let n = w * h;
-    // m, m u, m v, m u^2, m u v, m v^2, m d, m u d, m v d, m d^2
-    let mut maps: Vec<Vec<f64>> = vec![vec![0f64; n]; 10];
-    for (i, &v) in d.iter().enumerate() {
+    // m, m u, m v, m u^2, m u v, m v^2, m d, m u d, m v d, m d^2 (u, v about the image centre)
+    let moment = |k: usize, i: usize| -> f64 {
+        let v = d[i];
         if !v.is_finite() {
-            continue;
+            return 0.0;
         }
-        let (u, vv, dd) = ((i % w) as f64 - cx, (i / w) as f64 - cy, v as f64);
-        for (k, val) in [
-            1.0,
-            u,
-            vv,
-            u * u,
-            u * vv,
-            vv * vv,
-            dd,
-            u * dd,
-            vv * dd,
-            dd * dd,
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            maps[k][i] = val;
+        let (u, t, dd) = ((i % w) as f64 - cx, (i / w) as f64 - cy, v as f64);
+        match k {
+            0 => 1.0,
+            1 => u,
+            2 => t,
+            3 => u * u,
+            4 => u * t,
+            5 => t * t,
+            6 => dd,
+            7 => u * dd,
+            8 => t * dd,
+            _ => dd * dd,
         }
-    }
-    let s: Vec<Vec<f64>> = maps.iter().map(|m| box3_zero(m, w, h, b)).collect();
+    };
+    let s: Vec<Vec<f64>> = (0..10)
+        .map(|k| {
+            let mut m = vec![0f64; n];
+            for_each_row(&mut m, w, |y, row| {
+                for (x, v) in row.iter_mut().enumerate() {
+                    *v = moment(k, y * w + x);
+                }
+            });
+            box3_zero(&m, w, h, b)
+        })
+        .collect();
     let mut plane = vec![f32::NAN; n];
     let mut resid = vec![f32::NAN; n];
-    for i in 0..n {
-        let m0 = s[0][i];
-        if m0 <= 0.5 {
-            continue;
-        }
-        let (up, vp) = ((i % w) as f64 - cx, (i / w) as f64 - cy);
-        // Moments about the pixel itself.
-        let mu = s[1][i] - up * m0;
-        let mv = s[2][i] - vp * m0;
-        let muu = s[3][i] - 2.0 * up * s[1][i] + up * up * m0;
-        let muv = s[4][i] - up * s[2][i] - vp * s[1][i] + up * vp * m0;
-        let mvv = s[5][i] - 2.0 * vp * s[2][i] + vp * vp * m0;
-        let md = s[6][i];
-        let mud = s[7][i] - up * md;
-        let mvd = s[8][i] - vp * md;
-        let mdd = s[9][i];
-        // Solve [m0 mu mv; mu muu muv; mv muv mvv] (a b c) = (md mud mvd) by Cramer's rule.
-        let det =
-            m0 * (muu * mvv - muv * muv) - mu * (mu * mvv - muv * mv) + mv * (mu * muv - muu * mv);
-        let scale = m0 * (muu * mvv).max(1e-300);
-        let (a, fit) = if det > 1e-9 * scale {
-            let a = (md * (muu * mvv - muv * muv) - mu * (mud * mvv - muv * mvd)
-                + mv * (mud * muv - muu * mvd))
-                / det;
-            let bb = (m0 * (mud * mvv - muv * mvd) - md * (mu * mvv - muv * mv)
-                + mv * (mu * mvd - mud * mv))
-                / det;
-            let c = (m0 * (muu * mvd - mud * muv) - mu * (mu * mvd - mud * mv)
-                + md * (mu * muv - muu * mv))
-                / det;
-            (a, a * md + bb * mud + c * mvd)
-        } else {
-            let a = md / m0;
-            (a, a * md)
-        };
-        plane[i] = a as f32;
-        resid[i] = ((mdd - fit) / m0).max(0.0).sqrt() as f32;
-    }
+    plane
+        .par_chunks_mut(w)
+        .zip(resid.par_chunks_mut(w))
+        .enumerate()
+        .for_each(|(y, (prow, rrow))| {
+            for x in 0..w {
+                let i = y * w + x;
+                if let Some((a, r)) = plane_at(&s, i, x as f64 - cx, y as f64 - cy) {
+                    prow[x] = a as f32;
+                    rrow[x] = r as f32;
+                }
+            }
+        });
     (plane, resid)
+}
+
+/// The plane's value and RMS residual at pixel `i` (at `(up, vp)` about the image centre) from
+/// the ten box-summed moments of [`nc_plane`]; None where no value is within reach.
+#[inline]
+fn plane_at(s: &[Vec<f64>], i: usize, up: f64, vp: f64) -> Option<(f64, f64)> {
+    let m0 = s[0][i];
+    if m0 <= 0.5 {
+        return None;
+    }
+    // Moments about the pixel itself.
+    let mu = s[1][i] - up * m0;
+    let mv = s[2][i] - vp * m0;
+    let muu = s[3][i] - 2.0 * up * s[1][i] + up * up * m0;
+    let muv = s[4][i] - up * s[2][i] - vp * s[1][i] + up * vp * m0;
+    let mvv = s[5][i] - 2.0 * vp * s[2][i] + vp * vp * m0;
+    let md = s[6][i];
+    let mud = s[7][i] - up * md;
+    let mvd = s[8][i] - vp * md;
+    let mdd = s[9][i];
+    // Solve [m0 mu mv; mu muu muv; mv muv mvv] (a b c) = (md mud mvd) by Cramer's rule.
+    let det =
+        m0 * (muu * mvv - muv * muv) - mu * (mu * mvv - muv * mv) + mv * (mu * muv - muu * mv);
+    let scale = m0 * (muu * mvv).max(1e-300);
+    let (a, fit) = if det > 1e-9 * scale {
+        let a = (md * (muu * mvv - muv * muv) - mu * (mud * mvv - muv * mvd)
+            + mv * (mud * muv - muu * mvd))
+            / det;
+        let bb = (m0 * (mud * mvv - muv * mvd) - md * (mu * mvv - muv * mv)
+            + mv * (mu * mvd - mud * mv))
+            / det;
+        let c = (m0 * (muu * mvd - mud * muv) - mu * (mu * mvd - mud * mv)
+            + md * (mu * muv - muu * mv))
+            / det;
+        (a, a * md + bb * mud + c * mvd)
+    } else {
+        let a = md / m0;
+        (a, a * md)
+    };
+    Some((a, ((mdd - fit) / m0).max(0.0).sqrt()))
 }
 
 /// Normalised-convolution smoothing of a map with holes (NaN): `K*(v m) / K*m` with the
