@@ -44,6 +44,9 @@ DEFAULTS = {
     "centre_tol": 0.05,
     "rescue_min": 3,
     "rescue_med": 0.75,
+    "fallback": True,
+    "fallback_alt_support": 2.0,
+    "fallback_min_support": 0.5,
     "min_agree": 8,
     "agree_tol": 1,
     "agree_share": 0.8,
@@ -320,6 +323,37 @@ def run_dynamics(
     return v, trace
 
 
+def _fallback(neurons: list[dict], rows: list[list[tuple[int, float]]], v: np.ndarray, p: dict):
+    """Final selection's fallback: a point without an active candidate gets its best one back
+    when an active alternative has support < fallback_alt_support (or, with none active, the
+    best has support >= fallback_min_support) and no other point's active neuron holds the
+    right pixel. Support = sum of the positive weights from active neurons."""
+    if not p["fallback"]:
+        return v
+    out = v.copy()
+    support = [sum(t for b, t in row if t > 0 and v[b] == 1) for row in rows]
+    held: dict[tuple[int, int], set[int]] = {}
+    for a in np.nonzero(v)[0].tolist():
+        held.setdefault((neurons[a]["xr"], neurons[a]["yr"]), set()).add(neurons[a]["point"])
+    groups: dict[int, list[int]] = {}
+    for a, n in enumerate(neurons):
+        groups.setdefault(n["point"], []).append(a)
+    for q, g in groups.items():
+        a = g[0]  # best ZNCC first
+        if v[a]:
+            continue
+        alt = [support[b] for b in g[1:] if v[b]]
+        weak = (
+            max(alt) < float(np.float32(p["fallback_alt_support"]))
+            if alt
+            else support[a] >= float(np.float32(p["fallback_min_support"]))
+        )
+        free = held.get((neurons[a]["xr"], neurons[a]["yr"]), set()) <= {q}
+        if weak and free:
+            out[a] = 1
+    return out
+
+
 def _rescue(neurons: list[dict], chosen: list[int], p: dict) -> list[int]:
     """Edge-test survivors of ``chosen`` with the side rescue iterated to a fixed point: a match
     failing only half-window tests is accepted when, for every failing half (bit k: left,
@@ -431,6 +465,7 @@ def hopfield_match(
     )
     init = np.array([n["sim"] >= p["s_init"] for n in neurons], dtype=np.int8)
     v, trace = run_dynamics(rows, inp, init, int(p["seed"]), int(p["max_sweeps"]))
+    v = _fallback(neurons, rows, v, p)
     best: dict[int, int] = {}
     for a in np.nonzero(v)[0].tolist():
         q = neurons[a]["point"]

@@ -62,6 +62,9 @@ DEFAULTS: dict[str, Any] = {
     "centre_tol": 0.05,  # centre grey-level difference (C.10)
     "rescue_min": 3,  # side rescue: >= 3 accepted matches on a failing half's side, all agreeing
     "rescue_med": 0.75,  # ... and their median within 0.75 px of the match (0 rescue_min = off)
+    "fallback": True,  # final selection: weakly dropped points keep their best candidate ...
+    "fallback_alt_support": 2.0,  # ... if an active alternative has support below this
+    "fallback_min_support": 0.5,  # ... or (no active alternative) it has support >= this
     "min_agree": 8,  # agreeing neighbour matches in the 40x40 window (C.10)
     "agree_tol": 1,  # neighbours agree within +-1 px
     "agree_share": 0.8,  # sparse areas: this share of the (< 8) neighbour matches agrees ...
@@ -215,7 +218,8 @@ def hopfield_match(
         ``compat_slope`` (1/px), ``compat_grad`` (px per px), ``s_init``, ``max_sweeps``,
         ``seed``, ``tau_y`` (px), ``edge_test``, ``edge_tol`` (px), ``edge_margin`` (ZNCC),
         ``edge_penalty``, ``centre_tol`` (window-mean-free grey levels in [0, 1]),
-        ``rescue_min``, ``rescue_med`` (px), ``min_agree``, ``agree_tol`` (px),
+        ``rescue_min``, ``rescue_med`` (px), ``fallback``, ``fallback_alt_support``,
+        ``fallback_min_support``, ``min_agree``, ``agree_tol`` (px),
         ``agree_share``, ``min_agree_sparse``, ``subpixel``.
 
     Returns

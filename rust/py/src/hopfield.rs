@@ -17,7 +17,10 @@ use crate::convert::{image_from_numpy, image_to_numpy};
 use crate::errors::guard;
 use crate::params::{check_keys, get};
 
-const KEYS: [&str; 36] = [
+const KEYS: [&str; 39] = [
+    "fallback",
+    "fallback_alt_support",
+    "fallback_min_support",
     "compat_grad",
     "rescue_min",
     "rescue_med",
@@ -97,6 +100,9 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
     get(d, "edge_margin", &mut p.edge_margin)?;
     get(d, "edge_penalty", &mut p.edge_penalty)?;
     get(d, "centre_tol", &mut p.centre_tol)?;
+    get(d, "fallback", &mut p.fallback)?;
+    get(d, "fallback_alt_support", &mut p.fallback_alt_support)?;
+    get(d, "fallback_min_support", &mut p.fallback_min_support)?;
     get(d, "rescue_min", &mut p.rescue_min)?;
     get(d, "rescue_med", &mut p.rescue_med)?;
     get(d, "min_agree", &mut p.min_agree)?;

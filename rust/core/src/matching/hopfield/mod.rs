@@ -88,6 +88,18 @@ pub struct HopfieldParams {
     pub rescue_min: usize,
     /// Largest distance (px) between a rescued match and the median of its side's matches.
     pub rescue_med: f32,
+    /// Final selection: a point the network leaves without an active candidate falls back to
+    /// its best candidate when the network's reason is weak and the right pixel is free (no
+    /// active neuron of another point holds it). Weak: an active alternative candidate of the
+    /// point has support (positive weights from active neurons) below `fallback_alt_support`,
+    /// or, with no active alternative, the best candidate itself has support of at least
+    /// `fallback_min_support`. Correct matches on a minority surface or on a slanted one are
+    /// switched off by the inhibition of the dominant surface; they keep some support.
+    pub fallback: bool,
+    /// See [`HopfieldParams::fallback`] (2.0).
+    pub fallback_alt_support: f32,
+    /// See [`HopfieldParams::fallback`] (0.5).
+    pub fallback_min_support: f32,
     /// Agreeing neighbour matches required in the 40x40 window (C.10: 8).
     pub min_agree: usize,
     /// Sparse-area alternative to `min_agree`: this share of the neighbour matches agrees
@@ -124,6 +136,9 @@ impl Default for HopfieldParams {
             centre_tol: 0.05,
             rescue_min: 3,
             rescue_med: 0.75,
+            fallback: true,
+            fallback_alt_support: 2.0,
+            fallback_min_support: 0.5,
             min_agree: 8,
             agree_tol: 1,
             agree_share: 0.8,
@@ -205,6 +220,8 @@ fn validate(left: &Image, right: &Image, p: &HopfieldParams) -> Result<()> {
         ("centre_tol", p.centre_tol),
         ("compat_grad", w.compat_grad),
         ("rescue_med", p.rescue_med),
+        ("fallback_alt_support", p.fallback_alt_support),
+        ("fallback_min_support", p.fallback_min_support),
         ("edge_penalty", p.edge_penalty),
     ] {
         if !v.is_finite() {
@@ -570,6 +587,64 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
     }
 }
 
+/// The final selection's fallback to the best candidate (see [`HopfieldParams::fallback`]):
+/// the network's state with the best candidate of some points switched on.
+fn fallback(neurons: &[Neuron], csr: &Csr, state: &[u8], p: &HopfieldParams) -> Vec<u8> {
+    let mut out = state.to_vec();
+    if !p.fallback {
+        return out;
+    }
+    // Support of every neuron: its positive (compatibility) weights from active neurons, summed
+    // in row order in f64.
+    let support: Vec<f64> = (0..neurons.len())
+        .into_par_iter()
+        .map(|a| {
+            let (idx, val) = csr.row(a);
+            idx.iter()
+                .zip(val)
+                .filter(|&(&b, &t)| t > 0.0 && state[b as usize] == 1)
+                .map(|(_, &t)| t as f64)
+                .sum()
+        })
+        .collect();
+    // Right pixels held by an active neuron: (yr, xr) -> its left point (u32::MAX: several).
+    let mut held: HashMap<(i32, i32), u32> = HashMap::new();
+    for (n, _) in neurons.iter().zip(state).filter(|&(_, &v)| v == 1) {
+        held.entry((n.yr, n.xr))
+            .and_modify(|q| {
+                if *q != n.point {
+                    *q = u32::MAX
+                }
+            })
+            .or_insert(n.point);
+    }
+    let mut a = 0;
+    while a < neurons.len() {
+        let mut e = a;
+        while e < neurons.len() && neurons[e].point == neurons[a].point {
+            e += 1;
+        }
+        // Neurons a..e: one point, best ZNCC first.
+        if state[a] == 0 {
+            let alt = (a + 1..e)
+                .filter(|&b| state[b] == 1)
+                .map(|b| support[b])
+                .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))));
+            let weak = match alt {
+                Some(s) => s < p.fallback_alt_support as f64,
+                None => support[a] >= p.fallback_min_support as f64,
+            };
+            let n = &neurons[a];
+            let free = held.get(&(n.yr, n.xr)).is_none_or(|&q| q == n.point);
+            if weak && free {
+                out[a] = 1;
+            }
+        }
+        a = e;
+    }
+    out
+}
+
 /// Depth-edge filters and sub-pixel refinement of the selected neurons.
 fn finish(
     left: &Image,
@@ -677,7 +752,8 @@ pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result
         .map(|n| u8::from(n.sim >= p.s_init))
         .collect();
     let dynamics = run_dynamics(&csr, &input, &init, p.seed, p.max_sweeps);
-    let chosen = disambiguate(&neurons, &dynamics.state, p);
+    let selected = fallback(&neurons, &csr, &dynamics.state, p);
+    let chosen = disambiguate(&neurons, &selected, p);
     let matches = finish(left, right, &neurons, &chosen, p);
     Ok(HopfieldOutput {
         matches,
