@@ -535,6 +535,9 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
         .collect();
     let half = p.weights.nbr_half.max(1);
     let mut side: Vec<f32> = Vec::new();
+    // Points accepted in the previous round: a candidate with none of them in its window
+    // sees the same side sets as before and keeps its verdict.
+    let mut fresh: Option<network::PointGrid> = None;
     loop {
         let acc: Vec<usize> = (0..chosen.len())
             .filter(|&c| ok[c])
@@ -552,6 +555,13 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
             }
             let n = &neurons[chosen[c]];
             let (x, y, d) = (n.xl.max(0), n.yl.max(0), n.dx());
+            if let Some(g) = &fresh {
+                let mut near = false;
+                g.for_each_in_window((x, y), half, |_| near = true);
+                if !near {
+                    continue;
+                }
+            }
             let dsub = d as f32 + n.sub;
             let pass = (0..4).filter(|k| n.halves_fail >> k & 1 == 1).all(|k| {
                 side.clear();
@@ -581,6 +591,11 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
         if added.is_empty() {
             return ok;
         }
+        let nxy: Vec<(i32, i32)> = added
+            .iter()
+            .map(|&c| (neurons[chosen[c]].xl.max(0), neurons[chosen[c]].yl.max(0)))
+            .collect();
+        fresh = Some(network::PointGrid::new(&nxy, half));
         for c in added {
             ok[c] = true;
         }
@@ -594,17 +609,40 @@ fn fallback(neurons: &[Neuron], csr: &Csr, state: &[u8], p: &HopfieldParams) -> 
     if !p.fallback {
         return out;
     }
-    // Support of every neuron: its positive (compatibility) weights from active neurons, summed
-    // in row order in f64.
-    let support: Vec<f64> = (0..neurons.len())
-        .into_par_iter()
-        .map(|a| {
-            let (idx, val) = csr.row(a);
-            idx.iter()
-                .zip(val)
-                .filter(|&(&b, &t)| t > 0.0 && state[b as usize] == 1)
-                .map(|(_, &t)| t as f64)
-                .sum()
+    // Groups of neurons per point (best ZNCC first) whose best candidate is off.
+    let mut groups: Vec<(usize, usize)> = Vec::new();
+    let mut a = 0;
+    while a < neurons.len() {
+        let mut e = a;
+        while e < neurons.len() && neurons[e].point == neurons[a].point {
+            e += 1;
+        }
+        if state[a] == 0 {
+            groups.push((a, e));
+        }
+        a = e;
+    }
+    // Support (positive weights from active neurons, summed in row order in f64) of the
+    // neurons the rule reads: the active alternatives, else the best candidate.
+    let support_of = |a: usize| -> f64 {
+        let (idx, val) = csr.row(a);
+        idx.iter()
+            .zip(val)
+            .filter(|&(&b, &t)| t > 0.0 && state[b as usize] == 1)
+            .map(|(_, &t)| t as f64)
+            .sum()
+    };
+    let weak: Vec<bool> = groups
+        .par_iter()
+        .map(|&(a, e)| {
+            let alt = (a + 1..e)
+                .filter(|&b| state[b] == 1)
+                .map(support_of)
+                .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))));
+            match alt {
+                Some(s) => s < p.fallback_alt_support as f64,
+                None => support_of(a) >= p.fallback_min_support as f64,
+            }
         })
         .collect();
     // Right pixels held by an active neuron: (yr, xr) -> its left point (u32::MAX: several).
@@ -618,29 +656,12 @@ fn fallback(neurons: &[Neuron], csr: &Csr, state: &[u8], p: &HopfieldParams) -> 
             })
             .or_insert(n.point);
     }
-    let mut a = 0;
-    while a < neurons.len() {
-        let mut e = a;
-        while e < neurons.len() && neurons[e].point == neurons[a].point {
-            e += 1;
+    for (&(a, _), &weak) in groups.iter().zip(&weak) {
+        let n = &neurons[a];
+        let free = held.get(&(n.yr, n.xr)).is_none_or(|&q| q == n.point);
+        if weak && free {
+            out[a] = 1;
         }
-        // Neurons a..e: one point, best ZNCC first.
-        if state[a] == 0 {
-            let alt = (a + 1..e)
-                .filter(|&b| state[b] == 1)
-                .map(|b| support[b])
-                .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))));
-            let weak = match alt {
-                Some(s) => s < p.fallback_alt_support as f64,
-                None => support[a] >= p.fallback_min_support as f64,
-            };
-            let n = &neurons[a];
-            let free = held.get(&(n.yr, n.xr)).is_none_or(|&q| q == n.point);
-            if weak && free {
-                out[a] = 1;
-            }
-        }
-        a = e;
     }
     out
 }
