@@ -3,9 +3,11 @@
 The kernel lives in ``rust/core/src/matching/hopfield``: Moravec interest points (squared
 differences, 3x3 non-maximum suppression, 0.1 % of the maximum), right candidates as 7x7 ZNCC
 peaks along the epipolar row (or the right image's interest points), a sparse binary Hopfield
-network over the candidate pairs (compatibility in the 40x40 window, uniqueness on both sides,
-similarity input) with asynchronous seeded sweeps until a sweep without a flip, C.5
-disambiguation, the C.10 depth-edge test and parabola sub-pixel refinement.
+network over the candidate pairs (compatibility in the 40x40 window growing with distance,
+uniqueness on both sides, similarity input) with asynchronous seeded sweeps until a sweep
+without a flip, a fallback to the best candidate where the network drops a point for a weak
+reason, C.5 disambiguation, the C.10 depth-edge test with the side rescue of half-window
+failures, and parabola sub-pixel refinement.
 
 :func:`best_match` is the same pipeline without the network (the best ZNCC candidate of every
 point): the reference the network is measured against.

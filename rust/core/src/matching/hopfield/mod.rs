@@ -6,12 +6,16 @@
 //!    (default, C.10), or the right image's interest points in the epipolar band (the paper's
 //!    point-to-point network, kept as a high-precision option). ZNCC `>= s_min`, best `k_cand`.
 //! 3. The sparse binary Hopfield network ([`network`]) over the candidates: compatibility in the
-//!    40x40 window, uniqueness on both sides, similarity input; asynchronous seeded sweeps until a
-//!    sweep without a flip.
-//! 4. Disambiguation of points left with several active candidates (C.5: local median of the
-//!    vertical disparity of single matches, tie-break on similarity, both sides).
-//! 5. Depth-edge filters (C.10): the four half-windows agree within +-1 px, centre grey-level
-//!    check, at least 8 agreeing neighbour matches; parabola sub-pixel refinement.
+//!    40x40 window (crossing 0 at `compat_theta + compat_grad * distance`), uniqueness on both
+//!    sides, similarity input minus `edge_penalty` for depth-edge failures; asynchronous seeded
+//!    sweeps until a sweep without a flip.
+//! 4. Final selection: points the network drops for a weak reason fall back to their best
+//!    candidate ([`HopfieldParams::fallback`]); disambiguation of points left with several
+//!    active candidates (C.5: local median of the vertical disparity of single matches,
+//!    tie-break on similarity, both sides).
+//! 5. Depth-edge filters (C.10): the four half-windows agree within +-1 px (or, failing that,
+//!    the side rescue of [`HopfieldParams::rescue_min`]), centre grey-level check, at least 8
+//!    agreeing neighbour matches; parabola sub-pixel refinement.
 //!
 //! [`best_match`] runs the same pipeline without the network (best ZNCC candidate per point):
 //! the reference the network has to beat.
