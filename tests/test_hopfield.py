@@ -268,7 +268,9 @@ def test_accuracy_on_real_scenes(scene: str, min_p1: float, min_count: int) -> N
     assert sm.precision[1.0] >= min_p1
     assert sm.count >= min_count
     assert sm.coverage == 16
-    assert sm.precision[0.5] >= sm.precision[1.0] - 10.0  # sub-pixel refinement works
+    # Sub-pixel refinement works. Tsukuba's GT is integer-valued and the side rescue keeps
+    # matches next to depth edges: 87.6 % @0.5 against 97.96 % @1 (margin 12 points).
+    assert sm.precision[0.5] >= sm.precision[1.0] - 12.0
     # The network is at least as precise as the best-match reference on the same points.
     assert sm.precision[1.0] >= sr.precision[1.0] - 0.2
 
@@ -278,3 +280,15 @@ def test_points_mode_is_precise() -> None:
     m = sv.match(sc.left, sc.right, max_disparity=sc.max_disparity, candidates="points")
     sm = sparse_metrics(m.xl, m.yl, m.xr, sc.gt)
     assert sm.count > 300 and sm.precision[1.0] >= 97.0
+
+
+def test_side_rescue_adds_matches_at_equal_precision() -> None:
+    # The side rescue of the half-window test (rescue_min) keeps matches whose failing half has
+    # only agreeing matches on its side: many more matches, precision within half a point.
+    sc = _scene("eth3d/terrace")
+    on = sv.match(sc.left, sc.right, max_disparity=sc.max_disparity)
+    off = sv.match(sc.left, sc.right, max_disparity=sc.max_disparity, rescue_min=0)
+    s_on = sparse_metrics(on.xl, on.yl, on.xr, sc.gt)
+    s_off = sparse_metrics(off.xl, off.yl, off.xr, sc.gt)
+    assert s_on.count >= 1.3 * s_off.count
+    assert s_on.precision[1.0] >= s_off.precision[1.0] - 0.5

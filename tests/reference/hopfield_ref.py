@@ -33,14 +33,20 @@ DEFAULTS = {
     "nbr_half": 20,
     "compat_theta": 2.0,
     "compat_slope": 2.0,
+    "compat_grad": 0.05,
     "s_init": 0.8,
     "max_sweeps": 100,
     "seed": 0,
     "edge_test": True,
     "edge_tol": 1,
     "edge_margin": 0.0,
-    "edge_penalty": 0.0,
+    "edge_penalty": 0.5,
     "centre_tol": 0.05,
+    "rescue_min": 3,
+    "rescue_med": 0.75,
+    "fallback": True,
+    "fallback_alt_support": 2.0,
+    "fallback_min_support": 0.5,
     "min_agree": 8,
     "agree_tol": 1,
     "agree_share": 0.8,
@@ -176,9 +182,10 @@ def candidates(left: np.ndarray, right: np.ndarray, d_min: int, d_max: int, p: d
             ok_hi = d == d_hi or c > full[d + 1]
             if c >= p["s_min"] and ok_lo and ok_hi:
                 lo, hi = max(d - p["edge_tol"], d_min), min(d + p["edge_tol"], d_hi)
-                halves_ok = all(
-                    b is not None and c[lo : hi + 1].max() >= c[b] - p["edge_margin"]
-                    for b, c in zip(best, curves[1:], strict=True)
+                halves_fail = sum(
+                    (0 if b is not None and c[lo : hi + 1].max() >= c[b] - p["edge_margin"] else 1)
+                    << k
+                    for k, (b, c) in enumerate(zip(best, curves[1:], strict=True))
                 )
                 lw = left[y - 3 : y + 4, x - 3 : x + 4].astype(np.float64)
                 rw = right[y - 3 : y + 4, x - d - 3 : x - d + 4].astype(np.float64)
@@ -198,7 +205,9 @@ def candidates(left: np.ndarray, right: np.ndarray, d_min: int, d_max: int, p: d
                         "xr": x - d,
                         "yr": y,
                         "sim": float(c),
-                        "edge_ok": halves_ok and centre_ok,
+                        "edge_ok": halves_fail == 0 and centre_ok,
+                        "halves_fail": halves_fail,
+                        "centre_ok": centre_ok,
                         "sub": sub,
                     }
                 )
@@ -240,15 +249,20 @@ def build_weights(neurons: list[dict], p: dict) -> list[list[tuple[int, float]]]
         q = na["point"]
         for r in nbrs[q]:
             norm = p["A"] / max(len(nbrs[q]), len(nbrs[r]), 1)
+            # The crossing grows with the Chebyshev distance of the two points (f32 parameters
+            # widened to f64, as in Rust).
+            cheb = max(abs(pxy[r][0] - pxy[q][0]), abs(pxy[r][1] - pxy[q][1]))
+            ctheta = (
+                float(np.float32(p["compat_theta"])) + float(np.float32(p["compat_grad"])) * cheb
+            )
             for b in members[r]:
                 nb = neurons[b]
                 if (nb["xr"], nb["yr"]) == (na["xr"], na["yr"]):
                     continue
                 ex = (na["xl"] - na["xr"]) - (nb["xl"] - nb["xr"])
                 ey = (na["yl"] - na["yr"]) - (nb["yl"] - nb["yr"])
-                c = np.float32(
-                    _compat(np.sqrt(ex * ex + ey * ey), p["compat_theta"], p["compat_slope"])
-                )
+                slope = float(np.float32(p["compat_slope"]))
+                c = np.float32(_compat(np.sqrt(ex * ex + ey * ey), ctheta, slope))
                 row.append((b, float(np.float32(norm) * c)))
         rows.append(row)
     return rows
@@ -309,8 +323,102 @@ def run_dynamics(
     return v, trace
 
 
+def _fallback(neurons: list[dict], rows: list[list[tuple[int, float]]], v: np.ndarray, p: dict):
+    """Final selection's fallback: a point without an active candidate gets its best one back
+    when an active alternative has support < fallback_alt_support (or, with none active, the
+    best has support >= fallback_min_support) and no other point's active neuron holds the
+    right pixel. Support = sum of the positive weights from active neurons."""
+    if not p["fallback"]:
+        return v
+    out = v.copy()
+    support = [sum(t for b, t in row if t > 0 and v[b] == 1) for row in rows]
+    held: dict[tuple[int, int], set[int]] = {}
+    for a in np.nonzero(v)[0].tolist():
+        held.setdefault((neurons[a]["xr"], neurons[a]["yr"]), set()).add(neurons[a]["point"])
+    groups: dict[int, list[int]] = {}
+    for a, n in enumerate(neurons):
+        groups.setdefault(n["point"], []).append(a)
+    for q, g in groups.items():
+        a = g[0]  # best ZNCC first
+        if v[a]:
+            continue
+        alt = [support[b] for b in g[1:] if v[b]]
+        weak = (
+            max(alt) < float(np.float32(p["fallback_alt_support"]))
+            if alt
+            else support[a] >= float(np.float32(p["fallback_min_support"]))
+        )
+        free = held.get((neurons[a]["xr"], neurons[a]["yr"]), set()) <= {q}
+        if weak and free:
+            out[a] = 1
+    return out
+
+
+def _rescue(neurons: list[dict], chosen: list[int], p: dict) -> list[int]:
+    """Edge-test survivors of ``chosen`` with the side rescue iterated to a fixed point: a match
+    failing only half-window tests is accepted when, for every failing half (bit k: left,
+    right, top, bottom), >= rescue_min accepted matches lie on that side in the window, all
+    agree within agree_tol and their median sub-pixel disparity is within rescue_med."""
+    if not p["edge_test"]:
+        return list(chosen)
+    ok = {a: neurons[a]["edge_ok"] for a in chosen}
+    if p["rescue_min"] == 0:
+        return [a for a in chosen if ok[a]]
+    half = p["nbr_half"]
+    med_tol = np.float32(p["rescue_med"])
+    while True:
+        acc = [b for b in chosen if ok[b]]
+        added = []
+        for a in chosen:
+            n = neurons[a]
+            if ok[a] or not n["centre_ok"] or n["halves_fail"] == 0:
+                continue
+            d = n["xl"] - n["xr"]
+            dsub = np.float32(d) + np.float32(n["sub"])
+            good = True
+            for k in range(4):
+                if not (n["halves_fail"] >> k) & 1:
+                    continue
+                side = []
+                for b in acc:
+                    m = neurons[b]
+                    if abs(m["xl"] - n["xl"]) > half or abs(m["yl"] - n["yl"]) > half:
+                        continue
+                    dx, dy = m["xl"] - n["xl"], m["yl"] - n["yl"]
+                    if (dx < 0, dx > 0, dy < 0, dy > 0)[k]:
+                        side.append(m)
+                dm = [m["xl"] - m["xr"] for m in side]
+                if (
+                    len(side) < p["rescue_min"]
+                    or any(abs(v - d) > p["agree_tol"] for v in dm)
+                    or abs(
+                        np.float32(
+                            np.median(
+                                np.array(
+                                    [
+                                        np.float32(v) + np.float32(m["sub"])
+                                        for v, m in zip(dm, side, strict=True)
+                                    ],
+                                    dtype=np.float32,
+                                )
+                            )
+                        )
+                        - dsub
+                    )
+                    > med_tol
+                ):
+                    good = False
+                    break
+            if good:
+                added.append(a)
+        if not added:
+            return [a for a in chosen if ok[a]]
+        for a in added:
+            ok[a] = True
+
+
 def _finish(neurons: list[dict], chosen: list[int], p: dict) -> np.ndarray:
-    surv = [a for a in chosen if not p["edge_test"] or neurons[a]["edge_ok"]]
+    surv = _rescue(neurons, chosen, p)
     half = p["nbr_half"]
     out = []
     for a in surv:
@@ -357,6 +465,7 @@ def hopfield_match(
     )
     init = np.array([n["sim"] >= p["s_init"] for n in neurons], dtype=np.int8)
     v, trace = run_dynamics(rows, inp, init, int(p["seed"]), int(p["max_sweeps"]))
+    v = _fallback(neurons, rows, v, p)
     best: dict[int, int] = {}
     for a in np.nonzero(v)[0].tolist():
         q = neurons[a]["point"]

@@ -3,9 +3,11 @@
 The kernel lives in ``rust/core/src/matching/hopfield``: Moravec interest points (squared
 differences, 3x3 non-maximum suppression, 0.1 % of the maximum), right candidates as 7x7 ZNCC
 peaks along the epipolar row (or the right image's interest points), a sparse binary Hopfield
-network over the candidate pairs (compatibility in the 40x40 window, uniqueness on both sides,
-similarity input) with asynchronous seeded sweeps until a sweep without a flip, C.5
-disambiguation, the C.10 depth-edge test and parabola sub-pixel refinement.
+network over the candidate pairs (compatibility in the 40x40 window growing with distance,
+uniqueness on both sides, similarity input) with asynchronous seeded sweeps until a sweep
+without a flip, a fallback to the best candidate where the network drops a point for a weak
+reason, C.5 disambiguation, the C.10 depth-edge test with the side rescue of half-window
+failures, and parabola sub-pixel refinement.
 
 :func:`best_match` is the same pipeline without the network (the best ZNCC candidate of every
 point): the reference the network is measured against.
@@ -50,6 +52,7 @@ DEFAULTS: dict[str, Any] = {
     "nbr_half": 20,  # compatibility window half-size: the paper's 40x40 (px)
     "compat_theta": 2.0,  # disparity difference where compatibility crosses 0 (px, C.3)
     "compat_slope": 2.0,  # steepness of the compatibility sigmoid (1/px, C.3)
+    "compat_grad": 0.05,  # crossing grows by this per px of point distance (slanted surfaces)
     "s_init": 0.8,  # neurons with ZNCC >= s_init start on (C.4)
     "max_sweeps": 100,  # bound on asynchronous sweeps
     "seed": 0,  # update-order seed
@@ -57,8 +60,13 @@ DEFAULTS: dict[str, Any] = {
     "edge_test": True,  # C.10 depth-edge test
     "edge_tol": 1,  # half-window disparities agree within +-1 px (C.10)
     "edge_margin": 0.0,  # half-window ZNCC slack vs its best (0 = C.10's literal test)
-    "edge_penalty": 0.0,  # input penalty of edge-test failures in the network (0 = test after)
+    "edge_penalty": 0.5,  # input penalty of edge-test failures in the network (0 = test after)
     "centre_tol": 0.05,  # centre grey-level difference (C.10)
+    "rescue_min": 3,  # side rescue: >= 3 accepted matches on a failing half's side, all agreeing
+    "rescue_med": 0.75,  # ... and their median within 0.75 px of the match (0 rescue_min = off)
+    "fallback": True,  # final selection: weakly dropped points keep their best candidate ...
+    "fallback_alt_support": 2.0,  # ... if an active alternative has support below this
+    "fallback_min_support": 0.5,  # ... or (no active alternative) it has support >= this
     "min_agree": 8,  # agreeing neighbour matches in the 40x40 window (C.10)
     "agree_tol": 1,  # neighbours agree within +-1 px
     "agree_share": 0.8,  # sparse areas: this share of the (< 8) neighbour matches agrees ...
@@ -209,10 +217,12 @@ def hopfield_match(
         ``tile`` (px), ``floor_rel``,
         ``candidates`` (``"row"`` or ``"points"``), ``dy_window`` (px), ``s_min``, ``k_cand``,
         ``A``, ``B``, ``D``, ``theta``, ``nbr_half`` (px), ``compat_theta`` (px),
-        ``compat_slope`` (1/px), ``s_init``, ``max_sweeps``, ``seed``, ``tau_y`` (px),
-        ``edge_test``, ``edge_tol`` (px), ``edge_margin`` (ZNCC), ``edge_penalty``,
-        ``centre_tol`` (window-mean-free grey levels in [0, 1]), ``min_agree``, ``agree_tol``
-        (px), ``agree_share``, ``min_agree_sparse``, ``subpixel``.
+        ``compat_slope`` (1/px), ``compat_grad`` (px per px), ``s_init``, ``max_sweeps``,
+        ``seed``, ``tau_y`` (px), ``edge_test``, ``edge_tol`` (px), ``edge_margin`` (ZNCC),
+        ``edge_penalty``, ``centre_tol`` (window-mean-free grey levels in [0, 1]),
+        ``rescue_min``, ``rescue_med`` (px), ``fallback``, ``fallback_alt_support``,
+        ``fallback_min_support``, ``min_agree``, ``agree_tol`` (px),
+        ``agree_share``, ``min_agree_sparse``, ``subpixel``.
 
     Returns
     -------

@@ -17,7 +17,13 @@ use crate::convert::{image_from_numpy, image_to_numpy};
 use crate::errors::guard;
 use crate::params::{check_keys, get};
 
-const KEYS: [&str; 33] = [
+const KEYS: [&str; 39] = [
+    "fallback",
+    "fallback_alt_support",
+    "fallback_min_support",
+    "compat_grad",
+    "rescue_min",
+    "rescue_med",
     "tile",
     "floor_rel",
     "agree_share",
@@ -84,6 +90,7 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
     get(d, "nbr_half", &mut p.weights.nbr_half)?;
     get(d, "compat_theta", &mut p.weights.compat_theta)?;
     get(d, "compat_slope", &mut p.weights.compat_slope)?;
+    get(d, "compat_grad", &mut p.weights.compat_grad)?;
     get(d, "s_init", &mut p.s_init)?;
     get(d, "max_sweeps", &mut p.max_sweeps)?;
     get(d, "seed", &mut p.seed)?;
@@ -93,6 +100,11 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
     get(d, "edge_margin", &mut p.edge_margin)?;
     get(d, "edge_penalty", &mut p.edge_penalty)?;
     get(d, "centre_tol", &mut p.centre_tol)?;
+    get(d, "fallback", &mut p.fallback)?;
+    get(d, "fallback_alt_support", &mut p.fallback_alt_support)?;
+    get(d, "fallback_min_support", &mut p.fallback_min_support)?;
+    get(d, "rescue_min", &mut p.rescue_min)?;
+    get(d, "rescue_med", &mut p.rescue_med)?;
     get(d, "min_agree", &mut p.min_agree)?;
     get(d, "agree_tol", &mut p.agree_tol)?;
     get(d, "agree_share", &mut p.agree_share)?;

@@ -6,12 +6,16 @@
 //!    (default, C.10), or the right image's interest points in the epipolar band (the paper's
 //!    point-to-point network, kept as a high-precision option). ZNCC `>= s_min`, best `k_cand`.
 //! 3. The sparse binary Hopfield network ([`network`]) over the candidates: compatibility in the
-//!    40x40 window, uniqueness on both sides, similarity input; asynchronous seeded sweeps until a
-//!    sweep without a flip.
-//! 4. Disambiguation of points left with several active candidates (C.5: local median of the
-//!    vertical disparity of single matches, tie-break on similarity, both sides).
-//! 5. Depth-edge filters (C.10): the four half-windows agree within +-1 px, centre grey-level
-//!    check, at least 8 agreeing neighbour matches; parabola sub-pixel refinement.
+//!    40x40 window (crossing 0 at `compat_theta + compat_grad * distance`), uniqueness on both
+//!    sides, similarity input minus `edge_penalty` for depth-edge failures; asynchronous seeded
+//!    sweeps until a sweep without a flip.
+//! 4. Final selection: points the network drops for a weak reason fall back to their best
+//!    candidate ([`HopfieldParams::fallback`]); disambiguation of points left with several
+//!    active candidates (C.5: local median of the vertical disparity of single matches,
+//!    tie-break on similarity, both sides).
+//! 5. Depth-edge filters (C.10): the four half-windows agree within +-1 px (or, failing that,
+//!    the side rescue of [`HopfieldParams::rescue_min`]), centre grey-level check, at least 8
+//!    agreeing neighbour matches; parabola sub-pixel refinement.
 //!
 //! [`best_match`] runs the same pipeline without the network (best ZNCC candidate per point):
 //! the reference the network has to beat.
@@ -78,6 +82,28 @@ pub struct HopfieldParams {
     pub edge_penalty: f32,
     /// Centre grey-level difference allowed between the matched pixels (C.10: 0.05).
     pub centre_tol: f32,
+    /// Side rescue of the half-window test: a match failing only half-window tests (centre
+    /// check passed) is kept when, for every failing half, at least this many accepted matches
+    /// lie on that side of it in the 40x40 window, all agree with it within `agree_tol` and
+    /// their median sub-pixel disparity is within `rescue_med` of its own; repeated until no
+    /// match is added (0 = off, C.10's test only). A half lying on another surface finds that
+    /// surface's matches on its side; a spurious peak of a small half-window (repetitive or weak
+    /// texture: KITTI's road and vegetation) finds its own surface there.
+    pub rescue_min: usize,
+    /// Largest distance (px) between a rescued match and the median of its side's matches.
+    pub rescue_med: f32,
+    /// Final selection: a point the network leaves without an active candidate falls back to
+    /// its best candidate when the network's reason is weak and the right pixel is free (no
+    /// active neuron of another point holds it). Weak: an active alternative candidate of the
+    /// point has support (positive weights from active neurons) below `fallback_alt_support`,
+    /// or, with no active alternative, the best candidate itself has support of at least
+    /// `fallback_min_support`. Correct matches on a minority surface or on a slanted one are
+    /// switched off by the inhibition of the dominant surface; they keep some support.
+    pub fallback: bool,
+    /// See [`HopfieldParams::fallback`] (2.0).
+    pub fallback_alt_support: f32,
+    /// See [`HopfieldParams::fallback`] (0.5).
+    pub fallback_min_support: f32,
     /// Agreeing neighbour matches required in the 40x40 window (C.10: 8).
     pub min_agree: usize,
     /// Sparse-area alternative to `min_agree`: this share of the neighbour matches agrees
@@ -110,8 +136,13 @@ impl Default for HopfieldParams {
             edge_test: true,
             edge_tol: 1,
             edge_margin: 0.0,
-            edge_penalty: 0.0,
+            edge_penalty: 0.5,
             centre_tol: 0.05,
+            rescue_min: 3,
+            rescue_med: 0.75,
+            fallback: true,
+            fallback_alt_support: 2.0,
+            fallback_min_support: 0.5,
             min_agree: 8,
             agree_tol: 1,
             agree_share: 0.8,
@@ -191,6 +222,11 @@ fn validate(left: &Image, right: &Image, p: &HopfieldParams) -> Result<()> {
         ("compat_slope", w.compat_slope),
         ("tau_y", p.tau_y),
         ("centre_tol", p.centre_tol),
+        ("compat_grad", w.compat_grad),
+        ("rescue_med", p.rescue_med),
+        ("fallback_alt_support", p.fallback_alt_support),
+        ("fallback_min_support", p.fallback_min_support),
+        ("edge_penalty", p.edge_penalty),
     ] {
         if !v.is_finite() {
             return Err(CoreError::param(name, format!("must be finite, got {v}")));
@@ -307,8 +343,10 @@ fn point_candidates(
             // texture's equal peaks (laundry's basket) stay acceptable.
             let lo = d.saturating_sub(p.edge_tol).max(p.d_min);
             let hi = (d + p.edge_tol).min(d_hi);
-            let halves_ok = halves.iter().enumerate().all(|(k, best)| {
-                best.is_some_and(|best| max_of(&cv.curve[k + 1][lo..=hi]) >= best - p.edge_margin)
+            let halves_fail = halves.iter().enumerate().fold(0u8, |acc, (k, best)| {
+                let ok = best
+                    .is_some_and(|best| max_of(&cv.curve[k + 1][lo..=hi]) >= best - p.edge_margin);
+                acc | (u8::from(!ok) << k)
             });
             // Centre check on window-mean-free grey levels: insensitive to the exposure
             // offset between the cameras (ETH3D, KITTI), still catches a centre pixel
@@ -328,7 +366,9 @@ fn point_candidates(
                 xr: xr as i32,
                 yr: yr as i32,
                 sim: full[d],
-                edge_ok: halves_ok && centre_ok,
+                edge_ok: halves_fail == 0 && centre_ok,
+                halves_fail,
+                centre_ok,
                 sub,
             });
         }
@@ -479,6 +519,157 @@ fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usi
     out
 }
 
+/// Stage 1 of [`finish`]: which of `chosen` pass the depth-edge test, with the side rescue of
+/// [`HopfieldParams::rescue_min`] iterated to a fixed point (every round tests the remaining
+/// candidates against the matches accepted before it, so the order of the points is irrelevant).
+fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool> {
+    if !p.edge_test {
+        return vec![true; chosen.len()];
+    }
+    let mut ok: Vec<bool> = chosen.iter().map(|&a| neurons[a].edge_ok).collect();
+    if p.rescue_min == 0 {
+        return ok;
+    }
+    // Candidates of the rescue: failed half-window tests only.
+    let cands: Vec<usize> = (0..chosen.len())
+        .filter(|&c| {
+            let n = &neurons[chosen[c]];
+            !n.edge_ok && n.centre_ok && n.halves_fail != 0
+        })
+        .collect();
+    let half = p.weights.nbr_half.max(1);
+    let mut side: Vec<f32> = Vec::new();
+    // Points accepted in the previous round: a candidate with none of them in its window
+    // sees the same side sets as before and keeps its verdict.
+    let mut fresh: Option<network::PointGrid> = None;
+    loop {
+        let acc: Vec<usize> = (0..chosen.len())
+            .filter(|&c| ok[c])
+            .map(|c| chosen[c])
+            .collect();
+        let axy: Vec<(i32, i32)> = acc
+            .iter()
+            .map(|&a| (neurons[a].xl.max(0), neurons[a].yl.max(0)))
+            .collect();
+        let grid = network::PointGrid::new(&axy, half);
+        let mut added = Vec::new();
+        for &c in &cands {
+            if ok[c] {
+                continue;
+            }
+            let n = &neurons[chosen[c]];
+            let (x, y, d) = (n.xl.max(0), n.yl.max(0), n.dx());
+            if let Some(g) = &fresh {
+                let mut near = false;
+                g.for_each_in_window((x, y), half, |_| near = true);
+                if !near {
+                    continue;
+                }
+            }
+            let dsub = d as f32 + n.sub;
+            let pass = (0..4).filter(|k| n.halves_fail >> k & 1 == 1).all(|k| {
+                side.clear();
+                let mut all_agree = true;
+                grid.for_each_in_window((x, y), half, |t| {
+                    let (qx, qy) = axy[t];
+                    let on_side = match k {
+                        0 => qx < x,
+                        1 => qx > x,
+                        2 => qy < y,
+                        _ => qy > y,
+                    };
+                    if on_side {
+                        let b = &neurons[acc[t]];
+                        all_agree &= (b.dx() - d).abs() <= p.agree_tol;
+                        side.push(b.dx() as f32 + b.sub);
+                    }
+                });
+                all_agree
+                    && side.len() >= p.rescue_min
+                    && (median(&mut side) - dsub).abs() <= p.rescue_med
+            });
+            if pass {
+                added.push(c);
+            }
+        }
+        if added.is_empty() {
+            return ok;
+        }
+        let nxy: Vec<(i32, i32)> = added
+            .iter()
+            .map(|&c| (neurons[chosen[c]].xl.max(0), neurons[chosen[c]].yl.max(0)))
+            .collect();
+        fresh = Some(network::PointGrid::new(&nxy, half));
+        for c in added {
+            ok[c] = true;
+        }
+    }
+}
+
+/// The final selection's fallback to the best candidate (see [`HopfieldParams::fallback`]):
+/// the network's state with the best candidate of some points switched on.
+fn fallback(neurons: &[Neuron], csr: &Csr, state: &[u8], p: &HopfieldParams) -> Vec<u8> {
+    let mut out = state.to_vec();
+    if !p.fallback {
+        return out;
+    }
+    // Groups of neurons per point (best ZNCC first) whose best candidate is off.
+    let mut groups: Vec<(usize, usize)> = Vec::new();
+    let mut a = 0;
+    while a < neurons.len() {
+        let mut e = a;
+        while e < neurons.len() && neurons[e].point == neurons[a].point {
+            e += 1;
+        }
+        if state[a] == 0 {
+            groups.push((a, e));
+        }
+        a = e;
+    }
+    // Support (positive weights from active neurons, summed in row order in f64) of the
+    // neurons the rule reads: the active alternatives, else the best candidate.
+    let support_of = |a: usize| -> f64 {
+        let (idx, val) = csr.row(a);
+        idx.iter()
+            .zip(val)
+            .filter(|&(&b, &t)| t > 0.0 && state[b as usize] == 1)
+            .map(|(_, &t)| t as f64)
+            .sum()
+    };
+    let weak: Vec<bool> = groups
+        .par_iter()
+        .map(|&(a, e)| {
+            let alt = (a + 1..e)
+                .filter(|&b| state[b] == 1)
+                .map(support_of)
+                .fold(None, |m: Option<f64>, v| Some(m.map_or(v, |m| m.max(v))));
+            match alt {
+                Some(s) => s < p.fallback_alt_support as f64,
+                None => support_of(a) >= p.fallback_min_support as f64,
+            }
+        })
+        .collect();
+    // Right pixels held by an active neuron: (yr, xr) -> its left point (u32::MAX: several).
+    let mut held: HashMap<(i32, i32), u32> = HashMap::new();
+    for (n, _) in neurons.iter().zip(state).filter(|&(_, &v)| v == 1) {
+        held.entry((n.yr, n.xr))
+            .and_modify(|q| {
+                if *q != n.point {
+                    *q = u32::MAX
+                }
+            })
+            .or_insert(n.point);
+    }
+    for (&(a, _), &weak) in groups.iter().zip(&weak) {
+        let n = &neurons[a];
+        let free = held.get(&(n.yr, n.xr)).is_none_or(|&q| q == n.point);
+        if weak && free {
+            out[a] = 1;
+        }
+    }
+    out
+}
+
 /// Depth-edge filters and sub-pixel refinement of the selected neurons.
 fn finish(
     left: &Image,
@@ -488,15 +679,15 @@ fn finish(
     p: &HopfieldParams,
 ) -> Vec<Match> {
     let _ = (left, right);
-    // Stage 1: the per-candidate depth-edge verdict (computed with the ZNCC curves).
-    let stage1: Vec<Option<(usize, f32)>> = chosen
+    // Stage 1: the per-candidate depth-edge verdict (computed with the ZNCC curves), then the
+    // side rescue of half-window failures.
+    let accepted = rescue(neurons, chosen, p);
+    let survivors: Vec<(usize, f32)> = chosen
         .iter()
-        .map(|&a| {
-            let n = &neurons[a];
-            (!p.edge_test || n.edge_ok).then_some((a, n.dx() as f32 + n.sub))
-        })
+        .zip(&accepted)
+        .filter(|&(_, &ok)| ok)
+        .map(|(&a, _)| (a, neurons[a].dx() as f32 + neurons[a].sub))
         .collect();
-    let survivors: Vec<(usize, f32)> = stage1.into_iter().flatten().collect();
     // Stage 2: neighbour agreement among the survivors (uniform grid, cell = window half-size).
     let half = p.weights.nbr_half.max(1);
     let sxy: Vec<(i32, i32)> = survivors
@@ -586,7 +777,8 @@ pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result
         .map(|n| u8::from(n.sim >= p.s_init))
         .collect();
     let dynamics = run_dynamics(&csr, &input, &init, p.seed, p.max_sweeps);
-    let chosen = disambiguate(&neurons, &dynamics.state, p);
+    let selected = fallback(&neurons, &csr, &dynamics.state, p);
+    let chosen = disambiguate(&neurons, &selected, p);
     let matches = finish(left, right, &neurons, &chosen, p);
     Ok(HopfieldOutput {
         matches,

@@ -19,6 +19,10 @@ pub struct Neuron {
     pub sim: f32,
     /// Passed the depth-edge test (four half-windows agree, centre grey-level check).
     pub edge_ok: bool,
+    /// Half-windows that failed their test (bit `k`: left, right, top, bottom).
+    pub halves_fail: u8,
+    /// Passed the centre grey-level check.
+    pub centre_ok: bool,
     /// Parabola sub-pixel offset of the disparity (px, in [-0.5, 0.5]).
     pub sub: f32,
 }
@@ -51,6 +55,10 @@ pub struct EnergyWeights {
     pub compat_theta: f32,
     /// Steepness of the compatibility sigmoid (1/px, C.3).
     pub compat_slope: f32,
+    /// Growth of the compatibility crossing with the points' distance (px of disparity per px
+    /// of Chebyshev distance): the crossing is `compat_theta + compat_grad * r`, so that
+    /// neighbours on a slanted surface 20 px away still support each other (0 = C.3's form).
+    pub compat_grad: f32,
 }
 
 impl Default for EnergyWeights {
@@ -63,6 +71,7 @@ impl Default for EnergyWeights {
             nbr_half: 20,
             compat_theta: 2.0,
             compat_slope: 2.0,
+            compat_grad: 0.05,
         }
     }
 }
@@ -263,20 +272,29 @@ pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
             g0 = k;
         }
     }
-    // Compatibility lookup over the integer squared disparity-vector difference.
+    // Compatibility lookup per Chebyshev distance r of the two points (0..=half) over the
+    // integer squared disparity-vector difference q. A row ends where the f32 value has
+    // saturated at -1 (slope > 0, q past the crossing): larger q read the last entry, which is
+    // exactly what the formula gives there.
     let span = |f: fn(&Neuron) -> i32| {
         let lo = neurons.iter().map(f).min().unwrap_or(0);
         let hi = neurons.iter().map(f).max().unwrap_or(0);
         (hi - lo) as usize
     };
     let (max_dx, max_dy) = (span(Neuron::dx), span(Neuron::dy));
-    let lut: Vec<f32> = (0..=max_dx * max_dx + max_dy * max_dy)
-        .map(|q| {
-            compat(
-                (q as f64).sqrt(),
-                w.compat_theta as f64,
-                w.compat_slope as f64,
-            ) as f32
+    let max_q = max_dx * max_dx + max_dy * max_dy;
+    let luts: Vec<Vec<f32>> = (0..=half)
+        .map(|r| {
+            let theta = w.compat_theta as f64 + w.compat_grad as f64 * r as f64;
+            let mut row = Vec::new();
+            for q in 0..=max_q {
+                let v = compat((q as f64).sqrt(), theta, w.compat_slope as f64) as f32;
+                row.push(v);
+                if v == -1.0 && w.compat_slope > 0.0 && (q as f64).sqrt() > theta {
+                    break;
+                }
+            }
+            row
         })
         .collect();
     // Structure of arrays of what the rows read.
@@ -369,11 +387,14 @@ pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
                     let q = q as usize;
                     let (np, nq) = (a_over_n[p], a_over_n[q]);
                     let norm = if (np < nq) == a_pos { np } else { nq };
+                    let r = (pxy[q].0 - pxy[p].0).abs().max((pxy[q].1 - pxy[p].1).abs()) as usize;
+                    let lut = &luts[r];
+                    let last = lut.len() - 1;
                     for b in starts[q]..starts[q + 1] {
                         if rkey[b] != ka {
                             let ex = (dxa - dxs[b]).unsigned_abs() as usize;
                             let ey = (dya - dys[b]).unsigned_abs() as usize;
-                            put(b as u32, norm * lut[ex * ex + ey * ey]);
+                            put(b as u32, norm * lut[(ex * ex + ey * ey).min(last)]);
                         }
                     }
                 }
