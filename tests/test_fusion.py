@@ -146,11 +146,11 @@ def test_match_fused_on_cones(data_dir: Path) -> None:
     assert fm.precision[1.0] > 99.3 and fm.coverage == 16
     assert fm.count > max(st["channel_matches"].values())
     # Each channel alone, even all of its matches, gives fewer: MCGM 99.6 % of 7043, Hopfield
-    # 99.3 % of 2924 (fewer at the members' precision: a channel cannot exceed its own count).
+    # 98.9 % of 3016 (fewer at the members' precision: a channel cannot exceed its own count).
     for name in ("mcgm", "hopfield"):
         alone = sv_match(scene.left, scene.right, method=name, max_disparity=64)
         am = sparse_metrics(alone.xl, alone.yl, alone.xr, scene.gt)
-        assert fm.count > 1.2 * am.count and am.precision[1.0] > 99.0, name
+        assert fm.count > 1.2 * am.count and am.precision[1.0] > 98.5, name
 
 
 def test_fuse_pair_rejects_unknown_options() -> None:
