@@ -108,6 +108,24 @@ pub fn check_pair(left: &Image, right: &Image) -> Result<()> {
     Ok(())
 }
 
+/// Checks that a disparity map and its confidence both hold `w * h` values.
+pub fn check_map_pair(disp: &[f32], conf: &[f32], w: usize, h: usize) -> Result<()> {
+    let n = w
+        .checked_mul(h)
+        .ok_or_else(|| CoreError::param("shape", "width * height overflows"))?;
+    if disp.len() != n || conf.len() != n {
+        return Err(CoreError::param(
+            "disparity",
+            format!(
+                "disparity ({}) and confidence ({}) must both have {w} x {h} values",
+                disp.len(),
+                conf.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

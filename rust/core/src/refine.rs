@@ -22,6 +22,7 @@
 //! not depend on the thread count. `tests/reference/refine_ref.py` is the same maths in NumPy.
 
 use crate::error::{CoreError, Result};
+use crate::image::check_map_pair;
 use crate::parallel::for_each_row;
 use crate::simd::simd_fn;
 use crate::ImageView;
@@ -797,16 +798,7 @@ pub fn refine_disparity(
             right: (right.width, right.height),
         });
     }
-    if disp.len() != w * h || conf.len() != w * h {
-        return Err(CoreError::param(
-            "disparity",
-            format!(
-                "disparity ({}) and confidence ({}) must both have {w} x {h} values",
-                disp.len(),
-                conf.len()
-            ),
-        ));
-    }
+    check_map_pair(disp, conf, w, h)?;
     if !(d_min.is_finite() && d_max.is_finite() && d_max > d_min) {
         return Err(CoreError::param(
             "range",

@@ -8,6 +8,7 @@
 //! of a live frame at VGA.
 
 use crate::error::{CoreError, Result};
+use crate::image::check_map_pair;
 use crate::parallel::for_each_row2;
 
 /// Disparity uncertainty model (px): `sigma_d(conf) = max(s0 + slope * clamp(conf, 0, 1), s_min)`
@@ -32,19 +33,8 @@ pub fn depth_rectified(
     doffs: f32,
     sigma: SigmaModel,
 ) -> Result<(Vec<f32>, Vec<f32>)> {
-    let n = w
-        .checked_mul(h)
-        .ok_or_else(|| CoreError::param("shape", "width * height overflows"))?;
-    if disp.len() != n || conf.len() != n {
-        return Err(CoreError::param(
-            "disparity",
-            format!(
-                "disparity ({}) and confidence ({}) must both have {w} x {h} values",
-                disp.len(),
-                conf.len()
-            ),
-        ));
-    }
+    check_map_pair(disp, conf, w, h)?;
+    let n = w * h;
     for (name, v) in [("fb", fb), ("doffs", doffs), ("s0", sigma.s0)] {
         if !v.is_finite() {
             return Err(CoreError::param(name, format!("must be finite, got {v}")));

@@ -54,3 +54,24 @@ pub fn image_to_numpy<'py>(py: Python<'py>, img: Image) -> PyResult<Bound<'py, P
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(arr.into_pyarray(py))
 }
+
+/// The buffers of a disparity map and its confidence, both checked to be `(h, w)` and
+/// C-contiguous (the Python wrappers make them so); the error names the array.
+pub fn map_and_confidence<'a>(
+    disp: &'a PyReadonlyArray2<'_, f32>,
+    conf: &'a PyReadonlyArray2<'_, f32>,
+    (h, w): (usize, usize),
+) -> PyResult<(&'a [f32], &'a [f32])> {
+    let slice = |a: &'a PyReadonlyArray2<'_, f32>, name: &str| -> PyResult<&'a [f32]> {
+        if a.as_array().dim() != (h, w) {
+            return Err(PyValueError::new_err(format!(
+                "{name} shape {:?} differs from the expected shape {:?}",
+                a.as_array().dim(),
+                (h, w)
+            )));
+        }
+        a.as_slice()
+            .map_err(|_| PyValueError::new_err(format!("{name} must be C-contiguous")))
+    };
+    Ok((slice(disp, "disparity")?, slice(conf, "confidence")?))
+}

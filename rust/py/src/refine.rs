@@ -1,12 +1,11 @@
 //! Binding of `stereovision_core::refine`.
 
 use numpy::{PyArray2, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use stereovision_core::refine::{refine_disparity as core_refine, FillPass, RefineParams};
 use stereovision_core::Image;
 
-use crate::convert::{grey_from_numpy, image_to_numpy};
+use crate::convert::{grey_from_numpy, image_to_numpy, map_and_confidence};
 use crate::errors::guard;
 
 type Refined<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>, usize);
@@ -40,21 +39,7 @@ pub fn refine_disparity<'py>(
     let l = grey_from_numpy(&left, "left")?;
     let r = grey_from_numpy(&right, "right")?;
     let (w, h) = (l.view().width, l.view().height);
-    for (name, a) in [("disparity", &disp), ("confidence", &conf)] {
-        if a.as_array().dim() != (h, w) {
-            return Err(PyValueError::new_err(format!(
-                "{name} shape {:?} differs from the image shape {:?}",
-                a.as_array().dim(),
-                (h, w)
-            )));
-        }
-    }
-    let d = disp
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("disparity must be C-contiguous"))?;
-    let c = conf
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("confidence must be C-contiguous"))?;
+    let (d, c) = map_and_confidence(&disp, &conf, (h, w))?;
     let p = RefineParams {
         base_sigma,
         win_sigma,

@@ -1,11 +1,10 @@
 //! Binding of `stereovision_core::triangulation`.
 
 use numpy::PyReadonlyArray2;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use stereovision_core::triangulation::{depth_rectified as core_depth, SigmaModel};
 
-use crate::convert::image_to_numpy;
+use crate::convert::{image_to_numpy, map_and_confidence};
 use crate::errors::guard;
 use stereovision_core::Image;
 
@@ -31,19 +30,7 @@ pub fn depth_rectified<'py>(
     s_fill: f32,
 ) -> PyResult<Pair<'py>> {
     let (h, w) = disp.as_array().dim();
-    if conf.as_array().dim() != (h, w) {
-        return Err(PyValueError::new_err(format!(
-            "confidence shape {:?} differs from disparity shape {:?}",
-            conf.as_array().dim(),
-            (h, w)
-        )));
-    }
-    let d = disp
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("disp must be C-contiguous"))?;
-    let c = conf
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("conf must be C-contiguous"))?;
+    let (d, c) = map_and_confidence(&disp, &conf, (h, w))?;
     let m = SigmaModel {
         s0,
         slope,
