@@ -3,11 +3,11 @@
 A matcher's disparity is re-measured at every pixel by a zero-mean normalised cross-correlation
 (ZNCC) of Gaussian windows between the left image and the right image *warped by the smoothed
 estimate*, so the windows follow slanted surfaces. A pixel keeps the parabola vertex of the
-correlation around its smoothed estimate when the correlation peak lies within one pixel of it,
-and becomes NaN otherwise (the matcher and the correlation disagree: an occlusion edge or a wrong
-lock). Fill passes then give holes next to measured pixels a value from a wider smoothing, again
-only on a clear correlation peak (ZNCC >= ``min_score``), so a filled pixel is a measurement, not
-a guess.
+correlation (shifts half a pixel apart) when the peak lies within half a pixel of its smoothed
+estimate, and becomes NaN otherwise (the matcher and the correlation disagree: an occlusion edge
+or a wrong lock). A fill pass then gives holes near measured pixels a value from the local plane
+through them, again only on a clear correlation peak (ZNCC >= ``min_score``), so a filled pixel
+is a measurement, not a guess.
 
 Why: the Gabor channel's phase estimates spread by about a third of a pixel, which at the small
 disparities of a robot's working range is several per cent of the depth; on the shared scenes
@@ -119,7 +119,9 @@ def refine_disparity(
         Overrides of :data:`DEFAULTS`: ``base_sigma`` (px), ``win_sigma`` (px), ``win_radius``
         (px), ``search`` (shifts each side), ``step`` (px between shifts), ``fill_search`` and
         ``fill_step`` (the same for the fill passes), ``var_floor``, ``fills`` (a sequence of
-        ``(sigma_px, min_score)``; empty = no fill), ``fill_confidence``.
+        ``(sigma_px, min_score)``; empty = no fill), ``fill_confidence``, ``fill_plane`` (start
+        a fill from the local plane, else from the local mean), ``fill_max_residual`` (px: fill
+        only where the measured values lie within this RMS distance of that plane).
 
     Returns
     -------
