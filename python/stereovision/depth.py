@@ -269,8 +269,8 @@ def _depth_rectified(
     """Depth in metres and its one-sigma uncertainty of a rectified pair's measured disparity.
 
     ``Z = f B / (d + doffs)`` (:func:`stereovision.triangulation.depth_from_disparity`) in
-    float32 where ``measured_disp`` has a value (NaN = not measured: filled pixels are guesses,
-    not measurements, and get no depth); ``sigma_Z = Z sigma_d / (d + doffs)``
+    float32 where ``measured_disp`` has a value (NaN = not measured: row-filled pixels are
+    guesses, not measurements, and get no depth); ``sigma_Z = Z sigma_d / (d + doffs)``
     (:func:`disparity_sigma`). One parallel Rust pass; ``tests/reference/depth_ref.py`` is the
     same maths in NumPy. Pixels the refinement filled are passed with confidence -1, the
     kernel's mark for ``s_fill``.
@@ -365,8 +365,8 @@ def depth_map(
         measured pixels where it peaks clearly (:func:`stereovision.refine.refine_disparity`;
         filled pixels are measurements with confidence 0.25 and get a depth). None (default)
         = the method's own choice: on for ``"gabor"`` (the depth figures it brings are in
-        docs/refine.md), off for ``"fused"``, whose output is already completed. It costs
-        about the matcher's time again; live use can pass False.
+        docs/refine.md), off for ``"fused"``, whose output is already completed. It takes
+        2-3 times the Gabor channel's time; live use can pass False.
     return_channels : bool
         Keep each channel's own output in :attr:`DepthResult.channels`.
     cloud : bool

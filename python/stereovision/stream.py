@@ -416,7 +416,7 @@ def run_stream(
         Grab and rectify in a producer thread while the main thread matches (default).
     refine : bool
         Sub-pixel refinement of every frame (:func:`stereovision.refine.refine_disparity`).
-        Off by default: it about doubles the matching time, and a live view wants the rate;
+        Off by default: it takes 2-3 times the matching time, and a live view wants the rate;
         turn it on for measurements.
     on_report : callable, optional
         Called with each per-second report (a JSON-ready dict, see the module doc).
@@ -640,7 +640,7 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--method", choices=METHODS, help="matcher (default: depth_map's)")
     p.add_argument("--frames", type=int, help="stop after N pairs (default: until a source ends)")
     p.add_argument(
-        "--refine", action="store_true", help="sub-pixel refinement per frame (about 2x the time)"
+        "--refine", action="store_true", help="sub-pixel refinement per frame (2-3x the time)"
     )
     p.add_argument("--no-display", action="store_true", help="headless: do not serve the view")
     p.add_argument("--serve", type=int, default=DEFAULT_PORT, metavar="PORT", help="view port")
