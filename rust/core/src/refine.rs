@@ -277,12 +277,13 @@ pub fn box3_zero<T: BoxSample>(a: &[T], w: usize, h: usize, b: usize) -> Vec<T> 
 /// Local plane fit of a map with holes (first-order normalised convolution with the three-box
 /// kernel of [`box3_radius`]): at each pixel, the weighted least-squares plane
 /// `d = a + b dx + c dy` through the values around it. Returns the plane's value `a` there and
-/// the weighted RMS residual of the values about the plane (px): how far the neighbourhood is
-/// from one surface (a slanted road fits; a depth edge or foliage does not). Where the
+/// (with `residual`; NaN otherwise) the weighted RMS residual of the values about the plane
+/// (px): how far the neighbourhood is from one surface (a slanted road fits; a depth edge or
+/// foliage does not). Where the
 /// neighbourhood's positions do not fix a plane (fewer than three, or all on a line) the plane
 /// is flat (the mean). NaN where no value lies within reach. Moments in f64, about the image
 /// centre.
-pub fn nc_plane(d: &[f32], w: usize, h: usize, sigma: f32) -> (Vec<f32>, Vec<f32>) {
+pub fn nc_plane(d: &[f32], w: usize, h: usize, sigma: f32, residual: bool) -> (Vec<f32>, Vec<f32>) {
     use rayon::prelude::*;
     let b = box3_radius(sigma);
     let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
@@ -307,7 +308,9 @@ pub fn nc_plane(d: &[f32], w: usize, h: usize, sigma: f32) -> (Vec<f32>, Vec<f32
             _ => dd * dd,
         }
     };
-    let s: Vec<Vec<f64>> = (0..10)
+    // The d^2 moment serves the residual only.
+    let n_maps = if residual { 10 } else { 9 };
+    let s: Vec<Vec<f64>> = (0..n_maps)
         .map(|k| {
             let mut m = vec![0f64; n];
             for_each_row(&mut m, w, |y, row| {
@@ -353,7 +356,6 @@ fn plane_at(s: &[Vec<f64>], i: usize, up: f64, vp: f64) -> Option<(f64, f64)> {
     let md = s[6][i];
     let mud = s[7][i] - up * md;
     let mvd = s[8][i] - vp * md;
-    let mdd = s[9][i];
     // Solve [m0 mu mv; mu muu muv; mv muv mvv] (a b c) = (md mud mvd) by Cramer's rule.
     let det =
         m0 * (muu * mvv - muv * muv) - mu * (mu * mvv - muv * mv) + mv * (mu * muv - muu * mv);
@@ -373,7 +375,10 @@ fn plane_at(s: &[Vec<f64>], i: usize, up: f64, vp: f64) -> Option<(f64, f64)> {
         let a = md / m0;
         (a, a * md)
     };
-    Some((a, ((mdd - fit) / m0).max(0.0).sqrt()))
+    let rms = s
+        .get(9)
+        .map_or(f64::NAN, |mdd| ((mdd[i] - fit) / m0).max(0.0).sqrt());
+    Some((a, rms))
 }
 
 /// Normalised-convolution smoothing of a map with holes (NaN): `K*(v m) / K*m` with the
@@ -405,15 +410,24 @@ pub fn cubic_weights(f: f32) -> [f32; 4] {
     ]
 }
 
+/// `q . row[i - 1 ..= i + 2]`, the indices clamped to the row only near its ends.
+#[inline(always)]
+fn sample4(row: &[f32], i: i32, q: [f32; 4]) -> f32 {
+    let n = row.len() as i32;
+    if i >= 1 && i + 2 < n {
+        let r = &row[(i - 1) as usize..(i + 3) as usize];
+        q[0] * r[0] + q[1] * r[1] + q[2] * r[2] + q[3] * r[3]
+    } else {
+        let at = |j: i32| row[(i + j).clamp(0, n - 1) as usize];
+        q[0] * at(-1) + q[1] * at(0) + q[2] * at(1) + q[3] * at(2)
+    }
+}
+
 /// Catmull-Rom sample of `row` at real position `t` (indices clamped to the row).
 #[inline]
 pub fn cubic_sample(row: &[f32], t: f32) -> f32 {
-    let n = row.len() as i64;
     let fl = t.floor();
-    let q = cubic_weights(t - fl);
-    let i = fl as i64;
-    let at = |k: i64| row[(i + k).clamp(0, n - 1) as usize];
-    q[0] * at(-1) + q[1] * at(0) + q[2] * at(1) + q[3] * at(2)
+    sample4(row, fl as i32, cubic_weights(t - fl))
 }
 
 simd_fn! {
@@ -502,23 +516,11 @@ simd_fn! {
             // NaN base: t is NaN, max/min turn it into -2 (any index: its output is 0 below)
             // and the clamp keeps f NaN, which only reaches that discarded output.
             let fl = t.floor().max(-2.0).min(hi);
-            let f = (t - fl).clamp(0.0, 1.0);
-            let (f2, f3) = (f * f, f * f * f);
-            q0[x] = 0.5 * (-f3 + 2.0 * f2 - f);
-            q1[x] = 0.5 * (3.0 * f3 - 5.0 * f2 + 2.0);
-            q2[x] = 0.5 * (-3.0 * f3 + 4.0 * f2 + f);
-            q3[x] = 0.5 * (f3 - f2);
+            [q0[x], q1[x], q2[x], q3[x]] = cubic_weights((t - fl).clamp(0.0, 1.0));
             idx[x] = fl as i32;
         }
         for x in 0..w {
-            let i = idx[x];
-            let v = if i >= 1 && i + 2 < n {
-                let r = &row[(i - 1) as usize..(i + 3) as usize];
-                q0[x] * r[0] + q1[x] * r[1] + q2[x] * r[2] + q3[x] * r[3]
-            } else {
-                let at = |j: i32| row[(i + j).clamp(0, n - 1) as usize];
-                q0[x] * at(-1) + q1[x] * at(0) + q2[x] * at(1) + q3[x] * at(2)
-            };
+            let v = sample4(row, idx[x], [q0[x], q1[x], q2[x], q3[x]]);
             out[x] = if base[x].is_finite() { v - center } else { 0.0 };
         }
     }
@@ -850,11 +852,13 @@ pub fn refine_disparity(
     let mut filled = 0usize;
     for f in &p.fills {
         let (base, resid) = if p.fill_plane {
-            nc_plane(&out, w, h, f.sigma)
+            nc_plane(&out, w, h, f.sigma, p.fill_max_residual.is_finite())
         } else {
             (nc_smooth(&out, w, h, f.sigma), Vec::new())
         };
-        let planar = |i: usize| !p.fill_plane || resid[i] < p.fill_max_residual;
+        let planar = |i: usize| {
+            !(p.fill_plane && p.fill_max_residual.is_finite()) || resid[i] < p.fill_max_residual
+        };
         let before = out.clone();
         stage(
             &ls,
@@ -1000,7 +1004,7 @@ mod tests {
         for i in (0..w * h).filter(|i| (i * 7) % 5 == 0) {
             d[i] = f32::NAN;
         }
-        let (plane, resid) = nc_plane(&d, w, h, 4.0);
+        let (plane, resid) = nc_plane(&d, w, h, 4.0, true);
         for i in 0..w * h {
             let exact = 3.0 + 0.25 * (i % w) as f32 - 0.4 * (i / w) as f32;
             assert!(
@@ -1014,7 +1018,7 @@ mod tests {
         let step: Vec<f32> = (0..w * h)
             .map(|i| if i % w < 20 { 5.0 } else { 15.0 })
             .collect();
-        let (_, r) = nc_plane(&step, w, h, 4.0);
+        let (_, r) = nc_plane(&step, w, h, 4.0, true);
         assert!(r[15 * w + 20] > 2.0 && r[15 * w + 2] < 1e-3);
     }
 
