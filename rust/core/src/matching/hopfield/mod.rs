@@ -34,7 +34,9 @@ use rayon::prelude::*;
 use crate::error::{CoreError, Result};
 use crate::image::{check_pair, Image};
 pub use interest::{interest_points, moravec, InterestParams, InterestPoint};
-pub use network::{build_weights, run_dynamics, Csr, Dynamics, EnergyWeights, Neuron};
+pub use network::{
+    build_weights, run_dynamics, Csr, Dynamics, EnergyWeights, Network, Neuron, Weights,
+};
 use zncc::{max_of, zncc_curves, Curves, RightStats, FULL, N_REGIONS, SIM_RADIUS};
 
 /// Where the right candidates of a left point come from.
@@ -608,7 +610,7 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
 
 /// The final selection's fallback to the best candidate (see [`HopfieldParams::fallback`]):
 /// the network's state with the best candidate of some points switched on.
-fn fallback(neurons: &[Neuron], csr: &Csr, state: &[u8], p: &HopfieldParams) -> Vec<u8> {
+fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams) -> Vec<u8> {
     let mut out = state.to_vec();
     if !p.fallback {
         return out;
@@ -629,12 +631,13 @@ fn fallback(neurons: &[Neuron], csr: &Csr, state: &[u8], p: &HopfieldParams) -> 
     // Support (positive weights from active neurons, summed in row order in f64) of the
     // neurons the rule reads: the active alternatives, else the best candidate.
     let support_of = |a: usize| -> f64 {
-        let (idx, val) = csr.row(a);
-        idx.iter()
-            .zip(val)
-            .filter(|&(&b, &t)| t > 0.0 && state[b as usize] == 1)
-            .map(|(_, &t)| t as f64)
-            .sum()
+        let mut s = 0.0f64;
+        net.for_each_in_row(a, |b, t| {
+            if t > 0.0 && state[b as usize] == 1 {
+                s += t as f64;
+            }
+        });
+        s
     };
     let weak: Vec<bool> = groups
         .par_iter()
@@ -710,19 +713,7 @@ fn finish(
             }
             let d = neurons[a].dx();
             let (x, y) = sxy[s];
-            let (mut agree, mut near) = (0usize, 0usize);
-            // Branch-free count over the 3x3 cells (the survivor itself is excluded below).
-            for (r0, r1) in grid.ranges(x, y) {
-                let cells = grid.xs[r0..r1]
-                    .iter()
-                    .zip(&grid.ys[r0..r1])
-                    .zip(&sd[r0..r1]);
-                for ((&qx, &qy), &qd) in cells {
-                    let inside = (qx - x).abs() <= half && (qy - y).abs() <= half;
-                    near += usize::from(inside);
-                    agree += usize::from(inside && (qd - d).abs() <= p.agree_tol);
-                }
-            }
+            let (mut near, mut agree) = grid.count_in_window((x, y), half, &sd, d, p.agree_tol);
             near -= 1;
             agree -= usize::from(p.agree_tol >= 0); // the survivor itself
                                                     // Dense areas: at least min_agree agreeing neighbours (C.10). Sparse areas (weak
@@ -760,7 +751,7 @@ pub fn candidate_neurons(
 /// The Hopfield channel: interest points matched by energy minimisation (see the module docs).
 pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result<HopfieldOutput> {
     let (pts, neurons) = candidate_neurons(left, right, p)?;
-    let csr = build_weights(&neurons, &p.weights);
+    let net = Network::new(&neurons, &p.weights);
     let input: Vec<f64> = neurons
         .iter()
         .map(|n| {
@@ -776,8 +767,8 @@ pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result
         .iter()
         .map(|n| u8::from(n.sim >= p.s_init))
         .collect();
-    let dynamics = run_dynamics(&csr, &input, &init, p.seed, p.max_sweeps);
-    let selected = fallback(&neurons, &csr, &dynamics.state, p);
+    let dynamics = run_dynamics(&net, &input, &init, p.seed, p.max_sweeps);
+    let selected = fallback(&neurons, &net, &dynamics.state, p);
     let chosen = disambiguate(&neurons, &selected, p);
     let matches = finish(left, right, &neurons, &chosen, p);
     Ok(HopfieldOutput {
@@ -785,7 +776,7 @@ pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result
         energy_trace: dynamics.energy_trace,
         n_points: pts.len(),
         n_neurons: neurons.len(),
-        n_weights: csr.nnz(),
+        n_weights: dynamics.nnz,
         sweeps: dynamics.sweeps,
         converged: dynamics.converged,
         n_selected: chosen.len(),

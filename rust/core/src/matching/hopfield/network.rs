@@ -174,6 +174,40 @@ impl PointGrid {
         })
     }
 
+    /// Points within `half` of `(x, y)` in both coordinates, and those of them whose value
+    /// (`vals`, in grid order like `xs`) is within `tol` of `v` (the point itself included).
+    pub(crate) fn count_in_window(
+        &self,
+        (x, y): (i32, i32),
+        half: i32,
+        vals: &[i32],
+        v: i32,
+        tol: i32,
+    ) -> (usize, usize) {
+        let (mut near, mut agree) = (0usize, 0usize);
+        for (s, e) in self.ranges(x, y) {
+            let mut k0 = s;
+            #[cfg(target_arch = "x86_64")]
+            if has_avx2() {
+                let full = s + (e - s) / LANES * LANES;
+                // SAFETY: AVX2 is present and s..full lies within xs, ys and vals.
+                let (n, a) = unsafe {
+                    count_block_avx2(&self.xs, &self.ys, vals, s, full, (x, y, half, v, tol))
+                };
+                near += n;
+                agree += a;
+                k0 = full;
+            }
+            let tail = self.xs[k0..e].iter().zip(&self.ys[k0..e]).zip(&vals[k0..e]);
+            for ((&qx, &qy), &qv) in tail {
+                let inside = (qx - x).abs() <= half && (qy - y).abs() <= half;
+                near += usize::from(inside);
+                agree += usize::from(inside & ((qv - v).abs() <= tol));
+            }
+        }
+        (near, agree)
+    }
+
     /// Calls `f(q)` for every point `q` within `half` of `(x, y)` in both coordinates
     /// (`half` at most the grid's), in cell order.
     pub(crate) fn for_each_in_window(
@@ -192,221 +226,709 @@ impl PointGrid {
     }
 }
 
-/// Left points per parallel task of [`build_weights`] (rows are built per task, then
-/// concatenated in order: the matrix does not depend on the thread count).
-const POINTS_PER_TASK: usize = 64;
+/// [`PointGrid::count_in_window`] over `s..full` (a multiple of [`LANES`] long), 8 points at
+/// a time.
+///
+/// # Safety
+/// The CPU must support AVX2 and `full` must not exceed the three arrays' lengths.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn count_block_avx2(
+    xs: &[i32],
+    ys: &[i32],
+    vals: &[i32],
+    s: usize,
+    full: usize,
+    (x, y, half, v, tol): (i32, i32, i32, i32, i32),
+) -> (usize, usize) {
+    use std::arch::x86_64::*;
+    debug_assert!(full <= xs.len() && full <= ys.len() && full <= vals.len());
+    let ld = |a: &[i32], k: usize| _mm256_loadu_si256(a.as_ptr().add(k) as *const __m256i);
+    let (vx, vy, vv) = (
+        _mm256_set1_epi32(x),
+        _mm256_set1_epi32(y),
+        _mm256_set1_epi32(v),
+    );
+    let (vh, vt) = (_mm256_set1_epi32(half), _mm256_set1_epi32(tol));
+    let (mut near, mut agree) = (0u32, 0u32);
+    for k in (s..full).step_by(LANES) {
+        let out_x = _mm256_cmpgt_epi32(_mm256_abs_epi32(_mm256_sub_epi32(ld(xs, k), vx)), vh);
+        let out_y = _mm256_cmpgt_epi32(_mm256_abs_epi32(_mm256_sub_epi32(ld(ys, k), vy)), vh);
+        let off = _mm256_cmpgt_epi32(_mm256_abs_epi32(_mm256_sub_epi32(ld(vals, k), vv)), vt);
+        let out = _mm256_or_si256(out_x, out_y);
+        let m_out = _mm256_movemask_ps(_mm256_castsi256_ps(out)) as u32;
+        let m_bad = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(out, off))) as u32;
+        near += 8 - m_out.count_ones();
+        agree += 8 - m_bad.count_ones();
+    }
+    (near as usize, agree as usize)
+}
 
-/// Builds the CSR weights. `neurons` must be grouped by `point` in increasing order and have
-/// non-negative coordinates.
-pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
-    let m = neurons.len();
-    if m == 0 {
-        return Csr {
-            indptr: vec![0],
-            ..Csr::default()
-        };
-    }
-    // Points and their neuron ranges.
-    let mut starts: Vec<usize> = Vec::new();
-    for (a, nr) in neurons.iter().enumerate() {
-        if a == 0 || nr.point != neurons[a - 1].point {
-            starts.push(a);
-        }
-    }
-    let n_pts = starts.len();
-    starts.push(m);
-    let pxy: Vec<(i32, i32)> = (0..n_pts)
-        .map(|p| (neurons[starts[p]].xl.max(0), neurons[starts[p]].yl.max(0)))
-        .collect();
-    let half = w.nbr_half.max(1);
-    let grid = PointGrid::new(&pxy, half);
-    // Neighbour lists (left points with candidates in the 40x40 window, grid order), n_i =
-    // their count. Branch-free: every point of the 3x3 cells is written, the cursor advances
-    // only for those inside the window.
-    let near_parts: Vec<Vec<Vec<u32>>> = (0..n_pts)
-        .collect::<Vec<_>>()
-        .par_chunks(POINTS_PER_TASK)
-        .map(|ps| {
-            ps.iter()
-                .map(|&p| {
-                    let (x, y) = pxy[p];
-                    let rs = grid.ranges(x, y);
-                    let mut items = vec![0u32; rs.iter().map(|&(s, e)| e - s).sum()];
-                    let mut n = 0;
-                    for (s, e) in rs {
-                        for k in s..e {
-                            let q = grid.items[k];
-                            items[n] = q;
-                            let inside = (grid.xs[k] - x).abs() <= half
-                                && (grid.ys[k] - y).abs() <= half
-                                && q as usize != p;
-                            n += usize::from(inside);
-                        }
+/// Read access to a symmetric weight matrix, one row at a time: the dynamics only ever need
+/// whole rows (the initial net inputs, then the row of each flipped neuron).
+pub trait Weights: Sync {
+    /// Number of neurons.
+    fn n(&self) -> usize;
+    /// Calls `f(b, T_ab)` for every stored entry of row `a`, always in the same order.
+    fn for_each_in_row(&self, a: usize, f: impl FnMut(u32, f32));
+    /// The net inputs `u_a = input_a + sum_b T_ab [state_b == 1]` of every neuron (each summed
+    /// in a fixed order in `f64`, independent of the thread count) and the number of entries.
+    fn initial_input(&self, state: &[u8], input: &[f64]) -> (Vec<f64>, usize) {
+        let (u, counts): (Vec<f64>, Vec<usize>) = (0..self.n())
+            .into_par_iter()
+            .map(|a| {
+                let (mut s, mut k) = (input[a], 0usize);
+                self.for_each_in_row(a, |b, t| {
+                    k += 1;
+                    if state[b as usize] == 1 {
+                        s += t as f64;
                     }
-                    items.truncate(n);
-                    items
-                })
-                .collect()
-        })
-        .collect();
-    let near: Vec<Vec<u32>> = near_parts.into_iter().flatten().collect();
-    // A / max(n_p, n_q, 1) = min(A / max(n_p, 1), A / max(n_q, 1)) exactly: division rounds
-    // monotonically (max for a negative A). One division per point instead of per pair.
-    let a_over_n: Vec<f32> = near
-        .iter()
-        .map(|v| w.a / (v.len() as f32).max(1.0))
-        .collect();
-    let a_pos = w.a >= 0.0;
-    // Neurons sharing a right pixel (column inhibition), wherever their left points are:
-    // neuron indices sorted by right pixel, and each neuron's group range in that order.
-    let mut by_right: Vec<u32> = (0..m as u32).collect();
-    let key = |a: u32| (neurons[a as usize].yr, neurons[a as usize].xr);
-    by_right.sort_unstable_by_key(|&a| (key(a), a));
-    let mut group = vec![(0usize, 0usize); m];
-    let mut g0 = 0;
-    for k in 1..=m {
-        if k == m || key(by_right[k]) != key(by_right[g0]) {
-            for &a in &by_right[g0..k] {
-                group[a as usize] = (g0, k);
-            }
-            g0 = k;
+                });
+                (s, k)
+            })
+            .unzip();
+        (u, counts.iter().sum())
+    }
+    /// `u_b += sign * T_ab` for every entry of row `a`.
+    fn add_row(&self, a: usize, sign: f64, u: &mut [f64]) {
+        self.for_each_in_row(a, |b, t| u[b as usize] += sign * t as f64);
+    }
+}
+
+impl Weights for Csr {
+    fn n(&self) -> usize {
+        Csr::n(self)
+    }
+    #[inline]
+    fn for_each_in_row(&self, a: usize, mut f: impl FnMut(u32, f32)) {
+        let (idx, val) = self.row(a);
+        for (&b, &t) in idx.iter().zip(val) {
+            f(b, t);
         }
     }
-    // Compatibility lookup per Chebyshev distance r of the two points (0..=half) over the
-    // integer squared disparity-vector difference q. A row ends where the f32 value has
-    // saturated at -1 (slope > 0, q past the crossing): larger q read the last entry, which is
-    // exactly what the formula gives there.
-    let span = |f: fn(&Neuron) -> i32| {
-        let lo = neurons.iter().map(f).min().unwrap_or(0);
-        let hi = neurons.iter().map(f).max().unwrap_or(0);
-        (hi - lo) as usize
+}
+
+/// The Hopfield channel's weights, computed when a row is read instead of stored: a row is a
+/// scan of the 5x5 grid cells around the neuron's left point, which costs about what reading
+/// a stored row costs, while a stored matrix (1-4 M entries on a Middlebury or KITTI pair) has
+/// to be built, written and paged in first. Row `a` (left point `p`), in this order:
+/// 1. the other candidates of `p`: `-B` (uniqueness along the row);
+/// 2. the candidates of other points with `a`'s right pixel, in right-pixel order: `-B`
+///    (uniqueness along the column);
+/// 3. the candidates of the other points in `p`'s 41x41 window, in grid order, except those
+///    with `a`'s right pixel (already in 2): `A / max(n_p, n_q, 1) * C(|d_a - d_b|, r)`,
+///    `n` = the points' window neighbour counts, `r` = their Chebyshev distance.
+///
+/// Every entry is a symmetric function of the pair, so `T` is symmetric.
+pub struct Network {
+    b: f32,
+    half: i32,
+    /// Neuron range of every left point (`starts[p]..starts[p + 1]`).
+    starts: Vec<usize>,
+    p_of: Vec<u32>,
+    pxy: Vec<(i32, i32)>,
+    /// `A / max(n_p, 1)` per point.
+    a_over_n: Vec<f32>,
+    a_pos: bool,
+    /// Neuron indices sorted by right pixel, each neuron's range in that order, and the rank
+    /// of its right pixel among the distinct right pixels.
+    by_right: Vec<u32>,
+    group: Vec<(u32, u32)>,
+    rank: Vec<u32>,
+    /// Point grid; `gstart[k]..gstart[k + 1]` are the neurons of the point at grid position
+    /// `k` in `cells` (so the cells of one grid row around a point are ONE contiguous range).
+    grid: PointGrid,
+    gstart: Vec<u32>,
+    cells: Cells,
+    /// Per neuron (original order): disparity vector.
+    dxs: Vec<i32>,
+    dys: Vec<i32>,
+    /// Compatibility per Chebyshev distance `r` (row `r`, `lut_stride` entries) over the
+    /// squared disparity-vector difference, each row padded with its saturated last value.
+    lut: Vec<f32>,
+    lut_stride: usize,
+}
+
+/// Lanes of the window scan: one AVX2 register of `f32`.
+const LANES: usize = 8;
+
+/// What a row's window scan reads of the neurons, as arrays in grid order (so the neurons of
+/// the 5 cells of one grid row are contiguous), each padded with `LANES` entries so that a
+/// block of lanes never reads past the end.
+#[derive(Default)]
+struct Cells {
+    x: Vec<i32>,
+    y: Vec<i32>,
+    dx: Vec<i32>,
+    dy: Vec<i32>,
+    point: Vec<u32>,
+    rank: Vec<u32>,
+    /// `A / max(n_q, 1)` of the neuron's point.
+    norm: Vec<f32>,
+    /// Neuron index (original order).
+    idx: Vec<u32>,
+}
+
+/// The row's own values a window scan compares against.
+#[derive(Clone, Copy)]
+struct RowKey {
+    x: i32,
+    y: i32,
+    dx: i32,
+    dy: i32,
+    point: u32,
+    rank: u32,
+    np: f32,
+    half: i32,
+    stride: usize,
+    a_pos: bool,
+}
+
+/// `T_ab` of the `LANES` neurons `j0..j0 + LANES` of `cells` (0 for those at or past `e` and
+/// for those not in the row: outside the window, the row's own point or right pixel), and
+/// which of them are in the row. The AVX2 version ([`lane_weights_avx2`]) performs the same
+/// integer and `f32` operations lane by lane: identical results.
+#[inline(always)]
+fn lane_weights(
+    c: &Cells,
+    lut: &[f32],
+    k: &RowKey,
+    j0: usize,
+    e: usize,
+) -> ([f32; LANES], [bool; LANES]) {
+    let (half, stride) = (k.half, k.stride as i32);
+    let n_valid = e.saturating_sub(j0).min(LANES);
+    let mut t = [0.0f32; LANES];
+    let mut in_row = [false; LANES];
+    for l in 0..LANES {
+        let j = j0 + l;
+        let (ddx, ddy) = ((c.x[j] - k.x).abs(), (c.y[j] - k.y).abs());
+        let stored = l < n_valid
+            && ddx <= half
+            && ddy <= half
+            && c.point[j] != k.point
+            && c.rank[j] != k.rank;
+        let nq = c.norm[j];
+        let nrm = if (k.np < nq) == k.a_pos { k.np } else { nq };
+        // Out-of-window lanes read row `half` (any valid row: their value is zeroed).
+        let r = ddx.max(ddy).min(half);
+        let (ex, ey) = (k.dx.wrapping_sub(c.dx[j]), k.dy.wrapping_sub(c.dy[j]));
+        let q = ex.wrapping_mul(ex).wrapping_add(ey.wrapping_mul(ey));
+        let q = q.clamp(0, stride - 1);
+        let cv = lut[(r * stride + q) as usize];
+        t[l] = if stored { nrm * cv } else { 0.0 };
+        in_row[l] = stored;
+    }
+    (t, in_row)
+}
+
+/// AVX2 body of [`lane_weights`]: the values as one register, the row membership as a lane
+/// mask (all ones where stored).
+///
+/// # Safety
+/// The CPU must support AVX2; `j0 + LANES` must not exceed the (padded) `cells` arrays, and
+/// `lut` must hold `(k.half + 1) * k.stride` values.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+unsafe fn lane_weights_avx2(
+    c: &Cells,
+    lut: &[f32],
+    k: &RowKey,
+    j0: usize,
+    e: usize,
+) -> (std::arch::x86_64::__m256, std::arch::x86_64::__m256i) {
+    use std::arch::x86_64::*;
+    let ld = |v: &[i32]| _mm256_loadu_si256(v.as_ptr().add(j0) as *const __m256i);
+    let ldu = |v: &[u32]| _mm256_loadu_si256(v.as_ptr().add(j0) as *const __m256i);
+    let stride = k.stride as i32;
+    let half = _mm256_set1_epi32(k.half);
+    let ddx = _mm256_abs_epi32(_mm256_sub_epi32(ld(&c.x), _mm256_set1_epi32(k.x)));
+    let ddy = _mm256_abs_epi32(_mm256_sub_epi32(ld(&c.y), _mm256_set1_epi32(k.y)));
+    let n_valid = e.saturating_sub(j0).min(LANES) as i32;
+    let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    let ones = _mm256_set1_epi32(-1);
+    let valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(n_valid), lane);
+    let in_x = _mm256_xor_si256(_mm256_cmpgt_epi32(ddx, half), ones);
+    let in_y = _mm256_xor_si256(_mm256_cmpgt_epi32(ddy, half), ones);
+    let other_p = _mm256_xor_si256(
+        _mm256_cmpeq_epi32(ldu(&c.point), _mm256_set1_epi32(k.point as i32)),
+        ones,
+    );
+    let other_r = _mm256_xor_si256(
+        _mm256_cmpeq_epi32(ldu(&c.rank), _mm256_set1_epi32(k.rank as i32)),
+        ones,
+    );
+    let stored = _mm256_and_si256(
+        _mm256_and_si256(valid, _mm256_and_si256(in_x, in_y)),
+        _mm256_and_si256(other_p, other_r),
+    );
+    let nq = _mm256_loadu_ps(c.norm.as_ptr().add(j0));
+    let np = _mm256_set1_ps(k.np);
+    // (np < nq) == a_pos picks np; NaN-free inputs, so LT_OQ is `<`.
+    let lt = _mm256_cmp_ps::<_CMP_LT_OQ>(np, nq);
+    let pick_np = if k.a_pos {
+        lt
+    } else {
+        _mm256_xor_ps(lt, _mm256_castsi256_ps(ones))
     };
-    let (max_dx, max_dy) = (span(Neuron::dx), span(Neuron::dy));
-    let max_q = max_dx * max_dx + max_dy * max_dy;
-    let luts: Vec<Vec<f32>> = (0..=half)
-        .map(|r| {
-            let theta = w.compat_theta as f64 + w.compat_grad as f64 * r as f64;
-            let mut row = Vec::new();
-            for q in 0..=max_q {
-                let v = compat((q as f64).sqrt(), theta, w.compat_slope as f64) as f32;
-                row.push(v);
-                if v == -1.0 && w.compat_slope > 0.0 && (q as f64).sqrt() > theta {
-                    break;
+    let nrm = _mm256_blendv_ps(nq, np, pick_np);
+    let r = _mm256_min_epi32(_mm256_max_epi32(ddx, ddy), half);
+    let ex = _mm256_sub_epi32(_mm256_set1_epi32(k.dx), ld(&c.dx));
+    let ey = _mm256_sub_epi32(_mm256_set1_epi32(k.dy), ld(&c.dy));
+    let q = _mm256_add_epi32(_mm256_mullo_epi32(ex, ex), _mm256_mullo_epi32(ey, ey));
+    let q = _mm256_min_epi32(
+        _mm256_max_epi32(q, _mm256_setzero_si256()),
+        _mm256_set1_epi32(stride - 1),
+    );
+    let idx = _mm256_add_epi32(_mm256_mullo_epi32(r, _mm256_set1_epi32(stride)), q);
+    let cv = _mm256_i32gather_ps::<4>(lut.as_ptr(), idx);
+    let t = _mm256_and_ps(_mm256_mul_ps(nrm, cv), _mm256_castsi256_ps(stored));
+    (t, stored)
+}
+
+/// Does the running CPU have AVX2 (the answer is cached by std)?
+#[inline]
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Sum over the window part of a row of `T_ab * on_b` (`on` in grid order): one `f64`
+/// accumulator per lane, added up in lane order at the end; and the part's entry count.
+fn window_input(
+    c: &Cells,
+    lut: &[f32],
+    k: &RowKey,
+    ranges: &[(usize, usize)],
+    on: &[f32],
+) -> (f64, usize) {
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2() {
+        // SAFETY: AVX2 is present; `cells` and `on` are padded by LANES and `lut` holds
+        // (half + 1) * stride values (built so in `Network::new`).
+        return unsafe { window_input_avx2(c, lut, k, ranges, on) };
+    }
+    window_input_portable(c, lut, k, ranges, on)
+}
+
+/// Portable body of [`window_input`].
+fn window_input_portable(
+    c: &Cells,
+    lut: &[f32],
+    k: &RowKey,
+    ranges: &[(usize, usize)],
+    on: &[f32],
+) -> (f64, usize) {
+    let mut acc = [0.0f64; LANES];
+    let mut n = 0usize;
+    for &(s, e) in ranges {
+        for j0 in (s..e).step_by(LANES) {
+            let (t, in_row) = lane_weights(c, lut, k, j0, e);
+            for l in 0..LANES {
+                acc[l] += (t[l] * on[j0 + l]) as f64;
+            }
+            n += in_row.iter().filter(|&&v| v).count();
+        }
+    }
+    (acc.iter().sum(), n)
+}
+
+/// AVX2 body of [`window_input`].
+///
+/// # Safety
+/// As [`lane_weights_avx2`]; `on` padded like `cells`.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn window_input_avx2(
+    c: &Cells,
+    lut: &[f32],
+    k: &RowKey,
+    ranges: &[(usize, usize)],
+    on: &[f32],
+) -> (f64, usize) {
+    use std::arch::x86_64::*;
+    let (mut lo, mut hi) = (_mm256_setzero_pd(), _mm256_setzero_pd());
+    let mut n = 0usize;
+    for &(s, e) in ranges {
+        for j0 in (s..e).step_by(LANES) {
+            let (t, stored) = lane_weights_avx2(c, lut, k, j0, e);
+            let v = _mm256_mul_ps(t, _mm256_loadu_ps(on.as_ptr().add(j0)));
+            lo = _mm256_add_pd(lo, _mm256_cvtps_pd(_mm256_castps256_ps128(v)));
+            hi = _mm256_add_pd(hi, _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(v)));
+            n += _mm256_movemask_ps(_mm256_castsi256_ps(stored)).count_ones() as usize;
+        }
+    }
+    let mut acc = [0.0f64; LANES];
+    _mm256_storeu_pd(acc.as_mut_ptr(), lo);
+    _mm256_storeu_pd(acc.as_mut_ptr().add(4), hi);
+    (acc.iter().sum(), n)
+}
+
+/// `u_b += sign * T_ab` over the window part of a row (lanes not in the row add +-0, which
+/// leaves a net input bit-identical).
+fn window_add(
+    c: &Cells,
+    lut: &[f32],
+    k: &RowKey,
+    ranges: &[(usize, usize)],
+    sign: f64,
+    u: &mut [f64],
+) {
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2() {
+        // SAFETY: as in `window_input`.
+        return unsafe { window_add_avx2(c, lut, k, ranges, sign, u) };
+    }
+    window_add_portable(c, lut, k, ranges, sign, u)
+}
+
+/// Portable body of [`window_add`].
+fn window_add_portable(
+    c: &Cells,
+    lut: &[f32],
+    k: &RowKey,
+    ranges: &[(usize, usize)],
+    sign: f64,
+    u: &mut [f64],
+) {
+    for &(s, e) in ranges {
+        for j0 in (s..e).step_by(LANES) {
+            let (t, _) = lane_weights(c, lut, k, j0, e);
+            for (l, &tl) in t.iter().enumerate() {
+                u[c.idx[j0 + l] as usize] += sign * tl as f64;
+            }
+        }
+    }
+}
+
+/// AVX2 body of [`window_add`].
+///
+/// # Safety
+/// As [`lane_weights_avx2`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn window_add_avx2(
+    c: &Cells,
+    lut: &[f32],
+    k: &RowKey,
+    ranges: &[(usize, usize)],
+    sign: f64,
+    u: &mut [f64],
+) {
+    use std::arch::x86_64::*;
+    let mut t = [0.0f32; LANES];
+    for &(s, e) in ranges {
+        for j0 in (s..e).step_by(LANES) {
+            let (tv, stored) = lane_weights_avx2(c, lut, k, j0, e);
+            _mm256_storeu_ps(t.as_mut_ptr(), tv);
+            // Only the lanes in the row: the others would add +-0.
+            let mut m = _mm256_movemask_ps(_mm256_castsi256_ps(stored)) as u32;
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                u[c.idx[j0 + l] as usize] += sign * t[l] as f64;
+                m &= m - 1;
+            }
+        }
+    }
+}
+
+impl Network {
+    /// The network of `neurons`, which must be grouped by `point` in increasing order and
+    /// have non-negative coordinates.
+    pub fn new(neurons: &[Neuron], w: &EnergyWeights) -> Self {
+        let m = neurons.len();
+        let mut starts: Vec<usize> = Vec::new();
+        for (a, nr) in neurons.iter().enumerate() {
+            if a == 0 || nr.point != neurons[a - 1].point {
+                starts.push(a);
+            }
+        }
+        let n_pts = starts.len();
+        starts.push(m);
+        let pxy: Vec<(i32, i32)> = (0..n_pts)
+            .map(|p| (neurons[starts[p]].xl.max(0), neurons[starts[p]].yl.max(0)))
+            .collect();
+        let half = w.nbr_half.max(1);
+        let grid = PointGrid::new(&pxy, half);
+        // Window neighbour counts n_p from a summed-area table of the point positions (four
+        // reads per point instead of a scan of its 5x5 grid cells).
+        let counts = window_counts(&pxy, half);
+        // A / max(n_p, n_q, 1) = min(A / max(n_p, 1), A / max(n_q, 1)) exactly: division rounds
+        // monotonically (max for a negative A). One division per point instead of per pair.
+        let a_over_n: Vec<f32> = counts.iter().map(|&n| w.a / (n as f32).max(1.0)).collect();
+        let p_of: Vec<u32> = (0..n_pts)
+            .flat_map(|p| std::iter::repeat_n(p as u32, starts[p + 1] - starts[p]))
+            .collect();
+        let dxs: Vec<i32> = neurons.iter().map(Neuron::dx).collect();
+        let dys: Vec<i32> = neurons.iter().map(Neuron::dy).collect();
+        // Column groups: neurons sharing a right pixel, wherever their left points are.
+        let key = |a: u32| (neurons[a as usize].yr, neurons[a as usize].xr);
+        let mut by_right: Vec<u32> = (0..m as u32).collect();
+        by_right.sort_unstable_by_key(|&a| (key(a), a));
+        let mut group = vec![(0u32, 0u32); m];
+        let mut rank = vec![0u32; m];
+        let (mut g0, mut n_groups) = (0, 0u32);
+        for k in 1..=m {
+            if k == m || key(by_right[k]) != key(by_right[g0]) {
+                for &a in &by_right[g0..k] {
+                    group[a as usize] = (g0 as u32, k as u32);
+                    rank[a as usize] = n_groups;
+                }
+                g0 = k;
+                n_groups += 1;
+            }
+        }
+        // Grid-ordered neuron arrays.
+        let mut gstart = Vec::with_capacity(grid.items.len() + 1);
+        gstart.push(0u32);
+        let mut cells = Cells::default();
+        for &q in &grid.items {
+            let q = q as usize;
+            for b in starts[q]..starts[q + 1] {
+                cells.x.push(pxy[q].0);
+                cells.y.push(pxy[q].1);
+                cells.dx.push(dxs[b]);
+                cells.dy.push(dys[b]);
+                cells.point.push(q as u32);
+                cells.rank.push(rank[b]);
+                cells.norm.push(a_over_n[q]);
+                cells.idx.push(b as u32);
+            }
+            gstart.push(cells.idx.len() as u32);
+        }
+        let padded = cells.idx.len() + LANES;
+        cells.x.resize(padded, 0);
+        cells.y.resize(padded, 0);
+        cells.dx.resize(padded, 0);
+        cells.dy.resize(padded, 0);
+        cells.point.resize(padded, 0);
+        cells.rank.resize(padded, 0);
+        cells.norm.resize(padded, 0.0);
+        cells.idx.resize(padded, 0);
+        // Compatibility lookup per Chebyshev distance r of the two points (0..=half) over the
+        // integer squared disparity-vector difference q. A row ends where the f32 value has
+        // saturated at -1 (slope > 0, q past the crossing): larger q read the last entry, which
+        // is exactly what the formula gives there.
+        let span = |v: &[i32]| {
+            let lo = v.iter().copied().min().unwrap_or(0);
+            let hi = v.iter().copied().max().unwrap_or(0);
+            (hi - lo) as usize
+        };
+        let (max_dx, max_dy) = (span(&dxs), span(&dys));
+        let max_q = max_dx * max_dx + max_dy * max_dy;
+        let rows: Vec<Vec<f32>> = (0..=half)
+            .map(|r| {
+                let theta = w.compat_theta as f64 + w.compat_grad as f64 * r as f64;
+                let mut row = Vec::new();
+                for q in 0..=max_q {
+                    let v = compat((q as f64).sqrt(), theta, w.compat_slope as f64) as f32;
+                    row.push(v);
+                    if v == -1.0 && w.compat_slope > 0.0 && (q as f64).sqrt() > theta {
+                        break;
+                    }
+                }
+                row
+            })
+            .collect();
+        let lut_stride = rows.iter().map(Vec::len).max().unwrap_or(1);
+        let mut lut = Vec::with_capacity(rows.len() * lut_stride);
+        for row in &rows {
+            lut.extend_from_slice(row);
+            let last = row[row.len() - 1];
+            lut.resize(lut.len() + lut_stride - row.len(), last);
+        }
+        Network {
+            b: w.b,
+            half,
+            starts,
+            p_of,
+            pxy,
+            a_over_n,
+            a_pos: w.a >= 0.0,
+            by_right,
+            group,
+            rank,
+            grid,
+            gstart,
+            cells,
+            dxs,
+            dys,
+            lut,
+            lut_stride,
+        }
+    }
+
+    /// Number of stored entries (what a CSR of the network would hold).
+    pub fn nnz(&self) -> usize {
+        (0..self.n())
+            .into_par_iter()
+            .map(|a| {
+                let mut k = 0usize;
+                self.for_each_in_row(a, |_, _| k += 1);
+                k
+            })
+            .sum()
+    }
+
+    fn key(&self, a: usize) -> RowKey {
+        let p = self.p_of[a] as usize;
+        RowKey {
+            x: self.pxy[p].0,
+            y: self.pxy[p].1,
+            dx: self.dxs[a],
+            dy: self.dys[a],
+            point: p as u32,
+            rank: self.rank[a],
+            np: self.a_over_n[p],
+            half: self.half,
+            stride: self.lut_stride,
+            a_pos: self.a_pos,
+        }
+    }
+
+    /// The `cells` ranges of the 5 grid rows around `a`'s point.
+    fn window_ranges(&self, a: usize) -> [(usize, usize); 2 * GRID_SUB as usize + 1] {
+        let (x, y) = self.pxy[self.p_of[a] as usize];
+        self.grid
+            .ranges(x, y)
+            .map(|(s, e)| (self.gstart[s] as usize, self.gstart[e] as usize))
+    }
+
+    /// Calls `f(b, -B)` for the uniqueness part of row `a`: the other candidates of its point,
+    /// then the other points' candidates with its right pixel.
+    #[inline]
+    fn for_each_unique(&self, a: usize, mut f: impl FnMut(u32, f32)) {
+        let p = self.p_of[a] as usize;
+        for b in self.starts[p]..self.starts[p + 1] {
+            if b != a {
+                f(b as u32, -self.b);
+            }
+        }
+        let (gs, ge) = self.group[a];
+        for &b in &self.by_right[gs as usize..ge as usize] {
+            if self.p_of[b as usize] as usize != p {
+                f(b, -self.b);
+            }
+        }
+    }
+}
+
+impl Weights for Network {
+    fn n(&self) -> usize {
+        self.p_of.len()
+    }
+
+    fn for_each_in_row(&self, a: usize, mut f: impl FnMut(u32, f32)) {
+        self.for_each_unique(a, &mut f);
+        let k = self.key(a);
+        for (s, e) in self.window_ranges(a) {
+            for j0 in (s..e).step_by(LANES) {
+                let (t, in_row) = lane_weights(&self.cells, &self.lut, &k, j0, e);
+                for l in 0..LANES {
+                    if in_row[l] {
+                        f(self.cells.idx[j0 + l], t[l]);
+                    }
                 }
             }
-            row
+        }
+    }
+
+    fn initial_input(&self, state: &[u8], input: &[f64]) -> (Vec<f64>, usize) {
+        // The state in grid order, as f32 factors of the lanes (the padding off).
+        let n = self.cells.idx.len() - LANES;
+        let mut on: Vec<f32> = self.cells.idx[..n]
+            .iter()
+            .map(|&b| f32::from(state[b as usize]))
+            .collect();
+        on.resize(n + LANES, 0.0);
+        let (u, counts): (Vec<f64>, Vec<usize>) = (0..self.n())
+            .into_par_iter()
+            .map(|a| {
+                let (mut s, mut n) = (input[a], 0usize);
+                self.for_each_unique(a, |b, t| {
+                    n += 1;
+                    if state[b as usize] == 1 {
+                        s += t as f64;
+                    }
+                });
+                let k = self.key(a);
+                let (w, nw) = window_input(&self.cells, &self.lut, &k, &self.window_ranges(a), &on);
+                (s + w, n + nw)
+            })
+            .unzip();
+        (u, counts.iter().sum())
+    }
+
+    fn add_row(&self, a: usize, sign: f64, u: &mut [f64]) {
+        self.for_each_unique(a, |b, t| u[b as usize] += sign * t as f64);
+        let k = self.key(a);
+        window_add(&self.cells, &self.lut, &k, &self.window_ranges(a), sign, u);
+    }
+}
+
+/// Number of other points within `half` of each point in both coordinates.
+fn window_counts(pxy: &[(i32, i32)], half: i32) -> Vec<usize> {
+    let w = pxy.iter().map(|p| p.0).max().unwrap_or(0) as usize + 1;
+    let h = pxy.iter().map(|p| p.1).max().unwrap_or(0) as usize + 1;
+    // sat[(y + 1) * (w + 1) + x + 1] = points with both coordinates <= (x, y).
+    let sw = w + 1;
+    let mut sat = vec![0u32; sw * (h + 1)];
+    for &(x, y) in pxy {
+        sat[(y as usize + 1) * sw + x as usize + 1] += 1;
+    }
+    for y in 1..=h {
+        let mut run = 0u32;
+        for x in 1..=w {
+            run += sat[y * sw + x];
+            sat[y * sw + x] = run + sat[(y - 1) * sw + x];
+        }
+    }
+    let at = |x: i32, y: i32| -> u32 {
+        if x < 0 || y < 0 {
+            return 0;
+        }
+        sat[(y.min(h as i32 - 1) as usize + 1) * sw + x.min(w as i32 - 1) as usize + 1]
+    };
+    pxy.iter()
+        .map(|&(x, y)| {
+            let (x0, x1, y0, y1) = (x - half - 1, x + half, y - half - 1, y + half);
+            (at(x1, y1) + at(x0, y0) - at(x0, y1) - at(x1, y0)) as usize - 1
         })
-        .collect();
-    // Structure of arrays of what the rows read.
-    let dxs: Vec<i32> = neurons.iter().map(Neuron::dx).collect();
-    let dys: Vec<i32> = neurons.iter().map(Neuron::dy).collect();
-    let rkey: Vec<u64> = neurons
-        .iter()
-        .map(|n| ((n.yr as u32 as u64) << 32) | n.xr as u32 as u64)
-        .collect();
-    let p_of: Vec<u32> = (0..n_pts)
-        .flat_map(|p| std::iter::repeat_n(p as u32, starts[p + 1] - starts[p]))
-        .collect();
-    // Pass 1: row lengths. Row of `a` (point p): the other candidates of p, the other points'
-    // candidates with a's right pixel, and every candidate of p's window points except those
-    // with a's right pixel (already in the column part).
-    let win_cands: Vec<usize> = near
-        .par_iter()
-        .map(|nb| {
-            nb.iter()
-                .map(|&q| starts[q as usize + 1] - starts[q as usize])
-                .sum()
-        })
-        .collect();
-    let lens: Vec<usize> = (0..m)
+        .collect()
+}
+
+/// Builds the CSR weights (the [`Network`]'s rows, stored). `neurons` must be grouped by
+/// `point` in increasing order and have non-negative coordinates.
+pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
+    let net = Network::new(neurons, w);
+    let rows: Vec<(Vec<u32>, Vec<f32>)> = (0..net.n())
         .into_par_iter()
         .map(|a| {
-            let p = p_of[a] as usize;
-            let (gs, ge) = group[a];
-            let (mut col, mut col_in_win) = (0, 0);
-            for &b in &by_right[gs..ge] {
-                let q = p_of[b as usize] as usize;
-                if q != p {
-                    col += 1;
-                    let (dx, dy) = (pxy[q].0 - pxy[p].0, pxy[q].1 - pxy[p].1);
-                    col_in_win += usize::from(dx.abs() <= half && dy.abs() <= half);
-                }
-            }
-            (starts[p + 1] - starts[p] - 1) + col + win_cands[p] - col_in_win
+            let (mut idx, mut val) = (Vec::new(), Vec::new());
+            net.for_each_in_row(a, |b, t| {
+                idx.push(b);
+                val.push(t);
+            });
+            (idx, val)
         })
         .collect();
-    let mut indptr = Vec::with_capacity(m + 1);
-    indptr.push(0usize);
-    for &l in &lens {
-        indptr.push(indptr[indptr.len() - 1] + l);
+    let mut csr = Csr {
+        indptr: vec![0],
+        ..Csr::default()
+    };
+    for (idx, val) in rows {
+        csr.indices.extend(idx);
+        csr.data.extend(val);
+        csr.indptr.push(csr.indices.len());
     }
-    let nnz = indptr[m];
-    let mut indices = vec![0u32; nnz];
-    let mut data = vec![0.0f32; nnz];
-    // Pass 2: every task writes its points' rows straight into its slice of the CSR arrays.
-    let mut tasks: Vec<(usize, &mut [u32], &mut [f32])> = Vec::new();
-    {
-        let (mut ri, mut rd) = (indices.as_mut_slice(), data.as_mut_slice());
-        for p0 in (0..n_pts).step_by(POINTS_PER_TASK) {
-            let p1 = (p0 + POINTS_PER_TASK).min(n_pts);
-            let n = indptr[starts[p1]] - indptr[starts[p0]];
-            let (ti, rest_i) = std::mem::take(&mut ri).split_at_mut(n);
-            let (td, rest_d) = std::mem::take(&mut rd).split_at_mut(n);
-            tasks.push((p0, ti, td));
-            ri = rest_i;
-            rd = rest_d;
-        }
-    }
-    tasks.into_par_iter().for_each(|(p0, ti, td)| {
-        let p1 = (p0 + POINTS_PER_TASK).min(n_pts);
-        let mut k = 0usize;
-        let mut put = |b: u32, v: f32| {
-            ti[k] = b;
-            td[k] = v;
-            k += 1;
-        };
-        for p in p0..p1 {
-            for a in starts[p]..starts[p + 1] {
-                // Same left point: uniqueness (row) inhibition.
-                for b in starts[p]..starts[p + 1] {
-                    if b != a {
-                        put(b as u32, -w.b);
-                    }
-                }
-                // Same right pixel, other left point: uniqueness (column) inhibition.
-                let (gs, ge) = group[a];
-                for &b in &by_right[gs..ge] {
-                    if p_of[b as usize] as usize != p {
-                        put(b, -w.b);
-                    }
-                }
-                // Compatibility with the candidates of the other points in the 40x40 window
-                // (l != k: a shared right pixel is inhibited above instead).
-                let (ka, dxa, dya) = (rkey[a], dxs[a], dys[a]);
-                for &q in &near[p] {
-                    let q = q as usize;
-                    let (np, nq) = (a_over_n[p], a_over_n[q]);
-                    let norm = if (np < nq) == a_pos { np } else { nq };
-                    let r = (pxy[q].0 - pxy[p].0).abs().max((pxy[q].1 - pxy[p].1).abs()) as usize;
-                    let lut = &luts[r];
-                    let last = lut.len() - 1;
-                    for b in starts[q]..starts[q + 1] {
-                        if rkey[b] != ka {
-                            let ex = (dxa - dxs[b]).unsigned_abs() as usize;
-                            let ey = (dya - dys[b]).unsigned_abs() as usize;
-                            put(b as u32, norm * lut[(ex * ex + ey * ey).min(last)]);
-                        }
-                    }
-                }
-            }
-        }
-        debug_assert_eq!(k, ti.len());
-    });
-    Csr {
-        indptr,
-        indices,
-        data,
-    }
+    csr
 }
 
 /// SplitMix64: a tiny, well-mixed generator (mirrored exactly by the NumPy reference).
@@ -443,6 +965,8 @@ pub struct Dynamics {
     /// Sweeps run (the last one without a flip when `converged`).
     pub sweeps: usize,
     pub converged: bool,
+    /// Entries of the weight matrix (counted while the initial net inputs are summed).
+    pub nnz: usize,
 }
 
 /// Energy `E = -1/2 V^T T V - I^T V` from the net inputs `u = T V + I`.
@@ -456,30 +980,18 @@ fn energy(state: &[u8], u: &[f64], input: &[f64]) -> f64 {
 }
 
 /// Runs the asynchronous dynamics from `init` until a sweep without a flip (or `max_sweeps`).
-pub fn run_dynamics(
-    csr: &Csr,
+pub fn run_dynamics<W: Weights>(
+    net: &W,
     input: &[f64],
     init: &[u8],
     seed: u64,
     max_sweeps: usize,
 ) -> Dynamics {
-    let m = csr.n();
+    let m = net.n();
     let mut state = init.to_vec();
     // Initial net inputs u_a = I_a + sum_b T_ab V_b, each from its own row (T is symmetric):
     // in parallel, every sum in row order, so independent of the thread count.
-    let mut u: Vec<f64> = (0..m)
-        .into_par_iter()
-        .map(|a| {
-            let (idx, val) = csr.row(a);
-            let mut s = input[a];
-            for (&b, &t) in idx.iter().zip(val) {
-                if init[b as usize] == 1 {
-                    s += t as f64;
-                }
-            }
-            s
-        })
-        .collect();
+    let (mut u, nnz) = net.initial_input(init, input);
     let mut trace = vec![energy(&state, &u, input)];
     let mut rng = SplitMix64::new(seed);
     let mut order: Vec<u32> = (0..m as u32).collect();
@@ -501,10 +1013,7 @@ pub fn run_dynamics(
                 state[a] = new;
                 flips += 1;
                 let sign = if new == 1 { 1.0 } else { -1.0 };
-                let (idx, val) = csr.row(a);
-                for (&b, &t) in idx.iter().zip(val) {
-                    u[b as usize] += sign * t as f64;
-                }
+                net.add_row(a, sign, &mut u);
             }
         }
         sweeps += 1;
@@ -516,5 +1025,122 @@ pub fn run_dynamics(
         energy_trace: trace,
         sweeps,
         converged,
+        nnz,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Random neurons: points on a 160x120 image, 1-3 candidates each, some sharing a right
+    /// pixel, disparities 0-40 and vertical disparities -1..=1.
+    fn random_neurons(seed: u64) -> Vec<Neuron> {
+        let mut rng = SplitMix64::new(seed);
+        let mut next = |n: u64| (rng.next_u64() % n) as i32;
+        let mut out = Vec::new();
+        for p in 0..900u32 {
+            let (x, y) = (next(160) + 40, next(120));
+            for _ in 0..1 + next(3) {
+                let d = next(41);
+                out.push(Neuron {
+                    point: p,
+                    xl: x,
+                    yl: y,
+                    xr: x - d,
+                    yr: (y + next(3) - 1).max(0),
+                    sim: 0.8,
+                    edge_ok: true,
+                    halves_fail: 0,
+                    centre_ok: true,
+                    sub: 0.0,
+                });
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn avx2_and_portable_row_scans_are_bit_identical() {
+        for seed in 0..3 {
+            let neurons = random_neurons(seed);
+            let net = Network::new(&neurons, &EnergyWeights::default());
+            let on: Vec<f32> = (0..net.cells.idx.len())
+                .map(|j| {
+                    if j % 3 == 0 || j >= net.cells.idx.len() - LANES {
+                        0.0
+                    } else {
+                        1.0
+                    }
+                })
+                .collect();
+            let m = neurons.len();
+            let (mut u_simd, mut u_port) = (vec![0.5f64; m], vec![0.5f64; m]);
+            for a in 0..m {
+                let k = net.key(a);
+                let ranges = net.window_ranges(a);
+                let want = window_input_portable(&net.cells, &net.lut, &k, &ranges, &on);
+                assert_eq!(window_input(&net.cells, &net.lut, &k, &ranges, &on), want);
+                let sign = if a % 2 == 0 { 1.0 } else { -1.0 };
+                window_add(&net.cells, &net.lut, &k, &ranges, sign, &mut u_simd);
+                window_add_portable(&net.cells, &net.lut, &k, &ranges, sign, &mut u_port);
+            }
+            assert_eq!(u_simd, u_port);
+        }
+    }
+
+    #[test]
+    fn implicit_rows_give_the_stored_matrix_dynamics() {
+        let neurons = random_neurons(7);
+        let w = EnergyWeights::default();
+        let net = Network::new(&neurons, &w);
+        let csr = build_weights(&neurons, &w);
+        let m = neurons.len();
+        let input: Vec<f64> = (0..m).map(|a| 0.2 - 0.01 * (a % 7) as f64).collect();
+        let init: Vec<u8> = (0..m).map(|a| u8::from(a % 4 != 0)).collect();
+        // The initial net inputs differ only by the order of the f64 sums.
+        let (u_net, nnz) = net.initial_input(&init, &input);
+        let (u_csr, nnz_csr) = csr.initial_input(&init, &input);
+        assert_eq!((nnz, nnz_csr), (csr.nnz(), csr.nnz()));
+        assert!(nnz > 10_000, "{nnz}");
+        for (a, b) in u_net.iter().zip(&u_csr) {
+            assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()), "{a} vs {b}");
+        }
+        let (dn, dc) = (
+            run_dynamics(&net, &input, &init, 5, 100),
+            run_dynamics(&csr, &input, &init, 5, 100),
+        );
+        assert!(dn.converged && dn.sweeps >= 2);
+        assert_eq!(dn.state, dc.state);
+        assert_eq!(dn.nnz, dc.nnz);
+    }
+
+    #[test]
+    fn window_counts_equal_a_brute_force_count() {
+        let neurons = random_neurons(3);
+        let pxy: Vec<(i32, i32)> = neurons.iter().map(|n| (n.xl, n.yl)).collect();
+        let mut pxy_u = pxy.clone();
+        pxy_u.dedup();
+        for half in [1, 7, 20] {
+            let got = window_counts(&pxy_u, half);
+            let grid = PointGrid::new(&pxy_u, half);
+            let vals: Vec<i32> = grid.items.iter().map(|&k| (k % 5) as i32).collect();
+            for (i, &(x, y)) in pxy_u.iter().enumerate() {
+                let inside =
+                    |&(qx, qy): &(i32, i32)| (qx - x).abs() <= half && (qy - y).abs() <= half;
+                let want = pxy_u.iter().filter(|q| inside(q)).count();
+                assert_eq!(got[i], want - 1);
+                let agree = grid
+                    .items
+                    .iter()
+                    .zip(&vals)
+                    .filter(|&(&k, &v)| inside(&pxy_u[k as usize]) && (v - 2).abs() <= 1)
+                    .count();
+                assert_eq!(
+                    grid.count_in_window((x, y), half, &vals, 2, 1),
+                    (want, agree)
+                );
+            }
+        }
     }
 }
