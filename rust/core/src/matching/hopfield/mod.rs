@@ -630,15 +630,8 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
     }
     // Support (positive weights from active neurons, summed in row order in f64) of the
     // neurons the rule reads: the active alternatives, else the best candidate.
-    let support_of = |a: usize| -> f64 {
-        let mut s = 0.0f64;
-        net.for_each_in_row(a, |b, t| {
-            if t > 0.0 && state[b as usize] == 1 {
-                s += t as f64;
-            }
-        });
-        s
-    };
+    let on = net.grid_state(state);
+    let support_of = |a: usize| net.support(a, state, &on);
     let weak: Vec<bool> = groups
         .par_iter()
         .map(|&(a, e)| {

@@ -500,9 +500,10 @@ fn has_avx2() -> bool {
     }
 }
 
-/// Sum over the window part of a row of `T_ab * on_b` (`on` in grid order): one `f64`
-/// accumulator per lane, added up in lane order at the end; and the part's entry count.
-fn window_input(
+/// Sum over the window part of a row of `T_ab * on_b` (`on` in grid order; with `POS`, the
+/// positive `T_ab` only): one `f64` accumulator per lane, added up in lane order at the end;
+/// and the part's entry count.
+fn window_input<const POS: bool>(
     c: &Cells,
     lut: &[f32],
     k: &RowKey,
@@ -513,13 +514,13 @@ fn window_input(
     if has_avx2() {
         // SAFETY: AVX2 is present; `cells` and `on` are padded by LANES and `lut` holds
         // (half + 1) * stride values (built so in `Network::new`).
-        return unsafe { window_input_avx2(c, lut, k, ranges, on) };
+        return unsafe { window_input_avx2::<POS>(c, lut, k, ranges, on) };
     }
-    window_input_portable(c, lut, k, ranges, on)
+    window_input_portable::<POS>(c, lut, k, ranges, on)
 }
 
 /// Portable body of [`window_input`].
-fn window_input_portable(
+fn window_input_portable<const POS: bool>(
     c: &Cells,
     lut: &[f32],
     k: &RowKey,
@@ -532,7 +533,8 @@ fn window_input_portable(
         for j0 in (s..e).step_by(LANES) {
             let (t, in_row) = lane_weights(c, lut, k, j0, e);
             for l in 0..LANES {
-                acc[l] += (t[l] * on[j0 + l]) as f64;
+                let tl = if !POS || t[l] > 0.0 { t[l] } else { 0.0 };
+                acc[l] += (tl * on[j0 + l]) as f64;
             }
             n += in_row.iter().filter(|&&v| v).count();
         }
@@ -546,7 +548,7 @@ fn window_input_portable(
 /// As [`lane_weights_avx2`]; `on` padded like `cells`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn window_input_avx2(
+unsafe fn window_input_avx2<const POS: bool>(
     c: &Cells,
     lut: &[f32],
     k: &RowKey,
@@ -558,7 +560,10 @@ unsafe fn window_input_avx2(
     let mut n = 0usize;
     for &(s, e) in ranges {
         for j0 in (s..e).step_by(LANES) {
-            let (t, stored) = lane_weights_avx2(c, lut, k, j0, e);
+            let (mut t, stored) = lane_weights_avx2(c, lut, k, j0, e);
+            if POS {
+                t = _mm256_and_ps(t, _mm256_cmp_ps::<_CMP_GT_OQ>(t, _mm256_setzero_ps()));
+            }
             let v = _mm256_mul_ps(t, _mm256_loadu_ps(on.as_ptr().add(j0)));
             lo = _mm256_add_pd(lo, _mm256_cvtps_pd(_mm256_castps256_ps128(v)));
             hi = _mm256_add_pd(hi, _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(v)));
@@ -777,6 +782,30 @@ impl Network {
             .sum()
     }
 
+    /// `state` (0/1 per neuron) in grid order, as `f32` factors of the lanes (padding 0).
+    pub fn grid_state(&self, state: &[u8]) -> Vec<f32> {
+        let n = self.cells.idx.len() - LANES;
+        let mut on: Vec<f32> = self.cells.idx[..n]
+            .iter()
+            .map(|&b| f32::from(state[b as usize]))
+            .collect();
+        on.resize(n + LANES, 0.0);
+        on
+    }
+
+    /// Support of neuron `a`: the sum of its positive weights from active neurons (`on` from
+    /// [`Network::grid_state`]), in a fixed order.
+    pub fn support(&self, a: usize, state: &[u8], on: &[f32]) -> f64 {
+        let mut s = 0.0f64;
+        self.for_each_unique(a, |b, t| {
+            if t > 0.0 && state[b as usize] == 1 {
+                s += t as f64;
+            }
+        });
+        let k = self.key(a);
+        s + window_input::<true>(&self.cells, &self.lut, &k, &self.window_ranges(a), on).0
+    }
+
     fn key(&self, a: usize) -> RowKey {
         let p = self.p_of[a] as usize;
         RowKey {
@@ -841,13 +870,7 @@ impl Weights for Network {
     }
 
     fn initial_input(&self, state: &[u8], input: &[f64]) -> (Vec<f64>, usize) {
-        // The state in grid order, as f32 factors of the lanes (the padding off).
-        let n = self.cells.idx.len() - LANES;
-        let mut on: Vec<f32> = self.cells.idx[..n]
-            .iter()
-            .map(|&b| f32::from(state[b as usize]))
-            .collect();
-        on.resize(n + LANES, 0.0);
+        let on = self.grid_state(state);
         let (u, counts): (Vec<f64>, Vec<usize>) = (0..self.n())
             .into_par_iter()
             .map(|a| {
@@ -859,7 +882,8 @@ impl Weights for Network {
                     }
                 });
                 let k = self.key(a);
-                let (w, nw) = window_input(&self.cells, &self.lut, &k, &self.window_ranges(a), &on);
+                let (w, nw) =
+                    window_input::<false>(&self.cells, &self.lut, &k, &self.window_ranges(a), &on);
                 (s + w, n + nw)
             })
             .unzip();
@@ -1079,8 +1103,16 @@ mod tests {
             for a in 0..m {
                 let k = net.key(a);
                 let ranges = net.window_ranges(a);
-                let want = window_input_portable(&net.cells, &net.lut, &k, &ranges, &on);
-                assert_eq!(window_input(&net.cells, &net.lut, &k, &ranges, &on), want);
+                let want = window_input_portable::<false>(&net.cells, &net.lut, &k, &ranges, &on);
+                assert_eq!(
+                    window_input::<false>(&net.cells, &net.lut, &k, &ranges, &on),
+                    want
+                );
+                let want = window_input_portable::<true>(&net.cells, &net.lut, &k, &ranges, &on);
+                assert_eq!(
+                    window_input::<true>(&net.cells, &net.lut, &k, &ranges, &on),
+                    want
+                );
                 let sign = if a % 2 == 0 { 1.0 } else { -1.0 };
                 window_add(&net.cells, &net.lut, &k, &ranges, sign, &mut u_simd);
                 window_add_portable(&net.cells, &net.lut, &k, &ranges, sign, &mut u_port);
