@@ -3,6 +3,8 @@ ValueError and never another exception type)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import cv2
 import numpy as np
 import pytest
@@ -11,6 +13,7 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from stereovision._validate import (
+    LUMA_WEIGHTS_BGR,
     as_bgr_uint8,
     as_gray_float,
     as_gray_uint8,
@@ -194,3 +197,36 @@ def test_positive_finite_accepts(value: object) -> None:
 def test_positive_finite_rejects(value: object) -> None:
     with pytest.raises(ValueError, match=r"^baseline: expected a positive finite number"):
         positive_finite(value, "baseline")
+
+
+def _numpy_grey(arr: np.ndarray) -> np.ndarray:
+    """The NumPy path of as_gray_float for uint8 input (what the Rust conversion replaces)."""
+    out = arr.astype(np.float32) / np.float32(255)
+    if out.ndim == 3:
+        if out.shape[2] == 1:
+            return np.ascontiguousarray(out[:, :, 0])
+        b, g, r = LUMA_WEIGHTS_BGR
+        grey = np.float32(b) * out[:, :, 0] + np.float32(g) * out[:, :, 1]
+        return np.clip(grey + np.float32(r) * out[:, :, 2], 0.0, 1.0)
+    return out
+
+
+@pytest.mark.parametrize("layout", ["bgr", "bgra", "grey", "grey1", "strided"])
+def test_uint8_grey_conversion_is_bit_identical_to_numpy(layout: str, data_dir: Path) -> None:
+    # A real photograph, plus all 256 levels in its first row.
+    img = cv2.imread(str(data_dir / "middlebury2003" / "cones" / "left.png"), cv2.IMREAD_COLOR)
+    assert img is not None
+    img[0, :256] = np.arange(256, dtype=np.uint8)[:, None]
+    arr = {
+        "bgr": img,
+        "bgra": cv2.cvtColor(img, cv2.COLOR_BGR2BGRA),
+        "grey": img[:, :, 1],
+        "grey1": img[:, :, 1:2],
+        "strided": img[::2, ::3],
+    }[layout]
+    got = as_gray_float(arr)
+    want = _numpy_grey(arr)
+    assert got.dtype == np.float32 and got.flags.c_contiguous and got.shape == arr.shape[:2]
+    assert np.array_equal(got.view(np.uint32), want.view(np.uint32))  # bit for bit
+    if layout != "strided":
+        assert got[0, 0] == 0.0 and got[0, 255] == 1.0

@@ -144,3 +144,9 @@ def refine_disparity(
     fill_max_residual: float,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32], int]:
     """``(disparity, confidence, n_filled)``: ZNCC sub-pixel refinement and validated fill."""
+
+def gray_u8(
+    image: npt.NDArray[np.uint8], weights: tuple[float, float, float]
+) -> npt.NDArray[np.float32]:
+    """Grey ``float32`` in ``[0, 1]`` of a C-contiguous ``(H, W)`` or ``(H, W, 1|3|4)`` uint8
+    image (BGR order), bit-identical to ``as_gray_float``'s NumPy path."""

@@ -126,6 +126,57 @@ pub fn check_map_pair(disp: &[f32], conf: &[f32], w: usize, h: usize) -> Result<
     Ok(())
 }
 
+/// Grey levels in `[0, 1]` of an 8-bit image of `channels` interleaved channels (1 = grey,
+/// 3 = BGR, 4 = BGRA, alpha ignored), row-major: `v / 255` per channel, then for colour
+/// `clamp((wb b + wg g) + wr r, 0, 1)` with `weights = (wb, wg, wr)`. The `f32` operations and
+/// their order are NumPy's in `stereovision._validate.as_gray_float`, so the result is
+/// bit-identical to it.
+pub fn grey_from_u8(
+    data: &[u8],
+    width: usize,
+    height: usize,
+    channels: usize,
+    weights: [f32; 3],
+) -> Result<Vec<f32>> {
+    use rayon::prelude::*;
+    if !matches!(channels, 1 | 3 | 4) {
+        return Err(CoreError::param(
+            "channels",
+            format!("must be 1, 3 or 4, got {channels}"),
+        ));
+    }
+    if width == 0 || height == 0 || data.len() != width * height * channels {
+        return Err(CoreError::param(
+            "image",
+            format!(
+                "buffer of {} bytes does not hold {height}x{width}x{channels}",
+                data.len()
+            ),
+        ));
+    }
+    let mut out = vec![0.0f32; width * height];
+    let [wb, wg, wr] = weights;
+    out.par_chunks_mut(width)
+        .zip(data.par_chunks(width * channels))
+        .for_each(|(o, px)| {
+            if channels == 1 {
+                for (v, &p) in o.iter_mut().zip(px) {
+                    *v = p as f32 / 255.0;
+                }
+                return;
+            }
+            for (v, p) in o.iter_mut().zip(px.chunks_exact(channels)) {
+                let (b, g, r) = (
+                    p[0] as f32 / 255.0,
+                    p[1] as f32 / 255.0,
+                    p[2] as f32 / 255.0,
+                );
+                *v = (wb * b + wg * g + wr * r).clamp(0.0, 1.0);
+            }
+        });
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,7 +1,7 @@
 //! NumPy <-> core image conversion.
 
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use stereovision_core::{Image, ImageView};
@@ -74,4 +74,42 @@ pub fn map_and_confidence<'a>(
             .map_err(|_| PyValueError::new_err(format!("{name} must be C-contiguous")))
     };
     Ok((slice(disp, "disparity")?, slice(conf, "confidence")?))
+}
+
+/// `stereovision._validate.as_gray_float` for 8-bit images, in Rust: `(H, W)` grey or
+/// `(H, W, C)` with `C` in 1, 3, 4 (BGR order), C-contiguous; bit-identical to the NumPy path.
+#[pyfunction]
+#[pyo3(signature = (image, weights))]
+pub fn gray_u8<'py>(
+    py: Python<'py>,
+    image: numpy::PyReadonlyArrayDyn<'py, u8>,
+    weights: (f32, f32, f32),
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let shape = image.shape().to_vec();
+    let (h, w, c) = match shape.as_slice() {
+        [h, w] => (*h, *w, 1),
+        [h, w, c] => (*h, *w, *c),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "image must have 2 or 3 dimensions, got shape {shape:?}"
+            )))
+        }
+    };
+    let data = image
+        .as_slice()
+        .map_err(|_| PyValueError::new_err("image must be C-contiguous"))?;
+    let wts = [weights.0, weights.1, weights.2];
+    let grey = py.detach(|| {
+        crate::errors::guard("gray_u8", || {
+            stereovision_core::image::grey_from_u8(data, w, h, c, wts)
+        })
+    })?;
+    image_to_numpy(
+        py,
+        Image {
+            width: w,
+            height: h,
+            data: grey,
+        },
+    )
 }

@@ -31,5 +31,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mcgm::mcgm_filter, m)?)?;
     m.add_function(wrap_pyfunction!(triangulation::depth_rectified, m)?)?;
     m.add_function(wrap_pyfunction!(refine::refine_disparity, m)?)?;
+    m.add_function(wrap_pyfunction!(convert::gray_u8, m)?)?;
     Ok(())
 }
