@@ -160,8 +160,8 @@ def as_gray_float(img: object, name: str = "left") -> npt.NDArray[np.float32]:
     if arr.dtype == np.uint8 and (arr.ndim == 2 or arr.shape[2] in (1, 3, 4)):
         # The same float32 operations in Rust, in one parallel pass: bit-identical, and
         # faster than the NumPy planes (tests/test_validate.py checks the identity).
-        weights = tuple(float(np.float32(w)) for w in LUMA_WEIGHTS_BGR)
-        return _core.gray_u8(np.ascontiguousarray(arr), weights)
+        b, g, r = (float(np.float32(w)) for w in LUMA_WEIGHTS_BGR)
+        return _core.gray_u8(np.ascontiguousarray(arr), (b, g, r))
     out = _to_unit_float(arr, name)
     if out.ndim == 3:
         if out.shape[2] == 1:
