@@ -499,7 +499,8 @@ fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usi
         best.filter(|b| b.0 <= p.tau_y).map(|b| b.2)
     };
     let mut kept = singles.clone();
-    kept.extend(ambiguous.iter().filter_map(|g| pick(g)));
+    let picked: Vec<usize> = ambiguous.par_iter().filter_map(|g| pick(g)).collect();
+    kept.extend(picked);
     // The same rule on the right side (neurons sharing a right pixel).
     kept.sort_unstable_by_key(|&a| (neurons[a].yr, neurons[a].xr, a));
     let mut out: Vec<usize> = Vec::with_capacity(kept.len());
@@ -540,7 +541,6 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
         })
         .collect();
     let half = p.weights.nbr_half.max(1);
-    let mut side: Vec<f32> = Vec::new();
     // Points accepted in the previous round: a candidate with none of them in its window
     // sees the same side sets as before and keeps its verdict.
     let mut fresh: Option<network::PointGrid> = None;
@@ -554,46 +554,48 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
             .map(|&a| (neurons[a].xl.max(0), neurons[a].yl.max(0)))
             .collect();
         let grid = network::PointGrid::new(&axy, half);
-        let mut added = Vec::new();
-        for &c in &cands {
-            if ok[c] {
-                continue;
-            }
-            let n = &neurons[chosen[c]];
-            let (x, y, d) = (n.xl.max(0), n.yl.max(0), n.dx());
-            if let Some(g) = &fresh {
-                let mut near = false;
-                g.for_each_in_window((x, y), half, |_| near = true);
-                if !near {
-                    continue;
+        // Candidates are tested independently within a round (in parallel, kept in order).
+        let added: Vec<usize> = cands
+            .par_iter()
+            .map_init(Vec::new, |side: &mut Vec<f32>, &c| {
+                if ok[c] {
+                    return None;
                 }
-            }
-            let dsub = d as f32 + n.sub;
-            let pass = (0..4).filter(|k| n.halves_fail >> k & 1 == 1).all(|k| {
-                side.clear();
-                let mut all_agree = true;
-                grid.for_each_in_window((x, y), half, |t| {
-                    let (qx, qy) = axy[t];
-                    let on_side = match k {
-                        0 => qx < x,
-                        1 => qx > x,
-                        2 => qy < y,
-                        _ => qy > y,
-                    };
-                    if on_side {
-                        let b = &neurons[acc[t]];
-                        all_agree &= (b.dx() - d).abs() <= p.agree_tol;
-                        side.push(b.dx() as f32 + b.sub);
+                let n = &neurons[chosen[c]];
+                let (x, y, d) = (n.xl.max(0), n.yl.max(0), n.dx());
+                if let Some(g) = &fresh {
+                    let mut near = false;
+                    g.for_each_in_window((x, y), half, |_| near = true);
+                    if !near {
+                        return None;
                     }
+                }
+                let dsub = d as f32 + n.sub;
+                let pass = (0..4).filter(|k| n.halves_fail >> k & 1 == 1).all(|k| {
+                    side.clear();
+                    let mut all_agree = true;
+                    grid.for_each_in_window((x, y), half, |t| {
+                        let (qx, qy) = axy[t];
+                        let on_side = match k {
+                            0 => qx < x,
+                            1 => qx > x,
+                            2 => qy < y,
+                            _ => qy > y,
+                        };
+                        if on_side {
+                            let b = &neurons[acc[t]];
+                            all_agree &= (b.dx() - d).abs() <= p.agree_tol;
+                            side.push(b.dx() as f32 + b.sub);
+                        }
+                    });
+                    all_agree
+                        && side.len() >= p.rescue_min
+                        && (median(side) - dsub).abs() <= p.rescue_med
                 });
-                all_agree
-                    && side.len() >= p.rescue_min
-                    && (median(&mut side) - dsub).abs() <= p.rescue_med
-            });
-            if pass {
-                added.push(c);
-            }
-        }
+                pass.then_some(c)
+            })
+            .flatten()
+            .collect();
         if added.is_empty() {
             return ok;
         }
