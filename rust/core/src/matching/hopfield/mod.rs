@@ -694,11 +694,12 @@ fn finish(
         .collect();
     let grid = network::PointGrid::new(&sxy, half);
     // Survivor disparities in grid order.
-    let sd: Vec<i32> = grid
+    let mut sd: Vec<i32> = grid
         .items
         .iter()
         .map(|&t| neurons[survivors[t as usize].0].dx())
         .collect();
+    sd.resize(grid.xs.len(), 0); // padded like the grid's coordinates
     survivors
         .par_iter()
         .enumerate()

@@ -142,8 +142,20 @@ impl PointGrid {
             items[fill[c]] = k as u32;
             fill[c] += 1;
         }
-        let xs = items.iter().map(|&k| pxy[k as usize].0).collect();
-        let ys = items.iter().map(|&k| pxy[k as usize].1).collect();
+        // Coordinates padded with LANES far-away entries: a block of lanes may read past the
+        // last point (its lanes beyond a range are masked, these are never inside a window).
+        let far = i32::MIN / 4;
+        let pad = std::iter::repeat_n(far, LANES);
+        let xs = items
+            .iter()
+            .map(|&k| pxy[k as usize].0)
+            .chain(pad.clone())
+            .collect();
+        let ys = items
+            .iter()
+            .map(|&k| pxy[k as usize].1)
+            .chain(pad)
+            .collect();
         PointGrid {
             cell,
             gw,
@@ -175,7 +187,8 @@ impl PointGrid {
     }
 
     /// Points within `half` of `(x, y)` in both coordinates, and those of them whose value
-    /// (`vals`, in grid order like `xs`) is within `tol` of `v` (the point itself included).
+    /// (`vals`, in grid order like `xs` and as long: padded) is within `tol` of `v` (the
+    /// point itself included).
     pub(crate) fn count_in_window(
         &self,
         (x, y): (i32, i32),
@@ -184,28 +197,13 @@ impl PointGrid {
         v: i32,
         tol: i32,
     ) -> (usize, usize) {
-        let (mut near, mut agree) = (0usize, 0usize);
-        for (s, e) in self.ranges(x, y) {
-            let mut k0 = s;
-            #[cfg(target_arch = "x86_64")]
-            if has_avx2() {
-                let full = s + (e - s) / LANES * LANES;
-                // SAFETY: AVX2 is present and s..full lies within xs, ys and vals.
-                let (n, a) = unsafe {
-                    count_block_avx2(&self.xs, &self.ys, vals, s, full, (x, y, half, v, tol))
-                };
-                near += n;
-                agree += a;
-                k0 = full;
-            }
-            let tail = self.xs[k0..e].iter().zip(&self.ys[k0..e]).zip(&vals[k0..e]);
-            for ((&qx, &qy), &qv) in tail {
-                let inside = (qx - x).abs() <= half && (qy - y).abs() <= half;
-                near += usize::from(inside);
-                agree += usize::from(inside & ((qv - v).abs() <= tol));
-            }
+        assert_eq!(vals.len(), self.xs.len(), "vals must be padded like xs");
+        #[cfg(target_arch = "x86_64")]
+        if has_avx2() {
+            // SAFETY: AVX2 is present; every range ends at most LANES before the padded end.
+            return unsafe { count_avx2(self, vals, (x, y, half, v, tol)) };
         }
-        (near, agree)
+        count_portable(self, vals, (x, y, half, v, tol))
     }
 
     /// Calls `f(q)` for every point `q` within `half` of `(x, y)` in both coordinates
@@ -226,23 +224,37 @@ impl PointGrid {
     }
 }
 
-/// [`PointGrid::count_in_window`] over `s..full` (a multiple of [`LANES`] long), 8 points at
-/// a time.
+/// Portable body of [`PointGrid::count_in_window`].
+fn count_portable(
+    g: &PointGrid,
+    vals: &[i32],
+    (x, y, half, v, tol): (i32, i32, i32, i32, i32),
+) -> (usize, usize) {
+    let (mut near, mut agree) = (0usize, 0usize);
+    for (s, e) in g.ranges(x, y) {
+        let cells = g.xs[s..e].iter().zip(&g.ys[s..e]).zip(&vals[s..e]);
+        for ((&qx, &qy), &qv) in cells {
+            let inside = (qx - x).abs() <= half && (qy - y).abs() <= half;
+            near += usize::from(inside);
+            agree += usize::from(inside & ((qv - v).abs() <= tol));
+        }
+    }
+    (near, agree)
+}
+
+/// AVX2 body of [`PointGrid::count_in_window`]: 8 points at a time, the lanes past a range's
+/// end masked.
 ///
 /// # Safety
-/// The CPU must support AVX2 and `full` must not exceed the three arrays' lengths.
+/// The CPU must support AVX2; `g.xs`, `g.ys` and `vals` hold LANES entries past every range.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn count_block_avx2(
-    xs: &[i32],
-    ys: &[i32],
+unsafe fn count_avx2(
+    g: &PointGrid,
     vals: &[i32],
-    s: usize,
-    full: usize,
     (x, y, half, v, tol): (i32, i32, i32, i32, i32),
 ) -> (usize, usize) {
     use std::arch::x86_64::*;
-    debug_assert!(full <= xs.len() && full <= ys.len() && full <= vals.len());
     let ld = |a: &[i32], k: usize| _mm256_loadu_si256(a.as_ptr().add(k) as *const __m256i);
     let (vx, vy, vv) = (
         _mm256_set1_epi32(x),
@@ -251,15 +263,22 @@ unsafe fn count_block_avx2(
     );
     let (vh, vt) = (_mm256_set1_epi32(half), _mm256_set1_epi32(tol));
     let (mut near, mut agree) = (0u32, 0u32);
-    for k in (s..full).step_by(LANES) {
-        let out_x = _mm256_cmpgt_epi32(_mm256_abs_epi32(_mm256_sub_epi32(ld(xs, k), vx)), vh);
-        let out_y = _mm256_cmpgt_epi32(_mm256_abs_epi32(_mm256_sub_epi32(ld(ys, k), vy)), vh);
-        let off = _mm256_cmpgt_epi32(_mm256_abs_epi32(_mm256_sub_epi32(ld(vals, k), vv)), vt);
-        let out = _mm256_or_si256(out_x, out_y);
-        let m_out = _mm256_movemask_ps(_mm256_castsi256_ps(out)) as u32;
-        let m_bad = _mm256_movemask_ps(_mm256_castsi256_ps(_mm256_or_si256(out, off))) as u32;
-        near += 8 - m_out.count_ones();
-        agree += 8 - m_bad.count_ones();
+    for (s, e) in g.ranges(x, y) {
+        debug_assert!(e + LANES <= g.xs.len());
+        for k in (s..e).step_by(LANES) {
+            let valid = (1u32 << (e - k).min(LANES)) - 1;
+            let out_x =
+                _mm256_cmpgt_epi32(_mm256_abs_epi32(_mm256_sub_epi32(ld(&g.xs, k), vx)), vh);
+            let out_y =
+                _mm256_cmpgt_epi32(_mm256_abs_epi32(_mm256_sub_epi32(ld(&g.ys, k), vy)), vh);
+            let off = _mm256_cmpgt_epi32(_mm256_abs_epi32(_mm256_sub_epi32(ld(vals, k), vv)), vt);
+            let out = _mm256_or_si256(out_x, out_y);
+            let m_in = !(_mm256_movemask_ps(_mm256_castsi256_ps(out)) as u32) & valid;
+            let bad = _mm256_or_si256(out, off);
+            let m_ok = !(_mm256_movemask_ps(_mm256_castsi256_ps(bad)) as u32) & valid;
+            near += m_in.count_ones();
+            agree += m_ok.count_ones();
+        }
     }
     (near as usize, agree as usize)
 }
@@ -663,7 +682,7 @@ impl Network {
         let half = w.nbr_half.max(1);
         let grid = PointGrid::new(&pxy, half);
         // Window neighbour counts n_p (8 grid points at a time, in parallel).
-        let zeros = vec![0i32; pxy.len()];
+        let zeros = vec![0i32; grid.xs.len()];
         let counts: Vec<usize> = pxy
             .par_iter()
             .map(|&xy| grid.count_in_window(xy, half, &zeros, 0, 0).0 - 1)
@@ -1127,7 +1146,8 @@ mod tests {
         pxy_u.dedup();
         for half in [1, 7, 20] {
             let grid = PointGrid::new(&pxy_u, half);
-            let vals: Vec<i32> = grid.items.iter().map(|&k| (k % 5) as i32).collect();
+            let mut vals: Vec<i32> = grid.items.iter().map(|&k| (k % 5) as i32).collect();
+            vals.resize(grid.xs.len(), 0);
             for &(x, y) in &pxy_u {
                 let inside =
                     |&(qx, qy): &(i32, i32)| (qx - x).abs() <= half && (qy - y).abs() <= half;
@@ -1138,6 +1158,10 @@ mod tests {
                     .zip(&vals)
                     .filter(|&(&k, &v)| inside(&pxy_u[k as usize]) && (v - 2).abs() <= 1)
                     .count();
+                assert_eq!(
+                    count_portable(&grid, &vals, (x, y, half, 2, 1)),
+                    (want, agree)
+                );
                 assert_eq!(
                     grid.count_in_window((x, y), half, &vals, 2, 1),
                     (want, agree)
