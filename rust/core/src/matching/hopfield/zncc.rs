@@ -503,6 +503,70 @@ pub fn max_of(c: &[f32]) -> f32 {
         .fold(f32::MIN, |a, v| if v > a { v } else { a })
 }
 
+/// The disparities `d_min..=d_hi` where `full` is a peak at least `s_min`: `full[d] >= s_min`,
+/// `>=` its left neighbour and `>` its right one (the range's ends compare with one side only),
+/// ascending, into `out`. On AVX2 the interior tests run eight at a time into a bit mask: as
+/// branches they were unpredictable, and their mispredictions cost more than the tests.
+pub fn row_peaks(full: &[f32], d_min: usize, d_hi: usize, s_min: f32, out: &mut Vec<usize>) {
+    out.clear();
+    if d_hi < d_min {
+        return;
+    }
+    let c = &full[d_min..=d_hi];
+    let n = c.len();
+    let peak =
+        |i: usize| c[i] >= s_min && (i == 0 || c[i] >= c[i - 1]) && (i + 1 == n || c[i] > c[i + 1]);
+    // Interior positions 1..=done are tested eight at a time (AVX2), the rest one by one.
+    let mut done = 0;
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2() && n >= LANES + 2 {
+        out.extend((peak(0)).then_some(d_min));
+        // SAFETY: AVX2 is present and n >= 10.
+        done = unsafe { interior_peaks_avx2(c, s_min, d_min, out) };
+    }
+    for i in if done == 0 { 0 } else { done + 1 }..n {
+        if peak(i) {
+            out.push(d_min + i);
+        }
+    }
+}
+
+/// The peaks of [`row_peaks`] at `1..=8 m` (`8 m <= c.len() - 2`, largest such `m`) appended
+/// to `out` as `d0 + i`; returns `8 m`. `>=` / `>` as ordered quiet compares: false on NaN,
+/// like the scalar tests.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn interior_peaks_avx2(c: &[f32], s_min: f32, d0: usize, out: &mut Vec<usize>) -> usize {
+    use std::arch::x86_64::*;
+    let end = (c.len() - 2) / LANES * LANES;
+    let s = _mm256_set1_ps(s_min);
+    let p = c.as_ptr();
+    let mut i = 1;
+    while i <= end {
+        // Reads c[i - 1 ..= i + 8], inside c as i + 8 <= end + 1 <= len - 1.
+        let v = _mm256_loadu_ps(p.add(i));
+        let l = _mm256_loadu_ps(p.add(i - 1));
+        let r = _mm256_loadu_ps(p.add(i + 1));
+        let ok = _mm256_and_ps(
+            _mm256_and_ps(
+                _mm256_cmp_ps::<_CMP_GE_OQ>(v, s),
+                _mm256_cmp_ps::<_CMP_GE_OQ>(v, l),
+            ),
+            _mm256_cmp_ps::<_CMP_GT_OQ>(v, r),
+        );
+        let mut bits = _mm256_movemask_ps(ok) as u32;
+        while bits != 0 {
+            out.push(d0 + i + bits.trailing_zeros() as usize);
+            bits &= bits - 1;
+        }
+        i += LANES;
+    }
+    end
+}
+
 /// Per-region centring and left normalisation of one point: `(A - shift S) * inv_R * inv_l`.
 struct Norm {
     shift: [f32; N_REGIONS],
@@ -724,6 +788,35 @@ mod tests {
                     let (u, v) = (a.curve[k][d], b.curve[k][d]);
                     assert_eq!(u.to_bits(), v.to_bits(), "x {x} region {k} d {d}");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn row_peaks_match_the_scalar_definition() {
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut got = Vec::new();
+        for len in [1, 2, 3, 9, 10, 11, 17, 33, 97, 130] {
+            // Coarse values: plateaus and exact ties with s_min occur.
+            let full: Vec<f32> = (0..len + 3).map(|_| (next() * 8.0).floor() / 8.0).collect();
+            for (d_min, s_min) in [(0, 0.5), (1, 0.0), (2, 0.875), (0, 2.0)] {
+                let d_hi = len - 1;
+                let want: Vec<usize> = (d_min..=d_hi)
+                    .filter(|&d| {
+                        let c = full[d];
+                        c >= s_min
+                            && (d == d_min || c >= full[d - 1])
+                            && (d == d_hi || c > full[d + 1])
+                    })
+                    .collect();
+                row_peaks(&full, d_min, d_hi, s_min, &mut got);
+                assert_eq!(got, want, "len {len} d_min {d_min} s_min {s_min}");
             }
         }
     }
