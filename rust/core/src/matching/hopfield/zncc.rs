@@ -384,10 +384,12 @@ fn curves_with(
     let len = d_hi + 1;
     let blocks = len.div_ceil(LANES);
     let lw = left.width;
-    let mut win = [[0.0f32; SIDE]; SIDE];
-    for (r, row) in win.iter_mut().enumerate() {
-        row.copy_from_slice(&left.data[(y + r - SIM_RADIUS) * lw + x - SIM_RADIUS..][..SIDE]);
-    }
+    // Row references, not a copy: the copy's overlapping 16-byte stores stalled the f64 loads
+    // that followed (store forwarding).
+    let win: [&[f32; SIDE]; SIDE] = std::array::from_fn(|r| {
+        let o = (y + r - SIM_RADIUS) * lw + x - SIM_RADIUS;
+        left.data[o..o + SIDE].try_into().expect("SIDE values")
+    });
     let (t, norm, mean) = template(&win);
     out.left_mean = mean;
     // Right rows yr-3..=yr+3 from column x0 = x - d_hi - 3: block b reads columns
@@ -447,7 +449,7 @@ simd_fn! {
 /// The left window `win` (7 rows of 7 values) centred on its mean `c` (`f32`), the regions'
 /// centring shifts and inverse zero-mean norms, and `c`. Cell sums (values, squares) in `f64`,
 /// each cell accumulated row by row, left to right.
-fn template(win: &[[f32; SIDE]; SIDE]) -> ([[f32; SIDE]; SIDE], Norm, f32) {
+fn template(win: &[&[f32; SIDE]; SIDE]) -> ([[f32; SIDE]; SIDE], Norm, f32) {
     let mut cs = [[0.0f64; 3]; 3];
     let mut cq = [[0.0f64; 3]; 3];
     for (r, row) in win.iter().enumerate() {
@@ -471,17 +473,20 @@ fn template(win: &[[f32; SIDE]; SIDE]) -> ([[f32; SIDE]; SIDE], Norm, f32) {
     }
     let (rs, rq) = (regions_of(&cs), regions_of(&cq));
     let c = rs[FULL] / region_n(FULL) as f64;
-    let mut shift = [0.0f32; N_REGIONS];
-    let mut inv_l = [0.0f32; N_REGIONS];
-    for k in 0..N_REGIONS {
-        let n = region_n(k) as f64;
-        let q = rq[k] - rs[k] * rs[k] / n;
-        shift[k] = (rs[k] / n - c) as f32;
-        // 0 for a textureless left region: its whole curve is then 0 (undefined).
-        if q >= n * MIN_WINDOW_STD * MIN_WINDOW_STD {
-            inv_l[k] = (1.0 / q.sqrt()) as f32;
+    // Element-wise over the five regions (vectorised: the divisions and square roots are the
+    // slow part of a point's setup).
+    let n: [f64; N_REGIONS] = std::array::from_fn(|k| region_n(k) as f64);
+    let q: [f64; N_REGIONS] = std::array::from_fn(|k| rq[k] - rs[k] * rs[k] / n[k]);
+    let shift: [f32; N_REGIONS] = std::array::from_fn(|k| (rs[k] / n[k] - c) as f32);
+    // 0 for a textureless left region: its whole curve is then 0 (undefined).
+    let inv_l: [f32; N_REGIONS] = std::array::from_fn(|k| {
+        let ok = q[k] >= n[k] * MIN_WINDOW_STD * MIN_WINDOW_STD;
+        if ok {
+            (1.0 / q[k].sqrt()) as f32
+        } else {
+            0.0
         }
-    }
+    });
     let t = std::array::from_fn(|r| std::array::from_fn(|col| (win[r][col] as f64 - c) as f32));
     (t, Norm { shift, inv_l }, c as f32)
 }
