@@ -145,9 +145,10 @@ fn band_sums(rows: [&[f32]; 3], out: &mut BandSums) {
 simd_fn! {
 /// Sums and inverse norms of the five regions along one row, written to `sums` / `invs`
 /// (`N_REGIONS` rows of `stride` values each; the columns where the window does not fit are
-/// left alone). `top` = `S(y - 3)`, `bot` = `S(y + 1)`, `mid` = image row `y`; `all` and `n2`
-/// are scratch.
-fn stats_row(top: &BandSums, mid: &[f32], bot: &BandSums, all: &mut BandSums, n2: &mut Vec<f32>, stride: usize, sums: &mut [f32], invs: &mut [f32]) {
+/// left alone, but for the left region's, which runs 4 further into the padding). `top` =
+/// `S(y - 3)`, `bot` = `S(y + 1)`, `mid` = image row `y`; `all` and `n2` are scratch. The top
+/// region is skipped unless `with_top` (the caller copies it: see [`fill_rows`]).
+fn stats_row(top: &BandSums, mid: &[f32], bot: &BandSums, all: &mut BandSums, n2: &mut Vec<f32>, with_top: bool, stride: usize, sums: &mut [f32], invs: &mut [f32]) {
     let w = mid.len();
     for i in 0..2 {
         let square = i == 1;
@@ -159,8 +160,9 @@ fn stats_row(top: &BandSums, mid: &[f32], bot: &BandSums, all: &mut BandSums, n2
     hsum3(&all.v[0], &mut all.h[0]);
     hsum3(&all.v[1], &mut all.h[1]);
     // Region k: (vertical sums: 0 top, 1 bottom, 2 all; horizontal parts): full / top / bottom
-    // = left 3 + centre + right 3 columns of the all / top / bottom band sums; left / right =
-    // 3 columns of all.
+    // = left 3 + centre + right 3 columns of the all / top / bottom band sums; left = the 3
+    // columns before the centre of all. The right region at x is the left one at x + 4 (the
+    // same 3-column sum): the left one is computed 4 columns further and copied.
     const PARTS: [(usize, bool, bool, bool); N_REGIONS] = [
         (2, true, true, true),
         (2, true, false, false),
@@ -170,32 +172,42 @@ fn stats_row(top: &BandSums, mid: &[f32], bot: &BandSums, all: &mut BandSums, n2
     ];
     let xs = SIM_RADIUS..w - SIM_RADIUS;
     let n_x = xs.len();
-    n2.resize(n_x, 0.0);
+    let shift = SIM_RADIUS + 1;
+    n2.resize(n_x + shift, 0.0);
     for (k, &(i, l, c, r)) in PARTS.iter().enumerate() {
+        if k == HALF_RIGHT || (k == HALF_TOP && !with_top) {
+            continue;
+        }
+        let m = if k == HALF_LEFT { n_x + shift } else { n_x };
         let n = region_n(k) as f64;
         let min_n2 = n * MIN_WINDOW_STD * MIN_WINDOW_STD;
         let src = [top, bot, &*all][i];
         let part = |a: usize| -> (&[f64], &[f64], &[f64]) {
-            (&src.h[a][..n_x], &src.v[a][SIM_RADIUS..SIM_RADIUS + n_x], &src.h[a][SIM_RADIUS + 1..SIM_RADIUS + 1 + n_x])
+            let h = &src.h[a];
+            (&h[..m], &src.v[a][SIM_RADIUS..SIM_RADIUS + m.min(n_x)], &h[shift..shift + m.min(n_x)])
         };
         let (sl, sc, sr) = part(0);
         let (ql, qc, qr) = part(1);
-        let srow = &mut sums[k * stride + SIM_RADIUS..k * stride + SIM_RADIUS + n_x];
-        let irow = &mut invs[k * stride + SIM_RADIUS..k * stride + SIM_RADIUS + n_x];
+        let srow = &mut sums[k * stride + SIM_RADIUS..k * stride + SIM_RADIUS + m];
+        let irow = &mut invs[k * stride + SIM_RADIUS..k * stride + SIM_RADIUS + m];
         // The parts as compile-time flags: with run-time ones the vectoriser turned the skipped
         // loads into masked loads (microcoded on AMD). Same sums in the same order.
-        let f = (n, min_n2, (sl, sc, sr), (ql, qc, qr), srow, &mut n2[..]);
+        let f = (n, min_n2, (sl, sc, sr), (ql, qc, qr), srow, &mut n2[..m]);
         match (l, c, r) {
             (true, true, true) => region_row::<true, true, true>(f),
             (true, false, false) => region_row::<true, false, false>(f),
-            (false, false, true) => region_row::<false, false, true>(f),
-            _ => unreachable!("PARTS has three patterns"),
+            _ => unreachable!("PARTS computes two patterns"),
         }
         // A loop of its own: the f32 square root and division then run 8 lanes wide (4 in
         // the f64 loop above), the costliest operations of the statistics.
         for (o, &q) in irow.iter_mut().zip(n2.iter()) {
             *o = if q > 0.0 { 1.0 / q.sqrt() } else { 0.0 };
         }
+    }
+    for buf in [sums, invs] {
+        let (lo, hi) = buf.split_at_mut(HALF_RIGHT * stride);
+        let from = HALF_LEFT * stride + SIM_RADIUS + shift;
+        hi[SIM_RADIUS..SIM_RADIUS + n_x].copy_from_slice(&lo[from..from + n_x]);
     }
 }
 }
@@ -319,18 +331,42 @@ fn fill_rows(img: &Image, y_lo: usize, y_hi: usize, s: &mut StatsScratch, chunk:
             band_sums([row(z), row(z + 1), row(z + 2)], &mut s.ring[z % RING]);
         }
     }
-    for (i, out) in chunk.chunks_mut(row_len).enumerate() {
+    for i in 0..chunk.len() / row_len {
         let y = y_lo + i;
         if !(lo..hi).contains(&y) {
-            out.fill(0.0);
+            chunk[i * row_len..(i + 1) * row_len].fill(0.0);
             continue;
         }
         // S(y + 1) replaces S(y - 4), read for the last time by row y - 1.
         let z = y + 1;
         band_sums([row(z), row(z + 1), row(z + 2)], &mut s.ring[z % RING]);
         let (top, bot) = (&s.ring[(y - SIM_RADIUS) % RING], &s.ring[z % RING]);
+        let (done, out) = chunk.split_at_mut(i * row_len);
+        let out = &mut out[..row_len];
+        // The top region of row y is the bottom one of row y - 4 (both read S(y - 3)).
+        let copy_top = y >= lo + 4;
         let (sums, invs) = out.split_at_mut(N_REGIONS * stride);
-        stats_row(top, row(y), bot, &mut s.all, &mut s.n2, stride, sums, invs);
+        stats_row(
+            top,
+            row(y),
+            bot,
+            &mut s.all,
+            &mut s.n2,
+            !copy_top,
+            stride,
+            sums,
+            invs,
+        );
+        if copy_top {
+            let prev = &done[(i - 4) * row_len..(i - 3) * row_len];
+            for (dst, src) in [
+                (sums, &prev[..N_REGIONS * stride]),
+                (invs, &prev[N_REGIONS * stride..]),
+            ] {
+                let (t, b) = (HALF_TOP * stride, HALF_BOTTOM * stride);
+                dst[t..t + stride].copy_from_slice(&src[b..b + stride]);
+            }
+        }
         for line in out.chunks_mut(stride) {
             line[..SIM_RADIUS].fill(0.0);
             line[w - SIM_RADIUS..].fill(0.0);
@@ -697,7 +733,8 @@ unsafe fn blocks_avx2(
         macro_rules! band {
             ($cells:ident, $r:expr) => {{
                 let row = p.add($r * stride);
-                for c in 0..SIDE {
+                // Left and right groups alternate (each keeps its column order).
+                for c in [0, 4, 1, 5, 2, 6, 3] {
                     let g = part_of(c);
                     let v = _mm256_loadu_ps(row.add(c));
                     $cells[g] = _mm256_add_ps($cells[g], _mm256_mul_ps(tb[$r * SIDE + c], v));
@@ -705,13 +742,14 @@ unsafe fn blocks_avx2(
             }};
         }
         let (mut top, mut mid, mut bot) = ([z; 3], [z; 3], [z; 3]);
+        // Top and bottom rows interleaved: each cell still receives its taps in row-major
+        // order (same sums), but six accumulation chains instead of three are in flight at a
+        // time; in band order the adds' latency bounded a block more than the loads.
         for r in 0..SIM_RADIUS {
             band!(top, r);
+            band!(bot, SIM_RADIUS + 1 + r);
         }
         band!(mid, SIM_RADIUS);
-        for r in SIM_RADIUS + 1..SIDE {
-            band!(bot, r);
-        }
         // regions_of, spelled out with the same association order.
         macro_rules! add {
             ($a:expr, $b:expr) => {
