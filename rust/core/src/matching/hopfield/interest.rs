@@ -189,6 +189,24 @@ fn peak_mask(up: &[f32], mid: &[f32], dn: &[f32], thr: f32, mask: &mut [u8]) {
 }
 }
 
+/// Largest value of `seg` and 0, eight lanes at a time: `f32::max` is exact and ignores NaN,
+/// so any order gives the value of a sequential fold.
+fn seg_max(seg: &[f32]) -> f32 {
+    let mut lanes = [0.0f32; 8];
+    let mut chunks = seg.chunks_exact(8);
+    for ch in &mut chunks {
+        for (l, &v) in lanes.iter_mut().zip(ch) {
+            *l = l.max(v);
+        }
+    }
+    chunks
+        .remainder()
+        .iter()
+        .chain(&lanes)
+        .copied()
+        .fold(0.0, f32::max)
+}
+
 /// Selection step of [`interest_points`] on a precomputed map (row bands in parallel, raster
 /// order).
 pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<InterestPoint> {
@@ -204,7 +222,7 @@ pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<I
             let mut tm = vec![0.0f32; tiles_x];
             for row in band.chunks(w) {
                 for (t, seg) in row.chunks(tile).enumerate() {
-                    tm[t] = seg.iter().copied().fold(tm[t], f32::max);
+                    tm[t] = tm[t].max(seg_max(seg));
                 }
             }
             tm
@@ -270,14 +288,14 @@ pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<I
                     let nb = |yy: usize| &m[yy * w + x0 - 1..yy * w + x1 + 1];
                     let flags = &mut mask[..x1 - x0];
                     peak_mask(nb(y - 1), nb(y), nb(y + 1), thr, flags);
+                    // Eight flags (0 or 1 bytes) at a time as one word: most are all zero.
                     let mut base = x0;
                     for chunk in flags.chunks(8) {
-                        let mut bits = chunk
-                            .iter()
-                            .enumerate()
-                            .fold(0u32, |b, (i, &f)| b | u32::from(f) << i);
+                        let mut word = [0u8; 8];
+                        word[..chunk.len()].copy_from_slice(chunk);
+                        let mut bits = u64::from_le_bytes(word);
                         while bits != 0 {
-                            let x = base + bits.trailing_zeros() as usize;
+                            let x = base + bits.trailing_zeros() as usize / 8;
                             bits &= bits - 1;
                             out.push(InterestPoint {
                                 x: x as u32,
