@@ -8,7 +8,7 @@
 //! products `(L - c) * R` are accumulated per cell in registers, the five regions are cell sums,
 //! and each is centred with the region's right-window sum:
 //! `sum (L - mu) R = sum (L - c) R - (mu - c) sum R`. Right-window sums and inverse norms come
-//! from `f64` cell sums computed once per image ([`RightStats`]).
+//! from `f64` cell sums computed once per image row ([`RightStats`], one band of rows per task).
 
 use rayon::prelude::*;
 
