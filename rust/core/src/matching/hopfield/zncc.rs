@@ -523,7 +523,13 @@ fn template(win: &[&[f32; SIDE]; SIDE]) -> ([[f32; SIDE]; SIDE], Norm, f32) {
             0.0
         }
     });
-    let t = std::array::from_fn(|r| std::array::from_fn(|col| (win[r][col] as f64 - c) as f32));
+    // Plain loops: the nested array::from_fn stayed an out-of-line call.
+    let mut t = [[0.0f32; SIDE]; SIDE];
+    for (tr, wr) in t.iter_mut().zip(win) {
+        for (tv, &v) in tr.iter_mut().zip(wr.iter()) {
+            *tv = (v as f64 - c) as f32;
+        }
+    }
     (t, Norm { shift, inv_l }, c as f32)
 }
 }
