@@ -58,54 +58,48 @@ pub struct InterestPoint {
 /// rows of horizontal sums it shares with its neighbours (12 % extra at 32 rows).
 const ROWS_PER_TASK: usize = 32;
 
+/// Rows of horizontal sums a vertical 5-sum reads: a ring of this many rows per direction
+/// (row `y` in slot `y % RING`) keeps a task's sums in L1 instead of a whole band of them.
+const RING: usize = 2 * MORAVEC_HALF + 1;
+
 /// The four steps `(sx, sy)`: horizontal, vertical, 45 degrees (down-right), 135 (up-right).
 const DIRS: [(usize, isize); 4] = [(1, 0), (0, 1), (1, 1), (1, -1)];
 
 simd_fn! {
 /// Horizontal 5-sums of the squared differences between row `a` and row `b` shifted by `sx`:
 /// `out[x] = sq[x-2] + sq[x-1] + sq[x] + sq[x+1] + sq[x+2]` (left to right, `f32`) for
-/// `x in 2..w-2-sx`, 0 elsewhere; `sq` is scratch.
-fn hsum_row(a: &[f32], b: &[f32], sx: usize, sq: &mut Vec<f32>, out: &mut [f32]) {
+/// `x in 2..w-2-sx`; the other entries of `out` are left as they are (never read: they only
+/// feed the zeroed border of `M`). `sq` is scratch of at least `w` values; `w >= 5 + sx`.
+fn hsum_row(a: &[f32], b: &[f32], sx: usize, sq: &mut [f32], out: &mut [f32]) {
     let w = a.len();
     let r = MORAVEC_HALF;
-    out.fill(0.0);
-    if w < 2 * r + 1 + sx {
-        return;
-    }
-    sq.resize(w - sx, 0.0);
-    for ((o, &p), &q) in sq.iter_mut().zip(a).zip(&b[sx..]) {
+    let m = w - 2 * r - sx;
+    let sq = &mut sq[..w - sx];
+    for ((o, &p), &q) in sq.iter_mut().zip(&a[..w - sx]).zip(&b[sx..]) {
         let d = p - q;
         *o = d * d;
     }
-    let m = w - 2 * r - sx;
-    let dst = &mut out[r..r + m];
-    dst.copy_from_slice(&sq[..m]);
-    for k in 1..=2 * r {
-        for (o, &v) in dst.iter_mut().zip(&sq[k..k + m]) {
-            *o += v;
-        }
+    // One pass with five loads instead of a copy and four read-modify-write passes.
+    let (s0, s1, s2, s3, s4) = (&sq[..m], &sq[1..m + 1], &sq[2..m + 2], &sq[3..m + 3], &sq[4..m + 4]);
+    for (i, o) in out[r..r + m].iter_mut().enumerate() {
+        *o = (((s0[i] + s1[i]) + s2[i]) + s3[i]) + s4[i];
     }
 }
 }
 
 simd_fn! {
-/// One row of `M`: per direction the vertical 5-sum of its horizontal sums (top to bottom),
-/// then the minimum over the four directions. `hs[dir]` holds the five rows `y-2..=y+2`.
-fn min_row(hs: &[[&[f32]; 2 * MORAVEC_HALF + 1]; 4], acc: &mut [f32], out: &mut [f32]) {
-    for (d, rows) in hs.iter().enumerate() {
-        acc.copy_from_slice(rows[0]);
-        for row in &rows[1..] {
-            for (o, &v) in acc.iter_mut().zip(row.iter()) {
-                *o += v;
-            }
-        }
-        if d == 0 {
-            out.copy_from_slice(acc);
-        } else {
-            for (o, &v) in out.iter_mut().zip(acc.iter()) {
-                *o = o.min(v);
-            }
-        }
+/// One row of `M` over `out.len()` columns: per direction the vertical 5-sum of its horizontal
+/// sums (top to bottom), then the minimum over the four directions, in one pass.
+/// `hs[dir][k]` holds row `y - 2 + k` from the first output column on.
+fn min_row(hs: &[[&[f32]; RING]; 4], out: &mut [f32]) {
+    let n = out.len();
+    // Slicing every row to `n` first lets the compiler drop the bounds checks and vectorise.
+    let [a, b, c, d] = hs.map(|rows| rows.map(|row| &row[..n]));
+    let vsum = |rows: &[&[f32]; RING], x: usize| {
+        (((rows[0][x] + rows[1][x]) + rows[2][x]) + rows[3][x]) + rows[4][x]
+    };
+    for (x, o) in out.iter_mut().enumerate() {
+        *o = vsum(&a, x).min(vsum(&b, x)).min(vsum(&c, x)).min(vsum(&d, x));
     }
 }
 }
@@ -126,30 +120,31 @@ pub fn moravec(img: &Image) -> Vec<f32> {
         .par_chunks_mut(ROWS_PER_TASK * w)
         .enumerate()
         .for_each_init(
-            || (Vec::new(), Vec::new(), vec![0.0f32; w]),
-            |(hs, sq, acc), (t, band)| {
+            || (vec![0.0f32; 4 * RING * w], vec![0.0f32; w]),
+            |(ring, sq), (t, band)| {
                 let y0 = BORDER + t * ROWS_PER_TASK;
-                let n = band.len() / w;
-                // Horizontal sums of rows y0-2 .. y0+n+1 for each direction.
-                let n_hs = n + 2 * r;
-                hs.resize(4 * n_hs * w, 0.0); // every value is overwritten by hsum_row
-                for (d, &(sx, sy)) in DIRS.iter().enumerate() {
-                    for i in 0..n_hs {
-                        let y = y0 + i - r;
-                        let yy = (y as isize + sy) as usize; // in 0..h: y in 1..h-1, |sy| <= 1
-                        let dst = &mut hs[(d * n_hs + i) * w..(d * n_hs + i + 1) * w];
-                        hsum_row(row(y), row(yy), sx, sq, dst);
+                // Horizontal sums of image row y (y - 1 and y + 1 stay inside the image: rows
+                // y0 - 2 ..= y_last + 2 with BORDER = 3), every direction, into its ring slot.
+                let mut fill = |ring: &mut [f32], y: usize| {
+                    for (d, &(sx, sy)) in DIRS.iter().enumerate() {
+                        let yy = (y as isize + sy) as usize;
+                        let o = (d * RING + y % RING) * w;
+                        hsum_row(row(y), row(yy), sx, sq, &mut ring[o..o + w]);
                     }
+                };
+                for y in y0 - r..y0 + r {
+                    fill(ring, y);
                 }
                 for (i, orow) in band.chunks_mut(w).enumerate() {
-                    let rows: [[&[f32]; 2 * MORAVEC_HALF + 1]; 4] = std::array::from_fn(|d| {
+                    let y = y0 + i;
+                    fill(ring, y + r);
+                    let hs: [[&[f32]; RING]; 4] = std::array::from_fn(|d| {
                         std::array::from_fn(|k| {
-                            &hs[(d * n_hs + i + k) * w..(d * n_hs + i + k + 1) * w]
+                            let o = (d * RING + (y + k - r) % RING) * w + BORDER;
+                            &ring[o..o + w - 2 * BORDER]
                         })
                     });
-                    min_row(&rows, acc, orow);
-                    orow[..BORDER].fill(0.0);
-                    orow[w - BORDER..].fill(0.0);
+                    min_row(&hs, &mut orow[BORDER..w - BORDER]);
                 }
             },
         );
@@ -166,10 +161,56 @@ pub fn interest_points(img: &Image, p: &InterestParams) -> Vec<InterestPoint> {
     select_points(&m, w, h, p)
 }
 
-/// Selection step of [`interest_points`] on a precomputed map (rows in parallel, raster order).
+/// Image rows per parallel task of [`select_points`].
+const SELECT_ROWS: usize = 16;
+
+simd_fn! {
+/// Peak flags of one row segment for the 3x3 neighbourhood: `mask[i]` is 1 when the centre
+/// `v = mid[i + 1]` passes `v > 0`, `v >= thr`, is strictly greater than its neighbours earlier
+/// in raster order (`up[i..i + 3]`, `mid[i]`) and at least as large as the later ones
+/// (`mid[i + 2]`, `dn[i..i + 3]`). Non-short-circuit `&` so the loop vectorises.
+fn peak_mask(up: &[f32], mid: &[f32], dn: &[f32], thr: f32, mask: &mut [u8]) {
+    let n = mask.len();
+    let (up, mid, dn) = (&up[..n + 2], &mid[..n + 2], &dn[..n + 2]);
+    for (i, o) in mask.iter_mut().enumerate() {
+        let v = mid[i + 1];
+        let keep = (v > 0.0)
+            & (v >= thr)
+            & (v > up[i])
+            & (v > up[i + 1])
+            & (v > up[i + 2])
+            & (v > mid[i])
+            & (v >= mid[i + 2])
+            & (v >= dn[i])
+            & (v >= dn[i + 1])
+            & (v >= dn[i + 2]);
+        *o = u8::from(keep);
+    }
+}
+}
+
+/// Largest value of `seg` and 0, eight lanes at a time: `f32::max` is exact and ignores NaN,
+/// so any order gives the value of a sequential fold.
+fn seg_max(seg: &[f32]) -> f32 {
+    let mut lanes = [0.0f32; 8];
+    let mut chunks = seg.chunks_exact(8);
+    for ch in &mut chunks {
+        for (l, &v) in lanes.iter_mut().zip(ch) {
+            *l = l.max(v);
+        }
+    }
+    chunks
+        .remainder()
+        .iter()
+        .chain(&lanes)
+        .copied()
+        .fold(0.0, f32::max)
+}
+
+/// Selection step of [`interest_points`] on a precomputed map (row bands in parallel, raster
+/// order).
 pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<InterestPoint> {
-    let max = m.iter().copied().fold(0.0f32, f32::max);
-    if max <= 0.0 || w == 0 {
+    if w == 0 {
         return Vec::new();
     }
     // Largest M per tile (a single tile covering the image when `tile == 0`).
@@ -181,12 +222,17 @@ pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<I
             let mut tm = vec![0.0f32; tiles_x];
             for row in band.chunks(w) {
                 for (t, seg) in row.chunks(tile).enumerate() {
-                    tm[t] = seg.iter().copied().fold(tm[t], f32::max);
+                    tm[t] = tm[t].max(seg_max(seg));
                 }
             }
             tm
         })
         .collect();
+    // The image's largest M is the largest tile maximum (max is exact: same value).
+    let max = tile_max.iter().copied().fold(0.0f32, f32::max);
+    if max <= 0.0 {
+        return Vec::new();
+    }
     let floor = max * p.floor_rel;
     let r = p.nms_half;
     // Is `v` (at x, y) above its later and strictly above its earlier neighbours?
@@ -203,50 +249,66 @@ pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<I
         }
         true
     };
-    // The 3x3 case (C.10's default) without loops or branches: BORDER >= 1 keeps every
-    // neighbour inside the image.
-    let peak = |x: usize, y: usize, v: f32| -> bool {
-        if r != 1 {
-            return is_peak(x, y, v);
-        }
-        let (up, mid, dn) = (
-            &m[(y - 1) * w..y * w],
-            &m[y * w..(y + 1) * w],
-            &m[(y + 1) * w..(y + 2) * w],
-        );
-        (v > up[x - 1])
-            & (v > up[x])
-            & (v > up[x + 1])
-            & (v > mid[x - 1])
-            & (v >= mid[x + 1])
-            & (v >= dn[x - 1])
-            & (v >= dn[x])
-            & (v >= dn[x + 1])
-    };
-    (BORDER..h.saturating_sub(BORDER))
-        .into_par_iter()
-        .flat_map_iter(|y| {
-            let row = &m[y * w..(y + 1) * w];
-            let tiles = &tile_max[(y / tile) * tiles_x..(y / tile + 1) * tiles_x];
+    let y_end = h.saturating_sub(BORDER);
+    let rows: Vec<usize> = (BORDER..y_end).step_by(SELECT_ROWS).collect();
+    let per_task: Vec<Vec<InterestPoint>> = rows
+        .par_iter()
+        .map(|&ya| {
             let mut out = Vec::new();
-            for (t, &tm) in tiles.iter().enumerate() {
-                let thr = (tm * p.rel_threshold).max(floor);
-                let xs = (t * tile).max(BORDER)..((t + 1) * tile).min(w.saturating_sub(BORDER));
-                for x in xs {
-                    let v = row[x];
-                    // Strictly greater than the neighbours earlier in raster order, at least
-                    // as large as the later ones (deterministic ties); the centre compares
-                    // equal to itself and is neither.
-                    if v > 0.0 && v >= thr && peak(x, y, v) {
-                        out.push(InterestPoint {
-                            x: x as u32,
-                            y: y as u32,
-                            value: v,
-                        });
+            let mut mask = vec![0u8; w];
+            for y in ya..(ya + SELECT_ROWS).min(y_end) {
+                let row = &m[y * w..(y + 1) * w];
+                let tiles = &tile_max[(y / tile) * tiles_x..(y / tile + 1) * tiles_x];
+                for (t, &tm) in tiles.iter().enumerate() {
+                    let thr = (tm * p.rel_threshold).max(floor);
+                    let (x0, x1) = (
+                        (t * tile).max(BORDER),
+                        ((t + 1) * tile).min(w.saturating_sub(BORDER)),
+                    );
+                    if x0 >= x1 {
+                        continue;
+                    }
+                    if r != 1 {
+                        for (x, &v) in row.iter().enumerate().take(x1).skip(x0) {
+                            // Strictly greater than the neighbours earlier in raster order, at
+                            // least as large as the later ones (deterministic ties); the centre
+                            // compares equal to itself and is neither.
+                            if v > 0.0 && v >= thr && is_peak(x, y, v) {
+                                out.push(InterestPoint {
+                                    x: x as u32,
+                                    y: y as u32,
+                                    value: v,
+                                });
+                            }
+                        }
+                        continue;
+                    }
+                    // The 3x3 case (C.10's default) as flags over the segment, then a scan of
+                    // the few set ones: BORDER >= 1 keeps every neighbour inside the image.
+                    let nb = |yy: usize| &m[yy * w + x0 - 1..yy * w + x1 + 1];
+                    let flags = &mut mask[..x1 - x0];
+                    peak_mask(nb(y - 1), nb(y), nb(y + 1), thr, flags);
+                    // Eight flags (0 or 1 bytes) at a time as one word: most are all zero.
+                    let mut base = x0;
+                    for chunk in flags.chunks(8) {
+                        let mut word = [0u8; 8];
+                        word[..chunk.len()].copy_from_slice(chunk);
+                        let mut bits = u64::from_le_bytes(word);
+                        while bits != 0 {
+                            let x = base + bits.trailing_zeros() as usize / 8;
+                            bits &= bits - 1;
+                            out.push(InterestPoint {
+                                x: x as u32,
+                                y: y as u32,
+                                value: row[x],
+                            });
+                        }
+                        base += chunk.len();
                     }
                 }
             }
             out
         })
-        .collect()
+        .collect();
+    per_task.concat()
 }

@@ -37,7 +37,7 @@ pub use interest::{interest_points, moravec, InterestParams, InterestPoint};
 pub use network::{
     build_weights, run_dynamics, Csr, Dynamics, EnergyWeights, Network, Neuron, Weights,
 };
-use zncc::{max_of, zncc_curves, Curves, RightStats, FULL, N_REGIONS, SIM_RADIUS};
+use zncc::{max_of, row_peaks, zncc_curves, Curves, RightStats, FULL, N_REGIONS, SIM_RADIUS};
 
 /// Where the right candidates of a left point come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -318,17 +318,7 @@ fn point_candidates(
         });
         sc.ds.clear();
         match p.candidates {
-            CandidateMode::Row => {
-                for d in p.d_min..=d_hi {
-                    let c = full[d];
-                    if c >= p.s_min
-                        && (d == p.d_min || c >= full[d - 1])
-                        && (d == d_hi || c > full[d + 1])
-                    {
-                        sc.ds.push(d);
-                    }
-                }
-            }
+            CandidateMode::Row => row_peaks(full, p.d_min, d_hi, p.s_min, &mut sc.ds),
             CandidateMode::Points => {
                 for &xr in right_xs {
                     if xr <= x && (p.d_min..=d_hi).contains(&(x - xr)) && full[x - xr] >= p.s_min {

@@ -8,7 +8,7 @@
 //! products `(L - c) * R` are accumulated per cell in registers, the five regions are cell sums,
 //! and each is centred with the region's right-window sum:
 //! `sum (L - mu) R = sum (L - c) R - (mu - c) sum R`. Right-window sums and inverse norms come
-//! from `f64` cell sums computed once per image ([`RightStats`]).
+//! from `f64` cell sums computed once per image row ([`RightStats`], one band of rows per task).
 
 use rayon::prelude::*;
 
@@ -90,66 +90,79 @@ pub struct RightStats {
     scratch: StatsScratch,
 }
 
-/// Scratch of [`stats_row`] (`f64`, one image row each): vertical sums of the top band (rows
-/// -3..=-1), the bottom band (1..=3) and all seven rows, for values (`v[0..3]`) and squares
-/// (`v[3..6]`); `h[i][x] = v[i][x] + v[i][x + 1] + v[i][x + 2]`.
+/// Vertical 3-row sums `S(z)` (rows `z, z+1, z+2`, in that order) of values and squares, and
+/// their horizontal 3-sums `h[x] = v[x] + v[x+1] + v[x+2]`: `f64`, one image row each.
 #[derive(Debug, Clone, Default)]
-struct StatsScratch {
-    v: [Vec<f64>; 6],
-    h: [Vec<f64>; 6],
+struct BandSums {
+    v: [Vec<f64>; 2],
+    h: [Vec<f64>; 2],
 }
 
-/// `out[x] = a[x] + b[x] + c[x]` in `f64` (values, or squares when `square`).
-#[inline(always)]
-fn sum3(out: &mut [f64], a: &[f32], b: &[f32], c: &[f32], square: bool) {
-    let f = |v: f32| {
-        let v = v as f64;
-        if square {
-            v * v
-        } else {
-            v
+/// Rows of [`BandSums`] kept while a band is filled: row `y` reads the top band `S(y - 3)` and
+/// the bottom band `S(y + 1)`, so `S(z)` serves as the bottom band of row `z - 1` and, four
+/// rows later, as the top band of row `z + 3` (slot `z % RING`).
+const RING: usize = 5;
+
+/// Scratch of [`RightStats::fill_band`]: the ring of band sums, the all-rows sums of the current
+/// row (same layout) and the `f32` squared norms of one region.
+#[derive(Debug, Clone, Default)]
+struct StatsScratch {
+    ring: [BandSums; RING],
+    all: BandSums,
+    n2: Vec<f32>,
+}
+
+impl BandSums {
+    fn resize(&mut self, w: usize) {
+        for a in self.v.iter_mut().chain(self.h.iter_mut()) {
+            a.resize(w, 0.0); // only grows: every value read is overwritten first
         }
-    };
-    for (((o, &a), &b), &c) in out.iter_mut().zip(a).zip(b).zip(c) {
-        *o = f(a) + f(b) + f(c);
     }
 }
 
-/// Statistics of image row `y` (`SIM_RADIUS <= y < H - SIM_RADIUS`) into `chunk`
-/// (`2 * N_REGIONS * stride` values).
-fn fill_row(img: &Image, y: usize, stride: usize, s: &mut StatsScratch, chunk: &mut [f32]) {
-    let w = img.width;
-    let rows: [&[f32]; SIDE] = std::array::from_fn(|r| &img.data[(y + r - SIM_RADIUS) * w..][..w]);
-    let (sums, invs) = chunk.split_at_mut(N_REGIONS * stride);
-    stats_row(&rows, s, stride, sums, invs);
+/// `h[x] = v[x] + v[x + 1] + v[x + 2]` (left to right) for `x < w - 2`.
+#[inline(always)]
+fn hsum3(v: &[f64], h: &mut [f64]) {
+    for (((o, &a), &b), &c) in h.iter_mut().zip(v).zip(&v[1..]).zip(&v[2..]) {
+        *o = a + b + c;
+    }
 }
 
 simd_fn! {
-/// Sums and inverse norms of the five regions along one row (`rows`: the 7 image rows around
-/// it), written to `sums` / `invs` (`N_REGIONS` rows of `stride` values each).
-fn stats_row(rows: &[&[f32]; SIDE], s: &mut StatsScratch, stride: usize, sums: &mut [f32], invs: &mut [f32]) {
-    let w = rows[0].len();
-    for a in s.v.iter_mut().chain(s.h.iter_mut()) {
-        a.resize(w, 0.0); // only grows: every value read below is overwritten first
+/// `S(z)` of the three image rows `rows` into `out` (values, squares, their horizontal sums).
+fn band_sums(rows: [&[f32]; 3], out: &mut BandSums) {
+    let [v, q] = &mut out.v;
+    for ((((ov, oq), &a), &b), &c) in v.iter_mut().zip(q.iter_mut()).zip(rows[0]).zip(rows[1]).zip(rows[2]) {
+        let (a, b, c) = (a as f64, b as f64, c as f64);
+        *ov = a + b + c;
+        *oq = a * a + b * b + c * c;
     }
-    for (i, square) in [(0, false), (3, true)] {
-        let [top, bot, all] = &mut s.v[i..i + 3] else {
-            return; // unreachable: v has six rows
-        };
-        sum3(top, rows[0], rows[1], rows[2], square);
-        sum3(bot, rows[4], rows[5], rows[6], square);
-        for (((o, &t), &b), &m) in all.iter_mut().zip(top.iter()).zip(bot.iter()).zip(rows[3]) {
+    hsum3(&out.v[0], &mut out.h[0]);
+    hsum3(&out.v[1], &mut out.h[1]);
+}
+}
+
+simd_fn! {
+/// Sums and inverse norms of the five regions along one row, written to `sums` / `invs`
+/// (`N_REGIONS` rows of `stride` values each; the columns where the window does not fit are
+/// left alone, but for the left region's, which runs 4 further into the padding). `top` =
+/// `S(y - 3)`, `bot` = `S(y + 1)`, `mid` = image row `y`; `all` and `n2` are scratch. The top
+/// region is skipped unless `with_top` (the caller copies it: see [`fill_rows`]).
+fn stats_row(top: &BandSums, mid: &[f32], bot: &BandSums, all: &mut BandSums, n2: &mut Vec<f32>, with_top: bool, stride: usize, sums: &mut [f32], invs: &mut [f32]) {
+    let w = mid.len();
+    for i in 0..2 {
+        let square = i == 1;
+        for (((o, &t), &b), &m) in all.v[i].iter_mut().zip(&top.v[i]).zip(&bot.v[i]).zip(mid) {
             let m = m as f64;
             *o = t + if square { m * m } else { m } + b;
         }
     }
-    for (v, h) in s.v.iter().zip(s.h.iter_mut()) {
-        for (((o, &a), &b), &c) in h.iter_mut().zip(v).zip(&v[1..]).zip(&v[2..]) {
-            *o = a + b + c;
-        }
-    }
-    // Region k: (vertical sums i, horizontal parts): full / top / bottom = left 3 + centre +
-    // right 3 columns of the all / top / bottom band sums; left / right = 3 columns of all.
+    hsum3(&all.v[0], &mut all.h[0]);
+    hsum3(&all.v[1], &mut all.h[1]);
+    // Region k: (vertical sums: 0 top, 1 bottom, 2 all; horizontal parts): full / top / bottom
+    // = left 3 + centre + right 3 columns of the all / top / bottom band sums; left = the 3
+    // columns before the centre of all. The right region at x is the left one at x + 4 (the
+    // same 3-column sum): the left one is computed 4 columns further and copied.
     const PARTS: [(usize, bool, bool, bool); N_REGIONS] = [
         (2, true, true, true),
         (2, true, false, false),
@@ -159,25 +172,42 @@ fn stats_row(rows: &[&[f32]; SIDE], s: &mut StatsScratch, stride: usize, sums: &
     ];
     let xs = SIM_RADIUS..w - SIM_RADIUS;
     let n_x = xs.len();
+    let shift = SIM_RADIUS + 1;
+    n2.resize(n_x + shift, 0.0);
     for (k, &(i, l, c, r)) in PARTS.iter().enumerate() {
+        if k == HALF_RIGHT || (k == HALF_TOP && !with_top) {
+            continue;
+        }
+        let m = if k == HALF_LEFT { n_x + shift } else { n_x };
         let n = region_n(k) as f64;
         let min_n2 = n * MIN_WINDOW_STD * MIN_WINDOW_STD;
+        let src = [top, bot, &*all][i];
         let part = |a: usize| -> (&[f64], &[f64], &[f64]) {
-            (&s.h[a][..n_x], &s.v[a][SIM_RADIUS..SIM_RADIUS + n_x], &s.h[a][SIM_RADIUS + 1..SIM_RADIUS + 1 + n_x])
+            let h = &src.h[a];
+            (&h[..m], &src.v[a][SIM_RADIUS..SIM_RADIUS + m.min(n_x)], &h[shift..shift + m.min(n_x)])
         };
-        let (sl, sc, sr) = part(i);
-        let (ql, qc, qr) = part(3 + i);
-        let srow = &mut sums[k * stride + SIM_RADIUS..k * stride + SIM_RADIUS + n_x];
-        let irow = &mut invs[k * stride + SIM_RADIUS..k * stride + SIM_RADIUS + n_x];
+        let (sl, sc, sr) = part(0);
+        let (ql, qc, qr) = part(1);
+        let srow = &mut sums[k * stride + SIM_RADIUS..k * stride + SIM_RADIUS + m];
+        let irow = &mut invs[k * stride + SIM_RADIUS..k * stride + SIM_RADIUS + m];
         // The parts as compile-time flags: with run-time ones the vectoriser turned the skipped
         // loads into masked loads (microcoded on AMD). Same sums in the same order.
-        let f = (n, min_n2, (sl, sc, sr), (ql, qc, qr), srow, irow);
+        let f = (n, min_n2, (sl, sc, sr), (ql, qc, qr), srow, &mut n2[..m]);
         match (l, c, r) {
             (true, true, true) => region_row::<true, true, true>(f),
             (true, false, false) => region_row::<true, false, false>(f),
-            (false, false, true) => region_row::<false, false, true>(f),
-            _ => unreachable!("PARTS has three patterns"),
+            _ => unreachable!("PARTS computes two patterns"),
         }
+        // A loop of its own: the f32 square root and division then run 8 lanes wide (4 in
+        // the f64 loop above), the costliest operations of the statistics.
+        for (o, &q) in irow.iter_mut().zip(n2.iter()) {
+            *o = if q > 0.0 { 1.0 / q.sqrt() } else { 0.0 };
+        }
+    }
+    for buf in [sums, invs] {
+        let (lo, hi) = buf.split_at_mut(HALF_RIGHT * stride);
+        let from = HALF_LEFT * stride + SIM_RADIUS + shift;
+        hi[SIM_RADIUS..SIM_RADIUS + n_x].copy_from_slice(&lo[from..from + n_x]);
     }
 }
 }
@@ -192,10 +222,11 @@ type RegionArgs<'a> = (
     &'a mut [f32],
 );
 
-/// Sum and inverse norm of one region along a row, from its left / centre / right parts.
+/// Sum of one region along a row, from its left / centre / right parts, and its zero-mean
+/// squared norm as `f32` where it reaches `min_n2` (else 0: textureless).
 #[inline(always)]
 fn region_row<const L: bool, const C: bool, const R: bool>(args: RegionArgs<'_>) {
-    let (n, min_n2, (sl, sc, sr), (ql, qc, qr), srow, irow) = args;
+    let (n, min_n2, (sl, sc, sr), (ql, qc, qr), srow, n2row) = args;
     let pick = |a: &[f64], b: &[f64], d: &[f64], x: usize| {
         let mut v = 0.0;
         if L {
@@ -209,35 +240,30 @@ fn region_row<const L: bool, const C: bool, const R: bool>(args: RegionArgs<'_>)
         }
         v
     };
-    for x in 0..srow.len().min(irow.len()) {
+    for x in 0..srow.len().min(n2row.len()) {
         let sm = pick(sl, sc, sr, x);
         let sq = pick(ql, qc, qr, x);
         let n2 = sq - sm * sm / n;
         srow[x] = sm as f32;
-        irow[x] = if n2 >= min_n2 {
-            1.0 / (n2 as f32).sqrt()
-        } else {
-            0.0
-        };
+        // min_n2 > 0, so a kept value stays > 0 as f32 (>= 2e-5): the flag survives.
+        n2row[x] = if n2 >= min_n2 { n2 as f32 } else { 0.0 };
     }
 }
 
 impl RightStats {
-    /// Statistics of every row of `img` (row-parallel).
+    /// Statistics of every row of `img` (bands of rows in parallel).
     pub fn new(img: &Image) -> Self {
         let (w, h) = img.size();
         let stride = w + LANES;
         let row_len = 2 * N_REGIONS * stride;
         let mut buf = vec![0.0f32; row_len * h];
-        if w >= SIDE && h >= SIDE {
-            buf.par_chunks_mut(row_len)
-                .enumerate()
-                .skip(SIM_RADIUS)
-                .take(h - 2 * SIM_RADIUS)
-                .for_each_init(StatsScratch::default, |s, (y, chunk)| {
-                    fill_row(img, y, stride, s, chunk);
-                });
-        }
+        const BAND: usize = 16;
+        buf.par_chunks_mut(row_len * BAND)
+            .enumerate()
+            .for_each_init(StatsScratch::default, |s, (b, chunk)| {
+                let y_lo = b * BAND;
+                fill_rows(img, y_lo, y_lo + chunk.len() / row_len, s, chunk);
+            });
         RightStats {
             stride,
             y0: 0,
@@ -256,25 +282,13 @@ impl RightStats {
         self.y0 = y_lo;
         self.rows = y_hi - y_lo;
         let row_len = 2 * N_REGIONS * self.stride;
-        self.buf.clear();
-        self.buf.resize(row_len * self.rows, 0.0);
-        if w < SIDE || h < SIDE {
-            return;
+        // Only grows, not cleared: fill_rows writes every value of the band.
+        if self.buf.len() < row_len * self.rows {
+            self.buf.resize(row_len * self.rows, 0.0);
         }
-        let lo = y_lo.max(SIM_RADIUS);
-        let hi = y_hi.min(h - SIM_RADIUS);
-        for y in lo..hi {
-            let o = (y - y_lo) * row_len;
-            fill_row(
-                img,
-                y,
-                self.stride,
-                &mut self.scratch,
-                &mut self.buf[o..o + row_len],
-            );
-        }
+        let chunk = &mut self.buf[..row_len * self.rows];
+        fill_rows(img, y_lo, y_hi, &mut self.scratch, chunk);
     }
-
     /// Window sums of region `k` along row `y` (`W + LANES` values, zero past the image).
     #[inline]
     fn sums(&self, k: usize, y: usize) -> &[f32] {
@@ -296,10 +310,75 @@ impl RightStats {
     }
 }
 
+/// Statistics of image rows `y_lo..y_hi` into `chunk` (`2 * N_REGIONS * (W + LANES)` values
+/// per row), every value written: zeros where the window does not fit and in the padding.
+fn fill_rows(img: &Image, y_lo: usize, y_hi: usize, s: &mut StatsScratch, chunk: &mut [f32]) {
+    let (w, h) = img.size();
+    let stride = w + LANES;
+    let row_len = 2 * N_REGIONS * stride;
+    let (lo, hi) = if w >= SIDE && h >= SIDE {
+        (y_lo.max(SIM_RADIUS), y_hi.min(h - SIM_RADIUS))
+    } else {
+        (y_hi, y_hi) // nothing fits
+    };
+    let row = |y: usize| &img.data[y * w..(y + 1) * w];
+    if lo < hi {
+        for b in s.ring.iter_mut().chain(std::iter::once(&mut s.all)) {
+            b.resize(w);
+        }
+        // S(lo - 3) ..= S(lo): the top bands of the first four rows.
+        for z in lo - SIM_RADIUS..=lo {
+            band_sums([row(z), row(z + 1), row(z + 2)], &mut s.ring[z % RING]);
+        }
+    }
+    for i in 0..chunk.len() / row_len {
+        let y = y_lo + i;
+        if !(lo..hi).contains(&y) {
+            chunk[i * row_len..(i + 1) * row_len].fill(0.0);
+            continue;
+        }
+        // S(y + 1) replaces S(y - 4), read for the last time by row y - 1.
+        let z = y + 1;
+        band_sums([row(z), row(z + 1), row(z + 2)], &mut s.ring[z % RING]);
+        let (top, bot) = (&s.ring[(y - SIM_RADIUS) % RING], &s.ring[z % RING]);
+        let (done, out) = chunk.split_at_mut(i * row_len);
+        let out = &mut out[..row_len];
+        // The top region of row y is the bottom one of row y - 4 (both read S(y - 3)).
+        let copy_top = y >= lo + 4;
+        let (sums, invs) = out.split_at_mut(N_REGIONS * stride);
+        stats_row(
+            top,
+            row(y),
+            bot,
+            &mut s.all,
+            &mut s.n2,
+            !copy_top,
+            stride,
+            sums,
+            invs,
+        );
+        if copy_top {
+            let prev = &done[(i - 4) * row_len..(i - 3) * row_len];
+            for (dst, src) in [
+                (sums, &prev[..N_REGIONS * stride]),
+                (invs, &prev[N_REGIONS * stride..]),
+            ] {
+                let (t, b) = (HALF_TOP * stride, HALF_BOTTOM * stride);
+                dst[t..t + stride].copy_from_slice(&src[b..b + stride]);
+            }
+        }
+        for line in out.chunks_mut(stride) {
+            line[..SIM_RADIUS].fill(0.0);
+            line[w - SIM_RADIUS..].fill(0.0);
+        }
+    }
+}
+
 /// Reusable buffers of [`zncc_curves`].
 #[derive(Debug, Clone, Default)]
 pub struct Curves {
-    /// The 7 right rows of the search span, zero-padded to whole blocks of [`LANES`].
+    /// The 7 right rows of the search span, zero-padded to whole blocks of [`LANES`], for the
+    /// rare span whose last block would read past the end of the image.
     rbuf: Vec<f32>,
     /// `curve[k][d]`: ZNCC of region `k` at disparity `d = 0..=d_hi` (0 = undefined; entries
     /// past `d_hi` are stale).
@@ -308,11 +387,27 @@ pub struct Curves {
     pub left_mean: f32,
 }
 
-simd_fn! {
 /// ZNCC curves of the five regions around left `(x, y)` against right `(x - d, yr)`,
 /// `d = 0..=d_hi`. The caller guarantees `SIM_RADIUS <= x - d_hi`, `x + SIM_RADIUS < W` and
 /// that rows `y` and `yr` are at least `SIM_RADIUS` from the top and bottom.
+#[allow(clippy::too_many_arguments)]
 pub fn zncc_curves(
+    left: &Image,
+    right: &Image,
+    stats: &RightStats,
+    x: usize,
+    y: usize,
+    yr: usize,
+    d_hi: usize,
+    out: &mut Curves,
+) {
+    curves_with(has_avx2(), left, right, stats, x, y, yr, d_hi, out);
+}
+
+/// [`zncc_curves`] on the AVX2 path when `avx2` (and the CPU has it), else the portable one.
+#[allow(clippy::too_many_arguments)]
+fn curves_with(
+    avx2: bool,
     left: &Image,
     right: &Image,
     stats: &RightStats,
@@ -324,81 +419,118 @@ pub fn zncc_curves(
 ) {
     let len = d_hi + 1;
     let blocks = len.div_ceil(LANES);
-    let span = blocks * LANES + SIDE - 1;
-    // Template cell sums (values, squares) in f64: region means and zero-mean norms.
-    let mut tmpl = [[0.0f32; SIDE]; SIDE];
+    let lw = left.width;
+    // Row references, not a copy: the copy's overlapping 16-byte stores stalled the f64 loads
+    // that followed (store forwarding).
+    let win: [&[f32; SIDE]; SIDE] = std::array::from_fn(|r| {
+        let o = (y + r - SIM_RADIUS) * lw + x - SIM_RADIUS;
+        left.data[o..o + SIDE].try_into().expect("SIDE values")
+    });
+    let (t, norm, mean) = template(&win);
+    out.left_mean = mean;
+    // Right rows yr-3..=yr+3 from column x0 = x - d_hi - 3: block b reads columns
+    // x0 + 8 b ..= x0 + 8 b + 14 of each. Read in place (the lanes past `len` read the next
+    // pixels of the row, or of the next one, and are never stored) unless the last block would
+    // run past the image: then from a copy padded with zeros.
+    let w = right.width;
+    let x0 = x - d_hi - SIM_RADIUS;
+    let first = (yr - SIM_RADIUS) * w + x0;
+    let reach = (SIDE - 1) * w + blocks * LANES + SIDE - 1;
+    let (src, stride) = if first + reach <= right.data.len() {
+        (&right.data[first..first + reach], w)
+    } else {
+        let span = blocks * LANES + SIDE - 1;
+        let avail = (len + SIDE - 1).min(w - x0);
+        out.rbuf.clear();
+        out.rbuf.resize(SIDE * span, 0.0);
+        for r in 0..SIDE {
+            let row = &right.data[first + r * w..][..avail];
+            out.rbuf[r * span..r * span + avail].copy_from_slice(row);
+        }
+        (&out.rbuf[..], span)
+    };
+    // Lanes past `len` read the padding of the statistics rows and are never stored.
+    let xr_lo = x - d_hi;
+    let st: [[&[f32]; N_REGIONS]; 2] = [
+        std::array::from_fn(|k| &stats.sums(k, yr)[xr_lo..xr_lo + blocks * LANES]),
+        std::array::from_fn(|k| &stats.inv_norms(k, yr)[xr_lo..xr_lo + blocks * LANES]),
+    ];
+    for cv in out.curve.iter_mut() {
+        if cv.len() < len {
+            cv.resize(len, 0.0);
+        }
+    }
+    let curves: [&mut [f32]; N_REGIONS] = {
+        let [a, b, c, d, e] = &mut out.curve;
+        [
+            &mut a[..len],
+            &mut b[..len],
+            &mut c[..len],
+            &mut d[..len],
+            &mut e[..len],
+        ]
+    };
+    #[cfg(target_arch = "x86_64")]
+    if avx2 && has_avx2() {
+        // SAFETY: AVX2 is present; `src` holds `reach` values from the first read, every
+        // statistics row `blocks * LANES` values and every curve `len`.
+        unsafe { blocks_avx2(&t, src, stride, &st, &norm, curves) };
+        return;
+    }
+    let _ = avx2;
+    blocks_portable(&t, src, stride, &st, &norm, curves);
+}
+
+simd_fn! {
+/// The left window `win` (7 rows of 7 values) centred on its mean `c` (`f32`), the regions'
+/// centring shifts and inverse zero-mean norms, and `c`. Cell sums (values, squares) in `f64`,
+/// each cell accumulated row by row, left to right.
+fn template(win: &[&[f32; SIDE]; SIDE]) -> ([[f32; SIDE]; SIDE], Norm, f32) {
     let mut cs = [[0.0f64; 3]; 3];
     let mut cq = [[0.0f64; 3]; 3];
-    for (r, row) in tmpl.iter_mut().enumerate() {
-        for (c, v) in row.iter_mut().enumerate() {
-            *v = left.at(x + c - SIM_RADIUS, y + r - SIM_RADIUS);
-            let f = *v as f64;
-            cs[part_of(r)][part_of(c)] += f;
-            cq[part_of(r)][part_of(c)] += f * f;
+    for (r, row) in win.iter().enumerate() {
+        let f: [f64; SIDE] = std::array::from_fn(|c| row[c] as f64);
+        // The three cells of this row's band, unrolled: constant column groups.
+        let (s, q) = (&mut cs[part_of(r)], &mut cq[part_of(r)]);
+        let (mut s0, mut s1, mut s2) = (s[0], s[1], s[2]);
+        let (mut q0, mut q1, mut q2) = (q[0], q[1], q[2]);
+        for &v in &f[..SIM_RADIUS] {
+            s0 += v;
+            q0 += v * v;
         }
+        s1 += f[SIM_RADIUS];
+        q1 += f[SIM_RADIUS] * f[SIM_RADIUS];
+        for &v in &f[SIM_RADIUS + 1..] {
+            s2 += v;
+            q2 += v * v;
+        }
+        *s = [s0, s1, s2];
+        *q = [q0, q1, q2];
     }
     let (rs, rq) = (regions_of(&cs), regions_of(&cq));
     let c = rs[FULL] / region_n(FULL) as f64;
-    let mut shift = [0.0f32; N_REGIONS];
-    let mut inv_l = [0.0f32; N_REGIONS];
-    for k in 0..N_REGIONS {
-        let n = region_n(k) as f64;
-        let q = rq[k] - rs[k] * rs[k] / n;
-        shift[k] = (rs[k] / n - c) as f32;
-        // 0 for a textureless left region: its whole curve is then 0 (undefined).
-        if q >= n * MIN_WINDOW_STD * MIN_WINDOW_STD {
-            inv_l[k] = (1.0 / q.sqrt()) as f32;
+    // Element-wise over the five regions (vectorised: the divisions and square roots are the
+    // slow part of a point's setup).
+    let n: [f64; N_REGIONS] = std::array::from_fn(|k| region_n(k) as f64);
+    let q: [f64; N_REGIONS] = std::array::from_fn(|k| rq[k] - rs[k] * rs[k] / n[k]);
+    let shift: [f32; N_REGIONS] = std::array::from_fn(|k| (rs[k] / n[k] - c) as f32);
+    // 0 for a textureless left region: its whole curve is then 0 (undefined).
+    let inv_l: [f32; N_REGIONS] = std::array::from_fn(|k| {
+        let ok = q[k] >= n[k] * MIN_WINDOW_STD * MIN_WINDOW_STD;
+        if ok {
+            (1.0 / q[k].sqrt()) as f32
+        } else {
+            0.0
         }
-    }
-    out.left_mean = c as f32;
+    });
+    // Plain loops: the nested array::from_fn stayed an out-of-line call.
     let mut t = [[0.0f32; SIDE]; SIDE];
-    for (tr, lr) in t.iter_mut().zip(&tmpl) {
-        for (tv, &lv) in tr.iter_mut().zip(lr) {
-            *tv = (lv as f64 - c) as f32;
+    for (tr, wr) in t.iter_mut().zip(win) {
+        for (tv, &v) in tr.iter_mut().zip(wr.iter()) {
+            *tv = (v as f64 - c) as f32;
         }
     }
-    // Right rows yr-3..=yr+3, columns x - d_hi - 3 .. x + 3 (+ zero padding of the last block).
-    let w = right.width;
-    let x0 = x - d_hi - SIM_RADIUS;
-    let avail = (len + SIDE - 1).min(w - x0);
-    // Only grows; lanes past `len` read stale (finite) values and are never stored.
-    if out.rbuf.len() < SIDE * span {
-        out.rbuf.resize(SIDE * span, 0.0);
-    }
-    for r in 0..SIDE {
-        let src = &right.data[(yr + r - SIM_RADIUS) * w + x0..][..avail];
-        out.rbuf[r * span..r * span + avail].copy_from_slice(src);
-    }
-    let xr_lo = x - d_hi;
-    // Lanes past `len` read the padding of the statistics rows and are never stored.
-    let sums: [&[f32]; N_REGIONS] = std::array::from_fn(|k| &stats.sums(k, yr)[xr_lo..]);
-    let invs: [&[f32]; N_REGIONS] = std::array::from_fn(|k| &stats.inv_norms(k, yr)[xr_lo..]);
-    for cv in out.curve.iter_mut() {
-        if cv.len() < blocks * LANES {
-            cv.resize(blocks * LANES, 0.0);
-        }
-    }
-    let rbuf = &out.rbuf;
-    let norm = Norm { shift, inv_l };
-    let avx2 = has_avx2();
-    for bl in 0..blocks {
-        let j0 = bl * LANES;
-        let rows: [&[f32]; SIDE] = std::array::from_fn(|r| &rbuf[r * span + j0..r * span + j0 + WIN]);
-        let st: [[&[f32]; N_REGIONS]; 2] = [
-            std::array::from_fn(|k| &sums[k][j0..j0 + LANES]),
-            std::array::from_fn(|k| &invs[k][j0..j0 + LANES]),
-        ];
-        let vals = block_zncc(avx2, &t, &rows, &st, &norm);
-        for (cv, v) in out.curve.iter_mut().zip(&vals) {
-            if let Some(dst) = cv[j0..].first_chunk_mut::<LANES>() {
-                *dst = *v;
-            }
-        }
-    }
-    // Index j = xr - xr_lo = d_hi - d: reverse into disparity order.
-    for cv in out.curve.iter_mut() {
-        cv[..len].reverse();
-    }
+    (t, Norm { shift, inv_l }, c as f32)
 }
 }
 
@@ -418,8 +550,69 @@ pub fn max_of(c: &[f32]) -> f32 {
         .fold(f32::MIN, |a, v| if v > a { v } else { a })
 }
 
-/// Right-row values one block of disparities reads: [`LANES`] positions plus the window.
-const WIN: usize = LANES + SIDE - 1;
+/// The disparities `d_min..=d_hi` where `full` is a peak at least `s_min`: `full[d] >= s_min`,
+/// `>=` its left neighbour and `>` its right one (the range's ends compare with one side only),
+/// ascending, into `out`. On AVX2 the interior tests run eight at a time into a bit mask: as
+/// branches they were unpredictable, and their mispredictions cost more than the tests.
+pub fn row_peaks(full: &[f32], d_min: usize, d_hi: usize, s_min: f32, out: &mut Vec<usize>) {
+    out.clear();
+    if d_hi < d_min {
+        return;
+    }
+    let c = &full[d_min..=d_hi];
+    let n = c.len();
+    let peak =
+        |i: usize| c[i] >= s_min && (i == 0 || c[i] >= c[i - 1]) && (i + 1 == n || c[i] > c[i + 1]);
+    // Interior positions 1..=done are tested eight at a time (AVX2), the rest one by one.
+    let mut done = 0;
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2() && n >= LANES + 2 {
+        out.extend((peak(0)).then_some(d_min));
+        // SAFETY: AVX2 is present and n >= 10.
+        done = unsafe { interior_peaks_avx2(c, s_min, d_min, out) };
+    }
+    for i in if done == 0 { 0 } else { done + 1 }..n {
+        if peak(i) {
+            out.push(d_min + i);
+        }
+    }
+}
+
+/// The peaks of [`row_peaks`] at `1..=8 m` (`8 m <= c.len() - 2`, largest such `m`) appended
+/// to `out` as `d0 + i`; returns `8 m`. `>=` / `>` as ordered quiet compares: false on NaN,
+/// like the scalar tests.
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn interior_peaks_avx2(c: &[f32], s_min: f32, d0: usize, out: &mut Vec<usize>) -> usize {
+    use std::arch::x86_64::*;
+    let end = (c.len() - 2) / LANES * LANES;
+    let s = _mm256_set1_ps(s_min);
+    let p = c.as_ptr();
+    let mut i = 1;
+    while i <= end {
+        // Reads c[i - 1 ..= i + 8], inside c as i + 8 <= end + 1 <= len - 1.
+        let v = _mm256_loadu_ps(p.add(i));
+        let l = _mm256_loadu_ps(p.add(i - 1));
+        let r = _mm256_loadu_ps(p.add(i + 1));
+        let ok = _mm256_and_ps(
+            _mm256_and_ps(
+                _mm256_cmp_ps::<_CMP_GE_OQ>(v, s),
+                _mm256_cmp_ps::<_CMP_GE_OQ>(v, l),
+            ),
+            _mm256_cmp_ps::<_CMP_GT_OQ>(v, r),
+        );
+        let mut bits = _mm256_movemask_ps(ok) as u32;
+        while bits != 0 {
+            out.push(d0 + i + bits.trailing_zeros() as usize);
+            bits &= bits - 1;
+        }
+        i += LANES;
+    }
+    end
+}
 
 /// Per-region centring and left normalisation of one point: `(A - shift S) * inv_R * inv_l`.
 struct Norm {
@@ -440,99 +633,160 @@ fn has_avx2() -> bool {
     }
 }
 
-/// ZNCC of the five regions for one block of [`LANES`] disparities. `rows[r]`: right row `r`
-/// of the window from the block's first lane ([`WIN`] values); `st[0][k]` / `st[1][k]`: region
-/// `k`'s right sums / inverse norms per lane ([`LANES`] values). The AVX2 and the portable versions perform the
-/// same `f32` operations in the same order (mul then add, no FMA): identical results.
-#[inline]
-fn block_zncc(
-    avx2: bool,
-    t: &[[f32; SIDE]; SIDE],
-    rows: &[&[f32]; SIDE],
-    st: &[[&[f32]; N_REGIONS]; 2],
-    norm: &Norm,
-) -> [[f32; LANES]; N_REGIONS] {
-    let fits = rows.iter().all(|r| r.len() >= WIN) && st.iter().flatten().all(|v| v.len() >= LANES);
-    debug_assert!(fits);
-    #[cfg(target_arch = "x86_64")]
-    if avx2 && fits {
-        // SAFETY: AVX2 is present (checked by the caller) and every row holds WIN values.
-        return unsafe { block_zncc_avx2(t, rows, st, norm) };
-    }
-    let _ = avx2;
-    let mut cells = [[[0.0f32; LANES]; 3]; 3];
-    for (r, (tr, row)) in t.iter().zip(rows).enumerate() {
-        for (c, &tv) in tr.iter().enumerate() {
-            let acc = &mut cells[part_of(r)][part_of(c)];
-            for l in 0..LANES {
-                acc[l] += tv * row[c + l];
-            }
+/// Block `b` (lanes `j = 8 b + l`, right column `x - d_hi + j`, disparity `d_hi - j`) of the
+/// five regions into the curves, which are in disparity order: lane `l` goes to
+/// `d = len - 1 - 8 b - l`, and only the lanes with `j < len`.
+#[inline(always)]
+fn store_block(curves: &mut [&mut [f32]; N_REGIONS], j0: usize, vals: &[[f32; LANES]; N_REGIONS]) {
+    for (cv, v) in curves.iter_mut().zip(vals) {
+        let len = cv.len();
+        for (l, &x) in v.iter().enumerate().take(len - j0) {
+            cv[len - 1 - j0 - l] = x;
         }
     }
-    let regs = regions_of(&cells.map(|band| band.map(Lanes)));
-    std::array::from_fn(|k| {
-        std::array::from_fn(|l| {
-            (regs[k].0[l] - norm.shift[k] * st[0][k][l]) * st[1][k][l] * norm.inv_l[k]
-        })
-    })
 }
 
-/// AVX2 body of [`block_zncc`]: the nine cell accumulators live in registers.
-///
-/// # Safety
-/// The CPU must support AVX2, every `rows[r]` must hold at least [`WIN`] values and every
-/// `st[i][k]` at least [`LANES`].
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn block_zncc_avx2(
+/// The curves of one point, [`LANES`] disparities per block: `src` holds right row `r` of the
+/// window at `r * stride`, block `b` reading `src[r * stride + 8 b + c + l]` for tap column `c`
+/// and lane `l`; `st[0][k]` / `st[1][k]`: region `k`'s right sums / inverse norms per lane.
+/// The AVX2 version ([`blocks_avx2`]) performs the same `f32` operations in the same order
+/// (mul then add, no FMA): identical results.
+fn blocks_portable(
     t: &[[f32; SIDE]; SIDE],
-    rows: &[&[f32]; SIDE],
+    src: &[f32],
+    stride: usize,
     st: &[[&[f32]; N_REGIONS]; 2],
     norm: &Norm,
-) -> [[f32; LANES]; N_REGIONS] {
-    use std::arch::x86_64::*;
-    // The seven taps of template row `r` on right row `r`, into the band's three cells
-    // (a macro, not a function: every intrinsic must sit inside this AVX2 function).
-    macro_rules! band {
-        ($cells:ident, $r:expr) => {{
-            let (tr, row) = (&t[$r], rows[$r].as_ptr());
-            for c in 0..SIDE {
-                let g = part_of(c);
-                let v = _mm256_loadu_ps(row.add(c));
-                $cells[g] = _mm256_add_ps($cells[g], _mm256_mul_ps(_mm256_set1_ps(tr[c]), v));
+    mut curves: [&mut [f32]; N_REGIONS],
+) {
+    let len = curves[0].len();
+    for j0 in (0..len).step_by(LANES) {
+        let mut cells = [[[0.0f32; LANES]; 3]; 3];
+        for (r, tr) in t.iter().enumerate() {
+            let row = &src[r * stride + j0..r * stride + j0 + WIN];
+            for (c, &tv) in tr.iter().enumerate() {
+                let acc = &mut cells[part_of(r)][part_of(c)];
+                for l in 0..LANES {
+                    acc[l] += tv * row[c + l];
+                }
             }
-        }};
+        }
+        let regs = regions_of(&cells.map(|band| band.map(Lanes)));
+        let vals: [[f32; LANES]; N_REGIONS] = std::array::from_fn(|k| {
+            let (s, iv) = (&st[0][k][j0..j0 + LANES], &st[1][k][j0..j0 + LANES]);
+            std::array::from_fn(|l| (regs[k].0[l] - norm.shift[k] * s[l]) * iv[l] * norm.inv_l[k])
+        });
+        store_block(&mut curves, j0, &vals);
     }
+}
+
+/// Right-row values one block of disparities reads: [`LANES`] positions plus the window.
+const WIN: usize = LANES + SIDE - 1;
+
+/// AVX2 body of [`blocks_portable`]: the template broadcast once per point (the products then
+/// read it from memory), the nine cell accumulators in registers, full blocks stored with
+/// their lanes reversed straight into disparity order.
+///
+/// # Safety
+/// The CPU must support AVX2, `src` must hold `6 * stride + 8 * blocks + 6` values, every
+/// `st[i][k]` `8 * blocks` (blocks = `ceil(len / 8)`, `len` the curves' common length).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn blocks_avx2(
+    t: &[[f32; SIDE]; SIDE],
+    src: &[f32],
+    stride: usize,
+    st: &[[&[f32]; N_REGIONS]; 2],
+    norm: &Norm,
+    mut curves: [&mut [f32]; N_REGIONS],
+) {
+    use std::arch::x86_64::*;
+    let len = curves[0].len();
+    let blocks = len.div_ceil(LANES);
+    debug_assert!(src.len() >= (SIDE - 1) * stride + blocks * LANES + SIDE - 1);
+    debug_assert!(st.iter().flatten().all(|v| v.len() >= blocks * LANES));
+    debug_assert!(curves.iter().all(|c| c.len() == len));
     let z = _mm256_setzero_ps();
-    let (mut top, mut mid, mut bot) = ([z; 3], [z; 3], [z; 3]);
-    for r in 0..SIM_RADIUS {
-        band!(top, r);
+    // Not `[z; 49]` then overwritten: that compiled to a memset per point.
+    let mut tb = std::mem::MaybeUninit::<[__m256; SIDE * SIDE]>::uninit();
+    let tp = tb.as_mut_ptr().cast::<__m256>();
+    for i in 0..SIDE * SIDE {
+        tp.add(i).write(_mm256_set1_ps(t[i / SIDE][i % SIDE]));
     }
-    band!(mid, SIM_RADIUS);
-    for r in SIM_RADIUS + 1..SIDE {
-        band!(bot, r);
+    // SAFETY: all SIDE * SIDE entries were written just above.
+    let tb = tb.assume_init();
+    let shift: [__m256; N_REGIONS] = [
+        _mm256_set1_ps(norm.shift[0]),
+        _mm256_set1_ps(norm.shift[1]),
+        _mm256_set1_ps(norm.shift[2]),
+        _mm256_set1_ps(norm.shift[3]),
+        _mm256_set1_ps(norm.shift[4]),
+    ];
+    let inv_l: [__m256; N_REGIONS] = [
+        _mm256_set1_ps(norm.inv_l[0]),
+        _mm256_set1_ps(norm.inv_l[1]),
+        _mm256_set1_ps(norm.inv_l[2]),
+        _mm256_set1_ps(norm.inv_l[3]),
+        _mm256_set1_ps(norm.inv_l[4]),
+    ];
+    let rev = _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0);
+    let base = src.as_ptr();
+    for bl in 0..blocks {
+        let j0 = bl * LANES;
+        let p = base.add(j0);
+        // The seven taps of template row `r` on right row `r`, into the band's three cells
+        // (a macro, not a function: every intrinsic must sit inside this AVX2 function).
+        macro_rules! band {
+            ($cells:ident, $r:expr) => {{
+                let row = p.add($r * stride);
+                // Left and right groups alternate (each keeps its column order).
+                for c in [0, 4, 1, 5, 2, 6, 3] {
+                    let g = part_of(c);
+                    let v = _mm256_loadu_ps(row.add(c));
+                    $cells[g] = _mm256_add_ps($cells[g], _mm256_mul_ps(tb[$r * SIDE + c], v));
+                }
+            }};
+        }
+        let (mut top, mut mid, mut bot) = ([z; 3], [z; 3], [z; 3]);
+        // Top and bottom rows interleaved: each cell still receives its taps in row-major
+        // order (same sums), but six accumulation chains instead of three are in flight at a
+        // time; in band order the adds' latency bounded a block more than the loads.
+        for r in 0..SIM_RADIUS {
+            band!(top, r);
+            band!(bot, SIM_RADIUS + 1 + r);
+        }
+        band!(mid, SIM_RADIUS);
+        // regions_of, spelled out with the same association order.
+        macro_rules! add {
+            ($a:expr, $b:expr) => {
+                _mm256_add_ps($a, $b)
+            };
+        }
+        let left = add!(add!(top[0], mid[0]), bot[0]);
+        let right = add!(add!(top[2], mid[2]), bot[2]);
+        let upper = add!(add!(top[0], top[1]), top[2]);
+        let lower = add!(add!(bot[0], bot[1]), bot[2]);
+        let full = add!(add!(add!(add!(left, right), top[1]), mid[1]), bot[1]);
+        let regs = [full, left, right, upper, lower];
+        let full_block = j0 + LANES <= len;
+        let mut part = [[0.0f32; LANES]; N_REGIONS];
+        for k in 0..N_REGIONS {
+            let s = _mm256_loadu_ps(st[0][k].as_ptr().add(j0));
+            let iv = _mm256_loadu_ps(st[1][k].as_ptr().add(j0));
+            let centred = _mm256_sub_ps(regs[k], _mm256_mul_ps(shift[k], s));
+            let v = _mm256_mul_ps(_mm256_mul_ps(centred, iv), inv_l[k]);
+            if full_block {
+                // Lanes j0..j0+8 are disparities len-1-j0 down to len-8-j0.
+                let dst = curves[k].as_mut_ptr().add(len - LANES - j0);
+                _mm256_storeu_ps(dst, _mm256_permutevar8x32_ps(v, rev));
+            } else {
+                _mm256_storeu_ps(part[k].as_mut_ptr(), v);
+            }
+        }
+        if !full_block {
+            store_block(&mut curves, j0, &part);
+        }
     }
-    // regions_of, spelled out with the same association order.
-    macro_rules! add {
-        ($a:expr, $b:expr) => {
-            _mm256_add_ps($a, $b)
-        };
-    }
-    let left = add!(add!(top[0], mid[0]), bot[0]);
-    let right = add!(add!(top[2], mid[2]), bot[2]);
-    let upper = add!(add!(top[0], top[1]), top[2]);
-    let lower = add!(add!(bot[0], bot[1]), bot[2]);
-    let full = add!(add!(add!(add!(left, right), top[1]), mid[1]), bot[1]);
-    let regs = [full, left, right, upper, lower];
-    let mut out = [[0.0f32; LANES]; N_REGIONS];
-    for k in 0..N_REGIONS {
-        let s = _mm256_loadu_ps(st[0][k].as_ptr());
-        let iv = _mm256_loadu_ps(st[1][k].as_ptr());
-        let centred = _mm256_sub_ps(regs[k], _mm256_mul_ps(_mm256_set1_ps(norm.shift[k]), s));
-        let v = _mm256_mul_ps(_mm256_mul_ps(centred, iv), _mm256_set1_ps(norm.inv_l[k]));
-        _mm256_storeu_ps(out[k].as_mut_ptr(), v);
-    }
-    out
 }
 
 /// Eight lanes added element-wise (the region sums of [`regions_of`] on whole registers).
@@ -552,7 +806,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn avx2_and_portable_blocks_are_bit_identical() {
+    fn avx2_and_portable_curves_are_bit_identical() {
         if !has_avx2() {
             return; // nothing to compare on this CPU
         }
@@ -563,29 +817,55 @@ mod tests {
             s ^= s << 17;
             (s >> 40) as f32 / (1u64 << 24) as f32
         };
-        for _ in 0..50 {
-            let t: [[f32; SIDE]; SIDE] =
-                std::array::from_fn(|_| std::array::from_fn(|_| next() - 0.5));
-            let data: Vec<Vec<f32>> = (0..SIDE)
-                .map(|_| (0..WIN).map(|_| next()).collect())
-                .collect();
-            let rows: [&[f32]; SIDE] = std::array::from_fn(|r| data[r].as_slice());
-            let st_data: Vec<Vec<f32>> = (0..2 * N_REGIONS)
-                .map(|_| (0..LANES).map(|_| next()).collect())
-                .collect();
-            let st: [[&[f32]; N_REGIONS]; 2] = std::array::from_fn(|i| {
-                std::array::from_fn(|k| st_data[i * N_REGIONS + k].as_slice())
-            });
-            let norm = Norm {
-                shift: std::array::from_fn(|_| next() - 0.5),
-                inv_l: std::array::from_fn(|_| next() + 0.5),
-            };
-            let a = block_zncc(true, &t, &rows, &st, &norm);
-            let b = block_zncc(false, &t, &rows, &st, &norm);
+        let (w, h) = (90, 20);
+        let left = Image::new(w, h, (0..w * h).map(|_| next()).collect()).expect("valid");
+        let right = Image::new(w, h, (0..w * h).map(|_| next()).collect()).expect("valid");
+        let stats = RightStats::new(&right);
+        let (mut a, mut b) = (Curves::default(), Curves::default());
+        // Full and partial last blocks, spans ending at the image's last pixel (the copy).
+        for (x, y, d_hi) in [
+            (40, 8, 37),
+            (86, 16, 63),
+            (86, 10, 8),
+            (20, 3, 0),
+            (60, 12, 15),
+        ] {
+            curves_with(true, &left, &right, &stats, x, y, y, d_hi, &mut a);
+            curves_with(false, &left, &right, &stats, x, y, y, d_hi, &mut b);
             for k in 0..N_REGIONS {
-                for l in 0..LANES {
-                    assert_eq!(a[k][l].to_bits(), b[k][l].to_bits(), "region {k} lane {l}");
+                for d in 0..=d_hi {
+                    let (u, v) = (a.curve[k][d], b.curve[k][d]);
+                    assert_eq!(u.to_bits(), v.to_bits(), "x {x} region {k} d {d}");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn row_peaks_match_the_scalar_definition() {
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut got = Vec::new();
+        for len in [1, 2, 3, 9, 10, 11, 17, 33, 97, 130] {
+            // Coarse values: plateaus and exact ties with s_min occur.
+            let full: Vec<f32> = (0..len + 3).map(|_| (next() * 8.0).floor() / 8.0).collect();
+            for (d_min, s_min) in [(0, 0.5), (1, 0.0), (2, 0.875), (0, 2.0)] {
+                let d_hi = len - 1;
+                let want: Vec<usize> = (d_min..=d_hi)
+                    .filter(|&d| {
+                        let c = full[d];
+                        c >= s_min
+                            && (d == d_min || c >= full[d - 1])
+                            && (d == d_hi || c > full[d + 1])
+                    })
+                    .collect();
+                row_peaks(&full, d_min, d_hi, s_min, &mut got);
+                assert_eq!(got, want, "len {len} d_min {d_min} s_min {s_min}");
             }
         }
     }
