@@ -154,24 +154,23 @@ pub fn grey_from_u8(
             ),
         ));
     }
+    // Per-level tables: `v / 255` and each channel's `w * (v / 255)`, the same f32 values the
+    // per-pixel arithmetic would give (a division per channel and pixel is the slow part).
+    let unit: [f32; 256] = std::array::from_fn(|v| v as f32 / 255.0);
+    let [tb, tg, tr] = weights.map(|w| unit.map(|u| w * u));
     let mut out = vec![0.0f32; width * height];
-    let [wb, wg, wr] = weights;
     out.par_chunks_mut(width)
         .zip(data.par_chunks(width * channels))
         .for_each(|(o, px)| {
             if channels == 1 {
                 for (v, &p) in o.iter_mut().zip(px) {
-                    *v = p as f32 / 255.0;
+                    *v = unit[p as usize];
                 }
                 return;
             }
             for (v, p) in o.iter_mut().zip(px.chunks_exact(channels)) {
-                let (b, g, r) = (
-                    p[0] as f32 / 255.0,
-                    p[1] as f32 / 255.0,
-                    p[2] as f32 / 255.0,
-                );
-                *v = (wb * b + wg * g + wr * r).clamp(0.0, 1.0);
+                let g = tb[p[0] as usize] + tg[p[1] as usize] + tr[p[2] as usize];
+                *v = g.clamp(0.0, 1.0);
             }
         });
     Ok(out)
