@@ -492,7 +492,10 @@ fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usi
     let picked: Vec<usize> = ambiguous.par_iter().filter_map(|g| pick(g)).collect();
     kept.extend(picked);
     // The same rule on the right side (neurons sharing a right pixel).
-    kept.sort_unstable_by_key(|&a| (neurons[a].yr, neurons[a].xr, a));
+    let kept: Vec<usize> = network::right_pixel_order(neurons, kept)
+        .into_iter()
+        .map(|a| a as usize)
+        .collect();
     let mut out: Vec<usize> = Vec::with_capacity(kept.len());
     let mut i = 0;
     while i < kept.len() {

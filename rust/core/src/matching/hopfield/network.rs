@@ -283,6 +283,25 @@ unsafe fn count_avx2(
     (near as usize, agree as usize)
 }
 
+/// `idx` (neuron indices) sorted by right pixel `(yr, xr)`, then index: one `u64` key per
+/// neuron (coordinates non-negative; below 2^21, else a tuple sort), sorted in parallel.
+pub(crate) fn right_pixel_order(neurons: &[Neuron], mut idx: Vec<usize>) -> Vec<u32> {
+    let fits = neurons.len() < 1 << 22 && neurons.iter().all(|n| n.xr < 1 << 21 && n.yr < 1 << 21);
+    if !fits {
+        idx.sort_unstable_by_key(|&a| (neurons[a].yr, neurons[a].xr, a));
+        return idx.into_iter().map(|a| a as u32).collect();
+    }
+    let mut keys: Vec<u64> = idx
+        .iter()
+        .map(|&a| {
+            let n = &neurons[a];
+            ((n.yr as u64) << 43) | ((n.xr as u64) << 22) | a as u64
+        })
+        .collect();
+    keys.par_sort_unstable();
+    keys.iter().map(|&k| (k & ((1 << 22) - 1)) as u32).collect()
+}
+
 /// Read access to a symmetric weight matrix, one row at a time: the dynamics only ever need
 /// whole rows (the initial net inputs, then the row of each flipped neuron).
 pub trait Weights: Sync {
@@ -697,8 +716,7 @@ impl Network {
         let dys: Vec<i32> = neurons.iter().map(Neuron::dy).collect();
         // Column groups: neurons sharing a right pixel, wherever their left points are.
         let key = |a: u32| (neurons[a as usize].yr, neurons[a as usize].xr);
-        let mut by_right: Vec<u32> = (0..m as u32).collect();
-        by_right.sort_unstable_by_key(|&a| (key(a), a));
+        let by_right: Vec<u32> = right_pixel_order(neurons, (0..m).collect::<Vec<_>>());
         let mut group = vec![(0u32, 0u32); m];
         let mut rank = vec![0u32; m];
         let (mut g0, mut n_groups) = (0, 0u32);
