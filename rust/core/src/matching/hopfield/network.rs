@@ -419,6 +419,8 @@ struct RowKey {
     np: f32,
     half: i32,
     stride: usize,
+    /// `log2(stride)`.
+    shift: u32,
     a_pos: bool,
 }
 
@@ -453,7 +455,7 @@ fn lane_weights(
         let (ex, ey) = (k.dx.wrapping_sub(c.dx[j]), k.dy.wrapping_sub(c.dy[j]));
         let q = ex.wrapping_mul(ex).wrapping_add(ey.wrapping_mul(ey));
         let q = q.clamp(0, stride - 1);
-        let cv = lut[(r * stride + q) as usize];
+        let cv = lut[((r << k.shift) + q) as usize];
         t[l] = if stored { nrm * cv } else { 0.0 };
         in_row[l] = stored;
     }
@@ -519,7 +521,7 @@ unsafe fn lane_weights_avx2(
         _mm256_max_epi32(q, _mm256_setzero_si256()),
         _mm256_set1_epi32(stride - 1),
     );
-    let idx = _mm256_add_epi32(_mm256_mullo_epi32(r, _mm256_set1_epi32(stride)), q);
+    let idx = _mm256_add_epi32(_mm256_sllv_epi32(r, _mm256_set1_epi32(k.shift as i32)), q);
     let cv = _mm256_i32gather_ps::<4>(lut.as_ptr(), idx);
     let t = _mm256_and_ps(_mm256_mul_ps(nrm, cv), _mm256_castsi256_ps(stored));
     (t, stored)
@@ -782,7 +784,13 @@ impl Network {
                 row
             })
             .collect();
-        let lut_stride = rows.iter().map(Vec::len).max().unwrap_or(1);
+        // A power-of-two stride: the lanes index the table with a shift, not a multiply.
+        let lut_stride = rows
+            .iter()
+            .map(Vec::len)
+            .max()
+            .unwrap_or(1)
+            .next_power_of_two();
         let mut lut = Vec::with_capacity(rows.len() * lut_stride);
         for row in &rows {
             lut.extend_from_slice(row);
@@ -858,6 +866,7 @@ impl Network {
             np: self.a_over_n[p],
             half: self.half,
             stride: self.lut_stride,
+            shift: self.lut_stride.trailing_zeros(),
             a_pos: self.a_pos,
         }
     }
