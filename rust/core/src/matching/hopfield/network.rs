@@ -2,8 +2,12 @@
 //!
 //! Weights `T_ab = A * C~_ab - B [same left point] - B [same right pixel]` (zero diagonal,
 //! symmetric by construction: every entry is a symmetric function of the pair), inputs
-//! `I_a = D * S_a - theta`. The CSR rows are built independently per neuron (rayon) from a
-//! uniform grid of the left points. Dynamics: asynchronous binary threshold updates in a seeded
+//! `I_a = D * S_a - theta`. The Hopfield channel never stores the matrix: a [`Network`] row is
+//! computed when it is read, 8 window neighbours at a time (AVX2, with a portable twin giving
+//! identical values), from a uniform grid of the left points; the dynamics read every row once
+//! for the initial net inputs (in parallel) and the row of each flip. A stored [`Csr`] (what
+//! [`build_weights`] returns, and what the graph-matching channel builds) gives the same
+//! entries in the same order. Dynamics: asynchronous binary threshold updates in a seeded
 //! random order, net inputs maintained incrementally, until a sweep without a flip.
 
 use rayon::prelude::*;
