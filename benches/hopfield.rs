@@ -6,8 +6,8 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use stereovision_core::matching::hopfield::{
-    candidate_neurons, hopfield_match, interest_points, run_dynamics, Network,
-    HopfieldParams, InterestParams,
+    candidate_neurons, hopfield_match, interest_points, run_dynamics, HopfieldParams,
+    InterestParams, Network,
 };
 use stereovision_core::Image;
 

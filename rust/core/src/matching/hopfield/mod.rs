@@ -625,7 +625,7 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
     }
     // Support (positive weights from active neurons, summed in row order in f64) of the
     // neurons the rule reads: the active alternatives, else the best candidate.
-    let on = net.grid_state(state);
+    let on = net.lane_state(state);
     let support_of = |a: usize| net.support(a, state, &on);
     let weak: Vec<bool> = groups
         .par_iter()

@@ -4,7 +4,7 @@
 //! symmetric by construction: every entry is a symmetric function of the pair), inputs
 //! `I_a = D * S_a - theta`. The Hopfield channel never stores the matrix: a [`Network`] row is
 //! computed when it is read, 8 window neighbours at a time (AVX2, with a portable twin giving
-//! identical values), from a uniform grid of the left points; the dynamics read every row once
+//! identical values), from the left points sorted into strips of rows; the dynamics read every row once
 //! for the initial net inputs (in parallel) and the row of each flip. A stored [`Csr`] (what
 //! [`build_weights`] returns, and what the graph-matching channel builds) gives the same
 //! entries in the same order. Dynamics: asynchronous binary threshold updates in a seeded
@@ -351,13 +351,14 @@ impl Weights for Csr {
 }
 
 /// The Hopfield channel's weights, computed when a row is read instead of stored: a row is a
-/// scan of the 5x5 grid cells around the neuron's left point, which costs about what reading
-/// a stored row costs, while a stored matrix (1-4 M entries on a Middlebury or KITTI pair) has
-/// to be built, written and paged in first. Row `a` (left point `p`), in this order:
+/// scan of the neighbours in the strips of rows around the neuron's left point (each strip's
+/// part cut to the window's x-range), while a stored matrix (1-4 M entries on a Middlebury or
+/// KITTI pair) has to be built, written and paged in first. Row `a` (left point `p`), in this
+/// order:
 /// 1. the other candidates of `p`: `-B` (uniqueness along the row);
 /// 2. the candidates of other points with `a`'s right pixel, in right-pixel order: `-B`
 ///    (uniqueness along the column);
-/// 3. the candidates of the other points in `p`'s 41x41 window, in grid order, except those
+/// 3. the candidates of the other points in `p`'s 41x41 window, in strip order, except those
 ///    with `a`'s right pixel (already in 2): `A / max(n_p, n_q, 1) * C(|d_a - d_b|, r)`,
 ///    `n` = the points' window neighbour counts, `r` = their Chebyshev distance.
 ///
@@ -377,10 +378,8 @@ pub struct Network {
     by_right: Vec<u32>,
     group: Vec<(u32, u32)>,
     rank: Vec<u32>,
-    /// Point grid; `gstart[k]..gstart[k + 1]` are the neurons of the point at grid position
-    /// `k` in `cells` (so the cells of one grid row around a point are ONE contiguous range).
-    grid: PointGrid,
-    gstart: Vec<u32>,
+    /// Per point: the `cells` ranges of its window, one per strip of rows it touches.
+    wranges: Vec<[(u32, u32); MAX_STRIPS]>,
     cells: Cells,
     /// Per neuron (original order): disparity vector.
     dxs: Vec<i32>,
@@ -391,12 +390,15 @@ pub struct Network {
     lut_stride: usize,
 }
 
+/// Strips of `ceil(half / 2)` rows a window of `2 half + 1` rows can touch: at most 6.
+const MAX_STRIPS: usize = 6;
+
 /// Lanes of the window scan: one AVX2 register of `f32`.
 const LANES: usize = 8;
 
-/// What a row's window scan reads of the neurons, as arrays in grid order (so the neurons of
-/// the 5 cells of one grid row are contiguous), each padded with `LANES` entries so that a
-/// block of lanes never reads past the end.
+/// What a row's window scan reads of the neurons, as arrays in strip order (strips of
+/// `ceil(half / 2)` rows, by x within a strip: a window's neurons in one strip are contiguous),
+/// each padded with `LANES` entries so that a block of lanes never reads past the end.
 #[derive(Default)]
 struct Cells {
     x: Vec<i32>,
@@ -544,7 +546,7 @@ fn has_avx2() -> bool {
     }
 }
 
-/// Sum over the window part of a row of `T_ab * on_b` (`on` in grid order; with `POS`, the
+/// Sum over the window part of a row of `T_ab * on_b` (`on` in strip order; with `POS`, the
 /// positive `T_ab` only): one `f64` accumulator per lane, added up in lane order at the end;
 /// and the part's entry count.
 fn window_input<const POS: bool>(
@@ -736,11 +738,28 @@ impl Network {
                 n_groups += 1;
             }
         }
-        // Grid-ordered neuron arrays.
-        let mut gstart = Vec::with_capacity(grid.items.len() + 1);
+        // Strip order: points in horizontal strips of `strip_h` rows, by x within a strip, so
+        // that a window's points in one strip are ONE contiguous range cut exactly in x.
+        let strip_h = (half + 1) / 2;
+        let mut sorder: Vec<u32> = (0..n_pts as u32).collect();
+        sorder.sort_unstable_by_key(|&q| {
+            let (x, y) = pxy[q as usize];
+            (y / strip_h, x, q)
+        });
+        let n_strips = pxy.iter().map(|p| p.1 / strip_h).max().unwrap_or(0) as usize + 1;
+        let mut strip_start = vec![0usize; n_strips + 1];
+        for &q in &sorder {
+            strip_start[(pxy[q as usize].1 / strip_h) as usize + 1] += 1;
+        }
+        for i in 1..=n_strips {
+            strip_start[i] += strip_start[i - 1];
+        }
+        let sx: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].0).collect();
+        // Strip-ordered neuron arrays.
+        let mut gstart = Vec::with_capacity(n_pts + 1);
         gstart.push(0u32);
         let mut cells = Cells::default();
-        for &q in &grid.items {
+        for &q in &sorder {
             let q = q as usize;
             for b in starts[q]..starts[q + 1] {
                 cells.x.push(pxy[q].0);
@@ -763,6 +782,23 @@ impl Network {
         cells.rank.resize(padded, 0);
         cells.norm.resize(padded, 0.0);
         cells.idx.resize(padded, 0);
+        // Per point, the `cells` range of its window in each strip the window's rows touch.
+        let wranges: Vec<[(u32, u32); MAX_STRIPS]> = pxy
+            .par_iter()
+            .map(|&(x, y)| {
+                let mut r = [(0u32, 0u32); MAX_STRIPS];
+                let s_lo = ((y - half).max(0) / strip_h) as usize;
+                let s_hi = (((y + half) / strip_h) as usize).min(n_strips - 1);
+                for (k, st) in (s_lo..=s_hi).enumerate() {
+                    let (a, b) = (strip_start[st], strip_start[st + 1]);
+                    let xs = &sx[a..b];
+                    let lo = a + xs.partition_point(|&v| v < x - half);
+                    let hi = a + xs.partition_point(|&v| v <= x + half);
+                    r[k] = (gstart[lo], gstart[hi]);
+                }
+                r
+            })
+            .collect();
         // Compatibility lookup per Chebyshev distance r of the two points (0..=half) over the
         // integer squared disparity-vector difference q. A row ends where the f32 value has
         // saturated at -1 (slope > 0, q past the crossing): larger q read the last entry, which
@@ -812,8 +848,7 @@ impl Network {
             by_right,
             group,
             rank,
-            grid,
-            gstart,
+            wranges,
             cells,
             dxs,
             dys,
@@ -834,8 +869,8 @@ impl Network {
             .sum()
     }
 
-    /// `state` (0/1 per neuron) in grid order, as `f32` factors of the lanes (padding 0).
-    pub fn grid_state(&self, state: &[u8]) -> Vec<f32> {
+    /// `state` (0/1 per neuron) in strip order, as `f32` factors of the lanes (padding 0).
+    pub fn lane_state(&self, state: &[u8]) -> Vec<f32> {
         let n = self.cells.idx.len() - LANES;
         let mut on: Vec<f32> = self.cells.idx[..n]
             .iter()
@@ -846,7 +881,7 @@ impl Network {
     }
 
     /// Support of neuron `a`: the sum of its positive weights from active neurons (`on` from
-    /// [`Network::grid_state`]), in a fixed order.
+    /// [`Network::lane_state`]), in a fixed order.
     pub fn support(&self, a: usize, state: &[u8], on: &[f32]) -> f64 {
         let mut s = 0.0f64;
         self.for_each_unique(a, |b, t| {
@@ -875,12 +910,9 @@ impl Network {
         }
     }
 
-    /// The `cells` ranges of the 5 grid rows around `a`'s point.
-    fn window_ranges(&self, a: usize) -> [(usize, usize); 2 * GRID_SUB as usize + 1] {
-        let (x, y) = self.pxy[self.p_of[a] as usize];
-        self.grid
-            .ranges(x, y)
-            .map(|(s, e)| (self.gstart[s] as usize, self.gstart[e] as usize))
+    /// The `cells` ranges of the window of `a`'s point (empty ones past its strips).
+    fn window_ranges(&self, a: usize) -> [(usize, usize); MAX_STRIPS] {
+        self.wranges[self.p_of[a] as usize].map(|(s, e)| (s as usize, e as usize))
     }
 
     /// Calls `f(b, -B)` for the uniqueness part of row `a`: the other candidates of its point,
@@ -923,7 +955,7 @@ impl Weights for Network {
     }
 
     fn initial_input(&self, state: &[u8], input: &[f64]) -> (Vec<f64>, usize) {
-        let on = self.grid_state(state);
+        let on = self.lane_state(state);
         let (u, counts): (Vec<f64>, Vec<usize>) = (0..self.n())
             .into_par_iter()
             .map(|a| {
