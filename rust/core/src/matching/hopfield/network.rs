@@ -460,7 +460,7 @@ fn lane_weights(
         let r = ddx.max(ddy).min(half);
         let (ex, ey) = (k.dx.wrapping_sub(c.dx[j]), k.dy.wrapping_sub(c.dy[j]));
         let q = ex.wrapping_mul(ex).wrapping_add(ey.wrapping_mul(ey));
-        let q = q.clamp(0, stride - 1);
+        let q = (q as u32).min(stride as u32 - 1) as i32;
         let cv = lut[((r << k.shift) + q) as usize];
         t[l] = if stored { nrm * cv } else { 0.0 };
         in_row[l] = stored;
@@ -493,40 +493,32 @@ unsafe fn lane_weights_avx2(
     let ddy = _mm256_abs_epi32(_mm256_sub_epi32(ld(&c.y), _mm256_set1_epi32(k.y)));
     let n_valid = e.saturating_sub(j0).min(LANES) as i32;
     let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-    let ones = _mm256_set1_epi32(-1);
     let valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(n_valid), lane);
-    let in_x = _mm256_xor_si256(_mm256_cmpgt_epi32(ddx, half), ones);
-    let in_y = _mm256_xor_si256(_mm256_cmpgt_epi32(ddy, half), ones);
-    let other_p = _mm256_xor_si256(
-        _mm256_cmpeq_epi32(ldu(&c.point), _mm256_set1_epi32(k.point as i32)),
-        ones,
+    // Not in the row: outside the window, the row's own point or right pixel (one `andnot`
+    // at the end instead of a negation per test: fewer live registers, no spills).
+    let out = _mm256_or_si256(
+        _mm256_or_si256(_mm256_cmpgt_epi32(ddx, half), _mm256_cmpgt_epi32(ddy, half)),
+        _mm256_or_si256(
+            _mm256_cmpeq_epi32(ldu(&c.point), _mm256_set1_epi32(k.point as i32)),
+            _mm256_cmpeq_epi32(ldu(&c.rank), _mm256_set1_epi32(k.rank as i32)),
+        ),
     );
-    let other_r = _mm256_xor_si256(
-        _mm256_cmpeq_epi32(ldu(&c.rank), _mm256_set1_epi32(k.rank as i32)),
-        ones,
-    );
-    let stored = _mm256_and_si256(
-        _mm256_and_si256(valid, _mm256_and_si256(in_x, in_y)),
-        _mm256_and_si256(other_p, other_r),
-    );
+    let stored = _mm256_andnot_si256(out, valid);
     let nq = _mm256_loadu_ps(c.norm.as_ptr().add(j0));
     let np = _mm256_set1_ps(k.np);
     // (np < nq) == a_pos picks np; NaN-free inputs, so LT_OQ is `<`.
     let lt = _mm256_cmp_ps::<_CMP_LT_OQ>(np, nq);
-    let pick_np = if k.a_pos {
-        lt
+    let nrm = if k.a_pos {
+        _mm256_blendv_ps(nq, np, lt)
     } else {
-        _mm256_xor_ps(lt, _mm256_castsi256_ps(ones))
+        _mm256_blendv_ps(np, nq, lt)
     };
-    let nrm = _mm256_blendv_ps(nq, np, pick_np);
     let r = _mm256_min_epi32(_mm256_max_epi32(ddx, ddy), half);
     let ex = _mm256_sub_epi32(_mm256_set1_epi32(k.dx), ld(&c.dx));
     let ey = _mm256_sub_epi32(_mm256_set1_epi32(k.dy), ld(&c.dy));
     let q = _mm256_add_epi32(_mm256_mullo_epi32(ex, ex), _mm256_mullo_epi32(ey, ey));
-    let q = _mm256_min_epi32(
-        _mm256_max_epi32(q, _mm256_setzero_si256()),
-        _mm256_set1_epi32(stride - 1),
-    );
+    // Unsigned minimum: a (wrapped) negative sum saturates like a large one.
+    let q = _mm256_min_epu32(q, _mm256_set1_epi32(stride - 1));
     let idx = _mm256_add_epi32(_mm256_sllv_epi32(r, _mm256_set1_epi32(k.shift as i32)), q);
     let cv = _mm256_i32gather_ps::<4>(lut.as_ptr(), idx);
     let t = _mm256_and_ps(_mm256_mul_ps(nrm, cv), _mm256_castsi256_ps(stored));
@@ -674,16 +666,22 @@ unsafe fn window_add_avx2(
     u: &mut [f64],
 ) {
     use std::arch::x86_64::*;
+    debug_assert!(sign == 1.0 || sign == -1.0);
+    let flip = _mm256_set1_ps(if sign < 0.0 { -0.0 } else { 0.0 });
     let mut t = [0.0f32; LANES];
     for &(s, e) in ranges {
         for j0 in (s..e).step_by(LANES) {
             let (tv, stored) = lane_weights_avx2(c, lut, k, j0, e);
-            _mm256_storeu_ps(t.as_mut_ptr(), tv);
+            // `sign * t` exactly, as a sign flip of the f32 (no multiply per lane).
+            _mm256_storeu_ps(t.as_mut_ptr(), _mm256_xor_ps(tv, flip));
             // Only the lanes in the row: the others would add +-0.
             let mut m = _mm256_movemask_ps(_mm256_castsi256_ps(stored)) as u32;
             while m != 0 {
                 let l = m.trailing_zeros() as usize;
-                u[c.idx[j0 + l] as usize] += sign * t[l] as f64;
+                let b = *c.idx.get_unchecked(j0 + l) as usize;
+                debug_assert!(b < u.len());
+                // SAFETY: `idx` holds neuron indices (< u.len()) and j0 + l < e <= its length.
+                *u.get_unchecked_mut(b) += t[l] as f64;
                 m &= m - 1;
             }
         }
