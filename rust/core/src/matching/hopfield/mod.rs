@@ -534,49 +534,41 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
         })
         .collect();
     let half = p.weights.nbr_half.max(1);
-    // Points accepted in the previous round: a candidate with none of them in its window
-    // sees the same side sets as before and keeps its verdict.
-    let mut fresh: Option<network::PointGrid> = None;
+    // One grid over every chosen match (filtered by `ok` when read) and one over the
+    // candidates: no grid is rebuilt per round.
+    let cxy: Vec<(i32, i32)> = chosen
+        .iter()
+        .map(|&a| (neurons[a].xl.max(0), neurons[a].yl.max(0)))
+        .collect();
+    let grid = network::PointGrid::new(&cxy, half);
+    let kxy: Vec<(i32, i32)> = cands.iter().map(|&c| cxy[c]).collect();
+    let cand_grid = network::PointGrid::new(&kxy, half);
+    // Round 1 tests every candidate; a later round only those with a point accepted in the
+    // round before in their window (the others see the same side sets and keep their verdict).
+    let mut to_test: Vec<usize> = (0..cands.len()).collect();
     loop {
-        let acc: Vec<usize> = (0..chosen.len())
-            .filter(|&c| ok[c])
-            .map(|c| chosen[c])
-            .collect();
-        let axy: Vec<(i32, i32)> = acc
-            .iter()
-            .map(|&a| (neurons[a].xl.max(0), neurons[a].yl.max(0)))
-            .collect();
-        let grid = network::PointGrid::new(&axy, half);
-        // Candidates are tested independently within a round (in parallel, kept in order).
-        let added: Vec<usize> = cands
+        // Candidates are tested independently within a round (in parallel, kept in order),
+        // against the matches accepted before the round.
+        let added: Vec<usize> = to_test
             .par_iter()
-            .map_init(Vec::new, |side: &mut Vec<f32>, &c| {
-                if ok[c] {
-                    return None;
-                }
+            .map_init(Vec::new, |side: &mut Vec<f32>, &k| {
+                let c = cands[k];
                 let n = &neurons[chosen[c]];
-                let (x, y, d) = (n.xl.max(0), n.yl.max(0), n.dx());
-                if let Some(g) = &fresh {
-                    let mut near = false;
-                    g.for_each_in_window((x, y), half, |_| near = true);
-                    if !near {
-                        return None;
-                    }
-                }
+                let (x, y, d) = (cxy[c].0, cxy[c].1, n.dx());
                 let dsub = d as f32 + n.sub;
-                let pass = (0..4).filter(|k| n.halves_fail >> k & 1 == 1).all(|k| {
+                let pass = (0..4).filter(|h| n.halves_fail >> h & 1 == 1).all(|h| {
                     side.clear();
                     let mut all_agree = true;
                     grid.for_each_in_window((x, y), half, |t| {
-                        let (qx, qy) = axy[t];
-                        let on_side = match k {
+                        let (qx, qy) = cxy[t];
+                        let on_side = match h {
                             0 => qx < x,
                             1 => qx > x,
                             2 => qy < y,
                             _ => qy > y,
                         };
-                        if on_side {
-                            let b = &neurons[acc[t]];
+                        if ok[t] && on_side {
+                            let b = &neurons[chosen[t]];
                             all_agree &= (b.dx() - d).abs() <= p.agree_tol;
                             side.push(b.dx() as f32 + b.sub);
                         }
@@ -585,21 +577,23 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
                         && side.len() >= p.rescue_min
                         && (median(side) - dsub).abs() <= p.rescue_med
                 });
-                pass.then_some(c)
+                pass.then_some(k)
             })
             .flatten()
             .collect();
         if added.is_empty() {
             return ok;
         }
-        let nxy: Vec<(i32, i32)> = added
-            .iter()
-            .map(|&c| (neurons[chosen[c]].xl.max(0), neurons[chosen[c]].yl.max(0)))
-            .collect();
-        fresh = Some(network::PointGrid::new(&nxy, half));
-        for c in added {
-            ok[c] = true;
+        for &k in &added {
+            ok[cands[k]] = true;
         }
+        let mut near = vec![false; cands.len()];
+        for &k in &added {
+            cand_grid.for_each_in_window(kxy[k], half, |j| near[j] = true);
+        }
+        to_test = (0..cands.len())
+            .filter(|&j| near[j] && !ok[cands[j]])
+            .collect();
     }
 }
 
