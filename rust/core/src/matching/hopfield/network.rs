@@ -739,18 +739,25 @@ impl Network {
         // Strip order: points in horizontal strips of `strip_h` rows, by x within a strip, so
         // that a window's points in one strip are ONE contiguous range cut exactly in x.
         let strip_h = (half + 1) / 2;
-        let mut sorder: Vec<u32> = (0..n_pts as u32).collect();
-        sorder.sort_unstable_by_key(|&q| {
-            let (x, y) = pxy[q as usize];
-            (y / strip_h, x, q)
-        });
         let n_strips = pxy.iter().map(|p| p.1 / strip_h).max().unwrap_or(0) as usize + 1;
         let mut strip_start = vec![0usize; n_strips + 1];
-        for &q in &sorder {
-            strip_start[(pxy[q as usize].1 / strip_h) as usize + 1] += 1;
+        for &(_, y) in &pxy {
+            strip_start[(y / strip_h) as usize + 1] += 1;
         }
         for i in 1..=n_strips {
             strip_start[i] += strip_start[i - 1];
+        }
+        // Counting sort into strips, then each strip (a few hundred points) by (x, index).
+        let mut sorder = vec![0u32; n_pts];
+        let mut fill = strip_start.clone();
+        for (q, &(_, y)) in pxy.iter().enumerate() {
+            let st = (y / strip_h) as usize;
+            sorder[fill[st]] = q as u32;
+            fill[st] += 1;
+        }
+        for st in 0..n_strips {
+            sorder[strip_start[st]..strip_start[st + 1]]
+                .sort_unstable_by_key(|&q| ((pxy[q as usize].0 as u64) << 32) | q as u64);
         }
         let sx: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].0).collect();
         // Strip-ordered neuron arrays.
