@@ -29,3 +29,17 @@ macro_rules! simd_fn {
     };
 }
 pub(crate) use simd_fn;
+
+/// Does the running CPU have AVX2 (the answer is cached by std)? For kernels with hand-written
+/// AVX2 bodies beside a portable one.
+#[inline]
+pub(crate) fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}

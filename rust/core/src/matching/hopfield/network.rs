@@ -12,6 +12,8 @@
 
 use rayon::prelude::*;
 
+use crate::simd::has_avx2;
+
 /// One neuron: left point index, right position and disparity vector `(x_l - x_r, y_l - y_r)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Neuron {
@@ -523,19 +525,6 @@ unsafe fn lane_weights_avx2(
     let cv = _mm256_i32gather_ps::<4>(lut.as_ptr(), idx);
     let t = _mm256_and_ps(_mm256_mul_ps(nrm, cv), _mm256_castsi256_ps(stored));
     (t, stored)
-}
-
-/// Does the running CPU have AVX2 (the answer is cached by std)?
-#[inline]
-fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
 }
 
 /// Sum over the window part of a row of `T_ab * on_b` (`on` in strip order; with `POS`, the

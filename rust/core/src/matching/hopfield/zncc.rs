@@ -13,7 +13,7 @@
 use rayon::prelude::*;
 
 use crate::image::Image;
-use crate::simd::simd_fn;
+use crate::simd::{has_avx2, simd_fn};
 
 /// Similarity window half-size (7x7, C.10).
 pub const SIM_RADIUS: usize = 3;
@@ -618,19 +618,6 @@ unsafe fn interior_peaks_avx2(c: &[f32], s_min: f32, d0: usize, out: &mut Vec<us
 struct Norm {
     shift: [f32; N_REGIONS],
     inv_l: [f32; N_REGIONS],
-}
-
-/// Does the running CPU have AVX2 (checked once per point; the answer is cached by std)?
-#[inline]
-fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
 }
 
 /// Block `b` (lanes `j = 8 b + l`, right column `x - d_hi + j`, disparity `d_hi - j`) of the
