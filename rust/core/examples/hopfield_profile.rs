@@ -1,0 +1,104 @@
+//! Stage timings and an output fingerprint of the Hopfield channel on a real pair, for
+//! profiling (`docs/hopfield.md`, "Reproduce"). The pair comes as raw little-endian float32
+//! grey images written by `benches/dump_grey.py`:
+//!
+//! ```text
+//! python benches/dump_grey.py middlebury2006/cloth3 /tmp/cloth3     # prints W H D
+//! cargo run --release --example hopfield_profile -- /tmp/cloth3 626 555 96
+//! cargo run --release --example hopfield_profile -- /tmp/cloth3 626 555 96 fingerprint
+//! ```
+//!
+//! Timing mode prints the median of 9 runs of each public stage (ms) with the current rayon
+//! thread count (`RAYON_NUM_THREADS`); `fingerprint` prints the match count, the number of
+//! weights, the sweeps and a hash of every match and energy value (to check that a change
+//! leaves the output bit-identical).
+
+use std::hash::{Hash, Hasher};
+use std::time::Instant;
+
+use stereovision_core::image::Image;
+use stereovision_core::matching::hopfield::{
+    candidate_neurons, hopfield_match, interest_points, run_dynamics, HopfieldParams, Network,
+};
+
+fn load(path: &str, w: usize, h: usize) -> Image {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let v: Vec<f32> = bytes
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    Image::new(w, h, v).expect("a w x h float32 image")
+}
+
+fn median_ms(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    if args.len() < 5 {
+        eprintln!("usage: hopfield_profile PREFIX W H MAX_DISPARITY [fingerprint]");
+        std::process::exit(2);
+    }
+    let num = |i: usize| -> usize { args[i].parse().expect("a number") };
+    let (w, h, d) = (num(2), num(3), num(4));
+    let l = load(&format!("{}_l.f32", args[1]), w, h);
+    let r = load(&format!("{}_r.f32", args[1]), w, h);
+    let p = HopfieldParams {
+        d_max: d,
+        ..HopfieldParams::default()
+    };
+    if args.get(5).map(String::as_str) == Some("fingerprint") {
+        let out = hopfield_match(&l, &r, &p).expect("valid input");
+        let mut hash = std::collections::hash_map::DefaultHasher::new();
+        for m in &out.matches {
+            [m.xl, m.yl, m.xr, m.yr, m.score]
+                .map(f32::to_bits)
+                .hash(&mut hash);
+        }
+        out.energy_trace
+            .iter()
+            .for_each(|e| e.to_bits().hash(&mut hash));
+        println!(
+            "matches {} weights {} sweeps {} hash {:016x}",
+            out.matches.len(),
+            out.n_weights,
+            out.sweeps,
+            hash.finish()
+        );
+        return;
+    }
+    let mut t = [(); 5].map(|_| Vec::new());
+    let ms = |s: Instant| s.elapsed().as_secs_f64() * 1e3;
+    for _ in 0..9 {
+        let s = Instant::now();
+        interest_points(&l, &p.interest);
+        t[0].push(ms(s));
+        let s = Instant::now();
+        let (_, neurons) = candidate_neurons(&l, &r, &p).expect("valid input");
+        t[1].push(ms(s));
+        let s = Instant::now();
+        let net = Network::new(&neurons, &p.weights);
+        t[2].push(ms(s));
+        let input: Vec<f64> = neurons
+            .iter()
+            .map(|n| (p.weights.d * n.sim - p.weights.theta) as f64)
+            .collect();
+        let init: Vec<u8> = neurons
+            .iter()
+            .map(|n| u8::from(n.sim >= p.s_init))
+            .collect();
+        let s = Instant::now();
+        run_dynamics(&net, &input, &init, p.seed, p.max_sweeps);
+        t[3].push(ms(s));
+        let s = Instant::now();
+        hopfield_match(&l, &r, &p).expect("valid input");
+        t[4].push(ms(s));
+    }
+    let [a, b, c, e, f] = t.map(median_ms);
+    println!(
+        "interest {a:.2}  candidates (incl. interest) {b:.2}  network {c:.2}  dynamics {e:.2}  \
+         whole matcher {f:.2}  (ms, median of 9)"
+    );
+}
