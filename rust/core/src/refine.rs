@@ -265,12 +265,13 @@ pub fn box3_zero<T: BoxSample>(a: &[T], w: usize, h: usize, b: usize) -> Vec<T> 
             })
             .collect()
     };
-    for (x0, strip) in done {
-        let sw = STRIP.min(w - x0);
-        for y in 0..h {
-            out[y * w + x0..y * w + x0 + sw].copy_from_slice(&strip[y * sw..(y + 1) * sw]);
+    // Back into rows, in parallel over the rows.
+    for_each_row(&mut out, w, |y, row| {
+        for (x0, strip) in &done {
+            let sw = STRIP.min(w - x0);
+            row[*x0..x0 + sw].copy_from_slice(&strip[y * sw..(y + 1) * sw]);
         }
-    }
+    });
     out
 }
 
@@ -310,7 +311,9 @@ pub fn nc_plane(d: &[f32], w: usize, h: usize, sigma: f32, residual: bool) -> (V
     };
     // The d^2 moment serves the residual only.
     let n_maps = if residual { 10 } else { 9 };
+    // The maps are independent: one parallel job each (each also parallel inside).
     let s: Vec<Vec<f64>> = (0..n_maps)
+        .into_par_iter()
         .map(|k| {
             let mut m = vec![0f64; n];
             for_each_row(&mut m, w, |y, row| {
