@@ -308,6 +308,37 @@ pub(crate) fn right_pixel_order(neurons: &[Neuron], mut idx: Vec<usize>) -> Vec<
     keys.iter().map(|&k| (k & ((1 << 22) - 1)) as u32).collect()
 }
 
+/// `f(a)` = (row sum, entry count) for every row, in parallel; the sums in row order and the
+/// total count (each row's sum in its own fixed order: independent of the thread count).
+fn row_sums(n: usize, f: impl Fn(usize) -> (f64, usize) + Sync + Send) -> (Vec<f64>, usize) {
+    let (u, counts): (Vec<f64>, Vec<usize>) = (0..n).into_par_iter().map(f).unzip();
+    (u, counts.iter().sum())
+}
+
+/// A net-input sum over row entries: every entry counted, those of active neurons added.
+struct ActiveSum<'a> {
+    s: f64,
+    n: usize,
+    state: &'a [u8],
+}
+
+impl<'a> ActiveSum<'a> {
+    fn new(start: f64, state: &'a [u8]) -> Self {
+        ActiveSum {
+            s: start,
+            n: 0,
+            state,
+        }
+    }
+    #[inline]
+    fn add(&mut self, b: u32, t: f32) {
+        self.n += 1;
+        if self.state[b as usize] == 1 {
+            self.s += t as f64;
+        }
+    }
+}
+
 /// Read access to a symmetric weight matrix, one row at a time: the dynamics only ever need
 /// whole rows (the initial net inputs, then the row of each flipped neuron).
 pub trait Weights: Sync {
@@ -318,20 +349,11 @@ pub trait Weights: Sync {
     /// The net inputs `u_a = input_a + sum_b T_ab [state_b == 1]` of every neuron (each summed
     /// in a fixed order in `f64`, independent of the thread count) and the number of entries.
     fn initial_input(&self, state: &[u8], input: &[f64]) -> (Vec<f64>, usize) {
-        let (u, counts): (Vec<f64>, Vec<usize>) = (0..self.n())
-            .into_par_iter()
-            .map(|a| {
-                let (mut s, mut k) = (input[a], 0usize);
-                self.for_each_in_row(a, |b, t| {
-                    k += 1;
-                    if state[b as usize] == 1 {
-                        s += t as f64;
-                    }
-                });
-                (s, k)
-            })
-            .unzip();
-        (u, counts.iter().sum())
+        row_sums(self.n(), |a| {
+            let mut acc = ActiveSum::new(input[a], state);
+            self.for_each_in_row(a, |b, t| acc.add(b, t));
+            (acc.s, acc.n)
+        })
     }
     /// `u_b += sign * T_ab` for every entry of row `a`.
     fn add_row(&self, a: usize, sign: f64, u: &mut [f64]) {
@@ -851,18 +873,6 @@ impl Network {
         }
     }
 
-    /// Number of stored entries (what a CSR of the network would hold).
-    pub fn nnz(&self) -> usize {
-        (0..self.n())
-            .into_par_iter()
-            .map(|a| {
-                let mut k = 0usize;
-                self.for_each_in_row(a, |_, _| k += 1);
-                k
-            })
-            .sum()
-    }
-
     /// `state` (0/1 per neuron) in strip order, as `f32` factors of the lanes (padding 0).
     pub fn lane_state(&self, state: &[u8]) -> Vec<f32> {
         let n = self.cells.idx.len() - LANES;
@@ -950,23 +960,14 @@ impl Weights for Network {
 
     fn initial_input(&self, state: &[u8], input: &[f64]) -> (Vec<f64>, usize) {
         let on = self.lane_state(state);
-        let (u, counts): (Vec<f64>, Vec<usize>) = (0..self.n())
-            .into_par_iter()
-            .map(|a| {
-                let (mut s, mut n) = (input[a], 0usize);
-                self.for_each_unique(a, |b, t| {
-                    n += 1;
-                    if state[b as usize] == 1 {
-                        s += t as f64;
-                    }
-                });
-                let k = self.key(a);
-                let (w, nw) =
-                    window_input::<false>(&self.cells, &self.lut, &k, &self.window_ranges(a), &on);
-                (s + w, n + nw)
-            })
-            .unzip();
-        (u, counts.iter().sum())
+        row_sums(self.n(), |a| {
+            let mut acc = ActiveSum::new(input[a], state);
+            self.for_each_unique(a, |b, t| acc.add(b, t));
+            let k = self.key(a);
+            let (w, nw) =
+                window_input::<false>(&self.cells, &self.lut, &k, &self.window_ranges(a), &on);
+            (acc.s + w, acc.n + nw)
+        })
     }
 
     fn add_row(&self, a: usize, sign: f64, u: &mut [f64]) {
