@@ -19,6 +19,7 @@ use std::time::Instant;
 use stereovision_core::image::Image;
 use stereovision_core::matching::hopfield::{
     candidate_neurons, hopfield_match, interest_points, run_dynamics, HopfieldParams, Network,
+    Weights,
 };
 
 fn load(path: &str, w: usize, h: usize) -> Image {
@@ -69,7 +70,7 @@ fn main() {
         );
         return;
     }
-    let mut t = [(); 5].map(|_| Vec::new());
+    let mut t = [(); 6].map(|_| Vec::new());
     let ms = |s: Instant| s.elapsed().as_secs_f64() * 1e3;
     for _ in 0..9 {
         let s = Instant::now();
@@ -90,15 +91,18 @@ fn main() {
             .map(|n| u8::from(n.sim >= p.s_init))
             .collect();
         let s = Instant::now();
+        net.initial_input(&init, &input);
+        t[5].push(ms(s));
+        let s = Instant::now();
         run_dynamics(&net, &input, &init, p.seed, p.max_sweeps);
         t[3].push(ms(s));
         let s = Instant::now();
         hopfield_match(&l, &r, &p).expect("valid input");
         t[4].push(ms(s));
     }
-    let [a, b, c, e, f] = t.map(median_ms);
+    let [a, b, c, e, f, g] = t.map(median_ms);
     println!(
-        "interest {a:.2}  candidates (incl. interest) {b:.2}  network {c:.2}  dynamics {e:.2}  \
+        "interest {a:.2}  candidates (incl. interest) {b:.2}  network {c:.2}  dynamics {e:.2} (initial input {g:.2})  \
          whole matcher {f:.2}  (ms, median of 9)"
     );
 }
