@@ -355,9 +355,19 @@ pub trait Weights: Sync {
             (acc.s, acc.n)
         })
     }
-    /// `u_b += sign * T_ab` for every entry of row `a`.
+    /// Length of the dynamics' net-input buffer (at least [`Weights::n`]).
+    fn slots(&self) -> usize {
+        self.n()
+    }
+    /// Where `u_a` lives in that buffer (identity unless rows are faster to add in another
+    /// order).
+    #[inline]
+    fn slot(&self, a: usize) -> usize {
+        a
+    }
+    /// `u[slot(b)] += sign * T_ab` for every entry of row `a` (`u`: [`Weights::slots`] long).
     fn add_row(&self, a: usize, sign: f64, u: &mut [f64]) {
-        self.for_each_in_row(a, |b, t| u[b as usize] += sign * t as f64);
+        self.for_each_in_row(a, |b, t| u[self.slot(b as usize)] += sign * t as f64);
     }
 }
 
@@ -405,6 +415,9 @@ pub struct Network {
     /// Per point: the `cells` ranges of its window, one per strip of rows it touches.
     wranges: Vec<[(u32, u32); MAX_STRIPS]>,
     cells: Cells,
+    /// Per neuron (original order): its position in `cells`, where the dynamics keep its net
+    /// input (a flip then adds whole lane blocks to contiguous net inputs, no scatter).
+    slot_of: Vec<u32>,
     /// Per neuron (original order): disparity vector.
     dxs: Vec<i32>,
     dys: Vec<i32>,
@@ -625,8 +638,8 @@ unsafe fn window_input_avx2<const POS: bool>(
     (acc.iter().sum(), n)
 }
 
-/// `u_b += sign * T_ab` over the window part of a row (lanes not in the row add +-0, which
-/// leaves a net input bit-identical).
+/// `u[j] += sign * T_ab` over the window part of a row, `u` in `cells` order (lanes not in
+/// the row add +-0, which leaves a net input bit-identical).
 fn window_add(
     c: &Cells,
     lut: &[f32],
@@ -656,7 +669,7 @@ fn window_add_portable(
         for j0 in (s..e).step_by(LANES) {
             let (t, _) = lane_weights(c, lut, k, j0, e);
             for (l, &tl) in t.iter().enumerate() {
-                u[c.idx[j0 + l] as usize] += sign * tl as f64;
+                u[j0 + l] += sign * tl as f64;
             }
         }
     }
@@ -665,7 +678,7 @@ fn window_add_portable(
 /// AVX2 body of [`window_add`].
 ///
 /// # Safety
-/// As [`lane_weights_avx2`].
+/// As [`lane_weights_avx2`]; `u` as long as the padded `cells`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn window_add_avx2(
@@ -678,23 +691,29 @@ unsafe fn window_add_avx2(
 ) {
     use std::arch::x86_64::*;
     debug_assert!(sign == 1.0 || sign == -1.0);
+    debug_assert!(u.len() >= c.idx.len());
     let flip = _mm256_set1_ps(if sign < 0.0 { -0.0 } else { 0.0 });
-    let mut t = [0.0f32; LANES];
     for &(s, e) in ranges {
         for j0 in (s..e).step_by(LANES) {
-            let (tv, stored) = lane_weights_avx2(c, lut, k, j0, e);
+            let (tv, _) = lane_weights_avx2(c, lut, k, j0, e);
             // `sign * t` exactly, as a sign flip of the f32 (no multiply per lane).
-            _mm256_storeu_ps(t.as_mut_ptr(), _mm256_xor_ps(tv, flip));
-            // Only the lanes in the row: the others would add +-0.
-            let mut m = _mm256_movemask_ps(_mm256_castsi256_ps(stored)) as u32;
-            while m != 0 {
-                let l = m.trailing_zeros() as usize;
-                let b = *c.idx.get_unchecked(j0 + l) as usize;
-                debug_assert!(b < u.len());
-                // SAFETY: `idx` holds neuron indices (< u.len()) and j0 + l < e <= its length.
-                *u.get_unchecked_mut(b) += t[l] as f64;
-                m &= m - 1;
-            }
+            let v = _mm256_xor_ps(tv, flip);
+            // SAFETY: j0 + LANES <= the padded cells length <= u.len().
+            let p = u.as_mut_ptr().add(j0);
+            _mm256_storeu_pd(
+                p,
+                _mm256_add_pd(
+                    _mm256_loadu_pd(p),
+                    _mm256_cvtps_pd(_mm256_castps256_ps128(v)),
+                ),
+            );
+            _mm256_storeu_pd(
+                p.add(4),
+                _mm256_add_pd(
+                    _mm256_loadu_pd(p.add(4)),
+                    _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(v)),
+                ),
+            );
         }
     }
 }
@@ -798,6 +817,10 @@ impl Network {
         cells.rank.resize(padded, 0);
         cells.norm.resize(padded, 0.0);
         cells.idx.resize(padded, 0);
+        let mut slot_of = vec![0u32; m];
+        for (j, &b) in cells.idx[..padded - LANES].iter().enumerate() {
+            slot_of[b as usize] = j as u32;
+        }
         // Per point, the `cells` range of its window in each strip the window's rows touch.
         let wranges: Vec<[(u32, u32); MAX_STRIPS]> = pxy
             .par_iter()
@@ -866,6 +889,7 @@ impl Network {
             rank,
             wranges,
             cells,
+            slot_of,
             dxs,
             dys,
             lut,
@@ -970,8 +994,19 @@ impl Weights for Network {
         })
     }
 
+    fn slots(&self) -> usize {
+        self.cells.idx.len()
+    }
+
+    #[inline]
+    fn slot(&self, a: usize) -> usize {
+        self.slot_of[a] as usize
+    }
+
     fn add_row(&self, a: usize, sign: f64, u: &mut [f64]) {
-        self.for_each_unique(a, |b, t| u[b as usize] += sign * t as f64);
+        self.for_each_unique(a, |b, t| {
+            u[self.slot_of[b as usize] as usize] += sign * t as f64
+        });
         let k = self.key(a);
         window_add(&self.cells, &self.lut, &k, &self.window_ranges(a), sign, u);
     }
@@ -1042,13 +1077,13 @@ pub struct Dynamics {
     pub nnz: usize,
 }
 
-/// Energy `E = -1/2 V^T T V - I^T V` from the net inputs `u = T V + I`.
-fn energy(state: &[u8], u: &[f64], input: &[f64]) -> f64 {
-    state
-        .iter()
-        .zip(u.iter().zip(input))
-        .filter(|(&v, _)| v == 1)
-        .map(|(_, (&ua, &ia))| -(0.5 * (ua - ia) + ia))
+/// Energy `E = -1/2 V^T T V - I^T V` from the net inputs `u = T V + I` (`(V_a, u_a)` in
+/// neuron order).
+fn energy_of(state_u: impl Iterator<Item = (u8, f64)>, input: &[f64]) -> f64 {
+    state_u
+        .zip(input)
+        .filter(|((v, _), _)| *v == 1)
+        .map(|((_, ua), &ia)| -(0.5 * (ua - ia) + ia))
         .sum()
 }
 
@@ -1064,8 +1099,17 @@ pub fn run_dynamics<W: Weights>(
     let mut state = init.to_vec();
     // Initial net inputs u_a = I_a + sum_b T_ab V_b, each from its own row (T is symmetric):
     // in parallel, every sum in row order, so independent of the thread count.
-    let (mut u, nnz) = net.initial_input(init, input);
-    let mut trace = vec![energy(&state, &u, input)];
+    let (u0, nnz) = net.initial_input(init, input);
+    // The net inputs in the weights' slot order (see `Weights::slot`).
+    let slot: Vec<usize> = (0..m).map(|a| net.slot(a)).collect();
+    let mut u = vec![0.0f64; net.slots()];
+    for (a, &ua) in u0.iter().enumerate() {
+        u[slot[a]] = ua;
+    }
+    let energy = |state: &[u8], u: &[f64]| -> f64 {
+        energy_of(state.iter().zip(&slot).map(|(&v, &j)| (v, u[j])), input)
+    };
+    let mut trace = vec![energy(&state, &u)];
     let mut rng = SplitMix64::new(seed);
     let mut order: Vec<u32> = (0..m as u32).collect();
     let mut sweeps = 0;
@@ -1075,9 +1119,10 @@ pub fn run_dynamics<W: Weights>(
         let mut flips = 0usize;
         for &a in &order {
             let a = a as usize;
-            let new = if u[a] > 0.0 {
+            let ua = u[slot[a]];
+            let new = if ua > 0.0 {
                 1
-            } else if u[a] < 0.0 {
+            } else if ua < 0.0 {
                 0
             } else {
                 state[a]
@@ -1090,7 +1135,7 @@ pub fn run_dynamics<W: Weights>(
             }
         }
         sweeps += 1;
-        trace.push(energy(&state, &u, input));
+        trace.push(energy(&state, &u));
         converged = flips == 0;
     }
     Dynamics {
@@ -1148,7 +1193,10 @@ mod tests {
                 })
                 .collect();
             let m = neurons.len();
-            let (mut u_simd, mut u_port) = (vec![0.5f64; m], vec![0.5f64; m]);
+            let (mut u_simd, mut u_port) = (
+                vec![0.5f64; net.cells.idx.len()],
+                vec![0.5f64; net.cells.idx.len()],
+            );
             for a in 0..m {
                 let k = net.key(a);
                 let ranges = net.window_ranges(a);
