@@ -6,8 +6,8 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use stereovision_core::matching::hopfield::{
-    candidate_neurons, hopfield_match, interest_points, run_dynamics, HopfieldParams,
-    InterestParams, Network,
+    candidate_neurons, hopfield_match, initial_state, interest_points, run_dynamics,
+    HopfieldParams, InterestParams, Network,
 };
 use stereovision_core::Image;
 
@@ -90,10 +90,7 @@ fn bench(c: &mut Criterion) {
             .iter()
             .map(|n| (p.weights.d * n.sim - p.weights.theta) as f64)
             .collect();
-        let init: Vec<u8> = neurons
-            .iter()
-            .map(|n| u8::from(n.sim >= p.s_init))
-            .collect();
+        let init = initial_state(&neurons, &p);
         // The implicit network: its set-up, then the dynamics (the initial net inputs from
         // every row, then the sweeps, each flip re-reading its row).
         g.bench_function(BenchmarkId::new("network", &id), |b| {

@@ -35,6 +35,7 @@ DEFAULTS = {
     "compat_slope": 2.0,
     "compat_grad": 0.05,
     "s_init": 0.8,
+    "init_best": True,
     "max_sweeps": 100,
     "seed": 0,
     "edge_test": True,
@@ -463,7 +464,15 @@ def hopfield_match(
             for n in neurons
         ]
     )
-    init = np.array([n["sim"] >= p["s_init"] for n in neurons], dtype=np.int8)
+    # Preset (C.4): ZNCC >= s_init, with init_best only each point's first (best) candidate.
+    first = [a == 0 or neurons[a - 1]["point"] != n["point"] for a, n in enumerate(neurons)]
+    init = np.array(
+        [
+            n["sim"] >= p["s_init"] and (f or not p["init_best"])
+            for n, f in zip(neurons, first, strict=True)
+        ],
+        dtype=np.int8,
+    )
     v, trace = run_dynamics(rows, inp, init, int(p["seed"]), int(p["max_sweeps"]))
     v = _fallback(neurons, rows, v, p)
     best: dict[int, int] = {}

@@ -53,7 +53,8 @@ DEFAULTS: dict[str, Any] = {
     "compat_theta": 2.0,  # disparity difference where compatibility crosses 0 (px, C.3)
     "compat_slope": 2.0,  # steepness of the compatibility sigmoid (1/px, C.3)
     "compat_grad": 0.05,  # crossing grows by this per px of point distance (slanted surfaces)
-    "s_init": 0.8,  # neurons with ZNCC >= s_init start on (C.4)
+    "s_init": 0.8,  # neurons with ZNCC >= s_init start on (C.4) ...
+    "init_best": True,  # ... only each point's best one (uniqueness holds from the start)
     "max_sweeps": 100,  # bound on asynchronous sweeps
     "seed": 0,  # update-order seed
     "tau_y": 1.0,  # disambiguation tolerance (px, C.5)
@@ -217,9 +218,9 @@ def hopfield_match(
         ``tile`` (px), ``floor_rel``,
         ``candidates`` (``"row"`` or ``"points"``), ``dy_window`` (px), ``s_min``, ``k_cand``,
         ``A``, ``B``, ``D``, ``theta``, ``nbr_half`` (px), ``compat_theta`` (px),
-        ``compat_slope`` (1/px), ``compat_grad`` (px per px), ``s_init``, ``max_sweeps``,
-        ``seed``, ``tau_y`` (px), ``edge_test``, ``edge_tol`` (px), ``edge_margin`` (ZNCC),
-        ``edge_penalty``, ``centre_tol`` (window-mean-free grey levels in [0, 1]),
+        ``compat_slope`` (1/px), ``compat_grad`` (px per px), ``s_init``, ``init_best``,
+        ``max_sweeps``, ``seed``, ``tau_y`` (px), ``edge_test``, ``edge_tol`` (px),
+        ``edge_margin`` (ZNCC), ``edge_penalty``, ``centre_tol`` (window-mean-free grey levels in [0, 1]),
         ``rescue_min``, ``rescue_med`` (px), ``fallback``, ``fallback_alt_support``,
         ``fallback_min_support``, ``min_agree``, ``agree_tol`` (px),
         ``agree_share``, ``min_agree_sparse``, ``subpixel``.

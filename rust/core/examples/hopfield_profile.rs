@@ -10,7 +10,7 @@
 //!
 //! Timing mode prints the median of 9 runs of each public stage (ms) with the current rayon
 //! thread count (`RAYON_NUM_THREADS`); `fingerprint` prints the match count, the number of
-//! weights, the sweeps and a hash of every match and energy value (to check that a change
+//! weights, the sweeps, a hash of every match and one of the energy trace (to check that a change
 //! leaves the output bit-identical).
 
 use std::hash::{Hash, Hasher};
@@ -18,8 +18,8 @@ use std::time::Instant;
 
 use stereovision_core::image::Image;
 use stereovision_core::matching::hopfield::{
-    candidate_neurons, hopfield_match, interest_points, run_dynamics, HopfieldParams, Network,
-    Weights,
+    candidate_neurons, hopfield_match, initial_state, interest_points, run_dynamics,
+    HopfieldParams, Network, Weights,
 };
 
 fn load(path: &str, w: usize, h: usize) -> Image {
@@ -58,15 +58,17 @@ fn main() {
                 .map(f32::to_bits)
                 .hash(&mut hash);
         }
+        let mut e_hash = std::collections::hash_map::DefaultHasher::new();
         out.energy_trace
             .iter()
-            .for_each(|e| e.to_bits().hash(&mut hash));
+            .for_each(|e| e.to_bits().hash(&mut e_hash));
         println!(
-            "matches {} weights {} sweeps {} hash {:016x}",
+            "matches {} weights {} sweeps {} match hash {:016x} energy hash {:016x}",
             out.matches.len(),
             out.n_weights,
             out.sweeps,
-            hash.finish()
+            hash.finish(),
+            e_hash.finish()
         );
         return;
     }
@@ -86,10 +88,7 @@ fn main() {
             .iter()
             .map(|n| (p.weights.d * n.sim - p.weights.theta) as f64)
             .collect();
-        let init: Vec<u8> = neurons
-            .iter()
-            .map(|n| u8::from(n.sim >= p.s_init))
-            .collect();
+        let init = initial_state(&neurons, &p);
         let s = Instant::now();
         net.initial_input(&init, &input);
         t[5].push(ms(s));

@@ -17,7 +17,7 @@ use crate::convert::{image_from_numpy, image_to_numpy};
 use crate::errors::guard;
 use crate::params::{check_keys, get};
 
-const KEYS: [&str; 39] = [
+const KEYS: [&str; 40] = [
     "fallback",
     "fallback_alt_support",
     "fallback_min_support",
@@ -46,6 +46,7 @@ const KEYS: [&str; 39] = [
     "compat_theta",
     "compat_slope",
     "s_init",
+    "init_best",
     "max_sweeps",
     "seed",
     "tau_y",
@@ -92,6 +93,7 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
     get(d, "compat_slope", &mut p.weights.compat_slope)?;
     get(d, "compat_grad", &mut p.weights.compat_grad)?;
     get(d, "s_init", &mut p.s_init)?;
+    get(d, "init_best", &mut p.init_best)?;
     get(d, "max_sweeps", &mut p.max_sweeps)?;
     get(d, "seed", &mut p.seed)?;
     get(d, "tau_y", &mut p.tau_y)?;

@@ -66,6 +66,11 @@ pub struct HopfieldParams {
     pub weights: EnergyWeights,
     /// Neurons with `S >= s_init` start on (C.4 "preset possible matches").
     pub s_init: f32,
+    /// ... only each point's best candidate among them (a start that already satisfies
+    /// uniqueness along the row): the sweeps then flip about 1/6 as many neurons as from
+    /// every candidate on, to the same final matches within a few per scene
+    /// (docs/hopfield.md, "Initial state").
+    pub init_best: bool,
     /// Upper bound on asynchronous sweeps.
     pub max_sweeps: usize,
     /// Seed of the update order.
@@ -132,6 +137,7 @@ impl Default for HopfieldParams {
             k_cand: 8,
             weights: EnergyWeights::default(),
             s_init: 0.8,
+            init_best: true,
             max_sweeps: 100,
             seed: 0,
             tau_y: 1.0,
@@ -731,6 +737,19 @@ pub fn candidate_neurons(
     Ok((pts, neurons))
 }
 
+/// The preset state (C.4): neurons with `S >= s_init` on, with [`HopfieldParams::init_best`]
+/// only the first (best) candidate of each point.
+pub fn initial_state(neurons: &[Neuron], p: &HopfieldParams) -> Vec<u8> {
+    neurons
+        .iter()
+        .enumerate()
+        .map(|(a, n)| {
+            let first = a == 0 || neurons[a - 1].point != n.point;
+            u8::from(n.sim >= p.s_init && (first || !p.init_best))
+        })
+        .collect()
+}
+
 /// The Hopfield channel: interest points matched by energy minimisation (see the module docs).
 pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result<HopfieldOutput> {
     let (pts, neurons) = candidate_neurons(left, right, p)?;
@@ -746,10 +765,7 @@ pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result
             (p.weights.d * n.sim - p.weights.theta - penalty) as f64
         })
         .collect();
-    let init: Vec<u8> = neurons
-        .iter()
-        .map(|n| u8::from(n.sim >= p.s_init))
-        .collect();
+    let init = initial_state(&neurons, p);
     let dynamics = run_dynamics(&net, &input, &init, p.seed, p.max_sweeps);
     let selected = fallback(&neurons, &net, &dynamics.state, p);
     let chosen = disambiguate(&neurons, &selected, p);

@@ -1077,13 +1077,13 @@ pub struct Dynamics {
     pub nnz: usize,
 }
 
-/// Energy `E = -1/2 V^T T V - I^T V` from the net inputs `u = T V + I` (`(V_a, u_a)` in
-/// neuron order).
-fn energy_of(state_u: impl Iterator<Item = (u8, f64)>, input: &[f64]) -> f64 {
-    state_u
-        .zip(input)
-        .filter(|((v, _), _)| *v == 1)
-        .map(|((_, ua), &ia)| -(0.5 * (ua - ia) + ia))
+/// Energy `E = -1/2 V^T T V - I^T V` from the net inputs `u = T V + I` (neuron order).
+fn energy(state: &[u8], u: &[f64], input: &[f64]) -> f64 {
+    state
+        .iter()
+        .zip(u.iter().zip(input))
+        .filter(|(&v, _)| v == 1)
+        .map(|(_, (&ua, &ia))| -(0.5 * (ua - ia) + ia))
         .sum()
 }
 
@@ -1100,43 +1100,54 @@ pub fn run_dynamics<W: Weights>(
     // Initial net inputs u_a = I_a + sum_b T_ab V_b, each from its own row (T is symmetric):
     // in parallel, every sum in row order, so independent of the thread count.
     let (u0, nnz) = net.initial_input(init, input);
-    // The net inputs in the weights' slot order (see `Weights::slot`).
-    let slot: Vec<usize> = (0..m).map(|a| net.slot(a)).collect();
+    let mut trace = vec![energy(&state, &u0, input)];
+    // The sweeps work in the weights' slot order (see `Weights::slot`): net inputs, states and
+    // the visiting order are indexed by slot, so a visit reads two arrays at one index.
+    let slot: Vec<u32> = (0..m).map(|a| net.slot(a) as u32).collect();
     let mut u = vec![0.0f64; net.slots()];
-    for (a, &ua) in u0.iter().enumerate() {
-        u[slot[a]] = ua;
+    let mut st = vec![0u8; net.slots()];
+    let mut neuron_at = vec![0u32; net.slots()];
+    for (a, &j) in slot.iter().enumerate() {
+        u[j as usize] = u0[a];
+        st[j as usize] = state[a];
+        neuron_at[j as usize] = a as u32;
     }
-    let energy = |state: &[u8], u: &[f64]| -> f64 {
-        energy_of(state.iter().zip(&slot).map(|(&v, &j)| (v, u[j])), input)
-    };
-    let mut trace = vec![energy(&state, &u)];
+    // The shuffle moves entries by position only, so shuffling the slots of 0..m visits the
+    // same neurons in the same sequence as shuffling 0..m.
+    let mut order = slot.clone();
     let mut rng = SplitMix64::new(seed);
-    let mut order: Vec<u32> = (0..m as u32).collect();
+    // Energy tracked per flip: switching `a` on changes E by -u_a, off by +u_a (T_aa = 0), and
+    // a flip happens only against the sign of u_a, so every step lowers E.
+    let mut e = trace[0];
     let mut sweeps = 0;
     let mut converged = m == 0;
     while !converged && sweeps < max_sweeps {
         rng.shuffle(&mut order);
         let mut flips = 0usize;
-        for &a in &order {
-            let a = a as usize;
-            let ua = u[slot[a]];
+        for &j in &order {
+            let j = j as usize;
+            let (ua, old) = (u[j], st[j]);
             let new = if ua > 0.0 {
                 1
             } else if ua < 0.0 {
                 0
             } else {
-                state[a]
+                old
             };
-            if new != state[a] {
-                state[a] = new;
+            if new != old {
+                st[j] = new;
                 flips += 1;
                 let sign = if new == 1 { 1.0 } else { -1.0 };
-                net.add_row(a, sign, &mut u);
+                e -= sign * ua;
+                net.add_row(neuron_at[j] as usize, sign, &mut u);
             }
         }
         sweeps += 1;
-        trace.push(energy(&state, &u));
+        trace.push(e);
         converged = flips == 0;
+    }
+    for (a, &j) in slot.iter().enumerate() {
+        state[a] = st[j as usize];
     }
     Dynamics {
         state,
