@@ -220,8 +220,9 @@ def hopfield_match(
         ``A``, ``B``, ``D``, ``theta``, ``nbr_half`` (px), ``compat_theta`` (px),
         ``compat_slope`` (1/px), ``compat_grad`` (px per px), ``s_init``, ``init_best``,
         ``max_sweeps``, ``seed``, ``tau_y`` (px), ``edge_test``, ``edge_tol`` (px),
-        ``edge_margin`` (ZNCC), ``edge_penalty``, ``centre_tol`` (window-mean-free grey levels in [0, 1]),
-        ``rescue_min``, ``rescue_med`` (px), ``fallback``, ``fallback_alt_support``,
+        ``edge_margin`` (ZNCC), ``edge_penalty``,
+        ``centre_tol`` (window-mean-free grey levels in [0, 1]), ``rescue_min``,
+        ``rescue_med`` (px), ``fallback``, ``fallback_alt_support``,
         ``fallback_min_support``, ``min_agree``, ``agree_tol`` (px),
         ``agree_share``, ``min_agree_sparse``, ``subpixel``.
 
