@@ -718,6 +718,64 @@ unsafe fn window_add_avx2(
     }
 }
 
+/// For every point of the strip order (strips of `strip_h` rows, by x within a strip; `sx`,
+/// `sy` its coordinates, `strip_start` the strips' starts): the ranges of strip-order positions
+/// within `half` of it in x, one per strip its window's rows touch (from the top; unused ones
+/// empty), and the number of other points within `half` in both coordinates. The ranges come
+/// from per-strip prefix counts (the points of a strip left of each column; a strip's points
+/// come by increasing x), without a search; the count is a range length for the strips inside
+/// the window's rows and a scan of the range's rows for the (at most two) strips cut by it.
+fn strip_windows(
+    sx: &[i32],
+    sy: &[i32],
+    strip_start: &[usize],
+    strip_h: i32,
+    half: i32,
+) -> Vec<([(u32, u32); MAX_STRIPS], usize)> {
+    let n_strips = strip_start.len() - 1;
+    let w = sx.iter().copied().max().unwrap_or(0) as usize + 1;
+    let stride = w + 1;
+    // xp[t][x]: points of strip t with sx < x.
+    let mut xp = vec![0u32; n_strips * stride];
+    xp.par_chunks_mut(stride).enumerate().for_each(|(t, row)| {
+        for &x in &sx[strip_start[t]..strip_start[t + 1]] {
+            row[x as usize + 1] += 1;
+        }
+        for x in 1..stride {
+            row[x] += row[x - 1];
+        }
+    });
+    let last = n_strips as i32 - 1;
+    (0..sx.len())
+        .into_par_iter()
+        .map(|i| {
+            let (x, y) = (sx[i], sy[i]);
+            let xa = (x - half).max(0) as usize;
+            let xb = ((x + half + 1) as usize).min(w);
+            let s_lo = (y - half).max(0) / strip_h;
+            let s_hi = ((y + half) / strip_h).min(last);
+            let mut r = [(0u32, 0u32); MAX_STRIPS];
+            let mut count = 0usize;
+            for t in s_lo..=s_hi {
+                let base = strip_start[t as usize];
+                let lo = base + xp[t as usize * stride + xa] as usize;
+                let hi = base + xp[t as usize * stride + xb] as usize;
+                r[(t - s_lo) as usize] = (lo as u32, hi as u32);
+                let inside = t * strip_h >= y - half && t * strip_h + strip_h - 1 <= y + half;
+                count += if inside {
+                    hi - lo
+                } else {
+                    sy[lo..hi]
+                        .iter()
+                        .filter(|&&qy| (qy - y).abs() <= half)
+                        .count()
+                };
+            }
+            (r, count - 1) // the point itself
+        })
+        .collect()
+}
+
 impl Network {
     /// The network of `neurons`, which must be grouped by `point` in increasing order and
     /// have non-negative coordinates.
@@ -735,37 +793,6 @@ impl Network {
             .map(|p| (neurons[starts[p]].xl.max(0), neurons[starts[p]].yl.max(0)))
             .collect();
         let half = w.nbr_half.max(1);
-        let grid = PointGrid::new(&pxy, half);
-        // Window neighbour counts n_p (8 grid points at a time, in parallel).
-        let zeros = vec![0i32; grid.xs.len()];
-        let counts: Vec<usize> = pxy
-            .par_iter()
-            .map(|&xy| grid.count_in_window(xy, half, &zeros, 0, 0).0 - 1)
-            .collect();
-        // A / max(n_p, n_q, 1) = min(A / max(n_p, 1), A / max(n_q, 1)) exactly: division rounds
-        // monotonically (max for a negative A). One division per point instead of per pair.
-        let a_over_n: Vec<f32> = counts.iter().map(|&n| w.a / (n as f32).max(1.0)).collect();
-        let p_of: Vec<u32> = (0..n_pts)
-            .flat_map(|p| std::iter::repeat_n(p as u32, starts[p + 1] - starts[p]))
-            .collect();
-        let dxs: Vec<i32> = neurons.iter().map(Neuron::dx).collect();
-        let dys: Vec<i32> = neurons.iter().map(Neuron::dy).collect();
-        // Column groups: neurons sharing a right pixel, wherever their left points are.
-        let key = |a: u32| (neurons[a as usize].yr, neurons[a as usize].xr);
-        let by_right: Vec<u32> = right_pixel_order(neurons, (0..m).collect::<Vec<_>>());
-        let mut group = vec![(0u32, 0u32); m];
-        let mut rank = vec![0u32; m];
-        let (mut g0, mut n_groups) = (0, 0u32);
-        for k in 1..=m {
-            if k == m || key(by_right[k]) != key(by_right[g0]) {
-                for &a in &by_right[g0..k] {
-                    group[a as usize] = (g0 as u32, k as u32);
-                    rank[a as usize] = n_groups;
-                }
-                g0 = k;
-                n_groups += 1;
-            }
-        }
         // Strip order: points in horizontal strips of `strip_h` rows, by x within a strip, so
         // that a window's points in one strip are ONE contiguous range cut exactly in x.
         let strip_h = (half + 1) / 2;
@@ -790,6 +817,37 @@ impl Network {
                 .sort_unstable_by_key(|&q| ((pxy[q as usize].0 as u64) << 32) | q as u64);
         }
         let sx: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].0).collect();
+        let sy: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].1).collect();
+        // Per point (strip order): its window's point ranges per strip and neighbour count n_p.
+        let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half);
+        let mut counts = vec![0usize; n_pts];
+        for (&q, w) in sorder.iter().zip(&wins) {
+            counts[q as usize] = w.1;
+        }
+        // A / max(n_p, n_q, 1) = min(A / max(n_p, 1), A / max(n_q, 1)) exactly: division rounds
+        // monotonically (max for a negative A). One division per point instead of per pair.
+        let a_over_n: Vec<f32> = counts.iter().map(|&n| w.a / (n as f32).max(1.0)).collect();
+        let p_of: Vec<u32> = (0..n_pts)
+            .flat_map(|p| std::iter::repeat_n(p as u32, starts[p + 1] - starts[p]))
+            .collect();
+        let dxs: Vec<i32> = neurons.iter().map(Neuron::dx).collect();
+        let dys: Vec<i32> = neurons.iter().map(Neuron::dy).collect();
+        // Column groups: neurons sharing a right pixel, wherever their left points are.
+        let key = |a: u32| (neurons[a as usize].yr, neurons[a as usize].xr);
+        let by_right: Vec<u32> = right_pixel_order(neurons, (0..m).collect::<Vec<_>>());
+        let mut group = vec![(0u32, 0u32); m];
+        let mut rank = vec![0u32; m];
+        let (mut g0, mut n_groups) = (0, 0u32);
+        for k in 1..=m {
+            if k == m || key(by_right[k]) != key(by_right[g0]) {
+                for &a in &by_right[g0..k] {
+                    group[a as usize] = (g0 as u32, k as u32);
+                    rank[a as usize] = n_groups;
+                }
+                g0 = k;
+                n_groups += 1;
+            }
+        }
         // Strip-ordered neuron arrays.
         let mut gstart = Vec::with_capacity(n_pts + 1);
         gstart.push(0u32);
@@ -822,22 +880,10 @@ impl Network {
             slot_of[b as usize] = j as u32;
         }
         // Per point, the `cells` range of its window in each strip the window's rows touch.
-        let wranges: Vec<[(u32, u32); MAX_STRIPS]> = pxy
-            .par_iter()
-            .map(|&(x, y)| {
-                let mut r = [(0u32, 0u32); MAX_STRIPS];
-                let s_lo = ((y - half).max(0) / strip_h) as usize;
-                let s_hi = (((y + half) / strip_h) as usize).min(n_strips - 1);
-                for (k, st) in (s_lo..=s_hi).enumerate() {
-                    let (a, b) = (strip_start[st], strip_start[st + 1]);
-                    let xs = &sx[a..b];
-                    let lo = a + xs.partition_point(|&v| v < x - half);
-                    let hi = a + xs.partition_point(|&v| v <= x + half);
-                    r[k] = (gstart[lo], gstart[hi]);
-                }
-                r
-            })
-            .collect();
+        let mut wranges = vec![[(0u32, 0u32); MAX_STRIPS]; n_pts];
+        for (&q, (r, _)) in sorder.iter().zip(&wins) {
+            wranges[q as usize] = r.map(|(lo, hi)| (gstart[lo as usize], gstart[hi as usize]));
+        }
         // Compatibility lookup per Chebyshev distance r of the two points (0..=half) over the
         // integer squared disparity-vector difference q. A row ends where the f32 value has
         // saturated at -1 (slope > 0, q past the crossing): larger q read the last entry, which
@@ -1187,6 +1233,49 @@ mod tests {
             }
         }
         out
+    }
+
+    #[test]
+    fn strip_windows_equal_searches_and_brute_force_counts() {
+        let mut rng = SplitMix64::new(11);
+        let (half, strip_h) = (20, 10);
+        // 700 distinct points on a 300x200 image, in strip order.
+        let mut pts: Vec<(i32, i32)> = (0..700)
+            .map(|_| ((rng.next_u64() % 300) as i32, (rng.next_u64() % 200) as i32))
+            .collect();
+        pts.sort_unstable_by_key(|&(x, y)| (y / strip_h, x, y));
+        pts.dedup();
+        let n_strips = (pts.iter().map(|p| p.1).max().unwrap() / strip_h + 1) as usize;
+        let mut strip_start = vec![0usize; n_strips + 1];
+        for &(_, y) in &pts {
+            strip_start[(y / strip_h) as usize + 1] += 1;
+        }
+        for i in 1..=n_strips {
+            strip_start[i] += strip_start[i - 1];
+        }
+        let sx: Vec<i32> = pts.iter().map(|p| p.0).collect();
+        let sy: Vec<i32> = pts.iter().map(|p| p.1).collect();
+        let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half);
+        for (i, &(x, y)) in pts.iter().enumerate() {
+            let brute = pts
+                .iter()
+                .filter(|&&(qx, qy)| (qx - x).abs() <= half && (qy - y).abs() <= half)
+                .count();
+            assert_eq!(wins[i].1, brute - 1, "count of point {i}");
+            let s_lo = ((y - half).max(0) / strip_h) as usize;
+            let s_hi = (((y + half) / strip_h) as usize).min(n_strips - 1);
+            for (k, st) in (s_lo..=s_hi).enumerate() {
+                let (a, b) = (strip_start[st], strip_start[st + 1]);
+                let lo = a + sx[a..b].partition_point(|&v| v < x - half);
+                let hi = a + sx[a..b].partition_point(|&v| v <= x + half);
+                assert_eq!(
+                    wins[i].0[k],
+                    (lo as u32, hi as u32),
+                    "strip {st} of point {i}"
+                );
+            }
+            assert!(wins[i].0[s_hi - s_lo + 1..].iter().all(|&r| r == (0, 0)));
+        }
     }
 
     #[test]
