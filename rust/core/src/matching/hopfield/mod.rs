@@ -557,34 +557,42 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
         // against the matches accepted before the round.
         let added: Vec<usize> = to_test
             .par_iter()
-            .map_init(Vec::new, |side: &mut Vec<f32>, &k| {
-                let c = cands[k];
-                let n = &neurons[chosen[c]];
-                let (x, y, d) = (cxy[c].0, cxy[c].1, n.dx());
-                let dsub = d as f32 + n.sub;
-                let pass = (0..4).filter(|h| n.halves_fail >> h & 1 == 1).all(|h| {
-                    side.clear();
-                    let mut all_agree = true;
+            .map_init(
+                || std::array::from_fn::<Vec<f32>, 4, _>(|_| Vec::new()),
+                |sides, &k| {
+                    let c = cands[k];
+                    let n = &neurons[chosen[c]];
+                    let (x, y, d) = (cxy[c].0, cxy[c].1, n.dx());
+                    let dsub = d as f32 + n.sub;
+                    // One pass over the window fills the side sets of every failing half (in
+                    // window order, as one pass per half would).
+                    let fails: [bool; 4] = std::array::from_fn(|h| n.halves_fail >> h & 1 == 1);
+                    let mut all_agree = [true; 4];
+                    sides.iter_mut().for_each(Vec::clear);
                     grid.for_each_in_window((x, y), half, |t| {
+                        if !ok[t] {
+                            return;
+                        }
                         let (qx, qy) = cxy[t];
-                        let on_side = match h {
-                            0 => qx < x,
-                            1 => qx > x,
-                            2 => qy < y,
-                            _ => qy > y,
-                        };
-                        if ok[t] && on_side {
-                            let b = &neurons[chosen[t]];
-                            all_agree &= (b.dx() - d).abs() <= p.agree_tol;
-                            side.push(b.dx() as f32 + b.sub);
+                        let b = &neurons[chosen[t]];
+                        let agree = (b.dx() - d).abs() <= p.agree_tol;
+                        let v = b.dx() as f32 + b.sub;
+                        for (h, on_side) in [qx < x, qx > x, qy < y, qy > y].into_iter().enumerate()
+                        {
+                            if fails[h] && on_side {
+                                all_agree[h] &= agree;
+                                sides[h].push(v);
+                            }
                         }
                     });
-                    all_agree
-                        && side.len() >= p.rescue_min
-                        && (median(side) - dsub).abs() <= p.rescue_med
-                });
-                pass.then_some(k)
-            })
+                    let pass = (0..4).filter(|&h| fails[h]).all(|h| {
+                        all_agree[h]
+                            && sides[h].len() >= p.rescue_min
+                            && (median(&mut sides[h]) - dsub).abs() <= p.rescue_med
+                    });
+                    pass.then_some(k)
+                },
+            )
             .flatten()
             .collect();
         if added.is_empty() {
