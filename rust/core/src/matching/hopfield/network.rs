@@ -812,10 +812,16 @@ impl Network {
             sorder[fill[st]] = q as u32;
             fill[st] += 1;
         }
+        let mut strips: Vec<&mut [u32]> = Vec::with_capacity(n_strips);
+        let mut rest = &mut sorder[..];
         for st in 0..n_strips {
-            sorder[strip_start[st]..strip_start[st + 1]]
-                .sort_unstable_by_key(|&q| ((pxy[q as usize].0 as u64) << 32) | q as u64);
+            let (head, tail) = rest.split_at_mut(strip_start[st + 1] - strip_start[st]);
+            strips.push(head);
+            rest = tail;
         }
+        strips.into_par_iter().for_each(|v| {
+            v.sort_unstable_by_key(|&q| ((pxy[q as usize].0 as u64) << 32) | q as u64)
+        });
         let sx: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].0).collect();
         let sy: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].1).collect();
         // Per point (strip order): its window's point ranges per strip and neighbour count n_p.
@@ -848,33 +854,33 @@ impl Network {
                 n_groups += 1;
             }
         }
-        // Strip-ordered neuron arrays.
+        // Strip-ordered neuron arrays: the neuron order first, then each array by an
+        // exact-size map over it (padded with LANES entries).
         let mut gstart = Vec::with_capacity(n_pts + 1);
         gstart.push(0u32);
-        let mut cells = Cells::default();
+        let mut idx: Vec<u32> = Vec::with_capacity(m + LANES);
         for &q in &sorder {
             let q = q as usize;
-            for b in starts[q]..starts[q + 1] {
-                cells.x.push(pxy[q].0);
-                cells.y.push(pxy[q].1);
-                cells.dx.push(dxs[b]);
-                cells.dy.push(dys[b]);
-                cells.point.push(q as u32);
-                cells.rank.push(rank[b]);
-                cells.norm.push(a_over_n[q]);
-                cells.idx.push(b as u32);
-            }
-            gstart.push(cells.idx.len() as u32);
+            idx.extend(starts[q] as u32..starts[q + 1] as u32);
+            gstart.push(idx.len() as u32);
         }
-        let padded = cells.idx.len() + LANES;
-        cells.x.resize(padded, 0);
-        cells.y.resize(padded, 0);
-        cells.dx.resize(padded, 0);
-        cells.dy.resize(padded, 0);
-        cells.point.resize(padded, 0);
-        cells.rank.resize(padded, 0);
-        cells.norm.resize(padded, 0.0);
-        cells.idx.resize(padded, 0);
+        fn padded<T: Copy + Default>(idx: &[u32], f: impl Fn(usize) -> T) -> Vec<T> {
+            let mut v: Vec<T> = Vec::with_capacity(idx.len() + LANES);
+            v.extend(idx.iter().map(|&b| f(b as usize)));
+            v.resize(idx.len() + LANES, T::default());
+            v
+        }
+        let cells = Cells {
+            x: padded(&idx, |b| pxy[p_of[b] as usize].0),
+            y: padded(&idx, |b| pxy[p_of[b] as usize].1),
+            dx: padded(&idx, |b| dxs[b]),
+            dy: padded(&idx, |b| dys[b]),
+            point: padded(&idx, |b| p_of[b]),
+            rank: padded(&idx, |b| rank[b]),
+            norm: padded(&idx, |b| a_over_n[p_of[b] as usize]),
+            idx: padded(&idx, |b| b as u32),
+        };
+        let padded = cells.idx.len();
         let mut slot_of = vec![0u32; m];
         for (j, &b) in cells.idx[..padded - LANES].iter().enumerate() {
             slot_of[b as usize] = j as u32;
