@@ -547,6 +547,26 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
         .map(|&a| (neurons[a].xl.max(0), neurons[a].yl.max(0)))
         .collect();
     let grid = network::PointGrid::new(&cxy, half);
+    // The chosen matches' disparity, sub-pixel disparity and verdict in grid order: a window
+    // scan reads them in place (same positions, same order as `for_each_in_window`).
+    let g_dx: Vec<i32> = grid
+        .items
+        .iter()
+        .map(|&t| neurons[chosen[t as usize]].dx())
+        .collect();
+    let g_v: Vec<f32> = grid
+        .items
+        .iter()
+        .map(|&t| {
+            let b = &neurons[chosen[t as usize]];
+            b.dx() as f32 + b.sub
+        })
+        .collect();
+    let mut g_of = vec![0usize; chosen.len()];
+    for (g, &t) in grid.items.iter().enumerate() {
+        g_of[t as usize] = g;
+    }
+    let mut ok_g: Vec<bool> = grid.items.iter().map(|&t| ok[t as usize]).collect();
     let kxy: Vec<(i32, i32)> = cands.iter().map(|&c| cxy[c]).collect();
     let cand_grid = network::PointGrid::new(&kxy, half);
     // Round 1 tests every candidate; a later round only those with a point accepted in the
@@ -569,22 +589,23 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
                     let fails: [bool; 4] = std::array::from_fn(|h| n.halves_fail >> h & 1 == 1);
                     let mut all_agree = [true; 4];
                     sides.iter_mut().for_each(Vec::clear);
-                    grid.for_each_in_window((x, y), half, |t| {
-                        if !ok[t] {
-                            return;
-                        }
-                        let (qx, qy) = cxy[t];
-                        let b = &neurons[chosen[t]];
-                        let agree = (b.dx() - d).abs() <= p.agree_tol;
-                        let v = b.dx() as f32 + b.sub;
-                        for (h, on_side) in [qx < x, qx > x, qy < y, qy > y].into_iter().enumerate()
-                        {
-                            if fails[h] && on_side {
-                                all_agree[h] &= agree;
-                                sides[h].push(v);
+                    for (s, e) in grid.ranges(x, y) {
+                        for g in s..e {
+                            let (qx, qy) = (grid.xs[g], grid.ys[g]);
+                            if !ok_g[g] || (qx - x).abs() > half || (qy - y).abs() > half {
+                                continue;
+                            }
+                            let agree = (g_dx[g] - d).abs() <= p.agree_tol;
+                            for (h, on_side) in
+                                [qx < x, qx > x, qy < y, qy > y].into_iter().enumerate()
+                            {
+                                if fails[h] && on_side {
+                                    all_agree[h] &= agree;
+                                    sides[h].push(g_v[g]);
+                                }
                             }
                         }
-                    });
+                    }
                     let pass = (0..4).filter(|&h| fails[h]).all(|h| {
                         all_agree[h]
                             && sides[h].len() >= p.rescue_min
@@ -600,6 +621,7 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
         }
         for &k in &added {
             ok[cands[k]] = true;
+            ok_g[g_of[cands[k]]] = true;
         }
         let mut near = vec![false; cands.len()];
         for &k in &added {
