@@ -424,16 +424,23 @@ fn candidates(
     per_task.concat()
 }
 
+/// Median (mean of the two middle values for an even count; 0 if empty), by selection: the
+/// values of a full sort, in linear time. Reorders `v`.
 fn median(v: &mut [f32]) -> f32 {
     if v.is_empty() {
         return 0.0;
     }
-    v.sort_by(f32::total_cmp);
     let n = v.len();
+    let (lower, &mut mid, _) = v.select_nth_unstable_by(n / 2, f32::total_cmp);
     if n % 2 == 1 {
-        v[n / 2]
+        mid
     } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
+        let below = lower
+            .iter()
+            .copied()
+            .max_by(f32::total_cmp)
+            .expect("n >= 2");
+        0.5 * (below + mid)
     }
 }
 
@@ -458,8 +465,14 @@ fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usi
         }
         a = e;
     }
-    let mut all_dy: Vec<f32> = singles.iter().map(|&s| neurons[s].dy() as f32).collect();
-    let global = median(&mut all_dy);
+    // Fallback reference of a window without single matches, computed when first needed.
+    let global = std::sync::OnceLock::new();
+    let global = || {
+        *global.get_or_init(|| {
+            let mut all_dy: Vec<f32> = singles.iter().map(|&s| neurons[s].dy() as f32).collect();
+            median(&mut all_dy)
+        })
+    };
     let half = p.weights.nbr_half.max(1);
     let sxy: Vec<(i32, i32)> = singles
         .iter()
@@ -474,7 +487,7 @@ fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usi
             v.push(neurons[singles[k]].dy() as f32)
         });
         if v.is_empty() {
-            global
+            global()
         } else {
             median(&mut v)
         }
@@ -670,20 +683,22 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
             }
         })
         .collect();
-    // Right pixels held by an active neuron: (yr, xr) -> its left point (u32::MAX: several).
-    let mut held: HashMap<(i32, i32), u32> = HashMap::new();
-    for (n, _) in neurons.iter().zip(state).filter(|&(_, &v)| v == 1) {
-        held.entry((n.yr, n.xr))
-            .and_modify(|q| {
-                if *q != n.point {
-                    *q = u32::MAX
-                }
-            })
-            .or_insert(n.point);
+    // Right pixels held by an active neuron: its left point (FREE: none, SEVERAL: several).
+    const FREE: u32 = u32::MAX;
+    const SEVERAL: u32 = u32::MAX - 1;
+    let mut held = vec![FREE; net.n_right_pixels()];
+    for (a, n) in neurons.iter().enumerate().filter(|&(a, _)| state[a] == 1) {
+        let h = &mut held[net.right_pixel(a)];
+        if *h == FREE {
+            *h = n.point;
+        } else if *h != n.point {
+            *h = SEVERAL;
+        }
     }
     for (&(a, _), &weak) in groups.iter().zip(&weak) {
         let n = &neurons[a];
-        let free = held.get(&(n.yr, n.xr)).is_none_or(|&q| q == n.point);
+        let h = held[net.right_pixel(a)];
+        let free = h == FREE || h == n.point;
         if weak && free {
             out[a] = 1;
         }

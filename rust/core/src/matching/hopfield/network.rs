@@ -949,6 +949,17 @@ impl Network {
         }
     }
 
+    /// The rank of neuron `a`'s right pixel among the distinct right pixels (`0..`
+    /// [`Network::n_right_pixels`]).
+    pub fn right_pixel(&self, a: usize) -> usize {
+        self.rank[a] as usize
+    }
+
+    /// Number of distinct right pixels of the neurons.
+    pub fn n_right_pixels(&self) -> usize {
+        self.rank.iter().max().map_or(0, |&r| r as usize + 1)
+    }
+
     /// `state` (0/1 per neuron) in strip order, as `f32` factors of the lanes (padding 0).
     pub fn lane_state(&self, state: &[u8]) -> Vec<f32> {
         let n = self.cells.idx.len() - LANES;

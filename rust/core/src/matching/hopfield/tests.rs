@@ -208,3 +208,25 @@ fn csr_rows_hold_every_pair_of_the_window_once() {
         assert_eq!(got, want, "row {a}");
     }
 }
+
+#[test]
+fn median_by_selection_equals_the_sorted_median() {
+    let mut rng = SplitMix64::new(5);
+    for n in 0..40 {
+        let v: Vec<f32> = (0..n)
+            .map(|_| ((rng.next_u64() % 41) as f32 - 20.0) * 0.25)
+            .collect();
+        let mut sorted = v.clone();
+        sorted.sort_by(f32::total_cmp);
+        let want = match n {
+            0 => 0.0,
+            _ if n % 2 == 1 => sorted[n / 2],
+            _ => 0.5 * (sorted[n / 2 - 1] + sorted[n / 2]),
+        };
+        assert_eq!(
+            super::median(&mut v.clone()).to_bits(),
+            want.to_bits(),
+            "n = {n}"
+        );
+    }
+}
