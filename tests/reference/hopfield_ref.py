@@ -48,6 +48,7 @@ DEFAULTS = {
     "fallback": True,
     "fallback_alt_support": 2.0,
     "fallback_min_support": 0.5,
+    "fallback_group": True,
     "min_agree": 8,
     "agree_tol": 1,
     "agree_share": 0.8,
@@ -328,7 +329,9 @@ def _fallback(neurons: list[dict], rows: list[list[tuple[int, float]]], v: np.nd
     """Final selection's fallback: a point without an active candidate gets its best one back
     when an active alternative has support < fallback_alt_support (or, with none active, the
     best has support >= fallback_min_support) and no other point's active neuron holds the
-    right pixel. Support = sum of the positive weights from active neurons."""
+    right pixel. Support = sum of the positive weights from active neurons. With fallback_group,
+    also an unsupported point whose one candidate passed the edge test, when more than
+    min_agree such points (itself included) in its window agree with it."""
     if not p["fallback"]:
         return v
     out = v.copy()
@@ -339,18 +342,40 @@ def _fallback(neurons: list[dict], rows: list[list[tuple[int, float]]], v: np.nd
     groups: dict[int, list[int]] = {}
     for a, n in enumerate(neurons):
         groups.setdefault(n["point"], []).append(a)
+    weak: dict[int, bool] = {}
     for q, g in groups.items():
         a = g[0]  # best ZNCC first
         if v[a]:
             continue
         alt = [support[b] for b in g[1:] if v[b]]
-        weak = (
+        weak[q] = (
             max(alt) < float(np.float32(p["fallback_alt_support"]))
             if alt
             else support[a] >= float(np.float32(p["fallback_min_support"]))
         )
+    if p["fallback_group"]:
+        # Thin surfaces: unsupported points with one edge-clean candidate fall back when more
+        # than min_agree of them (itself included) in the window agree within agree_tol.
+        lone = [q for q, w in weak.items() if not w and len(groups[q]) == 1]
+        lone = [q for q in lone if neurons[groups[q][0]]["edge_ok"]]
+        half = p["nbr_half"]
+        coherent = []
+        for q in lone:
+            n = neurons[groups[q][0]]
+            d = n["xl"] - n["xr"]
+            agree = 0
+            for r in lone:
+                m = neurons[groups[r][0]]
+                near = abs(m["xl"] - n["xl"]) <= half and abs(m["yl"] - n["yl"]) <= half
+                agree += near and abs((m["xl"] - m["xr"]) - d) <= p["agree_tol"]
+            if agree > p["min_agree"]:
+                coherent.append(q)
+        for q in coherent:
+            weak[q] = True
+    for q, w in weak.items():
+        a = groups[q][0]
         free = held.get((neurons[a]["xr"], neurons[a]["yr"]), set()) <= {q}
-        if weak and free:
+        if w and free:
             out[a] = 1
     return out
 

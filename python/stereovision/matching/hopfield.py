@@ -68,6 +68,7 @@ DEFAULTS: dict[str, Any] = {
     "fallback": True,  # final selection: weakly dropped points keep their best candidate ...
     "fallback_alt_support": 2.0,  # ... if an active alternative has support below this
     "fallback_min_support": 0.5,  # ... or (no active alternative) it has support >= this
+    "fallback_group": True,  # ... or >= min_agree such unsupported single-candidate points agree
     "min_agree": 8,  # agreeing neighbour matches in the 40x40 window (C.10)
     "agree_tol": 1,  # neighbours agree within +-1 px
     "agree_share": 0.8,  # sparse areas: this share of the (< 8) neighbour matches agrees ...
@@ -223,7 +224,7 @@ def hopfield_match(
         ``edge_margin`` (ZNCC), ``edge_penalty``,
         ``centre_tol`` (window-mean-free grey levels in [0, 1]), ``rescue_min``,
         ``rescue_med`` (px), ``fallback``, ``fallback_alt_support``,
-        ``fallback_min_support``, ``min_agree``, ``agree_tol`` (px),
+        ``fallback_min_support``, ``fallback_group``, ``min_agree``, ``agree_tol`` (px),
         ``agree_share``, ``min_agree_sparse``, ``subpixel``.
 
     Returns

@@ -17,10 +17,11 @@ use crate::convert::{image_from_numpy, image_to_numpy};
 use crate::errors::guard;
 use crate::params::{check_keys, get};
 
-const KEYS: [&str; 40] = [
+const KEYS: [&str; 41] = [
     "fallback",
     "fallback_alt_support",
     "fallback_min_support",
+    "fallback_group",
     "compat_grad",
     "rescue_min",
     "rescue_med",
@@ -105,6 +106,7 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
     get(d, "fallback", &mut p.fallback)?;
     get(d, "fallback_alt_support", &mut p.fallback_alt_support)?;
     get(d, "fallback_min_support", &mut p.fallback_min_support)?;
+    get(d, "fallback_group", &mut p.fallback_group)?;
     get(d, "rescue_min", &mut p.rescue_min)?;
     get(d, "rescue_med", &mut p.rescue_med)?;
     get(d, "min_agree", &mut p.min_agree)?;

@@ -111,6 +111,11 @@ pub struct HopfieldParams {
     pub fallback_alt_support: f32,
     /// See [`HopfieldParams::fallback`] (0.5).
     pub fallback_min_support: f32,
+    /// Fallback of thin surfaces: a point left with nothing whose only candidate passed the
+    /// depth-edge test, with no support, falls back too when at least `min_agree` other such
+    /// points in its window agree with it within `agree_tol` (the network's 40x40 window
+    /// inhibits a surface narrower than itself: wood2's strip at d = 24, 25 correct matches).
+    pub fallback_group: bool,
     /// Agreeing neighbour matches required in the 40x40 window (C.10: 8).
     pub min_agree: usize,
     /// Sparse-area alternative to `min_agree`: this share of the neighbour matches agrees
@@ -151,6 +156,7 @@ impl Default for HopfieldParams {
             fallback: true,
             fallback_alt_support: 2.0,
             fallback_min_support: 0.5,
+            fallback_group: true,
             min_agree: 8,
             agree_tol: 1,
             agree_share: 0.8,
@@ -683,6 +689,48 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
             }
         })
         .collect();
+    let mut weak = weak;
+    if p.fallback_group {
+        // Thin surfaces: points the network left with nothing (one candidate, edge test passed,
+        // no support) because the window's dominant surface inhibits them. Where at least
+        // `min_agree` other such points in the window agree with one (within `agree_tol`),
+        // they are a surface of their own, the evidence the final agreement filter asks for.
+        let lone: Vec<usize> = (0..groups.len())
+            .filter(|&g| {
+                let (a, e) = groups[g];
+                !weak[g] && e - a == 1 && neurons[a].edge_ok
+            })
+            .collect();
+        let half = p.weights.nbr_half.max(1);
+        let lxy: Vec<(i32, i32)> = lone
+            .iter()
+            .map(|&g| {
+                (
+                    neurons[groups[g].0].xl.max(0),
+                    neurons[groups[g].0].yl.max(0),
+                )
+            })
+            .collect();
+        let grid = network::PointGrid::new(&lxy, half);
+        let mut ld: Vec<i32> = grid
+            .items
+            .iter()
+            .map(|&t| neurons[groups[lone[t as usize]].0].dx())
+            .collect();
+        ld.resize(grid.xs.len(), 0); // padded like the grid's coordinates
+        let coherent: Vec<bool> = lone
+            .par_iter()
+            .zip(&lxy)
+            .map(|(&g, &xy)| {
+                let d = neurons[groups[g].0].dx();
+                // The count includes the point itself.
+                grid.count_in_window(xy, half, &ld, d, p.agree_tol).1 > p.min_agree
+            })
+            .collect();
+        for (&g, &c) in lone.iter().zip(&coherent) {
+            weak[g] |= c;
+        }
+    }
     // Right pixels held by an active neuron: its left point (FREE: none, SEVERAL: several).
     const FREE: u32 = u32::MAX;
     const SEVERAL: u32 = u32::MAX - 1;
