@@ -452,7 +452,7 @@ fn median(v: &mut [f32]) -> f32 {
 
 /// C.5 disambiguation: indices of the kept active neurons (at most one per left point and one
 /// per right pixel).
-fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usize> {
+fn disambiguate(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams) -> Vec<usize> {
     // Active neurons per left point (neurons are grouped by point): singles kept as they are.
     let m = neurons.len();
     let mut singles: Vec<usize> = Vec::new();
@@ -480,16 +480,22 @@ fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usi
         })
     };
     let half = p.weights.nbr_half.max(1);
-    let sxy: Vec<(i32, i32)> = singles
-        .iter()
-        .map(|&s| (neurons[s].xl.max(0), neurons[s].yl.max(0)))
-        .collect();
-    let grid = network::PointGrid::new(&sxy, half);
+    // The singles' grid, built when a conflict first needs it (most scenes have few).
+    let grid = std::sync::OnceLock::new();
+    let grid = || {
+        grid.get_or_init(|| {
+            let sxy: Vec<(i32, i32)> = singles
+                .iter()
+                .map(|&s| (neurons[s].xl.max(0), neurons[s].yl.max(0)))
+                .collect();
+            network::PointGrid::new(&sxy, half)
+        })
+    };
     // Reference vertical disparity: median over the single matches in the 40x40 window.
     let local_ref = |a: usize| -> f32 {
         let n = &neurons[a];
         let mut v: Vec<f32> = Vec::new();
-        grid.for_each_in_window((n.xl.max(0), n.yl.max(0)), half, |k| {
+        grid().for_each_in_window((n.xl.max(0), n.yl.max(0)), half, |k| {
             v.push(neurons[singles[k]].dy() as f32)
         });
         if v.is_empty() {
@@ -516,25 +522,18 @@ fn disambiguate(neurons: &[Neuron], state: &[u8], p: &HopfieldParams) -> Vec<usi
     let mut kept = singles.clone();
     let picked: Vec<usize> = ambiguous.par_iter().filter_map(|g| pick(g)).collect();
     kept.extend(picked);
-    // The same rule on the right side (neurons sharing a right pixel).
-    let kept: Vec<usize> = network::right_pixel_order(neurons, kept)
-        .into_iter()
-        .map(|a| a as usize)
-        .collect();
-    let mut out: Vec<usize> = Vec::with_capacity(kept.len());
-    let mut i = 0;
-    while i < kept.len() {
-        let key = (neurons[kept[i]].yr, neurons[kept[i]].xr);
-        let mut j = i;
-        while j < kept.len() && (neurons[kept[j]].yr, neurons[kept[j]].xr) == key {
-            j += 1;
-        }
-        if j - i == 1 {
-            out.push(kept[i]);
-        } else if let Some(a) = pick(&kept[i..j]) {
-            out.push(a);
-        }
-        i = j;
+    // The same rule on the right side (neurons sharing a right pixel, by the network's
+    // right-pixel rank): a pixel held once keeps its match, a conflict is picked as above
+    // (`pick` depends on the group's members only, not on their order).
+    let mut held = vec![0u32; net.n_right_pixels()];
+    for &a in &kept {
+        held[net.right_pixel(a)] += 1;
+    }
+    let (mut out, mut conflicts): (Vec<usize>, Vec<usize>) =
+        kept.iter().partition(|&&a| held[net.right_pixel(a)] == 1);
+    conflicts.sort_unstable_by_key(|&a| (net.right_pixel(a), a));
+    for group in conflicts.chunk_by(|&a, &b| net.right_pixel(a) == net.right_pixel(b)) {
+        out.extend(pick(group));
     }
     out.sort_unstable();
     out
@@ -861,7 +860,7 @@ pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result
     let init = initial_state(&neurons, p);
     let dynamics = run_dynamics(&net, &input, &init, p.seed, p.max_sweeps);
     let selected = fallback(&neurons, &net, &dynamics.state, p);
-    let chosen = disambiguate(&neurons, &selected, p);
+    let chosen = disambiguate(&neurons, &net, &selected, p);
     let matches = finish(left, right, &neurons, &chosen, p);
     Ok(HopfieldOutput {
         matches,

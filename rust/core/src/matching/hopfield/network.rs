@@ -412,6 +412,7 @@ pub struct Network {
     by_right: Vec<u32>,
     group: Vec<(u32, u32)>,
     rank: Vec<u32>,
+    n_rpix: usize,
     /// Per point: the `cells` ranges of its window, one per strip of rows it touches.
     wranges: Vec<[(u32, u32); MAX_STRIPS]>,
     cells: Cells,
@@ -939,6 +940,7 @@ impl Network {
             by_right,
             group,
             rank,
+            n_rpix: n_groups as usize,
             wranges,
             cells,
             slot_of,
@@ -957,7 +959,7 @@ impl Network {
 
     /// Number of distinct right pixels of the neurons.
     pub fn n_right_pixels(&self) -> usize {
-        self.rank.iter().max().map_or(0, |&r| r as usize + 1)
+        self.n_rpix
     }
 
     /// `state` (0/1 per neuron) in strip order, as `f32` factors of the lanes (padding 0).
