@@ -82,7 +82,7 @@ fn bench(c: &mut Criterion) {
         g.bench_with_input(
             BenchmarkId::new("candidates", &id),
             &(&l, &r),
-            |b, (l, r)| b.iter(|| candidate_neurons(l, r, &p).expect("valid input")),
+            |b, (l, r)| b.iter(|| candidate_neurons(*l, *r, &p).expect("valid input")),
         );
         let (_, neurons) = candidate_neurons(&l, &r, &p).expect("valid input");
         let net = Network::new(&neurons, &p.weights);

@@ -86,6 +86,26 @@ impl<'a> ImageView<'a> {
     }
 }
 
+impl<'a> From<&'a Image> for ImageView<'a> {
+    fn from(img: &'a Image) -> Self {
+        img.view()
+    }
+}
+
+impl<'a> From<&ImageView<'a>> for ImageView<'a> {
+    fn from(v: &ImageView<'a>) -> Self {
+        *v
+    }
+}
+
+impl ImageView<'_> {
+    /// Value at `(x, y)`; the caller guarantees bounds.
+    #[inline]
+    pub fn at(&self, x: usize, y: usize) -> f32 {
+        self.data[y * self.width + x]
+    }
+}
+
 impl Image {
     /// A borrowed view (already checked: an `Image` is valid by construction).
     pub fn view(&self) -> ImageView<'_> {

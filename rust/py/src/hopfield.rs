@@ -13,7 +13,7 @@ use stereovision_core::matching::hopfield::{
     interest::select_points, moravec, CandidateMode, HopfieldOutput, HopfieldParams,
 };
 
-use crate::convert::{image_from_numpy, image_to_numpy};
+use crate::convert::{grey_from_numpy, image_to_numpy};
 use crate::errors::guard;
 use crate::params::{check_keys, get};
 
@@ -133,7 +133,8 @@ pub fn hopfield_interest<'py>(
     Bound<'py, PyArray2<i32>>,
     Bound<'py, PyArray1<f32>>,
 )> {
-    let im = image_from_numpy(&img, "image")?;
+    let im = grey_from_numpy(&img, "image")?;
+    let im = im.view();
     let unit = |v: f32| v.is_finite() && (0.0..=1.0).contains(&v);
     if !unit(rel_threshold) || !unit(floor_rel) || nms_half == 0 {
         return Err(PyValueError::new_err(
@@ -209,8 +210,12 @@ pub fn hopfield_match<'py>(
     right: PyReadonlyArray2<'py, f32>,
     params: &Bound<'py, PyDict>,
 ) -> PyResult<MatchOut<'py>> {
-    let l = image_from_numpy(&left, "left")?;
-    let r = image_from_numpy(&right, "right")?;
+    // The arrays' own buffers (no copy: the wrappers pass C-contiguous arrays).
+    let (l, r) = (
+        grey_from_numpy(&left, "left")?,
+        grey_from_numpy(&right, "right")?,
+    );
+    let (l, r) = (l.view(), r.view());
     let p = self::params(params)?;
     let mut method = String::from("hopfield");
     get(params, "method", &mut method)?;
@@ -242,8 +247,12 @@ pub fn hopfield_candidates<'py>(
     right: PyReadonlyArray2<'py, f32>,
     params: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let l = image_from_numpy(&left, "left")?;
-    let r = image_from_numpy(&right, "right")?;
+    // The arrays' own buffers (no copy: the wrappers pass C-contiguous arrays).
+    let (l, r) = (
+        grey_from_numpy(&left, "left")?,
+        grey_from_numpy(&right, "right")?,
+    );
+    let (l, r) = (l.view(), r.view());
     let p = self::params(params)?;
     let (_, neurons) =
         py.detach(|| guard("hopfield_candidates", || candidate_neurons(&l, &r, &p)))?;

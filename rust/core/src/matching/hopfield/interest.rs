@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 
-use crate::image::Image;
+use crate::image::ImageView;
 use crate::simd::simd_fn;
 
 /// Half-size of the Moravec window (5x5, the paper's size).
@@ -107,7 +107,8 @@ fn min_row(hs: &[[&[f32]; RING]; 4], out: &mut [f32]) {
 /// The Moravec interest map `M` (f32, row-major `(H, W)`); 0 within [`BORDER`] px of the edge.
 /// Row bands in parallel; every value is computed in the fixed order of the module docs, so the
 /// map does not depend on the thread count.
-pub fn moravec(img: &Image) -> Vec<f32> {
+pub fn moravec<'a>(img: impl Into<ImageView<'a>>) -> Vec<f32> {
+    let img = &img.into();
     let (w, h) = img.size();
     let mut out = vec![0.0f32; w * h];
     if w < 2 * BORDER + 1 || h < 2 * BORDER + 1 {
@@ -155,7 +156,11 @@ pub fn moravec(img: &Image) -> Vec<f32> {
 /// neighbourhood (strictly greater than neighbours earlier in raster order, at least as large as
 /// later ones), with `M > 0` and `M >= max(rel_threshold * max_tile(M), floor_rel * max(M))`;
 /// raster order.
-pub fn interest_points(img: &Image, p: &InterestParams) -> Vec<InterestPoint> {
+pub fn interest_points<'a>(
+    img: impl Into<ImageView<'a>>,
+    p: &InterestParams,
+) -> Vec<InterestPoint> {
+    let img = img.into();
     let m = moravec(img);
     let (w, h) = img.size();
     select_points(&m, w, h, p)

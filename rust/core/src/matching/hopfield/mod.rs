@@ -32,7 +32,7 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use crate::error::{CoreError, Result};
-use crate::image::{check_pair, Image};
+use crate::image::ImageView;
 pub use interest::{interest_points, moravec, InterestParams, InterestPoint};
 pub use network::{
     build_weights, run_dynamics, Csr, Dynamics, EnergyWeights, Network, Neuron, Weights,
@@ -195,8 +195,13 @@ pub struct HopfieldOutput {
     pub n_selected: usize,
 }
 
-fn validate(left: &Image, right: &Image, p: &HopfieldParams) -> Result<()> {
-    check_pair(left, right)?;
+fn validate(left: &ImageView<'_>, right: &ImageView<'_>, p: &HopfieldParams) -> Result<()> {
+    if left.size() != right.size() {
+        return Err(CoreError::SizeMismatch {
+            left: left.size(),
+            right: right.size(),
+        });
+    }
     if p.d_max < p.d_min {
         return Err(CoreError::param(
             "max_disparity",
@@ -253,7 +258,7 @@ fn validate(left: &Image, right: &Image, p: &HopfieldParams) -> Result<()> {
 }
 
 /// Rows of the right image holding right interest points (points mode).
-fn right_rows(right: &Image, p: &HopfieldParams) -> HashMap<usize, Vec<usize>> {
+fn right_rows(right: &ImageView<'_>, p: &HopfieldParams) -> HashMap<usize, Vec<usize>> {
     let mut rows: HashMap<usize, Vec<usize>> = HashMap::new();
     if p.candidates == CandidateMode::Points {
         for rp in interest_points(right, &p.interest) {
@@ -288,8 +293,8 @@ struct CandScratch {
 /// `k_cand`), with their depth-edge verdict and sub-pixel offset.
 #[allow(clippy::too_many_arguments)]
 fn point_candidates(
-    left: &Image,
-    right: &Image,
+    left: &ImageView<'_>,
+    right: &ImageView<'_>,
     stats: &RightStats,
     rows: &HashMap<usize, Vec<usize>>,
     p: &HopfieldParams,
@@ -390,8 +395,8 @@ fn point_candidates(
 /// with their depth-edge verdict and sub-pixel offset. Points are processed in fixed chunks
 /// whose outputs are concatenated in order: the result does not depend on the thread count.
 fn candidates(
-    left: &Image,
-    right: &Image,
+    left: &ImageView<'_>,
+    right: &ImageView<'_>,
     pts: &[InterestPoint],
     p: &HopfieldParams,
 ) -> Vec<Neuron> {
@@ -755,8 +760,8 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
 
 /// Depth-edge filters and sub-pixel refinement of the selected neurons.
 fn finish(
-    left: &Image,
-    right: &Image,
+    left: &ImageView<'_>,
+    right: &ImageView<'_>,
     neurons: &[Neuron],
     chosen: &[usize],
     p: &HopfieldParams,
@@ -818,11 +823,12 @@ fn finish(
 }
 
 /// Interest points and candidate neurons (exposed for tests and the reference comparison).
-pub fn candidate_neurons(
-    left: &Image,
-    right: &Image,
+pub fn candidate_neurons<'a>(
+    left: impl Into<ImageView<'a>>,
+    right: impl Into<ImageView<'a>>,
     p: &HopfieldParams,
 ) -> Result<(Vec<InterestPoint>, Vec<Neuron>)> {
+    let (left, right) = (&left.into(), &right.into());
     validate(left, right, p)?;
     let pts = interest_points(left, &p.interest);
     let neurons = candidates(left, right, &pts, p);
@@ -843,7 +849,12 @@ pub fn initial_state(neurons: &[Neuron], p: &HopfieldParams) -> Vec<u8> {
 }
 
 /// The Hopfield channel: interest points matched by energy minimisation (see the module docs).
-pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result<HopfieldOutput> {
+pub fn hopfield_match<'a>(
+    left: impl Into<ImageView<'a>>,
+    right: impl Into<ImageView<'a>>,
+    p: &HopfieldParams,
+) -> Result<HopfieldOutput> {
+    let (left, right) = (&left.into(), &right.into());
     let (pts, neurons) = candidate_neurons(left, right, p)?;
     let net = Network::new(&neurons, &p.weights);
     let input: Vec<f64> = neurons
@@ -876,7 +887,12 @@ pub fn hopfield_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result
 
 /// The best-match reference: same points, candidates and filters, no network (the best ZNCC
 /// candidate of every point).
-pub fn best_match(left: &Image, right: &Image, p: &HopfieldParams) -> Result<HopfieldOutput> {
+pub fn best_match<'a>(
+    left: impl Into<ImageView<'a>>,
+    right: impl Into<ImageView<'a>>,
+    p: &HopfieldParams,
+) -> Result<HopfieldOutput> {
+    let (left, right) = (&left.into(), &right.into());
     let (pts, neurons) = candidate_neurons(left, right, p)?;
     let mut chosen = Vec::new();
     for (a, n) in neurons.iter().enumerate() {

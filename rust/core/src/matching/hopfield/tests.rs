@@ -1,5 +1,6 @@
 use super::network::SplitMix64;
 use super::*;
+use crate::image::Image;
 
 /// Smooth deterministic texture (3x3 box of hashed noise), `w x h`.
 fn texture(w: usize, h: usize, seed: u64) -> Vec<f32> {

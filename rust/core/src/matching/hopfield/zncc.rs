@@ -12,7 +12,7 @@
 
 use rayon::prelude::*;
 
-use crate::image::Image;
+use crate::image::ImageView;
 use crate::simd::{has_avx2, simd_fn};
 
 /// Similarity window half-size (7x7, C.10).
@@ -252,7 +252,7 @@ fn region_row<const L: bool, const C: bool, const R: bool>(args: RegionArgs<'_>)
 
 impl RightStats {
     /// Statistics of every row of `img` (bands of rows in parallel).
-    pub fn new(img: &Image) -> Self {
+    pub fn new(img: &ImageView<'_>) -> Self {
         let (w, h) = img.size();
         let stride = w + LANES;
         let row_len = 2 * N_REGIONS * stride;
@@ -274,7 +274,7 @@ impl RightStats {
     }
 
     /// Recomputes `self` for the rows `y_lo..y_hi` of `img` only (reusing its buffers).
-    pub fn fill_band(&mut self, img: &Image, y_lo: usize, y_hi: usize) {
+    pub fn fill_band(&mut self, img: &ImageView<'_>, y_lo: usize, y_hi: usize) {
         let (w, h) = img.size();
         let y_hi = y_hi.min(h);
         let y_lo = y_lo.min(y_hi);
@@ -312,7 +312,13 @@ impl RightStats {
 
 /// Statistics of image rows `y_lo..y_hi` into `chunk` (`2 * N_REGIONS * (W + LANES)` values
 /// per row), every value written: zeros where the window does not fit and in the padding.
-fn fill_rows(img: &Image, y_lo: usize, y_hi: usize, s: &mut StatsScratch, chunk: &mut [f32]) {
+fn fill_rows(
+    img: &ImageView<'_>,
+    y_lo: usize,
+    y_hi: usize,
+    s: &mut StatsScratch,
+    chunk: &mut [f32],
+) {
     let (w, h) = img.size();
     let stride = w + LANES;
     let row_len = 2 * N_REGIONS * stride;
@@ -392,8 +398,8 @@ pub struct Curves {
 /// that rows `y` and `yr` are at least `SIM_RADIUS` from the top and bottom.
 #[allow(clippy::too_many_arguments)]
 pub fn zncc_curves(
-    left: &Image,
-    right: &Image,
+    left: &ImageView<'_>,
+    right: &ImageView<'_>,
     stats: &RightStats,
     x: usize,
     y: usize,
@@ -408,8 +414,8 @@ pub fn zncc_curves(
 #[allow(clippy::too_many_arguments)]
 fn curves_with(
     avx2: bool,
-    left: &Image,
-    right: &Image,
+    left: &ImageView<'_>,
+    right: &ImageView<'_>,
     stats: &RightStats,
     x: usize,
     y: usize,
@@ -791,6 +797,7 @@ impl std::ops::Add for Lanes {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::image::Image;
 
     #[test]
     fn avx2_and_portable_curves_are_bit_identical() {
@@ -806,7 +813,9 @@ mod tests {
         };
         let (w, h) = (90, 20);
         let left = Image::new(w, h, (0..w * h).map(|_| next()).collect()).expect("valid");
+        let left = left.view();
         let right = Image::new(w, h, (0..w * h).map(|_| next()).collect()).expect("valid");
+        let right = right.view();
         let stats = RightStats::new(&right);
         let (mut a, mut b) = (Curves::default(), Curves::default());
         // Full and partial last blocks, spans ending at the image's last pixel (the copy).
@@ -864,6 +873,7 @@ mod tests {
             .map(|i| ((i * 7919) % 251) as f32 / 250.0)
             .collect();
         let img = Image::new(w, h, data).expect("valid");
+        let img = img.view();
         let full = RightStats::new(&img);
         let mut band = RightStats::default();
         band.fill_band(&img, 9, 17);
