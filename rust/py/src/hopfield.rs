@@ -150,7 +150,7 @@ pub fn hopfield_interest<'py>(
     };
     let (m, pts) = py.detach(|| {
         guard("hopfield_interest", || {
-            let m = moravec(&im);
+            let m = moravec(im);
             let pts = select_points(&m, w, h, &p);
             Ok((m, pts))
         })
