@@ -227,8 +227,8 @@ pub fn hopfield_match<'py>(
         )));
     }
     let out = match method.as_str() {
-        "hopfield" => py.detach(|| guard("hopfield_match", || core_match(&l, &r, &p)))?,
-        "best" => py.detach(|| guard("hopfield_match", || core_best(&l, &r, &p)))?,
+        "hopfield" => py.detach(|| guard("hopfield_match", || core_match(l, r, &p)))?,
+        "best" => py.detach(|| guard("hopfield_match", || core_best(l, r, &p)))?,
         other => {
             return Err(PyValueError::new_err(format!(
                 "method must be 'hopfield' or 'best', got {other:?}"
@@ -255,7 +255,7 @@ pub fn hopfield_candidates<'py>(
     let (l, r) = (l.view(), r.view());
     let p = self::params(params)?;
     let (_, neurons) =
-        py.detach(|| guard("hopfield_candidates", || candidate_neurons(&l, &r, &p)))?;
+        py.detach(|| guard("hopfield_candidates", || candidate_neurons(l, r, &p)))?;
     let flat: Vec<f32> = neurons
         .iter()
         .flat_map(|n| {
