@@ -598,47 +598,56 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
     loop {
         // Candidates are tested independently within a round (in parallel, kept in order),
         // against the matches accepted before the round.
-        let added: Vec<usize> = to_test
-            .par_iter()
-            .map_init(
-                || std::array::from_fn::<Vec<f32>, 4, _>(|_| Vec::new()),
-                |sides, &k| {
-                    let c = cands[k];
-                    let n = &neurons[chosen[c]];
-                    let (x, y, d) = (cxy[c].0, cxy[c].1, n.dx());
-                    let dsub = d as f32 + n.sub;
-                    // One pass over the window fills the side sets of every failing half (in
-                    // window order, as one pass per half would).
-                    let fails: [bool; 4] = std::array::from_fn(|h| n.halves_fail >> h & 1 == 1);
-                    let mut all_agree = [true; 4];
-                    sides.iter_mut().for_each(Vec::clear);
-                    for (s, e) in grid.ranges(x, y) {
-                        for g in s..e {
-                            let (qx, qy) = (grid.xs[g], grid.ys[g]);
-                            if !ok_g[g] || (qx - x).abs() > half || (qy - y).abs() > half {
-                                continue;
-                            }
-                            let agree = (g_dx[g] - d).abs() <= p.agree_tol;
-                            for (h, on_side) in
-                                [qx < x, qx > x, qy < y, qy > y].into_iter().enumerate()
-                            {
-                                if fails[h] && on_side {
-                                    all_agree[h] &= agree;
-                                    sides[h].push(g_v[g]);
-                                }
-                            }
+        let test = |sides: &mut [Vec<f32>; 4], k: usize| -> bool {
+            let c = cands[k];
+            let n = &neurons[chosen[c]];
+            let (x, y, d) = (cxy[c].0, cxy[c].1, n.dx());
+            let dsub = d as f32 + n.sub;
+            // One pass over the window fills the side sets of every failing half (in
+            // window order, as one pass per half would).
+            let fails: [bool; 4] = std::array::from_fn(|h| n.halves_fail >> h & 1 == 1);
+            let mut all_agree = [true; 4];
+            sides.iter_mut().for_each(Vec::clear);
+            for (s, e) in grid.ranges(x, y) {
+                for g in s..e {
+                    let (qx, qy) = (grid.xs[g], grid.ys[g]);
+                    if !ok_g[g] || (qx - x).abs() > half || (qy - y).abs() > half {
+                        continue;
+                    }
+                    let agree = (g_dx[g] - d).abs() <= p.agree_tol;
+                    for (h, on_side) in [qx < x, qx > x, qy < y, qy > y].into_iter().enumerate() {
+                        if fails[h] && on_side {
+                            all_agree[h] &= agree;
+                            sides[h].push(g_v[g]);
                         }
                     }
-                    let pass = (0..4).filter(|&h| fails[h]).all(|h| {
-                        all_agree[h]
-                            && sides[h].len() >= p.rescue_min
-                            && (median(&mut sides[h]) - dsub).abs() <= p.rescue_med
-                    });
-                    pass.then_some(k)
-                },
-            )
-            .flatten()
-            .collect();
+                }
+            }
+            let pass = (0..4).filter(|&h| fails[h]).all(|h| {
+                all_agree[h]
+                    && sides[h].len() >= p.rescue_min
+                    && (median(&mut sides[h]) - dsub).abs() <= p.rescue_med
+            });
+            pass
+        };
+        // Small rounds (the later ones) run on this thread: no dispatch to the pool.
+        let added: Vec<usize> = if to_test.len() < 256 {
+            let mut sides = std::array::from_fn(|_| Vec::new());
+            to_test
+                .iter()
+                .copied()
+                .filter(|&k| test(&mut sides, k))
+                .collect()
+        } else {
+            to_test
+                .par_iter()
+                .map_init(
+                    || std::array::from_fn::<Vec<f32>, 4, _>(|_| Vec::new()),
+                    |sides, &k| test(sides, k).then_some(k),
+                )
+                .flatten()
+                .collect()
+        };
         if added.is_empty() {
             return ok;
         }
