@@ -623,12 +623,11 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
                     }
                 }
             }
-            let pass = (0..4).filter(|&h| fails[h]).all(|h| {
+            (0..4).filter(|&h| fails[h]).all(|h| {
                 all_agree[h]
                     && sides[h].len() >= p.rescue_min
                     && (median(&mut sides[h]) - dsub).abs() <= p.rescue_med
-            });
-            pass
+            })
         };
         // Small rounds (the later ones) run on this thread: no dispatch to the pool.
         let added: Vec<usize> = if to_test.len() < 256 {
