@@ -419,6 +419,8 @@ pub struct Network {
     /// Per neuron (original order): its position in `cells`, where the dynamics keep its net
     /// input (a flip then adds whole lane blocks to contiguous net inputs, no scatter).
     slot_of: Vec<u32>,
+    /// First `cells` position of every strip (and the end).
+    cell_strip: Vec<u32>,
     /// Per neuron (original order): disparity vector.
     dxs: Vec<i32>,
     dys: Vec<i32>,
@@ -777,6 +779,101 @@ fn strip_windows(
         .collect()
 }
 
+/// The upper part of a row's window scan (`ranges` already cut to positions after the row's
+/// own): the sum of `T_ab * on_b` as [`window_input`] forms it, the part's entry count, and,
+/// with `push`, `T_ab` added to `buf[j - base]` for every lane `j` (the lower part of the
+/// other rows, by symmetry; lanes not in the row add +-0).
+fn window_sym(
+    c: &Cells,
+    lut: &[f32],
+    k: &RowKey,
+    ranges: &[(usize, usize)],
+    on: &[f32],
+    push: Option<(&mut [f64], usize)>,
+) -> (f64, usize) {
+    #[cfg(target_arch = "x86_64")]
+    if has_avx2() {
+        // SAFETY: as in `window_input`; `buf` reaches LANES past every range end (minus base).
+        return unsafe { window_sym_avx2(c, lut, k, ranges, on, push) };
+    }
+    window_sym_portable(c, lut, k, ranges, on, push)
+}
+
+/// Portable body of [`window_sym`].
+fn window_sym_portable(
+    c: &Cells,
+    lut: &[f32],
+    k: &RowKey,
+    ranges: &[(usize, usize)],
+    on: &[f32],
+    mut push: Option<(&mut [f64], usize)>,
+) -> (f64, usize) {
+    let mut acc = [0.0f64; LANES];
+    let mut n = 0usize;
+    for &(s, e) in ranges {
+        for j0 in (s..e).step_by(LANES) {
+            let (t, in_row) = lane_weights(c, lut, k, j0, e);
+            for l in 0..LANES {
+                acc[l] += (t[l] * on[j0 + l]) as f64;
+            }
+            n += in_row.iter().filter(|&&v| v).count();
+            if let Some((buf, base)) = push.as_mut() {
+                for (l, &tl) in t.iter().enumerate() {
+                    buf[j0 + l - *base] += tl as f64;
+                }
+            }
+        }
+    }
+    (acc.iter().sum(), n)
+}
+
+/// AVX2 body of [`window_sym`].
+///
+/// # Safety
+/// As [`lane_weights_avx2`]; `on` padded like `cells`; `buf[j - base]` valid for every lane.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn window_sym_avx2(
+    c: &Cells,
+    lut: &[f32],
+    k: &RowKey,
+    ranges: &[(usize, usize)],
+    on: &[f32],
+    push: Option<(&mut [f64], usize)>,
+) -> (f64, usize) {
+    use std::arch::x86_64::*;
+    let (mut lo, mut hi) = (_mm256_setzero_pd(), _mm256_setzero_pd());
+    let mut n = 0usize;
+    let (bp, base) = match push {
+        Some((buf, base)) => (buf.as_mut_ptr(), base),
+        None => (std::ptr::null_mut(), 0),
+    };
+    for &(s, e) in ranges {
+        for j0 in (s..e).step_by(LANES) {
+            let (t, stored) = lane_weights_avx2(c, lut, k, j0, e);
+            let v = _mm256_mul_ps(t, _mm256_loadu_ps(on.as_ptr().add(j0)));
+            lo = _mm256_add_pd(lo, _mm256_cvtps_pd(_mm256_castps256_ps128(v)));
+            hi = _mm256_add_pd(hi, _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(v)));
+            n += _mm256_movemask_ps(_mm256_castsi256_ps(stored)).count_ones() as usize;
+            if !bp.is_null() {
+                let p = bp.add(j0 - base);
+                let tl = _mm256_cvtps_pd(_mm256_castps256_ps128(t));
+                let th = _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(t));
+                _mm256_storeu_pd(p, _mm256_add_pd(_mm256_loadu_pd(p), tl));
+                _mm256_storeu_pd(p.add(4), _mm256_add_pd(_mm256_loadu_pd(p.add(4)), th));
+            }
+        }
+    }
+    let mut acc = [0.0f64; LANES];
+    _mm256_storeu_pd(acc.as_mut_ptr(), lo);
+    _mm256_storeu_pd(acc.as_mut_ptr().add(4), hi);
+    (acc.iter().sum(), n)
+}
+
+/// Strips per task of the symmetric initial pass: a fixed split of the rows, so the sums do
+/// not depend on the thread count.
+const SYM_STRIPS: usize = 4;
+
 impl Network {
     /// The network of `neurons`, which must be grouped by `point` in increasing order and
     /// have non-negative coordinates.
@@ -886,6 +983,7 @@ impl Network {
         for (j, &b) in cells.idx[..padded - LANES].iter().enumerate() {
             slot_of[b as usize] = j as u32;
         }
+        let cell_strip: Vec<u32> = strip_start.iter().map(|&q| gstart[q]).collect();
         // Per point, the `cells` range of its window in each strip the window's rows touch.
         let mut wranges = vec![[(0u32, 0u32); MAX_STRIPS]; n_pts];
         for (&q, (r, _)) in sorder.iter().zip(&wins) {
@@ -944,6 +1042,7 @@ impl Network {
             wranges,
             cells,
             slot_of,
+            cell_strip,
             dxs,
             dys,
             lut,
@@ -1047,16 +1146,69 @@ impl Weights for Network {
         }
     }
 
+    /// Each window pair once (`T` is symmetric): a row scans only the positions after its own,
+    /// sums `T_ab V_b` there and pushes `T_ab V_a` to the later rows; in fixed tasks of
+    /// [`SYM_STRIPS`] strips, each with its own push buffer, then added up in task order. Half
+    /// the lane work of one full scan per row; independent of the thread count.
     fn initial_input(&self, state: &[u8], input: &[f64]) -> (Vec<f64>, usize) {
         let on = self.lane_state(state);
-        row_sums(self.n(), |a| {
-            let mut acc = ActiveSum::new(input[a], state);
-            self.for_each_unique(a, |b, t| acc.add(b, t));
-            let k = self.key(a);
-            let (w, nw) =
-                window_input::<false>(&self.cells, &self.lut, &k, &self.window_ranges(a), &on);
-            (acc.s + w, acc.n + nw)
-        })
+        let slots = self.cells.idx.len();
+        let n_strips = self.cell_strip.len() - 1;
+        let tasks: Vec<(usize, usize)> = (0..n_strips)
+            .step_by(SYM_STRIPS)
+            .map(|st| {
+                let end = (st + SYM_STRIPS).min(n_strips);
+                (self.cell_strip[st] as usize, self.cell_strip[end] as usize)
+            })
+            .collect();
+        // Per task: the rows' own sums (input, uniqueness part, upper window part), the push
+        // buffer from `j0`, and the entry count.
+        let parts: Vec<(Vec<f64>, Vec<f64>, usize)> = tasks
+            .par_iter()
+            .map(|&(j0, j1)| {
+                let reach = (j0..j1)
+                    .map(|j| {
+                        let a = self.cells.idx[j] as usize;
+                        self.window_ranges(a).iter().map(|r| r.1).max().unwrap_or(0)
+                    })
+                    .max()
+                    .unwrap_or(j1)
+                    .max(j1);
+                let mut buf = vec![0.0f64; reach - j0 + LANES];
+                let mut own = Vec::with_capacity(j1 - j0);
+                let mut n = 0usize;
+                for j in j0..j1 {
+                    let a = self.cells.idx[j] as usize;
+                    let mut acc = ActiveSum::new(input[a], state);
+                    self.for_each_unique(a, |b, t| acc.add(b, t));
+                    let ranges = self
+                        .window_ranges(a)
+                        .map(|(s, e)| (s.max(j + 1), e.max(j + 1)));
+                    let push = (on[j] != 0.0).then_some((&mut buf[..], j0));
+                    let k = self.key(a);
+                    let (w, nw) = window_sym(&self.cells, &self.lut, &k, &ranges, &on, push);
+                    own.push(acc.s + w);
+                    n += acc.n + 2 * nw;
+                }
+                (own, buf, n)
+            })
+            .collect();
+        let mut u_slot = vec![0.0f64; slots];
+        let mut nnz = 0usize;
+        for (&(j0, j1), (own, _, n)) in tasks.iter().zip(&parts) {
+            u_slot[j0..j1].copy_from_slice(own);
+            nnz += n;
+        }
+        for (&(j0, _), (_, buf, _)) in tasks.iter().zip(&parts) {
+            let end = (j0 + buf.len()).min(slots);
+            for (u, &b) in u_slot[j0..end].iter_mut().zip(buf) {
+                *u += b;
+            }
+        }
+        let u = (0..self.n())
+            .map(|a| u_slot[self.slot_of[a] as usize])
+            .collect();
+        (u, nnz)
     }
 
     fn slots(&self) -> usize {
@@ -1332,6 +1484,30 @@ mod tests {
                 let sign = if a % 2 == 0 { 1.0 } else { -1.0 };
                 window_add(&net.cells, &net.lut, &k, &ranges, sign, &mut u_simd);
                 window_add_portable(&net.cells, &net.lut, &k, &ranges, sign, &mut u_port);
+                // The upper part of the row with its pushes, from position j + 1.
+                let j = net.slot_of[a] as usize;
+                let upper = ranges.map(|(s, e)| (s.max(j + 1), e.max(j + 1)));
+                let (mut b_simd, mut b_port) =
+                    (vec![0.0f64; net.slots()], vec![0.0f64; net.slots()]);
+                assert_eq!(
+                    window_sym(
+                        &net.cells,
+                        &net.lut,
+                        &k,
+                        &upper,
+                        &on,
+                        Some((&mut b_simd, 0))
+                    ),
+                    window_sym_portable(
+                        &net.cells,
+                        &net.lut,
+                        &k,
+                        &upper,
+                        &on,
+                        Some((&mut b_port, 0))
+                    )
+                );
+                assert_eq!(b_simd, b_port);
             }
             assert_eq!(u_simd, u_port);
         }
