@@ -12,6 +12,7 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 
@@ -311,3 +312,24 @@ def test_thin_surface_fallback_matches_the_reference_count_on_wood2() -> None:
     assert s_on.precision[1.0] >= s_off.precision[1.0] - 0.05
     at_p = count_at_precision(best.xl, best.yl, best.xr, best.score, sc.gt, s_on.precision[1.0])
     assert s_on.count >= at_p
+
+
+@pytest.mark.parametrize("layout", ["bgr", "grey", "grey1", "bgra"])
+def test_uint8_input_gives_the_float_path_matches(layout: str) -> None:
+    # 8-bit pairs are converted to grey inside the kernel's call; the matches must be those of
+    # the float32 grey images check_pair makes (bit for bit).
+    from stereovision._validate import as_gray_float
+
+    sc = _scene("middlebury2003/cones")
+    left, right = sc.left[40:240, 60:360], sc.right[40:240, 60:360]
+    if layout != "bgr":
+        left = cv2.cvtColor(left, cv2.COLOR_BGR2GRAY if layout != "bgra" else cv2.COLOR_BGR2BGRA)
+        right = cv2.cvtColor(right, cv2.COLOR_BGR2GRAY if layout != "bgra" else cv2.COLOR_BGR2BGRA)
+        if layout == "grey1":
+            left, right = left[:, :, None], right[:, :, None]
+    a = hp.hopfield_match(left, right, max_disparity=sc.max_disparity)
+    b = hp.hopfield_match(as_gray_float(left), as_gray_float(right), max_disparity=sc.max_disparity)
+    assert len(a) > 200
+    for f in ("xl", "yl", "xr", "yr", "score"):
+        assert np.array_equal(getattr(a, f), getattr(b, f)), f
+    assert a.image_shape == b.image_shape == (200, 300)

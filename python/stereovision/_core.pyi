@@ -83,6 +83,12 @@ def hopfield_interest(
 def hopfield_match(
     left: npt.NDArray[np.float32], right: npt.NDArray[np.float32], params: dict[str, Any]
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float64], dict[str, Any]]: ...
+def hopfield_match_u8(
+    left: npt.NDArray[np.uint8],
+    right: npt.NDArray[np.uint8],
+    weights: tuple[float, float, float],
+    params: dict[str, Any],
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float64], dict[str, Any]]: ...
 def hopfield_candidates(
     left: npt.NDArray[np.float32], right: npt.NDArray[np.float32], params: dict[str, Any]
 ) -> npt.NDArray[np.float32]: ...

@@ -160,8 +160,7 @@ def as_gray_float(img: object, name: str = "left") -> npt.NDArray[np.float32]:
     if arr.dtype == np.uint8 and (arr.ndim == 2 or arr.shape[2] in (1, 3, 4)):
         # The same float32 operations in Rust, in one parallel pass: bit-identical, and
         # faster than the NumPy planes (tests/test_validate.py checks the identity).
-        b, g, r = (float(np.float32(w)) for w in LUMA_WEIGHTS_BGR)
-        return _core.gray_u8(np.ascontiguousarray(arr), (b, g, r))
+        return _core.gray_u8(np.ascontiguousarray(arr), luma_weights())
     out = _to_unit_float(arr, name)
     if out.ndim == 3:
         if out.shape[2] == 1:
@@ -279,6 +278,40 @@ def check_pair(
             f"right {rarr.shape}"
         )
     return as_gray_float(larr, "left"), as_gray_float(rarr, "right")
+
+
+def u8_pair(left: object, right: object) -> tuple[np.ndarray, np.ndarray] | None:
+    """Both images as C-contiguous ``uint8`` arrays when they are valid 8-bit images of one shape.
+
+    For kernels that convert 8-bit images to grey themselves (bit-identical to
+    :func:`as_gray_float`, without the ``float32`` intermediates).
+
+    Parameters
+    ----------
+    left, right : object
+        Candidate images.
+
+    Returns
+    -------
+    tuple of numpy.ndarray or None
+        ``(left, right)`` when both are non-empty ``uint8`` arrays of the same shape ``(H, W)``
+        or ``(H, W, C)`` with ``C`` in 1, 3, 4; else None (callers then use :func:`check_pair`,
+        which also raises the errors).
+    """
+    if not (isinstance(left, np.ndarray) and isinstance(right, np.ndarray)):
+        return None
+    if left.dtype != np.uint8 or right.dtype != np.uint8 or left.shape != right.shape:
+        return None
+    ok = left.ndim == 2 or (left.ndim == 3 and left.shape[2] in (1, 3, 4))
+    if not ok or left.size == 0:
+        return None
+    return np.ascontiguousarray(left), np.ascontiguousarray(right)
+
+
+def luma_weights() -> tuple[float, float, float]:
+    """:data:`LUMA_WEIGHTS_BGR` as the ``float32`` values the grey conversion uses."""
+    b, g, r = (float(np.float32(w)) for w in LUMA_WEIGHTS_BGR)
+    return b, g, r
 
 
 def positive_finite(value: object, name: str) -> float:

@@ -22,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import as_gray_float, check_pair
+from stereovision._validate import as_gray_float, check_pair, luma_weights, u8_pair
 from stereovision.matches import Matches
 
 __all__ = [
@@ -179,17 +179,27 @@ def _run(
     min_disparity: int,
     params: dict[str, Any],
 ) -> Matches:
-    gl, gr = check_pair(left, right)
-    kw = _params(max_disparity, min_disparity, params)
-    kw["method"] = method
-    m, trace, stats = _core.hopfield_match(gl, gr, kw)
+    pair = u8_pair(left, right)
+    if pair is None:
+        gl, gr = check_pair(left, right)
+        kw = _params(max_disparity, min_disparity, params)
+        kw["method"] = method
+        m, trace, stats = _core.hopfield_match(gl, gr, kw)
+        shape = gl.shape
+    else:
+        # 8-bit input (camera frames): the grey conversion runs in the kernel's call, with the
+        # same values as check_pair's (no float32 intermediates).
+        kw = _params(max_disparity, min_disparity, params)
+        kw["method"] = method
+        m, trace, stats = _core.hopfield_match_u8(pair[0], pair[1], luma_weights(), kw)
+        shape = pair[0].shape
     return Matches(
         xl=m[:, 0],
         yl=m[:, 1],
         xr=m[:, 2],
         yr=m[:, 3],
         score=m[:, 4],
-        image_shape=(gl.shape[0], gl.shape[1]),
+        image_shape=(shape[0], shape[1]),
         energy_trace=trace,
         stats=dict(stats),
     )

@@ -4,10 +4,11 @@
 //! `stereovision.matching.hopfield.DEFAULTS`); unknown keys and wrong types are `ValueError`s.
 
 use numpy::ndarray::{Array1, Array2};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use stereovision_core::image::{Image, ImageView};
 use stereovision_core::matching::hopfield::{
     best_match as core_best, candidate_neurons, hopfield_match as core_match,
     interest::select_points, moravec, CandidateMode, HopfieldOutput, HopfieldParams,
@@ -215,7 +216,59 @@ pub fn hopfield_match<'py>(
         grey_from_numpy(&left, "left")?,
         grey_from_numpy(&right, "right")?,
     );
-    let (l, r) = (l.view(), r.view());
+    run_match(py, l.view(), r.view(), params)
+}
+
+/// [`hopfield_match`] on 8-bit images (`(H, W)` grey or `(H, W, C)` BGR/BGRA, C-contiguous):
+/// the grey conversion (`weights`: BGR luma weights, bit-identical to `_validate.as_gray_float`)
+/// runs in the same call, without NumPy intermediates.
+#[pyfunction]
+#[pyo3(signature = (left, right, weights, params))]
+pub fn hopfield_match_u8<'py>(
+    py: Python<'py>,
+    left: numpy::PyReadonlyArrayDyn<'py, u8>,
+    right: numpy::PyReadonlyArrayDyn<'py, u8>,
+    weights: (f32, f32, f32),
+    params: &Bound<'py, PyDict>,
+) -> PyResult<MatchOut<'py>> {
+    let grey = |a: &numpy::PyReadonlyArrayDyn<'py, u8>, what: &str| -> PyResult<Image> {
+        let shape = a.shape().to_vec();
+        let (h, w, c) = match shape.as_slice() {
+            [h, w] => (*h, *w, 1),
+            [h, w, c] => (*h, *w, *c),
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "{what}: expected (H, W) or (H, W, C), got shape {shape:?}"
+                )))
+            }
+        };
+        let data = a
+            .as_slice()
+            .map_err(|_| PyValueError::new_err(format!("{what}: must be C-contiguous")))?;
+        let wts = [weights.0, weights.1, weights.2];
+        let data = py.detach(|| {
+            guard("hopfield_match_u8", || {
+                stereovision_core::image::grey_from_u8(data, w, h, c, wts)
+            })
+        })?;
+        // Finite by construction (levels / 255): no check needed.
+        Ok(Image {
+            width: w,
+            height: h,
+            data,
+        })
+    };
+    let (l, r) = (grey(&left, "left")?, grey(&right, "right")?);
+    run_match(py, l.view(), r.view(), params)
+}
+
+/// The matcher of `params["method"]` on a grey pair.
+fn run_match<'py>(
+    py: Python<'py>,
+    l: ImageView<'_>,
+    r: ImageView<'_>,
+    params: &Bound<'py, PyDict>,
+) -> PyResult<MatchOut<'py>> {
     let p = self::params(params)?;
     let mut method = String::from("hopfield");
     get(params, "method", &mut method)?;

@@ -24,6 +24,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gabor::gabor_lr_check, m)?)?;
     m.add_function(wrap_pyfunction!(hopfield::hopfield_interest, m)?)?;
     m.add_function(wrap_pyfunction!(hopfield::hopfield_match, m)?)?;
+    m.add_function(wrap_pyfunction!(hopfield::hopfield_match_u8, m)?)?;
     m.add_function(wrap_pyfunction!(hopfield::hopfield_candidates, m)?)?;
     m.add_function(wrap_pyfunction!(mcgm::mcgm_log, m)?)?;
     m.add_function(wrap_pyfunction!(mcgm::mcgm_curves, m)?)?;
