@@ -146,6 +146,22 @@ pub fn check_map_pair(disp: &[f32], conf: &[f32], w: usize, h: usize) -> Result<
     Ok(())
 }
 
+/// [`grey_from_u8`] of a stereo pair of one layout, both images in one parallel region.
+pub fn grey_pair_from_u8(
+    left: &[u8],
+    right: &[u8],
+    width: usize,
+    height: usize,
+    channels: usize,
+    weights: [f32; 3],
+) -> Result<(Vec<f32>, Vec<f32>)> {
+    let (l, r) = rayon::join(
+        || grey_from_u8(left, width, height, channels, weights),
+        || grey_from_u8(right, width, height, channels, weights),
+    );
+    Ok((l?, r?))
+}
+
 /// Grey levels in `[0, 1]` of an 8-bit image of `channels` interleaved channels (1 = grey,
 /// 3 = BGR, 4 = BGRA, alpha ignored), row-major: `v / 255` per channel, then for colour
 /// `clamp((wb b + wg g) + wr r, 0, 1)` with `weights = (wb, wg, wr)`. The `f32` operations and

@@ -231,34 +231,41 @@ pub fn hopfield_match_u8<'py>(
     weights: (f32, f32, f32),
     params: &Bound<'py, PyDict>,
 ) -> PyResult<MatchOut<'py>> {
-    let grey = |a: &numpy::PyReadonlyArrayDyn<'py, u8>, what: &str| -> PyResult<Image> {
+    let layout = |a: &numpy::PyReadonlyArrayDyn<'py, u8>, what: &str| {
         let shape = a.shape().to_vec();
-        let (h, w, c) = match shape.as_slice() {
-            [h, w] => (*h, *w, 1),
-            [h, w, c] => (*h, *w, *c),
-            _ => {
-                return Err(PyValueError::new_err(format!(
-                    "{what}: expected (H, W) or (H, W, C), got shape {shape:?}"
-                )))
-            }
-        };
-        let data = a
-            .as_slice()
-            .map_err(|_| PyValueError::new_err(format!("{what}: must be C-contiguous")))?;
-        let wts = [weights.0, weights.1, weights.2];
-        let data = py.detach(|| {
-            guard("hopfield_match_u8", || {
-                stereovision_core::image::grey_from_u8(data, w, h, c, wts)
-            })
-        })?;
-        // Finite by construction (levels / 255): no check needed.
-        Ok(Image {
-            width: w,
-            height: h,
-            data,
-        })
+        match shape.as_slice() {
+            [h, w] => Ok((*h, *w, 1)),
+            [h, w, c] => Ok((*h, *w, *c)),
+            _ => Err(PyValueError::new_err(format!(
+                "{what}: expected (H, W) or (H, W, C), got shape {shape:?}"
+            ))),
+        }
     };
-    let (l, r) = (grey(&left, "left")?, grey(&right, "right")?);
+    let (h, w, c) = layout(&left, "left")?;
+    if layout(&right, "right")? != (h, w, c) {
+        return Err(PyValueError::new_err(format!(
+            "left and right images must have the same shape, got left {:?} and right {:?}",
+            left.shape(),
+            right.shape()
+        )));
+    }
+    let not_contiguous =
+        |what: &str| PyValueError::new_err(format!("{what}: must be C-contiguous"));
+    let ld = left.as_slice().map_err(|_| not_contiguous("left"))?;
+    let rd = right.as_slice().map_err(|_| not_contiguous("right"))?;
+    let wts = [weights.0, weights.1, weights.2];
+    let (lg, rg) = py.detach(|| {
+        guard("hopfield_match_u8", || {
+            stereovision_core::image::grey_pair_from_u8(ld, rd, w, h, c, wts)
+        })
+    })?;
+    // Finite by construction (levels / 255): no check needed.
+    let image = |data| Image {
+        width: w,
+        height: h,
+        data,
+    };
+    let (l, r) = (image(lg), image(rg));
     run_match(py, l.view(), r.view(), params)
 }
 
