@@ -8,9 +8,11 @@
 //! 3. The sparse binary Hopfield network ([`network`]) over the candidates: compatibility in the
 //!    40x40 window (crossing 0 at `compat_theta + compat_grad * distance`), uniqueness on both
 //!    sides, similarity input minus `edge_penalty` for depth-edge failures; asynchronous seeded
-//!    sweeps until a sweep without a flip.
+//!    sweeps from each point's best candidate ([`HopfieldParams::init_best`]) until a sweep
+//!    without a flip.
 //! 4. Final selection: points the network drops for a weak reason fall back to their best
-//!    candidate ([`HopfieldParams::fallback`]); disambiguation of points left with several
+//!    candidate ([`HopfieldParams::fallback`], and [`HopfieldParams::fallback_group`] for
+//!    thin surfaces the window's inhibition removes); disambiguation of points left with several
 //!    active candidates (C.5: local median of the vertical disparity of single matches,
 //!    tie-break on similarity, both sides).
 //! 5. Depth-edge filters (C.10): the four half-windows agree within +-1 px (or, failing that,
@@ -69,7 +71,7 @@ pub struct HopfieldParams {
     /// ... only each point's best candidate among them (a start that already satisfies
     /// uniqueness along the row): the sweeps then flip about 1/6 as many neurons as from
     /// every candidate on, to the same final matches within a few per scene
-    /// (docs/hopfield.md, "Initial state").
+    /// (docs/hopfield.md, "Round 4").
     pub init_best: bool,
     /// Upper bound on asynchronous sweeps.
     pub max_sweeps: usize,

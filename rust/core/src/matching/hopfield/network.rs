@@ -1157,7 +1157,7 @@ impl Weights for Network {
 
     /// Each window pair once (`T` is symmetric): a row scans only the positions after its own,
     /// sums `T_ab V_b` there and pushes `T_ab V_a` to the later rows; in fixed tasks of
-    /// [`SYM_STRIPS`] strips, each with its own push buffer, then added up in task order. Half
+    /// `SYM_STRIPS` strips, each with its own push buffer, then added up in task order. Half
     /// the lane work of one full scan per row; independent of the thread count.
     fn initial_input(&self, state: &[u8], input: &[f64]) -> (Vec<f64>, usize) {
         let on = self.lane_state(state);
