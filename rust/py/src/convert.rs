@@ -76,6 +76,27 @@ pub fn map_and_confidence<'a>(
     Ok((slice(disp, "disparity")?, slice(conf, "confidence")?))
 }
 
+/// `(H, W, C, data)` of an 8-bit image array `(H, W)` (C = 1) or `(H, W, C)`, C-contiguous.
+pub fn u8_layout<'a>(
+    a: &'a numpy::PyReadonlyArrayDyn<'_, u8>,
+    what: &str,
+) -> PyResult<(usize, usize, usize, &'a [u8])> {
+    let shape = a.shape().to_vec();
+    let (h, w, c) = match shape.as_slice() {
+        [h, w] => (*h, *w, 1),
+        [h, w, c] => (*h, *w, *c),
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "{what} must have 2 or 3 dimensions, got shape {shape:?}"
+            )))
+        }
+    };
+    let data = a
+        .as_slice()
+        .map_err(|_| PyValueError::new_err(format!("{what} must be C-contiguous")))?;
+    Ok((h, w, c, data))
+}
+
 /// `stereovision._validate.as_gray_float` for 8-bit images, in Rust: `(H, W)` grey or
 /// `(H, W, C)` with `C` in 1, 3, 4 (BGR order), C-contiguous; bit-identical to the NumPy path.
 #[pyfunction]
@@ -85,19 +106,7 @@ pub fn gray_u8<'py>(
     image: numpy::PyReadonlyArrayDyn<'py, u8>,
     weights: (f32, f32, f32),
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let shape = image.shape().to_vec();
-    let (h, w, c) = match shape.as_slice() {
-        [h, w] => (*h, *w, 1),
-        [h, w, c] => (*h, *w, *c),
-        _ => {
-            return Err(PyValueError::new_err(format!(
-                "image must have 2 or 3 dimensions, got shape {shape:?}"
-            )))
-        }
-    };
-    let data = image
-        .as_slice()
-        .map_err(|_| PyValueError::new_err("image must be C-contiguous"))?;
+    let (h, w, c, data) = u8_layout(&image, "image")?;
     let wts = [weights.0, weights.1, weights.2];
     let grey = py.detach(|| {
         crate::errors::guard("gray_u8", || {

@@ -14,7 +14,7 @@ use stereovision_core::matching::hopfield::{
     interest::select_points, moravec, CandidateMode, HopfieldOutput, HopfieldParams,
 };
 
-use crate::convert::{grey_from_numpy, image_to_numpy};
+use crate::convert::{grey_from_numpy, image_to_numpy, u8_layout};
 use crate::errors::guard;
 use crate::params::{check_keys, get};
 
@@ -231,28 +231,15 @@ pub fn hopfield_match_u8<'py>(
     weights: (f32, f32, f32),
     params: &Bound<'py, PyDict>,
 ) -> PyResult<MatchOut<'py>> {
-    let layout = |a: &numpy::PyReadonlyArrayDyn<'py, u8>, what: &str| {
-        let shape = a.shape().to_vec();
-        match shape.as_slice() {
-            [h, w] => Ok((*h, *w, 1)),
-            [h, w, c] => Ok((*h, *w, *c)),
-            _ => Err(PyValueError::new_err(format!(
-                "{what}: expected (H, W) or (H, W, C), got shape {shape:?}"
-            ))),
-        }
-    };
-    let (h, w, c) = layout(&left, "left")?;
-    if layout(&right, "right")? != (h, w, c) {
+    let (h, w, c, ld) = u8_layout(&left, "left")?;
+    let (hr, wr, cr, rd) = u8_layout(&right, "right")?;
+    if (hr, wr, cr) != (h, w, c) {
         return Err(PyValueError::new_err(format!(
             "left and right images must have the same shape, got left {:?} and right {:?}",
             left.shape(),
             right.shape()
         )));
     }
-    let not_contiguous =
-        |what: &str| PyValueError::new_err(format!("{what}: must be C-contiguous"));
-    let ld = left.as_slice().map_err(|_| not_contiguous("left"))?;
-    let rd = right.as_slice().map_err(|_| not_contiguous("right"))?;
     let wts = [weights.0, weights.1, weights.2];
     let (lg, rg) = py.detach(|| {
         guard("hopfield_match_u8", || {

@@ -576,21 +576,25 @@ unsafe fn lane_weights_avx2(
 
 /// Sum over the window part of a row of `T_ab * on_b` (`on` in strip order; with `POS`, the
 /// positive `T_ab` only): one `f64` accumulator per lane, added up in lane order at the end;
-/// and the part's entry count.
+/// and the part's entry count. With `push = Some((buf, base))`, also `T_ab` added to
+/// `buf[j - base]` for every lane `j` (the symmetric initial pass hands a row's upper part to
+/// the later rows this way; lanes not in the row add +-0).
 fn window_input<const POS: bool>(
     c: &Cells,
     lut: &[f32],
     k: &RowKey,
     ranges: &[(usize, usize)],
     on: &[f32],
+    push: Option<(&mut [f64], usize)>,
 ) -> (f64, usize) {
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
         // SAFETY: AVX2 is present; `cells` and `on` are padded by LANES and `lut` holds
-        // (half + 1) * stride values (built so in `Network::new`).
-        return unsafe { window_input_avx2::<POS>(c, lut, k, ranges, on) };
+        // (half + 1) * stride values (built so in `Network::new`); `buf` reaches LANES past
+        // every range end (minus base).
+        return unsafe { window_input_avx2::<POS>(c, lut, k, ranges, on, push) };
     }
-    window_input_portable::<POS>(c, lut, k, ranges, on)
+    window_input_portable::<POS>(c, lut, k, ranges, on, push)
 }
 
 /// Portable body of [`window_input`].
@@ -600,6 +604,7 @@ fn window_input_portable<const POS: bool>(
     k: &RowKey,
     ranges: &[(usize, usize)],
     on: &[f32],
+    mut push: Option<(&mut [f64], usize)>,
 ) -> (f64, usize) {
     let mut acc = [0.0f64; LANES];
     let mut n = 0usize;
@@ -611,6 +616,11 @@ fn window_input_portable<const POS: bool>(
                 acc[l] += (tl * on[j0 + l]) as f64;
             }
             n += in_row.iter().filter(|&&v| v).count();
+            if let Some((buf, base)) = push.as_mut() {
+                for (l, &tl) in t.iter().enumerate() {
+                    buf[j0 + l - *base] += tl as f64;
+                }
+            }
         }
     }
     (acc.iter().sum(), n)
@@ -619,7 +629,7 @@ fn window_input_portable<const POS: bool>(
 /// AVX2 body of [`window_input`].
 ///
 /// # Safety
-/// As [`lane_weights_avx2`]; `on` padded like `cells`.
+/// As [`lane_weights_avx2`]; `on` padded like `cells`; `buf[j - base]` valid for every lane.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn window_input_avx2<const POS: bool>(
@@ -628,20 +638,34 @@ unsafe fn window_input_avx2<const POS: bool>(
     k: &RowKey,
     ranges: &[(usize, usize)],
     on: &[f32],
+    push: Option<(&mut [f64], usize)>,
 ) -> (f64, usize) {
     use std::arch::x86_64::*;
     let (mut lo, mut hi) = (_mm256_setzero_pd(), _mm256_setzero_pd());
     let mut n = 0usize;
+    let (bp, base) = match push {
+        Some((buf, base)) => (buf.as_mut_ptr(), base),
+        None => (std::ptr::null_mut(), 0),
+    };
     for &(s, e) in ranges {
         for j0 in (s..e).step_by(LANES) {
-            let (mut t, stored) = lane_weights_avx2(c, lut, k, j0, e);
-            if POS {
-                t = _mm256_and_ps(t, _mm256_cmp_ps::<_CMP_GT_OQ>(t, _mm256_setzero_ps()));
-            }
+            let (t0, stored) = lane_weights_avx2(c, lut, k, j0, e);
+            let t = if POS {
+                _mm256_and_ps(t0, _mm256_cmp_ps::<_CMP_GT_OQ>(t0, _mm256_setzero_ps()))
+            } else {
+                t0
+            };
             let v = _mm256_mul_ps(t, _mm256_loadu_ps(on.as_ptr().add(j0)));
             lo = _mm256_add_pd(lo, _mm256_cvtps_pd(_mm256_castps256_ps128(v)));
             hi = _mm256_add_pd(hi, _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(v)));
             n += _mm256_movemask_ps(_mm256_castsi256_ps(stored)).count_ones() as usize;
+            if !bp.is_null() {
+                let p = bp.add(j0 - base);
+                let tl = _mm256_cvtps_pd(_mm256_castps256_ps128(t0));
+                let th = _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(t0));
+                _mm256_storeu_pd(p, _mm256_add_pd(_mm256_loadu_pd(p), tl));
+                _mm256_storeu_pd(p.add(4), _mm256_add_pd(_mm256_loadu_pd(p.add(4)), th));
+            }
         }
     }
     let mut acc = [0.0f64; LANES];
@@ -786,97 +810,6 @@ fn strip_windows(
             (r, count - 1) // the point itself
         })
         .collect()
-}
-
-/// The upper part of a row's window scan (`ranges` already cut to positions after the row's
-/// own): the sum of `T_ab * on_b` as [`window_input`] forms it, the part's entry count, and,
-/// with `push`, `T_ab` added to `buf[j - base]` for every lane `j` (the lower part of the
-/// other rows, by symmetry; lanes not in the row add +-0).
-fn window_sym(
-    c: &Cells,
-    lut: &[f32],
-    k: &RowKey,
-    ranges: &[(usize, usize)],
-    on: &[f32],
-    push: Option<(&mut [f64], usize)>,
-) -> (f64, usize) {
-    #[cfg(target_arch = "x86_64")]
-    if has_avx2() {
-        // SAFETY: as in `window_input`; `buf` reaches LANES past every range end (minus base).
-        return unsafe { window_sym_avx2(c, lut, k, ranges, on, push) };
-    }
-    window_sym_portable(c, lut, k, ranges, on, push)
-}
-
-/// Portable body of [`window_sym`].
-fn window_sym_portable(
-    c: &Cells,
-    lut: &[f32],
-    k: &RowKey,
-    ranges: &[(usize, usize)],
-    on: &[f32],
-    mut push: Option<(&mut [f64], usize)>,
-) -> (f64, usize) {
-    let mut acc = [0.0f64; LANES];
-    let mut n = 0usize;
-    for &(s, e) in ranges {
-        for j0 in (s..e).step_by(LANES) {
-            let (t, in_row) = lane_weights(c, lut, k, j0, e);
-            for l in 0..LANES {
-                acc[l] += (t[l] * on[j0 + l]) as f64;
-            }
-            n += in_row.iter().filter(|&&v| v).count();
-            if let Some((buf, base)) = push.as_mut() {
-                for (l, &tl) in t.iter().enumerate() {
-                    buf[j0 + l - *base] += tl as f64;
-                }
-            }
-        }
-    }
-    (acc.iter().sum(), n)
-}
-
-/// AVX2 body of [`window_sym`].
-///
-/// # Safety
-/// As [`lane_weights_avx2`]; `on` padded like `cells`; `buf[j - base]` valid for every lane.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn window_sym_avx2(
-    c: &Cells,
-    lut: &[f32],
-    k: &RowKey,
-    ranges: &[(usize, usize)],
-    on: &[f32],
-    push: Option<(&mut [f64], usize)>,
-) -> (f64, usize) {
-    use std::arch::x86_64::*;
-    let (mut lo, mut hi) = (_mm256_setzero_pd(), _mm256_setzero_pd());
-    let mut n = 0usize;
-    let (bp, base) = match push {
-        Some((buf, base)) => (buf.as_mut_ptr(), base),
-        None => (std::ptr::null_mut(), 0),
-    };
-    for &(s, e) in ranges {
-        for j0 in (s..e).step_by(LANES) {
-            let (t, stored) = lane_weights_avx2(c, lut, k, j0, e);
-            let v = _mm256_mul_ps(t, _mm256_loadu_ps(on.as_ptr().add(j0)));
-            lo = _mm256_add_pd(lo, _mm256_cvtps_pd(_mm256_castps256_ps128(v)));
-            hi = _mm256_add_pd(hi, _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(v)));
-            n += _mm256_movemask_ps(_mm256_castsi256_ps(stored)).count_ones() as usize;
-            if !bp.is_null() {
-                let p = bp.add(j0 - base);
-                let tl = _mm256_cvtps_pd(_mm256_castps256_ps128(t));
-                let th = _mm256_cvtps_pd(_mm256_extractf128_ps::<1>(t));
-                _mm256_storeu_pd(p, _mm256_add_pd(_mm256_loadu_pd(p), tl));
-                _mm256_storeu_pd(p.add(4), _mm256_add_pd(_mm256_loadu_pd(p.add(4)), th));
-            }
-        }
-    }
-    let mut acc = [0.0f64; LANES];
-    _mm256_storeu_pd(acc.as_mut_ptr(), lo);
-    _mm256_storeu_pd(acc.as_mut_ptr().add(4), hi);
-    (acc.iter().sum(), n)
 }
 
 /// Strips per task of the symmetric initial pass: a fixed split of the rows, so the sums do
@@ -1091,7 +1024,8 @@ impl Network {
             }
         });
         let k = self.key(a);
-        s + window_input::<true>(&self.cells, &self.lut, &k, &self.window_ranges(a), on).0
+        let ranges = self.window_ranges(a);
+        s + window_input::<true>(&self.cells, &self.lut, &k, &ranges, on, None).0
     }
 
     fn key(&self, a: usize) -> RowKey {
@@ -1195,7 +1129,8 @@ impl Weights for Network {
                         .map(|(s, e)| (s.max(j + 1), e.max(j + 1)));
                     let push = (on[j] != 0.0).then_some((&mut buf[..], j0));
                     let k = self.key(a);
-                    let (w, nw) = window_sym(&self.cells, &self.lut, &k, &ranges, &on, push);
+                    let (w, nw) =
+                        window_input::<false>(&self.cells, &self.lut, &k, &ranges, &on, push);
                     own.push(acc.s + w);
                     n += acc.n + 2 * nw;
                 }
@@ -1480,14 +1415,16 @@ mod tests {
             for a in 0..m {
                 let k = net.key(a);
                 let ranges = net.window_ranges(a);
-                let want = window_input_portable::<false>(&net.cells, &net.lut, &k, &ranges, &on);
+                let want =
+                    window_input_portable::<false>(&net.cells, &net.lut, &k, &ranges, &on, None);
                 assert_eq!(
-                    window_input::<false>(&net.cells, &net.lut, &k, &ranges, &on),
+                    window_input::<false>(&net.cells, &net.lut, &k, &ranges, &on, None),
                     want
                 );
-                let want = window_input_portable::<true>(&net.cells, &net.lut, &k, &ranges, &on);
+                let want =
+                    window_input_portable::<true>(&net.cells, &net.lut, &k, &ranges, &on, None);
                 assert_eq!(
-                    window_input::<true>(&net.cells, &net.lut, &k, &ranges, &on),
+                    window_input::<true>(&net.cells, &net.lut, &k, &ranges, &on, None),
                     want
                 );
                 let sign = if a % 2 == 0 { 1.0 } else { -1.0 };
@@ -1499,7 +1436,7 @@ mod tests {
                 let (mut b_simd, mut b_port) =
                     (vec![0.0f64; net.slots()], vec![0.0f64; net.slots()]);
                 assert_eq!(
-                    window_sym(
+                    window_input::<false>(
                         &net.cells,
                         &net.lut,
                         &k,
@@ -1507,7 +1444,7 @@ mod tests {
                         &on,
                         Some((&mut b_simd, 0))
                     ),
-                    window_sym_portable(
+                    window_input_portable::<false>(
                         &net.cells,
                         &net.lut,
                         &k,
