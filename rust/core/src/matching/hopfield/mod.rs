@@ -610,21 +610,19 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
             let fails: [bool; 4] = std::array::from_fn(|h| n.halves_fail >> h & 1 == 1);
             let mut all_agree = [true; 4];
             sides.iter_mut().for_each(Vec::clear);
-            for (s, e) in grid.ranges(x, y) {
-                for g in s..e {
-                    let (qx, qy) = (grid.xs[g], grid.ys[g]);
-                    if !ok_g[g] || (qx - x).abs() > half || (qy - y).abs() > half {
-                        continue;
-                    }
-                    let agree = (g_dx[g] - d).abs() <= p.agree_tol;
-                    for (h, on_side) in [qx < x, qx > x, qy < y, qy > y].into_iter().enumerate() {
-                        if fails[h] && on_side {
-                            all_agree[h] &= agree;
-                            sides[h].push(g_v[g]);
-                        }
+            grid.for_each_pos_in_window((x, y), half, |g| {
+                if !ok_g[g] {
+                    return;
+                }
+                let (qx, qy) = (grid.xs[g], grid.ys[g]);
+                let agree = (g_dx[g] - d).abs() <= p.agree_tol;
+                for (h, on_side) in [qx < x, qx > x, qy < y, qy > y].into_iter().enumerate() {
+                    if fails[h] && on_side {
+                        all_agree[h] &= agree;
+                        sides[h].push(g_v[g]);
                     }
                 }
-            }
+            });
             (0..4).filter(|&h| fails[h]).all(|h| {
                 all_agree[h]
                     && sides[h].len() >= p.rescue_min

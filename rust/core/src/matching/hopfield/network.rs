@@ -220,10 +220,22 @@ impl PointGrid {
         half: i32,
         mut f: impl FnMut(usize),
     ) {
+        self.for_each_pos_in_window((x, y), half, |k| f(self.items[k] as usize));
+    }
+
+    /// Calls `f(k)` with the grid position `k` (index into `items`, `xs`, `ys`) of every point
+    /// within `half` of `(x, y)`, in the order of [`PointGrid::for_each_in_window`]: for data
+    /// kept in grid order.
+    pub(crate) fn for_each_pos_in_window(
+        &self,
+        (x, y): (i32, i32),
+        half: i32,
+        mut f: impl FnMut(usize),
+    ) {
         for (s, e) in self.ranges(x, y) {
             for k in s..e {
                 if (self.xs[k] - x).abs() <= half && (self.ys[k] - y).abs() <= half {
-                    f(self.items[k] as usize);
+                    f(k);
                 }
             }
         }
