@@ -574,11 +574,7 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
     let grid = network::PointGrid::new(&cxy, half);
     // The chosen matches' disparity, sub-pixel disparity and verdict in grid order: a window
     // scan reads them in place (same positions, same order as `for_each_in_window`).
-    let g_dx: Vec<i32> = grid
-        .items
-        .iter()
-        .map(|&t| neurons[chosen[t as usize]].dx())
-        .collect();
+    let g_dx = grid.values_in_grid_order(|t| neurons[chosen[t]].dx());
     let g_v: Vec<f32> = grid
         .items
         .iter()
@@ -688,7 +684,7 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
     // neurons the rule reads: the active alternatives, else the best candidate.
     let on = net.lane_state(state);
     let support_of = |a: usize| net.support(a, state, &on);
-    let weak: Vec<bool> = groups
+    let mut weak: Vec<bool> = groups
         .par_iter()
         .map(|&(a, e)| {
             let alt = (a + 1..e)
@@ -701,7 +697,6 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
             }
         })
         .collect();
-    let mut weak = weak;
     if p.fallback_group {
         // Thin surfaces: points the network left with nothing (one candidate, edge test passed,
         // no support) because the window's dominant surface inhibits them. Where at least
@@ -724,12 +719,7 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
             })
             .collect();
         let grid = network::PointGrid::new(&lxy, half);
-        let mut ld: Vec<i32> = grid
-            .items
-            .iter()
-            .map(|&t| neurons[groups[lone[t as usize]].0].dx())
-            .collect();
-        ld.resize(grid.xs.len(), 0); // padded like the grid's coordinates
+        let ld = grid.values_in_grid_order(|t| neurons[groups[lone[t]].0].dx());
         let coherent: Vec<bool> = lone
             .par_iter()
             .zip(&lxy)
@@ -792,12 +782,7 @@ fn finish(
         .collect();
     let grid = network::PointGrid::new(&sxy, half);
     // Survivor disparities in grid order.
-    let mut sd: Vec<i32> = grid
-        .items
-        .iter()
-        .map(|&t| neurons[survivors[t as usize].0].dx())
-        .collect();
-    sd.resize(grid.xs.len(), 0); // padded like the grid's coordinates
+    let sd = grid.values_in_grid_order(|t| neurons[survivors[t].0].dx());
     survivors
         .par_iter()
         .enumerate()

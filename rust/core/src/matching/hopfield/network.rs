@@ -223,6 +223,14 @@ impl PointGrid {
         self.for_each_pos_in_window((x, y), half, |k| f(self.items[k] as usize));
     }
 
+    /// `f(t)` of every point `t` in grid order, padded like `xs` (the `vals` of
+    /// [`PointGrid::count_in_window`]).
+    pub(crate) fn values_in_grid_order(&self, f: impl Fn(usize) -> i32) -> Vec<i32> {
+        let mut v: Vec<i32> = self.items.iter().map(|&t| f(t as usize)).collect();
+        v.resize(self.xs.len(), 0);
+        v
+    }
+
     /// Calls `f(k)` with the grid position `k` (index into `items`, `xs`, `ys`) of every point
     /// within `half` of `(x, y)`, in the order of [`PointGrid::for_each_in_window`]: for data
     /// kept in grid order.
