@@ -774,19 +774,21 @@ unsafe fn window_add_avx2(
     }
 }
 
-/// For every point of the strip order (strips of `strip_h` rows, by x within a strip; `sx`,
-/// `sy` its coordinates, `strip_start` the strips' starts): the ranges of strip-order positions
-/// within `half` of it in x, one per strip its window's rows touch (from the top; unused ones
-/// empty), and the number of other points within `half` in both coordinates. The ranges come
-/// from per-strip prefix counts (the points of a strip left of each column; a strip's points
-/// come by increasing x), without a search; the count is a range length for the strips inside
-/// the window's rows and a scan of the range's rows for the (at most two) strips cut by it.
+/// For every query point (`queries`, one of the points, in any order) of the points in strip
+/// order (strips of `strip_h` rows, by x within a strip; `sx`, `sy` their coordinates,
+/// `strip_start` the strips' starts): the ranges of strip-order positions within `half` of it
+/// in x, one per strip its window's rows touch (from the top; unused ones empty), and the
+/// number of other points within `half` in both coordinates. The ranges come from per-strip
+/// prefix counts (the points of a strip left of each column; a strip's points come by
+/// increasing x), without a search; the count is a range length for the strips inside the
+/// window's rows and a scan of the range's rows for the (at most two) strips cut by it.
 fn strip_windows(
     sx: &[i32],
     sy: &[i32],
     strip_start: &[usize],
     strip_h: i32,
     half: i32,
+    queries: &[(i32, i32)],
 ) -> Vec<([(u32, u32); MAX_STRIPS], usize)> {
     let n_strips = strip_start.len() - 1;
     let w = sx.iter().copied().max().unwrap_or(0) as usize + 1;
@@ -802,10 +804,9 @@ fn strip_windows(
         }
     });
     let last = n_strips as i32 - 1;
-    (0..sx.len())
-        .into_par_iter()
-        .map(|i| {
-            let (x, y) = (sx[i], sy[i]);
+    queries
+        .par_iter()
+        .map(|&(x, y)| {
             let xa = (x - half).max(0) as usize;
             let xb = ((x + half + 1) as usize).min(w);
             let s_lo = (y - half).max(0) / strip_h;
@@ -864,35 +865,37 @@ impl Network {
         for i in 1..=n_strips {
             strip_start[i] += strip_start[i - 1];
         }
-        // Counting sort into strips, then each strip (a few hundred points) by (x, index).
+        // Strips by (x, index): a stable counting sort by x, then a stable one into strips.
+        let w_max = pxy.iter().map(|p| p.0).max().unwrap_or(0) as usize;
+        let mut x_start = vec![0usize; w_max + 2];
+        for &(x, _) in &pxy {
+            x_start[x as usize + 1] += 1;
+        }
+        for i in 1..x_start.len() {
+            x_start[i] += x_start[i - 1];
+        }
+        let mut by_x = vec![0u32; n_pts];
+        for (q, &(x, _)) in pxy.iter().enumerate() {
+            by_x[x_start[x as usize]] = q as u32;
+            x_start[x as usize] += 1;
+        }
         let mut sorder = vec![0u32; n_pts];
         let mut fill = strip_start.clone();
-        for (q, &(_, y)) in pxy.iter().enumerate() {
-            let st = (y / strip_h) as usize;
-            sorder[fill[st]] = q as u32;
+        for &q in &by_x {
+            let st = (pxy[q as usize].1 / strip_h) as usize;
+            sorder[fill[st]] = q;
             fill[st] += 1;
         }
-        let mut strips: Vec<&mut [u32]> = Vec::with_capacity(n_strips);
-        let mut rest = &mut sorder[..];
-        for st in 0..n_strips {
-            let (head, tail) = rest.split_at_mut(strip_start[st + 1] - strip_start[st]);
-            strips.push(head);
-            rest = tail;
-        }
-        strips.into_par_iter().for_each(|v| {
-            v.sort_unstable_by_key(|&q| ((pxy[q as usize].0 as u64) << 32) | q as u64)
-        });
         let sx: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].0).collect();
         let sy: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].1).collect();
         // Per point (strip order): its window's point ranges per strip and neighbour count n_p.
-        let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half);
-        let mut counts = vec![0usize; n_pts];
-        for (&q, w) in sorder.iter().zip(&wins) {
-            counts[q as usize] = w.1;
-        }
+        let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half, &pxy);
         // A / max(n_p, n_q, 1) = min(A / max(n_p, 1), A / max(n_q, 1)) exactly: division rounds
         // monotonically (max for a negative A). One division per point instead of per pair.
-        let a_over_n: Vec<f32> = counts.iter().map(|&n| w.a / (n as f32).max(1.0)).collect();
+        let a_over_n: Vec<f32> = wins
+            .iter()
+            .map(|&(_, n)| w.a / (n as f32).max(1.0))
+            .collect();
         let p_of: Vec<u32> = (0..n_pts)
             .flat_map(|p| std::iter::repeat_n(p as u32, starts[p + 1] - starts[p]))
             .collect();
@@ -947,10 +950,10 @@ impl Network {
         }
         let cell_strip: Vec<u32> = strip_start.iter().map(|&q| gstart[q]).collect();
         // Per point, the `cells` range of its window in each strip the window's rows touch.
-        let mut wranges = vec![[(0u32, 0u32); MAX_STRIPS]; n_pts];
-        for (&q, (r, _)) in sorder.iter().zip(&wins) {
-            wranges[q as usize] = r.map(|(lo, hi)| (gstart[lo as usize], gstart[hi as usize]));
-        }
+        let wranges: Vec<[(u32, u32); MAX_STRIPS]> = wins
+            .par_iter()
+            .map(|(r, _)| r.map(|(lo, hi)| (gstart[lo as usize], gstart[hi as usize])))
+            .collect();
         // Compatibility lookup per Chebyshev distance r of the two points (0..=half) over the
         // integer squared disparity-vector difference q. A row ends where the f32 value has
         // saturated at -1 (slope > 0, q past the crossing): larger q read the last entry, which
@@ -1390,7 +1393,7 @@ mod tests {
         }
         let sx: Vec<i32> = pts.iter().map(|p| p.0).collect();
         let sy: Vec<i32> = pts.iter().map(|p| p.1).collect();
-        let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half);
+        let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half, &pts);
         for (i, &(x, y)) in pts.iter().enumerate() {
             let brute = pts
                 .iter()
@@ -1411,6 +1414,11 @@ mod tests {
             }
             assert!(wins[i].0[s_hi - s_lo + 1..].iter().all(|&r| r == (0, 0)));
         }
+        // The queries in any order: the same answer per point.
+        let rev: Vec<(i32, i32)> = pts.iter().rev().copied().collect();
+        let mut wins_rev = strip_windows(&sx, &sy, &strip_start, strip_h, half, &rev);
+        wins_rev.reverse();
+        assert_eq!(wins_rev, wins);
     }
 
     #[test]
