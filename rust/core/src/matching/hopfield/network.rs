@@ -833,6 +833,76 @@ fn strip_windows(
         .collect()
 }
 
+/// Strip order of the points `pxy` (strips of `(half + 1) / 2` rows, by x within a strip, so
+/// that a window's points in one strip are ONE contiguous range cut exactly in x): the strips'
+/// starts, the points in strip order and each point's window ([`strip_windows`], point order).
+#[allow(clippy::type_complexity)]
+fn strip_order(
+    pxy: &[(i32, i32)],
+    half: i32,
+) -> (Vec<usize>, Vec<u32>, Vec<([(u32, u32); MAX_STRIPS], usize)>) {
+    let n_pts = pxy.len();
+    let strip_h = (half + 1) / 2;
+    let n_strips = pxy.iter().map(|p| p.1 / strip_h).max().unwrap_or(0) as usize + 1;
+    let mut strip_start = vec![0usize; n_strips + 1];
+    for &(_, y) in pxy {
+        strip_start[(y / strip_h) as usize + 1] += 1;
+    }
+    for i in 1..=n_strips {
+        strip_start[i] += strip_start[i - 1];
+    }
+    // Strips by (x, index): a stable counting sort by x, then a stable one into strips.
+    let w_max = pxy.iter().map(|p| p.0).max().unwrap_or(0) as usize;
+    let mut x_start = vec![0usize; w_max + 2];
+    for &(x, _) in pxy {
+        x_start[x as usize + 1] += 1;
+    }
+    for i in 1..x_start.len() {
+        x_start[i] += x_start[i - 1];
+    }
+    let mut by_x = vec![0u32; n_pts];
+    for (q, &(x, _)) in pxy.iter().enumerate() {
+        by_x[x_start[x as usize]] = q as u32;
+        x_start[x as usize] += 1;
+    }
+    let mut sorder = vec![0u32; n_pts];
+    let mut fill = strip_start.clone();
+    for &q in &by_x {
+        let st = (pxy[q as usize].1 / strip_h) as usize;
+        sorder[fill[st]] = q;
+        fill[st] += 1;
+    }
+    let sx: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].0).collect();
+    let sy: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].1).collect();
+    // Per point (point order): its window's point ranges per strip and neighbour count n_p.
+    let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half, pxy);
+    (strip_start, sorder, wins)
+}
+
+/// Column groups: neurons sharing a right pixel, wherever their left points are. The neurons
+/// in right-pixel order, each neuron's group (its range in that order) and its right pixel's
+/// rank, and the number of right pixels.
+#[allow(clippy::type_complexity)]
+fn right_groups(neurons: &[Neuron]) -> (Vec<u32>, Vec<(u32, u32)>, Vec<u32>, u32) {
+    let m = neurons.len();
+    let key = |a: u32| (neurons[a as usize].yr, neurons[a as usize].xr);
+    let by_right: Vec<u32> = right_pixel_order(neurons, (0..m).collect::<Vec<_>>());
+    let mut group = vec![(0u32, 0u32); m];
+    let mut rank = vec![0u32; m];
+    let (mut g0, mut n_groups) = (0, 0u32);
+    for k in 1..=m {
+        if k == m || key(by_right[k]) != key(by_right[g0]) {
+            for &a in &by_right[g0..k] {
+                group[a as usize] = (g0 as u32, k as u32);
+                rank[a as usize] = n_groups;
+            }
+            g0 = k;
+            n_groups += 1;
+        }
+    }
+    (by_right, group, rank, n_groups)
+}
+
 /// Strips per task of the symmetric initial pass: a fixed split of the rows, so the sums do
 /// not depend on the thread count.
 const SYM_STRIPS: usize = 4;
@@ -854,69 +924,21 @@ impl Network {
             .map(|p| (neurons[starts[p]].xl.max(0), neurons[starts[p]].yl.max(0)))
             .collect();
         let half = w.nbr_half.max(1);
-        // Strip order: points in horizontal strips of `strip_h` rows, by x within a strip, so
-        // that a window's points in one strip are ONE contiguous range cut exactly in x.
-        let strip_h = (half + 1) / 2;
-        let n_strips = pxy.iter().map(|p| p.1 / strip_h).max().unwrap_or(0) as usize + 1;
-        let mut strip_start = vec![0usize; n_strips + 1];
-        for &(_, y) in &pxy {
-            strip_start[(y / strip_h) as usize + 1] += 1;
-        }
-        for i in 1..=n_strips {
-            strip_start[i] += strip_start[i - 1];
-        }
-        // Strips by (x, index): a stable counting sort by x, then a stable one into strips.
-        let w_max = pxy.iter().map(|p| p.0).max().unwrap_or(0) as usize;
-        let mut x_start = vec![0usize; w_max + 2];
-        for &(x, _) in &pxy {
-            x_start[x as usize + 1] += 1;
-        }
-        for i in 1..x_start.len() {
-            x_start[i] += x_start[i - 1];
-        }
-        let mut by_x = vec![0u32; n_pts];
-        for (q, &(x, _)) in pxy.iter().enumerate() {
-            by_x[x_start[x as usize]] = q as u32;
-            x_start[x as usize] += 1;
-        }
-        let mut sorder = vec![0u32; n_pts];
-        let mut fill = strip_start.clone();
-        for &q in &by_x {
-            let st = (pxy[q as usize].1 / strip_h) as usize;
-            sorder[fill[st]] = q;
-            fill[st] += 1;
-        }
-        let sx: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].0).collect();
-        let sy: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].1).collect();
-        // Per point (strip order): its window's point ranges per strip and neighbour count n_p.
-        let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half, &pxy);
+        let p_of: Vec<u32> = (0..n_pts)
+            .flat_map(|p| std::iter::repeat_n(p as u32, starts[p + 1] - starts[p]))
+            .collect();
+        let dxs: Vec<i32> = neurons.iter().map(Neuron::dx).collect();
+        let dys: Vec<i32> = neurons.iter().map(Neuron::dy).collect();
+        // The strip order and windows, and the right-pixel groups, are independent: built side
+        // by side.
+        let ((strip_start, sorder, wins), (by_right, group, rank, n_groups)) =
+            rayon::join(|| strip_order(&pxy, half), || right_groups(neurons));
         // A / max(n_p, n_q, 1) = min(A / max(n_p, 1), A / max(n_q, 1)) exactly: division rounds
         // monotonically (max for a negative A). One division per point instead of per pair.
         let a_over_n: Vec<f32> = wins
             .iter()
             .map(|&(_, n)| w.a / (n as f32).max(1.0))
             .collect();
-        let p_of: Vec<u32> = (0..n_pts)
-            .flat_map(|p| std::iter::repeat_n(p as u32, starts[p + 1] - starts[p]))
-            .collect();
-        let dxs: Vec<i32> = neurons.iter().map(Neuron::dx).collect();
-        let dys: Vec<i32> = neurons.iter().map(Neuron::dy).collect();
-        // Column groups: neurons sharing a right pixel, wherever their left points are.
-        let key = |a: u32| (neurons[a as usize].yr, neurons[a as usize].xr);
-        let by_right: Vec<u32> = right_pixel_order(neurons, (0..m).collect::<Vec<_>>());
-        let mut group = vec![(0u32, 0u32); m];
-        let mut rank = vec![0u32; m];
-        let (mut g0, mut n_groups) = (0, 0u32);
-        for k in 1..=m {
-            if k == m || key(by_right[k]) != key(by_right[g0]) {
-                for &a in &by_right[g0..k] {
-                    group[a as usize] = (g0 as u32, k as u32);
-                    rank[a as usize] = n_groups;
-                }
-                g0 = k;
-                n_groups += 1;
-            }
-        }
         // Strip-ordered neuron arrays: the neuron order first, then each array by an
         // exact-size map over it (padded with LANES entries).
         let mut gstart = Vec::with_capacity(n_pts + 1);
