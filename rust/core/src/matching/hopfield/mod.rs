@@ -281,7 +281,7 @@ fn parabola(a: f32, b: f32, c: f32) -> f32 {
 
 /// Image rows per parallel task of the candidate search: its right-image statistics are
 /// computed for these rows only (small enough for an even split over the threads).
-const ROWS_PER_TASK: usize = 8;
+const ROWS_PER_TASK: usize = 16;
 
 /// Scratch of [`point_candidates`], reused across the points of a thread.
 #[derive(Default)]
@@ -527,7 +527,12 @@ fn disambiguate(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldPar
         best.filter(|b| b.0 <= p.tau_y).map(|b| b.2)
     };
     let mut kept = singles.clone();
-    let picked: Vec<usize> = ambiguous.par_iter().filter_map(|g| pick(g)).collect();
+    // Few conflicts (the usual case) are picked on this thread: no dispatch to the pool.
+    let picked: Vec<usize> = if ambiguous.len() < 256 {
+        ambiguous.iter().filter_map(|g| pick(g)).collect()
+    } else {
+        ambiguous.par_iter().filter_map(|g| pick(g)).collect()
+    };
     kept.extend(picked);
     // The same rule on the right side (neurons sharing a right pixel, by the network's
     // right-pixel rank): a pixel held once keeps its match, a conflict is picked as above
