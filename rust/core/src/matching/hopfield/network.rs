@@ -114,11 +114,35 @@ impl Csr {
 /// inside, against 47 % with cells of `half`).
 const GRID_SUB: i32 = 2;
 
+/// `floor(x / d)` for `0 <= x < 2^31` by a multiply and a shift (the round-up method of
+/// Granlund and Montgomery: `m = ceil(2^(31 + l) / d)` with `2^l >= d` is exact for 31-bit `x`).
+#[derive(Debug, Clone, Copy)]
+struct DivBy {
+    m: u64,
+    shift: u32,
+}
+
+impl DivBy {
+    fn new(d: u32) -> Self {
+        assert!(d >= 1, "division by zero");
+        let l = 32 - (d - 1).leading_zeros(); // ceil(log2 d)
+        let shift = 31 + l;
+        let m = (1u128 << shift).div_ceil(d as u128) as u64;
+        DivBy { m, shift }
+    }
+
+    #[inline]
+    fn of(self, x: i32) -> i32 {
+        debug_assert!(x >= 0);
+        ((x as u64 * self.m) >> self.shift) as i32
+    }
+}
+
 /// Uniform grid over the left points, counting-sorted: `items` lists the point indices cell by
 /// cell (raster order of the cells, point order within a cell) with their coordinates beside
 /// them, so the cells of one grid row around a point form ONE contiguous range.
 pub(crate) struct PointGrid {
-    cell: i32,
+    cell: DivBy,
     gw: i32,
     gh: i32,
     start: Vec<usize>,
@@ -128,25 +152,31 @@ pub(crate) struct PointGrid {
 }
 
 impl PointGrid {
-    /// Grid for window queries of half-size `half` (>= 1).
+    /// Grid over points with non-negative coordinates, for window queries of half-size `half`
+    /// (>= 1).
     pub(crate) fn new(pxy: &[(i32, i32)], half: i32) -> Self {
         let cell = (half.max(1) + GRID_SUB - 1) / GRID_SUB;
-        let gw = pxy.iter().map(|p| p.0 / cell).max().unwrap_or(0) + 1;
-        let gh = pxy.iter().map(|p| p.1 / cell).max().unwrap_or(0) + 1;
-        let idx = |p: &(i32, i32)| ((p.1 / cell) * gw + p.0 / cell) as usize;
+        // Coordinates are >= 0: the largest cell index is the largest coordinate's. Each
+        // point's cell computed once, by a multiply (divisions were most of the build).
+        let cell = DivBy::new(cell as u32);
+        let gw = cell.of(pxy.iter().map(|p| p.0).max().unwrap_or(0)) + 1;
+        let gh = cell.of(pxy.iter().map(|p| p.1).max().unwrap_or(0)) + 1;
+        let cells: Vec<u32> = pxy
+            .iter()
+            .map(|p| (cell.of(p.1) * gw + cell.of(p.0)) as u32)
+            .collect();
         let mut start = vec![0usize; (gw * gh) as usize + 1];
-        for p in pxy {
-            start[idx(p) + 1] += 1;
+        for &c in &cells {
+            start[c as usize + 1] += 1;
         }
         for i in 1..start.len() {
             start[i] += start[i - 1];
         }
         let mut fill = start.clone();
         let mut items = vec![0u32; pxy.len()];
-        for (k, p) in pxy.iter().enumerate() {
-            let c = idx(p);
-            items[fill[c]] = k as u32;
-            fill[c] += 1;
+        for (k, &c) in cells.iter().enumerate() {
+            items[fill[c as usize]] = k as u32;
+            fill[c as usize] += 1;
         }
         // Coordinates padded with LANES far-away entries: a block of lanes may read past the
         // last point (its lanes beyond a range are masked, these are never inside a window).
@@ -177,7 +207,7 @@ impl PointGrid {
     /// `GRID_SUB` cells of `(x, y)`'s cell, one per grid row, in cell raster order.
     #[inline]
     pub(crate) fn ranges(&self, x: i32, y: i32) -> [(usize, usize); 2 * GRID_SUB as usize + 1] {
-        let (cx, cy) = (x / self.cell, y / self.cell);
+        let (cx, cy) = (self.cell.of(x.max(0)), self.cell.of(y.max(0)));
         let (gx0, gx1) = ((cx - GRID_SUB).max(0), (cx + GRID_SUB).min(self.gw - 1));
         std::array::from_fn(|k| {
             let gy = cy - GRID_SUB + k as i32;
@@ -1393,6 +1423,23 @@ mod tests {
             }
         }
         out
+    }
+
+    #[test]
+    fn division_by_multiply_is_exact() {
+        let mut rng = SplitMix64::new(5);
+        for d in (1..=300u32).chain([1 << 10, 1000, 4095, 65_537, (1 << 31) - 1]) {
+            let div = DivBy::new(d);
+            let edges = [0, 1, d - 1, d, d + 1, i32::MAX as u32 - 1, i32::MAX as u32];
+            let random = (0..200).map(|_| (rng.next_u64() >> 33) as u32);
+            for x in edges
+                .into_iter()
+                .chain(random)
+                .filter(|&x| x <= i32::MAX as u32)
+            {
+                assert_eq!(div.of(x as i32), (x / d) as i32, "{x} / {d}");
+            }
+        }
     }
 
     #[test]
