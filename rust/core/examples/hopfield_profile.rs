@@ -6,13 +6,15 @@
 //! python benches/dump_grey.py middlebury2006/cloth3 /tmp/cloth3     # prints W H D
 //! cargo run --release --example hopfield_profile -- /tmp/cloth3 626 555 96
 //! cargo run --release --example hopfield_profile -- /tmp/cloth3 626 555 96 fingerprint
+//! cargo run --release --example hopfield_profile -- /tmp/cloth3 626 555 96 whole=60
 //! ```
 //!
 //! Timing mode prints the minimum of 9 runs of each public stage (ms; the least disturbed by
 //! other load on a shared machine) with the current rayon
 //! thread count (`RAYON_NUM_THREADS`); `fingerprint` prints the match count, the number of
 //! weights, the sweeps, a hash of every match and one of the energy trace (to check that a change
-//! leaves the output bit-identical).
+//! leaves the output bit-identical); `whole=N` runs the matcher N times and nothing else (for
+//! `perf record`).
 
 use std::hash::{Hash, Hasher};
 use std::time::Instant;
@@ -39,7 +41,7 @@ fn min_ms(v: Vec<f64>) -> f64 {
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     if args.len() < 5 {
-        eprintln!("usage: hopfield_profile PREFIX W H MAX_DISPARITY [fingerprint]");
+        eprintln!("usage: hopfield_profile PREFIX W H MAX_DISPARITY [fingerprint | whole=N]");
         std::process::exit(2);
     }
     let num = |i: usize| -> usize { args[i].parse().expect("a number") };
@@ -50,6 +52,7 @@ fn main() {
         d_max: d,
         ..HopfieldParams::default()
     };
+    let ms = |s: Instant| s.elapsed().as_secs_f64() * 1e3;
     if args.get(5).map(String::as_str) == Some("fingerprint") {
         let out = hopfield_match(&l, &r, &p).expect("valid input");
         let mut hash = std::collections::hash_map::DefaultHasher::new();
@@ -72,8 +75,14 @@ fn main() {
         );
         return;
     }
+    if let Some(n) = args.get(5).and_then(|a| a.strip_prefix("whole=")) {
+        let n: usize = n.parse().expect("a run count");
+        for _ in 0..n {
+            hopfield_match(&l, &r, &p).expect("valid input");
+        }
+        return;
+    }
     let mut t = [(); 6].map(|_| Vec::new());
-    let ms = |s: Instant| s.elapsed().as_secs_f64() * 1e3;
     for _ in 0..9 {
         let s = Instant::now();
         interest_points(&l, &p.interest);
