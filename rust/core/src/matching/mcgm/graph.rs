@@ -149,29 +149,27 @@ pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Vec<Vec<u32>> {
         return adj;
     }
     let cell = r_max.max(1.0);
-    let key = |s: &Segment| {
-        (
-            (s.centroid.0 / cell).floor() as i64,
-            (s.centroid.1 / cell).floor() as i64,
-        )
-    };
+    // Centroids apart from the segments (their pixel lists made the scan miss the cache).
+    let cs: Vec<(f32, f32)> = segs.iter().map(|s| s.centroid).collect();
+    let key = |c: (f32, f32)| ((c.0 / cell).floor() as i64, (c.1 / cell).floor() as i64);
     let mut grid: std::collections::HashMap<(i64, i64), Vec<u32>> = Default::default();
-    for (i, s) in segs.iter().enumerate() {
-        grid.entry(key(s)).or_default().push(i as u32);
+    for (i, &c) in cs.iter().enumerate() {
+        grid.entry(key(c)).or_default().push(i as u32);
     }
+    let by_dist = |a: &(f32, u32), b: &(f32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
     let nearest: Vec<Vec<u32>> = (0..n)
         .into_par_iter()
-        .map(|i| {
-            let (cx, cy) = key(&segs[i]);
-            let (x, y) = segs[i].centroid;
-            let mut d: Vec<(f32, u32)> = Vec::new();
+        .map_init(Vec::new, |d: &mut Vec<(f32, u32)>, i| {
+            let (cx, cy) = key(cs[i]);
+            let (x, y) = cs[i];
+            d.clear();
             for gy in cy - 1..=cy + 1 {
                 for gx in cx - 1..=cx + 1 {
                     for &j in grid.get(&(gx, gy)).map(|v| v.as_slice()).unwrap_or(&[]) {
                         if j as usize == i {
                             continue;
                         }
-                        let (u, v) = segs[j as usize].centroid;
+                        let (u, v) = cs[j as usize];
                         let dd = ((u - x) * (u - x) + (v - y) * (v - y)).sqrt();
                         if dd <= r_max {
                             d.push((dd, j));
@@ -179,9 +177,13 @@ pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Vec<Vec<u32>> {
                     }
                 }
             }
-            d.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            d.truncate(k);
-            d.into_iter().map(|(_, j)| j).collect()
+            // The k nearest (ties by id), then in that order: a selection, not a full sort.
+            if d.len() > k {
+                d.select_nth_unstable_by(k - 1, by_dist);
+                d.truncate(k);
+            }
+            d.sort_by(by_dist);
+            d.iter().map(|&(_, j)| j).collect()
         })
         .collect();
     for (i, nb) in nearest.iter().enumerate() {

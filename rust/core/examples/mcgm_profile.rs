@@ -1,0 +1,65 @@
+//! Stage timings of the MCGM channel on a real pair (raw float32 grey images from
+//! `benches/dump_grey.py`): `cargo run --release --example mcgm_profile -- PREFIX W H D [fingerprint | whole=N]`
+//! (`fingerprint`: match count and a hash of every match, to check that a change leaves the
+//! output bit-identical).
+
+use std::time::Instant;
+
+use stereovision_core::image::Image;
+use stereovision_core::matching::mcgm::{image_curves, mcgm_match, McgmParams};
+
+fn load(path: &str, w: usize, h: usize) -> Image {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let v: Vec<f32> = bytes
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    Image::new(w, h, v).expect("a w x h float32 image")
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let num = |i: usize| -> usize { args[i].parse().expect("a number") };
+    let (w, h, d) = (num(2), num(3), num(4));
+    let l = load(&format!("{}_l.f32", args[1]), w, h);
+    let r = load(&format!("{}_r.f32", args[1]), w, h);
+    let p = McgmParams {
+        d_max: d,
+        ..McgmParams::default()
+    };
+    if let Some(n) = args.get(5).and_then(|a| a.strip_prefix("whole=")) {
+        for _ in 0..n.parse::<usize>().expect("a run count") {
+            mcgm_match(&l, &r, &p).expect("valid input");
+        }
+        return;
+    }
+    if args.get(5).map(String::as_str) == Some("fingerprint") {
+        use std::hash::{Hash, Hasher};
+        let out = mcgm_match(&l, &r, &p).expect("valid input");
+        let mut hash = std::collections::hash_map::DefaultHasher::new();
+        for m in &out.matches {
+            [m.xl, m.yl, m.xr, m.yr, m.score]
+                .map(f32::to_bits)
+                .hash(&mut hash);
+            m.channel.hash(&mut hash);
+        }
+        let per: Vec<usize> = out.channels.iter().map(|c| c.matches.len()).collect();
+        println!(
+            "matches {} per channel {per:?} hash {:016x}",
+            out.matches.len(),
+            hash.finish()
+        );
+        return;
+    }
+    let ms = |s: Instant| s.elapsed().as_secs_f64() * 1e3;
+    let (mut curves, mut whole) = (f64::INFINITY, f64::INFINITY);
+    for _ in 0..7 {
+        let s = Instant::now();
+        image_curves(&l, &p).expect("valid");
+        curves = curves.min(ms(s));
+        let s = Instant::now();
+        mcgm_match(&l, &r, &p).expect("valid input");
+        whole = whole.min(ms(s));
+    }
+    println!("one image's curves {curves:.2}  whole matcher {whole:.2}  (ms, min of 7)");
+}
