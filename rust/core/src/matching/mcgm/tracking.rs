@@ -114,12 +114,18 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
     let max_turn = (p.max_turn_deg as f64).to_radians();
     let mut labels = vec![-1i32; n];
     let mut segments = Vec::new();
-    let grow = |start: usize, sign: f64, state: &mut Vec<u8>, out: &mut Vec<u32>| {
+    // Grows from `start` (tangent `t0`) along `sign * t0`, appending the pixels taken and their
+    // tangents to `out`.
+    let grow = |start: usize,
+                t0: (f64, f64),
+                sign: f64,
+                state: &mut Vec<u8>,
+                out: &mut Vec<(u32, (f64, f64))>| {
         let mut cur = start;
-        let (tx, ty) = tangent(zc.theta[start]);
-        let mut dir = (sign * tx, sign * ty);
+        let mut dir = (sign * t0.0, sign * t0.1);
+        // The position follows the steps (no division per step).
+        let (mut cx, mut cy) = ((start % w) as i32, (start / w) as i32);
         loop {
-            let (cx, cy) = ((cur % w) as i32, (cur / w) as i32);
             let tc = zc.theta[cur] as f64;
             let mut best: Option<(f64, f32, usize, (i32, i32))> = None;
             for &(dx, dy) in &NEIGHBOURS {
@@ -134,12 +140,13 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
                 if wrap_angle(zc.theta[q] as f64 - tc).abs() >= max_turn {
                     continue;
                 }
-                let len = if dx != 0 && dy != 0 {
-                    std::f64::consts::SQRT_2
+                let proj = dx as f64 * dir.0 + dy as f64 * dir.1;
+                // An axis step's length is 1: no division (x / 1.0 == x).
+                let dot = if dx != 0 && dy != 0 {
+                    proj / std::f64::consts::SQRT_2
                 } else {
-                    1.0
+                    proj
                 };
-                let dot = (dx as f64 * dir.0 + dy as f64 * dir.1) / len;
                 if dot <= 0.0 {
                     continue; // forward half-plane only
                 }
@@ -152,8 +159,8 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
                 break;
             };
             state[q] = TAKEN;
-            out.push(q as u32);
             let (tx, ty) = tangent(zc.theta[q]);
+            out.push((q as u32, (tx, ty)));
             let sgn = if tx * dx as f64 + ty * dy as f64 >= 0.0 {
                 1.0
             } else {
@@ -161,26 +168,29 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
             };
             dir = (sgn * tx, sgn * ty);
             cur = q;
+            (cx, cy) = (cx + dx, cy + dy);
         }
     };
+    let (mut fwd, mut bwd) = (Vec::new(), Vec::new());
     for &s in &seeds {
         let s = s as usize;
         if state[s] != FREE {
             continue;
         }
         state[s] = TAKEN;
-        let mut fwd = Vec::new();
-        let mut bwd = Vec::new();
-        grow(s, 1.0, &mut state, &mut fwd);
-        grow(s, -1.0, &mut state, &mut bwd);
+        let t0 = tangent(zc.theta[s]);
+        fwd.clear();
+        bwd.clear();
+        grow(s, t0, 1.0, &mut state, &mut fwd);
+        grow(s, t0, -1.0, &mut state, &mut bwd);
         if 1 + fwd.len() + bwd.len() < p.min_len {
             continue;
         }
-        let mut pixels: Vec<u32> = bwd.into_iter().rev().collect();
-        pixels.push(s as u32);
-        pixels.extend(fwd);
+        let mut pixels: Vec<(u32, (f64, f64))> = bwd.iter().rev().copied().collect();
+        pixels.push((s as u32, t0));
+        pixels.extend_from_slice(&fwd);
         let id = segments.len() as i32;
-        segments.push(make_segment(zc, pixels, &mut labels, id));
+        segments.push(make_segment(w, &pixels, &mut labels, id));
     }
     Curves {
         segments,
@@ -190,19 +200,18 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
     }
 }
 
-fn make_segment(zc: &ZeroCrossings, pixels: Vec<u32>, labels: &mut [i32], id: i32) -> Segment {
-    let w = zc.width;
+/// The segment of `pixels` (with their tangents `(-sin theta, cos theta)`), labelled `id`.
+fn make_segment(w: usize, pixels: &[(u32, (f64, f64))], labels: &mut [i32], id: i32) -> Segment {
     let (mut sx, mut sy, mut sc, mut ss) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let (mut x_min, mut x_max, mut y_min, mut y_max) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
-    for &i in &pixels {
+    for &(i, (tx, ty)) in pixels {
         let i = i as usize;
         labels[i] = id;
         let (x, y) = ((i % w) as i32, (i / w) as i32);
         sx += x as f64;
         sy += y as f64;
-        let t = zc.theta[i] as f64;
-        sc += t.cos();
-        ss += t.sin();
+        sc += ty; // cos theta
+        ss += -tx; // sin theta
         x_min = x_min.min(x);
         x_max = x_max.max(x);
         y_min = y_min.min(y);
@@ -217,6 +226,6 @@ fn make_segment(zc: &ZeroCrossings, pixels: Vec<u32>, labels: &mut [i32], id: i3
         y_min,
         y_max,
         mean_theta: (if m < 0.0 { m + TAU } else { m }) as f32 % std::f32::consts::TAU,
-        pixels,
+        pixels: pixels.iter().map(|&(i, _)| i).collect(),
     }
 }
