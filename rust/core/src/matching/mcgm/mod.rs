@@ -386,51 +386,104 @@ const SPREAD_ORDER: [(i32, i32); 8] = [
 ];
 
 /// Nearest-valid fill of a NaN map up to `radius` px in chessboard distance (B.4.11's
-/// distance-limited spread): `radius` synchronous 8-neighbour dilations, each new pixel taking
-/// the value of its first valid neighbour in [`SPREAD_ORDER`] from the previous step.
+/// distance-limited spread): the result of `radius` synchronous 8-neighbour dilations, each new
+/// pixel taking the value of its first valid neighbour in [`SPREAD_ORDER`] from the previous
+/// step. Computed without the dilations: the pixels a dilation fills at step `t` are those at
+/// chessboard distance `t` from the valid ones (an exact two-pass distance transform), and their
+/// valid neighbours one step before are the neighbours at distance `t - 1`; so the levels are
+/// filled in order, each from the one before.
 pub fn spread_prior(map: &[f32], w: usize, h: usize, radius: i32) -> Vec<f32> {
     let mut cur = map.to_vec();
-    let mut front: Vec<usize> = (0..w * h).filter(|&i| cur[i].is_finite()).collect();
-    let mut seen = vec![false; w * h];
-    for _ in 0..radius {
-        let mut next: Vec<usize> = Vec::new();
-        for &i in &front {
-            let (x, y) = ((i % w) as i32, (i / w) as i32);
+    if radius <= 0 || w == 0 || h == 0 {
+        return cur;
+    }
+    let far = radius.min(u16::MAX as i32 - 1) as u16 + 1;
+    let mut dist: Vec<u16> = map
+        .iter()
+        .map(|v| if v.is_finite() { 0 } else { far })
+        .collect();
+    // Forward pass (neighbours above and to the left), then backward (below and right): each
+    // row takes its vertical and diagonal terms from the row before, then the chain along x.
+    for pass in 0..2 {
+        for k in 0..h {
+            let y = if pass == 0 { k } else { h - 1 - k };
+            let (row, prev) = if k == 0 {
+                (&mut dist[y * w..(y + 1) * w], None)
+            } else {
+                let py = if pass == 0 { y - 1 } else { y + 1 };
+                let (lo, hi) = dist.split_at_mut(y.max(py) * w);
+                if pass == 0 {
+                    (&mut hi[..w], Some(&lo[py * w..(py + 1) * w]))
+                } else {
+                    (&mut lo[y * w..(y + 1) * w], Some(&hi[..w]))
+                }
+            };
+            if let Some(p) = prev {
+                for x in 0..w {
+                    let mut m = p[x];
+                    if x > 0 {
+                        m = m.min(p[x - 1]);
+                    }
+                    if x + 1 < w {
+                        m = m.min(p[x + 1]);
+                    }
+                    row[x] = row[x].min(m + 1);
+                }
+            }
+            if pass == 0 {
+                for x in 1..w {
+                    row[x] = row[x].min(row[x - 1] + 1);
+                }
+            } else {
+                for x in (0..w - 1).rev() {
+                    row[x] = row[x].min(row[x + 1] + 1);
+                }
+            }
+            for v in row.iter_mut() {
+                *v = (*v).min(far);
+            }
+        }
+    }
+    // The pixels of each level 1..=radius in raster order (counting sort), filled level by
+    // level.
+    let levels = far as usize;
+    let mut start = vec![0usize; levels + 1];
+    for &d in &dist {
+        if d >= 1 && d < far {
+            start[d as usize] += 1;
+        }
+    }
+    let mut acc = 0;
+    for s in start.iter_mut() {
+        let c = *s;
+        *s = acc;
+        acc += c;
+    }
+    let mut order = vec![(0i32, 0i32); acc];
+    let mut fill = start.clone();
+    for y in 0..h {
+        for (x, &d) in dist[y * w..(y + 1) * w].iter().enumerate() {
+            if d >= 1 && d < far {
+                order[fill[d as usize]] = (x as i32, y as i32);
+                fill[d as usize] += 1;
+            }
+        }
+    }
+    for t in 1..levels {
+        let want = t as u16 - 1;
+        for &(x, y) in &order[start[t]..fill[t]] {
             for &(dx, dy) in &SPREAD_ORDER {
                 let (nx, ny) = (x + dx, y + dy);
                 if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
                     continue;
                 }
                 let q = ny as usize * w + nx as usize;
-                if !cur[q].is_finite() && !seen[q] {
-                    seen[q] = true;
-                    next.push(q);
+                if dist[q] == want {
+                    cur[y as usize * w + x as usize] = cur[q];
+                    break;
                 }
             }
         }
-        // Values from the previous step only (synchronous update).
-        let vals: Vec<f32> = next
-            .iter()
-            .map(|&q| {
-                let (x, y) = ((q % w) as i32, (q / w) as i32);
-                SPREAD_ORDER
-                    .iter()
-                    .filter_map(|&(dx, dy)| {
-                        let (nx, ny) = (x + dx, y + dy);
-                        (nx >= 0 && ny >= 0 && nx < w as i32 && ny < h as i32)
-                            .then(|| cur[ny as usize * w + nx as usize])
-                    })
-                    .find(|v| v.is_finite())
-                    .unwrap_or(f32::NAN)
-            })
-            .collect();
-        for (&q, v) in next.iter().zip(vals) {
-            cur[q] = v;
-        }
-        if next.is_empty() {
-            break;
-        }
-        front = next;
     }
     cur
 }

@@ -205,3 +205,87 @@ fn bad_parameters_are_errors_not_panics() {
         .matches
         .is_empty());
 }
+
+/// The former implementation (frontier dilations): the reference of [`spread_prior`].
+/// Nearest-valid fill of a NaN map up to `radius` px in chessboard distance (B.4.11's
+/// distance-limited spread): `radius` synchronous 8-neighbour dilations, each new pixel taking
+/// the value of its first valid neighbour in [`SPREAD_ORDER`] from the previous step.
+fn spread_by_dilations(map: &[f32], w: usize, h: usize, radius: i32) -> Vec<f32> {
+    let mut cur = map.to_vec();
+    let mut front: Vec<usize> = (0..w * h).filter(|&i| cur[i].is_finite()).collect();
+    let mut seen = vec![false; w * h];
+    for _ in 0..radius {
+        let mut next: Vec<usize> = Vec::new();
+        for &i in &front {
+            let (x, y) = ((i % w) as i32, (i / w) as i32);
+            for &(dx, dy) in &SPREAD_ORDER {
+                let (nx, ny) = (x + dx, y + dy);
+                if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
+                    continue;
+                }
+                let q = ny as usize * w + nx as usize;
+                if !cur[q].is_finite() && !seen[q] {
+                    seen[q] = true;
+                    next.push(q);
+                }
+            }
+        }
+        // Values from the previous step only (synchronous update).
+        let vals: Vec<f32> = next
+            .iter()
+            .map(|&q| {
+                let (x, y) = ((q % w) as i32, (q / w) as i32);
+                SPREAD_ORDER
+                    .iter()
+                    .filter_map(|&(dx, dy)| {
+                        let (nx, ny) = (x + dx, y + dy);
+                        (nx >= 0 && ny >= 0 && nx < w as i32 && ny < h as i32)
+                            .then(|| cur[ny as usize * w + nx as usize])
+                    })
+                    .find(|v| v.is_finite())
+                    .unwrap_or(f32::NAN)
+            })
+            .collect();
+        for (&q, v) in next.iter().zip(vals) {
+            cur[q] = v;
+        }
+        if next.is_empty() {
+            break;
+        }
+        front = next;
+    }
+    cur
+}
+
+#[test]
+fn spread_prior_equals_the_dilations() {
+    let mut rng = crate::matching::hopfield::network::SplitMix64::new(3);
+    for &(w, h, density, radius) in &[
+        (1, 1, 1, 3),
+        (7, 5, 10, 2),
+        (60, 40, 50, 4),
+        (83, 61, 300, 9),
+        (40, 30, 2000, 40),
+        (50, 50, 0, 3),
+    ] {
+        let map: Vec<f32> = (0..w * h)
+            .map(|_| {
+                let r = rng.next_u64();
+                if density > 0 && r % density == 0 {
+                    (r >> 40) as f32 / 1000.0
+                } else if r % 97 == 1 {
+                    f32::INFINITY
+                } else {
+                    f32::NAN
+                }
+            })
+            .collect();
+        let want = spread_by_dilations(&map, w, h, radius);
+        let got = spread_prior(&map, w, h, radius);
+        let same = want
+            .iter()
+            .zip(&got)
+            .all(|(a, b)| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan()));
+        assert!(same, "{w}x{h} density 1/{density} radius {radius}");
+    }
+}
