@@ -654,14 +654,16 @@ fn half_mad(
     sad / n
 }
 
-/// Whether a half-window matches better (mean absolute difference + `sides_best_margin` below
-/// `here`) at another disparity `d + k`, `k` integer in `ks` with `|k| > 1`. Integer steps keep
-/// the interpolation weights of `d` (right samples `r[b - k] + f (r[b - k + 1] - r[b - k])`
-/// with `b = floor(x - d)`, `f = x - d - b`), so every `k` is compared fairly with `here`; the
-/// differences are laid out with `k` innermost (contiguous, vectorised) and summed in the
-/// window's raster order.
+/// Mean absolute differences of one half-window (as [`half_mad`]) at the disparities `d + k`,
+/// `k` integer in `ks` and such that every right sample lies inside the row, into `scratch.sad`
+/// (the sums; `sad[j] / n` is the value at `k = k_hi - j`). Returns `(k_lo, k_hi, n)`, or `None`
+/// when no `k` is left. Integer steps keep the interpolation weights of `d` (right samples
+/// `r[b - k] + f (r[b - k + 1] - r[b - k])` with `b = floor(x - d)`, `f = x - d - b`), so every
+/// `k` is compared fairly with `k = 0`, whose value is exactly [`half_mad`]'s (the same terms
+/// summed in the same order); the differences are laid out with `k` innermost (contiguous,
+/// vectorised) and summed in the window's raster order.
 #[allow(clippy::too_many_arguments)]
-fn other_disparity_better(
+fn half_sads(
     left: &Image,
     right: &Image,
     xi: i32,
@@ -670,11 +672,10 @@ fn other_disparity_better(
     d: f32,
     side: i32,
     (inner, outer, hh): (i32, i32, i32),
-    f: &FilterParams,
+    mean_free: bool,
     ks: (i32, i32),
-    here: f32,
     scratch: &mut SidesScratch,
-) -> bool {
+) -> Option<(i32, i32, f32)> {
     let w = right.width as i32;
     let n_cols = (outer - inner + 1) as usize;
     // Window columns and their interpolation bases.
@@ -690,14 +691,14 @@ fn other_disparity_better(
     // Every sample r[b - k], r[b - k + 1] must lie inside the row.
     let k_hi = ks.1.min(b_min);
     let k_lo = ks.0.max(b_max + 2 - w);
-    if k_hi < k_lo || (k_lo >= -1 && k_hi <= 1) {
-        return false;
+    if k_hi < k_lo {
+        return None;
     }
     // j = k_hi - k: the right samples of one window pixel are contiguous and ascending in j.
     let nk = (k_hi - k_lo + 1) as usize;
     let n_el = n_cols * (2 * hh + 1) as usize;
     let SidesScratch { diffs, off, sad } = scratch;
-    diffs.clear();
+    // Every difference is written below: no clearing.
     diffs.resize(n_el * nk, 0.0);
     off.clear();
     off.resize(nk, 0.0);
@@ -719,14 +720,14 @@ fn other_disparity_better(
                 lv,
                 fr,
             );
-            if f.sides_mean_free {
+            if mean_free {
                 add_row(off, out);
             }
             e += 1;
         }
     }
     let n = n_el as f32;
-    if f.sides_mean_free {
+    if mean_free {
         for v in off.iter_mut() {
             *v /= n;
         }
@@ -734,10 +735,7 @@ fn other_disparity_better(
     for e in 0..n_el {
         abs_dev_row(sad, &diffs[e * nk..(e + 1) * nk], off);
     }
-    (0..nk).any(|j| {
-        let k = k_hi - j as i32;
-        k.abs() > 1 && sad[j] / n + f.sides_best_margin < here
-    })
+    Some((k_lo, k_hi, n))
 }
 
 simd_fn! {
@@ -808,17 +806,16 @@ fn sides_ok(
         return false;
     }
     let geom = (inner, outer, hh);
+    let (k0, k1) = (
+        (range.0 as f32 - d).ceil() as i32,
+        (range.1 as f32 - d).floor() as i32,
+    );
     for side in [-1i32, 1] {
-        let here = half_mad(left, right, xi, yl, yr, d, side, geom, f.sides_mean_free);
-        if here > f.sides_mad {
-            return false;
-        }
-        if f.sides_best {
-            let (k0, k1) = (
-                (range.0 as f32 - d).ceil() as i32,
-                (range.1 as f32 - d).floor() as i32,
-            );
-            if other_disparity_better(
+        // With the other-disparity test, one pass gives `here` (k = 0) and the others (k in
+        // k0..=k1); k = 0 is added to the span when the range does not hold it.
+        let sads = if f.sides_best {
+            let span = (k0.min(0), k1.max(0));
+            half_sads(
                 left,
                 right,
                 xi,
@@ -827,11 +824,45 @@ fn sides_ok(
                 d,
                 side,
                 geom,
-                f,
-                (k0, k1),
-                here,
+                f.sides_mean_free,
+                span,
                 scratch,
-            ) {
+            )
+            .filter(|&(lo, hi, _)| lo <= 0 && 0 <= hi)
+        } else {
+            None
+        };
+        let here = match sads {
+            Some((_, hi, n)) => scratch.sad[hi as usize] / n,
+            None => half_mad(left, right, xi, yl, yr, d, side, geom, f.sides_mean_free),
+        };
+        if here > f.sides_mad {
+            return false;
+        }
+        if !f.sides_best {
+            continue;
+        }
+        let sads = sads.or_else(|| {
+            half_sads(
+                left,
+                right,
+                xi,
+                yl,
+                yr,
+                d,
+                side,
+                geom,
+                f.sides_mean_free,
+                (k0, k1),
+                scratch,
+            )
+        });
+        // Another disparity of the range, more than 1 px away, fits better.
+        if let Some((lo, hi, n)) = sads {
+            let better = (lo.max(k0)..=hi.min(k1)).any(|k| {
+                k.abs() > 1 && scratch.sad[(hi - k) as usize] / n + f.sides_best_margin < here
+            });
+            if better {
                 return false;
             }
         }
