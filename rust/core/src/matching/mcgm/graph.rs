@@ -13,7 +13,7 @@
 
 use rayon::prelude::*;
 
-use super::rtable::{ght_vote, RTable};
+use super::rtable::{ght_vote, voters, RTable};
 use super::tracking::{wrap_angle, Segment};
 use crate::matching::hopfield::{run_dynamics, Csr};
 
@@ -61,6 +61,10 @@ pub fn candidates(
         }
     }
     let tol = (p.seg_theta_tol_deg as f64).to_radians();
+    let right_voters: Vec<Vec<(i32, i32, u32)>> = right
+        .par_iter()
+        .map(|s| voters(&s.pixels, theta_r, w, p.n_bins))
+        .collect();
     let per: Vec<Vec<Candidate>> = left
         .par_iter()
         .enumerate()
@@ -109,9 +113,7 @@ pub fn candidates(
                     let Some(g) = ght_vote(
                         &rtables[ia],
                         a.pixels.len(),
-                        &b.pixels,
-                        theta_r,
-                        w,
+                        &right_voters[ib as usize],
                         lo,
                         hi,
                         p.dy_band,

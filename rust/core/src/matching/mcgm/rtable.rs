@@ -71,16 +71,27 @@ pub struct Ght {
     pub peak: u32,
 }
 
-/// Votes `A'` (pixels `right`, normals `theta_r` of width `w`) against the R-table of `A` over
-/// translations `tx in [lo, hi]`, `ty in [-dy, dy]`; `acc` is scratch space. `None` when the
+/// A segment's pixels as voters of [`ght_vote`]: integer position and orientation bin of each
+/// (computed once per segment instead of once per comparison). `theta`: the image's normal
+/// directions, `w` its width.
+pub fn voters(pixels: &[u32], theta: &[f32], w: usize, n_bins: usize) -> Vec<(i32, i32, u32)> {
+    pixels
+        .iter()
+        .map(|&q| {
+            let (x, y) = ((q as usize % w) as i32, (q as usize / w) as i32);
+            (x, y, theta_bin(theta[q as usize], n_bins) as u32)
+        })
+        .collect()
+}
+
+/// Votes `A'` (its [`voters`]: pixel positions and orientation bins) against the R-table of `A`
+/// over translations `tx in [lo, hi]`, `ty in [-dy, dy]`; `acc` is scratch space. `None` when the
 /// window is empty or nothing voted. The caller guarantees `2 tol + 1 <= n_bins`.
 #[allow(clippy::too_many_arguments)]
 pub fn ght_vote(
     rt: &RTable,
     len_a: usize,
-    right: &[u32],
-    theta_r: &[f32],
-    w: usize,
+    right: &[(i32, i32, u32)],
     lo: i32,
     hi: i32,
     dy: i32,
@@ -95,9 +106,8 @@ pub fn ght_vote(
     let ny = (2 * dy + 1) as usize;
     acc.clear();
     acc.resize(nx * ny, 0);
-    for &q in right {
-        let (qx, qy) = ((q as usize % w) as i32, (q as usize / w) as i32);
-        let b = theta_bin(theta_r[q as usize], n_bins);
+    for &(qx, qy, b) in right {
+        let b = b as usize;
         for db in 0..=2 * tol {
             let bin = (b + n_bins + db - tol) % n_bins;
             let (s, e) = (rt.offsets[bin] as usize, rt.offsets[bin + 1] as usize);

@@ -3,7 +3,7 @@
 //! sub-pixel shift end to end.
 
 use super::log::{log_filter, log_kernels};
-use super::rtable::{build_rtable, ght_vote};
+use super::rtable::{build_rtable, ght_vote, voters};
 use super::tracking::track;
 use super::zerocross::{zero_crossings, ZC_H};
 use super::*;
@@ -130,9 +130,7 @@ fn ght_of_a_translated_contour_scores_one_at_the_translation() {
     let g = ght_vote(
         &rt,
         seg.pixels.len(),
-        &moved,
-        &theta,
-        w,
+        &voters(&moved, &theta, w, 36),
         0,
         20,
         1,
