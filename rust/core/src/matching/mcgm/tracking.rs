@@ -106,11 +106,14 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
             }
         }
     }
-    seeds.sort_unstable_by(|&a, &b| {
-        zc.strength[b as usize]
-            .total_cmp(&zc.strength[a as usize])
-            .then(a.cmp(&b))
-    });
+    // By decreasing strength, then index: one u64 key each (strengths are > 0, so their bit
+    // patterns order as the values do), not a comparison reading the strength map.
+    let mut keys: Vec<u64> = seeds
+        .iter()
+        .map(|&i| (u64::from(!zc.strength[i as usize].to_bits()) << 32) | u64::from(i))
+        .collect();
+    keys.sort_unstable();
+    let seeds: Vec<u32> = keys.iter().map(|&k| k as u32).collect();
     let max_turn = (p.max_turn_deg as f64).to_radians();
     let mut labels = vec![-1i32; n];
     let mut segments = Vec::new();
