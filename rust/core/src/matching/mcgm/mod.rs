@@ -654,6 +654,7 @@ fn half_mad(
     sad / n
 }
 
+simd_fn! {
 /// Mean absolute differences of one half-window (as [`half_mad`]) at the disparities `d + k`,
 /// `k` integer in `ks` and such that every right sample lies inside the row, into `scratch.sad`
 /// (the sums; `sad[j] / n` is the value at `k = k_hi - j`). Returns `(k_lo, k_hi, n)`, or `None`
@@ -662,7 +663,6 @@ fn half_mad(
 /// `k` is compared fairly with `k = 0`, whose value is exactly [`half_mad`]'s (the same terms
 /// summed in the same order); the differences are laid out with `k` innermost (contiguous,
 /// vectorised) and summed in the window's raster order.
-#[allow(clippy::too_many_arguments)]
 fn half_sads(
     left: &Image,
     right: &Image,
@@ -671,11 +671,14 @@ fn half_sads(
     yr: i32,
     d: f32,
     side: i32,
-    (inner, outer, hh): (i32, i32, i32),
+    geom: (i32, i32, i32),
     mean_free: bool,
     ks: (i32, i32),
     scratch: &mut SidesScratch,
 ) -> Option<(i32, i32, f32)> {
+    // One feature dispatch per half-window (this whole body is compiled for AVX2 as well): the
+    // row kernels below are inlined into it.
+    let (inner, outer, hh) = geom;
     let w = right.width as i32;
     let n_cols = (outer - inner + 1) as usize;
     // Window columns and their interpolation bases.
@@ -737,35 +740,33 @@ fn half_sads(
     }
     Some((k_lo, k_hi, n))
 }
+}
 
-simd_fn! {
-    /// `out[j] = lv - (a[j] + fr (b[j] - a[j]))`: left value minus the interpolated right one.
-    fn diff_row(out: &mut [f32], a: &[f32], b: &[f32], lv: f32, fr: f32) {
-        for ((o, &x0), &x1) in out.iter_mut().zip(a).zip(b) {
-            *o = lv - (x0 + fr * (x1 - x0));
-        }
+/// `out[j] = lv - (a[j] + fr (b[j] - a[j]))`: left value minus the interpolated right one.
+#[inline(always)]
+fn diff_row(out: &mut [f32], a: &[f32], b: &[f32], lv: f32, fr: f32) {
+    for ((o, &x0), &x1) in out.iter_mut().zip(a).zip(b) {
+        *o = lv - (x0 + fr * (x1 - x0));
     }
 }
 
-simd_fn! {
-    /// `acc[j] += v[j]`.
-    fn add_row(acc: &mut [f32], v: &[f32]) {
-        for (s, &x) in acc.iter_mut().zip(v) {
-            *s += x;
-        }
+/// `acc[j] += v[j]`.
+#[inline(always)]
+fn add_row(acc: &mut [f32], v: &[f32]) {
+    for (s, &x) in acc.iter_mut().zip(v) {
+        *s += x;
     }
 }
 
-simd_fn! {
-    /// `acc[j] += |v[j] - m[j]|`.
-    fn abs_dev_row(acc: &mut [f32], v: &[f32], m: &[f32]) {
-        for ((s, &x), &y) in acc.iter_mut().zip(v).zip(m) {
-            *s += (x - y).abs();
-        }
+/// `acc[j] += |v[j] - m[j]|`.
+#[inline(always)]
+fn abs_dev_row(acc: &mut [f32], v: &[f32], m: &[f32]) {
+    for ((s, &x), &y) in acc.iter_mut().zip(v).zip(m) {
+        *s += (x - y).abs();
     }
 }
 
-/// Per-thread buffers of [`other_disparity_better`] (no allocation per match).
+/// Per-thread buffers of [`half_sads`] (no allocation per match).
 #[derive(Default)]
 struct SidesScratch {
     diffs: Vec<f32>,
