@@ -97,12 +97,16 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
     const TAKEN: u8 = 2;
     let mut state = vec![0u8; n];
     let mut seeds: Vec<u32> = Vec::new();
-    for i in zc.marked() {
-        let s = zc.strength[i];
-        if s >= t_low && s > 0.0 {
-            state[i] = FREE;
-            if s >= t_high {
-                seeds.push(i as u32);
+    // Interior pixels only (zero_crossings marks no others): the growth reads the 8
+    // neighbours of a pixel without a bounds test.
+    for y in 1..h.saturating_sub(1) {
+        for i in y * w + 1..(y + 1) * w - 1 {
+            let s = zc.strength[i];
+            if zc.mark[i] != 0 && s >= t_low && s > 0.0 {
+                state[i] = FREE;
+                if s >= t_high {
+                    seeds.push(i as u32);
+                }
             }
         }
     }
@@ -131,12 +135,10 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
         loop {
             let tc = zc.theta[cur] as f64;
             let mut best: Option<(f64, f32, usize, (i32, i32))> = None;
+            // `cur` is an interior pixel (see `state`): its neighbours are inside the image.
+            debug_assert!(cx >= 1 && cy >= 1 && cx + 1 < w as i32 && cy + 1 < h as i32);
             for &(dx, dy) in &NEIGHBOURS {
-                let (nx, ny) = (cx + dx, cy + dy);
-                if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
-                    continue;
-                }
-                let q = ny as usize * w + nx as usize;
+                let q = (cy + dy) as usize * w + (cx + dx) as usize;
                 if state[q] != FREE {
                     continue;
                 }

@@ -51,9 +51,21 @@ pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
     let inside = |x: usize, y: usize| x >= 1 && y >= 1 && x + 1 < w && y + 1 < h;
     // Horizontal scan: the crossing between p and p + (1, 0) is marked on the pixel with the
     // smaller |L| (ties: p); a pixel with L = 0 exactly is marked if its neighbours differ in sign.
+    // Candidate positions first (sign change or an exact zero: a branch-free pass the compiler
+    // vectorises), then the rule at those positions only, in the same order.
+    let mut cand: Vec<u8> = Vec::with_capacity(w);
+    let flags = |cand: &mut Vec<u8>, a: &[f32], b: &[f32]| {
+        cand.clear();
+        cand.extend(
+            a.iter()
+                .zip(b)
+                .map(|(&a, &b)| u8::from(a * b < 0.0) | u8::from(a == 0.0)),
+        );
+    };
     for y in 1..h.saturating_sub(1) {
         let row = &l[y * w..(y + 1) * w];
-        for x in 0..w.saturating_sub(1) {
+        flags(&mut cand, &row[..w.saturating_sub(1)], &row[1.min(w)..]);
+        for x in (0..cand.len()).filter(|&x| cand[x] != 0) {
             let (a, b) = (row[x], row[x + 1]);
             let (px, pos) = if a * b < 0.0 {
                 let px = if a.abs() <= b.abs() { x } else { x + 1 };
@@ -76,8 +88,10 @@ pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
     }
     // Vertical scan: the same rule along y.
     for y in 0..h.saturating_sub(1) {
-        for x in 1..w.saturating_sub(1) {
-            let (a, b) = (l[y * w + x], l[(y + 1) * w + x]);
+        let (ra, rb) = (&l[y * w..(y + 1) * w], &l[(y + 1) * w..(y + 2) * w]);
+        flags(&mut cand, ra, rb);
+        for x in (1..w.saturating_sub(1)).filter(|&x| cand[x] != 0) {
+            let (a, b) = (ra[x], rb[x]);
             let py = if a * b < 0.0 {
                 if a.abs() <= b.abs() {
                     y
@@ -96,37 +110,49 @@ pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
     }
     let mut strength = vec![0.0f32; n];
     let mut theta = vec![0.0f32; n];
-    for i in 0..n {
-        if mark[i] == 0 {
-            continue;
-        }
-        let (x, y) = (i % w, i / w);
-        let gx = 0.5 * (l[i + 1] - l[i - 1]);
-        let gy = 0.5 * (l[i + w] - l[i - w]);
-        let st = (gx * gx + gy * gy).sqrt();
-        if st < MIN_STRENGTH {
-            mark[i] = 0;
-            xsub[i] = f32::NAN;
-            continue;
-        }
-        strength[i] = st;
-        let t = gy.atan2(gx);
-        theta[i] = if t < 0.0 { (t + TAU) % TAU } else { t };
-        if mark[i] & ZC_H == 0 {
-            // Vertical-only mark: x from the horizontal crossing next to it, else a Newton step.
-            let left = x as f32 - 1.0 + l[i - 1] / (l[i - 1] - l[i]);
-            let right = x as f32 + l[i] / (l[i] - l[i + 1]);
-            xsub[i] = if l[i - 1] * l[i] < 0.0 {
-                left
-            } else if l[i] * l[i + 1] < 0.0 {
-                right
-            } else if gx != 0.0 && (l[i] / gx).abs() <= MAX_NEWTON_STEP {
-                x as f32 - l[i] / gx
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            if mark[i] == 0 {
+                continue;
+            }
+            let gx = 0.5 * (l[i + 1] - l[i - 1]);
+            let gy = 0.5 * (l[i + w] - l[i - w]);
+            let st = (gx * gx + gy * gy).sqrt();
+            if st < MIN_STRENGTH {
+                mark[i] = 0;
+                xsub[i] = f32::NAN;
+                continue;
+            }
+            strength[i] = st;
+            let t = gy.atan2(gx);
+            // `(t + TAU) % TAU` without the fmod call: u = t + TAU lies in [pi, TAU], and
+            // u - TAU is exact there (Sterbenz).
+            theta[i] = if t < 0.0 {
+                let u = t + TAU;
+                if u >= TAU {
+                    u - TAU
+                } else {
+                    u
+                }
             } else {
-                x as f32
+                t
             };
+            if mark[i] & ZC_H == 0 {
+                // Vertical-only mark: x from the horizontal crossing next to it, else a Newton step.
+                let left = x as f32 - 1.0 + l[i - 1] / (l[i - 1] - l[i]);
+                let right = x as f32 + l[i] / (l[i] - l[i + 1]);
+                xsub[i] = if l[i - 1] * l[i] < 0.0 {
+                    left
+                } else if l[i] * l[i + 1] < 0.0 {
+                    right
+                } else if gx != 0.0 && (l[i] / gx).abs() <= MAX_NEWTON_STEP {
+                    x as f32 - l[i] / gx
+                } else {
+                    x as f32
+                };
+            }
         }
-        let _ = y;
     }
     ZeroCrossings {
         width: w,
