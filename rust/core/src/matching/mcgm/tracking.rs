@@ -99,14 +99,13 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
     let mut seeds: Vec<u32> = Vec::new();
     // Interior pixels only (zero_crossings marks no others): the growth reads the 8
     // neighbours of a pixel without a bounds test.
-    for y in 1..h.saturating_sub(1) {
-        for i in y * w + 1..(y + 1) * w - 1 {
-            let s = zc.strength[i];
-            if zc.mark[i] != 0 && s >= t_low && s > 0.0 {
-                state[i] = FREE;
-                if s >= t_high {
-                    seeds.push(i as u32);
-                }
+    let interior = (1..h.saturating_sub(1)).flat_map(|y| y * w + 1..(y + 1) * w - 1);
+    for i in interior {
+        let s = zc.strength[i];
+        if zc.mark[i] != 0 && s >= t_low && s > 0.0 {
+            state[i] = FREE;
+            if s >= t_high {
+                seeds.push(i as u32);
             }
         }
     }
