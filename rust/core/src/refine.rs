@@ -234,8 +234,8 @@ fn box_cols<T: BoxSample>(src: &[T], dst: &mut [T], w: usize, h: usize, b: usize
 
 /// Three box passes of half-width `b` along x, then three along y (zero padding): a
 /// Gaussian-like smoothing whose cost does not grow with its width.
-pub fn box3_zero<T: BoxSample>(a: &[T], w: usize, h: usize, b: usize) -> Vec<T> {
-    let mut rows = a.to_vec();
+pub fn box3_zero<T: BoxSample>(a: Vec<T>, w: usize, h: usize, b: usize) -> Vec<T> {
+    let mut rows = a;
     for_each_row(&mut rows, w, |_, row| {
         let mut tmp = vec![T::default(); row.len()];
         for _ in 0..3 {
@@ -245,7 +245,6 @@ pub fn box3_zero<T: BoxSample>(a: &[T], w: usize, h: usize, b: usize) -> Vec<T> 
     });
     // Columns in parallel strips of 64 (each strip's running sums are independent).
     const STRIP: usize = 64;
-    let mut out = vec![T::default(); w * h];
     let strips: Vec<usize> = (0..w).step_by(STRIP).collect();
     let done: Vec<(usize, Vec<T>)> = {
         use rayon::prelude::*;
@@ -265,7 +264,8 @@ pub fn box3_zero<T: BoxSample>(a: &[T], w: usize, h: usize, b: usize) -> Vec<T> 
             })
             .collect()
     };
-    // Back into rows, in parallel over the rows.
+    // Back into rows (the row-pass buffer, no longer read), in parallel over the rows.
+    let mut out = rows;
     for_each_row(&mut out, w, |y, row| {
         for (x0, strip) in &done {
             let sw = STRIP.min(w - x0);
@@ -290,12 +290,12 @@ pub fn nc_plane(d: &[f32], w: usize, h: usize, sigma: f32, residual: bool) -> (V
     let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
     let n = w * h;
     // m, m u, m v, m u^2, m u v, m v^2, m d, m u d, m v d, m d^2 (u, v about the image centre)
-    let moment = |k: usize, i: usize| -> f64 {
-        let v = d[i];
+    let moment = |k: usize, x: usize, y: usize| -> f64 {
+        let v = d[y * w + x];
         if !v.is_finite() {
             return 0.0;
         }
-        let (u, t, dd) = ((i % w) as f64 - cx, (i / w) as f64 - cy, v as f64);
+        let (u, t, dd) = (x as f64 - cx, y as f64 - cy, v as f64);
         match k {
             0 => 1.0,
             1 => u,
@@ -318,10 +318,10 @@ pub fn nc_plane(d: &[f32], w: usize, h: usize, sigma: f32, residual: bool) -> (V
             let mut m = vec![0f64; n];
             for_each_row(&mut m, w, |y, row| {
                 for (x, v) in row.iter_mut().enumerate() {
-                    *v = moment(k, y * w + x);
+                    *v = moment(k, x, y);
                 }
             });
-            box3_zero(&m, w, h, b)
+            box3_zero(m, w, h, b)
         })
         .collect();
     let mut plane = vec![f32::NAN; n];
@@ -393,8 +393,8 @@ pub fn nc_smooth(d: &[f32], w: usize, h: usize, sigma: f32) -> Vec<f32> {
         .iter()
         .map(|&v| if v.is_finite() { v } else { 0.0 })
         .collect();
-    let num = box3_zero(&vm, w, h, b);
-    let den = box3_zero(&m, w, h, b);
+    let num = box3_zero(vm, w, h, b);
+    let den = box3_zero(m, w, h, b);
     num.iter()
         .zip(&den)
         .map(|(&n, &dd)| if dd > 0.5 { n / dd } else { f32::NAN })
