@@ -205,6 +205,33 @@ fn box_row<T: BoxSample>(src: &[T], dst: &mut [T], b: usize) {
     }
 }
 
+/// Rows [`box3_zero`] sums together.
+const ROWS_AT_ONCE: usize = 4;
+
+/// [`box_row`] of `N` consecutive rows of width `w` (`src`, `dst`: `N * w` values), the rows'
+/// running sums interleaved: each row's values are exactly [`box_row`]'s.
+#[inline(always)]
+fn box_rows<T: BoxSample, const N: usize>(src: &[T], dst: &mut [T], w: usize, b: usize) {
+    let mut acc = [0f64; N];
+    for (r, a) in acc.iter_mut().enumerate() {
+        for v in src[r * w..].iter().take(b.min(w)) {
+            *a += v.to64();
+        }
+    }
+    for x in 0..w {
+        for (r, a) in acc.iter_mut().enumerate() {
+            let row = &src[r * w..(r + 1) * w];
+            if x + b < w {
+                *a += row[x + b].to64();
+            }
+            if x > b {
+                *a -= row[x - b - 1].to64();
+            }
+            dst[r * w + x] = T::from64(*a);
+        }
+    }
+}
+
 /// Box sum of half-width `b` down the columns (zero padding): a running sum per column, whole
 /// rows at a time (vectorised over x).
 fn box_cols<T: BoxSample>(src: &[T], dst: &mut [T], w: usize, h: usize, b: usize) {
@@ -236,13 +263,29 @@ fn box_cols<T: BoxSample>(src: &[T], dst: &mut [T], w: usize, h: usize, b: usize
 /// Gaussian-like smoothing whose cost does not grow with its width.
 pub fn box3_zero<T: BoxSample>(a: Vec<T>, w: usize, h: usize, b: usize) -> Vec<T> {
     let mut rows = a;
-    for_each_row(&mut rows, w, |_, row| {
-        let mut tmp = vec![T::default(); row.len()];
-        for _ in 0..3 {
-            box_row(row, &mut tmp, b);
-            row.copy_from_slice(&tmp);
+    // Rows in groups of ROWS_AT_ONCE: their running sums interleaved, so the adds of one row do
+    // not wait on each other (each row's sums in its own order, as box_row).
+    {
+        use rayon::prelude::*;
+        if w > 0 {
+            rows.par_chunks_mut(w * ROWS_AT_ONCE).for_each_init(
+                Vec::new,
+                |tmp: &mut Vec<T>, group| {
+                    tmp.resize(group.len(), T::default());
+                    for _ in 0..3 {
+                        if group.len() == w * ROWS_AT_ONCE {
+                            box_rows::<T, ROWS_AT_ONCE>(group, tmp, w, b);
+                        } else {
+                            for (src, dst) in group.chunks(w).zip(tmp.chunks_mut(w)) {
+                                box_row(src, dst, b);
+                            }
+                        }
+                        group.copy_from_slice(tmp);
+                    }
+                },
+            );
         }
-    });
+    }
     // Columns in parallel strips of 64 (each strip's running sums are independent).
     const STRIP: usize = 64;
     let strips: Vec<usize> = (0..w).step_by(STRIP).collect();
