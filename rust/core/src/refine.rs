@@ -614,10 +614,45 @@ fn image_mean(a: &[f32]) -> f32 {
     (a.iter().map(|&v| v as f64).sum::<f64>() / a.len().max(1) as f64) as f32
 }
 
+/// [`window_sum`] of an image of ones, without the passes: every row of the row pass is the
+/// same, so every row whose column window lies inside the image sums the same terms in the same
+/// order; those rows are one copied row, the others (the top and bottom `r`) are summed.
+fn window_mass(w: usize, h: usize, taps: &[f32]) -> Vec<f32> {
+    let r = taps.len() / 2;
+    let ones = vec![1f32; w];
+    let mut row = vec![0f32; w];
+    hconv(&ones, &mut row, taps);
+    // Column sums of the taps whose row `y + k - r` is inside the image.
+    let column = |y: usize, o: &mut [f32]| {
+        for (k, &g) in taps.iter().enumerate() {
+            let yy = y as i64 + k as i64 - r as i64;
+            if yy < 0 || yy >= h as i64 {
+                continue;
+            }
+            for (ov, &v) in o.iter_mut().zip(&row) {
+                *ov += g * v;
+            }
+        }
+    };
+    let mut inner = vec![0f32; w];
+    if h > 2 * r {
+        column(r, &mut inner);
+    }
+    let mut out = vec![0f32; w * h];
+    for_each_row(&mut out, w, |y, o| {
+        if y >= r && y + r < h {
+            o.copy_from_slice(&inner);
+        } else {
+            column(y, o);
+        }
+    });
+    out
+}
+
 fn left_stats(l: &[f32], r: &[f32], w: usize, h: usize, taps: &[f32]) -> LeftStats {
     let lm = image_mean(l);
     let lc: Vec<f32> = l.iter().map(|v| v - lm).collect();
-    let mass = window_sum(&vec![1f32; w * h], w, h, taps);
+    let mass = window_mass(w, h, taps);
     let s1 = window_sum(&lc, w, h, taps);
     let sq: Vec<f32> = lc.iter().map(|v| v * v).collect();
     let s2 = window_sum(&sq, w, h, taps);
@@ -942,6 +977,21 @@ pub fn refine_disparity(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn window_mass_equals_the_window_sum_of_ones() {
+        let taps = gaussian_taps(4.5, 9);
+        for (w, h) in [(30, 40), (7, 5), (50, 19), (12, 18), (3, 1)] {
+            let want = window_sum(&vec![1f32; w * h], w, h, &taps);
+            let got = window_mass(w, h, &taps);
+            assert!(
+                want.iter()
+                    .zip(&got)
+                    .all(|(a, b)| a.to_bits() == b.to_bits()),
+                "{w}x{h}"
+            );
+        }
+    }
 
     /// A textured pair with a known sub-pixel slanted disparity `d(x, y) = 6.3 + 0.01 y`.
     fn slanted_pair(w: usize, h: usize) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
