@@ -477,35 +477,73 @@ pub fn cubic_sample(row: &[f32], t: f32) -> f32 {
 }
 
 simd_fn! {
-    /// `out[x] = sum_k g_k src[x + k - r]` over the taps inside the row (zero padding).
+    /// `out[x] = sum_k g_k src[x + k - r]` over the taps inside the row (zero padding), the
+    /// taps added in order from 0.
     fn hconv(src: &[f32], out: &mut [f32], taps: &[f32]) {
         let w = src.len();
         let r = taps.len() / 2;
-        out.fill(0.0);
-        for (k, &g) in taps.iter().enumerate() {
-            let lo = r.saturating_sub(k);
-            let hi = (w + r).saturating_sub(k).min(w);
-            if lo >= hi {
-                continue;
+        // Pixels whose window lies inside the row, LANES at a time with the sums in registers.
+        const LANES: usize = 8;
+        let (a, b) = (r.min(w), w.saturating_sub(r));
+        let mut x = a;
+        while x + LANES <= b {
+            let mut acc = [0.0f32; LANES];
+            for (k, &g) in taps.iter().enumerate() {
+                let s = &src[x + k - r..x + k - r + LANES];
+                for l in 0..LANES {
+                    acc[l] += g * s[l];
+                }
             }
-            for (o, &v) in out[lo..hi].iter_mut().zip(&src[lo + k - r..hi + k - r]) {
-                *o += g * v;
+            out[x..x + LANES].copy_from_slice(&acc);
+            x += LANES;
+        }
+        // The borders and the interior's tail: the taps inside the row, in the same order.
+        for xx in (0..a).chain(x..w) {
+            let mut acc = 0.0f32;
+            for (k, &g) in taps.iter().enumerate() {
+                let j = xx as isize + k as isize - r as isize;
+                if j >= 0 && (j as usize) < w {
+                    acc += g * src[j as usize];
+                }
             }
+            out[xx] = acc;
         }
     }
 }
 
 simd_fn! {
-    /// `a[x] += g * sa[x]`, and the same for `b` and `c` (the column pass of the window sums).
-    fn vacc3(a: &mut [f32], b: &mut [f32], c: &mut [f32], g: f32, sa: &[f32], sb: &[f32], sc: &[f32]) {
-        for (o, &v) in a.iter_mut().zip(sa) {
-            *o += g * v;
+    /// `a[x] = sum_t g_t sa[o_t + x]` over `taps` = `(g_t, o_t)` in order from 0, and the same
+    /// for `b` and `c` (the column pass of the window sums), LANES columns at a time with the
+    /// sums in registers.
+    fn vsum3(a: &mut [f32], b: &mut [f32], c: &mut [f32], taps: &[(f32, usize)], sa: &[f32], sb: &[f32], sc: &[f32]) {
+        const LANES: usize = 8;
+        let w = a.len();
+        let mut x = 0;
+        while x + LANES <= w {
+            let (mut p, mut q, mut r) = ([0.0f32; LANES], [0.0f32; LANES], [0.0f32; LANES]);
+            for &(g, o) in taps {
+                let (u, v, z) = (&sa[o + x..o + x + LANES], &sb[o + x..o + x + LANES], &sc[o + x..o + x + LANES]);
+                for l in 0..LANES {
+                    p[l] += g * u[l];
+                    q[l] += g * v[l];
+                    r[l] += g * z[l];
+                }
+            }
+            a[x..x + LANES].copy_from_slice(&p);
+            b[x..x + LANES].copy_from_slice(&q);
+            c[x..x + LANES].copy_from_slice(&r);
+            x += LANES;
         }
-        for (o, &v) in b.iter_mut().zip(sb) {
-            *o += g * v;
-        }
-        for (o, &v) in c.iter_mut().zip(sc) {
-            *o += g * v;
+        for xx in x..w {
+            let (mut p, mut q, mut r) = (0.0f32, 0.0f32, 0.0f32);
+            for &(g, o) in taps {
+                p += g * sa[o + xx];
+                q += g * sb[o + xx];
+                r += g * sc[o + xx];
+            }
+            a[xx] = p;
+            b[xx] = q;
+            c[xx] = r;
         }
     }
 }
@@ -754,17 +792,16 @@ fn zncc_band(
         let a12 = sized(&mut sc.a12, w);
         let z = &mut sc.z[k * band_len..(k + 1) * band_len];
         for y in y0..y1 {
-            a1.fill(0.0);
-            a2.fill(0.0);
-            a12.fill(0.0);
-            for (t, &g) in taps.iter().enumerate() {
-                let yy = y as i64 + t as i64 - rad as i64;
-                if yy < 0 || yy >= h as i64 {
-                    continue;
-                }
-                let o = (yy as usize - ya) * w;
-                vacc3(a1, a2, a12, g, &h1[o..o + w], &h2[o..o + w], &h12[o..o + w]);
-            }
+            // The taps whose row is inside the image, in order (their rows' offsets in the band).
+            let rows_in: Vec<(f32, usize)> = taps
+                .iter()
+                .enumerate()
+                .filter_map(|(t, &g)| {
+                    let yy = y as i64 + t as i64 - rad as i64;
+                    (yy >= 0 && yy < h as i64).then(|| (g, (yy as usize - ya) * w))
+                })
+                .collect();
+            vsum3(a1, a2, a12, &rows_in, h1, h2, h12);
             let rows = y * w..(y + 1) * w;
             zncc_row(
                 &mut z[(y - y0) * w..(y - y0 + 1) * w],
