@@ -512,38 +512,29 @@ simd_fn! {
 }
 
 simd_fn! {
-    /// `a[x] = sum_t g_t sa[o_t + x]` over `taps` = `(g_t, o_t)` in order from 0, and the same
-    /// for `b` and `c` (the column pass of the window sums), LANES columns at a time with the
-    /// sums in registers.
-    fn vsum3(a: &mut [f32], b: &mut [f32], c: &mut [f32], taps: &[(f32, usize)], sa: &[f32], sb: &[f32], sc: &[f32]) {
+    /// `a[x] = sum_t g_t sa[o_t + x]` over `taps` = `(g_t, o_t)` in order from 0, LANES columns at
+    /// a time with the sums in registers (the column pass of the window sums).
+    fn vsum1(a: &mut [f32], taps: &[(f32, usize)], sa: &[f32]) {
         const LANES: usize = 8;
         let w = a.len();
         let mut x = 0;
         while x + LANES <= w {
-            let (mut p, mut q, mut r) = ([0.0f32; LANES], [0.0f32; LANES], [0.0f32; LANES]);
+            let mut p = [0.0f32; LANES];
             for &(g, o) in taps {
-                let (u, v, z) = (&sa[o + x..o + x + LANES], &sb[o + x..o + x + LANES], &sc[o + x..o + x + LANES]);
+                let u = &sa[o + x..o + x + LANES];
                 for l in 0..LANES {
                     p[l] += g * u[l];
-                    q[l] += g * v[l];
-                    r[l] += g * z[l];
                 }
             }
             a[x..x + LANES].copy_from_slice(&p);
-            b[x..x + LANES].copy_from_slice(&q);
-            c[x..x + LANES].copy_from_slice(&r);
             x += LANES;
         }
         for xx in x..w {
-            let (mut p, mut q, mut r) = (0.0f32, 0.0f32, 0.0f32);
+            let mut p = 0.0f32;
             for &(g, o) in taps {
                 p += g * sa[o + xx];
-                q += g * sb[o + xx];
-                r += g * sc[o + xx];
             }
             a[xx] = p;
-            b[xx] = q;
-            c[xx] = r;
         }
     }
 }
@@ -631,18 +622,15 @@ fn window_sum(a: &[f32], w: usize, h: usize, taps: &[f32]) -> Vec<f32> {
     });
     let mut out = vec![0f32; w * h];
     for_each_row(&mut out, w, |y, o| {
-        for (k, &g) in taps.iter().enumerate() {
-            let yy = y as i64 + k as i64 - r as i64;
-            if yy < 0 || yy >= h as i64 {
-                continue;
-            }
-            for (ov, &v) in o
-                .iter_mut()
-                .zip(&tmp[yy as usize * w..(yy as usize + 1) * w])
-            {
-                *ov += g * v;
-            }
-        }
+        let rows_in: Vec<(f32, usize)> = taps
+            .iter()
+            .enumerate()
+            .filter_map(|(k, &g)| {
+                let yy = y as i64 + k as i64 - r as i64;
+                (yy >= 0 && yy < h as i64).then(|| (g, yy as usize * w))
+            })
+            .collect();
+        vsum1(o, &rows_in, &tmp);
     });
     out
 }
@@ -801,7 +789,9 @@ fn zncc_band(
                     (yy >= 0 && yy < h as i64).then(|| (g, (yy as usize - ya) * w))
                 })
                 .collect();
-            vsum3(a1, a2, a12, &rows_in, h1, h2, h12);
+            vsum1(a1, &rows_in, h1);
+            vsum1(a2, &rows_in, h2);
+            vsum1(a12, &rows_in, h12);
             let rows = y * w..(y + 1) * w;
             zncc_row(
                 &mut z[(y - y0) * w..(y - y0 + 1) * w],
