@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import itertools
 import time
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
@@ -334,7 +334,11 @@ def fuse_pair(
         raise ValueError(f"unknown channel(s) {bad}: expected {sorted(CHANNEL_BITS)}")
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
     rng: dict[str, Any] = {"max_disparity": max_disparity, "min_disparity": min_disparity}
-    runs = {"gabor": gabor_disparity, "mcgm": mcgm_match, "hopfield": hopfield_match}
+    runs: dict[str, Callable[..., Any]] = {
+        "gabor": gabor_disparity,
+        "mcgm": mcgm_match,
+        "hopfield": hopfield_match,
+    }
 
     def timed(name: str) -> tuple[Any, float]:
         t0 = time.perf_counter()
