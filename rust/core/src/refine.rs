@@ -615,22 +615,13 @@ struct LeftStats {
 
 /// Separable Gaussian-window sums (zero padding, rows then columns) of a full image.
 fn window_sum(a: &[f32], w: usize, h: usize, taps: &[f32]) -> Vec<f32> {
-    let r = taps.len() / 2;
     let mut tmp = vec![0f32; w * h];
     for_each_row(&mut tmp, w, |y, out| {
         hconv(&a[y * w..(y + 1) * w], out, taps)
     });
     let mut out = vec![0f32; w * h];
     for_each_row(&mut out, w, |y, o| {
-        let rows_in: Vec<(f32, usize)> = taps
-            .iter()
-            .enumerate()
-            .filter_map(|(k, &g)| {
-                let yy = y as i64 + k as i64 - r as i64;
-                (yy >= 0 && yy < h as i64).then(|| (g, yy as usize * w))
-            })
-            .collect();
-        vsum1(o, &rows_in, &tmp);
+        vsum1(o, &taps_inside(taps, y, h, |yy| yy * w), &tmp);
     });
     out
 }
@@ -638,6 +629,24 @@ fn window_sum(a: &[f32], w: usize, h: usize, taps: &[f32]) -> Vec<f32> {
 /// Mean of an image, summed in f64 in a fixed order.
 fn image_mean(a: &[f32]) -> f32 {
     (a.iter().map(|&v| v as f64).sum::<f64>() / a.len().max(1) as f64) as f32
+}
+
+/// The taps of a column window centred on row `y` whose row lies inside the image (`h` rows),
+/// in order, as `(weight, offset(row))`: the `taps` argument of [`vsum1`].
+fn taps_inside(
+    taps: &[f32],
+    y: usize,
+    h: usize,
+    offset: impl Fn(usize) -> usize,
+) -> Vec<(f32, usize)> {
+    let r = taps.len() / 2;
+    taps.iter()
+        .enumerate()
+        .filter_map(|(k, &g)| {
+            let yy = y as i64 + k as i64 - r as i64;
+            (yy >= 0 && yy < h as i64).then(|| (g, offset(yy as usize)))
+        })
+        .collect()
 }
 
 /// [`window_sum`] of an image of ones, without the passes: every row of the row pass is the
@@ -648,18 +657,8 @@ fn window_mass(w: usize, h: usize, taps: &[f32]) -> Vec<f32> {
     let ones = vec![1f32; w];
     let mut row = vec![0f32; w];
     hconv(&ones, &mut row, taps);
-    // Column sums of the taps whose row `y + k - r` is inside the image.
-    let column = |y: usize, o: &mut [f32]| {
-        for (k, &g) in taps.iter().enumerate() {
-            let yy = y as i64 + k as i64 - r as i64;
-            if yy < 0 || yy >= h as i64 {
-                continue;
-            }
-            for (ov, &v) in o.iter_mut().zip(&row) {
-                *ov += g * v;
-            }
-        }
-    };
+    // Every tap reads the same row (offset 0).
+    let column = |y: usize, o: &mut [f32]| vsum1(o, &taps_inside(taps, y, h, |_| 0), &row);
     let mut inner = vec![0f32; w];
     if h > 2 * r {
         column(r, &mut inner);
@@ -780,15 +779,8 @@ fn zncc_band(
         let a12 = sized(&mut sc.a12, w);
         let z = &mut sc.z[k * band_len..(k + 1) * band_len];
         for y in y0..y1 {
-            // The taps whose row is inside the image, in order (their rows' offsets in the band).
-            let rows_in: Vec<(f32, usize)> = taps
-                .iter()
-                .enumerate()
-                .filter_map(|(t, &g)| {
-                    let yy = y as i64 + t as i64 - rad as i64;
-                    (yy >= 0 && yy < h as i64).then(|| (g, (yy as usize - ya) * w))
-                })
-                .collect();
+            // The taps whose row is inside the image (offsets in the band's rows).
+            let rows_in = taps_inside(taps, y, h, |yy| (yy - ya) * w);
             vsum1(a1, &rows_in, h1);
             vsum1(a2, &rows_in, h2);
             vsum1(a12, &rows_in, h12);
