@@ -14,7 +14,14 @@ from stereovision.evaluate import dense_metrics, sparse_metrics
 from stereovision.io import load_scene
 from stereovision.match import match as sv_match
 from stereovision.matches import Matches
-from stereovision.matching.fusion import CHANNEL_BITS, fuse, fuse_pair, fused_dense
+from stereovision.matching.fusion import (
+    CHANNEL_BITS,
+    _nearest_within,
+    _radius_offsets,
+    fuse,
+    fuse_pair,
+    fused_dense,
+)
 from stereovision.matching.gabor import gabor_disparity
 from stereovision.matching.hopfield import hopfield_match
 
@@ -58,6 +65,27 @@ def test_sparse_channels_meet_within_radius() -> None:
     np.testing.assert_allclose(res.matches.xl - res.matches.xr, [7.25, 7.25])
     np.testing.assert_array_equal(res.sources, [2 | 4, 2 | 4])
     assert len(fuse(None, {"mcgm": mcgm, "hopfield": hop}, r_spatial=1.0)) == 0
+
+
+@pytest.mark.parametrize("r", [1.0, 1.5, 2.5])
+def test_nearest_within_takes_the_first_measured_offset(r: float) -> None:
+    rng = np.random.default_rng(int(r * 10))
+    h, w = 23, 31
+    dx = np.where(rng.random((h, w)) < 0.15, rng.random((h, w)) * 40, np.nan).astype(np.float32)
+    dy = np.where(rng.random((h, w)) < 0.9, rng.random((h, w)), np.nan).astype(np.float32)
+    got_x, got_y = _nearest_within(dx, dy, r)
+    want_x = np.full((h, w), np.nan, np.float32)
+    want_y = np.full((h, w), np.nan, np.float32)
+    for y in range(h):
+        for x in range(w):
+            for oy, ox in _radius_offsets(r):
+                sy, sx = y + oy, x + ox
+                if 0 <= sy < h and 0 <= sx < w and np.isfinite(dx[sy, sx]):
+                    want_x[y, x], want_y[y, x] = dx[sy, sx], dy[sy, sx]
+                    break
+    assert np.array_equal(got_x, want_x, equal_nan=True)
+    assert np.array_equal(got_y, want_y, equal_nan=True)
+    assert np.isfinite(got_x).sum() > np.isfinite(dx).sum()  # it did spread
 
 
 def test_vote_prefers_larger_subset_then_smaller_spread() -> None:

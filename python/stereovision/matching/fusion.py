@@ -102,18 +102,24 @@ def _radius_offsets(r: float) -> list[tuple[int, int]]:
 
 
 def _nearest_within(dx: F32, dy: F32, r: float) -> tuple[F32, F32]:
-    """Each pixel takes the nearest measured ``(dx, dy)`` within ``r`` px (NaN if none)."""
+    """Each pixel takes the nearest measured ``(dx, dy)`` within ``r`` px (NaN if none).
+
+    "Nearest" is the first offset of :func:`_radius_offsets` whose pixel is measured. The
+    measured pixels are sparse, so each offset moves them all at once, the offsets written from
+    the last to the first: a nearer offset overwrites a farther one (one offset never writes a
+    pixel twice).
+    """
     h, w = dx.shape
     out_x = np.full((h, w), np.nan, np.float32)
     out_y = np.full((h, w), np.nan, np.float32)
-    for oy, ox in _radius_offsets(r):
-        # target[y, x] <- source[y + oy, x + ox] where the target is still empty
-        ys, yt = slice(max(oy, 0), h + min(oy, 0)), slice(max(-oy, 0), h + min(-oy, 0))
-        xs, xt = slice(max(ox, 0), w + min(ox, 0)), slice(max(-ox, 0), w + min(-ox, 0))
-        src_x, src_y = dx[ys, xs], dy[ys, xs]
-        take = np.isnan(out_x[yt, xt]) & np.isfinite(src_x)
-        out_x[yt, xt] = np.where(take, src_x, out_x[yt, xt])
-        out_y[yt, xt] = np.where(take, src_y, out_y[yt, xt])
+    ys, xs = np.nonzero(np.isfinite(dx))
+    vx, vy = dx[ys, xs], dy[ys, xs]
+    for oy, ox in reversed(_radius_offsets(r)):
+        # target[y, x] <- source[y + oy, x + ox]
+        ty, tx = ys - oy, xs - ox
+        ok = (ty >= 0) & (ty < h) & (tx >= 0) & (tx < w)
+        out_x[ty[ok], tx[ok]] = vx[ok]
+        out_y[ty[ok], tx[ok]] = vy[ok]
     return out_x, out_y
 
 
