@@ -716,15 +716,11 @@ fn half_sads(
             let (b, fr) = base[c];
             let start = (b - k_hi) as usize;
             let out = &mut diffs[e * nk..(e + 1) * nk];
-            diff_row(
-                out,
-                &rrow[start..start + nk],
-                &rrow[start + 1..start + nk + 1],
-                lv,
-                fr,
-            );
+            let (a, b) = (&rrow[start..start + nk], &rrow[start + 1..start + nk + 1]);
             if mean_free {
-                add_row(off, out);
+                diff_add_row(out, off, a, b, lv, fr);
+            } else {
+                diff_row(out, a, b, lv, fr);
             }
             e += 1;
         }
@@ -750,11 +746,13 @@ fn diff_row(out: &mut [f32], a: &[f32], b: &[f32], lv: f32, fr: f32) {
     }
 }
 
-/// `acc[j] += v[j]`.
+/// [`diff_row`] into `out`, each difference also added to `acc[j]` (one pass).
 #[inline(always)]
-fn add_row(acc: &mut [f32], v: &[f32]) {
-    for (s, &x) in acc.iter_mut().zip(v) {
-        *s += x;
+fn diff_add_row(out: &mut [f32], acc: &mut [f32], a: &[f32], b: &[f32], lv: f32, fr: f32) {
+    for (((o, s), &x0), &x1) in out.iter_mut().zip(acc.iter_mut()).zip(a).zip(b) {
+        let v = lv - (x0 + fr * (x1 - x0));
+        *o = v;
+        *s += v;
     }
 }
 
