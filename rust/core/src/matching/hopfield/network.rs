@@ -138,6 +138,30 @@ impl DivBy {
     }
 }
 
+/// Stable counting sort of `items` by `key(item) < n_keys`: each key's start in the result
+/// (`n_keys + 1` values) and the items by key, in their given order within a key.
+fn counting_sort(
+    items: impl Iterator<Item = u32> + Clone,
+    key: impl Fn(u32) -> usize,
+    n_keys: usize,
+) -> (Vec<usize>, Vec<u32>) {
+    let mut start = vec![0usize; n_keys + 1];
+    for it in items.clone() {
+        start[key(it) + 1] += 1;
+    }
+    for i in 1..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut fill = start.clone();
+    let mut out = vec![0u32; start[n_keys]];
+    for it in items {
+        let k = key(it);
+        out[fill[k]] = it;
+        fill[k] += 1;
+    }
+    (start, out)
+}
+
 /// Uniform grid over the left points, counting-sorted: `items` lists the point indices cell by
 /// cell (raster order of the cells, point order within a cell) with their coordinates beside
 /// them, so the cells of one grid row around a point form ONE contiguous range.
@@ -165,19 +189,9 @@ impl PointGrid {
             .iter()
             .map(|p| (cell.of(p.1) * gw + cell.of(p.0)) as u32)
             .collect();
-        let mut start = vec![0usize; (gw * gh) as usize + 1];
-        for &c in &cells {
-            start[c as usize + 1] += 1;
-        }
-        for i in 1..start.len() {
-            start[i] += start[i - 1];
-        }
-        let mut fill = start.clone();
-        let mut items = vec![0u32; pxy.len()];
-        for (k, &c) in cells.iter().enumerate() {
-            items[fill[c as usize]] = k as u32;
-            fill[c as usize] += 1;
-        }
+        let n_cells = (gw * gh) as usize;
+        let (start, items) =
+            counting_sort(0..pxy.len() as u32, |k| cells[k as usize] as usize, n_cells);
         // Coordinates padded with LANES far-away entries: a block of lanes may read past the
         // last point (its lanes beyond a range are masked, these are never inside a window).
         let far = i32::MIN / 4;
@@ -871,37 +885,17 @@ fn strip_order(
     pxy: &[(i32, i32)],
     half: i32,
 ) -> (Vec<usize>, Vec<u32>, Vec<([(u32, u32); MAX_STRIPS], usize)>) {
-    let n_pts = pxy.len();
     let strip_h = (half + 1) / 2;
     let n_strips = pxy.iter().map(|p| p.1 / strip_h).max().unwrap_or(0) as usize + 1;
-    let mut strip_start = vec![0usize; n_strips + 1];
-    for &(_, y) in pxy {
-        strip_start[(y / strip_h) as usize + 1] += 1;
-    }
-    for i in 1..=n_strips {
-        strip_start[i] += strip_start[i - 1];
-    }
-    // Strips by (x, index): a stable counting sort by x, then a stable one into strips.
     let w_max = pxy.iter().map(|p| p.0).max().unwrap_or(0) as usize;
-    let mut x_start = vec![0usize; w_max + 2];
-    for &(x, _) in pxy {
-        x_start[x as usize + 1] += 1;
-    }
-    for i in 1..x_start.len() {
-        x_start[i] += x_start[i - 1];
-    }
-    let mut by_x = vec![0u32; n_pts];
-    for (q, &(x, _)) in pxy.iter().enumerate() {
-        by_x[x_start[x as usize]] = q as u32;
-        x_start[x as usize] += 1;
-    }
-    let mut sorder = vec![0u32; n_pts];
-    let mut fill = strip_start.clone();
-    for &q in &by_x {
-        let st = (pxy[q as usize].1 / strip_h) as usize;
-        sorder[fill[st]] = q;
-        fill[st] += 1;
-    }
+    // Strips by (x, index): a stable counting sort by x, then a stable one into strips.
+    let (_, by_x) = counting_sort(
+        0..pxy.len() as u32,
+        |q| pxy[q as usize].0 as usize,
+        w_max + 1,
+    );
+    let strip_of = |q: u32| (pxy[q as usize].1 / strip_h) as usize;
+    let (strip_start, sorder) = counting_sort(by_x.iter().copied(), strip_of, n_strips);
     let sx: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].0).collect();
     let sy: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].1).collect();
     // Per point (point order): its window's point ranges per strip and neighbour count n_p.
