@@ -810,8 +810,8 @@ fn sides_ok(
         (range.1 as f32 - d).floor() as i32,
     );
     for side in [-1i32, 1] {
-        // With the other-disparity test, one pass gives `here` (k = 0) and the others (k in
-        // k0..=k1); k = 0 is added to the span when the range does not hold it.
+        // With the other-disparity test, one pass gives the other disparities (k in k0..=k1)
+        // and `here` (k = 0; added to the span when the range does not hold it).
         let sads = if f.sides_best {
             let span = (k0.min(0), k1.max(0));
             half_sads(
@@ -827,35 +827,17 @@ fn sides_ok(
                 span,
                 scratch,
             )
-            .filter(|&(lo, hi, _)| lo <= 0 && 0 <= hi)
         } else {
             None
         };
+        // Without the test, or with k = 0 cut off at the row's end: half_mad (clamped samples).
         let here = match sads {
-            Some((_, hi, n)) => scratch.sad[hi as usize] / n,
-            None => half_mad(left, right, xi, yl, yr, d, side, geom, f.sides_mean_free),
+            Some((lo, hi, n)) if lo <= 0 && 0 <= hi => scratch.sad[hi as usize] / n,
+            _ => half_mad(left, right, xi, yl, yr, d, side, geom, f.sides_mean_free),
         };
         if here > f.sides_mad {
             return false;
         }
-        if !f.sides_best {
-            continue;
-        }
-        let sads = sads.or_else(|| {
-            half_sads(
-                left,
-                right,
-                xi,
-                yl,
-                yr,
-                d,
-                side,
-                geom,
-                f.sides_mean_free,
-                (k0, k1),
-                scratch,
-            )
-        });
         // Another disparity of the range, more than 1 px away, fits better.
         if let Some((lo, hi, n)) = sads {
             let better = (lo.max(k0)..=hi.min(k1)).any(|k| {
