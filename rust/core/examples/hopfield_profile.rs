@@ -16,23 +16,15 @@
 //! leaves the output bit-identical); `whole=N` runs the matcher N times and nothing else (for
 //! `perf record`).
 
+mod common;
+
 use std::hash::{Hash, Hasher};
 use std::time::Instant;
 
-use stereovision_core::image::Image;
 use stereovision_core::matching::hopfield::{
     candidate_neurons, hopfield_match, initial_state, interest_points, run_dynamics,
     HopfieldParams, Network, Weights,
 };
-
-fn load(path: &str, w: usize, h: usize) -> Image {
-    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let v: Vec<f32> = bytes
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
-    Image::new(w, h, v).expect("a w x h float32 image")
-}
 
 fn min_ms(v: Vec<f64>) -> f64 {
     v.into_iter().fold(f64::INFINITY, f64::min)
@@ -40,14 +32,10 @@ fn min_ms(v: Vec<f64>) -> f64 {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    if args.len() < 5 {
-        eprintln!("usage: hopfield_profile PREFIX W H MAX_DISPARITY [fingerprint | whole=N]");
-        std::process::exit(2);
-    }
-    let num = |i: usize| -> usize { args[i].parse().expect("a number") };
-    let (w, h, d) = (num(2), num(3), num(4));
-    let l = load(&format!("{}_l.f32", args[1]), w, h);
-    let r = load(&format!("{}_r.f32", args[1]), w, h);
+    let (l, r, d) = common::load_pair(
+        &args,
+        "hopfield_profile PREFIX W H MAX_DISPARITY [fingerprint | whole=N]",
+    );
     let p = HopfieldParams {
         d_max: d,
         ..HopfieldParams::default()

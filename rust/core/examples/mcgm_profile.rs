@@ -3,26 +3,18 @@
 //! (`fingerprint`: match count and a hash of every match, to check that a change leaves the
 //! output bit-identical).
 
+mod common;
+
 use std::time::Instant;
 
-use stereovision_core::image::Image;
 use stereovision_core::matching::mcgm::{image_curves, mcgm_match, McgmParams};
-
-fn load(path: &str, w: usize, h: usize) -> Image {
-    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{path}: {e}"));
-    let v: Vec<f32> = bytes
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect();
-    Image::new(w, h, v).expect("a w x h float32 image")
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let num = |i: usize| -> usize { args[i].parse().expect("a number") };
-    let (w, h, d) = (num(2), num(3), num(4));
-    let l = load(&format!("{}_l.f32", args[1]), w, h);
-    let r = load(&format!("{}_r.f32", args[1]), w, h);
+    let (l, r, d) = common::load_pair(
+        &args,
+        "mcgm_profile PREFIX W H MAX_DISPARITY [fingerprint | whole=N]",
+    );
     let p = McgmParams {
         d_max: d,
         ..McgmParams::default()
