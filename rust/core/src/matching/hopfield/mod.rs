@@ -35,6 +35,7 @@ use rayon::prelude::*;
 
 use crate::error::{CoreError, Result};
 use crate::image::ImageView;
+use crate::simd::simd_fn;
 pub use interest::{interest_points, moravec, InterestParams, InterestPoint};
 pub use network::{
     build_weights, run_dynamics, Csr, Dynamics, EnergyWeights, Network, Neuron, Weights,
@@ -291,9 +292,10 @@ struct CandScratch {
     found: Vec<Neuron>,
 }
 
+simd_fn! {
 /// The candidate neurons of left point `i` appended to `out` (best ZNCC first, at most
-/// `k_cand`), with their depth-edge verdict and sub-pixel offset.
-#[allow(clippy::too_many_arguments)]
+/// `k_cand`), with their depth-edge verdict and sub-pixel offset. Compiled for AVX2 too: the
+/// curves' maxima then run eight lanes wide.
 fn point_candidates(
     left: &ImageView<'_>,
     right: &ImageView<'_>,
@@ -391,6 +393,7 @@ fn point_candidates(
             .then(a.yr.cmp(&b.yr))
     });
     out.extend(sc.found.iter().take(p.k_cand));
+}
 }
 
 /// Candidate neurons of every left point, grouped by point (point order, then best ZNCC first),

@@ -676,9 +676,15 @@ fn blocks_portable(
 /// Right-row values one block of disparities reads: [`LANES`] positions plus the window.
 const WIN: usize = LANES + SIDE - 1;
 
-/// AVX2 body of [`blocks_portable`]: the template broadcast once per point (the products then
-/// read it from memory), the nine cell accumulators in registers, full blocks stored with
-/// their lanes reversed straight into disparity order.
+/// Blocks per pass of [`blocks_avx2`]: their nine cells each stay in L1 between template rows.
+const CHUNK: usize = 16;
+
+/// AVX2 body of [`blocks_portable`], template row by template row: the row's seven taps stay
+/// in registers while it runs over up to [`CHUNK`] blocks, each block's nine cell accumulators
+/// kept in a small array between rows. Every cell still receives its taps in row-major order
+/// from zero (same sums); a block then costs its 49 right-row loads and 12 accumulator reloads
+/// instead of 49 + 49 template broadcasts (the loads bounded the block-by-block version).
+/// Full blocks are stored with their lanes reversed straight into disparity order.
 ///
 /// # Safety
 /// The CPU must support AVX2, `src` must hold `6 * stride + 8 * blocks + 6` values, every
@@ -700,14 +706,6 @@ unsafe fn blocks_avx2(
     debug_assert!(st.iter().flatten().all(|v| v.len() >= blocks * LANES));
     debug_assert!(curves.iter().all(|c| c.len() == len));
     let z = _mm256_setzero_ps();
-    // Not `[z; 49]` then overwritten: that compiled to a memset per point.
-    let mut tb = std::mem::MaybeUninit::<[__m256; SIDE * SIDE]>::uninit();
-    let tp = tb.as_mut_ptr().cast::<__m256>();
-    for i in 0..SIDE * SIDE {
-        tp.add(i).write(_mm256_set1_ps(t[i / SIDE][i % SIDE]));
-    }
-    // SAFETY: all SIDE * SIDE entries were written just above.
-    let tb = tb.assume_init();
     let shift: [__m256; N_REGIONS] = [
         _mm256_set1_ps(norm.shift[0]),
         _mm256_set1_ps(norm.shift[1]),
@@ -723,61 +721,74 @@ unsafe fn blocks_avx2(
         _mm256_set1_ps(norm.inv_l[4]),
     ];
     let rev = _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0);
+    // cells[b][3 * band + group]; every entry is written (first row of its band) before read.
+    let mut cells = std::mem::MaybeUninit::<[[__m256; 9]; CHUNK]>::uninit();
+    let cp = cells.as_mut_ptr().cast::<__m256>();
     let base = src.as_ptr();
-    for bl in 0..blocks {
-        let j0 = bl * LANES;
-        let p = base.add(j0);
-        // The seven taps of template row `r` on right row `r`, into the band's three cells
-        // (a macro, not a function: every intrinsic must sit inside this AVX2 function).
-        macro_rules! band {
-            ($cells:ident, $r:expr) => {{
-                let row = p.add($r * stride);
+    for b0 in (0..blocks).step_by(CHUNK) {
+        let nb = CHUNK.min(blocks - b0);
+        for (r, trow) in t.iter().enumerate() {
+            let band = part_of(r);
+            // The first row of a band starts its cells from zero (as the sums always did).
+            let first = r == 0 || r == SIM_RADIUS || r == SIM_RADIUS + 1;
+            let tr: [__m256; SIDE] = std::array::from_fn(|c| _mm256_set1_ps(trow[c]));
+            let row = base.add(r * stride + b0 * LANES);
+            for b in 0..nb {
+                let p = row.add(b * LANES);
+                let acc = cp.add(b * 9 + 3 * band);
+                let (mut a0, mut a1, mut a2) = if first {
+                    (z, z, z)
+                } else {
+                    (acc.read(), acc.add(1).read(), acc.add(2).read())
+                };
                 // Left and right groups alternate (each keeps its column order).
-                for c in [0, 4, 1, 5, 2, 6, 3] {
-                    let g = part_of(c);
-                    let v = _mm256_loadu_ps(row.add(c));
-                    $cells[g] = _mm256_add_ps($cells[g], _mm256_mul_ps(tb[$r * SIDE + c], v));
-                }
-            }};
-        }
-        let (mut top, mut mid, mut bot) = ([z; 3], [z; 3], [z; 3]);
-        // Top and bottom rows interleaved: each cell still receives its taps in row-major
-        // order (same sums), but six accumulation chains instead of three are in flight at a
-        // time; in band order the adds' latency bounded a block more than the loads.
-        for r in 0..SIM_RADIUS {
-            band!(top, r);
-            band!(bot, SIM_RADIUS + 1 + r);
-        }
-        band!(mid, SIM_RADIUS);
-        // regions_of, spelled out with the same association order.
-        macro_rules! add {
-            ($a:expr, $b:expr) => {
-                _mm256_add_ps($a, $b)
-            };
-        }
-        let left = add!(add!(top[0], mid[0]), bot[0]);
-        let right = add!(add!(top[2], mid[2]), bot[2]);
-        let upper = add!(add!(top[0], top[1]), top[2]);
-        let lower = add!(add!(bot[0], bot[1]), bot[2]);
-        let full = add!(add!(add!(add!(left, right), top[1]), mid[1]), bot[1]);
-        let regs = [full, left, right, upper, lower];
-        let full_block = j0 + LANES <= len;
-        let mut part = [[0.0f32; LANES]; N_REGIONS];
-        for k in 0..N_REGIONS {
-            let s = _mm256_loadu_ps(st[0][k].as_ptr().add(j0));
-            let iv = _mm256_loadu_ps(st[1][k].as_ptr().add(j0));
-            let centred = _mm256_sub_ps(regs[k], _mm256_mul_ps(shift[k], s));
-            let v = _mm256_mul_ps(_mm256_mul_ps(centred, iv), inv_l[k]);
-            if full_block {
-                // Lanes j0..j0+8 are disparities len-1-j0 down to len-8-j0.
-                let dst = curves[k].as_mut_ptr().add(len - LANES - j0);
-                _mm256_storeu_ps(dst, _mm256_permutevar8x32_ps(v, rev));
-            } else {
-                _mm256_storeu_ps(part[k].as_mut_ptr(), v);
+                a0 = _mm256_add_ps(a0, _mm256_mul_ps(tr[0], _mm256_loadu_ps(p)));
+                a2 = _mm256_add_ps(a2, _mm256_mul_ps(tr[4], _mm256_loadu_ps(p.add(4))));
+                a0 = _mm256_add_ps(a0, _mm256_mul_ps(tr[1], _mm256_loadu_ps(p.add(1))));
+                a2 = _mm256_add_ps(a2, _mm256_mul_ps(tr[5], _mm256_loadu_ps(p.add(5))));
+                a0 = _mm256_add_ps(a0, _mm256_mul_ps(tr[2], _mm256_loadu_ps(p.add(2))));
+                a2 = _mm256_add_ps(a2, _mm256_mul_ps(tr[6], _mm256_loadu_ps(p.add(6))));
+                a1 = _mm256_add_ps(a1, _mm256_mul_ps(tr[3], _mm256_loadu_ps(p.add(3))));
+                acc.write(a0);
+                acc.add(1).write(a1);
+                acc.add(2).write(a2);
             }
         }
-        if !full_block {
-            store_block(&mut curves, j0, &part);
+        for b in 0..nb {
+            // SAFETY: rows 0, 3 and 4 wrote all nine cells of this block.
+            let c: [__m256; 9] = cp.add(b * 9).cast::<[__m256; 9]>().read();
+            let (top, mid, bot) = ([c[0], c[1], c[2]], [c[3], c[4], c[5]], [c[6], c[7], c[8]]);
+            // regions_of, spelled out with the same association order.
+            macro_rules! add {
+                ($a:expr, $b:expr) => {
+                    _mm256_add_ps($a, $b)
+                };
+            }
+            let left = add!(add!(top[0], mid[0]), bot[0]);
+            let right = add!(add!(top[2], mid[2]), bot[2]);
+            let upper = add!(add!(top[0], top[1]), top[2]);
+            let lower = add!(add!(bot[0], bot[1]), bot[2]);
+            let full = add!(add!(add!(add!(left, right), top[1]), mid[1]), bot[1]);
+            let regs = [full, left, right, upper, lower];
+            let j0 = (b0 + b) * LANES;
+            let full_block = j0 + LANES <= len;
+            let mut part = [[0.0f32; LANES]; N_REGIONS];
+            for k in 0..N_REGIONS {
+                let s = _mm256_loadu_ps(st[0][k].as_ptr().add(j0));
+                let iv = _mm256_loadu_ps(st[1][k].as_ptr().add(j0));
+                let centred = _mm256_sub_ps(regs[k], _mm256_mul_ps(shift[k], s));
+                let v = _mm256_mul_ps(_mm256_mul_ps(centred, iv), inv_l[k]);
+                if full_block {
+                    // Lanes j0..j0+8 are disparities len-1-j0 down to len-8-j0.
+                    let dst = curves[k].as_mut_ptr().add(len - LANES - j0);
+                    _mm256_storeu_ps(dst, _mm256_permutevar8x32_ps(v, rev));
+                } else {
+                    _mm256_storeu_ps(part[k].as_mut_ptr(), v);
+                }
+            }
+            if !full_block {
+                store_block(&mut curves, j0, &part);
+            }
         }
     }
 }
