@@ -1,7 +1,7 @@
 """Valid members of the channels' agreement vs each sparse channel alone, on every GT scene.
 
-For each scene: the Gabor map, the sparse channels of :data:`stereovision.match.METHODS` that are
-channels of the fusion (``mcgm``, ``hopfield``), and their valid members (:func:`fuse`, vote mode,
+For each scene: the channels and their valid members as ``match(..., method="fused")`` gives
+them (:func:`fuse_pair`: the Gabor map re-measured, ``mcgm``, ``hopfield``; vote mode,
 algorithms.md D.3 defaults). Printed per scene: precision@1 (@2 on KITTI, whose LiDAR GT sits
 about 0.4 px off), count with GT and 4x4 coverage of the members and of each channel, and each
 channel's *count at the members' precision*: the most matches it keeps, taken in decreasing
@@ -22,9 +22,8 @@ from _common import DATA
 from stereovision._validate import as_gray_float
 from stereovision.evaluate import count_at_precision, sparse_metrics
 from stereovision.io import find_scenes, load_scene
-from stereovision.match import METHODS, match
-from stereovision.matching.fusion import CHANNEL_BITS, fuse
-from stereovision.matching.gabor import gabor_disparity
+from stereovision.match import METHODS
+from stereovision.matching.fusion import CHANNEL_BITS, fuse_pair
 
 SPARSE = [m for m in METHODS if m in CHANNEL_BITS]
 
@@ -42,9 +41,8 @@ def main() -> None:
         tol = 2.0 if "kitti" in str(d) else 1.0
         md = int(sc.max_disparity)
         gl, gr = as_gray_float(sc.left, "left"), as_gray_float(sc.right, "right")
-        g = gabor_disparity(gl, gr, max_disparity=md)
-        chans = {m: match(sc.left, sc.right, method=m, max_disparity=md) for m in SPARSE}
-        res = fuse((g.disparity, g.confidence), chans)
+        res = fuse_pair(gl, gr, max_disparity=md)
+        chans = {m: res.channel_outputs[m] for m in SPARSE}
         fm = sparse_metrics(res.matches.xl, res.matches.yl, res.matches.xr, sc.gt)
         row = {
             "bench": "fusion",

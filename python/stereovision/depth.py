@@ -217,6 +217,7 @@ def _run_matcher(
     d_max: float,
     params: dict,
     channels: dict[str, Any] | None = None,
+    remeasure: bool = True,
 ) -> tuple[np.ndarray, np.ndarray]:
     if method == "gabor":
         from stereovision.matching.gabor import gabor_disparity
@@ -229,9 +230,17 @@ def _run_matcher(
         from stereovision.matching import fusion
 
         dense_kw = {k: params.pop(k) for k in list(params) if k in fusion.DENSE_DEFAULTS}
-        fr = fusion.fuse_pair(left, right, max_disparity=d_max, min_disparity=d_min, **params)
+        fr = fusion.fuse_pair(
+            left,
+            right,
+            max_disparity=d_max,
+            min_disparity=d_min,
+            remeasure_gabor=remeasure,
+            **params,
+        )
         g = fr.channel_outputs["gabor"]
-        disp, conf = fusion.fused_dense(g.disparity, g.confidence, fr.dispx, **dense_kw)
+        base = fr.channel_outputs.get("gabor_remeasured", g.disparity)
+        disp, conf = fusion.fused_dense(base, g.confidence, fr.dispx, **dense_kw)
         if channels is not None:
             channels.update(fr.channel_outputs, members=fr)
         return disp, conf
@@ -360,13 +369,14 @@ def depth_map(
         dense map (filled), ``"gabor"`` leaves a pixel it is not sure of NaN. Filled pixels keep
         confidence 0 and get no depth or 3-D point.
     refine : bool, optional
-        Re-measure the matcher's disparity to sub-pixel precision by a correlation that follows
-        the surface, drop pixels where the correlation disagrees, and fill holes next to
-        measured pixels where it peaks clearly (:func:`stereovision.refine.refine_disparity`;
-        filled pixels are measurements with confidence 0.25 and get a depth). None (default)
-        = the method's own choice: on for ``"gabor"`` (the depth figures it brings are in
-        docs/refine.md), off for ``"fused"``, whose output is already completed. It takes
-        2-3 times the Gabor channel's time; live use can pass False.
+        Re-measure the disparity to sub-pixel precision by a correlation that follows the
+        surface (:func:`stereovision.refine.refine_disparity`). ``"gabor"``: the output is
+        re-measured, pixels where the correlation disagrees are dropped, and holes next to
+        measured pixels are filled where it peaks clearly (filled pixels are measurements with
+        confidence 0.25 and get a depth); it takes 2-3 times the Gabor channel's time. ``"fused"``:
+        the Gabor map is re-measured before the vote
+        (:func:`stereovision.matching.fusion.remeasure`, about the Gabor channel's time, beside
+        the sparse channels). None (default) = on; live use can pass False.
     return_channels : bool
         Keep each channel's own output in :attr:`DepthResult.channels`.
     cloud : bool
@@ -453,18 +463,28 @@ def depth_map(
         )
     stage("prepare")
     channels: dict[str, Any] | None = {} if return_channels else None
+    if refine is None:
+        refine = True
+    # "gabor" refines its output below; "fused" re-measures the Gabor map before the vote (its
+    # output is already completed, and the refinement's drops would reopen holes).
     disp, conf = _run_matcher(
-        method, gl, gr, float(min_disparity), float(max_disparity), dict(params), channels
+        method,
+        gl,
+        gr,
+        float(min_disparity),
+        float(max_disparity),
+        dict(params),
+        channels,
+        remeasure=refine,
     )
     disp = np.ascontiguousarray(disp, dtype=np.float32)
     conf = np.ascontiguousarray(conf, dtype=np.float32)
     measured = np.isfinite(disp)
     conf = np.where(measured, conf, np.float32(0)).astype(np.float32)
     stage("match")
-    if refine is None:
-        refine = method not in _DENSE_METHODS
+    post_refine = refine and method not in _DENSE_METHODS
     filled: npt.NDArray[np.bool_] | None = None
-    if refine:
+    if post_refine:
         from stereovision.refine import refine_disparity
 
         ref = refine_disparity(
@@ -486,7 +506,7 @@ def depth_map(
     colors = np.zeros((0, 3), np.uint8)
     pixels = np.zeros((0, 2), np.int32)
     if calib is not None:
-        depth, depth_sigma = _depth_rectified(measured_disp, conf, calib, bool(refine), filled)
+        depth, depth_sigma = _depth_rectified(measured_disp, conf, calib, post_refine, filled)
         if cloud:
             points, colors, pixels = _cloud(depth, calib, left_bgr)
         stage("triangulate")

@@ -37,6 +37,7 @@ __all__ = [
     "fuse",
     "fuse_pair",
     "fused_dense",
+    "remeasure",
 ]
 
 F32 = npt.NDArray[np.float32]
@@ -75,7 +76,9 @@ class FusionResult:
         The channels that took part, in bit order.
     channel_outputs : dict
         What each channel returned, by name (:func:`fuse_pair` fills it: ``"gabor"`` a
-        :class:`~stereovision.matching.gabor.GaborResult`, the sparse ones :class:`Matches`).
+        :class:`~stereovision.matching.gabor.GaborResult`, the sparse ones :class:`Matches`),
+        and ``"gabor_remeasured"``, the Gabor map the vote used (:func:`remeasure`), when
+        :func:`fuse_pair` re-measured it.
     """
 
     matches: Matches
@@ -130,6 +133,53 @@ def _check_map(a: npt.ArrayLike, name: str, shape: tuple[int, int] | None) -> F3
     if shape is not None and arr.shape != shape:
         raise ValueError(f"{name}: shape {arr.shape} differs from the others' {shape}")
     return arr
+
+
+def remeasure(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    disparity: npt.ArrayLike,
+    confidence: npt.ArrayLike,
+    *,
+    max_disparity: float,
+    min_disparity: float = 0.0,
+) -> F32:
+    """The Gabor map re-measured to sub-pixel precision where it measured.
+
+    :func:`stereovision.refine.refine_disparity`'s correlation on the right image warped by the
+    map gives each measured pixel a new value; a pixel the correlation drops keeps the Gabor
+    value, and holes stay holes (the refinement's fill is not run: the vote and the members'
+    completion decide there). Gabor's phase estimates spread by about a third of a pixel; the
+    re-measured ones by half that (docs/refine.md), which the members' average and the dense
+    map inherit.
+
+    Parameters
+    ----------
+    left, right : array_like
+        The rectified grey pair.
+    disparity, confidence : array_like
+        ``(H, W)`` Gabor disparity (NaN = none) and confidence.
+    max_disparity, min_disparity : float
+        The range the channels searched (px).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` float32, NaN exactly where ``disparity`` is.
+    """
+    from stereovision.refine import refine_disparity
+
+    d = _check_map(disparity, "disparity", None)
+    r = refine_disparity(
+        left,
+        right,
+        d,
+        confidence,
+        min_disparity=min_disparity,
+        max_disparity=max_disparity,
+        fills=(),
+    )
+    return np.where(np.isfinite(r.disparity), r.disparity, d).astype(np.float32)
 
 
 def fuse(
@@ -301,6 +351,7 @@ def fuse_pair(
     max_disparity: float,
     min_disparity: float = 0.0,
     channels: tuple[str, ...] = ("gabor", "mcgm", "hopfield"),
+    remeasure_gabor: bool = True,
     **params: Any,
 ) -> FusionResult:
     """Run the channels on a rectified pair and fuse them (:func:`fuse`).
@@ -314,6 +365,14 @@ def fuse_pair(
         Disparity range every channel searches (px).
     channels : tuple of str
         Which channels take part: ``"gabor"`` and at least one of ``"mcgm"``, ``"hopfield"``.
+    remeasure_gabor : bool
+        Re-measure the Gabor map where it measured (:func:`remeasure`, in the Gabor channel's
+        thread while the sparse channels run) and vote with that; it is kept in
+        ``channel_outputs["gabor_remeasured"]``. Default True: on the 17 shared scenes the
+        members' precision@1 rose on 10 (>= 99 % on 10 of the 16 Middlebury/ETH3D/TartanAir
+        scenes instead of 8), terrace's member depth RMSE fell from 3.19 to 2.77 %, and the
+        dense map built on it (:func:`fused_dense`) has a lower bad-2.0 on 12 and a lower
+        bad-0.5 on all 17 (README, "Fusion").
     **params
         :func:`fuse`'s options (:data:`DEFAULTS`).
 
@@ -349,6 +408,9 @@ def fuse_pair(
     def timed(name: str) -> tuple[Any, float]:
         t0 = time.perf_counter()
         out = runs[name](gl, gr, **rng)
+        if name == "gabor" and remeasure_gabor:
+            # In this thread: it needs only the Gabor map, and the sparse channels run on.
+            out = (out, remeasure(gl, gr, out.disparity, out.confidence, **rng))
         return out, time.perf_counter() - t0
 
     # The channels run side by side: each kernel releases the GIL and has sequential stretches
@@ -363,7 +425,12 @@ def fuse_pair(
     outputs: dict[str, Any] = {}
     if "gabor" in done:
         g = done["gabor"][0]
-        dense = (g.disparity, g.confidence)
+        if remeasure_gabor:
+            g, g_disp = g
+            outputs["gabor_remeasured"] = g_disp
+        else:
+            g_disp = g.disparity
+        dense = (g_disp, g.confidence)
         outputs["gabor"] = g
     sparse: dict[str, Matches] = {n: done[n][0] for n in ("mcgm", "hopfield") if n in done}
     t = time.perf_counter()
