@@ -44,7 +44,8 @@ _DISPARITY_STEP = 16  # ranges are multiples of 16, like the evaluation protocol
 _SIGMA_RAW = (0.74, -0.52, 0.2)
 # After the refinement (the default; 3.1 M pixels): 0.34 px at confidence 0.18, 0.30 at 0.52,
 # 0.20 at 0.86; the pixels it filled (13 % of them) spread by 0.63 px, whatever their neighbours'
-# confidence.
+# confidence. The fused map on the re-measured Gabor map fits the same line (2.8 M pixels: 0.31 px
+# at confidence 0.47, 0.24 at 0.77, members 0.21; error / sigma median 0.69, 64 % within 1 sigma).
 _SIGMA_REFINED = (0.405, -0.221, 0.18)
 _SIGMA_FILLED = 0.63
 
@@ -506,7 +507,7 @@ def depth_map(
     colors = np.zeros((0, 3), np.uint8)
     pixels = np.zeros((0, 2), np.int32)
     if calib is not None:
-        depth, depth_sigma = _depth_rectified(measured_disp, conf, calib, post_refine, filled)
+        depth, depth_sigma = _depth_rectified(measured_disp, conf, calib, bool(refine), filled)
         if cloud:
             points, colors, pixels = _cloud(depth, calib, left_bgr)
         stage("triangulate")
