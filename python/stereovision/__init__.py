@@ -11,7 +11,7 @@ The hot kernels are Rust (``stereovision._core``); this package owns the API.
 """
 
 from stereovision import evaluate, io
-from stereovision._core import __version__
+from stereovision._core import __version__, release_memory
 from stereovision.calibration import Calibration
 from stereovision.depth import DepthResult, depth_map, estimate_max_disparity
 from stereovision.match import match
@@ -29,5 +29,6 @@ __all__ = [
     "evaluate",
     "io",
     "match",
+    "release_memory",
     "triangulate",
 ]

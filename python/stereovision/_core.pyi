@@ -156,3 +156,10 @@ def gray_u8(
 ) -> npt.NDArray[np.float32]:
     """Grey ``float32`` in ``[0, 1]`` of a C-contiguous ``(H, W)`` or ``(H, W, 1|3|4)`` uint8
     image (BGR order), bit-identical to ``as_gray_float``'s NumPy path."""
+
+def release_memory() -> int:
+    """Return the image-sized blocks the extension keeps for reuse to the system; bytes freed."""
+
+def kept_memory() -> tuple[int, int]:
+    """``(blocks, bytes)`` the extension keeps for reuse (freed blocks of >= 128 KiB, 128 MiB at
+    most)."""

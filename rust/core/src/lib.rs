@@ -2,6 +2,7 @@
 //!
 //! Layout mirrors the pipeline (see `docs/architecture.md`):
 //! * [`image`]: a minimal owned grey image and validation of inputs;
+//! * [`alloc`]: the allocator the extension installs (freed large blocks kept for the next call);
 //! * [`error`]: the one error type every kernel returns (mapped to Python exceptions by `rust/py`);
 //! * [`matching`]: the correspondence channels (`gabor`, `mcgm`, `hopfield`);
 //! * [`refine`]: sub-pixel refinement and validated completion of a disparity map;
@@ -11,6 +12,7 @@
 //! `x` = column, `y` = row; disparity `d = x_left - x_right`, stored at left-image pixels,
 //! `NaN` = no estimate.
 
+pub mod alloc;
 pub mod error;
 pub mod image;
 pub mod matching;

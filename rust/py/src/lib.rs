@@ -15,6 +15,23 @@ mod params;
 mod refine;
 mod triangulation;
 
+/// Freed image-sized blocks are kept for the next call instead of being returned to the system
+/// and faulted in again (`stereovision_core::alloc`); only the extension's allocations use it.
+#[global_allocator]
+static ALLOC: stereovision_core::alloc::BlockCache = stereovision_core::alloc::BlockCache::new();
+
+/// Returns the kept blocks to the system; the number of bytes released.
+#[pyfunction]
+fn release_memory() -> usize {
+    ALLOC.clear()
+}
+
+/// `(blocks, bytes)` kept for reuse.
+#[pyfunction]
+fn kept_memory() -> (usize, usize) {
+    ALLOC.kept()
+}
+
 #[pymodule(gil_used = false)]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
@@ -33,5 +50,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(triangulation::depth_rectified, m)?)?;
     m.add_function(wrap_pyfunction!(refine::refine_disparity, m)?)?;
     m.add_function(wrap_pyfunction!(convert::gray_u8, m)?)?;
+    m.add_function(wrap_pyfunction!(release_memory, m)?)?;
+    m.add_function(wrap_pyfunction!(kept_memory, m)?)?;
     Ok(())
 }
