@@ -158,8 +158,8 @@ def gray_u8(
     image (BGR order), bit-identical to ``as_gray_float``'s NumPy path."""
 
 def release_memory() -> int:
-    """Return the image-sized blocks the extension keeps for reuse to the system; bytes freed."""
+    """Return the memory the extension keeps for the next call to the system; bytes released."""
 
-def kept_memory() -> tuple[int, int]:
-    """``(blocks, bytes)`` the extension keeps for reuse (freed blocks of >= 128 KiB, 128 MiB at
-    most)."""
+def kept_memory() -> tuple[tuple[int, int], int]:
+    """``((blocks, bytes), pool_bytes)``: freed blocks of >= 128 KiB the allocator keeps (128 MiB
+    at most) and the Gabor planes' pool (256 MiB at most)."""

@@ -10,6 +10,8 @@
 //! its size and alignment (a frame of the same size asks for the same sizes); the oldest is
 //! released when the cache is full. Everything else goes straight to the system allocator. Only
 //! the extension's own (Rust) allocations use it: `rust/py` installs it as `#[global_allocator]`.
+//! The Gabor channel keeps its planes in its own pool (`matching::gabor::pool`: best-fit reuse
+//! without a zero fill, also under `cargo bench`); `stereovision.release_memory()` empties both.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::Mutex;

@@ -20,16 +20,22 @@ mod triangulation;
 #[global_allocator]
 static ALLOC: stereovision_core::alloc::BlockCache = stereovision_core::alloc::BlockCache::new();
 
-/// Returns the kept blocks to the system; the number of bytes released.
+use stereovision_core::matching::gabor::pool;
+
+/// Returns the memory kept for the next call to the system (the Gabor planes' pool, then the
+/// allocator's blocks, which the pool's buffers pass through); the number of bytes released.
 #[pyfunction]
 fn release_memory() -> usize {
-    ALLOC.clear()
+    let held = pool::held_bytes() + ALLOC.kept().1;
+    pool::release();
+    ALLOC.clear();
+    held
 }
 
-/// `(blocks, bytes)` kept for reuse.
+/// `(blocks, bytes)` the allocator keeps and the bytes the Gabor planes' pool keeps.
 #[pyfunction]
-fn kept_memory() -> (usize, usize) {
-    ALLOC.kept()
+fn kept_memory() -> ((usize, usize), usize) {
+    (ALLOC.kept(), pool::held_bytes())
 }
 
 #[pymodule(gil_used = false)]

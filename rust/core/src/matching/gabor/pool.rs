@@ -107,6 +107,17 @@ impl Drop for Buf {
     }
 }
 
+/// Bytes the pool holds between uses.
+pub fn held_bytes() -> usize {
+    lock().iter().map(|b| b.capacity() * 4).sum()
+}
+
+/// Frees every pooled buffer; returns the bytes they held.
+pub fn release() -> usize {
+    let all = std::mem::take(&mut *lock());
+    all.iter().map(|b| b.capacity() * 4).sum()
+}
+
 #[cfg(test)]
 mod tests {
     use super::Buf;
