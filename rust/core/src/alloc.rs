@@ -31,6 +31,13 @@ struct Block {
     align: usize,
 }
 
+/// An unused slot.
+const EMPTY: Block = Block {
+    ptr: 0,
+    size: 0,
+    align: 0,
+};
+
 /// The kept blocks, oldest first.
 struct Kept {
     blocks: [Block; SLOTS],
@@ -48,11 +55,7 @@ impl BlockCache {
     pub const fn new() -> Self {
         BlockCache {
             kept: Mutex::new(Kept {
-                blocks: [Block {
-                    ptr: 0,
-                    size: 0,
-                    align: 0,
-                }; SLOTS],
+                blocks: [EMPTY; SLOTS],
                 len: 0,
                 bytes: 0,
             }),
@@ -93,11 +96,7 @@ impl BlockCache {
         if l.size() > MAX_CACHED_BYTES {
             return false;
         }
-        let mut release = [Block {
-            ptr: 0,
-            size: 0,
-            align: 0,
-        }; SLOTS];
+        let mut release = [EMPTY; SLOTS];
         let mut n_release = 0;
         {
             let Some(mut k) = self.lock() else {
@@ -130,11 +129,7 @@ impl BlockCache {
     /// Returns every kept block to the system (e.g. before a long idle period); returns the
     /// bytes released (0 if another thread held the cache).
     pub fn clear(&self) -> usize {
-        let mut all = [Block {
-            ptr: 0,
-            size: 0,
-            align: 0,
-        }; SLOTS];
+        let mut all = [EMPTY; SLOTS];
         let (n, bytes) = {
             let Some(mut k) = self.lock() else {
                 return 0;
