@@ -5,6 +5,7 @@
 //! (`errors.rs`). No algorithm lives here.
 
 use pyo3::prelude::*;
+use stereovision_core::matching::gabor::pool;
 
 mod convert;
 mod errors;
@@ -19,8 +20,6 @@ mod triangulation;
 /// and faulted in again (`stereovision_core::alloc`); only the extension's allocations use it.
 #[global_allocator]
 static ALLOC: stereovision_core::alloc::BlockCache = stereovision_core::alloc::BlockCache::new();
-
-use stereovision_core::matching::gabor::pool;
 
 /// Returns the memory kept for the next call to the system (the Gabor planes' pool, then the
 /// allocator's blocks, which the pool's buffers pass through); the number of bytes released.
