@@ -301,7 +301,8 @@ def test_fused_depth_sigma_follows_its_map(data_dir: Path, refine: bool) -> None
 
 
 def test_fused_is_bit_identical_across_thread_counts(data_dir: Path) -> None:
-    """Issue 5: same inputs, same bits, with 1 or 2 rayon threads (dense map and members)."""
+    """Issue 5: same inputs, same bits, with 1, 2 or 3 rayon threads (dense map and members),
+    and with the kernels' waiting workers (``parallel::run_hot``) on or off."""
     import os
     import subprocess
     import sys
@@ -317,10 +318,10 @@ def test_fused_is_bit_identical_across_thread_counts(data_dir: Path) -> None:
         "print(h.hexdigest(), len(m))\n"
     )
     outs = []
-    for threads in ("1", "2"):
-        env = dict(os.environ, RAYON_NUM_THREADS=threads)
+    for threads, spin in (("1", "1"), ("2", "1"), ("2", "0"), ("3", "1")):
+        env = dict(os.environ, RAYON_NUM_THREADS=threads, STEREOVISION_SPIN_WAIT=spin)
         proc = subprocess.run(
             [sys.executable, "-c", script], env=env, capture_output=True, text=True, check=True
         )
         outs.append(proc.stdout.split())
-    assert outs[0] == outs[1] and int(outs[0][1]) > 1000
+    assert all(o == outs[0] for o in outs) and int(outs[0][1]) > 1000

@@ -13,6 +13,7 @@ use stereovision_core::matching::hopfield::{
     best_match as core_best, candidate_neurons, hopfield_match as core_match,
     interest::select_points, moravec, CandidateMode, HopfieldOutput, HopfieldParams,
 };
+use stereovision_core::parallel::run_hot;
 
 use crate::convert::{grey_from_numpy, image_to_numpy, u8_layout};
 use crate::errors::guard;
@@ -241,28 +242,29 @@ pub fn hopfield_match_u8<'py>(
         )));
     }
     let wts = [weights.0, weights.1, weights.2];
-    let (lg, rg) = py.detach(|| {
+    let (p, best) = parse_match(params)?;
+    // Grey conversion and matcher in one hot region of the pool (`run_hot`): one wake-up of
+    // the workers per call instead of one per parallel region.
+    let out = py.detach(|| {
         guard("hopfield_match_u8", || {
-            stereovision_core::image::grey_pair_from_u8(ld, rd, w, h, c, wts)
+            run_hot(|| {
+                let (lg, rg) = stereovision_core::image::grey_pair_from_u8(ld, rd, w, h, c, wts)?;
+                // Finite by construction (levels / 255): no check needed.
+                let image = |data| Image {
+                    width: w,
+                    height: h,
+                    data,
+                };
+                let (l, r) = (image(lg), image(rg));
+                run_matcher(l.view(), r.view(), &p, best)
+            })
         })
     })?;
-    // Finite by construction (levels / 255): no check needed.
-    let image = |data| Image {
-        width: w,
-        height: h,
-        data,
-    };
-    let (l, r) = (image(lg), image(rg));
-    run_match(py, l.view(), r.view(), params)
+    output(py, out)
 }
 
-/// The matcher of `params["method"]` on a grey pair.
-fn run_match<'py>(
-    py: Python<'py>,
-    l: ImageView<'_>,
-    r: ImageView<'_>,
-    params: &Bound<'py, PyDict>,
-) -> PyResult<MatchOut<'py>> {
+/// The matcher's parameters and whether `params["method"]` is the best-match reference.
+fn parse_match(params: &Bound<'_, PyDict>) -> PyResult<(HopfieldParams, bool)> {
     let p = self::params(params)?;
     let mut method = String::from("hopfield");
     get(params, "method", &mut method)?;
@@ -273,15 +275,38 @@ fn run_match<'py>(
             "energy must be 'recommended', got {energy:?}"
         )));
     }
-    let out = match method.as_str() {
-        "hopfield" => py.detach(|| guard("hopfield_match", || core_match(l, r, &p)))?,
-        "best" => py.detach(|| guard("hopfield_match", || core_best(l, r, &p)))?,
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "method must be 'hopfield' or 'best', got {other:?}"
-            )))
-        }
-    };
+    match method.as_str() {
+        "hopfield" => Ok((p, false)),
+        "best" => Ok((p, true)),
+        other => Err(PyValueError::new_err(format!(
+            "method must be 'hopfield' or 'best', got {other:?}"
+        ))),
+    }
+}
+
+/// `best_match` or `hopfield_match` on a grey pair.
+fn run_matcher(
+    l: ImageView<'_>,
+    r: ImageView<'_>,
+    p: &HopfieldParams,
+    best: bool,
+) -> stereovision_core::Result<HopfieldOutput> {
+    if best {
+        core_best(l, r, p)
+    } else {
+        core_match(l, r, p)
+    }
+}
+
+/// The matcher of `params["method"]` on a grey pair.
+fn run_match<'py>(
+    py: Python<'py>,
+    l: ImageView<'_>,
+    r: ImageView<'_>,
+    params: &Bound<'py, PyDict>,
+) -> PyResult<MatchOut<'py>> {
+    let (p, best) = parse_match(params)?;
+    let out = py.detach(|| guard("hopfield_match", || run_matcher(l, r, &p, best)))?;
     output(py, out)
 }
 

@@ -856,6 +856,15 @@ pub fn hopfield_match<'a>(
     p: &HopfieldParams,
 ) -> Result<HopfieldOutput> {
     let (left, right) = (&left.into(), &right.into());
+    crate::parallel::run_hot(|| match_hot(left, right, p))
+}
+
+/// The body of [`hopfield_match`], run inside the pool.
+fn match_hot(
+    left: &ImageView<'_>,
+    right: &ImageView<'_>,
+    p: &HopfieldParams,
+) -> Result<HopfieldOutput> {
     let (pts, neurons) = candidate_neurons(left, right, p)?;
     let net = Network::new(&neurons, &p.weights);
     let input: Vec<f64> = neurons
@@ -894,6 +903,15 @@ pub fn best_match<'a>(
     p: &HopfieldParams,
 ) -> Result<HopfieldOutput> {
     let (left, right) = (&left.into(), &right.into());
+    crate::parallel::run_hot(|| best_hot(left, right, p))
+}
+
+/// The body of [`best_match`], run inside the pool.
+fn best_hot(
+    left: &ImageView<'_>,
+    right: &ImageView<'_>,
+    p: &HopfieldParams,
+) -> Result<HopfieldOutput> {
     let (pts, neurons) = candidate_neurons(left, right, p)?;
     let mut chosen = Vec::new();
     for (a, n) in neurons.iter().enumerate() {
