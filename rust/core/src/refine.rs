@@ -892,6 +892,19 @@ pub fn refine_disparity(
     d_max: f32,
     p: &RefineParams,
 ) -> Result<(Vec<f32>, Vec<f32>, usize)> {
+    crate::parallel::run_hot(|| refine_disparity_hot(left, right, disp, conf, d_min, d_max, p))
+}
+
+/// The body of [`refine_disparity`], run inside the pool ([`crate::parallel::run_hot`]).
+fn refine_disparity_hot(
+    left: ImageView<'_>,
+    right: ImageView<'_>,
+    disp: &[f32],
+    conf: &[f32],
+    d_min: f32,
+    d_max: f32,
+    p: &RefineParams,
+) -> Result<(Vec<f32>, Vec<f32>, usize)> {
     p.validate()?;
     let (w, h) = (left.width, left.height);
     if (right.width, right.height) != (w, h) {

@@ -6,7 +6,6 @@ use stereovision_core::matching::gabor::{
     gabor_disparity_view as core_gabor, gabor_newton_step as core_step,
     gabor_responses as core_resp, post::lr_check, GaborParams,
 };
-use stereovision_core::parallel::run_hot;
 use stereovision_core::Image;
 
 use crate::convert::{grey_from_numpy, image_from_numpy, image_to_numpy};
@@ -150,7 +149,7 @@ pub fn gabor_disparity<'py>(
         speckle_size,
         speckle_range,
     );
-    let out = py.detach(|| guard("gabor_disparity", || run_hot(|| core_gabor(l, r, &p))))?;
+    let out = py.detach(|| guard("gabor_disparity", || core_gabor(l, r, &p)))?;
     Ok((
         image_to_numpy(py, out.disparity)?,
         image_to_numpy(py, out.confidence)?,

@@ -12,7 +12,6 @@ use stereovision_core::matching::mcgm::{
     edge_filters, image_curves, log::log_filter, mcgm_match as core_match, ChannelCurves, Match,
     McgmParams,
 };
-use stereovision_core::parallel::run_hot;
 use stereovision_core::Image;
 
 use crate::convert::{image_from_numpy, image_to_numpy};
@@ -268,7 +267,7 @@ pub fn mcgm_match<'py>(
     let l = image_from_numpy(&left, "left")?;
     let r = image_from_numpy(&right, "right")?;
     let p = self::params(params)?;
-    let out = py.detach(|| guard("mcgm_match", || run_hot(|| core_match(&l, &r, &p))))?;
+    let out = py.detach(|| guard("mcgm_match", || core_match(&l, &r, &p)))?;
     let stats = PyDict::new(py);
     stats.set_item("n_combined", out.n_combined)?;
     stats.set_item("n_sides", out.n_sides)?;

@@ -2,7 +2,6 @@
 
 use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
-use stereovision_core::parallel::run_hot;
 use stereovision_core::refine::{refine_disparity as core_refine, FillPass, RefineParams};
 use stereovision_core::Image;
 
@@ -61,7 +60,7 @@ pub fn refine_disparity<'py>(
     let (lv, rv) = (l.view(), r.view());
     let (out, oc, filled) = py.detach(|| {
         guard("refine_disparity", || {
-            run_hot(|| core_refine(lv, rv, d, c, d_min, d_max, &p))
+            core_refine(lv, rv, d, c, d_min, d_max, &p)
         })
     })?;
     let img = |data| Image {

@@ -296,6 +296,15 @@ pub fn gabor_disparity_view(
     right: ImageView<'_>,
     params: &GaborParams,
 ) -> Result<GaborOutput> {
+    crate::parallel::run_hot(|| gabor_disparity_hot(left, right, params))
+}
+
+/// The body of [`gabor_disparity_view`], run inside the pool ([`crate::parallel::run_hot`]).
+fn gabor_disparity_hot(
+    left: ImageView<'_>,
+    right: ImageView<'_>,
+    params: &GaborParams,
+) -> Result<GaborOutput> {
     if left.size() != right.size() {
         return Err(CoreError::SizeMismatch {
             left: left.size(),

@@ -937,6 +937,11 @@ pub fn edge_filters(
 
 /// The MCGM channel end to end (see the module docs).
 pub fn mcgm_match(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOutput> {
+    crate::parallel::run_hot(|| mcgm_match_hot(left, right, p))
+}
+
+/// The body of [`mcgm_match`], run inside the pool ([`crate::parallel::run_hot`]).
+fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOutput> {
     check_pair(left, right)?;
     validate_params(p)?;
     let (fw, fh) = left.size();
