@@ -1,4 +1,5 @@
-//! Row-band parallelism helpers (rayon).
+//! Row-band parallelism helpers (rayon), and [`run_hot`], which every kernel entry point wraps
+//! its work in.
 //!
 //! Kernels split an image into bands of rows; each band is processed independently so results are
 //! bit-identical whatever the thread count (no reductions across bands in floating point).
