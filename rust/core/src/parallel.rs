@@ -1,5 +1,5 @@
-//! Row-band parallelism helpers (rayon), and [`run_hot`], which every kernel entry point wraps
-//! its work in.
+//! Row-band parallelism helpers (rayon), and [`run_hot`], which the matchers' and the
+//! refinement's entry points wrap their work in.
 //!
 //! Kernels split an image into bands of rows; each band is processed independently so results are
 //! bit-identical whatever the thread count (no reductions across bands in floating point).

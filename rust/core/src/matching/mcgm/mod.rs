@@ -387,11 +387,12 @@ const SPREAD_ORDER: [(i32, i32); 8] = [
 
 /// Nearest-valid fill of a NaN map up to `radius` px in chessboard distance (B.4.11's
 /// distance-limited spread): the result of `radius` synchronous 8-neighbour dilations, each new
-/// pixel taking the value of its first valid neighbour in `SPREAD_ORDER` (up, left, right, down, then the diagonals) from the previous
-/// step. Computed without the dilations: the pixels a dilation fills at step `t` are those at
-/// chessboard distance `t` from the valid ones (an exact two-pass distance transform), and their
-/// valid neighbours one step before are the neighbours at distance `t - 1`; so the levels are
-/// filled in order, each from the one before.
+/// pixel taking the value of its first valid neighbour from the previous step, in the order of
+/// `SPREAD_ORDER` (up, left, right, down, then the diagonals). Computed without the dilations:
+/// the pixels a dilation fills at step `t` are those at chessboard distance `t` from the valid
+/// ones (an exact two-pass distance transform), and their valid neighbours one step before are
+/// the neighbours at distance `t - 1`; so the levels are filled in order, each from the one
+/// before.
 pub fn spread_prior(map: &[f32], w: usize, h: usize, radius: i32) -> Vec<f32> {
     let mut cur = map.to_vec();
     if radius <= 0 || w == 0 || h == 0 {
