@@ -37,8 +37,10 @@ fn main() {
         }
         let per: Vec<usize> = out.channels.iter().map(|c| c.matches.len()).collect();
         println!(
-            "matches {} per channel {per:?} hash {:016x}",
+            "matches {} per channel {per:?} combined {} after sides {} hash {:016x}",
             out.matches.len(),
+            out.n_combined,
+            out.n_sides,
             hash.finish()
         );
         return;

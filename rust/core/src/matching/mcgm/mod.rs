@@ -662,8 +662,9 @@ simd_fn! {
 /// when no `k` is left. Integer steps keep the interpolation weights of `d` (right samples
 /// `r[b - k] + f (r[b - k + 1] - r[b - k])` with `b = floor(x - d)`, `f = x - d - b`), so every
 /// `k` is compared fairly with `k = 0`, whose value is exactly [`half_mad`]'s (the same terms
-/// summed in the same order); the differences are laid out with `k` innermost (contiguous,
-/// vectorised) and summed in the window's raster order.
+/// summed in the same order). The right samples of one window pixel are contiguous in `j`:
+/// blocks of 32 `j` keep their sums in registers over the window's pixels (raster order), and
+/// the mean-free pass recomputes each difference instead of storing it.
 fn half_sads(
     left: &Image,
     right: &Image,
@@ -678,10 +679,9 @@ fn half_sads(
     scratch: &mut SidesScratch,
 ) -> Option<(i32, i32, f32)> {
     // One feature dispatch per half-window (this whole body is compiled for AVX2 as well): the
-    // row kernels below are inlined into it.
+    // block kernels below are inlined into it.
     let (inner, outer, hh) = geom;
     let w = right.width as i32;
-    let n_cols = (outer - inner + 1) as usize;
     // Window columns and their interpolation bases.
     let mut base = [(0i32, 0.0f32); MAX_SIDES_WIDTH];
     let (mut b_min, mut b_max) = (i32::MAX, i32::MIN);
@@ -698,78 +698,85 @@ fn half_sads(
     if k_hi < k_lo {
         return None;
     }
-    // j = k_hi - k: the right samples of one window pixel are contiguous and ascending in j.
+    // j = k_hi - k.
     let nk = (k_hi - k_lo + 1) as usize;
-    let n_el = n_cols * (2 * hh + 1) as usize;
-    let SidesScratch { diffs, off, sad } = scratch;
-    // Every difference is written below: no clearing.
-    diffs.resize(n_el * nk, 0.0);
-    off.clear();
-    off.resize(nk, 0.0);
-    sad.clear();
-    sad.resize(nk, 0.0);
-    let mut e = 0;
+    let SidesScratch { els, sad } = scratch;
+    // The window's pixels in raster order: (offset of r[b - k_hi] in the right image, left
+    // value, interpolation weight).
+    els.clear();
     for dy in -hh..=hh {
         let lrow = &left.data[(yl + dy) as usize * left.width..][..left.width];
-        let rrow = &right.data[(yr + dy) as usize * right.width..][..right.width];
+        let rrow = (yr + dy) as usize * right.width;
         for (c, k) in (inner..=outer).enumerate() {
-            let lv = lrow[(xi + side * k) as usize];
             let (b, fr) = base[c];
-            let start = (b - k_hi) as usize;
-            let out = &mut diffs[e * nk..(e + 1) * nk];
-            let (a, b) = (&rrow[start..start + nk], &rrow[start + 1..start + nk + 1]);
-            if mean_free {
-                diff_add_row(out, off, a, b, lv, fr);
-            } else {
-                diff_row(out, a, b, lv, fr);
-            }
-            e += 1;
+            els.push((rrow + (b - k_hi) as usize, lrow[(xi + side * k) as usize], fr));
         }
     }
-    let n = n_el as f32;
-    if mean_free {
-        for v in off.iter_mut() {
-            *v /= n;
-        }
+    let n = els.len() as f32;
+    sad.clear();
+    sad.resize(nk, 0.0);
+    let r = &right.data[..];
+    let mut j = 0;
+    while j + 32 <= nk {
+        sads_block::<32>(r, els, j, n, mean_free, &mut sad[j..j + 32]);
+        j += 32;
     }
-    for e in 0..n_el {
-        abs_dev_row(sad, &diffs[e * nk..(e + 1) * nk], off);
+    while j + 8 <= nk {
+        sads_block::<8>(r, els, j, n, mean_free, &mut sad[j..j + 8]);
+        j += 8;
+    }
+    while j < nk {
+        sads_block::<1>(r, els, j, n, mean_free, &mut sad[j..j + 1]);
+        j += 1;
     }
     Some((k_lo, k_hi, n))
 }
 }
 
-/// `out[j] = lv - (a[j] + fr (b[j] - a[j]))`: left value minus the interpolated right one.
+/// The sums of [`half_sads`] for `J` consecutive `j` from `j0`: per `j`, the mean difference
+/// (with `mean_free`; 0 otherwise) summed over the window's pixels in order and divided by
+/// `n`, then the absolute deviations from it summed in the same order.
 #[inline(always)]
-fn diff_row(out: &mut [f32], a: &[f32], b: &[f32], lv: f32, fr: f32) {
-    for ((o, &x0), &x1) in out.iter_mut().zip(a).zip(b) {
-        *o = lv - (x0 + fr * (x1 - x0));
+fn sads_block<const J: usize>(
+    r: &[f32],
+    els: &[(usize, f32, f32)],
+    j0: usize,
+    n: f32,
+    mean_free: bool,
+    out: &mut [f32],
+) {
+    // `lv - (r[o] + fr (r[o + 1] - r[o]))`: left value minus the interpolated right one.
+    #[inline(always)]
+    fn diffs<const J: usize>(r: &[f32], &(o, lv, fr): &(usize, f32, f32), j0: usize) -> [f32; J] {
+        let (a, b) = (&r[o + j0..o + j0 + J], &r[o + j0 + 1..o + j0 + J + 1]);
+        std::array::from_fn(|t| lv - (a[t] + fr * (b[t] - a[t])))
     }
-}
-
-/// [`diff_row`] into `out`, each difference also added to `acc[j]` (one pass).
-#[inline(always)]
-fn diff_add_row(out: &mut [f32], acc: &mut [f32], a: &[f32], b: &[f32], lv: f32, fr: f32) {
-    for (((o, s), &x0), &x1) in out.iter_mut().zip(acc.iter_mut()).zip(a).zip(b) {
-        let v = lv - (x0 + fr * (x1 - x0));
-        *o = v;
-        *s += v;
+    let mut off = [0.0f32; J];
+    if mean_free {
+        for e in els {
+            let v = diffs::<J>(r, e, j0);
+            for t in 0..J {
+                off[t] += v[t];
+            }
+        }
+        for o in off.iter_mut() {
+            *o /= n;
+        }
     }
-}
-
-/// `acc[j] += |v[j] - m[j]|`.
-#[inline(always)]
-fn abs_dev_row(acc: &mut [f32], v: &[f32], m: &[f32]) {
-    for ((s, &x), &y) in acc.iter_mut().zip(v).zip(m) {
-        *s += (x - y).abs();
+    let mut acc = [0.0f32; J];
+    for e in els {
+        let v = diffs::<J>(r, e, j0);
+        for t in 0..J {
+            acc[t] += (v[t] - off[t]).abs();
+        }
     }
+    out.copy_from_slice(&acc);
 }
 
 /// Per-thread buffers of [`half_sads`] (no allocation per match).
 #[derive(Default)]
 struct SidesScratch {
-    diffs: Vec<f32>,
-    off: Vec<f32>,
+    els: Vec<(usize, f32, f32)>,
     sad: Vec<f32>,
 }
 
