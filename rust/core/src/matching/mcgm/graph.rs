@@ -13,7 +13,7 @@
 
 use rayon::prelude::*;
 
-use super::rtable::{ght_vote, voters, RTable};
+use super::rtable::{ght_vote_rows, voters, RTable, RowIndex};
 use super::tracking::{wrap_angle, Segment};
 use crate::matching::hopfield::{run_dynamics, Csr};
 
@@ -53,10 +53,17 @@ pub fn candidates(
     window: &[Option<(i32, i32)>],
     p: &CandParams,
 ) -> Vec<Candidate> {
-    // Row buckets of the right segments (each listed on every row it spans).
+    // The right segments overlapping rows `y0..=y1` are those spanning row `y0` plus those
+    // starting in `y0 + 1..=y1`: per row, the segments spanning it and the segments starting
+    // on it (each segment met once, without scanning every row of a long left segment).
     let mut rows: Vec<Vec<u32>> = vec![Vec::new(); h];
+    let mut starts: Vec<Vec<u32>> = vec![Vec::new(); h];
     for (id, s) in right.iter().enumerate() {
-        for y in s.y_min.max(0)..=s.y_max.min(h as i32 - 1) {
+        let (a, b) = (s.y_min.max(0), s.y_max.min(h as i32 - 1));
+        if a <= b {
+            starts[a as usize].push(id as u32);
+        }
+        for y in a..=b {
             rows[y as usize].push(id as u32);
         }
     }
@@ -68,76 +75,68 @@ pub fn candidates(
     let per: Vec<Vec<Candidate>> = left
         .par_iter()
         .enumerate()
-        .map_init(
-            || {
-                (
-                    Vec::<u32>::new(),
-                    Vec::<u32>::new(),
-                    vec![u32::MAX; right.len()],
-                )
-            },
-            |(acc, near, stamp), (ia, a)| {
-                let Some((lo, hi)) = window[ia] else {
-                    return Vec::new();
+        .map_init(Vec::<u32>::new, |acc, (ia, a)| {
+            let Some((lo, hi)) = window[ia] else {
+                return Vec::new();
+            };
+            // Right segments on the rows of A (the order does not matter: the candidates
+            // are sorted below).
+            let y0 = (a.y_min - p.dy_band).max(0);
+            let y1 = (a.y_max + p.dy_band).min(h as i32 - 1);
+            let near = (y0 <= y1)
+                .then(|| {
+                    let later = starts[(y0 + 1) as usize..=y1 as usize].iter().flatten();
+                    rows[y0 as usize].iter().chain(later)
+                })
+                .into_iter()
+                .flatten();
+            let ext_a = a.y_max - a.y_min + 1;
+            let mut out: Vec<Candidate> = Vec::new();
+            let mut index: Option<RowIndex> = None;
+            for &ib in near {
+                let b = &right[ib as usize];
+                if wrap_angle(a.mean_theta as f64 - b.mean_theta as f64).abs() >= tol {
+                    continue;
+                }
+                let ov =
+                    (a.y_max + p.dy_band).min(b.y_max) - (a.y_min - p.dy_band).max(b.y_min) + 1;
+                let ext_b = b.y_max - b.y_min + 1;
+                if (ov as f32) < 0.5 * ext_a.min(ext_b) as f32 {
+                    continue;
+                }
+                let slack = 0.5 * (a.x_max - a.x_min + 1).max(b.x_max - b.x_min + 1) as f32;
+                let dc = a.centroid.0 - b.centroid.0;
+                if dc < lo as f32 - slack || dc > hi as f32 + slack {
+                    continue;
+                }
+                let ix = index.get_or_insert_with(|| RowIndex::new(&rtables[ia]));
+                let Some(g) = ght_vote_rows(
+                    ix,
+                    a.pixels.len(),
+                    &right_voters[ib as usize],
+                    lo,
+                    hi,
+                    p.dy_band,
+                    p.n_bins,
+                    p.vote_bin_tol,
+                    acc,
+                ) else {
+                    continue;
                 };
-                // Right segments on the rows of A, each once (stamped with A's id: no sort).
-                near.clear();
-                let y0 = (a.y_min - p.dy_band).max(0);
-                let y1 = (a.y_max + p.dy_band).min(h as i32 - 1);
-                for y in y0..=y1 {
-                    for &b in &rows[y as usize] {
-                        if stamp[b as usize] != ia as u32 {
-                            stamp[b as usize] = ia as u32;
-                            near.push(b);
-                        }
-                    }
+                if g.score >= p.ght_min_score {
+                    out.push(Candidate {
+                        left: ia as u32,
+                        right: ib,
+                        score: g.score,
+                        tx: g.tx,
+                        ty: g.ty,
+                    });
                 }
-                let ext_a = a.y_max - a.y_min + 1;
-                let mut out: Vec<Candidate> = Vec::new();
-                for &ib in near.iter() {
-                    let b = &right[ib as usize];
-                    if wrap_angle(a.mean_theta as f64 - b.mean_theta as f64).abs() >= tol {
-                        continue;
-                    }
-                    let ov =
-                        (a.y_max + p.dy_band).min(b.y_max) - (a.y_min - p.dy_band).max(b.y_min) + 1;
-                    let ext_b = b.y_max - b.y_min + 1;
-                    if (ov as f32) < 0.5 * ext_a.min(ext_b) as f32 {
-                        continue;
-                    }
-                    let slack = 0.5 * (a.x_max - a.x_min + 1).max(b.x_max - b.x_min + 1) as f32;
-                    let dc = a.centroid.0 - b.centroid.0;
-                    if dc < lo as f32 - slack || dc > hi as f32 + slack {
-                        continue;
-                    }
-                    let Some(g) = ght_vote(
-                        &rtables[ia],
-                        a.pixels.len(),
-                        &right_voters[ib as usize],
-                        lo,
-                        hi,
-                        p.dy_band,
-                        p.n_bins,
-                        p.vote_bin_tol,
-                        acc,
-                    ) else {
-                        continue;
-                    };
-                    if g.score >= p.ght_min_score {
-                        out.push(Candidate {
-                            left: ia as u32,
-                            right: ib,
-                            score: g.score,
-                            tx: g.tx,
-                            ty: g.ty,
-                        });
-                    }
-                }
-                out.sort_by(|x, y| y.score.total_cmp(&x.score).then(x.right.cmp(&y.right)));
-                out.truncate(p.k_cand);
-                out
-            },
-        )
+            }
+            out.sort_by(|x, y| y.score.total_cmp(&x.score).then(x.right.cmp(&y.right)));
+            out.truncate(p.k_cand);
+            out
+        })
         .collect();
     per.into_iter().flatten().collect()
 }

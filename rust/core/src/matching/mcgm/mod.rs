@@ -386,107 +386,114 @@ const SPREAD_ORDER: [(i32, i32); 8] = [
 ];
 
 /// Nearest-valid fill of a NaN map up to `radius` px in chessboard distance (B.4.11's
-/// distance-limited spread): the result of `radius` synchronous 8-neighbour dilations, each new
-/// pixel taking the value of its first valid neighbour from the previous step, in the order of
-/// `SPREAD_ORDER` (up, left, right, down, then the diagonals). Computed without the dilations:
-/// the pixels a dilation fills at step `t` are those at chessboard distance `t` from the valid
-/// ones (an exact two-pass distance transform), and their valid neighbours one step before are
-/// the neighbours at distance `t - 1`; so the levels are filled in order, each from the one
-/// before.
-pub fn spread_prior(map: &[f32], w: usize, h: usize, radius: i32) -> Vec<f32> {
-    let mut cur = map.to_vec();
-    if radius <= 0 || w == 0 || h == 0 {
-        return cur;
-    }
-    let far = radius.min(u16::MAX as i32 - 1) as u16 + 1;
-    let mut dist: Vec<u16> = map
-        .iter()
-        .map(|v| if v.is_finite() { 0 } else { far })
-        .collect();
-    // Forward pass (neighbours above and to the left), then backward (below and right): each
-    // row takes its vertical and diagonal terms from the row before, then the chain along x.
-    for pass in 0..2 {
-        for k in 0..h {
-            let y = if pass == 0 { k } else { h - 1 - k };
-            let (row, prev) = if k == 0 {
-                (&mut dist[y * w..(y + 1) * w], None)
-            } else {
-                let py = if pass == 0 { y - 1 } else { y + 1 };
-                let (lo, hi) = dist.split_at_mut(y.max(py) * w);
-                if pass == 0 {
-                    (&mut hi[..w], Some(&lo[py * w..(py + 1) * w]))
+/// distance-limited spread), read pixel by pixel: the value of `radius` synchronous
+/// 8-neighbour dilations, each new pixel taking the value of its first valid neighbour from the
+/// previous step, in the order of `SPREAD_ORDER` (up, left, right, down, then the diagonals).
+/// Computed without the dilations: the pixels a dilation fills at step `t` are those at
+/// chessboard distance `t` from the valid ones (an exact two-pass distance transform), and
+/// their valid neighbours one step before are the neighbours at distance `t - 1`; so a pixel's
+/// value is found by following its first such neighbour down to distance 0. Only the pixels
+/// asked for are followed (the windows need the segments' pixels, not the whole image).
+pub struct SpreadPrior<'a> {
+    map: &'a [f32],
+    dist: Vec<u16>,
+    w: usize,
+    h: usize,
+    far: u16,
+}
+
+impl<'a> SpreadPrior<'a> {
+    /// The distance transform of `map` (`w x h`, NaN = no value), capped at `radius + 1`
+    /// (`radius <= 0`: no spread).
+    pub fn new(map: &'a [f32], w: usize, h: usize, radius: i32) -> Self {
+        let far = radius.clamp(0, u16::MAX as i32 - 1) as u16 + 1;
+        let mut dist: Vec<u16> = map
+            .iter()
+            .map(|v| if v.is_finite() { 0 } else { far })
+            .collect();
+        // Forward pass (neighbours above and to the left), then backward (below and right): each
+        // row takes its vertical and diagonal terms from the row before, then the chain along x.
+        for pass in 0..2 {
+            for k in 0..h {
+                let y = if pass == 0 { k } else { h - 1 - k };
+                let (row, prev) = if k == 0 {
+                    (&mut dist[y * w..(y + 1) * w], None)
                 } else {
-                    (&mut lo[y * w..(y + 1) * w], Some(&hi[..w]))
-                }
-            };
-            if let Some(p) = prev {
-                for x in 0..w {
-                    let mut m = p[x];
-                    if x > 0 {
-                        m = m.min(p[x - 1]);
+                    let py = if pass == 0 { y - 1 } else { y + 1 };
+                    let (lo, hi) = dist.split_at_mut(y.max(py) * w);
+                    if pass == 0 {
+                        (&mut hi[..w], Some(&lo[py * w..(py + 1) * w]))
+                    } else {
+                        (&mut lo[y * w..(y + 1) * w], Some(&hi[..w]))
                     }
-                    if x + 1 < w {
-                        m = m.min(p[x + 1]);
+                };
+                if let Some(p) = prev {
+                    for x in 0..w {
+                        let mut m = p[x];
+                        if x > 0 {
+                            m = m.min(p[x - 1]);
+                        }
+                        if x + 1 < w {
+                            m = m.min(p[x + 1]);
+                        }
+                        row[x] = row[x].min(m + 1);
                     }
-                    row[x] = row[x].min(m + 1);
                 }
-            }
-            if pass == 0 {
-                for x in 1..w {
-                    row[x] = row[x].min(row[x - 1] + 1);
+                if pass == 0 {
+                    for x in 1..w {
+                        row[x] = row[x].min(row[x - 1] + 1);
+                    }
+                } else {
+                    for x in (0..w.saturating_sub(1)).rev() {
+                        row[x] = row[x].min(row[x + 1] + 1);
+                    }
                 }
-            } else {
-                for x in (0..w - 1).rev() {
-                    row[x] = row[x].min(row[x + 1] + 1);
-                }
-            }
-            for v in row.iter_mut() {
-                *v = (*v).min(far);
-            }
-        }
-    }
-    // The pixels of each level 1..=radius in raster order (counting sort), filled level by
-    // level.
-    let levels = far as usize;
-    let mut start = vec![0usize; levels + 1];
-    for &d in &dist {
-        if d >= 1 && d < far {
-            start[d as usize] += 1;
-        }
-    }
-    let mut acc = 0;
-    for s in start.iter_mut() {
-        let c = *s;
-        *s = acc;
-        acc += c;
-    }
-    let mut order = vec![(0i32, 0i32); acc];
-    let mut fill = start.clone();
-    for y in 0..h {
-        for (x, &d) in dist[y * w..(y + 1) * w].iter().enumerate() {
-            if d >= 1 && d < far {
-                order[fill[d as usize]] = (x as i32, y as i32);
-                fill[d as usize] += 1;
-            }
-        }
-    }
-    for t in 1..levels {
-        let want = t as u16 - 1;
-        for &(x, y) in &order[start[t]..fill[t]] {
-            for &(dx, dy) in &SPREAD_ORDER {
-                let (nx, ny) = (x + dx, y + dy);
-                if nx < 0 || ny < 0 || nx >= w as i32 || ny >= h as i32 {
-                    continue;
-                }
-                let q = ny as usize * w + nx as usize;
-                if dist[q] == want {
-                    cur[y as usize * w + x as usize] = cur[q];
-                    break;
+                for v in row.iter_mut() {
+                    *v = (*v).min(far);
                 }
             }
         }
+        SpreadPrior {
+            map,
+            dist,
+            w,
+            h,
+            far,
+        }
     }
-    cur
+
+    /// The spread value at `(x, y)` (beyond the radius: the map's own value, NaN or infinite).
+    pub fn at(&self, x: usize, y: usize) -> f32 {
+        let (w, h) = (self.w as i32, self.h as i32);
+        let i = y * self.w + x;
+        let mut d = self.dist[i];
+        if d >= self.far {
+            return self.map[i];
+        }
+        let (mut x, mut y) = (x as i32, y as i32);
+        while d > 0 {
+            // A pixel at distance d >= 1 has a neighbour at d - 1 (exact transform).
+            let (nx, ny) = SPREAD_ORDER
+                .iter()
+                .map(|&(dx, dy)| (x + dx, y + dy))
+                .find(|&(nx, ny)| {
+                    nx >= 0
+                        && ny >= 0
+                        && nx < w
+                        && ny < h
+                        && self.dist[ny as usize * self.w + nx as usize] == d - 1
+                })
+                .expect("an exact chessboard distance has a neighbour one step closer");
+            (x, y, d) = (nx, ny, d - 1);
+        }
+        self.map[y as usize * self.w + x as usize]
+    }
+}
+
+/// The whole spread map of [`SpreadPrior`] (`radius <= 0`: `map` itself).
+pub fn spread_prior(map: &[f32], w: usize, h: usize, radius: i32) -> Vec<f32> {
+    let sp = SpreadPrior::new(map, w, h, radius);
+    (0..w * h).map(|i| sp.at(i % w, i / w)).collect()
 }
 
 /// Median (lower of the two middle values for even counts: a value that exists).
@@ -503,7 +510,7 @@ fn median_lower(v: &mut [f32]) -> Option<f32> {
 /// `+- width` channel px around it; the full range without a prior.
 fn windows(
     cc: &ChannelCurves,
-    prior: Option<&[f32]>,
+    prior: Option<&SpreadPrior>,
     fw: usize,
     width: f32,
     lo_c: i32,
@@ -515,7 +522,7 @@ fn windows(
     };
     let s = cc.scale as f32;
     let w = cc.width;
-    let fh = prior.len() / fw.max(1);
+    let fh = prior.h;
     cc.curves
         .segments
         .par_iter()
@@ -526,7 +533,7 @@ fn windows(
                 // Channel pixel centre in full-resolution coordinates.
                 let fx = ((s * x + 0.5 * (s - 1.0)).round() as usize).min(fw - 1);
                 let fy = ((s * y + 0.5 * (s - 1.0)).round() as usize).min(fh - 1);
-                let v = prior[fy * fw + fx];
+                let v = prior.at(fx, fy);
                 if v.is_finite() {
                     vals.push(v / s);
                 }
@@ -968,10 +975,12 @@ fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
         } else {
             0
         };
-        let spread = prior.as_deref().map(|m| spread_prior(m, fw, fh, radius));
+        let spread = prior
+            .as_deref()
+            .map(|m| SpreadPrior::new(m, fw, fh, radius));
         let win = windows(
             l,
-            spread.as_deref(),
+            spread.as_ref(),
             fw,
             p.prior_width_sigmas * l.sigma,
             lo_c,

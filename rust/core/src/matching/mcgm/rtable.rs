@@ -119,7 +119,12 @@ pub fn ght_vote(
             }
         }
     }
-    // First maximum in scan order (ty, then tx ascending).
+    peak(acc, nx, ny, lo, dy, len_a.max(right.len()))
+}
+
+/// The first maximum of a GHT accumulator (scan order: `ty`, then `tx` ascending), scored by
+/// `norm` votes, its translation the vote-weighted centroid of the 3x3 cells around it.
+fn peak(acc: &[u32], nx: usize, ny: usize, lo: i32, dy: i32, norm: usize) -> Option<Ght> {
     let (mut best, mut bi) = (0u32, 0usize);
     for (i, &v) in acc.iter().enumerate() {
         if v > best {
@@ -141,9 +146,95 @@ pub fn ght_vote(
         }
     }
     Some(Ght {
-        score: best as f32 / len_a.max(right.len()) as f32,
+        score: best as f32 / norm as f32,
         tx: (sx / sw) as f32,
         ty: (sy / sw) as f32,
         peak: best,
     })
+}
+
+/// The entries of an R-table listed by row (integer `x` and orientation bin each): a voter of
+/// [`ght_vote_rows`] only meets the entries within `dy` rows of its own, where [`ght_vote`]
+/// scans whole orientation bins.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RowIndex {
+    y_min: i32,
+    /// `offsets[r]..offsets[r + 1]` index the entries of row `y_min + r`.
+    offsets: Vec<u32>,
+    ents: Vec<(i32, u32)>,
+}
+
+impl RowIndex {
+    /// Indexes `rt`'s entries by row.
+    pub fn new(rt: &RTable) -> Self {
+        let y_min = rt.px.iter().map(|p| p.1).min().unwrap_or(0);
+        let y_max = rt.px.iter().map(|p| p.1).max().unwrap_or(-1);
+        let rows = (y_max - y_min + 1).max(0) as usize;
+        let mut offsets = vec![0u32; rows + 1];
+        for &(_, y) in &rt.px {
+            offsets[(y - y_min) as usize + 1] += 1;
+        }
+        for r in 1..=rows {
+            offsets[r] += offsets[r - 1];
+        }
+        let mut fill = offsets.clone();
+        let mut ents = vec![(0i32, 0u32); rt.px.len()];
+        for b in 0..rt.offsets.len().saturating_sub(1) {
+            for &(x, y) in &rt.px[rt.offsets[b] as usize..rt.offsets[b + 1] as usize] {
+                let r = (y - y_min) as usize;
+                ents[fill[r] as usize] = (x, b as u32);
+                fill[r] += 1;
+            }
+        }
+        RowIndex {
+            y_min,
+            offsets,
+            ents,
+        }
+    }
+}
+
+/// [`ght_vote`] through a [`RowIndex`] of the same R-table: the same votes (each pair of a
+/// voter and an entry within `tol` bins and `dy` rows counts once, in any order), so the same
+/// result.
+#[allow(clippy::too_many_arguments)]
+pub fn ght_vote_rows(
+    ix: &RowIndex,
+    len_a: usize,
+    right: &[(i32, i32, u32)],
+    lo: i32,
+    hi: i32,
+    dy: i32,
+    n_bins: usize,
+    tol: usize,
+    acc: &mut Vec<u32>,
+) -> Option<Ght> {
+    if hi < lo || right.is_empty() || len_a == 0 {
+        return None;
+    }
+    let nx = (hi - lo + 1) as usize;
+    let ny = (2 * dy + 1) as usize;
+    acc.clear();
+    acc.resize(nx * ny, 0);
+    let rows = ix.offsets.len() as i32 - 1;
+    let (nb, tol) = (n_bins as i32, tol as i32);
+    for &(qx, qy, b) in right {
+        let r0 = (qy - dy - ix.y_min).max(0);
+        let r1 = (qy + dy - ix.y_min).min(rows - 1);
+        for r in r0..=r1 {
+            let base = (r + ix.y_min - qy + dy) as usize * nx;
+            let (s, e) = (ix.offsets[r as usize] as usize, ix.offsets[r as usize + 1]);
+            for &(px, pb) in &ix.ents[s..e as usize] {
+                let tx = px - qx;
+                let mut db = pb as i32 - b as i32;
+                if db < 0 {
+                    db += nb;
+                }
+                if tx >= lo && tx <= hi && (db <= tol || db >= nb - tol) {
+                    acc[base + (tx - lo) as usize] += 1;
+                }
+            }
+        }
+    }
+    peak(acc, nx, ny, lo, dy, len_a.max(right.len()))
 }

@@ -3,7 +3,7 @@
 //! sub-pixel shift end to end.
 
 use super::log::{log_filter, log_kernels};
-use super::rtable::{build_rtable, ght_vote, voters};
+use super::rtable::{build_rtable, ght_vote, ght_vote_rows, voters, RowIndex};
 use super::tracking::track;
 use super::zerocross::{zero_crossings, ZC_H};
 use super::*;
@@ -143,6 +143,34 @@ fn ght_of_a_translated_contour_scores_one_at_the_translation() {
     assert_eq!(g.peak as usize, seg.pixels.len());
     // The 3x3 centroid is pulled a little by coincidental votes of other pixel pairs.
     assert!((g.tx - 7.0).abs() < 0.5 && g.ty.abs() < 0.5, "{g:?}");
+    let _ = h;
+}
+
+#[test]
+fn ght_by_rows_equals_ght_by_bins() {
+    // Every pair of a left and a right segment of two real-like channels, over several
+    // windows, bands and bin tolerances: the row index gives the same votes, so the same peak,
+    // score and translation, bit for bit.
+    let (w, h) = (160, 100);
+    let p = McgmParams::default();
+    let cl = channel_curves(&blobs(w, h, 0.0), 1.0, 1, &p);
+    let cr = channel_curves(&blobs(w, h, 3.4), 1.0, 1, &p);
+    let (mut acc, mut acc2) = (Vec::new(), Vec::new());
+    let mut compared = 0;
+    for (a, rt) in cl.curves.segments.iter().zip(&cl.rtables).take(40) {
+        let ix = RowIndex::new(rt);
+        for b in cr.curves.segments.iter().take(60) {
+            let vb = voters(&b.pixels, &cr.zc.theta, w, 36);
+            for (lo, hi, dy, tol) in [(0, 16, 1, 1), (-5, 40, 0, 0), (2, 9, 2, 3)] {
+                let want = ght_vote(rt, a.pixels.len(), &vb, lo, hi, dy, 36, tol, &mut acc);
+                let got = ght_vote_rows(&ix, a.pixels.len(), &vb, lo, hi, dy, 36, tol, &mut acc2);
+                assert_eq!(want, got);
+                assert_eq!(acc, acc2);
+                compared += usize::from(want.is_some());
+            }
+        }
+    }
+    assert!(compared > 100, "{compared} voting pairs");
     let _ = h;
 }
 
