@@ -613,16 +613,6 @@ fn decompose(
     per.into_iter().flatten().collect()
 }
 
-/// Linear interpolation of row `y` of `img` at column `x` (caller keeps `0 <= x <= w - 1`).
-#[inline]
-fn sample(img: &Image, x: f32, y: usize) -> f32 {
-    let x0 = (x.floor() as usize).min(img.width - 1);
-    let x1 = (x0 + 1).min(img.width - 1);
-    let f = x - x0 as f32;
-    let row = &img.data[y * img.width..(y + 1) * img.width];
-    row[x0] + f * (row[x1] - row[x0])
-}
-
 /// Mean absolute difference of one half-window (columns `xi + side * (inner..=outer)`, rows
 /// `yl +- hh`) against the right image shifted by `d` (linear interpolation along x). With
 /// `mean_free` the two windows' mean grey levels are removed first: insensitive to an exposure
@@ -640,13 +630,28 @@ fn half_mad(
     mean_free: bool,
 ) -> f32 {
     let n = ((outer - inner + 1) * (2 * hh + 1)) as f32;
+    // Per column: the left x, the two right columns of the linear interpolation and its weight
+    // (the same on every row: computed once, not once per row and pass).
+    let mut cols = [(0usize, 0usize, 0usize, 0.0f32); MAX_SIDES_WIDTH];
+    let nc = (outer - inner + 1) as usize;
+    for (c, k) in (inner..=outer).enumerate() {
+        let x = xi + side * k;
+        let pos = x as f32 - d;
+        let x0 = (pos.floor() as usize).min(right.width - 1);
+        let x1 = (x0 + 1).min(right.width - 1);
+        cols[c] = (x as usize, x0, x1, pos - x0 as f32);
+    }
+    let diff = |ly: usize, ry: usize, c: usize| {
+        let (x, x0, x1, f) = cols[c];
+        let row = &right.data[ry * right.width..(ry + 1) * right.width];
+        left.at(x, ly) - (row[x0] + f * (row[x1] - row[x0]))
+    };
     let mut offset = 0.0f32;
     if mean_free {
         for dy in -hh..=hh {
             let (ly, ry) = ((yl + dy) as usize, (yr + dy) as usize);
-            for k in inner..=outer {
-                let x = xi + side * k;
-                offset += left.at(x as usize, ly) - sample(right, x as f32 - d, ry);
+            for c in 0..nc {
+                offset += diff(ly, ry, c);
             }
         }
         offset /= n;
@@ -654,39 +659,36 @@ fn half_mad(
     let mut sad = 0.0f32;
     for dy in -hh..=hh {
         let (ly, ry) = ((yl + dy) as usize, (yr + dy) as usize);
-        for k in inner..=outer {
-            let x = xi + side * k;
-            sad += (left.at(x as usize, ly) - sample(right, x as f32 - d, ry) - offset).abs();
+        for c in 0..nc {
+            sad += (diff(ly, ry, c) - offset).abs();
         }
     }
     sad / n
 }
 
 simd_fn! {
-/// Mean absolute differences of one half-window (as [`half_mad`]) at the disparities `d + k`,
-/// `k` integer in `ks` and such that every right sample lies inside the row, into `scratch.sad`
-/// (the sums; `sad[j] / n` is the value at `k = k_hi - j`). Returns `(k_lo, k_hi, n)`, or `None`
-/// when no `k` is left. Integer steps keep the interpolation weights of `d` (right samples
-/// `r[b - k] + f (r[b - k + 1] - r[b - k])` with `b = floor(x - d)`, `f = x - d - b`), so every
-/// `k` is compared fairly with `k = 0`, whose value is exactly [`half_mad`]'s (the same terms
-/// summed in the same order). The right samples of one window pixel are contiguous in `j`:
-/// blocks of 32 `j` keep their sums in registers over the window's pixels (raster order), and
-/// the mean-free pass recomputes each difference instead of storing it.
-fn half_sads(
+/// Whether one half-window fits another disparity better: its mean absolute difference (as
+/// [`half_mad`]) at some `d + k`, `k` integer in `ks`, `|k| > 1`, every right sample inside the
+/// row, plus `margin` is below `here` (its value at `d`). Integer steps keep the interpolation
+/// weights of `d` (right samples `r[b - k] + f (r[b - k + 1] - r[b - k])` with
+/// `b = floor(x - d)`, `f = x - d - b`), so every `k` is compared fairly with `k = 0`, whose
+/// value would be exactly [`half_mad`]'s (the same terms summed in the same order). The right
+/// samples of one window pixel are contiguous in `j = k_hi - k`: blocks of 32 `j` keep their
+/// sums in registers over the window's pixels (raster order), the mean-free pass recomputes
+/// each difference instead of storing it, and the scan stops at the first block that fits
+/// better. `at`: the match `(x, left row, right row, disparity)`; `limit`: `(here, margin)`.
+fn half_better(
     left: &Image,
     right: &Image,
-    xi: i32,
-    yl: i32,
-    yr: i32,
-    d: f32,
+    at: (i32, i32, i32, f32),
     side: i32,
     geom: (i32, i32, i32),
     mean_free: bool,
     ks: (i32, i32),
-    scratch: &mut SidesScratch,
-) -> Option<(i32, i32, f32)> {
-    // One feature dispatch per half-window (this whole body is compiled for AVX2 as well): the
-    // block kernels below are inlined into it.
+    limit: (f32, f32),
+    els: &mut Vec<(usize, f32, f32)>,
+) -> bool {
+    let (xi, yl, yr, d) = at;
     let (inner, outer, hh) = geom;
     let w = right.width as i32;
     // Window columns and their interpolation bases.
@@ -703,11 +705,9 @@ fn half_sads(
     let k_hi = ks.1.min(b_min);
     let k_lo = ks.0.max(b_max + 2 - w);
     if k_hi < k_lo {
-        return None;
+        return false;
     }
-    // j = k_hi - k.
     let nk = (k_hi - k_lo + 1) as usize;
-    let SidesScratch { els, sad } = scratch;
     // The window's pixels in raster order: (offset of r[b - k_hi] in the right image, left
     // value, interpolation weight).
     els.clear();
@@ -720,48 +720,70 @@ fn half_sads(
         }
     }
     let n = els.len() as f32;
-    sad.clear();
-    sad.resize(nk, 0.0);
     let r = &right.data[..];
+    // Lanes `j` whose `k = k_hi - j` is within 1 px of the match are not compared.
+    let near = |j0: usize, lanes: usize| -> u32 {
+        let mut m = 0u32;
+        for k in -1..=1 {
+            let j = k_hi - k - j0 as i32;
+            if j >= 0 && (j as usize) < lanes {
+                m |= 1 << j;
+            }
+        }
+        m
+    };
     let mut j = 0;
     while j + 32 <= nk {
-        sads_block::<32>(r, els, j, n, mean_free, &mut sad[j..j + 32]);
+        if sads_fit_mask::<32>(r, els, j, n, mean_free, limit) & !near(j, 32) != 0 {
+            return true;
+        }
         j += 32;
     }
     while j + 8 <= nk {
-        sads_block::<8>(r, els, j, n, mean_free, &mut sad[j..j + 8]);
+        if sads_fit_mask::<8>(r, els, j, n, mean_free, limit) & !near(j, 8) != 0 {
+            return true;
+        }
         j += 8;
     }
     while j < nk {
-        sads_block::<1>(r, els, j, n, mean_free, &mut sad[j..j + 1]);
+        if sads_fit_mask::<1>(r, els, j, n, mean_free, limit) & !near(j, 1) != 0 {
+            return true;
+        }
         j += 1;
     }
-    Some((k_lo, k_hi, n))
+    false
 }
 }
 
-/// The sums of [`half_sads`] for `J` consecutive `j` from `j0`: per `j`, the mean difference
-/// (with `mean_free`; 0 otherwise) summed over the window's pixels in order and divided by
-/// `n`, then the absolute deviations from it summed in the same order.
+/// For `J` consecutive `j` from `j0` (`J` = 1, 8 or 32), bit `t` set when lane `j0 + t` fits
+/// better: its sum over the window's pixels (in order) of the absolute deviations of the
+/// differences from their mean (with `mean_free`; 0 otherwise), divided by `n`, plus `margin`,
+/// is below `here` (`limit = (here, margin)`). AVX2 when the CPU has it, the same operations in
+/// the same order per lane otherwise (bit-identical).
 #[inline(always)]
-fn sads_block<const J: usize>(
+fn sads_fit_mask<const J: usize>(
     r: &[f32],
     els: &[(usize, f32, f32)],
     j0: usize,
     n: f32,
     mean_free: bool,
-    out: &mut [f32],
-) {
-    // `lv - (r[o] + fr (r[o + 1] - r[o]))`: left value minus the interpolated right one.
-    #[inline(always)]
-    fn diffs<const J: usize>(r: &[f32], &(o, lv, fr): &(usize, f32, f32), j0: usize) -> [f32; J] {
-        let (a, b) = (&r[o + j0..o + j0 + J], &r[o + j0 + 1..o + j0 + J + 1]);
-        std::array::from_fn(|t| lv - (a[t] + fr * (b[t] - a[t])))
+    limit: (f32, f32),
+) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    if J % 8 == 0 && crate::simd::has_avx2() {
+        // SAFETY: AVX2 is present; every element's `J + 1` samples from `o + j0` lie in `r`
+        // (checked by the slice below).
+        return unsafe { sads_fit_mask_avx2::<J>(r, els, j0, n, mean_free, limit) };
     }
+    // `lv - (r[o] + fr (r[o + 1] - r[o]))`: left value minus the interpolated right one.
+    let diffs = |&(o, lv, fr): &(usize, f32, f32)| -> [f32; J] {
+        let s = &r[o + j0..o + j0 + J + 1];
+        std::array::from_fn(|t| lv - (s[t] + fr * (s[t + 1] - s[t])))
+    };
     let mut off = [0.0f32; J];
     if mean_free {
         for e in els {
-            let v = diffs::<J>(r, e, j0);
+            let v = diffs(e);
             for t in 0..J {
                 off[t] += v[t];
             }
@@ -772,19 +794,84 @@ fn sads_block<const J: usize>(
     }
     let mut acc = [0.0f32; J];
     for e in els {
-        let v = diffs::<J>(r, e, j0);
+        let v = diffs(e);
         for t in 0..J {
             acc[t] += (v[t] - off[t]).abs();
         }
     }
-    out.copy_from_slice(&acc);
+    let (here, margin) = limit;
+    let mut m = 0u32;
+    for (t, &a) in acc.iter().enumerate() {
+        m |= u32::from(a / n + margin < here) << t;
+    }
+    m
 }
 
-/// Per-thread buffers of [`half_sads`] (no allocation per match).
+/// [`sads_fit_mask`] with AVX2 intrinsics: `J / 8` vectors of sums kept in registers, the
+/// shifted samples loaded unaligned (the compiler otherwise builds them by shuffles).
+///
+/// # Safety
+/// The CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn sads_fit_mask_avx2<const J: usize>(
+    r: &[f32],
+    els: &[(usize, f32, f32)],
+    j0: usize,
+    n: f32,
+    mean_free: bool,
+    (here, margin): (f32, f32),
+) -> u32 {
+    use std::arch::x86_64::*;
+    const MAXQ: usize = 4;
+    let q = J / 8;
+    debug_assert!(q <= MAXQ);
+    let mut off = [_mm256_setzero_ps(); MAXQ];
+    let mut acc = [_mm256_setzero_ps(); MAXQ];
+    let diff = |p: *const f32, lv: __m256, fr: __m256| {
+        let a = _mm256_loadu_ps(p);
+        let b = _mm256_loadu_ps(p.add(1));
+        _mm256_sub_ps(lv, _mm256_add_ps(a, _mm256_mul_ps(fr, _mm256_sub_ps(b, a))))
+    };
+    if mean_free {
+        for &(o, lv, fr) in els {
+            let p = r[o + j0..o + j0 + J + 1].as_ptr();
+            let (lv, fr) = (_mm256_set1_ps(lv), _mm256_set1_ps(fr));
+            for (v, off) in off.iter_mut().enumerate().take(q) {
+                *off = _mm256_add_ps(*off, diff(p.add(8 * v), lv, fr));
+            }
+        }
+        let nv = _mm256_set1_ps(n);
+        for off in off.iter_mut().take(q) {
+            *off = _mm256_div_ps(*off, nv);
+        }
+    }
+    let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
+    for &(o, lv, fr) in els {
+        let p = r[o + j0..o + j0 + J + 1].as_ptr();
+        let (lv, fr) = (_mm256_set1_ps(lv), _mm256_set1_ps(fr));
+        for v in 0..q {
+            let dev = _mm256_and_ps(_mm256_sub_ps(diff(p.add(8 * v), lv, fr), off[v]), abs);
+            acc[v] = _mm256_add_ps(acc[v], dev);
+        }
+    }
+    let (nv, mv, hv) = (
+        _mm256_set1_ps(n),
+        _mm256_set1_ps(margin),
+        _mm256_set1_ps(here),
+    );
+    let mut m = 0u32;
+    for (v, a) in acc.iter().enumerate().take(q) {
+        let fit = _mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_add_ps(_mm256_div_ps(*a, nv), mv), hv);
+        m |= (_mm256_movemask_ps(fit) as u32) << (8 * v);
+    }
+    m
+}
+
+/// Per-thread buffer of [`half_better`] (no allocation per match).
 #[derive(Default)]
 struct SidesScratch {
     els: Vec<(usize, f32, f32)>,
-    sad: Vec<f32>,
 }
 
 /// Widest half-window of the both-sides check (columns; validated).
@@ -824,41 +911,27 @@ fn sides_ok(
         (range.0 as f32 - d).ceil() as i32,
         (range.1 as f32 - d).floor() as i32,
     );
-    for side in [-1i32, 1] {
-        // With the other-disparity test, one pass gives the other disparities (k in k0..=k1)
-        // and `here` (k = 0; added to the span when the range does not hold it).
-        let sads = if f.sides_best {
-            let span = (k0.min(0), k1.max(0));
-            half_sads(
+    // Both half-windows' own fit first (cheap), then the other disparities.
+    let mut here = [0.0f32; 2];
+    for (h, side) in here.iter_mut().zip([-1i32, 1]) {
+        *h = half_mad(left, right, xi, yl, yr, d, side, geom, f.sides_mean_free);
+        if *h > f.sides_mad {
+            return false;
+        }
+    }
+    if f.sides_best {
+        for (h, side) in here.into_iter().zip([-1i32, 1]) {
+            if half_better(
                 left,
                 right,
-                xi,
-                yl,
-                yr,
-                d,
+                (xi, yl, yr, d),
                 side,
                 geom,
                 f.sides_mean_free,
-                span,
-                scratch,
-            )
-        } else {
-            None
-        };
-        // Without the test, or with k = 0 cut off at the row's end: half_mad (clamped samples).
-        let here = match sads {
-            Some((lo, hi, n)) if lo <= 0 && 0 <= hi => scratch.sad[hi as usize] / n,
-            _ => half_mad(left, right, xi, yl, yr, d, side, geom, f.sides_mean_free),
-        };
-        if here > f.sides_mad {
-            return false;
-        }
-        // Another disparity of the range, more than 1 px away, fits better.
-        if let Some((lo, hi, n)) = sads {
-            let better = (lo.max(k0)..=hi.min(k1)).any(|k| {
-                k.abs() > 1 && scratch.sad[(hi - k) as usize] / n + f.sides_best_margin < here
-            });
-            if better {
+                (k0, k1),
+                (h, f.sides_best_margin),
+                &mut scratch.els,
+            ) {
                 return false;
             }
         }
@@ -892,33 +965,37 @@ pub fn edge_filters(
         .collect();
     let n_sides = keep.iter().filter(|&&k| k).count();
     if f.disc {
-        // Survivors bucketed by rounded left pixel (counting sort: several per pixel possible).
+        // Survivors bucketed by the row of their rounded left pixel, by column within a row
+        // (several per pixel possible): a neighbourhood is a few binary searches, not a scan
+        // of its cells.
         let pos = |m: &Match| -> Option<(i32, i32)> {
             let (x, y) = (m.xl.round() as i32, m.yl.round() as i32);
             (x >= 0 && y >= 0 && x < w as i32 && y < h as i32).then_some((x, y))
         };
-        let cell: Vec<Option<usize>> = matches
+        let cell: Vec<Option<(i32, i32)>> = matches
             .iter()
             .zip(&keep)
             .map(|(m, &k)| if k { pos(m) } else { None })
-            .map(|o| o.map(|(x, y)| y as usize * w + x as usize))
             .collect();
-        let mut start = vec![0u32; w * h + 1];
-        for c in cell.iter().flatten() {
-            start[c + 1] += 1;
+        let mut start = vec![0u32; h + 1];
+        for &(_, y) in cell.iter().flatten() {
+            start[y as usize + 1] += 1;
         }
         for i in 1..start.len() {
             start[i] += start[i - 1];
         }
         let mut fill = start.clone();
-        let mut items = vec![0u32; start[w * h] as usize];
+        // (column, match index) per row.
+        let mut items = vec![(0i32, 0u32); start[h] as usize];
         for (i, c) in cell.iter().enumerate() {
-            if let Some(c) = *c {
-                items[fill[c] as usize] = i as u32;
-                fill[c] += 1;
+            if let Some((x, y)) = *c {
+                items[fill[y as usize] as usize] = (x, i as u32);
+                fill[y as usize] += 1;
             }
         }
-        let bucket = |c: usize| &items[start[c] as usize..start[c + 1] as usize];
+        for y in 0..h {
+            items[start[y] as usize..start[y + 1] as usize].sort_unstable();
+        }
         let drop: Vec<bool> = matches
             .par_iter()
             .enumerate()
@@ -926,17 +1003,21 @@ pub fn edge_filters(
                 if !keep[i] {
                     return false;
                 }
-                let Some((x, y)) = pos(m) else {
+                let Some((x, y)) = cell[i] else {
                     return true;
                 };
                 let d = m.xl - m.xr;
+                let (x0, x1) = (x - f.disc_dx, x + f.disc_dx);
                 for yy in (y - f.disc_dy).max(0)..=(y + f.disc_dy).min(h as i32 - 1) {
-                    for xx in (x - f.disc_dx).max(0)..=(x + f.disc_dx).min(w as i32 - 1) {
-                        for &j in bucket(yy as usize * w + xx as usize) {
-                            let o = &matches[j as usize];
-                            if j as usize != i && ((o.xl - o.xr) - d).abs() > f.disc_tol {
-                                return true;
-                            }
+                    let row = &items[start[yy as usize] as usize..start[yy as usize + 1] as usize];
+                    let from = row.partition_point(|&(c, _)| c < x0);
+                    for &(c, j) in &row[from..] {
+                        if c > x1 {
+                            break;
+                        }
+                        let o = &matches[j as usize];
+                        if j as usize != i && ((o.xl - o.xr) - d).abs() > f.disc_tol {
+                            return true;
                         }
                     }
                 }
