@@ -775,6 +775,26 @@ fn sads_fit_mask<const J: usize>(
         // (checked by the slice below).
         return unsafe { sads_fit_mask_avx2::<J>(r, els, j0, n, mean_free, limit) };
     }
+    let (here, margin) = limit;
+    let mut m = 0u32;
+    for (t, &a) in sads_scalar::<J>(r, els, j0, n, mean_free)
+        .iter()
+        .enumerate()
+    {
+        m |= u32::from(a / n + margin < here) << t;
+    }
+    m
+}
+
+/// The sums of [`sads_fit_mask`] (portable).
+#[inline(always)]
+fn sads_scalar<const J: usize>(
+    r: &[f32],
+    els: &[(usize, f32, f32)],
+    j0: usize,
+    n: f32,
+    mean_free: bool,
+) -> [f32; J] {
     // `lv - (r[o] + fr (r[o + 1] - r[o]))`: left value minus the interpolated right one.
     let diffs = |&(o, lv, fr): &(usize, f32, f32)| -> [f32; J] {
         let s = &r[o + j0..o + j0 + J + 1];
@@ -799,12 +819,7 @@ fn sads_fit_mask<const J: usize>(
             acc[t] += (v[t] - off[t]).abs();
         }
     }
-    let (here, margin) = limit;
-    let mut m = 0u32;
-    for (t, &a) in acc.iter().enumerate() {
-        m |= u32::from(a / n + margin < here) << t;
-    }
-    m
+    acc
 }
 
 /// [`sads_fit_mask`] with AVX2 intrinsics: `J / 8` vectors of sums kept in registers, the

@@ -315,3 +315,38 @@ fn spread_prior_equals_the_dilations() {
         assert!(same, "{w}x{h} density 1/{density} radius {radius}");
     }
 }
+
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn both_sides_avx2_blocks_equal_the_portable_sums() {
+    // Random rows and windows: at a threshold equal to a lane's portable value the lane does
+    // not fit better, one ulp above it does; the AVX2 blocks must agree on every lane, so
+    // their sums are the portable ones bit for bit.
+    if !crate::simd::has_avx2() {
+        return;
+    }
+    let mut rng = crate::matching::hopfield::network::SplitMix64::new(11);
+    let mut unit = || (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
+    let r: Vec<f32> = (0..4000).map(|_| unit()).collect();
+    for trial in 0..20 {
+        let els: Vec<(usize, f32, f32)> =
+            (0..28).map(|e| (e * 100 + trial, unit(), unit())).collect();
+        let n = els.len() as f32;
+        for mean_free in [false, true] {
+            let sums = sads_scalar::<32>(&r, &els, 3, n, mean_free);
+            for (t, &s) in sums.iter().enumerate() {
+                let v = s / n + 0.01;
+                for (here, want) in [(v, false), (v.next_up(), true)] {
+                    let m = unsafe {
+                        sads_fit_mask_avx2::<32>(&r, &els, 3, n, mean_free, (here, 0.01))
+                    };
+                    assert_eq!((m >> t) & 1 == 1, want, "trial {trial} lane {t}");
+                    let m8 = unsafe {
+                        sads_fit_mask_avx2::<8>(&r, &els, 3 + t / 8 * 8, n, mean_free, (here, 0.01))
+                    };
+                    assert_eq!((m8 >> (t % 8)) & 1 == 1, want, "trial {trial} lane {t} (8)");
+                }
+            }
+        }
+    }
+}
