@@ -26,7 +26,9 @@ pub struct RTable {
 /// Orientation bin `floor(K theta / 2 pi)` of a normal direction in `[0, 2 pi)`.
 #[inline]
 pub fn theta_bin(theta: f32, n_bins: usize) -> usize {
-    ((theta as f64 * n_bins as f64 / TAU).floor() as usize) % n_bins
+    // The quotient is >= 0 (or NaN, giving 0 either way): truncation is its floor, without a
+    // libm call on the baseline target.
+    ((theta as f64 * n_bins as f64 / TAU) as usize) % n_bins
 }
 
 /// Builds the R-table of `seg` (`theta`: normal directions of the image, `w`: its width).
