@@ -122,7 +122,7 @@ fn radix_sort_upper(keys: &mut Vec<u64>) {
         for &k in keys.iter() {
             count[((k >> shift) & mask) as usize + 1] += 1;
         }
-        if count.iter().any(|&c| c == keys.len()) {
+        if count.contains(&keys.len()) {
             continue; // one bucket: the pass would not move anything
         }
         for b in 1..count.len() {
