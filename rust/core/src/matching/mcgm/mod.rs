@@ -1046,6 +1046,91 @@ pub fn edge_filters(
     Ok((keep, n_sides))
 }
 
+/// Matches one channel (`ci`: its index in `sigmas`) given its curves in both images, with the
+/// prior of the coarser channels (full-resolution disparities, NaN = none), which it extends.
+fn match_channel(
+    ci: usize,
+    l: &ChannelCurves,
+    r: &ChannelCurves,
+    prior: &mut Option<Vec<f32>>,
+    (fw, fh): (usize, usize),
+    p: &McgmParams,
+) -> ChannelResult {
+    let s = l.scale as f32;
+    // No disparity reaches past the image width: a huge max_disparity must not size the
+    // GHT accumulators.
+    let lo_c = (p.d_min.min(fw) as f32 / s).floor() as i32;
+    let hi_c = (p.d_max.min(fw) as f32 / s).ceil() as i32;
+    let radius = if ci > 0 {
+        (p.prior_radius_sigmas * p.sigmas[ci - 1]).ceil() as i32
+    } else {
+        0
+    };
+    let spread = prior
+        .as_deref()
+        .map(|m| SpreadPrior::new(m, fw, fh, radius));
+    let win = windows(
+        l,
+        spread.as_ref(),
+        fw,
+        p.prior_width_sigmas * l.sigma,
+        lo_c,
+        hi_c,
+    );
+    let cands = candidates(
+        &l.curves.segments,
+        &l.rtables,
+        &r.curves.segments,
+        &r.zc.theta,
+        l.width,
+        l.height,
+        &win,
+        &p.cand,
+    );
+    let adj = knn_graph(&l.curves.segments, p.knn, p.r_graph / s);
+    let csr = association_weights(
+        &cands,
+        &l.curves.segments,
+        &adj,
+        r.curves.segments.len(),
+        &p.solver,
+    );
+    let sol = solve(&cands, &csr, l.curves.segments.len(), &p.solver);
+    let matches = decompose(l, r, &cands, &sol.chosen, p.horiz_skip_deg, ci as u8);
+    // Prior for the finer channels: this channel's disparities over the coarser ones'.
+    let map = prior.get_or_insert_with(|| vec![f32::NAN; fw * fh]);
+    for m in &matches {
+        let (x, y) = (m.xl.round() as i64, m.yl.round() as i64);
+        if x >= 0 && y >= 0 && (x as usize) < fw && (y as usize) < fh {
+            map[y as usize * fw + x as usize] = m.xl - m.xr;
+        }
+    }
+    let edges = adj
+        .iter()
+        .enumerate()
+        .flat_map(|(i, nb)| {
+            nb.iter()
+                .filter(move |&&j| (j as usize) > i)
+                .map(move |&j| (i as u32, j))
+        })
+        .collect();
+    ChannelResult {
+        sigma: l.sigma,
+        scale: l.scale,
+        n_left: l.curves.segments.len(),
+        n_right: r.curves.segments.len(),
+        windows: win,
+        candidates: cands,
+        state: sol.state,
+        chosen: sol.chosen,
+        edges,
+        n_weights: sol.n_weights,
+        sweeps: sol.sweeps,
+        converged: sol.converged,
+        matches,
+    }
+}
+
 /// The MCGM channel end to end (see the module docs).
 pub fn mcgm_match(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOutput> {
     crate::parallel::run_hot(|| mcgm_match_hot(left, right, p))
@@ -1056,85 +1141,48 @@ fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
     check_pair(left, right)?;
     validate_params(p)?;
     let (fw, fh) = left.size();
-    let (cl, cr) = rayon::join(|| image_curves(left, p), || image_curves(right, p));
-    let (cl, cr) = (cl?, cr?);
-    let mut prior: Option<Vec<f32>> = None;
-    let mut channels: Vec<ChannelResult> = Vec::with_capacity(p.sigmas.len());
-    for (ci, (l, r)) in cl.iter().zip(&cr).enumerate() {
-        let s = l.scale as f32;
-        // No disparity reaches past the image width: a huge max_disparity must not size the
-        // GHT accumulators.
-        let lo_c = (p.d_min.min(fw) as f32 / s).floor() as i32;
-        let hi_c = (p.d_max.min(fw) as f32 / s).ceil() as i32;
-        let radius = if ci > 0 {
-            (p.prior_radius_sigmas * p.sigmas[ci - 1]).ceil() as i32
-        } else {
-            0
+    // Curves of every channel; the finest (the most pixels) computed beside the coarser
+    // channels' curves and matching, whose sequential steps (distance transform, network,
+    // assembly) would otherwise leave the other worker idle. Each channel's work and output is
+    // the same as computed in order.
+    let n = p.sigmas.len();
+    let half = p
+        .sigmas
+        .iter()
+        .any(|&s| s >= p.half_res_sigma)
+        .then(|| rayon::join(|| log::decimate2(left), || log::decimate2(right)));
+    let curves_of = |ci: usize| {
+        let (sig, scale) = channel_geometry(p.sigmas[ci], p);
+        let (l, r) = match (&half, scale) {
+            (Some((hl, hr)), 2) => (hl, hr),
+            _ => (left, right),
         };
-        let spread = prior
-            .as_deref()
-            .map(|m| SpreadPrior::new(m, fw, fh, radius));
-        let win = windows(
-            l,
-            spread.as_ref(),
-            fw,
-            p.prior_width_sigmas * l.sigma,
-            lo_c,
-            hi_c,
-        );
-        let cands = candidates(
-            &l.curves.segments,
-            &l.rtables,
-            &r.curves.segments,
-            &r.zc.theta,
-            l.width,
-            l.height,
-            &win,
-            &p.cand,
-        );
-        let adj = knn_graph(&l.curves.segments, p.knn, p.r_graph / s);
-        let csr = association_weights(
-            &cands,
-            &l.curves.segments,
-            &adj,
-            r.curves.segments.len(),
-            &p.solver,
-        );
-        let sol = solve(&cands, &csr, l.curves.segments.len(), &p.solver);
-        let matches = decompose(l, r, &cands, &sol.chosen, p.horiz_skip_deg, ci as u8);
-        // Prior for the finer channels: this channel's disparities over the coarser ones'.
-        let map = prior.get_or_insert_with(|| vec![f32::NAN; fw * fh]);
-        for m in &matches {
-            let (x, y) = (m.xl.round() as i64, m.yl.round() as i64);
-            if x >= 0 && y >= 0 && (x as usize) < fw && (y as usize) < fh {
-                map[y as usize * fw + x as usize] = m.xl - m.xr;
-            }
-        }
-        let edges = adj
-            .iter()
-            .enumerate()
-            .flat_map(|(i, nb)| {
-                nb.iter()
-                    .filter(move |&&j| (j as usize) > i)
-                    .map(move |&j| (i as u32, j))
-            })
-            .collect();
-        channels.push(ChannelResult {
-            sigma: l.sigma,
-            scale: l.scale,
-            n_left: l.curves.segments.len(),
-            n_right: r.curves.segments.len(),
-            windows: win,
-            candidates: cands,
-            state: sol.state,
-            chosen: sol.chosen,
-            edges,
-            n_weights: sol.n_weights,
-            sweeps: sol.sweeps,
-            converged: sol.converged,
-            matches,
-        });
-    }
+        rayon::join(
+            || channel_curves(l, sig, scale, p),
+            || channel_curves(r, sig, scale, p),
+        )
+    };
+    let (finest, (mut channels, mut prior)) = rayon::join(
+        || curves_of(n - 1),
+        || {
+            let coarse: Vec<_> = (0..n - 1).into_par_iter().map(curves_of).collect();
+            let mut prior: Option<Vec<f32>> = None;
+            let channels: Vec<ChannelResult> = coarse
+                .iter()
+                .enumerate()
+                .map(|(ci, (l, r))| match_channel(ci, l, r, &mut prior, (fw, fh), p))
+                .collect();
+            (channels, prior)
+        },
+    );
+    channels.push(match_channel(
+        n - 1,
+        &finest.0,
+        &finest.1,
+        &mut prior,
+        (fw, fh),
+        p,
+    ));
     // Combination: finest full-resolution channel first; coarser ones fill empty places.
     let mut taken = vec![false; fw * fh];
     let mut combined: Vec<Match> = Vec::new();
