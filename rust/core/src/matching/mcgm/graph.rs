@@ -142,39 +142,92 @@ pub fn candidates(
 }
 
 /// Symmetrised k-nearest-neighbour adjacency of segment centroids within `r_max` px (sorted
-/// lists; ties by id). Uniform grid of cell `r_max`.
+/// lists; ties by id). Uniform grid of cell `r_max / 4`, searched ring by ring around each
+/// centroid's cell until the `k` nearest are known: a point in a further ring is at least the
+/// ring's inner distance away, so the search stops once the `k`-th nearest is closer than
+/// that (with a margin for rounding) or the rings pass `r_max`.
 pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Vec<Vec<u32>> {
     let n = segs.len();
     let mut adj: Vec<Vec<u32>> = vec![Vec::new(); n];
     if n == 0 || k == 0 {
         return adj;
     }
-    let cell = r_max.max(1.0);
     // Centroids apart from the segments (their pixel lists made the scan miss the cache).
     let cs: Vec<(f32, f32)> = segs.iter().map(|s| s.centroid).collect();
-    let key = |c: (f32, f32)| ((c.0 / cell).floor() as i64, (c.1 / cell).floor() as i64);
-    let mut grid: std::collections::HashMap<(i64, i64), Vec<u32>> = Default::default();
+    let cell = (r_max / 4.0).max(1.0);
+    let (x0, y0) = cs.iter().fold((f32::INFINITY, f32::INFINITY), |a, c| {
+        (a.0.min(c.0), a.1.min(c.1))
+    });
+    let key = |c: (f32, f32)| {
+        (
+            ((c.0 - x0) / cell).floor().max(0.0) as usize,
+            ((c.1 - y0) / cell).floor().max(0.0) as usize,
+        )
+    };
+    let (gw, gh) = cs.iter().fold((1, 1), |a, &c| {
+        let (x, y) = key(c);
+        (a.0.max(x + 1), a.1.max(y + 1))
+    });
+    // Cells in CSR form, each listing its points by id.
+    let mut start = vec![0u32; gw * gh + 1];
+    for &c in &cs {
+        let (x, y) = key(c);
+        start[y * gw + x + 1] += 1;
+    }
+    for i in 1..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut fill = start.clone();
+    let mut items = vec![0u32; n];
     for (i, &c) in cs.iter().enumerate() {
-        grid.entry(key(c)).or_default().push(i as u32);
+        let (x, y) = key(c);
+        items[fill[y * gw + x] as usize] = i as u32;
+        fill[y * gw + x] += 1;
     }
     let by_dist = |a: &(f32, u32), b: &(f32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+    let max_ring = (r_max / cell).ceil() as i64 + 1;
     let nearest: Vec<Vec<u32>> = (0..n)
         .into_par_iter()
         .map_init(Vec::new, |d: &mut Vec<(f32, u32)>, i| {
             let (cx, cy) = key(cs[i]);
+            let (cx, cy) = (cx as i64, cy as i64);
             let (x, y) = cs[i];
             d.clear();
-            for gy in cy - 1..=cy + 1 {
-                for gx in cx - 1..=cx + 1 {
-                    for &j in grid.get(&(gx, gy)).map(|v| v.as_slice()).unwrap_or(&[]) {
-                        if j as usize == i {
-                            continue;
+            for ring in 0..=max_ring {
+                // The points not yet seen (rings `ring` and beyond) are at least
+                // `(ring - 1) * cell` away.
+                let beyond = (ring - 1) as f32 * cell;
+                if d.len() >= k {
+                    d.select_nth_unstable_by(k - 1, by_dist);
+                    if d[k - 1].0 < beyond * (1.0 - 1e-5) - 1e-3 {
+                        break;
+                    }
+                }
+                if beyond > r_max + 1e-3 {
+                    break;
+                }
+                for gy in cy - ring..=cy + ring {
+                    if gy < 0 || gy >= gh as i64 {
+                        continue;
+                    }
+                    let edge_row = gy == cy - ring || gy == cy + ring;
+                    let step = if edge_row { 1 } else { (2 * ring).max(1) };
+                    let mut gx = cx - ring;
+                    while gx <= cx + ring {
+                        if gx >= 0 && gx < gw as i64 {
+                            let c = gy as usize * gw + gx as usize;
+                            for &j in &items[start[c] as usize..start[c + 1] as usize] {
+                                if j as usize == i {
+                                    continue;
+                                }
+                                let (u, v) = cs[j as usize];
+                                let dd = ((u - x) * (u - x) + (v - y) * (v - y)).sqrt();
+                                if dd <= r_max {
+                                    d.push((dd, j));
+                                }
+                            }
                         }
-                        let (u, v) = cs[j as usize];
-                        let dd = ((u - x) * (u - x) + (v - y) * (v - y)).sqrt();
-                        if dd <= r_max {
-                            d.push((dd, j));
-                        }
+                        gx += step;
                     }
                 }
             }

@@ -4,7 +4,7 @@
 
 use super::log::{log_filter, log_kernels};
 use super::rtable::{build_rtable, ght_vote, ght_vote_rows, voters, RowIndex};
-use super::tracking::track;
+use super::tracking::{track, Segment};
 use super::zerocross::{zero_crossings, ZC_H};
 use super::*;
 
@@ -348,5 +348,64 @@ fn both_sides_avx2_blocks_equal_the_portable_sums() {
                 }
             }
         }
+    }
+}
+
+#[test]
+fn knn_graph_equals_the_brute_force_neighbours() {
+    // Random centroids, some repeated and some on a lattice (exact distance ties), several
+    // densities and radii: the ring search gives the brute-force k nearest within r_max
+    // (ties by id), symmetrised.
+    let mut rng = crate::matching::hopfield::network::SplitMix64::new(5);
+    let mut unit = || (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
+    for &(n, size, k, r_max) in &[
+        (300usize, 200.0f32, 6usize, 60.0f32),
+        (2000, 900.0, 6, 60.0),
+        (500, 100.0, 3, 7.5),
+        (40, 1000.0, 6, 60.0),
+        (1, 10.0, 6, 60.0),
+    ] {
+        let mut cs: Vec<(f32, f32)> = (0..n)
+            .map(|i| match i % 5 {
+                0 => ((i % 37) as f32 * 4.0, (i / 37) as f32 * 4.0),
+                _ => (unit() * size, unit() * size),
+            })
+            .collect();
+        if n > 10 {
+            cs[7] = cs[3];
+        }
+        let segs: Vec<Segment> = cs
+            .iter()
+            .map(|&c| Segment {
+                pixels: vec![0],
+                centroid: c,
+                x_min: 0,
+                x_max: 0,
+                y_min: 0,
+                y_max: 0,
+                mean_theta: 0.0,
+            })
+            .collect();
+        let got = graph::knn_graph(&segs, k, r_max);
+        let mut want: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for (i, &(x, y)) in cs.iter().enumerate() {
+            let mut d: Vec<(f32, u32)> = cs
+                .iter()
+                .enumerate()
+                .filter(|&(j, _)| j != i)
+                .map(|(j, &(u, v))| (((u - x) * (u - x) + (v - y) * (v - y)).sqrt(), j as u32))
+                .filter(|&(dd, _)| dd <= r_max)
+                .collect();
+            d.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for &(_, j) in d.iter().take(k) {
+                want[i].push(j);
+                want[j as usize].push(i as u32);
+            }
+        }
+        for a in want.iter_mut() {
+            a.sort_unstable();
+            a.dedup();
+        }
+        assert_eq!(got, want, "n {n} size {size} k {k} r_max {r_max}");
     }
 }
