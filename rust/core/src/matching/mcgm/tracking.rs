@@ -186,11 +186,20 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
             let mut best: Option<(f64, f32, usize, (i32, i32))> = None;
             // `cur` is an interior pixel (see `state`): its neighbours are inside the image.
             debug_assert!(cx >= 1 && cy >= 1 && cx + 1 < w as i32 && cy + 1 < h as i32);
-            for &(dx, dy) in &NEIGHBOURS {
+            // The free neighbours in the forward half-plane (`dx dir.0 + dy dir.1 > 0`; the
+            // diagonals' `/ sqrt 2` keeps the sign), found without a branch per neighbour; then
+            // those, in NEIGHBOURS order.
+            let mut cand = 0u32;
+            for (k, &(dx, dy)) in NEIGHBOURS.iter().enumerate() {
+                let q = (cur as isize + dy as isize * w as isize + dx as isize) as usize;
+                let proj = dx as f64 * dir.0 + dy as f64 * dir.1;
+                cand |= u32::from((state[q] == FREE) & (proj > 0.0)) << k;
+            }
+            while cand != 0 {
+                let k = cand.trailing_zeros() as usize;
+                cand &= cand - 1;
+                let (dx, dy) = NEIGHBOURS[k];
                 let q = (cy + dy) as usize * w + (cx + dx) as usize;
-                if state[q] != FREE {
-                    continue;
-                }
                 if wrap_angle(zc.theta[q] as f64 - tc).abs() >= max_turn {
                     continue;
                 }
