@@ -28,7 +28,14 @@ pub struct RTable {
 pub fn theta_bin(theta: f32, n_bins: usize) -> usize {
     // The quotient is >= 0 (or NaN, giving 0 either way): truncation is its floor, without a
     // libm call on the baseline target.
-    ((theta as f64 * n_bins as f64 / TAU) as usize) % n_bins
+    // `theta < 2 pi` gives a quotient below `n_bins` (or equal to it by rounding): the
+    // 64-bit remainder only in that rare case.
+    let b = (theta as f64 * n_bins as f64 / TAU) as usize;
+    if b >= n_bins {
+        b % n_bins
+    } else {
+        b
+    }
 }
 
 /// Builds the R-table of `seg` (`theta`: normal directions of the image, `w`: its width).
