@@ -428,28 +428,35 @@ impl<'a> SpreadPrior<'a> {
                     }
                 };
                 if let Some(p) = prev {
-                    for x in 0..w {
-                        let mut m = p[x];
-                        if x > 0 {
-                            m = m.min(p[x - 1]);
+                    // The three pixels above (or below); the interior without branches.
+                    let up = |m: u16| m.saturating_add(1);
+                    if w == 1 {
+                        row[0] = row[0].min(up(p[0]));
+                    } else {
+                        row[0] = row[0].min(up(p[0].min(p[1])));
+                        row[w - 1] = row[w - 1].min(up(p[w - 1].min(p[w - 2])));
+                        for ((o, a), (b, c)) in row[1..w - 1]
+                            .iter_mut()
+                            .zip(&p[..w - 2])
+                            .zip(p[1..w - 1].iter().zip(&p[2..]))
+                        {
+                            *o = (*o).min(up((*a).min(*b).min(*c)));
                         }
-                        if x + 1 < w {
-                            m = m.min(p[x + 1]);
-                        }
-                        row[x] = row[x].min(m + 1);
                     }
                 }
+                // The chain along the row, its running value kept in a register. (Every value
+                // stays <= far: it starts at 0 or far and only takes minima.)
+                let mut run = far;
                 if pass == 0 {
-                    for x in 1..w {
-                        row[x] = row[x].min(row[x - 1] + 1);
+                    for v in row.iter_mut() {
+                        run = (*v).min(run.saturating_add(1));
+                        *v = run;
                     }
                 } else {
-                    for x in (0..w.saturating_sub(1)).rev() {
-                        row[x] = row[x].min(row[x + 1] + 1);
+                    for v in row.iter_mut().rev() {
+                        run = (*v).min(run.saturating_add(1));
+                        *v = run;
                     }
-                }
-                for v in row.iter_mut() {
-                    *v = (*v).min(far);
                 }
             }
         }
