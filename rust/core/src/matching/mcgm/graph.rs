@@ -109,6 +109,13 @@ pub fn candidates(
                 if dc < lo as f32 - slack || dc > hi as f32 + slack {
                     continue;
                 }
+                // A translation pairs each pixel of A with at most one of B and vice versa:
+                // the peak is at most the shorter length, so the score at most shorter /
+                // longer (the float quotient too: division is monotonic).
+                let (la, lb) = (a.pixels.len(), b.pixels.len());
+                if (la.min(lb) as f32 / la.max(lb).max(1) as f32) < p.ght_min_score {
+                    continue;
+                }
                 let ix = index.get_or_insert_with(|| RowIndex::new(&rtables[ia]));
                 let Some(g) = ght_vote_rows(
                     ix,

@@ -472,28 +472,34 @@ impl<'a> SpreadPrior<'a> {
     /// The spread value at `(x, y)` (beyond the radius: the map's own value, NaN or infinite).
     pub fn at(&self, x: usize, y: usize) -> f32 {
         let (w, h) = (self.w as i32, self.h as i32);
-        let i = y * self.w + x;
+        let mut i = y * self.w + x;
         let mut d = self.dist[i];
         if d >= self.far {
             return self.map[i];
         }
         let (mut x, mut y) = (x as i32, y as i32);
+        let step = SPREAD_ORDER.map(|(dx, dy)| dy as isize * self.w as isize + dx as isize);
         while d > 0 {
-            // A pixel at distance d >= 1 has a neighbour at d - 1 (exact transform).
-            let (nx, ny) = SPREAD_ORDER
-                .iter()
-                .map(|&(dx, dy)| (x + dx, y + dy))
-                .find(|&(nx, ny)| {
+            // A pixel at distance d >= 1 has a neighbour at d - 1 (exact transform): the
+            // first in SPREAD_ORDER, found without bounds tests away from the border.
+            let k = if x >= 1 && y >= 1 && x + 1 < w && y + 1 < h {
+                step.iter()
+                    .position(|&o| self.dist[(i as isize + o) as usize] == d - 1)
+            } else {
+                SPREAD_ORDER.iter().position(|&(dx, dy)| {
+                    let (nx, ny) = (x + dx, y + dy);
                     nx >= 0
                         && ny >= 0
                         && nx < w
                         && ny < h
                         && self.dist[ny as usize * self.w + nx as usize] == d - 1
                 })
-                .expect("an exact chessboard distance has a neighbour one step closer");
-            (x, y, d) = (nx, ny, d - 1);
+            }
+            .expect("an exact chessboard distance has a neighbour one step closer");
+            (x, y, d) = (x + SPREAD_ORDER[k].0, y + SPREAD_ORDER[k].1, d - 1);
+            i = (i as isize + step[k]) as usize;
         }
-        self.map[y as usize * self.w + x as usize]
+        self.map[i]
     }
 }
 
@@ -528,7 +534,7 @@ fn windows(
         return vec![full; cc.curves.segments.len()];
     };
     let s = cc.scale as f32;
-    let w = cc.width;
+    let (w, sc) = (cc.width, cc.scale);
     let fh = prior.h;
     cc.curves
         .segments
@@ -536,10 +542,11 @@ fn windows(
         .map(|seg| {
             let mut vals: Vec<f32> = Vec::with_capacity(seg.pixels.len());
             for &i in &seg.pixels {
-                let (x, y) = ((i as usize % w) as f32, (i as usize / w) as f32);
-                // Channel pixel centre in full-resolution coordinates.
-                let fx = ((s * x + 0.5 * (s - 1.0)).round() as usize).min(fw - 1);
-                let fy = ((s * y + 0.5 * (s - 1.0)).round() as usize).min(fh - 1);
+                let (x, y) = (i as usize % w, i as usize / w);
+                // Channel pixel centre in full-resolution coordinates, rounded (half away
+                // from zero): `round(s x + (s - 1) / 2) = s x + s / 2` for integer s, x.
+                let fx = (sc * x + sc / 2).min(fw - 1);
+                let fy = (sc * y + sc / 2).min(fh - 1);
                 let v = prior.at(fx, fy);
                 if v.is_finite() {
                     vals.push(v / s);
