@@ -76,13 +76,20 @@ pub fn high_threshold(zc: &ZeroCrossings, q: f32) -> f32 {
     // do: the k-th is found in the bucket of its upper 12 bits (one histogram pass), then by
     // selection among that bucket's values only.
     const SHIFT: u32 = 20;
-    let mut hist = vec![0usize; 1 << (32 - SHIFT)];
-    let mut count = 0usize;
-    for (&m, &s) in zc.mark.iter().zip(&zc.strength) {
-        let on = usize::from(m != 0);
-        hist[(s.to_bits() >> SHIFT) as usize] += on;
-        count += on;
+    const BUCKETS: usize = 1 << (32 - SHIFT);
+    // Unmarked pixels count into 16 spare slots by column (not all into one slot: each add
+    // would wait for the previous one's store).
+    let mut hist = vec![0usize; BUCKETS + 16];
+    for (i, (&m, &s)) in zc.mark.iter().zip(&zc.strength).enumerate() {
+        let b = if m != 0 {
+            (s.to_bits() >> SHIFT) as usize
+        } else {
+            BUCKETS + (i & 15)
+        };
+        hist[b] += 1;
     }
+    hist.truncate(BUCKETS);
+    let count: usize = hist.iter().sum();
     if count == 0 {
         return 0.0;
     }
