@@ -225,6 +225,32 @@ fn bad_parameters_are_errors_not_panics() {
         Err(CoreError::SizeMismatch { .. })
     ));
     // Tiny images: no crossings, no matches, no panic.
+    // Strips 1 to 4 pixels wide or high (the half-resolution channel of a 3-pixel strip is 1
+    // pixel wide): no interior to track, no error.
+    for (w, h) in [
+        (1, 40),
+        (2, 40),
+        (3, 40),
+        (4, 40),
+        (40, 1),
+        (40, 2),
+        (40, 3),
+        (40, 4),
+    ] {
+        let img = Image {
+            width: w,
+            height: h,
+            data: (0..w * h).map(|i| ((i * 37) % 11) as f32 / 11.0).collect(),
+        };
+        let out = mcgm_match(&img, &img, &McgmParams::default()).expect("valid");
+        assert!(out.matches.is_empty(), "{w}x{h}");
+        assert_eq!(
+            image_curves(&img, &McgmParams::default())
+                .expect("valid")
+                .len(),
+            3
+        );
+    }
     let tiny = Image::filled(2, 2, 0.3);
     assert!(mcgm_match(&tiny, &tiny, &McgmParams::default())
         .expect("valid")

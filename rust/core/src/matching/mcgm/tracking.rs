@@ -155,7 +155,8 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
     const FREE: u8 = 1;
     const TAKEN: u8 = 2;
     let mut state = vec![0u8; n];
-    for y in 1..h.saturating_sub(1) {
+    // (Images narrower than 3 pixels have no interior.)
+    for y in (1..h.saturating_sub(1)).filter(|_| w >= 3) {
         let r = y * w + 1..(y + 1) * w - 1;
         let (st, mk, sr) = (&mut state[r.clone()], &zc.mark[r.clone()], &zc.strength[r]);
         for x in 0..st.len() {
