@@ -16,7 +16,7 @@ from stereovision.match import match as sv_match
 from stereovision.matches import Matches
 from stereovision.matching.fusion import (
     CHANNEL_BITS,
-    _nearest_within,
+    _nearest_within_at,
     _radius_offsets,
     fuse,
     fuse_pair,
@@ -74,7 +74,8 @@ def test_nearest_within_takes_the_first_measured_offset(r: float) -> None:
     h, w = 23, 31
     dx = np.where(rng.random((h, w)) < 0.15, rng.random((h, w)) * 40, np.nan).astype(np.float32)
     dy = np.where(rng.random((h, w)) < 0.9, rng.random((h, w)), np.nan).astype(np.float32)
-    got_x, got_y = _nearest_within(dx, dy, r)
+    ys, xs = np.nonzero(np.ones((h, w), bool))
+    got_x, got_y = (v.reshape(h, w) for v in _nearest_within_at(dx, dy, r, ys, xs))
     want_x = np.full((h, w), np.nan, np.float32)
     want_y = np.full((h, w), np.nan, np.float32)
     for y in range(h):

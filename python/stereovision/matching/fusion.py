@@ -104,25 +104,33 @@ def _radius_offsets(r: float) -> list[tuple[int, int]]:
     return sorted(offs, key=lambda o: (o[0] ** 2 + o[1] ** 2, o[0], o[1]))
 
 
-def _nearest_within(dx: F32, dy: F32, r: float) -> tuple[F32, F32]:
-    """Each pixel takes the nearest measured ``(dx, dy)`` within ``r`` px (NaN if none).
+def _nearest_within_at(
+    dx: F32, dy: F32, r: float, ys: npt.NDArray[np.intp], xs: npt.NDArray[np.intp]
+) -> tuple[F32, F32]:
+    """The nearest measured ``(dx, dy)`` within ``r`` px of each pixel ``(ys[k], xs[k])``.
 
-    "Nearest" is the first offset of :func:`_radius_offsets` whose pixel is measured. The
-    measured pixels are sparse, so each offset moves them all at once, the offsets written from
-    the last to the first: a nearer offset overwrites a farther one (one offset never writes a
-    pixel twice).
+    "Nearest" is the first offset of :func:`_radius_offsets` whose pixel is measured (finite
+    ``dx``); NaN if none. Each pixel looks at its offsets nearest first and stops at the first
+    measured one, so the work follows the (sparse) pixels asked for, not the whole image.
     """
     h, w = dx.shape
-    out_x = np.full((h, w), np.nan, np.float32)
-    out_y = np.full((h, w), np.nan, np.float32)
-    ys, xs = np.nonzero(np.isfinite(dx))
-    vx, vy = dx[ys, xs], dy[ys, xs]
-    for oy, ox in reversed(_radius_offsets(r)):
-        # target[y, x] <- source[y + oy, x + ox]
-        ty, tx = ys - oy, xs - ox
-        ok = (ty >= 0) & (ty < h) & (tx >= 0) & (tx < w)
-        out_x[ty[ok], tx[ok]] = vx[ok]
-        out_y[ty[ok], tx[ok]] = vy[ok]
+    out_x = np.full(len(ys), np.nan, np.float32)
+    out_y = np.full(len(ys), np.nan, np.float32)
+    todo = np.arange(len(ys))
+    for oy, ox in _radius_offsets(r):
+        if len(todo) == 0:
+            break
+        sy, sx = ys[todo] + oy, xs[todo] + ox
+        inside = np.nonzero((sy >= 0) & (sy < h) & (sx >= 0) & (sx < w))[0]
+        sy, sx = sy[inside], sx[inside]
+        v = dx[sy, sx]
+        hit = np.isfinite(v)
+        found = todo[inside[hit]]
+        out_x[found] = v[hit]
+        out_y[found] = dy[sy[hit], sx[hit]]
+        done = np.zeros(len(todo), bool)
+        done[inside[hit]] = True
+        todo = todo[~done]
     return out_x, out_y
 
 
@@ -238,21 +246,18 @@ def fuse(
         raise ValueError(f"min_agree: expected at least 2, got {min_agree}")
 
     names: list[str] = []
-    maps_x: list[F32] = []
-    maps_y: list[F32] = []
-    weights: list[F32] = []
     shape: tuple[int, int] | None = None
+    gabor_maps: tuple[F32, F32] | None = None
     if gabor is not None:
         gx = _check_map(gabor[0], "gabor dispx", None)
         gc = _check_map(gabor[1], "gabor conf", gx.shape)
         shape = (int(gx.shape[0]), int(gx.shape[1]))
-        ok = np.isfinite(gx) & (gc >= a_conf_min)
         names.append("gabor")
-        maps_x.append(np.where(ok, gx, np.nan).astype(np.float32))
-        maps_y.append(np.where(ok, 0.0, np.nan).astype(np.float32))
-        weights.append(np.where(ok, gc, 0.0).astype(np.float32))
+        gabor_maps = (gx, gc)
+    order = sorted(sparse, key=CHANNEL_BITS.__getitem__)
     measured = None
-    for name in sorted(sparse, key=CHANNEL_BITS.__getitem__):
+    raster: list[tuple[F32, F32]] = []
+    for name in order:
         m = sparse[name]
         if shape is None:
             shape = m.image_shape
@@ -263,19 +268,31 @@ def fuse(
         dx, dy = m.dispx, m.dispy
         here = np.isfinite(dx)
         measured = here if measured is None else measured | here
-        nx, ny = _nearest_within(dx, dy, r_spatial)
+        raster.append((dx, dy))
         names.append(name)
-        maps_x.append(nx)
-        maps_y.append(ny)
-        weights.append(np.ones_like(nx))
     assert shape is not None and measured is not None
 
-    # Candidates: the sparse channels' own pixels (D.4 step 3), in row-major order.
+    # Candidates: the sparse channels' own pixels (D.4 step 3), in row-major order; every
+    # channel's value there (a sparse channel's: its nearest measurement within r_spatial).
     yy, xx = np.nonzero(measured)
+    cols_x: list[F32] = []
+    cols_y: list[F32] = []
+    cols_w: list[F32] = []
+    if gabor_maps is not None:
+        gxv, gcv = gabor_maps[0][yy, xx], gabor_maps[1][yy, xx]
+        ok = np.isfinite(gxv) & (gcv >= a_conf_min)
+        cols_x.append(np.where(ok, gxv, np.nan).astype(np.float32))
+        cols_y.append(np.where(ok, 0.0, np.nan).astype(np.float32))
+        cols_w.append(np.where(ok, gcv, 0.0).astype(np.float32))
+    for dx, dy in raster:
+        nx, ny = _nearest_within_at(dx, dy, r_spatial, yy, xx)
+        cols_x.append(nx)
+        cols_y.append(ny)
+        cols_w.append(np.ones_like(nx))
     n_ch = len(names)
-    vx = np.stack([mx[yy, xx] for mx in maps_x])  # (n_ch, P)
-    vy = np.stack([my[yy, xx] for my in maps_y])
-    vw = np.stack([mw[yy, xx] for mw in weights])
+    vx = np.stack(cols_x)  # (n_ch, P)
+    vy = np.stack(cols_y)
+    vw = np.stack(cols_w)
     present = np.isfinite(vx)
 
     best = np.zeros(len(yy), np.int64)  # chosen subset mask (bits over channel positions)
