@@ -113,6 +113,21 @@ pub fn high_threshold(zc: &ZeroCrossings, q: f32) -> f32 {
     *vals.select_nth_unstable_by(k - below, f32::total_cmp).1
 }
 
+/// Hints the CPU to fetch the cache line of `v[i]` (no effect on any value; `i` in range).
+#[inline(always)]
+fn prefetch<T>(v: &[T], i: usize) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        let p = v[i..].as_ptr() as *const i8;
+        // SAFETY: `p` points into `v` (the slice above is bounds-checked); a prefetch only
+        // reads ahead into the cache.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (v, i);
+}
+
 fn tangent(theta: f32) -> (f64, f64) {
     let t = theta as f64;
     (-t.sin(), t.cos())
@@ -240,6 +255,13 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
             dir = (sgn * tx, sgn * ty);
             cur = q;
             (cx, cy) = (cx + dx, cy + dy);
+            // Curves are smooth: the step after next most likely reads the pixels one more
+            // step ahead. Ask for their cache lines now (a hint only; no effect on the result).
+            let ahead = (cy + 2 * dy).clamp(0, h as i32 - 1) as usize * w
+                + (cx + 2 * dx).clamp(0, w as i32 - 1) as usize;
+            prefetch(&zc.theta, ahead);
+            prefetch(&zc.strength, ahead);
+            prefetch(&state, ahead);
         }
     };
     let (mut fwd, mut bwd) = (Vec::new(), Vec::new());
