@@ -261,7 +261,7 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
                 + (cx + 2 * dx).clamp(0, w as i32 - 1) as usize;
             prefetch(&zc.theta, ahead);
             prefetch(&zc.strength, ahead);
-            prefetch(&state, ahead);
+            prefetch(state, ahead);
         }
     };
     let (mut fwd, mut bwd) = (Vec::new(), Vec::new());
