@@ -397,6 +397,9 @@ const SPREAD_ORDER: [(i32, i32); 8] = [
 pub struct SpreadPrior<'a> {
     map: &'a [f32],
     dist: Vec<u16>,
+    /// Per pixel inside the border: the index in `SPREAD_ORDER` of its first neighbour one
+    /// step closer (meaningful where `0 < dist < far`).
+    parent: Vec<u8>,
     w: usize,
     h: usize,
     far: u16,
@@ -460,9 +463,34 @@ impl<'a> SpreadPrior<'a> {
                 }
             }
         }
+        // The first closer neighbour of every pixel inside the border, for all directions at
+        // once (rows in parallel, compares without branches): the last match in reverse order
+        // is the first in SPREAD_ORDER.
+        let mut parent = vec![0u8; w * h];
+        if w >= 3 && h >= 3 {
+            let dist = &dist;
+            crate::parallel::for_each_row(&mut parent, w, |y, out| {
+                if y == 0 || y + 1 == h {
+                    return;
+                }
+                let c = &dist[y * w + 1..(y + 1) * w - 1];
+                for (k, &(dx, dy)) in SPREAD_ORDER.iter().enumerate().rev() {
+                    let o = ((y as i32 + dy) as usize) * w + (1 + dx) as usize;
+                    let q = &dist[o..o + w - 2];
+                    for ((p, &dc), &dq) in out[1..w - 1].iter_mut().zip(c).zip(q) {
+                        *p = if dq.wrapping_add(1) == dc {
+                            k as u8
+                        } else {
+                            *p
+                        };
+                    }
+                }
+            });
+        }
         SpreadPrior {
             map,
             dist,
+            parent,
             w,
             h,
             far,
@@ -481,10 +509,9 @@ impl<'a> SpreadPrior<'a> {
         let step = SPREAD_ORDER.map(|(dx, dy)| dy as isize * self.w as isize + dx as isize);
         while d > 0 {
             // A pixel at distance d >= 1 has a neighbour at d - 1 (exact transform): the
-            // first in SPREAD_ORDER, found without bounds tests away from the border.
+            // first in SPREAD_ORDER, looked up away from the border.
             let k = if x >= 1 && y >= 1 && x + 1 < w && y + 1 < h {
-                step.iter()
-                    .position(|&o| self.dist[(i as isize + o) as usize] == d - 1)
+                Some(self.parent[i] as usize)
             } else {
                 SPREAD_ORDER.iter().position(|&(dx, dy)| {
                     let (nx, ny) = (x + dx, y + dy);
