@@ -26,11 +26,21 @@ pub struct RTable {
 /// Orientation bin `floor(K theta / 2 pi)` of a normal direction in `[0, 2 pi)`.
 #[inline]
 pub fn theta_bin(theta: f32, n_bins: usize) -> usize {
-    // The quotient is >= 0 (or NaN, giving 0 either way): truncation is its floor, without a
-    // libm call on the baseline target.
+    // floor(theta n / 2 pi) of the rounded f64 quotient. A product by 1 / (2 pi) is within
+    // n 2^-50 of it (theta n <= 2 pi n, exact in f64), so for n <= 2^20 it has the same floor
+    // unless it lies within 1e-9 of an integer; there, the division itself decides. The quotient is
+    // >= 0 (or NaN, giving 0 either way): truncation is its floor, without a libm call.
+    let q = theta as f64 * n_bins as f64;
+    let r = q * (1.0 / TAU);
+    let t = r as usize;
+    let frac = r - t as f64;
+    let b = if n_bins <= 1 << 20 && (1e-9..1.0 - 1e-9).contains(&frac) {
+        t
+    } else {
+        (q / TAU) as usize
+    };
     // `theta < 2 pi` gives a quotient below `n_bins` (or equal to it by rounding): the
     // 64-bit remainder only in that rare case.
-    let b = (theta as f64 * n_bins as f64 / TAU) as usize;
     if b >= n_bins {
         b % n_bins
     } else {

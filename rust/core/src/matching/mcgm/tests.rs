@@ -435,3 +435,25 @@ fn knn_graph_equals_the_brute_force_neighbours() {
         assert_eq!(got, want, "n {n} size {size} k {k} r_max {r_max}");
     }
 }
+
+#[test]
+fn orientation_bin_equals_the_floor_of_the_quotient() {
+    // Every f32 in [0, 2 pi) 997 ulps apart, and every f32 within 64 ulps of each bin edge:
+    // the product form gives the bin of the rounded f64 quotient.
+    use std::f64::consts::TAU;
+    let want = |t: f32, n: usize| ((t as f64 * n as f64 / TAU) as usize) % n;
+    for n in [3usize, 36, 72, 1000, 1 << 20, (1 << 20) + 1] {
+        let mut t = 0.0f32;
+        while (t as f64) < TAU {
+            assert_eq!(rtable::theta_bin(t, n), want(t, n), "theta {t} n {n}");
+            t = f32::from_bits(t.to_bits() + 997);
+        }
+        for b in 1..n.min(5000) {
+            let edge = (b as f64 * TAU / n as f64) as f32;
+            for k in -64i32..=64 {
+                let t = f32::from_bits((edge.to_bits() as i32 + k) as u32);
+                assert_eq!(rtable::theta_bin(t, n), want(t, n), "theta {t} n {n}");
+            }
+        }
+    }
+}
