@@ -541,8 +541,9 @@ fn median_lower(v: &mut [f32]) -> Option<f32> {
     if v.is_empty() {
         return None;
     }
-    v.sort_by(f32::total_cmp);
-    Some(v[(v.len() - 1) / 2])
+    // The element a total-order sort would put there (a selection: no full sort).
+    let k = (v.len() - 1) / 2;
+    Some(*v.select_nth_unstable_by(k, f32::total_cmp).1)
 }
 
 /// Disparity windows of the left segments of a channel from the spread prior map
