@@ -105,7 +105,8 @@ pub fn voters(pixels: &[u32], theta: &[f32], w: usize, n_bins: usize) -> Vec<(i3
 
 /// Votes `A'` (its [`voters`]: pixel positions and orientation bins) against the R-table of `A`
 /// over translations `tx in [lo, hi]`, `ty in [-dy, dy]`; `acc` is scratch space. `None` when the
-/// window is empty or nothing voted. The caller guarantees `2 tol + 1 <= n_bins`.
+/// window is empty or nothing voted. The caller guarantees `2 tol + 1 <= n_bins`. The plain
+/// form, scanning whole orientation bins: the matcher uses [`ght_vote_rows`], tested equal.
 #[allow(clippy::too_many_arguments)]
 pub fn ght_vote(
     rt: &RTable,
