@@ -36,13 +36,7 @@ fn curves(l: &Image, p: &McgmParams) {
         let (w, h) = img.size();
         let lg = log::log_filter(img, sig);
         let zc = zerocross::zero_crossings(&lg, w, h);
-        let tp = tracking::TrackParams {
-            min_len: p
-                .track
-                .min_len
-                .max((p.min_len_sigmas * sig).ceil() as usize),
-            ..p.track
-        };
+        let tp = p.track_params(sig);
         let c = tracking::track(&zc, &tp);
         let t_log = best_ms(9, || drop(log::log_filter(img, sig)));
         let t_zc = best_ms(9, || drop(zerocross::zero_crossings(&lg, w, h)));
@@ -116,13 +110,7 @@ fn count(l: &Image, p: &McgmParams) {
             .zip(&zc.mark)
             .filter(|&(&s, &m)| m != 0 && s >= t_low)
             .count();
-        let tp = tracking::TrackParams {
-            min_len: p
-                .track
-                .min_len
-                .max((p.min_len_sigmas * sig).ceil() as usize),
-            ..p.track
-        };
+        let tp = p.track_params(sig);
         let c = tracking::track(&zc, &tp);
         let kept: usize = c.segments.iter().map(|s| s.pixels.len()).sum();
         println!(

@@ -161,6 +161,20 @@ impl Default for McgmParams {
     }
 }
 
+impl McgmParams {
+    /// The tracking thresholds of a channel of `sigma` (its own pixels): the shortest kept
+    /// segment is `max(min_len, min_len_sigmas * sigma)` pixels.
+    pub fn track_params(&self, sigma: f32) -> TrackParams {
+        TrackParams {
+            min_len: self
+                .track
+                .min_len
+                .max((self.min_len_sigmas * sigma).ceil() as usize),
+            ..self.track
+        }
+    }
+}
+
 /// One per-pixel correspondence (full-resolution coordinates).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Match {
@@ -326,13 +340,7 @@ pub fn channel_curves(img: &Image, sigma: f32, scale: usize, p: &McgmParams) -> 
     let (w, h) = img.size();
     let log = log::log_filter(img, sigma);
     let zc = zero_crossings(&log, w, h);
-    let tp = TrackParams {
-        min_len: p
-            .track
-            .min_len
-            .max((p.min_len_sigmas * sigma).ceil() as usize),
-        ..p.track
-    };
+    let tp = p.track_params(sigma);
     let curves = track(&zc, &tp);
     let rtables = curves
         .segments

@@ -119,13 +119,7 @@ pub fn ght_vote(
     tol: usize,
     acc: &mut Vec<u32>,
 ) -> Option<Ght> {
-    if hi < lo || right.is_empty() || len_a == 0 {
-        return None;
-    }
-    let nx = (hi - lo + 1) as usize;
-    let ny = (2 * dy + 1) as usize;
-    acc.clear();
-    acc.resize(nx * ny, 0);
+    let (nx, ny) = cleared(acc, len_a, right, lo, hi, dy)?;
     for &(qx, qy, b) in right {
         let b = b as usize;
         for db in 0..=2 * tol {
@@ -140,6 +134,25 @@ pub fn ght_vote(
         }
     }
     peak(acc, nx, ny, lo, dy, len_a.max(right.len()))
+}
+
+/// The accumulator of a vote over `tx in [lo, hi]`, `ty in [-dy, dy]`, zeroed and sized:
+/// `(nx, ny)`, or `None` when the window is empty or a segment has no pixel.
+fn cleared(
+    acc: &mut Vec<u32>,
+    len_a: usize,
+    right: &[(i32, i32, u32)],
+    lo: i32,
+    hi: i32,
+    dy: i32,
+) -> Option<(usize, usize)> {
+    if hi < lo || right.is_empty() || len_a == 0 {
+        return None;
+    }
+    let (nx, ny) = ((hi - lo + 1) as usize, (2 * dy + 1) as usize);
+    acc.clear();
+    acc.resize(nx * ny, 0);
+    Some((nx, ny))
 }
 
 /// The first maximum of a GHT accumulator (scan order: `ty`, then `tx` ascending), scored by
@@ -229,13 +242,7 @@ pub fn ght_vote_rows(
     tol: usize,
     acc: &mut Vec<u32>,
 ) -> Option<Ght> {
-    if hi < lo || right.is_empty() || len_a == 0 {
-        return None;
-    }
-    let nx = (hi - lo + 1) as usize;
-    let ny = (2 * dy + 1) as usize;
-    acc.clear();
-    acc.resize(nx * ny, 0);
+    let (nx, ny) = cleared(acc, len_a, right, lo, hi, dy)?;
     let rows = ix.offsets.len() as i32 - 1;
     let (nb, tol) = (n_bins as i32, tol as i32);
     for &(qx, qy, b) in right {
