@@ -335,6 +335,22 @@ fn channel_geometry(sigma: f32, p: &McgmParams) -> (f32, usize) {
     }
 }
 
+/// Whether some channel runs on the 2x-decimated image.
+fn needs_half(p: &McgmParams) -> bool {
+    p.sigmas.iter().any(|&s| s >= p.half_res_sigma)
+}
+
+/// The curves of nominal channel `sigma` of an image (`half`: its decimation, when some
+/// channel needs it).
+fn curves_at(img: &Image, half: Option<&Image>, sigma: f32, p: &McgmParams) -> ChannelCurves {
+    let (sig, scale) = channel_geometry(sigma, p);
+    let src = match (half, scale) {
+        (Some(h), 2) => h,
+        _ => img,
+    };
+    channel_curves(src, sig, scale, p)
+}
+
 /// LoG, zero crossings, curves and R-tables of `img` (already at the channel's resolution).
 pub fn channel_curves(img: &Image, sigma: f32, scale: usize, p: &McgmParams) -> ChannelCurves {
     let (w, h) = img.size();
@@ -362,22 +378,10 @@ pub fn channel_curves(img: &Image, sigma: f32, scale: usize, p: &McgmParams) -> 
 /// Curves of every channel of one image (the debugging / GUI view of `curves(image)`).
 pub fn image_curves(img: &Image, p: &McgmParams) -> Result<Vec<ChannelCurves>> {
     validate_params(p)?;
-    let half = p
-        .sigmas
-        .iter()
-        .any(|&s| s >= p.half_res_sigma)
-        .then(|| log::decimate2(img));
+    let half = needs_half(p).then(|| log::decimate2(img));
     Ok(p.sigmas
         .par_iter()
-        .map(|&s| {
-            let (sig, scale) = channel_geometry(s, p);
-            let src = if scale == 2 {
-                half.as_ref().unwrap_or(img)
-            } else {
-                img
-            };
-            channel_curves(src, sig, scale, p)
-        })
+        .map(|&s| curves_at(img, half.as_ref(), s, p))
         .collect())
 }
 
@@ -1196,20 +1200,14 @@ fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
     // assembly) would otherwise leave the other worker idle. Each channel's work and output is
     // the same as computed in order.
     let n = p.sigmas.len();
-    let half = p
-        .sigmas
-        .iter()
-        .any(|&s| s >= p.half_res_sigma)
-        .then(|| rayon::join(|| log::decimate2(left), || log::decimate2(right)));
+    let half =
+        needs_half(p).then(|| rayon::join(|| log::decimate2(left), || log::decimate2(right)));
+    let (half_l, half_r) = (half.as_ref().map(|h| &h.0), half.as_ref().map(|h| &h.1));
     let curves_of = |ci: usize| {
-        let (sig, scale) = channel_geometry(p.sigmas[ci], p);
-        let (l, r) = match (&half, scale) {
-            (Some((hl, hr)), 2) => (hl, hr),
-            _ => (left, right),
-        };
+        let s = p.sigmas[ci];
         rayon::join(
-            || channel_curves(l, sig, scale, p),
-            || channel_curves(r, sig, scale, p),
+            || curves_at(left, half_l, s, p),
+            || curves_at(right, half_r, s, p),
         )
     };
     let (finest, (mut channels, mut prior)) = rayon::join(
