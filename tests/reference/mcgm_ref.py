@@ -69,6 +69,8 @@ DEFAULTS: dict[str, Any] = {
     "disc_dx": 6,
     "disc_dy": 2,
     "disc_tol": 1.0,
+    "zncc_check": True,
+    "zncc_tol": 0.5,
 }
 
 
@@ -677,7 +679,46 @@ def edge_filters(
             if np.any(np.abs(d[near] - d[i]) > np.float32(p["disc_tol"])):
                 drop[i] = True
         keep &= ~drop
+    if p["zncc_check"]:
+        for i in np.flatnonzero(keep):
+            keep[i] = area_ok(l, r, matches[i], p["zncc_tol"])
     return keep
+
+
+def _zncc_window(img: np.ndarray, x: int, y: int) -> np.ndarray | None:
+    """Mean-free float64 7x7 window at ``(x, y)``; None off the image or flat (std <= 1e-3)."""
+    h, w = img.shape
+    if x < 3 or y < 3 or x + 3 >= w or y + 3 >= h:
+        return None
+    v = img[y - 3 : y + 4, x - 3 : x + 4].astype(np.float64).ravel()
+    v = v - v.mean()
+    return v if math.sqrt(float(v @ v) / 49.0) > 1e-3 else None
+
+
+def area_ok(l: np.ndarray, r: np.ndarray, m: np.ndarray, tol: float) -> bool:
+    """Area check: 7x7 ZNCC at ``round(d) + k``, ``|k| <= 2``; the best (first of ties) is an
+    interior peak whose parabola vertex lies within ``tol`` px of ``d``."""
+    xl, yl, xr, yr = (np.float32(v) for v in m[:4])
+    x, y, yri = rround(xl), rround(yl), rround(yr)
+    d = np.float32(xl - xr)
+    d0 = rround(d)
+    a = _zncc_window(l, x, y)
+    if a is None:
+        return False
+    z = np.full(5, -np.inf)
+    for k in range(5):
+        b = _zncc_window(r, x - d0 - (k - 2), yri)
+        if b is not None:
+            z[k] = float(a @ b) / math.sqrt(float(a @ a) * float(b @ b))
+    best = int(np.argmax(z))
+    if best in (0, 4):
+        return False
+    c0, c1, c2 = z[best - 1], z[best], z[best + 1]
+    den = c0 - 2.0 * c1 + c2
+    if not (np.isfinite(c0) and np.isfinite(c2) and den < 0):
+        return False
+    off = min(max(0.5 * (c0 - c2) / den, -0.5), 0.5)
+    return abs(d0 + (best - 2) + off - float(d)) <= tol
 
 
 def channel_curves(
@@ -811,6 +852,9 @@ def mcgm_match(
         for y, x in mine:
             taken[y, x] = True
     arr = np.array(combined, np.float32).reshape(-1, 6)
+    # Exact repeats of a correspondence (one crossing on two curve pixels) once, the first kept.
+    _, first = np.unique(arr[:, :4], axis=0, return_index=True)
+    arr = arr[np.sort(first)]
     keep = edge_filters(
         left.astype(np.float32), right.astype(np.float32), arr[:, :4], p, (d_min, d_max)
     )

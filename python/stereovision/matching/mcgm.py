@@ -78,6 +78,8 @@ DEFAULTS: dict[str, Any] = {
     "disc_dx": 6,  # +- columns (B.8)
     "disc_dy": 2,  # +- rows (B.8)
     "disc_tol": 1.0,  # largest disparity difference to a neighbour (px, B.8)
+    "zncc_check": True,  # area check: 7x7 ZNCC re-measure around the disparity agrees ...
+    "zncc_tol": 0.5,  # ... within this many px (an interior peak of round(d) +- 2)
 }
 
 
@@ -248,7 +250,7 @@ def mcgm_match(
     Matches
         Per-pixel correspondences: ``xl`` / ``xr`` the sub-pixel crossings, ``yl == yr`` the row,
         ``score`` the GHT score of the matched segment pair; ``stats`` has the counters
-        (``n_candidates``, ``n_pairs``, ``n_combined``, ``n_sides``, ``n_matches``) and
+        (``n_candidates``, ``n_pairs``, ``n_combined``, ``n_sides``, ``n_disc``, ``n_matches``) and
         ``channel`` (``(N,)`` int index into ``sigmas`` of each match).
 
     Raises
@@ -294,7 +296,8 @@ def edge_filters(
     min_disparity: float = 0,
     **params: Any,
 ) -> npt.NDArray[np.bool_]:
-    """B.8's occlusion filters (both-sides check, discontinuity filter) on any matches.
+    """Occlusion filters on any matches: B.8's both-sides check and discontinuity filter, then
+    the area check (``zncc_check``).
 
     Parameters
     ----------
@@ -306,8 +309,8 @@ def edge_filters(
         The searched range (the ``sides_best`` test looks for better disparities in it).
     **params
         ``sides``, ``sides_mad``, ``sides_width``, ``sides_height``, ``sides_gap``,
-        ``sides_best``, ``sides_best_margin``, ``disc``, ``disc_dx``, ``disc_dy``, ``disc_tol``
-        (:data:`DEFAULTS`).
+        ``sides_best``, ``sides_best_margin``, ``disc``, ``disc_dx``, ``disc_dy``, ``disc_tol``,
+        ``zncc_check``, ``zncc_tol`` (:data:`DEFAULTS`).
 
     Returns
     -------
@@ -479,4 +482,6 @@ _FILTER_KEYS = (
     "disc_dx",
     "disc_dy",
     "disc_tol",
+    "zncc_check",
+    "zncc_tol",
 )

@@ -18,7 +18,7 @@ use crate::convert::{image_from_numpy, image_to_numpy};
 use crate::errors::guard;
 use crate::params::{check_keys, get};
 
-const KEYS: [&str; 41] = [
+const KEYS: [&str; 43] = [
     "min_disparity",
     "max_disparity",
     "sigmas",
@@ -60,6 +60,8 @@ const KEYS: [&str; 41] = [
     "disc_dx",
     "disc_dy",
     "disc_tol",
+    "zncc_check",
+    "zncc_tol",
 ];
 
 /// Core parameters from the `params` dict (missing keys keep the core defaults).
@@ -107,6 +109,8 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<McgmParams> {
     get(d, "disc_dx", &mut p.filters.disc_dx)?;
     get(d, "disc_dy", &mut p.filters.disc_dy)?;
     get(d, "disc_tol", &mut p.filters.disc_tol)?;
+    get(d, "zncc_check", &mut p.filters.zncc_check)?;
+    get(d, "zncc_tol", &mut p.filters.zncc_tol)?;
     Ok(p)
 }
 
@@ -271,6 +275,7 @@ pub fn mcgm_match<'py>(
     let stats = PyDict::new(py);
     stats.set_item("n_combined", out.n_combined)?;
     stats.set_item("n_sides", out.n_sides)?;
+    stats.set_item("n_disc", out.n_disc)?;
     stats.set_item("n_matches", out.matches.len())?;
     let chans = PyList::empty(py);
     let (mut n_cand, mut n_pairs) = (0usize, 0usize);

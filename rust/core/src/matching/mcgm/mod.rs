@@ -97,6 +97,11 @@ pub struct FilterParams {
     pub disc_dy: i32,
     /// Largest disparity difference to a neighbour (px, B.8: 1).
     pub disc_tol: f32,
+    /// Area check on / off: a 7x7 ZNCC re-measure of the disparity (best of the five integer
+    /// disparities around the match's, parabola sub-pixel) must be an interior peak within
+    /// `zncc_tol` px of the match's own (zero-crossing) disparity.
+    pub zncc_check: bool,
+    pub zncc_tol: f32,
 }
 
 impl Default for FilterParams {
@@ -114,6 +119,8 @@ impl Default for FilterParams {
             disc_dx: 6,
             disc_dy: 2,
             disc_tol: 1.0,
+            zncc_check: true,
+            zncc_tol: 0.5,
         }
     }
 }
@@ -237,6 +244,8 @@ pub struct McgmOutput {
     pub n_combined: usize,
     /// ... after the both-sides check.
     pub n_sides: usize,
+    /// ... after the discontinuity filter (before the area check).
+    pub n_disc: usize,
 }
 
 fn validate_params(p: &McgmParams) -> Result<()> {
@@ -299,6 +308,7 @@ fn validate_params(p: &McgmParams) -> Result<()> {
         ("prior_width_sigmas", p.prior_width_sigmas),
         ("sides_mad", p.filters.sides_mad),
         ("disc_tol", p.filters.disc_tol),
+        ("zncc_tol", p.filters.zncc_tol),
     ] {
         if !v.is_finite() || v < 0.0 {
             return Err(CoreError::param(
@@ -1008,18 +1018,102 @@ fn sides_ok(
     true
 }
 
-/// B.8's two occlusion-boundary filters on a match list (also applied to the ZNCC reference):
-/// the both-sides check, then the discontinuity filter among its survivors (drop a match if
+/// Half-size of the area check's ZNCC window (7x7, as the ZNCC reference's).
+const AREA_RADIUS: i32 = 3;
+/// The area check searches the integer disparities `round(d) +- AREA_REACH`.
+const AREA_REACH: i32 = 2;
+/// A window flatter than this grey-level std has no ZNCC (as the reference's).
+const AREA_MIN_STD: f64 = 1e-3;
+
+/// Mean-free 7x7 window of `img` centred at `(x, y)` and its sum of squares, or `None` where
+/// it leaves the image or is flat (std <= [`AREA_MIN_STD`]).
+fn area_window(img: &Image, x: i32, y: i32) -> Option<([f64; 49], f64)> {
+    let (w, h) = img.size();
+    let r = AREA_RADIUS;
+    if x < r || y < r || x + r >= w as i32 || y + r >= h as i32 {
+        return None;
+    }
+    let mut v = [0.0f64; 49];
+    for (k, dy) in (-r..=r).enumerate() {
+        let o = (y + dy) as usize * w + (x - r) as usize;
+        let row = &img.data[o..o + 7];
+        for (j, &p) in row.iter().enumerate() {
+            v[k * 7 + j] = f64::from(p);
+        }
+    }
+    let mean = v.iter().sum::<f64>() / 49.0;
+    let mut ss = 0.0;
+    for p in &mut v {
+        *p -= mean;
+        ss += *p * *p;
+    }
+    ((ss / 49.0).sqrt() > AREA_MIN_STD).then_some((v, ss))
+}
+
+/// The area check of one match (see [`FilterParams::zncc_check`]): ZNCC of the left window at
+/// the rounded left pixel against the right windows at the five integer disparities around
+/// the match's; the best must be an interior peak (ties: the first) whose parabola vertex lies
+/// within `tol` px of the match's disparity.
+fn area_ok(left: &Image, right: &Image, m: &Match, tol: f32) -> bool {
+    let (x, y, yr) = (
+        m.xl.round() as i32,
+        m.yl.round() as i32,
+        m.yr.round() as i32,
+    );
+    let d = m.xl - m.xr;
+    let d0 = d.round() as i32;
+    let Some((a, sa)) = area_window(left, x, y) else {
+        return false;
+    };
+    let mut z = [f64::NEG_INFINITY; (2 * AREA_REACH + 1) as usize];
+    for (k, zk) in z.iter_mut().enumerate() {
+        let xr = x - d0 - (k as i32 - AREA_REACH);
+        if let Some((b, sb)) = area_window(right, xr, yr) {
+            let dot: f64 = a.iter().zip(&b).map(|(p, q)| p * q).sum();
+            *zk = dot / (sa * sb).sqrt();
+        }
+    }
+    let mut best = 0;
+    for k in 1..z.len() {
+        if z[k] > z[best] {
+            best = k;
+        }
+    }
+    if best == 0 || best == z.len() - 1 {
+        return false;
+    }
+    let (c0, c1, c2) = (z[best - 1], z[best], z[best + 1]);
+    let den = c0 - 2.0 * c1 + c2;
+    if !(c0.is_finite() && c2.is_finite() && den < 0.0) {
+        return false;
+    }
+    let off = (0.5 * (c0 - c2) / den).clamp(-0.5, 0.5);
+    let dz = f64::from(d0) + (best as f64 - f64::from(AREA_REACH)) + off;
+    (dz - f64::from(d)).abs() <= f64::from(tol)
+}
+
+/// Counts of [`edge_filters`]' survivors after each step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FilterCounts {
+    /// After the both-sides check.
+    pub sides: usize,
+    /// After the discontinuity filter.
+    pub disc: usize,
+}
+
+/// The occlusion-boundary filters on a match list (also applied to the ZNCC reference): B.8's
+/// both-sides check, then B.8's discontinuity filter among its survivors (drop a match if
 /// another one within `+- disc_dx` columns and `+- disc_dy` rows differs by more than
-/// `disc_tol` px). `range` is the searched disparity range (`sides_best`). Returns the kept
-/// flags and the count after the first filter.
+/// `disc_tol` px), then the area check ([`FilterParams::zncc_check`]). `range` is the
+/// searched disparity range (`sides_best`). Returns the kept flags and the counts after the
+/// first two filters.
 pub fn edge_filters(
     left: &Image,
     right: &Image,
     matches: &[Match],
     f: &FilterParams,
     range: (i32, i32),
-) -> Result<(Vec<bool>, usize)> {
+) -> Result<(Vec<bool>, FilterCounts)> {
     check_pair(left, right)?;
     let (w, h) = left.size();
     let mut keep: Vec<bool> = matches
@@ -1097,7 +1191,19 @@ pub fn edge_filters(
             *k &= !d;
         }
     }
-    Ok((keep, n_sides))
+    let n_disc = keep.iter().filter(|&&k| k).count();
+    if f.zncc_check {
+        keep.par_iter_mut().zip(matches).for_each(|(k, m)| {
+            *k = *k && area_ok(left, right, m, f.zncc_tol);
+        });
+    }
+    Ok((
+        keep,
+        FilterCounts {
+            sides: n_sides,
+            disc: n_disc,
+        },
+    ))
 }
 
 /// Matches one channel (`ci`: its index in `sigmas`) given its curves in both images, with the
@@ -1185,6 +1291,31 @@ fn match_channel(
     }
 }
 
+/// Drops exact repeats of a correspondence (the same `xl, yl, xr, yr` bits), keeping the first:
+/// two curve pixels on one row can carry the same crossing (a vertical-only mark takes its
+/// neighbour's horizontal crossing), and the pair would otherwise be reported, and counted,
+/// twice.
+fn drop_repeats(ms: &mut Vec<Match>) {
+    let key = |m: &Match| {
+        (
+            m.yl.to_bits(),
+            m.xl.to_bits(),
+            m.xr.to_bits(),
+            m.yr.to_bits(),
+        )
+    };
+    let mut order: Vec<u32> = (0..ms.len() as u32).collect();
+    order.sort_unstable_by_key(|&i| (key(&ms[i as usize]), i));
+    let mut keep = vec![true; ms.len()];
+    for pair in order.windows(2) {
+        if key(&ms[pair[0] as usize]) == key(&ms[pair[1] as usize]) {
+            keep[pair[1] as usize] = false;
+        }
+    }
+    let mut k = keep.into_iter();
+    ms.retain(|_| k.next().unwrap_or(true));
+}
+
 /// The MCGM channel end to end (see the module docs).
 pub fn mcgm_match(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOutput> {
     crate::parallel::run_hot(|| mcgm_match_hot(left, right, p))
@@ -1254,7 +1385,8 @@ fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
             taken[row + x] = true;
         }
     }
-    let (keep, n_sides) = edge_filters(
+    drop_repeats(&mut combined);
+    let (keep, counts) = edge_filters(
         left,
         right,
         &combined,
@@ -1271,6 +1403,7 @@ fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
         matches,
         channels,
         n_combined,
-        n_sides,
+        n_sides: counts.sides,
+        n_disc: counts.disc,
     })
 }

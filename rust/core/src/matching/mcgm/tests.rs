@@ -457,3 +457,54 @@ fn orientation_bin_equals_the_floor_of_the_quotient() {
         }
     }
 }
+
+#[test]
+fn area_check_keeps_the_true_disparity_and_rejects_one_pixel_off() {
+    let d = 4.4f32;
+    let (l, r) = (blobs(200, 150, 0.0), blobs(200, 150, d));
+    let at = |x: f32, y: f32, dd: f32| Match {
+        xl: x,
+        yl: y,
+        xr: x - dd,
+        yr: y,
+        score: 0.0,
+        channel: 0,
+    };
+    let (mut kept, mut off_kept, mut n) = (0, 0, 0);
+    for y in (10..140).step_by(7) {
+        for x in (20..190).step_by(5) {
+            let (x, y) = (x as f32 + 0.3, y as f32);
+            n += 1;
+            kept += usize::from(area_ok(&l, &r, &at(x, y, d), 0.5));
+            off_kept += usize::from(area_ok(&l, &r, &at(x, y, d + 1.0), 0.5));
+        }
+    }
+    assert!(kept as f32 > 0.9 * n as f32, "{kept} of {n}");
+    assert!((off_kept as f32) < 0.05 * n as f32, "{off_kept} of {n}");
+    // Windows leaving the image, and flat windows, have no ZNCC: rejected.
+    assert!(!area_ok(&l, &r, &at(2.0, 50.0, 0.0), 0.5));
+    let flat = Image::filled(200, 150, 0.5);
+    assert!(!area_ok(&flat, &flat, &at(100.0, 50.0, 0.0), 0.5));
+}
+
+#[test]
+fn repeated_correspondences_are_dropped_keeping_the_first() {
+    let m = |xl: f32, xr: f32, score: f32| Match {
+        xl,
+        yl: 3.0,
+        xr,
+        yr: 3.0,
+        score,
+        channel: 0,
+    };
+    let mut ms = vec![
+        m(5.5, 1.0, 1.0),
+        m(7.0, 2.0, 2.0),
+        m(5.5, 1.0, 3.0),
+        m(5.5, 1.5, 4.0),
+        m(7.0, 2.0, 5.0),
+    ];
+    drop_repeats(&mut ms);
+    let scores: Vec<f32> = ms.iter().map(|m| m.score).collect();
+    assert_eq!(scores, [1.0, 2.0, 4.0]);
+}
