@@ -40,7 +40,7 @@ DEFAULTS: dict[str, Any] = {
     "seg_theta_tol_deg": 30.0,
     "dy_band": 1,
     "n_theta_bins": 36,
-    "vote_bin_tol": 1,
+    "vote_bin_tol": 2,
     "ght_min_score": 0.5,
     "k_cand": 6,
     "knn": 6,

@@ -49,7 +49,7 @@ DEFAULTS: dict[str, Any] = {
     "seg_theta_tol_deg": 30.0,  # mean-orientation difference of candidate segments (B.2)
     "dy_band": 1,  # epipolar band (rows; B.8: t_y in {-1, 0, 1} for 1.5 px)
     "n_theta_bins": 36,  # R-table orientation bins over [0, 2 pi) (B.2)
-    "vote_bin_tol": 1,  # +- bins when indexing the R-table (B.2)
+    "vote_bin_tol": 2,  # +- bins when indexing the R-table (B.2: 1; 2 measured, docs/mcgm.md)
     "ght_min_score": 0.5,  # GHT peak / max(|A|, |A'|) (B.8: 0.5)
     "k_cand": 6,  # candidates per left segment (B.2)
     "knn": 6,  # neighbours in the segment graph (B.4.9)

@@ -35,6 +35,8 @@ pub struct CandParams {
     /// Epipolar band (rows): y-ranges are widened by this and GHT rows are `-dy..=dy`.
     pub dy_band: i32,
     pub n_bins: usize,
+    /// `+-` orientation bins an edge pixel votes through (B.2: 1; default 2, 25 degrees at 36
+    /// bins: the finest channel's orientations are noisy, docs/mcgm.md).
     pub vote_bin_tol: usize,
     pub ght_min_score: f32,
     pub k_cand: usize,

@@ -143,7 +143,7 @@ impl Default for McgmParams {
                 seg_theta_tol_deg: 30.0,
                 dy_band: 1,
                 n_bins: 36,
-                vote_bin_tol: 1,
+                vote_bin_tol: 2,
                 ght_min_score: 0.5,
                 k_cand: 6,
             },
