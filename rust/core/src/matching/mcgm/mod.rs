@@ -1055,6 +1055,9 @@ fn area_window(img: &Image, x: i32, y: i32) -> Option<([f64; 49], f64)> {
 /// the match's; the best must be an interior peak (ties: the first) whose parabola vertex lies
 /// within `tol` px of the match's disparity.
 fn area_ok(left: &Image, right: &Image, m: &Match, tol: f32) -> bool {
+    const SIDE: usize = (2 * AREA_RADIUS + 1) as usize;
+    const NK: usize = (2 * AREA_REACH + 1) as usize;
+    const SPAN: usize = SIDE + NK - 1;
     let (x, y, yr) = (
         m.xl.round() as i32,
         m.yl.round() as i32,
@@ -1065,21 +1068,59 @@ fn area_ok(left: &Image, right: &Image, m: &Match, tol: f32) -> bool {
     let Some((a, sa)) = area_window(left, x, y) else {
         return false;
     };
-    let mut z = [f64::NEG_INFINITY; (2 * AREA_REACH + 1) as usize];
-    for (k, zk) in z.iter_mut().enumerate() {
-        let xr = x - d0 - (k as i32 - AREA_REACH);
-        if let Some((b, sb)) = area_window(right, xr, yr) {
-            let dot: f64 = a.iter().zip(&b).map(|(p, q)| p * q).sum();
-            *zk = dot / (sa * sb).sqrt();
+    let (w, h) = right.size();
+    if yr < AREA_RADIUS || yr + AREA_RADIUS >= h as i32 {
+        return false;
+    }
+    // The five right windows share one 7 x 11 block: its columns' sums and sums of squares
+    // give each window's statistics, and since the left window is mean-free its dot product
+    // with the raw right window is the covariance.
+    let bx = x - d0 - AREA_REACH - AREA_RADIUS;
+    let mut blk = [[0.0f64; SPAN]; SIDE];
+    let mut col_ok = [false; SPAN];
+    let (mut cs, mut cq) = ([0.0f64; SPAN], [0.0f64; SPAN]);
+    for j in 0..SPAN {
+        let c = bx + j as i32;
+        if c < 0 || c >= w as i32 {
+            continue;
+        }
+        col_ok[j] = true;
+        for (r, row) in blk.iter_mut().enumerate() {
+            let v = f64::from(right.data[(yr - AREA_RADIUS + r as i32) as usize * w + c as usize]);
+            row[j] = v;
+            cs[j] += v;
+            cq[j] += v * v;
         }
     }
+    let n = (SIDE * SIDE) as f64;
+    let mut z = [f64::NEG_INFINITY; NK];
+    for (k, zk) in z.iter_mut().enumerate() {
+        // Window k (disparity d0 + k - AREA_REACH) starts AREA_REACH * 2 - k columns in.
+        let off = NK - 1 - k;
+        if !col_ok[off..off + SIDE].iter().all(|&ok| ok) {
+            continue;
+        }
+        let sum: f64 = cs[off..off + SIDE].iter().sum();
+        let sq: f64 = cq[off..off + SIDE].iter().sum();
+        let ss = (sq - sum * sum / n).max(0.0);
+        if (ss / n).sqrt() <= AREA_MIN_STD {
+            continue;
+        }
+        let mut dot = 0.0;
+        for (r, row) in blk.iter().enumerate() {
+            for c in 0..SIDE {
+                dot += a[r * SIDE + c] * row[off + c];
+            }
+        }
+        *zk = dot / (sa * ss).sqrt();
+    }
     let mut best = 0;
-    for k in 1..z.len() {
+    for k in 1..NK {
         if z[k] > z[best] {
             best = k;
         }
     }
-    if best == 0 || best == z.len() - 1 {
+    if best == 0 || best == NK - 1 {
         return false;
     }
     let (c0, c1, c2) = (z[best - 1], z[best], z[best + 1]);
@@ -1090,6 +1131,26 @@ fn area_ok(left: &Image, right: &Image, m: &Match, tol: f32) -> bool {
     let off = (0.5 * (c0 - c2) / den).clamp(-0.5, 0.5);
     let dz = f64::from(d0) + (best as f64 - f64::from(AREA_REACH)) + off;
     (dz - f64::from(d)).abs() <= f64::from(tol)
+}
+
+/// Indices of `matches` by the row, then the column, of the rounded left pixel (ties in index
+/// order; non-finite positions last).
+fn raster_order(matches: &[Match]) -> Vec<u32> {
+    let key = |m: &Match| -> u64 {
+        if !(m.xl.is_finite() && m.yl.is_finite()) {
+            return u64::MAX;
+        }
+        // Rows and columns as offset 32-bit values: the order of (row, column) for any i32.
+        let (x, y) = (m.xl.round() as i32, m.yl.round() as i32);
+        ((y as u32 ^ 0x8000_0000) as u64) << 32 | (x as u32 ^ 0x8000_0000) as u64
+    };
+    let mut keyed: Vec<(u64, u32)> = matches
+        .iter()
+        .enumerate()
+        .map(|(i, m)| (key(m), i as u32))
+        .collect();
+    keyed.sort_unstable();
+    keyed.into_iter().map(|(_, i)| i).collect()
 }
 
 /// Counts of [`edge_filters`]' survivors after each step.
@@ -1116,9 +1177,14 @@ pub fn edge_filters(
 ) -> Result<(Vec<bool>, FilterCounts)> {
     check_pair(left, right)?;
     let (w, h) = left.size();
-    let mut keep: Vec<bool> = matches
+    // Both per-match checks run in raster order of the left pixel: neighbouring checks read
+    // the same image rows (in match order, the windows' rows were mostly cache misses).
+    let order = raster_order(matches);
+    let mut keep = vec![false; matches.len()];
+    let ok: Vec<bool> = order
         .par_iter()
-        .map_init(SidesScratch::default, |scratch, m| {
+        .map_init(SidesScratch::default, |scratch, &i| {
+            let m = &matches[i as usize];
             m.xl.is_finite()
                 && m.xr.is_finite()
                 && m.yl.is_finite()
@@ -1126,6 +1192,9 @@ pub fn edge_filters(
                 && (!f.sides || sides_ok(left, right, m, f, range, scratch))
         })
         .collect();
+    for (&i, o) in order.iter().zip(ok) {
+        keep[i as usize] = o;
+    }
     let n_sides = keep.iter().filter(|&&k| k).count();
     if f.disc {
         // Survivors bucketed by the row of their rounded left pixel, by column within a row
@@ -1193,9 +1262,14 @@ pub fn edge_filters(
     }
     let n_disc = keep.iter().filter(|&&k| k).count();
     if f.zncc_check {
-        keep.par_iter_mut().zip(matches).for_each(|(k, m)| {
-            *k = *k && area_ok(left, right, m, f.zncc_tol);
-        });
+        let live: Vec<u32> = order.into_iter().filter(|&i| keep[i as usize]).collect();
+        let ok: Vec<bool> = live
+            .par_iter()
+            .map(|&i| area_ok(left, right, &matches[i as usize], f.zncc_tol))
+            .collect();
+        for (&i, o) in live.iter().zip(ok) {
+            keep[i as usize] = o;
+        }
     }
     Ok((
         keep,
