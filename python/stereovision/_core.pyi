@@ -151,6 +151,19 @@ def refine_disparity(
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32], int]:
     """``(disparity, confidence, n_filled)``: ZNCC sub-pixel refinement and validated fill."""
 
+def sgm_disparity(
+    left: npt.NDArray[np.float32],
+    right: npt.NDArray[np.float32],
+    d_min: int,
+    d_max: int,
+    p1: int,
+    p2: int,
+    gamma: float,
+    uniqueness: int,
+    lr_tol: int,
+) -> npt.NDArray[np.float32]:
+    """Census semi-global disparity over ``[d_min, d_max]``, NaN where rejected."""
+
 def gray_u8(
     image: npt.NDArray[np.uint8], weights: tuple[float, float, float]
 ) -> npt.NDArray[np.float32]:

@@ -14,6 +14,7 @@ mod hopfield;
 mod mcgm;
 mod params;
 mod refine;
+mod sgm;
 mod triangulation;
 
 /// Freed image-sized blocks are kept for the next call instead of being returned to the system
@@ -54,6 +55,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mcgm::mcgm_filter, m)?)?;
     m.add_function(wrap_pyfunction!(triangulation::depth_rectified, m)?)?;
     m.add_function(wrap_pyfunction!(refine::refine_disparity, m)?)?;
+    m.add_function(wrap_pyfunction!(sgm::sgm_disparity, m)?)?;
     m.add_function(wrap_pyfunction!(convert::gray_u8, m)?)?;
     m.add_function(wrap_pyfunction!(release_memory, m)?)?;
     m.add_function(wrap_pyfunction!(kept_memory, m)?)?;

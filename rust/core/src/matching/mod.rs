@@ -3,3 +3,4 @@
 pub mod gabor;
 pub mod hopfield;
 pub mod mcgm;
+pub mod sgm;

@@ -1,0 +1,94 @@
+"""Semi-global matching on a census cost: the fused dense map's completion (issue 5).
+
+The kernel lives in ``rust/core/src/matching/sgm.rs``: a 9x7 census of each image, the Hamming
+distance as the cost, aggregation along 8 paths (Hirschmueller 2008) with an intensity-adaptive
+P2, winner-take-all with a uniqueness test, a left-right check and a parabola vertex. It is not
+one of the paper's three channels: :func:`stereovision.matching.fusion.fused_dense` uses it where
+the Gabor channel has no value, and as a second opinion where it has one (algorithms.md A.9: a
+filled SGBM is beaten only with global aggregation). NumPy reference:
+``tests/reference/sgm_ref.py``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from stereovision import _core
+from stereovision._validate import as_gray_float, check_pair
+
+__all__ = ["DEFAULTS", "sgm_disparity"]
+
+#: Default parameters (mirror ``SgmParams::default`` in Rust). Chosen once on the 17 shared
+#: scenes (README, "Fusion"); the same for every scene.
+DEFAULTS: dict[str, Any] = {
+    "p1": 8,  # penalty of a 1-level change between path neighbours (census bits)
+    "p2": 96,  # penalty of a larger jump, before the intensity adaptation
+    "gamma": 16.0,  # grey levels (0-255) of intensity step per halving of P2
+    "uniqueness": 5,  # %: another level (beyond +-1) this close to the winner rejects the pixel
+    "lr_tol": 1,  # levels: left-right check tolerance
+}
+
+
+def sgm_disparity(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    *,
+    max_disparity: float,
+    min_disparity: float = 0.0,
+    **params: Any,
+) -> npt.NDArray[np.float32]:
+    """Dense disparity of a rectified pair by census semi-global matching.
+
+    Parameters
+    ----------
+    left, right : array_like
+        Rectified pair, ``(H, W)`` grey (or anything :func:`as_gray_float` takes), same shape.
+    max_disparity, min_disparity : float
+        Search range (px); rounded outwards to integers.
+    **params
+        :data:`DEFAULTS`' keys.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` float32 disparity, NaN where the uniqueness test or the left-right check
+        fails, and in the left ``max_disparity`` columns (their match may lie outside the
+        right image).
+
+    Raises
+    ------
+    ValueError
+        Bad images, an unknown option, a range with ``max_disparity < min_disparity`` or a
+        parameter out of its range.
+    """
+    unknown = sorted(set(params) - set(DEFAULTS))
+    if unknown:
+        raise ValueError(f"unknown SGM option(s) {unknown}: expected {sorted(DEFAULTS)}")
+    p = {**DEFAULTS, **params}
+    for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
+        if not math.isfinite(v):
+            raise ValueError(f"{name}: expected a finite number, got {v}")
+    if max_disparity < min_disparity:
+        raise ValueError(
+            f"max_disparity ({max_disparity}) is smaller than min_disparity ({min_disparity})"
+        )
+    for name in ("p1", "p2", "uniqueness", "lr_tol"):
+        v = p[name]
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
+            raise ValueError(f"{name}: expected a non-negative integer, got {v!r}")
+    gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
+    return _core.sgm_disparity(
+        np.ascontiguousarray(gl),
+        np.ascontiguousarray(gr),
+        math.floor(min_disparity),
+        math.ceil(max_disparity),
+        int(p["p1"]),
+        int(p["p2"]),
+        float(p["gamma"]),
+        int(p["uniqueness"]),
+        int(p["lr_tol"]),
+    )

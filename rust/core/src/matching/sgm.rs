@@ -1,0 +1,603 @@
+//! Semi-global matching on a census cost: the dense map's completion where the Gabor channel has
+//! no value, and its second opinion where it has one (issue 5; algorithms.md A.9 found that a
+//! filled SGBM is only beaten with global aggregation).
+//!
+//! Steps (NumPy reference: `tests/reference/sgm_ref.py`; integer arithmetic, so the two agree
+//! exactly):
+//! 1. 9x7 census of each image (bit set where the neighbour is darker than the centre; borders
+//!    replicated); the cost `C(x, d)` is the Hamming distance of the codes at `x` and `x - d`;
+//!    where `x - d` leaves the image, the best cost of the levels inside (neutral).
+//! 2. Aggregation along 8 paths (Hirschmueller 2008) with P1 for a 1-level change and an
+//!    intensity-adaptive P2 = `p2 / (1 + floor(|dI| / gamma))` (at least `p1 + 1`; `dI` in 0-255
+//!    grey levels) for a jump: an edge in the image is where a depth jump may be.
+//!    The four paths that come from above or the left run in one raster pass, the other four in a
+//!    reverse raster pass; the two passes run on two threads, so the output does not depend on the
+//!    thread count.
+//! 3. Winner-take-all, a uniqueness test (no level beyond +-1 within `uniqueness` % of the
+//!    winner), a left-right check against the right view's winners read off the same volume
+//!    (within `lr_tol` levels), and the parabola vertex as the sub-pixel part. Pixels whose range reaches outside the right
+//!    image (`x < d_max`) are not reported: their match may lie outside, and the levels that do
+//!    not are favoured (on wood2 reporting them cost 10 points of bad-2.0 after the row fill).
+
+use rayon::prelude::*;
+
+use crate::error::{CoreError, Result};
+use crate::image::ImageView;
+use crate::simd::simd_fn;
+
+/// Census half-window along x.
+pub const RX: usize = 4;
+/// Census half-window along y.
+pub const RY: usize = 3;
+/// Cost of every level of a pixel whose whole range falls outside the right image: one more
+/// than the 62 census bits (levels outside beside levels inside take the best inside cost).
+pub const OUTSIDE: u8 = ((2 * RX + 1) * (2 * RY + 1)) as u8;
+/// Pad value around each path-cost vector: larger than any path cost plus P1, far from overflow.
+const BIG: u16 = 16_000;
+/// Largest P2: eight path costs of at most `OUTSIDE + p2` each must fit a `u16` sum.
+pub const MAX_P2: u16 = 4000;
+
+/// Parameters of [`sgm_disparity`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SgmParams {
+    /// Penalty of a 1-level disparity change between path neighbours.
+    pub p1: u16,
+    /// Penalty of a larger jump, before the intensity adaptation.
+    pub p2: u16,
+    /// Grey levels (0-255) of intensity step that halve P2 once (`p2 / (1 + floor(step / gamma))`).
+    pub gamma: f32,
+    /// A level beyond +-1 of the winner within this percentage of its cost rejects the pixel.
+    pub uniqueness: u32,
+    /// Largest difference, in levels, between the left winner and the right view's winner.
+    pub lr_tol: u32,
+}
+
+impl Default for SgmParams {
+    fn default() -> Self {
+        SgmParams {
+            p1: 8,
+            p2: 96,
+            gamma: 16.0,
+            uniqueness: 5,
+            lr_tol: 1,
+        }
+    }
+}
+
+impl SgmParams {
+    /// Checks every field's range.
+    pub fn validate(&self) -> Result<()> {
+        if self.p1 == 0 || self.p1 >= self.p2 {
+            return Err(CoreError::param(
+                "p1",
+                format!(
+                    "expected 0 < p1 < p2, got p1 = {}, p2 = {}",
+                    self.p1, self.p2
+                ),
+            ));
+        }
+        if self.p2 > MAX_P2 {
+            return Err(CoreError::param(
+                "p2",
+                format!("expected at most {MAX_P2}, got {}", self.p2),
+            ));
+        }
+        if !(self.gamma.is_finite() && self.gamma > 0.0) {
+            return Err(CoreError::param(
+                "gamma",
+                format!("expected a positive number, got {}", self.gamma),
+            ));
+        }
+        if self.uniqueness > 100 {
+            return Err(CoreError::param(
+                "uniqueness",
+                format!("expected a percentage in [0, 100], got {}", self.uniqueness),
+            ));
+        }
+        Ok(())
+    }
+}
+
+simd_fn! {
+    /// One census row: `rows` are the 7 image rows around it (clamped at the image's edges).
+    fn census_row(rows: &[&[f32]], code: &mut [u64]) {
+        let w = code.len();
+        let centre = rows[RY];
+        code.fill(0);
+        let mut bit = 0u32;
+        for (dy, r) in rows.iter().enumerate() {
+            for dx in -(RX as isize)..=RX as isize {
+                if dy == RY && dx == 0 {
+                    continue;
+                }
+                // Interior columns in one vectorisable loop, the edges with clamped columns.
+                let (lo, hi) = if w > 2 * RX { (RX, w - RX) } else { (0, 0) };
+                if hi > lo {
+                    let src = &r[(lo as isize + dx) as usize..];
+                    for ((c, &v), &ctr) in code[lo..hi].iter_mut().zip(src).zip(&centre[lo..hi]) {
+                        *c |= u64::from(v < ctr) << bit;
+                    }
+                }
+                for x in (0..lo).chain(hi..w) {
+                    let xx = (x as isize + dx).clamp(0, w as isize - 1) as usize;
+                    code[x] |= u64::from(r[xx] < centre[x]) << bit;
+                }
+                bit += 1;
+            }
+        }
+    }
+}
+
+/// 9x7 census codes, row-major: bit `k` (window row-major, centre skipped) set where that
+/// neighbour is darker than the centre.
+pub fn census(img: ImageView<'_>) -> Vec<u64> {
+    let (w, h) = (img.width, img.height);
+    let mut out = vec![0u64; w * h];
+    out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        let rows: Vec<&[f32]> = (-(RY as isize)..=RY as isize)
+            .map(|dy| {
+                let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
+                &img.data[yy * w..(yy + 1) * w]
+            })
+            .collect();
+        census_row(&rows, row);
+    });
+    out
+}
+
+/// One row of the cost volume, `n` levels per pixel.
+#[inline(always)]
+fn cost_row_imp(cl: &[u64], cr_rev: &[u64], d_min: i64, n: usize, out: &mut [u8]) {
+    let w = cl.len() as i64;
+    for (x, cell) in out.chunks_exact_mut(n).enumerate() {
+        let a = cl[x];
+        // Levels whose right pixel x - d_min - k lies in [0, w).
+        let hi = (x as i64 - d_min).min(n as i64 - 1);
+        let lo = (x as i64 - d_min - w + 1).max(0);
+        if lo > hi {
+            cell.fill(OUTSIDE);
+            continue;
+        }
+        let (lo, hi) = (lo as usize, hi as usize);
+        // Level k pairs with right pixel x - d_min - k, i.e. entry w - 1 - x + d_min + k of the
+        // reversed right row: consecutive levels read consecutive codes (a vectorised popcount).
+        let start = (w - 1 - x as i64 + d_min) as usize + lo;
+        let right = &cr_rev[start..start + hi + 1 - lo];
+        for (v, &b) in cell[lo..=hi].iter_mut().zip(right) {
+            *v = (a ^ b).count_ones() as u8;
+        }
+        let best = cell[lo..=hi].iter().fold(OUTSIDE, |m, &v| m.min(v));
+        // Levels whose right pixel is outside the image cost what the best inside level does:
+        // neutral, so the paths from the left edge carry no preference for the levels that stay
+        // inside (with a high cost a flat region took d_min from the edge, far along the rows).
+        cell[..lo].fill(best);
+        cell[hi + 1..].fill(best);
+    }
+}
+
+/// [`cost_row_imp`] with a hardware popcount where the CPU has one (same result).
+fn cost_row(cl: &[u64], cr_rev: &[u64], d_min: i64, n: usize, out: &mut [u8]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "popcnt,avx2")]
+        unsafe fn fast(cl: &[u64], cr: &[u64], d_min: i64, n: usize, out: &mut [u8]) {
+            cost_row_imp(cl, cr, d_min, n, out)
+        }
+        if std::is_x86_feature_detected!("popcnt") && std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the running CPU supports every feature enabled on `fast`.
+            return unsafe { fast(cl, cr_rev, d_min, n, out) };
+        }
+    }
+    cost_row_imp(cl, cr_rev, d_min, n, out)
+}
+
+/// The cost volume `C[(y * w + x) * n + k]` for disparity `d_min + k`.
+pub fn cost_volume(cl: &[u64], cr: &[u64], w: usize, d_min: i64, n: usize) -> Vec<u8> {
+    let mut c = vec![0u8; cl.len() * n];
+    c.par_chunks_mut(w * n)
+        .enumerate()
+        .for_each_init(Vec::new, |rev, (y, row)| {
+            rev.clear();
+            rev.extend(cr[y * w..(y + 1) * w].iter().rev());
+            cost_row(&cl[y * w..(y + 1) * w], rev, d_min, n, row)
+        });
+    c
+}
+
+/// P2 by intensity step: `lut[q] = max(p2 / (1 + q), p1 + 1)` for `q = floor(step / gamma)`,
+/// the last entry standing for every larger `q` (a table instead of a division per path step).
+fn p2_table(p: &SgmParams) -> Vec<u16> {
+    let len = usize::from(p.p2 / (p.p1 + 1)) + 2;
+    (0..len)
+        .map(|q| ((u32::from(p.p2) / (1 + q as u32)) as u16).max(p.p1 + 1))
+        .collect()
+}
+
+/// P2 for a step between grey values `a` and `b` (in [0, 1]).
+#[inline(always)]
+fn p2_at(a: f32, b: f32, gamma: f32, lut: &[u16]) -> u16 {
+    let q = ((a * 255.0 - b * 255.0).abs() / gamma).floor() as usize; // saturates
+    lut[q.min(lut.len() - 1)]
+}
+
+/// The four paths' step at one pixel: for each path `r`,
+/// `out_r[k] = c[k] + min(lp_r[k], lp_r[k +- 1] + p1, m_r + p2_r) - m_r` (`lp_r`, `out_r`: `n + 2`
+/// values with a [`BIG`] pad at each end; `m_r` = min of `lp_r`; a path's first pixel has a zero
+/// `lp_r`, which gives `out_r = c`). Writes their sum to `acc` and returns their minima.
+#[inline(always)]
+fn step4(
+    lp: [&[u16]; 4],
+    m: [u16; 4],
+    p2: [u16; 4],
+    p1: u16,
+    c: &[u8],
+    out: [&mut [u16]; 4],
+    acc: &mut [u16],
+) -> [u16; 4] {
+    let n = c.len();
+    let acc = &mut acc[..n];
+    let [o0, o1, o2, o3] = out;
+    let (o0, o1, o2, o3) = (
+        &mut o0[1..n + 1],
+        &mut o1[1..n + 1],
+        &mut o2[1..n + 1],
+        &mut o3[1..n + 1],
+    );
+    let lo = |r: usize| (&lp[r][..n], &lp[r][1..n + 1], &lp[r][2..n + 2]);
+    let ((a0, b0, c0), (a1, b1, c1), (a2, b2, c2), (a3, b3, c3)) = (lo(0), lo(1), lo(2), lo(3));
+    let lim = [m[0] + p2[0], m[1] + p2[1], m[2] + p2[2], m[3] + p2[3]];
+    let mut mn = [u16::MAX; 4];
+    for k in 0..n {
+        let ck = u16::from(c[k]);
+        let v0 = ck + b0[k].min(a0[k].min(c0[k]) + p1).min(lim[0]) - m[0];
+        let v1 = ck + b1[k].min(a1[k].min(c1[k]) + p1).min(lim[1]) - m[1];
+        let v2 = ck + b2[k].min(a2[k].min(c2[k]) + p1).min(lim[2]) - m[2];
+        let v3 = ck + b3[k].min(a3[k].min(c3[k]) + p1).min(lim[3]) - m[3];
+        o0[k] = v0;
+        o1[k] = v1;
+        o2[k] = v2;
+        o3[k] = v3;
+        acc[k] = v0 + v1 + v2 + v3;
+        mn[0] = mn[0].min(v0);
+        mn[1] = mn[1].min(v1);
+        mn[2] = mn[2].min(v2);
+        mn[3] = mn[3].min(v3);
+    }
+    mn
+}
+
+simd_fn! {
+    /// Four paths in one raster (`forward`) or reverse raster pass; returns their summed costs.
+    /// (Compiled for AVX2 too: the per-level loop of the four paths vectorises.)
+    fn pass(
+        c: &[u8],
+        img: &[f32],
+        w: usize,
+        h: usize,
+        n: usize,
+        p: &SgmParams,
+        forward: bool,
+    ) -> Vec<u16> {
+        let stride = n + 2;
+        let lut = p2_table(p);
+        // Every entry is written, and written before it is read: the pages are mapped once by
+        // the write (reading fresh zero pages first costs a copy and a TLB flush on every core).
+        let mut s = vec![0u16; w * h * n];
+        // Path costs of the previous row for the vertical path and the diagonals whose
+        // predecessor is at x - sgn and x + sgn; index x * stride.
+        let mut prev: [Vec<u16>; 3] = std::array::from_fn(|_| vec![BIG; w * stride]);
+        let mut cur: [Vec<u16>; 3] = std::array::from_fn(|_| vec![BIG; w * stride]);
+        let mut prev_min = [vec![0u16; w], vec![0u16; w], vec![0u16; w]];
+        let mut hl = vec![BIG; stride];
+        let mut hl_next = vec![BIG; stride];
+        // A path's first pixel steps from zeros (its output is then its cost).
+        let mut zero = vec![0u16; stride];
+        zero[0] = BIG;
+        zero[n + 1] = BIG;
+        let sgn: isize = if forward { 1 } else { -1 };
+        for i in 0..h {
+            let y = if forward { i } else { h - 1 - i };
+            let yp = y as isize - sgn; // predecessor row
+            let irow = &img[y * w..(y + 1) * w];
+            let prow = (yp >= 0 && yp < h as isize).then(|| &img[yp as usize * w..(yp as usize + 1) * w]);
+            let mut hmin = 0u16;
+            let mut cur_min = [vec![0u16; w], vec![0u16; w], vec![0u16; w]];
+            for j in 0..w {
+                let x = if forward { j } else { w - 1 - j };
+                let ci = &c[(y * w + x) * n..(y * w + x + 1) * n];
+                let acc = &mut s[(y * w + x) * n..(y * w + x + 1) * n];
+                let v = irow[x];
+                let mut lps: [&[u16]; 4] = [&zero; 4];
+                let mut ms = [0u16; 4];
+                let mut p2s = [0u16; 4];
+                if j > 0 {
+                    // Horizontal path, predecessor x - sgn on this row.
+                    lps[0] = &hl;
+                    ms[0] = hmin;
+                    p2s[0] = p2_at(v, irow[(x as isize - sgn) as usize], p.gamma, &lut);
+                }
+                if let Some(pr) = prow {
+                    // Vertical and diagonal paths from the previous row.
+                    for (r, dx) in [(0usize, 0isize), (1, -sgn), (2, sgn)] {
+                        let xp = x as isize + dx;
+                        if xp >= 0 && xp < w as isize {
+                            let xp = xp as usize;
+                            lps[r + 1] = &prev[r][xp * stride..(xp + 1) * stride];
+                            ms[r + 1] = prev_min[r][xp];
+                            p2s[r + 1] = p2_at(v, pr[xp], p.gamma, &lut);
+                        }
+                    }
+                }
+                let [c0, c1, c2] = &mut cur;
+                let outs = [
+                    &mut hl_next[..],
+                    &mut c0[x * stride..(x + 1) * stride],
+                    &mut c1[x * stride..(x + 1) * stride],
+                    &mut c2[x * stride..(x + 1) * stride],
+                ];
+                let mn = step4(lps, ms, p2s, p.p1, ci, outs, acc);
+                hmin = mn[0];
+                for r in 0..3 {
+                    cur_min[r][x] = mn[r + 1];
+                }
+                std::mem::swap(&mut hl, &mut hl_next);
+            }
+            std::mem::swap(&mut prev, &mut cur);
+            prev_min = cur_min;
+        }
+        s
+    }
+}
+
+simd_fn! {
+    /// `out = a + b`, element-wise (one row of the two passes' volumes).
+    fn add_rows(a: &[u16], b: &[u16], out: &mut [u16]) {
+        for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
+            *o = *x + *y;
+        }
+    }
+}
+
+simd_fn! {
+    /// Minimum of a slice (`u16::MAX` when empty).
+    fn min_u16(v: &[u16]) -> u16 {
+        v.iter().fold(u16::MAX, |m, &x| m.min(x))
+    }
+}
+
+/// First index of the minimum of a non-empty slice, and the minimum.
+#[inline]
+fn argmin(cell: &[u16]) -> (usize, u16) {
+    let m = min_u16(cell);
+    // Blocks of 16 compared at once (vectorised), then the one holding it scanned.
+    let mut base = 0;
+    for block in cell.chunks(16) {
+        if block.iter().fold(false, |f, &v| f | (v == m)) {
+            let i = block.iter().position(|&v| v == m).unwrap_or(0);
+            return (base + i, m);
+        }
+        base += block.len();
+    }
+    (0, m)
+}
+
+simd_fn! {
+    /// The right view's winner at every right pixel `xr` of a row: the first level `j`
+    /// minimising `S[xr + d_min + j, j]` (Hirschmueller's left-right check reads it off the same
+    /// volume). Kept in reversed order, `rk[w - 1 - xr]`: for one left pixel the levels then map
+    /// to consecutive entries, and the update is a vectorised compare-and-select. Levels are
+    /// visited in increasing `j` for every `xr`, so a strict `<` keeps the first minimum.
+    fn right_winners(s: &[u16], w: usize, n: usize, d_min: i64, rbest: &mut [u16], rk: &mut [u16]) {
+        rbest.fill(u16::MAX);
+        rk.fill(0);
+        for xl in 0..w {
+            let cell = &s[xl * n..(xl + 1) * n];
+            // Levels j with 0 <= xl - d_min - j < w.
+            let j_hi = (xl as i64 - d_min).min(n as i64 - 1);
+            let j_lo = (xl as i64 - d_min - w as i64 + 1).max(0);
+            if j_lo > j_hi {
+                continue;
+            }
+            let (j_lo, j_hi) = (j_lo as usize, j_hi as usize);
+            let base = (w as i64 - 1 - xl as i64 + d_min + j_lo as i64) as usize;
+            let len = j_hi + 1 - j_lo;
+            let rb = &mut rbest[base..base + len];
+            let rj = &mut rk[base..base + len];
+            for (t, ((&v, b), kk)) in cell[j_lo..=j_hi].iter().zip(rb).zip(rj).enumerate() {
+                // Arithmetic select: stores every lane, so the loop vectorises without masks.
+                let mask = u16::from(v < *b).wrapping_neg();
+                *kk = (((j_lo + t) as u16) & mask) | (*kk & !mask);
+                *b = (*b).min(v);
+            }
+        }
+    }
+}
+
+/// Winner, uniqueness, left-right check and sub-pixel vertex for one row of the summed volume.
+fn select_row(s: &[u16], w: usize, n: usize, d_min: i64, p: &SgmParams, out: &mut [f32]) {
+    let d_max = d_min + n as i64 - 1;
+    let mut rbest = vec![0u16; w];
+    let mut rk = vec![0u16; w];
+    right_winners(s, w, n, d_min, &mut rbest, &mut rk);
+    for (x, o) in out.iter_mut().enumerate() {
+        // Only where the whole range lands inside the right image: elsewhere the true match may
+        // lie outside it, and the winner is biased to the levels that do not (SGBM's rule too).
+        if x as i64 - d_max < 0 || x as i64 - d_min >= w as i64 {
+            *o = f32::NAN;
+            continue;
+        }
+        let cell = &s[x * n..(x + 1) * n];
+        let (k, m) = argmin(cell);
+        let best = u64::from(m);
+        let other = u64::from(min_u16(&cell[..k.saturating_sub(1)]).min(if k + 2 < n {
+            min_u16(&cell[k + 2..])
+        } else {
+            u16::MAX
+        }));
+        let unique = 100 * other > (100 + u64::from(p.uniqueness)) * best;
+        let xr = (x as i64 - (d_min + k as i64)) as usize; // inside: the whole range is
+        let consistent = usize::from(rk[w - 1 - xr]).abs_diff(k) <= p.lr_tol as usize;
+        *o = if unique && consistent {
+            let mut frac = 0.0f64;
+            if k > 0 && k < n - 1 {
+                let (sm, sp) = (f64::from(cell[k - 1]), f64::from(cell[k + 1]));
+                let den = sm + sp - 2.0 * best as f64;
+                if den > 0.0 {
+                    frac = (sm - sp) / (2.0 * den);
+                }
+            }
+            ((d_min + k as i64) as f64 + frac) as f32
+        } else {
+            f32::NAN
+        };
+    }
+}
+
+/// Dense disparity of the pair over `[d_min, d_max]` (integers), `NaN` where the uniqueness test
+/// or the left-right check fails. Row-major `(H, W)`.
+pub fn sgm_disparity(
+    left: ImageView<'_>,
+    right: ImageView<'_>,
+    d_min: i32,
+    d_max: i32,
+    p: &SgmParams,
+) -> Result<Vec<f32>> {
+    p.validate()?;
+    if (left.width, left.height) != (right.width, right.height) {
+        return Err(CoreError::SizeMismatch {
+            left: (left.width, left.height),
+            right: (right.width, right.height),
+        });
+    }
+    if d_max < d_min {
+        return Err(CoreError::param(
+            "d_max",
+            format!("expected d_max >= d_min, got d_min = {d_min}, d_max = {d_max}"),
+        ));
+    }
+    let n = (i64::from(d_max) - i64::from(d_min) + 1) as usize;
+    if n > 2048 {
+        return Err(CoreError::param(
+            "d_max",
+            format!("the range holds {n} levels; at most 2048 are supported"),
+        ));
+    }
+    let (w, h) = (left.width, left.height);
+    let (cl, cr) = rayon::join(|| census(left), || census(right));
+    let c = cost_volume(&cl, &cr, w, i64::from(d_min), n);
+    drop((cl, cr));
+    let (sf, sb) = rayon::join(
+        || pass(&c, left.data, w, h, n, p, true),
+        || pass(&c, left.data, w, h, n, p, false),
+    );
+    drop(c);
+    let mut out = vec![f32::NAN; w * h];
+    out.par_chunks_mut(w)
+        .zip(sf.par_chunks(w * n).zip(sb.par_chunks(w * n)))
+        .for_each_init(
+            || vec![0u16; w * n],
+            |row, (o, (a, b))| {
+                add_rows(a, b, row);
+                select_row(row, w, n, i64::from(d_min), p, o)
+            },
+        );
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ramp(w: usize, h: usize, shift: f32) -> Vec<f32> {
+        (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f32 + shift, (i / w) as f32);
+                0.5 + 0.25 * (0.37 * x).sin() * (0.23 * y + 0.11 * x * x / 40.0).cos()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn recovers_a_constant_shift() {
+        let (w, h) = (80, 40);
+        let l = ramp(w, h, 0.0);
+        let r = ramp(w, h, 6.0); // r(x) = l(x + 6): disparity 6
+        let lv = ImageView::new(w, h, &l).unwrap();
+        let rv = ImageView::new(w, h, &r).unwrap();
+        let d = sgm_disparity(lv, rv, 0, 15, &SgmParams::default()).unwrap();
+        let inner: Vec<f32> = (5..h - 5)
+            .flat_map(|y| (20..w - 5).map(move |x| (x, y)))
+            .map(|(x, y)| d[y * w + x])
+            .collect();
+        let good = inner.iter().filter(|v| (**v - 6.0).abs() < 0.5).count();
+        assert!(good * 100 >= inner.len() * 95, "{good} of {}", inner.len());
+    }
+
+    #[test]
+    fn rejects_bad_parameters_and_shapes() {
+        let img = vec![0.5f32; 64];
+        let v = ImageView::new(8, 8, &img).unwrap();
+        let small = ImageView::new(4, 4, &img[..16]).unwrap();
+        let bad = |p: SgmParams| sgm_disparity(v, v, 0, 4, &p).unwrap_err();
+        let d = SgmParams::default();
+        assert!(matches!(
+            bad(SgmParams { p1: 0, ..d }),
+            CoreError::InvalidParameter { name: "p1", .. }
+        ));
+        assert!(matches!(
+            bad(SgmParams { p2: 5000, ..d }),
+            CoreError::InvalidParameter { name: "p2", .. }
+        ));
+        assert!(matches!(
+            bad(SgmParams {
+                gamma: f32::NAN,
+                ..d
+            }),
+            CoreError::InvalidParameter { name: "gamma", .. }
+        ));
+        assert!(matches!(
+            sgm_disparity(v, v, 4, 2, &d).unwrap_err(),
+            CoreError::InvalidParameter { name: "d_max", .. }
+        ));
+        assert!(matches!(
+            sgm_disparity(v, small, 0, 4, &d).unwrap_err(),
+            CoreError::SizeMismatch { .. }
+        ));
+    }
+
+    #[test]
+    fn census_and_costs_on_a_step() {
+        // A vertical step: left half dark. Census bits count darker neighbours.
+        let (w, h) = (12, 9);
+        let img: Vec<f32> = (0..w * h)
+            .map(|i| if i % w < 6 { 0.2 } else { 0.8 })
+            .collect();
+        let v = ImageView::new(w, h, &img).unwrap();
+        let c = census(v);
+        assert_eq!(
+            c[4 * w + 2],
+            0,
+            "a flat neighbourhood has no darker neighbour"
+        );
+        // x = 6, the first bright column: its window holds dark columns 2-5, 4 x 7 darker pixels.
+        assert_eq!(c[4 * w + 6].count_ones(), 28);
+        let vol = cost_volume(&c, &c, w, 0, 3);
+        let cell = |x: usize, k: usize| vol[(4 * w + x) * 3 + k];
+        assert_eq!(cell(6, 0), 0);
+        assert_eq!(cell(6, 1), (c[4 * w + 6] ^ c[4 * w + 5]).count_ones() as u8);
+        // Right pixel outside: the best inside level's cost (here level 0, a perfect match).
+        assert_eq!((cell(0, 1), cell(1, 2), cell(0, 0)), (0, 0, 0));
+        let far = cost_volume(&c, &c, w, 20, 2);
+        assert!(far.iter().all(|&v| v == OUTSIDE), "no level inside");
+    }
+
+    #[test]
+    fn tiny_images_and_single_levels_work() {
+        let img: Vec<f32> = (0..6).map(|i| i as f32 / 6.0).collect();
+        let v = ImageView::new(3, 2, &img).unwrap();
+        for (a, b) in [(0, 0), (0, 5), (-2, 2)] {
+            let d = sgm_disparity(v, v, a, b, &SgmParams::default()).unwrap();
+            assert_eq!(d.len(), 6);
+        }
+    }
+}
