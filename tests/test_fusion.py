@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from stereovision._validate import as_gray_float
-from stereovision.baselines import row_fill
+from stereovision.baselines import opencv_sgbm, row_fill
 from stereovision.depth import depth_map as sv_depth_map
 from stereovision.evaluate import dense_metrics, sparse_metrics
 from stereovision.io import load_scene
@@ -245,12 +245,33 @@ def test_depth_map_fused_beats_gabor_on_a_scene(data_dir: Path) -> None:
     assert bf < 0.8 * bg  # measured 10.5 -> 5.1 % (filled)
     ch = fused.channels
     assert ch is not None
-    assert set(ch) == {"gabor", "gabor_remeasured", "mcgm", "hopfield", "members"}
+    assert set(ch) == {"gabor", "gabor_remeasured", "mcgm", "hopfield", "sgm", "members"}
     members = ch["members"]
     m = np.isfinite(members.dispx)
     np.testing.assert_array_equal(fused.disparity[m], members.dispx[m])
     assert np.all(fused.confidence[m] == 1.0)
     assert gabor.channels is None
+
+
+@pytest.mark.parametrize(
+    ("scene", "bar"), [("middlebury2003/teddy", 0.7), ("middlebury2005/reindeer", 0.85)]
+)
+def test_semi_global_completion_beats_filled_sgbm(data_dir: Path, scene: str, bar: float) -> None:
+    """The census semi-global map fills Gabor's holes and vetoes its disagreeing values: bad-2.0
+    (holes counted) against SGBM-3WAY + the same row fill, OpenCV in the same run. Measured:
+    teddy 12.0 -> 9.0 % (SGBM + fill 15.0), reindeer 21.3 -> 10.9 % (14.4)."""
+    sc = load_scene(data_dir / scene)
+    kw = {"max_disparity": sc.max_disparity, "method": "fused"}
+    on = sv_depth_map(sc.left, sc.right, **kw)
+    off = sv_depth_map(sc.left, sc.right, semi_global=False, **kw)
+    sgbm = row_fill(opencv_sgbm(sc.left, sc.right, sc.max_disparity))
+    b_on, b_off, b_cv = (
+        dense_metrics(d, sc.gt).bad[2.0] for d in (on.disparity, off.disparity, sgbm)
+    )
+    assert b_on < bar * b_cv, (b_on, b_cv)
+    assert b_on < 0.8 * b_off, (b_on, b_off)
+    # Pixels the census map alone measured carry its confidence; they get a depth like others.
+    assert np.any(on.confidence == 0.5)
 
 
 def test_remeasure_keeps_the_holes_and_sharpens_gabor(data_dir: Path) -> None:

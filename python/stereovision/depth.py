@@ -231,17 +231,25 @@ def _run_matcher(
         from stereovision.matching import fusion
 
         dense_kw = {k: params.pop(k) for k in list(params) if k in fusion.DENSE_DEFAULTS}
+        semi_global = bool(params.pop("semi_global", True))
         fr = fusion.fuse_pair(
             left,
             right,
             max_disparity=d_max,
             min_disparity=d_min,
             remeasure_gabor=remeasure,
+            dense_sgm=semi_global,
             **params,
         )
         g = fr.channel_outputs["gabor"]
         base = fr.channel_outputs.get("gabor_remeasured", g.disparity)
-        disp, conf = fusion.fused_dense(base, g.confidence, fr.dispx, **dense_kw)
+        disp, conf = fusion.fused_dense(
+            base,
+            g.confidence,
+            fr.dispx,
+            second=fr.channel_outputs.get("sgm"),
+            **dense_kw,
+        )
         if channels is not None:
             channels.update(fr.channel_outputs, members=fr)
         return disp, conf
@@ -387,7 +395,11 @@ def depth_map(
     progress : callable, optional
         Called with a stage name as the pipeline advances.
     **params
-        Passed to the matcher (see :func:`stereovision.matching.gabor.gabor_disparity`).
+        Passed to the matcher (see :func:`stereovision.matching.gabor.gabor_disparity`). For
+        ``"fused"``: :func:`stereovision.matching.fusion.fuse`'s options, the dense map's
+        (:data:`stereovision.matching.fusion.DENSE_DEFAULTS`), and ``semi_global`` (default
+        True: the census semi-global map, :mod:`stereovision.matching.sgm`, completes and
+        checks the Gabor map; False skips it, about 0.15 s less on a 0.35-megapixel pair).
 
     Returns
     -------

@@ -370,6 +370,7 @@ def fuse_pair(
     channels: tuple[str, ...] = ("gabor", "mcgm", "hopfield"),
     remeasure_gabor: bool = True,
     check_members: bool = True,
+    dense_sgm: bool = False,
     **params: Any,
 ) -> FusionResult:
     """Run the channels on a rectified pair and fuse them (:func:`fuse`).
@@ -399,6 +400,12 @@ def fuse_pair(
         and are not tested again. Gabor and Hopfield can agree on a foreground disparity that a
         fattened edge carried onto the background; the background's half-window then does not
         fit it. Default True (README, "Fusion").
+    dense_sgm : bool
+        Also run the census semi-global matcher (:func:`stereovision.matching.sgm.sgm_disparity`)
+        beside the channels, for :func:`fused_dense`'s ``second``; its map is kept in
+        ``channel_outputs["sgm"]``. It takes no part in the vote. ``depth_map`` turns it on
+        (``semi_global=False`` there turns it off). Not re-measured: the re-measure moved
+        values it filled by more than 2 px often enough to cost 0.04 of the mean ratio.
     **params
         :func:`fuse`'s options (:data:`DEFAULTS`).
 
@@ -416,6 +423,7 @@ def fuse_pair(
     from stereovision.matching.gabor import gabor_disparity
     from stereovision.matching.hopfield import hopfield_match
     from stereovision.matching.mcgm import mcgm_match
+    from stereovision.matching.sgm import sgm_disparity
 
     unknown = sorted(set(params) - set(DEFAULTS))
     if unknown:
@@ -429,6 +437,7 @@ def fuse_pair(
         "gabor": gabor_disparity,
         "mcgm": mcgm_match,
         "hopfield": hopfield_match,
+        "sgm": sgm_disparity,
     }
 
     outputs: dict[str, Any] = {}
@@ -446,10 +455,13 @@ def fuse_pair(
     # (MCGM's tracking and spreading, the Hopfield sweeps) where the other core would idle.
     # Their outputs do not depend on the scheduling (every kernel is bit-identical across
     # thread counts).
-    names = [n for n in ("gabor", "mcgm", "hopfield") if n in channels]
+    names: list[str] = [n for n in ("gabor", "mcgm", "hopfield") if n in channels]
+    names += ["sgm"] if dense_sgm else []
     with ThreadPoolExecutor(max_workers=len(names)) as pool:
         done = dict(zip(names, pool.map(timed, names), strict=True))
-    seconds: dict[str, float] = {n: done[n][1] for n in names}
+    if dense_sgm:
+        outputs["sgm"] = done.pop("sgm")[0]
+    seconds: dict[str, float] = {n: done[n][1] for n in names if n in done}
     dense = None
     if "gabor" in done:
         g = done["gabor"][0]
@@ -539,6 +551,8 @@ DENSE_DEFAULTS = {
     "tau": 2.0,  # px: ... when they differ by more than this (the bad-2 bar)
     "fill_radius": 3.0,  # px: holes this close to a member take its value
     "fill_confidence": 0.25,  # confidence of such anchor-filled pixels
+    "second_tol": 1.0,  # px: Gabor and the semi-global map further apart than this -> hole
+    "second_confidence": 0.5,  # confidence of pixels only the semi-global map measured
 }
 
 
@@ -568,6 +582,9 @@ def fused_dense(
     tau: float = 2.0,
     fill_radius: float = 3.0,
     fill_confidence: float = 0.25,
+    second: npt.ArrayLike | None = None,
+    second_tol: float = 1.0,
+    second_confidence: float = 0.5,
 ) -> tuple[F32, F32]:
     """The dense map built on the valid members: Gabor corrected and completed by the anchors.
 
@@ -577,6 +594,10 @@ def fused_dense(
        dropped: a region locked to a wrong phase cycle, or a fattened foreground edge.
     3. A hole within ``fill_radius`` of a member takes the member's value (confidence
        ``fill_confidence``); other holes stay NaN.
+    4. With a ``second`` map (the census semi-global matcher's): where both have a value and
+       differ by more than ``second_tol`` the pixel becomes a hole (one of them is wrong, and
+       neither says which); where they agree the pixel keeps its value; a hole ``second`` measured
+       takes its value (confidence ``second_confidence``). Members keep their values.
 
     Parameters
     ----------
@@ -584,8 +605,10 @@ def fused_dense(
         ``(H, W)`` Gabor disparity (NaN = none) and confidence.
     members : array_like
         ``(H, W)`` members' disparity (:attr:`FusionResult.dispx`), NaN elsewhere.
-    radius, tau, fill_radius, fill_confidence : float
+    radius, tau, fill_radius, fill_confidence, second_tol, second_confidence : float
         See above (:data:`DENSE_DEFAULTS`).
+    second : array_like, optional
+        ``(H, W)`` second dense opinion (NaN = none), e.g. ``channel_outputs["sgm"]``.
 
     Returns
     -------
@@ -601,16 +624,23 @@ def fused_dense(
     shape = (int(d.shape[0]), int(d.shape[1]))
     c = _check_map(confidence, "confidence", shape)
     a = _check_map(members, "members", shape)
-    for name, v in (("radius", radius), ("tau", tau), ("fill_radius", fill_radius)):
+    b = None if second is None else _check_map(second, "second", shape)
+    for name, v in (
+        ("radius", radius),
+        ("tau", tau),
+        ("fill_radius", fill_radius),
+        ("second_tol", second_tol),
+    ):
         if not np.isfinite(v) or v < 0:
             raise ValueError(f"{name}: expected a non-negative number, got {v}")
-    if not 0 <= fill_confidence <= 1:
-        raise ValueError(f"fill_confidence: expected a value in [0, 1], got {fill_confidence}")
+    for name, v in (("fill_confidence", fill_confidence), ("second_confidence", second_confidence)):
+        if not 0 <= v <= 1:
+            raise ValueError(f"{name}: expected a value in [0, 1], got {v}")
     out = d.copy()
     conf = np.where(np.isfinite(d), c, 0.0).astype(np.float32)
     has = np.isfinite(a)
     if not has.any():
-        return out, conf
+        return _second_opinion(out, conf, has, b, second_tol, second_confidence)
     near, dist = _nearest_member(a)
     with np.errstate(invalid="ignore"):
         veto = (dist <= radius) & np.isfinite(out) & (np.abs(out - near) > tau)
@@ -621,4 +651,30 @@ def fused_dense(
     hole = ~np.isfinite(out) & (dist <= fill_radius)
     out[hole] = near[hole]
     conf[hole] = fill_confidence
+    return _second_opinion(out, conf, has, b, second_tol, second_confidence)
+
+
+def _second_opinion(
+    out: F32,
+    conf: F32,
+    members: npt.NDArray[np.bool_],
+    second: F32 | None,
+    tol: float,
+    confidence: float,
+) -> tuple[F32, F32]:
+    """Step 4 of :func:`fused_dense` (in place; members are left alone)."""
+    if second is None:
+        return out, conf
+    s_ok = np.isfinite(second)
+    mine = np.isfinite(out) & ~members
+    both = mine & s_ok
+    with np.errstate(invalid="ignore"):
+        off = both & (np.abs(out - second) > tol)
+    # Where they agree the value stays: the re-measured Gabor map is the finer one (averaging in
+    # the census map's raised terrace's share of depths off by > 5 % from 10.0 to 15.2 %).
+    out[off] = np.nan
+    conf[off] = 0.0
+    only = ~np.isfinite(out) & ~off & s_ok
+    out[only] = second[only]
+    conf[only] = confidence
     return out, conf
