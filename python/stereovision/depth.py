@@ -219,14 +219,16 @@ def _run_matcher(
     params: dict,
     channels: dict[str, Any] | None = None,
     remeasure: bool = True,
-) -> tuple[np.ndarray, np.ndarray]:
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """``(disparity, confidence, coarse)``: ``coarse`` marks the pixels whose value has a
+    larger spread than the confidence line predicts (the census map's, in ``"fused"``)."""
     if method == "gabor":
         from stereovision.matching.gabor import gabor_disparity
 
         res = gabor_disparity(left, right, max_disparity=d_max, min_disparity=d_min, **params)
         if channels is not None:
             channels["gabor"] = res
-        return res.disparity, res.confidence
+        return res.disparity, res.confidence, None
     if method == "fused":
         from stereovision.matching import fusion
 
@@ -243,16 +245,18 @@ def _run_matcher(
         )
         g = fr.channel_outputs["gabor"]
         base = fr.channel_outputs.get("gabor_remeasured", g.disparity)
+        only_second = np.zeros(base.shape, bool)
         disp, conf = fusion.fused_dense(
             base,
             g.confidence,
             fr.dispx,
             second=fr.channel_outputs.get("sgm"),
+            _only_second=only_second,
             **dense_kw,
         )
         if channels is not None:
             channels.update(fr.channel_outputs, members=fr)
-        return disp, conf
+        return disp, conf, only_second
     raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
 
 
@@ -480,7 +484,7 @@ def depth_map(
         refine = True
     # "gabor" refines its output below; "fused" re-measures the Gabor map before the vote (its
     # output is already completed, and the refinement's drops would reopen holes).
-    disp, conf = _run_matcher(
+    disp, conf, coarse = _run_matcher(
         method,
         gl,
         gr,
@@ -496,7 +500,9 @@ def depth_map(
     conf = np.where(measured, conf, np.float32(0)).astype(np.float32)
     stage("match")
     post_refine = refine and method not in _DENSE_METHODS
-    filled: npt.NDArray[np.bool_] | None = None
+    # The census map's values (pixel-locked parabola vertices: pooled over the 17 GT scenes a
+    # median error of 0.37 px) get the spread of filled pixels, not the confidence line's.
+    filled: npt.NDArray[np.bool_] | None = coarse
     if post_refine:
         from stereovision.refine import refine_disparity
 

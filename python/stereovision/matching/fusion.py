@@ -585,6 +585,7 @@ def fused_dense(
     second: npt.ArrayLike | None = None,
     second_tol: float = 1.0,
     second_confidence: float = 0.5,
+    _only_second: npt.NDArray[np.bool_] | None = None,
 ) -> tuple[F32, F32]:
     """The dense map built on the valid members: Gabor corrected and completed by the anchors.
 
@@ -640,7 +641,7 @@ def fused_dense(
     conf = np.where(np.isfinite(d), c, 0.0).astype(np.float32)
     has = np.isfinite(a)
     if not has.any():
-        return _second_opinion(out, conf, has, b, second_tol, second_confidence)
+        return _second_opinion(out, conf, has, b, second_tol, second_confidence, _only_second)
     near, dist = _nearest_member(a)
     with np.errstate(invalid="ignore"):
         veto = (dist <= radius) & np.isfinite(out) & (np.abs(out - near) > tau)
@@ -651,7 +652,7 @@ def fused_dense(
     hole = ~np.isfinite(out) & (dist <= fill_radius)
     out[hole] = near[hole]
     conf[hole] = fill_confidence
-    return _second_opinion(out, conf, has, b, second_tol, second_confidence)
+    return _second_opinion(out, conf, has, b, second_tol, second_confidence, _only_second)
 
 
 def _second_opinion(
@@ -661,8 +662,10 @@ def _second_opinion(
     second: F32 | None,
     tol: float,
     confidence: float,
+    out_only: npt.NDArray[np.bool_] | None = None,
 ) -> tuple[F32, F32]:
-    """Step 4 of :func:`fused_dense` (in place; members are left alone)."""
+    """Step 4 of :func:`fused_dense` (in place; members are left alone). Also sets
+    ``out_only`` (when given) where the value came from ``second`` alone."""
     if second is None:
         return out, conf
     s_ok = np.isfinite(second)
@@ -677,4 +680,6 @@ def _second_opinion(
     only = ~np.isfinite(out) & ~off & s_ok
     out[only] = second[only]
     conf[only] = confidence
+    if out_only is not None:
+        out_only[only] = True
     return out, conf
