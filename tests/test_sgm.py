@@ -103,16 +103,21 @@ def test_bad_input() -> None:
 
 def test_fused_dense_second_opinion() -> None:
     nan = np.float32(np.nan)
-    gabor = np.array([[10, 10, nan, 10, 10]], np.float32)
-    second = np.array([[11, 20, 7, nan, 30]], np.float32)
-    members = np.array([[nan, nan, nan, nan, 10]], np.float32)
+    gabor = np.array([[10, 10, nan, 10, 10, 8]], np.float32)
+    second = np.array([[11, 20, 7, nan, 30, nan]], np.float32)
+    members = np.array([[nan, nan, nan, nan, 10, nan]], np.float32)
     conf = np.full(gabor.shape, 0.8, np.float32)
     d, c = fused_dense(gabor, conf, members, second=second, radius=0.0, fill_radius=0.0)
-    # agree -> kept; 10 px apart -> hole; hole -> second's value; second missing -> Gabor's;
-    # a member keeps its value whatever the second map says.
-    np.testing.assert_array_equal(d, np.array([[10, nan, 7, 10, 10]], np.float32))
-    np.testing.assert_array_equal(c, np.array([[0.8, 0, 0.5, 0.8, 1.0]], np.float32))
+    # agree -> kept; 10 px apart -> hole; hole -> second's value; a member keeps its value
+    # whatever the second map says; Gabor alone: 10 stands 3 px above the row fill of the others
+    # (min(7, 10)) -> hole (an occluded strip), 8 is below its fill (10) -> kept.
+    np.testing.assert_array_equal(d, np.array([[10, nan, 7, nan, 10, 8]], np.float32))
+    np.testing.assert_array_equal(c, np.array([[0.8, 0, 0.5, 0, 1.0, 0.8]], np.float32))
+    d, _ = fused_dense(gabor, conf, members, second=second, fill_radius=0.0, occlusion_tau=5.0)
+    assert d[0, 3] == 10  # within the tolerance now
     with pytest.raises(ValueError, match="second_tol"):
         fused_dense(gabor, conf, members, second=second, second_tol=-1.0)
+    with pytest.raises(ValueError, match="occlusion_tau"):
+        fused_dense(gabor, conf, members, second=second, occlusion_tau=float("nan"))
     with pytest.raises(ValueError, match="second"):
         fused_dense(gabor, conf, members, second=second[:, :3])

@@ -553,6 +553,7 @@ DENSE_DEFAULTS = {
     "fill_confidence": 0.25,  # confidence of such anchor-filled pixels
     "second_tol": 1.0,  # px: Gabor and the semi-global map further apart than this -> hole
     "second_confidence": 0.5,  # confidence of pixels only the semi-global map measured
+    "occlusion_tau": 2.0,  # px: Gabor alone this far above the row fill -> hole (occluded strip)
 }
 
 
@@ -585,6 +586,7 @@ def fused_dense(
     second: npt.ArrayLike | None = None,
     second_tol: float = 1.0,
     second_confidence: float = 0.5,
+    occlusion_tau: float = 2.0,
     _only_second: npt.NDArray[np.bool_] | None = None,
 ) -> tuple[F32, F32]:
     """The dense map built on the valid members: Gabor corrected and completed by the anchors.
@@ -599,6 +601,10 @@ def fused_dense(
        differ by more than ``second_tol`` the pixel becomes a hole (one of them is wrong, and
        neither says which); where they agree the pixel keeps its value; a hole ``second`` measured
        takes its value (confidence ``second_confidence``). Members keep their values.
+    5. A Gabor value ``second`` has no value at (and no member or anchor supports) that stands
+       more than ``occlusion_tau`` above the reference row fill of the other pixels is dropped:
+       Gabor's filters carry a foreground disparity into the strip it occludes, where the census
+       map's left-right check leaves a hole; the row fill then gives the background.
 
     Parameters
     ----------
@@ -606,7 +612,7 @@ def fused_dense(
         ``(H, W)`` Gabor disparity (NaN = none) and confidence.
     members : array_like
         ``(H, W)`` members' disparity (:attr:`FusionResult.dispx`), NaN elsewhere.
-    radius, tau, fill_radius, fill_confidence, second_tol, second_confidence : float
+    radius, tau, fill_radius, fill_confidence, second_tol, second_confidence, occlusion_tau : float
         See above (:data:`DENSE_DEFAULTS`).
     second : array_like, optional
         ``(H, W)`` second dense opinion (NaN = none), e.g. ``channel_outputs["sgm"]``.
@@ -631,6 +637,7 @@ def fused_dense(
         ("tau", tau),
         ("fill_radius", fill_radius),
         ("second_tol", second_tol),
+        ("occlusion_tau", occlusion_tau),
     ):
         if not np.isfinite(v) or v < 0:
             raise ValueError(f"{name}: expected a non-negative number, got {v}")
@@ -640,8 +647,10 @@ def fused_dense(
     out = d.copy()
     conf = np.where(np.isfinite(d), c, 0.0).astype(np.float32)
     has = np.isfinite(a)
+    anchored = has.copy()
+    opinion = (b, second_tol, second_confidence, occlusion_tau, _only_second)
     if not has.any():
-        return _second_opinion(out, conf, has, b, second_tol, second_confidence, _only_second)
+        return _second_opinion(out, conf, has, anchored, *opinion)
     near, dist = _nearest_member(a)
     with np.errstate(invalid="ignore"):
         veto = (dist <= radius) & np.isfinite(out) & (np.abs(out - near) > tau)
@@ -652,22 +661,28 @@ def fused_dense(
     hole = ~np.isfinite(out) & (dist <= fill_radius)
     out[hole] = near[hole]
     conf[hole] = fill_confidence
-    return _second_opinion(out, conf, has, b, second_tol, second_confidence, _only_second)
+    anchored |= hole
+    return _second_opinion(out, conf, has, anchored, *opinion)
 
 
 def _second_opinion(
     out: F32,
     conf: F32,
     members: npt.NDArray[np.bool_],
+    anchored: npt.NDArray[np.bool_],
     second: F32 | None,
     tol: float,
     confidence: float,
+    occlusion_tau: float,
     out_only: npt.NDArray[np.bool_] | None = None,
 ) -> tuple[F32, F32]:
-    """Step 4 of :func:`fused_dense` (in place; members are left alone). Also sets
-    ``out_only`` (when given) where the value came from ``second`` alone."""
+    """Steps 4 and 5 of :func:`fused_dense` (in place; members are left alone, and by step 5
+    their anchor fills too). Also sets ``out_only`` (when given) where the value came from
+    ``second`` alone."""
     if second is None:
         return out, conf
+    from stereovision.baselines import row_fill
+
     s_ok = np.isfinite(second)
     mine = np.isfinite(out) & ~members
     both = mine & s_ok
@@ -682,4 +697,12 @@ def _second_opinion(
     conf[only] = confidence
     if out_only is not None:
         out_only[only] = True
+    alone = mine & ~anchored & ~s_ok
+    if alone.any():
+        with np.errstate(invalid="ignore"):
+            fattened = alone & (
+                out > row_fill(np.where(alone, np.float32(np.nan), out)) + occlusion_tau
+            )
+        out[fattened] = np.nan
+        conf[fattened] = 0.0
     return out, conf
