@@ -161,7 +161,7 @@ fn cost_row_imp(cl: &[u64], cr_rev: &[u64], d_min: i64, n: usize, out: &mut [u8]
         let (lo, hi) = (lo as usize, hi as usize);
         // Level k pairs with right pixel x - d_min - k, i.e. entry w - 1 - x + d_min + k of the
         // reversed right row: consecutive levels read consecutive codes (a vectorised popcount).
-        let start = (w - 1 - x as i64 + d_min) as usize + lo;
+        let start = (w - 1 - x as i64 + d_min + lo as i64) as usize; // >= 0 by lo's bound
         let right = &cr_rev[start..start + hi + 1 - lo];
         for (v, &b) in cell[lo..=hi].iter_mut().zip(right) {
             *v = (a ^ b).count_ones() as u8;
