@@ -17,15 +17,11 @@ import numpy as np
 from _common import DATA, gt_scenes, interleaved_ms
 
 from stereovision.baselines import opencv_sgbm, row_fill
+from stereovision.evaluate import dense_metrics
 from stereovision.io import load_scene
 from stereovision.matching.sgm import sgm_disparity
 
 SPEED = ("middlebury2006/cloth3", "middeval3/teddyH")
-
-
-def bad2(d: np.ndarray, gt: np.ndarray) -> float:
-    v = np.isfinite(gt) & (gt > 0)
-    return float(100 * (v & ~(np.abs(d - gt) <= 2)).sum() / v.sum())
 
 
 def main() -> None:
@@ -40,8 +36,9 @@ def main() -> None:
             sc = load_scene(DATA / name)
             assert sc.gt is not None
             d = sgm_disparity(sc.left, sc.right, max_disparity=sc.max_disparity)
-            ours = bad2(row_fill(d), sc.gt)
-            ref = bad2(row_fill(opencv_sgbm(sc.left, sc.right, sc.max_disparity)), sc.gt)
+            ours = dense_metrics(row_fill(d), sc.gt).bad[2.0]
+            ref = dense_metrics(row_fill(opencv_sgbm(sc.left, sc.right, sc.max_disparity)), sc.gt)
+            ref = ref.bad[2.0]
             ratios.append(ours / ref)
             dens = 100 * float(np.isfinite(d).mean())
             print(f"{name:40s} {ours:9.2f} {ref:9.2f} {ours / ref:6.3f} {dens:7.1f}")

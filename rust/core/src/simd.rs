@@ -2,10 +2,12 @@
 //!
 //! The wheel targets baseline x86-64 (SSE2); the row kernels are written as plain f32 loops the
 //! compiler vectorises, and `simd_fn!` compiles each one twice: as is, and inside a
-//! `#[target_feature(enable = "avx2,fma")]` wrapper chosen at run time. No `mul_add` is used and
+//! `#[target_feature(enable = "avx2,fma,popcnt")]` wrapper chosen at run time (popcnt: the
+//! census matcher's Hamming costs). No `mul_add` is used and
 //! LLVM does not contract or reorder f32 arithmetic, so both versions give bit-identical results.
 
-/// Defines `fn name(args) -> ret` whose body is compiled for the baseline and for AVX2+FMA.
+/// Defines `fn name(args) -> ret` whose body is compiled for the baseline and for
+/// AVX2+FMA+POPCNT.
 macro_rules! simd_fn {
     ($(#[$m:meta])* $vis:vis fn $name:ident($($a:ident: $t:ty),* $(,)?) $(-> $ret:ty)? $body:block) => {
         $(#[$m])*
@@ -16,10 +18,13 @@ macro_rules! simd_fn {
             fn imp($($a: $t),*) $(-> $ret)? $body
             #[cfg(target_arch = "x86_64")]
             {
-                #[target_feature(enable = "avx2,fma")]
+                #[target_feature(enable = "avx2,fma,popcnt")]
                 #[allow(clippy::too_many_arguments)]
                 unsafe fn avx2($($a: $t),*) $(-> $ret)? { imp($($a),*) }
-                if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+                if std::is_x86_feature_detected!("avx2")
+                    && std::is_x86_feature_detected!("fma")
+                    && std::is_x86_feature_detected!("popcnt")
+                {
                     // SAFETY: the running CPU supports every feature enabled on `avx2`.
                     return unsafe { avx2($($a),*) };
                 }

@@ -145,50 +145,36 @@ pub fn census(img: ImageView<'_>) -> Vec<u64> {
     out
 }
 
-/// One row of the cost volume, `n` levels per pixel.
-#[inline(always)]
-fn cost_row_imp(cl: &[u64], cr_rev: &[u64], d_min: i64, n: usize, out: &mut [u8]) {
-    let w = cl.len() as i64;
-    for (x, cell) in out.chunks_exact_mut(n).enumerate() {
-        let a = cl[x];
-        // Levels whose right pixel x - d_min - k lies in [0, w).
-        let hi = (x as i64 - d_min).min(n as i64 - 1);
-        let lo = (x as i64 - d_min - w + 1).max(0);
-        if lo > hi {
-            cell.fill(OUTSIDE);
-            continue;
-        }
-        let (lo, hi) = (lo as usize, hi as usize);
-        // Level k pairs with right pixel x - d_min - k, i.e. entry w - 1 - x + d_min + k of the
-        // reversed right row: consecutive levels read consecutive codes (a vectorised popcount).
-        let start = (w - 1 - x as i64 + d_min + lo as i64) as usize; // >= 0 by lo's bound
-        let right = &cr_rev[start..start + hi + 1 - lo];
-        for (v, &b) in cell[lo..=hi].iter_mut().zip(right) {
-            *v = (a ^ b).count_ones() as u8;
-        }
-        let best = cell[lo..=hi].iter().fold(OUTSIDE, |m, &v| m.min(v));
-        // Levels whose right pixel is outside the image cost what the best inside level does:
-        // neutral, so the paths from the left edge carry no preference for the levels that stay
-        // inside (with a high cost a flat region took d_min from the edge, far along the rows).
-        cell[..lo].fill(best);
-        cell[hi + 1..].fill(best);
-    }
-}
-
-/// [`cost_row_imp`] with a hardware popcount where the CPU has one (same result).
-fn cost_row(cl: &[u64], cr_rev: &[u64], d_min: i64, n: usize, out: &mut [u8]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        #[target_feature(enable = "popcnt,avx2")]
-        unsafe fn fast(cl: &[u64], cr: &[u64], d_min: i64, n: usize, out: &mut [u8]) {
-            cost_row_imp(cl, cr, d_min, n, out)
-        }
-        if std::is_x86_feature_detected!("popcnt") && std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the running CPU supports every feature enabled on `fast`.
-            return unsafe { fast(cl, cr_rev, d_min, n, out) };
+simd_fn! {
+    /// One row of the cost volume, `n` levels per pixel (the popcount is a hardware one in the
+    /// AVX2 build).
+    fn cost_row(cl: &[u64], cr_rev: &[u64], d_min: i64, n: usize, out: &mut [u8]) {
+        let w = cl.len() as i64;
+        for (x, cell) in out.chunks_exact_mut(n).enumerate() {
+            let a = cl[x];
+            // Levels whose right pixel x - d_min - k lies in [0, w).
+            let hi = (x as i64 - d_min).min(n as i64 - 1);
+            let lo = (x as i64 - d_min - w + 1).max(0);
+            if lo > hi {
+                cell.fill(OUTSIDE);
+                continue;
+            }
+            let (lo, hi) = (lo as usize, hi as usize);
+            // Level k pairs with right pixel x - d_min - k, i.e. entry w - 1 - x + d_min + k of the
+            // reversed right row: consecutive levels read consecutive codes (a vectorised popcount).
+            let start = (w - 1 - x as i64 + d_min + lo as i64) as usize; // >= 0 by lo's bound
+            let right = &cr_rev[start..start + hi + 1 - lo];
+            for (v, &b) in cell[lo..=hi].iter_mut().zip(right) {
+                *v = (a ^ b).count_ones() as u8;
+            }
+            let best = cell[lo..=hi].iter().fold(OUTSIDE, |m, &v| m.min(v));
+            // Levels whose right pixel is outside the image cost what the best inside level does:
+            // neutral, so the paths from the left edge carry no preference for the levels that stay
+            // inside (with a high cost a flat region took d_min from the edge, far along the rows).
+            cell[..lo].fill(best);
+            cell[hi + 1..].fill(best);
         }
     }
-    cost_row_imp(cl, cr_rev, d_min, n, out)
 }
 
 /// The cost volume `C[(y * w + x) * n + k]` for disparity `d_min + k`.
@@ -288,6 +274,7 @@ simd_fn! {
         let mut prev: [Vec<u16>; 3] = std::array::from_fn(|_| vec![BIG; w * stride]);
         let mut cur: [Vec<u16>; 3] = std::array::from_fn(|_| vec![BIG; w * stride]);
         let mut prev_min = [vec![0u16; w], vec![0u16; w], vec![0u16; w]];
+        let mut cur_min = [vec![0u16; w], vec![0u16; w], vec![0u16; w]];
         let mut hl = vec![BIG; stride];
         let mut hl_next = vec![BIG; stride];
         // A path's first pixel steps from zeros (its output is then its cost).
@@ -301,7 +288,6 @@ simd_fn! {
             let irow = &img[y * w..(y + 1) * w];
             let prow = (yp >= 0 && yp < h as isize).then(|| &img[yp as usize * w..(yp as usize + 1) * w]);
             let mut hmin = 0u16;
-            let mut cur_min = [vec![0u16; w], vec![0u16; w], vec![0u16; w]];
             for j in 0..w {
                 let x = if forward { j } else { w - 1 - j };
                 let ci = &c[(y * w + x) * n..(y * w + x + 1) * n];
@@ -342,8 +328,9 @@ simd_fn! {
                 }
                 std::mem::swap(&mut hl, &mut hl_next);
             }
+            // Every x of `cur` and `cur_min` is written in the next row before it is read.
             std::mem::swap(&mut prev, &mut cur);
-            prev_min = cur_min;
+            std::mem::swap(&mut prev_min, &mut cur_min);
         }
         s
     }
