@@ -459,9 +459,9 @@ def fuse_pair(
     names += ["sgm"] if dense_sgm else []
     with ThreadPoolExecutor(max_workers=len(names)) as pool:
         done = dict(zip(names, pool.map(timed, names), strict=True))
+    seconds: dict[str, float] = {n: done[n][1] for n in names}
     if dense_sgm:
         outputs["sgm"] = done.pop("sgm")[0]
-    seconds: dict[str, float] = {n: done[n][1] for n in names if n in done}
     dense = None
     if "gabor" in done:
         g = done["gabor"][0]
