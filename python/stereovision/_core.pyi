@@ -161,6 +161,7 @@ def sgm_disparity(
     gamma: float,
     uniqueness: int,
     lr_tol: int,
+    edge_margin: int,
 ) -> npt.NDArray[np.float32]:
     """Census semi-global disparity over ``[d_min, d_max]``, NaN where rejected."""
 

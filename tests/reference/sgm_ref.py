@@ -123,17 +123,26 @@ def aggregate(
     return s
 
 
-def select(s: np.ndarray, d_min: int, uniqueness: int, lr_tol: int) -> np.ndarray:
-    """Winner, uniqueness, left-right check, parabola vertex: float32 disparity, NaN = none."""
+def select(
+    s: np.ndarray, d_min: int, uniqueness: int, lr_tol: int, edge_margin: int = 4
+) -> np.ndarray:
+    """Winner, uniqueness, left-right check, parabola vertex: float32 disparity, NaN = none.
+
+    In the left band only the levels whose match lands in the right image (``x - d >= 0``)
+    compete, and a winner with ``x - d < edge_margin`` is rejected."""
     h, w, n = s.shape
-    k = s.argmin(axis=-1)
-    best = np.take_along_axis(s, k[..., None], -1)[..., 0].astype(np.int64)
+    xs = np.arange(w)
     ks = np.arange(n)
+    # Levels 0..inside-1 land in the right image (at most n).
+    inside = np.minimum(xs - d_min + 1, n)
+    big = np.iinfo(np.uint16).max  # the Rust min over no level
+    sin = np.where(ks[None, None, :] < inside[None, :, None], s.astype(np.int64), big)
+    k = sin.argmin(axis=-1)
+    best = np.take_along_axis(sin, k[..., None], -1)[..., 0]
     far = np.abs(ks[None, None, :] - k[..., None]) > 1
-    other = np.where(far, s, np.iinfo(np.int32).max).min(axis=-1).astype(np.int64)
+    other = np.where(far, sin, big).min(axis=-1)
     unique = 100 * other > (100 + uniqueness) * best
     # The right view's winner at xr: argmin over k of S[y, xr + d_k, k] (first minimum).
-    xs = np.arange(w)
     sr = np.full((h, w, n), np.iinfo(np.int32).max, np.int64)
     for j in range(n):
         xl = xs + d_min + j
@@ -141,19 +150,22 @@ def select(s: np.ndarray, d_min: int, uniqueness: int, lr_tol: int) -> np.ndarra
         sr[:, ok, j] = s[:, xl[ok], j]
     kr = sr.argmin(axis=-1)
     xr = xs[None, :] - (d_min + k)
-    inside = (xr >= 0) & (xr < w)
+    in_right = (xr >= 0) & (xr < w)
     yy = np.arange(h)[:, None].repeat(w, 1)
-    kr_at = np.where(inside, kr[yy, np.clip(xr, 0, w - 1)], -(10**6))
-    d_max = d_min + n - 1
-    whole = (xs - d_max >= 0) & (xs - d_min < w)  # the whole range lands inside the right image
-    consistent = whole[None, :] & inside & (np.abs(kr_at - k) <= lr_tol)
+    kr_at = np.where(in_right, kr[yy, np.clip(xr, 0, w - 1)], -(10**6))
+    band = inside < n
+    # inside - 1 - k = x - d: the winner's right column.
+    kept = ((inside > 0) & (xs - d_min < w))[None, :] & ~(
+        band[None, :] & (inside[None, :] - 1 - k < edge_margin)
+    )
+    consistent = kept & in_right & (np.abs(kr_at - k) <= lr_tol)
     # Parabola vertex through S[k-1], S[k], S[k+1] (interior winners only).
     km = np.clip(k - 1, 0, n - 1)
     kp = np.clip(k + 1, 0, n - 1)
     sm = np.take_along_axis(s, km[..., None], -1)[..., 0].astype(np.float64)
     sp = np.take_along_axis(s, kp[..., None], -1)[..., 0].astype(np.float64)
     den = sm + sp - 2.0 * best
-    interior = (k > 0) & (k < n - 1) & (den > 0)
+    interior = (k > 0) & (k < inside[None, :] - 1) & (den > 0)
     with np.errstate(divide="ignore", invalid="ignore"):
         frac = np.where(interior, (sm - sp) / (2.0 * den), 0.0)
     d = (d_min + k + frac).astype(np.float32)
@@ -171,8 +183,9 @@ def sgm_disparity(
     gamma: float = 16.0,
     uniqueness: int = 5,
     lr_tol: int = 1,
+    edge_margin: int = 4,
 ) -> np.ndarray:
     """The whole matcher: census cost, 8-path aggregation, selection."""
     c = cost_volume(left, right, d_min, d_max)
     s = aggregate(c, left, p1, p2, gamma)
-    return select(s, d_min, uniqueness, lr_tol)
+    return select(s, d_min, uniqueness, lr_tol, edge_margin)

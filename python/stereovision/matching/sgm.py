@@ -30,6 +30,9 @@ DEFAULTS: dict[str, Any] = {
     "gamma": 16.0,  # grey levels (0-255) of intensity step per halving of P2
     "uniqueness": 5,  # %: another level (beyond +-1) this close to the winner rejects the pixel
     "lr_tol": 1,  # levels: left-right check tolerance
+    # columns: in the left band (x < max_disparity) the winner's right pixel must lie this far
+    # inside the right image (a match outside pushes the winner against the edge)
+    "edge_margin": 4,
 }
 
 
@@ -56,8 +59,9 @@ def sgm_disparity(
     -------
     numpy.ndarray
         ``(H, W)`` float32 disparity, NaN where the uniqueness test or the left-right check
-        fails, and in the left ``max_disparity`` columns (their match may lie outside the
-        right image).
+        fails. In the left ``max_disparity`` columns only the levels whose match lands in the
+        right image compete, and a winner within ``edge_margin`` columns of its edge is NaN too
+        (the true match probably lies outside).
 
     Raises
     ------
@@ -76,7 +80,7 @@ def sgm_disparity(
         raise ValueError(
             f"max_disparity ({max_disparity}) is smaller than min_disparity ({min_disparity})"
         )
-    for name in ("p1", "p2", "uniqueness", "lr_tol"):
+    for name in ("p1", "p2", "uniqueness", "lr_tol", "edge_margin"):
         v = p[name]
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
             raise ValueError(f"{name}: expected a non-negative integer, got {v!r}")
@@ -91,4 +95,5 @@ def sgm_disparity(
         float(p["gamma"]),
         int(p["uniqueness"]),
         int(p["lr_tol"]),
+        int(p["edge_margin"]),
     )
