@@ -384,3 +384,31 @@ def test_member_check_drops_members_the_sides_check_rejects(data_dir: Path) -> N
     assert np.count_nonzero(on.sources & mcgm_bit) == np.count_nonzero(off.sources & mcgm_bit)
     assert np.count_nonzero(np.isfinite(on.dispx)) == len(on) == np.count_nonzero(on.count_map)
     assert on.matches.stats["members_before_check"] == len(off)
+
+
+def test_fused_dense_drops_speckles() -> None:
+    """Step 6: a 3x3 island off its surroundings (9 px < 5e-5 of 400x500) becomes a hole; a
+    5x50 strip (250 px) and the slanted background stay."""
+    h, w = 400, 500
+    # A slanted background: 0.5 px from row to row (one region at speckle_diff = 1).
+    bg = np.tile(20.0 + 0.5 * np.arange(h, dtype=np.float32)[:, None], (1, w))
+    d = bg.copy()
+    d[100:103, 100:103] = 35.0
+    d[200:205, 300:350] = 5.0
+    conf = np.full(d.shape, 0.8, np.float32)
+    none = np.full(d.shape, np.nan, np.float32)
+    assert 9 < 5e-5 * h * w < 250
+    out, c = fused_dense(d, conf, none)
+    assert np.isnan(out[100:103, 100:103]).all() and (c[100:103, 100:103] == 0).all()
+    gone = np.isnan(out)
+    assert gone.sum() == 9
+    np.testing.assert_array_equal(out[~gone], d[~gone])
+    kept, _ = fused_dense(d, conf, none, speckle_area=0.0)
+    np.testing.assert_array_equal(kept, d)
+    # An island 1 px off its surroundings is part of them (speckle_diff = 1).
+    d2 = bg.copy()
+    d2[100:103, 100:103] += 1.0
+    out2, _ = fused_dense(d2, conf, none)
+    assert np.isfinite(out2).all()
+    with pytest.raises(ValueError, match="speckle_area"):
+        fused_dense(d, conf, none, speckle_area=-1.0)
