@@ -76,8 +76,9 @@ def test_depth_sigma_formula_on_a_plane() -> None:
     h, w, d = 96, 160, 6.5
     left = _texture(h, w)
     right = _shift(left, d)
-    raw = sv.depth_map(left, right, _rect_calib(w, h), max_disparity=16, refine=False)
-    res = sv.depth_map(left, right, _rect_calib(w, h), max_disparity=16)
+    kw = {"method": "gabor", "max_disparity": 16}
+    raw = sv.depth_map(left, right, _rect_calib(w, h), refine=False, **kw)
+    res = sv.depth_map(left, right, _rect_calib(w, h), **kw)
     for r, refined in ((raw, False), (res, True)):
         assert r.depth is not None and r.depth_sigma is not None
         ok = np.isfinite(r.depth)

@@ -393,7 +393,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser("demo", help="run the pipeline on the bundled Middlebury scene")
     d.add_argument("-o", "--output", default="demo_output", help="output folder")
-    d.add_argument("--method", default="gabor", choices=METHODS)
+    d.add_argument("--method", default=METHODS[0], choices=METHODS)
     d.set_defaults(func=cmd_demo)
 
     d = sub.add_parser("depth", help="disparity, depth and point cloud of one pair")
@@ -401,7 +401,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("right")
     d.add_argument("--calib", help="YAML/JSON calibration, Middlebury calib.txt or KITTI calib")
     d.add_argument("--max-disparity", type=int, default=None, help="default: from the images")
-    d.add_argument("--method", default="gabor", choices=METHODS)
+    d.add_argument("--method", default=METHODS[0], choices=METHODS)
     d.add_argument(
         "--fill", action="store_const", const=True, help="fill holes (default: the method's)"
     )
@@ -420,7 +420,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser("eval", help="evaluate against ground truth, OpenCV beside")
     d.add_argument("scenes", nargs="+", help="scene folders (or folders containing scenes)")
-    d.add_argument("--method", default="gabor", choices=METHODS)
+    d.add_argument("--method", default=METHODS[0], choices=METHODS)
     d.add_argument("--json", action="store_true", help="one JSON object per scene on stdout")
     d.add_argument("--no-opencv", action="store_true", help="skip the OpenCV references")
     d.set_defaults(func=cmd_eval)

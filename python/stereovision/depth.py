@@ -23,8 +23,8 @@ from stereovision.calibration import Calibration
 
 __all__ = ["METHODS", "DepthResult", "depth_map", "disparity_sigma", "estimate_max_disparity"]
 
-#: Matchers ``depth_map`` knows, by name.
-METHODS = ("gabor", "fused")
+#: Matchers ``depth_map`` knows, by name; the first is its default.
+METHODS = ("fused", "gabor")
 #: Methods whose output is dense by default (holes filled, ``fill=None``).
 _DENSE_METHODS = ("fused",)
 
@@ -345,7 +345,7 @@ def depth_map(
     right: npt.ArrayLike,
     calib: Calibration | None = None,
     *,
-    method: str = "gabor",
+    method: str = "fused",
     max_disparity: int | None = None,
     min_disparity: float = 0.0,
     fill: bool | None = None,
@@ -365,11 +365,13 @@ def depth_map(
         (they are rectified first); already rectified images otherwise.
     calib : Calibration, optional
         Rig calibration. Without it only disparity is computed (``depth`` is None).
-    method : {"gabor", "fused"}
-        ``"gabor"``: the dense Gabor phase channel (algorithms.md A); ``"fused"``: the Gabor
-        map corrected and completed by the valid members where the Gabor, graph-matching and
-        Hopfield channels agree (algorithms.md D; :func:`stereovision.matching.fusion.fused_dense`;
-        about the three channels' time together).
+    method : {"fused", "gabor"}
+        ``"fused"`` (default): the Gabor map corrected and completed by the valid members where
+        the Gabor, graph-matching and Hopfield channels agree (algorithms.md D), checked and
+        completed by a census semi-global map (:func:`stereovision.matching.fusion.fused_dense`;
+        the most accurate: mean bad-2.0 8.7 % over the 17 GT scenes, README). ``"gabor"``: the
+        dense Gabor phase channel alone (algorithms.md A), 3-4 times faster and less accurate
+        (16 % filled): the choice for a live view.
     max_disparity : int, optional
         Largest disparity searched, in pixels. None chooses it from the images
         (:func:`estimate_max_disparity`: ORB matches, 1.15 x their 99th percentile, multiple of 16).

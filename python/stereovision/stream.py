@@ -387,7 +387,7 @@ def run_stream(
     camera: StereoCamera,
     calib: Calibration | None = None,
     *,
-    method: str | None = None,
+    method: str = "gabor",
     max_disparity: int | None = None,
     frames: int | None = None,
     pipelined: bool = True,
@@ -406,8 +406,9 @@ def run_stream(
         Rig calibration of the camera's output size. A raw rig calibration is applied by the
         producer (rectification); a rectified one (Middlebury, KITTI) is used as is. Without one,
         only disparity is computed.
-    method : str, optional
-        Matcher; None = :func:`stereovision.depth.depth_map`'s default.
+    method : str
+        Matcher (:data:`stereovision.depth.METHODS`). ``"gabor"`` by default: a live view wants
+        the rate, and it is 3-4 times faster than ``depth_map``'s default ``"fused"``.
     max_disparity : int, optional
         Disparity range. None estimates it once, from the first pair.
     frames : int, optional
@@ -446,9 +447,7 @@ def run_stream(
     rect_calib = None
     if calib is not None:
         rect_calib = calib if calib.rectified else calib.rectified_calibration()
-    kw: dict[str, Any] = {"refine": refine}
-    if method is not None:
-        kw["method"] = method
+    kw: dict[str, Any] = {"refine": refine, "method": method}
     source = _pairs(camera, calib, frames)
     producer: _Producer | None = None
     q: queue.Queue[Any] = queue.Queue()
@@ -637,7 +636,9 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--calib", help="calibration of the rig (YAML/JSON, Middlebury, KITTI)")
     p.add_argument("--size", help="requested size WIDTHxHEIGHT (frames are resized if needed)")
     p.add_argument("--max-disparity", type=int, help="default: estimated from the first pair")
-    p.add_argument("--method", choices=METHODS, help="matcher (default: depth_map's)")
+    p.add_argument(
+        "--method", default="gabor", choices=METHODS, help="matcher (default: gabor, the fast one)"
+    )
     p.add_argument("--frames", type=int, help="stop after N pairs (default: until a source ends)")
     p.add_argument(
         "--refine", action="store_true", help="sub-pixel refinement per frame (2-3x the time)"
