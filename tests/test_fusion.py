@@ -390,8 +390,8 @@ def test_member_check_drops_members_the_sides_check_rejects(data_dir: Path) -> N
 
 
 def test_fused_dense_drops_speckles() -> None:
-    """Step 6: a 3x3 island off its surroundings (9 px < 5e-5 of 400x500) becomes a hole; a
-    5x50 strip (250 px) and the slanted background stay."""
+    """Step 6: a 3x3 island off its surroundings (9 px, fewer than 5e-5 of 400x500 = 10) becomes
+    a hole; a 5x50 strip (250 px) and the slanted background stay."""
     h, w = 400, 500
     # A slanted background: 0.5 px from row to row (one region at speckle_diff = 1).
     bg = np.tile(20.0 + 0.5 * np.arange(h, dtype=np.float32)[:, None], (1, w))

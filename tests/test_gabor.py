@@ -243,3 +243,24 @@ def test_bit_identical_runs_and_thread_counts() -> None:
         digests.append(out.stdout.strip())
     assert digests[0] == digests[1]
     assert len(digests[0]) == len(hashlib.sha256().hexdigest())
+
+
+@pytest.mark.parametrize(("min_size", "max_diff"), [(9, 1.0), (100, 1.0), (40, 0.5)])
+def test_remove_speckles_equals_opencv_filter_speckles(min_size: int, max_diff: float) -> None:
+    """The speckle kernel (also the fused map's step 6) against OpenCV's filterSpeckles, the rule
+    it follows, on a real raw Gabor map (no speckle step, values on OpenCV's 1/16 px grid)."""
+    import cv2
+
+    left, right = _grey("middlebury2003/cones")
+    g = gabor_disparity(left, right, max_disparity=64, speckle_size=0, lr_check=False)
+    d = np.round(g.disparity * 16) / 16
+    ours = _core.gabor_remove_speckles(d.astype(np.float32), min_size, max_diff)
+    q = np.where(np.isfinite(d), d * 16, -32768).astype(np.int16)
+    # OpenCV removes regions of at most maxSpeckleSize pixels; the kernel, fewer than min_size.
+    cv2.filterSpeckles(q, -32768, min_size - 1, max_diff * 16)
+    theirs = np.where(q == -32768, np.nan, q / 16).astype(np.float32)
+    removed = np.isfinite(d) & np.isnan(ours)
+    assert removed.sum() > 100  # a real test: the map has speckles of that size
+    np.testing.assert_array_equal(ours, theirs)
+    with pytest.raises(ValueError, match="max_diff"):
+        _core.gabor_remove_speckles(d.astype(np.float32), 9, float("nan"))

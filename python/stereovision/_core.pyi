@@ -71,6 +71,12 @@ def gabor_lr_check(
 ) -> npt.NDArray[np.bool_]:
     """Left-right consistency mask (``disp_right`` on the right-image grid)."""
 
+def gabor_remove_speckles(
+    disp: npt.NDArray[np.float32], min_size: int, max_diff: float
+) -> npt.NDArray[np.float32]:
+    """A copy with 4-connected regions (neighbours within ``max_diff``) smaller than
+    ``min_size`` pixels set to NaN."""
+
 # --- Hopfield network channel (rust/py/src/hopfield.rs) ------------------------------------------
 
 def hopfield_interest(

@@ -4,7 +4,9 @@ use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use stereovision_core::matching::gabor::{
     gabor_disparity_view as core_gabor, gabor_newton_step as core_step,
-    gabor_responses as core_resp, post::lr_check, GaborParams,
+    gabor_responses as core_resp,
+    post::{lr_check, remove_speckles},
+    GaborParams,
 };
 use stereovision_core::Image;
 
@@ -245,6 +247,31 @@ pub fn gabor_lr_check<'py>(
     let dr: Vec<f32> = b.iter().copied().collect();
     let ok = py.detach(|| lr_check(&dl, &dr, w, h, tol));
     let arr = numpy::ndarray::Array2::from_shape_vec((h, w), ok)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
+    Ok(numpy::IntoPyArray::into_pyarray(arr, py))
+}
+
+/// A copy of `disp` with the 4-connected regions smaller than `min_size` pixels (neighbours within
+/// `max_diff` px) set to NaN: the Gabor channel's speckle step (OpenCV's `filterSpeckles` rule on
+/// float disparities), for maps made elsewhere (the fused dense map).
+#[pyfunction]
+#[pyo3(signature = (disp, min_size, max_diff))]
+pub fn gabor_remove_speckles<'py>(
+    py: Python<'py>,
+    disp: PyReadonlyArray2<'py, f32>,
+    min_size: usize,
+    max_diff: f32,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    if !(max_diff.is_finite() && max_diff >= 0.0) {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "max_diff: expected a non-negative number, got {max_diff}"
+        )));
+    }
+    let a = disp.as_array();
+    let (h, w) = a.dim();
+    let mut d: Vec<f32> = a.iter().copied().collect();
+    py.detach(|| remove_speckles(&mut d, w, h, min_size, max_diff));
+    let arr = numpy::ndarray::Array2::from_shape_vec((h, w), d)
         .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
     Ok(numpy::IntoPyArray::into_pyarray(arr, py))
 }

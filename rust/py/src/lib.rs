@@ -45,6 +45,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(gabor::gabor_responses, m)?)?;
     m.add_function(wrap_pyfunction!(gabor::gabor_newton_step, m)?)?;
     m.add_function(wrap_pyfunction!(gabor::gabor_lr_check, m)?)?;
+    m.add_function(wrap_pyfunction!(gabor::gabor_remove_speckles, m)?)?;
     m.add_function(wrap_pyfunction!(hopfield::hopfield_interest, m)?)?;
     m.add_function(wrap_pyfunction!(hopfield::hopfield_match, m)?)?;
     m.add_function(wrap_pyfunction!(hopfield::hopfield_match_u8, m)?)?;
