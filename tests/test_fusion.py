@@ -415,3 +415,36 @@ def test_fused_dense_drops_speckles() -> None:
     assert np.isfinite(out2).all()
     with pytest.raises(ValueError, match="speckle_area"):
         fused_dense(d, conf, none, speckle_area=-1.0)
+
+
+def test_fused_dense_snaps_jumps_to_image_edges() -> None:
+    """Step 7: a foreground square (disparity 20 on 10) whose outline the matcher drew 3 px too
+    wide on every side (not at the corners, which neither a row nor a column through them
+    can tell); the image's edges are where the square really ends."""
+    h, w = 60, 80
+    guide = np.full((h, w), 0.2, np.float32)
+    guide[20:40, 30:50] = 0.8  # the square in the image: rows 20-39, columns 30-49
+    guide += np.random.default_rng(1).normal(0, 0.01, (h, w)).astype(np.float32)  # weak texture
+    d = np.full((h, w), 10.0, np.float32)
+    d[20:40, 27:53] = 20.0  # fattened by 3 px left and right ...
+    d[17:43, 30:50] = 20.0  # ... and above and below
+    conf = np.full(d.shape, 0.8, np.float32)
+    none = np.full(d.shape, np.nan, np.float32)
+    out, c = fused_dense(d, conf, none, guide=guide, speckle_area=0.0)
+    truth = np.full((h, w), 10.0, np.float32)
+    truth[20:40, 30:50] = 20.0
+    fat = (d != truth)
+    assert np.isnan(out[fat]).all() and (c[fat] == 0).all()  # the fattened ring became holes
+    np.testing.assert_array_equal(out[~fat], d[~fat])  # nothing else moved
+    np.testing.assert_array_equal(row_fill(out), truth)  # and the row fill gives the background
+    # Without a guide, or with edge_radius 0, the step does not run; members stay.
+    np.testing.assert_array_equal(fused_dense(d, conf, none, speckle_area=0.0)[0], d)
+    np.testing.assert_array_equal(
+        fused_dense(d, conf, none, guide=guide, speckle_area=0.0, edge_radius=0)[0], d
+    )
+    members = none.copy()
+    members[25, 28] = 20.0
+    kept, _ = fused_dense(d, conf, members, guide=guide, speckle_area=0.0, radius=0, fill_radius=0)
+    assert kept[25, 28] == 20.0 and np.isnan(kept[25, 27])
+    with pytest.raises(ValueError, match="guide"):
+        fused_dense(d, conf, none, guide=guide[:, :10])

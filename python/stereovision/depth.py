@@ -251,6 +251,7 @@ def _run_matcher(
             g.confidence,
             fr.dispx,
             second=fr.channel_outputs.get("sgm"),
+            guide=left,
             _only_second=only_second,
             **dense_kw,
         )
