@@ -433,7 +433,7 @@ def test_fused_dense_snaps_jumps_to_image_edges() -> None:
     out, c = fused_dense(d, conf, none, guide=guide, speckle_area=0.0)
     truth = np.full((h, w), 10.0, np.float32)
     truth[20:40, 30:50] = 20.0
-    fat = (d != truth)
+    fat = d != truth
     assert np.isnan(out[fat]).all() and (c[fat] == 0).all()  # the fattened ring became holes
     np.testing.assert_array_equal(out[~fat], d[~fat])  # nothing else moved
     np.testing.assert_array_equal(row_fill(out), truth)  # and the row fill gives the background

@@ -720,10 +720,9 @@ def _finish(
     _drop_speckles(out, conf, area, diff, only_second)
     if guide is None or radius < 1:
         return out, conf
-    gone = (
-        _fattened(out, guide, radius, ratio, jump) | _fattened(out.T, guide.T, radius, ratio, jump).T
-    ) & ~members
-    gone &= np.isfinite(out)
+    rows = _fattened(out, guide, radius, ratio, jump)
+    cols = _fattened(out.T, guide.T, radius, ratio, jump).T
+    gone = (rows | cols) & ~members & np.isfinite(out)
     out[gone] = np.nan
     conf[gone] = 0.0
     if only_second is not None:
