@@ -120,6 +120,12 @@ def mcgm_filter(
 ) -> npt.NDArray[np.bool_]:
     """B.8 occlusion filters on ``(N, 4)`` matches: kept flags."""
 
+# --- Hole fill (rust/py/src/fill.rs) --------------------------------------------------------------
+
+def row_fill(disp: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
+    """A copy with each hole (non-finite) given the smaller of the nearest valid values left and
+    right of it in its row (one side only: that one; none: NaN)."""
+
 # --- Triangulation (rust/py/src/triangulation.rs) ------------------------------------------------
 
 def depth_rectified(

@@ -163,7 +163,7 @@ def opencv_sgbm(left: object, right: object, max_disparity: float) -> npt.NDArra
 
 
 def row_fill(disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
-    """The reference hole fill of evaluation.md (vectorised, no per-pixel Python loop).
+    """The reference hole fill of evaluation.md (a Rust kernel; rows in parallel).
 
     Along each row, a hole (NaN) takes the smaller (background) of the nearest valid disparity
     to its left and the nearest valid disparity to its right; with a valid value on one side
@@ -192,17 +192,10 @@ def row_fill(disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
     d = np.asarray(disp)
     if d.ndim != 2 or d.dtype.kind not in "iuf":
         raise ValueError(f"disp: expected a real (H, W) array, got shape {d.shape} dtype {d.dtype}")
-    d = d.astype(np.float32)
-    h, w = d.shape
     if d.size == 0:
-        return d
-    valid = np.isfinite(d)
-    cols = np.broadcast_to(np.arange(w), (h, w))
-    # Index of the nearest valid pixel at or to the left (-1: none) and at or to the right (w).
-    left_idx = np.maximum.accumulate(np.where(valid, cols, -1), axis=1)
-    right_idx = np.minimum.accumulate(np.where(valid, cols, w)[:, ::-1], axis=1)[:, ::-1]
-    rows = np.arange(h)[:, None]
-    left_val = np.where(left_idx >= 0, d[rows, np.clip(left_idx, 0, w - 1)], np.nan)
-    right_val = np.where(right_idx < w, d[rows, np.clip(right_idx, 0, w - 1)], np.nan)
-    filled = np.fmin(left_val, right_val).astype(np.float32)  # fmin ignores a missing side
-    return np.where(valid, d, filled).astype(np.float32)
+        return d.astype(np.float32)
+    from stereovision import _core
+
+    # The Rust kernel (rust/core/src/fill.rs; NumPy reference tests/reference/row_fill_ref.py):
+    # the fused map fills rows four times per frame, and this is 15-25 x the vectorised NumPy.
+    return _core.row_fill(np.ascontiguousarray(d, dtype=np.float32))

@@ -6,6 +6,7 @@
 //! * [`error`]: the one error type every kernel returns (mapped to Python exceptions by `rust/py`);
 //! * [`matching`]: the correspondence channels (`gabor`, `mcgm`, `hopfield`);
 //! * [`refine`]: sub-pixel refinement and validated completion of a disparity map;
+//! * [`fill`]: the evaluation's reference row fill of a map's holes;
 //! * [`triangulation`]: depth and its uncertainty from a rectified disparity map.
 //!
 //! Conventions (algorithms.md section 0): images are `f32` in `[0, 1]`, row-major `(H, W)`;
@@ -14,6 +15,7 @@
 
 pub mod alloc;
 pub mod error;
+pub mod fill;
 pub mod image;
 pub mod matching;
 pub mod parallel;

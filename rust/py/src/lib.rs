@@ -9,6 +9,7 @@ use stereovision_core::matching::gabor::pool;
 
 mod convert;
 mod errors;
+mod fill;
 mod gabor;
 mod hopfield;
 mod mcgm;
@@ -57,6 +58,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(triangulation::depth_rectified, m)?)?;
     m.add_function(wrap_pyfunction!(refine::refine_disparity, m)?)?;
     m.add_function(wrap_pyfunction!(sgm::sgm_disparity, m)?)?;
+    m.add_function(wrap_pyfunction!(fill::row_fill, m)?)?;
     m.add_function(wrap_pyfunction!(convert::gray_u8, m)?)?;
     m.add_function(wrap_pyfunction!(release_memory, m)?)?;
     m.add_function(wrap_pyfunction!(kept_memory, m)?)?;
