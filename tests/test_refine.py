@@ -106,8 +106,8 @@ def test_depth_map_metric_depth_beats_sgbm(
 
     Measured (ours / SGBM; coverage ratio), gabor: playground 2.68 / 2.82 %, 25.6 / 29.8 %,
     1.01; terrace 1.35 / 2.18 %, 11.8 / 17.5 %, 1.00; kitti 1.58 / 1.79 %, 15.2 / 18.2 %, 0.92.
-    fused (2026-12-02): playground 2.60 %, 24.8 %, 0.99; terrace 1.44 %, 13.2 %, 0.97; kitti
-    1.66 %, 13.9 %, 0.89.
+    fused (2026-12-02): playground 2.60 %, 24.7 %, 0.99; terrace 1.43 %, 13.1 %, 0.96; kitti
+    1.64 %, 13.6 %, 0.86.
     """
     scene = load_scene(data_dir / scene_name)
     assert scene.calib is not None and scene.gt is not None
