@@ -17,6 +17,8 @@ import numpy.typing as npt
 RX, RY = 4, 3
 #: Cost where no level's right pixel is inside the image: worse than any Hamming distance.
 OUTSIDE = (2 * RX + 1) * (2 * RY + 1)  # 63: one more than the 62 bits
+#: A level outside the right image costs the pixel's best inside level plus this (at most OUTSIDE).
+OUTSIDE_MARGIN = 5
 
 PATHS = ((0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
 
@@ -51,10 +53,13 @@ def cost_volume(left: npt.ArrayLike, right: npt.ArrayLike, d_min: int, d_max: in
         ok = (xr >= 0) & (xr < w)
         inside[:, k] = ok
         c[:, ok, k] = np.bitwise_count(cl[:, ok] ^ cr[:, xr[ok]]).astype(np.int32)
-    # Levels outside take the best inside cost of their pixel (neutral); OUTSIDE stays only
-    # where no level is inside.
+    # Levels outside take the best inside cost of their pixel plus a margin (nearly neutral),
+    # or just the best where every inside level costs the same (a flat patch); OUTSIDE stays
+    # only where no level is inside.
     best = np.where(inside[None], c, OUTSIDE).min(axis=-1, keepdims=True)
-    return np.where(inside[None], c, best).astype(np.int32)
+    worst = np.where(inside[None], c, 0).max(axis=-1, keepdims=True)
+    out = np.where(worst == best, best, np.minimum(best + OUTSIDE_MARGIN, OUTSIDE))
+    return np.where(inside[None], c, out).astype(np.int32)
 
 
 def _p2_map(img: np.ndarray, dy: int, dx: int, p1: int, p2: int, gamma: float) -> np.ndarray:
