@@ -257,12 +257,12 @@ def test_depth_map_fused_beats_gabor_on_a_scene(data_dir: Path) -> None:
 
 
 @pytest.mark.parametrize(
-    ("scene", "bar"), [("middlebury2003/teddy", 0.6), ("middlebury2005/reindeer", 0.65)]
+    ("scene", "bar"), [("middlebury2003/teddy", 0.6), ("middlebury2005/reindeer", 0.55)]
 )
 def test_semi_global_completion_beats_filled_sgbm(data_dir: Path, scene: str, bar: float) -> None:
     """The census semi-global map fills Gabor's holes and vetoes its disagreeing values: bad-2.0
     (holes counted) against SGBM-3WAY + the same row fill, OpenCV in the same run. Measured:
-    teddy 12.0 -> 7.3 % (SGBM + fill 15.0), reindeer 21.4 -> 7.8 % (14.4)."""
+    teddy 12.0 -> 6.9 % (SGBM + fill 15.0), reindeer 21.4 -> 6.0 % (14.4)."""
     sc = load_scene(data_dir / scene)
     kw = {"max_disparity": sc.max_disparity, "method": "fused"}
     on = sv_depth_map(sc.left, sc.right, **kw)
