@@ -20,10 +20,11 @@
 //! 4. The left band, where the range reaches outside the right image (`x < d_max`): only the
 //!    levels that land inside compete, and the pixel is reported only if its winner's right pixel
 //!    lies at least `edge_margin` columns inside (`x - d >= edge_margin`). A pixel whose true match
-//!    lies outside has its winner pushed against the edge (`x - d` near 0). With the margin 4,
-//!    95-100 % of the reported band pixels are within 2 px of the GT on 15 of the GT scenes
-//!    (tsukuba: none reported; KITTI 78 %, about its rate inside); without it, wood2's band
-//!    errors moved its bad-2.0 after the row fill from 1.9 to 3.7 %.
+//!    lies outside has its winner pushed against the edge (`x - d` near 0). With the margin 4
+//!    (and [`OUTSIDE_MARGIN`]), 35-74 % of the band's GT pixels are reported on 16 GT scenes
+//!    (tsukuba's band is too narrow), 87-99 % of them within 2 px (KITTI 78 %, about its rate
+//!    inside); without the margin, wood2's band errors moved its bad-2.0 after the row fill
+//!    from 1.9 to 3.7 %.
 
 use rayon::prelude::*;
 
@@ -36,7 +37,8 @@ pub const RX: usize = 4;
 /// Census half-window along y.
 pub const RY: usize = 3;
 /// Cost of every level of a pixel whose whole range falls outside the right image: one more
-/// than the 62 census bits (levels outside beside levels inside take the best inside cost).
+/// than the 62 census bits (levels outside beside levels inside cost the best inside level plus
+/// [`OUTSIDE_MARGIN`]).
 pub const OUTSIDE: u8 = ((2 * RX + 1) * (2 * RY + 1)) as u8;
 /// What a level whose right pixel lies outside the image costs above the pixel's best inside
 /// level. Over the 17 GT scenes (fused map's mean ratio to SGBM-3WAY + fill): 0 -> 0.658, 2 ->
@@ -439,11 +441,12 @@ fn select_row(s: &[u16], w: usize, n_all: usize, d_min: i64, p: &SgmParams, out:
             continue;
         }
         let band = x as i64 - d_max < 0;
-        let (n, inside) = (inside as usize, inside as usize);
+        let n = inside as usize;
         let cell = &s[x * n_all..x * n_all + n];
         let (k, m) = argmin(cell);
-        // In the band a true match outside the image pushes the winner against its edge.
-        if band && ((inside - 1 - k) as u32) < p.edge_margin {
+        // In the band a true match outside the image pushes the winner against its edge
+        // (n - 1 - k = x - d: the winner's right column).
+        if band && ((n - 1 - k) as u32) < p.edge_margin {
             *o = f32::NAN;
             continue;
         }
