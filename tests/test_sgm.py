@@ -107,6 +107,10 @@ def test_bad_input() -> None:
         sgm_disparity(img, img, max_disparity=8, p2=9000)
     with pytest.raises(ValueError, match="p1"):
         sgm_disparity(img, img, max_disparity=8, p1=-1)
+    with pytest.raises(ValueError, match="p1"):
+        sgm_disparity(img, img, max_disparity=8, p1=70000)
+    with pytest.raises(ValueError, match="edge_margin"):
+        sgm_disparity(img, img, max_disparity=8, edge_margin=2**40)
     with pytest.raises(ValueError, match="max_disparity"):
         sgm_disparity(img, img, max_disparity=float("nan"))
     with pytest.raises(ValueError):

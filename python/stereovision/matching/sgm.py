@@ -80,10 +80,17 @@ def sgm_disparity(
         raise ValueError(
             f"max_disparity ({max_disparity}) is smaller than min_disparity ({min_disparity})"
         )
-    for name in ("p1", "p2", "uniqueness", "lr_tol", "edge_margin"):
+    # The kernel's integer widths: P1/P2 are u16, the rest u32.
+    for name, top in (
+        ("p1", 2**16 - 1),
+        ("p2", 2**16 - 1),
+        ("uniqueness", 2**32 - 1),
+        ("lr_tol", 2**32 - 1),
+        ("edge_margin", 2**32 - 1),
+    ):
         v = p[name]
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
-            raise ValueError(f"{name}: expected a non-negative integer, got {v!r}")
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 0 <= v <= top:
+            raise ValueError(f"{name}: expected an integer in [0, {top}], got {v!r}")
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
     return _core.sgm_disparity(
         np.ascontiguousarray(gl),
