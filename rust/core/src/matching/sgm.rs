@@ -26,6 +26,8 @@
 //!    inside); without the margin, wood2's band errors moved its bad-2.0 after the row fill
 //!    from 1.9 to 3.7 %.
 
+use std::sync::Mutex;
+
 use rayon::prelude::*;
 
 use crate::error::{CoreError, Result};
@@ -290,12 +292,13 @@ simd_fn! {
         n: usize,
         p: &SgmParams,
         forward: bool,
-    ) -> Vec<u16> {
+        emit: &mut dyn FnMut(usize, &mut Vec<u16>),
+    ) {
         let stride = n + 2;
         let lut = p2_table(p);
-        // Every entry is written, and written before it is read: the pages are mapped once by
-        // the write (reading fresh zero pages first costs a copy and a TLB flush on every core).
-        let mut s = vec![0u16; w * h * n];
+        // The four paths' sum for one row; `emit` may swap in another buffer, whose every entry
+        // the next row writes before reading.
+        let mut row = vec![0u16; w * n];
         // Path costs of the previous row for the vertical path and the diagonals whose
         // predecessor is at x - sgn and x + sgn; index x * stride.
         let mut prev: [Vec<u16>; 3] = std::array::from_fn(|_| vec![BIG; w * stride]);
@@ -318,7 +321,7 @@ simd_fn! {
             for j in 0..w {
                 let x = if forward { j } else { w - 1 - j };
                 let ci = &c[(y * w + x) * n..(y * w + x + 1) * n];
-                let acc = &mut s[(y * w + x) * n..(y * w + x + 1) * n];
+                let acc = &mut row[x * n..(x + 1) * n];
                 let v = irow[x];
                 let mut lps: [&[u16]; 4] = [&zero; 4];
                 let mut ms = [0u16; 4];
@@ -358,16 +361,16 @@ simd_fn! {
             // Every x of `cur` and `cur_min` is written in the next row before it is read.
             std::mem::swap(&mut prev, &mut cur);
             std::mem::swap(&mut prev_min, &mut cur_min);
+            emit(y, &mut row);
         }
-        s
     }
 }
 
 simd_fn! {
-    /// `out = a + b`, element-wise (one row of the two passes' volumes).
-    fn add_rows(a: &[u16], b: &[u16], out: &mut [u16]) {
-        for ((o, x), y) in out.iter_mut().zip(a).zip(b) {
-            *o = *x + *y;
+    /// `a += b`, element-wise (one row of the two passes' sums).
+    fn add_into(a: &mut [u16], b: &[u16]) {
+        for (x, y) in a.iter_mut().zip(b) {
+            *x += *y;
         }
     }
 }
@@ -508,21 +511,39 @@ pub fn sgm_disparity(
     let (cl, cr) = rayon::join(|| census(left), || census(right));
     let c = cost_volume(&cl, &cr, w, i64::from(d_min), n);
     drop((cl, cr));
-    let (sf, sb) = rayon::join(
-        || pass(&c, left.data, w, h, n, p, true),
-        || pass(&c, left.data, w, h, n, p, false),
-    );
+    // The two passes meet row by row: whichever reaches a row first leaves its sum there; the
+    // second adds its own and selects the row. One volume of sums is held at most (the rows
+    // each pass reached first), not one per pass; the addition commutes, so the output does
+    // not depend on which came first.
+    let slots: Vec<Mutex<Option<Vec<u16>>>> = (0..h).map(|_| Mutex::new(None)).collect();
+    let meet = |forward: bool| -> Vec<(usize, Vec<f32>)> {
+        let mut done = Vec::new();
+        let mut emit = |y: usize, row: &mut Vec<u16>| {
+            let other = {
+                let mut slot = slots[y].lock().unwrap_or_else(|e| e.into_inner());
+                match slot.take() {
+                    Some(other) => other,
+                    None => {
+                        *slot = Some(std::mem::replace(row, vec![0u16; w * n]));
+                        return;
+                    }
+                }
+            };
+            add_into(row, &other);
+            drop(other);
+            let mut o = vec![f32::NAN; w];
+            select_row(row, w, n, i64::from(d_min), p, &mut o);
+            done.push((y, o));
+        };
+        pass(&c, left.data, w, h, n, p, forward, &mut emit);
+        done
+    };
+    let (a, b) = rayon::join(|| meet(true), || meet(false));
     drop(c);
     let mut out = vec![f32::NAN; w * h];
-    out.par_chunks_mut(w)
-        .zip(sf.par_chunks(w * n).zip(sb.par_chunks(w * n)))
-        .for_each_init(
-            || vec![0u16; w * n],
-            |row, (o, (a, b))| {
-                add_rows(a, b, row);
-                select_row(row, w, n, i64::from(d_min), p, o)
-            },
-        );
+    for (y, o) in a.into_iter().chain(b) {
+        out[y * w..(y + 1) * w].copy_from_slice(&o);
+    }
     Ok(out)
 }
 
