@@ -13,7 +13,8 @@
 //!    grey levels) for a jump: an edge in the image is where a depth jump may be.
 //!    The four paths that come from above or the left run in one raster pass, the other four in a
 //!    reverse raster pass; the two passes run on two threads, so the output does not depend on the
-//!    thread count.
+//!    thread count. They meet row by row: the first to reach a row leaves its sum there, the
+//!    second adds its own and runs step 3 on the row (one volume of sums held, not two).
 //! 3. Winner-take-all, a uniqueness test (no level beyond +-1 within `uniqueness` % of the
 //!    winner), a left-right check against the right view's winners read off the same volume
 //!    (within `lr_tol` levels), and the parabola vertex as the sub-pixel part.
