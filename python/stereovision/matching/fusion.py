@@ -487,7 +487,7 @@ def fuse_pair(
     if edge_members and dense is not None:
         base = dense[0]
         r, ratio, jump = _EDGE_MEMBERS
-        fat = _fattened(base, gl, r, ratio, jump) | _fattened(base.T, gl.T, r, ratio, jump).T
+        fat = _fattened(base, gl, r, ratio, jump)
         keep &= ~fat[res.matches.yl.astype(np.intp), res.matches.xl.astype(np.intp)]
     if check_members or edge_members:
         res = _members_where(res, keep)
@@ -739,9 +739,7 @@ def _finish(
     _drop_speckles(out, conf, area, diff, only_second)
     if guide is None or radius < 1:
         return out, conf
-    rows = _fattened(out, guide, radius, ratio, jump)
-    cols = _fattened(out.T, guide.T, radius, ratio, jump).T
-    gone = (rows | cols) & ~members & np.isfinite(out)
+    gone = _fattened(out, guide, radius, ratio, jump) & ~members & np.isfinite(out)
     out[gone] = np.nan
     conf[gone] = 0.0
     if only_second is not None:
@@ -750,8 +748,16 @@ def _finish(
 
 
 def _fattened(d: F32, guide: F32, radius: int, ratio: float, jump: float) -> npt.NDArray[np.bool_]:
-    """Step 7 along the rows of ``d``: the pixels between each jump and the stronger edge on its
-    background side (vectorised over all jumps)."""
+    """Step 7's pixels: those between a jump and the stronger edge on its background side, along
+    the rows and along the columns of ``d``."""
+    rows = _fattened_rows(d, guide, radius, ratio, jump)
+    return rows | _fattened_rows(d.T, guide.T, radius, ratio, jump).T
+
+
+def _fattened_rows(
+    d: F32, guide: F32, radius: int, ratio: float, jump: float
+) -> npt.NDArray[np.bool_]:
+    """:func:`_fattened` along the rows only (vectorised over all jumps)."""
     from stereovision.baselines import row_fill
 
     h, w = d.shape

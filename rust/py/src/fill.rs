@@ -3,6 +3,9 @@
 use numpy::{PyArray2, PyReadonlyArray2};
 use pyo3::prelude::*;
 use stereovision_core::fill::row_fill as core_row_fill;
+use stereovision_core::Image;
+
+use crate::convert::image_to_numpy;
 
 /// A copy of `disp` with its holes filled by the reference row rule (module docs of the core).
 #[pyfunction]
@@ -14,7 +17,12 @@ pub fn row_fill<'py>(
     let (h, w) = a.dim();
     let mut d: Vec<f32> = a.iter().copied().collect();
     py.detach(|| core_row_fill(&mut d, w));
-    let arr = numpy::ndarray::Array2::from_shape_vec((h, w), d)
-        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
-    Ok(numpy::IntoPyArray::into_pyarray(arr, py))
+    image_to_numpy(
+        py,
+        Image {
+            width: w,
+            height: h,
+            data: d,
+        },
+    )
 }

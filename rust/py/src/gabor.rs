@@ -271,7 +271,12 @@ pub fn gabor_remove_speckles<'py>(
     let (h, w) = a.dim();
     let mut d: Vec<f32> = a.iter().copied().collect();
     py.detach(|| remove_speckles(&mut d, w, h, min_size, max_diff));
-    let arr = numpy::ndarray::Array2::from_shape_vec((h, w), d)
-        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
-    Ok(numpy::IntoPyArray::into_pyarray(arr, py))
+    image_to_numpy(
+        py,
+        Image {
+            width: w,
+            height: h,
+            data: d,
+        },
+    )
 }
