@@ -120,7 +120,23 @@ def mcgm_filter(
 ) -> npt.NDArray[np.bool_]:
     """B.8 occlusion filters on ``(N, 4)`` matches: kept flags."""
 
-# --- Hole fill (rust/py/src/fill.rs) --------------------------------------------------------------
+# --- Hole fills (rust/py/src/fill.rs, segment.rs) -------------------------------------------------
+
+def graph_segments(
+    image: npt.NDArray[np.float32], k: float, min_size: int
+) -> npt.NDArray[np.uint32]:
+    """Felzenszwalb-Huttenlocher segments of an ``(H, W, C)`` image, labels in raster order of
+    first pixels (``k`` 0: the regions of equal value)."""
+
+def plane_fill(
+    disp: npt.NDArray[np.float32],
+    labels: npt.NDArray[np.uint32],
+    min_pixels: int,
+    max_residual: float,
+    lo: float,
+    hi: float,
+) -> tuple[npt.NDArray[np.float32], int, int]:
+    """Holes filled by their segment's plane; ``(filled, planes used, holes filled)``."""
 
 def row_fill(disp: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
     """A copy with each hole (non-finite) given the smaller of the nearest valid values left and

@@ -20,6 +20,7 @@ pub mod image;
 pub mod matching;
 pub mod parallel;
 pub mod refine;
+pub mod segment;
 pub(crate) mod simd;
 pub mod triangulation;
 

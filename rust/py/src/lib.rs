@@ -15,6 +15,7 @@ mod hopfield;
 mod mcgm;
 mod params;
 mod refine;
+mod segment;
 mod sgm;
 mod triangulation;
 
@@ -59,6 +60,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(refine::refine_disparity, m)?)?;
     m.add_function(wrap_pyfunction!(sgm::sgm_disparity, m)?)?;
     m.add_function(wrap_pyfunction!(fill::row_fill, m)?)?;
+    m.add_function(wrap_pyfunction!(segment::graph_segments, m)?)?;
+    m.add_function(wrap_pyfunction!(segment::plane_fill, m)?)?;
     m.add_function(wrap_pyfunction!(convert::gray_u8, m)?)?;
     m.add_function(wrap_pyfunction!(release_memory, m)?)?;
     m.add_function(wrap_pyfunction!(kept_memory, m)?)?;

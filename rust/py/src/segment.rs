@@ -1,0 +1,82 @@
+//! Binding of `stereovision_core::segment`.
+
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyReadonlyArray3};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use stereovision_core::segment::{graph_segments as core_segments, plane_fill as core_plane_fill};
+use stereovision_core::Image;
+
+use crate::convert::image_to_numpy;
+
+/// Felzenszwalb-Huttenlocher segments of an `(H, W, C)` float32 image: `(H, W)` uint32 labels
+/// numbered in raster order of each segment's first pixel.
+#[pyfunction]
+#[pyo3(signature = (image, k, min_size))]
+pub fn graph_segments<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray3<'py, f32>,
+    k: f32,
+    min_size: usize,
+) -> PyResult<Bound<'py, PyArray2<u32>>> {
+    if !(k.is_finite() && k >= 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "k: expected a non-negative number, got {k}"
+        )));
+    }
+    let a = image.as_array();
+    let (h, w, c) = a.dim();
+    if c == 0 || h == 0 || w == 0 {
+        return Err(PyValueError::new_err(format!(
+            "image: expected (H, W, C) with no zero size, got ({h}, {w}, {c})"
+        )));
+    }
+    if a.iter().any(|v| !v.is_finite()) {
+        return Err(PyValueError::new_err("image: contains NaN or inf"));
+    }
+    let img: Vec<f32> = a.iter().copied().collect();
+    let labels = py.detach(|| core_segments(&img, w, h, c, k, min_size));
+    let arr = numpy::ndarray::Array2::from_shape_vec((h, w), labels)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(arr.into_pyarray(py))
+}
+
+/// A copy of `disp` whose holes took their segment's plane (core docs), with the number of
+/// planes used and of holes filled.
+#[pyfunction]
+#[pyo3(signature = (disp, labels, min_pixels, max_residual, lo, hi))]
+#[allow(clippy::type_complexity)]
+pub fn plane_fill<'py>(
+    py: Python<'py>,
+    disp: PyReadonlyArray2<'py, f32>,
+    labels: PyReadonlyArray2<'py, u32>,
+    min_pixels: usize,
+    max_residual: f32,
+    lo: f32,
+    hi: f32,
+) -> PyResult<(Bound<'py, PyArray2<f32>>, usize, usize)> {
+    let a = disp.as_array();
+    let (h, w) = a.dim();
+    if labels.as_array().dim() != (h, w) {
+        return Err(PyValueError::new_err(format!(
+            "labels: expected shape ({h}, {w}) like disp, got {:?}",
+            labels.as_array().dim()
+        )));
+    }
+    if !(max_residual.is_finite() && max_residual >= 0.0) || lo.is_nan() || hi.is_nan() {
+        return Err(PyValueError::new_err(format!(
+            "max_residual must be a non-negative number and lo/hi not NaN, got {max_residual}, {lo}, {hi}"
+        )));
+    }
+    let mut d: Vec<f32> = a.iter().copied().collect();
+    let l: Vec<u32> = labels.as_array().iter().copied().collect();
+    let s = py.detach(|| core_plane_fill(&mut d, &l, w, min_pixels, max_residual, lo, hi));
+    let out = image_to_numpy(
+        py,
+        Image {
+            width: w,
+            height: h,
+            data: d,
+        },
+    )?;
+    Ok((out, s.planes, s.filled))
+}
