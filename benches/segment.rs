@@ -1,0 +1,50 @@
+//! Criterion bench of the fused map's plane fill: equal-colour segments (`k = 0`, the fill's
+//! case), Felzenszwalb segments (`k = 300`) and the per-segment plane fits, at 640x480 on a
+//! synthetic image of quantised blocks and a slanted map with a hole every 5th pixel.
+//! Throughput is pixels per second.
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use stereovision_core::segment::{graph_segments, plane_fill};
+
+fn bench_segment(c: &mut Criterion) {
+    let (w, h) = (640usize, 480usize);
+    // Blocks of 8x6 pixels with 3 channels of pseudo-random bins: many small segments, like the
+    // quantised image of a textured scene.
+    let img: Vec<f32> = (0..w * h * 3)
+        .map(|i| {
+            let p = i / 3;
+            let block = (p % w) / 8 + 97 * ((p / w) / 6);
+            ((block * 2_654_435_761usize + i % 3 * 40_503) >> 7) as f32 % 4.0
+        })
+        .collect();
+    let disp: Vec<f32> = (0..w * h)
+        .map(|p| {
+            if p % 5 == 0 {
+                f32::NAN
+            } else {
+                10.0 + 0.05 * (p % w) as f32 + 0.02 * (p / w) as f32
+            }
+        })
+        .collect();
+    let mut g = c.benchmark_group("segment_640x480");
+    g.sample_size(20).measurement_time(Duration::from_secs(3));
+    g.throughput(Throughput::Elements((w * h) as u64));
+    g.bench_function("equal_regions", |b| {
+        b.iter(|| graph_segments(&img, w, h, 3, 0.0, 1))
+    });
+    g.bench_function("felzenszwalb_k300", |b| {
+        b.iter(|| graph_segments(&img, w, h, 3, 300.0, 20))
+    });
+    let labels = graph_segments(&img, w, h, 3, 0.0, 1);
+    g.bench_function("plane_fill", |b| {
+        b.iter(|| {
+            let mut d = disp.clone();
+            plane_fill(&mut d, &labels, w, 50, 1.0, 0.0, 100.0)
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_segment);
+criterion_main!(benches);
