@@ -3,7 +3,7 @@
 A hole left in a dense map (an occluded strip, a patch no matcher was sure of, the left band
 whose match lies outside the right image) usually belongs to a surface that was measured around
 it. The left image is cut into segments of one colour; a plane ``d = a x + b y + c`` is fitted to
-each segment's measured disparities, and where it fits (median residual within 1 px, 50 measured
+each segment's measured disparities, and where it fits (median residual within 0.7 px, 50 measured
 pixels or more) the segment's holes take the plane's value. The reference row fill would give
 them whichever side's disparity is smaller, which is the wrong surface wherever the hole is not
 an occlusion of the background.
@@ -13,7 +13,7 @@ quantisation in steps of ``step`` grey levels. A quantisation boundary falls in 
 on a gradient, so two quantisations half a step apart are used and a hole filled by both takes
 the mean. The holes no plane fills get the row fill. On the 17 GT scenes the default
 ``depth_map`` (fused) fills this way: its mean bad-2.0 ratio to SGBM-3WAY + fill goes from 0.633
-(row fill alone) to 0.561, lower on every scene (README, "Fusion"; books 0.94 -> 0.65).
+(row fill alone) to 0.555, lower on every scene (README, "Fusion"; books 0.94 -> 0.63).
 
 The kernels are Rust (:func:`stereovision._core.graph_segments`,
 :func:`stereovision._core.plane_fill`; NumPy reference ``tests/reference/planes_ref.py``).
@@ -34,7 +34,7 @@ F32 = npt.NDArray[np.float32]
 _BLUR = 2.0  # px: Gaussian sigma before the quantisation
 _STEP = 16  # grey levels (0-255) per quantisation bin
 _MIN_PIXELS = 50  # measured pixels a segment needs for a plane
-_MAX_RESIDUAL = 1.0  # px: largest median absolute residual of an accepted plane
+_MAX_RESIDUAL = 0.7  # px: largest median absolute residual of an accepted plane
 
 #: The defaults of :func:`fill_planes`.
 DEFAULTS: dict[str, float] = {
