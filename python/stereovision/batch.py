@@ -447,7 +447,7 @@ def run_batch(
     max_disparity : int, optional
         Disparity range for every pair; None = estimated per pair.
     fill : bool, optional
-        Reference row fill of the holes; None = the method's default (:func:`depth_map`).
+        Fill the holes (:func:`depth_map`'s ``fill``); None = the method's default.
     calib : path, optional
         Calibration for every pair (else each scene's ``calib.txt``).
     retry_failed : bool
@@ -719,7 +719,7 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--max-disparity", type=int, help="for every pair (default: per pair)")
     p.add_argument("--calib", help="calibration for every pair (default: each scene's calib.txt)")
     p.add_argument(
-        "--fill", action="store_const", const=True, help="fill holes (reference row fill)"
+        "--fill", action="store_const", const=True, help="fill holes (default: the method's)"
     )
     p.add_argument(
         "--no-fill", dest="fill", action="store_const", const=False, help="leave holes NaN"

@@ -147,7 +147,7 @@ def depth_outputs(
     max_disparity : int, optional
         None = estimated from the pair.
     fill : bool, optional
-        Reference row fill of the holes; None = the method's default (:func:`depth_map`).
+        Fill the holes (:func:`depth_map`'s ``fill``); None = the method's default.
     refine : bool, optional
         Sub-pixel refinement; None = the method's default (:func:`depth_map`).
 
@@ -219,8 +219,8 @@ def cmd_demo(args: argparse.Namespace) -> int:
     raw = dense_metrics(res.disparity, scene.gt)
     from stereovision.baselines import row_fill
 
-    # A dense method's output is already filled (planes, then the row rule); a sparse one's
-    # also gets the reference row fill, for comparison with the table in the README.
+    # A dense method's output is already filled (planes, then the row rule); one with holes
+    # ("gabor") is shown with the reference row fill too, as the README's tables count it.
     bad2 = (
         f"bad-2.0 {raw.bad[2.0]:.1f} % (filled)"
         if raw.density >= 100.0
