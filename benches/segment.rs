@@ -1,11 +1,12 @@
-//! Criterion bench of the fused map's plane fill: equal-colour segments (`k = 0`, the fill's
-//! case), Felzenszwalb segments (`k = 300`) and the per-segment plane fits, at 640x480 on a
-//! synthetic image of quantised blocks and a slanted map with a hole every 5th pixel.
+//! Criterion bench of the fused map's plane fill: equal-colour segments (`k = 0`, and the
+//! quantised regions the fill uses), Felzenszwalb segments (`k = 300`) and the per-segment plane
+//! fits, at 640x480 on a synthetic image of quantised blocks and a slanted map with a hole every
+//! 5th pixel.
 //! Throughput is pixels per second.
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use stereovision_core::segment::{graph_segments, plane_fill};
+use stereovision_core::segment::{graph_segments, plane_fill, quantised_regions};
 
 fn bench_segment(c: &mut Criterion) {
     let (w, h) = (640usize, 480usize);
@@ -32,6 +33,10 @@ fn bench_segment(c: &mut Criterion) {
     g.throughput(Throughput::Elements((w * h) as u64));
     g.bench_function("equal_regions", |b| {
         b.iter(|| graph_segments(&img, w, h, 3, 0.0, 1))
+    });
+    let img_u8: Vec<u8> = img.iter().map(|&v| (v * 16.0) as u8).collect();
+    g.bench_function("quantised_regions", |b| {
+        b.iter(|| quantised_regions(&img_u8, w, h, 3, 16, 0))
     });
     g.bench_function("felzenszwalb_k300", |b| {
         b.iter(|| graph_segments(&img, w, h, 3, 300.0, 20))

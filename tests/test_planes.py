@@ -38,7 +38,9 @@ def test_graph_segments_equal_numpy_reference(data_dir: Path, k: float, min_size
     np.testing.assert_array_equal(got, ref)
     assert 5 < got.max() < 48 * 64 // 2  # a real segmentation, neither one region nor pixels
     if k == 0:
+        # segments() takes the kernel that bins and labels a uint8 image in one scan.
         np.testing.assert_array_equal(got, segments(img))
+        np.testing.assert_array_equal(got, segments(img.astype(np.float32)))  # the general path
 
 
 @pytest.mark.parametrize("scene", ["middlebury2003/cones", "middlebury2005/books"])
@@ -111,3 +113,9 @@ def test_fill_planes_edge_cases_and_bad_input() -> None:
         _core.plane_fill(full, np.zeros((4, 4), np.uint32), 1, 1.0, 0.0, 1.0)
     with pytest.raises(ValueError, match="k"):
         _core.graph_segments(np.zeros((4, 4, 1), np.float32), -1.0, 1)
+    with pytest.raises(ValueError, match="step"):
+        _core.quantised_regions(np.zeros((4, 4, 3), np.uint8), 0, 0)
+    with pytest.raises(ValueError, match="C in 1-3"):
+        _core.quantised_regions(np.zeros((4, 4, 4), np.uint8), 16, 0)
+    with pytest.raises(ValueError, match="passes"):
+        fill_planes(np.where(full > 0, np.nan, full), img, passes=((0, 50),))

@@ -128,6 +128,12 @@ def graph_segments(
     """Felzenszwalb-Huttenlocher segments of an ``(H, W, C)`` image, labels in raster order of
     first pixels (``k`` 0: the regions of equal value)."""
 
+def quantised_regions(
+    image: npt.NDArray[np.uint8], step: int, offset: int
+) -> npt.NDArray[np.uint32]:
+    """Regions of equal bin ``(value + offset) // step`` of an ``(H, W, C)`` uint8 image (C 1-3),
+    labels in raster order of first pixels (``graph_segments`` with ``k`` 0 on the bins)."""
+
 def plane_fill(
     disp: npt.NDArray[np.float32],
     labels: npt.NDArray[np.uint32],

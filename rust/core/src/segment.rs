@@ -155,6 +155,85 @@ fn raster_labels(f: &mut Forest, n: usize) -> Vec<u32> {
     labels
 }
 
+/// Connected regions (4-neighbours) of equal quantised colour of a row-major `(H, W, C)` u8
+/// image, `C` in 1..=3: a pixel's bin in each channel is `(value + offset) / step`. Labels as
+/// [`graph_segments`] numbers them (it gives the same labels with `k = 0` on the bins), in one
+/// union-find scan whose roots are each region's first pixel.
+///
+/// # Panics
+/// If `img.len() != w * h * c`, `c` is not 1..=3, or `step` is 0.
+pub fn quantised_regions(
+    img: &[u8],
+    w: usize,
+    h: usize,
+    c: usize,
+    step: u32,
+    offset: u32,
+) -> Vec<u32> {
+    assert!(
+        (1..=3).contains(&c) && img.len() == w * h * c,
+        "image size does not match w * h * c"
+    );
+    assert!(step > 0, "step must be positive");
+    let n = w * h;
+    // Each bin fits 9 bits ((255 + offset) / step < 512 for offset < 257 * step).
+    // Bins by table: a division per channel and pixel would cost more than the labelling.
+    let bin: Vec<u32> = (0..256u32)
+        .map(|v| ((v + offset) / step).min(511))
+        .collect();
+    let mut keys = vec![0u32; n];
+    keys.par_chunks_mut(w.max(1))
+        .zip(img.par_chunks(w.max(1) * c))
+        .for_each(|(k, row)| {
+            for (k, px) in k.iter_mut().zip(row.chunks_exact(c)) {
+                let mut v = 0u32;
+                for (i, &b) in px.iter().enumerate() {
+                    v |= bin[b as usize] << (9 * i);
+                }
+                *k = v;
+            }
+        });
+    // parent[p] <= p always: a region's root is its first pixel in raster order.
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let find = |parent: &mut [u32], mut a: usize| -> usize {
+        while parent[a] as usize != a {
+            let p = parent[a] as usize;
+            parent[a] = parent[p];
+            a = p;
+        }
+        a
+    };
+    let mut x = 0usize;
+    for p in 0..n {
+        let mut rp = p;
+        if x > 0 && keys[p - 1] == keys[p] {
+            rp = find(&mut parent, p - 1);
+            parent[p] = rp as u32;
+        }
+        if p >= w && keys[p - w] == keys[p] {
+            let b = find(&mut parent, p - w);
+            if rp != b {
+                let (lo, hi) = (rp.min(b), rp.max(b));
+                parent[hi] = lo as u32;
+            }
+        }
+        x = if x + 1 == w { 0 } else { x + 1 };
+    }
+    // parent[p] < p unless p is a root, and its label is final by then: no search needed.
+    let mut labels = vec![0u32; n];
+    let mut next = 0u32;
+    for p in 0..n {
+        let q = parent[p] as usize;
+        if q == p {
+            labels[p] = next;
+            next += 1;
+        } else {
+            labels[p] = labels[q];
+        }
+    }
+    labels
+}
+
 /// Outcome of [`plane_fill`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct PlaneFillStats {
@@ -277,14 +356,19 @@ fn segment_fill(
     lo: f32,
     hi: f32,
 ) -> Vec<(u32, f32)> {
+    // Most segments are small: count before collecting anything.
+    let n_meas = pix
+        .iter()
+        .filter(|&&p| disp[p as usize].is_finite())
+        .count();
+    if n_meas == pix.len() || n_meas < min_pixels.max(3) {
+        return Vec::new();
+    }
     let holes: Vec<u32> = pix
         .iter()
         .copied()
         .filter(|&p| !disp[p as usize].is_finite())
         .collect();
-    if holes.is_empty() || pix.len() - holes.len() < min_pixels.max(3) {
-        return Vec::new();
-    }
     let pts: Vec<(f32, f32, f32)> = pix
         .iter()
         .filter(|&&p| disp[p as usize].is_finite())
@@ -353,6 +437,30 @@ mod tests {
         let fast = graph_segments(&img, w, h, 1, 0.0, 1);
         assert_eq!(fast, graph_segments(&img, w, h, 1, 0.0, 2));
         assert_eq!(*fast.iter().max().unwrap(), 11); // 3 columns x 4 row bands
+    }
+
+    #[test]
+    fn quantised_regions_equal_graph_segments_on_the_bins() {
+        let (w, h, c) = (23usize, 17usize, 3usize);
+        // Smooth ramps with a few steps: regions of many shapes, some touching only diagonally.
+        let img: Vec<u8> = (0..w * h * c)
+            .map(|i| {
+                let (p, ch) = (i / c, i % c);
+                let (x, y) = (p % w, p / w);
+                ((x * 7 + y * 3 * (ch + 1) + (x * y) % 5 * 20) % 256) as u8
+            })
+            .collect();
+        for (step, offset) in [(16u32, 0u32), (16, 8), (24, 12), (1, 0)] {
+            let bins: Vec<f32> = img
+                .iter()
+                .map(|&v| ((v as u32 + offset) / step) as f32)
+                .collect();
+            assert_eq!(
+                quantised_regions(&img, w, h, c, step, offset),
+                graph_segments(&bins, w, h, c, 0.0, 1),
+                "step {step} offset {offset}"
+            );
+        }
     }
 
     #[test]

@@ -62,6 +62,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fill::row_fill, m)?)?;
     m.add_function(wrap_pyfunction!(segment::graph_segments, m)?)?;
     m.add_function(wrap_pyfunction!(segment::plane_fill, m)?)?;
+    m.add_function(wrap_pyfunction!(segment::quantised_regions, m)?)?;
     m.add_function(wrap_pyfunction!(convert::gray_u8, m)?)?;
     m.add_function(wrap_pyfunction!(release_memory, m)?)?;
     m.add_function(wrap_pyfunction!(kept_memory, m)?)?;

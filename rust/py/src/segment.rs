@@ -1,9 +1,12 @@
 //! Binding of `stereovision_core::segment`.
 
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyReadonlyArray3};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-use stereovision_core::segment::{graph_segments as core_segments, plane_fill as core_plane_fill};
+use stereovision_core::segment::{
+    graph_segments as core_segments, plane_fill as core_plane_fill,
+    quantised_regions as core_regions,
+};
 use stereovision_core::Image;
 
 use crate::convert::image_to_numpy;
@@ -79,4 +82,32 @@ pub fn plane_fill<'py>(
         },
     )?;
     Ok((out, s.planes, s.filled))
+}
+
+/// Connected regions of equal quantised colour of an `(H, W, C)` uint8 image (`C` 1-3; bin
+/// `(value + offset) // step`): `(H, W)` uint32 labels in raster order of first pixels.
+#[pyfunction]
+#[pyo3(signature = (image, step, offset))]
+pub fn quantised_regions<'py>(
+    py: Python<'py>,
+    image: PyReadonlyArray3<'py, u8>,
+    step: u32,
+    offset: u32,
+) -> PyResult<Bound<'py, PyArray2<u32>>> {
+    let (h, w, c) = (image.shape()[0], image.shape()[1], image.shape()[2]);
+    if !(1..=3).contains(&c) || h == 0 || w == 0 {
+        return Err(PyValueError::new_err(format!(
+            "image: expected (H, W, C) with C in 1-3 and no zero size, got ({h}, {w}, {c})"
+        )));
+    }
+    if step == 0 || step > 255 || offset > 255 {
+        return Err(PyValueError::new_err(format!(
+            "step must be in 1-255 and offset in 0-255, got step={step}, offset={offset}"
+        )));
+    }
+    let img: Vec<u8> = image.as_array().iter().copied().collect();
+    let labels = py.detach(|| core_regions(&img, w, h, c, step, offset));
+    let arr = numpy::ndarray::Array2::from_shape_vec((h, w), labels)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(arr.into_pyarray(py))
 }
