@@ -1,14 +1,16 @@
-//! Colour segments and the planes fitted in them: the fused dense map's last completion step
+//! Colour segments and the planes fitted in them: the fused dense map's fill before the row rule
 //! (NumPy reference: `tests/reference/planes_ref.py`).
 //!
-//! [`graph_segments`] is Felzenszwalb and Huttenlocher's graph-based segmentation (IJCV 2004) on
-//! the 4-connected pixel grid: edges in increasing colour distance merge two components while
-//! the distance is at most each one's internal difference plus `k / size`; components smaller
-//! than `min_size` then join a neighbour. [`plane_fill`] fits `d = a x + b y + c` to the
-//! measured disparities of each segment (least squares, re-fitted twice on the pixels within
-//! `max(1, 2 * median residual)`) and gives the plane's value to the segment's holes when the
-//! fit is good: a hole inside a surface takes that surface's disparity, where the row fill would
-//! take whichever side happens to be farther.
+//! [`quantised_regions`] (what the fill uses) labels the connected regions of equal binned
+//! colour in one union-find scan. [`graph_segments`] is Felzenszwalb and Huttenlocher's
+//! graph-based segmentation (IJCV 2004) on the 4-connected pixel grid: edges in increasing
+//! colour distance merge two components while the distance is at most each one's internal
+//! difference plus `k / size`; components smaller than `min_size` then join a neighbour (with
+//! `k = 0` it gives the same regions as [`quantised_regions`] on binned values). [`plane_fill`]
+//! fits `d = a x + b y + c` to the measured disparities of each segment (least squares, re-fitted
+//! twice on the pixels within `max(1, 2 * median residual)`) and gives the plane's value to the
+//! segment's holes when the fit is good: a hole inside a surface takes that surface's disparity,
+//! where the row fill would take whichever side happens to be farther.
 
 use rayon::prelude::*;
 
@@ -31,7 +33,7 @@ impl Forest {
     fn find(&mut self, mut a: u32) -> u32 {
         while self.parent[a as usize] != a {
             let p = self.parent[a as usize];
-            // Path halving: order-independent roots, so the labels stay deterministic.
+            // Path halving.
             self.parent[a as usize] = self.parent[p as usize];
             a = p;
         }
@@ -80,7 +82,7 @@ pub fn graph_segments(
     };
     if k == 0.0 && min_size <= 1 {
         // Only zero-weight edges merge (the threshold stays 0), whatever their order: the same
-        // labels without the sort, 5-10x faster (the fused map's fill uses this case).
+        // labels without the sort, 5-10x faster.
         let mut f = Forest::new(n, k);
         for p in 0..n {
             for q in [p + 1, p + w] {

@@ -38,6 +38,16 @@ pub fn graph_segments<'py>(
     }
     let img: Vec<f32> = a.iter().copied().collect();
     let labels = py.detach(|| core_segments(&img, w, h, c, k, min_size));
+    labels_to_numpy(py, h, w, labels)
+}
+
+/// `(H, W)` uint32 array of row-major labels.
+fn labels_to_numpy<'py>(
+    py: Python<'py>,
+    h: usize,
+    w: usize,
+    labels: Vec<u32>,
+) -> PyResult<Bound<'py, PyArray2<u32>>> {
     let arr = numpy::ndarray::Array2::from_shape_vec((h, w), labels)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(arr.into_pyarray(py))
@@ -107,7 +117,5 @@ pub fn quantised_regions<'py>(
     }
     let img: Vec<u8> = image.as_array().iter().copied().collect();
     let labels = py.detach(|| core_regions(&img, w, h, c, step, offset));
-    let arr = numpy::ndarray::Array2::from_shape_vec((h, w), labels)
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    Ok(arr.into_pyarray(py))
+    labels_to_numpy(py, h, w, labels)
 }
