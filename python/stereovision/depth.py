@@ -370,7 +370,7 @@ def depth_map(
         ``"fused"`` (default): the Gabor map corrected and completed by the valid members where
         the Gabor, graph-matching and Hopfield channels agree (algorithms.md D), checked and
         completed by a census semi-global map (:func:`stereovision.matching.fusion.fused_dense`;
-        the most accurate: mean bad-2.0 7.0 % over the 17 GT scenes, README). ``"gabor"``: the
+        the most accurate: mean bad-2.0 6.8 % over the 17 GT scenes, README). ``"gabor"``: the
         dense Gabor phase channel alone (algorithms.md A), 3-4 times faster and less accurate
         (16 % filled): the choice for a live view.
     max_disparity : int, optional
