@@ -284,7 +284,8 @@ fn median(v: &mut [f32]) -> f32 {
 /// the result does not depend on the thread count.
 ///
 /// # Panics
-/// If `labels.len() != disp.len()`.
+/// If `labels.len() != disp.len()` or a label is not below it (labels as the segment functions
+/// number them).
 pub fn plane_fill(
     disp: &mut [f32],
     labels: &[u32],
@@ -303,6 +304,10 @@ pub fn plane_fill(
         return PlaneFillStats::default();
     }
     let n_seg = labels.iter().max().map_or(0, |&m| m as usize + 1);
+    assert!(
+        n_seg <= labels.len(),
+        "labels must be below the pixel count"
+    );
     // Pixels grouped by segment (counting sort), raster order inside each.
     let mut start = vec![0usize; n_seg + 1];
     for &l in labels {

@@ -10,6 +10,7 @@ use stereovision_core::segment::{
 use stereovision_core::Image;
 
 use crate::convert::image_to_numpy;
+use crate::errors::guard;
 
 /// Felzenszwalb-Huttenlocher segments of an `(H, W, C)` float32 image: `(H, W)` uint32 labels
 /// numbered in raster order of each segment's first pixel.
@@ -37,7 +38,11 @@ pub fn graph_segments<'py>(
         return Err(PyValueError::new_err("image: contains NaN or inf"));
     }
     let img: Vec<f32> = a.iter().copied().collect();
-    let labels = py.detach(|| core_segments(&img, w, h, c, k, min_size));
+    let labels = py.detach(|| {
+        guard("graph_segments", || {
+            Ok(core_segments(&img, w, h, c, k, min_size))
+        })
+    })?;
     labels_to_numpy(py, h, w, labels)
 }
 
@@ -82,7 +87,26 @@ pub fn plane_fill<'py>(
     }
     let mut d: Vec<f32> = a.iter().copied().collect();
     let l: Vec<u32> = labels.as_array().iter().copied().collect();
-    let s = py.detach(|| core_plane_fill(&mut d, &l, w, min_pixels, max_residual, lo, hi));
+    // The kernel sizes its tables by the largest label: one per pixel at most.
+    if l.iter().any(|&v| v as usize >= h * w) {
+        return Err(PyValueError::new_err(format!(
+            "labels: expected values below H * W = {}, as segments() numbers them",
+            h * w
+        )));
+    }
+    let s = py.detach(|| {
+        guard("plane_fill", || {
+            Ok(core_plane_fill(
+                &mut d,
+                &l,
+                w,
+                min_pixels,
+                max_residual,
+                lo,
+                hi,
+            ))
+        })
+    })?;
     let out = image_to_numpy(
         py,
         Image {
@@ -116,6 +140,10 @@ pub fn quantised_regions<'py>(
         )));
     }
     let img: Vec<u8> = image.as_array().iter().copied().collect();
-    let labels = py.detach(|| core_regions(&img, w, h, c, step, offset));
+    let labels = py.detach(|| {
+        guard("quantised_regions", || {
+            Ok(core_regions(&img, w, h, c, step, offset))
+        })
+    })?;
     labels_to_numpy(py, h, w, labels)
 }
