@@ -114,6 +114,8 @@ def test_fill_planes_edge_cases_and_bad_input() -> None:
         segments(img, step=0)
     with pytest.raises(ValueError, match="labels"):
         _core.plane_fill(full, np.zeros((4, 4), np.uint32), 1, 1.0, 0.0, 1.0)
+    with pytest.raises(ValueError, match="labels"):
+        plane_fill(full, np.zeros(64, np.uint32))
     with pytest.raises(ValueError, match="below H \\* W"):
         plane_fill(full, np.full((8, 8), 2**31, np.uint32))
     with pytest.raises(ValueError, match="k"):

@@ -135,6 +135,12 @@ def plane_fill(
     -------
     numpy.ndarray
         ``(H, W)`` float32, a new array; measured values are unchanged.
+
+    Raises
+    ------
+    ValueError
+        ``disp`` not 2-D, ``labels`` of another shape or not below ``H * W``, a negative
+        ``max_residual``.
     """
     from stereovision import _core
 
@@ -142,6 +148,8 @@ def plane_fill(
     lab = np.ascontiguousarray(labels, dtype=np.uint32)
     if d.ndim != 2:
         raise ValueError(f"disp: expected an (H, W) array, got {d.shape}")
+    if lab.shape != d.shape:
+        raise ValueError(f"labels: expected shape {d.shape} like disp, got {lab.shape}")
     out, _, _ = _core.plane_fill(d, lab, int(min_pixels), float(max_residual), lo, hi)
     return out
 
