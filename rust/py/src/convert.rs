@@ -50,8 +50,17 @@ pub fn grey_from_numpy<'a>(
 
 /// Moves a core [`Image`] into a new NumPy array without copying.
 pub fn image_to_numpy<'py>(py: Python<'py>, img: Image) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let arr = Array2::from_shape_vec((img.height, img.width), img.data)
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    vec_to_numpy(py, (img.height, img.width), img.data)
+}
+
+/// Moves a row-major vector into a new `(rows, cols)` NumPy array without copying.
+pub fn vec_to_numpy<'py, T: numpy::Element>(
+    py: Python<'py>,
+    shape: (usize, usize),
+    data: Vec<T>,
+) -> PyResult<Bound<'py, PyArray2<T>>> {
+    let arr =
+        Array2::from_shape_vec(shape, data).map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(arr.into_pyarray(py))
 }
 

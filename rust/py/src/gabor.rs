@@ -246,9 +246,7 @@ pub fn gabor_lr_check<'py>(
     let dl: Vec<f32> = a.iter().copied().collect();
     let dr: Vec<f32> = b.iter().copied().collect();
     let ok = py.detach(|| lr_check(&dl, &dr, w, h, tol));
-    let arr = numpy::ndarray::Array2::from_shape_vec((h, w), ok)
-        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))?;
-    Ok(numpy::IntoPyArray::into_pyarray(arr, py))
+    crate::convert::vec_to_numpy(py, (h, w), ok)
 }
 
 /// A copy of `disp` with the 4-connected regions smaller than `min_size` pixels (neighbours within
@@ -262,11 +260,7 @@ pub fn gabor_remove_speckles<'py>(
     min_size: usize,
     max_diff: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    if !(max_diff.is_finite() && max_diff >= 0.0) {
-        return Err(pyo3::exceptions::PyValueError::new_err(format!(
-            "max_diff: expected a non-negative number, got {max_diff}"
-        )));
-    }
+    crate::params::non_negative("max_diff", max_diff)?;
     let a = disp.as_array();
     let (h, w) = a.dim();
     let mut d: Vec<f32> = a.iter().copied().collect();

@@ -31,3 +31,14 @@ pub fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
     }
     Ok(())
 }
+
+/// `Ok` when `v` is a finite number >= 0, else a `ValueError` naming it.
+pub fn non_negative(name: &str, v: f32) -> PyResult<()> {
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(PyValueError::new_err(format!(
+            "{name}: expected a non-negative number, got {v}"
+        )))
+    }
+}

@@ -1,6 +1,6 @@
 //! Binding of `stereovision_core::segment`.
 
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use numpy::{PyArray2, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use stereovision_core::segment::{
@@ -9,8 +9,9 @@ use stereovision_core::segment::{
 };
 use stereovision_core::Image;
 
-use crate::convert::image_to_numpy;
+use crate::convert::{image_to_numpy, vec_to_numpy};
 use crate::errors::guard;
+use crate::params::non_negative;
 
 /// Felzenszwalb-Huttenlocher segments of an `(H, W, C)` float32 image: `(H, W)` uint32 labels
 /// numbered in raster order of each segment's first pixel.
@@ -22,11 +23,7 @@ pub fn graph_segments<'py>(
     k: f32,
     min_size: usize,
 ) -> PyResult<Bound<'py, PyArray2<u32>>> {
-    if !(k.is_finite() && k >= 0.0) {
-        return Err(PyValueError::new_err(format!(
-            "k: expected a non-negative number, got {k}"
-        )));
-    }
+    non_negative("k", k)?;
     let a = image.as_array();
     let (h, w, c) = a.dim();
     if c == 0 || h == 0 || w == 0 {
@@ -43,19 +40,7 @@ pub fn graph_segments<'py>(
             Ok(core_segments(&img, w, h, c, k, min_size))
         })
     })?;
-    labels_to_numpy(py, h, w, labels)
-}
-
-/// `(H, W)` uint32 array of row-major labels.
-fn labels_to_numpy<'py>(
-    py: Python<'py>,
-    h: usize,
-    w: usize,
-    labels: Vec<u32>,
-) -> PyResult<Bound<'py, PyArray2<u32>>> {
-    let arr = numpy::ndarray::Array2::from_shape_vec((h, w), labels)
-        .map_err(|e| PyValueError::new_err(e.to_string()))?;
-    Ok(arr.into_pyarray(py))
+    vec_to_numpy(py, (h, w), labels)
 }
 
 /// A copy of `disp` whose holes took their segment's plane (core docs), with the number of
@@ -80,9 +65,10 @@ pub fn plane_fill<'py>(
             labels.as_array().dim()
         )));
     }
-    if !(max_residual.is_finite() && max_residual >= 0.0) || lo.is_nan() || hi.is_nan() {
+    non_negative("max_residual", max_residual)?;
+    if lo.is_nan() || hi.is_nan() {
         return Err(PyValueError::new_err(format!(
-            "max_residual must be a non-negative number and lo/hi not NaN, got {max_residual}, {lo}, {hi}"
+            "lo and hi: expected numbers, got {lo}, {hi}"
         )));
     }
     let mut d: Vec<f32> = a.iter().copied().collect();
@@ -145,5 +131,5 @@ pub fn quantised_regions<'py>(
             Ok(core_regions(&img, w, h, c, step, offset))
         })
     })?;
-    labels_to_numpy(py, h, w, labels)
+    vec_to_numpy(py, (h, w), labels)
 }
