@@ -83,8 +83,6 @@ def segments(
     ValueError
         A non-2-D/3-D image, a non-positive ``step`` or a negative ``blur``/``k``.
     """
-    import cv2
-
     from stereovision import _core
 
     im = np.asarray(image)
@@ -92,20 +90,26 @@ def segments(
         raise ValueError(f"image: expected a real (H, W) or (H, W, C) array, got {im.shape}")
     if step < 1 or blur < 0 or not np.isfinite(blur):
         raise ValueError(f"step must be >= 1 and blur >= 0, got step={step}, blur={blur}")
+    if blur > 0:
+        im = _blurred(im, blur)
     fast = im.dtype == np.uint8 and (im.ndim == 2 or im.shape[2] <= 3) and 0 <= offset <= 255
     if k == 0 and fast and step <= 255:
         # Equal regions of a uint8 image: the kernel bins and labels in one pass.
-        u8 = cv2.GaussianBlur(im, (0, 0), blur) if blur > 0 else im
-        u8 = u8[:, :, None] if u8.ndim == 2 else u8
+        u8 = im[:, :, None] if im.ndim == 2 else im
         return _core.quantised_regions(np.ascontiguousarray(u8), int(step), int(offset))
-    f = im.astype(np.float32)
-    if blur > 0:
-        # uint8 in, uint8 out: OpenCV rounds the blurred values, as the reference does.
-        f = cv2.GaussianBlur(np.clip(f, 0, 255).astype(np.uint8), (0, 0), blur).astype(np.float32)
-    key = np.floor((f + offset) / step).astype(np.float32)
+    key = np.floor((im.astype(np.float32) + offset) / step).astype(np.float32)
     if key.ndim == 2:
         key = key[:, :, None]
     return _core.graph_segments(np.ascontiguousarray(key, np.float32), float(k), int(min_size))
+
+
+def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
+    """The Gaussian blur :func:`segments` starts with: uint8 in (other types clipped to 0-255),
+    uint8 out (OpenCV rounds the blurred values, as the reference does)."""
+    import cv2
+
+    u8 = im if im.dtype == np.uint8 else np.clip(im.astype(np.float32), 0, 255).astype(np.uint8)
+    return np.asarray(cv2.GaussianBlur(u8, (0, 0), blur), np.uint8)
 
 
 def plane_fill(
@@ -198,22 +202,24 @@ def fill_planes(
         raise ValueError(f"image: expected {d.shape} pixels like disp, got {im.shape[:2]}")
     if any(int(step) < 1 for step, _ in passes):
         raise ValueError(f"passes: every step must be >= 1, got {passes}")
+    if blur > 0 and (~np.isfinite(d)).any():
+        im = _blurred(im, blur)  # once for every pass and binning
     for step, min_pixels in passes:
-        d = _fill_pass(d, im, int(step), int(min_pixels), blur, max_residual)
+        d = _fill_pass(d, im, int(step), int(min_pixels), max_residual)
     return d
 
 
 def _fill_pass(
-    d: F32, im: npt.NDArray[Any], step: int, min_pixels: int, blur: float, max_residual: float
+    d: F32, im: npt.NDArray[Any], step: int, min_pixels: int, max_residual: float
 ) -> F32:
-    """One pass of :func:`fill_planes`."""
+    """One pass of :func:`fill_planes` on the blurred image ``im``."""
     ok = np.isfinite(d)
     if not ok.any() or ok.all():
         return d.copy()
     lo, hi = float(d[ok].min()), float(d[ok].max())
 
     def one(offset: int) -> F32:
-        lab = segments(im, blur=blur, step=step, offset=offset)
+        lab = segments(im, blur=0, step=step, offset=offset)
         return plane_fill(d, lab, min_pixels=min_pixels, max_residual=max_residual, lo=lo, hi=hi)
 
     # The two quantisations on the two cores (the kernels release the GIL).

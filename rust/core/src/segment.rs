@@ -80,23 +80,6 @@ pub fn graph_segments(
         }
         s.sqrt()
     };
-    if k == 0.0 && min_size <= 1 {
-        // Only zero-weight edges merge (the threshold stays 0), whatever their order: the same
-        // labels without the sort, 5-10x faster.
-        let mut f = Forest::new(n, k);
-        for p in 0..n {
-            for q in [p + 1, p + w] {
-                let inside = if q == p + 1 { p % w + 1 < w } else { q < n };
-                if inside && dist(p, q) == 0.0 {
-                    let (a, b) = (f.find(p as u32), f.find(q as u32));
-                    if a != b {
-                        f.join(a, b);
-                    }
-                }
-            }
-        }
-        return raster_labels(&mut f, n);
-    }
     // Edge e: 2 * pixel (to the right), 2 * pixel + 1 (downwards). The key sorts by weight
     // (a non-negative f32's bits order like the value), then by edge index: a total order, so
     // the unstable parallel sort is deterministic.
@@ -434,16 +417,16 @@ mod tests {
     }
 
     #[test]
-    fn equal_value_regions_need_no_sort() {
-        // k = 0 with min_size 1 takes the union-find shortcut; min_size 2 the sorted path, which
-        // merges the same zero-weight edges here (no region is a single pixel).
+    fn k_zero_merges_the_equal_value_regions() {
+        // k = 0 merges exactly the zero-weight edges; min_size 2 changes nothing here (no region
+        // is a single pixel).
         let (w, h) = (9, 7);
         let img: Vec<f32> = (0..w * h)
             .map(|p| ((p % w) / 3 + 3 * ((p / w) / 2)) as f32)
             .collect();
-        let fast = graph_segments(&img, w, h, 1, 0.0, 1);
-        assert_eq!(fast, graph_segments(&img, w, h, 1, 0.0, 2));
-        assert_eq!(*fast.iter().max().unwrap(), 11); // 3 columns x 4 row bands
+        let one = graph_segments(&img, w, h, 1, 0.0, 1);
+        assert_eq!(one, graph_segments(&img, w, h, 1, 0.0, 2));
+        assert_eq!(*one.iter().max().unwrap(), 11); // 3 columns x 4 row bands
     }
 
     #[test]

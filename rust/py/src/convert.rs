@@ -53,6 +53,20 @@ pub fn image_to_numpy<'py>(py: Python<'py>, img: Image) -> PyResult<Bound<'py, P
     vec_to_numpy(py, (img.height, img.width), img.data)
 }
 
+/// A copy of a 2-D float32 map changed by `kernel(data, w, h)` with the GIL released, and what
+/// the kernel returned: the bindings of the kernels that work on a map in place.
+pub fn map_copy_in_place<'py, R: Send>(
+    py: Python<'py>,
+    map: &PyReadonlyArray2<'py, f32>,
+    kernel: impl FnOnce(&mut [f32], usize, usize) -> R + Send,
+) -> PyResult<(Bound<'py, PyArray2<f32>>, R)> {
+    let a = map.as_array();
+    let (h, w) = a.dim();
+    let mut d: Vec<f32> = a.iter().copied().collect();
+    let r = py.detach(|| kernel(&mut d, w, h));
+    Ok((vec_to_numpy(py, (h, w), d)?, r))
+}
+
 /// Moves a row-major vector into a new `(rows, cols)` NumPy array without copying.
 pub fn vec_to_numpy<'py, T: numpy::Element>(
     py: Python<'py>,

@@ -261,16 +261,6 @@ pub fn gabor_remove_speckles<'py>(
     max_diff: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     crate::params::non_negative("max_diff", max_diff)?;
-    let a = disp.as_array();
-    let (h, w) = a.dim();
-    let mut d: Vec<f32> = a.iter().copied().collect();
-    py.detach(|| remove_speckles(&mut d, w, h, min_size, max_diff));
-    image_to_numpy(
-        py,
-        Image {
-            width: w,
-            height: h,
-            data: d,
-        },
-    )
+    let kernel = |d: &mut [f32], w, h| remove_speckles(d, w, h, min_size, max_diff);
+    Ok(crate::convert::map_copy_in_place(py, &disp, kernel)?.0)
 }

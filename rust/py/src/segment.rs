@@ -7,9 +7,8 @@ use stereovision_core::segment::{
     graph_segments as core_segments, plane_fill as core_plane_fill,
     quantised_regions as core_regions,
 };
-use stereovision_core::Image;
 
-use crate::convert::{image_to_numpy, vec_to_numpy};
+use crate::convert::{map_copy_in_place, vec_to_numpy};
 use crate::errors::guard;
 use crate::params::non_negative;
 
@@ -71,7 +70,6 @@ pub fn plane_fill<'py>(
             "lo and hi: expected numbers, got {lo}, {hi}"
         )));
     }
-    let mut d: Vec<f32> = a.iter().copied().collect();
     let l: Vec<u32> = labels.as_array().iter().copied().collect();
     // The kernel sizes its tables by the largest label: one per pixel at most.
     if l.iter().any(|&v| v as usize >= h * w) {
@@ -80,27 +78,12 @@ pub fn plane_fill<'py>(
             h * w
         )));
     }
-    let s = py.detach(|| {
+    let (out, s) = map_copy_in_place(py, &disp, |d, w, _| {
         guard("plane_fill", || {
-            Ok(core_plane_fill(
-                &mut d,
-                &l,
-                w,
-                min_pixels,
-                max_residual,
-                lo,
-                hi,
-            ))
+            Ok(core_plane_fill(d, &l, w, min_pixels, max_residual, lo, hi))
         })
     })?;
-    let out = image_to_numpy(
-        py,
-        Image {
-            width: w,
-            height: h,
-            data: d,
-        },
-    )?;
+    let s = s?;
     Ok((out, s.planes, s.filled))
 }
 
