@@ -26,6 +26,7 @@ from stereovision.matching.fusion import (
 )
 from stereovision.matching.gabor import gabor_disparity
 from stereovision.matching.hopfield import hopfield_match
+from tests.reference import edges_ref
 
 H, W = 20, 30
 
@@ -403,6 +404,44 @@ def test_edge_check_drops_members_on_fattened_edges(data_dir: Path) -> None:
     assert 0.97 * p_off.count < p_on.count < p_off.count
     keys = [set(zip(r.matches.xl.tolist(), r.matches.yl.tolist(), strict=True)) for r in (on, off)]
     assert keys[0] < keys[1]
+
+
+@pytest.mark.parametrize("scene", ["middlebury2003/cones", "kitti2015/000005_10"])
+@pytest.mark.parametrize(("radius", "ratio", "jump"), [(3, 2.0, 2.0), (7, 1.5, 2.0)])
+def test_fattened_kernel_equals_numpy_reference(
+    data_dir: Path, scene: str, radius: int, ratio: float, jump: float
+) -> None:
+    """The edge kernel (``_core.fattened``, fused_dense's step 7 and fuse_pair's member check)
+    against tests/reference/edges_ref.py on SGBM-3WAY's real maps, holes included, with the
+    settings both callers use."""
+    from stereovision import _core
+
+    s = load_scene(data_dir / scene)
+    d = opencv_sgbm(s.left, s.right, s.max_disparity)
+    g = as_gray_float(s.left, "left")
+    got = _core.fattened(d, g, radius, ratio, jump)
+    want = edges_ref.fattened(d, g, radius, ratio, jump)
+    assert got.dtype == np.bool_ and got.shape == d.shape
+    np.testing.assert_array_equal(got, want)
+    assert 100 < int(got.sum()) < 0.2 * got.size  # a real test: edges found, not everything
+
+
+def test_fattened_kernel_small_and_bad_input() -> None:
+    """Maps under 3 pixels along one axis are checked along the other only; shapes that differ
+    and negative thresholds are ValueErrors."""
+    from stereovision import _core
+
+    col = np.array([[1.0], [1.0], [1.0], [9.0], [9.0], [9.0], [9.0], [9.0]], np.float32)
+    g = np.array([[0.2]] * 6 + [[0.8]] * 2, np.float32)
+    got = _core.fattened(col, g, 3, 2.0, 2.0)
+    np.testing.assert_array_equal(got, edges_ref.fattened(col, g, 3, 2.0, 2.0))
+    assert got[:, 0].tolist() == [False] * 3 + [True] * 3 + [False] * 2
+    with pytest.raises(ValueError, match="guide"):
+        _core.fattened(col, g[:4], 3, 2.0, 2.0)
+    with pytest.raises(ValueError, match="ratio"):
+        _core.fattened(col, g, 3, -1.0, 2.0)
+    with pytest.raises(ValueError, match="jump"):
+        _core.fattened(col, g, 3, 2.0, float("nan"))
 
 
 def test_fused_dense_drops_speckles() -> None:

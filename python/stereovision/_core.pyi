@@ -144,9 +144,31 @@ def plane_fill(
 ) -> tuple[npt.NDArray[np.float32], int, int]:
     """Holes filled by their segment's plane; ``(filled, planes used, holes filled)``."""
 
+def fill_planes(
+    disp: npt.NDArray[np.float32],
+    image: npt.NDArray[np.uint8],
+    passes: list[tuple[int, int]],
+    max_residual: float,
+) -> npt.NDArray[np.float32]:
+    """``planes.fill_planes``'s passes ``(step, min_pixels)`` on the blurred ``(H, W, C)`` image:
+    per pass two cuts (offsets 0 and ``step // 2``), their planes, the mean where both fill.
+    ``ValueError``: an image of another size or C outside 1-3, a step outside 1-255."""
+
 def row_fill(disp: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
     """A copy with each hole (non-finite) given the smaller of the nearest valid values left and
     right of it in its row (one side only: that one; none: NaN)."""
+
+def fattened(
+    disp: npt.NDArray[np.float32],
+    guide: npt.NDArray[np.float32],
+    radius: int,
+    ratio: float,
+    jump: float,
+) -> npt.NDArray[np.bool_]:
+    """The pixels between a disparity jump (> ``jump``, on the row-filled map) and the strongest
+    step of ``guide`` within ``radius`` on its background side, if that step is ``ratio`` times
+    the one at the jump; along rows and along columns. ``ValueError``: shapes differ, or a
+    negative ``ratio`` / ``jump``."""
 
 # --- Triangulation (rust/py/src/triangulation.rs) ------------------------------------------------
 

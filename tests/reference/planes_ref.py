@@ -7,9 +7,12 @@ centred on the measured pixels' mean, re-fitted twice on the pixels within
 ``max(1, 2 * median residual)``; the holes take the plane when the last median residual is at
 most ``max_residual`` and the value lies in ``[lo, hi]``. (NumPy's ``lstsq`` solves what the
 kernel's 3x3 normal equations solve, in another order: values agree to float rounding.)
+``fill_planes``: the passes and the two cuts of each, with the kernels given.
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
 
 import numpy as np
 import numpy.typing as npt
@@ -107,3 +110,32 @@ def plane_fill(
 def _median(r: np.ndarray) -> float:
     """The kernel's median: the element at index n // 2 of the sorted values (the upper one)."""
     return float(np.sort(r)[len(r) // 2])
+
+
+def fill_planes(
+    disp: npt.ArrayLike,
+    image_u8: np.ndarray,
+    passes: tuple[tuple[int, int], ...],
+    max_residual: float,
+    regions: Callable[[np.ndarray, int, int], np.ndarray],
+    fill: Callable[[np.ndarray, np.ndarray, int, float, float, float], np.ndarray],
+) -> np.ndarray:
+    """The passes of ``planes.fill_planes`` on the blurred ``(H, W, C)`` uint8 image, with the
+    region and plane kernels given (``regions(image, step, offset)`` -> labels,
+    ``fill(disp, labels, min_pixels, max_residual, lo, hi)`` -> filled copy): per pass two cuts
+    half a step apart, the mean where both fill."""
+    d = np.asarray(disp, np.float32).copy()
+    for step, min_pixels in passes:
+        ok = np.isfinite(d)
+        if not ok.any() or ok.all():
+            continue
+        lo, hi = float(d[ok].min()), float(d[ok].max())
+        a, b = (
+            fill(d, regions(image_u8, step, off), min_pixels, max_residual, lo, hi)
+            for off in (0, step // 2)
+        )
+        out = np.where(np.isfinite(a), a, b)
+        both = ~ok & np.isfinite(a) & np.isfinite(b)
+        out[both] = np.float32(0.5) * (a[both] + b[both])
+        d = out.astype(np.float32)
+    return d

@@ -749,39 +749,17 @@ def _finish(
 
 def _fattened(d: F32, guide: F32, radius: int, ratio: float, jump: float) -> npt.NDArray[np.bool_]:
     """Step 7's pixels: those between a jump and the stronger edge on its background side, along
-    the rows and along the columns of ``d``."""
-    rows = _fattened_rows(d, guide, radius, ratio, jump)
-    return rows | _fattened_rows(d.T, guide.T, radius, ratio, jump).T
+    the rows and along the columns of ``d`` (Rust kernel ``_core.fattened``; NumPy reference
+    ``tests/reference/edges_ref.py``)."""
+    from stereovision import _core
 
-
-def _fattened_rows(
-    d: F32, guide: F32, radius: int, ratio: float, jump: float
-) -> npt.NDArray[np.bool_]:
-    """:func:`_fattened` along the rows only (vectorised over all jumps)."""
-    from stereovision.baselines import row_fill
-
-    h, w = d.shape
-    if w < 3:
-        return np.zeros((h, w), bool)
-    # step[y, x]: the intensity step between x - 1 and x (0 at x = 0).
-    step = np.zeros((h, w), np.float32)
-    step[:, 1:] = np.abs(np.diff(guide, axis=1))
-    f = row_fill(d)
-    with np.errstate(invalid="ignore"):
-        ys, js = np.nonzero(np.abs(np.diff(f, axis=1)) > jump)
-    js = js + 1  # the jump lies between js - 1 and js
-    xs = np.clip(js[:, None] + np.arange(-radius, radius + 1)[None, :], 1, w - 1)
-    e = xs[np.arange(len(js)), np.argmax(step[ys[:, None], xs], axis=1)]
-    strong = step[ys, e] >= ratio * step[ys, js]
-    fg_right = f[ys, js] > f[ys, js - 1]
-    # Foreground on the right carried leftwards: [j, e) with e > j; on the left: [e, j), e < j.
-    lo = np.where(fg_right, js, e)
-    hi = np.where(fg_right, e, js)
-    keep = strong & (hi > lo)
-    marks = np.zeros(h * w + 1, np.int32)
-    np.add.at(marks, ys[keep] * w + lo[keep], 1)
-    np.add.at(marks, ys[keep] * w + hi[keep], -1)
-    return (np.cumsum(marks[:-1]) > 0).reshape(h, w)
+    return _core.fattened(
+        np.ascontiguousarray(d, np.float32),
+        np.ascontiguousarray(guide, np.float32),
+        int(radius),
+        float(ratio),
+        float(jump),
+    )
 
 
 def _drop_speckles(

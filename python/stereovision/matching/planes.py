@@ -17,12 +17,13 @@ first left, and the holes no plane fills get the row fill. On the 17 GT scenes t
 (row fill alone) to 0.555 with the first pass and 0.527 with both (README, "Fusion").
 
 The kernels are Rust (:func:`stereovision._core.graph_segments`,
-:func:`stereovision._core.plane_fill`; NumPy reference ``tests/reference/planes_ref.py``).
+:func:`stereovision._core.plane_fill`, and :func:`stereovision._core.fill_planes`, which runs
+the passes with the two cuts of each on the two cores; NumPy reference
+``tests/reference/planes_ref.py``).
 """
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 import numpy as np
@@ -105,10 +106,12 @@ def segments(
 
 def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
     """The Gaussian blur :func:`segments` starts with: uint8 in (other types clipped to 0-255),
-    uint8 out (OpenCV rounds the blurred values, as the reference does)."""
+    uint8 out (OpenCV rounds the blurred values, as the reference does); ``blur`` 0: none."""
     import cv2
 
     u8 = im if im.dtype == np.uint8 else np.clip(im.astype(np.float32), 0, 255).astype(np.uint8)
+    if blur <= 0:
+        return u8
     return np.asarray(cv2.GaussianBlur(u8, (0, 0), blur), np.uint8)
 
 
@@ -178,9 +181,10 @@ def fill_planes(
     disp : array_like
         ``(H, W)`` disparity, NaN = hole.
     image : array_like
-        The left image, ``(H, W)`` or ``(H, W, C)``, 0-255.
+        The left image, ``(H, W)`` or ``(H, W, C)`` with 1-3 channels, 0-255 (uint8; other
+        types are clipped to 0-255 and truncated).
     passes : tuple of (int, int)
-        ``(step, min_pixels)`` per pass, in order.
+        ``(step, min_pixels)`` per pass, in order; steps in 1-255.
     blur, max_residual : float
         Gaussian sigma (px) before the quantisation; the largest median absolute residual (px)
         of an accepted plane.
@@ -194,38 +198,22 @@ def fill_planes(
     Raises
     ------
     ValueError
-        An image of another size, or a pass with ``step < 1``.
+        An image of another size or with more than 3 channels, or a step outside 1-255.
     """
+    from stereovision import _core
+
     d = np.ascontiguousarray(disp, dtype=np.float32)
     im = np.asarray(image)
     if im.shape[:2] != d.shape:
         raise ValueError(f"image: expected {d.shape} pixels like disp, got {im.shape[:2]}")
+    if im.ndim == 3 and not 1 <= im.shape[2] <= 3:
+        raise ValueError(f"image: expected 1-3 channels, got {im.shape[2]}")
     if any(int(step) < 1 for step, _ in passes):
         raise ValueError(f"passes: every step must be >= 1, got {passes}")
-    if blur > 0 and (~np.isfinite(d)).any():
-        im = _blurred(im, blur)  # once for every pass and binning
-    for step, min_pixels in passes:
-        d = _fill_pass(d, im, int(step), int(min_pixels), max_residual)
-    return d
-
-
-def _fill_pass(
-    d: F32, im: npt.NDArray[Any], step: int, min_pixels: int, max_residual: float
-) -> F32:
-    """One pass of :func:`fill_planes` on the blurred image ``im``."""
-    ok = np.isfinite(d)
-    if not ok.any() or ok.all():
+    if np.isfinite(d).all():
         return d.copy()
-    lo, hi = float(d[ok].min()), float(d[ok].max())
-
-    def one(offset: int) -> F32:
-        lab = segments(im, blur=0, step=step, offset=offset)
-        return plane_fill(d, lab, min_pixels=min_pixels, max_residual=max_residual, lo=lo, hi=hi)
-
-    # The two quantisations on the two cores (the kernels release the GIL).
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        a, b = pool.map(one, (0, step // 2))
-    out = np.where(np.isfinite(a), a, b)
-    both = ~ok & np.isfinite(a) & np.isfinite(b)
-    out[both] = 0.5 * (a[both] + b[both])
-    return out.astype(np.float32)
+    # Blurred once for every pass and binning (uint8: other types clipped to 0-255).
+    im = _blurred(im, blur)
+    u8 = np.ascontiguousarray(im[:, :, None] if im.ndim == 2 else im)
+    steps = [(int(step), int(min_pixels)) for step, min_pixels in passes]
+    return _core.fill_planes(d, u8, steps, float(max_residual))

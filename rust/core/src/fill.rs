@@ -18,7 +18,7 @@ pub fn row_fill(disp: &mut [f32], w: usize) {
 }
 
 /// One row; `left` is scratch of the row's length.
-fn fill_row(row: &mut [f32], left: &mut [f32]) {
+pub(crate) fn fill_row(row: &mut [f32], left: &mut [f32]) {
     let mut last = f32::NAN;
     for (v, l) in row.iter().zip(left.iter_mut()) {
         if v.is_finite() {

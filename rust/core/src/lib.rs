@@ -7,6 +7,7 @@
 //! * [`matching`]: the correspondence channels (`gabor`, `mcgm`, `hopfield`);
 //! * [`refine`]: sub-pixel refinement and validated completion of a disparity map;
 //! * [`fill`]: the evaluation's reference row fill of a map's holes;
+//! * [`edges`]: foreground fattened past depth edges (the fused dense map's edge step);
 //! * [`triangulation`]: depth and its uncertainty from a rectified disparity map.
 //!
 //! Conventions (algorithms.md section 0): images are `f32` in `[0, 1]`, row-major `(H, W)`;
@@ -14,6 +15,7 @@
 //! `NaN` = no estimate.
 
 pub mod alloc;
+pub mod edges;
 pub mod error;
 pub mod fill;
 pub mod image;

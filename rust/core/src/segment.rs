@@ -306,9 +306,10 @@ pub fn plane_fill(
         at[l as usize] += 1;
     }
     let src: &[f32] = disp;
+    // Most segments fill nothing: one vector per task, not one per segment.
     let fills: Vec<(u32, f32)> = (0..n_seg)
         .into_par_iter()
-        .flat_map_iter(|s| {
+        .fold(Vec::new, |mut acc, s| {
             segment_fill(
                 src,
                 &order[start[s]..start[s + 1]],
@@ -317,9 +318,14 @@ pub fn plane_fill(
                 max_residual,
                 lo,
                 hi,
-            )
+                &mut acc,
+            );
+            acc
         })
-        .collect();
+        .reduce(Vec::new, |mut a, mut b| {
+            a.append(&mut b);
+            a
+        });
     let mut planes = 0;
     let mut last = u32::MAX;
     for &(p, v) in &fills {
@@ -336,7 +342,8 @@ pub fn plane_fill(
     }
 }
 
-/// The holes of one segment (`pix`, raster order) and their plane values.
+/// The holes of one segment (`pix`, raster order) and their plane values, appended to `out`.
+#[allow(clippy::too_many_arguments)]
 fn segment_fill(
     disp: &[f32],
     pix: &[u32],
@@ -345,14 +352,15 @@ fn segment_fill(
     max_residual: f32,
     lo: f32,
     hi: f32,
-) -> Vec<(u32, f32)> {
+    out: &mut Vec<(u32, f32)>,
+) {
     // Most segments are small: count before collecting anything.
     let n_meas = pix
         .iter()
         .filter(|&&p| disp[p as usize].is_finite())
         .count();
     if n_meas == pix.len() || n_meas < min_pixels.max(3) {
-        return Vec::new();
+        return;
     }
     let holes: Vec<u32> = pix
         .iter()
@@ -377,7 +385,7 @@ fn segment_fill(
     let mut plane = [0.0f64; 3];
     for _ in 0..3 {
         let Some(c) = fit_plane(&pts, &keep, cx, cy) else {
-            return Vec::new();
+            return;
         };
         plane = c;
         for (r, &(x, y, d)) in res.iter_mut().zip(&pts) {
@@ -390,16 +398,65 @@ fn segment_fill(
         }
     }
     if median(&mut res) > max_residual {
-        return Vec::new();
+        return;
     }
-    holes
-        .into_iter()
-        .filter_map(|p| {
-            let (x, y) = ((p as usize % w) as f64, (p as usize / w) as f64);
-            let v = (plane[0] * (x - cx) + plane[1] * (y - cy) + plane[2]) as f32;
-            (v >= lo && v <= hi).then_some((p, v))
-        })
-        .collect()
+    out.extend(holes.into_iter().filter_map(|p| {
+        let (x, y) = ((p as usize % w) as f64, (p as usize / w) as f64);
+        let v = (plane[0] * (x - cx) + plane[1] * (y - cy) + plane[2]) as f32;
+        (v >= lo && v <= hi).then_some((p, v))
+    }));
+}
+
+/// One pass of [`fill_planes`]: `(step, min_pixels)`.
+pub type PlanePass = (u32, usize);
+
+/// The fused dense map's plane fill (`stereovision.matching.planes.fill_planes`), in place on a
+/// row-major `(H, W)` map with its (already blurred) `(H, W, C)` u8 image. Each pass cuts the
+/// image twice, binned in steps of `step` grey levels at offsets 0 and `step / 2`
+/// ([`quantised_regions`]), fills each cut's holes with [`plane_fill`] (planes within the
+/// measured range), and takes the mean where both filled a hole; the next pass sees those fills
+/// as measured. A pass on a map with no hole or no measured value leaves it. The two cuts run
+/// side by side; each is computed as alone, so the result does not depend on the thread count.
+///
+/// # Panics
+/// As [`quantised_regions`] (image size, `c`, `step`) and [`plane_fill`].
+pub fn fill_planes(
+    disp: &mut [f32],
+    img: &[u8],
+    w: usize,
+    c: usize,
+    passes: &[PlanePass],
+    max_residual: f32,
+) {
+    let h = disp.len().checked_div(w).unwrap_or(0);
+    for &(step, min_pixels) in passes {
+        let (mut lo, mut hi, mut holes) = (f32::INFINITY, f32::NEG_INFINITY, false);
+        for &v in disp.iter() {
+            if v.is_finite() {
+                lo = lo.min(v);
+                hi = hi.max(v);
+            } else {
+                holes = true;
+            }
+        }
+        if !holes || lo > hi {
+            continue; // nothing to fill, or nothing to fit
+        }
+        let cut = |offset: u32| {
+            let labels = quantised_regions(img, w, h, c, step, offset);
+            let mut out = disp.to_vec();
+            plane_fill(&mut out, &labels, w, min_pixels, max_residual, lo, hi);
+            out
+        };
+        let (a, b) = rayon::join(|| cut(0), || cut(step / 2));
+        for ((d, &a), &b) in disp.iter_mut().zip(&a).zip(&b) {
+            let hole = !d.is_finite();
+            *d = if a.is_finite() { a } else { b };
+            if hole && a.is_finite() && b.is_finite() {
+                *d = 0.5 * (a + b);
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -520,5 +577,39 @@ mod tests {
             1
         );
         assert_eq!(flat[0], 3.0);
+    }
+
+    #[test]
+    fn fill_planes_takes_the_mean_of_the_two_cuts() {
+        // Two columns of grey: 20 on the left half, 30 on the right. At step 16 the cut at
+        // offset 0 joins them (bins 1 and 1), the cut at offset 8 parts them (bins 1 and 2).
+        // Left half at disparity 4, right half at 8: the joined segment's plane is no fit
+        // (median residual 2), so each hole takes its own half's plane from the parting cut.
+        let (w, h) = (10, 10);
+        let img: Vec<u8> = (0..w * h)
+            .map(|p| if p % w < 5 { 20 } else { 30 })
+            .collect();
+        let mut d: Vec<f32> = (0..w * h)
+            .map(|p| if p % w < 5 { 4.0 } else { 8.0 })
+            .collect();
+        for p in [22, 77] {
+            d[p] = f32::NAN;
+        }
+        let mut one = d.clone();
+        fill_planes(&mut one, &img, w, 1, &[(16, 10)], 0.5);
+        assert_eq!((one[22], one[77]), (4.0, 8.0));
+        // Where both cuts fill, the mean: one colour, one plane each way.
+        let flat = vec![20u8; w * h];
+        let mut e: Vec<f32> = (0..w * h).map(|p| 2.0 + 0.5 * (p % w) as f32).collect();
+        e[44] = f32::NAN;
+        fill_planes(&mut e, &flat, w, 1, &[(16, 10)], 0.5);
+        assert!((e[44] - 4.0).abs() < 1e-5, "{}", e[44]);
+        // No hole, or nothing measured: unchanged.
+        let mut full = vec![1.0f32; w * h];
+        fill_planes(&mut full, &img, w, 1, &[(16, 10)], 0.5);
+        assert!(full.iter().all(|&v| v == 1.0));
+        let mut empty = vec![f32::NAN; w * h];
+        fill_planes(&mut empty, &img, w, 1, &[(16, 10)], 0.5);
+        assert!(empty.iter().all(|v| v.is_nan()));
     }
 }

@@ -1,8 +1,12 @@
-//! Binding of `stereovision_core::fill`.
+//! Binding of `stereovision_core::fill` and `stereovision_core::edges`.
 
-use crate::convert::map_copy_in_place;
+use crate::convert::{map_copy_in_place, vec_to_numpy};
+use crate::errors::guard;
+use crate::params::non_negative;
 use numpy::{PyArray2, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use stereovision_core::edges::{fattened as core_fattened, FattenParams};
 use stereovision_core::fill::row_fill as core_row_fill;
 
 /// A copy of `disp` with its holes filled by the reference row rule (module docs of the core).
@@ -12,4 +16,42 @@ pub fn row_fill<'py>(
     disp: PyReadonlyArray2<'py, f32>,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     Ok(map_copy_in_place(py, &disp, |d, w, _| core_row_fill(d, w))?.0)
+}
+
+/// The pixels of `disp` a matcher carried past an edge of `guide` (`(H, W)` bool; core docs).
+#[pyfunction]
+#[pyo3(signature = (disp, guide, radius, ratio, jump))]
+pub fn fattened<'py>(
+    py: Python<'py>,
+    disp: PyReadonlyArray2<'py, f32>,
+    guide: PyReadonlyArray2<'py, f32>,
+    radius: usize,
+    ratio: f32,
+    jump: f32,
+) -> PyResult<Bound<'py, PyArray2<bool>>> {
+    non_negative("ratio", ratio)?;
+    non_negative("jump", jump)?;
+    let (h, w) = disp.as_array().dim();
+    if guide.as_array().dim() != (h, w) {
+        return Err(PyValueError::new_err(format!(
+            "guide: expected shape ({h}, {w}) like disp, got {:?}",
+            guide.as_array().dim()
+        )));
+    }
+    let (d, g) = (contiguous(&disp), contiguous(&guide));
+    let p = FattenParams {
+        radius,
+        ratio,
+        jump,
+    };
+    let mask = py.detach(|| guard("fattened", || Ok(core_fattened(&d, &g, w, h, &p))))?;
+    vec_to_numpy(py, (h, w), mask)
+}
+
+/// The array's row-major values: borrowed when C-contiguous, else copied.
+fn contiguous<'a>(a: &'a PyReadonlyArray2<'_, f32>) -> std::borrow::Cow<'a, [f32]> {
+    match a.as_slice() {
+        Ok(s) => std::borrow::Cow::Borrowed(s),
+        Err(_) => std::borrow::Cow::Owned(a.as_array().iter().copied().collect()),
+    }
 }

@@ -60,8 +60,10 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(refine::refine_disparity, m)?)?;
     m.add_function(wrap_pyfunction!(sgm::sgm_disparity, m)?)?;
     m.add_function(wrap_pyfunction!(fill::row_fill, m)?)?;
+    m.add_function(wrap_pyfunction!(fill::fattened, m)?)?;
     m.add_function(wrap_pyfunction!(segment::graph_segments, m)?)?;
     m.add_function(wrap_pyfunction!(segment::plane_fill, m)?)?;
+    m.add_function(wrap_pyfunction!(segment::fill_planes, m)?)?;
     m.add_function(wrap_pyfunction!(segment::quantised_regions, m)?)?;
     m.add_function(wrap_pyfunction!(convert::gray_u8, m)?)?;
     m.add_function(wrap_pyfunction!(release_memory, m)?)?;

@@ -4,8 +4,8 @@ use numpy::{PyArray2, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods}
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use stereovision_core::segment::{
-    graph_segments as core_segments, plane_fill as core_plane_fill,
-    quantised_regions as core_regions,
+    fill_planes as core_fill_planes, graph_segments as core_segments,
+    plane_fill as core_plane_fill, quantised_regions as core_regions,
 };
 
 use crate::convert::{map_copy_in_place, vec_to_numpy};
@@ -115,4 +115,40 @@ pub fn quantised_regions<'py>(
         })
     })?;
     vec_to_numpy(py, (h, w), labels)
+}
+
+/// A copy of `disp` with the plane fill's passes run (core `fill_planes`) on the already
+/// blurred `(H, W, C)` uint8 image.
+#[pyfunction]
+#[pyo3(signature = (disp, image, passes, max_residual))]
+pub fn fill_planes<'py>(
+    py: Python<'py>,
+    disp: PyReadonlyArray2<'py, f32>,
+    image: PyReadonlyArray3<'py, u8>,
+    passes: Vec<(u32, usize)>,
+    max_residual: f32,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let (h, w, c) = (image.shape()[0], image.shape()[1], image.shape()[2]);
+    if disp.as_array().dim() != (h, w) || !(1..=3).contains(&c) {
+        return Err(PyValueError::new_err(format!(
+            "image: expected (H, W, C) with C in 1-3 and (H, W) = {:?} like disp, got \
+             ({h}, {w}, {c})",
+            disp.as_array().dim()
+        )));
+    }
+    if let Some(&(step, _)) = passes.iter().find(|(s, _)| *s == 0 || *s > 255) {
+        return Err(PyValueError::new_err(format!(
+            "passes: every step must be in 1-255, got {step}"
+        )));
+    }
+    non_negative("max_residual", max_residual)?;
+    let img: Vec<u8> = image.as_array().iter().copied().collect();
+    let (out, done) = map_copy_in_place(py, &disp, |d, w, _| {
+        guard("fill_planes", || {
+            core_fill_planes(d, &img, w, c, &passes, max_residual);
+            Ok(())
+        })
+    })?;
+    done?;
+    Ok(out)
 }

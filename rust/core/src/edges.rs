@@ -1,0 +1,184 @@
+//! Foreground fattening at depth edges: the pixels a window matcher carried past an object's
+//! outline (the fused dense map's step 7 and the members' edge check; NumPy reference:
+//! `tests/reference/edges_ref.py`, bit-identical).
+//!
+//! Along each row, and along each column, a disparity jump of more than `jump` between
+//! neighbours of the row-filled map (so across holes too) looks `radius` pixels either side for
+//! the strongest intensity step of the guide image (the first of equal ones). If that step is at
+//! least `ratio` times the step at the jump and lies on the background side, the pixels from the
+//! jump up to it, on the foreground's side, are marked: the outline is there, and what lies
+//! between is background that took the foreground's disparity.
+
+use rayon::prelude::*;
+
+use crate::fill::fill_row;
+
+/// Thresholds of [`fattened`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FattenParams {
+    /// Columns (rows) searched either side of a jump for the image's edge.
+    pub radius: usize,
+    /// How much stronger than the step at the jump the image's edge must be.
+    pub ratio: f32,
+    /// Smallest disparity difference between neighbours that is a jump (px).
+    pub jump: f32,
+}
+
+/// The fattened pixels of a row-major `(h, w)` disparity map `d` (NaN = hole) with the grey
+/// `guide` image of the same size: marked along the rows or along the columns (module docs).
+/// Rows (and columns) run in parallel, each independent of the others.
+pub fn fattened(d: &[f32], guide: &[f32], w: usize, h: usize, p: &FattenParams) -> Vec<bool> {
+    assert_eq!(d.len(), w * h, "d must hold w * h values");
+    assert_eq!(guide.len(), w * h, "guide must hold w * h values");
+    let mut out = vec![false; w * h];
+    if w == 0 || h == 0 {
+        return out;
+    }
+    mark_rows(d, guide, w, p, &mut out);
+    // The columns: the same rule on the transposed map, marks transposed back.
+    let (dt, gt) = (transpose(d, w, h), transpose(guide, w, h));
+    let mut cols = vec![false; w * h];
+    mark_rows(&dt, &gt, h, p, &mut cols);
+    for (o, c) in out.iter_mut().zip(transpose(&cols, h, w)) {
+        *o |= c;
+    }
+    out
+}
+
+/// The `(w, h)` transpose of a row-major `(h, w)` map: bands of `TILE` output rows (input
+/// columns) in parallel, each read row by row, so both sides stay in the cache.
+fn transpose<T: Copy + Default + Send + Sync>(a: &[T], w: usize, h: usize) -> Vec<T> {
+    const TILE: usize = 32;
+    let mut t = vec![T::default(); w * h];
+    t.par_chunks_mut(TILE * h)
+        .enumerate()
+        .for_each(|(b, band)| {
+            let x0 = b * TILE;
+            let n = band.len() / h;
+            for (y, row) in a.chunks_exact(w).enumerate() {
+                for (i, &v) in row[x0..x0 + n].iter().enumerate() {
+                    band[i * h + y] = v;
+                }
+            }
+        });
+    t
+}
+
+/// Marks the fattened pixels along the rows of width `w` into `out` (same layout).
+fn mark_rows(d: &[f32], guide: &[f32], w: usize, p: &FattenParams, out: &mut [bool]) {
+    if w < 3 {
+        return;
+    }
+    out.par_chunks_mut(w)
+        .zip(d.par_chunks(w).zip(guide.par_chunks(w)))
+        .for_each_init(
+            || {
+                (
+                    vec![0.0f32; w],
+                    vec![0.0f32; w],
+                    vec![0i32; w + 1],
+                    vec![0.0f32; w],
+                )
+            },
+            |(f, step, marks, scratch), (o, (dr, gr))| {
+                mark_row(dr, gr, p, f, step, marks, scratch, o)
+            },
+        );
+}
+
+/// One row: `f`, `step`, `marks` and `scratch` are buffers of the row's length (`marks` one
+/// more).
+#[allow(clippy::too_many_arguments)]
+fn mark_row(
+    d: &[f32],
+    g: &[f32],
+    p: &FattenParams,
+    f: &mut [f32],
+    step: &mut [f32],
+    marks: &mut [i32],
+    scratch: &mut [f32],
+    out: &mut [bool],
+) {
+    let w = d.len();
+    f.copy_from_slice(d);
+    fill_row(f, scratch);
+    // step[x]: the intensity step between x - 1 and x (0 at x = 0).
+    step[0] = 0.0;
+    for x in 1..w {
+        step[x] = (g[x] - g[x - 1]).abs();
+    }
+    marks.fill(0);
+    let r = p.radius as isize;
+    for j in 1..w {
+        // NaN (a row with no value) is no jump.
+        let is_jump = (f[j] - f[j - 1]).abs() > p.jump;
+        if !is_jump {
+            continue;
+        }
+        // The strongest step within the radius (columns clipped to [1, w - 1]; the first of
+        // equal ones).
+        let mut e = (j as isize - r).clamp(1, w as isize - 1) as usize;
+        for t in -r..=r {
+            let x = (j as isize + t).clamp(1, w as isize - 1) as usize;
+            if step[x] > step[e] {
+                e = x;
+            }
+        }
+        let strong = step[e] >= p.ratio * step[j];
+        if !strong {
+            continue;
+        }
+        // Foreground on the right carried leftwards: [j, e) with e > j; on the left: [e, j).
+        let (lo, hi) = if f[j] > f[j - 1] { (j, e) } else { (e, j) };
+        if hi > lo {
+            marks[lo] += 1;
+            marks[hi] -= 1;
+        }
+    }
+    let mut run = 0i32;
+    for (o, &m) in out.iter_mut().zip(marks.iter()) {
+        run += m;
+        *o = run > 0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const P: FattenParams = FattenParams {
+        radius: 3,
+        ratio: 2.0,
+        jump: 2.0,
+    };
+
+    #[test]
+    fn marks_the_foreground_carried_past_the_image_edge() {
+        // Background 1 on columns 0-5, foreground 9 from column 3 on (carried 3 px left); the
+        // image's edge lies between columns 5 and 6.
+        let w = 10;
+        let d: Vec<f32> = (0..w).map(|x| if x < 3 { 1.0 } else { 9.0 }).collect();
+        let g: Vec<f32> = (0..w).map(|x| if x < 6 { 0.2 } else { 0.8 }).collect();
+        let m = fattened(&d, &g, w, 1, &P);
+        let marked: Vec<usize> = (0..w).filter(|&x| m[x]).collect();
+        assert_eq!(marked, vec![3, 4, 5]);
+    }
+
+    #[test]
+    fn leaves_a_jump_on_the_image_edge_alone() {
+        let w = 10;
+        let d: Vec<f32> = (0..w).map(|x| if x < 6 { 1.0 } else { 9.0 }).collect();
+        let g: Vec<f32> = (0..w).map(|x| if x < 6 { 0.2 } else { 0.8 }).collect();
+        assert!(fattened(&d, &g, w, 1, &P).iter().all(|&m| !m));
+    }
+
+    #[test]
+    fn columns_are_checked_too() {
+        // The same profile down a column of a 1-wide map.
+        let h = 10;
+        let d: Vec<f32> = (0..h).map(|y| if y < 3 { 1.0 } else { 9.0 }).collect();
+        let g: Vec<f32> = (0..h).map(|y| if y < 6 { 0.2 } else { 0.8 }).collect();
+        let m = fattened(&d, &g, 1, h, &P);
+        assert_eq!((0..h).filter(|&y| m[y]).collect::<Vec<_>>(), vec![3, 4, 5]);
+    }
+}
