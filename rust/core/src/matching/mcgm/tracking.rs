@@ -265,7 +265,18 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
         }
     };
     let (mut fwd, mut bwd) = (Vec::new(), Vec::new());
-    for &key in &keys {
+    // Seeds lie anywhere in the image (strength order): ask for a later seed's cache lines
+    // now, so its state and neighbourhood are there when its turn comes (a hint only).
+    const AHEAD: usize = 8;
+    for (i, &key) in keys.iter().enumerate() {
+        if let Some(&next) = keys.get(i + AHEAD) {
+            let q = next as u32 as usize;
+            prefetch(&state, q);
+            prefetch(&zc.theta, q.saturating_sub(w));
+            prefetch(&zc.theta, q);
+            prefetch(&zc.theta, (q + w).min(n - 1));
+            prefetch(&zc.strength, q);
+        }
         let s = key as u32 as usize;
         if state[s] != FREE {
             continue;
