@@ -1,12 +1,14 @@
-//! Criterion bench of the fused map's plane fill: equal-colour segments (`k = 0`, and the
-//! quantised regions the fill uses), Felzenszwalb segments (`k = 300`) and the per-segment plane
-//! fits, at 640x480 on a synthetic image of quantised blocks and a slanted map with a hole every
-//! 5th pixel.
+//! Criterion bench of the fused map's plane fill and edge step: equal-colour segments (`k = 0`,
+//! and the quantised regions the fill uses), Felzenszwalb segments (`k = 300`), the per-segment
+//! plane fits, the whole fill (`fill_planes`: two passes of two cuts each) and the fattened-edge
+//! marks (`edges::fattened`), at 640x480 on a synthetic image of quantised blocks and a slanted
+//! map with a hole every 5th pixel (and a raised square for the edges).
 //! Throughput is pixels per second.
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
-use stereovision_core::segment::{graph_segments, plane_fill, quantised_regions};
+use stereovision_core::edges::{fattened, FattenParams};
+use stereovision_core::segment::{fill_planes, graph_segments, plane_fill, quantised_regions};
 
 fn bench_segment(c: &mut Criterion) {
     let (w, h) = (640usize, 480usize);
@@ -47,6 +49,44 @@ fn bench_segment(c: &mut Criterion) {
             let mut d = disp.clone();
             plane_fill(&mut d, &labels, w, 50, 1.0, 0.0, 100.0)
         })
+    });
+    g.bench_function("fill_planes", |b| {
+        b.iter(|| {
+            let mut d = disp.clone();
+            fill_planes(&mut d, &img_u8, w, 3, &[(16, 50), (24, 200)], 0.7);
+            d
+        })
+    });
+    // A square raised by 8 px whose left and top edges are carried 3 px past the image's.
+    let grey: Vec<f32> = (0..w * h)
+        .map(|p| {
+            let (x, y) = (p % w, p / w);
+            if (200..400).contains(&x) && (150..300).contains(&y) {
+                0.8
+            } else {
+                0.2 + 0.001 * (x % 7) as f32
+            }
+        })
+        .collect();
+    let raised: Vec<f32> = disp
+        .iter()
+        .enumerate()
+        .map(|(p, &v)| {
+            let (x, y) = (p % w, p / w);
+            if (197..400).contains(&x) && (147..300).contains(&y) {
+                v + 8.0
+            } else {
+                v
+            }
+        })
+        .collect();
+    let fp = FattenParams {
+        radius: 3,
+        ratio: 2.0,
+        jump: 2.0,
+    };
+    g.bench_function("fattened", |b| {
+        b.iter(|| fattened(&raised, &grey, w, h, &fp))
     });
     g.finish();
 }

@@ -383,6 +383,8 @@ fn segment_fill(
     let mut keep = vec![true; pts.len()];
     let mut res = vec![0.0f32; pts.len()];
     let mut plane = [0.0f64; 3];
+    let mut med = 0.0f32;
+    let mut scratch = vec![0.0f32; pts.len()];
     for _ in 0..3 {
         let Some(c) = fit_plane(&pts, &keep, cx, cy) else {
             return;
@@ -392,12 +394,15 @@ fn segment_fill(
             let e = c[0] * (x as f64 - cx) + c[1] * (y as f64 - cy) + c[2] - d as f64;
             *r = e.abs() as f32;
         }
-        let cut = (2.0 * median(&mut res.clone())).max(1.0);
+        scratch.copy_from_slice(&res);
+        med = median(&mut scratch);
+        let cut = (2.0 * med).max(1.0);
         for (k, &r) in keep.iter_mut().zip(&res) {
             *k = r < cut;
         }
     }
-    if median(&mut res) > max_residual {
+    // The last fit's median residual (the cut above used it too).
+    if med > max_residual {
         return;
     }
     out.extend(holes.into_iter().filter_map(|p| {
