@@ -385,7 +385,7 @@ def depth_map(
         disparities left and right of it, i.e. the background, which is what an occluded pixel
         shows). Over the 17 GT scenes the planes lower the mean bad-2.0 ratio to SGBM-3WAY +
         fill from 0.63 to 0.53 (``"fused"``) and from 1.44 to 1.18 (``"gabor"``); they cost
-        about 80 ms on a 900x750 frame. None (default) = the method's own choice: ``"fused"``
+        about 60 ms on a 900x750 frame. None (default) = the method's own choice: ``"fused"``
         returns a dense map (filled), ``"gabor"`` leaves a pixel it is not sure of NaN. Filled
         pixels keep confidence 0 and get no depth or 3-D point.
     refine : bool, optional
