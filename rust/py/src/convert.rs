@@ -1,10 +1,22 @@
 //! NumPy <-> core image conversion.
 
-use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::ndarray::{Array2, Dimension};
+use numpy::{IntoPyArray, PyArray2, PyReadonlyArray, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use stereovision_core::{Image, ImageView};
+
+/// The array's buffer when it is C-contiguous (row-major: what every kernel reads), else None.
+/// (`as_slice` alone also hands out a Fortran-ordered buffer, which holds the transpose.)
+pub fn c_slice<'a, T: numpy::Element, D: Dimension>(
+    a: &'a PyReadonlyArray<'_, T, D>,
+) -> Option<&'a [T]> {
+    if a.is_c_contiguous() {
+        a.as_slice().ok()
+    } else {
+        None
+    }
+}
 
 /// Copies a 2-D float32 array into a core [`Image`] (validated: non-empty, finite).
 pub fn image_from_numpy(arr: &PyReadonlyArray2<'_, f32>, what: &str) -> PyResult<Image> {
@@ -40,11 +52,11 @@ pub fn grey_from_numpy<'a>(
     what: &str,
 ) -> PyResult<GreyInput<'a>> {
     let (h, w) = arr.as_array().dim();
-    match arr.as_slice() {
-        Ok(s) => ImageView::new(w, h, s)
+    match c_slice(arr) {
+        Some(s) => ImageView::new(w, h, s)
             .map(GreyInput::View)
             .map_err(|e| PyValueError::new_err(format!("{what}: {e}"))),
-        Err(_) => image_from_numpy(arr, what).map(GreyInput::Owned),
+        None => image_from_numpy(arr, what).map(GreyInput::Owned),
     }
 }
 
@@ -93,8 +105,7 @@ pub fn map_and_confidence<'a>(
                 (h, w)
             )));
         }
-        a.as_slice()
-            .map_err(|_| PyValueError::new_err(format!("{name} must be C-contiguous")))
+        c_slice(a).ok_or_else(|| PyValueError::new_err(format!("{name} must be C-contiguous")))
     };
     Ok((slice(disp, "disparity")?, slice(conf, "confidence")?))
 }
@@ -114,9 +125,8 @@ pub fn u8_layout<'a>(
             )))
         }
     };
-    let data = a
-        .as_slice()
-        .map_err(|_| PyValueError::new_err(format!("{what} must be C-contiguous")))?;
+    let data =
+        c_slice(a).ok_or_else(|| PyValueError::new_err(format!("{what} must be C-contiguous")))?;
     Ok((h, w, c, data))
 }
 

@@ -1,6 +1,6 @@
 //! Binding of `stereovision_core::fill` and `stereovision_core::edges`.
 
-use crate::convert::{map_copy_in_place, vec_to_numpy};
+use crate::convert::{c_slice, map_copy_in_place, vec_to_numpy};
 use crate::errors::guard;
 use crate::params::non_negative;
 use numpy::{PyArray2, PyReadonlyArray2};
@@ -50,8 +50,8 @@ pub fn fattened<'py>(
 
 /// The array's row-major values: borrowed when C-contiguous, else copied.
 fn contiguous<'a>(a: &'a PyReadonlyArray2<'_, f32>) -> std::borrow::Cow<'a, [f32]> {
-    match a.as_slice() {
-        Ok(s) => std::borrow::Cow::Borrowed(s),
-        Err(_) => std::borrow::Cow::Owned(a.as_array().iter().copied().collect()),
+    match c_slice(a) {
+        Some(s) => std::borrow::Cow::Borrowed(s),
+        None => std::borrow::Cow::Owned(a.as_array().iter().copied().collect()),
     }
 }
