@@ -396,7 +396,8 @@ def depth_map(
         measured pixels are filled where it peaks clearly (filled pixels are measurements with
         confidence 0.25 and get a depth); it takes 2-3 times the Gabor channel's time. With
         ``fill=True`` only the re-measure runs (pixels it drops keep the Gabor value, as in
-        ``"fused"``) and the fill completes the map. ``"fused"``:
+        ``"fused"``) and the fill completes the map: a more accurate map, with depth on fewer
+        pixels (terrace: 247 k instead of 288 k; the fill gives none). ``"fused"``:
         the Gabor map is re-measured before the vote
         (:func:`stereovision.matching.fusion.remeasure`, about the Gabor channel's time, beside
         the sparse channels). None (default) = on; live use can pass False.
