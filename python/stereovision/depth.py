@@ -386,9 +386,9 @@ def depth_map(
         shows). Over the 17 GT scenes the planes lower the mean bad-2.0 ratio to SGBM-3WAY +
         fill from 0.63 to 0.53 (``"fused"``) and from 1.44 to 1.01 (``"gabor"``, whose refinement
         then only re-measures); they cost about 60 ms on a 900x750 frame. None (default) = the
-        method's own choice: ``"fused"``
-        returns a dense map (filled), ``"gabor"`` leaves a pixel it is not sure of NaN. Filled
-        pixels keep confidence 0 and get no depth or 3-D point.
+        method's own choice: ``"fused"`` returns a dense map (filled), ``"gabor"`` leaves a
+        pixel it is not sure of NaN. Filled pixels keep confidence 0 and get no depth or 3-D
+        point.
     refine : bool, optional
         Re-measure the disparity to sub-pixel precision by a correlation that follows the
         surface (:func:`stereovision.refine.refine_disparity`). ``"gabor"``: the output is
