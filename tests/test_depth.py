@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import stereovision as sv
+from stereovision._validate import as_gray_float
 from stereovision.calibration import Calibration
 from stereovision.io import load_scene, read_ply
 
@@ -176,6 +177,35 @@ def test_fill_flag_fills_but_keeps_depth_measured_only() -> None:
     assert np.isfinite(filled.disparity).sum() >= np.isfinite(raw.disparity).sum()
     assert filled.depth is not None and raw.depth is not None
     np.testing.assert_array_equal(np.isfinite(filled.depth), np.isfinite(raw.depth))
+
+
+@pytest.mark.parametrize(
+    ("scene", "orb_alone", "coarse_alone"),
+    [
+        ("kitti2015/000005_10", 80, 128),
+        ("eth3d/playground", 16, 32),
+        ("middlebury2001/venus", 32, 16),
+    ],
+)
+def test_auto_max_disparity_covers_the_near_ground(
+    data_dir: Path, scene: str, orb_alone: int, coarse_alone: int
+) -> None:
+    """The range covers the GT's 99.5th percentile where the ORB features alone fall short
+    (KITTI's near road, playground's near ground: the shrunk SGBM's dense map sees them) and
+    where the dense map alone would (venus: the shrunk SGBM reaches 12.5 px of 18.5)."""
+    from stereovision.depth import _coarse_top, _orb_top
+
+    s = load_scene(data_dir / scene)
+    md = sv.estimate_max_disparity(s.left, s.right)
+    top = float(np.percentile(s.gt[np.isfinite(s.gt)], 99.5))
+    assert top <= md <= 2 * top + 16 and md % 16 == 0
+    gl, gr = (np.asarray(as_gray_float(a) * 255, np.uint8) for a in (s.left, s.right))
+    orb, coarse = _orb_top(gl, gr), _coarse_top(gl, gr)
+    assert orb is not None and coarse is not None
+    # Each estimate alone (1.15 x, rounded up to 16); the range takes the larger.
+    alone = [int(np.ceil(1.15 * t / 16) * 16) for t in (orb, coarse)]
+    assert alone == [orb_alone, coarse_alone]
+    assert md == max(alone)
 
 
 def test_auto_max_disparity_on_real_scene(data_dir: Path) -> None:
