@@ -182,7 +182,7 @@ def test_fill_flag_fills_but_keeps_depth_measured_only() -> None:
 @pytest.mark.parametrize(
     ("scene", "orb_alone", "coarse_alone"),
     [
-        ("kitti2015/000005_10", 80, 128),
+        ("kitti2015/000005_10", 96, 128),
         ("eth3d/playground", 16, 32),
         ("middlebury2001/venus", 32, 16),
     ],
