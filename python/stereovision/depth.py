@@ -40,6 +40,7 @@ _AUTO_FALLBACK_FRACTION = 1 / 8  # of the width, when the pair has too few featu
 _AUTO_COARSE_SCALE = 4
 _AUTO_ORB_HALF_FROM = 256  # px, shorter side: ORB runs on the pair at half resolution
 _AUTO_ORB_FEATURES = 1500  # ... with this many features
+_AUTO_ORB_FEATURES_FULL = 4000  # features on a smaller pair, matched at full resolution
 _AUTO_COARSE_PERCENTILE = 99.5
 _AUTO_COARSE_MIN_SIZE = (16, 64)  # (rows, columns) of the shrunk pair, else no second opinion
 _DISPARITY_STEP = 16  # ranges are multiples of 16, like the evaluation protocol's
@@ -109,7 +110,8 @@ def _orb_top(gl: npt.NDArray[np.uint8], gr: npt.NDArray[np.uint8]) -> float | No
         size = (gl.shape[1] // s, gl.shape[0] // s)
         gl = np.asarray(cv2.resize(gl, size, interpolation=cv2.INTER_AREA), np.uint8)
         gr = np.asarray(cv2.resize(gr, size, interpolation=cv2.INTER_AREA), np.uint8)
-    orb = cv2.ORB_create(nfeatures=_AUTO_ORB_FEATURES if s > 1 else 4000)  # type: ignore[attr-defined]
+    n = _AUTO_ORB_FEATURES if s > 1 else _AUTO_ORB_FEATURES_FULL
+    orb = cv2.ORB_create(nfeatures=n)  # type: ignore[attr-defined]
     kl, dl = orb.detectAndCompute(gl, None)
     kr, dr = orb.detectAndCompute(gr, None)
     if dl is None or dr is None or len(kl) < _AUTO_MIN_MATCHES or len(kr) < _AUTO_MIN_MATCHES:

@@ -1,5 +1,7 @@
 //! NumPy <-> core image conversion.
 
+use std::borrow::Cow;
+
 use numpy::ndarray::{Array2, Dimension};
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -15,6 +17,16 @@ pub fn c_slice<'a, T: numpy::Element, D: Dimension>(
         a.as_slice().ok()
     } else {
         None
+    }
+}
+
+/// The array's values in row-major order: its own buffer when C-contiguous, else a copy.
+pub fn row_major<'a, T: numpy::Element + Copy, D: Dimension>(
+    a: &'a PyReadonlyArray<'_, T, D>,
+) -> Cow<'a, [T]> {
+    match c_slice(a) {
+        Some(s) => Cow::Borrowed(s),
+        None => Cow::Owned(a.as_array().iter().copied().collect()),
     }
 }
 

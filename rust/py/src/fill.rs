@@ -1,6 +1,6 @@
 //! Binding of `stereovision_core::fill` and `stereovision_core::edges`.
 
-use crate::convert::{c_slice, map_copy_in_place, vec_to_numpy};
+use crate::convert::{map_copy_in_place, row_major, vec_to_numpy};
 use crate::errors::guard;
 use crate::params::non_negative;
 use numpy::{PyArray2, PyReadonlyArray2};
@@ -38,7 +38,7 @@ pub fn fattened<'py>(
             guide.as_array().dim()
         )));
     }
-    let (d, g) = (contiguous(&disp), contiguous(&guide));
+    let (d, g) = (row_major(&disp), row_major(&guide));
     let p = FattenParams {
         radius,
         ratio,
@@ -46,12 +46,4 @@ pub fn fattened<'py>(
     };
     let mask = py.detach(|| guard("fattened", || Ok(core_fattened(&d, &g, w, h, &p))))?;
     vec_to_numpy(py, (h, w), mask)
-}
-
-/// The array's row-major values: borrowed when C-contiguous, else copied.
-fn contiguous<'a>(a: &'a PyReadonlyArray2<'_, f32>) -> std::borrow::Cow<'a, [f32]> {
-    match c_slice(a) {
-        Some(s) => std::borrow::Cow::Borrowed(s),
-        None => std::borrow::Cow::Owned(a.as_array().iter().copied().collect()),
-    }
 }

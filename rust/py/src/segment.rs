@@ -8,7 +8,7 @@ use stereovision_core::segment::{
     plane_fill as core_plane_fill, quantised_regions as core_regions,
 };
 
-use crate::convert::{map_copy_in_place, vec_to_numpy};
+use crate::convert::{map_copy_in_place, row_major, vec_to_numpy};
 use crate::errors::guard;
 use crate::params::non_negative;
 
@@ -33,7 +33,7 @@ pub fn graph_segments<'py>(
     if a.iter().any(|v| !v.is_finite()) {
         return Err(PyValueError::new_err("image: contains NaN or inf"));
     }
-    let img: Vec<f32> = a.iter().copied().collect();
+    let img = row_major(&image);
     let labels = py.detach(|| {
         guard("graph_segments", || {
             Ok(core_segments(&img, w, h, c, k, min_size))
@@ -70,7 +70,7 @@ pub fn plane_fill<'py>(
             "lo and hi: expected numbers, got {lo}, {hi}"
         )));
     }
-    let l: Vec<u32> = labels.as_array().iter().copied().collect();
+    let l = row_major(&labels);
     // The kernel sizes its tables by the largest label: one per pixel at most.
     if l.iter().any(|&v| v as usize >= h * w) {
         return Err(PyValueError::new_err(format!(
@@ -108,7 +108,7 @@ pub fn quantised_regions<'py>(
             "step must be in 1-255 and offset in 0-255, got step={step}, offset={offset}"
         )));
     }
-    let img: Vec<u8> = image.as_array().iter().copied().collect();
+    let img = row_major(&image);
     let labels = py.detach(|| {
         guard("quantised_regions", || {
             Ok(core_regions(&img, w, h, c, step, offset))
@@ -142,7 +142,7 @@ pub fn fill_planes<'py>(
         )));
     }
     non_negative("max_residual", max_residual)?;
-    let img: Vec<u8> = image.as_array().iter().copied().collect();
+    let img = row_major(&image);
     let (out, done) = map_copy_in_place(py, &disp, |d, w, _| {
         guard("fill_planes", || {
             core_fill_planes(d, &img, w, c, &passes, max_residual);
