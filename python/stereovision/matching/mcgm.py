@@ -50,7 +50,7 @@ DEFAULTS: dict[str, Any] = {
     "dy_band": 1,  # epipolar band (rows; B.8: t_y in {-1, 0, 1} for 1.5 px)
     "n_theta_bins": 36,  # R-table orientation bins over [0, 2 pi) (B.2)
     "vote_bin_tol": 2,  # +- bins when indexing the R-table (B.2: 1; 2 measured, docs/mcgm.md)
-    "ght_min_score": 0.5,  # GHT peak / max(|A|, |A'|) (B.8: 0.5)
+    "ght_min_score": 0.4,  # GHT peak / max(|A|, |A'|) (B.8: 0.5; docs/mcgm.md)
     "k_cand": 6,  # candidates per left segment (B.2)
     "knn": 6,  # neighbours in the segment graph (B.4.9)
     "r_graph": 60.0,  # longest graph edge (px, B.2)
@@ -67,8 +67,8 @@ DEFAULTS: dict[str, Any] = {
     "prior_width_sigmas": 2.0 * float(np.sqrt(2.0)),  # window around the prior, fine sigmas
     "fill_radius": 1,  # coarser matches only where no finer one within +- 1 column
     "sides": True,  # B.8 both-sides check
-    "sides_mad": 0.04,  # mean absolute grey difference per half-window (B.8)
-    "sides_width": 4,  # half-window columns (B.8: 4 x 7)
+    "sides_mad": 0.06,  # mean absolute grey difference per half-window (B.8: 0.04)
+    "sides_width": 6,  # half-window columns (B.8: 4 x 7; docs/mcgm.md)
     "sides_height": 7,  # half-window rows
     "sides_gap": 1,  # columns between the edge and each half-window (B.8)
     "sides_best": True,  # ... and no other disparity (> 1 px away) fits a half-window better

@@ -38,6 +38,8 @@ pub struct CandParams {
     /// `+-` orientation bins an edge pixel votes through (B.2: 1; default 2, 25 degrees at 36
     /// bins: the finest channel's orientations are noisy, docs/mcgm.md).
     pub vote_bin_tol: usize,
+    /// Lowest GHT score of a candidate pair (peak / larger segment length), also the lowest
+    /// length ratio of a pair (B.8: 0.5; default 0.4, docs/mcgm.md).
     pub ght_min_score: f32,
     pub k_cand: usize,
 }
