@@ -6,7 +6,10 @@ algorithms.md D.3 defaults). Printed per scene: precision@1 (@2 on KITTI, whose 
 about 0.4 px off), count with GT and 4x4 coverage of the members and of each channel, and each
 channel's *count at the members' precision*: the most matches it keeps, taken in decreasing
 score, while its precision stays at or above the members' (the issue's "more of them than either
-sparse channel alone would give at that precision"). One JSON line per scene.
+sparse channel alone would give at that precision"). MCGM is counted twice: as it votes
+(:data:`~stereovision.matching.fusion.MEMBER_MCGM`, B.8's settings) and alone with its own,
+looser defaults (``mcgm_defaults``, what ``match(..., method="mcgm")`` returns). One JSON line
+per scene.
 
 Usage: ``python benches/bench_fusion.py [SCENE ...]`` (default: every GT scene of shared/data)
 """
@@ -24,6 +27,7 @@ from stereovision.evaluate import count_at_precision, sparse_metrics
 from stereovision.io import find_scenes, load_scene
 from stereovision.match import METHODS
 from stereovision.matching.fusion import CHANNEL_BITS, fuse_pair
+from stereovision.matching.mcgm import mcgm_match
 
 SPARSE = [m for m in METHODS if m in CHANNEL_BITS]
 
@@ -43,6 +47,7 @@ def main() -> None:
         gl, gr = as_gray_float(sc.left, "left"), as_gray_float(sc.right, "right")
         res = fuse_pair(gl, gr, max_disparity=md)
         chans = {m: res.channel_outputs[m] for m in SPARSE}
+        chans["mcgm_defaults"] = mcgm_match(gl, gr, max_disparity=md)
         fm = sparse_metrics(res.matches.xl, res.matches.yl, res.matches.xr, sc.gt)
         row = {
             "bench": "fusion",
