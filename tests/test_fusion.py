@@ -19,6 +19,7 @@ from stereovision.matching.fusion import (
     FusionResult,
     _nearest_within_at,
     _radius_offsets,
+    fill_enclosed_far,
     fuse,
     fuse_pair,
     fused_dense,
@@ -504,3 +505,49 @@ def test_fused_dense_snaps_jumps_to_image_edges() -> None:
     assert kept[25, 28] == 20.0 and np.isnan(kept[25, 27])
     with pytest.raises(ValueError, match="guide"):
         fused_dense(d, conf, none, guide=guide[:, :10])
+
+
+def test_enclosed_far_fills_dark_locked_regions_only() -> None:
+    h, w = 60, 80
+    d = np.full((h, w), 6.0, np.float32)
+    d[:, 40:] += np.linspace(0, 2, w - 40, dtype=np.float32)  # a slanted part: the median is taken
+    g = np.full((h, w), 0.6, np.float32)
+    d[20:30, 10:25], g[20:30, 10:25] = 0.2, 0.1  # dark, at the floor, enclosed: filled
+    d[35:45, 10:25], g[35:45, 10:25] = 0.0, 0.9  # bright (sky through a gap): kept
+    d[0:8, 50:60], g[0:8, 50:60] = 0.0, 0.1  # touches the border: kept
+    d[40:44, 50:54], g[40:44, 50:54] = 2.0, 0.1  # not at the floor: kept
+    out, filled = fill_enclosed_far(d, g)
+    assert filled.sum() == 150 and filled[20:30, 10:25].all()
+    assert np.all(out[20:30, 10:25] == 6.0)
+    keep = ~filled
+    np.testing.assert_array_equal(out[keep], d[keep])
+    # The floor is the range's: with a floor of -1, 0 is 1 px above it and nothing is filled.
+    assert not fill_enclosed_far(d, g, floor=-1.0)[1].any()
+    # A surround less than `jump` above the floor: kept.
+    assert not fill_enclosed_far(d, g, jump=9.0)[1].any()
+    # NaN pixels belong to no region and to no surround.
+    dn = d.copy()
+    dn[16:34, 6:29] = np.nan  # wider than the ring
+    dn[20:30, 10:25] = 0.2
+    out_n, filled_n = fill_enclosed_far(dn, g)
+    assert not filled_n.any() and np.array_equal(np.isnan(out_n), np.isnan(dn))
+    for kw, needle in (({"far": -1.0}, "far"), ({"ring": 0}, "ring"), ({"jump": np.nan}, "jump")):
+        with pytest.raises(ValueError, match=needle):
+            fill_enclosed_far(d, g, **kw)
+    with pytest.raises(ValueError, match="guide"):
+        fill_enclosed_far(d, g[:, :-1])
+
+
+def test_enclosed_far_on_tartanair(data_dir: Path) -> None:
+    """TartanAir's dark shop window is matched at disparity 0 (GT 5-6 px): depth_map fills it
+    from its surround and gives it no depth. Measured: bad-2.0 8.96 -> 7.55 %, SGBM-3WAY + fill
+    10.17 % (ratio 0.74; issue 5 asks for 0.8)."""
+    sc = load_scene(data_dir / "tartanair" / "oldtown_easy_p000_001116")
+    r = sv_depth_map(sc.left, sc.right, max_disparity=sc.max_disparity, calib=sc.calib)
+    sgbm = row_fill(opencv_sgbm(sc.left, sc.right, sc.max_disparity))
+    b, b_cv = (dense_metrics(x, sc.gt).bad[2.0] for x in (r.disparity, sgbm))
+    assert b < 0.78 * b_cv, (b, b_cv)
+    win = (slice(240, 285), slice(320, 380))
+    assert np.median(r.disparity[win]) > 4.0  # the glass, not the locked 0
+    assert r.depth is not None and np.isnan(r.depth[win]).mean() > 0.9
+    assert np.all(r.confidence[win][np.isnan(r.depth[win])] == 0)

@@ -602,6 +602,15 @@ def depth_map(
         from stereovision.matching.planes import fill_planes
 
         disp = row_fill(fill_planes(disp, left_bgr)).astype(np.float32)
+        if method == "fused":
+            from stereovision.matching.fusion import fill_enclosed_far
+
+            # Dark regions locked to the range's floor inside a nearer surround: the surround's
+            # value, and no depth (the locked values were not the scene's).
+            disp, far = fill_enclosed_far(disp, gl, floor=float(min_disparity))
+            if far.any():
+                measured_disp = np.where(far, np.float32(np.nan), measured_disp)
+                conf = np.where(far, np.float32(0), conf).astype(np.float32)
     depth = None
     depth_sigma = None
     points = np.zeros((0, 3), np.float32)

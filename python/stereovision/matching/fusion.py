@@ -36,6 +36,7 @@ __all__ = [
     "DENSE_DEFAULTS",
     "MEMBER_MCGM",
     "FusionResult",
+    "fill_enclosed_far",
     "fuse",
     "fuse_pair",
     "fused_dense",
@@ -574,6 +575,96 @@ def _members_where(res: FusionResult, keep: npt.NDArray[np.bool_]) -> FusionResu
 #: the dense map's (7 px, an edge 1.5 x the step at the jump, jumps over 2 px): 5 px / 1.5 x
 #: lifted teddyH to 99.00 %, 3 px / 2 x to 98.94 %.
 _EDGE_MEMBERS = (7, 1.5, 2.0)
+
+def fill_enclosed_far(
+    disparity: npt.ArrayLike,
+    guide: npt.ArrayLike,
+    *,
+    floor: float = 0.0,
+    far: float = 0.5,
+    jump: float = 3.0,
+    ring: int = 3,
+) -> tuple[F32, npt.NDArray[np.bool_]]:
+    """Fill the dark regions locked to the far end of the range inside a nearer surround.
+
+    In a dark, nearly flat region the census matcher compares noise: where the cameras' noise
+    has a fixed pattern (dark-signal non-uniformity, a renderer's dithering) it is the same at
+    the same pixel in both images and matches at the range's floor, disparity 0. A region at
+    the floor that touches no image border, whose surround (``ring`` px wide) has a median
+    disparity ``jump`` px or more above the floor, and that is darker on average than that
+    surround takes the surround's median: a dark shop window in a wall gets the wall's
+    disparity, the pane's rather than the locked noise's. Bright far regions seen through a
+    gap (sky between branches) are not darker than their surround and keep their values.
+
+    Over the 17 GT scenes (fused map, ``depth_map``'s last step): TartanAir's bad-2.0
+    8.96 -> 7.55 % (4434 pixels of a shop window and awning, GT 5-6 px, matched at 0), ratio to
+    SGBM-3WAY + fill 0.881 -> 0.743; 51 pixels elsewhere (playground, tsukuba, teddy), no
+    figure moved by 0.01. ``far`` 1.0, ``jump`` 2 or 5, ``ring`` 5 or a surround 0.8 x as
+    bright gave TartanAir 0.738-0.752.
+
+    Parameters
+    ----------
+    disparity : array_like
+        ``(H, W)`` disparity map (NaN = none; NaN pixels are never part of a region or a
+        surround).
+    guide : array_like
+        ``(H, W)`` grey left image (any scale).
+    floor : float
+        The searched range's smallest disparity (px).
+    far, jump : float
+        px: how near the floor a region lies, how far above it its surround.
+    ring : int
+        Width of the surround (px).
+
+    Returns
+    -------
+    disparity : numpy.ndarray
+        ``(H, W)`` float32, a copy with the regions filled.
+    filled : numpy.ndarray
+        ``(H, W)`` bool, the pixels filled.
+
+    Raises
+    ------
+    ValueError
+        Maps of different shapes, a non-finite or negative ``far`` / ``jump``, ``ring`` < 1.
+    """
+    import cv2
+
+    d = _check_map(disparity, "disparity", None)
+    shape = (int(d.shape[0]), int(d.shape[1]))
+    g = _check_map(guide, "guide", shape)
+    for name, v in (("far", far), ("jump", jump), ("floor", floor)):
+        if not np.isfinite(v) or (name != "floor" and v < 0):
+            raise ValueError(f"{name}: expected a non-negative number, got {v}")
+    if int(ring) != ring or ring < 1:
+        raise ValueError(f"ring: expected a whole number >= 1, got {ring}")
+    r = int(ring)
+    out = d.copy()
+    filled = np.zeros(shape, bool)
+    with np.errstate(invalid="ignore"):
+        low = (d < floor + far).astype(np.uint8)  # NaN compares False
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(low, connectivity=8)
+    h, w = shape
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
+    for i in range(1, n):
+        x, y, bw, bh = (int(v) for v in stats[i, :4])
+        if x == 0 or y == 0 or x + bw == w or y + bh == h:
+            continue  # open to the border: sky above a horizon, the far end of a street
+        # The component's box grown by the ring (it touches no border, so the ring fits).
+        y0, y1, x0, x1 = max(y - r, 0), min(y + bh + r, h), max(x - r, 0), min(x + bw + r, w)
+        comp = lab[y0:y1, x0:x1] == i
+        dc = d[y0:y1, x0:x1]
+        around = cv2.dilate(comp.astype(np.uint8), kernel).astype(bool) & ~comp
+        around &= np.isfinite(dc)
+        if not around.any():
+            continue
+        med = float(np.median(dc[around]))
+        gc = g[y0:y1, x0:x1]
+        if med - floor >= jump and float(gc[comp].mean()) < float(gc[around].mean()):
+            out[y0:y1, x0:x1][comp] = med
+            filled[y0:y1, x0:x1] |= comp
+    return out, filled
+
 
 #: Dense completion defaults (measured on the 17 GT scenes with the Gabor + MCGM + Hopfield
 #: members: filled bad-2.0 15.9 -> 14.5 % mean, lower on every scene than Gabor alone; a 25 px
