@@ -576,6 +576,7 @@ def _members_where(res: FusionResult, keep: npt.NDArray[np.bool_]) -> FusionResu
 #: lifted teddyH to 99.00 %, 3 px / 2 x to 98.94 %.
 _EDGE_MEMBERS = (7, 1.5, 2.0)
 
+
 def fill_enclosed_far(
     disparity: npt.ArrayLike,
     guide: npt.ArrayLike,
