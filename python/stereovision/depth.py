@@ -430,7 +430,7 @@ def depth_map(
         ``"fused"`` (default): the Gabor map corrected and completed by the valid members where
         the Gabor, graph-matching and Hopfield channels agree (algorithms.md D), checked and
         completed by a census semi-global map (:func:`stereovision.matching.fusion.fused_dense`;
-        the most accurate: mean bad-2.0 6.8 % over the 17 GT scenes, README). ``"gabor"``: the
+        the most accurate: mean bad-2.0 6.7 % over the 17 GT scenes, README). ``"gabor"``: the
         dense Gabor phase channel alone (algorithms.md A), 3-4 times faster and less accurate
         (16 % filled): the choice for a live view.
     max_disparity : int, optional
@@ -448,7 +448,8 @@ def depth_map(
         then only re-measures); they cost about 60 ms on a 900x750 frame. None (default) = the
         method's own choice: ``"fused"`` returns a dense map (filled), ``"gabor"`` leaves a
         pixel it is not sure of NaN. Filled pixels keep confidence 0 and get no depth or 3-D
-        point.
+        point. ``"fused"`` then fills dark regions locked to the range's floor inside a nearer
+        surround (:func:`stereovision.matching.fusion.fill_enclosed_far`) the same way.
     refine : bool, optional
         Re-measure the disparity to sub-pixel precision by a correlation that follows the
         surface (:func:`stereovision.refine.refine_disparity`). ``"gabor"``: the output is
