@@ -5,8 +5,9 @@ For each scene: OpenCV SGBM-3WAY (evaluation.md configuration), the whole defaul
 census semi-global map), then the stages after the channels on their cached outputs: the vote
 (:func:`fuse`), the member checks ``fuse_pair`` runs (B.8's both-sides check on the members MCGM is
 not part of, the edge check on the re-measured Gabor map), the dense map (:func:`fused_dense`) and
-the fill (:func:`fill_planes`, then the reference row rule). Interleaved (SGBM, whole, channel,
-..., SGBM, ...), median of ``--repeats`` after a warm-up; each case's ms and its ratio to SGBM.
+the fill (:func:`fill_planes`, then the reference row rule, then the enclosed far regions).
+Interleaved (SGBM, whole, channel, ..., SGBM, ...), median of ``--repeats`` after a warm-up;
+each case's ms and its ratio to SGBM.
 The channels run side by side in ``depth_map`` (their times do not add up to its own); the
 stages after them run one after another. One JSON line per case, then a table.
 
@@ -76,7 +77,7 @@ def cases(scene: Path) -> dict[str, Callable[[], object]]:
         "after: vote": lambda: fusion.fuse((base, g.confidence), sparse),
         "after: member checks": checks,
         "after: dense map": dense,
-        "after: fill": lambda: row_fill(fill_planes(d, sc.left)),
+        "after: fill": lambda: fusion.fill_enclosed_far(row_fill(fill_planes(d, sc.left)), gl),
     }
 
 
