@@ -531,7 +531,9 @@ def test_enclosed_far_fills_dark_locked_regions_only() -> None:
     dn[20:30, 10:25] = 0.2
     out_n, filled_n = fill_enclosed_far(dn, g)
     assert not filled_n.any() and np.array_equal(np.isnan(out_n), np.isnan(dn))
-    for kw, needle in (({"far": -1.0}, "far"), ({"ring": 0}, "ring"), ({"jump": np.nan}, "jump")):
+    bad = ({"far": -1.0}, {"ring": 0}, {"ring": 1.5}, {"jump": np.nan}, {"floor": np.inf})
+    for kw in bad:
+        needle = next(iter(kw))
         with pytest.raises(ValueError, match=needle):
             fill_enclosed_far(d, g, **kw)
     with pytest.raises(ValueError, match="guide"):

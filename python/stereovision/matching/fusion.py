@@ -627,15 +627,18 @@ def fill_enclosed_far(
     Raises
     ------
     ValueError
-        Maps of different shapes, a non-finite or negative ``far`` / ``jump``, ``ring`` < 1.
+        Maps of different shapes, a non-finite ``floor``, a non-finite or negative ``far`` /
+        ``jump``, ``ring`` not a whole number >= 1.
     """
     import cv2
 
     d = _check_map(disparity, "disparity", None)
     shape = (int(d.shape[0]), int(d.shape[1]))
     g = _check_map(guide, "guide", shape)
-    for name, v in (("far", far), ("jump", jump), ("floor", floor)):
-        if not np.isfinite(v) or (name != "floor" and v < 0):
+    if not np.isfinite(floor):
+        raise ValueError(f"floor: expected a finite number, got {floor}")
+    for name, v in (("far", far), ("jump", jump)):
+        if not np.isfinite(v) or v < 0:
             raise ValueError(f"{name}: expected a non-negative number, got {v}")
     if int(ring) != ring or ring < 1:
         raise ValueError(f"ring: expected a whole number >= 1, got {ring}")
