@@ -609,9 +609,8 @@ def depth_map(
             # Dark regions locked to the range's floor inside a nearer surround: the surround's
             # value, and no depth (the locked values were not the scene's).
             disp, far = fill_enclosed_far(disp, gl, floor=float(min_disparity))
-            if far.any():
-                measured_disp = np.where(far, np.float32(np.nan), measured_disp)
-                conf = np.where(far, np.float32(0), conf).astype(np.float32)
+            measured_disp[far] = np.nan  # fused_dense's own array, as is conf
+            conf[far] = 0
     depth = None
     depth_sigma = None
     points = np.zeros((0, 3), np.float32)
