@@ -301,6 +301,7 @@ def _run_matcher(
             min_disparity=d_min,
             remeasure_gabor=remeasure,
             dense_sgm=semi_global,
+            census_members=False,
             **params,
         )
         g = fr.channel_outputs["gabor"]
@@ -316,7 +317,12 @@ def _run_matcher(
             **dense_kw,
         )
         if channels is not None:
-            channels.update(fr.channel_outputs, members=fr)
+            # The dense map anchors on all members (the census check's dropped ones are 96 %
+            # right and the census map checks the dense map anyway); the members reported are
+            # the checked ones, as ``match(method="fused")`` gives them.
+            sgm = fr.channel_outputs.get("sgm")
+            members = fusion.census_clear(fr, sgm) if sgm is not None else fr
+            channels.update(fr.channel_outputs, members=members)
         return disp, conf, only_second
     raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
 

@@ -44,9 +44,10 @@ def match(
         ``"hopfield"``: the network (:func:`stereovision.matching.hopfield.hopfield_match`);
         ``"best"``: the best-match reference without the network; ``"mcgm"``: multi-channel
         graph matching of LoG zero-crossing curves (:func:`stereovision.matching.mcgm.mcgm_match`);
-        ``"fused"``: the valid members where Gabor, MCGM and Hopfield agree
-        (:func:`stereovision.matching.fusion.fuse_pair`; its ``count`` and ``sources`` per
-        member are in ``stats``).
+        ``"fused"``: the valid members where Gabor, MCGM and Hopfield agree, less those near a
+        depth edge (:func:`stereovision.matching.fusion.fuse_pair`, which also runs the census
+        semi-global map for that check; its ``count`` and ``sources`` per member are in
+        ``stats``).
     max_disparity : int, optional
         Largest disparity searched (px). None estimates it from the pair
         (:func:`stereovision.estimate_max_disparity`).

@@ -36,6 +36,7 @@ __all__ = [
     "DENSE_DEFAULTS",
     "MEMBER_MCGM",
     "FusionResult",
+    "census_clear",
     "fill_enclosed_far",
     "fuse",
     "fuse_pair",
@@ -383,6 +384,7 @@ def fuse_pair(
     remeasure_gabor: bool = True,
     check_members: bool = True,
     edge_members: bool = True,
+    census_members: bool = True,
     dense_sgm: bool = False,
     **params: Any,
 ) -> FusionResult:
@@ -421,10 +423,18 @@ def fuse_pair(
         edges, on the foreground's disparity. Default True: over the 17 GT scenes precision@1
         rose on 15 (teddyH 98.92 -> 99.03 %, dolls 98.08 -> 98.33 %) and fell by at most 0.03
         point, with 0.2-1.9 % fewer members.
+    census_members : bool
+        Drop the members near a depth edge of the census semi-global map
+        (:func:`census_clear`); runs that matcher beside the channels if ``dense_sgm`` does
+        not. Default True: over the 17 GT scenes precision@1 >= 99 % on all 16
+        Middlebury/ETH3D/TartanAir scenes (teddy 97.89 -> 99.47 %, dolls 98.33 -> 99.39 %,
+        TartanAir 97.53 -> 99.03 %; KITTI @2 98.60 -> 98.86 %) with 13 % fewer members
+        (README, "Fusion").
     dense_sgm : bool
         Also run the census semi-global matcher (:func:`stereovision.matching.sgm.sgm_disparity`)
         beside the channels, for :func:`fused_dense`'s ``second``; its map is kept in
-        ``channel_outputs["sgm"]``. It takes no part in the vote. ``depth_map`` turns it on
+        ``channel_outputs["sgm"]``. It takes no part in the vote (``census_members`` checks
+        the members against it afterwards). ``depth_map`` turns it on
         (``semi_global=False`` there turns it off). Not re-measured: the re-measure moved
         values it filled by more than 2 px often enough to cost 0.04 of the mean ratio.
     **params
@@ -477,12 +487,13 @@ def fuse_pair(
     # Their outputs do not depend on the scheduling (every kernel is bit-identical across
     # thread counts).
     names: list[str] = [n for n in ("gabor", "mcgm", "hopfield") if n in channels]
-    names += ["sgm"] if dense_sgm else []
+    names += ["sgm"] if dense_sgm or census_members else []
     with ThreadPoolExecutor(max_workers=len(names)) as pool:
         done = dict(zip(names, pool.map(timed, names), strict=True))
     seconds: dict[str, float] = {n: done[n][1] for n in names}
+    sgm_map = done.pop("sgm")[0] if "sgm" in done else None
     if dense_sgm:
-        outputs["sgm"] = done.pop("sgm")[0]
+        outputs["sgm"] = sgm_map
     dense = None
     if "gabor" in done:
         g = done["gabor"][0]
@@ -504,6 +515,8 @@ def fuse_pair(
         keep &= ~fat[res.matches.yl.astype(np.intp), res.matches.xl.astype(np.intp)]
     if check_members or edge_members:
         res = _members_where(res, keep)
+    if census_members and sgm_map is not None:
+        res = census_clear(res, sgm_map)
     seconds["fuse"] = time.perf_counter() - t
     res.channel_outputs.update(outputs, **sparse)
     res.matches.stats.update(
@@ -537,6 +550,63 @@ def _sides_ok(
     )
 
 
+def census_clear(
+    res: FusionResult,
+    census: npt.ArrayLike,
+    *,
+    radius: int = 7,
+    jump: float = 1.5,
+) -> FusionResult:
+    """Keep the members that no depth edge of the census map lies near.
+
+    A member is dropped where the census semi-global map
+    (:func:`stereovision.matching.sgm.sgm_disparity`) has a value more than ``jump`` px below
+    the member's disparity within ``radius`` px (a square window). The wrong members sit on
+    depth edges with the foreground's disparity, on a background pixel: Gabor, MCGM and
+    Hopfield all carry the foreground's edge there, and so does the census map, by a few
+    pixels; its values beyond that reach show where the background is.
+
+    Parameters
+    ----------
+    res : FusionResult
+        Members (:func:`fuse`).
+    census : array_like
+        ``(H, W)`` census map of the same pair, NaN where it has no value.
+    radius : int
+        Half-width of the window (px). Default 7: the census window's half-width (4) plus the
+        few pixels the aggregation carries an edge.
+    jump : float
+        How far below the member's disparity a census value must lie (px). Default 1.5.
+
+    Returns
+    -------
+    FusionResult
+        The members kept (:func:`fuse_pair` with ``census_members=True``, the default).
+
+    Raises
+    ------
+    ValueError
+        A census map of another shape, a negative radius or jump.
+    """
+    import cv2
+
+    c = _check_map(census, "census", res.dispx.shape)
+    if int(radius) != radius or radius < 0:
+        raise ValueError(f"radius must be a non-negative integer, got {radius!r}")
+    if not jump >= 0:
+        raise ValueError(f"jump must be >= 0, got {jump!r}")
+    k = np.ones((2 * int(radius) + 1, 2 * int(radius) + 1), np.uint8)
+    # The window's minimum (an erosion); NaN as +inf so that unmeasured pixels never count.
+    low = cv2.erode(
+        np.where(np.isfinite(c), c, np.inf).astype(np.float32), k, borderType=cv2.BORDER_REPLICATE
+    )
+    m = res.matches
+    lowest = low[m.yl.astype(np.intp), m.xl.astype(np.intp)]
+    out = _members_where(res, ~(lowest < (m.xl - m.xr) - jump))
+    out.matches.stats["members_before_census"] = len(m)
+    return out
+
+
 def _members_where(res: FusionResult, keep: npt.NDArray[np.bool_]) -> FusionResult:
     """``res`` with only the members where ``keep`` (matches, per-member arrays, rasters)."""
     m = res.matches
@@ -548,7 +618,8 @@ def _members_where(res: FusionResult, keep: npt.NDArray[np.bool_]) -> FusionResu
     dispy[ys, xs] = np.nan
     cmap[ys, xs] = 0
     smap[ys, xs] = 0
-    stats = {**m.stats, "members": int(keep.sum()), "members_before_check": len(m)}
+    stats = {**m.stats, "members": int(keep.sum())}
+    stats.setdefault("members_before_check", len(m))
     kept = Matches(
         xl=m.xl[keep],
         yl=m.yl[keep],
