@@ -183,7 +183,8 @@ def depth_rectified(
     s_fill: float,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
     """``(Z, sigma_Z)``: ``fb / (d + doffs)``, ``Z max(s0 + slope clip(c), s_min) / (d+doffs)``
-    (``Z s_fill / (d + doffs)`` where ``c < 0``)."""
+    (``Z s_fill / (d + doffs)`` where ``c < 0``); NaN where ``d + doffs`` is not above that
+    ``sigma_d``."""
 
 def refine_disparity(
     left: npt.NDArray[np.float32],

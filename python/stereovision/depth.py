@@ -166,6 +166,9 @@ class DepthResult:
         Matcher confidence in [0, 1]; 0 where there is no estimate.
     depth : ndarray, float32 (H, W) or None
         Depth ``Z`` along the optical axis in metres (NaN where none); None without calibration.
+        NaN also where the disparity is not above its predicted uncertainty ``sigma_d``
+        (``depth_sigma``): such a depth's one-sigma interval reaches infinity (the far sky, a
+        wrong lock at the range's floor).
     points : ndarray, float32 (N, 3)
         3-D points in metres in the left rectified camera frame (X right, Y down, Z forward), one
         per pixel with a depth, in row-major pixel order. Empty without calibration or with
@@ -359,7 +362,8 @@ def _depth_rectified(
 
     ``Z = f B / (d + doffs)`` (:func:`stereovision.triangulation.depth_from_disparity`) in
     float32 where ``measured_disp`` has a value (NaN = not measured: row-filled pixels are
-    guesses, not measurements, and get no depth); ``sigma_Z = Z sigma_d / (d + doffs)``
+    guesses, not measurements, and get no depth; nor do pixels with ``d + doffs <= sigma_d``);
+    ``sigma_Z = Z sigma_d / (d + doffs)``
     (:func:`disparity_sigma`). One parallel Rust pass; ``tests/reference/depth_ref.py`` is the
     same maths in NumPy. Pixels the refinement filled are passed with confidence -1, the
     kernel's mark for ``s_fill``.
