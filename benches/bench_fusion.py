@@ -2,7 +2,7 @@
 
 For each scene: the channels and their valid members as ``match(..., method="fused")`` gives
 them (:func:`fuse_pair`: the Gabor map re-measured, ``mcgm``, ``hopfield``; vote mode,
-algorithms.md D.3 defaults). Printed per scene: precision@1 (@2 on KITTI, whose LiDAR GT sits
+algorithms.md D.3 defaults; then the both-sides, edge and census checks on the members). Printed per scene: precision@1 (@2 on KITTI, whose LiDAR GT sits
 about 0.4 px off), count with GT and 4x4 coverage of the members and of each channel, and each
 channel's *count at the members' precision*: the most matches it keeps, taken in decreasing
 score, while its precision stays at or above the members' (the issue's "more of them than either
