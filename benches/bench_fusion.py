@@ -1,15 +1,15 @@
 """Valid members of the channels' agreement vs each sparse channel alone, on every GT scene.
 
-For each scene: the channels and their valid members as ``match(..., method="fused")`` gives
-them (:func:`fuse_pair`: the Gabor map re-measured, ``mcgm``, ``hopfield``; vote mode,
-algorithms.md D.3 defaults; then the both-sides, edge and census checks on the members). Printed per scene: precision@1 (@2 on KITTI, whose LiDAR GT sits
-about 0.4 px off), count with GT and 4x4 coverage of the members and of each channel, and each
-channel's *count at the members' precision*: the most matches it keeps, taken in decreasing
-score, while its precision stays at or above the members' (the issue's "more of them than either
-sparse channel alone would give at that precision"). MCGM is counted twice: as it votes
-(:data:`~stereovision.matching.fusion.MEMBER_MCGM`, B.8's settings) and alone with its own,
-looser defaults (``mcgm_defaults``, what ``match(..., method="mcgm")`` returns). One JSON line
-per scene.
+For each scene: the channels and their valid members as ``match(..., method="fused")`` gives them
+(:func:`fuse_pair`: the Gabor map re-measured, ``mcgm``, ``hopfield``; vote mode, algorithms.md D.3
+defaults; then the both-sides, edge and census checks on the members). Printed per scene:
+precision@1 (@2 on KITTI, whose LiDAR GT sits about 0.4 px off), count with GT and 4x4 coverage of
+the members and of each channel, and each channel's *count at the members' precision*: the most
+matches it keeps, taken in decreasing score, while its precision stays at or above the members'
+(the issue's "more of them than either sparse channel alone would give at that precision"). MCGM is
+counted twice: as it votes (:data:`~stereovision.matching.fusion.MEMBER_MCGM`, B.8's settings) and
+alone with its own, looser defaults (``mcgm_defaults``, what ``match(..., method="mcgm")``
+returns). One JSON line per scene.
 
 Usage: ``python benches/bench_fusion.py [SCENE ...]`` (default: every GT scene of shared/data)
 """
