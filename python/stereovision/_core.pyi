@@ -233,4 +233,5 @@ def release_memory() -> int:
 
 def kept_memory() -> tuple[tuple[int, int], int]:
     """``((blocks, bytes), pool_bytes)``: freed blocks of >= 128 KiB the allocator keeps (128 MiB
-    at most) and the Gabor planes' pool (256 MiB at most)."""
+    at most), and the kernels' own pools: the Gabor planes' (256 MiB at most) and the census
+    matcher's cost volume and row sums (256 MiB at most)."""

@@ -6,6 +6,7 @@
 
 use pyo3::prelude::*;
 use stereovision_core::matching::gabor::pool;
+use stereovision_core::matching::sgm as sgm_kept;
 
 mod convert;
 mod errors;
@@ -24,20 +25,23 @@ mod triangulation;
 #[global_allocator]
 static ALLOC: stereovision_core::alloc::BlockCache = stereovision_core::alloc::BlockCache::new();
 
-/// Returns the memory kept for the next call to the system (the Gabor planes' pool, then the
-/// allocator's blocks, which the pool's buffers pass through); the number of bytes released.
+/// Returns the memory kept for the next call to the system (the Gabor planes' pool and the
+/// census matcher's buffers, then the allocator's blocks, which the pool's buffers pass
+/// through); the number of bytes released.
 #[pyfunction]
 fn release_memory() -> usize {
-    let held = pool::held_bytes() + ALLOC.kept().1;
+    let held = pool::held_bytes() + sgm_kept::kept_bytes() + ALLOC.kept().1;
     pool::release();
+    sgm_kept::release_kept();
     ALLOC.clear();
     held
 }
 
-/// `(blocks, bytes)` the allocator keeps and the bytes the Gabor planes' pool keeps.
+/// `(blocks, bytes)` the allocator keeps, and the bytes the kernels' own pools keep (the Gabor
+/// planes and the census matcher's cost volume and rows).
 #[pyfunction]
 fn kept_memory() -> ((usize, usize), usize) {
-    (ALLOC.kept(), pool::held_bytes())
+    (ALLOC.kept(), pool::held_bytes() + sgm_kept::kept_bytes())
 }
 
 #[pymodule(gil_used = false)]

@@ -209,7 +209,15 @@ simd_fn! {
 
 /// The cost volume `C[(y * w + x) * n + k]` for disparity `d_min + k`.
 pub fn cost_volume(cl: &[u64], cr: &[u64], w: usize, d_min: i64, n: usize) -> Vec<u8> {
-    let mut c = vec![0u8; cl.len() * n];
+    let mut c = Vec::new();
+    cost_volume_into(cl, cr, w, d_min, n, &mut c);
+    c
+}
+
+/// [`cost_volume`] into `c`, resized to fit; every entry is written, so `c` may hold anything
+/// before (a kept buffer is reused without a fill).
+pub fn cost_volume_into(cl: &[u64], cr: &[u64], w: usize, d_min: i64, n: usize, c: &mut Vec<u8>) {
+    c.resize(cl.len() * n, 0);
     c.par_chunks_mut(w * n)
         .enumerate()
         .for_each_init(Vec::new, |rev, (y, row)| {
@@ -217,7 +225,6 @@ pub fn cost_volume(cl: &[u64], cr: &[u64], w: usize, d_min: i64, n: usize) -> Ve
             rev.extend(cr[y * w..(y + 1) * w].iter().rev());
             cost_row(&cl[y * w..(y + 1) * w], rev, d_min, n, row)
         });
-    c
 }
 
 /// P2 by intensity step: `lut[q] = max(p2 / (1 + q), p1 + 1)` for `q = floor(step / gamma)`,
@@ -293,13 +300,13 @@ simd_fn! {
         n: usize,
         p: &SgmParams,
         forward: bool,
+        row: &mut Vec<u16>,
         emit: &mut dyn FnMut(usize, &mut Vec<u16>),
     ) {
         let stride = n + 2;
         let lut = p2_table(p);
-        // The four paths' sum for one row; `emit` may swap in another buffer, whose every entry
-        // the next row writes before reading.
-        let mut row = vec![0u16; w * n];
+        // `row`: the four paths' sum for one row (`w * n` values); `emit` may swap in another
+        // buffer. Every entry is written before it is read, so its contents do not matter.
         // Path costs of the previous row for the vertical path and the diagonals whose
         // predecessor is at x - sgn and x + sgn; index x * stride.
         let mut prev: [Vec<u16>; 3] = std::array::from_fn(|_| vec![BIG; w * stride]);
@@ -362,7 +369,7 @@ simd_fn! {
             // Every x of `cur` and `cur_min` is written in the next row before it is read.
             std::mem::swap(&mut prev, &mut cur);
             std::mem::swap(&mut prev_min, &mut cur_min);
-            emit(y, &mut row);
+            emit(y, row);
         }
     }
 }
@@ -479,6 +486,86 @@ fn select_row(s: &[u16], w: usize, n_all: usize, d_min: i64, p: &SgmParams, out:
     }
 }
 
+/// The cost volume and the row buffers kept between calls (video frames), so that the next
+/// call of the same size reuses them instead of faulting fresh pages in: on teddyH (900x750,
+/// 129 levels) they are an 87 MB volume and about 375 rows of 232 KB (the rows one pass
+/// reaches before the other), and a fused `depth_map` call faulted in about 200 MB of fresh
+/// pages without them. At most [`KEEP_MAX_BYTES`] are kept; [`release_kept`] frees them.
+mod kept {
+    use std::sync::Mutex;
+
+    /// Bytes kept at most between calls.
+    pub const KEEP_MAX_BYTES: usize = 256 << 20;
+
+    struct Kept {
+        volume: Vec<u8>,
+        rows: Vec<Vec<u16>>,
+    }
+
+    static KEPT: Mutex<Kept> = Mutex::new(Kept {
+        volume: Vec::new(),
+        rows: Vec::new(),
+    });
+
+    fn lock() -> std::sync::MutexGuard<'static, Kept> {
+        // Moves of whole vectors only: a panic cannot leave it inconsistent.
+        KEPT.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The kept volume (any length) and the kept rows of exactly `row_len` values.
+    pub fn take(row_len: usize) -> (Vec<u8>, Vec<Vec<u16>>) {
+        let mut k = lock();
+        let volume = std::mem::take(&mut k.volume);
+        let rows = std::mem::take(&mut k.rows);
+        drop(k);
+        let rows = rows.into_iter().filter(|r| r.len() == row_len).collect();
+        (volume, rows)
+    }
+
+    /// Keeps the volume, then as many rows as fit under [`KEEP_MAX_BYTES`].
+    pub fn put(volume: Vec<u8>, mut rows: Vec<Vec<u16>>) {
+        let mut room = KEEP_MAX_BYTES;
+        let volume = if volume.capacity() <= room {
+            room -= volume.capacity();
+            volume
+        } else {
+            Vec::new()
+        };
+        let per_row = rows.first().map_or(1, |r| (r.capacity() * 2).max(1));
+        rows.truncate(room / per_row);
+        let mut k = lock();
+        k.volume = volume;
+        k.rows = rows;
+    }
+
+    /// Bytes kept.
+    pub fn held_bytes() -> usize {
+        let k = lock();
+        k.volume.capacity() + k.rows.iter().map(|r| r.capacity() * 2).sum::<usize>()
+    }
+
+    /// Frees what is kept; returns the bytes.
+    pub fn release() -> usize {
+        let held = held_bytes();
+        let mut k = lock();
+        k.volume = Vec::new();
+        k.rows = Vec::new();
+        held
+    }
+}
+
+pub use kept::KEEP_MAX_BYTES;
+
+/// Bytes of cost volume and row buffers kept for the next call.
+pub fn kept_bytes() -> usize {
+    kept::held_bytes()
+}
+
+/// Frees the buffers kept for the next call; returns the bytes released.
+pub fn release_kept() -> usize {
+    kept::release()
+}
+
 /// Dense disparity of the pair over `[d_min, d_max]` (integers), `NaN` where the uniqueness test
 /// or the left-right check fails. Row-major `(H, W)`.
 pub fn sgm_disparity(
@@ -510,8 +597,16 @@ pub fn sgm_disparity(
     }
     let (w, h) = (left.width, left.height);
     let (cl, cr) = rayon::join(|| census(left), || census(right));
-    let c = cost_volume(&cl, &cr, w, i64::from(d_min), n);
+    let (mut c, rows) = kept::take(w * n);
+    cost_volume_into(&cl, &cr, w, i64::from(d_min), n, &mut c);
     drop((cl, cr));
+    // Row buffers of `w * n` sums: the kept ones first, then fresh ones; a row's buffer goes
+    // back to this list once both passes have added into it.
+    let free = Mutex::new(rows);
+    let fresh = || {
+        let kept = free.lock().unwrap_or_else(|e| e.into_inner()).pop();
+        kept.unwrap_or_else(|| vec![0u16; w * n])
+    };
     // The two passes meet row by row: whichever reaches a row first leaves its sum there; the
     // second adds its own and selects the row. One volume of sums is held at most (the rows
     // each pass reached first), not one per pass; the addition commutes, so the output does
@@ -525,22 +620,24 @@ pub fn sgm_disparity(
                 match slot.take() {
                     Some(other) => other,
                     None => {
-                        *slot = Some(std::mem::replace(row, vec![0u16; w * n]));
+                        *slot = Some(std::mem::replace(row, fresh()));
                         return;
                     }
                 }
             };
             add_into(row, &other);
-            drop(other);
+            free.lock().unwrap_or_else(|e| e.into_inner()).push(other);
             let mut o = vec![f32::NAN; w];
             select_row(row, w, n, i64::from(d_min), p, &mut o);
             done.push((y, o));
         };
-        pass(&c, left.data, w, h, n, p, forward, &mut emit);
+        let mut row = fresh();
+        pass(&c, left.data, w, h, n, p, forward, &mut row, &mut emit);
+        free.lock().unwrap_or_else(|e| e.into_inner()).push(row);
         done
     };
     let (a, b) = rayon::join(|| meet(true), || meet(false));
-    drop(c);
+    kept::put(c, free.into_inner().unwrap_or_else(|e| e.into_inner()));
     let mut out = vec![f32::NAN; w * h];
     for (y, o) in a.into_iter().chain(b) {
         out[y * w..(y + 1) * w].copy_from_slice(&o);
@@ -643,6 +740,30 @@ mod tests {
         assert_eq!((cell(0, 1), cell(1, 2), cell(0, 0)), (0, 0, 0));
         let far = cost_volume(&c, &c, w, 20, 2);
         assert!(far.iter().all(|&v| v == OUTSIDE), "no level inside");
+    }
+
+    #[test]
+    fn kept_buffers_do_not_change_the_output() {
+        // Calls of other sizes in between leave a larger volume and rows of another length in
+        // the keep; the output must not depend on what they hold.
+        let (w, h) = (80, 40);
+        let (l, r) = (ramp(w, h, 0.0), ramp(w, h, 6.0));
+        let lv = ImageView::new(w, h, &l).unwrap();
+        let rv = ImageView::new(w, h, &r).unwrap();
+        let p = SgmParams::default();
+        release_kept();
+        let first = sgm_disparity(lv, rv, 0, 15, &p).unwrap();
+        let (l2, r2) = (ramp(120, 50, 0.0), ramp(120, 50, 3.0));
+        let big = (
+            ImageView::new(120, 50, &l2).unwrap(),
+            ImageView::new(120, 50, &r2).unwrap(),
+        );
+        sgm_disparity(big.0, big.1, 0, 31, &p).unwrap();
+        let again = sgm_disparity(lv, rv, 0, 15, &p).unwrap();
+        let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same(&first, &again));
+        sgm_disparity(lv, rv, 0, 15, &p).unwrap();
+        assert!(same(&first, &sgm_disparity(lv, rv, 0, 15, &p).unwrap()));
     }
 
     #[test]
