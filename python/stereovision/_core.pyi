@@ -158,6 +158,14 @@ def row_fill(disp: npt.NDArray[np.float32]) -> npt.NDArray[np.float32]:
     """A copy with each hole (non-finite) given the smaller of the nearest valid values left and
     right of it in its row (one side only: that one; none: NaN)."""
 
+def side_fill(
+    disp: npt.NDArray[np.float32], lab: npt.NDArray[np.float32], tau: float
+) -> npt.NDArray[np.float32]:
+    """A copy where each hole run with a nearer left than right neighbour in its row takes, per
+    pixel, the left value if its ``(H, W, 3)`` colour is closer to the left neighbour's by more
+    than ``tau``, else the right value; other holes stay. ``ValueError``: ``lab`` of another
+    size, a negative ``tau``."""
+
 def fattened(
     disp: npt.NDArray[np.float32],
     guide: npt.NDArray[np.float32],

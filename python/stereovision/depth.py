@@ -455,8 +455,11 @@ def depth_map(
         disparities left and right of it, i.e. the background, which is what an occluded pixel
         shows). Over the 17 GT scenes the planes lower the mean bad-2.0 ratio to SGBM-3WAY +
         fill from 0.63 to 0.53 (``"fused"``) and from 1.44 to 1.01 (``"gabor"``, whose refinement
-        then only re-measures); they cost about 60 ms on a 900x750 frame. None (default) = the
-        method's own choice: ``"fused"`` returns a dense map (filled), ``"gabor"`` leaves a
+        then only re-measures); they cost about 60 ms on a 900x750 frame. ``"fused"`` runs the
+        colour side rule between the two (:func:`stereovision.matching.planes.side_fill`: a
+        hole whose left neighbour is the nearer one is no occlusion, and takes the side its
+        colour matches; mean ratio 0.519 -> 0.514, largest 0.795 -> 0.779). None (default) =
+        the method's own choice: ``"fused"`` returns a dense map (filled), ``"gabor"`` leaves a
         pixel it is not sure of NaN. Filled pixels keep confidence 0 and get no depth or 3-D
         point. ``"fused"`` then fills dark regions locked to the range's floor inside a nearer
         surround (:func:`stereovision.matching.fusion.fill_enclosed_far`) the same way.
@@ -610,17 +613,25 @@ def depth_map(
     measured_disp = disp  # NaN where not measured; the fill below makes a new array
     if fill:
         from stereovision.baselines import row_fill
-        from stereovision.matching.planes import fill_planes
+        from stereovision.matching.planes import fill_planes, side_fill
 
-        disp = row_fill(fill_planes(disp, left_bgr)).astype(np.float32)
+        planed = fill_planes(disp, left_bgr)
         if method == "fused":
             from stereovision.matching.fusion import fill_enclosed_far
 
+            # The colour side rule before the row rule (on the Gabor channel's own holes it
+            # changed the 17-scene mean bad-2.0 by 0.01 point, so that path keeps the row rule).
+            sided = row_fill(side_fill(planed, left_bgr))
             # Dark regions locked to the range's floor inside a nearer surround: the surround's
-            # value, and no depth (the locked values were not the scene's).
-            disp, far = fill_enclosed_far(disp, gl, floor=float(min_disparity))
+            # value, and no depth (the locked values were not the scene's). They are found on
+            # the row rule's fill: the side rule can give a locked region's holes a nearer
+            # neighbour's value, and the region would then not be found whole.
+            base, far = fill_enclosed_far(row_fill(planed), gl, floor=float(min_disparity))
+            disp = np.where(far, base, sided).astype(np.float32)
             measured_disp[far] = np.nan  # fused_dense's own array, as is conf
             conf[far] = 0
+        else:
+            disp = row_fill(planed).astype(np.float32)
     depth = None
     depth_sigma = None
     points = np.zeros((0, 3), np.float32)

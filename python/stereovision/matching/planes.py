@@ -1,4 +1,5 @@
-"""Colour segments and their planes: the first half of ``depth_map``'s hole fill.
+"""Colour segments and their planes, and the colour side rule: ``depth_map``'s hole fill before
+the reference row rule.
 
 A hole left in a dense map (an occluded strip, a patch no matcher was sure of, the left band
 whose match lies outside the right image) usually belongs to a surface that was measured around
@@ -29,7 +30,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["DEFAULTS", "fill_planes", "plane_fill", "segments"]
+__all__ = ["DEFAULTS", "fill_planes", "plane_fill", "segments", "side_fill"]
 
 F32 = npt.NDArray[np.float32]
 
@@ -217,3 +218,79 @@ def fill_planes(
     u8 = np.ascontiguousarray(im[:, :, None] if im.ndim == 2 else im)
     steps = [(int(step), int(min_pixels)) for step, min_pixels in passes]
     return _core.fill_planes(d, u8, steps, float(max_residual))
+
+
+#: The colour side rule's defaults (:func:`side_fill`): chosen once on the 17 GT scenes.
+SIDE_TAU = 5.0  # CIE Lab units (OpenCV's 8-bit scale): how much closer the left colour must be
+SIDE_BLUR = 1.0  # px: Gaussian sigma of the left image before its colours are compared
+
+
+def side_fill(
+    disp: npt.ArrayLike,
+    image: npt.ArrayLike,
+    *,
+    tau: float = SIDE_TAU,
+    blur: float = SIDE_BLUR,
+) -> F32:
+    """The colour side rule: the holes the reference row rule would fill on the wrong side.
+
+    The row rule (:func:`stereovision.baselines.row_fill`) gives a hole the smaller, background
+    disparity of its row neighbours. That is right for the strips an occlusion leaves: in the
+    left view such a strip lies left of the nearer surface, so its left neighbour is the farther
+    one. A hole run whose *left* neighbour is the nearer one is no occlusion (a patch no matcher
+    was sure of, a fattened edge the dense map dropped) and belongs to either side as likely:
+    here each pixel takes the left value where its colour is closer to the left neighbour's by
+    more than ``tau``, else the right value. Other holes stay NaN for the row rule. Over the 17
+    GT scenes the fused map's mean bad-2.0 ratio to SGBM-3WAY + fill goes from 0.519 to 0.514
+    and its largest from 0.795 to 0.779 (tsukuba), no scene worse by more than 0.001 (README,
+    "Fusion"). Rust kernel (``_core.side_fill``; NumPy reference
+    ``tests/reference/row_fill_ref.py``).
+
+    Parameters
+    ----------
+    disp : array_like
+        ``(H, W)`` disparity, NaN (or any non-finite value) = hole.
+    image : array_like
+        The left image, ``(H, W)`` grey or ``(H, W, 3)`` BGR, uint8 (other types are clipped to
+        0-255).
+    tau : float
+        How much closer (CIE Lab distance, OpenCV's 8-bit scale) a pixel's colour must be to the
+        left neighbour's for the left value.
+    blur : float
+        Gaussian sigma (px) of the image before the colours are compared; 0 for none.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` float32, a new array; valid values unchanged.
+
+    Raises
+    ------
+    ValueError
+        ``disp`` not 2-D, an image of another size or with a channel count other than 1 or 3,
+        a negative ``tau`` or ``blur``.
+    """
+    import cv2
+
+    from stereovision import _core
+
+    d = np.ascontiguousarray(disp, dtype=np.float32)
+    if d.ndim != 2:
+        raise ValueError(f"disp: expected an (H, W) array, got {d.shape}")
+    im = np.asarray(image)
+    if (
+        im.shape[:2] != d.shape
+        or im.ndim not in (2, 3)
+        or (im.ndim == 3 and im.shape[2] not in (1, 3))
+    ):
+        raise ValueError(
+            f"image: expected (H, W) or (H, W, 3) with (H, W) = {d.shape}, got {im.shape}"
+        )
+    if not (np.isfinite(blur) and blur >= 0):
+        raise ValueError(f"blur: expected a non-negative number, got {blur}")
+    if np.isfinite(d).all():
+        return d.copy()
+    u8 = _blurred(im, blur)
+    bgr = cv2.cvtColor(u8, cv2.COLOR_GRAY2BGR) if u8.ndim == 2 or u8.shape[2] == 1 else u8
+    lab = np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2LAB), np.float32)
+    return _core.side_fill(d, lab, float(tau))

@@ -1,5 +1,6 @@
 //! The reference hole fill of evaluation.md, used by the evaluation and by the fused dense map
-//! (NumPy reference: `tests/reference/row_fill_ref.py`, bit-identical).
+//! (NumPy reference: `tests/reference/row_fill_ref.py`, bit-identical), and the colour side rule
+//! the dense map runs before it ([`side_fill`]).
 //!
 //! Along each row a hole (any non-finite value) takes the smaller, i.e. the background, of the
 //! nearest valid disparity to its left and the nearest valid disparity to its right; with a
@@ -37,9 +38,104 @@ pub(crate) fn fill_row(row: &mut [f32], left: &mut [f32]) {
     }
 }
 
+/// The colour side rule, run before [`row_fill`] (NumPy reference:
+/// `tests/reference/row_fill_ref.py`, bit-identical): a hole run between a nearer valid value on
+/// its left and a farther one on its right takes, pixel by pixel, the left value where the
+/// pixel's colour is closer to the left neighbour's than to the right neighbour's by more than
+/// `tau`, and the right value otherwise. The row rule's background preference is right for the
+/// runs an occlusion leaves (in the left view the occluded strip lies left of the nearer
+/// surface, so its left neighbour is the farther one), and those runs are left to it, as are
+/// the runs that touch the row's ends. A run with a nearer left side is no occlusion: what is
+/// missing there (a patch no matcher was sure of, a foreground edge the dense map dropped) is
+/// as likely to belong to either side, and the colour tells which.
+///
+/// `lab` is row-major `(H, W, 3)` colour (the caller's: CIE Lab of the blurred left image); the
+/// distance is Euclidean. Rows run in parallel and independently, so the result does not depend
+/// on the thread count.
+///
+/// # Panics
+/// If `lab.len() != 3 * disp.len()`.
+pub fn side_fill(disp: &mut [f32], lab: &[f32], w: usize, tau: f32) {
+    assert_eq!(
+        lab.len(),
+        3 * disp.len(),
+        "lab must hold 3 values per pixel"
+    );
+    if w == 0 {
+        return;
+    }
+    disp.par_chunks_mut(w)
+        .zip(lab.par_chunks(3 * w))
+        .for_each(|(row, lab)| side_row(row, lab, tau));
+}
+
+/// Euclidean distance of two colours (the reference sums the squares in the same order).
+#[inline]
+fn colour_distance(a: &[f32], b: &[f32]) -> f32 {
+    let (x, y, z) = (a[0] - b[0], a[1] - b[1], a[2] - b[2]);
+    (x * x + y * y + z * z).sqrt()
+}
+
+/// One row of [`side_fill`].
+fn side_row(row: &mut [f32], lab: &[f32], tau: f32) {
+    let w = row.len();
+    let mut x = 0;
+    while x < w {
+        if row[x].is_finite() {
+            x += 1;
+            continue;
+        }
+        let a = x;
+        while x < w && !row[x].is_finite() {
+            x += 1;
+        }
+        if a == 0 || x == w {
+            continue; // a run at an end of the row: the row rule's
+        }
+        let (vl, vr) = (row[a - 1], row[x]);
+        if vl <= vr {
+            continue; // the occlusion pattern (or equal sides): the row rule's
+        }
+        let (cl, cr) = (&lab[3 * (a - 1)..3 * a], &lab[3 * x..3 * x + 3]);
+        for (p, v) in row[a..x].iter_mut().enumerate() {
+            let c = &lab[3 * (a + p)..3 * (a + p) + 3];
+            *v = if colour_distance(c, cl) + tau < colour_distance(c, cr) {
+                vl
+            } else {
+                vr
+            };
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_side_rule_follows_the_colour_where_the_left_is_nearer() {
+        let nan = f32::NAN;
+        // Row 0: nearer left (5) than right (2); pixels 2-3 have the left colour, 4 the right's.
+        // Row 1: farther left (1) than right (4): the occlusion pattern, left to the row rule.
+        // Row 2: a run at the row's start: left to the row rule.
+        let mut d = vec![
+            5.0, 5.0, nan, nan, nan, 2.0, //
+            1.0, nan, nan, nan, nan, 4.0, //
+            nan, nan, 3.0, nan, nan, 1.0,
+        ];
+        let colours: [f32; 18] = [
+            10.0, 10.0, 10.0, 11.0, 50.0, 50.0, //
+            0.0, 0.0, 0.0, 0.0, 0.0, 0.0, //
+            0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+        ];
+        let lab: Vec<f32> = colours.iter().flat_map(|&c| [c, 0.0, 0.0]).collect();
+        side_fill(&mut d, &lab, 6, 5.0);
+        assert_eq!(&d[..6], &[5.0, 5.0, 5.0, 5.0, 2.0, 2.0]);
+        assert!(d[7..11].iter().all(|v| v.is_nan()));
+        assert!(d[12].is_nan() && d[13].is_nan());
+        // Pixels 15-16 (between 3 and 1, all colours equal): not closer to the left by tau.
+        assert_eq!(&d[15..17], &[1.0, 1.0]);
+    }
 
     #[test]
     fn fills_with_the_background_side() {

@@ -3,11 +3,11 @@
 use crate::convert::{map_copy_in_place, row_major, vec_to_numpy};
 use crate::errors::guard;
 use crate::params::non_negative;
-use numpy::{PyArray2, PyReadonlyArray2};
+use numpy::{PyArray2, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use stereovision_core::edges::{fattened as core_fattened, FattenParams};
-use stereovision_core::fill::row_fill as core_row_fill;
+use stereovision_core::fill::{row_fill as core_row_fill, side_fill as core_side_fill};
 
 /// A copy of `disp` with its holes filled by the reference row rule (module docs of the core).
 #[pyfunction]
@@ -16,6 +16,27 @@ pub fn row_fill<'py>(
     disp: PyReadonlyArray2<'py, f32>,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     Ok(map_copy_in_place(py, &disp, |d, w, _| core_row_fill(d, w))?.0)
+}
+
+/// A copy of `disp` with the colour side rule applied (`(H, W, 3)` `lab`; core docs).
+#[pyfunction]
+#[pyo3(signature = (disp, lab, tau))]
+pub fn side_fill<'py>(
+    py: Python<'py>,
+    disp: PyReadonlyArray2<'py, f32>,
+    lab: PyReadonlyArray3<'py, f32>,
+    tau: f32,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    non_negative("tau", tau)?;
+    let (h, w) = disp.as_array().dim();
+    if lab.shape() != [h, w, 3] {
+        return Err(PyValueError::new_err(format!(
+            "lab: expected shape ({h}, {w}, 3) like disp, got {:?}",
+            lab.shape()
+        )));
+    }
+    let lab = row_major(&lab);
+    Ok(map_copy_in_place(py, &disp, |d, w, _| core_side_fill(d, &lab, w, tau))?.0)
 }
 
 /// The pixels of `disp` a matcher carried past an edge of `guide` (`(H, W)` bool; core docs).

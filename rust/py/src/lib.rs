@@ -64,6 +64,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(refine::refine_disparity, m)?)?;
     m.add_function(wrap_pyfunction!(sgm::sgm_disparity, m)?)?;
     m.add_function(wrap_pyfunction!(fill::row_fill, m)?)?;
+    m.add_function(wrap_pyfunction!(fill::side_fill, m)?)?;
     m.add_function(wrap_pyfunction!(fill::fattened, m)?)?;
     m.add_function(wrap_pyfunction!(segment::graph_segments, m)?)?;
     m.add_function(wrap_pyfunction!(segment::plane_fill, m)?)?;
