@@ -5,7 +5,8 @@ For each scene: OpenCV SGBM-3WAY (evaluation.md configuration), the whole defaul
 census semi-global map), then the stages after the channels on their cached outputs: the vote
 (:func:`fuse`), the member checks ``fuse_pair`` runs (B.8's both-sides check on the members MCGM is
 not part of, the edge check on the re-measured Gabor map), the dense map (:func:`fused_dense`) and
-the fill (:func:`fill_planes`, then the reference row rule, then the enclosed far regions).
+the fill (:func:`~stereovision.depth.fill_holes`: the planes, the colour side rule, the reference
+row rule, the enclosed far regions).
 Interleaved (SGBM, whole, channel, ..., SGBM, ...), median of ``--repeats`` after a warm-up;
 each case's ms and its ratio to SGBM.
 The channels run side by side in ``depth_map`` (their times do not add up to its own); the
@@ -26,13 +27,13 @@ from _common import DATA, interleaved_ms
 
 from stereovision import depth_map
 from stereovision._validate import as_gray_float
-from stereovision.baselines import opencv_sgbm, row_fill
+from stereovision.baselines import opencv_sgbm
+from stereovision.depth import fill_holes
 from stereovision.io import load_scene
 from stereovision.matching import fusion
 from stereovision.matching.gabor import gabor_disparity
 from stereovision.matching.hopfield import hopfield_match
 from stereovision.matching.mcgm import mcgm_match
-from stereovision.matching.planes import fill_planes
 from stereovision.matching.sgm import sgm_disparity
 
 SCENES = ("middlebury2006/cloth3", "middeval3/teddyH")
@@ -77,7 +78,7 @@ def cases(scene: Path) -> dict[str, Callable[[], object]]:
         "after: vote": lambda: fusion.fuse((base, g.confidence), sparse),
         "after: member checks": checks,
         "after: dense map": dense,
-        "after: fill": lambda: fusion.fill_enclosed_far(row_fill(fill_planes(d, sc.left)), gl),
+        "after: fill": lambda: fill_holes(d, sc.left, fused=True, grey=gl),
     }
 
 

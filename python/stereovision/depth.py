@@ -330,6 +330,61 @@ def _run_matcher(
     raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
 
 
+def fill_holes(
+    disp: npt.NDArray[np.float32],
+    left_bgr: npt.NDArray[np.uint8],
+    *,
+    fused: bool,
+    floor: float = 0.0,
+    grey: npt.NDArray[np.float32] | None = None,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.bool_] | None]:
+    """``depth_map``'s fill (``fill=True``): ``(filled map, enclosed far regions or None)``.
+
+    The planes of colour segments (:func:`stereovision.matching.planes.fill_planes`), then the
+    reference row rule. ``fused``: the colour side rule between the two
+    (:func:`stereovision.matching.planes.side_fill`; on the Gabor channel's own holes it moved
+    the 17-scene mean bad-2.0 by 0.01 point, so that path keeps the row rule), and the dark
+    regions locked to the range's ``floor`` inside a nearer surround take the surround's value
+    (:func:`stereovision.matching.fusion.fill_enclosed_far`); their mask is returned (they get
+    no depth: the locked values were not the scene's).
+
+    Parameters
+    ----------
+    disp : numpy.ndarray
+        ``(H, W)`` float32 disparity, NaN = hole.
+    left_bgr : numpy.ndarray
+        The left (rectified) image, ``(H, W, 3)`` BGR uint8.
+    fused : bool
+        The fused map's fill (side rule, enclosed far regions) or the Gabor channel's.
+    floor : float
+        The range's smallest disparity (``min_disparity``).
+    grey : numpy.ndarray, optional
+        The left image as ``(H, W)`` float32 in ``[0, 1]`` (``depth_map``'s); None: made from
+        ``left_bgr``.
+
+    Returns
+    -------
+    disparity : numpy.ndarray
+        ``(H, W)`` float32, NaN only in rows with no valid value.
+    far : numpy.ndarray or None
+        ``(H, W)`` bool, the enclosed far regions (``fused`` only).
+    """
+    from stereovision.baselines import row_fill
+    from stereovision.matching.planes import fill_planes, side_fill
+
+    planed = fill_planes(disp, left_bgr)
+    if not fused:
+        return row_fill(planed).astype(np.float32), None
+    from stereovision.matching.fusion import fill_enclosed_far
+
+    sided = row_fill(side_fill(planed, left_bgr))
+    # The far regions are found on the row rule's fill: the side rule can give a locked
+    # region's holes a nearer neighbour's value, and the region would then not be found whole.
+    gl = as_gray_float(left_bgr, "left") if grey is None else grey
+    base, far = fill_enclosed_far(row_fill(planed), gl, floor=floor)
+    return np.where(far, base, sided).astype(np.float32), far
+
+
 @functools.lru_cache(maxsize=2)
 def _pixel_grids(
     w: int, h: int, fx: float, fy: float, cx: float, cy: float
@@ -612,26 +667,11 @@ def depth_map(
         stage("refine")
     measured_disp = disp  # NaN where not measured; the fill below makes a new array
     if fill:
-        from stereovision.baselines import row_fill
-        from stereovision.matching.planes import fill_planes, side_fill
-
-        planed = fill_planes(disp, left_bgr)
-        if method == "fused":
-            from stereovision.matching.fusion import fill_enclosed_far
-
-            # The colour side rule before the row rule (on the Gabor channel's own holes it
-            # changed the 17-scene mean bad-2.0 by 0.01 point, so that path keeps the row rule).
-            sided = row_fill(side_fill(planed, left_bgr))
-            # Dark regions locked to the range's floor inside a nearer surround: the surround's
-            # value, and no depth (the locked values were not the scene's). They are found on
-            # the row rule's fill: the side rule can give a locked region's holes a nearer
-            # neighbour's value, and the region would then not be found whole.
-            base, far = fill_enclosed_far(row_fill(planed), gl, floor=float(min_disparity))
-            disp = np.where(far, base, sided).astype(np.float32)
+        fused = method == "fused"
+        disp, far = fill_holes(disp, left_bgr, fused=fused, floor=float(min_disparity), grey=gl)
+        if far is not None:
             measured_disp[far] = np.nan  # fused_dense's own array, as is conf
             conf[far] = 0
-        else:
-            disp = row_fill(planed).astype(np.float32)
     depth = None
     depth_sigma = None
     points = np.zeros((0, 3), np.float32)
