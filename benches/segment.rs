@@ -1,13 +1,14 @@
 //! Criterion bench of the fused map's plane fill and edge step: equal-colour segments (`k = 0`,
 //! and the quantised regions the fill uses), Felzenszwalb segments (`k = 300`), the per-segment
-//! plane fits, the whole fill (`fill_planes`: two passes of two cuts each) and the fattened-edge
-//! marks (`edges::fattened`), at 640x480 on a synthetic image of quantised blocks and a slanted
+//! plane fits, the whole fill (`fill_planes`: two passes of two cuts each), the fattened-edge
+//! marks (`edges::fattened`) and the colour side and row rules (`fill`), at 640x480 on a synthetic image of quantised blocks and a slanted
 //! map with a hole every 5th pixel (and a raised square for the edges).
 //! Throughput is pixels per second.
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use stereovision_core::edges::{fattened, FattenParams};
+use stereovision_core::fill::{row_fill, side_fill};
 use stereovision_core::segment::{fill_planes, graph_segments, plane_fill, quantised_regions};
 
 fn bench_segment(c: &mut Criterion) {
@@ -87,6 +88,26 @@ fn bench_segment(c: &mut Criterion) {
     };
     g.bench_function("fattened", |b| {
         b.iter(|| fattened(&raised, &grey, w, h, &fp))
+    });
+    // The fill's last two steps on the raised map: the colour side rule (its holes next to the
+    // square's left edge have a nearer left side half the time) and the reference row rule.
+    let lab: Vec<f32> = grey
+        .iter()
+        .flat_map(|&v| [v * 255.0, 128.0, 128.0])
+        .collect();
+    g.bench_function("side_fill", |b| {
+        b.iter(|| {
+            let mut d = raised.clone();
+            side_fill(&mut d, &lab, w, 5.0);
+            d
+        })
+    });
+    g.bench_function("row_fill", |b| {
+        b.iter(|| {
+            let mut d = raised.clone();
+            row_fill(&mut d, w);
+            d
+        })
     });
     g.finish();
 }
