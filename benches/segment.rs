@@ -1,8 +1,9 @@
 //! Criterion bench of the fused map's plane fill and edge step: equal-colour segments (`k = 0`,
 //! and the quantised regions the fill uses), Felzenszwalb segments (`k = 300`), the per-segment
 //! plane fits, the whole fill (`fill_planes`: two passes of two cuts each), the fattened-edge
-//! marks (`edges::fattened`) and the colour side and row rules (`fill`), at 640x480 on a synthetic image of quantised blocks and a slanted
-//! map with a hole every 5th pixel (and a raised square for the edges).
+//! marks (`edges::fattened`) and the colour side and row rules (`fill`), at 640x480 on a
+//! synthetic image of quantised blocks and a slanted map with a hole every 5th pixel (and a
+//! raised square for the edges).
 //! Throughput is pixels per second.
 use std::time::Duration;
 
