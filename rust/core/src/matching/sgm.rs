@@ -243,20 +243,76 @@ fn p2_at(a: f32, b: f32, gamma: f32, lut: &[u16]) -> u16 {
     lut[q.min(lut.len() - 1)]
 }
 
+/// A path cost: `u16` always fits; `u8` fits when [`u8_fits`] (the default parameters), and then
+/// halves the path buffers' memory traffic and doubles the lanes per vector. Both give the same
+/// integers (see [`PathCost::step`]).
+trait PathCost: Copy + Ord {
+    /// Pad around each path-cost vector: at least any path cost plus P1.
+    const PAD: Self;
+    const MAX: Self;
+    fn of(v: u16) -> Self;
+    fn wide(self) -> u16;
+    /// `c + min(b, min(a, n) + p1, lim) - m`, with `m <= min(b, ...)` and `lim = m + p2`.
+    fn step(c: Self, a: Self, b: Self, n: Self, p1: Self, lim: Self, m: Self) -> Self;
+}
+
+impl PathCost for u16 {
+    const PAD: Self = BIG;
+    const MAX: Self = u16::MAX;
+    #[inline(always)]
+    fn of(v: u16) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn wide(self) -> u16 {
+        self
+    }
+    #[inline(always)]
+    fn step(c: Self, a: Self, b: Self, n: Self, p1: Self, lim: Self, m: Self) -> Self {
+        c + b.min(a.min(n) + p1).min(lim) - m
+    }
+}
+
+impl PathCost for u8 {
+    const PAD: Self = u8::MAX;
+    const MAX: Self = u8::MAX;
+    #[inline(always)]
+    fn of(v: u16) -> Self {
+        v as u8 // callers pass values below 256 (`u8_fits`)
+    }
+    #[inline(always)]
+    fn wide(self) -> u16 {
+        u16::from(self)
+    }
+    #[inline(always)]
+    fn step(c: Self, a: Self, b: Self, n: Self, p1: Self, lim: Self, m: Self) -> Self {
+        // `min(a, n) + p1` saturates only above `lim` (<= 255), where the minimum is `lim`
+        // either way; the result is at most `c + p2`, below 256 when `u8_fits`.
+        (b.min(a.min(n).saturating_add(p1)).min(lim) - m) + c
+    }
+}
+
+/// Whether path costs fit `u8`: a path cost is at most `OUTSIDE + P2`, and `m + P2` (the jump
+/// limit) at most `OUTSIDE + 2 P2`, which must stay below 256 (the default P2 96 gives 255).
+fn u8_fits(lut: &[u16]) -> bool {
+    let p2_max = lut.iter().copied().max().unwrap_or(0);
+    u32::from(OUTSIDE) + 2 * u32::from(p2_max) <= 255
+}
+
 /// The four paths' step at one pixel: for each path `r`,
 /// `out_r[k] = c[k] + min(lp_r[k], lp_r[k +- 1] + p1, m_r + p2_r) - m_r` (`lp_r`, `out_r`: `n + 2`
-/// values with a [`BIG`] pad at each end; `m_r` = min of `lp_r`; a path's first pixel has a zero
+/// values with a pad at each end; `m_r` = min of `lp_r`; a path's first pixel has a zero
 /// `lp_r`, which gives `out_r = c`). Writes their sum to `acc` and returns their minima.
 #[inline(always)]
-fn step4(
-    lp: [&[u16]; 4],
-    m: [u16; 4],
+fn step4<T: PathCost>(
+    lp: [&[T]; 4],
+    m: [T; 4],
     p2: [u16; 4],
     p1: u16,
     c: &[u8],
-    out: [&mut [u16]; 4],
+    out: [&mut [T]; 4],
     acc: &mut [u16],
-) -> [u16; 4] {
+) -> [T; 4] {
     let n = c.len();
     let acc = &mut acc[..n];
     let [o0, o1, o2, o3] = out;
@@ -268,19 +324,20 @@ fn step4(
     );
     let lo = |r: usize| (&lp[r][..n], &lp[r][1..n + 1], &lp[r][2..n + 2]);
     let ((a0, b0, c0), (a1, b1, c1), (a2, b2, c2), (a3, b3, c3)) = (lo(0), lo(1), lo(2), lo(3));
-    let lim = [m[0] + p2[0], m[1] + p2[1], m[2] + p2[2], m[3] + p2[3]];
-    let mut mn = [u16::MAX; 4];
+    let lim: [T; 4] = std::array::from_fn(|r| T::of(m[r].wide() + p2[r]));
+    let p1 = T::of(p1);
+    let mut mn = [T::MAX; 4];
     for k in 0..n {
-        let ck = u16::from(c[k]);
-        let v0 = ck + b0[k].min(a0[k].min(c0[k]) + p1).min(lim[0]) - m[0];
-        let v1 = ck + b1[k].min(a1[k].min(c1[k]) + p1).min(lim[1]) - m[1];
-        let v2 = ck + b2[k].min(a2[k].min(c2[k]) + p1).min(lim[2]) - m[2];
-        let v3 = ck + b3[k].min(a3[k].min(c3[k]) + p1).min(lim[3]) - m[3];
+        let ck = T::of(u16::from(c[k]));
+        let v0 = T::step(ck, a0[k], b0[k], c0[k], p1, lim[0], m[0]);
+        let v1 = T::step(ck, a1[k], b1[k], c1[k], p1, lim[1], m[1]);
+        let v2 = T::step(ck, a2[k], b2[k], c2[k], p1, lim[2], m[2]);
+        let v3 = T::step(ck, a3[k], b3[k], c3[k], p1, lim[3], m[3]);
         o0[k] = v0;
         o1[k] = v1;
         o2[k] = v2;
         o3[k] = v3;
-        acc[k] = v0 + v1 + v2 + v3;
+        acc[k] = v0.wide() + v1.wide() + v2.wide() + v3.wide();
         mn[0] = mn[0].min(v0);
         mn[1] = mn[1].min(v1);
         mn[2] = mn[2].min(v2);
@@ -289,10 +346,96 @@ fn step4(
     mn
 }
 
+/// Four paths in one raster (`forward`) or reverse raster pass; hands each row's summed costs
+/// to `emit`. Path costs are kept as `T` ([`PathCost`]).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn pass_impl<T: PathCost>(
+    c: &[u8],
+    img: &[f32],
+    w: usize,
+    h: usize,
+    n: usize,
+    p: &SgmParams,
+    forward: bool,
+    row: &mut Vec<u16>,
+    emit: &mut dyn FnMut(usize, &mut Vec<u16>),
+) {
+    let stride = n + 2;
+    let lut = p2_table(p);
+    // `row`: the four paths' sum for one row (`w * n` values); `emit` may swap in another
+    // buffer. Every entry is written before it is read, so its contents do not matter.
+    // Path costs of the previous row for the vertical path and the diagonals whose
+    // predecessor is at x - sgn and x + sgn; index x * stride.
+    let mut prev: [Vec<T>; 3] = std::array::from_fn(|_| vec![T::PAD; w * stride]);
+    let mut cur: [Vec<T>; 3] = std::array::from_fn(|_| vec![T::PAD; w * stride]);
+    let mut prev_min = [vec![T::of(0); w], vec![T::of(0); w], vec![T::of(0); w]];
+    let mut cur_min = [vec![T::of(0); w], vec![T::of(0); w], vec![T::of(0); w]];
+    let mut hl = vec![T::PAD; stride];
+    let mut hl_next = vec![T::PAD; stride];
+    // A path's first pixel steps from zeros (its output is then its cost).
+    let mut zero = vec![T::of(0); stride];
+    zero[0] = T::PAD;
+    zero[n + 1] = T::PAD;
+    let sgn: isize = if forward { 1 } else { -1 };
+    for i in 0..h {
+        let y = if forward { i } else { h - 1 - i };
+        let yp = y as isize - sgn; // predecessor row
+        let irow = &img[y * w..(y + 1) * w];
+        let prow =
+            (yp >= 0 && yp < h as isize).then(|| &img[yp as usize * w..(yp as usize + 1) * w]);
+        let mut hmin = T::of(0);
+        for j in 0..w {
+            let x = if forward { j } else { w - 1 - j };
+            let ci = &c[(y * w + x) * n..(y * w + x + 1) * n];
+            let acc = &mut row[x * n..(x + 1) * n];
+            let v = irow[x];
+            let mut lps: [&[T]; 4] = [&zero; 4];
+            let mut ms = [T::of(0); 4];
+            let mut p2s = [0u16; 4];
+            if j > 0 {
+                // Horizontal path, predecessor x - sgn on this row.
+                lps[0] = &hl;
+                ms[0] = hmin;
+                p2s[0] = p2_at(v, irow[(x as isize - sgn) as usize], p.gamma, &lut);
+            }
+            if let Some(pr) = prow {
+                // Vertical and diagonal paths from the previous row.
+                for (r, dx) in [(0usize, 0isize), (1, -sgn), (2, sgn)] {
+                    let xp = x as isize + dx;
+                    if xp >= 0 && xp < w as isize {
+                        let xp = xp as usize;
+                        lps[r + 1] = &prev[r][xp * stride..(xp + 1) * stride];
+                        ms[r + 1] = prev_min[r][xp];
+                        p2s[r + 1] = p2_at(v, pr[xp], p.gamma, &lut);
+                    }
+                }
+            }
+            let [c0, c1, c2] = &mut cur;
+            let outs = [
+                &mut hl_next[..],
+                &mut c0[x * stride..(x + 1) * stride],
+                &mut c1[x * stride..(x + 1) * stride],
+                &mut c2[x * stride..(x + 1) * stride],
+            ];
+            let mn = step4(lps, ms, p2s, p.p1, ci, outs, acc);
+            hmin = mn[0];
+            for r in 0..3 {
+                cur_min[r][x] = mn[r + 1];
+            }
+            std::mem::swap(&mut hl, &mut hl_next);
+        }
+        // Every x of `cur` and `cur_min` is written in the next row before it is read.
+        std::mem::swap(&mut prev, &mut cur);
+        std::mem::swap(&mut prev_min, &mut cur_min);
+        emit(y, row);
+    }
+}
+
 simd_fn! {
-    /// Four paths in one raster (`forward`) or reverse raster pass; returns their summed costs.
-    /// (Compiled for AVX2 too: the per-level loop of the four paths vectorises.)
-    fn pass(
+    /// [`pass_impl`] with `u8` path costs (compiled for AVX2 too: the per-level loop of the
+    /// four paths vectorises).
+    fn pass_u8(
         c: &[u8],
         img: &[f32],
         w: usize,
@@ -303,74 +446,45 @@ simd_fn! {
         row: &mut Vec<u16>,
         emit: &mut dyn FnMut(usize, &mut Vec<u16>),
     ) {
-        let stride = n + 2;
-        let lut = p2_table(p);
-        // `row`: the four paths' sum for one row (`w * n` values); `emit` may swap in another
-        // buffer. Every entry is written before it is read, so its contents do not matter.
-        // Path costs of the previous row for the vertical path and the diagonals whose
-        // predecessor is at x - sgn and x + sgn; index x * stride.
-        let mut prev: [Vec<u16>; 3] = std::array::from_fn(|_| vec![BIG; w * stride]);
-        let mut cur: [Vec<u16>; 3] = std::array::from_fn(|_| vec![BIG; w * stride]);
-        let mut prev_min = [vec![0u16; w], vec![0u16; w], vec![0u16; w]];
-        let mut cur_min = [vec![0u16; w], vec![0u16; w], vec![0u16; w]];
-        let mut hl = vec![BIG; stride];
-        let mut hl_next = vec![BIG; stride];
-        // A path's first pixel steps from zeros (its output is then its cost).
-        let mut zero = vec![0u16; stride];
-        zero[0] = BIG;
-        zero[n + 1] = BIG;
-        let sgn: isize = if forward { 1 } else { -1 };
-        for i in 0..h {
-            let y = if forward { i } else { h - 1 - i };
-            let yp = y as isize - sgn; // predecessor row
-            let irow = &img[y * w..(y + 1) * w];
-            let prow = (yp >= 0 && yp < h as isize).then(|| &img[yp as usize * w..(yp as usize + 1) * w]);
-            let mut hmin = 0u16;
-            for j in 0..w {
-                let x = if forward { j } else { w - 1 - j };
-                let ci = &c[(y * w + x) * n..(y * w + x + 1) * n];
-                let acc = &mut row[x * n..(x + 1) * n];
-                let v = irow[x];
-                let mut lps: [&[u16]; 4] = [&zero; 4];
-                let mut ms = [0u16; 4];
-                let mut p2s = [0u16; 4];
-                if j > 0 {
-                    // Horizontal path, predecessor x - sgn on this row.
-                    lps[0] = &hl;
-                    ms[0] = hmin;
-                    p2s[0] = p2_at(v, irow[(x as isize - sgn) as usize], p.gamma, &lut);
-                }
-                if let Some(pr) = prow {
-                    // Vertical and diagonal paths from the previous row.
-                    for (r, dx) in [(0usize, 0isize), (1, -sgn), (2, sgn)] {
-                        let xp = x as isize + dx;
-                        if xp >= 0 && xp < w as isize {
-                            let xp = xp as usize;
-                            lps[r + 1] = &prev[r][xp * stride..(xp + 1) * stride];
-                            ms[r + 1] = prev_min[r][xp];
-                            p2s[r + 1] = p2_at(v, pr[xp], p.gamma, &lut);
-                        }
-                    }
-                }
-                let [c0, c1, c2] = &mut cur;
-                let outs = [
-                    &mut hl_next[..],
-                    &mut c0[x * stride..(x + 1) * stride],
-                    &mut c1[x * stride..(x + 1) * stride],
-                    &mut c2[x * stride..(x + 1) * stride],
-                ];
-                let mn = step4(lps, ms, p2s, p.p1, ci, outs, acc);
-                hmin = mn[0];
-                for r in 0..3 {
-                    cur_min[r][x] = mn[r + 1];
-                }
-                std::mem::swap(&mut hl, &mut hl_next);
-            }
-            // Every x of `cur` and `cur_min` is written in the next row before it is read.
-            std::mem::swap(&mut prev, &mut cur);
-            std::mem::swap(&mut prev_min, &mut cur_min);
-            emit(y, row);
-        }
+        pass_impl::<u8>(c, img, w, h, n, p, forward, row, emit)
+    }
+}
+
+simd_fn! {
+    /// [`pass_impl`] with `u16` path costs (any parameters).
+    fn pass_u16(
+        c: &[u8],
+        img: &[f32],
+        w: usize,
+        h: usize,
+        n: usize,
+        p: &SgmParams,
+        forward: bool,
+        row: &mut Vec<u16>,
+        emit: &mut dyn FnMut(usize, &mut Vec<u16>),
+    ) {
+        pass_impl::<u16>(c, img, w, h, n, p, forward, row, emit)
+    }
+}
+
+/// Four paths in one raster (`forward`) or reverse raster pass; returns their summed costs
+/// through `emit`. `u8` path costs where they fit ([`u8_fits`]), else `u16`: the same integers.
+#[allow(clippy::too_many_arguments)]
+fn pass(
+    c: &[u8],
+    img: &[f32],
+    w: usize,
+    h: usize,
+    n: usize,
+    p: &SgmParams,
+    forward: bool,
+    row: &mut Vec<u16>,
+    emit: &mut dyn FnMut(usize, &mut Vec<u16>),
+) {
+    if u8_fits(&p2_table(p)) {
+        pass_u8(c, img, w, h, n, p, forward, row, emit)
+    } else {
+        pass_u16(c, img, w, h, n, p, forward, row, emit)
     }
 }
 
@@ -764,6 +878,45 @@ mod tests {
         assert!(same(&first, &again));
         sgm_disparity(lv, rv, 0, 15, &p).unwrap();
         assert!(same(&first, &sgm_disparity(lv, rv, 0, 15, &p).unwrap()));
+    }
+
+    /// Every row's summed path costs of one pass, with `u8` or `u16` path costs.
+    fn pass_rows(u8_costs: bool, forward: bool, p: &SgmParams) -> Vec<(usize, Vec<u16>)> {
+        let (w, h, n) = (90, 40, 24);
+        let (l, r) = (ramp(w, h, 0.0), ramp(w, h, 7.0));
+        // Strong steps too: the intensity-adaptive P2 takes all its levels.
+        let l: Vec<f32> = l
+            .iter()
+            .enumerate()
+            .map(|(i, v)| if i % 13 < 2 { 1.0 } else { *v })
+            .collect();
+        let cl = census(ImageView::new(w, h, &l).unwrap());
+        let cr = census(ImageView::new(w, h, &r).unwrap());
+        let c = cost_volume(&cl, &cr, w, -3, n);
+        let mut rows = Vec::new();
+        let mut emit = |y: usize, row: &mut Vec<u16>| rows.push((y, row.clone()));
+        let mut row = vec![0u16; w * n];
+        let run = if u8_costs { pass_u8 } else { pass_u16 };
+        run(&c, &l, w, h, n, p, forward, &mut row, &mut emit);
+        rows
+    }
+
+    #[test]
+    fn u8_and_u16_path_costs_give_the_same_sums() {
+        let p = SgmParams::default();
+        assert!(u8_fits(&p2_table(&p)));
+        for forward in [true, false] {
+            assert_eq!(pass_rows(true, forward, &p), pass_rows(false, forward, &p));
+        }
+        // The largest P2 that fits, with the smallest gamma (every step a full P2 or P1 + 1).
+        let edge = SgmParams {
+            p2: 96,
+            gamma: 0.5,
+            ..p
+        };
+        assert_eq!(pass_rows(true, true, &edge), pass_rows(false, true, &edge));
+        let over = SgmParams { p2: 97, ..p };
+        assert!(!u8_fits(&p2_table(&over)));
     }
 
     #[test]
