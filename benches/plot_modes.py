@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -40,8 +41,8 @@ def main() -> None:
     valid = np.isfinite(gt) & (gt > 0)
     md = sc.max_disparity
 
-    def mode(**kw: object) -> np.ndarray:
-        return depth_map(sc.left, sc.right, max_disparity=md, **kw).disparity  # type: ignore[arg-type]
+    def mode(**kw: Any) -> np.ndarray:
+        return depth_map(sc.left, sc.right, max_disparity=md, **kw).disparity
 
     maps = {
         "SGBM-3WAY + row fill": row_fill(opencv_sgbm(sc.left, sc.right, md)),
