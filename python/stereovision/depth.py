@@ -541,9 +541,10 @@ def depth_map(
         (16 % filled): the choice for a live view. ``"census"``: the census semi-global map
         alone (:mod:`stereovision.matching.sgm`, not one of the paper's channels), re-measured
         to sub-pixel, its speckles and edge-fattened pixels dropped as in the fused map, then
-        filled: about 2.5 times faster than ``"fused"`` and as accurate on average over the 17
-        GT scenes, but worse where the census cost is weak (ETH3D playground: bad-2.0 0.85 x
-        SGBM-3WAY + fill's, ``"fused"`` 0.53 x; README "Choosing a mode").
+        filled: about 2.2 times faster than ``"fused"`` (median over the 17 GT scenes) and as
+        accurate on average, but worse where the census cost is fooled (a periodic texture on
+        ETH3D playground: bad-2.0 0.85 x SGBM-3WAY + fill's, ``"fused"`` 0.53 x; README
+        "Choosing a mode").
     max_disparity : int, optional
         Largest disparity searched, in pixels. None chooses it from the images
         (:func:`estimate_max_disparity`: ORB matches, 1.15 x their 99th percentile, multiple of 16).

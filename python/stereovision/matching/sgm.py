@@ -6,9 +6,8 @@ P2, winner-take-all with a uniqueness test, a left-right check and a parabola ve
 one of the paper's three channels: :func:`stereovision.matching.fusion.fused_dense` uses it where
 the Gabor channel has no value, and as a second opinion where it has one (algorithms.md A.9: a
 filled SGBM is beaten only with global aggregation). ``depth_map(method="census")`` runs it
-alone, re-measured, checked and filled as the fused map is (README, "Choosing a mode"). NumPy
-reference:
-``tests/reference/sgm_ref.py``.
+alone, re-measured, checked and filled as the fused map is (README, "Choosing a mode").
+NumPy reference: ``tests/reference/sgm_ref.py``.
 """
 
 from __future__ import annotations
