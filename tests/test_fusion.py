@@ -345,8 +345,9 @@ def test_fused_depth_sigma_follows_its_map(data_dir: Path, refine: bool) -> None
 
 
 def test_fused_is_bit_identical_across_thread_counts(data_dir: Path) -> None:
-    """Issue 5: same inputs, same bits, with 1, 2 or 3 rayon threads (dense map and members),
-    and with the kernels' waiting workers (``parallel::run_hot``) on or off."""
+    """Issue 5: same inputs, same bits, with 1, 2 or 3 rayon threads (dense map and members;
+    the census mode's map too), and with the kernels' waiting workers (``parallel::run_hot``)
+    on or off."""
     import os
     import subprocess
     import sys
@@ -357,7 +358,9 @@ def test_fused_is_bit_identical_across_thread_counts(data_dir: Path) -> None:
         f"sc = load_scene({str(data_dir / 'middlebury2001' / 'tsukuba')!r})\n"
         "r = sv.depth_map(sc.left, sc.right, method='fused', max_disparity=16)\n"
         "m = sv.match(sc.left, sc.right, method='fused', max_disparity=16)\n"
+        "c = sv.depth_map(sc.left, sc.right, method='census', max_disparity=16)\n"
         "h = hashlib.sha1(r.disparity.tobytes() + r.confidence.tobytes())\n"
+        "h.update(c.disparity.tobytes())\n"
         "h.update(m.to_array().tobytes())\n"
         "print(h.hexdigest(), len(m))\n"
     )
