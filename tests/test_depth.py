@@ -177,6 +177,10 @@ def test_fill_flag_fills_but_keeps_depth_measured_only() -> None:
     assert np.isfinite(filled.disparity).sum() >= np.isfinite(raw.disparity).sum()
     assert filled.depth is not None and raw.depth is not None
     np.testing.assert_array_equal(np.isfinite(filled.depth), np.isfinite(raw.depth))
+    # The fill is a stage of its own in the timings (the stream reports it).
+    unfilled = sv.depth_map(left, right, calib, max_disparity=16, fill=False)
+    assert filled.timings["fill"] > 0 and "fill" not in unfilled.timings
+    assert list(filled.timings)[-2:] == ["fill", "triangulate"]
 
 
 @pytest.mark.parametrize(

@@ -65,6 +65,7 @@ def test_stream_json_reports(videos: dict[str, Path], capsys: pytest.CaptureFixt
         for k in ("grab", "prepare", "match", "triangulate"):
             assert r["stage_ms"][k] > 0, k
         assert r["stage_ms"]["rectify"] >= 0  # rectified calibration: nothing to remap
+        assert r["stage_ms"]["fill"] == 0  # the Gabor channel leaves its holes
         # A pair's latency covers at least its own grab and matching.
         assert r["latency_ms"] >= r["stage_ms"]["match"] + r["stage_ms"]["grab"] - 1e-6
         assert 0 <= r["skew_ms"]["mean"] <= r["skew_ms"]["max"] < 1000
@@ -76,6 +77,27 @@ def test_stream_json_reports(videos: dict[str, Path], capsys: pytest.CaptureFixt
     assert summary["ended"] == "end of stream"
     assert summary["fps"] == pytest.approx(N_FRAMES / summary["seconds"], rel=1e-2)
     assert summary["stage_ms"]["match"] > 0
+
+
+@pytest.mark.parametrize("fill", [None, False])
+def test_stream_census_fills_unless_told(
+    videos: dict[str, Path], capsys: pytest.CaptureFixture[str], fill: bool | None
+) -> None:
+    """``--method census`` fills its holes (a stage of its own in the reports); ``--no-fill``
+    leaves them."""
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--calib", str(videos["calib"]), "--max-disparity", "64", "--no-display", "--json"]
+    argv += ["--method", "census", "--frames", "2"] + (["--no-fill"] if fill is False else [])
+    assert main(argv) == 0
+    objs = _json_lines(capsys.readouterr().out)
+    reports, summary = objs[:-1], objs[-1]
+    assert summary["frames"] == 2
+    if fill is None:
+        assert summary["stage_ms"]["fill"] > 0
+        assert all(r["density"] == 1.0 for r in reports)
+    else:
+        assert summary["stage_ms"]["fill"] == 0
+        assert all(0.6 < r["density"] < 1.0 for r in reports)  # measured: 0.83
 
 
 def test_stream_results_are_the_frames_depth(videos: dict[str, Path]) -> None:

@@ -198,7 +198,8 @@ class DepthResult:
     calibration : Calibration or None
         Calibration of the rectified pair the depth was computed with.
     timings : dict
-        Seconds spent per stage.
+        Seconds spent per stage (``rectify``, ``prepare``, ``match``, ``refine`` and ``fill``
+        when they ran, ``triangulate`` with a calibration).
     depth_sigma : ndarray, float32 (H, W) or None
         One-sigma depth uncertainty in metres where ``depth`` is known (NaN elsewhere; None
         without a calibration): ``sigma_Z = Z^2 sigma_d / (f B)`` with ``sigma_d`` the disparity
@@ -724,6 +725,7 @@ def depth_map(
         if far is not None:
             measured_disp[far] = np.nan  # fused_dense's own array, as is conf
             conf[far] = 0
+        stage("fill")
     depth = None
     depth_sigma = None
     points = np.zeros((0, 3), np.float32)

@@ -70,7 +70,7 @@ JPEG_QUALITY = 85
 MAX_MESH_VERTICES = 120_000
 
 #: Progress (per cent) reached at each stage reported by ``depth_map``.
-_STAGE_PROGRESS = {"rectify": 10, "prepare": 20, "match": 80, "triangulate": 90}
+_STAGE_PROGRESS = {"rectify": 10, "prepare": 20, "match": 75, "fill": 85, "triangulate": 90}
 
 #: Camera slider ranges: degrees for the rotations, metres for the translations.
 ANGLE_RANGE = 90.0
