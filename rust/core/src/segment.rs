@@ -188,21 +188,43 @@ pub fn quantised_regions(
         }
         a
     };
-    let mut x = 0usize;
-    for p in 0..n {
-        let mut rp = p;
-        if x > 0 && keys[p - 1] == keys[p] {
-            rp = find(&mut parent, p - 1);
-            parent[p] = rp as u32;
-        }
-        if p >= w && keys[p - w] == keys[p] {
-            let b = find(&mut parent, p - w);
-            if rp != b {
-                let (lo, hi) = (rp.min(b), rp.max(b));
-                parent[hi] = lo as u32;
+    // By runs of equal keys along each row: a run's pixels point to its first one, and the run
+    // joins each run of the same key that touches it from the row above (one `find` per such
+    // run, not per pixel). Unions keep the smaller root, as a pixel-by-pixel scan would.
+    for y in 0..h {
+        let row = y * w;
+        let mut x = 0;
+        while x < w {
+            let k = keys[row + x];
+            let s = x;
+            x += 1;
+            while x < w && keys[row + x] == k {
+                parent[row + x] = (row + s) as u32;
+                x += 1;
+            }
+            if y == 0 {
+                continue;
+            }
+            let mut rp = row + s; // the run's root so far (its first pixel, or a smaller one)
+            let mut q = row - w + s;
+            let end = row - w + x;
+            while q < end {
+                if keys[q] != k {
+                    q += 1;
+                    continue;
+                }
+                let b = find(&mut parent, q);
+                if b != rp {
+                    let (lo, hi) = (rp.min(b), rp.max(b));
+                    parent[hi] = lo as u32;
+                    rp = lo;
+                }
+                // Skip the rest of this run above: its pixels share the root just joined.
+                while q < end && keys[q] == k {
+                    q += 1;
+                }
             }
         }
-        x = if x + 1 == w { 0 } else { x + 1 };
     }
     // parent[p] < p unless p is a root, and its label is final by then: no search needed.
     let mut labels = vec![0u32; n];
@@ -291,23 +313,41 @@ pub fn plane_fill(
         n_seg <= labels.len(),
         "labels must be below the pixel count"
     );
-    // Pixels grouped by segment (counting sort), raster order inside each.
+    // Measured pixels and holes per segment: only a segment with a hole and enough measured
+    // pixels can fill anything (`segment_fill` would return at once for the others).
+    let mut meas = vec![0u32; n_seg];
+    let mut holes = vec![0u32; n_seg];
+    for (&l, &d) in labels.iter().zip(disp.iter()) {
+        if d.is_finite() {
+            meas[l as usize] += 1;
+        } else {
+            holes[l as usize] += 1;
+        }
+    }
+    let min_meas = min_pixels.max(3);
+    let active: Vec<usize> = (0..n_seg)
+        .filter(|&s| holes[s] > 0 && meas[s] as usize >= min_meas)
+        .collect();
+    // Their pixels grouped by segment (counting sort), raster order inside each.
     let mut start = vec![0usize; n_seg + 1];
-    for &l in labels {
-        start[l as usize + 1] += 1;
+    for &s in &active {
+        start[s + 1] = (meas[s] + holes[s]) as usize;
     }
     for i in 0..n_seg {
         start[i + 1] += start[i];
     }
-    let mut order = vec![0u32; labels.len()];
+    let mut order = vec![0u32; start[n_seg]];
     let mut at = start.clone();
     for (p, &l) in labels.iter().enumerate() {
-        order[at[l as usize]] = p as u32;
-        at[l as usize] += 1;
+        let l = l as usize;
+        if at[l] < start[l + 1] {
+            order[at[l]] = p as u32;
+            at[l] += 1;
+        }
     }
     let src: &[f32] = disp;
     // Most segments fill nothing: one vector per task, not one per segment.
-    let fills: Vec<(u32, f32)> = (0..n_seg)
+    let fills: Vec<(u32, f32)> = active
         .into_par_iter()
         .fold(Vec::new, |mut acc, s| {
             segment_fill(
@@ -511,6 +551,30 @@ mod tests {
                 quantised_regions(&img, w, h, c, step, offset),
                 graph_segments(&bins, w, h, c, 0.0, 1),
                 "step {step} offset {offset}"
+            );
+        }
+    }
+
+    #[test]
+    fn quantised_regions_join_u_shapes_and_spirals() {
+        // Random two- and three-level images: regions that meet only rows below where they
+        // start (U shapes, spirals), which the run-by-run unions must join like a pixel scan.
+        let (w, h) = (61usize, 47usize);
+        let mut state = 12345u64;
+        for levels in [2u64, 3] {
+            let img: Vec<u8> = (0..w * h)
+                .map(|_| {
+                    state = state
+                        .wrapping_mul(6364136223846793005)
+                        .wrapping_add(1442695040888963407);
+                    ((state >> 33) % levels * 100) as u8
+                })
+                .collect();
+            let bins: Vec<f32> = img.iter().map(|&v| (v as u32 / 16) as f32).collect();
+            assert_eq!(
+                quantised_regions(&img, w, h, 1, 16, 0),
+                graph_segments(&bins, w, h, 1, 0.0, 1),
+                "{levels} levels"
             );
         }
     }
