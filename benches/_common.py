@@ -46,3 +46,42 @@ def interleaved_ms(fns: Sequence[Callable[[], object]], repeats: int) -> list[fl
             fn()
             acc.append(time.perf_counter() - t)
     return [1e3 * statistics.median(t) for t in times]
+
+
+def plot_bad2_panels(
+    title: str,
+    left: np.ndarray,
+    gt: np.ndarray,
+    maps: dict[str, np.ndarray],
+    out: Path,
+    figsize: tuple[float, float],
+) -> Path:
+    """A 2 x 3 figure for the README: the left image, the GT, then each of the four ``maps``
+    (disparity, NaN = hole) coloured like the GT with every pixel off by more than 2 px painted
+    red and its bad-2.0 (holes counted) in the panel's title. Written to ``out`` (PNG, 80 dpi)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    valid = np.isfinite(gt) & (gt > 0)
+    vmax = float(np.nanmax(gt[valid]))
+    fig, axes = plt.subplots(2, 3, figsize=figsize)
+    axes[0, 0].imshow(left if left.ndim == 2 else left[..., ::-1], cmap="gray")
+    axes[0, 0].set_title(f"{title}: left")
+    axes[0, 1].imshow(np.where(valid, gt, np.nan), cmap="turbo", vmin=0, vmax=vmax)
+    axes[0, 1].set_title("ground truth")
+    for ax, (name, d) in zip([axes[0, 2], *axes[1]], maps.items(), strict=True):
+        bad = valid & ~(np.abs(d - gt) <= 2)
+        rgb = plt.get_cmap("turbo")(np.clip(np.nan_to_num(d) / vmax, 0, 1))[..., :3]
+        rgb[bad] = (1.0, 0.0, 0.0)
+        ax.imshow(rgb)
+        ax.set_title(f"{name}: bad-2.0 {100 * bad.sum() / valid.sum():.2f} %")
+    for ax in axes.flat:
+        ax.set_xticks([])
+        ax.set_yticks([])
+    fig.tight_layout()
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(out, dpi=80)
+    plt.close(fig)
+    return out

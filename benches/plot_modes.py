@@ -16,12 +16,8 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
-from _common import DATA
+from _common import DATA, plot_bad2_panels
 
 from stereovision.baselines import opencv_sgbm, row_fill
 from stereovision.depth import depth_map
@@ -38,7 +34,6 @@ def main() -> None:
     sc = load_scene(DATA / args.scene)
     gt = sc.gt
     assert gt is not None
-    valid = np.isfinite(gt) & (gt > 0)
     md = sc.max_disparity
 
     def mode(**kw: Any) -> np.ndarray:
@@ -50,25 +45,7 @@ def main() -> None:
         'method="census"': mode(method="census"),
         "fused (default)": mode(),
     }
-    vmax = float(np.nanmax(gt[valid]))
-    fig, axes = plt.subplots(2, 3, figsize=(13, 5.6))
-    left = sc.left if sc.left.ndim == 2 else sc.left[..., ::-1]
-    axes[0, 0].imshow(left, cmap="gray")
-    axes[0, 0].set_title(f"{args.scene}: left")
-    axes[0, 1].imshow(np.where(valid, gt, np.nan), cmap="turbo", vmin=0, vmax=vmax)
-    axes[0, 1].set_title("ground truth")
-    for ax, (name, d) in zip([axes[0, 2], *axes[1]], maps.items(), strict=True):
-        bad = valid & ~(np.abs(d - gt) <= 2)
-        rgb = plt.get_cmap("turbo")(np.clip(np.nan_to_num(d) / vmax, 0, 1))[..., :3]
-        rgb[bad] = (1.0, 0.0, 0.0)
-        ax.imshow(rgb)
-        ax.set_title(f"{name}: bad-2.0 {100 * bad.sum() / valid.sum():.2f} %")
-    for ax in axes.flat:
-        ax.set_xticks([])
-        ax.set_yticks([])
-    fig.tight_layout()
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(args.out, dpi=80)
+    plot_bad2_panels(args.scene, sc.left, gt, maps, args.out, (13, 5.6))
     print(args.out)
 
 

@@ -432,40 +432,29 @@ fn pass_impl<T: PathCost>(
     }
 }
 
-simd_fn! {
-    /// [`pass_impl`] with `u8` path costs (compiled for AVX2 too: the per-level loop of the
-    /// four paths vectorises).
-    fn pass_u8(
-        c: &[u8],
-        img: &[f32],
-        w: usize,
-        h: usize,
-        n: usize,
-        p: &SgmParams,
-        forward: bool,
-        row: &mut Vec<u16>,
-        emit: &mut dyn FnMut(usize, &mut Vec<u16>),
-    ) {
-        pass_impl::<u8>(c, img, w, h, n, p, forward, row, emit)
-    }
+/// `fn $name`: [`pass_impl`] with `$t` path costs, compiled for the baseline and AVX2 (the
+/// per-level loop of the four paths vectorises).
+macro_rules! pass_with {
+    ($name:ident, $t:ty) => {
+        simd_fn! {
+            fn $name(
+                c: &[u8],
+                img: &[f32],
+                w: usize,
+                h: usize,
+                n: usize,
+                p: &SgmParams,
+                forward: bool,
+                row: &mut Vec<u16>,
+                emit: &mut dyn FnMut(usize, &mut Vec<u16>),
+            ) {
+                pass_impl::<$t>(c, img, w, h, n, p, forward, row, emit)
+            }
+        }
+    };
 }
-
-simd_fn! {
-    /// [`pass_impl`] with `u16` path costs (any parameters).
-    fn pass_u16(
-        c: &[u8],
-        img: &[f32],
-        w: usize,
-        h: usize,
-        n: usize,
-        p: &SgmParams,
-        forward: bool,
-        row: &mut Vec<u16>,
-        emit: &mut dyn FnMut(usize, &mut Vec<u16>),
-    ) {
-        pass_impl::<u16>(c, img, w, h, n, p, forward, row, emit)
-    }
-}
+pass_with!(pass_u8, u8);
+pass_with!(pass_u16, u16);
 
 /// Four paths in one raster (`forward`) or reverse raster pass; returns their summed costs
 /// through `emit`. `u8` path costs where they fit ([`u8_fits`]), else `u16`: the same integers.
