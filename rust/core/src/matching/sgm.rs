@@ -456,27 +456,6 @@ macro_rules! pass_with {
 pass_with!(pass_u8, u8);
 pass_with!(pass_u16, u16);
 
-/// Four paths in one raster (`forward`) or reverse raster pass; returns their summed costs
-/// through `emit`. `u8` path costs where they fit ([`u8_fits`]), else `u16`: the same integers.
-#[allow(clippy::too_many_arguments)]
-fn pass(
-    c: &[u8],
-    img: &[f32],
-    w: usize,
-    h: usize,
-    n: usize,
-    p: &SgmParams,
-    forward: bool,
-    row: &mut Vec<u16>,
-    emit: &mut dyn FnMut(usize, &mut Vec<u16>),
-) {
-    if u8_fits(&p2_table(p)) {
-        pass_u8(c, img, w, h, n, p, forward, row, emit)
-    } else {
-        pass_u16(c, img, w, h, n, p, forward, row, emit)
-    }
-}
-
 simd_fn! {
     /// `a += b`, element-wise (one row of the two passes' sums).
     fn add_into(a: &mut [u16], b: &[u16]) {
@@ -715,6 +694,12 @@ pub fn sgm_disparity(
     // each pass reached first), not one per pass; the addition commutes, so the output does
     // not depend on which came first.
     let slots: Vec<Mutex<Option<Vec<u16>>>> = (0..h).map(|_| Mutex::new(None)).collect();
+    // Path costs as u8 where they fit, else u16: the same integers.
+    let pass = if u8_fits(&p2_table(p)) {
+        pass_u8
+    } else {
+        pass_u16
+    };
     let meet = |forward: bool| -> Vec<(usize, Vec<f32>)> {
         let mut done = Vec::new();
         let mut emit = |y: usize, row: &mut Vec<u16>| {
