@@ -377,6 +377,114 @@ fn both_sides_avx2_blocks_equal_the_portable_sums() {
     }
 }
 
+/// Every lane's mean absolute deviation of one half-window, as [`half_better`] defines it
+/// (the portable sums, no bound): `(k, value)` for the `k` in `ks` whose samples lie inside
+/// the row and `|k| > 1`.
+fn lane_mads(
+    left: &Image,
+    right: &Image,
+    (xi, yl, yr, d): (i32, i32, i32, f32),
+    side: i32,
+    (inner, outer, hh): (i32, i32, i32),
+    mean_free: bool,
+    ks: (i32, i32),
+) -> Vec<(i32, f32)> {
+    let w = right.width as i32;
+    let base: Vec<(i32, f32)> = (inner..=outer)
+        .map(|k| {
+            let pos = (xi + side * k) as f32 - d;
+            (pos.floor() as i32, pos - pos.floor())
+        })
+        .collect();
+    let b_min = base.iter().map(|b| b.0).min().unwrap();
+    let b_max = base.iter().map(|b| b.0).max().unwrap();
+    let (k_hi, k_lo) = (ks.1.min(b_min), ks.0.max(b_max + 2 - w));
+    let mut els = Vec::new();
+    for dy in -hh..=hh {
+        for (c, k) in (inner..=outer).enumerate() {
+            let (b, f) = base[c];
+            let o = (yr + dy) as usize * right.width + (b - k_hi) as usize;
+            els.push((o, left.at((xi + side * k) as usize, (yl + dy) as usize), f));
+        }
+    }
+    let n = els.len() as f32;
+    (k_lo..=k_hi)
+        .filter(|k| k.abs() > 1)
+        .map(|k| {
+            let j = (k_hi - k) as usize;
+            (
+                k,
+                sads_scalar::<1>(&right.data, &els, j, n, mean_free)[0] / n,
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn both_sides_bound_never_rules_out_the_best_other_disparity() {
+    // half_better sums only the lanes its lower bound leaves open. With `here` one ulp above
+    // the best other disparity's value (+ margin) that lane fits better and must be found; at
+    // the value itself nothing fits better. Smooth and noisy pairs, grey levels in [0, 1] and
+    // in [0, 255], both polarities of the window, with and without the mean removed.
+    let (w, h) = (160, 40);
+    let mut rng = crate::matching::hopfield::network::SplitMix64::new(5);
+    let mut unit = || (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
+    let noise: Vec<f32> = (0..w * h).map(|_| unit()).collect();
+    let pairs = [
+        (blobs(w, h, 0.0), blobs(w, h, 7.3)),
+        (
+            Image::new(w, h, noise.clone()).unwrap(),
+            Image::new(w, h, noise.iter().map(|v| 0.9 * v + 0.05).collect()).unwrap(),
+        ),
+    ];
+    let mut checked = 0;
+    for (l, r) in &pairs {
+        for scale in [1.0f32, 255.0] {
+            let l = Image::new(w, h, l.data.iter().map(|v| v * scale).collect()).unwrap();
+            let r = Image::new(w, h, r.data.iter().map(|v| v * scale).collect()).unwrap();
+            let mut scratch = SidesScratch {
+                scale,
+                ..SidesScratch::default()
+            };
+            for (t, geom) in [(1, 4, 3), (2, 7, 3), (1, 16, 1)].into_iter().enumerate() {
+                for mean_free in [false, true] {
+                    for side in [-1, 1] {
+                        let at = (60 + 13 * t as i32, 20, 20, 7.3 + 0.37 * t as f32);
+                        let ks = (-7, 40);
+                        let v = lane_mads(&l, &r, at, side, geom, mean_free, ks);
+                        let best = v.iter().map(|p| p.1).fold(f32::INFINITY, f32::min);
+                        for margin in [0.0f32, 0.01 * scale] {
+                            let fits = (best + margin).next_up();
+                            let args = (at, side, geom, mean_free, ks);
+                            let run = |here: f32, s: &mut SidesScratch| {
+                                let (at, side, geom, mean_free, ks) = args;
+                                half_better(
+                                    &l,
+                                    &r,
+                                    at,
+                                    side,
+                                    geom,
+                                    mean_free,
+                                    ks,
+                                    (here, margin),
+                                    s,
+                                )
+                            };
+                            assert!(
+                                run(fits, &mut scratch),
+                                "{geom:?} {mean_free} {side} x{scale}"
+                            );
+                            assert!(!run(best + margin, &mut scratch), "{geom:?} {mean_free}");
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 2 * 2 * 3 * 2 * 2 * 2);
+}
+
 #[test]
 fn knn_graph_equals_the_brute_force_neighbours() {
     // Random centroids, some repeated and some on a lattice (exact distance ties), several
