@@ -1,13 +1,14 @@
 //! Criterion benches of the MCGM channel: the separable LoG, zero crossings, curve tracking,
-//! one image's curves over all channels, and the whole matcher, at three image sizes (synthetic
+//! one image's curves over all channels, the whole matcher and B.8's occlusion filters, at
+//! three image sizes (synthetic
 //! smooth-texture pairs with a known 6 px shift, so the benches need no data files).
 //! Throughput is pixels per second.
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use stereovision_core::matching::mcgm::{
-    image_curves, log::log_filter, mcgm_match, tracking::track, zerocross::zero_crossings,
-    McgmParams,
+    edge_filters, image_curves, log::log_filter, mcgm_match, tracking::track,
+    zerocross::zero_crossings, McgmParams,
 };
 use stereovision_core::Image;
 
@@ -100,6 +101,18 @@ fn bench(c: &mut Criterion) {
         });
         g.bench_function(BenchmarkId::new("mcgm_match", &id), |b| {
             b.iter(|| mcgm_match(&l, &r, &p).expect("valid input"))
+        });
+        // B.8's occlusion filters (both-sides check with its other-disparity scan, the
+        // discontinuity filter) on the finest channel's matches.
+        let out = mcgm_match(&l, &r, &p).expect("valid input");
+        let fine: Vec<_> = out
+            .channels
+            .iter()
+            .filter(|c| c.scale == 1)
+            .flat_map(|c| c.matches.iter().copied())
+            .collect();
+        g.bench_function(BenchmarkId::new("edge_filters", &id), |b| {
+            b.iter(|| edge_filters(&l, &r, &fine, &p.filters, (0, D_MAX as i32)))
         });
     }
     g.finish();
