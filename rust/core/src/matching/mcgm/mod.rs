@@ -844,12 +844,11 @@ fn half_better(
 /// cannot fit better, so [`half_better`]'s answer is the same as without it.
 struct SidesBound {
     nc: usize,
-    /// Interpolation weight and left sums (upper, lower half) of each column, by right base.
-    f_of: [f32; MAX_SIDES_WIDTH],
-    l_top: [f32; MAX_SIDES_WIDTH],
-    l_bot: [f32; MAX_SIDES_WIDTH],
+    /// Per window column: the offset of its right base from the smallest one, its
+    /// interpolation weight, and the left sums of its upper and lower half.
+    cols: [(usize, f32, f32, f32); MAX_SIDES_WIDTH],
     ltot: f32,
-    /// Rows in the upper and lower half, and their product with nc.
+    /// Rows in the upper and lower half.
     rows: (f32, f32),
     n: f32,
 }
@@ -872,33 +871,34 @@ impl SidesBound {
         let nc = (outer - inner + 1) as usize;
         let nr = (2 * hh + 1) as usize;
         let n_top = nr.div_ceil(2);
-        // The window's columns by their right base b (consecutive: the same x - d fraction).
+        // Each column keeps its own base and weight, as the exact sums do (the bases are
+        // consecutive but for rounding of x - d next to a whole pixel).
         let b_min = base[..nc].iter().map(|&(b, _)| b).min().unwrap_or(0);
-        let mut f_of = [0.0f32; MAX_SIDES_WIDTH];
-        let (mut l_top, mut l_bot) = ([0.0f32; MAX_SIDES_WIDTH], [0.0f32; MAX_SIDES_WIDTH]);
+        let b_max = base[..nc].iter().map(|&(b, _)| b).max().unwrap_or(0);
+        let mut cols = [(0usize, 0.0f32, 0.0f32, 0.0f32); MAX_SIDES_WIDTH];
         for (c, k) in (inner..=outer).enumerate() {
             let (b, f) = base[c];
-            let o = (b - b_min) as usize;
-            f_of[o] = f;
             let x = (xi + side * k) as usize;
+            let (mut top, mut bot) = (0.0f32, 0.0f32);
             for (ri, dy) in (-hh..=hh).enumerate() {
                 let v = left.data[(yl + dy) as usize * left.width + x];
                 if ri < n_top {
-                    l_top[o] += v;
+                    top += v;
                 } else {
-                    l_bot[o] += v;
+                    bot += v;
                 }
             }
+            cols[c] = ((b - b_min) as usize, f, top, bot);
         }
-        let ltot: f32 = l_top[..nc].iter().chain(&l_bot[..nc]).sum();
-        // Right samples p0 .. p0 + nc + nk: lane j's column of base b reads
-        // p0 + (b - b_min) + j and the next one.
-        let span = nc + nk;
+        let ltot: f32 = cols[..nc].iter().map(|c| c.2 + c.3).sum();
+        // Right samples p0 ..= p0 + (b_max - b_min) + nk: lane j of a column at offset o reads
+        // p0 + o + j and the next one (inside the row: half_better's lane range ensures it).
+        let span = (b_max - b_min) as usize + nk + 1;
         let p0 = (b_min - k_hi) as usize;
         let (v_top, v_bot) = (&mut scratch.v_top, &mut scratch.v_bot);
         for v in [&mut *v_top, &mut *v_bot] {
             v.clear();
-            v.resize(nc + nk.div_ceil(8) * 8 + 1, 0.0);
+            v.resize(span + nk.div_ceil(8) * 8 - nk, 0.0);
         }
         for (ri, dy) in (-hh..=hh).enumerate() {
             let o = (yr + dy) as usize * right.width + p0;
@@ -910,9 +910,7 @@ impl SidesBound {
         }
         Self {
             nc,
-            f_of,
-            l_top,
-            l_bot,
+            cols,
             ltot,
             rows: (n_top as f32, (nr - n_top) as f32),
             n: (nc * nr) as f32,
@@ -933,10 +931,10 @@ impl SidesBound {
             let v = &v[o + j0..o + j0 + 9];
             std::array::from_fn(|t| v[t] + f * (v[t + 1] - v[t]))
         };
-        let nc = self.nc;
+        let cols = &self.cols[..self.nc];
         let mut m = [0.0f32; 8];
         if mean_free {
-            for (o, &f) in self.f_of[..nc].iter().enumerate() {
+            for &(o, f, _, _) in cols {
                 let (t, b) = (interp(v_top, o, f), interp(v_bot, o, f));
                 for q in 0..8 {
                     m[q] += t[q] + b[q];
@@ -948,9 +946,8 @@ impl SidesBound {
         }
         let (wt, wb) = self.rows;
         let mut acc = [0.0f32; 8];
-        for (o, &f) in self.f_of[..nc].iter().enumerate() {
+        for &(o, f, lt, lb) in cols {
             let (t, b) = (interp(v_top, o, f), interp(v_bot, o, f));
-            let (lt, lb) = (self.l_top[o], self.l_bot[o]);
             for q in 0..8 {
                 acc[q] += (lt - t[q] - wt * m[q]).abs() + (lb - b[q] - wb * m[q]).abs();
             }

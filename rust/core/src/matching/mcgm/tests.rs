@@ -420,9 +420,55 @@ fn lane_mads(
         .collect()
 }
 
+/// Asserts that [`SidesBound`] leaves every lane open whose exact value (`lane_mads`) is at
+/// most the threshold: the bound never exceeds the value beyond half_better's rounding slack.
+#[allow(clippy::too_many_arguments)]
+fn bound_keeps_every_lane(
+    left: &Image,
+    right: &Image,
+    at: (i32, i32, i32, f32),
+    side: i32,
+    geom: (i32, i32, i32),
+    mean_free: bool,
+    ks: (i32, i32),
+    scratch: &mut SidesScratch,
+) -> usize {
+    let (xi, _, _, d) = at;
+    let (inner, outer, _) = geom;
+    let mut base = [(0i32, 0.0f32); MAX_SIDES_WIDTH];
+    for (c, k) in (inner..=outer).enumerate() {
+        let pos = (xi + side * k) as f32 - d;
+        base[c] = (pos.floor() as i32, pos - pos.floor());
+    }
+    let nc = (outer - inner + 1) as usize;
+    let b_min = base[..nc].iter().map(|b| b.0).min().unwrap();
+    let b_max = base[..nc].iter().map(|b| b.0).max().unwrap();
+    let (k_hi, k_lo) = (ks.1.min(b_min), ks.0.max(b_max + 2 - right.width as i32));
+    let nk = (k_hi - k_lo + 1) as usize;
+    let bound = SidesBound::new(left, right, at, side, geom, (k_hi, nk), &base, scratch);
+    let slack = 1e-4 * (1.0 + scratch.scale);
+    let values = lane_mads(left, right, at, side, geom, mean_free, ks);
+    for &(k, v) in &values {
+        let j = (k_hi - k) as usize;
+        let bits = bound.open_lanes(
+            &scratch.v_top,
+            &scratch.v_bot,
+            j / 8 * 8,
+            mean_free,
+            v + slack,
+        );
+        assert!(
+            bits >> (j % 8) & 1 == 1,
+            "lane k = {k} (value {v}) ruled out: {at:?} {geom:?}"
+        );
+    }
+    values.len()
+}
+
 #[test]
 fn both_sides_bound_never_rules_out_the_best_other_disparity() {
-    // half_better sums only the lanes its lower bound leaves open. With `here` one ulp above
+    // half_better sums only the lanes its lower bound leaves open: every lane whose exact value
+    // is at most a threshold must stay open at that threshold. And with `here` one ulp above
     // the best other disparity's value (+ margin) that lane fits better and must be found; at
     // the value itself nothing fits better. Smooth and noisy pairs, grey levels in [0, 1] and
     // in [0, 255], both polarities of the window, with and without the mean removed.
@@ -453,6 +499,17 @@ fn both_sides_bound_never_rules_out_the_best_other_disparity() {
                         let ks = (-7, 40);
                         let v = lane_mads(&l, &r, at, side, geom, mean_free, ks);
                         let best = v.iter().map(|p| p.1).fold(f32::INFINITY, f32::min);
+                        let lanes = bound_keeps_every_lane(
+                            &l,
+                            &r,
+                            at,
+                            side,
+                            geom,
+                            mean_free,
+                            ks,
+                            &mut scratch,
+                        );
+                        assert_eq!(lanes, v.len());
                         for margin in [0.0f32, 0.01 * scale] {
                             let fits = (best + margin).next_up();
                             let args = (at, side, geom, mean_free, ks);
@@ -483,6 +540,37 @@ fn both_sides_bound_never_rules_out_the_best_other_disparity() {
         }
     }
     assert_eq!(checked, 2 * 2 * 3 * 2 * 2 * 2);
+
+    // A window whose right bases skip a pixel: x - d rounds differently on either side of 512
+    // (at d = 7 + 2e-5 the columns 517..=522 have bases 509, 510, 511, 513, 514, 515).
+    // Smooth texture shifted by the disparity: small values on many lanes, which a bound that
+    // mixed up the columns would exceed.
+    let w = 640;
+    let (l, r) = (blobs(w, h, 0.0), blobs(w, h, 7.0));
+    let d = 7.0f32 + 2e-5;
+    let bases: Vec<i32> = (517..=522).map(|x| (x as f32 - d).floor() as i32).collect();
+    assert_eq!(bases, [509, 510, 511, 513, 514, 515]);
+    let mut scratch = SidesScratch {
+        scale: 1.0,
+        ..SidesScratch::default()
+    };
+    for mean_free in [false, true] {
+        let (at, geom, ks) = ((515, 20, 20, d), (2, 7, 3), (-7, 60));
+        let v = lane_mads(&l, &r, at, 1, geom, mean_free, ks);
+        assert!(bound_keeps_every_lane(&l, &r, at, 1, geom, mean_free, ks, &mut scratch) > 50);
+        let best = v.iter().map(|p| p.1).fold(f32::INFINITY, f32::min);
+        let run = |here: f32, s: &mut SidesScratch| {
+            half_better(&l, &r, at, 1, geom, mean_free, ks, (here, 0.0), s)
+        };
+        assert!(
+            run(best.next_up(), &mut scratch),
+            "skipped base, mean_free {mean_free}"
+        );
+        assert!(
+            !run(best, &mut scratch),
+            "skipped base, mean_free {mean_free}"
+        );
+    }
 }
 
 #[test]
