@@ -739,10 +739,11 @@ simd_fn! {
 /// weights of `d` (right samples `r[b - k] + f (r[b - k + 1] - r[b - k])` with
 /// `b = floor(x - d)`, `f = x - d - b`), so every `k` is compared fairly with `k = 0`, whose
 /// value would be exactly [`half_mad`]'s (the same terms summed in the same order). The right
-/// samples of one window pixel are contiguous in `j = k_hi - k`: blocks of 32 `j` keep their
+/// samples of one window pixel are contiguous in `j = k_hi - k`: a block of 8 `j` keeps its
 /// sums in registers over the window's pixels (raster order), the mean-free pass recomputes
-/// each difference instead of storing it, and the scan stops at the first block that fits
-/// better. `at`: the match `(x, left row, right row, disparity)`; `limit`: `(here, margin)`.
+/// each difference instead of storing it, only the blocks with a lane that [`SidesBound`]
+/// leaves open are summed, and the scan stops at the first lane that fits better. `at`: the
+/// match `(x, left row, right row, disparity)`; `limit`: `(here, margin)`.
 fn half_better(
     left: &Image,
     right: &Image,
