@@ -732,6 +732,31 @@ fn half_mad(
     sad / n
 }
 
+/// A half-window's columns (`x = xi + side * (inner..=outer)`): each one's right interpolation
+/// base and weight (`x - d` split into floor and fraction), the smallest and largest base, and
+/// the range `(k_lo, k_hi)` of integer steps whose samples `r[b - k]`, `r[b - k + 1]` all lie
+/// inside a row of `width` (empty when `k_hi < k_lo`).
+#[allow(clippy::type_complexity)]
+fn window_bases(
+    (xi, _, _, d): (i32, i32, i32, f32),
+    side: i32,
+    (inner, outer, _): (i32, i32, i32),
+    ks: (i32, i32),
+    width: usize,
+) -> ([(i32, f32); MAX_SIDES_WIDTH], (i32, i32), (i32, i32)) {
+    let mut base = [(0i32, 0.0f32); MAX_SIDES_WIDTH];
+    let (mut b_min, mut b_max) = (i32::MAX, i32::MIN);
+    for (c, k) in (inner..=outer).enumerate() {
+        let pos = (xi + side * k) as f32 - d;
+        let b = pos.floor();
+        base[c] = (b as i32, pos - b);
+        b_min = b_min.min(b as i32);
+        b_max = b_max.max(b as i32);
+    }
+    let ks = (ks.0.max(b_max + 2 - width as i32), ks.1.min(b_min));
+    (base, (b_min, b_max), ks)
+}
+
 simd_fn! {
 /// Whether one half-window fits another disparity better: its mean absolute difference (as
 /// [`half_mad`]) at some `d + k`, `k` integer in `ks`, `|k| > 1`, every right sample inside the
@@ -755,28 +780,15 @@ fn half_better(
     limit: (f32, f32),
     scratch: &mut SidesScratch,
 ) -> bool {
-    let (xi, yl, yr, d) = at;
+    let (xi, yl, yr, _) = at;
     let (inner, outer, hh) = geom;
-    let w = right.width as i32;
-    // Window columns and their interpolation bases.
-    let mut base = [(0i32, 0.0f32); MAX_SIDES_WIDTH];
-    let (mut b_min, mut b_max) = (i32::MAX, i32::MIN);
-    for (c, k) in (inner..=outer).enumerate() {
-        let pos = (xi + side * k) as f32 - d;
-        let b = pos.floor();
-        base[c] = (b as i32, pos - b);
-        b_min = b_min.min(b as i32);
-        b_max = b_max.max(b as i32);
-    }
-    // Every sample r[b - k], r[b - k + 1] must lie inside the row.
-    let k_hi = ks.1.min(b_min);
-    let k_lo = ks.0.max(b_max + 2 - w);
+    let (base, b_range, (k_lo, k_hi)) = window_bases(at, side, geom, ks, right.width);
     if k_hi < k_lo {
         return false;
     }
     let nk = (k_hi - k_lo + 1) as usize;
     scratch.els.clear();
-    let bound = SidesBound::new(left, right, at, side, geom, (k_hi, nk), &base, scratch);
+    let bound = SidesBound::new(left, right, at, side, geom, (k_hi, nk), (&base, b_range), scratch);
     let (here, margin) = limit;
     // Rounding: every sum of the bound and of the exact test adds at most 2 nc nr terms of
     // magnitude <= 2 max|value| (`scale`: the pair's largest); 1e-4 of that is far above
@@ -866,7 +878,7 @@ impl SidesBound {
         side: i32,
         (inner, outer, hh): (i32, i32, i32),
         (k_hi, nk): (i32, usize),
-        base: &[(i32, f32); MAX_SIDES_WIDTH],
+        (base, (b_min, b_max)): (&[(i32, f32); MAX_SIDES_WIDTH], (i32, i32)),
         scratch: &mut SidesScratch,
     ) -> Self {
         let nc = (outer - inner + 1) as usize;
@@ -874,8 +886,6 @@ impl SidesBound {
         let n_top = nr.div_ceil(2);
         // Each column keeps its own base and weight, as the exact sums do (the bases are
         // consecutive but for rounding of x - d next to a whole pixel).
-        let b_min = base[..nc].iter().map(|&(b, _)| b).min().unwrap_or(0);
-        let b_max = base[..nc].iter().map(|&(b, _)| b).max().unwrap_or(0);
         let mut cols = [(0usize, 0.0f32, 0.0f32, 0.0f32); MAX_SIDES_WIDTH];
         for (c, k) in (inner..=outer).enumerate() {
             let (b, f) = base[c];

@@ -383,22 +383,15 @@ fn both_sides_avx2_blocks_equal_the_portable_sums() {
 fn lane_mads(
     left: &Image,
     right: &Image,
-    (xi, yl, yr, d): (i32, i32, i32, f32),
+    at: (i32, i32, i32, f32),
     side: i32,
-    (inner, outer, hh): (i32, i32, i32),
+    geom: (i32, i32, i32),
     mean_free: bool,
     ks: (i32, i32),
 ) -> Vec<(i32, f32)> {
-    let w = right.width as i32;
-    let base: Vec<(i32, f32)> = (inner..=outer)
-        .map(|k| {
-            let pos = (xi + side * k) as f32 - d;
-            (pos.floor() as i32, pos - pos.floor())
-        })
-        .collect();
-    let b_min = base.iter().map(|b| b.0).min().unwrap();
-    let b_max = base.iter().map(|b| b.0).max().unwrap();
-    let (k_hi, k_lo) = (ks.1.min(b_min), ks.0.max(b_max + 2 - w));
+    let (xi, yl, yr, _) = at;
+    let (inner, outer, hh) = geom;
+    let (base, _, (k_lo, k_hi)) = window_bases(at, side, geom, ks, right.width);
     let mut els = Vec::new();
     for dy in -hh..=hh {
         for (c, k) in (inner..=outer).enumerate() {
@@ -433,19 +426,18 @@ fn bound_keeps_every_lane(
     ks: (i32, i32),
     scratch: &mut SidesScratch,
 ) -> usize {
-    let (xi, _, _, d) = at;
-    let (inner, outer, _) = geom;
-    let mut base = [(0i32, 0.0f32); MAX_SIDES_WIDTH];
-    for (c, k) in (inner..=outer).enumerate() {
-        let pos = (xi + side * k) as f32 - d;
-        base[c] = (pos.floor() as i32, pos - pos.floor());
-    }
-    let nc = (outer - inner + 1) as usize;
-    let b_min = base[..nc].iter().map(|b| b.0).min().unwrap();
-    let b_max = base[..nc].iter().map(|b| b.0).max().unwrap();
-    let (k_hi, k_lo) = (ks.1.min(b_min), ks.0.max(b_max + 2 - right.width as i32));
+    let (base, b_range, (k_lo, k_hi)) = window_bases(at, side, geom, ks, right.width);
     let nk = (k_hi - k_lo + 1) as usize;
-    let bound = SidesBound::new(left, right, at, side, geom, (k_hi, nk), &base, scratch);
+    let bound = SidesBound::new(
+        left,
+        right,
+        at,
+        side,
+        geom,
+        (k_hi, nk),
+        (&base, b_range),
+        scratch,
+    );
     let slack = 1e-4 * (1.0 + scratch.scale);
     let values = lane_mads(left, right, at, side, geom, mean_free, ks);
     for &(k, v) in &values {
