@@ -212,6 +212,26 @@ def test_auto_max_disparity_covers_the_near_ground(
     assert md == max(alone)
 
 
+@pytest.mark.parametrize(
+    ("shape", "expected"), [((1, 1), 16), ((1, 120), 16), ((120, 1), 16), ((62, 300), 48), ((2, 2), 16)]
+)
+def test_auto_max_disparity_on_images_too_small_for_features(
+    shape: tuple[int, int], expected: int
+) -> None:
+    """A side under ORB's 63 px gives no features (a 1-px side made OpenCV's pyramid fail, a
+    cv2.error out of ``depth_map``): the range falls back to width / 8 (at least 16; the shrunk
+    SGBM needs 64 rows), and ``depth_map`` either runs or names the problem."""
+    rng = np.random.default_rng(5)
+    left = (rng.random(shape) * 255).astype(np.uint8)
+    right = np.roll(left, -2, axis=1)
+    assert sv.estimate_max_disparity(left, right) == expected
+    if shape[1] > expected:
+        assert sv.depth_map(left, right).disparity.shape == shape
+    else:
+        with pytest.raises(ValueError, match="not smaller than the image width"):
+            sv.depth_map(left, right)
+
+
 def test_auto_max_disparity_on_real_scene(data_dir: Path) -> None:
     scene = load_scene(data_dir / "middlebury2003" / "cones")
     md = sv.estimate_max_disparity(scene.left, scene.right)

@@ -57,6 +57,9 @@ _AUTO_ORB_FEATURES = 1500  # ... with this many features
 _AUTO_ORB_FEATURES_FULL = 4000  # features on a smaller pair, matched at full resolution
 _AUTO_COARSE_PERCENTILE = 99.5
 _AUTO_COARSE_MIN_SIZE = (16, 64)  # (rows, columns) of the shrunk pair, else no second opinion
+# ORB keeps keypoints 31 px (its edge threshold) from every border: a side shorter than 63 px has
+# none, and a 1-px side makes its pyramid fail inside OpenCV.
+_AUTO_ORB_MIN_SIDE = 63
 _DISPARITY_STEP = 16  # ranges are multiples of 16, like the evaluation protocol's
 
 # Disparity uncertainty from the matcher's confidence: sigma_d = max(s0 + slope * conf, s_min)
@@ -119,6 +122,8 @@ def _orb_top(gl: npt.NDArray[np.uint8], gr: npt.NDArray[np.uint8]) -> float | No
     1500 features: over the 17 GT scenes the range is the same as with 4000 at full resolution
     on 16 (laundry: 96 px instead of 144, for a GT reaching 77 px), in 5-33 ms instead of
     12-191 ms."""
+    if min(gl.shape) < _AUTO_ORB_MIN_SIDE:
+        return None
     s = 2 if min(gl.shape) >= _AUTO_ORB_HALF_FROM else 1
     if s > 1:
         size = (gl.shape[1] // s, gl.shape[0] // s)
