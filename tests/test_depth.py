@@ -213,7 +213,8 @@ def test_auto_max_disparity_covers_the_near_ground(
 
 
 @pytest.mark.parametrize(
-    ("shape", "expected"), [((1, 1), 16), ((1, 120), 16), ((120, 1), 16), ((62, 300), 48), ((2, 2), 16)]
+    ("shape", "expected"),
+    [((1, 1), 16), ((1, 120), 16), ((120, 1), 16), ((62, 300), 48), ((2, 2), 16)],
 )
 def test_auto_max_disparity_on_images_too_small_for_features(
     shape: tuple[int, int], expected: int
