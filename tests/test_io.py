@@ -81,6 +81,25 @@ def test_imread_garbage(tmp_path: Path) -> None:
         imread(empty)
 
 
+def test_imread_truncated_says_it_once(tmp_path: Path, capfd: pytest.CaptureFixture[str]) -> None:
+    """A cut file gives our one error; OpenCV's own ``[ERROR] imdecode_`` log line (printed on
+    the C stderr for a truncated PGM header) stays silent, and its log level is put back."""
+    import cv2
+
+    ok, png = cv2.imencode(".png", np.arange(64 * 48 * 3, dtype=np.uint8).reshape(48, 64, 3))
+    assert ok
+    cut = tmp_path / "cut.png"
+    cut.write_bytes(png.tobytes()[: png.size // 3])
+    pgm = tmp_path / "cut.pgm"
+    pgm.write_bytes(b"P5\n")
+    level = cv2.utils.logging.getLogLevel()  # type: ignore[attr-defined]
+    for path in (cut, pgm):
+        with pytest.raises(ValueError, match="cannot decode"):
+            imread(path)
+    assert capfd.readouterr().err == ""
+    assert cv2.utils.logging.getLogLevel() == level  # type: ignore[attr-defined]
+
+
 # ---------------------------------------------------------------------------------------- PFM
 
 

@@ -182,10 +182,9 @@ def find_pairs(
 
 
 def _decode(name: str, data: bytes) -> Any:
-    import cv2
-    import numpy as np
+    from stereovision.io import decode_image
 
-    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR) if data else None
+    img = decode_image(data)
     if img is None:
         raise ValueError(f"cannot decode {name} as an image")
     return img

@@ -36,6 +36,7 @@ __all__ = [
     "MAX_DISPARITY_MARGIN",
     "Scene",
     "atomic_write",
+    "decode_image",
     "find_scenes",
     "imread",
     "load_scene",
@@ -122,6 +123,23 @@ def _existing_file(path: PathLike, what: str) -> Path:
 # --------------------------------------------------------------------------------------- images
 
 
+def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] | None:
+    """``cv2.imdecode`` to BGR with OpenCV's own logging silenced for the call: a file it cannot
+    read returns None, and the caller's error names the file (OpenCV would also print its own
+    ``[ERROR] ... imdecode_`` line on stderr, a second message for one problem)."""
+    buf = np.frombuffer(data, np.uint8) if isinstance(data, bytes) else data
+    if buf.size == 0:
+        return None
+    log = cv2.utils.logging  # type: ignore[attr-defined]
+    level = log.getLogLevel()
+    log.setLogLevel(log.LOG_LEVEL_SILENT)
+    try:
+        img = cv2.imdecode(buf, cv2.IMREAD_COLOR)
+    finally:
+        log.setLogLevel(level)
+    return None if img is None else np.asarray(img, dtype=np.uint8)
+
+
 def imread(path: PathLike, gray: bool = False) -> npt.NDArray[np.uint8]:
     """Read an image file as OpenCV does (8-bit, BGR channel order).
 
@@ -148,14 +166,14 @@ def imread(path: PathLike, gray: bool = False) -> npt.NDArray[np.uint8]:
     p = _existing_file(path, "image file")
     # imdecode from bytes: works for non-ASCII paths, and fails loudly instead of returning None.
     data = np.fromfile(p, dtype=np.uint8)
-    img = cv2.imdecode(data, cv2.IMREAD_COLOR) if data.size else None
+    img = decode_image(data)
     if img is None:
         raise ValueError(f"cannot decode {p} as an image")
     if gray:
         # Same conversion as everywhere else in the package (cv2.cvtColor, BT.601), not the
         # codec's own (libpng's differs by one grey level on some pixels).
-        img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
-    return np.asarray(img, dtype=np.uint8)
+        return np.asarray(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY), dtype=np.uint8)
+    return img
 
 
 # ------------------------------------------------------------------------------------------ PFM
