@@ -148,6 +148,8 @@ impl Default for GaborParams {
 /// highest horizontal frequency, which carry most of the horizontal disparity information).
 pub const LIGHT_ORIENTATIONS: usize = 3;
 
+/// Widest disparity range accepted (px).
+pub const MAX_RANGE: f32 = 8192.0;
 /// Maximum pyramid depth accepted.
 const MAX_LEVELS: usize = 10;
 /// The automatic pyramid stops before the top level gets narrower than this (px).
@@ -171,6 +173,17 @@ impl GaborParams {
             return Err(CoreError::param(
                 "d_max",
                 format!("must be > d_min ({}), got {}", self.d_min, self.d_max),
+            ));
+        }
+        // The coarsest level searches every whole disparity of the range: a range wider than any
+        // image would only allocate (1e12 px asked for terabytes and aborted the process).
+        if self.d_max - self.d_min > MAX_RANGE {
+            return Err(CoreError::param(
+                "d_max",
+                format!(
+                    "the range d_max - d_min is at most {MAX_RANGE} px, got {}",
+                    self.d_max - self.d_min
+                ),
             ));
         }
         if self.orientations_deg.is_empty() || self.orientations_deg.len() > 8 {

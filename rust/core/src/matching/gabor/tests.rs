@@ -114,6 +114,15 @@ fn bad_parameters_are_errors() {
             conf_min: 2.0,
             ..GaborParams::default()
         },
+        // A range no image has: it allocated 4 bytes per disparity and aborted the process.
+        GaborParams {
+            d_min: -1e12,
+            ..GaborParams::default()
+        },
+        GaborParams {
+            d_max: MAX_RANGE + 1.0,
+            ..GaborParams::default()
+        },
     ];
     for p in bad {
         assert!(

@@ -250,6 +250,9 @@ pub struct McgmOutput {
     pub n_disc: usize,
 }
 
+/// Largest `n_theta_bins` (a tenth of a degree per bin).
+pub const MAX_THETA_BINS: usize = 3600;
+
 fn validate_params(p: &McgmParams) -> Result<()> {
     if p.d_max < p.d_min {
         return Err(CoreError::param(
@@ -278,10 +281,17 @@ fn validate_params(p: &McgmParams) -> Result<()> {
     if !(p.track.max_turn_deg.is_finite() && p.track.max_turn_deg > 0.0) {
         return Err(CoreError::param("max_turn_deg", "must be > 0"));
     }
-    if p.cand.n_bins < 3 || 2 * p.cand.vote_bin_tol + 1 > p.cand.n_bins {
+    // The R-tables hold n_bins entries per segment: an unbounded count is an allocation that
+    // aborts the process instead of an error.
+    if !(3..=MAX_THETA_BINS).contains(&p.cand.n_bins)
+        || 2 * p.cand.vote_bin_tol.min(MAX_THETA_BINS) + 1 > p.cand.n_bins
+    {
         return Err(CoreError::param(
             "n_theta_bins",
-            "needs >= 3 bins and 2 * vote_bin_tol + 1 <= n_theta_bins",
+            format!(
+                "needs 3..={MAX_THETA_BINS} bins and 2 * vote_bin_tol + 1 <= n_theta_bins, got {} and {}",
+                p.cand.n_bins, p.cand.vote_bin_tol
+            ),
         ));
     }
     if p.cand.k_cand == 0 {

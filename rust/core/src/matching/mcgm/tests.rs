@@ -213,7 +213,19 @@ fn bad_parameters_are_errors_not_panics() {
             ..McgmParams::default()
         },
     ];
-    for p in bad {
+    // Bin counts that would ask for terabytes (an abort, not an error) or overflow.
+    let bins = [
+        (MAX_THETA_BINS + 1, 1),
+        (1_000_000_000_000, 1),
+        (36, usize::MAX),
+    ]
+    .map(|(n_bins, vote_bin_tol)| {
+        let mut p = McgmParams::default();
+        p.cand.n_bins = n_bins;
+        p.cand.vote_bin_tol = vote_bin_tol;
+        p
+    });
+    for p in bad.into_iter().chain(bins) {
         assert!(matches!(
             mcgm_match(&img, &img, &p),
             Err(CoreError::InvalidParameter { .. })
