@@ -66,6 +66,21 @@ class GaborResult:
     confidence: npt.NDArray[np.float32]
 
 
+# Parameters the kernel takes as counts (usize): a negative or fractional value is a ValueError
+# naming the key here, not an OverflowError from the binding.
+_COUNT_KEYS = (
+    "n_levels",
+    "iters_per_level",
+    "research_radius",
+    "search_pool_radius",
+    "lr_coarse_levels",
+    "iters_finest",
+    "orientations_finest",
+    "fine_levels",
+    "speckle_size",
+)
+
+
 def _as_grey(img: object, name: str) -> npt.NDArray[np.float32]:
     arr = np.asarray(img)
     if arr.ndim != 2:
@@ -126,6 +141,12 @@ def gabor_disparity(
         if not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
             raise ValueError(f"{name} must be a finite number, got {v!r}")
     kw: dict[str, Any] = {**DEFAULTS, **params}
+    for name in _COUNT_KEYS:
+        v = kw[name]
+        if v is None and name == "n_levels":
+            continue
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 0 <= v < 2**31:
+            raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
     orient = kw["orientations_deg"]
     if not isinstance(orient, Sequence) and not isinstance(orient, np.ndarray):
         raise ValueError(f"orientations_deg must be a sequence of degrees, got {orient!r}")

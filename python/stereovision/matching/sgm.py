@@ -75,8 +75,9 @@ def sgm_disparity(
         raise ValueError(f"unknown SGM option(s) {unknown}: expected {sorted(DEFAULTS)}")
     p = {**DEFAULTS, **params}
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
-        if not math.isfinite(v):
-            raise ValueError(f"{name}: expected a finite number, got {v}")
+        # The kernel takes i32 levels (and at most 2048 of them).
+        if not math.isfinite(v) or abs(v) >= 2**31 - 1:
+            raise ValueError(f"{name}: expected a finite number of pixels, got {v}")
     if max_disparity < min_disparity:
         raise ValueError(
             f"max_disparity ({max_disparity}) is smaller than min_disparity ({min_disparity})"

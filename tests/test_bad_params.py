@@ -1,0 +1,91 @@
+"""Every tuning parameter of every channel, given a value out of its range (negative, huge, NaN,
+infinite, of the wrong type), either works or raises ValueError / TypeError naming the problem:
+never another exception, and never a process abort (an allocation of terabytes from a huge bin
+count or disparity range ended the interpreter before these checks existed)."""
+
+from __future__ import annotations
+
+import inspect
+import warnings
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import stereovision as sv
+from stereovision._validate import as_gray_float
+from stereovision.io import load_scene
+from stereovision.matching import fusion, gabor, hopfield, mcgm, sgm
+
+BAD_VALUES: list[Any] = [-1, 0, 0.5, 10**12, -(10**12), float("nan"), float("inf"), "x", None]
+
+
+@pytest.fixture(scope="module")
+def crop(data_dir: Path) -> tuple[np.ndarray, np.ndarray]:
+    """A 100 x 160 crop of cones: real texture, small enough for some 2000 calls."""
+    s = load_scene(data_dir / "middlebury2003" / "cones")
+    return s.left[100:200, 100:260], s.right[100:200, 100:260]
+
+
+def _keyword_defaults(fn: Callable[..., Any], skip: set[str]) -> list[str]:
+    sig = inspect.signature(fn)
+    empty = inspect.Parameter.empty
+    return [k for k, p in sig.parameters.items() if p.default is not empty and k not in skip]
+
+
+CALLS: dict[str, tuple[list[str], Callable[..., Any]]] = {
+    "mcgm": (list(mcgm.DEFAULTS), lambda a, b, kw: mcgm.mcgm_match(a, b, max_disparity=32, **kw)),
+    "hopfield": (
+        list(hopfield.DEFAULTS),
+        lambda a, b, kw: hopfield.hopfield_match(a, b, max_disparity=32, **kw),
+    ),
+    "gabor": (
+        list(gabor.DEFAULTS),
+        lambda a, b, kw: gabor.gabor_disparity(a, b, max_disparity=32, **kw),
+    ),
+    "sgm": (list(sgm.DEFAULTS), lambda a, b, kw: sgm.sgm_disparity(a, b, max_disparity=32, **kw)),
+    # Its other keywords are on/off flags.
+    "fuse_pair": (
+        ["min_disparity", "channels"],
+        lambda a, b, kw: fusion.fuse_pair(a, b, max_disparity=32, **kw),
+    ),
+}
+
+
+@pytest.mark.parametrize("what", list(CALLS))
+def test_out_of_range_parameters_raise_value_or_type_error(
+    what: str, crop: tuple[np.ndarray, np.ndarray]
+) -> None:
+    keys, call = CALLS[what]
+    gl, gr = (as_gray_float(a) for a in crop)
+    rejected = 0
+    for key in keys:
+        for value in BAD_VALUES:
+            try:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    call(gl, gr, {key: value})
+            except (ValueError, TypeError):
+                rejected += 1
+            except Exception as exc:
+                pytest.fail(f"{what}({key}={value!r}) raised {type(exc).__name__}: {exc}")
+    # Most of these values are out of range for most keys: the checks are there, not bypassed.
+    assert rejected > len(keys) * 3
+
+
+@pytest.mark.parametrize("key", _keyword_defaults(sv.depth_map, {"calib", "progress"}))
+def test_depth_map_keywords_out_of_range(key: str, crop: tuple[np.ndarray, np.ndarray]) -> None:
+    for value in BAD_VALUES:
+        kw: dict[str, Any] = {key: value}
+        if key != "max_disparity":
+            kw["max_disparity"] = 32
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                sv.depth_map(*crop, **kw)
+        except (ValueError, TypeError):
+            pass
+        except Exception as exc:
+            pytest.fail(f"depth_map({key}={value!r}) raised {type(exc).__name__}: {exc}")
