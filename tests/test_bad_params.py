@@ -1,7 +1,8 @@
-"""Every tuning parameter of every channel, given a value out of its range (negative, huge, NaN,
-infinite, of the wrong type), either works or raises ValueError / TypeError naming the problem:
-never another exception, and never a process abort (an allocation of terabytes from a huge bin
-count or disparity range ended the interpreter before these checks existed)."""
+"""Every tuning parameter of every channel, the refinement and the plane fills, given a value
+out of its range (negative, huge, NaN, infinite, of the wrong type), either works or raises
+ValueError / TypeError naming the problem: never another exception, and never a process abort
+(an allocation of terabytes from a huge bin count or disparity range ended the interpreter, and a
+huge blur ran for minutes or raised cv2.error, before these checks existed)."""
 
 from __future__ import annotations
 
@@ -15,18 +16,27 @@ import numpy as np
 import pytest
 
 import stereovision as sv
+from stereovision import refine
 from stereovision._validate import as_gray_float
 from stereovision.io import load_scene
-from stereovision.matching import fusion, gabor, hopfield, mcgm, sgm
+from stereovision.matching import fusion, gabor, hopfield, mcgm, planes, sgm
 
 BAD_VALUES: list[Any] = [-1, 0, 0.5, 10**12, -(10**12), float("nan"), float("inf"), "x", None]
 
 
 @pytest.fixture(scope="module")
 def crop(data_dir: Path) -> tuple[np.ndarray, np.ndarray]:
-    """A 100 x 160 crop of cones: real texture, small enough for some 2000 calls."""
+    """A 100 x 160 crop of cones: real texture, small enough for about 1500 calls."""
     s = load_scene(data_dir / "middlebury2003" / "cones")
     return s.left[100:200, 100:260], s.right[100:200, 100:260]
+
+
+@pytest.fixture(scope="module")
+def ctx(crop: tuple[np.ndarray, np.ndarray]) -> dict[str, Any]:
+    """The crop, its grey pair and its Gabor map (the refinement's and the fills' input)."""
+    gl, gr = (as_gray_float(a) for a in crop)
+    g = gabor.gabor_disparity(gl, gr, max_disparity=32)
+    return {"bgr": crop[0], "gl": gl, "gr": gr, "disp": g.disparity, "conf": g.confidence}
 
 
 def _keyword_defaults(fn: Callable[..., Any], skip: set[str]) -> list[str]:
@@ -35,38 +45,62 @@ def _keyword_defaults(fn: Callable[..., Any], skip: set[str]) -> list[str]:
     return [k for k, p in sig.parameters.items() if p.default is not empty and k not in skip]
 
 
-CALLS: dict[str, tuple[list[str], Callable[..., Any]]] = {
-    "mcgm": (list(mcgm.DEFAULTS), lambda a, b, kw: mcgm.mcgm_match(a, b, max_disparity=32, **kw)),
+Call = Callable[[dict[str, Any], dict[str, Any]], object]
+CALLS: dict[str, tuple[list[str], Call]] = {
+    "mcgm": (
+        list(mcgm.DEFAULTS),
+        lambda c, kw: mcgm.mcgm_match(c["gl"], c["gr"], max_disparity=32, **kw),
+    ),
     "hopfield": (
         list(hopfield.DEFAULTS),
-        lambda a, b, kw: hopfield.hopfield_match(a, b, max_disparity=32, **kw),
+        lambda c, kw: hopfield.hopfield_match(c["gl"], c["gr"], max_disparity=32, **kw),
     ),
     "gabor": (
         list(gabor.DEFAULTS),
-        lambda a, b, kw: gabor.gabor_disparity(a, b, max_disparity=32, **kw),
+        lambda c, kw: gabor.gabor_disparity(c["gl"], c["gr"], max_disparity=32, **kw),
     ),
-    "sgm": (list(sgm.DEFAULTS), lambda a, b, kw: sgm.sgm_disparity(a, b, max_disparity=32, **kw)),
+    "sgm": (
+        list(sgm.DEFAULTS),
+        lambda c, kw: sgm.sgm_disparity(c["gl"], c["gr"], max_disparity=32, **kw),
+    ),
     # Its other keywords are on/off flags.
     "fuse_pair": (
         ["min_disparity", "channels"],
-        lambda a, b, kw: fusion.fuse_pair(a, b, max_disparity=32, **kw),
+        lambda c, kw: fusion.fuse_pair(c["gl"], c["gr"], max_disparity=32, **kw),
     ),
+    "refine": (
+        [*refine.DEFAULTS, "min_disparity"],
+        lambda c, kw: refine.refine_disparity(
+            c["gl"], c["gr"], c["disp"], c["conf"], max_disparity=32, **kw
+        ),
+    ),
+    "fill_planes": (
+        ["passes", "blur", "max_residual"],
+        lambda c, kw: planes.fill_planes(c["disp"], c["bgr"], **kw),
+    ),
+    "segments": (
+        ["blur", "step", "offset", "k", "min_size"],
+        lambda c, kw: planes.segments(c["bgr"], **kw),
+    ),
+    "plane_fill": (
+        ["min_pixels", "max_residual", "lo", "hi"],
+        lambda c, kw: planes.plane_fill(c["disp"], planes.segments(c["bgr"]), **kw),
+    ),
+    "side_fill": (["tau", "blur"], lambda c, kw: planes.side_fill(c["disp"], c["bgr"], **kw)),
 }
 
 
 @pytest.mark.parametrize("what", list(CALLS))
-def test_out_of_range_parameters_raise_value_or_type_error(
-    what: str, crop: tuple[np.ndarray, np.ndarray]
-) -> None:
+def test_out_of_range_parameters_raise_value_or_type_error(what: str, ctx: dict[str, Any]) -> None:
     keys, call = CALLS[what]
-    gl, gr = (as_gray_float(a) for a in crop)
+    values = [*BAD_VALUES, ((10**9, 1),), ((-1, 5),)] if what == "fill_planes" else BAD_VALUES
     rejected = 0
     for key in keys:
-        for value in BAD_VALUES:
+        for value in values:
             try:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore")
-                    call(gl, gr, {key: value})
+                    call(ctx, {key: value})
             except (ValueError, TypeError):
                 rejected += 1
             except Exception as exc:

@@ -78,11 +78,13 @@ _FLOAT_KEYS = (
 
 
 def _number(v: object, name: str, whole: bool = False) -> float:
-    """A real parameter value (a whole number when ``whole``), else ValueError naming it."""
+    """A real parameter value (a non-negative whole number when ``whole``), else ValueError
+    naming it."""
     if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
         raise ValueError(f"{name} must be a number, got {v!r}")
-    if whole and int(v) != v:
-        raise ValueError(f"{name} must be a whole number, got {v!r}")
+    # Whole numbers are the kernel's counts and radii (usize).
+    if whole and not (math.isfinite(v) and 0 <= v < 2**31 and int(v) == v):
+        raise ValueError(f"{name} must be a non-negative whole number, got {v!r}")
     return float(v)
 
 

@@ -36,6 +36,9 @@ F32 = npt.NDArray[np.float32]
 
 # Chosen once on the 17 GT scenes (README, "Fusion"); the same for every scene.
 _BLUR = 2.0  # px: Gaussian sigma before the quantisation
+# px: the largest blur accepted. OpenCV's kernel grows with sigma: 1e4 px took 100 s on a 100 x 160
+# crop and 1e6 px raised cv2.error (bad_array_new_length).
+_MAX_BLUR = 64.0
 _STEP = 16  # grey levels (0-255) per quantisation bin
 _MIN_PIXELS = 50  # measured pixels a segment needs for a plane
 _MAX_RESIDUAL = 0.7  # px: largest median absolute residual of an accepted plane
@@ -83,7 +86,8 @@ def segments(
     Raises
     ------
     ValueError
-        A non-2-D/3-D image, a non-positive ``step`` or a negative ``blur``/``k``.
+        A non-2-D/3-D image, a non-positive ``step``, a ``blur`` outside [0, 64] px or a
+        negative ``k``.
     """
     from stereovision import _core
 
@@ -110,10 +114,12 @@ def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
     uint8 out (OpenCV rounds the blurred values, as the reference does); ``blur`` 0: none."""
     import cv2
 
+    if not (np.isfinite(blur) and 0 <= blur <= _MAX_BLUR):
+        raise ValueError(f"blur: expected a sigma in [0, {_MAX_BLUR:g}] px, got {blur}")
     u8 = im if im.dtype == np.uint8 else np.clip(im.astype(np.float32), 0, 255).astype(np.uint8)
     if blur <= 0:
         return u8
-    return np.asarray(cv2.GaussianBlur(u8, (0, 0), blur), np.uint8)
+    return np.asarray(cv2.GaussianBlur(u8, (0, 0), float(blur)), np.uint8)
 
 
 def plane_fill(
@@ -148,7 +154,7 @@ def plane_fill(
     ------
     ValueError
         ``disp`` not 2-D, ``labels`` of another shape or not below ``H * W``, a negative
-        ``max_residual``.
+        ``min_pixels`` or ``max_residual``.
     """
     from stereovision import _core
 
@@ -158,6 +164,10 @@ def plane_fill(
         raise ValueError(f"disp: expected an (H, W) array, got {d.shape}")
     if lab.shape != d.shape:
         raise ValueError(f"labels: expected shape {d.shape} like disp, got {lab.shape}")
+    if isinstance(min_pixels, bool) or not isinstance(min_pixels, (int, np.integer)):
+        raise ValueError(f"min_pixels: expected a whole number, got {min_pixels!r}")
+    if not 0 <= min_pixels < 2**31:
+        raise ValueError(f"min_pixels: expected a non-negative count, got {min_pixels}")
     out, _, _ = _core.plane_fill(d, lab, int(min_pixels), float(max_residual), lo, hi)
     return out
 
@@ -199,7 +209,8 @@ def fill_planes(
     Raises
     ------
     ValueError
-        An image of another size or with more than 3 channels, or a step outside 1-255.
+        An image of another size or with more than 3 channels, a step outside 1-255 or a
+        ``blur`` outside [0, 64] px.
     """
     from stereovision import _core
 
@@ -268,7 +279,7 @@ def side_fill(
     ------
     ValueError
         ``disp`` not 2-D, an image of another size or with a channel count other than 1 or 3,
-        a negative ``tau`` or ``blur``.
+        a negative ``tau`` or a ``blur`` outside [0, 64] px.
     """
     import cv2
 
