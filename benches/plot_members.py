@@ -1,4 +1,4 @@
-"""Draw where the census check drops valid members, on one GT scene (README picture).
+"""Draw where the census check drops valid members, on one GT scene (docs/fusion.md picture).
 
 Two panels over the left image (grey): the members before the census check
 (``fuse_pair(census_members=False)``) and after it (the default), each member a dot: green

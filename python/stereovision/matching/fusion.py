@@ -407,7 +407,7 @@ def fuse_pair(
         members' precision@1 rose on 10 (>= 99 % on 10 of the 16 Middlebury/ETH3D/TartanAir
         scenes instead of 8), terrace's member depth RMSE fell from 3.19 to 2.77 %, and the
         dense map built on it (:func:`fused_dense`) has a lower bad-2.0 on 12 and a lower
-        bad-0.5 on all 17 (README, "Fusion").
+        bad-0.5 on all 17 (docs/fusion.md).
     check_members : bool
         Keep only the members that pass B.8's both-sides check on the pair
         (:func:`stereovision.matching.mcgm.edge_filters` with ``sides`` alone, settings of
@@ -415,7 +415,7 @@ def fuse_pair(
         member's disparity, and no other disparity fits one of them better); members MCGM is
         part of passed it as MCGM matches and are not tested again. Gabor and Hopfield can
         agree on a foreground disparity that a fattened edge carried onto the background; the
-        background's half-window then does not fit it. Default True (README, "Fusion").
+        background's half-window then does not fit it. Default True (docs/fusion.md).
     edge_members : bool
         Drop the members that lie where a foreground edge of the (re-measured) Gabor map is
         carried past the image's edge (:func:`fused_dense`'s step 7 on the Gabor map, 7 px
@@ -429,7 +429,7 @@ def fuse_pair(
         not. Default True: over the 17 GT scenes precision@1 >= 99 % on all 16
         Middlebury/ETH3D/TartanAir scenes (teddy 97.89 -> 99.47 %, dolls 98.33 -> 99.39 %,
         TartanAir 97.53 -> 99.03 %; KITTI @2 98.60 -> 98.86 %) with 13 % fewer members
-        (README, "Fusion").
+        (docs/fusion.md).
     dense_sgm : bool
         Also run the census semi-global matcher (:func:`stereovision.matching.sgm.sgm_disparity`)
         beside the channels, for :func:`fused_dense`'s ``second``; its map is kept in

@@ -15,7 +15,7 @@ on a gradient, so two quantisations half a step apart are used and a hole filled
 the mean. A second pass with coarser segments (24 levels, 200 measured pixels) fills what the
 first left, and the holes no plane fills get the row fill. On the 17 GT scenes the default
 ``depth_map`` (fused) fills this way: its mean bad-2.0 ratio to SGBM-3WAY + fill goes from 0.633
-(row fill alone) to 0.555 with the first pass and 0.527 with both (README, "Fusion").
+(row fill alone) to 0.555 with the first pass and 0.527 with both (docs/fusion.md).
 
 The kernels are Rust (:func:`stereovision._core.graph_segments`,
 :func:`stereovision._core.plane_fill`, and :func:`stereovision._core.fill_planes`, which runs
@@ -34,7 +34,7 @@ __all__ = ["DEFAULTS", "fill_planes", "plane_fill", "segments", "side_fill"]
 
 F32 = npt.NDArray[np.float32]
 
-# Chosen once on the 17 GT scenes (README, "Fusion"); the same for every scene.
+# Chosen once on the 17 GT scenes (docs/fusion.md); the same for every scene.
 _BLUR = 2.0  # px: Gaussian sigma before the quantisation
 # px: the largest blur accepted. OpenCV's kernel grows with sigma: 1e4 px took 100 s on a 100 x 160
 # crop and 1e6 px raised cv2.error (bad_array_new_length).
@@ -253,8 +253,8 @@ def side_fill(
     here each pixel takes the left value where its colour is closer to the left neighbour's by
     more than ``tau``, else the right value. Other holes stay NaN for the row rule. Over the 17
     GT scenes the fused map's mean bad-2.0 ratio to SGBM-3WAY + fill goes from 0.519 to 0.514
-    and its largest from 0.795 to 0.779 (tsukuba), no scene worse by more than 0.001 (README,
-    "Fusion"). Rust kernel (``_core.side_fill``; NumPy reference
+    and its largest from 0.795 to 0.779 (tsukuba), no scene worse by more than 0.001
+    (docs/fusion.md, "The fill"). Rust kernel (``_core.side_fill``; NumPy reference
     ``tests/reference/row_fill_ref.py``).
 
     Parameters

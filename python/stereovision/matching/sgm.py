@@ -24,7 +24,7 @@ from stereovision._validate import as_gray_float, check_pair
 __all__ = ["DEFAULTS", "sgm_disparity"]
 
 #: Default parameters (mirror ``SgmParams::default`` in Rust). Chosen once on the 17 shared
-#: scenes (README, "Fusion"); the same for every scene.
+#: scenes (docs/fusion.md); the same for every scene.
 DEFAULTS: dict[str, Any] = {
     "p1": 8,  # penalty of a 1-level change between path neighbours (census bits)
     "p2": 96,  # penalty of a larger jump, before the intensity adaptation
