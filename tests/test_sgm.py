@@ -211,3 +211,56 @@ def test_census_mode_rejects_unknown_options() -> None:
         sv.depth_map(img, img, max_disparity=8, method="census", second_confidence=2.0)
     r = sv.depth_map(img, np.roll(img, -3, axis=1), max_disparity=8, method="census", p2=120)
     assert abs(float(np.nanmedian(r.disparity[:, 10:])) - 3.0) < 0.05
+
+
+def test_memory_check_refuses_before_allocating(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """With less memory available than the kernel's peak (3 bytes per pixel and level), every
+    path to the census map raises MemoryError naming the sizes, and the CLI prints one line and
+    exits 2, before the system's OOM killer would end the process."""
+    import stereovision as sv
+    from stereovision import cli
+    from stereovision.matching import sgm
+
+    rng = np.random.default_rng(0)
+    img = rng.random((120, 160)).astype(np.float32)
+    shifted = np.roll(img, -3, axis=1)
+    need = 3 * 160 * 120 * 33  # levels 0..32
+    monkeypatch.setattr(sgm, "_available_bytes", lambda: need - 1)
+    monkeypatch.setattr(sgm._core, "kept_memory", lambda: ((0, 0), 0))
+    with pytest.raises(MemoryError, match=r"160x120 pair over 33 disparity levels"):
+        sgm_disparity(img, shifted, max_disparity=32)
+    for method in ("fused", "census"):
+        with pytest.raises(MemoryError, match="lower max_disparity"):
+            sv.depth_map(img, shifted, max_disparity=32, method=method)
+    # The Gabor channel alone runs no census map.
+    assert sv.depth_map(img, shifted, max_disparity=32, method="gabor").disparity.shape == img.shape
+    # Exactly enough, or no way to tell: it runs.
+    monkeypatch.setattr(sgm, "_available_bytes", lambda: need)
+    d = sgm_disparity(img, shifted, max_disparity=32)
+    assert abs(float(np.nanmedian(d[:, 40:])) - 3.0) < 0.05
+    monkeypatch.setattr(sgm, "_available_bytes", lambda: None)
+    assert np.array_equal(sgm_disparity(img, shifted, max_disparity=32), d, equal_nan=True)
+
+    import cv2
+
+    monkeypatch.setattr(sgm, "_available_bytes", lambda: 1000)
+    for name, a in (("l.png", img), ("r.png", shifted)):
+        cv2.imwrite(str(tmp_path / name), np.clip(a * 255, 0, 255).astype(np.uint8))
+    argv = ["depth", str(tmp_path / "l.png"), str(tmp_path / "r.png"), "-o", str(tmp_path / "o")]
+    code = cli.main(argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "needs about" in err[0], err
+
+
+def test_available_memory_is_read() -> None:
+    """On Linux the check has a figure to compare with: positive and below the machine's RAM."""
+    from stereovision.matching import sgm
+
+    avail = sgm._available_bytes()
+    if not Path("/proc/meminfo").exists():
+        pytest.skip("no /proc/meminfo")
+    with open("/proc/meminfo") as f:
+        total = int(next(line for line in f if line.startswith("MemTotal:")).split()[1]) * 1024
+    assert avail is not None and 0 < avail <= total

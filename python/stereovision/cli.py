@@ -453,7 +453,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("stereovision: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
-    except (CliError, ValueError, OSError, RuntimeError) as exc:
+    except (CliError, ValueError, OSError, RuntimeError, MemoryError) as exc:
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         print(f"stereovision: error: {msg}", file=sys.stderr)
         return EXIT_ERROR

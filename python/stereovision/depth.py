@@ -611,6 +611,10 @@ def depth_map(
     ------
     ValueError
         Bad images (shape, dtype, empty, NaN, mismatched sizes), a bad range or unknown method.
+    MemoryError
+        With ``method="fused"`` or ``"census"``, before the census semi-global map allocates
+        more than the memory available (3 bytes per pixel and disparity level: about 14 GiB for
+        a 3840 x 2160 pair over 576 px, 2 GiB at 1920 x 1080 over 288 px).
 
     Examples
     --------
