@@ -236,6 +236,23 @@ def test_app_controllers_report_errors_and_compute(tmp_path):
     assert app.state.stats.startswith("opencv-bm · 450×375")
     assert "No calibration" in app.state.message_3d
 
+    # A pair too large for the machine's memory: the census map's check refuses it, and the page
+    # says so instead of the task dying.
+    from stereovision.matching import sgm
+
+    async def too_big() -> None:
+        app.state.method = "fused"
+        await app.recompute()
+
+    saved = sgm._available_bytes
+    sgm._available_bytes = lambda: 1000
+    try:
+        asyncio.run(too_big())
+    finally:
+        sgm._available_bytes = saved
+    assert app.state.error.startswith("the census semi-global map needs about")
+    assert app.state.computations == 1
+
 
 # ----------------------------------------------------------------------------- browser
 

@@ -587,7 +587,8 @@ class StereoApp:
                         progress=progress,
                     ),
                 )
-            except (ValueError, OSError, RuntimeError) as exc:
+            except (ValueError, OSError, RuntimeError, MemoryError) as exc:
+                # MemoryError: the census map's check refused a pair too large for this machine.
                 self._fail(exc)
                 return
             self._publish(view)
