@@ -21,7 +21,19 @@ from stereovision._validate import as_gray_float
 from stereovision.io import load_scene
 from stereovision.matching import fusion, gabor, hopfield, mcgm, planes, sgm
 
-BAD_VALUES: list[Any] = [-1, 0, 0.5, 10**12, -(10**12), float("nan"), float("inf"), "x", None]
+BAD_VALUES: list[Any] = [
+    -1,
+    0,
+    0.5,
+    10**9,
+    2**31 - 1,
+    10**12,
+    -(10**12),
+    float("nan"),
+    float("inf"),
+    "x",
+    None,
+]
 
 
 @pytest.fixture(scope="module")

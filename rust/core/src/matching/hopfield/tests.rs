@@ -131,6 +131,15 @@ fn bad_parameters_are_errors() {
         ..params(8)
     };
     assert!(hopfield_match(&l, &r, &p).is_err());
+    // A window beyond any image (1e9 px ran for minutes).
+    for half in [0, MAX_NBR_HALF + 1, 1_000_000_000] {
+        let mut p = params(8);
+        p.weights.nbr_half = half;
+        assert!(matches!(
+            hopfield_match(&l, &r, &p),
+            Err(CoreError::InvalidParameter { .. })
+        ));
+    }
     let small = Image::filled(20, 30, 0.5);
     assert!(matches!(
         hopfield_match(&l, &small, &params(8)),

@@ -250,6 +250,10 @@ pub struct McgmOutput {
     pub n_disc: usize,
 }
 
+/// Largest `dy_band` (rows): a rectified pair's matches lie within a row or two.
+pub const MAX_DY_BAND: i32 = 64;
+/// Largest `fill_radius` (px).
+pub const MAX_RADIUS: i32 = 4096;
 /// Largest `n_theta_bins` (a tenth of a degree per bin).
 pub const MAX_THETA_BINS: usize = 3600;
 
@@ -297,8 +301,13 @@ fn validate_params(p: &McgmParams) -> Result<()> {
     if p.cand.k_cand == 0 {
         return Err(CoreError::param("k_cand", "must be >= 1"));
     }
-    if p.cand.dy_band < 0 {
-        return Err(CoreError::param("dy_band", "must be >= 0"));
+    // Upper bounds keep the row index small and the window arithmetic inside i32: 1e9 rows of
+    // band asked for 136 GB (an abort), a fill radius of i32::MAX overflowed into a bad index.
+    if !(0..=MAX_DY_BAND).contains(&p.cand.dy_band) {
+        return Err(CoreError::param(
+            "dy_band",
+            format!("must be in 0..={MAX_DY_BAND} rows, got {}", p.cand.dy_band),
+        ));
     }
     if p.solver.max_sweeps == 0 {
         return Err(CoreError::param("max_sweeps", "must be >= 1"));
@@ -342,8 +351,11 @@ fn validate_params(p: &McgmParams) -> Result<()> {
             "sides_width in 1..=16, sides_height >= 1; sides_gap, disc_dx, disc_dy >= 0",
         ));
     }
-    if p.fill_radius < 0 {
-        return Err(CoreError::param("fill_radius", "must be >= 0"));
+    if !(0..=MAX_RADIUS).contains(&p.fill_radius) {
+        return Err(CoreError::param(
+            "fill_radius",
+            format!("must be in 0..={MAX_RADIUS} px, got {}", p.fill_radius),
+        ));
     }
     Ok(())
 }

@@ -225,7 +225,21 @@ fn bad_parameters_are_errors_not_panics() {
         p.cand.vote_bin_tol = vote_bin_tol;
         p
     });
-    for p in bad.into_iter().chain(bins) {
+    // A band of 1e9 rows asked for 136 GB (an abort); a fill radius of i32::MAX overflowed the
+    // window's arithmetic into an out-of-bounds index.
+    let ranges = [
+        (MAX_DY_BAND + 1, 1),
+        (1_000_000_000, 1),
+        (1, MAX_RADIUS + 1),
+        (1, i32::MAX),
+    ]
+    .map(|(dy_band, fill_radius)| {
+        let mut p = McgmParams::default();
+        p.cand.dy_band = dy_band;
+        p.fill_radius = fill_radius;
+        p
+    });
+    for p in bad.into_iter().chain(bins).chain(ranges) {
         assert!(matches!(
             mcgm_match(&img, &img, &p),
             Err(CoreError::InvalidParameter { .. })
