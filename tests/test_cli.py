@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -23,6 +24,11 @@ def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
     )
     assert proc.returncode == 0, proc.stderr
     assert "bad-2.0" in proc.stdout and "density" in proc.stdout
+    # Ours (filled) against OpenCV's SGBM after the same row fill, both printed: ours is lower.
+    ours = re.search(r"fused on cones .*?bad-2\.0 ([\d.]+) % \(filled\)", proc.stdout)
+    sgbm = re.search(r"StereoSGBM 3-way .*?, ([\d.]+) % with the row fill", proc.stdout)
+    assert ours and sgbm, proc.stdout
+    assert float(ours.group(1)) < 0.8 * float(sgbm.group(1))
     for name in ("disparity.png", "depth.png", "disparity.pfm", "depth.npy", "cloud.ply"):
         assert (out / name).stat().st_size > 0, name
     disp = read_pfm(out / "disparity.pfm")
@@ -32,6 +38,22 @@ def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
     assert img is not None and img.shape == (375, 450, 3) and img.std() > 10
     pts, _ = read_ply(out / "cloud.ply")
     assert len(pts) > 10000
+
+
+def test_closed_pipe_stops_quietly(tmp_path: Path) -> None:
+    """`stereovision demo | head -1`: the reader goes away while the pipeline runs; the CLI
+    stops with 141 (128 + SIGPIPE, as a shell reports) and prints no error."""
+    proc = subprocess.Popen(
+        [*SV, "demo", "-o", str(tmp_path / "demo")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stdout is not None and proc.stderr is not None
+    assert proc.stdout.readline().startswith("demo scene:")
+    proc.stdout.close()  # before the results are printed (the pipeline takes a fraction of a s)
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == 141 and err == "", err
 
 
 def test_depth_command_on_metric_scene(tmp_path: Path, data_dir: Path) -> None:

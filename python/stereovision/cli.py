@@ -7,7 +7,9 @@ written atomically after all computation succeeded, so an error never destroys e
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import os
 import sys
 import time
 from collections.abc import Sequence
@@ -20,6 +22,7 @@ import numpy as np
 
 EXIT_ERROR = 2
 EXIT_INTERRUPTED = 130
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell reports for `yes | head`
 
 
 class CliError(Exception):
@@ -231,6 +234,19 @@ def cmd_demo(args: argparse.Namespace) -> int:
         f"{args.method} on cones (max_disparity {res.max_disparity}): {bad2} "
         f"(density {raw.density:.1f} %, avgerr {raw.avgerr:.2f} px), "
         f"{sum(res.timings.values()):.2f} s"
+    )
+    # What the user has today, on the same pair: OpenCV's SGBM (evaluation.md's configuration),
+    # as it comes and after the same reference row fill.
+    from stereovision.baselines import opencv_sgbm
+
+    t = time.perf_counter()
+    sgbm = opencv_sgbm(scene.left, scene.right, res.max_disparity)
+    t_sgbm = time.perf_counter() - t
+    sg = dense_metrics(sgbm, scene.gt)
+    print(
+        f"  OpenCV StereoSGBM 3-way on the same pair: bad-2.0 {sg.bad[2.0]:.1f} % "
+        f"(density {sg.density:.1f} %), {dense_metrics(row_fill(sgbm), scene.gt).bad[2.0]:.1f} % "
+        f"with the row fill, {t_sgbm:.2f} s"
     )
     if res.depth is not None and scene.calib is not None:
         dm = depth_metrics(res.depth, gt_depth(scene.gt, scene.calib))
@@ -453,6 +469,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("stereovision: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        # The reader went away (`stereovision eval DIR | head`): stop quietly, as Unix tools do,
+        # and keep Python from reporting the pipe again when it flushes stdout at exit.
+        with contextlib.suppress(OSError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
     except (CliError, ValueError, OSError, RuntimeError, MemoryError) as exc:
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         print(f"stereovision: error: {msg}", file=sys.stderr)
