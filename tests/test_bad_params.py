@@ -58,28 +58,20 @@ def _keyword_defaults(fn: Callable[..., Any], skip: set[str]) -> list[str]:
 
 
 Call = Callable[[dict[str, Any], dict[str, Any]], object]
+
+
+def _on_pair(fn: Callable[..., object]) -> Call:
+    """A channel called on the grey pair over 0..32 px with the keyword under test."""
+    return lambda c, kw: fn(c["gl"], c["gr"], max_disparity=32, **kw)
+
+
 CALLS: dict[str, tuple[list[str], Call]] = {
-    "mcgm": (
-        list(mcgm.DEFAULTS),
-        lambda c, kw: mcgm.mcgm_match(c["gl"], c["gr"], max_disparity=32, **kw),
-    ),
-    "hopfield": (
-        list(hopfield.DEFAULTS),
-        lambda c, kw: hopfield.hopfield_match(c["gl"], c["gr"], max_disparity=32, **kw),
-    ),
-    "gabor": (
-        list(gabor.DEFAULTS),
-        lambda c, kw: gabor.gabor_disparity(c["gl"], c["gr"], max_disparity=32, **kw),
-    ),
-    "sgm": (
-        list(sgm.DEFAULTS),
-        lambda c, kw: sgm.sgm_disparity(c["gl"], c["gr"], max_disparity=32, **kw),
-    ),
+    "mcgm": (list(mcgm.DEFAULTS), _on_pair(mcgm.mcgm_match)),
+    "hopfield": (list(hopfield.DEFAULTS), _on_pair(hopfield.hopfield_match)),
+    "gabor": (list(gabor.DEFAULTS), _on_pair(gabor.gabor_disparity)),
+    "sgm": (list(sgm.DEFAULTS), _on_pair(sgm.sgm_disparity)),
     # Its other keywords are on/off flags.
-    "fuse_pair": (
-        ["min_disparity", "channels"],
-        lambda c, kw: fusion.fuse_pair(c["gl"], c["gr"], max_disparity=32, **kw),
-    ),
+    "fuse_pair": (["min_disparity", "channels"], _on_pair(fusion.fuse_pair)),
     "refine": (
         [*refine.DEFAULTS, "min_disparity"],
         lambda c, kw: refine.refine_disparity(
