@@ -209,6 +209,9 @@ def test_resolution_request_and_resize_warning(tmp_path: Path) -> None:
     for bad in ("big", "0x5", "12x"):
         with pytest.raises(ValueError, match="WIDTHxHEIGHT"):
             parse_size(bad)
+    assert parse_size("16384x8640") == (16384, 8640)
+    with pytest.raises(ValueError, match="at most 16384 px per side, got 100000x100000"):
+        parse_size("100000x100000")
     assert parse_source("0") == 0 and parse_source("a.avi") == "a.avi"
 
 

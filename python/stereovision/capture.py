@@ -91,13 +91,18 @@ def parse_source(text: str | int) -> int | str:
     return int(text) if text.strip().isdigit() else text
 
 
+#: Largest frame side accepted for ``--size`` (16K video is 15360 px wide).
+MAX_SIDE = 16384
+
+
 def parse_size(text: str | tuple[int, int] | None) -> tuple[int, int] | None:
     """Parse ``"1280x720"`` to ``(1280, 720)``.
 
     Raises
     ------
     ValueError
-        If the text is not two positive integers separated by ``x``.
+        If the text is not two positive integers separated by ``x``, or a side exceeds
+        :data:`MAX_SIDE`.
     """
     if text is None:
         return None
@@ -108,6 +113,10 @@ def parse_size(text: str | tuple[int, int] | None) -> tuple[int, int] | None:
         vals = (int(text[0]), int(text[1])) if len(text) == 2 else (0, 0)
     if min(vals) <= 0:
         raise ValueError(f"size: expected WIDTHxHEIGHT with positive integers, got {text!r}")
+    # Frames of another size are resized to this one: 100000x100000 made OpenCV fail to
+    # allocate 30 GB per frame, an internal error instead of a word about the size.
+    if max(vals) > MAX_SIDE:
+        raise ValueError(f"size: at most {MAX_SIDE} px per side, got {vals[0]}x{vals[1]}")
     return vals
 
 
