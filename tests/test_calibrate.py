@@ -331,6 +331,11 @@ def test_input_errors(tmp_path: Path) -> None:
         calibrate(left[:2], right[:3], square_size=1.0)
     with pytest.raises(ValueError, match="square_size"):
         calibrate(left[:2], right[:2], square_size=-1.0)
+    # 1e308 overflowed the float32 board into inf (an OpenCV assertion); 1e-12 m is no board.
+    with pytest.raises(ValueError, match="between 1 nm and 100 m"):
+        calibrate(left[:2], right[:2], square_size=1e308)
+    with pytest.raises(ValueError, match=r"square_size: 1e-09 mm is 1e-12 m"):
+        calibrate(left[:2], right[:2], square_size=1e-9, unit="mm")
     with pytest.raises(ValueError, match="unit"):
         calibrate(left[:2], right[:2], square_size=1.0, unit="parsec")
     with pytest.raises(ValueError, match="distortion"):

@@ -774,6 +774,14 @@ def calibrate(
     square = positive_finite(square_size, "square_size")
     if unit not in UNIT_TO_METRES:
         raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+    # The board's corners are float32 for OpenCV: 1e308 overflowed them into inf and the solver
+    # failed an assertion. No printed or built board has squares outside these bounds.
+    metres = square * UNIT_TO_METRES[unit]
+    if not 1e-9 <= metres <= 100.0:
+        raise ValueError(
+            f"square_size: {square:g} {unit} is {metres:g} m; expected a board square between "
+            "1 nm and 100 m"
+        )
     if distortion != "auto" and distortion not in DISTORTION_MODELS:
         raise ValueError(
             f"distortion: expected 'auto' or one of {list(DISTORTION_MODELS)}, got {distortion!r}"
