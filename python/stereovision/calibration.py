@@ -769,6 +769,16 @@ def parse_middlebury_calib(path: PathLike) -> dict[str, Any]:
     other ``key=number`` line (``doffs``, ``baseline``, ``width``, ``height``, ``ndisp``,
     ``vmin``, ...) a float.
 
+    Parameters
+    ----------
+    path : path
+        The ``calib.txt`` file.
+
+    Returns
+    -------
+    dict
+        Key -> ``(3, 3)`` array (``cam0``, ``cam1``) or float.
+
     Raises
     ------
     FileNotFoundError
@@ -809,6 +819,16 @@ def parse_kitti_calib(path: PathLike) -> dict[str, F64]:
 
     Handles ``key: v1 v2 ...`` on one line and values continued over following lines; keys whose
     values are not all numbers (``calib_time``) are skipped, as is free text before the first key.
+
+    Parameters
+    ----------
+    path : path
+        The calibration file (``calib_cam_to_cam.txt`` or a per-frame ``calib.txt``).
+
+    Returns
+    -------
+    dict
+        Key (``P_rect_02``, ``R_02``, ...) -> 1-D float64 array of its values, row-major.
 
     Raises
     ------

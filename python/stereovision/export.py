@@ -65,6 +65,11 @@ def organised_points(
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8]]:
     """Image-shaped points and colours of ``result`` (NaN points where there is no depth).
 
+    Parameters
+    ----------
+    result : DepthResult
+        A :func:`stereovision.depth_map` result computed with a calibration.
+
     Returns
     -------
     points : ndarray, float32 (H, W, 3)
@@ -90,6 +95,18 @@ def organised_points(
 
 def write_cloud_ply(path: PathLike, result: DepthResult) -> Path:
     """Coloured point cloud of ``result`` as binary PLY (see the module conventions).
+
+    Parameters
+    ----------
+    path : path
+        File to write (atomically: an existing file is replaced only once the new one is whole).
+    result : DepthResult
+        A :func:`stereovision.depth_map` result computed with a calibration.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
 
     Raises
     ------
@@ -168,6 +185,18 @@ def _unpack_rgb(packed: npt.NDArray[np.float32]) -> npt.NDArray[np.uint8]:
 def write_pcd(path: PathLike, result: DepthResult) -> Path:
     """Organised binary PCD (``WIDTH`` x ``HEIGHT`` = image size, NaN where no depth).
 
+    Parameters
+    ----------
+    path : path
+        File to write (atomically).
+    result : DepthResult
+        A :func:`stereovision.depth_map` result computed with a calibration.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
     Raises
     ------
     ValueError
@@ -196,6 +225,11 @@ def read_pcd(
     path: PathLike,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]:
     """Read a PCD file with ``x y z`` (float) and optional packed ``rgb`` (ascii or binary data).
+
+    Parameters
+    ----------
+    path : path
+        The ``.pcd`` file.
 
     Returns
     -------
@@ -276,6 +310,18 @@ def write_npz(path: PathLike, result: DepthResult) -> Path:
     """Bundle depth, confidence, disparity and the intrinsics into a compressed ``.npz``.
 
     Without calibration ``depth`` is all NaN and ``K`` / ``baseline`` / ``doffs`` are NaN.
+
+    Parameters
+    ----------
+    path : path
+        File to write (atomically).
+    result : DepthResult
+        Any :func:`stereovision.depth_map` result.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
     """
     h, w = result.disparity.shape[:2]
     calib = result.calibration
@@ -307,8 +353,21 @@ def write_npz(path: PathLike, result: DepthResult) -> Path:
 def read_npz(path: PathLike) -> dict[str, Any]:
     """Read a bundle written by :func:`write_npz` into a dict of arrays (scalars as Python values).
 
+    Parameters
+    ----------
+    path : path
+        The ``.npz`` file.
+
+    Returns
+    -------
+    dict
+        ``depth``, ``confidence``, ``disparity`` (H, W) float32, ``K`` (3, 3), ``baseline``,
+        ``doffs``, ``image_size``, ``method``, ``max_disparity``.
+
     Raises
     ------
+    FileNotFoundError
+        Missing file.
     ValueError
         If the file is not an ``.npz`` bundle with ``depth`` and ``K``.
     """
@@ -345,6 +404,11 @@ def load_cloud(
     path: PathLike,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]:
     """Read a point cloud from PLY, PCD or an ``.npz`` bundle (chosen by content, not by name).
+
+    Parameters
+    ----------
+    path : path
+        The file.
 
     Returns
     -------
@@ -392,6 +456,15 @@ def export_result(
     formats: tuple[str, ...] = tuple(EXPORT_FORMATS),
 ) -> dict[str, Path]:
     """Write the result in the chosen formats (``"ply"``, ``"pcd"``, ``"npz"``) into ``out_dir``.
+
+    Parameters
+    ----------
+    result : DepthResult
+        A :func:`stereovision.depth_map` result.
+    out_dir : path
+        Folder, created if missing; each file is written atomically.
+    formats : tuple of str
+        Any of ``"ply"``, ``"pcd"``, ``"npz"`` (default: all three).
 
     Returns
     -------

@@ -126,7 +126,18 @@ def _existing_file(path: PathLike, what: str) -> Path:
 def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] | None:
     """``cv2.imdecode`` to BGR with OpenCV's own logging silenced for the call: a file it cannot
     read returns None, and the caller's error names the file (OpenCV would also print its own
-    ``[ERROR] ... imdecode_`` line on stderr, a second message for one problem)."""
+    ``[ERROR] ... imdecode_`` line on stderr, a second message for one problem).
+
+    Parameters
+    ----------
+    data : ndarray of uint8 or bytes
+        The encoded file's bytes (PNG, JPEG, PPM/PGM, ...).
+
+    Returns
+    -------
+    numpy.ndarray or None
+        ``uint8`` ``(H, W, 3)`` BGR; None if the bytes are empty or not a readable image.
+    """
     buf = np.frombuffer(data, np.uint8) if isinstance(data, bytes) else data
     if buf.size == 0:
         return None
