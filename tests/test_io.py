@@ -100,6 +100,38 @@ def test_imread_truncated_says_it_once(tmp_path: Path, capfd: pytest.CaptureFixt
     assert cv2.utils.logging.getLogLevel() == level  # type: ignore[attr-defined]
 
 
+def test_concurrent_decodes_put_the_log_level_back() -> None:
+    """Threads decoding at once (good and bad files): OpenCV's process-wide log level ends as it
+    was, and each call's result is its own."""
+    import threading
+
+    import cv2
+
+    from stereovision.io import decode_image
+
+    ok, png = cv2.imencode(".png", np.full((32, 48, 3), 7, np.uint8))
+    assert ok
+    good, bad = png.tobytes(), png.tobytes()[: png.size // 3]
+    log = cv2.utils.logging  # type: ignore[attr-defined]
+    before = log.getLogLevel()
+    results: list[bool] = []
+
+    def work(k: int) -> None:
+        for i in range(200):
+            img = decode_image(good if (i + k) % 2 else bad)
+            results.append(
+                img is not None and img.shape == (32, 48, 3) if (i + k) % 2 else img is None
+            )
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert len(results) == 800 and all(results)
+    assert log.getLogLevel() == before
+
+
 # ---------------------------------------------------------------------------------------- PFM
 
 

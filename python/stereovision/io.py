@@ -17,6 +17,7 @@ import math
 import os
 import re
 import tempfile
+import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -141,14 +142,33 @@ def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] |
     buf = np.frombuffer(data, np.uint8) if isinstance(data, bytes) else data
     if buf.size == 0:
         return None
-    log = cv2.utils.logging  # type: ignore[attr-defined]
-    level = log.getLogLevel()
-    log.setLogLevel(log.LOG_LEVEL_SILENT)
-    try:
+    with _opencv_quiet():
         img = cv2.imdecode(buf, cv2.IMREAD_COLOR)
-    finally:
-        log.setLogLevel(level)
     return None if img is None else np.asarray(img, dtype=np.uint8)
+
+
+# OpenCV's log level is process-wide: the first of concurrent decodes silences it and the last
+# puts back what was there (a plain save and restore per call could leave it silenced for good
+# when two threads interleave).
+_QUIET_LOCK = threading.Lock()
+_quiet = {"depth": 0, "level": 0}
+
+
+@contextmanager
+def _opencv_quiet() -> Iterator[None]:
+    log = cv2.utils.logging  # type: ignore[attr-defined]
+    with _QUIET_LOCK:
+        if _quiet["depth"] == 0:
+            _quiet["level"] = log.getLogLevel()
+            log.setLogLevel(log.LOG_LEVEL_SILENT)
+        _quiet["depth"] += 1
+    try:
+        yield
+    finally:
+        with _QUIET_LOCK:
+            _quiet["depth"] -= 1
+            if _quiet["depth"] == 0:
+                log.setLogLevel(_quiet["level"])
 
 
 def imread(path: PathLike, gray: bool = False) -> npt.NDArray[np.uint8]:
