@@ -118,12 +118,6 @@ def _load_calibration(path: str | None) -> Any:
     return Calibration.from_file(path)
 
 
-def _progress(enabled: bool = True) -> Any:
-    from tqdm import tqdm
-
-    return tqdm(disable=not enabled or not sys.stderr.isatty(), file=sys.stderr, leave=False)
-
-
 def depth_outputs(
     left: np.ndarray,
     right: np.ndarray,
