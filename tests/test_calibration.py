@@ -227,6 +227,35 @@ def test_load_errors(tmp_path: Path) -> None:
         Calibration.load(tmp_path / "c.json")
 
 
+def test_damaged_opencv_yaml_is_a_value_error_naming_the_problem(tmp_path: Path) -> None:
+    """OpenCV's parser raises cv2.error (or a SystemError around it) on a damaged file: each
+    reaches the user as a ValueError with the file, the field and OpenCV's reason (it was an
+    internal error in the CLI)."""
+    good = tmp_path / "rig.yaml"
+    raw_calib().save(good)
+    text = good.read_text()
+    lines = text.splitlines()
+    r = next(i for i, line in enumerate(lines) if line.startswith("R:"))
+    cases = {
+        # a matrix whose "rows" line is gone (FileNode.mat() wrote past its buffer on such a
+        # matrix and corrupted the heap; the matrices are read number by number now)
+        "no_rows.yaml": "\n".join(lines[: r + 1] + lines[r + 2 :]),
+        # a matrix whose data holds a word
+        "word.yaml": text.replace("data: [", "data: [ x,", 1),
+        # a list cut in the middle, then more keys: a parse error with its line
+        "cut.yaml": text.replace("]", "", 1),
+    }
+    expected = {
+        "no_rows.yaml": r"no_rows\.yaml: field 'R' is not a matrix: rows and cols must be integers",
+        "word.yaml": r"word\.yaml: field 'K1' is not a matrix: data holds 10 numbers for 3 x 3",
+        "cut.yaml": r"cannot parse .*cut\.yaml as OpenCV YAML/XML: line \d+: ",
+    }
+    for name, body in cases.items():
+        (tmp_path / name).write_text(body)
+        with pytest.raises(ValueError, match=expected[name]):
+            Calibration.from_file(tmp_path / name)
+
+
 # --------------------------------------------------------------------------------- Middlebury
 
 

@@ -90,6 +90,50 @@ def _close(a: float, b: float, rel: float = RECTIFIED_REL_TOL) -> bool:
     return abs(a - b) <= rel * max(abs(a), abs(b), 1.0)
 
 
+def _node_matrix(node: Any, key: str, source: str) -> npt.NDArray[np.float64]:
+    """An ``!!opencv-matrix`` node read number by number, checked before anything is sized.
+
+    Not ``FileNode.mat()``: on a damaged matrix (``rows`` or ``cols`` missing, ``data`` shorter
+    than ``rows x cols``) OpenCV 5.1 sizes the matrix before its own check fails and writes past
+    the buffer; the heap corruption aborted the process a few calibration files later (seen under
+    ``MALLOC_CHECK_=3`` in a fuzz of 150 damaged files)."""
+
+    def bad(why: str) -> ValueError:
+        return ValueError(f"{source}: field {key!r} is not a matrix: {why}")
+
+    if not node.isMap():
+        raise bad("expected rows, cols and data")
+    rows, cols, data = (node.getNode(k) for k in ("rows", "cols", "data"))
+    if not (rows.isInt() and cols.isInt()):
+        raise bad("rows and cols must be integers")
+    if not data.isSeq():
+        raise bad("data must be a list of numbers")
+    r, c, n = int(rows.real()), int(cols.real()), int(data.size())
+    if r < 0 or c < 0 or n != r * c:
+        raise bad(f"data holds {n} numbers for {r} x {c}")
+    values = []
+    for i in range(n):
+        v = data.at(i)
+        if not (v.isReal() or v.isInt()):
+            raise bad(f"element {i} of data is not a number")
+        values.append(v.real())
+    return np.array(values, dtype=np.float64).reshape(r, c)
+
+
+def _first_line(exc: BaseException) -> str:
+    """OpenCV's own words from a cv2.error (``... error: (-215:Assertion failed) WHAT in
+    function ...``: WHAT), also through the SystemError its constructors wrap it in."""
+    if isinstance(exc, SystemError) and exc.__cause__ is not None:
+        exc = exc.__cause__
+    text = str(exc).strip()
+    m = re.search(r"error: \([^)]*\) (.*?)(?: in function '([^']*)')?\s*$", text, re.S)
+    if m:
+        # The YAML parser puts the line and the reason where the function name would be.
+        where = re.fullmatch(r"\((\d+)\): (.*)", m.group(2) or "")
+        return f"line {where.group(1)}: {where.group(2)}" if where else m.group(1).strip()
+    return text.splitlines()[0] if text else type(exc).__name__
+
+
 @dataclass(eq=False, frozen=True)
 class Calibration:
     """Intrinsics and extrinsics of a stereo pair (OpenCV conventions, see module docstring).
@@ -557,7 +601,14 @@ class Calibration:
 
     @classmethod
     def _from_filestorage_text(cls, text: str, source: str) -> Calibration:
-        fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
+        # A damaged file makes OpenCV's parser raise cv2.error (or, from the constructor, a
+        # SystemError wrapping it): both are the file's fault, so a ValueError naming it.
+        try:
+            fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
+        except (cv2.error, SystemError) as exc:
+            raise ValueError(
+                f"cannot parse {source} as OpenCV YAML/XML: {_first_line(exc)}"
+            ) from None
         if not fs.isOpened():
             raise ValueError(f"cannot parse {source} as OpenCV YAML/XML")
 
@@ -571,8 +622,7 @@ class Calibration:
                 return int(node.real())
             if node.isReal():
                 return node.real()
-            mat = node.mat()
-            return None if mat is None else np.asarray(mat, dtype=np.float64)
+            return _node_matrix(node, key, source)
 
         try:
             return cls._from_mapping(get, source)
