@@ -135,3 +135,28 @@ def test_load_cloud_errors(tmp_path):
     np.savez(bad_npz, foo=np.zeros(3))
     with pytest.raises(ValueError, match="not a stereovision depth bundle"):
         export.load_cloud(bad_npz)
+
+
+def test_damaged_pcd_and_npz_are_value_errors(result, tmp_path):
+    """A garbled PCD type letter (a KeyError before) and a bundle whose compressed data is
+    damaged (zlib.error before) are ValueErrors naming the file."""
+    bad_type = tmp_path / "t.pcd"
+    bad_type.write_bytes(
+        b"# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F Q F\nCOUNT 1 1 1\n"
+        b"WIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA binary\n" + b"\0" * 12
+    )
+    with pytest.raises(ValueError, match=r"t\.pcd: unsupported fields"):
+        export.load_cloud(bad_type)
+    good = export.write_npz(tmp_path / "a.npz", result)
+    data = bytearray(good.read_bytes())
+    # Flip bytes inside the first member's deflate stream (past its 30-byte local header and
+    # name), where the zip directory still reads fine.
+    name_len = int.from_bytes(data[26:28], "little")
+    start = 30 + name_len + int.from_bytes(data[28:30], "little")
+    for i in range(start + 4, start + 40):
+        data[i] ^= 0x5A
+    damaged = tmp_path / "d.npz"
+    damaged.write_bytes(bytes(data))
+    for fn in (export.read_npz, export.load_cloud):
+        with pytest.raises(ValueError, match=r"d\.npz"):
+            fn(damaged)

@@ -19,6 +19,7 @@ from __future__ import annotations
 import io as _io
 import os
 import zipfile
+import zlib
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -276,12 +277,20 @@ def read_pcd(
     if not {"x", "y", "z"} <= set(names):
         raise ValueError(f"PCD file {p}: fields {names}, expected x y z")
     kinds = {"F": "f", "U": "u", "I": "i"}
-    dtype = np.dtype(
-        [
-            (n, f"<{kinds[t]}{s}", (c,)) if c > 1 else (n, f"<{kinds[t]}{s}")
-            for n, s, t, c in zip(names, sizes, types, counts, strict=True)
-        ]
-    )
+    try:
+        dtype = np.dtype(
+            [
+                (n, f"<{kinds[t]}{s}", (c,)) if c > 1 else (n, f"<{kinds[t]}{s}")
+                for n, s, t, c in zip(names, sizes, types, counts, strict=True)
+            ]
+        )
+    except (KeyError, TypeError, ValueError):
+        # A type letter other than F/U/I, a size numpy has no type for, fewer sizes than fields.
+        raise ValueError(
+            f"PCD file {p}: unsupported fields {names} (SIZE {sizes}, TYPE {types})"
+        ) from None
+    if width < 0 or height < 0:
+        raise ValueError(f"PCD file {p}: negative WIDTH or HEIGHT ({width} x {height})")
     n = width * height
     if mode == "binary":
         if len(raw) - pos < n * dtype.itemsize:
@@ -377,8 +386,9 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     try:
         with np.load(p, allow_pickle=False) as z:
             data = {k: z[k] for k in z.files}
-    except (zipfile.BadZipFile, ValueError, OSError):
-        raise ValueError(f"not an .npz bundle: {p}") from None
+    except (zipfile.BadZipFile, zlib.error, EOFError, ValueError, OSError):
+        # zlib.error / EOFError: a bundle whose compressed members are damaged or cut.
+        raise ValueError(f"not an .npz bundle (or a damaged one): {p}") from None
     if "depth" not in data or "K" not in data:
         raise ValueError(f"{p}: not a stereovision depth bundle (needs depth and K)")
     for key, value in list(data.items()):
