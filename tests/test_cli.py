@@ -56,6 +56,17 @@ def test_closed_pipe_stops_quietly(tmp_path: Path) -> None:
     assert proc.wait(timeout=120) == 141 and err == "", err
 
 
+def test_warnings_are_one_line(tmp_path: Path, data_dir: Path) -> None:
+    """A swapped pair runs, and the CLI says so in one line (not Python's file:line echo)."""
+    scene = data_dir / "middlebury2003" / "cones"
+    argv = ["depth", str(scene / "right.png"), str(scene / "left.png"), "-o", str(tmp_path)]
+    proc = subprocess.run([*SV, *argv], capture_output=True, text=True, check=False)
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert lines[0].startswith("stereovision: warning: the left and right images look swapped")
+
+
 def test_depth_command_on_metric_scene(tmp_path: Path, data_dir: Path) -> None:
     scene = data_dir / "eth3d" / "terrace"
     out = tmp_path / "o"

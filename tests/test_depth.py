@@ -233,6 +233,19 @@ def test_auto_max_disparity_on_images_too_small_for_features(
             sv.depth_map(left, right)
 
 
+def test_swapped_pair_is_warned_about(data_dir: Path) -> None:
+    """Swapped cameras are a classic set-up mistake: the range estimate's feature matches then
+    have negative disparities, and it says so (given the right way round: no warning)."""
+    import warnings
+
+    s = load_scene(data_dir / "middlebury2003" / "cones")
+    with pytest.warns(UserWarning, match=r"look swapped: 100% of the \d+ feature matches"):
+        sv.estimate_max_disparity(s.right, s.left)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        sv.estimate_max_disparity(s.left, s.right)
+
+
 def test_auto_max_disparity_on_real_scene(data_dir: Path) -> None:
     scene = load_scene(data_dir / "middlebury2003" / "cones")
     md = sv.estimate_max_disparity(scene.left, scene.right)
