@@ -196,6 +196,18 @@ def test_scaled_calibration_and_compute_view():
     assert (canvas[60, 100] != np.hstack([res.left_rectified, right])[60, 100]).any()
 
 
+def test_compute_view_shows_the_swapped_warning(data_dir):
+    """A swapped pair: the page's statistics line carries the library's warning (once), and the
+    pair given the right way round carries none."""
+    from stereovision.gui.app import compute_view
+    from stereovision.io import load_scene
+
+    s = load_scene(data_dir / "middlebury2003" / "cones")
+    swapped = compute_view(s.right, s.left, None, "gabor")
+    assert swapped.stats.count("warning: the left and right images look swapped") == 1
+    assert "warning" not in compute_view(s.left, s.right, None, "gabor").stats
+
+
 def test_app_controllers_report_errors_and_compute(tmp_path, monkeypatch):
     """The page's controllers in-process (no browser): errors land in ``state.error``."""
     import asyncio

@@ -24,6 +24,7 @@ import concurrent.futures
 import logging
 import math
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -236,17 +237,20 @@ def compute_view(
     d_max = None if max_disparity is None else max(16, math.ceil(max_disparity * s / 16) * 16)
     t0 = time.perf_counter()
     report(5, f"{method}: matching {left_s.shape[1]}x{left_s.shape[0]}")
-    if method in EXTRA_METHODS:
-        d = d_max or estimate_max_disparity(left_s, right_s)
-        result = _opencv_result(method, left_s, right_s, calib_s, d)
-    else:
+    # The library's warnings (a pair that looks swapped) go on the page, not the server's log.
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        if method in EXTRA_METHODS:
+            d = d_max or estimate_max_disparity(left_s, right_s)
+            result = _opencv_result(method, left_s, right_s, calib_s, d)
+        else:
 
-        def stage(name: str) -> None:
-            report(_STAGE_PROGRESS.get(name, 50), f"{method}: {name} done")
+            def stage(name: str) -> None:
+                report(_STAGE_PROGRESS.get(name, 50), f"{method}: {name} done")
 
-        result = depth_map(
-            left_s, right_s, calib_s, method=method, max_disparity=d_max, progress=stage
-        )
+            result = depth_map(
+                left_s, right_s, calib_s, method=method, max_disparity=d_max, progress=stage
+            )
     elapsed = time.perf_counter() - t0
     report(92, "drawing")
     shown_left = result.left_rectified if result.left_rectified is not None else left_s
@@ -277,6 +281,9 @@ def compute_view(
     )
     if result.depth is not None and len(result.points):
         stats += f" · median depth {float(np.median(result.points[:, 2])):.2f} m"
+    said = [str(c.message) for c in caught if issubclass(c.category, UserWarning)]
+    for msg in dict.fromkeys(said):  # once each, in order
+        stats += f" · warning: {msg}"
     return ViewData(
         result=result,
         left_url=_data_url(shown_left),
