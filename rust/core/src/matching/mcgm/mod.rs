@@ -779,6 +779,32 @@ fn window_bases(
     (base, (b_min, b_max), ks)
 }
 
+/// A half-window's pixels in raster order, appended to `els`: (offset of `r[b - k_hi]` in a
+/// right image `right_width` wide, left value, interpolation weight), with `base` from
+/// [`window_bases`].
+fn window_elements(
+    left: &Image,
+    right_width: usize,
+    (xi, yl, yr, _): (i32, i32, i32, f32),
+    side: i32,
+    (inner, outer, hh): (i32, i32, i32),
+    (base, k_hi): (&[(i32, f32); MAX_SIDES_WIDTH], i32),
+    els: &mut Vec<(usize, f32, f32)>,
+) {
+    for dy in -hh..=hh {
+        let lrow = &left.data[(yl + dy) as usize * left.width..][..left.width];
+        let rrow = (yr + dy) as usize * right_width;
+        for (c, k) in (inner..=outer).enumerate() {
+            let (b, fr) = base[c];
+            els.push((
+                rrow + (b - k_hi) as usize,
+                lrow[(xi + side * k) as usize],
+                fr,
+            ));
+        }
+    }
+}
+
 simd_fn! {
 /// Whether one half-window fits another disparity better: its mean absolute difference (as
 /// [`half_mad`]) at some `d + k`, `k` integer in `ks`, `|k| > 1`, every right sample inside the
@@ -802,8 +828,6 @@ fn half_better(
     limit: (f32, f32),
     scratch: &mut SidesScratch,
 ) -> bool {
-    let (xi, yl, yr, _) = at;
-    let (inner, outer, hh) = geom;
     let (base, b_range, (k_lo, k_hi)) = window_bases(at, side, geom, ks, right.width);
     if k_hi < k_lo {
         return false;
@@ -842,16 +866,7 @@ fn half_better(
         }
         let els = &mut scratch.els;
         if els.is_empty() {
-            // The window's pixels in raster order: (offset of r[b - k_hi] in the right
-            // image, left value, interpolation weight).
-            for dy in -hh..=hh {
-                let lrow = &left.data[(yl + dy) as usize * left.width..][..left.width];
-                let rrow = (yr + dy) as usize * right.width;
-                for (c, k) in (inner..=outer).enumerate() {
-                    let (b, fr) = base[c];
-                    els.push((rrow + (b - k_hi) as usize, lrow[(xi + side * k) as usize], fr));
-                }
-            }
+            window_elements(left, right.width, at, side, geom, (&base, k_hi), els);
             n = els.len() as f32;
         }
         let fits = if lanes == 8 {

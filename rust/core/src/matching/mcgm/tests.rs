@@ -415,17 +415,9 @@ fn lane_mads(
     mean_free: bool,
     ks: (i32, i32),
 ) -> Vec<(i32, f32)> {
-    let (xi, yl, yr, _) = at;
-    let (inner, outer, hh) = geom;
     let (base, _, (k_lo, k_hi)) = window_bases(at, side, geom, ks, right.width);
     let mut els = Vec::new();
-    for dy in -hh..=hh {
-        for (c, k) in (inner..=outer).enumerate() {
-            let (b, f) = base[c];
-            let o = (yr + dy) as usize * right.width + (b - k_hi) as usize;
-            els.push((o, left.at((xi + side * k) as usize, (yl + dy) as usize), f));
-        }
-    }
+    window_elements(left, right.width, at, side, geom, (&base, k_hi), &mut els);
     let n = els.len() as f32;
     (k_lo..=k_hi)
         .filter(|k| k.abs() > 1)
