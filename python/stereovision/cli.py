@@ -215,7 +215,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
     written.update(render_outputs(res, out_dir))
     raw = dense_metrics(res.disparity, scene.gt)
-    from stereovision.baselines import row_fill
+    from stereovision.baselines import opencv_sgbm, row_fill
 
     # A dense method's output is already filled (planes, then the row rule); one with holes
     # ("gabor") is shown with the reference row fill too, as the README's tables count it.
@@ -232,8 +232,6 @@ def cmd_demo(args: argparse.Namespace) -> int:
     )
     # What the user has today, on the same pair: OpenCV's SGBM (evaluation.md's configuration),
     # as it comes and after the same reference row fill.
-    from stereovision.baselines import opencv_sgbm
-
     t = time.perf_counter()
     sgbm = opencv_sgbm(scene.left, scene.right, res.max_disparity)
     t_sgbm = time.perf_counter() - t
