@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import json
 import logging
 import os
@@ -235,3 +236,24 @@ def test_batch_ctrl_c_keeps_finished_pairs(data_dir: Path, tmp_path: Path) -> No
     assert main([*cmd[3:], "--workers", "1"]) == 0
     s = _summary(out)
     assert s["run"]["skipped"] == len(done) and s["run"]["processed"] == 12 - len(done)
+
+
+def test_ros_camera_info_folder_as_batch_calibration(scenes: Path, tmp_path: Path) -> None:
+    """--calib may be a ROS camera_info folder: the worker gets it as one JSON file and gives
+    the depth depth_map gives with that calibration."""
+    from stereovision.batch import _task, process_pair
+
+    terrace = scenes / "eth3d/terrace"
+    cal = Calibration.from_file(terrace / "calib.txt")
+    cal.save_ros(tmp_path / "ros")
+    (job,) = find_pairs(terrace, calib=tmp_path / "ros")
+    task = _task(job, {"method": "gabor", "max_disparity": 32, "fill": None})
+    assert task["calib"][0] == "calib.json"
+    out = process_pair(task)
+    left, right = imread(terrace / "left.png"), imread(terrace / "right.png")
+    ref = depth_map(
+        left, right, Calibration.from_file(tmp_path / "ros"), method="gabor", max_disparity=32
+    )
+    assert ref.depth is not None
+    depth = np.load(io.BytesIO(out["files"]["depth.npy"]))
+    np.testing.assert_array_equal(depth, ref.depth)

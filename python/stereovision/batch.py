@@ -133,7 +133,7 @@ def find_pairs(
     if not r.is_dir():
         raise NotADirectoryError(f"input is not a folder: {r}")
     cal = Path(calib) if calib is not None else None
-    if cal is not None and not cal.is_file():
+    if cal is not None and not cal.exists():
         raise FileNotFoundError(f"calibration file not found: {cal}")
     found: list[PairJob] = []
     for d, _dirs, files in os.walk(r):
@@ -406,12 +406,24 @@ def _start_client(scheduler: str | None, workers: int) -> tuple[Any, Any, str]:
     return client, cluster, f"LocalCluster({workers} worker processes)"
 
 
+def _calib_payload(path: Path) -> tuple[str, bytes]:
+    """A calibration as one file's name and bytes for a worker: a ROS camera_info folder
+    (left.yaml, right.yaml) is read here and shipped as this package's JSON."""
+    if path.is_file():
+        return path.name, path.read_bytes()
+    from stereovision.calibration import Calibration
+
+    with tempfile.TemporaryDirectory(prefix="stereovision-calib-") as tmp:
+        out = Calibration.from_file(path).save(Path(tmp) / "calib.json")
+        return out.name, out.read_bytes()
+
+
 def _task(job: PairJob, opts: dict[str, Any]) -> dict[str, Any]:
     return {
         "name": job.name,
         "left": (str(job.left), job.left.read_bytes()),
         "right": (str(job.right), job.right.read_bytes()),
-        "calib": None if job.calib is None else (job.calib.name, job.calib.read_bytes()),
+        "calib": None if job.calib is None else _calib_payload(job.calib),
         **opts,
     }
 
@@ -716,7 +728,11 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--scheduler", metavar="ADDRESS", help="existing Dask scheduler, tcp://...")
     p.add_argument("--method", choices=METHODS, help="matcher (default: depth_map's)")
     p.add_argument("--max-disparity", type=int, help="for every pair (default: per pair)")
-    p.add_argument("--calib", help="calibration for every pair (default: each scene's calib.txt)")
+    p.add_argument(
+        "--calib",
+        help="calibration for every pair, a file or a ROS camera_info folder (default: each "
+        "scene's calib.txt)",
+    )
     p.add_argument(
         "--fill", action="store_const", const=True, help="fill holes (default: the method's)"
     )

@@ -1322,7 +1322,8 @@ def _expand(pattern: str, option: str) -> list[str]:
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
-    """``stereovision calibrate --left GLOB --right GLOB --pattern 9x6 --square S -o FILE``."""
+    """``stereovision calibrate --left GLOB --right GLOB --pattern 9x6 --square S -o FILE``
+    (``--ros DIR`` also writes ROS ``camera_info`` files)."""
     lefts = [f for g in args.left for f in _expand(g, "--left")]
     rights = [f for g in args.right for f in _expand(g, "--right")]
     if len(lefts) != len(rights):
@@ -1332,6 +1333,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         raise ValueError(f"-o {args.output}: use a .yaml, .yml, .xml or .json file name")
     if not out.parent.exists() and str(out.parent):
         raise FileNotFoundError(f"-o {args.output}: directory {out.parent} does not exist")
+    ros_dir = Path(args.ros) if args.ros else None
+    if ros_dir is not None and ros_dir.exists() and not ros_dir.is_dir():
+        raise ValueError(f"--ros {args.ros}: is a file; give a folder for left.yaml and right.yaml")
     cal, rep = calibrate(
         lefts,
         rights,
@@ -1344,6 +1348,14 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     cal.save(out)
     print(rep.summary())
     print(f"calibration written to {out}")
+    if ros_dir is not None:
+        try:
+            left_yaml, right_yaml = cal.save_ros(ros_dir)
+        except ValueError as exc:
+            raise ValueError(
+                f"calibration written to {out}, but not as ROS camera_info: {exc}"
+            ) from None
+        print(f"ROS camera_info written to {left_yaml} and {right_yaml}")
     if args.report:
         paths = rep.write(args.report)
         print(f"report written to {paths['html']}")
@@ -1372,4 +1384,10 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--drop-outliers", action="store_true", help="drop outlier pairs and re-solve")
     p.add_argument("-o", "--output", required=True, help="calibration file (.yaml/.json)")
     p.add_argument("--report", metavar="DIR", help="write report.html/.yaml/.json into DIR")
+    p.add_argument(
+        "--ros",
+        metavar="DIR",
+        help="also write ROS camera_info left.yaml/right.yaml into DIR (metres, for "
+        "stereo_image_proc)",
+    )
     p.set_defaults(func=cmd_calibrate)

@@ -29,10 +29,12 @@ from stereovision._validate import as_image_array, positive_finite
 
 __all__ = [
     "DISTORTION_LENGTHS",
+    "ROS_DISTORTION_MODELS",
     "UNIT_TO_METRES",
     "Calibration",
     "parse_kitti_calib",
     "parse_middlebury_calib",
+    "parse_ros_camera_info",
 ]
 
 PathLike = str | os.PathLike[str]
@@ -680,7 +682,10 @@ class Calibration:
 
         OpenCV YAML/XML and JSON (:meth:`load`), Middlebury ``calib.txt``
         (:meth:`from_middlebury`), KITTI ``calib_cam_to_cam`` / object calibration
-        (:meth:`from_kitti`; ``image_size`` is passed on).
+        (:meth:`from_kitti`; ``image_size`` is passed on), and ROS ``camera_info``
+        (:meth:`from_ros`): a folder holding ``left.yaml`` and ``right.yaml``, ROS
+        ``camera_calibration``'s ``calibrationdata.tar.gz``, or one of the two files when the
+        other lies beside it (``left`` and ``right`` swapped in its name).
 
         Raises
         ------
@@ -689,7 +694,28 @@ class Calibration:
         ValueError
             If the format is not recognised or the content is invalid.
         """
+        p = Path(path)
+        if p.is_dir():
+            pair = _ros_pair_from_folder(p)
+            if pair is None:
+                raise ValueError(
+                    f"calibration path {p} is a folder without left.yaml and right.yaml "
+                    "(ROS camera_info); pass a calibration file"
+                )
+            return cls.from_ros(*pair)
+        if p.is_file() and p.name.lower().endswith((".tar.gz", ".tgz", ".tar")):
+            ltext, rtext = _read_ros_tar(p)
+            return cls._from_ros_texts(ltext, rtext, f"{p}:left.yaml", f"{p}:right.yaml")
         p, text = cls._read_text(path)
+        if _ROS_HEAD.search(text) and "projection_matrix" in text:
+            pair = _ros_sibling(p)
+            if pair is None:
+                raise ValueError(
+                    f"{p} is one camera's ROS camera_info and its partner (left/right swapped "
+                    "in the name) is not beside it; pass the folder holding left.yaml and "
+                    "right.yaml"
+                )
+            return cls.from_ros(*pair)
         head = text.lstrip()
         if head.startswith(("%YAML", "<?xml", "<opencv", "{")):
             return cls.load(p)
@@ -699,7 +725,7 @@ class Calibration:
             return cls.from_kitti(p, image_size=image_size)
         raise ValueError(
             f"unrecognised calibration format in {p}: expected OpenCV YAML/XML, JSON, "
-            "Middlebury calib.txt or KITTI calibration"
+            "Middlebury calib.txt, KITTI calibration or ROS camera_info"
         )
 
     # ------------------------------------------------------------------ dataset formats
@@ -808,6 +834,197 @@ class Calibration:
             rectified=True,
         )
 
+    @classmethod
+    def from_ros(cls, left: PathLike, right: PathLike) -> Calibration:
+        """Calibration of a rig from its two ROS ``camera_info`` files (metres).
+
+        ROS ``camera_calibration`` (stereo) writes ``left.yaml`` and ``right.yaml``: each camera's
+        ``K`` and ``D``, its rectifying rotation ``R_i`` and its rectified projection ``P_i``
+        (``P_i[:, 3] = K' t_i``, ``t_i`` in metres). The rig follows from them: with
+        ``t_i = P_i[:, :3]^-1 P_i[:, 3]``, ``R = R_2^T R_1`` and ``T = R_2^T (t_2 - t_1)``.
+        Rectification is recomputed from ``K``, ``D``, ``R`` and ``T`` (``cv2.stereoRectify``,
+        like ROS); the files' own ``P`` matrices are not kept. A pair that is already rectified
+        (no distortion, ``R_i = I``, ``K_i = P_i[:, :3]``) gives a ``rectified`` calibration.
+        Rectifying rotations rounded to a few decimals are snapped to the nearest rotation.
+
+        Parameters
+        ----------
+        left, right : str or os.PathLike
+            The left and right camera's ``camera_info`` YAML files.
+
+        Returns
+        -------
+        Calibration
+            ``unit="m"``.
+
+        Raises
+        ------
+        FileNotFoundError
+            If a file does not exist.
+        ValueError
+            If a file is not a ``camera_info`` (field named), the image sizes differ, a model is
+            unsupported, or the files hold no baseline (two monocular calibrations).
+        """
+        lp, ltext = cls._read_text(left)
+        rp, rtext = cls._read_text(right)
+        return cls._from_ros_texts(ltext, rtext, str(lp), str(rp))
+
+    @classmethod
+    def _from_ros_texts(cls, ltext: str, rtext: str, lsrc: str, rsrc: str) -> Calibration:
+        cams = [parse_ros_camera_info(ltext, lsrc), parse_ros_camera_info(rtext, rsrc)]
+        if cams[0]["image_size"] != cams[1]["image_size"]:
+            raise ValueError(
+                f"ROS camera_info: {lsrc} is {cams[0]['image_size']} px, {rsrc} is "
+                f"{cams[1]['image_size']} px (width, height); a rig needs one size"
+            )
+        rots, ts = [], []
+        for cam, src in zip(cams, (lsrc, rsrc), strict=True):
+            r = cam["R"]
+            if np.abs(r @ r.T - np.eye(3)).max() > 1e-4 or np.linalg.det(r) < 0:
+                raise ValueError(f"{src}: rectification_matrix is not a rotation: {r.tolist()}")
+            u, _, vt = np.linalg.svd(r)
+            rots.append(u @ vt)
+            p = cam["P"]
+            if not (p[0, 0] > 0 and p[1, 1] > 0 and p[2, 2] > 0):
+                raise ValueError(
+                    f"{src}: projection_matrix needs positive fx, fy and P[2, 2], got {p.tolist()}"
+                )
+            ts.append(np.linalg.solve(p[:, :3], p[:, 3]))
+        R = rots[1].T @ rots[0]
+        T = rots[1].T @ (ts[1] - ts[0])
+        if not float(np.linalg.norm(T)) > 0:
+            raise ValueError(
+                f"ROS camera_info {rsrc}: projection_matrix has no baseline (P[0, 3] = 0): these "
+                "are two monocular calibrations; calibrate the cameras as a stereo pair"
+            )
+        size = cams[0]["image_size"]
+        looks_rectified = all(
+            not np.any(c["D"])
+            and np.abs(c["R"] - np.eye(3)).max() <= _ROS_IDENTITY_TOL
+            and np.allclose(c["K"], c["P"][:, :3], rtol=RECTIFIED_REL_TOL, atol=0)
+            for c in cams
+        )
+        if looks_rectified:
+            try:
+                return cls(
+                    K1=cams[0]["K"],
+                    D1=np.zeros(5),
+                    K2=cams[1]["K"],
+                    D2=np.zeros(5),
+                    R=np.eye(3),
+                    T=T,
+                    image_size=size,
+                    unit="m",
+                    rectified=True,
+                )
+            except ValueError:
+                pass  # e.g. a vertical rig: keep it as a raw rig that stereoRectify handles
+        return cls(
+            K1=cams[0]["K"],
+            D1=cams[0]["D"],
+            K2=cams[1]["K"],
+            D2=cams[1]["D"],
+            R=R,
+            T=T,
+            image_size=size,
+            unit="m",
+        )
+
+    def to_ros(
+        self, alpha: float = 0.0, names: tuple[str, str] = ("left", "right")
+    ) -> tuple[str, str]:
+        """The rig as two ROS ``camera_info`` YAML texts (left, right), in metres.
+
+        What ROS ``camera_calibration`` would write and ``stereo_image_proc`` reads: each
+        camera's ``K`` and ``D``, and ``cv2.stereoRectify``'s rotation ``R_i`` and projection
+        ``P_i`` (``alpha`` as in :meth:`rectify`), with ``P_2[0, 3] = -f B`` and ``B`` in metres.
+        A ``rectified`` calibration gives ``R_i = I`` and ``P_i = [K_i | K_i t_i]``.
+
+        Parameters
+        ----------
+        alpha : float
+            Free scaling of the rectification, in ``[0, 1]``.
+        names : tuple of str
+            The ``camera_name`` fields.
+
+        Returns
+        -------
+        tuple of str
+            ``(left_yaml, right_yaml)``.
+
+        Raises
+        ------
+        ValueError
+            If ``alpha`` is outside ``[0, 1]``, or the distortion has 12 or 14 coefficients with
+            the thin-prism or tilt terms in use (ROS has no model for them).
+        """
+        if not 0.0 <= alpha <= 1.0:
+            raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
+        metres = self.to_metres_factor
+        if self.rectified:
+            r1 = r2 = np.eye(3)
+            p1 = np.hstack([self.K1, np.zeros((3, 1))])
+            p2 = np.hstack([self.K2, (self.K2 @ self.T * metres).reshape(3, 1)])
+        else:
+            r1, r2, p1, p2, _ = self._stereo_rectify(alpha)
+            p1, p2 = p1.copy(), p2.copy()
+            p1[:, 3] *= metres
+            p2[:, 3] *= metres
+        texts = []
+        for name, K, D, r, p, field_ in (
+            (names[0], self.K1, self.D1, r1, p1, "D1"),
+            (names[1], self.K2, self.D2, r2, p2, "D2"),
+        ):
+            if D.size > 8:
+                if np.any(D[8:]):
+                    raise ValueError(
+                        f"{field_}: ROS camera_info has no model for the thin-prism or tilt "
+                        f"terms (coefficients 9-{D.size} are not zero)"
+                    )
+                D = D[:8]
+            if D.size == 4:
+                D = np.append(D, 0.0)
+            model = "plumb_bob" if D.size == 5 else "rational_polynomial"
+            texts.append(_ros_yaml(name, self.image_size, K, D, r, p, model))
+        return texts[0], texts[1]
+
+    def save_ros(
+        self, directory: PathLike, alpha: float = 0.0, names: tuple[str, str] = ("left", "right")
+    ) -> tuple[Path, Path]:
+        """Write ``left.yaml`` and ``right.yaml`` (ROS ``camera_info``, see :meth:`to_ros`).
+
+        Parameters
+        ----------
+        directory : str or os.PathLike
+            Created if missing; each file is replaced atomically.
+        alpha : float
+            Free scaling of the rectification, in ``[0, 1]``.
+        names : tuple of str
+            The ``camera_name`` fields.
+
+        Returns
+        -------
+        tuple of pathlib.Path
+            The two files written.
+
+        Raises
+        ------
+        ValueError
+            As :meth:`to_ros`, or if ``directory`` is an existing file.
+        """
+        from stereovision.io import atomic_write
+
+        d = Path(directory)
+        if d.exists() and not d.is_dir():
+            raise ValueError(f"cannot write ROS camera_info into {d}: it is a file, not a folder")
+        texts = self.to_ros(alpha, names)
+        d.mkdir(parents=True, exist_ok=True)
+        paths = (d / "left.yaml", d / "right.yaml")
+        for path, text in zip(paths, texts, strict=True):
+            with atomic_write(path, "w") as fh:
+                fh.write(text)
+        return paths
+
 
 _MB_LINE = re.compile(r"^\s*([A-Za-z_]\w*)\s*=\s*(.*?)\s*$")
 
@@ -910,3 +1127,191 @@ def parse_kitti_calib(path: PathLike) -> dict[str, F64]:
             values.append(tok)
     flush()
     return out
+
+
+# --------------------------------------------------------------------------- ROS camera_info
+
+#: ROS ``distortion_model`` names this package can use, with the coefficient counts they take.
+ROS_DISTORTION_MODELS: dict[str, tuple[int, ...]] = {
+    "plumb_bob": (4, 5),
+    "rational_polynomial": (8,),
+}
+_ROS_FIELDS = (
+    "camera_matrix",
+    "distortion_coefficients",
+    "rectification_matrix",
+    "projection_matrix",
+)
+_ROS_MATRIX_SHAPES = {
+    "camera_matrix": (3, 3),
+    "rectification_matrix": (3, 3),
+    "projection_matrix": (3, 4),
+}
+#: How far from identity a ROS ``rectification_matrix`` may be for the pair to count as rectified.
+_ROS_IDENTITY_TOL = 1e-12
+_ROS_HEAD = re.compile(r"^\s*camera_matrix\s*:", re.MULTILINE)
+
+
+def _ros_matrix(value: object, key: str, source: str, size: int | None) -> F64:
+    # camera_calibration writes {rows, cols, data}; hand-written files often give a flat list.
+    rows = cols = None
+    if isinstance(value, dict):
+        rows, cols, value = value.get("rows"), value.get("cols"), value.get("data")
+    if not isinstance(value, list):
+        raise ValueError(f"{source}: {key} has no list of numbers (data)")
+    try:
+        arr = np.array([float(v) for v in value], dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"{source}: {key} holds a value that is not a number") from None
+    if rows is not None and cols is not None:
+        if not all(isinstance(n, int) and n > 0 for n in (rows, cols)) or rows * cols != arr.size:
+            raise ValueError(
+                f"{source}: {key} says rows={rows!r}, cols={cols!r} but holds {arr.size} numbers"
+            )
+    if size is not None and arr.size != size:
+        raise ValueError(f"{source}: {key} holds {arr.size} numbers, expected {size}")
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{source}: {key} holds NaN or infinity")
+    return arr
+
+
+def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
+    """Parse one camera's ROS ``camera_info`` YAML (as written by ROS ``camera_calibration``).
+
+    Accepts ``{rows, cols, data}`` matrices or flat lists, OpenCV's ``%YAML:1.0`` header and
+    ``!!opencv-matrix`` tags, and the old spellings ``distortion_coefficents`` and
+    ``camera_model``.
+
+    Parameters
+    ----------
+    text : str
+        The file's content.
+    source : str
+        Name used in error messages.
+
+    Returns
+    -------
+    dict
+        ``image_size`` (width, height), ``camera_name`` (str or None), ``distortion_model``,
+        ``K`` (3x3), ``D`` (n,), ``R`` (3x3) and ``P`` (3x4) as float64 arrays.
+
+    Raises
+    ------
+    ValueError
+        If the YAML does not parse, a field is missing or malformed (named), or the distortion
+        model is one this package cannot use (``equidistant``, a fisheye model).
+    """
+    import yaml
+
+    # OpenCV writes "%YAML:1.0", which PyYAML reads as a bad directive, and tags its matrices.
+    clean = re.sub(r"^%YAML:1\.0[^\n]*\n", "", text.lstrip("\ufeff"))
+    clean = re.sub(r"!!opencv-matrix\b", "", clean)
+    try:
+        doc = yaml.safe_load(clean)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"line {mark.line + 1}: " if mark is not None else ""
+        raise ValueError(
+            f"cannot parse {source} as ROS camera_info YAML: {where}"
+            f"{getattr(exc, 'problem', None) or exc}"
+        ) from None
+    if not isinstance(doc, dict):
+        raise ValueError(f"{source}: expected a ROS camera_info mapping")
+    if "distortion_coefficients" not in doc and "distortion_coefficents" in doc:
+        doc["distortion_coefficients"] = doc["distortion_coefficents"]
+    for key in (*_ROS_FIELDS, "image_width", "image_height"):
+        if key not in doc:
+            raise ValueError(f"ROS camera_info {source} lacks field {key!r}")
+    size = []
+    for key in ("image_width", "image_height"):
+        v = doc[key]
+        if isinstance(v, bool) or not isinstance(v, int) or v <= 0:
+            raise ValueError(f"{source}: {key} must be a positive integer, got {v!r}")
+        size.append(v)
+    model = doc.get("distortion_model", doc.get("camera_model", "plumb_bob"))
+    if model not in ROS_DISTORTION_MODELS:
+        hint = " (a fisheye model, not supported)" if model == "equidistant" else ""
+        raise ValueError(
+            f"{source}: distortion_model {model!r}{hint}; expected one of "
+            f"{list(ROS_DISTORTION_MODELS)}"
+        )
+    out: dict[str, Any] = {
+        "image_size": (size[0], size[1]),
+        "camera_name": None if doc.get("camera_name") is None else str(doc["camera_name"]),
+        "distortion_model": model,
+    }
+    for key, short in zip(_ROS_FIELDS, "KDRP", strict=True):
+        shape = _ROS_MATRIX_SHAPES.get(key)
+        arr = _ros_matrix(doc[key], key, source, None if shape is None else shape[0] * shape[1])
+        out[short] = arr if shape is None else arr.reshape(shape)
+    d = out["D"]
+    if d.size == 0:  # ROS writes an empty list for a camera calibrated without distortion
+        out["D"] = d = np.zeros(5)
+    if d.size not in ROS_DISTORTION_MODELS[model]:
+        raise ValueError(
+            f"{source}: distortion_model {model!r} takes {ROS_DISTORTION_MODELS[model]} "
+            f"coefficients, distortion_coefficients holds {d.size}"
+        )
+    if d.size == 4:
+        out["D"] = np.append(d, 0.0)
+    return out
+
+
+def _ros_yaml(name: str, size: tuple[int, int], K: F64, D: F64, R: F64, P: F64, model: str) -> str:
+    def mat(key: str, a: F64) -> str:
+        rows, cols = (1, a.size) if a.ndim == 1 else a.shape
+        data = ", ".join(repr(float(v)) for v in a.ravel())
+        return f"{key}:\n  rows: {rows}\n  cols: {cols}\n  data: [{data}]\n"
+
+    return (
+        f"image_width: {size[0]}\nimage_height: {size[1]}\ncamera_name: {json.dumps(name)}\n"
+        + mat("camera_matrix", K)
+        + f"distortion_model: {model}\n"
+        + mat("distortion_coefficients", D)
+        + mat("rectification_matrix", R)
+        + mat("projection_matrix", P)
+    )
+
+
+def _ros_pair_from_folder(folder: Path) -> tuple[Path, Path] | None:
+    for ext in (".yaml", ".yml"):
+        left, right = folder / f"left{ext}", folder / f"right{ext}"
+        if left.is_file() and right.is_file():
+            return left, right
+    return None
+
+
+def _ros_sibling(path: Path) -> tuple[Path, Path] | None:
+    # "left.yaml" names "right.yaml" (and cam_left_x.yml names cam_right_x.yml), and back.
+    name = path.name
+    for a, b in (("left", "right"), ("Left", "Right"), ("LEFT", "RIGHT")):
+        if a in name:
+            other = path.with_name(name.replace(a, b))
+            return (path, other) if other.is_file() else None
+        if b in name:
+            other = path.with_name(name.replace(b, a))
+            return (other, path) if other.is_file() else None
+    return None
+
+
+def _read_ros_tar(path: Path) -> tuple[str, str]:
+    import tarfile
+
+    try:
+        with tarfile.open(path) as tar:
+            found: dict[str, str] = {}
+            for member in tar.getmembers():
+                base = Path(member.name).name
+                if member.isfile() and base in ("left.yaml", "right.yaml") and base not in found:
+                    fh = tar.extractfile(member)
+                    if fh is not None:
+                        found[base] = fh.read().decode("utf-8", errors="replace")
+    except (tarfile.TarError, EOFError, OSError) as exc:
+        raise ValueError(f"cannot read {path} as a tar archive: {exc}") from None
+    missing = [n for n in ("left.yaml", "right.yaml") if n not in found]
+    if missing:
+        raise ValueError(
+            f"{path} holds no {' and no '.join(missing)} (ROS camera_calibration's "
+            "calibrationdata.tar.gz has both)"
+        )
+    return found["left.yaml"], found["right.yaml"]

@@ -414,7 +414,11 @@ def build_parser() -> argparse.ArgumentParser:
     d = sub.add_parser("depth", help="disparity, depth and point cloud of one pair")
     d.add_argument("left")
     d.add_argument("right")
-    d.add_argument("--calib", help="YAML/JSON calibration, Middlebury calib.txt or KITTI calib")
+    d.add_argument(
+        "--calib",
+        help="YAML/JSON calibration, Middlebury calib.txt, KITTI calib, or a ROS camera_info "
+        "folder (left.yaml, right.yaml)",
+    )
     d.add_argument("--max-disparity", type=int, default=None, help="default: from the images")
     d.add_argument("--method", default=METHODS[0], choices=METHODS)
     d.add_argument(

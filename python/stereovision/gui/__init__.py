@@ -103,7 +103,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The ``gui`` options."""
     p.add_argument("--left", help="left camera: device index, video file or image pattern")
     p.add_argument("--right", help="right camera: device index, video file or image pattern")
-    p.add_argument("--calib", help="calibration of the camera pair (YAML/JSON, calib.txt, KITTI)")
+    p.add_argument(
+        "--calib", help="calibration of the camera pair (YAML/JSON, calib.txt, KITTI, ROS folder)"
+    )
     p.add_argument(
         "--data",
         action="append",

@@ -1,0 +1,286 @@
+"""ROS camera_info calibrations: reading a rig from left.yaml / right.yaml, writing them."""
+
+from __future__ import annotations
+
+import dataclasses
+import subprocess
+import sys
+import tarfile
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+import yaml
+
+from stereovision.calibration import Calibration, _ros_yaml, parse_ros_camera_info
+from tests.test_calibration import raw_calib, rect_calib
+
+STEREOPI = Path("stereopi_rig") / "reference_calib_result"
+
+
+def _write_pair(folder: Path, cams: list[tuple[np.ndarray, ...]], size=(320, 240)) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    for side, (K, D, R, P) in zip(("left", "right"), cams, strict=True):
+        (folder / f"{side}.yaml").write_text(_ros_yaml(side, size, K, D, R, P, "plumb_bob"))
+    return folder
+
+
+def test_rig_from_a_third_partys_rectification(data_dir: Path, tmp_path: Path) -> None:
+    """The StereoPi tutorial's own cv2.stereoRectify output (R1, R2, P1, P2 from its R, T, in
+    cm) written as ROS camera_info gives back its R and T (in metres): R = R2^T R1 and
+    T = R2^T (t2 - t1) invert what ROS's camera_calibration writes."""
+    ref = data_dir / STEREOPI
+    cams = []
+    for side in ("left", "right"):
+        P = np.load(ref / f"proj_mats_{side}.npy").copy()
+        P[:, 3] *= 0.01  # cm -> m, the ROS unit
+        cams.append(
+            (
+                np.load(ref / f"cam_mats_{side}.npy"),
+                np.load(ref / f"dist_coefs_{side}.npy").ravel(),
+                np.load(ref / f"rect_trans_{side}.npy"),
+                P,
+            )
+        )
+    c = Calibration.from_file(_write_pair(tmp_path / "ros", cams))
+    assert c.unit == "m" and not c.rectified
+    np.testing.assert_allclose(c.R, np.load(ref / "rot_mat.npy"), atol=1e-12)
+    np.testing.assert_allclose(c.T, np.load(ref / "trans_vec.npy").ravel() * 0.01, atol=1e-12)
+    assert c.baseline_m == pytest.approx(0.05396, abs=1e-5)
+    np.testing.assert_array_equal(c.K1, cams[0][0])
+    np.testing.assert_array_equal(c.D2, cams[1][1])
+
+
+def test_round_trip_of_a_raw_rig(tmp_path: Path) -> None:
+    c = dataclasses.replace(raw_calib(), unit="cm", T=np.array([-12.0, 0.2, 0.3]))
+    left, right = c.save_ros(tmp_path / "new" / "rig")
+    assert (left.name, right.name) == ("left.yaml", "right.yaml")
+    doc = yaml.safe_load(right.read_text())
+    assert doc["distortion_model"] == "plumb_bob" and doc["camera_name"] == "right"
+    P2 = np.array(doc["projection_matrix"]["data"]).reshape(3, 4)
+    # ROS's convention: P2[0, 3] = -f B with B in metres; the rotation is stereoRectify's R2
+    assert P2[0, 3] == pytest.approx(-P2[0, 0] * c.baseline_m, rel=1e-12)
+    r1, r2, p1, _, _ = c._stereo_rectify(0.0)
+    np.testing.assert_array_equal(np.array(doc["rectification_matrix"]["data"]).reshape(3, 3), r2)
+    back = Calibration.from_file(tmp_path / "new" / "rig")
+    assert back.unit == "m" and not back.rectified and back.image_size == c.image_size
+    for name in ("K1", "D1", "K2", "D2"):
+        np.testing.assert_array_equal(getattr(back, name), getattr(c, name))
+    np.testing.assert_allclose(back.R, c.R, atol=1e-14)
+    np.testing.assert_allclose(back.T, c.T * 0.01, atol=1e-15)
+    # the same rectification follows from it (rows and focal length to 1e-9 px)
+    np.testing.assert_allclose(back._stereo_rectify(0.0)[0], r1, atol=1e-12)
+    np.testing.assert_allclose(back._stereo_rectify(0.0)[2][:, :3], p1[:, :3], atol=1e-9)
+    # one of the two files names the other; a tarball like ROS camera_calibration's works too
+    np.testing.assert_array_equal(Calibration.from_file(right).T, back.T)
+    np.testing.assert_array_equal(Calibration.from_file(left).R, back.R)
+    tar = tmp_path / "calibrationdata.tar.gz"
+    with tarfile.open(tar, "w:gz") as t:
+        t.add(left, arcname="left.yaml")
+        t.add(right, arcname="right.yaml")
+    assert Calibration.from_file(tar) == back
+
+
+def test_rectified_scene_to_ros_keeps_depth(data_dir: Path, tmp_path: Path) -> None:
+    """An ETH3D calib.txt (Middlebury format, mm) and a rig with doffs 11.5 px, written as ROS
+    camera_info and read back, are the same rectified rigs in metres; depth by image_geometry's
+    formula from the files' numbers equals ours."""
+    k2 = np.array([[500.0, 0.0, 171.5], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]])
+    for c in (
+        Calibration.from_file(data_dir / "eth3d" / "terrace" / "calib.txt"),
+        rect_calib(K2=k2, doffs=11.5),
+    ):
+        _check_rectified_round_trip(c, tmp_path)
+
+
+def _check_rectified_round_trip(c: Calibration, tmp_path: Path) -> None:
+    left, right = c.save_ros(tmp_path)
+    back = Calibration.from_file(tmp_path)
+    assert back.rectified and back.unit == "m"
+    np.testing.assert_array_equal(back.K2, c.K2)
+    assert back.baseline_m == pytest.approx(c.baseline_m, rel=1e-14)
+    assert back.doffs_px == pytest.approx(c.doffs_px, abs=1e-12)
+    disp = np.array([[10.0, 55.5, 120.25]])
+    np.testing.assert_allclose(back.depth_from_disparity(disp), c.depth_from_disparity(disp))
+    # image_geometry::StereoCameraModel: Tx = P2[0, 3] / fx (-B), Z = -Tx fx / (d - (cxl - cxr))
+    pl = np.array(yaml.safe_load(left.read_text())["projection_matrix"]["data"]).reshape(3, 4)
+    pr = np.array(yaml.safe_load(right.read_text())["projection_matrix"]["data"]).reshape(3, 4)
+    fx, tx = pr[0, 0], pr[0, 3] / pr[0, 0]
+    z_ros = -tx * fx / (disp - (pl[0, 2] - pr[0, 2]))
+    np.testing.assert_allclose(c.depth_from_disparity(disp), z_ros, rtol=1e-6)
+
+
+def test_kitti_and_rect_calib_round_trip(data_dir: Path, tmp_path: Path) -> None:
+    for c in (
+        Calibration.from_file(data_dir / "kitti2015" / "000005_10" / "calib.txt"),
+        rect_calib(),
+    ):
+        c.save_ros(tmp_path)
+        back = Calibration.from_ros(tmp_path / "left.yaml", tmp_path / "right.yaml")
+        assert back.rectified
+        assert back.focal_px == c.focal_px and back.baseline_m == pytest.approx(c.baseline_m)
+
+
+def test_files_as_other_tools_write_them(tmp_path: Path) -> None:
+    """OpenCV's FileStorage header and tags, the old 'distortion_coefficents' spelling, flat
+    lists, 4 plumb_bob coefficients and rounded rectifying rotations all read."""
+    c = raw_calib()
+    r1, r2, p1, p2, _ = c._stereo_rectify(0.0)
+    p2 = p2.copy()
+    p2[:, 3] *= c.to_metres_factor
+
+    def fmt(a: np.ndarray) -> str:
+        return "[" + ", ".join(f"{v:.6f}" for v in np.ravel(a)) + "]"
+
+    texts = []
+    for side, K, D, R, P in (("left", c.K1, c.D1, r1, p1), ("right", c.K2, c.D2, r2, p2)):
+        texts.append(
+            "%YAML:1.0\n"
+            f"image_width: 320\nimage_height: 240\ncamera_name: narrow_stereo/{side}\n"
+            f"camera_matrix: !!opencv-matrix\n  rows: 3\n  cols: 3\n  dt: d\n  data: {fmt(K)}\n"
+            "camera_model: plumb_bob\n"
+            f"distortion_coefficents:\n  rows: 1\n  cols: 4\n  data: {fmt(D[:4])}\n"
+            f"rectification_matrix: {fmt(R)}\n"
+            f"projection_matrix:\n  rows: 3\n  cols: 4\n  data: {fmt(P)}\n"
+        )
+    (tmp_path / "cam_left.yml").write_text(texts[0])
+    (tmp_path / "cam_right.yml").write_text(texts[1])
+    back = Calibration.from_file(tmp_path / "cam_left.yml")
+    assert back.D1.tolist() == pytest.approx([*c.D1[:4], 0.0], abs=1e-6)
+    # six decimals in R1, R2 and P: the rig to about 1e-5
+    np.testing.assert_allclose(back.R, c.R, atol=2e-5)
+    np.testing.assert_allclose(back.T, c.T, atol=2e-5)
+    info = parse_ros_camera_info(texts[1], "right")
+    assert info["camera_name"] == "narrow_stereo/right" and info["image_size"] == (320, 240)
+
+
+def _cam_text(**changes: object) -> str:
+    doc: dict[str, object] = {
+        "image_width": 320,
+        "image_height": 240,
+        "camera_matrix": {"rows": 3, "cols": 3, "data": [300, 0, 160, 0, 300, 120, 0, 0, 1]},
+        "distortion_model": "plumb_bob",
+        "distortion_coefficients": {"rows": 1, "cols": 5, "data": [0.0] * 5},
+        "rectification_matrix": {"rows": 3, "cols": 3, "data": [1, 0, 0, 0, 1, 0, 0, 0, 1]},
+        "projection_matrix": {
+            "rows": 3,
+            "cols": 4,
+            "data": [300, 0, 160, -30.0, 0, 300, 120, 0, 0, 0, 1, 0],
+        },
+    }
+    for key, value in changes.items():
+        if value is None:
+            doc.pop(key)
+        else:
+            doc[key] = value
+    return yaml.safe_dump(doc)
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"projection_matrix": None}, "lacks field 'projection_matrix'"),
+        ({"distortion_model": "equidistant"}, "fisheye"),
+        ({"distortion_model": "rational_polynomial"}, "takes \\(8,\\) coefficients"),
+        ({"camera_matrix": {"rows": 3, "cols": 3, "data": [1, 2]}}, "holds 2 numbers"),
+        ({"camera_matrix": {"rows": 2, "cols": 3, "data": list(range(9))}}, "rows=2"),
+        ({"camera_matrix": [1, 0, 0, 0, "x", 0, 0, 0, 1]}, "not a number"),
+        ({"camera_matrix": [float("nan")] * 9}, "NaN"),
+        ({"image_width": -3}, "image_width must be a positive integer"),
+        ({"rectification_matrix": [2, 0, 0, 0, 1, 0, 0, 0, 1]}, "not a rotation"),
+        ({"projection_matrix": [0] * 12}, "positive fx"),
+    ],
+)
+def test_bad_camera_info_names_the_field(
+    tmp_path: Path, changes: dict[str, object], message: str
+) -> None:
+    left = _cam_text(projection_matrix=[300, 0, 160, 0, 0, 300, 120, 0, 0, 0, 1, 0])
+    (tmp_path / "left.yaml").write_text(left)
+    (tmp_path / "right.yaml").write_text(_cam_text(**changes))
+    with pytest.raises(ValueError, match=message):
+        Calibration.from_file(tmp_path)
+
+
+def test_pairs_that_are_not_a_rig(tmp_path: Path) -> None:
+    mono = _cam_text(projection_matrix=[300, 0, 160, 0, 0, 300, 120, 0, 0, 0, 1, 0])
+    (tmp_path / "left.yaml").write_text(mono)
+    (tmp_path / "right.yaml").write_text(mono)
+    with pytest.raises(ValueError, match="two monocular calibrations"):
+        Calibration.from_file(tmp_path)
+    (tmp_path / "right.yaml").write_text(_cam_text(image_width=640))
+    with pytest.raises(ValueError, match="a rig needs one size"):
+        Calibration.from_file(tmp_path)
+    (tmp_path / "right.yaml").write_text("camera_matrix: [1, 2\n")
+    with pytest.raises(ValueError, match=r"cannot parse .* line"):
+        Calibration.from_file(tmp_path / "left.yaml")
+    (tmp_path / "right.yaml").unlink()
+    with pytest.raises(ValueError, match=r"partner .* is not beside it"):
+        Calibration.from_file(tmp_path / "left.yaml")
+    with pytest.raises(ValueError, match=r"folder without left.yaml and right.yaml"):
+        Calibration.from_file(tmp_path)
+    tar = tmp_path / "calibrationdata.tar.gz"
+    with tarfile.open(tar, "w:gz") as t:
+        t.add(tmp_path / "left.yaml", arcname="left.yaml")
+    with pytest.raises(ValueError, match=r"holds no right.yaml"):
+        Calibration.from_file(tar)
+    tar.write_bytes(b"not a tar archive")
+    with pytest.raises(ValueError, match=r"cannot read .* as a tar archive"):
+        Calibration.from_file(tar)
+    with pytest.raises(FileNotFoundError):
+        Calibration.from_ros(tmp_path / "left.yaml", tmp_path / "nowhere.yaml")
+
+
+def test_writing_refuses_what_ros_cannot_hold(tmp_path: Path) -> None:
+    d14 = np.zeros(14)
+    d14[12] = 0.01  # a tilted sensor: no ROS model
+    with pytest.raises(ValueError, match="D1: ROS camera_info has no model"):
+        raw_calib(D1=d14).to_ros()
+    d14[12] = 0.0
+    d14[:8] = 0.01
+    text = raw_calib(D1=d14).to_ros()[0]
+    assert "rational_polynomial" in text
+    assert len(parse_ros_camera_info(text)["D"]) == 8
+    with pytest.raises(ValueError, match="alpha"):
+        raw_calib().to_ros(alpha=1.5)
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(ValueError, match="is a file, not a folder"):
+        raw_calib().save_ros(tmp_path / "file")
+    assert (tmp_path / "file").read_text() == "x"
+
+
+def test_cli_calibrate_writes_ros_and_depth_reads_it(data_dir: Path, tmp_path: Path) -> None:
+    """`stereovision calibrate --ros DIR` on OpenCV's chessboard pairs writes camera_info that
+    reads back as the calibration it saved, and `depth --calib DIR` uses it."""
+    board = data_dir / "chessboard"
+    out = tmp_path / "rig.yaml"
+    cmd = [sys.executable, "-m", "stereovision.cli", "calibrate"]
+    args = ["--left", str(board / "left*.jpg"), "--right", str(board / "right*.jpg")]
+    args += ["--square", "25", "--unit", "mm", "-o", str(out), "--ros", str(tmp_path / "ros")]
+    run = subprocess.run(cmd + args, capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    assert "ROS camera_info written to" in run.stdout
+    saved = Calibration.load(out)
+    ros = Calibration.from_file(tmp_path / "ros")
+    np.testing.assert_allclose(ros.R, saved.R, atol=1e-12)
+    np.testing.assert_allclose(ros.T, saved.T * 1e-3, atol=1e-15)
+    np.testing.assert_array_equal(ros.K1, saved.K1)
+    left = cv2.imread(str(board / "left01.jpg"))
+    right = cv2.imread(str(board / "right01.jpg"))
+    cv2.imwrite(str(tmp_path / "l.png"), left)
+    cv2.imwrite(str(tmp_path / "r.png"), right)
+    run = subprocess.run(
+        [
+            *(sys.executable, "-m", "stereovision.cli", "depth"),
+            *(str(tmp_path / "l.png"), str(tmp_path / "r.png")),
+            *("--calib", str(tmp_path / "ros"), "--method", "gabor", "-o", str(tmp_path / "out")),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert run.returncode == 0, run.stderr
+    assert (tmp_path / "out" / "cloud.ply").is_file()
+    run = subprocess.run(cmd + args[:-1] + [str(out)], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 2 and run.stderr.count("\n") == 1
+    assert "--ros" in run.stderr and "is a file" in run.stderr
