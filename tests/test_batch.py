@@ -26,7 +26,13 @@ from stereovision.io import imread, read_pfm, read_ply
 
 SCALE = 0.5  # half-size copies keep the cluster run short
 DISPARITY_FILES = {"disparity.png", "disparity.pfm"}
-DEPTH_FILES = DISPARITY_FILES | {"depth.png", "depth.npy", "cloud.ply", "render.png"}
+DEPTH_FILES = DISPARITY_FILES | {
+    "depth.png",
+    "depth.npy",
+    "depth_mm.png",
+    "cloud.ply",
+    "render.png",
+}
 
 
 def _half(src: Path, dst: Path) -> None:

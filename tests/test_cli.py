@@ -29,7 +29,8 @@ def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
     sgbm = re.search(r"StereoSGBM 3-way .*?, ([\d.]+) % with the row fill", proc.stdout)
     assert ours and sgbm, proc.stdout
     assert float(ours.group(1)) < 0.8 * float(sgbm.group(1))
-    for name in ("disparity.png", "depth.png", "disparity.pfm", "depth.npy", "cloud.ply"):
+    names = ("disparity.png", "depth.png", "disparity.pfm", "depth.npy", "depth_mm.png")
+    for name in (*names, "cloud.ply"):
         assert (out / name).stat().st_size > 0, name
     disp = read_pfm(out / "disparity.pfm")
     assert disp.shape == (375, 450)
@@ -87,6 +88,11 @@ def test_depth_command_on_metric_scene(tmp_path: Path, data_dir: Path) -> None:
     depth = np.load(out / "depth.npy")
     assert depth.shape == (434, 713) and depth.dtype == np.float32
     assert 1.0 < float(np.nanmedian(depth)) < 30.0  # metres
+    # the 16-bit PNG holds the same depths in millimetres, 0 where there are none
+    mm = cv2.imread(str(out / "depth_mm.png"), cv2.IMREAD_UNCHANGED)
+    assert mm.dtype == np.uint16 and mm.shape == depth.shape
+    np.testing.assert_array_equal(mm == 0, ~np.isfinite(depth))
+    assert np.abs(mm[mm > 0] / 1000.0 - depth[mm > 0]).max() <= 0.0005 + 1e-6
 
 
 def test_errors_are_one_line_and_keep_earlier_outputs(tmp_path: Path, data_dir: Path) -> None:

@@ -89,7 +89,13 @@ def test_npz_bundle(result, tmp_path):
 
 def test_export_result_writes_all(result, tmp_path):
     written = export.export_result(result, tmp_path / "out")
-    assert set(written) == {"cloud.ply", "cloud.pcd", "depth.npz"}
+    assert set(written) == {
+        "cloud.ply",
+        "cloud.pcd",
+        "depth.npz",
+        "depth_mm.png",
+        "disparity_16.png",
+    }
     assert all(p.is_file() and p.stat().st_size > 0 for p in written.values())
     for name in ("cloud.ply", "cloud.pcd"):
         pts, _ = export.load_cloud(written[name])
@@ -160,3 +166,53 @@ def test_damaged_pcd_and_npz_are_value_errors(result, tmp_path):
     for fn in (export.read_npz, export.load_cloud):
         with pytest.raises(ValueError, match=r"d\.npz"):
             fn(damaged)
+
+
+def test_depth_png_in_millimetres(result, tmp_path):
+    """16-bit depth as ROS 16UC1 / TUM / Open3D read it: round(Z * 1000), 0 = none; depths
+    that do not fit 16 bits are dropped, not clipped to 65.535 m."""
+    import cv2
+
+    path = export.write_depth_png(tmp_path / "d.png", result)
+    raw = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    assert raw.dtype == np.uint16 and raw.shape == (syn.H, syn.W)
+    assert raw[60, 80] == round(syn.BOX_Z * 1000) and raw[5, 150] == round(syn.WALL_Z * 1000)
+    assert (raw[syn.HOLE] == 0).all()
+    back = export.read_depth_png(path)
+    np.testing.assert_allclose(back, result.depth, atol=0.0005 + 1e-7)
+    np.testing.assert_array_equal(np.isnan(back), np.isnan(result.depth))
+    z = np.array([[0.0004, 0.0006, 1.2344, 65.535, 65.5356, np.inf, np.nan, -2.0]])
+    raw = cv2.imread(str(export.write_depth_png(tmp_path / "z.png", z)), cv2.IMREAD_UNCHANGED)
+    assert raw.tolist() == [[0, 1, 1234, 65535, 0, 0, 0, 0]]
+    tum = export.read_depth_png(export.write_depth_png(tmp_path / "t.png", z, scale=5000), 5000)
+    assert tum[0, 2] == pytest.approx(1.2344, abs=1e-4) and np.isnan(tum[0, 3])
+    bare = replace(result, depth=None, calibration=None)
+    with pytest.raises(ValueError, match="no depth"):
+        export.write_depth_png(tmp_path / "n.png", bare)
+    with pytest.raises(ValueError, match="scale"):
+        export.write_depth_png(tmp_path / "n.png", z, scale=0)
+    with pytest.raises(ValueError, match=r"\(H, W\) array"):
+        export.write_depth_png(tmp_path / "n.png", np.zeros(5))
+    assert not (tmp_path / "n.png").exists()
+
+
+def test_disparity_png_kitti_format(data_dir, result, tmp_path):
+    """KITTI's disparity PNG (d * 256): ours round-trips within 1/512 px, and KITTI's own GT
+    file reads as the PFM it was converted to."""
+    back = export.read_disparity_png(export.write_disparity_png(tmp_path / "d.png", result))
+    finite = np.isfinite(result.disparity) & (result.disparity > 0)
+    np.testing.assert_array_equal(np.isfinite(back), finite)
+    np.testing.assert_allclose(back[finite], result.disparity[finite], atol=1 / 512 + 1e-6)
+    from stereovision.io import read_pfm
+
+    gt = read_pfm(data_dir / "kitti2015" / "000005_10" / "gt_disp.pfm")
+    path = export.write_disparity_png(tmp_path / "gt.png", np.where(np.isinf(gt), np.nan, gt))
+    again = export.read_disparity_png(path)
+    ok = np.isfinite(gt)
+    np.testing.assert_array_equal(np.isfinite(again), ok)
+    np.testing.assert_allclose(again[ok], gt[ok], atol=1 / 512 + 1e-6)
+    (tmp_path / "rgb.png").write_bytes((tmp_path / "gt.png").read_bytes()[:40])
+    with pytest.raises(ValueError, match="16-bit PNG"):
+        export.read_disparity_png(tmp_path / "rgb.png")
+    with pytest.raises(FileNotFoundError):
+        export.read_depth_png(tmp_path / "none.png")

@@ -76,6 +76,12 @@ def _png_bytes(img: np.ndarray) -> bytes:
     return buf.tobytes()
 
 
+def _depth_mm_png(depth: np.ndarray) -> bytes:
+    from stereovision.export import DEPTH_PNG_SCALE, _scaled_u16
+
+    return _png_bytes(_scaled_u16(depth, DEPTH_PNG_SCALE, "depth").astype(np.uint16))
+
+
 def _npy_bytes(arr: np.ndarray) -> bytes:
     import io as _io
 
@@ -85,7 +91,8 @@ def _npy_bytes(arr: np.ndarray) -> bytes:
 
 
 def write_depth_outputs(result: Any, out_dir: Path) -> dict[str, Path]:
-    """Write disparity.png, disparity.pfm, depth.png, depth.npy and cloud.ply into ``out_dir``.
+    """Write disparity.png, disparity.pfm, depth.png, depth.npy, depth_mm.png (16-bit,
+    millimetres) and cloud.ply into ``out_dir``.
 
     Everything is encoded in memory first, then each file is replaced atomically.
     """
@@ -97,6 +104,7 @@ def write_depth_outputs(result: Any, out_dir: Path) -> dict[str, Path]:
         inv = np.where(np.isfinite(result.depth), 1.0 / result.depth, np.nan)
         files["depth.png"] = _png_bytes(colorize(inv))
         files["depth.npy"] = _npy_bytes(result.depth.astype(np.float32))
+        files["depth_mm.png"] = _depth_mm_png(result.depth)
     out_dir.mkdir(parents=True, exist_ok=True)
     written: dict[str, Path] = {}
     for name, data in files.items():

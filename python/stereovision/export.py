@@ -10,6 +10,8 @@ Conventions shared with pyvista, Open3D, MeshLab and PCL:
   ``HEIGHT`` = image height, row-major), pixels without depth are NaN points (``is_dense`` false).
 - NPZ: ``depth``, ``confidence``, ``disparity`` (H, W float32, NaN = none), ``K`` (3x3),
   ``baseline`` (metres), ``doffs`` (pixels), ``image_size`` (W, H), ``method``, ``max_disparity``.
+- 16-bit PNG: depth in millimetres (ROS ``16UC1``, TUM RGB-D, Open3D), disparity times 256
+  (KITTI); 0 = none.
 
 Every writer replaces its file atomically (:func:`stereovision.io.atomic_write`).
 """
@@ -20,6 +22,7 @@ import io as _io
 import os
 import zipfile
 import zlib
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -34,13 +37,19 @@ if TYPE_CHECKING:
     from stereovision.depth import DepthResult
 
 __all__ = [
+    "DEPTH_PNG_SCALE",
+    "DISPARITY_PNG_SCALE",
     "EXPORT_FORMATS",
     "export_result",
     "load_cloud",
     "organised_points",
+    "read_depth_png",
+    "read_disparity_png",
     "read_npz",
     "read_pcd",
     "write_cloud_ply",
+    "write_depth_png",
+    "write_disparity_png",
     "write_mesh_ply",
     "write_npz",
     "write_pcd",
@@ -49,7 +58,13 @@ __all__ = [
 PathLike = str | os.PathLike[str]
 
 #: Formats :func:`export_result` writes, with their file names.
-EXPORT_FORMATS = {"ply": "cloud.ply", "pcd": "cloud.pcd", "npz": "depth.npz"}
+EXPORT_FORMATS = {
+    "ply": "cloud.ply",
+    "pcd": "cloud.pcd",
+    "npz": "depth.npz",
+    "depth16": "depth_mm.png",
+    "disp16": "disparity_16.png",
+}
 
 _PCD_MAGIC = (b"# .PCD", b"VERSION")
 _PLY_MAGIC = b"ply"
@@ -460,12 +475,176 @@ def load_cloud(
     return np.ascontiguousarray(pts[keep]), cols
 
 
+# ------------------------------------------------------------------------- 16-bit PNG
+
+#: Units per metre of the 16-bit depth PNG: millimetres, as ROS ``16UC1`` depth images, the TUM
+#: RGB-D and Open3D (``depth_scale=1000``) store depth.
+DEPTH_PNG_SCALE = 1000.0
+#: KITTI's disparity PNG: ``disparity * 256`` as uint16, 0 = no disparity.
+DISPARITY_PNG_SCALE = 256.0
+
+
+def _png16(path: PathLike, values: npt.NDArray[np.float64], what: str) -> Path:
+    import cv2
+
+    ok, buf = cv2.imencode(".png", values.astype(np.uint16))
+    if not ok:
+        raise ValueError(f"could not encode the {what} as a 16-bit PNG")
+    with atomic_write(path) as fh:
+        fh.write(buf.tobytes())
+    return Path(path)
+
+
+def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.float64]:
+    if not (np.isfinite(scale) and scale > 0):
+        raise ValueError(f"scale: expected a positive number, got {scale!r}")
+    a = np.asarray(arr, dtype=np.float64)
+    if a.ndim != 2 or a.size == 0:
+        raise ValueError(f"{name}: expected a non-empty (H, W) array, got shape {a.shape}")
+    s = np.rint(np.where(np.isfinite(a), a, 0.0) * scale)
+    # 0 means "none": values that round to 0 or do not fit 16 bits are dropped, not clipped, so
+    # no pixel is written at a wrong distance.
+    return np.where((s >= 1) & (s <= 65535), s, 0.0)
+
+
+def write_depth_png(
+    path: PathLike, depth: DepthResult | npt.ArrayLike, scale: float = DEPTH_PNG_SCALE
+) -> Path:
+    """Depth as a single-channel 16-bit PNG: ``round(Z * scale)``, millimetres by default.
+
+    The format of ROS ``16UC1`` depth images, the TUM RGB-D benchmark and Open3D's
+    ``create_from_depth_image`` (``depth_scale=1000``). 0 marks pixels without depth; depths
+    beyond ``65535 / scale`` (65.5 m in millimetres) are written as 0, not clipped.
+
+    Parameters
+    ----------
+    path : path
+        File to write (atomically).
+    depth : DepthResult or array_like
+        A :func:`stereovision.depth_map` result with a calibration, or an ``(H, W)`` depth
+        map in metres (NaN = none).
+    scale : float
+        Units per metre.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    ValueError
+        A result without calibration (no depth), a map that is not 2-D, or a bad ``scale``.
+    """
+    from stereovision.depth import DepthResult
+
+    if isinstance(depth, DepthResult):
+        if depth.depth is None:
+            raise ValueError("no depth: depth_map was called without a calibration")
+        return _png16(path, _scaled_u16(depth.depth, scale, "depth"), "depth")
+    return _png16(path, _scaled_u16(depth, scale, "depth"), "depth")
+
+
+def write_disparity_png(path: PathLike, disparity: DepthResult | npt.ArrayLike) -> Path:
+    """Disparity in KITTI's 16-bit PNG format: ``round(d * 256)``, 0 = no disparity.
+
+    Disparities at or below 1/512 px and above 255.996 px are written as 0.
+
+    Parameters
+    ----------
+    path : path
+        File to write (atomically).
+    disparity : DepthResult or array_like
+        A :func:`stereovision.depth_map` result or an ``(H, W)`` disparity map (NaN = none).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    ValueError
+        A map that is not 2-D.
+    """
+    from stereovision.depth import DepthResult
+
+    d = disparity.disparity if isinstance(disparity, DepthResult) else disparity
+    return _png16(path, _scaled_u16(d, DISPARITY_PNG_SCALE, "disparity"), "disparity")
+
+
+def _read_png16(path: PathLike, scale: float, what: str) -> npt.NDArray[np.float32]:
+    import cv2
+
+    from stereovision.io import _existing_file
+
+    p = _existing_file(path, what)
+    raw = np.fromfile(p, dtype=np.uint8)
+    img = cv2.imdecode(raw, cv2.IMREAD_UNCHANGED) if raw.size else None
+    if img is None or img.ndim != 2 or img.dtype != np.uint16:
+        got = "not a PNG" if img is None else f"{img.dtype} with shape {img.shape}"
+        raise ValueError(f"{p}: expected a single-channel 16-bit PNG, got {got}")
+    out = img.astype(np.float32) / np.float32(scale)
+    out[img == 0] = np.nan
+    return out
+
+
+def read_depth_png(path: PathLike, scale: float = DEPTH_PNG_SCALE) -> npt.NDArray[np.float32]:
+    """Read a 16-bit depth PNG (see :func:`write_depth_png`) as metres, NaN where 0.
+
+    Parameters
+    ----------
+    path : path
+        The PNG.
+    scale : float
+        Units per metre of the file (1000 for millimetres, 5000 for the TUM RGB-D benchmark).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` float32 metres.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    ValueError
+        If it is not a single-channel 16-bit PNG, or ``scale`` is not positive.
+    """
+    if not (np.isfinite(scale) and scale > 0):
+        raise ValueError(f"scale: expected a positive number, got {scale!r}")
+    return _read_png16(path, scale, "depth PNG")
+
+
+def read_disparity_png(path: PathLike) -> npt.NDArray[np.float32]:
+    """Read a KITTI 16-bit disparity PNG (``d * 256``) as pixels, NaN where 0.
+
+    Parameters
+    ----------
+    path : path
+        The PNG.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` float32 disparity in pixels.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the file does not exist.
+    ValueError
+        If it is not a single-channel 16-bit PNG.
+    """
+    return _read_png16(path, DISPARITY_PNG_SCALE, "disparity PNG")
+
+
 def export_result(
     result: DepthResult,
     out_dir: PathLike,
     formats: tuple[str, ...] = tuple(EXPORT_FORMATS),
 ) -> dict[str, Path]:
-    """Write the result in the chosen formats (``"ply"``, ``"pcd"``, ``"npz"``) into ``out_dir``.
+    """Write the result in the chosen formats into ``out_dir`` (:data:`EXPORT_FORMATS`).
 
     Parameters
     ----------
@@ -474,7 +653,8 @@ def export_result(
     out_dir : path
         Folder, created if missing; each file is written atomically.
     formats : tuple of str
-        Any of ``"ply"``, ``"pcd"``, ``"npz"`` (default: all three).
+        Any of ``"ply"``, ``"pcd"``, ``"npz"``, ``"depth16"`` (millimetres, 16-bit PNG) and
+        ``"disp16"`` (KITTI's 16-bit disparity PNG); default: all.
 
     Returns
     -------
@@ -484,7 +664,7 @@ def export_result(
     Raises
     ------
     ValueError
-        Unknown format, or PLY / PCD asked for a result without calibration.
+        Unknown format, or PLY / PCD / depth PNG asked for a result without calibration.
     """
     unknown = set(formats) - set(EXPORT_FORMATS)
     if unknown:
@@ -493,7 +673,13 @@ def export_result(
         )
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    writers = {"ply": write_cloud_ply, "pcd": write_pcd, "npz": write_npz}
+    writers: dict[str, Callable[[Path, DepthResult], Path]] = {
+        "ply": write_cloud_ply,
+        "pcd": write_pcd,
+        "npz": write_npz,
+        "depth16": write_depth_png,
+        "disp16": write_disparity_png,
+    }
     written: dict[str, Path] = {}
     for fmt in formats:
         name = EXPORT_FORMATS[fmt]
