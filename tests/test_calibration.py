@@ -484,3 +484,30 @@ def test_valid_roi_depends_on_alpha() -> None:
     assert len(roi_r0) == 4
     with pytest.raises(ValueError, match="alpha"):
         c.valid_roi(-0.5)
+
+
+def test_points_back_to_the_left_cameras_own_frame() -> None:
+    """Points triangulated in the rectified frame, mapped by to_camera_frame, are the points
+    the raw cameras saw (R1 turns 3.4 degrees on this rig; without it they are cm off)."""
+    c = raw_calib()
+    gx, gy = np.meshgrid(np.linspace(-0.3, 0.3, 4), np.linspace(-0.2, 0.2, 3))
+    Z = 1.0 + 0.5 * (np.arange(gx.size) % 4)
+    pts = np.column_stack([gx.ravel() * Z, gy.ravel() * Z, Z])
+    pl = cv2.projectPoints(pts, np.zeros(3), np.zeros(3), c.K1, c.D1)[0]
+    pr = cv2.projectPoints(pts, cv2.Rodrigues(c.R)[0], c.T, c.K2, c.D2)[0]
+    r1, r2, p1, p2, _ = c._stereo_rectify(0.0)
+    el = cv2.undistortPoints(pl, c.K1, c.D1, R=r1, P=p1).reshape(-1, 2)
+    er = cv2.undistortPoints(pr, c.K2, c.D2, R=r2, P=p2).reshape(-1, 2)
+    rc = c.rectified_calibration()
+    z = rc.focal_px * rc.baseline / (el[:, 0] - er[:, 0])
+    rect = np.column_stack(
+        [(el[:, 0] - rc.K1[0, 2]) * z / rc.focal_px, (el[:, 1] - rc.K1[1, 2]) * z / rc.K1[1, 1], z]
+    )
+    assert np.abs(rect - pts).max() > 0.01  # the rectified frame is not the camera's
+    back = c.to_camera_frame(rect)
+    np.testing.assert_allclose(back, pts, atol=1e-6)
+    assert c.to_camera_frame(rect.astype(np.float32)).dtype == np.float32
+    assert c.to_camera_frame(rect.reshape(3, 4, 3)).shape == (3, 4, 3)
+    np.testing.assert_array_equal(rect_calib().to_camera_frame(rect), rect)
+    with pytest.raises(ValueError, match=r"shape \(\.\.\., 3\)"):
+        c.to_camera_frame(np.zeros((4, 2)))

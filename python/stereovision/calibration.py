@@ -485,6 +485,41 @@ class Calibration:
         cal: Calibration = self._cache[key]
         return cal
 
+    def to_camera_frame(self, points: npt.ArrayLike) -> npt.NDArray[np.floating[Any]]:
+        """Points from the left *rectified* frame to the left camera's own frame.
+
+        :func:`stereovision.depth_map` returns points in the rectified left camera's frame,
+        which ``cv2.stereoRectify`` turns by ``R1`` away from the physical left camera (a
+        degree or more on a hand-built rig). A robot's transform tree places the physical
+        camera, so map the points back first: ``X_cam = R1^T X_rect``. ``R1`` does not depend
+        on ``alpha``. For a ``rectified`` calibration the frames coincide.
+
+        Parameters
+        ----------
+        points : array_like
+            ``(..., 3)`` points in the left rectified frame (any unit).
+
+        Returns
+        -------
+        numpy.ndarray
+            The same shape and float dtype (float32 stays float32), in the left camera frame.
+
+        Raises
+        ------
+        ValueError
+            If the last axis is not 3.
+        """
+        pts = np.asarray(points)
+        if pts.ndim == 0 or pts.shape[-1] != 3:
+            raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
+        dtype = pts.dtype if pts.dtype in (np.float32, np.float64) else np.float64
+        if self.rectified:
+            return pts.astype(dtype, copy=True)
+        r1 = self._stereo_rectify(0.0)[0]
+        # row vectors: (R1^T x)^T = x^T R1
+        out: npt.NDArray[np.floating[Any]] = (pts.astype(np.float64) @ r1).astype(dtype)
+        return out
+
     # ------------------------------------------------------------------------------- depth
 
     def depth_from_disparity(self, disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
