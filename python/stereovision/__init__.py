@@ -16,6 +16,7 @@ from stereovision.calibration import Calibration
 from stereovision.depth import DepthResult, depth_map, estimate_max_disparity
 from stereovision.match import match
 from stereovision.matches import Matches
+from stereovision.rectification_check import check_rectification
 from stereovision.triangulation import depth_from_disparity, triangulate
 
 __all__ = [
@@ -23,6 +24,7 @@ __all__ = [
     "DepthResult",
     "Matches",
     "__version__",
+    "check_rectification",
     "depth_from_disparity",
     "depth_map",
     "estimate_max_disparity",

@@ -1,4 +1,4 @@
-"""Command line: ``stereovision demo|depth|eval|capture|stream|batch|bench|calibrate|view|gui``.
+"""Command line: ``stereovision COMMAND`` (demo, depth, check, eval, capture, stream, batch, ...).
 
 Errors print one line on stderr and exit with status 2 (never a traceback); every output file is
 written atomically after all computation succeeded, so an error never destroys earlier outputs.
@@ -196,6 +196,19 @@ def cmd_depth(args: argparse.Namespace) -> int:
     for name, path in written.items():
         print(f"  {name:14s} {path}")
     return 0
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """``stereovision check LEFT RIGHT [--calib F]``: is the pair (still) rectified?"""
+    from stereovision.io import imread
+    from stereovision.rectification_check import check_rectification
+
+    left = imread(args.left)
+    right = imread(args.right)
+    calib = _load_calibration(args.calib)
+    res = check_rectification(left, right, calib, tolerance=args.tolerance)
+    print(json.dumps(res.as_dict()) if args.json else res.summary())
+    return 0 if res.ok else 1
 
 
 def _demo_scene_dir() -> Path:
@@ -444,6 +457,21 @@ def build_parser() -> argparse.ArgumentParser:
     )
     d.add_argument("-o", "--output", required=True, help="output folder")
     d.set_defaults(func=cmd_depth)
+
+    d = sub.add_parser(
+        "check",
+        help="is a pair rectified? row offset of its features (exit 1 if not)",
+        description="Measure how far a pair's SIFT feature matches lie off each other's rows "
+        "after rectification, to catch a calibration that a bump or heat has spoiled. Exit "
+        "status 0 when the median is within --tolerance, 1 when not or when the pair has too "
+        "little texture to tell.",
+    )
+    d.add_argument("left")
+    d.add_argument("right")
+    d.add_argument("--calib", help="the rig's calibration (omit for a rectified pair)")
+    d.add_argument("--tolerance", type=float, default=0.5, help="median |dy| in px (default 0.5)")
+    d.add_argument("--json", action="store_true", help="one JSON object instead of a line")
+    d.set_defaults(func=cmd_check)
 
     d = sub.add_parser("eval", help="evaluate against ground truth, OpenCV beside")
     d.add_argument("scenes", nargs="+", help="scene folders (or folders containing scenes)")

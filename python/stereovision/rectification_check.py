@@ -1,0 +1,257 @@
+"""Is a rig still rectified? Row alignment of a pair measured from its features, no chessboard.
+
+A bump, heat or a loose mount turns one camera by a fraction of a degree and the calibration no
+longer rectifies: matched features stop lying on the same row, and every row-searching matcher
+(ours, OpenCV's, ROS's) loses accuracy quickly (a row off by 1 px already costs block matchers a
+large share of their matches on fine texture). :func:`check_rectification` measures it on any
+textured pair: SIFT features on the rectified pair, mutual nearest matches with Lowe's ratio
+test, then a robust fit of the row offset ``dy = a + b (x - cx) + c (y - cy)`` (``a``: a pitch
+between the cameras; ``b``: a roll; ``c``: a focal-length or pitch difference).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from stereovision._validate import as_gray_uint8
+
+__all__ = ["RectificationCheck", "check_rectification"]
+
+#: Median row error (px) of the matched features up to which a pair counts as rectified.
+DEFAULT_TOLERANCE_PX = 0.5
+#: Fewest consistent matches for a verdict.
+MIN_MATCHES = 30
+#: SIFT runs on a copy at most this wide or tall (its coordinates scaled back).
+_MAX_SIDE = 1600
+_RATIO = 0.75
+_INLIER_PX = 1.0
+_RANSAC_ROUNDS = 400
+
+
+@dataclass(frozen=True)
+class RectificationCheck:
+    """Row alignment of a rectified pair (:func:`check_rectification`).
+
+    Attributes
+    ----------
+    matches : int
+        Feature matches consistent with one row-offset model (the fit's inliers).
+    median_dy, p95_dy : float
+        Median and 95th percentile of ``|y_left - y_right|`` over those matches (px).
+    offset : float
+        Fitted row offset at the image centre, ``y_left - y_right`` (px).
+    slope_x, slope_y : float
+        Fitted change of the offset per 1000 px along x (a roll between the cameras) and y.
+    ok : bool or None
+        ``median_dy <= tolerance``; None when fewer than ``MIN_MATCHES`` matches were found
+        (too little texture to tell).
+    tolerance : float
+        The tolerance used (px).
+    swapped : bool
+        Most matches have a negative disparity: the left and right images look swapped.
+
+    Notes
+    -----
+    When the matches fit no common row model (a pair far from rectified) ``offset`` and the
+    slopes are NaN and ``median_dy`` is over all matches.
+    """
+
+    matches: int
+    median_dy: float
+    p95_dy: float
+    offset: float
+    slope_x: float
+    slope_y: float
+    ok: bool | None
+    tolerance: float
+    swapped: bool = False
+
+    def as_dict(self) -> dict[str, Any]:
+        """The fields as a JSON-ready dict (NaN as None)."""
+        return {
+            k: None if isinstance(v, float) and not np.isfinite(v) else v
+            for k, v in asdict(self).items()
+        }
+
+    def summary(self) -> str:
+        """One line for a log or a terminal."""
+        if self.ok is None:
+            return (
+                f"rectification: cannot tell, {self.matches} consistent feature matches "
+                f"(at least {MIN_MATCHES} needed: point the cameras at something textured)"
+            )
+        if self.swapped:
+            return (
+                f"rectification: the left and right images look swapped (most of "
+                f"{self.matches} feature matches have a negative disparity)"
+            )
+        verdict = "ok" if self.ok else "NOT rectified: recalibrate"
+        if not np.isfinite(self.offset):
+            return (
+                f"rectification {verdict}: median |dy| {self.median_dy:.1f} px over "
+                f"{self.matches} matches, which fit no common row offset"
+            )
+        return (
+            f"rectification {verdict}: median |dy| {self.median_dy:.2f} px (95 % "
+            f"{self.p95_dy:.2f}, tolerance {self.tolerance:g}) over {self.matches} matches; "
+            f"offset {self.offset:+.2f} px, roll {self.slope_x:+.2f} px per 1000 px"
+        )
+
+
+def _features(gray: npt.NDArray[np.uint8]) -> tuple[npt.NDArray[np.float64], np.ndarray | None]:
+    h, w = gray.shape
+    s = min(1.0, _MAX_SIDE / max(h, w))
+    img = (
+        gray
+        if s == 1.0
+        else cv2.resize(gray, (round(w * s), round(h * s)), interpolation=cv2.INTER_AREA)
+    )
+    sift = cv2.SIFT.create(nfeatures=4000)
+    kps, desc = sift.detectAndCompute(img, None)
+    pts = np.array([k.pt for k in kps], dtype=np.float64).reshape(-1, 2)
+    if s != 1.0:  # pixel centres: x_full + 0.5 = (x_small + 0.5) / s
+        pts = (pts + 0.5) / s - 0.5
+    return pts, desc
+
+
+def _mutual_matches(da: np.ndarray, db: np.ndarray) -> npt.NDArray[np.intp]:
+    bf = cv2.BFMatcher(cv2.NORM_L2)
+    fwd = bf.knnMatch(da, db, k=2)
+    back = {m[0].queryIdx: m[0].trainIdx for m in bf.knnMatch(db, da, k=1) if m}
+    pairs = [
+        (m[0].queryIdx, m[0].trainIdx)
+        for m in fwd
+        if len(m) == 2
+        and m[0].distance < _RATIO * m[1].distance
+        and back.get(m[0].trainIdx) == m[0].queryIdx
+    ]
+    return np.array(pairs, dtype=np.intp).reshape(-1, 2)
+
+
+def _robust_fit(
+    a: npt.NDArray[np.float64], dy: npt.NDArray[np.float64]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.bool_]]:
+    # RANSAC over 3-match samples with a fixed seed (the same pair gives the same answer), then
+    # least squares on the largest consensus set.
+    rng = np.random.default_rng(0)
+    n = len(dy)
+    best = np.zeros(n, dtype=bool)
+    for _ in range(_RANSAC_ROUNDS):
+        idx = rng.choice(n, 3, replace=False)
+        try:
+            coef = np.linalg.solve(a[idx], dy[idx])
+        except np.linalg.LinAlgError:
+            continue
+        inl = np.abs(a @ coef - dy) <= _INLIER_PX
+        if inl.sum() > best.sum():
+            best = inl
+    fit: npt.NDArray[np.float64] = np.asarray(
+        np.linalg.lstsq(a[best], dy[best], rcond=None)[0], dtype=np.float64
+    )
+    return fit, np.abs(a @ fit - dy) <= _INLIER_PX
+
+
+def check_rectification(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    calib: Any = None,
+    *,
+    tolerance: float = DEFAULT_TOLERANCE_PX,
+    alpha: float = 0.0,
+) -> RectificationCheck:
+    """Measure how far the features of a pair lie off each other's rows after rectification.
+
+    Parameters
+    ----------
+    left, right : array_like
+        A raw pair (rectified with ``calib`` first) or, without ``calib``, a rectified pair;
+        grey or colour, any dtype the package reads.
+    calib : Calibration, optional
+        The rig's calibration; omit it for a pair that is already rectified.
+    tolerance : float
+        Median ``|dy|`` (px) up to which the pair counts as rectified.
+    alpha : float
+        Rectification scaling, as in :meth:`Calibration.rectify`.
+
+    Returns
+    -------
+    RectificationCheck
+        ``ok`` True / False, or None when the pair has too little texture to tell.
+
+    Raises
+    ------
+    ValueError
+        Images that are not images, of different sizes or of the wrong size for ``calib``, or
+        a tolerance that is not a positive number.
+    """
+    if (
+        isinstance(tolerance, bool)
+        or not isinstance(tolerance, (int, float))
+        or not (np.isfinite(tolerance) and tolerance > 0)
+    ):
+        raise ValueError(f"tolerance: expected a positive number of pixels, got {tolerance!r}")
+    if calib is not None:
+        left, right = calib.rectify(left, right, alpha=alpha)
+    gl, gr = as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
+    if gl.shape != gr.shape:
+        raise ValueError(f"left is {gl.shape[::-1]} px, right is {gr.shape[::-1]} px (W, H)")
+    h, w = gl.shape
+    pl, dl = _features(gl)
+    pr, dr = _features(gr)
+    tol = float(tolerance)
+    pairs = (
+        _mutual_matches(dl, dr)
+        if dl is not None and dr is not None and len(pl) >= 2 and len(pr) >= 2
+        else np.zeros((0, 2), dtype=np.intp)
+    )
+    nan = float("nan")
+    if len(pairs) < MIN_MATCHES:
+        return RectificationCheck(len(pairs), nan, nan, nan, nan, nan, None, tol)
+    xl, yl = pl[pairs[:, 0]].T
+    xr, yr = pr[pairs[:, 1]].T
+    dy, dx = yl - yr, xl - xr
+    # A rectified side-by-side rig: a match far off its row, or with a disparity well below
+    # zero, is a wrong match, not drift, unless most matches are like that.
+    near_row = np.abs(dy) <= 0.1 * h
+    keep = near_row & (dx >= -max(8.0, 0.02 * w))
+    swapped = bool(near_row.sum() >= MIN_MATCHES and (dx[near_row] < -1.0).mean() > 0.5)
+    inl = np.zeros(len(dy), dtype=bool)
+    coef = np.full(3, nan)
+    if keep.sum() >= MIN_MATCHES:
+        a = np.column_stack(
+            [np.ones(len(dy)), (xl - (w - 1) / 2) / 1000, (yl - (h - 1) / 2) / 1000]
+        )
+        coef, fit_inl = _robust_fit(a[keep], dy[keep])
+        inl[np.flatnonzero(keep)[fit_inl]] = True
+    if inl.sum() >= MIN_MATCHES and not swapped:
+        ady = np.abs(dy[inl])
+        med = float(np.median(ady))
+        return RectificationCheck(
+            int(inl.sum()),
+            med,
+            float(np.percentile(ady, 95)),
+            float(coef[0]),
+            float(coef[1]),
+            float(coef[2]),
+            med <= tol,
+            tol,
+        )
+    # Plenty of matches, but not on a common row model (a pair far from rectified, or not a
+    # side-by-side pair at all) or mostly at negative disparities: not rectified.
+    ady = np.abs(dy)
+    return RectificationCheck(
+        len(pairs),
+        float(np.median(ady)),
+        float(np.percentile(ady, 95)),
+        nan,
+        nan,
+        nan,
+        False,
+        tol,
+        swapped=swapped,
+    )

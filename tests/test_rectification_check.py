@@ -1,0 +1,148 @@
+"""check_rectification: the row alignment of real pairs, as given and with the rig disturbed."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+import stereovision as sv
+from stereovision.calibration import Calibration
+from stereovision.io import imread
+from stereovision.rectification_check import MIN_MATCHES, check_rectification
+
+SV = [sys.executable, "-m", "stereovision.cli"]
+
+
+def _pair(data_dir: Path, scene: str) -> tuple[np.ndarray, np.ndarray]:
+    return imread(data_dir / scene / "left.png"), imread(data_dir / scene / "right.png")
+
+
+def _warp(img: np.ndarray, m: np.ndarray) -> np.ndarray:
+    h, w = img.shape[:2]
+    return cv2.warpAffine(img, m, (w, h), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REFLECT)
+
+
+@pytest.mark.parametrize(
+    "scene",
+    [
+        "middlebury2003/cones",
+        "eth3d/terrace",
+        "kitti2015/000005_10",
+        "tartanair/oldtown_easy_p000_001116",
+    ],
+)
+def test_rectified_scenes_pass_and_a_one_pixel_drift_fails(data_dir: Path, scene: str) -> None:
+    """Measured on the 17 GT scenes of ../shared/data as given: median |dy| 0.06-0.24 px; with
+    the right image 1 px lower, the offset moves by -0.95 to -1.02 px and every verdict is
+    False."""
+    left, right = _pair(data_dir, scene)
+    res = check_rectification(left, right)
+    assert res.ok is True and res.matches >= 200
+    assert res.median_dy < 0.3 and abs(res.offset) < 0.3
+    assert check_rectification(left, right) == res  # deterministic
+    low = check_rectification(left, _warp(right, np.float32([[1, 0, 0], [0, 1, 1.0]])))
+    assert low.ok is False and low.offset - res.offset == pytest.approx(-1.0, abs=0.15)
+    assert low.median_dy > 0.8
+
+
+def test_a_roll_is_measured_as_a_slope(data_dir: Path) -> None:
+    """KITTI's right image turned 0.2 degrees: the row offset changes by tan(0.2 deg) = 3.49 px
+    per 1000 px across the image (measured 3.11); 1242 px wide, the median |dy| exceeds 0.5."""
+    left, right = _pair(data_dir, "kitti2015/000005_10")
+    h, w = right.shape[:2]
+    res = check_rectification(
+        left, _warp(right, cv2.getRotationMatrix2D(((w - 1) / 2, (h - 1) / 2), 0.2, 1.0))
+    )
+    assert res.slope_x == pytest.approx(1000 * np.tan(np.radians(0.2)), abs=0.6)
+    assert res.ok is False
+
+
+def test_large_images_are_checked_on_a_smaller_copy(data_dir: Path) -> None:
+    """At 2484x750 SIFT runs on a 1600 px copy; the offset is still found in full-size pixels."""
+    left, right = _pair(data_dir, "kitti2015/000005_10")
+    big = [cv2.resize(im, None, fx=2, fy=2, interpolation=cv2.INTER_CUBIC) for im in (left, right)]
+    res = check_rectification(big[0], big[1])
+    assert res.ok is True and res.median_dy < 0.5
+    low = check_rectification(big[0], _warp(big[1], np.float32([[1, 0, 0], [0, 1, 2.0]])))
+    # KITTI's own rows are 0.24 px apart (0.48 px at this size): the 2 px come on top
+    assert low.offset - res.offset == pytest.approx(-2.0, abs=0.2) and low.ok is False
+
+
+def _stereopi(data_dir: Path) -> Calibration:
+    ref = data_dir / "stereopi_rig" / "reference_calib_result"
+    return Calibration(
+        K1=np.load(ref / "cam_mats_left.npy"),
+        D1=np.load(ref / "dist_coefs_left.npy"),
+        K2=np.load(ref / "cam_mats_right.npy"),
+        D2=np.load(ref / "dist_coefs_right.npy"),
+        R=np.load(ref / "rot_mat.npy"),
+        T=np.load(ref / "trans_vec.npy"),
+        image_size=(320, 240),
+        unit="cm",
+    )
+
+
+def test_a_raw_rig_with_its_calibration_and_with_a_bumped_one(data_dir: Path) -> None:
+    """The StereoPi scene: raw 0.59 px median |dy| (not rectified), 0.30 px through its own
+    calibration; the right camera pitched by 0.25 degrees more gives a 1.9 px offset."""
+    cal = _stereopi(data_dir)
+    left, right = _pair(data_dir, "stereopi_rig/scene_photo")
+    assert check_rectification(left, right).ok is False
+    good = check_rectification(left, right, cal)
+    assert good.ok is True and good.median_dy < 0.4
+    bump = cv2.Rodrigues(np.array([np.radians(0.25), 0.0, 0.0]))[0]
+    bad = check_rectification(left, right, dataclasses.replace(cal, R=bump @ cal.R))
+    assert bad.ok is False and bad.offset == pytest.approx(-1.9, abs=0.4)
+
+
+def test_swapped_flat_and_unaligned_pairs(data_dir: Path) -> None:
+    left, right = _pair(data_dir, "middlebury2003/cones")
+    swapped = check_rectification(right, left)
+    assert swapped.swapped and swapped.ok is False and "swapped" in swapped.summary()
+    flat = np.full((240, 320), 128, np.uint8)
+    none = check_rectification(flat, flat)
+    assert none.ok is None and none.matches < MIN_MATCHES and "cannot tell" in none.summary()
+    upside = check_rectification(left, np.ascontiguousarray(left[::-1]))
+    assert upside.ok is False and not upside.swapped and upside.median_dy > 50
+    assert json.dumps(upside.as_dict())  # NaN fields become null
+    with pytest.raises(ValueError, match="tolerance"):
+        check_rectification(left, right, tolerance=0)
+    with pytest.raises(ValueError, match="left is"):
+        check_rectification(left, right[:-1])
+    assert sv.check_rectification is check_rectification
+
+
+def test_cli_check(data_dir: Path, tmp_path: Path) -> None:
+    cones = data_dir / "middlebury2003" / "cones"
+    run = subprocess.run(
+        [*SV, "check", str(cones / "left.png"), str(cones / "right.png")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 0 and run.stdout.startswith("rectification ok: median |dy| 0.")
+    left = cv2.imread(str(cones / "right.png"))
+    cv2.imwrite(str(tmp_path / "low.png"), _warp(left, np.float32([[1, 0, 0], [0, 1, 1.5]])))
+    run = subprocess.run(
+        [*SV, "check", str(cones / "left.png"), str(tmp_path / "low.png"), "--json"],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 1
+    out = json.loads(run.stdout)
+    assert out["ok"] is False and out["offset"] == pytest.approx(-1.5, abs=0.3)
+    run = subprocess.run(
+        [*SV, "check", str(cones / "left.png"), str(tmp_path / "none.png")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 2 and run.stderr.count("\n") == 1 and "none.png" in run.stderr
