@@ -93,6 +93,20 @@ def test_depth_command_on_metric_scene(tmp_path: Path, data_dir: Path) -> None:
     assert mm.dtype == np.uint16 and mm.shape == depth.shape
     np.testing.assert_array_equal(mm == 0, ~np.isfinite(depth))
     assert np.abs(mm[mm > 0] / 1000.0 - depth[mm > 0]).max() <= 0.0005 + 1e-6
+    # --max-depth keeps the near half: depth, its PNG and the cloud lose the rest
+    med = float(np.nanmedian(depth))
+    argv = ["depth", str(scene / "left.png"), str(scene / "right.png"), "--calib"]
+    argv += [str(scene / "calib.txt"), "--max-disparity", "32", "-o", str(tmp_path / "near")]
+    assert main([*argv, "--max-depth", f"{med:.3f}"]) == 0
+    near = np.load(tmp_path / "near" / "depth.npy")
+    with np.errstate(invalid="ignore"):
+        np.testing.assert_array_equal(np.isfinite(near), depth <= round(med, 3))
+    pts, _ = read_ply(tmp_path / "near" / "cloud.ply")
+    assert len(pts) == np.isfinite(near).sum() and pts[:, 2].max() <= med + 1e-3
+    assert main([*argv, "--max-depth", "0"]) == 2
+    argv = ["depth", str(scene / "left.png"), str(scene / "right.png"), "--max-sigma", "0.1"]
+    assert main([*argv, "-o", str(tmp_path / "x")]) == 2
+    assert not (tmp_path / "x").exists()
 
 
 def test_errors_are_one_line_and_keep_earlier_outputs(tmp_path: Path, data_dir: Path) -> None:

@@ -311,3 +311,38 @@ def test_cloud_false_keeps_depth_and_to_ply_writes_the_full_cloud(
     assert len(full.points) > 100000
     np.testing.assert_array_equal(pts, full.points)
     np.testing.assert_array_equal(cols, full.colors)
+
+
+def test_filtered_keeps_a_working_range_and_trusted_depths(data_dir: Path) -> None:
+    """ETH3D terrace, metric: filtering by range and by uncertainty drops exactly the pixels
+    outside the limits from depth, depth_sigma and the cloud; the disparity stays whole."""
+    scene = load_scene(data_dir / "eth3d" / "terrace")
+    res = sv.depth_map(scene.left, scene.right, scene.calib, method="gabor", max_disparity=32)
+    assert res.depth is not None and res.depth_sigma is not None
+    z = res.depth
+    med = float(np.nanmedian(z))
+    near = res.filtered(min_depth=1.0, max_depth=med)
+    kept = np.isfinite(near.depth)
+    with np.errstate(invalid="ignore"):
+        np.testing.assert_array_equal(kept, np.isfinite(z) & (z >= 1.0) & (z <= med))
+    assert 0.3 < kept.sum() / np.isfinite(z).sum() < 0.7
+    np.testing.assert_array_equal(near.depth[kept], z[kept])
+    np.testing.assert_array_equal(near.disparity, res.disparity)
+    assert len(near.points) == kept.sum() and near.points[:, 2].max() <= med + 1e-5
+    on = kept[res.pixels[:, 1], res.pixels[:, 0]]
+    np.testing.assert_array_equal(near.points, res.points[on])
+    np.testing.assert_array_equal(near.colors, res.colors[on])
+    # the median sigma here is 0.13 m (3.0 % of the depth)
+    sure = res.filtered(max_sigma=0.15, max_relative_sigma=0.03)
+    ok = np.isfinite(sure.depth)
+    assert 0.2 < ok.sum() / np.isfinite(z).sum() < 0.8
+    assert (sure.depth_sigma[ok] <= 0.15).all()
+    assert (sure.depth_sigma[ok] <= 0.03 * sure.depth[ok]).all()
+    assert np.isnan(sure.depth_sigma[~ok]).all()
+    assert np.isfinite(res.depth).sum() == np.isfinite(z).sum()  # the original is untouched
+    for bad in ({"max_depth": -1.0}, {"max_sigma": 0.0}, {"min_depth": float("nan")}):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            res.filtered(**bad)
+    bare = sv.depth_map(scene.left, scene.right, None, method="gabor", max_disparity=32)
+    with pytest.raises(ValueError, match="no depth to filter"):
+        bare.filtered(max_depth=5.0)

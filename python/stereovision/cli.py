@@ -137,6 +137,8 @@ def depth_outputs(
     max_disparity: int | None = None,
     fill: bool | None = None,
     refine: bool | None = None,
+    max_depth: float | None = None,
+    max_sigma: float | None = None,
 ) -> tuple[Any, dict[str, Path]]:
     """What ``stereovision depth`` computes and writes for one pair (``batch`` writes the same).
 
@@ -156,6 +158,9 @@ def depth_outputs(
         Fill the holes (:func:`depth_map`'s ``fill``); None = the method's default.
     refine : bool, optional
         Sub-pixel refinement; None = the method's default (:func:`depth_map`).
+    max_depth, max_sigma : float, optional
+        Keep only depths up to ``max_depth`` metres with a one-sigma uncertainty up to
+        ``max_sigma`` metres in the depth outputs and the cloud (:meth:`DepthResult.filtered`).
 
     Returns
     -------
@@ -165,8 +170,17 @@ def depth_outputs(
     from stereovision.depth import depth_map
     from stereovision.render import render_outputs
 
+    if calib is None and (max_depth is not None or max_sigma is not None):
+        raise CliError("--max-depth and --max-sigma need --calib (no depth without one)")
+    from stereovision._validate import positive_finite
+
+    for value, flag in ((max_depth, "--max-depth"), (max_sigma, "--max-sigma")):
+        if value is not None:
+            positive_finite(value, flag)
     kw: dict[str, Any] = {} if method is None else {"method": method}
     res = depth_map(left, right, calib, max_disparity=max_disparity, fill=fill, refine=refine, **kw)
+    if max_depth is not None or max_sigma is not None:
+        res = res.filtered(max_depth=max_depth, max_sigma=max_sigma)
     written = write_depth_outputs(res, out_dir)
     written.update(render_outputs(res, out_dir))
     return res, written
@@ -188,6 +202,8 @@ def cmd_depth(args: argparse.Namespace) -> int:
         max_disparity=args.max_disparity,
         fill=args.fill,
         refine=args.refine,
+        max_depth=args.max_depth,
+        max_sigma=args.max_sigma,
     )
     print(
         f"{args.method}: max_disparity {res.max_disparity} px, density {100 * res.density:.1f} %,"
@@ -454,6 +470,15 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_const",
         const=False,
         help="skip the sub-pixel refinement (default: the method's)",
+    )
+    d.add_argument(
+        "--max-depth", type=float, metavar="M", help="keep depths up to M metres (and points)"
+    )
+    d.add_argument(
+        "--max-sigma",
+        type=float,
+        metavar="M",
+        help="keep depths whose one-sigma uncertainty is at most M metres",
     )
     d.add_argument("-o", "--output", required=True, help="output folder")
     d.set_defaults(func=cmd_depth)

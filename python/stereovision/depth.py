@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import time
 import warnings
@@ -264,6 +265,88 @@ class DepthResult:
     def density(self) -> float:
         """Fraction of pixels with a disparity estimate."""
         return float(self.valid.mean())
+
+    def filtered(
+        self,
+        *,
+        min_depth: float | None = None,
+        max_depth: float | None = None,
+        max_sigma: float | None = None,
+        max_relative_sigma: float | None = None,
+    ) -> DepthResult:
+        """A copy whose depth, uncertainty and points keep only the depths asked for.
+
+        What a robot keeps before planning: a working range, and the depths it can trust
+        (``depth_sigma``, the one-sigma uncertainty, in metres or relative to the depth). The
+        disparity and confidence maps are kept whole; only ``depth``, ``depth_sigma``,
+        ``points``, ``colors`` and ``pixels`` lose the pixels outside the limits.
+
+        Parameters
+        ----------
+        min_depth, max_depth : float, optional
+            Working range in metres.
+        max_sigma : float, optional
+            Largest one-sigma depth uncertainty in metres.
+        max_relative_sigma : float, optional
+            Largest ``depth_sigma / depth`` (0.02 = 2 %).
+
+        Returns
+        -------
+        DepthResult
+            The filtered copy (this result is unchanged).
+
+        Raises
+        ------
+        ValueError
+            A result without depth (no calibration), or a limit that is not a positive
+            number (``min_depth`` may be 0).
+        """
+        if self.depth is None:
+            raise ValueError("no depth to filter: depth_map was called without a calibration")
+        limits = {
+            "min_depth": min_depth,
+            "max_depth": max_depth,
+            "max_sigma": max_sigma,
+            "max_relative_sigma": max_relative_sigma,
+        }
+        for name, v in limits.items():
+            ok_number = isinstance(v, (int, float, np.floating, np.integer)) and not isinstance(
+                v, bool
+            )
+            if v is not None and not (
+                ok_number and np.isfinite(v) and (v > 0 or (name == "min_depth" and v == 0))
+            ):
+                raise ValueError(f"{name}: expected a positive number, got {v!r}")
+        z = self.depth
+        keep = np.isfinite(z)
+        with np.errstate(invalid="ignore"):
+            if min_depth is not None:
+                keep &= z >= min_depth
+            if max_depth is not None:
+                keep &= z <= max_depth
+            if max_sigma is not None or max_relative_sigma is not None:
+                sig = self.depth_sigma
+                if sig is None:
+                    raise ValueError("max_sigma: this result has no depth_sigma")
+                if max_sigma is not None:
+                    keep &= sig <= max_sigma
+                if max_relative_sigma is not None:
+                    keep &= sig <= max_relative_sigma * z
+        nan = np.float32(np.nan)
+        sigma = None if self.depth_sigma is None else np.where(keep, self.depth_sigma, nan)
+        if len(self.points):
+            on = keep[self.pixels[:, 1], self.pixels[:, 0]]
+            points, colors, pixels = self.points[on], self.colors[on], self.pixels[on]
+        else:
+            points, colors, pixels = self.points, self.colors, self.pixels
+        return dataclasses.replace(
+            self,
+            depth=np.where(keep, z, nan).astype(np.float32),
+            depth_sigma=None if sigma is None else sigma.astype(np.float32),
+            points=points,
+            colors=colors,
+            pixels=pixels,
+        )
 
     def to_ply(self, path: str | Path) -> Path:
         """Write the coloured point cloud as a binary PLY (metres), atomically.
