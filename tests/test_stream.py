@@ -55,6 +55,9 @@ def test_stream_json_reports(videos: dict[str, Path], capsys: pytest.CaptureFixt
     objs = _json_lines(capsys.readouterr().out)  # every stdout line is one JSON object
     reports, summary = objs[:-1], objs[-1]
     assert reports and all("summary" not in r for r in reports)
+    # the first pair's rows were checked: the scene is rectified
+    assert summary["rectification"]["ok"] is True
+    assert summary["rectification"]["median_dy"] < 0.3
     # Every pair is in exactly one per-second report; the counts add up.
     assert sum(r["frames"] for r in reports) == N_FRAMES
     assert [r["total_frames"] for r in reports] == list(np.cumsum([r["frames"] for r in reports]))
@@ -216,3 +219,33 @@ def test_frame_server_serves_left_and_disparity() -> None:
         assert _get(base + "nope")[0] == 404
     finally:
         srv.close()
+
+
+def test_stream_warns_when_the_rig_is_not_rectified(
+    videos: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A calibration whose right camera is pitched 1 degree more than the rectified frames show:
+    the first pair's rows are about 5.6 px apart, and the stream says so in one line."""
+    k = np.array([[320.0, 0, 320], [0, 320.0, 240], [0, 0, 1]])
+    rig = Calibration(
+        K1=k,
+        D1=np.zeros(5),
+        K2=k,
+        D2=np.zeros(5),
+        R=cv2.Rodrigues(np.array([np.radians(1.0), 0.0, 0.0]))[0],
+        T=np.array([-0.25, 0.0, 0.0]),
+        image_size=(640, 480),
+        unit="m",
+    )
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--calib", str(rig.save(tmp_path / "rig.yaml")), "--max-disparity", "64"]
+    argv += ["--no-display", "--json", "--frames", "1"]
+    assert main(argv) == 0
+    cap = capsys.readouterr()
+    check = _json_lines(cap.out)[-1]["rectification"]
+    assert check["ok"] is False and abs(check["offset"]) > 3
+    warned = [ln for ln in cap.err.splitlines() if "NOT rectified" in ln]
+    assert len(warned) == 1 and warned[0].startswith("stereovision: warning: first pair:")
+    assert main([*argv, "--no-check"]) == 0
+    cap = capsys.readouterr()
+    assert _json_lines(cap.out)[-1]["rectification"] is None and "NOT" not in cap.err

@@ -28,6 +28,7 @@ import statistics
 import sys
 import threading
 import time
+import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -112,6 +113,9 @@ class StreamReport:
         Whether grab/rectify ran in the producer thread.
     ended : str
         ``"frames"`` (the ``frames`` limit), ``"end of stream"`` or ``"interrupted"``.
+    rectification : dict or None
+        :func:`~stereovision.rectification_check.check_rectification` of the first pair, as a
+        dict (None when ``check=False`` or no pair came).
     """
 
     frames: int
@@ -126,6 +130,7 @@ class StreamReport:
     ended: str
     density: float = math.nan
     reports: list[dict[str, Any]] = field(default_factory=list, repr=False)
+    rectification: dict[str, Any] | None = None
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON summary object (``"summary": true``)."""
@@ -142,6 +147,7 @@ class StreamReport:
             "max_disparity": self.max_disparity,
             "pipelined": self.pipelined,
             "ended": self.ended,
+            "rectification": self.rectification,
         }
 
 
@@ -396,6 +402,7 @@ def run_stream(
     on_report: Callable[[dict[str, Any]], None] | None = None,
     on_result: Callable[[np.ndarray, Any], None] | None = None,
     report_period: float = REPORT_PERIOD,
+    check: bool = True,
 ) -> StreamReport:
     """Depth maps from a stereo camera until it ends, ``frames`` pairs, or Ctrl-C.
 
@@ -431,6 +438,10 @@ def run_stream(
         with ``cloud=False``: its ``points`` are empty, its ``to_ply`` writes the full cloud.
     report_period : float
         Seconds between reports.
+    check : bool
+        Check that the first (rectified) pair's features lie on common rows
+        (:func:`~stereovision.rectification_check.check_rectification`, 35-480 ms once) and
+        warn when they do not: a spoiled calibration, or raw cameras without one.
 
     Returns
     -------
@@ -472,6 +483,7 @@ def run_stream(
         return item  # type: ignore[no-any-return]
 
     all_done: list[_Done] = []
+    rectification: dict[str, Any] | None = None
     window: list[_Done] = []
     reports: list[dict[str, Any]] = []
     md = max_disparity
@@ -486,6 +498,8 @@ def run_stream(
             if pair is None:
                 break
             t_got = time.perf_counter()
+            if check and not all_done:
+                rectification = _check_first_pair(pair.left, pair.right)
             if md is None:
                 md = estimate_max_disparity(pair.left, pair.right)
             # No point cloud per frame: the live view shows disparity and depth.
@@ -555,7 +569,17 @@ def run_stream(
         ended=ended,
         density=_mean([d.density for d in all_done]),
         reports=reports,
+        rectification=rectification,
     )
+
+
+def _check_first_pair(left: np.ndarray, right: np.ndarray) -> dict[str, Any]:
+    from stereovision.rectification_check import check_rectification
+
+    res = check_rectification(left, right)
+    if res.ok is False:
+        warnings.warn(f"first pair: {res.summary()}", stacklevel=3)
+    return res.as_dict()
 
 
 # ---------------------------------------------------------------------------------------- CLI
@@ -606,6 +630,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             fill=args.fill,
             on_report=on_report,
             on_result=on_result,
+            check=not args.no_check,
         )
     finally:
         cam.close()
@@ -662,6 +687,11 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--serve", type=int, default=DEFAULT_PORT, metavar="PORT", help="view port")
     p.add_argument("--host", default="127.0.0.1", help="view address (default 127.0.0.1)")
     p.add_argument("--json", action="store_true", help="one JSON object per second on stdout")
+    p.add_argument(
+        "--no-check",
+        action="store_true",
+        help="skip the rectification check of the first pair (a warning when rows disagree)",
+    )
     p.add_argument(
         "--no-pipeline", action="store_true", help="grab, rectify and match in one thread"
     )
