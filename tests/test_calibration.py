@@ -511,3 +511,39 @@ def test_points_back_to_the_left_cameras_own_frame() -> None:
     np.testing.assert_array_equal(rect_calib().to_camera_frame(rect), rect)
     with pytest.raises(ValueError, match=r"shape \(\.\.\., 3\)"):
         c.to_camera_frame(np.zeros((4, 2)))
+
+
+def test_scaled_to_a_lower_resolution() -> None:
+    """A raw rig calibrated at 320x240 run at 640x480 (and back): points project where the
+    resized image puts them, x' = (x + 0.5) s - 0.5; a rectified rig keeps its depth."""
+    c = raw_calib()
+    big = c.scaled_to((640, 480))
+    assert big.image_size == (640, 480) and big.scaled_to(SIZE) == c
+    assert c.scaled_to(SIZE) is c
+    pts = np.array([[0.1, -0.05, 1.5], [-0.3, 0.2, 2.5], [0.0, 0.0, 4.0]])
+    for cam, rvec, tvec in (("1", np.zeros(3), np.zeros(3)), ("2", cv2.Rodrigues(c.R)[0], c.T)):
+        k, d = getattr(c, "K" + cam), getattr(c, "D" + cam)
+        kb = getattr(big, "K" + cam)
+        small = cv2.projectPoints(pts, rvec, tvec, k, d)[0].reshape(-1, 2)
+        large = cv2.projectPoints(pts, rvec, tvec, kb, d)[0].reshape(-1, 2)
+        np.testing.assert_allclose(large, (small + 0.5) * 2 - 0.5, atol=1e-9)
+    # the rectified rig at the new size has twice the focal length, the same baseline
+    assert big.focal_px == pytest.approx(2 * c.focal_px, rel=1e-3)
+    r = rect_calib(K2=np.array([[500.0, 0, 170.0], [0, 500.0, 120.0], [0, 0, 1]]), doffs=10.0)
+    half = r.scaled_to((160, 120))
+    assert half.doffs == 5.0 and half.doffs_px == pytest.approx(5.0)
+    disp = np.array([[20.0]])
+    np.testing.assert_allclose(half.depth_from_disparity(disp / 2), r.depth_from_disparity(disp))
+    with pytest.raises(ValueError, match="image_size"):
+        c.scaled_to((0, 10))
+
+
+def test_fit_to_frames_scales_or_names_a_crop() -> None:
+    from stereovision.calibration import fit_to_frames
+
+    c = raw_calib()
+    assert fit_to_frames(c, SIZE) == (c, None)
+    scaled, note = fit_to_frames(c, (160, 120))
+    assert scaled.image_size == (160, 120) and note is not None and "scaled" in note
+    with pytest.raises(ValueError, match="another aspect ratio"):
+        fit_to_frames(c, (320, 180))

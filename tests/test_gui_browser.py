@@ -186,9 +186,14 @@ def test_scaled_calibration_and_compute_view():
     assert view.result.method == "opencv-sgbm"
     with pytest.raises(ValueError, match="unknown method"):
         compute_view(res.left_rectified, right, calib, "nope")
-    small = sources.scale_pair(res.left_rectified, right, 80)[0]
-    with pytest.raises(ValueError, match="calibration is for 160x120"):
-        compute_view(small, small, calib, "opencv-sgbm")
+    # frames at half the calibration's resolution: the calibration is scaled, with a note
+    small, small_r, _ = sources.scale_pair(res.left_rectified, right, 80)
+    half_view = compute_view(small, small_r, calib, "opencv-sgbm", max_disparity=16)
+    assert half_view.result.calibration.K1[0, 0] == pytest.approx(syn.F / 2)
+    assert "warning: the calibration is for 160x120 and the frames are 80x60" in half_view.stats
+    cropped = np.ascontiguousarray(res.left_rectified[:, :100])
+    with pytest.raises(ValueError, match=r"calibration is for 160x120 .* another aspect"):
+        compute_view(cropped, cropped, calib, "opencv-sgbm")
     sparse = np.full(res.disparity.shape, np.nan, np.float32)
     sparse[60, 100] = 10.0
     canvas = draw_matches(res.left_rectified, right, sparse)

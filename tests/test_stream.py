@@ -249,3 +249,23 @@ def test_stream_warns_when_the_rig_is_not_rectified(
     assert main([*argv, "--no-check"]) == 0
     cap = capsys.readouterr()
     assert _json_lines(cap.out)[-1]["rectification"] is None and "NOT" not in cap.err
+
+
+def test_stream_scales_a_calibration_made_at_another_resolution(
+    videos: dict[str, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--size 320x240 with the scene's 640x480 calibration: the frames and the calibration are
+    halved (one warning line each), and depth is computed at the lower resolution."""
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--calib", str(videos["calib"]), "--size", "320x240", "--max-disparity", "32"]
+    argv += ["--no-display", "--json", "--frames", "2"]
+    assert main(argv) == 0
+    cap = capsys.readouterr()
+    summary = _json_lines(cap.out)[-1]
+    assert summary["frames"] == 2 and summary["stage_ms"]["triangulate"] > 0
+    assert summary["rectification"]["ok"] is True
+    notes = [ln for ln in cap.err.splitlines() if "calibration is for 640x480" in ln]
+    assert len(notes) == 1 and "frames are 320x240: scaled" in notes[0]
+    argv[argv.index("320x240")] = "320x180"
+    assert main(argv) == 2
+    assert "another aspect ratio" in capsys.readouterr().err

@@ -32,6 +32,7 @@ __all__ = [
     "ROS_DISTORTION_MODELS",
     "UNIT_TO_METRES",
     "Calibration",
+    "fit_to_frames",
     "parse_kitti_calib",
     "parse_middlebury_calib",
     "parse_ros_camera_info",
@@ -484,6 +485,55 @@ class Calibration:
             )
         cal: Calibration = self._cache[key]
         return cal
+
+    def scaled_to(self, image_size: tuple[int, int]) -> Calibration:
+        """The calibration of the same rig for its images resized (not cropped) to ``image_size``.
+
+        A camera run at a lower resolution than it was calibrated at (640x360 from a 1280x720
+        calibration) scales its pixels: ``x' = (x + 0.5) s_x - 0.5`` with ``s_x = W' / W``, so
+        ``f_x' = s_x f_x``, ``c_x' = (c_x + 0.5) s_x - 0.5`` (likewise in y), ``doffs' =
+        s_x doffs``. Distortion (in normalised coordinates), ``R`` and ``T`` are unchanged. A
+        camera mode that crops the sensor instead needs a calibration of its own.
+
+        Parameters
+        ----------
+        image_size : tuple of int
+            ``(width, height)`` of the resized images.
+
+        Returns
+        -------
+        Calibration
+            This calibration when the size is already ``image_size``.
+
+        Raises
+        ------
+        ValueError
+            If ``image_size`` is not two positive integers.
+        """
+        size = self._check_size(image_size)
+        if size == self.image_size:
+            return self
+        sx, sy = size[0] / self.image_size[0], size[1] / self.image_size[1]
+
+        def scale(k: F64) -> F64:
+            out = k.copy()
+            out[0, 0], out[0, 1], out[1, 1] = k[0, 0] * sx, k[0, 1] * sx, k[1, 1] * sy
+            out[0, 2] = (k[0, 2] + 0.5) * sx - 0.5
+            out[1, 2] = (k[1, 2] + 0.5) * sy - 0.5
+            return out
+
+        return Calibration(
+            K1=scale(self.K1),
+            D1=self.D1,
+            K2=scale(self.K2),
+            D2=self.D2,
+            R=self.R,
+            T=self.T,
+            image_size=size,
+            unit=self.unit,
+            rectified=self.rectified,
+            doffs=None if self.doffs is None else self.doffs * sx,
+        )
 
     def to_camera_frame(self, points: npt.ArrayLike) -> npt.NDArray[np.floating[Any]]:
         """Points from the left *rectified* frame to the left camera's own frame.
@@ -1059,6 +1109,44 @@ class Calibration:
             with atomic_write(path, "w") as fh:
                 fh.write(text)
         return paths
+
+
+def fit_to_frames(calib: Calibration, size: tuple[int, int]) -> tuple[Calibration, str | None]:
+    """``calib`` for frames of ``size``: itself, or scaled when only the resolution differs.
+
+    Parameters
+    ----------
+    calib : Calibration
+        The rig's calibration.
+    size : tuple of int
+        ``(width, height)`` of the frames.
+
+    Returns
+    -------
+    tuple
+        ``(calibration, note)``: the note (None when nothing changed) says what was scaled,
+        for a warning or a status line.
+
+    Raises
+    ------
+    ValueError
+        If the aspect ratios differ by more than 1 % (a camera mode that crops: it needs its
+        own calibration).
+    """
+    (w0, h0), (w, h) = calib.image_size, (int(size[0]), int(size[1]))
+    if (w0, h0) == (w, h):
+        return calib, None
+    sx, sy = w / w0, h / h0
+    if abs(sx - sy) > 0.01 * max(sx, sy):
+        raise ValueError(
+            f"calibration is for {w0}x{h0} images, the frames are {w}x{h}: another aspect "
+            "ratio (a camera mode that crops), which needs its own calibration"
+        )
+    note = (
+        f"the calibration is for {w0}x{h0} and the frames are {w}x{h}: scaled to them (a "
+        "camera mode that crops instead of scaling needs its own calibration)"
+    )
+    return calib.scaled_to((w, h)), note
 
 
 _MB_LINE = re.compile(r"^\s*([A-Za-z_]\w*)\s*=\s*(.*?)\s*$")

@@ -764,7 +764,7 @@ def depth_map(
         if tuple(calib.image_size) != (w, h):
             raise ValueError(
                 f"calibration is for {calib.image_size[0]}x{calib.image_size[1]} images, "
-                f"got {w}x{h}"
+                f"got {w}x{h} (images resized, not cropped: calib.scaled_to(({w}, {h})))"
             )
         if not calib.rectified:
             left_bgr, right_bgr = calib.rectify(left_bgr, right_bgr)

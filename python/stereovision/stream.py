@@ -37,7 +37,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from stereovision.calibration import Calibration
+from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import SourceError, StereoCamera, parse_size, parse_source
 
 __all__ = [
@@ -411,9 +411,10 @@ def run_stream(
     camera : StereoCamera
         The two sources (devices, video files or image sequences).
     calib : Calibration, optional
-        Rig calibration of the camera's output size. A raw rig calibration is applied by the
-        producer (rectification); a rectified one (Middlebury, KITTI) is used as is. Without one,
-        only disparity is computed.
+        Rig calibration. A raw rig calibration is applied by the producer (rectification); a
+        rectified one (Middlebury, KITTI) is used as is. Without one, only disparity is
+        computed. One made at another resolution of the same aspect ratio is scaled to the
+        frames (:meth:`~stereovision.calibration.Calibration.scaled_to`), with a warning.
     method : str
         Matcher (:data:`stereovision.depth.METHODS`). ``"gabor"`` by default: a live view wants
         the rate, and it is 3-4 times faster than ``depth_map``'s default ``"fused"``.
@@ -460,6 +461,11 @@ def run_stream(
         raise ValueError(f"frames: expected a positive number, got {frames}")
     if max_disparity is not None and max_disparity <= 0:
         raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
+    size = camera.size or camera.delivered_size.get("left")
+    if calib is not None and size is not None:
+        calib, note = fit_to_frames(calib, size)
+        if note is not None:
+            warnings.warn(note, stacklevel=2)
     rect_calib = None
     if calib is not None:
         rect_calib = calib if calib.rectified else calib.rectified_calibration()

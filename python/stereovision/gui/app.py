@@ -33,6 +33,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from stereovision.calibration import fit_to_frames
 from stereovision.gui.sources import (
     CLOUD_SUFFIXES,
     IMAGE_SUFFIXES,
@@ -227,11 +228,11 @@ def compute_view(
 
     if method not in METHODS and method not in EXTRA_METHODS:
         raise ValueError(f"unknown method {method!r}")
-    if calib is not None and tuple(calib.image_size) != (left.shape[1], left.shape[0]):
-        w, h = calib.image_size
-        raise ValueError(
-            f"calibration is for {w}x{h} images, the cameras give {left.shape[1]}x{left.shape[0]}"
-        )
+    notes: list[str] = []
+    if calib is not None:
+        # a calibration made at another resolution of the same aspect is scaled, with a note
+        calib, note = fit_to_frames(calib, (left.shape[1], left.shape[0]))
+        notes += [] if note is None else [note]
     left_s, right_s, s = scale_pair(left, right, width)
     calib_s = scaled_calibration(calib, s, (left_s.shape[1], left_s.shape[0]))
     d_max = None if max_disparity is None else max(16, math.ceil(max_disparity * s / 16) * 16)
@@ -281,7 +282,7 @@ def compute_view(
     )
     if result.depth is not None and len(result.points):
         stats += f" · median depth {float(np.median(result.points[:, 2])):.2f} m"
-    said = [str(c.message) for c in caught if issubclass(c.category, UserWarning)]
+    said = notes + [str(c.message) for c in caught if issubclass(c.category, UserWarning)]
     for msg in dict.fromkeys(said):  # once each, in order
         stats += f" · warning: {msg}"
     return ViewData(

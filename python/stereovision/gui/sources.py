@@ -315,20 +315,8 @@ def scale_pair(
 
 
 def scaled_calibration(calib: Any, factor: float, size: Sequence[int]) -> Any:
-    """``calib`` for images scaled by ``factor`` to ``size = (width, height)`` (K, doffs scaled)."""
+    """``calib`` for images scaled by ``factor`` to ``size = (width, height)``
+    (:meth:`~stereovision.calibration.Calibration.scaled_to`, from the exact size ratio)."""
     if calib is None or factor == 1.0:
         return calib
-    from dataclasses import replace
-
-    def k(m: np.ndarray) -> np.ndarray:
-        out = np.array(m, dtype=np.float64)
-        out[0, 0] *= factor
-        out[1, 1] *= factor
-        out[0, 2] = (out[0, 2] + 0.5) * factor - 0.5
-        out[1, 2] = (out[1, 2] + 0.5) * factor - 0.5
-        return out
-
-    doffs = None if calib.doffs is None else calib.doffs * factor
-    return replace(
-        calib, K1=k(calib.K1), K2=k(calib.K2), image_size=(int(size[0]), int(size[1])), doffs=doffs
-    )
+    return calib.scaled_to((int(size[0]), int(size[1])))
