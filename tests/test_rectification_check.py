@@ -112,6 +112,10 @@ def test_swapped_flat_and_unaligned_pairs(data_dir: Path) -> None:
     upside = check_rectification(left, np.ascontiguousarray(left[::-1]))
     assert upside.ok is False and not upside.swapped and upside.median_dy > 50
     assert json.dumps(upside.as_dict())  # NaN fields become null
+    res = check_rectification(left, right)
+    assert res.points.shape == (res.matches, 4)
+    dy = res.points[:, 1] - res.points[:, 3]
+    assert float(np.median(np.abs(dy))) == pytest.approx(res.median_dy, abs=1e-5)
     with pytest.raises(ValueError, match="tolerance"):
         check_rectification(left, right, tolerance=0)
     with pytest.raises(ValueError, match="left is"):
@@ -139,6 +143,21 @@ def test_cli_check(data_dir: Path, tmp_path: Path) -> None:
     assert run.returncode == 1
     out = json.loads(run.stdout)
     assert out["ok"] is False and out["offset"] == pytest.approx(-1.5, abs=0.3)
+    assert "points" not in out
+    plot = tmp_path / "check.png"
+    run = subprocess.run(
+        [*SV, "check", str(cones / "left.png"), str(cones / "right.png"), "--plot", str(plot)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 0
+    img = cv2.imread(str(plot))
+    assert img.shape[1] == 900 and img.shape[0] > 375
+    # the summary band on top, then the pair with green dots (matches within tolerance)
+    pair = img[-375:]
+    green = (pair[..., 1] > 150) & (pair[..., 0] < 80) & (pair[..., 2] < 80)
+    assert green[:, :450].sum() > 500 and green[:, 450:].sum() > 500
     run = subprocess.run(
         [*SV, "check", str(cones / "left.png"), str(tmp_path / "none.png")],
         capture_output=True,

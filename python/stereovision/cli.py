@@ -222,7 +222,13 @@ def cmd_check(args: argparse.Namespace) -> int:
     left = imread(args.left)
     right = imread(args.right)
     calib = _load_calibration(args.calib)
-    res = check_rectification(left, right, calib, tolerance=args.tolerance)
+    if calib is not None:
+        left, right = calib.rectify(left, right)
+    res = check_rectification(left, right, tolerance=args.tolerance)
+    if args.plot:
+        from stereovision.rectification_check import draw_rectification_check
+
+        _atomic_write_bytes(Path(args.plot), _png_bytes(draw_rectification_check(left, right, res)))
     print(json.dumps(res.as_dict()) if args.json else res.summary())
     return 0 if res.ok else 1
 
@@ -496,6 +502,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--calib", help="the rig's calibration (omit for a rectified pair)")
     d.add_argument("--tolerance", type=float, default=0.5, help="median |dy| in px (default 0.5)")
     d.add_argument("--json", action="store_true", help="one JSON object instead of a line")
+    d.add_argument("--plot", metavar="PNG", help="draw the rectified pair and its matches")
     d.set_defaults(func=cmd_check)
 
     d = sub.add_parser("eval", help="evaluate against ground truth, OpenCV beside")

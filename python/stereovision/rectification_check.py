@@ -11,7 +11,7 @@ between the cameras; ``b``: a roll; ``c``: a focal-length or pitch difference).
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, field, fields
 from typing import Any
 
 import cv2
@@ -20,7 +20,7 @@ import numpy.typing as npt
 
 from stereovision._validate import as_gray_uint8
 
-__all__ = ["RectificationCheck", "check_rectification"]
+__all__ = ["RectificationCheck", "check_rectification", "draw_rectification_check"]
 
 #: Median row error (px) of the matched features up to which a pair counts as rectified.
 DEFAULT_TOLERANCE_PX = 0.5
@@ -54,6 +54,9 @@ class RectificationCheck:
         The tolerance used (px).
     swapped : bool
         Most matches have a negative disparity: the left and right images look swapped.
+    points : ndarray, float32 (N, 4)
+        The matches the figures are over, ``[x_left, y_left, x_right, y_right]`` in the
+        rectified pair (for :func:`draw_rectification_check`; not in :meth:`as_dict`).
 
     Notes
     -----
@@ -70,13 +73,18 @@ class RectificationCheck:
     ok: bool | None
     tolerance: float
     swapped: bool = False
+    points: npt.NDArray[np.float32] = field(
+        default_factory=lambda: np.zeros((0, 4), np.float32), repr=False, compare=False
+    )
 
     def as_dict(self) -> dict[str, Any]:
         """The fields as a JSON-ready dict (NaN as None)."""
-        return {
-            k: None if isinstance(v, float) and not np.isfinite(v) else v
-            for k, v in asdict(self).items()
-        }
+        out: dict[str, Any] = {}
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name != "points":
+                out[f.name] = None if isinstance(v, float) and not np.isfinite(v) else v
+        return out
 
     def summary(self) -> str:
         """One line for a log or a terminal."""
@@ -228,6 +236,7 @@ def check_rectification(
         )
         coef, fit_inl = _robust_fit(a[keep], dy[keep])
         inl[np.flatnonzero(keep)[fit_inl]] = True
+    quad = np.column_stack([xl, yl, xr, yr]).astype(np.float32)
     if inl.sum() >= MIN_MATCHES and not swapped:
         ady = np.abs(dy[inl])
         med = float(np.median(ady))
@@ -240,6 +249,7 @@ def check_rectification(
             float(coef[2]),
             med <= tol,
             tol,
+            points=quad[inl],
         )
     # Plenty of matches, but not on a common row model (a pair far from rectified, or not a
     # side-by-side pair at all) or mostly at negative disparities: not rectified.
@@ -254,4 +264,60 @@ def check_rectification(
         False,
         tol,
         swapped=swapped,
+        points=quad,
     )
+
+
+def draw_rectification_check(
+    left: npt.ArrayLike, right: npt.ArrayLike, check: RectificationCheck
+) -> npt.NDArray[np.uint8]:
+    """The rectified pair side by side with the check's matches, coloured by their row error.
+
+    Each match is a dot in both images, green where ``|dy|`` is within the tolerance, yellow up
+    to 3 times it, red beyond; in the left image a tick from the dot shows ``10 dy`` (where the
+    right image has the feature, ten times magnified). Faint lines every 40 px mark rows.
+
+    Parameters
+    ----------
+    left, right : array_like
+        The *rectified* pair the check ran on (``calib.rectify(left, right)`` for a raw rig).
+    check : RectificationCheck
+        Its result.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H + band, 2 W, 3)`` BGR ``uint8`` image, the summary in a band above the pair.
+    """
+    from stereovision._validate import as_bgr_uint8
+
+    lb, rb = as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right")
+    h, w = lb.shape[:2]
+    canvas = np.concatenate([lb, rb], axis=1)
+    canvas = (canvas * 0.7).astype(np.uint8)
+    for y in range(20, h, 40):
+        cv2.line(canvas, (0, y), (2 * w - 1, y), (200, 200, 200), 1, cv2.LINE_AA)
+    tol = check.tolerance
+    for xl, yl, xr, yr in check.points:
+        e = abs(float(yl - yr))
+        colour = (0, 200, 0) if e <= tol else (0, 220, 255) if e <= 3 * tol else (0, 0, 255)
+        # each match a dot in both images, and in the left one a tick ten times its row error
+        pl = (round(float(xl)), round(float(yl)))
+        pr = (round(float(xr)) + w, round(float(yr)))
+        cv2.line(canvas, pl, (pl[0], round(float(yl + 10 * (yr - yl)))), colour, 1, cv2.LINE_AA)
+        cv2.circle(canvas, pl, 2, colour, -1, cv2.LINE_AA)
+        cv2.circle(canvas, pr, 2, colour, -1, cv2.LINE_AA)
+    # the summary above the pair, wrapped to its width
+    font, scale = cv2.FONT_HERSHEY_SIMPLEX, 0.5
+    lines: list[str] = []
+    for word in check.summary().split(" "):
+        trial = f"{lines[-1]} {word}" if lines else word
+        if lines and cv2.getTextSize(trial, font, scale, 1)[0][0] <= 2 * w - 16:
+            lines[-1] = trial
+        else:
+            lines.append(word)
+    band = np.full((8 + 20 * len(lines), 2 * w, 3), 255, np.uint8)
+    for i, line in enumerate(lines):
+        cv2.putText(band, line, (8, 20 + 20 * i), font, scale, (0, 0, 0), 1, cv2.LINE_AA)
+    canvas = np.concatenate([band, canvas], axis=0)
+    return canvas
