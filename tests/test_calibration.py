@@ -441,11 +441,10 @@ def test_rectify_raw_pair_rows_and_depth() -> None:
         c.rectify(left, right, alpha=2.0)
 
 
-def test_stereopi_reference_calibration(data_dir: Path) -> None:
-    """The StereoPi tutorial's cv2.stereoCalibrate output loads (unit cm) and our convention
-    X_R = R X_L + T reproduces its rectification rotations."""
+def stereopi_calib(data_dir: Path) -> Calibration:
+    """The StereoPi tutorial's own cv2.stereoCalibrate output (320x240, unit cm)."""
     ref = data_dir / "stereopi_rig" / "reference_calib_result"
-    c = Calibration(
+    return Calibration(
         K1=np.load(ref / "cam_mats_left.npy"),
         D1=np.load(ref / "dist_coefs_left.npy"),
         K2=np.load(ref / "cam_mats_right.npy"),
@@ -455,6 +454,13 @@ def test_stereopi_reference_calibration(data_dir: Path) -> None:
         image_size=(320, 240),
         unit="cm",
     )
+
+
+def test_stereopi_reference_calibration(data_dir: Path) -> None:
+    """The StereoPi tutorial's cv2.stereoCalibrate output loads (unit cm) and our convention
+    X_R = R X_L + T reproduces its rectification rotations."""
+    ref = data_dir / "stereopi_rig" / "reference_calib_result"
+    c = stereopi_calib(data_dir)
     assert c.baseline_m == pytest.approx(0.05396, abs=1e-5)
     r1, r2, *_ = c._stereo_rectify(0.0)
     # 2.4e-4 apart (another OpenCV version); R transposed or inverted rigs are 0.009 to 0.04 off

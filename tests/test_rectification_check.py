@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 import stereovision as sv
-from stereovision.calibration import Calibration
 from stereovision.io import imread
 from stereovision.rectification_check import MIN_MATCHES, check_rectification
+from tests.test_calibration import stereopi_calib
 
 SV = [sys.executable, "-m", "stereovision.cli"]
 
@@ -75,24 +75,10 @@ def test_large_images_are_checked_on_a_smaller_copy(data_dir: Path) -> None:
     assert low.offset - res.offset == pytest.approx(-2.0, abs=0.2) and low.ok is False
 
 
-def _stereopi(data_dir: Path) -> Calibration:
-    ref = data_dir / "stereopi_rig" / "reference_calib_result"
-    return Calibration(
-        K1=np.load(ref / "cam_mats_left.npy"),
-        D1=np.load(ref / "dist_coefs_left.npy"),
-        K2=np.load(ref / "cam_mats_right.npy"),
-        D2=np.load(ref / "dist_coefs_right.npy"),
-        R=np.load(ref / "rot_mat.npy"),
-        T=np.load(ref / "trans_vec.npy"),
-        image_size=(320, 240),
-        unit="cm",
-    )
-
-
 def test_a_raw_rig_with_its_calibration_and_with_a_bumped_one(data_dir: Path) -> None:
     """The StereoPi scene: raw 0.59 px median |dy| (not rectified), 0.30 px through its own
     calibration; the right camera pitched by 0.25 degrees more gives a 1.9 px offset."""
-    cal = _stereopi(data_dir)
+    cal = stereopi_calib(data_dir)
     left, right = _pair(data_dir, "stereopi_rig/scene_photo")
     assert check_rectification(left, right).ok is False
     good = check_rectification(left, right, cal)
