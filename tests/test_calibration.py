@@ -553,3 +553,20 @@ def test_fit_to_frames_scales_or_names_a_crop() -> None:
     assert scaled.image_size == (160, 120) and note is not None and "scaled" in note
     with pytest.raises(ValueError, match="another aspect ratio"):
         fit_to_frames(c, (320, 180))
+
+
+def test_depth_step_and_describe() -> None:
+    """f 500 px, B 0.1 m: fB = 50 m px, so one pixel of disparity is Z^2 / 50 of depth."""
+    c = rect_calib()
+    np.testing.assert_allclose(c.depth_step([1.0, 5.0]), [0.02, 0.5])
+    assert float(c.depth_step(2.0, 0.25)) == pytest.approx(0.02)
+    text = c.describe(depths=(1.0, 5.0))
+    assert "baseline 10.0 cm (100 mm), focal length 500.0 px" in text
+    # 2 atan(320 / 1000) and 2 atan(240 / 1000)
+    assert "field of view 35.5 x 27.0 degrees" in text
+    assert "depth Z = 50.000 m px / (d + 0.00 px)" in text
+    assert "64 px 78.1 cm, 128 px 39.1 cm" in text
+    assert "at 1 m 2.0 cm, at 5 m 50.0 cm" in text
+    assert "farthest depth, at a disparity of 1 px: 50.00 m" in text
+    raw = raw_calib().describe()
+    assert "raw rig, rectified with alpha 0" in raw and "baseline 12.0 cm" in raw

@@ -185,3 +185,11 @@ def test_eval_metric_scene_reports_validated_matches(
     # Members' median 1.37 %, SGBM's 2.18 %; the refined dense map's is as low (1.35 %).
     assert members["median_rel"] < sgbm["median_rel"]
     assert row["depth"]["median_rel"] < sgbm["median_rel"]
+
+
+def test_info_describes_the_rig(data_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["info", str(data_dir / "eth3d" / "terrace" / "calib.txt")]) == 0
+    out = capsys.readouterr().out
+    assert "baseline 6.0 cm (59.9432 mm), focal length 711.5 px" in out
+    assert "farthest depth, at a disparity of 1 px: 42.65 m" in out
+    assert main(["info", str(data_dir / "nowhere.txt")]) == 2

@@ -1347,6 +1347,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     )
     cal.save(out)
     print(rep.summary())
+    print(cal.describe())
     print(f"calibration written to {out}")
     if ros_dir is not None:
         try:

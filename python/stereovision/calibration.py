@@ -486,6 +486,70 @@ class Calibration:
         cal: Calibration = self._cache[key]
         return cal
 
+    def depth_step(self, depth_m: npt.ArrayLike, disparity_step: float = 1.0) -> F64:
+        """Depth change (metres) that a disparity change of ``disparity_step`` px makes at
+        ``depth_m``: ``Z^2 dd / (f B)``, the rig's depth resolution.
+
+        Parameters
+        ----------
+        depth_m : array_like
+            Depths in metres.
+        disparity_step : float
+            Disparity change in pixels (1 for a whole pixel; a matcher's sub-pixel error).
+
+        Returns
+        -------
+        numpy.ndarray
+            float64, the shape of ``depth_m``.
+        """
+        z = np.asarray(depth_m, dtype=np.float64)
+        fb = self.focal_px * self.baseline_m
+        out: F64 = z * z * float(disparity_step) / fb
+        return out
+
+    def describe(self, depths: tuple[float, ...] = (1.0, 2.0, 5.0, 10.0)) -> str:
+        """What the rig can measure, in a few lines: baseline, focal length, field of view,
+        nearest depth per disparity range, depth step per pixel, farthest depth.
+
+        Parameters
+        ----------
+        depths : tuple of float
+            Depths (metres) at which to give the depth step.
+
+        Returns
+        -------
+        str
+            Lines for a terminal or a log.
+        """
+        rc = self if self.rectified else self.rectified_calibration()
+        w, h = self.image_size
+        f, fy = float(rc.K1[0, 0]), float(rc.K1[1, 1])
+        b = self.baseline_m
+        doffs = rc.doffs_px
+        hfov = math.degrees(2 * math.atan(w / (2 * f)))
+        vfov = math.degrees(2 * math.atan(h / (2 * fy)))
+
+        def length(m: float) -> str:
+            return f"{100 * m:.1f} cm" if m < 1 else f"{m:.2f} m"
+
+        near = ", ".join(
+            f"{d} px {length(f * b / (d + doffs))}" for d in (64, 128, 256) if d + doffs > 0
+        )
+        steps = ", ".join(f"at {z:g} m {length(float(self.depth_step(z)))}" for z in depths)
+        far = f * b / (1 + doffs) if 1 + doffs > 0 else math.inf
+        kind = "rectified pair" if self.rectified else "raw rig, rectified with alpha 0"
+        return "\n".join(
+            [
+                f"{w}x{h} px, {kind}: baseline {length(b)} ({self.baseline:g} {self.unit}), "
+                f"focal length {f:.1f} px, doffs {doffs:.2f} px",
+                f"field of view {hfov:.1f} x {vfov:.1f} degrees",
+                f"depth Z = {f * b:.3f} m px / (d + {doffs:.2f} px)",
+                f"nearest depth a disparity range reaches: {near}",
+                f"depth step per pixel of disparity: {steps} (a 0.1 px error: a tenth of it)",
+                f"farthest depth, at a disparity of 1 px: {length(far)}",
+            ]
+        )
+
     def scaled_to(self, image_size: tuple[int, int]) -> Calibration:
         """The calibration of the same rig for its images resized (not cropped) to ``image_size``.
 

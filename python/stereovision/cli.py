@@ -1,4 +1,4 @@
-"""Command line: ``stereovision COMMAND`` (demo, depth, check, eval, capture, stream, batch, ...).
+"""Command line: ``stereovision COMMAND`` (demo, depth, check, info, eval, capture, stream, ...).
 
 Errors print one line on stderr and exit with status 2 (never a traceback); every output file is
 written atomically after all computation succeeded, so an error never destroys earlier outputs.
@@ -231,6 +231,12 @@ def cmd_check(args: argparse.Namespace) -> int:
         _atomic_write_bytes(Path(args.plot), _png_bytes(draw_rectification_check(left, right, res)))
     print(json.dumps(res.as_dict()) if args.json else res.summary())
     return 0 if res.ok else 1
+
+
+def cmd_info(args: argparse.Namespace) -> int:
+    """``stereovision info CALIB``: what the rig can measure."""
+    print(_load_calibration(args.calib).describe())
+    return 0
 
 
 def _demo_scene_dir() -> Path:
@@ -504,6 +510,13 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--json", action="store_true", help="one JSON object instead of a line")
     d.add_argument("--plot", metavar="PNG", help="draw the rectified pair and its matches")
     d.set_defaults(func=cmd_check)
+
+    d = sub.add_parser(
+        "info",
+        help="what a calibrated rig can measure: field of view, depth range and resolution",
+    )
+    d.add_argument("calib", help="calibration file or ROS camera_info folder")
+    d.set_defaults(func=cmd_info)
 
     d = sub.add_parser("eval", help="evaluate against ground truth, OpenCV beside")
     d.add_argument("scenes", nargs="+", help="scene folders (or folders containing scenes)")
