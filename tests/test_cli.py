@@ -104,6 +104,13 @@ def test_depth_command_on_metric_scene(tmp_path: Path, data_dir: Path) -> None:
     pts, _ = read_ply(tmp_path / "near" / "cloud.ply")
     assert len(pts) == np.isfinite(near).sum() and pts[:, 2].max() <= med + 1e-3
     assert main([*argv, "--max-depth", "0"]) == 2
+    # --voxel: one point per 5 cm cube in cloud.ply, the depth maps whole
+    assert main([*argv, "--voxel", "0.05"]) == 0
+    vox, _ = read_ply(tmp_path / "near" / "cloud.ply")
+    assert 0 < len(vox) < 0.2 * np.isfinite(depth).sum()
+    cells = np.floor(vox / 0.05)
+    assert len(np.unique(cells, axis=0)) == len(vox)
+    np.testing.assert_array_equal(np.load(tmp_path / "near" / "depth.npy"), depth)
     argv = ["depth", str(scene / "left.png"), str(scene / "right.png"), "--max-sigma", "0.1"]
     assert main([*argv, "-o", str(tmp_path / "x")]) == 2
     assert not (tmp_path / "x").exists()

@@ -216,3 +216,41 @@ def test_disparity_png_kitti_format(data_dir, result, tmp_path):
         export.read_disparity_png(tmp_path / "rgb.png")
     with pytest.raises(FileNotFoundError):
         export.read_depth_png(tmp_path / "none.png")
+
+
+def _voxel_reference(points, colors, voxel):
+    """Plain Python: group by cube, mean per cube, sorted by (z, y, x) cube index."""
+    groups: dict[tuple[int, int, int], list[int]] = {}
+    for i, p in enumerate(points):
+        if np.isfinite(p).all():
+            groups.setdefault(tuple(int(v) for v in np.floor(p / voxel))[::-1], []).append(i)
+    keys = sorted(groups)
+    pts = np.array([points[groups[k]].mean(axis=0) for k in keys])
+    cols = np.array([np.rint(colors[groups[k]].astype(float).mean(axis=0)) for k in keys])
+    return pts, cols
+
+
+def test_voxel_downsample_against_a_plain_reference(result):
+    rng = np.random.default_rng(3)
+    pts = result.points[rng.choice(len(result.points), 3000, replace=False)].astype(np.float64)
+    pts[5] = np.nan
+    cols = rng.integers(0, 256, size=pts.shape).astype(np.uint8)
+    for voxel in (0.05, 0.2):
+        down, dc = export.voxel_downsample(pts, cols, voxel=voxel)
+        ref_p, ref_c = _voxel_reference(pts, cols, voxel)
+        assert len(down) == len(ref_p) < len(pts)
+        np.testing.assert_allclose(down, ref_p, rtol=1e-6, atol=1e-6)
+        np.testing.assert_array_equal(dc, ref_c)
+    # coordinates whose cube indices do not fit one int64 key take the row-wise path
+    far = pts[:50].copy()
+    far[::2, 0] += 1e12
+    down, _ = export.voxel_downsample(far, cols[:50], voxel=1e-4)
+    ref_p, _ = _voxel_reference(far, cols[:50], 1e-4)
+    np.testing.assert_allclose(down, ref_p, rtol=1e-6)
+    assert export.voxel_downsample(np.zeros((0, 3)))[0].shape == (0, 3)
+    with pytest.raises(ValueError, match="voxel"):
+        export.voxel_downsample(pts, voxel=0)
+    with pytest.raises(ValueError, match="colors"):
+        export.voxel_downsample(pts, cols[:10])
+    with pytest.raises(ValueError, match="points"):
+        export.voxel_downsample(pts[:, :2])

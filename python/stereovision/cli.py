@@ -90,9 +90,9 @@ def _npy_bytes(arr: np.ndarray) -> bytes:
     return bio.getvalue()
 
 
-def write_depth_outputs(result: Any, out_dir: Path) -> dict[str, Path]:
+def write_depth_outputs(result: Any, out_dir: Path, voxel: float | None = None) -> dict[str, Path]:
     """Write disparity.png, disparity.pfm, depth.png, depth.npy, depth_mm.png (16-bit,
-    millimetres) and cloud.ply into ``out_dir``.
+    millimetres) and cloud.ply (one point per ``voxel`` cube when given) into ``out_dir``.
 
     Everything is encoded in memory first, then each file is replaced atomically.
     """
@@ -112,7 +112,12 @@ def write_depth_outputs(result: Any, out_dir: Path) -> dict[str, Path]:
         written[name] = out_dir / name
     written["disparity.pfm"] = Path(write_pfm(out_dir / "disparity.pfm", result.disparity))
     if result.depth is not None:
-        written["cloud.ply"] = Path(write_ply(out_dir / "cloud.ply", result.points, result.colors))
+        points, colors = result.points, result.colors
+        if voxel is not None:
+            from stereovision.export import voxel_downsample
+
+            points, colors = voxel_downsample(points, colors, voxel)
+        written["cloud.ply"] = Path(write_ply(out_dir / "cloud.ply", points, colors))
     return written
 
 
@@ -139,6 +144,7 @@ def depth_outputs(
     refine: bool | None = None,
     max_depth: float | None = None,
     max_sigma: float | None = None,
+    voxel: float | None = None,
 ) -> tuple[Any, dict[str, Path]]:
     """What ``stereovision depth`` computes and writes for one pair (``batch`` writes the same).
 
@@ -161,6 +167,9 @@ def depth_outputs(
     max_depth, max_sigma : float, optional
         Keep only depths up to ``max_depth`` metres with a one-sigma uncertainty up to
         ``max_sigma`` metres in the depth outputs and the cloud (:meth:`DepthResult.filtered`).
+    voxel : float, optional
+        Write the cloud with one point per cube of this side in metres
+        (:func:`stereovision.export.voxel_downsample`).
 
     Returns
     -------
@@ -174,14 +183,14 @@ def depth_outputs(
         raise CliError("--max-depth and --max-sigma need --calib (no depth without one)")
     from stereovision._validate import positive_finite
 
-    for value, flag in ((max_depth, "--max-depth"), (max_sigma, "--max-sigma")):
+    for value, flag in ((max_depth, "--max-depth"), (max_sigma, "--max-sigma"), (voxel, "--voxel")):
         if value is not None:
             positive_finite(value, flag)
     kw: dict[str, Any] = {} if method is None else {"method": method}
     res = depth_map(left, right, calib, max_disparity=max_disparity, fill=fill, refine=refine, **kw)
     if max_depth is not None or max_sigma is not None:
         res = res.filtered(max_depth=max_depth, max_sigma=max_sigma)
-    written = write_depth_outputs(res, out_dir)
+    written = write_depth_outputs(res, out_dir, voxel)
     written.update(render_outputs(res, out_dir))
     return res, written
 
@@ -204,6 +213,7 @@ def cmd_depth(args: argparse.Namespace) -> int:
         refine=args.refine,
         max_depth=args.max_depth,
         max_sigma=args.max_sigma,
+        voxel=args.voxel,
     )
     print(
         f"{args.method}: max_disparity {res.max_disparity} px, density {100 * res.density:.1f} %,"
@@ -491,6 +501,9 @@ def build_parser() -> argparse.ArgumentParser:
         type=float,
         metavar="M",
         help="keep depths whose one-sigma uncertainty is at most M metres",
+    )
+    d.add_argument(
+        "--voxel", type=float, metavar="M", help="cloud.ply with one point per M-metre cube"
     )
     d.add_argument("-o", "--output", required=True, help="output folder")
     d.set_defaults(func=cmd_depth)

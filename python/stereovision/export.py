@@ -47,6 +47,7 @@ __all__ = [
     "read_disparity_png",
     "read_npz",
     "read_pcd",
+    "voxel_downsample",
     "write_cloud_ply",
     "write_depth_png",
     "write_disparity_png",
@@ -473,6 +474,78 @@ def load_cloud(
         raise ValueError(f"empty point cloud: {p} has no finite 3-D point")
     cols = None if cols is None else cols.reshape(-1, 3)[keep]
     return np.ascontiguousarray(pts[keep]), cols
+
+
+# --------------------------------------------------------------------------- voxel grid
+
+
+def voxel_downsample(
+    points: npt.ArrayLike, colors: npt.ArrayLike | None = None, voxel: float = 0.05
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]:
+    """One point per occupied cube of side ``voxel``: the mean of its points (and colours).
+
+    The usual first step before a robot's planner or ICP: a 900x750 depth map gives 600 k
+    points, mostly redundant near the camera. Cubes are aligned to the origin (the camera),
+    and the output is ordered by cube (z, then y, then x), so the same cloud always gives the
+    same result.
+
+    Parameters
+    ----------
+    points : array_like
+        ``(N, 3)`` points (metres); non-finite rows are dropped.
+    colors : array_like, optional
+        ``(N, 3)`` uint8 colours of the points.
+    voxel : float
+        Cube side, in the points' unit.
+
+    Returns
+    -------
+    tuple
+        ``(points float32 (M, 3), colors uint8 (M, 3) or None)``.
+
+    Raises
+    ------
+    ValueError
+        If ``points`` is not ``(N, 3)``, ``colors`` does not match it, or ``voxel`` is not a
+        positive number.
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 3:
+        raise ValueError(f"points: expected shape (N, 3), got {pts.shape}")
+    if isinstance(voxel, bool) or not (np.isfinite(voxel) and voxel > 0):
+        raise ValueError(f"voxel: expected a positive cube side, got {voxel!r}")
+    cols = None
+    if colors is not None:
+        cols = np.asarray(colors)
+        if cols.shape != pts.shape:
+            raise ValueError(f"colors: expected shape {pts.shape}, got {cols.shape}")
+    keep = np.isfinite(pts).all(axis=1)
+    pts = pts[keep]
+    if cols is not None:
+        cols = cols[keep]
+    if len(pts) == 0:
+        empty_c = None if cols is None else np.zeros((0, 3), np.uint8)
+        return np.zeros((0, 3), np.float32), empty_c
+    cells = np.floor(pts / voxel).astype(np.int64)
+    cells -= cells.min(axis=0)
+    ext = cells.max(axis=0) + 1
+    if float(ext[0]) * float(ext[1]) * float(ext[2]) < 2.0**62:
+        # one int64 key per cube (x fastest): a 1-D unique is ~10x faster than rows
+        key = (cells[:, 2] * ext[1] + cells[:, 1]) * ext[0] + cells[:, 0]
+        _, inverse, counts = np.unique(key, return_inverse=True, return_counts=True)
+    else:  # a cloud spanning more cubes than an int64 counts
+        _, inverse, counts = np.unique(
+            cells[:, ::-1], axis=0, return_inverse=True, return_counts=True
+        )
+    inverse = inverse.reshape(-1)
+
+    def mean(values: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        sums = [np.bincount(inverse, weights=values[:, k], minlength=len(counts)) for k in range(3)]
+        out: npt.NDArray[np.float64] = np.column_stack(sums) / counts[:, None]
+        return out
+
+    out_c = None if cols is None else np.rint(mean(cols.astype(np.float64))).astype(np.uint8)
+    return mean(pts).astype(np.float32), out_c
 
 
 # ------------------------------------------------------------------------- 16-bit PNG
