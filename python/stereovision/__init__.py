@@ -16,7 +16,7 @@ from stereovision.calibration import Calibration
 from stereovision.depth import DepthResult, depth_map, estimate_max_disparity
 from stereovision.match import match
 from stereovision.matches import Matches
-from stereovision.rectification_check import check_rectification
+from stereovision.rectification_check import check_rectification, refine_rectification
 from stereovision.triangulation import depth_from_disparity, triangulate
 
 __all__ = [
@@ -31,6 +31,7 @@ __all__ = [
     "evaluate",
     "io",
     "match",
+    "refine_rectification",
     "release_memory",
     "triangulate",
 ]

@@ -225,13 +225,23 @@ def cmd_depth(args: argparse.Namespace) -> int:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    """``stereovision check LEFT RIGHT [--calib F]``: is the pair (still) rectified?"""
+    """``stereovision check LEFT RIGHT [--calib F] [--fix OUT]``: is the pair (still)
+    rectified? With ``--fix``, the rig's rotation corrected from the pair is written to OUT."""
     from stereovision.io import imread
     from stereovision.rectification_check import check_rectification
 
     left = imread(args.left)
     right = imread(args.right)
     calib = _load_calibration(args.calib)
+    fix = Path(args.fix) if args.fix else None
+    if fix is not None:
+        if calib is None:
+            raise CliError("--fix needs --calib: the calibration to correct")
+        if fix.suffix.lower() not in (".yaml", ".yml", ".xml", ".json"):
+            raise CliError(f"--fix {args.fix}: use a .yaml, .yml, .xml or .json file name")
+        if str(fix.parent) and not fix.parent.is_dir():
+            raise FileNotFoundError(f"--fix {args.fix}: directory {fix.parent} does not exist")
+    raw_left, raw_right = left, right
     if calib is not None:
         left, right = calib.rectify(left, right)
     res = check_rectification(left, right, tolerance=args.tolerance)
@@ -240,7 +250,23 @@ def cmd_check(args: argparse.Namespace) -> int:
 
         _atomic_write_bytes(Path(args.plot), _png_bytes(draw_rectification_check(left, right, res)))
     print(json.dumps(res.as_dict()) if args.json else res.summary())
-    return 0 if res.ok else 1
+    if fix is None:
+        return 0 if res.ok else 1
+    from stereovision.rectification_check import refine_rectification
+
+    fixed, after = refine_rectification(raw_left, raw_right, calib, tolerance=args.tolerance)
+    turn = float(np.degrees(np.linalg.norm(cv2.Rodrigues(fixed.R @ calib.R.T)[0])))
+    if args.json:
+        print(json.dumps({"fixed": after.as_dict(), "turn_deg": turn}))
+    else:
+        print(f"corrected (the right camera turned {turn:.3f} degrees): {after.summary()}")
+    if not after.ok:
+        print("stereovision: the corrected calibration still fails: not written", file=sys.stderr)
+        return 1
+    fixed.save(fix)
+    if not args.json:
+        print(f"corrected calibration written to {fix}")
+    return 0
 
 
 def cmd_info(args: argparse.Namespace) -> int:
@@ -522,6 +548,11 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--tolerance", type=float, default=0.5, help="median |dy| in px (default 0.5)")
     d.add_argument("--json", action="store_true", help="one JSON object instead of a line")
     d.add_argument("--plot", metavar="PNG", help="draw the rectified pair and its matches")
+    d.add_argument(
+        "--fix",
+        metavar="OUT",
+        help="correct the rig's pitch and roll from this pair and write the calibration to OUT",
+    )
     d.set_defaults(func=cmd_check)
 
     d = sub.add_parser(

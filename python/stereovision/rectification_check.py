@@ -20,7 +20,12 @@ import numpy.typing as npt
 
 from stereovision._validate import as_gray_uint8
 
-__all__ = ["RectificationCheck", "check_rectification", "draw_rectification_check"]
+__all__ = [
+    "RectificationCheck",
+    "check_rectification",
+    "draw_rectification_check",
+    "refine_rectification",
+]
 
 #: Median row error (px) of the matched features up to which a pair counts as rectified.
 DEFAULT_TOLERANCE_PX = 0.5
@@ -321,3 +326,109 @@ def draw_rectification_check(
         cv2.putText(band, line, (8, 20 + 20 * i), font, scale, (0, 0, 0), 1, cv2.LINE_AA)
     canvas = np.concatenate([band, canvas], axis=0)
     return canvas
+
+
+#: Largest turn (degrees) :func:`refine_rectification` makes: more is not a drift.
+MAX_CORRECTION_DEG = 3.0
+
+
+def _turn_rows(
+    q: npt.NDArray[np.float64], w: npt.NDArray[np.float64], fy: float, cy: float
+) -> npt.NDArray[np.float64]:
+    """Rows of the rays ``q`` (3, N) after turning them by ``Rodrigues(w)``."""
+    r = cv2.Rodrigues(w.reshape(3, 1))[0]
+    p = r @ q
+    out: npt.NDArray[np.float64] = fy * p[1] / p[2] + cy
+    return out
+
+
+def refine_rectification(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    calib: Any,
+    *,
+    tolerance: float = DEFAULT_TOLERANCE_PX,
+    alpha: float = 0.0,
+) -> tuple[Any, RectificationCheck]:
+    """Correct a rig's rotation from one textured pair, so that its rows line up again.
+
+    A bump or heat turns a camera by a fraction of a degree: its pitch and roll relative to the
+    other camera put features off each other's rows (:func:`check_rectification`). This fits
+    the small turn ``dR`` (about the rectified x axis, pitch, and the optical axis, roll) of
+    the right camera that brings the matched features of the rectified pair onto their rows
+    (Gauss-Newton on the rows of the turned rays, twice, the second time without the matches
+    off by more than 1 px), then updates the rig: with the rectifying rotation ``R2`` of the
+    old calibration, ``R' = R2^T dR^T R2 R`` and ``T' = R2^T dR^T R2 T`` (the baseline keeps
+    its length). A turn about the vertical axis (yaw) changes disparities, not rows, so one
+    pair cannot tell it: it is left as it was, and with it the depth scale.
+
+    Parameters
+    ----------
+    left, right : array_like
+        A raw pair of the rig (for a ``rectified`` calibration: the rectified pair).
+    calib : Calibration
+        The calibration to correct.
+    tolerance : float
+        As in :func:`check_rectification`, for the check after the correction.
+    alpha : float
+        Rectification scaling, as in :meth:`Calibration.rectify`.
+
+    Returns
+    -------
+    tuple
+        ``(corrected Calibration, RectificationCheck after the correction)``. The corrected
+        calibration is not ``rectified`` (its ``R`` is no longer the identity).
+
+    Raises
+    ------
+    ValueError
+        Too little texture, a pair that looks swapped or fits no row model, or a correction of
+        more than :data:`MAX_CORRECTION_DEG` degrees (not a drift: calibrate again).
+    """
+    from dataclasses import replace
+
+    before = check_rectification(left, right, calib, tolerance=tolerance, alpha=alpha)
+    if before.ok is None:
+        raise ValueError(f"cannot refine: {before.summary()}")
+    if before.swapped or not np.isfinite(before.offset):
+        raise ValueError(f"cannot refine: {before.summary()}")
+    rc = calib.rectified_calibration(alpha) if not calib.rectified else calib
+    k2 = rc.K2
+    xl, yl, xr, yr = before.points.astype(np.float64).T
+    q = np.linalg.solve(k2, np.vstack([xr, yr, np.ones_like(xr)]))
+    fy, cy = float(k2[1, 1]), float(k2[1, 2])
+    keep = np.ones(len(xl), dtype=bool)
+    w = np.zeros(3)
+    for _ in range(2):
+        for _ in range(10):
+            base = _turn_rows(q[:, keep], w, fy, cy) - yl[keep]
+            jac = np.empty((int(keep.sum()), 2))
+            for j, axis in enumerate((0, 2)):
+                step = np.zeros(3)
+                step[axis] = 1e-7
+                jac[:, j] = (_turn_rows(q[:, keep], w + step, fy, cy) - yl[keep] - base) / 1e-7
+            delta = np.linalg.lstsq(jac, -base, rcond=None)[0]
+            w[[0, 2]] += delta
+            if np.abs(delta).max() < 1e-10:
+                break
+        keep = np.abs(_turn_rows(q, w, fy, cy) - yl) <= 1.0
+        if keep.sum() < MIN_MATCHES:
+            raise ValueError(f"cannot refine: {int(keep.sum())} matches fit a turn within 1 px")
+    turn = float(np.degrees(np.linalg.norm(w)))
+    if turn > MAX_CORRECTION_DEG:
+        raise ValueError(
+            f"the rows need the right camera turned by {turn:.1f} degrees, more than a drift "
+            f"(at most {MAX_CORRECTION_DEG:g}): calibrate the rig again"
+        )
+    d_r = cv2.Rodrigues(w.reshape(3, 1))[0]
+    r2 = np.eye(3) if calib.rectified else calib._stereo_rectify(alpha)[1]
+    turn_rig = r2.T @ d_r.T @ r2
+    fixed = replace(
+        calib,
+        R=turn_rig @ calib.R,
+        T=turn_rig @ calib.T,
+        rectified=False,
+        doffs=None,
+    )
+    after = check_rectification(left, right, fixed, tolerance=tolerance, alpha=alpha)
+    return fixed, after
