@@ -183,7 +183,7 @@ def _deg(rot: np.ndarray) -> float:
 def test_refine_turns_the_rig_back(data_dir: Path, scene: str, turn: tuple) -> None:
     """A rectified scene seen through a calibration that says the right camera is pitched or
     rolled by 0.3 degrees: rows 0.49-3.9 px apart; refined, within 0.15 px, and the rig's
-    rotation is back to the identity within 0.03 degrees (measured 0.001-0.019)."""
+    rotation is back to the identity within 0.03 degrees (benches/bench_rectification.py)."""
     left, right = _pair(data_dir, scene)
     h, w = left.shape[:2]
     bumped = _rig(w, h, turn)
