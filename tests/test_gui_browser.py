@@ -250,6 +250,14 @@ def test_app_controllers_report_errors_and_compute(tmp_path, monkeypatch):
     asyncio.run(run())
     assert app.state.error == ""
     assert app.state.computations == 1
+    asyncio.run(app.check_rows())
+    assert app.state.rows_label.startswith("rectification ok: median |dy| 0.0")
+
+    async def reload() -> None:
+        app.load_files()  # a new pair: the old verdict goes
+
+    asyncio.run(reload())
+    assert app.state.rows_label == ""
     assert app.state.stats.startswith("opencv-bm · 450×375")
     assert "No calibration" in app.state.message_3d
 
@@ -425,6 +433,18 @@ def test_method_switch_updates_disparity(page):
     page.click(f"#method-{METHODS[0]}")  # and back
     _wait_computations(page, n + 2)
     assert page.inner_text("#stats").startswith(METHODS[0])
+
+
+def test_check_rows_button(page):
+    """The acquisition panel's "Check rows" runs the rectification check on the current pair
+    (the cones videos, rectified): its summary appears beside the button."""
+    _wait_computations(page, 1)
+    page.click("#check-rows-btn")
+    page.wait_for_function(
+        "document.querySelector('#rows-label')?.textContent.includes('rectification ok')"
+    )
+    text = page.inner_text("#rows-label")
+    assert "median |dy| 0." in text and "matches" in text
 
 
 def test_resolution_control_rescales(page):

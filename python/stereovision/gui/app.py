@@ -381,6 +381,7 @@ class StereoApp:
         st.stats = ""
         st.message_3d = ""
         st.source_label = ""
+        st.rows_label = ""
         st.cam_left, st.cam_right = source_names
         st.live = source is not None
         st.scene = ""
@@ -436,6 +437,7 @@ class StereoApp:
         self.calib = scene.calib
         self.max_disparity = scene.max_disparity
         self.state.source_label = f"scene {self.folders.label(scene_dir)}"
+        self.state.rows_label = ""
 
     def _grab(self) -> None:
         if self.source is None:
@@ -448,6 +450,7 @@ class StereoApp:
         self.max_disparity = None
         names = (Path(str(n)).name or str(n) for n in (self.state.cam_left, self.state.cam_right))
         self.state.source_label = "cameras " + " / ".join(names)
+        self.state.rows_label = ""
 
     def _camera_source(self, text: str) -> int | str:
         src = parse_source(text)
@@ -531,6 +534,7 @@ class StereoApp:
         self.calib = c if fits else None
         self.max_disparity = None
         self.state.source_label = "files"
+        self.state.rows_label = ""
         self._spawn(self.recompute())
 
     def open_cloud(self) -> None:
@@ -600,6 +604,34 @@ class StereoApp:
                 self._fail(exc)
                 return
             self._publish(view)
+
+    def check_rows_clicked(self) -> None:
+        """The page's "Check rows" button."""
+        self._spawn(self.check_rows())
+
+    async def check_rows(self) -> None:
+        """Check that the current pair's features lie on common rows (with its calibration)."""
+        if self.pair is None:
+            return
+        from stereovision.calibration import fit_to_frames
+        from stereovision.rectification_check import check_rectification
+
+        left, right = self.pair
+        calib = self.calib
+
+        def run() -> str:
+            if calib is None:
+                return check_rectification(left, right).summary()
+            fitted, _ = fit_to_frames(calib, (left.shape[1], left.shape[0]))
+            return check_rectification(left, right, fitted).summary()
+
+        try:
+            text = await asyncio.get_running_loop().run_in_executor(self._executor, run)
+        except (ValueError, OSError, RuntimeError) as exc:
+            self._fail(exc)
+            return
+        with self.state:
+            self.state.rows_label = text
 
     def _set_progress(self, pct: int, text: str) -> None:
         with self.state:
@@ -754,6 +786,18 @@ class StereoApp:
             v3.VCardTitle("1 · Acquisition")
             with v3.VCardText():
                 html.Div("{{ source_label }}", id="source-label", classes="text-caption mb-1")
+                with v3.VRow(dense=True, align="center", classes="mb-1"):
+                    with v3.VCol(cols=3):
+                        v3.VBtn(
+                            "Check rows",
+                            id="check-rows-btn",
+                            size="small",
+                            variant="outlined",
+                            block=True,
+                            click=self.check_rows_clicked,
+                        )
+                    with v3.VCol(cols=9):
+                        html.Div("{{ rows_label }}", id="rows-label", classes="text-caption")
                 with v3.VRow(dense=True):
                     with v3.VCol(cols=6):
                         html.Div("left", classes="text-caption")
