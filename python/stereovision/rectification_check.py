@@ -22,6 +22,7 @@ from stereovision._validate import as_gray_uint8
 
 __all__ = [
     "RectificationCheck",
+    "align_rows",
     "check_rectification",
     "draw_rectification_check",
     "refine_rectification",
@@ -432,3 +433,44 @@ def refine_rectification(
     )
     after = check_rectification(left, right, fixed, tolerance=tolerance, alpha=alpha)
     return fixed, after
+
+
+def align_rows(
+    left: npt.ArrayLike, right: npt.ArrayLike, check: RectificationCheck | None = None
+) -> tuple[npt.NDArray[Any], RectificationCheck]:
+    """Resample the right image of a rectified pair so that its rows match the left image's.
+
+    For a pair whose calibration cannot be corrected (a dataset's rectified images, or a
+    camera that rectifies on board): the fitted row offset ``dy = a + b x + c y`` of
+    :func:`check_rectification` is undone by moving the right image's content by ``dy``
+    (bicubic). The left image, and so the disparity map's frame, stay as they are.
+
+    Parameters
+    ----------
+    left, right : array_like
+        The rectified pair.
+    check : RectificationCheck, optional
+        Its check, when already computed; else it is run here.
+
+    Returns
+    -------
+    tuple
+        ``(right_aligned, check)``: the right image (same shape and dtype) and the check it
+        was aligned by. The right image is returned unchanged when the check found no common
+        row model (too little texture, or far from rectified).
+    """
+    ra = np.asarray(right)
+    res = check if check is not None else check_rectification(left, right)
+    if res.ok is None or not np.isfinite(res.offset):
+        return ra, res
+    h, w = ra.shape[:2]
+    xx, yy = np.meshgrid(np.arange(w, dtype=np.float32), np.arange(h, dtype=np.float32))
+    dy = (
+        res.offset
+        + res.slope_x * (xx - (w - 1) / 2) / 1000
+        + res.slope_y * (yy - (h - 1) / 2) / 1000
+    )
+    out = cv2.remap(
+        ra, xx, (yy - dy).astype(np.float32), cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE
+    )
+    return np.asarray(out, dtype=ra.dtype), res
