@@ -553,6 +553,9 @@ def test_fit_to_frames_scales_or_names_a_crop() -> None:
     assert scaled.image_size == (160, 120) and note is not None and "scaled" in note
     with pytest.raises(ValueError, match="another aspect ratio"):
         fit_to_frames(c, (320, 180))
+    for size in ((1,), (0, 0), (2.5, 3)):
+        with pytest.raises(ValueError, match="image_size"):
+            fit_to_frames(c, size)  # type: ignore[arg-type]
 
 
 def test_depth_step_and_describe() -> None:

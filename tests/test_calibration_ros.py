@@ -243,6 +243,9 @@ def test_writing_refuses_what_ros_cannot_hold(tmp_path: Path) -> None:
     assert len(parse_ros_camera_info(text)["D"]) == 8
     with pytest.raises(ValueError, match="alpha"):
         raw_calib().to_ros(alpha=1.5)
+    for names in ("lr", ("left",), ("left", 3)):
+        with pytest.raises(ValueError, match="names"):
+            raw_calib().to_ros(names=names)  # type: ignore[arg-type]
     (tmp_path / "file").write_text("x")
     with pytest.raises(ValueError, match="is a file, not a folder"):
         raw_calib().save_ros(tmp_path / "file")

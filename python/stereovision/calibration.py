@@ -1104,11 +1104,18 @@ class Calibration:
         Raises
         ------
         ValueError
-            If ``alpha`` is outside ``[0, 1]``, or the distortion has 12 or 14 coefficients with
-            the thin-prism or tilt terms in use (ROS has no model for them).
+            If ``alpha`` is outside ``[0, 1]``, ``names`` is not two strings, or the distortion
+            has 12 or 14 coefficients with the thin-prism or tilt terms in use (ROS has no
+            model for them).
         """
         if not 0.0 <= alpha <= 1.0:
             raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
+        if not (
+            isinstance(names, (tuple, list))
+            and len(names) == 2
+            and all(isinstance(n, str) for n in names)
+        ):
+            raise ValueError(f"names: expected two camera names (str), got {names!r}")
         metres = self.to_metres_factor
         if self.rectified:
             r1 = r2 = np.eye(3)
@@ -1194,10 +1201,10 @@ def fit_to_frames(calib: Calibration, size: tuple[int, int]) -> tuple[Calibratio
     Raises
     ------
     ValueError
-        If the aspect ratios differ by more than 1 % (a camera mode that crops: it needs its
-        own calibration).
+        If ``size`` is not two positive integers, or the aspect ratios differ by more than 1 %
+        (a camera mode that crops: it needs its own calibration).
     """
-    (w0, h0), (w, h) = calib.image_size, (int(size[0]), int(size[1]))
+    (w0, h0), (w, h) = calib.image_size, Calibration._check_size(size)
     if (w0, h0) == (w, h):
         return calib, None
     sx, sy = w / w0, h / h0
