@@ -127,3 +127,44 @@ def test_depth_map_keywords_out_of_range(key: str, crop: tuple[np.ndarray, np.nd
             pass
         except Exception as exc:
             pytest.fail(f"depth_map({key}={value!r}) raised {type(exc).__name__}: {exc}")
+
+
+def test_rig_and_export_helpers_refuse_bad_values(crop: tuple[np.ndarray, np.ndarray]) -> None:
+    """The calibration's size and ROS helpers, the depth filters, the voxel grid and the
+    rectification check, given each bad value (and bad sizes and names): ValueError or
+    TypeError only (an IndexError came from a one-element size or a string of names)."""
+    from stereovision import export
+    from stereovision.calibration import fit_to_frames
+    from stereovision.rectification_check import check_rectification
+    from tests.test_calibration import raw_calib
+
+    c = raw_calib()
+    pts = np.random.default_rng(0).normal(size=(50, 3))
+    shapes: list[Any] = [(1,), (0, 0), (1, 1), (-5, 10), (2.5, 3), "lr", ("left", 3)]
+    res = sv.depth_map(
+        crop[0],
+        crop[1],
+        c.rectified_calibration().scaled_to((160, 100)),
+        method="gabor",
+        max_disparity=16,
+    )
+    calls: list[Callable[[Any], object]] = [
+        c.scaled_to,
+        lambda v: fit_to_frames(c, v),
+        lambda v: c.to_ros(alpha=v),
+        lambda v: c.to_ros(names=v),
+        c.to_camera_frame,
+        lambda v: export.voxel_downsample(pts, voxel=v),
+        lambda v: check_rectification(crop[0], crop[1], tolerance=v),
+        lambda v: res.filtered(max_depth=v),
+        lambda v: res.filtered(min_depth=v, max_relative_sigma=v),
+    ]
+    n = 0
+    for call in calls:
+        for v in [*BAD_VALUES, *shapes]:
+            try:
+                call(v)
+            except (ValueError, TypeError):
+                pass
+            n += 1
+    assert n == len(calls) * (len(BAD_VALUES) + len(shapes))
