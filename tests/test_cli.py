@@ -200,3 +200,20 @@ def test_info_describes_the_rig(data_dir: Path, capsys: pytest.CaptureFixture[st
     assert "baseline 6.0 cm (59.9432 mm), focal length 711.5 px" in out
     assert "farthest depth, at a disparity of 1 px: 42.65 m" in out
     assert main(["info", str(data_dir / "nowhere.txt")]) == 2
+
+
+def test_version_and_python_m() -> None:
+    """``stereovision --version`` names the package's version; ``python -m stereovision`` is
+    the same command line."""
+    proc = subprocess.run(
+        [sys.executable, "-m", "stereovision", "--version"], capture_output=True, text=True
+    )
+    from stereovision import __version__
+
+    assert proc.returncode == 0 and proc.stdout.strip() == f"stereovision {__version__}"
+    proc = subprocess.run(
+        [sys.executable, "-m", "stereovision", "info", "nowhere.yaml"],
+        capture_output=True,
+        text=True,
+    )
+    assert proc.returncode == 2 and proc.stderr.count("\n") == 1

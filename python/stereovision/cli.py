@@ -489,6 +489,9 @@ def build_parser() -> argparse.ArgumentParser:
     from stereovision.depth import METHODS
 
     p = argparse.ArgumentParser(prog="stereovision", description=__doc__.splitlines()[0])
+    from stereovision import __version__
+
+    p.add_argument("--version", action="version", version=f"stereovision {__version__}")
     sub = p.add_subparsers(dest="command", required=True)
 
     d = sub.add_parser("demo", help="run the pipeline on the bundled Middlebury scene")
