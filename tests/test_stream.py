@@ -269,3 +269,38 @@ def test_stream_scales_a_calibration_made_at_another_resolution(
     argv[argv.index("320x240")] = "320x180"
     assert main(argv) == 2
     assert "another aspect ratio" in capsys.readouterr().err
+
+
+def test_stream_checks_every_nth_pair_and_warns_once_when_the_rows_drift(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Eight pairs, the right camera 'bumped' 3 px down from pair 4 on; checked every 2nd pair:
+    pairs 0 and 2 pass, 4 and 6 fail, and one warning names pair 4 (pipelined and not)."""
+    scene = data_dir / SCENE
+    paths = {}
+    for side in ("left", "right"):
+        img = cv2.imread(str(scene / f"{side}.png"))
+        path = tmp_path / f"{side}.avi"
+        vw = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), FPS, (640, 480))
+        for i in range(8):
+            vw.write(np.roll(img, 3, axis=0) if side == "right" and i >= 4 else img)
+        vw.release()
+        paths[side] = path
+    argv = ["stream", "--left", str(paths["left"]), "--right", str(paths["right"])]
+    argv += ["--max-disparity", "64", "--no-display", "--json", "--check-every", "2"]
+    for extra in ([], ["--no-pipeline"]):
+        assert main([*argv, *extra]) == 0
+        cap = capsys.readouterr()
+        summary = _json_lines(cap.out)[-1]
+        assert [(c["pair"], c["ok"]) for c in summary["checks"]] == [
+            (0, True),
+            (2, True),
+            (4, False),
+            (6, False),
+        ]
+        assert summary["checks"][2]["offset"] == pytest.approx(-3.0, abs=0.3)
+        assert summary["rectification"] == summary["checks"][0]
+        warned = [ln for ln in cap.err.splitlines() if "NOT rectified" in ln]
+        assert len(warned) == 1 and warned[0].startswith("stereovision: warning: pair 4:")
+    assert main([*argv, "--check-every", "0"]) == 2
+    assert "check_every" in capsys.readouterr().err

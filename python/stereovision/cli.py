@@ -601,8 +601,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the exit status (0 ok, 2 error, 130 interrupted)."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    shown = warnings.showwarning
-    warnings.showwarning = _one_line_warning
+    with warnings.catch_warnings():
+        # Each run shows its warnings afresh (setting a filter resets the registry that would
+        # hide a message already shown by an earlier call in the same process).
+        warnings.simplefilter("default")
+        warnings.showwarning = _one_line_warning
+        return _run(args)
+
+
+def _run(args: argparse.Namespace) -> int:
     try:
         return int(args.func(args))
     except KeyboardInterrupt:
@@ -625,8 +632,6 @@ def main(argv: Sequence[str] | None = None) -> int:
             file=sys.stderr,
         )
         return EXIT_ERROR
-    finally:
-        warnings.showwarning = shown
 
 
 if __name__ == "__main__":

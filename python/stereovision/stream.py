@@ -74,6 +74,7 @@ class _Pair:
     grab_s: float
     rectify_s: float
     skew_ms: float
+    check: dict[str, Any] | None = None  # the rectification check of this pair, if it had one
 
 
 @dataclass
@@ -116,6 +117,9 @@ class StreamReport:
     rectification : dict or None
         :func:`~stereovision.rectification_check.check_rectification` of the first pair, as a
         dict (None when ``check=False`` or no pair came).
+    checks : list of dict
+        Every check made (the first pair's and, with ``check_every``, the later ones), each
+        with the index of its ``pair``.
     """
 
     frames: int
@@ -131,6 +135,7 @@ class StreamReport:
     density: float = math.nan
     reports: list[dict[str, Any]] = field(default_factory=list, repr=False)
     rectification: dict[str, Any] | None = None
+    checks: list[dict[str, Any]] = field(default_factory=list, repr=False)
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON summary object (``"summary": true``)."""
@@ -148,6 +153,7 @@ class StreamReport:
             "pipelined": self.pipelined,
             "ended": self.ended,
             "rectification": self.rectification,
+            "checks": self.checks,
         }
 
 
@@ -310,8 +316,16 @@ class FrameServer:
 # ----------------------------------------------------------------------------------- pipeline
 
 
-def _pairs(camera: StereoCamera, calib: Calibration | None, frames: int | None) -> Iterator[_Pair]:
-    """Grab (and rectify, for a raw rig calibration) pairs until the end or ``frames`` pairs."""
+def _pairs(
+    camera: StereoCamera,
+    calib: Calibration | None,
+    frames: int | None,
+    check_every: int | None = None,
+) -> Iterator[_Pair]:
+    """Grab (and rectify, for a raw rig calibration) pairs until the end or ``frames`` pairs;
+    check the rows of pair 0 and, when positive, every ``check_every``-th pair (None: none)."""
+    from stereovision.rectification_check import check_rectification
+
     n = 0
     while frames is None or n < frames:
         t0 = time.perf_counter()
@@ -326,7 +340,11 @@ def _pairs(camera: StereoCamera, calib: Calibration | None, frames: int | None) 
         if calib is not None and not calib.rectified:
             left, right = calib.rectify(left, right)
         t2 = time.perf_counter()
-        yield _Pair(left, right, fr.index, t0, t1 - t0, t2 - t1, fr.skew_ms)
+        checked = None
+        # In the producer thread when pipelined: the matcher keeps working meanwhile.
+        if check_every is not None and (n == 0 or (check_every > 0 and n % check_every == 0)):
+            checked = {"pair": n, **check_rectification(left, right).as_dict()}
+        yield _Pair(left, right, fr.index, t0, t1 - t0, t2 - t1, fr.skew_ms, checked)
         n += 1
 
 
@@ -403,6 +421,7 @@ def run_stream(
     on_result: Callable[[np.ndarray, Any], None] | None = None,
     report_period: float = REPORT_PERIOD,
     check: bool = True,
+    check_every: int | None = None,
 ) -> StreamReport:
     """Depth maps from a stereo camera until it ends, ``frames`` pairs, or Ctrl-C.
 
@@ -441,8 +460,11 @@ def run_stream(
         Seconds between reports.
     check : bool
         Check that the first (rectified) pair's features lie on common rows
-        (:func:`~stereovision.rectification_check.check_rectification`, 35-480 ms once) and
-        warn when they do not: a spoiled calibration, or raw cameras without one.
+        (:func:`~stereovision.rectification_check.check_rectification`, 35-480 ms) and warn
+        when they do not: a spoiled calibration, or raw cameras without one.
+    check_every : int, optional
+        Also check every ``check_every``-th pair (in the grab thread when pipelined), and warn
+        when the rows stop agreeing: a rig bumped while running. None: the first pair only.
 
     Returns
     -------
@@ -470,7 +492,9 @@ def run_stream(
     if calib is not None:
         rect_calib = calib if calib.rectified else calib.rectified_calibration()
     kw: dict[str, Any] = {"refine": refine, "method": method, "fill": fill}
-    source = _pairs(camera, calib, frames)
+    if check_every is not None and (isinstance(check_every, bool) or check_every <= 0):
+        raise ValueError(f"check_every: expected a positive number of pairs, got {check_every}")
+    source = _pairs(camera, calib, frames, (check_every or 0) if check else None)
     producer: _Producer | None = None
     q: queue.Queue[Any] = queue.Queue()
     if pipelined:
@@ -489,7 +513,7 @@ def run_stream(
         return item  # type: ignore[no-any-return]
 
     all_done: list[_Done] = []
-    rectification: dict[str, Any] | None = None
+    checks: list[dict[str, Any]] = []
     window: list[_Done] = []
     reports: list[dict[str, Any]] = []
     md = max_disparity
@@ -504,8 +528,8 @@ def run_stream(
             if pair is None:
                 break
             t_got = time.perf_counter()
-            if check and not all_done:
-                rectification = _check_first_pair(pair.left, pair.right)
+            if pair.check is not None:
+                _note_check(pair.check, checks)
             if md is None:
                 md = estimate_max_disparity(pair.left, pair.right)
             # No point cloud per frame: the live view shows disparity and depth.
@@ -575,17 +599,24 @@ def run_stream(
         ended=ended,
         density=_mean([d.density for d in all_done]),
         reports=reports,
-        rectification=rectification,
+        rectification=checks[0] if checks else None,
+        checks=checks,
     )
 
 
-def _check_first_pair(left: np.ndarray, right: np.ndarray) -> dict[str, Any]:
-    from stereovision.rectification_check import check_rectification
+def _note_check(result: dict[str, Any], checks: list[dict[str, Any]]) -> None:
+    """Record a pair's check; warn when the rows stop agreeing (once per change)."""
+    from stereovision.rectification_check import RectificationCheck
 
-    res = check_rectification(left, right)
-    if res.ok is False:
-        warnings.warn(f"first pair: {res.summary()}", stacklevel=3)
-    return res.as_dict()
+    was_ok = checks[-1]["ok"] if checks else True
+    checks.append(result)
+    if result["ok"] is False and was_ok is not False:
+        fields: dict[str, Any] = {
+            k: (np.nan if v is None else v) for k, v in result.items() if k != "pair"
+        }
+        text = RectificationCheck(**fields).summary()
+        where = "first pair" if result["pair"] == 0 else f"pair {result['pair']}"
+        warnings.warn(f"{where}: {text}", stacklevel=3)
 
 
 # ---------------------------------------------------------------------------------------- CLI
@@ -637,6 +668,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             on_report=on_report,
             on_result=on_result,
             check=not args.no_check,
+            check_every=args.check_every,
         )
     finally:
         cam.close()
@@ -697,6 +729,12 @@ def add_cli(subparsers: Any) -> None:
         "--no-check",
         action="store_true",
         help="skip the rectification check of the first pair (a warning when rows disagree)",
+    )
+    p.add_argument(
+        "--check-every",
+        type=int,
+        metavar="N",
+        help="also check the rows of every N-th pair (a rig bumped while running)",
     )
     p.add_argument(
         "--no-pipeline", action="store_true", help="grab, rectify and match in one thread"
