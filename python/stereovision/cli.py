@@ -291,6 +291,9 @@ def cmd_demo(args: argparse.Namespace) -> int:
         raise CliError(f"the bundled demo scene in {scene_dir} lacks its ground truth")
     print(f"demo scene: Middlebury 2003 'Cones' ({scene_dir})")
     print("  (c) Scharstein & Szeliski, CVPR 2003; calibration nominal, see its README.md")
+    from stereovision.rectification_check import check_rectification
+
+    print(f"  {check_rectification(scene.left, scene.right, scene.calib).summary()}")
     res = depth_map(
         scene.left, scene.right, scene.calib, method=args.method, max_disparity=scene.max_disparity
     )
