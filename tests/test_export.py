@@ -250,6 +250,8 @@ def test_voxel_downsample_against_a_plain_reference(result):
     assert export.voxel_downsample(np.zeros((0, 3)))[0].shape == (0, 3)
     with pytest.raises(ValueError, match="voxel"):
         export.voxel_downsample(pts, voxel=0)
+    with pytest.raises(ValueError, match="too small"):
+        export.voxel_downsample(pts, voxel=1e-300)
     with pytest.raises(ValueError, match="colors"):
         export.voxel_downsample(pts, cols[:10])
     with pytest.raises(ValueError, match="points"):

@@ -611,8 +611,12 @@ def _note_check(result: dict[str, Any], checks: list[dict[str, Any]]) -> None:
     was_ok = checks[-1]["ok"] if checks else True
     checks.append(result)
     if result["ok"] is False and was_ok is not False:
+        # as_dict wrote NaN figures as None (JSON); ok stays as it is
+        figures = ("median_dy", "p95_dy", "offset", "slope_x", "slope_y")
         fields: dict[str, Any] = {
-            k: (np.nan if v is None else v) for k, v in result.items() if k != "pair"
+            k: (np.nan if v is None and k in figures else v)
+            for k, v in result.items()
+            if k != "pair"
         }
         text = RectificationCheck(**fields).summary()
         where = "first pair" if result["pair"] == 0 else f"pair {result['pair']}"
