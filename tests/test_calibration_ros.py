@@ -287,3 +287,97 @@ def test_cli_calibrate_writes_ros_and_depth_reads_it(data_dir: Path, tmp_path: P
     run = subprocess.run(cmd + args[:-1] + [str(out)], capture_output=True, text=True, timeout=60)
     assert run.returncode == 2 and run.stderr.count("\n") == 1
     assert "--ros" in run.stderr and "is a file" in run.stderr
+
+
+# ------------------------------------------------------------------------------ Kalibr
+
+
+def _camchain(cams: list[dict]) -> str:
+    """A camchain.yaml as Kalibr writes it (block lists for T_cn_cnm1, flow lists elsewhere)."""
+    out = []
+    for n, cam in enumerate(cams):
+        out.append(f"cam{n}:")
+        if "T" in cam:
+            out.append("  T_cn_cnm1:")
+            out += [f"  - [{', '.join(repr(float(v)) for v in row)}]" for row in cam["T"]]
+        out.append(f"  cam_overlaps: [{1 - n if len(cams) == 2 else 0}]")
+        out.append(f"  camera_model: {cam.get('model', 'pinhole')}")
+        d = ", ".join(repr(float(v)) for v in cam["D"][:4])
+        out.append(f"  distortion_coeffs: [{d}]")
+        out.append(f"  distortion_model: {cam.get('dist', 'radtan')}")
+        k = cam["K"]
+        fu, fv, pu, pv = (float(k[i, j]) for i, j in ((0, 0), (1, 1), (0, 2), (1, 2)))
+        out.append(f"  intrinsics: [{fu!r}, {fv!r}, {pu!r}, {pv!r}]")
+        out.append(f"  resolution: [{cam['size'][0]}, {cam['size'][1]}]")
+        out.append(f"  rostopic: /cam{n}/image_raw")
+    return "\n".join(out) + "\n"
+
+
+def _pose(rot: np.ndarray, t: np.ndarray) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, :3], m[:3, 3] = rot, t
+    return m
+
+
+def test_kalibr_camchain(tmp_path: Path) -> None:
+    """cam1's T_cn_cnm1 (X_cam1 = T X_cam0) is the rig's R, T; radtan is OpenCV's k1 k2 p1 p2;
+    a third camera's pose chains through cam1."""
+    c = raw_calib(D1=np.array([-0.12, 0.05, 0.001, -0.0005, 0.0]))
+    turn = cv2.Rodrigues(np.array([0.0, 0.02, 0.01]))[0]
+    cams = [
+        {"K": c.K1, "D": c.D1, "size": c.image_size},
+        {"K": c.K2, "D": c.D2, "size": c.image_size, "T": _pose(c.R, c.T)},
+        {"K": c.K2, "D": c.D2, "size": c.image_size, "T": _pose(turn, np.array([-0.1, 0, 0]))},
+    ]
+    path = tmp_path / "camchain.yaml"
+    path.write_text(_camchain(cams))
+    rig = Calibration.from_file(path)
+    assert rig.unit == "m" and rig.image_size == c.image_size and not rig.rectified
+    for name in ("K1", "D1", "K2", "D2"):
+        np.testing.assert_array_equal(getattr(rig, name), getattr(c, name))
+    np.testing.assert_allclose(rig.R, c.R, atol=1e-15)
+    np.testing.assert_allclose(rig.T, c.T, atol=1e-15)
+    far = Calibration.from_kalibr(path, cameras=("cam0", "cam2"))
+    np.testing.assert_allclose(far.R, turn @ c.R, atol=1e-12)
+    np.testing.assert_allclose(far.T, turn @ c.T + [-0.1, 0, 0], atol=1e-12)
+    # printed to 6 decimals, as some tools do: snapped to a rotation
+    rounded = tmp_path / "rounded.yaml"
+    rounded.write_text(
+        _camchain(
+            [cams[0], {**cams[1], "T": np.round(_pose(c.R, c.T), 6)}],
+        )
+    )
+    np.testing.assert_allclose(Calibration.from_file(rounded).R, c.R, atol=2e-6)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"dist": "equidistant"}, "fisheye"),
+        ({"model": "omni"}, "only 'pinhole'"),
+        ({"size": (640, 480)}, "a rig needs one size"),
+        ({"T": np.zeros((4, 4))}, "last row"),
+        ({"T": _pose(2 * np.eye(3), np.zeros(3))}, "does not hold a rotation"),
+    ],
+)
+def test_kalibr_errors_name_the_problem(tmp_path: Path, change: dict, message: str) -> None:
+    c = raw_calib()
+    cam1 = {"K": c.K2, "D": c.D2, "size": c.image_size, "T": _pose(c.R, c.T), **change}
+    path = tmp_path / "camchain.yaml"
+    path.write_text(_camchain([{"K": c.K1, "D": c.D1, "size": c.image_size}, cam1]))
+    with pytest.raises(ValueError, match=message):
+        Calibration.from_file(path)
+
+
+def test_kalibr_camera_choice_errors(tmp_path: Path) -> None:
+    c = raw_calib()
+    path = tmp_path / "camchain.yaml"
+    cams = [{"K": c.K1, "D": c.D1, "size": c.image_size}]
+    path.write_text(_camchain([*cams, {**cams[0], "T": _pose(c.R, c.T)}]))
+    with pytest.raises(ValueError, match="no camera 'cam5'"):
+        Calibration.from_kalibr(path, cameras=("cam0", "cam5"))
+    with pytest.raises(ValueError, match="must come after"):
+        Calibration.from_kalibr(path, cameras=("cam1", "cam0"))
+    path.write_text(_camchain([*cams, {**cams[0]}]))  # cam1 without its pose
+    with pytest.raises(ValueError, match="lacks field 'T_cn_cnm1'"):
+        Calibration.from_file(path)

@@ -834,7 +834,8 @@ class Calibration:
         (:meth:`from_kitti`; ``image_size`` is passed on), and ROS ``camera_info``
         (:meth:`from_ros`): a folder holding ``left.yaml`` and ``right.yaml``, ROS
         ``camera_calibration``'s ``calibrationdata.tar.gz``, or one of the two files when the
-        other lies beside it (``left`` and ``right`` swapped in its name).
+        other lies beside it (``left`` and ``right`` swapped in its name), and Kalibr's
+        ``camchain.yaml`` (:meth:`from_kalibr`, ``cam0`` and ``cam1``).
 
         Raises
         ------
@@ -856,6 +857,8 @@ class Calibration:
             ltext, rtext = _read_ros_tar(p)
             return cls._from_ros_texts(ltext, rtext, f"{p}:left.yaml", f"{p}:right.yaml")
         p, text = cls._read_text(path)
+        if re.search(r"^cam\d+\s*:", text, re.MULTILINE) and "intrinsics" in text:
+            return cls.from_kalibr(p)
         if _ROS_HEAD.search(text) and "projection_matrix" in text:
             pair = _ros_sibling(p)
             if pair is None:
@@ -874,7 +877,7 @@ class Calibration:
             return cls.from_kitti(p, image_size=image_size)
         raise ValueError(
             f"unrecognised calibration format in {p}: expected OpenCV YAML/XML, JSON, "
-            "Middlebury calib.txt, KITTI calibration or ROS camera_info"
+            "Middlebury calib.txt, KITTI calibration, ROS camera_info or Kalibr camchain"
         )
 
     # ------------------------------------------------------------------ dataset formats
@@ -1076,6 +1079,85 @@ class Calibration:
             R=R,
             T=T,
             image_size=size,
+            unit="m",
+        )
+
+    @classmethod
+    def from_kalibr(
+        cls, camchain: PathLike, cameras: tuple[str, str] = ("cam0", "cam1")
+    ) -> Calibration:
+        """A rig from Kalibr's ``camchain.yaml`` (or ``camchain-imucam.yaml``), metres.
+
+        Kalibr, the usual calibrator of camera-IMU rigs, gives each camera ``intrinsics``
+        ``[fu, fv, pu, pv]``, ``distortion_coeffs`` (``radtan``: OpenCV's ``k1 k2 p1 p2``),
+        ``resolution`` and, from the second camera on, ``T_cn_cnm1``: the 4x4 transform from the
+        previous camera's frame to its own, ``X_n = T X_{n-1}`` in metres. The rig's ``R``,
+        ``T`` are that transform (chained when the two cameras are not neighbours).
+
+        Parameters
+        ----------
+        camchain : str or os.PathLike
+            The YAML file.
+        cameras : tuple of str
+            The left and right camera's keys (the left one earlier in the chain).
+
+        Returns
+        -------
+        Calibration
+            ``unit="m"``.
+
+        Raises
+        ------
+        FileNotFoundError
+            If the file does not exist.
+        ValueError
+            A camera missing or out of order, a camera model other than ``pinhole`` or a
+            distortion other than ``radtan``/``none`` (``equidistant`` is a fisheye model, not
+            supported), a malformed field (named), or cameras of different resolutions.
+        """
+        import yaml
+
+        p, text = cls._read_text(camchain)
+        try:
+            doc = yaml.safe_load(text)
+        except yaml.YAMLError as exc:
+            raise ValueError(f"cannot parse {p} as Kalibr YAML: {exc}") from None
+        if not isinstance(doc, dict):
+            raise ValueError(f"{p}: expected Kalibr's camchain mapping (cam0, cam1, ...)")
+        chain = sorted(
+            (k for k in doc if isinstance(k, str) and re.fullmatch(r"cam\d+", k)),
+            key=lambda k: int(k[3:]),
+        )
+        left, right = cameras
+        for name in (left, right):
+            if name not in chain:
+                raise ValueError(f"{p}: no camera {name!r} (has {chain})")
+        i, j = chain.index(left), chain.index(right)
+        if j <= i:
+            raise ValueError(f"{p}: {right!r} must come after {left!r} in the chain")
+        cams = [_kalibr_camera(doc[name], f"{p}:{name}") for name in (left, right)]
+        if cams[0]["resolution"] != cams[1]["resolution"]:
+            raise ValueError(
+                f"{p}: {left} is {cams[0]['resolution']} px, {right} is "
+                f"{cams[1]['resolution']} px; a rig needs one size"
+            )
+        transform = np.eye(4)
+        for name in chain[i + 1 : j + 1]:
+            transform = _kalibr_transform(doc[name], f"{p}:{name}") @ transform
+        rot = transform[:3, :3]
+        # printed with a few decimals: snap to the nearest rotation (within 1e-4 of one)
+        if np.abs(rot @ rot.T - np.eye(3)).max() > 1e-4 or np.linalg.det(rot) < 0:
+            raise ValueError(f"{p}: T_cn_cnm1 of {right!r} does not hold a rotation: {rot}")
+        u, _, vt = np.linalg.svd(rot)
+        transform[:3, :3] = u @ vt
+        return cls(
+            K1=cams[0]["K"],
+            D1=cams[0]["D"],
+            K2=cams[1]["K"],
+            D2=cams[1]["D"],
+            R=transform[:3, :3],
+            T=transform[:3, 3],
+            image_size=cams[0]["resolution"],
             unit="m",
         )
 
@@ -1509,3 +1591,52 @@ def _read_ros_tar(path: Path) -> tuple[str, str]:
             "calibrationdata.tar.gz has both)"
         )
     return found["left.yaml"], found["right.yaml"]
+
+
+# ------------------------------------------------------------------------------ Kalibr
+
+
+def _kalibr_numbers(value: object, key: str, source: str, size: int) -> F64:
+    try:
+        arr = np.array(value, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise ValueError(f"{source}: {key} is not a list of numbers") from None
+    if arr.size != size or not np.all(np.isfinite(arr)):
+        raise ValueError(f"{source}: {key} needs {size} finite numbers, got {value!r}")
+    return arr
+
+
+def _kalibr_camera(cam: object, source: str) -> dict[str, Any]:
+    if not isinstance(cam, dict):
+        raise ValueError(f"{source}: expected a camera mapping")
+    for key in ("intrinsics", "resolution"):
+        if key not in cam:
+            raise ValueError(f"{source} lacks field {key!r}")
+    model = cam.get("camera_model", "pinhole")
+    if model != "pinhole":
+        raise ValueError(f"{source}: camera_model {model!r}; only 'pinhole' is supported")
+    dist = cam.get("distortion_model", "radtan")
+    if dist not in ("radtan", "none"):
+        hint = " (a fisheye model, not supported)" if dist == "equidistant" else ""
+        raise ValueError(f"{source}: distortion_model {dist!r}{hint}; expected 'radtan' or 'none'")
+    fu, fv, pu, pv = _kalibr_numbers(cam["intrinsics"], "intrinsics", source, 4)
+    d = np.zeros(5)
+    if dist == "radtan":
+        d[:4] = _kalibr_numbers(cam.get("distortion_coeffs"), "distortion_coeffs", source, 4)
+    res = _kalibr_numbers(cam["resolution"], "resolution", source, 2)
+    if not np.all(res == np.round(res)) or np.any(res <= 0):
+        raise ValueError(f"{source}: resolution must be two positive integers, got {res}")
+    return {
+        "K": np.array([[fu, 0.0, pu], [0.0, fv, pv], [0.0, 0.0, 1.0]]),
+        "D": d,
+        "resolution": (int(res[0]), int(res[1])),
+    }
+
+
+def _kalibr_transform(cam: object, source: str) -> F64:
+    if not isinstance(cam, dict) or "T_cn_cnm1" not in cam:
+        raise ValueError(f"{source} lacks field 'T_cn_cnm1' (its pose in the chain)")
+    t = _kalibr_numbers(cam["T_cn_cnm1"], "T_cn_cnm1", source, 16).reshape(4, 4)
+    if np.abs(t[3] - [0.0, 0.0, 0.0, 1.0]).max() > 1e-9:
+        raise ValueError(f"{source}: T_cn_cnm1's last row must be [0, 0, 0, 1], got {t[3]}")
+    return t

@@ -507,8 +507,8 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("right")
     d.add_argument(
         "--calib",
-        help="YAML/JSON calibration, Middlebury calib.txt, KITTI calib, or a ROS camera_info "
-        "folder (left.yaml, right.yaml)",
+        help="YAML/JSON calibration, Middlebury calib.txt, KITTI calib, Kalibr camchain, or a "
+        "ROS camera_info folder (left.yaml, right.yaml)",
     )
     d.add_argument("--max-disparity", type=int, default=None, help="default: from the images")
     d.add_argument("--method", default=METHODS[0], choices=METHODS)

@@ -708,7 +708,7 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--left", required=True, help="device index, video file or pattern (%%03d)")
     p.add_argument("--right", required=True, help="device index, video file or pattern")
     p.add_argument(
-        "--calib", help="calibration of the rig (YAML/JSON, Middlebury, KITTI, ROS folder)"
+        "--calib", help="calibration of the rig (YAML/JSON, Middlebury, KITTI, Kalibr, ROS folder)"
     )
     p.add_argument("--size", help="requested size WIDTHxHEIGHT (frames are resized if needed)")
     p.add_argument("--max-disparity", type=int, help="default: estimated from the first pair")

@@ -104,7 +104,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--left", help="left camera: device index, video file or image pattern")
     p.add_argument("--right", help="right camera: device index, video file or image pattern")
     p.add_argument(
-        "--calib", help="calibration of the camera pair (YAML/JSON, calib.txt, KITTI, ROS folder)"
+        "--calib",
+        help="calibration of the camera pair (YAML/JSON, calib.txt, KITTI, Kalibr, ROS folder)",
     )
     p.add_argument(
         "--data",
