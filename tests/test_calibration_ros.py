@@ -188,7 +188,7 @@ def _cam_text(**changes: object) -> str:
         ({"camera_matrix": [1, 0, 0, 0, "x", 0, 0, 0, 1]}, "not a number"),
         ({"camera_matrix": [float("nan")] * 9}, "NaN"),
         ({"image_width": -3}, "image_width must be a positive integer"),
-        ({"rectification_matrix": [2, 0, 0, 0, 1, 0, 0, 0, 1]}, "not a rotation"),
+        ({"rectification_matrix": [2, 0, 0, 0, 1, 0, 0, 0, 1]}, "does not hold a rotation"),
         ({"projection_matrix": [0] * 12}, "positive fx"),
     ],
 )

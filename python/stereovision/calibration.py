@@ -1031,11 +1031,7 @@ class Calibration:
             )
         rots, ts = [], []
         for cam, src in zip(cams, (lsrc, rsrc), strict=True):
-            r = cam["R"]
-            if np.abs(r @ r.T - np.eye(3)).max() > 1e-4 or np.linalg.det(r) < 0:
-                raise ValueError(f"{src}: rectification_matrix is not a rotation: {r.tolist()}")
-            u, _, vt = np.linalg.svd(r)
-            rots.append(u @ vt)
+            rots.append(_snap_rotation(cam["R"], f"{src}: rectification_matrix"))
             p = cam["P"]
             if not (p[0, 0] > 0 and p[1, 1] > 0 and p[2, 2] > 0):
                 raise ValueError(
@@ -1144,12 +1140,7 @@ class Calibration:
         transform = np.eye(4)
         for name in chain[i + 1 : j + 1]:
             transform = _kalibr_transform(doc[name], f"{p}:{name}") @ transform
-        rot = transform[:3, :3]
-        # printed with a few decimals: snap to the nearest rotation (within 1e-4 of one)
-        if np.abs(rot @ rot.T - np.eye(3)).max() > 1e-4 or np.linalg.det(rot) < 0:
-            raise ValueError(f"{p}: T_cn_cnm1 of {right!r} does not hold a rotation: {rot}")
-        u, _, vt = np.linalg.svd(rot)
-        transform[:3, :3] = u @ vt
+        transform[:3, :3] = _snap_rotation(transform[:3, :3], f"{p}: T_cn_cnm1 of {right!r}")
         return cls(
             K1=cams[0]["K"],
             D1=cams[0]["D"],
@@ -1449,6 +1440,15 @@ def _ros_matrix(value: object, key: str, source: str, size: int | None) -> F64:
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{source}: {key} holds NaN or infinity")
     return arr
+
+
+def _snap_rotation(rot: F64, what: str) -> F64:
+    """The rotation nearest ``rot`` (a file prints it with a few decimals), if within 1e-4."""
+    if np.abs(rot @ rot.T - np.eye(3)).max() > 1e-4 or np.linalg.det(rot) < 0:
+        raise ValueError(f"{what} does not hold a rotation: {rot.tolist()}")
+    u, _, vt = np.linalg.svd(rot)
+    out: F64 = u @ vt
+    return out
 
 
 def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
