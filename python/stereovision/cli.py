@@ -76,12 +76,6 @@ def _png_bytes(img: np.ndarray) -> bytes:
     return buf.tobytes()
 
 
-def _depth_mm_png(depth: np.ndarray) -> bytes:
-    from stereovision.export import DEPTH_PNG_SCALE, _scaled_u16
-
-    return _png_bytes(_scaled_u16(depth, DEPTH_PNG_SCALE, "depth").astype(np.uint16))
-
-
 def _npy_bytes(arr: np.ndarray) -> bytes:
     import io as _io
 
@@ -104,7 +98,9 @@ def write_depth_outputs(result: Any, out_dir: Path, voxel: float | None = None) 
         inv = np.where(np.isfinite(result.depth), 1.0 / result.depth, np.nan)
         files["depth.png"] = _png_bytes(colorize(inv))
         files["depth.npy"] = _npy_bytes(result.depth.astype(np.float32))
-        files["depth_mm.png"] = _depth_mm_png(result.depth)
+        from stereovision.export import encode_depth_png
+
+        files["depth_mm.png"] = encode_depth_png(result.depth)
     out_dir.mkdir(parents=True, exist_ok=True)
     written: dict[str, Path] = {}
     for name, data in files.items():
@@ -254,7 +250,10 @@ def cmd_check(args: argparse.Namespace) -> int:
         return 0 if res.ok else 1
     from stereovision.rectification_check import refine_rectification
 
-    fixed, after = refine_rectification(raw_left, raw_right, calib, tolerance=args.tolerance)
+    # the check above was of this pair through this calibration: reuse its matches
+    fixed, after = refine_rectification(
+        raw_left, raw_right, calib, tolerance=args.tolerance, check=res
+    )
     turn = float(np.degrees(np.linalg.norm(cv2.Rodrigues(fixed.R @ calib.R.T)[0])))
     if args.json:
         print(json.dumps({"fixed": after.as_dict(), "turn_deg": turn}))

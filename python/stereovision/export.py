@@ -40,6 +40,7 @@ __all__ = [
     "DEPTH_PNG_SCALE",
     "DISPARITY_PNG_SCALE",
     "EXPORT_FORMATS",
+    "encode_depth_png",
     "export_result",
     "load_cloud",
     "organised_points",
@@ -560,15 +561,38 @@ DEPTH_PNG_SCALE = 1000.0
 DISPARITY_PNG_SCALE = 256.0
 
 
-def _png16(path: PathLike, values: npt.NDArray[np.float64], what: str) -> Path:
+def _png16_bytes(values: npt.NDArray[np.float64], what: str) -> bytes:
     import cv2
 
     ok, buf = cv2.imencode(".png", values.astype(np.uint16))
     if not ok:
         raise ValueError(f"could not encode the {what} as a 16-bit PNG")
+    return bytes(buf.tobytes())
+
+
+def _png16(path: PathLike, values: npt.NDArray[np.float64], what: str) -> Path:
+    data = _png16_bytes(values, what)
     with atomic_write(path) as fh:
-        fh.write(buf.tobytes())
+        fh.write(data)
     return Path(path)
+
+
+def encode_depth_png(depth: npt.ArrayLike, scale: float = DEPTH_PNG_SCALE) -> bytes:
+    """The bytes :func:`write_depth_png` writes, for a depth map in metres (NaN = none).
+
+    Parameters
+    ----------
+    depth : array_like
+        ``(H, W)`` depth in metres.
+    scale : float
+        Units per metre.
+
+    Returns
+    -------
+    bytes
+        A single-channel 16-bit PNG.
+    """
+    return _png16_bytes(_scaled_u16(depth, scale, "depth"), "depth")
 
 
 def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.float64]:

@@ -347,6 +347,7 @@ def refine_rectification(
     *,
     tolerance: float = DEFAULT_TOLERANCE_PX,
     alpha: float = 0.0,
+    check: RectificationCheck | None = None,
 ) -> tuple[Any, RectificationCheck]:
     """Correct a rig's rotation from one textured pair, so that its rows line up again.
 
@@ -370,6 +371,9 @@ def refine_rectification(
         As in :func:`check_rectification`, for the check after the correction.
     alpha : float
         Rectification scaling, as in :meth:`Calibration.rectify`.
+    check : RectificationCheck, optional
+        :func:`check_rectification` of this pair with ``calib`` and ``alpha``, when already
+        computed; else it is run here.
 
     Returns
     -------
@@ -385,7 +389,11 @@ def refine_rectification(
     """
     from dataclasses import replace
 
-    before = check_rectification(left, right, calib, tolerance=tolerance, alpha=alpha)
+    before = (
+        check
+        if check is not None
+        else check_rectification(left, right, calib, tolerance=tolerance, alpha=alpha)
+    )
     if before.ok is None:
         raise ValueError(f"cannot refine: {before.summary()}")
     if before.swapped or not np.isfinite(before.offset):

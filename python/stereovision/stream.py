@@ -39,6 +39,7 @@ import numpy as np
 
 from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import SourceError, StereoCamera, parse_size, parse_source
+from stereovision.rectification_check import RectificationCheck, check_rectification
 
 __all__ = [
     "STAGES",
@@ -74,7 +75,8 @@ class _Pair:
     grab_s: float
     rectify_s: float
     skew_ms: float
-    check: dict[str, Any] | None = None  # the rectification check of this pair, if it had one
+    check: RectificationCheck | None = None  # the rectification check of this pair, if any
+    pair: int = 0  # index of the pair in this stream
 
 
 @dataclass
@@ -324,8 +326,6 @@ def _pairs(
 ) -> Iterator[_Pair]:
     """Grab (and rectify, for a raw rig calibration) pairs until the end or ``frames`` pairs;
     check the rows of pair 0 and, when positive, every ``check_every``-th pair (None: none)."""
-    from stereovision.rectification_check import check_rectification
-
     n = 0
     while frames is None or n < frames:
         t0 = time.perf_counter()
@@ -343,8 +343,8 @@ def _pairs(
         checked = None
         # In the producer thread when pipelined: the matcher keeps working meanwhile.
         if check_every is not None and (n == 0 or (check_every > 0 and n % check_every == 0)):
-            checked = {"pair": n, **check_rectification(left, right).as_dict()}
-        yield _Pair(left, right, fr.index, t0, t1 - t0, t2 - t1, fr.skew_ms, checked)
+            checked = check_rectification(left, right)
+        yield _Pair(left, right, fr.index, t0, t1 - t0, t2 - t1, fr.skew_ms, checked, n)
         n += 1
 
 
@@ -529,7 +529,7 @@ def run_stream(
                 break
             t_got = time.perf_counter()
             if pair.check is not None:
-                _note_check(pair.check, checks)
+                _note_check(pair.pair, pair.check, checks)
             if md is None:
                 md = estimate_max_disparity(pair.left, pair.right)
             # No point cloud per frame: the live view shows disparity and depth.
@@ -604,23 +604,13 @@ def run_stream(
     )
 
 
-def _note_check(result: dict[str, Any], checks: list[dict[str, Any]]) -> None:
+def _note_check(pair: int, result: RectificationCheck, checks: list[dict[str, Any]]) -> None:
     """Record a pair's check; warn when the rows stop agreeing (once per change)."""
-    from stereovision.rectification_check import RectificationCheck
-
     was_ok = checks[-1]["ok"] if checks else True
-    checks.append(result)
-    if result["ok"] is False and was_ok is not False:
-        # as_dict wrote NaN figures as None (JSON); ok stays as it is
-        figures = ("median_dy", "p95_dy", "offset", "slope_x", "slope_y")
-        fields: dict[str, Any] = {
-            k: (np.nan if v is None and k in figures else v)
-            for k, v in result.items()
-            if k != "pair"
-        }
-        text = RectificationCheck(**fields).summary()
-        where = "first pair" if result["pair"] == 0 else f"pair {result['pair']}"
-        warnings.warn(f"{where}: {text}", stacklevel=3)
+    checks.append({"pair": pair, **result.as_dict()})
+    if result.ok is False and was_ok is not False:
+        where = "first pair" if pair == 0 else f"pair {pair}"
+        warnings.warn(f"{where}: {result.summary()}", stacklevel=3)
 
 
 # ---------------------------------------------------------------------------------------- CLI
