@@ -1,13 +1,16 @@
-"""Stereo calibration from chessboard pairs, with a report people can check.
+"""Stereo calibration from chessboard or ChArUco pairs, with a report people can check.
 
 Pipeline (:func:`calibrate`):
 
-1. **Corners.** ``cv2.findChessboardCornersSB`` (the sector-based detector, robust to blur and
-   glare) finds the board; if it fails, the classic ``cv2.findChessboardCorners`` is tried.
-   Every corner is then refined by ``cv2.cornerSubPix`` with a window sized to the board's
-   square in that image (:data:`SUBPIX_WINDOW_FRACTION`): on OpenCV's sample pairs this lowers the
-   per-camera RMS from 0.25 px (SB alone) and 0.41-0.46 px (classic + the usual fixed 11x11
-   window) to 0.18 px. The right corners are put in the same order as the left ones.
+1. **Corners.** A ChArUco board (``board=CharucoBoard(...)``, :mod:`stereovision.charuco`) gives
+   each corner an id, so a pair whose board is cut by an image edge still counts: the corners seen
+   by both cameras are used. For a chessboard, ``cv2.findChessboardCornersSB`` (the sector-based
+   detector, robust to blur and glare) finds the board; if it fails, the classic
+   ``cv2.findChessboardCorners`` is tried. Every corner is then refined by ``cv2.cornerSubPix``
+   with a window sized to the board's square in that image (:data:`SUBPIX_WINDOW_FRACTION`): on
+   OpenCV's sample pairs this lowers the per-camera RMS from 0.25 px (SB alone) and 0.41-0.46 px
+   (classic + the usual fixed 11x11 window) to 0.18 px. The right corners are put in the same
+   order as the left ones.
 2. **Each camera alone** (``cv2.calibrateCamera``), with a distortion model chosen by
    leave-one-view-out cross-validation (``distortion="auto"``, see :data:`DISTORTION_MODELS`).
 3. **Extrinsics** (``cv2.stereoCalibrate`` with ``CALIB_FIX_INTRINSIC``), then an optional joint
@@ -32,7 +35,7 @@ import json
 import math
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -42,6 +45,7 @@ import numpy.typing as npt
 
 if TYPE_CHECKING:
     from stereovision.calibration import Calibration
+    from stereovision.charuco import CharucoBoard
 
 __all__ = [
     "DISTORTION_MODELS",
@@ -113,6 +117,8 @@ OUTLIER_FACTOR = 3.0
 OUTLIER_MIN_PX = 0.5
 #: The fewest pairs a stereo calibration is attempted with (intrinsics need several views).
 MIN_PAIRS = 3
+#: Fewest ChArUco corners seen by both cameras for a pair to be used (see charuco.MIN_CORNERS).
+CHARUCO_MIN_COMMON = 6
 #: Outlier rejection rounds at most (each round re-solves once).
 MAX_OUTLIER_ROUNDS = 3
 
@@ -323,15 +329,22 @@ def board_pose_params(
 def _coverage_mask(
     corner_sets: Sequence[F64], pattern: tuple[int, int], image_size: tuple[int, int]
 ) -> npt.NDArray[np.uint16]:
-    """Per-pixel count (at 1/:data:`COVERAGE_DOWNSCALE` resolution) of boards covering it."""
+    """Per-pixel count (at 1/:data:`COVERAGE_DOWNSCALE` resolution) of boards covering it.
+
+    A whole board covers the quadrilateral of its outer corners; a partial one (ChArUco) the
+    convex hull of the corners seen.
+    """
     cols, rows = pattern
     w, h = image_size
     s = COVERAGE_DOWNSCALE
     count = np.zeros((max(1, h // s), max(1, w // s)), np.uint16)
     for c in corner_sets:
-        quad = c[[0, cols - 1, cols * rows - 1, cols * (rows - 1)]] / s
+        if len(c) == cols * rows:
+            poly = c[[0, cols - 1, cols * rows - 1, cols * (rows - 1)]] / s
+        else:
+            poly = cv2.convexHull(np.asarray(c, np.float32)).reshape(-1, 2) / s
         m = np.zeros(count.shape, np.uint8)
-        cv2.fillConvexPoly(m, np.round(quad).astype(np.int32), 1)
+        cv2.fillConvexPoly(m, np.round(poly).astype(np.int32), 1)
         count += m
     return count
 
@@ -373,7 +386,13 @@ class CalibrationReport:
     refined : bool
         Whether the joint refinement was kept.
     pattern, image_size, unit, baseline, focal_left, focal_right : ...
-        Board pattern, image size ``(w, h)``, length unit, ``|T|`` and ``fx`` of each camera.
+        Board's inner corners ``(cols, rows)``, image size ``(w, h)``, length unit, ``|T|`` and
+        ``fx`` of each camera.
+    board : str
+        The board, in words (``"chessboard 9x6 inner corners"`` or the ChArUco board's
+        :meth:`~stereovision.charuco.CharucoBoard.describe`).
+    corners_used : int
+        Corners used over all pairs (each seen by both cameras).
     """
 
     rms: float
@@ -401,9 +420,12 @@ class CalibrationReport:
     baseline: float
     focal_left: float
     focal_right: float
+    board: str = "chessboard"
+    corners_used: int = 0
     # Data for the pictures; not part of the serialised report.
     _calibration: Any = field(default=None, repr=False, compare=False)
     _corners: dict[str, tuple[F64, F64]] = field(default_factory=dict, repr=False, compare=False)
+    _ids: dict[str, npt.NDArray[np.int64]] = field(default_factory=dict, repr=False, compare=False)
     _sample: tuple[str, np.ndarray, np.ndarray] | None = field(
         default=None, repr=False, compare=False
     )
@@ -434,7 +456,8 @@ class CalibrationReport:
         n = len(self.used_pairs)
         total = n + len(self.rejected_pairs)
         lines = [
-            f"{n}/{total} pairs used; stereo RMS {self.rms:.3f} px "
+            f"{n}/{total} pairs used ({self.corners_used} corners, {self.board}); "
+            f"stereo RMS {self.rms:.3f} px "
             f"(left {self.rms_left:.3f}, right {self.rms_right:.3f}; "
             f"model {self.distortion_model})",
             f"rectified epipolar error |dy|: mean {self.epipolar_mean_dy:.3f} px, "
@@ -651,8 +674,13 @@ def _rectified_checks(
     left: Sequence[F64],
     right: Sequence[F64],
     pattern: tuple[int, int],
+    ids: Sequence[npt.NDArray[np.int64]],
 ) -> tuple[float, float, float, float]:
-    """Epipolar |dy| (mean, max) and triangulated square size (median, std) of all corners."""
+    """Epipolar |dy| (mean, max) and triangulated square size (median, std) of all corners.
+
+    ``ids`` are each pair's corners' indices in the ``pattern`` grid (row-major); the square size
+    is measured between grid neighbours both seen.
+    """
     R1, R2, P1, P2, _, _, _ = cv2.stereoRectify(
         sol.K1, sol.D1, sol.K2, sol.D2, size, sol.R, sol.T.reshape(3, 1),
         flags=cv2.CALIB_ZERO_DISPARITY, alpha=0,
@@ -660,16 +688,21 @@ def _rectified_checks(
     dys: list[F64] = []
     sides: list[F64] = []
     cols, rows = pattern
-    for cl, cr in zip(left, right, strict=True):
+    for cl, cr, idx in zip(left, right, ids, strict=True):
         ul = cv2.undistortPoints(cl.reshape(-1, 1, 2), sol.K1, sol.D1, R=R1, P=P1).reshape(-1, 2)
         ur = cv2.undistortPoints(cr.reshape(-1, 1, 2), sol.K2, sol.D2, R=R2, P=P2).reshape(-1, 2)
         dys.append(np.abs(ul[:, 1] - ur[:, 1]))
-        X = cv2.triangulatePoints(P1, P2, ul.T, ur.T)
-        X = (X[:3] / X[3]).T.reshape(rows, cols, 3)
+        Xh = cv2.triangulatePoints(P1, P2, ul.T, ur.T)
+        flat = np.full((rows * cols, 3), np.nan)
+        flat[idx] = (Xh[:3] / Xh[3]).T
+        X = flat.reshape(rows, cols, 3)  # NaN where a corner was not seen by both
         sides.append(np.linalg.norm(np.diff(X, axis=1), axis=2).ravel())
         sides.append(np.linalg.norm(np.diff(X, axis=0), axis=2).ravel())
     dy = np.concatenate(dys)
     side = np.concatenate(sides)
+    side = side[np.isfinite(side)]
+    if side.size == 0:  # no two neighbouring corners seen together
+        return float(dy.mean()), float(dy.max()), math.nan, math.nan
     return float(dy.mean()), float(dy.max()), float(np.median(side)), float(side.std())
 
 
@@ -712,14 +745,15 @@ def calibrate(
     right_images: Sequence[ImageInput],
     *,
     pattern: tuple[int, int] | str = (9, 6),
-    square_size: float,
+    square_size: float | None = None,
+    board: CharucoBoard | None = None,
     unit: str = "m",
     distortion: str = "auto",
     refine: bool = True,
     drop_outliers: bool = False,
     names: Sequence[str] | None = None,
 ) -> tuple[Calibration, CalibrationReport]:
-    """Calibrate a stereo rig from chessboard pairs.
+    """Calibrate a stereo rig from chessboard or ChArUco pairs.
 
     Parameters
     ----------
@@ -727,9 +761,15 @@ def calibrate(
         The pairs, in the same order: image files (any format OpenCV reads) or arrays (grey or
         BGR, ``uint8``/``uint16``/float in [0, 1]). All images must have one size.
     pattern : tuple of int or str
-        Inner corners ``(cols, rows)`` or ``"9x6"``.
+        A chessboard's inner corners ``(cols, rows)`` or ``"9x6"`` (ignored with ``board``).
     square_size : float
-        Side of one square in ``unit``; ``T`` and the baseline come out in that unit.
+        Side of one chessboard square in ``unit``; ``T`` and the baseline come out in that unit.
+        Required for a chessboard; with ``board`` it must be omitted or equal the board's.
+    board : stereovision.charuco.CharucoBoard, optional
+        A ChArUco board (its sizes in ``unit``). A pair is used when both cameras see at least
+        :data:`~stereovision.charuco.MIN_CORNERS` common corners, not all on one line; the board
+        may be cut by the image edges. ``dictionary="auto"`` is settled on the first image that
+        shows the board.
     unit : str
         Length unit of ``square_size`` (``"m"``, ``"mm"``, ``"cm"``, ``"ft"``, ``"in"``).
     distortion : str
@@ -756,6 +796,7 @@ def calibrate(
     ValueError
         If a file cannot be decoded, the lists differ in length, the images differ in size, an
         argument is invalid, or fewer than :data:`MIN_PAIRS` pairs show the board in both images.
+        With ``dictionary="auto"``, also if no image shows enough of the board's markers.
 
     Examples
     --------
@@ -769,9 +810,27 @@ def calibrate(
     """
     from stereovision._validate import positive_finite
     from stereovision.calibration import UNIT_TO_METRES, Calibration
+    from stereovision.charuco import CharucoBoard, corners_span_plane, find_charuco_corners
 
-    pat = parse_pattern(pattern)
-    square = positive_finite(square_size, "square_size")
+    if board is not None:
+        if not isinstance(board, CharucoBoard):
+            raise ValueError(
+                f"board: expected a stereovision.charuco.CharucoBoard, got {type(board).__name__}"
+            )
+        if square_size is not None and positive_finite(square_size, "square_size") != float(
+            board.square_size
+        ):
+            raise ValueError(
+                f"square_size: {square_size:g} differs from the board's {board.square_size:g}; "
+                "give the size once, in the board"
+            )
+        pat = board.inner
+        square = float(board.square_size)
+    else:
+        pat = parse_pattern(pattern)
+        if square_size is None:
+            raise ValueError("square_size: required for a chessboard (the side of one square)")
+        square = positive_finite(square_size, "square_size")
     if unit not in UNIT_TO_METRES:
         raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
     # The board's corners are float32 for OpenCV: 1e308 overflowed them into inf and the solver
@@ -800,6 +859,9 @@ def calibrate(
     right_names: list[str | None] = []
     corners_l: list[F64 | None] = []
     corners_r: list[F64 | None] = []
+    corner_ids: list[npt.NDArray[np.int64] | None] = []
+    short: dict[int, str] = {}  # pairs whose boards were seen, but not enough of them in common
+    full_ids = np.arange(pat[0] * pat[1], dtype=np.int64)
     sample: tuple[int, np.ndarray, np.ndarray] | None = None
     for item in (*lefts, *rights):
         if isinstance(item, (str, os.PathLike)) and not Path(item).is_file():
@@ -818,30 +880,61 @@ def calibrate(
                 raise ValueError(
                     f"{label}: image is {s[0]}x{s[1]}, but {first_name} is {size[0]}x{size[1]}"
                 )
-        # (findChessboardCornersSB already runs on all cores: no thread pool here)
-        cl, cr = find_corners(gl, pat), find_corners(gr, pat)
-        if cl is not None and cr is not None:
-            cr = _match_order(cl, cr, pat)
-            if sample is None:
-                sample = (i, gl, gr)
+        ids: npt.NDArray[np.int64] | None = full_ids
+        if board is not None:
+            if not board.resolved:  # settle dictionary="auto" on the first image showing it
+                board = board.resolve(gl) or board.resolve(gr) or board
+            found_l = find_charuco_corners(gl, board) if board.resolved else None
+            found_r = find_charuco_corners(gr, board) if board.resolved else None
+            cl = cr = ids = None
+            if found_l is not None and found_r is not None:
+                common, il, ir = np.intersect1d(found_l[0], found_r[0], return_indices=True)
+                if len(common) >= CHARUCO_MIN_COMMON and corners_span_plane(board, common):
+                    ids, cl, cr = common, found_l[1][il], found_r[1][ir]
+                else:
+                    short[i] = (
+                        f"only {len(common)} corners seen in both images (at least "
+                        f"{CHARUCO_MIN_COMMON}, not all on one line)"
+                    )
+            else:
+                cl = None if found_l is None else found_l[1]
+                cr = None if found_r is None else found_r[1]
+        else:
+            # (findChessboardCornersSB already runs on all cores: no thread pool here)
+            cl, cr = find_corners(gl, pat), find_corners(gr, pat)
+            if cl is not None and cr is not None:
+                cr = _match_order(cl, cr, pat)
+        if cl is not None and cr is not None and sample is None and i not in short:
+            sample = (i, gl, gr)
         corners_l.append(cl)
         corners_r.append(cr)
+        corner_ids.append(ids)
     assert size is not None
     pair_names = _pair_names(left_names, right_names, names)
 
     rejected: dict[str, str] = {}
     used: list[int] = []
     for i, (cl, cr) in enumerate(zip(corners_l, corners_r, strict=True)):
-        if cl is None or cr is None:
+        if i in short:
+            rejected[pair_names[i]] = short[i]
+        elif cl is None or cr is None or corner_ids[i] is None:
             where = (
                 "both images" if cl is None and cr is None else "left" if cl is None else "right"
             )
             rejected[pair_names[i]] = f"board not found in {where}"
         else:
             used.append(i)
+    board_text = (
+        f"chessboard {pat[0]}x{pat[1]} inner corners" if board is None else board.describe(unit)
+    )
+    if board is not None and not board.resolved:
+        raise ValueError(
+            f"no image shows enough markers of the {board.squares[0]}x{board.squares[1]} "
+            "ChArUco board to tell its dictionary; give dictionary= (e.g. 'DICT_5X5_100')"
+        )
     if len(used) < MIN_PAIRS:
         raise ValueError(
-            f"the {pat[0]}x{pat[1]} board was found in both images of only {len(used)} of "
+            f"the {board_text} was found in both images of only {len(used)} of "
             f"{len(lefts)} pairs; at least {MIN_PAIRS} are needed"
             + (f" (rejected: {', '.join(rejected)})" if rejected else "")
         )
@@ -849,7 +942,7 @@ def calibrate(
     obj_pts = board_object_points(pat, square)
     outliers: list[str] = []
     for _ in range(MAX_OUTLIER_ROUNDS + 1):
-        obj = [obj_pts] * len(used)
+        obj = [obj_pts[corner_ids[i]] for i in used]  # type: ignore[index]
         pl = [corners_l[i].astype(np.float32) for i in used]  # type: ignore[union-attr]
         pr = [corners_r[i].astype(np.float32) for i in used]  # type: ignore[union-attr]
         sol = _solve(obj, pl, pr, size, distortion, refine)
@@ -872,11 +965,20 @@ def calibrate(
     cal = Calibration(
         K1=sol.K1, D1=sol.D1, K2=sol.K2, D2=sol.D2, R=sol.R, T=sol.T, image_size=size, unit=unit
     )
-    used_l = [corners_l[i] for i in used]
-    used_r = [corners_r[i] for i in used]
-    mean_dy, max_dy, side_med, side_std = _rectified_checks(sol, size, used_l, used_r, pat)  # type: ignore[arg-type]
-    cov_l = _coverage_mask(used_l, pat, size)  # type: ignore[arg-type]
-    cov_r = _coverage_mask(used_r, pat, size)  # type: ignore[arg-type]
+    used_l: list[F64] = []
+    used_r: list[F64] = []
+    used_ids: list[npt.NDArray[np.int64]] = []
+    for i in used:
+        cl, cr, ix = corners_l[i], corners_r[i], corner_ids[i]
+        assert cl is not None and cr is not None and ix is not None
+        used_l.append(cl)
+        used_r.append(cr)
+        used_ids.append(ix)
+    mean_dy, max_dy, side_med, side_std = _rectified_checks(
+        sol, size, used_l, used_r, pat, used_ids
+    )
+    cov_l = _coverage_mask(used_l, pat, size)
+    cov_r = _coverage_mask(used_r, pat, size)
     names_used = [pair_names[i] for i in used]
     report = CalibrationReport(
         rms=sol.rms,
@@ -911,8 +1013,11 @@ def calibrate(
         baseline=float(np.linalg.norm(sol.T)),
         focal_left=float(sol.K1[0, 0]),
         focal_right=float(sol.K2[0, 0]),
+        board=board_text,
+        corners_used=sum(len(ix) for ix in used_ids),
         _calibration=cal,
         _corners={pair_names[i]: (corners_l[i], corners_r[i]) for i in used},  # type: ignore[misc]
+        _ids={pair_names[i]: corner_ids[i] for i in used},  # type: ignore[misc]
         _sample=None if sample is None else (pair_names[sample[0]], sample[1], sample[2]),
     )
     return cal, report
@@ -1069,10 +1174,12 @@ def _rig_picture(rep: CalibrationReport) -> np.ndarray | None:
     T = np.asarray(cal.T)
     c_right = -Rm.T @ T  # right camera centre in left coordinates
     axis_right = Rm.T @ np.array([0.0, 0.0, 1.0])
-    # Board centres in the left camera frame (from the rectified triangulation's geometry).
+    # Board corners in the left camera frame (each view's pose from its corners).
     centres = []
-    obj = board_object_points(rep.pattern, rep.square_size).astype(np.float64)
-    for cl, _ in rep._corners.values():
+    grid = board_object_points(rep.pattern, rep.square_size).astype(np.float64)
+    for name, (cl, _) in rep._corners.items():
+        ids = rep._ids.get(name)
+        obj = grid if ids is None else grid[ids]
         ok, rvec, tvec = cv2.solvePnP(obj, cl, cal.K1, cal.D1, flags=cv2.SOLVEPNP_IPPE)
         if ok:
             Rb, _ = cv2.Rodrigues(rvec)
@@ -1094,9 +1201,10 @@ def _rig_picture(rep: CalibrationReport) -> np.ndarray | None:
     def px(x: float, z: float) -> tuple[int, int]:
         return round(40 + (x - xmin) * s), round(h - 40 - (z - zmin) * s)
 
-    for pts in centres:
-        for a, b in ((0, rep.pattern[0] - 1), (0, len(pts) - rep.pattern[0])):
-            cv2.line(img, px(pts[a, 0], pts[a, 2]), px(pts[b, 0], pts[b, 2]), _GREY, 1, cv2.LINE_AA)
+    for pts in centres:  # each board's outline seen from above
+        top = np.array([px(p[0], p[2]) for p in pts], np.int32)
+        hull = cv2.convexHull(top.reshape(-1, 1, 2))
+        cv2.polylines(img, [hull], True, _GREY, 1, cv2.LINE_AA)
     fov = base * 0.8
     for c, ax, color, name in (
         (np.zeros(3), np.array([0.0, 0.0, 1.0]), _BLUE, "L"),
@@ -1167,8 +1275,8 @@ def _render_html(rep: CalibrationReport) -> str:
         ),
         ("joint refinement", "kept" if rep.refined else "not used"),
         (
-            "pattern / image",
-            f"{rep.pattern[0]}x{rep.pattern[1]} inner corners, "
+            "board / image",
+            f"{rep.board}, {rep.corners_used} corners used, "
             f"{rep.image_size[0]}x{rep.image_size[1]} px",
         ),
     ]
@@ -1323,7 +1431,8 @@ def _expand(pattern: str, option: str) -> list[str]:
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
     """``stereovision calibrate --left GLOB --right GLOB --pattern 9x6 --square S -o FILE``
-    (``--ros DIR`` also writes ROS ``camera_info`` files)."""
+    (``--board charuco --marker M`` for a ChArUco board; ``--ros DIR`` also writes ROS
+    ``camera_info`` files)."""
     lefts = [f for g in args.left for f in _expand(g, "--left")]
     rights = [f for g in args.right for f in _expand(g, "--right")]
     if len(lefts) != len(rights):
@@ -1336,11 +1445,13 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     ros_dir = Path(args.ros) if args.ros else None
     if ros_dir is not None and ros_dir.exists() and not ros_dir.is_dir():
         raise ValueError(f"--ros {args.ros}: is a file; give a folder for left.yaml and right.yaml")
+    board = _cli_board(args, printing=False)
     cal, rep = calibrate(
         lefts,
         rights,
-        pattern=parse_pattern(args.pattern),
+        pattern=parse_pattern(args.pattern or "9x6"),
         square_size=args.square,
+        board=board,
         unit=args.unit,
         distortion=args.distortion,
         drop_outliers=args.drop_outliers,
@@ -1363,19 +1474,117 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cli_board(args: argparse.Namespace, *, printing: bool) -> CharucoBoard | None:
+    """The ChArUco board the options describe (None for a chessboard)."""
+    if args.board != "charuco":
+        if args.marker is not None or args.dictionary != "auto" or args.legacy is not None:
+            raise ValueError("--marker, --dictionary and --legacy are for --board charuco")
+        return None
+    from stereovision.charuco import DICTIONARY_FAMILIES, CharucoBoard
+
+    if args.pattern is None:
+        raise ValueError("--pattern: give the ChArUco board's squares as COLSxROWS (e.g. 7x5)")
+    if args.marker is None:
+        raise ValueError("--marker: give the ChArUco marker's side, in --unit")
+    try:
+        board = CharucoBoard(
+            args.pattern, args.square, args.marker, args.dictionary, legacy=args.legacy
+        )
+        if printing and board.dictionary == "auto":  # a print needs one: the smallest 5X5 fitting
+            fitting = [n for n, k in DICTIONARY_FAMILIES["5X5"] if k >= board.n_markers]
+            if not fitting:
+                raise ValueError(
+                    f"{board.n_markers} markers do not fit a 5X5 dictionary; give --dictionary"
+                )
+            board = replace(board, dictionary=fitting[0])
+        if printing and board.legacy is None:
+            board = replace(board, legacy=False)
+    except ValueError as exc:
+        raise ValueError(f"--board charuco: {exc}") from None
+    return board
+
+
+def cmd_board(args: argparse.Namespace) -> int:
+    """``stereovision board -o board.png --pattern 9x6 --square 0.03`` (or ``--board charuco``):
+    a printable board at its true size."""
+    from stereovision.calibration import UNIT_TO_METRES
+    from stereovision.charuco import board_png
+    from stereovision.io import atomic_write
+
+    out = Path(args.output)
+    if out.suffix.lower() != ".png":
+        raise ValueError(f"-o {args.output}: the board is written as a .png file")
+    if not out.parent.exists() and str(out.parent):
+        raise FileNotFoundError(f"-o {args.output}: directory {out.parent} does not exist")
+    if args.unit not in UNIT_TO_METRES:
+        raise ValueError(f"--unit: expected one of {list(UNIT_TO_METRES)}, got {args.unit!r}")
+    board = _cli_board(args, printing=True)
+    from stereovision._validate import positive_finite
+
+    square = positive_finite(args.square, "--square")
+    dpi = positive_finite(args.dpi, "--dpi")
+    if board is not None:
+        data, (w, h) = board_png(board, square * UNIT_TO_METRES[args.unit], dpi)
+        what = board.describe(args.unit)
+    else:
+        pat = parse_pattern(args.pattern or "9x6")
+        data, (w, h) = board_png(pat, square * UNIT_TO_METRES[args.unit], dpi)
+        what = f"chessboard {pat[0]}x{pat[1]} inner corners, square {square:g} {args.unit}"
+    with atomic_write(out) as fh:
+        fh.write(data)
+    mm = 25.4 / dpi
+    side_mm = round(square * UNIT_TO_METRES[args.unit] / 0.0254 * dpi) * mm  # whole pixels
+    print(f"{out}: {what}")
+    print(
+        f"{w}x{h} px; printed at {dpi:g} dpi and 100 % scale it is {w * mm:.1f} x {h * mm:.1f} "
+        f"mm with {side_mm:.2f} mm squares. Measure a square on the print and give that size "
+        "to calibrate --square."
+    )
+    return 0
+
+
+def _add_board_options(p: argparse.ArgumentParser) -> None:
+    """The options that describe a board, shared by ``calibrate`` and ``board``."""
+    p.add_argument(
+        "--board",
+        default="chessboard",
+        choices=["chessboard", "charuco"],
+        help="calibration target (default chessboard)",
+    )
+    p.add_argument(
+        "--pattern",
+        default=None,
+        help="chessboard: inner corners COLSxROWS (default 9x6); charuco: squares COLSxROWS",
+    )
+    p.add_argument("--square", required=True, type=float, help="square side in --unit")
+    p.add_argument("--unit", default="m", help="length unit of --square (default m)")
+    p.add_argument("--marker", type=float, help="charuco: marker side in --unit")
+
+
 def add_cli(subparsers: Any) -> None:
-    """Register the ``calibrate`` subcommand on an ``argparse`` subparsers object."""
+    """Register the ``calibrate`` and ``board`` subcommands on an ``argparse`` subparsers
+    object."""
     p = subparsers.add_parser(
         "calibrate",
-        help="calibrate a stereo rig from chessboard pairs",
-        description="Calibrate a stereo rig from chessboard image pairs (sorted glob matches "
-        "are paired in order).",
+        help="calibrate a stereo rig from chessboard or ChArUco pairs",
+        description="Calibrate a stereo rig from chessboard or ChArUco image pairs (sorted glob "
+        "matches are paired in order).",
     )
     p.add_argument("--left", required=True, nargs="+", help="left images (glob patterns, quoted)")
     p.add_argument("--right", required=True, nargs="+", help="right images (glob patterns)")
-    p.add_argument("--pattern", default="9x6", help="inner corners COLSxROWS (default 9x6)")
-    p.add_argument("--square", required=True, type=float, help="square side in --unit")
-    p.add_argument("--unit", default="m", help="length unit of --square (default m)")
+    _add_board_options(p)
+    p.add_argument(
+        "--dictionary",
+        default="auto",
+        help="charuco: ArUco dictionary, e.g. DICT_5X5_100 (default: found from the images)",
+    )
+    p.add_argument(
+        "--legacy",
+        default=None,
+        action=argparse.BooleanOptionalAction,
+        help="charuco: OpenCV's pre-4.6 layout for an even number of rows (default: found from "
+        "the images)",
+    )
     p.add_argument(
         "--distortion",
         default="auto",
@@ -1392,3 +1601,25 @@ def add_cli(subparsers: Any) -> None:
         "stereo_image_proc)",
     )
     p.set_defaults(func=cmd_calibrate)
+
+    b = subparsers.add_parser(
+        "board",
+        help="write a printable chessboard or ChArUco board (PNG at its true size)",
+        description="Write a calibration board as a PNG whose DPI makes it print at its true "
+        "size; calibrate with the same --board/--pattern/--square/--marker options.",
+    )
+    b.add_argument("-o", "--output", required=True, help="PNG file to write")
+    _add_board_options(b)
+    b.add_argument(
+        "--dictionary",
+        default="auto",
+        help="charuco: ArUco dictionary (default: the smallest DICT_5X5 that holds the markers)",
+    )
+    b.add_argument(
+        "--legacy",
+        default=None,
+        action=argparse.BooleanOptionalAction,
+        help="charuco: OpenCV's pre-4.6 layout (default: the current one)",
+    )
+    b.add_argument("--dpi", type=float, default=300.0, help="printer resolution (default 300)")
+    b.set_defaults(func=cmd_board)

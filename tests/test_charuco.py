@@ -1,0 +1,386 @@
+"""ChArUco boards: detection against the rendering's exact corners, the dictionary and layout
+found from the images, partial views, a synthetic stereo rig recovered through boards cut by the
+image edges, errors, the printable board and the CLI."""
+
+from __future__ import annotations
+
+import math
+import re
+import struct
+import subprocess
+import sys
+import zlib
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import pytest
+
+from stereovision.calibrate import calibrate
+from stereovision.charuco import (
+    CharucoBoard,
+    board_png,
+    dictionary_name,
+    find_charuco_corners,
+    render_charuco,
+)
+
+SIZE = (640, 480)
+K1 = np.array([[600.0, 0, 330], [0, 602, 238], [0, 0, 1]])
+D1 = np.array([-0.30, 0.12, 0.0008, -0.0004, 0])
+K2 = np.array([[605.0, 0, 316], [0, 604, 244], [0, 0, 1]])
+D2 = np.array([-0.28, 0.10, -0.0006, 0.0005, 0])
+ROT = cv2.Rodrigues(np.array([0.01, -0.03, 0.005]))[0]
+T = np.array([-0.12, 0.002, 0.001])
+#: 10x7 squares = the 9x6 inner corners of OpenCV's sample chessboard.
+BOARD = CharucoBoard("10x7", 0.03, 0.022, "DICT_5X5_100")
+SS = 2  # supersampling of the renderings (2 keeps the module's set-up near 2 s)
+
+
+def _project(board: CharucoBoard, ids: Any, rv: Any, tv: Any, K: Any, D: Any) -> np.ndarray:
+    p, _ = cv2.projectPoints(board.object_points(ids).astype(np.float64), rv, tv, K, D)
+    return np.asarray(p).reshape(-1, 2)
+
+
+def _right_pose(rv: np.ndarray, tv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    r, t = cv2.composeRT(
+        rv.reshape(3, 1), tv.reshape(3, 1), cv2.Rodrigues(ROT)[0].reshape(3, 1), T.reshape(3, 1)
+    )[:2]
+    return np.asarray(r).ravel(), np.asarray(t).ravel()
+
+
+def _poses(n: int, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Board poses 0.35-0.6 m away whose centres range over the whole image (and past it)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    centre = np.array([5 * BOARD.square_size, 3.5 * BOARD.square_size, 0])
+    for _ in range(n):
+        rv = rng.normal(0, 0.25, 3)
+        z = rng.uniform(0.35, 0.6)
+        c = np.array([rng.uniform(-0.25, 0.25) * z, rng.uniform(-0.18, 0.18) * z, z])
+        out.append((rv, c - cv2.Rodrigues(rv)[0] @ centre))
+    return out
+
+
+def _noisy(img: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    return np.clip(img + rng.normal(0, 1.0, img.shape), 0, 255).astype(np.uint8)
+
+
+@pytest.fixture(scope="module")
+def rig() -> dict[str, Any]:
+    rng = np.random.default_rng(3)
+    poses = _poses(14, seed=7)
+    left, right = [], []
+    for rv, tv in poses:
+        left.append(_noisy(render_charuco(BOARD, K1, D1, rv, tv, supersample=SS), rng))
+        r2, t2 = _right_pose(rv, tv)
+        right.append(_noisy(render_charuco(BOARD, K2, D2, r2, t2, supersample=SS), rng))
+    return {"poses": poses, "left": left, "right": right}
+
+
+# ---------------------------------------------------------------------------------- detection
+
+
+def test_corners_agree_with_the_rendered_board() -> None:
+    """Every corner found lies within 0.4 px of its projection (0.04-0.08 px mean measured)."""
+    for rv, tv in _poses(4, seed=1):
+        img = render_charuco(BOARD, K1, D1, rv, tv, supersample=SS)
+        found = find_charuco_corners(img, BOARD)
+        assert found is not None
+        ids, pts = found
+        assert np.all(np.diff(ids) > 0) and ids.min() >= 0 and ids.max() < BOARD.n_corners
+        err = np.linalg.norm(pts - _project(BOARD, ids, rv, tv, K1, D1), axis=1)
+        assert err.mean() < 0.15 and err.max() < 0.4, (err.mean(), err.max())
+
+
+def test_a_board_cut_by_the_image_edge_gives_its_visible_corners() -> None:
+    """Shifted right until a third of it leaves the image, the board still gives corners (those
+    whose two neighbouring markers are in view), each with its right id."""
+    rv = np.array([0.1, 0.2, 0.0])
+    counts = []
+    for shift in (0.0, 0.2, 0.25):
+        tv = np.array([-0.17 + shift, -0.1, 0.5])
+        img = render_charuco(BOARD, K1, D1, rv, tv, supersample=SS)
+        found = find_charuco_corners(img, BOARD)
+        assert found is not None
+        ids, pts = found
+        truth = _project(BOARD, np.arange(BOARD.n_corners), rv, tv, K1, D1)
+        assert np.all(truth[ids, 0] < SIZE[0] - 1)
+        err = np.linalg.norm(pts - truth[ids], axis=1)
+        assert err.max() < 0.4
+        counts.append(len(ids))
+    # measured 54, 37, 30 (of 54, 42 and 36 inside the image)
+    assert counts[0] == BOARD.n_corners
+    assert 30 <= counts[2] < counts[1] < counts[0]
+
+
+@pytest.mark.parametrize(
+    ("dictionary", "squares", "legacy"),
+    [
+        ("DICT_4X4_50", "8x6", False),
+        ("DICT_6X6_250", "8x6", True),
+        ("DICT_7X7_1000", "7x5", False),
+        ("DICT_ARUCO_ORIGINAL", "8x6", False),
+        ("DICT_APRILTAG_36H11", "7x5", False),
+    ],
+)
+def test_dictionary_and_layout_are_found_from_the_image(
+    dictionary: str, squares: str, legacy: bool
+) -> None:
+    true = CharucoBoard(squares, 0.04, 0.03, dictionary, legacy=legacy)
+    rv, tv = np.array([0.2, -0.3, 0.1]), np.array([-0.12, -0.08, 0.5])
+    img = render_charuco(true, K1, D1, rv, tv, supersample=SS)
+    found = CharucoBoard(squares, 0.04, 0.03).resolve(img)
+    assert found is not None
+    family = dictionary.rsplit("_", 1)[0] if dictionary[5].isdigit() else dictionary
+    assert found.dictionary.startswith(family)  # the smallest of the family that holds the board
+    assert found.legacy is legacy
+    a = find_charuco_corners(img, CharucoBoard(squares, 0.04, 0.03))
+    b = find_charuco_corners(img, true)
+    assert a is not None and b is not None
+    np.testing.assert_array_equal(a[0], b[0])
+    np.testing.assert_allclose(a[1], b[1], atol=1e-9)
+    assert len(a[0]) == true.n_corners
+
+
+def test_the_wrong_layout_finds_fewer_corners() -> None:
+    """An even-rowed board printed in the legacy layout: read with the current one, fewer
+    corners (the two layouts put the markers in different squares)."""
+    true = CharucoBoard("8x6", 0.04, 0.03, "DICT_5X5_100", legacy=True)
+    img = render_charuco(true, K1, D1, np.array([0.1, -0.2, 0.0]), np.array([-0.15, -0.1, 0.5]))
+    right = find_charuco_corners(img, true)
+    wrong = find_charuco_corners(img, CharucoBoard("8x6", 0.04, 0.03, "DICT_5X5_100", False))
+    assert right is not None and len(right[0]) == true.n_corners
+    assert wrong is None or len(wrong[0]) < len(right[0]) // 2
+
+
+def test_no_board_no_corners() -> None:
+    flat = np.full((240, 320), 128, np.uint8)
+    assert find_charuco_corners(flat, BOARD) is None
+    assert CharucoBoard("10x7", 0.03, 0.022).resolve(flat) is None
+    noise = np.random.default_rng(0).integers(0, 256, (240, 320)).astype(np.uint8)
+    assert find_charuco_corners(noise, CharucoBoard("10x7", 0.03, 0.022)) is None
+
+
+# -------------------------------------------------------------------------------- calibration
+
+
+def _truth_errors(cal: Any) -> tuple[np.ndarray, np.ndarray]:
+    """Points seen by the true rig, rectified with the estimate: row offsets (px) and relative
+    range errors."""
+    rng = np.random.default_rng(11)
+    R1, R2, P1, P2, *_ = cv2.stereoRectify(
+        cal.K1, cal.D1, cal.K2, cal.D2, SIZE, cal.R, cal.T.reshape(3, 1),
+        flags=cv2.CALIB_ZERO_DISPARITY, alpha=0,
+    )  # fmt: skip
+    pts = np.c_[rng.uniform(-1.5, 1.5, 4000), rng.uniform(-1, 1, 4000), rng.uniform(2, 6, 4000)]
+    pl = cv2.projectPoints(pts, np.zeros(3), np.zeros(3), K1, D1)[0].reshape(-1, 2)
+    pr = cv2.projectPoints(pts, cv2.Rodrigues(ROT)[0], T, K2, D2)[0].reshape(-1, 2)
+    w, h = SIZE
+    ok = np.all((pl >= 0) & (pl < (w, h)) & (pr >= 0) & (pr < (w, h)), axis=1)
+    ul = cv2.undistortPoints(pl[ok].reshape(-1, 1, 2), cal.K1, cal.D1, R=R1, P=P1).reshape(-1, 2)
+    ur = cv2.undistortPoints(pr[ok].reshape(-1, 1, 2), cal.K2, cal.D2, R=R2, P=P2).reshape(-1, 2)
+    X = cv2.triangulatePoints(P1, P2, ul.T, ur.T)
+    rng_est = np.linalg.norm((X[:3] / X[3]).T, axis=1)
+    return np.abs(ul[:, 1] - ur[:, 1]), np.abs(rng_est / np.linalg.norm(pts[ok], axis=1) - 1)
+
+
+def test_stereo_calibration_recovers_the_rig_through_cut_boards(rig: dict[str, Any]) -> None:
+    """14 pairs whose boards are often cut by an image edge: all are used, and the rig comes
+    back (measured: |T| within 0.01 mm, rotation 0.06 degrees, rows 0.03 px at the 95th
+    percentile, ranges 0.2 %)."""
+    cal, rep = calibrate(rig["left"], rig["right"], board=BOARD)
+    assert len(rep.used_pairs) == 14 and not rep.rejected_pairs
+    partial = [n for n, ids in rep._ids.items() if len(ids) < BOARD.n_corners]
+    assert len(partial) >= 4  # the point of the exercise: views a chessboard could not use
+    assert rep.corners_used == sum(len(ids) for ids in rep._ids.values())
+    assert rep.rms < 0.15
+    assert abs(np.linalg.norm(cal.T) - np.linalg.norm(T)) < 2e-4
+    angle = math.degrees(float(np.linalg.norm(cv2.Rodrigues(cal.R @ ROT.T)[0])))
+    assert angle < 0.15
+    assert abs(cal.K1[0, 0] - K1[0, 0]) < 1.5 and abs(cal.K2[0, 0] - K2[0, 0]) < 1.5
+    assert abs(rep.square_size_measured / BOARD.square_size - 1) < 0.002
+    dy, rel = _truth_errors(cal)
+    assert np.percentile(dy, 95) < 0.1 and np.median(rel) < 0.003
+    assert "ChArUco 10x7 squares" in rep.summary() and "DICT_5X5_100" in rep.board
+
+
+def test_dictionary_auto_calibrates_the_same(rig: dict[str, Any]) -> None:
+    """dictionary='auto' settles on DICT_5X5_50 (a prefix of 5X5_100): the same corners, the
+    same calibration."""
+    sub = slice(0, 6)
+    a, ra = calibrate(rig["left"][sub], rig["right"][sub], board=BOARD)
+    auto = CharucoBoard("10x7", 0.03, 0.022)
+    b, rb = calibrate(rig["left"][sub], rig["right"][sub], board=auto)
+    assert "DICT_5X5_50" in rb.board
+    assert ra.corners_used == rb.corners_used
+    np.testing.assert_allclose(b.T, a.T, atol=1e-9)
+
+
+def test_pairs_with_too_few_common_corners_are_rejected_by_name(rig: dict[str, Any]) -> None:
+    """A pair whose cameras see different parts of the board is rejected with the count."""
+    left = list(rig["left"][:6])
+    right = list(rig["right"][:6])
+    # Pair 4 sees the whole board in both images: the left image keeps the board's columns 0-5,
+    # the right one columns 3-8; corners need both neighbouring markers, so 4 remain in common.
+    rv, tv = rig["poses"][4]
+    r2, t2 = _right_pose(rv, tv)
+    grid = np.arange(BOARD.n_corners)
+    pl = _project(BOARD, grid, rv, tv, K1, D1).reshape(6, 9, 2)
+    pr = _project(BOARD, grid, r2, t2, K2, D2).reshape(6, 9, 2)
+    left[4] = left[4].copy()
+    left[4][:, int((pl[:, 5, 0].max() + pl[:, 6, 0].min()) / 2) :] = 60
+    right[4] = right[4].copy()
+    right[4][:, : int((pr[:, 2, 0].max() + pr[:, 3, 0].min()) / 2)] = 60
+    right[1] = np.full_like(right[1], 60)
+    _, rep = calibrate(left, right, board=BOARD, names=[f"p{i}" for i in range(6)])
+    assert rep.rejected_pairs == {
+        "p1": "board not found in right",
+        "p4": "only 4 corners seen in both images (at least 6, not all on one line)",
+    }
+    assert len(rep.used_pairs) == 4
+
+
+def test_report_pictures_with_partial_boards(rig: dict[str, Any], tmp_path: Path) -> None:
+    _, rep = calibrate(rig["left"][:6], rig["right"][:6], board=BOARD)
+    paths = rep.write(tmp_path)
+    page = paths["html"].read_text()
+    assert "ChArUco 10x7 squares" in page and f"{rep.corners_used} corners used" in page
+    assert page.count("data:image/png;base64,") >= 3
+    assert 0.2 < rep.coverage_left < 1.0
+
+
+# ------------------------------------------------------------------------------------- errors
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (("2x5", 0.03, 0.02), "squares"),
+        (("7", 0.03, 0.02), "squares"),
+        ((("a", 5), 0.03, 0.02), "squares"),
+        (("7x5", 0.03, 0.03), "marker_size"),
+        (("7x5", -0.03, 0.02), "square_size"),
+        (("7x5", 0.03, float("nan")), "marker_size"),
+        (("7x5", 0.03, 0.02, "DICT_9X9_50"), "unknown ArUco dictionary"),
+        (("12x10", 0.03, 0.02, "DICT_4X4_50"), "has 50 markers, but a 12x10 board needs 60"),
+    ],
+)
+def test_bad_boards_are_named(args: tuple[Any, ...], match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        CharucoBoard(*args)
+
+
+def test_dictionary_names() -> None:
+    assert dictionary_name("5x5_100") == "DICT_5X5_100"
+    assert dictionary_name("apriltag_36h11") == "DICT_APRILTAG_36H11"
+    with pytest.raises(ValueError, match="expected one of 4X4_50"):
+        dictionary_name("nope")
+
+
+def test_calibrate_argument_errors(rig: dict[str, Any]) -> None:
+    left, right = rig["left"][:3], rig["right"][:3]
+    differs = "square_size: 0.05 differs from the board's 0.03"
+    with pytest.raises(ValueError, match=re.escape(differs)):
+        calibrate(left, right, board=BOARD, square_size=0.05)
+    with pytest.raises(
+        ValueError, match=re.escape("board: expected a stereovision.charuco.CharucoBoard")
+    ):
+        calibrate(left, right, board="charuco")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="square_size: required for a chessboard"):
+        calibrate(left, right)
+    flat = [np.full((480, 640), 90, np.uint8)] * 3
+    with pytest.raises(ValueError, match="no image shows enough markers"):
+        calibrate(flat, flat, board=CharucoBoard("10x7", 0.03, 0.022))
+
+
+# -------------------------------------------------------------------------- printable board
+
+
+def _png_chunks(data: bytes) -> dict[bytes, bytes]:
+    out, pos = {}, 8
+    while pos < len(data):
+        (n,) = struct.unpack(">I", data[pos : pos + 4])
+        kind, body = data[pos + 4 : pos + 8], data[pos + 8 : pos + 8 + n]
+        (crc,) = struct.unpack(">I", data[pos + 8 + n : pos + 12 + n])
+        assert crc == zlib.crc32(kind + body) & 0xFFFFFFFF
+        out[kind] = body
+        pos += 12 + n
+    return out
+
+
+def test_board_png_prints_at_its_true_size() -> None:
+    data, (w, h) = board_png(BOARD, 0.03, dpi=300)
+    ppm = struct.unpack(">IIB", _png_chunks(data)[b"pHYs"])
+    assert ppm == (11811, 11811, 1)  # 300 dpi in pixels per metre
+    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_GRAYSCALE)
+    side = round(0.03 / 0.0254 * 300)  # 354 px per 30 mm square
+    assert img.shape == (h, w) == (9 * side, 12 * side)
+    found = find_charuco_corners(img, CharucoBoard("10x7", 0.03, 0.022))
+    assert found is not None and len(found[0]) == BOARD.n_corners
+    # Corner id 0 sits one margin plus one square from the top-left, at pixel centre - 0.5.
+    np.testing.assert_allclose(found[1][0], (2 * side - 0.5, 2 * side - 0.5), atol=0.1)
+    chess, (cw, ch) = board_png((9, 6), 0.025, dpi=200)
+    img = cv2.imdecode(np.frombuffer(chess, np.uint8), cv2.IMREAD_GRAYSCALE)
+    assert img.shape == (ch, cw) and cv2.findChessboardCornersSB(img, (9, 6))[0]
+    with pytest.raises(ValueError, match="10 to 20000 px per square"):
+        board_png(BOARD, 0.0005, dpi=300)
+
+
+# ---------------------------------------------------------------------------------------- CLI
+
+
+def _cli(*args: str, timeout: int = 120) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "stereovision.cli", *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+def test_cli_board_then_calibrate(rig: dict[str, Any], tmp_path: Path) -> None:
+    run = _cli("board", "-o", str(tmp_path / "b.png"), "--board", "charuco", "--pattern", "10x7",
+               "--square", "30", "--unit", "mm", "--marker", "22")  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert "DICT_5X5_50" in run.stdout and "29.97 mm squares" in run.stdout
+    assert find_charuco_corners(cv2.imread(str(tmp_path / "b.png"), 0), BOARD) is not None
+    for i in range(6):
+        cv2.imwrite(str(tmp_path / f"left{i:02d}.png"), rig["left"][i])
+        cv2.imwrite(str(tmp_path / f"right{i:02d}.png"), rig["right"][i])
+    out = tmp_path / "rig.yaml"
+    run = _cli("calibrate", "--left", str(tmp_path / "left*.png"), "--right",
+               str(tmp_path / "right*.png"), "--board", "charuco", "--pattern", "10x7",
+               "--square", "30", "--unit", "mm", "--marker", "22", "-o", str(out))  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert "6/6 pairs used" in run.stdout and "ChArUco 10x7 squares" in run.stdout
+    from stereovision.calibration import Calibration
+
+    cal = Calibration.load(out)
+    assert cal.unit == "mm" and abs(np.linalg.norm(cal.T) - 120.0) < 0.5
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (["--board", "charuco", "--pattern", "10x7"], "--marker: give the ChArUco marker's side"),
+        (["--board", "charuco", "--marker", "0.02"], "--pattern: give the ChArUco board's"),
+        (["--marker", "0.02"], "--marker, --dictionary and --legacy are for --board charuco"),
+        (
+            ["--board", "charuco", "--pattern", "10x7", "--marker", "0.04"],
+            "--board charuco: marker_size: 0.04 must be smaller than square_size 0.03",
+        ),
+    ],
+)
+def test_cli_board_errors_are_one_line(args: list[str], match: str, tmp_path: Path) -> None:
+    (tmp_path / "x.png").write_bytes(b"")
+    images = ["--left", str(tmp_path / "x.png"), "--right", str(tmp_path / "x.png")]
+    for cmd in (
+        ["board", "-o", str(tmp_path / "b.png")],
+        ["calibrate", "-o", str(tmp_path / "c.yaml"), *images],
+    ):
+        run = _cli(*cmd, "--square", "0.03", *args)
+        assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr
+        assert match in run.stderr
+    assert not (tmp_path / "b.png").exists() and not (tmp_path / "c.yaml").exists()
