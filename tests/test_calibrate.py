@@ -315,6 +315,38 @@ def test_find_corners_matches_projection() -> None:
     assert 0 < x < 1 and 0 < y < 1 and 0.1 < size < 0.8 and 0 <= skew <= 1
 
 
+def test_a_board_cut_by_the_edge_is_not_read_one_square_off() -> None:
+    """A 9x6 board whose last corner column is out of view: OpenCV's exhaustive detector takes
+    the border squares' L-shaped outer corners for the first column and returns the board one
+    square off; find_corners sees that the side is not made of X-junctions and refuses it."""
+    K = np.array([[600.0, 0, 330], [0, 602, 238], [0, 0, 1]])
+    D = np.array([-0.30, 0.12, 0.0008, -0.0004, 0])
+    rv, tv = np.array([-0.289, 0.072, 0.195]), np.array([-0.0169, -0.0796, 0.3933])
+    img = render_chessboard(K, D, rv, tv, pattern=(9, 6), square_size=0.03, image_size=(640, 480))
+    truth = cv2.projectPoints(board_object_points((9, 6), 0.03).astype(np.float64), rv, tv, K, D)[
+        0
+    ].reshape(6, 9, 2)
+    assert truth[:, -1, 0].max() > 639  # the last column is out of the image
+    flags = calmod.SB_FLAG_SETS[-1]
+    ok, found = cv2.findChessboardCornersSB(img, (9, 6), flags=flags)
+    assert ok  # the hazard: OpenCV reports a board ...
+    first = np.asarray(found).reshape(6, 9, 2)[0, 0]
+    # ... whose first corner is the border square's outer corner, one square left of corner 0
+    assert np.linalg.norm(first - truth[0, 0]) > 30
+    assert np.linalg.norm(first - (2 * truth[0, 0] - truth[0, 1])) < 3
+    assert find_corners(img, (9, 6)) is None
+    # moved 4 cm left, the whole board is in view and found where it is
+    tv_in = tv - np.array([0.04, 0, 0])
+    img = render_chessboard(
+        K, D, rv, tv_in, pattern=(9, 6), square_size=0.03, image_size=(640, 480)
+    )
+    corners = find_corners(img, (9, 6))
+    truth = cv2.projectPoints(
+        board_object_points((9, 6), 0.03).astype(np.float64), rv, tv_in, K, D
+    )[0].reshape(-1, 2)
+    assert corners is not None and np.abs(corners - truth).max() < 0.4
+
+
 # ------------------------------------------------------------------------------ errors, CLI
 
 
