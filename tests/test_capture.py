@@ -21,12 +21,14 @@ from stereovision.capture import (
     StereoCamera,
     add_cli,
     capture,
+    charuco_pose_params,
     detect_board_live,
     next_pair_index,
     parse_size,
     parse_source,
     save_pair,
 )
+from stereovision.charuco import CharucoBoard, find_charuco_corners, render_charuco
 
 #: Frame numbers are written as a row of black/white blocks (robust to MJPG) at the top left.
 CODE_BITS = 10
@@ -428,6 +430,64 @@ def test_collector_decisions() -> None:
     assert col.progress() == {"x": 0.0, "y": 0.0, "size": 0.0, "skew": 0.0}
 
 
+def _charuco_frame(pose: tuple[np.ndarray, np.ndarray] | None, n: int, right: bool) -> np.ndarray:
+    if pose is None:
+        img = np.full((BOARD_SIZE[1], BOARD_SIZE[0]), 60, np.uint8)
+    else:
+        rv, tv = pose
+        if right:
+            rv = cv2.Rodrigues(RIG_R @ cv2.Rodrigues(rv)[0])[0].ravel()
+            tv = RIG_R @ tv + RIG_T
+        # The ChArUco board's corner 0 is one square in from its outer corner.
+        t0 = tv - cv2.Rodrigues(rv)[0] @ np.array([SQUARE, SQUARE, 0.0])
+        img = render_charuco(CHARUCO, K, D, rv, t0, image_size=BOARD_SIZE, supersample=2)
+    return _stamp(cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), n)
+
+
+#: 10x7 squares: the same 9x6 inner corners as the chessboard above.
+CHARUCO = CharucoBoard("10x7", SQUARE, 0.022, "DICT_5X5_100")
+#: POSE_B moved right until a quarter of the board leaves the left image.
+POSE_CUT = _pose(0.2, 0.06, 0.55)
+
+
+def test_charuco_pose_is_the_whole_boards() -> None:
+    """A board cut by the edge gets its whole pose: x beyond the centroid of the part seen."""
+    found = find_charuco_corners(_charuco_frame(POSE_CUT, 0, False), CHARUCO)
+    assert found is not None and 20 <= len(found[0]) < CHARUCO.n_corners
+    x = charuco_pose_params(found[0], found[1], CHARUCO, BOARD_SIZE)[0]
+    assert x > found[1][:, 0].mean() / BOARD_SIZE[0] + 0.05
+    whole = find_charuco_corners(_charuco_frame(POSE_A, 0, False), CHARUCO)
+    chess = detect_board_live(_board(POSE_A, 0, False), (9, 6))
+    assert whole is not None and chess is not None
+    p = charuco_pose_params(whole[0], whole[1], CHARUCO, BOARD_SIZE)
+    np.testing.assert_allclose(p, board_pose_params(chess, (9, 6), BOARD_SIZE), atol=0.01)
+
+
+def test_charuco_autocapture_keeps_cut_boards(tmp_path: Path) -> None:
+    """Frames: A, the board cut by the left image's edge, A again, tilted C, a board in the left
+    camera only, none. Saved: 0, 1 and 3."""
+    seq = [(POSE_A, POSE_A), (POSE_CUT, POSE_CUT), (POSE_A, POSE_A), (POSE_C, POSE_C),
+           (POSE_D, None), (None, None)]  # fmt: skip
+    left = _write_video(
+        tmp_path / "l.avi", [_charuco_frame(a, i, False) for i, (a, _) in enumerate(seq)]
+    )
+    right = _write_video(
+        tmp_path / "r.avi", [_charuco_frame(b, i, True) for i, (_, b) in enumerate(seq)]
+    )
+    auto = CharucoBoard("10x7", SQUARE, 0.022)  # dictionary found from the first frame
+    with StereoCamera(left, right) as cam:
+        result = capture(cam, tmp_path / "ch", charuco=auto)
+    assert [_read_stamp(cv2.imread(str(p[0]))) for p in result.saved] == [0, 1, 3]
+    with pytest.raises(ValueError, match="give one calibration target"):
+        capture(StereoCamera(left, right), tmp_path / "x", chessboard="9x6", charuco=auto)
+    col = ChessboardCollector(CHARUCO.inner, board=CHARUCO)
+    mk = capmod.StereoFrame
+    img = _charuco_frame(POSE_A, 0, False)
+    flat = _charuco_frame(None, 0, False)
+    assert col.consider(mk(flat, img, 0.0, 0.0, 0)).reason == "no board in left"
+    assert col.consider(mk(img, flat, 0.0, 0.0, 0)).reason == "no board in right"
+
+
 # ---------------------------------------------------------------------------------- CLI
 
 
@@ -464,5 +524,14 @@ def test_cli_capture(
         run("--left", str(left), "--right", str(right), "--count", "0", "-o", str(out))
     with pytest.raises(ValueError, match="pattern"):
         run("--left", str(left), "--right", str(right), "--chessboard", "9", "-o", str(out))
+    src = ("--left", str(left), "--right", str(right), "-o", str(out))
+    with pytest.raises(ValueError, match="give the board's --square and --marker sides too"):
+        run(*src, "--charuco", "10x7")
+    with pytest.raises(ValueError, match="--square, --marker and --dictionary are for --charuco"):
+        run(*src, "--square", "0.03")
+    with pytest.raises(ValueError, match="give one calibration target, not both"):
+        run(*src, "--charuco", "10x7", "--chessboard", "9x6", "--square", "3", "--marker", "2")
+    with pytest.raises(ValueError, match="--charuco: marker_size"):
+        run(*src, "--charuco", "10x7", "--square", "3", "--marker", "4")
     with pytest.raises(SourceError, match="after 6 pairs"):
         run("--left", str(left), "--right", str(right), "--count", "9", "-o", str(out))

@@ -14,6 +14,9 @@ written last: a pair is complete when its right image exists.
 In chessboard mode (:class:`ChessboardCollector`) a pair is saved only when both cameras see the
 board and its pose -- ``(x, y, size, skew)`` as in ROS's ``camera_calibration`` -- differs enough
 from every pair saved so far; the coverage of each of the four parameters is printed as it grows.
+With a ChArUco board (``charuco=``) a pair needs enough corners seen by both cameras (the board
+may be cut by the image edge) and its pose is that of the whole board, placed through the
+homography of the corners seen.
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ from stereovision.calibrate import (
     board_pose_params,
     parse_pattern,
 )
+from stereovision.charuco import CharucoBoard
 
 __all__ = [
     "MIN_POSE_DISTANCE",
@@ -476,6 +480,24 @@ class Decision:
     params: tuple[float, float, float, float] | None = None
 
 
+def charuco_pose_params(
+    ids: npt.ArrayLike, corners: npt.ArrayLike, board: CharucoBoard, image_size: tuple[int, int]
+) -> tuple[float, float, float, float]:
+    """:func:`~stereovision.calibrate.board_pose_params` of a ChArUco board seen in part.
+
+    The whole board's inner corners are placed in the image through the homography of the
+    corners seen, so that a board cut by the image edge gets the pose it has, not that of the
+    part in view.
+    """
+    obj = board.object_points(ids)[:, :2].astype(np.float64)
+    H, _ = cv2.findHomography(obj, np.asarray(corners, np.float64).reshape(-1, 2))
+    if H is None:  # a degenerate layout (corners_span_plane guards against it)
+        raise ValueError("the corners seen do not fix the board's pose")
+    full = board.object_points()[:, :2].astype(np.float64).reshape(-1, 1, 2)
+    grid = cv2.perspectiveTransform(full, H).reshape(-1, 2)
+    return board_pose_params(grid, board.inner, image_size)
+
+
 @dataclass
 class ChessboardCollector:
     """Choose pairs for calibration: both boards found, pose new enough (ROS's rule).
@@ -483,25 +505,60 @@ class ChessboardCollector:
     Parameters
     ----------
     pattern : tuple of int
-        ``(cols, rows)`` inner corners.
+        ``(cols, rows)`` inner corners (ignored with ``board``).
     min_distance : float
         A pair is kept when ``sum(|p - q|)`` over ``(x, y, size, skew)`` is above this for every
         kept pair ``q`` (:data:`MIN_POSE_DISTANCE`).
+    board : stereovision.charuco.CharucoBoard, optional
+        A ChArUco board instead of a chessboard: a pair counts when both cameras see at least
+        :data:`~stereovision.calibrate.CHARUCO_MIN_COMMON` common corners, not all on one line.
     """
 
     pattern: tuple[int, int]
     min_distance: float = MIN_POSE_DISTANCE
     kept: list[tuple[float, float, float, float]] = field(default_factory=list)
+    board: CharucoBoard | None = None
+
+    def _charuco_pose(self, frame: StereoFrame) -> tuple[float, float, float, float] | str:
+        from stereovision.calibrate import CHARUCO_MIN_COMMON
+        from stereovision.charuco import corners_span_plane, find_charuco_corners
+
+        assert self.board is not None
+        if not self.board.resolved:
+            found = self.board.resolve(frame.left)
+            if found is None:
+                return "no board in left"
+            self.board = found
+        fl = find_charuco_corners(frame.left, self.board)
+        if fl is None:
+            return "no board in left"
+        fr = find_charuco_corners(frame.right, self.board)
+        if fr is None:
+            return "no board in right"
+        common = np.intersect1d(fl[0], fr[0])
+        if len(common) < CHARUCO_MIN_COMMON or not corners_span_plane(self.board, common):
+            return f"only {len(common)} corners seen by both cameras"
+        h, w = frame.left.shape[:2]
+        try:
+            return charuco_pose_params(fl[0], fl[1], self.board, (w, h))
+        except ValueError as exc:
+            return str(exc)
 
     def consider(self, frame: StereoFrame) -> Decision:
         """Decide whether ``frame`` is worth saving; a kept pose is remembered."""
-        cl = detect_board_live(frame.left, self.pattern)
-        if cl is None:
-            return Decision(False, "no board in left")
-        if detect_board_live(frame.right, self.pattern) is None:
-            return Decision(False, "no board in right")
-        h, w = frame.left.shape[:2]
-        p = board_pose_params(cl, self.pattern, (w, h))
+        if self.board is not None:
+            pose = self._charuco_pose(frame)
+            if isinstance(pose, str):
+                return Decision(False, pose)
+            p = pose
+        else:
+            cl = detect_board_live(frame.left, self.pattern)
+            if cl is None:
+                return Decision(False, "no board in left")
+            if detect_board_live(frame.right, self.pattern) is None:
+                return Decision(False, "no board in right")
+            h, w = frame.left.shape[:2]
+            p = board_pose_params(cl, self.pattern, (w, h))
         if self.kept:
             nearest = min(sum(abs(a - b) for a, b in zip(p, q, strict=True)) for q in self.kept)
             if nearest <= self.min_distance:
@@ -547,6 +604,7 @@ def capture(
     *,
     count: int | None = None,
     chessboard: tuple[int, int] | str | None = None,
+    charuco: CharucoBoard | None = None,
     min_distance: float = MIN_POSE_DISTANCE,
     every: int = 1,
     ext: str = ".png",
@@ -564,6 +622,9 @@ def capture(
     chessboard : tuple of int or str, optional
         Pattern (``(9, 6)`` or ``"9x6"``): save only pairs with the board in both images and a
         new pose (:class:`ChessboardCollector`).
+    charuco : stereovision.charuco.CharucoBoard, optional
+        The same with a ChArUco board (it may be cut by the image edges); not with
+        ``chessboard``.
     min_distance : float
         Pose distance of the chessboard mode.
     every : int
@@ -589,7 +650,13 @@ def capture(
         raise ValueError(f"count: expected a positive number of pairs, got {count!r}")
     if every <= 0:
         raise ValueError(f"every: expected a positive integer, got {every!r}")
-    collector = ChessboardCollector(parse_pattern(chessboard), min_distance) if chessboard else None
+    if chessboard and charuco is not None:
+        raise ValueError("chessboard and charuco: give one calibration target, not both")
+    collector = None
+    if charuco is not None:
+        collector = ChessboardCollector(charuco.inner, min_distance, board=charuco)
+    elif chessboard:
+        collector = ChessboardCollector(parse_pattern(chessboard), min_distance)
     out = Path(directory)
     out.mkdir(parents=True, exist_ok=True)
     index = next_pair_index(out)
@@ -634,6 +701,20 @@ def capture(
 def cmd_capture(args: argparse.Namespace) -> int:
     """``stereovision capture --left 0 --right 1 --size 1280x720 -o pairs/``."""
     pattern = parse_pattern(args.chessboard) if args.chessboard else None
+    board = None
+    if args.charuco:
+        from stereovision.charuco import CharucoBoard
+
+        if pattern is not None:
+            raise ValueError("--chessboard and --charuco: give one calibration target, not both")
+        if args.square is None or args.marker is None:
+            raise ValueError("--charuco: give the board's --square and --marker sides too")
+        try:
+            board = CharucoBoard(args.charuco, args.square, args.marker, args.dictionary)
+        except ValueError as exc:
+            raise ValueError(f"--charuco: {exc}") from None
+    elif args.square is not None or args.marker is not None or args.dictionary != "auto":
+        raise ValueError("--square, --marker and --dictionary are for --charuco")
     if args.count is not None and args.count <= 0:
         raise ValueError(f"--count: expected a positive number, got {args.count}")
     cam = StereoCamera(
@@ -645,7 +726,13 @@ def cmd_capture(args: argparse.Namespace) -> int:
     try:
         print(cam.describe())
         result = capture(
-            cam, args.output, count=args.count, chessboard=pattern, every=args.every, log=print
+            cam,
+            args.output,
+            count=args.count,
+            chessboard=pattern,
+            charuco=board,
+            every=args.every,
+            log=print,
         )
     finally:
         cam.close()
@@ -673,5 +760,15 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("-o", "--output", required=True, help="output directory")
     p.add_argument("--count", type=int, help="pairs to save (default: until a source ends)")
     p.add_argument("--chessboard", metavar="COLSxROWS", help="auto-capture distinct board poses")
-    p.add_argument("--every", type=int, default=1, help="without --chessboard: save every Nth")
+    p.add_argument(
+        "--charuco",
+        metavar="COLSxROWS",
+        help="auto-capture distinct poses of a ChArUco board of COLSxROWS squares",
+    )
+    p.add_argument("--square", type=float, help="--charuco: square side")
+    p.add_argument("--marker", type=float, help="--charuco: marker side (same unit)")
+    p.add_argument(
+        "--dictionary", default="auto", help="--charuco: ArUco dictionary (default: found)"
+    )
+    p.add_argument("--every", type=int, default=1, help="without a board: save every Nth pair")
     p.set_defaults(func=cmd_capture)
