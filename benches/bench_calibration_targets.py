@@ -44,7 +44,7 @@ def degrade(img: np.ndarray, rng: np.random.Generator, hard: bool) -> np.ndarray
         f = f * gx
     f = np.clip(f + rng.normal(0, 1.0, f.shape), 0, 255).astype(np.uint8)
     if hard:
-        ok, buf = cv2.imencode(".jpg", f, [cv2.IMWRITE_JPEG_QUALITY, 85])
+        _, buf = cv2.imencode(".jpg", f, [cv2.IMWRITE_JPEG_QUALITY, 85])
         f = cv2.imdecode(buf, cv2.IMREAD_GRAYSCALE)
     return f
 

@@ -168,3 +168,43 @@ def test_rig_and_export_helpers_refuse_bad_values(crop: tuple[np.ndarray, np.nda
                 pass
             n += 1
     assert n == len(calls) * (len(BAD_VALUES) + len(shapes))
+
+
+def test_charuco_helpers_refuse_bad_values() -> None:
+    """A ChArUco board's sizes, dictionary and layout, its images, the printable PNG and the
+    renderer, given each bad value: ValueError or TypeError only."""
+    from stereovision.charuco import CharucoBoard, board_png, find_charuco_corners, render_charuco
+
+    board = CharucoBoard("7x5", 0.03, 0.02, "DICT_4X4_50", legacy=False)
+    K = np.array([[300.0, 0, 80], [0, 300, 60], [0, 0, 1]])
+    pose = (np.zeros(3), np.array([-0.1, -0.07, 0.5]))
+    calls: list[Callable[[Any], object]] = [
+        lambda v: CharucoBoard(v, 0.03, 0.02),
+        lambda v: CharucoBoard("7x5", v, 0.02),
+        lambda v: CharucoBoard("7x5", 0.03, v),
+        lambda v: CharucoBoard("7x5", 0.03, 0.02, v),
+        lambda v: find_charuco_corners(v, board),
+        board.image,
+        lambda v: board.image(100, margin=v),
+        lambda v: board_png(board, v),
+        lambda v: board_png(board, 0.03, dpi=v),
+        lambda v: board_png((9, 6), v),
+        lambda v: render_charuco(
+            board, K, np.zeros(5), *pose, image_size=(160, 120), supersample=v
+        ),
+        lambda v: render_charuco(board, K, np.zeros(5), *pose, image_size=v),
+        lambda v: render_charuco(
+            board, K, np.zeros(5), *pose, image_size=(160, 120), pixels_per_square=v
+        ),
+    ]
+    shapes: list[Any] = [(1,), (0, 0), (-5, 10), (2.5, 3), "lr", ("left", 3), np.zeros((2, 2, 7))]
+    rejected = 0
+    for call in calls:
+        for v in [*BAD_VALUES, *shapes]:
+            try:
+                call(v)
+            except (ValueError, TypeError):
+                rejected += 1
+            except Exception as exc:
+                pytest.fail(f"{v!r}: {type(exc).__name__}: {exc}")
+    assert rejected > len(calls) * 8

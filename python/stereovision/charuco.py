@@ -66,6 +66,20 @@ DICTIONARY_FAMILIES: dict[str, tuple[tuple[str, int], ...]] = {
 AUTO_MIN_MARKERS = 2
 
 
+#: Largest board image (pixels) :meth:`CharucoBoard.image` and :func:`board_png` make: a 1 m board
+#: at 600 dpi is 5.6e8 px; 2.5e8 (250 MB of grey) covers A0 at 300 dpi with room to spare.
+MAX_IMAGE_PIXELS = 250_000_000
+
+
+def _int_in(value: object, name: str, lo: int, hi: int) -> int:
+    """``value`` as an int within ``[lo, hi]``, else a ValueError naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer, float, np.floating)):
+        raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
+    if not np.isfinite(value) or int(value) != value or not lo <= int(value) <= hi:
+        raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
+    return int(value)
+
+
 def dictionary_name(name: str) -> str:
     """Canonical OpenCV name of a predefined ArUco dictionary.
 
@@ -246,14 +260,15 @@ class CharucoBoard:
         numpy.ndarray
             ``uint8`` ``(rows * p + 2 margin, cols * p + 2 margin)``.
         """
-        p = int(pixels_per_square)
-        if p < 10:
-            raise ValueError(f"pixels_per_square: expected at least 10, got {pixels_per_square}")
-        mg = p if margin is None else int(margin)
-        if mg < 0:
-            raise ValueError(f"margin: expected >= 0 pixels, got {margin}")
+        p = _int_in(pixels_per_square, "pixels_per_square", 10, 20000)
+        mg = p if margin is None else _int_in(margin, "margin", 0, 10 * p)
         cols, rows = self.squares
         size = (cols * p + 2 * mg, rows * p + 2 * mg)
+        if size[0] * size[1] > MAX_IMAGE_PIXELS:
+            raise ValueError(
+                f"pixels_per_square: a {size[0]}x{size[1]} image is over "
+                f"{MAX_IMAGE_PIXELS:.2g} pixels; use fewer pixels per square"
+            )
         return np.asarray(self.cv_board().generateImage(size, marginSize=mg, borderBits=1))
 
     def resolve(self, image: npt.ArrayLike) -> CharucoBoard | None:
@@ -436,8 +451,14 @@ def render_charuco(
     numpy.ndarray
         ``(height, width)`` ``uint8``.
     """
-    w, h = image_size
-    ss = int(supersample)
+    try:
+        w, h = (_int_in(v, "image_size", 1, 20000) for v in image_size)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"image_size: expected (width, height) in pixels, got {image_size!r}"
+        ) from None
+    ss = _int_in(supersample, "supersample", 1, 8)
+    _int_in(pixels_per_square, "pixels_per_square", 10, 2000)
     Kf = np.asarray(K, np.float64)
     Df = np.asarray(D, np.float64).ravel()
     Rb, _ = cv2.Rodrigues(np.asarray(rvec, np.float64).reshape(3, 1))
@@ -501,7 +522,9 @@ def board_png(
     bytes, tuple of int
         The PNG file's bytes and its ``(width, height)`` in pixels.
     """
-    p = square_metres / 0.0254 * dpi
+    from stereovision._validate import positive_finite
+
+    p = positive_finite(square_metres, "square_metres") / 0.0254 * positive_finite(dpi, "dpi")
     if not 10 <= p <= 20000:
         raise ValueError(
             f"a {square_metres * 1000:g} mm square at {dpi:g} dpi is {p:.1f} px; use a square "
@@ -511,8 +534,12 @@ def board_png(
     if isinstance(board, CharucoBoard):
         img = board.image(pix, margin=pix)
     else:
-        cols, rows = board
+        from stereovision.calibrate import parse_pattern
+
+        cols, rows = parse_pattern(board)
         sq_c, sq_r = cols + 1, rows + 1
+        if (sq_c + 2) * (sq_r + 2) * pix * pix > MAX_IMAGE_PIXELS:
+            raise ValueError(f"a {cols}x{rows} chessboard at {pix} px per square is too large")
         img = np.full((sq_r * pix + 2 * pix, sq_c * pix + 2 * pix), 255, np.uint8)
         for r in range(sq_r):
             for c in range(sq_c):
