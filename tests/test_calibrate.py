@@ -371,7 +371,7 @@ def test_input_errors(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="unit"):
         calibrate(left[:2], right[:2], square_size=1.0, unit="parsec")
     with pytest.raises(ValueError, match="distortion"):
-        calibrate(left[:2], right[:2], square_size=1.0, distortion="fisheye")
+        calibrate(left[:2], right[:2], square_size=1.0, distortion="kannala_brandt")
     small = np.zeros((240, 320), np.uint8)
     with pytest.raises(ValueError, match="320x240"):
         calibrate([left[0], small], [right[0], small], square_size=1.0)

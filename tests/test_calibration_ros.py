@@ -181,7 +181,15 @@ def _cam_text(**changes: object) -> str:
     ("changes", "message"),
     [
         ({"projection_matrix": None}, "lacks field 'projection_matrix'"),
-        ({"distortion_model": "equidistant"}, "fisheye"),
+        ({"distortion_model": "equidistant"}, "'equidistant' takes \\(4,\\) coefficients"),
+        (
+            {
+                "distortion_model": "equidistant",
+                "distortion_coefficients": {"rows": 1, "cols": 4, "data": [0.0] * 4},
+            },
+            "'plumb_bob', .* is 'equidistant'; a rig needs one lens model",
+        ),
+        ({"distortion_model": "kannala_brandt"}, "distortion_model 'kannala_brandt'"),
         ({"distortion_model": "rational_polynomial"}, "takes \\(8,\\) coefficients"),
         ({"camera_matrix": {"rows": 3, "cols": 3, "data": [1, 2]}}, "holds 2 numbers"),
         ({"camera_matrix": {"rows": 2, "cols": 3, "data": list(range(9))}}, "rows=2"),
@@ -353,7 +361,8 @@ def test_kalibr_camchain(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("change", "message"),
     [
-        ({"dist": "equidistant"}, "fisheye"),
+        ({"dist": "equidistant"}, "use different distortion models; a rig needs one"),
+        ({"dist": "double_sphere"}, "expected 'radtan', 'equidistant' or 'none'"),
         ({"model": "omni"}, "only 'pinhole'"),
         ({"size": (640, 480)}, "a rig needs one size"),
         ({"T": np.zeros((4, 4))}, "last row"),

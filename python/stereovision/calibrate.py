@@ -110,6 +110,9 @@ DISTORTION_MODELS: dict[str, int] = {
     "k1k2p1p2k3": 0,
     "rational": cv2.CALIB_RATIONAL_MODEL,
 }
+#: ``cv2.fisheye`` calibration flags (``distortion="fisheye"``): extrinsics re-estimated at each
+#: step (the solver's own advice for convergence), no skew.
+FISHEYE_FLAGS = cv2.fisheye.CALIB_RECOMPUTE_EXTRINSIC | cv2.fisheye.CALIB_FIX_SKEW
 #: Candidates of ``distortion="auto"``, simplest first. The rational model is not a candidate:
 #: on OpenCV's sample pairs it fits the corners as well as k1 k2 p1 p2 but extrapolates wildly
 #: outside them (5 of 13 boards no longer found after rectification).
@@ -649,6 +652,113 @@ def _radial_is_monotonic(K: F64, D: F64, size: tuple[int, int]) -> bool:
     return bool(reach.max() >= rd_max)
 
 
+def _fisheye_unusable(
+    obj: Sequence[np.ndarray],
+    left: Sequence[np.ndarray],
+    right: Sequence[np.ndarray],
+    size: tuple[int, int],
+) -> list[int]:
+    """Views whose pose ``cv2.fisheye.calibrate`` cannot initialise (it then aborts the whole
+    solve): each view is tried beside the view with the most corners, in both cameras."""
+    o = [np.asarray(x, np.float64).reshape(-1, 1, 3) for x in obj]
+    ref = int(np.argmax([len(x) for x in o]))
+    crit = (cv2.TERM_CRITERIA_COUNT + cv2.TERM_CRITERIA_EPS, 5, 1e-6)
+    bad = []
+    for i in range(len(o)):
+        views = [ref] if i == ref else [ref, i]
+        for pts in (left, right):
+            p = [np.asarray(pts[k], np.float64).reshape(-1, 1, 2) for k in views]
+            try:
+                cv2.fisheye.calibrate(
+                    [o[k] for k in views], p, size, np.eye(3), np.zeros(4),
+                    flags=FISHEYE_FLAGS, criteria=crit,
+                )  # fmt: skip
+            except cv2.error:
+                bad.append(i)
+                break
+    return bad
+
+
+def _solve_fisheye(
+    obj: Sequence[np.ndarray],
+    left: Sequence[np.ndarray],
+    right: Sequence[np.ndarray],
+    size: tuple[int, int],
+    refine: bool,
+) -> _Solution:
+    """``cv2.fisheye.calibrate`` per camera, then the rig from the undistorted corners.
+
+    ``cv2.fisheye.stereoCalibrate`` cannot take views with different numbers of corners (OpenCV
+    issue 21748: a reshape error), which every ChArUco pair has. So each camera's corners are
+    undistorted with its own fisheye intrinsics into a virtual pinhole camera (no distortion,
+    the mean focal length) and ``cv2.stereoCalibrateExtended`` solves ``R``, ``T`` and the board
+    poses there with those intrinsics fixed; the errors reported are then measured in the real
+    fisheye images. (``refine`` has no fisheye counterpart: the intrinsics stay as calibrated.)
+    """
+    o = [np.asarray(x, np.float64).reshape(-1, 1, 3) for x in obj]
+    pl = [np.asarray(x, np.float64).reshape(-1, 1, 2) for x in left]
+    pr = [np.asarray(x, np.float64).reshape(-1, 1, 2) for x in right]
+    try:
+        mono: Any = [
+            cv2.fisheye.calibrate(
+                o, pts, size, np.eye(3), np.zeros(4), flags=FISHEYE_FLAGS, criteria=SOLVER_CRITERIA
+            )
+            for pts in (pl, pr)
+        ]
+    except cv2.error as exc:
+        raise ValueError(
+            f"the fisheye solver failed ({str(exc).strip().splitlines()[-1]}); check that the "
+            "lens is a fisheye one and that the boards are found"
+        ) from None
+    rms_l, K1, D1 = mono[0][:3]
+    rms_r, K2, D2 = mono[1][:3]
+    f_v = float(K1[0, 0] + K2[0, 0]) / 2
+    k_v = np.array([[f_v, 0.0, 0.0], [0.0, f_v, 0.0], [0.0, 0.0, 1.0]])
+    crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 40, 1e-12)
+
+    def virtual(pts: np.ndarray, K: np.ndarray, D: np.ndarray) -> np.ndarray:
+        und = cv2.fisheye.undistortPoints(pts, K, D, criteria=crit)
+        return (np.asarray(und, np.float64) * f_v).astype(np.float32)
+
+    vl = [virtual(p, K1, D1) for p in pl]
+    vr = [virtual(p, K2, D2) for p in pr]
+    of = [x.astype(np.float32) for x in o]
+    out: Any = cv2.stereoCalibrateExtended(
+        of, vl, vr, k_v, np.zeros(5), k_v, np.zeros(5), size, np.eye(3), np.zeros((3, 1)),
+        flags=cv2.CALIB_FIX_INTRINSIC, criteria=SOLVER_CRITERIA,
+    )  # fmt: skip
+    R = np.asarray(out[5], np.float64)
+    T = np.asarray(out[6], np.float64).reshape(3, 1)
+    rvecs, tvecs = out[9], out[10]
+    per_view = np.zeros((len(o), 2))
+    sq, n = 0.0, 0
+    for i in range(len(o)):
+        rb = cv2.Rodrigues(np.asarray(rvecs[i], np.float64).reshape(3, 1))[0]
+        tb = np.asarray(tvecs[i], np.float64).reshape(3, 1)
+        poses = ((rb, tb, K1, D1, pl[i]), (R @ rb, R @ tb + T, K2, D2, pr[i]))
+        for cam, (rot, t, K, D, pts) in enumerate(poses):
+            proj, _ = cv2.fisheye.projectPoints(o[i], cv2.Rodrigues(rot)[0], t, K, D)
+            err2 = np.sum((proj.reshape(-1, 2) - pts.reshape(-1, 2)) ** 2, axis=1)
+            per_view[i, cam] = math.sqrt(float(np.mean(err2)))
+            sq += float(np.sum(err2))
+            n += len(err2)
+    return _Solution(
+        rms=math.sqrt(sq / max(n, 1)),
+        rms_left=float(rms_l),
+        rms_right=float(rms_r),
+        K1=np.asarray(K1, np.float64),
+        D1=np.asarray(D1, np.float64).ravel(),
+        K2=np.asarray(K2, np.float64),
+        D2=np.asarray(D2, np.float64).ravel(),
+        R=R,
+        T=T.ravel(),
+        per_view=per_view,
+        refined=False,
+        model="fisheye",
+        model_selection={},
+    )
+
+
 def _solve(
     obj: Sequence[np.ndarray],
     left: Sequence[np.ndarray],
@@ -657,6 +767,8 @@ def _solve(
     distortion: str,
     refine: bool,
 ) -> _Solution:
+    if distortion == "fisheye":
+        return _solve_fisheye(obj, left, right, size, refine)
     selection: dict[str, float] = {}
     if distortion == "auto":
         candidates = AUTO_CANDIDATES
@@ -717,8 +829,7 @@ def _solve(
 
 
 def _rectified_checks(
-    sol: _Solution,
-    size: tuple[int, int],
+    cal: Calibration,
     left: Sequence[F64],
     right: Sequence[F64],
     pattern: tuple[int, int],
@@ -729,16 +840,13 @@ def _rectified_checks(
     ``ids`` are each pair's corners' indices in the ``pattern`` grid (row-major); the square size
     is measured between grid neighbours both seen.
     """
-    R1, R2, P1, P2, _, _, _ = cv2.stereoRectify(
-        sol.K1, sol.D1, sol.K2, sol.D2, size, sol.R, sol.T.reshape(3, 1),
-        flags=cv2.CALIB_ZERO_DISPARITY, alpha=0,
-    )  # fmt: skip
+    _, _, P1, P2, _ = cal._stereo_rectify(0.0)
     dys: list[F64] = []
     sides: list[F64] = []
     cols, rows = pattern
     for cl, cr, idx in zip(left, right, ids, strict=True):
-        ul = cv2.undistortPoints(cl.reshape(-1, 1, 2), sol.K1, sol.D1, R=R1, P=P1).reshape(-1, 2)
-        ur = cv2.undistortPoints(cr.reshape(-1, 1, 2), sol.K2, sol.D2, R=R2, P=P2).reshape(-1, 2)
+        ul = cal.rectify_points(cl, "left")
+        ur = cal.rectify_points(cr, "right")
         dys.append(np.abs(ul[:, 1] - ur[:, 1]))
         Xh = cv2.triangulatePoints(P1, P2, ul.T, ur.T)
         flat = np.full((rows * cols, 3), np.nan)
@@ -821,8 +929,9 @@ def calibrate(
     unit : str
         Length unit of ``square_size`` (``"m"``, ``"mm"``, ``"cm"``, ``"ft"``, ``"in"``).
     distortion : str
-        ``"auto"`` (k1 k2 p1 p2, with k3 only when it predicts held-out views better), or one of
-        :data:`DISTORTION_MODELS`.
+        ``"auto"`` (k1 k2 p1 p2, with k3 only when it predicts held-out views better), one of
+        :data:`DISTORTION_MODELS`, or ``"fisheye"``: ``cv2.fisheye``'s equidistant model (k1..k4)
+        for wide-angle lenses, giving a ``model="fisheye"`` calibration.
     refine : bool
         Run the joint refinement of intrinsics and extrinsics after the fixed-intrinsics solve.
     drop_outliers : bool
@@ -889,9 +998,10 @@ def calibrate(
             f"square_size: {square:g} {unit} is {metres:g} m; expected a board square between "
             "1 nm and 100 m"
         )
-    if distortion != "auto" and distortion not in DISTORTION_MODELS:
+    if distortion not in ("auto", "fisheye") and distortion not in DISTORTION_MODELS:
         raise ValueError(
-            f"distortion: expected 'auto' or one of {list(DISTORTION_MODELS)}, got {distortion!r}"
+            f"distortion: expected 'auto', 'fisheye' or one of {list(DISTORTION_MODELS)}, got "
+            f"{distortion!r}"
         )
     lefts, rights = list(left_images), list(right_images)
     if len(lefts) != len(rights):
@@ -988,6 +1098,24 @@ def calibrate(
         )
 
     obj_pts = board_object_points(pat, square)
+    if distortion == "fisheye":
+        unusable = _fisheye_unusable(
+            [obj_pts[corner_ids[i]] for i in used],  # type: ignore[index]
+            [corners_l[i] for i in used],  # type: ignore[misc]
+            [corners_r[i] for i in used],  # type: ignore[misc]
+            size,
+        )
+        for k in unusable:
+            rejected[pair_names[used[k]]] = (
+                "the fisheye solver cannot start from this view (too few corners, or too close "
+                "to a line)"
+            )
+        used = [i for k, i in enumerate(used) if k not in set(unusable)]
+        if len(used) < MIN_PAIRS:
+            raise ValueError(
+                f"only {len(used)} pairs can start the fisheye solver; at least {MIN_PAIRS} are "
+                f"needed (rejected: {', '.join(rejected)})"
+            )
     outliers: list[str] = []
     for _ in range(MAX_OUTLIER_ROUNDS + 1):
         obj = [obj_pts[corner_ids[i]] for i in used]  # type: ignore[index]
@@ -1011,8 +1139,9 @@ def calibrate(
         used = [i for k, i in enumerate(used) if k not in set(bad)]
 
     cal = Calibration(
-        K1=sol.K1, D1=sol.D1, K2=sol.K2, D2=sol.D2, R=sol.R, T=sol.T, image_size=size, unit=unit
-    )
+        K1=sol.K1, D1=sol.D1, K2=sol.K2, D2=sol.D2, R=sol.R, T=sol.T, image_size=size, unit=unit,
+        model="fisheye" if sol.model == "fisheye" else "pinhole",
+    )  # fmt: skip
     used_l: list[F64] = []
     used_r: list[F64] = []
     used_ids: list[npt.NDArray[np.int64]] = []
@@ -1022,9 +1151,7 @@ def calibrate(
         used_l.append(cl)
         used_r.append(cr)
         used_ids.append(ix)
-    mean_dy, max_dy, side_med, side_std = _rectified_checks(
-        sol, size, used_l, used_r, pat, used_ids
-    )
+    mean_dy, max_dy, side_med, side_std = _rectified_checks(cal, used_l, used_r, pat, used_ids)
     cov_l = _coverage_mask(used_l, pat, size)
     cov_r = _coverage_mask(used_r, pat, size)
     names_used = [pair_names[i] for i in used]
@@ -1192,18 +1319,8 @@ def _rectified_picture(rep: CalibrationReport) -> np.ndarray | None:
     if rep._sample is None or rep._calibration is None:
         return None
     cal = rep._calibration
-    R1, R2, P1, P2, _, _, _ = cv2.stereoRectify(
-        cal.K1, cal.D1, cal.K2, cal.D2, cal.image_size, cal.R, cal.T.reshape(3, 1),
-        flags=cv2.CALIB_ZERO_DISPARITY, alpha=0,
-    )  # fmt: skip
-    out = []
-    for img, K, D, Rr, P in (
-        (rep._sample[1], cal.K1, cal.D1, R1, P1),
-        (rep._sample[2], cal.K2, cal.D2, R2, P2),
-    ):
-        mx, my = cv2.initUndistortRectifyMap(K, D, Rr, P, cal.image_size, cv2.CV_32FC1)
-        out.append(cv2.cvtColor(cv2.remap(img, mx, my, cv2.INTER_LINEAR), cv2.COLOR_GRAY2BGR))
-    pair = np.hstack(out)
+    rl, rr = cal.rectify(rep._sample[1], rep._sample[2])
+    pair = np.hstack([cv2.cvtColor(im, cv2.COLOR_GRAY2BGR) for im in (rl, rr)])
     h = pair.shape[0]
     step = max(8, h // 16)
     colors = [(0, 0, 255), (0, 200, 0), (255, 0, 0), (0, 200, 255)]
@@ -1636,8 +1753,9 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument(
         "--distortion",
         default="auto",
-        choices=["auto", *DISTORTION_MODELS],
-        help="distortion model (default: auto, chosen by cross-validation)",
+        choices=["auto", *DISTORTION_MODELS, "fisheye"],
+        help="distortion model (default: auto, chosen by cross-validation; fisheye: "
+        "cv2.fisheye's equidistant model for wide-angle lenses)",
     )
     p.add_argument("--drop-outliers", action="store_true", help="drop outlier pairs and re-solve")
     p.add_argument("-o", "--output", required=True, help="calibration file (.yaml/.json)")

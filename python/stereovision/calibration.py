@@ -6,7 +6,9 @@ Conventions (OpenCV's, same as Bouguet's toolbox and ``cv2.stereoCalibrate``):
 * ``X_R = R @ X_L + T`` maps a point from left-camera to right-camera coordinates, so a standard
   left/right rig has ``T ~ (-B, 0, 0)`` with ``B`` the baseline;
 * distortion coefficients in OpenCV's order ``(k1, k2, p1, p2[, k3[, k4, k5, k6[, s1..s4[, tx,
-  ty]]]])``;
+  ty]]]])``; with ``model="fisheye"`` (wide-angle lenses), OpenCV's equidistant model
+  ``cv2.fisheye`` (``theta_d = theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8)``,
+  four coefficients; ROS's and Kalibr's ``equidistant``);
 * lengths (``T``, baseline) are in the calibration's ``unit``; depths and points returned by
   :meth:`Calibration.depth_from_disparity` and :meth:`Calibration.reproject` are in metres.
 """
@@ -28,6 +30,7 @@ import numpy.typing as npt
 from stereovision._validate import as_image_array, positive_finite
 
 __all__ = [
+    "CAMERA_MODELS",
     "DISTORTION_LENGTHS",
     "ROS_DISTORTION_MODELS",
     "UNIT_TO_METRES",
@@ -45,6 +48,8 @@ F64 = npt.NDArray[np.float64]
 UNIT_TO_METRES: dict[str, float] = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "ft": 0.3048, "in": 0.0254}
 #: Distortion vector lengths OpenCV accepts.
 DISTORTION_LENGTHS: tuple[int, ...] = (4, 5, 8, 12, 14)
+#: Lens models: OpenCV's pinhole with polynomial distortion, and its fisheye (equidistant) model.
+CAMERA_MODELS: tuple[str, ...] = ("pinhole", "fisheye")
 #: Tolerance of the rotation check on R (orthonormality and det = +1).
 ROTATION_TOL = 1e-6
 #: Relative tolerance for "equal" numbers of the two cameras of a rectified calibration.
@@ -161,6 +166,10 @@ class Calibration:
     doffs : float, optional
         Rectified only: ``cx_right - cx_left`` in pixels (Middlebury's ``doffs``); derived from
         ``K1``/``K2`` when omitted, checked against them when given.
+    model : str
+        ``"pinhole"`` (OpenCV's polynomial distortion) or ``"fisheye"`` (``cv2.fisheye``'s
+        equidistant model, ``D`` of 4 coefficients ``k1..k4``): a fisheye rig is rectified by
+        ``cv2.fisheye.stereoRectify`` to a pinhole pair, and everything downstream is the same.
 
     Notes
     -----
@@ -185,6 +194,7 @@ class Calibration:
     unit: str = "m"
     rectified: bool = False
     doffs: float | None = None
+    model: str = "pinhole"
     _cache: dict[Any, Any] = field(default_factory=dict, init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -219,6 +229,17 @@ class Calibration:
             if not self.rectified:
                 raise ValueError("doffs: only applies to a rectified calibration")
             object.__setattr__(self, "doffs", d)
+        if self.model not in CAMERA_MODELS:
+            raise ValueError(f"model: expected one of {list(CAMERA_MODELS)}, got {self.model!r}")
+        if self.model == "fisheye":
+            for name, coeffs in (("D1", self.D1), ("D2", self.D2)):
+                if coeffs.size != 4:
+                    raise ValueError(
+                        f"{name}: the fisheye model takes 4 coefficients (k1..k4), got "
+                        f"{coeffs.size}"
+                    )
+            if self.rectified:
+                raise ValueError("model: a rectified calibration is a pinhole pair, not fisheye")
         if self.rectified:
             self._check_rectified()
 
@@ -276,6 +297,7 @@ class Calibration:
             and self.unit == other.unit
             and self.rectified == other.rectified
             and self.doffs == other.doffs
+            and self.model == other.model
         )
 
     __hash__ = None  # type: ignore[assignment]
@@ -342,6 +364,23 @@ class Calibration:
 
     def _stereo_rectify(self, alpha: float) -> tuple[F64, F64, F64, F64, F64]:
         key = ("stereoRectify", float(alpha))
+        if key not in self._cache and self.model == "fisheye":
+            # alpha plays the part of cv2.fisheye's balance: 0 the focal length that keeps only
+            # valid pixels, 1 the one that keeps the whole field.
+            r1, r2, p1, p2, q = cv2.fisheye.stereoRectify(
+                self.K1,
+                self.D1,
+                self.K2,
+                self.D2,
+                self.image_size,
+                self.R,
+                self.T.reshape(3, 1),
+                flags=cv2.fisheye.CALIB_ZERO_DISPARITY,
+                newImageSize=self.image_size,
+                balance=float(alpha),
+                fov_scale=1.0,
+            )
+            self._cache[key] = (r1, r2, p1, p2, q)
         if key not in self._cache:
             r1, r2, p1, p2, q, roi1, roi2 = cv2.stereoRectify(
                 self.K1,
@@ -384,6 +423,12 @@ class Calibration:
         if not 0.0 <= alpha <= 1.0:
             raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
         self._stereo_rectify(alpha)
+        if ("roi", float(alpha)) not in self._cache:  # fisheye: OpenCV gives none; from the maps
+            m1x, m1y, m2x, m2y = self._maps(alpha)
+            self._cache[("roi", float(alpha))] = (
+                _inner_rectangle(m1x, m1y, self.image_size),
+                _inner_rectangle(m2x, m2y, self.image_size),
+            )
         rois: tuple[tuple[int, int, int, int], tuple[int, int, int, int]] = self._cache[
             ("roi", float(alpha))
         ]
@@ -393,12 +438,13 @@ class Calibration:
         key = ("maps", float(alpha))
         if key not in self._cache:
             r1, r2, p1, p2, _ = self._stereo_rectify(alpha)
-            m1x, m1y = cv2.initUndistortRectifyMap(
-                self.K1, self.D1, r1, p1, self.image_size, cv2.CV_32FC1
+            init = (
+                cv2.fisheye.initUndistortRectifyMap
+                if self.model == "fisheye"
+                else cv2.initUndistortRectifyMap
             )
-            m2x, m2y = cv2.initUndistortRectifyMap(
-                self.K2, self.D2, r2, p2, self.image_size, cv2.CV_32FC1
-            )
+            m1x, m1y = init(self.K1, self.D1, r1, p1, self.image_size, cv2.CV_32FC1)
+            m2x, m2y = init(self.K2, self.D2, r2, p2, self.image_size, cv2.CV_32FC1)
             self._cache[key] = (m1x, m1y, m2x, m2y)
         out: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] = self._cache[key]
         return out
@@ -448,6 +494,53 @@ class Calibration:
         lr = cv2.remap(la, m1x, m1y, cv2.INTER_LINEAR)
         rr = cv2.remap(ra, m2x, m2y, cv2.INTER_LINEAR)
         return lr, rr
+
+    def rectify_points(self, points: npt.ArrayLike, side: str = "left", alpha: float = 0.0) -> F64:
+        """Raw pixel positions of one camera mapped to the rectified image of :meth:`rectify`.
+
+        ``cv2.undistortPoints`` (``cv2.fisheye.undistortPoints`` for a fisheye rig) with that
+        camera's rectifying rotation and projection: features found on raw frames (a tracker's,
+        a board's corners) land where :meth:`rectify` puts their pixels. A ``rectified``
+        calibration returns the points unchanged.
+
+        Parameters
+        ----------
+        points : array_like
+            ``(N, 2)`` raw pixel coordinates ``(x, y)``.
+        side : str
+            ``"left"`` or ``"right"``.
+        alpha : float
+            As in :meth:`rectify`.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(N, 2)`` float64 rectified pixel coordinates.
+
+        Raises
+        ------
+        ValueError
+            For points not of shape ``(N, 2)``, an unknown ``side`` or ``alpha`` outside
+            ``[0, 1]``.
+        """
+        pts = np.asarray(points, dtype=np.float64)
+        if pts.ndim != 2 or pts.shape[1] != 2:
+            raise ValueError(f"points: expected shape (N, 2), got {pts.shape}")
+        if side not in ("left", "right"):
+            raise ValueError(f"side: expected 'left' or 'right', got {side!r}")
+        if self.rectified or len(pts) == 0:
+            return pts.copy()
+        if not 0.0 <= alpha <= 1.0:
+            raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
+        r1, r2, p1, p2, _ = self._stereo_rectify(alpha)
+        K, D, r, p = (self.K1, self.D1, r1, p1) if side == "left" else (self.K2, self.D2, r2, p2)
+        src = pts.reshape(-1, 1, 2)
+        # Iterate to convergence: OpenCV's default 5 steps leave a visible error far off axis.
+        crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 40, 1e-12)
+        undistort = cv2.fisheye.undistortPoints if self.model == "fisheye" else cv2.undistortPoints
+        out = undistort(src, K, D, R=r, P=p, criteria=crit)
+        res: F64 = np.asarray(out, np.float64).reshape(-1, 2)
+        return res
 
     def rectified_calibration(self, alpha: float = 0.0) -> Calibration:
         """Calibration of the pair produced by :meth:`rectify` with the same ``alpha``.
@@ -597,6 +690,7 @@ class Calibration:
             unit=self.unit,
             rectified=self.rectified,
             doffs=None if self.doffs is None else self.doffs * sx,
+            model=self.model,
         )
 
     def to_camera_frame(self, points: npt.ArrayLike) -> npt.NDArray[np.floating[Any]]:
@@ -674,6 +768,8 @@ class Calibration:
         }
         if self.doffs is not None:
             rec["doffs"] = self.doffs
+        if self.model != "pinhole":  # older files have no model: they are pinhole
+            rec["model"] = self.model
         return rec
 
     def save(self, path: PathLike) -> Path:
@@ -737,6 +833,7 @@ class Calibration:
         width = need("image_width")
         height = need("image_height")
         doffs = get("doffs")
+        model = get("model")
         return cls(
             K1=need("K1", "M1"),
             D1=need("D1"),
@@ -748,6 +845,7 @@ class Calibration:
             unit=str(need("unit")),
             rectified=bool(int(get("rectified") or 0)),
             doffs=None if doffs is None else float(doffs),
+            model="pinhole" if model is None else str(model),
         )
 
     @classmethod
@@ -1046,7 +1144,13 @@ class Calibration:
                 "are two monocular calibrations; calibrate the cameras as a stereo pair"
             )
         size = cams[0]["image_size"]
-        looks_rectified = all(
+        fisheye = [c["distortion_model"] == "equidistant" for c in cams]
+        if fisheye[0] != fisheye[1]:
+            raise ValueError(
+                f"ROS camera_info: {lsrc} is {cams[0]['distortion_model']!r}, {rsrc} is "
+                f"{cams[1]['distortion_model']!r}; a rig needs one lens model"
+            )
+        looks_rectified = not fisheye[0] and all(
             not np.any(c["D"])
             and np.abs(c["R"] - np.eye(3)).max() <= _ROS_IDENTITY_TOL
             and np.allclose(c["K"], c["P"][:, :3], rtol=RECTIFIED_REL_TOL, atol=0)
@@ -1076,6 +1180,7 @@ class Calibration:
             T=T,
             image_size=size,
             unit="m",
+            model="fisheye" if fisheye[0] else "pinhole",
         )
 
     @classmethod
@@ -1085,7 +1190,8 @@ class Calibration:
         """A rig from Kalibr's ``camchain.yaml`` (or ``camchain-imucam.yaml``), metres.
 
         Kalibr, the usual calibrator of camera-IMU rigs, gives each camera ``intrinsics``
-        ``[fu, fv, pu, pv]``, ``distortion_coeffs`` (``radtan``: OpenCV's ``k1 k2 p1 p2``),
+        ``[fu, fv, pu, pv]``, ``distortion_coeffs`` (``radtan``: OpenCV's ``k1 k2 p1 p2``;
+        ``equidistant``: ``cv2.fisheye``'s ``k1..k4``, read as ``model="fisheye"``),
         ``resolution`` and, from the second camera on, ``T_cn_cnm1``: the 4x4 transform from the
         previous camera's frame to its own, ``X_n = T X_{n-1}`` in metres. The rig's ``R``,
         ``T`` are that transform (chained when the two cameras are not neighbours).
@@ -1108,8 +1214,9 @@ class Calibration:
             If the file does not exist.
         ValueError
             A camera missing or out of order, a camera model other than ``pinhole`` or a
-            distortion other than ``radtan``/``none`` (``equidistant`` is a fisheye model, not
-            supported), a malformed field (named), or cameras of different resolutions.
+            distortion other than ``radtan``/``equidistant``/``none``, the two cameras with
+            different distortion models, a malformed field (named), or cameras of different
+            resolutions.
         """
         import yaml
 
@@ -1141,6 +1248,10 @@ class Calibration:
         for name in chain[i + 1 : j + 1]:
             transform = _kalibr_transform(doc[name], f"{p}:{name}") @ transform
         transform[:3, :3] = _snap_rotation(transform[:3, :3], f"{p}: T_cn_cnm1 of {right!r}")
+        if cams[0]["fisheye"] != cams[1]["fisheye"]:
+            raise ValueError(
+                f"{p}: {left} and {right} use different distortion models; a rig needs one"
+            )
         return cls(
             K1=cams[0]["K"],
             D1=cams[0]["D"],
@@ -1150,6 +1261,7 @@ class Calibration:
             T=transform[:3, 3],
             image_size=cams[0]["resolution"],
             unit="m",
+            model="fisheye" if cams[0]["fisheye"] else "pinhole",
         )
 
     def to_ros(
@@ -1211,9 +1323,12 @@ class Calibration:
                         f"terms (coefficients 9-{D.size} are not zero)"
                     )
                 D = D[:8]
-            if D.size == 4:
-                D = np.append(D, 0.0)
-            model = "plumb_bob" if D.size == 5 else "rational_polynomial"
+            if self.model == "fisheye":
+                model = "equidistant"
+            else:
+                if D.size == 4:
+                    D = np.append(D, 0.0)
+                model = "plumb_bob" if D.size == 5 else "rational_polynomial"
             texts.append(_ros_yaml(name, self.image_size, K, D, r, p, model))
         return texts[0], texts[1]
 
@@ -1253,6 +1368,38 @@ class Calibration:
             with atomic_write(path, "w") as fh:
                 fh.write(text)
         return paths
+
+
+def _inner_rectangle(
+    mx: np.ndarray, my: np.ndarray, size: tuple[int, int]
+) -> tuple[int, int, int, int]:
+    """A rectangle ``(x, y, w, h)`` of a rectification map whose pixels all come from inside the
+    source image: the map's valid bounding box, shrunk on its worst side until all are valid."""
+    w, h = size
+    valid = (mx >= 0) & (mx <= w - 1) & (my >= 0) & (my <= h - 1)
+    ys, xs = np.nonzero(valid)
+    if ys.size == 0:
+        return 0, 0, 0, 0
+    x0, x1, y0, y1 = int(xs.min()), int(xs.max()), int(ys.min()), int(ys.max())
+    while x0 <= x1 and y0 <= y1:
+        sides = (
+            int(np.count_nonzero(~valid[y0, x0 : x1 + 1])),
+            int(np.count_nonzero(~valid[y1, x0 : x1 + 1])),
+            int(np.count_nonzero(~valid[y0 : y1 + 1, x0])),
+            int(np.count_nonzero(~valid[y0 : y1 + 1, x1])),
+        )
+        worst = int(np.argmax(sides))
+        if sides[worst] == 0:
+            return x0, y0, x1 - x0 + 1, y1 - y0 + 1
+        if worst == 0:
+            y0 += 1
+        elif worst == 1:
+            y1 -= 1
+        elif worst == 2:
+            x0 += 1
+        else:
+            x1 -= 1
+    return 0, 0, 0, 0
 
 
 def fit_to_frames(calib: Calibration, size: tuple[int, int]) -> tuple[Calibration, str | None]:
@@ -1402,6 +1549,7 @@ def parse_kitti_calib(path: PathLike) -> dict[str, F64]:
 ROS_DISTORTION_MODELS: dict[str, tuple[int, ...]] = {
     "plumb_bob": (4, 5),
     "rational_polynomial": (8,),
+    "equidistant": (4,),
 }
 _ROS_FIELDS = (
     "camera_matrix",
@@ -1475,7 +1623,7 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
     ------
     ValueError
         If the YAML does not parse, a field is missing or malformed (named), or the distortion
-        model is one this package cannot use (``equidistant``, a fisheye model).
+        model is not one of :data:`ROS_DISTORTION_MODELS` (``equidistant`` is the fisheye model).
     """
     import yaml
 
@@ -1506,10 +1654,8 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
         size.append(v)
     model = doc.get("distortion_model", doc.get("camera_model", "plumb_bob"))
     if model not in ROS_DISTORTION_MODELS:
-        hint = " (a fisheye model, not supported)" if model == "equidistant" else ""
         raise ValueError(
-            f"{source}: distortion_model {model!r}{hint}; expected one of "
-            f"{list(ROS_DISTORTION_MODELS)}"
+            f"{source}: distortion_model {model!r}; expected one of {list(ROS_DISTORTION_MODELS)}"
         )
     out: dict[str, Any] = {
         "image_size": (size[0], size[1]),
@@ -1528,7 +1674,7 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
             f"{source}: distortion_model {model!r} takes {ROS_DISTORTION_MODELS[model]} "
             f"coefficients, distortion_coefficients holds {d.size}"
         )
-    if d.size == 4:
+    if d.size == 4 and model != "equidistant":
         out["D"] = np.append(d, 0.0)
     return out
 
@@ -1616,12 +1762,13 @@ def _kalibr_camera(cam: object, source: str) -> dict[str, Any]:
     if model != "pinhole":
         raise ValueError(f"{source}: camera_model {model!r}; only 'pinhole' is supported")
     dist = cam.get("distortion_model", "radtan")
-    if dist not in ("radtan", "none"):
-        hint = " (a fisheye model, not supported)" if dist == "equidistant" else ""
-        raise ValueError(f"{source}: distortion_model {dist!r}{hint}; expected 'radtan' or 'none'")
+    if dist not in ("radtan", "none", "equidistant"):
+        raise ValueError(
+            f"{source}: distortion_model {dist!r}; expected 'radtan', 'equidistant' or 'none'"
+        )
     fu, fv, pu, pv = _kalibr_numbers(cam["intrinsics"], "intrinsics", source, 4)
-    d = np.zeros(5)
-    if dist == "radtan":
+    d = np.zeros(4 if dist == "equidistant" else 5)
+    if dist in ("radtan", "equidistant"):
         d[:4] = _kalibr_numbers(cam.get("distortion_coeffs"), "distortion_coeffs", source, 4)
     res = _kalibr_numbers(cam["resolution"], "resolution", source, 2)
     if not np.all(res == np.round(res)) or np.any(res <= 0):
@@ -1630,6 +1777,7 @@ def _kalibr_camera(cam: object, source: str) -> dict[str, Any]:
         "K": np.array([[fu, 0.0, pu], [0.0, fv, pv], [0.0, 0.0, 1.0]]),
         "D": d,
         "resolution": (int(res[0]), int(res[1])),
+        "fisheye": dist == "equidistant",
     }
 
 

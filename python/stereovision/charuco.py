@@ -30,6 +30,8 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from stereovision.synthetic import render_plane
+
 __all__ = [
     "DICTIONARY_FAMILIES",
     "MIN_CORNERS",
@@ -390,25 +392,6 @@ def find_charuco_corners(
 
 # ------------------------------------------------------------------------------ synthetic views
 
-_RAYS: dict[tuple[Any, ...], F64] = {}
-
-
-def _pixel_rays(K: F64, D: F64, size: tuple[int, int], ss: int) -> F64:
-    """Undistorted normalised coordinates of every supersampled pixel centre (cached per camera)."""
-    key = (K.tobytes(), D.tobytes(), size, ss)
-    if key not in _RAYS:
-        w, h = size
-        xs = (np.arange(w * ss) + 0.5) / ss - 0.5
-        ys = (np.arange(h * ss) + 0.5) / ss - 0.5
-        gx, gy = np.meshgrid(xs, ys)
-        pts = np.stack([gx.ravel(), gy.ravel()], axis=1).reshape(-1, 1, 2)
-        crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 40, 1e-12)
-        und = cv2.undistortPoints(pts, K, D, R=None, P=None, criteria=crit)
-        if len(_RAYS) > 8:
-            _RAYS.clear()
-        _RAYS[key] = np.asarray(und, np.float64).reshape(h * ss, w * ss, 2)
-    return _RAYS[key]
-
 
 def render_charuco(
     board: CharucoBoard,
@@ -421,13 +404,14 @@ def render_charuco(
     supersample: int = 3,
     pixels_per_square: int = 120,
     background: int = 60,
+    model: str = "pinhole",
 ) -> npt.NDArray[np.uint8]:
     """Render a ChArUco board seen by a camera, for tests and demos (antialiased, distorted).
 
-    Every supersampled pixel's ray (lens distortion undone by ``cv2.undistortPointsIter``) is
-    intersected with the board plane and looks up the board's image; the supersampled picture is
-    then area-averaged down. The board lies in its ``Z = 0`` plane as
-    :meth:`CharucoBoard.object_points`; its white margin is one square wide.
+    :func:`stereovision.synthetic.render_plane` of the board's image: every supersampled pixel's
+    ray (lens distortion undone) meets the board plane and looks up the board's image there. The
+    board lies in its ``Z = 0`` plane as :meth:`CharucoBoard.object_points`; its white margin is
+    one square wide.
 
     Parameters
     ----------
@@ -445,6 +429,8 @@ def render_charuco(
         Resolution of the board image that is looked up.
     background : int
         Grey level off the board (the board is 0 and 255; it is mapped to 25 .. 230).
+    model : str
+        ``"pinhole"`` or ``"fisheye"`` (``D`` then holds ``cv2.fisheye``'s k1..k4).
 
     Returns
     -------
@@ -458,30 +444,23 @@ def render_charuco(
             f"image_size: expected (width, height) in pixels, got {image_size!r}"
         ) from None
     ss = _int_in(supersample, "supersample", 1, 8)
-    _int_in(pixels_per_square, "pixels_per_square", 10, 2000)
-    Kf = np.asarray(K, np.float64)
-    Df = np.asarray(D, np.float64).ravel()
-    Rb, _ = cv2.Rodrigues(np.asarray(rvec, np.float64).reshape(3, 1))
-    t = np.asarray(tvec, np.float64).ravel()
-    H = np.column_stack([Rb[:, 0], Rb[:, 1], t])  # (u, v, 1) on the board -> ray
-    Hi = np.linalg.inv(H)
-    rays = _pixel_rays(Kf, Df, (w, h), ss)
-    u = Hi[0, 0] * rays[..., 0] + Hi[0, 1] * rays[..., 1] + Hi[0, 2]
-    v = Hi[1, 0] * rays[..., 0] + Hi[1, 1] * rays[..., 1] + Hi[1, 2]
-    q = Hi[2, 0] * rays[..., 0] + Hi[2, 1] * rays[..., 1] + Hi[2, 2]
-    # Rays that meet the plane behind the camera (q <= 0 for a board in front) see background.
-    front = q > 1e-12
-    qs = np.where(front, q, 1.0)
-    p = int(pixels_per_square)
+    p = _int_in(pixels_per_square, "pixels_per_square", 10, 2000)
     img = board.image(p, margin=p)
-    # Board coordinate 0 is the image's outer edge of the squares, at pixel p - 0.5 (centres).
-    mx = np.where(front, u / qs / board.square_size * p + p - 0.5, -1e6).astype(np.float32)
-    my = np.where(front, v / qs / board.square_size * p + p - 0.5, -1e6).astype(np.float32)
     tone = (img.astype(np.float32) * ((230.0 - 25.0) / 255.0) + 25.0).astype(np.float32)
-    canvas = cv2.remap(
-        tone, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=background
+    # Board coordinate 0 is the outer edge of the squares: the image's pixel p - 0.5 (centres).
+    out = render_plane(
+        tone,
+        board.square_size / p,
+        K,
+        D,
+        rvec,
+        tvec,
+        image_size=(w, h),
+        supersample=ss,
+        background=background,
+        model=model,
+        origin_px=(p - 0.5, p - 0.5),
     )
-    out = cv2.resize(canvas, (w, h), interpolation=cv2.INTER_AREA)
     return np.asarray(np.clip(np.round(out), 0, 255), np.uint8)
 
 

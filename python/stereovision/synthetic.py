@@ -1,0 +1,155 @@
+"""Rendered views of a textured plane through a calibrated camera, for tests, benches and demos.
+
+:func:`render_plane` traces every (supersampled) pixel's ray -- the lens distortion undone by
+OpenCV's own inverse, ``cv2.undistortPoints`` or ``cv2.fisheye.undistortPoints`` -- to the plane
+and looks up the texture there, then area-averages the samples down. Boards
+(:func:`stereovision.charuco.render_charuco`) and textured walls seen by a pinhole or a fisheye
+rig are rendered this way, so that a test knows the exact geometry behind every pixel.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+__all__ = ["render_plane"]
+
+F64 = npt.NDArray[np.float64]
+
+_RAYS: dict[tuple[Any, ...], F64] = {}
+
+
+def _int_in(value: object, name: str, lo: int, hi: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer, float, np.floating)):
+        raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
+    if not np.isfinite(value) or int(value) != value or not lo <= int(value) <= hi:
+        raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
+    return int(value)
+
+
+def pixel_rays(K: F64, D: F64, size: tuple[int, int], ss: int, model: str = "pinhole") -> F64:
+    """Normalised undistorted ray ``(x, y)`` (``z = 1``) of every supersampled pixel centre.
+
+    Cached per camera. Supersampled pixel ``j`` covers ``[j / ss - 0.5, (j + 1) / ss - 0.5]``
+    of the image's x axis (pixel centres at integers).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(h * ss, w * ss, 2)`` float64; NaN where the model has no ray in front of the camera.
+    """
+    key = (K.tobytes(), D.tobytes(), size, ss, model)
+    if key not in _RAYS:
+        w, h = size
+        xs = (np.arange(w * ss) + 0.5) / ss - 0.5
+        ys = (np.arange(h * ss) + 0.5) / ss - 0.5
+        gx, gy = np.meshgrid(xs, ys)
+        pts = np.stack([gx.ravel(), gy.ravel()], axis=1).reshape(-1, 1, 2)
+        crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 40, 1e-12)
+        if model == "fisheye":
+            und = cv2.fisheye.undistortPoints(pts, K, D, criteria=crit)
+        else:
+            und = cv2.undistortPoints(pts, K, D, R=None, P=None, criteria=crit)
+        rays = np.asarray(und, np.float64).reshape(h * ss, w * ss, 2)
+        if model == "fisheye":
+            # Past 90 degrees off axis there is no ray with z = 1: OpenCV returns garbage there.
+            theta_d = np.hypot((gx - K[0, 2]) / K[0, 0], (gy - K[1, 2]) / K[1, 1])
+            rays[theta_d >= np.pi / 2 * 0.999] = np.nan
+        if len(_RAYS) > 8:
+            _RAYS.clear()
+        _RAYS[key] = rays
+    return _RAYS[key]
+
+
+def render_plane(
+    texture: npt.ArrayLike,
+    units_per_pixel: float,
+    K: npt.ArrayLike,
+    D: npt.ArrayLike,
+    rvec: npt.ArrayLike,
+    tvec: npt.ArrayLike,
+    *,
+    image_size: tuple[int, int] = (640, 480),
+    supersample: int = 3,
+    background: float = 60.0,
+    model: str = "pinhole",
+    origin_px: tuple[float, float] = (-0.5, -0.5),
+) -> np.ndarray:
+    """Render a textured plane seen by a camera (antialiased, through its lens distortion).
+
+    The plane is the ``Z = 0`` plane of its own frame; texture pixel ``(i, j)`` (row, column)
+    covers ``[(j + 0.5 + origin_px[0]) s, ...]`` with ``s = units_per_pixel``, i.e. the plane
+    point ``(u, v)`` reads the texture at pixel ``(u / s + origin_px[0], v / s + origin_px[1])``
+    (bilinear). The default origin puts ``(0, 0)`` at the texture's top-left pixel corner.
+
+    Parameters
+    ----------
+    texture : array_like
+        Grey ``(H, W)`` or colour ``(H, W, 3)`` image, any dtype ``cv2.remap`` takes.
+    units_per_pixel : float
+        Size of one texture pixel on the plane (in the unit of ``tvec``).
+    K, D : array_like
+        Camera matrix and distortion coefficients (OpenCV's order; 4 for ``model="fisheye"``).
+    rvec, tvec : array_like
+        Plane-to-camera rotation (Rodrigues) and translation.
+    image_size : tuple of int
+        ``(width, height)``.
+    supersample : int
+        Samples per pixel side (1 to 8).
+    background : float
+        Value off the plane.
+    model : str
+        ``"pinhole"`` or ``"fisheye"`` (``cv2.fisheye``'s equidistant model).
+    origin_px : tuple of float
+        Texture pixel coordinate of the plane's origin.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(height, width[, 3])`` of the texture's dtype (float textures stay float).
+
+    Raises
+    ------
+    ValueError
+        For a bad size, supersampling or model.
+    """
+    if model not in ("pinhole", "fisheye"):
+        raise ValueError(f"model: expected 'pinhole' or 'fisheye', got {model!r}")
+    try:
+        w, h = (_int_in(v, "image_size", 1, 20000) for v in image_size)
+    except (TypeError, ValueError):
+        raise ValueError(
+            f"image_size: expected (width, height) in pixels, got {image_size!r}"
+        ) from None
+    ss = _int_in(supersample, "supersample", 1, 8)
+    tex = np.asarray(texture)
+    s = float(units_per_pixel)
+    if not (np.isfinite(s) and s > 0):
+        raise ValueError(f"units_per_pixel: expected a positive number, got {units_per_pixel!r}")
+    Kf = np.asarray(K, np.float64)
+    Df = np.asarray(D, np.float64).ravel()
+    Rb, _ = cv2.Rodrigues(np.asarray(rvec, np.float64).reshape(3, 1))
+    t = np.asarray(tvec, np.float64).ravel()
+    Hi = np.linalg.inv(np.column_stack([Rb[:, 0], Rb[:, 1], t]))  # ray -> (u, v, 1) on the plane
+    rays = pixel_rays(Kf, Df, (w, h), ss, model)
+    x, y = rays[..., 0], rays[..., 1]
+    u = Hi[0, 0] * x + Hi[0, 1] * y + Hi[0, 2]
+    v = Hi[1, 0] * x + Hi[1, 1] * y + Hi[1, 2]
+    q = Hi[2, 0] * x + Hi[2, 1] * y + Hi[2, 2]
+    # Rays that meet the plane behind the camera (q <= 0 for a plane in front) see background.
+    front = np.isfinite(q) & (q > 1e-12)
+    qs = np.where(front, q, 1.0)
+    mx = np.where(front, u / qs / s + origin_px[0], -1e6).astype(np.float32)
+    my = np.where(front, v / qs / s + origin_px[1], -1e6).astype(np.float32)
+    work = tex.astype(np.float32)
+    canvas = cv2.remap(
+        work, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=background
+    )
+    out = cv2.resize(canvas, (w, h), interpolation=cv2.INTER_AREA)
+    if np.issubdtype(tex.dtype, np.integer):
+        info = np.iinfo(tex.dtype)
+        return np.clip(np.round(out), info.min, info.max).astype(tex.dtype)
+    return out.astype(tex.dtype)
