@@ -630,7 +630,11 @@ class Calibration:
         )
         steps = ", ".join(f"at {z:g} m {length(float(self.depth_step(z)))}" for z in depths)
         far = f * b / (1 + doffs) if 1 + doffs > 0 else math.inf
-        kind = "rectified pair" if self.rectified else "raw rig, rectified with alpha 0"
+        kind = (
+            "rectified pair"
+            if self.rectified
+            else f"raw {'fisheye ' if self.model == 'fisheye' else ''}rig, rectified with alpha 0"
+        )
         return "\n".join(
             [
                 f"{w}x{h} px, {kind}: baseline {length(b)} ({self.baseline:g} {self.unit}), "

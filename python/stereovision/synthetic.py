@@ -145,8 +145,9 @@ def render_plane(
     mx = np.where(front, u / qs / s + origin_px[0], -1e6).astype(np.float32)
     my = np.where(front, v / qs / s + origin_px[1], -1e6).astype(np.float32)
     work = tex.astype(np.float32)
+    fill = (float(background),) * (tex.shape[2] if tex.ndim == 3 else 1)  # grey in every channel
     canvas = cv2.remap(
-        work, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=background
+        work, mx, my, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=fill
     )
     out = cv2.resize(canvas, (w, h), interpolation=cv2.INTER_AREA)
     if np.issubdtype(tex.dtype, np.integer):
