@@ -16,23 +16,22 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 import time
+from pathlib import Path
 
 import cv2
 import numpy as np
 
 from stereovision.calibrate import calibrate, render_chessboard
-from stereovision.charuco import CharucoBoard, render_charuco
+from stereovision.charuco import render_charuco
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+# The rig of tests/test_charuco.py: 640x480, k1 about -0.3, 120 mm baseline; its 10x7 board.
+from tests.test_charuco import BOARD, D1, D2, K1, K2, ROT, T
 
 SIZE = (640, 480)
-K1 = np.array([[600.0, 0, 330], [0, 602, 238], [0, 0, 1]])
-D1 = np.array([-0.30, 0.12, 0.0008, -0.0004, 0])
-K2 = np.array([[605.0, 0, 316], [0, 604, 244], [0, 0, 1]])
-D2 = np.array([-0.28, 0.10, -0.0006, 0.0005, 0])
-ROT = cv2.Rodrigues(np.array([0.01, -0.03, 0.005]))[0]
-T = np.array([-0.12, 0.002, 0.001])
 SQUARE = 0.03
-BOARD = CharucoBoard("10x7", SQUARE, 0.022, "DICT_5X5_100")
 
 
 def degrade(img: np.ndarray, rng: np.random.Generator, hard: bool) -> np.ndarray:

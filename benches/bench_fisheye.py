@@ -18,6 +18,7 @@ import argparse
 import math
 import sys
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -26,35 +27,17 @@ from _common import DATA
 import stereovision as sv
 from stereovision.calibrate import calibrate
 from stereovision.calibration import Calibration
-from stereovision.synthetic import render_plane
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 from tests import test_fisheye as rig  # noqa: E402  (the rig and views of the tests)
 
 
-def wall(calib: Calibration, z_wall: float) -> tuple[np.ndarray, np.ndarray, object, np.ndarray]:
+def wall(calib: Calibration, z_wall: float) -> tuple[np.ndarray, np.ndarray, Any, np.ndarray]:
     tex = cv2.imread(str(DATA / "middlebury2003" / "cones" / "left.png"), cv2.IMREAD_COLOR)
-    tex = np.tile(tex, (4, 4, 1))
-    s = 0.004 * z_wall / 2.5  # the texture's scale in the image stays the same
-    tv = np.array([-tex.shape[1] * s / 2, -tex.shape[0] * s / 2, z_wall])
-    kw = {"image_size": rig.SIZE, "model": "fisheye", "supersample": 2}
-    left = render_plane(tex, s, rig.K1, rig.D1, np.zeros(3), tv, **kw)
-    r2, t2 = rig._right_pose(np.zeros(3), tv)
-    right = render_plane(tex, s, rig.K2, rig.D2, r2, t2, **kw)
+    left, right = rig.render_wall(tex, z_wall)
     res = sv.depth_map(left, right, calib, max_disparity=32)
-    r1 = calib._stereo_rectify(0.0)[0]
-    # The true wall in the estimated rectified frame: the frame is turned by the estimate's R1
-    # from the true left camera (the estimate's left camera is taken as the true one).
-    n = r1 @ np.array([0.0, 0.0, 1.0])
-    rc = calib.rectified_calibration()
-    h, w = res.depth.shape
-    xs, ys = np.meshgrid(np.arange(w), np.arange(h))
-    rays = np.stack(
-        [(xs - rc.K1[0, 2]) / rc.K1[0, 0], (ys - rc.K1[1, 2]) / rc.K1[1, 1], np.ones_like(xs)],
-        axis=-1,
-    )
-    return left, right, res, z_wall / (rays @ n)
+    return left, right, res, rig.wall_depth(calib, z_wall)
 
 
 def main() -> None:

@@ -330,7 +330,11 @@ def test_no_partial_file_visible_to_a_concurrent_reader(tmp_path: Path) -> None:
 # ---------------------------------------------------------------------------- chessboard
 
 
-def _board(pose: tuple[np.ndarray, np.ndarray] | None, n: int, right: bool) -> np.ndarray:
+def _board(
+    pose: tuple[np.ndarray, np.ndarray] | None, n: int, right: bool, charuco: bool = False
+) -> np.ndarray:
+    """The 9x6 chessboard (or the 10x7-square ChArUco board with the same corners) at ``pose``
+    seen by the left or right camera, stamped with frame number ``n``."""
     if pose is None:
         img = np.full((BOARD_SIZE[1], BOARD_SIZE[0]), 60, np.uint8)
     else:
@@ -338,9 +342,14 @@ def _board(pose: tuple[np.ndarray, np.ndarray] | None, n: int, right: bool) -> n
         if right:
             rv = cv2.Rodrigues(RIG_R @ cv2.Rodrigues(rv)[0])[0].ravel()
             tv = RIG_R @ tv + RIG_T
-        img = render_chessboard(
-            K, D, rv, tv, pattern=(9, 6), square_size=SQUARE, image_size=BOARD_SIZE
-        )
+        if charuco:
+            # The ChArUco board's corner 0 is one square in from its outer corner.
+            t0 = tv - cv2.Rodrigues(rv)[0] @ np.array([SQUARE, SQUARE, 0.0])
+            img = render_charuco(CHARUCO, K, D, rv, t0, image_size=BOARD_SIZE, supersample=2)
+        else:
+            img = render_chessboard(
+                K, D, rv, tv, pattern=(9, 6), square_size=SQUARE, image_size=BOARD_SIZE
+            )
     return _stamp(cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), n)
 
 
@@ -430,20 +439,6 @@ def test_collector_decisions() -> None:
     assert col.progress() == {"x": 0.0, "y": 0.0, "size": 0.0, "skew": 0.0}
 
 
-def _charuco_frame(pose: tuple[np.ndarray, np.ndarray] | None, n: int, right: bool) -> np.ndarray:
-    if pose is None:
-        img = np.full((BOARD_SIZE[1], BOARD_SIZE[0]), 60, np.uint8)
-    else:
-        rv, tv = pose
-        if right:
-            rv = cv2.Rodrigues(RIG_R @ cv2.Rodrigues(rv)[0])[0].ravel()
-            tv = RIG_R @ tv + RIG_T
-        # The ChArUco board's corner 0 is one square in from its outer corner.
-        t0 = tv - cv2.Rodrigues(rv)[0] @ np.array([SQUARE, SQUARE, 0.0])
-        img = render_charuco(CHARUCO, K, D, rv, t0, image_size=BOARD_SIZE, supersample=2)
-    return _stamp(cv2.cvtColor(img, cv2.COLOR_GRAY2BGR), n)
-
-
 #: 10x7 squares: the same 9x6 inner corners as the chessboard above.
 CHARUCO = CharucoBoard("10x7", SQUARE, 0.022, "DICT_5X5_100")
 #: POSE_B moved right until a quarter of the board leaves the left image.
@@ -452,11 +447,11 @@ POSE_CUT = _pose(0.2, 0.06, 0.55)
 
 def test_charuco_pose_is_the_whole_boards() -> None:
     """A board cut by the edge gets its whole pose: x beyond the centroid of the part seen."""
-    found = find_charuco_corners(_charuco_frame(POSE_CUT, 0, False), CHARUCO)
+    found = find_charuco_corners(_board(POSE_CUT, 0, False, charuco=True), CHARUCO)
     assert found is not None and 20 <= len(found[0]) < CHARUCO.n_corners
     x = charuco_pose_params(found[0], found[1], CHARUCO, BOARD_SIZE)[0]
     assert x > found[1][:, 0].mean() / BOARD_SIZE[0] + 0.05
-    whole = find_charuco_corners(_charuco_frame(POSE_A, 0, False), CHARUCO)
+    whole = find_charuco_corners(_board(POSE_A, 0, False, charuco=True), CHARUCO)
     chess = detect_board_live(_board(POSE_A, 0, False), (9, 6))
     assert whole is not None and chess is not None
     p = charuco_pose_params(whole[0], whole[1], CHARUCO, BOARD_SIZE)
@@ -469,10 +464,10 @@ def test_charuco_autocapture_keeps_cut_boards(tmp_path: Path) -> None:
     seq = [(POSE_A, POSE_A), (POSE_CUT, POSE_CUT), (POSE_A, POSE_A), (POSE_C, POSE_C),
            (POSE_D, None), (None, None)]  # fmt: skip
     left = _write_video(
-        tmp_path / "l.avi", [_charuco_frame(a, i, False) for i, (a, _) in enumerate(seq)]
+        tmp_path / "l.avi", [_board(a, i, False, charuco=True) for i, (a, _) in enumerate(seq)]
     )
     right = _write_video(
-        tmp_path / "r.avi", [_charuco_frame(b, i, True) for i, (_, b) in enumerate(seq)]
+        tmp_path / "r.avi", [_board(b, i, True, charuco=True) for i, (_, b) in enumerate(seq)]
     )
     auto = CharucoBoard("10x7", SQUARE, 0.022)  # dictionary found from the first frame
     with StereoCamera(left, right) as cam:
@@ -482,8 +477,8 @@ def test_charuco_autocapture_keeps_cut_boards(tmp_path: Path) -> None:
         capture(StereoCamera(left, right), tmp_path / "x", chessboard="9x6", charuco=auto)
     col = ChessboardCollector(CHARUCO.inner, board=CHARUCO)
     mk = capmod.StereoFrame
-    img = _charuco_frame(POSE_A, 0, False)
-    flat = _charuco_frame(None, 0, False)
+    img = _board(POSE_A, 0, False, charuco=True)
+    flat = _board(None, 0, False, charuco=True)
     assert col.consider(mk(flat, img, 0.0, 0.0, 0)).reason == "no board in left"
     assert col.consider(mk(img, flat, 0.0, 0.0, 0)).reason == "no board in right"
 

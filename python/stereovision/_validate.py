@@ -26,6 +26,7 @@ __all__ = [
     "as_gray_uint8",
     "as_image_array",
     "check_pair",
+    "int_in_range",
     "positive_finite",
 ]
 
@@ -347,3 +348,21 @@ def positive_finite(value: object, name: str) -> float:
     if not math.isfinite(out) or out <= 0.0:
         raise ValueError(f"{name}: expected a positive finite number, got {out!r}")
     return out
+
+
+def int_in_range(value: object, name: str, lo: int, hi: int) -> int:
+    """``value`` as an ``int`` within ``[lo, hi]`` (an integral float is accepted).
+
+    Raises
+    ------
+    ValueError
+        Naming ``name``, for a bool, a non-number, a non-integral or non-finite number, or one
+        outside the range.
+    """
+    ok = not isinstance(value, bool) and isinstance(value, (int, np.integer, float, np.floating))
+    if ok:
+        v = float(value)  # type: ignore[arg-type]
+        ok = math.isfinite(v) and v == int(v) and lo <= int(v) <= hi
+    if not ok:
+        raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
+    return int(value)  # type: ignore[call-overload]

@@ -364,25 +364,8 @@ class Calibration:
 
     def _stereo_rectify(self, alpha: float) -> tuple[F64, F64, F64, F64, F64]:
         key = ("stereoRectify", float(alpha))
-        if key not in self._cache and self.model == "fisheye":
-            # alpha plays the part of cv2.fisheye's balance: 0 the focal length that keeps only
-            # valid pixels, 1 the one that keeps the whole field.
-            r1, r2, p1, p2, q = cv2.fisheye.stereoRectify(
-                self.K1,
-                self.D1,
-                self.K2,
-                self.D2,
-                self.image_size,
-                self.R,
-                self.T.reshape(3, 1),
-                flags=cv2.fisheye.CALIB_ZERO_DISPARITY,
-                newImageSize=self.image_size,
-                balance=float(alpha),
-                fov_scale=1.0,
-            )
-            self._cache[key] = (r1, r2, p1, p2, q)
         if key not in self._cache:
-            r1, r2, p1, p2, q, roi1, roi2 = cv2.stereoRectify(
+            rig = (
                 self.K1,
                 self.D1,
                 self.K2,
@@ -390,11 +373,23 @@ class Calibration:
                 self.image_size,
                 self.R,
                 self.T.reshape(3, 1),
-                flags=cv2.CALIB_ZERO_DISPARITY,
-                alpha=float(alpha),
             )
+            if self.model == "fisheye":
+                # alpha plays the part of cv2.fisheye's balance: 0 the focal length that keeps
+                # only valid pixels, 1 the one that keeps the whole field.
+                r1, r2, p1, p2, q = cv2.fisheye.stereoRectify(
+                    *rig,
+                    flags=cv2.fisheye.CALIB_ZERO_DISPARITY,
+                    newImageSize=self.image_size,
+                    balance=float(alpha),
+                    fov_scale=1.0,
+                )
+            else:
+                r1, r2, p1, p2, q, roi1, roi2 = cv2.stereoRectify(
+                    *rig, flags=cv2.CALIB_ZERO_DISPARITY, alpha=float(alpha)
+                )
+                self._cache[("roi", float(alpha))] = (tuple(roi1), tuple(roi2))
             self._cache[key] = (r1, r2, p1, p2, q)
-            self._cache[("roi", float(alpha))] = (tuple(roi1), tuple(roi2))
         out: tuple[F64, F64, F64, F64, F64] = self._cache[key]
         return out
 

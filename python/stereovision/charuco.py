@@ -30,6 +30,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import int_in_range
 from stereovision.synthetic import render_plane
 
 __all__ = [
@@ -71,15 +72,6 @@ AUTO_MIN_MARKERS = 2
 #: Largest board image (pixels) :meth:`CharucoBoard.image` and :func:`board_png` make: a 1 m board
 #: at 600 dpi is 5.6e8 px; 2.5e8 (250 MB of grey) covers A0 at 300 dpi with room to spare.
 MAX_IMAGE_PIXELS = 250_000_000
-
-
-def _int_in(value: object, name: str, lo: int, hi: int) -> int:
-    """``value`` as an int within ``[lo, hi]``, else a ValueError naming ``name``."""
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer, float, np.floating)):
-        raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
-    if not np.isfinite(value) or int(value) != value or not lo <= int(value) <= hi:
-        raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
-    return int(value)
 
 
 def dictionary_name(name: str) -> str:
@@ -262,8 +254,8 @@ class CharucoBoard:
         numpy.ndarray
             ``uint8`` ``(rows * p + 2 margin, cols * p + 2 margin)``.
         """
-        p = _int_in(pixels_per_square, "pixels_per_square", 10, 20000)
-        mg = p if margin is None else _int_in(margin, "margin", 0, 10 * p)
+        p = int_in_range(pixels_per_square, "pixels_per_square", 10, 20000)
+        mg = p if margin is None else int_in_range(margin, "margin", 0, 10 * p)
         cols, rows = self.squares
         size = (cols * p + 2 * mg, rows * p + 2 * mg)
         if size[0] * size[1] > MAX_IMAGE_PIXELS:
@@ -437,14 +429,7 @@ def render_charuco(
     numpy.ndarray
         ``(height, width)`` ``uint8``.
     """
-    try:
-        w, h = (_int_in(v, "image_size", 1, 20000) for v in image_size)
-    except (TypeError, ValueError):
-        raise ValueError(
-            f"image_size: expected (width, height) in pixels, got {image_size!r}"
-        ) from None
-    ss = _int_in(supersample, "supersample", 1, 8)
-    p = _int_in(pixels_per_square, "pixels_per_square", 10, 2000)
+    p = int_in_range(pixels_per_square, "pixels_per_square", 10, 2000)
     img = board.image(p, margin=p)
     tone = (img.astype(np.float32) * ((230.0 - 25.0) / 255.0) + 25.0).astype(np.float32)
     # Board coordinate 0 is the outer edge of the squares: the image's pixel p - 0.5 (centres).
@@ -455,8 +440,8 @@ def render_charuco(
         D,
         rvec,
         tvec,
-        image_size=(w, h),
-        supersample=ss,
+        image_size=image_size,
+        supersample=supersample,
         background=background,
         model=model,
         origin_px=(p - 0.5, p - 0.5),

@@ -15,19 +15,13 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import int_in_range
+
 __all__ = ["render_plane"]
 
 F64 = npt.NDArray[np.float64]
 
 _RAYS: dict[tuple[Any, ...], F64] = {}
-
-
-def _int_in(value: object, name: str, lo: int, hi: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer, float, np.floating)):
-        raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
-    if not np.isfinite(value) or int(value) != value or not lo <= int(value) <= hi:
-        raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
-    return int(value)
 
 
 def pixel_rays(K: F64, D: F64, size: tuple[int, int], ss: int, model: str = "pinhole") -> F64:
@@ -119,12 +113,12 @@ def render_plane(
     if model not in ("pinhole", "fisheye"):
         raise ValueError(f"model: expected 'pinhole' or 'fisheye', got {model!r}")
     try:
-        w, h = (_int_in(v, "image_size", 1, 20000) for v in image_size)
+        w, h = (int_in_range(v, "image_size", 1, 20000) for v in image_size)
     except (TypeError, ValueError):
         raise ValueError(
             f"image_size: expected (width, height) in pixels, got {image_size!r}"
         ) from None
-    ss = _int_in(supersample, "supersample", 1, 8)
+    ss = int_in_range(supersample, "supersample", 1, 8)
     tex = np.asarray(texture)
     s = float(units_per_pixel)
     if not (np.isfinite(s) and s > 0):
