@@ -14,6 +14,7 @@ from stereovision import evaluate, io
 from stereovision._core import __version__, release_memory
 from stereovision.calibration import Calibration
 from stereovision.depth import DepthResult, depth_map, estimate_max_disparity
+from stereovision.ground import GroundPlane, fit_ground_plane, obstacle_mask
 from stereovision.match import match
 from stereovision.matches import Matches
 from stereovision.rectification_check import check_rectification, refine_rectification
@@ -22,6 +23,7 @@ from stereovision.triangulation import depth_from_disparity, triangulate
 __all__ = [
     "Calibration",
     "DepthResult",
+    "GroundPlane",
     "Matches",
     "__version__",
     "check_rectification",
@@ -29,8 +31,10 @@ __all__ = [
     "depth_map",
     "estimate_max_disparity",
     "evaluate",
+    "fit_ground_plane",
     "io",
     "match",
+    "obstacle_mask",
     "refine_rectification",
     "release_memory",
     "triangulate",

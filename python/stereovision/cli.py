@@ -198,6 +198,8 @@ def cmd_depth(args: argparse.Namespace) -> int:
     left = imread(args.left)
     right = imread(args.right)
     calib = _load_calibration(args.calib)
+    if args.ground and calib is None:
+        raise CliError("--ground needs --calib (the floor is found in metres)")
     res, written = depth_outputs(
         left,
         right,
@@ -215,9 +217,37 @@ def cmd_depth(args: argparse.Namespace) -> int:
         f"{args.method}: max_disparity {res.max_disparity} px, density {100 * res.density:.1f} %,"
         f" {len(res.points)} points, {sum(res.timings.values()):.2f} s"
     )
+    if args.ground:
+        written.update(_ground_outputs(res.disparity, calib, Path(args.output)))
     for name, path in written.items():
         print(f"  {name:14s} {path}")
     return 0
+
+
+def _ground_outputs(disparity: Any, calib: Any, out: Path) -> dict[str, Path]:
+    """``depth --ground``: the floor's plane (``ground.json``) and what stands on it
+    (``obstacles.png``: 255 between 0.15 and 2 m above the floor)."""
+    import cv2
+
+    from stereovision.ground import fit_ground_plane, obstacle_mask
+    from stereovision.io import atomic_write
+
+    plane = fit_ground_plane(disparity, calib)
+    if plane is None:
+        print("ground plane: none found (no near-level plane holds 3 % of the pixels)")
+        return {}
+    print(plane.describe())
+    rc = calib if calib.rectified else calib.rectified_calibration()
+    mask = obstacle_mask(rc.reproject(disparity), plane)
+    paths = {"ground": out / "ground.json", "obstacles": out / "obstacles.png"}
+    with atomic_write(paths["ground"], "w") as fh:
+        fh.write(json.dumps({**plane.as_dict(), "obstacle_share": float(mask.mean())}, indent=2))
+    ok, buf = cv2.imencode(".png", mask.astype(np.uint8) * 255)
+    if not ok:
+        raise RuntimeError("could not encode obstacles.png")
+    with atomic_write(paths["obstacles"]) as fh:
+        fh.write(buf.tobytes())
+    return paths
 
 
 def cmd_check(args: argparse.Namespace) -> int:
@@ -535,6 +565,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     d.add_argument(
         "--voxel", type=float, metavar="M", help="cloud.ply with one point per M-metre cube"
+    )
+    d.add_argument(
+        "--ground",
+        action="store_true",
+        help="find the floor: camera height, pitch and roll (ground.json) and what stands on it "
+        "(obstacles.png)",
     )
     d.add_argument("-o", "--output", required=True, help="output folder")
     d.set_defaults(func=cmd_depth)

@@ -1,0 +1,299 @@
+"""The ground plane under a stereo rig, the camera's height and tilt above it, and obstacles.
+
+A mobile robot wants three things from a depth map before anything else: where the floor is,
+whether the camera still sits where its mount says (height, pitch, roll), and what stands up
+from the floor. :func:`fit_ground_plane` finds the floor as a plane in *disparity space*: for a
+rectified pair a 3-D plane ``n . X + h = 0`` is the plane ``d = a u + b v + c`` of the disparity
+map, and a disparity's error is about the same everywhere (a fraction of a pixel), while a
+depth's grows with its square. RANSAC with a threshold in pixels therefore treats near and far
+floor alike, where a 3-D fit with a fixed threshold in metres drops the far floor, or lets walls
+in once the threshold grows with the depth.
+
+Conventions: the left rectified camera's frame (X right, Y down, Z forward, metres), as
+:func:`stereovision.depth_map`'s points. The plane's normal points up, away from the floor
+(``n_y < 0``); ``height`` is the camera's distance above the plane; ``pitch`` is how far the
+optical axis points down (positive: towards the floor), ``roll`` the turn about the optical
+axis (positive: the floor's normal leans to the camera's right, i.e. the camera is rolled
+counter-clockwise as seen from behind).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+if TYPE_CHECKING:
+    from stereovision.calibration import Calibration
+
+__all__ = [
+    "GROUND_INLIER_PX",
+    "MAX_TILT_DEG",
+    "GroundPlane",
+    "fit_ground_plane",
+    "obstacle_mask",
+]
+
+F64 = npt.NDArray[np.float64]
+
+#: A pixel lies on the plane when its disparity is within this many pixels of the plane's.
+GROUND_INLIER_PX = 1.0
+#: The floor's normal may lean this far from the camera's "up" (-Y): the camera's own pitch and
+#: roll on its mount. Planes tilted further (walls, ramps seen head-on) are not the floor. (At
+#: 45 degrees, sloping structures of ETH3D playground outvote its floor.)
+MAX_TILT_DEG = 35.0
+#: RANSAC hypotheses, and pixels each is scored on (a random subset; the final fit uses all).
+RANSAC_ITERATIONS = 500
+RANSAC_SAMPLE = 40000
+#: Fewest disparities with a value for a fit to be tried.
+MIN_PIXELS = 500
+#: The floor must hold at least this share of the pixels with a disparity.
+MIN_INLIER_SHARE = 0.03
+
+
+@dataclass(frozen=True)
+class GroundPlane:
+    """The floor under the rig (see the module docstring for frames and signs).
+
+    Attributes
+    ----------
+    normal : numpy.ndarray
+        ``(3,)`` unit normal pointing up, in the left rectified camera frame.
+    height : float
+        Camera's distance above the plane (metres): the plane is ``normal . X + height = 0``.
+    disparity_plane : tuple of float
+        ``(a, b, c)`` with the floor's disparity ``d = a u + b v + c`` (pixels).
+    inliers : numpy.ndarray
+        ``(H, W)`` bool: pixels whose disparity lies on the plane.
+    inlier_share : float
+        Share of the pixels with a disparity that lie on the plane.
+    rms_px : float
+        RMS disparity residual of the inliers (pixels).
+    """
+
+    normal: F64
+    height: float
+    disparity_plane: tuple[float, float, float]
+    inliers: npt.NDArray[np.bool_]
+    inlier_share: float
+    rms_px: float
+
+    @property
+    def pitch_deg(self) -> float:
+        """Optical axis below the horizon (degrees; positive: looking down at the floor)."""
+        # Looking down by t puts the up vector at (0, -cos t, -sin t) in the camera frame.
+        return math.degrees(math.asin(max(-1.0, min(1.0, -float(self.normal[2])))))
+
+    @property
+    def roll_deg(self) -> float:
+        """Rotation about the optical axis (degrees; 0 when the image rows are level)."""
+        return math.degrees(math.atan2(float(self.normal[0]), -float(self.normal[1])))
+
+    def height_of(self, points: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Signed height above the floor of ``(..., 3)`` points (metres; NaN stays NaN)."""
+        pts = np.asarray(points, np.float64)
+        if pts.ndim == 0 or pts.shape[-1] != 3:
+            raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
+        out: F64 = pts @ self.normal + self.height  # the camera (X = 0) is at +height
+        return out
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready figures (no masks)."""
+        return {
+            "normal": [float(v) for v in self.normal],
+            "height_m": self.height,
+            "pitch_deg": self.pitch_deg,
+            "roll_deg": self.roll_deg,
+            "disparity_plane": list(self.disparity_plane),
+            "inlier_share": self.inlier_share,
+            "rms_px": self.rms_px,
+        }
+
+    def describe(self) -> str:
+        """One line for a terminal."""
+        return (
+            f"ground plane: camera {self.height:.3f} m above it, pitch {self.pitch_deg:+.2f} deg, "
+            f"roll {self.roll_deg:+.2f} deg ({100 * self.inlier_share:.0f} % of the pixels, "
+            f"RMS {self.rms_px:.2f} px)"
+        )
+
+
+def _rig(calib: Calibration) -> tuple[float, float, float, float, float]:
+    rc = calib if calib.rectified else calib.rectified_calibration()
+    return (
+        float(rc.K1[0, 0]),
+        float(rc.K1[0, 2]),
+        float(rc.K1[1, 2]),
+        calib.baseline_m,
+        rc.doffs_px,
+    )
+
+
+def _plane_3d(
+    coef: npt.ArrayLike, rig: tuple[float, float, float, float, float]
+) -> tuple[F64, float]:
+    """The 3-D plane ``n . X + h = 0`` (n unit, h > 0) of the disparity plane ``coef``.
+
+    With ``X = (u - cx) Z / f``, ``Y = (v - cy) Z / f`` and ``Z = f B / (d + doffs)``, the plane
+    divided by ``Z`` reads ``d + doffs = -(B / h) (n_x (u - cx) + n_y (v - cy) + f n_z)``.
+    """
+    f, cx, cy, b, doffs = rig
+    a, bb, c = (float(v) for v in np.asarray(coef, np.float64).ravel())
+    m = np.array([-a / b, -bb / b, -(c + doffs) / (f * b) - a * cx / (f * b) - bb * cy / (f * b)])
+    norm = float(np.linalg.norm(m))
+    if not norm > 0:
+        return np.array([0.0, -1.0, 0.0]), math.inf
+    return m / norm, 1.0 / norm
+
+
+def fit_ground_plane(
+    disparity: npt.ArrayLike,
+    calib: Calibration,
+    *,
+    inlier_px: float = GROUND_INLIER_PX,
+    max_tilt_deg: float = MAX_TILT_DEG,
+    seed: int = 0,
+) -> GroundPlane | None:
+    """Find the floor in a disparity map (RANSAC in disparity space, then least squares).
+
+    Parameters
+    ----------
+    disparity : array_like
+        ``(H, W)`` disparity of the rectified left image (``DepthResult.disparity``); NaN where
+        unknown.
+    calib : Calibration
+        The rig (rectified or raw: its rectified geometry is used).
+    inlier_px : float
+        Disparity tolerance of the plane (pixels).
+    max_tilt_deg : float
+        Largest angle between the floor's normal and the camera's up axis.
+    seed : int
+        RANSAC's random seed (the result is deterministic for a seed).
+
+    Returns
+    -------
+    GroundPlane or None
+        None when no plane within the tilt holds :data:`MIN_INLIER_SHARE` of the pixels (no
+        floor in view), or fewer than :data:`MIN_PIXELS` disparities are known.
+
+    Raises
+    ------
+    ValueError
+        If ``disparity`` is not 2-D or its size is not the calibration's, or a parameter is out
+        of range.
+    """
+    from stereovision._validate import positive_finite
+
+    disp = np.asarray(disparity, np.float64)
+    if disp.ndim != 2:
+        raise ValueError(f"disparity: expected a (H, W) map, got shape {disp.shape}")
+    w0, h0 = calib.image_size
+    if disp.shape != (h0, w0):
+        raise ValueError(
+            f"disparity: map is {disp.shape[1]}x{disp.shape[0]}, the calibration's images are "
+            f"{w0}x{h0}"
+        )
+    tol = positive_finite(inlier_px, "inlier_px")
+    tilt = positive_finite(max_tilt_deg, "max_tilt_deg")
+    if tilt >= 90:
+        raise ValueError(f"max_tilt_deg: expected less than 90 degrees, got {max_tilt_deg!r}")
+    rig = _rig(calib)
+    known = np.isfinite(disp) & (disp + rig[4] > 0)
+    if int(known.sum()) < MIN_PIXELS:
+        return None
+    vv, uu = np.nonzero(known)
+    u, v, d = uu.astype(np.float64), vv.astype(np.float64), disp[known]
+    design = np.column_stack([u, v, np.ones_like(u)])
+    rng = np.random.default_rng(seed)
+    sample = rng.choice(len(d), min(len(d), RANSAC_SAMPLE), replace=False)
+    a_s, d_s = design[sample], d[sample]
+    cos_max = math.cos(math.radians(tilt))
+    best_count, best = 0, None
+    for _ in range(RANSAC_ITERATIONS):
+        pick = rng.choice(len(d_s), 3, replace=False)
+        try:
+            coef = np.linalg.solve(a_s[pick], d_s[pick])
+        except np.linalg.LinAlgError:
+            continue
+        normal, _ = _plane_3d(coef, rig)
+        if -normal[1] < cos_max:  # not a floor (the normal must point up, within the tilt)
+            continue
+        count = int(np.count_nonzero(np.abs(a_s @ coef - d_s) < tol))
+        if count > best_count:
+            best_count, best = count, coef
+    if best is None:
+        return None
+    coef = best
+    inl = np.abs(design @ coef - d) < tol
+    for _ in range(3):  # least squares on all inliers, which moves the inlier set a little
+        refit = np.linalg.lstsq(design[inl], d[inl], rcond=None)[0]
+        if -_plane_3d(refit, rig)[0][1] < cos_max:
+            break  # a floor at the edge of the tilt cone: keep the last fit inside it
+        coef = refit
+        inl = np.abs(design @ coef - d) < tol
+    share = float(inl.mean())
+    normal, height = _plane_3d(coef, rig)
+    if share < MIN_INLIER_SHARE or not math.isfinite(height):
+        return None
+    mask = np.zeros(disp.shape, bool)
+    mask[vv[inl], uu[inl]] = True
+    resid = design[inl] @ coef - d[inl]
+    return GroundPlane(
+        normal=normal,
+        height=height,
+        disparity_plane=(float(coef[0]), float(coef[1]), float(coef[2])),
+        inliers=mask,
+        inlier_share=share,
+        rms_px=float(np.sqrt(np.mean(resid**2))),
+    )
+
+
+def obstacle_mask(
+    points: npt.ArrayLike,
+    plane: GroundPlane,
+    *,
+    min_height: float = 0.15,
+    max_height: float = 2.0,
+    max_range: float = math.inf,
+) -> npt.NDArray[np.bool_]:
+    """Pixels whose point stands between ``min_height`` and ``max_height`` above the floor.
+
+    Parameters
+    ----------
+    points : array_like
+        ``(H, W, 3)`` points in the left rectified frame (``calib.reproject(disparity)``), NaN
+        where unknown.
+    plane : GroundPlane
+    min_height, max_height : float
+        Height band above the floor (metres): below it is floor (and its noise), above it what
+        the robot passes under.
+    max_range : float
+        Farthest distance (metres, along the optical axis) considered.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` bool.
+
+    Raises
+    ------
+    ValueError
+        For points not of shape ``(H, W, 3)`` or an empty or negative band.
+    """
+    pts = np.asarray(points, np.float64)
+    if pts.ndim != 3 or pts.shape[2] != 3:
+        raise ValueError(f"points: expected shape (H, W, 3), got {pts.shape}")
+    lo, hi = float(min_height), float(max_height)
+    if not (math.isfinite(lo) and lo >= 0 and hi > lo):
+        raise ValueError(
+            f"min_height, max_height: expected 0 <= min_height < max_height, got {lo!r}, {hi!r}"
+        )
+    if not float(max_range) > 0:
+        raise ValueError(f"max_range: expected a positive distance, got {max_range!r}")
+    with np.errstate(invalid="ignore"):
+        h = plane.height_of(pts)
+        out: npt.NDArray[np.bool_] = (h > lo) & (h < hi) & (pts[..., 2] < float(max_range))
+    return out
