@@ -227,6 +227,30 @@ def test_load_errors(tmp_path: Path) -> None:
         Calibration.load(tmp_path / "c.json")
 
 
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("image_width", 1e400, "image_width must be an integer"),
+        ("image_width", [640, 1], "image_width must be an integer"),
+        ("image_height", 2.5, "image_height must be an integer"),
+        ("rectified", [1], "rectified must be 0 or 1"),
+        ("rectified", 7, "rectified must be 0 or 1"),
+        ("doffs", "x", "doffs must be a number"),
+        ("model", "omni", "model: expected one of"),
+    ],
+)
+def test_damaged_json_fields_are_named(
+    tmp_path: Path, field: str, value: object, message: str
+) -> None:
+    """A fuzz of 3000 damaged saved calibrations found an OverflowError (a width of 1e400) and a
+    TypeError (a list): both are ValueErrors naming the field now."""
+    rec = json.loads(raw_calib().save(tmp_path / "c.json").read_text())
+    rec[field] = value
+    (tmp_path / "e.json").write_text(json.dumps(rec).replace("Infinity", "1e400"))
+    with pytest.raises(ValueError, match=message):
+        Calibration.load(tmp_path / "e.json")
+
+
 def test_damaged_opencv_yaml_is_a_value_error_naming_the_problem(tmp_path: Path) -> None:
     """OpenCV's parser raises cv2.error (or a SystemError around it) on a damaged file: each
     reaches the user as a ValueError with the file, the field and OpenCV's reason (it was an

@@ -829,9 +829,25 @@ class Calibration:
                     return v
             raise ValueError(f"calibration file {source} lacks field {key!r}")
 
-        width = need("image_width")
-        height = need("image_height")
+        def integer(key: str) -> int:
+            v = need(key)
+            ok = isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(v, bool)
+            if not ok or not math.isfinite(float(v)) or float(v) != int(v):
+                raise ValueError(f"calibration file {source}: {key} must be an integer, got {v!r}")
+            return int(v)
+
+        width = integer("image_width")
+        height = integer("image_height")
+        rectified = get("rectified") or 0
+        if rectified not in (0, 1, True, False):
+            raise ValueError(
+                f"calibration file {source}: rectified must be 0 or 1, got {rectified!r}"
+            )
         doffs = get("doffs")
+        if doffs is not None and (
+            isinstance(doffs, bool) or not isinstance(doffs, (int, float, np.integer, np.floating))
+        ):
+            raise ValueError(f"calibration file {source}: doffs must be a number, got {doffs!r}")
         model = get("model")
         return cls(
             K1=need("K1", "M1"),
@@ -840,9 +856,9 @@ class Calibration:
             D2=need("D2"),
             R=need("R"),
             T=need("T"),
-            image_size=(int(width), int(height)),
+            image_size=(width, height),
             unit=str(need("unit")),
-            rectified=bool(int(get("rectified") or 0)),
+            rectified=bool(rectified),
             doffs=None if doffs is None else float(doffs),
             model="pinhole" if model is None else str(model),
         )
