@@ -21,9 +21,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 from _common import DATA
+from scipy.ndimage import binary_dilation
 
 import stereovision as sv
-from stereovision.ground import fit_ground_plane, obstacle_mask
+from stereovision.ground import fit_ground_plane, obstacle_mask, occupancy_grid
 from stereovision.io import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -75,8 +76,27 @@ def main() -> None:
             cv2.rectangle(img, (0, 0), (12 + 8 * len(text), 24), (30, 30, 30), -1)
             cv2.putText(img, text, (6, 17), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1,
                         cv2.LINE_AA)  # fmt: skip
-            cv2.imwrite(str(args.picture), img, [cv2.IMWRITE_JPEG_QUALITY, 88])
+            grid = occupancy_grid(pts, ours, resolution=0.1, forward=(0, 30), lateral=(-15, 15))
+            bev = cv2.cvtColor(grid.image(), cv2.COLOR_GRAY2BGR)
+            bev = cv2.rotate(bev, cv2.ROTATE_90_COUNTERCLOCKWISE)  # forward up, left to the left
+            bev = cv2.resize(bev, (img.shape[0], img.shape[0]), interpolation=cv2.INTER_NEAREST)
+            cv2.putText(bev, "grid 0.1 m, 30 m ahead", (6, 17), cv2.FONT_HERSHEY_SIMPLEX, 0.5,
+                        (40, 40, 230), 1, cv2.LINE_AA)  # fmt: skip
+            gap = np.full((img.shape[0], 6, 3), 255, np.uint8)
+            cv2.imwrite(
+                str(args.picture), np.hstack([img, gap, bev]), [cv2.IMWRITE_JPEG_QUALITY, 88]
+            )
             print(f"wrote {args.picture}")
+            for far in (15.0, 30.0):
+                kw = {"resolution": 0.2, "forward": (0.0, far), "lateral": (-far / 2, far / 2)}
+                occ_gt = occupancy_grid(pts_gt[has], gt, **kw).data == 100
+                occ = occupancy_grid(pts[has], ours, **kw).data == 100
+                prec = (occ & binary_dilation(occ_gt)).sum() / max(int(occ.sum()), 1)
+                rec = (occ_gt & binary_dilation(occ)).sum() / max(int(occ_gt.sum()), 1)
+                print(
+                    f"  grid within {far:g} m, 0.2 m cells, pixels with GT: occupied cells "
+                    f"precision {prec:.3f} recall {rec:.3f} within one cell"
+                )
     sys.path.insert(0, str(ROOT))
     from tests import test_ground as tg
 

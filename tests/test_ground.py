@@ -186,7 +186,17 @@ def test_cli_depth_ground(data_dir: Path, tmp_path: Path) -> None:
     cli = [sys.executable, "-m", "stereovision.cli", "depth"]
     pair = [str(kitti / "left.png"), str(kitti / "right.png")]
     run = subprocess.run(
-        [*cli, *pair, "--calib", str(kitti / "calib.txt"), "--ground", "-o", str(tmp_path)],
+        [
+            *cli,
+            *pair,
+            "--calib",
+            str(kitti / "calib.txt"),
+            "--ground",
+            "--grid",
+            "0.1",
+            "-o",
+            str(tmp_path),
+        ],
         capture_output=True,
         text=True,
         timeout=300,
@@ -197,9 +207,96 @@ def test_cli_depth_ground(data_dir: Path, tmp_path: Path) -> None:
     assert info["height_m"] == pytest.approx(1.62, abs=0.03)
     mask = cv2.imread(str(tmp_path / "obstacles.png"), cv2.IMREAD_GRAYSCALE)
     assert mask.shape == (375, 1242) and 0.05 < (mask > 0).mean() < 0.6
+    grid = cv2.imread(str(tmp_path / "map.png"), cv2.IMREAD_GRAYSCALE)
+    assert grid.shape == (200, 200) and (grid == 0).sum() > 500 and (grid == 254).sum() > 1000
+    assert "resolution: 0.1" in (tmp_path / "map.yaml").read_text()
     run = subprocess.run(
         [*cli, *pair, "--ground", "-o", str(tmp_path / "x")], capture_output=True, text=True,
         timeout=120,
     )  # fmt: skip
     assert run.returncode == 2 and run.stderr.count("\n") == 1
     assert "--ground needs --calib" in run.stderr
+    run = subprocess.run(
+        [*cli, *pair, "--calib", str(kitti / "calib.txt"), "--grid", "0.1", "-o", str(tmp_path)],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert run.returncode == 2 and "--grid needs --ground" in run.stderr
+
+
+def test_occupancy_grid_of_the_rendered_box(scene: dict, tmp_path: Path) -> None:
+    """The box face (3 m ahead, 1 m wide, y from -0.7 to 0.3 m) in a 0.1 m grid: its cells
+    occupied, the floor before it free; measured: 33 of 39 occupied cells within x 2.8-3.2 m,
+    the rest edge-fattening strays up to 4.4 m."""
+    from stereovision.ground import occupancy_grid
+
+    res = sv.depth_map(scene["left"], scene["right"], RIG, max_disparity=64)
+    plane = fit_ground_plane(res.disparity, RIG)
+    assert plane is not None
+    grid = occupancy_grid(
+        RIG.reproject(res.disparity), plane, resolution=0.1, forward=(0, 8), lateral=(-4, 4)
+    )
+    assert grid.data.shape == (80, 80)
+    occupied = np.argwhere(grid.data == 100)
+    x = occupied[:, 1] * 0.1
+    y = -4 + occupied[:, 0] * 0.1
+    near_box = (x >= 2.8) & (x < 3.2) & (y >= -0.9) & (y < 0.4)
+    assert near_box.mean() > 0.8
+    face = [grid.cell_of(3.0, yy) for yy in np.arange(-0.6, 0.25, 0.1)]
+    assert np.mean([grid.data[r, c] == 100 for r, c in face]) > 0.85
+    before = grid.data[grid.cell_of(0, -1.0)[0] : grid.cell_of(0, 1.0)[0], 15:25]
+    assert (before == 0).mean() > 0.9  # the floor 1.5-2.5 m ahead is seen free
+    png, yml = grid.save(tmp_path)
+    img = cv2.imread(str(png), cv2.IMREAD_GRAYSCALE)
+    assert img.shape == (80, 80) and set(np.unique(img)) <= {0, 205, 254}
+    # map_server: columns along x, rows along y from the top (left) down
+    r, c = grid.cell_of(3.0, 0.0)
+    assert img[79 - r, c] == 0
+    text = yml.read_text()
+    assert "resolution: 0.1" in text and "origin: [0.0, -4.0, 0.0]" in text
+
+
+def test_occupancy_grid_on_kitti(data_dir: Path) -> None:
+    """KITTI within 15 m, 0.2 m cells, on the pixels with LiDAR GT: our occupied cells against
+    the GT's, within one cell (measured: precision 0.679, recall 0.947; a car's depth is off by
+    2-3 % at most ranges, which smears it along its rays)."""
+    from scipy.ndimage import binary_dilation
+
+    from stereovision.ground import occupancy_grid
+
+    sc = load_scene(data_dir / "kitti2015" / "000005_10")
+    assert sc.calib is not None and sc.gt is not None
+    res = sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity)
+    gt, ours = fit_ground_plane(sc.gt, sc.calib), fit_ground_plane(res.disparity, sc.calib)
+    assert gt is not None and ours is not None
+    pts_gt = sc.calib.reproject(sc.gt)
+    has = np.all(np.isfinite(pts_gt), axis=-1)
+    kw: dict = {"resolution": 0.2, "forward": (0, 15), "lateral": (-7.5, 7.5)}
+    truth = occupancy_grid(pts_gt[has], gt, **kw).data == 100
+    found = occupancy_grid(sc.calib.reproject(res.disparity)[has], ours, **kw).data == 100
+    assert truth.sum() > 200
+    precision = (found & binary_dilation(truth)).sum() / found.sum()
+    recall = (truth & binary_dilation(found)).sum() / truth.sum()
+    assert precision > 0.6 and recall > 0.9
+
+
+def test_occupancy_grid_bad_input() -> None:
+    from stereovision.ground import occupancy_grid
+
+    plane = fit_ground_plane(
+        np.where(np.mgrid[0 : SIZE[1], 0 : SIZE[0]][0] > 180, 1.0, np.nan)
+        * (np.mgrid[0 : SIZE[1], 0 : SIZE[0]][0] - 179.5)
+        / 4,
+        RIG,
+    )
+    assert plane is not None
+    pts = np.zeros((5, 3))
+    with pytest.raises(ValueError, match="resolution"):
+        occupancy_grid(pts, plane, resolution=0)
+    with pytest.raises(ValueError, match="over 4096 cells a side"):
+        occupancy_grid(pts, plane, resolution=1e-4)
+    with pytest.raises(ValueError, match="forward: expected"):
+        occupancy_grid(pts, plane, forward=(5, 1))
+    with pytest.raises(ValueError, match="lateral: expected"):
+        occupancy_grid(pts, plane, lateral=(1, float("nan")))
+    with pytest.raises(ValueError, match="expected shape"):
+        occupancy_grid(np.zeros((5, 2)), plane)

@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import math
 import os
 import sys
 import time
@@ -200,6 +201,10 @@ def cmd_depth(args: argparse.Namespace) -> int:
     calib = _load_calibration(args.calib)
     if args.ground and calib is None:
         raise CliError("--ground needs --calib (the floor is found in metres)")
+    if args.grid is not None and not args.ground:
+        raise CliError("--grid needs --ground (the grid lies on the floor)")
+    if args.grid is not None and not (math.isfinite(args.grid) and 0.01 <= args.grid <= 10):
+        raise CliError(f"--grid: expected a cell side from 0.01 to 10 m, got {args.grid}")
     res, written = depth_outputs(
         left,
         right,
@@ -218,18 +223,21 @@ def cmd_depth(args: argparse.Namespace) -> int:
         f" {len(res.points)} points, {sum(res.timings.values()):.2f} s"
     )
     if args.ground:
-        written.update(_ground_outputs(res.disparity, calib, Path(args.output)))
+        written.update(_ground_outputs(res.disparity, calib, Path(args.output), args.grid))
     for name, path in written.items():
         print(f"  {name:14s} {path}")
     return 0
 
 
-def _ground_outputs(disparity: Any, calib: Any, out: Path) -> dict[str, Path]:
+def _ground_outputs(
+    disparity: Any, calib: Any, out: Path, grid: float | None = None
+) -> dict[str, Path]:
     """``depth --ground``: the floor's plane (``ground.json``) and what stands on it
-    (``obstacles.png``: 255 between 0.15 and 2 m above the floor)."""
+    (``obstacles.png``: 255 between 0.15 and 2 m above the floor); with ``--grid M`` also a
+    ROS map_server occupancy grid of M-metre cells (``map.png``, ``map.yaml``)."""
     import cv2
 
-    from stereovision.ground import fit_ground_plane, obstacle_mask
+    from stereovision.ground import fit_ground_plane, obstacle_mask, occupancy_grid
     from stereovision.io import atomic_write
 
     plane = fit_ground_plane(disparity, calib)
@@ -247,6 +255,10 @@ def _ground_outputs(disparity: Any, calib: Any, out: Path) -> dict[str, Path]:
         raise RuntimeError("could not encode obstacles.png")
     with atomic_write(paths["obstacles"]) as fh:
         fh.write(buf.tobytes())
+    if grid is not None:
+        paths["map"], paths["map.yaml"] = occupancy_grid(
+            rc.reproject(disparity), plane, resolution=grid
+        ).save(out)
     return paths
 
 
@@ -571,6 +583,13 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="find the floor: camera height, pitch and roll (ground.json) and what stands on it "
         "(obstacles.png)",
+    )
+    d.add_argument(
+        "--grid",
+        type=float,
+        metavar="M",
+        help="with --ground: a bird's-eye occupancy grid of M-metre cells, 20 m ahead and 10 m "
+        "to each side, as ROS map_server's map.png and map.yaml",
     )
     d.add_argument("-o", "--output", required=True, help="output folder")
     d.set_defaults(func=cmd_depth)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -33,8 +34,11 @@ __all__ = [
     "GROUND_INLIER_PX",
     "MAX_TILT_DEG",
     "GroundPlane",
+    "OccupancyGrid",
     "fit_ground_plane",
+    "floor_frame",
     "obstacle_mask",
+    "occupancy_grid",
 ]
 
 F64 = npt.NDArray[np.float64]
@@ -297,3 +301,166 @@ def obstacle_mask(
         h = plane.height_of(pts)
         out: npt.NDArray[np.bool_] = (h > lo) & (h < hi) & (pts[..., 2] < float(max_range))
     return out
+
+
+#: nav_msgs/OccupancyGrid cell values.
+UNKNOWN, FREE, OCCUPIED = -1, 0, 100
+#: Obstacle points a cell needs to be occupied (one stray point is noise).
+MIN_OBSTACLE_POINTS = 3
+
+
+@dataclass(frozen=True)
+class OccupancyGrid:
+    """A bird's-eye grid of the floor around the rig, as ROS's ``nav_msgs/OccupancyGrid``.
+
+    Frame (ROS REP 103): origin on the floor under the camera, ``x`` forward (the optical axis
+    laid on the floor), ``y`` to the left, metres. Row ``i``, column ``j`` is the cell whose
+    corner nearest the origin is ``origin + (j, i) * resolution``.
+
+    Attributes
+    ----------
+    data : numpy.ndarray
+        ``(rows, cols)`` int8: -1 unknown, 0 free (floor seen), 100 occupied.
+    resolution : float
+        Cell side (metres).
+    origin : tuple of float
+        ``(x, y)`` of cell ``(0, 0)``'s corner (metres).
+    """
+
+    data: npt.NDArray[np.int8]
+    resolution: float
+    origin: tuple[float, float]
+
+    def cell_of(self, x: float, y: float) -> tuple[int, int]:
+        """``(row, col)`` of the cell holding floor point ``(x, y)``."""
+        return (
+            math.floor((y - self.origin[1]) / self.resolution),
+            math.floor((x - self.origin[0]) / self.resolution),
+        )
+
+    def image(self) -> npt.NDArray[np.uint8]:
+        """map_server's picture: occupied 0 (black), free 254, unknown 205. As map_server reads
+        it, the picture's columns run along ``x`` (forward, to the right) and its rows along
+        ``y`` from the top (left) down: the grid's rows flipped."""
+        img = np.full(self.data.shape, 205, np.uint8)
+        img[self.data == FREE] = 254
+        img[self.data == OCCUPIED] = 0
+        out: npt.NDArray[np.uint8] = img[::-1]
+        return out
+
+    def save(self, directory: str | Path, name: str = "map") -> tuple[Path, Path]:
+        """Write ``NAME.png`` and ``NAME.yaml`` for ROS ``map_server`` (nav2 loads them).
+
+        Returns
+        -------
+        tuple of pathlib.Path
+            The picture and the YAML file.
+        """
+        import cv2
+
+        from stereovision.io import atomic_write
+
+        d = Path(str(directory))
+        d.mkdir(parents=True, exist_ok=True)
+        png, yml = d / f"{name}.png", d / f"{name}.yaml"
+        ok, buf = cv2.imencode(".png", self.image())
+        if not ok:
+            raise RuntimeError("could not encode the occupancy grid as PNG")
+        with atomic_write(png) as fh:
+            fh.write(buf.tobytes())
+        with atomic_write(yml, "w") as fh:
+            fh.write(
+                f"image: {png.name}\nmode: trinary\nresolution: {self.resolution!r}\n"
+                f"origin: [{self.origin[0]!r}, {self.origin[1]!r}, 0.0]\nnegate: 0\n"
+                "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+            )
+        return png, yml
+
+
+def floor_frame(plane: GroundPlane) -> F64:
+    """``(3, 3)`` rows: the floor frame's ``x`` (forward), ``y`` (left), ``z`` (up) axes in the
+    camera frame (REP 103)."""
+    up = plane.normal
+    forward = np.array([0.0, 0.0, 1.0]) - up * up[2]  # the optical axis laid on the floor
+    norm = float(np.linalg.norm(forward))
+    if norm < 1e-6:  # looking straight down: forward is the image's up
+        forward = np.array([0.0, -1.0, 0.0]) - up * (-up[1])
+        norm = float(np.linalg.norm(forward))
+    forward = forward / norm
+    left = np.cross(up, forward)
+    return np.stack([forward, left, up])
+
+
+def occupancy_grid(
+    points: npt.ArrayLike,
+    plane: GroundPlane,
+    *,
+    resolution: float = 0.1,
+    forward: tuple[float, float] = (0.0, 20.0),
+    lateral: tuple[float, float] = (-10.0, 10.0),
+    min_height: float = 0.15,
+    max_height: float = 2.0,
+) -> OccupancyGrid:
+    """A bird's-eye occupancy grid from a depth map's points and its floor.
+
+    A cell is occupied when at least :data:`MIN_OBSTACLE_POINTS` points stand in the height band
+    over it, free when floor points (within ``min_height`` of the plane) fall in it and it is not
+    occupied, unknown otherwise (not seen: behind an obstacle, out of view).
+
+    Parameters
+    ----------
+    points : array_like
+        ``(H, W, 3)`` or ``(N, 3)`` points in the left rectified frame (metres, NaN skipped).
+    plane : GroundPlane
+    resolution : float
+        Cell side (metres).
+    forward, lateral : tuple of float
+        Extent along ``x`` (forward) and ``y`` (left), metres.
+    min_height, max_height : float
+        The obstacle band above the floor (as :func:`obstacle_mask`).
+
+    Returns
+    -------
+    OccupancyGrid
+
+    Raises
+    ------
+    ValueError
+        For points not of shape ``(..., 3)``, a non-positive resolution, an empty extent, a grid
+        over 4096 cells a side, or a bad height band.
+    """
+    from stereovision._validate import positive_finite
+
+    pts = np.asarray(points, np.float64)
+    if pts.ndim == 0 or pts.shape[-1] != 3:
+        raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
+    res = positive_finite(resolution, "resolution")
+    (x0, x1), (y0, y1) = (float(v) for v in forward), (float(v) for v in lateral)
+    if not (math.isfinite(x0) and math.isfinite(x1) and x1 > x0):
+        raise ValueError(f"forward: expected (near, far) with far > near, got {forward!r}")
+    if not (math.isfinite(y0) and math.isfinite(y1) and y1 > y0):
+        raise ValueError(f"lateral: expected (right, left) with left > right, got {lateral!r}")
+    cols, rows = math.ceil((x1 - x0) / res), math.ceil((y1 - y0) / res)
+    if cols > 4096 or rows > 4096:
+        raise ValueError(f"resolution: a {cols} x {rows} grid is over 4096 cells a side")
+    lo, hi = float(min_height), float(max_height)
+    if not (math.isfinite(lo) and lo >= 0 and hi > lo):
+        raise ValueError(
+            f"min_height, max_height: expected 0 <= min_height < max_height, got {lo!r}, {hi!r}"
+        )
+    flat = pts.reshape(-1, 3)
+    flat = flat[np.all(np.isfinite(flat), axis=1)]
+    axes = floor_frame(plane)
+    xyz = flat @ axes.T
+    h = xyz[:, 2] + plane.height  # height above the floor
+    j = np.floor((xyz[:, 0] - x0) / res).astype(np.int64)
+    i = np.floor((xyz[:, 1] - y0) / res).astype(np.int64)
+    inside = (j >= 0) & (j < cols) & (i >= 0) & (i < rows)
+    obstacle = inside & (h > lo) & (h < hi)
+    floor = inside & (np.abs(h) <= lo)
+    n_obs = np.bincount(i[obstacle] * cols + j[obstacle], minlength=rows * cols)
+    n_floor = np.bincount(i[floor] * cols + j[floor], minlength=rows * cols)
+    data = np.full(rows * cols, UNKNOWN, np.int8)
+    data[n_floor > 0] = FREE
+    data[n_obs >= MIN_OBSTACLE_POINTS] = OCCUPIED
+    return OccupancyGrid(data.reshape(rows, cols), res, (x0, y0))
