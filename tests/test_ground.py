@@ -44,10 +44,17 @@ def _camera_rotation(pitch_deg: float, roll_deg: float) -> np.ndarray:
     return out
 
 
-def _render(texture: np.ndarray, s: float, rb: np.ndarray, origin: np.ndarray) -> tuple:
+def _render(
+    texture: np.ndarray,
+    s: float,
+    rb: np.ndarray,
+    origin: np.ndarray,
+    pitch: float = PITCH,
+    roll: float = ROLL,
+) -> tuple:
     """A plane (axes ``rb``'s columns, origin ``origin`` in the level frame) in both cameras of
     the pitched and rolled rig, NaN off the plane."""
-    rc = _camera_rotation(PITCH, ROLL)
+    rc = _camera_rotation(pitch, roll)
     rv = cv2.Rodrigues(rc @ rb)[0].ravel()
     tv = rc @ origin
     kw = {"image_size": SIZE, "supersample": 2, "background": np.nan}
@@ -56,22 +63,36 @@ def _render(texture: np.ndarray, s: float, rb: np.ndarray, origin: np.ndarray) -
     return left, right
 
 
-@pytest.fixture(scope="module")
-def scene(data_dir: Path) -> dict:
-    """A textured floor 1.1 m under the camera (pitched 12 degrees down, rolled 3) and a box face
-    1.0 m wide and 0.8 m tall standing on it 3 m ahead."""
-    tex = cv2.imread(str(data_dir / "middlebury2003" / "cones" / "left.png"), cv2.IMREAD_GRAYSCALE)
-    tex = np.tile(tex, (6, 6)).astype(np.float32)  # 2700 x 2250 px
+def floor_scene(
+    texture: np.ndarray, pitch: float = PITCH, roll: float = ROLL
+) -> tuple[tuple[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """A textured floor 1.1 m under the camera and a box face 1.0 m wide and 0.8 m tall standing
+    on it 3 m ahead: the floor's and the box's renderings (left, right; NaN off them)."""
+    tex = np.tile(texture, (6, 6)).astype(np.float32)  # 2700 x 2250 px
     s = 0.008  # a 21.6 x 18 m floor
     floor_axes = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]]).T  # u: X, v: -Z, normal: up
-    floor = _render(tex, s, floor_axes, np.array([-10.8, HEIGHT, 17.0]))
+    floor = _render(tex, s, floor_axes, np.array([-10.8, HEIGHT, 17.0]), pitch, roll)
     box_tex = tex[:100, :125]  # 1.0 x 0.8 m at 8 mm
     box_axes = np.eye(3)  # facing the camera
-    box = _render(box_tex, s, box_axes, np.array([-0.3, HEIGHT - 0.8, 3.0]))
+    box = _render(box_tex, s, box_axes, np.array([-0.3, HEIGHT - 0.8, 3.0]), pitch, roll)
+    return floor, box
+
+
+def composite(floor: tuple, box: tuple) -> list[np.ndarray]:
+    """The box in front of the floor, grey where neither is: the uint8 pair."""
     pair = []
     for f, b in zip(floor, box, strict=True):
         img = np.where(np.isfinite(b), b, f)
         pair.append(np.clip(np.nan_to_num(img, nan=60.0), 0, 255).astype(np.uint8))
+    return pair
+
+
+@pytest.fixture(scope="module")
+def scene(data_dir: Path) -> dict:
+    """The floor and box of :func:`floor_scene`, the camera pitched 12 degrees down, rolled 3."""
+    tex = cv2.imread(str(data_dir / "middlebury2003" / "cones" / "left.png"), cv2.IMREAD_GRAYSCALE)
+    floor, box = floor_scene(tex)
+    pair = composite(floor, box)
     seen = np.isfinite(floor[0]) | np.isfinite(box[0])  # above the horizon: blank grey
     return {"left": pair[0], "right": pair[1], "box": np.isfinite(box[0]), "seen": seen}
 

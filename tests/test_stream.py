@@ -6,6 +6,7 @@ import json
 import shutil
 import urllib.error
 import urllib.request
+import warnings
 from pathlib import Path
 
 import cv2
@@ -305,3 +306,36 @@ def test_stream_checks_every_nth_pair_and_warns_once_when_the_rows_drift(
         assert len(warned) == 1 and warned[0].startswith("stereovision: warning: pair 4:")
     assert main([*argv, "--check-every", "0"]) == 2
     assert "check_every" in capsys.readouterr().err
+
+
+def test_stream_watches_the_floor_and_warns_once_when_the_mount_moves(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """Rendered frames of a floor 1.1 m below a camera pitched 12 degrees down; from pair 4 on
+    the camera looks 16 degrees down. Fits on pairs 0, 2, 4, 6: the first two agree, pair 4 is
+    flagged and named in one warning."""
+    from tests.test_ground import RIG, composite, floor_scene
+
+    tex = cv2.imread(str(data_dir / "middlebury2003" / "cones" / "left.png"), cv2.IMREAD_GRAYSCALE)
+    frames = {12.0: composite(*floor_scene(tex, 12.0)), 16.0: composite(*floor_scene(tex, 16.0))}
+    for n in range(8):
+        left, right = frames[12.0 if n < 4 else 16.0]
+        cv2.imwrite(str(tmp_path / f"left_{n:03d}.png"), left)
+        cv2.imwrite(str(tmp_path / f"right_{n:03d}.png"), right)
+    cam = StereoCamera(str(tmp_path / "left_%03d.png"), str(tmp_path / "right_%03d.png"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rep = run_stream(cam, RIG, max_disparity=64, ground_every=2, check=False)
+    cam.close()
+    assert [g["pair"] for g in rep.grounds] == [0, 2, 4, 6]
+    assert all(g["found"] for g in rep.grounds)
+    assert [g["moved"] for g in rep.grounds] == [False, False, True, True]
+    assert rep.grounds[0]["height_m"] == pytest.approx(1.1, rel=0.02)
+    assert rep.grounds[0]["pitch_deg"] == pytest.approx(12.0, abs=0.5)
+    assert rep.grounds[2]["pitch_deg"] == pytest.approx(16.0, abs=0.5)
+    moved = [str(w.message) for w in caught if "moved on its mount" in str(w.message)]
+    assert len(moved) == 1 and moved[0].startswith("pair 4:")
+    assert rep.as_dict()["grounds"][1]["pair"] == 2
+    with pytest.raises(ValueError, match="give a calibration"):
+        run_stream(StereoCamera(str(tmp_path / "left_%03d.png"), str(tmp_path / "right_%03d.png")),
+                   None, ground_every=2)  # fmt: skip
