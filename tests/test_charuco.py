@@ -264,6 +264,7 @@ def test_report_pictures_with_partial_boards(rig: dict[str, Any], tmp_path: Path
         (("7x5", -0.03, 0.02), "square_size"),
         (("7x5", 0.03, float("nan")), "marker_size"),
         (("7x5", 0.03, 0.02, "DICT_9X9_50"), "unknown ArUco dictionary"),
+        (("100x100", 0.03, 0.02), "5000 markers; no predefined dictionary holds more than 2320"),
         (("12x10", 0.03, 0.02, "DICT_4X4_50"), "has 50 markers, but a 12x10 board needs 60"),
     ],
 )

@@ -159,6 +159,12 @@ class CharucoBoard:
                 f"(e.g. 7x5), got {sq!r}"
             )
         object.__setattr__(self, "squares", (vals[0], vals[1]))
+        largest = max(n for members in DICTIONARY_FAMILIES.values() for _, n in members)
+        if self.n_markers > largest:
+            raise ValueError(
+                f"squares: a {vals[0]}x{vals[1]} board has {self.n_markers} markers; no predefined "
+                f"dictionary holds more than {largest}"
+            )
         s = positive_finite(self.square_size, "square_size")
         m = positive_finite(self.marker_size, "marker_size")
         if m >= s:
