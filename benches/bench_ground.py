@@ -63,7 +63,8 @@ def main() -> None:
             f"{name}: GT height {gt.height:.3f} m, pitch {gt.pitch_deg:+.2f}, roll "
             f"{gt.roll_deg:+.2f}; ours {ours.height:.3f} m ({dh:+.1f} %), pitch "
             f"{ours.pitch_deg:+.2f}, roll {ours.roll_deg:+.2f}; {angle:.2f} deg apart; "
-            f"{100 * ours.inlier_share:.0f} % on it; fit {1000 * dt:.0f} ms; obstacles precision "
+            f"{100 * ours.inlier_share:.0f} % on it, {100 * ours.below_share:.1f} % below it; "
+            f"fit {1000 * dt:.0f} ms; obstacles precision "
             f"{tp / max(int(found.sum()), 1):.3f} recall {tp / max(int(truth.sum()), 1):.3f}"
         )
         if name.startswith("kitti"):

@@ -277,6 +277,48 @@ def test_app_controllers_report_errors_and_compute(tmp_path, monkeypatch):
     assert app.state.computations == 1
 
 
+def test_find_floor_controller_on_kitti(data_dir):
+    """The stereo panel's "Find floor", in-process: on KITTI (scaled to the page's width) the
+    camera's height above the road and a picture of floor and obstacles; without a
+    calibration, a sentence saying so."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui.app import StereoApp
+
+    app = StereoApp(
+        get_server("test-floor", client_type="vue3"),
+        AllowedFolders([data_dir]),
+        data_dir / "kitti2015" / "000005_10",
+    )
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._load_scene(data_dir / "kitti2015" / "000005_10")
+        await app.recompute()
+        await app.find_floor()
+
+    asyncio.run(run())
+    assert app.state.error == ""
+    text = app.state.floor_label
+    height = float(re.search(r"camera ([0-9.]+) m above it", text).group(1))
+    assert height == pytest.approx(1.62, abs=0.05)
+    assert app.state.img_floor.startswith("data:image/jpeg;base64,")
+    picture = _decode(app.state.img_floor)
+    assert (np.abs(picture[..., 1] - picture[..., 0]) > 60).mean() > 0.05  # green floor shown
+
+    async def no_calib() -> None:
+        app.calib = None
+        await app.recompute()
+        await app.find_floor()
+
+    asyncio.run(no_calib())
+    assert app.state.floor_label == "finding the floor needs a calibration (--calib)"
+    assert app.state.img_floor == ""
+
+
 # ----------------------------------------------------------------------------- browser
 
 
@@ -445,6 +487,18 @@ def test_check_rows_button(page):
     )
     text = page.inner_text("#rows-label")
     assert "median |dy| 0." in text and "matches" in text
+
+
+def test_find_floor_button(page):
+    """The stereo panel's "Find floor" button answers beside it (the cones videos: a table top
+    or no floor, either way a sentence starting "ground plane")."""
+    _wait_computations(page, 1)
+    page.click("#floor-btn")
+    page.wait_for_function(
+        "document.querySelector('#floor-label')?.textContent.includes('ground plane')"
+    )
+    assert page.inner_text("#floor-label").startswith("ground plane")
+    _shot(page, "gui-floor.png")
 
 
 def test_resolution_control_rescales(page):

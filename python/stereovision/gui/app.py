@@ -149,6 +149,27 @@ class ViewData:
     message_3d: str
 
 
+def floor_view(result: Any) -> tuple[str, str]:
+    """The floor of a depth result: a line of text and a picture (data URL; "" when none)."""
+    from stereovision.ground import fit_ground_plane, obstacle_mask
+
+    calib = result.calibration
+    plane = fit_ground_plane(result.disparity, calib)
+    if plane is None:
+        return "ground plane: none found (no near-level plane holds 3 % of the pixels)", ""
+    img = result.left_rectified if result.left_rectified is not None else None
+    if img is None:
+        return plane.describe(), ""
+    out = np.array(img, np.uint8)
+    if out.ndim == 2:
+        out = np.repeat(out[..., None], 3, axis=2)
+    rc = calib if calib.rectified else calib.rectified_calibration()
+    obstacles = obstacle_mask(rc.reproject(result.disparity), plane)
+    for mask, colour in ((plane.inliers, (60, 200, 60)), (obstacles, (40, 40, 230))):
+        out[mask] = (0.5 * out[mask] + 0.5 * np.array(colour)).astype(np.uint8)
+    return plane.describe(), _data_url(out)
+
+
 def _opencv_result(method: str, left: np.ndarray, right: np.ndarray, calib: Any, d_max: int) -> Any:
     """A ``DepthResult`` from an OpenCV reference matcher (for comparison in the GUI)."""
     from stereovision import baselines
@@ -382,6 +403,8 @@ class StereoApp:
         st.message_3d = ""
         st.source_label = ""
         st.rows_label = ""
+        st.floor_label = ""
+        st.img_floor = ""
         st.cam_left, st.cam_right = source_names
         st.live = source is not None
         st.scene = ""
@@ -633,6 +656,34 @@ class StereoApp:
         with self.state:
             self.state.rows_label = text
 
+    def find_floor_clicked(self) -> None:
+        """The page's "Find floor" button."""
+        self._spawn(self.find_floor())
+
+    async def find_floor(self) -> None:
+        """Fit the floor of the depth map on show: the camera's height, pitch and roll, and a
+        picture with the floor in green and what stands 0.15-2 m on it in red."""
+        view = self.view
+        if view is None:
+            return
+        res = view.result
+        if res.depth is None or getattr(res, "calibration", None) is None:
+            with self.state:
+                self.state.floor_label = "finding the floor needs a calibration (--calib)"
+            return
+
+        def run() -> tuple[str, str]:
+            return floor_view(res)
+
+        try:
+            text, url = await asyncio.get_running_loop().run_in_executor(self._executor, run)
+        except (ValueError, OSError, RuntimeError) as exc:
+            self._fail(exc)
+            return
+        with self.state:
+            self.state.floor_label = text
+            self.state.img_floor = url
+
     def _set_progress(self, pct: int, text: str) -> None:
         with self.state:
             self.state.progress = pct
@@ -658,6 +709,7 @@ class StereoApp:
             st.busy = False
             st.status = "ready"
             st.error = ""
+            st.floor_label = st.img_floor = ""  # a new depth map: its floor is not found yet
             st.computations += 1
 
     # ------------------------------------------------------------------------- 3-D view
@@ -890,6 +942,21 @@ class StereoApp:
                     html.Div("matches", classes="text-caption")
                     html.Img(id="img-matches", src=("img_matches",), style=img_style)
                 html.Div("{{ stats }}", id="stats", classes="text-caption mt-2")
+                with v3.VRow(dense=True, classes="mt-1", align="center"):
+                    with v3.VCol(cols=3):
+                        v3.VBtn(
+                            "Find floor",
+                            id="floor-btn",
+                            size="small",
+                            variant="outlined",
+                            block=True,
+                            click=self.find_floor_clicked,
+                        )
+                    with v3.VCol(cols=9):
+                        html.Div("{{ floor_label }}", id="floor-label", classes="text-caption")
+                with html.Div(v_if="img_floor", classes="mt-1"):
+                    html.Div("floor (green), obstacles 0.15-2 m (red)", classes="text-caption")
+                    html.Img(id="img-floor", src=("img_floor",), style=img_style)
 
     def _camera_controls(self, v3: Any, html: Any) -> None:
         with v3.VRow(dense=True, classes="mt-2", align="center"):
