@@ -385,3 +385,52 @@ def test_cli_board_errors_are_one_line(args: list[str], match: str, tmp_path: Pa
         assert run.returncode == 2 and run.stderr.count("\n") == 1, run.stderr
         assert match in run.stderr
     assert not (tmp_path / "b.png").exists() and not (tmp_path / "c.yaml").exists()
+
+
+def _write_video(path: Path, frames: list[np.ndarray]) -> Path:
+    vw = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 10.0, SIZE)
+    assert vw.isOpened()
+    for f in frames:
+        vw.write(cv2.cvtColor(f, cv2.COLOR_GRAY2BGR))
+    vw.release()
+    return path
+
+
+def test_calibrate_from_two_videos(rig: dict[str, Any], tmp_path: Path) -> None:
+    """Two MJPG recordings of the board waved about, each pose held for two frames: the
+    distinct poses are kept (the repeats are not) and the rig comes back (|T| within 0.5 mm);
+    the CLI takes the two videos in place of the image globs."""
+    from stereovision.calibrate import calibrate_from_video
+
+    frames = [i for i in range(10) for _ in range(2)]
+    left = _write_video(tmp_path / "l.avi", [rig["left"][i] for i in frames])
+    right = _write_video(tmp_path / "r.avi", [rig["right"][i] for i in frames])
+    lines: list[str] = []
+    cal, rep = calibrate_from_video(left, right, board=CharucoBoard("10x7", 0.03, 0.022),
+                                    log=lines.append)  # fmt: skip
+    kept = len(rep.used_pairs) + len(rep.rejected_pairs)
+    assert lines == [f"{kept} of 20 frame pairs kept (the board in both views, a new pose)"]
+    assert 7 <= kept <= 10 and all(n.startswith("frame_") for n in rep.used_pairs)
+    assert abs(np.linalg.norm(cal.T) - np.linalg.norm(T)) < 5e-4
+    assert "DICT_5X5_50" in rep.board  # found while reading
+    out = tmp_path / "rig.yaml"
+    board_args = [
+        "--board",
+        "charuco",
+        "--pattern",
+        "10x7",
+        "--square",
+        "0.03",
+        "--marker",
+        "0.022",
+    ]
+    run = _cli("calibrate", "--left", str(left), "--right", str(right), *board_args, "-o", str(out))
+    assert run.returncode == 0, run.stderr
+    assert "of 20 frame pairs kept" in run.stdout and out.is_file()
+    run = _cli("calibrate", "--left", str(left), "--right", str(tmp_path / "x*.png"),
+               "--square", "0.03", "-o", str(out))  # fmt: skip
+    assert run.returncode == 2 and "give two videos, or two sets of images" in run.stderr
+    with pytest.raises(FileNotFoundError, match="left source not found"):
+        calibrate_from_video(tmp_path / "none.avi", right, board=BOARD)
+    with pytest.raises(ValueError, match="max_pairs"):
+        calibrate_from_video(str(left), str(right), board=BOARD, max_pairs=2)

@@ -56,6 +56,7 @@ __all__ = [
     "board_object_points",
     "board_pose_params",
     "calibrate",
+    "calibrate_from_video",
     "find_corners",
     "parse_pattern",
     "render_chessboard",
@@ -146,6 +147,12 @@ POSE_PARAM_RANGES: tuple[float, ...] = (0.7, 0.7, 0.4, 0.5)
 
 #: Width of the report's pictures (px).
 FIGURE_WIDTH = 960
+
+#: File suffixes read as videos by ``calibrate`` (a pair of recordings of the board waved about).
+VIDEO_SUFFIXES: tuple[str, ...] = (".avi", ".mp4", ".mkv", ".mov", ".webm")
+#: Most pairs :func:`calibrate_from_video` keeps: the first distinct board poses (a calibration
+#: gains little past a few dozen views, and each view costs solver time).
+MAX_VIDEO_PAIRS = 60
 
 
 # ------------------------------------------------------------------------------------- helpers
@@ -1198,6 +1205,98 @@ def calibrate(
     return cal, report
 
 
+def calibrate_from_video(
+    left: PathLike | int,
+    right: PathLike | int,
+    *,
+    pattern: tuple[int, int] | str = (9, 6),
+    square_size: float | None = None,
+    board: CharucoBoard | None = None,
+    max_pairs: int = MAX_VIDEO_PAIRS,
+    min_distance: float | None = None,
+    log: Any = None,
+    **kwargs: Any,
+) -> tuple[Calibration, CalibrationReport]:
+    """Calibrate from two recordings of the board waved about (or two live cameras).
+
+    The pairs are read as ``stereovision capture`` reads them, and a pair is kept when both
+    cameras see the board and its pose differs from every pair kept so far
+    (:class:`~stereovision.capture.ChessboardCollector`, ROS's rule), up to ``max_pairs``; the
+    kept pairs are then calibrated by :func:`calibrate`.
+
+    Parameters
+    ----------
+    left, right : str or int
+        Video files, image-sequence patterns (``frames/left_%03d.png``) or device indices.
+    pattern, square_size, board :
+        The board, as for :func:`calibrate`.
+    max_pairs : int
+        Stop reading once this many distinct poses are kept.
+    min_distance : float, optional
+        The collector's pose distance (default :data:`stereovision.capture.MIN_POSE_DISTANCE`).
+    log : callable, optional
+        Receives one line when the reading is done.
+    **kwargs
+        Passed to :func:`calibrate` (``unit``, ``distortion``, ``drop_outliers``, ...).
+
+    Returns
+    -------
+    calibration, report
+        As :func:`calibrate`; the pairs are named ``frame_NNNNN`` by their index in the videos.
+
+    Raises
+    ------
+    FileNotFoundError
+        If a video file does not exist (the message names the side).
+    ValueError
+        As :func:`calibrate` (too few distinct poses with the board in both views, ...), or for
+        a ``max_pairs`` below :data:`MIN_PAIRS`.
+    """
+    from stereovision.capture import (
+        MIN_POSE_DISTANCE,
+        ChessboardCollector,
+        SourceError,
+        StereoCamera,
+    )
+
+    if isinstance(max_pairs, bool) or not isinstance(max_pairs, int) or max_pairs < MIN_PAIRS:
+        raise ValueError(
+            f"max_pairs: expected an integer of at least {MIN_PAIRS}, got {max_pairs!r}"
+        )
+    pat = board.inner if board is not None else parse_pattern(pattern)
+    collector = ChessboardCollector(
+        pat, MIN_POSE_DISTANCE if min_distance is None else float(min_distance), board=board
+    )
+    lefts: list[np.ndarray] = []
+    rights: list[np.ndarray] = []
+    names: list[str] = []
+    read = 0
+    cam = StereoCamera(
+        left if isinstance(left, int) else str(left),
+        right if isinstance(right, int) else str(right),
+    )
+    try:
+        while len(lefts) < max_pairs:
+            try:
+                frame = cam.read()
+            except SourceError:
+                break  # the end of a recording
+            read += 1
+            if collector.consider(frame).save:
+                lefts.append(frame.left)
+                rights.append(frame.right)
+                names.append(f"frame_{frame.index:05d}")
+    finally:
+        cam.close()
+    if log is not None:
+        log(f"{len(lefts)} of {read} frame pairs kept (the board in both views, a new pose)")
+    if board is not None and collector.board is not None and collector.board.resolved:
+        board = collector.board  # the dictionary found while reading
+    return calibrate(
+        lefts, rights, pattern=pattern, square_size=square_size, board=board, names=names, **kwargs
+    )
+
+
 # ---------------------------------------------------------------------------------- pictures
 
 _BLUE = (200, 120, 40)
@@ -1581,6 +1680,11 @@ def render_chessboard(
 # ------------------------------------------------------------------------------------------ CLI
 
 
+def _is_video(path: str) -> bool:
+    """A video file or an image-sequence pattern (``left_%03d.png``), read frame by frame."""
+    return "%" in path or Path(path).suffix.lower() in VIDEO_SUFFIXES
+
+
 def _expand(pattern: str, option: str) -> list[str]:
     """Sorted files matching a glob pattern (or the file itself)."""
     if glob.has_magic(pattern):
@@ -1598,10 +1702,16 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     """``stereovision calibrate --left GLOB --right GLOB --pattern 9x6 --square S -o FILE``
     (``--board charuco --marker M`` for a ChArUco board; ``--ros DIR`` also writes ROS
     ``camera_info`` files)."""
-    lefts = [f for g in args.left for f in _expand(g, "--left")]
-    rights = [f for g in args.right for f in _expand(g, "--right")]
-    if len(lefts) != len(rights):
-        raise ValueError(f"--left matches {len(lefts)} files but --right matches {len(rights)}")
+    video = len(args.left) == 1 and _is_video(args.left[0])
+    if video != (len(args.right) == 1 and _is_video(args.right[0])):
+        raise ValueError("--left and --right: give two videos, or two sets of images")
+    lefts: list[str] = []
+    rights: list[str] = []
+    if not video:
+        lefts = [f for g in args.left for f in _expand(g, "--left")]
+        rights = [f for g in args.right for f in _expand(g, "--right")]
+        if len(lefts) != len(rights):
+            raise ValueError(f"--left matches {len(lefts)} files but --right matches {len(rights)}")
     out = Path(args.output)
     if out.suffix.lower() not in (".yaml", ".yml", ".xml", ".json"):
         raise ValueError(f"-o {args.output}: use a .yaml, .yml, .xml or .json file name")
@@ -1611,16 +1721,20 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     if ros_dir is not None and ros_dir.exists() and not ros_dir.is_dir():
         raise ValueError(f"--ros {args.ros}: is a file; give a folder for left.yaml and right.yaml")
     board = _cli_board(args, printing=False)
-    cal, rep = calibrate(
-        lefts,
-        rights,
-        pattern=parse_pattern(args.pattern or "9x6"),
-        square_size=args.square,
-        board=board,
-        unit=args.unit,
-        distortion=args.distortion,
-        drop_outliers=args.drop_outliers,
-    )
+    common: dict[str, Any] = {
+        "pattern": parse_pattern(args.pattern or "9x6"),
+        "square_size": args.square,
+        "board": board,
+        "unit": args.unit,
+        "distortion": args.distortion,
+        "drop_outliers": args.drop_outliers,
+    }
+    if video:
+        cal, rep = calibrate_from_video(
+            args.left[0], args.right[0], max_pairs=args.max_pairs, log=print, **common
+        )
+    else:
+        cal, rep = calibrate(lefts, rights, **common)
     cal.save(out)
     print(rep.summary())
     print(cal.describe())
@@ -1735,8 +1849,20 @@ def add_cli(subparsers: Any) -> None:
         description="Calibrate a stereo rig from chessboard or ChArUco image pairs (sorted glob "
         "matches are paired in order).",
     )
-    p.add_argument("--left", required=True, nargs="+", help="left images (glob patterns, quoted)")
-    p.add_argument("--right", required=True, nargs="+", help="right images (glob patterns)")
+    p.add_argument(
+        "--left",
+        required=True,
+        nargs="+",
+        help="left images (glob patterns, quoted), or one video (or %%03d pattern) of the board "
+        "waved about",
+    )
+    p.add_argument("--right", required=True, nargs="+", help="right images (glob), or a video")
+    p.add_argument(
+        "--max-pairs",
+        type=int,
+        default=MAX_VIDEO_PAIRS,
+        help=f"videos: keep at most N distinct board poses (default {MAX_VIDEO_PAIRS})",
+    )
     _add_board_options(p)
     p.add_argument(
         "--dictionary",
