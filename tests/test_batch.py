@@ -263,3 +263,26 @@ def test_ros_camera_info_folder_as_batch_calibration(scenes: Path, tmp_path: Pat
     assert ref.depth is not None
     depth = np.load(io.BytesIO(out["files"]["depth.npy"]))
     np.testing.assert_array_equal(depth, ref.depth)
+
+
+def test_batch_ground_outputs(data_dir: Path, tmp_path: Path) -> None:
+    """--ground: a worker writes the pair's floor and obstacles (and with --grid its occupancy
+    grid) beside the depth outputs; the options of a run without it are those of earlier
+    versions (outputs made before stay valid)."""
+    from stereovision.batch import _task, process_pair, run_batch
+
+    kitti = data_dir / "kitti2015" / "000005_10"
+    (job,) = find_pairs(kitti)
+    out = process_pair(_task(job, {"method": None, "max_disparity": None, "fill": None,
+                                   "ground": True, "grid": 0.2}))  # fmt: skip
+    files = out["files"]
+    assert {"ground.json", "obstacles.png", "map.png", "map.yaml"} <= set(files)
+    floor = json.loads(files["ground.json"])
+    assert floor["height_m"] == pytest.approx(1.62, abs=0.03)
+    with pytest.raises(ValueError, match="it needs ground=True"):
+        run_batch(kitti, tmp_path / "o", grid=0.2)
+    tsukuba = data_dir / "middlebury2001" / "tsukuba"  # no metric calibration: a failed pair
+    (job,) = find_pairs(tsukuba)
+    with pytest.raises(Exception, match="--ground needs --calib"):
+        process_pair(_task(job, {"method": "gabor", "max_disparity": 16, "fill": None,
+                                 "ground": True}))  # fmt: skip

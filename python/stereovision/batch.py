@@ -20,6 +20,7 @@ from __future__ import annotations
 import argparse
 import datetime as _dt
 import json
+import math
 import os
 import re
 import shutil
@@ -234,6 +235,8 @@ def process_pair(task: dict[str, Any]) -> dict[str, Any]:
             method=task.get("method"),
             max_disparity=task.get("max_disparity"),
             fill=task.get("fill"),
+            ground=bool(task.get("ground", False)),
+            grid=task.get("grid"),
         )
         files = {name: Path(p).read_bytes() for name, p in written.items()}
     return {
@@ -439,6 +442,8 @@ def run_batch(
     fill: bool | None = None,
     calib: str | os.PathLike[str] | None = None,
     retry_failed: bool = False,
+    ground: bool = False,
+    grid: float | None = None,
     log: Callable[[str], None] | None = None,
     progress: bool = True,
 ) -> BatchResult:
@@ -461,6 +466,11 @@ def run_batch(
         Fill the holes (:func:`depth_map`'s ``fill``); None = the method's default.
     calib : path, optional
         Calibration for every pair (else each scene's ``calib.txt``).
+    ground : bool
+        Also write each pair's floor (``ground.json``, ``obstacles.png``;
+        :func:`stereovision.ground.fit_ground_plane`).
+    grid : float, optional
+        With ``ground``: each pair's occupancy grid of this cell side (``map.png``, ``map.yaml``).
     retry_failed : bool
         Also redo the pairs that failed before on the same inputs (by default a failed pair is
         redone only once its files or the options change).
@@ -486,6 +496,10 @@ def run_batch(
     """
     if workers is not None and workers <= 0:
         raise ValueError(f"workers: expected a positive number, got {workers}")
+    if grid is not None and not ground:
+        raise ValueError("grid: the occupancy grid lies on the floor; it needs ground=True")
+    if grid is not None and not (math.isfinite(grid) and 0.01 <= grid <= 10):
+        raise ValueError(f"grid: expected a cell side from 0.01 to 10 m, got {grid}")
     if max_disparity is not None and max_disparity <= 0:
         raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
     t0 = time.perf_counter()
@@ -498,7 +512,9 @@ def run_batch(
     out = Path(output_dir)
     out.mkdir(parents=True, exist_ok=True)
     summary = _Summary(out)
-    opts = {"method": method, "max_disparity": max_disparity, "fill": fill}
+    opts: dict[str, Any] = {"method": method, "max_disparity": max_disparity, "fill": fill}
+    if ground:  # only when asked: outputs of earlier runs without it stay valid
+        opts.update(ground=True, grid=grid)
     summary.data.update(
         input=str(Path(input_dir).resolve()),
         output=str(out.resolve()),
@@ -689,6 +705,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
             fill=args.fill,
             calib=args.calib,
             retry_failed=args.retry_failed,
+            ground=args.ground,
+            grid=args.grid,
             log=log,
         )
     except KeyboardInterrupt:
@@ -741,5 +759,13 @@ def add_cli(subparsers: Any) -> None:
     )
     p.add_argument(
         "--retry-failed", action="store_true", help="redo pairs that failed on unchanged inputs"
+    )
+    p.add_argument(
+        "--ground",
+        action="store_true",
+        help="also each pair's floor and obstacles (ground.json, obstacles.png)",
+    )
+    p.add_argument(
+        "--grid", type=float, metavar="M", help="with --ground: an occupancy grid of M-metre cells"
     )
     p.set_defaults(func=cmd_batch)

@@ -142,6 +142,9 @@ def depth_outputs(
     max_depth: float | None = None,
     max_sigma: float | None = None,
     voxel: float | None = None,
+    ground: bool = False,
+    grid: float | None = None,
+    log: Any = None,
 ) -> tuple[Any, dict[str, Path]]:
     """What ``stereovision depth`` computes and writes for one pair (``batch`` writes the same).
 
@@ -167,6 +170,13 @@ def depth_outputs(
     voxel : float, optional
         Write the cloud with one point per cube of this side in metres
         (:func:`stereovision.export.voxel_downsample`).
+    ground : bool
+        Also fit the floor and write ``ground.json`` and ``obstacles.png`` (needs ``calib``).
+    grid : float, optional
+        With ``ground``: a bird's-eye occupancy grid of this cell side (``map.png``,
+        ``map.yaml``).
+    log : callable, optional
+        Receives the floor's one-line description.
 
     Returns
     -------
@@ -178,6 +188,12 @@ def depth_outputs(
 
     if calib is None and (max_depth is not None or max_sigma is not None):
         raise CliError("--max-depth and --max-sigma need --calib (no depth without one)")
+    if ground and calib is None:
+        raise CliError("--ground needs --calib (the floor is found in metres)")
+    if grid is not None and not ground:
+        raise CliError("--grid needs --ground (the grid lies on the floor)")
+    if grid is not None and not (math.isfinite(grid) and 0.01 <= grid <= 10):
+        raise CliError(f"--grid: expected a cell side from 0.01 to 10 m, got {grid}")
     from stereovision._validate import positive_finite
 
     for value, flag in ((max_depth, "--max-depth"), (max_sigma, "--max-sigma"), (voxel, "--voxel")):
@@ -189,6 +205,8 @@ def depth_outputs(
         res = res.filtered(max_depth=max_depth, max_sigma=max_sigma)
     written = write_depth_outputs(res, out_dir, voxel)
     written.update(render_outputs(res, out_dir))
+    if ground:
+        written.update(_ground_outputs(res.disparity, calib, out_dir, grid, log))
     return res, written
 
 
@@ -199,12 +217,6 @@ def cmd_depth(args: argparse.Namespace) -> int:
     left = imread(args.left)
     right = imread(args.right)
     calib = _load_calibration(args.calib)
-    if args.ground and calib is None:
-        raise CliError("--ground needs --calib (the floor is found in metres)")
-    if args.grid is not None and not args.ground:
-        raise CliError("--grid needs --ground (the grid lies on the floor)")
-    if args.grid is not None and not (math.isfinite(args.grid) and 0.01 <= args.grid <= 10):
-        raise CliError(f"--grid: expected a cell side from 0.01 to 10 m, got {args.grid}")
     res, written = depth_outputs(
         left,
         right,
@@ -217,20 +229,21 @@ def cmd_depth(args: argparse.Namespace) -> int:
         max_depth=args.max_depth,
         max_sigma=args.max_sigma,
         voxel=args.voxel,
+        ground=args.ground,
+        grid=args.grid,
+        log=print,
     )
     print(
         f"{args.method}: max_disparity {res.max_disparity} px, density {100 * res.density:.1f} %,"
         f" {len(res.points)} points, {sum(res.timings.values()):.2f} s"
     )
-    if args.ground:
-        written.update(_ground_outputs(res.disparity, calib, Path(args.output), args.grid))
     for name, path in written.items():
         print(f"  {name:14s} {path}")
     return 0
 
 
 def _ground_outputs(
-    disparity: Any, calib: Any, out: Path, grid: float | None = None
+    disparity: Any, calib: Any, out: Path, grid: float | None = None, log: Any = None
 ) -> dict[str, Path]:
     """``depth --ground``: the floor's plane (``ground.json``) and what stands on it
     (``obstacles.png``: 255 between 0.15 and 2 m above the floor); with ``--grid M`` also a
@@ -242,21 +255,23 @@ def _ground_outputs(
 
     plane = fit_ground_plane(disparity, calib)
     if plane is None:
-        print("ground plane: none found (no near-level plane holds 3 % of the pixels)")
+        if log is not None:
+            log("ground plane: none found (no near-level plane holds 3 % of the pixels)")
         return {}
-    print(plane.describe())
+    if log is not None:
+        log(plane.describe())
     rc = calib if calib.rectified else calib.rectified_calibration()
     mask = obstacle_mask(rc.reproject(disparity), plane)
-    paths = {"ground": out / "ground.json", "obstacles": out / "obstacles.png"}
-    with atomic_write(paths["ground"], "w") as fh:
+    paths = {"ground.json": out / "ground.json", "obstacles.png": out / "obstacles.png"}
+    with atomic_write(paths["ground.json"], "w") as fh:
         fh.write(json.dumps({**plane.as_dict(), "obstacle_share": float(mask.mean())}, indent=2))
     ok, buf = cv2.imencode(".png", mask.astype(np.uint8) * 255)
     if not ok:
         raise RuntimeError("could not encode obstacles.png")
-    with atomic_write(paths["obstacles"]) as fh:
+    with atomic_write(paths["obstacles.png"]) as fh:
         fh.write(buf.tobytes())
     if grid is not None:
-        paths["map"], paths["map.yaml"] = occupancy_grid(
+        paths["map.png"], paths["map.yaml"] = occupancy_grid(
             rc.reproject(disparity), plane, resolution=grid
         ).save(out)
     return paths
