@@ -320,6 +320,17 @@ def compute_view(
     )
 
 
+def _button_and_answer(
+    v3: Any, html: Any, text: str, button_id: str, click: Any, answer: str, answer_id: str
+) -> None:
+    """A small button with the line it answers beside it (state variable ``answer``)."""
+    with v3.VRow(dense=True, align="center", classes="my-1"):
+        with v3.VCol(cols=3):
+            v3.VBtn(text, id=button_id, size="small", variant="outlined", block=True, click=click)
+        with v3.VCol(cols=9):
+            html.Div("{{ " + answer + " }}", id=answer_id, classes="text-caption")
+
+
 def _file_picker(label: str, model: str, items: str, element_id: str) -> None:
     """A combobox choosing one of the allowed files (``items`` holds ``{title, value}`` dicts)."""
     from trame.widgets import vuetify3 as v3
@@ -838,18 +849,15 @@ class StereoApp:
             v3.VCardTitle("1 · Acquisition")
             with v3.VCardText():
                 html.Div("{{ source_label }}", id="source-label", classes="text-caption mb-1")
-                with v3.VRow(dense=True, align="center", classes="mb-1"):
-                    with v3.VCol(cols=3):
-                        v3.VBtn(
-                            "Check rows",
-                            id="check-rows-btn",
-                            size="small",
-                            variant="outlined",
-                            block=True,
-                            click=self.check_rows_clicked,
-                        )
-                    with v3.VCol(cols=9):
-                        html.Div("{{ rows_label }}", id="rows-label", classes="text-caption")
+                _button_and_answer(
+                    v3,
+                    html,
+                    "Check rows",
+                    "check-rows-btn",
+                    self.check_rows_clicked,
+                    "rows_label",
+                    "rows-label",
+                )
                 with v3.VRow(dense=True):
                     with v3.VCol(cols=6):
                         html.Div("left", classes="text-caption")
@@ -942,18 +950,15 @@ class StereoApp:
                     html.Div("matches", classes="text-caption")
                     html.Img(id="img-matches", src=("img_matches",), style=img_style)
                 html.Div("{{ stats }}", id="stats", classes="text-caption mt-2")
-                with v3.VRow(dense=True, classes="mt-1", align="center"):
-                    with v3.VCol(cols=3):
-                        v3.VBtn(
-                            "Find floor",
-                            id="floor-btn",
-                            size="small",
-                            variant="outlined",
-                            block=True,
-                            click=self.find_floor_clicked,
-                        )
-                    with v3.VCol(cols=9):
-                        html.Div("{{ floor_label }}", id="floor-label", classes="text-caption")
+                _button_and_answer(
+                    v3,
+                    html,
+                    "Find floor",
+                    "floor-btn",
+                    self.find_floor_clicked,
+                    "floor_label",
+                    "floor-label",
+                )
                 with html.Div(v_if="img_floor", classes="mt-1"):
                     html.Div("floor (green), obstacles 0.15-2 m (red)", classes="text-caption")
                     html.Img(id="img-floor", src=("img_floor",), style=img_style)
