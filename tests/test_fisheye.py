@@ -171,7 +171,7 @@ def render_views() -> tuple[list[np.ndarray], list[np.ndarray]]:
     return left, right
 
 
-def test_fisheye_calibration_recovers_the_rig(views: Any) -> None:
+def test_fisheye_calibration_recovers_the_rig(views: Any, tmp_path: Path) -> None:
     """distortion='fisheye' brings the rig back (measured: 34 pairs, rotation 0.041 degrees off,
     baseline within 0.02 mm, rows of the true points 0.023 px median and 0.084 px at the 95th
     percentile); the pinhole model cannot fit the lens (rotation 2.8 degrees off, rows 3.3 px at
@@ -185,6 +185,8 @@ def test_fisheye_calibration_recovers_the_rig(views: Any) -> None:
     assert abs(cal.K1[0, 0] - K1[0, 0]) < 1.5
     dy = _row_errors(cal)
     assert np.median(dy) < 0.08 and np.percentile(dy, 95) < 0.25
+    page = rep.write(tmp_path)["html"].read_text()  # the report's pictures through the model
+    assert "model fisheye" in rep.summary() and page.count("data:image/png;base64,") >= 3
     pin, prep = calibrate(*views, board=BOARD, distortion="auto")
     assert prep.rms > 2 * rep.rms
     assert np.percentile(_row_errors(pin), 95) > 10 * np.percentile(dy, 95)

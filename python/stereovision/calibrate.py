@@ -1444,7 +1444,13 @@ def _rig_picture(rep: CalibrationReport) -> np.ndarray | None:
     for name, (cl, _) in rep._corners.items():
         ids = rep._ids.get(name)
         obj = grid if ids is None else grid[ids]
-        ok, rvec, tvec = cv2.solvePnP(obj, cl, cal.K1, cal.D1, flags=cv2.SOLVEPNP_IPPE)
+        if cal.model == "fisheye":  # the pose from the corners undistorted by the lens model
+            und = cv2.fisheye.undistortPoints(cl.reshape(-1, 1, 2), cal.K1, cal.D1)
+            ok, rvec, tvec = cv2.solvePnP(
+                obj, und.reshape(-1, 2), np.eye(3), None, flags=cv2.SOLVEPNP_IPPE
+            )
+        else:
+            ok, rvec, tvec = cv2.solvePnP(obj, cl, cal.K1, cal.D1, flags=cv2.SOLVEPNP_IPPE)
         if ok:
             Rb, _ = cv2.Rodrigues(rvec)
             pts = (Rb @ obj.T).T + tvec.ravel()
