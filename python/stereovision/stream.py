@@ -684,20 +684,34 @@ def _format_report(rep: dict[str, Any]) -> str:
 def cmd_stream(args: argparse.Namespace) -> int:
     """``stereovision stream --left SRC --right SRC``."""
     calib = Calibration.from_file(args.calib) if args.calib else None
+    if args.bag and calib is None:
+        raise ValueError("--bag: a bag holds depth; give --calib")
     out = sys.stdout
     log = sys.stderr
     server: FrameServer | None = None
     size = parse_size(args.size)
     cam = StereoCamera(parse_source(args.left), parse_source(args.right), size=size)
+    bag = None
     try:
-        on_result = None
+        if args.bag:
+            from stereovision.rosbag import BagWriter
+
+            bag = BagWriter(args.bag)
+        sinks: list[Callable[[np.ndarray, Any], None]] = []
         if not args.no_display:
             server = FrameServer(args.host, args.serve)
             print(f"serving the live view on {server.url}", file=log, flush=True)
             srv = server
+            sinks.append(
+                lambda left, res: srv.update(left, res.disparity, float(res.max_disparity))
+            )
+        if bag is not None:
+            writer = bag
+            sinks.append(lambda left, res: writer.write(res, time.time_ns()))
 
-            def on_result(left: np.ndarray, res: Any) -> None:
-                srv.update(left, res.disparity, float(res.max_disparity))
+        def on_result(left: np.ndarray, res: Any) -> None:
+            for sink in sinks:
+                sink(left, res)
 
         def on_report(rep: dict[str, Any]) -> None:
             if args.json:
@@ -715,7 +729,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             refine=args.refine,
             fill=args.fill,
             on_report=on_report,
-            on_result=on_result,
+            on_result=on_result if sinks else None,
             check=not args.no_check,
             check_every=args.check_every,
             ground_every=args.ground_every,
@@ -724,7 +738,11 @@ def cmd_stream(args: argparse.Namespace) -> int:
         cam.close()
         if server is not None:
             server.close()
+        if bag is not None:
+            bag.close()  # a bag cut short by Ctrl-C or an error is still a valid bag
     summary = report.as_dict()
+    if bag is not None:
+        print(f"ROS 2 bag written to {bag.path} ({bag.messages} messages)", file=log)
     if args.json:
         print(json.dumps(summary), file=out, flush=True)
     else:
@@ -798,6 +816,12 @@ def add_cli(subparsers: Any) -> None:
         type=int,
         metavar="N",
         help="also check the rows of every N-th pair (a rig bumped while running)",
+    )
+    p.add_argument(
+        "--bag",
+        metavar="DIR",
+        help="also record every frame into a new ROS 2 bag (rectified left image, camera_info, "
+        "depth, points); needs --calib and the rosbags package",
     )
     p.add_argument(
         "--ground-every",

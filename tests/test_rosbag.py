@@ -1,0 +1,91 @@
+"""ROS 2 bags of depth results, read back with rosbags' own reader: every topic's values."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stereovision as sv
+from stereovision.io import load_scene
+
+rosbags = pytest.importorskip("rosbags")
+
+
+@pytest.fixture(scope="module")
+def kitti(data_dir: Path) -> tuple:
+    sc = load_scene(data_dir / "kitti2015" / "000005_10")
+    res = sv.depth_map(sc.left, sc.right, sc.calib, method="gabor", max_disparity=sc.max_disparity)
+    lean = sv.depth_map(sc.left, sc.right, sc.calib, method="gabor",
+                        max_disparity=sc.max_disparity, cloud=False)  # fmt: skip
+    return res, lean
+
+
+def _read(path: Path) -> dict[str, list]:
+    from rosbags.rosbag2 import Reader
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    out: dict[str, list] = {}
+    with Reader(path) as reader:
+        for conn, stamp, raw in reader.messages():
+            out.setdefault(conn.topic, []).append((stamp, ts.deserialize_cdr(raw, conn.msgtype)))
+    return out
+
+
+def test_bag_holds_the_results_values(kitti: tuple, tmp_path: Path) -> None:
+    from stereovision.rosbag import BagWriter
+
+    res, lean = kitti
+    with BagWriter(tmp_path / "run") as bag:
+        bag.write(res, 1_700_000_000_123_456_789)
+        bag.write(lean, 1_700_000_000_223_456_789)
+    assert bag.messages == 8
+    topics = _read(tmp_path / "run")
+    assert sorted(topics) == ["/stereo/depth", "/stereo/left/camera_info",
+                              "/stereo/left/image_rect_color", "/stereo/points"]  # fmt: skip
+    stamp, depth = topics["/stereo/depth"][0]
+    assert stamp == 1_700_000_000_123_456_789
+    assert depth.header.stamp.sec == 1_700_000_000 and depth.header.stamp.nanosec == 123_456_789
+    assert depth.header.frame_id == "stereo_left_optical" and depth.encoding == "32FC1"
+    d = np.frombuffer(depth.data.tobytes(), "<f4").reshape(depth.height, depth.width)
+    np.testing.assert_array_equal(d, res.depth.astype(np.float32))  # NaN where none, metres
+    img = topics["/stereo/left/image_rect_color"][0][1]
+    assert img.encoding == "bgr8" and img.step == 3 * img.width
+    np.testing.assert_array_equal(
+        np.frombuffer(img.data.tobytes(), np.uint8).reshape(img.height, img.width, 3),
+        res.left_rectified,
+    )
+    info = topics["/stereo/left/camera_info"][0][1]
+    np.testing.assert_allclose(info.k.reshape(3, 3), res.calibration.K1)
+    assert info.p[3] == 0.0 and (info.width, info.height) == res.calibration.image_size
+    cloud = topics["/stereo/points"][0][1]
+    xyz_rgb = [("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("rgb", "<u4")]
+    rec = np.frombuffer(cloud.data.tobytes(), dtype=xyz_rgb)
+    assert cloud.width == len(res.points) == len(rec) and cloud.point_step == 16
+    np.testing.assert_array_equal(np.c_[rec["x"], rec["y"], rec["z"]], res.points)
+    c = res.colors.astype(np.uint32)
+    np.testing.assert_array_equal(rec["rgb"], (c[:, 0] << 16) | (c[:, 1] << 8) | c[:, 2])
+    # the result made without a cloud (stream's) gets its cloud from the depth map: the same
+    lean_cloud = topics["/stereo/points"][1][1]
+    rec2 = np.frombuffer(lean_cloud.data.tobytes(), dtype=rec.dtype)
+    np.testing.assert_allclose(np.c_[rec2["x"], rec2["y"], rec2["z"]], res.points, rtol=1e-6)
+    np.testing.assert_array_equal(rec2["rgb"], rec["rgb"])
+
+
+def test_bag_errors(kitti: tuple, tmp_path: Path, data_dir: Path) -> None:
+    from stereovision.rosbag import BagWriter
+
+    (tmp_path / "exists").mkdir()
+    with pytest.raises(FileExistsError, match="bag folder already exists"):
+        BagWriter(tmp_path / "exists")
+    with pytest.raises(FileNotFoundError, match="parent does not exist"):
+        BagWriter(tmp_path / "no" / "bag")
+    sc = load_scene(data_dir / "middlebury2001" / "tsukuba")
+    no_depth = sv.depth_map(sc.left, sc.right, method="gabor", max_disparity=16)
+    with BagWriter(tmp_path / "b") as bag:
+        with pytest.raises(ValueError, match="compute the result with a calibration"):
+            bag.write(no_depth, 0)
+        with pytest.raises(ValueError, match="stamp_ns"):
+            bag.write(kitti[0], -5)
