@@ -189,6 +189,45 @@ def test_plane_geometry_round_trips(doffs: float) -> None:
     assert json.loads(json.dumps(plane.as_dict()))["height_m"] == pytest.approx(1.3)
 
 
+def test_the_cameras_pose_on_the_floor_and_its_ros2_transform() -> None:
+    """camera_in_floor puts the camera 1.3 m above the floor's origin, floor points at z = 0,
+    the optical axis 8 degrees below the horizon; the ROS 2 command's quaternion is that
+    rotation."""
+    from stereovision.ground import _quaternion
+
+    n_true = _camera_rotation(8.0, -5.0) @ np.array([0.0, -1.0, 0.0])
+    v, u = np.mgrid[0 : SIZE[1], 0 : SIZE[0]].astype(np.float64)
+    rays = np.stack([(u - 239.5) / F, (v - 179.5) / F, np.ones_like(u)], axis=-1)
+    z = -1.3 / (rays @ n_true)
+    plane = fit_ground_plane(np.where(z > 0, F * 0.12 / z, np.nan), RIG)
+    assert plane is not None
+    pose = plane.camera_in_floor()
+    np.testing.assert_allclose(pose[:3, 3], [0, 0, 1.3], atol=1e-9)
+    floor_pt = RIG.reproject(np.where(z > 0, F * 0.12 / z, np.nan))[300, 240]
+    np.testing.assert_allclose((pose @ np.r_[floor_pt, 1.0])[2], 0.0, atol=1e-6)  # float32 points
+    axis = pose[:3, :3] @ [0.0, 0.0, 1.0]  # the optical axis: forward, 8 degrees down
+    assert axis[1] == pytest.approx(0.0, abs=1e-9)
+    assert math.degrees(math.asin(-axis[2])) == pytest.approx(8.0, abs=1e-6)
+    x, y, zq, w = _quaternion(pose[:3, :3])
+    rot = np.array(
+        [
+            [1 - 2 * (y * y + zq * zq), 2 * (x * y - zq * w), 2 * (x * zq + y * w)],
+            [2 * (x * y + zq * w), 1 - 2 * (x * x + zq * zq), 2 * (y * zq - x * w)],
+            [2 * (x * zq - y * w), 2 * (y * zq + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+    np.testing.assert_allclose(rot, pose[:3, :3], atol=1e-12)
+    cmd = plane.ros2_static_transform()
+    assert cmd.startswith("ros2 run tf2_ros static_transform_publisher --x 0 --y 0 --z 1.3000")
+    assert f"--qw {w:.6f}" in cmd and cmd.endswith(
+        "--frame-id base_footprint --child-frame-id stereo_left_optical"
+    )
+    for r in (np.eye(3), np.diag([1.0, -1.0, -1.0]), np.diag([-1.0, 1.0, -1.0]),
+              np.diag([-1.0, -1.0, 1.0])):  # fmt: skip
+        q = _quaternion(r)
+        assert abs(np.linalg.norm(q) - 1) < 1e-12
+
+
 def test_bad_input_is_named() -> None:
     d = np.zeros((SIZE[1], SIZE[0]))
     with pytest.raises(ValueError, match="expected a \\(H, W\\) map"):
@@ -238,6 +277,8 @@ def test_cli_depth_ground(data_dir: Path, tmp_path: Path) -> None:
     assert "ground plane: camera 1.6" in run.stdout
     info = json.loads((tmp_path / "ground.json").read_text())
     assert info["height_m"] == pytest.approx(1.62, abs=0.03)
+    assert info["camera_in_floor"][2][3] == info["height_m"]
+    assert "static_transform_publisher --x 0 --y 0 --z 1.6" in run.stdout
     mask = cv2.imread(str(tmp_path / "obstacles.png"), cv2.IMREAD_GRAYSCALE)
     assert mask.shape == (375, 1242) and 0.05 < (mask > 0).mean() < 0.6
     grid = cv2.imread(str(tmp_path / "map.png"), cv2.IMREAD_GRAYSCALE)

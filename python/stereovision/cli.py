@@ -260,6 +260,7 @@ def _ground_outputs(
         return {}
     if log is not None:
         log(plane.describe())
+        log("the camera on the floor, for ROS 2: " + plane.ros2_static_transform())
     rc = calib if calib.rectified else calib.rectified_calibration()
     mask = obstacle_mask(rc.reproject(disparity), plane)
     paths = {"ground.json": out / "ground.json", "obstacles.png": out / "obstacles.png"}

@@ -115,6 +115,32 @@ class GroundPlane:
         out: F64 = pts @ self.normal + self.height  # the camera (X = 0) is at +height
         return out
 
+    def camera_in_floor(self) -> F64:
+        """``(4, 4)`` pose of the camera in the floor frame (ROS REP 103: ``x`` forward, ``y``
+        left, ``z`` up; origin on the floor under the camera): ``X_floor = T @ X_camera``.
+
+        The floor fixes the height, pitch and roll; the robot's heading and position are not
+        seen, so ``x`` is the optical axis laid on the floor and the camera sits at ``(0, 0,
+        height)``.
+        """
+        out: F64 = np.eye(4)
+        out[:3, :3] = floor_frame(self)
+        out[2, 3] = self.height
+        return out
+
+    def ros2_static_transform(
+        self, parent: str = "base_footprint", child: str = "stereo_left_optical"
+    ) -> str:
+        """The ``ros2 run tf2_ros static_transform_publisher`` command publishing
+        :meth:`camera_in_floor` (the camera's optical frame under ``parent``)."""
+        rot = floor_frame(self)  # floor <- camera: its columns are the camera's axes
+        x, y, z, w = _quaternion(rot)
+        return (
+            "ros2 run tf2_ros static_transform_publisher --x 0 --y 0 "
+            f"--z {self.height:.4f} --qx {x:.6f} --qy {y:.6f} --qz {z:.6f} --qw {w:.6f} "
+            f"--frame-id {parent} --child-frame-id {child}"
+        )
+
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready figures (no masks)."""
         return {
@@ -126,6 +152,7 @@ class GroundPlane:
             "inlier_share": self.inlier_share,
             "rms_px": self.rms_px,
             "below_share": self.below_share,
+            "camera_in_floor": self.camera_in_floor().tolist(),
         }
 
     def describe(self) -> str:
@@ -141,6 +168,27 @@ class GroundPlane:
                 "one flat floor"
             )
         return text
+
+
+def _quaternion(rot: F64) -> tuple[float, float, float, float]:
+    """``(x, y, z, w)`` of a rotation matrix (Shepperd's method; ``w >= 0``)."""
+    m = np.asarray(rot, np.float64)
+    tr = float(np.trace(m))
+    if tr > 0:
+        s = 2.0 * math.sqrt(tr + 1.0)
+        q = ((m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, s / 4)
+    else:
+        i = int(np.argmax(np.diag(m)))
+        j, k = (i + 1) % 3, (i + 2) % 3
+        s = 2.0 * math.sqrt(1.0 + m[i, i] - m[j, j] - m[k, k])
+        v = [0.0, 0.0, 0.0]
+        v[i] = s / 4
+        v[j] = (m[j, i] + m[i, j]) / s
+        v[k] = (m[k, i] + m[i, k]) / s
+        q = (v[0], v[1], v[2], (m[k, j] - m[j, k]) / s)
+    if q[3] < 0:
+        q = (-q[0], -q[1], -q[2], -q[3])
+    return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
 
 
 def _rig(calib: Calibration) -> tuple[float, float, float, float, float]:
