@@ -140,19 +140,13 @@ class CharucoBoard:
 
     def __post_init__(self) -> None:
         from stereovision._validate import positive_finite
+        from stereovision.calibrate import parse_pattern
 
         sq = self.squares
-        if isinstance(sq, str):
-            parts = sq.lower().replace("*", "x").split("x")
-            try:
-                vals = [int(p) for p in parts]
-            except ValueError:
-                vals = []
-        else:
-            try:
-                vals = [int(v) for v in sq]
-            except (TypeError, ValueError):
-                vals = []
+        try:  # the chessboard's "COLSxROWS" parser; a ChArUco board counts squares, >= 3 each
+            vals = list(parse_pattern(sq))
+        except (TypeError, ValueError):
+            vals = []
         if len(vals) != 2 or min(vals) < 3:
             raise ValueError(
                 f"squares: expected a ChArUco board's squares as COLSxROWS, each at least 3 "

@@ -262,7 +262,8 @@ def _ground_outputs(
         log(plane.describe())
         log("the camera on the floor, for ROS 2: " + plane.ros2_static_transform())
     rc = calib if calib.rectified else calib.rectified_calibration()
-    mask = obstacle_mask(rc.reproject(disparity), plane)
+    points = rc.reproject(disparity)  # once, for the obstacles and the grid
+    mask = obstacle_mask(points, plane)
     paths = {"ground.json": out / "ground.json", "obstacles.png": out / "obstacles.png"}
     with atomic_write(paths["ground.json"], "w") as fh:
         fh.write(json.dumps({**plane.as_dict(), "obstacle_share": float(mask.mean())}, indent=2))
@@ -272,9 +273,9 @@ def _ground_outputs(
     with atomic_write(paths["obstacles.png"]) as fh:
         fh.write(buf.tobytes())
     if grid is not None:
-        paths["map.png"], paths["map.yaml"] = occupancy_grid(
-            rc.reproject(disparity), plane, resolution=grid
-        ).save(out)
+        paths["map.png"], paths["map.yaml"] = occupancy_grid(points, plane, resolution=grid).save(
+            out
+        )
     return paths
 
 
