@@ -56,6 +56,7 @@ __all__ = [
     "board_object_points",
     "board_pose_params",
     "calibrate",
+    "calibrate_from_bag",
     "calibrate_from_video",
     "find_corners",
     "parse_pattern",
@@ -1252,30 +1253,112 @@ def calibrate_from_video(
         As :func:`calibrate` (too few distinct poses with the board in both views, ...), or for
         a ``max_pairs`` below :data:`MIN_PAIRS`.
     """
-    from stereovision.capture import (
-        MIN_POSE_DISTANCE,
-        ChessboardCollector,
-        SourceError,
-        StereoCamera,
-    )
+    from stereovision.capture import StereoCamera
 
-    if isinstance(max_pairs, bool) or not isinstance(max_pairs, int) or max_pairs < MIN_PAIRS:
-        raise ValueError(
-            f"max_pairs: expected an integer of at least {MIN_PAIRS}, got {max_pairs!r}"
-        )
-    pat = board.inner if board is not None else parse_pattern(pattern)
-    collector = ChessboardCollector(
-        pat, MIN_POSE_DISTANCE if min_distance is None else float(min_distance), board=board
-    )
-    lefts: list[np.ndarray] = []
-    rights: list[np.ndarray] = []
-    names: list[str] = []
-    read = 0
+    _check_max_pairs(max_pairs)
     cam = StereoCamera(
         left if isinstance(left, int) else str(left),
         right if isinstance(right, int) else str(right),
     )
+    return _calibrate_from_camera(
+        cam,
+        pattern=pattern,
+        square_size=square_size,
+        board=board,
+        max_pairs=max_pairs,
+        min_distance=min_distance,
+        log=log,
+        **kwargs,
+    )
+
+
+def calibrate_from_bag(
+    path: PathLike,
+    *,
+    left_topic: str | None = None,
+    right_topic: str | None = None,
+    max_skew_ms: float | None = None,
+    pattern: tuple[int, int] | str = (9, 6),
+    square_size: float | None = None,
+    board: CharucoBoard | None = None,
+    max_pairs: int = MAX_VIDEO_PAIRS,
+    min_distance: float | None = None,
+    log: Any = None,
+    **kwargs: Any,
+) -> tuple[Calibration, CalibrationReport]:
+    """Calibrate from a ROS 1 or ROS 2 bag of the board waved in front of the rig.
+
+    The pairs are read by :class:`~stereovision.rosbag.BagCamera` (topics found or given, pairs
+    matched on their stamps) and kept as :func:`calibrate_from_video` keeps them.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The bag (a ROS 1 ``.bag`` file or a ROS 2 bag folder).
+    left_topic, right_topic, max_skew_ms :
+        As :class:`~stereovision.rosbag.BagCamera`.
+    pattern, square_size, board, max_pairs, min_distance, log, **kwargs :
+        As :func:`calibrate_from_video`.
+
+    Returns
+    -------
+    calibration, report
+        As :func:`calibrate`; the pairs are named ``frame_NNNNN`` by their index in the bag.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the bag does not exist.
+    ValueError
+        As :class:`~stereovision.rosbag.BagCamera` and :func:`calibrate`.
+    """
+    from stereovision.rosbag import BagCamera
+
+    _check_max_pairs(max_pairs)
+    cam = BagCamera(path, left_topic=left_topic, right_topic=right_topic, max_skew_ms=max_skew_ms)
+    return _calibrate_from_camera(
+        cam,
+        pattern=pattern,
+        square_size=square_size,
+        board=board,
+        max_pairs=max_pairs,
+        min_distance=min_distance,
+        log=log,
+        **kwargs,
+    )
+
+
+def _check_max_pairs(max_pairs: object) -> None:
+    if isinstance(max_pairs, bool) or not isinstance(max_pairs, int) or max_pairs < MIN_PAIRS:
+        raise ValueError(
+            f"max_pairs: expected an integer of at least {MIN_PAIRS}, got {max_pairs!r}"
+        )
+
+
+def _calibrate_from_camera(
+    cam: Any,
+    *,
+    pattern: tuple[int, int] | str,
+    square_size: float | None,
+    board: CharucoBoard | None,
+    max_pairs: int,
+    min_distance: float | None,
+    log: Any,
+    **kwargs: Any,
+) -> tuple[Calibration, CalibrationReport]:
+    """Keep the distinct board poses a camera (or recording) shows, then :func:`calibrate`;
+    the camera is closed."""
+    from stereovision.capture import MIN_POSE_DISTANCE, ChessboardCollector, SourceError
+
+    lefts: list[np.ndarray] = []
+    rights: list[np.ndarray] = []
+    names: list[str] = []
+    read = 0
     try:
+        pat = board.inner if board is not None else parse_pattern(pattern)
+        collector = ChessboardCollector(
+            pat, MIN_POSE_DISTANCE if min_distance is None else float(min_distance), board=board
+        )
         while len(lefts) < max_pairs:
             try:
                 frame = cam.read()
@@ -1708,12 +1791,19 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     """``stereovision calibrate --left GLOB --right GLOB --pattern 9x6 --square S -o FILE``
     (``--board charuco --marker M`` for a ChArUco board; ``--ros DIR`` also writes ROS
     ``camera_info`` files)."""
-    video = len(args.left) == 1 and _is_video(args.left[0])
-    if video != (len(args.right) == 1 and _is_video(args.right[0])):
+    if args.from_bag:
+        if args.left or args.right:
+            raise ValueError("--from-bag replaces --left and --right: give one source")
+    elif args.left_topic or args.right_topic or args.max_skew_ms is not None:
+        raise ValueError("--left-topic, --right-topic and --max-skew-ms are for --from-bag")
+    elif not (args.left and args.right):
+        raise ValueError("give the board's pairs (--left and --right) or a recording (--from-bag)")
+    video = bool(args.left) and len(args.left) == 1 and _is_video(args.left[0])
+    if args.right and video != (len(args.right) == 1 and _is_video(args.right[0])):
         raise ValueError("--left and --right: give two videos, or two sets of images")
     lefts: list[str] = []
     rights: list[str] = []
-    if not video:
+    if not video and not args.from_bag:
         lefts = [f for g in args.left for f in _expand(g, "--left")]
         rights = [f for g in args.right for f in _expand(g, "--right")]
         if len(lefts) != len(rights):
@@ -1735,7 +1825,17 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         "distortion": args.distortion,
         "drop_outliers": args.drop_outliers,
     }
-    if video:
+    if args.from_bag:
+        cal, rep = calibrate_from_bag(
+            args.from_bag,
+            left_topic=args.left_topic,
+            right_topic=args.right_topic,
+            max_skew_ms=args.max_skew_ms,
+            max_pairs=args.max_pairs,
+            log=print,
+            **common,
+        )
+    elif video:
         cal, rep = calibrate_from_video(
             args.left[0], args.right[0], max_pairs=args.max_pairs, log=print, **common
         )
@@ -1857,17 +1957,26 @@ def add_cli(subparsers: Any) -> None:
     )
     p.add_argument(
         "--left",
-        required=True,
         nargs="+",
         help="left images (glob patterns, quoted), or one video (or %%03d pattern) of the board "
         "waved about",
     )
-    p.add_argument("--right", required=True, nargs="+", help="right images (glob), or a video")
+    p.add_argument("--right", nargs="+", help="right images (glob), or a video")
+    p.add_argument(
+        "--from-bag", metavar="BAG", help="a ROS 1 / ROS 2 bag of the board waved about instead"
+    )
+    p.add_argument("--left-topic", help="--from-bag: left image topic (default: found)")
+    p.add_argument("--right-topic", help="--from-bag: right image topic (default: found)")
+    p.add_argument(
+        "--max-skew-ms",
+        type=float,
+        help="--from-bag: largest stamp difference of a pair (default: half a frame period)",
+    )
     p.add_argument(
         "--max-pairs",
         type=int,
         default=MAX_VIDEO_PAIRS,
-        help=f"videos: keep at most N distinct board poses (default {MAX_VIDEO_PAIRS})",
+        help=f"videos, bags: keep at most N distinct board poses (default {MAX_VIDEO_PAIRS})",
     )
     _add_board_options(p)
     p.add_argument(

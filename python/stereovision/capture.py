@@ -2,9 +2,11 @@
 
 A source is anything :class:`cv2.VideoCapture` opens -- a device index (``0``), a video file
 (``left.avi``) or an image-sequence pattern (``frames/left_%03d.png``) -- so everything here is
-testable without cameras. A pair is taken the way OpenCV recommends for multi-camera rigs: *grab*
-both cameras first (cheap, latches the frames), then *retrieve* (decode) both, and each grab is
-timestamped so the left/right skew can be measured and reported.
+testable without cameras; a recording in a ROS bag is read by
+:class:`~stereovision.rosbag.BagCamera`, which has the same interface (``--from-bag``). A pair
+is taken the way OpenCV recommends for multi-camera rigs: *grab* both cameras first (cheap,
+latches the frames), then *retrieve* (decode) both, and each grab is timestamped so the
+left/right skew can be measured and reported.
 
 Saved pairs are numbered ``left_0001.png`` / ``right_0001.png``; each file is encoded in memory,
 written to a temporary file in the destination directory and renamed over its final name with
@@ -53,7 +55,9 @@ __all__ = [
     "StereoCamera",
     "StereoFrame",
     "add_cli",
+    "add_source_args",
     "capture",
+    "open_source",
     "parse_size",
     "parse_source",
     "save_pair",
@@ -370,6 +374,57 @@ class StereoCamera:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+# ---------------------------------------------------------------------------- CLI sources
+
+
+def add_source_args(p: argparse.ArgumentParser) -> None:
+    """The pair source options of ``capture`` and ``stream``: two cameras, or a ROS bag."""
+    p.add_argument("--left", help="device index, video file or pattern (%%03d)")
+    p.add_argument("--right", help="device index, video file or pattern")
+    p.add_argument(
+        "--from-bag",
+        metavar="BAG",
+        help="read the pairs from a recorded ROS 1 bag or ROS 2 bag folder instead",
+    )
+    p.add_argument("--left-topic", help="--from-bag: left image topic (default: found)")
+    p.add_argument("--right-topic", help="--from-bag: right image topic (default: found)")
+    p.add_argument(
+        "--max-skew-ms",
+        type=float,
+        help="--from-bag: largest stamp difference of a pair (default: half a frame period)",
+    )
+
+
+def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
+    """The :class:`StereoCamera` or :class:`~stereovision.rosbag.BagCamera` the options name.
+
+    Raises
+    ------
+    ValueError
+        If both or neither source kind is given, or a bag option comes without ``--from-bag``.
+    """
+    size = parse_size(args.size)
+    if args.from_bag:
+        if args.left is not None or args.right is not None:
+            raise ValueError("--from-bag replaces --left and --right: give one source")
+        if fps is not None:
+            raise ValueError("--fps: a bag is read as recorded, it has no frame rate to ask for")
+        from stereovision.rosbag import BagCamera
+
+        return BagCamera(
+            args.from_bag,
+            left_topic=args.left_topic,
+            right_topic=args.right_topic,
+            max_skew_ms=args.max_skew_ms,
+            size=size,
+        )
+    if args.left_topic or args.right_topic or args.max_skew_ms is not None:
+        raise ValueError("--left-topic, --right-topic and --max-skew-ms are for --from-bag")
+    if args.left is None or args.right is None:
+        raise ValueError("give the two cameras (--left and --right) or a recording (--from-bag)")
+    return StereoCamera(parse_source(args.left), parse_source(args.right), size=size, fps=fps)
 
 
 # ---------------------------------------------------------------------------------- saving
@@ -717,12 +772,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
         raise ValueError("--square, --marker and --dictionary are for --charuco")
     if args.count is not None and args.count <= 0:
         raise ValueError(f"--count: expected a positive number, got {args.count}")
-    cam = StereoCamera(
-        parse_source(args.left),
-        parse_source(args.right),
-        size=parse_size(args.size),
-        fps=args.fps,
-    )
+    cam = open_source(args, fps=args.fps)
     try:
         print(cam.describe())
         result = capture(
@@ -749,12 +799,11 @@ def add_cli(subparsers: Any) -> None:
     """Register the ``capture`` subcommand on an ``argparse`` subparsers object."""
     p = subparsers.add_parser(
         "capture",
-        help="capture stereo pairs from two cameras (or videos / image sequences)",
+        help="capture stereo pairs from two cameras (or videos / image sequences / a ROS bag)",
         description="Save synchronised pairs; with --chessboard, only pairs with the board in "
         "both views and a new pose.",
     )
-    p.add_argument("--left", required=True, help="device index, video file or pattern (%%03d)")
-    p.add_argument("--right", required=True, help="device index, video file or pattern")
+    add_source_args(p)
     p.add_argument("--size", help="requested size WIDTHxHEIGHT (frames are resized if needed)")
     p.add_argument("--fps", type=float, help="requested frame rate")
     p.add_argument("-o", "--output", required=True, help="output directory")

@@ -15,17 +15,57 @@ topic (``prefix`` = ``/stereo``)  type                         content
 
 The bag is written with the pure-Python ``rosbags`` library (``pip install rosbags``, or the
 ``ros`` extra), as a ROS 2 bag (sqlite3, CDR) that ``ros2 bag play`` reads.
+
+:class:`BagCamera` goes the other way: it reads a recorded rig -- a ROS 1 bag, or a ROS 2 bag
+(sqlite3 or MCAP) -- as synchronised pairs, with the same interface as
+:class:`~stereovision.capture.StereoCamera`, so ``stream``, ``capture`` (and through it
+``calibrate``) run on a recording as on live cameras:
+
+- **Topics.** The left and right image topics (``sensor_msgs/Image`` or ``CompressedImage``) are
+  given, or found: two image topics whose names differ in one part, ``left``/``right`` or a
+  number (``/cam0/image_raw`` and ``/cam1/image_raw``); raw ones are preferred when a bag also
+  holds rectified ones. Anything else is a clear error that lists the bag's image topics.
+- **Pairs** are matched on the messages' header stamps (the time of exposure, not of
+  recording), each left frame with the nearest right frame within ``max_skew_ms`` (default:
+  half the faster topic's frame period, so no frame can be used twice); a frame without a
+  partner is skipped and counted (:attr:`BagCamera.dropped`).
+- **Images** of every ROS encoding a camera driver publishes (``mono8/16``, ``bgr8``, ``rgb8``,
+  ``bgra8``, ``rgba8`` and their 16-bit forms, the four Bayer patterns, ``yuv422``/``uyvy`` and
+  ``yuyv``; row padding and big-endian data) and compressed ones (JPEG, PNG) come out as BGR
+  ``uint8``, like a camera's. 16-bit pairs are brought to 8 bits by one power-of-two shift for
+  both images, the smallest that keeps their brightest pixel (a 12-bit sensor in a 16-bit
+  container is shifted by 4, not left nearly black).
+- **Calibration.** When the bag holds each camera's ``camera_info`` (beside its image topic),
+  :meth:`BagCamera.calibration` makes the rig's :class:`~stereovision.calibration.Calibration`
+  from them, as :meth:`~stereovision.calibration.Calibration.from_ros` does from the YAML files;
+  for rectified topics (``image_rect...``), the rectified rig of the two ``P`` matrices.
 """
 
 from __future__ import annotations
 
+import itertools
+import math
 import os
+import re
+import statistics
+from collections import deque
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 
-__all__ = ["DEFAULT_FRAME_ID", "DEFAULT_PREFIX", "BagWriter"]
+__all__ = [
+    "DEFAULT_FRAME_ID",
+    "DEFAULT_PREFIX",
+    "ENCODINGS",
+    "BagCamera",
+    "BagWriter",
+    "decode_image",
+    "find_stereo_topics",
+    "to_8bit",
+]
 
 #: The frame the messages are stamped with (the left rectified camera's optical frame).
 DEFAULT_FRAME_ID = "stereo_left_optical"
@@ -231,6 +271,537 @@ class BagWriter:
             self._writer = None
 
     def __enter__(self) -> BagWriter:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+# ==================================================================================== reading
+
+IMAGE_TYPE = "sensor_msgs/msg/Image"
+COMPRESSED_TYPE = "sensor_msgs/msg/CompressedImage"
+CAMERA_INFO_TYPE = "sensor_msgs/msg/CameraInfo"
+#: Stamps of this many first frames of each side set the default pairing tolerance.
+PERIOD_SAMPLE = 8
+#: Left frames held back while waiting for a right one; beyond, the oldest is decided as if the
+#: recording had ended (a right topic that stopped must not make the reader hold the whole bag).
+MAX_WAITING = 64
+
+# ROS encoding -> (channels, bytes per channel, OpenCV conversion to BGR or None). ROS names a
+# Bayer pattern by its first two pixels (rggb: R G / G B), OpenCV by the second row's second and
+# third, so ROS's rggb is OpenCV's BayerBG: cv_bridge's table, checked in the tests.
+_ENCODINGS: dict[str, tuple[int, int, int | None]] = {
+    "mono8": (1, 1, cv2.COLOR_GRAY2BGR),
+    "8uc1": (1, 1, cv2.COLOR_GRAY2BGR),
+    "mono16": (1, 2, cv2.COLOR_GRAY2BGR),
+    "16uc1": (1, 2, cv2.COLOR_GRAY2BGR),
+    "bgr8": (3, 1, None),
+    "8uc3": (3, 1, None),
+    "rgb8": (3, 1, cv2.COLOR_RGB2BGR),
+    "bgr16": (3, 2, None),
+    "16uc3": (3, 2, None),
+    "rgb16": (3, 2, cv2.COLOR_RGB2BGR),
+    "bgra8": (4, 1, cv2.COLOR_BGRA2BGR),
+    "8uc4": (4, 1, cv2.COLOR_BGRA2BGR),
+    "rgba8": (4, 1, cv2.COLOR_RGBA2BGR),
+    "bgra16": (4, 2, cv2.COLOR_BGRA2BGR),
+    "16uc4": (4, 2, cv2.COLOR_BGRA2BGR),
+    "rgba16": (4, 2, cv2.COLOR_RGBA2BGR),
+    "bayer_rggb8": (1, 1, cv2.COLOR_BayerBG2BGR),
+    "bayer_bggr8": (1, 1, cv2.COLOR_BayerRG2BGR),
+    "bayer_gbrg8": (1, 1, cv2.COLOR_BayerGR2BGR),
+    "bayer_grbg8": (1, 1, cv2.COLOR_BayerGB2BGR),
+    "bayer_rggb16": (1, 2, cv2.COLOR_BayerBG2BGR),
+    "bayer_bggr16": (1, 2, cv2.COLOR_BayerRG2BGR),
+    "bayer_gbrg16": (1, 2, cv2.COLOR_BayerGR2BGR),
+    "bayer_grbg16": (1, 2, cv2.COLOR_BayerGB2BGR),
+    "yuv422": (2, 1, cv2.COLOR_YUV2BGR_UYVY),
+    "uyvy": (2, 1, cv2.COLOR_YUV2BGR_UYVY),
+    "yuv422_yuy2": (2, 1, cv2.COLOR_YUV2BGR_YUY2),
+    "yuyv": (2, 1, cv2.COLOR_YUV2BGR_YUY2),
+}
+#: The ROS image encodings :func:`decode_image` reads.
+ENCODINGS = tuple(sorted(_ENCODINGS))
+
+
+def _reader_cls() -> Any:
+    try:
+        from rosbags.highlevel import AnyReader
+    except ImportError:
+        raise ImportError(
+            "reading ROS bags needs the rosbags package: pip install rosbags (or the package's "
+            "'ros' extra)"
+        ) from None
+    return AnyReader
+
+
+def decode_image(msg: Any) -> np.ndarray:
+    """A ``sensor_msgs/Image`` or ``CompressedImage`` message as a BGR image.
+
+    Parameters
+    ----------
+    msg : object
+        The deserialised message (``rosbags``' classes, or anything with the same fields).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W, 3)`` BGR, ``uint8`` or, for 16-bit encodings, ``uint16`` (see :func:`to_8bit`).
+
+    Raises
+    ------
+    ValueError
+        For an encoding that is not one of :data:`ENCODINGS` (named), a ``compressedDepth``
+        image, data that does not decode, or a size, ``step`` and data length that disagree.
+    """
+    if hasattr(msg, "format"):  # CompressedImage
+        fmt = str(msg.format)
+        if "compresseddepth" in fmt.lower():
+            raise ValueError(f"compressed image format {fmt!r} is a depth image, not a camera's")
+        buf = np.asarray(msg.data, np.uint8).reshape(-1)
+        img = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED) if buf.size else None
+        if img is None:
+            raise ValueError(f"compressed image ({fmt!r}, {buf.size} bytes) does not decode")
+        if img.ndim == 2:
+            return np.asarray(cv2.cvtColor(img, cv2.COLOR_GRAY2BGR))
+        if img.shape[2] == 4:
+            return np.asarray(cv2.cvtColor(img, cv2.COLOR_BGRA2BGR))
+        return np.asarray(img)
+    enc = str(msg.encoding)
+    spec = _ENCODINGS.get(enc.lower())
+    if spec is None:
+        raise ValueError(
+            f"image encoding {enc!r} is not a camera image this reader knows; expected one of "
+            f"{', '.join(ENCODINGS)}"
+        )
+    ch, nbytes, code = spec
+    h, w, step = int(msg.height), int(msg.width), int(msg.step)
+    data = np.asarray(msg.data, np.uint8).reshape(-1)
+    row = w * ch * nbytes
+    if h <= 0 or w <= 0 or step < row or data.size < step * h:
+        raise ValueError(
+            f"{enc} image of {w}x{h} px: step {step} and {data.size} data bytes do not hold it "
+            f"({row} bytes per row needed)"
+        )
+    rows = np.ascontiguousarray(data[: step * h].reshape(h, step)[:, :row])
+    arr: np.ndarray = rows
+    if nbytes == 2:
+        arr = rows.view(">u2" if msg.is_bigendian else "<u2").astype(np.uint16)
+    arr = arr.reshape((h, w) if ch == 1 else (h, w, ch))
+    return np.asarray(cv2.cvtColor(arr, code)) if code is not None else arr
+
+
+def to_8bit(*images: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Bring 16-bit images to ``uint8`` with one power-of-two shift for all of them.
+
+    The shift is the smallest that keeps the brightest pixel of the images, so a pair keeps one
+    scale (the matchers compare the two images) and a 10- or 12-bit sensor's data in a 16-bit
+    container is not left nearly black. ``uint8`` images are returned as they are.
+    """
+    peak = max((int(im.max()) for im in images if im.dtype == np.uint16 and im.size), default=0)
+    shift = max(0, peak.bit_length() - 8)
+    return tuple(
+        (im >> shift).astype(np.uint8) if im.dtype == np.uint16 else np.asarray(im, np.uint8)
+        for im in images
+    )
+
+
+def _stamp_ns(msg: Any, recorded_ns: int) -> int:
+    """The header's stamp in nanoseconds; the recording time when the driver left it 0."""
+    stamp = msg.header.stamp
+    ns = int(stamp.sec) * 1_000_000_000 + int(getattr(stamp, "nanosec", 0))
+    return ns if ns > 0 else int(recorded_ns)
+
+
+def _is_left_right(a: str, b: str) -> bool:
+    """Is ``a``/``b`` one topic-name part of a left/right pair (``left``/``right``, ``cam0``/
+    ``cam1``, ``infra1``/``infra2``)?"""
+    if "left" in a.lower() and a.lower().replace("left", "right") == b.lower():
+        return True
+    ma, mb = re.fullmatch(r"(\D*)(\d+)(\D*)", a), re.fullmatch(r"(\D*)(\d+)(\D*)", b)
+    return bool(ma and mb and ma[1] == mb[1] and ma[3] == mb[3] and int(ma[2]) < int(mb[2]))
+
+
+def _base_topic(topic: str) -> str:
+    """The image topic without an image_transport suffix (``.../image_raw/compressed``)."""
+    return re.sub(r"/(compressed|theora|ffmpeg|zstd)$", "", topic)
+
+
+def find_stereo_topics(image_topics: list[str]) -> tuple[str, str]:
+    """Pick the left and right image topics among a bag's image topics.
+
+    Two topics form a pair when their names differ in one ``/``-separated part, ``left`` against
+    ``right`` or a lower against a higher number (``cam0``/``cam1``). Among several pairs, raw
+    (``image_raw``) and uncompressed ones are preferred.
+
+    Raises
+    ------
+    ValueError
+        When no pair, or more than one equally good pair, is found (the topics are listed).
+    """
+    pairs = []
+    for a in image_topics:
+        pa = a.split("/")
+        for b in image_topics:
+            pb = b.split("/")
+            if a == b or len(pa) != len(pb):
+                continue
+            diff = [i for i in range(len(pa)) if pa[i] != pb[i]]
+            if len(diff) == 1 and _is_left_right(pa[diff[0]], pb[diff[0]]):
+                pairs.append((a, b))
+    listing = ", ".join(sorted(image_topics)) or "none"
+    if not pairs:
+        raise ValueError(
+            f"no left/right pair among the bag's image topics ({listing}); give the topics "
+            "(--left-topic, --right-topic)"
+        )
+
+    def rank(pair: tuple[str, str]) -> tuple[bool, bool]:
+        return ("raw" in pair[0], _base_topic(pair[0]) == pair[0])
+
+    best = max(rank(p) for p in pairs)
+    top = [p for p in pairs if rank(p) == best]
+    if len(top) > 1:
+        names = "; ".join(f"{a} + {b}" for a, b in top)
+        raise ValueError(
+            f"the bag holds several stereo pairs ({names}); give the topics (--left-topic, "
+            "--right-topic)"
+        )
+    return top[0]
+
+
+class BagCamera:
+    """A stereo rig recorded in a ROS 1 or ROS 2 bag, read as synchronised pairs.
+
+    It has :class:`~stereovision.capture.StereoCamera`'s interface (``read``, ``frames``,
+    ``skew_report``, ``describe``, ``close``, ``size``, ``count``, ``skews_ms``), so it is
+    accepted wherever a camera is; see the module doc for how topics, pairs and images are
+    read. The frames' ``t_left`` / ``t_right`` are the header stamps (seconds), their skew the
+    stamps' difference, and ``pos_*_ms`` the time since the bag's start.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ROS 1 ``.bag`` file, or a ROS 2 bag folder (sqlite3 or MCAP).
+    left_topic, right_topic : str, optional
+        The image topics; found when not given (both or neither).
+    max_skew_ms : float, optional
+        Largest stamp difference of a pair. Default: half the frame period of the faster topic
+        (from the first :data:`PERIOD_SAMPLE` frames' stamps), so a frame pairs at most once.
+    size : tuple of int or str, optional
+        Resize the frames to ``(width, height)``. Default: as recorded.
+
+    Attributes
+    ----------
+    topics : dict of str to str
+        ``{"left": topic, "right": topic}``.
+    info_topics : dict of str to str or None
+        Each side's ``camera_info`` topic, None when the bag has none beside the image topic.
+    dropped : dict of str to int
+        Frames of each side that found no partner within ``max_skew_ms`` (so far).
+    stamps_ns : list of int
+        The left header stamp of every pair read, in order.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    ValueError
+        If it is not a bag, a given topic is not an image topic of the bag, or the topics
+        cannot be found (the bag's image topics are listed).
+    ImportError
+        Without the ``rosbags`` package.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        *,
+        left_topic: str | None = None,
+        right_topic: str | None = None,
+        max_skew_ms: float | None = None,
+        size: tuple[int, int] | str | None = None,
+    ) -> None:
+        from stereovision.capture import parse_size
+
+        self.path = Path(path)
+        if not self.path.exists():
+            raise FileNotFoundError(f"bag not found: {self.path}")
+        if self.path.is_file() and (self.path.parent / "metadata.yaml").is_file():
+            self.path = self.path.parent  # a file of a ROS 2 bag (its .db3, .mcap or metadata)
+        if (left_topic is None) != (right_topic is None):
+            raise ValueError("give both the left and the right topic, or neither")
+        if max_skew_ms is not None and not (math.isfinite(max_skew_ms) and max_skew_ms >= 0):
+            raise ValueError(f"max_skew_ms: expected a number >= 0, got {max_skew_ms!r}")
+        self.requested_size = parse_size(size)
+        reader_cls = _reader_cls()
+        try:
+            reader = reader_cls([self.path])
+            reader.open()
+        except Exception as exc:  # rosbags' errors name no common base class
+            raise ValueError(f"{self.path} is not a readable ROS 1 or ROS 2 bag: {exc}") from None
+        self._reader: Any = reader
+        try:
+            self._setup(left_topic, right_topic, max_skew_ms)
+        except BaseException:
+            self.close()
+            raise
+
+    def _setup(self, left: str | None, right: str | None, max_skew_ms: float | None) -> None:
+        topics = self._reader.topics
+        images = sorted(t for t, i in topics.items() if i.msgtype in (IMAGE_TYPE, COMPRESSED_TYPE))
+        if left is None or right is None:
+            left, right = find_stereo_topics(images)
+        for side, topic in (("left", left), ("right", right)):
+            if topic not in images:
+                raise ValueError(
+                    f"{side} topic {topic!r} is not an image topic of {self.path} (its image "
+                    f"topics: {', '.join(images) or 'none'})"
+                )
+        if left == right:
+            raise ValueError(f"the left and right topics are the same: {left!r}")
+        self.topics = {"left": left, "right": right}
+        self.sources = {"left": f"{self.path}:{left}", "right": f"{self.path}:{right}"}
+        self.info_topics: dict[str, str | None] = {}
+        for side, topic in self.topics.items():
+            info = _base_topic(topic).rsplit("/", 1)[0] + "/camera_info"
+            ok = info in topics and topics[info].msgtype == CAMERA_INFO_TYPE
+            self.info_topics[side] = info if ok else None
+        self.rectified_topics = all(
+            "rect" in _base_topic(t).rsplit("/", 1)[-1] for t in (left, right)
+        )
+        self._conns = [c for c in self._reader.connections if c.topic in (left, right)]
+        span_s = max(self._reader.duration, 1) / 1e9
+        self.delivered_fps = {s: topics[t].msgcount / span_s for s, t in self.topics.items()}
+        self.size = self.requested_size
+        self.delivered_size: dict[str, tuple[int, int]] = {}
+        self.skews_ms: list[float] = []
+        self.stamps_ns: list[int] = []
+        self.count = 0
+        self.dropped = {"left": 0, "right": 0}
+        self.max_skew_ms = max_skew_ms
+        self._tol_ns: float | None = None if max_skew_ms is None else max_skew_ms * 1e6
+        self._first: dict[str, list[int]] = {"left": [], "right": []}
+        self._pairs = self._pair_iter()
+
+    # ------------------------------------------------------------------------------ pairing
+
+    def _default_tolerance(self) -> float:
+        periods = []
+        for stamps in self._first.values():
+            steps = [b - a for a, b in itertools.pairwise(stamps) if b > a]
+            if steps:
+                periods.append(statistics.median(steps))
+        return 0.5 * min(periods) if periods else math.inf
+
+    def _match(
+        self, lefts: deque[tuple[int, Any]], rights: deque[tuple[int, Any]], final: bool
+    ) -> Iterator[tuple[int, Any, int, Any]]:
+        if self._tol_ns is None:
+            sampled = all(len(s) >= PERIOD_SAMPLE for s in self._first.values())
+            if not (final or sampled or len(lefts) > MAX_WAITING):
+                return
+            self._tol_ns = self._default_tolerance()
+            self.max_skew_ms = self._tol_ns / 1e6
+        tol = self._tol_ns
+        while lefts:
+            sl = lefts[0][0]
+            while rights and rights[0][0] < sl - tol:
+                rights.popleft()
+                self.dropped["right"] += 1
+            waiting = not rights or rights[-1][0] < sl
+            if waiting and not final and len(lefts) <= MAX_WAITING:
+                return  # a nearer right frame may still come
+            best = None
+            for i, (sr, _) in enumerate(rights):
+                if sr > sl + tol:
+                    break
+                if best is None or abs(sr - sl) < abs(rights[best][0] - sl):
+                    best = i
+            _, ml = lefts.popleft()
+            if best is None:
+                self.dropped["left"] += 1
+                continue
+            for _ in range(best):
+                rights.popleft()
+                self.dropped["right"] += 1
+            sr, mr = rights.popleft()
+            yield sl, ml, sr, mr
+
+    def _pair_iter(self) -> Iterator[tuple[int, Any, int, Any]]:
+        lefts: deque[tuple[int, Any]] = deque()
+        rights: deque[tuple[int, Any]] = deque()
+        left_topic = self.topics["left"]
+        for conn, recorded, raw in self._reader.messages(connections=self._conns):
+            msg = self._reader.deserialize(raw, conn.msgtype)
+            side = "left" if conn.topic == left_topic else "right"
+            stamp = _stamp_ns(msg, recorded)
+            if len(self._first[side]) < PERIOD_SAMPLE:
+                self._first[side].append(stamp)
+            (lefts if side == "left" else rights).append((stamp, msg))
+            yield from self._match(lefts, rights, final=False)
+        yield from self._match(lefts, rights, final=True)
+        self.dropped["right"] += len(rights)
+
+    # ------------------------------------------------------------------------------ reading
+
+    def _fit(self, side: str, img: np.ndarray) -> np.ndarray:
+        h, w = img.shape[:2]
+        self.delivered_size[side] = (w, h)
+        if self.size is None:
+            self.size = (w, h)
+        if (w, h) == self.size:
+            return img
+        interp = cv2.INTER_AREA if w > self.size[0] else cv2.INTER_LINEAR
+        return np.asarray(cv2.resize(img, self.size, interpolation=interp))
+
+    def read(self) -> Any:
+        """The next pair, as a :class:`~stereovision.capture.StereoFrame`.
+
+        Raises
+        ------
+        SourceError
+            At the end of the recording, or when the bag is closed.
+        ValueError
+            If a frame does not decode (its topic and stamp named).
+        """
+        from stereovision.capture import SourceError, StereoFrame
+
+        if self._reader is None:
+            raise SourceError("the bag is closed")
+        nxt = next(self._pairs, None)
+        if nxt is None:
+            raise SourceError(
+                f"bag {self.path}: end of the recording after {self.count} pairs "
+                f"({self.dropped['left']} left and {self.dropped['right']} right frames without "
+                "a partner)"
+            )
+        sl, ml, sr, mr = nxt
+        imgs = []
+        for side, msg, stamp in (("left", ml, sl), ("right", mr, sr)):
+            try:
+                imgs.append(decode_image(msg))
+            except ValueError as exc:
+                raise ValueError(f"{self.topics[side]} at stamp {stamp} ns: {exc}") from None
+        left, right = to_8bit(*imgs)
+        start = self._reader.start_time
+        frame = StereoFrame(
+            left=self._fit("left", left),
+            right=self._fit("right", right),
+            t_left=sl / 1e9,
+            t_right=sr / 1e9,
+            index=self.count,
+            pos_left_ms=(sl - start) / 1e6,
+            pos_right_ms=(sr - start) / 1e6,
+        )
+        self.count += 1
+        self.skews_ms.append(frame.skew_ms)
+        self.stamps_ns.append(sl)
+        return frame
+
+    def frames(self, *, stop_at_end: bool = True) -> Iterator[Any]:
+        """Iterate over the pairs until the end of the recording."""
+        from stereovision.capture import SourceError
+
+        while True:
+            try:
+                frame = self.read()
+            except SourceError:
+                if stop_at_end:
+                    return
+                raise
+            yield frame
+
+    def skew_report(self) -> dict[str, float]:
+        """Stamp difference over the pairs read: ``n``, ``mean_ms``, ``median_ms``, ``max_ms``."""
+        s = self.skews_ms
+        if not s:
+            return {"n": 0, "mean_ms": math.nan, "median_ms": math.nan, "max_ms": math.nan}
+        return {
+            "n": len(s),
+            "mean_ms": float(statistics.fmean(s)),
+            "median_ms": float(statistics.median(s)),
+            "max_ms": float(max(s)),
+        }
+
+    def describe(self) -> str:
+        """One line: the bag, its two topics with their size and rate, the pairing tolerance."""
+        parts = []
+        for side in ("left", "right"):
+            d = self.delivered_size.get(side)
+            got = f"{d[0]}x{d[1]}" if d else "?"
+            parts.append(
+                f"{side} {self.topics[side]}: {got} @ {self.delivered_fps.get(side, 0.0):.3g} fps"
+            )
+        tol = self.max_skew_ms
+        skew = "max skew: auto" if tol is None else f"max skew {tol:.3g} ms"
+        return f"bag {self.path}; " + "; ".join(parts) + f"; {skew}"
+
+    # ---------------------------------------------------------------------------- calibration
+
+    def calibration(self) -> Any:
+        """The rig's calibration from the bag's ``camera_info`` messages (the first of each
+        side), in metres; None when the bag has no ``camera_info`` beside both image topics.
+
+        For raw topics it is the rig of :meth:`Calibration.from_ros
+        <stereovision.calibration.Calibration.from_ros>`; for rectified topics (``image_rect``)
+        the rectified rig of the two ``P`` matrices. Binned images (``binning_x/y`` > 1) get
+        the calibration scaled to their size.
+
+        Raises
+        ------
+        ValueError
+            If a ``camera_info`` is not a stereo camera's (no baseline), its model is not
+            supported, or it describes a region of interest (named).
+        """
+        from stereovision.calibration import Calibration, _ros_yaml
+
+        if self._reader is None or None in self.info_topics.values():
+            return None
+        texts, binning = [], set()
+        for side in ("left", "right"):
+            topic = self.info_topics[side]
+            conns = [c for c in self._reader.connections if c.topic == topic]
+            conn, _, raw = next(iter(self._reader.messages(connections=conns)))
+            msg = self._reader.deserialize(raw, conn.msgtype)
+
+            # ROS 2 spells the matrices k, d, r, p; ROS 1 K, D, R, P
+            K, D, R, P = (
+                np.asarray(getattr(msg, n) if hasattr(msg, n) else getattr(msg, n.upper()), float)
+                for n in "kdrp"
+            )
+            K, R, P = K.reshape(3, 3), R.reshape(3, 3), P.reshape(3, 4)
+            roi = msg.roi
+            size = (int(msg.width), int(msg.height))
+            if roi.width and roi.height and (roi.width, roi.height) != size:
+                raise ValueError(
+                    f"{topic}: camera_info has a region of interest ({roi.width}x{roi.height} at "
+                    f"{roi.x_offset},{roi.y_offset}); cropped cameras are not supported"
+                )
+            model = str(msg.distortion_model) or "plumb_bob"
+            if self.rectified_topics:
+                K, D, R, model = P[:, :3], np.zeros(5), np.eye(3), "plumb_bob"
+            texts.append(_ros_yaml(side, size, K, D, R, P, model))
+            binning.add((max(int(msg.binning_x), 1), max(int(msg.binning_y), 1)))
+        calib = Calibration._from_ros_texts(
+            texts[0], texts[1], str(self.info_topics["left"]), str(self.info_topics["right"])
+        )
+        bx, by = max(b[0] for b in binning), max(b[1] for b in binning)
+        if (bx, by) != (1, 1):
+            w, h = calib.image_size
+            calib = calib.scaled_to((w // bx, h // by))
+        return calib
+
+    def close(self) -> None:
+        """Close the bag (idempotent)."""
+        if self._reader is not None:
+            try:
+                self._reader.close()
+            finally:
+                self._reader = None
+
+    def __enter__(self) -> BagCamera:
         return self
 
     def __exit__(self, *exc: object) -> None:

@@ -21,6 +21,7 @@ asks for them. ``--no-display`` turns the server off (headless robots).
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import math
 import queue
@@ -38,7 +39,7 @@ import cv2
 import numpy as np
 
 from stereovision.calibration import Calibration, fit_to_frames
-from stereovision.capture import SourceError, StereoCamera, parse_size, parse_source
+from stereovision.capture import SourceError, StereoCamera, add_source_args, open_source
 from stereovision.rectification_check import RectificationCheck, check_rectification
 
 __all__ = [
@@ -684,15 +685,26 @@ def _format_report(rep: dict[str, Any]) -> str:
 def cmd_stream(args: argparse.Namespace) -> int:
     """``stereovision stream --left SRC --right SRC``."""
     calib = Calibration.from_file(args.calib) if args.calib else None
-    if args.bag and calib is None:
-        raise ValueError("--bag: a bag holds depth; give --calib")
     out = sys.stdout
     log = sys.stderr
     server: FrameServer | None = None
-    size = parse_size(args.size)
-    cam = StereoCamera(parse_source(args.left), parse_source(args.right), size=size)
+    cam = open_source(args)
+    stamps: Callable[[], int] = time.time_ns
+    if hasattr(cam, "stamps_ns"):  # a recording: its results keep the frames' stamps
+        played = itertools.count()
+        stamps = lambda: cam.stamps_ns[next(played)]  # noqa: E731 -- results come in read order
+        if calib is None:
+            try:
+                calib = cam.calibration()
+            except BaseException:
+                cam.close()
+                raise
+            if calib is not None:
+                print(f"calibration: the bag's {' and '.join(cam.info_topics.values())}", file=log)
     bag = None
     try:
+        if args.bag and calib is None:
+            raise ValueError("--bag: a bag holds depth; give --calib")
         if args.bag:
             from stereovision.rosbag import BagWriter
 
@@ -707,7 +719,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             )
         if bag is not None:
             writer = bag
-            sinks.append(lambda left, res: writer.write(res, time.time_ns()))
+            sinks.append(lambda left, res: writer.write(res, stamps()))
 
         def on_result(left: np.ndarray, res: Any) -> None:
             for sink in sinks:
@@ -778,14 +790,15 @@ def add_cli(subparsers: Any) -> None:
 
     p = subparsers.add_parser(
         "stream",
-        help="live depth from two cameras (or videos), with fps and per-stage latency",
+        help="live depth from two cameras (videos, a ROS bag), with fps and per-stage latency",
         description="Grab synchronised pairs, rectify, compute depth, serve the live view "
         "over HTTP (MJPEG) and report fps, stage times and skew every second.",
     )
-    p.add_argument("--left", required=True, help="device index, video file or pattern (%%03d)")
-    p.add_argument("--right", required=True, help="device index, video file or pattern")
+    add_source_args(p)
     p.add_argument(
-        "--calib", help="calibration of the rig (YAML/JSON, Middlebury, KITTI, Kalibr, ROS folder)"
+        "--calib",
+        help="calibration of the rig (YAML/JSON, Middlebury, KITTI, Kalibr, ROS folder); "
+        "--from-bag: default the bag's camera_info",
     )
     p.add_argument("--size", help="requested size WIDTHxHEIGHT (frames are resized if needed)")
     p.add_argument("--max-disparity", type=int, help="default: estimated from the first pair")

@@ -1,0 +1,511 @@
+"""Recorded rigs read from ROS 1 and ROS 2 bags (``BagCamera``): topics, pairing, encodings,
+calibration from ``camera_info``, and the ``stream`` / ``capture`` commands on a bag.
+
+The bags are written here with rosbags' own writers from real images (Middlebury cones and
+OpenCV's chessboard pairs), so every frame read back can be compared with its source.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import pytest
+
+import stereovision as sv
+from stereovision.calibration import Calibration, parse_ros_camera_info
+from stereovision.io import load_scene
+
+rosbags = pytest.importorskip("rosbags")
+
+from rosbags.typesys import Stores, get_typestore  # noqa: E402
+
+from stereovision.capture import SourceError  # noqa: E402
+from stereovision.rosbag import (  # noqa: E402
+    BagCamera,
+    decode_image,
+    find_stereo_topics,
+    to_8bit,
+)
+
+LEFT, RIGHT = "/stereo/left/image_raw", "/stereo/right/image_raw"
+PERIOD_NS = 33_333_333  # 30 fps
+T0 = 1_700_000_000_000_000_000
+
+
+@pytest.fixture(scope="module")
+def cones(data_dir: Path) -> Any:
+    return load_scene(data_dir / "middlebury2003" / "cones")
+
+
+# ------------------------------------------------------------------------------- encoding
+
+
+def _image_fields(img: np.ndarray, encoding: str, *, pad: int = 0, big: bool = False) -> dict:
+    """``img`` (BGR uint8, or uint16 for 16-bit encodings) laid out as ROS ``encoding`` does,
+    written independently of the reader (numpy slicing, no OpenCV conversion codes)."""
+    h, w = img.shape[:2]
+    if encoding in ("mono8", "mono16"):
+        arr = img if img.ndim == 2 else img[..., 1]
+    elif encoding == "rgb8":
+        arr = img[..., ::-1]
+    elif encoding in ("bgr8", "bgr16"):
+        arr = img
+    elif encoding == "bgra8":
+        arr = np.dstack([img, np.full((h, w), 255, img.dtype)])
+    elif encoding.startswith("bayer_"):
+        pattern = encoding[6:10]  # e.g. rggb: (0,0) R, (0,1) G, (1,0) G, (1,1) B
+        index = {"b": 0, "g": 1, "r": 2}
+        arr = np.empty((h, w), img.dtype)
+        for k, colour in enumerate(pattern):
+            dy, dx = divmod(k, 2)
+            arr[dy::2, dx::2] = img[dy::2, dx::2, index[colour]]
+    elif encoding in ("yuv422", "yuv422_yuy2"):
+        y = img if img.ndim == 2 else img[..., 1]
+        arr = np.empty((h, w, 2), np.uint8)
+        # a grey image: chroma 128; UYVY puts chroma first, YUY2 luma first
+        luma, chroma = (1, 0) if encoding == "yuv422" else (0, 1)
+        arr[..., luma] = y
+        arr[..., chroma] = 128
+    else:
+        raise AssertionError(encoding)
+    arr = np.ascontiguousarray(arr)
+    if arr.dtype == np.uint16:
+        arr = arr.astype(">u2" if big else "<u2")
+    rows = arr.view(np.uint8).reshape(h, -1)
+    step = rows.shape[1] + pad
+    data = np.zeros((h, step), np.uint8)
+    data[:, : rows.shape[1]] = rows
+    return {"height": h, "width": w, "encoding": encoding, "is_bigendian": int(big),
+            "step": step, "data": data.reshape(-1)}  # fmt: skip
+
+
+class _Msg:
+    def __init__(self, **kw: Any) -> None:
+        self.__dict__.update(kw)
+
+
+def test_encodings_decode_to_the_source_image(cones: Any) -> None:
+    bgr = cones.left
+    grey = cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)
+    for enc in ("bgr8", "rgb8", "bgra8"):
+        np.testing.assert_array_equal(decode_image(_Msg(**_image_fields(bgr, enc, pad=7))), bgr)
+    out = decode_image(_Msg(**_image_fields(grey, "mono8", pad=3)))
+    assert out.shape == (*grey.shape, 3)
+    np.testing.assert_array_equal(out[..., 0], grey)
+    # 12-bit data in 16-bit containers, both byte orders: one shift of 4 brings it back
+    g12 = grey.astype(np.uint16) << 4
+    for big in (False, True):
+        raw = decode_image(_Msg(**_image_fields(g12, "mono16", pad=2, big=big)))
+        assert raw.dtype == np.uint16
+        (back,) = to_8bit(raw)
+        np.testing.assert_array_equal(back[..., 2], grey)
+    c16 = bgr.astype(np.uint16) << 8
+    np.testing.assert_array_equal(to_8bit(decode_image(_Msg(**_image_fields(c16, "bgr16"))))[0],
+                                  bgr)  # fmt: skip
+    # UYVY and YUY2 of the same grey image agree, and give its grey levels back through
+    # BT.601's video range (luma 16..235 is black..white)
+    a = decode_image(_Msg(**_image_fields(grey, "yuv422")))
+    b = decode_image(_Msg(**_image_fields(grey, "yuv422_yuy2")))
+    np.testing.assert_array_equal(a, b)
+    full = np.clip((grey.astype(float) - 16) * 255 / 219, 0, 255)
+    assert np.abs(a[..., 1] - full).max() <= 1.0
+
+
+@pytest.mark.parametrize("pattern", ["rggb", "bggr", "gbrg", "grbg"])
+def test_bayer_patterns_keep_red_and_blue(cones: Any, pattern: str) -> None:
+    smooth = cv2.GaussianBlur(cones.left, (0, 0), 2.0)
+    out = decode_image(_Msg(**_image_fields(smooth, f"bayer_{pattern}8")))
+    err = np.abs(out.astype(int) - smooth).mean()
+    swapped = np.abs(out[..., ::-1].astype(int) - smooth).mean()
+    assert err < 2.0, (pattern, err)  # demosaicing error on a smooth image
+    assert swapped > 3 * err, (pattern, err, swapped)  # red and blue not exchanged
+
+
+def test_compressed_images(cones: Any) -> None:
+    _, png = cv2.imencode(".png", cones.left)
+    out = decode_image(_Msg(format="bgr8; png compressed bgr8", data=png.reshape(-1)))
+    np.testing.assert_array_equal(out, cones.left)
+    _ok, jpg = cv2.imencode(".jpg", cv2.cvtColor(cones.left, cv2.COLOR_BGR2GRAY))
+    assert decode_image(_Msg(format="mono8; jpeg compressed mono8", data=jpg.reshape(-1))).shape \
+        == cones.left.shape  # fmt: skip
+    with pytest.raises(ValueError, match="depth image"):
+        decode_image(_Msg(format="16UC1; compressedDepth png", data=png.reshape(-1)))
+    with pytest.raises(ValueError, match="does not decode"):
+        decode_image(_Msg(format="jpeg", data=np.zeros(50, np.uint8)))
+
+
+def test_bad_image_messages(cones: Any) -> None:
+    f = _image_fields(cones.left, "bgr8")
+    with pytest.raises(ValueError, match="'32FC1' is not a camera image"):
+        decode_image(_Msg(**{**f, "encoding": "32FC1"}))
+    with pytest.raises(ValueError, match="step 100 and"):
+        decode_image(_Msg(**{**f, "step": 100}))
+    with pytest.raises(ValueError, match="data bytes do not hold it"):
+        decode_image(_Msg(**{**f, "data": f["data"][:-1]}))
+
+
+# --------------------------------------------------------------------------------- topics
+
+
+def test_topic_discovery() -> None:
+    assert find_stereo_topics(["/cam0/image_raw", "/cam1/image_raw", "/imu"]) == (
+        "/cam0/image_raw", "/cam1/image_raw")  # fmt: skip
+    assert find_stereo_topics(["/camera/infra2/image_rect_raw", "/camera/infra1/image_rect_raw",
+                               "/camera/color/image_raw"]) == (
+        "/camera/infra1/image_rect_raw", "/camera/infra2/image_rect_raw")  # fmt: skip
+    both = [LEFT, RIGHT, "/stereo/left/image_rect", "/stereo/right/image_rect",
+            LEFT + "/compressed", RIGHT + "/compressed"]  # fmt: skip
+    assert find_stereo_topics(both) == (LEFT, RIGHT)  # raw and uncompressed preferred
+    rect = ["/zed/Left/image_rect_color", "/zed/Right/image_rect_color"]
+    assert find_stereo_topics(rect) == tuple(rect)
+    with pytest.raises(ValueError, match=r"no left/right pair .*\(/a/image, /b/image\)"):
+        find_stereo_topics(["/a/image", "/b/image"])
+    with pytest.raises(ValueError, match="several stereo pairs"):
+        find_stereo_topics(["/cam0/image_raw", "/cam1/image_raw", "/cam2/image_raw"])
+    with pytest.raises(ValueError, match="none"):
+        find_stereo_topics([])
+
+
+# ------------------------------------------------------------------------------- the bags
+
+
+def _info_fields(cam: dict, ros1: bool, binning: int = 0) -> dict:
+    names = ("D", "K", "R", "P") if ros1 else ("d", "k", "r", "p")
+    return {
+        "height": cam["image_size"][1], "width": cam["image_size"][0],
+        "distortion_model": cam["distortion_model"],
+        names[0]: cam["D"], names[1]: cam["K"].ravel(), names[2]: cam["R"].ravel(),
+        names[3]: cam["P"].ravel(), "binning_x": binning, "binning_y": binning,
+    }  # fmt: skip
+
+
+def write_bag(
+    path: Path,
+    frames: list[tuple[int | None, np.ndarray, int | None, np.ndarray]],
+    *,
+    flavour: str = "ros2",
+    encoding: str = "bgr8",
+    topics: tuple[str, str] = (LEFT, RIGHT),
+    infos: tuple[dict, dict] | None = None,
+    binning: int = 0,
+) -> Path:
+    """A bag of ``(stamp_left, left, stamp_right, right)`` frames (a None stamp: not recorded),
+    each message recorded 2 ms after its stamp, in recording order; ``infos``: the two cameras'
+    parsed camera_info, published beside the image topics once per left frame."""
+    ros1 = flavour == "ros1"
+    ts = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
+    t = ts.types
+    msgs: list[tuple[int, str, str, Any]] = []
+    for sl, left, sr, right in frames:
+        for topic, stamp, img in ((topics[0], sl, left), (topics[1], sr, right)):
+            if stamp is None:
+                continue
+            time = t["builtin_interfaces/msg/Time"](sec=stamp // 10**9, nanosec=stamp % 10**9)
+            hdr = {"stamp": time, "frame_id": "cam"} | ({"seq": 0} if ros1 else {})
+            header = t["std_msgs/msg/Header"](**hdr)
+            if encoding == "png":
+                _ok, buf = cv2.imencode(".png", img)
+                msg = t["sensor_msgs/msg/CompressedImage"](header=header, format="bgr8; png",
+                                                           data=buf.reshape(-1))  # fmt: skip
+                msgs.append((stamp + 2_000_000, topic, "sensor_msgs/msg/CompressedImage", msg))
+            else:
+                msg = t["sensor_msgs/msg/Image"](header=header, **_image_fields(img, encoding))
+                msgs.append((stamp + 2_000_000, topic, "sensor_msgs/msg/Image", msg))
+            if infos is not None:
+                cam = infos[0] if topic == topics[0] else infos[1]
+                roi = t["sensor_msgs/msg/RegionOfInterest"](
+                    x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)  # fmt: skip
+                info = t["sensor_msgs/msg/CameraInfo"](
+                    header=header, roi=roi, **_info_fields(cam, ros1, binning))  # fmt: skip
+                info_topic = topic.rsplit("/", 1)[0] + "/camera_info"
+                msgs.append((stamp + 2_000_001, info_topic, "sensor_msgs/msg/CameraInfo", info))
+    msgs.sort(key=lambda m: m[0])
+    if ros1:
+        from rosbags.rosbag1 import Writer as W1
+
+        writer: Any = W1(path)
+    else:
+        from rosbags.rosbag2 import StoragePlugin, Writer
+
+        plugin = StoragePlugin.MCAP if flavour == "mcap" else StoragePlugin.SQLITE3
+        writer = Writer(path, version=9, storage_plugin=plugin)
+    conns: dict[str, Any] = {}
+    with writer:
+        for recorded, topic, msgtype, msg in msgs:
+            if topic not in conns:
+                conns[topic] = writer.add_connection(topic, msgtype, typestore=ts)
+            data = ts.serialize_ros1(msg, msgtype) if ros1 else ts.serialize_cdr(msg, msgtype)
+            writer.write(conns[topic], recorded, data)
+    return path
+
+
+def _jittered(cones: Any, n: int) -> tuple[list, list[int]]:
+    """``n`` distinct frames (the cones pair rolled by k px), the right stamps off by -4..+4 ms;
+    right frame 5 and left frame 9 not recorded."""
+    jitter = [((k * 7) % 9 - 4) * 1_000_000 for k in range(n)]
+    frames = []
+    for k in range(n):
+        sl = None if k == 9 else T0 + k * PERIOD_NS
+        sr = None if k == 5 else T0 + k * PERIOD_NS + jitter[k]
+        frames.append((sl, np.roll(cones.left, k, axis=1), sr, np.roll(cones.right, k, axis=1)))
+    return frames, jitter
+
+
+@pytest.mark.parametrize("flavour", ["ros2", "mcap", "ros1"])
+def test_pairs_are_matched_on_their_stamps(cones: Any, tmp_path: Path, flavour: str) -> None:
+    frames, jitter = _jittered(cones, 14)
+    bag = write_bag(tmp_path / ("rig.bag" if flavour == "ros1" else "rig"), frames,
+                    flavour=flavour)  # fmt: skip
+    with BagCamera(bag) as cam:
+        assert cam.topics == {"left": LEFT, "right": RIGHT}
+        got = list(cam.frames())
+        assert cam.max_skew_ms == pytest.approx(PERIOD_NS / 2e6, rel=0.1)  # half of 33 ms
+        assert cam.dropped == {"left": 1, "right": 1}  # left 5 and right 9 had no partner
+        assert "bag " in cam.describe() and f"{LEFT}: 450x375" in cam.describe()
+    kept = [k for k in range(14) if k not in (5, 9)]
+    assert [round((f.t_left * 1e9 - T0) / PERIOD_NS) for f in got] == kept
+    for f, k in zip(got, kept, strict=True):
+        np.testing.assert_array_equal(f.left, frames[k][1])
+        np.testing.assert_array_equal(f.right, frames[k][3])
+        assert f.skew_ms == pytest.approx(abs(jitter[k]) / 1e6, abs=1e-3)
+    assert cam.stamps_ns == [T0 + k * PERIOD_NS for k in kept]
+    with pytest.raises(SourceError, match="closed"):
+        cam.read()
+
+
+def test_max_skew_and_end_of_recording(cones: Any, tmp_path: Path) -> None:
+    frames, jitter = _jittered(cones, 14)
+    bag = write_bag(tmp_path / "rig", frames)
+    with BagCamera(bag, max_skew_ms=2.5) as cam:
+        got = list(cam.frames())
+        with pytest.raises(SourceError, match=r"end of the recording after \d+ pairs"):
+            cam.read()
+    # only frames within 2.5 ms pair; the others are dropped on both sides
+    want = [k for k in range(14) if k not in (5, 9) and abs(jitter[k]) <= 2_500_000]
+    assert [f.index for f in got] == list(range(len(want)))
+    assert cam.stamps_ns == [T0 + k * PERIOD_NS for k in want]
+    assert cam.dropped == {"left": 13 - len(want), "right": 13 - len(want)}
+
+
+def test_mono16_pairs_share_one_shift_and_resize(cones: Any, tmp_path: Path) -> None:
+    # a dim 12-bit left image and a bright right one: one scale for both (the matchers compare them)
+    gl = cv2.cvtColor(cones.left, cv2.COLOR_BGR2GRAY).astype(np.uint16) << 2
+    gr = cv2.cvtColor(cones.right, cv2.COLOR_BGR2GRAY).astype(np.uint16) << 4
+    bag = write_bag(tmp_path / "rig", [(T0, gl, T0, gr)], encoding="mono16")
+    with BagCamera(bag) as cam:
+        f = cam.read()
+    np.testing.assert_array_equal(f.left[..., 0], (gl >> 4).astype(np.uint8))
+    np.testing.assert_array_equal(f.right[..., 0], (gr >> 4).astype(np.uint8))
+    with BagCamera(bag, size="225x188") as cam:
+        assert cam.read().left.shape == (188, 225, 3)
+
+
+def test_calibration_from_camera_info(cones: Any, tmp_path: Path) -> None:
+    raw = Calibration(
+        K1=np.array([[420.0, 0, 221.3], [0, 421.0, 190.2], [0, 0, 1]]),
+        D1=np.array([-0.21, 0.05, 0.001, -0.0005, 0.0]),
+        K2=np.array([[418.0, 0, 228.9], [0, 419.5, 185.7], [0, 0, 1]]),
+        D2=np.array([-0.19, 0.04, -0.0008, 0.0004, 0.0]),
+        R=cv2.Rodrigues(np.array([0.004, -0.011, 0.002]))[0],
+        T=np.array([-0.1203, 0.0011, -0.0007]),
+        image_size=(450, 375),
+        unit="m",
+    )
+    texts = raw.to_ros()
+    cams = tuple(parse_ros_camera_info(t) for t in texts)
+    frames = [(T0, cones.left, T0, cones.right)]
+    (tmp_path / "yaml").mkdir()
+    for name, text in zip(("left.yaml", "right.yaml"), texts, strict=True):
+        (tmp_path / "yaml" / name).write_text(text)
+    want = Calibration.from_file(tmp_path / "yaml")
+    for flavour in ("ros2", "ros1"):
+        (tmp_path / flavour).mkdir()
+        name = "rig.bag" if flavour == "ros1" else "rig"
+        bag = write_bag(tmp_path / flavour / name, frames, flavour=flavour, infos=cams)
+        if flavour == "ros2":  # a file of the bag folder names the bag too
+            bag = bag / "metadata.yaml"
+        with BagCamera(bag) as cam:
+            assert cam.info_topics == {"left": "/stereo/left/camera_info",
+                                       "right": "/stereo/right/camera_info"}  # fmt: skip
+            got = cam.calibration()
+        assert got == want and not got.rectified
+        np.testing.assert_allclose(got.T, raw.T, atol=1e-9)  # the rig comes back
+        np.testing.assert_allclose(got.R, raw.R, atol=1e-9)
+        np.testing.assert_allclose(got.K1, raw.K1) and np.testing.assert_allclose(got.D2, raw.D2)
+    # rectified topics: the rectified rig of the two P matrices
+    rect = ("/stereo/left/image_rect", "/stereo/right/image_rect")
+    bag = write_bag(tmp_path / "rect", frames, topics=rect, infos=cams)
+    with BagCamera(bag) as cam:
+        got = cam.calibration()
+    assert got.rectified
+    np.testing.assert_allclose(got.K1, cams[0]["P"][:, :3])
+    assert got.baseline_m == pytest.approx(-cams[1]["P"][0, 3] / cams[1]["P"][0, 0])
+    # binned 2x2: the calibration of the half-size images
+    bag = write_bag(tmp_path / "binned", frames, infos=cams, binning=2)
+    with BagCamera(bag) as cam:
+        got = cam.calibration()
+    assert got.image_size == (225, 187)
+    np.testing.assert_allclose(got.K1[0, 0], raw.K1[0, 0] * 225 / 450)
+    # no camera_info: None
+    with BagCamera(write_bag(tmp_path / "bare", frames)) as cam:
+        assert cam.info_topics == {"left": None, "right": None} and cam.calibration() is None
+
+
+def test_bag_errors(cones: Any, tmp_path: Path) -> None:
+    with pytest.raises(FileNotFoundError, match="bag not found"):
+        BagCamera(tmp_path / "missing")
+    (tmp_path / "notabag").mkdir()
+    with pytest.raises(ValueError, match="not a readable ROS 1 or ROS 2 bag"):
+        BagCamera(tmp_path / "notabag")
+    (tmp_path / "text.bag").write_text("hello")
+    with pytest.raises(ValueError, match="not a readable"):
+        BagCamera(tmp_path / "text.bag")
+    bag = write_bag(tmp_path / "rig", [(T0, cones.left, T0, cones.right)], encoding="png")
+    with pytest.raises(ValueError, match=r"left topic '/x' is not an image topic .* "
+                                         r"\(its image topics: /stereo/left"):  # fmt: skip
+        BagCamera(bag, left_topic="/x", right_topic=RIGHT)
+    with pytest.raises(ValueError, match="both the left and the right topic"):
+        BagCamera(bag, left_topic=LEFT)
+    with pytest.raises(ValueError, match="max_skew_ms"):
+        BagCamera(bag, max_skew_ms=-1.0)
+    with pytest.raises(ValueError, match="the same"):
+        BagCamera(bag, left_topic=LEFT, right_topic=LEFT)
+    with BagCamera(bag) as cam:  # compressed frames read
+        np.testing.assert_array_equal(cam.read().left, cones.left)
+    bad = write_bag(tmp_path / "float", [(T0, cones.left, T0, cones.right)], encoding="bgr8")
+    # a depth stream recorded under an image name: refused at read, topic named
+    from rosbags.rosbag2 import Reader, Writer
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    with Reader(bad) as r, Writer(tmp_path / "f32", version=9) as w:
+        conns = {}
+        for conn, stamp, raw in r.messages():
+            msg = ts.deserialize_cdr(raw, conn.msgtype)
+            if conn.topic == RIGHT:
+                msg.encoding = "32FC1"
+            conns.setdefault(conn.topic, w.add_connection(conn.topic, conn.msgtype, typestore=ts))
+            w.write(conns[conn.topic], stamp, ts.serialize_cdr(msg, conn.msgtype))
+    with (
+        BagCamera(tmp_path / "f32") as cam,
+        pytest.raises(ValueError, match=rf"{RIGHT} at stamp {T0} ns: image encoding '32FC1'"),
+    ):
+        cam.read()
+
+
+# ------------------------------------------------------------------------------------ CLI
+
+
+@pytest.fixture()
+def run(capsys: pytest.CaptureFixture[str]) -> Callable[..., tuple[int, str, str]]:
+    from stereovision.cli import main
+
+    def go(*argv: str) -> tuple[int, str, str]:
+        code = main(list(argv))
+        out = capsys.readouterr()
+        return code, out.out, out.err
+
+    return go
+
+
+def test_cli_stream_from_bag_keeps_stamps_and_calibration(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    k = np.array([[430.0, 0, 224.5], [0, 430.0, 187.0], [0, 0, 1]])
+    rect = Calibration(K1=k, D1=np.zeros(5), K2=k, D2=np.zeros(5), R=np.eye(3),
+                       T=np.array([-0.16, 0, 0]), image_size=(450, 375), unit="m",
+                       rectified=True)  # fmt: skip
+    cams = tuple(parse_ros_camera_info(t) for t in rect.to_ros())
+    frames = [(T0 + k * PERIOD_NS, cones.left, T0 + k * PERIOD_NS + 1_000_000, cones.right)
+              for k in range(3)]  # fmt: skip
+    bag = write_bag(tmp_path / "rig", frames, infos=cams)
+    code, out, err = run("stream", "--from-bag", str(bag), "--no-display", "--json",
+                         "--method", "gabor", "--max-disparity", "64", "--no-check",
+                         "--bag", str(tmp_path / "out"))  # fmt: skip
+    assert code == 0, err
+    assert "calibration: the bag's /stereo/left/camera_info and /stereo/right/camera_info" in err
+    summary = json.loads(out.strip().splitlines()[-1])
+    assert summary["frames"] == 3 and summary["skew_ms"]["mean"] == pytest.approx(1.0)
+    from rosbags.rosbag2 import Reader
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    with Reader(tmp_path / "out") as r:
+        depth = [(s, ts.deserialize_cdr(raw, c.msgtype)) for c, s, raw in r.messages()
+                 if c.topic == "/stereo/depth"]  # fmt: skip
+    assert [s for s, _ in depth] == [T0 + k * PERIOD_NS for k in range(3)]  # the frames' stamps
+    want = sv.depth_map(cones.left, cones.right, rect, method="gabor", max_disparity=64,
+                        cloud=False, refine=False)  # stream's defaults  # fmt: skip
+    d = np.frombuffer(depth[0][1].data.tobytes(), "<f4").reshape(want.depth.shape)
+    np.testing.assert_array_equal(d, want.depth.astype(np.float32))
+
+
+def test_cli_capture_and_calibrate_from_bag(
+    data_dir: Path, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """OpenCV's chessboard pairs recorded as a ROS 1 bag of mono8 frames on EuRoC-style topics;
+    ``capture --chessboard`` takes the board poses out of it, ``calibrate --from-bag`` the rig."""
+    cb = data_dir / "chessboard"
+    names = sorted(p.name[4:] for p in cb.glob("left*.jpg"))
+    frames = []
+    for k, name in enumerate(names):
+        left = cv2.imread(str(cb / f"left{name}"))
+        right = cv2.imread(str(cb / f"right{name}"))
+        frames.append((T0 + k * 10**9, left, T0 + k * 10**9, right))
+    bag = write_bag(tmp_path / "board.bag", frames, flavour="ros1", encoding="mono8",
+                    topics=("/cam0/image_raw", "/cam1/image_raw"))  # fmt: skip
+    code, out, err = run("capture", "--from-bag", str(bag), "--chessboard", "9x6",
+                         "-o", str(tmp_path / "pairs"))  # fmt: skip
+    assert code == 0, err
+    saved = sorted((tmp_path / "pairs").glob("left_*.png"))
+    assert f"{len(saved)} pairs saved" in out and f"{len(names)} pairs read" in out
+    assert len(saved) >= 6  # distinct poses only (ROS's rule)
+    for (
+        path
+    ) in saved:  # every saved pair is a recorded pair, pixel for pixel (mono8 of a grey JPEG)
+        left = cv2.imread(str(path))
+        right = cv2.imread(str(path).replace("left_", "right_"))
+        assert any(np.array_equal(left, f[1]) and np.array_equal(right, f[3]) for f in frames)
+    # calibrate straight from the bag: the same poses kept, the rig of the JPEG pairs
+    code, out, err = run("calibrate", "--from-bag", str(bag), "--pattern", "9x6",
+                         "--square", "0.025", "-o", str(tmp_path / "bag.yaml"))  # fmt: skip
+    assert code == 0, err
+    assert f"{len(saved)} of {len(names)} frame pairs kept" in out
+    code, out, err = run("calibrate", "--left", str(cb / "left*.jpg"), "--right",
+                         str(cb / "right*.jpg"), "--pattern", "9x6", "--square", "0.025",
+                         "-o", str(tmp_path / "jpg.yaml"))  # fmt: skip
+    assert code == 0, err
+    got = Calibration.from_file(tmp_path / "bag.yaml")
+    want = Calibration.from_file(tmp_path / "jpg.yaml")
+    assert got.baseline_m == pytest.approx(want.baseline_m, rel=0.005)  # 83.26 vs 83.18 mm
+    assert got.focal_px == pytest.approx(want.focal_px, rel=0.005)
+    for argv, msg in [
+        (("--from-bag", str(bag), "--left", "x.png"), "replaces --left"),
+        (("--left-topic", "/a", "--left", "x.png", "--right", "y.png"), "are for --from-bag"),
+        ((), "give the board's pairs (--left and --right) or a recording"),
+    ]:  # fmt: skip
+        code, out, err = run("calibrate", *argv, "--square", "1", "-o", str(tmp_path / "x.yaml"))
+        assert code != 0 and msg in err and "Traceback" not in err, err
+
+
+def test_cli_source_errors(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    bag = write_bag(tmp_path / "rig", [(T0, cones.left, T0, cones.right)])
+    for argv, msg in [
+        (("stream", "--from-bag", str(tmp_path / "nope"), "--no-display"), "bag not found"),
+        (("stream", "--no-display"), "give the two cameras (--left and --right) or a recording"),
+        (("stream", "--from-bag", str(bag), "--left", "0", "--no-display"), "replaces --left"),
+        (("capture", "--left", "0", "--right", "1", "--left-topic", "/a", "-o", str(tmp_path)),
+         "are for --from-bag"),
+        (("capture", "--from-bag", str(bag), "--fps", "10", "-o", str(tmp_path / "x")),
+         "a bag is read as recorded"),
+        (("stream", "--from-bag", str(bag), "--no-display", "--bag", str(tmp_path / "o")),
+         "--bag: a bag holds depth; give --calib"),
+    ]:  # fmt: skip
+        code, _out, err = run(*argv)
+        assert code != 0 and msg in err, (argv, err)
+        assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
