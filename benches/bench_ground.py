@@ -1,5 +1,6 @@
 """The ground plane and obstacles on the scenes with a metric calibration, against the plane of
-their own GT (docs/robotics.md's table and docs/images/ground_kitti.jpg). One run.
+their own GT (docs/robotics.md's table and docs/images/ground_kitti.jpg), and KITTI's laser
+scan beside OpenCV SGBM-3WAY's. One run.
 
 For each scene: the floor found in the GT disparity and in the default ``depth_map``'s (RANSAC
 in disparity space, :func:`stereovision.fit_ground_plane`), the angle between them, the
@@ -24,7 +25,7 @@ from _common import DATA
 from scipy.ndimage import binary_dilation
 
 import stereovision as sv
-from stereovision.ground import fit_ground_plane, obstacle_mask, occupancy_grid
+from stereovision.ground import fit_ground_plane, laser_scan, obstacle_mask, occupancy_grid
 from stereovision.io import load_scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -34,6 +35,32 @@ SCENES = (
     "eth3d/terrace",
     "tartanair/oldtown_easy_p000_001116",
 )
+
+
+def _scan_table(
+    sc: object, gt: object, fused: np.ndarray, pts_gt: np.ndarray, has: np.ndarray
+) -> None:
+    """The laser scan of each map against the GT's, on the GT's floor and pixels."""
+    from stereovision.baselines import opencv_sgbm, row_fill
+
+    sgbm = opencv_sgbm(sc.left, sc.right, sc.max_disparity)  # type: ignore[attr-defined]
+    maps = {"fused (default)": fused, "SGBM-3WAY": sgbm, "SGBM-3WAY + fill": row_fill(sgbm)}
+    calib = sc.calib  # type: ignore[attr-defined]
+    for far in (15.0, 30.0):
+        inside = has & (pts_gt[..., 2] < far + 5)
+        truth = laser_scan(pts_gt[inside], gt, calib, range_max=far)  # type: ignore[arg-type]
+        hit = np.isfinite(truth.ranges)
+        for name, d in maps.items():
+            s = laser_scan(calib.reproject(d)[inside], gt, calib, range_max=far)  # type: ignore[arg-type]
+            both = hit & np.isfinite(s.ranges)
+            rel = np.abs(s.ranges[both] / truth.ranges[both] - 1)
+            false = int((np.isinf(truth.ranges) & np.isfinite(s.ranges)).sum())
+            print(
+                f"  scan within {far:g} m, pixels with GT, GT floor: {name}: {int(both.sum())} of "
+                f"{int(hit.sum())} beams hit, median |error| {100 * np.median(rel):.2f} %, "
+                f"{100 * np.mean(rel < 0.05):.1f} % within 5 %, {false} hits where the GT "
+                "sees free floor"
+            )
 
 
 def main() -> None:
@@ -80,9 +107,17 @@ def main() -> None:
             grid = occupancy_grid(pts, ours, resolution=0.1, forward=(0, 30), lateral=(-15, 15))
             bev = cv2.cvtColor(grid.image(), cv2.COLOR_GRAY2BGR)
             bev = cv2.rotate(bev, cv2.ROTATE_90_COUNTERCLOCKWISE)  # forward up, left to the left
-            bev = cv2.resize(bev, (img.shape[0], img.shape[0]), interpolation=cv2.INTER_NEAREST)
+            side = img.shape[0]
+            bev = cv2.resize(bev, (side, side), interpolation=cv2.INTER_NEAREST)
+            # the laser scan's hits: x forward (up), y left (to the left), 30 m over the side
+            scan = laser_scan(pts, ours, sc.calib, range_max=30.0)
+            for x, y in scan.endpoints():
+                u, v = side / 2 - y * side / 30, side - x * side / 30
+                cv2.circle(bev, (int(u), int(v)), 1, (200, 120, 0), -1)
             cv2.putText(bev, "grid 0.1 m, 30 m ahead", (6, 17), cv2.FONT_HERSHEY_SIMPLEX, 0.5,
                         (40, 40, 230), 1, cv2.LINE_AA)  # fmt: skip
+            cv2.putText(bev, "laser scan", (6, 35), cv2.FONT_HERSHEY_SIMPLEX, 0.5,
+                        (200, 120, 0), 1, cv2.LINE_AA)  # fmt: skip
             gap = np.full((img.shape[0], 6, 3), 255, np.uint8)
             cv2.imwrite(
                 str(args.picture), np.hstack([img, gap, bev]), [cv2.IMWRITE_JPEG_QUALITY, 88]
@@ -98,6 +133,7 @@ def main() -> None:
                     f"  grid within {far:g} m, 0.2 m cells, pixels with GT: occupied cells "
                     f"precision {prec:.3f} recall {rec:.3f} within one cell"
                 )
+            _scan_table(sc, gt, res.disparity, pts_gt, has)
     sys.path.insert(0, str(ROOT))
     from tests import test_ground as tg
 

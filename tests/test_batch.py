@@ -276,7 +276,7 @@ def test_batch_ground_outputs(data_dir: Path, tmp_path: Path) -> None:
     out = process_pair(_task(job, {"method": None, "max_disparity": None, "fill": None,
                                    "ground": True, "grid": 0.2}))  # fmt: skip
     files = out["files"]
-    assert {"ground.json", "obstacles.png", "map.png", "map.yaml"} <= set(files)
+    assert {"ground.json", "obstacles.png", "scan.json", "map.png", "map.yaml"} <= set(files)
     floor = json.loads(files["ground.json"])
     assert floor["height_m"] == pytest.approx(1.62, abs=0.03)
     with pytest.raises(ValueError, match="it needs ground=True"):

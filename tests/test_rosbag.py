@@ -89,3 +89,22 @@ def test_bag_errors(kitti: tuple, tmp_path: Path, data_dir: Path) -> None:
             bag.write(no_depth, 0)
         with pytest.raises(ValueError, match="stamp_ns"):
             bag.write(kitti[0], -5)
+
+
+def test_bag_scan_topic(kitti: tuple, tmp_path: Path, data_dir: Path) -> None:
+    """A LaserScan given with the result is written as /stereo/scan, in the floor's frame."""
+    from stereovision.ground import fit_ground_plane, laser_scan
+    from stereovision.rosbag import BagWriter
+
+    res = kitti[0]
+    plane = fit_ground_plane(res.disparity, res.calibration)
+    assert plane is not None
+    scan = laser_scan(res.calibration.reproject(res.disparity), plane, res.calibration)
+    with BagWriter(tmp_path / "run", points=False, scan_frame_id="robot_floor") as bag:
+        bag.write(res, 42, scan=scan)
+    msg = _read(tmp_path / "run")["/stereo/scan"][0][1]
+    assert msg.header.frame_id == "robot_floor"
+    assert msg.angle_min == pytest.approx(scan.angle_min, rel=1e-6)
+    assert msg.angle_increment == pytest.approx(scan.angle_increment, rel=1e-6)
+    np.testing.assert_array_equal(msg.ranges, scan.ranges)  # inf and NaN kept (REP 117)
+    assert np.isinf(msg.ranges).any() and np.isfinite(msg.ranges).sum() > 500

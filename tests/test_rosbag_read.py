@@ -443,6 +443,42 @@ def test_cli_stream_from_bag_keeps_stamps_and_calibration(
     np.testing.assert_array_equal(d, want.depth.astype(np.float32))
 
 
+def test_cli_stream_from_a_kitti_bag_with_floor_scans(
+    data_dir: Path, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """``stream --from-bag ... --ground-every 1 --bag OUT``: each frame's obstacles as a
+    LaserScan on the floor fitted to it, the same as ``laser_scan`` on that frame's map."""
+    from stereovision.ground import fit_ground_plane, laser_scan
+
+    sc = load_scene(data_dir / "kitti2015" / "000005_10")
+    cams = tuple(parse_ros_camera_info(t) for t in sc.calib.to_ros())
+    frames = [(T0 + k * PERIOD_NS, sc.left, T0 + k * PERIOD_NS, sc.right) for k in range(2)]
+    bag = write_bag(tmp_path / "kitti", frames, infos=cams)
+    code, _out, err = run("stream", "--from-bag", str(bag), "--no-display", "--method", "gabor",
+                         "--max-disparity", "112", "--no-check", "--ground-every", "1",
+                         "--bag", str(tmp_path / "out"))  # fmt: skip
+    assert code == 0, err
+    from rosbags.rosbag2 import Reader
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    with Reader(tmp_path / "out") as r:
+        scans = [(s, ts.deserialize_cdr(raw, c.msgtype)) for c, s, raw in r.messages()
+                 if c.topic == "/stereo/scan"]  # fmt: skip
+    assert [s for s, _ in scans] == [T0, T0 + PERIOD_NS]
+    with BagCamera(bag) as cam:
+        rc = cam.calibration()
+    assert rc.rectified and rc.baseline_m == pytest.approx(sc.calib.baseline_m)
+    want = sv.depth_map(sc.left, sc.right, rc, method="gabor", max_disparity=112, cloud=False,
+                        refine=False)  # fmt: skip
+    plane = fit_ground_plane(want.disparity, rc)
+    assert plane is not None
+    expected = laser_scan(rc.reproject(want.disparity), plane, rc)
+    msg = scans[0][1]
+    assert msg.header.frame_id == "base_footprint"
+    np.testing.assert_array_equal(msg.ranges, expected.ranges)
+    assert np.isfinite(msg.ranges).sum() > 500
+
+
 def test_cli_capture_and_calibrate_from_bag(
     data_dir: Path, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
 ) -> None:

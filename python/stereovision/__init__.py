@@ -14,7 +14,7 @@ from stereovision import evaluate, io
 from stereovision._core import __version__, release_memory
 from stereovision.calibration import Calibration
 from stereovision.depth import DepthResult, depth_map, estimate_max_disparity
-from stereovision.ground import GroundPlane, fit_ground_plane, obstacle_mask
+from stereovision.ground import GroundPlane, LaserScan, fit_ground_plane, laser_scan, obstacle_mask
 from stereovision.match import match
 from stereovision.matches import Matches
 from stereovision.rectification_check import check_rectification, refine_rectification
@@ -24,6 +24,7 @@ __all__ = [
     "Calibration",
     "DepthResult",
     "GroundPlane",
+    "LaserScan",
     "Matches",
     "__version__",
     "check_rectification",
@@ -33,6 +34,7 @@ __all__ = [
     "evaluate",
     "fit_ground_plane",
     "io",
+    "laser_scan",
     "match",
     "obstacle_mask",
     "refine_rectification",

@@ -467,8 +467,8 @@ def run_batch(
     calib : path, optional
         Calibration for every pair (else each scene's ``calib.txt``).
     ground : bool
-        Also write each pair's floor (``ground.json``, ``obstacles.png``;
-        :func:`stereovision.ground.fit_ground_plane`).
+        Also write each pair's floor (``ground.json``, ``obstacles.png``, ``scan.json``;
+        :func:`stereovision.ground.fit_ground_plane`, :func:`~stereovision.ground.laser_scan`).
     grid : float, optional
         With ``ground``: each pair's occupancy grid of this cell side (``map.png``, ``map.yaml``).
     retry_failed : bool
@@ -763,7 +763,7 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument(
         "--ground",
         action="store_true",
-        help="also each pair's floor and obstacles (ground.json, obstacles.png)",
+        help="also each pair's floor and obstacles (ground.json, obstacles.png, scan.json)",
     )
     p.add_argument(
         "--grid", type=float, metavar="M", help="with --ground: an occupancy grid of M-metre cells"

@@ -245,12 +245,13 @@ def cmd_depth(args: argparse.Namespace) -> int:
 def _ground_outputs(
     disparity: Any, calib: Any, out: Path, grid: float | None = None, log: Any = None
 ) -> dict[str, Path]:
-    """``depth --ground``: the floor's plane (``ground.json``) and what stands on it
-    (``obstacles.png``: 255 between 0.15 and 2 m above the floor); with ``--grid M`` also a
-    ROS map_server occupancy grid of M-metre cells (``map.png``, ``map.yaml``)."""
+    """``depth --ground``: the floor's plane (``ground.json``), what stands on it
+    (``obstacles.png``: 255 between 0.15 and 2 m above the floor) and its planar scan
+    (``scan.json``, ``sensor_msgs/LaserScan``'s fields); with ``--grid M`` also a ROS map_server
+    occupancy grid of M-metre cells (``map.png``, ``map.yaml``)."""
     import cv2
 
-    from stereovision.ground import fit_ground_plane, obstacle_mask, occupancy_grid
+    from stereovision.ground import fit_ground_plane, laser_scan, obstacle_mask, occupancy_grid
     from stereovision.io import atomic_write
 
     plane = fit_ground_plane(disparity, calib)
@@ -272,6 +273,20 @@ def _ground_outputs(
         raise RuntimeError("could not encode obstacles.png")
     with atomic_write(paths["obstacles.png"]) as fh:
         fh.write(buf.tobytes())
+    scan = laser_scan(points, plane, rc)
+    paths["scan.json"] = out / "scan.json"
+    with atomic_write(paths["scan.json"], "w") as fh:
+        fh.write(json.dumps(scan.as_dict()))
+    if log is not None:
+        hits = np.isfinite(scan.ranges)
+        if hits.any():
+            i = int(np.nanargmin(np.where(hits, scan.ranges, np.nan)))
+            log(
+                f"scan: {int(hits.sum())} of {len(hits)} beams on an obstacle, the nearest "
+                f"{float(scan.ranges[i]):.2f} m away at {math.degrees(scan.angles[i]):+.1f} deg"
+            )
+        else:
+            log(f"scan: no obstacle on any of the {len(hits)} beams")
     if grid is not None:
         paths["map.png"], paths["map.yaml"] = occupancy_grid(points, plane, resolution=grid).save(
             out
@@ -598,8 +613,8 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument(
         "--ground",
         action="store_true",
-        help="find the floor: camera height, pitch and roll (ground.json) and what stands on it "
-        "(obstacles.png)",
+        help="find the floor: camera height, pitch and roll (ground.json), what stands on it "
+        "(obstacles.png) and a planar scan of it (scan.json, ROS LaserScan)",
     )
     d.add_argument(
         "--grid",

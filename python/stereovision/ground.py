@@ -34,9 +34,11 @@ __all__ = [
     "GROUND_INLIER_PX",
     "MAX_TILT_DEG",
     "GroundPlane",
+    "LaserScan",
     "OccupancyGrid",
     "fit_ground_plane",
     "floor_frame",
+    "laser_scan",
     "obstacle_mask",
     "occupancy_grid",
 ]
@@ -535,3 +537,186 @@ def occupancy_grid(
     data[n_floor > 0] = FREE
     data[n_obs >= MIN_OBSTACLE_POINTS] = OCCUPIED
     return OccupancyGrid(data.reshape(rows, cols), res, (x0, y0))
+
+
+# ---------------------------------------------------------------------------------- laser scan
+
+
+@dataclass(frozen=True)
+class LaserScan:
+    """A planar scan of the obstacles around the rig, as ROS's ``sensor_msgs/LaserScan``.
+
+    The scan lies in the floor plane, centred on the floor point under the camera, in the floor
+    frame of :class:`OccupancyGrid` (REP 103: angle 0 along ``x``, the optical axis laid on the
+    floor; positive angles to the left). Beam ``i`` points at ``angle_min + i *
+    angle_increment``. Ranges follow REP 117: a distance where an obstacle was seen, ``+inf``
+    where the floor was seen and nothing stands on it within ``range_max``, NaN where the beam
+    saw neither (above the horizon, out of view).
+
+    Attributes
+    ----------
+    angle_min, angle_max, angle_increment : float
+        Radians.
+    range_min, range_max : float
+        Metres.
+    ranges : numpy.ndarray
+        ``(n,)`` float32 metres.
+    """
+
+    angle_min: float
+    angle_max: float
+    angle_increment: float
+    range_min: float
+    range_max: float
+    ranges: npt.NDArray[np.float32]
+
+    @property
+    def angles(self) -> F64:
+        """The beams' angles (radians)."""
+        out: F64 = self.angle_min + self.angle_increment * np.arange(
+            len(self.ranges), dtype=np.float64
+        )
+        return out
+
+    def endpoints(self) -> F64:
+        """``(m, 2)`` floor-frame ``(x, y)`` of the beams that hit an obstacle (metres)."""
+        hit = np.isfinite(self.ranges)
+        r, a = self.ranges[hit].astype(np.float64), self.angles[hit]
+        out: F64 = np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
+        return out
+
+    def as_dict(self) -> dict[str, Any]:
+        """The ``sensor_msgs/LaserScan`` fields, JSON-ready: JSON has no NaN or infinity, so
+        a NaN range is ``null`` and ``+inf`` the string ``"inf"``."""
+        ranges: list[Any] = [
+            None if math.isnan(v) else ("inf" if math.isinf(v) else round(float(v), 4))
+            for v in self.ranges
+        ]
+        return {
+            "angle_min": self.angle_min,
+            "angle_max": self.angle_max,
+            "angle_increment": self.angle_increment,
+            "time_increment": 0.0,
+            "scan_time": 0.0,
+            "range_min": self.range_min,
+            "range_max": self.range_max,
+            "ranges": ranges,
+            "intensities": [],
+        }
+
+
+def _beam_span(calib: Calibration, axes: F64) -> tuple[float, float, int]:
+    """Floor-frame angles of the image's sides (the rays of its border pixels) and its width."""
+    w, h = calib.image_size
+    k_inv = np.linalg.inv(np.asarray(calib.K1, np.float64))
+    u = np.r_[np.zeros(h), np.full(h, w - 1.0), np.arange(w), np.arange(w)]
+    v = np.r_[np.arange(h), np.arange(h), np.zeros(w), np.full(w, h - 1.0)]
+    rays = np.stack([u, v, np.ones_like(u)], axis=1) @ k_inv.T @ axes[:2].T
+    ang = np.arctan2(rays[:, 1], rays[:, 0])
+    return float(ang.min()), float(ang.max()), w
+
+
+def laser_scan(
+    points: npt.ArrayLike,
+    plane: GroundPlane,
+    calib: Calibration | None = None,
+    *,
+    angle_min: float | None = None,
+    angle_max: float | None = None,
+    angle_increment: float | None = None,
+    min_height: float = 0.15,
+    max_height: float = 2.0,
+    range_min: float = 0.0,
+    range_max: float = 20.0,
+    min_points: int = MIN_OBSTACLE_POINTS,
+) -> LaserScan:
+    """A ``LaserScan`` of the obstacles standing on the floor, for a 2-D navigation stack.
+
+    What ROS's ``depthimage_to_laserscan`` does with a band of image rows, done on the floor:
+    every point between ``min_height`` and ``max_height`` above the floor (as
+    :func:`obstacle_mask`) is laid on the floor plane, and each beam's range is the distance of
+    its ``min_points``-th nearest such point (one stray point is not an obstacle). A camera
+    pitched towards the floor thus still gives a level scan, and the floor itself never shows
+    up as an obstacle.
+
+    Parameters
+    ----------
+    points : array_like
+        ``(H, W, 3)`` or ``(N, 3)`` points in the left rectified frame (metres, NaN skipped).
+    plane : GroundPlane
+    calib : Calibration, optional
+        The rectified rig the points come from: sets the default angles, from the left to the
+        right side of the image, one beam per image column.
+    angle_min, angle_max, angle_increment : float, optional
+        The beams (radians; REP 103: positive to the left). Needed without ``calib``.
+    min_height, max_height : float
+        The obstacle band above the floor (metres).
+    range_min, range_max : float
+        Distances kept (metres, on the floor from the point under the camera).
+    min_points : int
+        Obstacle points a beam needs; its range is the distance of that many-th nearest.
+
+    Returns
+    -------
+    LaserScan
+
+    Raises
+    ------
+    ValueError
+        For points not of shape ``(..., 3)``, no angles (no ``calib`` and no ``angle_min`` /
+        ``angle_max``), ``angle_max <= angle_min``, a non-positive increment or over 100000
+        beams, a bad height band or range, or ``min_points < 1``.
+    """
+    from stereovision._validate import positive_finite
+
+    pts = np.asarray(points, np.float64)
+    if pts.ndim == 0 or pts.shape[-1] != 3:
+        raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
+    lo, hi = float(min_height), float(max_height)
+    if not (math.isfinite(lo) and lo >= 0 and hi > lo):
+        raise ValueError(
+            f"min_height, max_height: expected 0 <= min_height < max_height, got {lo!r}, {hi!r}"
+        )
+    r0, r1 = float(range_min), float(range_max)
+    if not (math.isfinite(r0) and r0 >= 0 and r1 > r0):
+        raise ValueError(
+            f"range_min, range_max: expected 0 <= range_min < range_max, got {r0!r}, {r1!r}"
+        )
+    if isinstance(min_points, bool) or not isinstance(min_points, int) or min_points < 1:
+        raise ValueError(f"min_points: expected an integer >= 1, got {min_points!r}")
+    axes = floor_frame(plane)
+    if angle_min is None or angle_max is None:
+        if calib is None:
+            raise ValueError("laser_scan: give calib (the image's field of view) or the angles")
+        a0, a1, n_cols = _beam_span(calib, axes)
+        a0 = a0 if angle_min is None else float(angle_min)
+        a1 = a1 if angle_max is None else float(angle_max)
+        inc = (a1 - a0) / max(n_cols - 1, 1) if angle_increment is None else angle_increment
+    else:
+        a0, a1 = float(angle_min), float(angle_max)
+        inc = math.radians(0.25) if angle_increment is None else angle_increment
+    inc = positive_finite(inc, "angle_increment")
+    if not (math.isfinite(a0) and math.isfinite(a1) and a1 > a0):
+        raise ValueError(f"angle_min, angle_max: expected angle_max > angle_min, got {a0}, {a1}")
+    n = math.floor((a1 - a0) / inc + 1e-9) + 1
+    if n > 100_000:
+        raise ValueError(f"angle_increment: {n} beams; at most 100000")
+    flat = pts.reshape(-1, 3)
+    flat = flat[np.all(np.isfinite(flat), axis=1)]
+    xyz = flat @ axes.T
+    h = xyz[:, 2] + plane.height
+    dist = np.hypot(xyz[:, 0], xyz[:, 1])
+    beam = np.floor((np.arctan2(xyz[:, 1], xyz[:, 0]) - a0) / inc + 0.5).astype(np.int64)
+    keep = (beam >= 0) & (beam < n) & (dist >= r0) & (dist <= r1)
+    ranges = np.full(n, np.nan, np.float32)
+    floor = keep & (np.abs(h) <= lo)
+    ranges[np.unique(beam[floor])] = np.inf  # the floor seen along the beam: free
+    obstacle = keep & (h > lo) & (h < hi)
+    b, d = beam[obstacle], dist[obstacle]
+    order = np.lexsort((d, b))  # by beam, then by distance
+    b, d = b[order], d[order]
+    counts = np.bincount(b, minlength=n)
+    first = np.cumsum(counts) - counts
+    hit = counts >= min_points
+    ranges[hit] = d[first[hit] + min_points - 1]
+    return LaserScan(a0, a0 + (n - 1) * inc, inc, r0, r1, ranges)

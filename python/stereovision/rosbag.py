@@ -1,4 +1,4 @@
-"""Depth results as a ROS 2 bag: replay a run in RViz or feed it to a ROS pipeline, without ROS.
+"""ROS bags without ROS: depth results written as ROS 2 bags, recorded rigs read from bags.
 
 :class:`BagWriter` writes, for every result, the topics ``stereo_image_proc`` and
 ``depth_image_proc`` publish (REP 118 for depth images), stamped with the frame's time and in the
@@ -11,6 +11,8 @@ topic (``prefix`` = ``/stereo``)  type                         content
 ``left/camera_info``              ``sensor_msgs/CameraInfo``   the rectified left camera (``P``)
 ``depth``                         ``sensor_msgs/Image``        ``32FC1`` metres, NaN where none
 ``points``                        ``sensor_msgs/PointCloud2``  ``x y z`` (float32) and ``rgb``
+``scan`` (when given)             ``sensor_msgs/LaserScan``    the obstacles on the floor,
+                                                               in ``scan_frame_id``
 ================================  ===========================  ==================================
 
 The bag is written with the pure-Python ``rosbags`` library (``pip install rosbags``, or the
@@ -98,6 +100,10 @@ class BagWriter:
         ``header.frame_id`` of every message.
     points : bool
         Also write the point cloud (the largest topic).
+    scan_frame_id : str
+        ``header.frame_id`` of the scans: the floor frame under the camera, the parent frame of
+        :meth:`GroundPlane.ros2_static_transform <stereovision.ground.GroundPlane.\
+ros2_static_transform>`.
 
     Raises
     ------
@@ -119,6 +125,7 @@ class BagWriter:
         prefix: str = DEFAULT_PREFIX,
         frame_id: str = DEFAULT_FRAME_ID,
         points: bool = True,
+        scan_frame_id: str = "base_footprint",
     ) -> None:
         self.path = Path(path)
         if self.path.exists():
@@ -129,6 +136,7 @@ class BagWriter:
         self.prefix = "/" + prefix.strip("/") if prefix.strip("/") else ""
         self.frame_id = str(frame_id)
         self.points = bool(points)
+        self.scan_frame_id = str(scan_frame_id)
         self.messages = 0
         self._writer = writer_cls(self.path, version=9)
         self._writer.open()
@@ -227,11 +235,30 @@ class BagWriter:
             is_dense=True,
         )
 
+    def _scan(self, stamp_ns: int, scan: Any) -> Any:
+        t = self._types.types
+        stamp = t["builtin_interfaces/msg/Time"](
+            sec=int(stamp_ns // 1_000_000_000), nanosec=int(stamp_ns % 1_000_000_000)
+        )
+        return t["sensor_msgs/msg/LaserScan"](
+            header=t["std_msgs/msg/Header"](stamp=stamp, frame_id=self.scan_frame_id),
+            angle_min=float(scan.angle_min),
+            angle_max=float(scan.angle_max),
+            angle_increment=float(scan.angle_increment),
+            time_increment=0.0,
+            scan_time=0.0,
+            range_min=float(scan.range_min),
+            range_max=float(scan.range_max),
+            ranges=np.asarray(scan.ranges, np.float32),
+            intensities=np.zeros(0, np.float32),
+        )
+
     # --------------------------------------------------------------------------------- API
 
-    def write(self, result: Any, stamp_ns: int) -> None:
+    def write(self, result: Any, stamp_ns: int, *, scan: Any = None) -> None:
         """Write one depth result (:class:`~stereovision.depth.DepthResult` with a calibration)
-        stamped ``stamp_ns`` nanoseconds (the frame's time).
+        stamped ``stamp_ns`` nanoseconds (the frame's time), and its
+        :class:`~stereovision.ground.LaserScan` when given.
 
         Raises
         ------
@@ -263,6 +290,8 @@ class BagWriter:
         self._put("depth", "sensor_msgs/msg/Image", self._image(header, depth, "32FC1"), stamp)
         if self.points:
             self._put("points", "sensor_msgs/msg/PointCloud2", self._cloud(header, result), stamp)
+        if scan is not None:
+            self._put("scan", "sensor_msgs/msg/LaserScan", self._scan(stamp, scan), stamp)
 
     def close(self) -> None:
         """Finish the bag (its metadata.yaml); the writer cannot be used afterwards."""

@@ -434,6 +434,7 @@ def run_stream(
     check: bool = True,
     check_every: int | None = None,
     ground_every: int | None = None,
+    on_ground: Callable[[Any], None] | None = None,
 ) -> StreamReport:
     """Depth maps from a stereo camera until it ends, ``frames`` pairs, or Ctrl-C.
 
@@ -482,6 +483,10 @@ def run_stream(
         every ``ground_every``-th pair, and warn once when the camera's height moves by more
         than :data:`GROUND_HEIGHT_SHARE` of the first fit's or its pitch or roll by more than
         :data:`GROUND_TILT_DEG`: a mount that slipped. Needs ``calib``.
+    on_ground : callable, optional
+        With ``ground_every``: called with each fit's
+        :class:`~stereovision.ground.GroundPlane` (None when no floor was found), before the
+        pair's ``on_result``.
 
     Returns
     -------
@@ -561,7 +566,9 @@ def run_stream(
             res = depth_map(pair.left, pair.right, rect_calib, max_disparity=md, cloud=False, **kw)
             if ground_every is not None and len(all_done) % ground_every == 0:
                 assert rect_calib is not None
-                _note_ground(len(all_done), res.disparity, rect_calib, grounds)
+                plane = _note_ground(len(all_done), res.disparity, rect_calib, grounds)
+                if on_ground is not None:
+                    on_ground(plane)
             t_last = time.perf_counter()
             tm = res.timings
             stages = {
@@ -644,14 +651,15 @@ def _note_check(pair: int, result: RectificationCheck, checks: list[dict[str, An
 
 def _note_ground(
     pair: int, disparity: np.ndarray, calib: Calibration, grounds: list[dict[str, Any]]
-) -> None:
-    """Fit the floor of a pair; warn (once) when the mount has moved from the first fit."""
+) -> Any:
+    """Fit the floor of a pair; warn (once) when the mount has moved from the first fit.
+    Returns the plane (None when none was found)."""
     from stereovision.ground import fit_ground_plane
 
     plane = fit_ground_plane(disparity, calib)
     if plane is None:
         grounds.append({"pair": pair, "found": False})
-        return
+        return None
     entry = {"pair": pair, "found": True, **plane.as_dict(), "moved": False}
     first = next((g for g in grounds if g["found"]), None)
     if first is not None:
@@ -667,6 +675,7 @@ def _note_ground(
                 stacklevel=3,
             )
     grounds.append(entry)
+    return plane
 
 
 # ---------------------------------------------------------------------------------------- CLI
@@ -717,9 +726,20 @@ def cmd_stream(args: argparse.Namespace) -> int:
             sinks.append(
                 lambda left, res: srv.update(left, res.disparity, float(res.max_disparity))
             )
+        floor: list[Any] = [None]  # the latest fit of --ground-every
         if bag is not None:
             writer = bag
-            sinks.append(lambda left, res: writer.write(res, stamps()))
+
+            def to_bag(left: np.ndarray, res: Any) -> None:
+                scan = None
+                if floor[0] is not None:  # with --ground-every: the obstacles as a LaserScan
+                    from stereovision.ground import laser_scan
+
+                    rc = res.calibration
+                    scan = laser_scan(rc.reproject(res.disparity), floor[0], rc)
+                writer.write(res, stamps(), scan=scan)
+
+            sinks.append(to_bag)
 
         def on_result(left: np.ndarray, res: Any) -> None:
             for sink in sinks:
@@ -745,6 +765,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             check=not args.no_check,
             check_every=args.check_every,
             ground_every=args.ground_every,
+            on_ground=(lambda plane: floor.__setitem__(0, plane)) if bag is not None else None,
         )
     finally:
         cam.close()
