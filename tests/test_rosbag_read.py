@@ -306,16 +306,7 @@ def test_mono16_pairs_share_one_shift_and_resize(cones: Any, tmp_path: Path) -> 
 
 
 def test_calibration_from_camera_info(cones: Any, tmp_path: Path) -> None:
-    raw = Calibration(
-        K1=np.array([[420.0, 0, 221.3], [0, 421.0, 190.2], [0, 0, 1]]),
-        D1=np.array([-0.21, 0.05, 0.001, -0.0005, 0.0]),
-        K2=np.array([[418.0, 0, 228.9], [0, 419.5, 185.7], [0, 0, 1]]),
-        D2=np.array([-0.19, 0.04, -0.0008, 0.0004, 0.0]),
-        R=cv2.Rodrigues(np.array([0.004, -0.011, 0.002]))[0],
-        T=np.array([-0.1203, 0.0011, -0.0007]),
-        image_size=(450, 375),
-        unit="m",
-    )
+    raw = _raw_rig()
     texts = raw.to_ros()
     cams = tuple(parse_ros_camera_info(t) for t in texts)
     frames = [(T0, cones.left, T0, cones.right)]
@@ -545,3 +536,57 @@ def test_cli_source_errors(
         code, _out, err = run(*argv)
         assert code != 0 and msg in err, (argv, err)
         assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+
+
+def test_gui_plays_a_bag(cones: Any, tmp_path: Path) -> None:
+    """``gui --from-bag``: the pairs of the bag, again from the start at its end, with the
+    bag's calibration and the topics on the page."""
+    pytest.importorskip("trame")
+    import argparse
+
+    from stereovision.gui import add_arguments, build_app
+
+    cams = tuple(parse_ros_camera_info(t) for t in _raw_rig().to_ros())
+    frames = [(T0 + k * PERIOD_NS, np.roll(cones.left, k, axis=1), T0 + k * PERIOD_NS,
+               np.roll(cones.right, k, axis=1)) for k in range(2)]  # fmt: skip
+    bag = write_bag(tmp_path / "rig", frames, infos=cams)
+    p = argparse.ArgumentParser()
+    add_arguments(p)
+    app = build_app(p.parse_args(["--from-bag", str(bag), "--port", "0", "--no-browser"]))
+    try:
+        assert app.source_calib == Calibration.from_file(_ros_folder(tmp_path, cams))
+        for k in (0, 1, 0):  # the third read starts the recording again
+            app._grab()
+            assert app.pair is not None
+            np.testing.assert_array_equal(app.pair[0], frames[k][1])
+            np.testing.assert_array_equal(app.pair[1], frames[k][3])
+        assert app.state.source_label == f"bag rig: {LEFT} / {RIGHT}"
+    finally:
+        app.source.close()
+    with pytest.raises(ValueError, match="replaces --left and --right"):
+        build_app(p.parse_args(["--from-bag", str(bag), "--left", "0", "--right", "1"]))
+
+
+def _raw_rig() -> Calibration:
+    return Calibration(
+        K1=np.array([[420.0, 0, 221.3], [0, 421.0, 190.2], [0, 0, 1]]),
+        D1=np.array([-0.21, 0.05, 0.001, -0.0005, 0.0]),
+        K2=np.array([[418.0, 0, 228.9], [0, 419.5, 185.7], [0, 0, 1]]),
+        D2=np.array([-0.19, 0.04, -0.0008, 0.0004, 0.0]),
+        R=cv2.Rodrigues(np.array([0.004, -0.011, 0.002]))[0],
+        T=np.array([-0.1203, 0.0011, -0.0007]),
+        image_size=(450, 375),
+        unit="m",
+    )
+
+
+def _ros_folder(tmp_path: Path, cams: tuple) -> Path:
+    from stereovision.calibration import _ros_yaml
+
+    d = tmp_path / "ros"
+    d.mkdir(exist_ok=True)
+    for name, c in zip(("left", "right"), cams, strict=True):
+        text = _ros_yaml(name, c["image_size"], c["K"], c["D"], c["R"], c["P"],
+                         c["distortion_model"])  # fmt: skip
+        (d / f"{name}.yaml").write_text(text)
+    return d

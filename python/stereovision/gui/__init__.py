@@ -45,6 +45,9 @@ def build_app(args: argparse.Namespace) -> Any:
 
     if (args.left is None) != (args.right is None):
         raise ValueError("give both --left and --right camera sources, or neither")
+    from_bag = getattr(args, "from_bag", None)
+    if from_bag is not None and args.left is not None:
+        raise ValueError("--from-bag replaces --left and --right: give one source")
     if not 0 <= args.port <= 65535:
         raise ValueError(f"--port must be in 0..65535, got {args.port}")
     folders = AllowedFolders([bundled_data_dir(), *(args.data or [])])
@@ -54,15 +57,24 @@ def build_app(args: argparse.Namespace) -> Any:
 
         calib = Calibration.from_file(args.calib)
     source = None
+    label = None
+    names = (str(args.left or ""), str(args.right or ""))
     if args.left is not None:
         source = open_stereo_source(args.left, args.right)
+    elif from_bag is not None:
+        from stereovision.gui.sources import open_bag_source
+
+        source, bag_calib, topics = open_bag_source(
+            from_bag, getattr(args, "left_topic", None), getattr(args, "right_topic", None)
+        )
+        calib = calib if calib is not None else bag_calib
+        label = f"bag {Path(from_bag).name}: {topics[0]} / {topics[1]}"
     from trame.app import get_server
 
     from stereovision.gui.app import StereoApp
 
     server = get_server("stereovision-gui", client_type="vue3")
     server.state.trame__title = "stereovision"
-    names = (str(args.left or ""), str(args.right or ""))
     return StereoApp(
         server,
         folders,
@@ -70,6 +82,7 @@ def build_app(args: argparse.Namespace) -> Any:
         source=source,
         calib=calib,
         source_names=names,
+        source_label=label,
     )
 
 
@@ -103,6 +116,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The ``gui`` options."""
     p.add_argument("--left", help="left camera: device index, video file or image pattern")
     p.add_argument("--right", help="right camera: device index, video file or image pattern")
+    p.add_argument(
+        "--from-bag",
+        metavar="BAG",
+        help="play a rig recorded in a ROS 1 / ROS 2 bag instead (its camera_info as calibration)",
+    )
+    p.add_argument("--left-topic", help="--from-bag: left image topic (default: found)")
+    p.add_argument("--right-topic", help="--from-bag: right image topic (default: found)")
     p.add_argument(
         "--calib",
         help="calibration of the camera pair (YAML/JSON, calib.txt, KITTI, Kalibr, ROS folder)",

@@ -363,6 +363,10 @@ class StereoApp:
         Opened live / video camera pair (``--left`` / ``--right``).
     calib : Calibration, optional
         Calibration of the camera pair (``--calib``).
+    source_names : tuple of str
+        The two camera sources as typed (shown in the page's camera fields).
+    source_label : str, optional
+        What the page calls the opened source (default: "cameras" and the sources' names).
     """
 
     def __init__(
@@ -373,6 +377,7 @@ class StereoApp:
         source: StereoSource | None = None,
         calib: Any = None,
         source_names: tuple[str, str] = ("", ""),
+        source_label: str | None = None,
     ) -> None:
         import pyvista as pv
 
@@ -387,6 +392,7 @@ class StereoApp:
         self.demo_scene = demo_scene
         self.source = source
         self.source_calib = calib
+        self._source_label = source_label
         self.pair: tuple[np.ndarray, np.ndarray] | None = None
         self.calib: Any = None
         self.max_disparity: int | None = None
@@ -483,7 +489,7 @@ class StereoApp:
         self.calib = self.source_calib
         self.max_disparity = None
         names = (Path(str(n)).name or str(n) for n in (self.state.cam_left, self.state.cam_right))
-        self.state.source_label = "cameras " + " / ".join(names)
+        self.state.source_label = self._source_label or "cameras " + " / ".join(names)
         self.state.rows_label = ""
 
     def _camera_source(self, text: str) -> int | str:
@@ -546,6 +552,7 @@ class StereoApp:
         if self.source is not None:
             self.source.close()
         self.source = source
+        self._source_label = None  # the cameras typed on the page, named by their fields
         self.state.live = True
         self.state.error = ""
         self.capture()

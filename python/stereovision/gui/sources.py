@@ -25,6 +25,7 @@ __all__ = [
     "AllowedFolders",
     "StereoSource",
     "VideoPair",
+    "open_bag_source",
     "open_stereo_source",
     "parse_source",
 ]
@@ -320,3 +321,32 @@ def scaled_calibration(calib: Any, factor: float, size: Sequence[int]) -> Any:
     if calib is None or factor == 1.0:
         return calib
     return calib.scaled_to((int(size[0]), int(size[1])))
+
+
+def open_bag_source(
+    path: str | os.PathLike[str], left_topic: str | None = None, right_topic: str | None = None
+) -> tuple[StereoSource, Any, tuple[str, str]]:
+    """A rig recorded in a ROS bag, played like a camera pair that starts again at the end.
+
+    Returns
+    -------
+    source : StereoSource
+    calibration : Calibration or None
+        From the bag's ``camera_info`` (None when it has none).
+    names : tuple of str
+        The two image topics (the page's camera fields show them).
+
+    Raises
+    ------
+    FileNotFoundError, ValueError, ImportError
+        As :class:`stereovision.rosbag.BagCamera` (no bag, no stereo topics, no ``rosbags``).
+    """
+    from stereovision.rosbag import BagCamera
+
+    def factory() -> BagCamera:
+        return BagCamera(path, left_topic=left_topic, right_topic=right_topic)
+
+    with factory() as probe:
+        calib = probe.calibration()
+        names = (probe.topics["left"], probe.topics["right"])
+    return _CaptureAdapter(factory, files=True), calib, names
