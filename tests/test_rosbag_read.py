@@ -590,3 +590,26 @@ def _ros_folder(tmp_path: Path, cams: tuple) -> Path:
                          c["distortion_model"])  # fmt: skip
         (d / f"{name}.yaml").write_text(text)
     return d
+
+
+def test_cli_info_on_a_bag(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    cams = tuple(parse_ros_camera_info(t) for t in _raw_rig().to_ros())
+    frames = [(T0 + k * PERIOD_NS, cones.left, T0 + k * PERIOD_NS, cones.right) for k in range(4)]
+    for flavour, name in (("ros2", "rig"), ("ros1", "rig.bag")):
+        (tmp_path / flavour).mkdir()
+        bag = write_bag(tmp_path / flavour / name, frames, flavour=flavour, infos=cams)
+        code, out, err = run("info", str(bag))
+        assert code == 0, err
+        kind = "ROS 2" if flavour == "ros2" else "ROS 1"
+        assert f"({kind}, 0.1 s, 4 topics)" in out
+        lines = {ln.split()[0]: ln for ln in out.splitlines() if ln.startswith("  /")}
+        assert lines[LEFT].endswith("<- left") and " 4 msgs " in lines[LEFT]
+        assert lines["/stereo/right/camera_info"].endswith("<- right camera_info")
+        assert "the rig, from its camera_info:" in out and "baseline 12.0 cm" in out
+    bare = write_bag(tmp_path / "bare", frames)
+    code, out, err = run("info", str(bare))
+    assert code == 0 and "no camera_info beside the image topics" in out
+    code, out, err = run("info", str(tmp_path / "ros1" / "nothing.bag"))
+    assert code != 0 and "not found" in err and "Traceback" not in err

@@ -343,8 +343,24 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_info(args: argparse.Namespace) -> int:
-    """``stereovision info CALIB``: what the rig can measure."""
-    print(_load_calibration(args.calib).describe())
+    """``stereovision info CALIB``: what the rig can measure; ``info BAG``: what a recording
+    holds (its topics, the stereo pair found) and, from its ``camera_info``, what its rig can
+    measure."""
+    from stereovision.rosbag import is_bag
+
+    if not is_bag(args.calib):
+        print(_load_calibration(args.calib).describe())
+        return 0
+    from stereovision.rosbag import BagCamera
+
+    with BagCamera(args.calib) as cam:
+        print(cam.summary())
+        calib = cam.calibration()
+    if calib is None:
+        print("no camera_info beside the image topics: give the rig's calibration (--calib)")
+    else:
+        print("the rig, from its camera_info:")
+        print(calib.describe())
     return 0
 
 
@@ -651,7 +667,7 @@ def build_parser() -> argparse.ArgumentParser:
         "info",
         help="what a calibrated rig can measure: field of view, depth range and resolution",
     )
-    d.add_argument("calib", help="calibration file or ROS camera_info folder")
+    d.add_argument("calib", help="calibration file, ROS camera_info folder, or a ROS 1 / ROS 2 bag")
     d.set_defaults(func=cmd_info)
 
     d = sub.add_parser("eval", help="evaluate against ground truth, OpenCV beside")

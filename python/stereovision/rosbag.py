@@ -66,6 +66,7 @@ __all__ = [
     "BagWriter",
     "decode_image",
     "find_stereo_topics",
+    "is_bag",
     "to_8bit",
 ]
 
@@ -436,6 +437,22 @@ def to_8bit(*images: np.ndarray) -> tuple[np.ndarray, ...]:
     )
 
 
+def is_bag(path: str | os.PathLike[str]) -> bool:
+    """Does ``path`` name a ROS bag: a ``.bag`` file, a ROS 2 bag folder (``metadata.yaml``)
+    or one of its files?"""
+    p = Path(path)
+    if p.is_file() and p.suffix == ".bag":
+        return True
+    folder = p if p.is_dir() else p.parent
+    return (folder / "metadata.yaml").is_file()
+
+
+def _rate(count: int, reader: Any) -> float:
+    """Messages per second of a topic over the bag's span (n messages span n - 1 periods)."""
+    span_s = reader.duration / 1e9
+    return (count - 1) / span_s if count > 1 and span_s > 0 else 0.0
+
+
 def _stamp_ns(msg: Any, recorded_ns: int) -> int:
     """The header's stamp in nanoseconds; the recording time when the driver left it 0."""
     stamp = msg.header.stamp
@@ -601,8 +618,9 @@ class BagCamera:
             "rect" in _base_topic(t).rsplit("/", 1)[-1] for t in (left, right)
         )
         self._conns = [c for c in self._reader.connections if c.topic in (left, right)]
-        span_s = max(self._reader.duration, 1) / 1e9
-        self.delivered_fps = {s: topics[t].msgcount / span_s for s, t in self.topics.items()}
+        self.delivered_fps = {
+            s: _rate(topics[t].msgcount, self._reader) for s, t in self.topics.items()
+        }
         self.size = self.requested_size
         self.delivered_size: dict[str, tuple[int, int]] = {}
         self.skews_ms: list[float] = []
@@ -766,6 +784,25 @@ class BagCamera:
         tol = self.max_skew_ms
         skew = "max skew: auto" if tol is None else f"max skew {tol:.3g} ms"
         return f"bag {self.path}; " + "; ".join(parts) + f"; {skew}"
+
+    def summary(self) -> str:
+        """The bag's topics (type, messages, rate), which are the left and right images and
+        their ``camera_info``: a few lines for a terminal."""
+        reader = self._reader
+        if reader is None:
+            return f"bag {self.path} (closed)"
+        span_s = max(reader.duration, 1) / 1e9
+        kind = "ROS 2" if getattr(reader, "is2", True) else "ROS 1"
+        lines = [f"bag {self.path} ({kind}, {span_s:.1f} s, {len(reader.topics)} topics)"]
+        roles = {t: f"  <- {side}" for side, t in self.topics.items()}
+        roles |= {t: f"  <- {side} camera_info" for side, t in self.info_topics.items() if t}
+        width = max(len(t) for t in reader.topics)
+        for topic, info in sorted(reader.topics.items()):
+            lines.append(
+                f"  {topic:<{width}}  {info.msgtype:<31} {info.msgcount:7d} msgs "
+                f"{_rate(info.msgcount, reader):7.2f} Hz{roles.get(topic, '')}"
+            )
+        return "\n".join(lines)
 
     # ---------------------------------------------------------------------------- calibration
 
