@@ -342,6 +342,53 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_rectify(args: argparse.Namespace) -> int:
+    """``stereovision rectify LEFT RIGHT -o DIR [--calib F]``: the rectified pair, and with no
+    calibration the homographies found from the pair's features."""
+    from stereovision.io import imread
+    from stereovision.rectification_check import check_rectification, draw_rectification_check
+
+    left = imread(args.left)
+    right = imread(args.right)
+    calib = _load_calibration(args.calib)
+    out = Path(args.output)
+    if out.exists() and not out.is_dir():
+        raise CliError(f"-o {args.output}: is a file; give a folder")
+    written: dict[str, Path] = {}
+    if calib is not None:
+        if args.model != "auto":
+            raise CliError("--model is for rectifying without a calibration (no --calib)")
+        lr, rr = calib.rectify(left, right)
+        summary = None
+    else:
+        from stereovision.uncalibrated import rectify_uncalibrated
+
+        rect = rectify_uncalibrated(left, right, model=args.model)
+        lr, rr = rect.rectify(left, right)
+        summary = rect
+    out.mkdir(parents=True, exist_ok=True)
+    check = check_rectification(lr, rr)
+    for name, img in (
+        ("left_rect.png", lr),
+        ("right_rect.png", rr),
+        ("check.png", draw_rectification_check(lr, rr, check)),
+    ):
+        written[name] = out / name
+        _atomic_write_bytes(written[name], _png_bytes(img))
+    if summary is not None:
+        written["rectification.json"] = summary.save(out / "rectification.json")
+        print(summary.describe())
+        print(
+            f"  disparity, not depth: for depth in metres calibrate the rig. Next: stereovision "
+            f"depth {written['left_rect.png']} {written['right_rect.png']} --max-disparity "
+            f"{summary.max_disparity} -o OUT"
+        )
+    print(check.summary())
+    for name, path in written.items():
+        print(f"  {name:19s} {path}")
+    return 0
+
+
 def cmd_info(args: argparse.Namespace) -> int:
     """``stereovision info CALIB``: what the rig can measure; ``info BAG``: what a recording
     holds (its topics, the stereo pair found) and, from its ``camera_info``, what its rig can
@@ -662,6 +709,27 @@ def build_parser() -> argparse.ArgumentParser:
         help="correct the rig's pitch and roll from this pair and write the calibration to OUT",
     )
     d.set_defaults(func=cmd_check)
+
+    d = sub.add_parser(
+        "rectify",
+        help="rectify a pair: with --calib, or without a calibration from its own features",
+        description="Write the rectified pair (left_rect.png, right_rect.png) and how its rows "
+        "agree. Without --calib the homographies are found from the pair's feature matches "
+        "(disparity, not metric depth) and saved as rectification.json, with the disparity "
+        "range to search.",
+    )
+    d.add_argument("left")
+    d.add_argument("right")
+    d.add_argument("--calib", help="the rig's calibration (default: none, from the features)")
+    d.add_argument(
+        "--model",
+        default="auto",
+        choices=("auto", "quasi-euclidean", "projective"),
+        help="without --calib: turned cameras (quasi-euclidean), Hartley's homographies of F "
+        "(projective), or the first when it fits (auto, the default)",
+    )
+    d.add_argument("-o", "--output", required=True, help="output folder")
+    d.set_defaults(func=cmd_rectify)
 
     d = sub.add_parser(
         "info",

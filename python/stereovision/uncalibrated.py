@@ -1,0 +1,591 @@
+"""Rectification without a calibration: two cameras row-aligned from their own features.
+
+A robot's two cameras may need a look at disparity before anyone has waved a board in front of
+them. :func:`rectify_uncalibrated` finds SIFT matches between the two views (mutual nearest
+neighbours with Lowe's ratio test, as :func:`~stereovision.rectification_check.check_rectification`
+does), keeps those that fit one fundamental matrix ``F`` (OpenCV's MAGSAC++), and finds two
+homographies that put every pair of corresponding points on the same row:
+
+- **The model.** Two cameras side by side, each turned a little about its centre: Fusiello and
+  Irsara's quasi-Euclidean rectification (five angles and a focal length, here with a second
+  focal length for the right camera), fitted by Levenberg-Marquardt to the matches' Sampson
+  distances. It is far better posed than ``F``'s seven degrees of freedom when the matches lie
+  near one plane. When the turns do not fit (a hand-held pair, very different views), Hartley's
+  projective homographies of ``F`` (``cv2.stereoRectifyUncalibrated``) are used.
+- **Orientation**: the two images keep their sense (no mirror, not upside down).
+- **Shape**: each image is sheared along its rows so that its middle lines stay perpendicular
+  and keep their length ratio (Loop and Zhang's shearing transform, "Computing rectifying
+  homographies for stereo vision", CVPR 1999): Hartley's homographies alone can skew an image by
+  degrees and double its aspect ratio. A shear along the rows leaves the rows alone.
+- **Size and disparities**: one scale for both keeps the matched part's area, the output holds
+  the matched part and a margin, and the left image is shifted along its rows so that the
+  disparities start near 0; the search range comes from the matches and a coarse dense match
+  (SGBM at a quarter size), which sees the textureless background the features miss.
+
+The result gives disparity, not metric depth: without a calibration the scale of the scene is
+unknown, and the rectified images are a projective, not a Euclidean, view. Calibrate
+(``stereovision calibrate``) for depth in metres.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+from stereovision._validate import as_gray_uint8
+from stereovision.rectification_check import MIN_MATCHES, _features, _mutual_matches
+
+__all__ = [
+    "MAX_STRETCH",
+    "MODELS",
+    "UncalibratedRectification",
+    "rectify_uncalibrated",
+]
+
+F64 = npt.NDArray[np.float64]
+
+#: The epipolar distance (px) up to which a match fits the fundamental matrix.
+RANSAC_PX = 1.0
+#: A rectified image may be at most this many times the input's width or height; more means the
+#: epipole lies near the image (the cameras look along their baseline) or the views hardly differ.
+MAX_STRETCH = 4.0
+#: The matches' disparities from this percentile to its complement span the scene (wrong matches
+#: along an epipolar line still fit ``F``: on repetitive texture a few per cent of them); the
+#: search range reaches this share of that span beyond it on both sides (a textureless
+#: background has no matches to say how far it is: measured up to 23 % of the span below them),
+#: starts at this disparity (px) and is at least 16 px.
+_SPAN_PERCENTILE = 5.0
+#: The coarse dense match that completes the features' span runs on the pair shrunk this much.
+_PROBE_SCALE = 4
+_RANGE_MARGIN = 0.3
+_LOW_DISPARITY = 2.0
+#: The output reaches this share of the matched part's size beyond it (within the images).
+_MARGIN = 0.25
+#: Levenberg-Marquardt steps of the quasi-Euclidean fit, the Huber scale of its residuals (px),
+#: and the median residual (px) above which its model (turned cameras) is taken not to fit and
+#: Hartley's projective homographies are used instead.
+_QE_ITERATIONS = 60
+_QE_HUBER_PX = 1.0
+_QE_MAX_MEDIAN_PX = 0.5
+#: A quasi-Euclidean fit turning a camera further than this (degrees) is not of a side-by-side
+#: rig (it can fold an image onto a sliver, where every match fits): the projective way is used.
+_QE_MAX_TURN_DEG = 30.0
+
+
+def _apply(h: F64, pts: F64) -> F64:
+    q = np.column_stack([pts, np.ones(len(pts))]) @ h.T
+    out: F64 = q[:, :2] / q[:, 2:3]
+    return out
+
+
+def _midpoints(w: int, h: int) -> F64:
+    """The middles of the top, right, bottom and left edges."""
+    return np.array(
+        [[(w - 1) / 2, 0.0], [w - 1.0, (h - 1) / 2], [(w - 1) / 2, h - 1.0], [0.0, (h - 1) / 2]]
+    )
+
+
+def _shape(h: F64, w: int, hgt: int) -> tuple[float, float]:
+    """Loop and Zhang's distortion figures of an image under ``h``: how far its middle lines are
+    from perpendicular (degrees), and their length ratio against the original's (1: kept)."""
+    a, b, c, d = _apply(h, _midpoints(w, hgt))
+    x, y = b - d, c - a
+    cos = float(x @ y / (np.linalg.norm(x) * np.linalg.norm(y)))
+    skew = abs(90.0 - math.degrees(math.acos(max(-1.0, min(1.0, cos)))))
+    aspect = float(np.linalg.norm(x) / np.linalg.norm(y)) / ((w - 1) / (hgt - 1))
+    return skew, aspect
+
+
+def _shear(h: F64, w: int, hgt: int) -> F64:
+    """Loop and Zhang's shearing transform ``S`` (x' = k1 x + k2 y): ``S h`` keeps the image's
+    middle lines perpendicular and their length ratio."""
+    a, b, c, d = _apply(h, _midpoints(w, hgt))
+    x, y = b - d, c - a
+    den = hgt * w
+    cross = x[1] * y[0] - x[0] * y[1]
+    if abs(cross) < 1e-12:
+        return np.eye(3)
+    k1 = (hgt**2 * x[1] ** 2 + w**2 * y[1] ** 2) / (den * cross)
+    k2 = (hgt**2 * x[0] * x[1] + w**2 * y[0] * y[1]) / (den * -cross)
+    if k1 < 0:
+        k1, k2 = -k1, -k2
+    return np.array([[k1, k2, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _rotation(ax: float, ay: float, az: float) -> F64:
+    cx, sx, cy, sy, cz, sz = (
+        math.cos(ax),
+        math.sin(ax),
+        math.cos(ay),
+        math.sin(ay),
+        math.cos(az),
+        math.sin(az),
+    )
+    rx = np.array([[1, 0, 0], [0, cx, -sx], [0, sx, cx]])
+    ry = np.array([[cy, 0, sy], [0, 1, 0], [-sy, 0, cy]])
+    rz = np.array([[cz, -sz, 0], [sz, cz, 0], [0, 0, 1]])
+    out: F64 = rz @ ry @ rx
+    return out
+
+
+#: The fundamental matrix of a rectified pair: corresponding points share their row.
+_RECTIFIED_F = np.array([[0.0, 0, 0], [0, 0, -1], [0, 1, 0]])
+
+
+def _qe_homographies(params: F64, w: int, h: int) -> tuple[F64, F64]:
+    """Fusiello and Irsara's quasi-Euclidean rectification ("Quasi-Euclidean epipolar
+    rectification of uncalibrated images", MVA 2011): each camera turned about its centre,
+    ``H = K R K^-1`` with ``K`` of focal ``3^a (w + h)`` and the principal point at the image's
+    centre; the left camera turns about y and z, the right about x, y and z. A seventh
+    parameter, beyond the paper, lets the right camera's focal length differ from the left's
+    by a share (two lenses of one model differ by a per cent or so)."""
+    ayl, azl, axr, ayr, azr, a, zoom = (float(v) for v in params)
+    f = 3.0 ** min(3.0, max(-3.0, a)) * (w + h)  # a focal length 1/27 to 27 times w + h
+    k = np.array([[f, 0, (w - 1) / 2], [0, f, (h - 1) / 2], [0, 0, 1.0]])
+    fr = f * (1.0 + min(0.5, max(-0.5, zoom)))  # the right camera's focal length
+    kr = np.array([[fr, 0, (w - 1) / 2], [0, fr, (h - 1) / 2], [0, 0, 1.0]])
+    return k @ _rotation(0.0, ayl, azl) @ np.linalg.inv(k), k @ _rotation(axr, ayr, azr) @ (
+        np.linalg.inv(kr)
+    )
+
+
+def _sampson(fm: F64, x1: F64, x2: F64) -> F64:
+    """Signed Sampson distances (px) of the matches ``x1``, ``x2`` (homogeneous rows) to ``fm``."""
+    fx1 = x1 @ fm.T
+    ftx2 = x2 @ fm
+    num = np.sum(x2 * fx1, axis=1)
+    den = np.sqrt(fx1[:, 0] ** 2 + fx1[:, 1] ** 2 + ftx2[:, 0] ** 2 + ftx2[:, 1] ** 2)
+    out: F64 = num / np.maximum(den, 1e-12)
+    return out
+
+
+def _quasi_euclidean(p1: F64, p2: F64, w: int, h: int) -> tuple[F64, F64, float]:
+    """Fit :func:`_qe_homographies`' seven parameters to the matches (Levenberg-Marquardt on their
+    Sampson distances to the rectified pair's ``F``, Huber-weighted at 1 px), from no turn."""
+    x1 = np.column_stack([p1, np.ones(len(p1))])
+    x2 = np.column_stack([p2, np.ones(len(p2))])
+
+    def resid(q: F64) -> F64:
+        hl, hr = _qe_homographies(q, w, h)
+        return _sampson(hr.T @ _RECTIFIED_F @ hl, x1, x2)
+
+    n_par = 7
+    q = np.zeros(n_par)
+    r = resid(q)
+    lam = 1e-2
+    for _ in range(_QE_ITERATIONS):
+        wts = np.sqrt(np.minimum(1.0, _QE_HUBER_PX / np.maximum(np.abs(r), 1e-12)))
+        jac = np.empty((len(r), n_par))
+        for i in range(n_par):
+            step = np.zeros(n_par)
+            step[i] = 1e-6
+            jac[:, i] = (resid(q + step) - resid(q - step)) / 2e-6
+        jw, rw = jac * wts[:, None], r * wts
+        a_mat, g = jw.T @ jw, jw.T @ rw
+        cost = float(rw @ rw)
+        while True:
+            try:
+                delta = np.linalg.solve(a_mat + lam * np.diag(np.diag(a_mat) + 1e-12), -g)
+            except np.linalg.LinAlgError:
+                delta = np.zeros(n_par)
+            r_new = resid(q + delta)
+            new_cost = float(np.sum((r_new * wts) ** 2))
+            if (math.isfinite(new_cost) and new_cost < cost) or lam > 1e8:
+                break
+            lam *= 10
+        if lam > 1e8:
+            break
+        q, r = q + delta, r_new
+        lam = max(lam / 10, 1e-9)
+        if float(np.abs(delta).max()) < 1e-10:
+            break
+    hl, hr = _qe_homographies(q, w, h)
+    turned = max(abs(v) for v in q[:5])
+    if turned > math.radians(_QE_MAX_TURN_DEG) or abs(q[6]) > 0.3 or not np.isfinite(r).all():
+        return hl, hr, math.inf  # not two cameras side by side: a collapsed or wild fit
+    return hl, hr, float(np.median(np.abs(r)))
+
+
+def _dense_span(
+    gl: npt.NDArray[np.uint8],
+    gr: npt.NDArray[np.uint8],
+    h1: F64,
+    h2: F64,
+    s: float,
+    tx: tuple[float, float],
+    y0: float,
+    size: tuple[int, int],
+    search: int,
+) -> tuple[float, float] | None:
+    """0.5th and 99.5th percentile of OpenCV SGBM's disparities (px of the output), searched up
+    to ``search``, on the pair rectified with these offsets and shrunk :data:`_PROBE_SCALE`
+    times; None when too small or nothing matched. Both images are moved right by the search
+    range first: SGBM leaves the first ``numDisparities`` columns without a value."""
+    k = _PROBE_SCALE
+    n = 16 * max(1, math.ceil(search / k / 16))
+    shape = (max(1, (size[0] + n * k) // k), max(1, size[1] // k))
+    if shape[1] < 16 or shape[0] < n + 16:
+        return None
+    imgs = []
+    for img, hom, t in ((gl, h1, tx[0]), (gr, h2, tx[1])):
+        move = np.array([[s / k, 0, t / k + n], [0, s / k, -s * y0 / k], [0, 0, 1.0]])
+        imgs.append(cv2.warpPerspective(img, move @ hom, shape, flags=cv2.INTER_AREA))
+    sgbm = cv2.StereoSGBM_create(  # type: ignore[attr-defined]
+        minDisparity=0, numDisparities=n, blockSize=5, P1=8 * 25, P2=32 * 25,
+        disp12MaxDiff=1, uniquenessRatio=15, speckleWindowSize=50, speckleRange=2,
+    )  # fmt: skip
+    d = sgbm.compute(imgs[0], imgs[1]).astype(np.float32) / 16.0
+    d = d[d > 0]
+    if d.size < 100:
+        return None
+    lo, hi = np.percentile(d, [0.5, 99.5])
+    return float(lo) * k, float(hi) * k
+
+
+def _corners(w: int, h: int) -> F64:
+    return np.array([[0.0, 0.0], [w - 1.0, 0.0], [w - 1.0, h - 1.0], [0.0, h - 1.0]])
+
+
+def _hull_area(pts: F64) -> float:
+    return float(cv2.contourArea(cv2.convexHull(pts.astype(np.float32))))
+
+
+@dataclass(frozen=True)
+class UncalibratedRectification:
+    """Two homographies that rectify a pair, found from its features (see the module doc).
+
+    Attributes
+    ----------
+    H1, H2 : numpy.ndarray
+        ``(3, 3)``: input left / right pixel -> rectified pixel.
+    size : tuple of int
+        ``(width, height)`` of the rectified images.
+    input_size : tuple of int
+        ``(width, height)`` of the input images.
+    F : numpy.ndarray
+        ``(3, 3)`` fundamental matrix, ``x_r^T F x_l = 0``.
+    matches : int
+        Feature matches that fit ``F`` (within :data:`RANSAC_PX`).
+    median_dy, p95_dy : float
+        ``|y_left - y_right|`` of those matches after rectification (px).
+    disparity_range : tuple of float
+        Their disparities after rectification, 5th to 95th percentile (px).
+    max_disparity : int
+        Suggested search range for the matchers.
+    skew_deg : tuple of float
+        Each rectified image's middle lines off perpendicular (degrees; 0: kept).
+    aspect : tuple of float
+        Each rectified image's middle-line length ratio against the input's (1: kept).
+    model : str
+        ``"quasi-euclidean"`` (the cameras turned about their centres) or ``"projective"``
+        (Hartley's homographies of ``F``, when the turns do not fit the matches).
+    """
+
+    H1: F64
+    H2: F64
+    size: tuple[int, int]
+    input_size: tuple[int, int]
+    F: F64
+    matches: int
+    median_dy: float
+    p95_dy: float
+    disparity_range: tuple[float, float]
+    max_disparity: int
+    skew_deg: tuple[float, float]
+    aspect: tuple[float, float]
+    model: str = "quasi-euclidean"
+
+    def rectify(
+        self, left: npt.ArrayLike, right: npt.ArrayLike, *, interpolation: int = cv2.INTER_LINEAR
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Warp a pair of this rig (input size) into its rectified pair (black outside).
+
+        Raises
+        ------
+        ValueError
+            If an image is not of :attr:`input_size`.
+        """
+        out = []
+        for name, img, hom in (("left", left, self.H1), ("right", right, self.H2)):
+            arr = np.asarray(img)
+            if arr.ndim < 2 or (arr.shape[1], arr.shape[0]) != self.input_size:
+                got = f"{arr.shape[1]}x{arr.shape[0]}" if arr.ndim >= 2 else str(arr.shape)
+                raise ValueError(
+                    f"{name} image is {got} px; this rectification is for "
+                    f"{self.input_size[0]}x{self.input_size[1]}"
+                )
+            out.append(np.asarray(cv2.warpPerspective(arr, hom, self.size, flags=interpolation)))
+        return out[0], out[1]
+
+    def rectify_points(self, points: npt.ArrayLike, side: str = "left") -> F64:
+        """``(N, 2)`` input pixel positions of one image -> rectified positions."""
+        if side not in ("left", "right"):
+            raise ValueError(f"side: expected 'left' or 'right', got {side!r}")
+        pts = np.asarray(points, np.float64).reshape(-1, 2)
+        return _apply(self.H1 if side == "left" else self.H2, pts)
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready: the homographies, ``F`` and the figures."""
+        return {
+            "H1": self.H1.tolist(),
+            "H2": self.H2.tolist(),
+            "size": list(self.size),
+            "input_size": list(self.input_size),
+            "F": self.F.tolist(),
+            "matches": self.matches,
+            "median_dy": self.median_dy,
+            "p95_dy": self.p95_dy,
+            "disparity_range": list(self.disparity_range),
+            "max_disparity": self.max_disparity,
+            "skew_deg": list(self.skew_deg),
+            "aspect": list(self.aspect),
+            "model": self.model,
+        }
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write :meth:`as_dict` as JSON (atomically)."""
+        from stereovision.io import atomic_write
+
+        p = Path(path)
+        with atomic_write(p, "w") as fh:
+            fh.write(json.dumps(self.as_dict(), indent=2))
+        return p
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> UncalibratedRectification:
+        """Read a file written by :meth:`save`.
+
+        Raises
+        ------
+        FileNotFoundError
+            If it does not exist.
+        ValueError
+            If it is not such a file (the field named).
+        """
+        p = Path(path)
+        if not p.is_file():
+            raise FileNotFoundError(f"rectification file not found: {p}")
+        try:
+            d = json.loads(p.read_text())
+            mats = {k: np.asarray(d[k], np.float64).reshape(3, 3) for k in ("H1", "H2", "F")}
+            return cls(
+                mats["H1"],
+                mats["H2"],
+                (int(d["size"][0]), int(d["size"][1])),
+                (int(d["input_size"][0]), int(d["input_size"][1])),
+                mats["F"],
+                int(d["matches"]),
+                float(d["median_dy"]),
+                float(d["p95_dy"]),
+                (float(d["disparity_range"][0]), float(d["disparity_range"][1])),
+                int(d["max_disparity"]),
+                (float(d["skew_deg"][0]), float(d["skew_deg"][1])),
+                (float(d["aspect"][0]), float(d["aspect"][1])),
+                str(d.get("model", "projective")),
+            )
+        except (ValueError, KeyError, TypeError, IndexError) as exc:
+            what = f"field {exc}" if isinstance(exc, KeyError) else str(exc)
+            raise ValueError(f"{p} is not an uncalibrated rectification: {what}") from None
+
+    def describe(self) -> str:
+        """One line for a terminal."""
+        return (
+            f"rectified without a calibration ({self.model}) from {self.matches} feature "
+            "matches: rows "
+            f"median |dy| {self.median_dy:.2f} px (95 % {self.p95_dy:.2f}); disparities "
+            f"{self.disparity_range[0]:.0f}-{self.disparity_range[1]:.0f} px (max_disparity "
+            f"{self.max_disparity}); {self.size[0]}x{self.size[1]} px, skew "
+            f"{max(self.skew_deg):.2f} deg, aspect {self.aspect[0]:.3f} / {self.aspect[1]:.3f}"
+        )
+
+
+#: The rectification models :func:`rectify_uncalibrated` offers.
+MODELS = ("auto", "quasi-euclidean", "projective")
+
+
+def rectify_uncalibrated(
+    left: npt.ArrayLike,
+    right: npt.ArrayLike,
+    *,
+    ransac_px: float = RANSAC_PX,
+    model: str = "auto",
+) -> UncalibratedRectification:
+    """Find the homographies that rectify a pair from the pair itself (see the module doc).
+
+    Parameters
+    ----------
+    left, right : array_like
+        The two views, the same size; grey or colour, any dtype the package reads. The left
+        camera is the one on the left (its image's matches lie to the right of the other's).
+    ransac_px : float
+        Epipolar distance (px) up to which a match fits the fundamental matrix.
+    model : str
+        ``"auto"``: the two cameras turned about their centres (quasi-Euclidean), or Hartley's
+        projective homographies of ``F`` when the turns do not fit; ``"quasi-euclidean"`` or
+        ``"projective"`` to choose one.
+
+    Returns
+    -------
+    UncalibratedRectification
+        Its :meth:`~UncalibratedRectification.rectify` warps the pair.
+
+    Raises
+    ------
+    ValueError
+        Images of different sizes, fewer than 30 matches or fewer than 30 that fit one
+        fundamental matrix (too little texture in common), two views with no parallax, an
+        epipole inside the image (the cameras look along their baseline), or homographies that
+        would stretch an image more than :data:`MAX_STRETCH` times.
+    """
+    if model not in MODELS:
+        raise ValueError(f"model: expected one of {', '.join(MODELS)}, got {model!r}")
+    if isinstance(ransac_px, bool) or not (
+        isinstance(ransac_px, (int, float)) and math.isfinite(ransac_px) and ransac_px > 0
+    ):
+        raise ValueError(f"ransac_px: expected a positive number of pixels, got {ransac_px!r}")
+    gl, gr = as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
+    if gl.shape != gr.shape:
+        raise ValueError(
+            f"left is {gl.shape[1]}x{gl.shape[0]} px, right is {gr.shape[1]}x{gr.shape[0]} px: "
+            "rectification without a calibration needs one size (resize one first)"
+        )
+    h, w = gl.shape
+    pl, dl = _features(gl)
+    pr, dr = _features(gr)
+    pairs = (
+        _mutual_matches(dl, dr)
+        if dl is not None and dr is not None and len(pl) >= 2 and len(pr) >= 2
+        else np.zeros((0, 2), dtype=np.intp)
+    )
+    if len(pairs) < MIN_MATCHES:
+        raise ValueError(
+            f"only {len(pairs)} feature matches between the two images (at least {MIN_MATCHES} "
+            "needed): point the cameras at something textured that both see"
+        )
+    p1, p2 = pl[pairs[:, 0]], pr[pairs[:, 1]]
+    if float(np.median(np.linalg.norm(p1 - p2, axis=1))) < 0.5:
+        raise ValueError("the two images show the same view (no parallax): nothing to rectify")
+    found, mask = cv2.findFundamentalMat(p1, p2, cv2.USAC_MAGSAC, float(ransac_px), 0.9999, 10000)
+    inl = np.zeros(len(p1), bool) if mask is None else mask.ravel().astype(bool)
+    if found is None or found.shape != (3, 3) or inl.sum() < MIN_MATCHES:
+        raise ValueError(
+            f"{int(inl.sum())} of {len(p1)} feature matches fit one fundamental matrix (at least "
+            f"{MIN_MATCHES} needed): the views share too little, or a moving scene"
+        )
+    fm: F64 = np.asarray(found, np.float64)
+    p1, p2 = p1[inl], p2[inl]
+    for name, mat in (("left", fm), ("right", fm.T)):
+        e = np.linalg.svd(mat)[2][-1]  # mat @ e = 0: the epipole of that image
+        if abs(e[2]) > 1e-12:
+            ex, ey = e[0] / e[2], e[1] / e[2]
+            if 0 <= ex <= w - 1 and 0 <= ey <= h - 1:
+                raise ValueError(
+                    f"the {name} image's epipole lies at ({ex:.0f}, {ey:.0f}), in the image: "
+                    "the cameras look along their baseline (one in front of the other), and no "
+                    "homography rectifies such a pair"
+                )
+    # Two cameras side by side, turned a little: a model of five angles and two focal lengths is
+    # far better posed than F's seven degrees of freedom when the matches lie near one plane
+    # (then F is ambiguous and its homographies tilt the rows away from the matches).
+    qe_median = math.inf
+    if model != "projective":
+        h1, h2, qe_median = _quasi_euclidean(p1, p2, w, h)
+    used = "quasi-euclidean"
+    if model == "quasi-euclidean" and not qe_median <= _QE_MAX_MEDIAN_PX:
+        raise ValueError(
+            f"two turned cameras do not fit the matches (median residual {qe_median:.2f} px, "
+            f"at most {_QE_MAX_MEDIAN_PX} px): use model='projective' or 'auto'"
+        )
+    if not qe_median <= _QE_MAX_MEDIAN_PX:
+        ok, h1_cv, h2_cv = cv2.stereoRectifyUncalibrated(p1, p2, fm, (w, h))
+        if not ok:
+            raise ValueError("OpenCV found no rectifying homographies for these matches")
+        h1, h2 = np.asarray(h1_cv, np.float64), np.asarray(h2_cv, np.float64)
+        used = "projective"
+    # Orientation: the left image's x and y keep their sense; the right one follows (its rows
+    # must stay the left's rows).
+    cx, cy = (w - 1) / 2, (h - 1) / 2
+    axes = np.array([[cx, cy], [cx + 1, cy], [cx, cy + 1]])
+    o, ex_, ey_ = _apply(h1, axes)
+    flip = np.diag([1.0 if ex_[0] > o[0] else -1.0, 1.0 if ey_[1] > o[1] else -1.0, 1.0])
+    h1, h2 = flip @ h1, flip @ h2
+    o, ex_, _ = _apply(h2, axes)
+    if ex_[0] <= o[0]:
+        raise ValueError("the rectified right image would be mirrored: are left and right swapped?")
+    h1, h2 = _shear(h1, w, h) @ h1, _shear(h2, w, h) @ h2
+    # One scale for both: the matched part of the left image keeps its area. The output holds
+    # the rows and columns of the matched part and a margin, within the images: an image whose
+    # epipole lies near it is stretched without bound towards the epipole, where nothing is
+    # matched anyway.
+    r1, r2 = _apply(h1, p1), _apply(h2, p2)
+    area = _hull_area(r1)
+    if not area > 0:
+        raise ValueError("the rectifying homographies collapse the left image")
+    s = math.sqrt(_hull_area(p1) / area)
+    q1, q2 = _apply(h1, _corners(w, h)), _apply(h2, _corners(w, h))
+
+    def span(lo_img: float, hi_img: float, vals: F64) -> tuple[float, float]:
+        lo, hi = float(vals.min()), float(vals.max())
+        m = _MARGIN * (hi - lo)
+        return max(lo_img, lo - m), min(hi_img, hi + m)
+
+    rows = np.concatenate([r1[:, 1], r2[:, 1]])
+    y0, y1 = span(max(q1[:, 1].min(), q2[:, 1].min()), min(q1[:, 1].max(), q2[:, 1].max()), rows)
+    x1_hi = span(q1[:, 0].min(), q1[:, 0].max(), r1[:, 0])[1]
+    x2_lo, x2_hi = span(q2[:, 0].min(), q2[:, 0].max(), r2[:, 0])
+    p_lo, p_hi = np.percentile(r1[:, 0] - r2[:, 0], [_SPAN_PERCENTILE, 100 - _SPAN_PERCENTILE])
+    spread = float(p_hi - p_lo)
+    low = float(p_lo) - _RANGE_MARGIN * spread
+    high = float(p_hi) + _RANGE_MARGIN * spread
+    tx2 = -s * x2_lo
+    height = math.ceil(s * (y1 - y0))
+    # The features say where the textured part of the scene is; a coarse dense match of the
+    # pair, shifted so that everything down to three spans below them is in front, says where
+    # the rest is (a textureless wall far behind them, a floor up close).
+    probe_low = float(p_lo) - 3 * spread - 8 / s
+    probe_tx1 = tx2 - s * probe_low
+    probe_width = math.ceil(max(s * x1_hi + probe_tx1, s * x2_hi + tx2))
+    probe_range = math.ceil(s * (float(p_hi) + 3 * spread - probe_low) + 8)
+    probe = _dense_span(gl, gr, h1, h2, s, (probe_tx1, tx2), y0, (probe_width, height), probe_range)
+    if probe is not None:
+        low = min(low, probe_low + probe[0] / s)
+        high = max(high, probe_low + probe[1] / s)
+    tx1 = tx2 - s * low + _LOW_DISPARITY
+    move1 = np.array([[s, 0, tx1], [0, s, -s * y0], [0, 0, 1.0]])
+    move2 = np.array([[s, 0, tx2], [0, s, -s * y0], [0, 0, 1.0]])
+    h1, h2 = move1 @ h1, move2 @ h2
+    width = math.ceil(max(s * x1_hi + tx1, s * x2_hi + tx2))
+    if not (0 < height <= MAX_STRETCH * h and 0 < width <= MAX_STRETCH * w):
+        raise ValueError(
+            f"the rectified images would be {width}x{height} px from {w}x{h}: the views hardly "
+            "differ, or the epipole lies near the image; rectification needs cameras side by side"
+        )
+    r1, r2 = _apply(h1, p1), _apply(h2, p2)
+    ady = np.abs(r1[:, 1] - r2[:, 1])
+    disp = r1[:, 0] - r2[:, 0]
+    lo, hi = (float(v) for v in np.percentile(disp, [_SPAN_PERCENTILE, 100 - _SPAN_PERCENTILE]))
+    max_disp = max(16, math.ceil(s * (high - low) + 2 * _LOW_DISPARITY))
+    shapes = [_shape(hm, w, h) for hm in (h1, h2)]
+    return UncalibratedRectification(
+        H1=h1 / h1[2, 2],
+        H2=h2 / h2[2, 2],
+        size=(width, height),
+        input_size=(w, h),
+        F=fm,
+        matches=len(p1),
+        median_dy=float(np.median(ady)),
+        p95_dy=float(np.percentile(ady, 95)),
+        disparity_range=(lo, hi),
+        max_disparity=max_disp,
+        skew_deg=(shapes[0][0], shapes[1][0]),
+        aspect=(shapes[0][1], shapes[1][1]),
+        model=used,
+    )
