@@ -1962,16 +1962,9 @@ def add_cli(subparsers: Any) -> None:
         "waved about",
     )
     p.add_argument("--right", nargs="+", help="right images (glob), or a video")
-    p.add_argument(
-        "--from-bag", metavar="BAG", help="a ROS 1 / ROS 2 bag of the board waved about instead"
-    )
-    p.add_argument("--left-topic", help="--from-bag: left image topic (default: found)")
-    p.add_argument("--right-topic", help="--from-bag: right image topic (default: found)")
-    p.add_argument(
-        "--max-skew-ms",
-        type=float,
-        help="--from-bag: largest stamp difference of a pair (default: half a frame period)",
-    )
+    from stereovision.capture import add_bag_args
+
+    add_bag_args(p, "a ROS 1 / ROS 2 bag of the board waved about instead")
     p.add_argument(
         "--max-pairs",
         type=int,

@@ -51,9 +51,11 @@ __all__ = [
     "MIN_POSE_DISTANCE",
     "CaptureResult",
     "ChessboardCollector",
+    "PairSource",
     "SourceError",
     "StereoCamera",
     "StereoFrame",
+    "add_bag_args",
     "add_cli",
     "add_source_args",
     "capture",
@@ -169,7 +171,52 @@ def _describe_source(src: Source) -> str:
     return type(src).__name__
 
 
-class StereoCamera:
+class PairSource:
+    """What every pair source shares (:class:`StereoCamera`,
+    :class:`~stereovision.rosbag.BagCamera`): iteration until the end, the skew report, ``with``.
+    A subclass provides :meth:`read`, :meth:`close` and the list ``skews_ms``."""
+
+    skews_ms: list[float]
+
+    def read(self) -> StereoFrame:
+        """The next pair (:class:`SourceError` at the end)."""
+        raise NotImplementedError
+
+    def close(self) -> None:
+        """Release the source (idempotent)."""
+        raise NotImplementedError
+
+    def frames(self, *, stop_at_end: bool = True) -> Iterator[StereoFrame]:
+        """Iterate over pairs; the end of a source ends the iteration when ``stop_at_end``."""
+        while True:
+            try:
+                frame = self.read()
+            except SourceError:
+                if stop_at_end:
+                    return
+                raise
+            yield frame
+
+    def skew_report(self) -> dict[str, float]:
+        """Skew over the pairs read: ``n``, ``mean_ms``, ``median_ms``, ``max_ms``."""
+        s = self.skews_ms
+        if not s:
+            return {"n": 0, "mean_ms": math.nan, "median_ms": math.nan, "max_ms": math.nan}
+        return {
+            "n": len(s),
+            "mean_ms": float(statistics.fmean(s)),
+            "median_ms": float(statistics.median(s)),
+            "max_ms": float(max(s)),
+        }
+
+    def __enter__(self) -> PairSource:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class StereoCamera(PairSource):
     """Two video sources read as synchronised pairs.
 
     Parameters
@@ -323,29 +370,6 @@ class StereoCamera:
         self.skews_ms.append(frame.skew_ms)
         return frame
 
-    def frames(self, *, stop_at_end: bool = True) -> Iterator[StereoFrame]:
-        """Iterate over pairs; the end of a source ends the iteration when ``stop_at_end``."""
-        while True:
-            try:
-                frame = self.read()
-            except SourceError:
-                if stop_at_end:
-                    return
-                raise
-            yield frame
-
-    def skew_report(self) -> dict[str, float]:
-        """Grab skew over the pairs read: ``n``, ``mean_ms``, ``median_ms``, ``max_ms``."""
-        s = self.skews_ms
-        if not s:
-            return {"n": 0, "mean_ms": math.nan, "median_ms": math.nan, "max_ms": math.nan}
-        return {
-            "n": len(s),
-            "mean_ms": float(statistics.fmean(s)),
-            "median_ms": float(statistics.median(s)),
-            "max_ms": float(max(s)),
-        }
-
     def describe(self) -> str:
         """One line: requested vs delivered size and fps of each source."""
         parts = []
@@ -372,29 +396,28 @@ class StereoCamera:
     def __enter__(self) -> StereoCamera:
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
-
 
 # ---------------------------------------------------------------------------- CLI sources
+
+
+def add_bag_args(p: argparse.ArgumentParser, what: str, *, skew: bool = True) -> None:
+    """``--from-bag BAG`` (``what`` says what it holds) and its topic (and skew) options."""
+    p.add_argument("--from-bag", metavar="BAG", help=what)
+    p.add_argument("--left-topic", help="--from-bag: left image topic (default: found)")
+    p.add_argument("--right-topic", help="--from-bag: right image topic (default: found)")
+    if skew:
+        p.add_argument(
+            "--max-skew-ms",
+            type=float,
+            help="--from-bag: largest stamp difference of a pair (default: half a frame period)",
+        )
 
 
 def add_source_args(p: argparse.ArgumentParser) -> None:
     """The pair source options of ``capture`` and ``stream``: two cameras, or a ROS bag."""
     p.add_argument("--left", help="device index, video file or pattern (%%03d)")
     p.add_argument("--right", help="device index, video file or pattern")
-    p.add_argument(
-        "--from-bag",
-        metavar="BAG",
-        help="read the pairs from a recorded ROS 1 bag or ROS 2 bag folder instead",
-    )
-    p.add_argument("--left-topic", help="--from-bag: left image topic (default: found)")
-    p.add_argument("--right-topic", help="--from-bag: right image topic (default: found)")
-    p.add_argument(
-        "--max-skew-ms",
-        type=float,
-        help="--from-bag: largest stamp difference of a pair (default: half a frame period)",
-    )
+    add_bag_args(p, "read the pairs from a recorded ROS 1 bag or ROS 2 bag folder instead")
 
 
 def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:

@@ -58,6 +58,8 @@ from typing import Any
 import cv2
 import numpy as np
 
+from stereovision.capture import PairSource, SourceError, StereoFrame
+
 __all__ = [
     "DEFAULT_FRAME_ID",
     "DEFAULT_PREFIX",
@@ -517,7 +519,7 @@ def find_stereo_topics(image_topics: list[str]) -> tuple[str, str]:
     return top[0]
 
 
-class BagCamera:
+class BagCamera(PairSource):
     """A stereo rig recorded in a ROS 1 or ROS 2 bag, read as synchronised pairs.
 
     It has :class:`~stereovision.capture.StereoCamera`'s interface (``read``, ``frames``,
@@ -703,7 +705,7 @@ class BagCamera:
         interp = cv2.INTER_AREA if w > self.size[0] else cv2.INTER_LINEAR
         return np.asarray(cv2.resize(img, self.size, interpolation=interp))
 
-    def read(self) -> Any:
+    def read(self) -> StereoFrame:
         """The next pair, as a :class:`~stereovision.capture.StereoFrame`.
 
         Raises
@@ -713,8 +715,6 @@ class BagCamera:
         ValueError
             If a frame does not decode (its topic and stamp named).
         """
-        from stereovision.capture import SourceError, StereoFrame
-
         if self._reader is None:
             raise SourceError("the bag is closed")
         nxt = next(self._pairs, None)
@@ -746,31 +746,6 @@ class BagCamera:
         self.skews_ms.append(frame.skew_ms)
         self.stamps_ns.append(sl)
         return frame
-
-    def frames(self, *, stop_at_end: bool = True) -> Iterator[Any]:
-        """Iterate over the pairs until the end of the recording."""
-        from stereovision.capture import SourceError
-
-        while True:
-            try:
-                frame = self.read()
-            except SourceError:
-                if stop_at_end:
-                    return
-                raise
-            yield frame
-
-    def skew_report(self) -> dict[str, float]:
-        """Stamp difference over the pairs read: ``n``, ``mean_ms``, ``median_ms``, ``max_ms``."""
-        s = self.skews_ms
-        if not s:
-            return {"n": 0, "mean_ms": math.nan, "median_ms": math.nan, "max_ms": math.nan}
-        return {
-            "n": len(s),
-            "mean_ms": float(statistics.fmean(s)),
-            "median_ms": float(statistics.median(s)),
-            "max_ms": float(max(s)),
-        }
 
     def describe(self) -> str:
         """One line: the bag, its two topics with their size and rate, the pairing tolerance."""
@@ -869,6 +844,3 @@ class BagCamera:
 
     def __enter__(self) -> BagCamera:
         return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()

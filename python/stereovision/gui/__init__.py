@@ -116,13 +116,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The ``gui`` options."""
     p.add_argument("--left", help="left camera: device index, video file or image pattern")
     p.add_argument("--right", help="right camera: device index, video file or image pattern")
-    p.add_argument(
-        "--from-bag",
-        metavar="BAG",
-        help="play a rig recorded in a ROS 1 / ROS 2 bag instead (its camera_info as calibration)",
+    from stereovision.capture import add_bag_args
+
+    add_bag_args(
+        p,
+        "play a rig recorded in a ROS 1 / ROS 2 bag instead (its camera_info as calibration)",
+        skew=False,
     )
-    p.add_argument("--left-topic", help="--from-bag: left image topic (default: found)")
-    p.add_argument("--right-topic", help="--from-bag: right image topic (default: found)")
     p.add_argument(
         "--calib",
         help="calibration of the camera pair (YAML/JSON, calib.txt, KITTI, Kalibr, ROS folder)",
