@@ -278,6 +278,21 @@ def test_pairs_are_matched_on_their_stamps(cones: Any, tmp_path: Path, flavour: 
         cam.read()
 
 
+def test_a_bag_without_message_definitions(cones: Any, tmp_path: Path) -> None:
+    """ROS 2 bags recorded before Iron (Humble's) hold no message definitions: read with
+    Humble's."""
+    import sqlite3
+
+    bag = write_bag(tmp_path / "humble", [(T0, cones.left, T0, cones.right)])
+    db = sqlite3.connect(next(bag.glob("*.db3")))
+    db.execute("DELETE FROM message_definitions")
+    db.commit()
+    db.close()
+    with BagCamera(bag) as cam:
+        frame = cam.read()
+    np.testing.assert_array_equal(frame.left, cones.left)
+
+
 def test_max_skew_and_end_of_recording(cones: Any, tmp_path: Path) -> None:
     frames, jitter = _jittered(cones, 14)
     bag = write_bag(tmp_path / "rig", frames)

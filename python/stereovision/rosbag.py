@@ -357,15 +357,20 @@ _ENCODINGS: dict[str, tuple[int, int, int | None]] = {
 ENCODINGS = tuple(sorted(_ENCODINGS))
 
 
-def _reader_cls() -> Any:
+def _open_reader(path: Path) -> Any:
+    """rosbags' reader of a ROS 1 or ROS 2 bag, opened. A ROS 2 bag recorded before Iron holds
+    no message definitions: ``sensor_msgs`` are then read with Humble's (the same since)."""
     try:
         from rosbags.highlevel import AnyReader
+        from rosbags.typesys import Stores, get_typestore
     except ImportError:
         raise ImportError(
             "reading ROS bags needs the rosbags package: pip install rosbags (or the package's "
             "'ros' extra)"
         ) from None
-    return AnyReader
+    reader = AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
+    reader.open()
+    return reader
 
 
 def decode_image(msg: Any) -> np.ndarray:
@@ -583,10 +588,10 @@ class BagCamera(PairSource):
         if max_skew_ms is not None and not (math.isfinite(max_skew_ms) and max_skew_ms >= 0):
             raise ValueError(f"max_skew_ms: expected a number >= 0, got {max_skew_ms!r}")
         self.requested_size = parse_size(size)
-        reader_cls = _reader_cls()
         try:
-            reader = reader_cls([self.path])
-            reader.open()
+            reader = _open_reader(self.path)
+        except ImportError:
+            raise
         except Exception as exc:  # rosbags' errors name no common base class
             raise ValueError(f"{self.path} is not a readable ROS 1 or ROS 2 bag: {exc}") from None
         self._reader: Any = reader
