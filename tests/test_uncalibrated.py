@@ -268,6 +268,22 @@ def test_cli_rectify(data_dir: Path, tmp_path: Path) -> None:
     left = cv2.imread(str(tmp_path / "u" / "left_rect.png"))
     assert (left.shape[1], left.shape[0]) == rect.size
     assert f"--max-disparity {rect.max_disparity}" in run.stdout
+    # the homographies serve the rig's other pairs: depth --rectification on the raw pair gives
+    # the disparity of the rectified pair written above
+    depth = [sys.executable, "-m", "stereovision.cli", "depth"]
+    run = subprocess.run([*depth, str(sp / "left.png"), str(sp / "right.png"), "--rectification",
+                          str(tmp_path / "u" / "rectification.json"), "-o", str(tmp_path / "d1")],
+                         capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    run = subprocess.run([*depth, str(tmp_path / "u" / "left_rect.png"),
+                          str(tmp_path / "u" / "right_rect.png"), "--max-disparity",
+                          str(rect.max_disparity), "-o", str(tmp_path / "d2")],
+                         capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    from stereovision.io import read_pfm
+
+    np.testing.assert_array_equal(read_pfm(tmp_path / "d1" / "disparity.pfm"),
+                                  read_pfm(tmp_path / "d2" / "disparity.pfm"))  # fmt: skip
     # with the rig's calibration: its rectification, checked the same way
     from tests.test_calibration import stereopi_calib
 

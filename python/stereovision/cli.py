@@ -217,13 +217,22 @@ def cmd_depth(args: argparse.Namespace) -> int:
     left = imread(args.left)
     right = imread(args.right)
     calib = _load_calibration(args.calib)
+    max_disparity = args.max_disparity
+    if args.rectification:
+        from stereovision.uncalibrated import UncalibratedRectification
+
+        if calib is not None:
+            raise CliError("--rectification and --calib: give one way to rectify the pair")
+        rect = UncalibratedRectification.load(args.rectification)
+        left, right = rect.rectify(left, right)
+        max_disparity = max_disparity or rect.max_disparity
     res, written = depth_outputs(
         left,
         right,
         calib,
         Path(args.output),
         method=args.method,
-        max_disparity=args.max_disparity,
+        max_disparity=max_disparity,
         fill=args.fill,
         refine=args.refine,
         max_depth=args.max_depth,
@@ -685,6 +694,12 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="M",
         help="with --ground: a bird's-eye occupancy grid of M-metre cells, 20 m ahead and 10 m "
         "to each side, as ROS map_server's map.png and map.yaml",
+    )
+    d.add_argument(
+        "--rectification",
+        metavar="JSON",
+        help="a raw pair of a rig rectified without a calibration: the homographies "
+        "`stereovision rectify` wrote (rectification.json); disparity only",
     )
     d.add_argument("-o", "--output", required=True, help="output folder")
     d.set_defaults(func=cmd_depth)
