@@ -319,6 +319,60 @@ def test_find_floor_controller_on_kitti(data_dir):
     assert app.state.img_floor == ""
 
 
+def test_rectify_controller_without_a_calibration(data_dir):
+    """The acquisition panel's "Rectify", in-process, on StereoPi's raw pair (rows 0.59 px
+    apart): rectified from its features, the rows check passes, and the cameras' next pair
+    goes through the same homographies; with a calibration, a sentence saying so."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui.app import StereoApp
+
+    sp = data_dir / "stereopi_rig" / "scene_photo"
+    raw = (cv2.imread(str(sp / "left.png")), cv2.imread(str(sp / "right.png")))
+
+    class Cameras:
+        def read(self):
+            return raw
+
+        def close(self):
+            pass
+
+    app = StereoApp(
+        get_server("test-rectify", client_type="vue3"),
+        AllowedFolders([data_dir]),
+        data_dir / "middlebury2003" / "cones",
+        source=Cameras(),
+    )
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._grab()
+        await app.check_rows()
+        assert "NOT rectified" in app.state.rows_label
+        await app.rectify_from_features()
+        await app.check_rows()
+
+    asyncio.run(run())
+    assert app.state.error == ""
+    rect = app.homographies
+    assert rect is not None and app.pair[0].shape[:2] == rect.size[::-1]
+    assert app.state.rows_label.startswith("rectification ok")
+    assert app.view is not None and app.view.result.max_disparity >= rect.max_disparity
+    app._grab()  # the next pair from the cameras: rectified the same way
+    np.testing.assert_array_equal(app.pair[0], rect.rectify(*raw)[0])
+    assert app.state.source_label.endswith("(rectified from features)")
+
+    async def with_calib() -> None:
+        app.calib = object()
+        await app.rectify_from_features()
+
+    asyncio.run(with_calib())
+    assert app.state.rows_label == "this pair has a calibration: it is rectified with it"
+
+
 # ----------------------------------------------------------------------------- browser
 
 

@@ -393,6 +393,9 @@ class StereoApp:
         self.source = source
         self.source_calib = calib
         self._source_label = source_label
+        #: The pair's rectification from its features ("Rectify" button), kept for the
+        #: cameras' next pairs; None when the pair is used as it comes.
+        self.homographies: Any = None
         self.pair: tuple[np.ndarray, np.ndarray] | None = None
         self.calib: Any = None
         self.max_disparity: int | None = None
@@ -476,6 +479,7 @@ class StereoApp:
         self.pair = (scene.left, scene.right)
         self.calib = scene.calib
         self.max_disparity = scene.max_disparity
+        self.homographies = None  # another rig
         self.state.source_label = f"scene {self.folders.label(scene_dir)}"
         self.state.rows_label = ""
 
@@ -491,6 +495,13 @@ class StereoApp:
         names = (Path(str(n)).name or str(n) for n in (self.state.cam_left, self.state.cam_right))
         self.state.source_label = self._source_label or "cameras " + " / ".join(names)
         self.state.rows_label = ""
+        rect = self.homographies
+        if rect is not None and rect.input_size == (left.shape[1], left.shape[0]):
+            # the cameras rectified from their features: every new pair through the same
+            # homographies (the rows stay as the button left them)
+            self.pair = rect.rectify(left, right)
+            self.max_disparity = rect.max_disparity
+            self.state.source_label += " (rectified from features)"
 
     def _camera_source(self, text: str) -> int | str:
         src = parse_source(text)
@@ -552,6 +563,7 @@ class StereoApp:
         if self.source is not None:
             self.source.close()
         self.source = source
+        self.homographies = None
         self._source_label = None  # the cameras typed on the page, named by their fields
         self.state.live = True
         self.state.error = ""
@@ -570,6 +582,7 @@ class StereoApp:
             self._fail(exc)
             return
         self.pair = (left, right)
+        self.homographies = None
         c = self.source_calib
         fits = c is not None and tuple(c.image_size) == (left.shape[1], left.shape[0])
         self.calib = c if fits else None
@@ -673,6 +686,37 @@ class StereoApp:
             return
         with self.state:
             self.state.rows_label = text
+
+    def rectify_clicked(self) -> None:
+        """The page's "Rectify" button."""
+        self._spawn(self.rectify_from_features())
+
+    async def rectify_from_features(self) -> None:
+        """Rectify the pair on show from its own features (no calibration: disparity only);
+        the cameras' next pairs go through the same homographies."""
+        if self.pair is None:
+            return
+        if self.calib is not None:
+            with self.state:
+                self.state.rows_label = "this pair has a calibration: it is rectified with it"
+            return
+        from stereovision.uncalibrated import rectify_uncalibrated
+
+        left, right = self.pair
+        try:
+            rect = await asyncio.get_running_loop().run_in_executor(
+                self._executor, lambda: rectify_uncalibrated(left, right)
+            )
+        except (ValueError, OSError, RuntimeError) as exc:
+            self._fail(exc)
+            return
+        self.homographies = rect
+        self.pair = rect.rectify(left, right)
+        self.max_disparity = rect.max_disparity
+        with self.state:
+            self.state.rows_label = rect.describe()
+            self.state.source_label += " (rectified from features)"
+        await self.recompute()
 
     def find_floor_clicked(self) -> None:
         """The page's "Find floor" button."""
@@ -865,6 +909,17 @@ class StereoApp:
                     "rows_label",
                     "rows-label",
                 )
+                with v3.VRow(dense=True, classes="my-1"):
+                    with v3.VCol(cols=3):
+                        v3.VBtn(
+                            "Rectify",
+                            id="rectify-btn",
+                            size="small",
+                            variant="outlined",
+                            block=True,
+                            click=self.rectify_clicked,
+                            title="no calibration: rectify the pair from its own features",
+                        )
                 with v3.VRow(dense=True):
                     with v3.VCol(cols=6):
                         html.Div("left", classes="text-caption")
