@@ -9,9 +9,12 @@ homographies that put every pair of corresponding points on the same row:
 - **The model.** Two cameras side by side, each turned a little about its centre: Fusiello and
   Irsara's quasi-Euclidean rectification (five angles and a focal length, here with a second
   focal length for the right camera), fitted by Levenberg-Marquardt to the matches' Sampson
-  distances. It is far better posed than ``F``'s seven degrees of freedom when the matches lie
-  near one plane. When the turns do not fit (a hand-held pair, very different views), Hartley's
-  projective homographies of ``F`` (``cv2.stereoRectifyUncalibrated``) are used.
+  distances: it describes what a rig is (two cameras, not any two views), so it cannot
+  distort the images as freely as a general homography. When the turns do not fit (a hand-held
+  pair, very different views), Hartley's projective homographies of ``F``
+  (``cv2.stereoRectifyUncalibrated``) are used. On 17 bumped GT scenes the two leave the rows
+  within 0.1 px of each other on 12; the turned cameras are better on 4, worse on 1
+  (docs/robotics.md).
 - **Orientation**: the two images keep their sense (no mirror, not upside down).
 - **Shape**: each image is sheared along its rows so that its middle lines stay perpendicular
   and keep their length ratio (Loop and Zhang's shearing transform, "Computing rectifying
@@ -492,9 +495,8 @@ def rectify_uncalibrated(
                     "the cameras look along their baseline (one in front of the other), and no "
                     "homography rectifies such a pair"
                 )
-    # Two cameras side by side, turned a little: a model of five angles and two focal lengths is
-    # far better posed than F's seven degrees of freedom when the matches lie near one plane
-    # (then F is ambiguous and its homographies tilt the rows away from the matches).
+    # Two cameras side by side, turned a little (five angles, two focal lengths); Hartley's
+    # homographies of F when that does not fit.
     qe_median = math.inf
     if model != "projective":
         h1, h2, qe_median = _quasi_euclidean(p1, p2, w, h)
