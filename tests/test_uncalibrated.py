@@ -290,3 +290,31 @@ def test_cli_rectify(data_dir: Path, tmp_path: Path) -> None:
                           "-o", str(tmp_path / "m")], capture_output=True, text=True,
                          timeout=120)  # fmt: skip
     assert run.returncode == 2 and "--model is for rectifying without" in run.stderr
+
+
+def test_stream_through_the_homographies(data_dir: Path, tmp_path: Path) -> None:
+    """``stream --rectification``: a rig without a calibration streams disparity on rows that
+    agree (the first pair's row check passes; as taken its rows are 0.59 px apart)."""
+    from stereovision.capture import StereoCamera
+    from stereovision.stream import run_stream
+
+    sp = data_dir / "stereopi_rig" / "scene_photo"
+    left, right = cv2.imread(str(sp / "left.png")), cv2.imread(str(sp / "right.png"))
+    for k in range(3):
+        cv2.imwrite(str(tmp_path / f"left_{k:03d}.png"), left)
+        cv2.imwrite(str(tmp_path / f"right_{k:03d}.png"), right)
+    rect = rectify_uncalibrated(left, right)
+    with StereoCamera(str(tmp_path / "left_%03d.png"), str(tmp_path / "right_%03d.png")) as cam:
+        report = run_stream(cam, homographies=rect, frames=2, method="gabor")
+    assert report.frames == 2 and report.max_disparity == rect.max_disparity
+    assert report.rectification is not None and report.rectification["ok"] is True
+    rect.save(tmp_path / "rect.json")
+    run = subprocess.run(
+        [sys.executable, "-m", "stereovision.cli", "stream", "--left",
+         str(tmp_path / "left_%03d.png"), "--right", str(tmp_path / "right_%03d.png"),
+         "--rectification", str(tmp_path / "rect.json"), "--no-display", "--json",
+         "--frames", "2", "--calib", str(tmp_path / "rect.json")],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert run.returncode == 2 and "give it as --rectification" in run.stderr
+    assert run.stderr.count("\n") == 1

@@ -901,6 +901,11 @@ class Calibration:
             raise ValueError(f"cannot parse {source} as JSON: {exc}") from None
         if not isinstance(obj, dict):
             raise ValueError(f"{source}: expected a JSON object, got {type(obj).__name__}")
+        if "H1" in obj and "H2" in obj and "F" in obj:
+            raise ValueError(
+                f"{source} holds the homographies `stereovision rectify` found for a rig without "
+                "a calibration (disparity only): give it as --rectification"
+            )
         return cls._from_mapping(obj.get, source)
 
     @staticmethod

@@ -334,6 +334,7 @@ def _pairs(
     calib: Calibration | None,
     frames: int | None,
     check_every: int | None = None,
+    homographies: Any = None,
 ) -> Iterator[_Pair]:
     """Grab (and rectify, for a raw rig calibration) pairs until the end or ``frames`` pairs;
     check the rows of pair 0 and, when positive, every ``check_every``-th pair (None: none)."""
@@ -350,6 +351,8 @@ def _pairs(
         left, right = fr.left, fr.right
         if calib is not None and not calib.rectified:
             left, right = calib.rectify(left, right)
+        elif homographies is not None:
+            left, right = homographies.rectify(left, right)
         t2 = time.perf_counter()
         checked = None
         # In the producer thread when pipelined: the matcher keeps working meanwhile.
@@ -435,6 +438,7 @@ def run_stream(
     check_every: int | None = None,
     ground_every: int | None = None,
     on_ground: Callable[[Any], None] | None = None,
+    homographies: Any = None,
 ) -> StreamReport:
     """Depth maps from a stereo camera until it ends, ``frames`` pairs, or Ctrl-C.
 
@@ -483,6 +487,10 @@ def run_stream(
         every ``ground_every``-th pair, and warn once when the camera's height moves by more
         than :data:`GROUND_HEIGHT_SHARE` of the first fit's or its pitch or roll by more than
         :data:`GROUND_TILT_DEG`: a mount that slipped. Needs ``calib``.
+    homographies : UncalibratedRectification, optional
+        For a rig without a calibration: every pair is rectified through these homographies
+        (:func:`~stereovision.uncalibrated.rectify_uncalibrated`), disparity only; its search
+        range is the default ``max_disparity``.
     on_ground : callable, optional
         With ``ground_every``: called with each fit's
         :class:`~stereovision.ground.GroundPlane` (None when no floor was found), before the
@@ -503,6 +511,10 @@ def run_stream(
 
     if frames is not None and frames <= 0:
         raise ValueError(f"frames: expected a positive number, got {frames}")
+    if homographies is not None:
+        if calib is not None:
+            raise ValueError("homographies and calib: give one way to rectify the pairs")
+        max_disparity = max_disparity or homographies.max_disparity
     if max_disparity is not None and max_disparity <= 0:
         raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
     size = camera.size or camera.delivered_size.get("left")
@@ -523,7 +535,7 @@ def run_stream(
             )
         if rect_calib is None:
             raise ValueError("ground_every: the floor is found in metres; give a calibration")
-    source = _pairs(camera, calib, frames, (check_every or 0) if check else None)
+    source = _pairs(camera, calib, frames, (check_every or 0) if check else None, homographies)
     producer: _Producer | None = None
     q: queue.Queue[Any] = queue.Queue()
     if pipelined:
@@ -697,12 +709,19 @@ def cmd_stream(args: argparse.Namespace) -> int:
     out = sys.stdout
     log = sys.stderr
     server: FrameServer | None = None
+    homographies = None
+    if args.rectification:
+        from stereovision.uncalibrated import UncalibratedRectification
+
+        if args.calib:
+            raise ValueError("--rectification and --calib: give one way to rectify the pairs")
+        homographies = UncalibratedRectification.load(args.rectification)
     cam = open_source(args)
     stamps: Callable[[], int] = time.time_ns
     if hasattr(cam, "stamps_ns"):  # a recording: its results keep the frames' stamps
         played = itertools.count()
         stamps = lambda: cam.stamps_ns[next(played)]  # noqa: E731 -- results come in read order
-        if calib is None:
+        if calib is None and homographies is None:
             try:
                 calib = cam.calibration()
             except BaseException:
@@ -766,6 +785,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             check_every=args.check_every,
             ground_every=args.ground_every,
             on_ground=(lambda plane: floor.__setitem__(0, plane)) if bag is not None else None,
+            homographies=homographies,
         )
     finally:
         cam.close()
@@ -820,6 +840,12 @@ def add_cli(subparsers: Any) -> None:
         "--calib",
         help="calibration of the rig (YAML/JSON, Middlebury, KITTI, Kalibr, ROS folder); "
         "--from-bag: default the bag's camera_info",
+    )
+    p.add_argument(
+        "--rectification",
+        metavar="JSON",
+        help="a rig without a calibration: the homographies `stereovision rectify` found "
+        "(disparity only)",
     )
     p.add_argument("--size", help="requested size WIDTHxHEIGHT (frames are resized if needed)")
     p.add_argument("--max-disparity", type=int, help="default: estimated from the first pair")
