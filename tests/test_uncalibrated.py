@@ -318,3 +318,18 @@ def test_stream_through_the_homographies(data_dir: Path, tmp_path: Path) -> None
     )  # fmt: skip
     assert run.returncode == 2 and "give it as --rectification" in run.stderr
     assert run.stderr.count("\n") == 1
+
+
+def test_depth_map_takes_the_homographies(data_dir: Path) -> None:
+    """``sv.depth_map(left, right, rect)`` with a rectification found without a calibration:
+    the raw pair rectified through it, its search range, disparity only."""
+    sp = data_dir / "stereopi_rig" / "scene_photo"
+    left, right = cv2.imread(str(sp / "left.png")), cv2.imread(str(sp / "right.png"))
+    rect = rectify_uncalibrated(left, right)
+    res = sv.depth_map(left, right, rect, method="gabor")
+    lr, rr = rect.rectify(left, right)
+    want = sv.depth_map(lr, rr, method="gabor", max_disparity=rect.max_disparity)
+    assert res.depth is None and res.max_disparity == rect.max_disparity
+    np.testing.assert_array_equal(res.disparity, want.disparity)
+    with pytest.raises(ValueError, match="this rectification is for 320x240"):
+        sv.depth_map(left[:100], right[:100], rect)

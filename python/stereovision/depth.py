@@ -14,7 +14,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import cv2
 import numpy as np
@@ -22,6 +22,9 @@ import numpy.typing as npt
 
 from stereovision._validate import as_bgr_uint8, as_gray_float, check_pair
 from stereovision.calibration import Calibration
+
+if TYPE_CHECKING:
+    from stereovision.uncalibrated import UncalibratedRectification
 
 __all__ = ["METHODS", "DepthResult", "depth_map", "disparity_sigma", "estimate_max_disparity"]
 
@@ -623,7 +626,7 @@ def _cloud(
 def depth_map(
     left: npt.ArrayLike,
     right: npt.ArrayLike,
-    calib: Calibration | None = None,
+    calib: Calibration | UncalibratedRectification | None = None,
     *,
     method: str = "fused",
     max_disparity: int | None = None,
@@ -643,8 +646,11 @@ def depth_map(
         The two images, (H, W) grey or (H, W, 3) BGR as ``cv2.imread`` gives, uint8, uint16 or
         float in [0, 1]. Raw camera images when ``calib`` is an unrectified rig calibration
         (they are rectified first); already rectified images otherwise.
-    calib : Calibration, optional
-        Rig calibration. Without it only disparity is computed (``depth`` is None).
+    calib : Calibration or UncalibratedRectification, optional
+        Rig calibration. Without it only disparity is computed (``depth`` is None); so too with
+        the homographies :func:`~stereovision.uncalibrated.rectify_uncalibrated` found for a rig
+        without a calibration, which rectify the raw pair first (their search range is the
+        default ``max_disparity``).
     method : {"fused", "gabor", "census"}
         ``"fused"`` (default): the Gabor map corrected and completed by the valid members where
         the Gabor, graph-matching and Hopfield channels agree (algorithms.md D), checked and
@@ -755,10 +761,19 @@ def depth_map(
             f"left and right images must have the same shape, got left {left_bgr.shape} and "
             f"right {right_bgr.shape}"
         )
+    from stereovision.uncalibrated import UncalibratedRectification
+
+    if isinstance(calib, UncalibratedRectification):
+        # a rig without a calibration: its pair through the homographies, disparity only
+        left_bgr, right_bgr = calib.rectify(left_bgr, right_bgr)
+        left, right = left_bgr, right_bgr
+        max_disparity = calib.max_disparity if max_disparity is None else max_disparity
+        calib = None
     if calib is not None:
         if not isinstance(calib, Calibration):
             raise ValueError(
-                f"calib must be a stereovision.Calibration, got {type(calib).__name__}"
+                "calib must be a stereovision.Calibration (or an UncalibratedRectification), "
+                f"got {type(calib).__name__}"
             )
         h, w = left_bgr.shape[:2]
         if tuple(calib.image_size) != (w, h):
