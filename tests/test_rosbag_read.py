@@ -293,6 +293,22 @@ def test_a_bag_without_message_definitions(cones: Any, tmp_path: Path) -> None:
     np.testing.assert_array_equal(frame.left, cones.left)
 
 
+def test_a_ros1_recording_split_in_files(cones: Any, tmp_path: Path) -> None:
+    """``rosbag record --split``: a folder of .bag files read as one recording, in order."""
+    frames, _ = _jittered(cones, 14)
+    (tmp_path / "run").mkdir()
+    write_bag(tmp_path / "run" / "run_0.bag", frames[:7], flavour="ros1")
+    write_bag(tmp_path / "run" / "run_1.bag", frames[7:], flavour="ros1")
+    from stereovision.rosbag import is_bag
+
+    assert is_bag(tmp_path / "run") and not is_bag(tmp_path)
+    with BagCamera(tmp_path / "run") as cam:
+        got = list(cam.frames())
+    kept = [k for k in range(14) if k not in (5, 9)]
+    assert cam.stamps_ns == [T0 + k * PERIOD_NS for k in kept]
+    np.testing.assert_array_equal(got[-1].right, frames[13][3])
+
+
 def test_max_skew_and_end_of_recording(cones: Any, tmp_path: Path) -> None:
     frames, jitter = _jittered(cones, 14)
     bag = write_bag(tmp_path / "rig", frames)

@@ -357,6 +357,17 @@ _ENCODINGS: dict[str, tuple[int, int, int | None]] = {
 ENCODINGS = tuple(sorted(_ENCODINGS))
 
 
+def _bag_paths(path: Path) -> list[Path]:
+    """The files rosbags opens for ``path``: a ROS 2 bag folder as it is; a folder of ROS 1
+    ``.bag`` files (a recording split by ``rosbag record --split``) as all of them, in name
+    order; a ``.bag`` file alone."""
+    if path.is_dir() and not (path / "metadata.yaml").is_file():
+        parts = sorted(path.glob("*.bag"))
+        if parts:
+            return parts
+    return [path]
+
+
 def _open_reader(path: Path) -> Any:
     """rosbags' reader of a ROS 1 or ROS 2 bag, opened. A ROS 2 bag recorded before Iron holds
     no message definitions: ``sensor_msgs`` are then read with Humble's (the same since)."""
@@ -368,7 +379,7 @@ def _open_reader(path: Path) -> Any:
             "reading ROS bags needs the rosbags package: pip install rosbags (or the package's "
             "'ros' extra)"
         ) from None
-    reader = AnyReader([path], default_typestore=get_typestore(Stores.ROS2_HUMBLE))
+    reader = AnyReader(_bag_paths(path), default_typestore=get_typestore(Stores.ROS2_HUMBLE))
     reader.open()
     return reader
 
@@ -445,13 +456,13 @@ def to_8bit(*images: np.ndarray) -> tuple[np.ndarray, ...]:
 
 
 def is_bag(path: str | os.PathLike[str]) -> bool:
-    """Does ``path`` name a ROS bag: a ``.bag`` file, a ROS 2 bag folder (``metadata.yaml``)
-    or one of its files?"""
+    """Does ``path`` name a ROS bag: a ``.bag`` file, a folder of them (a split recording), a
+    ROS 2 bag folder (``metadata.yaml``) or one of its files?"""
     p = Path(path)
     if p.is_file() and p.suffix == ".bag":
         return True
     folder = p if p.is_dir() else p.parent
-    return (folder / "metadata.yaml").is_file()
+    return (folder / "metadata.yaml").is_file() or (p.is_dir() and any(p.glob("*.bag")))
 
 
 def _rate(count: int, reader: Any) -> float:
@@ -536,7 +547,8 @@ class BagCamera(PairSource):
     Parameters
     ----------
     path : str or os.PathLike
-        A ROS 1 ``.bag`` file, or a ROS 2 bag folder (sqlite3 or MCAP).
+        A ROS 1 ``.bag`` file or a folder of them (a recording split by ``rosbag record
+        --split``, read in name order), or a ROS 2 bag folder (sqlite3 or MCAP).
     left_topic, right_topic : str, optional
         The image topics; found when not given (both or neither).
     max_skew_ms : float, optional
