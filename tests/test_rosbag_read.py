@@ -644,3 +644,25 @@ def test_cli_info_on_a_bag(
     assert code == 0 and "no camera_info beside the image topics" in out
     code, out, err = run("info", str(tmp_path / "ros1" / "nothing.bag"))
     assert code != 0 and "not found" in err and "Traceback" not in err
+
+
+def test_one_camera_stops(cones: Any, tmp_path: Path) -> None:
+    """The left camera stops after 10 frames, the right one goes on for 100: 10 pairs, the
+    right frames after them dropped (and not all held in memory: at most 64 wait)."""
+    from stereovision import rosbag
+
+    frames = [(T0 + k * PERIOD_NS if k < 10 else None, cones.left, T0 + k * PERIOD_NS,
+               cones.right) for k in range(100)]  # fmt: skip
+    bag = write_bag(tmp_path / "rig", frames, encoding="png")
+    held: list[int] = []
+    with BagCamera(bag) as cam:
+        real = cam._match
+
+        def spy(lefts: Any, rights: Any, final: bool) -> Any:
+            yield from real(lefts, rights, final)
+            held.append(len(rights))
+
+        cam._match = spy  # type: ignore[method-assign]
+        assert len(list(cam.frames())) == 10
+    assert cam.dropped == {"left": 0, "right": 90}
+    assert max(held) <= rosbag.MAX_WAITING

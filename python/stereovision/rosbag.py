@@ -318,6 +318,7 @@ CAMERA_INFO_TYPE = "sensor_msgs/msg/CameraInfo"
 PERIOD_SAMPLE = 8
 #: Left frames held back while waiting for a right one; beyond, the oldest is decided as if the
 #: recording had ended (a right topic that stopped must not make the reader hold the whole bag).
+#: Right frames beyond this many without a left one are dropped, oldest first.
 MAX_WAITING = 64
 
 # ROS encoding -> (channels, bytes per channel, OpenCV conversion to BGR or None). ROS names a
@@ -694,6 +695,9 @@ class BagCamera(PairSource):
                 self.dropped["right"] += 1
             sr, mr = rights.popleft()
             yield sl, ml, sr, mr
+        while len(rights) > MAX_WAITING:  # a left topic that stopped: keep the newest only
+            rights.popleft()
+            self.dropped["right"] += 1
 
     def _pair_iter(self) -> Iterator[tuple[int, Any, int, Any]]:
         lefts: deque[tuple[int, Any]] = deque()
