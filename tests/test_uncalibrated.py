@@ -333,3 +333,16 @@ def test_depth_map_takes_the_homographies(data_dir: Path) -> None:
     np.testing.assert_array_equal(res.disparity, want.disparity)
     with pytest.raises(ValueError, match="this rectification is for 320x240"):
         sv.depth_map(left[:100], right[:100], rect)
+
+
+def test_a_folding_homography_is_refused(data_dir: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A homography whose horizon crosses the image would fold it onto itself: refused (forced
+    here by a shear step that puts the horizon through the middle of the image)."""
+    import stereovision.uncalibrated as unc
+
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    w = sc.left.shape[1]
+    fold = np.array([[1.0, 0, 0], [0, 1, 0], [-2.0 / w, 0, 1]])
+    monkeypatch.setattr(unc, "_shear", lambda *a: fold)
+    with pytest.raises(ValueError, match="folded across the horizon"):
+        rectify_uncalibrated(sc.left, sc.right)

@@ -523,6 +523,14 @@ def rectify_uncalibrated(
     if ex_[0] <= o[0]:
         raise ValueError("the rectified right image would be mirrored: are left and right swapped?")
     h1, h2 = _shear(h1, w, h) @ h1, _shear(h2, w, h) @ h2
+    corners = np.column_stack([_corners(w, h), np.ones(4)])
+    for name, hom in (("left", h1), ("right", h2)):
+        depth = corners @ hom[2]  # the homogeneous scale of each corner
+        if not (np.all(depth > 0) or np.all(depth < 0)):
+            raise ValueError(
+                f"the {name} image would be folded across the horizon (its epipole lies too "
+                "close to it): the views differ too much for a rectification by homographies"
+            )
     # One scale for both: the matched part of the left image keeps its area. The output holds
     # the rows and columns of the matched part and a margin, within the images: an image whose
     # epipole lies near it is stretched without bound towards the epipole, where nothing is
