@@ -41,10 +41,21 @@ def test_bag_holds_the_results_values(kitti: tuple, tmp_path: Path) -> None:
     with BagWriter(tmp_path / "run") as bag:
         bag.write(res, 1_700_000_000_123_456_789)
         bag.write(lean, 1_700_000_000_223_456_789)
-    assert bag.messages == 8
+    assert bag.messages == 10
     topics = _read(tmp_path / "run")
-    assert sorted(topics) == ["/stereo/depth", "/stereo/left/camera_info",
+    assert sorted(topics) == ["/stereo/depth", "/stereo/disparity", "/stereo/left/camera_info",
                               "/stereo/left/image_rect_color", "/stereo/points"]  # fmt: skip
+    # stereo_image_proc's disparity: Z = f t / d, -1 (below min_disparity) where none
+    disp = topics["/stereo/disparity"][0][1]
+    assert disp.f == pytest.approx(res.calibration.focal_px)
+    assert disp.t == pytest.approx(res.calibration.baseline_m)
+    dimg = np.frombuffer(disp.image.data.tobytes(), "<f4").reshape(disp.image.height,
+                                                                   disp.image.width)  # fmt: skip
+    valid = dimg >= disp.min_disparity
+    np.testing.assert_array_equal(valid, np.isfinite(res.disparity))
+    z = disp.f * disp.t / dimg[valid]
+    np.testing.assert_allclose(z, res.depth[valid], rtol=1e-5)  # the depth image's values
+    assert disp.max_disparity == res.max_disparity and disp.delta_d == 1 / 16
     stamp, depth = topics["/stereo/depth"][0]
     assert stamp == 1_700_000_000_123_456_789
     assert depth.header.stamp.sec == 1_700_000_000 and depth.header.stamp.nanosec == 123_456_789

@@ -363,5 +363,6 @@ def test_stream_records_a_ros2_bag(data_dir: Path, tmp_path: Path) -> None:
     with Reader(bag) as reader:
         counts = {c.topic: c.msgcount for c in reader.connections}
     assert counts == {"/stereo/left/image_rect_color": 3, "/stereo/left/camera_info": 3,
-                      "/stereo/depth": 3, "/stereo/points": 3}  # fmt: skip
+                      "/stereo/depth": 3, "/stereo/disparity": 3,
+                      "/stereo/points": 3}  # fmt: skip
     assert main(["stream", *src, "--no-display", "--bag", str(tmp_path / "b2")]) == 2

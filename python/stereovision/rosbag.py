@@ -10,6 +10,8 @@ topic (``prefix`` = ``/stereo``)  type                         content
 ``left/image_rect_color``         ``sensor_msgs/Image``        the rectified left image, ``bgr8``
 ``left/camera_info``              ``sensor_msgs/CameraInfo``   the rectified left camera (``P``)
 ``depth``                         ``sensor_msgs/Image``        ``32FC1`` metres, NaN where none
+``disparity``                     ``stereo_msgs/Disparity...`` as ``stereo_image_proc``: ``f``,
+                                                               ``t``, ``d + doffs``, -1 where none
 ``points``                        ``sensor_msgs/PointCloud2``  ``x y z`` (float32) and ``rgb``
 ``scan`` (when given)             ``sensor_msgs/LaserScan``    the obstacles on the floor,
                                                                in ``scan_frame_id``
@@ -238,6 +240,36 @@ ros2_static_transform>`.
             is_dense=True,
         )
 
+    def _disparity(self, header: Any, result: Any) -> Any:
+        """``stereo_msgs/DisparityImage`` as ``stereo_image_proc`` publishes it: ``Z = f t / d``,
+        so ``d`` is the disparity plus the rig's ``doffs`` (0 for a rig rectified by OpenCV);
+        a pixel without one is below ``min_disparity`` (-1: ROS's readers test ``d <
+        min_disparity``, which NaN would pass)."""
+        t = self._types.types
+        cal = result.calibration
+        d = np.asarray(result.disparity, np.float32) + np.float32(cal.doffs_px)
+        known = np.isfinite(d)
+        lo = float(cal.doffs_px + result.min_disparity)
+        d = np.where(known, d, np.float32(lo - 1.0)).astype(np.float32)
+        rows, cols = np.nonzero(known)
+        roi = t["sensor_msgs/msg/RegionOfInterest"](
+            x_offset=int(cols.min()) if cols.size else 0,
+            y_offset=int(rows.min()) if rows.size else 0,
+            height=int(rows.max() - rows.min() + 1) if rows.size else 0,
+            width=int(cols.max() - cols.min() + 1) if cols.size else 0,
+            do_rectify=False,
+        )
+        return t["stereo_msgs/msg/DisparityImage"](
+            header=header,
+            image=self._image(header, d, "32FC1"),
+            f=float(cal.focal_px),
+            t=float(cal.baseline_m),
+            valid_window=roi,
+            min_disparity=lo,
+            max_disparity=float(cal.doffs_px + result.max_disparity),
+            delta_d=1.0 / 16,  # the floating map is finer; stereo_image_proc's SGBM step
+        )
+
     def _scan(self, stamp_ns: int, scan: Any) -> Any:
         t = self._types.types
         stamp = t["builtin_interfaces/msg/Time"](
@@ -291,6 +323,12 @@ ros2_static_transform>`.
         )
         depth = np.asarray(result.depth, np.float32)
         self._put("depth", "sensor_msgs/msg/Image", self._image(header, depth, "32FC1"), stamp)
+        self._put(
+            "disparity",
+            "stereo_msgs/msg/DisparityImage",
+            self._disparity(header, result),
+            stamp,
+        )
         if self.points:
             self._put("points", "sensor_msgs/msg/PointCloud2", self._cloud(header, result), stamp)
         if scan is not None:
