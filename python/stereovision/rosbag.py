@@ -4,26 +4,30 @@
 ``depth_image_proc`` publish (REP 118 for depth images), stamped with the frame's time and in the
 left rectified camera's optical frame (X right, Y down, Z forward: this package's frame):
 
-================================  ===========================  ==================================
-topic (``prefix`` = ``/stereo``)  type                         content
-================================  ===========================  ==================================
-``left/image_rect_color``         ``sensor_msgs/Image``        the rectified left image, ``bgr8``
-``left/camera_info``              ``sensor_msgs/CameraInfo``   the rectified left camera (``P``)
-``depth``                         ``sensor_msgs/Image``        ``32FC1`` metres, NaN where none
-``disparity``                     ``stereo_msgs/Disparity...`` as ``stereo_image_proc``: ``f``,
-                                                               ``t``, ``d + doffs``, -1 where none
-``points``                        ``sensor_msgs/PointCloud2``  ``x y z`` (float32) and ``rgb``
-``scan`` (when given)             ``sensor_msgs/LaserScan``    the obstacles on the floor,
-                                                               in ``scan_frame_id``
-================================  ===========================  ==================================
+================================  ================================  ===============================
+topic (``prefix`` = ``/stereo``)  type                              content
+================================  ================================  ===============================
+``left/image_rect_color``         ``sensor_msgs/Image``             the rectified left image,
+                                                                    ``bgr8``
+``left/camera_info``              ``sensor_msgs/CameraInfo``        the rectified left camera
+                                                                    (``P``)
+``depth``                         ``sensor_msgs/Image``             ``32FC1`` metres, NaN where
+                                                                    none
+``disparity``                     ``stereo_msgs/DisparityImage``    as ``stereo_image_proc``:
+                                                                    ``Z = f t / d``, below
+                                                                    ``min_disparity`` where none
+``points``                        ``sensor_msgs/PointCloud2``       ``x y z`` (float32), ``rgb``
+``scan`` (when given)             ``sensor_msgs/LaserScan``         the obstacles on the floor,
+                                                                    in ``scan_frame_id``
+================================  ================================  ===============================
 
 The bag is written with the pure-Python ``rosbags`` library (``pip install rosbags``, or the
 ``ros`` extra), as a ROS 2 bag (sqlite3, CDR) that ``ros2 bag play`` reads.
 
-:class:`BagCamera` goes the other way: it reads a recorded rig -- a ROS 1 bag, or a ROS 2 bag
-(sqlite3 or MCAP) -- as synchronised pairs, with the same interface as
-:class:`~stereovision.capture.StereoCamera`, so ``stream``, ``capture`` (and through it
-``calibrate``) run on a recording as on live cameras:
+:class:`BagCamera` goes the other way: it reads a recorded rig -- a ROS 1 bag (or a folder of
+them, split), or a ROS 2 bag (sqlite3 or MCAP) -- as synchronised pairs, with the same interface
+as :class:`~stereovision.capture.StereoCamera`, so ``stream``, ``capture``, ``calibrate`` and
+``gui`` run on a recording as on live cameras (``--from-bag``):
 
 - **Topics.** The left and right image topics (``sensor_msgs/Image`` or ``CompressedImage``) are
   given, or found: two image topics whose names differ in one part, ``left``/``right`` or a
