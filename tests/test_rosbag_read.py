@@ -563,6 +563,8 @@ def test_cli_source_errors(
          "a bag is read as recorded"),
         (("stream", "--from-bag", str(bag), "--no-display", "--bag", str(tmp_path / "o")),
          "--bag: a bag holds depth; give --calib"),
+        (("stream", "--left", "0", "--right", "1", "--realtime", "--no-display"),
+         "it goes with --from-bag"),
     ]:  # fmt: skip
         code, _out, err = run(*argv)
         assert code != 0 and msg in err, (argv, err)
@@ -666,3 +668,28 @@ def test_one_camera_stops(cones: Any, tmp_path: Path) -> None:
         assert len(list(cam.frames())) == 10
     assert cam.dropped == {"left": 0, "right": 90}
     assert max(held) <= rosbag.MAX_WAITING
+
+
+def test_realtime_playback_skips_what_a_slow_reader_misses(cones: Any, tmp_path: Path) -> None:
+    """``realtime``: pairs 100 ms apart, a reader that takes 250 ms per pair gets pairs 0, 2, 5,
+    7 and 9 (the newest whose time has come), 5 skipped; a fast reader (10 ms) gets all 10 and
+    waits out the rest of each period."""
+    frames = [(T0 + k * 100_000_000, cones.left, T0 + k * 100_000_000, cones.right)
+              for k in range(10)]  # fmt: skip
+    bag = write_bag(tmp_path / "rig", frames, encoding="png")
+    for work_s, want, slept in ((0.25, [0, 2, 5, 7, 9], 0.0), (0.01, list(range(10)), 0.81)):
+        now = [0.0]
+        waits: list[float] = []
+
+        def sleep(dt: float, now: list[float] = now, waits: list[float] = waits) -> None:
+            waits.append(dt)
+            now[0] += dt
+
+        with BagCamera(bag, realtime=True) as cam:
+            cam._clock, cam._sleep = (lambda now=now: now[0]), sleep
+            got = []
+            for f in cam.frames():
+                got.append(round((f.t_left * 1e9 - T0) / 100_000_000))
+                now[0] += work_s  # the matcher's time on this pair
+        assert got == want and cam.skipped == 10 - len(want)
+        assert sum(waits) == pytest.approx(slept, abs=1e-6)

@@ -442,7 +442,10 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
             right_topic=args.right_topic,
             max_skew_ms=args.max_skew_ms,
             size=size,
+            realtime=bool(getattr(args, "realtime", False)),
         )
+    if getattr(args, "realtime", False):
+        raise ValueError("--realtime plays a recording at its pace: it goes with --from-bag")
     if args.left_topic or args.right_topic or args.max_skew_ms is not None:
         raise ValueError("--left-topic, --right-topic and --max-skew-ms are for --from-bag")
     if args.left is None or args.right is None:

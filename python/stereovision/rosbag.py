@@ -56,6 +56,7 @@ import math
 import os
 import re
 import statistics
+import time
 from collections import deque
 from collections.abc import Iterator
 from pathlib import Path
@@ -599,6 +600,10 @@ class BagCamera(PairSource):
         (from the first :data:`PERIOD_SAMPLE` frames' stamps), so a frame pairs at most once.
     size : tuple of int or str, optional
         Resize the frames to ``(width, height)``. Default: as recorded.
+    realtime : bool
+        Play the recording at its own pace, as a live camera would deliver it: each read waits
+        for the next pair's time, and gives the newest pair whose time has come, skipping those
+        a slow reader missed (counted in :attr:`skipped`). Default: every pair, at once.
 
     Attributes
     ----------
@@ -610,6 +615,8 @@ class BagCamera(PairSource):
         Frames of each side that found no partner within ``max_skew_ms`` (so far).
     stamps_ns : list of int
         The left header stamp of every pair read, in order.
+    skipped : int
+        Pairs passed over by ``realtime`` playback because the reader was late for them.
 
     Raises
     ------
@@ -630,6 +637,7 @@ class BagCamera(PairSource):
         right_topic: str | None = None,
         max_skew_ms: float | None = None,
         size: tuple[int, int] | str | None = None,
+        realtime: bool = False,
     ) -> None:
         from stereovision.capture import parse_size
 
@@ -650,6 +658,12 @@ class BagCamera(PairSource):
         except Exception as exc:  # rosbags' errors name no common base class
             raise ValueError(f"{self.path} is not a readable ROS 1 or ROS 2 bag: {exc}") from None
         self._reader: Any = reader
+        self.realtime = bool(realtime)
+        self.skipped = 0
+        self._clock: Any = time.monotonic  # the wall clock and the wait (tests replace them)
+        self._sleep: Any = time.sleep
+        self._start: tuple[float, int] | None = None  # (wall time, stamp) of the first pair
+        self._peeked: deque[tuple[int, Any, int, Any]] = deque()
         try:
             self._setup(left_topic, right_topic, max_skew_ms)
         except BaseException:
@@ -780,7 +794,7 @@ class BagCamera(PairSource):
         """
         if self._reader is None:
             raise SourceError("the bag is closed")
-        nxt = next(self._pairs, None)
+        nxt = self._next_pair()
         if nxt is None:
             raise SourceError(
                 f"bag {self.path}: end of the recording after {self.count} pairs "
@@ -809,6 +823,28 @@ class BagCamera(PairSource):
         self.skews_ms.append(frame.skew_ms)
         self.stamps_ns.append(sl)
         return frame
+
+    def _next_pair(self) -> tuple[int, Any, int, Any] | None:
+        """The next pair; with ``realtime``, the newest whose time has come (waiting for it)."""
+        nxt = self._peeked.popleft() if self._peeked else next(self._pairs, None)
+        if not self.realtime or nxt is None:
+            return nxt
+        if self._start is None:
+            self._start = (self._clock(), nxt[0])
+            return nxt
+        wall0, stamp0 = self._start
+        due = stamp0 + (self._clock() - wall0) * 1e9  # the recording's time now
+        while nxt[0] <= due:
+            later = next(self._pairs, None)
+            if later is None or later[0] > due:
+                if later is not None:
+                    self._peeked.append(later)
+                break
+            nxt = later  # the camera would have overwritten it: a late reader misses it
+            self.skipped += 1
+        if nxt[0] > due:
+            self._sleep((nxt[0] - due) / 1e9)
+        return nxt
 
     def describe(self) -> str:
         """One line: the bag, its two topics with their size and rate, the pairing tolerance."""

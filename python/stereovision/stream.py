@@ -794,6 +794,14 @@ def cmd_stream(args: argparse.Namespace) -> int:
         if bag is not None:
             bag.close()  # a bag cut short by Ctrl-C or an error is still a valid bag
     summary = report.as_dict()
+    skipped = getattr(cam, "skipped", 0)
+    if skipped:
+        summary["skipped"] = skipped
+        print(
+            f"{skipped} recorded pairs skipped: the matcher was slower than the recording "
+            "(--realtime)",
+            file=log,
+        )
     if bag is not None:
         print(f"ROS 2 bag written to {bag.path} ({bag.messages} messages)", file=log)
     if args.json:
@@ -840,6 +848,12 @@ def add_cli(subparsers: Any) -> None:
         "--calib",
         help="calibration of the rig (YAML/JSON, Middlebury, KITTI, Kalibr, ROS folder); "
         "--from-bag: default the bag's camera_info",
+    )
+    p.add_argument(
+        "--realtime",
+        action="store_true",
+        help="--from-bag: play the recording at its own pace, skipping the pairs a slower "
+        "matcher would miss (as live cameras do)",
     )
     p.add_argument(
         "--rectification",
