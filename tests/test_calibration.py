@@ -597,3 +597,29 @@ def test_depth_step_and_describe() -> None:
     assert "farthest depth, at a disparity of 1 px: 50.00 m" in text
     raw = raw_calib().describe()
     assert "raw rig, rectified with alpha 0" in raw and "baseline 12.0 cm" in raw
+
+
+def test_a_rig_on_paper(data_dir: Path) -> None:
+    """``Calibration.ideal``: KITTI's image size, field of view and baseline give back its focal
+    length and depth steps; ``info --size --hfov --baseline`` prints them."""
+    import math
+    import subprocess
+    import sys
+
+    kitti = Calibration.from_file(data_dir / "kitti2015" / "000005_10" / "calib.txt")
+    w, h = kitti.image_size
+    hfov = math.degrees(2 * math.atan(w / (2 * kitti.focal_px)))
+    paper = Calibration.ideal((w, h), hfov, kitti.baseline_m)
+    assert paper.rectified and paper.focal_px == pytest.approx(kitti.focal_px, rel=1e-12)
+    np.testing.assert_allclose(paper.depth_step([1.0, 5.0, 20.0]),
+                               kitti.depth_step([1.0, 5.0, 20.0]), rtol=1e-9)  # fmt: skip
+    for bad in ((0.0, 0.1), (180.0, 0.1), (90.0, 0.0), (True, 0.1), (90.0, float("nan"))):
+        with pytest.raises(ValueError, match=r"hfov_deg|baseline_m"):
+            Calibration.ideal((640, 480), *bad)
+    cli = [sys.executable, "-m", "stereovision.cli", "info"]
+    run = subprocess.run([*cli, "--size", "1280x720", "--hfov", "90", "--baseline", "0.12"],
+                         capture_output=True, text=True, timeout=60)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert "a rig on paper" in run.stdout and "focal length 640.0 px" in run.stdout
+    run = subprocess.run([*cli, "--size", "1280x720"], capture_output=True, text=True, timeout=60)
+    assert run.returncode == 2 and "a rig on paper: --size, --hfov and --baseline" in run.stderr

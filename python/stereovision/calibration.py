@@ -1001,6 +1001,46 @@ class Calibration:
     # ------------------------------------------------------------------ dataset formats
 
     @classmethod
+    def ideal(cls, image_size: tuple[int, int], hfov_deg: float, baseline_m: float) -> Calibration:
+        """A rig on paper: two identical pinhole cameras side by side, already rectified, of
+        this image size, horizontal field of view and baseline (square pixels, principal points
+        at the centres). To compare rig designs before buying cameras
+        (``stereovision info --size 1280x720 --hfov 90 --baseline 0.12``).
+
+        Raises
+        ------
+        ValueError
+            For a size that is not two positive integers, a field of view outside (0, 180)
+            degrees, or a baseline that is not a positive number of metres.
+        """
+        size = cls._check_size(image_size)
+        numbers = (int, float, np.integer, np.floating)
+        if isinstance(hfov_deg, bool) or not (isinstance(hfov_deg, numbers) and 0 < hfov_deg < 180):
+            raise ValueError(
+                f"hfov_deg: expected a field of view in (0, 180) degrees, got {hfov_deg!r}"
+            )
+        if isinstance(baseline_m, bool) or not (
+            isinstance(baseline_m, numbers) and math.isfinite(baseline_m) and baseline_m > 0
+        ):
+            raise ValueError(
+                f"baseline_m: expected a positive number of metres, got {baseline_m!r}"
+            )
+        w, h = size
+        f = w / (2 * math.tan(math.radians(hfov_deg) / 2))
+        k = np.array([[f, 0, (w - 1) / 2], [0, f, (h - 1) / 2], [0, 0, 1.0]])
+        return cls(
+            K1=k,
+            D1=np.zeros(5),
+            K2=k.copy(),
+            D2=np.zeros(5),
+            R=np.eye(3),
+            T=np.array([-float(baseline_m), 0.0, 0.0]),
+            image_size=size,
+            unit="m",
+            rectified=True,
+        )
+
+    @classmethod
     def from_middlebury(cls, calib_txt: PathLike) -> Calibration:
         """Rectified calibration from a Middlebury ``calib.txt``.
 

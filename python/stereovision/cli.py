@@ -404,6 +404,22 @@ def cmd_info(args: argparse.Namespace) -> int:
     measure."""
     from stereovision.rosbag import is_bag
 
+    design = (args.size, args.hfov, args.baseline)
+    if args.calib is None:
+        if None in design:
+            raise CliError(
+                "give a calibration (or a bag), or a rig on paper: --size, --hfov and --baseline"
+            )
+        from stereovision.calibration import Calibration
+        from stereovision.capture import parse_size
+
+        size = parse_size(args.size)
+        assert size is not None
+        print("a rig on paper (two ideal cameras, rectified):")
+        print(Calibration.ideal(size, args.hfov, args.baseline).describe())
+        return 0
+    if design != (None, None, None):
+        raise CliError("--size, --hfov and --baseline describe a rig on paper: give no calibration")
     if not is_bag(args.calib):
         print(_load_calibration(args.calib).describe())
         return 0
@@ -750,7 +766,14 @@ def build_parser() -> argparse.ArgumentParser:
         "info",
         help="what a calibrated rig can measure: field of view, depth range and resolution",
     )
-    d.add_argument("calib", help="calibration file, ROS camera_info folder, or a ROS 1 / ROS 2 bag")
+    d.add_argument(
+        "calib",
+        nargs="?",
+        help="calibration file, ROS camera_info folder, or a ROS 1 / ROS 2 bag",
+    )
+    d.add_argument("--size", metavar="WxH", help="a rig on paper: image size, e.g. 1280x720")
+    d.add_argument("--hfov", type=float, metavar="DEG", help="a rig on paper: horizontal FOV")
+    d.add_argument("--baseline", type=float, metavar="M", help="a rig on paper: baseline (m)")
     d.set_defaults(func=cmd_info)
 
     d = sub.add_parser("eval", help="evaluate against ground truth, OpenCV beside")
