@@ -177,6 +177,19 @@ class PairSource:
     A subclass provides :meth:`read`, :meth:`close` and the list ``skews_ms``."""
 
     skews_ms: list[float]
+    delivered_size: dict[str, tuple[int, int]]
+    delivered_fps: dict[str, float]
+
+    def _delivered(self, names: dict[str, str]) -> str:
+        """``left NAME: WxH @ F fps; right ...``: what each side delivered."""
+        parts = []
+        for side in ("left", "right"):
+            d = self.delivered_size.get(side)
+            got = f"{d[0]}x{d[1]}" if d else "?"
+            parts.append(
+                f"{side} {names[side]}: {got} @ {self.delivered_fps.get(side, 0.0):.3g} fps"
+            )
+        return "; ".join(parts)
 
     def read(self) -> StereoFrame:
         """The next pair (:class:`SourceError` at the end)."""
@@ -372,17 +385,10 @@ class StereoCamera(PairSource):
 
     def describe(self) -> str:
         """One line: requested vs delivered size and fps of each source."""
-        parts = []
-        for side in ("left", "right"):
-            d = self.delivered_size.get(side)
-            got = f"{d[0]}x{d[1]}" if d else "?"
-            parts.append(
-                f"{side} {_describe_source(self.sources[side])}: {got} "
-                f"@ {self.delivered_fps.get(side, 0.0):g} fps"
-            )
         req = self.requested_size
         asked = f"asked {req[0]}x{req[1]}" if req else "native size"
-        return f"{asked}; " + "; ".join(parts)
+        names = {side: _describe_source(src) for side, src in self.sources.items()}
+        return f"{asked}; " + self._delivered(names)
 
     def close(self) -> None:
         """Release both sources (idempotent)."""

@@ -848,16 +848,9 @@ class BagCamera(PairSource):
 
     def describe(self) -> str:
         """One line: the bag, its two topics with their size and rate, the pairing tolerance."""
-        parts = []
-        for side in ("left", "right"):
-            d = self.delivered_size.get(side)
-            got = f"{d[0]}x{d[1]}" if d else "?"
-            parts.append(
-                f"{side} {self.topics[side]}: {got} @ {self.delivered_fps.get(side, 0.0):.3g} fps"
-            )
         tol = self.max_skew_ms
         skew = "max skew: auto" if tol is None else f"max skew {tol:.3g} ms"
-        return f"bag {self.path}; " + "; ".join(parts) + f"; {skew}"
+        return f"bag {self.path}; " + self._delivered(self.topics) + f"; {skew}"
 
     def summary(self) -> str:
         """The bag's topics (type, messages, rate), which are the left and right images and
