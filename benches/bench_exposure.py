@@ -1,0 +1,56 @@
+"""Cameras that expose differently: the right image darker, or with another gamma and black
+level, on every GT scene (docs/robotics.md, "Cameras that expose differently"). One run.
+
+Two robot cameras with their own auto-exposure rarely agree. For each scene the right image is
+made 0.6 times as bright, or given a gamma of 0.7 and a black level of +15 (of 255), and the
+default depth map's bad-2.0 is measured beside OpenCV SGBM-3WAY followed by evaluation.md's row
+fill, on the same pair.
+
+Usage: ``python benches/bench_exposure.py [--scenes S ...]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from _common import DATA, gt_scenes
+
+import stereovision as sv
+from stereovision.baselines import opencv_sgbm, row_fill
+from stereovision.evaluate import dense_metrics
+from stereovision.io import load_scene
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from tests.test_exposure import expose
+
+#: ``(gain, gamma, offset)`` of each case, applied as ``255 (gain x)^gamma + offset``.
+CASES = {"as given": None, "0.6 x darker": (0.6, 1.0, 0.0), "gamma 0.7, +15": (1.0, 0.7, 15.0)}
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--scenes", nargs="*", help="family/scene names (default: every GT scene)")
+    args = ap.parse_args()
+    print("| scene | " + " | ".join(f"{c}: ours / SGBM-3WAY + fill" for c in CASES) + " |")
+    print("|---" * (len(CASES) + 1) + "|")
+    worst = {c: [0.0, 0.0] for c in CASES}
+    for name in args.scenes or gt_scenes():
+        sc = load_scene(DATA / name)
+        cells = []
+        for case, p in CASES.items():
+            right = sc.right if p is None else expose(sc.right, *p)
+            res = sv.depth_map(sc.left, right, max_disparity=sc.max_disparity)
+            ours = dense_metrics(res.disparity, sc.gt).bad[2.0]
+            theirs = dense_metrics(row_fill(opencv_sgbm(sc.left, right, sc.max_disparity)),
+                                   sc.gt).bad[2.0]  # fmt: skip
+            cells.append(f"{ours:.2f} / {theirs:.2f}")
+            worst[case] = [max(worst[case][0], ours), max(worst[case][1], theirs)]
+        print(f"| {name} | " + " | ".join(cells) + " |", flush=True)
+    for case, (a, b) in worst.items():
+        print(f"{case}: worst scene ours {a:.2f} %, SGBM-3WAY + fill {b:.2f} %")
+
+
+if __name__ == "__main__":
+    main()
