@@ -1,10 +1,11 @@
-"""Cameras that expose differently: the right image darker, or with another gamma and black
-level, on every GT scene (docs/robotics.md, "Cameras that expose differently"). One run.
+"""Cameras that expose differently, and noisy cameras: on every GT scene (docs/robotics.md,
+"Cameras that expose differently"). One run.
 
 Two robot cameras with their own auto-exposure rarely agree. For each scene the right image is
-made 0.6 times as bright, or given a gamma of 0.7 and a black level of +15 (of 255), and the
-default depth map's bad-2.0 is measured beside OpenCV SGBM-3WAY followed by evaluation.md's row
-fill, on the same pair.
+made 0.6 times as bright, or given a gamma of 0.7 and a black level of +15 (of 255); then both
+images get Gaussian noise of 8 grey levels (a camera in low light; seeded). The default depth
+map's bad-2.0 is measured beside OpenCV SGBM-3WAY followed by evaluation.md's row fill, on the
+same pair.
 
 Usage: ``python benches/bench_exposure.py [--scenes S ...]``
 """
@@ -14,7 +15,9 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+from typing import Any
 
+import numpy as np
 from _common import DATA, gt_scenes
 
 import stereovision as sv
@@ -26,7 +29,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from tests.test_exposure import expose
 
 #: ``(gain, gamma, offset)`` of each case, applied as ``255 (gain x)^gamma + offset``.
-CASES = {"as given": None, "0.6 x darker": (0.6, 1.0, 0.0), "gamma 0.7, +15": (1.0, 0.7, 15.0)}
+CASES: dict[str, Any] = {
+    "as given": None,
+    "0.6 x darker": (0.6, 1.0, 0.0),
+    "gamma 0.7, +15": (1.0, 0.7, 15.0),
+    "noise 8": "noise",
+}
+#: Standard deviation (grey levels) of the noise case.
+NOISE = 8.0
 
 
 def main() -> None:
@@ -40,10 +50,18 @@ def main() -> None:
         sc = load_scene(DATA / name)
         cells = []
         for case, p in CASES.items():
-            right = sc.right if p is None else expose(sc.right, *p)
-            res = sv.depth_map(sc.left, right, max_disparity=sc.max_disparity)
+            left, right = sc.left, sc.right
+            if p == "noise":
+                rng = np.random.default_rng(0)
+                left, right = (
+                    np.clip(i + rng.normal(0, NOISE, i.shape), 0, 255).astype(np.uint8)
+                    for i in (left, right)
+                )
+            elif p is not None:
+                right = expose(right, *p)
+            res = sv.depth_map(left, right, max_disparity=sc.max_disparity)
             ours = dense_metrics(res.disparity, sc.gt).bad[2.0]
-            theirs = dense_metrics(row_fill(opencv_sgbm(sc.left, right, sc.max_disparity)),
+            theirs = dense_metrics(row_fill(opencv_sgbm(left, right, sc.max_disparity)),
                                    sc.gt).bad[2.0]  # fmt: skip
             cells.append(f"{ours:.2f} / {theirs:.2f}")
             worst[case] = [max(worst[case][0], ours), max(worst[case][1], theirs)]
