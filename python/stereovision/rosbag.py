@@ -209,12 +209,12 @@ ros2_static_transform>`.
             roi=roi,
         )
 
-    def _cloud(self, header: Any, result: Any) -> Any:
+    def _cloud(self, header: Any, result: Any, grid: Any) -> Any:
         t = self._types.types
         pts = np.asarray(result.points, np.float32).reshape(-1, 3)
         colors = np.asarray(result.colors, np.uint8).reshape(-1, 3)
         if len(pts) == 0:  # computed with cloud=False (stream): the cloud from the depth map
-            grid = result.calibration.reproject(result.disparity)
+            grid = grid()
             keep = np.isfinite(result.depth)
             pts = np.asarray(grid[keep], np.float32)
             colors = np.zeros((len(pts), 3), np.uint8)
@@ -295,10 +295,12 @@ ros2_static_transform>`.
 
     # --------------------------------------------------------------------------------- API
 
-    def write(self, result: Any, stamp_ns: int, *, scan: Any = None) -> None:
+    def write(self, result: Any, stamp_ns: int, *, scan: Any = None, ground: Any = None) -> None:
         """Write one depth result (:class:`~stereovision.depth.DepthResult` with a calibration)
         stamped ``stamp_ns`` nanoseconds (the frame's time), and its
-        :class:`~stereovision.ground.LaserScan` when given.
+        :class:`~stereovision.ground.LaserScan`: ``scan`` when given, else the scan of the
+        obstacles on ``ground`` (a :class:`~stereovision.ground.GroundPlane`), from the same
+        reprojection of the depth map as the cloud.
 
         Raises
         ------
@@ -334,8 +336,20 @@ ros2_static_transform>`.
             self._disparity(header, result),
             stamp,
         )
+        memo: list[Any] = []
+
+        def grid() -> Any:  # the depth map's points, reprojected once for the cloud and scan
+            if not memo:
+                memo.append(result.calibration.reproject(result.disparity))
+            return memo[0]
+
         if self.points:
-            self._put("points", "sensor_msgs/msg/PointCloud2", self._cloud(header, result), stamp)
+            cloud = self._cloud(header, result, grid)
+            self._put("points", "sensor_msgs/msg/PointCloud2", cloud, stamp)
+        if scan is None and ground is not None:
+            from stereovision.ground import laser_scan
+
+            scan = laser_scan(grid(), ground, result.calibration)
         if scan is not None:
             self._put("scan", "sensor_msgs/msg/LaserScan", self._scan(stamp, scan), stamp)
 

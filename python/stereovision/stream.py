@@ -750,13 +750,8 @@ def cmd_stream(args: argparse.Namespace) -> int:
             writer = bag
 
             def to_bag(left: np.ndarray, res: Any) -> None:
-                scan = None
-                if floor[0] is not None:  # with --ground-every: the obstacles as a LaserScan
-                    from stereovision.ground import laser_scan
-
-                    rc = res.calibration
-                    scan = laser_scan(rc.reproject(res.disparity), floor[0], rc)
-                writer.write(res, stamps(), scan=scan)
+                # with --ground-every: the obstacles on the latest floor as a LaserScan
+                writer.write(res, stamps(), ground=floor[0])
 
             sinks.append(to_bag)
 
