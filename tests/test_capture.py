@@ -23,7 +23,9 @@ from stereovision.capture import (
     capture,
     charuco_pose_params,
     detect_board_live,
+    fourcc_text,
     next_pair_index,
+    parse_fourcc,
     parse_size,
     parse_source,
     save_pair,
@@ -187,6 +189,72 @@ def test_grab_both_then_retrieve_both() -> None:
     cam.read()
     assert log == ["L.grab", "R.grab", "L.retrieve", "R.retrieve"]
     cam.close()
+
+
+class _FormatCap(_FakeCap):
+    """A webcam stand-in with V4L2's habit: it offers sizes per pixel format, so it logs each
+    property set in order and keeps the format only if it has it."""
+
+    def __init__(self, name: str, log: list[str], formats: tuple[str, ...]) -> None:
+        super().__init__(name, log)
+        self.formats = formats
+        self.fourcc = cv2.VideoWriter.fourcc(*formats[0])
+
+    def get(self, prop: int) -> float:
+        return float(self.fourcc) if prop == cv2.CAP_PROP_FOURCC else super().get(prop)
+
+    def set(self, prop: int, value: float) -> bool:
+        self.log.append(f"{self.name}.set {prop}")
+        if prop == cv2.CAP_PROP_FOURCC and fourcc_text(value) in self.formats:
+            self.fourcc = int(value)
+            return True
+        return False
+
+
+def test_pixel_format_asked_first_and_reported() -> None:
+    log: list[str] = []
+    caps = [_FormatCap(n, log, ("YUYV", "MJPG")) for n in "LR"]
+    cam = StereoCamera(*caps, size=(320, 240), fps=30, fourcc="MJPG")
+    # The format before the size and the rate (the camera's sizes depend on it), for each side.
+    assert log == [
+        f"{n}.set {p}"
+        for n in "LR"
+        for p in (cv2.CAP_PROP_FOURCC, cv2.CAP_PROP_FRAME_WIDTH, cv2.CAP_PROP_FRAME_HEIGHT,
+                  cv2.CAP_PROP_FPS)
+    ]  # fmt: skip
+    assert cam.delivered_fourcc == {"left": "MJPG", "right": "MJPG"}
+    assert cam.describe().startswith("asked 320x240 MJPG;")
+    assert cam.describe().endswith("format left MJPG, right MJPG")
+    cam.close()
+    # Not asked: nothing set, the camera's own format reported.
+    log.clear()
+    cam = StereoCamera(*(_FormatCap(n, log, ("YUYV",)) for n in "LR"))
+    assert log == [] and cam.delivered_fourcc == {"left": "YUYV", "right": "YUYV"}
+    cam.close()
+
+
+def test_pixel_format_refused_is_named() -> None:
+    log: list[str] = []
+    caps = [_FormatCap("L", log, ("YUYV", "MJPG")), _FormatCap("R", log, ("YUYV",))]
+    with pytest.warns(UserWarning, match=r"right source .* delivers 'YUYV', not 'MJPG'") as rec:
+        cam = StereoCamera(*caps, fourcc="MJPG")
+    assert len(rec) == 1 and cam.delivered_fourcc == {"left": "MJPG", "right": "YUYV"}
+    cam.close()
+    with pytest.warns(UserWarning, match="delivers no reported format, not 'YUYV'"):
+        StereoCamera(_FakeCap("L", log), _FakeCap("R", log), fourcc="YUYV").close()
+
+
+def test_fourcc_codes() -> None:
+    assert parse_fourcc(None) is None and parse_fourcc("Y800") == "Y800"
+    for bad in ("MJPEG", "YUV", "", "MJ\tG", 1196444237):
+        with pytest.raises(ValueError, match="four characters such as 'MJPG'"):
+            parse_fourcc(bad)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="fourcc"):
+        StereoCamera(_FakeCap("L", []), _FakeCap("R", []), fourcc="mjpeg")
+    assert fourcc_text(cv2.VideoWriter.fourcc(*"YUYV")) == "YUYV"
+    assert fourcc_text(1196444237.0) == "MJPG"  # what OpenCV reports for a V4L2 MJPG stream
+    assert fourcc_text(0.0) == fourcc_text(-1.0) == fourcc_text(float("nan")) == ""
+    assert fourcc_text(7.0) == ""  # unprintable bytes are not a format
 
 
 def test_resolution_request_and_resize_warning(tmp_path: Path) -> None:
@@ -530,3 +598,7 @@ def test_cli_capture(
         run(*src, "--charuco", "10x7", "--square", "3", "--marker", "4")
     with pytest.raises(SourceError, match="after 6 pairs"):
         run("--left", str(left), "--right", str(right), "--count", "9", "-o", str(out))
+    with pytest.raises(ValueError, match="four characters"):
+        run(*src, "--fourcc", "MJPEG")
+    with pytest.raises(ValueError, match="--fourcc asks a camera for a format"):
+        run("--from-bag", str(tmp_path), "--fourcc", "MJPG", "-o", str(out))

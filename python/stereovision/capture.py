@@ -59,7 +59,9 @@ __all__ = [
     "add_cli",
     "add_source_args",
     "capture",
+    "fourcc_text",
     "open_source",
+    "parse_fourcc",
     "parse_size",
     "parse_source",
     "save_pair",
@@ -131,6 +133,28 @@ def parse_size(text: str | tuple[int, int] | None) -> tuple[int, int] | None:
 
 
 # ---------------------------------------------------------------------------------- camera
+
+
+def parse_fourcc(text: str | None) -> str | None:
+    """A pixel format's four-character code (``"MJPG"``, ``"YUYV"``), checked; None stays None.
+
+    Raises
+    ------
+    ValueError
+        If it is not four printable ASCII characters.
+    """
+    if text is None:
+        return None
+    if not (isinstance(text, str) and len(text) == 4 and all(" " <= c <= "~" for c in text)):
+        raise ValueError(f"fourcc: expected four characters such as 'MJPG' or 'YUYV', got {text!r}")
+    return text
+
+
+def fourcc_text(code: float) -> str:
+    """``CAP_PROP_FOURCC``'s number as its four characters (``""`` for 0 or unprintable)."""
+    n = int(code) if math.isfinite(code) and code > 0 else 0
+    text = "".join(chr((n >> (8 * k)) & 0xFF) for k in range(4))
+    return text if n and all(" " <= c <= "~" for c in text) else ""
 
 
 @dataclass
@@ -244,6 +268,13 @@ class StereoCamera(PairSource):
     fps : float, optional
         Requested frame rate (``CAP_PROP_FPS``); what the source reports is in
         :attr:`delivered_fps`.
+    fourcc : str, optional
+        Pixel format asked of the sources before the size and rate (``CAP_PROP_FOURCC``; with
+        V4L2 the format decides which sizes and rates a webcam offers): ``"YUYV"`` for
+        uncompressed frames, ``"MJPG"`` for the compressed stream that lets two webcams share
+        one USB bus at a higher size or rate. JPEG costs the matchers some accuracy
+        (docs/robotics.md, "Webcams: compressed or raw"). A source that delivers another
+        format gets one :class:`UserWarning`; what each delivers is in :attr:`delivered_fourcc`.
 
     Attributes
     ----------
@@ -254,6 +285,9 @@ class StereoCamera(PairSource):
         from the frames themselves.
     delivered_fps : dict of str to float
         ``CAP_PROP_FPS`` of each source after the request (0 when unknown).
+    delivered_fourcc : dict of str to str
+        ``CAP_PROP_FOURCC`` of each source after the request, as four characters (``""`` when
+        the source reports none; a video file reports its codec).
     skews_ms : list of float
         Grab skew of every pair read.
 
@@ -264,7 +298,7 @@ class StereoCamera(PairSource):
     SourceError
         If a source cannot be opened (the message names it).
     ValueError
-        If ``size`` or ``fps`` is invalid.
+        If ``size``, ``fps`` or ``fourcc`` is invalid.
     """
 
     def __init__(
@@ -274,11 +308,14 @@ class StereoCamera(PairSource):
         *,
         size: tuple[int, int] | str | None = None,
         fps: float | None = None,
+        fourcc: str | None = None,
     ) -> None:
         self.sources = {"left": left, "right": right}
         self.requested_size = parse_size(size)
         if fps is not None and not (math.isfinite(fps) and fps > 0):
             raise ValueError(f"fps: expected a positive number, got {fps!r}")
+        self.requested_fourcc = parse_fourcc(fourcc)
+        self.delivered_fourcc: dict[str, str] = {}
         self.size: tuple[int, int] | None = self.requested_size
         self.delivered_size: dict[str, tuple[int, int]] = {}
         self.delivered_fps: dict[str, float] = {}
@@ -306,6 +343,9 @@ class StereoCamera(PairSource):
         if not cap.isOpened():
             cap.release()
             raise SourceError(f"cannot open {side} source {_describe_source(src)}")
+        # The format first: V4L2 offers sizes and rates per format.
+        if self.requested_fourcc is not None:
+            cap.set(cv2.CAP_PROP_FOURCC, cv2.VideoWriter.fourcc(*self.requested_fourcc))
         if self.requested_size is not None:
             cap.set(cv2.CAP_PROP_FRAME_WIDTH, self.requested_size[0])
             cap.set(cv2.CAP_PROP_FRAME_HEIGHT, self.requested_size[1])
@@ -315,6 +355,15 @@ class StereoCamera(PairSource):
         w, h = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
         if w > 0 and h > 0:
             self.delivered_size[side] = (w, h)
+        got = fourcc_text(cap.get(cv2.CAP_PROP_FOURCC))
+        self.delivered_fourcc[side] = got
+        if self.requested_fourcc is not None and got != self.requested_fourcc:
+            warnings.warn(
+                f"{side} source {_describe_source(src)} delivers "
+                f"{repr(got) if got else 'no reported format'}, not {self.requested_fourcc!r}",
+                UserWarning,
+                stacklevel=3,
+            )
         return cap
 
     # -- reading
@@ -387,8 +436,12 @@ class StereoCamera(PairSource):
         """One line: requested vs delivered size and fps of each source."""
         req = self.requested_size
         asked = f"asked {req[0]}x{req[1]}" if req else "native size"
+        if self.requested_fourcc:
+            asked += f" {self.requested_fourcc}"
         names = {side: _describe_source(src) for side, src in self.sources.items()}
-        return f"{asked}; " + self._delivered(names)
+        out = f"{asked}; " + self._delivered(names)
+        formats = [f"{side} {f}" for side, f in self.delivered_fourcc.items() if f]
+        return out + (f"; format {', '.join(formats)}" if formats else "")
 
     def close(self) -> None:
         """Release both sources (idempotent)."""
@@ -423,6 +476,11 @@ def add_source_args(p: argparse.ArgumentParser) -> None:
     """The pair source options of ``capture`` and ``stream``: two cameras, or a ROS bag."""
     p.add_argument("--left", help="device index, video file or pattern (%%03d)")
     p.add_argument("--right", help="device index, video file or pattern")
+    p.add_argument(
+        "--fourcc",
+        help="pixel format asked of the cameras: YUYV (raw) or MJPG (compressed, more size/fps "
+        "over USB; costs some accuracy)",
+    )
     add_bag_args(p, "read the pairs from a recorded ROS 1 bag or ROS 2 bag folder instead")
 
 
@@ -440,6 +498,8 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
             raise ValueError("--from-bag replaces --left and --right: give one source")
         if fps is not None:
             raise ValueError("--fps: a bag is read as recorded, it has no frame rate to ask for")
+        if getattr(args, "fourcc", None):
+            raise ValueError("--fourcc asks a camera for a format: a bag holds what it recorded")
         from stereovision.rosbag import BagCamera
 
         return BagCamera(
@@ -456,7 +516,13 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
         raise ValueError("--left-topic, --right-topic and --max-skew-ms are for --from-bag")
     if args.left is None or args.right is None:
         raise ValueError("give the two cameras (--left and --right) or a recording (--from-bag)")
-    return StereoCamera(parse_source(args.left), parse_source(args.right), size=size, fps=fps)
+    return StereoCamera(
+        parse_source(args.left),
+        parse_source(args.right),
+        size=size,
+        fps=fps,
+        fourcc=getattr(args, "fourcc", None),
+    )
 
 
 # ---------------------------------------------------------------------------------- saving
