@@ -1,11 +1,11 @@
-"""Cameras that expose differently, and noisy cameras: on every GT scene (docs/robotics.md,
-"Cameras that expose differently"). One run.
+"""Cameras that expose differently, noisy cameras, webcams' JPEG: on every GT scene
+(docs/robotics.md, "Cameras that expose differently" and "Webcams: compressed or raw"). One run.
 
 Two robot cameras with their own auto-exposure rarely agree. For each scene the right image is
-made 0.6 times as bright, or given a gamma of 0.7 and a black level of +15 (of 255); then both
-images get Gaussian noise of 8 grey levels (a camera in low light; seeded). The default depth
-map's bad-2.0 is measured beside OpenCV SGBM-3WAY followed by evaluation.md's row fill, on the
-same pair.
+made 0.6 times as bright, or given a gamma of 0.7 and a black level of +15 (of 255); or both
+images get Gaussian noise of 8 grey levels (a camera in low light; seeded); or both go through
+JPEG at quality 90 or 75 (a webcam's MJPG stream). The default depth map's bad-2.0 is measured
+beside OpenCV SGBM-3WAY followed by evaluation.md's row fill, on the same pair.
 
 Usage: ``python benches/bench_exposure.py [--scenes S ...]``
 """
@@ -26,7 +26,7 @@ from stereovision.evaluate import dense_metrics
 from stereovision.io import load_scene
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from tests.test_exposure import expose
+from tests.test_exposure import expose, jpeg
 
 #: ``(gain, gamma, offset)`` of each case, applied as ``255 (gain x)^gamma + offset``.
 CASES: dict[str, Any] = {
@@ -34,6 +34,8 @@ CASES: dict[str, Any] = {
     "0.6 x darker": (0.6, 1.0, 0.0),
     "gamma 0.7, +15": (1.0, 0.7, 15.0),
     "noise 8": "noise",
+    "JPEG 90": ("jpeg", 90),
+    "JPEG 75": ("jpeg", 75),
 }
 #: Standard deviation (grey levels) of the noise case.
 NOISE = 8.0
@@ -57,6 +59,8 @@ def main() -> None:
                     np.clip(i + rng.normal(0, NOISE, i.shape), 0, 255).astype(np.uint8)
                     for i in (left, right)
                 )
+            elif isinstance(p, tuple) and p[0] == "jpeg":
+                left, right = jpeg(left, p[1]), jpeg(right, p[1])
             elif p is not None:
                 right = expose(right, *p)
             res = sv.depth_map(left, right, max_disparity=sc.max_disparity)
