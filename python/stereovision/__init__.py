@@ -18,6 +18,7 @@ from stereovision.ground import GroundPlane, LaserScan, fit_ground_plane, laser_
 from stereovision.match import match
 from stereovision.matches import Matches
 from stereovision.rectification_check import check_rectification, refine_rectification
+from stereovision.temporal import TemporalFilter
 from stereovision.triangulation import depth_from_disparity, triangulate
 
 __all__ = [
@@ -26,6 +27,7 @@ __all__ = [
     "GroundPlane",
     "LaserScan",
     "Matches",
+    "TemporalFilter",
     "__version__",
     "check_rectification",
     "depth_from_disparity",

@@ -236,6 +236,24 @@ def gray_u8(
     """Grey ``float32`` in ``[0, 1]`` of a C-contiguous ``(H, W)`` or ``(H, W, 1|3|4)`` uint8
     image (BGR order), bit-identical to ``as_gray_float``'s NumPy path."""
 
+def temporal_grey_difference(
+    frame: npt.NDArray[np.uint8], mean: npt.NDArray[np.float32]
+) -> npt.NDArray[np.float32]:
+    """``(H, W)`` grey value of ``frame - mean`` (channel weights B 0.114, G 0.587, R 0.299;
+    alpha 0), both C-contiguous ``(H, W)`` or ``(H, W, 1|3|4)``."""
+
+def temporal_running_mean(
+    frame: npt.NDArray[np.uint8],
+    mean: npt.NDArray[np.float32],
+    count: npt.NDArray[np.uint8],
+    diff: npt.NDArray[np.float32],
+    ks: float,
+    max_frames: int,
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
+    """``(mean, count, rounded mean)`` after one more frame: a pixel with ``|diff| <= ks
+    sqrt(1 + 1/count)`` keeps averaging (``count`` up to ``max_frames``), any other starts
+    again from the frame."""
+
 def release_memory() -> int:
     """Return the memory the extension keeps for the next call to the system; bytes released."""
 

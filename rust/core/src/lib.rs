@@ -8,6 +8,7 @@
 //! * [`refine`]: sub-pixel refinement and validated completion of a disparity map;
 //! * [`fill`]: the evaluation's reference row fill of a map's holes;
 //! * [`edges`]: foreground fattened past depth edges (the fused dense map's edge step);
+//! * [`temporal`]: a still rig's frames averaged over time (less sensor noise);
 //! * [`triangulation`]: depth and its uncertainty from a rectified disparity map.
 //!
 //! Conventions (algorithms.md section 0): images are `f32` in `[0, 1]`, row-major `(H, W)`;
@@ -24,6 +25,7 @@ pub mod parallel;
 pub mod refine;
 pub mod segment;
 pub(crate) mod simd;
+pub mod temporal;
 pub mod triangulation;
 
 pub use error::{CoreError, Result};

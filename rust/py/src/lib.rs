@@ -18,6 +18,7 @@ mod params;
 mod refine;
 mod segment;
 mod sgm;
+mod temporal;
 mod triangulation;
 
 /// Freed image-sized blocks are kept for the next call instead of being returned to the system
@@ -71,6 +72,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(segment::fill_planes, m)?)?;
     m.add_function(wrap_pyfunction!(segment::quantised_regions, m)?)?;
     m.add_function(wrap_pyfunction!(convert::gray_u8, m)?)?;
+    m.add_function(wrap_pyfunction!(temporal::temporal_grey_difference, m)?)?;
+    m.add_function(wrap_pyfunction!(temporal::temporal_running_mean, m)?)?;
     m.add_function(wrap_pyfunction!(release_memory, m)?)?;
     m.add_function(wrap_pyfunction!(kept_memory, m)?)?;
     Ok(())

@@ -1,0 +1,89 @@
+//! Binding of `stereovision_core::temporal`.
+
+use numpy::ndarray::{ArrayD, IxDyn};
+use numpy::{
+    IntoPyArray, PyArray2, PyArrayDyn, PyReadonlyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use stereovision_core::temporal::{grey_difference, running_mean};
+
+use crate::convert::{c_slice, u8_layout, vec_to_numpy};
+use crate::errors::guard;
+
+/// The mean's buffer, checked to have the frame's shape and to be C-contiguous.
+fn mean_slice<'a>(
+    mean: &'a PyReadonlyArrayDyn<'_, f32>,
+    frame_shape: &[usize],
+) -> PyResult<&'a [f32]> {
+    if mean.shape() != frame_shape {
+        return Err(PyValueError::new_err(format!(
+            "mean shape {:?} differs from the frame's {:?}",
+            mean.shape(),
+            frame_shape
+        )));
+    }
+    c_slice(mean).ok_or_else(|| PyValueError::new_err("mean must be C-contiguous"))
+}
+
+/// Grey value of `frame - mean` per pixel, `(H, W)` float32 (module docs of the core).
+#[pyfunction]
+pub fn temporal_grey_difference<'py>(
+    py: Python<'py>,
+    frame: PyReadonlyArrayDyn<'py, u8>,
+    mean: PyReadonlyArrayDyn<'py, f32>,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let (h, w, c, f) = u8_layout(&frame, "frame")?;
+    let m = mean_slice(&mean, frame.shape())?;
+    let d = py.detach(|| {
+        guard("temporal_grey_difference", || {
+            grey_difference(f, m, h * w, c)
+        })
+    })?;
+    vec_to_numpy(py, (h, w), d)
+}
+
+/// The running mean after one more frame: `(mean, count, rounded mean)`.
+#[pyfunction]
+#[pyo3(signature = (frame, mean, count, diff, ks, max_frames))]
+#[allow(clippy::type_complexity)]
+pub fn temporal_running_mean<'py>(
+    py: Python<'py>,
+    frame: PyReadonlyArrayDyn<'py, u8>,
+    mean: PyReadonlyArrayDyn<'py, f32>,
+    count: PyReadonlyArray2<'py, u8>,
+    diff: PyReadonlyArray2<'py, f32>,
+    ks: f32,
+    max_frames: u8,
+) -> PyResult<(
+    Bound<'py, PyArrayDyn<f32>>,
+    Bound<'py, PyArray2<u8>>,
+    Bound<'py, PyArrayDyn<u8>>,
+)> {
+    let (h, w, c, f) = u8_layout(&frame, "frame")?;
+    let shape = frame.shape().to_vec();
+    let m = mean_slice(&mean, &shape)?;
+    for (name, dims) in [("count", count.shape()), ("diff", diff.shape())] {
+        if dims != [h, w] {
+            return Err(PyValueError::new_err(format!(
+                "{name} shape {dims:?} differs from the frame's {:?}",
+                [h, w]
+            )));
+        }
+    }
+    let n = c_slice(&count).ok_or_else(|| PyValueError::new_err("count must be C-contiguous"))?;
+    let d = c_slice(&diff).ok_or_else(|| PyValueError::new_err("diff must be C-contiguous"))?;
+    let a = py.detach(|| {
+        guard("temporal_running_mean", || {
+            running_mean(f, m, n, d, c, ks, max_frames)
+        })
+    })?;
+    let to_err = |e: numpy::ndarray::ShapeError| PyValueError::new_err(e.to_string());
+    let mean_out = ArrayD::from_shape_vec(IxDyn(&shape), a.mean).map_err(to_err)?;
+    let out = ArrayD::from_shape_vec(IxDyn(&shape), a.out).map_err(to_err)?;
+    Ok((
+        mean_out.into_pyarray(py),
+        vec_to_numpy(py, (h, w), a.count)?,
+        out.into_pyarray(py),
+    ))
+}
