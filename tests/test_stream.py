@@ -366,3 +366,59 @@ def test_stream_records_a_ros2_bag(data_dir: Path, tmp_path: Path) -> None:
                       "/stereo/depth": 3, "/stereo/disparity": 3,
                       "/stereo/points": 3}  # fmt: skip
     assert main(["stream", *src, "--no-display", "--bag", str(tmp_path / "b2")]) == 2
+
+
+def test_stream_averages_a_still_noisy_rig(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Six PNG frames of the still scene with fresh noise each (8 grey levels): with --temporal
+    the matcher gets the running mean (1, 2, ... 6 frames), its noise down by more than half on
+    the last pair; the moving videos above restart on every pair and pass through."""
+    from stereovision.temporal import TemporalFilter
+
+    scene = data_dir / SCENE
+    rng = np.random.default_rng(0)
+    clean = {s: cv2.imread(str(scene / f"{s}.png")) for s in ("left", "right")}
+    for i in range(6):
+        for side, img in clean.items():
+            noisy = np.clip(img + rng.normal(0, 8.0, img.shape), 0, 255).astype(np.uint8)
+            cv2.imwrite(str(tmp_path / f"{side}_{i:02d}.png"), noisy)
+    calib = Calibration.from_file(scene / "calib.txt")
+    got: list[np.ndarray] = []
+    with StereoCamera(str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png")) as cam:
+        rep = run_stream(
+            cam,
+            calib,
+            max_disparity=64,
+            temporal=TemporalFilter(),
+            on_result=lambda left, res: got.append(left.copy()),
+        )
+    assert rep.frames == 6 and rep.temporal is not None
+    assert rep.temporal["restarts"] == 0 and rep.temporal["frames_averaged"] > 3.4  # (1+..+6)/6
+    assert 4.8 < rep.temporal["noise_sigma"] < 7.0
+    assert rep.stage_ms["temporal"] > 0
+    last_raw = cv2.imread(str(tmp_path / "left_05.png")).astype(np.float32)
+    ref = clean["left"].astype(np.float32)
+    assert np.std(got[-1] - ref) < 0.5 * np.std(last_raw - ref)
+
+    argv = ["stream", "--left", str(tmp_path / "left_%02d.png"), "--right"]
+    argv += [str(tmp_path / "right_%02d.png"), "--calib", str(scene / "calib.txt")]
+    argv += ["--max-disparity", "64", "--no-display", "--temporal", "8"]
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "temporal: 3.5 frames averaged per pixel on average, 0 restarts" in out
+    assert main([*argv[:-1], "1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["stereovision: error: --temporal: expected at least 2 pairs to average, got 1"]
+
+
+def test_stream_temporal_restarts_on_a_moving_view(
+    videos: dict[str, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The videos' frames move by a row each: every pair after the first restarts the mean."""
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--max-disparity", "64", "--no-display", "--json", "--temporal", "8"]
+    assert main(argv) == 0
+    summary = _json_lines(capsys.readouterr().out)[-1]
+    assert summary["temporal"]["restarts"] == N_FRAMES - 1
+    assert summary["temporal"]["frames_averaged"] == 1.0

@@ -52,7 +52,7 @@ __all__ = [
 ]
 
 #: Stages timed for every pair, in pipeline order.
-STAGES = ("grab", "rectify", "prepare", "match", "fill", "triangulate")
+STAGES = ("grab", "rectify", "temporal", "prepare", "match", "fill", "triangulate")
 #: Pairs grabbed ahead of the one being matched. One is enough to hide the grab and rectify
 #: behind the matching; more would only age a live camera's frames.
 QUEUE_SIZE = 1
@@ -83,6 +83,8 @@ class _Pair:
     skew_ms: float
     check: RectificationCheck | None = None  # the rectification check of this pair, if any
     pair: int = 0  # index of the pair in this stream
+    temporal_s: float = 0.0
+    averaged: float = 1.0  # mean frames in a pixel's temporal mean (1: not averaged)
 
 
 @dataclass
@@ -94,6 +96,7 @@ class _Done:
     wait_s: float
     skew_ms: float
     density: float
+    averaged: float = 1.0
 
 
 @dataclass
@@ -131,6 +134,10 @@ class StreamReport:
     grounds : list of dict
         With ``ground_every``: every floor fit (:meth:`~stereovision.ground.GroundPlane.as_dict`
         and the ``pair``), or ``{"pair": n, "found": False}`` when no floor was in view.
+    temporal : dict or None
+        With a :class:`~stereovision.temporal.TemporalFilter`: ``frames_averaged`` (mean over
+        the pairs of the frames in a pixel's mean), ``restarts`` (pairs on which the rig or
+        scene moved) and ``noise_sigma`` (its last noise estimate, grey levels).
     """
 
     frames: int
@@ -148,6 +155,7 @@ class StreamReport:
     rectification: dict[str, Any] | None = None
     checks: list[dict[str, Any]] = field(default_factory=list, repr=False)
     grounds: list[dict[str, Any]] = field(default_factory=list, repr=False)
+    temporal: dict[str, float] | None = None
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON summary object (``"summary": true``)."""
@@ -167,6 +175,7 @@ class StreamReport:
             "rectification": self.rectification,
             "checks": self.checks,
             "grounds": self.grounds,
+            "temporal": self.temporal,
         }
 
 
@@ -335,6 +344,7 @@ def _pairs(
     frames: int | None,
     check_every: int | None = None,
     homographies: Any = None,
+    temporal: Any = None,
 ) -> Iterator[_Pair]:
     """Grab (and rectify, for a raw rig calibration) pairs until the end or ``frames`` pairs;
     check the rows of pair 0 and, when positive, every ``check_every``-th pair (None: none)."""
@@ -354,11 +364,18 @@ def _pairs(
         elif homographies is not None:
             left, right = homographies.rectify(left, right)
         t2 = time.perf_counter()
+        averaged = 1.0
+        if temporal is not None:
+            left, right = temporal(left, right)
+            averaged = temporal.mean_frames()
+        t3 = time.perf_counter()
         checked = None
         # In the producer thread when pipelined: the matcher keeps working meanwhile.
         if check_every is not None and (n == 0 or (check_every > 0 and n % check_every == 0)):
             checked = check_rectification(left, right)
-        yield _Pair(left, right, fr.index, t0, t1 - t0, t2 - t1, fr.skew_ms, checked, n)
+        yield _Pair(
+            left, right, fr.index, t0, t1 - t0, t2 - t1, fr.skew_ms, checked, n, t3 - t2, averaged
+        )
         n += 1
 
 
@@ -416,6 +433,7 @@ def _window_report(
             "max": round(max((d.skew_ms for d in done), default=math.nan), 4),
         },
         "density": round(_mean([d.density for d in done]), 4),
+        "frames_averaged": round(_mean([d.averaged for d in done]), 3),
         "max_disparity": md,
         "pipelined": pipelined,
     }
@@ -439,6 +457,7 @@ def run_stream(
     ground_every: int | None = None,
     on_ground: Callable[[Any], None] | None = None,
     homographies: Any = None,
+    temporal: Any = None,
 ) -> StreamReport:
     """Depth maps from a stereo camera until it ends, ``frames`` pairs, or Ctrl-C.
 
@@ -495,6 +514,10 @@ def run_stream(
         With ``ground_every``: called with each fit's
         :class:`~stereovision.ground.GroundPlane` (None when no floor was found), before the
         pair's ``on_result``.
+    temporal : TemporalFilter, optional
+        Average a still rig's frames (:class:`~stereovision.temporal.TemporalFilter`; in the
+        grab thread when pipelined) before matching: less noise in low light, the same pairs
+        when the rig or the scene moves. ``on_result`` gets the averaged left image.
 
     Returns
     -------
@@ -535,7 +558,9 @@ def run_stream(
             )
         if rect_calib is None:
             raise ValueError("ground_every: the floor is found in metres; give a calibration")
-    source = _pairs(camera, calib, frames, (check_every or 0) if check else None, homographies)
+    source = _pairs(
+        camera, calib, frames, (check_every or 0) if check else None, homographies, temporal
+    )
     producer: _Producer | None = None
     q: queue.Queue[Any] = queue.Queue()
     if pipelined:
@@ -586,6 +611,7 @@ def run_stream(
             stages = {
                 "grab": pair.grab_s,
                 "rectify": pair.rectify_s,
+                "temporal": pair.temporal_s,
                 # depth_map's own "rectify" is only input conversion for a rectified pair
                 "prepare": tm.get("rectify", 0.0) + tm.get("prepare", 0.0),
                 "match": tm.get("match", 0.0) + tm.get("refine", 0.0),
@@ -598,6 +624,7 @@ def run_stream(
                 wait_s=t_got - t_wait,
                 skew_ms=pair.skew_ms,
                 density=res.density,
+                averaged=pair.averaged,
             )
             all_done.append(d)
             window.append(d)
@@ -649,6 +676,13 @@ def run_stream(
         rectification=checks[0] if checks else None,
         checks=checks,
         grounds=grounds,
+        temporal=None
+        if temporal is None
+        else {
+            "frames_averaged": round(_mean([d.averaged for d in all_done]), 3),
+            "restarts": temporal.restarts,
+            "noise_sigma": round(temporal.sigma, 3),
+        },
     )
 
 
@@ -700,6 +734,7 @@ def _format_report(rep: dict[str, Any]) -> str:
         f"{rep['fps']:5.1f} fps | {stages} ms | latency {rep['latency_ms']:.0f} ms,"
         f" waited {rep['wait_ms']:.1f} ms | skew {rep['skew_ms']['mean']:.2f} ms"
         f" | density {100 * rep['density']:.0f} %"
+        + (f" | {rep['frames_averaged']:.1f} frames averaged" if rep["frames_averaged"] > 1 else "")
     )
 
 
@@ -716,6 +751,15 @@ def cmd_stream(args: argparse.Namespace) -> int:
         if args.calib:
             raise ValueError("--rectification and --calib: give one way to rectify the pairs")
         homographies = UncalibratedRectification.load(args.rectification)
+    temporal = None
+    if args.temporal is not None:
+        from stereovision.temporal import TemporalFilter
+
+        if args.temporal < 2:
+            raise ValueError(
+                f"--temporal: expected at least 2 pairs to average, got {args.temporal}"
+            )
+        temporal = TemporalFilter(max_frames=args.temporal)
     cam = open_source(args)
     stamps: Callable[[], int] = time.time_ns
     if hasattr(cam, "stamps_ns"):  # a recording: its results keep the frames' stamps
@@ -781,6 +825,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             ground_every=args.ground_every,
             on_ground=(lambda plane: floor.__setitem__(0, plane)) if bag is not None else None,
             homographies=homographies,
+            temporal=temporal,
         )
     finally:
         cam.close()
@@ -812,6 +857,14 @@ def cmd_stream(args: argparse.Namespace) -> int:
             f" max_disparity {report.max_disparity}",
             file=out,
         )
+        if report.temporal is not None:
+            tp = report.temporal
+            print(
+                f"temporal: {tp['frames_averaged']:.1f} frames averaged per pixel on average,"
+                f" {tp['restarts']} restarts (the rig or the view moved), noise"
+                f" {tp['noise_sigma']:.1f} grey levels",
+                file=out,
+            )
         found = [g for g in report.grounds if g["found"]]
         if report.grounds:
             last = found[-1] if found else None
@@ -898,6 +951,13 @@ def add_cli(subparsers: Any) -> None:
         metavar="N",
         help="fit the floor on every N-th pair and warn when the camera's height, pitch or roll "
         "moves (a mount that slipped); needs --calib",
+    )
+    p.add_argument(
+        "--temporal",
+        type=int,
+        metavar="N",
+        help="average a still rig's frames over up to N pairs (e.g. 8) before matching: less "
+        "noise in low light; starts again where the rig or the scene moves",
     )
     p.add_argument(
         "--no-pipeline", action="store_true", help="grab, rectify and match in one thread"
