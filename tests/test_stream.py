@@ -405,8 +405,16 @@ def test_stream_averages_a_still_noisy_rig(
     argv += [str(tmp_path / "right_%02d.png"), "--calib", str(scene / "calib.txt")]
     argv += ["--max-disparity", "64", "--no-display", "--temporal", "8"]
     assert main(argv) == 0
-    out = capsys.readouterr().out
-    assert "temporal: 3.5 frames averaged per pixel on average, 0 restarts" in out
+    cap = capsys.readouterr()
+    assert "temporal: 3.5 frames averaged per pixel on average, 0 restarts" in cap.out
+    assert "noisy" not in cap.err  # averaging already
+    # Without --temporal the first frame's noise (5.5 grey levels) brings a one-line hint.
+    assert main([*argv[:-2], "--json"]) == 0
+    cap = capsys.readouterr()
+    hints = [ln for ln in cap.err.splitlines() if "noisy" in ln]
+    assert len(hints) == 1 and hints[0].startswith("stereovision: warning: the cameras are noisy")
+    assert "--temporal 8" in hints[0]
+    assert 4.8 < _json_lines(cap.out)[-1]["noise_sigma"] < 7.0
     assert main([*argv[:-1], "1"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["stereovision: error: --temporal: expected at least 2 pairs to average, got 1"]
@@ -419,6 +427,8 @@ def test_stream_temporal_restarts_on_a_moving_view(
     argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
     argv += ["--max-disparity", "64", "--no-display", "--json", "--temporal", "8"]
     assert main(argv) == 0
-    summary = _json_lines(capsys.readouterr().out)[-1]
+    cap = capsys.readouterr()
+    summary = _json_lines(cap.out)[-1]
     assert summary["temporal"]["restarts"] == N_FRAMES - 1
     assert summary["temporal"]["frames_averaged"] == 1.0
+    assert summary["noise_sigma"] < 3.0 and "noisy" not in cap.err  # a clean scene: no hint
