@@ -136,19 +136,47 @@ def test_a_new_size_starts_again_and_bad_input_is_named() -> None:
     assert tf.mean_frames() == 0.0
 
 
-def test_max_frames_caps_the_mean() -> None:
-    """Beyond ``max_frames`` the mean follows new frames by 1/max_frames each: a light that
-    changes slowly still comes through."""
+def test_max_frames_caps_the_mean_and_a_new_light_is_followed() -> None:
+    """Beyond ``max_frames`` the mean follows a still pixel's new value by 1/max_frames each;
+    a change of the whole image's brightness (a flickering light, an auto-exposure step) is
+    carried into the mean first, so the averaging goes on."""
     tf = TemporalFilter(max_frames=3)
     rng = np.random.default_rng(4)
     base = rng.integers(60, 200, (40, 40)).astype(np.uint8)
     for _ in range(6):
         tf(base, base)
+    assert tf.mean_frames() == 3.0 and tf.relit == 0
+    patch = base.copy()
+    patch[:4] += 2  # a tenth of the image, within the noise test: averaged, 1/3 of the way
+    out, _ = tf(patch, patch)
+    assert np.array_equal(out[:4], base[:4] + 1) and np.array_equal(out[4:], base[4:])
     assert tf.mean_frames() == 3.0
-    brighter = (base + 2).astype(np.uint8)  # within the noise test of a still pixel
+    relit = tf.relit  # the patch may have moved the fit by a hair (no visible change)
+    brighter = np.clip(base * 1.04 + 3, 0, 255).astype(np.uint8)  # the whole image
     out, _ = tf(brighter, brighter)
-    # 1/3 of the way (the mean of 3 frames): 2/3 of a level, rounded to 1.
-    assert np.array_equal(out, base + 1)
+    assert tf.relit == relit + 2 and tf.restarts == 0 and tf.mean_frames() == 3.0
+    assert np.abs(out.astype(int) - brighter).max() <= 1  # the new light, not a blend
+
+
+def test_a_flickering_light_keeps_averaging(data_dir: Path) -> None:
+    """Venus with noise 8 under a light that flickers by up to 4 % from frame to frame: the
+    means are relit, not restarted (before the relighting: 7 restarts of 7, nothing averaged),
+    and the map gains as in a steady light."""
+    sc = load_scene(data_dir / VENUS)
+    rng = np.random.default_rng(6)
+    tf = TemporalFilter()
+    for k in range(8):
+        gain = 1.0 + 0.04 * np.sin(2.1 * k)
+        left, right = (
+            _noisy(np.clip(img * gain, 0, 255).astype(np.uint8), 8.0, rng)
+            for img in (sc.left, sc.right)
+        )
+        avg = tf(left, right)
+    assert tf.restarts == 0 and tf.relit >= 10 and tf.mean_frames() > 7.8
+    md = sc.max_disparity
+    one = dense_metrics(sv.depth_map(left, right, max_disparity=md).disparity, sc.gt).bad[2.0]
+    many = dense_metrics(sv.depth_map(*avg, max_disparity=md).disparity, sc.gt).bad[2.0]
+    assert many < 0.5 * one, (many, one)
 
 
 @pytest.mark.parametrize("colour", [True, False])
@@ -175,8 +203,9 @@ def test_kernels_match_the_numpy_reference(data_dir: Path, colour: bool) -> None
     count = rng.integers(1, 9, img.shape[:2]).astype(np.uint8)
     diff = _core.temporal_grey_difference(frame, mean)
     np.testing.assert_array_equal(diff, ref.grey_difference(frame, mean))
-    got = _core.temporal_running_mean(frame, mean, count, diff, 16.0, 8)
     want = ref.running_mean(frame, mean, count, diff, 16.0, 8)
+    out = _core.temporal_running_mean(frame, mean, count, diff, 16.0, 8)  # mean, count in place
+    got = (mean, count, out)
     for g, w in zip(got, want, strict=True):
         assert g.shape == w.shape and g.dtype == w.dtype
         np.testing.assert_array_equal(g, w)
@@ -186,3 +215,5 @@ def test_kernels_match_the_numpy_reference(data_dir: Path, colour: bool) -> None
         _core.temporal_grey_difference(frame, mean[:10])
     with pytest.raises(ValueError, match="count shape"):
         _core.temporal_running_mean(frame, mean, count[:10], diff, 16.0, 8)
+    with pytest.raises(ValueError, match="mean and count must be C-contiguous"):
+        _core.temporal_running_mean(frame, mean, np.asfortranarray(count), diff, 16.0, 8)

@@ -249,10 +249,10 @@ def temporal_running_mean(
     diff: npt.NDArray[np.float32],
     ks: float,
     max_frames: int,
-) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
-    """``(mean, count, rounded mean)`` after one more frame: a pixel with ``|diff| <= ks
-    sqrt(1 + 1/count)`` keeps averaging (``count`` up to ``max_frames``), any other starts
-    again from the frame."""
+) -> npt.NDArray[np.uint8]:
+    """One more frame into ``mean`` and ``count``, in place (both C-contiguous); returns the
+    mean rounded to uint8. A pixel with ``|diff| <= ks sqrt(1 + 1/count)`` keeps averaging
+    (``count`` up to ``max_frames``), any other starts again from the frame."""
 
 def release_memory() -> int:
     """Return the memory the extension keeps for the next call to the system; bytes released."""

@@ -75,33 +75,22 @@ pub fn grey_difference(
     Ok(out)
 }
 
-/// What [`running_mean`] returns.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Averaged {
-    /// New running mean, `(H, W, C)`.
-    pub mean: Vec<f32>,
-    /// New frame counts, `(H, W)`.
-    pub count: Vec<u8>,
-    /// The mean rounded half up, `(H, W, C)`.
-    pub out: Vec<u8>,
-}
-
-/// The running mean after one more frame, with the new per-pixel counts and the mean rounded to
-/// `u8` (what the matchers get).
+/// One more frame into the running mean, in place: `mean` and `count` are updated, and the
+/// mean rounded half up to `u8` (what the matchers get) is returned, `(H, W, C)`.
 ///
 /// A pixel whose grey difference `|diff|` is at most `ks * sqrt(1 + 1/n)` (`n` its count; `ks`
 /// is `k` noise sigmas) keeps averaging: `n' = min(n + 1, max_frames)`, `mean' = mean +
-/// (frame - mean) / n'`. Any other pixel starts again from the frame (`n' = 1`).
-#[allow(clippy::too_many_arguments)]
+/// (frame - mean) / n'`. Any other pixel starts again from the frame (`n' = 1`). In place: the
+/// stream calls it on every pair, and fresh arrays cost their page faults each time.
 pub fn running_mean(
     frame: &[u8],
-    mean: &[f32],
-    count: &[u8],
+    mean: &mut [f32],
+    count: &mut [u8],
     diff: &[f32],
     channels: usize,
     ks: f32,
     max_frames: u8,
-) -> Result<Averaged> {
+) -> Result<Vec<u8>> {
     weights(channels)?;
     let pixels = count.len();
     check(frame, mean, pixels, channels)?;
@@ -125,49 +114,30 @@ pub fn running_mean(
         .map(|n| ks * (1.0 + 1.0 / n.max(1) as f32).sqrt())
         .collect();
     let weight: Vec<f32> = (0..=255u32).map(|n| 1.0 / n.max(1) as f32).collect();
-    let mut new_mean = vec![0f32; mean.len()];
-    let mut new_count = vec![0u8; pixels];
     let mut out = vec![0u8; mean.len()];
-    const ROW: usize = 2048;
     let ch = channels;
-    new_count
-        .chunks_mut(ROW)
-        .zip(new_mean.chunks_mut(ROW * ch))
-        .zip(out.chunks_mut(ROW * ch))
-        .enumerate()
-        .for_each(|(block, ((cnt, mn), o))| {
-            let p0 = block * ROW;
-            let len = cnt.len();
-            let fr = &frame[p0 * ch..(p0 + len) * ch];
-            let me = &mean[p0 * ch..(p0 + len) * ch];
-            let (co, di) = (&count[p0..p0 + len], &diff[p0..p0 + len]);
-            let pixels = cnt
-                .iter_mut()
-                .zip(co.iter().zip(di))
-                .zip(fr.chunks_exact(ch).zip(me.chunks_exact(ch)))
-                .zip(mn.chunks_exact_mut(ch).zip(o.chunks_exact_mut(ch)));
-            for (((n_out, (&n, &d)), (f, m)), (mn, o)) in pixels {
-                let n1 = if d.abs() <= limit[usize::from(n)] {
-                    n.saturating_add(1).min(max_frames)
-                } else {
-                    1
-                };
-                *n_out = n1;
-                let w = weight[usize::from(n1)];
-                for (((&f, &m), mn), o) in f.iter().zip(m).zip(mn.iter_mut()).zip(o.iter_mut()) {
-                    let v = m + (f32::from(f) - m) * w;
-                    *mn = v;
-                    // Half up: the mean of u8 values is in [0, 255], so truncation is floor
-                    // (and `as` saturates), without a libm call per value.
-                    *o = (v + 0.5) as u8;
-                }
-            }
-        });
-    Ok(Averaged {
-        mean: new_mean,
-        count: new_count,
-        out,
-    })
+    let pixels = count
+        .iter_mut()
+        .zip(diff)
+        .zip(frame.chunks_exact(ch))
+        .zip(mean.chunks_exact_mut(ch).zip(out.chunks_exact_mut(ch)));
+    for (((n, &d), f), (m, o)) in pixels {
+        let n1 = if d.abs() <= limit[usize::from(*n)] {
+            n.saturating_add(1).min(max_frames)
+        } else {
+            1
+        };
+        *n = n1;
+        let w = weight[usize::from(n1)];
+        for ((&f, m), o) in f.iter().zip(m.iter_mut()).zip(o.iter_mut()) {
+            let v = *m + (f32::from(f) - *m) * w;
+            *m = v;
+            // Half up: the mean of u8 values is in [0, 255], so truncation is floor (and `as`
+            // saturates), without a libm call per value.
+            *o = (v + 0.5) as u8;
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -177,21 +147,21 @@ mod tests {
     #[test]
     fn still_pixels_average_and_changed_ones_restart() {
         // Two BGR pixels: the first within the limit, the second far off.
-        let mean = vec![100.0, 100.0, 100.0, 10.0, 10.0, 10.0];
+        let mut mean = vec![100.0, 100.0, 100.0, 10.0, 10.0, 10.0];
         let frame = vec![104u8, 104, 104, 200, 200, 200];
-        let count = vec![3u8, 3];
+        let mut count = vec![3u8, 3];
         let diff = grey_difference(&frame, &mean, 2, 3).unwrap();
         assert!((diff[0] - 4.0).abs() < 1e-5 && (diff[1] - 190.0).abs() < 1e-3);
-        let a = running_mean(&frame, &mean, &count, &diff, 3, 5.0, 8).unwrap();
-        assert_eq!(a.count, vec![4, 1]);
-        assert_eq!(&a.mean[..3], &[101.0, 101.0, 101.0]);
-        assert_eq!(&a.mean[3..], &[200.0, 200.0, 200.0]);
-        assert_eq!(a.out, vec![101, 101, 101, 200, 200, 200]);
+        let out = running_mean(&frame, &mut mean, &mut count, &diff, 3, 5.0, 8).unwrap();
+        assert_eq!(count, vec![4, 1]);
+        assert_eq!(mean, vec![101.0, 101.0, 101.0, 200.0, 200.0, 200.0]);
+        assert_eq!(out, vec![101, 101, 101, 200, 200, 200]);
         // At the cap the count stays and the weight is 1 / max_frames.
-        let a = running_mean(&frame[..3], &mean[..3], &[8], &diff[..1], 3, 5.0, 8).unwrap();
-        assert_eq!(a.count, vec![8]);
-        assert_eq!(a.mean[0], 100.5);
-        assert_eq!(a.out[0], 101); // half up
+        let (mut mean, mut count) = (vec![100.0f32; 3], vec![8u8]);
+        let out = running_mean(&frame[..3], &mut mean, &mut count, &diff[..1], 3, 5.0, 8).unwrap();
+        assert_eq!(count, vec![8]);
+        assert_eq!(mean[0], 100.5);
+        assert_eq!(out[0], 101); // half up
     }
 
     #[test]
@@ -200,11 +170,12 @@ mod tests {
         assert!(e.to_string().contains("1, 3 or 4 channels"));
         let e = grey_difference(&[0; 5], &[0.0; 6], 2, 3).unwrap_err();
         assert!(e.to_string().contains("`frame`"));
-        let e = running_mean(&[0; 2], &[0.0; 2], &[1, 1], &[0.0], 1, 1.0, 8).unwrap_err();
+        let (mut m, mut n) = ([0.0f32; 2], [1u8, 1]);
+        let e = running_mean(&[0; 2], &mut m, &mut n, &[0.0], 1, 1.0, 8).unwrap_err();
         assert!(e.to_string().contains("`diff`"));
-        let e = running_mean(&[0; 2], &[0.0; 2], &[1, 1], &[0.0; 2], 1, f32::NAN, 8).unwrap_err();
+        let e = running_mean(&[0; 2], &mut m, &mut n, &[0.0; 2], 1, f32::NAN, 8).unwrap_err();
         assert!(e.to_string().contains("`ks`"));
-        let e = running_mean(&[0; 2], &[0.0; 2], &[1, 1], &[0.0; 2], 1, 1.0, 0).unwrap_err();
+        let e = running_mean(&[0; 2], &mut m, &mut n, &[0.0; 2], 1, 1.0, 0).unwrap_err();
         assert!(e.to_string().contains("`max_frames`"));
         assert!(grey_difference(&[], &[], 0, 1).is_err());
     }

@@ -2,7 +2,8 @@
 
 use numpy::ndarray::{ArrayD, IxDyn};
 use numpy::{
-    IntoPyArray, PyArray2, PyArrayDyn, PyReadonlyArray2, PyReadonlyArrayDyn, PyUntypedArrayMethods,
+    IntoPyArray, PyArray2, PyArrayDyn, PyReadonlyArray2, PyReadonlyArrayDyn, PyReadwriteArray2,
+    PyReadwriteArrayDyn, PyUntypedArrayMethods,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -43,26 +44,28 @@ pub fn temporal_grey_difference<'py>(
     vec_to_numpy(py, (h, w), d)
 }
 
-/// The running mean after one more frame: `(mean, count, rounded mean)`.
+/// One more frame into the running mean, in place (`mean` and `count`); returns the mean
+/// rounded to uint8, the frame's shape.
 #[pyfunction]
 #[pyo3(signature = (frame, mean, count, diff, ks, max_frames))]
-#[allow(clippy::type_complexity)]
 pub fn temporal_running_mean<'py>(
     py: Python<'py>,
     frame: PyReadonlyArrayDyn<'py, u8>,
-    mean: PyReadonlyArrayDyn<'py, f32>,
-    count: PyReadonlyArray2<'py, u8>,
+    mut mean: PyReadwriteArrayDyn<'py, f32>,
+    mut count: PyReadwriteArray2<'py, u8>,
     diff: PyReadonlyArray2<'py, f32>,
     ks: f32,
     max_frames: u8,
-) -> PyResult<(
-    Bound<'py, PyArrayDyn<f32>>,
-    Bound<'py, PyArray2<u8>>,
-    Bound<'py, PyArrayDyn<u8>>,
-)> {
+) -> PyResult<Bound<'py, PyArrayDyn<u8>>> {
     let (h, w, c, f) = u8_layout(&frame, "frame")?;
     let shape = frame.shape().to_vec();
-    let m = mean_slice(&mean, &shape)?;
+    if mean.shape() != shape.as_slice() {
+        return Err(PyValueError::new_err(format!(
+            "mean shape {:?} differs from the frame's {:?}",
+            mean.shape(),
+            shape
+        )));
+    }
     for (name, dims) in [("count", count.shape()), ("diff", diff.shape())] {
         if dims != [h, w] {
             return Err(PyValueError::new_err(format!(
@@ -71,19 +74,19 @@ pub fn temporal_running_mean<'py>(
             )));
         }
     }
-    let n = c_slice(&count).ok_or_else(|| PyValueError::new_err("count must be C-contiguous"))?;
     let d = c_slice(&diff).ok_or_else(|| PyValueError::new_err("diff must be C-contiguous"))?;
-    let a = py.detach(|| {
+    let contiguous = mean.is_c_contiguous() && count.is_c_contiguous();
+    let m = mean.as_slice_mut().ok().filter(|_| contiguous);
+    let n = count.as_slice_mut().ok().filter(|_| contiguous);
+    let (Some(m), Some(n)) = (m, n) else {
+        return Err(PyValueError::new_err("mean and count must be C-contiguous"));
+    };
+    let out = py.detach(|| {
         guard("temporal_running_mean", || {
             running_mean(f, m, n, d, c, ks, max_frames)
         })
     })?;
-    let to_err = |e: numpy::ndarray::ShapeError| PyValueError::new_err(e.to_string());
-    let mean_out = ArrayD::from_shape_vec(IxDyn(&shape), a.mean).map_err(to_err)?;
-    let out = ArrayD::from_shape_vec(IxDyn(&shape), a.out).map_err(to_err)?;
-    Ok((
-        mean_out.into_pyarray(py),
-        vec_to_numpy(py, (h, w), a.count)?,
-        out.into_pyarray(py),
-    ))
+    let out = ArrayD::from_shape_vec(IxDyn(&shape), out)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(out.into_pyarray(py))
 }
