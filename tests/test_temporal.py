@@ -36,7 +36,7 @@ def test_noise_sigma_measures_sensor_noise(data_dir: Path) -> None:
 
 def test_a_still_noisy_rig_matches_as_if_less_noisy(data_dir: Path) -> None:
     """Venus, noise 8 on each channel, 8 still frames: the default map's bad-2.0 measured 4.98
-    % on the last frame alone, 1.49 % on the filter's output (0.83 % without noise)."""
+    % on the last frame alone, 1.37 % on the filter's output (0.83 % without noise)."""
     sc = load_scene(data_dir / VENUS)
     rng = np.random.default_rng(1)
     tf = TemporalFilter()
@@ -161,7 +161,7 @@ def test_max_frames_caps_the_mean_and_a_new_light_is_followed() -> None:
 def test_a_flickering_light_keeps_averaging(data_dir: Path) -> None:
     """Venus with noise 8 under a light that flickers by up to 4 % from frame to frame: the
     means are relit, not restarted (before the relighting: 7 restarts of 7, nothing averaged),
-    and the map gains as in a steady light."""
+    and the map gains as in a steady light (measured 4.58 -> 1.80 %, 14 relit images)."""
     sc = load_scene(data_dir / VENUS)
     rng = np.random.default_rng(6)
     tf = TemporalFilter()
