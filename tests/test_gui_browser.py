@@ -373,6 +373,51 @@ def test_rectify_controller_without_a_calibration(data_dir):
     assert app.state.rows_label == "this pair has a calibration: it is rectified with it"
 
 
+def test_capture_averages_still_frames_when_asked(data_dir):
+    """The acquisition panel's "average 8 still frames", in-process: cameras giving venus with
+    fresh noise of 8 grey levels on every read. Off, a capture is one noisy frame; on, it is
+    the mean of 8 (its noise about a third) and the label says so."""
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui.app import AVERAGE_FRAMES, StereoApp
+
+    venus = data_dir / "middlebury2001" / "venus"
+    clean = [cv2.imread(str(venus / f"{s}.png")) for s in ("left", "right")]
+    rng = np.random.default_rng(0)
+
+    class Cameras:
+        reads = 0
+
+        def read(self):
+            Cameras.reads += 1
+            return tuple(
+                np.clip(c + rng.normal(0, 8.0, c.shape), 0, 255).astype(np.uint8) for c in clean
+            )
+
+        def close(self):
+            pass
+
+    app = StereoApp(
+        get_server("test-average", client_type="vue3"),
+        AllowedFolders([data_dir]),
+        data_dir / "middlebury2003" / "cones",
+        source=Cameras(),
+    )
+
+    def noise() -> float:
+        return float(np.std(app.pair[0].astype(np.float32) - clean[0]))
+
+    app._grab()
+    single = noise()
+    assert Cameras.reads == 1 and "averaged" not in app.state.source_label
+    app.state.average = True
+    app._grab()
+    assert Cameras.reads == 1 + AVERAGE_FRAMES
+    assert noise() < 0.45 * single, (noise(), single)
+    assert app.state.source_label.endswith("(8.0 frames averaged)")
+
+
 # ----------------------------------------------------------------------------- browser
 
 
@@ -510,6 +555,20 @@ def test_capture_changes_images(page):
     after_l, after_r = _src(page, "#img-left"), _src(page, "#img-right")
     assert after_l != before_l and after_r != before_r
     assert np.abs(_decode(after_l) - _decode(before_l)).mean() > 10  # a new frame, not noise
+
+
+def test_average_switch_reports_the_frames(page):
+    """The "average 8 still frames" switch: the next capture reads 8 pairs through the
+    temporal filter. The test videos roll by a few rows every frame, so the filter sees a view
+    that moves and says so on the page."""
+    _wait_computations(page, 1)
+    n = _computations(page)
+    page.click("#average-switch")
+    page.click("#capture-btn")
+    _wait_computations(page, n + 1)
+    label = page.inner_text("#source-label")
+    assert "1.0 frames averaged, 7 restarts: the view moved" in label, label
+    page.click("#average-switch")  # off again for the tests that follow
 
 
 def test_method_switch_updates_disparity(page):

@@ -52,6 +52,10 @@ log = logging.getLogger(__name__)
 #: Processing widths offered by the resolution control ("full" keeps the input size).
 RESOLUTIONS = ("full", "640", "320")
 
+#: Frames a capture averages when "average still frames" is on (a still rig in low light:
+#: :class:`~stereovision.temporal.TemporalFilter`, docs/robotics.md).
+AVERAGE_FRAMES = 8
+
 #: OpenCV references offered beside the package's matchers (evaluation.md baselines).
 EXTRA_METHODS = ("opencv-sgbm", "opencv-bm")
 
@@ -418,6 +422,7 @@ class StereoApp:
         st.error = ""
         st.computations = 0
         st.captures = 0
+        st.average = False
         st.img_left = st.img_right = st.img_disparity = st.img_depth = st.img_matches = ""
         st.stats = ""
         st.message_3d = ""
@@ -489,11 +494,21 @@ class StereoApp:
         left, right = self.source.read()
         if left.shape != right.shape:
             raise ValueError(f"the cameras give different sizes: {left.shape} and {right.shape}")
+        averaged = ""
+        if self.state.average:
+            from stereovision.temporal import TemporalFilter
+
+            tf = TemporalFilter(max_frames=AVERAGE_FRAMES)
+            left, right = tf(left, right)
+            for _ in range(AVERAGE_FRAMES - 1):
+                left, right = tf(*self.source.read())
+            moved = f", {tf.restarts} restarts: the view moved" if tf.restarts else ""
+            averaged = f" ({tf.mean_frames():.1f} frames averaged{moved})"
         self.pair = (left, right)
         self.calib = self.source_calib
         self.max_disparity = None
         names = (Path(str(n)).name or str(n) for n in (self.state.cam_left, self.state.cam_right))
-        self.state.source_label = self._source_label or "cameras " + " / ".join(names)
+        self.state.source_label = (self._source_label or "cameras " + " / ".join(names)) + averaged
         self.state.rows_label = ""
         rect = self.homographies
         if rect is not None and rect.input_size == (left.shape[1], left.shape[0]):
@@ -937,6 +952,15 @@ class StereoApp:
                             click=self.ctrl.capture,
                             disabled=("!live",),
                             prepend_icon="mdi-camera",
+                        )
+                        v3.VSwitch(
+                            label=f"average {AVERAGE_FRAMES} still frames (low light)",
+                            v_model=("average",),
+                            density="compact",
+                            hide_details=True,
+                            color="primary",
+                            disabled=("!live",),
+                            id="average-switch",
                         )
                     with v3.VCol(cols=6):
                         html.Div("resolution", classes="text-caption")
