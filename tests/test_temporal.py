@@ -217,3 +217,19 @@ def test_kernels_match_the_numpy_reference(data_dir: Path, colour: bool) -> None
         _core.temporal_running_mean(frame, mean, count[:10], diff, 16.0, 8)
     with pytest.raises(ValueError, match="mean and count must be C-contiguous"):
         _core.temporal_running_mean(frame, mean, np.asfortranarray(count), diff, 16.0, 8)
+
+
+def test_bgra_and_grey_frames(data_dir: Path) -> None:
+    """BGRA (alpha 255, left out of the grey and the saturation test) and grey frames average
+    as BGR ones do."""
+    sc = load_scene(data_dir / VENUS)
+    rng = np.random.default_rng(7)
+    for convert in (cv2.COLOR_BGR2BGRA, cv2.COLOR_BGR2GRAY):
+        tf = TemporalFilter()
+        for _ in range(4):
+            left, right = (cv2.cvtColor(_noisy(i, 8.0, rng), convert) for i in (sc.left, sc.right))
+            out = tf(left, right)
+        assert tf.restarts == 0 and tf.mean_frames() > 3.9
+        assert out[0].shape == left.shape
+        if convert == cv2.COLOR_BGR2BGRA:
+            assert (out[0][..., 3] == 255).all()

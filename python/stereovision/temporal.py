@@ -260,7 +260,7 @@ class TemporalFilter:
             blurred = cv2.GaussianBlur(d, (0, 0), _BLUR)[::_STRIDE, ::_STRIDE]
             # Saturated pixels do not follow a change of light: left out of the test.
             sub = img[::_STRIDE, ::_STRIDE]
-            bright = (sub.max(axis=2) if sub.ndim == 3 else sub) >= _SATURATED
+            bright = (sub[..., :3].max(axis=2) if sub.ndim == 3 else sub) >= _SATURATED
             if bright.mean() < 0.5:
                 blurred = blurred[~bright]
             n = float(np.mean(m.count[::_STRIDE, ::_STRIDE]))
