@@ -220,14 +220,21 @@ def test_kernels_match_the_numpy_reference(data_dir: Path, colour: bool) -> None
 
 
 def test_bgra_and_grey_frames(data_dir: Path) -> None:
-    """BGRA (alpha 255, left out of the grey and the saturation test) and grey frames average
-    as BGR ones do."""
+    """BGRA (alpha 255, left out of the grey and the saturation test), grey and (H, W, 1)
+    frames average as BGR ones do."""
     sc = load_scene(data_dir / VENUS)
     rng = np.random.default_rng(7)
-    for convert in (cv2.COLOR_BGR2BGRA, cv2.COLOR_BGR2GRAY):
+    for convert in (cv2.COLOR_BGR2BGRA, cv2.COLOR_BGR2GRAY, None):
         tf = TemporalFilter()
         for _ in range(4):
-            left, right = (cv2.cvtColor(_noisy(i, 8.0, rng), convert) for i in (sc.left, sc.right))
+            left, right = (
+                cv2.cvtColor(
+                    _noisy(i, 8.0, rng), cv2.COLOR_BGR2GRAY if convert is None else convert
+                )
+                for i in (sc.left, sc.right)
+            )
+            if convert is None:
+                left, right = left[..., None], right[..., None]
             out = tf(left, right)
         assert tf.restarts == 0 and tf.mean_frames() > 3.9
         assert out[0].shape == left.shape

@@ -91,7 +91,9 @@ def _brightness_change(
 
 
 def _grey(img: np.ndarray) -> npt.NDArray[np.float32]:
-    if img.ndim == 3:
+    if img.ndim == 3 and img.shape[2] == 1:
+        img = img[..., 0]
+    elif img.ndim == 3:
         code = cv2.COLOR_BGRA2GRAY if img.shape[2] == 4 else cv2.COLOR_BGR2GRAY
         img = cv2.cvtColor(img, code)
     return np.asarray(img, dtype=np.float32)
@@ -255,7 +257,7 @@ class TemporalFilter:
                 d = _core.temporal_grey_difference(img, m.mean)
             diffs.append(d)
         # The blurred difference of a frame and an n-frame mean, noise alone: a normal of
-        # sigma * gain * sqrt(1 + 1/n); its median absolute value is 0.6745 of that.
+        # sigma * _BLUR_GAIN * sqrt(1 + 1/n); its median absolute value is 0.6745 of that.
         for img, d, m in zip(imgs, diffs, self._means, strict=True):
             blurred = cv2.GaussianBlur(d, (0, 0), _BLUR)[::_STRIDE, ::_STRIDE]
             # Saturated pixels do not follow a change of light: left out of the test.
