@@ -26,7 +26,7 @@ from stereovision.evaluate import dense_metrics
 from stereovision.io import load_scene
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from tests.test_exposure import expose, jpeg
+from tests.test_exposure import expose, jpeg, noisy
 
 #: ``(gain, gamma, offset)`` of each case, applied as ``255 (gain x)^gamma + offset``.
 CASES: dict[str, Any] = {
@@ -55,10 +55,7 @@ def main() -> None:
             left, right = sc.left, sc.right
             if p == "noise":
                 rng = np.random.default_rng(0)
-                left, right = (
-                    np.clip(i + rng.normal(0, NOISE, i.shape), 0, 255).astype(np.uint8)
-                    for i in (left, right)
-                )
+                left, right = noisy(left, NOISE, rng), noisy(right, NOISE, rng)
             elif isinstance(p, tuple) and p[0] == "jpeg":
                 left, right = jpeg(left, p[1]), jpeg(right, p[1])
             elif p is not None:

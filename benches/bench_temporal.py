@@ -19,7 +19,9 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import sys
 import time
+from pathlib import Path
 
 import cv2
 import numpy as np
@@ -30,15 +32,11 @@ from stereovision.evaluate import dense_metrics
 from stereovision.io import load_scene
 from stereovision.temporal import TemporalFilter
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from tests.test_exposure import noisy
+
 FRAMES = 8
 MOVING = ("middeval3/teddyH", "middlebury2005/reindeer", "middlebury2006/wood2")
-
-
-def _noisy(img: np.ndarray, sigma: float, rng: np.random.Generator) -> np.ndarray:
-    if not sigma:
-        return img
-    out: np.ndarray = np.clip(img + rng.normal(0, sigma, img.shape), 0, 255).astype(np.uint8)
-    return out
 
 
 def _bad2(left: np.ndarray, right: np.ndarray, gt: np.ndarray, md: float) -> float:
@@ -66,7 +64,7 @@ def still(scenes: list[str]) -> None:
             for k in range(FRAMES):
                 gain = 1.0 + 0.04 * np.sin(2.1 * k) if flicker else 1.0
                 left, right = (
-                    _noisy(np.clip(i * gain, 0, 255).astype(np.uint8), sigma, rng)
+                    noisy(np.clip(i * gain, 0, 255).astype(np.uint8), sigma, rng)
                     for i in (sc.left, sc.right)
                 )
                 avg = tf(left, right)
@@ -108,8 +106,8 @@ def moving() -> None:
                 for k in range(FRAMES):
                     dx = speed * k
 
-                    left = _noisy(_shift(sc.left, dx, margin), sigma, rng)
-                    right = _noisy(_shift(sc.right, dx, margin), sigma, rng)
+                    left = noisy(_shift(sc.left, dx, margin), sigma, rng)
+                    right = noisy(_shift(sc.right, dx, margin), sigma, rng)
                     gt = _shift(gt0, dx, margin, cv2.INTER_NEAREST)
                     gt[gt < 0] = np.nan
                     out = tf(left, right)
@@ -133,7 +131,7 @@ def timing() -> None:
             cv2.resize(i, size, interpolation=cv2.INTER_LINEAR) for i in (sc.left, sc.right)
         )
         rng = np.random.default_rng(0)
-        frames = [(_noisy(left, 4.0, rng), _noisy(right, 4.0, rng)) for _ in range(8)]
+        frames = [(noisy(left, 4.0, rng), noisy(right, 4.0, rng)) for _ in range(8)]
         tf = TemporalFilter()
         for fr in frames:
             tf(*fr)

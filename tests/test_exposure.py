@@ -24,6 +24,15 @@ def expose(img: np.ndarray, gain: float, gamma: float, offset: float) -> np.ndar
     return out
 
 
+def noisy(img: np.ndarray, sigma: float, rng: np.random.Generator) -> np.ndarray:
+    """The image as a camera in low light would have taken it: Gaussian noise of ``sigma`` grey
+    levels on every value (each colour channel), uint8; the image itself for ``sigma`` 0."""
+    if not sigma:
+        return img
+    out: np.ndarray = np.clip(img + rng.normal(0, sigma, img.shape), 0, 255).astype(np.uint8)
+    return out
+
+
 def jpeg(img: np.ndarray, quality: int) -> np.ndarray:
     """The image through a JPEG encoder at ``quality`` (0-100) and back: what a webcam's MJPG
     stream delivers (the same 8x8 block grid in both images, as in two webcams)."""

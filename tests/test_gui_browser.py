@@ -381,6 +381,7 @@ def test_capture_averages_still_frames_when_asked(data_dir):
     from trame.app import get_server
 
     from stereovision.gui.app import AVERAGE_FRAMES, StereoApp
+    from tests.test_exposure import noisy
 
     venus = data_dir / "middlebury2001" / "venus"
     clean = [cv2.imread(str(venus / f"{s}.png")) for s in ("left", "right")]
@@ -391,9 +392,7 @@ def test_capture_averages_still_frames_when_asked(data_dir):
 
         def read(self):
             Cameras.reads += 1
-            return tuple(
-                np.clip(c + rng.normal(0, 8.0, c.shape), 0, 255).astype(np.uint8) for c in clean
-            )
+            return tuple(noisy(c, 8.0, rng) for c in clean)
 
         def close(self):
             pass

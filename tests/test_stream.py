@@ -375,14 +375,14 @@ def test_stream_averages_a_still_noisy_rig(
     the matcher gets the running mean (1, 2, ... 6 frames), its noise down by more than half on
     the last pair; the moving videos above restart on every pair and pass through."""
     from stereovision.temporal import TemporalFilter
+    from tests.test_exposure import noisy
 
     scene = data_dir / SCENE
     rng = np.random.default_rng(0)
     clean = {s: cv2.imread(str(scene / f"{s}.png")) for s in ("left", "right")}
     for i in range(6):
         for side, img in clean.items():
-            noisy = np.clip(img + rng.normal(0, 8.0, img.shape), 0, 255).astype(np.uint8)
-            cv2.imwrite(str(tmp_path / f"{side}_{i:02d}.png"), noisy)
+            cv2.imwrite(str(tmp_path / f"{side}_{i:02d}.png"), noisy(img, 8.0, rng))
     calib = Calibration.from_file(scene / "calib.txt")
     got: list[np.ndarray] = []
     with StereoCamera(str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png")) as cam:

@@ -13,35 +13,31 @@ import stereovision as sv
 from stereovision.evaluate import dense_metrics
 from stereovision.io import load_scene
 from stereovision.temporal import TemporalFilter, noise_sigma
+from tests.test_exposure import noisy
 
 VENUS = "middlebury2001/venus"
-
-
-def _noisy(img: np.ndarray, sigma: float, rng: np.random.Generator) -> np.ndarray:
-    out: np.ndarray = np.clip(img + rng.normal(0, sigma, img.shape), 0, 255).astype(np.uint8)
-    return out
 
 
 def test_noise_sigma_measures_sensor_noise(data_dir: Path) -> None:
     """Gaussian noise of 8 per colour channel is 5.34 on the grey image (BT.601 weights)."""
     img = load_scene(data_dir / VENUS).left
     clean = noise_sigma(img)
-    noisy = noise_sigma(_noisy(img, 8.0, np.random.default_rng(0)))
+    with_noise = noise_sigma(noisy(img, 8.0, np.random.default_rng(0)))
     assert clean < 1.5, clean  # measured 0.90: the flattest 30 % still hold some texture
-    assert 4.8 < noisy < 6.5, noisy  # measured 5.66
+    assert 4.8 < with_noise < 6.5, with_noise  # measured 5.66
     assert noise_sigma(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)) == clean  # grey in: the same
     with pytest.raises(ValueError, match="at least 3 x 3"):
         noise_sigma(np.zeros((2, 5), np.uint8))
 
 
-def test_a_still_noisy_rig_matches_as_if_less_noisy(data_dir: Path) -> None:
+def test_a_still_noisy_rig_matches_as_if_lessnoisy(data_dir: Path) -> None:
     """Venus, noise 8 on each channel, 8 still frames: the default map's bad-2.0 measured 4.98
     % on the last frame alone, 1.37 % on the filter's output (0.83 % without noise)."""
     sc = load_scene(data_dir / VENUS)
     rng = np.random.default_rng(1)
     tf = TemporalFilter()
     for _ in range(8):
-        left, right = _noisy(sc.left, 8.0, rng), _noisy(sc.right, 8.0, rng)
+        left, right = noisy(sc.left, 8.0, rng), noisy(sc.right, 8.0, rng)
         avg_l, avg_r = tf(left, right)
     assert tf.restarts == 0 and tf.mean_frames() > 7.8
     # The averaged image's noise: about 1/sqrt(8) of a frame's.
@@ -82,7 +78,7 @@ def test_a_moving_rig_starts_again(data_dir: Path, sigma: float) -> None:
             for img in (sc.left, sc.right)
         )
         if sigma:
-            left, right = _noisy(left, sigma, rng), _noisy(right, sigma, rng)
+            left, right = noisy(left, sigma, rng), noisy(right, sigma, rng)
         out = tf(left, right)
         assert np.array_equal(out[0], left) and np.array_equal(out[1], right), k
     assert tf.restarts == 4
@@ -100,7 +96,7 @@ def test_something_moving_through_a_still_view_leaves_no_ghost(data_dir: Path) -
         left = sc.left.copy()
         x = 40 + 12 * k
         left[150:230, x : x + 80] = patch
-        left, right = _noisy(left, 8.0, rng), _noisy(sc.right, 8.0, rng)
+        left, right = noisy(left, 8.0, rng), noisy(sc.right, 8.0, rng)
         out_l, _ = tf(left, right)
     assert tf.restarts == 0
     diff = np.abs(out_l.astype(np.float32) - left)
@@ -168,7 +164,7 @@ def test_a_flickering_light_keeps_averaging(data_dir: Path) -> None:
     for k in range(8):
         gain = 1.0 + 0.04 * np.sin(2.1 * k)
         left, right = (
-            _noisy(np.clip(img * gain, 0, 255).astype(np.uint8), 8.0, rng)
+            noisy(np.clip(img * gain, 0, 255).astype(np.uint8), 8.0, rng)
             for img in (sc.left, sc.right)
         )
         avg = tf(left, right)
@@ -193,7 +189,7 @@ def test_kernels_match_the_numpy_reference(data_dir: Path, colour: bool) -> None
     mean = np.ascontiguousarray(
         np.clip(img + rng.normal(0, 3, img.shape), 0, 255).astype(np.float32)
     )
-    frame = _noisy(img, 8.0, rng)
+    frame = noisy(img, 8.0, rng)
     # Something moved there: black where the block was bright, white where it was dark.
     block = frame[100:200, 100:300]
     grey = cv2.cvtColor(block, cv2.COLOR_BGR2GRAY) if colour else block
@@ -228,9 +224,7 @@ def test_bgra_and_grey_frames(data_dir: Path) -> None:
         tf = TemporalFilter()
         for _ in range(4):
             left, right = (
-                cv2.cvtColor(
-                    _noisy(i, 8.0, rng), cv2.COLOR_BGR2GRAY if convert is None else convert
-                )
+                cv2.cvtColor(noisy(i, 8.0, rng), cv2.COLOR_BGR2GRAY if convert is None else convert)
                 for i in (sc.left, sc.right)
             )
             if convert is None:

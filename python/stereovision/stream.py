@@ -383,7 +383,17 @@ def _pairs(
         if check_every is not None and (n == 0 or (check_every > 0 and n % check_every == 0)):
             checked = check_rectification(left, right)
         yield _Pair(
-            left, right, fr.index, t0, t1 - t0, t2 - t1, fr.skew_ms, checked, n, t3 - t2, averaged
+            left,
+            right,
+            fr.index,
+            t0,
+            t1 - t0,
+            t2 - t1,
+            fr.skew_ms,
+            checked,
+            n,
+            temporal_s=t3 - t2,
+            averaged=averaged,
         )
         n += 1
 
