@@ -1,5 +1,6 @@
 //! Criterion bench of the census semi-global matcher (census, cost volume, 8-path aggregation,
-//! selection) at two image sizes and two disparity ranges, on a textured synthetic pair with a
+//! selection; and the one-pass 3-path variant, `paths_3/...`) at two image sizes and two
+//! disparity ranges, on a textured synthetic pair with a
 //! slanted disparity. Throughput is cost-volume cells (pixels x levels) per second.
 use std::time::Duration;
 
@@ -26,17 +27,23 @@ fn pair(w: usize, h: usize) -> (Vec<f32>, Vec<f32>) {
 fn bench_sgm(c: &mut Criterion) {
     let mut g = c.benchmark_group("sgm_disparity");
     g.sample_size(10).measurement_time(Duration::from_secs(4));
-    let p = SgmParams::default();
-    for ((w, h), d) in [((320, 240), 64), ((640, 480), 64), ((640, 480), 128)] {
-        let (l, r) = pair(w, h);
-        let lv = ImageView::new(w, h, &l).unwrap();
-        let rv = ImageView::new(w, h, &r).unwrap();
-        g.throughput(Throughput::Elements((w * h * d) as u64));
-        g.bench_with_input(
-            BenchmarkId::from_parameter(format!("{w}x{h}xD{d}")),
-            &(),
-            |b, _| b.iter(|| sgm_disparity(lv, rv, 0, d as i32 - 1, &p).unwrap()),
-        );
+    for paths in [8u8, 3] {
+        let p = SgmParams {
+            paths,
+            ..SgmParams::default()
+        };
+        let prefix = if paths == 8 { "" } else { "paths_3/" };
+        for ((w, h), d) in [((320, 240), 64), ((640, 480), 64), ((640, 480), 128)] {
+            let (l, r) = pair(w, h);
+            let lv = ImageView::new(w, h, &l).unwrap();
+            let rv = ImageView::new(w, h, &r).unwrap();
+            g.throughput(Throughput::Elements((w * h * d) as u64));
+            g.bench_with_input(
+                BenchmarkId::from_parameter(format!("{prefix}{w}x{h}xD{d}")),
+                &(),
+                |b, _| b.iter(|| sgm_disparity(lv, rv, 0, d as i32 - 1, &p).unwrap()),
+            );
+        }
     }
     g.finish();
 }

@@ -36,6 +36,16 @@ def _crop(data_dir: Path, scene: str, rows: slice, cols: slice) -> tuple[np.ndar
             32,
             {"p1": 5, "p2": 200, "gamma": 4.0, "uniqueness": 0, "lr_tol": 0, "edge_margin": 1},
         ),
+        # One pass over three paths (left, right, top): u8 path costs, then u16 ones (P2 200).
+        ("middlebury2001/tsukuba", slice(100, 180), slice(0, 200), -3, 24, {"paths": 3}),
+        (
+            "eth3d/terrace",
+            slice(200, 280),
+            slice(300, 480),
+            0,
+            32,
+            {"p1": 5, "p2": 200, "gamma": 4.0, "uniqueness": 0, "lr_tol": 0, "paths": 3},
+        ),
     ],
 )
 def test_bit_identical_to_the_numpy_reference(
@@ -113,6 +123,9 @@ def test_bad_input() -> None:
         sgm_disparity(img, img, max_disparity=8, edge_margin=2**40)
     with pytest.raises(ValueError, match="max_disparity"):
         sgm_disparity(img, img, max_disparity=float("nan"))
+    for paths in (5, True, "3"):
+        with pytest.raises(ValueError, match="paths"):
+            sgm_disparity(img, img, max_disparity=8, paths=paths)
     with pytest.raises(ValueError):
         sgm_disparity(img, img[:, :30], max_disparity=8)
 
@@ -264,3 +277,50 @@ def test_available_memory_is_read() -> None:
     with open("/proc/meminfo") as f:
         total = int(next(line for line in f if line.startswith("MemTotal:")).split()[1]) * 1024
     assert avail is not None and 0 < avail <= total
+
+
+@pytest.mark.parametrize(
+    ("scene", "bar"), [("middlebury2003/teddy", 0.45), ("eth3d/terrace", 0.25)]
+)
+def test_fast_mode_beats_filled_sgbm(data_dir: Path, scene: str, bar: float) -> None:
+    """``depth_map(method="fast")``: the census map over three paths in one pass, checked and
+    filled as ``"census"`` is, no re-measure. bad-2.0 against SGBM-3WAY + the row fill, OpenCV
+    in the same run (measured: teddy 4.64 vs 14.97 %, terrace 1.12 vs 8.51 %); the same map as
+    ``method="census", paths=3, refine=False``, and not the 8-path one."""
+    import stereovision as sv
+
+    sc = load_scene(data_dir / scene)
+    assert sc.gt is not None
+    md = sc.max_disparity
+    r = sv.depth_map(sc.left, sc.right, max_disparity=md, method="fast", return_channels=True)
+    sgbm = row_fill(opencv_sgbm(sc.left, sc.right, md))
+    ours, ref = (dense_metrics(d, sc.gt).bad[2.0] for d in (r.disparity, sgbm))
+    assert ours < bar * ref, (ours, ref)
+    assert r.density == 1.0 and "refine" not in r.timings
+    same = sv.depth_map(sc.left, sc.right, max_disparity=md, method="census", paths=3, refine=False)
+    np.testing.assert_array_equal(r.disparity, same.disparity)
+    assert r.channels is not None
+    eight = sgm_disparity(sc.left, sc.right, max_disparity=md)
+    assert not np.array_equal(r.channels["sgm"], eight, equal_nan=True)
+
+
+def test_fast_mode_unfilled_beats_the_gabor_channel_live(data_dir: Path) -> None:
+    """What ``stereovision stream`` can run: the Gabor channel as it streams by default
+    (``refine=False``, holes left) against ``method="fast", fill=False``. On teddy the fast map
+    measures more pixels and less than half as many of them are off by more than 2 px
+    (measured: 85.1 % measured, 2.80 % wrong, against 77.5 % and 7.83 %)."""
+    import stereovision as sv
+
+    sc = load_scene(data_dir / "middlebury2003/teddy")
+    gt = sc.gt
+    assert gt is not None
+    valid = np.isfinite(gt) & (gt > 0)
+    md = sc.max_disparity
+    figures = []
+    for kw in ({"method": "gabor", "refine": False}, {"method": "fast", "fill": False}):
+        d = sv.depth_map(sc.left, sc.right, max_disparity=md, **kw).disparity
+        m = valid & np.isfinite(d)
+        figures.append((m.sum() / valid.sum(), float((np.abs(d[m] - gt[m]) > 2).mean())))
+    (g_dens, g_bad), (f_dens, f_bad) = figures
+    assert f_dens > g_dens + 0.03, figures
+    assert f_bad < 0.5 * g_bad, figures

@@ -227,8 +227,10 @@ def sgm_disparity(
     uniqueness: int,
     lr_tol: int,
     edge_margin: int,
+    paths: int = 8,
 ) -> npt.NDArray[np.float32]:
-    """Census semi-global disparity over ``[d_min, d_max]``, NaN where rejected."""
+    """Census semi-global disparity over ``[d_min, d_max]``, NaN where rejected; ``paths`` 8
+    (two passes over a cost volume) or 3 (left, right and top, one pass)."""
 
 def gray_u8(
     image: npt.NDArray[np.uint8], weights: tuple[float, float, float]

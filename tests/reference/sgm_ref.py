@@ -21,6 +21,8 @@ OUTSIDE = (2 * RX + 1) * (2 * RY + 1)  # 63: one more than the 62 bits
 OUTSIDE_MARGIN = 5
 
 PATHS = ((0, 1), (0, -1), (1, 0), (-1, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
+#: ``paths=3``: left to right, right to left, top to bottom (OpenCV SGBM-3WAY's set).
+PATHS_3 = ((0, 1), (0, -1), (1, 0))
 
 
 def census(img: npt.ArrayLike) -> npt.NDArray[np.uint64]:
@@ -189,8 +191,9 @@ def sgm_disparity(
     uniqueness: int = 5,
     lr_tol: int = 1,
     edge_margin: int = 4,
+    paths: int = 8,
 ) -> np.ndarray:
-    """The whole matcher: census cost, 8-path aggregation, selection."""
+    """The whole matcher: census cost, 8-path (or 3-path) aggregation, selection."""
     c = cost_volume(left, right, d_min, d_max)
-    s = aggregate(c, left, p1, p2, gamma)
+    s = aggregate(c, left, p1, p2, gamma, PATHS if paths == 8 else PATHS_3)
     return select(s, d_min, uniqueness, lr_tol, edge_margin)

@@ -6,6 +6,7 @@
 //! python benches/dump_grey.py middlebury2006/cloth3 /tmp/cloth3     # prints W H D
 //! cargo run --release --example sgm_profile -- /tmp/cloth3 626 555 96            # min of 15
 //! cargo run --release --example sgm_profile -- /tmp/cloth3 626 555 96 whole=60   # for perf
+//! cargo run --release --example sgm_profile -- /tmp/cloth3 626 555 96 paths=3    # one pass
 //! ```
 //!
 //! Prints the minimum wall time of the runs (ms; the least disturbed by other load on a shared
@@ -22,12 +23,20 @@ use stereovision_core::matching::sgm::{sgm_disparity, SgmParams};
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let (l, r, d) = common::load_pair(&args, "sgm_profile PREFIX W H MAX_DISPARITY [whole=N]");
-    let p = SgmParams::default();
-    let runs = args
-        .get(5)
-        .and_then(|a| a.strip_prefix("whole="))
-        .map_or(15, |n| n.parse().expect("whole=N"));
+    let (l, r, d) = common::load_pair(
+        &args,
+        "sgm_profile PREFIX W H MAX_DISPARITY [whole=N] [paths=8|3]",
+    );
+    let opt = |key: &str| {
+        args.iter()
+            .skip(5)
+            .find_map(|a| a.strip_prefix(key).map(|v| v.parse::<usize>().expect(key)))
+    };
+    let runs = opt("whole=").unwrap_or(15);
+    let p = SgmParams {
+        paths: opt("paths=").map_or(8, |v| v as u8),
+        ..SgmParams::default()
+    };
     let mut best = f64::INFINITY;
     let mut out = Vec::new();
     for _ in 0..runs {

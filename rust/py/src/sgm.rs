@@ -10,7 +10,7 @@ use crate::errors::guard;
 
 /// Census semi-global disparity over `[d_min, d_max]`, NaN where rejected (module docs of the core).
 #[pyfunction]
-#[pyo3(signature = (left, right, d_min, d_max, p1, p2, gamma, uniqueness, lr_tol, edge_margin))]
+#[pyo3(signature = (left, right, d_min, d_max, p1, p2, gamma, uniqueness, lr_tol, edge_margin, paths=8))]
 #[allow(clippy::too_many_arguments)]
 pub fn sgm_disparity<'py>(
     py: Python<'py>,
@@ -24,6 +24,7 @@ pub fn sgm_disparity<'py>(
     uniqueness: u32,
     lr_tol: u32,
     edge_margin: u32,
+    paths: u8,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let l = grey_from_numpy(&left, "left")?;
     let r = grey_from_numpy(&right, "right")?;
@@ -35,6 +36,7 @@ pub fn sgm_disparity<'py>(
         uniqueness,
         lr_tol,
         edge_margin,
+        paths,
     };
     let (lv, rv) = (l.view(), r.view());
     let out = py.detach(|| guard("sgm_disparity", || core_sgm(lv, rv, d_min, d_max, &p)))?;

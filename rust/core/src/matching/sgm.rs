@@ -69,6 +69,10 @@ pub struct SgmParams {
     /// In the left band (`x < d_max`), the fewest columns between the winner's right pixel and
     /// the right image's left edge (`x - d`) for the pixel to be reported.
     pub edge_margin: u32,
+    /// Aggregation paths: 8 (Hirschmueller's, two passes over a cost volume) or 3 (left to
+    /// right, right to left and top to bottom, OpenCV SGBM-3WAY's set, in one pass with no
+    /// volume: [`sgm_three_paths`]).
+    pub paths: u8,
 }
 
 impl Default for SgmParams {
@@ -80,6 +84,7 @@ impl Default for SgmParams {
             uniqueness: 5,
             lr_tol: 1,
             edge_margin: 4,
+            paths: 8,
         }
     }
 }
@@ -106,6 +111,12 @@ impl SgmParams {
             return Err(CoreError::param(
                 "gamma",
                 format!("expected a positive number, got {}", self.gamma),
+            ));
+        }
+        if self.paths != 8 && self.paths != 3 {
+            return Err(CoreError::param(
+                "paths",
+                format!("expected 8 or 3, got {}", self.paths),
             ));
         }
         if self.uniqueness > 100 {
@@ -582,11 +593,14 @@ mod kept {
     struct Kept {
         volume: Vec<u8>,
         rows: Vec<Vec<u16>>,
+        /// The three-path matcher's rows in flight: costs and sums.
+        pairs: Vec<(Vec<u8>, Vec<u16>)>,
     }
 
     static KEPT: Mutex<Kept> = Mutex::new(Kept {
         volume: Vec::new(),
         rows: Vec::new(),
+        pairs: Vec::new(),
     });
 
     fn lock() -> std::sync::MutexGuard<'static, Kept> {
@@ -605,8 +619,9 @@ mod kept {
     }
 
     /// Keeps the volume, then as many rows as fit under [`KEEP_MAX_BYTES`].
+    /// The three-path rows kept stay, and count against the limit.
     pub fn put(volume: Vec<u8>, mut rows: Vec<Vec<u16>>) {
-        let mut room = KEEP_MAX_BYTES;
+        let mut room = KEEP_MAX_BYTES.saturating_sub(pairs_bytes(&lock().pairs));
         let volume = if volume.capacity() <= room {
             room -= volume.capacity();
             volume
@@ -620,10 +635,42 @@ mod kept {
         k.rows = rows;
     }
 
+    fn pairs_bytes(pairs: &[(Vec<u8>, Vec<u16>)]) -> usize {
+        pairs
+            .iter()
+            .map(|(c, a)| c.capacity() + 2 * a.capacity())
+            .sum()
+    }
+
+    /// The kept three-path rows of exactly `row_len` levels.
+    pub fn take_pairs(row_len: usize) -> Vec<(Vec<u8>, Vec<u16>)> {
+        let pairs = std::mem::take(&mut lock().pairs);
+        pairs
+            .into_iter()
+            .filter(|(c, _)| c.len() == row_len)
+            .collect()
+    }
+
+    /// Keeps as many three-path rows as fit under [`KEEP_MAX_BYTES`] (the volume and 8-path
+    /// rows, which a three-path call does not use, are left as they are).
+    pub fn put_pairs(mut pairs: Vec<(Vec<u8>, Vec<u16>)>) {
+        let per = pairs
+            .first()
+            .map_or(1, |(c, a)| (c.capacity() + 2 * a.capacity()).max(1));
+        let mut k = lock();
+        let room = KEEP_MAX_BYTES.saturating_sub(
+            k.volume.capacity() + k.rows.iter().map(|r| r.capacity() * 2).sum::<usize>(),
+        );
+        pairs.truncate(room / per);
+        k.pairs = pairs;
+    }
+
     /// Bytes kept.
     pub fn held_bytes() -> usize {
         let k = lock();
-        k.volume.capacity() + k.rows.iter().map(|r| r.capacity() * 2).sum::<usize>()
+        k.volume.capacity()
+            + k.rows.iter().map(|r| r.capacity() * 2).sum::<usize>()
+            + pairs_bytes(&k.pairs)
     }
 
     /// Frees what is kept; returns the bytes.
@@ -632,6 +679,7 @@ mod kept {
         let mut k = lock();
         k.volume = Vec::new();
         k.rows = Vec::new();
+        k.pairs = Vec::new();
         held
     }
 }
@@ -678,6 +726,9 @@ pub fn sgm_disparity(
         ));
     }
     let (w, h) = (left.width, left.height);
+    if p.paths == 3 {
+        return Ok(sgm_three_paths(left, right, i64::from(d_min), n, p));
+    }
     let (cl, cr) = rayon::join(|| census(left), || census(right));
     let (mut c, rows) = kept::take(w * n);
     cost_volume_into(&cl, &cr, w, i64::from(d_min), n, &mut c);
@@ -731,6 +782,327 @@ pub fn sgm_disparity(
         out[y * w..(y + 1) * w].copy_from_slice(&o);
     }
     Ok(out)
+}
+
+/// One path's step at one pixel (see [`step4`]): `out[1..n + 1]` gets the new path costs, which
+/// are stored into `acc` (`ADD` false) or added to it; returns their minimum.
+#[inline(always)]
+fn step1<T: PathCost, const ADD: bool>(
+    lp: &[T],
+    m: T,
+    p2: u16,
+    p1: u16,
+    c: &[u8],
+    out: &mut [T],
+    acc: &mut [u16],
+) -> T {
+    let n = c.len();
+    let (a, b, nx) = (&lp[..n], &lp[1..n + 1], &lp[2..n + 2]);
+    let (out, acc) = (&mut out[1..n + 1], &mut acc[..n]);
+    let lim = T::of(m.wide() + p2);
+    let p1 = T::of(p1);
+    let mut mn = T::MAX;
+    for k in 0..n {
+        let v = T::step(T::of(u16::from(c[k])), a[k], b[k], nx[k], p1, lim, m);
+        out[k] = v;
+        acc[k] = if ADD { acc[k] + v.wide() } else { v.wide() };
+        mn = mn.min(v);
+    }
+    mn
+}
+
+/// The two horizontal paths of one row (left to right stored into `acc`, right to left added):
+/// `c` and `acc` hold `n` levels per pixel, `bufs` three vectors of `n + 2` path costs (the
+/// first all zeros inside its pads: a path's first pixel steps from it).
+#[inline(always)]
+fn horizontal_impl<T: PathCost>(
+    c: &[u8],
+    irow: &[f32],
+    n: usize,
+    p: &SgmParams,
+    lut: &[u16],
+    acc: &mut [u16],
+    bufs: &mut [Vec<T>; 3],
+) {
+    let w = irow.len();
+    let [zero, hl, hl_next] = bufs;
+    for forward in [true, false] {
+        let mut hmin = T::of(0);
+        for j in 0..w {
+            let (x, xp) = if forward {
+                (j, j.wrapping_sub(1))
+            } else {
+                (w - 1 - j, w - j)
+            };
+            let (ci, a) = (&c[x * n..(x + 1) * n], &mut acc[x * n..(x + 1) * n]);
+            let (lp, m, p2) = if j == 0 {
+                (&zero[..], T::of(0), 0)
+            } else {
+                (&hl[..], hmin, p2_at(irow[x], irow[xp], p.gamma, lut))
+            };
+            hmin = if forward {
+                step1::<T, false>(lp, m, p2, p.p1, ci, hl_next, a)
+            } else {
+                step1::<T, true>(lp, m, p2, p.p1, ci, hl_next, a)
+            };
+            std::mem::swap(hl, hl_next);
+        }
+    }
+}
+
+/// The top-to-bottom path of one row, added to `acc`: `prev` / `prev_min` are the previous row's
+/// path costs (`n + 2` per pixel) and their minima (`prow` is that row's image, `None` on the
+/// first row), `cur` / `cur_min` receive this row's.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn vertical_impl<T: PathCost>(
+    c: &[u8],
+    irow: &[f32],
+    prow: Option<&[f32]>,
+    n: usize,
+    p: &SgmParams,
+    lut: &[u16],
+    acc: &mut [u16],
+    prev: &[T],
+    prev_min: &[T],
+    cur: &mut [T],
+    cur_min: &mut [T],
+    zero: &[T],
+) {
+    let stride = n + 2;
+    for x in 0..irow.len() {
+        let (lp, m, p2) = match prow {
+            Some(pr) => (
+                &prev[x * stride..(x + 1) * stride],
+                prev_min[x],
+                p2_at(irow[x], pr[x], p.gamma, lut),
+            ),
+            None => (zero, T::of(0), 0),
+        };
+        cur_min[x] = step1::<T, true>(
+            lp,
+            m,
+            p2,
+            p.p1,
+            &c[x * n..(x + 1) * n],
+            &mut cur[x * stride..(x + 1) * stride],
+            &mut acc[x * n..(x + 1) * n],
+        );
+    }
+}
+
+/// `fn $h` / `fn $v`: [`horizontal_impl`] / [`vertical_impl`] with `$t` path costs, compiled
+/// for the baseline and AVX2.
+macro_rules! three_with {
+    ($h:ident, $v:ident, $t:ty) => {
+        simd_fn! {
+            fn $h(
+                c: &[u8],
+                irow: &[f32],
+                n: usize,
+                p: &SgmParams,
+                lut: &[u16],
+                acc: &mut [u16],
+                bufs: &mut [Vec<$t>; 3],
+            ) {
+                horizontal_impl::<$t>(c, irow, n, p, lut, acc, bufs)
+            }
+        }
+        simd_fn! {
+            fn $v(
+                c: &[u8],
+                irow: &[f32],
+                prow: Option<&[f32]>,
+                n: usize,
+                p: &SgmParams,
+                lut: &[u16],
+                acc: &mut [u16],
+                prev: &[$t],
+                prev_min: &[$t],
+                cur: &mut [$t],
+                cur_min: &mut [$t],
+                zero: &[$t],
+            ) {
+                vertical_impl::<$t>(
+                    c, irow, prow, n, p, lut, acc, prev, prev_min, cur, cur_min, zero,
+                )
+            }
+        }
+    };
+}
+three_with!(horizontal_u8, vertical_u8, u8);
+three_with!(horizontal_u16, vertical_u16, u16);
+
+/// Path-cost buffers of [`sgm_three_paths`] for one path-cost type.
+trait ThreePaths: PathCost + Send {
+    #[allow(clippy::too_many_arguments)]
+    fn horizontal(
+        c: &[u8],
+        irow: &[f32],
+        n: usize,
+        p: &SgmParams,
+        lut: &[u16],
+        acc: &mut [u16],
+        bufs: &mut [Vec<Self>; 3],
+    );
+    #[allow(clippy::too_many_arguments)]
+    fn vertical(
+        c: &[u8],
+        irow: &[f32],
+        prow: Option<&[f32]>,
+        n: usize,
+        p: &SgmParams,
+        lut: &[u16],
+        acc: &mut [u16],
+        prev: &[Self],
+        prev_min: &[Self],
+        cur: &mut [Self],
+        cur_min: &mut [Self],
+        zero: &[Self],
+    );
+}
+
+macro_rules! three_paths_for {
+    ($t:ty, $h:ident, $v:ident) => {
+        impl ThreePaths for $t {
+            fn horizontal(
+                c: &[u8],
+                irow: &[f32],
+                n: usize,
+                p: &SgmParams,
+                lut: &[u16],
+                acc: &mut [u16],
+                bufs: &mut [Vec<Self>; 3],
+            ) {
+                $h(c, irow, n, p, lut, acc, bufs)
+            }
+            fn vertical(
+                c: &[u8],
+                irow: &[f32],
+                prow: Option<&[f32]>,
+                n: usize,
+                p: &SgmParams,
+                lut: &[u16],
+                acc: &mut [u16],
+                prev: &[Self],
+                prev_min: &[Self],
+                cur: &mut [Self],
+                cur_min: &mut [Self],
+                zero: &[Self],
+            ) {
+                $v(
+                    c, irow, prow, n, p, lut, acc, prev, prev_min, cur, cur_min, zero,
+                )
+            }
+        }
+    };
+}
+three_paths_for!(u8, horizontal_u8, vertical_u8);
+three_paths_for!(u16, horizontal_u16, vertical_u16);
+
+/// A path-cost vector of `n + 2` entries: zeros inside the two pads.
+fn zero_path<T: PathCost>(n: usize) -> Vec<T> {
+    let mut z = vec![T::of(0); n + 2];
+    z[0] = T::PAD;
+    z[n + 1] = T::PAD;
+    z
+}
+
+/// The matcher with `paths` 3: left to right, right to left and top to bottom (OpenCV
+/// SGBM-3WAY's set), one row at a time with no cost volume. Two workers meet row by row: the
+/// first computes each row's costs and its two horizontal paths, the second adds the vertical
+/// path, which needs the rows in order, and selects the row. Every row is the same arithmetic
+/// whichever worker is ahead, so the output does not depend on the thread count; on one thread
+/// the first worker runs to the end before the second starts (its rows queue up).
+fn sgm_three_paths(
+    left: ImageView<'_>,
+    right: ImageView<'_>,
+    d_min: i64,
+    n: usize,
+    p: &SgmParams,
+) -> Vec<f32> {
+    let lut = p2_table(p);
+    if u8_fits(&lut) {
+        three_paths_as::<u8>(left, right, d_min, n, p, &lut)
+    } else {
+        three_paths_as::<u16>(left, right, d_min, n, p, &lut)
+    }
+}
+
+fn three_paths_as<T: ThreePaths>(
+    left: ImageView<'_>,
+    right: ImageView<'_>,
+    d_min: i64,
+    n: usize,
+    p: &SgmParams,
+    lut: &[u16],
+) -> Vec<f32> {
+    let (w, h) = (left.width, left.height);
+    let (cl, cr) = rayon::join(|| census(left), || census(right));
+    let img = left.data;
+    // Rows travel to the second worker with their costs and horizontal sums, and come back
+    // to be reused.
+    type Row = (Vec<u8>, Vec<u16>);
+    let (to_second, rows_in) = std::sync::mpsc::channel::<(usize, Row)>();
+    let (to_first, rows_back) = std::sync::mpsc::channel::<Row>();
+    // The rows kept from the last call of this size first (a video's next frame).
+    for row in kept::take_pairs(w * n) {
+        let _ = to_first.send(row);
+    }
+    let mut out = vec![f32::NAN; w * h];
+    let first = move || {
+        let mut rev = Vec::with_capacity(w);
+        let mut bufs: [Vec<T>; 3] = [zero_path(n), vec![T::PAD; n + 2], vec![T::PAD; n + 2]];
+        for y in 0..h {
+            let (mut c, mut acc) = rows_back
+                .try_recv()
+                .unwrap_or_else(|_| (vec![0u8; w * n], vec![0u16; w * n]));
+            rev.clear();
+            rev.extend(cr[y * w..(y + 1) * w].iter().rev());
+            cost_row(&cl[y * w..(y + 1) * w], &rev, d_min, n, &mut c);
+            T::horizontal(&c, &img[y * w..(y + 1) * w], n, p, lut, &mut acc, &mut bufs);
+            if to_second.send((y, (c, acc))).is_err() {
+                break; // the second worker stopped (a panic): nothing left to do
+            }
+        }
+        // The second worker's loop ends with the last row; the rows it sends back after this
+        // wait in the channel, which outlives this worker.
+        drop(to_second);
+        rows_back
+    };
+    let out_rows = &mut out;
+    let second = move || {
+        let stride = n + 2;
+        let zero = zero_path::<T>(n);
+        let (mut prev, mut cur) = (vec![T::PAD; w * stride], vec![T::PAD; w * stride]);
+        let (mut prev_min, mut cur_min) = (vec![T::of(0); w], vec![T::of(0); w]);
+        for (y, (c, mut acc)) in rows_in.iter() {
+            let irow = &img[y * w..(y + 1) * w];
+            let prow = (y > 0).then(|| &img[(y - 1) * w..y * w]);
+            T::vertical(
+                &c,
+                irow,
+                prow,
+                n,
+                p,
+                lut,
+                &mut acc,
+                &prev,
+                &prev_min,
+                &mut cur,
+                &mut cur_min,
+                &zero,
+            );
+            std::mem::swap(&mut prev, &mut cur);
+            std::mem::swap(&mut prev_min, &mut cur_min);
+            select_row(&acc, w, n, d_min, p, &mut out_rows[y * w..(y + 1) * w]);
+            let _ = to_first.send((c, acc)); // reused, or kept for the next call below
+        }
+    };
+    // The producer first: on one thread `join` runs it to the end before the consumer.
+    let (rows_back, ()) = rayon::join(first, second);
+    kept::put_pairs(rows_back.try_iter().collect());
+    out
 }
 
 #[cfg(test)]
@@ -852,6 +1224,19 @@ mod tests {
         assert!(same(&first, &again));
         sgm_disparity(lv, rv, 0, 15, &p).unwrap();
         assert!(same(&first, &sgm_disparity(lv, rv, 0, 15, &p).unwrap()));
+        // The three-path matcher's kept rows, between calls of either kind and size.
+        let p3 = SgmParams { paths: 3, ..p };
+        let first3 = sgm_disparity(lv, rv, 0, 15, &p3).unwrap();
+        for (a, b, d, q) in [
+            (big.0, big.1, 31, p3),
+            (lv, rv, 15, p3),
+            (big.0, big.1, 31, p),
+        ] {
+            sgm_disparity(a, b, 0, d, &q).unwrap();
+            assert!(same(&first3, &sgm_disparity(lv, rv, 0, 15, &p3).unwrap()));
+            assert!(same(&first, &sgm_disparity(lv, rv, 0, 15, &p).unwrap()));
+        }
+        assert!(kept_bytes() <= KEEP_MAX_BYTES);
     }
 
     /// Every row's summed path costs of one pass, with `u8` or `u16` path costs.
@@ -894,12 +1279,82 @@ mod tests {
     }
 
     #[test]
+    fn three_paths_recover_a_shift_alike_on_any_thread_count_and_cost_width() {
+        let (w, h) = (80, 40);
+        let (l, r) = (ramp(w, h, 0.0), ramp(w, h, 6.0));
+        let lv = ImageView::new(w, h, &l).unwrap();
+        let rv = ImageView::new(w, h, &r).unwrap();
+        let p = SgmParams {
+            paths: 3,
+            ..SgmParams::default()
+        };
+        let d = sgm_disparity(lv, rv, 0, 15, &p).unwrap();
+        let inner: Vec<f32> = (5..h - 5)
+            .flat_map(|y| (20..w - 5).map(move |x| (x, y)))
+            .map(|(x, y)| d[y * w + x])
+            .collect();
+        let good = inner.iter().filter(|v| (**v - 6.0).abs() < 0.5).count();
+        assert!(good * 100 >= inner.len() * 95, "{good} of {}", inner.len());
+        // Not the eight paths' map: another aggregation (so the option is not ignored).
+        let eight = sgm_disparity(lv, rv, 0, 15, &SgmParams::default()).unwrap();
+        let bits = |a: &[f32]| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_ne!(bits(&d), bits(&eight));
+        // One worker (the rows queue up) and three give the same bits.
+        for threads in [1, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let again = pool.install(|| sgm_disparity(lv, rv, 0, 15, &p).unwrap());
+            assert_eq!(bits(&again), bits(&d), "{threads} threads");
+        }
+        // u8 and u16 path costs: the same integers, with steps that take every P2 level.
+        let lut = p2_table(&p);
+        assert!(u8_fits(&lut));
+        let spiky: Vec<f32> = l
+            .iter()
+            .enumerate()
+            .map(|(i, v)| if i % 13 < 2 { 1.0 } else { *v })
+            .collect();
+        let sv = ImageView::new(w, h, &spiky).unwrap();
+        let a = three_paths_as::<u8>(sv, rv, -3, 19, &p, &lut);
+        let b = three_paths_as::<u16>(sv, rv, -3, 19, &p, &lut);
+        assert_eq!(bits(&a), bits(&b));
+        assert!(a.iter().filter(|v| v.is_finite()).count() > w * h / 3);
+    }
+
+    #[test]
+    fn paths_other_than_8_or_3_are_refused() {
+        let img = vec![0.5f32; 64];
+        let v = ImageView::new(8, 8, &img).unwrap();
+        let p = SgmParams {
+            paths: 4,
+            ..SgmParams::default()
+        };
+        assert!(matches!(
+            sgm_disparity(v, v, 0, 4, &p).unwrap_err(),
+            CoreError::InvalidParameter { name: "paths", .. }
+        ));
+    }
+
+    #[test]
     fn tiny_images_and_single_levels_work() {
         let img: Vec<f32> = (0..6).map(|i| i as f32 / 6.0).collect();
         let v = ImageView::new(3, 2, &img).unwrap();
-        for (a, b) in [(0, 0), (0, 5), (-2, 2)] {
-            let d = sgm_disparity(v, v, a, b, &SgmParams::default()).unwrap();
-            assert_eq!(d.len(), 6);
+        for paths in [8, 3] {
+            let p = SgmParams {
+                paths,
+                ..SgmParams::default()
+            };
+            for (a, b) in [(0, 0), (0, 5), (-2, 2)] {
+                let d = sgm_disparity(v, v, a, b, &p).unwrap();
+                assert_eq!(d.len(), 6);
+            }
+            // One row, one column.
+            let row = ImageView::new(6, 1, &img).unwrap();
+            let col = ImageView::new(1, 6, &img).unwrap();
+            assert_eq!(sgm_disparity(row, row, 0, 3, &p).unwrap().len(), 6);
+            assert_eq!(sgm_disparity(col, col, 0, 0, &p).unwrap().len(), 6);
         }
     }
 }
