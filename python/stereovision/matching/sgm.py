@@ -44,6 +44,9 @@ DEFAULTS: dict[str, Any] = {
 # every row when the two aggregation passes meet in the middle (measured: a 3840 x 2160 pair
 # over 577 levels peaked at 14.7 GB for the whole default depth_map, 4.8 G cells).
 _BYTES_PER_CELL = 3
+# paths=3 holds rows, not a volume: at most THREE_PATHS_LEAD (8) rows wait for the vertical path,
+# one is being filled and one selected, and the census codes take 16 bytes a pixel.
+_ROWS_IN_FLIGHT_3 = 8 + 2
 _MAX_LEVELS = 2048  # the kernel's limit
 
 
@@ -71,11 +74,12 @@ def _available_bytes() -> int | None:
     return avail
 
 
-def _check_memory(width: int, height: int, levels: int) -> None:
+def _check_memory(width: int, height: int, levels: int, paths: int = 8) -> None:
     """MemoryError, naming the sizes and what to change, when the kernel's peak would not fit:
     past that point the system's OOM killer ends the whole process (on a robot, every node in
     it) instead of one call failing."""
-    need = _BYTES_PER_CELL * width * height * levels
+    rows = height if paths == 8 else min(height, _ROWS_IN_FLIGHT_3)
+    need = _BYTES_PER_CELL * width * rows * levels + (0 if paths == 8 else 16 * width * height)
     avail = _available_bytes()
     if avail is None:
         return
@@ -86,7 +90,7 @@ def _check_memory(width: int, height: int, levels: int) -> None:
         raise MemoryError(
             f"the census semi-global map needs about {need / 2**30:.1f} GiB for a {width}x"
             f"{height} pair over {levels} disparity levels, and {avail / 2**30:.1f} GiB is "
-            "available: lower max_disparity, shrink the pair, or use method='gabor'"
+            "available: lower max_disparity, shrink the pair, or use method='fast' or 'gabor'"
         )
 
 
@@ -154,7 +158,7 @@ def sgm_disparity(
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
     levels = math.ceil(max_disparity) - math.floor(min_disparity) + 1
     if levels <= _MAX_LEVELS:  # beyond it the kernel's own range error is the clearer one
-        _check_memory(gl.shape[1], gl.shape[0], levels)
+        _check_memory(gl.shape[1], gl.shape[0], levels, int(p["paths"]))
     return _core.sgm_disparity(
         np.ascontiguousarray(gl),
         np.ascontiguousarray(gr),

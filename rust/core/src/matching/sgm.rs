@@ -1029,6 +1029,34 @@ fn sgm_three_paths(
     }
 }
 
+/// Rows the first worker of [`sgm_three_paths`] may run ahead of the vertical path before it
+/// takes the vertical path's next row itself: the rows in flight, and so the memory, stay
+/// bounded (a few rows of `3 w n` bytes) even when the second worker never starts.
+pub const THREE_PATHS_LEAD: usize = 8;
+
+/// One row in flight: its costs and its path sums.
+type Row = (Vec<u8>, Vec<u16>);
+
+/// The rows between the two workers of [`sgm_three_paths`].
+struct Flight {
+    /// Rows with their horizontal paths, in order, waiting for the vertical path.
+    ready: std::collections::VecDeque<(usize, Row)>,
+    /// Rows done with, to be reused.
+    free: Vec<Row>,
+    /// Every row has been queued.
+    all_queued: bool,
+}
+
+/// The vertical path's state: the previous row's path costs and minima, and the output.
+struct Vertical<'a, T> {
+    prev: Vec<T>,
+    cur: Vec<T>,
+    prev_min: Vec<T>,
+    cur_min: Vec<T>,
+    zero: Vec<T>,
+    out: &'a mut [f32],
+}
+
 fn three_paths_as<T: ThreePaths>(
     left: ImageView<'_>,
     right: ImageView<'_>,
@@ -1037,71 +1065,104 @@ fn three_paths_as<T: ThreePaths>(
     p: &SgmParams,
     lut: &[u16],
 ) -> Vec<f32> {
+    use std::sync::{Condvar, Mutex, MutexGuard};
+    fn lock(m: &Mutex<Flight>) -> MutexGuard<'_, Flight> {
+        // Moves of whole rows only: a panic cannot leave it inconsistent.
+        m.lock().unwrap_or_else(|e| e.into_inner())
+    }
     let (w, h) = (left.width, left.height);
     let (cl, cr) = rayon::join(|| census(left), || census(right));
     let img = left.data;
-    // Rows travel to the second worker with their costs and horizontal sums, and come back
-    // to be reused.
-    type Row = (Vec<u8>, Vec<u16>);
-    let (to_second, rows_in) = std::sync::mpsc::channel::<(usize, Row)>();
-    let (to_first, rows_back) = std::sync::mpsc::channel::<Row>();
-    // The rows kept from the last call of this size first (a video's next frame).
-    for row in kept::take_pairs(w * n) {
-        let _ = to_first.send(row);
-    }
+    let stride = n + 2;
     let mut out = vec![f32::NAN; w * h];
-    let first = move || {
+    // The rows kept from the last call of this size first (a video's next frame).
+    let flight = Mutex::new(Flight {
+        ready: Default::default(),
+        free: kept::take_pairs(w * n),
+        all_queued: false,
+    });
+    let queued = Condvar::new();
+    let vertical = Mutex::new(Vertical {
+        prev: vec![T::PAD; w * stride],
+        cur: vec![T::PAD; w * stride],
+        prev_min: vec![T::of(0); w],
+        cur_min: vec![T::of(0); w],
+        zero: zero_path::<T>(n),
+        out: &mut out,
+    });
+    // The vertical path and the selection of the next queued row, by whichever worker calls it;
+    // false when no row is queued. The rows are taken and run in order under `vertical`'s
+    // lock (always taken before `flight`'s), so the output does not depend on who runs them.
+    let vertical_step = || -> bool {
+        let mut v = vertical.lock().unwrap_or_else(|e| e.into_inner());
+        let Some((y, (c, mut acc))) = lock(&flight).ready.pop_front() else {
+            return false;
+        };
+        let v = &mut *v;
+        let irow = &img[y * w..(y + 1) * w];
+        let prow = (y > 0).then(|| &img[(y - 1) * w..y * w]);
+        T::vertical(
+            &c,
+            irow,
+            prow,
+            n,
+            p,
+            lut,
+            &mut acc,
+            &v.prev,
+            &v.prev_min,
+            &mut v.cur,
+            &mut v.cur_min,
+            &v.zero,
+        );
+        std::mem::swap(&mut v.prev, &mut v.cur);
+        std::mem::swap(&mut v.prev_min, &mut v.cur_min);
+        select_row(&acc, w, n, d_min, p, &mut v.out[y * w..(y + 1) * w]);
+        lock(&flight).free.push((c, acc));
+        true
+    };
+    let first = || {
         let mut rev = Vec::with_capacity(w);
         let mut bufs: [Vec<T>; 3] = [zero_path(n), vec![T::PAD; n + 2], vec![T::PAD; n + 2]];
         for y in 0..h {
-            let (mut c, mut acc) = rows_back
-                .try_recv()
-                .unwrap_or_else(|_| (vec![0u8; w * n], vec![0u16; w * n]));
+            let reused = lock(&flight).free.pop();
+            let (mut c, mut acc) = reused.unwrap_or_else(|| (vec![0u8; w * n], vec![0u16; w * n]));
             rev.clear();
             rev.extend(cr[y * w..(y + 1) * w].iter().rev());
             cost_row(&cl[y * w..(y + 1) * w], &rev, d_min, n, &mut c);
             T::horizontal(&c, &img[y * w..(y + 1) * w], n, p, lut, &mut acc, &mut bufs);
-            if to_second.send((y, (c, acc))).is_err() {
-                break; // the second worker stopped (a panic): nothing left to do
+            let waiting = {
+                let mut f = lock(&flight);
+                f.ready.push_back((y, (c, acc)));
+                f.ready.len()
+            };
+            queued.notify_one();
+            if waiting > THREE_PATHS_LEAD {
+                vertical_step(); // too far ahead (or alone): take the vertical path's next row
             }
         }
-        // The second worker's loop ends with the last row; the rows it sends back after this
-        // wait in the channel, which outlives this worker.
-        drop(to_second);
-        rows_back
+        lock(&flight).all_queued = true;
+        queued.notify_all();
+        while vertical_step() {}
     };
-    let out_rows = &mut out;
-    let second = move || {
-        let stride = n + 2;
-        let zero = zero_path::<T>(n);
-        let (mut prev, mut cur) = (vec![T::PAD; w * stride], vec![T::PAD; w * stride]);
-        let (mut prev_min, mut cur_min) = (vec![T::of(0); w], vec![T::of(0); w]);
-        for (y, (c, mut acc)) in rows_in.iter() {
-            let irow = &img[y * w..(y + 1) * w];
-            let prow = (y > 0).then(|| &img[(y - 1) * w..y * w]);
-            T::vertical(
-                &c,
-                irow,
-                prow,
-                n,
-                p,
-                lut,
-                &mut acc,
-                &prev,
-                &prev_min,
-                &mut cur,
-                &mut cur_min,
-                &zero,
-            );
-            std::mem::swap(&mut prev, &mut cur);
-            std::mem::swap(&mut prev_min, &mut cur_min);
-            select_row(&acc, w, n, d_min, p, &mut out_rows[y * w..(y + 1) * w]);
-            let _ = to_first.send((c, acc)); // reused, or kept for the next call below
+    let second = || loop {
+        {
+            let mut f = lock(&flight);
+            while f.ready.is_empty() && !f.all_queued {
+                f = queued.wait(f).unwrap_or_else(|e| e.into_inner());
+            }
+            if f.ready.is_empty() {
+                return; // all queued and all taken
+            }
         }
+        vertical_step();
     };
-    // The producer first: on one thread `join` runs it to the end before the consumer.
-    let (rows_back, ()) = rayon::join(first, second);
-    kept::put_pairs(rows_back.try_iter().collect());
+    // The first worker on this thread: on one thread `join` runs it to the end (it takes every
+    // row's vertical path itself once it is `THREE_PATHS_LEAD` ahead), then the second, which
+    // finds nothing left.
+    rayon::join(first, second);
+    drop(vertical);
+    kept::put_pairs(flight.into_inner().unwrap_or_else(|e| e.into_inner()).free);
     out
 }
 
@@ -1321,6 +1382,30 @@ mod tests {
         let b = three_paths_as::<u16>(sv, rv, -3, 19, &p, &lut);
         assert_eq!(bits(&a), bits(&b));
         assert!(a.iter().filter(|v| v.is_finite()).count() > w * h / 3);
+    }
+
+    #[test]
+    fn three_paths_hold_a_few_rows_even_on_one_thread() {
+        // On one thread the second worker starts only after the first is done: the first takes
+        // the vertical path's rows itself once it is THREE_PATHS_LEAD ahead. A size no other
+        // test uses, so the rows kept afterwards are this call's.
+        let (w, h) = (70, 300);
+        let (l, r) = (ramp(w, h, 0.0), ramp(w, h, 4.0));
+        let lv = ImageView::new(w, h, &l).unwrap();
+        let rv = ImageView::new(w, h, &r).unwrap();
+        let p = SgmParams {
+            paths: 3,
+            ..SgmParams::default()
+        };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let d = pool.install(|| sgm_disparity(lv, rv, 0, 9, &p).unwrap());
+        let rows = kept::take_pairs(w * 10).len();
+        assert!(rows <= THREE_PATHS_LEAD + 3, "{rows} rows allocated");
+        let good = d.iter().filter(|v| (**v - 4.0).abs() < 0.5).count();
+        assert!(good * 10 >= d.len() * 8, "{good} of {}", d.len());
     }
 
     #[test]
