@@ -492,6 +492,9 @@ def run_stream(
     method : str
         Matcher (:data:`stereovision.depth.METHODS`). ``"gabor"`` by default: a live view wants
         the rate, and it is 3-4 times faster than ``depth_map``'s default ``"fused"``.
+        ``"fast"`` with ``fill=False`` measures more pixels with less than half as many of them
+        wrong (over the 17 GT scenes 82 % measured, 3.4 % off by more than 2 px, against 74 %
+        and 7.7 %) at about three quarters of the Gabor channel's frame rate.
     max_disparity : int, optional
         Disparity range. None estimates it once, from the first pair.
     frames : int, optional
@@ -504,8 +507,8 @@ def run_stream(
         turn it on for measurements.
     fill : bool, optional
         Fill the holes (:func:`stereovision.depth.depth_map`'s ``fill``). None (default): the
-        method's choice (``"fused"`` and ``"census"`` fill; the plane fill is about a third of
-        the census mode's frame at 640x480).
+        method's choice (``"fused"``, ``"census"`` and ``"fast"`` fill; the plane fill is about a
+        third of the census mode's frame at 640x480).
     on_report : callable, optional
         Called with each per-second report (a JSON-ready dict, see the module doc).
     on_result : callable, optional
@@ -951,7 +954,10 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--size", help="requested size WIDTHxHEIGHT (frames are resized if needed)")
     p.add_argument("--max-disparity", type=int, help="default: estimated from the first pair")
     p.add_argument(
-        "--method", default="gabor", choices=METHODS, help="matcher (default: gabor, the fast one)"
+        "--method",
+        default="gabor",
+        choices=METHODS,
+        help="matcher (default: gabor, the quickest; fast --no-fill: half its wrong pixels)",
     )
     p.add_argument("--frames", type=int, help="stop after N pairs (default: until a source ends)")
     p.add_argument(
