@@ -811,9 +811,48 @@ fn step1<T: PathCost, const ADD: bool>(
     mn
 }
 
+/// The horizontal paths' state: a path's first pixel steps from `zero` (zeros inside the two
+/// pads), then from the previous pixel's costs (`last`; `next` receives the new ones).
+struct Horizontal<T> {
+    zero: Vec<T>,
+    last: Vec<T>,
+    next: Vec<T>,
+}
+
+impl<T: PathCost> Horizontal<T> {
+    fn new(n: usize) -> Self {
+        Horizontal {
+            zero: zero_path(n),
+            last: vec![T::PAD; n + 2],
+            next: vec![T::PAD; n + 2],
+        }
+    }
+}
+
+/// The vertical path's state: the previous row's path costs (`n + 2` per pixel) and their
+/// minima; `cur` / `cur_min` receive this row's.
+struct VerticalPath<T> {
+    zero: Vec<T>,
+    prev: Vec<T>,
+    prev_min: Vec<T>,
+    cur: Vec<T>,
+    cur_min: Vec<T>,
+}
+
+impl<T: PathCost> VerticalPath<T> {
+    fn new(w: usize, n: usize) -> Self {
+        VerticalPath {
+            zero: zero_path(n),
+            prev: vec![T::PAD; w * (n + 2)],
+            prev_min: vec![T::of(0); w],
+            cur: vec![T::PAD; w * (n + 2)],
+            cur_min: vec![T::of(0); w],
+        }
+    }
+}
+
 /// The two horizontal paths of one row (left to right stored into `acc`, right to left added):
-/// `c` and `acc` hold `n` levels per pixel, `bufs` three vectors of `n + 2` path costs (the
-/// first all zeros inside its pads: a path's first pixel steps from it).
+/// `c` and `acc` hold `n` levels per pixel.
 #[inline(always)]
 fn horizontal_impl<T: PathCost>(
     c: &[u8],
@@ -822,10 +861,9 @@ fn horizontal_impl<T: PathCost>(
     p: &SgmParams,
     lut: &[u16],
     acc: &mut [u16],
-    bufs: &mut [Vec<T>; 3],
+    hp: &mut Horizontal<T>,
 ) {
     let w = irow.len();
-    let [zero, hl, hl_next] = bufs;
     for forward in [true, false] {
         let mut hmin = T::of(0);
         for j in 0..w {
@@ -836,23 +874,22 @@ fn horizontal_impl<T: PathCost>(
             };
             let (ci, a) = (&c[x * n..(x + 1) * n], &mut acc[x * n..(x + 1) * n]);
             let (lp, m, p2) = if j == 0 {
-                (&zero[..], T::of(0), 0)
+                (&hp.zero[..], T::of(0), 0)
             } else {
-                (&hl[..], hmin, p2_at(irow[x], irow[xp], p.gamma, lut))
+                (&hp.last[..], hmin, p2_at(irow[x], irow[xp], p.gamma, lut))
             };
             hmin = if forward {
-                step1::<T, false>(lp, m, p2, p.p1, ci, hl_next, a)
+                step1::<T, false>(lp, m, p2, p.p1, ci, &mut hp.next, a)
             } else {
-                step1::<T, true>(lp, m, p2, p.p1, ci, hl_next, a)
+                step1::<T, true>(lp, m, p2, p.p1, ci, &mut hp.next, a)
             };
-            std::mem::swap(hl, hl_next);
+            std::mem::swap(&mut hp.last, &mut hp.next);
         }
     }
 }
 
-/// The top-to-bottom path of one row, added to `acc`: `prev` / `prev_min` are the previous row's
-/// path costs (`n + 2` per pixel) and their minima (`prow` is that row's image, `None` on the
-/// first row), `cur` / `cur_min` receive this row's.
+/// The top-to-bottom path of one row, added to `acc` (`prow`: the previous row's image, `None`
+/// on the first row); `vp` moves on to this row.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn vertical_impl<T: PathCost>(
@@ -863,38 +900,42 @@ fn vertical_impl<T: PathCost>(
     p: &SgmParams,
     lut: &[u16],
     acc: &mut [u16],
-    prev: &[T],
-    prev_min: &[T],
-    cur: &mut [T],
-    cur_min: &mut [T],
-    zero: &[T],
+    vp: &mut VerticalPath<T>,
 ) {
     let stride = n + 2;
     for x in 0..irow.len() {
         let (lp, m, p2) = match prow {
             Some(pr) => (
-                &prev[x * stride..(x + 1) * stride],
-                prev_min[x],
+                &vp.prev[x * stride..(x + 1) * stride],
+                vp.prev_min[x],
                 p2_at(irow[x], pr[x], p.gamma, lut),
             ),
-            None => (zero, T::of(0), 0),
+            None => (&vp.zero[..], T::of(0), 0),
         };
-        cur_min[x] = step1::<T, true>(
+        vp.cur_min[x] = step1::<T, true>(
             lp,
             m,
             p2,
             p.p1,
             &c[x * n..(x + 1) * n],
-            &mut cur[x * stride..(x + 1) * stride],
+            &mut vp.cur[x * stride..(x + 1) * stride],
             &mut acc[x * n..(x + 1) * n],
         );
     }
+    std::mem::swap(&mut vp.prev, &mut vp.cur);
+    std::mem::swap(&mut vp.prev_min, &mut vp.cur_min);
 }
+
+/// [`horizontal_impl`] for one path-cost type (`simd_fn!` takes no generics).
+type HorizontalFn<T> = fn(&[u8], &[f32], usize, &SgmParams, &[u16], &mut [u16], &mut Horizontal<T>);
+/// [`vertical_impl`] for one path-cost type.
+type VerticalFn<T> =
+    fn(&[u8], &[f32], Option<&[f32]>, usize, &SgmParams, &[u16], &mut [u16], &mut VerticalPath<T>);
 
 /// `fn $h` / `fn $v`: [`horizontal_impl`] / [`vertical_impl`] with `$t` path costs, compiled
 /// for the baseline and AVX2.
-macro_rules! three_with {
-    ($h:ident, $v:ident, $t:ty) => {
+macro_rules! three_paths_for {
+    ($t:ty, $h:ident, $v:ident) => {
         simd_fn! {
             fn $h(
                 c: &[u8],
@@ -903,9 +944,9 @@ macro_rules! three_with {
                 p: &SgmParams,
                 lut: &[u16],
                 acc: &mut [u16],
-                bufs: &mut [Vec<$t>; 3],
+                hp: &mut Horizontal<$t>,
             ) {
-                horizontal_impl::<$t>(c, irow, n, p, lut, acc, bufs)
+                horizontal_impl(c, irow, n, p, lut, acc, hp)
             }
         }
         simd_fn! {
@@ -917,82 +958,9 @@ macro_rules! three_with {
                 p: &SgmParams,
                 lut: &[u16],
                 acc: &mut [u16],
-                prev: &[$t],
-                prev_min: &[$t],
-                cur: &mut [$t],
-                cur_min: &mut [$t],
-                zero: &[$t],
+                vp: &mut VerticalPath<$t>,
             ) {
-                vertical_impl::<$t>(
-                    c, irow, prow, n, p, lut, acc, prev, prev_min, cur, cur_min, zero,
-                )
-            }
-        }
-    };
-}
-three_with!(horizontal_u8, vertical_u8, u8);
-three_with!(horizontal_u16, vertical_u16, u16);
-
-/// Path-cost buffers of [`sgm_three_paths`] for one path-cost type.
-trait ThreePaths: PathCost + Send {
-    #[allow(clippy::too_many_arguments)]
-    fn horizontal(
-        c: &[u8],
-        irow: &[f32],
-        n: usize,
-        p: &SgmParams,
-        lut: &[u16],
-        acc: &mut [u16],
-        bufs: &mut [Vec<Self>; 3],
-    );
-    #[allow(clippy::too_many_arguments)]
-    fn vertical(
-        c: &[u8],
-        irow: &[f32],
-        prow: Option<&[f32]>,
-        n: usize,
-        p: &SgmParams,
-        lut: &[u16],
-        acc: &mut [u16],
-        prev: &[Self],
-        prev_min: &[Self],
-        cur: &mut [Self],
-        cur_min: &mut [Self],
-        zero: &[Self],
-    );
-}
-
-macro_rules! three_paths_for {
-    ($t:ty, $h:ident, $v:ident) => {
-        impl ThreePaths for $t {
-            fn horizontal(
-                c: &[u8],
-                irow: &[f32],
-                n: usize,
-                p: &SgmParams,
-                lut: &[u16],
-                acc: &mut [u16],
-                bufs: &mut [Vec<Self>; 3],
-            ) {
-                $h(c, irow, n, p, lut, acc, bufs)
-            }
-            fn vertical(
-                c: &[u8],
-                irow: &[f32],
-                prow: Option<&[f32]>,
-                n: usize,
-                p: &SgmParams,
-                lut: &[u16],
-                acc: &mut [u16],
-                prev: &[Self],
-                prev_min: &[Self],
-                cur: &mut [Self],
-                cur_min: &mut [Self],
-                zero: &[Self],
-            ) {
-                $v(
-                    c, irow, prow, n, p, lut, acc, prev, prev_min, cur, cur_min, zero,
-                )
+                vertical_impl(c, irow, prow, n, p, lut, acc, vp)
             }
         }
     };
@@ -1011,9 +979,10 @@ fn zero_path<T: PathCost>(n: usize) -> Vec<T> {
 /// The matcher with `paths` 3: left to right, right to left and top to bottom (OpenCV
 /// SGBM-3WAY's set), one row at a time with no cost volume. Two workers meet row by row: the
 /// first computes each row's costs and its two horizontal paths, the second adds the vertical
-/// path, which needs the rows in order, and selects the row. Every row is the same arithmetic
-/// whichever worker is ahead, so the output does not depend on the thread count; on one thread
-/// the first worker runs to the end before the second starts (its rows queue up).
+/// path, which needs the rows in order, and selects the row; the first takes those steps itself
+/// when it is [`THREE_PATHS_LEAD`] rows ahead (on one thread, every row from then on). Every
+/// row is the same arithmetic whichever worker runs it, so the output does not depend on the
+/// thread count.
 fn sgm_three_paths(
     left: ImageView<'_>,
     right: ImageView<'_>,
@@ -1023,9 +992,9 @@ fn sgm_three_paths(
 ) -> Vec<f32> {
     let lut = p2_table(p);
     if u8_fits(&lut) {
-        three_paths_as::<u8>(left, right, d_min, n, p, &lut)
+        three_paths_as::<u8>(left, right, d_min, n, p, &lut, horizontal_u8, vertical_u8)
     } else {
-        three_paths_as::<u16>(left, right, d_min, n, p, &lut)
+        three_paths_as::<u16>(left, right, d_min, n, p, &lut, horizontal_u16, vertical_u16)
     }
 }
 
@@ -1047,23 +1016,23 @@ struct Flight {
     all_queued: bool,
 }
 
-/// The vertical path's state: the previous row's path costs and minima, and the output.
+/// The vertical path's state and the output, which the two workers of [`sgm_three_paths`]
+/// take turns at.
 struct Vertical<'a, T> {
-    prev: Vec<T>,
-    cur: Vec<T>,
-    prev_min: Vec<T>,
-    cur_min: Vec<T>,
-    zero: Vec<T>,
+    path: VerticalPath<T>,
     out: &'a mut [f32],
 }
 
-fn three_paths_as<T: ThreePaths>(
+#[allow(clippy::too_many_arguments)]
+fn three_paths_as<T: PathCost + Send>(
     left: ImageView<'_>,
     right: ImageView<'_>,
     d_min: i64,
     n: usize,
     p: &SgmParams,
     lut: &[u16],
+    horizontal: HorizontalFn<T>,
+    vertical: VerticalFn<T>,
 ) -> Vec<f32> {
     use std::sync::{Condvar, Mutex, MutexGuard};
     fn lock(m: &Mutex<Flight>) -> MutexGuard<'_, Flight> {
@@ -1073,7 +1042,6 @@ fn three_paths_as<T: ThreePaths>(
     let (w, h) = (left.width, left.height);
     let (cl, cr) = rayon::join(|| census(left), || census(right));
     let img = left.data;
-    let stride = n + 2;
     let mut out = vec![f32::NAN; w * h];
     // The rows kept from the last call of this size first (a video's next frame).
     let flight = Mutex::new(Flight {
@@ -1082,55 +1050,36 @@ fn three_paths_as<T: ThreePaths>(
         all_queued: false,
     });
     let queued = Condvar::new();
-    let vertical = Mutex::new(Vertical {
-        prev: vec![T::PAD; w * stride],
-        cur: vec![T::PAD; w * stride],
-        prev_min: vec![T::of(0); w],
-        cur_min: vec![T::of(0); w],
-        zero: zero_path::<T>(n),
+    let state = Mutex::new(Vertical {
+        path: VerticalPath::<T>::new(w, n),
         out: &mut out,
     });
     // The vertical path and the selection of the next queued row, by whichever worker calls it;
-    // false when no row is queued. The rows are taken and run in order under `vertical`'s
-    // lock (always taken before `flight`'s), so the output does not depend on who runs them.
+    // false when no row is queued. The rows are taken and run in order under `state`'s lock
+    // (always taken before `flight`'s), so the output does not depend on who runs them.
     let vertical_step = || -> bool {
-        let mut v = vertical.lock().unwrap_or_else(|e| e.into_inner());
+        let mut v = state.lock().unwrap_or_else(|e| e.into_inner());
         let Some((y, (c, mut acc))) = lock(&flight).ready.pop_front() else {
             return false;
         };
         let v = &mut *v;
-        let irow = &img[y * w..(y + 1) * w];
         let prow = (y > 0).then(|| &img[(y - 1) * w..y * w]);
-        T::vertical(
-            &c,
-            irow,
-            prow,
-            n,
-            p,
-            lut,
-            &mut acc,
-            &v.prev,
-            &v.prev_min,
-            &mut v.cur,
-            &mut v.cur_min,
-            &v.zero,
-        );
-        std::mem::swap(&mut v.prev, &mut v.cur);
-        std::mem::swap(&mut v.prev_min, &mut v.cur_min);
+        let irow = &img[y * w..(y + 1) * w];
+        vertical(&c, irow, prow, n, p, lut, &mut acc, &mut v.path);
         select_row(&acc, w, n, d_min, p, &mut v.out[y * w..(y + 1) * w]);
         lock(&flight).free.push((c, acc));
         true
     };
     let first = || {
         let mut rev = Vec::with_capacity(w);
-        let mut bufs: [Vec<T>; 3] = [zero_path(n), vec![T::PAD; n + 2], vec![T::PAD; n + 2]];
+        let mut hp = Horizontal::<T>::new(n);
         for y in 0..h {
             let reused = lock(&flight).free.pop();
             let (mut c, mut acc) = reused.unwrap_or_else(|| (vec![0u8; w * n], vec![0u16; w * n]));
             rev.clear();
             rev.extend(cr[y * w..(y + 1) * w].iter().rev());
             cost_row(&cl[y * w..(y + 1) * w], &rev, d_min, n, &mut c);
-            T::horizontal(&c, &img[y * w..(y + 1) * w], n, p, lut, &mut acc, &mut bufs);
+            horizontal(&c, &img[y * w..(y + 1) * w], n, p, lut, &mut acc, &mut hp);
             let waiting = {
                 let mut f = lock(&flight);
                 f.ready.push_back((y, (c, acc)));
@@ -1161,7 +1110,7 @@ fn three_paths_as<T: ThreePaths>(
     // row's vertical path itself once it is `THREE_PATHS_LEAD` ahead), then the second, which
     // finds nothing left.
     rayon::join(first, second);
-    drop(vertical);
+    drop(state);
     kept::put_pairs(flight.into_inner().unwrap_or_else(|e| e.into_inner()).free);
     out
 }
@@ -1378,8 +1327,8 @@ mod tests {
             .map(|(i, v)| if i % 13 < 2 { 1.0 } else { *v })
             .collect();
         let sv = ImageView::new(w, h, &spiky).unwrap();
-        let a = three_paths_as::<u8>(sv, rv, -3, 19, &p, &lut);
-        let b = three_paths_as::<u16>(sv, rv, -3, 19, &p, &lut);
+        let a = three_paths_as::<u8>(sv, rv, -3, 19, &p, &lut, horizontal_u8, vertical_u8);
+        let b = three_paths_as::<u16>(sv, rv, -3, 19, &p, &lut, horizontal_u16, vertical_u16);
         assert_eq!(bits(&a), bits(&b));
         assert!(a.iter().filter(|v| v.is_finite()).count() > w * h / 3);
     }
