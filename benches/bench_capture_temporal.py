@@ -1,0 +1,105 @@
+"""Calibration from noisy captures: one frame per board pose against the mean of N still frames
+(``stereovision capture --temporal N``).
+
+The rendered rig of ``bench_calibration_targets.py`` (640x480, k1 about -0.3, 120 mm baseline)
+sees a 9x6 chessboard in 20 random poses per seed. Each pose is taken as a low-light camera would
+give it: grey noise of ``--sigma`` levels, fresh in every frame. ``single`` calibrates on the
+first frame of each pose; ``mean N`` on the output of a
+:class:`~stereovision.temporal.TemporalFilter` after N frames (what ``capture --temporal N``
+saves). Both are scored against the true rig as in ``bench_calibration_targets.py``: points 2-6 m
+away seen by the true cameras, rectified with the estimate, give the row offset (px) and the
+range error.
+
+Usage: ``python benches/bench_capture_temporal.py [--seeds 3] [--sigma 8 20] [--frames 8]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+from pathlib import Path
+
+import cv2
+import numpy as np
+from bench_calibration_targets import SIZE, SQUARE, truth_errors
+
+from stereovision.calibrate import calibrate, render_chessboard
+from stereovision.temporal import TemporalFilter
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from tests.test_charuco import D1, D2, K1, K2, ROT, T
+from tests.test_exposure import noisy
+
+
+def poses(rng: np.random.Generator, views: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Clean left and right renders of ``views`` random board poses (float64, 0-255)."""
+    centre = np.array([5 * SQUARE, 3.5 * SQUARE, 0])
+    out = []
+    for _ in range(views):
+        rv = rng.normal(0, 0.25, 3)
+        z = rng.uniform(0.35, 0.6)
+        c = np.array([rng.uniform(-0.25, 0.25) * z, rng.uniform(-0.18, 0.18) * z, z])
+        tv = c - cv2.Rodrigues(rv)[0] @ centre
+        r2, t2 = cv2.composeRT(
+            rv.reshape(3, 1), tv.reshape(3, 1), cv2.Rodrigues(ROT)[0], T.reshape(3, 1)
+        )[:2]
+        pair = []
+        for K, D, r, t in ((K1, D1, rv, tv), (K2, D2, r2, t2)):
+            # The chessboard's corner (0, 0) one square in, as in bench_calibration_targets.py.
+            Rb = cv2.Rodrigues(np.asarray(r, np.float64).reshape(3, 1))[0]
+            t_c = np.asarray(t, np.float64).ravel() + Rb @ np.array([SQUARE, SQUARE, 0])
+            img = render_chessboard(
+                K, D, r, t_c, pattern=(9, 6), square_size=SQUARE, image_size=SIZE
+            )
+            pair.append(img.astype(np.float64))
+        out.append((pair[0], pair[1]))
+    return out
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--views", type=int, default=20)
+    ap.add_argument("--sigma", type=float, nargs="+", default=[8.0, 20.0])
+    ap.add_argument("--frames", type=int, default=8)
+    args = ap.parse_args()
+    print(
+        "sigma  case     seed  pairs  RMS px  |T| err mm  rot err deg  rows p95 px  "
+        "range err median/p95 %"
+    )
+    for sigma in args.sigma:
+        for seed in range(args.seeds):
+            rng = np.random.default_rng(100 + seed)
+            clean = poses(rng, args.views)
+            single: tuple[list[np.ndarray], list[np.ndarray]] = ([], [])
+            mean: tuple[list[np.ndarray], list[np.ndarray]] = ([], [])
+            for cl, cr in clean:
+                tf = TemporalFilter(max_frames=args.frames)
+                for i in range(args.frames):
+                    fl, fr = noisy(cl, sigma, rng), noisy(cr, sigma, rng)
+                    if i == 0:
+                        single[0].append(fl)
+                        single[1].append(fr)
+                    al, ar = tf(fl, fr)
+                mean[0].append(al)
+                mean[1].append(ar)
+            for name, (left, right) in (("single", single), (f"mean {args.frames}", mean)):
+                try:
+                    cal, rep = calibrate(left, right, square_size=SQUARE)
+                except ValueError as exc:
+                    print(f"{sigma:5.1f}  {name:<7} {seed:>4}  failed: {exc}")
+                    continue
+                dy, rel = truth_errors(cal, np.random.default_rng(seed))
+                rot = math.degrees(float(np.linalg.norm(cv2.Rodrigues(cal.R @ ROT.T)[0])))
+                print(
+                    f"{sigma:5.1f}  {name:<7} {seed:>4}  {len(rep.used_pairs):>2}/{args.views}  "
+                    f"{rep.rms:6.3f}  {1000 * abs(np.linalg.norm(cal.T) - np.linalg.norm(T)):10.3f}"
+                    f"  {rot:11.4f}  {np.percentile(dy, 95):11.3f}  "
+                    f"{100 * np.median(rel):10.2f} / {100 * np.percentile(rel, 95):.2f}",
+                    flush=True,
+                )
+
+
+if __name__ == "__main__":
+    main()
