@@ -417,6 +417,54 @@ def test_capture_averages_still_frames_when_asked(data_dir):
     assert app.state.source_label.endswith("(8.0 frames averaged)")
 
 
+def test_open_cameras_asks_the_chosen_pixel_format(data_dir, monkeypatch):
+    """The camera row's "format" select, in-process: "MJPG" and "YUYV" reach the cameras as
+    ``StereoCamera(..., fourcc=)`` (what ``capture --fourcc`` asks), "driver" asks nothing, and
+    ``stereovision gui --fourcc`` does the same for the cameras it opens."""
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision import capture
+    from stereovision.gui import add_arguments, build_app
+    from stereovision.gui.app import FOURCCS, StereoApp
+
+    asked: list[str | None] = []
+    frame = cv2.imread(str(data_dir / "middlebury2001" / "venus" / "left.png"))
+
+    class Cameras:
+        def __init__(self, left, right, *, size=None, fourcc=None):
+            asked.append(fourcc)
+
+        def read(self):
+            return frame, frame
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    app = StereoApp(
+        get_server("test-fourcc", client_type="vue3"),
+        AllowedFolders([data_dir]),
+        data_dir / "middlebury2003" / "cones",
+    )
+    monkeypatch.setattr(app, "_spawn", lambda coro: coro.close())  # no event loop here
+    assert app.state.fourccs == list(FOURCCS) and app.state.fourcc == "driver"
+    app.state.cam_left, app.state.cam_right = "0", "1"
+    for choice in ("MJPG", "YUYV", "driver"):
+        app.state.fourcc = choice
+        app.open_cameras()
+        assert app.state.error == "" and app.state.live
+    assert asked == ["MJPG", "YUYV", None]
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    built = build_app(parser.parse_args(["--left", "0", "--right", "1", "--fourcc", "MJPG"]))
+    assert asked[-1] == "MJPG" and built.state.live
+    with pytest.raises(ValueError, match="four characters"):
+        build_app(parser.parse_args(["--left", "0", "--right", "1", "--fourcc", "MJPEG"]))
+    with pytest.raises(ValueError, match="--fourcc asks the cameras for a format"):
+        build_app(parser.parse_args(["--fourcc", "MJPG"]))
+
+
 # ----------------------------------------------------------------------------- browser
 
 
@@ -542,6 +590,9 @@ def test_page_has_three_panels_and_images(page):
     assert "2 · Stereo output" in page.inner_text("#panel-stereo")
     assert "3 · 3-D view" in page.inner_text("#panel-3d")
     assert "median depth" in page.inner_text("#stats")
+    # The camera row's pixel format select, on the driver's own by default.
+    fmt = page.locator(".v-select:has(#cam-fourcc)").inner_text()
+    assert "format" in fmt and "driver" in fmt, fmt
     _shot(page, "gui-start.png")
 
 

@@ -45,6 +45,8 @@ def build_app(args: argparse.Namespace) -> Any:
 
     if (args.left is None) != (args.right is None):
         raise ValueError("give both --left and --right camera sources, or neither")
+    if getattr(args, "fourcc", None) is not None and args.left is None:
+        raise ValueError("--fourcc asks the cameras for a format: give --left and --right too")
     from_bag = getattr(args, "from_bag", None)
     if from_bag is not None and args.left is not None:
         raise ValueError("--from-bag replaces --left and --right: give one source")
@@ -60,7 +62,7 @@ def build_app(args: argparse.Namespace) -> Any:
     label = None
     names = (str(args.left or ""), str(args.right or ""))
     if args.left is not None:
-        source = open_stereo_source(args.left, args.right)
+        source = open_stereo_source(args.left, args.right, fourcc=getattr(args, "fourcc", None))
     elif from_bag is not None:
         from stereovision.gui.sources import open_bag_source
 
@@ -116,6 +118,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     """The ``gui`` options."""
     p.add_argument("--left", help="left camera: device index, video file or image pattern")
     p.add_argument("--right", help="right camera: device index, video file or image pattern")
+    p.add_argument(
+        "--fourcc",
+        help="pixel format asked of the cameras: YUYV (raw) or MJPG (compressed; two webcams on "
+        "one USB 2 bus often need it)",
+    )
     from stereovision.capture import add_bag_args
 
     add_bag_args(

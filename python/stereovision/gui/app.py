@@ -49,6 +49,9 @@ __all__ = ["EXTRA_METHODS", "RESOLUTIONS", "StereoApp", "compute_view"]
 
 log = logging.getLogger(__name__)
 
+#: Pixel formats the camera row offers ("driver": whatever the cameras deliver by default);
+#: two webcams on one USB 2 bus often need MJPG for their full size and rate.
+FOURCCS = ("driver", "MJPG", "YUYV")
 #: Processing widths offered by the resolution control ("full" keeps the input size).
 RESOLUTIONS = ("full", "640", "320")
 
@@ -423,6 +426,8 @@ class StereoApp:
         st.computations = 0
         st.captures = 0
         st.average = False
+        st.fourccs = list(FOURCCS)
+        st.fourcc = FOURCCS[0]
         st.img_left = st.img_right = st.img_disparity = st.img_depth = st.img_matches = ""
         st.stats = ""
         st.message_3d = ""
@@ -571,7 +576,8 @@ class StereoApp:
         try:
             left = self._camera_source(self.state.cam_left)
             right = self._camera_source(self.state.cam_right)
-            source = open_stereo_source(left, right)
+            fourcc = None if self.state.fourcc == FOURCCS[0] else self.state.fourcc
+            source = open_stereo_source(left, right, fourcc=fourcc)
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
             return
@@ -991,7 +997,7 @@ class StereoApp:
                     with v3.VCol(cols=2):
                         v3.VBtn("Load", click=self.ctrl.load_files, id="load-files", block=True)
                 with v3.VRow(dense=True, classes="mt-1"):
-                    with v3.VCol(cols=5):
+                    with v3.VCol(cols=4):
                         v3.VTextField(
                             label="Left camera",
                             v_model=("cam_left",),
@@ -999,13 +1005,22 @@ class StereoApp:
                             hide_details=True,
                             id="cam-left",
                         )
-                    with v3.VCol(cols=5):
+                    with v3.VCol(cols=4):
                         v3.VTextField(
                             label="Right camera",
                             v_model=("cam_right",),
                             density="compact",
                             hide_details=True,
                             id="cam-right",
+                        )
+                    with v3.VCol(cols=2):
+                        v3.VSelect(
+                            label="format",
+                            v_model=("fourcc",),
+                            items=("fourccs",),
+                            density="compact",
+                            hide_details=True,
+                            id="cam-fourcc",
                         )
                     with v3.VCol(cols=2):
                         v3.VBtn("Open", click=self.ctrl.open_cameras, id="cam-open", block=True)

@@ -274,7 +274,10 @@ class _CaptureAdapter:
 
 
 def open_stereo_source(
-    left: int | str, right: int | str, size: tuple[int, int] | None = None
+    left: int | str,
+    right: int | str,
+    size: tuple[int, int] | None = None,
+    fourcc: str | None = None,
 ) -> StereoSource:
     """Open a camera pair: ``stereovision.capture.StereoCamera`` if available, else OpenCV.
 
@@ -284,6 +287,9 @@ def open_stereo_source(
         Device index, video file or image-sequence pattern.
     size : (int, int), optional
         Requested ``(width, height)``.
+    fourcc : str, optional
+        Pixel format asked of the cameras (``"MJPG"``, ``"YUYV"``; None: the driver's), as
+        ``stereovision capture --fourcc``: two webcams on one USB 2 bus often need MJPG.
 
     Raises
     ------
@@ -292,11 +298,12 @@ def open_stereo_source(
     """
     left, right = parse_source(left), parse_source(right)
     try:
-        from stereovision.capture import StereoCamera
+        from stereovision.capture import StereoCamera, parse_fourcc
     except ImportError:
         return VideoPair(left, right, size)
+    code = parse_fourcc(fourcc)
     files = isinstance(left, str) and isinstance(right, str)
-    return _CaptureAdapter(lambda: StereoCamera(left, right, size=size), files)
+    return _CaptureAdapter(lambda: StereoCamera(left, right, size=size, fourcc=code), files)
 
 
 def scale_pair(
