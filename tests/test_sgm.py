@@ -248,11 +248,11 @@ def test_memory_check_refuses_before_allocating(
         with pytest.raises(MemoryError, match="lower max_disparity"):
             sv.depth_map(img, shifted, max_disparity=32, method=method)
     # The Gabor channel alone runs no census map; the three-path one holds rows, not a volume
-    # (at most 10 rows of 3 bytes a level, and 16 bytes a pixel of census codes).
+    # (at most 11 rows of 3 bytes a level, and 16 bytes a pixel of census codes).
     assert sv.depth_map(img, shifted, max_disparity=32, method="gabor").disparity.shape == img.shape
     fast = sv.depth_map(img, shifted, max_disparity=32, method="fast", fill=False).disparity
     assert abs(float(np.nanmedian(fast[:, 40:])) - 3.0) < 0.05
-    rows_need = 3 * 160 * 10 * 33 + 16 * 160 * 120
+    rows_need = 3 * 160 * 11 * 33 + 16 * 160 * 120
     monkeypatch.setattr(sgm, "_available_bytes", lambda: rows_need - 1)
     with pytest.raises(MemoryError, match="lower max_disparity"):
         sv.depth_map(img, shifted, max_disparity=32, method="fast")

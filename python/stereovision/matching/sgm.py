@@ -44,9 +44,9 @@ DEFAULTS: dict[str, Any] = {
 # every row when the two aggregation passes meet in the middle (measured: a 3840 x 2160 pair
 # over 577 levels peaked at 14.7 GB for the whole default depth_map, 4.8 G cells).
 _BYTES_PER_CELL = 3
-# paths=3 holds rows, not a volume: at most THREE_PATHS_LEAD (8) rows wait for the vertical path,
-# one is being filled and one selected, and the census codes take 16 bytes a pixel.
-_ROWS_IN_FLIGHT_3 = 8 + 2
+# paths=3 holds rows, not a volume: at most THREE_PATHS_LEAD + 1 (9) rows wait for the vertical
+# path, one is being filled and one selected; the census codes take 16 bytes a pixel.
+_ROWS_IN_FLIGHT_3 = 8 + 3
 _MAX_LEVELS = 2048  # the kernel's limit
 
 
