@@ -1023,6 +1023,16 @@ struct Vertical<'a, T> {
     out: &'a mut [f32],
 }
 
+/// Marks every row queued (and wakes the second worker) when dropped.
+struct AllQueued<'a>(&'a std::sync::Mutex<Flight>, &'a std::sync::Condvar);
+
+impl Drop for AllQueued<'_> {
+    fn drop(&mut self) {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).all_queued = true;
+        self.1.notify_all();
+    }
+}
+
 #[allow(clippy::too_many_arguments)]
 fn three_paths_as<T: PathCost + Send>(
     left: ImageView<'_>,
@@ -1071,9 +1081,14 @@ fn three_paths_as<T: PathCost + Send>(
         true
     };
     let first = || {
+        // Set when this worker ends, by a panic too: the second would otherwise wait forever
+        // and `join` could not hand the panic on.
+        let _end = AllQueued(&flight, &queued);
         let mut rev = Vec::with_capacity(w);
         let mut hp = Horizontal::<T>::new(n);
         for y in 0..h {
+            #[cfg(test)]
+            assert!((w, h, y) != tests::PANIC_AT, "a fault injected by a test");
             let reused = lock(&flight).free.pop();
             let (mut c, mut acc) = reused.unwrap_or_else(|| (vec![0u8; w * n], vec![0u16; w * n]));
             rev.clear();
@@ -1090,8 +1105,7 @@ fn three_paths_as<T: PathCost + Send>(
                 vertical_step(); // too far ahead (or alone): take the vertical path's next row
             }
         }
-        lock(&flight).all_queued = true;
-        queued.notify_all();
+        drop(_end);
         while vertical_step() {}
     };
     let second = || loop {
@@ -1355,6 +1369,38 @@ mod tests {
         assert!(rows <= THREE_PATHS_LEAD + 3, "{rows} rows allocated");
         let good = d.iter().filter(|v| (**v - 4.0).abs() < 0.5).count();
         assert!(good * 10 >= d.len() * 8, "{good} of {}", d.len());
+    }
+
+    /// `(w, h, y)`: the three-path matcher's first worker panics on row `y` of a pair of this
+    /// size (a size no other test uses).
+    pub(super) const PANIC_AT: (usize, usize, usize) = (37, 23, 5);
+
+    #[test]
+    fn a_panicking_worker_ends_the_call_instead_of_hanging_it() {
+        // Without the end marker the second worker would wait for rows forever and `join`
+        // could not return; the call must end (with the panic) within seconds.
+        let (w, h, _) = PANIC_AT;
+        let img = ramp(w, h, 0.0);
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let v = ImageView::new(w, h, &img).unwrap();
+            let p = SgmParams {
+                paths: 3,
+                ..SgmParams::default()
+            };
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(2)
+                .build()
+                .unwrap();
+            let got = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                pool.install(|| sgm_disparity(v, v, 0, 7, &p))
+            }));
+            let _ = tx.send(got.is_err());
+        });
+        let panicked = rx
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .expect("the call hung");
+        assert!(panicked);
     }
 
     #[test]
