@@ -987,6 +987,14 @@ def _second_opinion(
 
     s_ok = np.isfinite(second)
     mine = np.isfinite(out) & ~members
+    if not members.any() and not mine.any():
+        # No map of its own and no members (``method="census"`` / ``"fast"``): ``second`` as it
+        # is, the same outcome as the steps below with less work (a live frame's 3 ms of 40).
+        np.copyto(out, second, where=s_ok)
+        conf[s_ok] = confidence
+        if out_only is not None:
+            out_only |= s_ok
+        return out, conf
     both = mine & s_ok
     with np.errstate(invalid="ignore"):
         off = both & (np.abs(out - second) > tol)
