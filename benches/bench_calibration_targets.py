@@ -67,13 +67,38 @@ def truth_errors(cal: object, rng: np.random.Generator) -> tuple[np.ndarray, np.
     return np.abs(ul[:, 1] - ur[:, 1]), np.abs(est / np.linalg.norm(pts[ok], axis=1) - 1)
 
 
+def random_views(rng: np.random.Generator) -> tuple[tuple[np.ndarray, ...], ...]:
+    """One random board pose as each camera of the rig sees it: ``((K, D, rvec, tvec), ...)``
+    for the left and the right camera, the ChArUco board's outer corner as the origin (0.35-0.6
+    m away, centred anywhere over the image)."""
+    centre = np.array([5 * SQUARE, 3.5 * SQUARE, 0])
+    rv = rng.normal(0, 0.25, 3)
+    z = rng.uniform(0.35, 0.6)
+    c = np.array([rng.uniform(-0.25, 0.25) * z, rng.uniform(-0.18, 0.18) * z, z])
+    tv = c - cv2.Rodrigues(rv)[0] @ centre
+    r2, t2 = cv2.composeRT(
+        rv.reshape(3, 1), tv.reshape(3, 1), cv2.Rodrigues(ROT)[0], T.reshape(3, 1)
+    )[:2]
+    return (K1, D1, rv, tv), (K2, D2, r2, t2)
+
+
+def chessboard_view(K: np.ndarray, D: np.ndarray, r: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """The 9x6 chessboard at a :func:`random_views` pose: its corner (0, 0) is the ChArUco's
+    corner 0, one square in from the outer corner."""
+    Rb = cv2.Rodrigues(np.asarray(r, np.float64).reshape(3, 1))[0]
+    t_c = np.asarray(t, np.float64).ravel() + Rb @ np.array([SQUARE, SQUARE, 0])
+    img: np.ndarray = render_chessboard(
+        K, D, r, t_c, pattern=(9, 6), square_size=SQUARE, image_size=SIZE
+    )
+    return img
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--views", type=int, default=20)
     ap.add_argument("--hard", action="store_true", help="blur, lighting gradient and JPEG")
     args = ap.parse_args()
-    centre = np.array([5 * SQUARE, 3.5 * SQUARE, 0])
     print(
         "target      seed  pairs  corners  RMS px  |T| err mm  rot err deg  rows p95 px  "
         "range err median/p95 %  time s"
@@ -85,22 +110,10 @@ def main() -> None:
             "chessboard": ([], []),
         }
         for _ in range(args.views):
-            rv = rng.normal(0, 0.25, 3)
-            z = rng.uniform(0.35, 0.6)
-            c = np.array([rng.uniform(-0.25, 0.25) * z, rng.uniform(-0.18, 0.18) * z, z])
-            tv = c - cv2.Rodrigues(rv)[0] @ centre
-            r2, t2 = cv2.composeRT(
-                rv.reshape(3, 1), tv.reshape(3, 1), cv2.Rodrigues(ROT)[0], T.reshape(3, 1)
-            )[:2]
-            for side, (K, D, r, t) in enumerate(((K1, D1, rv, tv), (K2, D2, r2, t2))):
+            for side, (K, D, r, t) in enumerate(random_views(rng)):
                 img = render_charuco(BOARD, K, D, r, t, image_size=SIZE)
                 sets["charuco"][side].append(degrade(img, rng, args.hard))
-                # The chessboard's corner (0, 0) is the ChArUco's corner 0, one square in.
-                Rb = cv2.Rodrigues(np.asarray(r, np.float64).reshape(3, 1))[0]
-                t_c = np.asarray(t, np.float64).ravel() + Rb @ np.array([SQUARE, SQUARE, 0])
-                img = render_chessboard(
-                    K, D, r, t_c, pattern=(9, 6), square_size=SQUARE, image_size=SIZE
-                )
+                img = chessboard_view(K, D, r, t)
                 sets["chessboard"][side].append(degrade(img, rng, args.hard))
         for name, (left, right) in sets.items():
             kw = {"board": BOARD} if name == "charuco" else {"square_size": SQUARE}

@@ -22,38 +22,22 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-from bench_calibration_targets import SIZE, SQUARE, truth_errors
+from bench_calibration_targets import SQUARE, chessboard_view, random_views, truth_errors
 
-from stereovision.calibrate import calibrate, render_chessboard
+from stereovision.calibrate import calibrate
 from stereovision.temporal import TemporalFilter
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from tests.test_charuco import D1, D2, K1, K2, ROT, T
+from tests.test_charuco import ROT, T
 from tests.test_exposure import noisy
 
 
 def poses(rng: np.random.Generator, views: int) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Clean left and right renders of ``views`` random board poses (float64, 0-255)."""
-    centre = np.array([5 * SQUARE, 3.5 * SQUARE, 0])
+    """Clean left and right chessboard renders of ``views`` random poses (float64, 0-255)."""
     out = []
     for _ in range(views):
-        rv = rng.normal(0, 0.25, 3)
-        z = rng.uniform(0.35, 0.6)
-        c = np.array([rng.uniform(-0.25, 0.25) * z, rng.uniform(-0.18, 0.18) * z, z])
-        tv = c - cv2.Rodrigues(rv)[0] @ centre
-        r2, t2 = cv2.composeRT(
-            rv.reshape(3, 1), tv.reshape(3, 1), cv2.Rodrigues(ROT)[0], T.reshape(3, 1)
-        )[:2]
-        pair = []
-        for K, D, r, t in ((K1, D1, rv, tv), (K2, D2, r2, t2)):
-            # The chessboard's corner (0, 0) one square in, as in bench_calibration_targets.py.
-            Rb = cv2.Rodrigues(np.asarray(r, np.float64).reshape(3, 1))[0]
-            t_c = np.asarray(t, np.float64).ravel() + Rb @ np.array([SQUARE, SQUARE, 0])
-            img = render_chessboard(
-                K, D, r, t_c, pattern=(9, 6), square_size=SQUARE, image_size=SIZE
-            )
-            pair.append(img.astype(np.float64))
-        out.append((pair[0], pair[1]))
+        left, right = (chessboard_view(*v).astype(np.float64) for v in random_views(rng))
+        out.append((left, right))
     return out
 
 

@@ -1142,6 +1142,32 @@ mod tests {
             .collect()
     }
 
+    /// The default parameters with three paths.
+    fn three() -> SgmParams {
+        SgmParams {
+            paths: 3,
+            ..SgmParams::default()
+        }
+    }
+
+    fn pool(threads: usize) -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+    }
+
+    /// Asserts that at least 95 % of the 80x40 ramp pair's inner pixels (rows 5-34, columns
+    /// 20-74) are within 0.5 px of disparity 6.
+    fn assert_shift_6(d: &[f32], w: usize, h: usize) {
+        let inner: Vec<f32> = (5..h - 5)
+            .flat_map(|y| (20..w - 5).map(move |x| (x, y)))
+            .map(|(x, y)| d[y * w + x])
+            .collect();
+        let good = inner.iter().filter(|v| (**v - 6.0).abs() < 0.5).count();
+        assert!(good * 100 >= inner.len() * 95, "{good} of {}", inner.len());
+    }
+
     #[test]
     fn recovers_a_constant_shift() {
         let (w, h) = (80, 40);
@@ -1150,12 +1176,7 @@ mod tests {
         let lv = ImageView::new(w, h, &l).unwrap();
         let rv = ImageView::new(w, h, &r).unwrap();
         let d = sgm_disparity(lv, rv, 0, 15, &SgmParams::default()).unwrap();
-        let inner: Vec<f32> = (5..h - 5)
-            .flat_map(|y| (20..w - 5).map(move |x| (x, y)))
-            .map(|(x, y)| d[y * w + x])
-            .collect();
-        let good = inner.iter().filter(|v| (**v - 6.0).abs() < 0.5).count();
-        assert!(good * 100 >= inner.len() * 95, "{good} of {}", inner.len());
+        assert_shift_6(&d, w, h);
         // The left band (x < 15): the match lands at x - 6 >= edge_margin from x = 10 on.
         let band: Vec<f32> = (5..h - 5)
             .flat_map(|y| (10..15).map(move |x| (x, y)))
@@ -1308,28 +1329,16 @@ mod tests {
         let (l, r) = (ramp(w, h, 0.0), ramp(w, h, 6.0));
         let lv = ImageView::new(w, h, &l).unwrap();
         let rv = ImageView::new(w, h, &r).unwrap();
-        let p = SgmParams {
-            paths: 3,
-            ..SgmParams::default()
-        };
+        let p = three();
         let d = sgm_disparity(lv, rv, 0, 15, &p).unwrap();
-        let inner: Vec<f32> = (5..h - 5)
-            .flat_map(|y| (20..w - 5).map(move |x| (x, y)))
-            .map(|(x, y)| d[y * w + x])
-            .collect();
-        let good = inner.iter().filter(|v| (**v - 6.0).abs() < 0.5).count();
-        assert!(good * 100 >= inner.len() * 95, "{good} of {}", inner.len());
+        assert_shift_6(&d, w, h);
         // Not the eight paths' map: another aggregation (so the option is not ignored).
         let eight = sgm_disparity(lv, rv, 0, 15, &SgmParams::default()).unwrap();
         let bits = |a: &[f32]| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
         assert_ne!(bits(&d), bits(&eight));
-        // One worker (the rows queue up) and three give the same bits.
+        // One worker (it takes the vertical path's rows too) and three give the same bits.
         for threads in [1, 3] {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap();
-            let again = pool.install(|| sgm_disparity(lv, rv, 0, 15, &p).unwrap());
+            let again = pool(threads).install(|| sgm_disparity(lv, rv, 0, 15, &p).unwrap());
             assert_eq!(bits(&again), bits(&d), "{threads} threads");
         }
         // u8 and u16 path costs: the same integers, with steps that take every P2 level.
@@ -1356,15 +1365,7 @@ mod tests {
         let (l, r) = (ramp(w, h, 0.0), ramp(w, h, 4.0));
         let lv = ImageView::new(w, h, &l).unwrap();
         let rv = ImageView::new(w, h, &r).unwrap();
-        let p = SgmParams {
-            paths: 3,
-            ..SgmParams::default()
-        };
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(1)
-            .build()
-            .unwrap();
-        let d = pool.install(|| sgm_disparity(lv, rv, 0, 9, &p).unwrap());
+        let d = pool(1).install(|| sgm_disparity(lv, rv, 0, 9, &three()).unwrap());
         let rows = kept::take_pairs(w * 10).len();
         assert!(rows <= THREE_PATHS_LEAD + 3, "{rows} rows allocated");
         let good = d.iter().filter(|v| (**v - 4.0).abs() < 0.5).count();
@@ -1384,16 +1385,8 @@ mod tests {
         let (tx, rx) = std::sync::mpsc::channel();
         std::thread::spawn(move || {
             let v = ImageView::new(w, h, &img).unwrap();
-            let p = SgmParams {
-                paths: 3,
-                ..SgmParams::default()
-            };
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(2)
-                .build()
-                .unwrap();
             let got = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                pool.install(|| sgm_disparity(v, v, 0, 7, &p))
+                pool(2).install(|| sgm_disparity(v, v, 0, 7, &three()))
             }));
             let _ = tx.send(got.is_err());
         });
