@@ -6,6 +6,38 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+__all__ = [
+    "__version__",
+    "gabor_disparity",
+    "gabor_responses",
+    "gabor_newton_step",
+    "gabor_lr_check",
+    "gabor_remove_speckles",
+    "hopfield_interest",
+    "hopfield_match",
+    "hopfield_match_u8",
+    "hopfield_candidates",
+    "mcgm_log",
+    "mcgm_curves",
+    "mcgm_match",
+    "mcgm_filter",
+    "depth_rectified",
+    "refine_disparity",
+    "sgm_disparity",
+    "row_fill",
+    "side_fill",
+    "fattened",
+    "graph_segments",
+    "plane_fill",
+    "fill_planes",
+    "quantised_regions",
+    "gray_u8",
+    "temporal_grey_difference",
+    "temporal_running_mean",
+    "release_memory",
+    "kept_memory",
+]
+
 __version__: str
 
 # --- Gabor phase-disparity channel (rust/py/src/gabor.rs) ---------------------------------------
