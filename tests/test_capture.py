@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import itertools
 import os
+import subprocess
+import sys
 import threading
 from pathlib import Path
 from typing import Any
@@ -670,3 +672,20 @@ def test_cli_capture(
         run(*src, "--temporal", "4", "--every", "3")
     with pytest.raises(ValueError, match="--fourcc asks a camera for a format"):
         run("--from-bag", str(tmp_path), "--fourcc", "MJPG", "-o", str(out))
+
+
+def test_cli_missing_camera_is_one_line_naming_its_device(tmp_path: Path) -> None:
+    # OpenCV's backends log each failed attempt to stderr; the CLI's one line says it instead.
+    if os.path.exists("/dev/video97") or not os.path.isdir("/dev"):
+        pytest.skip("needs a /dev without video97")
+    run = subprocess.run(
+        [sys.executable, "-m", "stereovision", "capture", "--left", "97", "--right", "98",
+         "--count", "1", "-o", str(tmp_path / "pairs")],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert run.returncode == 2
+    assert run.stderr.splitlines() == [
+        "stereovision: error: cannot open left source camera 97 "
+        "(no /dev/video97: is the camera plugged in?)"
+    ]
+    assert not (tmp_path / "pairs").exists() or not any((tmp_path / "pairs").iterdir())

@@ -51,6 +51,7 @@ from stereovision.calibrate import (
     parse_pattern,
 )
 from stereovision.charuco import CharucoBoard
+from stereovision.io import _opencv_quiet
 
 __all__ = [
     "MIN_POSE_DISTANCE",
@@ -203,6 +204,18 @@ def _describe_source(src: Source) -> str:
     return type(src).__name__
 
 
+def camera_hint(src: object) -> str:
+    """Why a camera index may not open, where Linux can tell (V4L2 device nodes)."""
+    if not isinstance(src, (int, np.integer)) or not os.path.isdir("/dev"):
+        return ""
+    node = f"/dev/video{int(src)}"
+    if not os.path.exists(node):
+        return f" (no {node}: is the camera plugged in?)"
+    if not os.access(node, os.R_OK | os.W_OK):
+        return f" ({node} is not readable: is this user in the 'video' group?)"
+    return f" ({node} exists: is another program using it?)"
+
+
 class PairSource:
     """What every pair source shares (:class:`StereoCamera`,
     :class:`~stereovision.rosbag.BagCamera`): iteration until the end, the skew report, ``with``.
@@ -343,14 +356,18 @@ class StereoCamera(PairSource):
             path = os.fspath(src)
             if "%" not in path and "://" not in path and not os.path.exists(path):
                 raise FileNotFoundError(f"{side} source not found: {path}")
-            cap: Any = cv2.VideoCapture(path)
+            # OpenCV logs its backends' attempts to stderr; the error below says what failed.
+            with _opencv_quiet():
+                cap: Any = cv2.VideoCapture(path)
         elif isinstance(src, (int, np.integer)):
-            cap = cv2.VideoCapture(int(src))
+            with _opencv_quiet():
+                cap = cv2.VideoCapture(int(src))
         else:
             cap = src
         if not cap.isOpened():
             cap.release()
-            raise SourceError(f"cannot open {side} source {_describe_source(src)}")
+            what = f"{_describe_source(src)}{camera_hint(src)}"
+            raise SourceError(f"cannot open {side} source {what}")
         # The format first: V4L2 offers sizes and rates per format.
         if self.requested_fourcc is not None:
             cap.set(cv2.CAP_PROP_FOURCC, cv2.VideoWriter.fourcc(*self.requested_fourcc))

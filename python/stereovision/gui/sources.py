@@ -18,6 +18,9 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from stereovision.capture import camera_hint
+from stereovision.io import _opencv_quiet
+
 __all__ = [
     "CLOUD_SUFFIXES",
     "IMAGE_SUFFIXES",
@@ -192,10 +195,11 @@ class VideoPair:
                 is_file = isinstance(src, str)
                 if is_file and "%" not in str(src) and not Path(str(src)).exists():
                     raise FileNotFoundError(f"{side} camera source not found: {src}")
-                cap = cv2.VideoCapture(src)
+                with _opencv_quiet():  # the error below says what failed
+                    cap = cv2.VideoCapture(src)
                 if not cap.isOpened():
                     cap.release()
-                    raise OSError(f"cannot open camera {src!r} ({side})")
+                    raise OSError(f"cannot open camera {src!r} ({side}){camera_hint(src)}")
                 if size is not None and not is_file:
                     cap.set(cv2.CAP_PROP_FRAME_WIDTH, size[0])
                     cap.set(cv2.CAP_PROP_FRAME_HEIGHT, size[1])
