@@ -85,6 +85,9 @@ def main() -> None:
         pts = sc.calib.reproject(res.disparity)
         found = obstacle_mask(pts, ours, max_range=30) & has
         tp = int((found & truth).sum())
+        # what `depth --ground` marks: the pixels with a depth only (no filled guesses)
+        kept = obstacle_mask(res.point_image(), ours, max_range=30) & has
+        tp_kept = int((kept & truth).sum())
         dh = 100 * (ours.height / gt.height - 1)
         print(
             f"{name}: GT height {gt.height:.3f} m, pitch {gt.pitch_deg:+.2f}, roll "
@@ -92,7 +95,10 @@ def main() -> None:
             f"{ours.pitch_deg:+.2f}, roll {ours.roll_deg:+.2f}; {angle:.2f} deg apart; "
             f"{100 * ours.inlier_share:.0f} % on it, {100 * ours.below_share:.1f} % below it; "
             f"fit {1000 * dt:.0f} ms; obstacles precision "
-            f"{tp / max(int(found.sum()), 1):.3f} recall {tp / max(int(truth.sum()), 1):.3f}"
+            f"{tp / max(int(found.sum()), 1):.3f} recall {tp / max(int(truth.sum()), 1):.3f}; "
+            f"on the pixels with a depth ({100 * np.isfinite(res.depth).mean():.0f} %): "
+            f"precision {tp_kept / max(int(kept.sum()), 1):.3f} recall "
+            f"{tp_kept / max(int(truth.sum()), 1):.3f}"
         )
         if name.startswith("kitti"):
             img = sc.left.copy()

@@ -256,3 +256,57 @@ def test_voxel_downsample_against_a_plain_reference(result):
         export.voxel_downsample(pts, cols[:10])
     with pytest.raises(ValueError, match="points"):
         export.voxel_downsample(pts[:, :2])
+
+
+def test_point_image_without_the_cloud(result, tmp_path):
+    """``cloud=False`` results (the live rate) still give their image-shaped points and an
+    organised PCD: from the depth map, as the cloud would have them."""
+    pts = result.point_image()
+    assert pts.shape == (syn.H, syn.W, 3) and pts.dtype == np.float32
+    x, y = result.pixels[:, 0], result.pixels[:, 1]
+    np.testing.assert_allclose(pts[y, x], result.points, atol=1e-5)
+    assert np.isnan(pts[~np.isfinite(result.depth)]).all()
+    assert np.isnan(pts[syn.HOLE]).all()
+    bare = replace(
+        result,
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+    )
+    back, cols = export.read_pcd(export.write_pcd(tmp_path / "live.pcd", bare))
+    np.testing.assert_allclose(back[y, x], result.points, atol=1e-5)
+    assert np.isfinite(back[..., 2]).sum() == len(result.points)
+    np.testing.assert_array_equal(cols, result.left_rectified[..., ::-1])
+    # a filtered result loses its far points in the image too
+    near = result.filtered(max_depth=float(syn.BOX_Z) + 0.01)
+    far = near.point_image()[5, 150]
+    assert np.isnan(far).all() and near.point_image()[60, 80, 2] == pytest.approx(syn.BOX_Z)
+    with pytest.raises(ValueError, match="without a calibration"):
+        replace(result, depth=None, calibration=None).point_image()
+
+
+def test_point_image_filled_keeps_the_guesses_within_the_working_range(result):
+    """Filled pixels have a disparity and no depth: ``filled=True`` gives them their point
+    within :meth:`filtered`'s depth range, and none under an uncertainty limit."""
+    z = np.where(np.isfinite(result.disparity), result.depth, np.nan)
+    guess = np.zeros(result.disparity.shape, bool)
+    guess[70:90, 20:100] = True  # pretend these were filled: no depth, a disparity (box and wall)
+    filled = replace(result, depth=np.where(guess, np.nan, z).astype(np.float32))
+    assert np.isnan(filled.point_image()[guess]).all()
+    both = filled.point_image(filled=True)
+    np.testing.assert_allclose(both[guess], result.point_image()[guess], atol=1e-5)
+    np.testing.assert_array_equal(both[~guess], filled.point_image()[~guess])
+    box, wall = float(syn.BOX_Z), float(syn.WALL_Z)
+    assert box < wall
+    assert filled.limits == {}
+    near = filled.filtered(max_depth=0.5 * (box + wall)).filtered(max_depth=wall * 2)
+    assert near.limits == {"max_depth": 0.5 * (box + wall)}  # the tighter of the two
+    pts = near.point_image(filled=True)
+    far_guess = guess & (result.depth > near.limits["max_depth"])
+    near_guess = guess & (result.depth <= near.limits["max_depth"])
+    assert far_guess.sum() > 0 and near_guess.sum() > 0
+    assert np.isnan(pts[far_guess]).all() and np.isfinite(pts[near_guess]).all()
+    sigma = np.where(np.isfinite(filled.depth), 0.01, np.nan).astype(np.float32)
+    trusted = replace(filled, depth_sigma=sigma).filtered(max_sigma=1e3)
+    assert trusted.limits == {"max_sigma": 1e3}
+    assert np.isnan(trusted.point_image(filled=True)[guess]).all()

@@ -17,7 +17,7 @@ import pytest
 import stereovision as sv
 from stereovision.calibration import Calibration
 from stereovision.ground import fit_ground_plane, obstacle_mask
-from stereovision.io import load_scene
+from stereovision.io import load_scene, read_pfm
 from stereovision.synthetic import render_plane
 
 SIZE = (480, 360)
@@ -290,6 +290,25 @@ def test_cli_depth_ground(data_dir: Path, tmp_path: Path) -> None:
     hits = [r for r in scan["ranges"] if isinstance(r, float)]
     assert len(hits) > 700 and min(hits) > 3.0  # KITTI: cars from about 5 m on
     assert "beams on an obstacle, the nearest" in run.stdout
+    # --max-depth bounds the obstacles and the scan too, not only the depth outputs; filled
+    # pixels (no depth of their own) count within it
+    near = tmp_path / "near"
+    run = subprocess.run(
+        [*cli, *pair, "--calib", str(kitti / "calib.txt"), "--ground", "--max-depth", "10",
+         "-o", str(near)], capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    depth_near = np.load(near / "depth.npy")
+    mask_near = cv2.imread(str(near / "obstacles.png"), cv2.IMREAD_GRAYSCALE) > 0
+    kcal = Calibration.from_file(kitti / "calib.txt")
+    z = kcal.reproject(read_pfm(near / "disparity.pfm"))[..., 2]
+    assert np.nanmax(depth_near) <= 10.0 and (z[mask_near] <= 10.0 + 1e-4).all()
+    assert 500 < mask_near.sum() < (mask > 0).sum()
+    assert (~np.isfinite(depth_near[mask_near])).sum() > 100  # filled pixels
+    scan_near = json.loads((near / "scan.json").read_text())
+    hits_near = [r for r in scan_near["ranges"] if isinstance(r, float)]
+    # Z <= 10 m within a half field of view of 40.6 degrees: at most 10 / cos(40.6) = 13.2 m away
+    assert max(hits) > 14.0 and 100 < len(hits_near) and max(hits_near) < 13.2
     run = subprocess.run(
         [*cli, *pair, "--ground", "-o", str(tmp_path / "x")], capture_output=True, text=True,
         timeout=120,

@@ -206,7 +206,7 @@ def depth_outputs(
     written = write_depth_outputs(res, out_dir, voxel)
     written.update(render_outputs(res, out_dir))
     if ground:
-        written.update(_ground_outputs(res.disparity, calib, out_dir, grid, log))
+        written.update(_ground_outputs(res, calib, out_dir, grid, log))
     return res, written
 
 
@@ -252,18 +252,21 @@ def cmd_depth(args: argparse.Namespace) -> int:
 
 
 def _ground_outputs(
-    disparity: Any, calib: Any, out: Path, grid: float | None = None, log: Any = None
+    res: Any, calib: Any, out: Path, grid: float | None = None, log: Any = None
 ) -> dict[str, Path]:
     """``depth --ground``: the floor's plane (``ground.json``), what stands on it
     (``obstacles.png``: 255 between 0.15 and 2 m above the floor) and its planar scan
     (``scan.json``, ``sensor_msgs/LaserScan``'s fields); with ``--grid M`` also a ROS map_server
-    occupancy grid of M-metre cells (``map.png``, ``map.yaml``)."""
+    occupancy grid of M-metre cells (``map.png``, ``map.yaml``). The floor is fitted to the
+    whole disparity map; obstacles, scan and grid come from its points within ``--max-depth``,
+    filled pixels included unless ``--max-sigma`` asks for trusted depths only
+    (:meth:`DepthResult.point_image`)."""
     import cv2
 
     from stereovision.ground import fit_ground_plane, laser_scan, obstacle_mask, occupancy_grid
     from stereovision.io import atomic_write
 
-    plane = fit_ground_plane(disparity, calib)
+    plane = fit_ground_plane(res.disparity, calib)
     if plane is None:
         if log is not None:
             log("ground plane: none found (no near-level plane holds 3 % of the pixels)")
@@ -272,7 +275,7 @@ def _ground_outputs(
         log(plane.describe())
         log("the camera on the floor, for ROS 2: " + plane.ros2_static_transform())
     rc = calib if calib.rectified else calib.rectified_calibration()
-    points = rc.reproject(disparity)  # once, for the obstacles and the grid
+    points = res.point_image(filled=True)  # once, for the obstacles, the scan and the grid
     mask = obstacle_mask(points, plane)
     paths = {"ground.json": out / "ground.json", "obstacles.png": out / "obstacles.png"}
     with atomic_write(paths["ground.json"], "w") as fh:

@@ -244,6 +244,9 @@ class DepthResult:
         :class:`~stereovision.matching.gabor.GaborResult`; with ``method="fused"`` also
         ``"mcgm"`` and ``"hopfield"`` :class:`~stereovision.Matches` and ``"members"``, the
         :class:`~stereovision.matching.fusion.FusionResult` with ``count`` and ``sources``).
+    limits : dict
+        The limits :meth:`filtered` applied (``min_depth``, ``max_depth``, ``max_sigma``,
+        ``max_relative_sigma``; empty for an unfiltered result).
     """
 
     disparity: npt.NDArray[np.float32]
@@ -260,6 +263,7 @@ class DepthResult:
     timings: dict[str, float] = field(default_factory=dict)
     depth_sigma: npt.NDArray[np.float32] | None = None
     channels: dict[str, Any] | None = field(default=None, repr=False)
+    limits: dict[str, float] = field(default_factory=dict, repr=False)
 
     @property
     def valid(self) -> npt.NDArray[np.bool_]:
@@ -270,6 +274,51 @@ class DepthResult:
     def density(self) -> float:
         """Fraction of pixels with a disparity estimate."""
         return float(self.valid.mean())
+
+    def point_image(self, *, filled: bool = False) -> npt.NDArray[np.float32]:
+        """``(H, W, 3)`` float32 points in metres, NaN where the pixel has none.
+
+        The left rectified camera's frame (X right, Y down, Z forward), image-shaped: what
+        :func:`~stereovision.obstacle_mask`, :func:`~stereovision.laser_scan` and
+        :func:`~stereovision.ground.occupancy_grid` take. It does not need the cloud
+        (``cloud=False`` results have one too).
+
+        Parameters
+        ----------
+        filled : bool
+            False: the pixels with a depth only (the cloud's). True: also the filled pixels,
+            guesses from their neighbours that get no depth of their own, within the working
+            range of :meth:`filtered` (none when it asked for a ``max_sigma`` or
+            ``max_relative_sigma``: a guess has no uncertainty to pass). For obstacles the
+            filled pixels count: on KITTI the obstacle recall is 0.975 with them and 0.65
+            without, at the same precision (``benches/bench_ground.py``).
+
+        Returns
+        -------
+        ndarray
+            float32 ``(H, W, 3)``.
+
+        Raises
+        ------
+        ValueError
+            A result without depth (no calibration).
+        """
+        if self.depth is None or self.calibration is None:
+            raise ValueError("no 3-D points: depth_map was called without a calibration")
+        pts = self.calibration.reproject(self.disparity)
+        keep = np.isfinite(self.depth)
+        lim = self.limits
+        if filled and "max_sigma" not in lim and "max_relative_sigma" not in lim:
+            z = pts[..., 2]
+            guess = ~keep & np.isfinite(z)
+            with np.errstate(invalid="ignore"):
+                if "min_depth" in lim:
+                    guess &= z >= lim["min_depth"]
+                if "max_depth" in lim:
+                    guess &= z <= lim["max_depth"]
+            keep |= guess
+        pts[~keep] = np.nan
+        return pts
 
     def filtered(
         self,
@@ -344,8 +393,14 @@ class DepthResult:
             points, colors, pixels = self.points[on], self.colors[on], self.pixels[on]
         else:
             points, colors, pixels = self.points, self.colors, self.pixels
+        tighter = {"min_depth": max}  # the other limits: the smaller of two
+        merged = dict(self.limits)
+        for name, v in limits.items():
+            if v is not None:
+                merged[name] = float(tighter.get(name, min)(merged.get(name, v), v))
         return dataclasses.replace(
             self,
+            limits=merged,
             depth=np.where(keep, z, nan).astype(np.float32),
             depth_sigma=None if sigma is None else sigma.astype(np.float32),
             points=points,

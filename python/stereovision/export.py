@@ -97,9 +97,12 @@ def organised_points(
     """
     _require_metric(result)
     h, w = result.disparity.shape[:2]
-    pts = np.full((h, w, 3), np.nan, dtype=np.float32)
+    if len(result.points) == 0:  # computed with cloud=False: from the depth map
+        pts = result.point_image()
+    else:
+        pts = np.full((h, w, 3), np.nan, dtype=np.float32)
+        pts[result.pixels[:, 1], result.pixels[:, 0]] = result.points
     xs, ys = result.pixels[:, 0], result.pixels[:, 1]
-    pts[ys, xs] = result.points
     if result.left_rectified is not None:
         cols = np.ascontiguousarray(result.left_rectified[..., ::-1], dtype=np.uint8)
     else:

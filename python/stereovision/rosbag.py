@@ -340,7 +340,7 @@ ros2_static_transform>`.
 
         def grid() -> Any:  # the depth map's points, reprojected once for the cloud and scan
             if not memo:
-                memo.append(result.calibration.reproject(result.disparity))
+                memo.append(result.point_image(filled=True))
             return memo[0]
 
         if self.points:

@@ -170,8 +170,7 @@ def floor_view(result: Any) -> tuple[str, str]:
     out = np.array(img, np.uint8)
     if out.ndim == 2:
         out = np.repeat(out[..., None], 3, axis=2)
-    rc = calib if calib.rectified else calib.rectified_calibration()
-    obstacles = obstacle_mask(rc.reproject(result.disparity), plane)
+    obstacles = obstacle_mask(result.point_image(filled=True), plane)
     for mask, colour in ((plane.inliers, (60, 200, 60)), (obstacles, (40, 40, 230))):
         out[mask] = (0.5 * out[mask] + 0.5 * np.array(colour)).astype(np.uint8)
     return plane.describe(), _data_url(out)
