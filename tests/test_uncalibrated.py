@@ -161,6 +161,12 @@ def test_stereopi_raw_pair_and_the_books(data_dir: Path) -> None:
     assert rect.median_dy < 0.4 and rect.matches > 60
     e = np.linalg.svd(rect.F.T)[2][-1]
     assert math.hypot(e[0] / e[2] + 46, e[1] / e[2] - 76) < 15  # the right image's epipole
+    # The search range a matcher can use: its coarse probe ran to the end of its search here
+    # (a range of 697 px on a 575 px output before), so the features' span sets it (41-169 px).
+    assert rect.max_disparity <= rect.size[0] / 2 and rect.disparity_range[0] < 60
+    lr, rr = rect.rectify(left, right)
+    res = sv.depth_map(lr, rr, method="fast", max_disparity=rect.max_disparity)
+    assert res.density > 0.5
 
 
 def test_opencv_homographies_are_skewed_and_the_shear_fixes_them(data_dir: Path) -> None:

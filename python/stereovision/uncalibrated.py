@@ -566,8 +566,17 @@ def rectify_uncalibrated(
     probe_range = math.ceil(s * (float(p_hi) + 3 * spread - probe_low) + 8)
     probe = _dense_span(gl, gr, h1, h2, s, (probe_tx1, tx2), y0, (probe_width, height), probe_range)
     if probe is not None:
-        low = min(low, probe_low + probe[0] / s)
-        high = max(high, probe_low + probe[1] / s)
+        p_low = min(low, probe_low + probe[0] / s)
+        p_high = max(high, probe_low + probe[1] / s)
+        # A coarse match that ran to the end of its search found no end there, and a range
+        # wider than half the output leaves a matcher little to match: the features' span then.
+        # (OpenCV's hand-held books pair: the probe ran to 956 of 960 px, for a range of 697 px
+        # on a 575 px wide output; the features' alone: 132-260 px.)
+        ran_out = probe[1] >= _PROBE_SCALE * (probe_range / _PROBE_SCALE - 2)
+        p_tx1 = tx2 - s * p_low + _LOW_DISPARITY
+        p_width = max(s * x1_hi + p_tx1, s * x2_hi + tx2)
+        if not ran_out and s * (p_high - p_low) + 2 * _LOW_DISPARITY <= p_width / 2:
+            low, high = p_low, p_high
     tx1 = tx2 - s * low + _LOW_DISPARITY
     move1 = np.array([[s, 0, tx1], [0, s, -s * y0], [0, 0, 1.0]])
     move2 = np.array([[s, 0, tx2], [0, s, -s * y0], [0, 0, 1.0]])
