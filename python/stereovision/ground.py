@@ -117,6 +117,41 @@ class GroundPlane:
         out: F64 = pts @ self.normal + self.height  # the camera (X = 0) is at +height
         return out
 
+    def support(
+        self, disparity: npt.ArrayLike, calib: Calibration, *, inlier_px: float = GROUND_INLIER_PX
+    ) -> float:
+        """Share of the pixels with a disparity in ``disparity`` that lie on this plane, counted
+        as :attr:`inlier_share` counts them: does this floor still hold in another frame?
+
+        A fresh fit on uneven ground or on a noisy frame may settle on another part of the
+        ground (on TartanAir's street, JPEG noise alone moved the fit by 4 degrees) while the
+        first floor still holds its share; a camera turned on its mount by 2 degrees leaves
+        the first floor under a tenth of it (``tests/test_stream.py``).
+
+        Parameters
+        ----------
+        disparity : array_like
+            ``(H, W)`` disparity of another frame of the same rig; NaN where unknown.
+        calib : Calibration
+            The rig.
+        inlier_px : float
+            Disparity tolerance (pixels), as :func:`fit_ground_plane`'s.
+
+        Returns
+        -------
+        float
+            In [0, 1]; 0 when no pixel has a disparity.
+        """
+        disp = np.asarray(disparity, np.float64)
+        if disp.ndim != 2:
+            raise ValueError(f"disparity: expected a (H, W) map, got shape {disp.shape}")
+        known = np.isfinite(disp) & (disp + _rig(calib)[4] > 0)
+        vv, uu = np.nonzero(known)
+        if len(vv) == 0:
+            return 0.0
+        a, b, c = self.disparity_plane
+        return float(np.mean(np.abs(a * uu + b * vv + c - disp[known]) < inlier_px))
+
     def camera_in_floor(self) -> F64:
         """``(4, 4)`` pose of the camera in the floor frame (ROS REP 103: ``x`` forward, ``y``
         left, ``z`` up; origin on the floor under the camera): ``X_floor = T @ X_camera``.
