@@ -170,6 +170,32 @@ def test_eval_json_one_object_per_scene(data_dir: Path) -> None:
     assert row["ours+fill"]["bad_2.0"] < row["bm"]["bad_2.0"]
 
 
+def test_eval_goes_on_past_a_damaged_scene(data_dir: Path, tmp_path: Path) -> None:
+    """One undecodable scene among several is reported in one line and the rest evaluated;
+    the exit status is 1 (as batch's for a failed pair). Alone it is the usual error."""
+    import json
+    import shutil
+
+    good = tmp_path / "a_tsukuba"
+    shutil.copytree(data_dir / "middlebury2001" / "tsukuba", good)
+    bad = tmp_path / "b_broken"
+    shutil.copytree(good, bad)
+    (bad / "left.png").write_bytes(b"not a png")
+    proc = subprocess.run(
+        [*SV, "eval", str(tmp_path), "--json", "--no-opencv"],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert proc.returncode == 1, proc.stderr
+    rows = [json.loads(line) for line in proc.stdout.splitlines() if line.strip()]
+    assert [Path(r["scene"]).name for r in rows] == ["a_tsukuba"]
+    assert rows[0]["ours"]["bad_2.0"] < 10
+    err = proc.stderr.strip().splitlines()
+    assert len(err) == 2 and err[0].startswith(f"failed {bad}: ") and "left.png" in err[0]
+    assert err[1] == "stereovision: 1 of 2 scenes failed (above)"
+    alone = subprocess.run([*SV, "eval", str(bad)], capture_output=True, text=True, check=False)
+    assert alone.returncode == 2 and alone.stderr.count("\n") == 1 and "left.png" in alone.stderr
+
+
 @pytest.mark.parametrize("argv", [["depth"], ["bogus"], []])
 def test_usage_errors_exit_nonzero(argv: list[str]) -> None:
     proc = subprocess.run([*SV, *argv], capture_output=True, text=True, check=False)

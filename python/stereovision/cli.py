@@ -595,14 +595,23 @@ def cmd_eval(args: argparse.Namespace) -> int:
         print(header)
         print(sub)
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
+    failed: list[str] = []
     for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
-        scene = load_scene(d)
-        if scene.gt is None:
+        try:
+            scene = load_scene(d)
+            if scene.gt is None:
+                if len(dirs) == 1:
+                    raise CliError(f"{d}: no ground truth (gt_disp.pfm) to evaluate against")
+                tqdm.write(f"skipped {d}: no ground truth (gt_disp.pfm)", file=sys.stderr)
+                continue
+            row = _eval_scene(scene, args.method, not args.no_opencv)
+        except (ValueError, OSError, RuntimeError) as e:
             if len(dirs) == 1:
-                raise CliError(f"{d}: no ground truth (gt_disp.pfm) to evaluate against")
-            tqdm.write(f"skipped {d}: no ground truth (gt_disp.pfm)", file=sys.stderr)
+                raise
+            # one damaged scene of many: say so and go on (the exit status says it at the end)
+            failed.append(str(d))
+            tqdm.write(f"failed {d}: {e}", file=sys.stderr)
             continue
-        row = _eval_scene(scene, args.method, not args.no_opencv)
         rows.append(row)
         if args.json:
             print(json.dumps({k: v for k, v in row.items() if not k.startswith("_")}))
@@ -611,8 +620,12 @@ def cmd_eval(args: argparse.Namespace) -> int:
         for key in ("bm", "sgbm", "sgbm+fill"):
             cells.append(_fmt_dense(row[key]) if key in row else " " * 20)
         tqdm.write(f"{row['scene']:38s} {row['max_disparity']:4d} | " + " | ".join(cells))
+    status = 0
+    if failed:
+        print(f"stereovision: {len(failed)} of {len(dirs)} scenes failed (above)", file=sys.stderr)
+        status = 1
     if args.json or not rows:
-        return 0
+        return status
     mean = {
         k: float(np.mean([r[k]["bad_2.0"] for r in rows]))
         for k in ("ours", "ours+fill", "bm", "sgbm")
@@ -645,7 +658,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
             print(line)
             if "_members_table1_text" in r:
                 print(r["_members_table1_text"])
-    return 0
+    return status
 
 
 # ----------------------------------------------------------------------------- entry point
