@@ -259,6 +259,24 @@ def test_fourcc_codes() -> None:
     assert fourcc_text(7.0) == ""  # unprintable bytes are not a format
 
 
+def test_frames_of_another_shape_are_not_stretched(tmp_path: Path) -> None:
+    """Asked 16:9 of a 4:3 source: the frames stay 4:3 at their own size (one warning), as a
+    resize would stretch them and every calibration made of them; a right source of another
+    shape than the left's is refused."""
+    left, right = _videos(tmp_path, 3, 3, size=(160, 120))
+    with pytest.warns(UserWarning, match=r"delivers 160x120, not 320x180: another shape") as rec:
+        with StereoCamera(left, right, size=(320, 180)) as cam:
+            frame = cam.read()
+            assert cam.size == (160, 120)
+    assert len(rec) == 1  # the right source then matches the size kept
+    assert frame.left.shape == frame.right.shape == (120, 160, 3)
+    wide = _write_video(tmp_path / "wide.avi", [_numbered(i, (160, 90)) for i in range(3)])
+    with StereoCamera(left, wide) as cam:
+        with pytest.raises(SourceError, match=r"right source .* delivers 160x90, the left "
+                           r"source 160x120: frames of another shape"):  # fmt: skip
+            cam.read()
+
+
 def test_resolution_request_and_resize_warning(tmp_path: Path) -> None:
     left, right = _videos(tmp_path, 3, 3, size=(160, 120))
     with pytest.warns(UserWarning, match=r"delivers 160x120, not 320x240") as rec:

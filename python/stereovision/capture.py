@@ -285,7 +285,10 @@ class StereoCamera(PairSource):
     size : tuple of int, optional
         Requested ``(width, height)``, asked of the sources with ``CAP_PROP_FRAME_WIDTH`` /
         ``CAP_PROP_FRAME_HEIGHT``. Frames that come in another size (a file cannot be asked) are
-        resized to it, with one :class:`UserWarning` per camera. Default: the left source's size.
+        resized to it, with one :class:`UserWarning` per camera; frames of another shape (4:3
+        for 16:9) are kept at their own size instead, as a resize would stretch them, and a
+        right source whose shape differs from the left's raises :class:`SourceError`. Default:
+        the left source's size.
     fps : float, optional
         Requested frame rate (``CAP_PROP_FPS``); what the source reports is in
         :attr:`delivered_fps`.
@@ -343,6 +346,7 @@ class StereoCamera(PairSource):
         self.skews_ms: list[float] = []
         self.count = 0
         self._warned: set[str] = set()
+        self._size_locked = False  # a frame has fixed the output size
         self._caps: dict[str, Any] = {}
         try:
             for side, src in self.sources.items():
@@ -407,7 +411,31 @@ class StereoCamera(PairSource):
         if self.size is None:
             self.size = (w, h)
         if (w, h) == self.size:
+            self._size_locked = True
             return frame
+        if abs((w / h) / (self.size[0] / self.size[1]) - 1) > 0.01:
+            # A resize to another shape would stretch the frames (and every calibration made
+            # of them): the first frame's own size is kept instead, and two sources of
+            # different shapes are refused.
+            if self._size_locked:
+                first = "right" if side == "left" else "left"
+                raise SourceError(
+                    f"{side} source {_describe_source(self.sources[side])} delivers {w}x{h}, "
+                    f"the {first} source {self.size[0]}x{self.size[1]}: frames of another shape "
+                    "cannot be paired without stretching one (ask both for the same size)"
+                )
+            warnings.warn(
+                f"{side} source {_describe_source(self.sources[side])} delivers {w}x{h}, not "
+                f"{self.size[0]}x{self.size[1]}: another shape, so its frames are kept at "
+                f"{w}x{h} (a resize would stretch them)",
+                UserWarning,
+                stacklevel=3,
+            )
+            self._warned.add(side)
+            self.size = (w, h)
+            self._size_locked = True
+            return frame
+        self._size_locked = True
         if side not in self._warned:
             self._warned.add(side)
             warnings.warn(
@@ -966,7 +994,10 @@ def add_cli(subparsers: Any) -> None:
         "both views and a new pose.",
     )
     add_source_args(p)
-    p.add_argument("--size", help="requested size WIDTHxHEIGHT (frames are resized if needed)")
+    p.add_argument(
+        "--size",
+        help="requested size WIDTHxHEIGHT (frames of the same shape are resized if needed)",
+    )
     p.add_argument("--fps", type=float, help="requested frame rate")
     p.add_argument("-o", "--output", required=True, help="output directory")
     p.add_argument("--count", type=int, help="pairs to save (default: until a source ends)")
