@@ -646,6 +646,18 @@ def test_cli_info_on_a_bag(
     assert code == 0 and "no camera_info beside the image topics" in out
     code, out, err = run("info", str(tmp_path / "ros1" / "nothing.bag"))
     assert code != 0 and "not found" in err and "Traceback" not in err
+    # topics no rule pairs: the error names the options, and info has them
+    odd = write_bag(tmp_path / "odd", frames, topics=("/a/image", "/b/image"))
+    code, out, err = run("info", str(odd))
+    assert code == 2 and "give the topics (--left-topic, --right-topic)" in err
+    code, out, err = run("info", str(odd), "--left-topic", "/a/image", "--right-topic", "/b/image")
+    assert code == 0, err
+    assert " 4 msgs " in out and "/a/image" in out and "<- left" in out
+    code, out, err = run("info", str(tmp_path / "ros2" / "rig"), "--left-topic", "/x")
+    assert code == 2 and "give both the left and the right topic" in err
+    cal = _raw_rig().save(tmp_path / "rig.yaml")
+    code, out, err = run("info", str(cal), "--left-topic", "/a/image")
+    assert code == 2 and err.strip().endswith("--left-topic and --right-topic are for a bag")
 
 
 def test_one_camera_stops(cones: Any, tmp_path: Path) -> None:

@@ -423,16 +423,22 @@ def cmd_info(args: argparse.Namespace) -> int:
         return 0
     if design != (None, None, None):
         raise CliError("--size, --hfov and --baseline describe a rig on paper: give no calibration")
+    topics = (args.left_topic, args.right_topic)
     if not is_bag(args.calib):
+        if topics != (None, None):
+            raise CliError("--left-topic and --right-topic are for a bag")
         print(_load_calibration(args.calib).describe())
         return 0
     from stereovision.rosbag import BagCamera
 
-    with BagCamera(args.calib) as cam:
+    with BagCamera(args.calib, left_topic=topics[0], right_topic=topics[1]) as cam:
         print(cam.summary())
         calib = cam.calibration()
     if calib is None:
-        print("no camera_info beside the image topics: give the rig's calibration (--calib)")
+        print(
+            "no camera_info beside the image topics: give the rig's calibration to the command "
+            "that reads the bag (stream --from-bag BAG --calib RIG)"
+        )
     else:
         print("the rig, from its camera_info:")
         print(calib.describe())
@@ -790,6 +796,8 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--size", metavar="WxH", help="a rig on paper: image size, e.g. 1280x720")
     d.add_argument("--hfov", type=float, metavar="DEG", help="a rig on paper: horizontal FOV")
     d.add_argument("--baseline", type=float, metavar="M", help="a rig on paper: baseline (m)")
+    d.add_argument("--left-topic", help="a bag: its left image topic (default: found)")
+    d.add_argument("--right-topic", help="a bag: its right image topic (default: found)")
     d.set_defaults(func=cmd_info)
 
     d = sub.add_parser("eval", help="evaluate against ground truth, OpenCV beside")
