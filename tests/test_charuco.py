@@ -409,7 +409,9 @@ def test_calibrate_from_two_videos(rig: dict[str, Any], tmp_path: Path) -> None:
     cal, rep = calibrate_from_video(left, right, board=CharucoBoard("10x7", 0.03, 0.022),
                                     log=lines.append)  # fmt: skip
     kept = len(rep.used_pairs) + len(rep.rejected_pairs)
-    assert lines == [f"{kept} of 20 frame pairs kept (the board in both views, a new pose)"]
+    assert lines == [
+        f"{kept} of 20 frame pairs kept (a quick look saw the board in both views, in a new pose)"
+    ]
     assert 7 <= kept <= 10 and all(n.startswith("frame_") for n in rep.used_pairs)
     assert abs(np.linalg.norm(cal.T) - np.linalg.norm(T)) < 5e-4
     assert "DICT_5X5_50" in rep.board  # found while reading

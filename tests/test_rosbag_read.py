@@ -553,6 +553,13 @@ def test_cli_source_errors(
     cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
 ) -> None:
     bag = write_bag(tmp_path / "rig", [(T0, cones.left, T0, cones.right)])
+    # a recording without the board: said in those words (it was "no image pairs given")
+    code, _, err = run("calibrate", "--from-bag", str(bag), "--pattern", "9x6", "--square",
+                         "0.025", "-o", str(tmp_path / "c.yaml"))  # fmt: skip
+    assert code == 2 and not (tmp_path / "c.yaml").exists()
+    assert err.strip().endswith(
+        "no frame pair of the 1 read shows the chessboard 9x6 inner corners in both views"
+    )
     for argv, msg in [
         (("stream", "--from-bag", str(tmp_path / "nope"), "--no-display"), "bag not found"),
         (("stream", "--no-display"), "give the two cameras (--left and --right) or a recording"),

@@ -1371,8 +1371,16 @@ def _calibrate_from_camera(
                 names.append(f"frame_{frame.index:05d}")
     finally:
         cam.close()
+    what = board.describe() if board is not None else f"chessboard {pat[0]}x{pat[1]} inner corners"
+    if not lefts:
+        raise ValueError(
+            f"no frame pair of the {read} read shows the {what} in both views"
+            + (" (none read: an empty recording)" if read == 0 else "")
+        )
     if log is not None:
-        log(f"{len(lefts)} of {read} frame pairs kept (the board in both views, a new pose)")
+        # The live detector's quick look; calibrate's own detector then has the last word.
+        log(f"{len(lefts)} of {read} frame pairs kept (a quick look saw the board in both views, "
+            "in a new pose)")  # fmt: skip
     if board is not None and collector.board is not None and collector.board.resolved:
         board = collector.board  # the dictionary found while reading
     return calibrate(
