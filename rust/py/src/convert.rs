@@ -87,7 +87,7 @@ pub fn map_copy_in_place<'py, R: Send>(
     let a = map.as_array();
     let (h, w) = a.dim();
     let mut d: Vec<f32> = a.iter().copied().collect();
-    let r = py.detach(|| kernel(&mut d, w, h));
+    let r = crate::workers::detach(py, || kernel(&mut d, w, h));
     Ok((vec_to_numpy(py, (h, w), d)?, r))
 }
 
@@ -153,7 +153,7 @@ pub fn gray_u8<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let (h, w, c, data) = u8_layout(&image, "image")?;
     let wts = [weights.0, weights.1, weights.2];
-    let grey = py.detach(|| {
+    let grey = crate::workers::detach(py, || {
         crate::errors::guard("gray_u8", || {
             stereovision_core::image::grey_from_u8(data, w, h, c, wts)
         })

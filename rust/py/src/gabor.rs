@@ -151,7 +151,7 @@ pub fn gabor_disparity<'py>(
         speckle_size,
         speckle_range,
     );
-    let out = py.detach(|| guard("gabor_disparity", || core_gabor(l, r, &p)))?;
+    let out = crate::workers::detach(py, || guard("gabor_disparity", || core_gabor(l, r, &p)))?;
     Ok((
         image_to_numpy(py, out.disparity)?,
         image_to_numpy(py, out.confidence)?,
@@ -171,7 +171,7 @@ pub fn gabor_responses<'py>(
 ) -> PyResult<Pair<'py>> {
     let im = image_from_numpy(&img, "img")?;
     let (w, h) = im.size();
-    let (re, imag) = py.detach(|| {
+    let (re, imag) = crate::workers::detach(py, || {
         guard("gabor_responses", || {
             core_resp(&im, freq, theta_deg, bandwidth_oct, aspect)
         })
@@ -216,7 +216,9 @@ pub fn gabor_newton_step<'py>(
         stability_tau,
         ..GaborParams::default()
     };
-    let (delta, conf) = py.detach(|| guard("gabor_newton_step", || core_step(&l, &r, &d, &p)))?;
+    let (delta, conf) = crate::workers::detach(py, || {
+        guard("gabor_newton_step", || core_step(&l, &r, &d, &p))
+    })?;
     Ok((
         image_to_numpy(py, to_image(w, h, delta))?,
         image_to_numpy(py, to_image(w, h, conf))?,
@@ -245,7 +247,7 @@ pub fn gabor_lr_check<'py>(
     let (h, w) = a.dim();
     let dl: Vec<f32> = a.iter().copied().collect();
     let dr: Vec<f32> = b.iter().copied().collect();
-    let ok = py.detach(|| lr_check(&dl, &dr, w, h, tol));
+    let ok = crate::workers::detach(py, || lr_check(&dl, &dr, w, h, tol));
     crate::convert::vec_to_numpy(py, (h, w), ok)
 }
 

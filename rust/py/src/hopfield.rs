@@ -150,7 +150,7 @@ pub fn hopfield_interest<'py>(
         tile,
         floor_rel,
     };
-    let (m, pts) = py.detach(|| {
+    let (m, pts) = crate::workers::detach(py, || {
         guard("hopfield_interest", || {
             let m = moravec(im);
             let pts = select_points(&m, w, h, &p);
@@ -245,7 +245,7 @@ pub fn hopfield_match_u8<'py>(
     let (p, best) = parse_match(params)?;
     // Grey conversion and matcher in one hot region of the pool (`run_hot`): one wake-up of
     // the workers per call instead of one per parallel region.
-    let out = py.detach(|| {
+    let out = crate::workers::detach(py, || {
         guard("hopfield_match_u8", || {
             run_hot(|| {
                 let (lg, rg) = stereovision_core::image::grey_pair_from_u8(ld, rd, w, h, c, wts)?;
@@ -306,7 +306,9 @@ fn run_match<'py>(
     params: &Bound<'py, PyDict>,
 ) -> PyResult<MatchOut<'py>> {
     let (p, best) = parse_match(params)?;
-    let out = py.detach(|| guard("hopfield_match", || run_matcher(l, r, &p, best)))?;
+    let out = crate::workers::detach(py, || {
+        guard("hopfield_match", || run_matcher(l, r, &p, best))
+    })?;
     output(py, out)
 }
 
@@ -326,8 +328,9 @@ pub fn hopfield_candidates<'py>(
     );
     let (l, r) = (l.view(), r.view());
     let p = self::params(params)?;
-    let (_, neurons) =
-        py.detach(|| guard("hopfield_candidates", || candidate_neurons(l, r, &p)))?;
+    let (_, neurons) = crate::workers::detach(py, || {
+        guard("hopfield_candidates", || candidate_neurons(l, r, &p))
+    })?;
     let flat: Vec<f32> = neurons
         .iter()
         .flat_map(|n| {

@@ -20,6 +20,7 @@ mod segment;
 mod sgm;
 mod temporal;
 mod triangulation;
+mod workers;
 
 /// Freed image-sized blocks are kept for the next call instead of being returned to the system
 /// and faulted in again (`stereovision_core::alloc`); only the extension's allocations use it.

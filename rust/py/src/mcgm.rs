@@ -143,7 +143,7 @@ pub fn mcgm_log<'py>(
         )));
     }
     let (w, h) = im.size();
-    let data = py.detach(|| guard("mcgm_log", || Ok(log_filter(&im, sigma))))?;
+    let data = crate::workers::detach(py, || guard("mcgm_log", || Ok(log_filter(&im, sigma))))?;
     image_to_numpy(
         py,
         Image {
@@ -243,7 +243,7 @@ pub fn mcgm_curves<'py>(
 ) -> PyResult<Bound<'py, PyList>> {
     let im = image_from_numpy(&img, "image")?;
     let p = self::params(params)?;
-    let chans = py.detach(|| guard("mcgm_curves", || image_curves(&im, &p)))?;
+    let chans = crate::workers::detach(py, || guard("mcgm_curves", || image_curves(&im, &p)))?;
     let out = PyList::empty(py);
     for c in chans {
         out.append(curves_dict(py, c)?)?;
@@ -271,7 +271,7 @@ pub fn mcgm_match<'py>(
     let l = image_from_numpy(&left, "left")?;
     let r = image_from_numpy(&right, "right")?;
     let p = self::params(params)?;
-    let out = py.detach(|| guard("mcgm_match", || core_match(&l, &r, &p)))?;
+    let out = crate::workers::detach(py, || guard("mcgm_match", || core_match(&l, &r, &p)))?;
     let stats = PyDict::new(py);
     stats.set_item("n_combined", out.n_combined)?;
     stats.set_item("n_sides", out.n_sides)?;
@@ -367,7 +367,7 @@ pub fn mcgm_filter<'py>(
             channel: 0,
         })
         .collect();
-    let (keep, _) = py.detach(|| {
+    let (keep, _) = crate::workers::detach(py, || {
         guard("mcgm_filter", || {
             edge_filters(
                 &l,

@@ -58,7 +58,7 @@ pub fn refine_disparity<'py>(
         fill_max_residual,
     };
     let (lv, rv) = (l.view(), r.view());
-    let (out, oc, filled) = py.detach(|| {
+    let (out, oc, filled) = crate::workers::detach(py, || {
         guard("refine_disparity", || {
             core_refine(lv, rv, d, c, d_min, d_max, &p)
         })

@@ -34,7 +34,7 @@ pub fn graph_segments<'py>(
         return Err(PyValueError::new_err("image: contains NaN or inf"));
     }
     let img = row_major(&image);
-    let labels = py.detach(|| {
+    let labels = crate::workers::detach(py, || {
         guard("graph_segments", || {
             Ok(core_segments(&img, w, h, c, k, min_size))
         })
@@ -109,7 +109,7 @@ pub fn quantised_regions<'py>(
         )));
     }
     let img = row_major(&image);
-    let labels = py.detach(|| {
+    let labels = crate::workers::detach(py, || {
         guard("quantised_regions", || {
             Ok(core_regions(&img, w, h, c, step, offset))
         })

@@ -39,7 +39,9 @@ pub fn sgm_disparity<'py>(
         paths,
     };
     let (lv, rv) = (l.view(), r.view());
-    let out = py.detach(|| guard("sgm_disparity", || core_sgm(lv, rv, d_min, d_max, &p)))?;
+    let out = crate::workers::detach(py, || {
+        guard("sgm_disparity", || core_sgm(lv, rv, d_min, d_max, &p))
+    })?;
     image_to_numpy(
         py,
         Image {

@@ -36,7 +36,7 @@ pub fn temporal_grey_difference<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let (h, w, c, f) = u8_layout(&frame, "frame")?;
     let m = mean_slice(&mean, frame.shape())?;
-    let d = py.detach(|| {
+    let d = crate::workers::detach(py, || {
         guard("temporal_grey_difference", || {
             grey_difference(f, m, h * w, c)
         })
@@ -81,7 +81,7 @@ pub fn temporal_running_mean<'py>(
     let (Some(m), Some(n)) = (m, n) else {
         return Err(PyValueError::new_err("mean and count must be C-contiguous"));
     };
-    let out = py.detach(|| {
+    let out = crate::workers::detach(py, || {
         guard("temporal_running_mean", || {
             running_mean(f, m, n, d, c, ks, max_frames)
         })

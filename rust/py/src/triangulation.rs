@@ -37,7 +37,9 @@ pub fn depth_rectified<'py>(
         s_min,
         s_fill,
     };
-    let (z, s) = py.detach(|| guard("depth_rectified", || core_depth(d, c, w, h, fb, doffs, m)))?;
+    let (z, s) = crate::workers::detach(py, || {
+        guard("depth_rectified", || core_depth(d, c, w, h, fb, doffs, m))
+    })?;
     let img = |data| Image {
         width: w,
         height: h,
