@@ -25,6 +25,7 @@ BAD_VALUES: list[Any] = [
     -1,
     0,
     0.5,
+    1e-9,  # tiny and positive: a Gabor freq of 1e-9 asked for a 10^9 px envelope
     10**9,
     2**31 - 1,
     10**12,

@@ -66,6 +66,10 @@ pub struct Channel {
     pub dc: [f32; 2],
 }
 
+/// Largest Gaussian envelope of a channel (px, either axis): about 40 times the default's
+/// (1.57 px at freq 1/4 and 1.5 octaves), and a filter of 2 x 3 x 64 + 1 taps.
+pub const MAX_ENVELOPE_SIGMA: f32 = 64.0;
+
 impl Channel {
     /// Builds the channel `(freq, theta_deg)` with radial bandwidth `bandwidth_oct` and envelope
     /// aspect ratio `aspect` (`sigma_x / sigma_y`).
@@ -96,6 +100,19 @@ impl Channel {
         }
         let sigma = sigma_from_bandwidth(freq, bandwidth_oct);
         let (sigma_x, sigma_y) = (aspect * sigma, sigma);
+        // The envelope grows as 1 / freq: freq 1e-9 asked for a filter of 10^10 taps per image
+        // row and the process was killed for its memory.
+        if !(sigma_x.max(sigma_y) <= MAX_ENVELOPE_SIGMA) {
+            return Err(CoreError::param(
+                "freq",
+                format!(
+                    "freq {freq} with bandwidth {bandwidth_oct} octaves and aspect {aspect} \
+                     gives an envelope of sigma {:.3e} px, at most {MAX_ENVELOPE_SIGMA} px: raise \
+                     freq or the bandwidth",
+                    sigma_x.max(sigma_y)
+                ),
+            ));
+        }
         let th = (theta_deg as f64).to_radians();
         let k = 2.0 * std::f64::consts::PI * freq as f64;
         let (kx, ky) = (k * th.cos(), k * th.sin());

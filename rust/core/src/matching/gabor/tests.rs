@@ -99,6 +99,15 @@ fn bad_parameters_are_errors() {
             ..GaborParams::default()
         },
         GaborParams {
+            freq: 1e-9, // an envelope of 10^9 px: refused, not allocated
+            ..GaborParams::default()
+        },
+        GaborParams {
+            bandwidth_oct: 0.06,
+            freq: 0.01,
+            ..GaborParams::default()
+        },
+        GaborParams {
             orientations_deg: vec![],
             ..GaborParams::default()
         },
@@ -355,4 +364,22 @@ fn percentile_of_two_equals_the_plain_selection() {
         }
     }
     assert_eq!(level::percentile_of_two(&[], &[], 0.95), 0.0);
+}
+
+#[test]
+fn the_envelope_is_bounded() {
+    use super::filter::{sigma_from_bandwidth, Channel, MAX_ENVELOPE_SIGMA};
+    // the smallest frequency whose envelope fits, and just below it
+    let f = sigma_from_bandwidth(1.0, 1.5) / MAX_ENVELOPE_SIGMA;
+    assert!(Channel::new(f * 1.001, 0.0, 1.5, 1.0).is_ok());
+    let err = Channel::new(f * 0.999, 0.0, 1.5, 1.0)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("freq") && err.contains("at most 64 px"),
+        "{err}"
+    );
+    // the aspect stretches the envelope along x
+    assert!(Channel::new(0.25, 0.0, 1.5, 10.0).is_ok());
+    assert!(Channel::new(0.03, 0.0, 1.5, 10.0).is_err());
 }
