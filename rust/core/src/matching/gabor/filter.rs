@@ -102,14 +102,15 @@ impl Channel {
         let (sigma_x, sigma_y) = (aspect * sigma, sigma);
         // The envelope grows as 1 / freq: freq 1e-9 asked for a filter of 10^10 taps per image
         // row and the process was killed for its memory.
-        if !(sigma_x.max(sigma_y) <= MAX_ENVELOPE_SIGMA) {
+        let widest = sigma_x.max(sigma_y);
+        if widest.is_nan() || widest > MAX_ENVELOPE_SIGMA {
             return Err(CoreError::param(
                 "freq",
                 format!(
                     "freq {freq} with bandwidth {bandwidth_oct} octaves and aspect {aspect} \
                      gives an envelope of sigma {:.3e} px, at most {MAX_ENVELOPE_SIGMA} px: raise \
                      freq or the bandwidth",
-                    sigma_x.max(sigma_y)
+                    widest
                 ),
             ));
         }
