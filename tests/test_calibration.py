@@ -320,6 +320,16 @@ def test_from_middlebury_with_doffs(tmp_path: Path) -> None:
     (tmp_path / "partial.txt").write_text("cam0=[1 0 0; 0 1 0; 0 0 1]\nbaseline=1\n")
     with pytest.raises(ValueError, match="lacks 'cam1'"):
         Calibration.from_middlebury(tmp_path / "partial.txt")
+    # the image size: a whole number of pixels, named with its file (inf was an OverflowError,
+    # nan a bare "cannot convert float NaN to integer", 713.7 read as 713)
+    cams = "cam0=[1 0 0; 0 1 0; 0 0 1]\ncam1=[1 0 0; 0 1 0; 0 0 1]\nbaseline=5\n"
+    for width, shown in (("inf", "inf"), ("nan", "nan"), ("713.7", "713.7"), ("-4", "-4")):
+        (tmp_path / "size.txt").write_text(f"{cams}width={width}\nheight=3\n")
+        with pytest.raises(ValueError, match=rf"width in .*size\.txt: expected a positive whole "
+                           rf"number of pixels, got {shown}$"):  # fmt: skip
+            Calibration.from_middlebury(tmp_path / "size.txt")
+    (tmp_path / "size.txt").write_text(f"{cams}width=4.0\nheight=3\n")
+    assert Calibration.from_middlebury(tmp_path / "size.txt").image_size == (4, 3)
 
 
 # -------------------------------------------------------------------------------------- KITTI
@@ -363,6 +373,9 @@ def test_from_kitti_raw_and_object_formats(tmp_path: Path) -> None:
     (tmp_path / "none.txt").write_text("P0: 1 2 3\n")
     with pytest.raises(ValueError, match="lacks P_rect_02"):
         Calibration.from_kitti(tmp_path / "none.txt", image_size=(10, 10))
+    (tmp_path / "inf.txt").write_text(f"P_rect_02: {p2}\nP_rect_03: {p3}\nS_rect_02: inf 375\n")
+    with pytest.raises(ValueError, match=r"S_rect_02 width in .*inf\.txt: .* got inf$"):
+        Calibration.from_kitti(tmp_path / "inf.txt")
 
 
 # ------------------------------------------------------------------------------------ Q, rectify

@@ -196,10 +196,22 @@ def test_eval_goes_on_past_a_damaged_scene(data_dir: Path, tmp_path: Path) -> No
     assert alone.returncode == 2 and alone.stderr.count("\n") == 1 and "left.png" in alone.stderr
 
 
-@pytest.mark.parametrize("argv", [["depth"], ["bogus"], []])
-def test_usage_errors_exit_nonzero(argv: list[str]) -> None:
+@pytest.mark.parametrize(
+    ("argv", "says"),
+    [
+        (["depth"], "stereovision depth: error: the following arguments are required: left"),
+        (["bogus"], "stereovision: error: argument command: invalid choice: 'bogus'"),
+        ([], "stereovision: error: the following arguments are required: command"),
+        (["depth", "a", "b", "-o", "x", "--max-disparity", "abc"], "invalid int value: 'abc'"),
+        (["stream", "--method", "sgbm"], "stereovision stream: error: argument --method"),
+    ],
+)
+def test_usage_errors_are_one_line(argv: list[str], says: str) -> None:
+    """argparse's errors too: one line naming the command and its --help, not the usage block."""
     proc = subprocess.run([*SV, *argv], capture_output=True, text=True, check=False)
     assert proc.returncode == 2
+    assert proc.stderr.count("\n") == 1 and says in proc.stderr, proc.stderr
+    assert proc.stderr.rstrip().endswith("--help)")
 
 
 def test_eval_metric_scene_reports_validated_matches(

@@ -142,6 +142,15 @@ def _first_line(exc: BaseException) -> str:
     return text.splitlines()[0] if text else type(exc).__name__
 
 
+def _pixels(value: object, what: str) -> int:
+    """A file's image width or height: a positive whole number of pixels (``1242.0`` is read as
+    1242; ``inf``, ``nan``, ``-5`` and ``713.7`` are refused, naming the field and the file)."""
+    v = float(value)  # type: ignore[arg-type]
+    if not (math.isfinite(v) and v >= 1 and abs(v - round(v)) < 1e-6):
+        raise ValueError(f"{what}: expected a positive whole number of pixels, got {v:g}")
+    return round(v)
+
+
 @dataclass(eq=False, frozen=True)
 class Calibration:
     """Intrinsics and extrinsics of a stereo pair (OpenCV conventions, see module docstring).
@@ -1067,7 +1076,10 @@ class Calibration:
             D2=np.zeros(5),
             R=np.eye(3),
             T=np.array([-positive_finite(v["baseline"], f"baseline in {p}"), 0.0, 0.0]),
-            image_size=(int(v["width"]), int(v["height"])),
+            image_size=(
+                _pixels(v["width"], f"width in {p}"),
+                _pixels(v["height"], f"height in {p}"),
+            ),
             unit="mm",
             rectified=True,
             doffs=float(v["doffs"]) if "doffs" in v else None,
@@ -1114,7 +1126,10 @@ class Calibration:
         baseline = (p2[0, 3] - p3[0, 3]) / f
         size: tuple[int, int] | None = None
         if "S_rect_02" in v and v["S_rect_02"].size == 2:
-            size = (int(np.rint(v["S_rect_02"][0])), int(np.rint(v["S_rect_02"][1])))
+            size = (
+                _pixels(v["S_rect_02"][0], f"S_rect_02 width in {p}"),
+                _pixels(v["S_rect_02"][1], f"S_rect_02 height in {p}"),
+            )
         elif image_size is not None:
             size = image_size
         else:

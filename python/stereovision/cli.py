@@ -17,7 +17,7 @@ import warnings
 from collections.abc import Sequence
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import cv2
 import numpy as np
@@ -670,11 +670,19 @@ def cmd_eval(args: argparse.Namespace) -> int:
 # ----------------------------------------------------------------------------- entry point
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse with its errors in one line, as the command's own (not the usage block)."""
+
+    def error(self, message: str) -> NoReturn:
+        sys.stderr.write(f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+        sys.exit(EXIT_ERROR)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``stereovision`` command."""
     from stereovision.depth import METHODS
 
-    p = argparse.ArgumentParser(prog="stereovision", description=__doc__.splitlines()[0])
+    p = _Parser(prog="stereovision", description=__doc__.splitlines()[0])
     from stereovision import __version__
 
     p.add_argument("--version", action="version", version=f"stereovision {__version__}")
