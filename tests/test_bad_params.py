@@ -183,6 +183,7 @@ def test_charuco_helpers_refuse_bad_values() -> None:
         lambda v: CharucoBoard(v, 0.03, 0.02),
         lambda v: CharucoBoard("7x5", v, 0.02),
         lambda v: CharucoBoard("7x5", 0.03, v),
+        lambda v: CharucoBoard("7x5", 0.03, v, "DICT_4X4_50").image(100),  # 1e-9: cv2.error
         lambda v: CharucoBoard("7x5", 0.03, 0.02, v),
         lambda v: find_charuco_corners(v, board),
         board.image,

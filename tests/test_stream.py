@@ -194,6 +194,13 @@ def _get(url: str) -> tuple[int, str, bytes]:
         return e.code, e.headers["Content-Type"], e.read()
 
 
+def test_frame_server_refuses_a_port_out_of_range() -> None:
+    # bind() raised OverflowError ("internal ... please report this" from the CLI)
+    for port in (-1, 65536, 99999):
+        with pytest.raises(ValueError, match=rf"port: expected 0 to 65535 .*got {port}"):
+            FrameServer("127.0.0.1", port)
+
+
 def test_frame_server_serves_left_and_disparity() -> None:
     srv = FrameServer("127.0.0.1", 0)
     try:

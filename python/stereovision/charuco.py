@@ -263,7 +263,16 @@ class CharucoBoard:
                 f"pixels_per_square: a {size[0]}x{size[1]} image is over "
                 f"{MAX_IMAGE_PIXELS:.2g} pixels; use fewer pixels per square"
             )
-        return np.asarray(self.cv_board().generateImage(size, marginSize=mg, borderBits=1))
+        cv_board = self.cv_board()
+        need = int(cv_board.getDictionary().markerSize) + 2  # the bits and a black border
+        marker_px = p * self.marker_size / self.square_size
+        if marker_px < need:  # OpenCV failed an assertion here
+            raise ValueError(
+                f"marker_size: a {self.marker_size:g} marker in a {self.square_size:g} square is "
+                f"{marker_px:.2g} px at {p} px per square; {self.dictionary}'s markers need at "
+                f"least {need} px: use a larger marker or more pixels per square"
+            )
+        return np.asarray(cv_board.generateImage(size, marginSize=mg, borderBits=1))
 
     def resolve(self, image: npt.ArrayLike) -> CharucoBoard | None:
         """The board with its dictionary and layout found from one image (None if not seen).

@@ -225,6 +225,8 @@ class FrameServer:
     """
 
     def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT) -> None:
+        if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
+            raise ValueError(f"port: expected 0 to 65535 (0 = any free port), got {port!r}")
         self._cond = threading.Condition()
         self._latest: tuple[np.ndarray, np.ndarray, float] | None = None
         self._seq = 0
