@@ -190,7 +190,7 @@ def test_find_pairs_names(tmp_path: Path) -> None:
     assert jobs[1].right == tmp_path / "cams/000_Right.jpg"
     assert jobs[2].right == tmp_path / "caps/right_0001.png" and jobs[2].calib is None
     # A scene folder given itself is named after the folder; --calib applies to every pair.
-    (tmp_path / "rig.yaml").write_text("x")
+    Calibration.ideal((8, 8), 60.0, 0.1).save(tmp_path / "rig.yaml")
     solo = find_pairs(tmp_path / "a/scene1", calib=tmp_path / "rig.yaml")
     assert [(j.name, j.calib) for j in solo] == [("scene1", tmp_path / "rig.yaml")]
 
@@ -202,6 +202,17 @@ def test_batch_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 3
     assert "not found" in err[0] and "no pair under" in err[1] and "workers" in err[2]
+    # a bad --calib is one error before any pair runs (it was one failed pair per scene)
+    for i in range(3):
+        (tmp_path / f"s{i}").mkdir()
+        for side in ("left", "right"):
+            cv2.imwrite(str(tmp_path / f"s{i}" / f"{side}.png"), np.zeros((8, 8, 3), np.uint8))
+    (tmp_path / "bad.yaml").write_text("K1: [1, 2]\n")
+    assert main(["batch", str(tmp_path), "-o", str(tmp_path / "o"), "--calib",
+                 str(tmp_path / "bad.yaml")]) == 2  # fmt: skip
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "bad.yaml" in err[0], err
+    assert not (tmp_path / "o").exists()
 
 
 def test_batch_ctrl_c_keeps_finished_pairs(data_dir: Path, tmp_path: Path) -> None:

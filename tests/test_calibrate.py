@@ -434,6 +434,14 @@ def test_cli_end_to_end(
     with pytest.raises(ValueError, match=r"\.yaml"):
         run("--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "R*.png"), *base,
             "-o", str(tmp_path / "rig.txt"))  # fmt: skip
+    # an output folder that cannot be made is refused before the work (rig.yaml was written,
+    # then the report failed)
+    fresh = tmp_path / "fresh.yaml"
+    for flag in ("--report", "--ros"):
+        with pytest.raises(ValueError, match=rf"{flag} .*: .*L00\.png is a file, not a folder"):
+            run("--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "R*.png"), *base,
+                "-o", str(fresh), flag, str(tmp_path / "L00.png" / "sub"))  # fmt: skip
+        assert not fresh.exists()
     with pytest.raises(ValueError, match="pattern"):
         run("--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "R*.png"),
             "--pattern", "nine", "--square", "1", "-o", str(out))  # fmt: skip

@@ -136,6 +136,12 @@ def find_pairs(
     cal = Path(calib) if calib is not None else None
     if cal is not None and not cal.exists():
         raise FileNotFoundError(f"calibration file not found: {cal}")
+    if cal is not None:
+        # One calibration for every pair: read it once here, so that a bad file is one error
+        # now, not one failed pair per scene.
+        from stereovision.calibration import Calibration
+
+        Calibration.from_file(cal)
     found: list[PairJob] = []
     for d, _dirs, files in os.walk(r):
         dirs = sorted(_dirs)
