@@ -19,6 +19,7 @@ from stereovision.io import (
     find_scenes,
     imread,
     load_scene,
+    make_folder,
     read_pfm,
     read_ply,
     scene_max_disparity,
@@ -221,6 +222,22 @@ def test_atomic_write_leaves_old_file_on_error(tmp_path: Path) -> None:
     assert dest.stat().st_mode & 0o777 == 0o666 & ~umask  # not mkstemp's private 0o600
     with pytest.raises(FileNotFoundError, match="does not exist"):
         write_pfm(tmp_path / "missing_dir" / "x.pfm", np.zeros((1, 1), np.float32))
+
+
+def test_writing_onto_a_folder_or_under_a_file_names_it(tmp_path: Path) -> None:
+    """A folder where a file goes, or a file where a folder goes: the error says which (it
+    showed the temporary file's name, or mkdir's bare "[Errno 17] File exists")."""
+    (tmp_path / "out").mkdir()
+    with pytest.raises(IsADirectoryError, match=r"cannot write .*out: it is a folder"):
+        write_pfm(tmp_path / "out", np.zeros((1, 1), np.float32))
+    afile = tmp_path / "a.txt"
+    afile.write_text("x")
+    with pytest.raises(NotADirectoryError, match=r"a\.txt is a file, not a folder"):
+        write_pfm(afile / "x.pfm", np.zeros((1, 1), np.float32))
+    with pytest.raises(NotADirectoryError, match=r"cannot make the folder .*: .*a\.txt is a file"):
+        make_folder(afile / "sub" / "deeper")
+    assert make_folder(tmp_path / "new" / "deeper").is_dir()
+    assert sorted(os.listdir(tmp_path)) == ["a.txt", "new", "out"]  # nothing else left
 
 
 # ---------------------------------------------------------------------------------------- PLY

@@ -1437,7 +1437,9 @@ class Calibration:
         if d.exists() and not d.is_dir():
             raise ValueError(f"cannot write ROS camera_info into {d}: it is a file, not a folder")
         texts = self.to_ros(alpha, names)
-        d.mkdir(parents=True, exist_ok=True)
+        from stereovision.io import make_folder
+
+        make_folder(d)
         paths = (d / "left.yaml", d / "right.yaml")
         for path, text in zip(paths, texts, strict=True):
             with atomic_write(path, "w") as fh:

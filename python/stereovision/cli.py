@@ -35,9 +35,9 @@ class CliError(Exception):
 
 
 def _atomic_write_bytes(path: Path, data: bytes) -> None:
-    from stereovision.io import atomic_write
+    from stereovision.io import atomic_write, make_folder
 
-    path.parent.mkdir(parents=True, exist_ok=True)
+    make_folder(path.parent)
     with atomic_write(path, "wb") as fh:
         fh.write(data)
 
@@ -91,7 +91,7 @@ def write_depth_outputs(result: Any, out_dir: Path, voxel: float | None = None) 
 
     Everything is encoded in memory first, then each file is replaced atomically.
     """
-    from stereovision.io import write_pfm, write_ply
+    from stereovision.io import make_folder, write_pfm, write_ply
 
     files: dict[str, bytes] = {"disparity.png": _png_bytes(colorize(result.disparity, lo=0.0))}
     if result.depth is not None:
@@ -102,7 +102,7 @@ def write_depth_outputs(result: Any, out_dir: Path, voxel: float | None = None) 
         from stereovision.export import encode_depth_png
 
         files["depth_mm.png"] = encode_depth_png(result.depth)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    make_folder(out_dir)
     written: dict[str, Path] = {}
     for name, data in files.items():
         _atomic_write_bytes(out_dir / name, data)
@@ -357,7 +357,7 @@ def cmd_check(args: argparse.Namespace) -> int:
 def cmd_rectify(args: argparse.Namespace) -> int:
     """``stereovision rectify LEFT RIGHT -o DIR [--calib F]``: the rectified pair, and with no
     calibration the homographies found from the pair's features."""
-    from stereovision.io import imread
+    from stereovision.io import imread, make_folder
     from stereovision.rectification_check import check_rectification, draw_rectification_check
 
     left = imread(args.left)
@@ -378,7 +378,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         rect = rectify_uncalibrated(left, right, model=args.model)
         lr, rr = rect.rectify(left, right)
         summary = rect
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     check = check_rectification(lr, rr)
     for name, img in (
         ("left_rect.png", lr),

@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision.io import atomic_write, read_ply, write_ply
+from stereovision.io import atomic_write, make_folder, read_ply, write_ply
 
 if TYPE_CHECKING:
     import pyvista as pv
@@ -775,7 +775,7 @@ def export_result(
             f"unknown export format(s) {sorted(unknown)}: expected {list(EXPORT_FORMATS)}"
         )
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     writers: dict[str, Callable[[Path, DepthResult], Path]] = {
         "ply": write_cloud_ply,
         "pcd": write_pcd,

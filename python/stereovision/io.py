@@ -64,6 +64,26 @@ def _current_umask() -> int:
     return mask
 
 
+def make_folder(path: PathLike) -> Path:
+    """``mkdir -p``, with an error that names the file in the way (``mkdir`` says only
+    "[Errno 17] File exists" with the file's name, or "Not a directory").
+
+    Raises
+    ------
+    NotADirectoryError
+        If ``path`` or a folder above it is a file.
+    """
+    folder = Path(path)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except (FileExistsError, NotADirectoryError):
+        blocker = next((p for p in (folder, *folder.parents) if p.is_file()), folder)
+        raise NotADirectoryError(
+            f"cannot make the folder {folder}: {blocker} is a file, not a folder"
+        ) from None
+    return folder
+
+
 @contextmanager
 def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
     """Open a temporary file next to ``path``; on success it atomically replaces ``path``.
@@ -85,9 +105,15 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
     ------
     FileNotFoundError
         If the destination directory does not exist.
+    IsADirectoryError, NotADirectoryError
+        If ``path`` is a folder, or its directory is a file.
     """
     dest = Path(path)
     directory = dest.parent if str(dest.parent) else Path(".")
+    if dest.is_dir():
+        raise IsADirectoryError(f"cannot write {dest}: it is a folder; give a file name")
+    if directory.exists() and not directory.is_dir():
+        raise NotADirectoryError(f"cannot write {dest}: {directory} is a file, not a folder")
     if not directory.is_dir():
         raise FileNotFoundError(f"cannot write {dest}: directory {directory} does not exist")
     fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=directory)
