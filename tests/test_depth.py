@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -292,6 +293,17 @@ def test_bad_arguments_raise_value_error() -> None:
         sv.depth_map(img, img, max_disparity=64)
     with pytest.raises(ValueError, match="calibration is for"):
         sv.depth_map(img, img, _rect_calib(100, 50), max_disparity=8)
+    # the type first: "no" was true, True a disparity of 1, "8" a NumPy ufunc error
+    for kw, says in (
+        ({"fill": "no"}, "fill: expected True, False or None, got 'no'"),
+        ({"refine": 1}, "refine: expected True, False or None, got 1"),
+        ({"max_disparity": True}, "max_disparity: expected a number of pixels, got True"),
+        ({"max_disparity": "8"}, "max_disparity: expected a number of pixels, got '8'"),
+        ({"min_disparity": None}, "min_disparity: expected a number of pixels, got None"),
+    ):
+        with pytest.raises(TypeError, match=re.escape(says)):
+            sv.depth_map(img, img, **{"max_disparity": 8, **kw})
+    assert sv.depth_map(img, img, max_disparity=np.int64(8), fill=np.bool_(False)).max_disparity
 
 
 def test_cloud_false_keeps_depth_and_to_ply_writes_the_full_cloud(

@@ -819,6 +819,17 @@ def depth_map(
 
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
+    # The switches and the range are checked for their type first: "no" would be true, True
+    # a disparity of 1, and "32" failed in NumPy's isfinite.
+    for name, flag in (("fill", fill), ("refine", refine)):
+        if flag is not None and not isinstance(flag, (bool, np.bool_)):
+            raise TypeError(f"{name}: expected True, False or None, got {flag!r}")
+    for name, value in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
+        if (value is not None or name == "min_disparity") and (
+            isinstance(value, (bool, np.bool_))
+            or not isinstance(value, (int, float, np.integer, np.floating))
+        ):
+            raise TypeError(f"{name}: expected a number of pixels, got {value!r}")
     left_bgr = as_bgr_uint8(left, "left")
     right_bgr = as_bgr_uint8(right, "right")
     # Each image is validated by as_bgr_uint8; the pair check without check_pair's grey
