@@ -220,6 +220,8 @@ def test_image_without_edges_gives_zero_matches() -> None:
     wide = mcgm.mcgm_match(left, right, max_disparity=10**9)
     assert len(wide) > 0 and np.all(np.abs((wide.xl - wide.xr) - 3.0) < 1.0)
     assert len(mcgm.zncc_reference(left, right, max_disparity=10**9)) > 0
+    huge = mcgm.mcgm_match(left, right, max_disparity=10**30)  # NumPy's isfinite refused it
+    np.testing.assert_array_equal(huge.xl, wide.xl)
 
 
 # --- bad input ---

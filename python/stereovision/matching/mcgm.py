@@ -17,6 +17,7 @@ pixels, left-right check, the same filters).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -154,11 +155,14 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
         if (
             isinstance(v, bool)
             or not isinstance(v, (int, float, np.integer, np.floating))
-            or not np.isfinite(v)
+            or not math.isfinite(float(v))
             or v < 0
         ):
             raise ValueError(f"{name} must be a non-negative number of pixels, got {v!r}")
-    lo, hi = int(np.floor(min_disparity)), int(np.ceil(max_disparity))
+    # The kernel clips the range to the image; the clip here keeps it within its integers.
+    big = float(2**31 - 1)
+    lo = math.floor(min(float(min_disparity), big))
+    hi = math.ceil(min(float(max_disparity), big))
     if hi < lo:
         raise ValueError(f"max_disparity ({max_disparity}) must be >= min_disparity ({lo})")
     kw = {**DEFAULTS, **params, "min_disparity": lo, "max_disparity": hi}
