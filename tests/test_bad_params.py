@@ -210,3 +210,33 @@ def test_charuco_helpers_refuse_bad_values() -> None:
             except Exception as exc:
                 pytest.fail(f"{v!r}: {type(exc).__name__}: {exc}")
     assert rejected > len(calls) * 8
+
+
+def test_wrong_objects_are_type_errors_naming_the_argument(tmp_path: Path) -> None:
+    """None (or a string) where a calibration, a floor or a result goes: a TypeError naming
+    the argument (they were AttributeErrors from deep inside)."""
+    from stereovision import export
+    from stereovision.evaluate import gt_depth
+    from stereovision.ground import occupancy_grid
+    from stereovision.triangulation import depth_from_disparity, reproject, triangulate
+
+    d = np.ones((4, 4), np.float32)
+    pts = np.zeros((4, 4, 3))
+    cases: list[tuple[Callable[[], object], str]] = [
+        (lambda: sv.fit_ground_plane(d, None), "calib: expected a stereovision.Calibration"),
+        (lambda: gt_depth(d, None), "calib: expected a stereovision.Calibration"),
+        (lambda: triangulate([1.0], [1.0], None), "calib: expected"),
+        (lambda: depth_from_disparity(d, "rig.yaml"), "calib: expected .*Calibration, got str"),
+        (lambda: reproject(d, None), "calib: expected"),
+        (lambda: sv.refine_rectification(d, d, None), "calib: expected"),
+        (lambda: sv.obstacle_mask(pts, None), "plane: expected a stereovision.GroundPlane"),
+        (lambda: occupancy_grid(pts, None), "plane: expected"),
+        (lambda: sv.laser_scan(pts, None), "plane: expected"),
+        (lambda: export.write_cloud_ply(tmp_path / "c.ply", "r"), "result: expected .*, got str"),
+        (lambda: export.write_pcd(tmp_path / "c.pcd", None), "result: expected"),
+        (lambda: export.write_npz(tmp_path / "c.npz", None), "result: expected"),
+    ]  # fmt: skip
+    for call, says in cases:
+        with pytest.raises(TypeError, match=says):
+            call()
+    assert list(tmp_path.iterdir()) == []

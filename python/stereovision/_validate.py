@@ -366,3 +366,33 @@ def int_in_range(value: object, name: str, lo: int, hi: int) -> int:
     if not ok:
         raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
     return int(value)  # type: ignore[call-overload]
+
+
+#: The classes :func:`require` checks for, by name, and their modules (imported on use: the
+#: modules that check do not import them at load time).
+_CLASSES = {
+    "Calibration": "stereovision.calibration",
+    "DepthResult": "stereovision.depth",
+    "GroundPlane": "stereovision.ground",
+}
+
+
+def require(value: object, kind: str, name: str) -> None:
+    """A TypeError naming the argument when ``value`` is not a ``stereovision.<kind>`` (None
+    included): a public function given the wrong object says so instead of failing on an
+    attribute deep inside.
+
+    Parameters
+    ----------
+    value : object
+        The argument.
+    kind : str
+        ``"Calibration"``, ``"DepthResult"`` or ``"GroundPlane"``.
+    name : str
+        The argument's name.
+    """
+    import importlib
+
+    cls = getattr(importlib.import_module(_CLASSES[kind]), kind)
+    if not isinstance(value, cls):
+        raise TypeError(f"{name}: expected a stereovision.{kind}, got {type(value).__name__}")

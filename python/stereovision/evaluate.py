@@ -21,6 +21,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import require as _require_type
+
 if TYPE_CHECKING:
     from stereovision.calibration import Calibration
 
@@ -275,6 +277,7 @@ def gt_depth(gt_disp: npt.ArrayLike, calib: Calibration) -> npt.NDArray[np.float
     numpy.ndarray
         ``(H, W)`` ``float32`` depth in metres, NaN where unknown.
     """
+    _require_type(calib, "Calibration", "calib")
     from stereovision.triangulation import depth_from_disparity
 
     return depth_from_disparity(gt_disp, calib)

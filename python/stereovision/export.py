@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import require as _require_type
 from stereovision.io import atomic_write, make_folder, read_ply, write_ply
 
 if TYPE_CHECKING:
@@ -95,6 +96,7 @@ def organised_points(
     colors : ndarray, uint8 (H, W, 3)
         RGB of the left rectified image (zeros if the result does not carry it).
     """
+    _require_type(result, "DepthResult", "result")
     _require_metric(result)
     h, w = result.disparity.shape[:2]
     if len(result.points) == 0:  # computed with cloud=False: from the depth map
@@ -134,6 +136,7 @@ def write_cloud_ply(path: PathLike, result: DepthResult) -> Path:
     ValueError
         If the result has no calibration (no metric points).
     """
+    _require_type(result, "DepthResult", "result")
     _require_metric(result)
     write_ply(path, result.points, result.colors)
     return Path(path)
@@ -223,6 +226,7 @@ def write_pcd(path: PathLike, result: DepthResult) -> Path:
     ValueError
         If the result has no calibration.
     """
+    _require_type(result, "DepthResult", "result")
     pts, cols = organised_points(result)
     h, w = pts.shape[:2]
     rec = np.empty(
@@ -352,6 +356,7 @@ def write_npz(path: PathLike, result: DepthResult) -> Path:
     pathlib.Path
         ``path``.
     """
+    _require_type(result, "DepthResult", "result")
     h, w = result.disparity.shape[:2]
     calib = result.calibration
     k = np.full((3, 3), np.nan)

@@ -27,6 +27,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import require as _require_type
+
 if TYPE_CHECKING:
     from stereovision.calibration import Calibration
 
@@ -292,6 +294,7 @@ def fit_ground_plane(
         If ``disparity`` is not 2-D or its size is not the calibration's, or a parameter is out
         of range.
     """
+    _require_type(calib, "Calibration", "calib")
     from stereovision._validate import positive_finite
 
     disp = np.asarray(disparity, np.float64)
@@ -395,6 +398,7 @@ def obstacle_mask(
     ValueError
         For points not of shape ``(H, W, 3)`` or an empty or negative band.
     """
+    _require_type(plane, "GroundPlane", "plane")
     pts = np.asarray(points, np.float64)
     if pts.ndim != 3 or pts.shape[2] != 3:
         raise ValueError(f"points: expected shape (H, W, 3), got {pts.shape}")
@@ -537,6 +541,7 @@ def occupancy_grid(
         For points not of shape ``(..., 3)``, a non-positive resolution, an empty extent, a grid
         over 4096 cells a side, or a bad height band.
     """
+    _require_type(plane, "GroundPlane", "plane")
     from stereovision._validate import positive_finite
 
     pts = np.asarray(points, np.float64)
@@ -702,6 +707,7 @@ def laser_scan(
         ``angle_max``), ``angle_max <= angle_min``, a non-positive increment or over 100000
         beams, a bad height band or range, or ``min_points < 1``.
     """
+    _require_type(plane, "GroundPlane", "plane")
     from stereovision._validate import positive_finite
 
     pts = np.asarray(points, np.float64)

@@ -19,6 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import as_gray_uint8
+from stereovision._validate import require as _require_type
 
 __all__ = [
     "RectificationCheck",
@@ -387,6 +388,7 @@ def refine_rectification(
         Too little texture, a pair that looks swapped or fits no row model, or a correction of
         more than :data:`MAX_CORRECTION_DEG` degrees (not a drift: calibrate again).
     """
+    _require_type(calib, "Calibration", "calib")
     from dataclasses import replace
 
     before = (

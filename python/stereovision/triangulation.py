@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import require as _require_type
 from stereovision.calibration import UNIT_TO_METRES, Calibration
 
 __all__ = [
@@ -211,6 +212,7 @@ def triangulate(
     ValueError
         If ``xl``/``xr`` are not ``(N, 2)`` of equal length or ``unit`` is unknown.
     """
+    _require_type(calib, "Calibration", "calib")
     pl = _points(xl, "xl")
     pr = _points(xr, "xr")
     if pl.shape != pr.shape:
@@ -282,6 +284,7 @@ def depth_from_disparity(
     ValueError
         If ``disparity`` is not a real 2-D array or ``unit`` is unknown.
     """
+    _require_type(calib, "Calibration", "calib")
     d = _disparity(disparity)
     cal = calib if calib.rectified else calib.rectified_calibration()
     scale = _unit_scale(cal, unit)
@@ -316,6 +319,7 @@ def reproject(
     numpy.ndarray
         ``(H, W, 3)`` ``float32``, NaN where the depth is invalid.
     """
+    _require_type(calib, "Calibration", "calib")
     z = depth_from_disparity(disparity, calib, unit).astype(np.float64)
     cal = calib if calib.rectified else calib.rectified_calibration()
     h, w = z.shape
