@@ -67,6 +67,17 @@ def chessboard() -> tuple[Calibration, CalibrationReport]:
     return calibrate(left, right, pattern=(9, 6), square_size=1.0)
 
 
+def test_swapped_cameras_are_named(cached_corners: None) -> None:
+    """OpenCV's pairs with left and right swapped: the error says so (it was "T: T[0] must be
+    negative ... for a rectified pair", from the rectification after the solve); a single path
+    instead of a list is refused, not read one character at a time."""
+    left, right = _chessboard_paths()
+    with pytest.raises(ValueError, match=r"sits to the left .*: left and right look swapped"):
+        calibrate(right, left, pattern=(9, 6), square_size=1.0)
+    with pytest.raises(TypeError, match="left_images: expected a sequence of images or paths"):
+        calibrate(str(left[0]), str(right[0]), pattern=(9, 6), square_size=1.0)
+
+
 def _visible(p: np.ndarray, margin: float = 15.0) -> bool:
     p = p.reshape(-1, 2)
     w, h = SYN_SIZE

@@ -1011,6 +1011,12 @@ def calibrate(
             f"distortion: expected 'auto', 'fisheye' or one of {list(DISTORTION_MODELS)}, got "
             f"{distortion!r}"
         )
+    for name, given in (("left_images", left_images), ("right_images", right_images)):
+        if isinstance(given, (str, bytes, os.PathLike)):  # one path: list() would split it
+            raise TypeError(
+                f"{name}: expected a sequence of images or paths, got one path {given!r} "
+                "(a list of one, or a glob through stereovision calibrate --left 'left*.png')"
+            )
     lefts, rights = list(left_images), list(right_images)
     if len(lefts) != len(rights):
         raise ValueError(
@@ -1146,6 +1152,14 @@ def calibrate(
             )
         used = [i for k, i in enumerate(used) if k not in set(bad)]
 
+    t = np.ravel(sol.T)
+    if t[0] > 0 and abs(t[0]) > abs(t[1]):
+        # OpenCV's T is (-B, 0, 0) for a right camera on the right; rectifying would fail later
+        # with a message about T's sign.
+        raise ValueError(
+            f"the right images' camera sits to the left of the left images' camera (T = "
+            f"({t[0]:+.4g}, {t[1]:+.4g}, {t[2]:+.4g}) {unit}): left and right look swapped"
+        )
     cal = Calibration(
         K1=sol.K1, D1=sol.D1, K2=sol.K2, D2=sol.D2, R=sol.R, T=sol.T, image_size=size, unit=unit,
         model="fisheye" if sol.model == "fisheye" else "pinhole",
