@@ -257,6 +257,18 @@ def test_cli_check_fix(data_dir: Path, tmp_path: Path) -> None:
         timeout=120,
     )
     assert run.returncode == 2 and "--fix needs --calib" in run.stderr
+    # a failed check says what to do, as the rig has a calibration or not
+    run = subprocess.run([*SV, "check", *pair, "--calib", str(bumped)], capture_output=True,
+                         text=True, timeout=120)  # fmt: skip
+    assert run.returncode == 1 and "recalibrate, or correct the right camera" in run.stdout
+    down = np.float32([[1, 0, 0], [0, 1, 2]])  # the right image 2 px lower
+    right = cv2.warpAffine(cv2.imread(pair[1]), down, img.shape[1::-1])
+    cv2.imwrite(str(tmp_path / "low.png"), right)
+    run = subprocess.run([*SV, "check", pair[0], str(tmp_path / "low.png")], capture_output=True,
+                         text=True, timeout=120)  # fmt: skip
+    assert run.returncode == 1 and run.stdout.startswith("rectification NOT rectified:")
+    assert "give the rig's calibration (--calib), or rectify them" in run.stdout
+    assert "recalibrate" not in run.stdout
 
 
 def test_align_rows_undoes_a_row_offset(data_dir: Path) -> None:

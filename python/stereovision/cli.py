@@ -332,6 +332,14 @@ def cmd_check(args: argparse.Namespace) -> int:
 
         _atomic_write_bytes(Path(args.plot), _png_bytes(draw_rectification_check(left, right, res)))
     print(json.dumps(res.as_dict()) if args.json else res.summary())
+    if res.ok is False and not res.swapped and not args.json and fix is None:
+        print(
+            "  the calibration no longer rectifies this rig: recalibrate, or correct the right "
+            "camera's pitch and roll with --fix OUT"
+            if calib is not None
+            else "  these images are not rectified: give the rig's calibration (--calib), or "
+            "rectify them from their own features (stereovision rectify LEFT RIGHT -o DIR)"
+        )
     if fix is None:
         return 0 if res.ok else 1
     from stereovision.rectification_check import refine_rectification

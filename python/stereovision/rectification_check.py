@@ -105,7 +105,7 @@ class RectificationCheck:
                 f"rectification: the left and right images look swapped (most of "
                 f"{self.matches} feature matches have a negative disparity)"
             )
-        verdict = "ok" if self.ok else "NOT rectified: recalibrate"
+        verdict = "ok" if self.ok else "NOT rectified"
         if not np.isfinite(self.offset):
             return (
                 f"rectification {verdict}: median |dy| {self.median_dy:.1f} px over "
