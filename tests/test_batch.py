@@ -83,7 +83,9 @@ def _tree(out: Path) -> dict[str, float]:
     }
 
 
-def test_batch_runs_skips_and_records_failures(scenes: Path, tmp_path: Path) -> None:
+def test_batch_runs_skips_and_records_failures(
+    scenes: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     out = tmp_path / "out"
     t = time.perf_counter()
     rc = main(["batch", str(scenes), "-o", str(out), "--workers", "2"])
@@ -126,6 +128,8 @@ def test_batch_runs_skips_and_records_failures(scenes: Path, tmp_path: Path) -> 
     rc = main(["batch", str(scenes), "-o", str(out), "--workers", "2"])
     second = time.perf_counter() - t
     assert rc == 1  # the corrupt pair still has no outputs
+    said = capsys.readouterr().out
+    assert "0 failed in" in said and "exit status 1: 1 pair(s) still without outputs" in said
     s = _summary(out)
     assert s["run"]["processed"] == 0 and s["run"]["skipped"] == 3
     assert s["run"]["skipped_failed"] == 1 and s["run"]["scheduler"] is None

@@ -196,6 +196,17 @@ def test_eval_goes_on_past_a_damaged_scene(data_dir: Path, tmp_path: Path) -> No
     assert alone.returncode == 2 and alone.stderr.count("\n") == 1 and "left.png" in alone.stderr
 
 
+def test_depth_warns_about_one_image_given_twice(data_dir: Path, tmp_path: Path) -> None:
+    img = str(data_dir / "middlebury2001" / "tsukuba" / "left.png")
+    proc = subprocess.run(
+        [*SV, "depth", img, img, "--method", "fast", "-o", str(tmp_path)],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr.splitlines()[0].startswith("stereovision: warning: ")
+    assert "are the same image: every disparity comes out 0" in proc.stderr
+
+
 @pytest.mark.parametrize(
     ("argv", "says"),
     [

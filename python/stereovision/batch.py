@@ -731,6 +731,9 @@ def cmd_batch(args: argparse.Namespace) -> int:
         f"{len(res.processed)} processed, {len(res.skipped)} skipped (done before){again}, "
         f"{len(res.failed)} failed in {res.seconds:.1f} s; summary: {res.summary_path}"
     )
+    if res.failed_before and not res.failed:
+        # the exit status counts every pair without outputs, this run's failures or earlier ones
+        print(f"exit status 1: {len(res.failed_before)} pair(s) still without outputs")
     return 1 if res.failed or res.failed_before else 0
 
 

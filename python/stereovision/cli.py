@@ -216,6 +216,12 @@ def cmd_depth(args: argparse.Namespace) -> int:
 
     left = imread(args.left)
     right = imread(args.right)
+    if left.shape == right.shape and np.array_equal(left, right):
+        warnings.warn(
+            f"{args.left} and {args.right} are the same image: every disparity comes out 0 "
+            "(two views of the scene are needed)",
+            stacklevel=1,
+        )
     calib = _load_calibration(args.calib)
     max_disparity = args.max_disparity
     if args.rectification:
