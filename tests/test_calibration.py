@@ -457,6 +457,11 @@ def test_rectify_raw_pair_rows_and_depth() -> None:
     rl, rr = c.rectify(left, right)
     assert rl.shape == left.shape and rl.dtype == np.float32
     assert len([k for k in c._cache if k[0] == "maps"]) == 1
+    # float16 and long double, which OpenCV's remap refuses, come back in their own dtype
+    for dt in (np.float16, np.longdouble):
+        hl, hr = c.rectify(left.astype(dt), right.astype(dt))
+        assert hl.dtype == hr.dtype == dt
+        np.testing.assert_allclose(hl.astype(np.float32), rl, atol=1e-2)  # float16 steps
     rc = c.rectified_calibration()
     r1, r2, p1, p2, _ = c._stereo_rectify(0.0)
     el = cv2.undistortPoints(pl.reshape(-1, 1, 2), c.K1, c.D1, R=r1, P=p1).reshape(-1, 2)

@@ -285,6 +285,10 @@ def test_align_rows_undoes_a_row_offset(data_dir: Path) -> None:
     assert before.ok is False and aligned.shape == moved.shape and aligned.dtype == np.uint8
     after = check_rectification(left, aligned)
     assert after.ok is True and after.median_dy < 0.15 and abs(after.offset) < 0.15
+    # a float16 image (OpenCV's remap refuses it) is aligned the same and stays float16
+    half, _ = align_rows(left, (moved / 255).astype(np.float16), check=before)
+    assert half.dtype == np.float16
+    assert np.abs(half.astype(np.float32) * 255 - aligned).mean() < 0.6
     flat = np.full((h, w), 100, np.uint8)
     same, res = align_rows(flat, flat)
     assert res.ok is None and same is not None and np.array_equal(same, flat)

@@ -396,3 +396,18 @@ def require(value: object, kind: str, name: str) -> None:
     cls = getattr(importlib.import_module(_CLASSES[kind]), kind)
     if not isinstance(value, cls):
         raise TypeError(f"{name}: expected a stereovision.{kind}, got {type(value).__name__}")
+
+
+def remap_image(img: np.ndarray, *args: Any, **kwargs: Any) -> np.ndarray:
+    """``cv2.remap`` of an image of any dtype :func:`as_image_array` accepts, returned in that
+    dtype: float16 and long-double images (which OpenCV's remap refuses) go through float32 /
+    float64."""
+    import cv2
+
+    work = img
+    if img.dtype.kind == "f" and img.dtype.itemsize == 2:
+        work = img.astype(np.float32)
+    elif img.dtype.kind == "f" and img.dtype.itemsize > 8:
+        work = img.astype(np.float64)
+    out = np.asarray(cv2.remap(work, *args, **kwargs))
+    return out if out.dtype == img.dtype else out.astype(img.dtype)

@@ -495,9 +495,12 @@ class Calibration:
         if not 0.0 <= alpha <= 1.0:
             raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
         m1x, m1y, m2x, m2y = self._maps(alpha)
-        lr = cv2.remap(la, m1x, m1y, cv2.INTER_LINEAR)
-        rr = cv2.remap(ra, m2x, m2y, cv2.INTER_LINEAR)
-        return lr, rr
+        from stereovision._validate import remap_image
+
+        return (
+            remap_image(la, m1x, m1y, cv2.INTER_LINEAR),
+            remap_image(ra, m2x, m2y, cv2.INTER_LINEAR),
+        )
 
     def rectify_points(self, points: npt.ArrayLike, side: str = "left", alpha: float = 0.0) -> F64:
         """Raw pixel positions of one camera mapped to the rectified image of :meth:`rectify`.

@@ -18,7 +18,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_gray_uint8
+from stereovision._validate import as_gray_uint8, as_image_array, remap_image
 from stereovision._validate import require as _require_type
 
 __all__ = [
@@ -466,7 +466,7 @@ def align_rows(
         was aligned by. The right image is returned unchanged when the check found no common
         row model (too little texture, or far from rectified).
     """
-    ra = np.asarray(right)
+    ra = as_image_array(right, "right")
     res = check if check is not None else check_rectification(left, right)
     if res.ok is None or not np.isfinite(res.offset):
         return ra, res
@@ -477,7 +477,7 @@ def align_rows(
         + res.slope_x * (xx - (w - 1) / 2) / 1000
         + res.slope_y * (yy - (h - 1) / 2) / 1000
     )
-    out = cv2.remap(
+    out = remap_image(
         ra, xx, (yy - dy).astype(np.float32), cv2.INTER_CUBIC, borderMode=cv2.BORDER_REPLICATE
     )
-    return np.asarray(out, dtype=ra.dtype), res
+    return out, res
