@@ -56,6 +56,18 @@ MAX_TILT_DEG = 35.0
 #: RANSAC hypotheses, and pixels each is scored on (a random subset; the final fit uses all).
 RANSAC_ITERATIONS = 500
 RANSAC_SAMPLE = 40000
+#: When the best plane of those holds under :data:`LOCAL_SHARE` of the sample, three random
+#: pixels rarely all lie on the floor (at 10 %, one hypothesis in a thousand), so
+#: :data:`LOCAL_ITERATIONS` more hypotheses take their second and third pixel in the first's
+#: cell of a 6 x 6 grid over the image (:data:`LOCAL_WINDOW`); one of them replaces the
+#: first search's plane only if it holds :data:`LOCAL_GAIN` times its pixels. KITTI's road under
+#: the live maps (the Gabor channel unfilled, 58 % of the pixels measured) was missed: a plane
+#: 19.5 degrees off, the camera 3.93 m up; found: 0.25 degrees off and 1.633 m (GT 1.621 m). The
+#: fit then takes about twice as long.
+LOCAL_SHARE = 0.2
+LOCAL_ITERATIONS = 1000
+LOCAL_WINDOW = 6
+LOCAL_GAIN = 1.2
 #: Fewest disparities with a value for a fit to be tried.
 MIN_PIXELS = 500
 #: The floor must hold at least this share of the pixels with a disparity.
@@ -322,18 +334,41 @@ def fit_ground_plane(
     a_s, d_s = design[sample], d[sample]
     cos_max = math.cos(math.radians(tilt))
     best_count, best = 0, None
-    for _ in range(RANSAC_ITERATIONS):
-        pick = rng.choice(len(d_s), 3, replace=False)
+
+    def score(pick: Any) -> tuple[int, Any]:
         try:
             coef = np.linalg.solve(a_s[pick], d_s[pick])
         except np.linalg.LinAlgError:
-            continue
+            return 0, None
         normal, _ = _plane_3d(coef, rig)
         if -normal[1] < cos_max:  # not a floor (the normal must point up, within the tilt)
-            continue
-        count = int(np.count_nonzero(np.abs(a_s @ coef - d_s) < tol))
+            return 0, None
+        return int(np.count_nonzero(np.abs(a_s @ coef - d_s) < tol)), coef
+
+    for _ in range(RANSAC_ITERATIONS):
+        count, coef = score(rng.choice(len(d_s), 3, replace=False))
         if count > best_count:
             best_count, best = count, coef
+    if best_count < LOCAL_SHARE * len(d_s):
+        local_count, local = 0, None
+        near_rng = np.random.default_rng(seed + 1)
+        # the sample's pixels by cell of a LOCAL_WINDOW x LOCAL_WINDOW grid over the image
+        cx = np.minimum((a_s[:, 0] * LOCAL_WINDOW / disp.shape[1]).astype(int), LOCAL_WINDOW - 1)
+        cy = np.minimum((a_s[:, 1] * LOCAL_WINDOW / disp.shape[0]).astype(int), LOCAL_WINDOW - 1)
+        cell = cy * LOCAL_WINDOW + cx
+        order = np.argsort(cell, kind="stable")
+        starts = np.searchsorted(cell[order], np.arange(LOCAL_WINDOW**2 + 1))
+        for _ in range(LOCAL_ITERATIONS):
+            i = int(near_rng.integers(len(d_s)))
+            near = order[starts[cell[i]] : starts[cell[i] + 1]]
+            if len(near) < 3:
+                continue
+            j, k = near_rng.choice(near, 2, replace=False)
+            count, coef = score([i, j, k])
+            if count > local_count:
+                local_count, local = count, coef
+        if local_count >= LOCAL_GAIN * best_count:
+            best_count, best = local_count, local
     if best is None:
         return None
     coef = best
