@@ -310,7 +310,7 @@ def test_open_failures_name_the_source(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError, match=r"right source not found: .*missing\.avi"):
         StereoCamera(left, tmp_path / "missing.avi")
     pattern = str(tmp_path / "none_%03d.png")
-    with pytest.raises(SourceError, match=r"cannot open left source .*none_%03d\.png"):
+    with pytest.raises(FileNotFoundError, match=r"left source: no file matches .*none_%03d\.png"):
         StereoCamera(pattern, left)
     log: list[str] = []
     good = _FakeCap("L", log)
@@ -707,3 +707,15 @@ def test_cli_missing_camera_is_one_line_naming_its_device(tmp_path: Path) -> Non
         "(no /dev/video97: is the camera plugged in?)"
     ]
     assert not (tmp_path / "pairs").exists() or not any((tmp_path / "pairs").iterdir())
+
+
+def test_cli_missing_image_sequence_is_one_line(tmp_path: Path) -> None:
+    # FFmpeg printed "[image2 @ 0x...] Could find no file ..." before the CLI's own line
+    pattern = str(tmp_path / "none_%03d.png")
+    run = subprocess.run(
+        [sys.executable, "-m", "stereovision", "capture", "--left", pattern, "--right", pattern,
+         "--count", "1", "-o", str(tmp_path / "pairs")],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert run.returncode == 2
+    assert run.stderr.splitlines() == [f"stereovision: error: left source: no file matches {pattern}"]

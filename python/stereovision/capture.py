@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import glob
 import math
 import os
 import re
@@ -360,6 +361,10 @@ class StereoCamera(PairSource):
             path = os.fspath(src)
             if "%" not in path and "://" not in path and not os.path.exists(path):
                 raise FileNotFoundError(f"{side} source not found: {path}")
+            pattern = re.sub(r"%0?\d*d", "*", path)
+            if "%" in path and "://" not in path and pattern != path and not glob.glob(pattern):
+                # said here: FFmpeg would print its own line first
+                raise FileNotFoundError(f"{side} source: no file matches {path}")
             # OpenCV logs its backends' attempts to stderr; the error below says what failed.
             with _opencv_quiet():
                 cap: Any = cv2.VideoCapture(path)
