@@ -718,4 +718,5 @@ def test_cli_missing_image_sequence_is_one_line(tmp_path: Path) -> None:
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert run.returncode == 2
-    assert run.stderr.splitlines() == [f"stereovision: error: left source: no file matches {pattern}"]
+    said = f"stereovision: error: left source: no file matches {pattern}"
+    assert run.stderr.splitlines() == [said]
