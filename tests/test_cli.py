@@ -196,6 +196,19 @@ def test_eval_goes_on_past_a_damaged_scene(data_dir: Path, tmp_path: Path) -> No
     assert alone.returncode == 2 and alone.stderr.count("\n") == 1 and "left.png" in alone.stderr
 
 
+def test_depth_refuses_an_output_under_a_file_before_matching(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    img = str(data_dir / "middlebury2001" / "tsukuba" / "left.png")
+    (tmp_path / "a.txt").write_text("x")
+    proc = subprocess.run(
+        [*SV, "depth", img, img.replace("left", "right"), "-o", str(tmp_path / "a.txt" / "out")],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert proc.returncode == 2 and proc.stdout == ""  # no matcher line: it never ran
+    assert proc.stderr.strip().endswith("a.txt is a file, not a folder")
+
+
 def test_depth_warns_about_one_image_given_twice(data_dir: Path, tmp_path: Path) -> None:
     img = str(data_dir / "middlebury2001" / "tsukuba" / "left.png")
     proc = subprocess.run(

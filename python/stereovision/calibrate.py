@@ -1840,9 +1840,11 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         raise ValueError(f"--ros {args.ros}: is a file; give a folder for left.yaml and right.yaml")
     # Every output folder before the work: a report that cannot be written is said now, not
     # after minutes of corner finding and a calibration already saved.
+    from stereovision.io import check_output_folder
+
     for flag, folder in (("--ros", args.ros), ("--report", args.report)):
         if folder:
-            _check_output_folder(Path(folder), flag)
+            check_output_folder(folder, flag)
     board = _cli_board(args, printing=False)
     common: dict[str, Any] = {
         "pattern": parse_pattern(args.pattern or "9x6"),
@@ -1884,22 +1886,6 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         paths = rep.write(args.report)
         print(f"report written to {paths['html']}")
     return 0
-
-
-def _check_output_folder(folder: Path, flag: str) -> None:
-    """A folder the command will create (or fill): refused now if a file stands in its way or
-    the nearest existing folder above it is not writable."""
-    if folder.exists() and not folder.is_dir():
-        raise ValueError(f"{flag} {folder}: is a file, not a folder")
-    above = folder
-    while not above.exists():
-        if above.parent == above:
-            break
-        above = above.parent
-    if above.exists() and not above.is_dir():
-        raise ValueError(f"{flag} {folder}: {above} is a file, not a folder")
-    if above.exists() and not os.access(above, os.W_OK | os.X_OK):
-        raise PermissionError(f"{flag} {folder}: cannot write in {above}")
 
 
 def _cli_board(args: argparse.Namespace, *, printing: bool) -> CharucoBoard | None:

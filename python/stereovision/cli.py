@@ -184,8 +184,10 @@ def depth_outputs(
         ``(DepthResult, {file name: path})``.
     """
     from stereovision.depth import depth_map
+    from stereovision.io import check_output_folder
     from stereovision.render import render_outputs
 
+    check_output_folder(out_dir, "-o")  # before the matching, not after it
     if calib is None and (max_depth is not None or max_sigma is not None):
         raise CliError("--max-depth and --max-sigma need --calib (no depth without one)")
     if ground and calib is None:

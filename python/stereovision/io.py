@@ -84,6 +84,36 @@ def make_folder(path: PathLike) -> Path:
     return folder
 
 
+def check_output_folder(folder: PathLike, flag: str) -> None:
+    """A folder a command will create (or fill), checked before its work: refused if a file
+    stands in its way or the nearest existing folder above it is not writable.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The output folder (it need not exist yet).
+    flag : str
+        How the user gave it (``"-o"``, ``"--report"``), for the message.
+
+    Raises
+    ------
+    ValueError
+        If ``folder``, or a folder above it, is a file.
+    PermissionError
+        If the nearest existing folder above it is not writable.
+    """
+    path = Path(folder)
+    if path.exists() and not path.is_dir():
+        raise ValueError(f"{flag} {path}: is a file, not a folder")
+    above = path
+    while not above.exists() and above.parent != above:
+        above = above.parent
+    if above.exists() and not above.is_dir():
+        raise ValueError(f"{flag} {path}: {above} is a file, not a folder")
+    if above.exists() and not os.access(above, os.W_OK | os.X_OK):
+        raise PermissionError(f"{flag} {path}: cannot write in {above}")
+
+
 @contextmanager
 def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
     """Open a temporary file next to ``path``; on success it atomically replaces ``path``.
