@@ -103,6 +103,13 @@ def _step_case(shift_px: float = 0.0) -> tuple[np.ndarray, ...]:
     return d_ours, c_ours, d_ref, c_ref
 
 
+def test_step_names_a_map_of_another_size() -> None:
+    # the core's pair check called it "right"
+    img = np.zeros((20, 30), np.float32)
+    with pytest.raises(ValueError, match=r"disp: map is \(10, 10\) .*the images are \(20, 30\)"):
+        _core.gabor_newton_step(img, img, np.zeros((10, 10), np.float32))
+
+
 def ref_disp_tsukuba(shape: tuple[int, int]) -> np.ndarray:
     """A smooth, non-trivial disparity field (sub-pixel, varying in x and y) for the step test."""
     h, w = shape

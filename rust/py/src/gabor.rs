@@ -202,6 +202,13 @@ pub fn gabor_newton_step<'py>(
     amp_rel_thresh: f32,
     stability_tau: f32,
 ) -> PyResult<Pair<'py>> {
+    // The core names the second image of a size mismatch "right"; here it may be the map.
+    let (map_dim, img_dim) = (disp.as_array().dim(), left.as_array().dim());
+    if map_dim != img_dim {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "disp: map is {map_dim:?} (rows, columns), the images are {img_dim:?}"
+        )));
+    }
     let l = image_from_numpy(&left, "left")?;
     let r = image_from_numpy(&right, "right")?;
     let d = image_from_numpy(&disp, "disp")?;
