@@ -166,6 +166,15 @@ def test_damaged_pcd_and_npz_are_value_errors(result, tmp_path):
     for fn in (export.read_npz, export.load_cloud):
         with pytest.raises(ValueError, match=r"d\.npz"):
             fn(damaged)
+    # an ASCII PCD with a short row (NumPy's message alone before) or too few columns
+    head = b"# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+    for name, rows, says in (
+        ("short.pcd", b"1 2 3\n4 5\n", r"damaged PCD file .*short\.pcd: "),
+        ("narrow.pcd", b"1 2\n4 5\n", r"narrow\.pcd: rows of 2 values, FIELDS has 3"),
+    ):
+        (tmp_path / name).write_bytes(head + b"WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n" + rows)
+        with pytest.raises(ValueError, match=says):
+            export.read_pcd(tmp_path / name)
 
 
 def test_depth_png_in_millimetres(result, tmp_path):

@@ -321,7 +321,14 @@ def read_pcd(
             raise ValueError(f"truncated PCD file {p}: expected {n} points")
         rec = np.frombuffer(raw, dtype=dtype, count=n, offset=pos)
     elif mode == "ascii":
-        table = np.loadtxt(_io.BytesIO(raw[pos:]), dtype=np.float64, ndmin=2)
+        try:
+            table = np.loadtxt(_io.BytesIO(raw[pos:]), dtype=np.float64, ndmin=2)
+        except ValueError as exc:  # a short or damaged row: NumPy's words, with the file's name
+            raise ValueError(f"damaged PCD file {p}: {str(exc).splitlines()[0]}") from None
+        if table.shape[1] < len(names):
+            raise ValueError(
+                f"PCD file {p}: rows of {table.shape[1]} values, FIELDS has {len(names)}"
+            )
         if table.shape[0] != n:
             raise ValueError(f"PCD file {p}: expected {n} points, got {table.shape[0]}")
         rec = np.empty(n, dtype=dtype)
