@@ -280,3 +280,28 @@ def test_version_and_python_m() -> None:
         text=True,
     )
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1
+
+
+def test_a_missing_optional_package_is_one_line_with_its_pip_line(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The wheel alone has no trame, rosbags or dask (extras): the command says which to
+    install (the GUI and the bag reader gave an 'internal ImportError ... please report')."""
+    for mod in ("trame", "trame.app", "rosbags", "rosbags.highlevel", "rosbags.rosbag2"):
+        monkeypatch.setitem(sys.modules, mod, None)  # import raises ImportError
+    cones = data_dir / "middlebury2003" / "cones"
+    assert (
+        main(["gui", "--left", str(cones / "left.png"), "--right", str(cones / "right.png")]) == 2
+    )
+    assert capsys.readouterr().err == (
+        "stereovision: error: the GUI needs trame: pip install 'stereovision-rs[gui]'\n"
+    )
+    (tmp_path / "bag").mkdir()
+    (tmp_path / "bag" / "metadata.yaml").write_text("rosbag2_bagfile_information: {}\n")
+    assert main(["stream", "--from-bag", str(tmp_path / "bag"), "--no-display"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "needs the rosbags package: pip install rosbags" in err
+    assert "internal" not in err

@@ -880,7 +880,8 @@ def _run(args: argparse.Namespace) -> int:
         with contextlib.suppress(OSError):
             os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_BROKEN_PIPE
-    except (CliError, ValueError, OSError, RuntimeError, MemoryError) as exc:
+    # ImportError: an optional package missing (trame, rosbags, dask), said with its pip line
+    except (CliError, ValueError, OSError, RuntimeError, MemoryError, ImportError) as exc:
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         print(f"stereovision: error: {msg}", file=sys.stderr)
         return EXIT_ERROR

@@ -43,6 +43,10 @@ def build_app(args: argparse.Namespace) -> Any:
     """
     from stereovision.gui.sources import AllowedFolders, open_stereo_source
 
+    try:  # before a camera is opened
+        import trame.app  # noqa: F401
+    except ImportError:
+        raise RuntimeError("the GUI needs trame: pip install 'stereovision-rs[gui]'") from None
     if (args.left is None) != (args.right is None):
         raise ValueError("give both --left and --right camera sources, or neither")
     if getattr(args, "fourcc", None) is not None and args.left is None:
