@@ -86,7 +86,9 @@ def _as_float_array(value: object, name: str, shapes: tuple[tuple[int, ...], ...
 def _check_camera_matrix(K: F64, name: str) -> None:
     fx, fy = K[0, 0], K[1, 1]
     if not (fx > 0 and fy > 0):
-        raise ValueError(f"{name}: focal lengths must be positive, got fx={fx!r}, fy={fy!r}")
+        raise ValueError(
+            f"{name}: focal lengths must be positive, got fx={float(fx):g}, fy={float(fy):g}"
+        )
     if K[1, 0] != 0 or not np.allclose(K[2], (0.0, 0.0, 1.0), rtol=0, atol=1e-12):
         raise ValueError(
             f"{name}: expected a camera matrix [[fx, s, cx], [0, fy, cy], [0, 0, 1]], got "
@@ -1125,7 +1127,7 @@ class Calibration:
         p2, p3 = mats
         f = float(p2[0, 0])
         if not f > 0:
-            raise ValueError(f"KITTI calibration {p}: {k2} focal length {f!r} is not positive")
+            raise ValueError(f"KITTI calibration {p}: {k2} focal length {f:g} is not positive")
         baseline = (p2[0, 3] - p3[0, 3]) / f
         size: tuple[int, int] | None = None
         if "S_rect_02" in v and v["S_rect_02"].size == 2:
