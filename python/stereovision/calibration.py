@@ -286,7 +286,8 @@ class Calibration:
         for i, j, what in ((0, 0, "fx"), (1, 1, "fy"), (1, 2, "cy")):
             if not _close(self.K1[i, j], self.K2[i, j]):
                 raise ValueError(
-                    f"K2: {what} = {self.K2[i, j]!r} differs from K1's {self.K1[i, j]!r}; a "
+                    f"K2: {what} = {float(self.K2[i, j]):g} differs from K1's "
+                    f"{float(self.K1[i, j]):g}; a "
                     "rectified pair shares focal length and image rows"
                 )
         if self.doffs is not None:
