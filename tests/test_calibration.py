@@ -72,6 +72,7 @@ def test_valid_calibration_properties() -> None:
     ("field", "value", "message"),
     [
         ("K1", np.full((3, 3), np.nan), "K1: contains NaN"),
+        ("K1", np.diag([300.0, 300.0, 1.0]) + 1j, "K1: expected a real array, got complex"),
         ("K2", np.diag([0.0, 300.0, 1.0]), "K2: focal lengths must be positive"),
         ("K1", np.diag([-300.0, 300.0, 1.0]), "K1: focal lengths must be positive"),
         ("K1", np.eye(2), r"K1: expected shape \(3, 3\)"),

@@ -62,6 +62,8 @@ _FORMAT_VERSION = 1
 
 
 def _as_float_array(value: object, name: str, shapes: tuple[tuple[int, ...], ...]) -> F64:
+    if np.iscomplexobj(value):  # NumPy would drop the imaginary part with a warning
+        raise ValueError(f"{name}: expected a real array, got complex values")
     try:
         arr = np.array(value, dtype=np.float64)
     except (TypeError, ValueError):
