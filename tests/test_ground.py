@@ -234,6 +234,8 @@ def test_bad_input_is_named() -> None:
         fit_ground_plane(np.zeros(5), RIG)
     with pytest.raises(ValueError, match="map is 10x10, the calibration's images are 480x360"):
         fit_ground_plane(np.zeros((10, 10)), RIG)
+    with pytest.raises(ValueError, match="disparity: expected a real map, got complex"):
+        fit_ground_plane(d + 1j, RIG)
     with pytest.raises(ValueError, match="max_tilt_deg: expected less than 90"):
         fit_ground_plane(d, RIG, max_tilt_deg=90)
     with pytest.raises(ValueError, match="inlier_px"):

@@ -309,6 +309,8 @@ def fit_ground_plane(
     _require_type(calib, "Calibration", "calib")
     from stereovision._validate import positive_finite
 
+    if np.iscomplexobj(disparity):  # NumPy would drop the imaginary part with a warning
+        raise ValueError("disparity: expected a real map, got complex values")
     disp = np.asarray(disparity, np.float64)
     if disp.ndim != 2:
         raise ValueError(f"disparity: expected a (H, W) map, got shape {disp.shape}")
