@@ -21,7 +21,7 @@ import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import cv2
 import numpy as np
@@ -62,7 +62,7 @@ _FORMAT_VERSION = 1
 
 
 def _as_float_array(value: object, name: str, shapes: tuple[tuple[int, ...], ...]) -> F64:
-    if np.iscomplexobj(value):  # NumPy would drop the imaginary part with a warning
+    if np.iscomplexobj(cast(Any, value)):  # NumPy would drop the imaginary part, with a warning
         raise ValueError(f"{name}: expected a real array, got complex values")
     try:
         arr = np.array(value, dtype=np.float64)
