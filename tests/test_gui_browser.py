@@ -236,6 +236,13 @@ def test_app_controllers_report_errors_and_compute(tmp_path, monkeypatch):
     assert app.state.error.startswith("not a point cloud file")
     app.capture()
     assert app.state.error.startswith("no camera open")
+    # an emptied field sends None (a TypeError the page never showed)
+    app.state.left_file, app.state.cloud_path = None, None
+    app.load_files()
+    assert app.state.error == "empty or invalid path"
+    app.state.error = ""
+    app.open_cloud()
+    assert app.state.error == "empty or invalid path"
     app._on_scene(scene="../../../../etc")
     assert app.state.error == "path outside the allowed folders: ../../../../etc"
     assert [s["title"] for s in app.state.scenes] == ["data/cones"]
@@ -275,6 +282,49 @@ def test_app_controllers_report_errors_and_compute(tmp_path, monkeypatch):
     asyncio.run(too_big())
     assert app.state.error.startswith("the census semi-global map needs about")
     assert app.state.computations == 1
+
+
+def test_files_at_another_resolution_keep_the_calibration_and_the_view_mode(data_dir, tmp_path):
+    """Files twice the calibration's size are matched with it scaled (it was dropped, and the
+    page asked for --calib); another shape says why there is no depth. A new result is drawn
+    as the points / surface toggle shows (it went back to the surface)."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.calibration import Calibration
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import StereoApp
+
+    cones = bundled_data_dir() / "cones"  # with its calib.txt
+    for side in ("left", "right"):
+        img = cv2.imread(str(cones / f"{side}.png"))
+        cv2.imwrite(str(tmp_path / f"big_{side}.png"), cv2.resize(img, None, fx=2, fy=2))
+        cv2.imwrite(str(tmp_path / f"wide_{side}.png"), cv2.resize(img, (900, 375)))
+    app = StereoApp(
+        get_server("test-files-calib", client_type="vue3"),
+        AllowedFolders([tmp_path]),
+        cones,
+        calib=Calibration.from_file(cones / "calib.txt"),
+    )
+
+    async def load(prefix: str) -> None:
+        app._lock = asyncio.Lock()
+        app.state.left_file = str(tmp_path / f"{prefix}_left.png")
+        app.state.right_file = str(tmp_path / f"{prefix}_right.png")
+        app.load_files()
+        await app.recompute()
+
+    app.state.method = "fast"
+    app.state.view_mode = "points"
+    asyncio.run(load("big"))
+    assert app.state.error == "" and app.calib is not None
+    assert "No calibration" not in app.state.message_3d and "median depth" in app.state.stats
+    shown = app.plotter.actors["scene"].GetMapper().GetInput()
+    assert shown.GetNumberOfPolys() == 0 and shown.GetNumberOfPoints() > 1000  # points, no faces
+    asyncio.run(load("wide"))
+    assert app.calib is None and "another aspect ratio" in app.state.rows_label
 
 
 def test_find_floor_controller_on_kitti(data_dir):
@@ -364,6 +414,18 @@ def test_rectify_controller_without_a_calibration(data_dir):
     app._grab()  # the next pair from the cameras: rectified the same way
     np.testing.assert_array_equal(app.pair[0], rect.rectify(*raw)[0])
     assert app.state.source_label.endswith("(rectified from features)")
+
+    async def again() -> None:
+        await app.rectify_from_features()  # pressed a second time
+
+    # It starts again from the raw pair: its homographies still fit the cameras' frames (the
+    # second press rectified the rectified pair, and the next capture went unrectified).
+    asyncio.run(again())
+    assert app.homographies.input_size == (raw[0].shape[1], raw[0].shape[0])
+    assert app.state.source_label.count("(rectified from features)") == 1
+    app._grab()
+    np.testing.assert_array_equal(app.pair[0], app.homographies.rectify(*raw)[0])
+    assert app.state.source_label.count("(rectified from features)") == 1
 
     async def with_calib() -> None:
         app.calib = object()

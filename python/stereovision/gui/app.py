@@ -403,6 +403,8 @@ class StereoApp:
         #: cameras' next pairs; None when the pair is used as it comes.
         self.homographies: Any = None
         self.pair: tuple[np.ndarray, np.ndarray] | None = None
+        # the pair as the source gave it, before "Rectify" (which starts from it again)
+        self.raw_pair: tuple[np.ndarray, np.ndarray] | None = None
         self.calib: Any = None
         self.max_disparity: int | None = None
         self.view: ViewData | None = None
@@ -485,7 +487,7 @@ class StereoApp:
 
         scene_dir = self.folders.resolve(path) if Path(path) != self.demo_scene else Path(path)
         scene = load_scene(scene_dir)
-        self.pair = (scene.left, scene.right)
+        self.pair = self.raw_pair = (scene.left, scene.right)
         self.calib = scene.calib
         self.max_disparity = scene.max_disparity
         self.homographies = None  # another rig
@@ -508,7 +510,7 @@ class StereoApp:
                 left, right = tf(*self.source.read())
             moved = f", {tf.restarts} restarts: the view moved" if tf.restarts else ""
             averaged = f" ({tf.mean_frames():.1f} frames averaged{moved})"
-        self.pair = (left, right)
+        self.pair = self.raw_pair = (left, right)
         self.calib = self.source_calib
         self.max_disparity = None
         names = (Path(str(n)).name or str(n) for n in (self.state.cam_left, self.state.cam_right))
@@ -593,22 +595,28 @@ class StereoApp:
         """Use the chosen left / right image files (calibration: ``--calib`` if its size fits)."""
         from stereovision.io import imread
 
-        try:
-            left = imread(self.folders.resolve(self.state.left_file))
-            right = imread(self.folders.resolve(self.state.right_file))
+        try:  # an emptied field sends None
+            left = imread(self.folders.resolve(self.state.left_file or ""))
+            right = imread(self.folders.resolve(self.state.right_file or ""))
             if left.shape != right.shape:
                 raise ValueError(f"left {left.shape} and right {right.shape} differ in size")
         except (ValueError, OSError) as exc:
             self._fail(exc)
             return
-        self.pair = (left, right)
+        self.pair = self.raw_pair = (left, right)
         self.homographies = None
-        c = self.source_calib
-        fits = c is not None and tuple(c.image_size) == (left.shape[1], left.shape[0])
-        self.calib = c if fits else None
+        c, note = self.source_calib, ""
+        if c is not None:
+            from stereovision.calibration import fit_to_frames
+
+            try:  # another resolution of the same shape is scaled when the view is computed
+                fit_to_frames(c, (left.shape[1], left.shape[0]))
+            except ValueError as exc:
+                c, note = None, f"{exc}: disparity only"
+        self.calib = c
         self.max_disparity = None
         self.state.source_label = "files"
-        self.state.rows_label = ""
+        self.state.rows_label = note
         self._spawn(self.recompute())
 
     def open_cloud(self) -> None:
@@ -617,7 +625,7 @@ class StereoApp:
         from stereovision.render import point_cloud
 
         try:
-            path = self.folders.resolve(self.state.cloud_path)
+            path = self.folders.resolve(self.state.cloud_path or "")
             pts, cols = load_cloud(path)
             cloud = point_cloud(pts, cols)
         except (ValueError, OSError) as exc:
@@ -723,6 +731,13 @@ class StereoApp:
         from stereovision.uncalibrated import rectify_uncalibrated
 
         left, right = self.pair
+        if self.homographies is not None and self.raw_pair is not None:
+            # pressed again: estimate again from the raw pair, not from the rectified one (its
+            # homographies would not fit the cameras' next frames)
+            left, right = self.raw_pair
+            self.state.source_label = self.state.source_label.replace(
+                " (rectified from features)", ""
+            )
         try:
             rect = await asyncio.get_running_loop().run_in_executor(
                 self._executor, lambda: rectify_uncalibrated(left, right)
@@ -731,6 +746,7 @@ class StereoApp:
             self._fail(exc)
             return
         self.homographies = rect
+        self.raw_pair = (left, right)
         self.pair = rect.rectify(left, right)
         self.max_disparity = rect.max_disparity
         with self.state:
@@ -773,8 +789,8 @@ class StereoApp:
 
     def _publish(self, view: ViewData) -> None:
         self.view = view
-        if view.mesh is not None:
-            self._show_geometry(view.mesh, view.intrinsics)
+        if view.mesh is not None:  # drawn as the points / surface toggle shows
+            self._show_geometry(self._geometry_for_mode(), view.intrinsics)
         else:
             actor = self.plotter.actors.get("scene")
             if actor is not None:
