@@ -268,6 +268,19 @@ def test_app_controllers_report_errors_and_compute(tmp_path, monkeypatch):
     assert app.state.stats.startswith("opencv-bm · 450×375")
     assert "No calibration" in app.state.message_3d
 
+    # A pair that fails to compute: the page keeps the previous one, and so does the app (Check
+    # rows and Find floor used to work on the failed pair the page did not show).
+    tiny = np.zeros((8, 8, 3), np.uint8)
+    app.pair, app.state.source_label = (tiny, tiny), "tiny files"
+
+    async def fails() -> None:
+        await app.recompute()
+
+    asyncio.run(fails())
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.pair[0].shape == (375, 450, 3) and app.state.source_label == "files"
+    assert app.state.computations == 1
+
     # A pair too large for the machine's memory: the census map's check refuses it, and the page
     # says so instead of the task dying.
     from stereovision.matching import sgm

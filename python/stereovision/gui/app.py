@@ -408,6 +408,9 @@ class StereoApp:
         self.calib: Any = None
         self.max_disparity: int | None = None
         self.view: ViewData | None = None
+        # what the page shows came from: put back when a new pair fails to compute, so that
+        # Check rows and Find floor never work on a pair the page does not show
+        self._shown: dict[str, Any] | None = None
         self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1)
         self._generation = 0
         self._lock: asyncio.Lock | None = None
@@ -681,10 +684,27 @@ class StereoApp:
                         progress=progress,
                     ),
                 )
-            except (ValueError, OSError, RuntimeError, MemoryError) as exc:
-                # MemoryError: the census map's check refused a pair too large for this machine.
+            except (ValueError, OSError, RuntimeError, MemoryError, cv2.error) as exc:
+                # MemoryError: the census map's check refused a pair too large for this machine;
+                # cv2.error: an OpenCV reference method on a pair it cannot take.
                 self._fail(exc)
+                shown = self._shown
+                if shown is not None and shown["pair"] is not self.pair:
+                    for name, value in shown.items():
+                        if name != "source_label":
+                            setattr(self, name, value)
+                    with self.state:
+                        self.state.source_label = shown["source_label"]
+                        self.state.error += " (the page still shows the previous pair)"
                 return
+            self._shown = {
+                "pair": self.pair,
+                "raw_pair": self.raw_pair,
+                "calib": self.calib,
+                "max_disparity": self.max_disparity,
+                "homographies": self.homographies,
+                "source_label": self.state.source_label,
+            }
             self._publish(view)
 
     def check_rows_clicked(self) -> None:
