@@ -340,6 +340,34 @@ def test_files_at_another_resolution_keep_the_calibration_and_the_view_mode(data
     assert app.calib is None and "another aspect ratio" in app.state.rows_label
 
 
+def test_buttons_before_a_pair_say_so():
+    """Check rows, Rectify, Find floor and a method click before any pair: one sentence on the
+    page (they did nothing, silently)."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import NO_PAIR, StereoApp
+
+    app = StereoApp(
+        get_server("test-no-pair", client_type="vue3"),
+        AllowedFolders([bundled_data_dir()]),
+        bundled_data_dir() / "cones",
+    )
+    app.pair = None
+    app.view = None
+    app._lock = asyncio.Lock()
+    for action in (app.check_rows, app.rectify_from_features, app.find_floor):
+        app.state.error = ""
+        asyncio.run(action())
+        assert app.state.error == NO_PAIR, action.__name__
+    app.state.error = ""
+    app._on_method()
+    assert app.state.error == NO_PAIR
+
+
 def test_find_floor_controller_on_kitti(data_dir):
     """The stereo panel's "Find floor", in-process: on KITTI (scaled to the page's width) the
     camera's height above the road and a picture of floor and obstacles; without a

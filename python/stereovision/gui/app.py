@@ -48,6 +48,8 @@ from stereovision.gui.sources import (
 __all__ = ["EXTRA_METHODS", "RESOLUTIONS", "StereoApp", "compute_view"]
 
 log = logging.getLogger(__name__)
+#: What a button that needs a pair says before there is one (it did nothing).
+NO_PAIR = "no pair yet: capture from the cameras, load two files or choose a scene first"
 
 #: Pixel formats the camera row offers ("driver": whatever the cameras deliver by default);
 #: two webcams on one USB 2 bus often need MJPG for their full size and rate.
@@ -554,6 +556,8 @@ class StereoApp:
     def _on_method(self, **_: Any) -> None:
         if self.pair is not None:
             self._spawn(self.recompute())
+        elif self._lock is not None:  # the page is up: a click, not the start-up state
+            self._fail(ValueError(NO_PAIR))
 
     def _on_scene(self, scene: str = "", **_: Any) -> None:
         if not scene:
@@ -714,6 +718,7 @@ class StereoApp:
     async def check_rows(self) -> None:
         """Check that the current pair's features lie on common rows (with its calibration)."""
         if self.pair is None:
+            self._fail(ValueError(NO_PAIR))
             return
         from stereovision.calibration import fit_to_frames
         from stereovision.rectification_check import check_rectification
@@ -743,6 +748,7 @@ class StereoApp:
         """Rectify the pair on show from its own features (no calibration: disparity only);
         the cameras' next pairs go through the same homographies."""
         if self.pair is None:
+            self._fail(ValueError(NO_PAIR))
             return
         if self.calib is not None:
             with self.state:
@@ -783,6 +789,7 @@ class StereoApp:
         picture with the floor in green and what stands 0.15-2 m on it in red."""
         view = self.view
         if view is None:
+            self._fail(ValueError(NO_PAIR))
             return
         res = view.result
         if res.depth is None or getattr(res, "calibration", None) is None:
