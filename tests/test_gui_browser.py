@@ -111,6 +111,16 @@ def test_allowed_folders_listing_and_errors(tree):
         AllowedFolders([data / "nope"])
 
 
+def test_two_data_folders_of_one_name_are_told_apart(tmp_path):
+    # the bundled ".../stereovision/data" and "--data .../shared/data" both read "data/..."
+    a, b = tmp_path / "pkg" / "data", tmp_path / "shared" / "data"
+    for d in (a, b):
+        (d / "cones").mkdir(parents=True)
+    both = AllowedFolders([a, b])
+    assert [both.label(d / "cones") for d in (a, b)] == ["pkg/data/cones", "shared/data/cones"]
+    assert AllowedFolders([a]).label(a / "cones") == "data/cones"  # alone: as before
+
+
 # ----------------------------------------------------------------------------- sources
 
 

@@ -66,6 +66,17 @@ class AllowedFolders:
             if rp not in resolved:
                 resolved.append(rp)
         self.roots: tuple[Path, ...] = tuple(resolved)
+        # Each root's display name: its folder name, with as many parents as make it unique
+        # (the bundled ".../stereovision/data" and a user's ".../shared/data" both read "data").
+        self._names: dict[Path, str] = {}
+        for r in self.roots:
+            depth = 1
+            while (
+                depth < len(r.parts)
+                and sum(o.parts[-depth:] == r.parts[-depth:] for o in self.roots) > 1
+            ):
+                depth += 1
+            self._names[r] = "/".join(r.parts[-depth:])
 
     def resolve(self, path: str | os.PathLike[str]) -> Path:
         """The real path of ``path`` if it lies inside an allowed folder.
@@ -132,8 +143,8 @@ class AllowedFolders:
         """Short display name: ``<root name>/<relative path>``."""
         for r in self.roots:
             if path == r or path.is_relative_to(r):
-                rel = path.relative_to(r)
-                return f"{r.name}/{rel}" if str(rel) != "." else r.name
+                rel, name = path.relative_to(r), self._names[r]
+                return f"{name}/{rel}" if str(rel) != "." else name
         return path.name
 
 
