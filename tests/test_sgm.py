@@ -4,6 +4,7 @@ accuracy on real scenes beside OpenCV, the fused dense map's use of it, errors."
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -152,6 +153,20 @@ def test_fused_dense_second_opinion() -> None:
         fused_dense(gabor, conf, members, second=second[:, :3])
 
 
+def _mode_against_filled_sgbm(data_dir: Path, scene: str, method: str) -> tuple[Any, ...]:
+    """``depth_map(method=...)`` on a GT scene with its channels, and bad-2.0 of it and of
+    SGBM-3WAY + the row fill from the same run: ``(scene, max_disparity, result, ours, ref)``."""
+    import stereovision as sv
+
+    sc = load_scene(data_dir / scene)
+    assert sc.gt is not None
+    md = sc.max_disparity
+    r = sv.depth_map(sc.left, sc.right, max_disparity=md, method=method, return_channels=True)
+    sgbm = row_fill(opencv_sgbm(sc.left, sc.right, md))
+    ours, ref = (dense_metrics(d, sc.gt).bad[2.0] for d in (r.disparity, sgbm))
+    return sc, md, r, ours, ref
+
+
 @pytest.mark.parametrize(
     ("scene", "bar"), [("middlebury2001/venus", 0.45), ("middlebury2003/cones", 0.7)]
 )
@@ -159,14 +174,7 @@ def test_depth_map_census_mode_beats_filled_sgbm(data_dir: Path, scene: str, bar
     """``depth_map(method="census")``: the census map re-measured, checked and filled. bad-2.0
     against SGBM-3WAY + the row fill, OpenCV in the same run (measured: venus 0.61 vs 1.84 %,
     cones 6.9 vs 11.2 %); dense; measured pixels carry confidence 0.5, filled ones 0."""
-    import stereovision as sv
-
-    sc = load_scene(data_dir / scene)
-    assert sc.gt is not None
-    md = sc.max_disparity
-    r = sv.depth_map(sc.left, sc.right, max_disparity=md, method="census", return_channels=True)
-    sgbm = row_fill(opencv_sgbm(sc.left, sc.right, md))
-    ours, ref = (dense_metrics(d, sc.gt).bad[2.0] for d in (r.disparity, sgbm))
+    _, _, r, ours, ref = _mode_against_filled_sgbm(data_dir, scene, "census")
     assert ours < bar * ref, (ours, ref)
     assert r.density == 1.0
     assert set(np.unique(r.confidence).tolist()) == {0.0, 0.5}
@@ -297,12 +305,7 @@ def test_fast_mode_beats_filled_sgbm(data_dir: Path, scene: str, bar: float) -> 
     ``method="census", paths=3, refine=False``, and not the 8-path one."""
     import stereovision as sv
 
-    sc = load_scene(data_dir / scene)
-    assert sc.gt is not None
-    md = sc.max_disparity
-    r = sv.depth_map(sc.left, sc.right, max_disparity=md, method="fast", return_channels=True)
-    sgbm = row_fill(opencv_sgbm(sc.left, sc.right, md))
-    ours, ref = (dense_metrics(d, sc.gt).bad[2.0] for d in (r.disparity, sgbm))
+    sc, md, r, ours, ref = _mode_against_filled_sgbm(data_dir, scene, "fast")
     assert ours < bar * ref, (ours, ref)
     assert r.density == 1.0 and "refine" not in r.timings
     same = sv.depth_map(sc.left, sc.right, max_disparity=md, method="census", paths=3, refine=False)

@@ -824,11 +824,11 @@ def depth_map(
     for name, flag in (("fill", fill), ("refine", refine)):
         if flag is not None and not isinstance(flag, (bool, np.bool_)):
             raise TypeError(f"{name}: expected True, False or None, got {flag!r}")
+    numbers = (int, float, np.integer, np.floating)
     for name, value in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
-        if (value is not None or name == "min_disparity") and (
-            isinstance(value, (bool, np.bool_))
-            or not isinstance(value, (int, float, np.integer, np.floating))
-        ):
+        if value is None and name == "max_disparity":
+            continue  # estimated from the images below
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers):
             raise TypeError(f"{name}: expected a number of pixels, got {value!r}")
     left_bgr = as_bgr_uint8(left, "left")
     right_bgr = as_bgr_uint8(right, "right")
