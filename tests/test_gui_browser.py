@@ -350,6 +350,51 @@ def test_files_at_another_resolution_keep_the_calibration_and_the_view_mode(data
     assert app.calib is None and "another aspect ratio" in app.state.rows_label
 
 
+def test_a_later_success_clears_an_error_and_a_scene_can_be_chosen_again(data_dir):
+    """A failed camera open left the toolbar on "error" while the old results stayed; a later
+    successful Check rows now clears it. Choosing the scene on show again after files were
+    loaded reloaded nothing: trame reports only a changed choice."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import StereoApp
+
+    cones = bundled_data_dir() / "cones"
+    app = StereoApp(
+        get_server("test-error-clears", client_type="vue3"),
+        AllowedFolders([bundled_data_dir()]),
+        cones,
+    )
+    app.state.method = "fast"
+    app._spawn = lambda coro: coro.close()  # no server loop here: computed by hand below
+
+    async def run(action) -> None:
+        app._lock = app._lock or asyncio.Lock()
+        await action()
+
+    app._on_scene(scene=str(cones))
+    asyncio.run(run(app.recompute))
+    assert app.state.status == "ready" and app.state.computations == 1
+    app.state.cam_left, app.state.cam_right = "cones/none.mp4", "cones/none.mp4"
+    app.open_cameras()
+    assert app.state.status == "error" and app.state.error.startswith("no such file")
+    asyncio.run(run(app.check_rows))
+    assert app.state.status == "ready" and app.state.error == ""
+    assert app.state.rows_label.startswith("rectification ok")
+
+    app.state.scene = str(cones)
+    app.state.left_file, app.state.right_file = "cones/right.png", "cones/right.png"
+    app.load_files()
+    assert app.state.source_label == "files" and app.state.scene == ""
+    assert app.pair[0] is app.pair[1] or np.array_equal(app.pair[0], app.pair[1])
+    app._on_scene(scene=str(cones))
+    assert app.state.source_label == "scene data/cones"
+    assert not np.array_equal(app.pair[0], app.pair[1])
+
+
 def test_buttons_before_a_pair_say_so():
     """Check rows, Rectify, Find floor and a method click before any pair: one sentence on the
     page (they did nothing, silently)."""

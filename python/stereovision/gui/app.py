@@ -413,6 +413,7 @@ class StereoApp:
         # what the page shows came from: put back when a new pair fails to compute, so that
         # Check rows and Find floor never work on a pair the page does not show
         self._shown: dict[str, Any] | None = None
+        self._computing = False
         self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1)
         self._generation = 0
         self._lock: asyncio.Lock | None = None
@@ -477,8 +478,22 @@ class StereoApp:
         log.info("gui error: %s", msg)
         with self.state:
             self.state.error = msg
-            self.state.busy = False
-            self.state.status = "error"
+            if not self._computing:  # a failed click during a computation leaves its progress
+                self.state.busy = False
+                self.state.status = "error"
+
+    def _done(self) -> None:
+        """A button's action succeeded: an earlier failure's message and "error" status go (they
+        stayed until the next computed pair)."""
+        with self.state:
+            self.state.error = ""
+            if not self._computing and self.view is not None:
+                self.state.status = "ready"
+
+    def _other_source(self) -> None:
+        """The pair no longer comes from the scene list: clear its choice, so that choosing the
+        same scene again loads it (trame reports only a changed value)."""
+        self.state.scene = ""
 
     def _spawn(self, coro: Any) -> None:
         from trame.app import asynchronous
@@ -516,6 +531,7 @@ class StereoApp:
             moved = f", {tf.restarts} restarts: the view moved" if tf.restarts else ""
             averaged = f" ({tf.mean_frames():.1f} frames averaged{moved})"
         self.pair = self.raw_pair = (left, right)
+        self._other_source()
         self.calib = self.source_calib
         self.max_disparity = None
         names = (Path(str(n)).name or str(n) for n in (self.state.cam_left, self.state.cam_right))
@@ -611,6 +627,7 @@ class StereoApp:
             self._fail(exc)
             return
         self.pair = self.raw_pair = (left, right)
+        self._other_source()
         self.homographies = None
         c, note = self.source_calib, ""
         if c is not None:
@@ -639,8 +656,8 @@ class StereoApp:
             self._fail(exc)
             return
         self._show_geometry(cloud, None)
+        self._done()
         with self.state:
-            self.state.error = ""
             self.state.message_3d = f"{self.folders.label(path)}: {cloud.n_points} points"
 
     def reset_camera(self) -> None:
@@ -675,6 +692,7 @@ class StereoApp:
             def progress(pct: int, text: str) -> None:
                 loop.call_soon_threadsafe(self._set_progress, pct, text)
 
+            self._computing = True
             try:
                 view = await loop.run_in_executor(
                     self._executor,
@@ -691,6 +709,7 @@ class StereoApp:
             except (ValueError, OSError, RuntimeError, MemoryError, cv2.error) as exc:
                 # MemoryError: the census map's check refused a pair too large for this machine;
                 # cv2.error: an OpenCV reference method on a pair it cannot take.
+                self._computing = False
                 self._fail(exc)
                 shown = self._shown
                 if shown is not None and shown["pair"] is not self.pair:
@@ -701,6 +720,8 @@ class StereoApp:
                         self.state.source_label = shown["source_label"]
                         self.state.error += " (the page still shows the previous pair)"
                 return
+            finally:
+                self._computing = False
             self._shown = {
                 "pair": self.pair,
                 "raw_pair": self.raw_pair,
@@ -737,6 +758,7 @@ class StereoApp:
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
             return
+        self._done()
         with self.state:
             self.state.rows_label = text
 
@@ -805,6 +827,7 @@ class StereoApp:
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
             return
+        self._done()
         with self.state:
             self.state.floor_label = text
             self.state.img_floor = url
