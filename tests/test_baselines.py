@@ -11,7 +11,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
-from stereovision.baselines import opencv_bm, opencv_sgbm, round_up16, row_fill
+from stereovision.baselines import (
+    opencv_bm,
+    opencv_sgbm,
+    ros_stereo_image_proc,
+    round_up16,
+    row_fill,
+    stereovision_1_0,
+)
 from stereovision.evaluate import dense_metrics
 from stereovision.io import load_scene
 from tests.reference import row_fill_ref
@@ -169,6 +176,44 @@ def test_sgbm_tsukuba_reference_figures(data_dir: Path) -> None:
     assert filled.density == 100.0
     bm = dense_metrics(opencv_bm(s.left, s.right, s.max_disparity), s.gt)
     assert bm.bad[2.0] == pytest.approx(12.7, abs=0.5)
+
+
+def test_tool_defaults_relate_to_the_references(data_dir: Path) -> None:
+    """ROS's BM is the BM reference plus the node's speckle filter (100 px, range 4): a subset of
+    its pixels with the same values; StereoVision 1.0.4's BM is OpenCV's BM at window 21. The
+    SGBM settings are told apart by their figures on cones (benches/bench_tools.py, 2026-12-03:
+    bad-2.0 holes counted ROS BM 30.9, ROS SGBM 25.2, 1.0.4 BM 34.1, 1.0.4 SGBM 21.1 %)."""
+    s = load_scene(data_dir / "middlebury2003" / "cones")
+    assert s.gt is not None and s.max_disparity is not None
+    ref = opencv_bm(s.left, s.right, s.max_disparity)
+    ros = ros_stereo_image_proc(s.left, s.right, s.max_disparity)
+    kept = np.isfinite(ros)
+    assert np.isfinite(ref[kept]).all()
+    np.testing.assert_array_equal(ros[kept], ref[kept])
+    assert 0.8 < kept.sum() / np.isfinite(ref).sum() < 0.99  # the speckle filter took some
+    raw = cv2.StereoBM.create(round_up16(s.max_disparity), 21).compute(
+        cv2.cvtColor(s.left, cv2.COLOR_BGR2GRAY), cv2.cvtColor(s.right, cv2.COLOR_BGR2GRAY)
+    )
+    expected = np.where(raw < 0, np.nan, raw / 16).astype(np.float32)
+    np.testing.assert_array_equal(stereovision_1_0(s.left, s.right, s.max_disparity), expected)
+    figures = {
+        ("ros", "bm"): 30.9,
+        ("ros", "sgbm"): 25.2,
+        ("1.0", "bm"): 34.1,
+        ("1.0", "sgbm"): 21.1,
+    }
+    for (tool, algo), bad2 in figures.items():
+        fn = ros_stereo_image_proc if tool == "ros" else stereovision_1_0
+        m = dense_metrics(fn(s.left, s.right, s.max_disparity, algo), s.gt)
+        assert m.bad[2.0] == pytest.approx(bad2, abs=0.1), (tool, algo)
+
+
+def test_tool_defaults_reject_an_unknown_algorithm() -> None:
+    left, right = _shifted_pair(3)
+    for fn in (ros_stereo_image_proc, stereovision_1_0):
+        with pytest.raises(ValueError, match="algorithm: expected 'bm' or 'sgbm', got 'hh'"):
+            fn(left, right, 16, "hh")
+        assert np.median(fn(left, right, 16, "sgbm")[10:-10, 40:-10]) == pytest.approx(3, abs=0.1)
 
 
 # evaluation.md "Reference figures": scene -> (BM bad-2, SGBM bad-1, SGBM bad-2, SGBM density,

@@ -8,6 +8,14 @@ Every accuracy or speed figure of the project is reported beside these reference
 * :func:`row_fill` -- the "filled reference" rule (a hole takes the smaller of the nearest valid
   disparities to its left and right in its row).
 
+And, for ``benches/bench_tools.py``, the matchers robotics users run as their tools ship them:
+
+* :func:`ros_stereo_image_proc` -- ROS 2 ``stereo_image_proc``'s disparity node (BM or SGBM) with
+  the node's default parameters;
+* :func:`stereovision_1_0` -- the ``StereoVision`` 1.0.4 package on PyPI (2017, Python 2 and
+  OpenCV 2: it no longer imports with OpenCV 4) with its ``StereoBM`` / ``StereoSGBM`` defaults,
+  set through OpenCV 4's API.
+
 Outputs follow the project's convention: ``float32`` disparity in pixels, ``d = x_left - x_right``
 at left-image pixels, NaN for "no estimate" (OpenCV's 16x fixed point divided by 16, negative
 values turned into NaN).
@@ -28,8 +36,10 @@ __all__ = [
     "SGBM_BLOCK_SIZE",
     "opencv_bm",
     "opencv_sgbm",
+    "ros_stereo_image_proc",
     "round_up16",
     "row_fill",
+    "stereovision_1_0",
 ]
 
 #: OpenCV disparities are fixed point with 4 fractional bits.
@@ -160,6 +170,139 @@ def opencv_sgbm(left: object, right: object, max_disparity: float) -> npt.NDArra
     )
     raw = matcher.compute(as_bgr_uint8(la, "left"), as_bgr_uint8(ra, "right"))
     return _from_opencv(raw)
+
+
+def _algorithm(algorithm: str) -> str:
+    if algorithm not in ("bm", "sgbm"):
+        raise ValueError(f"algorithm: expected 'bm' or 'sgbm', got {algorithm!r}")
+    return algorithm
+
+
+def ros_stereo_image_proc(
+    left: object, right: object, max_disparity: float, algorithm: str = "bm"
+) -> npt.NDArray[np.float32]:
+    """ROS 2 ``stereo_image_proc``'s disparity node with its default parameters, on the grey
+    pair (the node takes ``mono8`` rectified images).
+
+    The defaults are those ``disparity_node.cpp`` declares (ros-perception/image_pipeline):
+    ``stereo_algorithm`` 0 (BM), ``prefilter_size`` 9, ``prefilter_cap`` 31,
+    ``correlation_window_size`` 15, ``min_disparity`` 0, ``uniqueness_ratio`` 15,
+    ``speckle_size`` 100, ``speckle_range`` 4, and for SGBM ``P1`` 200, ``P2`` 400,
+    ``disp12_max_diff`` 0, ``full_dp`` false (``MODE_SGBM``). The node declares the texture
+    threshold as ``texture_ratio`` but reads ``texture_threshold``, so BM keeps OpenCV's 10.
+    ``disparity_range`` (64 by default) is the one setting a user must fit to the rig: here it
+    is ``max_disparity`` rounded up to a multiple of 16, as for every matcher of the benches.
+    The node's disparity image also subtracts ``cx_left - cx_right``; this returns the matcher's
+    disparity ``x_left - x_right`` in pixels, as the other references do.
+
+    Parameters
+    ----------
+    left, right : array_like
+        Rectified pair, grey or BGR (converted to grey), ``uint8``, ``uint16`` or float in
+        ``[0, 1]``.
+    max_disparity : float
+        Largest disparity searched, in pixels (rounded up to a multiple of 16).
+    algorithm : {"bm", "sgbm"}
+        The node's ``stereo_algorithm`` 0 or 1.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` ``float32`` disparity in pixels, NaN where the matcher reports none.
+
+    Raises
+    ------
+    ValueError
+        On invalid images, mismatched sizes, a negative or non-finite ``max_disparity`` or an
+        unknown ``algorithm``.
+    """
+    algo = _algorithm(algorithm)
+    la, ra = as_image_array(left, "left"), as_image_array(right, "right")
+    _check_pair_shapes(la, ra)
+    num = round_up16(max_disparity)
+    gl, gr = as_gray_uint8(la, "left"), as_gray_uint8(ra, "right")
+    matcher: cv2.StereoMatcher
+    if algo == "bm":
+        bm = cv2.StereoBM.create()
+        bm.setPreFilterSize(9)
+        bm.setPreFilterCap(31)
+        matcher = bm
+    else:
+        sg = cv2.StereoSGBM.create(1, 1, 10)  # as stereo_processor.hpp creates it
+        sg.setPreFilterCap(31)
+        sg.setMode(cv2.STEREO_SGBM_MODE_SGBM)
+        sg.setP1(200)
+        sg.setP2(400)
+        sg.setDisp12MaxDiff(0)
+        matcher = sg
+    matcher.setBlockSize(15)
+    matcher.setMinDisparity(0)
+    matcher.setNumDisparities(num)
+    matcher.setSpeckleWindowSize(100)
+    matcher.setSpeckleRange(4)
+    if algo == "bm":
+        bm.setUniquenessRatio(15)
+    else:
+        sg.setUniquenessRatio(15)
+    return _from_opencv(matcher.compute(gl, gr))
+
+
+def stereovision_1_0(
+    left: object, right: object, max_disparity: float, algorithm: str = "bm"
+) -> npt.NDArray[np.float32]:
+    """The ``StereoVision`` 1.0.4 package on PyPI (erget/StereoVision, 2017) with the defaults
+    of its ``blockmatchers.StereoBM`` / ``StereoSGBM`` classes.
+
+    That package is Python 2 and OpenCV 2 code (``cv2.STEREO_BM_BASIC_PRESET``,
+    ``cv2.StereoSGBM()``) and does not import with OpenCV 4; this sets the same parameters
+    through OpenCV 4's API. BM: ``window_size`` 21 on the grey pair, the rest OpenCV's BM
+    defaults (prefilter 9 / 31, texture 10, uniqueness 15, no speckle filter) -- what OpenCV 2's
+    basic preset set. SGBM on the pair as given (BGR): ``sad_window_size`` 3, ``uniqueness`` 10,
+    ``speckle_window_size`` 100, ``speckle_range`` 32, ``p1`` 216, ``p2`` 864,
+    ``max_disparity`` (OpenCV's ``disp12MaxDiff``) 1, ``full_dp`` False. The search range is
+    ``max_disparity`` rounded up to a multiple of 16 from 0 (the package's defaults, 80 for BM
+    and 16..112 for SGBM, are what a user changes for the rig).
+
+    Parameters
+    ----------
+    left, right : array_like
+        Rectified pair, grey or BGR, ``uint8``, ``uint16`` or float in ``[0, 1]``.
+    max_disparity : float
+        Largest disparity searched, in pixels (rounded up to a multiple of 16).
+    algorithm : {"bm", "sgbm"}
+        Which of the package's block matchers.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` ``float32`` disparity in pixels, NaN where the matcher reports none.
+
+    Raises
+    ------
+    ValueError
+        On invalid images, mismatched sizes, a negative or non-finite ``max_disparity`` or an
+        unknown ``algorithm``.
+    """
+    algo = _algorithm(algorithm)
+    la, ra = as_image_array(left, "left"), as_image_array(right, "right")
+    _check_pair_shapes(la, ra)
+    num = round_up16(max_disparity)
+    if algo == "bm":
+        bm = cv2.StereoBM.create(numDisparities=num, blockSize=21)
+        return _from_opencv(bm.compute(as_gray_uint8(la, "left"), as_gray_uint8(ra, "right")))
+    sg = cv2.StereoSGBM.create(
+        minDisparity=0,
+        numDisparities=num,
+        blockSize=3,
+        P1=216,
+        P2=864,
+        disp12MaxDiff=1,
+        uniquenessRatio=10,
+        speckleWindowSize=100,
+        speckleRange=32,
+        mode=cv2.STEREO_SGBM_MODE_SGBM,
+    )
+    return _from_opencv(sg.compute(as_bgr_uint8(la, "left"), as_bgr_uint8(ra, "right")))
 
 
 def row_fill(disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
