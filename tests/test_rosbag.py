@@ -34,6 +34,25 @@ def _read(path: Path) -> dict[str, list]:
     return out
 
 
+def test_bag_disparity_only_where_there_is_a_depth(data_dir: Path, tmp_path: Path) -> None:
+    """The default (filled) map: its filled pixels have no depth, and one at or below its
+    uncertainty none either (d near 0). The disparity topic carried them all, some at d = 0
+    (Z infinite for a reader computing f t / d)."""
+    from stereovision.rosbag import BagWriter
+
+    sc = load_scene(data_dir / "kitti2015" / "000005_10")
+    res = sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity, cloud=False)
+    assert np.isfinite(res.disparity).all() and not np.isfinite(res.depth).all()
+    with BagWriter(tmp_path / "run") as bag:
+        bag.write(res, 1)
+    disp = _read(tmp_path / "run")["/stereo/disparity"][0][1]
+    dimg = np.frombuffer(disp.image.data.tobytes(), "<f4").reshape(disp.image.height, -1)
+    valid = dimg >= disp.min_disparity
+    np.testing.assert_array_equal(valid, np.isfinite(res.depth))
+    assert dimg[valid].min() > 0
+    np.testing.assert_allclose(disp.f * disp.t / dimg[valid], res.depth[valid], rtol=1e-5)
+
+
 def test_bag_holds_the_results_values(kitti: tuple, tmp_path: Path) -> None:
     from stereovision.rosbag import BagWriter
 

@@ -249,11 +249,13 @@ ros2_static_transform>`.
         """``stereo_msgs/DisparityImage`` as ``stereo_image_proc`` publishes it: ``Z = f t / d``,
         so ``d`` is the disparity plus the rig's ``doffs`` (0 for a rig rectified by OpenCV);
         a pixel without one is below ``min_disparity`` (-1: ROS's readers test ``d <
-        min_disparity``, which NaN would pass)."""
+        min_disparity``, which NaN would pass). Only the pixels with a depth carry one: a
+        filled pixel (no depth) or one at or below its uncertainty (``d`` near 0, ``Z`` near
+        infinity) would give a reader a point the depth image does not have."""
         t = self._types.types
         cal = result.calibration
         d = np.asarray(result.disparity, np.float32) + np.float32(cal.doffs_px)
-        known = np.isfinite(d)
+        known = np.isfinite(np.asarray(result.depth)) & np.isfinite(d)
         lo = float(cal.doffs_px + result.min_disparity)
         d = np.where(known, d, np.float32(lo - 1.0)).astype(np.float32)
         rows, cols = np.nonzero(known)
