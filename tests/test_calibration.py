@@ -642,3 +642,17 @@ def test_a_rig_on_paper(data_dir: Path) -> None:
     assert "a rig on paper" in run.stdout and "focal length 640.0 px" in run.stdout
     run = subprocess.run([*cli, "--size", "1280x720"], capture_output=True, text=True, timeout=60)
     assert run.returncode == 2 and "a rig on paper: --size, --hfov and --baseline" in run.stderr
+
+
+def test_a_skewed_camera_matrix_is_named_in_a_warning() -> None:
+    """OpenCV's undistortion maps drop K[0,1]: a skewed K (a converted or hand-written file)
+    is rectified as if it had none, so the user is told; OpenCV's own zero takes none."""
+    import warnings
+
+    skewed = np.array([[300.0, 5.0, 161.3], [0.0, 302.0, 118.7], [0.0, 0.0, 1.0]])
+    with pytest.warns(UserWarning, match=r"K1: skew K\[0,1\] = 5 px is ignored by the rectif"):
+        raw_calib(K1=skewed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        raw_calib()
+        raw_calib(K1=np.array([[300.0, 1e-9, 161.3], [0.0, 302.0, 118.7], [0.0, 0.0, 1.0]]))
