@@ -608,8 +608,11 @@ def test_depth_step_and_describe() -> None:
     assert float(c.depth_step(2.0, 0.25)) == pytest.approx(0.02)
     text = c.describe(depths=(1.0, 5.0))
     assert "baseline 10.0 cm (100 mm), focal length 500.0 px" in text
-    # 2 atan(320 / 1000) and 2 atan(240 / 1000)
+    # 2 atan(320 / 1000) and 2 atan(240 / 1000), about the principal point (160, 120)
     assert "field of view 35.5 x 27.0 degrees" in text
+    # one off centre: atan(100.5 / 500) + atan(219.5 / 500), edge to edge
+    off = rect_calib(K1=np.array([[500.0, 0.0, 100.0], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]]))
+    assert "field of view 35.1 x 27.0 degrees" in off.describe()
     assert "depth Z = 50.000 m px / (d + 0.00 px)" in text
     assert "64 px 78.1 cm, 128 px 39.1 cm" in text
     assert "at 1 m 2.0 cm, at 5 m 50.0 cm" in text

@@ -646,8 +646,11 @@ class Calibration:
         f, fy = float(rc.K1[0, 0]), float(rc.K1[1, 1])
         b = self.baseline_m
         doffs = rc.doffs_px
-        hfov = math.degrees(2 * math.atan(w / (2 * f)))
-        vfov = math.degrees(2 * math.atan(h / (2 * fy)))
+        # edge to edge (pixel centres at 0 .. w - 1) about the principal point, which need not
+        # be centred (ETH3D's playground: 81.35, not 81.9 degrees)
+        cx, cy = float(rc.K1[0, 2]), float(rc.K1[1, 2])
+        hfov = math.degrees(math.atan((cx + 0.5) / f) + math.atan((w - 0.5 - cx) / f))
+        vfov = math.degrees(math.atan((cy + 0.5) / fy) + math.atan((h - 0.5 - cy) / fy))
 
         def length(m: float) -> str:
             return f"{100 * m:.1f} cm" if m < 1 else f"{m:.2f} m"
