@@ -242,8 +242,10 @@ class DepthResult:
     channels : dict or None
         With ``return_channels=True``: each channel's own output by name (``"gabor"``: a
         :class:`~stereovision.matching.gabor.GaborResult`; with ``method="fused"`` also
-        ``"mcgm"`` and ``"hopfield"`` :class:`~stereovision.Matches` and ``"members"``, the
-        :class:`~stereovision.matching.fusion.FusionResult` with ``count`` and ``sources``).
+        ``"mcgm"`` and ``"hopfield"`` :class:`~stereovision.Matches`, ``"members"``, the
+        :class:`~stereovision.matching.fusion.FusionResult` with ``count`` and ``sources``, and
+        ``"gabor_remeasured"``, the re-measured Gabor map the vote used; with ``"fused"``,
+        ``"census"`` and ``"fast"``, ``"sgm"``: the census semi-global disparity map).
     limits : dict
         The limits :meth:`filtered` applied (``min_depth``, ``max_depth``, ``max_sigma``,
         ``max_relative_sigma``; empty for an unfiltered result).
@@ -733,7 +735,8 @@ def depth_map(
         at 0.75 x its frame rate (README "Choosing a mode").
     max_disparity : int, optional
         Largest disparity searched, in pixels. None chooses it from the images
-        (:func:`estimate_max_disparity`: ORB matches, 1.15 x their 99th percentile, multiple of 16).
+        (:func:`estimate_max_disparity`: the larger of ORB matches' 99th percentile and a
+        coarse SGBM map's 99.5th, times 1.15, a multiple of 16).
     min_disparity : float
         Smallest disparity searched (default 0).
     fill : bool, optional

@@ -394,6 +394,9 @@ def write_ply(
 
     Parameters
     ----------
+    path : str or os.PathLike
+        The ``.ply`` file; its folder must exist. Written under a temporary name and renamed,
+        so a reader never sees half a file.
     points : array_like
         ``(N, 3)`` (or ``(H, W, 3)``, flattened row-major) coordinates, cast to ``float32``;
         the project's frame is the left rectified camera, metres, X right, Y down, Z forward.
@@ -413,6 +416,8 @@ def write_ply(
     ValueError
         If ``points`` is not ``(..., 3)`` real, or ``colors`` does not match it or is not
         ``uint8``.
+    FileNotFoundError
+        If the folder of ``path`` does not exist.
     """
     pts = np.asarray(points)
     if pts.dtype.kind not in "iuf" or pts.ndim < 2 or pts.shape[-1] != 3:
