@@ -238,7 +238,10 @@ class DepthResult:
     depth_sigma : ndarray, float32 (H, W) or None
         One-sigma depth uncertainty in metres where ``depth`` is known (NaN elsewhere; None
         without a calibration): ``sigma_Z = Z^2 sigma_d / (f B)`` with ``sigma_d`` the disparity
-        uncertainty predicted from the confidence (:func:`disparity_sigma`).
+        uncertainty predicted from the confidence (:func:`disparity_sigma`), except on the
+        pixels the refinement filled and, in the fused map, those only the census map
+        measured: they take 0.63 px whatever their confidence (so ``disparity_sigma(
+        confidence)`` gives back ``depth_sigma`` on the other pixels only).
     channels : dict or None
         With ``return_channels=True``: each channel's own output by name (``"gabor"``: a
         :class:`~stereovision.matching.gabor.GaborResult`; with ``method="fused"`` also
