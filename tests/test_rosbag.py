@@ -138,3 +138,30 @@ def test_bag_scan_topic(kitti: tuple, tmp_path: Path, data_dir: Path) -> None:
     assert msg.angle_increment == pytest.approx(scan.angle_increment, rel=1e-6)
     np.testing.assert_array_equal(msg.ranges, scan.ranges)  # inf and NaN kept (REP 117)
     assert np.isinf(msg.ranges).any() and np.isfinite(msg.ranges).sum() > 500
+
+
+def test_a_full_disk_is_named_and_committed_frames_stay(
+    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The bag was one transaction until close: a full disk lost every frame, and sqlite's
+    OperationalError reached the CLI as an "internal" error. Now it is an OSError naming the
+    bag, and the frames committed before it (every second) stay."""
+    import sqlite3
+
+    from stereovision import rosbag
+
+    res, _ = kitti
+    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 0.0)  # commit after every frame
+    bag = rosbag.BagWriter(tmp_path / "run")
+    bag.write(res, 1)
+    storage = bag._writer.storage
+
+    def full(*_a: object) -> None:
+        raise sqlite3.OperationalError("database or disk is full")
+
+    monkeypatch.setattr(storage, "write", full)
+    with pytest.raises(OSError, match=r"^bag .*run: database or disk is full$"):
+        bag.write(res, 2)
+    storage.conn.close()  # the process dies here; no metadata.yaml
+    with sqlite3.connect(tmp_path / "run" / "run.db3") as db:
+        assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 5

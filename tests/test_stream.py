@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import time
 import urllib.error
 import urllib.request
 import warnings
@@ -466,3 +467,98 @@ def test_stream_temporal_restarts_on_a_moving_view(
     assert summary["temporal"]["restarts"] == N_FRAMES - 1
     assert summary["temporal"]["frames_averaged"] == 1.0
     assert summary["noise_sigma"] < 3.0 and "noisy" not in cap.err  # a clean scene: no hint
+
+
+def test_signals_wait_for_the_end_of_a_deferred_block() -> None:
+    """A Ctrl-C in the middle of a bag frame waited for the frame's last message."""
+    import os
+    import signal
+
+    from stereovision._interrupt import signals_deferred
+
+    done = []
+    with pytest.raises(KeyboardInterrupt):
+        with signals_deferred():
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.05)  # the handler would have run here
+            done.append("frame")
+    assert done == ["frame"]
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def test_the_summary_keeps_bounded_figures(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Medians over the latest MEDIAN_PAIRS pairs, means, maximum and count over all."""
+    from stereovision import stream
+
+    monkeypatch.setattr(stream, "MEDIAN_PAIRS", 4)
+    tally = stream._Tally()
+    for i in range(11):
+        stages = dict.fromkeys(STAGES, float(i))
+        tally.add(stream._Done(stages, float(i), 0.0, skew_ms=float(i % 5), density=float(i)))
+    assert tally.n == 11
+    assert tally.median("match") == 8.5  # of 7, 8, 9, 10
+    assert len(tally._cols["match"]) < 8  # the oldest dropped
+    assert tally.mean("density") == 5.0 and tally.skew_max == 4.0
+
+
+def test_stream_results_are_stamped_at_their_grab(videos: dict[str, Path]) -> None:
+    """A live pair's stamp is its grab time, not the time its depth was done (the bag's
+    messages were stamped a frame's latency late, against TF and odometry)."""
+    cam = StereoCamera(str(videos["left"]), str(videos["right"]))
+    seen: list[tuple[int, int, float]] = []
+
+    def on_stamped(left: np.ndarray, res: object, stamp_ns: int) -> None:
+        seen.append((stamp_ns, time.time_ns(), sum(res.timings.values())))  # type: ignore[attr-defined]
+
+    t0 = time.time_ns()
+    run_stream(cam, method="gabor", max_disparity=64, frames=3, pipelined=False,
+               check=False, on_stamped_result=on_stamped)  # fmt: skip
+    cam.close()
+    assert len(seen) == 3
+    for stamp, called, compute_s in seen:
+        assert t0 <= stamp <= called - 0.9e9 * compute_s  # the matching came after the stamp
+
+
+def test_sigterm_finishes_the_bag_of_a_stream(data_dir: Path, tmp_path: Path) -> None:
+    """SIGTERM (kill, systemd) to `stream --bag` left a .db3 without metadata.yaml that no
+    reader opens: the bag was one transaction, finished only by a normal end or Ctrl-C. Now
+    the CLI turns SIGTERM into an interrupt: the bag is finished, every frame whole."""
+    import signal
+    import subprocess
+    import sys
+
+    pytest.importorskip("rosbags")
+    from rosbags.rosbag2 import Reader
+
+    scene = data_dir / SCENE
+    for side in ("left", "right"):
+        img = cv2.imread(str(scene / f"{side}.png"))
+        vw = cv2.VideoWriter(str(tmp_path / f"{side}.avi"), cv2.VideoWriter_fourcc(*"MJPG"),
+                             FPS, (640, 480))  # fmt: skip
+        for i in range(300):
+            vw.write(np.roll(img, i % 3, axis=0))
+        vw.release()
+    bag = tmp_path / "bag"
+    cmd = [sys.executable, "-m", "stereovision.cli", "stream",
+           "--left", str(tmp_path / "left.avi"), "--right", str(tmp_path / "right.avi"),
+           "--calib", str(scene / "calib.txt"), "--no-display", "--max-disparity", "64",
+           "--no-check", "--bag", str(bag)]  # fmt: skip
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and proc.poll() is None:
+        db = bag / "bag.db3"
+        if db.exists() and db.stat().st_size > 4e6:  # a few frames in (about 1.5 MB each)
+            break
+        time.sleep(0.2)
+    time.sleep(0.5)
+    assert proc.poll() is None, proc.communicate()
+    proc.send_signal(signal.SIGTERM)
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143, err  # 128 + SIGTERM, after the summary and the bag
+    assert " s (terminated): " in out and "Traceback" not in err
+    assert err.strip().splitlines()[-1].startswith(f"ROS 2 bag written to {bag} (")
+    with Reader(bag) as reader:
+        counts = {c.topic: c.msgcount for c in reader.connections}
+        rows = sum(1 for _ in reader.messages())
+    assert len(counts) == 5 and len(set(counts.values())) == 1, counts  # whole frames
+    assert 1 <= counts["/stereo/depth"] < 300 and rows == sum(counts.values())

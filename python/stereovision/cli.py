@@ -11,7 +11,9 @@ import contextlib
 import json
 import math
 import os
+import signal
 import sys
+import threading
 import time
 import warnings
 from collections.abc import Sequence
@@ -22,9 +24,12 @@ from typing import Any, NoReturn
 import cv2
 import numpy as np
 
+from stereovision._interrupt import Terminated, raise_terminated
+
 EXIT_ERROR = 2
 EXIT_INTERRUPTED = 130
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell reports for `yes | head`
+EXIT_TERMINATED = 143  # 128 + SIGTERM
 
 
 class CliError(Exception):
@@ -865,12 +870,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         # hide a message already shown by an earlier call in the same process).
         warnings.simplefilter("default")
         warnings.showwarning = _one_line_warning
-        return _run(args)
+        if threading.current_thread() is not threading.main_thread():
+            return _run(args)
+        kept = signal.signal(signal.SIGTERM, raise_terminated)
+        try:
+            return _run(args)
+        finally:
+            signal.signal(signal.SIGTERM, kept)
 
 
 def _run(args: argparse.Namespace) -> int:
     try:
-        return int(args.func(args))
+        status = int(args.func(args))
+    except Terminated:
+        print("stereovision: terminated (SIGTERM)", file=sys.stderr)
+        return EXIT_TERMINATED
     except KeyboardInterrupt:
         print("stereovision: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
@@ -892,6 +906,7 @@ def _run(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return EXIT_ERROR
+    return status
 
 
 if __name__ == "__main__":

@@ -55,6 +55,7 @@ import itertools
 import math
 import os
 import re
+import sqlite3
 import statistics
 import time
 from collections import deque
@@ -65,6 +66,7 @@ from typing import Any
 import cv2
 import numpy as np
 
+from stereovision._interrupt import signals_deferred
 from stereovision.capture import PairSource, SourceError, StereoFrame
 
 __all__ = [
@@ -83,6 +85,9 @@ __all__ = [
 DEFAULT_FRAME_ID = "stereo_left_optical"
 #: Topic namespace.
 DEFAULT_PREFIX = "/stereo"
+#: Seconds between commits of the bag's database: a process killed (SIGKILL, power) keeps the
+#: frames committed before in its ``.db3``, which ``ros2 bag reindex`` gives a metadata.yaml.
+COMMIT_PERIOD_S = 1.0
 
 
 def _rosbags() -> tuple[Any, Any]:
@@ -151,6 +156,7 @@ ros2_static_transform>`.
         self._writer = writer_cls(self.path, version=9)
         self._writer.open()
         self._conns: dict[str, Any] = {}
+        self._committed = time.monotonic()
 
     # ------------------------------------------------------------------------------ helpers
 
@@ -314,6 +320,24 @@ ros2_static_transform>`.
         stamp = int(stamp_ns)
         if stamp < 0:
             raise ValueError(f"stamp_ns: expected a time in nanoseconds >= 0, got {stamp_ns!r}")
+        if self._writer is None:
+            raise ValueError(f"bag {self.path} is closed")
+        try:
+            with signals_deferred():
+                self._write_frame(result, stamp, scan, ground)
+                if time.monotonic() - self._committed >= COMMIT_PERIOD_S:
+                    self._commit()
+        except sqlite3.Error as exc:  # e.g. "database or disk is full"
+            raise OSError(f"bag {self.path}: {exc}") from exc
+
+    def _commit(self) -> None:
+        """Commit the frames written so far (rosbags keeps one transaction until close)."""
+        conn = getattr(getattr(self._writer, "storage", None), "conn", None)
+        if isinstance(conn, sqlite3.Connection):
+            conn.commit()
+        self._committed = time.monotonic()
+
+    def _write_frame(self, result: Any, stamp: int, scan: Any, ground: Any) -> None:
         header = self._header(stamp)
         if result.left_rectified is not None:
             left = np.asarray(result.left_rectified, np.uint8)
@@ -356,10 +380,30 @@ ros2_static_transform>`.
             self._put("scan", "sensor_msgs/msg/LaserScan", self._scan(stamp, scan), stamp)
 
     def close(self) -> None:
-        """Finish the bag (its metadata.yaml); the writer cannot be used afterwards."""
-        if self._writer is not None:
-            self._writer.close()
-            self._writer = None
+        """Finish the bag (its metadata.yaml); the writer cannot be used afterwards.
+
+        Raises
+        ------
+        OSError
+            When the bag cannot be finished (a full disk): the frames committed before are in
+            its ``.db3`` and ``ros2 bag reindex`` rebuilds its metadata.
+        """
+        writer, self._writer = self._writer, None
+        if writer is None:
+            return
+        try:
+            with signals_deferred():
+                writer.close()
+        except sqlite3.Error as exc:
+            storage = getattr(writer, "storage", None)
+            conn = getattr(storage, "conn", None)
+            if isinstance(conn, sqlite3.Connection):
+                conn.close()
+            raise OSError(
+                f"bag {self.path} could not be finished ({exc}): the frames committed before "
+                f"(every {COMMIT_PERIOD_S:g} s) are in its .db3; `ros2 bag reindex {self.path}` "
+                "rebuilds its metadata.yaml"
+            ) from exc
 
     def __enter__(self) -> BagWriter:
         return self

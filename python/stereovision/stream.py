@@ -21,7 +21,6 @@ asks for them. ``--no-display`` turns the server off (headless robots).
 from __future__ import annotations
 
 import argparse
-import itertools
 import json
 import math
 import queue
@@ -30,6 +29,7 @@ import sys
 import threading
 import time
 import warnings
+from array import array
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -38,6 +38,7 @@ from typing import Any
 import cv2
 import numpy as np
 
+from stereovision._interrupt import Terminated
 from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import SourceError, StereoCamera, add_source_args, open_source
 from stereovision.rectification_check import RectificationCheck, check_rectification
@@ -94,6 +95,7 @@ class _Pair:
     pair: int = 0  # index of the pair in this stream
     temporal_s: float = 0.0
     averaged: float = 1.0  # mean frames in a pixel's temporal mean (1: not averaged)
+    stamp_ns: int = 0  # the grab's time, ns since the epoch (a recording: its own stamp)
 
 
 @dataclass
@@ -133,7 +135,8 @@ class StreamReport:
     pipelined : bool
         Whether grab/rectify ran in the producer thread.
     ended : str
-        ``"frames"`` (the ``frames`` limit), ``"end of stream"`` or ``"interrupted"``.
+        ``"frames"`` (the ``frames`` limit), ``"end of stream"``, ``"interrupted"`` (Ctrl-C)
+        or ``"terminated"`` (SIGTERM, under the CLI).
     rectification : dict or None
         :func:`~stereovision.rectification_check.check_rectification` of the first pair, as a
         dict (None when ``check=False`` or no pair came).
@@ -374,6 +377,12 @@ def _pairs(
                 raise
             return
         t1 = time.perf_counter()
+        recorded = getattr(camera, "stamps_ns", None)
+        if recorded:  # a recording (BagCamera): the stamp of the pair just read
+            stamp_ns = int(recorded[-1])
+        else:  # the wall clock at the middle of the two grabs (host monotonic times)
+            ago = time.monotonic() - 0.5 * (fr.t_left + fr.t_right)
+            stamp_ns = time.time_ns() - round(1e9 * ago)
         left, right = fr.left, fr.right
         if calib is not None and not calib.rectified:
             left, right = calib.rectify(left, right)
@@ -401,6 +410,7 @@ def _pairs(
             n,
             temporal_s=t3 - t2,
             averaged=averaged,
+            stamp_ns=stamp_ns,
         )
         n += 1
 
@@ -443,6 +453,44 @@ def _mean(values: list[float]) -> float:
     return float(statistics.fmean(values)) if values else math.nan
 
 
+#: Latest pairs the summary's medians are taken over (an hour at 30 fps, 80 bytes a pair); its
+#: count, means and maximum cover every pair. A stream can run for days.
+MEDIAN_PAIRS = 108_000
+
+
+class _Tally:
+    """The summary's figures of every finished pair in bounded memory (a list of every pair's
+    record grew by about 600 bytes a pair)."""
+
+    _MEDIANS = (*STAGES, "latency_s", "wait_s")
+
+    def __init__(self) -> None:
+        self.n = 0
+        self._cols = {k: array("d") for k in self._MEDIANS}
+        self._sums = {"skew_ms": 0.0, "density": 0.0, "averaged": 0.0}
+        self.skew_max = math.nan
+
+    def add(self, d: _Done) -> None:
+        self.n += 1
+        values = {**d.stages, "latency_s": d.latency_s, "wait_s": d.wait_s}
+        for k, col in self._cols.items():
+            col.append(values[k])
+            if len(col) >= 2 * MEDIAN_PAIRS:  # drop the oldest half at once: amortised O(1)
+                del col[:MEDIAN_PAIRS]
+        for k in self._sums:
+            self._sums[k] += float(getattr(d, k))
+        # as max() over the list did: the first value, then any larger one
+        if self.n == 1 or d.skew_ms > self.skew_max:
+            self.skew_max = d.skew_ms
+
+    def median(self, key: str) -> float:
+        col = self._cols[key]
+        return float(statistics.median(col[-MEDIAN_PAIRS:])) if self.n else math.nan
+
+    def mean(self, key: str) -> float:
+        return self._sums[key] / self.n if self.n else math.nan
+
+
 def _window_report(
     done: list[_Done], t_window: float, total: int, elapsed: float, md: int, pipelined: bool
 ) -> dict[str, Any]:
@@ -477,6 +525,7 @@ def run_stream(
     fill: bool | None = None,
     on_report: Callable[[dict[str, Any]], None] | None = None,
     on_result: Callable[[np.ndarray, Any], None] | None = None,
+    on_stamped_result: Callable[[np.ndarray, Any, int], None] | None = None,
     report_period: float = REPORT_PERIOD,
     check: bool = True,
     check_every: int | None = None,
@@ -521,6 +570,11 @@ def run_stream(
     on_result : callable, optional
         Called with ``(left_rectified_bgr, DepthResult)`` of every pair. The result is computed
         with ``cloud=False``: its ``points`` are empty, its ``to_ply`` writes the full cloud.
+    on_stamped_result : callable, optional
+        Called like ``on_result`` with a third argument: the pair's time in nanoseconds since
+        the epoch, taken at its grab (the middle of the two cameras' grabs; a recording's own
+        stamp), not when its depth was done (a live frame's latency later): the time to stamp
+        messages for TF and odometry with.
     report_period : float
         Seconds between reports.
     check : bool
@@ -607,7 +661,7 @@ def run_stream(
             raise item
         return item  # type: ignore[no-any-return]
 
-    all_done: list[_Done] = []
+    tally = _Tally()
     noise = math.nan  # the first left frame's noise
     checks: list[dict[str, Any]] = []
     grounds: list[dict[str, Any]] = []
@@ -630,13 +684,13 @@ def run_stream(
                 _note_check(pair.pair, pair.check, checks)
             if md is None:
                 md = estimate_max_disparity(pair.left, pair.right)
-            if not all_done:
+            if tally.n == 0:
                 noise = _note_noise(pair.left, temporal is not None)
             # No point cloud per frame: the live view shows disparity and depth.
             res = depth_map(pair.left, pair.right, rect_calib, max_disparity=md, cloud=False, **kw)
-            if ground_every is not None and len(all_done) % ground_every == 0:
+            if ground_every is not None and tally.n % ground_every == 0:
                 assert rect_calib is not None
-                plane = _note_ground(len(all_done), res.disparity, rect_calib, grounds, first_plane)
+                plane = _note_ground(tally.n, res.disparity, rect_calib, grounds, first_plane)
                 if on_ground is not None:
                     on_ground(plane)
             t_last = time.perf_counter()
@@ -659,52 +713,50 @@ def run_stream(
                 density=res.density,
                 averaged=pair.averaged,
             )
-            all_done.append(d)
+            tally.add(d)
             window.append(d)
             if on_result is not None:
                 on_result(pair.left, res)
+            if on_stamped_result is not None:
+                on_stamped_result(pair.left, res, pair.stamp_ns)
             if t_last - t_window >= report_period:
                 rep = _window_report(
-                    window, t_last - t_window, len(all_done), t_last - t_begin, md, pipelined
+                    window, t_last - t_window, tally.n, t_last - t_begin, md, pipelined
                 )
                 reports.append(rep)
                 if on_report is not None:
                     on_report(rep)
                 window = []
                 t_window = t_last
-        if frames is not None and len(all_done) >= frames:
+        if frames is not None and tally.n >= frames:
             ended = "frames"
-    except KeyboardInterrupt:
-        ended = "interrupted"
+    except KeyboardInterrupt as exc:
+        ended = "terminated" if isinstance(exc, Terminated) else "interrupted"
     finally:
         if producer is not None:
             producer.stop.set()
             producer.join(timeout=5.0)
     if window:  # the last, partial second
         rep = _window_report(
-            window, t_last - t_window, len(all_done), t_last - t_begin, md or 0, pipelined
+            window, t_last - t_window, tally.n, t_last - t_begin, md or 0, pipelined
         )
         reports.append(rep)
         if on_report is not None:
             on_report(rep)
-    n = len(all_done)
+    n = tally.n
     seconds = t_last - t_begin
-    skews = [d.skew_ms for d in all_done]
     return StreamReport(
         frames=n,
         seconds=seconds,
         fps=n / seconds if seconds > 0 else 0.0,
-        stage_ms={
-            k: 1e3 * statistics.median([d.stages[k] for d in all_done]) if n else math.nan
-            for k in STAGES
-        },
-        latency_ms=1e3 * statistics.median([d.latency_s for d in all_done]) if n else math.nan,
-        wait_ms=1e3 * statistics.median([d.wait_s for d in all_done]) if n else math.nan,
-        skew_ms={"mean": _mean(skews), "max": max(skews, default=math.nan)},
+        stage_ms={k: 1e3 * tally.median(k) if n else math.nan for k in STAGES},
+        latency_ms=1e3 * tally.median("latency_s") if n else math.nan,
+        wait_ms=1e3 * tally.median("wait_s") if n else math.nan,
+        skew_ms={"mean": tally.mean("skew_ms"), "max": tally.skew_max},
         max_disparity=int(md or 0),
         pipelined=pipelined,
         ended=ended,
-        density=_mean([d.density for d in all_done]),
+        density=tally.mean("density"),
         reports=reports,
         rectification=checks[0] if checks else None,
         checks=checks,
@@ -713,7 +765,7 @@ def run_stream(
         temporal=None
         if temporal is None
         else {
-            "frames_averaged": round(_mean([d.averaged for d in all_done]), 3),
+            "frames_averaged": round(tally.mean("averaged"), 3),
             "restarts": temporal.restarts,
             "noise_sigma": round(temporal.sigma, 3),
         },
@@ -822,10 +874,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             )
         temporal = TemporalFilter(max_frames=args.temporal)
     cam = open_source(args)
-    stamps: Callable[[], int] = time.time_ns
     if hasattr(cam, "stamps_ns"):  # a recording: its results keep the frames' stamps
-        played = itertools.count()
-        stamps = lambda: cam.stamps_ns[next(played)]  # noqa: E731 -- results come in read order
         if calib is None and homographies is None:
             try:
                 calib = cam.calibration()
@@ -854,11 +903,10 @@ def cmd_stream(args: argparse.Namespace) -> int:
         if bag is not None:
             writer = bag
 
-            def to_bag(left: np.ndarray, res: Any) -> None:
-                # with --ground-every: the obstacles on the latest floor as a LaserScan
-                writer.write(res, stamps(), ground=floor[0])
-
-            sinks.append(to_bag)
+            def to_bag(left: np.ndarray, res: Any, stamp_ns: int) -> None:
+                # stamped at the grab; with --ground-every: the obstacles on the latest floor
+                # as a LaserScan
+                writer.write(res, stamp_ns, ground=floor[0])
 
         def on_result(left: np.ndarray, res: Any) -> None:
             for sink in sinks:
@@ -881,6 +929,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             fill=args.fill,
             on_report=on_report,
             on_result=on_result if sinks else None,
+            on_stamped_result=to_bag if bag is not None else None,
             check=not args.no_check,
             check_every=args.check_every,
             ground_every=args.ground_every,
@@ -939,7 +988,8 @@ def cmd_stream(args: argparse.Namespace) -> int:
                 ),
                 file=out,
             )
-    return 0
+    # the summary and the bag are out; the exit status still tells a script it was cut short
+    return {"interrupted": 130, "terminated": 143}.get(report.ended, 0)
 
 
 def add_cli(subparsers: Any) -> None:
