@@ -313,7 +313,10 @@ ros2_static_transform>`.
         Raises
         ------
         ValueError
-            For a result without depth (computed without a calibration), or a negative stamp.
+            For a result without depth (computed without a calibration), a negative stamp, or
+            a closed bag.
+        OSError
+            When the bag's database cannot be written (a full disk), naming the bag.
         """
         if result.depth is None or result.calibration is None:
             raise ValueError("a bag holds depth: compute the result with a calibration")
