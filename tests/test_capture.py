@@ -153,6 +153,44 @@ def test_image_sequence_source_and_capture(tmp_path: Path) -> None:
     assert result.skew["n"] == 5
 
 
+def test_image_sequence_frames_keep_their_own_size(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """A pattern is read by OpenCV's image reader: a frame of another size comes at its own size
+    (FFmpeg's reader stretched a 300x300 frame of a 384x288 sequence to 384x288 unseen), so a
+    frame of another shape stops the pairs and one of another size of the same shape is
+    resized with a warning. Its end logs nothing."""
+    frames = [_numbered(i) for i in range(6)]
+    frames[3] = _numbered(3, (100, 100))
+    lpat = _write_sequence(tmp_path / "odd", "left", frames)
+    rpat = _write_sequence(tmp_path / "odd", "right", [_numbered(i) for i in range(6)])
+    with StereoCamera(lpat, rpat) as cam:
+        assert [cam.read().left.shape for _ in range(3)] == [(240, 320, 3)] * 3
+        with pytest.raises(SourceError) as ei:
+            cam.read()
+    assert str(ei.value) == (
+        f"left source {lpat!r} delivers 100x100 in pair 4, after 3 pairs of 320x240: a frame "
+        "of another shape cannot be paired without stretching it"
+    )
+    assert (ei.value.side, ei.value.end, ei.value.frames) == ("left", False, 3)
+    frames[3] = cv2.resize(_numbered(3), (160, 120), interpolation=cv2.INTER_AREA)  # half size
+    lpat = _write_sequence(tmp_path / "half", "left", frames)
+    rpat = _write_sequence(tmp_path / "half", "right", [_numbered(i) for i in range(6)])
+    capfd.readouterr()
+    with pytest.warns(UserWarning, match=r"delivers 160x120, not 320x240: its frames are resized"):
+        with StereoCamera(lpat, rpat) as cam:
+            got = list(cam.frames())
+            assert cam.delivered_fps == {"left": 0.0, "right": 0.0}  # a sequence has no rate
+    assert len(got) == 6 and got[3].left.shape == (240, 320, 3)
+    assert [_read_stamp(f.left) for f in got] == list(range(6))
+    assert capfd.readouterr().err == ""  # OpenCV's warning for the file after the last is quiet
+    # A sequence starting at 2 (FFmpeg's image2 looks at 0-4) opens from its first file.
+    for i in range(2, 5):
+        cv2.imwrite(str(tmp_path / f"late_{i:03d}.png"), _numbered(i))
+    with StereoCamera(str(tmp_path / "late_%03d.png"), str(tmp_path / "late_%03d.png")) as cam:
+        assert [_read_stamp(f.left) for f in cam.frames()] == [2, 3, 4]
+
+
 class _FakeCap:
     """A VideoCapture stand-in that logs calls into a shared list."""
 

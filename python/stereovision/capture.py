@@ -28,6 +28,7 @@ a stand or a still scene.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import glob
 import math
@@ -100,7 +101,67 @@ _PAIR_RE = re.compile(r"^(left|right)_(\d+)\.[A-Za-z0-9]+$")
 
 
 class SourceError(OSError):
-    """A camera or video source failed to open or stopped delivering frames."""
+    """A camera or video source failed to open or stopped delivering frames.
+
+    Parameters
+    ----------
+    message : str
+    side : str, optional
+        ``"left"``, ``"right"`` or ``"both"``: the source(s) concerned.
+    end : bool
+        True when a source came to its end (a file or sequence read to its last frame, a camera
+        that stopped delivering): :func:`capture` without ``count`` then ends normally. False
+        for a failure of another kind (a frame that does not decode, a frame of another shape,
+        a closed camera).
+    frames : int, optional
+        Frames read from the source concerned before this (pairs read before).
+    other_had_frames : bool, optional
+        With one ``side`` ended: whether the other source still delivered a frame.
+    expected_frames : int, optional
+        The frame count an ended video file (or sequence) announces (``CAP_PROP_FRAME_COUNT``),
+        when it announced more than were read.
+
+    Attributes
+    ----------
+    side, end, frames, other_had_frames, expected_frames
+        As given.
+    """
+
+    def __init__(
+        self,
+        message: str,
+        *,
+        side: str | None = None,
+        end: bool = True,
+        frames: int | None = None,
+        other_had_frames: bool | None = None,
+        expected_frames: int | None = None,
+    ) -> None:
+        super().__init__(message)
+        self.side = side
+        self.end = end
+        self.frames = frames
+        self.other_had_frames = other_had_frames
+        self.expected_frames = expected_frames
+
+    @property
+    def ended_early(self) -> bool:
+        """A source ended while the other still had frames, or before the frames it announced."""
+        return bool(self.other_had_frames) or self.expected_frames is not None
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        kwargs = {
+            "side": self.side,
+            "end": self.end,
+            "frames": self.frames,
+            "other_had_frames": self.other_had_frames,
+            "expected_frames": self.expected_frames,
+        }
+        return (_source_error, (str(self), kwargs))
+
+
+def _source_error(message: str, kwargs: dict[str, Any]) -> SourceError:
+    return SourceError(message, **kwargs)
 
 
 # --------------------------------------------------------------------------------- parsing
@@ -197,12 +258,55 @@ class StereoFrame:
         return abs(self.t_left - self.t_right) * 1000.0
 
 
+def _media_ms(cap: Any) -> float:
+    """``CAP_PROP_POS_MSEC``; NaN for a source that has none (``CAP_IMAGES`` says -1)."""
+    ms = float(cap.get(cv2.CAP_PROP_POS_MSEC))
+    return ms if ms >= 0 else math.nan
+
+
 def _describe_source(src: Source) -> str:
     if isinstance(src, int):
         return f"camera {src}"
     if isinstance(src, (str, os.PathLike)):
         return repr(os.fspath(src))
     return type(src).__name__
+
+
+#: A frame number in an image-sequence pattern (``left_%03d.png``).
+_SEQ_RE = re.compile(r"%(0?\d*)d")
+
+
+def _sequence_first(path: str) -> tuple[int, str] | None:
+    """The first file of an image-sequence pattern and its number, looked for as FFmpeg's
+    image2 does (numbers 0-4); None when ``path`` is no pattern or none of those exists."""
+    m = _SEQ_RE.search(path)
+    if m is None or "://" in path or os.path.exists(path):
+        return None
+    for i in range(5):
+        name = path[: m.start()] + ("%" + m.group(1) + "d") % i + path[m.end() :]
+        if os.path.exists(name):
+            return i, name
+    return None
+
+
+def _open_path(path: str) -> Any:
+    """``cv2.VideoCapture`` of a file, a URL or an image-sequence pattern.
+
+    A pattern is opened with OpenCV's own image reader (``CAP_IMAGES``): FFmpeg's, the default,
+    rescales a frame of another size to the first frame's before anyone sees it (a 300x300
+    frame in a 384x288 sequence came out stretched to 384x288), while ``CAP_IMAGES`` gives
+    every frame at its own size, so that :class:`StereoCamera`'s size and shape rules apply.
+    ``CAP_IMAGES`` starts a pattern at number 0 or 1; a sequence starting at 2-4 (FFmpeg's range)
+    is opened by its first file, whose number it reads. The default backend remains for what
+    ``CAP_IMAGES`` cannot open.
+    """
+    first = _sequence_first(path)
+    if first is not None:
+        cap = cv2.VideoCapture(path if first[0] <= 1 else first[1], cv2.CAP_IMAGES)
+        if cap.isOpened():
+            return cap
+        cap.release()
+    return cv2.VideoCapture(path)
 
 
 def camera_hint(src: object) -> str:
@@ -281,8 +385,9 @@ class StereoCamera(PairSource):
     Parameters
     ----------
     left, right : int, str, os.PathLike or VideoCapture-like
-        Device index, video file, image-sequence pattern (``frames/left_%03d.png``), or an object
-        with the ``cv2.VideoCapture`` methods ``isOpened grab retrieve get set release``.
+        Device index, video file, image-sequence pattern (``frames/left_%03d.png``, read with
+        OpenCV's image reader so that each frame comes at its own size), or an object with the
+        ``cv2.VideoCapture`` methods ``isOpened grab retrieve get set release``.
     size : tuple of int, optional
         Requested ``(width, height)``, asked of the sources with ``CAP_PROP_FRAME_WIDTH`` /
         ``CAP_PROP_FRAME_HEIGHT``. Frames that come in another size (a file cannot be asked) are
@@ -349,6 +454,8 @@ class StereoCamera(PairSource):
         self._warned: set[str] = set()
         self._size_locked = False  # a frame has fixed the output size
         self._caps: dict[str, Any] = {}
+        #: Sources read by OpenCV's image-sequence reader (it logs a warning at the end).
+        self._sequence: dict[str, bool] = {}
         try:
             for side, src in self.sources.items():
                 self._caps[side] = self._open(side, src, fps)
@@ -367,7 +474,8 @@ class StereoCamera(PairSource):
                 raise FileNotFoundError(f"{side} source: no file matches {path}")
             # OpenCV logs its backends' attempts to stderr; the error below says what failed.
             with _opencv_quiet():
-                cap: Any = cv2.VideoCapture(path)
+                cap: Any = _open_path(path)
+            self._sequence[side] = cap.isOpened() and cap.getBackendName() == "CV_IMAGES"
         elif isinstance(src, (int, np.integer)):
             with _opencv_quiet():
                 cap = cv2.VideoCapture(int(src))
@@ -385,7 +493,8 @@ class StereoCamera(PairSource):
             cap.set(cv2.CAP_PROP_FRAME_HEIGHT, self.requested_size[1])
         if fps is not None:
             cap.set(cv2.CAP_PROP_FPS, float(fps))
-        self.delivered_fps[side] = float(cap.get(cv2.CAP_PROP_FPS) or 0.0)
+        # CAP_IMAGES says -1 (no rate): 0 for unknown, as other sources say it.
+        self.delivered_fps[side] = max(0.0, float(cap.get(cv2.CAP_PROP_FPS) or 0.0))
         w, h = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
         if w > 0 and h > 0:
             self.delivered_size[side] = (w, h)
@@ -423,11 +532,24 @@ class StereoCamera(PairSource):
             # of them): the first frame's own size is kept instead, and two sources of
             # different shapes are refused.
             if self._size_locked:
-                first = "right" if side == "left" else "left"
+                name = _describe_source(self.sources[side])
+                if self.count == 0:
+                    first = "right" if side == "left" else "left"
+                    raise SourceError(
+                        f"{side} source {name} delivers {w}x{h}, the {first} source "
+                        f"{self.size[0]}x{self.size[1]}: frames of another shape cannot be "
+                        "paired without stretching one (ask both for the same size)",
+                        side=side,
+                        end=False,
+                        frames=self.count,
+                    )
                 raise SourceError(
-                    f"{side} source {_describe_source(self.sources[side])} delivers {w}x{h}, "
-                    f"the {first} source {self.size[0]}x{self.size[1]}: frames of another shape "
-                    "cannot be paired without stretching one (ask both for the same size)"
+                    f"{side} source {name} delivers {w}x{h} in pair {self.count + 1}, after "
+                    f"{self.count} pairs of {self.size[0]}x{self.size[1]}: a frame of another "
+                    "shape cannot be paired without stretching it",
+                    side=side,
+                    end=False,
+                    frames=self.count,
                 )
             warnings.warn(
                 f"{side} source {_describe_source(self.sources[side])} delivers {w}x{h}, not "
@@ -464,10 +586,12 @@ class StereoCamera(PairSource):
         caps = self._caps
         if len(caps) != 2:
             raise SourceError("the stereo camera is closed")
-        ok_l = caps["left"].grab()
-        t_l = time.monotonic()
-        ok_r = caps["right"].grab()
-        t_r = time.monotonic()
+        # OpenCV's image-sequence reader logs a warning for the file after the last.
+        with _opencv_quiet() if any(self._sequence.values()) else contextlib.nullcontext():
+            ok_l = caps["left"].grab()
+            t_l = time.monotonic()
+            ok_r = caps["right"].grab()
+            t_r = time.monotonic()
         for side, ok in (("left", ok_l), ("right", ok_r)):
             if not ok:
                 raise self._fail(side, "delivered no frame")
@@ -483,8 +607,8 @@ class StereoCamera(PairSource):
             t_left=t_l,
             t_right=t_r,
             index=self.count,
-            pos_left_ms=float(caps["left"].get(cv2.CAP_PROP_POS_MSEC)),
-            pos_right_ms=float(caps["right"].get(cv2.CAP_PROP_POS_MSEC)),
+            pos_left_ms=_media_ms(caps["left"]),
+            pos_right_ms=_media_ms(caps["right"]),
         )
         self.count += 1
         self.skews_ms.append(frame.skew_ms)
