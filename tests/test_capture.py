@@ -364,19 +364,80 @@ def test_disconnect_mid_run_keeps_saved_pairs(tmp_path: Path) -> None:
     left, right = _videos(tmp_path, 10, 4)
     out = tmp_path / "pairs"
     with StereoCamera(left, right) as cam:
-        with pytest.raises(SourceError, match=r"right source .*right\.avi.* after 4 pairs") as ei:
+        with pytest.raises(SourceError) as ei:
             capture(cam, out, count=8)
-    assert "4 of 8 pairs were saved" in str(ei.value)
+    assert str(ei.value) == (
+        f"right source {str(right)!r} ended after 4 frames; the left source still had frames; "
+        f"4 of 8 pairs were saved in {out} and are kept"
+    )
+    assert (ei.value.side, ei.value.end, ei.value.frames) == ("right", True, 4)
+    assert ei.value.other_had_frames and ei.value.expected_frames is None
     names = sorted(p.name for p in out.iterdir())
     assert names == [f"{s}_{i:04d}.png" for s in ("left", "right") for i in range(1, 5)]
     for i in range(1, 5):
         assert _read_stamp(cv2.imread(str(out / f"left_{i:04d}.png"))) == i - 1
-    # Without --count the end of a source ends the capture normally; numbering continues.
+    # Without --count the end of a source ends the capture, said as it is (the right video
+    # ended, the left one had more); numbering continues.
     with StereoCamera(left, right) as cam:
         result = capture(cam, out, every=2)
-    assert result.ended == "end of stream" and result.frames_read == 4
+    assert result.ended == (
+        f"right source {str(right)!r} ended after 4 frames; the left source still had frames"
+    )
+    assert result.frames_read == 4
     assert [p[0].name for p in result.saved] == ["left_0005.png", "left_0006.png"]
     assert [_read_stamp(cv2.imread(str(p[0]))) for p in result.saved] == [0, 2]
+    # The left one shorter: named the same way; both ending together is a plain end.
+    with StereoCamera(right, left) as cam:
+        assert capture(cam, tmp_path / "p2").ended == (
+            f"left source {str(right)!r} ended after 4 frames; the right source still had frames"
+        )
+    with StereoCamera(left, left) as cam:
+        with pytest.raises(SourceError, match=r"^both sources ended after 10 frames; 10 of 11 "):
+            capture(cam, tmp_path / "p3", count=11)
+    with StereoCamera(left, left) as cam:
+        assert capture(cam, tmp_path / "p4").ended == "end of stream"
+
+
+def test_truncated_video_is_named_and_its_last_pair_too(tmp_path: Path) -> None:
+    """A video cut at 60 % of its bytes: 11 of the 20 frames its header announces are read, the
+    end says the file ended early and which saved pair holds its last (maybe half-decoded)
+    frame. A frame of another shape stops the capture with an error, not as an end."""
+    left, right = _videos(tmp_path, 20, 20)
+    data = left.read_bytes()
+    cut = tmp_path / "cut.avi"
+    cut.write_bytes(data[: len(data) * 6 // 10])
+    with StereoCamera(cut, right) as cam:
+        result = capture(cam, tmp_path / "pairs")
+    assert len(result.saved) == result.frames_read == 11
+    assert result.ended == (
+        f"left source {str(cut)!r} ended after 11 of the 20 frames its header announces: the "
+        "file ended early (likely truncated or damaged; its last frame, in pair 11, may be "
+        "incomplete); the right source still had frames; that pair was saved as "
+        "left_0011.png, right_0011.png"
+    )
+    with StereoCamera(cut, right) as cam:
+        with pytest.raises(SourceError) as ei:
+            for _ in range(12):
+                cam.read()
+    assert (ei.value.side, ei.value.frames, ei.value.expected_frames) == ("left", 11, 20)
+    assert ei.value.ended_early and ei.value.end
+    # Both cut: both named.
+    with StereoCamera(cut, cut) as cam:
+        both = capture(cam, tmp_path / "both", every=100)
+    assert both.ended.count("ended after 11 of the 20 frames its header announces") == 2
+    assert both.ended.startswith("left source") and "; right source" in both.ended
+    # A sequence whose frame 3 has another shape: an error even without a count.
+    frames = [_numbered(i) for i in range(6)]
+    frames[3] = _numbered(3, (100, 100))
+    lpat = _write_sequence(tmp_path / "odd", "left", frames)
+    rpat = _write_sequence(tmp_path / "odd", "right", [_numbered(i) for i in range(6)])
+    with StereoCamera(lpat, rpat) as cam:
+        with pytest.raises(SourceError, match=r"delivers 100x100 in pair 4, .*; 3 pairs were "):
+            capture(cam, tmp_path / "odd_pairs")
+        with pytest.raises(SourceError, match="closed"):
+            cam.close()
+            capture(cam, tmp_path / "odd_pairs")
+    assert len(list((tmp_path / "odd_pairs").glob("right_*.png"))) == 3
 
 
 # -------------------------------------------------------------------------------- saving
@@ -718,7 +779,7 @@ def test_cli_capture(
         run(*src, "--charuco", "10x7", "--chessboard", "9x6", "--square", "3", "--marker", "2")
     with pytest.raises(ValueError, match="--charuco: marker_size"):
         run(*src, "--charuco", "10x7", "--square", "3", "--marker", "4")
-    with pytest.raises(SourceError, match="after 6 pairs"):
+    with pytest.raises(SourceError, match="both sources ended after 6 frames; 6 of 9 pairs"):
         run("--left", str(left), "--right", str(right), "--count", "9", "-o", str(out))
     with pytest.raises(ValueError, match="four characters"):
         run(*src, "--fourcc", "MJPEG")

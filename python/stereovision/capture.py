@@ -149,15 +149,21 @@ class SourceError(OSError):
         """A source ended while the other still had frames, or before the frames it announced."""
         return bool(self.other_had_frames) or self.expected_frames is not None
 
-    def __reduce__(self) -> tuple[Any, ...]:
-        kwargs = {
+    def _kwargs(self) -> dict[str, Any]:
+        return {
             "side": self.side,
             "end": self.end,
             "frames": self.frames,
             "other_had_frames": self.other_had_frames,
             "expected_frames": self.expected_frames,
         }
-        return (_source_error, (str(self), kwargs))
+
+    def with_message(self, message: str) -> SourceError:
+        """The same error with another message (its attributes kept)."""
+        return SourceError(message, **self._kwargs())
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (_source_error, (str(self), self._kwargs()))
 
 
 def _source_error(message: str, kwargs: dict[str, Any]) -> SourceError:
@@ -350,12 +356,13 @@ class PairSource:
         raise NotImplementedError
 
     def frames(self, *, stop_at_end: bool = True) -> Iterator[StereoFrame]:
-        """Iterate over pairs; the end of a source ends the iteration when ``stop_at_end``."""
+        """Iterate over pairs; the end of a source ends the iteration when ``stop_at_end``
+        (another :class:`SourceError`, such as a frame of another shape, is raised)."""
         while True:
             try:
                 frame = self.read()
-            except SourceError:
-                if stop_at_end:
+            except SourceError as exc:
+                if stop_at_end and exc.end:
                     return
                 raise
             yield frame
@@ -513,8 +520,69 @@ class StereoCamera(PairSource):
 
     def _fail(self, side: str, what: str) -> SourceError:
         return SourceError(
-            f"{side} source {_describe_source(self.sources[side])} {what} after {self.count} "
-            "pairs (disconnected or end of stream)"
+            f"{side} source {_describe_source(self.sources[side])} {what} after {self.count} pairs",
+            side=side,
+            end=False,
+            frames=self.count,
+        )
+
+    def _announced(self, side: str) -> int | None:
+        """The frame count a video file or image sequence announces (None for others)."""
+        if not isinstance(self.sources[side], (str, os.PathLike)):
+            return None  # a camera has none; an object's may mean anything
+        try:
+            total = float(self._caps[side].get(cv2.CAP_PROP_FRAME_COUNT))
+        except Exception:  # a VideoCapture-like without it
+            return None
+        return int(total) if math.isfinite(total) and total > 0 else None
+
+    def _short(self, side: str) -> int | None:
+        """The announced frame count of a source that ended clearly before it (None if not).
+
+        A container without an index estimates its count from its duration (off by a frame
+        or so), hence the margin: more than one frame and 1 % short."""
+        total = self._announced(side)
+        n = self.count
+        return total if total is not None and total - n > max(1, total // 100) else None
+
+    def _end_phrase(self, side: str) -> str:
+        src, n = self.sources[side], self.count
+        name = _describe_source(src)
+        if isinstance(src, (int, np.integer)):
+            return f"{side} source {name} stopped delivering frames after {n} (disconnected?)"
+        total = self._short(side)
+        if total is None:
+            return f"{side} source {name} ended after {n} frames"
+        if self._sequence.get(side):
+            return (
+                f"{side} source {name} ended after {n} of its {total} images: the next one "
+                "does not read (damaged?)"
+            )
+        return (
+            f"{side} source {name} ended after {n} of the {total} frames its header announces: "
+            f"the file ended early (likely truncated or damaged; its last frame, in pair {n}, "
+            "may be incomplete)"
+        )
+
+    def _ended(self, ok: dict[str, bool]) -> SourceError:
+        """The end of one source or both, said as it is: which one, whether the other still had
+        frames, and whether a file ended before the frames its header announces."""
+        gone = [side for side in ("left", "right") if not ok[side]]
+        short = [t for side in gone if (t := self._short(side)) is not None]
+        if len(gone) == 2 and not short:
+            message = f"both sources ended after {self.count} frames"
+        elif len(gone) == 2:
+            message = "; ".join(self._end_phrase(side) for side in gone)
+        else:
+            other = "right" if gone[0] == "left" else "left"
+            message = f"{self._end_phrase(gone[0])}; the {other} source still had frames"
+        return SourceError(
+            message,
+            side=gone[0] if len(gone) == 1 else "both",
+            end=True,
+            frames=self.count,
+            other_had_frames=len(gone) == 1,
+            expected_frames=short[0] if short else None,
         )
 
     def _fit(self, side: str, frame: np.ndarray) -> np.ndarray:
@@ -580,21 +648,23 @@ class StereoCamera(PairSource):
         Raises
         ------
         SourceError
-            If a source delivers no frame (device unplugged, end of a file or sequence); the
-            message names the source and the number of pairs read before.
+            If a source delivers no frame (device unplugged, end of a file or sequence): the
+            message names the source that ended, the frames read, whether the other still had
+            frames and whether a file ended before the frames its header announces (attributes
+            ``side``, ``frames``, ``other_had_frames``, ``expected_frames``; ``end`` True). A
+            frame that does not decode or of another shape raises it with ``end`` False.
         """
         caps = self._caps
         if len(caps) != 2:
-            raise SourceError("the stereo camera is closed")
+            raise SourceError("the stereo camera is closed", end=False)
         # OpenCV's image-sequence reader logs a warning for the file after the last.
         with _opencv_quiet() if any(self._sequence.values()) else contextlib.nullcontext():
             ok_l = caps["left"].grab()
             t_l = time.monotonic()
             ok_r = caps["right"].grab()
             t_r = time.monotonic()
-        for side, ok in (("left", ok_l), ("right", ok_r)):
-            if not ok:
-                raise self._fail(side, "delivered no frame")
+        if not (ok_l and ok_r):
+            raise self._ended({"left": ok_l, "right": ok_r})
         frames = {}
         for side in ("left", "right"):
             ok, img = caps[side].retrieve()
@@ -924,7 +994,13 @@ class ChessboardCollector:
 
 @dataclass
 class CaptureResult:
-    """What :func:`capture` did."""
+    """What :func:`capture` did.
+
+    ``ended`` is ``"count reached"``, ``"end of stream"`` (both sources ended together, as
+    announced), or, when a source ended before the other or a file before its announced frames,
+    what ended (``"right source 'r.avi' ended after 100 frames; the left source still had
+    frames"``).
+    """
 
     saved: list[tuple[Path, Path]]
     frames_read: int
@@ -954,7 +1030,9 @@ def capture(
     directory : str or os.PathLike
         Created if missing; numbering continues after pairs already there (none is overwritten).
     count : int, optional
-        Pairs to save. Without it, capture runs until a source ends (normal for files).
+        Pairs to save. Without it, capture runs until a source ends (normal for files); when
+        one ends before the other, or a video file before the frames its header announces
+        (truncated), :attr:`CaptureResult.ended` says so (the CLI prints it).
     chessboard : tuple of int or str, optional
         Pattern (``(9, 6)`` or ``"9x6"``): save only pairs with the board in both images and a
         new pose (:class:`ChessboardCollector`).
@@ -984,8 +1062,9 @@ def capture(
     Raises
     ------
     SourceError
-        If a source fails or ends before ``count`` pairs were saved; the pairs saved so far stay
-        on disk, and the message says how many.
+        If a source fails (a frame that does not decode or of another shape, with or without
+        ``count``) or ends before ``count`` pairs were saved; the pairs saved so far stay on
+        disk, and the message says how many.
     ValueError
         For an invalid ``count``, ``every``, ``temporal`` or pattern.
     """
@@ -1016,16 +1095,16 @@ def capture(
     index = next_pair_index(out)
     saved: list[tuple[Path, Path]] = []
     ended = "count reached"
+    last_index = -1  # the frame index of the pair saved last
     while count is None or len(saved) < count:
         try:
             frame = camera.read()
         except SourceError as exc:
-            if count is None:
-                ended = "end of stream"
+            if count is None and exc.end:
+                ended = _end_reason(exc, saved, last_index)
                 break
-            raise SourceError(
-                f"{exc}; {len(saved)} of {count} pairs were saved in {out} and are kept"
-            ) from exc
+            kept = f"{len(saved)} of {count}" if count is not None else f"{len(saved)}"
+            raise exc.with_message(f"{exc}; {kept} pairs were saved in {out} and are kept") from exc
         averaged = None
         if tf is not None:
             left, right = tf(frame.left, frame.right)
@@ -1043,6 +1122,7 @@ def capture(
             continue
         paths = save_pair(out, index, frame.left, frame.right, ext=ext)
         saved.append(paths)
+        last_index = frame.index
         index += 1
         if tf is not None:
             tf.reset()  # the next pair from frames of its own
@@ -1060,6 +1140,20 @@ def capture(
         coverage=None if collector is None else collector.progress(),
         ended=ended,
     )
+
+
+def _end_reason(exc: SourceError, saved: list[tuple[Path, Path]], last_index: int) -> str:
+    """``"end of stream"`` when both sources ended together as announced; else what ended
+    (:meth:`StereoCamera.read`'s words) and, for a file that ended early, which saved pair holds
+    its last frame."""
+    if not exc.ended_early:
+        return "end of stream"
+    reason = str(exc)
+    frames = exc.frames
+    if exc.expected_frames is not None and frames and saved and last_index == frames - 1:
+        left, right = saved[-1]
+        reason += f"; that pair was saved as {left.name}, {right.name}"
+    return reason
 
 
 # -------------------------------------------------------------------------------------- CLI
