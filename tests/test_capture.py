@@ -134,6 +134,31 @@ def test_video_files_count_order_and_skew(tmp_path: Path) -> None:
     assert 0.0 <= report["mean_ms"] <= report["max_ms"] < 250.0
 
 
+def test_videos_of_different_rates_drift_apart_once(tmp_path: Path) -> None:
+    """10 fps left, 5 fps right: read in turn, the grab skew stays below a millisecond or so,
+    but the media times part (pair 4 at 300 and 600 ms), more than the slower video's frame
+    (200 ms): one warning naming both rates, and the pairs still come. Same rates: none."""
+    left = _write_video(tmp_path / "l10.avi", [_numbered(i) for i in range(8)], fps=10.0)
+    right = _write_video(tmp_path / "r5.avi", [_numbered(i, shade=160) for i in range(8)], fps=5.0)
+    with pytest.warns(UserWarning) as rec:
+        with StereoCamera(left, right) as cam:
+            frames = list(cam.frames())
+    assert len(frames) == 8 and len(rec) == 1
+    assert str(rec[0].message) == (
+        f"left source {str(left)!r} (10 fps) and right source {str(right)!r} (5 fps) drift "
+        "apart: pair 4 is at 300 ms of the left video and 600 ms of the right, more than a "
+        "frame (200 ms) from the first pair's offset; the pairs are not simultaneous (the grab "
+        "skew only says when each frame was read)"
+    )
+    assert [f.pos_right_ms - f.pos_left_ms for f in frames[:4]] == pytest.approx([0, 100, 200, 300])
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with StereoCamera(left, left) as cam:
+            assert len(list(cam.frames())) == 8
+
+
 def test_image_sequence_source_and_capture(tmp_path: Path) -> None:
     lpat = _write_sequence(tmp_path / "frames", "left", [_numbered(i) for i in range(7)])
     rpat = _write_sequence(

@@ -463,6 +463,7 @@ class StereoCamera(PairSource):
         self._caps: dict[str, Any] = {}
         #: Sources read by OpenCV's image-sequence reader (it logs a warning at the end).
         self._sequence: dict[str, bool] = {}
+        self._media_offset: float | None = None  # left - right media time of the first pair
         try:
             for side, src in self.sources.items():
                 self._caps[side] = self._open(side, src, fps)
@@ -682,7 +683,53 @@ class StereoCamera(PairSource):
         )
         self.count += 1
         self.skews_ms.append(frame.skew_ms)
+        self._check_media_drift(frame)
         return frame
+
+    def _video_files(self) -> bool:
+        """Both sources are local video files, whose media times are comparable."""
+        return all(
+            isinstance(src, (str, os.PathLike))
+            and "://" not in os.fspath(src)
+            and not self._sequence.get(side)
+            for side, src in self.sources.items()
+        )
+
+    def _check_media_drift(self, frame: StereoFrame) -> None:
+        """Warn once when two video files' media times drift apart by more than a frame.
+
+        The grab skew is host time (``time.monotonic``): two files read in turn are always a
+        fraction of a millisecond apart, even when one runs at 15 fps and the other at 30 (pair
+        49 at 1633 and 3267 ms of media time). The media times (``CAP_PROP_POS_MSEC``) tell:
+        their difference, taken from the first pair's (a container may start at another time),
+        may move by up to a frame period of the slower source (its frames stand for that long).
+        """
+        if "media drift" in self._warned or not self._video_files():
+            return
+        pl, pr = frame.pos_left_ms, frame.pos_right_ms
+        if not (math.isfinite(pl) and math.isfinite(pr)):
+            return
+        if self._media_offset is None:
+            self._media_offset = pl - pr
+            return
+        rates = [f for f in self.delivered_fps.values() if f > 0]
+        if not rates:
+            return
+        period = 1000.0 / min(rates)
+        if abs(pl - pr - self._media_offset) <= period:
+            return
+        self._warned.add("media drift")
+        fps = {side: self.delivered_fps.get(side, 0.0) for side in ("left", "right")}
+        name = {side: _describe_source(src) for side, src in self.sources.items()}
+        warnings.warn(
+            f"left source {name['left']} ({fps['left']:.3g} fps) and right source "
+            f"{name['right']} ({fps['right']:.3g} fps) drift apart: pair {frame.index + 1} is at "
+            f"{pl:.0f} ms of the left video and {pr:.0f} ms of the right, more than a frame "
+            f"({period:.0f} ms) from the first pair's offset; the pairs are not simultaneous "
+            "(the grab skew only says when each frame was read)",
+            UserWarning,
+            stacklevel=3,
+        )
 
     def describe(self) -> str:
         """One line: requested vs delivered size and fps of each source."""
