@@ -510,6 +510,75 @@ def test_atomic_pair_writes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> 
         save_pair(out, 3, img, img, ext=".nope")
 
 
+@pytest.mark.parametrize("where", ["fdopen", "write", "fsync", "replace"])
+def test_interrupted_pair_save_leaves_no_temp_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, where: str
+) -> None:
+    """KeyboardInterrupt (SIGTERM in the CLI) at any step after the temporary file exists:
+    it is removed, and no final name appears for the image being written."""
+    img = _numbered(1)
+    real = {"fdopen": os.fdopen, "fsync": os.fsync, "replace": os.replace}
+
+    def interrupt(*args: Any, **kwargs: Any) -> Any:
+        raise KeyboardInterrupt
+
+    if where == "write":
+
+        class _File:
+            def __init__(self, fd: int, mode: str) -> None:
+                self.fh = real["fdopen"](fd, mode)
+
+            def __enter__(self) -> _File:
+                return self
+
+            def __exit__(self, *exc: object) -> None:
+                self.fh.close()
+
+            def write(self, data: bytes) -> int:
+                self.fh.write(data[: len(data) // 2])
+                raise KeyboardInterrupt
+
+        monkeypatch.setattr(os, "fdopen", _File)
+    else:
+        monkeypatch.setattr(os, where, interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        save_pair(tmp_path, 1, img, img)
+    monkeypatch.undo()
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_capture_removes_temp_files_a_killed_capture_left(tmp_path: Path) -> None:
+    """A capture killed outright (SIGKILL, SIGTERM without a handler) cannot remove its
+    temporary file; the next capture into the folder does, and says so. A file of a process
+    still running, and other hidden files, are kept."""
+    out = tmp_path / "pairs"
+    out.mkdir()
+    done = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True, check=True)  # fmt: skip
+    dead = int(done.stdout)  # a process that has ended
+    names = [
+        f".left_0003.png.{dead}-9f2c01ab.tmp",  # left by a killed capture
+        ".right_0002.png.k3x_9a2b.tmp",  # tempfile's name (before the process id was in it)
+        f".left_0004.png.{os.getppid()}-00aa11bb.tmp",  # a capture still writing
+        ".notes.txt.tmp",  # not ours
+    ]
+    for name in names:
+        (out / name).write_bytes(b"half a png")
+    left, right = _videos(tmp_path, 2, 2)
+    lines: list[str] = []
+    with StereoCamera(left, right) as cam:
+        result = capture(cam, out, count=1, log=lines.append)
+    assert result.removed_temps == sorted(names[:2])
+    assert lines[0] == (
+        f"removed 2 temporary files an interrupted capture left in {out}: "
+        f"{', '.join(sorted(names[:2]))}"
+    )
+    assert sorted(p.name for p in out.iterdir()) == sorted(
+        [*names[2:], "left_0001.png", "right_0001.png"]
+    )
+    assert capmod.remove_stale_temps(tmp_path / "none") == []
+
+
 def test_no_partial_file_visible_to_a_concurrent_reader(tmp_path: Path) -> None:
     out = tmp_path / "pairs"
     out.mkdir()

@@ -34,6 +34,7 @@ import glob
 import math
 import os
 import re
+import secrets
 import statistics
 import time
 import warnings
@@ -72,6 +73,7 @@ __all__ = [
     "parse_fourcc",
     "parse_size",
     "parse_source",
+    "remove_stale_temps",
     "save_pair",
 ]
 
@@ -827,11 +829,65 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
 # ---------------------------------------------------------------------------------- saving
 
 
-def _atomic_write_bytes(path: Path, data: bytes) -> None:
-    from stereovision.io import atomic_write
+#: A temporary file of :func:`save_pair`: ``.left_0001.png.<pid>-<random>.tmp`` (before,
+#: ``tempfile``'s ``.left_0001.png.<random>.tmp``, without the writer's process id).
+_TMP_RE = re.compile(r"^\.(?:left|right)_\d+\.[A-Za-z0-9]+\.(?:(\d+)-)?[a-z0-9_]+\.tmp$")
 
-    with atomic_write(path, "wb") as fh:
-        fh.write(data)
+
+def _atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to a temporary file beside ``path``, then rename it over ``path``.
+
+    The temporary file is named before it exists, so that any exception -- KeyboardInterrupt
+    included, at any point from its creation on -- removes it; its name carries this process's
+    id, so that :func:`remove_stale_temps` can tell a file a killed capture left from one being
+    written."""
+    tmp = path.with_name(f".{path.name}.{os.getpid()}-{secrets.token_hex(4)}.tmp")
+    try:
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def _pid_alive(pid: int) -> bool:
+    """Whether process ``pid`` runs (True when it cannot be told)."""
+    if pid == os.getpid() or os.name != "posix":
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's: alive
+        return True
+    return True
+
+
+def remove_stale_temps(directory: PathLike) -> list[str]:
+    """Remove the temporary files of :func:`save_pair` that a killed capture left in
+    ``directory`` (``.left_0003.png.1234-9f2c.tmp``: a capture ended by SIGKILL, or SIGTERM
+    without a handler, has no chance to remove its own); those of a process still running are
+    kept. Returns the names removed, sorted."""
+    d = Path(directory)
+    removed: list[str] = []
+    if not d.is_dir():
+        return removed
+    for p in d.iterdir():
+        m = _TMP_RE.match(p.name)
+        if m is None or (m.group(1) is not None and _pid_alive(int(m.group(1)))):
+            continue
+        try:
+            if p.is_file():
+                p.unlink()
+                removed.append(p.name)
+        except OSError:  # gone meanwhile, or not ours to remove
+            pass
+    return sorted(removed)
 
 
 def next_pair_index(directory: PathLike) -> int:
@@ -854,7 +910,10 @@ def save_pair(
     """Save a pair atomically as ``left_NNNN.ext`` and ``right_NNNN.ext``.
 
     Both images are encoded in memory first; each is then written to a temporary file in
-    ``directory`` and renamed over its final name (``os.replace``), left first, right last.
+    ``directory`` (``.left_0001.png.<pid>-<random>.tmp``) and renamed over its final name
+    (``os.replace``), left first, right last. Any exception, KeyboardInterrupt included, removes
+    the temporary file; one that a killed process left is removed by the next :func:`capture`
+    into the folder (:func:`remove_stale_temps`).
 
     Parameters
     ----------
@@ -1054,6 +1113,8 @@ class CaptureResult:
     skew: dict[str, float]
     coverage: dict[str, float] | None = None
     ended: str = "count reached"
+    #: Temporary files a killed capture had left in the folder, removed at the start.
+    removed_temps: list[str] = field(default_factory=list)
 
 
 def capture(
@@ -1076,6 +1137,7 @@ def capture(
     camera : StereoCamera
     directory : str or os.PathLike
         Created if missing; numbering continues after pairs already there (none is overwritten).
+        Temporary files a killed capture left there are removed first (said to ``log``).
     count : int, optional
         Pairs to save. Without it, capture runs until a source ends (normal for files); when
         one ends before the other, or a video file before the frames its header announces
@@ -1139,6 +1201,12 @@ def capture(
         collector = ChessboardCollector(parse_pattern(chessboard), min_distance)
     out = Path(directory)
     out.mkdir(parents=True, exist_ok=True)
+    stale = remove_stale_temps(out)
+    if stale and log is not None:
+        log(
+            f"removed {len(stale)} temporary file{'s' if len(stale) > 1 else ''} an interrupted "
+            f"capture left in {out}: {', '.join(stale)}"
+        )
     index = next_pair_index(out)
     saved: list[tuple[Path, Path]] = []
     ended = "count reached"
@@ -1186,6 +1254,7 @@ def capture(
         skew=camera.skew_report(),
         coverage=None if collector is None else collector.progress(),
         ended=ended,
+        removed_temps=stale,
     )
 
 
