@@ -159,6 +159,42 @@ def test_videos_of_different_rates_drift_apart_once(tmp_path: Path) -> None:
             assert len(list(cam.frames())) == 8
 
 
+def test_skews_are_kept_in_bounded_memory() -> None:
+    """The skews of a long run: the latest SKEW_WINDOW one by one (a sequence of float, as the
+    list was), the count, mean and maximum of all exact, the median exact up to the window and
+    within 0.5 % beyond; the camera reports them the same way."""
+    import statistics
+
+    rng = np.random.default_rng(5)
+    values = [float(v) for v in rng.gamma(2.0, 0.2, 5000)] + [0.0, 3.5]
+    stats = capmod.SkewStats()
+    for v in values[:500]:
+        stats.append(v)
+    assert list(stats) == values[:500] and len(stats) == 500 and stats[-1] == values[499]
+    assert stats.report() == {
+        "n": 500,
+        "mean_ms": pytest.approx(statistics.fmean(values[:500]), rel=1e-12),
+        "median_ms": statistics.median(values[:500]),
+        "max_ms": max(values[:500]),
+    }
+    for v in values[500:]:
+        stats.append(v)
+    assert len(stats) == capmod.SKEW_WINDOW == 1024 and list(stats) == values[-1024:]
+    assert stats[:2] == values[-1024:-1022]
+    rep = stats.report()
+    assert rep["n"] == 5002 and rep["max_ms"] == 3.5
+    assert rep["mean_ms"] == pytest.approx(statistics.fmean(values), rel=1e-12)
+    assert rep["median_ms"] == pytest.approx(statistics.median(values), rel=0.005)
+    assert capmod.SkewStats().report()["n"] == 0
+    # The camera: 1100 pairs read, 1024 skews kept, the report over all 1100.
+    cam = StereoCamera(_FakeCap("L", [], frames=2000), _FakeCap("R", [], frames=2000))
+    frames = [cam.read() for _ in range(1100)]
+    assert len(cam.skews_ms) == 1024 and list(cam.skews_ms) == [f.skew_ms for f in frames[76:]]
+    report = cam.skew_report()
+    assert report["n"] == 1100 and report["max_ms"] == max(f.skew_ms for f in frames)
+    cam.close()
+
+
 def test_image_sequence_source_and_capture(tmp_path: Path) -> None:
     lpat = _write_sequence(tmp_path / "frames", "left", [_numbered(i) for i in range(7)])
     rpat = _write_sequence(
