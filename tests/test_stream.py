@@ -562,3 +562,21 @@ def test_sigterm_finishes_the_bag_of_a_stream(data_dir: Path, tmp_path: Path) ->
         rows = sum(1 for _ in reader.messages())
     assert len(counts) == 5 and len(set(counts.values())) == 1, counts  # whole frames
     assert 1 <= counts["/stereo/depth"] < 300 and rows == sum(counts.values())
+
+
+def test_stream_says_when_one_video_ends_first(data_dir: Path, tmp_path: Path) -> None:
+    """Two videos of different lengths: the stream ended at the shorter one as if both had
+    ended; now a warning names the source that ended and that the other had more."""
+    scene = data_dir / SCENE
+    for side, n in (("left", 5), ("right", 3)):
+        img = cv2.resize(cv2.imread(str(scene / f"{side}.png")), (320, 240))
+        vw = cv2.VideoWriter(str(tmp_path / f"{side}.avi"), cv2.VideoWriter_fourcc(*"MJPG"),
+                             FPS, (320, 240))  # fmt: skip
+        for _ in range(n):
+            vw.write(img)
+        vw.release()
+    cam = StereoCamera(str(tmp_path / "left.avi"), str(tmp_path / "right.avi"))
+    with pytest.warns(UserWarning, match=r"right source .* ended after 3 frames; the left"):
+        rep = run_stream(cam, method="gabor", max_disparity=32, pipelined=False, check=False)
+    cam.close()
+    assert rep.frames == 3 and rep.ended == "end of stream"

@@ -1376,7 +1376,9 @@ def _calibrate_from_camera(
         while len(lefts) < max_pairs:
             try:
                 frame = cam.read()
-            except SourceError:
+            except SourceError as exc:
+                if not getattr(exc, "end", True):
+                    raise  # a frame that does not decode or of another shape: not an end
                 break  # the end of a recording
             read += 1
             if collector.consider(frame).save:

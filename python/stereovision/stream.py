@@ -372,9 +372,14 @@ def _pairs(
         t0 = time.perf_counter()
         try:
             fr = camera.read()
-        except SourceError:
-            if camera.count == 0:
+        except SourceError as exc:
+            # no first frame, or a failure that is not an end (a frame that does not decode or
+            # of another shape): an error; an end is the end of the stream, said plainly when
+            # one source ended before the other or before the frames its file announced
+            if camera.count == 0 or not getattr(exc, "end", True):
                 raise
+            if getattr(exc, "ended_early", False):
+                warnings.warn(str(exc), UserWarning, stacklevel=2)
             return
         t1 = time.perf_counter()
         recorded = getattr(camera, "stamps_ns", None)
