@@ -11,8 +11,9 @@ A re-run skips the pairs the summary records as done whose inputs (size, modific
 options are unchanged and whose folder still exists, without starting a cluster when nothing is
 left to do. A pair that fails (an unreadable image, sizes that differ, ...) is recorded with its
 error and the others go on; a re-run tries it again once its files (or the options) change, or
-with ``retry_failed``. Ctrl-C cancels what is running and
-keeps everything already written.
+with ``retry_failed``. Ctrl-C (or SIGTERM, for the CLI) cancels what is running, keeps
+everything already written and marks the summary as interrupted; the LocalCluster's worker
+processes do not take Ctrl-C themselves (they block SIGINT): the client stops them.
 """
 
 from __future__ import annotations
@@ -24,19 +25,23 @@ import math
 import os
 import re
 import shutil
+import signal
 import socket
 import sys
 import tempfile
+import threading
 import time
 import uuid
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import FrameType, TracebackType
 from typing import Any
 
 __all__ = [
     "IMAGE_EXTS",
     "SUMMARY_NAME",
+    "BatchInterrupted",
     "BatchResult",
     "PairJob",
     "add_cli",
@@ -332,6 +337,20 @@ class BatchResult:
     failed_before: list[str] = field(default_factory=list)
 
 
+class BatchInterrupted(KeyboardInterrupt):
+    """The KeyboardInterrupt :func:`run_batch` raises once it has recorded an interrupted run.
+
+    Attributes
+    ----------
+    result : BatchResult
+        What the run did up to the interrupt (``interrupted`` is True).
+    """
+
+    def __init__(self, result: BatchResult) -> None:
+        super().__init__()
+        self.result = result
+
+
 class _Summary:
     """``OUT/summary.json``: one entry per pair, rewritten atomically after every change."""
 
@@ -382,37 +401,150 @@ def _skip(
     return entry.get("status") == "failed" and not retry_failed
 
 
-def _start_client(scheduler: str | None, workers: int) -> tuple[Any, Any, str]:
-    try:
-        import logging
+class _HeldInterrupts:
+    """Hold Ctrl-C (and SIGTERM when Python handles it, as the CLI does) while Dask starts or stops.
 
-        from distributed import Client, LocalCluster
-    except ImportError:
-        raise RuntimeError(
-            "batch needs Dask distributed: pip install 'stereovision-rs[batch]'"
-        ) from None
-    if scheduler is not None:
+    A Dask client or LocalCluster stopped half-way through its constructor cannot be closed
+    (distributed's exit hook then prints a traceback), so the first signal is only recorded here
+    and, with ``replay``, sent again once the block is over. A second one is not held. Does
+    nothing outside the main thread (signal handlers cannot be set there).
+    """
+
+    def __init__(self, replay: bool = True) -> None:
+        self.replay = replay
+        self.received: list[int] = []
+        self._old: dict[int, Any] = {}
+        self._gone = False
+
+    def __enter__(self) -> _HeldInterrupts:
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                handler = signal.getsignal(sig)
+                if callable(handler):  # Python's KeyboardInterrupt, a caller's SIGTERM handler
+                    self._old[sig] = handler
+                    signal.signal(sig, self._hold)
+        return self
+
+    def _hold(self, signum: int, frame: FrameType | None) -> None:
+        if not self.received:
+            self.received.append(signum)
+            return
+        self._restore()  # a second signal: acted on now
+        self._gone = True
+        self._old.get(signum, signal.default_int_handler)(signum, frame)
+
+    def _restore(self) -> None:
+        for sig, handler in self._old.items():
+            signal.signal(sig, handler)
+        self._old = {}
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self._restore()
+        if self.received and self.replay and not self._gone:
+            signal.raise_signal(self.received[0])  # the restored handler raises
+
+
+def _in_thread_without_sigint(fn: Callable[[], None]) -> None:
+    """Run ``fn`` in a thread that blocks SIGINT, and so do the threads it starts and the
+    processes those start (a signal mask survives fork and exec): LocalCluster's worker
+    processes then ignore the Ctrl-C a terminal sends to the whole process group, where each
+    printed its own KeyboardInterrupt traceback; this process stops them itself."""
+    errors: list[BaseException] = []
+
+    def target() -> None:
         try:
-            client = Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, TimeoutError) as exc:
-            raise OSError(
-                f"cannot reach the Dask scheduler at {scheduler}: {_error_line(exc)}"
+            fn()
+        except BaseException as exc:
+            errors.append(exc)
+
+    thread = threading.Thread(target=target, name="stereovision-batch-start", daemon=True)
+    if hasattr(signal, "pthread_sigmask"):
+        # multiprocessing's resource tracker unblocks SIGINT in the thread that starts it: it
+        # is started here, from this thread, before the mask is set
+        from multiprocessing import resource_tracker
+
+        resource_tracker.ensure_running()
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            thread.start()
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+    else:
+        thread.start()
+    thread.join()
+    if errors:
+        raise errors[0]
+
+
+class _Dask:
+    """The client (and the LocalCluster) of a run: started and closed with interrupts held."""
+
+    def __init__(self) -> None:
+        self.client: Any = None
+        self.cluster: Any = None
+        self.desc = ""
+
+    def start(self, scheduler: str | None, workers: int) -> None:
+        try:
+            import logging
+
+            from distributed import Client, LocalCluster
+        except ImportError:
+            raise RuntimeError(
+                "batch needs Dask distributed: pip install 'stereovision-rs[batch]'"
             ) from None
-        return client, None, scheduler
-    # One worker process per core by default, each kernel with its share of the cores, so the
-    # workers do not oversubscribe the machine.
-    threads = str(max(1, (os.cpu_count() or 1) // workers))
-    env = {"RAYON_NUM_THREADS": threads, "OMP_NUM_THREADS": threads, "OPENCV_LOG_LEVEL": "ERROR"}
-    cluster = LocalCluster(
-        n_workers=workers,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=None,
-        silence_logs=logging.CRITICAL,  # failures are reported per pair
-        env=env,
-    )
-    client = Client(cluster)
-    return client, cluster, f"LocalCluster({workers} worker processes)"
+
+        def connect() -> None:
+            try:
+                self.client = Client(scheduler, timeout=CONNECT_TIMEOUT)
+            except (OSError, TimeoutError) as exc:
+                raise OSError(
+                    f"cannot reach the Dask scheduler at {scheduler}: {_error_line(exc)}"
+                ) from None
+            self.desc = str(scheduler)
+
+        def local() -> None:
+            # One worker process per core by default, each kernel with its share of the cores,
+            # so the workers do not oversubscribe the machine.
+            threads = str(max(1, (os.cpu_count() or 1) // workers))
+            env = {
+                "RAYON_NUM_THREADS": threads,
+                "OMP_NUM_THREADS": threads,
+                "OPENCV_LOG_LEVEL": "ERROR",
+            }
+            self.cluster = LocalCluster(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                silence_logs=logging.CRITICAL,  # failures are reported per pair
+                env=env,
+            )
+            self.client = Client(self.cluster)
+            self.desc = f"LocalCluster({workers} worker processes)"
+
+        with _HeldInterrupts():
+            if scheduler is not None:
+                connect()
+            else:
+                _in_thread_without_sigint(local)
+
+    def close(self, futures: Iterable[Any] = ()) -> None:
+        with _HeldInterrupts():
+            try:
+                for fut in futures:
+                    fut.cancel()
+                if self.client is not None:
+                    self.client.close()
+                if self.cluster is not None:
+                    self.cluster.close()
+            except Exception:  # shutting down is best effort; the results are already written
+                pass
 
 
 def _calib_payload(path: Path) -> tuple[str, bytes]:
@@ -497,8 +629,11 @@ def run_batch(
         Bad ``workers`` / ``max_disparity``, or no pair under the input.
     OSError
         The scheduler cannot be reached.
-    KeyboardInterrupt
-        After recording what was finished (Ctrl-C).
+    BatchInterrupted
+        A KeyboardInterrupt (Ctrl-C, or a SIGTERM that the caller turns into one) raised in the
+        main thread during the run, after Dask was stopped and the summary recorded the run as
+        interrupted; its ``result`` tells what was done. An interrupt before the summary is
+        first written (while the input is searched) is raised as it came.
     """
     if workers is not None and workers <= 0:
         raise ValueError(f"workers: expected a positive number, got {workers}")
@@ -557,17 +692,35 @@ def run_batch(
         "interrupted": False,
     }
     summary.data["run"] = run
-    summary.save()
     processed: list[str] = []
     failed: list[str] = []
     interrupted = False
-    if todo:
-        processed, failed, interrupted = _run_jobs(
-            todo, opts, out, summary, run, scheduler, n_workers, log, progress
-        )
-    seconds = time.perf_counter() - t0
-    run.update(finished=_now(), seconds=round(seconds, 3), interrupted=interrupted)
-    summary.save()
+    try:
+        summary.save()
+        if todo:
+            _run_jobs(
+                todo,
+                opts,
+                out,
+                summary,
+                run,
+                scheduler,
+                n_workers,
+                log,
+                progress,
+                processed,
+                failed,
+            )
+    except KeyboardInterrupt:
+        interrupted = True
+    with _HeldInterrupts(replay=False) as held:  # the record of the run is written whole
+        seconds = time.perf_counter() - t0
+        run.update(finished=_now(), seconds=round(seconds, 3), interrupted=interrupted)
+        summary.save()
+    if held.received and not interrupted:
+        interrupted = True
+        run["interrupted"] = True
+        summary.save()
     pending = [j.name for j in todo if j.name not in processed and j.name not in failed]
     result = BatchResult(
         processed,
@@ -580,7 +733,7 @@ def run_batch(
         failed_before=failed_before,
     )
     if interrupted:
-        raise KeyboardInterrupt
+        raise BatchInterrupted(result)
     return result
 
 
@@ -594,13 +747,13 @@ def _run_jobs(
     n_workers: int,
     log: Callable[[str], None] | None,
     progress: bool,
-) -> tuple[list[str], list[str], bool]:
+    processed: list[str],
+    failed: list[str],
+) -> None:
+    """Run ``todo`` on Dask, recording each pair as it finishes into ``processed`` / ``failed``
+    and the summary; a KeyboardInterrupt is raised on after Dask is stopped."""
     from tqdm import tqdm
 
-    processed: list[str] = []
-    failed: list[str] = []
-    client, cluster, desc = _start_client(scheduler, n_workers)
-    run["scheduler"] = desc
     bar = tqdm(
         total=len(todo),
         desc="pairs",
@@ -609,10 +762,13 @@ def _run_jobs(
         disable=not progress or not sys.stderr.isatty(),
     )
     futures: dict[Any, PairJob] = {}
-    interrupted = False
+    dask = _Dask()
     try:
         from distributed import as_completed
 
+        dask.start(scheduler, n_workers)
+        client = dask.client
+        run["scheduler"] = dask.desc
         n_live = len(client.scheduler_info().get("workers", {})) or n_workers
         limit = max(1, IN_FLIGHT_PER_WORKER * n_live)
         queue: Iterator[PairJob] = iter(todo)
@@ -674,32 +830,34 @@ def _run_jobs(
             fut.release()
             while len(futures) < limit and submit_next():
                 pass
-    except KeyboardInterrupt:
-        interrupted = True
-        for fut in list(futures):
-            fut.cancel()
     finally:
         bar.close()
-        try:
-            client.close()
-            if cluster is not None:
-                cluster.close()
-        except Exception:  # shutting down is best effort; the results are already written
-            pass
-    return processed, failed, interrupted
+        dask.close(list(futures))
 
 
 # ---------------------------------------------------------------------------------------- CLI
 
 
+def _raise_interrupt(signum: int, frame: FrameType | None) -> None:
+    raise KeyboardInterrupt
+
+
 def cmd_batch(args: argparse.Namespace) -> int:
-    """``stereovision batch INPUT -o OUT``: exit status 0, or 1 when a pair has no outputs."""
+    """``stereovision batch INPUT -o OUT``: exit status 0, 1 when a pair has no outputs, 130 when
+    interrupted (Ctrl-C or SIGTERM: one line, the summary marked as interrupted)."""
+    from stereovision.cli import EXIT_INTERRUPTED
 
     def log(line: str) -> None:
         from tqdm import tqdm
 
         tqdm.write(line, file=sys.stderr)
 
+    # SIGTERM (a service manager, `kill`) stops the run as Ctrl-C does, unless the caller
+    # already handles it (the CLI may turn it into a KeyboardInterrupt itself).
+    term = None
+    if threading.current_thread() is threading.main_thread():
+        if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
+            term = signal.signal(signal.SIGTERM, _raise_interrupt)
     try:
         res = run_batch(
             args.input,
@@ -715,13 +873,22 @@ def cmd_batch(args: argparse.Namespace) -> int:
             grid=args.grid,
             log=log,
         )
-    except KeyboardInterrupt:
-        print(
-            f"interrupted: finished pairs are in {args.output} and recorded in "
-            f"{Path(args.output) / SUMMARY_NAME}; run again to continue",
-            file=sys.stderr,
-        )
-        raise
+    except KeyboardInterrupt as exc:
+        if isinstance(exc, BatchInterrupted):
+            r = exc.result
+            done = len(r.processed) + len(r.failed)
+            print(
+                f"stereovision: interrupted: {done} of {done + len(r.pending)} pairs finished "
+                f"this run, in {args.output} and recorded in {r.summary_path}; run again to "
+                "continue",
+                file=sys.stderr,
+            )
+        else:  # while the input was searched: nothing written
+            print("stereovision: interrupted before any pair started", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    finally:
+        if term is not None:
+            signal.signal(signal.SIGTERM, term)
     again = (
         f", {len(res.failed_before)} skipped (failed before; --retry-failed redoes them)"
         if res.failed_before
