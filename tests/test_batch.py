@@ -444,3 +444,56 @@ def test_batch_keeps_a_sigterm_handler_that_raises_keyboardinterrupt(
     assert len(err) == 1 and err[0].startswith("stereovision: interrupted: "), err
     s = _summary(out)
     assert s["run"]["interrupted"] is True and 1 <= s["counts"]["done"] < 40
+
+
+def _tiny(root: Path, data_dir: Path, *names: str) -> None:
+    """A 96 x 64 crop of Tsukuba under each name: the left image's for ``...left...`` names."""
+    src = data_dir / "middlebury2001/tsukuba"
+    crops = {s: cv2.imread(str(src / f"{s}.png"))[100:164, 150:246] for s in ("left", "right")}
+    for name in names:
+        p = root / name
+        p.parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(p), crops["left" if "left" in p.name.lower() else "right"])
+
+
+def test_batch_reports_an_image_without_its_pair(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """left.png without right.png, x_left.png without x_right.png, y_right.png without
+    y_left.png: each a failed pair saying which file is missing, exit 1 (they were ignored:
+    "1 processed ... 0 failed", exit 0, nowhere in the summary). The pairs found are the same."""
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, "a/left.png", "a/right.png", "b/left.png", "c/x_left.png",
+          "c/y_right.png", "c/.z_left.png")  # fmt: skip
+    (root / "c/notes_left.txt").write_text("not an image")
+    assert [j.name for j in find_pairs(root)] == ["a"]
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 1
+    said = capsys.readouterr()
+    assert said.out.startswith(
+        "1 processed, 0 skipped (done before), 3 failed (3 with an image missing) in "
+    )
+    missing = {"b": ("right.png", "b/left.png"), "c/x": ("x_right.png", "c/x_left.png"),
+               "c/y": ("y_left.png", "c/y_right.png")}  # fmt: skip
+    s = _summary(out)
+    assert sorted(s["pairs"]) == ["a", "b", "c/x", "c/y"]
+    assert s["counts"] == {"done": 1, "failed": 3, "pending": 0}
+    assert s["run"]["pairs"] == 4 and s["run"]["unpaired"] == 3 and s["run"]["failed"] == 3
+    for name, (gone, there) in missing.items():
+        entry = s["pairs"][name]
+        error = f"unpaired image: no {gone} beside {root / there}"
+        assert entry["status"] == "failed" and entry["error"] == error
+        assert f"failed {name}: {error}" in said.err
+    assert s["pairs"]["c/y"]["left"] == str(root / "c/y_left.png")
+    # the missing image comes: that pair is done, the others stay failed
+    _tiny(root, data_dir, "b/right.png")
+    assert main(args) == 1
+    assert capsys.readouterr().out.startswith("1 processed, 1 skipped (done before), 2 failed (2 ")
+    assert _summary(out)["counts"] == {"done": 2, "failed": 2, "pending": 0}
+    # images without their pair only: the error says so
+    assert main(["batch", str(root / "c"), "-o", str(tmp_path / "o2")]) == 2
+    assert capsys.readouterr().err.strip() == (
+        f"stereovision: error: no pair under {root / 'c'} (scene folders with left.png + "
+        "right.png, or files named ...left... / ...right...); 2 image(s) without the other of "
+        f"their pair, e.g. no x_right.png beside {root / 'c/x_left.png'}"
+    )

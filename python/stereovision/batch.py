@@ -62,6 +62,7 @@ IN_FLIGHT_PER_WORKER = 2
 CONNECT_TIMEOUT = "10s"
 _SUMMARY_VERSION = 1
 _LEFT_RE = re.compile(r"left", re.IGNORECASE)
+_RIGHT_RE = re.compile(r"right", re.IGNORECASE)
 _SCENE_CALIB = "calib.txt"
 
 
@@ -85,20 +86,44 @@ class PairJob:
     calib: Path | None = None
 
 
-def _last_left(stem: str) -> re.Match[str] | None:
-    found = list(_LEFT_RE.finditer(stem))
+def _last(regex: re.Pattern[str], stem: str) -> re.Match[str] | None:
+    found = list(regex.finditer(stem))
     return found[-1] if found else None
 
 
-def _right_of(left: Path) -> Path | None:
-    """The ``right`` counterpart of a file whose stem contains ``left`` (its case kept)."""
-    m = _last_left(left.stem)
-    if m is None:
-        return None
+def _last_left(stem: str) -> re.Match[str] | None:
+    return _last(_LEFT_RE, stem)
+
+
+def _swap(path: Path, m: re.Match[str], to: str) -> Path:
+    """``path`` with the word ``m`` (``left`` or ``right``) replaced by ``to``, its case kept."""
     word = m.group(0)
-    right = "RIGHT" if word.isupper() else "Right" if word[0].isupper() else "right"
-    stem = left.stem[: m.start()] + right + left.stem[m.end() :]
-    return left.with_name(stem + left.suffix)
+    new = to.upper() if word.isupper() else to.title() if word[0].isupper() else to
+    return path.with_name(path.stem[: m.start()] + new + path.stem[m.end() :] + path.suffix)
+
+
+@dataclass(frozen=True)
+class _Unpaired:
+    """An image named as one of a pair whose other image is not there."""
+
+    name: str
+    present: Path
+    missing: Path
+    side: str  # of ``present``: "left" or "right"
+
+    @property
+    def error(self) -> str:
+        return f"unpaired image: no {self.missing.name} beside {self.present}"
+
+
+def _pair_name(p: Path, m: re.Match[str], rel: str, root: Path) -> str:
+    """``seq/0001`` for ``seq/left_0001.png``: the folder and the stem without the word ``m``
+    (and separators around it); the folder alone for ``left.jpg``, like a scene."""
+    before, after = p.stem[: m.start()].rstrip("_-. "), p.stem[m.end() :].lstrip("_-. ")
+    short = "_".join(x for x in (before, after) if x)
+    if not short:
+        return rel if rel != "." else root.resolve().name
+    return short if rel == "." else f"{rel}/{short}"
 
 
 def find_pairs(
@@ -112,7 +137,8 @@ def find_pairs(
     * Any other image whose name contains ``left`` (``left_0001.png`` as ``stereovision capture``
       saves them, ``cam_left.jpg``, ``0001_Left.png``) pairs with the file named with ``right``
       in its place; the pair is named by its folder and the file name without ``left`` (and
-      separators around it), e.g. ``seq/0001``. Files without a counterpart are ignored.
+      separators around it), e.g. ``seq/0001``. Files without a counterpart are not pairs
+      (:func:`run_batch` reports them as failed pairs).
 
     Parameters
     ----------
@@ -133,6 +159,15 @@ def find_pairs(
     NotADirectoryError
         If ``root`` is not a folder.
     """
+    return _scan(root, calib)[0]
+
+
+def _scan(
+    root: str | os.PathLike[str], calib: str | os.PathLike[str] | None = None
+) -> tuple[list[PairJob], list[_Unpaired]]:
+    """:func:`find_pairs`, and the images named as one of a pair without the other: a ``left``
+    image without its ``right`` one, a ``right`` image (no ``left`` in its name) without its
+    ``left`` one; named as their pair would be, after the pairs' names."""
     r = Path(root)
     if not r.exists():
         raise FileNotFoundError(f"input folder not found: {r}")
@@ -148,12 +183,14 @@ def find_pairs(
 
         Calibration.from_file(cal)
     found: list[PairJob] = []
+    unpaired: list[_Unpaired] = []
     for d, _dirs, files in os.walk(r):
         dirs = sorted(_dirs)
         _dirs[:] = [x for x in dirs if not x.startswith(".")]
         here = Path(d)
         rel = here.relative_to(r).as_posix()
         names = set(files)
+        paired: set[str] = set()
         if "left.png" in names and "right.png" in names:
             scene_cal = here / _SCENE_CALIB if _SCENE_CALIB in names else None
             found.append(
@@ -164,22 +201,27 @@ def find_pairs(
                     cal if cal is not None else scene_cal,
                 )
             )
-        for f in sorted(files):
+            paired |= {"left.png", "right.png"}
+        images = [f for f in sorted(files) if Path(f).suffix.lower() in IMAGE_EXTS and f[0] != "."]
+        for f in images:
             p = here / f
-            if p.suffix.lower() not in IMAGE_EXTS or f == "left.png" or f.startswith("."):
-                continue
-            rp = _right_of(p)
-            if rp is None or rp.name not in names:
-                continue
             m = _last_left(p.stem)
-            assert m is not None
-            before, after = p.stem[: m.start()].rstrip("_-. "), p.stem[m.end() :].lstrip("_-. ")
-            short = "_".join(x for x in (before, after) if x)
-            if not short:  # "left.jpg": named by its folder, like a scene
-                short = rel if rel != "." else r.resolve().name
-                found.append(PairJob(short, p, rp, cal))
+            if m is None or f in paired:
                 continue
-            found.append(PairJob(short if rel == "." else f"{rel}/{short}", p, rp, cal))
+            rp = _swap(p, m, "right")
+            if rp.name not in names:
+                unpaired.append(_Unpaired(_pair_name(p, m, rel, r), p, rp, "left"))
+                continue
+            found.append(PairJob(_pair_name(p, m, rel, r), p, rp, cal))
+            paired |= {f, rp.name}
+        for f in images:
+            p = here / f
+            m = _last(_RIGHT_RE, p.stem)
+            if m is None or f in paired or _last_left(p.stem) is not None:
+                continue
+            lp = _swap(p, m, "left")
+            if lp.name not in names:
+                unpaired.append(_Unpaired(_pair_name(p, m, rel, r), p, lp, "right"))
     found.sort(key=lambda j: j.name)
     seen: dict[str, int] = {}
     unique: list[PairJob] = []
@@ -187,7 +229,17 @@ def find_pairs(
         n = seen.get(j.name, 0)
         seen[j.name] = n + 1
         unique.append(j if n == 0 else PairJob(f"{j.name}~{n + 1}", j.left, j.right, j.calib))
-    return unique
+    # the pairs keep the names they had before these were reported; these take the next ones
+    taken = {j.name for j in unique}
+    named: list[_Unpaired] = []
+    for u in sorted(unpaired, key=lambda u: (u.name, u.present.name)):
+        name, n = u.name, 1
+        while name in taken:
+            n += 1
+            name = f"{u.name}~{n}"
+        taken.add(name)
+        named.append(_Unpaired(name, u.present, u.missing, u.side))
+    return unique, named
 
 
 # ------------------------------------------------------------------------------- the worker
@@ -317,6 +369,9 @@ class BatchResult:
         Pair names, by outcome in this run (``skipped``: done before).
     failed_before : list of str
         Pairs skipped because they failed before on the same inputs and options.
+    unpaired : list of str
+        Images named as one of a pair whose other image is missing (``failed`` lists them
+        too; their summary entry says which file is missing).
     pending : list of str
         Pairs not finished (interrupted run).
     seconds : float
@@ -335,6 +390,7 @@ class BatchResult:
     summary_path: Path
     interrupted: bool = False
     failed_before: list[str] = field(default_factory=list)
+    unpaired: list[str] = field(default_factory=list)
 
 
 class BatchInterrupted(KeyboardInterrupt):
@@ -644,11 +700,17 @@ def run_batch(
     if max_disparity is not None and max_disparity <= 0:
         raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
     t0 = time.perf_counter()
-    jobs = find_pairs(input_dir, calib)
+    jobs, unpaired = _scan(input_dir, calib)
     if not jobs:
+        alone = (
+            f"; {len(unpaired)} image(s) without the other of their pair, e.g. no "
+            f"{unpaired[0].missing.name} beside {unpaired[0].present}"
+            if unpaired
+            else ""
+        )
         raise ValueError(
             f"no pair under {input_dir} (scene folders with left.png + right.png, or "
-            "files named ...left... / ...right...)"
+            f"files named ...left... / ...right...){alone}"
         )
     out = Path(output_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -680,20 +742,35 @@ def run_batch(
             "fingerprint": fp,
         }
         todo.append(job)
+    processed: list[str] = []
+    failed: list[str] = []
+    for u in unpaired:  # a failed pair, every run until the missing image is there
+        left, right = (u.present, u.missing) if u.side == "left" else (u.missing, u.present)
+        summary.pairs[u.name] = {
+            "status": "failed",
+            "left": str(left),
+            "right": str(right),
+            "calib": None,
+            "error": u.error,
+            "finished": _now(),
+            "this_run": "failed",
+        }
+        failed.append(u.name)
+        if log is not None:
+            log(f"failed {u.name}: {u.error}")
     n_workers = workers or os.cpu_count() or 1
     run: dict[str, Any] = {
         "started": _now(),
         "scheduler": None,
-        "pairs": len(jobs),
+        "pairs": len(jobs) + len(unpaired),
         "processed": 0,
         "skipped": len(skipped),
         "skipped_failed": len(failed_before),
-        "failed": 0,
+        "failed": len(failed),
+        "unpaired": len(unpaired),
         "interrupted": False,
     }
     summary.data["run"] = run
-    processed: list[str] = []
-    failed: list[str] = []
     interrupted = False
     try:
         summary.save()
@@ -731,6 +808,7 @@ def run_batch(
         summary.path,
         interrupted=interrupted,
         failed_before=failed_before,
+        unpaired=[u.name for u in unpaired],
     )
     if interrupted:
         raise BatchInterrupted(result)
@@ -894,9 +972,10 @@ def cmd_batch(args: argparse.Namespace) -> int:
         if res.failed_before
         else ""
     )
+    alone = f" ({len(res.unpaired)} with an image missing)" if res.unpaired else ""
     print(
         f"{len(res.processed)} processed, {len(res.skipped)} skipped (done before){again}, "
-        f"{len(res.failed)} failed in {res.seconds:.1f} s; summary: {res.summary_path}"
+        f"{len(res.failed)} failed{alone} in {res.seconds:.1f} s; summary: {res.summary_path}"
     )
     if res.failed_before and not res.failed:
         # the exit status counts every pair without outputs, this run's failures or earlier ones
