@@ -497,3 +497,30 @@ def test_batch_reports_an_image_without_its_pair(
         "right.png, or files named ...left... / ...right...); 2 image(s) without the other of "
         f"their pair, e.g. no x_right.png beside {root / 'c/x_left.png'}"
     )
+
+
+def test_batch_progress_lines_when_stderr_is_not_a_terminal(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Without a terminal (a log file, a pipe) a plain line every tenth of the pairs, or every
+    PROGRESS_SECONDS (there was none: tqdm only shows on a terminal)."""
+    import stereovision.batch as batch
+
+    root = tmp_path / "in"
+    _tiny(root, data_dir, *(f"seq/{i:04d}_{s}.png" for i in range(12) for s in ("left", "right")))
+    args = ["batch", str(root), "--workers", "1", "--max-disparity", "16"]
+    line = re.compile(r"batch: (\d+)/12 pairs, \d+ s, about \d+ s left")
+
+    def counts() -> list[int]:
+        err = capsys.readouterr().err.splitlines()
+        assert all(line.fullmatch(x) for x in err), err
+        return [int(m[1]) for x in err if (m := line.fullmatch(x))]
+
+    assert main([*args, "-o", str(tmp_path / "o1")]) == 0
+    assert counts() == [2, 4, 6, 8, 10]  # every tenth, rounded up: 2 pairs
+    monkeypatch.setattr(batch, "PROGRESS_SECONDS", 0.0)
+    assert main([*args, "-o", str(tmp_path / "o2")]) == 0
+    assert counts() == list(range(1, 12))
