@@ -524,3 +524,50 @@ def test_batch_progress_lines_when_stderr_is_not_a_terminal(
     monkeypatch.setattr(batch, "PROGRESS_SECONDS", 0.0)
     assert main([*args, "-o", str(tmp_path / "o2")]) == 0
     assert counts() == list(range(1, 12))
+
+
+def test_batch_output_folder_moved_during_the_run(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The output folder moved away after two pairs: the pairs written before are counted as
+    missing (pending in the summary), exit 1, and a re-run redoes them (the summary said all
+    were done, exit 0)."""
+    import stereovision.batch as batch
+
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, *(f"seq/{i:04d}_{s}.png" for i in range(4) for s in ("left", "right")))
+    commit = batch._commit_pair
+    written: list[str] = []
+
+    def commit_then_move(out_dir: Path, name: str, files: dict[str, bytes]) -> Path:
+        dest = commit(out_dir, name, files)
+        written.append(name)
+        if len(written) == 2:
+            out_dir.rename(tmp_path / "moved")
+        return dest
+
+    monkeypatch.setattr(batch, "_commit_pair", commit_then_move)
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 1
+    said = capsys.readouterr()
+    assert said.out.splitlines()[1] == (
+        f"exit status 1: 2 pair(s) recorded as done have no outputs in {out} any more (moved or "
+        "deleted during the run?); run again to redo them"
+    )
+    assert f"{out} is gone (moved or deleted?): made again for the pairs to come" in said.err
+    s = _summary(out)
+    assert s["counts"] == {"done": 2, "failed": 0, "pending": 2} and s["run"]["missing"] == 2
+    for name in written[:2]:
+        assert (
+            s["pairs"][name]["status"] == "pending"
+            and "moved or deleted" in s["pairs"][name]["note"]
+        )
+        assert not (out / name).exists() and (tmp_path / "moved" / name / "disparity.pfm").is_file()
+    monkeypatch.setattr(batch, "_commit_pair", commit)
+    assert main(args) == 0
+    s = _summary(out)
+    assert s["run"]["processed"] == 2 and s["run"]["skipped"] == 2 and s["run"]["missing"] == 0
+    assert s["counts"] == {"done": 4, "failed": 0, "pending": 0}

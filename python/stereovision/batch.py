@@ -67,6 +67,7 @@ _SUMMARY_VERSION = 1
 _LEFT_RE = re.compile(r"left", re.IGNORECASE)
 _RIGHT_RE = re.compile(r"right", re.IGNORECASE)
 _SCENE_CALIB = "calib.txt"
+_GONE = "its outputs were gone at the end of the run (the output folder moved or deleted?)"
 
 
 @dataclass(frozen=True)
@@ -375,6 +376,9 @@ class BatchResult:
     unpaired : list of str
         Images named as one of a pair whose other image is missing (``failed`` lists them
         too; their summary entry says which file is missing).
+    missing : list of str
+        Pairs recorded as done whose outputs were not in the output folder at the end of the run
+        (it was moved or deleted meanwhile); recorded as pending, so that a re-run redoes them.
     pending : list of str
         Pairs not finished (interrupted run).
     seconds : float
@@ -394,6 +398,7 @@ class BatchResult:
     interrupted: bool = False
     failed_before: list[str] = field(default_factory=list)
     unpaired: list[str] = field(default_factory=list)
+    missing: list[str] = field(default_factory=list)
 
 
 class BatchInterrupted(KeyboardInterrupt):
@@ -413,8 +418,9 @@ class BatchInterrupted(KeyboardInterrupt):
 class _Summary:
     """``OUT/summary.json``: one entry per pair, rewritten atomically after every change."""
 
-    def __init__(self, out: Path) -> None:
+    def __init__(self, out: Path, log: Callable[[str], None] | None = None) -> None:
         self.path = out / SUMMARY_NAME
+        self.log = log
         self.data: dict[str, Any] = {"version": _SUMMARY_VERSION, "pairs": {}}
         if self.path.is_file():
             try:
@@ -428,10 +434,19 @@ class _Summary:
     def pairs(self) -> dict[str, Any]:
         return self.data["pairs"]  # type: ignore[no-any-return]
 
+    def ensure_folder(self) -> None:
+        """Make the output folder again if it went away (moved or deleted during the run)."""
+        folder = self.path.parent
+        if not folder.is_dir():
+            if self.log is not None:
+                self.log(f"{folder} is gone (moved or deleted?): made again for the pairs to come")
+            folder.mkdir(parents=True, exist_ok=True)
+
     def save(self) -> None:
         from stereovision.io import atomic_write
 
         pairs = self.pairs.values()
+        self.ensure_folder()
         self.data["counts"] = {
             s: sum(1 for p in pairs if p.get("status") == s) for s in ("done", "failed", "pending")
         }
@@ -718,7 +733,7 @@ def run_batch(
         )
     out = Path(output_dir)
     out.mkdir(parents=True, exist_ok=True)
-    summary = _Summary(out)
+    summary = _Summary(out, log)
     opts: dict[str, Any] = {"method": method, "max_disparity": max_disparity, "fill": fill}
     if ground:  # only when asked: outputs of earlier runs without it stay valid
         opts.update(ground=True, grid=grid)
@@ -795,8 +810,11 @@ def run_batch(
     except KeyboardInterrupt:
         interrupted = True
     with _HeldInterrupts(replay=False) as held:  # the record of the run is written whole
+        gone = _outputs_gone(out, summary, [j.name for j in jobs])
         seconds = time.perf_counter() - t0
-        run.update(finished=_now(), seconds=round(seconds, 3), interrupted=interrupted)
+        run.update(
+            finished=_now(), seconds=round(seconds, 3), interrupted=interrupted, missing=len(gone)
+        )
         summary.save()
     if held.received and not interrupted:
         interrupted = True
@@ -813,10 +831,23 @@ def run_batch(
         interrupted=interrupted,
         failed_before=failed_before,
         unpaired=[u.name for u in unpaired],
+        missing=gone,
     )
     if interrupted:
         raise BatchInterrupted(result)
     return result
+
+
+def _outputs_gone(out: Path, summary: _Summary, names: list[str]) -> list[str]:
+    """The pairs of ``names`` recorded as done whose outputs are not in ``out`` (moved or
+    deleted during the run), recorded as pending with a note: the next run redoes them."""
+    gone = []
+    for name in names:
+        entry = summary.pairs.get(name)
+        if entry and entry.get("status") == "done" and not (out / name / "disparity.pfm").is_file():
+            entry.update(status="pending", note=_GONE)
+            gone.append(name)
+    return gone
 
 
 class _Progress:
@@ -923,6 +954,7 @@ def _run_jobs(
                 record_failure(job, exc)
             else:
                 res = fut.result()
+                summary.ensure_folder()
                 _commit_pair(out, job.name, res["files"])
                 entry = summary.pairs[job.name]
                 entry.update(
@@ -1016,7 +1048,12 @@ def cmd_batch(args: argparse.Namespace) -> int:
     if res.failed_before and not res.failed:
         # the exit status counts every pair without outputs, this run's failures or earlier ones
         print(f"exit status 1: {len(res.failed_before)} pair(s) still without outputs")
-    return 1 if res.failed or res.failed_before else 0
+    if res.missing:
+        print(
+            f"exit status 1: {len(res.missing)} pair(s) recorded as done have no outputs in "
+            f"{args.output} any more (moved or deleted during the run?); run again to redo them"
+        )
+    return 1 if res.failed or res.failed_before or res.missing else 0
 
 
 def add_cli(subparsers: Any) -> None:
