@@ -571,3 +571,33 @@ def test_batch_output_folder_moved_during_the_run(
     s = _summary(out)
     assert s["run"]["processed"] == 2 and s["run"]["skipped"] == 2 and s["run"]["missing"] == 0
     assert s["counts"] == {"done": 4, "failed": 0, "pending": 0}
+
+
+def test_batch_says_when_other_options_redo_finished_pairs(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Another --method redoes every finished pair: one line says so before (it was silent)."""
+    from stereovision.batch import _changes
+
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, *(f"seq/{i:04d}_{s}.png" for i in range(2) for s in ("left", "right")))
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main([*args, "--method", "fast"]) == 0
+    assert "other options" not in capsys.readouterr().err
+    assert main([*args, "--method", "census"]) == 0
+    said = capsys.readouterr()
+    assert said.out.startswith("2 processed, 0 skipped (done before), 0 failed in ")
+    assert said.err.splitlines()[0] == (
+        "2 pair(s) were done with other options (method: fast -> census); they are redone and "
+        "their outputs replaced"
+    )
+    assert all(p["options"]["method"] == "census" for p in _summary(out)["pairs"].values())
+    assert main([*args, "--method", "census"]) == 0  # the same options: skipped, nothing said
+    said = capsys.readouterr()
+    assert "other options" not in said.err and said.out.startswith("0 processed, 2 skipped")
+    # --ground added to a run made without it (whose options have no ground key)
+    before = {"method": None, "max_disparity": None, "fill": None}
+    assert _changes(before, {**before, "ground": True, "grid": 0.2}) == [
+        "ground: off -> on",
+        "grid: default -> 0.2",
+    ]

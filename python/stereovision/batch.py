@@ -379,6 +379,8 @@ class BatchResult:
     missing : list of str
         Pairs recorded as done whose outputs were not in the output folder at the end of the run
         (it was moved or deleted meanwhile); recorded as pending, so that a re-run redoes them.
+    redone : list of str
+        Pairs done before on the same images with other options, redone (outputs replaced).
     pending : list of str
         Pairs not finished (interrupted run).
     seconds : float
@@ -399,6 +401,7 @@ class BatchResult:
     failed_before: list[str] = field(default_factory=list)
     unpaired: list[str] = field(default_factory=list)
     missing: list[str] = field(default_factory=list)
+    redone: list[str] = field(default_factory=list)
 
 
 class BatchInterrupted(KeyboardInterrupt):
@@ -457,6 +460,18 @@ class _Summary:
 
 def _unchanged(entry: dict[str, Any] | None, fp: dict[str, Any], opts: dict[str, Any]) -> bool:
     return entry is not None and entry.get("fingerprint") == fp and entry.get("options") == opts
+
+
+def _changes(old: dict[str, Any], new: dict[str, Any]) -> list[str]:
+    """``method: gabor -> census`` for each option that differs (no ``ground`` key: off)."""
+
+    def show(v: Any) -> str:
+        return "default" if v is None else "on" if v is True else "off" if v is False else str(v)
+
+    a, b = {"ground": False, "grid": None, **old}, {"ground": False, "grid": None, **new}
+    return [
+        f"{k}: {show(a.get(k))} -> {show(b.get(k))}" for k in {**a, **b} if a.get(k) != b.get(k)
+    ]
 
 
 def _skip(
@@ -687,7 +702,8 @@ def run_batch(
         Also redo the pairs that failed before on the same inputs (by default a failed pair is
         redone only once its files or the options change).
     log : callable, optional
-        Receives one line per failed pair.
+        Receives one line per failed pair, and notes: pairs done before with other options
+        (redone), an output folder that went away during the run.
     progress : bool
         Show a progress bar on a terminal (stderr), else a plain line on stderr every tenth of
         the pairs or every :data:`PROGRESS_SECONDS`.
@@ -744,6 +760,8 @@ def run_batch(
     todo: list[PairJob] = []
     skipped: list[str] = []
     failed_before: list[str] = []
+    redone: list[str] = []
+    changes: set[str] = set()
     for job in jobs:
         fp = _fingerprint(job)
         entry = summary.pairs.get(job.name)
@@ -752,6 +770,14 @@ def run_batch(
             entry["this_run"] = "skipped"
             (skipped if entry["status"] == "done" else failed_before).append(job.name)
             continue
+        if (
+            entry is not None
+            and entry.get("status") == "done"
+            and entry.get("fingerprint") == fp
+            and (out / job.name / "disparity.pfm").is_file()
+        ):  # done on the same images, with other options: its outputs are replaced
+            redone.append(job.name)
+            changes.update(_changes(entry.get("options") or {}, opts))
         summary.pairs[job.name] = {
             "status": "pending",
             "left": str(job.left),
@@ -761,6 +787,12 @@ def run_batch(
             "fingerprint": fp,
         }
         todo.append(job)
+    if redone and log is not None:
+        shown = sorted(changes)[:3] + (["..."] if len(changes) > 3 else [])
+        log(
+            f"{len(redone)} pair(s) were done with other options ({'; '.join(shown)}); they are "
+            "redone and their outputs replaced"
+        )
     processed: list[str] = []
     failed: list[str] = []
     for u in unpaired:  # a failed pair, every run until the missing image is there
@@ -832,6 +864,7 @@ def run_batch(
         failed_before=failed_before,
         unpaired=[u.name for u in unpaired],
         missing=gone,
+        redone=redone,
     )
     if interrupted:
         raise BatchInterrupted(result)
