@@ -32,7 +32,7 @@ import tempfile
 import threading
 import time
 import uuid
-from collections.abc import Callable, Iterable, Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import FrameType, TracebackType
@@ -623,11 +623,11 @@ class _Dask:
             else:
                 _in_thread_without_sigint(local)
 
-    def close(self, futures: Iterable[Any] = ()) -> None:
+    def close(self, futures: list[Any]) -> None:
         with _HeldInterrupts():
             try:
-                for fut in futures:
-                    fut.cancel()
+                if self.client is not None and futures:
+                    self.client.cancel(futures)
                 if self.client is not None:
                     self.client.close()
                 if self.cluster is not None:
@@ -1062,8 +1062,12 @@ def cmd_batch(args: argparse.Namespace) -> int:
                 "continue",
                 file=sys.stderr,
             )
-        else:  # while the input was searched: nothing written
-            print("stereovision: interrupted before any pair started", file=sys.stderr)
+        else:  # while the input was searched, or a second Ctrl-C
+            print(
+                f"stereovision: interrupted; finished pairs are kept in {args.output}, run again "
+                "to continue",
+                file=sys.stderr,
+            )
         return EXIT_INTERRUPTED
     finally:
         if term is not None:
@@ -1099,7 +1103,8 @@ def add_cli(subparsers: Any) -> None:
         description="Process every scene folder (left.png + right.png) or ...left.../...right... "
         "image pair under INPUT into OUT/<name>/ (the files `stereovision depth` writes), "
         "recorded in OUT/summary.json; a re-run skips finished pairs. Exit status 1 when a pair "
-        "failed (its error is in the summary), 2 on errors.",
+        "failed (its error is in the summary), 2 on errors, 130 when interrupted (Ctrl-C, "
+        "SIGTERM).",
     )
     p.add_argument("input", help="folder with scene folders or left/right image pairs")
     p.add_argument("-o", "--output", required=True, help="output folder")
