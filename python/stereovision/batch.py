@@ -823,6 +823,7 @@ def run_batch(
     }
     summary.data["run"] = run
     interrupted = False
+    cause: KeyboardInterrupt | None = None
     try:
         summary.save()
         if todo:
@@ -839,8 +840,9 @@ def run_batch(
                 processed,
                 failed,
             )
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         interrupted = True
+        cause = exc
     with _HeldInterrupts(replay=False) as held:  # the record of the run is written whole
         gone = _outputs_gone(out, summary, [j.name for j in jobs])
         seconds = time.perf_counter() - t0
@@ -867,7 +869,7 @@ def run_batch(
         redone=redone,
     )
     if interrupted:
-        raise BatchInterrupted(result)
+        raise BatchInterrupted(result) from cause
     return result
 
 
@@ -1023,8 +1025,10 @@ def _raise_interrupt(signum: int, frame: FrameType | None) -> None:
 
 def cmd_batch(args: argparse.Namespace) -> int:
     """``stereovision batch INPUT -o OUT``: exit status 0, 1 when a pair has no outputs, 130 when
-    interrupted (Ctrl-C or SIGTERM: one line, the summary marked as interrupted)."""
-    from stereovision.cli import EXIT_INTERRUPTED
+    interrupted (Ctrl-C), 143 when terminated (SIGTERM): one line, the summary marked as
+    interrupted."""
+    from stereovision._interrupt import Terminated
+    from stereovision.cli import EXIT_INTERRUPTED, EXIT_TERMINATED
 
     def log(line: str) -> None:
         from tqdm import tqdm
@@ -1053,22 +1057,24 @@ def cmd_batch(args: argparse.Namespace) -> int:
             log=log,
         )
     except KeyboardInterrupt as exc:
+        terminated = isinstance(exc, Terminated) or isinstance(exc.__cause__, Terminated)
+        what = "terminated (SIGTERM)" if terminated else "interrupted"
         if isinstance(exc, BatchInterrupted):
             r = exc.result
             done = len(r.processed) + len(r.failed)
             print(
-                f"stereovision: interrupted: {done} of {done + len(r.pending)} pairs finished "
+                f"stereovision: {what}: {done} of {done + len(r.pending)} pairs finished "
                 f"this run, in {args.output} and recorded in {r.summary_path}; run again to "
                 "continue",
                 file=sys.stderr,
             )
         else:  # while the input was searched, or a second Ctrl-C
             print(
-                f"stereovision: interrupted; finished pairs are kept in {args.output}, run again "
+                f"stereovision: {what}; finished pairs are kept in {args.output}, run again "
                 "to continue",
                 file=sys.stderr,
             )
-        return EXIT_INTERRUPTED
+        return EXIT_TERMINATED if terminated else EXIT_INTERRUPTED
     finally:
         if term is not None:
             signal.signal(signal.SIGTERM, term)
@@ -1103,8 +1109,8 @@ def add_cli(subparsers: Any) -> None:
         description="Process every scene folder (left.png + right.png) or ...left.../...right... "
         "image pair under INPUT into OUT/<name>/ (the files `stereovision depth` writes), "
         "recorded in OUT/summary.json; a re-run skips finished pairs. Exit status 1 when a pair "
-        "failed (its error is in the summary), 2 on errors, 130 when interrupted (Ctrl-C, "
-        "SIGTERM).",
+        "failed (its error is in the summary), 2 on errors, 130 when interrupted (Ctrl-C), 143 "
+        "when terminated (SIGTERM).",
     )
     p.add_argument("input", help="folder with scene folders or left/right image pairs")
     p.add_argument("-o", "--output", required=True, help="output folder")
