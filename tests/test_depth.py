@@ -358,3 +358,19 @@ def test_filtered_keeps_a_working_range_and_trusted_depths(data_dir: Path) -> No
     bare = sv.depth_map(scene.left, scene.right, None, method="gabor", max_disparity=32)
     with pytest.raises(ValueError, match="no depth to filter"):
         bare.filtered(max_depth=5.0)
+
+
+def test_results_print_as_summaries() -> None:
+    """At a prompt a DepthResult printed 3.5 kB of arrays; it and Matches now say what they
+    hold in one line."""
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")  # with its calib.txt
+    res = sv.depth_map(s.left, s.right, s.calib, method="fast", max_disparity=64)
+    text = repr(res)
+    assert text.startswith("DepthResult(method='fast'; 450x375; disparity [0, 64] px, 100.0 %")
+    z = res.depth[np.isfinite(res.depth)]
+    assert f"(median {np.median(z):.3g} m)" in text and f"; {len(res.points)} points;" in text
+    assert len(text) < 250 and "\n" not in text
+    assert "no calibration: no depth" in repr(sv.depth_map(s.left, s.right, method="fast"))
+    m = sv.match(s.left, s.right, method="hopfield", max_disparity=64)
+    assert repr(m).startswith(f"Matches({len(m)} matches in 450x375; disparity ")
+    assert repr(sv.Matches(*(np.zeros(0),) * 5, image_shape=(4, 5))) == "Matches(0 matches in 5x4)"

@@ -280,6 +280,32 @@ class DepthResult:
         """Fraction of pixels with a disparity estimate."""
         return float(self.valid.mean())
 
+    def __repr__(self) -> str:
+        # A summary, not the arrays (the dataclass repr printed 3.5 kB of them at a prompt).
+        h, w = self.disparity.shape[:2]
+        parts = [
+            f"method={self.method!r}",
+            f"{w}x{h}",
+            f"disparity [{self.min_disparity:g}, {self.max_disparity}] px, "
+            f"{100 * self.density:.1f} % of pixels",
+        ]
+        if self.depth is not None:
+            z = self.depth[np.isfinite(self.depth)]
+            parts.append(
+                f"depth {float(z.min()):.3g}-{float(z.max()):.3g} m (median "
+                f"{float(np.median(z)):.3g} m) on {100 * z.size / self.depth.size:.1f} %"
+                if z.size
+                else "no depth"
+            )
+            parts.append(f"{len(self.points)} points")
+        else:
+            parts.append("no calibration: no depth")
+        if self.limits:
+            parts.append("limits " + ", ".join(f"{k}={v:g}" for k, v in self.limits.items()))
+        if self.timings:
+            parts.append(f"{1e3 * sum(self.timings.values()):.0f} ms")
+        return f"DepthResult({'; '.join(parts)})"
+
     def point_image(self, *, filled: bool = False) -> npt.NDArray[np.float32]:
         """``(H, W, 3)`` float32 points in metres, NaN where the pixel has none.
 

@@ -80,6 +80,19 @@ class Matches:
     def __len__(self) -> int:
         return int(self.xl.shape[0])
 
+    def __repr__(self) -> str:
+        # A summary, not the five arrays (``to_array()`` gives the numbers).
+        h, w = self.image_shape
+        n = len(self)
+        if n == 0:
+            return f"Matches(0 matches in {w}x{h})"
+        d = self.xl - self.xr
+        return (
+            f"Matches({n} matches in {w}x{h}; disparity {float(d.min()):.2f}-"
+            f"{float(d.max()):.2f} px (median {float(np.median(d)):.2f}); score "
+            f"{float(self.score.min()):.3g}-{float(self.score.max()):.3g})"
+        )
+
     def _raster(self, values: F32) -> F32:
         h, w = self.image_shape
         out = np.full((h, w), np.nan, dtype=np.float32)
