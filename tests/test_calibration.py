@@ -60,7 +60,8 @@ def test_valid_calibration_properties() -> None:
     r = rect_calib()
     assert r.baseline == 100.0 and r.baseline_m == pytest.approx(0.1)
     assert r.to_metres_factor == 1e-3 and r.focal_px == 500.0 and r.doffs_px == 0.0
-    assert rect_calib(unit="ft").baseline_m == pytest.approx(30.48)
+    with pytest.warns(UserWarning, match=r"baseline 100 ft = 30.48 m, longer than a robot's"):
+        assert rect_calib(unit="ft").baseline_m == pytest.approx(30.48)
     # OpenCV-shaped inputs: (1, 5) distortion and (3, 1) translation
     c2 = raw_calib(D1=np.zeros((1, 5)), T=np.array([[-0.12], [0.0], [0.0]]))
     assert c2.D1.shape == (5,) and c2.T.shape == (3,)

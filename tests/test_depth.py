@@ -374,3 +374,81 @@ def test_results_print_as_summaries() -> None:
     m = sv.match(s.left, s.right, method="hopfield", max_disparity=64)
     assert repr(m).startswith(f"Matches({len(m)} matches in 450x375; disparity ")
     assert repr(sv.Matches(*(np.zeros(0),) * 5, image_shape=(4, 5))) == "Matches(0 matches in 5x4)"
+
+
+def test_a_result_owns_its_arrays_and_a_filtered_copy_is_a_copy() -> None:
+    """The result kept the caller's left image (a camera loop refilling its frame blackened
+    the cloud written later), and filtered()'s 'copy' shared the disparity map."""
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")
+    left = s.left.copy()
+    res = sv.depth_map(left, s.right, s.calib, method="fast", cloud=False)
+    assert not np.may_share_memory(res.left_rectified, left)
+    kept = res.left_rectified.copy()
+    left[:] = 0  # cap.read(left) for the next frame
+    np.testing.assert_array_equal(res.left_rectified, kept)
+    f = res.filtered(max_depth=3.0)
+    f.disparity[0, 0] = -999.0
+    assert res.disparity[0, 0] != -999.0
+    with pytest.raises(ValueError, match=r"min_depth, max_depth: an empty range, 5 > 3 m"):
+        res.filtered(min_depth=5, max_depth=3)
+
+
+def test_pair_and_calibration_mistakes_are_named() -> None:
+    """A grey and a colour image made a pair (match() refused it); calibration= failed as an
+    unknown fusion option; a size error always suggested scaled_to, even for swapped sizes or
+    another aspect ratio (scaled_to then stretches the intrinsics)."""
+    import dataclasses
+
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")
+    grey = s.left[:, :, 0].copy()
+    with pytest.raises(ValueError, match=r"same shape, got left \(375, 450\) and right \(375, "):
+        sv.depth_map(grey, s.right, method="fast")
+    with pytest.raises(TypeError, match="the calibration is the argument calib, not calibration"):
+        sv.depth_map(s.left, s.right, calibration=s.calib)
+    swapped = dataclasses.replace(s.calib, image_size=(375, 450))
+    with pytest.raises(ValueError, match=r"450x375 \(width and height swapped\? image_size is"):
+        sv.depth_map(s.left, s.right, swapped)
+    other = dataclasses.replace(s.calib, image_size=(640, 480))
+    with pytest.raises(ValueError, match=r"got 450x375 \(another aspect ratio: another camera"):
+        sv.depth_map(s.left, s.right, other)
+    half = dataclasses.replace(s.calib, image_size=(900, 750))
+    with pytest.raises(ValueError, match=r"calib.scaled_to\(\(450, 375\)\)"):
+        sv.depth_map(s.left, s.right, half)
+
+
+def test_a_whole_result_or_a_wrong_unit_is_named(tmp_path: Path) -> None:
+    """A DepthResult passed where one of its arrays is meant failed deep inside ("float()
+    argument must be ... not 'DepthResult'"); to_ply('x.pcd') wrote PLY bytes, a depth PNG named
+    .jpg was PNG bytes, and a depth map in millimetres wrote an all-zero image silently; a
+    12-bit image in uint16 reached the matchers as 0-16 grey levels without a word."""
+    import warnings
+
+    from stereovision import export
+    from stereovision.evaluate import dense_metrics
+    from stereovision.ground import fit_ground_plane
+
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")
+    res = sv.depth_map(s.left, s.right, s.calib, method="fast")
+    with pytest.raises(TypeError, match=r"disparity: got a DepthResult; pass its array, result.d"):
+        fit_ground_plane(res, s.calib)
+    with pytest.raises(TypeError, match=r"disp: got a DepthResult; pass its array, result.disp"):
+        dense_metrics(res, s.gt)
+    with pytest.raises(TypeError, match=r"points: got a DepthResult; pass its array, result.poi"):
+        export.voxel_downsample(res, 0.05)
+    with pytest.raises(ValueError, match=r"cloud.pcd: to_ply writes a .ply file"):
+        res.to_ply(tmp_path / "cloud.pcd")
+    with pytest.raises(ValueError, match=r"d.jpg: a 16-bit depth image is written as .png"):
+        export.write_depth_png(tmp_path / "d.jpg", res)
+    assert not (tmp_path / "d.jpg").exists()
+    with pytest.warns(UserWarning, match=r"depth: none of its \d+ values fits 1..65535 at scale"):
+        export.write_depth_png(tmp_path / "mm.png", res.depth * 1000)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        export.write_depth_png(tmp_path / "m.png", res)
+    twelve = s.left.astype(np.uint16) * 16  # a 12-bit camera's image
+    with pytest.warns(UserWarning, match=r"left: uint16 image whose largest value is 4080 \(12"):
+        sv.depth_map(twelve, s.right.astype(np.uint16) * 16, method="fast")
+    from stereovision import render
+
+    with pytest.raises(ValueError, match=r"max_side: expected at least 16 pixels, got 0"):
+        render.render_result(res, max_side=0)  # was a ZeroDivisionError

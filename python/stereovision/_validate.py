@@ -100,9 +100,33 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
     return arr
 
 
+#: A uint16 image whose values all lie below this is most likely 12-bit (or 8-bit) data in a
+#: 16-bit container: scaled as 16-bit, the 8-bit paths keep 4 bits of it (or none).
+LOW_UINT16_MAX = 4096
+
+
+def _warn_low_uint16(arr: np.ndarray, name: str) -> None:
+    """Warn when a uint16 image uses only its lowest 12 bits: it is scaled by 65535 (by 257 to
+    8 bits), so a 12-bit camera's image reaches the matchers as 0-16 grey levels."""
+    import warnings
+
+    top = int(arr.max())
+    if top < LOW_UINT16_MAX:
+        warnings.warn(
+            f"{name}: uint16 image whose largest value is {top} (12-bit or 8-bit data in a "
+            "16-bit container?): it is scaled as 16-bit, leaving the matchers about "
+            f"{max(0.0, np.log2(max(top, 1) / 257)):.0f} bits of it; scale it to the full range "
+            "first (img << 4 for 12-bit data, or img.astype(np.uint8) for 8-bit values)",
+            UserWarning,
+            stacklevel=4,
+        )
+
+
 def _to_unit_float(arr: np.ndarray, name: str) -> npt.NDArray[np.float32]:
     """Scale a validated image array to float32 in [0, 1] (channels untouched)."""
     if arr.dtype in _INT_FULL_SCALE:
+        if arr.dtype == np.uint16:
+            _warn_low_uint16(arr, name)
         # divide (not multiply by the reciprocal) so that full scale maps to exactly 1.0
         return arr.astype(np.float32) / np.float32(_INT_FULL_SCALE[arr.dtype])
     if not np.isfinite(arr).all():
@@ -396,6 +420,14 @@ def require(value: object, kind: str, name: str) -> None:
     cls = getattr(importlib.import_module(_CLASSES[kind]), kind)
     if not isinstance(value, cls):
         raise TypeError(f"{name}: expected a stereovision.{kind}, got {type(value).__name__}")
+
+
+def not_a_result(value: object, name: str, field: str) -> None:
+    """A TypeError when a whole ``DepthResult`` is passed where one of its arrays is meant,
+    saying which (it failed deep inside with "float() argument must be ... not 'DepthResult'").
+    """
+    if type(value).__name__ == "DepthResult" and hasattr(value, "disparity"):
+        raise TypeError(f"{name}: got a DepthResult; pass its array, result.{field}")
 
 
 def remap_image(img: np.ndarray, *args: Any, **kwargs: Any) -> np.ndarray:

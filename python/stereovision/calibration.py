@@ -85,6 +85,10 @@ def _as_float_array(value: object, name: str, shapes: tuple[tuple[int, ...], ...
     return arr
 
 
+#: Baselines above this (metres) get a warning: almost always T, or the calibration board's
+#: square size, given in millimetres with the default unit "m" (83 m for a 8 cm rig). Long-range
+#: rigs on vehicles reach 1-2 m.
+LONG_BASELINE_M = 5.0
 #: Largest camera-matrix skew (px) taken without a warning: OpenCV's calibration writes 0, and
 #: a converted or hand-written file may carry rounding dust.
 SKEW_IGNORED_PX = 1e-6
@@ -270,6 +274,16 @@ class Calibration:
                 raise ValueError("model: a rectified calibration is a pinhole pair, not fisheye")
         if self.rectified:
             self._check_rectified()
+        if self.baseline_m > LONG_BASELINE_M:
+            import warnings
+
+            warnings.warn(
+                f"baseline {self.baseline:g} {self.unit} = {self.baseline_m:g} m, longer than "
+                f"a robot's rig ({LONG_BASELINE_M:g} m): are T (or the board's square size) in "
+                f"another unit than unit={self.unit!r}? e.g. unit='mm'",
+                UserWarning,
+                stacklevel=3,
+            )
 
     @staticmethod
     def _check_size(size: object) -> tuple[int, int]:

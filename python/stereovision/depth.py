@@ -402,6 +402,10 @@ class DepthResult:
                 ok_number and np.isfinite(v) and (v > 0 or (name == "min_depth" and v == 0))
             ):
                 raise ValueError(f"{name}: expected a positive number, got {v!r}")
+        if min_depth is not None and max_depth is not None and min_depth > max_depth:
+            raise ValueError(
+                f"min_depth, max_depth: an empty range, {min_depth!r} > {max_depth!r} m"
+            )
         z = self.depth
         keep = np.isfinite(z)
         with np.errstate(invalid="ignore"):
@@ -432,6 +436,10 @@ class DepthResult:
         return dataclasses.replace(
             self,
             limits=merged,
+            # a copy: writing into the filtered maps must not change this result's
+            disparity=self.disparity.copy(),
+            confidence=self.confidence.copy(),
+            left_rectified=None if self.left_rectified is None else self.left_rectified.copy(),
             depth=np.where(keep, z, nan).astype(np.float32),
             depth_sigma=None if sigma is None else sigma.astype(np.float32),
             points=points,
@@ -451,6 +459,11 @@ class DepthResult:
 
         if self.depth is None:
             raise ValueError("no point cloud: depth_map was called without a calibration")
+        if Path(path).suffix.lower() != ".ply":
+            raise ValueError(
+                f"{path}: to_ply writes a .ply file (export.write_pcd writes .pcd, "
+                "export.write_npz .npz)"
+            )
         points, colors = self.points, self.colors
         cal, left = self.calibration, self.left_rectified
         if len(points) == 0 and cal is not None and left is not None:  # depth_map(cloud=False)
@@ -851,6 +864,8 @@ def depth_map(
 
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
+    if "calibration" in params:  # the result's field is .calibration; the argument is calib
+        raise TypeError("depth_map: the calibration is the argument calib, not calibration")
     # The switches and the range are checked for their type first: "no" would be true, True
     # a disparity of 1, and "32" failed in NumPy's isfinite.
     for name, flag in (("fill", fill), ("refine", refine)):
@@ -865,12 +880,18 @@ def depth_map(
     left_bgr = as_bgr_uint8(left, "left")
     right_bgr = as_bgr_uint8(right, "right")
     # Each image is validated by as_bgr_uint8; the pair check without check_pair's grey
-    # conversions (the grey pair is made once, below).
-    if left_bgr.shape != right_bgr.shape:
+    # conversions (the grey pair is made once, below). Before the grey one is made BGR: a grey
+    # and a colour image are not a pair (match() refuses them too).
+    shapes = [np.shape(left), np.shape(right)]
+    if left_bgr.shape != right_bgr.shape or len(shapes[0]) != len(shapes[1]):
         raise ValueError(
-            f"left and right images must have the same shape, got left {left_bgr.shape} and "
-            f"right {right_bgr.shape}"
+            f"left and right images must have the same shape, got left {shapes[0]} and "
+            f"right {shapes[1]}"
         )
+    if np.may_share_memory(left_bgr, left):
+        # the result keeps the left image (its cloud's colours, exports): not the caller's
+        # buffer, which a camera loop refills (cap.read(frame)) before the cloud is written
+        left_bgr = left_bgr.copy()
     from stereovision.uncalibrated import UncalibratedRectification
 
     if isinstance(calib, UncalibratedRectification):
@@ -887,10 +908,14 @@ def depth_map(
             )
         h, w = left_bgr.shape[:2]
         if tuple(calib.image_size) != (w, h):
-            raise ValueError(
-                f"calibration is for {calib.image_size[0]}x{calib.image_size[1]} images, "
-                f"got {w}x{h} (images resized, not cropped: calib.scaled_to(({w}, {h})))"
-            )
+            cw, ch = calib.image_size
+            if (cw, ch) == (h, w):
+                hint = "width and height swapped? image_size is (width, height)"
+            elif cw * h == ch * w:
+                hint = f"images resized, not cropped: calib.scaled_to(({w}, {h}))"
+            else:
+                hint = "another aspect ratio: another camera mode or camera, or cropped images"
+            raise ValueError(f"calibration is for {cw}x{ch} images, got {w}x{h} ({hint})")
         if not calib.rectified:
             left_bgr, right_bgr = calib.rectify(left_bgr, right_bgr)
             calib = calib.rectified_calibration()

@@ -54,6 +54,9 @@ _TO_METRES = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "ft": 0.3048, "in": 0.0254}
 
 
 def _real_2d(a: object, name: str) -> npt.NDArray[np.float64]:
+    from stereovision._validate import not_a_result
+
+    not_a_result(a, name, "depth" if "depth" in name else "disparity")
     arr = np.asarray(a)
     if arr.ndim != 2 or arr.dtype.kind not in "iuf":
         raise ValueError(

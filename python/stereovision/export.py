@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import io as _io
 import os
+import warnings
 import zipfile
 import zlib
 from collections.abc import Callable
@@ -525,6 +526,9 @@ def voxel_downsample(
         If ``points`` is not ``(N, 3)``, ``colors`` does not match it, or ``voxel`` is not a
         positive number.
     """
+    from stereovision._validate import not_a_result
+
+    not_a_result(points, "points", "points")
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ValueError(f"points: expected shape (N, 3), got {pts.shape}")
@@ -586,6 +590,8 @@ def _png16_bytes(values: npt.NDArray[np.float64], what: str) -> bytes:
 
 
 def _png16(path: PathLike, values: npt.NDArray[np.float64], what: str) -> Path:
+    if Path(path).suffix.lower() != ".png":
+        raise ValueError(f"{path}: a 16-bit {what} image is written as .png (lossless)")
     data = _png16_bytes(values, what)
     with atomic_write(path) as fh:
         fh.write(data)
@@ -619,7 +625,17 @@ def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.f
     s = np.rint(np.where(np.isfinite(a), a, 0.0) * scale)
     # 0 means "none": values that round to 0 or do not fit 16 bits are dropped, not clipped, so
     # no pixel is written at a wrong distance.
-    return np.where((s >= 1) & (s <= 65535), s, 0.0)
+    kept = (s >= 1) & (s <= 65535)
+    known = int(np.count_nonzero(np.isfinite(a) & (a > 0)))
+    if known and not kept.any():
+        warnings.warn(
+            f"{name}: none of its {known} values fits 1..65535 at scale {scale:g}"
+            + (" (a depth in metres is expected; millimetres given?)" if name == "depth" else "")
+            + ": the image is all 0",
+            UserWarning,
+            stacklevel=3,
+        )
+    return np.where(kept, s, 0.0)
 
 
 def write_depth_png(

@@ -307,8 +307,9 @@ def fit_ground_plane(
         of range.
     """
     _require_type(calib, "Calibration", "calib")
-    from stereovision._validate import positive_finite
+    from stereovision._validate import not_a_result, positive_finite
 
+    not_a_result(disparity, "disparity", "disparity")
     if np.iscomplexobj(disparity):  # NumPy would drop the imaginary part with a warning
         raise ValueError("disparity: expected a real map, got complex values")
     disp = np.asarray(disparity, np.float64)
@@ -436,6 +437,9 @@ def obstacle_mask(
         For points not of shape ``(H, W, 3)`` or an empty or negative band.
     """
     _require_type(plane, "GroundPlane", "plane")
+    from stereovision._validate import not_a_result
+
+    not_a_result(points, "points", "point_image()")
     pts = np.asarray(points, np.float64)
     if pts.ndim != 3 or pts.shape[2] != 3:
         raise ValueError(f"points: expected shape (H, W, 3), got {pts.shape}")

@@ -605,7 +605,20 @@ def render_result(
 
     ``controls`` default to an orbit of :data:`RENDER_YAW_DEG` / :data:`RENDER_PITCH_DEG` around
     the scene's median depth (a 3-D impression rather than the left image itself).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W, 3)`` uint8 in **RGB** order, as VTK renders (``img[..., ::-1]`` for
+        ``cv2.imwrite``).
+
+    Raises
+    ------
+    ValueError
+        A result without calibration or 3-D points, or ``max_side`` below 16.
     """
+    if isinstance(max_side, bool) or not isinstance(max_side, (int, np.integer)) or max_side < 16:
+        raise ValueError(f"max_side: expected at least 16 pixels, got {max_side!r}")
     mesh = surface_mesh(result)
     intr = Intrinsics.from_result(result)
     assert intr is not None  # _check_result in surface_mesh
