@@ -288,6 +288,13 @@ def test_view_writes_screenshot(result, tmp_path, capsys):
     img = cv2.imread(str(shot))
     assert img is not None and not render.is_blank(img[..., ::-1])
     assert f"{len(result.points)} points" in capsys.readouterr().out
+    # a .jpg name gets JPEG bytes (it got PNG), another suffix an error before rendering
+    jpg = tmp_path / "shot.jpg"
+    args = _view_args(tmp_path, jpg, yaw=5.0, forward=0.5)
+    assert args.func(args) == 0 and jpg.read_bytes()[:3] == b"\xff\xd8\xff"
+    args = _view_args(tmp_path, tmp_path / "shot.tif", yaw=5.0, forward=0.5)
+    with pytest.raises(ValueError, match=r"shot.tif: a screenshot is written as .png, .jpg or"):
+        args.func(args)
 
 
 def test_view_bad_inputs_clear_errors(tmp_path):

@@ -743,8 +743,12 @@ def cmd_view(args: argparse.Namespace) -> int:
         plotter.show()
         return 0
     out = Path(args.output or "view.png")
+    # the format the name asks for (a .jpg got PNG bytes); PNG for a name without one
+    suffix = out.suffix.lower()
+    if suffix not in ("", ".png", ".jpg", ".jpeg", ".bmp"):
+        raise ValueError(f"{out}: a screenshot is written as .png, .jpg or .bmp")
     img = render_view(geometry, controls, intrinsics=intr)
-    ok, buf = cv2.imencode(".png", img[..., ::-1])
+    ok, buf = cv2.imencode(suffix or ".png", img[..., ::-1])
     if not ok:
         raise OSError(f"could not encode {out}")
     from stereovision.io import atomic_write
