@@ -452,3 +452,17 @@ def test_a_whole_result_or_a_wrong_unit_is_named(tmp_path: Path) -> None:
 
     with pytest.raises(ValueError, match=r"max_side: expected at least 16 pixels, got 0"):
         render.render_result(res, max_side=0)  # was a ZeroDivisionError
+
+
+def test_results_compare_by_identity() -> None:
+    """``==`` on two results raised "truth value of an array is ambiguous", and a floor could
+    not be hashed (a dict key, a set) although frozen."""
+    import copy
+
+    from stereovision.ground import fit_ground_plane
+
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")
+    res = sv.depth_map(s.left, s.right, s.calib, method="fast")
+    assert res == res and res != copy.deepcopy(res)
+    plane = fit_ground_plane(res.disparity, res.calibration, max_tilt_deg=80)
+    assert plane is not None and {plane: 1}[plane] == 1 and plane != copy.deepcopy(plane)

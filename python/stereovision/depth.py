@@ -203,7 +203,7 @@ def _coarse_top(gl: npt.NDArray[np.uint8], gr: npt.NDArray[np.uint8]) -> float |
     return float(np.percentile(d, _AUTO_COARSE_PERCENTILE)) * s
 
 
-@dataclass
+@dataclass(eq=False)  # array fields: == by identity (it raised on the arrays' truth value)
 class DepthResult:
     """Output of :func:`depth_map`.
 

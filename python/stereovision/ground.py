@@ -80,7 +80,7 @@ BELOW_M = 0.15
 BELOW_WARN_SHARE = 0.05
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: == and hash by identity
 class GroundPlane:
     """The floor under the rig (see the module docstring for frames and signs).
 
@@ -462,7 +462,7 @@ UNKNOWN, FREE, OCCUPIED = -1, 0, 100
 MIN_OBSTACLE_POINTS = 3
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: == and hash by identity
 class OccupancyGrid:
     """A bird's-eye grid of the floor around the rig, as ROS's ``nav_msgs/OccupancyGrid``.
 
@@ -623,7 +623,7 @@ def occupancy_grid(
 # ---------------------------------------------------------------------------------- laser scan
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: == and hash by identity
 class LaserScan:
     """A planar scan of the obstacles around the rig, as ROS's ``sensor_msgs/LaserScan``.
 
