@@ -660,3 +660,10 @@ def test_a_skewed_camera_matrix_is_named_in_a_warning() -> None:
         warnings.simplefilter("error")
         raw_calib()
         raw_calib(K1=np.array([[300.0, 1e-9, 161.3], [0.0, 302.0, 118.7], [0.0, 0.0, 1.0]]))
+
+
+def test_a_raw_rig_with_the_right_camera_on_the_left_is_named() -> None:
+    """``from_ros(right.yaml, left.yaml)`` built a rig with T[0] > 0 without a word (a rectified
+    one is refused)."""
+    with pytest.warns(UserWarning, match=r"T: the right camera sits to the left of the left one"):
+        raw_calib(T=np.array([0.12, 0.002, 0.003]))

@@ -301,7 +301,7 @@ def test_match_api_curves_and_graph(tmp_path: Path) -> None:
         assert len(set(cand[chosen, 1])) == len(chosen)  # ... and per right segment
         assert c["edges"].shape[1] == 2 and len(c["edges"]) > 0
     path = tmp_path / "m.csv"
-    m.save_csv(path)
+    assert m.save_csv(path) == path  # a Path, as the other writers return
     rows = list(csv.reader(path.open()))
     assert rows[0] == ["x_left", "y_left", "x_right", "y_right", "score"]
     assert len(rows) == len(m) + 1

@@ -145,6 +145,16 @@ def test_units_metres_by_default_and_feet() -> None:
     np.testing.assert_allclose(ft.XL, pts / 0.3048, rtol=1e-9)
     with pytest.raises(ValueError, match="unit"):
         triangulate(xl, xr, c_mm, unit="yard")
+    # the Calibration methods take the unit as the module functions do (they had none)
+    disp = np.full((4, 5), 20.0)
+    np.testing.assert_allclose(
+        c_mm.depth_from_disparity(disp, unit="ft"),
+        depth_from_disparity(disp, c_mm) / 0.3048,
+        rtol=1e-6,
+    )
+    np.testing.assert_allclose(
+        c_mm.reproject(disp, unit="mm"), reproject(disp, c_mm) * 1000, rtol=1e-6
+    )
 
 
 def test_agrees_with_cv2_triangulate_points() -> None:

@@ -274,6 +274,17 @@ class Calibration:
                 raise ValueError("model: a rectified calibration is a pinhole pair, not fisheye")
         if self.rectified:
             self._check_rectified()
+        tx, ty, tz = (abs(float(v)) for v in self.T)
+        if float(self.T[0]) > 0 and tx > max(ty, tz):
+            import warnings
+
+            warnings.warn(
+                f"T: the right camera sits to the left of the left one (T[0] = "
+                f"{float(self.T[0]):+g} {self.unit}; a left-right rig has T[0] < 0): are the two "
+                "cameras (or their files) swapped?",
+                UserWarning,
+                stacklevel=3,
+            )
         if self.baseline_m > LONG_BASELINE_M:
             import warnings
 
@@ -778,24 +789,26 @@ class Calibration:
 
     # ------------------------------------------------------------------------------- depth
 
-    def depth_from_disparity(self, disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
-        """Depth in metres from a rectified-frame disparity map (algorithms.md E.3).
+    def depth_from_disparity(self, disp: npt.ArrayLike, unit: str = "m") -> npt.NDArray[np.float32]:
+        """Depth from a rectified-frame disparity map (algorithms.md E.3), in metres unless
+        ``unit`` says otherwise (as :func:`stereovision.depth_from_disparity`).
 
-        ``Z = f B / (d + doffs)`` scaled to metres; ``d <= -doffs`` or NaN gives NaN. See
+        ``Z = f B / (d + doffs)``; ``d <= -doffs`` or NaN gives NaN. See
         :func:`stereovision.triangulation.depth_from_disparity`.
         """
         from stereovision.triangulation import depth_from_disparity
 
-        return depth_from_disparity(disp, self)
+        return depth_from_disparity(disp, self, unit)
 
-    def reproject(self, disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
-        """``(H, W, 3)`` points in metres (left rectified frame: X right, Y down, Z forward).
+    def reproject(self, disp: npt.ArrayLike, unit: str = "m") -> npt.NDArray[np.float32]:
+        """``(H, W, 3)`` points in metres unless ``unit`` says otherwise (left rectified frame:
+        X right, Y down, Z forward).
 
         See :func:`stereovision.triangulation.reproject`.
         """
         from stereovision.triangulation import reproject
 
-        return reproject(disp, self)
+        return reproject(disp, self, unit)
 
     # ------------------------------------------------------------------------------ saving
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -116,15 +117,21 @@ class Matches:
         """``(N, 4)`` float32 array of ``[x, y, x', y']`` (left then right position) per match."""
         return np.stack([self.xl, self.yl, self.xr, self.yr], axis=1).astype(np.float32)
 
-    def save_csv(self, path: str | os.PathLike[str]) -> None:
+    def save_csv(self, path: str | os.PathLike[str]) -> Path:
         """Write ``x_left,y_left,x_right,y_right,score`` rows (header first), atomically.
 
         Parameters
         ----------
         path : str or os.PathLike
             Destination; its directory must exist. The file is replaced only once fully written.
+
+        Returns
+        -------
+        pathlib.Path
+            ``path`` (as the other writers return it).
         """
         with atomic_write(path, "w") as fh:
             fh.write("x_left,y_left,x_right,y_right,score\n")
             for row in zip(self.xl, self.yl, self.xr, self.yr, self.score, strict=True):
                 fh.write(",".join(f"{float(v):.4f}" for v in row) + "\n")
+        return Path(path)
