@@ -37,15 +37,15 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import cv2
 import numpy as np
 import numpy.typing as npt
 
-if TYPE_CHECKING:
-    from stereovision.calibration import Calibration
-    from stereovision.charuco import CharucoBoard
+# at run time too, so that typing.get_type_hints resolves the public signatures
+from stereovision.calibration import Calibration
+from stereovision.charuco import CharucoBoard
 
 __all__ = [
     "DISTORTION_MODELS",

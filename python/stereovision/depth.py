@@ -14,7 +14,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import cv2
 import numpy as np
@@ -23,8 +23,8 @@ import numpy.typing as npt
 from stereovision._validate import as_bgr_uint8, as_gray_float, check_pair
 from stereovision.calibration import Calibration
 
-if TYPE_CHECKING:
-    from stereovision.uncalibrated import UncalibratedRectification
+# at run time too, so that typing.get_type_hints resolves the public signatures
+from stereovision.uncalibrated import UncalibratedRectification
 
 __all__ = ["METHODS", "DepthResult", "depth_map", "disparity_sigma", "estimate_max_disparity"]
 

@@ -16,15 +16,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import require as _require_type
 
-if TYPE_CHECKING:
-    from stereovision.calibration import Calibration
+# at run time too, so that typing.get_type_hints resolves the public signatures
+from stereovision.calibration import Calibration
 
 __all__ = [
     "DEFAULT_THRESHOLDS",

@@ -31,12 +31,13 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import require as _require_type
+
+# at run time too, so that typing.get_type_hints resolves the public signatures
+from stereovision.depth import DepthResult
 from stereovision.io import atomic_write, make_folder, read_ply, write_ply
 
 if TYPE_CHECKING:
     import pyvista as pv
-
-    from stereovision.depth import DepthResult
 
 __all__ = [
     "DEPTH_PNG_SCALE",

@@ -32,10 +32,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+# at run time too, so that typing.get_type_hints resolves the public signatures
+from stereovision.depth import DepthResult
+
 if TYPE_CHECKING:
     import pyvista as pv
-
-    from stereovision.depth import DepthResult
 
 __all__ = [
     "BACKGROUND",
