@@ -466,3 +466,26 @@ def test_results_compare_by_identity() -> None:
     assert res == res and res != copy.deepcopy(res)
     plane = fit_ground_plane(res.disparity, res.calibration, max_tilt_deg=80)
     assert plane is not None and {plane: 1}[plane] == 1 and plane != copy.deepcopy(plane)
+
+
+def test_matches_select_and_triangulate() -> None:
+    """Matches could not be sliced or filtered (``m[0:5]`` was a TypeError) nor turned into
+    3-D points without raw pixels; the points equal the dense reprojection at those pixels."""
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")
+    m = sv.match(s.left, s.right, method="hopfield", max_disparity=64)
+    good = m[m.score > 0.95]
+    assert isinstance(good, sv.Matches) and 0 < len(good) < len(m)
+    assert (good.score > 0.95).all() and good.image_shape == m.image_shape
+    assert len(m[0:5]) == 5 and m[3].xl[0] == m.xl[3] and len(m[-1]) == 1
+    pts = good.to_points(s.calib)
+    assert pts.shape == (len(good), 3) and pts.dtype == np.float32
+    disp = np.full(s.left.shape[:2], np.nan, np.float32)
+    xi, yi = np.rint(good.xl).astype(int), np.rint(good.yl).astype(int)
+    on_pixel = (good.xl == xi) & (good.yl == yi)  # hopfield's points are pixel centres
+    assert on_pixel.sum() > 0.9 * len(good)
+    disp[yi[on_pixel], xi[on_pixel]] = (good.xl - good.xr)[on_pixel]
+    ref = s.calib.reproject(disp)[yi[on_pixel], xi[on_pixel]]
+    np.testing.assert_allclose(pts[on_pixel], ref, rtol=1e-5)
+    np.testing.assert_allclose(good.to_points(s.calib, unit="mm"), pts * 1000, rtol=1e-5)
+    with pytest.raises(TypeError, match=r"calib: expected a stereovision\.Calibration"):
+        good.to_points(None)

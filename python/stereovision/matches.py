@@ -94,6 +94,54 @@ class Matches:
             f"{float(self.score.min()):.3g}-{float(self.score.max()):.3g})"
         )
 
+    def __getitem__(self, index: Any) -> Matches:
+        """The matches picked by a slice, an integer array or a boolean mask, as ``Matches``
+        (``m[m.score > 0.9]``); the image shape and stats are kept, the energy trace too."""
+        if isinstance(index, (int, np.integer)):
+            index = slice(int(index), int(index) + 1 or None)
+        pick = np.asarray(np.arange(len(self))[index])
+        if pick.ndim != 1:
+            raise IndexError(f"Matches: expected a 1-D index or mask, got shape {pick.shape}")
+        return Matches(
+            self.xl[pick],
+            self.yl[pick],
+            self.xr[pick],
+            self.yr[pick],
+            self.score[pick],
+            self.image_shape,
+            self.energy_trace,
+            dict(self.stats),
+        )
+
+    def to_points(self, calib: Any, unit: str = "m") -> npt.NDArray[np.float32]:
+        """``(N, 3)`` float32 points of the matches, in the left rectified camera frame (X right,
+        Y down, Z forward), metres unless ``unit`` says otherwise.
+
+        The matches are in the rectified pair's pixels (what :func:`stereovision.match` gives,
+        with or without a calibration); ``calib`` is the pair's calibration (a raw rig's
+        rectified geometry is used). ``Z = f B / (x_l - x_r + doffs)``; a match whose disparity
+        is not positive gives NaN.
+
+        Raises
+        ------
+        TypeError
+            If ``calib`` is not a :class:`~stereovision.Calibration`.
+        ValueError
+            An unknown ``unit``.
+        """
+        from stereovision._validate import require
+        from stereovision.triangulation import depth_from_disparity
+
+        require(calib, "Calibration", "calib")
+        cal = calib if calib.rectified else calib.rectified_calibration()
+        z = depth_from_disparity((self.xl - self.xr)[None, :], cal, unit)[0].astype(np.float64)
+        k = cal.K1
+        out = np.empty((len(self), 3), np.float32)
+        out[:, 0] = (self.xl - k[0, 2]) * z / k[0, 0]
+        out[:, 1] = (self.yl - k[1, 2]) * z / k[1, 1]
+        out[:, 2] = z
+        return out
+
     def _raster(self, values: F32) -> F32:
         h, w = self.image_shape
         out = np.full((h, w), np.nan, dtype=np.float32)
