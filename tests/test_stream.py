@@ -474,11 +474,11 @@ def test_signals_wait_for_the_end_of_a_deferred_block() -> None:
     import os
     import signal
 
-    from stereovision._interrupt import signals_deferred
+    from stereovision._interrupt import HeldInterrupts
 
     done = []
     with pytest.raises(KeyboardInterrupt):
-        with signals_deferred():
+        with HeldInterrupts():
             os.kill(os.getpid(), signal.SIGINT)
             time.sleep(0.05)  # the handler would have run here
             done.append("frame")

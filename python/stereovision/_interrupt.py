@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import signal
 import threading
-from collections.abc import Iterator
-from contextlib import contextmanager
+from types import FrameType, TracebackType
+from typing import Any
 
 
 class Terminated(KeyboardInterrupt):
@@ -19,23 +19,50 @@ def raise_terminated(signum: int, _frame: object) -> None:
     raise Terminated(f"signal {signum}")
 
 
-@contextmanager
-def signals_deferred() -> Iterator[None]:
-    """Hold Ctrl-C and SIGTERM until the block ends, then deliver them to the handlers the
-    process had: what the block writes goes out whole or not at all. Only the main thread
-    receives signals; in another thread this does nothing."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    got: list[int] = []
-    kept = {}
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        kept[sig] = signal.getsignal(sig)
-        signal.signal(sig, lambda signum, _frame: got.append(signum))
-    try:
-        yield
-    finally:
-        for sig, handler in kept.items():
+class HeldInterrupts:
+    """Hold Ctrl-C (and SIGTERM when Python handles it, as the CLI does) for a block that an
+    interrupt must not cut in half: a bag frame's messages, Dask starting or stopping (a client
+    stopped half-way through its constructor cannot be closed), a run's record.
+
+    The first signal is only recorded here and, with ``replay``, sent again once the block is
+    over; a second one is not held. Does nothing outside the main thread (signal handlers cannot
+    be set there).
+    """
+
+    def __init__(self, replay: bool = True) -> None:
+        self.replay = replay
+        self.received: list[int] = []
+        self._old: dict[int, Any] = {}
+        self._gone = False
+
+    def __enter__(self) -> HeldInterrupts:
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                handler = signal.getsignal(sig)
+                if callable(handler):  # Python's KeyboardInterrupt, a caller's SIGTERM handler
+                    self._old[sig] = handler
+                    signal.signal(sig, self._hold)
+        return self
+
+    def _hold(self, signum: int, frame: FrameType | None) -> None:
+        if not self.received:
+            self.received.append(signum)
+            return
+        self._restore()  # a second signal: acted on now
+        self._gone = True
+        self._old.get(signum, signal.default_int_handler)(signum, frame)
+
+    def _restore(self) -> None:
+        for sig, handler in self._old.items():
             signal.signal(sig, handler)
-        for signum in dict.fromkeys(got):
-            signal.raise_signal(signum)
+        self._old = {}
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self._restore()
+        if self.received and self.replay and not self._gone:
+            signal.raise_signal(self.received[0])  # the restored handler raises

@@ -35,8 +35,9 @@ import uuid
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import FrameType, TracebackType
 from typing import Any
+
+from stereovision._interrupt import HeldInterrupts, raise_terminated
 
 __all__ = [
     "IMAGE_EXTS",
@@ -490,54 +491,6 @@ def _skip(
     return entry.get("status") == "failed" and not retry_failed
 
 
-class _HeldInterrupts:
-    """Hold Ctrl-C (and SIGTERM when Python handles it, as the CLI does) while Dask starts or stops.
-
-    A Dask client or LocalCluster stopped half-way through its constructor cannot be closed
-    (distributed's exit hook then prints a traceback), so the first signal is only recorded here
-    and, with ``replay``, sent again once the block is over. A second one is not held. Does
-    nothing outside the main thread (signal handlers cannot be set there).
-    """
-
-    def __init__(self, replay: bool = True) -> None:
-        self.replay = replay
-        self.received: list[int] = []
-        self._old: dict[int, Any] = {}
-        self._gone = False
-
-    def __enter__(self) -> _HeldInterrupts:
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                handler = signal.getsignal(sig)
-                if callable(handler):  # Python's KeyboardInterrupt, a caller's SIGTERM handler
-                    self._old[sig] = handler
-                    signal.signal(sig, self._hold)
-        return self
-
-    def _hold(self, signum: int, frame: FrameType | None) -> None:
-        if not self.received:
-            self.received.append(signum)
-            return
-        self._restore()  # a second signal: acted on now
-        self._gone = True
-        self._old.get(signum, signal.default_int_handler)(signum, frame)
-
-    def _restore(self) -> None:
-        for sig, handler in self._old.items():
-            signal.signal(sig, handler)
-        self._old = {}
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self._restore()
-        if self.received and self.replay and not self._gone:
-            signal.raise_signal(self.received[0])  # the restored handler raises
-
-
 def _in_thread_without_sigint(fn: Callable[[], None]) -> None:
     """Run ``fn`` in a thread that blocks SIGINT, and so do the threads it starts and the
     processes those start (a signal mask survives fork and exec): LocalCluster's worker
@@ -617,14 +570,14 @@ class _Dask:
             self.client = Client(self.cluster)
             self.desc = f"LocalCluster({workers} worker processes)"
 
-        with _HeldInterrupts():
+        with HeldInterrupts():
             if scheduler is not None:
                 connect()
             else:
                 _in_thread_without_sigint(local)
 
     def close(self, futures: list[Any]) -> None:
-        with _HeldInterrupts():
+        with HeldInterrupts():
             try:
                 if self.client is not None and futures:
                     self.client.cancel(futures)
@@ -843,7 +796,7 @@ def run_batch(
     except KeyboardInterrupt as exc:
         interrupted = True
         cause = exc
-    with _HeldInterrupts(replay=False) as held:  # the record of the run is written whole
+    with HeldInterrupts(replay=False) as held:  # the record of the run is written whole
         gone = _outputs_gone(out, summary, [j.name for j in jobs])
         seconds = time.perf_counter() - t0
         run.update(
@@ -1019,10 +972,6 @@ def _run_jobs(
 # ---------------------------------------------------------------------------------------- CLI
 
 
-def _raise_interrupt(signum: int, frame: FrameType | None) -> None:
-    raise KeyboardInterrupt
-
-
 def cmd_batch(args: argparse.Namespace) -> int:
     """``stereovision batch INPUT -o OUT``: exit status 0, 1 when a pair has no outputs, 130 when
     interrupted (Ctrl-C), 143 when terminated (SIGTERM): one line, the summary marked as
@@ -1040,7 +989,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
     term = None
     if threading.current_thread() is threading.main_thread():
         if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
-            term = signal.signal(signal.SIGTERM, _raise_interrupt)
+            term = signal.signal(signal.SIGTERM, raise_terminated)
     try:
         res = run_batch(
             args.input,

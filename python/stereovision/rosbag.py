@@ -66,7 +66,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from stereovision._interrupt import signals_deferred
+from stereovision._interrupt import HeldInterrupts
 from stereovision.capture import PairSource, SourceError, StereoFrame
 
 __all__ = [
@@ -326,7 +326,7 @@ ros2_static_transform>`.
         if self._writer is None:
             raise ValueError(f"bag {self.path} is closed")
         try:
-            with signals_deferred():
+            with HeldInterrupts():
                 self._write_frame(result, stamp, scan, ground)
                 if time.monotonic() - self._committed >= COMMIT_PERIOD_S:
                     self._commit()
@@ -395,7 +395,7 @@ ros2_static_transform>`.
         if writer is None:
             return
         try:
-            with signals_deferred():
+            with HeldInterrupts():
                 writer.close()
         except sqlite3.Error as exc:
             storage = getattr(writer, "storage", None)
