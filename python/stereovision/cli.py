@@ -39,6 +39,34 @@ class CliError(Exception):
 # ----------------------------------------------------------------------------- output helpers
 
 
+def _refuse_an_input(flag: str, output: Path, inputs: dict[str, str | None]) -> None:
+    """Refuse an output path that names one of the run's input files.
+
+    Parameters
+    ----------
+    flag : str
+        The option that names ``output`` (``--plot``), for the message.
+    output : pathlib.Path
+        The file about to be written.
+    inputs : dict
+        What each input is (``"the left image"``) -> its path as given (None: not given).
+
+    Raises
+    ------
+    CliError
+        If ``output`` is one of ``inputs`` (the same file, through any link or spelling).
+    """
+    for what, given in inputs.items():
+        if not given:
+            continue
+        try:
+            same = os.path.samefile(output, given)
+        except OSError:  # one of them does not exist (yet): compare the spelled-out paths
+            same = output.resolve() == Path(given).resolve()
+        if same:
+            raise CliError(f"{flag} {output}: is {what} ({given}); give another file name")
+
+
 def _atomic_write_bytes(path: Path, data: bytes) -> None:
     from stereovision.io import atomic_write, make_folder
 
@@ -336,6 +364,10 @@ def cmd_check(args: argparse.Namespace) -> int:
             raise CliError(f"--fix {args.fix}: use a .yaml, .yml, .xml or .json file name")
         if str(fix.parent) and not fix.parent.is_dir():
             raise FileNotFoundError(f"--fix {args.fix}: directory {fix.parent} does not exist")
+    inputs = {"the left image": args.left, "the right image": args.right,
+              "the calibration": args.calib}  # fmt: skip
+    if args.plot:
+        _refuse_an_input("--plot", Path(args.plot), inputs)
     raw_left, raw_right = left, right
     if calib is not None:
         left, right = calib.rectify(left, right)
