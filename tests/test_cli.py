@@ -338,3 +338,31 @@ def test_check_plot_refuses_to_overwrite_an_input(tmp_path: Path, data_dir: Path
                          timeout=120)  # fmt: skip
     assert run.returncode == 0, run.stderr
     assert cv2.imread(str(tmp_path / "plot.png")) is not None
+
+
+def test_depth_removes_its_own_outputs_of_an_earlier_run(
+    tmp_path: Path, data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A run without a calibration into a folder of a run with one left the earlier cloud.ply,
+    depth maps and render there (``stereovision view DIR`` showed the earlier scene): they go;
+    the user's own files, and an output name that is a folder, stay."""
+    scene = data_dir / "eth3d" / "terrace"
+    out = tmp_path / "o"
+    argv = ["depth", str(scene / "left.png"), str(scene / "right.png"), "--max-disparity", "32"]
+    assert main([*argv, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
+    for name in ("cloud.ply", "depth.npy", "depth.png", "depth_mm.png", "render.png"):
+        assert (out / name).is_file(), name
+    (out / "notes.txt").write_text("mine")
+    (out / "scan.json").mkdir()  # not a file this tool wrote
+    capsys.readouterr()
+    assert main([*argv, "-o", str(out)]) == 0
+    said = capsys.readouterr().out
+    assert sorted(p.name for p in out.iterdir()) == [
+        "disparity.pfm",
+        "disparity.png",
+        "notes.txt",
+        "scan.json",
+    ]
+    assert (out / "notes.txt").read_text() == "mine"
+    for name in ("cloud.ply", "depth.npy", "depth.png", "depth_mm.png", "render.png"):
+        assert f"removed {name} of an earlier run" in said

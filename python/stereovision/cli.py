@@ -245,6 +245,52 @@ def depth_outputs(
     return res, written
 
 
+#: Every file ``stereovision depth`` may write into its ``-o`` folder.
+DEPTH_OUTPUTS = (
+    "disparity.png",
+    "disparity.pfm",
+    "depth.png",
+    "depth.npy",
+    "depth_mm.png",
+    "cloud.ply",
+    "render.png",
+    "ground.json",
+    "obstacles.png",
+    "scan.json",
+    "map.png",
+    "map.yaml",
+)
+
+
+def remove_stale_outputs(out_dir: Path, written: dict[str, Path]) -> list[Path]:
+    """Remove the depth outputs of an earlier run that this run did not rewrite.
+
+    A folder that held ``cloud.ply`` from a run with a calibration would otherwise keep it after
+    a run without one, and ``stereovision view DIR`` would show the earlier scene. Only the
+    names in :data:`DEPTH_OUTPUTS` are touched, and only regular files; any other file in the
+    folder stays.
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        The ``-o`` folder.
+    written : dict
+        What this run wrote: file name -> path.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The files removed.
+    """
+    removed = []
+    for name in DEPTH_OUTPUTS:
+        path = out_dir / name
+        if name not in written and path.is_file() and not path.is_symlink():
+            path.unlink()
+            removed.append(path)
+    return removed
+
+
 def cmd_depth(args: argparse.Namespace) -> int:
     """``stereovision depth LEFT RIGHT -o DIR``."""
     from stereovision.io import imread
@@ -289,6 +335,8 @@ def cmd_depth(args: argparse.Namespace) -> int:
     )
     for name, path in written.items():
         print(f"  {name:14s} {path}")
+    for path in remove_stale_outputs(Path(args.output), written):
+        print(f"  removed {path.name} of an earlier run (not written by this one)")
     return 0
 
 
