@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import cv2
@@ -295,6 +298,43 @@ def test_view_writes_screenshot(result, tmp_path, capsys):
     args = _view_args(tmp_path, tmp_path / "shot.tif", yaw=5.0, forward=0.5)
     with pytest.raises(ValueError, match=r"shot.tif: a screenshot is written as .png, .jpg or"):
         args.func(args)
+
+
+@pytest.mark.skipif(
+    not sys.platform.startswith("linux") or Path("/tmp/.X11-unix/X99").exists(),
+    reason="needs Linux with no X server at :99",
+)
+def test_view_with_a_display_no_server_answers_writes_the_screenshot(result, tmp_path):
+    """``DISPLAY=:99`` with no X server there: ``view`` counted it a display, opened no window,
+    wrote nothing and exited 0. Now: a one-line warning and the screenshot, as without one."""
+    from stereovision.export import write_cloud_ply
+
+    write_cloud_ply(tmp_path / "cloud.ply", result)
+    env = {**os.environ, "DISPLAY": ":99"}
+    env.pop("WAYLAND_DISPLAY", None)
+    env["PYTHONPATH"] = os.pathsep.join(
+        [str(Path(render.__file__).parents[1]), env.get("PYTHONPATH", "")]
+    )
+    run = subprocess.run([sys.executable, "-m", "stereovision", "view", str(tmp_path)],
+                         cwd=tmp_path, env=env, capture_output=True, text=True,
+                         timeout=120)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert run.stderr == (
+        "stereovision: warning: no X server answers at DISPLAY=:99: no window; writing a "
+        "screenshot to view.png instead (-o names another)\n"
+    )
+    assert f"{len(result.points)} points" in run.stdout
+    img = cv2.imread(str(tmp_path / "view.png"))
+    assert img is not None and not render.is_blank(img[..., ::-1])
+
+
+def test_has_display_asks_the_x_server(monkeypatch):
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setenv("DISPLAY", ":99")
+    if sys.platform.startswith("linux") and not Path("/tmp/.X11-unix/X99").exists():
+        assert render._has_display() is False
+    monkeypatch.delenv("DISPLAY")
+    assert render._has_display() is False
 
 
 def test_view_bad_inputs_clear_errors(tmp_path):

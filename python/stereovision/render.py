@@ -667,8 +667,58 @@ def render_outputs(result: DepthResult, out_dir: str | os.PathLike[str]) -> dict
 # ----------------------------------------------------------------------------- `stereovision view`
 
 
+#: X display name -> whether its server accepted a connection (asked once per process).
+_X_DISPLAYS: dict[str, bool] = {}
+
+
+def _x_server_answers(name: str) -> bool:
+    """Whether the X server ``name`` (a ``$DISPLAY`` value) accepts a connection.
+
+    libX11's ``XOpenDisplay``, closed again at once: the call VTK's window makes first. False
+    when libX11 cannot be loaded (VTK cannot open a window without it either).
+
+    Parameters
+    ----------
+    name : str
+        The display, e.g. ``":0"`` or ``"localhost:10.0"``.
+
+    Returns
+    -------
+    bool
+    """
+    if name not in _X_DISPLAYS:
+        import ctypes
+        import ctypes.util
+
+        x11 = None
+        for lib in ("libX11.so.6", ctypes.util.find_library("X11")):
+            if lib:
+                try:
+                    x11 = ctypes.CDLL(lib)
+                    break
+                except OSError:
+                    continue
+        answers = False
+        if x11 is not None:
+            x11.XOpenDisplay.restype = ctypes.c_void_p
+            x11.XOpenDisplay.argtypes = [ctypes.c_char_p]
+            x11.XCloseDisplay.argtypes = [ctypes.c_void_p]
+            dpy = x11.XOpenDisplay(name.encode())
+            if dpy:
+                x11.XCloseDisplay(dpy)
+                answers = True
+        _X_DISPLAYS[name] = answers
+    return _X_DISPLAYS[name]
+
+
 def _has_display() -> bool:
-    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    """Whether a window can be shown: on Linux an X server that answers at ``$DISPLAY`` (a
+    ``DISPLAY`` naming no running server counted before, and ``view`` then showed nothing and
+    wrote nothing), elsewhere ``DISPLAY`` or ``WAYLAND_DISPLAY`` set."""
+    x = os.environ.get("DISPLAY")
+    if x and sys.platform.startswith("linux"):
+        return _x_server_answers(x)
+    return bool(x or os.environ.get("WAYLAND_DISPLAY"))
 
 
 def load_view_source(path: str | os.PathLike[str]) -> tuple[pv.PolyData, Intrinsics | None]:
@@ -743,6 +793,14 @@ def cmd_view(args: argparse.Namespace) -> int:
         )
         plotter.show()
         return 0
+    if args.output is None and os.environ.get("DISPLAY"):
+        import warnings
+
+        warnings.warn(
+            f"no X server answers at DISPLAY={os.environ['DISPLAY']}: no window; writing a "
+            "screenshot to view.png instead (-o names another)",
+            stacklevel=1,
+        )
     out = Path(args.output or "view.png")
     # the format the name asks for (a .jpg got PNG bytes); PNG for a name without one
     suffix = out.suffix.lower()
