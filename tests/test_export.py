@@ -319,3 +319,30 @@ def test_point_image_filled_keeps_the_guesses_within_the_working_range(result):
     trusted = replace(filled, depth_sigma=sigma).filtered(max_sigma=1e3)
     assert trusted.limits == {"max_sigma": 1e3}
     assert np.isnan(trusted.point_image(filled=True)[guess]).all()
+
+
+def test_cloud_false_result_writes_the_same_cloud(data_dir, tmp_path):
+    """A ``cloud=False`` result (what ``stream`` hands ``on_result``) has no points of its own:
+    ``write_cloud_ply`` and ``export_result`` write the cloud its depth map gives, the same
+    points and colours as the ``cloud=True`` result (they wrote a PLY with 0 vertices)."""
+    import stereovision as sv
+    from stereovision.io import load_scene, read_ply
+
+    scene = load_scene(data_dir / "eth3d" / "terrace")
+    kw = {"method": "census", "max_disparity": scene.max_disparity}
+    full = sv.depth_map(scene.left, scene.right, scene.calib, **kw)
+    live = sv.depth_map(scene.left, scene.right, scene.calib, cloud=False, **kw)
+    assert len(live.points) == 0 and len(full.points) > 10_000
+    pts, cols = read_ply(export.write_cloud_ply(tmp_path / "live.ply", live))
+    np.testing.assert_array_equal(pts, full.points)
+    np.testing.assert_array_equal(cols, full.colors)
+    written = export.export_result(live, tmp_path / "out", ("ply", "pcd"))
+    for name in ("cloud.ply", "cloud.pcd"):
+        back, _ = export.load_cloud(written[name])
+        assert len(back) == len(full.points)
+        np.testing.assert_allclose(back, full.points, atol=1e-6)
+    # a result without its left image: the same points, black
+    bare = replace(live, left_rectified=None)
+    pts, cols = read_ply(export.write_cloud_ply(tmp_path / "bare.ply", bare))
+    np.testing.assert_array_equal(pts, full.points)
+    assert not cols.any()

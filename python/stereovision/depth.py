@@ -464,11 +464,25 @@ class DepthResult:
                 f"{path}: to_ply writes a .ply file (export.write_pcd writes .pcd, "
                 "export.write_npz .npz)"
             )
-        points, colors = self.points, self.colors
-        cal, left = self.calibration, self.left_rectified
-        if len(points) == 0 and cal is not None and left is not None:  # depth_map(cloud=False)
-            points, colors, _ = _cloud(self.depth, cal, left)
+        points, colors = self._cloud_points()
         return Path(write_ply(path, points, colors))
+
+    def _cloud_points(self) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8]]:
+        """``(points, colors)`` of the cloud, rebuilt from the depth map for ``cloud=False``.
+
+        What :meth:`to_ply` and :func:`stereovision.export.write_cloud_ply` write: the result's
+        own ``points`` and ``colors`` when it has them, otherwise the same cloud ``depth_map``
+        would have built (one point per pixel with a depth, row-major; black without the left
+        image).
+        """
+        points, colors = self.points, self.colors
+        cal, depth = self.calibration, self.depth
+        if len(points) == 0 and cal is not None and depth is not None:  # depth_map(cloud=False)
+            left = self.left_rectified
+            if left is None or left.ndim != 3:
+                left = np.zeros((*depth.shape, 3), np.uint8)
+            points, colors, _ = _cloud(depth, cal, left)
+        return points, colors
 
 
 def disparity_sigma(

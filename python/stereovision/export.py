@@ -126,7 +126,9 @@ def write_cloud_ply(path: PathLike, result: DepthResult) -> Path:
     path : path
         File to write (atomically: an existing file is replaced only once the new one is whole).
     result : DepthResult
-        A :func:`stereovision.depth_map` result computed with a calibration.
+        A :func:`stereovision.depth_map` result computed with a calibration; one computed with
+        ``cloud=False`` (as :func:`stereovision.stream.run` gives them) is written with the
+        cloud its depth map gives, the same points as with ``cloud=True``.
 
     Returns
     -------
@@ -140,7 +142,9 @@ def write_cloud_ply(path: PathLike, result: DepthResult) -> Path:
     """
     _require_type(result, "DepthResult", "result")
     _require_metric(result)
-    write_ply(path, result.points, result.colors)
+    # A cloud=False result (stream's) has no points of its own: the cloud from its depth map.
+    points, colors = result._cloud_points()
+    write_ply(path, points, colors)
     return Path(path)
 
 
