@@ -71,6 +71,66 @@ def test_pcd_rgb_is_packed_like_pcl():
     np.testing.assert_array_equal(export._unpack_rgb(packed), [[255, 0, 0], [0, 128, 1]])
 
 
+_COLOURS = np.array([[255, 0, 0], [10, 20, 30], [0, 128, 1]], np.uint8)
+_POINTS = np.array([[1, 2, 3], [4, 5, 6], [np.nan, np.nan, np.nan]], np.float32)
+
+
+def _hand_written_pcd(path, kind, mode, field="rgb", alpha=0):
+    """A 3-point PCD as another tool writes it: ``TYPE F F F <kind>``, DATA ``mode``."""
+    c = _COLOURS.astype(np.uint32)
+    bits = (np.uint32(alpha) << 24) | (c[:, 0] << 16) | (c[:, 1] << 8) | c[:, 2]
+    head = (
+        f"# .PCD v0.7\nVERSION 0.7\nFIELDS x y z {field}\nSIZE 4 4 4 4\nTYPE F F F {kind}\n"
+        "COUNT 1 1 1 1\nWIDTH 3\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\n"
+        f"DATA {mode}\n"
+    )
+    if mode == "binary":
+        rec = np.empty(3, [("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("c", "<u4")])
+        rec["x"], rec["y"], rec["z"] = _POINTS.T
+        rec["c"] = bits
+        path.write_bytes(head.encode() + rec.tobytes())
+    else:
+        if kind == "F" and alpha == 0:  # an old writer: the float holding the bits
+            tokens = [repr(float(v)) for v in bits.astype("<u4").view("<f4")]
+        else:  # PCL's own writer, and TYPE U: the bits as an integer
+            tokens = [str(int(v)) for v in bits]
+        rows = [f"{x} {y} {z} {t}" for (x, y, z), t in zip(_POINTS.tolist(), tokens, strict=True)]
+        path.write_text(head + "\n".join(rows) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("mode", ["binary", "ascii"])
+@pytest.mark.parametrize(
+    ("kind", "field", "alpha"), [("F", "rgb", 0), ("U", "rgb", 0), ("U", "rgba", 255)]
+)
+def test_pcd_colours_are_read_as_bits(tmp_path, mode, kind, field, alpha):
+    """The packed colour is bits: a ``TYPE U`` field was converted numerically (red read back
+    as (127, 0, 0) in binary, black in ASCII), an old writer's ASCII float as black."""
+    path = _hand_written_pcd(tmp_path / "c.pcd", kind, mode, field, alpha)
+    pts, cols = export.read_pcd(path)
+    np.testing.assert_array_equal(pts.reshape(-1, 3), _POINTS)
+    np.testing.assert_array_equal(cols.reshape(-1, 3), _COLOURS)
+    back, back_cols = export.load_cloud(path)
+    np.testing.assert_array_equal(back, _POINTS[:2])
+    np.testing.assert_array_equal(back_cols, _COLOURS[:2])
+
+
+def test_pcd_ascii_float_colour_as_pcl_writes_it(tmp_path):
+    """PCL writes a ``TYPE F`` rgb in ASCII as its bits' integer (``4294901760`` for opaque
+    red, NaN as a float): read as those bits."""
+    path = tmp_path / "pcl.pcd"
+    path.write_text(
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\n"
+        "COUNT 1 1 1 1\nWIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n"
+        f"1 2 3 {0xFFFF0000}\n4 5 6 {0x000A141E}\n"
+    )
+    _, cols = export.read_pcd(path)
+    assert cols.reshape(-1, 3).tolist() == [[255, 0, 0], [10, 20, 30]]
+    path.write_text(path.read_text().replace("SIZE 4 4 4 4", "SIZE 4 4 4 8"))
+    with pytest.raises(ValueError, match="field 'rgb' of SIZE 8 COUNT 1, expected a packed"):
+        export.read_pcd(path)
+
+
 def test_npz_bundle(result, tmp_path):
     data = export.read_npz(export.write_npz(tmp_path / "d.npz", result))
     np.testing.assert_array_equal(data["depth"], result.depth)

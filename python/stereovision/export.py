@@ -207,9 +207,37 @@ def _pack_rgb(colors: npt.NDArray[np.uint8]) -> npt.NDArray[np.float32]:
     return packed.astype("<u4").view("<f4")
 
 
-def _unpack_rgb(packed: npt.NDArray[np.float32]) -> npt.NDArray[np.uint8]:
-    u = np.ascontiguousarray(packed, dtype="<f4").view("<u4")
+def _unpack_rgb(packed: npt.NDArray[Any]) -> npt.NDArray[np.uint8]:
+    """RGB of PCL's packed colours, ``0x00RRGGBB`` in the bits of 4-byte values.
+
+    The bits, whatever the type that holds them: PCL packs ``rgb`` into a float32 (``TYPE F``),
+    ``rgba`` and some writers into a uint32 (``TYPE U``); a numeric conversion between the two
+    would change the colour.
+    """
+    a = np.ascontiguousarray(packed)
+    if a.dtype.itemsize != 4:
+        raise ValueError(f"packed rgb: expected 4-byte values, got {a.dtype}")
+    u = a.astype(a.dtype.newbyteorder("<"), copy=False).view("<u4")
     return np.stack([(u >> 16) & 255, (u >> 8) & 255, u & 255], axis=-1).astype(np.uint8)
+
+
+def _ascii_rgb_bits(values: npt.NDArray[np.float64], kind: str) -> npt.NDArray[np.uint32]:
+    """The 32 bits of an ASCII PCD's packed colour column (read as float64 numbers).
+
+    ``TYPE U`` and ``I``: the integer is the bits. ``TYPE F``: PCL writes the float's bits as an
+    integer (``16711680`` for red: a float would be NaN for every opaque colour), older writers
+    the float itself (``2.3418052e-38``); an integer token is taken as the bits, any other as
+    the float whose bits they are.
+    """
+    if kind in ("U", "I"):
+        ints = np.where(np.isfinite(values), values, 0).astype(np.int64)
+        return (ints & 0xFFFFFFFF).astype(np.uint32)
+    with np.errstate(invalid="ignore"):
+        integral = np.isfinite(values) & (values == np.floor(values))
+        integral &= (values >= 0) & (values < 2.0**32)
+    as_int = np.where(integral, values, 0).astype(np.uint32)
+    as_float = values.astype("<f4").view("<u4")
+    return np.where(integral, as_int, as_float).astype(np.uint32)
 
 
 def write_pcd(path: PathLike, result: DepthResult) -> Path:
@@ -256,6 +284,11 @@ def read_pcd(
     path: PathLike,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]:
     """Read a PCD file with ``x y z`` (float) and optional packed ``rgb`` (ascii or binary data).
+
+    The colour is PCL's packed ``0x00RRGGBB`` in a 4-byte ``rgb`` (or ``rgba``) field, read as
+    bits whether the header types it ``F`` (``pcl::PointXYZRGB``), ``U`` or ``I``. In ASCII
+    data an integer is the bits (as PCL writes ``rgb``) and, for ``TYPE F``, any other number
+    the float holding them.
 
     Parameters
     ----------
@@ -321,6 +354,14 @@ def read_pcd(
         ) from None
     if width < 0 or height < 0:
         raise ValueError(f"PCD file {p}: negative WIDTH or HEIGHT ({width} x {height})")
+    # The packed colour: "rgb" (PCL's PointXYZRGB, TYPE F) or "rgba" (PointXYZRGBA, TYPE U).
+    colour = next((c for c in ("rgb", "rgba") if c in names), None)
+    if colour is not None and (dtype[colour].shape != () or dtype[colour].itemsize != 4):
+        i = names.index(colour)
+        raise ValueError(
+            f"PCD file {p}: field {colour!r} of SIZE {sizes[i]} COUNT {counts[i]}, expected a "
+            "packed colour (SIZE 4, COUNT 1)"
+        )
     n = width * height
     if mode == "binary":
         if len(raw) - pos < n * dtype.itemsize:
@@ -340,11 +381,15 @@ def read_pcd(
         rec = np.empty(n, dtype=dtype)
         for i, name in enumerate(names):
             col = table[:, i]
-            rec[name] = col.astype(np.uint32).view(np.float32) if name == "rgb" else col
+            if name == colour:  # the bits, stored in the field's own type
+                bits = _ascii_rgb_bits(col, types[i])
+                rec[name] = bits.astype("<u4").view(dtype[name])
+            else:
+                rec[name] = col
     else:
         raise ValueError(f"PCD file {p}: unsupported DATA {mode!r} (ascii or binary)")
     pts = np.stack([rec["x"], rec["y"], rec["z"]], axis=-1).astype(np.float32)
-    cols = _unpack_rgb(np.asarray(rec["rgb"])) if "rgb" in names else None
+    cols = None if colour is None else _unpack_rgb(np.asarray(rec[colour]))
     shape = (height, width)
     return pts.reshape(*shape, 3), None if cols is None else cols.reshape(*shape, 3)
 
