@@ -91,6 +91,13 @@ def test_bag_holds_the_results_values(kitti: tuple, tmp_path: Path) -> None:
     np.testing.assert_allclose(info.k.reshape(3, 3), res.calibration.K1)
     assert info.p[3] == 0.0 and (info.width, info.height) == res.calibration.image_size
     cloud = topics["/stereo/points"][0][1]
+    # PCL's PointXYZRGB: four FLOAT32 (7) fields, rgb the float holding the bits 0x00RRGGBB
+    fields = [(f.name, f.offset, f.datatype, f.count) for f in cloud.fields]
+    assert fields == [("x", 0, 7, 1), ("y", 4, 7, 1), ("z", 8, 7, 1), ("rgb", 12, 7, 1)]
+    as_declared = np.frombuffer(cloud.data.tobytes(), dtype=[(n, "<f4") for n, *_ in fields])
+    bits = as_declared["rgb"].view("<u4")  # what a PCL / RViz reader does with the float
+    rgb = np.stack([(bits >> 16) & 255, (bits >> 8) & 255, bits & 255], axis=-1)
+    np.testing.assert_array_equal(rgb, res.colors)
     xyz_rgb = [("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("rgb", "<u4")]
     rec = np.frombuffer(cloud.data.tobytes(), dtype=xyz_rgb)
     assert cloud.width == len(res.points) == len(rec) and cloud.point_step == 16

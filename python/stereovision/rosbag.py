@@ -17,6 +17,8 @@ topic (``prefix`` = ``/stereo``)  type                              content
                                                                     ``Z = f t / d``, below
                                                                     ``min_disparity`` where none
 ``points``                        ``sensor_msgs/PointCloud2``       ``x y z`` (float32), ``rgb``
+                                                                    (PCL's packed ``0x00RRGGBB``
+                                                                    in a float32)
 ``scan`` (when given)             ``sensor_msgs/LaserScan``         the obstacles on the floor,
                                                                     in ``scan_frame_id``
 ================================  ================================  ===============================
@@ -237,7 +239,9 @@ ros2_static_transform>`.
             field(name="x", offset=0, datatype=7, count=1),  # FLOAT32
             field(name="y", offset=4, datatype=7, count=1),
             field(name="z", offset=8, datatype=7, count=1),
-            field(name="rgb", offset=12, datatype=6, count=1),  # UINT32, as PCL packs it
+            # FLOAT32 (7) holding the bits 0x00RRGGBB: the type pcl::PointXYZRGB gives its rgb
+            # field (pcl_conversions, RViz's RGB8); the bytes are the same as a UINT32's
+            field(name="rgb", offset=12, datatype=7, count=1),
         ]
         return t["sensor_msgs/msg/PointCloud2"](
             header=header,
