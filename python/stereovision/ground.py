@@ -687,9 +687,14 @@ class LaserScan:
 
 
 def _beam_span(calib: Calibration, axes: F64) -> tuple[float, float, int]:
-    """Floor-frame angles of the image's sides (the rays of its border pixels) and its width."""
-    w, h = calib.image_size
-    k_inv = np.linalg.inv(np.asarray(calib.K1, np.float64))
+    """Floor-frame angles of the image's sides (the rays of its border pixels) and its width.
+
+    The rays of the left rectified camera, the frame of the points: a raw rig's own ``K1``
+    (another focal length and centre) would give another field of view.
+    """
+    rc = calib if calib.rectified else calib.rectified_calibration()
+    w, h = rc.image_size
+    k_inv = np.linalg.inv(np.asarray(rc.K1, np.float64))
     u = np.r_[np.zeros(h), np.full(h, w - 1.0), np.arange(w), np.arange(w)]
     v = np.r_[np.arange(h), np.arange(h), np.zeros(w), np.full(w, h - 1.0)]
     rays = np.stack([u, v, np.ones_like(u)], axis=1) @ k_inv.T @ axes[:2].T
@@ -726,8 +731,9 @@ def laser_scan(
         ``(H, W, 3)`` or ``(N, 3)`` points in the left rectified frame (metres, NaN skipped).
     plane : GroundPlane
     calib : Calibration, optional
-        The rectified rig the points come from: sets the default angles, from the left to the
-        right side of the image, one beam per image column.
+        The rig the points come from (rectified or raw: its rectified camera is used): sets
+        the default angles, from the left to the right side of the rectified image, one beam
+        per image column.
     angle_min, angle_max, angle_increment : float, optional
         The beams (radians; REP 103: positive to the left). Needed without ``calib``.
     min_height, max_height : float
