@@ -230,8 +230,29 @@ def test_auto_max_disparity_on_images_too_small_for_features(
     if shape[1] > expected:
         assert sv.depth_map(left, right).disparity.shape == shape
     else:
-        with pytest.raises(ValueError, match="not smaller than the image width"):
+        with pytest.raises(ValueError, match="too narrow for stereo matching"):
             sv.depth_map(left, right)
+
+
+@pytest.mark.parametrize("width", [8, 16])
+def test_too_narrow_images_are_named_not_a_range_never_given(width: int) -> None:
+    """An image 16 px wide or narrower, no range given: the error is the image's width and the
+    17 px the automatic range needs (it named "disparity range 16.0", a range the caller never
+    gave); a range the caller gives that fits runs, one that does not is named."""
+    rng = np.random.default_rng(5)
+    left = (rng.random((12, width)) * 255).astype(np.uint8)
+    right = np.roll(left, -1, axis=1)
+    calib = sv.Calibration.ideal((width, 12), 90, 0.1)
+    with pytest.raises(
+        ValueError,
+        match=rf"^image too narrow for stereo matching: {width} px wide, .* needs images at "
+        rf"least 17 px wide; give a max_disparity below {width} to match it$",
+    ):
+        sv.depth_map(left, right, calib)
+    res = sv.depth_map(left, right, calib, max_disparity=width // 2, method="census")
+    assert res.disparity.shape == (12, width) and res.max_disparity == width // 2
+    with pytest.raises(ValueError, match=rf"disparity range 40 is not smaller .* width {width}"):
+        sv.depth_map(left, right, calib, max_disparity=40)
 
 
 def test_swapped_pair_is_warned_about(data_dir: Path) -> None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 import time
 import warnings
 from collections.abc import Callable
@@ -938,6 +939,7 @@ def depth_map(
     stage("rectify")
     gl = as_gray_float(left, "left")
     gr = as_gray_float(right, "right")
+    automatic = max_disparity is None  # the range is this function's choice, not the caller's
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
     if not np.isfinite(min_disparity) or not np.isfinite(max_disparity):
@@ -946,9 +948,18 @@ def depth_map(
         raise ValueError(
             f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"
         )
+    if max_disparity - min_disparity >= gl.shape[1] and automatic:
+        # a range the caller never gave: the image is the problem (the automatic range is at
+        # least 16 px, so 16 px wide images and narrower are refused)
+        need = math.floor(max_disparity - min_disparity) + 1
+        raise ValueError(
+            f"image too narrow for stereo matching: {gl.shape[1]} px wide, and the automatic "
+            f"disparity range (at least {_DISPARITY_STEP} px) needs images at least {need} px "
+            f"wide; give a max_disparity below {gl.shape[1] + min_disparity:g} to match it"
+        )
     if max_disparity - min_disparity >= gl.shape[1]:
         raise ValueError(
-            f"disparity range {max_disparity - min_disparity} is not smaller than the image "
+            f"disparity range {max_disparity - min_disparity:g} is not smaller than the image "
             f"width {gl.shape[1]}"
         )
     stage("prepare")
