@@ -119,8 +119,45 @@ class Matches:
 
         The matches are in the rectified pair's pixels (what :func:`stereovision.match` gives,
         with or without a calibration); ``calib`` is the pair's calibration (a raw rig's
-        rectified geometry is used). ``Z = f B / (x_l - x_r + doffs)``; a match whose disparity
-        is not positive gives NaN.
+        rectified geometry is used). ``Z = f B / (x_l - x_r + doffs)``, ``doffs = cx_right -
+        cx_left`` (:attr:`~stereovision.Calibration.doffs_px`): a match whose ``x_l - x_r +
+        doffs`` is not positive gives NaN, not one whose disparity is not positive. With
+        ``doffs > 0`` (Middlebury's rigs) a disparity down to ``-doffs`` still gives a point;
+        with ``doffs < 0`` a positive disparity up to ``-doffs`` gives NaN; with ``doffs = 0``
+        (OpenCV's rectification) the two read the same.
+
+        Parameters
+        ----------
+        calib : Calibration
+            The pair's calibration (rectified or raw).
+        unit : str
+            Output unit, metres by default (as :func:`stereovision.depth_from_disparity`).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(N, 3)`` float32, NaN rows where ``x_l - x_r + doffs <= 0``.
+
+        Examples
+        --------
+        Disparities -10, 0 and 5 px with ``doffs = 50`` (``f B`` = 10 m px): three points;
+        disparities 3 and 10 px with ``doffs = -5``: the first is NaN.
+
+        >>> import numpy as np, stereovision as sv
+        >>> K1 = np.array([[100.0, 0, 80], [0, 100, 60], [0, 0, 1]])
+        >>> def rig(doffs):
+        ...     K2 = K1 + [[0, 0, doffs], [0, 0, 0], [0, 0, 0]]
+        ...     return sv.Calibration(K1=K1, D1=np.zeros(5), K2=K2, D2=np.zeros(5), R=np.eye(3),
+        ...                           T=np.array([-0.1, 0, 0]), image_size=(160, 120),
+        ...                           rectified=True)
+        >>> def at_centre(d):
+        ...     n = len(d)
+        ...     return sv.Matches(xl=[80.0] * n, yl=[60.0] * n, xr=80.0 - np.array(d),
+        ...                       yr=[60.0] * n, score=[1.0] * n, image_shape=(120, 160))
+        >>> at_centre([-10, 0, 5]).to_points(rig(50))[:, 2].astype(float).round(4).tolist()
+        [0.25, 0.2, 0.1818]
+        >>> at_centre([3, 10]).to_points(rig(-5))[:, 2].tolist()
+        [nan, 2.0]
 
         Raises
         ------
