@@ -60,10 +60,11 @@ def test_bag_holds_the_results_values(kitti: tuple, tmp_path: Path) -> None:
     with BagWriter(tmp_path / "run") as bag:
         bag.write(res, 1_700_000_000_123_456_789)
         bag.write(lean, 1_700_000_000_223_456_789)
-    assert bag.messages == 10
+    assert bag.messages == 14
     topics = _read(tmp_path / "run")
-    assert sorted(topics) == ["/stereo/depth", "/stereo/disparity", "/stereo/left/camera_info",
-                              "/stereo/left/image_rect_color", "/stereo/points"]  # fmt: skip
+    assert sorted(topics) == ["/stereo/camera_info", "/stereo/depth", "/stereo/disparity",
+                              "/stereo/left/camera_info", "/stereo/left/image_rect_color",
+                              "/stereo/points", "/stereo/right/camera_info"]  # fmt: skip
     # stereo_image_proc's disparity: Z = f t / d, -1 (below min_disparity) where none
     disp = topics["/stereo/disparity"][0][1]
     assert disp.f == pytest.approx(res.calibration.focal_px)
@@ -109,6 +110,47 @@ def test_bag_holds_the_results_values(kitti: tuple, tmp_path: Path) -> None:
     rec2 = np.frombuffer(lean_cloud.data.tobytes(), dtype=rec.dtype)
     np.testing.assert_allclose(np.c_[rec2["x"], rec2["y"], rec2["z"]], res.points, rtol=1e-6)
     np.testing.assert_array_equal(rec2["rgb"], rec["rgb"])
+
+
+def test_bag_camera_infos_of_the_depth_image_and_the_right_camera(
+    kitti: tuple, tmp_path: Path
+) -> None:
+    """The depth image's ``camera_info`` beside it (``/stereo/camera_info``, where
+    image_transport and depth_image_proc look: the bag had none), and the rectified right
+    camera's, whose ``P`` carries ``-fx B``: ROS's stereo model of the two gives back the
+    depth image (``Z = -Tx / (d + cx_r - cx_l)``) and this package's reading of them the rig."""
+    from stereovision.calibration import Calibration, _ros_yaml
+    from stereovision.rosbag import BagWriter
+
+    res, _ = kitti
+    cal = res.calibration
+    with BagWriter(tmp_path / "run") as bag:
+        bag.write(res, 5)
+    topics = _read(tmp_path / "run")
+    left = topics["/stereo/left/camera_info"][0][1]
+    depth_info = topics["/stereo/camera_info"][0][1]
+    right = topics["/stereo/right/camera_info"][0][1]
+    for name in ("k", "d", "r", "p"):
+        np.testing.assert_array_equal(getattr(depth_info, name), getattr(left, name))
+    assert depth_info.header.frame_id == left.header.frame_id == "stereo_left_optical"
+    assert (depth_info.width, depth_info.height) == cal.image_size
+    pl, pr = left.p.reshape(3, 4), right.p.reshape(3, 4)
+    np.testing.assert_allclose(pr[:, :3], cal.K2)
+    assert pr[0, 3] == pytest.approx(-cal.focal_px * cal.baseline_m)
+    assert pl[0, 3] == 0.0 and pr[1, 3] == pr[2, 3] == 0.0
+    assert -pr[0, 3] / pr[0, 0] == pytest.approx(0.5327, abs=1e-4)  # KITTI's 0.54 m rig
+    ok = np.isfinite(res.depth)
+    z = -pr[0, 3] / (res.disparity[ok] + pr[0, 2] - pl[0, 2])
+    np.testing.assert_allclose(z, res.depth[ok], rtol=1e-5)
+    texts = [
+        _ros_yaml(side, (m.width, m.height), m.p.reshape(3, 4)[:, :3], np.zeros(5), np.eye(3),
+                  m.p.reshape(3, 4), "plumb_bob")
+        for side, m in (("left", left), ("right", right))
+    ]  # fmt: skip
+    back = Calibration._from_ros_texts(texts[0], texts[1], "left", "right")
+    assert back.focal_px == pytest.approx(cal.focal_px)
+    assert back.baseline_m == pytest.approx(cal.baseline_m)
+    assert back.doffs_px == pytest.approx(cal.doffs_px, abs=1e-9)
 
 
 def test_bag_errors(kitti: tuple, tmp_path: Path, data_dir: Path) -> None:
@@ -171,4 +213,4 @@ def test_a_full_disk_is_named_and_committed_frames_stay(
         bag.write(res, 2)
     storage.conn.close()  # the process dies here; no metadata.yaml
     with sqlite3.connect(tmp_path / "run" / "run.db3") as db:
-        assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 5
+        assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 7  # one frame

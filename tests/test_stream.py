@@ -398,6 +398,7 @@ def test_stream_records_a_ros2_bag(data_dir: Path, tmp_path: Path) -> None:
     with Reader(bag) as reader:
         counts = {c.topic: c.msgcount for c in reader.connections}
     assert counts == {"/stereo/left/image_rect_color": 3, "/stereo/left/camera_info": 3,
+                      "/stereo/right/camera_info": 3, "/stereo/camera_info": 3,
                       "/stereo/depth": 3, "/stereo/disparity": 3,
                       "/stereo/points": 3}  # fmt: skip
     assert main(["stream", *src, "--no-display", "--bag", str(tmp_path / "b2")]) == 2
@@ -560,7 +561,7 @@ def test_sigterm_finishes_the_bag_of_a_stream(data_dir: Path, tmp_path: Path) ->
     with Reader(bag) as reader:
         counts = {c.topic: c.msgcount for c in reader.connections}
         rows = sum(1 for _ in reader.messages())
-    assert len(counts) == 5 and len(set(counts.values())) == 1, counts  # whole frames
+    assert len(counts) == 7 and len(set(counts.values())) == 1, counts  # whole frames
     assert 1 <= counts["/stereo/depth"] < 300 and rows == sum(counts.values())
 
 

@@ -10,9 +10,16 @@ topic (``prefix`` = ``/stereo``)  type                              content
 ``left/image_rect_color``         ``sensor_msgs/Image``             the rectified left image,
                                                                     ``bgr8``
 ``left/camera_info``              ``sensor_msgs/CameraInfo``        the rectified left camera
-                                                                    (``P``)
+                                                                    (``P = [K | 0]``)
+``right/camera_info``             ``sensor_msgs/CameraInfo``        the rectified right camera:
+                                                                    ``P = [K | (-fx B, 0, 0)]``,
+                                                                    left frame (no right image)
 ``depth``                         ``sensor_msgs/Image``             ``32FC1`` metres, NaN where
                                                                     none
+``camera_info``                   ``sensor_msgs/CameraInfo``        the depth image's camera
+                                                                    (the left one), where
+                                                                    ``image_transport`` and
+                                                                    ``depth_image_proc`` look
 ``disparity``                     ``stereo_msgs/DisparityImage``    as ``stereo_image_proc``:
                                                                     ``Z = f t / d``, below
                                                                     ``min_disparity`` where none
@@ -194,11 +201,19 @@ ros2_static_transform>`.
             data=arr.view(np.uint8).reshape(-1),
         )
 
-    def _camera_info(self, header: Any, result: Any) -> Any:
+    def _camera_info(self, header: Any, result: Any, side: str = "left") -> Any:
+        """The rectified ``side`` camera as ROS's ``CameraInfo``: ``K``, no distortion, and
+        ``P = [K | t]`` projecting points of the left rectified frame, ``t = 0`` for the left
+        camera and ``(-fx B, 0, 0)`` for the right one (ROS's stereo convention: a reader's
+        baseline is ``-P[0, 3] / P[0, 0]``)."""
         t = self._types.types
         cal = result.calibration
-        k = np.asarray(cal.K1, np.float64)
-        p = np.hstack([k, np.zeros((3, 1))])
+        cal = cal if cal.rectified else cal.rectified_calibration()
+        k = np.asarray(cal.K1 if side == "left" else cal.K2, np.float64)
+        shift = np.zeros((3, 1))
+        if side == "right":
+            shift[0, 0] = -k[0, 0] * cal.baseline_m
+        p = np.hstack([k, shift])
         w, h = cal.image_size
         roi = t["sensor_msgs/msg/RegionOfInterest"](
             x_offset=0, y_offset=0, height=0, width=0, do_rectify=False
@@ -355,12 +370,15 @@ ros2_static_transform>`.
                 self._image(header, left, enc),
                 stamp,
             )
-        self._put(
-            "left/camera_info",
-            "sensor_msgs/msg/CameraInfo",
-            self._camera_info(header, result),
-            stamp,
-        )
+        left_info = self._camera_info(header, result)
+        for topic, info in (
+            ("left/camera_info", left_info),
+            ("right/camera_info", self._camera_info(header, result, "right")),
+            # the depth image's camera, where image_transport looks for it: beside ``depth``
+            # (depth_image_proc's point_cloud_xyz subscribes to the two as one camera)
+            ("camera_info", left_info),
+        ):
+            self._put(topic, "sensor_msgs/msg/CameraInfo", info, stamp)
         depth = np.asarray(result.depth, np.float32)
         self._put("depth", "sensor_msgs/msg/Image", self._image(header, depth, "32FC1"), stamp)
         self._put(
