@@ -90,8 +90,8 @@ _QE_MAX_TURN_DEG = 30.0
 #: of a few px: the bump's turn moves more); swapped 0.09 TartanAir, 0.35 and 0.69 ETH3D. The
 #: check refuses 23 of the 27 swapped pairs; it misses bumped ETH3D terrace and playground, and
 #: Tsukuba and a chessboard pair, which swapped fit only Hartley's homographies. Not checked
-#: under them: a hand-held or converging pair's turn can move every match one way (OpenCV's books pair, in
-#: the right order: 0 of 91).
+#: under them: a hand-held or converging pair's turn can move every match one way (OpenCV's
+#: books pair, in the right order: 0 of 91).
 _SWAPPED_SHARE = 0.2
 
 
