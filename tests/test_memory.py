@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import stereovision as sv
 from stereovision import _core
@@ -75,3 +76,48 @@ def test_concurrent_calls_from_python_threads_match_sequential_ones(data_dir: Pa
     assert len(got) == 3 * len(cases)
     for c, out in got:
         np.testing.assert_array_equal(out, expected[c], err_msg=str(c))
+
+
+def _rss_mib() -> float:
+    """The process's resident set (``VmRSS`` of /proc/self/status), MiB."""
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith("VmRSS:"):
+            return int(line.split()[1]) / 1024
+    raise AssertionError("no VmRSS line in /proc/self/status")
+
+
+def _has_malloc_trim() -> bool:
+    import ctypes
+
+    try:
+        ctypes.CDLL(None).malloc_trim  # noqa: B018 (the lookup is the test)
+    except (OSError, TypeError, AttributeError):
+        return False
+    return True
+
+
+@pytest.mark.skipif(
+    not Path("/proc/self/status").exists() or not _has_malloc_trim(),
+    reason="needs Linux's /proc and glibc's malloc_trim",
+)
+def test_release_memory_returns_the_freed_heap_to_the_system() -> None:
+    """After a depth_map on a 3600 x 3000 pair the process stayed at 11-12 GB resident with
+    0.6 GiB kept: the rest was free memory glibc held in its heap. release_memory now trims
+    that heap as well (here a 900 x 750 pair: about 530 MiB at the peak; the old function left
+    210-265 MiB of it resident, the new about 45)."""
+    from stereovision.gui import bundled_data_dir
+
+    scene = load_scene(bundled_data_dir() / "cones")
+    left = np.repeat(np.repeat(scene.left, 2, axis=0), 2, axis=1)
+    right = np.repeat(np.repeat(scene.right, 2, axis=0), 2, axis=1)
+    sv.release_memory()
+    base = _rss_mib()
+    res = sv.depth_map(left, right, max_disparity=2 * scene.max_disparity, cloud=False)
+    del res
+    peak = _rss_mib()
+    assert peak - base > 300, (base, peak)  # the call did grow the heap
+    released = sv.release_memory()
+    assert released > 0
+    assert _core.kept_memory() == ((0, 0), 0)
+    after = _rss_mib()
+    assert after - base < 0.2 * (peak - base), (base, peak, after)
