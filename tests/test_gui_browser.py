@@ -438,6 +438,44 @@ def test_a_computed_pair_hands_its_memory_back():
     assert _core.kept_memory() == ((0, 0), 0)
 
 
+def test_an_opened_cloud_stays_shown_in_both_view_modes(tmp_path):
+    """After "Open" of a PLY the points / surface toggle swapped in the scene's points while the
+    caption still named the file. The file now stays on show in both modes (it has no surface:
+    the caption says so), until the next computed pair replaces it."""
+    from stereovision.gui import bundled_data_dir
+
+    n = 500
+    pts = np.random.default_rng(0).uniform([-1, -1, 2], [1, 1, 4], (n, 3)).astype("<f4")
+    header = f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\n"
+    header += "property float x\nproperty float y\nproperty float z\nend_header\n"
+    (tmp_path / "blob.ply").write_bytes(header.encode() + pts.tobytes())
+    app = _scene_app("test-cloud-modes", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")  # with its calibration: a 3-D scene
+    _run(app, app.recompute)
+
+    def shown() -> tuple[int, int]:
+        poly = app.plotter.actors["scene"].GetMapper().GetInput()
+        return poly.GetNumberOfPoints(), poly.GetNumberOfPolys()
+
+    assert shown()[0] > 10 * n and shown()[1] > 0  # the scene's surface
+    app.state.cloud_path = str(tmp_path / "blob.ply")
+    app.open_cloud()
+    assert app.state.error == ""
+    label = app.folders.label((tmp_path / "blob.ply").resolve())
+    assert shown() == (n, 0)
+    no_surface = " (a point cloud has no surface: shown as points)"
+    assert app.state.message_3d == f"{label}: {n} points{no_surface}"
+    for mode in ("points", "surface", "points"):
+        app.state.view_mode = mode
+        app._on_view_mode()
+        assert shown() == (n, 0), mode
+        assert app.state.message_3d.startswith(f"{label}: {n} points"), mode
+    assert app.state.message_3d == f"{label}: {n} points"
+    _run(app, app.recompute)  # a new pair: its scene replaces the file, drawn as points
+    assert shown()[0] > 10 * n and shown()[1] == 0
+    assert "blob" not in app.state.message_3d
+
+
 def test_buttons_before_a_pair_say_so():
     """Check rows, Rectify, Find floor and a method click before any pair: one sentence on the
     page (they did nothing, silently)."""

@@ -411,6 +411,10 @@ class StereoApp:
         self.calib: Any = None
         self.max_disparity: int | None = None
         self.view: ViewData | None = None
+        #: The point-cloud file on show ("Open") and its caption: it stays in the 3-D view
+        #: whichever way the surface / points toggle is set, until the next computed pair.
+        self._cloud: Any = None
+        self._cloud_caption = ""
         # what the page shows came from: put back when a new pair fails to compute, so that
         # Check rows and Find floor never work on a pair the page does not show
         self._shown: dict[str, Any] | None = None
@@ -656,10 +660,18 @@ class StereoApp:
         except (ValueError, OSError) as exc:
             self._fail(exc)
             return
+        self._cloud = cloud
+        self._cloud_caption = f"{self.folders.label(path)}: {cloud.n_points} points"
         self._show_geometry(cloud, None)
         self._done()
         with self.state:
-            self.state.message_3d = f"{self.folders.label(path)}: {cloud.n_points} points"
+            self.state.message_3d = self._cloud_message()
+
+    def _cloud_message(self) -> str:
+        """The 3-D caption while a point-cloud file is shown (it has no surface to draw)."""
+        if self.state.view_mode == "points":
+            return self._cloud_caption
+        return f"{self._cloud_caption} (a point cloud has no surface: shown as points)"
 
     def reset_camera(self) -> None:
         """Back to the left camera's pose (all six controls at zero)."""
@@ -845,6 +857,7 @@ class StereoApp:
 
     def _publish(self, view: ViewData) -> None:
         self.view = view
+        self._cloud = None  # the new pair's scene replaces an opened cloud file
         if view.mesh is not None:  # drawn as the points / surface toggle shows
             self._show_geometry(self._geometry_for_mode(), view.intrinsics)
         else:
@@ -871,6 +884,8 @@ class StereoApp:
     def _geometry_for_mode(self) -> Any:
         from stereovision.render import point_cloud
 
+        if self._cloud is not None:
+            return self._cloud  # an opened file: points in either mode
         v = self.view
         if v is None or v.mesh is None:
             return None
@@ -913,6 +928,10 @@ class StereoApp:
         self._apply_camera()
 
     def _on_view_mode(self, **_: Any) -> None:
+        if self._cloud is not None:  # the opened file stays; only its caption changes
+            with self.state:
+                self.state.message_3d = self._cloud_message()
+            return
         geometry = self._geometry_for_mode()
         if geometry is not None:
             self._show_geometry(geometry, self.view.intrinsics if self.view else None)
