@@ -476,6 +476,46 @@ def test_an_opened_cloud_stays_shown_in_both_view_modes(tmp_path):
     assert "blob" not in app.state.message_3d
 
 
+def test_a_failed_scene_choice_puts_the_list_back(tmp_path):
+    """A scene that failed (to load, or to compute) stayed chosen in the list, so choosing it
+    again did nothing (trame reports only a changed value). The list now goes back to the
+    scene on show, and choosing the failed one again retries (and fails again, saying so)."""
+    import asyncio
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    good = tmp_path / "good"
+    shutil.copytree(bundled_data_dir() / "cones", good)
+    (tmp_path / "tiny").mkdir()  # loads, then fails to compute
+    (tmp_path / "odd").mkdir()  # fails to load: the two images differ in size
+    for side in ("left", "right"):
+        cv2.imwrite(str(tmp_path / "tiny" / f"{side}.png"), np.zeros((8, 8, 3), np.uint8))
+    cv2.imwrite(str(tmp_path / "odd" / "left.png"), np.zeros((40, 50, 3), np.uint8))
+    cv2.imwrite(str(tmp_path / "odd" / "right.png"), np.zeros((40, 60, 3), np.uint8))
+    app = _scene_app("test-scene-back", [tmp_path])
+    app._lock = asyncio.Lock()
+    app._spawn = asyncio.run  # a loaded scene is computed at once
+
+    def choose(path: Path) -> None:
+        app.state.scene = str(path)
+        app._on_scene(scene=str(path))
+
+    choose(good)
+    assert app.state.computations == 1 and app.state.scene == str(good)
+    for bad in ("odd", "tiny", "odd", "tiny"):
+        app.state.error = ""
+        choose(tmp_path / bad)
+        assert app.state.error != "", bad  # it was tried (the first time, and again)
+        assert app.state.scene == str(good), bad
+        assert app.state.source_label == "scene data/good" or app.state.source_label.endswith(
+            "/good"
+        ), bad
+        assert app.state.computations == 1, bad
+    # the good scene is still the one the app works on
+    assert app.pair[0].shape == (375, 450, 3)
+
+
 def test_buttons_before_a_pair_say_so():
     """Check rows, Rectify, Find floor and a method click before any pair: one sentence on the
     page (they did nothing, silently)."""

@@ -418,6 +418,9 @@ class StereoApp:
         # what the page shows came from: put back when a new pair fails to compute, so that
         # Check rows and Find floor never work on a pair the page does not show
         self._shown: dict[str, Any] | None = None
+        #: The scene list's value the current pair came from ("" for any other source): what
+        #: the list goes back to when another choice fails.
+        self._scene = ""
         self._computing = False
         self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1)
         self._generation = 0
@@ -498,6 +501,7 @@ class StereoApp:
     def _other_source(self) -> None:
         """The pair no longer comes from the scene list: clear its choice, so that choosing the
         same scene again loads it (trame reports only a changed value)."""
+        self._scene = ""
         self.state.scene = ""
 
     def _spawn(self, coro: Any) -> None:
@@ -581,13 +585,17 @@ class StereoApp:
             self._fail(ValueError(NO_PAIR))
 
     def _on_scene(self, scene: str = "", **_: Any) -> None:
-        if not scene:
+        if not scene or scene == self._scene:  # cleared, or put back after a failure
             return
         try:
             self._load_scene(scene)
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
+            # the list shows the scene on show again, so that choosing the failed one retries
+            # (trame reports only a changed value)
+            self.state.scene = self._scene
             return
+        self._scene = scene
         self._spawn(self.recompute())
 
     def capture(self) -> None:
@@ -736,6 +744,7 @@ class StereoApp:
                             setattr(self, name, value)
                     with self.state:
                         self.state.source_label = shown["source_label"]
+                        self.state.scene = self._scene  # the failed choice can be made again
                         self.state.error += " (the page still shows the previous pair)"
                 return
             finally:
@@ -747,6 +756,7 @@ class StereoApp:
                 "max_disparity": self.max_disparity,
                 "homographies": self.homographies,
                 "source_label": self.state.source_label,
+                "_scene": self._scene,
             }
             self._publish(view)
 
