@@ -170,6 +170,65 @@ def test_gui_cli_errors_exit_2(tmp_path, capsys):
     assert "data folder not found" in capsys.readouterr().err
 
 
+def _gui_process(*args: str) -> subprocess.Popen:
+    cmd = [sys.executable, "-m", "stereovision.gui", "--no-browser", *args]
+    return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def test_gui_port_0_announces_the_port_it_got():
+    """``gui --port 0`` printed ``http://127.0.0.1:0/``: the address was printed before the
+    server bound. It is now printed once the server listens, with the port the system chose."""
+    import threading
+    import urllib.request
+
+    pytest.importorskip("trame")
+    proc = _gui_process("--port", "0")
+    watchdog = threading.Timer(STARTUP_TIMEOUT_S, proc.kill)  # a hung start ends the read
+    watchdog.start()
+    try:
+        line = proc.stdout.readline()  # blocks until the server listens (or exits)
+        watchdog.cancel()
+        m = re.fullmatch(
+            r"stereovision gui on http://127\.0\.0\.1:(\d+)/ \(Ctrl\+C to stop\)\n", line
+        )
+        assert m is not None, (line, proc.poll())
+        port = int(m.group(1))
+        assert port > 0
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=30) as reply:
+            assert reply.status == 200 and b"<html" in reply.read().lower()
+    finally:
+        watchdog.cancel()
+        proc.terminate()
+        proc.wait(timeout=30)
+
+
+def test_gui_on_a_busy_port_says_so_in_one_line():
+    """A busy port: the address was announced first, then
+    ``[Errno 98] error while attempting to bind on address ...``. Now nothing is announced and
+    the error says which port is taken and what to do."""
+    pytest.importorskip("trame")
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        proc = _gui_process("--port", str(port))
+        out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 2
+    assert out == ""
+    assert err == (
+        f"stereovision: error: port {port} on 127.0.0.1 is in use (another server?): "
+        "choose another with --port, or --port 0 for a free one\n"
+    )
+
+
+def test_gui_url_brackets_an_ipv6_host():
+    from stereovision.gui import url_for
+
+    assert url_for("127.0.0.1", 8080) == "http://127.0.0.1:8080/"
+    assert url_for("::1", 41000) == "http://[::1]:41000/"
+    assert url_for("localhost", 1) == "http://localhost:1/"
+
+
 def test_add_cli_registers_gui():
     from stereovision.gui import DEFAULT_HOST, add_cli
 

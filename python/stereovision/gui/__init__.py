@@ -13,13 +13,14 @@ from the bundled demo data and the folders given with ``--data``.
 from __future__ import annotations
 
 import argparse
+import errno
 import sys
 from collections.abc import Sequence
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
-__all__ = ["DEFAULT_HOST", "DEFAULT_PORT", "add_cli", "build_app", "cmd_gui", "main"]
+__all__ = ["DEFAULT_HOST", "DEFAULT_PORT", "add_cli", "build_app", "cmd_gui", "main", "url_for"]
 
 #: Loopback only by default: exposing the robot's cameras is an explicit decision (--host).
 DEFAULT_HOST = "127.0.0.1"
@@ -92,16 +93,46 @@ def build_app(args: argparse.Namespace) -> Any:
     )
 
 
+def url_for(host: str, port: int) -> str:
+    """The page's address: ``http://host:port/`` (an IPv6 host in brackets).
+
+    Examples
+    --------
+    >>> url_for("127.0.0.1", 8080)
+    'http://127.0.0.1:8080/'
+    >>> url_for("::1", 8080)
+    'http://[::1]:8080/'
+    """
+    return f"http://[{host}]:{port}/" if ":" in host else f"http://{host}:{port}/"
+
+
 def cmd_gui(args: argparse.Namespace) -> int:
-    """``stereovision gui``: build the app and serve it until interrupted."""
+    """``stereovision gui``: build the app and serve it until interrupted.
+
+    The address is printed once the server listens, with the port it got (``--port 0``: a
+    free one the system chose).
+
+    Raises
+    ------
+    OSError
+        The server cannot listen there: ``"port 8080 on 127.0.0.1 is in use ..."`` when another
+        program holds the port, the system's reason otherwise.
+    """
     app = build_app(args)
-    url = f"http://{args.host}:{args.port}/"
-    print(f"stereovision gui on {url} (Ctrl+C to stop)", flush=True)
-    if args.host not in LOOPBACK_HOSTS:
-        print(
-            f"note: listening on {args.host}: anyone who can reach this address sees the cameras",
-            file=sys.stderr,
-        )
+    bound = []
+
+    def announce(**_: Any) -> None:
+        bound.append(app.server.port)
+        url = url_for(args.host, app.server.port)
+        print(f"stereovision gui on {url} (Ctrl+C to stop)", flush=True)
+        if args.host not in LOOPBACK_HOSTS:
+            print(
+                f"note: listening on {args.host}: anyone who can reach this address sees the "
+                "cameras",
+                file=sys.stderr,
+            )
+
+    app.ctrl.on_server_ready.add(announce)  # after the bind: the real port, and only if it bound
     argv, sys.argv = sys.argv, sys.argv[:1]  # trame parses sys.argv itself: give it nothing
     try:
         app.server.start(
@@ -111,6 +142,19 @@ def cmd_gui(args: argparse.Namespace) -> int:
             show_connection_info=False,
             timeout=0,
         )
+    except OSError as exc:
+        if bound:  # a later failure: its own message
+            raise
+        if exc.errno == errno.EADDRINUSE:
+            msg = (
+                f"port {args.port} on {args.host} is in use (another server?): choose another "
+                "with --port, or --port 0 for a free one"
+            )
+        else:
+            msg = f"cannot listen on {args.host} port {args.port}: {exc.strerror or exc}"
+        err = OSError(msg)
+        err.errno = exc.errno
+        raise err from exc
     finally:
         sys.argv = argv
         if app.source is not None:
