@@ -27,7 +27,19 @@ from stereovision.calibrate import (
 )
 from stereovision.calibration import Calibration
 
-DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "chessboard"
+#: ``<repo>/../shared/data/chessboard``, or the shared copy when the repo is a git worktree
+#: elsewhere (as tests/test_doctests.py finds it).
+DATA = next(
+    (
+        d
+        for d in (
+            Path(__file__).resolve().parents[2] / "shared" / "data" / "chessboard",
+            Path("/work/shared/data/chessboard"),
+        )
+        if d.is_dir()
+    ),
+    Path(__file__).resolve().parents[2] / "shared" / "data" / "chessboard",
+)
 CHESSBOARD_IDS = ("01", "02", "03", "04", "05", "06", "07", "08", "09", "11", "12", "13", "14")
 
 #: Acceptance figures of issue 6 on OpenCV's sample pairs (its stereo_calib pipeline: 0.448 px
