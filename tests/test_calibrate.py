@@ -181,7 +181,7 @@ def test_chessboard_all_pairs_used_and_rms(
 ) -> None:
     cal, rep = chessboard
     print("\n" + rep.summary())
-    assert rep.used_pairs == [f"left{i}.jpg" for i in CHESSBOARD_IDS]
+    assert rep.used_pairs == [f"left{i}.jpg / right{i}.jpg" for i in CHESSBOARD_IDS]
     assert rep.rejected_pairs == {}
     assert rep.rms <= MAX_STEREO_RMS
     assert rep.rms_left <= MAX_STEREO_RMS and rep.rms_right <= MAX_STEREO_RMS
@@ -435,8 +435,8 @@ def test_cli_end_to_end(
     text = capsys.readouterr().out
     n = SYN_GOOD_PAIRS
     assert f"{n}/{n + 2} pairs used" in text
-    assert f"rejected L{n:02d}.png: board not found in left" in text
-    assert f"rejected L{n + 1:02d}.png: outlier" in text
+    assert f"rejected L{n:02d}.png / R{n:02d}.png: board not found in left" in text
+    assert f"rejected L{n + 1:02d}.png / R{n + 1:02d}.png: outlier" in text
     cal = Calibration.load(out)
     ref = synthetic_dropped[0]
     assert np.allclose(cal.K1, ref.K1, rtol=1e-9) and np.allclose(cal.T, ref.T, rtol=1e-9)
@@ -468,3 +468,67 @@ def test_cli_end_to_end(
     with pytest.raises(ValueError, match="pattern"):
         run("--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "R*.png"),
             "--pattern", "nine", "--square", "1", "-o", str(out))  # fmt: skip
+
+
+# ------------------------------------------------------------------------ mis-paired images
+
+
+def _mispaired_paths() -> tuple[list[Path], list[Path]]:
+    """OpenCV's pairs with left05 and right06 missing: left06 is paired with right05."""
+    left, right = _chessboard_paths()
+    return [p for p in left if p.name != "left05.jpg"], [
+        p for p in right if p.name != "right06.jpg"
+    ]
+
+
+def test_mispaired_images_are_refused(cached_corners: None) -> None:
+    """One dropped frame on each side (left05, right06) paired left06 with right05: the stereo
+    RMS was 11.6 px (each camera alone 0.18 / 0.19 px), the baseline 0.25 m for 0.083 m, and the
+    calibration was returned. Now a ValueError names the worst pair by both its files, and the
+    different file numbers are warned about; dropping the outliers recovers the rig."""
+    left, right = _mispaired_paths()
+    with (
+        pytest.warns(UserWarning, match=r"file numbers differ in left06\.jpg / right05\.jpg:"),
+        pytest.raises(ValueError, match=r"stereo RMS 1\d\.\d px, while each camera alone") as err,
+    ):
+        calibrate(left, right, pattern=(9, 6), square_size=1.0)
+    msg = str(err.value)
+    assert "mis-paired" in msg and "drop_outliers=True" in msg
+    assert "Worst pairs: left06.jpg / right05.jpg (26." in msg
+    with pytest.warns(UserWarning, match="file numbers differ"):
+        _, rep = calibrate(left, right, pattern=(9, 6), square_size=1.0, drop_outliers=True)
+    assert list(rep.rejected_pairs) == ["left06.jpg / right05.jpg"]
+    assert rep.rms < MAX_STEREO_RMS and len(rep.used_pairs) == 11
+    assert rep.used_pairs[0] == "left01.jpg / right01.jpg"
+
+
+def test_a_swapped_pair_is_refused(cached_corners: None) -> None:
+    """Pair 03's left and right images swapped: stereo RMS 30.8 px, returned with exit 0."""
+    left, right = _chessboard_paths()
+    left[2], right[2] = right[2], left[2]
+    with pytest.raises(ValueError, match=r"Worst pairs: right03\.jpg / left03\.jpg \(9\d\.\d px\)"):
+        calibrate(left, right, pattern=(9, 6), square_size=1.0)
+
+
+def test_cli_mispaired_says_the_option(
+    cached_corners: None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """From the CLI the hint is --drop-outliers (it said drop_outliers=...), nothing is written;
+    with --drop-outliers the summary names the rejected pair by both files."""
+    left, right = _mispaired_paths()
+    for p in (*left, *right):
+        (tmp_path / p.name).symlink_to(p)
+    out = tmp_path / "rig.yaml"
+    argv = ["calibrate", "--left", str(tmp_path / "left*.jpg"), "--right",
+            str(tmp_path / "right*.jpg"), "--square", "0.025", "-o", str(out)]  # fmt: skip
+    args = _parser().parse_args(argv)
+    with pytest.warns(UserWarning), pytest.raises(ValueError) as err:
+        args.func(args)
+    assert "--drop-outliers" in str(err.value) and "drop_outliers" not in str(err.value)
+    assert not out.exists()
+    args = _parser().parse_args([*argv, "--drop-outliers"])
+    with pytest.warns(UserWarning):
+        assert args.func(args) == 0
+    text = capsys.readouterr().out
+    assert "rejected left06.jpg / right05.jpg: outlier: error 26." in text
+    assert Calibration.load(out).baseline == pytest.approx(0.083, abs=0.001)

@@ -17,7 +17,10 @@ Pipeline (:func:`calibrate`):
    refinement of all parameters (``CALIB_USE_INTRINSIC_GUESS``), kept only if it lowers the RMS.
 4. **Outliers.** A pair whose reprojection error is above :data:`OUTLIER_FACTOR` x the median
    (and above :data:`OUTLIER_MIN_PX`) is reported; with ``drop_outliers=True`` it is dropped and
-   the solve repeated.
+   the solve repeated. A final stereo RMS above :data:`MAX_STEREO_RMS_PX` and
+   :data:`MISPAIRED_RMS_RATIO` x each camera's own RMS is refused as mis-paired images (a
+   ValueError naming the worst pairs), and left and right file names numbered differently are
+   warned about.
 5. **Checks** reported in :class:`CalibrationReport`: rectified epipolar error of all corners,
    the square size measured by triangulating the corners, image coverage.
 
@@ -34,6 +37,8 @@ import html
 import json
 import math
 import os
+import re
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -137,6 +142,21 @@ MIN_PAIRS = 3
 CHARUCO_MIN_COMMON = 6
 #: Outlier rejection rounds at most (each round re-solves once).
 MAX_OUTLIER_ROUNDS = 3
+#: A stereo solution is refused when its RMS exceeds this (px) ...
+MAX_STEREO_RMS_PX = 3.0
+#: ... and this multiple of each camera's own RMS. A correct rig's stereo RMS is close to the
+#: single-camera ones (OpenCV's sample pairs: 0.20 px stereo, 0.18 / 0.19 px alone; the
+#: ChArUco set: 0.08 / 0.07 / 0.09 px): each camera fits its own boards, so a stereo error far
+#: above theirs means the pairs do not show one rig. One pair of those samples mis-paired (a
+#: dropped frame shifting the pairing) gave 11.6 px; the pairing shifted from the fifth pair on,
+#: 27.1 px; one pair swapped left for right, 30.8 px, with baselines of 0.25-1.7 m for 0.08 m.
+MISPAIRED_RMS_RATIO = 3.0
+#: Pairs named in the error of a refused solution (the worst first).
+WORST_PAIRS_SHOWN = 3
+#: The API's and the CLI's words for dropping the outliers (a message says the one its reader
+#: can type).
+DROP_OUTLIERS_API = "drop_outliers=True"
+DROP_OUTLIERS_CLI = "--drop-outliers"
 
 #: The coverage mask is computed at 1/4 resolution (the figure is a percentage).
 COVERAGE_DOWNSCALE = 4
@@ -510,8 +530,20 @@ class CalibrationReport:
             }
         return out
 
-    def summary(self) -> str:
-        """A few lines for a terminal."""
+    def summary(self, *, drop_option: str = DROP_OUTLIERS_API) -> str:
+        """A few lines for a terminal.
+
+        Parameters
+        ----------
+        drop_option : str
+            How the reader drops outliers, named where outliers were kept (the CLI passes
+            ``"--drop-outliers"``).
+
+        Returns
+        -------
+        str
+            The summary, one figure per line.
+        """
         n = len(self.used_pairs)
         total = n + len(self.rejected_pairs)
         lines = [
@@ -531,7 +563,7 @@ class CalibrationReport:
             lines.append(f"  rejected {name}: {reason}")
         for name in self.outlier_pairs:
             if name not in self.rejected_pairs:
-                lines.append(f"  outlier kept (drop_outliers=False): {name}")
+                lines.append(f"  outlier kept: {name} (drop it with {drop_option})")
         return "\n".join(lines)
 
     def save(self, path: PathLike) -> None:
@@ -887,6 +919,8 @@ def _load_gray(item: object, what: str) -> tuple[np.ndarray, str | None]:
 def _pair_names(
     left_names: list[str | None], right_names: list[str | None], names: Sequence[str] | None
 ) -> list[str]:
+    """Each pair's name: ``names``, else ``"left06.png / right06.png"`` (one name when both files
+    have it), else ``pair_NN``; made unique with an index prefix."""
     n = len(left_names)
     if names is not None:
         out = [str(s) for s in names]
@@ -895,10 +929,66 @@ def _pair_names(
     else:
         out = []
         for i, (a, b) in enumerate(zip(left_names, right_names, strict=True)):
-            out.append(a or b or f"pair_{i:02d}")
+            if a and b and a != b:
+                out.append(f"{a} / {b}")
+            else:
+                out.append(a or b or f"pair_{i:02d}")
     if len(set(out)) != len(out):
         out = [f"{i:02d}:{s}" for i, s in enumerate(out)]
     return out
+
+
+def _file_number(name: str | None) -> int | None:
+    """The last number in a file name's stem (``left06.jpg`` -> 6), or None."""
+    if not name:
+        return None
+    digits = re.findall(r"\d+", Path(name).stem)
+    return int(digits[-1]) if digits else None
+
+
+def _numbers_differ(
+    left_names: Sequence[str | None], right_names: Sequence[str | None], pair_names: Sequence[str]
+) -> list[str]:
+    """Pairs whose left and right file names both carry a number, and not the same one."""
+    out = []
+    for a, b, name in zip(left_names, right_names, pair_names, strict=True):
+        na, nb = _file_number(a), _file_number(b)
+        if na is not None and nb is not None and na != nb:
+            out.append(name)
+    return out
+
+
+def _check_pairing(
+    sol: _Solution, names: Sequence[str], differ: Sequence[str], dropped: bool
+) -> None:
+    """Refuse a solution whose pairs do not show one rig (see :data:`MISPAIRED_RMS_RATIO`)."""
+    mono = max(sol.rms_left, sol.rms_right)
+    if sol.rms <= MAX_STEREO_RMS_PX or sol.rms <= MISPAIRED_RMS_RATIO * mono:
+        return
+    pair_err = np.sqrt(np.mean(sol.per_view**2, axis=1))
+    worst = np.argsort(-pair_err)[:WORST_PAIRS_SHOWN]
+    listed = ", ".join(f"{names[k]} ({pair_err[k]:.1f} px)" for k in worst)
+    numbers = (
+        f"; the file numbers differ in {', '.join(differ[:WORST_PAIRS_SHOWN])}"
+        + (
+            f" and {len(differ) - WORST_PAIRS_SHOWN} more"
+            if len(differ) > WORST_PAIRS_SHOWN
+            else ""
+        )
+        if differ
+        else ""
+    )
+    raise ValueError(
+        f"stereo RMS {sol.rms:.1f} px, while each camera alone fits its boards to "
+        f"{sol.rms_left:.2f} / {sol.rms_right:.2f} px: the pairs do not show one rig; are they "
+        f"mis-paired (a missing file shifting the pairing, or a pair swapped)? Worst pairs: "
+        f"{listed}{numbers}. "
+        + (
+            "Dropping the outliers left too many such pairs: check the pairing of the files"
+            if dropped
+            else f"Check those pairs, or drop the outliers with {DROP_OUTLIERS_API}"
+        )
+    )
 
 
 # ------------------------------------------------------------------------------------- public
@@ -961,7 +1051,16 @@ def calibrate(
     ValueError
         If a file cannot be decoded, the lists differ in length, the images differ in size, an
         argument is invalid, or fewer than :data:`MIN_PAIRS` pairs show the board in both images.
-        With ``dictionary="auto"``, also if no image shows enough of the board's markers.
+        With ``dictionary="auto"``, also if no image shows enough of the board's markers. If the
+        pairs do not show one rig (stereo RMS above :data:`MAX_STEREO_RMS_PX` and
+        :data:`MISPAIRED_RMS_RATIO` x each camera's; mis-paired or swapped images): the message
+        names the worst pairs.
+
+    Warns
+    -----
+    UserWarning
+        If the left and right file names of a pair carry different numbers (``left06.jpg`` with
+        ``right05.jpg``).
 
     Examples
     --------
@@ -1083,6 +1182,20 @@ def calibrate(
         corner_ids.append(ids)
     assert size is not None
     pair_names = _pair_names(left_names, right_names, names)
+    differ = _numbers_differ(left_names, right_names, pair_names)
+    if differ:
+        shown = ", ".join(differ[:WORST_PAIRS_SHOWN])
+        more = (
+            f" and {len(differ) - WORST_PAIRS_SHOWN} more"
+            if len(differ) > WORST_PAIRS_SHOWN
+            else ""
+        )
+        warnings.warn(
+            f"the left and right file numbers differ in {shown}{more}: the pairs are taken in "
+            "order, so a missing or extra file shifts the pairing",
+            UserWarning,
+            stacklevel=2,
+        )
 
     rejected: dict[str, str] = {}
     used: list[int] = []
@@ -1151,6 +1264,9 @@ def calibrate(
                 f"({OUTLIER_FACTOR:g} x median, at least {OUTLIER_MIN_PX:g} px)"
             )
         used = [i for k, i in enumerate(used) if k not in set(bad)]
+    _check_pairing(
+        sol, [pair_names[i] for i in used], [d for d in differ if d not in rejected], drop_outliers
+    )
 
     t = np.ravel(sol.T)
     if t[0] > 0 and abs(t[0]) > abs(t[1]):
@@ -1458,7 +1574,8 @@ def _error_chart(rep: CalibrationReport) -> np.ndarray:
         color_r = _RED if n in rep.outlier_pairs else _ORANGE
         cv2.rectangle(img, (x0, ypix(el[k])), (x0 + bw, top + plot_h), color_l, -1)
         cv2.rectangle(img, (x0 + bw, ypix(er[k])), (x0 + 2 * bw, top + plot_h), color_r, -1)
-        label = n if len(n) <= 16 else n[:15] + "~"
+        label = n.split(" / ")[0]  # the left file's name: both do not fit the axis
+        label = label if len(label) <= 16 else label[:15] + "~"
         (tw, th), _ = cv2.getTextSize(label, _FONT, 0.4, 1)
         tag = np.full((th + 6, tw + 4, 3), 255, np.uint8)
         _text(tag, label, (2, th + 2), 0.4)
@@ -1856,24 +1973,27 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         "distortion": args.distortion,
         "drop_outliers": args.drop_outliers,
     }
-    if args.from_bag:
-        cal, rep = calibrate_from_bag(
-            args.from_bag,
-            left_topic=args.left_topic,
-            right_topic=args.right_topic,
-            max_skew_ms=args.max_skew_ms,
-            max_pairs=args.max_pairs,
-            log=print,
-            **common,
-        )
-    elif video:
-        cal, rep = calibrate_from_video(
-            args.left[0], args.right[0], max_pairs=args.max_pairs, log=print, **common
-        )
-    else:
-        cal, rep = calibrate(lefts, rights, **common)
+    try:
+        if args.from_bag:
+            cal, rep = calibrate_from_bag(
+                args.from_bag,
+                left_topic=args.left_topic,
+                right_topic=args.right_topic,
+                max_skew_ms=args.max_skew_ms,
+                max_pairs=args.max_pairs,
+                log=print,
+                **common,
+            )
+        elif video:
+            cal, rep = calibrate_from_video(
+                args.left[0], args.right[0], max_pairs=args.max_pairs, log=print, **common
+            )
+        else:
+            cal, rep = calibrate(lefts, rights, **common)
+    except ValueError as exc:  # say the CLI's option, not the API's keyword
+        raise ValueError(str(exc).replace(DROP_OUTLIERS_API, DROP_OUTLIERS_CLI)) from None
     cal.save(out)
-    print(rep.summary())
+    print(rep.summary(drop_option=DROP_OUTLIERS_CLI))
     print(cal.describe())
     print(f"calibration written to {out}")
     if ros_dir is not None:
