@@ -532,3 +532,54 @@ def test_cli_mispaired_says_the_option(
     text = capsys.readouterr().out
     assert "rejected left06.jpg / right05.jpg: outlier: error 26." in text
     assert Calibration.load(out).baseline == pytest.approx(0.083, abs=0.001)
+
+
+# --------------------------------------------------------------------- outputs, before the work
+
+
+def test_cli_outputs_that_collide_or_cannot_be_written_are_refused_first(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """-o rp/report.yaml --report rp, and -o ros/left.yaml --ros ros: the report and the ROS
+    files overwrote the calibration just written. An -o in a folder that cannot be written was
+    found after the calibration, naming a hidden temp file. All are refused before any corner
+    is looked for, and a file already there is kept."""
+
+    def no_work(*_: Any, **__: Any) -> Any:
+        raise AssertionError("the corners were looked for before the outputs were checked")
+
+    monkeypatch.setattr(calmod, "find_corners", no_work)
+    left, right = _chessboard_paths()
+    base = ["calibrate", "--left", str(left[0].parent / "left0*.jpg"), "--right",
+            str(right[0].parent / "right0*.jpg"), "--square", "0.025"]  # fmt: skip
+
+    def run(*argv: str) -> int:
+        a = _parser().parse_args([*base, *argv])
+        return int(a.func(a))
+
+    (tmp_path / "rp").mkdir()
+    kept = tmp_path / "rp" / "report.yaml"
+    kept.write_text("kept\n")
+    with pytest.raises(
+        ValueError,
+        match=r"-o .*report\.yaml: --report .*rp writes report\.yaml there too and would "
+        "overwrite the calibration",
+    ):
+        run("-o", str(kept), "--report", str(tmp_path / "rp"))
+    assert kept.read_text() == "kept\n"
+    (tmp_path / "ros").mkdir()
+    for name in ("left.yaml", "right.yaml"):
+        with pytest.raises(ValueError, match=rf"--ros .*ros/\. writes {name} there too"):
+            run("-o", str(tmp_path / "ros" / name), "--ros", str(tmp_path / "ros") + "/.")
+    (tmp_path / "dir.yaml").mkdir()
+    with pytest.raises(ValueError, match=r"-o .*dir\.yaml: is a folder"):
+        run("-o", str(tmp_path / "dir.yaml"))
+
+    def refused(*_: Any, **__: Any) -> Any:
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(calmod.tempfile, "mkstemp", refused)
+    with pytest.raises(
+        PermissionError, match=rf"-o {tmp_path}/rig\.yaml: cannot write in {tmp_path} \(Perm"
+    ):
+        run("-o", str(tmp_path / "rig.yaml"))

@@ -38,6 +38,7 @@ import json
 import math
 import os
 import re
+import tempfile
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
@@ -1928,6 +1929,55 @@ def _expand(pattern: str, option: str) -> list[str]:
     return [p]
 
 
+def _check_output_file(
+    out: Path, given: str, *, ros: str | None = None, report: str | None = None
+) -> None:
+    """Refuse, before the work, an ``-o`` that cannot be written or that another output of the
+    same run would overwrite (the report's ``report.yaml``, the ROS ``left.yaml``).
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The calibration file.
+    given : str
+        ``-o`` as the user typed it, for the messages.
+    ros, report : str, optional
+        The ``--ros`` and ``--report`` folders.
+
+    Raises
+    ------
+    ValueError
+        If ``out`` is a folder, or is one of the files ``--ros`` or ``--report`` write.
+    PermissionError
+        If ``out``'s folder (or ``out`` itself, when it exists) is not writable.
+    """
+    if out.is_dir():
+        raise ValueError(f"-o {given}: is a folder; give a calibration file name")
+    folder = out.parent if str(out.parent) else Path(".")
+    # A probe file, as the atomic save will make one (os.access says yes to root everywhere).
+    try:
+        fd, probe = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".probe", dir=folder)
+    except OSError as exc:
+        raise PermissionError(f"-o {given}: cannot write in {folder} ({exc.strerror})") from None
+    os.close(fd)
+    os.remove(probe)
+    if out.exists() and not os.access(out, os.W_OK):
+        raise PermissionError(f"-o {given}: the file is not writable")
+    target = out.resolve()
+    for flag, where, files in (
+        ("--report", report, ("report.html", "report.yaml", "report.json")),
+        ("--ros", ros, ("left.yaml", "right.yaml")),
+    ):
+        if not where:
+            continue
+        for name in files:
+            if (Path(where) / name).resolve() == target:
+                raise ValueError(
+                    f"-o {given}: {flag} {where} writes {name} there too and would overwrite the "
+                    "calibration; give -o another name or folder"
+                )
+
+
 def cmd_calibrate(args: argparse.Namespace) -> int:
     """``stereovision calibrate --left GLOB --right GLOB --pattern 9x6 --square S -o FILE``
     (``--board charuco --marker M`` for a ChArUco board; ``--ros DIR`` also writes ROS
@@ -1954,6 +2004,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         raise ValueError(f"-o {args.output}: use a .yaml, .yml, .xml or .json file name")
     if not out.parent.exists() and str(out.parent):
         raise FileNotFoundError(f"-o {args.output}: directory {out.parent} does not exist")
+    _check_output_file(out, args.output, ros=args.ros, report=args.report)
     ros_dir = Path(args.ros) if args.ros else None
     if ros_dir is not None and ros_dir.exists() and not ros_dir.is_dir():
         raise ValueError(f"--ros {args.ros}: is a file; give a folder for left.yaml and right.yaml")
