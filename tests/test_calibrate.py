@@ -583,3 +583,31 @@ def test_cli_outputs_that_collide_or_cannot_be_written_are_refused_first(
         PermissionError, match=rf"-o {tmp_path}/rig\.yaml: cannot write in {tmp_path} \(Perm"
     ):
         run("-o", str(tmp_path / "rig.yaml"))
+
+
+def test_patterns_too_small_or_not_integers_are_refused(tmp_path: Path) -> None:
+    """2x2 and 2x5 reached OpenCV ("internal error" from cv2.error), 9 said "'int' object is not
+    iterable", and (9.5, 6) was truncated to (9, 6)."""
+    for bad in ("2x2", "2x5", (5, 2)):
+        with pytest.raises(ValueError, match=r"needs at least 3 each way"):
+            parse_pattern(bad)
+    with pytest.raises(ValueError, match=r"--pattern: 2x5 inner corners; a chessboard needs"):
+        parse_pattern("2x5", "--pattern")
+    with pytest.raises(TypeError, match=r"pattern: expected inner corners as \(cols, rows\)"):
+        parse_pattern(9)  # type: ignore[arg-type]
+    for bad_pair in ((9.5, 6), (9, 6.0), (True, 6)):
+        with pytest.raises(TypeError, match=r"pattern: corner counts must be integers"):
+            parse_pattern(bad_pair)  # type: ignore[arg-type]
+    assert parse_pattern((np.int64(9), np.int32(6))) == (9, 6)
+    assert parse_pattern("3x3") == (3, 3)
+    left, right = _chessboard_paths()
+    with pytest.raises(TypeError, match=r"corner counts must be integers, got 9\.5"):
+        calibrate(left[:3], right[:3], pattern=(9.5, 6), square_size=1.0)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="needs at least 3 each way"):
+        find_corners(np.zeros((100, 100), np.uint8), (2, 5))
+    args = _parser().parse_args(
+        ["board", "-o", str(tmp_path / "b.png"), "--pattern", "2x5", "--square", "0.025"]
+    )
+    with pytest.raises(ValueError, match=r"^--pattern: 2x5 inner corners"):
+        args.func(args)
+    assert not (tmp_path / "b.png").exists()

@@ -898,7 +898,7 @@ def test_cli_capture(
         run("--left", str(left), "--right", str(right), "--size", "big", "-o", str(out))
     with pytest.raises(ValueError, match="count"):
         run("--left", str(left), "--right", str(right), "--count", "0", "-o", str(out))
-    with pytest.raises(ValueError, match="pattern"):
+    with pytest.raises(ValueError, match=r"--chessboard: expected inner corners as COLSxROWS"):
         run("--left", str(left), "--right", str(right), "--chessboard", "9", "-o", str(out))
     src = ("--left", str(left), "--right", str(right), "-o", str(out))
     with pytest.raises(ValueError, match="give the board's --square and --marker sides too"):

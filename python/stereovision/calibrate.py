@@ -83,6 +83,9 @@ SB_FLAG_SETS: tuple[int, ...] = (
     cv2.CALIB_CB_ACCURACY,
     cv2.CALIB_CB_ACCURACY | cv2.CALIB_CB_NORMALIZE_IMAGE | cv2.CALIB_CB_EXHAUSTIVE,
 )
+#: Fewest inner corners of a chessboard each way: OpenCV's detectors refuse fewer (2x5 was an
+#: "internal error" from cv2.error).
+MIN_PATTERN_CORNERS = 3
 #: Flags of the classic detector, the last resort.
 CLASSIC_FLAGS = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
 #: ``cornerSubPix`` half-window as a fraction of the smallest corner spacing in the image.
@@ -180,23 +183,28 @@ MAX_VIDEO_PAIRS = 60
 # ------------------------------------------------------------------------------------- helpers
 
 
-def parse_pattern(text: str | Sequence[int]) -> tuple[int, int]:
+def parse_pattern(text: str | Sequence[int], name: str = "pattern") -> tuple[int, int]:
     """Parse a chessboard pattern ``"9x6"`` (inner corners per row x per column).
 
     Parameters
     ----------
     text : str or sequence of int
-        ``"COLSxROWS"`` or ``(cols, rows)``.
+        ``"COLSxROWS"`` or ``(cols, rows)`` (Python or NumPy integers).
+    name : str
+        How the caller calls it, for the messages (the CLI's ``"--pattern"``).
 
     Returns
     -------
     tuple of int
-        ``(cols, rows)``, both >= 2.
+        ``(cols, rows)``, both >= :data:`MIN_PATTERN_CORNERS`.
 
     Raises
     ------
+    TypeError
+        If ``text`` is neither a string nor a pair of integers (``9``, ``(9.5, 6)``).
     ValueError
-        If the text is not two integers >= 2 separated by ``x``.
+        If the text is not two integers separated by ``x``, or a count is below
+        :data:`MIN_PATTERN_CORNERS` (OpenCV's detectors need a corner inside each side).
     """
     if isinstance(text, str):
         parts = text.lower().replace("*", "x").split("x")
@@ -204,10 +212,34 @@ def parse_pattern(text: str | Sequence[int]) -> tuple[int, int]:
             vals = [int(p) for p in parts]
         except ValueError:
             vals = []
+        if len(vals) != 2:
+            raise ValueError(
+                f"{name}: expected inner corners as COLSxROWS (e.g. 9x6), got {text!r}"
+            )
     else:
-        vals = [int(v) for v in text]
-    if len(vals) != 2 or min(vals) < 2:
-        raise ValueError(f"pattern: expected inner corners as COLSxROWS (e.g. 9x6), got {text!r}")
+        try:
+            items = list(text)
+        except TypeError:
+            raise TypeError(
+                f"{name}: expected inner corners as (cols, rows) or 'COLSxROWS' (e.g. '9x6'), "
+                f"got {type(text).__name__} {text!r}"
+            ) from None
+        if len(items) != 2:
+            raise ValueError(
+                f"{name}: expected inner corners as (cols, rows), got {len(items)} values {text!r}"
+            )
+        for v in items:
+            if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, np.integer)):
+                raise TypeError(
+                    f"{name}: corner counts must be integers, got {v!r} "
+                    f"({type(v).__name__}) in {text!r}"
+                )
+        vals = [int(v) for v in items]
+    if min(vals) < MIN_PATTERN_CORNERS:
+        raise ValueError(
+            f"{name}: {vals[0]}x{vals[1]} inner corners; a chessboard needs at least "
+            f"{MIN_PATTERN_CORNERS} each way (e.g. 9x6 for a board of 10x7 squares)"
+        )
     return vals[0], vals[1]
 
 
@@ -330,10 +362,14 @@ def find_corners(image: npt.ArrayLike, pattern: tuple[int, int] = (9, 6)) -> F64
     Raises
     ------
     ValueError
-        If ``image`` is not an image.
+        If ``image`` is not an image, or ``pattern`` is not a chessboard's (see
+        :func:`parse_pattern`).
+    TypeError
+        If ``pattern`` is not a pair of integers or a ``"COLSxROWS"`` string.
     """
     from stereovision._validate import as_gray_uint8
 
+    pattern = parse_pattern(pattern)
     gray = as_gray_uint8(image, "image")
     found: npt.NDArray[np.float32] | None = None
     # checkChessboard (~2 ms) is a quick look for a board: it saw all 26 sample boards; when it
@@ -2017,7 +2053,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
             check_output_folder(folder, flag)
     board = _cli_board(args, printing=False)
     common: dict[str, Any] = {
-        "pattern": parse_pattern(args.pattern or "9x6"),
+        "pattern": parse_pattern(args.pattern or "9x6", "--pattern"),
         "square_size": args.square,
         "board": board,
         "unit": args.unit,
@@ -2114,7 +2150,7 @@ def cmd_board(args: argparse.Namespace) -> int:
         data, (w, h) = board_png(board, square * UNIT_TO_METRES[args.unit], dpi)
         what = board.describe(args.unit)
     else:
-        pat = parse_pattern(args.pattern or "9x6")
+        pat = parse_pattern(args.pattern or "9x6", "--pattern")
         data, (w, h) = board_png(pat, square * UNIT_TO_METRES[args.unit], dpi)
         what = f"chessboard {pat[0]}x{pat[1]} inner corners, square {square:g} {args.unit}"
     with atomic_write(out) as fh:

@@ -1369,7 +1369,7 @@ def _end_reason(exc: SourceError, saved: list[tuple[Path, Path]], last_index: in
 
 def cmd_capture(args: argparse.Namespace) -> int:
     """``stereovision capture --left 0 --right 1 --size 1280x720 -o pairs/``."""
-    pattern = parse_pattern(args.chessboard) if args.chessboard else None
+    pattern = parse_pattern(args.chessboard, "--chessboard") if args.chessboard else None
     board = None
     if args.charuco:
         from stereovision.charuco import CharucoBoard
