@@ -611,3 +611,19 @@ def test_patterns_too_small_or_not_integers_are_refused(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match=r"^--pattern: 2x5 inner corners"):
         args.func(args)
     assert not (tmp_path / "b.png").exists()
+
+
+def test_the_triangulated_square_is_not_claimed_as_a_check_of_the_given_one(
+    chessboard: tuple[Calibration, CalibrationReport], cached_corners: None
+) -> None:
+    """The summary said "square 1.00022 measured vs 1 given (+0.02 %)" as if the square size had
+    been checked; the triangulation inherits the given square's scale, so twice the square gives
+    the same +0.02 %. The summary now gives the sides' spread and says what it cannot tell."""
+    _, rep = chessboard
+    left, right = _chessboard_paths()
+    _, rep2 = calibrate(left, right, pattern=(9, 6), square_size=2.0, unit="cm")
+    assert rep2.square_size_error == pytest.approx(rep.square_size_error, abs=1e-6)
+    text = rep.summary()
+    assert "measured vs" not in text
+    assert "triangulated square sides spread 0.65 % (in the given square's scale: a wrong " in text
+    assert "square size is not detected" in text
