@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -627,3 +628,29 @@ def test_the_triangulated_square_is_not_claimed_as_a_check_of_the_given_one(
     assert "measured vs" not in text
     assert "triangulated square sides spread 0.65 % (in the given square's scale: a wrong " in text
     assert "square size is not detected" in text
+
+
+def test_cli_unit_warning_is_given_once_in_the_cli_words(
+    cached_corners: None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--square 0.025 --unit mm (a square in metres, said to be millimetres) passed silently and
+    printed "baseline 0.0 cm"; --square 25 (millimetres, unit m) was warned about three times,
+    as unit='m' with the suggestion unit='mm' whatever the case."""
+    left, right = _chessboard_paths()
+    base = ["calibrate", "--left", str(left[0].parent / "left*.jpg"), "--right",
+            str(right[0].parent / "right*.jpg"), "-o", str(tmp_path / "rig.yaml"),
+            "--ros", str(tmp_path / "ros")]  # fmt: skip
+    for square, unit, said in (
+        ("0.025", "mm", r"shorter than any stereo rig's \(1 mm\): are T \(or --square\) in "
+         r"another unit than --unit mm\? With --unit m it would be 8\.3 cm\."),
+        ("25", "m", r"longer than a robot's rig \(5 m\): are T \(or --square\) in another unit "
+         r"than --unit m\? With --unit mm it would be 8\.3 cm\."),
+    ):  # fmt: skip
+        args = _parser().parse_args([*base, "--square", square, "--unit", unit])
+        with pytest.warns(UserWarning) as record:
+            assert args.func(args) == 0
+        texts = [str(w.message) for w in record]
+        assert len([t for t in texts if "baseline" in t]) == 1, texts
+        assert any(re.search(said, t) for t in texts), texts
+    out = capsys.readouterr().out
+    assert "baseline 0.0832 mm (0.0831" in out and "baseline 0.0 cm" not in out

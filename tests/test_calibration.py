@@ -128,14 +128,16 @@ def test_frozen_and_replace_revalidates() -> None:
         c.unit = "mm"  # type: ignore[misc]
     with pytest.raises(ValueError, match="read-only"):
         c.T[0] = 5.0
-    assert dataclasses.replace(c, unit="mm").baseline_m == pytest.approx(c.baseline / 1000)
+    with pytest.warns(UserWarning, match="shorter than any stereo rig"):  # 0.12 mm: re-checked
+        assert dataclasses.replace(c, unit="mm").baseline_m == pytest.approx(c.baseline / 1000)
     with pytest.raises(ValueError, match="T: zero baseline"):
         dataclasses.replace(c, T=np.zeros(3))
 
 
 def test_equality() -> None:
     assert raw_calib() == raw_calib()
-    assert raw_calib() != raw_calib(unit="mm")
+    with pytest.warns(UserWarning, match="shorter than any stereo rig"):
+        assert raw_calib() != raw_calib(unit="mm")
     assert raw_calib() != raw_calib(T=np.array([-0.13, 0.0, 0.0]))
 
 
@@ -667,3 +669,28 @@ def test_a_raw_rig_with_the_right_camera_on_the_left_is_named() -> None:
     one is refused)."""
     with pytest.warns(UserWarning, match=r"T: the right camera sits to the left of the left one"):
         raw_calib(T=np.array([0.12, 0.002, 0.003]))
+
+
+def test_baseline_implausible_for_its_unit_is_warned_once_and_printed_readably() -> None:
+    """A 0.03 m square given with unit="mm" made a 0.12 mm "rig" without a word, whose describe
+    said "baseline 0.0 cm"; the long-baseline warning suggested unit='mm' whatever the unit was
+    and came again from every derived calibration (describe, rescaling)."""
+    import warnings
+
+    with pytest.warns(
+        UserWarning,
+        match=r"^baseline 0\.12 mm = 0\.00012 m, shorter than any stereo rig's \(1 mm\): are T "
+        r"\(or the board's square size\) in another unit than unit='mm'\? With unit='m' it "
+        r"would be 12\.0 cm\.$",
+    ):
+        tiny = raw_calib(T=np.array([-0.12, 0.0, 0.0]), unit="mm")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # derived calibrations do not warn again
+        text = tiny.describe()
+        tiny.scaled_to((160, 120)).rectified_calibration()
+    assert "baseline 0.12 mm (0.12 mm)" in text and "0.0 cm" not in text
+    with pytest.warns(UserWarning, match=r"longer than a robot's rig \(5 m\): .* unit='m'\? With "):
+        raw_calib(T=np.array([-120.0, 0.0, 0.0]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        raw_calib(T=np.array([-4.0, 0.0, 0.0]), unit="mm")  # an endoscope's 4 mm

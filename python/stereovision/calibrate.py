@@ -2023,6 +2023,38 @@ def _check_output_file(
                 )
 
 
+def _cli_words(text: str) -> str:
+    """A message of :func:`calibrate` in the CLI's words (``--drop-outliers``, ``--unit mm``)."""
+    text = text.replace(DROP_OUTLIERS_API, DROP_OUTLIERS_CLI)
+    text = text.replace("the board's square size", "--square")
+    return re.sub(r"\bunit='(\w+)'", r"--unit \1", text)
+
+
+def _calibrate_source(
+    args: argparse.Namespace,
+    video: bool,
+    lefts: list[str],
+    rights: list[str],
+    common: dict[str, Any],
+) -> tuple[Calibration, CalibrationReport]:
+    """Calibrate from the source the options give: a bag, two videos or two sets of images."""
+    if args.from_bag:
+        return calibrate_from_bag(
+            args.from_bag,
+            left_topic=args.left_topic,
+            right_topic=args.right_topic,
+            max_skew_ms=args.max_skew_ms,
+            max_pairs=args.max_pairs,
+            log=print,
+            **common,
+        )
+    if video:
+        return calibrate_from_video(
+            args.left[0], args.right[0], max_pairs=args.max_pairs, log=print, **common
+        )
+    return calibrate(lefts, rights, **common)
+
+
 def cmd_calibrate(args: argparse.Namespace) -> int:
     """``stereovision calibrate --left GLOB --right GLOB --pattern 9x6 --square S -o FILE``
     (``--board charuco --marker M`` for a ChArUco board; ``--ros DIR`` also writes ROS
@@ -2069,25 +2101,20 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         "distortion": args.distortion,
         "drop_outliers": args.drop_outliers,
     }
+    caught: list[warnings.WarningMessage] = []
     try:
-        if args.from_bag:
-            cal, rep = calibrate_from_bag(
-                args.from_bag,
-                left_topic=args.left_topic,
-                right_topic=args.right_topic,
-                max_skew_ms=args.max_skew_ms,
-                max_pairs=args.max_pairs,
-                log=print,
-                **common,
-            )
-        elif video:
-            cal, rep = calibrate_from_video(
-                args.left[0], args.right[0], max_pairs=args.max_pairs, log=print, **common
-            )
-        else:
-            cal, rep = calibrate(lefts, rights, **common)
-    except ValueError as exc:  # say the CLI's option, not the API's keyword
-        raise ValueError(str(exc).replace(DROP_OUTLIERS_API, DROP_OUTLIERS_CLI)) from None
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            cal, rep = _calibrate_source(args, video, lefts, rights, common)
+    except ValueError as exc:
+        raise ValueError(_cli_words(str(exc))) from None
+    finally:  # said in the CLI's words, once each (and also when the calibration failed)
+        seen: set[str] = set()
+        for w in caught:
+            text = _cli_words(str(w.message))
+            if text not in seen:
+                seen.add(text)
+                warnings.warn(text, w.category, stacklevel=1)
     cal.save(out)
     print(rep.summary(drop_option=DROP_OUTLIERS_CLI))
     print(cal.describe())

@@ -19,6 +19,7 @@ import json
 import math
 import os
 import re
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, cast
@@ -89,9 +90,53 @@ def _as_float_array(value: object, name: str, shapes: tuple[tuple[int, ...], ...
 #: square size, given in millimetres with the default unit "m" (83 m for a 8 cm rig). Long-range
 #: rigs on vehicles reach 1-2 m.
 LONG_BASELINE_M = 5.0
+#: Baselines below this (metres) get a warning too: the square size given in metres with
+#: unit="mm" (a 0.083 mm "rig" for 8.3 cm). The smallest stereo rigs (endoscopes) have a few
+#: millimetres.
+SHORT_BASELINE_M = 1e-3
+#: The baseline range (metres) a suggested other unit should bring the baseline into: from a
+#: phone's or an endoscope's rig to a car's.
+PLAUSIBLE_BASELINE_M = (0.005, 2.0)
 #: Largest camera-matrix skew (px) taken without a warning: OpenCV's calibration writes 0, and
 #: a converted or hand-written file may carry rounding dust.
 SKEW_IGNORED_PX = 1e-6
+
+
+#: Set while this module derives a calibration from one already checked (the rectified pair,
+#: a rescaled one): the baseline warnings were given for the original, once.
+_DERIVING: ContextVar[bool] = ContextVar("_DERIVING", default=False)
+
+
+def _unit_suggestion(baseline: float, unit: str) -> str:
+    """The units in which ``baseline`` (a number given in ``unit``) would be a plausible rig's,
+    as ``" With unit='m' it would be 8.3 cm."``, or ``""``."""
+    lo, hi = PLAUSIBLE_BASELINE_M
+    for other, factor in UNIT_TO_METRES.items():
+        m = baseline * factor
+        if other != unit and lo <= m <= hi:
+            return f" With unit={other!r} it would be {_format_length(m)}."
+    return ""
+
+
+def _format_length(metres: float) -> str:
+    """A length for people: ``"1.25 m"``, ``"8.3 cm"``, ``"0.0832 mm"`` (never ``"0.0 cm"``).
+
+    Parameters
+    ----------
+    metres : float
+        The length in metres (``inf`` and NaN are written as such).
+
+    Returns
+    -------
+    str
+        Metres from 1 m, centimetres from 1 cm, else millimetres with 3 significant digits.
+    """
+    m = float(metres)
+    if not math.isfinite(m) or abs(m) >= 1:
+        return f"{m:.2f} m"
+    if abs(m) >= 0.01:
+        return f"{100 * m:.1f} cm"
+    return f"{1000 * m:.3g} mm"
 
 
 def _check_camera_matrix(K: F64, name: str) -> None:
@@ -285,13 +330,21 @@ class Calibration:
                 UserWarning,
                 stacklevel=3,
             )
-        if self.baseline_m > LONG_BASELINE_M:
+        if _DERIVING.get():
+            return
+        if self.baseline_m > LONG_BASELINE_M or self.baseline_m < SHORT_BASELINE_M:
             import warnings
 
+            long = self.baseline_m > LONG_BASELINE_M
             warnings.warn(
-                f"baseline {self.baseline:g} {self.unit} = {self.baseline_m:g} m, longer than "
-                f"a robot's rig ({LONG_BASELINE_M:g} m): are T (or the board's square size) in "
-                f"another unit than unit={self.unit!r}? e.g. unit='mm'",
+                f"baseline {self.baseline:g} {self.unit} = {self.baseline_m:g} m, "
+                + (
+                    f"longer than a robot's rig ({LONG_BASELINE_M:g} m)"
+                    if long
+                    else f"shorter than any stereo rig's ({1000 * SHORT_BASELINE_M:g} mm)"
+                )
+                + f": are T (or the board's square size) in another unit than "
+                f"unit={self.unit!r}?{_unit_suggestion(self.baseline, self.unit)}",
                 UserWarning,
                 stacklevel=3,
             )
@@ -617,17 +670,21 @@ class Calibration:
                     "R, T: the rig is vertical (stereoRectify produced a vertical baseline); "
                     "only horizontal rigs are supported"
                 )
-            self._cache[key] = Calibration(
-                K1=p1[:, :3],
-                D1=np.zeros(5),
-                K2=p2[:, :3],
-                D2=np.zeros(5),
-                R=np.eye(3),
-                T=np.array([p2[0, 3] / p2[0, 0], 0.0, 0.0]),
-                image_size=self.image_size,
-                unit=self.unit,
-                rectified=True,
-            )
+            token = _DERIVING.set(True)
+            try:
+                self._cache[key] = Calibration(
+                    K1=p1[:, :3],
+                    D1=np.zeros(5),
+                    K2=p2[:, :3],
+                    D2=np.zeros(5),
+                    R=np.eye(3),
+                    T=np.array([p2[0, 3] / p2[0, 0], 0.0, 0.0]),
+                    image_size=self.image_size,
+                    unit=self.unit,
+                    rectified=True,
+                )
+            finally:
+                _DERIVING.reset(token)
         cal: Calibration = self._cache[key]
         return cal
 
@@ -677,9 +734,7 @@ class Calibration:
         hfov = math.degrees(math.atan((cx + 0.5) / f) + math.atan((w - 0.5 - cx) / f))
         vfov = math.degrees(math.atan((cy + 0.5) / fy) + math.atan((h - 0.5 - cy) / fy))
 
-        def length(m: float) -> str:
-            return f"{100 * m:.1f} cm" if m < 1 else f"{m:.2f} m"
-
+        length = _format_length
         near = ", ".join(
             f"{d} px {length(f * b / (d + doffs))}" for d in (64, 128, 256) if d + doffs > 0
         )
@@ -738,19 +793,23 @@ class Calibration:
             out[1, 2] = (k[1, 2] + 0.5) * sy - 0.5
             return out
 
-        return Calibration(
-            K1=scale(self.K1),
-            D1=self.D1,
-            K2=scale(self.K2),
-            D2=self.D2,
-            R=self.R,
-            T=self.T,
-            image_size=size,
-            unit=self.unit,
-            rectified=self.rectified,
-            doffs=None if self.doffs is None else self.doffs * sx,
-            model=self.model,
-        )
+        token = _DERIVING.set(True)
+        try:
+            return Calibration(
+                K1=scale(self.K1),
+                D1=self.D1,
+                K2=scale(self.K2),
+                D2=self.D2,
+                R=self.R,
+                T=self.T,
+                image_size=size,
+                unit=self.unit,
+                rectified=self.rectified,
+                doffs=None if self.doffs is None else self.doffs * sx,
+                model=self.model,
+            )
+        finally:
+            _DERIVING.reset(token)
 
     def to_camera_frame(self, points: npt.ArrayLike) -> npt.NDArray[np.floating[Any]]:
         """Points from the left *rectified* frame to the left camera's own frame.
