@@ -654,3 +654,30 @@ def test_cli_unit_warning_is_given_once_in_the_cli_words(
         assert any(re.search(said, t) for t in texts), texts
     out = capsys.readouterr().out
     assert "baseline 0.0832 mm (0.0831" in out and "baseline 0.0 cm" not in out
+
+
+def test_identical_images_and_folders_are_named(cached_corners: None, tmp_path: Path) -> None:
+    """The same images as left and right solved to a 2e-11 m baseline, were written, and then
+    "the rig is vertical" was the error; a folder given as --left was "image file not found"."""
+    left, _ = _chessboard_paths()
+    with pytest.raises(
+        ValueError,
+        match=r"^the left and right images look identical: the board is at the same pixels "
+        r"\(within 0\.01 px\) in both images of all 4 pairs; are they the same files",
+    ):
+        calibrate(left[:4], left[:4], pattern=(9, 6), square_size=1.0)
+    with pytest.raises(ValueError, match=r": is a folder, not an image file; list its images"):
+        calibrate([DATA] * 3, [DATA] * 3, square_size=1.0)
+    out = tmp_path / "rig.yaml"
+    args = _parser().parse_args(
+        ["calibrate", "--left", str(DATA), "--right", str(DATA), "--square", "1", "-o", str(out)]
+    )
+    with pytest.raises(ValueError, match=rf"^--left {DATA}: is a folder; give its images as a "):
+        args.func(args)
+    args = _parser().parse_args(
+        ["calibrate", "--left", str(DATA / "left0*.jpg"), "--right", str(DATA / "left0*.jpg"),
+         "--square", "1", "-o", str(out)]
+    )  # fmt: skip
+    with pytest.raises(ValueError, match="look identical"):
+        args.func(args)
+    assert not out.exists()

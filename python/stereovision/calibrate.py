@@ -158,6 +158,9 @@ MAX_STEREO_RMS_PX = 3.0
 #: dropped frame shifting the pairing) gave 11.6 px; the pairing shifted from the fifth pair on,
 #: 27.1 px; one pair swapped left for right, 30.8 px, with baselines of 0.25-1.7 m for 0.08 m.
 MISPAIRED_RMS_RATIO = 3.0
+#: Left and right corners closer than this (px) in every pair: the two image sets are one
+#: (the solver then returned a 2e-11 m baseline and the rectification called the rig vertical).
+IDENTICAL_CORNERS_PX = 0.01
 #: Pairs named in the error of a refused solution (the worst first).
 WORST_PAIRS_SHOWN = 3
 #: The API's and the CLI's words for dropping the outliers (a message says the one its reader
@@ -1181,6 +1184,8 @@ def calibrate(
     sample: tuple[int, np.ndarray, np.ndarray] | None = None
     for item in (*lefts, *rights):
         if isinstance(item, (str, os.PathLike)) and not Path(item).is_file():
+            if Path(item).is_dir():
+                raise ValueError(f"{item}: is a folder, not an image file; list its images")
             raise FileNotFoundError(f"image file not found: {item}")
 
     for i, (li, ri) in enumerate(zip(lefts, rights, strict=True)):
@@ -1269,6 +1274,13 @@ def calibrate(
             + (f" (rejected: {', '.join(rejected)})" if rejected else "")
         )
 
+    gap = max(float(np.abs(corners_l[i] - corners_r[i]).max()) for i in used)  # type: ignore[operator]
+    if gap < IDENTICAL_CORNERS_PX:
+        raise ValueError(
+            f"the left and right images look identical: the board is at the same pixels (within "
+            f"{IDENTICAL_CORNERS_PX:g} px) in both images of all {len(used)} pairs; are they the "
+            "same files, or one camera twice?"
+        )
     obj_pts = board_object_points(pat, square)
     if distortion == "fisheye":
         unusable = _fisheye_unusable(
@@ -1971,6 +1983,11 @@ def _expand(pattern: str, option: str) -> list[str]:
     p = os.path.expanduser(pattern)
     if not os.path.exists(p):
         raise FileNotFoundError(f"{option}: file not found: {pattern}")
+    if os.path.isdir(p):
+        example = os.path.join(pattern, "*.png")
+        raise ValueError(
+            f"{option} {pattern}: is a folder; give its images as a quoted glob, e.g. '{example}'"
+        )
     return [p]
 
 
