@@ -296,6 +296,39 @@ def test_calibrate_argument_errors(rig: dict[str, Any]) -> None:
         calibrate(flat, flat, board=CharucoBoard("10x7", 0.03, 0.022))
 
 
+def test_an_unresolved_board_blames_what_is_unknown(tmp_path: Path) -> None:
+    """With the dictionary given (an even number of rows, so the layout unknown), the error
+    still said "to tell its dictionary; give dictionary= ...", also from the CLI."""
+    import argparse
+
+    from stereovision.calibrate import add_cli
+
+    flat = [np.full((480, 640), 90, np.uint8)] * 3
+    with pytest.raises(ValueError) as err:
+        calibrate(flat, flat, board=CharucoBoard("10x6", 0.03, 0.022, "DICT_5X5_100"))
+    msg = str(err.value)
+    assert msg.startswith(
+        "no image shows the 10x6 ChArUco board's DICT_5X5_100 markers well enough to tell its "
+        "layout: check that the board has these squares and markers of that dictionary"
+    )
+    assert "legacy=True for OpenCV's pre-4.6" in msg and "give it" not in msg
+    for i in range(3):
+        cv2.imwrite(str(tmp_path / f"L{i}.png"), flat[0])
+    parser = argparse.ArgumentParser(prog="stereovision")
+    add_cli(parser.add_subparsers(dest="command", required=True))
+    base = ["calibrate", "--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "L*.png"),
+            "--board", "charuco", "--square", "0.03", "--marker", "0.022",
+            "-o", str(tmp_path / "rig.yaml")]  # fmt: skip
+    for extra, said in (
+        (["--pattern", "10x6", "--dictionary", "DICT_5X5_100"], "(--legacy for OpenCV's pre-4.6 "),
+        (["--pattern", "10x7"], "dictionary; give it (e.g. --dictionary DICT_5X5_100)"),
+    ):
+        args = parser.parse_args([*base, *extra])
+        with pytest.raises(ValueError) as err:
+            args.func(args)
+        assert said in str(err.value) and "=" not in str(err.value), str(err.value)
+
+
 # -------------------------------------------------------------------------- printable board
 
 

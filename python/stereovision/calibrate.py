@@ -1263,9 +1263,18 @@ def calibrate(
         f"chessboard {pat[0]}x{pat[1]} inner corners" if board is None else board.describe(unit)
     )
     if board is not None and not board.resolved:
+        squares = f"{board.squares[0]}x{board.squares[1]}"
+        if board.dictionary == "auto":
+            raise ValueError(
+                f"no image shows enough markers of the {squares} ChArUco board to tell its "
+                "dictionary; give it (e.g. dictionary='DICT_5X5_100')"
+            )
+        # the dictionary was given: the layout of an even number of rows was what stayed unknown
         raise ValueError(
-            f"no image shows enough markers of the {board.squares[0]}x{board.squares[1]} "
-            "ChArUco board to tell its dictionary; give dictionary= (e.g. 'DICT_5X5_100')"
+            f"no image shows the {squares} ChArUco board's {board.dictionary} markers well "
+            "enough to tell its layout: check that the board has these squares and markers "
+            "of that dictionary, or give the layout (legacy=True for OpenCV's pre-4.6 boards, "
+            "legacy=False for later ones)"
         )
     if len(used) < MIN_PAIRS:
         raise ValueError(
@@ -2044,6 +2053,8 @@ def _cli_words(text: str) -> str:
     """A message of :func:`calibrate` in the CLI's words (``--drop-outliers``, ``--unit mm``)."""
     text = text.replace(DROP_OUTLIERS_API, DROP_OUTLIERS_CLI)
     text = text.replace("the board's square size", "--square")
+    text = text.replace("legacy=True", "--legacy").replace("legacy=False", "--no-legacy")
+    text = re.sub(r"\bdictionary='(\w+)'", r"--dictionary \1", text)
     return re.sub(r"\bunit='(\w+)'", r"--unit \1", text)
 
 
