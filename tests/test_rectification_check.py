@@ -310,3 +310,17 @@ def test_align_rows_on_kitti(data_dir: Path) -> None:
     b0 = dense_metrics(given.disparity, s.gt).bad[2.0]
     b1 = dense_metrics(fixed.disparity, s.gt).bad[2.0]
     assert b0 == pytest.approx(13.18, abs=0.01) and b1 < b0 - 2.0
+
+
+def test_a_calibration_file_name_and_numpy_tolerances() -> None:
+    """check_rectification(L, R, "pi.yaml") failed with AttributeError ('str' object has no
+    attribute 'rectify'), where refine_rectification says TypeError; tolerance=np.float32(0.5)
+    was refused as "not a positive number"."""
+    flat = np.zeros((60, 80), np.uint8)
+    with pytest.raises(TypeError, match=r"^calib: expected a stereovision\.Calibration, got str$"):
+        check_rectification(flat, flat, "pi.yaml")
+    for tol in (np.float32(0.5), np.float64(0.5), np.int64(1)):
+        assert check_rectification(flat, flat, tolerance=tol).tolerance == float(tol)
+    for bad in (np.float32("nan"), np.float64(-1.0), np.bool_(True), "0.5"):
+        with pytest.raises(ValueError, match="tolerance: expected a positive number of pixels"):
+            check_rectification(flat, flat, tolerance=bad)  # type: ignore[arg-type]

@@ -197,17 +197,21 @@ def check_rectification(
 
     Raises
     ------
+    TypeError
+        If ``calib`` is given and is not a :class:`~stereovision.Calibration` (a file name:
+        load it with ``Calibration.load``).
     ValueError
         Images that are not images, of different sizes or of the wrong size for ``calib``, or
-        a tolerance that is not a positive number.
+        a tolerance that is not a positive number (Python or NumPy real).
     """
     if (
-        isinstance(tolerance, bool)
-        or not isinstance(tolerance, (int, float))
+        isinstance(tolerance, (bool, np.bool_))
+        or not isinstance(tolerance, (int, float, np.integer, np.floating))
         or not (np.isfinite(tolerance) and tolerance > 0)
     ):
         raise ValueError(f"tolerance: expected a positive number of pixels, got {tolerance!r}")
     if calib is not None:
+        _require_type(calib, "Calibration", "calib")
         left, right = calib.rectify(left, right, alpha=alpha)
     gl, gr = as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
     if gl.shape != gr.shape:
