@@ -333,3 +333,13 @@ def test_uint8_input_gives_the_float_path_matches(layout: str) -> None:
     for f in ("xl", "yl", "xr", "yr", "score"):
         assert np.array_equal(getattr(a, f), getattr(b, f)), f
     assert a.image_shape == b.image_shape == (200, 300)
+
+
+def test_match_keeps_min_disparity() -> None:
+    # The parabola's sub-pixel vertex reached half a pixel below min_disparity (5.5 at 6).
+    sc = _scene("middlebury2001/tsukuba")
+    for method in ("hopfield", "best"):
+        m = sv.match(sc.left, sc.right, method=method, max_disparity=8, min_disparity=6)
+        d = m.xl - m.xr
+        assert len(m) > 500 and float(d.min()) >= 6.0 and float(d.max()) <= 8.0
+        assert m.stats["n_out_of_range"] > 0

@@ -390,3 +390,18 @@ def test_accuracy_on_kitti() -> None:
         sc.left, sc.right, method="mcgm", max_disparity=sc.max_disparity, **MEMBER_MCGM
     )
     assert sparse_metrics(strict.xl, strict.yl, strict.xr, sc.gt).count < 300
+
+
+def test_match_keeps_the_disparity_range() -> None:
+    # MCGM's sub-pixel crossings left the searched range: on cones with max_disparity=32, 190 of
+    # 4760 matches lay above 32 (up to 34.0), and min_disparity=6 on tsukuba gave 4.3 px.
+    sc = _scene("middlebury2003/cones")
+    m = sv.match(sc.left, sc.right, method="mcgm", max_disparity=32)
+    d = m.xl - m.xr
+    assert len(m) > 3000 and float(d.max()) <= 32.0 and float(d.min()) >= 0.0
+    assert m.stats["n_out_of_range"] > 50  # dropped, and said so
+    assert np.isfinite(m.dispx).sum() <= len(m)
+    ts = _scene("middlebury2001/tsukuba")
+    m = sv.match(ts.left, ts.right, method="mcgm", max_disparity=8, min_disparity=6)
+    d = m.xl - m.xr
+    assert len(m) > 500 and float(d.min()) >= 6.0 and float(d.max()) <= 8.0
