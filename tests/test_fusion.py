@@ -196,6 +196,9 @@ def test_fuse_pair_rejects_unknown_options() -> None:
         fuse_pair(img, img, max_disparity=8, tau=1.0)
     with pytest.raises(ValueError, match="unknown channel"):
         fuse_pair(img, img, max_disparity=8, channels=("gabor", "sgbm"))
+    # A misspelt keyword of fuse_pair itself was refused with a list that lacked it.
+    with pytest.raises(ValueError, match=r"did you mean 'check_members'\?.*census_members"):
+        sv_match(img, img, method="fused", max_disparity=8, check_member=False)
 
 
 def test_fused_dense_veto_replace_and_fill() -> None:

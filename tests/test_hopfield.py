@@ -343,3 +343,11 @@ def test_match_keeps_min_disparity() -> None:
         d = m.xl - m.xr
         assert len(m) > 500 and float(d.min()) >= 6.0 and float(d.max()) <= 8.0
         assert m.stats["n_out_of_range"] > 0
+
+
+def test_unknown_parameter_names_the_valid_ones() -> None:
+    ok = np.random.default_rng(0).random((40, 50), dtype=np.float32)
+    with pytest.raises(
+        ValueError, match=r"\['k_cnd'\] \(did you mean 'k_cand'\?\): expected one of .*s_min"
+    ):
+        sv.match(ok, ok, method="hopfield", max_disparity=8, k_cnd=3)

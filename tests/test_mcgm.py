@@ -426,3 +426,16 @@ def test_save_csv_round_trips_exactly(tmp_path: Path) -> None:
     (tmp_path / "short.csv").write_text("x_left,y_left,x_right,y_right,score\n1,2,3,4\n")
     with pytest.raises(ValueError, match="5 numbers"):
         sv.Matches.from_csv(tmp_path / "short.csv", image_shape=(10, 10))
+
+
+def test_unknown_parameter_names_the_valid_ones() -> None:
+    # It named the unknown key only: a user had to read the source for the spelling.
+    ok = np.random.default_rng(0).random((40, 50), dtype=np.float32)
+    with pytest.raises(
+        ValueError,
+        match=r"unknown MCGM parameter\(s\) \['ght_min_scor'\] \(did you mean 'ght_min_score'\?\)"
+        r": expected one of A, B, D, .*zncc_tol \(stereovision.matching.mcgm.DEFAULTS\)",
+    ):
+        sv.match(ok, ok, method="mcgm", max_disparity=8, ght_min_scor=0.5)
+    with pytest.raises(ValueError, match=r"\['zzz'\]: expected one of .*sigmas"):
+        mcgm.curves(ok, zzz=1)

@@ -401,6 +401,30 @@ _CLASSES = {
 }
 
 
+def refuse_unknown(what: str, given: object, valid: object, where: str = "") -> None:
+    """Raise ``ValueError`` naming the unknown keys of ``given``, the nearest valid spelling of
+    each and every valid key (``where``: the name of the defaults' dict, for the docs).
+
+    Examples
+    --------
+    >>> refuse_unknown("MCGM parameter", {"ght_min_scor": 1}, ["ght_min_score", "k_cand"])
+    Traceback (most recent call last):
+    ...
+    ValueError: unknown MCGM parameter(s) ['ght_min_scor'] (did you mean 'ght_min_score'?): \
+expected one of ght_min_score, k_cand
+    """
+    import difflib
+
+    keys = sorted(str(k) for k in valid)  # type: ignore[attr-defined]
+    unknown = sorted(set(given) - set(keys))  # type: ignore[call-overload]
+    if not unknown:
+        return
+    near = [m[0] for u in unknown if (m := difflib.get_close_matches(u, keys, n=1, cutoff=0.7))]
+    hint = f" (did you mean {', '.join(repr(n) for n in near)}?)" if near else ""
+    src = f" ({where})" if where else ""
+    raise ValueError(f"unknown {what}(s) {unknown}{hint}: expected one of {', '.join(keys)}{src}")
+
+
 def require(value: object, kind: str, name: str) -> None:
     """A TypeError naming the argument when ``value`` is not a ``stereovision.<kind>`` (None
     included): a public function given the wrong object says so instead of failing on an

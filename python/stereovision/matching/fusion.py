@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import refuse_unknown
 from stereovision.matches import Matches
 
 __all__ = [
@@ -456,9 +457,9 @@ def fuse_pair(
     from stereovision.matching.mcgm import mcgm_match
     from stereovision.matching.sgm import sgm_disparity
 
-    unknown = sorted(set(params) - set(DEFAULTS))
-    if unknown:
-        raise ValueError(f"unknown fusion option(s) {unknown}: expected {sorted(DEFAULTS)}")
+    # fuse_pair's own keywords are valid too: a misspelt one lands in params
+    own = ["channels", "remeasure_gabor", "check_members", "edge_members", "census_members"]
+    refuse_unknown("fusion option", params, [*DEFAULTS, *own, "dense_sgm", "min_disparity"])
     bad = sorted(set(channels) - set(CHANNEL_BITS))
     if bad:
         raise ValueError(f"unknown channel(s) {bad}: expected {sorted(CHANNEL_BITS)}")

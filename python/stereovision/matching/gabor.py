@@ -19,6 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
+from stereovision._validate import refuse_unknown
 
 __all__ = ["DEFAULTS", "GaborResult", "gabor_disparity", "gabor_responses"]
 
@@ -130,9 +131,7 @@ def gabor_disparity(
         If an image is not 2-D, empty, not floating point, non-finite, the shapes differ, a
         parameter is unknown or out of range.
     """
-    unknown = set(params) - set(DEFAULTS)
-    if unknown:
-        raise ValueError(f"unknown Gabor parameter(s): {sorted(unknown)}")
+    refuse_unknown("Gabor parameter", params, DEFAULTS, "stereovision.matching.gabor.DEFAULTS")
     lft = _as_grey(left, "left")
     rgt = _as_grey(right, "right")
     if lft.shape != rgt.shape:

@@ -22,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import as_gray_float, check_pair, luma_weights, u8_pair
+from stereovision._validate import as_gray_float, check_pair, luma_weights, refuse_unknown, u8_pair
 from stereovision.matches import Matches
 
 __all__ = [
@@ -157,9 +157,9 @@ def moravec(image: npt.ArrayLike) -> npt.NDArray[np.float32]:
 
 
 def _params(max_disparity: int, min_disparity: int, params: dict[str, Any]) -> dict[str, Any]:
-    unknown = set(params) - set(DEFAULTS)
-    if unknown:
-        raise ValueError(f"unknown Hopfield parameter(s): {sorted(unknown)}")
+    refuse_unknown(
+        "Hopfield parameter", params, DEFAULTS, "stereovision.matching.hopfield.DEFAULTS"
+    )
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
             if isinstance(v, (float, np.floating)) and np.isfinite(v) and v >= 0:

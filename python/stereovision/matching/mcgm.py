@@ -25,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import as_gray_float, check_pair
+from stereovision._validate import as_gray_float, check_pair, refuse_unknown
 from stereovision.matches import Matches
 
 __all__ = [
@@ -148,9 +148,7 @@ class ChannelCurves:
 
 
 def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:
-    unknown = set(params) - set(DEFAULTS)
-    if unknown:
-        raise ValueError(f"unknown MCGM parameter(s): {sorted(unknown)}")
+    refuse_unknown("MCGM parameter", params, DEFAULTS, "stereovision.matching.mcgm.DEFAULTS")
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
         if (
             isinstance(v, bool)
