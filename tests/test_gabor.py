@@ -271,3 +271,27 @@ def test_remove_speckles_equals_opencv_filter_speckles(min_size: int, max_diff: 
     np.testing.assert_array_equal(ours, theirs)
     with pytest.raises(ValueError, match="max_diff"):
         _core.gabor_remove_speckles(d.astype(np.float32), 9, float("nan"))
+
+
+def test_match_with_the_gabor_channel(data_dir: Path) -> None:
+    """``stereovision.match(method="gabor")`` shares the Matches API (issue 3): the channel's
+    confident pixels, one match each along the row, scored by the confidence."""
+    import stereovision as sv
+    from stereovision._validate import check_pair
+    from stereovision.evaluate import sparse_metrics
+    from stereovision.io import load_scene
+
+    sc = load_scene(data_dir / "eth3d" / "terrace")
+    m = sv.match(sc.left, sc.right, method="gabor", max_disparity=32)
+    g = gabor_disparity(*check_pair(sc.left, sc.right), max_disparity=32)
+    assert isinstance(m, sv.Matches) and m.xl.dtype == np.float32
+    assert len(m) == np.isfinite(g.disparity).sum() > 200_000  # 247361 measured
+    np.testing.assert_array_equal(np.isnan(m.dispx), np.isnan(g.disparity))
+    np.testing.assert_allclose(m.dispx, g.disparity, atol=1e-4, equal_nan=True)  # float32 xr
+    assert np.all(m.yl == m.yr) and np.all(
+        m.score == g.confidence[m.yl.astype(int), m.xl.astype(int)]
+    )
+    sm = sparse_metrics(m.xl, m.yl, m.xr, sc.gt)
+    assert sm.precision[2.0] > 97.0 and sm.count > 100_000  # 98.25 % of 129271 measured
+    with pytest.raises(ValueError, match="expected one of hopfield, best, mcgm, fused, gabor"):
+        sv.match(sc.left, sc.right, method="census", max_disparity=32)

@@ -18,8 +18,9 @@ __all__ = ["METHODS", "match"]
 
 #: Matchers of :func:`match`: the Hopfield network (algorithms.md C) and its best-match
 #: reference without the network; multi-channel graph matching of zero-crossing curves (B);
-#: the valid members of the three channels' agreement (D).
-METHODS = ("hopfield", "best", "mcgm", "fused")
+#: the valid members of the three channels' agreement (D); the Gabor phase channel's confident
+#: pixels (A).
+METHODS = ("hopfield", "best", "mcgm", "fused", "gabor")
 
 
 def match(
@@ -41,14 +42,16 @@ def match(
         rectified first and the matches are in rectified coordinates).
     calib : Calibration, optional
         Rig calibration of the pair.
-    method : {"hopfield", "best", "mcgm", "fused"}
+    method : {"hopfield", "best", "mcgm", "fused", "gabor"}
         ``"hopfield"``: the network (:func:`stereovision.matching.hopfield.hopfield_match`);
         ``"best"``: the best-match reference without the network; ``"mcgm"``: multi-channel
         graph matching of LoG zero-crossing curves (:func:`stereovision.matching.mcgm.mcgm_match`);
         ``"fused"``: the valid members where Gabor, MCGM and Hopfield agree, less those near a
         depth edge (:func:`stereovision.matching.fusion.fuse_pair`, which also runs the census
         semi-global map for that check; its ``count`` and ``sources`` per member are in
-        ``stats``).
+        ``stats``); ``"gabor"``: every pixel the Gabor phase channel is confident about
+        (:func:`stereovision.matching.gabor.gabor_disparity`, dense: one match per pixel,
+        ``xr = xl - d``, ``yr = yl``, ``score`` its confidence in ``[0, 1]``).
     max_disparity : int, optional
         Largest disparity searched (px). None estimates it from the pair
         (:func:`stereovision.estimate_max_disparity`). Every match returned has
@@ -56,7 +59,8 @@ def match(
         are dropped and counted in ``stats["n_out_of_range"]``).
     **params
         Matcher parameters (:data:`stereovision.matching.hopfield.DEFAULTS`,
-        :data:`stereovision.matching.mcgm.DEFAULTS`, or for ``"fused"`` those of
+        :data:`stereovision.matching.mcgm.DEFAULTS`,
+        :data:`stereovision.matching.gabor.DEFAULTS`, or for ``"fused"`` those of
         :data:`stereovision.matching.fusion.DEFAULTS`), plus ``min_disparity``.
 
     Returns
@@ -96,10 +100,35 @@ def match(
         res = fuse_pair(gl, gr, max_disparity=max_disparity, **params)
         res.matches.stats.update(count=res.count, sources=res.sources)
         m = res.matches
+    elif method == "gabor":
+        m = _gabor_matches(gl, gr, max_disparity, params)
     else:
         run = _hopfield.hopfield_match if method == "hopfield" else _hopfield.best_match
         m = run(gl, gr, max_disparity=max_disparity, **params)
     return _within_range(m, float(params.get("min_disparity", 0)), float(max_disparity))
+
+
+def _gabor_matches(
+    gl: npt.NDArray[np.float32],
+    gr: npt.NDArray[np.float32],
+    max_disparity: float,
+    params: dict[str, Any],
+) -> Matches:
+    """The Gabor channel's confident pixels as matches along the row."""
+    from stereovision.matching.gabor import gabor_disparity
+
+    res = gabor_disparity(gl, gr, max_disparity=max_disparity, **params)
+    ys, xs = np.nonzero(np.isfinite(res.disparity))
+    x = xs.astype(np.float32)
+    y = ys.astype(np.float32)
+    return Matches(
+        xl=x,
+        yl=y,
+        xr=x - res.disparity[ys, xs],
+        yr=y,
+        score=res.confidence[ys, xs],
+        image_shape=(gl.shape[0], gl.shape[1]),
+    )
 
 
 def _within_range(m: Matches, lo: float, hi: float) -> Matches:
