@@ -439,3 +439,18 @@ def test_unknown_parameter_names_the_valid_ones() -> None:
         sv.match(ok, ok, method="mcgm", max_disparity=8, ght_min_scor=0.5)
     with pytest.raises(ValueError, match=r"\['zzz'\]: expected one of .*sigmas"):
         mcgm.curves(ok, zzz=1)
+
+
+def test_dispx_keeps_the_best_scored_match_of_a_pixel() -> None:
+    # Matches rounding to one left pixel: the map kept whichever came last.
+    sc = _scene("middlebury2001/tsukuba")
+    m = sv.match(sc.left, sc.right, method="mcgm", max_disparity=16)
+    xi, yi = np.rint(m.xl).astype(int), np.rint(m.yl).astype(int)
+    d, dx = m.xl - m.xr, m.dispx
+    key = yi * 100_000 + xi
+    _, first, counts = np.unique(key, return_index=True, return_counts=True)
+    assert np.isfinite(dx).sum() == len(first) < len(m)  # 15 shared pixels measured
+    for k in np.unique(key[np.isin(key, key[first[counts > 1]])]):
+        idx = np.nonzero(key == k)[0]
+        best = idx[np.argmax(m.score[idx] + 1e-6 * np.arange(len(idx)))]  # later on a tie
+        assert dx[yi[best], xi[best]] == d[best]
