@@ -424,7 +424,7 @@ def test_save_csv_round_trips_exactly(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="header"):
         sv.Matches.from_csv(tmp_path / "bad.csv", image_shape=(10, 10))
     (tmp_path / "short.csv").write_text("x_left,y_left,x_right,y_right,score\n1,2,3,4\n")
-    with pytest.raises(ValueError, match="5 numbers"):
+    with pytest.raises(ValueError, match="row 2 has 4 values, expected 5"):
         sv.Matches.from_csv(tmp_path / "short.csv", image_shape=(10, 10))
 
 

@@ -262,11 +262,16 @@ class Matches:
             if head != _CSV_HEADER:
                 raise ValueError(f"{path}: expected the header {_CSV_HEADER!r}, got {head!r}")
             lines = [ln for ln in fh.read().splitlines() if ln.strip()]
+        rows = [ln.split(",") for ln in lines]
+        short = next((k for k, r in enumerate(rows) if len(r) != 5), None)
+        if short is not None:
+            raise ValueError(f"{path}: row {short + 2} has {len(rows[short])} values, expected 5")
         try:
-            a = np.array([[float(v) for v in ln.split(",")] for ln in lines], dtype=np.float64)
+            a = np.array([[float(v) for v in r] for r in rows], dtype=np.float64)
         except ValueError as e:
             raise ValueError(f"{path}: {e}") from None
         a = a.reshape(len(lines), -1) if lines else np.zeros((0, 5))
         if a.ndim != 2 or a.shape[1] != 5:
             raise ValueError(f"{path}: expected 5 numbers per row")
-        return cls(*(a[:, i] for i in range(5)), image_shape=image_shape)
+        xl, yl, xr, yr, score = (a[:, i].astype(np.float32) for i in range(5))
+        return cls(xl=xl, yl=yl, xr=xr, yr=yr, score=score, image_shape=image_shape)
