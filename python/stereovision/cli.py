@@ -697,7 +697,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
         f"{'scene':38s} {'D':>4s} | {'ours':^20s} | {'ours+fill':^20s} |"
         f" {'StereoBM':^20s} | {'SGBM-3WAY':^20s} | {'SGBM+fill':^20s}"
     )
-    sub = f"{'':38s} {'':>4s} |" + " bad-2  bad-1  dens |" * 5
+    # each column's three labels over its three numbers (_fmt_dense: 6 characters each)
+    labels = f"{'bad-2':>6s} {'bad-1':>6s} {'dens':>6s}"
+    sub = f"{'':38s} {'':>4s} | " + " | ".join([labels] * 5)
     if not args.json:
         print(header)
         print(sub)

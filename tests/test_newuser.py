@@ -1,0 +1,32 @@
+"""A new user's first runs: tables that line up, outputs that say what they are, and first
+mistakes (a video for an image, a range of 0) named in the command line's words."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from stereovision.cli import main
+
+CONES = Path(__file__).resolve().parents[1] / "python" / "stereovision" / "data" / "cones"
+
+
+def test_eval_table_labels_sit_over_their_numbers(capsys: pytest.CaptureFixture[str]) -> None:
+    """`stereovision eval`: the header, the label row and the scene rows put their column bars
+    at the same places, and each label ends where its number ends."""
+    assert main(["eval", str(CONES), "--no-opencv"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    header, labels, row = lines[0], lines[1], lines[2]
+    assert row.split()[0].endswith("cones")
+
+    def bars(line: str) -> list[int]:
+        return [i for i, c in enumerate(line) if c == "|"]
+
+    assert bars(header) == bars(labels)[: len(bars(header))]
+    assert bars(row) == bars(labels)[: len(bars(row))]
+    for label in ("bad-2", "bad-1", "dens"):
+        ends = [i + len(label) for i in range(len(labels)) if labels.startswith(label, i)]
+        assert len(ends) == 5, labels
+        for end in ends[:2]:  # ours, ours + fill: numbers printed under each label
+            assert row[end - 1].isdigit() and row[end] in " |", (labels, row)
