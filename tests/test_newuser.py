@@ -30,3 +30,18 @@ def test_eval_table_labels_sit_over_their_numbers(capsys: pytest.CaptureFixture[
         assert len(ends) == 5, labels
         for end in ends[:2]:  # ours, ours + fill: numbers printed under each label
             assert row[end - 1].isdigit() and row[end] in " |", (labels, row)
+
+
+def test_depth_without_calib_says_disparity_only(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Without --calib there is no depth: the summary says so instead of "0 points"."""
+    argv = ["depth", str(CONES / "left.png"), str(CONES / "right.png"), "--method", "gabor"]
+    assert main([*argv, "--max-disparity", "64", "-o", str(tmp_path / "a")]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert "disparity only (no depth or cloud without --calib)" in first
+    assert "0 points" not in first
+    calib = ["--calib", str(CONES / "calib.txt")]
+    assert main([*argv, *calib, "--max-disparity", "64", "-o", str(tmp_path / "b")]) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert " points, " in first and "disparity only" not in first

@@ -329,9 +329,14 @@ def cmd_depth(args: argparse.Namespace) -> int:
         grid=args.grid,
         log=print,
     )
+    cloud = (
+        f"{len(res.points)} points"
+        if res.depth is not None
+        else "disparity only (no depth or cloud without --calib)"
+    )
     print(
         f"{args.method}: max_disparity {res.max_disparity} px, density {100 * res.density:.1f} %,"
-        f" {len(res.points)} points, {sum(res.timings.values()):.2f} s"
+        f" {cloud}, {sum(res.timings.values()):.2f} s"
     )
     for name, path in written.items():
         print(f"  {name:14s} {path}")
