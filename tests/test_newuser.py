@@ -45,3 +45,21 @@ def test_depth_without_calib_says_disparity_only(
     assert main([*argv, *calib, "--max-disparity", "64", "-o", str(tmp_path / "b")]) == 0
     first = capsys.readouterr().out.splitlines()[0]
     assert " points, " in first and "disparity only" not in first
+
+
+@pytest.mark.parametrize("value", ["0", "-5", "1.5", "abc"])
+def test_max_disparity_refused_in_the_options_words(
+    value: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`depth --max-disparity 0`: one line naming the option (it used to name depth_map's
+    `min_disparity`, which the command line has no option for), exit 2, nothing written."""
+    argv = ["depth", str(CONES / "left.png"), str(CONES / "right.png")]
+    with pytest.raises(SystemExit) as exc:
+        main([*argv, f"--max-disparity={value}", "-o", str(tmp_path / "o")])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        "stereovision depth: error: argument --max-disparity: expected a whole number of pixels "
+        f"above 0, got '{value}' (see stereovision depth --help)"
+    ]
+    assert not (tmp_path / "o").exists()

@@ -778,6 +778,21 @@ def cmd_eval(args: argparse.Namespace) -> int:
 # ----------------------------------------------------------------------------- entry point
 
 
+def positive_pixels(text: str) -> int:
+    """argparse type of ``--max-disparity``: a whole number of pixels above 0.
+
+    Refused by argparse in the option's name (``argument --max-disparity: ...``), not later by
+    ``depth_map`` in its parameter's.
+    """
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number of pixels above 0, got {text!r}")
+    return value
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with its errors in one line, as the command's own (not the usage block)."""
 
@@ -809,7 +824,13 @@ def build_parser() -> argparse.ArgumentParser:
         help="YAML/JSON calibration, Middlebury calib.txt, KITTI calib, Kalibr camchain, or a "
         "ROS camera_info folder (left.yaml, right.yaml)",
     )
-    d.add_argument("--max-disparity", type=int, default=None, help="default: from the images")
+    d.add_argument(
+        "--max-disparity",
+        type=positive_pixels,
+        default=None,
+        metavar="N",
+        help="disparity range to search, in pixels (default: estimated from the images)",
+    )
     d.add_argument("--method", default=METHODS[0], choices=METHODS)
     d.add_argument(
         "--fill", action="store_const", const=True, help="fill holes (default: the method's)"
