@@ -226,7 +226,10 @@ def test_depth_warns_about_one_image_given_twice(data_dir: Path, tmp_path: Path)
         (["depth"], "stereovision depth: error: the following arguments are required: left"),
         (["bogus"], "stereovision: error: argument command: invalid choice: 'bogus'"),
         ([], "stereovision: error: the following arguments are required: command"),
-        (["depth", "a", "b", "-o", "x", "--max-disparity", "abc"], "invalid int value: 'abc'"),
+        (
+            ["depth", "a", "b", "-o", "x", "--max-disparity", "abc"],
+            "--max-disparity: expected a whole number of pixels above 0, got 'abc'",
+        ),
         (["stream", "--method", "sgbm"], "stereovision stream: error: argument --method"),
     ],
 )
