@@ -63,3 +63,46 @@ def test_max_disparity_refused_in_the_options_words(
         f"above 0, got '{value}' (see stereovision depth --help)"
     ]
     assert not (tmp_path / "o").exists()
+
+
+def _write_video(path: Path) -> None:
+    import cv2
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    writer = cv2.VideoWriter(str(path), cv2.VideoWriter_fourcc(*"MJPG"), 10, (450, 375))
+    for _ in range(3):
+        writer.write(frame)
+    writer.release()
+
+
+def test_a_video_given_as_an_image_is_named_a_video(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stereovision depth left.avi right.avi`: one line saying it is a video and which
+    commands read videos, exit 2 (it used to say only "cannot decode ... as an image")."""
+    video = tmp_path / "left.avi"
+    _write_video(video)
+    assert video.stat().st_size > 0
+    assert main(["depth", str(video), str(video), "-o", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"stereovision: error: cannot decode {video} as an image: it is a video; this command "
+        "takes one image per camera (stream, capture and calibrate read videos: --left VIDEO "
+        "--right VIDEO)"
+    ]
+    bag = tmp_path / "run.db3"
+    bag.write_bytes(b"SQLite format 3\x00" + bytes(100))
+    assert main(["check", str(bag), str(bag)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].endswith(
+        "it is a ROS bag; this command takes one image per "
+        "camera (stream, capture, calibrate and gui read "
+        "bags: --from-bag BAG)"
+    )
+    # any other undecodable file: the message as before, no guess
+    junk = tmp_path / "left.png"
+    junk.write_bytes(b"not a png")
+    assert main(["depth", str(junk), str(junk), "-o", str(tmp_path / "o")]) == 2
+    assert (
+        capsys.readouterr().err.strip() == f"stereovision: error: cannot decode {junk} as an image"
+    )

@@ -227,6 +227,27 @@ def _opencv_quiet() -> Iterator[None]:
                 log.setLogLevel(_quiet["level"])
 
 
+#: Files a first run passes where one image per camera is wanted (``depth LEFT RIGHT``).
+_VIDEO_SUFFIXES = (".avi", ".mp4", ".mkv", ".mov", ".webm", ".m4v", ".mpg", ".mpeg", ".h264")
+_BAG_SUFFIXES = (".bag", ".db3", ".mcap")
+
+
+def _not_an_image_hint(path: Path) -> str:
+    """What an undecodable file looks like instead, as the end of the error's one line."""
+    suffix = path.suffix.lower()
+    if suffix in _VIDEO_SUFFIXES:
+        return (
+            ": it is a video; this command takes one image per camera (stream, capture and "
+            "calibrate read videos: --left VIDEO --right VIDEO)"
+        )
+    if suffix in _BAG_SUFFIXES:
+        return (
+            ": it is a ROS bag; this command takes one image per camera (stream, capture, "
+            "calibrate and gui read bags: --from-bag BAG)"
+        )
+    return ""
+
+
 def imread(path: PathLike, gray: bool = False) -> npt.NDArray[np.uint8]:
     """Read an image file as OpenCV does (8-bit, BGR channel order).
 
@@ -255,7 +276,7 @@ def imread(path: PathLike, gray: bool = False) -> npt.NDArray[np.uint8]:
     data = np.fromfile(p, dtype=np.uint8)
     img = decode_image(data)
     if img is None:
-        raise ValueError(f"cannot decode {p} as an image")
+        raise ValueError(f"cannot decode {p} as an image{_not_an_image_hint(p)}")
     if gray:
         # Same conversion as everywhere else in the package (cv2.cvtColor, BT.601), not the
         # codec's own (libpng's differs by one grey level on some pixels).
