@@ -106,3 +106,29 @@ def test_a_video_given_as_an_image_is_named_a_video(
     assert (
         capsys.readouterr().err.strip() == f"stereovision: error: cannot decode {junk} as an image"
     )
+
+
+def test_help_says_where_to_start_and_every_option_what_it_is() -> None:
+    """`stereovision --help` is plain text that points at `demo`; every option and argument of
+    every command has a help line, and the defaults the README states are in them."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    top = parser.format_help()
+    assert "``" not in top  # the module docstring's reST markup is not the description
+    assert "Start with `stereovision demo`" in top
+    subs = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    missing = [
+        f"{name} {action.option_strings or action.dest}"
+        for name, sub in subs.choices.items()
+        for action in sub._actions
+        if not action.help and not isinstance(action, argparse._HelpAction)
+    ]
+    assert not missing, missing
+    helps = {name: " ".join(sub.format_help().split()) for name, sub in subs.choices.items()}
+    for name in ("demo", "depth", "eval"):
+        assert "matcher (default fused, the most accurate;" in helps[name], name
+    assert "timed runs per case (default 5)" in helps["bench"]  # README: "default 5"
+    assert "view port (default 8765)" in helps["stream"]  # README: 127.0.0.1:8765

@@ -270,6 +270,11 @@ def add_cli(subparsers: Any) -> None:
         "then one JSON line per case. Default scene: the bundled Middlebury Cones.",
     )
     p.add_argument("scenes", nargs="*", help="scene folders (or folders containing scenes)")
-    p.add_argument("--runs", type=int, default=DEFAULT_RUNS, help="timed runs per case")
+    p.add_argument(
+        "--runs",
+        type=int,
+        default=DEFAULT_RUNS,
+        help=f"timed runs per case (default {DEFAULT_RUNS})",
+    )
     p.add_argument("--json", action="store_true", help="only the JSON lines")
     p.set_defaults(func=cmd_bench)

@@ -801,11 +801,24 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(EXIT_ERROR)
 
 
+_METHOD_HELP = (
+    "matcher (default fused, the most accurate; census about half its time; fast a quarter; "
+    "gabor the live-rate channel, holes left unfilled)"
+)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``stereovision`` command."""
     from stereovision.depth import METHODS
 
-    p = _Parser(prog="stereovision", description=__doc__.splitlines()[0])
+    p = _Parser(
+        prog="stereovision",
+        description="Binocular depth for robots: calibrate a stereo rig, then disparity, "
+        "metric depth and point clouds from its pairs.",
+        epilog="Start with `stereovision demo` (the bundled scene: no camera, no network). "
+        "`stereovision COMMAND --help` lists a command's options. Errors print one line and "
+        "exit with status 2.",
+    )
     from stereovision import __version__
 
     p.add_argument("--version", action="version", version=f"stereovision {__version__}")
@@ -813,12 +826,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser("demo", help="run the pipeline on the bundled Middlebury scene")
     d.add_argument("-o", "--output", default="demo_output", help="output folder")
-    d.add_argument("--method", default=METHODS[0], choices=METHODS)
+    d.add_argument("--method", default=METHODS[0], choices=METHODS, help=_METHOD_HELP)
     d.set_defaults(func=cmd_demo)
 
     d = sub.add_parser("depth", help="disparity, depth and point cloud of one pair")
-    d.add_argument("left")
-    d.add_argument("right")
+    d.add_argument("left", help="left image: raw with a rig's --calib, else rectified")
+    d.add_argument("right", help="right image, the same size")
     d.add_argument(
         "--calib",
         help="YAML/JSON calibration, Middlebury calib.txt, KITTI calib, Kalibr camchain, or a "
@@ -831,7 +844,7 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="N",
         help="disparity range to search, in pixels (default: estimated from the images)",
     )
-    d.add_argument("--method", default=METHODS[0], choices=METHODS)
+    d.add_argument("--method", default=METHODS[0], choices=METHODS, help=_METHOD_HELP)
     d.add_argument(
         "--fill", action="store_const", const=True, help="fill holes (default: the method's)"
     )
@@ -887,8 +900,8 @@ def build_parser() -> argparse.ArgumentParser:
         "status 0 when the median is within --tolerance, 1 when not or when the pair has too "
         "little texture to tell.",
     )
-    d.add_argument("left")
-    d.add_argument("right")
+    d.add_argument("left", help="left image: raw with --calib, else rectified")
+    d.add_argument("right", help="right image, the same size")
     d.add_argument("--calib", help="the rig's calibration (omit for a rectified pair)")
     d.add_argument("--tolerance", type=float, default=0.5, help="median |dy| in px (default 0.5)")
     d.add_argument("--json", action="store_true", help="one JSON object instead of a line")
@@ -908,8 +921,8 @@ def build_parser() -> argparse.ArgumentParser:
         "(disparity, not metric depth) and saved as rectification.json, with the disparity "
         "range to search.",
     )
-    d.add_argument("left")
-    d.add_argument("right")
+    d.add_argument("left", help="left camera's raw image")
+    d.add_argument("right", help="right camera's raw image, the same size")
     d.add_argument("--calib", help="the rig's calibration (default: none, from the features)")
     d.add_argument(
         "--model",
@@ -939,7 +952,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser("eval", help="evaluate against ground truth, OpenCV beside")
     d.add_argument("scenes", nargs="+", help="scene folders (or folders containing scenes)")
-    d.add_argument("--method", default=METHODS[0], choices=METHODS)
+    d.add_argument("--method", default=METHODS[0], choices=METHODS, help=_METHOD_HELP)
     d.add_argument("--json", action="store_true", help="one JSON object per scene on stdout")
     d.add_argument("--no-opencv", action="store_true", help="skip the OpenCV references")
     d.set_defaults(func=cmd_eval)

@@ -1044,7 +1044,13 @@ def add_cli(subparsers: Any) -> None:
         "--no-fill", dest="fill", action="store_const", const=False, help="leave holes NaN"
     )
     p.add_argument("--no-display", action="store_true", help="headless: do not serve the view")
-    p.add_argument("--serve", type=int, default=DEFAULT_PORT, metavar="PORT", help="view port")
+    p.add_argument(
+        "--serve",
+        type=int,
+        default=DEFAULT_PORT,
+        metavar="PORT",
+        help=f"view port (default {DEFAULT_PORT})",
+    )
     p.add_argument("--host", default="127.0.0.1", help="view address (default 127.0.0.1)")
     p.add_argument("--json", action="store_true", help="one JSON object per second on stdout")
     p.add_argument(
