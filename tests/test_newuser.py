@@ -132,3 +132,19 @@ def test_help_says_where_to_start_and_every_option_what_it_is() -> None:
         assert "matcher (default fused, the most accurate;" in helps[name], name
     assert "timed runs per case (default 5)" in helps["bench"]  # README: "default 5"
     assert "view port (default 8765)" in helps["stream"]  # README: 127.0.0.1:8765
+
+
+def test_check_names_two_sizes_as_the_other_commands_do(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stereovision check` on a pair of two sizes: "450x375 px", as `rectify` says it, not
+    a (W, H) tuple."""
+    import cv2
+
+    small = tmp_path / "small.png"
+    cv2.imwrite(str(small), cv2.resize(cv2.imread(str(CONES / "right.png")), (300, 250)))
+    assert main(["check", str(CONES / "left.png"), str(small)]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "stereovision: error: left is 450x375 px, right is 300x250 px: the two images of a pair "
+        "have one size"
+    )

@@ -215,7 +215,10 @@ def check_rectification(
         left, right = calib.rectify(left, right, alpha=alpha)
     gl, gr = as_gray_uint8(left, "left"), as_gray_uint8(right, "right")
     if gl.shape != gr.shape:
-        raise ValueError(f"left is {gl.shape[::-1]} px, right is {gr.shape[::-1]} px (W, H)")
+        (hl, wl), (hr, wr) = gl.shape, gr.shape
+        raise ValueError(
+            f"left is {wl}x{hl} px, right is {wr}x{hr} px: the two images of a pair have one size"
+        )
     h, w = gl.shape
     pl, dl = _features(gl)
     pr, dr = _features(gr)
