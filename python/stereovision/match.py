@@ -98,8 +98,13 @@ def match(
         from stereovision.matching.fusion import fuse_pair
 
         res = fuse_pair(gl, gr, max_disparity=max_disparity, **params)
-        res.matches.stats.update(count=res.count, sources=res.sources)
-        m = res.matches
+        lo, hi = float(params.get("min_disparity", 0)), float(max_disparity)
+        m = _within_range(res.matches, lo, hi)
+        # per member, as the matches: a member dropped out of range takes its entries along
+        # (they were left whole, longer than the matches)
+        keep = _in_range(res.matches, lo, hi)
+        m.stats.update(count=res.count[keep], sources=res.sources[keep])
+        return m
     elif method == "gabor":
         m = _gabor_matches(gl, gr, max_disparity, params)
     else:
@@ -131,6 +136,12 @@ def _gabor_matches(
     )
 
 
+def _in_range(m: Matches, lo: float, hi: float) -> npt.NDArray[np.bool_]:
+    """Which matches have a disparity ``xl - xr`` in ``[lo, hi]``."""
+    d = m.xl - m.xr
+    return (d >= lo) & (d <= hi)
+
+
 def _within_range(m: Matches, lo: float, hi: float) -> Matches:
     """The matches whose disparity ``xl - xr`` lies in ``[lo, hi]``.
 
@@ -140,8 +151,7 @@ def _within_range(m: Matches, lo: float, hi: float) -> Matches:
     (a working volume, a near limit) gets no match outside it; ``stats["n_out_of_range"]``
     counts those dropped.
     """
-    d = m.xl - m.xr
-    keep = (d >= lo) & (d <= hi)
+    keep = _in_range(m, lo, hi)
     n_out = int(len(m) - np.count_nonzero(keep))
     out = m if n_out == 0 else m[keep]
     out.stats["n_out_of_range"] = n_out
