@@ -361,6 +361,7 @@ def test_depth_removes_its_own_outputs_of_an_earlier_run(
     assert main([*argv, "-o", str(out)]) == 0
     said = capsys.readouterr().out
     assert sorted(p.name for p in out.iterdir()) == [
+        ".stereovision-depth.json",  # what this run wrote: the next one removes only those
         "disparity.pfm",
         "disparity.png",
         "notes.txt",
@@ -369,3 +370,22 @@ def test_depth_removes_its_own_outputs_of_an_earlier_run(
     assert (out / "notes.txt").read_text() == "mine"
     for name in ("cloud.ply", "depth.npy", "depth.png", "depth_mm.png", "render.png"):
         assert f"removed {name} of an earlier run" in said
+
+
+def test_depth_keeps_same_named_files_it_did_not_write(
+    tmp_path: Path, data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``-o`` naming a folder of the user's: a ``cloud.ply``, ``map.png`` or ``render.png``
+    there that no depth run wrote stays (they were deleted as stale outputs by name)."""
+    scene = data_dir / "eth3d" / "terrace"
+    out = tmp_path / "mine"
+    out.mkdir()
+    own = {"cloud.ply": "my scan", "map.png": "my map", "render.png": "my render"}
+    for name, text in own.items():
+        (out / name).write_text(text)
+    argv = ["depth", str(scene / "left.png"), str(scene / "right.png"), "--max-disparity", "32"]
+    assert main([*argv, "-o", str(out)]) == 0
+    assert main([*argv, "-o", str(out)]) == 0  # a second run: still not its files
+    assert "removed" not in capsys.readouterr().out
+    for name, text in own.items():
+        assert (out / name).read_text() == text, name

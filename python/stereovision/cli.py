@@ -262,13 +262,21 @@ DEPTH_OUTPUTS = (
 )
 
 
+#: What ``stereovision depth`` wrote into its ``-o`` folder on its last run there (JSON list of
+#: file names): the only files a later run removes.
+DEPTH_MANIFEST = ".stereovision-depth.json"
+
+
 def remove_stale_outputs(out_dir: Path, written: dict[str, Path]) -> list[Path]:
     """Remove the depth outputs of an earlier run that this run did not rewrite.
 
     A folder that held ``cloud.ply`` from a run with a calibration would otherwise keep it after
-    a run without one, and ``stereovision view DIR`` would show the earlier scene. Only the
-    names in :data:`DEPTH_OUTPUTS` are touched, and only regular files; any other file in the
-    folder stays.
+    a run without one, and ``stereovision view DIR`` would show the earlier scene. Only files
+    the earlier run listed in :data:`DEPTH_MANIFEST` as its own are touched (and of those only
+    names in :data:`DEPTH_OUTPUTS`, regular files): a ``cloud.ply`` or ``map.png`` of the user's
+    in a folder given as ``-o`` stays, as does everything in a folder without the manifest
+    (an earlier version's outputs included). This run's outputs are then written as the new
+    manifest.
 
     Parameters
     ----------
@@ -282,12 +290,23 @@ def remove_stale_outputs(out_dir: Path, written: dict[str, Path]) -> list[Path]:
     list of pathlib.Path
         The files removed.
     """
+    from stereovision.io import atomic_write
+
+    manifest = out_dir / DEPTH_MANIFEST
+    try:
+        earlier = json.loads(manifest.read_text(encoding="utf-8"))
+    except (OSError, ValueError):  # none (a folder this command never wrote), or unreadable
+        earlier = []
+    if not isinstance(earlier, list):
+        earlier = []
     removed = []
     for name in DEPTH_OUTPUTS:
         path = out_dir / name
-        if name not in written and path.is_file() and not path.is_symlink():
+        if name in earlier and name not in written and path.is_file() and not path.is_symlink():
             path.unlink()
             removed.append(path)
+    with atomic_write(manifest, "w") as fh:
+        json.dump(sorted(n for n in written if n in DEPTH_OUTPUTS), fh)
     return removed
 
 
