@@ -27,20 +27,11 @@ from stereovision.calibrate import (
     render_chessboard,
 )
 from stereovision.calibration import Calibration
+from tests.conftest import DATA_DIR
 
-#: ``<repo>/../shared/data/chessboard``, or the shared copy when the repo is a git worktree
-#: elsewhere (as tests/test_doctests.py finds it).
-DATA = next(
-    (
-        d
-        for d in (
-            Path(__file__).resolve().parents[2] / "shared" / "data" / "chessboard",
-            Path("/work/shared/data/chessboard"),
-        )
-        if d.is_dir()
-    ),
-    Path(__file__).resolve().parents[2] / "shared" / "data" / "chessboard",
-)
+#: ``<repo>/../shared/data/chessboard``, where conftest finds every scene (a clone's CI, a
+#: worktree with the data beside it); the tests using it are skipped without it.
+DATA = DATA_DIR / "chessboard"
 CHESSBOARD_IDS = ("01", "02", "03", "04", "05", "06", "07", "08", "09", "11", "12", "13", "14")
 
 #: Acceptance figures of issue 6 on OpenCV's sample pairs (its stereo_calib pipeline: 0.448 px
@@ -672,7 +663,9 @@ def test_identical_images_and_folders_are_named(cached_corners: None, tmp_path: 
     args = _parser().parse_args(
         ["calibrate", "--left", str(DATA), "--right", str(DATA), "--square", "1", "-o", str(out)]
     )
-    with pytest.raises(ValueError, match=rf"^--left {DATA}: is a folder; give its images as a "):
+    with pytest.raises(
+        ValueError, match=rf"^--left {re.escape(str(DATA))}: is a folder; give its images as a "
+    ):
         args.func(args)
     args = _parser().parse_args(
         ["calibrate", "--left", str(DATA / "left0*.jpg"), "--right", str(DATA / "left0*.jpg"),
