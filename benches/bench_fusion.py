@@ -29,7 +29,9 @@ from stereovision.match import METHODS
 from stereovision.matching.fusion import CHANNEL_BITS, fuse_pair
 from stereovision.matching.mcgm import mcgm_match
 
-SPARSE = [m for m in METHODS if m in CHANNEL_BITS]
+#: The sparse channels (match.METHODS also has "gabor" since it gives Matches; fuse_pair keeps
+#: the Gabor channel as a GaborResult, the dense map, not Matches).
+SPARSE = [m for m in METHODS if m in CHANNEL_BITS and m != "gabor"]
 
 
 def main() -> None:
