@@ -494,6 +494,21 @@ def test_mispaired_images_are_refused(cached_corners: None) -> None:
     assert rep.used_pairs[0] == "left01.jpg / right01.jpg"
 
 
+def test_outliers_of_the_last_round_are_kept_not_dropped_unsolved(
+    cached_corners: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With no re-solve left, a round's outliers were dropped from the used pairs after the
+    solve: the solution's per-pair errors (12 pairs) and the names (11) fell out of step, and
+    the pairing check failed with an IndexError. Now they are kept, and named."""
+    monkeypatch.setattr("stereovision.calibrate.MAX_OUTLIER_ROUNDS", 0)
+    left, right = _mispaired_paths()
+    with (
+        pytest.warns(UserWarning, match="file numbers differ"),
+        pytest.raises(ValueError, match=r"Worst pairs: left06\.jpg / right05\.jpg \(26\."),
+    ):
+        calibrate(left, right, pattern=(9, 6), square_size=1.0, drop_outliers=True)
+
+
 def test_a_swapped_pair_is_refused(cached_corners: None) -> None:
     """Pair 03's left and right images swapped: stereo RMS 30.8 px, returned with exit 0."""
     left, right = _chessboard_paths()

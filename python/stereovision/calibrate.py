@@ -1310,7 +1310,7 @@ def calibrate(
                 f"needed (rejected: {', '.join(rejected)})"
             )
     outliers: list[str] = []
-    for _ in range(MAX_OUTLIER_ROUNDS + 1):
+    for rnd in range(MAX_OUTLIER_ROUNDS + 1):
         obj = [obj_pts[corner_ids[i]] for i in used]  # type: ignore[index]
         pl = [corners_l[i].astype(np.float32) for i in used]  # type: ignore[union-attr]
         pr = [corners_r[i].astype(np.float32) for i in used]  # type: ignore[union-attr]
@@ -1322,7 +1322,10 @@ def calibrate(
             name = pair_names[used[k]]
             if name not in outliers:
                 outliers.append(name)
-        if not bad or not drop_outliers or len(used) - len(bad) < MIN_PAIRS:
+        # no rounds left: the outliers are kept (dropping them now would leave `used` and
+        # the solution's per-pair errors out of step)
+        last = rnd == MAX_OUTLIER_ROUNDS
+        if not bad or not drop_outliers or last or len(used) - len(bad) < MIN_PAIRS:
             break
         for k in bad:
             rejected[pair_names[used[k]]] = (
