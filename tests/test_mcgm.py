@@ -424,8 +424,13 @@ def test_save_csv_round_trips_exactly(tmp_path: Path) -> None:
     with pytest.raises(ValueError, match="header"):
         sv.Matches.from_csv(tmp_path / "bad.csv", image_shape=(10, 10))
     (tmp_path / "short.csv").write_text("x_left,y_left,x_right,y_right,score\n1,2,3,4\n")
-    with pytest.raises(ValueError, match="row 2 has 4 values, expected 5"):
+    with pytest.raises(ValueError, match="line 2 has 4 values, expected 5"):
         sv.Matches.from_csv(tmp_path / "short.csv", image_shape=(10, 10))
+    # a blank line is skipped, and the message still names the file's own line
+    header = "x_left,y_left,x_right,y_right,score"
+    (tmp_path / "gap.csv").write_text(f"{header}\n\n1,2,3,4,1\n\n1,2,3\n")
+    with pytest.raises(ValueError, match="line 5 has 3 values"):
+        sv.Matches.from_csv(tmp_path / "gap.csv", image_shape=(10, 10))
 
 
 def test_unknown_parameter_names_the_valid_ones() -> None:

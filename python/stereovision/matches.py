@@ -261,11 +261,13 @@ class Matches:
             head = fh.readline().strip()
             if head != _CSV_HEADER:
                 raise ValueError(f"{path}: expected the header {_CSV_HEADER!r}, got {head!r}")
-            lines = [ln for ln in fh.read().splitlines() if ln.strip()]
-        rows = [ln.split(",") for ln in lines]
+            # (line number, text) of the non-blank rows, for the messages
+            lines = [(k, ln) for k, ln in enumerate(fh.read().splitlines(), 2) if ln.strip()]
+        rows = [ln.split(",") for _, ln in lines]
         short = next((k for k, r in enumerate(rows) if len(r) != 5), None)
         if short is not None:
-            raise ValueError(f"{path}: row {short + 2} has {len(rows[short])} values, expected 5")
+            line = lines[short][0]
+            raise ValueError(f"{path}: line {line} has {len(rows[short])} values, expected 5")
         try:
             a = np.array([[float(v) for v in r] for r in rows], dtype=np.float64)
         except ValueError as e:
