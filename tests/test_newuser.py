@@ -65,6 +65,22 @@ def test_max_disparity_refused_in_the_options_words(
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize("command", ["batch", "stream"])
+def test_max_disparity_of_batch_and_stream_refused_alike(
+    command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`batch`/`stream --max-disparity 0` were taken (a plain int) and failed later, per pair
+    or per frame, in depth_map's words; they are refused up front as `depth` refuses them."""
+    with pytest.raises(SystemExit) as exc:
+        main([command, "--max-disparity=0"])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"stereovision {command}: error: argument --max-disparity: expected a whole number of "
+        f"pixels above 0, got '0' (see stereovision {command} --help)"
+    ]
+
+
 def _write_video(path: Path) -> None:
     import cv2
 

@@ -1050,6 +1050,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision batch`` on the CLI's sub-parsers."""
+    from stereovision.cli import positive_pixels  # cli builds its parser with this
     from stereovision.depth import METHODS
 
     p = subparsers.add_parser(
@@ -1066,7 +1067,12 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--workers", type=int, help="LocalCluster worker processes (default: cores)")
     p.add_argument("--scheduler", metavar="ADDRESS", help="existing Dask scheduler, tcp://...")
     p.add_argument("--method", choices=METHODS, help="matcher (default: depth_map's)")
-    p.add_argument("--max-disparity", type=int, help="for every pair (default: per pair)")
+    p.add_argument(
+        "--max-disparity",
+        type=positive_pixels,
+        metavar="N",
+        help="for every pair (default: per pair)",
+    )
     p.add_argument(
         "--calib",
         help="calibration for every pair, a file or a ROS camera_info folder (default: each "

@@ -999,6 +999,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
 
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision stream`` on the CLI's sub-parsers."""
+    from stereovision.cli import positive_pixels  # cli builds its parser with this
     from stereovision.depth import METHODS
 
     p = subparsers.add_parser(
@@ -1026,7 +1027,12 @@ def add_cli(subparsers: Any) -> None:
         "(disparity only)",
     )
     p.add_argument("--size", help="requested size WIDTHxHEIGHT (frames are resized if needed)")
-    p.add_argument("--max-disparity", type=int, help="default: estimated from the first pair")
+    p.add_argument(
+        "--max-disparity",
+        type=positive_pixels,
+        metavar="N",
+        help="default: estimated from the first pair",
+    )
     p.add_argument(
         "--method",
         default="gabor",
