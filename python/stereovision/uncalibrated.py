@@ -526,7 +526,8 @@ def rectify_uncalibrated(
             raise ValueError(
                 f"left and right look swapped: {100 * ahead:.0f} % of the {len(p1)} feature "
                 "matches lie further right in the left image than in the right one (a left "
-                "camera's do, nearly all); give the images the other way round"
+                "camera's do, nearly all); give the images the other way round (a converging "
+                "rig looking past where its axes cross: model='projective', --model projective)"
             )
     else:
         ok, h1_cv, h2_cv = cv2.stereoRectifyUncalibrated(p1, p2, fm, (w, h))
