@@ -5,6 +5,7 @@ The benches run as scripts (``python benches/bench_x.py``), so this folder is on
 
 from __future__ import annotations
 
+import argparse
 import statistics
 import time
 from collections.abc import Callable, Sequence
@@ -16,6 +17,23 @@ from stereovision.evaluate import sparse_metrics
 from stereovision.matches import Matches
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+
+#: evaluation.md "Speed": the median of at least this many timed runs.
+MIN_RUNS = 5
+
+
+def timed_runs(text: str) -> int:
+    """argparse ``type`` of a bench's ``--runs`` / ``--repeats``: an integer of at least
+    :data:`MIN_RUNS` (the median of fewer runs is noise on the shared 2-core machines)."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+    if n < MIN_RUNS:
+        raise argparse.ArgumentTypeError(
+            f"at least {MIN_RUNS} (evaluation.md: the median of >= {MIN_RUNS} runs), got {n}"
+        )
+    return n
 
 
 def gt_scenes() -> list[str]:

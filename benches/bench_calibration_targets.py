@@ -106,7 +106,7 @@ def chessboard_view(K: np.ndarray, D: np.ndarray, r: np.ndarray, t: np.ndarray) 
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--views", type=int, default=20)
     ap.add_argument("--hard", action="store_true", help="blur, lighting gradient and JPEG")

@@ -39,7 +39,7 @@ def poses(rng: np.random.Generator, views: int) -> list[tuple[np.ndarray, np.nda
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--views", type=int, default=20)
     ap.add_argument("--sigma", type=float, nargs="+", default=[8.0, 20.0])

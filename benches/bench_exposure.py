@@ -42,7 +42,7 @@ NOISE = 8.0
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", nargs="*", help="family/scene names (default: every GT scene)")
     args = ap.parse_args()
     print("| scene | " + " | ".join(f"{c}: ours / SGBM-3WAY + fill" for c in CASES) + " |")

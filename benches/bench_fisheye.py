@@ -41,7 +41,7 @@ def wall(calib: Calibration, z_wall: float) -> tuple[np.ndarray, np.ndarray, Any
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--picture", type=Path, default=ROOT / "docs/images/fisheye_rig.jpg")
     args = ap.parse_args()
     views = rig.render_views()

@@ -35,7 +35,7 @@ SPARSE = [m for m in METHODS if m in CHANNEL_BITS and m != "gabor"]
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("scenes", nargs="*", help="scene folders (default: every GT scene)")
     args = ap.parse_args()
     dirs = [Path(s) for s in args.scenes] or find_scenes(DATA)

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import cv2
 import numpy as np
+from _common import timed_runs
 
 from stereovision.matching.gabor import gabor_disparity
 
@@ -44,8 +45,8 @@ def sgbm_matcher(max_disparity: int) -> cv2.StereoSGBM:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--runs", type=int, default=9)
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--runs", type=timed_runs, default=9)
     ap.add_argument("--param", action="append", default=[])
     args = ap.parse_args()
     params = {k: json.loads(v) for k, v in (kv.split("=", 1) for kv in args.param)}

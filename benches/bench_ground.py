@@ -64,7 +64,7 @@ def _scan_table(
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--picture", type=Path, default=ROOT / "docs/images/ground_kitti.jpg")
     args = ap.parse_args()
     for name in SCENES:

@@ -20,7 +20,7 @@ import argparse
 import json
 import time
 
-from _common import DATA, gt_scenes, interleaved_ms, sparse_row
+from _common import DATA, gt_scenes, interleaved_ms, sparse_row, timed_runs
 
 import stereovision as sv
 from stereovision import io
@@ -94,9 +94,9 @@ def speed(repeats: int) -> None:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", default="", help="comma-separated family/scene (default: all)")
-    ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--repeats", type=timed_runs, default=7)
     ap.add_argument("--no-speed", action="store_true")
     ap.add_argument("--no-accuracy", action="store_true")
     args = ap.parse_args()

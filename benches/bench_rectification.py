@@ -49,7 +49,7 @@ def degrees(rot: np.ndarray) -> float:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--skip-depth", action="store_true", help="only part 1 (a few seconds)")
     args = ap.parse_args()
     moves = []

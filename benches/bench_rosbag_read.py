@@ -28,7 +28,7 @@ from tests.test_rosbag_read import PERIOD_NS, T0, write_bag  # noqa: E402
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--pairs", type=int, default=200)
     args = ap.parse_args()
     sc = load_scene(DATA / "kitti2015" / "000005_10")

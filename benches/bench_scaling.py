@@ -8,13 +8,14 @@ change with the resize, so every size searches the same ``max_disparity``. Two s
 * size: VGA (640x480), 720p (1280x720), 1080p (1920x1080) at ``max_disparity`` 64;
 * range: ``max_disparity`` 32, 64, 128, 192 at VGA.
 
-"Ours" is :func:`stereovision.depth_map` with its default method and no calibration (the
-matcher, input checks and conversion); SGBM is :func:`stereovision.baselines.opencv_sgbm`.
+"Ours" is :func:`stereovision.depth_map` with ``--method`` (default: its default method) and no
+calibration (the matcher, input checks and conversion); SGBM is
+:func:`stereovision.baselines.opencv_sgbm`.
 Prints a table, the growth factors (largest / smallest case, ours and SGBM's) and one JSON line
 per case, and draws ``docs/images/scaling.png`` (``--plot PATH`` to change; matplotlib, the
 ``bench`` extra).
 
-Usage: ``python benches/bench_scaling.py [--runs 5] [--plot docs/images/scaling.png]``
+Usage: ``python benches/bench_scaling.py [--runs 5] [--method M] [--plot docs/images/scaling.png]``
 """
 
 from __future__ import annotations
@@ -25,9 +26,10 @@ import json
 from pathlib import Path
 
 import cv2
-from _common import interleaved_ms
+from _common import interleaved_ms, timed_runs
 
 from stereovision import baselines, depth_map
+from stereovision.depth import METHODS
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENE = ROOT.parent / "shared" / "data" / "tartanair" / "oldtown_easy_p000_001116"
@@ -37,7 +39,7 @@ D_SWEEP = (32, 64, 128, 192)
 DEFAULT_METHOD = inspect.signature(depth_map).parameters["method"].default
 
 
-def _plot(rows: list[dict], path: Path) -> None:
+def _plot(rows: list[dict], path: Path, method: str) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -50,7 +52,7 @@ def _plot(rows: list[dict], path: Path) -> None:
     ):
         sel = [r for r in rows if r["sweep"] == sweep]
         xs = [r[xkey] for r in sel]
-        ax.plot(xs, [r["ours_ms"] for r in sel], "o-", label=f"stereovision ({DEFAULT_METHOD})")
+        ax.plot(xs, [r["ours_ms"] for r in sel], "o-", label=f"stereovision ({method})")
         ax.plot(xs, [r["sgbm_ms"] for r in sel], "s--", label="OpenCV SGBM-3WAY")
         if sweep == "size":
             for r in sel:
@@ -75,12 +77,13 @@ def _plot(rows: list[dict], path: Path) -> None:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=5, help="timed runs per case (median)")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--runs", type=timed_runs, default=5, help="timed runs per case (median)")
+    ap.add_argument(
+        "--method", default=DEFAULT_METHOD, choices=METHODS, help=f"ours (default {DEFAULT_METHOD})"
+    )
     ap.add_argument("--plot", type=Path, default=ROOT / "docs" / "images" / "scaling.png")
     args = ap.parse_args()
-    if args.runs < 1:
-        raise SystemExit("--runs: expected at least 1")
     left0, right0 = cv2.imread(str(SCENE / "left.png")), cv2.imread(str(SCENE / "right.png"))
     if left0 is None or right0 is None:
         raise SystemExit(f"scene not found: {SCENE}")
@@ -95,7 +98,9 @@ def main() -> None:
         right = cv2.resize(right0, (w, h), interpolation=cv2.INTER_CUBIC)
         ours, sgbm = interleaved_ms(
             (
-                lambda left=left, right=right, d=d: depth_map(left, right, None, max_disparity=d),
+                lambda left=left, right=right, d=d: depth_map(
+                    left, right, None, method=args.method, max_disparity=d
+                ),
                 lambda left=left, right=right, d=d: baselines.opencv_sgbm(left, right, d),
             ),
             args.runs,
@@ -104,7 +109,7 @@ def main() -> None:
             "bench": "scaling",
             "sweep": sweep,
             "label": label,
-            "method": DEFAULT_METHOD,
+            "method": args.method,
             "width": w,
             "height": h,
             "megapixels": round(w * h / 1e6, 4),
@@ -137,7 +142,7 @@ def main() -> None:
         )
     for r in rows:
         print(json.dumps(r))
-    _plot([r for r in rows if r["bench"] == "scaling"], args.plot)
+    _plot([r for r in rows if r["bench"] == "scaling"], args.plot, args.method)
     print(f"plot: {args.plot}")
 
 

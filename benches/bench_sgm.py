@@ -15,7 +15,7 @@ import json
 import statistics
 
 import numpy as np
-from _common import DATA, gt_scenes, interleaved_ms
+from _common import DATA, gt_scenes, interleaved_ms, timed_runs
 
 from stereovision.baselines import opencv_sgbm, row_fill
 from stereovision.evaluate import dense_metrics
@@ -26,8 +26,8 @@ SPEED = ("middlebury2006/cloth3", "middeval3/teddyH")
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--runs", type=int, default=7)
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--runs", type=timed_runs, default=7)
     ap.add_argument("--no-accuracy", action="store_true")
     args = ap.parse_args()
     if not args.no_accuracy:

@@ -23,7 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
-from _common import DATA, interleaved_ms
+from _common import DATA, interleaved_ms, timed_runs
 
 from stereovision import depth_map
 from stereovision._validate import as_gray_float
@@ -83,8 +83,8 @@ def cases(scene: Path) -> dict[str, Callable[[], object]]:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeats", type=int, default=7, help="timed runs per case (>= 5)")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--repeats", type=timed_runs, default=7, help="timed runs per case (>= 5)")
     ap.add_argument("scenes", nargs="*", help="scene folders (default: cloth3 and teddyH)")
     args = ap.parse_args()
     dirs = [Path(s) for s in args.scenes] or [DATA / s for s in SCENES]

@@ -151,7 +151,7 @@ def timing() -> None:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", nargs="*", help="family/scene names (default: every GT scene)")
     ap.add_argument("--skip-moving", action="store_true", help="only the still scenes and time")
     args = ap.parse_args()

@@ -23,7 +23,7 @@ from functools import partial
 from pathlib import Path
 
 import numpy as np
-from _common import DATA, gt_scenes, interleaved_ms
+from _common import DATA, gt_scenes, interleaved_ms, timed_runs
 
 import stereovision as sv
 from stereovision.baselines import (
@@ -88,14 +88,12 @@ def speed(repeats: int) -> dict[str, dict[str, float]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeats", type=int, default=5, help="timed runs per matcher (>= 5)")
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--repeats", type=timed_runs, default=5, help="timed runs per matcher (>= 5)")
     ap.add_argument("--no-accuracy", action="store_true")
     ap.add_argument("--no-speed", action="store_true")
     ap.add_argument("--json", type=Path, help="also write the figures here")
     args = ap.parse_args(argv)
-    if args.repeats < 5:
-        ap.error("--repeats: at least 5 (the median of fewer runs is noise on this machine)")
     figures: dict[str, object] = {}
     if not args.no_accuracy:
         acc = accuracy()

@@ -57,7 +57,7 @@ def _opencv_shape(left: np.ndarray, right: np.ndarray, fm: np.ndarray) -> tuple:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", nargs="*", help="family/scene names (default: every GT scene)")
     ap.add_argument(
         "--picture", type=Path, default=ROOT / "docs/images/uncalibrated_rectification.jpg"

@@ -18,6 +18,9 @@ from stereovision.io import load_scene
 
 
 def main() -> int:
+    if sys.argv[1:] in (["-h"], ["--help"]):
+        print(f"usage: dump_grey.py SCENE PREFIX\n\n{__doc__}")
+        return 0
     if len(sys.argv) != 3:
         print("usage: dump_grey.py SCENE PREFIX", file=sys.stderr)
         return 2

@@ -29,7 +29,7 @@ DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser()
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", default="", help="comma-separated substrings of scene names")
     ap.add_argument("--param", action="append", default=[], help="key=JSON value (repeatable)")
     ap.add_argument("--no-cv", action="store_true", help="skip the OpenCV references")

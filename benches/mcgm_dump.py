@@ -95,13 +95,20 @@ def compare(a_path: str, b_path: str) -> int:
     return 1 if differ else 0
 
 
+USAGE = "usage: mcgm_dump.py OUT.npz | mcgm_dump.py --compare A.npz B.npz"
+
+
 def main() -> int:
-    if len(sys.argv) == 4 and sys.argv[1] == "--compare":
-        return compare(sys.argv[2], sys.argv[3])
-    if len(sys.argv) == 2:
-        dump(sys.argv[1])
+    args = sys.argv[1:]
+    if args in (["-h"], ["--help"]):
+        print(f"{USAGE}\n\n{__doc__}")
         return 0
-    print("usage: mcgm_dump.py OUT.npz | mcgm_dump.py --compare A.npz B.npz", file=sys.stderr)
+    if len(args) == 3 and args[0] == "--compare":
+        return compare(args[1], args[2])
+    if len(args) == 1 and not args[0].startswith("-"):
+        dump(args[0])
+        return 0
+    print(USAGE, file=sys.stderr)
     return 2
 
 

@@ -38,7 +38,7 @@ def label(img: np.ndarray, text: str, y: int = 24) -> None:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=ROOT / "docs/images/charuco_cut_board.jpg")
     args = ap.parse_args()
     rv, tv = np.array([-0.289, 0.072, 0.195]), np.array([-0.0169, -0.0796, 0.3933])

@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scene", default="middlebury2005/books")
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "images" / "fused_vs_sgbm.png")
     args = ap.parse_args()

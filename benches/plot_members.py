@@ -28,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scene", default="middlebury2003/teddy")
     ap.add_argument("--out", type=Path, default=ROOT / "docs" / "images" / "members_census.png")
     args = ap.parse_args()

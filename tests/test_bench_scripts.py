@@ -1,0 +1,67 @@
+"""The Python bench scripts of ``benches/``: their command lines, not their figures.
+
+Speed is measured by the scripts themselves (evaluation.md "Speed"); these tests only check that
+a script refuses a median of fewer than 5 runs and that ``--help`` helps instead of running.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from functools import cache
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+BENCHES = ROOT / "benches"
+TIMING = {
+    "bench_gabor_vs_sgbm.py": "--runs",
+    "bench_hopfield.py": "--repeats",
+    "bench_mcgm.py": "--repeats",
+    "bench_scaling.py": "--runs",
+    "bench_sgm.py": "--runs",
+    "bench_stages.py": "--repeats",
+    "bench_tools.py": "--repeats",
+}
+
+
+def _run(script: str, *args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONPATH": str(ROOT / "python")}
+    return subprocess.run(
+        [sys.executable, str(BENCHES / script), *args],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
+@cache
+def _help(script: str) -> str:
+    done = _run(script, "--help")
+    assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
+@pytest.mark.parametrize(("script", "option"), sorted(TIMING.items()))
+def test_timing_scripts_refuse_fewer_than_five_runs(script: str, option: str) -> None:
+    done = _run(script, option, "4")
+    assert done.returncode == 2
+    assert f"{option}: " in done.stderr and "at least 5" in done.stderr and "got 4" in done.stderr
+
+
+@pytest.mark.parametrize("script", ["mcgm_dump.py", "dump_grey.py"])
+def test_help_prints_usage_and_writes_nothing(script: str, tmp_path: Path) -> None:
+    done = _run(script, "--help", cwd=tmp_path)
+    assert done.returncode == 0 and done.stdout.startswith(f"usage: {script} ")
+    assert list(tmp_path.iterdir()) == []  # mcgm_dump.py wrote a 40 MB "--help.npz"
+
+
+def test_help_description_is_the_whole_first_paragraph() -> None:
+    # argparse re-wraps it; the first line alone stopped mid-sentence ("... against the plane of")
+    for script in ("bench_ground.py", "bench_tools.py", "bench_gabor_vs_sgbm.py"):
+        doc = (BENCHES / script).read_text().split('"""')[1].split("\n\n")[0]
+        assert " ".join(doc.split()) in " ".join(_help(script).split()), script
