@@ -1,12 +1,14 @@
 """The Python bench scripts of ``benches/``: their command lines, not their figures.
 
 Speed is measured by the scripts themselves (evaluation.md "Speed"); these tests only check that
-a script refuses a median of fewer than 5 runs and that ``--help`` helps instead of running.
+a script refuses a median of fewer than 5 runs, that ``--help`` helps instead of running, and that
+every ``benches/*.py`` command the README and docs cite takes the options it is cited with.
 """
 
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from functools import cache
@@ -65,3 +67,24 @@ def test_help_description_is_the_whole_first_paragraph() -> None:
     for script in ("bench_ground.py", "bench_tools.py", "bench_gabor_vs_sgbm.py"):
         doc = (BENCHES / script).read_text().split('"""')[1].split("\n\n")[0]
         assert " ".join(doc.split()) in " ".join(_help(script).split()), script
+
+
+def _cited_commands() -> list[tuple[str, str, list[str]]]:
+    """``(where, script, options)`` of each ``benches/X.py ...`` in backticks of the docs."""
+    found = []
+    for doc in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        for m in re.finditer(r"`(?:[.\w/]*python )?benches/(\w+\.py)([^`]*)`", doc.read_text()):
+            options = re.findall(r"(?<![\w-])--[a-z][\w-]*", m.group(2))
+            if options:
+                found.append((doc.name, m.group(1), options))
+    return found
+
+
+def test_docs_cite_bench_options_that_exist() -> None:
+    cited = _cited_commands()
+    assert ("README.md", "bench_scaling.py", ["--method", "--runs"]) in cited
+    for where, script, options in cited:
+        assert (BENCHES / script).is_file(), f"{where}: benches/{script}"
+        text = _help(script) if script != "mcgm_dump.py" else (BENCHES / script).read_text()
+        for opt in options:
+            assert re.search(rf"(?<![\w-]){re.escape(opt)}\b", text), f"{where}: {script} {opt}"
