@@ -1,4 +1,5 @@
 //! Criterion benches of the MCGM channel: the separable LoG, zero crossings, curve tracking,
+//! the R-tables of one image's curves and the GHT candidate votes against the other image's,
 //! one image's curves over all channels, the whole matcher and B.8's occlusion filters, at
 //! three image sizes (synthetic
 //! smooth-texture pairs with a known 6 px shift, so the benches need no data files).
@@ -7,8 +8,8 @@ use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use stereovision_core::matching::mcgm::{
-    edge_filters, image_curves, log::log_filter, mcgm_match, tracking::track,
-    zerocross::zero_crossings, McgmParams,
+    channel_curves, edge_filters, graph::candidates, image_curves, log::log_filter, mcgm_match,
+    rtable::build_rtable, tracking::track, zerocross::zero_crossings, McgmParams,
 };
 use stereovision_core::Image;
 
@@ -95,6 +96,34 @@ fn bench(c: &mut Criterion) {
         let zc = zero_crossings(&lg, w, h);
         g.bench_function(BenchmarkId::new("track", &id), |b| {
             b.iter(|| track(&zc, &p.track))
+        });
+        // R-tables (B.4 step 6) of the finest channel's segments, then the GHT votes of every
+        // left segment against the right segments in its rows over the whole range (step 8).
+        let cl = channel_curves(&l, p.sigmas[p.sigmas.len() - 1], 1, &p);
+        let cr = channel_curves(&r, p.sigmas[p.sigmas.len() - 1], 1, &p);
+        g.bench_function(BenchmarkId::new("rtables", &id), |b| {
+            b.iter(|| {
+                cl.curves
+                    .segments
+                    .iter()
+                    .map(|s| build_rtable(s, &cl.zc.theta, w, p.cand.n_bins))
+                    .collect::<Vec<_>>()
+            })
+        });
+        let window = vec![Some((0, D_MAX as i32)); cl.curves.segments.len()];
+        g.bench_function(BenchmarkId::new("ght_candidates", &id), |b| {
+            b.iter(|| {
+                candidates(
+                    &cl.curves.segments,
+                    &cl.rtables,
+                    &cr.curves.segments,
+                    &cr.zc.theta,
+                    w,
+                    h,
+                    &window,
+                    &p.cand,
+                )
+            })
         });
         g.bench_function(BenchmarkId::new("image_curves", &id), |b| {
             b.iter(|| image_curves(&l, &p).expect("valid input"))
