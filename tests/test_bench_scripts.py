@@ -7,6 +7,7 @@ every ``benches/*.py`` command the README and docs cite takes the options it is 
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import subprocess
@@ -88,3 +89,17 @@ def test_docs_cite_bench_options_that_exist() -> None:
         text = _help(script) if script != "mcgm_dump.py" else (BENCHES / script).read_text()
         for opt in options:
             assert re.search(rf"(?<![\w-]){re.escape(opt)}\b", text), f"{where}: {script} {opt}"
+
+
+def test_bench_fusion_compares_the_sparse_channels(data_dir: Path) -> None:
+    # match() took method="gabor" (its confident pixels as Matches), which made the bench take
+    # fuse_pair's dense GaborResult for a sparse channel: AttributeError 'xl' on every scene.
+    done = _run("bench_fusion.py", str(data_dir / "middlebury2001" / "tsukuba"))
+    assert done.returncode == 0, done.stderr
+    out = done.stdout.splitlines()
+    assert out[0] == "channels: gabor + hopfield + mcgm"
+    row = json.loads(out[-1])
+    assert row["scene"].endswith("tsukuba") and row["tol"] == 1.0
+    assert set(row) == {"bench", "scene", "tol", "members", "hopfield", "mcgm", "mcgm_defaults"}
+    assert row["members"]["count"] > 3500 and row["members"]["coverage"] == 16
+    assert row["members"]["precision"] > 99 and row["hopfield"]["count"] > 1000
