@@ -54,6 +54,9 @@ def test_bench_cli_json_lines(data_dir: Path, capsys: pytest.CaptureFixture[str]
     assert [ln["case"] for ln in lines][-2:] == ["StereoBM", "SGBM-3WAY"]
     assert all(ln["bench"] == "vs_opencv" and ln["scene"].endswith("tsukuba") for ln in lines)
     assert {"ms", "ratio_sgbm", "max_disparity"} <= set(lines[0])
+    # a count of matches is an integer in the JSON (it was written as 1326.0)
+    counts = [ln["count"] for ln in lines if ln["kind"] == "sparse"]
+    assert counts and all(type(c) is int and c > 100 for c in counts)
 
 
 @pytest.mark.parametrize(

@@ -170,6 +170,23 @@ def test_eval_json_one_object_per_scene(data_dir: Path) -> None:
     assert row["ours+fill"]["bad_2.0"] < row["bm"]["bad_2.0"]
 
 
+def test_eval_mean_line_has_every_column(
+    data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # The mean line left out SGBM-3WAY + fill, the reference a dense map must beat
+    # (evaluation.md), and named the others bm / sgbm instead of the table's headers.
+    assert main(["eval", str(data_dir / "middlebury2001" / "tsukuba")]) == 0
+    mean = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("mean bad-2.0")]
+    assert len(mean) == 1
+    m = re.fullmatch(
+        r"mean bad-2\.0: ours ([\d.]+) %, ours\+fill ([\d.]+) %, StereoBM 12\.7 %, "
+        r"SGBM-3WAY 5\.3 %, SGBM\+fill 4\.2 %",
+        mean[0],
+    )
+    assert m is not None, mean[0]
+    assert float(m[2]) < 4.2  # ours after the fill beats SGBM-3WAY + fill on tsukuba (3.3)
+
+
 def test_eval_goes_on_past_a_damaged_scene(data_dir: Path, tmp_path: Path) -> None:
     """One undecodable scene among several is reported in one line and the rest evaluated;
     the exit status is 1 (as batch's for a failed pair). Alone it is the usual error."""

@@ -182,7 +182,7 @@ def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
             acc: dict[str, float] = {}
             if gt is not None:
                 sm = sparse_metrics(out.xl, out.yl, out.xr, gt)
-                acc = {"precision@1.0": sm.precision[1.0], "count": float(sm.count)}
+                acc = {"precision@1.0": sm.precision[1.0], "count": sm.count}
         else:
             acc = _dense_accuracy(out, gt)
         result.append(
