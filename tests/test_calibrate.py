@@ -689,3 +689,20 @@ def test_identical_images_and_folders_are_named(cached_corners: None, tmp_path: 
     with pytest.raises(ValueError, match="look identical"):
         args.func(args)
     assert not out.exists()
+
+
+def test_report_chart_ticks_are_round_and_labels_stay_readable() -> None:
+    from stereovision.calibrate import _label, _nice_ticks
+
+    # the per-pair chart's axis read 0.00, 0.16, 0.31, 0.47, 0.63 on OpenCV's 13 pairs
+    assert _nice_ticks(0.626) == [0.0, 0.2, 0.4, 0.6]
+    assert _nice_ticks(3.3) == [0.0, 1.0, 2.0, 3.0]
+    assert _nice_ticks(0.05) == [0.0, 0.01, 0.02, 0.03, 0.04, 0.05]
+    # the grey median label sat on the bars (left12's hid "edia"): now on a white box
+    orange = (40, 140, 240)
+    img = np.full((60, 300, 3), orange, np.uint8)
+    x0, y0, x1, y1 = _label(img, "median 0.190 px", (20, 30), 0.4, (150, 150, 150))
+    box = img[y0 : y1 + 1, x0 : x1 + 1].reshape(-1, 3)
+    assert not (box == orange).all(axis=1).any()
+    assert (box == 255).all(axis=1).mean() > 0.5 and (box == 150).all(axis=1).any()
+    assert (img[:, x1 + 1 :] == orange).all()  # nothing drawn past the box

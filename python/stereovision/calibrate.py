@@ -1612,6 +1612,37 @@ def _text(
     cv2.putText(img, s, org, _FONT, scale, color, 1, cv2.LINE_AA)
 
 
+def _label(
+    img: np.ndarray,
+    s: str,
+    org: tuple[int, int],
+    scale: float,
+    color: Any,
+    background: Any = (255, 255, 255),
+) -> tuple[int, int, int, int]:
+    """``s`` at ``org`` (its baseline's left end) on a ``background`` box, so that bars and lines
+    under it cannot hide it; returns the box ``(x0, y0, x1, y1)``, ends included."""
+    (tw, th), base = cv2.getTextSize(s, _FONT, scale, 1)
+    x0, y0 = max(org[0] - 2, 0), max(org[1] - th - 2, 0)
+    x1 = min(org[0] + tw + 2, img.shape[1] - 1)
+    y1 = min(org[1] + base, img.shape[0] - 1)
+    cv2.rectangle(img, (x0, y0), (x1, y1), background, -1)
+    _text(img, s, org, scale, color)
+    return x0, y0, x1, y1
+
+
+def _nice_ticks(vmax: float, most: int = 6) -> list[float]:
+    """Round tick values ``0, step, 2 step, ... <= vmax`` with ``step`` 1, 2 or 5 x 10^k and at most
+    ``most`` ticks (the chart's axis read 0.00, 0.16, 0.31, 0.47, 0.63)."""
+    if not vmax > 0:
+        return [0.0]
+    raw = vmax / (most - 1)
+    mag = 10.0 ** np.floor(np.log10(raw))
+    step = next(m * mag for m in (1, 2, 5, 10) if m * mag >= raw - 1e-12 * mag)
+    n = int(np.floor(vmax / step + 1e-9))
+    return [float(round(k * step, 12)) for k in range(n + 1)]
+
+
 def _error_chart(rep: CalibrationReport) -> np.ndarray:
     """Bar chart of each used pair's left/right RMS, median and outlier threshold."""
     names = rep.used_pairs
@@ -1633,8 +1664,8 @@ def _error_chart(rep: CalibrationReport) -> np.ndarray:
     bw = max(2, int(slot * 0.35))
     cv2.line(img, (left_m, top), (left_m, top + plot_h), _BLACK, 1)
     cv2.line(img, (left_m, top + plot_h), (w - 20, top + plot_h), _BLACK, 1)
-    for t in np.linspace(0, vmax, 5):
-        y = ypix(float(t))
+    for t in _nice_ticks(vmax):
+        y = ypix(t)
         cv2.line(img, (left_m - 4, y), (left_m, y), _BLACK, 1)
         _text(img, f"{t:.2f}", (5, y + 4), 0.4)
     for k, n in enumerate(names):
@@ -1661,9 +1692,11 @@ def _error_chart(rep: CalibrationReport) -> np.ndarray:
         y = ypix(v)
         for x in range(left_m, w - 20, 12):
             cv2.line(img, (x, y), (min(x + 6, w - 20), y), color, 1)
-        _text(img, f"{label} {v:.3f} px", (w - 200, y - 4), 0.4, color)
-    _text(img, "per-pair RMS reprojection error (px): left", (left_m + 5, 18), 0.5, _BLUE)
-    _text(img, "right", (left_m + 395, 18), 0.5, _ORANGE)
+        _label(img, f"{label} {v:.3f} px", (w - 200, y - 4), 0.4, color)
+    title = "per-pair RMS reprojection error (px): left"
+    _text(img, title, (left_m + 5, 18), 0.5, _BLUE)
+    (tw, _), _ = cv2.getTextSize(title + " ", _FONT, 0.5, 1)
+    _text(img, "right", (left_m + 5 + tw, 18), 0.5, _ORANGE)
     return img
 
 
@@ -1718,7 +1751,7 @@ def _rectified_picture(rep: CalibrationReport) -> np.ndarray | None:
     colors = [(0, 0, 255), (0, 200, 0), (255, 0, 0), (0, 200, 255)]
     for k, y in enumerate(range(step // 2, h, step)):
         cv2.line(pair, (0, y), (pair.shape[1] - 1, y), colors[k % len(colors)], 1, cv2.LINE_AA)
-    _text(pair, f"rectified pair {rep._sample[0]}", (8, 22), 0.6, (0, 0, 255))
+    _label(pair, f"rectified pair {rep._sample[0]}", (8, 22), 0.6, (0, 0, 255))
     return _fit_width(pair)
 
 
