@@ -36,9 +36,11 @@ SPARSE = [m for m in METHODS if m in CHANNEL_BITS and m != "gabor"]
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("scenes", nargs="*", help="scene folders (default: every GT scene)")
+    ap.add_argument(
+        "scenes", nargs="*", help="scene folders or family/scene names (default: every GT scene)"
+    )
     args = ap.parse_args()
-    dirs = [Path(s) for s in args.scenes] or find_scenes(DATA)
+    dirs = [Path(s) if Path(s).is_dir() else DATA / s for s in args.scenes] or find_scenes(DATA)
     print(f"channels: gabor + {' + '.join(SPARSE)}")
     for d in dirs:
         sc = load_scene(d)

@@ -85,9 +85,11 @@ def cases(scene: Path) -> dict[str, Callable[[], object]]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--repeats", type=timed_runs, default=7, help="timed runs per case (>= 5)")
-    ap.add_argument("scenes", nargs="*", help="scene folders (default: cloth3 and teddyH)")
+    ap.add_argument(
+        "scenes", nargs="*", help="scene folders or family/scene names (default: cloth3 and teddyH)"
+    )
     args = ap.parse_args()
-    dirs = [Path(s) for s in args.scenes] or [DATA / s for s in SCENES]
+    dirs = [Path(s) if Path(s).is_dir() else DATA / s for s in args.scenes or SCENES]
     rows = []
     for scene in dirs:
         named = cases(scene)

@@ -94,7 +94,9 @@ def test_docs_cite_bench_options_that_exist() -> None:
 def test_bench_fusion_compares_the_sparse_channels(data_dir: Path) -> None:
     # match() took method="gabor" (its confident pixels as Matches), which made the bench take
     # fuse_pair's dense GaborResult for a sparse channel: AttributeError 'xl' on every scene.
-    done = _run("bench_fusion.py", str(data_dir / "middlebury2001" / "tsukuba"))
+    assert (data_dir / "middlebury2001" / "tsukuba").is_dir()
+    # a family/scene name, as bench_exposure / bench_temporal take them (it took folders only)
+    done = _run("bench_fusion.py", "middlebury2001/tsukuba")
     assert done.returncode == 0, done.stderr
     out = done.stdout.splitlines()
     assert out[0] == "channels: gabor + hopfield + mcgm"
