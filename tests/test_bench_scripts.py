@@ -8,7 +8,6 @@ every ``benches/*.py`` command the README and docs cite takes the options it is 
 from __future__ import annotations
 
 import json
-import os
 import re
 import subprocess
 import sys
@@ -31,11 +30,10 @@ TIMING = {
 
 
 def _run(script: str, *args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess[str]:
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "python")}
+    # the installed package, as `make` installs it (python/ holds no built extension)
     return subprocess.run(
         [sys.executable, str(BENCHES / script), *args],
         cwd=cwd,
-        env=env,
         capture_output=True,
         text=True,
         timeout=120,
