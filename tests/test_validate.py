@@ -230,3 +230,26 @@ def test_uint8_grey_conversion_is_bit_identical_to_numpy(layout: str, data_dir: 
     assert np.array_equal(got.view(np.uint32), want.view(np.uint32))  # bit for bit
     if layout != "strided":
         assert got[0, 0] == 0.0 and got[0, 255] == 1.0
+
+
+@pytest.mark.parametrize("dtype", ["uint16", "float32", "float64"])
+def test_big_endian_images_give_the_native_result(dtype: str, data_dir: Path) -> None:
+    """A big-endian uint16 image (``>u2``: FITS, some TIFF and PNG readers) was refused as an
+    "unsupported dtype >u2; expected uint8, uint16 ..."; big-endian floats were accepted. Both
+    now give what the same values in native byte order give, through the public API too."""
+    img = cv2.imread(str(data_dir / "middlebury2003" / "cones" / "left.png"), cv2.IMREAD_COLOR)
+    assert img is not None
+    native = img.astype(dtype) * 257 if dtype == "uint16" else img.astype(dtype) / 255
+    big = native.astype(np.dtype(dtype).newbyteorder(">"))
+    assert not big.dtype.isnative and np.array_equal(big, native)
+    assert np.array_equal(as_gray_float(big), as_gray_float(native))
+    assert np.array_equal(as_bgr_uint8(big), as_bgr_uint8(native))
+    assert np.array_equal(as_gray_uint8(big), as_gray_uint8(native))
+    if dtype == "uint16":
+        import stereovision as sv
+
+        right = cv2.imread(str(data_dir / "middlebury2003" / "cones" / "right.png"))
+        r16 = right.astype(np.uint16) * 257
+        want = sv.depth_map(native, r16, method="census", max_disparity=64, cloud=False)
+        got = sv.depth_map(big, r16.astype(">u2"), method="census", max_disparity=64, cloud=False)
+        np.testing.assert_array_equal(got.disparity, want.disparity)

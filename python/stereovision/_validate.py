@@ -60,8 +60,9 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
     Returns
     -------
     numpy.ndarray
-        The image as an array (no copy when ``img`` already is one), shape ``(H, W)`` or
-        ``(H, W, C)``, dtype ``uint8``, ``uint16`` or floating point.
+        The image as an array (no copy when ``img`` already is one in native byte order; a
+        big-endian one is converted), shape ``(H, W)`` or ``(H, W, C)``, dtype ``uint8``,
+        ``uint16`` or floating point.
 
     Raises
     ------
@@ -83,6 +84,11 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
             f"{name}: expected a numeric image array, got {type(img).__name__} "
             f"converting to dtype {arr.dtype}"
         )
+    if not arr.dtype.isnative:
+        # Big-endian data (FITS, some TIFF and PNG readers): the same values in native order.
+        # ">u2" is not np.uint16, so a big-endian 16-bit image was refused as an "unsupported
+        # dtype >u2" when uint16 was the expected one.
+        arr = arr.astype(arr.dtype.newbyteorder("="))
     if arr.ndim not in (2, 3):
         raise ValueError(
             f"{name}: expected a grey (H, W) or colour (H, W, C) image, got {arr.ndim} "
