@@ -302,3 +302,15 @@ def test_depth_kernel_matches_numpy_reference_on_a_real_scene(data_dir: Path) ->
         _core.depth_rectified(disp, conf, 0.0, *args[1:])
     with pytest.raises(ValueError, match="shape"):
         _core.depth_rectified(disp, conf[:, 1:].copy(), *args)
+
+
+@pytest.mark.parametrize("dtype", [np.complex128, np.bool_])
+def test_points_of_a_wrong_dtype_are_not_told_to_transpose(dtype: type) -> None:
+    """A (2, 2) array of another dtype was told "(transpose a (2, N) array)": transposing it
+    changes nothing; its dtype is what is wrong."""
+    pts = np.array([[100.0, 50.0], [200.0, 80.0]], dtype=dtype)
+    with pytest.raises(ValueError, match="dtype") as exc:
+        triangulate(pts, pts, raw_calib())
+    assert "transpose" not in str(exc.value)
+    with pytest.raises(ValueError, match="transpose"):
+        triangulate(np.zeros((2, 5)), np.zeros((2, 5)), raw_calib())

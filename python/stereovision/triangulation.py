@@ -77,7 +77,11 @@ def _unit_scale(calib: Calibration, unit: str) -> float:
 def _points(x: npt.ArrayLike, name: str) -> F64:
     a = np.asarray(x)
     if a.dtype.kind not in "iuf" or a.ndim != 2 or a.shape[1] != 2:
-        hint = " (transpose a (2, N) array)" if a.ndim == 2 and a.shape[0] == 2 else ""
+        hint = (
+            " (transpose a (2, N) array)"
+            if a.ndim == 2 and a.shape[0] == 2 and a.shape[1] != 2
+            else ""
+        )
         raise ValueError(
             f"{name}: expected an (N, 2) real array of (x, y) pixels, got shape {a.shape} "
             f"dtype {a.dtype}{hint}"
