@@ -218,8 +218,14 @@ pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<I
     if w == 0 {
         return Vec::new();
     }
-    // Largest M per tile (a single tile covering the image when `tile == 0`).
-    let tile = if p.tile == 0 { w.max(h) } else { p.tile };
+    // Largest M per tile (a single tile covering the image when `tile == 0`). A tile larger
+    // than the image is that single tile too: `tile * w` of a huge tile wrapped to 0 and
+    // panicked (`chunk_size must not be zero`) instead of using one tile.
+    let tile = if p.tile == 0 {
+        w.max(h)
+    } else {
+        p.tile.min(w.max(h))
+    };
     let tiles_x = w.div_ceil(tile);
     let tile_max: Vec<f32> = m
         .par_chunks(tile * w)
@@ -316,4 +322,34 @@ pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<I
         })
         .collect();
     per_task.concat()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A tile of any size beyond the image's is the whole image (`tile == 0`), never a
+    /// wrapped `tile * w` (a zero chunk size: a panic).
+    #[test]
+    fn huge_tile_is_the_whole_image() {
+        let (w, h) = (23, 17);
+        let m: Vec<f32> = (0..w * h).map(|i| ((i * 7919) % 101) as f32).collect();
+        let at = |tile| {
+            let p = InterestParams {
+                tile,
+                ..InterestParams::default()
+            };
+            select_points(&m, w, h, &p)
+        };
+        let whole = at(0);
+        assert!(!whole.is_empty());
+        for tile in [24, 1 << 40, usize::MAX / 2 + 1, usize::MAX] {
+            let got = at(tile);
+            assert_eq!(got.len(), whole.len(), "tile {tile}");
+            assert!(got
+                .iter()
+                .zip(&whole)
+                .all(|(a, b)| (a.x, a.y) == (b.x, b.y)));
+        }
+    }
 }

@@ -1,0 +1,43 @@
+"""Out-of-range arguments given to the extension directly are a ValueError naming them, never
+an internal error from a panic, nor a result computed from garbage without a word."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stereovision as sv
+from stereovision import _core
+from stereovision._validate import as_gray_float
+from stereovision.io import load_scene
+
+#: refine_disparity's scalar arguments after the four maps (0..32 px, one fill pass).
+REFINE_ARGS = (0.0, 32.0, 1.0, 1.5, 3, 2, 0.25, 2, 0.5, 1e-4, [(1.0, 0.5)], 0.1, True, 1.0)
+
+
+@pytest.fixture(scope="module")
+def crop(data_dir: Path) -> tuple[np.ndarray, np.ndarray]:
+    s = load_scene(data_dir / "middlebury2003" / "cones")
+    return s.left[100:200, 100:260], s.right[100:200, 100:260]
+
+
+@pytest.mark.parametrize("tile", [10**3, 2**40, 2**62, 2**63, 2**64 - 1])
+def test_a_tile_beyond_the_image_is_the_whole_image(
+    tile: int, crop: tuple[np.ndarray, np.ndarray]
+) -> None:
+    """``tile * width`` wrapped to 0 for a tile of 2**62 or more: the Moravec selection panicked
+    (``RuntimeError: internal error ... chunk_size must not be zero``) through ``_core`` and
+    ``stereovision.match`` alike. Any tile larger than the image is now the one tile 0 means."""
+    g = as_gray_float(crop[0])
+    m0, xy0, v0 = _core.hopfield_interest(g, tile=0)
+    m, xy, v = _core.hopfield_interest(g, tile=tile)
+    assert len(xy0) > 10
+    np.testing.assert_array_equal(xy, xy0)
+    np.testing.assert_array_equal(v, v0)
+    np.testing.assert_array_equal(m, m0)
+    whole = sv.match(*crop, method="best", max_disparity=32, tile=0)
+    got = sv.match(*crop, method="best", max_disparity=32, tile=tile)
+    np.testing.assert_array_equal(got.xl, whole.xl)
+    np.testing.assert_array_equal(got.xr, whole.xr)
