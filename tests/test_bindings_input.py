@@ -10,7 +10,7 @@ import pytest
 
 import stereovision as sv
 from stereovision import _core
-from stereovision._validate import as_gray_float
+from stereovision._validate import LUMA_WEIGHTS_BGR, as_gray_float
 from stereovision.io import load_scene
 
 #: refine_disparity's scalar arguments after the four maps (0..32 px, one fill pass).
@@ -41,3 +41,28 @@ def test_a_tile_beyond_the_image_is_the_whole_image(
     got = sv.match(*crop, method="best", max_disparity=32, tile=tile)
     np.testing.assert_array_equal(got.xl, whole.xl)
     np.testing.assert_array_equal(got.xr, whole.xr)
+
+
+@pytest.mark.parametrize("bad", [float("nan"), float("inf"), -0.5])
+def test_grey_weights_must_be_finite_and_non_negative(
+    bad: float, crop: tuple[np.ndarray, np.ndarray]
+) -> None:
+    """A NaN weight made every grey level NaN (``gray_u8``) and the matcher silently found
+    nothing (``hopfield_match_u8``)."""
+    weights = (bad, *LUMA_WEIGHTS_BGR[1:])
+    left, right = (np.ascontiguousarray(a) for a in crop)
+    with pytest.raises(ValueError, match="weights"):
+        _core.gray_u8(left, weights)
+    with pytest.raises(ValueError, match="weights"):
+        _core.hopfield_match_u8(left, right, weights, {"max_disparity": 32})
+    assert np.isfinite(_core.gray_u8(left, LUMA_WEIGHTS_BGR)).all()
+
+
+@pytest.mark.parametrize("tol", [-1.0, float("nan")])
+def test_lr_check_tolerance_must_not_be_negative(tol: float) -> None:
+    """A negative or NaN tolerance passed no pixel at all, without a word."""
+    d = np.full((6, 9), 2.0, np.float32)
+    assert _core.gabor_lr_check(d, d, 0.0)[:, 2:].all()
+    assert _core.gabor_lr_check(d, d, float("inf"))[:, 2:].all()
+    with pytest.raises(ValueError, match="tol"):
+        _core.gabor_lr_check(d, d, tol)

@@ -142,6 +142,19 @@ pub fn u8_layout<'a>(
     Ok((h, w, c, data))
 }
 
+/// The B, G, R grey weights as an array, checked to be finite and non-negative (a NaN weight
+/// made every grey level NaN, and the matcher found nothing, without a word).
+pub fn luma_weights(weights: (f32, f32, f32)) -> PyResult<[f32; 3]> {
+    let wts = [weights.0, weights.1, weights.2];
+    if wts.iter().all(|v| v.is_finite() && *v >= 0.0) {
+        Ok(wts)
+    } else {
+        Err(PyValueError::new_err(format!(
+            "weights: expected three finite non-negative numbers (B, G, R), got {wts:?}"
+        )))
+    }
+}
+
 /// `stereovision._validate.as_gray_float` for 8-bit images, in Rust: `(H, W)` grey or
 /// `(H, W, C)` with `C` in 1, 3, 4 (BGR order), C-contiguous; bit-identical to the NumPy path.
 #[pyfunction]
@@ -152,7 +165,7 @@ pub fn gray_u8<'py>(
     weights: (f32, f32, f32),
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let (h, w, c, data) = u8_layout(&image, "image")?;
-    let wts = [weights.0, weights.1, weights.2];
+    let wts = luma_weights(weights)?;
     let grey = crate::workers::detach(py, || {
         crate::errors::guard("gray_u8", || {
             stereovision_core::image::grey_from_u8(data, w, h, c, wts)

@@ -241,6 +241,13 @@ pub fn gabor_lr_check<'py>(
     disp_right: PyReadonlyArray2<'py, f32>,
     tol: f32,
 ) -> PyResult<Bound<'py, PyArray2<bool>>> {
+    // A negative or NaN tolerance passed no pixel, without a word; infinity passes every
+    // finite one.
+    if tol.is_nan() || tol < 0.0 {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "tol: expected a number >= 0, got {tol}"
+        )));
+    }
     // NaN is allowed here (it means "no estimate"), so no Image validation of finiteness.
     let a = disp_left.as_array();
     let b = disp_right.as_array();

@@ -241,7 +241,7 @@ pub fn hopfield_match_u8<'py>(
             right.shape()
         )));
     }
-    let wts = [weights.0, weights.1, weights.2];
+    let wts = crate::convert::luma_weights(weights)?;
     let (p, best) = parse_match(params)?;
     // Grey conversion and matcher in one hot region of the pool (`run_hot`): one wake-up of
     // the workers per call instead of one per parallel region.
