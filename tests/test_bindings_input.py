@@ -66,3 +66,45 @@ def test_lr_check_tolerance_must_not_be_negative(tol: float) -> None:
     assert _core.gabor_lr_check(d, d, float("inf"))[:, 2:].all()
     with pytest.raises(ValueError, match="tol"):
         _core.gabor_lr_check(d, d, tol)
+
+
+def test_every_kernel_lets_other_python_threads_run(crop: tuple[np.ndarray, np.ndarray]) -> None:
+    """The GIL is released around every kernel: a Python thread counting in a loop keeps
+    counting while one runs. Concurrent calls from threads giving the serial results is
+    tests/test_memory.py's."""
+    import threading
+    import time
+
+    gl, gr = (np.ascontiguousarray(np.tile(as_gray_float(a), (6, 6))) for a in crop)
+    bgr = np.ascontiguousarray(np.tile(crop[0], (6, 6, 1)))
+    d, conf = np.full_like(gl, 5.0), np.full_like(gl, 0.5)
+    kernels = {
+        "sgm_disparity": lambda: _core.sgm_disparity(gl, gr, 0, 127, 8, 32, 1.0, 10, 1, 0),
+        "gabor_disparity": lambda: _core.gabor_disparity(gl, gr, 0.0, 64.0),
+        "hopfield_match_u8": lambda: _core.hopfield_match_u8(
+            bgr, bgr, LUMA_WEIGHTS_BGR, {"max_disparity": 64}
+        ),
+        "mcgm_match": lambda: _core.mcgm_match(gl, gr, {"max_disparity": 32}),
+        "refine_disparity": lambda: _core.refine_disparity(gl, gr, d, conf, *REFINE_ARGS),
+        "graph_segments": lambda: _core.graph_segments(bgr.astype(np.float32), 1.0, 20),
+    }
+    count = [0]
+    stop = threading.Event()
+
+    def spin() -> None:  # lets go of the GIL at every step: the main thread never waits
+        while not stop.is_set():
+            count[0] += 1
+            time.sleep(0)
+
+    spinner = threading.Thread(target=spin, daemon=True)
+    spinner.start()
+    try:
+        for name, kernel in kernels.items():
+            before, t0 = count[0], time.perf_counter()
+            kernel()
+            ran, took = count[0] - before, time.perf_counter() - t0
+            # A call holding the GIL (re.match of 0.2 s, say) leaves 1 step; released, hundreds.
+            assert ran > 20, f"{name}: the other thread ran {ran} steps in {took:.3f} s"
+    finally:
+        stop.set()
+        spinner.join()
