@@ -3,6 +3,7 @@ an internal error from a panic, nor a result computed from garbage without a wor
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -108,3 +109,30 @@ def test_every_kernel_lets_other_python_threads_run(crop: tuple[np.ndarray, np.n
     finally:
         stop.set()
         spinner.join()
+
+
+def test_plane_fill_range_must_not_be_empty() -> None:
+    """``lo > hi`` filled nothing, without a word."""
+    from stereovision.matching import planes
+
+    disp = np.tile(np.arange(12, dtype=np.float32), (8, 1))
+    disp[3, 4:7] = np.nan
+    labels = np.zeros(disp.shape, np.uint32)
+    filled, _, holes = _core.plane_fill(disp, labels, 5, 1.0, 0.0, 20.0)
+    assert holes == 3 and np.isfinite(filled).all()
+    with pytest.raises(ValueError, match="lo <= hi"):
+        _core.plane_fill(disp, labels, 5, 1.0, 20.0, 0.0)
+    with pytest.raises(ValueError, match="lo <= hi"):
+        planes.plane_fill(disp, labels, lo=20.0, hi=0.0)
+
+
+@pytest.mark.parametrize("key", [1, None, b"max_disparity"])
+def test_parameter_dict_keys_must_be_names(key: object) -> None:
+    """A non-str key of a params dict gave "'int' object is not an instance of 'str'", naming
+    neither the dict nor the key."""
+    g = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    named = "Hopfield parameter names must be str.*" + re.escape(repr(key))
+    with pytest.raises(TypeError, match=named):
+        _core.hopfield_match(g, g, {key: 4})
+    with pytest.raises(TypeError, match="MCGM parameter names must be str"):
+        _core.mcgm_match(g, g, {key: 4})

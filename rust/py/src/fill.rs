@@ -15,7 +15,14 @@ pub fn row_fill<'py>(
     py: Python<'py>,
     disp: PyReadonlyArray2<'py, f32>,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    Ok(map_copy_in_place(py, &disp, |d, w, _| core_row_fill(d, w))?.0)
+    let (out, done) = map_copy_in_place(py, &disp, |d, w, _| {
+        guard("row_fill", || {
+            core_row_fill(d, w);
+            Ok(())
+        })
+    })?;
+    done?;
+    Ok(out)
 }
 
 /// A copy of `disp` with the colour side rule applied (`(H, W, 3)` `lab`; core docs).
@@ -36,7 +43,14 @@ pub fn side_fill<'py>(
         )));
     }
     let lab = row_major(&lab);
-    Ok(map_copy_in_place(py, &disp, |d, w, _| core_side_fill(d, &lab, w, tau))?.0)
+    let (out, done) = map_copy_in_place(py, &disp, |d, w, _| {
+        guard("side_fill", || {
+            core_side_fill(d, &lab, w, tau);
+            Ok(())
+        })
+    })?;
+    done?;
+    Ok(out)
 }
 
 /// The pixels of `disp` a matcher carried past an edge of `guide` (`(H, W)` bool; core docs).

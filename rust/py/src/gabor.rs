@@ -261,7 +261,9 @@ pub fn gabor_lr_check<'py>(
     let (h, w) = a.dim();
     let dl: Vec<f32> = a.iter().copied().collect();
     let dr: Vec<f32> = b.iter().copied().collect();
-    let ok = crate::workers::detach(py, || lr_check(&dl, &dr, w, h, tol));
+    let ok = crate::workers::detach(py, || {
+        guard("gabor_lr_check", || Ok(lr_check(&dl, &dr, w, h, tol)))
+    })?;
     crate::convert::vec_to_numpy(py, (h, w), ok)
 }
 
@@ -277,6 +279,13 @@ pub fn gabor_remove_speckles<'py>(
     max_diff: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     crate::params::non_negative("max_diff", max_diff)?;
-    let kernel = |d: &mut [f32], w, h| remove_speckles(d, w, h, min_size, max_diff);
-    Ok(crate::convert::map_copy_in_place(py, &disp, kernel)?.0)
+    let kernel = |d: &mut [f32], w, h| {
+        guard("gabor_remove_speckles", || {
+            remove_speckles(d, w, h, min_size, max_diff);
+            Ok(())
+        })
+    };
+    let (out, done) = crate::convert::map_copy_in_place(py, &disp, kernel)?;
+    done?;
+    Ok(out)
 }

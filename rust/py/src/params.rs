@@ -1,13 +1,20 @@
 //! Tuning parameters passed as one Python dict (keys = the Python names).
 
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 /// Every key of `d` must be one of `known`; `what` names the channel in the error.
 pub fn check_keys(d: &Bound<'_, PyDict>, known: &[&str], what: &str) -> PyResult<()> {
     for k in d.keys() {
-        let k: String = k.extract()?;
+        let k: String = k.extract().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "{what} parameter names must be str, got the key {k} ({})",
+                k.get_type()
+                    .name()
+                    .map_or_else(|_| "?".to_string(), |n| n.to_string())
+            ))
+        })?;
         if !known.contains(&k.as_str()) {
             return Err(PyValueError::new_err(format!(
                 "unknown {what} parameter `{k}`"

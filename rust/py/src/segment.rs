@@ -70,6 +70,12 @@ pub fn plane_fill<'py>(
             "lo and hi: expected numbers, got {lo}, {hi}"
         )));
     }
+    // An empty range filled nothing, without a word.
+    if lo > hi {
+        return Err(PyValueError::new_err(format!(
+            "lo and hi: expected lo <= hi, got lo = {lo}, hi = {hi}"
+        )));
+    }
     let l = row_major(&labels);
     // The kernel sizes its tables by the largest label: one per pixel at most.
     if l.iter().any(|&v| v as usize >= h * w) {
