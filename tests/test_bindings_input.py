@@ -136,3 +136,27 @@ def test_parameter_dict_keys_must_be_names(key: object) -> None:
         _core.hopfield_match(g, g, {key: 4})
     with pytest.raises(TypeError, match="MCGM parameter names must be str"):
         _core.mcgm_match(g, g, {key: 4})
+
+
+@pytest.mark.parametrize(
+    "bad", [{"sides_width": -1}, {"sides_width": 0}, {"sides_height": 0}, {"disc_dx": -1}]
+)
+def test_mcgm_filter_checks_its_parameters(bad: dict[str, int]) -> None:
+    """``mcgm_filter`` ran B.8's filters without ``mcgm_match``'s parameter checks: a
+    ``sides_width`` of -1 indexed past the half-window table (``RuntimeError: internal
+    error ... index out of bounds``)."""
+    g = np.random.default_rng(0).random((30, 50), dtype=np.float32)
+    ms = np.array([[25, 15, 22, 15]], np.float32)
+    assert _core.mcgm_filter(g, g, ms, {"max_disparity": 8}).shape == (1,)
+    with pytest.raises(ValueError, match=re.escape("sides_width in 1..=16")):
+        _core.mcgm_filter(g, g, ms, {"max_disparity": 8, **bad})
+
+
+@pytest.mark.parametrize("theta", [90.0, -95.0, float("nan")])
+def test_gabor_responses_names_theta_deg(theta: float) -> None:
+    """An angle out of range was blamed on ``orientations_deg``, a parameter this function
+    does not have."""
+    g = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    with pytest.raises(ValueError, match="theta_deg") as exc:
+        _core.gabor_responses(g, theta_deg=theta)
+    assert "orientations_deg" not in str(exc.value)

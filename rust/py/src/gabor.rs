@@ -169,6 +169,13 @@ pub fn gabor_responses<'py>(
     bandwidth_oct: f32,
     aspect: f32,
 ) -> PyResult<Pair<'py>> {
+    // The core checks the angle as one of `orientations_deg`, the name its error gave here.
+    if !(theta_deg.is_finite() && theta_deg.abs() < 90.0) {
+        return Err(pyo3::exceptions::PyValueError::new_err(format!(
+            "theta_deg: expected an angle in (-90, 90) degrees (a horizontal carrier), got \
+             {theta_deg}"
+        )));
+    }
     let im = image_from_numpy(&img, "img")?;
     let (w, h) = im.size();
     let (re, imag) = crate::workers::detach(py, || {

@@ -106,6 +106,43 @@ pub struct FilterParams {
     pub zncc_tol: f32,
 }
 
+impl FilterParams {
+    /// Checks every field's range ([`mcgm_match`] and [`edge_filters`] call it: a
+    /// `sides_width` below 1 indexed past the half-window's column table, a panic).
+    pub fn validate(&self) -> Result<()> {
+        for (name, v) in [
+            ("sides_mad", self.sides_mad),
+            ("disc_tol", self.disc_tol),
+            ("zncc_tol", self.zncc_tol),
+        ] {
+            if !v.is_finite() || v < 0.0 {
+                return Err(CoreError::param(
+                    name,
+                    format!("must be finite and >= 0, got {v}"),
+                ));
+            }
+        }
+        if self.sides_width < 1
+            || self.sides_width as usize > MAX_SIDES_WIDTH
+            || self.sides_height < 1
+            || self.sides_gap < 0
+            || self.disc_dx < 0
+            || self.disc_dy < 0
+        {
+            return Err(CoreError::param(
+                "filters",
+                format!(
+                    "sides_width in 1..={MAX_SIDES_WIDTH}, sides_height >= 1; sides_gap, \
+                     disc_dx, disc_dy >= 0, got sides_width = {}, sides_height = {}, \
+                     sides_gap = {}, disc_dx = {}, disc_dy = {}",
+                    self.sides_width, self.sides_height, self.sides_gap, self.disc_dx, self.disc_dy
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl Default for FilterParams {
     fn default() -> Self {
         FilterParams {
@@ -338,19 +375,7 @@ fn validate_params(p: &McgmParams) -> Result<()> {
             ));
         }
     }
-    let f = &p.filters;
-    if f.sides_width < 1
-        || f.sides_width as usize > MAX_SIDES_WIDTH
-        || f.sides_height < 1
-        || f.sides_gap < 0
-        || f.disc_dx < 0
-        || f.disc_dy < 0
-    {
-        return Err(CoreError::param(
-            "filters",
-            "sides_width in 1..=16, sides_height >= 1; sides_gap, disc_dx, disc_dy >= 0",
-        ));
-    }
+    p.filters.validate()?;
     if !(0..=MAX_RADIUS).contains(&p.fill_radius) {
         return Err(CoreError::param(
             "fill_radius",
@@ -1367,6 +1392,7 @@ pub fn edge_filters(
     f: &FilterParams,
     range: (i32, i32),
 ) -> Result<(Vec<bool>, FilterCounts)> {
+    f.validate()?;
     check_pair(left, right)?;
     let (w, h) = left.size();
     // Both per-match checks run in raster order of the left pixel: neighbouring checks read

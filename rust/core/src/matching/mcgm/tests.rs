@@ -714,3 +714,46 @@ fn repeated_correspondences_are_dropped_keeping_the_first() {
     let scores: Vec<f32> = ms.iter().map(|m| m.score).collect();
     assert_eq!(scores, [1.0, 2.0, 4.0]);
 }
+
+/// `edge_filters` (called directly, as `_core.mcgm_filter` does) checks its parameters like
+/// `mcgm_match`: a `sides_width` of 0 or -1 indexed past the column table (a panic).
+#[test]
+fn edge_filters_check_their_parameters() {
+    let (l, r) = (blobs(64, 40, 0.0), blobs(64, 40, 3.0));
+    let ms = [Match {
+        xl: 30.0,
+        yl: 20.0,
+        xr: 27.0,
+        yr: 20.0,
+        score: 1.0,
+        channel: 0,
+    }];
+    let ok = FilterParams::default();
+    assert!(edge_filters(&l, &r, &ms, &ok, (0, 16)).is_ok());
+    for bad in [
+        FilterParams {
+            sides_width: -1,
+            ..ok
+        },
+        FilterParams {
+            sides_width: 0,
+            ..ok
+        },
+        FilterParams {
+            sides_width: 17,
+            ..ok
+        },
+        FilterParams {
+            sides_height: 0,
+            ..ok
+        },
+        FilterParams { disc_dx: -1, ..ok },
+        FilterParams {
+            sides_mad: f32::NAN,
+            ..ok
+        },
+    ] {
+        let err = edge_filters(&l, &r, &ms, &bad, (0, 16)).unwrap_err();
+        assert!(matches!(err, CoreError::InvalidParameter { .. }), "{err}");
+    }
+}
