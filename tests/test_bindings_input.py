@@ -160,3 +160,23 @@ def test_gabor_responses_names_theta_deg(theta: float) -> None:
     with pytest.raises(ValueError, match="theta_deg") as exc:
         _core.gabor_responses(g, theta_deg=theta)
     assert "orientations_deg" not in str(exc.value)
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [
+        ("edge_margin", float("nan")),
+        ("edge_margin", -1.0),
+        ("centre_tol", -1.0),
+        ("agree_share", float("nan")),
+        ("agree_share", 1.5),
+    ],
+)
+def test_hopfield_slacks_and_shares_are_checked(
+    key: str, value: float, crop: tuple[np.ndarray, np.ndarray]
+) -> None:
+    """These failed every edge / centre test (no matches at all) or switched the sparse-area
+    rule off, without a word, through stereovision.match too."""
+    assert len(sv.match(*crop, method="hopfield", max_disparity=32).xl) > 50
+    with pytest.raises(ValueError, match=key):
+        sv.match(*crop, method="hopfield", max_disparity=32, **{key: value})

@@ -257,6 +257,22 @@ fn validate(left: &ImageView<'_>, right: &ImageView<'_>, p: &HopfieldParams) -> 
             return Err(CoreError::param(name, format!("must be finite, got {v}")));
         }
     }
+    // A NaN or negative slack / tolerance failed every edge or centre test: no matches at all,
+    // without a word; a NaN share silently switched the sparse-area rule off.
+    for (name, v) in [("edge_margin", p.edge_margin), ("centre_tol", p.centre_tol)] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(CoreError::param(
+                name,
+                format!("must be finite and >= 0, got {v}"),
+            ));
+        }
+    }
+    if !(p.agree_share.is_finite() && (0.0..=1.0).contains(&p.agree_share)) {
+        return Err(CoreError::param(
+            "agree_share",
+            format!("must lie in [0, 1], got {}", p.agree_share),
+        ));
+    }
     // 1e6 px took a minute on a 100 x 160 crop and 1e9 did not finish: a window beyond any
     // image is refused.
     if !(1..=MAX_NBR_HALF).contains(&w.nbr_half) {

@@ -140,6 +140,27 @@ fn bad_parameters_are_errors() {
             Err(CoreError::InvalidParameter { .. })
         ));
     }
+    // A NaN or negative edge slack / centre tolerance, a share outside [0, 1]: no matches at
+    // all (or the sparse rule off) without a word, before these were checked.
+    for (margin, tol, share) in [
+        (f32::NAN, 0.05, 0.8),
+        (-1.0, 0.05, 0.8),
+        (0.0, -1.0, 0.8),
+        (0.0, f32::NAN, 0.8),
+        (0.0, 0.05, f32::NAN),
+        (0.0, 0.05, 1.5),
+    ] {
+        let p = HopfieldParams {
+            edge_margin: margin,
+            centre_tol: tol,
+            agree_share: share,
+            ..params(8)
+        };
+        assert!(matches!(
+            hopfield_match(&l, &r, &p),
+            Err(CoreError::InvalidParameter { .. })
+        ));
+    }
     let small = Image::filled(20, 30, 0.5);
     assert!(matches!(
         hopfield_match(&l, &small, &params(8)),
