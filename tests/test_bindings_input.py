@@ -180,3 +180,14 @@ def test_hopfield_slacks_and_shares_are_checked(
     assert len(sv.match(*crop, method="hopfield", max_disparity=32).xl) > 50
     with pytest.raises(ValueError, match=key):
         sv.match(*crop, method="hopfield", max_disparity=32, **{key: value})
+
+
+@pytest.mark.parametrize("value", [float("nan"), -1.0])
+def test_mcgm_sides_best_margin_is_checked(
+    value: float, crop: tuple[np.ndarray, np.ndarray]
+) -> None:
+    """A negative ``sides_best_margin`` let no half-window pass (no matches at all) and a NaN
+    one switched the test off, without a word."""
+    assert len(sv.match(*crop, method="mcgm", max_disparity=32).xl) > 50
+    with pytest.raises(ValueError, match="sides_best_margin"):
+        sv.match(*crop, method="mcgm", max_disparity=32, sides_best_margin=value)

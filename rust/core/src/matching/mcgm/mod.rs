@@ -112,6 +112,8 @@ impl FilterParams {
     pub fn validate(&self) -> Result<()> {
         for (name, v) in [
             ("sides_mad", self.sides_mad),
+            // Negative: no half-window passed (no matches, without a word); NaN: the test off.
+            ("sides_best_margin", self.sides_best_margin),
             ("disc_tol", self.disc_tol),
             ("zncc_tol", self.zncc_tol),
         ] {

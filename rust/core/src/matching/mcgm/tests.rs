@@ -752,6 +752,14 @@ fn edge_filters_check_their_parameters() {
             sides_mad: f32::NAN,
             ..ok
         },
+        FilterParams {
+            sides_best_margin: -1.0,
+            ..ok
+        },
+        FilterParams {
+            sides_best_margin: f32::NAN,
+            ..ok
+        },
     ] {
         let err = edge_filters(&l, &r, &ms, &bad, (0, 16)).unwrap_err();
         assert!(matches!(err, CoreError::InvalidParameter { .. }), "{err}");
