@@ -179,12 +179,15 @@ def test_eval_mean_line_has_every_column(
     mean = [ln for ln in capsys.readouterr().out.splitlines() if ln.startswith("mean bad-2.0")]
     assert len(mean) == 1
     m = re.fullmatch(
-        r"mean bad-2\.0: ours ([\d.]+) %, ours\+fill ([\d.]+) %, StereoBM 12\.7 %, "
-        r"SGBM-3WAY 5\.3 %, SGBM\+fill 4\.2 %",
+        r"mean bad-2\.0: ours ([\d.]+) %, ours\+fill ([\d.]+) %, StereoBM ([\d.]+) %, "
+        r"SGBM-3WAY ([\d.]+) %, SGBM\+fill ([\d.]+) %",
         mean[0],
     )
     assert m is not None, mean[0]
-    assert float(m[2]) < 4.2  # ours after the fill beats SGBM-3WAY + fill on tsukuba (3.3)
+    # OpenCV's figures within test_baselines' tolerance (they move a little between versions)
+    bm, sgbm, sgbm_fill = float(m[3]), float(m[4]), float(m[5])
+    assert (bm, sgbm, sgbm_fill) == pytest.approx((12.7, 5.3, 4.2), abs=0.5)
+    assert float(m[2]) < sgbm_fill  # ours after the fill beats SGBM-3WAY + fill on tsukuba (3.3)
 
 
 def test_eval_goes_on_past_a_damaged_scene(data_dir: Path, tmp_path: Path) -> None:
