@@ -104,8 +104,10 @@ def test_every_kernel_lets_other_python_threads_run(crop: tuple[np.ndarray, np.n
             before, t0 = count[0], time.perf_counter()
             kernel()
             ran, took = count[0] - before, time.perf_counter() - t0
-            # A call holding the GIL (re.match of 0.2 s, say) leaves 1 step; released, hundreds.
-            assert ran > 20, f"{name}: the other thread ran {ran} steps in {took:.3f} s"
+            # A call holding the GIL (re.match of 0.2 s, say) leaves 0-2 steps; released,
+            # hundreds on an idle machine (hopfield_match_u8's 17 ms: 120-330), fewer under the
+            # load of a full run: the bound sits just above what a held GIL allows.
+            assert ran >= 5, f"{name}: the other thread ran {ran} steps in {took:.3f} s"
     finally:
         stop.set()
         spinner.join()
