@@ -154,7 +154,7 @@ def plane_fill(
     ------
     ValueError
         ``disp`` not 2-D, ``labels`` of another shape or not below ``H * W``, a negative
-        ``min_pixels`` or ``max_residual``.
+        ``min_pixels`` or ``max_residual``, ``lo`` above ``hi``.
     """
     from stereovision import _core
 
