@@ -257,6 +257,16 @@ def test_cli_check_fix(data_dir: Path, tmp_path: Path) -> None:
         timeout=120,
     )
     assert run.returncode == 2 and "--fix needs --calib" in run.stderr
+    # --fix naming the calibration it corrects replaced the original: refused, the file kept
+    before = bumped.read_bytes()
+    run = subprocess.run([*SV, "check", *pair, "--calib", str(bumped), "--fix", str(bumped)],
+                         capture_output=True, text=True, timeout=120)  # fmt: skip
+    assert run.returncode == 2 and run.stdout == ""
+    assert run.stderr == (
+        f"stereovision: error: --fix {bumped}: is the calibration ({bumped}); give another "
+        "file name\n"
+    )
+    assert bumped.read_bytes() == before
     # a failed check says what to do, as the rig has a calibration or not
     run = subprocess.run([*SV, "check", *pair, "--calib", str(bumped)], capture_output=True,
                          text=True, timeout=120)  # fmt: skip

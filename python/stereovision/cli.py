@@ -440,6 +440,8 @@ def cmd_check(args: argparse.Namespace) -> int:
               "the calibration": args.calib}  # fmt: skip
     if args.plot:
         _refuse_an_input("--plot", Path(args.plot), inputs)
+    if fix is not None:  # the corrected calibration in place of the original lost it
+        _refuse_an_input("--fix", fix, inputs)
     raw_left, raw_right = left, right
     if calib is not None:
         left, right = calib.rectify(left, right)
