@@ -585,7 +585,7 @@ def test_cli_outputs_that_collide_or_cannot_be_written_are_refused_first(
     def refused(*_: Any, **__: Any) -> Any:
         raise PermissionError(13, "Permission denied")
 
-    monkeypatch.setattr(calmod.tempfile, "mkstemp", refused)
+    monkeypatch.setattr("stereovision.io.tempfile.mkstemp", refused)
     with pytest.raises(
         PermissionError, match=rf"-o {tmp_path}/rig\.yaml: cannot write in {tmp_path} \(Perm"
     ):

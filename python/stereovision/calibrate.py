@@ -41,7 +41,6 @@ import json
 import math
 import os
 import re
-import tempfile
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
@@ -2060,14 +2059,12 @@ def _check_output_file(
     """
     if out.is_dir():
         raise ValueError(f"-o {given}: is a folder; give a calibration file name")
+    from stereovision.io import cannot_write_in
+
     folder = out.parent if str(out.parent) else Path(".")
-    # A probe file, as the atomic save will make one (os.access says yes to root everywhere).
-    try:
-        fd, probe = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".probe", dir=folder)
-    except OSError as exc:
-        raise PermissionError(f"-o {given}: cannot write in {folder} ({exc.strerror})") from None
-    os.close(fd)
-    os.remove(probe)
+    why = cannot_write_in(folder)
+    if why:
+        raise PermissionError(f"-o {given}: cannot write in {folder} ({why})")
     if out.exists() and not os.access(out, os.W_OK):
         raise PermissionError(f"-o {given}: the file is not writable")
     target = out.resolve()

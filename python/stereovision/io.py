@@ -110,8 +110,33 @@ def check_output_folder(folder: PathLike, flag: str) -> None:
         above = above.parent
     if above.exists() and not above.is_dir():
         raise ValueError(f"{flag} {path}: {above} is a file, not a folder")
-    if above.exists() and not os.access(above, os.W_OK | os.X_OK):
-        raise PermissionError(f"{flag} {path}: cannot write in {above}")
+    why = cannot_write_in(above) if above.exists() else None
+    if why:
+        raise PermissionError(f"{flag} {path}: cannot write in {above} ({why})")
+
+
+def cannot_write_in(folder: PathLike) -> str | None:
+    """Why no file can be made in ``folder`` (the system's reason), or None if one can.
+
+    A probe file, made and removed as :func:`atomic_write` makes its temporary: ``os.access``
+    says yes to root everywhere, ``/proc`` included.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        An existing folder.
+
+    Returns
+    -------
+    str or None
+    """
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".", suffix=".probe", dir=folder)
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    os.close(fd)
+    os.remove(probe)
+    return None
 
 
 @contextmanager
