@@ -98,11 +98,10 @@ def match(
         from stereovision.matching.fusion import fuse_pair
 
         res = fuse_pair(gl, gr, max_disparity=max_disparity, **params)
-        lo, hi = float(params.get("min_disparity", 0)), float(max_disparity)
-        m = _within_range(res.matches, lo, hi)
+        keep = _in_range(res.matches, float(params.get("min_disparity", 0)), max_disparity)
+        m = _keep(res.matches, keep)
         # per member, as the matches: a member dropped out of range takes its entries along
         # (they were left whole, longer than the matches)
-        keep = _in_range(res.matches, lo, hi)
         m.stats.update(count=res.count[keep], sources=res.sources[keep])
         return m
     elif method == "gabor":
@@ -110,7 +109,7 @@ def match(
     else:
         run = _hopfield.hopfield_match if method == "hopfield" else _hopfield.best_match
         m = run(gl, gr, max_disparity=max_disparity, **params)
-    return _within_range(m, float(params.get("min_disparity", 0)), float(max_disparity))
+    return _keep(m, _in_range(m, float(params.get("min_disparity", 0)), max_disparity))
 
 
 def _gabor_matches(
@@ -137,21 +136,19 @@ def _gabor_matches(
 
 
 def _in_range(m: Matches, lo: float, hi: float) -> npt.NDArray[np.bool_]:
-    """Which matches have a disparity ``xl - xr`` in ``[lo, hi]``."""
-    d = m.xl - m.xr
-    return (d >= lo) & (d <= hi)
-
-
-def _within_range(m: Matches, lo: float, hi: float) -> Matches:
-    """The matches whose disparity ``xl - xr`` lies in ``[lo, hi]``.
+    """Which matches have a disparity ``xl - xr`` in ``[lo, hi]``.
 
     The matchers search that range, but their sub-pixel estimates can leave it: MCGM's crossings
     by up to 2 px (cones, ``max_disparity=32``: 190 of 4760 matches above 32, up to 34.0), the
     Hopfield parabola by half a pixel below ``min_disparity``. A caller who bounds the range
-    (a working volume, a near limit) gets no match outside it; ``stats["n_out_of_range"]``
-    counts those dropped.
+    (a working volume, a near limit) gets no match outside it.
     """
-    keep = _in_range(m, lo, hi)
+    d = m.xl - m.xr
+    return (d >= lo) & (d <= hi)
+
+
+def _keep(m: Matches, keep: npt.NDArray[np.bool_]) -> Matches:
+    """``m[keep]``, with the matches dropped counted in ``stats["n_out_of_range"]``."""
     n_out = int(len(m) - np.count_nonzero(keep))
     out = m if n_out == 0 else m[keep]
     out.stats["n_out_of_range"] = n_out
