@@ -167,6 +167,33 @@ def test_no_floor_no_plane() -> None:
     assert fit_ground_plane(sparse, RIG) is None
 
 
+def test_a_floor_seen_along_a_line_is_no_plane() -> None:
+    """One row of a floor fixes the plane along that row only: any plane through it fits it
+    exactly. The fit returned one (row 300 of this 800 x 360 rig: the camera 2.32 m above it,
+    pitched 32 degrees, 100 % of the pixels at RMS 0 px; true 1.3 m and 8 degrees); now None.
+    A band of 40 rows still gives the floor."""
+    w, h = 800, 360
+    k = [[F, 0, 399.5], [0, F, 179.5], [0, 0, 1]]
+    rig = Calibration(
+        K1=k, D1=np.zeros(5), K2=k, D2=np.zeros(5), R=np.eye(3), T=[-0.12, 0, 0],
+        image_size=(w, h), rectified=True,
+    )  # fmt: skip
+    n_true = _camera_rotation(8.0, -5.0) @ np.array([0.0, -1.0, 0.0])
+    v, u = np.mgrid[0:h, 0:w].astype(np.float64)
+    rays = np.stack([(u - 399.5) / F, (v - 179.5) / F, np.ones_like(u)], axis=-1)
+    z = -1.3 / (rays @ n_true)
+    floor = np.where(z > 0, F * 0.12 / z, np.nan)
+    for rows in (slice(300, 301), slice(340, 341)):
+        line = np.full_like(floor, np.nan)
+        line[rows] = floor[rows]
+        assert fit_ground_plane(line, rig) is None
+    band = np.full_like(floor, np.nan)
+    band[300:340] = floor[300:340]
+    plane = fit_ground_plane(band, rig)
+    assert plane is not None and plane.height == pytest.approx(1.3, rel=1e-6)
+    assert plane.pitch_deg == pytest.approx(8.0, abs=1e-6)
+
+
 @pytest.mark.parametrize("doffs", [0.0, 15.0])
 def test_plane_geometry_round_trips(doffs: float) -> None:
     """A floor written as a disparity map from its 3-D plane is found exactly: the disparity
