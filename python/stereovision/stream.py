@@ -96,6 +96,7 @@ class _Pair:
     temporal_s: float = 0.0
     averaged: float = 1.0  # mean frames in a pixel's temporal mean (1: not averaged)
     stamp_ns: int = 0  # the grab's time, ns since the epoch (a recording: its own stamp)
+    raw_left: np.ndarray | None = None  # the first pair's left frame as grabbed (its noise)
 
 
 @dataclass
@@ -147,8 +148,8 @@ class StreamReport:
         With ``ground_every``: every floor fit (:meth:`~stereovision.ground.GroundPlane.as_dict`
         and the ``pair``), or ``{"pair": n, "found": False}`` when no floor was in view.
     noise_sigma : float
-        Noise of the first left frame in grey levels (:func:`~stereovision.temporal.noise_sigma`;
-        NaN when no pair came).
+        Noise of the first left frame as grabbed (before rectification), in grey levels
+        (:func:`~stereovision.temporal.noise_sigma`; NaN when no pair came).
     temporal : dict or None
         With a :class:`~stereovision.temporal.TemporalFilter`: ``frames_averaged`` (mean over
         the pairs of the frames in a pixel's mean), ``restarts`` (pairs on which the rig or
@@ -389,15 +390,19 @@ def _pairs(
             ago = time.monotonic() - 0.5 * (fr.t_left + fr.t_right)
             stamp_ns = time.time_ns() - round(1e9 * ago)
         left, right = fr.left, fr.right
-        if calib is not None and not calib.rectified:
-            left, right = calib.rectify(left, right)
-        elif homographies is not None:
-            left, right = homographies.rectify(left, right)
-        t2 = time.perf_counter()
+        # The mean of the frames as the cameras give them, then rectified: the filter measures
+        # the noise of each pixel (temporal.noise_sigma), which rectification's interpolation
+        # blurs into its neighbours (a half-pixel shift read 1.1 instead of 5.7 grey levels),
+        # and its motion test then took every pair of a still raw rig for a moving one.
         averaged = 1.0
         if temporal is not None:
             left, right = temporal(left, right)
             averaged = temporal.mean_frames()
+        t2 = time.perf_counter()
+        if calib is not None and not calib.rectified:
+            left, right = calib.rectify(left, right)
+        elif homographies is not None:
+            left, right = homographies.rectify(left, right)
         t3 = time.perf_counter()
         checked = None
         # In the producer thread when pipelined: the matcher keeps working meanwhile.
@@ -409,13 +414,14 @@ def _pairs(
             fr.index,
             t0,
             t1 - t0,
-            t2 - t1,
+            t3 - t2,
             fr.skew_ms,
             checked,
             n,
-            temporal_s=t3 - t2,
+            temporal_s=t2 - t1,
             averaged=averaged,
             stamp_ns=stamp_ns,
+            raw_left=fr.left if n == 0 else None,
         )
         n += 1
 
@@ -605,7 +611,9 @@ def run_stream(
     temporal : TemporalFilter, optional
         Average a still rig's frames (:class:`~stereovision.temporal.TemporalFilter`; in the
         grab thread when pipelined) before matching: less noise in low light, the same pairs
-        when the rig or the scene moves. ``on_result`` gets the averaged left image.
+        when the rig or the scene moves. It averages the frames as grabbed, before
+        rectification (whose interpolation blurs the noise it measures). ``on_result`` gets
+        the averaged left image.
 
     Returns
     -------
@@ -690,7 +698,8 @@ def run_stream(
             if md is None:
                 md = estimate_max_disparity(pair.left, pair.right)
             if tally.n == 0:
-                noise = _note_noise(pair.left, temporal is not None)
+                raw = pair.raw_left if pair.raw_left is not None else pair.left
+                noise = _note_noise(raw, temporal is not None)
             # No point cloud per frame: the live view shows disparity and depth.
             res = depth_map(pair.left, pair.right, rect_calib, max_disparity=md, cloud=False, **kw)
             if ground_every is not None and tally.n % ground_every == 0:

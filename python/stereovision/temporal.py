@@ -22,6 +22,11 @@ camera's frames while the scene holds still and starts again where it does not:
   the image's flattest 30 %; Immerkaer 1996), the median of the last 8 frames' estimates.
 
 A still, noiseless pair comes out unchanged (the mean of equal frames is the frame).
+
+Give it the frames as the cameras deliver them, before rectification or resizing: their
+interpolation spreads each pixel's noise over its neighbours, the estimate then reads a fraction
+of it (1.1 instead of 5.7 grey levels after a half-pixel shift), and the motion test takes every
+frame of a still rig for a moving one.
 """
 
 from __future__ import annotations
