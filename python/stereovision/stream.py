@@ -76,7 +76,7 @@ GROUND_TILT_DEG = 2.0
 GROUND_SUPPORT_KEPT = 0.5
 #: Noise (grey levels, :func:`~stereovision.temporal.noise_sigma` of the first left frame) above
 #: which the stream suggests ``--temporal``: Gaussian noise of 8 per colour channel measures
-#: 4.9-6.5 on the 17 GT scenes, the scenes as given 0.3-3.6 (fine texture counts a little).
+#: 5.2-6.6 on the GT scenes, the scenes as given 0.3-3.7 (fine texture counts a little).
 NOISY_SIGMA = 4.5
 
 
