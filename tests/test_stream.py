@@ -453,7 +453,11 @@ def test_stream_averages_a_still_noisy_rig(
     assert 4.8 < _json_lines(cap.out)[-1]["noise_sigma"] < 7.0
     assert main([*argv[:-1], "1"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["stereovision: error: --temporal: expected at least 2 pairs to average, got 1"]
+    assert err == ["stereovision: error: --temporal: expected 2-255 pairs to average, got 1"]
+    # Above 255 it named the filter's parameter (max_frames), not the option.
+    assert main([*argv[:-1], "256"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["stereovision: error: --temporal: expected 2-255 pairs to average, got 256"]
 
 
 def test_stream_averages_a_raw_rig_before_rectifying(

@@ -882,10 +882,8 @@ def cmd_stream(args: argparse.Namespace) -> int:
     if args.temporal is not None:
         from stereovision.temporal import TemporalFilter
 
-        if args.temporal < 2:
-            raise ValueError(
-                f"--temporal: expected at least 2 pairs to average, got {args.temporal}"
-            )
+        if not 2 <= args.temporal <= 255:
+            raise ValueError(f"--temporal: expected 2-255 pairs to average, got {args.temporal}")
         temporal = TemporalFilter(max_frames=args.temporal)
     cam = open_source(args)
     if hasattr(cam, "stamps_ns"):  # a recording: its results keep the frames' stamps
