@@ -222,6 +222,25 @@ def test_bad_inputs_raise() -> None:
     assert set(DEFAULTS) >= {"fills", "win_sigma", "search"}
 
 
+def test_a_confidence_outside_zero_one_is_named_and_nan_holes_are_allowed(data_dir: Path) -> None:
+    """A NaN confidence where the disparity has a value came out as the NaN confidence of a
+    refined pixel (146 371 of venus's 152 067), and 5.0 was clipped to 1 without a word: both
+    now raise. NaN where the disparity is NaN is not read: the same result as 0 there."""
+    sc = load_scene(data_dir / "middlebury2001" / "venus")
+    left, right = as_gray_float(sc.left), as_gray_float(sc.right)
+    disp = np.where(np.isfinite(sc.gt), sc.gt, np.nan).astype(np.float32)
+    disp[::7] = np.nan
+    for value in (np.nan, 5.0, -0.5):
+        with pytest.raises(ValueError, match="confidence: expected values in \\[0, 1\\]"):
+            refine_disparity(left, right, disp, np.full(disp.shape, value), max_disparity=30)
+    conf = np.where(np.isfinite(disp), 0.5, np.nan).astype(np.float32)
+    res = refine_disparity(left, right, disp, conf, max_disparity=30)
+    ref = refine_disparity(left, right, disp, np.nan_to_num(conf), max_disparity=30)
+    assert np.array_equal(res.confidence, ref.confidence)
+    assert np.isfinite(res.confidence).all()
+    assert set(np.unique(res.confidence)) <= {0.0, 0.25, 0.5}
+
+
 def test_bit_identical_across_thread_counts(data_dir: Path, tmp_path: Path) -> None:
     code = (
         "import sys, numpy as np; from tests.test_refine import _crop_inputs;"

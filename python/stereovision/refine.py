@@ -114,7 +114,8 @@ def refine_disparity(
     disparity : array_like
         ``(H, W)`` disparity of the left image (px), NaN = no estimate.
     confidence : array_like, optional
-        ``(H, W)`` confidence in ``[0, 1]`` carried over to refined pixels (default 1).
+        ``(H, W)`` confidence in ``[0, 1]`` carried over to refined pixels (default 1); where
+        the disparity is NaN it is not read (NaN allowed).
     min_disparity, max_disparity : float
         Values outside this range become NaN.
     **params
@@ -132,7 +133,8 @@ def refine_disparity(
     Raises
     ------
     ValueError
-        Shapes differ, an image is empty or not finite, a parameter is unknown or out of range.
+        Shapes differ, an image is empty or not finite, a confidence is NaN or outside
+        ``[0, 1]`` where the disparity has a value, a parameter is unknown or out of range.
     """
     unknown = set(params) - set(DEFAULTS)
     if unknown:
@@ -143,6 +145,19 @@ def refine_disparity(
             f"left {lft.shape}, right {rgt.shape} and disparity {dsp.shape} differ in shape"
         )
     conf = np.ones_like(dsp) if confidence is None else _grey(confidence, "confidence")
+    if confidence is not None:
+        if conf.shape != dsp.shape:
+            raise ValueError(f"confidence {conf.shape} and disparity {dsp.shape} differ in shape")
+        # Where the disparity has a value its confidence is carried over: a NaN there came out
+        # as a NaN confidence of a refined pixel, a value outside [0, 1] clipped without a word.
+        measured = np.isfinite(dsp)
+        bad = measured & ~((conf >= 0) & (conf <= 1))
+        if bad.any():
+            raise ValueError(
+                "confidence: expected values in [0, 1] where the disparity has one; "
+                f"{int(bad.sum())} pixels are not (e.g. {float(conf[bad][0])!r})"
+            )
+        conf = np.where(measured | np.isfinite(conf), conf, np.float32(0))
     for name, v in (("min_disparity", min_disparity), ("max_disparity", max_disparity)):
         if not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
             raise ValueError(f"{name} must be a finite number, got {v!r}")
