@@ -149,6 +149,8 @@ def test_a_new_size_starts_again_and_bad_input_is_named() -> None:
         TemporalFilter(max_frames=0)
     with pytest.raises(ValueError, match="k: expected a positive number"):
         TemporalFilter(k=-1.0)
+    with pytest.raises(ValueError, match="k: expected a positive number of sigmas, got '3'"):
+        TemporalFilter(k="3")  # type: ignore[arg-type]  # was a TypeError from np.isfinite
     tf.reset()
     assert tf.mean_frames() == 0.0
 

@@ -209,6 +209,10 @@ class TemporalFilter:
             raise ValueError(
                 f"max_frames: expected at least 1 and at most 255, got {self.max_frames}"
             )
+        if isinstance(self.k, bool) or not isinstance(
+            self.k, (int, float, np.integer, np.floating)
+        ):
+            raise ValueError(f"k: expected a positive number of sigmas, got {self.k!r}")
         if not (np.isfinite(self.k) and self.k > 0):
             raise ValueError(f"k: expected a positive number of sigmas, got {self.k!r}")
 
