@@ -194,6 +194,21 @@ def test_a_floor_seen_along_a_line_is_no_plane() -> None:
     assert plane.pitch_deg == pytest.approx(8.0, abs=1e-6)
 
 
+def test_support_refuses_a_map_of_another_size() -> None:
+    """support() on the plane's own map: all of it; on a map of another size the plane's pixel
+    coefficients mean other pixels: it returned a share (0.0 on the half-size map: "the floor
+    no longer holds"), now a ValueError naming the sizes."""
+    n_true = _camera_rotation(8.0, -5.0) @ np.array([0.0, -1.0, 0.0])
+    v, u = np.mgrid[0 : SIZE[1], 0 : SIZE[0]].astype(np.float64)
+    rays = np.stack([(u - 239.5) / F, (v - 179.5) / F, np.ones_like(u)], axis=-1)
+    z = -1.3 / (rays @ n_true)
+    floor = np.where(z > 0, F * 0.12 / z, np.nan)
+    plane = fit_ground_plane(floor, RIG)
+    assert plane is not None and plane.support(floor, RIG) == 1.0
+    with pytest.raises(ValueError, match="map is 240x180, the calibration's images are 480x360"):
+        plane.support(floor[::2, ::2], RIG)
+
+
 @pytest.mark.parametrize("doffs", [0.0, 15.0])
 def test_plane_geometry_round_trips(doffs: float) -> None:
     """A floor written as a disparity map from its 3-D plane is found exactly: the disparity

@@ -164,10 +164,23 @@ class GroundPlane:
         -------
         float
             In [0, 1]; 0 when no pixel has a disparity.
+
+        Raises
+        ------
+        ValueError
+            If ``disparity`` is not 2-D, or its size is not the calibration's and the plane's.
         """
+        _require_type(calib, "Calibration", "calib")
         disp = np.asarray(disparity, np.float64)
         if disp.ndim != 2:
             raise ValueError(f"disparity: expected a (H, W) map, got shape {disp.shape}")
+        w0, h0 = calib.image_size
+        if disp.shape != (h0, w0) or disp.shape != self.inliers.shape:
+            # another size: the plane's (u, v) coefficients mean other pixels there
+            raise ValueError(
+                f"disparity: map is {disp.shape[1]}x{disp.shape[0]}, the calibration's images "
+                f"are {w0}x{h0} and this plane's {self.inliers.shape[1]}x{self.inliers.shape[0]}"
+            )
         known = np.isfinite(disp) & (disp + _rig(calib)[4] > 0)
         vv, uu = np.nonzero(known)
         if len(vv) == 0:
