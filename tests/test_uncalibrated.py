@@ -381,3 +381,19 @@ def test_cli_rectify_swapped(data_dir: Path, tmp_path: Path) -> None:
     assert run.returncode == 2, run.stderr
     assert "left and right look swapped: 0 % of the" in run.stderr
     assert run.stderr.count("\n") == 1 and not (tmp_path / "u").exists()
+
+
+def test_rectify_points_refuses_other_layouts() -> None:
+    # A (2, N) array (Bouguet's layout) or homogeneous (N, 3) points were reshaped to (N, 2)
+    # and mapped as other points, silently.
+    shift = np.array([[1.0, 0, 5], [0, 1, -3], [0, 0, 1]])
+    rect = UncalibratedRectification(
+        shift, np.eye(3), (100, 80), (100, 80), np.zeros((3, 3)), 40, 0.1, 0.2, (1.0, 9.0), 16,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    pts = np.array([[10.0, 20.0], [30.0, 40.0], [50.0, 60.0]])
+    np.testing.assert_allclose(rect.rectify_points(pts), pts + np.array([5.0, -3.0]))
+    with pytest.raises(ValueError, match=r"got \(2, 3\) \(transpose a \(2, N\) array\)"):
+        rect.rectify_points(pts.T)
+    with pytest.raises(ValueError, match=r"expected shape \(N, 2\) of \(x, y\), got \(3, 3\)$"):
+        rect.rectify_points(np.column_stack([pts, np.ones(3)]))

@@ -341,10 +341,36 @@ class UncalibratedRectification:
         return out[0], out[1]
 
     def rectify_points(self, points: npt.ArrayLike, side: str = "left") -> F64:
-        """``(N, 2)`` input pixel positions of one image -> rectified positions."""
+        """Input pixel positions of one image -> their positions in the rectified image.
+
+        Parameters
+        ----------
+        points : array_like
+            ``(N, 2)`` pixel coordinates ``(x, y)`` in the input image.
+        side : str
+            ``"left"`` or ``"right"``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(N, 2)`` float64 rectified pixel coordinates.
+
+        Raises
+        ------
+        ValueError
+            For points not of shape ``(N, 2)`` (a ``(2, N)`` array, Bouguet's layout, or
+            homogeneous ``(N, 3)`` points were read as other points) or an unknown ``side``.
+        """
         if side not in ("left", "right"):
             raise ValueError(f"side: expected 'left' or 'right', got {side!r}")
-        pts = np.asarray(points, np.float64).reshape(-1, 2)
+        pts = np.asarray(points, np.float64)
+        if pts.ndim != 2 or pts.shape[1] != 2:
+            hint = (
+                " (transpose a (2, N) array)"
+                if pts.ndim == 2 and pts.shape[0] == 2 and pts.shape[1] != 2
+                else ""
+            )
+            raise ValueError(f"points: expected shape (N, 2) of (x, y), got {pts.shape}{hint}")
         return _apply(self.H1 if side == "left" else self.H2, pts)
 
     def as_dict(self) -> dict[str, Any]:
