@@ -135,6 +135,38 @@ def test_round_trip_with_distortion() -> None:
     np.testing.assert_allclose(res.XR, pts @ c.R.T + c.T, rtol=1e-9, atol=1e-9)
 
 
+def test_round_trip_of_a_fisheye_rig() -> None:
+    """A fisheye rig's k1..k4 (equidistant model) were read as the pinhole model's k1, k2, p1,
+    p2: its points came out up to metres off, all flagged valid."""
+    om = np.array([0.01, -0.02, 0.005])
+    c = Calibration(
+        K1=np.array([[280.0, 0.0, 640.0], [0.0, 280.0, 400.0], [0.0, 0.0, 1.0]]),
+        D1=np.array([-0.01, 0.05, -0.06, 0.02]),
+        K2=np.array([[285.0, 0.0, 645.0], [0.0, 282.0, 398.0], [0.0, 0.0, 1.0]]),
+        D2=np.array([-0.012, 0.04, -0.05, 0.018]),
+        R=cv2.Rodrigues(om)[0],
+        T=np.array([-64.0, 1.0, 0.5]),
+        image_size=(1280, 800),
+        unit="mm",
+        model="fisheye",
+    )
+    rng = np.random.default_rng(2)
+    theta, phi = rng.uniform(0, np.radians(80), 200), rng.uniform(0, 2 * np.pi, 200)
+    dist = rng.uniform(0.5, 10.0, 200)
+    pts = (
+        np.column_stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)])
+        * dist[:, None]
+    )  # metres, up to 80 degrees off axis
+    xl = cv2.fisheye.projectPoints(pts[:, None], np.zeros(3), np.zeros(3), c.K1, c.D1)[0]
+    xr = cv2.fisheye.projectPoints(pts[:, None] * 1000, om, c.T, c.K2, c.D2)[0]
+    xl = np.vstack([xl.reshape(-1, 2), [[np.nan, 5.0], [-1e6, -1e6]]])
+    xr = np.vstack([xr.reshape(-1, 2), [[5.0, 5.0], [5.0, 5.0]]])
+    res = triangulate(xl, xr, c)
+    assert res.valid.tolist() == [True] * 200 + [False, False]
+    np.testing.assert_allclose(res.XL[:200], pts, rtol=1e-9, atol=1e-9)
+    assert np.isnan(res.XL[200:]).all()
+
+
 def test_units_metres_by_default_and_feet() -> None:
     pts = scene_points(20, seed=2)
     c_mm = raw_calib(unit="mm", scale=1000.0)  # same rig, T in millimetres

@@ -22,6 +22,7 @@ from stereovision._validate import require as _require_type
 from stereovision.calibration import UNIT_TO_METRES, Calibration
 
 __all__ = [
+    "FISHEYE_ROUND_TRIP_PX",
     "PARALLEL_SIN2_TOL",
     "UNDISTORT_MAX_ITER",
     "UNDISTORT_TOL",
@@ -173,6 +174,39 @@ def undistort_normalized(
     return np.stack([x, y], axis=1), converged
 
 
+#: Pixels: a fisheye point whose undistorted ray projects back further than this from where it
+#: was measured did not converge (OpenCV's fisheye inversion has no flag of its own; a point
+#: beyond the lens' reach comes back at -1e6).
+FISHEYE_ROUND_TRIP_PX = 1e-6
+
+
+def _undistort_fisheye(
+    pts: F64, K: F64, D: F64, max_iter: int, tol: float
+) -> tuple[F64, npt.NDArray[np.bool_]]:
+    """:func:`undistort_normalized` for the equidistant (fisheye) model of
+    ``Calibration(model="fisheye")``: ``cv2.fisheye.undistortPoints`` iterated to ``tol``, each
+    point checked by projecting its ray back (``cv2.fisheye.distortPoints``)."""
+    import cv2
+
+    xy = np.full(pts.shape, np.nan)
+    finite = np.isfinite(pts).all(axis=1)
+    converged = np.zeros(len(pts), dtype=bool)
+    if finite.any():
+        src = pts[finite].reshape(-1, 1, 2)
+        crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, int(max_iter), float(tol))
+        und = np.asarray(cv2.fisheye.undistortPoints(src, K, D, criteria=crit), np.float64)
+        back = np.asarray(cv2.fisheye.distortPoints(und, K, D), np.float64).reshape(-1, 2)
+        und = und.reshape(-1, 2)
+        with np.errstate(invalid="ignore"):
+            ok = np.isfinite(und).all(axis=1) & (
+                np.hypot(*(back - pts[finite]).T) <= FISHEYE_ROUND_TRIP_PX
+            )
+        idx = np.flatnonzero(finite)
+        converged[idx] = ok
+        xy[idx[ok]] = und[ok]
+    return xy, converged
+
+
 def triangulate(
     xl: npt.ArrayLike,
     xr: npt.ArrayLike,
@@ -183,7 +217,9 @@ def triangulate(
 ) -> TriangulationResult:
     """Triangulate unrectified pixel correspondences with Bouguet's midpoint method (E.2).
 
-    Each point is normalised and undistorted (:func:`undistort_normalized`) into a ray
+    Each point is normalised and undistorted (:func:`undistort_normalized`; for a
+    ``model="fisheye"`` rig ``cv2.fisheye.undistortPoints``, each point checked by projecting
+    it back within :data:`FISHEYE_ROUND_TRIP_PX`) into a ray
     ``x = (x, y, 1)``. With ``u = R xL`` the depths along both optical axes minimise
     ``|ZR xR - ZL u - T|^2``::
 
@@ -222,8 +258,11 @@ def triangulate(
     if pl.shape != pr.shape:
         raise ValueError(f"xl and xr must have the same shape, got {pl.shape} and {pr.shape}")
     scale = _unit_scale(calib, unit)
-    nl, okl = undistort_normalized(pl, calib.K1, calib.D1, max_iter, tol)
-    nr, okr = undistort_normalized(pr, calib.K2, calib.D2, max_iter, tol)
+    # The fisheye model's four coefficients are k1..k4 of the equidistant model, not the
+    # pinhole model's k1, k2, p1, p2 (read as those, a fisheye rig's points were metres off).
+    normalise = _undistort_fisheye if calib.model == "fisheye" else undistort_normalized
+    nl, okl = normalise(pl, calib.K1, calib.D1, max_iter, tol)
+    nr, okr = normalise(pr, calib.K2, calib.D2, max_iter, tol)
     n = len(pl)
     ray_l = np.column_stack([nl, np.ones(n)])
     ray_r = np.column_stack([nr, np.ones(n)])
