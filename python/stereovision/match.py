@@ -88,8 +88,15 @@ def match(
                 f"got {w}x{h}"
             )
         if not calib.rectified:
-            lb, rb = calib.rectify(as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right"))
-            gl, gr = check_pair(lb, rb)
+            if np.asarray(left).dtype == np.uint8 and np.asarray(right).dtype == np.uint8:
+                lb, rb = calib.rectify(as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right"))
+                gl, gr = check_pair(lb, rb)
+            else:
+                # a 16-bit or float pair's own grey levels, rectified (its 8-bit copy kept 8
+                # bits of them), as depth_map does
+                rl, rr = calib.rectify(gl, gr)
+                gl = np.ascontiguousarray(np.clip(rl, 0.0, 1.0), np.float32)
+                gr = np.ascontiguousarray(np.clip(rr, 0.0, 1.0), np.float32)
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
     if method == "mcgm":
