@@ -20,6 +20,7 @@ from stereovision.io import (
     imread,
     load_scene,
     make_folder,
+    read_image,
     read_pfm,
     read_ply,
     scene_max_disparity,
@@ -64,6 +65,31 @@ def test_imread_colour_and_gray(tmp_path: Path) -> None:
     assert gray.shape == (4, 5)
     # BT.601: 0.114 B + 0.587 G + 0.299 R = 1.14 + 11.74 + 8.97 = 21.85 -> 22
     assert gray[1, 2] == 22
+
+
+def test_read_image_keeps_16_bits(tmp_path: Path) -> None:
+    """``stereovision depth``'s reader: a 16-bit file's values as they are (imread keeps the
+    top 8 bits: 4095 -> 15), grey replicated to BGR; an 8-bit file as imread reads it."""
+    grey16 = np.array([[0, 4095, 65535], [256, 1, 300]], np.uint16)
+    assert cv2.imwrite(str(tmp_path / "g16.png"), grey16)
+    got = read_image(tmp_path / "g16.png")
+    assert got.dtype == np.uint16 and got.shape == (2, 3, 3)
+    for c in range(3):
+        np.testing.assert_array_equal(got[..., c], grey16)
+    assert int(imread(tmp_path / "g16.png")[0, 1, 0]) == 15
+    bgr16 = np.stack([grey16, grey16 // 2, grey16 // 3], axis=2)
+    assert cv2.imwrite(str(tmp_path / "c16.png"), bgr16)
+    np.testing.assert_array_equal(read_image(tmp_path / "c16.png"), bgr16)
+    img8 = np.arange(24, dtype=np.uint8).reshape(2, 4, 3)
+    assert cv2.imwrite(str(tmp_path / "c8.png"), img8)
+    got8 = read_image(tmp_path / "c8.png")
+    assert got8.dtype == np.uint8
+    np.testing.assert_array_equal(got8, img8)
+    with pytest.raises(FileNotFoundError, match=r"nope\.png"):
+        read_image(tmp_path / "nope.png")
+    (tmp_path / "bad.png").write_bytes(b"not an image")
+    with pytest.raises(ValueError, match="cannot decode"):
+        read_image(tmp_path / "bad.png")
 
 
 def test_imread_missing(tmp_path: Path) -> None:

@@ -312,10 +312,11 @@ def remove_stale_outputs(out_dir: Path, written: dict[str, Path]) -> list[Path]:
 
 def cmd_depth(args: argparse.Namespace) -> int:
     """``stereovision depth LEFT RIGHT -o DIR``."""
-    from stereovision.io import imread
+    from stereovision.io import read_image
 
-    left = imread(args.left)
-    right = imread(args.right)
+    # 16-bit files keep their 16 bits (imread's 8-bit copy kept the top 8 of them)
+    left = read_image(args.left)
+    right = read_image(args.right)
     if left.shape == right.shape and np.array_equal(left, right):
         warnings.warn(
             f"{args.left} and {args.right} are the same image: every disparity comes out 0 "

@@ -41,6 +41,7 @@ __all__ = [
     "find_scenes",
     "imread",
     "load_scene",
+    "read_image",
     "read_pfm",
     "read_ply",
     "scene_max_disparity",
@@ -307,6 +308,42 @@ def imread(path: PathLike, gray: bool = False) -> npt.NDArray[np.uint8]:
         # codec's own (libpng's differs by one grey level on some pixels).
         return np.asarray(cv2.cvtColor(img, cv2.COLOR_BGR2GRAY), dtype=np.uint8)
     return img
+
+
+def read_image(path: PathLike) -> npt.NDArray[np.uint8] | npt.NDArray[np.uint16]:
+    """Read an image file keeping a 16-bit file's 16 bits (``stereovision depth``'s reader).
+
+    A 16-bit PNG or TIFF (a machine-vision camera's 12- or 16-bit frames) comes back as
+    ``uint16`` BGR, which :func:`stereovision.depth_map` scales by 65535 (and warns about when
+    only the low 12 bits are used); :func:`imread` keeps its top 8 bits (OpenCV's
+    ``IMREAD_COLOR``: a 12-bit frame's 0-4095 became 0-15). Any other file is read as
+    :func:`imread` reads it.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        Image file.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W, 3)`` BGR, ``uint16`` for a 16-bit file, else ``uint8``.
+
+    Raises
+    ------
+    FileNotFoundError
+        If ``path`` does not exist.
+    ValueError
+        If the file cannot be decoded as an image.
+    """
+    p = _existing_file(path, "image file")
+    data = np.fromfile(p, dtype=np.uint8)
+    if data.size:
+        with _opencv_quiet():
+            deep = cv2.imdecode(data, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
+        if deep is not None and deep.dtype == np.uint16:
+            return np.asarray(deep, dtype=np.uint16)
+    return imread(p)
 
 
 # ------------------------------------------------------------------------------------------ PFM
