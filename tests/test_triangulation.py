@@ -3,6 +3,7 @@ OpenCV oracles (undistortPoints, triangulatePoints, reprojectImageTo3D), degener
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import cv2
@@ -261,6 +262,30 @@ def test_depth_from_disparity_hand_computed() -> None:
     np.testing.assert_array_equal(c.depth_from_disparity(d), z)
     with pytest.raises(ValueError, match="disparity"):
         depth_from_disparity(np.zeros(3), c)
+
+
+def test_a_map_of_the_pair_resized_is_warned_about() -> None:
+    """A half-size map read with the full-size calibration gave twice the depths, silently."""
+    c = rect_calib(doffs=12.5)  # 640x480, f 700 px, B 0.12 m
+    half = np.full((240, 320), 20.0)  # 40 px at full size
+    with pytest.warns(UserWarning, match=r"is 320x240 px, the calibration's images 640x480") as w:
+        z = depth_from_disparity(half, c)
+    assert "about 2 x the true depths; use calib.scaled_to((320, 240))" in str(w[0].message)
+    assert w[0].filename == __file__  # the caller's line
+    assert z[0, 0] == pytest.approx(700 * 0.12 / (20 + 12.5), rel=1e-6)  # 2.58 m for 1.6 m
+    good = c.scaled_to((320, 240))
+    assert good.depth_from_disparity(half)[0, 0] == pytest.approx(700 * 0.12 / 52.5, rel=1e-3)
+    for call in (lambda: reproject(half, c), lambda: c.reproject(half)):
+        with pytest.warns(UserWarning, match="320x240 px") as w:
+            call()
+        assert w[0].filename == __file__
+    with pytest.warns(UserWarning, match="320x240 px") as w:
+        c.depth_from_disparity(half)
+    assert w[0].filename == __file__
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # its own size, a crop, a toy map, a row of matches
+        for shape in ((480, 640), (200, 640), (100, 90), (48, 64), (1, 500)):
+            depth_from_disparity(np.full(shape, 20.0), c)
 
 
 @pytest.mark.parametrize("doffs", [0.0, 12.5])

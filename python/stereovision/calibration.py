@@ -855,9 +855,9 @@ class Calibration:
         ``Z = f B / (d + doffs)``; ``d <= -doffs`` or NaN gives NaN. See
         :func:`stereovision.triangulation.depth_from_disparity`.
         """
-        from stereovision.triangulation import depth_from_disparity
+        from stereovision.triangulation import _depth_from_disparity
 
-        return depth_from_disparity(disp, self, unit)
+        return _depth_from_disparity(disp, self, unit, 2)
 
     def reproject(self, disp: npt.ArrayLike, unit: str = "m") -> npt.NDArray[np.float32]:
         """``(H, W, 3)`` points in metres unless ``unit`` says otherwise (left rectified frame:
@@ -865,9 +865,9 @@ class Calibration:
 
         See :func:`stereovision.triangulation.reproject`.
         """
-        from stereovision.triangulation import reproject
+        from stereovision.triangulation import _reproject
 
-        return reproject(disp, self, unit)
+        return _reproject(disp, self, unit, 2)
 
     # ------------------------------------------------------------------------------ saving
 

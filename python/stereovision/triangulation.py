@@ -24,6 +24,7 @@ from stereovision.calibration import UNIT_TO_METRES, Calibration
 __all__ = [
     "FISHEYE_ROUND_TRIP_PX",
     "PARALLEL_SIN2_TOL",
+    "RESIZED_MIN_SIDE",
     "UNDISTORT_MAX_ITER",
     "UNDISTORT_TOL",
     "TriangulationResult",
@@ -297,6 +298,35 @@ def _disparity(disparity: npt.ArrayLike) -> F64:
     return d.astype(np.float64)
 
 
+#: A disparity map at least this many pixels on each side whose size is the calibration's
+#: image size scaled by one factor (within a pixel of rounding) is taken for a resized pair's
+#: (smaller ones are crops or test arrays: nobody matches a pair shrunk to 48 rows).
+RESIZED_MIN_SIDE = 64
+
+
+def _warn_if_resized(shape: tuple[int, ...], calib: Calibration, stacklevel: int) -> None:
+    """Warn when a map looks like one of the pair resized: read against the calibration's own
+    image size its depths are off by the factor (``f`` and ``doffs`` scale with the images),
+    silently. A map of the calibration's size, or not of its shape (a crop, a row of matches),
+    passes."""
+    h, w = shape[:2]
+    cw, ch = calib.image_size
+    if (w, h) == (cw, ch) or min(w, h) < RESIZED_MIN_SIDE:
+        return
+    if abs(h - ch * w / cw) > 1.0 or abs(w - cw * h / ch) > 1.0:
+        return
+    import warnings
+
+    warnings.warn(
+        f"disparity map is {w}x{h} px, the calibration's images {cw}x{ch}: read with it, a map "
+        f"of the pair resized by {w / cw:.3g} gives about {cw / w:.3g} x the true depths; use "
+        f"calib.scaled_to(({w}, {h})) (a map of the images' top-left {w}x{h} px is read "
+        "right)",
+        UserWarning,
+        stacklevel=stacklevel + 1,
+    )
+
+
 def depth_from_disparity(
     disparity: npt.ArrayLike, calib: Calibration, unit: str = "m"
 ) -> npt.NDArray[np.float32]:
@@ -326,9 +356,27 @@ def depth_from_disparity(
     ------
     ValueError
         If ``disparity`` is not a real 2-D array or ``unit`` is unknown.
+
+    Warns
+    -----
+    UserWarning
+        When the map is the calibration's image size scaled by one factor (a resized pair's
+        map, whose depths would be off by that factor: :meth:`Calibration.scaled_to`).
     """
+    return _depth_from_disparity(disparity, calib, unit, 2)
+
+
+def _depth_from_disparity(
+    disparity: npt.ArrayLike, calib: Calibration, unit: str, stacklevel: int
+) -> npt.NDArray[np.float32]:
+    """:func:`depth_from_disparity`, its warning ``stacklevel`` frames up from the caller."""
     _require_type(calib, "Calibration", "calib")
     d = _disparity(disparity)
+    _warn_if_resized(d.shape, calib, stacklevel + 1)
+    return _depth(d, calib, unit)
+
+
+def _depth(d: F64, calib: Calibration, unit: str) -> npt.NDArray[np.float32]:
     cal = calib if calib.rectified else calib.rectified_calibration()
     scale = _unit_scale(cal, unit)
     denom = d + cal.doffs_px
@@ -363,9 +411,23 @@ def reproject(
     -------
     numpy.ndarray
         ``(H, W, 3)`` ``float32``, NaN where the depth is invalid.
+
+    Warns
+    -----
+    UserWarning
+        As :func:`depth_from_disparity`, for a map of the pair resized.
     """
+    return _reproject(disparity, calib, unit, 2)
+
+
+def _reproject(
+    disparity: npt.ArrayLike, calib: Calibration, unit: str, stacklevel: int
+) -> npt.NDArray[np.float32]:
+    """:func:`reproject`, its warning ``stacklevel`` frames up from the caller."""
     _require_type(calib, "Calibration", "calib")
-    z = depth_from_disparity(disparity, calib, unit).astype(np.float64)
+    d = _disparity(disparity)
+    _warn_if_resized(d.shape, calib, stacklevel + 1)
+    z = _depth(d, calib, unit).astype(np.float64)
     cal = calib if calib.rectified else calib.rectified_calibration()
     h, w = z.shape
     fx, fy, cx, cy = cal.K1[0, 0], cal.K1[1, 1], cal.K1[0, 2], cal.K1[1, 2]
