@@ -132,8 +132,13 @@ def test_pcd_ascii_float_colour_as_pcl_writes_it(tmp_path):
 
 
 def test_npz_bundle(result, tmp_path):
+    # sigma_Z = Z^2 sigma_d / (f B) with sigma_d = 0.5 px: the bundle keeps the uncertainty.
+    sigma = (result.depth.astype(np.float64) ** 2 * 0.5 / (syn.F * syn.B)).astype(np.float32)
+    result = replace(result, depth_sigma=sigma)
     data = export.read_npz(export.write_npz(tmp_path / "d.npz", result))
     np.testing.assert_array_equal(data["depth"], result.depth)
+    np.testing.assert_array_equal(data["depth_sigma"], sigma)
+    assert np.isfinite(data["depth_sigma"]).sum() > 1000
     np.testing.assert_array_equal(data["confidence"], result.confidence)
     np.testing.assert_array_equal(data["disparity"], result.disparity)
     np.testing.assert_allclose(data["K"], [[syn.F, 0, syn.CX], [0, syn.F, syn.CY], [0, 0, 1]])
@@ -165,13 +170,14 @@ def test_export_result_writes_all(result, tmp_path):
 
 
 def test_no_calibration_no_cloud(result, tmp_path):
-    bare = replace(result, depth=None, calibration=None)
+    bare = replace(result, depth=None, depth_sigma=None, calibration=None)
     with pytest.raises(ValueError, match="without a calibration"):
         export.write_cloud_ply(tmp_path / "c.ply", bare)
     with pytest.raises(ValueError, match="without a calibration"):
         export.write_pcd(tmp_path / "c.pcd", bare)
     data = export.read_npz(export.write_npz(tmp_path / "d.npz", bare))
     assert np.isnan(data["depth"]).all() and np.isnan(data["K"]).all()
+    assert np.isnan(data["depth_sigma"]).all()
 
 
 def test_load_cloud_errors(tmp_path):
@@ -255,7 +261,7 @@ def test_depth_png_in_millimetres(result, tmp_path):
     assert raw.tolist() == [[0, 1, 1234, 65535, 0, 0, 0, 0]]
     tum = export.read_depth_png(export.write_depth_png(tmp_path / "t.png", z, scale=5000), 5000)
     assert tum[0, 2] == pytest.approx(1.2344, abs=1e-4) and np.isnan(tum[0, 3])
-    bare = replace(result, depth=None, calibration=None)
+    bare = replace(result, depth=None, depth_sigma=None, calibration=None)
     with pytest.raises(ValueError, match="no depth"):
         export.write_depth_png(tmp_path / "n.png", bare)
     with pytest.raises(ValueError, match="scale"):

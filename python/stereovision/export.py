@@ -398,9 +398,10 @@ def read_pcd(
 
 
 def write_npz(path: PathLike, result: DepthResult) -> Path:
-    """Bundle depth, confidence, disparity and the intrinsics into a compressed ``.npz``.
+    """Bundle depth, its uncertainty, confidence, disparity and the intrinsics into a ``.npz``.
 
-    Without calibration ``depth`` is all NaN and ``K`` / ``baseline`` / ``doffs`` are NaN.
+    Without calibration ``depth`` and ``depth_sigma`` are all NaN and ``K`` / ``baseline`` /
+    ``doffs`` are NaN.
 
     Parameters
     ----------
@@ -423,11 +424,16 @@ def write_npz(path: PathLike, result: DepthResult) -> Path:
         k = np.asarray(calib.K1, dtype=np.float64)
         baseline = float(calib.baseline_m)
         doffs = float(calib.doffs_px)
-    depth = result.depth if result.depth is not None else np.full((h, w), np.nan, np.float32)
+    nan_map = np.full((h, w), np.nan, np.float32)
+    depth = result.depth if result.depth is not None else nan_map
+    # The one-sigma depth uncertainty is what a consumer weighs the depths by; without it the
+    # bundle could not be used for fusion or filtering downstream.
+    sigma = result.depth_sigma if result.depth_sigma is not None else nan_map
     bio = _io.BytesIO()
     np.savez_compressed(
         bio,
         depth=depth.astype(np.float32),
+        depth_sigma=sigma.astype(np.float32),
         confidence=result.confidence.astype(np.float32),
         disparity=result.disparity.astype(np.float32),
         K=k,
@@ -454,7 +460,8 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     -------
     dict
         ``depth``, ``confidence``, ``disparity`` (H, W) float32, ``K`` (3, 3), ``baseline``,
-        ``doffs``, ``image_size``, ``method``, ``max_disparity``.
+        ``doffs``, ``image_size``, ``method``, ``max_disparity``, and ``depth_sigma`` (H, W)
+        float32, the depth's one-sigma uncertainty in metres (absent from older bundles).
 
     Raises
     ------
