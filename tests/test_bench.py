@@ -20,7 +20,7 @@ SCENE = "middlebury2001/tsukuba"  # the smallest GT scene: 384x288, max_disparit
 
 def test_bench_scene_cases_and_figures(data_dir: Path) -> None:
     scene = load_scene(data_dir / SCENE)
-    cases = bench_scene(scene, runs=1)
+    cases = bench_scene(scene, runs=5)
     names = [c.case for c in cases]
     # gabor's Matches are its dense run's confident pixels: timed once, as a dense method
     sparse = [sparse_name(m) for m in SPARSE_METHODS if m != "gabor"]
@@ -49,7 +49,7 @@ def test_bench_scene_cases_and_figures(data_dir: Path) -> None:
 
 
 def test_bench_cli_json_lines(data_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["bench", "--runs", "1", "--json", str(data_dir / SCENE)]) == 0
+    assert main(["bench", "--runs", "5", "--json", str(data_dir / SCENE)]) == 0
     lines = [json.loads(ln) for ln in capsys.readouterr().out.splitlines() if ln.strip()]
     assert [ln["case"] for ln in lines][-2:] == ["StereoBM", "SGBM-3WAY"]
     assert all(ln["bench"] == "vs_opencv" and ln["scene"].endswith("tsukuba") for ln in lines)
@@ -63,6 +63,11 @@ def test_bench_cli_json_lines(data_dir: Path, capsys: pytest.CaptureFixture[str]
     ("argv", "needle"),
     [
         (["bench", "--runs", "0"], "--runs"),
+        # evaluation.md "Speed": the median of >= 5 runs (1..4 were accepted)
+        (
+            ["bench", "--runs", "4"],
+            "--runs: at least 5 (evaluation.md: the median of >= 5 runs), got 4",
+        ),
         (["bench", "/no/such/folder"], "not found"),
     ],
 )
@@ -72,6 +77,12 @@ def test_bench_cli_errors_one_line(
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and needle in err and err.startswith("stereovision: error:")
+
+
+def test_bench_scene_refuses_fewer_than_five_runs(data_dir: Path) -> None:
+    scene = load_scene(data_dir / SCENE)
+    with pytest.raises(ValueError, match=r"^runs: at least 5 .*, got 4$"):
+        bench_scene(scene, runs=4)
 
 
 def test_bench_cli_folder_without_scenes(
