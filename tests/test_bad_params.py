@@ -30,6 +30,8 @@ BAD_VALUES: list[Any] = [
     2**31 - 1,
     10**12,
     -(10**12),
+    2**70,  # beyond 64 bits: the bindings' OverflowError, NumPy's "ufunc 'isfinite'" TypeError
+    -(2**70),
     float("nan"),
     float("inf"),
     "x",
@@ -92,6 +94,18 @@ CALLS: dict[str, tuple[list[str], Call]] = {
         lambda c, kw: planes.plane_fill(c["disp"], planes.segments(c["bgr"]), **kw),
     ),
     "side_fill": (["tau", "blur"], lambda c, kw: planes.side_fill(c["disp"], c["bgr"], **kw)),
+    "interest_points": (
+        ["rel_threshold", "nms_half", "tile", "floor_rel"],
+        lambda c, kw: hopfield.interest_points(c["gl"], **kw),
+    ),
+    "fused_dense": (
+        list(fusion.DENSE_DEFAULTS),
+        lambda c, kw: fusion.fused_dense(c["disp"], c["conf"], c["disp"], guide=c["gl"], **kw),
+    ),
+    "fill_enclosed_far": (
+        ["floor", "far", "jump", "ring"],
+        lambda c, kw: fusion.fill_enclosed_far(c["disp"], c["gl"], **kw),
+    ),
 }
 
 
@@ -112,6 +126,84 @@ def test_out_of_range_parameters_raise_value_or_type_error(what: str, ctx: dict[
                 pytest.fail(f"{what}({key}={value!r}) raised {type(exc).__name__}: {exc}")
     # Most of these values are out of range for most keys: the checks are there, not bypassed.
     assert rejected > len(keys) * 3
+
+
+#: (call, the message's start): an integer beyond 64 bits, each given where it reached the
+#: native module (or NumPy, OpenCV) unchecked.
+HUGE = 2**70
+NAMED: list[tuple[Call, str]] = [
+    (lambda c, kw: sv.depth_map(c["bgr"], c["bgr"], max_disparity=-HUGE), "max_disparity"),
+    (
+        lambda c, kw: sv.depth_map(c["bgr"], c["bgr"], max_disparity=32, min_disparity=HUGE),
+        "max_disparity",
+    ),
+    (lambda c, kw: sv.depth_map(c["bgr"], c["bgr"], max_disparity=10**400), "max_disparity"),
+    (lambda c, kw: hopfield.interest_points(c["gl"], nms_half=HUGE), "nms_half"),
+    (lambda c, kw: hopfield.interest_points(c["gl"], tile=HUGE), "tile"),
+    (lambda c, kw: hopfield.interest_points(c["gl"], nms_half=float("nan")), "nms_half"),
+    (lambda c, kw: planes.segments(c["bgr"], blur=HUGE), "blur"),
+    (lambda c, kw: planes.segments(c["bgr"], k=1.0, min_size=HUGE), "min_size"),
+    (lambda c, kw: planes.side_fill(c["disp"], c["bgr"], blur=-HUGE), "blur"),
+    (lambda c, kw: planes.fill_planes(c["disp"], c["bgr"], passes=((HUGE, 50),)), "passes"),
+    (lambda c, kw: planes.fill_planes(c["disp"], c["bgr"], passes=((16, HUGE),)), "passes"),
+    (lambda c, kw: gabor.gabor_disparity(c["gl"], c["gr"], max_disparity=10**400), "max_disp"),
+    (
+        lambda c, kw: gabor.gabor_disparity(c["gl"], c["gr"], max_disparity=32, min_disparity=HUGE),
+        r"empty disparity range: max_disparity \(32\) must be larger than min_disparity",
+    ),
+    (
+        lambda c, kw: gabor.gabor_disparity(c["gl"], c["gr"], max_disparity=32, lr_check=5),
+        "lr_check",
+    ),
+    (
+        lambda c, kw: fusion.fuse_pair(c["gl"], c["gr"], max_disparity=32, min_disparity=HUGE),
+        r"empty disparity range: max_disparity \(32\) must be larger than min_disparity",
+    ),
+    (
+        lambda c, kw: refine.refine_disparity(
+            c["gl"], c["gr"], c["disp"], c["conf"], max_disparity=32, min_disparity=HUGE
+        ),
+        r"empty disparity range: max_disparity \(32\) must be larger than min_disparity",
+    ),
+    (
+        lambda c, kw: refine.refine_disparity(
+            c["gl"], c["gr"], c["disp"], c["conf"], max_disparity=32, win_radius=10**400
+        ),
+        "win_radius",
+    ),
+    (lambda c, kw: fusion.fused_dense(c["disp"], c["conf"], c["disp"], tau=10**400), "tau"),
+    (lambda c, kw: fusion.fill_enclosed_far(c["disp"], c["gl"], ring=10**400), "ring"),
+]
+
+
+@pytest.mark.parametrize("case", range(len(NAMED)))
+def test_huge_integers_are_value_errors_naming_the_parameter(
+    case: int, ctx: dict[str, Any]
+) -> None:
+    call, says = NAMED[case]
+    with pytest.raises((ValueError, TypeError), match=f"^{says}"):
+        call(ctx, {})
+
+
+def test_huge_sizes_act_as_the_whole_image(ctx: dict[str, Any]) -> None:
+    """A range, a window or a count beyond the image is the image (they overflowed the
+    bindings' integers, or asked NumPy / OpenCV for a kernel of 2**71 px)."""
+    gl, gr = ctx["gl"], ctx["gr"]
+    w = gl.shape[1]
+    ref = hopfield.hopfield_match(gl, gr, max_disparity=w)
+    got = hopfield.hopfield_match(gl, gr, max_disparity=HUGE)
+    assert len(got) == len(ref) > 0 and np.array_equal(got.xr, ref.xr)
+    big = hopfield.interest_points(gl, nms_half=10**6, tile=10**6)
+    assert len(hopfield.interest_points(gl, nms_half=HUGE // 2**40, tile=2**31 - 1)) == len(big)
+    args = (ctx["disp"], ctx["conf"], ctx["disp"])
+    a = fusion.fused_dense(*args, guide=gl, edge_radius=HUGE, speckle_area=1e30)
+    b = fusion.fused_dense(*args, guide=gl, edge_radius=max(gl.shape), speckle_area=1.0)
+    np.testing.assert_array_equal(a[0], b[0])
+    assert np.isnan(a[0]).all()  # a speckle area above the image's: every region goes
+    d = np.where(np.isfinite(ctx["disp"]), ctx["disp"], 0).astype(np.float32)
+    far = fusion.fill_enclosed_far(d, gl, ring=HUGE)
+    near = fusion.fill_enclosed_far(d, gl, ring=sum(gl.shape))
+    np.testing.assert_array_equal(far[0], near[0])
 
 
 @pytest.mark.parametrize("key", _keyword_defaults(sv.depth_map, {"calib", "progress"}))

@@ -26,6 +26,7 @@ __all__ = [
     "as_gray_uint8",
     "as_image_array",
     "check_pair",
+    "finite_number",
     "int_in_range",
     "positive_finite",
 ]
@@ -389,13 +390,46 @@ def int_in_range(value: object, name: str, lo: int, hi: int) -> int:
         Naming ``name``, for a bool, a non-number, a non-integral or non-finite number, or one
         outside the range.
     """
-    ok = not isinstance(value, bool) and isinstance(value, (int, np.integer, float, np.floating))
-    if ok:
-        v = float(value)  # type: ignore[arg-type]
+    ok = not isinstance(value, (bool, np.bool_))
+    if ok and isinstance(value, (int, np.integer)):
+        ok = lo <= int(value) <= hi  # exact: a float of 2**63 - 1 is 2**63
+    elif ok and isinstance(value, (float, np.floating)):
+        v = float(value)
         ok = math.isfinite(v) and v == int(v) and lo <= int(v) <= hi
+    else:
+        ok = False
     if not ok:
         raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
     return int(value)  # type: ignore[call-overload]
+
+
+def finite_number(value: object, name: str) -> float:
+    """``value`` as a finite Python float.
+
+    An integer too large for a float (``2**1100``), NaN, an infinity or a non-number is a
+    ``ValueError`` naming ``name``, not an OverflowError or NumPy's "ufunc 'isfinite' not
+    supported" (which a Python int beyond 64 bits gave).
+
+    Examples
+    --------
+    >>> finite_number(2**70, "max_disparity")
+    1.1805916207174113e+21
+    >>> finite_number(float("nan"), "blur")
+    Traceback (most recent call last):
+    ...
+    ValueError: blur: expected a finite number, got nan
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(
+        value, (int, float, np.integer, np.floating)
+    ):
+        raise ValueError(f"{name}: expected a finite number, got {value!r}")
+    try:
+        out = float(value)
+    except OverflowError:
+        out = math.inf
+    if not math.isfinite(out):
+        raise ValueError(f"{name}: expected a finite number, got {value!r}")
+    return out
 
 
 #: The classes :func:`require` checks for, by name, and their modules (imported on use: the

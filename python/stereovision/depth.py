@@ -21,7 +21,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_bgr_uint8, as_gray_float, check_pair
+from stereovision._validate import as_bgr_uint8, as_gray_float, check_pair, finite_number
 from stereovision.calibration import Calibration
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -956,8 +956,10 @@ def depth_map(
     automatic = max_disparity is None  # the range is this function's choice, not the caller's
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
-    if not np.isfinite(min_disparity) or not np.isfinite(max_disparity):
-        raise ValueError("min_disparity and max_disparity must be finite")
+    # a ValueError naming the argument for NaN, inf and ints beyond 64 bits (2**70 was NumPy's
+    # TypeError "ufunc 'isfinite' not supported")
+    finite_number(min_disparity, "min_disparity")
+    finite_number(max_disparity, "max_disparity")
     if max_disparity <= min_disparity:
         raise ValueError(
             f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"

@@ -25,6 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
+from stereovision._validate import finite_number
 
 __all__ = ["DEFAULTS", "RefineResult", "refine_disparity"]
 
@@ -82,10 +83,14 @@ def _number(v: object, name: str, whole: bool = False) -> float:
     naming it."""
     if isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
         raise ValueError(f"{name} must be a number, got {v!r}")
+    try:
+        out = float(v)
+    except OverflowError:  # an int beyond a float's range (2**1100)
+        raise ValueError(f"{name} must be a finite number, got {v!r}") from None
     # Whole numbers are the kernel's counts and radii (usize).
-    if whole and not (math.isfinite(v) and 0 <= v < 2**31 and int(v) == v):
+    if whole and not (math.isfinite(out) and 0 <= v < 2**31 and int(v) == v):
         raise ValueError(f"{name} must be a non-negative whole number, got {v!r}")
-    return float(v)
+    return out
 
 
 def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
@@ -158,9 +163,13 @@ def refine_disparity(
                 f"{int(bad.sum())} pixels are not (e.g. {float(conf[bad][0])!r})"
             )
         conf = np.where(measured | np.isfinite(conf), conf, np.float32(0))
-    for name, v in (("min_disparity", min_disparity), ("max_disparity", max_disparity)):
-        if not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
-            raise ValueError(f"{name} must be a finite number, got {v!r}")
+    finite_number(min_disparity, "min_disparity")  # 2**1100: math.isfinite's OverflowError
+    finite_number(max_disparity, "max_disparity")
+    if not max_disparity > min_disparity:  # the kernel's message named its d_min and d_max
+        raise ValueError(
+            "empty disparity range: "
+            f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"
+        )
     kw = {**DEFAULTS, **params}
     fills_raw = kw.pop("fills")
     try:

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import refuse_unknown
+from stereovision._validate import finite_number, refuse_unknown
 from stereovision.matches import Matches
 
 __all__ = [
@@ -254,7 +254,7 @@ def fuse(
         if name not in CHANNEL_BITS or name == "gabor":
             raise ValueError(f"unknown sparse channel {name!r}: expected mcgm or hopfield")
     for pname, v in (("r_spatial", r_spatial), ("tau_dx", tau_dx), ("tau_dy", tau_dy)):
-        if not np.isfinite(v) or v <= 0:
+        if finite_number(v, pname) <= 0:
             raise ValueError(f"{pname}: expected a positive number, got {v}")
     if min_agree < 2:
         raise ValueError(f"min_agree: expected at least 2, got {min_agree}")
@@ -592,11 +592,16 @@ def census_clear(
     import cv2
 
     c = _check_map(census, "census", res.dispx.shape)
-    if int(radius) != radius or radius < 0:
+    if isinstance(radius, (bool, np.bool_)) or int(finite_number(radius, "radius")) != radius:
+        raise ValueError(f"radius must be a non-negative integer, got {radius!r}")
+    if radius < 0:
         raise ValueError(f"radius must be a non-negative integer, got {radius!r}")
     if not jump >= 0:
         raise ValueError(f"jump must be >= 0, got {jump!r}")
-    k = np.ones((2 * int(radius) + 1, 2 * int(radius) + 1), np.uint8)
+    # A window wider than the map is the whole map (the border is replicated): 2**70 was NumPy's
+    # "Maximum allowed dimension exceeded", 10**5 a 40 GB kernel.
+    r = min(int(radius), max(c.shape))
+    k = np.ones((2 * r + 1, 2 * r + 1), np.uint8)
     # The window's minimum (an erosion); NaN as +inf so that unmeasured pixels never count.
     low = cv2.erode(
         np.where(np.isfinite(c), c, np.inf).astype(np.float32), k, borderType=cv2.BORDER_REPLICATE
@@ -709,14 +714,14 @@ def fill_enclosed_far(
     d = _check_map(disparity, "disparity", None)
     shape = (int(d.shape[0]), int(d.shape[1]))
     g = _check_map(guide, "guide", shape)
-    if not np.isfinite(floor):
-        raise ValueError(f"floor: expected a finite number, got {floor}")
+    finite_number(floor, "floor")
     for name, v in (("far", far), ("jump", jump)):
-        if not np.isfinite(v) or v < 0:
+        if finite_number(v, name) < 0:
             raise ValueError(f"{name}: expected a non-negative number, got {v}")
-    if int(ring) != ring or ring < 1:
+    if isinstance(ring, (bool, np.bool_)) or int(finite_number(ring, "ring")) != ring or ring < 1:
         raise ValueError(f"ring: expected a whole number >= 1, got {ring}")
-    r = int(ring)
+    # A ring wider than the map reaches all of it: 2**70 was cv2's "Can't parse 'ksize'".
+    r = min(int(ring), shape[0] + shape[1])
     out = d.copy()
     filled = np.zeros(shape, bool)
     with np.errstate(invalid="ignore"):
@@ -875,7 +880,7 @@ def fused_dense(
         ("edge_ratio", edge_ratio),
         ("edge_jump", edge_jump),
     ):
-        if not np.isfinite(v) or v < 0:
+        if finite_number(v, name) < 0:
             raise ValueError(f"{name}: expected a non-negative number, got {v}")
     for name, v in (("fill_confidence", fill_confidence), ("second_confidence", second_confidence)):
         if not 0 <= v <= 1:
@@ -886,7 +891,9 @@ def fused_dense(
     anchored = has.copy()
     g = None if guide is None else _check_map(guide, "guide", shape)
     opinion = (b, second_tol, second_confidence, occlusion_tau, _only_second)
-    finish = (speckle_area, speckle_diff, g, int(edge_radius), edge_ratio, edge_jump, _only_second)
+    # A look past the map's sides finds nothing more: the cap keeps it in the kernel's integers.
+    reach = min(int(edge_radius), max(shape))
+    finish = (speckle_area, speckle_diff, g, reach, edge_ratio, edge_jump, _only_second)
     if not has.any():
         _second_opinion(out, conf, has, anchored, *opinion)
         return _finish(out, conf, has, *finish)
@@ -955,7 +962,8 @@ def _drop_speckles(
     ``filterSpeckles`` rule, on the float disparities)."""
     from stereovision import _core
 
-    size = int(area * out.size)
+    # Above the map's size every region is smaller: the cap keeps it in the kernel's integers.
+    size = min(int(area * out.size), out.size + 1)
     ok = np.isfinite(out)
     if size < 1 or not ok.any():
         return out, conf

@@ -10,7 +10,6 @@ removal. Pixels that are not confident are ``NaN``.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -19,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import refuse_unknown
+from stereovision._validate import finite_number, refuse_unknown
 
 __all__ = ["DEFAULTS", "GaborResult", "gabor_disparity", "gabor_responses"]
 
@@ -136,10 +135,20 @@ def gabor_disparity(
     rgt = _as_grey(right, "right")
     if lft.shape != rgt.shape:
         raise ValueError(f"left {lft.shape} and right {rgt.shape} images differ in shape")
-    for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
-        if not isinstance(v, (int, float, np.integer, np.floating)) or not math.isfinite(v):
-            raise ValueError(f"{name} must be a finite number, got {v!r}")
+    finite_number(max_disparity, "max_disparity")  # 2**1100: math.isfinite's OverflowError
+    finite_number(min_disparity, "min_disparity")
+    if not max_disparity > min_disparity:  # the kernel's message named its d_max and d_min
+        raise ValueError(
+            "empty disparity range: "
+            f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"
+        )
     kw: dict[str, Any] = {**DEFAULTS, **params}
+    for name, default in DEFAULTS.items():
+        # the switches: 5 was the binding's TypeError "'int' object is not an instance of 'bool'"
+        if isinstance(default, bool):
+            if not isinstance(kw[name], (bool, np.bool_)):
+                raise TypeError(f"{name}: expected True or False, got {kw[name]!r}")
+            kw[name] = bool(kw[name])
     for name in _COUNT_KEYS:
         v = kw[name]
         if v is None and name == "n_levels":

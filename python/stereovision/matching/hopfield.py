@@ -15,6 +15,7 @@ point): the reference the network is measured against.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -22,7 +23,14 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import as_gray_float, check_pair, luma_weights, refuse_unknown, u8_pair
+from stereovision._validate import (
+    as_gray_float,
+    check_pair,
+    int_in_range,
+    luma_weights,
+    refuse_unknown,
+    u8_pair,
+)
 from stereovision.matches import Matches
 
 __all__ = [
@@ -122,9 +130,9 @@ def interest_points(
     rel_threshold : float
         Threshold as a fraction of the largest interest value, in ``[0, 1]``.
     nms_half : int
-        Half-size of the non-maximum suppression neighbourhood (>= 1).
+        Half-size of the non-maximum suppression neighbourhood (1 to 2**31 - 1).
     tile : int
-        Block size (px) of the relative threshold (0 = the whole image).
+        Block size (px) of the relative threshold (0 = the whole image; at most 2**31 - 1).
     floor_rel : float
         Lowest threshold, as a fraction of the image's largest interest value, in ``[0, 1]``.
 
@@ -141,12 +149,11 @@ def interest_points(
     for name, v in (("rel_threshold", rel_threshold), ("floor_rel", floor_rel)):
         if not (0.0 <= float(v) <= 1.0):
             raise ValueError(f"{name} must lie in [0, 1], got {v!r}")
-    if int(nms_half) < 1:
-        raise ValueError(f"nms_half must be >= 1, got {nms_half!r}")
-    if int(tile) < 0:
-        raise ValueError(f"tile must be >= 0, got {tile!r}")
+    # Sizes beyond the image act as the image: the cap keeps them within the kernel's integers.
+    nms = int_in_range(nms_half, "nms_half", 1, 2**31 - 1)
+    tiles = int_in_range(tile, "tile", 0, 2**31 - 1)
     resp, xy, vals = _core.hopfield_interest(
-        img, float(rel_threshold), int(nms_half), int(tile), float(floor_rel)
+        img, float(rel_threshold), nms, tiles, float(floor_rel)
     )
     return InterestPoints(xy=xy.astype(np.float32), values=vals, response=resp)
 
@@ -165,7 +172,10 @@ def _params(max_disparity: int, min_disparity: int, params: dict[str, Any]) -> d
             if isinstance(v, (float, np.floating)) and np.isfinite(v) and v >= 0:
                 continue
             raise ValueError(f"{name} must be a non-negative number of pixels, got {v!r}")
-    lo, hi = int(np.floor(min_disparity)), int(np.ceil(max_disparity))
+    # The kernel clips the range to the image; the clip here keeps it within its integers (2**70
+    # was the binding's "OverflowError: int too big to convert").
+    big = 2**31 - 1
+    lo, hi = math.floor(min(min_disparity, big)), math.ceil(min(max_disparity, big))
     if hi < lo:
         raise ValueError(f"max_disparity ({max_disparity}) must be >= min_disparity ({lo})")
     return {**DEFAULTS, **params, "min_disparity": lo, "max_disparity": hi}

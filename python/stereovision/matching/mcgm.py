@@ -153,14 +153,15 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
         if (
             isinstance(v, bool)
             or not isinstance(v, (int, float, np.integer, np.floating))
-            or not math.isfinite(float(v))
+            or (isinstance(v, (float, np.floating)) and not math.isfinite(v))
             or v < 0
         ):
             raise ValueError(f"{name} must be a non-negative number of pixels, got {v!r}")
-    # The kernel clips the range to the image; the clip here keeps it within its integers.
-    big = float(2**31 - 1)
-    lo = math.floor(min(float(min_disparity), big))
-    hi = math.ceil(min(float(max_disparity), big))
+    # The kernel clips the range to the image; the clip here keeps it within its integers
+    # (without a float of an int beyond a float's range: 2**1100 was an OverflowError).
+    big = 2**31 - 1
+    lo = math.floor(min(min_disparity, big))
+    hi = math.ceil(min(max_disparity, big))
     if hi < lo:
         raise ValueError(f"max_disparity ({max_disparity}) must be >= min_disparity ({lo})")
     kw = {**DEFAULTS, **params, "min_disparity": lo, "max_disparity": hi}

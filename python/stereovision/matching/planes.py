@@ -30,6 +30,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import finite_number, int_in_range
+
 __all__ = ["DEFAULTS", "fill_planes", "plane_fill", "segments", "side_fill"]
 
 F32 = npt.NDArray[np.float32]
@@ -39,6 +41,8 @@ _BLUR = 2.0  # px: Gaussian sigma before the quantisation
 # px: the largest blur accepted. OpenCV's kernel grows with sigma: 1e4 px took 100 s on a 100 x 160
 # crop and 1e6 px raised cv2.error (bad_array_new_length).
 _MAX_BLUR = 64.0
+#: The largest pixel count taken (``min_pixels``, ``min_size``): the kernels' counts.
+_MAX_COUNT = 2**31 - 1
 _STEP = 16  # grey levels (0-255) per quantisation bin
 _MIN_PIXELS = 50  # measured pixels a segment needs for a plane
 _MAX_RESIDUAL = 0.7  # px: largest median absolute residual of an accepted plane
@@ -86,16 +90,17 @@ def segments(
     Raises
     ------
     ValueError
-        A non-2-D/3-D image, a non-positive ``step``, a ``blur`` outside [0, 64] px or a
-        negative ``k``.
+        A non-2-D/3-D image, a non-positive ``step``, a ``blur`` outside [0, 64] px, a
+        ``min_size`` outside 0 to 2**31 - 1 or a negative ``k``.
     """
     from stereovision import _core
 
     im = np.asarray(image)
     if im.ndim not in (2, 3) or im.size == 0 or im.dtype.kind not in "iuf":
         raise ValueError(f"image: expected a real (H, W) or (H, W, C) array, got {im.shape}")
-    if step < 1 or blur < 0 or not np.isfinite(blur):
+    if step < 1 or finite_number(blur, "blur") < 0:
         raise ValueError(f"step must be >= 1 and blur >= 0, got step={step}, blur={blur}")
+    size = int_in_range(min_size, "min_size", 0, _MAX_COUNT)
     if blur > 0:
         im = _blurred(im, blur)
     fast = im.dtype == np.uint8 and (im.ndim == 2 or im.shape[2] <= 3) and 0 <= offset <= 255
@@ -106,7 +111,7 @@ def segments(
     key = np.floor((im.astype(np.float32) + offset) / step).astype(np.float32)
     if key.ndim == 2:
         key = key[:, :, None]
-    return _core.graph_segments(np.ascontiguousarray(key, np.float32), float(k), int(min_size))
+    return _core.graph_segments(np.ascontiguousarray(key, np.float32), float(k), size)
 
 
 def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
@@ -114,7 +119,7 @@ def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
     uint8 out (OpenCV rounds the blurred values, as the reference does); ``blur`` 0: none."""
     import cv2
 
-    if not (np.isfinite(blur) and 0 <= blur <= _MAX_BLUR):
+    if not 0 <= finite_number(blur, "blur") <= _MAX_BLUR:
         raise ValueError(f"blur: expected a sigma in [0, {_MAX_BLUR:g}] px, got {blur}")
     u8 = im if im.dtype == np.uint8 else np.clip(im.astype(np.float32), 0, 255).astype(np.uint8)
     if blur <= 0:
@@ -166,7 +171,7 @@ def plane_fill(
         raise ValueError(f"labels: expected shape {d.shape} like disp, got {lab.shape}")
     if isinstance(min_pixels, bool) or not isinstance(min_pixels, (int, np.integer)):
         raise ValueError(f"min_pixels: expected a whole number, got {min_pixels!r}")
-    if not 0 <= min_pixels < 2**31:
+    if not 0 <= min_pixels <= _MAX_COUNT:
         raise ValueError(f"min_pixels: expected a non-negative count, got {min_pixels}")
     out, _, _ = _core.plane_fill(d, lab, int(min_pixels), float(max_residual), lo, hi)
     return out
@@ -209,8 +214,8 @@ def fill_planes(
     Raises
     ------
     ValueError
-        An image of another size or with more than 3 channels, a step outside 1-255 or a
-        ``blur`` outside [0, 64] px.
+        An image of another size or with more than 3 channels, ``passes`` not pairs of a step
+        in 1-255 and a count in 0 to 2**31 - 1, or a ``blur`` outside [0, 64] px.
     """
     from stereovision import _core
 
@@ -220,14 +225,21 @@ def fill_planes(
         raise ValueError(f"image: expected {d.shape} pixels like disp, got {im.shape[:2]}")
     if im.ndim == 3 and not 1 <= im.shape[2] <= 3:
         raise ValueError(f"image: expected 1-3 channels, got {im.shape[2]}")
-    if any(int(step) < 1 for step, _ in passes):
-        raise ValueError(f"passes: every step must be >= 1, got {passes}")
+    try:
+        steps = [
+            (int_in_range(st, "step", 1, 255), int_in_range(n, "min_pixels", 0, _MAX_COUNT))
+            for st, n in passes
+        ]
+    except (TypeError, ValueError):  # not pairs, or a value out of range (2**70 overflowed)
+        raise ValueError(
+            "passes: expected (step, min_pixels) pairs, steps in 1-255 and counts in "
+            f"0-{_MAX_COUNT}, got {passes!r}"
+        ) from None
     if np.isfinite(d).all():
         return d.copy()
     # Blurred once for every pass and binning (uint8: other types clipped to 0-255).
     im = _blurred(im, blur)
     u8 = np.ascontiguousarray(im[:, :, None] if im.ndim == 2 else im)
-    steps = [(int(step), int(min_pixels)) for step, min_pixels in passes]
     return _core.fill_planes(d, u8, steps, float(max_residual))
 
 
@@ -297,7 +309,7 @@ def side_fill(
         raise ValueError(
             f"image: expected (H, W) or (H, W, 3) with (H, W) = {d.shape}, got {im.shape}"
         )
-    if not (np.isfinite(blur) and blur >= 0):
+    if finite_number(blur, "blur") < 0:
         raise ValueError(f"blur: expected a non-negative number, got {blur}")
     if np.isfinite(d).all():
         return d.copy()
