@@ -447,7 +447,7 @@ def test_a_later_success_clears_an_error_and_a_scene_can_be_chosen_again(data_di
     app.state.scene = str(cones)
     app.state.left_file, app.state.right_file = "cones/right.png", "cones/right.png"
     app.load_files()
-    assert app.state.source_label == "files" and app.state.scene == ""
+    assert app.state.source_label == "files" and app.state.scene is None
     assert app.pair[0] is app.pair[1] or np.array_equal(app.pair[0], app.pair[1])
     app._on_scene(scene=str(cones))
     assert app.state.source_label == "scene data/cones"
@@ -471,6 +471,23 @@ def _scene_app(name: str, folders: list[Path], **kw):
     app.state.method = "fast"
     app._spawn = lambda coro: coro.close()
     return app
+
+
+def test_the_demo_scene_is_the_scene_list_choice_at_start_up(tmp_path):
+    """At start-up the page showed "scene data/cones" above a scene list whose choice was an
+    empty entry (the state's "" is a chosen value to the select). The demo's entry is now the
+    choice; a pair from elsewhere clears it to None (no choice, the select's label alone)."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-demo-choice", [bundled_data_dir(), tmp_path])
+    assert app.state.scene is None
+    app._on_ready()
+    demo = str((bundled_data_dir() / "cones").resolve())
+    assert app.state.error == "" and app.state.source_label == "scene data/cones"
+    assert app.state.scene == demo
+    assert {i["value"]: i["title"] for i in app.state.scenes}[demo] == "data/cones"
+    app._other_source()
+    assert app.state.scene is None and app._scene == ""
 
 
 def _run(app, action) -> None:

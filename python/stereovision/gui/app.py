@@ -452,7 +452,8 @@ class StereoApp:
         st.img_floor = ""
         st.cam_left, st.cam_right = source_names
         st.live = source is not None
-        st.scene = ""
+        # None, not "": the select shows "" as a chosen, empty entry (its label raised above it)
+        st.scene = None
         st.scenes = []
         st.cloud_path = ""
         st.clouds = []
@@ -502,7 +503,15 @@ class StereoApp:
         """The pair no longer comes from the scene list: clear its choice, so that choosing the
         same scene again loads it (trame reports only a changed value)."""
         self._scene = ""
-        self.state.scene = ""
+        self.state.scene = None
+
+    def _show_demo_in_list(self) -> None:
+        """The scene list shows the demo scene on show at start-up (it showed an empty choice
+        beside "scene data/cones"): its entry, found by its real path."""
+        demo = str(Path(self.demo_scene).resolve())
+        if any(item["value"] == demo for item in self.state.scenes):
+            self._scene = demo
+            self.state.scene = demo
 
     def _spawn(self, coro: Any) -> None:
         from trame.app import asynchronous
@@ -573,6 +582,7 @@ class StereoApp:
                 self._grab()
             else:
                 self._load_scene(self.demo_scene)
+                self._show_demo_in_list()
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
             return
@@ -593,7 +603,7 @@ class StereoApp:
             self._fail(exc)
             # the list shows the scene on show again, so that choosing the failed one retries
             # (trame reports only a changed value)
-            self.state.scene = self._scene
+            self.state.scene = self._scene or None
             return
         self._scene = scene
         self._spawn(self.recompute())
@@ -744,7 +754,8 @@ class StereoApp:
                             setattr(self, name, value)
                     with self.state:
                         self.state.source_label = shown["source_label"]
-                        self.state.scene = self._scene  # the failed choice can be made again
+                        # the failed choice can be made again
+                        self.state.scene = self._scene or None
                         self.state.error += " (the page still shows the previous pair)"
                 return
             finally:
