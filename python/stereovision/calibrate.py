@@ -1111,11 +1111,14 @@ def calibrate(
 
     Examples
     --------
-    >>> import glob
+    ``chessboard`` is the folder of OpenCV's sample pairs ``left01.jpg`` ... ``right14.jpg``
+    (9 x 6 inner corners; the tests give ``shared/data/chessboard`` beside the repository):
+
+    >>> from pathlib import Path
     >>> from stereovision.calibrate import calibrate
-    >>> d = "/work/shared/data/chessboard/"
-    >>> cal, rep = calibrate(sorted(glob.glob(d + "left*.jpg"))[:4],
-    ...                      sorted(glob.glob(d + "right*.jpg"))[:4], square_size=1.0)
+    >>> d = Path(chessboard)
+    >>> cal, rep = calibrate(sorted(d.glob("left*.jpg"))[:4],
+    ...                      sorted(d.glob("right*.jpg"))[:4], square_size=1.0)
     >>> len(rep.used_pairs), rep.rms < 0.3
     (4, True)
     """
