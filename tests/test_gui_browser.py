@@ -121,6 +121,26 @@ def test_two_data_folders_of_one_name_are_told_apart(tmp_path):
     assert AllowedFolders([a]).label(a / "cones") == "data/cones"  # alone: as before
 
 
+def test_scene_list_is_not_cut_short_by_other_images(tmp_path, monkeypatch):
+    """The listing's limit counted PNG files: a folder of calibration pairs before the scenes
+    (in walking order) filled it, and the scenes after it were not offered."""
+    monkeypatch.setattr(sources, "MAX_LISTED", 5)
+    (tmp_path / "a_calib").mkdir()
+    for k in range(6):
+        (tmp_path / "a_calib" / f"left_{k:02d}.png").write_bytes(b"png")
+    for name in ("b_scene", "c_scene"):
+        (tmp_path / name).mkdir()
+        for side in ("left.png", "right.png"):
+            (tmp_path / name / side).write_bytes(b"png")
+    (tmp_path / "d_half").mkdir()
+    (tmp_path / "d_half" / "left.png").write_bytes(b"png")  # no right.png: not a scene
+    folders = AllowedFolders([tmp_path])
+    assert [folders.label(p) for p in folders.scenes()] == [
+        f"{tmp_path.name}/b_scene",
+        f"{tmp_path.name}/c_scene",
+    ]
+
+
 # ----------------------------------------------------------------------------- sources
 
 

@@ -133,11 +133,25 @@ class AllowedFolders:
         return self._walk(suffixes)
 
     def scenes(self) -> list[Path]:
-        """Scene folders (``left.png`` + ``right.png``) under the roots."""
-        return sorted(
-            {p.parent for p in self._walk(frozenset({".png"})) if p.name == "left.png"}
-            & {p.parent for p in self._walk(frozenset({".png"})) if p.name == "right.png"}
-        )
+        """Scene folders (``left.png`` + ``right.png``) under the roots (sorted, at most
+        :data:`MAX_LISTED`).
+
+        The limit counts scenes: it counted PNG files, so a folder of calibration pairs listed
+        first (500 images) left no scene after it in the list.
+        """
+        found: set[Path] = set()
+        for root in self.roots:
+            for dirpath, dirnames, filenames in os.walk(root):
+                dirnames[:] = sorted(d for d in dirnames if not d.startswith("."))
+                d = Path(dirpath)
+                names = set(filenames)
+                if {"left.png", "right.png"} <= names and all(
+                    self.contains(d / n) for n in ("left.png", "right.png")
+                ):
+                    found.add(d)
+                    if len(found) >= MAX_LISTED:
+                        return sorted(found)
+        return sorted(found)
 
     def label(self, path: Path) -> str:
         """Short display name: ``<root name>/<relative path>``."""
