@@ -32,6 +32,7 @@ BAD_VALUES: list[Any] = [
     -(10**12),
     2**70,  # beyond 64 bits: the bindings' OverflowError, NumPy's "ufunc 'isfinite'" TypeError
     -(2**70),
+    10**400,  # beyond a float: float()'s and the bindings' OverflowError
     float("nan"),
     float("inf"),
     "x",
@@ -173,6 +174,11 @@ NAMED: list[tuple[Call, str]] = [
     ),
     (lambda c, kw: fusion.fused_dense(c["disp"], c["conf"], c["disp"], tau=10**400), "tau"),
     (lambda c, kw: fusion.fill_enclosed_far(c["disp"], c["gl"], ring=10**400), "ring"),
+    # 10**400 where a float goes: float()'s or the binding's OverflowError
+    (lambda c, kw: sgm.sgm_disparity(c["gl"], c["gr"], max_disparity=10**400), "max_disparity"),
+    (lambda c, kw: gabor.gabor_disparity(c["gl"], c["gr"], max_disparity=32, freq=10**400), "freq"),
+    (lambda c, kw: planes.side_fill(c["disp"], c["bgr"], tau=-(10**400)), "tau"),
+    (lambda c, kw: mcgm.mcgm_match(c["gl"], c["gr"], max_disparity=32, sigmas=[10**400]), "sigmas"),
 ]
 
 

@@ -12,7 +12,7 @@ luma weights.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -27,9 +27,12 @@ __all__ = [
     "as_image_array",
     "check_pair",
     "finite_number",
+    "float_sized",
     "int_in_range",
     "positive_finite",
 ]
+
+_T = TypeVar("_T")
 
 #: ITU-R BT.601 luma weights in OpenCV's B, G, R channel order (the weights ``cv2.cvtColor``
 #: uses for ``COLOR_BGR2GRAY``), applied here in floating point without intermediate rounding.
@@ -403,6 +406,35 @@ def int_in_range(value: object, name: str, lo: int, hi: int) -> int:
     return int(value)  # type: ignore[call-overload]
 
 
+def float_sized(value: _T, name: str) -> _T:
+    """``value`` unchanged, after a ``ValueError`` naming ``name`` if it is a Python int beyond
+    a float's range (``10**400``: the OverflowError of ``float()`` and of the bindings' f32 / f64
+    parameters). Other values are left to the caller's own checks.
+
+    Examples
+    --------
+    >>> float_sized(3, "gamma")
+    3
+    >>> float_sized(10**400, "gamma")
+    Traceback (most recent call last):
+    ...
+    ValueError: gamma: an integer of 1329 bits is beyond a float's range
+    """
+    if isinstance(value, int) and not isinstance(value, bool):
+        try:
+            float(value)
+        except OverflowError:
+            raise ValueError(f"{name}: {_shown(value)} is beyond a float's range") from None
+    return value
+
+
+def _shown(value: object) -> str:
+    """``repr(value)``, or for an int beyond a float its size (10**5000 has no repr)."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 1024:
+        return f"an integer of {value.bit_length()} bits"
+    return repr(value)
+
+
 def finite_number(value: object, name: str) -> float:
     """``value`` as a finite Python float.
 
@@ -422,13 +454,13 @@ def finite_number(value: object, name: str) -> float:
     if isinstance(value, (bool, np.bool_)) or not isinstance(
         value, (int, float, np.integer, np.floating)
     ):
-        raise ValueError(f"{name}: expected a finite number, got {value!r}")
+        raise ValueError(f"{name}: expected a finite number, got {_shown(value)}")
     try:
         out = float(value)
     except OverflowError:
         out = math.inf
     if not math.isfinite(out):
-        raise ValueError(f"{name}: expected a finite number, got {value!r}")
+        raise ValueError(f"{name}: expected a finite number, got {_shown(value)}")
     return out
 
 

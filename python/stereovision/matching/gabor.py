@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import finite_number, refuse_unknown
+from stereovision._validate import finite_number, float_sized, refuse_unknown
 
 __all__ = ["DEFAULTS", "GaborResult", "gabor_disparity", "gabor_responses"]
 
@@ -144,6 +144,8 @@ def gabor_disparity(
         )
     kw: dict[str, Any] = {**DEFAULTS, **params}
     for name, default in DEFAULTS.items():
+        if isinstance(default, float) or default is None:
+            float_sized(kw[name], name)  # 10**400: the binding's OverflowError
         # the switches: 5 was the binding's TypeError "'int' object is not an instance of 'bool'"
         if isinstance(default, bool):
             if not isinstance(kw[name], (bool, np.bool_)):

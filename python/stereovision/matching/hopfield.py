@@ -26,6 +26,7 @@ from stereovision import _core
 from stereovision._validate import (
     as_gray_float,
     check_pair,
+    float_sized,
     int_in_range,
     luma_weights,
     refuse_unknown,
@@ -147,7 +148,7 @@ def interest_points(
     """
     img = as_gray_float(image, "image")
     for name, v in (("rel_threshold", rel_threshold), ("floor_rel", floor_rel)):
-        if not (0.0 <= float(v) <= 1.0):
+        if not (0.0 <= float(float_sized(v, name)) <= 1.0):
             raise ValueError(f"{name} must lie in [0, 1], got {v!r}")
     # Sizes beyond the image act as the image: the cap keeps them within the kernel's integers.
     nms = int_in_range(nms_half, "nms_half", 1, 2**31 - 1)

@@ -25,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import as_gray_float, check_pair, refuse_unknown
+from stereovision._validate import as_gray_float, check_pair, float_sized, refuse_unknown
 from stereovision.matches import Matches
 
 __all__ = [
@@ -165,7 +165,10 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
     if hi < lo:
         raise ValueError(f"max_disparity ({max_disparity}) must be >= min_disparity ({lo})")
     kw = {**DEFAULTS, **params, "min_disparity": lo, "max_disparity": hi}
-    kw["sigmas"] = [float(s) for s in np.atleast_1d(np.asarray(kw["sigmas"], dtype=np.float64))]
+    sig = kw["sigmas"]
+    for s in sig if isinstance(sig, (list, tuple)) else [sig]:
+        float_sized(s, "sigmas")
+    kw["sigmas"] = [float(s) for s in np.atleast_1d(np.asarray(sig, dtype=np.float64))]
     return kw
 
 

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import finite_number, int_in_range
+from stereovision._validate import finite_number, float_sized, int_in_range
 
 __all__ = ["DEFAULTS", "fill_planes", "plane_fill", "segments", "side_fill"]
 
@@ -108,10 +108,13 @@ def segments(
         # Equal regions of a uint8 image: the kernel bins and labels in one pass.
         u8 = im[:, :, None] if im.ndim == 2 else im
         return _core.quantised_regions(np.ascontiguousarray(u8), int(step), int(offset))
+    float_sized(step, "step")
+    float_sized(offset, "offset")
     key = np.floor((im.astype(np.float32) + offset) / step).astype(np.float32)
     if key.ndim == 2:
         key = key[:, :, None]
-    return _core.graph_segments(np.ascontiguousarray(key, np.float32), float(k), size)
+    k = float(float_sized(k, "k"))
+    return _core.graph_segments(np.ascontiguousarray(key, np.float32), k, size)
 
 
 def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
@@ -173,6 +176,8 @@ def plane_fill(
         raise ValueError(f"min_pixels: expected a whole number, got {min_pixels!r}")
     if not 0 <= min_pixels <= _MAX_COUNT:
         raise ValueError(f"min_pixels: expected a non-negative count, got {min_pixels}")
+    for name, v in (("max_residual", max_residual), ("lo", lo), ("hi", hi)):
+        float_sized(v, name)
     out, _, _ = _core.plane_fill(d, lab, int(min_pixels), float(max_residual), lo, hi)
     return out
 
@@ -240,7 +245,7 @@ def fill_planes(
     # Blurred once for every pass and binning (uint8: other types clipped to 0-255).
     im = _blurred(im, blur)
     u8 = np.ascontiguousarray(im[:, :, None] if im.ndim == 2 else im)
-    return _core.fill_planes(d, u8, steps, float(max_residual))
+    return _core.fill_planes(d, u8, steps, float(float_sized(max_residual, "max_residual")))
 
 
 #: The colour side rule's defaults (:func:`side_fill`): chosen once on the 17 GT scenes.
@@ -316,4 +321,4 @@ def side_fill(
     u8 = _blurred(im, blur)
     bgr = cv2.cvtColor(u8, cv2.COLOR_GRAY2BGR) if u8.ndim == 2 or u8.shape[2] == 1 else u8
     lab = np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2LAB), np.float32)
-    return _core.side_fill(d, lab, float(tau))
+    return _core.side_fill(d, lab, float(float_sized(tau, "tau")))

@@ -19,7 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import as_gray_float, check_pair
+from stereovision._validate import as_gray_float, check_pair, float_sized
 
 __all__ = ["DEFAULTS", "sgm_disparity"]
 
@@ -136,7 +136,7 @@ def sgm_disparity(
     p = {**DEFAULTS, **params}
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
         # The kernel takes i32 levels (and at most 2048 of them).
-        if not math.isfinite(v) or abs(v) >= 2**31 - 1:
+        if not math.isfinite(float_sized(v, name)) or abs(v) >= 2**31 - 1:
             raise ValueError(f"{name}: expected a finite number of pixels, got {v}")
     if max_disparity < min_disparity:
         raise ValueError(
@@ -166,7 +166,7 @@ def sgm_disparity(
         math.ceil(max_disparity),
         int(p["p1"]),
         int(p["p2"]),
-        float(p["gamma"]),
+        float(float_sized(p["gamma"], "gamma")),
         int(p["uniqueness"]),
         int(p["lr_tol"]),
         int(p["edge_margin"]),
