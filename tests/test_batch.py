@@ -16,6 +16,7 @@ import threading
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import cv2
 import distributed
@@ -544,8 +545,8 @@ def test_batch_output_folder_moved_during_the_run(
     commit = batch._commit_pair
     written: list[str] = []
 
-    def commit_then_move(out_dir: Path, name: str, files: dict[str, bytes]) -> Path:
-        dest = commit(out_dir, name, files)
+    def commit_then_move(out_dir: Path, name: str, files: dict[str, bytes], *more: Any) -> Path:
+        dest = commit(out_dir, name, files, *more)
         written.append(name)
         if len(written) == 2:
             out_dir.rename(tmp_path / "moved")
@@ -603,3 +604,43 @@ def test_batch_says_when_other_options_redo_finished_pairs(
         "ground: off -> on",
         "grid: default -> 0.2",
     ]
+
+
+def test_batch_never_deletes_what_an_output_folder_already_holds(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """A pair's outputs go into a folder that holds other things: the input images (-o given as
+    the input folder), the outputs of a pair nested in it, a user's file. They are kept; a pair
+    redone without --ground loses the ground files of its earlier run only. (The folder was
+    replaced whole: -o IN deleted IN/a/left.png and right.png, a redone pair `a` deleted the
+    outputs of `a/b`.)"""
+    root = tmp_path / "in"
+    _tiny(root, data_dir, "a/left.png", "a/right.png", "a/b/left.png", "a/b/right.png")
+    images = {p: p.read_bytes() for p in root.rglob("*.png")}
+    (root / "a/notes.txt").write_text("mine")
+    args = ["batch", str(root), "-o", str(root), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    assert {p: p.read_bytes() for p in images} == images  # the inputs are all there
+    assert (root / "a/notes.txt").read_text() == "mine"
+    assert {p.name for p in (root / "a/b").iterdir()} == {"left.png", "right.png", *DISPARITY_FILES}
+    # `a` redone (its image changed): the outputs of `a/b`, nested in its folder, stay
+    os.utime(root / "a/left.png", ns=(1, 1))
+    assert main(args) == 0
+    s = _summary(root)
+    assert s["run"]["processed"] == 1 and s["run"]["skipped"] == 1 and s["run"]["missing"] == 0
+    assert (root / "a/b/disparity.pfm").is_file() and (root / "a/left.png").is_file()
+    # an earlier run's file this run does not write is removed, a user's file stays
+    (root / "a/ground.json").write_text("{}")
+    entry = s["pairs"]["a"]
+    entry["outputs"] = [*entry["outputs"], "ground.json"]
+    entry["fingerprint"] = {}
+    (root / SUMMARY_NAME).write_text(json.dumps(s))
+    assert main(args) == 0
+    assert not (root / "a/ground.json").exists() and (root / "a/notes.txt").is_file()
+    assert {p.name for p in (root / "a").iterdir() if p.is_file()} == {
+        "left.png",
+        "right.png",
+        "notes.txt",
+        *DISPARITY_FILES,
+    }
+    assert not [p for p in root.rglob(".*")]  # no temporary folder left behind

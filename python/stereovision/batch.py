@@ -4,7 +4,8 @@ Each pair found under the input (:func:`find_pairs`) becomes one Dask task that 
 ``stereovision depth`` writes for it (:func:`stereovision.cli.depth_outputs`): the task receives the
 image bytes and returns the output files' bytes, so workers need neither the input nor the output
 folder -- a multi-node cluster works without a shared filesystem. The client (this process) writes
-each finished pair into ``OUT/<name>/`` atomically (a hidden temporary folder renamed into place)
+each finished pair into ``OUT/<name>/`` atomically (a hidden temporary folder renamed into place;
+into a folder already there, each file renamed over its own name, the rest of the folder kept)
 and records it in ``OUT/summary.json`` (itself replaced atomically after every pair).
 
 A re-run skips the pairs the summary records as done whose inputs (size, modification time) and
@@ -334,8 +335,19 @@ def _fingerprint(job: PairJob) -> dict[str, Any]:
     return fp
 
 
-def _commit_pair(out: Path, name: str, files: dict[str, bytes]) -> Path:
-    """Write a pair's files into ``out/name`` as a whole: temporary folder, then rename."""
+def _commit_pair(
+    out: Path, name: str, files: dict[str, bytes], previous: list[str] | None = None
+) -> Path:
+    """Write a pair's files into ``out/name``.
+
+    A new folder appears whole: the files are written into a hidden temporary folder renamed
+    into place. An existing folder is not replaced (that deleted what else it held: the folders
+    of the pairs nested in it, a user's files, the input images of an output folder given as
+    the input folder): each file is renamed over its own name, and of the files an earlier run
+    recorded (``previous``) those this run did not write are removed.
+    """
+    from stereovision.cli import DEPTH_OUTPUTS
+
     dest = out / name
     dest.parent.mkdir(parents=True, exist_ok=True)
     tmp = dest.parent / f".{dest.name}.partial-{uuid.uuid4().hex[:8]}"
@@ -346,16 +358,18 @@ def _commit_pair(out: Path, name: str, files: dict[str, bytes]) -> Path:
                 fh.write(data)
                 fh.flush()
                 os.fsync(fh.fileno())
-        old = None
-        if dest.exists():
-            old = dest.parent / f".{dest.name}.old-{uuid.uuid4().hex[:8]}"
-            os.replace(dest, old)
-        os.replace(tmp, dest)
-        if old is not None:
-            shutil.rmtree(old, ignore_errors=True)
-    except BaseException:
+        if not dest.exists():
+            os.replace(tmp, dest)
+            return dest
+        for fname in files:
+            os.replace(tmp / fname, dest / fname)
+        for fname in previous or []:
+            stale = dest / fname
+            if fname in DEPTH_OUTPUTS and fname not in files and stale.is_file():
+                if not stale.is_symlink():
+                    stale.unlink()
+    finally:
         shutil.rmtree(tmp, ignore_errors=True)
-        raise
     return dest
 
 
@@ -711,6 +725,7 @@ def run_batch(
         output=str(out.resolve()),
     )
     todo: list[PairJob] = []
+    previous: dict[str, list[str]] = {}  # the outputs an earlier run recorded, per pair
     skipped: list[str] = []
     failed_before: list[str] = []
     redone: list[str] = []
@@ -731,6 +746,8 @@ def run_batch(
         ):  # done on the same images, with other options: its outputs are replaced
             redone.append(job.name)
             changes.update(_changes(entry.get("options") or {}, opts))
+        if entry is not None and isinstance(entry.get("outputs"), list):
+            previous[job.name] = [str(f) for f in entry["outputs"]]
         summary.pairs[job.name] = {
             "status": "pending",
             "left": str(job.left),
@@ -792,6 +809,7 @@ def run_batch(
                 progress,
                 processed,
                 failed,
+                previous,
             )
     except KeyboardInterrupt as exc:
         interrupted = True
@@ -890,6 +908,7 @@ def _run_jobs(
     progress: bool,
     processed: list[str],
     failed: list[str],
+    previous: dict[str, list[str]] | None = None,
 ) -> None:
     """Run ``todo`` on Dask, recording each pair as it finishes into ``processed`` / ``failed``
     and the summary; a KeyboardInterrupt is raised on after Dask is stopped."""
@@ -943,7 +962,7 @@ def _run_jobs(
             else:
                 res = fut.result()
                 summary.ensure_folder()
-                _commit_pair(out, job.name, res["files"])
+                _commit_pair(out, job.name, res["files"], (previous or {}).get(job.name))
                 entry = summary.pairs[job.name]
                 entry.update(
                     status="done",
