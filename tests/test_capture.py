@@ -540,8 +540,8 @@ def test_atomic_pair_writes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> 
         save_pair(out, 2, img, img)
     monkeypatch.setattr(os, "fsync", real_fsync)
     names = sorted(p.name for p in out.iterdir())
-    assert names == ["left_0001.png", "left_0002.png", "right_0001.png"]
-    assert next_pair_index(out) == 3
+    assert names == ["left_0001.png", "right_0001.png"]  # no left_0002.png alone
+    assert next_pair_index(out) == 2
     with pytest.raises(ValueError, match="encode"):
         save_pair(out, 3, img, img, ext=".nope")
 
@@ -581,6 +581,43 @@ def test_interrupted_pair_save_leaves_no_temp_file(
         save_pair(tmp_path, 1, img, img)
     monkeypatch.undo()
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_ctrl_c_never_leaves_half_a_pair(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Ctrl-C while a pair is saved: a signal is held until the pair is whole, an interrupt
+    raised while the right image is written removes the left one. (The left image stayed
+    alone: `calibrate --left 'left_*' --right 'right_*'` refused the folder, 2 files vs 1.)"""
+    import signal
+
+    img = _numbered(1)
+    real_fsync, real_replace = os.fsync, os.replace
+    calls = {"fsync": 0, "replace": 0}
+
+    def fsync_with_ctrl_c(fd: int) -> None:
+        calls["fsync"] += 1
+        if calls["fsync"] == 1:  # the user presses Ctrl-C while the left image is written
+            signal.raise_signal(signal.SIGINT)
+        real_fsync(fd)
+
+    monkeypatch.setattr(os, "fsync", fsync_with_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        save_pair(tmp_path, 1, img, img)
+    monkeypatch.setattr(os, "fsync", real_fsync)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["left_0001.png", "right_0001.png"]
+    assert np.array_equal(cv2.imread(str(tmp_path / "right_0001.png")), img)
+
+    def replace_interrupted(src: Any, dst: Any) -> None:
+        calls["replace"] += 1
+        if calls["replace"] == 2:  # the right image's rename
+            raise KeyboardInterrupt
+        real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace_interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        save_pair(tmp_path, 2, img, img)
+    monkeypatch.undo()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["left_0001.png", "right_0001.png"]
+    assert next_pair_index(tmp_path) == 2
 
 
 def test_capture_removes_temp_files_a_killed_capture_left(tmp_path: Path) -> None:

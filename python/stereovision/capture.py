@@ -1003,9 +1003,11 @@ def save_pair(
 
     Both images are encoded in memory first; each is then written to a temporary file in
     ``directory`` (``.left_0001.png.<pid>-<random>.tmp``) and renamed over its final name
-    (``os.replace``), left first, right last. Any exception, KeyboardInterrupt included, removes
-    the temporary file; one that a killed process left is removed by the next :func:`capture`
-    into the folder (:func:`remove_stale_temps`).
+    (``os.replace``), left first, right last. Ctrl-C (and SIGTERM where Python handles it) is
+    held until both are written; a failure of the right image removes the left one, so a pair
+    is saved whole or not at all. Any exception, KeyboardInterrupt included, removes the
+    temporary file; one that a killed process left is removed by the next :func:`capture` into
+    the folder (:func:`remove_stale_temps`).
 
     Parameters
     ----------
@@ -1028,7 +1030,7 @@ def save_pair(
     ValueError
         If an image cannot be encoded in that format.
     OSError
-        If writing fails (no partial file is left behind).
+        If writing fails (no partial file, and no half pair, is left behind).
     """
     d = Path(directory)
     d.mkdir(parents=True, exist_ok=True)
@@ -1042,8 +1044,20 @@ def save_pair(
             raise ValueError(f"cannot encode the {side} image as {ext}")
         data.append(buf.tobytes())
     paths = tuple(d / PAIR_NAME.format(side=s, index=index, ext=ext) for s in ("left", "right"))
-    for p, b in zip(paths, data, strict=True):
-        _atomic_write_bytes(p, b)
+    # A pair is saved whole or not at all: Ctrl-C (SIGTERM in the CLI) is held until both
+    # images are written, and the left image is removed when the right one fails (a left
+    # image alone stayed: `calibrate --left 'left_*' --right 'right_*'` then refused the
+    # folder for its file counts, and every later capture numbered its pairs after it).
+    from stereovision._interrupt import HeldInterrupts
+
+    with HeldInterrupts():
+        _atomic_write_bytes(paths[0], data[0])
+        try:
+            _atomic_write_bytes(paths[1], data[1])
+        except BaseException:
+            with contextlib.suppress(OSError):
+                os.unlink(paths[0])
+            raise
     return paths[0], paths[1]
 
 
