@@ -712,3 +712,31 @@ def test_realtime_playback_skips_what_a_slow_reader_misses(cones: Any, tmp_path:
                 now[0] += work_s  # the matcher's time on this pair
         assert got == want and cam.skipped == 10 - len(want)
         assert sum(waits) == pytest.approx(slept, abs=1e-6)
+
+
+def test_topics_of_another_shape_are_refused_not_stretched(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """A right topic of another shape than the left one: an error naming both (its frames were
+    resized to the left's size, stretched without a word); one of the same shape and half the
+    size is resized, with one warning."""
+    squashed = cv2.resize(cones.right, (450, 300), interpolation=cv2.INTER_AREA)
+    frames = [(T0 + k * PERIOD_NS, cones.left, T0 + k * PERIOD_NS, squashed) for k in range(3)]
+    bag = write_bag(tmp_path / "rig", frames, encoding="png")
+    with BagCamera(bag) as cam, pytest.raises(SourceError) as info:
+        cam.read()
+    assert str(info.value) == (
+        f"bag {bag}: {RIGHT} at stamp {T0} ns is 450x300, the {LEFT} frames 450x375: frames of "
+        "another shape cannot be paired without stretching one (0 pairs read before)"
+    )
+    assert info.value.end is False
+    out = tmp_path / "pairs"
+    code, _, err = run("capture", "--from-bag", str(bag), "-o", str(out))
+    assert code == 2 and "frames of another shape cannot be paired" in err
+    assert len(err.strip().splitlines()) == 1 and not list(out.glob("*.png"))
+
+    half = cv2.resize(cones.right, (225, 188), interpolation=cv2.INTER_AREA)
+    bag = write_bag(tmp_path / "half", [(T0, cones.left, T0, half)], encoding="png")
+    with BagCamera(bag) as cam, pytest.warns(UserWarning, match=r"is 225x188, not 450x375"):
+        frame = cam.read()
+    assert frame.right.shape == cones.left.shape

@@ -67,6 +67,7 @@ import re
 import sqlite3
 import statistics
 import time
+import warnings
 from collections import deque
 from collections.abc import Iterator
 from pathlib import Path
@@ -783,6 +784,8 @@ class BagCamera(PairSource):
             s: _rate(topics[t].msgcount, self._reader) for s, t in self.topics.items()
         }
         self.size = self.requested_size
+        self._shape: tuple[int, int] | None = None  # the first left frame's size
+        self._warned: set[str] = set()
         self.delivered_size: dict[str, tuple[int, int]] = {}
         self.skews_ms: list[float] = []
         self.stamps_ns: list[int] = []
@@ -857,13 +860,38 @@ class BagCamera(PairSource):
 
     # ------------------------------------------------------------------------------ reading
 
-    def _fit(self, side: str, img: np.ndarray) -> np.ndarray:
+    def _fit(self, side: str, img: np.ndarray, stamp: int) -> np.ndarray:
+        """``img`` at the output size. A frame of another shape than the first left frame is
+        refused, as :class:`~stereovision.capture.StereoCamera` refuses it (a resize stretched
+        it silently: a 450x300 right topic came out as 450x375 beside a 450x375 left one, and
+        every depth or calibration made of it was wrong); one of the same shape and another
+        size is resized with one warning per side, unless ``size`` asked for it."""
         h, w = img.shape[:2]
         self.delivered_size[side] = (w, h)
+        if self._shape is None:
+            self._shape = (w, h)
         if self.size is None:
             self.size = (w, h)
+        sw, sh = self._shape
+        if abs((w / h) / (sw / sh) - 1) > 0.01:
+            raise SourceError(
+                f"bag {self.path}: {self.topics[side]} at stamp {stamp} ns is {w}x{h}, the "
+                f"{self.topics['left']} frames {sw}x{sh}: frames of another shape cannot be "
+                f"paired without stretching one ({self.count} pairs read before)",
+                side=side,
+                end=False,
+                frames=self.count,
+            )
         if (w, h) == self.size:
             return img
+        if self.requested_size is None and side not in self._warned:
+            self._warned.add(side)
+            warnings.warn(
+                f"{self.topics[side]} is {w}x{h}, not {self.size[0]}x{self.size[1]}: its frames "
+                "are resized",
+                UserWarning,
+                stacklevel=4,
+            )
         interp = cv2.INTER_AREA if w > self.size[0] else cv2.INTER_LINEAR
         return np.asarray(cv2.resize(img, self.size, interpolation=interp))
 
@@ -873,7 +901,8 @@ class BagCamera(PairSource):
         Raises
         ------
         SourceError
-            At the end of the recording, or when the bag is closed.
+            At the end of the recording, or when the bag is closed; for a frame whose shape
+            differs from the first left frame's (``end`` False).
         ValueError
             If a frame does not decode (its topic and stamp named).
         """
@@ -896,8 +925,8 @@ class BagCamera(PairSource):
         left, right = to_8bit(*imgs)
         start = self._reader.start_time
         frame = StereoFrame(
-            left=self._fit("left", left),
-            right=self._fit("right", right),
+            left=self._fit("left", left, sl),
+            right=self._fit("right", right, sr),
             t_left=sl / 1e9,
             t_right=sr / 1e9,
             index=self.count,
