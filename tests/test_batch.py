@@ -222,6 +222,17 @@ def test_batch_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "bad.yaml" in err[0], err
     assert not (tmp_path / "o").exists()
+    # -o naming a file: said so (it was "[Errno 17] File exists: ...")
+    (tmp_path / "taken").write_text("mine")
+    assert main(["batch", str(tmp_path), "-o", str(tmp_path / "taken")]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: error: -o {tmp_path / 'taken'}: is a file, not a folder"
+    ]
+    from stereovision.batch import run_batch
+
+    with pytest.raises(ValueError, match=r"output folder .*taken/x: .*taken is a file, not a"):
+        run_batch(tmp_path, tmp_path / "taken" / "x")
+    assert (tmp_path / "taken").read_text() == "mine"
 
 
 def test_batch_ctrl_c_keeps_finished_pairs(data_dir: Path, tmp_path: Path) -> None:

@@ -986,3 +986,25 @@ def test_cli_missing_image_sequence_is_one_line(tmp_path: Path) -> None:
     assert run.returncode == 2
     said = f"stereovision: error: left source: no file matches {pattern}"
     assert run.stderr.splitlines() == [said]
+
+
+def test_an_output_folder_that_is_a_file_is_said_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """-o naming a file, or a folder below one: one line saying so, before the sources are
+    opened (it was "[Errno 17] File exists: ..." after opening them)."""
+    from stereovision.cli import main
+
+    left, right = _videos(tmp_path, 2, 2)
+    (tmp_path / "taken").write_text("mine")
+    for out, said in (
+        (tmp_path / "taken", f"-o {tmp_path / 'taken'}: is a file, not a folder"),
+        (tmp_path / "taken" / "x", f"-o {tmp_path / 'taken' / 'x'}: {tmp_path / 'taken'} is a "
+         "file, not a folder"),
+    ):  # fmt: skip
+        argv = ["capture", "--left", str(left), "--right", str(right), "-o", str(out)]
+        assert main(argv) == 2
+        assert capsys.readouterr().err.splitlines() == [f"stereovision: error: {said}"]
+    assert (tmp_path / "taken").read_text() == "mine"
+    with StereoCamera(left, right) as cam, pytest.raises(ValueError, match="is a file, not a"):
+        capture(cam, tmp_path / "taken", count=1)

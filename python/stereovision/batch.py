@@ -684,7 +684,10 @@ def run_batch(
     FileNotFoundError, NotADirectoryError
         A missing input folder or calibration file.
     ValueError
-        Bad ``workers`` / ``max_disparity``, or no pair under the input.
+        Bad ``workers`` / ``max_disparity``, no pair under the input, or an output folder that
+        is a file (or below one).
+    PermissionError
+        If the output folder cannot be written.
     OSError
         The scheduler cannot be reached.
     BatchInterrupted
@@ -701,8 +704,13 @@ def run_batch(
         raise ValueError(f"grid: expected a cell side from 0.01 to 10 m, got {grid}")
     if max_disparity is not None and max_disparity <= 0:
         raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
+    from stereovision.io import check_output_folder
+
     t0 = time.perf_counter()
     jobs, unpaired = _scan(input_dir, calib)
+    # a file in the way, or a folder that cannot be written: said as such, before a cluster
+    # starts (it was "[Errno 17] File exists" or "[Errno 2] No such file or directory")
+    check_output_folder(output_dir, "output folder")
     if not jobs:
         alone = (
             f"; {len(unpaired)} image(s) without the other of their pair, e.g. no "
@@ -1009,6 +1017,9 @@ def cmd_batch(args: argparse.Namespace) -> int:
     if threading.current_thread() is threading.main_thread():
         if signal.getsignal(signal.SIGTERM) in (signal.SIG_DFL, None):
             term = signal.signal(signal.SIGTERM, raise_terminated)
+    from stereovision.io import check_output_folder
+
+    check_output_folder(args.output, "-o")
     try:
         res = run_batch(
             args.input,

@@ -55,7 +55,7 @@ from stereovision.calibrate import (
     parse_pattern,
 )
 from stereovision.charuco import CharucoBoard
-from stereovision.io import _opencv_quiet
+from stereovision.io import _opencv_quiet, check_output_folder
 
 __all__ = [
     "MIN_POSE_DISTANCE",
@@ -1281,7 +1281,10 @@ def capture(
         ``count``) or ends before ``count`` pairs were saved; the pairs saved so far stay on
         disk, and the message says how many.
     ValueError
-        For an invalid ``count``, ``every``, ``temporal`` or pattern.
+        For an invalid ``count``, ``every``, ``temporal`` or pattern, or a ``directory`` that
+        is a file (or below one).
+    PermissionError
+        If ``directory`` cannot be written.
     """
     if count is not None and count <= 0:
         raise ValueError(f"count: expected a positive number of pairs, got {count!r}")
@@ -1306,6 +1309,9 @@ def capture(
     elif chessboard:
         collector = ChessboardCollector(parse_pattern(chessboard), min_distance)
     out = Path(directory)
+    # a file in the way, or a folder that cannot be written: said as such (it was "[Errno 17]
+    # File exists" or "[Errno 2] No such file or directory")
+    check_output_folder(out, "output folder")
     out.mkdir(parents=True, exist_ok=True)
     stale = remove_stale_temps(out)
     if stale and log is not None:
@@ -1406,6 +1412,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
         raise ValueError(
             "--every and --temporal: give one (--temporal saves a pair per still view)"
         )
+    check_output_folder(args.output, "-o")  # before the cameras are opened
     cam = open_source(args, fps=args.fps)
     try:
         print(cam.describe())
