@@ -214,6 +214,32 @@ def test_image_sequence_source_and_capture(tmp_path: Path) -> None:
     assert result.skew["n"] == 5
 
 
+def test_a_gap_in_an_image_sequence_is_said(tmp_path: Path) -> None:
+    """Pair 3 deleted from both numbered sequences (a blurred pair taken out): the capture
+    stops there and says the images after the gap were not read (it said "end of stream", the
+    4 pairs after it silently left out)."""
+    frames = tmp_path / "frames"
+    lpat = _write_sequence(frames, "left", [_numbered(i) for i in range(8)])
+    rpat = _write_sequence(frames, "right", [_numbered(i, shade=160) for i in range(8)])
+    for side in ("left", "right"):
+        (frames / f"{side}_003.png").unlink()
+    with StereoCamera(lpat, rpat) as cam:
+        result = capture(cam, tmp_path / "pairs")
+    assert len(result.saved) == 3
+    assert result.ended == "; ".join(
+        f"{side} source {pat!r} ended after 3 images: {side}_003.png is missing, so the 4 "
+        "images numbered after it were not read (renumber them without the gap)"
+        for side, pat in (("left", lpat), ("right", rpat))
+    )
+    (frames / "right_004.png").rename(frames / "right_003.png")  # no image after the gap
+    for side in ("left", "right"):
+        for i in range(4, 8):
+            (frames / f"{side}_{i:03d}.png").unlink(missing_ok=True)
+    (frames / "left_003.png").write_bytes((frames / "right_003.png").read_bytes())
+    with StereoCamera(lpat, rpat) as cam:
+        assert capture(cam, tmp_path / "more").ended == "end of stream"
+
+
 def test_image_sequence_frames_keep_their_own_size(
     tmp_path: Path, capfd: pytest.CaptureFixture[str]
 ) -> None:

@@ -124,10 +124,12 @@ class SourceError(OSError):
     expected_frames : int, optional
         The frame count an ended video file (or sequence) announces (``CAP_PROP_FRAME_COUNT``),
         when it announced more than were read.
+    gap : str, optional
+        The image whose absence ended an image sequence while images numbered after it exist.
 
     Attributes
     ----------
-    side, end, frames, other_had_frames, expected_frames
+    side, end, frames, other_had_frames, expected_frames, gap
         As given.
     """
 
@@ -140,6 +142,7 @@ class SourceError(OSError):
         frames: int | None = None,
         other_had_frames: bool | None = None,
         expected_frames: int | None = None,
+        gap: str | None = None,
     ) -> None:
         super().__init__(message)
         self.side = side
@@ -147,11 +150,15 @@ class SourceError(OSError):
         self.frames = frames
         self.other_had_frames = other_had_frames
         self.expected_frames = expected_frames
+        self.gap = gap
 
     @property
     def ended_early(self) -> bool:
-        """A source ended while the other still had frames, or before the frames it announced."""
-        return bool(self.other_had_frames) or self.expected_frames is not None
+        """A source ended while the other still had frames, before the frames it announced, or
+        at a gap in its numbered images."""
+        return (
+            bool(self.other_had_frames) or self.expected_frames is not None or self.gap is not None
+        )
 
     def _kwargs(self) -> dict[str, Any]:
         return {
@@ -160,6 +167,7 @@ class SourceError(OSError):
             "frames": self.frames,
             "other_had_frames": self.other_had_frames,
             "expected_frames": self.expected_frames,
+            "gap": self.gap,
         }
 
     def with_message(self, message: str) -> SourceError:
@@ -297,6 +305,25 @@ def _sequence_first(path: str) -> tuple[int, str] | None:
         if os.path.exists(name):
             return i, name
     return None
+
+
+def _sequence_gap(path: str, read: int) -> tuple[str, int] | None:
+    """For an image-sequence pattern read to its end after ``read`` images: the file that
+    stopped it (the next number, missing) and how many files numbered after it exist; None
+    when no file is numbered after it (the sequence's real end) or ``path`` is no pattern."""
+    m = _SEQ_RE.search(path)
+    first = _sequence_first(path)
+    if m is None or first is None:
+        return None
+    number = first[0] + read
+    missing = path[: m.start()] + ("%" + m.group(1) + "d") % number + path[m.end() :]
+    head, tail = path[: m.start()], path[m.end() :]
+    later = 0
+    for name in glob.glob(glob.escape(head) + "*" + glob.escape(tail)):
+        digits = name[len(head) : len(name) - len(tail)]
+        if digits.isdigit() and int(digits) > number:
+            later += 1
+    return (os.path.basename(missing), later) if later else None
 
 
 def _open_path(path: str) -> Any:
@@ -640,12 +667,28 @@ class StereoCamera(PairSource):
         n = self.count
         return total if total is not None and total - n > max(1, total // 100) else None
 
+    def _gap(self, side: str) -> tuple[str, int] | None:
+        """:func:`_sequence_gap` of an image-sequence source (None for others)."""
+        src = self.sources[side]
+        if not self._sequence.get(side) or not isinstance(src, (str, os.PathLike)):
+            return None
+        return _sequence_gap(os.fspath(src), self.count)
+
     def _end_phrase(self, side: str) -> str:
         src, n = self.sources[side], self.count
         name = _describe_source(src)
         if isinstance(src, (int, np.integer)):
             return f"{side} source {name} stopped delivering frames after {n} (disconnected?)"
         total = self._short(side)
+        gap = self._gap(side)
+        if gap is not None:
+            # a numbered image taken out of a sequence (a blurred frame deleted) ended it there:
+            # the images after it were never read, which "ended after 4 frames" did not say
+            return (
+                f"{side} source {name} ended after {n} images: {gap[0]} is missing, so the "
+                f"{gap[1]} image{'s' if gap[1] > 1 else ''} numbered after it "
+                f"{'were' if gap[1] > 1 else 'was'} not read (renumber them without the gap)"
+            )
         if total is None:
             return f"{side} source {name} ended after {n} frames"
         if self._sequence.get(side):
@@ -664,7 +707,8 @@ class StereoCamera(PairSource):
         frames, and whether a file ended before the frames its header announces."""
         gone = [side for side in ("left", "right") if not ok[side]]
         short = [t for side in gone if (t := self._short(side)) is not None]
-        if len(gone) == 2 and not short:
+        gaps = [g[0] for side in gone if (g := self._gap(side)) is not None]
+        if len(gone) == 2 and not short and not gaps:
             message = f"both sources ended after {self.count} frames"
         elif len(gone) == 2:
             message = "; ".join(self._end_phrase(side) for side in gone)
@@ -678,6 +722,7 @@ class StereoCamera(PairSource):
             frames=self.count,
             other_had_frames=len(gone) == 1,
             expected_frames=short[0] if short else None,
+            gap=gaps[0] if gaps else None,
         )
 
     def _fit(self, side: str, frame: np.ndarray) -> np.ndarray:
