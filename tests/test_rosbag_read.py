@@ -740,3 +740,25 @@ def test_topics_of_another_shape_are_refused_not_stretched(
     with BagCamera(bag) as cam, pytest.warns(UserWarning, match=r"is 225x188, not 450x375"):
         frame = cam.read()
     assert frame.right.shape == cones.left.shape
+
+
+def test_capture_of_a_bag_without_a_pair_is_an_error(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """A bag whose right frames are all a second off the left ones: no pair, an error saying
+    why, exit 2, as `stream` says it (capture said "0 pairs saved (end of stream)", exit 0)."""
+    frames = [(T0 + k * PERIOD_NS, cones.left, T0 + 10**9 + k * PERIOD_NS, cones.right)
+              for k in range(5)]  # fmt: skip
+    bag = write_bag(tmp_path / "rig", frames, encoding="png")
+    want = (
+        f"stereovision: error: bag {bag}: end of the recording after 0 pairs (5 left and 5 right "
+        "frames without a partner)"
+    )
+    for argv in (["capture", "-o", str(tmp_path / "pairs")], ["stream", "--no-display"]):
+        code, _, err = run(argv[0], "--from-bag", str(bag), *argv[1:])
+        assert code == 2 and err.splitlines()[0].startswith(want), err
+        assert len(err.strip().splitlines()) == 1
+    from stereovision.capture import capture
+
+    with BagCamera(bag) as cam, pytest.raises(SourceError, match="without a partner"):
+        capture(cam, tmp_path / "more")

@@ -1323,8 +1323,8 @@ def capture(
     ------
     SourceError
         If a source fails (a frame that does not decode or of another shape, with or without
-        ``count``) or ends before ``count`` pairs were saved; the pairs saved so far stay on
-        disk, and the message says how many.
+        ``count``), ends before ``count`` pairs were saved, or ends before a first pair could
+        be read; the pairs saved so far stay on disk, and the message says how many.
     ValueError
         For an invalid ``count``, ``every``, ``temporal`` or pattern, or a ``directory`` that
         is a file (or below one).
@@ -1372,7 +1372,9 @@ def capture(
         try:
             frame = camera.read()
         except SourceError as exc:
-            if count is None and exc.end:
+            # an end before any pair is an error, as in `stream` (a bag whose frames found no
+            # partner said "0 pairs saved (end of stream)" and exited 0)
+            if count is None and exc.end and camera.count > 0:
                 ended = _end_reason(exc, saved, last_index)
                 break
             kept = f"{len(saved)} of {count}" if count is not None else f"{len(saved)}"
