@@ -655,3 +655,13 @@ def test_batch_never_deletes_what_an_output_folder_already_holds(
         *DISPARITY_FILES,
     }
     assert not [p for p in root.rglob(".*")]  # no temporary folder left behind
+
+
+def test_batch_starts_no_more_workers_than_pairs(data_dir: Path, tmp_path: Path) -> None:
+    """2 pairs, --workers 4: 2 worker processes (each starts Python, NumPy and OpenCV; the
+    default, one per core, started 64 on a 64-core machine for 2 pairs)."""
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, *(f"seq/{i:04d}_{s}.png" for i in range(2) for s in ("left", "right")))
+    args = ["batch", str(root), "-o", str(out), "--workers", "4", "--max-disparity", "16"]
+    assert main(args) == 0
+    assert _summary(out)["run"]["scheduler"] == "LocalCluster(2 worker processes)"

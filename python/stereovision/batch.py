@@ -648,8 +648,8 @@ def run_batch(
     input_dir, output_dir : path
         Input tree and output folder (created if missing).
     workers : int, optional
-        Worker processes of the LocalCluster (default: the number of cores). Ignored with
-        ``scheduler``.
+        Worker processes of the LocalCluster (default: the number of cores), at most one per
+        pair to do. Ignored with ``scheduler``.
     scheduler : str, optional
         Address of an existing Dask scheduler (``tcp://host:8786``).
     method : str, optional
@@ -787,7 +787,9 @@ def run_batch(
         failed.append(u.name)
         if log is not None:
             log(f"failed {u.name}: {u.error}")
-    n_workers = workers or os.cpu_count() or 1
+    # no more worker processes than pairs to do: each starts Python, NumPy and OpenCV (a 64-core
+    # machine started 64 for 2 pairs), and the cores go to the kernels' own threads instead
+    n_workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
     run: dict[str, Any] = {
         "started": _now(),
         "scheduler": None,
@@ -1094,7 +1096,11 @@ def add_cli(subparsers: Any) -> None:
     )
     p.add_argument("input", help="folder with scene folders or left/right image pairs")
     p.add_argument("-o", "--output", required=True, help="output folder")
-    p.add_argument("--workers", type=int, help="LocalCluster worker processes (default: cores)")
+    p.add_argument(
+        "--workers",
+        type=int,
+        help="LocalCluster worker processes (default: cores; at most one per pair)",
+    )
     p.add_argument("--scheduler", metavar="ADDRESS", help="existing Dask scheduler, tcp://...")
     p.add_argument("--method", choices=METHODS, help="matcher (default: depth_map's)")
     p.add_argument(
