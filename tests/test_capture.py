@@ -1034,3 +1034,34 @@ def test_an_output_folder_that_is_a_file_is_said_so(
     assert (tmp_path / "taken").read_text() == "mine"
     with StereoCamera(left, right) as cam, pytest.raises(ValueError, match="is a file, not a"):
         capture(cam, tmp_path / "taken", count=1)
+
+
+def test_capture_refuses_to_save_into_the_sequence_it_reads(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--left pairs/left_%04d.png -o pairs: each pair saved (left_0004.png) would be the
+    sequence's next frame; refused, one line (the capture never ended, filling the disk). A
+    pattern that cannot match the saved names may share the folder."""
+    from stereovision.cli import main
+
+    pairs = tmp_path / "pairs"
+    pairs.mkdir()
+    for i in range(1, 4):
+        cv2.imwrite(str(pairs / f"left_{i:04d}.png"), _numbered(i))
+        cv2.imwrite(str(pairs / f"right_{i:04d}.png"), _numbered(i, shade=160))
+    lpat, rpat = str(pairs / "left_%04d.png"), str(pairs / "right_%04d.png")
+    before = sorted(p.name for p in pairs.iterdir())
+    assert main(["capture", "--left", lpat, "--right", rpat, "-o", str(pairs)]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: error: -o {pairs}: the source {lpat} would read the pairs saved there as "
+        "its next frames, without end; save them in another folder"
+    ]
+    with StereoCamera(lpat, rpat) as cam, pytest.raises(ValueError, match="without end"):
+        capture(cam, pairs)
+    assert sorted(p.name for p in pairs.iterdir()) == before
+    lcam = _write_sequence(pairs, "cam0", [_numbered(i) for i in range(3)])
+    rcam = _write_sequence(pairs, "cam1", [_numbered(i, shade=160) for i in range(3)])
+    with StereoCamera(lcam, rcam) as cam:
+        result = capture(cam, pairs)
+    assert [p[0].name for p in result.saved] == ["left_0004.png", "left_0005.png", "left_0006.png"]
+    assert result.ended == "end of stream"

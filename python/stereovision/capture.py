@@ -1326,8 +1326,9 @@ def capture(
         ``count``), ends before ``count`` pairs were saved, or ends before a first pair could
         be read; the pairs saved so far stay on disk, and the message says how many.
     ValueError
-        For an invalid ``count``, ``every``, ``temporal`` or pattern, or a ``directory`` that
-        is a file (or below one).
+        For an invalid ``count``, ``every``, ``temporal`` or pattern, a ``directory`` that is a
+        file (or below one), or one whose saved pairs an image-sequence source would read as
+        its next frames (``--left 'pairs/left_%04d.png' -o pairs``).
     PermissionError
         If ``directory`` cannot be written.
     """
@@ -1357,6 +1358,7 @@ def capture(
     # a file in the way, or a folder that cannot be written: said as such (it was "[Errno 17]
     # File exists" or "[Errno 2] No such file or directory")
     check_output_folder(out, "output folder")
+    _refuse_own_output(getattr(camera, "sources", None), out, ext, "output folder")
     out.mkdir(parents=True, exist_ok=True)
     stale = remove_stale_temps(out)
     if stale and log is not None:
@@ -1417,6 +1419,44 @@ def capture(
     )
 
 
+def _reads_own_output(sources: Any, out: PathLike, ext: str = ".png") -> str | None:
+    """The image-sequence pattern (``left_%04d.png``) among ``sources`` (a camera's ``sources``
+    dict) that would read the pairs saved in ``out`` as its next frames, or None."""
+    if not isinstance(sources, dict):
+        return None
+    names = [PAIR_NAME.format(side=side, index=1, ext=ext) for side in ("left", "right")]
+    for src in sources.values():
+        if not isinstance(src, (str, os.PathLike)):
+            continue
+        path = os.fspath(src)
+        if "://" in path or _SEQ_RE.search(path) is None:
+            continue
+        folder, base = os.path.split(path)
+        regex = "".join(
+            r"\d+" if _SEQ_RE.fullmatch(part) else re.escape(part)
+            for part in re.split(r"(%0?\d*d)", base)
+        )
+        try:
+            same = os.path.samefile(folder or ".", out)
+        except OSError:
+            same = False
+        if same and any(re.fullmatch(regex, name) for name in names):
+            return path
+    return None
+
+
+def _refuse_own_output(sources: Any, out: PathLike, ext: str, flag: str) -> None:
+    """ValueError when a source would read the pairs saved in ``out`` (:func:`_reads_own_output`):
+    each pair saved became the sequence's next frame, and the capture never ended, filling the
+    disk."""
+    looping = _reads_own_output(sources, out, ext)
+    if looping is not None:
+        raise ValueError(
+            f"{flag} {out}: the source {looping} would read the pairs saved there as its next "
+            "frames, without end; save them in another folder"
+        )
+
+
 def _end_reason(exc: SourceError, saved: list[tuple[Path, Path]], last_index: int) -> str:
     """``"end of stream"`` when both sources ended together as announced; else what ended
     (:meth:`StereoCamera.read`'s words) and, for a file that ended early, which saved pair holds
@@ -1460,6 +1500,8 @@ def cmd_capture(args: argparse.Namespace) -> int:
             "--every and --temporal: give one (--temporal saves a pair per still view)"
         )
     check_output_folder(args.output, "-o")  # before the cameras are opened
+    if not args.from_bag:
+        _refuse_own_output({"left": args.left, "right": args.right}, args.output, ".png", "-o")
     cam = open_source(args, fps=args.fps)
     try:
         print(cam.describe())
