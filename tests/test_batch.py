@@ -665,3 +665,39 @@ def test_batch_starts_no_more_workers_than_pairs(data_dir: Path, tmp_path: Path)
     args = ["batch", str(root), "-o", str(out), "--workers", "4", "--max-disparity", "16"]
     assert main(args) == 0
     assert _summary(out)["run"]["scheduler"] == "LocalCluster(2 worker processes)"
+
+
+def test_a_large_summary_is_not_rewritten_after_every_pair(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A summary that takes 0.5 s to write (10000 pairs), pairs finishing every 0.125 s: written
+    once ten times its writing time has passed, not after each pair (that made a long run
+    quadratic: 0.5 s a pair at 10000 pairs); what is held back is written by flush()."""
+    import stereovision.batch as batch
+
+    clock = [0.0]
+    monkeypatch.setattr(batch.time, "monotonic", lambda: clock[0])
+    real_dump = batch.json.dump
+
+    def slow_dump(*args: Any, **kwargs: Any) -> None:
+        clock[0] += 0.5  # the write of a large summary
+        real_dump(*args, **kwargs)
+
+    monkeypatch.setattr(batch.json, "dump", slow_dump)
+    summary = batch._Summary(tmp_path)
+    writes = []
+    for k in range(100):
+        summary.pairs[f"p{k}"] = {"status": "done"}
+        before = clock[0]
+        summary.record()
+        if clock[0] != before:
+            writes.append(k)
+        clock[0] += 0.125  # the next pair
+    # written after the first pair, then each time 5 s (10 x 0.5 s) had passed since
+    assert writes == [0, 40, 80]
+    assert len(_summary(tmp_path)["pairs"]) == 81
+    summary.flush()
+    assert len(_summary(tmp_path)["pairs"]) == 100
+    clock[0] += 1.0
+    summary.flush()  # nothing left: not written again
+    assert clock[0] == 0.5 * 4 + 100 * 0.125 + 1.0

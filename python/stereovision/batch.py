@@ -6,7 +6,8 @@ image bytes and returns the output files' bytes, so workers need neither the inp
 folder -- a multi-node cluster works without a shared filesystem. The client (this process) writes
 each finished pair into ``OUT/<name>/`` atomically (a hidden temporary folder renamed into place;
 into a folder already there, each file renamed over its own name, the rest of the folder kept)
-and records it in ``OUT/summary.json`` (itself replaced atomically after every pair).
+and records it in ``OUT/summary.json`` (itself replaced atomically after every pair, or at most a
+tenth of the time for a large one).
 
 A re-run skips the pairs the summary records as done whose inputs (size, modification time) and
 options are unchanged and whose folder still exists, without starting a cluster when nothing is
@@ -63,6 +64,10 @@ IN_FLIGHT_PER_WORKER = 2
 #: Seconds between the plain progress lines written when stderr is not a terminal (there is
 #: also one every tenth of the pairs).
 PROGRESS_SECONDS = 10.0
+#: The summary is rewritten after a finished pair once this many times the duration of its last
+#: write has passed since (after every pair for a small one; at most a tenth of the time goes to
+#: rewriting a large one).
+SAVE_COST_RATIO = 10.0
 #: Seconds to wait for an existing scheduler.
 CONNECT_TIMEOUT = "10s"
 _SUMMARY_VERSION = 1
@@ -434,11 +439,15 @@ class BatchInterrupted(KeyboardInterrupt):
 
 
 class _Summary:
-    """``OUT/summary.json``: one entry per pair, rewritten atomically after every change."""
+    """``OUT/summary.json``: one entry per pair, rewritten atomically after every change
+    (:meth:`save`), or after a finished pair once enough time has passed (:meth:`record`)."""
 
     def __init__(self, out: Path, log: Callable[[str], None] | None = None) -> None:
         self.path = out / SUMMARY_NAME
         self.log = log
+        self._dirty = False  # changes recorded but not yet written
+        self._cost = 0.0  # seconds the last save took
+        self._saved_at = -math.inf  # time.monotonic() at its end
         self.data: dict[str, Any] = {"version": _SUMMARY_VERSION, "pairs": {}}
         if self.path.is_file():
             try:
@@ -460,9 +469,25 @@ class _Summary:
                 self.log(f"{folder} is gone (moved or deleted?): made again for the pairs to come")
             folder.mkdir(parents=True, exist_ok=True)
 
+    def record(self) -> None:
+        """Write the summary after a finished pair, unless the last write ended less than
+        :data:`SAVE_COST_RATIO` times its own duration ago: a small summary is written after
+        every pair, a large one no more than a tenth of the time (every pair rewrote all of it:
+        0.5 s at 10000 pairs, a quadratic cost that throttled a long run to a few pairs a
+        second). The run's end, an interrupt or an error writes what is left (:meth:`flush`)."""
+        self._dirty = True
+        if time.monotonic() - self._saved_at >= SAVE_COST_RATIO * self._cost:
+            self.save()
+
+    def flush(self) -> None:
+        """Write the changes :meth:`record` has not written yet."""
+        if self._dirty:
+            self.save()
+
     def save(self) -> None:
         from stereovision.io import atomic_write
 
+        t0 = time.monotonic()
         pairs = self.pairs.values()
         self.ensure_folder()
         self.data["counts"] = {
@@ -471,6 +496,9 @@ class _Summary:
         with atomic_write(self.path, "w") as fh:
             json.dump(self.data, fh, indent=1, sort_keys=False)
             fh.write("\n")
+        self._dirty = False
+        self._saved_at = time.monotonic()
+        self._cost = self._saved_at - t0
 
 
 def _unchanged(entry: dict[str, Any] | None, fp: dict[str, Any], opts: dict[str, Any]) -> bool:
@@ -957,7 +985,7 @@ def _run_jobs(
             )
             failed.append(job.name)
             run["failed"] = len(failed)
-            summary.save()
+            summary.record()
             bar.update(failed=True)
             if log is not None:
                 log(f"failed {job.name}: {entry['error']}")
@@ -988,7 +1016,7 @@ def _run_jobs(
                 entry.pop("error", None)
                 processed.append(job.name)
                 run["processed"] = len(processed)
-                summary.save()
+                summary.record()
                 bar.update()
             fut.release()
             while len(futures) < limit and submit_next():
@@ -996,6 +1024,7 @@ def _run_jobs(
     finally:
         bar.close()
         dask.close(list(futures))
+        summary.flush()  # what record() held back, whatever stopped the run
 
 
 # ---------------------------------------------------------------------------------------- CLI
