@@ -701,3 +701,35 @@ def test_a_large_summary_is_not_rewritten_after_every_pair(
     clock[0] += 1.0
     summary.flush()  # nothing left: not written again
     assert clock[0] == 0.5 * 4 + 100 * 0.125 + 1.0
+
+
+def test_batch_refuses_to_replace_the_outputs_of_another_input(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A second drive whose pairs have the first one's names, into the same -o: refused before
+    any work, one line (the first drive's outputs were replaced without a word). The same input
+    with a changed image is still redone, and the first input moved elsewhere is skipped."""
+    one, two, out = tmp_path / "drive1", tmp_path / "drive2", tmp_path / "out"
+    names = [f"seq/{i:04d}_{s}.png" for i in range(2) for s in ("left", "right")]
+    _tiny(one, data_dir, *names)
+    _tiny(two, data_dir, *names)
+    cv2.imwrite(str(two / "seq/0001_left.png"), np.zeros((64, 96, 3), np.uint8))
+    args = ["--workers", "1", "--max-disparity", "16"]
+    assert main(["batch", str(one), "-o", str(out), *args]) == 0
+    before = _tree(out)
+    capsys.readouterr()
+    assert main(["batch", str(two), "-o", str(out), *args]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err == [
+        f"stereovision: error: output folder {out} holds the outputs of 2 pair(s) of the same "
+        f"names made from other images, in {one} (e.g. seq/0000 from "
+        f"{one / 'seq/0000_left.png'}); give another output folder, or remove "
+        f"{out / SUMMARY_NAME} to replace them"
+    ]
+    assert _tree(out) == before and _summary(out)["input"] == str(one)
+    os.utime(one / "seq/0001_left.png", ns=(1, 1))  # the same input, an image changed
+    assert main(["batch", str(one), "-o", str(out), *args]) == 0
+    assert _summary(out)["run"]["processed"] == 1
+    shutil.move(one, tmp_path / "moved")  # the input moved: its pairs are done, skipped
+    assert main(["batch", str(tmp_path / "moved"), "-o", str(out), *args]) == 0
+    assert _summary(out)["run"]["skipped"] == 2

@@ -712,8 +712,9 @@ def run_batch(
     FileNotFoundError, NotADirectoryError
         A missing input folder or calibration file.
     ValueError
-        Bad ``workers`` / ``max_disparity``, no pair under the input, or an output folder that
-        is a file (or below one).
+        Bad ``workers`` / ``max_disparity``, no pair under the input, an output folder that
+        is a file (or below one), or one holding the outputs of pairs of the same names that
+        a run over another input folder made from other images (they would be replaced).
     PermissionError
         If the output folder cannot be written.
     OSError
@@ -753,6 +754,8 @@ def run_batch(
     out = Path(output_dir)
     out.mkdir(parents=True, exist_ok=True)
     summary = _Summary(out, log)
+    # the input folder of the runs that wrote OUT before (None for a new OUT)
+    earlier_input = summary.data.get("input") if summary.pairs else None
     opts: dict[str, Any] = {"method": method, "max_disparity": max_disparity, "fill": fill}
     if ground:  # only when asked: outputs of earlier runs without it stay valid
         opts.update(ground=True, grid=grid)
@@ -766,6 +769,7 @@ def run_batch(
     failed_before: list[str] = []
     redone: list[str] = []
     changes: set[str] = set()
+    others: list[tuple[str, str]] = []  # done from another input folder's images: (name, image)
     for job in jobs:
         fp = _fingerprint(job)
         entry = summary.pairs.get(job.name)
@@ -774,6 +778,15 @@ def run_batch(
             entry["this_run"] = "skipped"
             (skipped if entry["status"] == "done" else failed_before).append(job.name)
             continue
+        if (
+            entry is not None
+            and entry.get("status") == "done"
+            and earlier_input is not None
+            and earlier_input != summary.data["input"]
+            and entry.get("fingerprint") != fp
+            and (out / job.name / "disparity.pfm").is_file()
+        ):
+            others.append((job.name, str(entry.get("left"))))
         if (
             entry is not None
             and entry.get("status") == "done"
@@ -793,6 +806,14 @@ def run_batch(
             "fingerprint": fp,
         }
         todo.append(job)
+    if others:
+        # a second drive under the same pair names replaced the first one's outputs, unsaid
+        name, image = others[0]
+        raise ValueError(
+            f"output folder {out} holds the outputs of {len(others)} pair(s) of the same names "
+            f"made from other images, in {earlier_input} (e.g. {name} from {image}); give "
+            f"another output folder, or remove {out / SUMMARY_NAME} to replace them"
+        )
     if redone and log is not None:
         shown = sorted(changes)[:3] + (["..."] if len(changes) > 3 else [])
         log(
