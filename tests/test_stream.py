@@ -617,3 +617,21 @@ def test_stream_says_when_one_video_ends_first(data_dir: Path, tmp_path: Path) -
         rep = run_stream(cam, method="gabor", max_disparity=32, pipelined=False, check=False)
     cam.close()
     assert rep.frames == 3 and rep.ended == "end of stream"
+
+
+def test_a_port_in_use_is_said_with_its_number() -> None:
+    """The view's port taken (another stream): the error names the address and the way out
+    (it was "[Errno 98] Address already in use")."""
+    import errno
+
+    taken = FrameServer("127.0.0.1", 0)
+    try:
+        with pytest.raises(OSError) as info:
+            FrameServer("127.0.0.1", taken.port)
+    finally:
+        taken.close()
+    assert info.value.errno == errno.EADDRINUSE
+    assert str(info.value) == (
+        f"cannot serve the view on 127.0.0.1:{taken.port}: Address already in use (another "
+        "stream running? choose another port with --serve PORT, or --no-display)"
+    )

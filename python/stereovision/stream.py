@@ -292,7 +292,17 @@ class FrameServer:
                 except (BrokenPipeError, ConnectionResetError):
                     return
 
-        self._httpd = ThreadingHTTPServer((host, port), Handler)
+        try:
+            self._httpd = ThreadingHTTPServer((host, port), Handler)
+        except OSError as exc:
+            # "[Errno 98] Address already in use" named neither the port nor the way out
+            why = exc.strerror or str(exc)
+            err = OSError(
+                f"cannot serve the view on {host}:{port}: {why} (another stream running? "
+                "choose another port with --serve PORT, or --no-display)"
+            )
+            err.errno = exc.errno
+            raise err from None
         self._httpd.daemon_threads = True
         self._thread = threading.Thread(
             target=self._httpd.serve_forever, name="stereovision-serve", daemon=True
