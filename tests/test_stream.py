@@ -635,3 +635,24 @@ def test_a_port_in_use_is_said_with_its_number() -> None:
         f"cannot serve the view on 127.0.0.1:{taken.port}: Address already in use (another "
         "stream running? choose another port with --serve PORT, or --no-display)"
     )
+
+
+def test_a_stream_stopped_before_its_first_frame_leaves_no_empty_bag(
+    videos: dict[str, Path], data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A calibration for other frames stops the stream before its first frame: no empty bag is
+    left in the way, so the same --bag works once the calibration is fixed (it was refused:
+    "bag folder already exists")."""
+    pytest.importorskip("rosbags")
+    from rosbags.rosbag2 import Reader
+
+    wrong = data_dir / "kitti2015/000005_10/calib.txt"  # 1242x375 frames
+    bag = tmp_path / "bag"
+    src = ["--left", str(videos["left"]), "--right", str(videos["right"]), "--no-display"]
+    argv = [*src, "--frames", "2", "--max-disparity", "16", "--no-check", "--bag", str(bag)]
+    assert main(["stream", *argv, "--calib", str(wrong)]) == 2
+    assert "another aspect ratio" in capsys.readouterr().err
+    assert not bag.exists()
+    assert main(["stream", *argv, "--calib", str(videos["calib"])]) == 0
+    with Reader(bag) as reader:
+        assert {c.topic: c.msgcount for c in reader.connections}["/stereo/depth"] == 2

@@ -965,6 +965,13 @@ def cmd_stream(args: argparse.Namespace) -> int:
             server.close()
         if bag is not None:
             bag.close()  # a bag cut short by Ctrl-C or an error is still a valid bag
+            if bag.messages == 0:
+                # a run stopped before its first frame (a calibration for other frames, a
+                # source that does not open) left an empty bag in the way: the next run with the
+                # same --bag was refused ("bag folder already exists")
+                import shutil
+
+                shutil.rmtree(bag.path, ignore_errors=True)
     summary = report.as_dict()
     skipped = getattr(cam, "skipped", 0)
     if skipped:
