@@ -762,3 +762,25 @@ def test_capture_of_a_bag_without_a_pair_is_an_error(
 
     with BagCamera(bag) as cam, pytest.raises(SourceError, match="without a partner"):
         capture(cam, tmp_path / "more")
+
+
+@pytest.mark.parametrize("flavour", ["ros2", "mcap"])
+def test_a_ros2_bag_without_its_metadata_is_read(
+    cones: Any, tmp_path: Path, flavour: str, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """A recorder killed before writing metadata.yaml: the folder is read from its storage
+    files (it was "not a readable ROS 1 or ROS 2 bag: Expected metadata file ...", and
+    `ros2 bag reindex` needs ROS)."""
+    from stereovision.rosbag import is_bag
+
+    frames, _ = _jittered(cones, 14)
+    bag = write_bag(tmp_path / "rig", frames, flavour=flavour)
+    (bag / "metadata.yaml").unlink()
+    assert is_bag(bag)
+    with BagCamera(bag) as cam:
+        got = list(cam.frames())
+    kept = [k for k in range(14) if k not in (5, 9)]
+    assert cam.stamps_ns == [T0 + k * PERIOD_NS for k in kept]
+    np.testing.assert_array_equal(got[-1].right, frames[13][3])
+    code, out, _ = run("capture", "--from-bag", str(bag), "-o", str(tmp_path / "pairs"))
+    assert code == 0 and out.splitlines()[-1].startswith(f"{len(kept)} pairs saved in ")

@@ -490,9 +490,14 @@ ENCODINGS = tuple(sorted(_ENCODINGS))
 def _bag_paths(path: Path) -> list[Path]:
     """The files rosbags opens for ``path``: a ROS 2 bag folder as it is; a folder of ROS 1
     ``.bag`` files (a recording split by ``rosbag record --split``) as all of them, in name
-    order; a ``.bag`` file alone."""
+    order; a ROS 2 bag folder without its ``metadata.yaml`` (a recorder killed before writing
+    it) as its ``.db3`` or ``.mcap`` files (it was "not a readable bag": ``ros2 bag reindex``
+    needs ROS); a ``.bag`` file alone."""
     if path.is_dir() and not (path / "metadata.yaml").is_file():
         parts = sorted(path.glob("*.bag"))
+        if parts:
+            return parts
+        parts = sorted(path.glob("*.db3")) or sorted(path.glob("*.mcap"))
         if parts:
             return parts
     return [path]
@@ -587,12 +592,15 @@ def to_8bit(*images: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def is_bag(path: str | os.PathLike[str]) -> bool:
     """Does ``path`` name a ROS bag: a ``.bag`` file, a folder of them (a split recording), a
-    ROS 2 bag folder (``metadata.yaml``) or one of its files?"""
+    ROS 2 bag folder (``metadata.yaml``; or its ``.db3`` / ``.mcap`` files without it) or one of
+    its files?"""
     p = Path(path)
     if p.is_file() and p.suffix == ".bag":
         return True
     folder = p if p.is_dir() else p.parent
-    return (folder / "metadata.yaml").is_file() or (p.is_dir() and any(p.glob("*.bag")))
+    if (folder / "metadata.yaml").is_file():
+        return True
+    return p.is_dir() and any(any(p.glob(f"*{ext}")) for ext in (".bag", ".db3", ".mcap"))
 
 
 def _rate(count: int, reader: Any) -> float:
