@@ -784,3 +784,20 @@ def test_a_ros2_bag_without_its_metadata_is_read(
     np.testing.assert_array_equal(got[-1].right, frames[13][3])
     code, out, _ = run("capture", "--from-bag", str(bag), "-o", str(tmp_path / "pairs"))
     assert code == 0 and out.splitlines()[-1].startswith(f"{len(kept)} pairs saved in ")
+
+
+def test_a_size_of_another_shape_does_not_stretch_a_recording(cones: Any, tmp_path: Path) -> None:
+    """--size 450x200 for 450x375 frames: kept at 450x375 with a warning, as for cameras
+    (`capture --size`: "frames of the same shape are resized"); they were stretched."""
+    bag = write_bag(tmp_path / "rig", [(T0, cones.left, T0, cones.right)], encoding="png")
+    with (
+        BagCamera(bag, size="450x200") as cam,
+        pytest.warns(
+            UserWarning,
+            match=r"size 450x200 is another shape than the recording's "
+            r"450x375: its frames are kept at 450x375",
+        ),  # fmt: skip
+    ):
+        frame = cam.read()
+    np.testing.assert_array_equal(frame.left, cones.left)
+    np.testing.assert_array_equal(frame.right, cones.right)

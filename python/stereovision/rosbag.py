@@ -693,7 +693,9 @@ class BagCamera(PairSource):
         Largest stamp difference of a pair. Default: half the frame period of the faster topic
         (from the first :data:`PERIOD_SAMPLE` frames' stamps), so a frame pairs at most once.
     size : tuple of int or str, optional
-        Resize the frames to ``(width, height)``. Default: as recorded.
+        Resize the frames to ``(width, height)``; a size of another shape than the recording's
+        is not applied (a resize would stretch the frames), with a warning. Default: as
+        recorded.
     realtime : bool
         Play the recording at its own pace, as a live camera would deliver it: each read waits
         for the next pair's time, and gives the newest pair whose time has come, skipping those
@@ -873,11 +875,23 @@ class BagCamera(PairSource):
         refused, as :class:`~stereovision.capture.StereoCamera` refuses it (a resize stretched
         it silently: a 450x300 right topic came out as 450x375 beside a 450x375 left one, and
         every depth or calibration made of it was wrong); one of the same shape and another
-        size is resized with one warning per side, unless ``size`` asked for it."""
+        size is resized with one warning per side, unless ``size`` asked for it. A ``size`` of
+        another shape than the first frame's is dropped, with a warning."""
         h, w = img.shape[:2]
         self.delivered_size[side] = (w, h)
         if self._shape is None:
             self._shape = (w, h)
+            rw, rh = self.size or (w, h)
+            if abs((w / h) / (rw / rh) - 1) > 0.01:
+                # as StereoCamera (and `capture --size`'s help) has it: a size of another
+                # shape would stretch the frames, so they keep theirs (they were stretched)
+                warnings.warn(
+                    f"size {rw}x{rh} is another shape than the recording's {w}x{h}: its frames "
+                    f"are kept at {w}x{h} (a resize would stretch them)",
+                    UserWarning,
+                    stacklevel=4,
+                )
+                self.size = (w, h)
         if self.size is None:
             self.size = (w, h)
         sw, sh = self._shape
