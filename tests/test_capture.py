@@ -533,23 +533,23 @@ def test_truncated_video_is_named_and_its_last_pair_too(tmp_path: Path) -> None:
 def test_atomic_pair_writes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     out = tmp_path / "pairs"
     img = _numbered(7, (640, 480))
-    real_replace = os.replace
+    real_link = os.link
     seen: list[tuple[str, str]] = []
 
-    def checked_replace(src: Any, dst: Any) -> None:
+    def checked_link(src: Any, dst: Any) -> None:
         src, dst = Path(src), Path(dst)
-        assert src.parent == dst.parent  # same directory: a rename, never a copy
+        assert src.parent == dst.parent  # same directory: a link, never a copy
         assert src.name.startswith(".") and src.name.endswith(".tmp")
         assert not dst.exists()  # the final name appears only complete
-        assert cv2.imread(str(src)) is not None  # temp file complete before the rename
+        assert cv2.imread(str(src)) is not None  # temp file complete before the link
         seen.append((src.name, dst.name))
-        real_replace(src, dst)
+        real_link(src, dst)
 
-    monkeypatch.setattr(os, "replace", checked_replace)
+    monkeypatch.setattr(os, "link", checked_link)
     lp, rp = save_pair(out, 1, img, img)
     assert [d for _, d in seen] == ["left_0001.png", "right_0001.png"]  # right last
     assert np.array_equal(cv2.imread(str(lp)), img) and np.array_equal(cv2.imread(str(rp)), img)
-    monkeypatch.setattr(os, "replace", real_replace)
+    monkeypatch.setattr(os, "link", real_link)
 
     # A write failing half-way leaves no partial or temporary file.
     calls = {"n": 0}
@@ -572,14 +572,14 @@ def test_atomic_pair_writes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> 
         save_pair(out, 3, img, img, ext=".nope")
 
 
-@pytest.mark.parametrize("where", ["fdopen", "write", "fsync", "replace"])
+@pytest.mark.parametrize("where", ["fdopen", "write", "fsync", "link"])
 def test_interrupted_pair_save_leaves_no_temp_file(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, where: str
 ) -> None:
     """KeyboardInterrupt (SIGTERM in the CLI) at any step after the temporary file exists:
     it is removed, and no final name appears for the image being written."""
     img = _numbered(1)
-    real = {"fdopen": os.fdopen, "fsync": os.fsync, "replace": os.replace}
+    real = {"fdopen": os.fdopen, "fsync": os.fsync, "link": os.link}
 
     def interrupt(*args: Any, **kwargs: Any) -> Any:
         raise KeyboardInterrupt
@@ -616,8 +616,8 @@ def test_ctrl_c_never_leaves_half_a_pair(tmp_path: Path, monkeypatch: pytest.Mon
     import signal
 
     img = _numbered(1)
-    real_fsync, real_replace = os.fsync, os.replace
-    calls = {"fsync": 0, "replace": 0}
+    real_fsync, real_link = os.fsync, os.link
+    calls = {"fsync": 0, "link": 0}
 
     def fsync_with_ctrl_c(fd: int) -> None:
         calls["fsync"] += 1
@@ -632,13 +632,13 @@ def test_ctrl_c_never_leaves_half_a_pair(tmp_path: Path, monkeypatch: pytest.Mon
     assert sorted(p.name for p in tmp_path.iterdir()) == ["left_0001.png", "right_0001.png"]
     assert np.array_equal(cv2.imread(str(tmp_path / "right_0001.png")), img)
 
-    def replace_interrupted(src: Any, dst: Any) -> None:
-        calls["replace"] += 1
-        if calls["replace"] == 2:  # the right image's rename
+    def link_interrupted(src: Any, dst: Any) -> None:
+        calls["link"] += 1
+        if calls["link"] == 2:  # the right image's naming
             raise KeyboardInterrupt
-        real_replace(src, dst)
+        real_link(src, dst)
 
-    monkeypatch.setattr(os, "replace", replace_interrupted)
+    monkeypatch.setattr(os, "link", link_interrupted)
     with pytest.raises(KeyboardInterrupt):
         save_pair(tmp_path, 2, img, img)
     monkeypatch.undo()
@@ -1065,3 +1065,41 @@ def test_capture_refuses_to_save_into_the_sequence_it_reads(
         result = capture(cam, pairs)
     assert [p[0].name for p in result.saved] == ["left_0004.png", "left_0005.png", "left_0006.png"]
     assert result.ended == "end of stream"
+
+
+def test_two_captures_into_one_folder_never_overwrite_a_pair(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Another capture saves pair 2 while this one runs: this one's pairs take the next free
+    numbers, the other's pair is kept (a rename replaced it: two captures into one folder lost
+    pairs, or mixed one's left image with the other's right). save_pair never replaces a
+    file, on a filesystem without hard links too."""
+    out = tmp_path / "pairs"
+    left, right = _videos(tmp_path, 4, 4)
+    other = _numbered(99)
+    real_save = capmod.save_pair
+
+    def save_after_the_other(directory: Any, index: int, *args: Any, **kw: Any) -> Any:
+        if index == 2 and not (out / "left_0002.png").exists():
+            real_save(directory, 2, other, other)  # the other capture, just before
+        return real_save(directory, index, *args, **kw)
+
+    monkeypatch.setattr(capmod, "save_pair", save_after_the_other)
+    with StereoCamera(left, right) as cam:
+        result = capture(cam, out)
+    assert [p[0].name for p in result.saved] == [f"left_{i:04d}.png" for i in (1, 3, 4, 5)]
+    for side in ("left", "right"):
+        assert np.array_equal(cv2.imread(str(out / f"{side}_0002.png")), other)
+    assert [_read_stamp(cv2.imread(str(lp))) for lp, _ in result.saved] == [0, 1, 2, 3]
+    assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == []
+    monkeypatch.undo()
+
+    def no_links(src: Any, dst: Any) -> None:
+        raise PermissionError(1, "Operation not permitted")  # FAT, exFAT
+
+    monkeypatch.setattr(os, "link", no_links)
+    with pytest.raises(FileExistsError):
+        save_pair(out, 2, _numbered(5), _numbered(5))
+    assert np.array_equal(cv2.imread(str(out / "left_0002.png")), other)
+    assert save_pair(out, 6, other, other)[1].name == "right_0006.png"
+    assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == []

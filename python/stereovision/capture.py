@@ -9,9 +9,10 @@ latches the frames), then *retrieve* (decode) both, and each grab is timestamped
 left/right skew can be measured and reported.
 
 Saved pairs are numbered ``left_0001.png`` / ``right_0001.png``; each file is encoded in memory,
-written to a temporary file in the destination directory and renamed over its final name with
-:func:`os.replace`, so a reader never sees a half-written image. The right image of a pair is
-written last: a pair is complete when its right image exists.
+written to a temporary file in the destination directory and then given its final name (a hard
+link, which never replaces a file: two captures into one folder take turns for the numbers), so a
+reader never sees a half-written image. The right image of a pair is written last: a pair is
+complete when its right image exists.
 
 In chessboard mode (:class:`ChessboardCollector`) a pair is saved only when both cameras see the
 board and its pose -- ``(x, y, size, skew)`` as in ROS's ``camera_calibration`` -- differs enough
@@ -30,6 +31,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import errno
 import glob
 import math
 import os
@@ -972,12 +974,16 @@ _TMP_RE = re.compile(r"^\.(?:left|right)_\d+\.[A-Za-z0-9]+\.(?:(\d+)-)?[a-z0-9_]
 
 
 def _atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to a temporary file beside ``path``, then rename it over ``path``.
+    """Write ``data`` to a temporary file beside ``path``, then give it the name ``path`` if
+    no file has it (:class:`FileExistsError` otherwise; another capture into the folder may
+    have saved it meanwhile).
 
     The temporary file is named before it exists, so that any exception -- KeyboardInterrupt
     included, at any point from its creation on -- removes it; its name carries this process's
     id, so that :func:`remove_stale_temps` can tell a file a killed capture left from one being
-    written."""
+    written. The name is given by a hard link, which fails on an existing file (a rename
+    replaced it: two captures into one folder overwrote each other's pairs); on a filesystem
+    without hard links (FAT), by a rename after a check."""
     tmp = path.with_name(f".{path.name}.{os.getpid()}-{secrets.token_hex(4)}.tmp")
     try:
         fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0), 0o666)
@@ -985,11 +991,20 @@ def _atomic_write_bytes(path: Path, data: bytes) -> None:
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
-        os.replace(tmp, path)
+        try:
+            os.link(tmp, path)
+        except FileExistsError:
+            raise
+        except OSError:  # no hard links here
+            if os.path.lexists(path):
+                raise FileExistsError(errno.EEXIST, "file exists", str(path)) from None
+            os.replace(tmp, path)
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
         raise
+    with contextlib.suppress(OSError):
+        os.unlink(tmp)
 
 
 def _pid_alive(pid: int) -> bool:
@@ -1047,12 +1062,12 @@ def save_pair(
     """Save a pair atomically as ``left_NNNN.ext`` and ``right_NNNN.ext``.
 
     Both images are encoded in memory first; each is then written to a temporary file in
-    ``directory`` (``.left_0001.png.<pid>-<random>.tmp``) and renamed over its final name
-    (``os.replace``), left first, right last. Ctrl-C (and SIGTERM where Python handles it) is
-    held until both are written; a failure of the right image removes the left one, so a pair
-    is saved whole or not at all. Any exception, KeyboardInterrupt included, removes the
-    temporary file; one that a killed process left is removed by the next :func:`capture` into
-    the folder (:func:`remove_stale_temps`).
+    ``directory`` (``.left_0001.png.<pid>-<random>.tmp``) and given its final name, left
+    first, right last; an existing file is never replaced. Ctrl-C (and SIGTERM where Python
+    handles it) is held until both are written; a failure of the right image removes the left
+    one, so a pair is saved whole or not at all. Any exception, KeyboardInterrupt included,
+    removes the temporary file; one that a killed process left is removed by the next
+    :func:`capture` into the folder (:func:`remove_stale_temps`).
 
     Parameters
     ----------
@@ -1074,6 +1089,8 @@ def save_pair(
     ------
     ValueError
         If an image cannot be encoded in that format.
+    FileExistsError
+        If ``left_NNNN`` or ``right_NNNN`` exists (nothing of this pair is left behind).
     OSError
         If writing fails (no partial file, and no half pair, is left behind).
     """
@@ -1396,7 +1413,12 @@ def capture(
                 continue
         elif frame.index % every:
             continue
-        paths = save_pair(out, index, frame.left, frame.right, ext=ext)
+        while True:
+            try:
+                paths = save_pair(out, index, frame.left, frame.right, ext=ext)
+                break
+            except FileExistsError:  # another capture into the folder took this number
+                index = max(index + 1, next_pair_index(out))
         saved.append(paths)
         last_index = frame.index
         index += 1
