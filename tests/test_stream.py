@@ -635,6 +635,9 @@ def test_a_port_in_use_is_said_with_its_number() -> None:
         f"cannot serve the view on 127.0.0.1:{taken.port}: Address already in use (another "
         "stream running? choose another port with --serve PORT, or --no-display)"
     )
+    with pytest.raises(OSError, match=r"cannot serve the view on no\.such\.host\.invalid:0: .* "
+                                      r"\(check --host, or --no-display\)$"):  # fmt: skip
+        FrameServer("no.such.host.invalid", 0)
 
 
 def test_a_stream_stopped_before_its_first_frame_leaves_no_empty_bag(

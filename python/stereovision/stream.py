@@ -296,11 +296,15 @@ class FrameServer:
             self._httpd = ThreadingHTTPServer((host, port), Handler)
         except OSError as exc:
             # "[Errno 98] Address already in use" named neither the port nor the way out
+            import errno
+
             why = exc.strerror or str(exc)
-            err = OSError(
-                f"cannot serve the view on {host}:{port}: {why} (another stream running? "
-                "choose another port with --serve PORT, or --no-display)"
+            hint = (
+                "another stream running? choose another port with --serve PORT, or --no-display"
+                if exc.errno == errno.EADDRINUSE
+                else "check --host, or --no-display"
             )
+            err = OSError(f"cannot serve the view on {host}:{port}: {why} ({hint})")
             err.errno = exc.errno
             raise err from None
         self._httpd.daemon_threads = True
