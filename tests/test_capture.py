@@ -1103,3 +1103,44 @@ def test_two_captures_into_one_folder_never_overwrite_a_pair(
     assert np.array_equal(cv2.imread(str(out / "left_0002.png")), other)
     assert save_pair(out, 6, other, other)[1].name == "right_0006.png"
     assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == []
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+@pytest.mark.parametrize(
+    ("sig", "status", "what"), [(2, 130, "interrupted"), (15, 143, "terminated (SIGTERM)")]
+)
+def test_cli_capture_stopped_says_what_it_kept(
+    tmp_path: Path, sig: int, status: int, what: str
+) -> None:
+    """Ctrl-C or SIGTERM mid-capture: one line saying how many pairs were saved and kept (it
+    said "stereovision: interrupted" alone), every pair whole."""
+    import signal
+
+    left, right = _videos(tmp_path, 400, 400)
+    out = tmp_path / "pairs"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "stereovision", "capture", "--left", str(left), "--right",
+         str(right), "-o", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )  # fmt: skip
+    try:
+        assert proc.stdout is not None
+        for line in proc.stdout:
+            if line.startswith("saved left_0005.png"):
+                break
+        proc.send_signal(signal.Signals(sig))
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == status
+    n = len(list(out.glob("left_*.png")))
+    assert n >= 5 and len(list(out.glob("right_*.png"))) == n
+    assert err.splitlines() == [
+        f"stereovision: {what}: {n} pairs saved in {out} this run are kept; run again to add more"
+    ]
+    assert all(cv2.imread(str(p)) is not None for p in out.iterdir())
+    assert not [p for p in out.iterdir() if p.name.startswith(".")]

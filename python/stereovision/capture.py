@@ -38,6 +38,7 @@ import os
 import re
 import secrets
 import statistics
+import sys
 import time
 import warnings
 from collections import deque
@@ -1525,6 +1526,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
     if not args.from_bag:
         _refuse_own_output({"left": args.left, "right": args.right}, args.output, ".png", "-o")
     cam = open_source(args, fps=args.fps)
+    first = next_pair_index(args.output)
     try:
         print(cam.describe())
         result = capture(
@@ -1537,6 +1539,19 @@ def cmd_capture(args: argparse.Namespace) -> int:
             log=print,
             temporal=args.temporal,
         )
+    except KeyboardInterrupt as exc:
+        # what was kept, as `batch` says it (it was "stereovision: interrupted" alone)
+        from stereovision._interrupt import Terminated
+        from stereovision.cli import EXIT_INTERRUPTED, EXIT_TERMINATED
+
+        what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
+        n = next_pair_index(args.output) - first  # the pair being saved is saved whole
+        print(
+            f"stereovision: {what}: {n} pairs saved in {args.output} this run are kept; run "
+            "again to add more",
+            file=sys.stderr,
+        )
+        return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
     finally:
         cam.close()
     sk = result.skew
