@@ -706,3 +706,15 @@ def test_report_chart_ticks_are_round_and_labels_stay_readable() -> None:
     assert not (box == orange).all(axis=1).any()
     assert (box == 255).all(axis=1).mean() > 0.5 and (box == 150).all(axis=1).any()
     assert (img[:, x1 + 1 :] == orange).all()  # nothing drawn past the box
+
+
+def test_a_grid_read_off_the_image_is_no_board() -> None:
+    """OpenCV's left08.jpg read as 8x4 inner corners: the exhaustive detector returned corners
+    outside the image, and cornerSubPix raised cv2.error (the CLI's "internal error ... please
+    report this" for a --pattern typo)."""
+    if not DATA.is_dir():
+        pytest.skip(f"chessboard data not found at {DATA}")
+    gray = cv2.imread(str(DATA / "left08.jpg"), cv2.IMREAD_GRAYSCALE)
+    assert find_corners(gray, (8, 4)) is None
+    found = find_corners(gray, (9, 6))
+    assert found is not None and found.shape == (54, 2)

@@ -380,14 +380,23 @@ def find_corners(image: npt.ArrayLike, pattern: tuple[int, int] = (9, 6)) -> F64
     # checkChessboard (~2 ms) is a quick look for a board: it saw all 26 sample boards; when it
     # sees none, only the first flag set is tried (each SB call on a board-less image is ~0.5 s).
     flag_sets = SB_FLAG_SETS if cv2.checkChessboard(gray, pattern) else SB_FLAG_SETS[:1]
+    h, w = gray.shape[:2]
+
+    def inside(c: Any) -> bool:
+        # The detectors can return a grid with corners off the image (left08.jpg of OpenCV's
+        # samples read as 8x4 by the exhaustive SB pass): not a board, and cornerSubPix
+        # raised cv2.error on it.
+        p = np.asarray(c, np.float64).reshape(-1, 2)
+        return bool(np.all(np.isfinite(p)) and np.all((p >= 0) & (p <= (w - 1, h - 1))))
+
     for flags in flag_sets:
         ok, c = cv2.findChessboardCornersSB(gray, pattern, flags=flags)
-        if ok:
+        if ok and inside(c):
             found = np.asarray(c, np.float32).reshape(-1, 1, 2)
             break
     if found is None:
         ok, c = cv2.findChessboardCorners(gray, pattern, flags=CLASSIC_FLAGS)
-        if not ok:
+        if not ok or not inside(c):
             return None
         found = np.asarray(c, np.float32).reshape(-1, 1, 2)
     spacing = _min_spacing(found.reshape(-1, 2).astype(np.float64), pattern)
