@@ -718,3 +718,27 @@ def test_a_grid_read_off_the_image_is_no_board() -> None:
     assert find_corners(gray, (8, 4)) is None
     found = find_corners(gray, (9, 6))
     assert found is not None and found.shape == (54, 2)
+
+
+def test_a_pattern_smaller_than_the_board_is_refused(tmp_path: Path) -> None:
+    """OpenCV's 9x6 boards given as 8x6: the detector finds an 8x6 part of each board, not the
+    same part in every image, and the calibration was written (12 of 13 pairs, right RMS 0.36
+    px for 0.19, |dy| up to 3.1 px, one pair flagged an outlier and kept). Now the column of
+    corners past the grid is seen and the error says so, in the CLI's words there; the right
+    pattern still calibrates."""
+    left, right = _chessboard_paths()
+    with pytest.raises(
+        ValueError,
+        match=r"^pattern=\(8, 6\): the board has more inner corners than that \(a column of "
+        r"corners continues past the grid found in 7 of the 7 boards found\); .*\(at least 9x6\)",
+    ):
+        calibrate(left[:4], right[:4], pattern=(8, 6), square_size=1.0)
+    args = _parser().parse_args(
+        ["calibrate", "--left", *map(str, left[:4]), "--right", *map(str, right[:4]),
+         "--pattern", "8x6", "--square", "25", "--unit", "mm", "-o", str(tmp_path / "c.yaml")]
+    )  # fmt: skip
+    with pytest.raises(ValueError, match=r"^--pattern 8x6: the board has more inner corners"):
+        args.func(args)
+    assert not (tmp_path / "c.yaml").exists()
+    _, rep = calibrate(left[:4], right[:4], pattern=(9, 6), square_size=1.0)
+    assert len(rep.used_pairs) == 4 and not rep.rejected_pairs

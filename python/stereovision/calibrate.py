@@ -10,7 +10,9 @@ Pipeline (:func:`calibrate`):
    with a window sized to the board's square in that image (:data:`SUBPIX_WINDOW_FRACTION`): on
    OpenCV's sample pairs this lowers the per-camera RMS from 0.25 px (SB alone) and 0.41-0.46 px
    (classic + the usual fixed 11x11 window) to 0.18 px. The right corners are put in the same
-   order as the left ones.
+   order as the left ones. A chessboard whose grid continues past the corners found (a pattern
+   given smaller than the board: 8x6 for a 9x6 board) is refused, as a pattern error when most
+   boards do.
 2. **Each camera alone** (``cv2.calibrateCamera``), with a distortion model chosen by
    leave-one-view-out cross-validation (``distortion="auto"``, see :data:`DISTORTION_MODELS`).
 3. **Extrinsics** (``cv2.stereoCalibrate`` with ``CALIB_FIX_INTRINSIC``), then an optional joint
@@ -340,6 +342,56 @@ def _sides_are_x_junctions(gray: np.ndarray, corners: F64, pattern: tuple[int, i
         if 2 * bad > len(side):
             return False
     return True
+
+
+def _grid_continues(gray: np.ndarray, corners: F64, pattern: tuple[int, int]) -> tuple[bool, bool]:
+    """Whether the board has more inner corners than ``pattern`` past the grid found.
+
+    One grid step beyond each side of the detected corners, a correct pattern reaches the board's
+    outer edge (squares against the white margin: no X-junctions); a pattern smaller than the
+    board (8x6 given for a 9x6 board) reaches another row or column of X-junctions. A side
+    continues when most of its extrapolated points inside the image are X-junctions (the test
+    of :func:`_sides_are_x_junctions`).
+
+    Returns
+    -------
+    tuple of bool
+        ``(more columns, more rows)``: a column continues past the left or right side, a row
+        past the top or bottom.
+    """
+    cols, rows = pattern
+    g = corners.reshape(rows, cols, 2)
+    img = gray.astype(np.float32)
+    h, w = img.shape[:2]
+    a = RING_SAMPLE_FRACTION
+
+    def is_x(p: F64, u: F64, v: F64) -> bool:
+        ring = [p + a * (u + v), p + a * (u - v), p - a * (u + v), p - a * (u - v)]
+        if any(not (1 <= q[0] < w - 2 and 1 <= q[1] < h - 2) for q in ring):
+            return False
+        s1, s2, s3, s4 = (
+            float(cv2.getRectSubPix(img, (3, 3), (float(q[0]), float(q[1]))).mean()) for q in ring
+        )
+        contrast = abs((s1 + s3) - (s2 + s4)) / 2
+        return bool(contrast > 0 and max(abs(s1 - s3), abs(s2 - s4)) < X_JUNCTION_RATIO * contrast)
+
+    def side_continues(edge: F64, in1: F64, in2: F64, along: F64) -> bool:
+        # edge: the side's corners, in1 and in2 the next two lines in, along: the step along the
+        # side. The step outward is extrapolated to second order (perspective shrinks or grows
+        # the squares across the board).
+        step = (edge - in1) + ((edge - in1) - (in1 - in2))
+        hits = sum(is_x(edge[k] + step[k], along[k], step[k]) for k in range(len(edge)))
+        return 2 * hits > len(edge)
+
+    row_step: F64 = np.asarray(np.gradient(g, axis=1))  # along a row (to the next column)
+    col_step: F64 = np.asarray(np.gradient(g, axis=0))  # along a column (to the next row)
+    more_rows = side_continues(g[0], g[1], g[2], row_step[0]) or side_continues(
+        g[-1], g[-2], g[-3], row_step[-1]
+    )
+    more_cols = side_continues(g[:, 0], g[:, 1], g[:, 2], col_step[:, 0]) or side_continues(
+        g[:, -1], g[:, -2], g[:, -3], col_step[:, -1]
+    )
+    return more_cols, more_rows
 
 
 def find_corners(image: npt.ArrayLike, pattern: tuple[int, int] = (9, 6)) -> F64 | None:
@@ -1192,6 +1244,8 @@ def calibrate(
     corner_ids: list[npt.NDArray[np.int64] | None] = []
     short: dict[int, str] = {}  # pairs whose boards were seen, but not enough of them in common
     full_ids = np.arange(pat[0] * pat[1], dtype=np.int64)
+    # chessboards found, and those whose grid continues past a side (a pattern too small)
+    n_boards = n_more_cols = n_more_rows = 0
     sample: tuple[int, np.ndarray, np.ndarray] | None = None
     for item in (*lefts, *rights):
         if isinstance(item, (str, os.PathLike)) and not Path(item).is_file():
@@ -1234,6 +1288,17 @@ def calibrate(
         else:
             # (findChessboardCornersSB already runs on all cores: no thread pool here)
             cl, cr = find_corners(gl, pat), find_corners(gr, pat)
+            for gray, found in ((gl, cl), (gr, cr)):
+                if found is not None:
+                    n_boards += 1
+                    more_cols, more_rows = _grid_continues(gray, found, pat)
+                    n_more_cols += more_cols
+                    n_more_rows += more_rows
+                    if more_cols or more_rows:
+                        short[i] = (
+                            f"the board continues past the {pat[0]}x{pat[1]} corners found: it "
+                            "has more inner corners than the pattern"
+                        )
             if cl is not None and cr is not None:
                 cr = _match_order(cl, cr, pat)
         if cl is not None and cr is not None and sample is None and i not in short:
@@ -1242,6 +1307,17 @@ def calibrate(
         corners_r.append(cr)
         corner_ids.append(ids)
     assert size is not None
+    n_more = max(n_more_cols, n_more_rows)
+    if n_more and 2 * n_more >= n_boards:
+        # A grid smaller than the board is found somewhere on it, a different part of the board
+        # in each image: the corners' board coordinates are then wrong.
+        bigger = (pat[0] + (2 * n_more_cols >= n_boards), pat[1] + (2 * n_more_rows >= n_boards))
+        raise ValueError(
+            f"pattern=({pat[0]}, {pat[1]}): the board has more inner corners than that (a "
+            f"{'column' if n_more_cols >= n_more_rows else 'row'} of corners continues past the "
+            f"grid found in {n_more} of the {n_boards} boards found); count the points where four "
+            f"squares meet along a row and along a column (at least {bigger[0]}x{bigger[1]})"
+        )
     pair_names = _pair_names(left_names, right_names, names)
     differ = _numbers_differ(left_names, right_names, pair_names)
     if differ:
@@ -2100,6 +2176,7 @@ def _cli_words(text: str) -> str:
     text = text.replace("the board's square size", "--square")
     text = text.replace("legacy=True", "--legacy").replace("legacy=False", "--no-legacy")
     text = re.sub(r"\bdictionary='(\w+)'", r"--dictionary \1", text)
+    text = re.sub(r"\bpattern=\((\d+), (\d+)\)", r"--pattern \1x\2", text)
     return re.sub(r"\bunit='(\w+)'", r"--unit \1", text)
 
 
