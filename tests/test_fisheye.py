@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import stereovision as sv
-from stereovision.calibrate import calibrate
+from stereovision.calibrate import _cli_words, calibrate
 from stereovision.calibration import Calibration
 from stereovision.charuco import CharucoBoard, render_charuco
 from stereovision.synthetic import render_plane
@@ -187,8 +187,18 @@ def test_fisheye_calibration_recovers_the_rig(views: Any, tmp_path: Path) -> Non
     assert np.median(dy) < 0.08 and np.percentile(dy, 95) < 0.25
     page = rep.write(tmp_path)["html"].read_text()  # the report's pictures through the model
     assert "model fisheye" in rep.summary() and page.count("data:image/png;base64,") >= 3
-    pin, prep = calibrate(*views, board=BOARD, distortion="auto")
+    # The pinhole model's poor fit is said, with the option that fits (it was silent).
+    with pytest.warns(
+        UserWarning,
+        match=r"^the k1k2p1p2 model fits these views with 0\.6\d\d / 0\.7\d\d px \(left / right\), "
+        r"the fisheye model with 0\.[12]\d\d / 0\.[12]\d\d px: a wide-angle lens; calibrate with "
+        r"distortion='fisheye'$",
+    ):
+        pin, prep = calibrate(*views, board=BOARD, distortion="auto")
     assert prep.rms > 2 * rep.rms
+    assert (
+        _cli_words("calibrate with distortion='fisheye'") == "calibrate with --distortion fisheye"
+    )
     assert np.percentile(_row_errors(pin), 95) > 10 * np.percentile(dy, 95)
 
 
