@@ -694,3 +694,30 @@ def test_baseline_implausible_for_its_unit_is_warned_once_and_printed_readably()
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         raw_calib(T=np.array([-4.0, 0.0, 0.0]), unit="mm")  # an endoscope's 4 mm
+
+
+def test_a_rig_whose_baseline_runs_along_a_view_is_not_rectified(tmp_path: Path) -> None:
+    """A baseline along the optical axis made stereoRectify return a negative focal length, and
+    the error blamed "K1: focal lengths must be positive, got fx=-76.7" (a matrix the user never
+    gave); a right camera turned 90 degrees (no shared view) was described as a normal rig
+    (focal length 500.6 px, 65 degrees of view, depths to 50 m). Both now name R and T and the
+    angle; ``info`` says it in one line. A slight toe-in and a 30-degree one still rectify."""
+    forward = raw_calib(T=np.array([0.001, 0.0, 0.2]))
+    with pytest.raises(
+        ValueError,
+        match=r"^R, T: the baseline \(T = \(0\.001, 0, 0\.2\) m\) is 2\.1 degrees from the left "
+        r"camera's optical axis; a stereo pair's cameras sit side by side",
+    ):
+        forward.rectified_calibration()
+    turned = raw_calib(R=cv2.Rodrigues(np.array([0.0, np.pi / 2, 0.0]))[0])
+    with pytest.raises(ValueError, match=r"is \d\.\d degrees from the left camera's optical axis"):
+        turned.describe()
+    with pytest.raises(ValueError, match=r"^R, T: the baseline"):
+        turned.rectify(np.zeros((240, 320), np.uint8), np.zeros((240, 320), np.uint8))
+    assert raw_calib().rectified_calibration().focal_px > 0
+    toe_in = raw_calib(R=cv2.Rodrigues(np.array([0.0, np.pi / 6, 0.0]))[0])
+    assert toe_in.rectified_calibration().focal_px > 0
+    from stereovision.cli import main
+
+    path = forward.save(tmp_path / "forward.yaml")
+    assert main(["info", str(path)]) == 2

@@ -55,6 +55,13 @@ CAMERA_MODELS: tuple[str, ...] = ("pinhole", "fisheye")
 ROTATION_TOL = 1e-6
 #: Relative tolerance for "equal" numbers of the two cameras of a rectified calibration.
 RECTIFIED_REL_TOL = 1e-6
+#: Smallest angle (degrees) between the baseline and either camera's optical axis that is
+#: rectified. A stereo pair's baseline runs across the views (about 90 degrees); nearer an axis,
+#: one camera looks at the other: a baseline along the view (T = (0.001, 0, 0.2)) made
+#: stereoRectify return a negative focal length ("K1: focal lengths must be positive", of a
+#: matrix the user never gave), and a right camera turned 90 degrees was rectified into a rig
+#: reported as a normal one (focal length 500.6 px, 65 degrees of view) with no shared view.
+MIN_BASELINE_AXIS_ANGLE_DEG = 45.0
 #: Middlebury prints doffs and principal points with 3 decimals: allowed mismatch (px).
 DOFFS_TOL_PX = 2e-3
 #: Format tag written into saved files.
@@ -469,9 +476,32 @@ class Calibration:
 
     # ---------------------------------------------------------------------------- rectifying
 
+    def _check_side_by_side(self) -> None:
+        """Refuse to rectify a rig whose baseline is near a camera's optical axis.
+
+        Raises
+        ------
+        ValueError
+            If the baseline is within :data:`MIN_BASELINE_AXIS_ANGLE_DEG` of either optical axis.
+        """
+        centre = -self.R.T @ self.T  # the right camera's centre, in the left camera's frame
+        b = centre / float(np.linalg.norm(centre))
+        for side, axis in (("left", np.array([0.0, 0.0, 1.0])), ("right", self.R[2])):
+            angle = math.degrees(math.acos(min(1.0, abs(float(b @ axis)))))
+            if angle < MIN_BASELINE_AXIS_ANGLE_DEG:
+                t = ", ".join(f"{float(v):.4g}" for v in self.T)
+                raise ValueError(
+                    f"R, T: the baseline (T = ({t}) {self.unit}) is {angle:.1f} degrees from the "
+                    f"{side} camera's optical axis; a stereo pair's cameras sit side by side, "
+                    f"looking the same way (the baseline at least {MIN_BASELINE_AXIS_ANGLE_DEG:g} "
+                    "degrees from each axis): check R and T, and that they map left-camera "
+                    "points to the right camera"
+                )
+
     def _stereo_rectify(self, alpha: float) -> tuple[F64, F64, F64, F64, F64]:
         key = ("stereoRectify", float(alpha))
         if key not in self._cache:
+            self._check_side_by_side()
             rig = (
                 self.K1,
                 self.D1,
