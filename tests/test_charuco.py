@@ -469,3 +469,29 @@ def test_calibrate_from_two_videos(rig: dict[str, Any], tmp_path: Path) -> None:
         calibrate_from_video(tmp_path / "none.avi", right, board=BOARD)
     with pytest.raises(ValueError, match="max_pairs"):
         calibrate_from_video(str(left), str(right), board=BOARD, max_pairs=2)
+
+
+def test_a_wrong_dictionary_or_squares_is_named_from_the_markers_seen(
+    rig: dict[str, Any],
+) -> None:
+    """The 10x7 DICT_5X5 board given as DICT_4X4_100 was "found in both images of only 0 of 4
+    pairs" with no word of why; given as 7x10 (rows first) with the dictionary found from the
+    images, the error said to give the dictionary, which was not what was wrong. Both now say
+    what the first image's markers show."""
+    left, right = rig["left"][:4], rig["right"][:4]
+    with pytest.raises(
+        ValueError,
+        match=r"found in both images of only 0 of 4 pairs; at least 3 are needed; "
+        r"left_images\[0\] shows 35 markers of DICT_5X5, not of DICT_4X4_100: give the board's "
+        r"dictionary \(e\.g\. dictionary='DICT_5X5_50'\)",
+    ):
+        calibrate(left, right, board=CharucoBoard("10x7", 0.03, 0.022, "DICT_4X4_100"))
+    with pytest.raises(
+        ValueError,
+        match=r"^the 7x10 ChArUco board was not found: left_images\[0\] shows 35 of its DICT_5X5 "
+        r"markers, but not as a 7x10-square board's: check the squares \(columns x rows\)",
+    ):
+        calibrate(left, right, board=CharucoBoard("7x10", 0.03, 0.022))
+    from stereovision.calibrate import _cli_words
+
+    assert _cli_words("(e.g. dictionary='DICT_5X5_50')") == "(e.g. --dictionary DICT_5X5_50)"

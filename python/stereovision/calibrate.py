@@ -1050,6 +1050,26 @@ def _rectified_checks(
 # ------------------------------------------------------------------------------------ loading
 
 
+def _charuco_hint(board: CharucoBoard, gray: np.ndarray, name: str) -> str:
+    """Why a ChArUco board may not be found, from the markers an image shows (``""``: none)."""
+    from stereovision.charuco import AUTO_MIN_MARKERS
+
+    seen, count = board.markers_seen(gray)
+    if count < AUTO_MIN_MARKERS:
+        return ""
+    family = seen.rsplit("_", 1)[0]
+    if board.dictionary != "auto" and not board.dictionary.startswith(family + "_"):
+        return (
+            f"{name} shows {count} markers of {family}, not of {board.dictionary}: give the "
+            f"board's dictionary (e.g. dictionary='{seen}')"
+        )
+    return (
+        f"{name} shows {count} of its {family} markers, but not as a "
+        f"{board.squares[0]}x{board.squares[1]}-square board's: check the squares (columns x "
+        "rows) and the marker size"
+    )
+
+
 def _load_gray(item: object, what: str) -> tuple[np.ndarray, str | None]:
     """Grey uint8 image from a path or an array; the file name when it was a path."""
     from stereovision._validate import as_gray_uint8
@@ -1290,8 +1310,11 @@ def calibrate(
                 raise ValueError(f"{item}: is a folder, not an image file; list its images")
             raise FileNotFoundError(f"image file not found: {item}")
 
+    first_gray: np.ndarray | None = None
     for i, (li, ri) in enumerate(zip(lefts, rights, strict=True)):
         gl, nl = _load_gray(li, f"left_images[{i}]")
+        if first_gray is None:
+            first_gray = gl
         gr, nr = _load_gray(ri, f"right_images[{i}]")
         left_names.append(nl)
         right_names.append(nr)
@@ -1386,8 +1409,17 @@ def calibrate(
     board_text = (
         f"chessboard {pat[0]}x{pat[1]} inner corners" if board is None else board.describe(unit)
     )
+    board_hint = ""  # a ChArUco board not found: what the first image's markers tell
+    if (
+        board is not None
+        and first_gray is not None
+        and (not board.resolved or len(used) < MIN_PAIRS)
+    ):
+        board_hint = _charuco_hint(board, first_gray, first_name)
     if board is not None and not board.resolved:
         squares = f"{board.squares[0]}x{board.squares[1]}"
+        if board_hint:
+            raise ValueError(f"the {squares} ChArUco board was not found: {board_hint}")
         if board.dictionary == "auto":
             raise ValueError(
                 f"no image shows enough markers of the {squares} ChArUco board to tell its "
@@ -1404,6 +1436,7 @@ def calibrate(
         raise ValueError(
             f"the {board_text} was found in both images of only {len(used)} of "
             f"{len(lefts)} pairs; at least {MIN_PAIRS} are needed"
+            + (f"; {board_hint}" if board_hint else "")
             + (f" (rejected: {', '.join(rejected)})" if rejected else "")
         )
 

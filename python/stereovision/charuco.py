@@ -274,6 +274,36 @@ class CharucoBoard:
             )
         return np.asarray(cv_board.generateImage(size, marginSize=mg, borderBits=1))
 
+    def markers_seen(self, image: npt.ArrayLike) -> tuple[str, int]:
+        """The dictionary family that decodes most of this board's marker ids in an image.
+
+        Parameters
+        ----------
+        image : array_like
+            Grey or BGR image.
+
+        Returns
+        -------
+        str, int
+            The family's smallest dictionary that holds the board's markers (``""`` if none
+            decodes any) and how many markers with the board's ids it decodes.
+        """
+        from stereovision._validate import as_gray_uint8
+
+        gray = as_gray_uint8(image, "image")
+        best, best_count = "", 0
+        for members in DICTIONARY_FAMILIES.values():
+            fitting = [name for name, size in members if size >= self.n_markers]
+            if not fitting:
+                continue
+            name = fitting[0]
+            det = cv2.aruco.ArucoDetector(_dictionary(name))
+            _, ids, _ = det.detectMarkers(gray)
+            n = 0 if ids is None else int(np.count_nonzero(ids.ravel() < self.n_markers))
+            if n > best_count:
+                best, best_count = name, n
+        return best, best_count
+
     def resolve(self, image: npt.ArrayLike) -> CharucoBoard | None:
         """The board with its dictionary and layout found from one image (None if not seen).
 
@@ -287,17 +317,7 @@ class CharucoBoard:
         gray = as_gray_uint8(image, "image")
         board = self
         if board.dictionary == "auto":
-            best, best_count = "", 0
-            for members in DICTIONARY_FAMILIES.values():
-                fitting = [name for name, size in members if size >= self.n_markers]
-                if not fitting:
-                    continue
-                name = fitting[0]
-                det = cv2.aruco.ArucoDetector(_dictionary(name))
-                _, ids, _ = det.detectMarkers(gray)
-                n = 0 if ids is None else int(np.count_nonzero(ids.ravel() < self.n_markers))
-                if n > best_count:
-                    best, best_count = name, n
+            best, best_count = self.markers_seen(gray)
             if best_count < AUTO_MIN_MARKERS:
                 return None
             board = replace(board, dictionary=best)
