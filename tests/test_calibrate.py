@@ -742,3 +742,17 @@ def test_a_pattern_smaller_than_the_board_is_refused(tmp_path: Path) -> None:
     assert not (tmp_path / "c.yaml").exists()
     _, rep = calibrate(left[:4], right[:4], pattern=(9, 6), square_size=1.0)
     assert len(rep.used_pairs) == 4 and not rep.rejected_pairs
+
+
+def test_a_folding_distortion_model_is_warned_about(cached_corners: None) -> None:
+    """distortion='rational' on OpenCV's pairs fits the corners (0.178 px) but its left model
+    turns back inside the image (the rectified field of view 54.8 x 43.2 degrees for k1k2p1p2's
+    63.6 x 49.9); "auto" never picks such a model, a model asked for was written silently."""
+    left, right = _chessboard_paths()
+    with pytest.warns(
+        UserWarning,
+        match=r"^the rational distortion model of the left camera is not monotonic over the "
+        r"image: it folds the outer part of the image back inward",
+    ):
+        cal, _ = calibrate(left, right, pattern=(9, 6), square_size=1.0, distortion="rational")
+    assert not calmod._radial_is_monotonic(cal.K1, cal.D1, cal.image_size)

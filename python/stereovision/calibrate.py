@@ -1493,6 +1493,20 @@ def calibrate(
     _check_pairing(
         sol, [pair_names[i] for i in used], [d for d in differ if d not in rejected], drop_outliers
     )
+    folded = [
+        side
+        for side, K, D in (("left", sol.K1, sol.D1), ("right", sol.K2, sol.D2))
+        if sol.model != "fisheye" and not _radial_is_monotonic(K, D, size)
+    ]
+    if folded:
+        warnings.warn(
+            f"the {sol.model} distortion model of the {' and '.join(folded)} camera is not "
+            "monotonic over the image: it folds the outer part of the image back inward, and the "
+            "rectified images lose or repeat it; calibrate with distortion='auto' (or a simpler "
+            "model), or add views with the board near the image corners",
+            UserWarning,
+            stacklevel=2,
+        )
     if sol.model != "fisheye" and max(sol.rms_left, sol.rms_right) > FISHEYE_HINT_MIN_RMS_PX:
         fish = _fisheye_mono_rms(
             [obj_pts[corner_ids[i]] for i in used],  # type: ignore[index]
