@@ -744,15 +744,25 @@ def test_a_pattern_smaller_than_the_board_is_refused(tmp_path: Path) -> None:
     assert len(rep.used_pairs) == 4 and not rep.rejected_pairs
 
 
-def test_a_folding_distortion_model_is_warned_about(cached_corners: None) -> None:
+def test_a_folding_distortion_model_is_warned_about(
+    chessboard: tuple[Calibration, CalibrationReport], cached_corners: None, tmp_path: Path
+) -> None:
     """distortion='rational' on OpenCV's pairs fits the corners (0.178 px) but its left model
     turns back inside the image (the rectified field of view 54.8 x 43.2 degrees for k1k2p1p2's
-    63.6 x 49.9); "auto" never picks such a model, a model asked for was written silently."""
+    63.6 x 49.9); "auto" never picks such a model, a model asked for was written silently. The
+    warning is also in the report's files and at the top of its page (the report had none)."""
     left, right = _chessboard_paths()
-    with pytest.warns(
-        UserWarning,
-        match=r"^the rational distortion model of the left camera is not monotonic over the "
-        r"image: it folds the outer part of the image back inward",
-    ):
-        cal, _ = calibrate(left, right, pattern=(9, 6), square_size=1.0, distortion="rational")
+    said = (
+        "the rational distortion model of the left camera is not monotonic over the image: it "
+        "folds the outer part of the image back inward"
+    )
+    with pytest.warns(UserWarning, match="^" + re.escape(said)):
+        cal, rep = calibrate(left, right, pattern=(9, 6), square_size=1.0, distortion="rational")
     assert not calmod._radial_is_monotonic(cal.K1, cal.D1, cal.image_size)
+    assert len(rep.warnings) == 1 and rep.warnings[0].startswith(said)
+    paths = rep.write(tmp_path)
+    page = paths["html"].read_text()
+    assert page.index("<h2>Warnings</h2><ul><li>" + said) < page.index("<h2>Key figures</h2>")
+    assert json.loads(paths["json"].read_text())["warnings"] == rep.warnings
+    assert chessboard[1].warnings == []
+    assert "<h2>Warnings</h2>" not in calmod._render_html(chessboard[1])

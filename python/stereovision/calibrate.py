@@ -589,6 +589,9 @@ class CalibrationReport:
         :meth:`~stereovision.charuco.CharucoBoard.describe`).
     corners_used : int
         Corners used over all pairs (each seen by both cameras).
+    warnings : list of str
+        The warnings :func:`calibrate` gave about this calibration (a lens the model does not
+        fit, a model that folds the image, file numbers that differ), also on the HTML page.
     """
 
     rms: float
@@ -618,6 +621,7 @@ class CalibrationReport:
     focal_right: float
     board: str = "chessboard"
     corners_used: int = 0
+    warnings: list[str] = field(default_factory=list)
     # Data for the pictures; not part of the serialised report.
     _calibration: Any = field(default=None, repr=False, compare=False)
     _corners: dict[str, tuple[F64, F64]] = field(default_factory=dict, repr=False, compare=False)
@@ -1050,6 +1054,12 @@ def _rectified_checks(
 # ------------------------------------------------------------------------------------ loading
 
 
+def _warn(notes: list[str], message: str, category: type[Warning], stacklevel: int) -> None:
+    """Give a warning of :func:`calibrate`'s caller and keep it for the report."""
+    notes.append(message)
+    warnings.warn(message, category, stacklevel=stacklevel + 1)
+
+
 def _charuco_hint(board: CharucoBoard, gray: np.ndarray, name: str) -> str:
     """Why a ChArUco board may not be found, from the markers an image shows (``""``: none)."""
     from stereovision.charuco import AUTO_MIN_MARKERS
@@ -1294,6 +1304,7 @@ def calibrate(
 
     size: tuple[int, int] | None = None
     first_name = ""
+    notes: list[str] = []  # the warnings given, for the report
     left_names: list[str | None] = []
     right_names: list[str | None] = []
     corners_l: list[F64 | None] = []
@@ -1387,7 +1398,8 @@ def calibrate(
             if len(differ) > WORST_PAIRS_SHOWN
             else ""
         )
-        warnings.warn(
+        _warn(
+            notes,
             f"the left and right file numbers differ in {shown}{more}: the pairs are taken in "
             "order, so a missing or extra file shifts the pairing",
             UserWarning,
@@ -1499,7 +1511,8 @@ def calibrate(
         if sol.model != "fisheye" and not _radial_is_monotonic(K, D, size)
     ]
     if folded:
-        warnings.warn(
+        _warn(
+            notes,
             f"the {sol.model} distortion model of the {' and '.join(folded)} camera is not "
             "monotonic over the image: it folds the outer part of the image back inward, and the "
             "rectified images lose or repeat it; calibrate with distortion='auto' (or a simpler "
@@ -1518,7 +1531,8 @@ def calibrate(
             f * FISHEYE_HINT_GAIN < p
             for f, p in zip(fish, (sol.rms_left, sol.rms_right), strict=True)
         ):
-            warnings.warn(
+            _warn(
+                notes,
                 f"the {sol.model} model fits these views with {sol.rms_left:.3f} / "
                 f"{sol.rms_right:.3f} px (left / right), the fisheye model with {fish[0]:.3f} / "
                 f"{fish[1]:.3f} px: a wide-angle lens; calibrate with distortion='fisheye'",
@@ -1586,6 +1600,7 @@ def calibrate(
         focal_right=float(sol.K2[0, 0]),
         board=board_text,
         corners_used=sum(len(ix) for ix in used_ids),
+        warnings=notes,
         _calibration=cal,
         _corners={pair_names[i]: (corners_l[i], corners_r[i]) for i in used},  # type: ignore[misc]
         _ids={pair_names[i]: corner_ids[i] for i in used},  # type: ignore[misc]
@@ -2107,7 +2122,14 @@ def _render_html(rep: CalibrationReport) -> str:
         '<!DOCTYPE html><html lang="en"><head><meta charset="utf-8">'
         f"<title>Stereo calibration report</title><style>{style}</style></head><body>"
         "<h1>Stereo calibration report</h1>"
-        f"<h2>Key figures</h2>{_html_table(key, ('figure', 'value'))}"
+        + (
+            "<h2>Warnings</h2><ul>"
+            + "".join(f"<li>{html.escape(w)}</li>" for w in rep.warnings)
+            + "</ul>"
+            if rep.warnings
+            else ""
+        )
+        + f"<h2>Key figures</h2>{_html_table(key, ('figure', 'value'))}"
         f"<h2>Pairs</h2>{_html_table(pairs, _PAIR_COLUMNS)}"
         f"<h2>Pictures</h2>{fig_html}<h2>Calibration</h2>{mats}"
         "</body></html>\n"
@@ -2368,6 +2390,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
             if text not in seen:
                 seen.add(text)
                 warnings.warn(text, w.category, stacklevel=1)
+    rep.warnings[:] = [_cli_words(w) for w in rep.warnings]  # the report in the CLI's words
     cal.save(out)
     print(rep.summary(drop_option=DROP_OUTLIERS_CLI))
     print(cal.describe())
