@@ -766,3 +766,17 @@ def test_a_folding_distortion_model_is_warned_about(
     assert json.loads(paths["json"].read_text())["warnings"] == rep.warnings
     assert chessboard[1].warnings == []
     assert "<h2>Warnings</h2>" not in calmod._render_html(chessboard[1])
+
+
+def test_a_folding_fisheye_model_is_warned_about(cached_corners: None) -> None:
+    """OpenCV's pairs (a narrow lens) through distortion='fisheye': both cameras' theta_d
+    turns back before the image corners (left: peak 0.656 at 40 degrees, 0.79 needed), and
+    the corners' rays came out at 90 degrees; it was written without a word."""
+    left, right = _chessboard_paths()
+    with pytest.warns(
+        UserWarning,
+        match=r"^the fisheye distortion model of the left and right cameras is not monotonic",
+    ):
+        cal, rep = calibrate(left, right, pattern=(9, 6), square_size=1.0, distortion="fisheye")
+    assert cal.model == "fisheye" and len(rep.warnings) == 1
+    assert not calmod._fisheye_is_monotonic(cal.K1, cal.D1, cal.image_size)

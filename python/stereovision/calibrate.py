@@ -815,6 +815,23 @@ def _radial_is_monotonic(K: F64, D: F64, size: tuple[int, int]) -> bool:
     return bool(reach.max() >= rd_max)
 
 
+def _fisheye_is_monotonic(K: F64, D: F64, size: tuple[int, int]) -> bool:
+    """True if ``cv2.fisheye``'s ``theta_d = theta (1 + k1 theta^2 + ... + k4 theta^8)`` grows
+    from the centre out to the image's corners (else the outer image has no ray, and folds)."""
+    k1, k2, k3, k4 = (list(np.asarray(D, np.float64).ravel()) + [0.0] * 4)[:4]
+    w, h = size
+    corners = np.array([[0, 0], [w - 1, 0], [0, h - 1], [w - 1, h - 1]], np.float64)
+    xn = (corners[:, 0] - K[0, 2]) / K[0, 0]
+    yn = (corners[:, 1] - K[1, 2]) / K[1, 1]
+    rd_max = float(np.hypot(xn, yn).max()) * MONOTONIC_RADIUS_MARGIN
+    t = np.linspace(0.0, math.pi, 4000)
+    t2 = t * t
+    td = t * (1 + k1 * t2 + k2 * t2**2 + k3 * t2**3 + k4 * t2**4)
+    turn = np.nonzero(np.diff(td) <= 0)[0]
+    reach = td if turn.size == 0 else td[: turn[0] + 1]
+    return bool(reach.max() >= rd_max)
+
+
 def _fisheye_unusable(
     obj: Sequence[np.ndarray],
     left: Sequence[np.ndarray],
@@ -1508,12 +1525,15 @@ def calibrate(
     folded = [
         side
         for side, K, D in (("left", sol.K1, sol.D1), ("right", sol.K2, sol.D2))
-        if sol.model != "fisheye" and not _radial_is_monotonic(K, D, size)
+        if not (_fisheye_is_monotonic if sol.model == "fisheye" else _radial_is_monotonic)(
+            K, D, size
+        )
     ]
     if folded:
         _warn(
             notes,
-            f"the {sol.model} distortion model of the {' and '.join(folded)} camera is not "
+            f"the {sol.model} distortion model of the {' and '.join(folded)} camera"
+            f"{'s' if len(folded) == 2 else ''} is not "
             "monotonic over the image: it folds the outer part of the image back inward, and the "
             "rectified images lose or repeat it; calibrate with distortion='auto' (or a simpler "
             "model), or add views with the board near the image corners",
