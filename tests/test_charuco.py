@@ -492,6 +492,12 @@ def test_a_wrong_dictionary_or_squares_is_named_from_the_markers_seen(
         r"markers, but not as a 7x10-square board's: check the squares \(columns x rows\)",
     ):
         calibrate(left, right, board=CharucoBoard("7x10", 0.03, 0.022))
+    # Boards found, only too few pairs: no word of dictionary or squares.
+    with pytest.raises(ValueError) as err:
+        calibrate(left[:2], right[:2], board=BOARD)
+    assert str(err.value).endswith(
+        "found in both images of only 2 of 2 pairs; at least 3 are needed"
+    )
     from stereovision.calibrate import _cli_words
 
     assert _cli_words("(e.g. dictionary='DICT_5X5_50')") == "(e.g. --dictionary DICT_5X5_50)"

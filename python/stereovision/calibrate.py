@@ -1442,7 +1442,9 @@ def calibrate(
     if (
         board is not None
         and first_gray is not None
-        and (not board.resolved or len(used) < MIN_PAIRS)
+        and len(used) < MIN_PAIRS
+        and not short  # boards seen, but too few corners in common: not the board's words
+        and all(c is None for c in (*corners_l, *corners_r))
     ):
         board_hint = _charuco_hint(board, first_gray, first_name)
     if board is not None and not board.resolved:
