@@ -146,7 +146,7 @@ def test_help_says_where_to_start_and_every_option_what_it_is() -> None:
     helps = {name: " ".join(sub.format_help().split()) for name, sub in subs.choices.items()}
     for name in ("demo", "depth", "eval"):
         assert "matcher (default fused, the most accurate;" in helps[name], name
-    assert "timed runs per case (default 5)" in helps["bench"]  # README: "default 5"
+    assert "timed runs per case, at least 5 (default 5)" in helps["bench"]  # README: "default 5"
     assert "view port (default 8765)" in helps["stream"]  # README: 127.0.0.1:8765
 
 
