@@ -528,16 +528,26 @@ def test_cli_mispaired_says_the_option(
     out = tmp_path / "rig.yaml"
     argv = ["calibrate", "--left", str(tmp_path / "left*.jpg"), "--right",
             str(tmp_path / "right*.jpg"), "--square", "0.025", "-o", str(out)]  # fmt: skip
+    # With their own names the pairs are made on the numbers: the two alone are named, first.
     args = _parser().parse_args(argv)
-    with pytest.warns(UserWarning), pytest.raises(ValueError) as err:
+    with pytest.raises(ValueError, match=r"left06\.jpg \(no right\), right05\.jpg \(no left\)"):
+        args.func(args)
+    assert not out.exists()
+    # Numbered by position (one camera's frame dropped, the numbering went on): the stereo
+    # RMS refuses the mis-paired set, in the CLI's words.
+    for p in tmp_path.glob("*.jpg"):
+        p.unlink()
+    for side, paths in (("left", left), ("right", right)):
+        for i, p in enumerate(paths, 1):
+            (tmp_path / f"{side}{i:02d}.jpg").symlink_to(p)
+    with pytest.raises(ValueError) as err:
         args.func(args)
     assert "--drop-outliers" in str(err.value) and "drop_outliers" not in str(err.value)
     assert not out.exists()
     args = _parser().parse_args([*argv, "--drop-outliers"])
-    with pytest.warns(UserWarning):
-        assert args.func(args) == 0
+    assert args.func(args) == 0
     text = capsys.readouterr().out
-    assert "rejected left06.jpg / right05.jpg: outlier: error 26." in text
+    assert "rejected left05.jpg / right05.jpg: outlier: error 26." in text
     assert Calibration.load(out).baseline == pytest.approx(0.083, abs=0.001)
 
 
@@ -780,3 +790,32 @@ def test_a_folding_fisheye_model_is_warned_about(cached_corners: None) -> None:
         cal, rep = calibrate(left, right, pattern=(9, 6), square_size=1.0, distortion="fisheye")
     assert cal.model == "fisheye" and len(rep.warnings) == 1
     assert not calmod._fisheye_is_monotonic(cal.K1, cal.D1, cal.image_size)
+
+
+def test_cli_pairs_images_on_their_numbers(tmp_path):
+    # One left and one other right image deleted (left05, right09): the counts still match, and
+    # sorted position paired left06..left09 with right06..right10 (every pair a wrong partner).
+    src = sorted((DATA_DIR / "chessboard").glob("*.jpg"))
+    assert len(src) >= 20, "the chessboard pairs are part of the shared data"
+    for side in ("left", "right"):
+        for f in (DATA_DIR / "chessboard").glob(f"{side}*.jpg"):
+            (tmp_path / f.name).write_bytes(f.read_bytes())
+    (tmp_path / "left05.jpg").unlink()
+    (tmp_path / "right09.jpg").unlink()
+    out = tmp_path / "rig.yaml"
+    args = _parser().parse_args(
+        ["calibrate", "--left", str(tmp_path / "left*.jpg"), "--right",
+         str(tmp_path / "right*.jpg"), "--pattern", "9x6", "--square", "0.025", "-o", str(out)]
+    )  # fmt: skip
+    with pytest.raises(ValueError, match=r"2 image\(s\) have no partner with the same number: "
+                       r"left09\.jpg \(no right\), right05\.jpg \(no left\)"):  # fmt: skip
+        args.func(args)
+    assert not out.exists()
+    # Reordered partners are found by number: the pairs are the same as sorted ones.
+    lefts = [str(tmp_path / f"left{i:02d}.jpg") for i in (1, 2, 10)]
+    rights = [str(tmp_path / f"right{i:02d}.jpg") for i in (10, 1, 2)]
+    assert calmod._pair_by_number(lefts, rights) == [rights[1], rights[2], rights[0]]
+    # Each camera's own timestamps: no common numbers, position pairing as before.
+    stamps_l = ["l_1701000000101.png", "l_1701000000201.png"]
+    stamps_r = ["r_1701000000103.png", "r_1701000000204.png"]
+    assert calmod._pair_by_number(stamps_l, stamps_r) == stamps_r

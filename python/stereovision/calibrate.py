@@ -2269,6 +2269,65 @@ def _expand(pattern: str, option: str) -> list[str]:
     return [p]
 
 
+def _frame_number(path: str) -> int | None:
+    """The last run of digits in a file's name without its suffix (``left07.jpg`` -> 7)."""
+    runs = re.findall(r"\d+", Path(path).stem)
+    return int(runs[-1]) if runs else None
+
+
+def _pair_by_number(lefts: list[str], rights: list[str]) -> list[str]:
+    """The right images in the order of their left partners, paired on the number in the name.
+
+    Sorted globs pair by position, so one left and one other right image missing (``left05``
+    and ``right09`` deleted as blurred) kept the counts equal and paired every image between
+    them with the wrong partner: a calibration from mismatched views, without a word. When
+    every name on both sides has a number, unique per side, and most numbers are on both
+    sides, the pairs are made on them and an image without a partner is refused by name.
+    Names whose numbers do not correspond (timestamps taken by each camera) keep the
+    position pairing.
+
+    Parameters
+    ----------
+    lefts, rights : list of str
+        The files ``--left`` and ``--right`` matched, sorted.
+
+    Returns
+    -------
+    list of str
+        ``rights`` reordered to follow ``lefts``, or unchanged where the names cannot pair.
+
+    Raises
+    ------
+    ValueError
+        If the numbers pair most images but some have no partner (named, the first few).
+    """
+    kl = [_frame_number(f) for f in lefts]
+    kr = [_frame_number(f) for f in rights]
+    if None in kl or None in kr or len(set(kl)) != len(kl) or len(set(kr)) != len(kr):
+        return rights
+    by_number = dict(zip(kr, rights, strict=True))
+    common = set(kl) & set(kr)
+    if len(common) == len(kl) == len(kr):
+        return [by_number[k] for k in kl]
+    if len(common) < 2 or 2 * len(common) < min(len(kl), len(kr)):
+        return rights  # numbers of their own on each side (or one file): the counts decide
+    alone = [
+        f"{os.path.basename(f)} (no right)"
+        for f, k in zip(lefts, kl, strict=True)
+        if k not in common
+    ]
+    alone += [
+        f"{os.path.basename(f)} (no left)"
+        for f, k in zip(rights, kr, strict=True)
+        if k not in common
+    ]
+    more = f" and {len(alone) - 6} more" if len(alone) > 6 else ""
+    raise ValueError(
+        f"--left / --right: {len(alone)} image(s) have no partner with the same number: "
+        f"{', '.join(alone[:6])}{more}; remove them or restore their partners"
+    )
+
+
 def _check_output_file(
     out: Path, given: str, *, ros: str | None = None, report: str | None = None
 ) -> None:
@@ -2371,6 +2430,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     if not video and not args.from_bag:
         lefts = [f for g in args.left for f in _expand(g, "--left")]
         rights = [f for g in args.right for f in _expand(g, "--right")]
+        rights = _pair_by_number(lefts, rights)
         if len(lefts) != len(rights):
             raise ValueError(f"--left matches {len(lefts)} files but --right matches {len(rights)}")
     out = Path(args.output)
@@ -2524,8 +2584,9 @@ def add_cli(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "calibrate",
         help="calibrate a stereo rig from chessboard or ChArUco pairs",
-        description="Calibrate a stereo rig from chessboard or ChArUco image pairs (sorted glob "
-        "matches are paired in order).",
+        description="Calibrate a stereo rig from chessboard or ChArUco image pairs (glob "
+        "matches are paired on the number in their names, e.g. left07 with right07, or in sorted "
+        "order where the names carry no common numbers).",
     )
     p.add_argument(
         "--left",
