@@ -733,3 +733,24 @@ def test_batch_refuses_to_replace_the_outputs_of_another_input(
     shutil.move(one, tmp_path / "moved")  # the input moved: its pairs are done, skipped
     assert main(["batch", str(tmp_path / "moved"), "-o", str(out), *args]) == 0
     assert _summary(out)["run"]["skipped"] == 2
+
+
+def test_batch_redoes_a_changed_pair_of_its_input_after_a_run_over_another_one(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Two input folders with pairs of other names share one -o; a changed image of the first
+    is redone when the first is run again (it was refused as 'made from other images, in
+    drive2', the input of the last run, though the pair's images are drive1's own)."""
+    one, two, out = tmp_path / "drive1", tmp_path / "drive2", tmp_path / "out"
+    _tiny(one, data_dir, "a/left.png", "a/right.png")
+    _tiny(two, data_dir, "b/left.png", "b/right.png")
+    args = ["--workers", "1", "--max-disparity", "16"]
+    assert main(["batch", str(one), "-o", str(out), *args]) == 0
+    assert main(["batch", str(two), "-o", str(out), *args]) == 0
+    os.utime(one / "a/left.png", ns=(1, 1))
+    capsys.readouterr()
+    assert main(["batch", str(one), "-o", str(out), *args]) == 0, capsys.readouterr().err
+    summary = _summary(out)
+    assert summary["run"]["processed"] == 1
+    assert summary["pairs"]["a"]["status"] == "done"
+    assert summary["pairs"]["b"]["status"] == "done"

@@ -21,6 +21,7 @@ processes do not take Ctrl-C themselves (they block SIGINT): the client stops th
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime as _dt
 import json
 import math
@@ -338,6 +339,15 @@ def _fingerprint(job: PairJob) -> dict[str, Any]:
         st = p.stat()
         fp[key] = [st.st_size, st.st_mtime_ns]
     return fp
+
+
+def _same_file(recorded: Any, path: Path) -> bool:
+    """Whether ``recorded`` (an image path a summary holds) names the file ``path``."""
+    if not isinstance(recorded, str):
+        return False
+    with contextlib.suppress(OSError, RuntimeError):
+        return Path(recorded).resolve() == path.resolve()
+    return False
 
 
 def _commit_pair(
@@ -783,6 +793,8 @@ def run_batch(
             and entry.get("status") == "done"
             and earlier_input is not None
             and earlier_input != summary.data["input"]
+            # its images are not this pair's: a run over another input since is not enough
+            and not _same_file(entry.get("left"), job.left)
             and entry.get("fingerprint") != fp
             and (out / job.name / "disparity.pfm").is_file()
         ):
