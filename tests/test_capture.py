@@ -1144,3 +1144,43 @@ def test_cli_capture_stopped_says_what_it_kept(
     ]
     assert all(cv2.imread(str(p)) is not None for p in out.iterdir())
     assert not [p for p in out.iterdir() if p.name.startswith(".")]
+
+
+def test_cli_capture_interrupted_counts_its_own_pairs_only(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Another capture saves pair 2 into the folder meanwhile, and Ctrl-C comes while this one
+    saves its third pair (held until the pair is whole): 3 pairs saved this run, said as such
+    (the count was the span of the numbers, 4, the other capture's pair included), and the
+    pair saved under the held Ctrl-C is said too."""
+    from stereovision.cli import main
+
+    out = tmp_path / "pairs"
+    left, right = _videos(tmp_path, 8, 8)
+    other = _numbered(99)
+    real_save = capmod.save_pair
+    own: list[int] = []
+
+    def save_beside_another(directory: Any, index: int, *args: Any, **kw: Any) -> Any:
+        if index == 2 and not (out / "left_0002.png").exists():
+            real_save(directory, 2, other, other)  # the other capture, just before
+        paths = real_save(directory, index, *args, **kw)
+        own.append(index)
+        if len(own) == 3:
+            raise KeyboardInterrupt  # as HeldInterrupts replays it once the pair is whole
+        return paths
+
+    monkeypatch.setattr(capmod, "save_pair", save_beside_another)
+    argv = ["capture", "--left", str(left), "--right", str(right), "-o", str(out)]
+    assert main(argv) == 130
+    got = capsys.readouterr()
+    assert own == [1, 3, 4]
+    assert [ln.split()[1] for ln in got.out.splitlines() if ln.startswith("saved ")] == [
+        "left_0001.png",
+        "left_0003.png",
+        "left_0004.png",
+    ]
+    assert got.err.splitlines() == [
+        f"stereovision: interrupted: 3 pairs saved in {out} this run are kept; run again to "
+        "add more"
+    ]

@@ -1420,6 +1420,14 @@ def capture(
                 break
             except FileExistsError:  # another capture into the folder took this number
                 index = max(index + 1, next_pair_index(out))
+            except KeyboardInterrupt:
+                # held while both images were written (save_pair): a pair whose right image is
+                # there is saved whole, and said so before the interrupt goes on
+                rp = out / PAIR_NAME.format(side="right", index=index, ext=ext)
+                if log is not None and rp.exists():
+                    lp = out / PAIR_NAME.format(side="left", index=index, ext=ext)
+                    log(f"saved {lp.name} {rp.name} (skew {frame.skew_ms:.2f} ms)")
+                raise
         saved.append(paths)
         last_index = frame.index
         index += 1
@@ -1526,7 +1534,13 @@ def cmd_capture(args: argparse.Namespace) -> int:
     if not args.from_bag:
         _refuse_own_output({"left": args.left, "right": args.right}, args.output, ".png", "-o")
     cam = open_source(args, fps=args.fps)
-    first = next_pair_index(args.output)
+    saved = [0]  # the pairs this run saved, as capture says them (not another capture's)
+
+    def log(line: str) -> None:
+        if line.startswith("saved "):
+            saved[0] += 1
+        print(line)
+
     try:
         print(cam.describe())
         result = capture(
@@ -1536,7 +1550,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
             chessboard=pattern,
             charuco=board,
             every=args.every,
-            log=print,
+            log=log,
             temporal=args.temporal,
         )
     except KeyboardInterrupt as exc:
@@ -1545,7 +1559,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
         from stereovision.cli import EXIT_INTERRUPTED, EXIT_TERMINATED
 
         what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
-        n = next_pair_index(args.output) - first  # the pair being saved is saved whole
+        n = saved[0]  # the pair being saved is saved whole, and said
         print(
             f"stereovision: {what}: {n} pairs saved in {args.output} this run are kept; run "
             "again to add more",
