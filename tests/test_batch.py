@@ -754,3 +754,26 @@ def test_batch_redoes_a_changed_pair_of_its_input_after_a_run_over_another_one(
     assert summary["run"]["processed"] == 1
     assert summary["pairs"]["a"]["status"] == "done"
     assert summary["pairs"]["b"]["status"] == "done"
+
+
+def test_batch_a_file_where_a_pair_folder_goes_fails_that_pair_alone(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """OUT/a is a user's file: pair a fails naming it, the file is kept, pair b is done (the
+    run stopped at '[Errno 20] Not a directory: .../.a.partial-.../disparity.png', b undone;
+    before that, the file was moved to a hidden .a.old-... name)."""
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
+    out.mkdir()
+    (out / "a").write_text("notes")
+    assert main(["batch", str(root), "-o", str(out), "--workers", "1"]) == 1
+    err = capsys.readouterr().err
+    assert (
+        f"failed a: NotADirectoryError: {out / 'a'} is a file, where the pair's output folder "
+        f"{out / 'a'} goes: move it away"
+    ) in err
+    assert (out / "a").read_text() == "notes"
+    assert (out / "b" / "disparity.pfm").is_file()
+    assert sorted(p.name for p in out.iterdir()) == ["a", "b", SUMMARY_NAME]
+    pairs = _summary(out)["pairs"]
+    assert pairs["a"]["status"] == "failed" and pairs["b"]["status"] == "done"

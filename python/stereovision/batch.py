@@ -359,11 +359,19 @@ def _commit_pair(
     into place. An existing folder is not replaced (that deleted what else it held: the folders
     of the pairs nested in it, a user's files, the input images of an output folder given as
     the input folder): each file is renamed over its own name, and of the files an earlier run
-    recorded (``previous``) those this run did not write are removed.
+    recorded (``previous``) those this run did not write are removed. A file where the folder
+    goes is a :class:`NotADirectoryError` naming it (the pair fails, the file is kept).
     """
     from stereovision.cli import DEPTH_OUTPUTS
 
     dest = out / name
+    for folder in (dest, *dest.parents):
+        if folder == out:
+            break
+        if folder.exists() and not folder.is_dir():
+            raise NotADirectoryError(
+                f"{folder} is a file, where the pair's output folder {dest} goes: move it away"
+            )
     dest.parent.mkdir(parents=True, exist_ok=True)
     tmp = dest.parent / f".{dest.name}.partial-{uuid.uuid4().hex[:8]}"
     tmp.mkdir()
@@ -1033,7 +1041,14 @@ def _run_jobs(
             else:
                 res = fut.result()
                 summary.ensure_folder()
-                _commit_pair(out, job.name, res["files"], (previous or {}).get(job.name))
+                try:
+                    _commit_pair(out, job.name, res["files"], (previous or {}).get(job.name))
+                except NotADirectoryError as err:  # a file in the way: this pair alone fails
+                    record_failure(job, err)
+                    fut.release()
+                    while len(futures) < limit and submit_next():
+                        pass
+                    continue
                 entry = summary.pairs[job.name]
                 entry.update(
                     status="done",
