@@ -256,3 +256,22 @@ def test_big_endian_images_give_the_native_result(dtype: str, data_dir: Path) ->
         want = sv.depth_map(native, r16, method="census", max_disparity=64, cloud=False)
         got = sv.depth_map(big, r16.astype(">u2"), method="census", max_disparity=64, cloud=False)
         np.testing.assert_array_equal(got.disparity, want.disparity)
+
+
+@pytest.mark.parametrize(
+    ("value", "shown"),
+    [
+        (2**70, str(2**70)),
+        (10**400, "an integer of 1329 bits"),
+        (10**5000, "an integer of 16610 bits"),
+    ],
+    ids=["2**70", "10**400", "10**5000"],
+)
+def test_int_in_range_names_the_parameter_of_a_huge_int(value: int, shown: str) -> None:
+    """An int of over 4300 digits was a ValueError about Python's integer string conversion
+    limit, naming no parameter (its repr in the message raised); it is shown by its size."""
+    from stereovision._validate import int_in_range
+
+    with pytest.raises(ValueError) as info:
+        int_in_range(value, "nms_half", 1, 2**31 - 1)
+    assert str(info.value) == f"nms_half: expected an integer from 1 to 2147483647, got {shown}"

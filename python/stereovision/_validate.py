@@ -402,7 +402,7 @@ def int_in_range(value: object, name: str, lo: int, hi: int) -> int:
     else:
         ok = False
     if not ok:
-        raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {value!r}")
+        raise ValueError(f"{name}: expected an integer from {lo} to {hi}, got {_shown(value)}")
     return int(value)  # type: ignore[call-overload]
 
 
