@@ -777,3 +777,29 @@ def test_batch_a_file_where_a_pair_folder_goes_fails_that_pair_alone(
     assert sorted(p.name for p in out.iterdir()) == ["a", "b", SUMMARY_NAME]
     pairs = _summary(out)["pairs"]
     assert pairs["a"]["status"] == "failed" and pairs["b"]["status"] == "done"
+
+
+def test_batch_reads_16_bit_files_as_depth_does(data_dir: Path, tmp_path: Path) -> None:
+    """A 12-bit camera's pair in 16-bit PNGs: batch's disparity is the one `stereovision depth`
+    writes for it (batch decoded the top 8 bits of each pixel, 0-15 of 0-4095, while depth
+    keeps the 16 bits since it reads with io.read_image)."""
+    src = data_dir / "middlebury2001/tsukuba"
+    scene = tmp_path / "in/a"
+    scene.mkdir(parents=True)
+    for side in ("left", "right"):
+        crop = cv2.imread(str(src / f"{side}.png"))[100:164, 150:246]
+        cv2.imwrite(str(scene / f"{side}.png"), crop.astype(np.uint16) * 16)
+    args = ["--max-disparity", "16"]
+    argv = [
+        "depth",
+        str(scene / "left.png"),
+        str(scene / "right.png"),
+        "-o",
+        str(tmp_path / "depth"),
+    ]
+    assert main([*argv, *args]) == 0
+    assert main(["batch", str(tmp_path / "in"), "-o", str(tmp_path / "out"), "--workers", "1",
+                 *args]) == 0  # fmt: skip
+    want = read_pfm(tmp_path / "depth/disparity.pfm")
+    got = read_pfm(tmp_path / "out/a/disparity.pfm")
+    np.testing.assert_array_equal(got, want)

@@ -258,9 +258,12 @@ def _scan(
 
 
 def _decode(name: str, data: bytes) -> Any:
-    from stereovision.io import decode_image
+    from stereovision.io import _decode_16bit, decode_image
 
-    img = decode_image(data)
+    # 16-bit files keep their 16 bits, as `stereovision depth` reads them (read_image)
+    img: Any = _decode_16bit(data)
+    if img is None:
+        img = decode_image(data)
     if img is None:
         raise ValueError(f"cannot decode {name} as an image")
     return img

@@ -337,13 +337,21 @@ def read_image(path: PathLike) -> npt.NDArray[np.uint8] | npt.NDArray[np.uint16]
         If the file cannot be decoded as an image.
     """
     p = _existing_file(path, "image file")
-    data = np.fromfile(p, dtype=np.uint8)
-    if data.size:
-        with _opencv_quiet():
-            deep = cv2.imdecode(data, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
-        if deep is not None and deep.dtype == np.uint16:
-            return np.asarray(deep, dtype=np.uint16)
-    return imread(p)
+    deep = _decode_16bit(np.fromfile(p, dtype=np.uint8))
+    return deep if deep is not None else imread(p)
+
+
+def _decode_16bit(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint16] | None:
+    """A 16-bit image file's bytes as ``uint16`` BGR (:func:`read_image`'s, and ``batch``'s,
+    as ``stereovision depth`` reads them); None for any other file."""
+    buf = np.frombuffer(data, np.uint8) if isinstance(data, bytes) else data
+    if buf.size == 0:
+        return None
+    with _opencv_quiet():
+        deep = cv2.imdecode(buf, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
+    if deep is not None and deep.dtype == np.uint16:
+        return np.asarray(deep, dtype=np.uint16)
+    return None
 
 
 # ------------------------------------------------------------------------------------------ PFM
