@@ -1184,3 +1184,32 @@ def test_cli_capture_interrupted_counts_its_own_pairs_only(
         f"stereovision: interrupted: 3 pairs saved in {out} this run are kept; run again to "
         "add more"
     ]
+
+
+def test_capture_into_a_folder_replaced_by_a_file_stops(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The output folder replaced by a file while capturing: FileExistsError, not a retry on
+    the next number without end (each save's mkdir raised FileExistsError, read as a number
+    another capture took)."""
+    import shutil
+
+    out = tmp_path / "pairs"
+    left, right = _videos(tmp_path, 6, 6)
+    real_save = capmod.save_pair
+    calls: list[int] = []
+
+    def save(directory: Any, index: int, *args: Any, **kw: Any) -> Any:
+        calls.append(index)
+        if len(calls) == 2:
+            shutil.rmtree(out)
+            out.write_text("not a folder")
+        if len(calls) > 20:
+            raise RuntimeError(f"retried without end: {calls[-3:]}")
+        return real_save(directory, index, *args, **kw)
+
+    monkeypatch.setattr(capmod, "save_pair", save)
+    with StereoCamera(left, right) as cam, pytest.raises(FileExistsError):
+        capture(cam, out)
+    assert calls == [1, 2]
+    assert out.read_text() == "not a folder"

@@ -1419,6 +1419,9 @@ def capture(
                 paths = save_pair(out, index, frame.left, frame.right, ext=ext)
                 break
             except FileExistsError:  # another capture into the folder took this number
+                taken = (PAIR_NAME.format(side=s, index=index, ext=ext) for s in ("left", "right"))
+                if not any(os.path.lexists(out / name) for name in taken):
+                    raise  # not a number taken (the folder became a file): no retry without end
                 index = max(index + 1, next_pair_index(out))
             except KeyboardInterrupt:
                 # held while both images were written (save_pair): a pair whose right image is
