@@ -722,7 +722,7 @@ def test_batch_refuses_to_replace_the_outputs_of_another_input(
     err = capsys.readouterr().err.splitlines()
     assert err == [
         f"stereovision: error: output folder {out} holds the outputs of 2 pair(s) of the same "
-        f"names made from other images, in {one} (e.g. seq/0000 from "
+        f"names made from other images (e.g. seq/0000 from "
         f"{one / 'seq/0000_left.png'}); give another output folder, or remove "
         f"{out / SUMMARY_NAME} to replace them"
     ]

@@ -834,7 +834,8 @@ def run_batch(
         name, image = others[0]
         raise ValueError(
             f"output folder {out} holds the outputs of {len(others)} pair(s) of the same names "
-            f"made from other images, in {earlier_input} (e.g. {name} from {image}); give "
+            # the example's image names its folder: the last run's input may be another one
+            f"made from other images (e.g. {name} from {image}); give "
             f"another output folder, or remove {out / SUMMARY_NAME} to replace them"
         )
     if redone and log is not None:
