@@ -4,7 +4,8 @@ scan beside OpenCV SGBM-3WAY's. One run.
 
 For each scene: the floor found in the GT disparity and in the default ``depth_map``'s (RANSAC
 in disparity space, :func:`stereovision.fit_ground_plane`), the angle between them, the
-camera's height, pitch and roll from each, and the obstacle pixels (0.15-2 m above the floor,
+camera's height, pitch and roll from each, the share of the points measurably below each
+(``GroundPlane.below_share``), and the obstacle pixels (0.15-2 m above the floor,
 within 30 m) of our map against those of the GT, on the pixels with GT. Then the rendered floor
 of tests/test_ground.py (camera 1.1 m up, pitched 12 degrees down, rolled 3).
 
@@ -93,7 +94,8 @@ def main() -> None:
             f"{name}: GT height {gt.height:.3f} m, pitch {gt.pitch_deg:+.2f}, roll "
             f"{gt.roll_deg:+.2f}; ours {ours.height:.3f} m ({dh:+.1f} %), pitch "
             f"{ours.pitch_deg:+.2f}, roll {ours.roll_deg:+.2f}; {angle:.2f} deg apart; "
-            f"{100 * ours.inlier_share:.0f} % on it, {100 * ours.below_share:.1f} % below it; "
+            f"{100 * ours.inlier_share:.0f} % on it, {100 * ours.below_share:.1f} % below it "
+            f"(GT's: {100 * gt.below_share:.1f} % below its own); "
             f"fit {1000 * dt:.0f} ms; obstacles precision "
             f"{tp / max(int(found.sum()), 1):.3f} recall {tp / max(int(truth.sum()), 1):.3f}; "
             f"on the pixels with a depth ({100 * np.isfinite(res.depth).mean():.0f} %): "
@@ -147,7 +149,10 @@ def main() -> None:
     res = sv.depth_map(scene["left"], scene["right"], tg.RIG, max_disparity=64)
     plane = fit_ground_plane(res.disparity, tg.RIG)
     assert plane is not None
-    print(f"rendered floor (true: 1.100 m, pitch +12.00, roll +3.00): {plane.describe()}")
+    print(
+        f"rendered floor (true: 1.100 m, pitch +12.00, roll +3.00): {plane.describe()}; "
+        f"{100 * plane.below_share:.1f} % below it"
+    )
 
 
 if __name__ == "__main__":
