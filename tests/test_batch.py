@@ -508,8 +508,10 @@ def test_batch_reports_an_image_without_its_pair(
     assert main(["batch", str(root / "c"), "-o", str(tmp_path / "o2")]) == 2
     assert capsys.readouterr().err.strip() == (
         f"stereovision: error: no pair under {root / 'c'} (scene folders with left.png + "
-        "right.png, or files named ...left... / ...right...); 2 image(s) without the other of "
-        f"their pair, e.g. no x_right.png beside {root / 'c/x_left.png'}"
+        "right.png, files named ...left... / ...right..., or the same file names in sibling "
+        "camera folders left/ + right/, L/ + R/, image_2/ + image_3/, cam0/ + cam1/); 2 "
+        f"image(s) without the other of their pair, e.g. no x_right.png beside "
+        f"{root / 'c/x_left.png'}"
     )
 
 
@@ -803,3 +805,94 @@ def test_batch_reads_16_bit_files_as_depth_does(data_dir: Path, tmp_path: Path) 
     want = read_pfm(tmp_path / "depth/disparity.pfm")
     got = read_pfm(tmp_path / "out/a/disparity.pfm")
     np.testing.assert_array_equal(got, want)
+
+
+def _crops(root: Path, data_dir: Path, left: list[str], right: list[str]) -> None:
+    """The 96 x 64 Tsukuba crops of :func:`_tiny`: the left image's at each of ``left``, the
+    right image's at each of ``right`` (whatever their names)."""
+    src = data_dir / "middlebury2001/tsukuba"
+    for side, names in (("left", left), ("right", right)):
+        crop = cv2.imread(str(src / f"{side}.png"))[100:164, 150:246]
+        for name in names:
+            (root / name).parent.mkdir(parents=True, exist_ok=True)
+            cv2.imwrite(str(root / name), crop)
+
+
+@pytest.mark.parametrize(
+    ("left", "right", "names"),
+    [
+        (["seq/left/0001.png", "seq/left/0002.png"], ["seq/right/0001.png", "seq/right/0002.png"],
+         ["seq/0001", "seq/0002"]),
+        (["L/a.jpg"], ["R/a.jpg"], ["a"]),
+        (["training/image_2/000000_10.png", "training/image_2/000000_11.png"],
+         ["training/image_3/000000_10.png", "training/image_3/000000_11.png"],
+         ["training/000000_10", "training/000000_11"]),
+        (["mav0/cam0/data/1403636579763555584.png"], ["mav0/cam1/data/1403636579763555584.png"],
+         ["mav0/data/1403636579763555584"]),
+    ],
+    ids=["left-right", "L-R", "kitti", "euroc"],
+)  # fmt: skip
+def test_batch_pairs_images_of_the_same_name_in_sibling_camera_folders(
+    data_dir: Path, tmp_path: Path, left: list[str], right: list[str], names: list[str]
+) -> None:
+    """left/0001.png + right/0001.png (L/ R/, KITTI's image_2/ image_3/, EuRoC's cam0/data/
+    cam1/data/) are pairs, named by the parent and the path under the camera folder, whose
+    outputs are those of the same images named x_left.png / x_right.png (they were no pairs:
+    "no pair under ..."). The other files of the folders are not images of a pair."""
+    root, out = tmp_path / "in", tmp_path / "out"
+    ext = Path(left[0]).suffix  # the reference pair's images are encoded alike (JPEG)
+    _crops(root, data_dir, [*left, f"ref_left{ext}"], [*right, f"ref_right{ext}"])
+    (root / left[0]).with_name("sensor.yaml").write_text("rate_hz: 20\n")
+    jobs = find_pairs(root)
+    assert [j.name for j in jobs] == sorted([*names, "ref"])
+    by_name = {j.name: j for j in jobs}
+    for name, lp, rp in zip(names, left, right, strict=True):
+        assert (by_name[name].left, by_name[name].right) == (root / lp, root / rp)
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    s = _summary(out)
+    assert sorted(s["pairs"]) == sorted([*names, "ref"])
+    assert s["counts"] == {"done": len(names) + 1, "failed": 0, "pending": 0}
+    ref = read_pfm(out / "ref/disparity.pfm")
+    assert np.isfinite(ref).mean() > 0.5
+    for name in names:
+        assert {p.name for p in (out / name).iterdir()} == DISPARITY_FILES
+        np.testing.assert_array_equal(read_pfm(out / name / "disparity.pfm"), ref)
+    assert main(args) == 0  # a re-run skips them all
+    assert _summary(out)["run"]["skipped"] == len(names) + 1
+
+
+def test_camera_folders_half_pairs_clashes_and_the_other_layouts(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An image in one camera folder without the other is a failed pair saying which file is
+    missing; several rigs in one folder keep their left camera's folder in the names; a clash
+    with a pair of another layout leaves that one its name; files named ...left... in camera
+    folders are paired by name as before."""
+    root, out = tmp_path / "in", tmp_path / "out"
+    old = ["s/0001_left.png", "s/0001_right.png", "s/left/x_left.png", "s/left/x_right.png",
+           "s/0001/left.png", "s/0001/right.png"]  # fmt: skip
+    _tiny(root, data_dir, *old)
+    before = [(j.name, j.left, j.right) for j in find_pairs(root)]
+    assert [n for n, *_ in before] == ["s/0001", "s/0001~2", "s/left/x"]
+    lefts = ["s/left/0001.png", "s/left/0002.png", "k/image_0/7.png", "k/image_2/7.png"]
+    rights = ["s/right/0001.png", "s/right/0003.png", "k/image_1/7.png", "k/image_3/7.png"]
+    _crops(root, data_dir, lefts, rights)
+    jobs = find_pairs(root)
+    assert [(j.name, j.left, j.right) for j in jobs if j.left.name != "0001.png"] == [
+        ("k/image_0/7", root / "k/image_0/7.png", root / "k/image_1/7.png"),
+        ("k/image_2/7", root / "k/image_2/7.png", root / "k/image_3/7.png"),
+        *before,
+    ]
+    assert jobs[4] == PairJob("s/0001~3", root / "s/left/0001.png", root / "s/right/0001.png")
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 1
+    said = capsys.readouterr()
+    assert said.out.startswith("6 processed, 0 skipped (done before), 2 failed (2 with an image ")
+    s = _summary(out)
+    for name, there, gone in (("s/0002", "left", "right"), ("s/0003", "right", "left")):
+        n = name[-4:]
+        error = f"unpaired image: no {root / f's/{gone}/{n}.png'} for {root / f's/{there}/{n}.png'}"
+        assert s["pairs"][name]["error"] == error and f"failed {name}: {error}" in said.err
+        assert s["pairs"][name]["left"] == str(root / f"s/left/{n}.png")
+    assert {p.name for p in (out / "k/image_2/7").iterdir()} == DISPARITY_FILES

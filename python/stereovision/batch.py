@@ -75,6 +75,17 @@ _SUMMARY_VERSION = 1
 _LEFT_RE = re.compile(r"left", re.IGNORECASE)
 _RIGHT_RE = re.compile(r"right", re.IGNORECASE)
 _SCENE_CALIB = "calib.txt"
+#: Sibling folders holding a rig's two cameras, left one first (matched without case): images
+#: of the same path under both are a pair (``left/0001.png`` + ``right/0001.png``; KITTI's
+#: ``image_2``/``image_3`` colour and ``image_0``/``image_1`` grey; EuRoC's ``cam0/data`` +
+#: ``cam1/data``).
+CAMERA_FOLDERS = (
+    ("left", "right"),
+    ("l", "r"),
+    ("image_2", "image_3"),
+    ("image_0", "image_1"),
+    ("cam0", "cam1"),
+)
 _GONE = "its outputs were gone at the end of the run (the output folder moved or deleted?)"
 
 
@@ -125,7 +136,15 @@ class _Unpaired:
 
     @property
     def error(self) -> str:
-        return f"unpaired image: no {self.missing.name} beside {self.present}"
+        return f"unpaired image: {self.what}"
+
+    @property
+    def what(self) -> str:
+        """``no x_right.png beside .../x_left.png``; ``no .../right/0001.png for
+        .../left/0001.png`` when the other image goes in a sibling camera folder."""
+        if self.missing.parent != self.present.parent:
+            return f"no {self.missing} for {self.present}"
+        return f"no {self.missing.name} beside {self.present}"
 
 
 def _pair_name(p: Path, m: re.Match[str], rel: str, root: Path) -> str:
@@ -141,7 +160,8 @@ def _pair_name(p: Path, m: re.Match[str], rel: str, root: Path) -> str:
 def find_pairs(
     root: str | os.PathLike[str], calib: str | os.PathLike[str] | None = None
 ) -> list[PairJob]:
-    """Every pair under ``root``: scene folders and ``...left...`` / ``...right...`` image files.
+    """Every pair under ``root``: scene folders, ``...left...`` / ``...right...`` image files and
+    the same file names in sibling camera folders.
 
     * A folder holding ``left.png`` and ``right.png`` (evaluation.md's scene layout) is one pair,
       named by its path relative to ``root`` (``root``'s own name when ``root`` is the scene);
@@ -151,6 +171,15 @@ def find_pairs(
       in its place; the pair is named by its folder and the file name without ``left`` (and
       separators around it), e.g. ``seq/0001``. Files without a counterpart are not pairs
       (:func:`run_batch` reports them as failed pairs).
+    * Two sibling camera folders (:data:`CAMERA_FOLDERS`: ``left/`` + ``right/``, ``L/`` +
+      ``R/``, KITTI's ``image_2/`` + ``image_3/`` and ``image_0/`` + ``image_1/``, EuRoC's
+      ``cam0/`` + ``cam1/``): the images of the same path under both (any depth) are a pair,
+      named by the parent folder and that path without the extension (``seq/0001`` for
+      ``seq/left/0001.png``, ``mav0/data/1403...`` for ``mav0/cam0/data/1403....png``); when
+      one folder holds several such rigs, the name keeps the left camera's folder
+      (``00/image_2/000000``). Images with ``left`` or ``right`` in their names are paired by
+      name as above; an image without the other is not a pair (reported as above). Only
+      ``calib`` applies to these pairs (no ``calib.txt`` is looked for).
 
     Parameters
     ----------
@@ -196,6 +225,8 @@ def _scan(
         Calibration.from_file(cal)
     found: list[PairJob] = []
     unpaired: list[_Unpaired] = []
+    cam_found: list[PairJob] = []  # in sibling camera folders
+    cam_unpaired: list[_Unpaired] = []
     for d, _dirs, files in os.walk(r):
         dirs = sorted(_dirs)
         _dirs[:] = [x for x in dirs if not x.startswith(".")]
@@ -234,6 +265,19 @@ def _scan(
             lp = _swap(p, m, "left")
             if lp.name not in names:
                 unpaired.append(_Unpaired(_pair_name(p, m, rel, r), p, lp, "right"))
+        cams = _camera_folders(_dirs)
+        for left_dir, right_dir in cams:
+            # several rigs in one folder (KITTI's grey image_0/1 and colour image_2/3): each
+            # pair's name keeps its left camera's folder, so that they do not take each other's
+            prefix = "/".join(
+                x for x in (rel, left_dir if len(cams) > 1 else "") if x not in ("", ".")
+            )
+            pairs, alone = _sibling_pairs(here / left_dir, here / right_dir, prefix, cal)
+            cam_found += pairs
+            cam_unpaired += alone
+    # after the other layouts' pairs, so that those keep their names in a clash (the sort is
+    # stable): camera folders' images were not pairs before
+    found += cam_found
     found.sort(key=lambda j: j.name)
     seen: dict[str, int] = {}
     unique: list[PairJob] = []
@@ -244,7 +288,8 @@ def _scan(
     # the pairs keep the names they had before these were reported; these take the next ones
     taken = {j.name for j in unique}
     named: list[_Unpaired] = []
-    for u in sorted(unpaired, key=lambda u: (u.name, u.present.name)):
+    in_order = sorted(unpaired, key=lambda u: (u.name, u.present.name))
+    for u in in_order + sorted(cam_unpaired, key=lambda u: (u.name, u.present.name)):
         name, n = u.name, 1
         while name in taken:
             n += 1
@@ -252,6 +297,58 @@ def _scan(
         taken.add(name)
         named.append(_Unpaired(name, u.present, u.missing, u.side))
     return unique, named
+
+
+def _camera_folders(dirs: list[str]) -> list[tuple[str, str]]:
+    """The pairs of :data:`CAMERA_FOLDERS` among the (non-hidden) sub-folders ``dirs``, as
+    spelt there; a folder name matching two spellings (``left`` and ``Left``) is not guessed."""
+    by_lower: dict[str, list[str]] = {}
+    for d in dirs:
+        by_lower.setdefault(d.lower(), []).append(d)
+    cams = []
+    for a, b in CAMERA_FOLDERS:
+        la, lb = by_lower.get(a, []), by_lower.get(b, [])
+        if len(la) == 1 and len(lb) == 1:
+            cams.append((la[0], lb[0]))
+    return cams
+
+
+def _named_image(f: str) -> bool:
+    """An image :func:`find_pairs` pairs by its name (``left`` or ``right`` in it)."""
+    stem = Path(f).stem
+    return _last_left(stem) is not None or _last(_RIGHT_RE, stem) is not None
+
+
+def _camera_images(folder: Path) -> set[str]:
+    """The images under ``folder`` (any depth, hidden ones excepted) not paired by their name,
+    as POSIX paths relative to it."""
+    images: set[str] = set()
+    for d, dirs, files in os.walk(folder):
+        dirs[:] = [x for x in dirs if not x.startswith(".")]
+        sub = Path(d).relative_to(folder)
+        for f in files:
+            if Path(f).suffix.lower() in IMAGE_EXTS and f[0] != "." and not _named_image(f):
+                images.add((sub / f).as_posix())
+    return images
+
+
+def _sibling_pairs(
+    left_dir: Path, right_dir: Path, prefix: str, cal: Path | None
+) -> tuple[list[PairJob], list[_Unpaired]]:
+    """The pairs of two sibling camera folders: the images of the same path under both (those
+    with ``left`` or ``right`` in their names are paired by name, as everywhere). Each is named
+    ``prefix`` + its path under the camera folder without the extension (``seq/data/0001``
+    for ``seq/cam0/data/0001.png``); an image without the other is an :class:`_Unpaired`."""
+    lefts, rights = _camera_images(left_dir), _camera_images(right_dir)
+
+    def name(sub: str) -> str:
+        short = sub.rsplit(".", 1)[0]
+        return f"{prefix}/{short}" if prefix else short
+
+    pairs = [PairJob(name(f), left_dir / f, right_dir / f, cal) for f in sorted(lefts & rights)]
+    alone = [_Unpaired(name(f), left_dir / f, right_dir / f, "left") for f in lefts - rights]
+    alone += [_Unpaired(name(f), right_dir / f, left_dir / f, "right") for f in rights - lefts]
+    return pairs, alone
 
 
 # ------------------------------------------------------------------------------- the worker
@@ -763,14 +860,14 @@ def run_batch(
     check_output_folder(output_dir, "output folder")
     if not jobs:
         alone = (
-            f"; {len(unpaired)} image(s) without the other of their pair, e.g. no "
-            f"{unpaired[0].missing.name} beside {unpaired[0].present}"
+            f"; {len(unpaired)} image(s) without the other of their pair, e.g. {unpaired[0].what}"
             if unpaired
             else ""
         )
         raise ValueError(
-            f"no pair under {input_dir} (scene folders with left.png + right.png, or "
-            f"files named ...left... / ...right...){alone}"
+            f"no pair under {input_dir} (scene folders with left.png + right.png, "
+            "files named ...left... / ...right..., or the same file names in sibling camera "
+            f"folders left/ + right/, L/ + R/, image_2/ + image_3/, cam0/ + cam1/){alone}"
         )
     out = Path(output_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -1169,13 +1266,20 @@ def add_cli(subparsers: Any) -> None:
     p = subparsers.add_parser(
         "batch",
         help="depth outputs of every pair under a folder, on Dask (local or a cluster)",
-        description="Process every scene folder (left.png + right.png) or ...left.../...right... "
-        "image pair under INPUT into OUT/<name>/ (the files `stereovision depth` writes), "
+        description="Process every pair under INPUT into OUT/<name>/ (the files `stereovision "
+        "depth` writes): scene folders (left.png + right.png, with calib.txt), image files named "
+        "...left.../...right... (seq/0001_left.png + seq/0001_right.png -> seq/0001), and images "
+        "of the same name in sibling camera folders: left/ + right/, L/ + R/, KITTI's image_2/ + "
+        "image_3/ (image_0/ + image_1/), EuRoC's cam0/ + cam1/ (seq/left/0001.png + "
+        "seq/right/0001.png -> seq/0001; mav0/cam0/data/1.png -> mav0/data/1). An image without "
+        "the other of its pair is a failed pair. Pairs are "
         "recorded in OUT/summary.json; a re-run skips finished pairs. Exit status 1 when a pair "
         "failed (its error is in the summary), 2 on errors, 130 when interrupted (Ctrl-C), 143 "
         "when terminated (SIGTERM).",
     )
-    p.add_argument("input", help="folder with scene folders or left/right image pairs")
+    p.add_argument(
+        "input", help="folder with scene folders, left/right image pairs or camera folders"
+    )
     p.add_argument("-o", "--output", required=True, help="output folder")
     p.add_argument(
         "--workers",
