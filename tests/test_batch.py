@@ -896,3 +896,38 @@ def test_camera_folders_half_pairs_clashes_and_the_other_layouts(
         assert s["pairs"][name]["error"] == error and f"failed {name}: {error}" in said.err
         assert s["pairs"][name]["left"] == str(root / f"s/left/{n}.png")
     assert {p.name for p in (out / "k/image_2/7").iterdir()} == DISPARITY_FILES
+
+
+def test_a_redo_stopped_before_a_pair_is_written_keeps_its_earlier_outputs_listed(
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A pair done with --ground, redone without it by a run stopped before the pair was
+    written: the summary still lists the earlier run's outputs (it listed none), so the next
+    run removes the ground.json it does not write (it stayed, from the run with --ground)."""
+    import stereovision.batch as batch
+
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, "a/left.png", "a/right.png")
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    # as a run with --ground left it: its ground.json written and recorded
+    (out / "a/ground.json").write_text("{}")
+    s = _summary(out)
+    entry = s["pairs"]["a"]
+    entry["outputs"] = sorted([*entry["outputs"], "ground.json"])
+    entry["options"] = {**entry["options"], "ground": True, "grid": None}
+    (out / SUMMARY_NAME).write_text(json.dumps(s))
+
+    def stopped(*_args: Any, **_kwargs: Any) -> None:
+        raise KeyboardInterrupt
+
+    with monkeypatch.context() as m:
+        m.setattr(batch, "_run_jobs", stopped)
+        with pytest.raises(batch.BatchInterrupted):
+            batch.run_batch(root, out, workers=1, max_disparity=16)
+    pending = _summary(out)["pairs"]["a"]
+    assert pending["status"] == "pending"
+    assert pending["outputs"] == sorted([*DISPARITY_FILES, "ground.json"])
+    assert main(args) == 0
+    assert {p.name for p in (out / "a").iterdir()} == DISPARITY_FILES
+    assert _summary(out)["pairs"]["a"]["outputs"] == sorted(DISPARITY_FILES)

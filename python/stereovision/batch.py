@@ -925,6 +925,10 @@ def run_batch(
             "options": opts,
             "fingerprint": fp,
         }
+        if job.name in previous:
+            # still in its folder until this run writes the pair: a run stopped before (or
+            # failing it) keeps them listed, so the next one removes those it does not write
+            summary.pairs[job.name]["outputs"] = previous[job.name]
         todo.append(job)
     if others:
         # a second drive under the same pair names replaced the first one's outputs, unsaid
@@ -945,6 +949,7 @@ def run_batch(
     failed: list[str] = []
     for u in unpaired:  # a failed pair, every run until the missing image is there
         left, right = (u.present, u.missing) if u.side == "left" else (u.missing, u.present)
+        earlier = summary.pairs.get(u.name) or {}
         summary.pairs[u.name] = {
             "status": "failed",
             "left": str(left),
@@ -954,6 +959,8 @@ def run_batch(
             "finished": _now(),
             "this_run": "failed",
         }
+        if isinstance(earlier.get("outputs"), list):  # an earlier run's, still in its folder
+            summary.pairs[u.name]["outputs"] = earlier["outputs"]
         failed.append(u.name)
         if log is not None:
             log(f"failed {u.name}: {u.error}")
