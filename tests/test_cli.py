@@ -425,3 +425,18 @@ def test_depth_keeps_same_named_files_it_did_not_write(
     assert "removed" not in capsys.readouterr().out
     for name, text in own.items():
         assert (out / name).read_text() == text, name
+
+
+def test_a_12_bit_pair_gets_one_warning_line_per_image(tmp_path: Path, data_dir: Path) -> None:
+    """A 12-bit pair in 16-bit PNGs printed four warning lines, two per image (the 8-bit copy's
+    and the grey image's conversions each warned)."""
+    src = data_dir / "middlebury2001" / "tsukuba"
+    for side in ("left", "right"):
+        crop = cv2.imread(str(src / f"{side}.png"))[100:164, 150:246]
+        cv2.imwrite(str(tmp_path / f"{side}.png"), crop.astype(np.uint16) * 16)
+    argv = ["depth", str(tmp_path / "left.png"), str(tmp_path / "right.png")]
+    argv += ["-o", str(tmp_path / "out"), "--max-disparity", "16", "--method", "fast"]
+    proc = subprocess.run([*SV, *argv], capture_output=True, text=True, check=False)
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert [line.split(":")[2] for line in lines] == [" left", " right"], proc.stderr

@@ -542,3 +542,24 @@ def test_a_16_bit_raw_pair_is_matched_on_its_own_grey_levels(data_dir: Path) -> 
     got = sv.match(*dark, raw, method="hopfield", max_disparity=32)
     assert len(got) == len(ref) > 500
     np.testing.assert_array_equal(got.to_array(), ref.to_array())
+
+
+@pytest.mark.parametrize("rectified", [None, True, False])
+def test_a_12_bit_pair_is_warned_about_once_per_image(rectified: bool | None) -> None:
+    """A 12-bit pair in uint16 was warned about twice per image (the 8-bit copy's and the grey
+    image's conversions each warned), and the warning said the matchers got about 4 bits of it
+    while they read the float grey image, all 12; only its 8-bit copy keeps 4."""
+    import warnings
+
+    left = np.rint(_texture(48, 96) * 4095).astype(np.uint16)
+    right = np.rint(_shift(_texture(48, 96), 4.0) * 4095).astype(np.uint16)
+    calib = (
+        None if rectified is None else dataclasses.replace(_rect_calib(96, 48), rectified=rectified)
+    )
+    with warnings.catch_warnings(record=True) as seen:
+        warnings.simplefilter("always")
+        sv.depth_map(left, right, calib, method="fast", max_disparity=16)
+    texts = [str(w.message) for w in seen if "uint16 image whose largest value" in str(w.message)]
+    assert sorted(t.split(":")[0] for t in texts) == ["left", "right"], texts
+    assert "the matchers read all its bits, but its 8-bit copy" in texts[0]
+    assert "keeps about 4 bits of it" in texts[0] and "leaving the matchers" not in texts[0]

@@ -111,31 +111,36 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
 
 
 #: A uint16 image whose values all lie below this is most likely 12-bit (or 8-bit) data in a
-#: 16-bit container: scaled as 16-bit, the 8-bit paths keep 4 bits of it (or none).
+#: 16-bit container: scaled as 16-bit, its 8-bit copy keeps 4 bits of it (or none). The matchers
+#: read the float grey image, all of its bits.
 LOW_UINT16_MAX = 4096
 
 
 def _warn_low_uint16(arr: np.ndarray, name: str) -> None:
     """Warn when a uint16 image uses only its lowest 12 bits: it is scaled by 65535 (by 257 to
-    8 bits), so a 12-bit camera's image reaches the matchers as 0-16 grey levels."""
+    8 bits), so its 8-bit copy (colours, the fill's colour segments, the automatic range's
+    features) has 0-16 grey levels of a 12-bit camera's image; the matchers read all its bits."""
     import warnings
 
     top = int(arr.max())
     if top < LOW_UINT16_MAX:
         warnings.warn(
             f"{name}: uint16 image whose largest value is {top} (12-bit or 8-bit data in a "
-            "16-bit container?): it is scaled as 16-bit, leaving the matchers about "
-            f"{max(0.0, np.log2(max(top, 1) / 257)):.0f} bits of it; scale it to the full range "
-            "first (img << 4 for 12-bit data, or img.astype(np.uint8) for 8-bit values)",
+            "16-bit container?): it is scaled as 16-bit; the matchers read all its bits, but its "
+            f"8-bit copy (colours, the fill's colour segments, the automatic disparity range) "
+            f"keeps about {max(0.0, np.log2(max(top, 1) / 257)):.0f} bits of it; scale it to the "
+            "full range first (img << 4 for 12-bit data, or img.astype(np.uint8) for 8-bit "
+            "values)",
             UserWarning,
             stacklevel=4,
         )
 
 
-def _to_unit_float(arr: np.ndarray, name: str) -> npt.NDArray[np.float32]:
-    """Scale a validated image array to float32 in [0, 1] (channels untouched)."""
+def _to_unit_float(arr: np.ndarray, name: str, warn: bool = True) -> npt.NDArray[np.float32]:
+    """Scale a validated image array to float32 in [0, 1] (channels untouched); ``warn=False``
+    for an image whose low-values warning its caller has given already."""
     if arr.dtype in _INT_FULL_SCALE:
-        if arr.dtype == np.uint16:
+        if arr.dtype == np.uint16 and warn:
             _warn_low_uint16(arr, name)
         # divide (not multiply by the reciprocal) so that full scale maps to exactly 1.0
         return arr.astype(np.float32) / np.float32(_INT_FULL_SCALE[arr.dtype])
@@ -156,7 +161,7 @@ def _to_unit_float(arr: np.ndarray, name: str) -> npt.NDArray[np.float32]:
     return arr.astype(np.float32)
 
 
-def as_gray_float(img: object, name: str = "left") -> npt.NDArray[np.float32]:
+def as_gray_float(img: object, name: str = "left", *, warn: bool = True) -> npt.NDArray[np.float32]:
     """Return ``img`` as a C-contiguous grey ``(H, W)`` ``float32`` image in ``[0, 1]``.
 
     Scaling: ``uint8`` is divided by 255, ``uint16`` by 65535. Floating point images must already
@@ -172,6 +177,9 @@ def as_gray_float(img: object, name: str = "left") -> npt.NDArray[np.float32]:
         ``uint8``, ``uint16``, ``float16``, ``float32`` or ``float64``.
     name : str
         Argument name used in error messages.
+    warn : bool
+        Warn about a ``uint16`` image whose values all lie below 4096 (12-bit data in a 16-bit
+        container?). False for an image its caller has warned about already (its 8-bit copy).
 
     Returns
     -------
@@ -196,7 +204,7 @@ def as_gray_float(img: object, name: str = "left") -> npt.NDArray[np.float32]:
         # The same float32 operations in Rust, in one parallel pass: bit-identical, and
         # faster than the NumPy planes (tests/test_validate.py checks the identity).
         return _core.gray_u8(np.ascontiguousarray(arr), luma_weights())
-    out = _to_unit_float(arr, name)
+    out = _to_unit_float(arr, name, warn)
     if out.ndim == 3:
         if out.shape[2] == 1:
             out = out[:, :, 0]

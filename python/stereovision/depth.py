@@ -918,7 +918,10 @@ def depth_map(
     if isinstance(calib, UncalibratedRectification):
         # a rig without a calibration: its pair through the homographies, disparity only
         if deep:
-            grey = calib.rectify(as_gray_float(left, "left"), as_gray_float(right, "right"))
+            grey = calib.rectify(
+                as_gray_float(left, "left", warn=False),
+                as_gray_float(right, "right", warn=False),
+            )
         left_bgr, right_bgr = calib.rectify(left_bgr, right_bgr)
         left, right = left_bgr, right_bgr
         max_disparity = calib.max_disparity if max_disparity is None else max_disparity
@@ -941,7 +944,10 @@ def depth_map(
             raise ValueError(f"calibration is for {cw}x{ch} images, got {w}x{h} ({hint})")
         if not calib.rectified:
             if deep:
-                grey = calib.rectify(as_gray_float(left, "left"), as_gray_float(right, "right"))
+                grey = calib.rectify(
+                    as_gray_float(left, "left", warn=False),
+                    as_gray_float(right, "right", warn=False),
+                )
             left_bgr, right_bgr = calib.rectify(left_bgr, right_bgr)
             calib = calib.rectified_calibration()
             left = left_bgr
@@ -951,8 +957,9 @@ def depth_map(
         # bilinear warps of [0, 1] images stay in [0, 1] up to rounding
         gl, gr = (np.ascontiguousarray(np.clip(g, 0.0, 1.0), np.float32) for g in grey)
     else:
-        gl = as_gray_float(left, "left")
-        gr = as_gray_float(right, "right")
+        # as_bgr_uint8 warned about a 12-bit pair in 16 bits already (once per image)
+        gl = as_gray_float(left, "left", warn=False)
+        gr = as_gray_float(right, "right", warn=False)
     automatic = max_disparity is None  # the range is this function's choice, not the caller's
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
