@@ -563,3 +563,17 @@ def test_a_12_bit_pair_is_warned_about_once_per_image(rectified: bool | None) ->
     assert sorted(t.split(":")[0] for t in texts) == ["left", "right"], texts
     assert "the matchers read all its bits, but its 8-bit copy" in texts[0]
     assert "keeps about 4 bits of it" in texts[0] and "leaving the matchers" not in texts[0]
+
+
+def test_a_fractional_range_is_reported_as_searched(tmp_path: Path) -> None:
+    """``max_disparity=37.5`` was reported as 37 (``int()``), while the Gabor channel searched
+    up to 37.5 (its map reaches past 37); the NPZ bundle kept the 37 too."""
+    from stereovision.export import read_npz, write_npz
+
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")
+    res = sv.depth_map(s.left, s.right, s.calib, method="gabor", max_disparity=37.5)
+    assert res.max_disparity == 37.5 and float(np.nanmax(res.disparity)) > 37.0
+    assert "disparity [0, 37.5] px" in repr(res)
+    assert float(read_npz(write_npz(tmp_path / "r.npz", res))["max_disparity"]) == 37.5
+    whole = sv.depth_map(s.left, s.right, method="gabor", max_disparity=np.float64(32.0))
+    assert type(whole.max_disparity) is int and whole.max_disparity == 32

@@ -86,6 +86,12 @@ _SIGMA_REFINED = (0.405, -0.221, 0.18)
 _SIGMA_FILLED = 0.63
 
 
+def _whole_or_float(value: float) -> float:
+    """``value`` as an int when it is a whole number of pixels (64, not 64.0), else a float."""
+    v = float(value)
+    return int(v) if v.is_integer() else v
+
+
 def _round_up(value: float, step: int = _DISPARITY_STEP) -> int:
     return int(max(step, int(np.ceil(value / step)) * step))
 
@@ -229,8 +235,11 @@ class DepthResult:
         ``(x, y)`` pixel of each point.
     method : str
         Matcher used.
-    max_disparity : int
-        Disparity range searched, ``[min_disparity, max_disparity]``.
+    max_disparity : float
+        Disparity range searched, ``[min_disparity, max_disparity]``, as given or estimated: an
+        int for a whole number of pixels (the estimated range always is), else the float given
+        (37.5 stays 37.5: the Gabor channel searches up to it, the census semi-global map up to
+        the next whole pixel, 38).
     calibration : Calibration or None
         Calibration of the rectified pair the depth was computed with.
     timings : dict
@@ -262,7 +271,7 @@ class DepthResult:
     colors: npt.NDArray[np.uint8]
     pixels: npt.NDArray[np.int32]
     method: str
-    max_disparity: int
+    max_disparity: float
     min_disparity: float = 0.0
     calibration: Calibration | None = None
     left_rectified: npt.NDArray[np.uint8] | None = field(default=None, repr=False)
@@ -748,7 +757,7 @@ def depth_map(
     calib: Calibration | UncalibratedRectification | None = None,
     *,
     method: str = "fused",
-    max_disparity: int | None = None,
+    max_disparity: float | None = None,
     min_disparity: float = 0.0,
     fill: bool | None = None,
     refine: bool | None = None,
@@ -790,8 +799,9 @@ def depth_map(
         (``"census"`` 0.51 x), worse than it only on ETH3D playground (1.05 x); unfilled
         (``fill=False``) it measures more pixels than the Gabor channel with half its errors
         at 0.75 x its frame rate (README "Choosing a mode").
-    max_disparity : int, optional
-        Largest disparity searched, in pixels. None chooses it from the images
+    max_disparity : float, optional
+        Largest disparity searched, in pixels (the census semi-global map searches whole pixels,
+        up to the next one above a fractional range). None chooses it from the images
         (:func:`estimate_max_disparity`: the larger of ORB matches' 99th percentile and a
         coarse SGBM map's 99.5th, times 1.15, a multiple of 16).
     min_disparity : float
@@ -1058,7 +1068,8 @@ def depth_map(
         colors=colors,
         pixels=pixels,
         method=method,
-        max_disparity=int(max_disparity),
+        # the range as searched (int(37.5) reported 37 for a Gabor search up to 37.5)
+        max_disparity=_whole_or_float(max_disparity),
         min_disparity=float(min_disparity),
         calibration=calib,
         left_rectified=left_bgr,

@@ -9,7 +9,8 @@ Conventions shared with pyvista, Open3D, MeshLab and PCL:
   ``pcl::PointXYZRGB`` writes it); the cloud keeps the image layout (``WIDTH`` = image width,
   ``HEIGHT`` = image height, row-major), pixels without depth are NaN points (``is_dense`` false).
 - NPZ: ``depth``, ``confidence``, ``disparity`` (H, W float32, NaN = none), ``K`` (3x3),
-  ``baseline`` (metres), ``doffs`` (pixels), ``image_size`` (W, H), ``method``, ``max_disparity``.
+  ``baseline`` (metres), ``doffs`` (pixels), ``image_size`` (W, H), ``method``, ``max_disparity``
+  (int64; float64 for a fractional range).
 - 16-bit PNG: depth in millimetres (ROS ``16UC1``, TUM RGB-D, Open3D), disparity times 256
   (KITTI); 0 = none.
 
@@ -441,7 +442,8 @@ def write_npz(path: PathLike, result: DepthResult) -> Path:
         doffs=np.float64(doffs),
         image_size=np.array([w, h], dtype=np.int64),
         method=np.array(result.method),
-        max_disparity=np.int64(result.max_disparity),
+        # int64 for a whole range, float64 for a fractional one (int64 truncated 37.5 to 37)
+        max_disparity=np.asarray(result.max_disparity),
     )
     with atomic_write(path) as fh:
         fh.write(bio.getvalue())
