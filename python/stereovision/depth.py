@@ -251,7 +251,11 @@ class DepthResult:
         uncertainty predicted from the confidence (:func:`disparity_sigma`), except on the
         pixels the refinement filled and, in the fused map, those only the census map
         measured: they take 0.63 px whatever their confidence (so ``disparity_sigma(
-        confidence)`` gives back ``depth_sigma`` on the other pixels only).
+        confidence)`` gives back ``depth_sigma`` on the other pixels only). ``"census"`` and
+        ``"fast"`` give every measured pixel one confidence (``second_confidence``, 0.5), hence
+        one ``sigma_d``: 0.29 px when re-measured (``"census"``'s default), 0.63 px, as filled
+        pixels, when not (``"fast"``'s default, and ``refine=False``): their census values are
+        pixel-locked.
     channels : dict or None
         With ``return_channels=True``: each channel's own output by name (``"gabor"``: a
         :class:`~stereovision.matching.gabor.GaborResult`; with ``method="fused"`` also
