@@ -345,11 +345,13 @@ def _png_chunks(data: bytes) -> dict[bytes, bytes]:
 
 
 def test_board_png_prints_at_its_true_size() -> None:
+    """The file stored the requested 300 dpi (11811 px/m) while the square is a whole 354 px:
+    it printed at 29.97 mm. It stores 354 px / 30 mm = 11800 px/m, the square's exact size."""
     data, (w, h) = board_png(BOARD, 0.03, dpi=300)
     ppm = struct.unpack(">IIB", _png_chunks(data)[b"pHYs"])
-    assert ppm == (11811, 11811, 1)  # 300 dpi in pixels per metre
-    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_GRAYSCALE)
     side = round(0.03 / 0.0254 * 300)  # 354 px per 30 mm square
+    assert ppm == (11800, 11800, 1) and side / ppm[0] == pytest.approx(0.03, abs=1e-9)
+    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_GRAYSCALE)
     assert img.shape == (h, w) == (9 * side, 12 * side)
     found = find_charuco_corners(img, CharucoBoard("10x7", 0.03, 0.022))
     assert found is not None and len(found[0]) == BOARD.n_corners
@@ -378,7 +380,11 @@ def test_cli_board_then_calibrate(rig: dict[str, Any], tmp_path: Path) -> None:
     run = _cli("board", "-o", str(tmp_path / "b.png"), "--board", "charuco", "--pattern", "10x7",
                "--square", "30", "--unit", "mm", "--marker", "22")  # fmt: skip
     assert run.returncode == 0, run.stderr
-    assert "DICT_5X5_50" in run.stdout and "29.97 mm squares" in run.stdout
+    assert "DICT_5X5_50" in run.stdout and "30.00 mm squares" in run.stdout
+    assert "4248x3186 px at 11800 px/m (299.72 dpi: 354 px per square at 300 dpi)" in run.stdout
+    assert "it is 360.0 x 270.0 mm" in run.stdout
+    data = (tmp_path / "b.png").read_bytes()
+    assert struct.unpack(">IIB", _png_chunks(data)[b"pHYs"]) == (11800, 11800, 1)
     assert find_charuco_corners(cv2.imread(str(tmp_path / "b.png"), 0), BOARD) is not None
     for i in range(6):
         cv2.imwrite(str(tmp_path / f"left{i:02d}.png"), rig["left"][i])

@@ -2525,7 +2525,7 @@ def cmd_board(args: argparse.Namespace) -> int:
     """``stereovision board -o board.png --pattern 9x6 --square 0.03`` (or ``--board charuco``):
     a printable board at its true size."""
     from stereovision.calibration import UNIT_TO_METRES
-    from stereovision.charuco import board_png
+    from stereovision.charuco import _board_scale, board_png
     from stereovision.io import atomic_write
 
     out = Path(args.output)
@@ -2549,13 +2549,15 @@ def cmd_board(args: argparse.Namespace) -> int:
         what = f"chessboard {pat[0]}x{pat[1]} inner corners, square {square:g} {args.unit}"
     with atomic_write(out) as fh:
         fh.write(data)
-    mm = 25.4 / dpi
-    side_mm = round(square * UNIT_TO_METRES[args.unit] / 0.0254 * dpi) * mm  # whole pixels
+    # the PNG's resolution makes the whole-pixel square its exact size (_board_scale)
+    pix, ppm = _board_scale(square * UNIT_TO_METRES[args.unit], dpi)
+    mm = 1000 / ppm
     print(f"{out}: {what}")
     print(
-        f"{w}x{h} px; printed at {dpi:g} dpi and 100 % scale it is {w * mm:.1f} x {h * mm:.1f} "
-        f"mm with {side_mm:.2f} mm squares. Measure a square on the print and give that size "
-        "to calibrate --square."
+        f"{w}x{h} px at {ppm} px/m ({ppm * 0.0254:.2f} dpi: {pix} px per square at {dpi:g} "
+        f"dpi); printed at 100 % scale it is {w * mm:.1f} x {h * mm:.1f} mm with "
+        f"{pix * mm:.2f} mm squares. Measure a square on the print and give that size to "
+        "calibrate --square."
     )
     return 0
 
@@ -2654,5 +2656,11 @@ def add_cli(subparsers: Any) -> None:
         action=argparse.BooleanOptionalAction,
         help="charuco: OpenCV's pre-4.6 layout (default: the current one)",
     )
-    b.add_argument("--dpi", type=float, default=300.0, help="printer resolution (default 300)")
+    b.add_argument(
+        "--dpi",
+        type=float,
+        default=300.0,
+        help="printer resolution the squares' whole pixels are counted at (default 300; the PNG "
+        "stores the nearby resolution that prints them at their exact size)",
+    )
     b.set_defaults(func=cmd_board)

@@ -481,13 +481,31 @@ def render_charuco(
 # ------------------------------------------------------------------------------ printable board
 
 
-def _png_with_dpi(img: np.ndarray, dpi: float) -> bytes:
-    """PNG bytes with a ``pHYs`` chunk, so that printing at 100 % gives the board's true size."""
+def _board_scale(square_metres: float, dpi: float) -> tuple[int, int]:
+    """``(pixels per square, pixels per metre)`` of :func:`board_png`'s image: the square is
+    ``round(square / 25.4 mm x dpi)`` whole pixels, and the file's resolution is that count over
+    the square's size (rounded to a whole pixel per metre, as PNG stores it), so a print at
+    100 % gives the exact square size (30 mm at 300 dpi: 354 px, 11800 px/m, 299.72 dpi; the
+    requested 300 dpi printed 29.97 mm squares)."""
+    from stereovision._validate import positive_finite
+
+    p = positive_finite(square_metres, "square_metres") / 0.0254 * positive_finite(dpi, "dpi")
+    if not 10 <= p <= 20000:
+        raise ValueError(
+            f"a {square_metres * 1000:g} mm square at {dpi:g} dpi is {p:.1f} px; use a square "
+            "and dpi giving 10 to 20000 px per square"
+        )
+    pix = round(p)
+    return pix, round(pix / square_metres)
+
+
+def _png_with_ppm(img: np.ndarray, ppm: int) -> bytes:
+    """PNG bytes with a ``pHYs`` chunk of ``ppm`` pixels per metre, so that printing at 100 %
+    gives the board's true size."""
     ok, buf = cv2.imencode(".png", img)
     if not ok:
         raise ValueError("could not encode the board as PNG")
     data = buf.tobytes()
-    ppm = round(dpi / 0.0254)
     body = b"pHYs" + struct.pack(">IIB", ppm, ppm, 1)
     chunk = struct.pack(">I", 9) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
     ihdr_end = 8 + 8 + 13 + 4  # signature, IHDR length+type, IHDR data, CRC
@@ -499,7 +517,12 @@ def board_png(
     square_metres: float,
     dpi: float = 300.0,
 ) -> tuple[bytes, tuple[int, int]]:
-    """A printable PNG of a board at its true size (the DPI is stored in the file).
+    """A printable PNG of a board at its true size (its resolution is stored in the file).
+
+    The square is ``round(square / 25.4 mm x dpi)`` whole pixels; the file's ``pHYs`` resolution
+    is that count over the square's size (``_board_scale``), not ``dpi`` itself, so a print
+    at 100 % gives the exact square size (30 mm at 300 dpi: 354 px per square stored at 11800
+    px/m, 299.72 dpi; stored at 300 dpi it printed 29.97 mm squares).
 
     Parameters
     ----------
@@ -508,22 +531,14 @@ def board_png(
     square_metres : float
         The square's side in metres (sets the pixel size at ``dpi``).
     dpi : float
-        Printer resolution.
+        Printer resolution the square's pixel count is chosen at.
 
     Returns
     -------
     bytes, tuple of int
         The PNG file's bytes and its ``(width, height)`` in pixels.
     """
-    from stereovision._validate import positive_finite
-
-    p = positive_finite(square_metres, "square_metres") / 0.0254 * positive_finite(dpi, "dpi")
-    if not 10 <= p <= 20000:
-        raise ValueError(
-            f"a {square_metres * 1000:g} mm square at {dpi:g} dpi is {p:.1f} px; use a square "
-            "and dpi giving 10 to 20000 px per square"
-        )
-    pix = round(p)
+    pix, ppm = _board_scale(square_metres, dpi)
     if isinstance(board, CharucoBoard):
         img = board.image(pix, margin=pix)
     else:
@@ -539,4 +554,4 @@ def board_png(
                 if (r + c) % 2 == 0:
                     y0, x0 = pix + r * pix, pix + c * pix
                     img[y0 : y0 + pix, x0 : x0 + pix] = 0
-    return _png_with_dpi(img, dpi), (img.shape[1], img.shape[0])
+    return _png_with_ppm(img, ppm), (img.shape[1], img.shape[0])
