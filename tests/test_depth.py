@@ -6,6 +6,7 @@ import dataclasses
 import re
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 
@@ -597,3 +598,16 @@ def test_census_depth_sigma_is_one_value_as_documented() -> None:
         assert ok.sum() > 100_000 and np.allclose(sigma_d, want, atol=6e-3), (method, refine)
     assert "one ``sigma_d``: 0.29 px when re-measured" in doc
     assert '0.63 px, as filled pixels, when not (``"fast"``\'s default' in doc
+
+
+@pytest.mark.parametrize("scene", ["middeval3/teddyH", "kitti2015/000005_10"])
+def test_auto_max_disparity_of_a_10_bit_pair_in_16_bits(data_dir: Path, scene: str) -> None:
+    """A 10-bit camera's pair in uint16 (at most 1023 of 65535) was cut to 8 bits for ORB's
+    features as 0-3 grey levels: the automatic range came out 464 px on teddyH (112 from its
+    8-bit pair) and 624 on KITTI (128). One gain for both images now gives the 8-bit pair's."""
+    left = cv2.imread(str(data_dir / scene / "left.png"))
+    right = cv2.imread(str(data_dir / scene / "right.png"))
+    expected = sv.estimate_max_disparity(left, right)
+    assert expected in (112, 128)
+    got = sv.estimate_max_disparity(left.astype(np.uint16) * 4, right.astype(np.uint16) * 4)
+    assert got == expected

@@ -118,8 +118,8 @@ LOW_UINT16_MAX = 4096
 
 def _warn_low_uint16(arr: np.ndarray, name: str) -> None:
     """Warn when a uint16 image uses only its lowest 12 bits: it is scaled by 65535 (by 257 to
-    8 bits), so its 8-bit copy (colours, the fill's colour segments, the automatic range's
-    features) has 0-16 grey levels of a 12-bit camera's image; the matchers read all its bits."""
+    8 bits), so its 8-bit copy (colours, the fill's colour segments) has 0-16 grey levels of a
+    12-bit camera's image; the matchers read all its bits, the automatic range stretches it."""
     import warnings
 
     top = int(arr.max())
@@ -127,7 +127,7 @@ def _warn_low_uint16(arr: np.ndarray, name: str) -> None:
         warnings.warn(
             f"{name}: uint16 image whose largest value is {top} (12-bit or 8-bit data in a "
             "16-bit container?): it is scaled as 16-bit; the matchers read all its bits, but its "
-            f"8-bit copy (colours, the fill's colour segments, the automatic disparity range) "
+            f"8-bit copy (colours, the fill's colour segments) "
             f"keeps about {max(0.0, np.log2(max(top, 1) / 257)):.0f} bits of it; scale it to the "
             "full range first (img << 4 for 12-bit data, or img.astype(np.uint8) for 8-bit "
             "values)",
