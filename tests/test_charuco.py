@@ -507,3 +507,27 @@ def test_a_wrong_dictionary_or_squares_is_named_from_the_markers_seen(
     from stereovision.calibrate import _cli_words
 
     assert _cli_words("(e.g. dictionary='DICT_5X5_50')") == "(e.g. --dictionary DICT_5X5_50)"
+
+
+def test_a_wrong_dictionary_of_a_family_with_the_same_prefix_is_named() -> None:
+    """A board of DICT_APRILTAG_36H11 markers given as DICT_APRILTAG_25H9 (or DICT_ARUCO_ORIGINAL
+    as DICT_ARUCO_MIP_36H12) was said to show "35 of its DICT_APRILTAG markers, but not as a
+    10x7-square board's: check the squares": the family was the name up to its last '_', so
+    two families sharing a prefix were taken for one. The squares were right, the dictionary
+    was not."""
+    for printed, given in (
+        ("DICT_APRILTAG_36H11", "DICT_APRILTAG_25H9"),
+        ("DICT_ARUCO_ORIGINAL", "DICT_ARUCO_MIP_36H12"),
+    ):
+        board = CharucoBoard("10x7", 0.03, 0.022, printed)
+        left, right = [], []
+        for rv, tv in _poses(3, seed=7):
+            left.append(render_charuco(board, K1, D1, rv, tv, supersample=SS))
+            r2, t2 = _right_pose(rv, tv)
+            right.append(render_charuco(board, K2, D2, r2, t2, supersample=SS))
+        with pytest.raises(
+            ValueError,
+            match=rf"left_images\[0\] shows 35 markers of {printed}, not of {given}: give the "
+            rf"board's dictionary \(e\.g\. dictionary='{printed}'\)",
+        ):
+            calibrate(left, right, board=CharucoBoard("10x7", 0.03, 0.022, given))

@@ -1079,13 +1079,16 @@ def _warn(notes: list[str], message: str, category: type[Warning], stacklevel: i
 
 def _charuco_hint(board: CharucoBoard, gray: np.ndarray, name: str) -> str:
     """Why a ChArUco board may not be found, from the markers an image shows (``""``: none)."""
-    from stereovision.charuco import AUTO_MIN_MARKERS
+    from stereovision.charuco import AUTO_MIN_MARKERS, DICTIONARY_FAMILIES
 
     seen, count = board.markers_seen(gray)
     if count < AUTO_MIN_MARKERS:
         return ""
-    family = seen.rsplit("_", 1)[0]
-    if board.dictionary != "auto" and not board.dictionary.startswith(family + "_"):
+    # The family by membership, not by the name's prefix: DICT_APRILTAG_36H11 and
+    # DICT_APRILTAG_25H9 (DICT_ARUCO_ORIGINAL and DICT_ARUCO_MIP_36H12) are different families.
+    key = next(k for k, members in DICTIONARY_FAMILIES.items() if seen in dict(members))
+    family = f"DICT_{key}"
+    if board.dictionary != "auto" and board.dictionary not in dict(DICTIONARY_FAMILIES[key]):
         return (
             f"{name} shows {count} markers of {family}, not of {board.dictionary}: give the "
             f"board's dictionary (e.g. dictionary='{seen}')"
