@@ -819,3 +819,30 @@ def test_cli_pairs_images_on_their_numbers(tmp_path):
     stamps_l = ["l_1701000000101.png", "l_1701000000201.png"]
     stamps_r = ["r_1701000000103.png", "r_1701000000204.png"]
     assert calmod._pair_by_number(stamps_l, stamps_r) == stamps_r
+
+
+def test_a_rational_model_whose_pole_lies_past_the_image_is_not_said_to_fold() -> None:
+    """distortion='rational' on the StereoPi pairs: the right model grows out to a normalised
+    radius of 1.01 (the image's corners need 0.70) and turns back only past it, near the pole of
+    its denominator at r = 1.21 (a ray 50 degrees off the axis, outside the 53-degree view). The
+    check refused any pole out to 4x the corners' radius, and calibrate warned that the right
+    camera's model "folds the outer part of the image back inward", which it does not."""
+    stereopi = DATA_DIR / "stereopi_rig" / "calib_pairs"
+    if not stereopi.is_dir():
+        pytest.skip(f"StereoPi pairs not found at {stereopi}")
+    K = np.array([[302.156495, 0.0, 167.567094], [0.0, 303.497221, 127.313677], [0, 0, 1.0]])
+    D = np.array([-3.932681, 240.815422, -0.001524, 0.001167, -166.591863])
+    D = np.r_[D, -4.008717, 238.220417, -161.666174]
+    assert calmod._radial_is_monotonic(K, D, (320, 240))
+    # a model that turns back inside the image is still one that folds
+    assert not calmod._radial_is_monotonic(K, np.array([0.0, -2.0, 0, 0, 0]), (320, 240))
+    left = sorted(stereopi.glob("left_*.png"))
+    right = sorted(stereopi.glob("right_*.png"))
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        cal, rep = calibrate(left, right, pattern=(9, 6), square_size=2.5, distortion="rational")
+    assert not [w for w in caught if "not monotonic" in str(w.message)]
+    assert not [w for w in rep.warnings if "not monotonic" in w]
+    assert calmod._radial_is_monotonic(cal.K2, cal.D2, cal.image_size)

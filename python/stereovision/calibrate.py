@@ -807,9 +807,12 @@ def _radial_is_monotonic(K: F64, D: F64, size: tuple[int, int]) -> bool:
     r2 = r * r
     num = 1 + k1 * r2 + k2 * r2**2 + k3 * r2**3
     den = 1 + k4 * r2 + k5 * r2**2 + k6 * r2**3
-    if np.any(den <= 0):
-        return False
-    rd = r * num / den
+    # Up to the denominator's first zero (a pole): a pole past the radius where the model has
+    # already reached the image's corners lies outside the view (the rational model of the
+    # StereoPi right camera: corners at 0.70, reached before its turn at 1.01, pole at 1.21).
+    pole = np.nonzero(den <= 0)[0]
+    n = int(pole[0]) if pole.size else r.size
+    rd = r[:n] * num[:n] / den[:n]
     turn = np.nonzero(np.diff(rd) <= 0)[0]
     reach = rd if turn.size == 0 else rd[: turn[0] + 1]
     return bool(reach.max() >= rd_max)
