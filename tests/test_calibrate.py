@@ -846,3 +846,25 @@ def test_a_rational_model_whose_pole_lies_past_the_image_is_not_said_to_fold() -
     assert not [w for w in caught if "not monotonic" in str(w.message)]
     assert not [w for w in rep.warnings if "not monotonic" in w]
     assert calmod._radial_is_monotonic(cal.K2, cal.D2, cal.image_size)
+
+
+def test_a_folding_model_auto_chose_is_not_answered_with_auto() -> None:
+    """Five StereoPi pairs with distortion='auto' (too few views to compare models: the first
+    candidate, k1k2p1p2): its model turns back inside the image, and the warning said to
+    "calibrate with distortion='auto'", the option just used. It now names a simpler model and
+    more views."""
+    stereopi = DATA_DIR / "stereopi_rig" / "calib_pairs"
+    if not stereopi.is_dir():
+        pytest.skip(f"StereoPi pairs not found at {stereopi}")
+    left = [stereopi / f"left_0{i}.png" for i in range(1, 6)]
+    right = [stereopi / f"right_0{i}.png" for i in range(1, 6)]
+    with pytest.warns(UserWarning, match="not monotonic") as caught:
+        cal, _ = calibrate(left, right, pattern=(9, 6), square_size=2.5)
+    assert cal.model == "pinhole"
+    (text,) = [str(w.message) for w in caught if "not monotonic" in str(w.message)]
+    assert text.startswith("the k1k2p1p2 distortion model of the left and right cameras")
+    assert "distortion='auto'" not in text
+    assert text.endswith(
+        "add views with the board near the image corners, or calibrate with a simpler model "
+        "(distortion='k1k2')"
+    )

@@ -1543,8 +1543,15 @@ def calibrate(
             f"the {sol.model} distortion model of the {' and '.join(folded)} camera"
             f"{'s' if len(folded) == 2 else ''} is not "
             "monotonic over the image: it folds the outer part of the image back inward, and the "
-            "rectified images lose or repeat it; calibrate with distortion='auto' (or a simpler "
-            "model), or add views with the board near the image corners",
+            "rectified images lose or repeat it; "
+            + (
+                # auto chose it (too few views to compare, or the joint refinement moved it)
+                "add views with the board near the image corners, or calibrate with a simpler "
+                "model (distortion='k1k2')"
+                if distortion == "auto"
+                else "calibrate with distortion='auto' (or a simpler model), or add views with "
+                "the board near the image corners"
+            ),
             UserWarning,
             stacklevel=2,
         )
