@@ -528,9 +528,18 @@ def test_cli_mispaired_says_the_option(
     out = tmp_path / "rig.yaml"
     argv = ["calibrate", "--left", str(tmp_path / "left*.jpg"), "--right",
             str(tmp_path / "right*.jpg"), "--square", "0.025", "-o", str(out)]  # fmt: skip
-    # With their own names the pairs are made on the numbers: the two alone are named, first.
+    # With their own names: one pair whose numbers differ at the same sorted position (as two
+    # partners saved across a second's turn) keeps its position; the stereo RMS refuses it,
+    # naming the pair and its numbers.
     args = _parser().parse_args(argv)
-    with pytest.raises(ValueError, match=r"left06\.jpg \(no right\), right05\.jpg \(no left\)"):
+    with (
+        pytest.warns(UserWarning, match=r"file numbers differ in left06\.jpg / right05\.jpg:"),
+        pytest.raises(
+            ValueError,
+            match=r"Worst pairs: left06\.jpg / right05\.jpg .*; the file numbers differ in "
+            r"left06\.jpg / right05\.jpg\. .*--drop-outliers",
+        ),
+    ):
         args.func(args)
     assert not out.exists()
     # Numbered by position (one camera's frame dropped, the numbering went on): the stereo
@@ -868,3 +877,21 @@ def test_a_folding_model_auto_chose_is_not_answered_with_auto() -> None:
         "add views with the board near the image corners, or calibrate with a simpler model "
         "(distortion='k1k2')"
     )
+
+
+def test_names_numbered_by_capture_second_keep_their_pairs() -> None:
+    """Each camera's file named by the second it was saved (IMG_<date>_<hhmmss>_L.jpg): most
+    pairs share the second, one pair was saved across a second's turn. The sorted position
+    pairs every image with its partner, yet the number pairing refused the set ("2 image(s)
+    have no partner with the same number ... remove them"), though both have one. Position
+    pairing is kept when it pairs every shared number with itself; a deleted image (left05 and
+    right09) still shifts the pairs, and is still refused."""
+    secs_l = ["123456", "123510", "123559", "123631"]
+    secs_r = ["123456", "123510", "123600", "123631"]  # saved 1 s after its left partner
+    lefts = [f"IMG_20240501_{s}_L.jpg" for s in secs_l]
+    rights = [f"IMG_20240501_{s}_R.jpg" for s in secs_r]
+    assert calmod._pair_by_number(lefts, rights) == rights
+    lefts = [f"left{i:02d}.jpg" for i in (1, 2, 3, 4, 6, 7, 8, 9, 10)]
+    rights = [f"right{i:02d}.jpg" for i in (1, 2, 3, 4, 5, 6, 7, 8, 10)]
+    with pytest.raises(ValueError, match=r"left09\.jpg \(no right\), right05\.jpg \(no left\)"):
+        calmod._pair_by_number(lefts, rights)

@@ -2295,7 +2295,9 @@ def _pair_by_number(lefts: list[str], rights: list[str]) -> list[str]:
     and ``right09`` deleted as blurred) kept the counts equal and paired every image between
     them with the wrong partner: a calibration from mismatched views, without a word. When
     every name on both sides has a number, unique per side, and most numbers are on both
-    sides, the pairs are made on them and an image without a partner is refused by name.
+    sides, the pairs are made on them and an image without a partner is refused by name (unless
+    the sorted position already pairs every shared number with itself: partners whose numbers
+    differ, such as each camera's capture second).
     Names whose numbers do not correspond (timestamps taken by each camera) keep the
     position pairing.
 
@@ -2324,6 +2326,12 @@ def _pair_by_number(lefts: list[str], rights: list[str]) -> list[str]:
         return [by_number[k] for k in kl]
     if len(common) < 2 or 2 * len(common) < min(len(kl), len(kr)):
         return rights  # numbers of their own on each side (or one file): the counts decide
+    if len(kl) == len(kr) and all(
+        a == b for a, b in zip(kl, kr, strict=True) if a in common or b in common
+    ):
+        # The sorted position pairs every shared number with itself: the others are partners
+        # whose numbers differ (each camera's capture second, one pair saved across its turn).
+        return rights
     alone = [
         f"{os.path.basename(f)} (no right)"
         for f, k in zip(lefts, kl, strict=True)
