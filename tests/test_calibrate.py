@@ -851,7 +851,7 @@ def test_a_rational_model_whose_pole_lies_past_the_image_is_not_said_to_fold() -
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        cal, rep = calibrate(left, right, pattern=(9, 6), square_size=2.5, distortion="rational")
+        cal, rep = calibrate(left, right, pattern=(9, 6), square_size=0.025, distortion="rational")
     assert not [w for w in caught if "not monotonic" in str(w.message)]
     assert not [w for w in rep.warnings if "not monotonic" in w]
     assert calmod._radial_is_monotonic(cal.K2, cal.D2, cal.image_size)
@@ -868,7 +868,7 @@ def test_a_folding_model_auto_chose_is_not_answered_with_auto() -> None:
     left = [stereopi / f"left_0{i}.png" for i in range(1, 6)]
     right = [stereopi / f"right_0{i}.png" for i in range(1, 6)]
     with pytest.warns(UserWarning, match="not monotonic") as caught:
-        cal, _ = calibrate(left, right, pattern=(9, 6), square_size=2.5)
+        cal, _ = calibrate(left, right, pattern=(9, 6), square_size=0.025)
     assert cal.model == "pinhole"
     (text,) = [str(w.message) for w in caught if "not monotonic" in str(w.message)]
     assert text.startswith("the k1k2p1p2 distortion model of the left and right cameras")
