@@ -798,6 +798,11 @@ def test_a_folding_fisheye_model_is_warned_about(cached_corners: None) -> None:
     ):
         cal, rep = calibrate(left, right, pattern=(9, 6), square_size=1.0, distortion="fisheye")
     assert cal.model == "fisheye" and len(rep.warnings) == 1
+    # a true fisheye keeps its model (its fold is the rim the board never reached)
+    assert rep.warnings[0].endswith(
+        "if the lens is a fisheye, add views with the board near the image corners; "
+        "if not, calibrate with distortion='auto'"
+    )
     assert not calmod._fisheye_is_monotonic(cal.K1, cal.D1, cal.image_size)
 
 

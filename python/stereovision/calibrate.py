@@ -1549,6 +1549,10 @@ def calibrate(
                 "add views with the board near the image corners, or calibrate with a simpler "
                 "model (distortion='k1k2')"
                 if distortion == "auto"
+                # a true fisheye needs its model: its fold comes from the board missing the rim
+                else "if the lens is a fisheye, add views with the board near the image corners; "
+                "if not, calibrate with distortion='auto'"
+                if sol.model == "fisheye"
                 else "calibrate with distortion='auto' (or a simpler model), or add views with "
                 "the board near the image corners"
             ),
