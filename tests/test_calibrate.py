@@ -784,7 +784,10 @@ def test_a_folding_distortion_model_is_warned_about(
     assert page.index("<h2>Warnings</h2><ul><li>" + said) < page.index("<h2>Key figures</h2>")
     assert json.loads(paths["json"].read_text())["warnings"] == rep.warnings
     assert chessboard[1].warnings == []
-    assert "<h2>Warnings</h2>" not in calmod._render_html(chessboard[1])
+    page = calmod._render_html(chessboard[1])
+    assert "<h2>Warnings</h2>" not in page
+    # the translation's unit is the square size's (the report showed T without one)
+    assert f"<h3>T ({chessboard[0].unit})</h3>" in page and "<h3>K1 (px)</h3>" in page
 
 
 def test_a_folding_fisheye_model_is_warned_about(cached_corners: None) -> None:

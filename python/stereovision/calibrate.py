@@ -2147,8 +2147,11 @@ def _render_html(rep: CalibrationReport) -> str:
     mats = ""
     if cal is not None:
         with np.printoptions(precision=6, suppress=True):
+            # T is in the board's unit (the square size's), the rest unitless or pixels
+            heads = {"K1": "K1 (px)", "K2": "K2 (px)", "T": f"T ({html.escape(cal.unit)})"}
             mats = "".join(
-                f"<h3>{k}</h3><pre>{html.escape(str(np.asarray(getattr(cal, k))))}</pre>"
+                f"<h3>{heads.get(k, k)}</h3>"
+                f"<pre>{html.escape(str(np.asarray(getattr(cal, k))))}</pre>"
                 for k in ("K1", "D1", "K2", "D2", "R", "T")
             )
     style = (
