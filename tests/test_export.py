@@ -131,6 +131,43 @@ def test_pcd_ascii_float_colour_as_pcl_writes_it(tmp_path):
         export.read_pcd(path)
 
 
+def test_pcd_padding_fields_are_skipped(tmp_path):
+    """PCL's padding field ``_`` may appear several times (an Ouster scan as PCL saves it:
+    ``x y z _ intensity _``): such a file was refused as "unsupported fields"."""
+    fields = [("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("p", "u1", 4), ("rgb", "<u4")]
+    fields += [("i", "<f4"), ("q", "u1", 12)]
+    rec = np.zeros(2, dtype=fields)
+    rec["x"], rec["y"], rec["z"] = [1.0, 4.0], [2.0, 5.0], [3.0, 6.0]
+    rec["rgb"] = [0xFF0000, 0x0A141E]
+    rec["p"], rec["q"] = 7, 9
+    head = (
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z _ rgb intensity _\nSIZE 4 4 4 1 4 4 1\n"
+        "TYPE F F F U U F U\nCOUNT 1 1 1 4 1 1 12\nWIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA binary\n"
+    )
+    path = tmp_path / "pad.pcd"
+    path.write_bytes(head.encode() + rec.tobytes())
+    pts, cols = export.read_pcd(path)
+    assert pts.reshape(-1, 3).tolist() == [[1, 2, 3], [4, 5, 6]]
+    assert cols.reshape(-1, 3).tolist() == [[255, 0, 0], [10, 20, 30]]
+
+
+def test_pcd_ascii_field_of_several_values(tmp_path):
+    """An ASCII field of COUNT c takes c columns: the fields after a ``COUNT 2`` one were read
+    from the wrong columns (z from the field before it)."""
+    path = tmp_path / "count.pcd"
+    path.write_text(
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS uv x y z rgb\nSIZE 4 4 4 4 4\nTYPE F F F F U\n"
+        "COUNT 2 1 1 1 1\nWIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n"
+        f"0.5 0.25 1 2 3 {0xFF0000}\n0.5 0.25 4 5 6 {0x0A141E}\n"
+    )
+    pts, cols = export.read_pcd(path)
+    assert pts.reshape(-1, 3).tolist() == [[1, 2, 3], [4, 5, 6]]
+    assert cols.reshape(-1, 3).tolist() == [[255, 0, 0], [10, 20, 30]]
+    path.write_text(path.read_text().replace("1 2 3 ", "1 2 "))
+    with pytest.raises(ValueError, match=r"count\.pcd"):
+        export.read_pcd(path)
+
+
 def test_npz_bundle(result, tmp_path):
     # sigma_Z = Z^2 sigma_d / (f B) with sigma_d = 0.5 px: the bundle keeps the uncertainty.
     sigma = (result.depth.astype(np.float64) ** 2 * 0.5 / (syn.F * syn.B)).astype(np.float32)

@@ -341,11 +341,14 @@ def read_pcd(
     if not {"x", "y", "z"} <= set(names):
         raise ValueError(f"PCD file {p}: fields {names}, expected x y z")
     kinds = {"F": "f", "U": "u", "I": "i"}
+    # "_" is PCL's padding field and may appear more than once (Ouster's and PCL's binary
+    # files: "x y z _ intensity _"); each gets its own name so that the record type can hold it.
+    fields = [f"_pad{i}" if n == "_" else n for i, n in enumerate(names)]
     try:
         dtype = np.dtype(
             [
                 (n, f"<{kinds[t]}{s}", (c,)) if c > 1 else (n, f"<{kinds[t]}{s}")
-                for n, s, t, c in zip(names, sizes, types, counts, strict=True)
+                for n, s, t, c in zip(fields, sizes, types, counts, strict=True)
             ]
         )
     except (KeyError, TypeError, ValueError):
@@ -373,15 +376,19 @@ def read_pcd(
             table = np.loadtxt(_io.BytesIO(raw[pos:]), dtype=np.float64, ndmin=2)
         except ValueError as exc:  # a short or damaged row: NumPy's words, with the file's name
             raise ValueError(f"damaged PCD file {p}: {str(exc).splitlines()[0]}") from None
-        if table.shape[1] < len(names):
+        # A field of COUNT c takes c columns (PCL's FPFH histograms: 33, padding "_": 4).
+        if table.shape[1] < sum(counts):
             raise ValueError(
-                f"PCD file {p}: rows of {table.shape[1]} values, FIELDS has {len(names)}"
+                f"PCD file {p}: rows of {table.shape[1]} values, FIELDS has {sum(counts)}"
+                + (" (with its COUNT)" if len(counts) != sum(counts) else "")
             )
         if table.shape[0] != n:
             raise ValueError(f"PCD file {p}: expected {n} points, got {table.shape[0]}")
         rec = np.empty(n, dtype=dtype)
-        for i, name in enumerate(names):
-            col = table[:, i]
+        start = 0
+        for i, name in enumerate(fields):
+            col = table[:, start] if counts[i] == 1 else table[:, start : start + counts[i]]
+            start += counts[i]
             if name == colour:  # the bits, stored in the field's own type
                 bits = _ascii_rgb_bits(col, types[i])
                 rec[name] = bits.astype("<u4").view(dtype[name])
