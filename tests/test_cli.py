@@ -440,3 +440,67 @@ def test_a_12_bit_pair_gets_one_warning_line_per_image(tmp_path: Path, data_dir:
     assert proc.returncode == 0, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert [line.split(":")[2] for line in lines] == [" left", " right"], proc.stderr
+
+
+def test_eval_treats_a_gt_without_known_pixels_as_no_gt(data_dir: Path, tmp_path: Path) -> None:
+    """A gt_disp.pfm that is all +inf (unknown) was evaluated: every figure NaN, printed as
+    ``NaN`` in the --json line (not JSON) and as ``nan`` in the table's mean; exit 0."""
+    import json
+    import shutil
+
+    from stereovision.io import write_pfm
+
+    good = tmp_path / "a_tsukuba"
+    shutil.copytree(data_dir / "middlebury2001" / "tsukuba", good)
+    blank = tmp_path / "b_blank"
+    shutil.copytree(good, blank)
+    gt = read_pfm(blank / "gt_disp.pfm")
+    write_pfm(blank / "gt_disp.pfm", np.full_like(gt, np.inf))
+    argv = ["eval", "--json", "--no-opencv", "--method", "fast"]
+    proc = subprocess.run([*SV, *argv, str(tmp_path)], capture_output=True, text=True, check=False)
+    assert proc.returncode == 0, proc.stderr
+    rows = [json.loads(ln, parse_constant=_no_constant) for ln in proc.stdout.splitlines()]
+    assert [Path(r["scene"]).name for r in rows] == ["a_tsukuba"]
+    assert proc.stderr.strip() == (
+        f"skipped {blank}: no ground truth: gt_disp.pfm has no known (finite) pixel"
+    )
+    alone = subprocess.run([*SV, *argv, str(blank)], capture_output=True, text=True, check=False)
+    assert alone.returncode == 2 and alone.stdout == "", alone.stdout
+    assert alone.stderr.strip() == (
+        f"stereovision: error: {blank}: no ground truth: gt_disp.pfm has no known (finite) "
+        "pixel to evaluate against"
+    )
+
+
+def test_eval_json_lines_are_strict_json() -> None:
+    """Figures with nothing to measure (no pixel with both depths) are NaN: null in JSON."""
+    import json
+
+    from stereovision.cli import _json_line
+    from stereovision.evaluate import depth_metrics
+
+    row = {"depth": depth_metrics(np.full((2, 2), np.nan), np.ones((2, 2))).as_dict(), "x": [1.5]}
+    back = json.loads(_json_line(row))
+    assert back == {"depth": {"median_rel": None, "share_off_5": None, "rmse_pct": None,
+                              "rmse": None, "n": 0, "density": 0.0}, "x": [1.5]}  # fmt: skip
+
+
+def test_eval_with_no_scene_to_evaluate_fails(data_dir: Path, tmp_path: Path) -> None:
+    """Two scenes without ground truth: both skipped, nothing evaluated, and the exit status
+    was 0 (an empty table)."""
+    for name in ("a", "b"):
+        (tmp_path / name).mkdir()
+        for side in ("left", "right"):
+            src = data_dir / "stereopi_rig" / "scene_photo" / f"{side}.png"
+            (tmp_path / name / f"{side}.png").write_bytes(src.read_bytes())
+    proc = subprocess.run([*SV, "eval", str(tmp_path)], capture_output=True, text=True, check=False)
+    assert proc.returncode == 2, proc.stderr
+    err = proc.stderr.strip().splitlines()
+    assert err[:2] == [f"skipped {tmp_path / n}: no ground truth (gt_disp.pfm)" for n in "ab"]
+    assert err[2:] == [
+        "stereovision: error: none of the 2 scenes has ground truth to evaluate against"
+    ]
+
+
+def _no_constant(name: str) -> float:
+    raise ValueError(f"not JSON: {name}")

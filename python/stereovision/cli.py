@@ -700,6 +700,22 @@ def _eval_scene(scene: Any, method: str, with_opencv: bool) -> dict[str, Any]:
     return row
 
 
+def _json_ready(value: Any) -> Any:
+    """``value`` with every non-finite float (NaN, inf) as None, recursively."""
+    if isinstance(value, dict):
+        return {k: _json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_ready(v) for v in value]
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def _json_line(row: dict[str, Any]) -> str:
+    """One line of strict JSON (a figure with nothing to measure, NaN, is ``null``)."""
+    return json.dumps(_json_ready(row), allow_nan=False)
+
+
 def _fmt_dense(m: dict[str, Any]) -> str:
     return f"{m['bad_2.0']:6.1f} {m['bad_1.0']:6.1f} {m['density']:6.1f}"
 
@@ -732,13 +748,24 @@ def cmd_eval(args: argparse.Namespace) -> int:
         print(sub)
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
     failed: list[str] = []
+    skipped = 0
     for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
         try:
             scene = load_scene(d)
-            if scene.gt is None:
+            # a GT map with no known pixel (all +inf) is no ground truth either: its figures
+            # would all be NaN (and NaN in the --json line, which is not JSON)
+            why = (
+                "no ground truth (gt_disp.pfm)"
+                if scene.gt is None
+                else None
+                if np.isfinite(scene.gt).any()
+                else "no ground truth: gt_disp.pfm has no known (finite) pixel"
+            )
+            if why is not None:
                 if len(dirs) == 1:
-                    raise CliError(f"{d}: no ground truth (gt_disp.pfm) to evaluate against")
-                tqdm.write(f"skipped {d}: no ground truth (gt_disp.pfm)", file=sys.stderr)
+                    raise CliError(f"{d}: {why} to evaluate against")
+                tqdm.write(f"skipped {d}: {why}", file=sys.stderr)
+                skipped += 1
                 continue
             row = _eval_scene(scene, args.method, not args.no_opencv)
         except (ValueError, OSError, RuntimeError) as e:
@@ -750,7 +777,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
             continue
         rows.append(row)
         if args.json:
-            print(json.dumps({k: v for k, v in row.items() if not k.startswith("_")}))
+            print(_json_line({k: v for k, v in row.items() if not k.startswith("_")}))
             continue
         cells = [_fmt_dense(row["ours"]), _fmt_dense(row["ours+fill"])]
         for key in ("bm", "sgbm", "sgbm+fill"):
@@ -760,6 +787,8 @@ def cmd_eval(args: argparse.Namespace) -> int:
     if failed:
         print(f"stereovision: {len(failed)} of {len(dirs)} scenes failed (above)", file=sys.stderr)
         status = 1
+    elif skipped == len(dirs):  # nothing evaluated is not a success
+        raise CliError(f"none of the {len(dirs)} scenes has ground truth to evaluate against")
     if args.json or not rows:
         return status
     # the table's columns, SGBM-3WAY + fill included (the reference a dense map must beat)
