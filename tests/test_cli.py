@@ -504,3 +504,27 @@ def test_eval_with_no_scene_to_evaluate_fails(data_dir: Path, tmp_path: Path) ->
 
 def _no_constant(name: str) -> float:
     raise ValueError(f"not JSON: {name}")
+
+
+def test_rectify_with_calib_removes_an_earlier_runs_homographies(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """rectify without --calib, then with it into the same folder: the first run's
+    rectification.json stayed beside the new images, and `depth --rectification` would warp
+    the calibrated pair by the earlier homographies. A file of that name not ours stays."""
+    scene = data_dir / "eth3d" / "terrace"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    out = tmp_path / "rect"
+    assert main(["rectify", *pair, "-o", str(out)]) == 0
+    assert (out / "rectification.json").is_file()
+    capsys.readouterr()
+    assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
+    assert not (out / "rectification.json").exists()
+    said = capsys.readouterr().out.splitlines()
+    assert (
+        said[-1]
+        == "  removed rectification.json of an earlier run without --calib (not this pair's)"
+    )
+    (out / "rectification.json").write_text('{"mine": 1}')
+    assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
+    assert (out / "rectification.json").read_text() == '{"mine": 1}'

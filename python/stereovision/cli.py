@@ -526,6 +526,20 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     print(check.summary())
     for name, path in written.items():
         print(f"  {name:19s} {path}")
+    stale = out / "rectification.json"
+    if summary is None and stale.is_file() and not stale.is_symlink():
+        # An earlier run without --calib wrote it: kept, `depth --rectification` would warp
+        # these calibrated images by its homographies. A file of that name that is not one of
+        # ours stays.
+        from stereovision.uncalibrated import UncalibratedRectification
+
+        try:
+            UncalibratedRectification.load(stale)
+        except (OSError, ValueError):
+            pass
+        else:
+            stale.unlink()
+            print(f"  removed {stale.name} of an earlier run without --calib (not this pair's)")
     return 0
 
 
