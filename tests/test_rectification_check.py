@@ -334,3 +334,19 @@ def test_a_calibration_file_name_and_numpy_tolerances() -> None:
     for bad in (np.float32("nan"), np.float64(-1.0), np.bool_(True), "0.5"):
         with pytest.raises(ValueError, match="tolerance: expected a positive number of pixels"):
             check_rectification(flat, flat, tolerance=bad)  # type: ignore[arg-type]
+
+
+def test_an_unrectified_pair_is_not_called_swapped(data_dir: Path) -> None:
+    """OpenCV's hand-held books pair (no calibration, rows 36 px apart): most of its matches lie
+    within 10 % of the height of their rows at negative disparities, and the check said 'the
+    left and right images look swapped', not that the pair is not rectified. Swapping them
+    does not rectify it: only a pair whose negative-disparity matches share rows is swapped."""
+    books = data_dir / "opencv_uncalibrated" / "books"
+    left, right = imread(books / "left.jpg"), imread(books / "right.jpg")
+    res = check_rectification(left, right)
+    assert res.ok is False and not res.swapped
+    assert res.median_dy == pytest.approx(36.0, abs=1.0)
+    assert res.summary().startswith("rectification NOT rectified: median |dy| 36.0 px")
+    # a rectified pair given the other way round still is
+    cones_l, cones_r = _pair(data_dir, "middlebury2003/cones")
+    assert check_rectification(cones_r, cones_l).swapped

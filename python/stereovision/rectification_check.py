@@ -238,13 +238,19 @@ def check_rectification(
     # zero, is a wrong match, not drift, unless most matches are like that.
     near_row = np.abs(dy) <= 0.1 * h
     keep = near_row & (dx >= -max(8.0, 0.02 * w))
+    a = np.column_stack([np.ones(len(dy)), (xl - (w - 1) / 2) / 1000, (yl - (h - 1) / 2) / 1000])
+    # Swapped: most matches near their rows have a negative disparity, and those lie on common
+    # rows (the pair is rectified the other way round). Matches merely within 10 % of the
+    # height of their rows, at negative disparities, are an unrectified pair (OpenCV's
+    # hand-held books: 66 of 107 at median |dy| 24 px, only 23 on a common row model).
+    neg = near_row & (dx < -1.0)
     swapped = bool(near_row.sum() >= MIN_MATCHES and (dx[near_row] < -1.0).mean() > 0.5)
+    if swapped:
+        neg_inl = _robust_fit(a[neg], dy[neg])[1]
+        swapped = bool(neg_inl.sum() >= MIN_MATCHES and neg_inl.mean() > 0.5)
     inl = np.zeros(len(dy), dtype=bool)
     coef = np.full(3, nan)
     if keep.sum() >= MIN_MATCHES:
-        a = np.column_stack(
-            [np.ones(len(dy)), (xl - (w - 1) / 2) / 1000, (yl - (h - 1) / 2) / 1000]
-        )
         coef, fit_inl = _robust_fit(a[keep], dy[keep])
         inl[np.flatnonzero(keep)[fit_inl]] = True
     quad = np.column_stack([xl, yl, xr, yr]).astype(np.float32)
