@@ -528,3 +528,20 @@ def test_rectify_with_calib_removes_an_earlier_runs_homographies(
     (out / "rectification.json").write_text('{"mine": 1}')
     assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
     assert (out / "rectification.json").read_text() == '{"mine": 1}'
+
+
+def test_eval_counts_a_scene_given_twice_once(data_dir: Path) -> None:
+    """`eval middlebury2001 middlebury2001/tsukuba` evaluated tsukuba twice, and the mean
+    line counted it twice (2.5 % for fast instead of the two scenes' 2.0 %)."""
+    import json
+
+    both = [str(data_dir / "middlebury2001"), str(data_dir / "middlebury2001" / "tsukuba")]
+    proc = subprocess.run(
+        [*SV, "eval", *both, "--json", "--no-opencv", "--method", "fast"],
+        capture_output=True, text=True, check=False,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    rows = [json.loads(line) for line in proc.stdout.splitlines()]
+    assert [r["scene"] for r in rows] == ["middlebury2001/tsukuba", "middlebury2001/venus"]
+    tsukuba = data_dir / "middlebury2001" / "tsukuba"
+    assert proc.stderr == f"stereovision: {tsukuba} given more than once: evaluated once\n"

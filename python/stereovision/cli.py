@@ -749,6 +749,17 @@ def cmd_eval(args: argparse.Namespace) -> int:
         if not found:
             raise CliError(f"no scene (left.png + right.png) under {d}")
         dirs.extend(found)
+    # a scene named twice (its folder and a folder holding it) is evaluated once: twice, it
+    # counted twice in the mean line
+    seen: set[Path] = set()
+    unique = []
+    for s in dirs:
+        if s.resolve() in seen:
+            print(f"stereovision: {s} given more than once: evaluated once", file=sys.stderr)
+            continue
+        seen.add(s.resolve())
+        unique.append(s)
+    dirs = unique
     rows = []
     header = (
         f"{'scene':38s} {'D':>4s} | {'ours':^20s} | {'ours+fill':^20s} |"
