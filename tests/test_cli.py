@@ -545,3 +545,25 @@ def test_eval_counts_a_scene_given_twice_once(data_dir: Path) -> None:
     assert [r["scene"] for r in rows] == ["middlebury2001/tsukuba", "middlebury2001/venus"]
     tsukuba = data_dir / "middlebury2001" / "tsukuba"
     assert proc.stderr == f"stereovision: {tsukuba} given more than once: evaluated once\n"
+
+
+def test_rectify_refuses_to_overwrite_its_input_images(data_dir: Path, tmp_path: Path) -> None:
+    """`rectify rect/left_rect.png rect/right_rect.png -o rect` wrote its outputs over the
+    images it was given, without a word."""
+    scene = data_dir / "stereopi_rig" / "scene_photo"
+    rect = tmp_path / "rect"
+    rect.mkdir()
+    for side in ("left", "right"):
+        (rect / f"{side}_rect.png").write_bytes((scene / f"{side}.png").read_bytes())
+    before = (rect / "left_rect.png").read_bytes()
+    pair = [str(rect / "left_rect.png"), str(rect / "right_rect.png")]
+    proc = subprocess.run(
+        [*SV, "rectify", *pair, "-o", str(rect)], capture_output=True, text=True, check=False
+    )
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr == (
+        f"stereovision: error: -o {rect / 'left_rect.png'}: is the left image "
+        f"({rect / 'left_rect.png'}); give another file name\n"
+    )
+    assert (rect / "left_rect.png").read_bytes() == before
+    assert sorted(p.name for p in rect.iterdir()) == ["left_rect.png", "right_rect.png"]

@@ -494,6 +494,10 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise CliError(f"-o {args.output}: is a file; give a folder")
+    inputs = {"the left image": args.left, "the right image": args.right,
+              "the calibration": args.calib}  # fmt: skip
+    for name in ("left_rect.png", "right_rect.png", "check.png", "rectification.json"):
+        _refuse_an_input("-o", out / name, inputs)  # rectifying rect/*.png again into rect/
     written: dict[str, Path] = {}
     if calib is not None:
         if args.model != "auto":
