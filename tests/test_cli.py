@@ -567,3 +567,14 @@ def test_rectify_refuses_to_overwrite_its_input_images(data_dir: Path, tmp_path:
     )
     assert (rect / "left_rect.png").read_bytes() == before
     assert sorted(p.name for p in rect.iterdir()) == ["left_rect.png", "right_rect.png"]
+
+
+def test_eval_of_an_image_file_says_it_is_a_file(data_dir: Path) -> None:
+    """`eval scene/left.png` said 'scene root not found' of a file that exists."""
+    img = data_dir / "middlebury2001" / "tsukuba" / "left.png"
+    proc = subprocess.run([*SV, "eval", str(img)], capture_output=True, text=True, check=False)
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr == (
+        f"stereovision: error: {img}: is a file; give a scene folder (holding left.png, "
+        "right.png)\n"
+    )

@@ -749,6 +749,8 @@ def cmd_eval(args: argparse.Namespace) -> int:
         p = Path(d)
         if not p.exists():
             raise FileNotFoundError(f"scene folder not found: {d}")
+        if not p.is_dir():  # find_scenes said "scene root not found" of an existing image
+            raise CliError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
         found = find_scenes(p)
         if not found:
             raise CliError(f"no scene (left.png + right.png) under {d}")
