@@ -26,10 +26,12 @@ __all__ = [
     "as_gray_uint8",
     "as_image_array",
     "check_pair",
+    "disparity_range",
     "finite_number",
     "float_sized",
     "int_in_range",
     "positive_finite",
+    "xy_points",
 ]
 
 _T = TypeVar("_T")
@@ -470,6 +472,57 @@ def finite_number(value: object, name: str) -> float:
     if not math.isfinite(out):
         raise ValueError(f"{name}: expected a finite number, got {_shown(value)}")
     return out
+
+
+def disparity_range(min_disparity: object, max_disparity: object) -> tuple[float, float]:
+    """Check a disparity search range ``[min_disparity, max_disparity]``: both finite numbers
+    (:func:`finite_number`), the maximum the larger; the kernels' own messages named their
+    ``d_min`` and ``d_max``.
+
+    Examples
+    --------
+    >>> disparity_range(0, 64)
+    (0.0, 64.0)
+    >>> disparity_range(32, 32)
+    Traceback (most recent call last):
+    ...
+    ValueError: empty disparity range: max_disparity (32) must be larger than min_disparity (32)
+    """
+    lo = finite_number(min_disparity, "min_disparity")
+    hi = finite_number(max_disparity, "max_disparity")
+    if not hi > lo:
+        raise ValueError(
+            "empty disparity range: "
+            f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"
+        )
+    return lo, hi
+
+
+def xy_points(points: object, name: str = "points") -> npt.NDArray[np.float64]:
+    """``points`` as an ``(N, 2)`` float64 array of ``(x, y)`` pixels.
+
+    A ``(2, N)`` array (Bouguet's layout) or homogeneous ``(N, 3)`` points are a ``ValueError``
+    naming the shape (and the transpose for the first), not points reshaped and mapped as
+    others.
+
+    Examples
+    --------
+    >>> xy_points([[1, 2], [3, 4]]).shape
+    (2, 2)
+    >>> xy_points(np.zeros((2, 5)))
+    Traceback (most recent call last):
+    ...
+    ValueError: points: expected shape (N, 2) of (x, y), got (2, 5) (transpose a (2, N) array)
+    """
+    pts = np.asarray(points, np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        hint = (
+            " (transpose a (2, N) array)"
+            if pts.ndim == 2 and pts.shape[0] == 2 and pts.shape[1] != 2
+            else ""
+        )
+        raise ValueError(f"{name}: expected shape (N, 2) of (x, y), got {pts.shape}{hint}")
+    return pts
 
 
 #: The classes :func:`require` checks for, by name, and their modules (imported on use: the

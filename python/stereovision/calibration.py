@@ -28,7 +28,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_image_array, positive_finite
+from stereovision._validate import as_image_array, positive_finite, xy_points
 
 __all__ = [
     "CAMERA_MODELS",
@@ -658,9 +658,7 @@ class Calibration:
             For points not of shape ``(N, 2)``, an unknown ``side`` or ``alpha`` outside
             ``[0, 1]``.
         """
-        pts = np.asarray(points, dtype=np.float64)
-        if pts.ndim != 2 or pts.shape[1] != 2:
-            raise ValueError(f"points: expected shape (N, 2), got {pts.shape}")
+        pts = xy_points(points)
         if side not in ("left", "right"):
             raise ValueError(f"side: expected 'left' or 'right', got {side!r}")
         if self.rectified or len(pts) == 0:

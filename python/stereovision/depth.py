@@ -97,6 +97,21 @@ def _whole_or_float(value: float) -> float:
 _DARK_PAIR = 0.25
 
 
+def _rectify_grey(
+    rig: Calibration | UncalibratedRectification, left: npt.ArrayLike, right: npt.ArrayLike
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
+    """A 16-bit or float pair's own grey levels through ``rig``'s rectification (its 8-bit copy
+    keeps 8 bits of them), in ``[0, 1]`` (:func:`depth_map`'s and ``match``'s)."""
+    rl, rr = rig.rectify(
+        as_gray_float(left, "left", warn=False), as_gray_float(right, "right", warn=False)
+    )
+    # bilinear warps of [0, 1] images stay in [0, 1] up to rounding
+    return (
+        np.ascontiguousarray(np.clip(rl, 0.0, 1.0), np.float32),
+        np.ascontiguousarray(np.clip(rr, 0.0, 1.0), np.float32),
+    )
+
+
 def _round_up(value: float, step: int = _DISPARITY_STEP) -> int:
     return int(max(step, int(np.ceil(value / step)) * step))
 
@@ -943,14 +958,11 @@ def depth_map(
     # terrace through an identity raw rig: bad-2.0 11.1 % on the 8-bit copy, 1.6 % on its own
     # levels). An 8-bit pair keeps its path (grey levels of the rectified BGR images).
     deep = np.asarray(left).dtype != np.uint8 or np.asarray(right).dtype != np.uint8
-    grey: tuple[npt.NDArray[Any], npt.NDArray[Any]] | None = None
+    grey: tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]] | None = None
     if isinstance(calib, UncalibratedRectification):
         # a rig without a calibration: its pair through the homographies, disparity only
         if deep:
-            grey = calib.rectify(
-                as_gray_float(left, "left", warn=False),
-                as_gray_float(right, "right", warn=False),
-            )
+            grey = _rectify_grey(calib, left, right)
         left_bgr, right_bgr = calib.rectify(left_bgr, right_bgr)
         left, right = left_bgr, right_bgr
         max_disparity = calib.max_disparity if max_disparity is None else max_disparity
@@ -973,18 +985,14 @@ def depth_map(
             raise ValueError(f"calibration is for {cw}x{ch} images, got {w}x{h} ({hint})")
         if not calib.rectified:
             if deep:
-                grey = calib.rectify(
-                    as_gray_float(left, "left", warn=False),
-                    as_gray_float(right, "right", warn=False),
-                )
+                grey = _rectify_grey(calib, left, right)
             left_bgr, right_bgr = calib.rectify(left_bgr, right_bgr)
             calib = calib.rectified_calibration()
             left = left_bgr
             right = right_bgr
     stage("rectify")
     if grey is not None:
-        # bilinear warps of [0, 1] images stay in [0, 1] up to rounding
-        gl, gr = (np.ascontiguousarray(np.clip(g, 0.0, 1.0), np.float32) for g in grey)
+        gl, gr = grey
     else:
         # as_bgr_uint8 warned about a 12-bit pair in 16 bits already (once per image)
         gl = as_gray_float(left, "left", warn=False)

@@ -9,7 +9,7 @@ import numpy.typing as npt
 
 from stereovision._validate import as_bgr_uint8, check_pair
 from stereovision.calibration import Calibration
-from stereovision.depth import estimate_max_disparity
+from stereovision.depth import _rectify_grey, estimate_max_disparity
 from stereovision.matches import Matches
 from stereovision.matching import hopfield as _hopfield
 from stereovision.matching import mcgm as _mcgm
@@ -92,11 +92,7 @@ def match(
                 lb, rb = calib.rectify(as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right"))
                 gl, gr = check_pair(lb, rb)
             else:
-                # a 16-bit or float pair's own grey levels, rectified (its 8-bit copy kept 8
-                # bits of them), as depth_map does
-                rl, rr = calib.rectify(gl, gr)
-                gl = np.ascontiguousarray(np.clip(rl, 0.0, 1.0), np.float32)
-                gr = np.ascontiguousarray(np.clip(rr, 0.0, 1.0), np.float32)
+                gl, gr = _rectify_grey(calib, gl, gr)  # as depth_map does
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
     if method == "mcgm":

@@ -25,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import finite_number
+from stereovision._validate import disparity_range
 
 __all__ = ["DEFAULTS", "RefineResult", "refine_disparity"]
 
@@ -163,13 +163,7 @@ def refine_disparity(
                 f"{int(bad.sum())} pixels are not (e.g. {float(conf[bad][0])!r})"
             )
         conf = np.where(measured | np.isfinite(conf), conf, np.float32(0))
-    finite_number(min_disparity, "min_disparity")  # 2**1100: math.isfinite's OverflowError
-    finite_number(max_disparity, "max_disparity")
-    if not max_disparity > min_disparity:  # the kernel's message named its d_min and d_max
-        raise ValueError(
-            "empty disparity range: "
-            f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"
-        )
+    disparity_range(min_disparity, max_disparity)
     kw = {**DEFAULTS, **params}
     fills_raw = kw.pop("fills")
     try:

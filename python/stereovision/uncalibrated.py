@@ -43,7 +43,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_gray_uint8
+from stereovision._validate import as_gray_uint8, xy_points
 from stereovision.rectification_check import MIN_MATCHES, _features, _mutual_matches
 
 __all__ = [
@@ -363,15 +363,7 @@ class UncalibratedRectification:
         """
         if side not in ("left", "right"):
             raise ValueError(f"side: expected 'left' or 'right', got {side!r}")
-        pts = np.asarray(points, np.float64)
-        if pts.ndim != 2 or pts.shape[1] != 2:
-            hint = (
-                " (transpose a (2, N) array)"
-                if pts.ndim == 2 and pts.shape[0] == 2 and pts.shape[1] != 2
-                else ""
-            )
-            raise ValueError(f"points: expected shape (N, 2) of (x, y), got {pts.shape}{hint}")
-        return _apply(self.H1 if side == "left" else self.H2, pts)
+        return _apply(self.H1 if side == "left" else self.H2, xy_points(points))
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready: the homographies, ``F`` and the figures."""

@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import finite_number, float_sized, refuse_unknown
+from stereovision._validate import disparity_range, float_sized, refuse_unknown
 
 __all__ = ["DEFAULTS", "GaborResult", "gabor_disparity", "gabor_responses"]
 
@@ -135,13 +135,7 @@ def gabor_disparity(
     rgt = _as_grey(right, "right")
     if lft.shape != rgt.shape:
         raise ValueError(f"left {lft.shape} and right {rgt.shape} images differ in shape")
-    finite_number(max_disparity, "max_disparity")  # 2**1100: math.isfinite's OverflowError
-    finite_number(min_disparity, "min_disparity")
-    if not max_disparity > min_disparity:  # the kernel's message named its d_max and d_min
-        raise ValueError(
-            "empty disparity range: "
-            f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"
-        )
+    disparity_range(min_disparity, max_disparity)
     kw: dict[str, Any] = {**DEFAULTS, **params}
     for name, default in DEFAULTS.items():
         if isinstance(default, float) or default is None:
