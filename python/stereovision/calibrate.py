@@ -2289,12 +2289,6 @@ def _expand(pattern: str, option: str) -> list[str]:
     return [p]
 
 
-def _frame_number(path: str) -> int | None:
-    """The last run of digits in a file's name without its suffix (``left07.jpg`` -> 7)."""
-    runs = re.findall(r"\d+", Path(path).stem)
-    return int(runs[-1]) if runs else None
-
-
 def _pair_by_number(lefts: list[str], rights: list[str]) -> list[str]:
     """The right images in the order of their left partners, paired on the number in the name.
 
@@ -2323,8 +2317,8 @@ def _pair_by_number(lefts: list[str], rights: list[str]) -> list[str]:
     ValueError
         If the numbers pair most images but some have no partner (named, the first few).
     """
-    kl = [_frame_number(f) for f in lefts]
-    kr = [_frame_number(f) for f in rights]
+    kl = [_file_number(f) for f in lefts]
+    kr = [_file_number(f) for f in rights]
     if None in kl or None in kr or len(set(kl)) != len(kl) or len(set(kr)) != len(kr):
         return rights
     by_number = dict(zip(kr, rights, strict=True))
