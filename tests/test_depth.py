@@ -580,6 +580,20 @@ def test_a_fractional_range_is_reported_as_searched(tmp_path: Path) -> None:
     assert type(whole.max_disparity) is int and whole.max_disparity == 32
 
 
+@pytest.mark.parametrize(("method", "max_disparity"), [("fused", 37), ("gabor", 37.5)])
+def test_the_map_stays_in_the_range_searched(method: str, max_disparity: float) -> None:
+    """The fused map ran past a range set below the scene's (cones with 37: 13897 pixels up to
+    38.6, from its Gabor input and the plane fills) and below 0 on real scenes (teddyH's
+    bad-2.0 6.49 -> 6.40 % with the values out of range made holes, then filled in range)."""
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")
+    res = sv.depth_map(s.left, s.right, s.calib, method=method, max_disparity=max_disparity)
+    d = res.disparity
+    if method == "fused":
+        assert np.isfinite(d).mean() > 0.99  # still dense: the holes were filled in range
+    assert float(np.nanmin(d)) >= 0.0 and float(np.nanmax(d)) <= max_disparity
+    assert float(np.nanmax(d)) > max_disparity - 0.5  # cones reaches 55 px: the top is hit
+
+
 def test_census_depth_sigma_is_one_value_as_documented() -> None:
     """The docs of ``depth_sigma`` did not say that ``"fast"`` and ``"census"`` without the
     re-measure give every pixel sigma_d 0.63 px (and 0.29 px with it): one confidence, 0.5."""

@@ -1040,6 +1040,15 @@ def depth_map(
     )
     disp = np.ascontiguousarray(disp, dtype=np.float32)
     conf = np.ascontiguousarray(conf, dtype=np.float32)
+    # The range searched (the census map's reaches the next whole pixel above a fractional
+    # one): the fused map's Gabor input and plane fills ran past it (cones with 37: up to
+    # 38.6), values no matcher measured there. Out of it is a hole, as match() drops them.
+    hi = float(max_disparity) if method == "gabor" else float(math.ceil(max_disparity))
+    lo = float(min_disparity)
+    with np.errstate(invalid="ignore"):
+        out = (disp < lo) | (disp > hi)
+    if out.any():  # a new array: disp may be a channel's own output, kept in ``channels``
+        disp = np.where(out, np.float32(np.nan), disp)
     measured = np.isfinite(disp)
     conf = np.where(measured, conf, np.float32(0)).astype(np.float32)
     stage("match")
@@ -1073,6 +1082,7 @@ def depth_map(
     if fill:
         fused = method != "gabor"  # the fused map's fill suits the census map too
         disp, far = fill_holes(disp, left_bgr, fused=fused, floor=float(min_disparity), grey=gl)
+        np.clip(disp, lo, hi, out=disp)  # a plane may run past the range at a hole's far end
         if far is not None:
             measured_disp[far] = np.nan  # fused_dense's own array, as is conf
             conf[far] = 0
