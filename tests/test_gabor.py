@@ -216,6 +216,18 @@ def test_invalid_inputs_raise_value_error() -> None:
         gabor_disparity(bad, a, max_disparity=8)
 
 
+@pytest.mark.parametrize(("name", "value"), [("search_pool_radius", 17), ("research_radius", 17)])
+def test_a_radius_out_of_range_is_named(name: str, value: int) -> None:
+    """The kernel checks both radii in one test: ``search_pool_radius=20`` was reported as
+    "invalid parameter `research_radius`", a parameter the caller had not touched."""
+    a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    assert np.isfinite(gabor_disparity(a, a, max_disparity=8, **{name: 16}).disparity).any()
+    with pytest.raises(ValueError, match=name) as exc:
+        gabor_disparity(a, a, max_disparity=8, **{name: value})
+    other = {"search_pool_radius": "research_radius", "research_radius": "search_pool_radius"}
+    assert other[name] not in str(exc.value)
+
+
 # --- determinism ----------------------------------------------------------------------------------
 
 _HASH_SCRIPT = """

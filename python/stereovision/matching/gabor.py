@@ -151,6 +151,11 @@ def gabor_disparity(
             continue
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 0 <= v < 2**31:
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
+    # The kernel checks both radii in one test and names research_radius for either.
+    if kw["search_pool_radius"] > 16:
+        raise ValueError(
+            f"search_pool_radius must be at most 16 px, got {kw['search_pool_radius']!r}"
+        )
     orient = kw["orientations_deg"]
     if not isinstance(orient, Sequence) and not isinstance(orient, np.ndarray):
         raise ValueError(f"orientations_deg must be a sequence of degrees, got {orient!r}")
