@@ -241,3 +241,20 @@ def test_fill_planes_edge_cases_and_bad_input() -> None:
         fill_planes(np.where(full > 0, np.nan, full), img, passes=((256, 50),))
     with pytest.raises(ValueError, match="channels"):
         fill_planes(full, np.zeros((8, 8, 4), np.uint8))
+
+
+@pytest.mark.parametrize(
+    "labels",
+    [np.full((8, 8), 0.7), np.full((8, 8), 2**32, np.int64), np.full((8, 8), -1, np.int64)],
+)
+def test_plane_fill_refuses_labels_the_uint32_cast_would_change(labels: np.ndarray) -> None:
+    """Float labels were truncated (0.7 -> segment 0) and 64-bit ones wrapped (2**32 -> 0):
+    the holes took the plane of a segment the caller never made, without a word."""
+    yy, xx = np.mgrid[0:8, 0:8].astype(np.float32)
+    d = 0.5 * xx + 0.25 * yy + 3
+    holed = d.copy()
+    holed[3:5, 3:5] = np.nan
+    got = plane_fill(holed, np.zeros((8, 8), np.int64), min_pixels=5)
+    np.testing.assert_allclose(got, d, atol=1e-5)
+    with pytest.raises(ValueError, match="labels"):
+        plane_fill(holed, labels, min_pixels=5)

@@ -161,17 +161,27 @@ def plane_fill(
     Raises
     ------
     ValueError
-        ``disp`` not 2-D, ``labels`` of another shape or not below ``H * W``, a negative
-        ``min_pixels`` or ``max_residual``, ``lo`` above ``hi``.
+        ``disp`` not 2-D, ``labels`` of another shape, not integers or not in
+        ``0 .. H * W - 1``, a negative ``min_pixels`` or ``max_residual``, ``lo`` above ``hi``.
     """
     from stereovision import _core
 
     d = np.ascontiguousarray(disp, dtype=np.float32)
-    lab = np.ascontiguousarray(labels, dtype=np.uint32)
+    raw = np.asarray(labels)
     if d.ndim != 2:
         raise ValueError(f"disp: expected an (H, W) array, got {d.shape}")
-    if lab.shape != d.shape:
-        raise ValueError(f"labels: expected shape {d.shape} like disp, got {lab.shape}")
+    if raw.shape != d.shape:
+        raise ValueError(f"labels: expected shape {d.shape} like disp, got {raw.shape}")
+    # The cast to uint32 truncated float labels (0.7 -> 0) and wrapped wide ones (2**32 -> 0):
+    # segments merged without a word.
+    if raw.dtype.kind not in "iu":
+        raise ValueError(f"labels: expected integer labels, got dtype {raw.dtype}")
+    if raw.size and not 0 <= int(raw.min()) <= int(raw.max()) < raw.size:
+        raise ValueError(
+            f"labels: expected values from 0 and below H * W = {raw.size}, as segments()"
+            f" numbers them, got {int(raw.min())} .. {int(raw.max())}"
+        )
+    lab = np.ascontiguousarray(raw, dtype=np.uint32)
     if isinstance(min_pixels, bool) or not isinstance(min_pixels, (int, np.integer)):
         raise ValueError(f"min_pixels: expected a whole number, got {min_pixels!r}")
     if not 0 <= min_pixels <= _MAX_COUNT:
