@@ -258,3 +258,62 @@ def test_plane_fill_refuses_labels_the_uint32_cast_would_change(labels: np.ndarr
     np.testing.assert_allclose(got, d, atol=1e-5)
     with pytest.raises(ValueError, match="labels"):
         plane_fill(holed, labels, min_pixels=5)
+
+
+@pytest.mark.parametrize(
+    ("fill", "bad"),
+    [
+        ("fill_planes", {"blur": -1.0}),
+        ("fill_planes", {"blur": 100.0}),
+        ("fill_planes", {"max_residual": float("nan")}),
+        ("fill_planes", {"max_residual": -1.0}),
+        ("side_fill", {"tau": -1.0}),
+        ("side_fill", {"tau": float("nan")}),
+        ("side_fill", {"blur": 100.0}),
+    ],
+)
+def test_fill_parameters_are_checked_on_a_map_without_holes(
+    fill: str, bad: dict[str, float]
+) -> None:
+    """The parameters were checked only once a hole was found: the same bad call raised on one
+    frame and passed on the next."""
+    fn = {"fill_planes": fill_planes, "side_fill": side_fill}[fill]
+    img = np.zeros((8, 8, 3), np.uint8)
+    full = np.ones((8, 8), np.float32)
+    holed = full.copy()
+    holed[2, 2:5] = np.nan
+    np.testing.assert_array_equal(fn(full, img), full)
+    name = next(iter(bad))
+    for d in (holed, full):
+        with pytest.raises(ValueError, match=name):
+            fn(d, img, **bad)
+
+
+@pytest.mark.parametrize("fill", ["fill_planes", "side_fill", "segments"])
+@pytest.mark.parametrize(
+    "image",
+    [np.full((8, 8), np.nan, np.float32), np.full((8, 8), 100 + 1j)],
+    ids=["nan", "complex"],
+)
+def test_an_image_the_uint8_cast_would_garble_is_refused(fill: str, image: np.ndarray) -> None:
+    """The blur's cast to uint8 made NaN 0 and dropped the imaginary part, with only a NumPy
+    warning: the segments were cut in garbage."""
+    holed = np.ones((8, 8), np.float32)
+    holed[2, 2:5] = np.nan
+    calls = {
+        "fill_planes": lambda im: fill_planes(holed, im),
+        "side_fill": lambda im: side_fill(holed, im),
+        "segments": lambda im: segments(im, blur=1.0),
+    }
+    assert np.asarray(calls[fill](np.full((8, 8), 100.0))).shape == (8, 8)
+    with pytest.raises(ValueError, match="image"):
+        calls[fill](image)
+
+
+def test_fill_planes_names_a_disparity_map_that_is_not_2d() -> None:
+    """A 1-D map (and image) reached the binding: "TypeError: dimensionality mismatch"; an
+    (H, W, 1) map was reported as an image of the wrong size."""
+    with pytest.raises(ValueError, match="disp"):
+        fill_planes(np.array([1, np.nan, 3], np.float32), np.array([1, 2, 3], np.uint8))
+    with pytest.raises(ValueError, match="disp"):
+        fill_planes(np.full((8, 8, 1), np.nan, np.float32), np.zeros((8, 8, 1), np.uint8))

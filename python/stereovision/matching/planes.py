@@ -117,13 +117,24 @@ def segments(
     return _core.graph_segments(np.ascontiguousarray(key, np.float32), k, size)
 
 
+def _check_blur(blur: float) -> None:
+    """A ``ValueError`` naming ``blur`` unless it is a sigma in ``[0, _MAX_BLUR]`` px."""
+    if not 0 <= finite_number(blur, "blur") <= _MAX_BLUR:
+        raise ValueError(f"blur: expected a sigma in [0, {_MAX_BLUR:g}] px, got {blur}")
+
+
 def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
     """The Gaussian blur :func:`segments` starts with: uint8 in (other types clipped to 0-255),
     uint8 out (OpenCV rounds the blurred values, as the reference does); ``blur`` 0: none."""
     import cv2
 
-    if not 0 <= finite_number(blur, "blur") <= _MAX_BLUR:
-        raise ValueError(f"blur: expected a sigma in [0, {_MAX_BLUR:g}] px, got {blur}")
+    _check_blur(blur)
+    # The cast below turned NaN into 0 and complex values into their real part, with only a
+    # NumPy warning: the segments were cut in garbage.
+    if im.dtype.kind not in "biuf":
+        raise ValueError(f"image: expected real 0-255 values, got dtype {im.dtype}")
+    if im.dtype.kind == "f" and not np.isfinite(im).all():
+        raise ValueError("image: contains NaN or inf")
     u8 = im if im.dtype == np.uint8 else np.clip(im.astype(np.float32), 0, 255).astype(np.uint8)
     if blur <= 0:
         return u8
@@ -229,12 +240,16 @@ def fill_planes(
     Raises
     ------
     ValueError
-        An image of another size or with more than 3 channels, ``passes`` not pairs of a step
-        in 1-255 and a count in 0 to 2**31 - 1, or a ``blur`` outside [0, 64] px.
+        ``disp`` not 2-D, an image of another size, with more than 3 channels, not real or
+        with NaN/inf, ``passes`` not pairs of a step in 1-255 and a count in 0 to 2**31 - 1, a
+        ``blur`` outside [0, 64] px or a negative or non-finite ``max_residual`` (checked also
+        when ``disp`` has no hole).
     """
     from stereovision import _core
 
     d = np.ascontiguousarray(disp, dtype=np.float32)
+    if d.ndim != 2:
+        raise ValueError(f"disp: expected an (H, W) array, got {d.shape}")
     im = np.asarray(image)
     if im.shape[:2] != d.shape:
         raise ValueError(f"image: expected {d.shape} pixels like disp, got {im.shape[:2]}")
@@ -250,12 +265,17 @@ def fill_planes(
             "passes: expected (step, min_pixels) pairs, steps in 1-255 and counts in "
             f"0-{_MAX_COUNT}, got {passes!r}"
         ) from None
+    # Checked before the early return: a bad value was accepted whenever the map had no hole.
+    _check_blur(blur)
+    residual = float(finite_number(max_residual, "max_residual"))
+    if residual < 0:
+        raise ValueError(f"max_residual: expected a non-negative number, got {max_residual}")
     if np.isfinite(d).all():
         return d.copy()
     # Blurred once for every pass and binning (uint8: other types clipped to 0-255).
     im = _blurred(im, blur)
     u8 = np.ascontiguousarray(im[:, :, None] if im.ndim == 2 else im)
-    return _core.fill_planes(d, u8, steps, float(float_sized(max_residual, "max_residual")))
+    return _core.fill_planes(d, u8, steps, residual)
 
 
 #: The colour side rule's defaults (:func:`side_fill`): chosen once on the 17 GT scenes.
@@ -305,8 +325,9 @@ def side_fill(
     Raises
     ------
     ValueError
-        ``disp`` not 2-D, an image of another size or with a channel count other than 1 or 3,
-        a negative ``tau`` or a ``blur`` outside [0, 64] px.
+        ``disp`` not 2-D, an image of another size, with a channel count other than 1 or 3,
+        not real or with NaN/inf, a negative or non-finite ``tau`` or a ``blur`` outside
+        [0, 64] px (the parameters checked also when ``disp`` has no hole).
     """
     import cv2
 
@@ -324,11 +345,13 @@ def side_fill(
         raise ValueError(
             f"image: expected (H, W) or (H, W, 3) with (H, W) = {d.shape}, got {im.shape}"
         )
-    if finite_number(blur, "blur") < 0:
-        raise ValueError(f"blur: expected a non-negative number, got {blur}")
+    # Checked before the early return: a bad value was accepted whenever the map had no hole.
+    _check_blur(blur)
+    if not finite_number(tau, "tau") >= 0:
+        raise ValueError(f"tau: expected a non-negative number, got {tau}")
     if np.isfinite(d).all():
         return d.copy()
     u8 = _blurred(im, blur)
     bgr = cv2.cvtColor(u8, cv2.COLOR_GRAY2BGR) if u8.ndim == 2 or u8.shape[2] == 1 else u8
     lab = np.ascontiguousarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2LAB), np.float32)
-    return _core.side_fill(d, lab, float(float_sized(tau, "tau")))
+    return _core.side_fill(d, lab, float(tau))
