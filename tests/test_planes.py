@@ -317,3 +317,26 @@ def test_fill_planes_names_a_disparity_map_that_is_not_2d() -> None:
         fill_planes(np.array([1, np.nan, 3], np.float32), np.array([1, 2, 3], np.uint8))
     with pytest.raises(ValueError, match="disp"):
         fill_planes(np.full((8, 8, 1), np.nan, np.float32), np.zeros((8, 8, 1), np.uint8))
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.float32, np.int32])
+def test_segments_min_size_is_the_same_for_every_image_type(dtype: type) -> None:
+    """A uint8 image took the quantised-regions kernel, which has no ``min_size``: its 6-pixel
+    region stayed with ``min_size=50`` while the same image as floats had it joined to a
+    neighbour (3 segments against 2)."""
+    img = np.zeros((40, 60), np.uint8)
+    img[:, 30:] = 200
+    img[10:12, 5:8] = 100  # a 6-pixel region
+    im = img.astype(dtype)
+    assert np.unique(segments(im, blur=0)).size == 3
+    labels = segments(im, blur=0, min_size=50)
+    assert np.unique(labels).size == 2
+    assert labels[10, 5] == labels[0, 0]
+
+
+@pytest.mark.parametrize("bad", [{"step": float("nan")}, {"offset": float("nan")}])
+def test_segments_names_a_nan_step_or_offset(bad: dict[str, float]) -> None:
+    """A NaN step passed the ``step < 1`` test and made every key NaN: the error blamed the
+    image ("image: contains NaN or inf")."""
+    with pytest.raises(ValueError, match=next(iter(bad))):
+        segments(np.zeros((8, 8), np.uint8), blur=0, **bad)

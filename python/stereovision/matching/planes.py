@@ -79,8 +79,9 @@ def segments(
         A pixel's bin in each channel is ``(value + offset) // step``.
     k, min_size : float, int
         With ``k > 0`` neighbouring regions merge further by Felzenszwalb and Huttenlocher's
-        rule (an edge at most each region's internal difference + ``k / size``), and regions
-        under ``min_size`` pixels join a neighbour. The defaults (0, 1) keep the plain regions.
+        rule (an edge at most each region's internal difference + ``k / size``); regions
+        under ``min_size`` pixels join a neighbour (whatever ``k``). The defaults (0, 1) keep
+        the plain regions.
 
     Returns
     -------
@@ -90,21 +91,26 @@ def segments(
     Raises
     ------
     ValueError
-        A non-2-D/3-D image, a non-positive ``step``, a ``blur`` outside [0, 64] px, a
-        ``min_size`` outside 0 to 2**31 - 1 or a negative ``k``.
+        A non-2-D/3-D image, a ``step`` below 1 or not finite, a non-finite ``offset``, a
+        ``blur`` outside [0, 64] px, a ``min_size`` outside 0 to 2**31 - 1 or a negative ``k``.
     """
     from stereovision import _core
 
     im = np.asarray(image)
     if im.ndim not in (2, 3) or im.size == 0 or im.dtype.kind not in "iuf":
         raise ValueError(f"image: expected a real (H, W) or (H, W, C) array, got {im.shape}")
-    if step < 1 or finite_number(blur, "blur") < 0:
+    # A NaN step or offset passed this test and made every key NaN: "image: contains NaN".
+    if not finite_number(step, "step") >= 1 or finite_number(blur, "blur") < 0:
         raise ValueError(f"step must be >= 1 and blur >= 0, got step={step}, blur={blur}")
+    finite_number(offset, "offset")
     size = int_in_range(min_size, "min_size", 0, _MAX_COUNT)
     if blur > 0:
         im = _blurred(im, blur)
     fast = im.dtype == np.uint8 and (im.ndim == 2 or im.shape[2] <= 3) and 0 <= offset <= 255
-    if k == 0 and fast and step <= 255:
+    # The kernel has no min_size: it served a uint8 image with min_size 50 as if it were 1,
+    # while the same image as floats had its small regions joined to a neighbour.
+    whole = float(step).is_integer() and float(offset).is_integer()
+    if k == 0 and fast and step <= 255 and size <= 1 and whole:
         # Equal regions of a uint8 image: the kernel bins and labels in one pass.
         u8 = im[:, :, None] if im.ndim == 2 else im
         return _core.quantised_regions(np.ascontiguousarray(u8), int(step), int(offset))
