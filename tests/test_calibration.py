@@ -721,3 +721,24 @@ def test_a_rig_whose_baseline_runs_along_a_view_is_not_rectified(tmp_path: Path)
 
     path = forward.save(tmp_path / "forward.yaml")
     assert main(["info", str(path)]) == 2
+
+
+@pytest.mark.parametrize(
+    ("cx2", "far", "near"),
+    [
+        (140.0, "farthest depth, at a disparity of 21.00 px (1 px above infinity's 20.00 px): "
+         "50.00 m", "64 px 1.14 m, 128 px 46.3 cm, 256 px 21.2 cm"),
+        (-140.0, "farthest depth, at a disparity of 301.00 px (1 px above infinity's 300.00 "
+         "px): 50.00 m", "none (a depth needs a disparity above 300.00 px)"),
+    ],
+)  # fmt: skip
+def test_describe_with_a_negative_doffs(cx2: float, far: str, near: str) -> None:
+    """cx2 < cx1 (doffs -20 px, say): a disparity of 1 px is beyond infinity, yet the farthest
+    depth was "inf m" (and "(d + -20.00 px)"); at doffs -300 every range was left out, leaving
+    "nearest depth a disparity range reaches: " with nothing after it. fB = 50 m px."""
+    K2 = np.array([[500.0, 0.0, cx2], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]])
+    text = rect_calib(K2=K2).describe()
+    doffs = 160.0 - cx2
+    assert f"depth Z = 50.000 m px / (d - {doffs:.2f} px)" in text
+    assert far in text and "inf m" not in text
+    assert f"nearest depth a disparity range reaches: {near}\n" in text

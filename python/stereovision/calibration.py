@@ -766,8 +766,19 @@ class Calibration:
         near = ", ".join(
             f"{d} px {length(f * b / (d + doffs))}" for d in (64, 128, 256) if d + doffs > 0
         )
+        if not near:  # doffs <= -256: every range ends before a disparity gives a depth
+            near = f"none (a depth needs a disparity above {-doffs:.2f} px)"
         steps = ", ".join(f"at {z:g} m {length(float(self.depth_step(z)))}" for z in depths)
-        far = f * b / (1 + doffs) if 1 + doffs > 0 else math.inf
+        # d + doffs <= 0 is at or beyond infinity: with doffs <= -1 (cx2 < cx1 - 1) a disparity
+        # of 1 px has no depth, and the farthest is one pixel above infinity's -doffs (it said
+        # "inf m").
+        if 1 + doffs > 0:
+            far = f"farthest depth, at a disparity of 1 px: {length(f * b / (1 + doffs))}"
+        else:
+            far = (
+                f"farthest depth, at a disparity of {1 - doffs:.2f} px (1 px above infinity's "
+                f"{-doffs:.2f} px): {length(f * b)}"
+            )
         kind = (
             "rectified pair"
             if self.rectified
@@ -778,10 +789,10 @@ class Calibration:
                 f"{w}x{h} px, {kind}: baseline {length(b)} ({self.baseline:g} {self.unit}), "
                 f"focal length {f:.1f} px, doffs {doffs:.2f} px",
                 f"field of view {hfov:.1f} x {vfov:.1f} degrees",
-                f"depth Z = {f * b:.3f} m px / (d + {doffs:.2f} px)",
+                f"depth Z = {f * b:.3f} m px / (d {'-' if doffs < 0 else '+'} {abs(doffs):.2f} px)",
                 f"nearest depth a disparity range reaches: {near}",
                 f"depth step per pixel of disparity: {steps} (a 0.1 px error: a tenth of it)",
-                f"farthest depth, at a disparity of 1 px: {length(far)}",
+                far,
             ]
         )
 
