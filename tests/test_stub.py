@@ -48,3 +48,35 @@ def test_public_signatures_resolve_at_run_time() -> None:
                     if "'pv'" not in str(exc):
                         unresolved.append(f"{name}.{fn.__qualname__}: {exc}")
     assert unresolved == []
+
+
+def test_stub_defaults_are_the_extensions_values() -> None:
+    """``stubtest`` takes a default of ``...`` for any value: ``hopfield_interest``'s four
+    defaults were ``...`` in the stub, so an editor showed no default at all. Every default the
+    extension's text signature gives is written out in the stub, with its value."""
+    import ast
+    import inspect
+    from pathlib import Path
+
+    from stereovision import _core
+
+    stub = ast.parse(Path(inspect.getfile(_core)).with_name("_core.pyi").read_text())
+    written: dict[str, dict[str, object]] = {}
+    for node in stub.body:
+        if isinstance(node, ast.FunctionDef):
+            args = node.args
+            pos = args.posonlyargs + args.args
+            pairs = list(zip(pos[len(pos) - len(args.defaults) :], args.defaults, strict=True))
+            pairs += [
+                (a, d)
+                for a, d in zip(args.kwonlyargs, args.kw_defaults, strict=True)
+                if d is not None
+            ]
+            written[node.name] = {a.arg: ast.literal_eval(d) for a, d in pairs}
+    for name in _core.__all__ if hasattr(_core, "__all__") else dir(_core):
+        fn = getattr(_core, name)
+        if not callable(fn) or not fn.__text_signature__:
+            continue
+        sig = inspect.signature(fn)
+        real = {p: v.default for p, v in sig.parameters.items() if v.default is not v.empty}
+        assert written[name] == real, name

@@ -113,10 +113,10 @@ def gabor_remove_speckles(
 
 def hopfield_interest(
     img: npt.NDArray[np.float32],
-    rel_threshold: float = ...,
-    nms_half: int = ...,
-    tile: int = ...,
-    floor_rel: float = ...,
+    rel_threshold: float = 1e-3,
+    nms_half: int = 1,
+    tile: int = 64,
+    floor_rel: float = 1e-4,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.int32], npt.NDArray[np.float32]]: ...
 def hopfield_match(
     left: npt.NDArray[np.float32], right: npt.NDArray[np.float32], params: dict[str, Any]
