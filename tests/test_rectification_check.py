@@ -281,6 +281,34 @@ def test_cli_check_fix(data_dir: Path, tmp_path: Path) -> None:
     assert "recalibrate" not in run.stdout
 
 
+def test_cli_check_cannot_tell(tmp_path: Path) -> None:
+    """A pair too plain to judge: exit 3 (not 1, a verdict on the rig, nor 2, an error), with
+    and without --fix; --fix says in one line that it wrote nothing, and writes nothing."""
+    flat = tmp_path / "flat.png"
+    cv2.imwrite(str(flat), np.full((375, 450), 128, np.uint8))
+    rig = _rig(450, 375, (0.3, 0.0, 0.0)).save(tmp_path / "rig.yaml")
+    fixed = tmp_path / "fixed.yaml"
+    for extra in ([], ["--fix", str(fixed)], ["--json", "--fix", str(fixed)]):
+        run = subprocess.run([*SV, "check", str(flat), str(flat), "--calib", str(rig), *extra],
+                             capture_output=True, text=True, timeout=120)  # fmt: skip
+        assert run.returncode == 3, (extra, run.stderr)
+        out = json.loads(run.stdout) if "--json" in extra else run.stdout
+        if "--json" in extra:
+            assert out["ok"] is None and out["matches"] == 0
+        else:
+            assert out.startswith("rectification: cannot tell, 0 consistent feature matches")
+        if extra:
+            assert run.stderr == (
+                f"stereovision: not corrected, nothing written to {fixed}: too little texture "
+                "to tell the rows (give a textured pair)\n"
+            )
+        else:
+            assert run.stderr == ""
+        assert not fixed.exists()
+    run = subprocess.run([*SV, "check", "--help"], capture_output=True, text=True, timeout=120)
+    assert "3 when the pair has too little texture to tell" in " ".join(run.stdout.split())
+
+
 def test_align_rows_undoes_a_row_offset(data_dir: Path) -> None:
     """Cones with the right image 1.5 px lower and turned 0.2 degrees: aligned, the rows are
     back within 0.15 px; the left image (the disparity's frame) is untouched."""

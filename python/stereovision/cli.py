@@ -27,6 +27,7 @@ import numpy as np
 from stereovision._interrupt import Terminated, raise_terminated
 
 EXIT_ERROR = 2
+EXIT_CANNOT_TELL = 3  # `check`: too little texture to tell whether the rows agree
 EXIT_INTERRUPTED = 130
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, what a shell reports for `yes | head`
 EXIT_TERMINATED = 143  # 128 + SIGTERM
@@ -460,6 +461,16 @@ def cmd_check(args: argparse.Namespace) -> int:
             else "  these images are not rectified: give the rig's calibration (--calib), or "
             "rectify them from their own features (stereovision rectify LEFT RIGHT -o DIR)"
         )
+    if res.ok is None:
+        # Not an error of the command line (2), nor a verdict on the rig (1): the pair could
+        # not be judged, so there is nothing to correct either.
+        if fix is not None:
+            print(
+                f"stereovision: not corrected, nothing written to {fix}: too little texture "
+                "to tell the rows (give a textured pair)",
+                file=sys.stderr,
+            )
+        return EXIT_CANNOT_TELL
     if fix is None:
         return 0 if res.ok else 1
     from stereovision.rectification_check import refine_rectification
@@ -984,11 +995,12 @@ def build_parser() -> argparse.ArgumentParser:
 
     d = sub.add_parser(
         "check",
-        help="is a pair rectified? row offset of its features (exit 1 if not)",
+        help="is a pair rectified? row offset of its features (exit 1 if not, 3 if it cannot tell)",
         description="Measure how far a pair's SIFT feature matches lie off each other's rows "
         "after rectification, to catch a calibration that a bump or heat has spoiled. Exit "
-        "status 0 when the median is within --tolerance, 1 when not or when the pair has too "
-        "little texture to tell.",
+        "status 0 when the median is within --tolerance (with --fix: the corrected calibration "
+        "is), 1 when not, 2 on an error, 3 when the pair has too little texture to tell (with "
+        "--fix: nothing is written).",
     )
     d.add_argument("left", help="left image: raw with --calib, else rectified")
     d.add_argument("right", help="right image, the same size")
