@@ -515,7 +515,8 @@ def test_rectify_with_calib_removes_an_earlier_runs_homographies(
     scene = data_dir / "eth3d" / "terrace"
     pair = [str(scene / "left.png"), str(scene / "right.png")]
     out = tmp_path / "rect"
-    assert main(["rectify", *pair, "-o", str(out)]) == 0
+    # terrace is rectified already: --force has its homographies found all the same
+    assert main(["rectify", *pair, "--force", "-o", str(out)]) == 0
     assert (out / "rectification.json").is_file()
     capsys.readouterr()
     assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
@@ -528,6 +529,48 @@ def test_rectify_with_calib_removes_an_earlier_runs_homographies(
     (out / "rectification.json").write_text('{"mine": 1}')
     assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
     assert (out / "rectification.json").read_text() == '{"mine": 1}'
+
+
+def test_rectify_writes_a_rectified_pair_as_given(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`rectify` without --calib of a pair already rectified (cones) warped it by homographies
+    fitted to rows that already agreed: resampled, and 455x378 px instead of 450x375. It is
+    now written as given, said in one line; --force rectifies it from its features anyway."""
+    scene = data_dir / "middlebury2003" / "cones"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    out = tmp_path / "rect"
+    assert main(["rectify", *pair, "-o", str(out)]) == 0
+    said = capsys.readouterr().out.splitlines()
+    assert said[0].startswith("already rectified (rows median |dy| 0.")
+    assert said[0].endswith(
+        "tolerance 0.5): written as given, not warped (--force rectifies it from its features "
+        "anyway)"
+    )
+    assert [line.split()[0] for line in said[1:]] == ["left_rect.png", "right_rect.png",
+                                                     "check.png"]  # fmt: skip
+    for side in ("left", "right"):
+        np.testing.assert_array_equal(
+            cv2.imread(str(out / f"{side}_rect.png")), cv2.imread(str(scene / f"{side}.png"))
+        )
+    assert not (out / "rectification.json").exists()
+    assert main(["rectify", *pair, "--force", "-o", str(out)]) == 0
+    assert capsys.readouterr().out.startswith("rectified without a calibration")
+    assert (out / "rectification.json").is_file()
+    assert cv2.imread(str(out / "left_rect.png")).shape != cv2.imread(pair[0]).shape
+    # the homographies of the forced run are not this pair's any more: removed, and said
+    assert main(["rectify", *pair, "-o", str(out)]) == 0
+    assert not (out / "rectification.json").exists()
+    assert capsys.readouterr().out.splitlines()[-1] == (
+        "  removed rectification.json of an earlier run (not this pair's: it is rectified already)"
+    )
+    terrace = data_dir / "eth3d" / "terrace"
+    calib = ["--calib", str(terrace / "calib.txt")]
+    tp = [str(terrace / "left.png"), str(terrace / "right.png")]
+    assert main(["rectify", *tp, *calib, "--force", "-o", str(tmp_path / "c")]) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: --force is for rectifying without a calibration (no --calib)\n"
+    )
 
 
 def test_eval_counts_a_scene_given_twice_once(data_dir: Path) -> None:

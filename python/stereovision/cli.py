@@ -494,8 +494,9 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_rectify(args: argparse.Namespace) -> int:
-    """``stereovision rectify LEFT RIGHT -o DIR [--calib F]``: the rectified pair, and with no
-    calibration the homographies found from the pair's features."""
+    """``stereovision rectify LEFT RIGHT -o DIR [--calib F] [--force]``: the rectified pair,
+    and with no calibration the homographies found from the pair's features (a pair already
+    rectified is written as given, unless ``--force``)."""
     from stereovision.io import imread, make_folder
     from stereovision.rectification_check import check_rectification, draw_rectification_check
 
@@ -510,19 +511,33 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     for name in ("left_rect.png", "right_rect.png", "check.png", "rectification.json"):
         _refuse_an_input("-o", out / name, inputs)  # rectifying rect/*.png again into rect/
     written: dict[str, Path] = {}
+    given = None  # the pair's own check, when it is already rectified: written as given
     if calib is not None:
         if args.model != "auto":
             raise CliError("--model is for rectifying without a calibration (no --calib)")
+        if args.force:
+            raise CliError("--force is for rectifying without a calibration (no --calib)")
         lr, rr = calib.rectify(left, right)
         summary = None
     else:
         from stereovision.uncalibrated import rectify_uncalibrated
 
-        rect = rectify_uncalibrated(left, right, model=args.model)
-        lr, rr = rect.rectify(left, right)
-        summary = rect
+        if not args.force:
+            # A pair whose features already lie on common rows (a rectified dataset, a camera
+            # that rectifies on board): warping it by homographies fitted to those same rows
+            # only resamples it, and changes its size.
+            first = check_rectification(left, right)
+            if first.ok is True and not first.swapped:
+                given = first
+        if given is None:
+            rect = rectify_uncalibrated(left, right, model=args.model)
+            lr, rr = rect.rectify(left, right)
+            summary = rect
+        else:
+            lr, rr = left, right
+            summary = None
     make_folder(out)
-    check = check_rectification(lr, rr)
+    check = given if given is not None else check_rectification(lr, rr)
     for name, img in (
         ("left_rect.png", lr),
         ("right_rect.png", rr),
@@ -538,7 +553,14 @@ def cmd_rectify(args: argparse.Namespace) -> int:
             f"depth {written['left_rect.png']} {written['right_rect.png']} --max-disparity "
             f"{summary.max_disparity} -o OUT"
         )
-    print(check.summary())
+    if given is not None:
+        print(
+            f"already rectified (rows median |dy| {given.median_dy:.2f} px over {given.matches} "
+            f"matches, tolerance {given.tolerance:g}): written as given, not warped (--force "
+            "rectifies it from its features anyway)"
+        )
+    else:
+        print(check.summary())
     for name, path in written.items():
         print(f"  {name:19s} {path}")
     stale = out / "rectification.json"
@@ -554,7 +576,12 @@ def cmd_rectify(args: argparse.Namespace) -> int:
             pass
         else:
             stale.unlink()
-            print(f"  removed {stale.name} of an earlier run without --calib (not this pair's)")
+            print(
+                f"  removed {stale.name} of an earlier run (not this pair's: it is rectified "
+                "already)"
+                if given is not None
+                else f"  removed {stale.name} of an earlier run without --calib (not this pair's)"
+            )
     return 0
 
 
@@ -1021,7 +1048,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Write the rectified pair (left_rect.png, right_rect.png) and how its rows "
         "agree. Without --calib the homographies are found from the pair's feature matches "
         "(disparity, not metric depth) and saved as rectification.json, with the disparity "
-        "range to search.",
+        "range to search; a pair whose rows already agree (as `check` measures them) is "
+        "written as given, not warped, unless --force.",
     )
     d.add_argument("left", help="left camera's raw image")
     d.add_argument("right", help="right camera's raw image, the same size")
@@ -1032,6 +1060,12 @@ def build_parser() -> argparse.ArgumentParser:
         choices=("auto", "quasi-euclidean", "projective"),
         help="without --calib: turned cameras (quasi-euclidean), Hartley's homographies of F "
         "(projective), or the first when it fits (auto, the default)",
+    )
+    d.add_argument(
+        "--force",
+        action="store_true",
+        help="without --calib: rectify from the features even a pair whose rows already agree "
+        "(default: such a pair is written as given)",
     )
     d.add_argument("-o", "--output", required=True, help="output folder")
     d.set_defaults(func=cmd_rectify)
