@@ -341,6 +341,34 @@ def test_depth_map_takes_the_homographies(data_dir: Path) -> None:
         sv.depth_map(left[:100], right[:100], rect)
 
 
+def test_match_takes_the_homographies(data_dir: Path) -> None:
+    """``sv.match(left, right, rect)`` refused the rectification depth_map takes ("calib must
+    be a stereovision.Calibration"): now the raw pair through it, with its search range, as
+    depth_map; a 16-bit pair on its own grey levels, rectified as they are."""
+    from stereovision.depth import _rectify_grey
+
+    sp = data_dir / "stereopi_rig" / "scene_photo"
+    left, right = cv2.imread(str(sp / "left.png")), cv2.imread(str(sp / "right.png"))
+    rect = rectify_uncalibrated(left, right)
+    lr, rr = rect.rectify(left, right)
+    for method in ("hopfield", "gabor"):
+        got = sv.match(left, right, rect, method=method)
+        want = sv.match(lr, rr, method=method, max_disparity=rect.max_disparity)
+        assert len(got) == len(want) > 100
+        for f in ("xl", "yl", "xr", "yr"):
+            np.testing.assert_array_equal(getattr(got, f), getattr(want, f))
+        assert (got.xl - got.xr).max() <= rect.max_disparity
+    deep = [img.astype(np.uint16) * 257 for img in (left, right)]
+    got = sv.match(*deep, rect, method="gabor")
+    want = sv.match(*_rectify_grey(rect, *deep), method="gabor", max_disparity=rect.max_disparity)
+    assert len(got) > 100
+    np.testing.assert_array_equal(got.xl - got.xr, want.xl - want.xr)
+    with pytest.raises(ValueError, match="this rectification is for 320x240"):
+        sv.match(left[:100], right[:100], rect)
+    with pytest.raises(ValueError, match=r"Calibration \(or an UncalibratedRectification\), got"):
+        sv.match(left, right, rect.H1)
+
+
 def test_a_folding_homography_is_refused(data_dir: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     """A homography whose horizon crosses the image would fold it onto itself: refused (forced
     here by a shear step that puts the horizon through the middle of the image)."""

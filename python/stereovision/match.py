@@ -13,6 +13,7 @@ from stereovision.depth import _rectify_grey, estimate_max_disparity
 from stereovision.matches import Matches
 from stereovision.matching import hopfield as _hopfield
 from stereovision.matching import mcgm as _mcgm
+from stereovision.uncalibrated import UncalibratedRectification
 
 __all__ = ["METHODS", "match"]
 
@@ -26,7 +27,7 @@ METHODS = ("hopfield", "best", "mcgm", "fused", "gabor")
 def match(
     left: npt.ArrayLike,
     right: npt.ArrayLike,
-    calib: Calibration | None = None,
+    calib: Calibration | UncalibratedRectification | None = None,
     *,
     method: str = "hopfield",
     max_disparity: int | None = None,
@@ -38,10 +39,14 @@ def match(
     ----------
     left, right : array_like
         ``(H, W)`` grey or ``(H, W, 3)`` BGR images (uint8, uint16 or float in ``[0, 1]``), same
-        shape. Rectified, unless ``calib`` is an unrectified rig calibration (the pair is then
+        shape. Rectified, unless ``calib`` is an unrectified rig calibration or an
+        :class:`~stereovision.uncalibrated.UncalibratedRectification` (the pair is then
         rectified first and the matches are in rectified coordinates).
-    calib : Calibration, optional
-        Rig calibration of the pair.
+    calib : Calibration or UncalibratedRectification, optional
+        Rig calibration of the pair, or the homographies
+        :func:`~stereovision.uncalibrated.rectify_uncalibrated` found for a rig without one
+        (whose ``max_disparity`` is then the default search range), as for
+        :func:`~stereovision.depth_map`.
     method : {"hopfield", "best", "mcgm", "fused", "gabor"}
         ``"hopfield"``: the network (:func:`stereovision.matching.hopfield.hopfield_match`);
         ``"best"``: the best-match reference without the network; ``"mcgm"``: multi-channel
@@ -54,9 +59,10 @@ def match(
         ``xr = xl - d``, ``yr = yl``, ``score`` its confidence in ``[0, 1]``).
     max_disparity : int, optional
         Largest disparity searched (px). None estimates it from the pair
-        (:func:`stereovision.estimate_max_disparity`). Every match returned has
-        ``min_disparity <= xl - xr <= max_disparity`` (sub-pixel estimates that left the range
-        are dropped and counted in ``stats["n_out_of_range"]``).
+        (:func:`stereovision.estimate_max_disparity`), or takes an uncalibrated
+        rectification's. Every match returned has ``min_disparity <= xl - xr <= max_disparity``
+        (sub-pixel estimates that left the range are dropped and counted in
+        ``stats["n_out_of_range"]``).
     **params
         Matcher parameters (:data:`stereovision.matching.hopfield.DEFAULTS`,
         :data:`stereovision.matching.mcgm.DEFAULTS`,
@@ -70,16 +76,27 @@ def match(
     Raises
     ------
     ValueError
-        Bad images (shape, dtype, empty, NaN, mismatched sizes), a calibration for another image
-        size, an unknown method or parameter.
+        Bad images (shape, dtype, empty, NaN, mismatched sizes), a calibration or rectification
+        for another image size, a ``calib`` of another type, an unknown method or parameter.
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
     gl, gr = check_pair(left, right)
+    uint8 = np.asarray(left).dtype == np.uint8 and np.asarray(right).dtype == np.uint8
+    if isinstance(calib, UncalibratedRectification):
+        # a rig without a calibration: its pair through the homographies, as depth_map does
+        if uint8:
+            lb, rb = calib.rectify(as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right"))
+            gl, gr = check_pair(lb, rb)
+        else:
+            gl, gr = _rectify_grey(calib, gl, gr)
+        max_disparity = calib.max_disparity if max_disparity is None else max_disparity
+        calib = None
     if calib is not None:
         if not isinstance(calib, Calibration):
             raise ValueError(
-                f"calib must be a stereovision.Calibration, got {type(calib).__name__}"
+                "calib must be a stereovision.Calibration (or an UncalibratedRectification), "
+                f"got {type(calib).__name__}"
             )
         h, w = gl.shape
         if tuple(calib.image_size) != (w, h):
@@ -88,7 +105,7 @@ def match(
                 f"got {w}x{h}"
             )
         if not calib.rectified:
-            if np.asarray(left).dtype == np.uint8 and np.asarray(right).dtype == np.uint8:
+            if uint8:
                 lb, rb = calib.rectify(as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right"))
                 gl, gr = check_pair(lb, rb)
             else:
