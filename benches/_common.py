@@ -10,6 +10,7 @@ import statistics
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 
@@ -20,6 +21,8 @@ DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
 
 #: evaluation.md "Speed": the median of at least this many timed runs.
 MIN_RUNS = 5
+
+T = TypeVar("T")
 
 
 def timed_runs(text: str) -> int:
@@ -55,15 +58,22 @@ def sparse_row(m: Matches, gt: np.ndarray) -> dict[str, float | int]:
 
 def interleaved_ms(fns: Sequence[Callable[[], object]], repeats: int) -> list[float]:
     """Median ms of each function: one warm-up each, then A, B, ... A, B, ... ``repeats`` times."""
-    for fn in fns:
-        fn()
+    return interleaved_runs(fns, repeats)[0]
+
+
+def interleaved_runs(fns: Sequence[Callable[[], T]], repeats: int) -> tuple[list[float], list[T]]:
+    """:func:`interleaved_ms`, and what each function returned on its warm-up run (a bench that
+    scores the output and times it runs each side ``repeats + 1`` times, not once more)."""
+    if repeats < MIN_RUNS:
+        raise ValueError(f"repeats: at least {MIN_RUNS} (evaluation.md), got {repeats}")
+    results = [fn() for fn in fns]
     times: list[list[float]] = [[] for _ in fns]
     for _ in range(repeats):
         for fn, acc in zip(fns, times, strict=True):
             t = time.perf_counter()
             fn()
             acc.append(time.perf_counter() - t)
-    return [1e3 * statistics.median(t) for t in times]
+    return [1e3 * statistics.median(t) for t in times], results
 
 
 def plot_bad2_panels(

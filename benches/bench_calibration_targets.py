@@ -7,9 +7,11 @@ ChArUco board (the same 9x6 inner-corner grid), with grey noise (sigma 1) and, w
 ``--hard``, a Gaussian blur (sigma 0.8 px), a lighting gradient and JPEG compression (quality
 85). Each set is calibrated with :func:`stereovision.calibrate.calibrate` and the estimate is
 scored against the true rig: points 2-6 m away seen by the true cameras, rectified with the
-estimate, give the row offset (px) and the range error.
+estimate, give the row offset (px) and the range error. The two calibrations of a seed are timed
+interleaved (ChArUco, chessboard, ...), median of ``--runs`` after a warm-up (evaluation.md
+"Speed").
 
-Usage: ``python benches/bench_calibration_targets.py [--seeds 3] [--hard]``
+Usage: ``python benches/bench_calibration_targets.py [--seeds 3] [--hard] [--runs 5]``
 """
 
 from __future__ import annotations
@@ -17,11 +19,13 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import time
+from functools import partial
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
+from _common import interleaved_runs, timed_runs
 
 from stereovision.calibrate import calibrate, render_chessboard
 from stereovision.charuco import render_charuco
@@ -105,11 +109,22 @@ def chessboard_view(K: np.ndarray, D: np.ndarray, r: np.ndarray, t: np.ndarray) 
     return img
 
 
+def _calibrate_or_error(
+    left: list[np.ndarray], right: list[np.ndarray], **kw: Any
+) -> tuple[Any, Any] | ValueError:
+    """:func:`calibrate`'s result, or the ValueError it refused the set with (timed alike)."""
+    try:
+        return calibrate(left, right, **kw)
+    except ValueError as exc:
+        return exc
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--views", type=int, default=20)
     ap.add_argument("--hard", action="store_true", help="blur, lighting gradient and JPEG")
+    ap.add_argument("--runs", type=timed_runs, default=5, help="timed runs per target (median)")
     args = ap.parse_args()
     print(
         "target      seed  pairs  corners  RMS px  |T| err mm  rot err deg  rows p95 px  "
@@ -127,15 +142,19 @@ def main() -> None:
                 sets["charuco"][side].append(degrade(img, rng, args.hard))
                 img = chessboard_view(K, D, r, t)
                 sets["chessboard"][side].append(degrade(img, rng, args.hard))
-        for name, (left, right) in sets.items():
-            kw = {"board": BOARD} if name == "charuco" else {"square_size": SQUARE}
-            t0 = time.perf_counter()
-            try:
-                cal, rep = calibrate(left, right, **kw)  # type: ignore[arg-type]
-            except ValueError as exc:
-                print(f"{name:<11} {seed:>4}  failed: {exc}")
+        kws: dict[str, dict[str, Any]] = {
+            "charuco": {"board": BOARD},
+            "chessboard": {"square_size": SQUARE},
+        }
+        times, outs = interleaved_runs(
+            [partial(_calibrate_or_error, *sets[name], **kws[name]) for name in sets], args.runs
+        )
+        for name, ms, out in zip(sets, times, outs, strict=True):
+            dt = ms / 1e3
+            if isinstance(out, ValueError):
+                print(f"{name:<11} {seed:>4}  failed: {out}")
                 continue
-            dt = time.perf_counter() - t0
+            cal, rep = out
             print(
                 f"{name:<11} {seed:>4}  {len(rep.used_pairs):>2}/{args.views}  "
                 f"{rep.corners_used:>7}  {rep.rms:6.3f}  {truth_columns(cal, seed)}  {dt:10.1f}"

@@ -2,7 +2,8 @@
 
 Accuracy: for every scene of ``../shared/data`` with ``gt_disp.pfm``, the network
 (``method="hopfield"``) and the best-match reference without the network (``method="best"``: same
-points, candidates and filters) in the same run; evaluation.md's sparse metrics: precision@0.5/1/2,
+points, candidates and filters) in the same run, timed interleaved (network, reference, ...),
+median of ``--repeats`` runs after a warm-up; evaluation.md's sparse metrics: precision@0.5/1/2,
 count with GT, 4x4 coverage. ``ref_count_at_net_precision``: the reference's matches ranked by
 ZNCC and cut to the longest prefix whose precision@1 reaches the network's (count at equal
 precision). Speed: OpenCV SGBM-3WAY (evaluation.md configuration) and the network on
@@ -16,9 +17,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
+from functools import partial
 
-from _common import DATA, gt_scenes, interleaved_ms, sparse_row, timed_runs
+from _common import DATA, gt_scenes, interleaved_ms, interleaved_runs, sparse_row, timed_runs
 
 from stereovision import io
 from stereovision._validate import as_gray_float
@@ -31,22 +32,25 @@ SPEED_SCENES = ("middlebury2006/cloth3", "middeval3/teddyH")
 SPEED_TARGET = 1.0 / 3.0
 
 
-def accuracy(scenes: list[str]) -> None:
+def accuracy(scenes: list[str], repeats: int) -> None:
     for name in scenes:
         sc = io.load_scene(DATA / name)
         assert sc.gt is not None
         left, right = as_gray_float(sc.left), as_gray_float(sc.right)
-        t0 = time.perf_counter()
-        net = hopfield_match(left, right, max_disparity=sc.max_disparity)
-        t1 = time.perf_counter()
-        ref = best_match(left, right, max_disparity=sc.max_disparity)
-        t2 = time.perf_counter()
+        # evaluation.md "Speed": interleaved, median of >= 5 runs after a warm-up (one run of
+        # each gave whichever side the machine's other load happened to hit the slower time)
+        (ms_net, ms_ref), (net, ref) = interleaved_runs(
+            [partial(run, left, right, max_disparity=sc.max_disparity)
+             for run in (hopfield_match, best_match)],
+            repeats,
+        )  # fmt: skip
         mn, mr = sparse_row(net, sc.gt), sparse_row(ref, sc.gt)
         line = {
             "case": "accuracy",
             "scene": name,
-            "network": {**mn, "ms": round(1e3 * (t1 - t0), 1)},
-            "reference": {**mr, "ms": round(1e3 * (t2 - t1), 1)},
+            "network": {**mn, "ms": round(ms_net, 1)},
+            "reference": {**mr, "ms": round(ms_ref, 1)},
+            "repeats": repeats,
             "ref_count_at_net_precision": count_at_precision(
                 ref.xl, ref.yl, ref.xr, ref.score, sc.gt, float(mn["p1"])
             ),
@@ -97,7 +101,7 @@ def main() -> None:
     args = ap.parse_args()
     scenes = args.scenes.split(",") if args.scenes else gt_scenes()
     if not args.no_accuracy:
-        accuracy(scenes)
+        accuracy(scenes, args.repeats)
     if not args.no_speed:
         speed(args.repeats)
 

@@ -4,7 +4,8 @@ speed vs SGBM-3WAY.
 Accuracy: for every scene of ``../shared/data`` with ``gt_disp.pfm``, the channel
 (``stereovision.match(..., method="mcgm")``) and, in the same run, the plain reference
 (:func:`stereovision.matching.mcgm.zncc_reference`: best 7x7 ZNCC along the row on the same
-zero-crossing pixels, left-right check, the same B.8 filters); evaluation.md's sparse metrics:
+zero-crossing pixels, left-right check, the same B.8 filters), timed interleaved (channel,
+reference, ...), median of ``--repeats`` runs after a warm-up; evaluation.md's sparse metrics:
 precision@0.5/1/2, count with GT, 4x4 coverage. ``ref_count_at_mcgm_precision``: the reference's
 matches ranked by ZNCC, cut to the longest prefix whose precision@1 reaches the channel's.
 Speed: OpenCV SGBM-3WAY (evaluation.md configuration) and the channel on middlebury2006/cloth3
@@ -18,9 +19,9 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
+from functools import partial
 
-from _common import DATA, gt_scenes, interleaved_ms, sparse_row, timed_runs
+from _common import DATA, gt_scenes, interleaved_ms, interleaved_runs, sparse_row, timed_runs
 
 import stereovision as sv
 from stereovision import io
@@ -34,23 +35,26 @@ SPEED_SCENES = ("middlebury2006/cloth3", "middeval3/teddyH")
 SPEED_TARGET = 1.0 / 3.0
 
 
-def accuracy(scenes: list[str]) -> None:
+def accuracy(scenes: list[str], repeats: int) -> None:
     for name in scenes:
         sc = io.load_scene(DATA / name)
         assert sc.gt is not None
         left, right = as_gray_float(sc.left), as_gray_float(sc.right)
-        t0 = time.perf_counter()
-        m = sv.match(left, right, method="mcgm", max_disparity=sc.max_disparity)
-        t1 = time.perf_counter()
-        z = zncc_reference(left, right, max_disparity=sc.max_disparity)
-        t2 = time.perf_counter()
+        # evaluation.md "Speed": interleaved, median of >= 5 runs after a warm-up (one run of
+        # each gave whichever side the machine's other load happened to hit the slower time)
+        (ms_m, ms_z), (m, z) = interleaved_runs(
+            [partial(sv.match, left, right, method="mcgm", max_disparity=sc.max_disparity),
+             partial(zncc_reference, left, right, max_disparity=sc.max_disparity)],
+            repeats,
+        )  # fmt: skip
         mm, mz = sparse_row(m, sc.gt), sparse_row(z, sc.gt)
         line = {
             "case": "accuracy",
             "scene": name,
             "max_disparity": sc.max_disparity,
-            "mcgm": {**mm, "ms": round(1e3 * (t1 - t0), 1)},
-            "reference": {**mz, "ms": round(1e3 * (t2 - t1), 1)},
+            "mcgm": {**mm, "ms": round(ms_m, 1)},
+            "reference": {**mz, "ms": round(ms_z, 1)},
+            "repeats": repeats,
             "ref_count_at_mcgm_precision": count_at_precision(
                 z.xl, z.yl, z.xr, z.score, sc.gt, float(mm["p1"])
             ),
@@ -102,7 +106,7 @@ def main() -> None:
     args = ap.parse_args()
     scenes = args.scenes.split(",") if args.scenes else gt_scenes()
     if not args.no_accuracy:
-        accuracy(scenes)
+        accuracy(scenes, args.repeats)
     if not args.no_speed:
         speed(args.repeats)
 

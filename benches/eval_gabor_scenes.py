@@ -1,23 +1,26 @@
 """Scratch evaluation of the Gabor channel on the shared scenes (evaluation.md metrics).
 
 Prints, per scene with GT under ../shared/data: bad-2.0 of our output after the reference row fill
-and unfilled (holes count as errors), density, StereoBM and SGBM-3WAY bad-2.0 (unfilled), times;
-then the means, and the metric-depth comparison with SGBM-3WAY on the scenes with a metric
-calibration. Uses the package's scene loader (max_disparity per evaluation.md), OpenCV references,
-reference fill and metrics.
+and unfilled (holes count as errors), density, StereoBM and SGBM-3WAY bad-2.0 (unfilled), and
+the times of the channel and of SGBM-3WAY (evaluation.md "Speed": interleaved, median of ``--runs``
+after a warm-up; with ``--no-cv`` the channel's alone) with their ratio; then the means, and the
+metric-depth comparison with SGBM-3WAY on the scenes with a metric calibration. Uses the
+package's scene loader (max_disparity per evaluation.md), OpenCV references, reference fill and
+metrics.
 
-Usage: ``python benches/eval_gabor_scenes.py [--scenes a,b] [--param key=value ...] [--no-cv]``
+Usage: ``python benches/eval_gabor_scenes.py [--scenes a,b] [--param key=value ...] [--runs 5]
+[--no-cv]``
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import time
-from pathlib import Path
+from functools import partial
 
 import cv2
 import numpy as np
+from _common import DATA, interleaved_runs, timed_runs
 
 from stereovision import baselines
 from stereovision._validate import as_gray_float
@@ -25,14 +28,13 @@ from stereovision.evaluate import dense_metrics, depth_metrics, gt_depth
 from stereovision.io import find_scenes, load_scene
 from stereovision.matching.gabor import gabor_disparity
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
-
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", default="", help="comma-separated substrings of scene names")
     ap.add_argument("--param", action="append", default=[], help="key=JSON value (repeatable)")
     ap.add_argument("--no-cv", action="store_true", help="skip the OpenCV references")
+    ap.add_argument("--runs", type=timed_runs, default=5, help="timed runs per side (median)")
     args = ap.parse_args()
     params: dict[str, object] = {}
     for kv in args.param:
@@ -41,6 +43,7 @@ def main() -> None:
     cv2.setNumThreads(2)
     rows = []
     hdr = f"{'scene':38s} {'fill':>6s} {'unf':>6s} {'dens':>5s} {'BM':>6s} {'SGBM':>6s} {'ms':>6s}"
+    hdr += f" {'SGBMms':>6s} {'ratio':>5s}"
     print(hdr)
     for d in find_scenes(DATA):
         scene = load_scene(d)
@@ -49,9 +52,12 @@ def main() -> None:
             continue
         gt, dmax = scene.gt, scene.max_disparity
         lf, rf = as_gray_float(scene.left, "left"), as_gray_float(scene.right, "right")
-        t = time.perf_counter()
-        ours = gabor_disparity(lf, rf, max_disparity=dmax, **params).disparity
-        ms = 1e3 * (time.perf_counter() - t)
+        fns = [partial(gabor_disparity, lf, rf, max_disparity=dmax, **params)]
+        if not args.no_cv:  # evaluation.md's reference, interleaved with ours
+            fns.append(partial(baselines.opencv_sgbm, scene.left, scene.right, dmax))
+        times, outs = interleaved_runs(fns, args.runs)
+        ms = times[0]
+        ours = outs[0].disparity
         unf = dense_metrics(ours, gt)
         row = {
             "scene": name,
@@ -64,8 +70,9 @@ def main() -> None:
             row["bm"] = dense_metrics(baselines.opencv_bm(scene.left, scene.right, dmax), gt).bad[
                 2.0
             ]
-            sg = baselines.opencv_sgbm(scene.left, scene.right, dmax)
+            sg = outs[1]
             row["sgbm"] = dense_metrics(sg, gt).bad[2.0]
+            row["sgbm_ms"] = times[1]
             calib = scene.calib
             if calib is not None and calib.rectified:
                 zgt = gt_depth(gt, calib)
@@ -80,7 +87,8 @@ def main() -> None:
             verdict = "  BEATS-BM" if row["bm"] > row["fill"] else "  LOSES-TO-BM"
         print(
             f"{name:38s} {row['fill']:6.1f} {row['unf']:6.1f} {row['dens']:5.1f} "
-            f"{row.get('bm', np.nan):6.1f} {row.get('sgbm', np.nan):6.1f} {ms:6.0f}{verdict}"
+            f"{row.get('bm', np.nan):6.1f} {row.get('sgbm', np.nan):6.1f} {ms:6.0f} "
+            f"{row.get('sgbm_ms', np.nan):6.0f} {ms / row.get('sgbm_ms', np.nan):5.2f}{verdict}"
         )
     mean = {k: float(np.mean([r[k] for r in rows])) for k in ("fill", "unf", "dens", "ms")}
     line = f"{'MEAN':38s} {mean['fill']:6.1f} {mean['unf']:6.1f} {mean['dens']:5.1f}"

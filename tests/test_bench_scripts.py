@@ -19,6 +19,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 BENCHES = ROOT / "benches"
 TIMING = {
+    "bench_calibration_targets.py": "--runs",
     "bench_gabor_vs_sgbm.py": "--runs",
     "bench_hopfield.py": "--repeats",
     "bench_mcgm.py": "--repeats",
@@ -26,6 +27,7 @@ TIMING = {
     "bench_sgm.py": "--runs",
     "bench_stages.py": "--repeats",
     "bench_tools.py": "--repeats",
+    "eval_gabor_scenes.py": "--runs",
 }
 
 
@@ -103,3 +105,30 @@ def test_bench_fusion_compares_the_sparse_channels(data_dir: Path) -> None:
     assert set(row) == {"bench", "scene", "tol", "members", "hopfield", "mcgm", "mcgm_defaults"}
     assert row["members"]["count"] > 3500 and row["members"]["coverage"] == 16
     assert row["members"]["precision"] > 99 and row["hopfield"]["count"] > 1000
+
+
+@pytest.mark.parametrize(
+    ("script", "ours"), [("bench_hopfield.py", "network"), ("bench_mcgm.py", "mcgm")]
+)
+def test_accuracy_times_are_medians_of_the_repeats(data_dir: Path, script: str, ours: str) -> None:
+    # the accuracy lines' times were of one run of each side, one after the other
+    assert (data_dir / "middlebury2001" / "tsukuba").is_dir()
+    done = _run(script, "--scenes", "middlebury2001/tsukuba", "--no-speed", "--repeats", "5")
+    assert done.returncode == 0, done.stderr
+    row = json.loads(done.stdout.splitlines()[-1])
+    assert row["case"] == "accuracy" and row["repeats"] == 5
+    assert row[ours]["ms"] > 0 and row["reference"]["ms"] > 0
+    assert row[ours]["count"] > 1000 and row[ours]["p1"] > 97
+
+
+def test_eval_gabor_scenes_times_ours_beside_sgbm(data_dir: Path) -> None:
+    # our time was of one run, beside no timed reference
+    assert (data_dir / "middlebury2001" / "tsukuba").is_dir()
+    done = _run("eval_gabor_scenes.py", "--scenes", "tsukuba", "--runs", "5")
+    assert done.returncode == 0, done.stderr
+    head, row = done.stdout.splitlines()[:2]
+    assert head.split()[-3:] == ["ms", "SGBMms", "ratio"]
+    cells = row.split()
+    assert cells[0] == "middlebury2001/tsukuba" and cells[1:3] == ["7.3", "17.7"]
+    ms, sgbm_ms, ratio = (float(c) for c in cells[6:9])
+    assert ratio == pytest.approx(ms / sgbm_ms, abs=0.05 + 0.02 * ratio)
