@@ -1,6 +1,7 @@
 """The ground plane and obstacles on the scenes with a metric calibration, against the plane of
 their own GT (docs/robotics.md's table and docs/images/ground_kitti.jpg), and KITTI's laser
-scan beside OpenCV SGBM-3WAY's. One run.
+scan beside OpenCV SGBM-3WAY's. One run; the fit's time against SGBM-3WAY's on the same pair
+(evaluation.md "Speed": interleaved, median of ``--runs`` after a warm-up).
 
 For each scene: the floor found in the GT disparity and in the default ``depth_map``'s (RANSAC
 in disparity space, :func:`stereovision.fit_ground_plane`), the angle between them, the
@@ -9,7 +10,7 @@ camera's height, pitch and roll from each, the share of the points measurably be
 within 30 m) of our map against those of the GT, on the pixels with GT. Then the rendered floor
 of tests/test_ground.py (camera 1.1 m up, pitched 12 degrees down, rolled 3).
 
-Usage: ``python benches/bench_ground.py [--picture PATH]``
+Usage: ``python benches/bench_ground.py [--picture PATH] [--runs 5]``
 """
 
 from __future__ import annotations
@@ -17,12 +18,12 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-import time
+from functools import partial
 from pathlib import Path
 
 import cv2
 import numpy as np
-from _common import DATA
+from _common import DATA, interleaved_runs, timed_runs
 from scipy.ndimage import binary_dilation
 
 import stereovision as sv
@@ -67,15 +68,20 @@ def _scan_table(
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--picture", type=Path, default=ROOT / "docs/images/ground_kitti.jpg")
+    ap.add_argument("--runs", type=timed_runs, default=5, help="timed runs per side (median)")
     args = ap.parse_args()
     for name in SCENES:
         sc = load_scene(DATA / name)
         assert sc.calib is not None and sc.gt is not None
         gt = fit_ground_plane(sc.gt, sc.calib)
         res = sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity)
-        t0 = time.perf_counter()
-        ours = fit_ground_plane(res.disparity, sc.calib)
-        dt = time.perf_counter() - t0
+        from stereovision.baselines import opencv_sgbm
+
+        (fit_ms, sgbm_ms), (ours, _) = interleaved_runs(
+            [partial(fit_ground_plane, res.disparity, sc.calib),
+             partial(opencv_sgbm, sc.left, sc.right, sc.max_disparity)],
+            args.runs,
+        )  # fmt: skip
         if gt is None or ours is None:
             print(f"{name}: GT plane {gt is not None}, ours {ours is not None}")
             continue
@@ -96,7 +102,8 @@ def main() -> None:
             f"{ours.pitch_deg:+.2f}, roll {ours.roll_deg:+.2f}; {angle:.2f} deg apart; "
             f"{100 * ours.inlier_share:.0f} % on it, {100 * ours.below_share:.1f} % below it "
             f"(GT's: {100 * gt.below_share:.1f} % below its own); "
-            f"fit {1000 * dt:.0f} ms; obstacles precision "
+            f"fit {fit_ms:.0f} ms ({fit_ms / sgbm_ms:.2f} x SGBM-3WAY's {sgbm_ms:.0f} ms); "
+            f"obstacles precision "
             f"{tp / max(int(found.sum()), 1):.3f} recall {tp / max(int(truth.sum()), 1):.3f}; "
             f"on the pixels with a depth ({100 * np.isfinite(res.depth).mean():.0f} %): "
             f"precision {tp_kept / max(int(kept.sum()), 1):.3f} recall "

@@ -1,5 +1,7 @@
 """Rectification without a calibration (docs/robotics.md's table and
-docs/images/uncalibrated_rectification.jpg). One run.
+docs/images/uncalibrated_rectification.jpg). One run; the rectification's time against OpenCV
+SGBM-3WAY's on the bumped pair (evaluation.md "Speed": interleaved, median of ``--runs`` after a
+warm-up).
 
 For every scene with GT: its right image turned 1.5 degrees, 1 % larger, 3 px lower and tilted
 (``tests/test_uncalibrated.perturbation``: a bumped camera), then the default depth map's bad-2.0
@@ -10,21 +12,22 @@ bumped camera still sees); and the rectification's rows, search range and time. 
 raw pair and OpenCV's hand-held books pair, with the shape of OpenCV's own homographies beside
 ours.
 
-Usage: ``python benches/bench_uncalibrated.py [--scenes S ...] [--picture PATH]``
+Usage: ``python benches/bench_uncalibrated.py [--scenes S ...] [--picture PATH] [--runs 5]``
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
-import time
+from functools import partial
 from pathlib import Path
 
 import cv2
 import numpy as np
-from _common import DATA, gt_scenes
+from _common import DATA, gt_scenes, interleaved_runs, timed_runs
 
 import stereovision as sv
+from stereovision.baselines import opencv_sgbm
 from stereovision.evaluate import dense_metrics
 from stereovision.rectification_check import (
     _features,
@@ -59,6 +62,7 @@ def _opencv_shape(left: np.ndarray, right: np.ndarray, fm: np.ndarray) -> tuple:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenes", nargs="*", help="family/scene names (default: every GT scene)")
+    ap.add_argument("--runs", type=timed_runs, default=5, help="timed runs per side (median)")
     ap.add_argument(
         "--picture", type=Path, default=ROOT / "docs/images/uncalibrated_rectification.jpg"
     )
@@ -66,7 +70,7 @@ def main() -> None:
     print(
         "| scene | bad-2.0 as given | bumped, as it is | bumped, rectified from its features "
         "| the same, projective only | rows after, median / 95 % (px) | search range (scene's) "
-        "| time (ms) |"
+        "| time (ms; x SGBM-3WAY's) |"
     )
     print("|---|---|---|---|---|---|---|---|")
     ratios: dict[str, list[float]] = {"auto": [], "projective": []}
@@ -75,13 +79,18 @@ def main() -> None:
         md = sc.max_disparity
         given = dense_metrics(sv.depth_map(sc.left, sc.right, max_disparity=md).disparity, sc.gt)
         bumped = dense_metrics(sv.depth_map(sc.left, right, max_disparity=md).disparity, sc.gt)
-        t0 = time.perf_counter()
         try:
             rect = rectify_uncalibrated(sc.left, right)
         except ValueError as exc:
             print(f"| {name} | {given.bad[2.0]:.2f} | {bumped.bad[2.0]:.2f} | refused: {exc} |")
             continue
-        dt = time.perf_counter() - t0
+        (rect_ms, sgbm_ms), _ = interleaved_runs(
+            [
+                partial(rectify_uncalibrated, sc.left, right),
+                partial(opencv_sgbm, sc.left, right, md),
+            ],
+            args.runs,
+        )
         bads = []
         projective = rectify_uncalibrated(sc.left, right, model="projective")
         for kind, r in (("auto", rect), ("projective", projective)):
@@ -95,7 +104,7 @@ def main() -> None:
         print(
             f"| {name} | {given.bad[2.0]:.2f} | {bumped.bad[2.0]:.2f} | {bads[0]:.2f} | "
             f"{bads[1]:.2f} | {rect.median_dy:.2f} / {rect.p95_dy:.2f} | {rect.max_disparity} "
-            f"({md}) | {1000 * dt:.0f} |",
+            f"({md}) | {rect_ms:.0f} ({rect_ms / sgbm_ms:.2f} x SGBM-3WAY's {sgbm_ms:.0f}) |",
             flush=True,
         )
         if name == "middlebury2003/cones":

@@ -21,12 +21,14 @@ BENCHES = ROOT / "benches"
 TIMING = {
     "bench_calibration_targets.py": "--runs",
     "bench_gabor_vs_sgbm.py": "--runs",
+    "bench_ground.py": "--runs",
     "bench_hopfield.py": "--repeats",
     "bench_mcgm.py": "--repeats",
     "bench_scaling.py": "--runs",
     "bench_sgm.py": "--runs",
     "bench_stages.py": "--repeats",
     "bench_tools.py": "--repeats",
+    "bench_uncalibrated.py": "--runs",
     "eval_gabor_scenes.py": "--runs",
 }
 
