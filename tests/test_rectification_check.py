@@ -309,6 +309,29 @@ def test_cli_check_cannot_tell(tmp_path: Path) -> None:
     assert "3 when the pair has too little texture to tell" in " ".join(run.stdout.split())
 
 
+def test_cli_check_fix_says_once_what_it_cannot_correct(data_dir: Path, tmp_path: Path) -> None:
+    """--fix on a pair that fails the check in a way no drift explains: exit 1 (a verdict), not
+    2 (an error), and one line after the check's, not the check's line again as an error."""
+    cones = data_dir / "middlebury2003" / "cones"
+    pair = [str(cones / "left.png"), str(cones / "right.png")]
+    fixed = tmp_path / "fixed.yaml"
+    cases = (
+        (pair[::-1], (0.3, 0.0, 0.0), 700.0, "rectification: the left and right images look "
+         "swapped", "the left and right images look swapped: give them the other way round"),
+        (pair, (4.0, 0.0, 0.0), 300.0, "rectification NOT rectified: median |dy| 23.",
+         "the rows need the right camera turned by 4.0 degrees, more than a drift (at most 3): "
+         "calibrate the rig again"),
+    )  # fmt: skip
+    for images, turn, f, said, why in cases:
+        rig = _rig(450, 375, turn, f=f).save(tmp_path / "rig.yaml")
+        run = subprocess.run([*SV, "check", *images, "--calib", str(rig), "--fix", str(fixed)],
+                             capture_output=True, text=True, timeout=120)  # fmt: skip
+        assert run.returncode == 1, run.stderr
+        assert run.stdout.startswith(said) and run.stdout.count("\n") == 1
+        assert run.stderr == f"stereovision: not corrected, nothing written to {fixed}: {why}\n"
+        assert not fixed.exists()
+
+
 def test_align_rows_undoes_a_row_offset(data_dir: Path) -> None:
     """Cones with the right image 1.5 px lower and turned 0.2 degrees: aligned, the rows are
     back within 0.15 px; the left image (the disparity's frame) is untouched."""

@@ -475,10 +475,24 @@ def cmd_check(args: argparse.Namespace) -> int:
         return 0 if res.ok else 1
     from stereovision.rectification_check import refine_rectification
 
-    # the check above was of this pair through this calibration: reuse its matches
-    fixed, after = refine_rectification(
-        raw_left, raw_right, calib, tolerance=args.tolerance, check=res
-    )
+    # A verdict the pair cannot correct (exit 1, as a failed check), not an error of the command
+    # line (2): said once, after the check's line, without repeating it.
+    why = None
+    if res.swapped:
+        why = "the left and right images look swapped: give them the other way round"
+    elif not np.isfinite(res.offset):
+        why = "the matches fit no common row offset, too far off to correct: recalibrate"
+    else:
+        try:
+            # the check above was of this pair through this calibration: reuse its matches
+            fixed, after = refine_rectification(
+                raw_left, raw_right, calib, tolerance=args.tolerance, check=res
+            )
+        except ValueError as exc:
+            why = str(exc).removeprefix("cannot refine: ")
+    if why is not None:
+        print(f"stereovision: not corrected, nothing written to {fix}: {why}", file=sys.stderr)
+        return 1
     turn = float(np.degrees(np.linalg.norm(cv2.Rodrigues(fixed.R @ calib.R.T)[0])))
     if args.json:
         print(json.dumps({"fixed": after.as_dict(), "turn_deg": turn}))
@@ -1026,7 +1040,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Measure how far a pair's SIFT feature matches lie off each other's rows "
         "after rectification, to catch a calibration that a bump or heat has spoiled. Exit "
         "status 0 when the median is within --tolerance (with --fix: the corrected calibration "
-        "is), 1 when not, 2 on an error, 3 when the pair has too little texture to tell (with "
+        "is), 1 when not (with --fix: or when this pair cannot correct the calibration; nothing "
+        "is written), 2 on an error, 3 when the pair has too little texture to tell (with "
         "--fix: nothing is written).",
     )
     d.add_argument("left", help="left image: raw with --calib, else rectified")
