@@ -168,6 +168,27 @@ def test_pcd_ascii_field_of_several_values(tmp_path):
         export.read_pcd(path)
 
 
+def test_empty_ascii_pcd_is_an_empty_cloud(tmp_path):
+    """An ASCII PCD with ``POINTS 0`` (PCL saves an empty cloud so) was "rows of 1 values,
+    FIELDS has 3" after NumPy's "input contained no data" warning; it is an empty cloud, as
+    the binary one was, and ``load_cloud`` says so."""
+    import warnings
+
+    head = (
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\n"
+        "WIDTH 0\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 0\nDATA {}\n"
+    )
+    for mode in ("ascii", "binary"):
+        path = tmp_path / f"empty_{mode}.pcd"
+        path.write_text(head.format(mode))
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            pts, cols = export.read_pcd(path)
+        assert pts.shape == (1, 0, 3) and cols is not None and cols.shape == (1, 0, 3)
+        with pytest.raises(ValueError, match=rf"empty point cloud: .*empty_{mode}\.pcd has no"):
+            export.load_cloud(path)
+
+
 def test_npz_bundle(result, tmp_path):
     # sigma_Z = Z^2 sigma_d / (f B) with sigma_d = 0.5 px: the bundle keeps the uncertainty.
     sigma = (result.depth.astype(np.float64) ** 2 * 0.5 / (syn.F * syn.B)).astype(np.float32)

@@ -373,7 +373,11 @@ def read_pcd(
         rec = np.frombuffer(raw, dtype=dtype, count=n, offset=pos)
     elif mode == "ascii":
         try:
-            table = np.loadtxt(_io.BytesIO(raw[pos:]), dtype=np.float64, ndmin=2)
+            if n == 0 and not raw[pos:].strip():
+                # no rows: numpy would warn "input contained no data" and give a (0, 1) table
+                table = np.zeros((0, sum(counts)))
+            else:
+                table = np.loadtxt(_io.BytesIO(raw[pos:]), dtype=np.float64, ndmin=2)
         except ValueError as exc:  # a short or damaged row: NumPy's words, with the file's name
             raise ValueError(f"damaged PCD file {p}: {str(exc).splitlines()[0]}") from None
         # A field of COUNT c takes c columns (PCL's FPFH histograms: 33, padding "_": 4).
