@@ -300,6 +300,42 @@ def test_view_writes_screenshot(result, tmp_path, capsys):
         args.func(args)
 
 
+def test_view_checks_the_screenshot_name_before_any_work(result, tmp_path, monkeypatch):
+    """A missing -o folder (or -o naming a folder) was found only after the cloud was loaded
+    and rendered (a scene folder: its whole depth map computed first); now before."""
+    from stereovision.export import write_cloud_ply
+
+    write_cloud_ply(tmp_path / "cloud.ply", result)
+
+    def no_work(_source):
+        raise AssertionError("the source was loaded before the -o check")
+
+    monkeypatch.setattr(render, "load_view_source", no_work)
+    args = _view_args(tmp_path, tmp_path / "missing" / "shot.png")
+    with pytest.raises(FileNotFoundError, match=r"output folder does not exist: .*missing"):
+        args.func(args)
+    args = _view_args(tmp_path, tmp_path)
+    with pytest.raises(IsADirectoryError, match=r"is a folder; give the screenshot a file name"):
+        args.func(args)
+
+
+def test_view_refuses_to_write_over_the_scene_it_shows(tmp_path):
+    """``view SCENE -o SCENE/left.png`` computed the depth map, then replaced the scene's left
+    image with the screenshot without a word."""
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    scene = tmp_path / "cones"
+    shutil.copytree(bundled_data_dir() / "cones", scene)
+    before = (scene / "left.png").read_bytes()
+    for name in ("left.png", "right.png"):
+        args = _view_args(scene, scene / name)
+        with pytest.raises(ValueError, match=rf"-o .*{name}: is the input .*{name}; the screen"):
+            args.func(args)
+    assert (scene / "left.png").read_bytes() == before
+
+
 @pytest.mark.skipif(
     not sys.platform.startswith("linux") or Path("/tmp/.X11-unix/X99").exists(),
     reason="needs Linux with no X server at :99",

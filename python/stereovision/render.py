@@ -769,6 +769,55 @@ def load_view_source(path: str | os.PathLike[str]) -> tuple[pv.PolyData, Intrins
     return point_cloud(points, colors), None
 
 
+#: Screenshot formats of ``view -o`` (OpenCV writes each by its suffix; none: PNG).
+SCREENSHOT_SUFFIXES = ("", ".png", ".jpg", ".jpeg", ".bmp")
+
+
+def _check_screenshot_path(output: str | os.PathLike[str], source: str | os.PathLike[str]) -> Path:
+    """``view -o``'s file, checked before anything is loaded or rendered.
+
+    Parameters
+    ----------
+    output : path
+        The screenshot file.
+    source : path
+        What ``view`` shows (a cloud file, a ``depth`` output folder or a scene folder).
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    ValueError
+        An unsupported suffix, or ``output`` is one of the files ``view`` reads (a scene's
+        ``left.png`` / ``right.png``): the screenshot would replace it.
+    FileNotFoundError
+        The folder of ``output`` does not exist.
+    IsADirectoryError, NotADirectoryError
+        ``output`` is a folder, or its folder is a file.
+    """
+    out = Path(output)
+    if out.suffix.lower() not in SCREENSHOT_SUFFIXES:
+        raise ValueError(f"{out}: a screenshot is written as .png, .jpg or .bmp")
+    if out.is_dir():
+        raise IsADirectoryError(f"-o {out}: is a folder; give the screenshot a file name")
+    parent = out.parent
+    if parent.exists() and not parent.is_dir():
+        raise NotADirectoryError(f"-o {out}: {parent} is a file, not a folder")
+    if not parent.exists():
+        raise FileNotFoundError(f"output folder does not exist: {parent}")
+    src = Path(source)
+    inputs = [src / "left.png", src / "right.png"] if src.is_dir() else [src]
+    for inp in inputs:
+        if out.exists() and inp.exists() and os.path.samefile(out, inp):
+            raise ValueError(
+                f"-o {out}: is the input {inp}; the screenshot would replace it (choose "
+                "another name)"
+            )
+    return out
+
+
 def cmd_view(args: argparse.Namespace) -> int:
     """``stereovision view FILE.ply|DIR [--roll ...] [-o shot.png]``."""
     import cv2
@@ -781,8 +830,10 @@ def cmd_view(args: argparse.Namespace) -> int:
         up=args.up,
         right=args.right,
     )
+    # the screenshot's name is checked before the work (a scene folder computes its depth)
+    out = None if args.output is None else _check_screenshot_path(args.output, args.source)
     geometry, intr = load_view_source(args.source)
-    if args.output is None and _has_display():
+    if out is None and _has_display():
         plotter = make_plotter((1024, 768), off_screen=False)
         add_geometry(plotter, geometry)
         apply_camera(
@@ -793,7 +844,7 @@ def cmd_view(args: argparse.Namespace) -> int:
         )
         plotter.show()
         return 0
-    if args.output is None and os.environ.get("DISPLAY"):
+    if out is None and os.environ.get("DISPLAY"):
         import warnings
 
         warnings.warn(
@@ -801,19 +852,14 @@ def cmd_view(args: argparse.Namespace) -> int:
             "screenshot to view.png instead (-o names another)",
             stacklevel=1,
         )
-    out = Path(args.output or "view.png")
-    # the format the name asks for (a .jpg got PNG bytes); PNG for a name without one
-    suffix = out.suffix.lower()
-    if suffix not in ("", ".png", ".jpg", ".jpeg", ".bmp"):
-        raise ValueError(f"{out}: a screenshot is written as .png, .jpg or .bmp")
+    out = out or Path("view.png")
     img = render_view(geometry, controls, intrinsics=intr)
-    ok, buf = cv2.imencode(suffix or ".png", img[..., ::-1])
+    # the format the name asks for (a .jpg got PNG bytes); PNG for a name without one
+    ok, buf = cv2.imencode(out.suffix.lower() or ".png", img[..., ::-1])
     if not ok:
         raise OSError(f"could not encode {out}")
     from stereovision.io import atomic_write
 
-    if not out.parent.exists():
-        raise FileNotFoundError(f"output folder does not exist: {out.parent}")
     with atomic_write(out) as fh:
         fh.write(buf.tobytes())
     print(f"{geometry.n_points} points, {geometry.n_cells} cells -> {out}", file=sys.stdout)
