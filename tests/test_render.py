@@ -319,6 +319,28 @@ def test_view_checks_the_screenshot_name_before_any_work(result, tmp_path, monke
         args.func(args)
 
 
+def test_view_without_display_keeps_an_existing_view_png(result, tmp_path, monkeypatch):
+    """Without -o and without a display the screenshot went to ./view.png, replacing a file of
+    that name without a word, and nothing said why no window opened. Now the next free name
+    (view-2.png), said in one warning."""
+    from stereovision.export import write_cloud_ply
+
+    write_cloud_ply(tmp_path / "cloud.ply", result)
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.setattr(render, "_has_display", lambda: False)
+    (tmp_path / "view.png").write_bytes(b"mine")
+    args = _view_args(tmp_path / "cloud.ply", None)
+    with pytest.warns(UserWarning) as caught:
+        assert args.func(args) == 0
+    assert [str(w.message) for w in caught] == [
+        "no display: no window; writing a screenshot to view-2.png instead (-o names another)"
+    ]
+    assert (tmp_path / "view.png").read_bytes() == b"mine"
+    img = cv2.imread(str(tmp_path / "view-2.png"))
+    assert img is not None and not render.is_blank(img[..., ::-1])
+
+
 def test_view_refuses_to_write_over_the_scene_it_shows(tmp_path):
     """``view SCENE -o SCENE/left.png`` computed the depth map, then replaced the scene's left
     image with the screenshot without a word."""

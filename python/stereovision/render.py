@@ -773,6 +773,20 @@ def load_view_source(path: str | os.PathLike[str]) -> tuple[pv.PolyData, Intrins
 SCREENSHOT_SUFFIXES = ("", ".png", ".jpg", ".jpeg", ".bmp")
 
 
+#: Screenshot of ``view`` without ``-o`` and without a display (in the working folder).
+DEFAULT_SCREENSHOT = "view.png"
+
+
+def _free_name(path: Path) -> Path:
+    """``path`` if nothing is there, else the first free ``stem-2.suffix``, ``stem-3.suffix``..."""
+    k = 2
+    free = path
+    while free.exists() or free.is_symlink():
+        free = path.with_name(f"{path.stem}-{k}{path.suffix}")
+        k += 1
+    return free
+
+
 def _check_screenshot_path(output: str | os.PathLike[str], source: str | os.PathLike[str]) -> Path:
     """``view -o``'s file, checked before anything is loaded or rendered.
 
@@ -844,15 +858,17 @@ def cmd_view(args: argparse.Namespace) -> int:
         )
         plotter.show()
         return 0
-    if out is None and os.environ.get("DISPLAY"):
+    if out is None:
         import warnings
 
+        # a view.png already there (the user's, or an earlier view's) is kept: the next free name
+        out = _free_name(Path(DEFAULT_SCREENSHOT))
+        display = os.environ.get("DISPLAY")
+        why = f"no X server answers at DISPLAY={display}" if display else "no display"
         warnings.warn(
-            f"no X server answers at DISPLAY={os.environ['DISPLAY']}: no window; writing a "
-            "screenshot to view.png instead (-o names another)",
+            f"{why}: no window; writing a screenshot to {out} instead (-o names another)",
             stacklevel=1,
         )
-    out = out or Path("view.png")
     img = render_view(geometry, controls, intrinsics=intr)
     # the format the name asks for (a .jpg got PNG bytes); PNG for a name without one
     ok, buf = cv2.imencode(out.suffix.lower() or ".png", img[..., ::-1])
@@ -878,6 +894,10 @@ def add_cli(subparsers: Any) -> None:
     for name in ("forward", "up", "right"):
         p.add_argument(f"--{name}", type=float, default=0.0, help=f"move the camera {name} (m)")
     p.add_argument(
-        "-o", "--output", default=None, help="screenshot PNG (default view.png without a display)"
+        "-o",
+        "--output",
+        default=None,
+        help="screenshot .png/.jpg/.bmp (default without a display: view.png, or view-2.png... "
+        "when it exists)",
     )
     p.set_defaults(func=cmd_view)
