@@ -392,7 +392,18 @@ def test_has_display_asks_the_x_server(monkeypatch):
     if sys.platform.startswith("linux") and not Path("/tmp/.X11-unix/X99").exists():
         assert render._has_display() is False
     monkeypatch.delenv("DISPLAY")
-    assert render._has_display() is False
+    if sys.platform not in ("win32", "darwin"):  # native windows there, no X
+        assert render._has_display() is False
+
+
+@pytest.mark.parametrize("platform", ["win32", "darwin"])
+def test_windows_and_macos_have_a_display_without_x(monkeypatch, platform):
+    """VTK opens native windows there; with no DISPLAY (as always on Windows, usually on
+    macOS) ``view`` wrote a screenshot instead of opening its window."""
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setattr(sys, "platform", platform)
+    assert render._has_display() is True
 
 
 def test_view_bad_inputs_clear_errors(tmp_path):

@@ -714,7 +714,11 @@ def _x_server_answers(name: str) -> bool:
 def _has_display() -> bool:
     """Whether a window can be shown: on Linux an X server that answers at ``$DISPLAY`` (a
     ``DISPLAY`` naming no running server counted before, and ``view`` then showed nothing and
-    wrote nothing), elsewhere ``DISPLAY`` or ``WAYLAND_DISPLAY`` set."""
+    wrote nothing); on Windows and macOS always (VTK opens a native window there, no X server:
+    ``DISPLAY`` is unset and ``view`` wrote a screenshot instead of opening one); on other Unix
+    systems ``DISPLAY`` or ``WAYLAND_DISPLAY`` set."""
+    if sys.platform in ("win32", "darwin"):
+        return True
     x = os.environ.get("DISPLAY")
     if x and sys.platform.startswith("linux"):
         return _x_server_answers(x)
