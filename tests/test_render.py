@@ -341,6 +341,43 @@ def test_view_without_display_keeps_an_existing_view_png(result, tmp_path, monke
     assert img is not None and not render.is_blank(img[..., ::-1])
 
 
+def test_view_warns_when_no_point_is_in_view(tmp_path):
+    """A cloud in another frame (ROS: X forward, Z up) or behind the camera gave an empty
+    screenshot, exit 0 and no word; now a warning says none of its points is in view."""
+    from stereovision.io import write_ply
+
+    rng = np.random.default_rng(3)
+    front = rng.uniform([-0.5, -0.5, 3], [0.5, 0.5, 5], (1000, 3)).astype(np.float32)
+    ros = front[:, [2, 0, 1]]  # X forward, Y left, Z up: nothing along the camera's +Z
+    write_ply(tmp_path / "front.ply", front)
+    write_ply(tmp_path / "ros.ply", ros)
+    args = _view_args(tmp_path / "ros.ply", tmp_path / "ros.png")
+    with pytest.warns(UserWarning, match=r"none of the 1000 points is in view \(behind the"):
+        assert args.func(args) == 0
+    img = cv2.imread(str(tmp_path / "ros.png"))
+    assert render.is_blank(img[..., ::-1], min_fraction=1e-6)
+    import warnings
+
+    args = _view_args(tmp_path / "front.ply", tmp_path / "front.png")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert args.func(args) == 0
+
+
+def test_points_in_view_matches_the_render():
+    """The count of :func:`render.points_in_view` against rendered pixels: a small cluster 5 m
+    ahead, turned away from by yaw (800x600, 60 deg vertical: 37.6 deg half width)."""
+    rng = np.random.default_rng(4)
+    pts = (rng.normal(0, 0.02, (500, 3)) + np.array([0, 0, 5])).astype(np.float32)
+    cloud = render.point_cloud(pts, np.full((500, 3), 255, np.uint8))
+    for yaw, seen in ((0.0, 500), (35.0, 500), (-35.0, 500), (40.0, 0), (180.0, 0)):
+        controls = CameraControls(yaw=yaw)
+        assert render.points_in_view(pts, controls, (800, 600)) == seen, yaw
+        img = render.render_view(cloud, controls, size=(800, 600))
+        assert render.is_blank(img, min_fraction=1e-4) is (seen == 0), yaw
+    assert render.points_in_view(pts, CameraControls(forward=6), (800, 600)) == 0  # passed it
+
+
 def test_view_refuses_to_write_over_the_scene_it_shows(tmp_path):
     """``view SCENE -o SCENE/left.png`` computed the depth map, then replaced the scene's left
     image with the screenshot without a word."""

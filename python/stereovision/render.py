@@ -47,6 +47,7 @@ __all__ = [
     "camera_pose",
     "orbit_controls",
     "point_cloud",
+    "points_in_view",
     "pose_from_camera",
     "render_outputs",
     "render_view",
@@ -589,6 +590,47 @@ def render_view(
     return np.ascontiguousarray(np.asarray(img)[..., :3], dtype=np.uint8)
 
 
+def points_in_view(
+    points: npt.ArrayLike,
+    controls: CameraControls,
+    size: tuple[int, int],
+    intrinsics: Intrinsics | None = None,
+) -> int:
+    """How many of ``points`` project inside a ``size = (width, height)`` render of ``controls``.
+
+    The camera model of :func:`render_view`: ``intrinsics`` scaled to ``width``, or a
+    :data:`DEFAULT_FOV_DEG` vertical field of view centred on the picture.
+
+    Parameters
+    ----------
+    points : array_like (N, 3)
+        Metres, left camera frame; non-finite rows count as not in view.
+    controls : CameraControls
+    size : (int, int)
+    intrinsics : Intrinsics, optional
+
+    Returns
+    -------
+    int
+        Points in front of the camera and inside the picture.
+    """
+    w, h = size
+    if intrinsics is not None:
+        k = intrinsics.scaled(w / intrinsics.width)
+        f, cx, cy = k.f, k.cx, k.cy
+    else:
+        f = (h / 2) / math.tan(math.radians(DEFAULT_FOV_DEG / 2))
+        cx, cy = w / 2 - 0.5, h / 2 - 0.5
+    pose = controls.pose()
+    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    cam = (pts - pose[:3, 3]) @ pose[:3, :3]  # R^T (p - t)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = f * cam[:, 0] / cam[:, 2] + cx
+        y = f * cam[:, 1] / cam[:, 2] + cy
+    inside = (cam[:, 2] > 0) & (x >= -0.5) & (x < w - 0.5) & (y >= -0.5) & (y < h - 0.5)
+    return int(np.count_nonzero(inside))
+
+
 def is_blank(image: npt.NDArray[np.uint8], *, min_fraction: float = 0.01) -> bool:
     """True when fewer than ``min_fraction`` of the pixels differ from the render background."""
     bg = np.asarray(BACKGROUND, dtype=np.int16)
@@ -875,6 +917,16 @@ def cmd_view(args: argparse.Namespace) -> int:
         )
     img = render_view(geometry, controls, intrinsics=intr)
     # the format the name asks for (a .jpg got PNG bytes); PNG for a name without one
+    if points_in_view(geometry.points, controls, (img.shape[1], img.shape[0]), intr) == 0:
+        import warnings
+
+        # a cloud in another frame (ROS's X forward, Z up) or controls turned away from it
+        warnings.warn(
+            f"none of the {geometry.n_points} points is in view (behind the camera or outside "
+            "its field of view): the screenshot is empty; the cloud must be in the camera "
+            "frame (metres, X right, Y down, Z forward)",
+            stacklevel=1,
+        )
     ok, buf = cv2.imencode(out.suffix.lower() or ".png", img[..., ::-1])
     if not ok:
         raise OSError(f"could not encode {out}")
