@@ -302,6 +302,62 @@ def test_ply_without_colours_and_image_shaped(tmp_path: Path) -> None:
     assert kept.shape == (2, 3) and np.isnan(kept).all()
 
 
+def test_ascii_ply_and_float_colours(tmp_path: Path) -> None:
+    """ASCII PLY (MeshLab's, CloudCompare's, Open3D's ``write_ascii=True``) was refused as
+    "binary only"; float colours of 0-1 were cast to uint8 (every colour 0 or 1: black)."""
+    head = (
+        "ply\nformat ascii 1.0\ncomment made elsewhere\nelement vertex 3\nproperty float x\n"
+        "property float y\nproperty float z\nproperty float nx\nproperty float ny\n"
+        "property float nz\nproperty {t} red\nproperty {t} green\nproperty {t} blue\n"
+        "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+    body = "1 2 3 0 0 1 {}\n-0.5 0.25 4.5 0 0 1 {}\nnan 0 1 0 0 1 {}\n3 0 1 2\n"
+    (tmp_path / "u8.ply").write_text(
+        head.format(t="uchar") + body.format("255 0 10", "1 2 3", "0 0 0")
+    )
+    pts, cols = read_ply(tmp_path / "u8.ply")
+    np.testing.assert_array_equal(pts[:2], [[1, 2, 3], [-0.5, 0.25, 4.5]])
+    assert pts.dtype == np.float32 and np.isnan(pts[2, 0])
+    assert cols is not None and cols.tolist() == [[255, 0, 10], [1, 2, 3], [0, 0, 0]]
+    (tmp_path / "f.ply").write_text(
+        head.format(t="float") + body.format("1 0 0.5", "0.2 1.5 -1", "0 0 0")
+    )
+    _, cols = read_ply(tmp_path / "f.ply")
+    assert cols is not None and cols.tolist() == [[255, 0, 128], [51, 255, 0], [0, 0, 0]]
+    # binary with float colours, and MeshLab's diffuse_ names
+    rec = np.zeros(
+        1, [("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("r", "<f4"), ("g", "<f4"), ("b", "<f4")]
+    )
+    rec[0] = (1, 2, 3, 1.0, 0.5, 0.0)
+    raw = (
+        head.format(t="float")
+        .replace("ascii", "binary_little_endian")
+        .replace("element vertex 3", "element vertex 1")
+    )
+    raw = raw.replace("property float nx\nproperty float ny\nproperty float nz\n", "")
+    (tmp_path / "fb.ply").write_bytes(
+        raw.replace(" red", " diffuse_red")
+        .replace(" green", " diffuse_green")
+        .replace(" blue", " diffuse_blue")
+        .encode()
+        + rec.tobytes()
+    )
+    pts, cols = read_ply(tmp_path / "fb.ply")
+    assert pts.tolist() == [[1, 2, 3]] and cols is not None and cols.tolist() == [[255, 128, 0]]
+    # a short file and a damaged row say so, with the file's name
+    (tmp_path / "short.ply").write_text(head.format(t="uchar") + "1 2 3 0 0 1 4 5 6\n")
+    with pytest.raises(ValueError, match=r"truncated PLY file .*short\.ply: expected 3 vert"):
+        read_ply(tmp_path / "short.ply")
+    (tmp_path / "bad.ply").write_text(
+        head.format(t="uchar") + body.format("1 2 x", "1 2 3", "0 0 0")
+    )
+    with pytest.raises(ValueError, match=r"damaged PLY file .*bad\.ply"):
+        read_ply(tmp_path / "bad.ply")
+    (tmp_path / "e.ply").write_text(head.format(t="uchar").replace("vertex 3", "vertex 0"))
+    pts, cols = read_ply(tmp_path / "e.ply")
+    assert pts.shape == (0, 3) and cols is not None and cols.shape == (0, 3)
+
+
 def test_ply_errors(tmp_path: Path) -> None:
     (tmp_path / "g.ply").write_bytes(b"\x00\x01garbage")
     with pytest.raises(ValueError, match="not a PLY file"):

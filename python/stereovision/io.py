@@ -557,10 +557,13 @@ def write_ply(
 def read_ply(
     path: PathLike,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]:
-    """Read a binary PLY point cloud with ``x, y, z`` and optional ``red, green, blue``.
+    """Read a PLY point cloud with ``x, y, z`` and optional ``red, green, blue`` (or
+    ``diffuse_red, diffuse_green, diffuse_blue``).
 
-    Reads the files :func:`write_ply` writes and other binary (little- or big-endian) PLY files
-    whose first element is ``vertex`` with scalar properties (further elements are ignored).
+    Reads the files :func:`write_ply` writes and other ASCII or binary (little- or big-endian)
+    PLY files whose first element is ``vertex`` with scalar properties (further elements are
+    ignored). Colours of a floating-point type are taken as 0-1 (as some tools write them) and
+    scaled to 0-255.
 
     Parameters
     ----------
@@ -579,7 +582,7 @@ def read_ply(
     FileNotFoundError
         If ``path`` does not exist.
     ValueError
-        ``"not a PLY file"`` for anything else; ASCII PLY, missing ``x/y/z`` or truncated data
+        ``"not a PLY file"`` for anything else; missing ``x/y/z``, truncated or damaged data
         are also reported as ValueError.
     """
     p = _existing_file(path, "PLY file")
@@ -608,8 +611,13 @@ def read_ply(
                 order = "<"
             elif fmt == "binary_big_endian":
                 order = ">"
+            elif fmt == "ascii":
+                order = "="
             else:
-                raise ValueError(f"unsupported PLY format {fmt!r} in {p} (binary only)")
+                raise ValueError(
+                    f"unsupported PLY format {fmt!r} in {p} (ascii, binary_little_endian or "
+                    "binary_big_endian)"
+                )
         elif tok[0] == "element":
             if count >= 0 and in_vertex:
                 in_vertex = False
@@ -629,16 +637,52 @@ def read_ply(
         raise ValueError(f"PLY file {p}: vertex has properties {names}, expected x, y, z")
     dtype = np.dtype([(n, order + _PLY_TYPES[t]) for n, t in props])
     start = nl + 1
-    if len(raw) - start < count * dtype.itemsize:
+    if order == "=":
+        rec = _ascii_ply_vertices(raw[start:], dtype, count, p)
+    elif len(raw) - start < count * dtype.itemsize:
         raise ValueError(
             f"truncated PLY file {p}: expected {count} vertices of {dtype.itemsize} bytes"
         )
-    rec = np.frombuffer(raw, dtype=dtype, count=count, offset=start)
+    else:
+        rec = np.frombuffer(raw, dtype=dtype, count=count, offset=start)
     pts = np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float32)
     cols: npt.NDArray[np.uint8] | None = None
-    if {"red", "green", "blue"} <= set(names):
-        cols = np.stack([rec["red"], rec["green"], rec["blue"]], axis=1).astype(np.uint8)
+    prefix = next(
+        (q for q in ("", "diffuse_") if {f"{q}red", f"{q}green", f"{q}blue"} <= set(names)), None
+    )
+    if prefix is not None:  # "diffuse_red": MeshLab's and Blender's older name
+        rgb = np.stack([rec[f"{prefix}{c}"] for c in ("red", "green", "blue")], axis=1)
+        if rgb.dtype.kind == "f":  # 0-1 (a uint8 cast made every colour 0 or 1: black)
+            rgb = np.rint(np.clip(np.nan_to_num(rgb), 0.0, 1.0) * 255.0)
+        cols = rgb.astype(np.uint8)
     return pts, cols
+
+
+def _ascii_ply_vertices(
+    body: bytes, dtype: np.dtype[Any], count: int, path: Path
+) -> npt.NDArray[Any]:
+    """The first ``count`` rows of an ASCII PLY body as records of ``dtype`` (one value per
+    property; rows of later elements, faces, are not read)."""
+    import io as _io
+
+    rec = np.empty(count, dtype=dtype)
+    if count == 0:
+        return rec
+    try:
+        table = np.loadtxt(
+            _io.BytesIO(body),
+            dtype=np.float64,
+            ndmin=2,
+            max_rows=count,
+            usecols=range(len(dtype.names or ())),
+        )
+    except ValueError as exc:  # a short or damaged row: NumPy's words, with the file's name
+        raise ValueError(f"damaged PLY file {path}: {str(exc).splitlines()[0]}") from None
+    if table.shape[0] < count:
+        raise ValueError(f"truncated PLY file {path}: expected {count} vertices")
+    for i, name in enumerate(dtype.names or ()):
+        rec[name] = table[:, i]
+    return rec
 
 
 # --------------------------------------------------------------------------------------- scenes
