@@ -378,6 +378,34 @@ def test_points_in_view_matches_the_render():
     assert render.points_in_view(pts, CameraControls(forward=6), (800, 600)) == 0  # passed it
 
 
+def test_view_window_keeps_the_robust_clipping(tmp_path, monkeypatch):
+    """In ``view``'s window a mouse drag lets VTK reset the clipping range from the bounds: a
+    few far points (a near-zero disparity is kilometres away) put the near plane beyond the
+    whole scene. The GUI re-applied the robust range before each frame; ``view`` did not."""
+    from stereovision.io import write_ply
+
+    rng = np.random.default_rng(5)
+    pts = rng.uniform([-1, -1, 3], [1, 1, 5], (2000, 3))
+    pts[:4] = [[0, 0, 1e5], [1e3, 0, 2e5], [0, 5e3, 1.5e5], [0, 0, 8e4]]  # 0.2 % outliers
+    write_ply(tmp_path / "far.ply", pts, np.full((2000, 3), 255, np.uint8))
+    monkeypatch.setattr(render, "_has_display", lambda: True)
+    make = render.make_plotter
+    monkeypatch.setattr(render, "make_plotter", lambda size, off_screen=True: make(size))
+    seen: dict[str, object] = {}
+
+    def drag_then_draw(plotter, *args, **kwargs):
+        plotter.reset_camera_clipping_range()  # what the interactor does on every drag
+        seen["img"] = plotter.screenshot(return_img=True)
+        seen["range"] = plotter.camera.clipping_range
+
+    monkeypatch.setattr(pv.Plotter, "show", drag_then_draw)
+    args = _view_args(tmp_path / "far.ply", None)
+    assert args.func(args) == 0
+    near, far = seen["range"]
+    assert near < 3.0 < 5.0 < far, (near, far)
+    assert not render.is_blank(np.asarray(seen["img"])[..., :3])
+
+
 def test_view_refuses_to_write_over_the_scene_it_shows(tmp_path):
     """``view SCENE -o SCENE/left.png`` computed the depth map, then replaced the scene's left
     image with the screenshot without a word."""

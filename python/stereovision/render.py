@@ -896,6 +896,8 @@ def cmd_view(args: argparse.Namespace) -> int:
     if out is None and _has_display():
         plotter = make_plotter((1024, 768), off_screen=False)
         add_geometry(plotter, geometry)
+        # a mouse drag resets the clipping range from the bounds, which far outliers ruin
+        keep_robust_clipping(plotter, geometry.points)
         apply_camera(
             plotter,
             controls,
