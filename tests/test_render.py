@@ -290,7 +290,7 @@ def test_view_writes_screenshot(result, tmp_path, capsys):
     assert args.func(args) == 0
     img = cv2.imread(str(shot))
     assert img is not None and not render.is_blank(img[..., ::-1])
-    assert f"{len(result.points)} points" in capsys.readouterr().out
+    assert capsys.readouterr().out == f"{len(result.points)} points -> {shot}\n"  # not "cells"
     # a .jpg name gets JPEG bytes (it got PNG), another suffix an error before rendering
     jpg = tmp_path / "shot.jpg"
     args = _view_args(tmp_path, jpg, yaw=5.0, forward=0.5)
@@ -404,6 +404,24 @@ def test_view_window_keeps_the_robust_clipping(tmp_path, monkeypatch):
     near, far = seen["range"]
     assert near < 3.0 < 5.0 < far, (near, far)
     assert not render.is_blank(np.asarray(seen["img"])[..., :3])
+
+
+def test_view_help_gives_the_signs_and_units_of_the_controls():
+    """``--pitch`` said only "camera pitch (deg)": which way +10 turns was in the docstring."""
+    parser = argparse.ArgumentParser()
+    render.add_cli(parser.add_subparsers())
+    sub = parser._subparsers._group_actions[0].choices["view"]
+    helps = {a.dest: a.help for a in sub._actions}
+    assert helps["pitch"] == "degrees; > 0 looks up"
+    assert helps["yaw"] == "degrees; > 0 turns right"
+    assert helps["roll"] == "degrees; > 0 lowers the camera's right side"
+    assert helps["up"] == "move the camera up, metres (along the left camera's -Y)"
+    # and they do what they say (camera_pose): +pitch looks up, the scene moves down the picture
+    pts = np.array([[0.0, 0.0, 5.0]])
+    level = render.points_in_view(pts, CameraControls(), (800, 600))
+    assert level == 1 and render.points_in_view(pts, CameraControls(pitch=31), (800, 600)) == 0
+    np.testing.assert_allclose(_project(pts, CameraControls(pitch=10))[0, 1] - syn.CY,
+                               syn.F * math.tan(math.radians(10)))  # fmt: skip
 
 
 def test_view_refuses_to_write_over_the_scene_it_shows(tmp_path):

@@ -936,7 +936,11 @@ def cmd_view(args: argparse.Namespace) -> int:
 
     with atomic_write(out) as fh:
         fh.write(buf.tobytes())
-    print(f"{geometry.n_points} points, {geometry.n_cells} cells -> {out}", file=sys.stdout)
+    # a cloud's cells are its points: "N points, N cells" read as if it were a mesh
+    what = f"{geometry.n_points} points" + (
+        f", {geometry.n_faces} triangles" if geometry.n_faces else ""
+    )
+    print(f"{what} -> {out}", file=sys.stdout)
     return 0
 
 
@@ -947,10 +951,20 @@ def add_cli(subparsers: Any) -> None:
         help="show a point cloud / depth output (window, or a screenshot without a display)",
     )
     p.add_argument("source", help="cloud.ply / .pcd / .npz, a `depth` output folder or a scene")
-    for name, unit in (("roll", "deg"), ("pitch", "deg"), ("yaw", "deg")):
-        p.add_argument(f"--{name}", type=float, default=0.0, help=f"camera {name} ({unit})")
-    for name in ("forward", "up", "right"):
-        p.add_argument(f"--{name}", type=float, default=0.0, help=f"move the camera {name} (m)")
+    # the signs of camera_pose, said where a user looks for them
+    for name, sign in (
+        ("roll", "> 0 lowers the camera's right side"),
+        ("pitch", "> 0 looks up"),
+        ("yaw", "> 0 turns right"),
+    ):
+        p.add_argument(f"--{name}", type=float, default=0.0, help=f"degrees; {sign}")
+    for name, axis in (("forward", "+Z"), ("up", "-Y"), ("right", "+X")):
+        p.add_argument(
+            f"--{name}",
+            type=float,
+            default=0.0,
+            help=f"move the camera {name}, metres (along the left camera's {axis})",
+        )
     p.add_argument(
         "-o",
         "--output",
