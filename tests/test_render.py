@@ -504,6 +504,14 @@ def test_view_bad_inputs_clear_errors(tmp_path):
     (tmp_path / "emptydir").mkdir()
     with pytest.raises(FileNotFoundError, match=r"no cloud\.ply"):
         render.load_view_source(tmp_path / "emptydir")
+    # `depth` without --calib wrote disparities only: said so (it was "no cloud.ply and no scene")
+    out = tmp_path / "uncalibrated"
+    out.mkdir()
+    (out / "disparity.png").write_bytes(b"")
+    (out / "disparity.pfm").write_bytes(b"Pf\n1 1\n-1\n\0\0\0\0")
+    with pytest.raises(FileNotFoundError, match=r"a depth output without cloud\.ply \(depth "
+                       r"writes the cloud only with --calib"):  # fmt: skip
+        render.load_view_source(out)
 
 
 def test_view_scene_folder_shows_textured_surface():

@@ -807,6 +807,12 @@ def load_view_source(path: str | os.PathLike[str]) -> tuple[pv.PolyData, Intrins
                 scene.left, scene.right, scene.calib, max_disparity=scene.max_disparity
             )
             return surface_mesh(result), Intrinsics.from_result(result)
+        elif (p / "disparity.pfm").is_file():
+            # `stereovision depth` without --calib: disparities only, no metric point
+            raise FileNotFoundError(
+                f"{p}: a depth output without cloud.ply (depth writes the cloud only with "
+                "--calib: no metric 3-D points without one)"
+            )
         else:
             raise FileNotFoundError(
                 f"{p}: no cloud.ply and no scene (left.png + right.png) in this folder"
