@@ -349,8 +349,9 @@ def test_view_warns_when_no_point_is_in_view(tmp_path):
     rng = np.random.default_rng(3)
     front = rng.uniform([-0.5, -0.5, 3], [0.5, 0.5, 5], (1000, 3)).astype(np.float32)
     ros = front[:, [2, 0, 1]]  # X forward, Y left, Z up: nothing along the camera's +Z
-    write_ply(tmp_path / "front.ply", front)
-    write_ply(tmp_path / "ros.ply", ros)
+    white = np.full((1000, 3), 255, np.uint8)  # coloured: no depth scale bar in the picture
+    write_ply(tmp_path / "front.ply", front, white)
+    write_ply(tmp_path / "ros.ply", ros, white)
     args = _view_args(tmp_path / "ros.ply", tmp_path / "ros.png")
     with pytest.warns(UserWarning, match=r"none of the 1000 points is in view \(behind the"):
         assert args.func(args) == 0
@@ -422,6 +423,33 @@ def test_view_help_gives_the_signs_and_units_of_the_controls():
     assert level == 1 and render.points_in_view(pts, CameraControls(pitch=31), (800, 600)) == 0
     np.testing.assert_allclose(_project(pts, CameraControls(pitch=10))[0, 1] - syn.CY,
                                syn.F * math.tan(math.radians(10)))  # fmt: skip
+
+
+def test_cloud_without_colours_is_coloured_by_depth_with_a_metre_scale():
+    """A PLY without colours (another tool's) was drawn in one flat colour: no depth cue at
+    all. Now TURBO by Z over its 1st-99th percentiles, with a scale bar titled in metres."""
+    import cv2 as _cv2
+
+    rng = np.random.default_rng(6)
+    near = rng.uniform([-1.0, -0.5, 3.0], [-0.2, 0.5, 3.0], (3000, 3))
+    far = rng.uniform([0.4, -1.0, 6.0], [2.0, 1.0, 6.0], (3000, 3))
+    cloud = render.point_cloud(np.concatenate([near, far]))
+    plotter = render.make_plotter((400, 300))
+    try:
+        render.add_geometry(plotter, cloud)
+        render.apply_camera(plotter, CameraControls(), focal_distance=4.5, points=cloud.points)
+        img = np.asarray(plotter.screenshot(return_img=True))[..., :3]
+        bars = list(plotter.scalar_bars.keys())
+    finally:
+        plotter.close()
+    assert bars == ["depth Z (m)"] and "depth Z (m)" not in cloud.point_data
+    turbo = _cv2.applyColorMap(np.array([[0], [255]], np.uint8), _cv2.COLORMAP_TURBO)[:, 0, ::-1]
+    bg = np.array(render.BACKGROUND)
+    top = img[: 300 * 3 // 4]  # above the scale bar
+    for half, expected in ((top[:, :170], turbo[0]), (top[:, 230:], turbo[1])):
+        drawn = half[np.abs(half.astype(int) - bg).max(axis=-1) > 8].astype(int)
+        assert len(drawn) > 100
+        np.testing.assert_allclose(np.median(drawn, axis=0), expected, atol=12)
 
 
 def test_view_refuses_to_write_over_the_scene_it_shows(tmp_path):

@@ -512,10 +512,50 @@ def make_plotter(size: tuple[int, int], *, off_screen: bool = True) -> pv.Plotte
     return plotter
 
 
+#: Title of the scale bar of a cloud without colours, coloured by its depth.
+DEPTH_BAR_TITLE = "depth Z (m)"
+
+
+def _turbo_table(lo: float, hi: float) -> Any:
+    """A 256-entry TURBO lookup table over ``lo..hi`` (OpenCV's colours: no matplotlib)."""
+    import cv2
+
+    pv = _pv()
+    bgr = cv2.applyColorMap(np.arange(256, dtype=np.uint8).reshape(-1, 1), cv2.COLORMAP_TURBO)
+    rgba = np.concatenate([bgr[:, 0, ::-1], np.full((256, 1), 255, np.uint8)], axis=1)
+    table = pv.LookupTable(values=rgba)
+    table.scalar_range = (lo, hi)
+    return table
+
+
 def add_geometry(plotter: pv.Plotter, geometry: pv.PolyData) -> Any:
-    """Add a surface mesh (textured, unlit) or a point cloud (RGB points) to ``plotter``."""
+    """Add a surface mesh (textured, unlit) or a point cloud (RGB points) to ``plotter``.
+
+    A point cloud without colours (a PLY / PCD of another tool) is coloured by its depth Z
+    (TURBO over the 1st-99th percentiles) with a scale bar in metres (:data:`DEPTH_BAR_TITLE`);
+    plain points of one colour showed no depth at all.
+    """
     texture = texture_of(geometry) if geometry.n_cells and geometry.n_faces else None
     has_rgb = "RGB" in geometry.point_data
+    if not has_rgb and not geometry.n_faces and geometry.n_points:
+        z = np.asarray(geometry.points, dtype=np.float64)[:, 2]
+        finite = z[np.isfinite(z)]
+        lo, hi = (float(v) for v in np.percentile(finite, [1, 99])) if finite.size else (0, 1)
+        if not hi > lo:
+            lo, hi = lo - 0.5, lo + 0.5
+        coloured = geometry.copy(deep=False)  # the caller's geometry stays as it was
+        coloured.point_data[DEPTH_BAR_TITLE] = z
+        return plotter.add_mesh(
+            coloured,
+            scalars=DEPTH_BAR_TITLE,
+            cmap=_turbo_table(lo, hi),
+            clim=(lo, hi),
+            point_size=POINT_SIZE,
+            style="points",
+            lighting=False,
+            name="scene",
+            scalar_bar_args={"title": DEPTH_BAR_TITLE, "color": "white", "fmt": "%.2f"},
+        )
     if geometry.n_faces:
         if texture is not None:
             return plotter.add_mesh(geometry, texture=texture, lighting=False, name="scene")
