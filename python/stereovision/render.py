@@ -964,7 +964,6 @@ def cmd_view(args: argparse.Namespace) -> int:
             stacklevel=1,
         )
     img = render_view(geometry, controls, intrinsics=intr)
-    # the format the name asks for (a .jpg got PNG bytes); PNG for a name without one
     if points_in_view(geometry.points, controls, (img.shape[1], img.shape[0]), intr) == 0:
         import warnings
 
@@ -975,6 +974,7 @@ def cmd_view(args: argparse.Namespace) -> int:
             "frame (metres, X right, Y down, Z forward)",
             stacklevel=1,
         )
+    # the format the name asks for (a .jpg got PNG bytes); PNG for a name without one
     ok, buf = cv2.imencode(out.suffix.lower() or ".png", img[..., ::-1])
     if not ok:
         raise OSError(f"could not encode {out}")
