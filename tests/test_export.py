@@ -189,6 +189,16 @@ def test_empty_ascii_pcd_is_an_empty_cloud(tmp_path):
             export.load_cloud(path)
 
 
+def test_bundle_without_calibration_says_so(result, tmp_path):
+    """``load_cloud`` (and so ``view``) of a bundle written without calibration said "empty
+    point cloud: ... has no finite 3-D point"; the cause is that it has no intrinsics."""
+    path = export.write_npz(tmp_path / "u.npz", replace(result, calibration=None, depth=None))
+    with pytest.raises(ValueError, match=r"u\.npz: a depth bundle without calibration \(no intr"):
+        export.load_cloud(path)
+    pts, _ = export.load_cloud(export.write_npz(tmp_path / "c.npz", result))
+    assert len(pts) == len(result.points)
+
+
 def test_npz_bundle(result, tmp_path):
     # sigma_Z = Z^2 sigma_d / (f B) with sigma_d = 0.5 px: the bundle keeps the uncertainty.
     sigma = (result.depth.astype(np.float64) ** 2 * 0.5 / (syn.F * syn.B)).astype(np.float32)

@@ -500,9 +500,15 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     return data
 
 
-def _points_from_bundle(data: dict[str, Any]) -> npt.NDArray[np.float32]:
+def _points_from_bundle(data: dict[str, Any], path: Path) -> npt.NDArray[np.float32]:
     depth = np.asarray(data["depth"], dtype=np.float64)
     k = np.asarray(data["K"], dtype=np.float64)
+    if not np.isfinite(k).all():
+        # write_npz of a result without calibration: K and depth all NaN ("empty point cloud"
+        # named no cause)
+        raise ValueError(
+            f"{path}: a depth bundle without calibration (no intrinsics): no metric 3-D points"
+        )
     h, w = depth.shape
     ys, xs = np.mgrid[0:h, 0:w]
     x = (xs - k[0, 2]) * depth / k[0, 0]
@@ -550,7 +556,7 @@ def load_cloud(
     elif head.startswith(_PCD_MAGIC):
         pts, cols = read_pcd(p)
     elif head.startswith(_ZIP_MAGIC):
-        pts, cols = _points_from_bundle(read_npz(p)), None
+        pts, cols = _points_from_bundle(read_npz(p), p), None
     elif p.suffix.lower() == ".ply":
         raise ValueError(f"not a PLY file: {p}")
     else:
