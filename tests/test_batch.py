@@ -931,3 +931,38 @@ def test_a_redo_stopped_before_a_pair_is_written_keeps_its_earlier_outputs_liste
     assert main(args) == 0
     assert {p.name for p in (out / "a").iterdir()} == DISPARITY_FILES
     assert _summary(out)["pairs"]["a"]["outputs"] == sorted(DISPARITY_FILES)
+
+
+def test_a_second_batch_into_an_output_folder_in_use_is_refused(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A run started while another one writes into the same -o stops before any work, one
+    line; each run replaced the whole summary with its own, so the one that finished last
+    dropped the other's records without a word."""
+    import stereovision.batch as batch
+
+    one, two, out = tmp_path / "drive1", tmp_path / "drive2", tmp_path / "out"
+    _tiny(one, data_dir, "a/left.png", "a/right.png")
+    _tiny(two, data_dir, "b/left.png", "b/right.png")
+    said: dict[str, Any] = {}
+
+    def meanwhile(*_args: Any, **_kwargs: Any) -> None:
+        if said:  # the second run, on the code that let it in
+            return
+        said["rc"] = main(["batch", str(two), "-o", str(out), "--max-disparity", "16"])
+        said["err"] = capsys.readouterr().err.splitlines()
+
+    monkeypatch.setattr(batch, "_run_jobs", meanwhile)
+    batch.run_batch(one, out, workers=1, max_disparity=16)
+    assert said["rc"] == 2
+    assert said["err"] == [
+        f"stereovision: error: output folder {out} is in use by another stereovision batch "
+        "run; wait for it to end, or give another output folder"
+    ]
+    assert set(_summary(out)["pairs"]) == {"a"}
+    monkeypatch.undo()  # the folder is free again once the run is over
+    assert main(["batch", str(two), "-o", str(out), "--workers", "1", "--max-disparity", "16"]) == 0
+    assert set(_summary(out)["pairs"]) == {"a", "b"}

@@ -771,6 +771,44 @@ def _task(job: PairJob, opts: dict[str, Any]) -> dict[str, Any]:
     }
 
 
+@contextlib.contextmanager
+def _output_lock(out: Path) -> Iterator[None]:
+    """Hold an exclusive lock on the output folder for a run (``flock`` on the folder itself:
+    no file is left in it, and the system releases it when the process ends, killed or not).
+
+    Two runs into one folder each replaced the whole summary with their own, so the one that
+    finished last dropped the other's records without a word. Where the system or filesystem
+    cannot lock (Windows, some network filesystems), the run goes on unlocked, as before.
+
+    Raises
+    ------
+    ValueError
+        If another run holds the folder.
+    """
+    try:
+        import fcntl
+    except ImportError:  # Windows
+        fcntl = None  # type: ignore[assignment]
+    fd = None
+    with contextlib.suppress(OSError):
+        fd = os.open(out, os.O_RDONLY)
+    try:
+        if fcntl is not None and fd is not None:
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                raise ValueError(
+                    f"output folder {out} is in use by another stereovision batch run; wait "
+                    "for it to end, or give another output folder"
+                ) from None
+            except OSError:  # no locks on this filesystem
+                pass
+        yield
+    finally:
+        if fd is not None:
+            os.close(fd)  # releases the lock
+
+
 def run_batch(
     input_dir: str | os.PathLike[str],
     output_dir: str | os.PathLike[str],
@@ -832,7 +870,8 @@ def run_batch(
     ValueError
         Bad ``workers`` / ``max_disparity``, no pair under the input, an output folder that
         is a file (or below one), or one holding the outputs of pairs of the same names that
-        a run over another input folder made from other images (they would be replaced).
+        a run over another input folder made from other images (they would be replaced), or
+        one that another run is writing into.
     PermissionError
         If the output folder cannot be written.
     OSError
@@ -871,164 +910,168 @@ def run_batch(
         )
     out = Path(output_dir)
     out.mkdir(parents=True, exist_ok=True)
-    summary = _Summary(out, log)
-    # the input folder of the runs that wrote OUT before (None for a new OUT)
-    earlier_input = summary.data.get("input") if summary.pairs else None
-    opts: dict[str, Any] = {"method": method, "max_disparity": max_disparity, "fill": fill}
-    if ground:  # only when asked: outputs of earlier runs without it stay valid
-        opts.update(ground=True, grid=grid)
-    summary.data.update(
-        input=str(Path(input_dir).resolve()),
-        output=str(out.resolve()),
-    )
-    todo: list[PairJob] = []
-    previous: dict[str, list[str]] = {}  # the outputs an earlier run recorded, per pair
-    skipped: list[str] = []
-    failed_before: list[str] = []
-    redone: list[str] = []
-    changes: set[str] = set()
-    others: list[tuple[str, str]] = []  # done from another input folder's images: (name, image)
-    for job in jobs:
-        fp = _fingerprint(job)
-        entry = summary.pairs.get(job.name)
-        if _skip(entry, fp, opts, out, job.name, retry_failed):
-            assert entry is not None
-            entry["this_run"] = "skipped"
-            (skipped if entry["status"] == "done" else failed_before).append(job.name)
-            continue
-        if (
-            entry is not None
-            and entry.get("status") == "done"
-            and earlier_input is not None
-            and earlier_input != summary.data["input"]
-            # its images are not this pair's: a run over another input since is not enough
-            and not _same_file(entry.get("left"), job.left)
-            and entry.get("fingerprint") != fp
-            and (out / job.name / "disparity.pfm").is_file()
-        ):
-            others.append((job.name, str(entry.get("left"))))
-        if (
-            entry is not None
-            and entry.get("status") == "done"
-            and entry.get("fingerprint") == fp
-            and (out / job.name / "disparity.pfm").is_file()
-        ):  # done on the same images, with other options: its outputs are replaced
-            redone.append(job.name)
-            changes.update(_changes(entry.get("options") or {}, opts))
-        if entry is not None and isinstance(entry.get("outputs"), list):
-            previous[job.name] = [str(f) for f in entry["outputs"]]
-        summary.pairs[job.name] = {
-            "status": "pending",
-            "left": str(job.left),
-            "right": str(job.right),
-            "calib": None if job.calib is None else str(job.calib),
-            "options": opts,
-            "fingerprint": fp,
-        }
-        if job.name in previous:
-            # still in its folder until this run writes the pair: a run stopped before (or
-            # failing it) keeps them listed, so the next one removes those it does not write
-            summary.pairs[job.name]["outputs"] = previous[job.name]
-        todo.append(job)
-    if others:
-        # a second drive under the same pair names replaced the first one's outputs, unsaid
-        name, image = others[0]
-        raise ValueError(
-            f"output folder {out} holds the outputs of {len(others)} pair(s) of the same names "
-            # the example's image names its folder: the last run's input may be another one
-            f"made from other images (e.g. {name} from {image}); give "
-            f"another output folder, or remove {out / SUMMARY_NAME} to replace them"
+    with _output_lock(out):  # a second run into OUT would drop this one's records
+        summary = _Summary(out, log)
+        # the input folder of the runs that wrote OUT before (None for a new OUT)
+        earlier_input = summary.data.get("input") if summary.pairs else None
+        opts: dict[str, Any] = {"method": method, "max_disparity": max_disparity, "fill": fill}
+        if ground:  # only when asked: outputs of earlier runs without it stay valid
+            opts.update(ground=True, grid=grid)
+        summary.data.update(
+            input=str(Path(input_dir).resolve()),
+            output=str(out.resolve()),
         )
-    if redone and log is not None:
-        shown = sorted(changes)[:3] + (["..."] if len(changes) > 3 else [])
-        log(
-            f"{len(redone)} pair(s) were done with other options ({'; '.join(shown)}); they are "
-            "redone and their outputs replaced"
-        )
-    processed: list[str] = []
-    failed: list[str] = []
-    for u in unpaired:  # a failed pair, every run until the missing image is there
-        left, right = (u.present, u.missing) if u.side == "left" else (u.missing, u.present)
-        earlier = summary.pairs.get(u.name) or {}
-        summary.pairs[u.name] = {
-            "status": "failed",
-            "left": str(left),
-            "right": str(right),
-            "calib": None,
-            "error": u.error,
-            "finished": _now(),
-            "this_run": "failed",
-        }
-        if isinstance(earlier.get("outputs"), list):  # an earlier run's, still in its folder
-            summary.pairs[u.name]["outputs"] = earlier["outputs"]
-        failed.append(u.name)
-        if log is not None:
-            log(f"failed {u.name}: {u.error}")
-    # no more worker processes than pairs to do: each starts Python, NumPy and OpenCV (a 64-core
-    # machine started 64 for 2 pairs), and the cores go to the kernels' own threads instead
-    n_workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
-    run: dict[str, Any] = {
-        "started": _now(),
-        "scheduler": None,
-        "pairs": len(jobs) + len(unpaired),
-        "processed": 0,
-        "skipped": len(skipped),
-        "skipped_failed": len(failed_before),
-        "failed": len(failed),
-        "unpaired": len(unpaired),
-        "interrupted": False,
-    }
-    summary.data["run"] = run
-    interrupted = False
-    cause: KeyboardInterrupt | None = None
-    try:
-        summary.save()
-        if todo:
-            _run_jobs(
-                todo,
-                opts,
-                out,
-                summary,
-                run,
-                scheduler,
-                n_workers,
-                log,
-                progress,
-                processed,
-                failed,
-                previous,
+        todo: list[PairJob] = []
+        previous: dict[str, list[str]] = {}  # the outputs an earlier run recorded, per pair
+        skipped: list[str] = []
+        failed_before: list[str] = []
+        redone: list[str] = []
+        changes: set[str] = set()
+        others: list[tuple[str, str]] = []  # done from another input folder's images: (name, image)
+        for job in jobs:
+            fp = _fingerprint(job)
+            entry = summary.pairs.get(job.name)
+            if _skip(entry, fp, opts, out, job.name, retry_failed):
+                assert entry is not None
+                entry["this_run"] = "skipped"
+                (skipped if entry["status"] == "done" else failed_before).append(job.name)
+                continue
+            if (
+                entry is not None
+                and entry.get("status") == "done"
+                and earlier_input is not None
+                and earlier_input != summary.data["input"]
+                # its images are not this pair's: a run over another input since is not enough
+                and not _same_file(entry.get("left"), job.left)
+                and entry.get("fingerprint") != fp
+                and (out / job.name / "disparity.pfm").is_file()
+            ):
+                others.append((job.name, str(entry.get("left"))))
+            if (
+                entry is not None
+                and entry.get("status") == "done"
+                and entry.get("fingerprint") == fp
+                and (out / job.name / "disparity.pfm").is_file()
+            ):  # done on the same images, with other options: its outputs are replaced
+                redone.append(job.name)
+                changes.update(_changes(entry.get("options") or {}, opts))
+            if entry is not None and isinstance(entry.get("outputs"), list):
+                previous[job.name] = [str(f) for f in entry["outputs"]]
+            summary.pairs[job.name] = {
+                "status": "pending",
+                "left": str(job.left),
+                "right": str(job.right),
+                "calib": None if job.calib is None else str(job.calib),
+                "options": opts,
+                "fingerprint": fp,
+            }
+            if job.name in previous:
+                # still in its folder until this run writes the pair: a run stopped before (or
+                # failing it) keeps them listed, so the next one removes those it does not write
+                summary.pairs[job.name]["outputs"] = previous[job.name]
+            todo.append(job)
+        if others:
+            # a second drive under the same pair names replaced the first one's outputs, unsaid
+            name, image = others[0]
+            raise ValueError(
+                f"output folder {out} holds the outputs of {len(others)} pair(s) of the same names "
+                # the example's image names its folder: the last run's input may be another one
+                f"made from other images (e.g. {name} from {image}); give "
+                f"another output folder, or remove {out / SUMMARY_NAME} to replace them"
             )
-    except KeyboardInterrupt as exc:
-        interrupted = True
-        cause = exc
-    with HeldInterrupts(replay=False) as held:  # the record of the run is written whole
-        gone = _outputs_gone(out, summary, [j.name for j in jobs])
-        seconds = time.perf_counter() - t0
-        run.update(
-            finished=_now(), seconds=round(seconds, 3), interrupted=interrupted, missing=len(gone)
+        if redone and log is not None:
+            shown = sorted(changes)[:3] + (["..."] if len(changes) > 3 else [])
+            log(
+                f"{len(redone)} pair(s) were done with other options ({'; '.join(shown)}); they "
+                "are redone and their outputs replaced"
+            )
+        processed: list[str] = []
+        failed: list[str] = []
+        for u in unpaired:  # a failed pair, every run until the missing image is there
+            left, right = (u.present, u.missing) if u.side == "left" else (u.missing, u.present)
+            earlier = summary.pairs.get(u.name) or {}
+            summary.pairs[u.name] = {
+                "status": "failed",
+                "left": str(left),
+                "right": str(right),
+                "calib": None,
+                "error": u.error,
+                "finished": _now(),
+                "this_run": "failed",
+            }
+            if isinstance(earlier.get("outputs"), list):  # an earlier run's, still in its folder
+                summary.pairs[u.name]["outputs"] = earlier["outputs"]
+            failed.append(u.name)
+            if log is not None:
+                log(f"failed {u.name}: {u.error}")
+        # no more worker processes than pairs to do: each starts Python, NumPy and OpenCV (a 64-core
+        # machine started 64 for 2 pairs), and the cores go to the kernels' own threads instead
+        n_workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
+        run: dict[str, Any] = {
+            "started": _now(),
+            "scheduler": None,
+            "pairs": len(jobs) + len(unpaired),
+            "processed": 0,
+            "skipped": len(skipped),
+            "skipped_failed": len(failed_before),
+            "failed": len(failed),
+            "unpaired": len(unpaired),
+            "interrupted": False,
+        }
+        summary.data["run"] = run
+        interrupted = False
+        cause: KeyboardInterrupt | None = None
+        try:
+            summary.save()
+            if todo:
+                _run_jobs(
+                    todo,
+                    opts,
+                    out,
+                    summary,
+                    run,
+                    scheduler,
+                    n_workers,
+                    log,
+                    progress,
+                    processed,
+                    failed,
+                    previous,
+                )
+        except KeyboardInterrupt as exc:
+            interrupted = True
+            cause = exc
+        with HeldInterrupts(replay=False) as held:  # the record of the run is written whole
+            gone = _outputs_gone(out, summary, [j.name for j in jobs])
+            seconds = time.perf_counter() - t0
+            run.update(
+                finished=_now(),
+                seconds=round(seconds, 3),
+                interrupted=interrupted,
+                missing=len(gone),
+            )
+            summary.save()
+        if held.received and not interrupted:
+            interrupted = True
+            run["interrupted"] = True
+            summary.save()
+        pending = [j.name for j in todo if j.name not in processed and j.name not in failed]
+        result = BatchResult(
+            processed,
+            skipped,
+            failed,
+            pending,
+            seconds,
+            summary.path,
+            interrupted=interrupted,
+            failed_before=failed_before,
+            unpaired=[u.name for u in unpaired],
+            missing=gone,
+            redone=redone,
         )
-        summary.save()
-    if held.received and not interrupted:
-        interrupted = True
-        run["interrupted"] = True
-        summary.save()
-    pending = [j.name for j in todo if j.name not in processed and j.name not in failed]
-    result = BatchResult(
-        processed,
-        skipped,
-        failed,
-        pending,
-        seconds,
-        summary.path,
-        interrupted=interrupted,
-        failed_before=failed_before,
-        unpaired=[u.name for u in unpaired],
-        missing=gone,
-        redone=redone,
-    )
-    if interrupted:
-        raise BatchInterrupted(result) from cause
-    return result
+        if interrupted:
+            raise BatchInterrupted(result) from cause
+        return result
 
 
 def _outputs_gone(out: Path, summary: _Summary, names: list[str]) -> list[str]:
