@@ -966,3 +966,35 @@ def test_a_second_batch_into_an_output_folder_in_use_is_refused(
     monkeypatch.undo()  # the folder is free again once the run is over
     assert main(["batch", str(two), "-o", str(out), "--workers", "1", "--max-disparity", "16"]) == 0
     assert set(_summary(out)["pairs"]) == {"a", "b"}
+
+
+def test_camera_folders_pair_names_with_left_and_right_by_their_number(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """left/left_0001.png + right/right_0001.png is a pair (named by the folder and the frame
+    number, as seq/left_0001.png + seq/right_0001.png are); each image was reported as
+    unpaired, for want of a right_0001.png beside left_0001.png. Pairs named so in one folder
+    stay as they were, a number twice on one side is not guessed, a number alone stays alone."""
+    import stereovision.batch as batch
+
+    root = tmp_path / "in"
+    _tiny(
+        root,
+        data_dir,
+        *("s/left/left_0001.png", "s/right/right_0001.png"),
+        *("s/left/left_0002.png", "s/left/left_0003.png", "s/right/right_0003.png"),
+        *("s/left/x_left.png", "s/left/x_right.png"),
+        *("d/left/a_left_5.png", "d/left/b_left_5.png", "d/right/right_5.png"),
+    )
+    jobs, unpaired = batch._scan(root)
+    assert [(j.name, j.left, j.right) for j in jobs] == [
+        ("s/0001", root / "s/left/left_0001.png", root / "s/right/right_0001.png"),
+        ("s/0003", root / "s/left/left_0003.png", root / "s/right/right_0003.png"),
+        ("s/left/x", root / "s/left/x_left.png", root / "s/left/x_right.png"),
+    ]
+    assert sorted(u.present.relative_to(root).as_posix() for u in unpaired) == [
+        "d/left/a_left_5.png",
+        "d/left/b_left_5.png",
+        "d/right/right_5.png",
+        "s/left/left_0002.png",
+    ]

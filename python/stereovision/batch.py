@@ -178,7 +178,10 @@ def find_pairs(
       ``seq/left/0001.png``, ``mav0/data/1403...`` for ``mav0/cam0/data/1403....png``); when
       one folder holds several such rigs, the name keeps the left camera's folder
       (``00/image_2/000000``). Images with ``left`` or ``right`` in their names are paired by
-      name as above; an image without the other is not a pair (reported as above). Only
+      name as above; the images left over (and those named so without the other beside them)
+      by the number in their names, in the same sub-folder (``seq/left/left_0001.png`` +
+      ``seq/right/right_0001.png`` -> ``seq/0001``); an image without the other is not a pair
+      (reported as above). Only
       ``calib`` applies to these pairs (no ``calib.txt`` is looked for).
 
     Parameters
@@ -227,6 +230,7 @@ def _scan(
     unpaired: list[_Unpaired] = []
     cam_found: list[PairJob] = []  # in sibling camera folders
     cam_unpaired: list[_Unpaired] = []
+    cam_taken: set[Path] = set()  # named images paired across camera folders, by number
     for d, _dirs, files in os.walk(r):
         dirs = sorted(_dirs)
         _dirs[:] = [x for x in dirs if not x.startswith(".")]
@@ -249,7 +253,7 @@ def _scan(
         for f in images:
             p = here / f
             m = _last_left(p.stem)
-            if m is None or f in paired:
+            if m is None or f in paired or p in cam_taken:
                 continue
             rp = _swap(p, m, "right")
             if rp.name not in names:
@@ -260,7 +264,7 @@ def _scan(
         for f in images:
             p = here / f
             m = _last(_RIGHT_RE, p.stem)
-            if m is None or f in paired or _last_left(p.stem) is not None:
+            if m is None or f in paired or p in cam_taken or _last_left(p.stem) is not None:
                 continue
             lp = _swap(p, m, "left")
             if lp.name not in names:
@@ -272,9 +276,10 @@ def _scan(
             prefix = "/".join(
                 x for x in (rel, left_dir if len(cams) > 1 else "") if x not in ("", ".")
             )
-            pairs, alone = _sibling_pairs(here / left_dir, here / right_dir, prefix, cal)
+            pairs, alone, by_number = _sibling_pairs(here / left_dir, here / right_dir, prefix, cal)
             cam_found += pairs
             cam_unpaired += alone
+            cam_taken |= by_number
     # after the other layouts' pairs, so that those keep their names in a clash (the sort is
     # stable): camera folders' images were not pairs before
     found += cam_found
@@ -334,11 +339,15 @@ def _camera_images(folder: Path) -> set[str]:
 
 def _sibling_pairs(
     left_dir: Path, right_dir: Path, prefix: str, cal: Path | None
-) -> tuple[list[PairJob], list[_Unpaired]]:
+) -> tuple[list[PairJob], list[_Unpaired], set[Path]]:
     """The pairs of two sibling camera folders: the images of the same path under both (those
-    with ``left`` or ``right`` in their names are paired by name, as everywhere). Each is named
-    ``prefix`` + its path under the camera folder without the extension (``seq/data/0001``
-    for ``seq/cam0/data/0001.png``); an image without the other is an :class:`_Unpaired`."""
+    with ``left`` or ``right`` in their names are paired by name, as everywhere); then those
+    left, and the images named as one of a pair without the other beside them, by the number
+    in their names (``left/left_0001.png`` + ``right/right_0001.png``). Each is named
+    ``prefix`` + its left image's path under the camera folder without the extension (and
+    without ``left``: ``seq/data/0001`` for ``seq/cam0/data/0001.png``, ``seq/0001`` for
+    ``seq/left/left_0001.png``); an image without the other is an :class:`_Unpaired`. Also
+    returns the named images paired here (the folder's own walk does not report them)."""
     lefts, rights = _camera_images(left_dir), _camera_images(right_dir)
 
     def name(sub: str) -> str:
@@ -346,9 +355,79 @@ def _sibling_pairs(
         return f"{prefix}/{short}" if prefix else short
 
     pairs = [PairJob(name(f), left_dir / f, right_dir / f, cal) for f in sorted(lefts & rights)]
-    alone = [_Unpaired(name(f), left_dir / f, right_dir / f, "left") for f in lefts - rights]
-    alone += [_Unpaired(name(f), right_dir / f, left_dir / f, "right") for f in rights - lefts]
-    return pairs, alone
+    # the others, by the number in their names (left/left_0001.png + right/right_0001.png)
+    by_number = _by_number(
+        (lefts - rights) | _lone_named_images(left_dir),
+        (rights - lefts) | _lone_named_images(right_dir),
+    )
+    for a, b in by_number:
+        pairs.append(PairJob(name(_without_side(a)), left_dir / a, right_dir / b, cal))
+    taken = {a for a, _ in by_number} | {b for _, b in by_number}
+    alone = [
+        _Unpaired(name(f), left_dir / f, right_dir / f, "left")
+        for f in lefts - rights
+        if f not in taken
+    ]
+    alone += [
+        _Unpaired(name(f), right_dir / f, left_dir / f, "right")
+        for f in rights - lefts
+        if f not in taken
+    ]
+    return (
+        pairs,
+        alone,
+        {left_dir / a for a, _ in by_number} | {right_dir / b for _, b in by_number},
+    )
+
+
+def _lone_named_images(folder: Path) -> set[str]:
+    """The images under ``folder`` (any depth, hidden ones excepted) named as one of a pair
+    (``left`` or ``right`` in the name) without the other beside them, as POSIX paths relative
+    to it."""
+    lone: set[str] = set()
+    for d, dirs, files in os.walk(folder):
+        dirs[:] = [x for x in dirs if not x.startswith(".")]
+        sub, names = Path(d).relative_to(folder), set(files)
+        for f in files:
+            if Path(f).suffix.lower() not in IMAGE_EXTS or f[0] == ".":
+                continue
+            m = _last_left(Path(f).stem)
+            other = None if m is None else _swap(Path(f), m, "right")
+            if other is None:
+                m = _last(_RIGHT_RE, Path(f).stem)
+                other = None if m is None else _swap(Path(f), m, "left")
+            if other is not None and other.name not in names:
+                lone.add((sub / f).as_posix())
+    return lone
+
+
+def _by_number(lefts: set[str], rights: set[str]) -> list[tuple[str, str]]:
+    """Images of two camera folders paired by the number in their names (the frame number,
+    :func:`stereovision.calibrate._file_number`), in the same sub-folder; a number two images
+    of one side carry is not paired (which of them is meant is not guessed)."""
+    from stereovision.calibrate import _file_number
+
+    def index(files: set[str]) -> dict[tuple[str, int], str]:
+        found: dict[tuple[str, int], list[str]] = {}
+        for f in files:
+            k = _file_number(f)
+            if k is not None:
+                found.setdefault((Path(f).parent.as_posix(), k), []).append(f)
+        return {key: v[0] for key, v in found.items() if len(v) == 1}
+
+    il, ir = index(lefts), index(rights)
+    return sorted((il[k], ir[k]) for k in il.keys() & ir.keys())
+
+
+def _without_side(sub: str) -> str:
+    """``seq/0001.png`` for ``seq/left_0001.png``: a pair's name does not say ``left``."""
+    p = Path(sub)
+    m = _last_left(p.stem)
+    if m is None:
+        return sub
+    before, after = p.stem[: m.start()].rstrip("_-. "), p.stem[m.end() :].lstrip("_-. ")
+    short = "_".join(x for x in (before, after) if x) or p.stem
+    return (p.parent / (short + p.suffix)).as_posix()
 
 
 # ------------------------------------------------------------------------------- the worker
