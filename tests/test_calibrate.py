@@ -903,3 +903,27 @@ def test_names_numbered_by_capture_second_keep_their_pairs() -> None:
     rights = [f"right{i:02d}.jpg" for i in (1, 2, 3, 4, 5, 6, 7, 8, 10)]
     with pytest.raises(ValueError, match=r"left09\.jpg \(no right\), right05\.jpg \(no left\)"):
         calmod._pair_by_number(lefts, rights)
+
+
+def test_numbers_shifted_by_a_constant_are_paired_in_order() -> None:
+    """Each camera's counter started elsewhere (left_0001..0020, right_0011..0030): the pairs
+    are taken in order, said in one line. With the runs overlapping, the number pairing refused
+    every image ("20 image(s) have no partner with the same number"); without (right_0101..
+    0120), the calibration warned that the numbers differ in every pair and that "a missing or
+    extra file shifts the pairing", though none is missing. A run with a gap is still refused."""
+    lefts = [f"cams/left_{i:04d}.png" for i in range(1, 21)]
+    for first, said in ((11, "10 more"), (101, "100 more")):
+        rights = [f"cams/right_{i:04d}.png" for i in range(first, first + 20)]
+        with pytest.warns(UserWarning) as caught:
+            assert calmod._pair_by_number(lefts, rights[::-1]) == rights
+        assert [str(w.message) for w in caught] == [
+            f"--left / --right: the right images are numbered {said} than the left ones "
+            f"(left_0001.png...left_0020.png with right_{first:04d}.png...right_"
+            f"{first + 19:04d}.png, no gap on either side): paired in order"
+        ]
+        assert calmod._numbers_differ(lefts, rights, lefts) == []
+        assert calmod._numbers_differ(lefts, [*rights[:5], *rights[6:], rights[5]], lefts) != []
+    gap_l = [f for f in lefts if f != "cams/left_0005.png"]
+    gap_r = [f"cams/right_{i:04d}.png" for i in range(11, 31) if i != 25]
+    with pytest.raises(ValueError, match=r"18 image\(s\) have no partner with the same number"):
+        calmod._pair_by_number(gap_l, gap_r)

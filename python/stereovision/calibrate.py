@@ -1144,13 +1144,32 @@ def _file_number(name: str | None) -> int | None:
     return int(digits[-1]) if digits else None
 
 
+def _constant_shift(kl: Sequence[int | None], kr: Sequence[int | None]) -> int | None:
+    """``d`` when the right numbers are the left ones + ``d`` (``d != 0``), both an unbroken
+    run of as many numbers (``left_0001..0020`` and ``right_0101..0120``, in any order); else
+    None."""
+    if len(kl) < 2 or len(kl) != len(kr) or None in kl or None in kr:
+        return None
+    nl, nr = sorted(k for k in kl if k is not None), sorted(k for k in kr if k is not None)
+    if nl != list(range(nl[0], nl[0] + len(nl))) or nr != list(range(nr[0], nr[0] + len(nr))):
+        return None
+    return nr[0] - nl[0] or None
+
+
 def _numbers_differ(
     left_names: Sequence[str | None], right_names: Sequence[str | None], pair_names: Sequence[str]
 ) -> list[str]:
-    """Pairs whose left and right file names both carry a number, and not the same one."""
+    """Pairs whose left and right file names both carry a number, and not the same one; none
+    when the numbers of two unbroken runs differ by one constant in every pair
+    (:func:`_constant_shift`: each camera's counter started elsewhere, nothing shifted)."""
+    kl, kr = [_file_number(a) for a in left_names], [_file_number(b) for b in right_names]
+    shift = _constant_shift(kl, kr)
+    if shift is not None and all(
+        a is not None and b is not None and b - a == shift for a, b in zip(kl, kr, strict=True)
+    ):
+        return []
     out = []
-    for a, b, name in zip(left_names, right_names, pair_names, strict=True):
-        na, nb = _file_number(a), _file_number(b)
+    for na, nb, name in zip(kl, kr, pair_names, strict=True):
         if na is not None and nb is not None and na != nb:
             out.append(name)
     return out
@@ -2298,7 +2317,9 @@ def _pair_by_number(lefts: list[str], rights: list[str]) -> list[str]:
     every name on both sides has a number, unique per side, and most numbers are on both
     sides, the pairs are made on them and an image without a partner is refused by name (unless
     the sorted position already pairs every shared number with itself: partners whose numbers
-    differ, such as each camera's capture second).
+    differ, such as each camera's capture second). Two unbroken runs of as many numbers that
+    differ by a constant (``left_0001..0020`` with ``right_0101..0120`` or ``right_0011..0030``:
+    each camera's counter started elsewhere) are paired in order, said in one UserWarning.
     Names whose numbers do not correspond (timestamps taken by each camera) keep the
     position pairing.
 
@@ -2325,6 +2346,23 @@ def _pair_by_number(lefts: list[str], rights: list[str]) -> list[str]:
     common = set(kl) & set(kr)
     if len(common) == len(kl) == len(kr):
         return [by_number[k] for k in kl]
+    shift = _constant_shift(kl, kr)
+    if shift is not None:
+        # Two unbroken runs of the same length (each camera's counter started elsewhere): the
+        # n-th left goes with the n-th right. A missing file would break a run (refused below).
+        nums = [k for k in kl if k is not None]
+        paired = [by_number[k + shift] for k in nums]
+        lo, hi = nums.index(min(nums)), nums.index(max(nums))
+        name = os.path.basename
+        warnings.warn(
+            f"--left / --right: the right images are numbered {abs(shift)} "
+            f"{'more' if shift > 0 else 'less'} than the left ones ({name(lefts[lo])}..."
+            f"{name(lefts[hi])} with {name(paired[lo])}...{name(paired[hi])}, no gap on either "
+            "side): paired in order",
+            UserWarning,
+            stacklevel=2,
+        )
+        return paired
     if len(common) < 2 or 2 * len(common) < min(len(kl), len(kr)):
         return rights  # numbers of their own on each side (or one file): the counts decide
     if len(kl) == len(kr) and all(
