@@ -1213,3 +1213,21 @@ def test_capture_into_a_folder_replaced_by_a_file_stops(
         capture(cam, out)
     assert calls == [1, 2]
     assert out.read_text() == "not a folder"
+
+
+def test_a_frame_resized_after_a_dropped_size_is_said(tmp_path: Path) -> None:
+    """size=(320, 180) of a 4:3 sequence is dropped (its frames kept at 320x240, one warning);
+    a later frame of half that size is then resized to it: one more warning says so (the
+    warning about the dropped size took the side's only warning, and the resize was silent)."""
+    frames = [_numbered(i) for i in range(3)]
+    frames[1] = cv2.resize(frames[1], (160, 120), interpolation=cv2.INTER_AREA)
+    lpat = _write_sequence(tmp_path, "left", frames)
+    rpat = _write_sequence(tmp_path, "right", [_numbered(i) for i in range(3)])
+    with pytest.warns(UserWarning) as caught, StereoCamera(lpat, rpat, size=(320, 180)) as cam:
+        got = list(cam.frames())
+    assert [str(w.message) for w in caught] == [
+        f"left source {lpat!r} delivers 320x240, not 320x180: another shape, so its frames are "
+        "kept at 320x240 (a resize would stretch them)",
+        f"left source {lpat!r} delivers 160x120, not 320x240: its frames are resized",
+    ]
+    assert [f.left.shape for f in got] == [(240, 320, 3)] * 3

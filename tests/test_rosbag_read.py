@@ -801,3 +801,20 @@ def test_a_size_of_another_shape_does_not_stretch_a_recording(cones: Any, tmp_pa
         frame = cam.read()
     np.testing.assert_array_equal(frame.left, cones.left)
     np.testing.assert_array_equal(frame.right, cones.right)
+
+
+def test_frames_resized_after_a_dropped_size_are_said(cones: Any, tmp_path: Path) -> None:
+    """--size 450x200 of a 450x375 left topic is dropped (another shape); the half-size right
+    topic is then resized to 450x375, which nobody asked: one warning says so (there was none,
+    as if the size asked had been applied)."""
+    half = cv2.resize(cones.right, (225, 188), interpolation=cv2.INTER_AREA)
+    frames = [(T0 + k * PERIOD_NS, cones.left, T0 + k * PERIOD_NS, half) for k in range(3)]
+    bag = write_bag(tmp_path / "rig", frames, encoding="png")
+    with pytest.warns(UserWarning) as caught, BagCamera(bag, size="450x200") as cam:
+        got = list(cam.frames())
+    assert [str(w.message) for w in caught] == [
+        "size 450x200 is another shape than the recording's 450x375: its frames are kept at "
+        "450x375 (a resize would stretch them)",
+        f"{RIGHT} is 225x188, not 450x375: its frames are resized",
+    ]
+    assert len(got) == 3 and got[2].right.shape == cones.left.shape

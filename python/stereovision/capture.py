@@ -769,7 +769,7 @@ class StereoCamera(PairSource):
                 UserWarning,
                 stacklevel=3,
             )
-            self._warned.add(side)
+            # not marked as warned: a later frame resized to this size is said (it was not)
             self.size = (w, h)
             self._size_locked = True
             return frame

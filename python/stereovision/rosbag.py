@@ -876,7 +876,8 @@ class BagCamera(PairSource):
         it silently: a 450x300 right topic came out as 450x375 beside a 450x375 left one, and
         every depth or calibration made of it was wrong); one of the same shape and another
         size is resized with one warning per side, unless ``size`` asked for it. A ``size`` of
-        another shape than the first frame's is dropped, with a warning."""
+        another shape than the first frame's is dropped, with a warning (and the frames then
+        resized to the first one's are said, as without a ``size``)."""
         h, w = img.shape[:2]
         self.delivered_size[side] = (w, h)
         if self._shape is None:
@@ -906,7 +907,8 @@ class BagCamera(PairSource):
             )
         if (w, h) == self.size:
             return img
-        if self.requested_size is None and side not in self._warned:
+        # said unless the size is the one asked (not when a size asked was dropped above)
+        if self.size != self.requested_size and side not in self._warned:
             self._warned.add(side)
             warnings.warn(
                 f"{self.topics[side]} is {w}x{h}, not {self.size[0]}x{self.size[1]}: its frames "
