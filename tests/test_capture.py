@@ -1231,3 +1231,19 @@ def test_a_frame_resized_after_a_dropped_size_is_said(tmp_path: Path) -> None:
         f"left source {lpat!r} delivers 160x120, not 320x240: its frames are resized",
     ]
     assert [f.left.shape for f in got] == [(240, 320, 3)] * 3
+
+
+def test_temporal_averaging_of_enlarged_frames_is_said(tmp_path: Path) -> None:
+    """size=(320, 240) of 160x120 sources: the frames are enlarged before the filter, whose
+    motion test takes their interpolated noise for motion; one warning says so (none did)."""
+    frames = [_numbered(0, (160, 120)) for _ in range(4)]
+    lpat = _write_sequence(tmp_path / "in", "left", frames)
+    rpat = _write_sequence(tmp_path / "in", "right", frames)
+    with pytest.warns(UserWarning) as caught, StereoCamera(lpat, rpat, size=(320, 240)) as cam:
+        capture(cam, tmp_path / "pairs", temporal=2)
+    said = [str(w.message) for w in caught if str(w.message).startswith("temporal")]
+    assert said == [
+        "temporal averaging: the left frames are enlarged from 160x120 to 320x240, and "
+        "interpolation spreads their noise, which the filter takes for motion (it may average "
+        "nothing); ask for the cameras' own size"
+    ]

@@ -8,6 +8,7 @@ OpenCV's chessboard pairs), so every frame read back can be compared with its so
 from __future__ import annotations
 
 import json
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -818,3 +819,43 @@ def test_frames_resized_after_a_dropped_size_are_said(cones: Any, tmp_path: Path
         f"{RIGHT} is 225x188, not 450x375: its frames are resized",
     ]
     assert len(got) == 3 and got[2].right.shape == cones.left.shape
+
+
+def test_temporal_averaging_of_rectified_topics_is_said(cones: Any, tmp_path: Path) -> None:
+    """A still rig's noisy frames from image_rect topics: their interpolation spread the noise,
+    the filter's motion test takes it for motion and restarts on every pair, and `capture
+    --temporal` saved no pair without a word. One warning now says why; the raw topics of the
+    same rig (no warning) give pairs."""
+    from stereovision.capture import capture
+    from stereovision.temporal import TemporalFilter
+
+    rng = np.random.default_rng(3)
+    h, w = cones.left.shape[:2]
+    half_px = np.float32([[1, 0, 0.5], [0, 1, 0.5]])
+
+    def noisy(img: np.ndarray) -> np.ndarray:
+        return np.clip(img + rng.normal(0, 8, img.shape), 0, 255).astype(np.uint8)
+
+    raw = [(noisy(cones.left), noisy(cones.right)) for _ in range(6)]
+    rect = [tuple(cv2.warpAffine(i, half_px, (w, h)) for i in pair) for pair in raw]
+    topics = ("/stereo/left/image_rect", "/stereo/right/image_rect")
+    stamps = [T0 + k * PERIOD_NS for k in range(6)]
+    frames = [(t, lft, t, rgt) for t, (lft, rgt) in zip(stamps, rect, strict=True)]
+    bag = write_bag(tmp_path / "rect", frames, topics=topics)
+    tf = TemporalFilter()
+    for lft, rgt in rect:
+        tf(lft, rgt)
+    assert tf.restarts == 5  # the limit itself (temporal.py): every pair taken for a moving one
+    with BagCamera(bag) as cam, pytest.warns(UserWarning) as caught:
+        saved = capture(cam, tmp_path / "pairs", temporal=2)
+    assert saved.saved == [] and saved.frames_read == 6
+    assert [str(w.message) for w in caught] == [
+        f"temporal averaging: the topics {topics[0]} and {topics[1]} are rectified, and "
+        "interpolation spreads their noise, which the filter takes for motion (it may average "
+        "nothing); give the raw image topics (--left-topic, --right-topic)"
+    ]
+    frames = [(t, lft, t, rgt) for t, (lft, rgt) in zip(stamps, raw, strict=True)]
+    bag = write_bag(tmp_path / "raw", frames)
+    with BagCamera(bag) as cam, warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert len(capture(cam, tmp_path / "raw_pairs", temporal=2).saved) == 3

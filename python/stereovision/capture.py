@@ -1401,6 +1401,8 @@ def capture(
             raise exc.with_message(f"{exc}; {kept} pairs were saved in {out} and are kept") from exc
         averaged = None
         if tf is not None:
+            if tf.frames == 0:
+                warn_resampled_for_temporal(camera, stacklevel=2)
             left, right = tf(frame.left, frame.right)
             averaged = tf.mean_frames()
             # Every pixel's mean full but a few that something crossed (or noise beyond 3
@@ -1477,6 +1479,43 @@ def _reads_own_output(sources: Any, out: PathLike, ext: str = ".png") -> str | N
         if same and any(re.fullmatch(regex, name) for name in names):
             return path
     return None
+
+
+def warn_resampled_for_temporal(camera: Any, stacklevel: int = 1) -> None:
+    """Warn once when ``camera``'s frames reach a :class:`~stereovision.temporal.TemporalFilter`
+    already resampled: a bag's rectified topics, or frames enlarged to the size asked. Their
+    interpolation spreads each pixel's noise over its neighbours, which the filter's motion test
+    takes for motion (every pair of a still rig restarted: nothing averaged, and ``capture
+    --temporal`` saved no pair). Call it after the first pair is read (its size is known then).
+
+    Parameters
+    ----------
+    camera : StereoCamera or BagCamera
+        The source, after its first :meth:`read`.
+    stacklevel : int
+        Of the warning, counted from the caller.
+    """
+    topics = getattr(camera, "topics", None)
+    why: tuple[str, str] | None = None
+    if getattr(camera, "rectified_topics", False) and topics:
+        why = (
+            f"the topics {topics['left']} and {topics['right']} are rectified",
+            "give the raw image topics (--left-topic, --right-topic)",
+        )
+    size = getattr(camera, "size", None)
+    for side, (w, h) in sorted(getattr(camera, "delivered_size", {}).items()):
+        if why is None and size is not None and size[0] > w:
+            why = (
+                f"the {side} frames are enlarged from {w}x{h} to {size[0]}x{size[1]}",
+                "ask for the cameras' own size",
+            )
+    if why is not None:
+        warnings.warn(
+            f"temporal averaging: {why[0]}, and interpolation spreads their noise, which the "
+            f"filter takes for motion (it may average nothing); {why[1]}",
+            UserWarning,
+            stacklevel=stacklevel + 1,
+        )
 
 
 def _refuse_own_output(sources: Any, out: PathLike, ext: str, flag: str) -> None:

@@ -40,7 +40,13 @@ import numpy as np
 
 from stereovision._interrupt import Terminated
 from stereovision.calibration import Calibration, fit_to_frames
-from stereovision.capture import SourceError, StereoCamera, add_source_args, open_source
+from stereovision.capture import (
+    SourceError,
+    StereoCamera,
+    add_source_args,
+    open_source,
+    warn_resampled_for_temporal,
+)
 from stereovision.rectification_check import RectificationCheck, check_rectification
 
 __all__ = [
@@ -410,6 +416,8 @@ def _pairs(
         # and its motion test then took every pair of a still raw rig for a moving one.
         averaged = 1.0
         if temporal is not None:
+            if n == 0:
+                warn_resampled_for_temporal(camera, stacklevel=2)
             left, right = temporal(left, right)
             averaged = temporal.mean_frames()
         t2 = time.perf_counter()
