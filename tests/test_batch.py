@@ -974,7 +974,8 @@ def test_camera_folders_pair_names_with_left_and_right_by_their_number(
     """left/left_0001.png + right/right_0001.png is a pair (named by the folder and the frame
     number, as seq/left_0001.png + seq/right_0001.png are); each image was reported as
     unpaired, for want of a right_0001.png beside left_0001.png. Pairs named so in one folder
-    stay as they were, a number twice on one side is not guessed, a number alone stays alone."""
+    stay as they were, a number twice on one side is not guessed, a number alone stays alone,
+    and names that differ otherwise (KITTI's 000000_11 and 000001_11) are not paired."""
     import stereovision.batch as batch
 
     root = tmp_path / "in"
@@ -985,9 +986,16 @@ def test_camera_folders_pair_names_with_left_and_right_by_their_number(
         *("s/left/left_0002.png", "s/left/left_0003.png", "s/right/right_0003.png"),
         *("s/left/x_left.png", "s/left/x_right.png"),
         *("d/left/a_left_5.png", "d/left/b_left_5.png", "d/right/right_5.png"),
+        *(
+            "k/image_2/000000_11.png",
+            "k/image_3/000001_11.png",
+            "k/L/Left-7.png",
+            "k/R/right_07.png",
+        ),
     )
     jobs, unpaired = batch._scan(root)
     assert [(j.name, j.left, j.right) for j in jobs] == [
+        ("k/L/7", root / "k/L/Left-7.png", root / "k/R/right_07.png"),
         ("s/0001", root / "s/left/left_0001.png", root / "s/right/right_0001.png"),
         ("s/0003", root / "s/left/left_0003.png", root / "s/right/right_0003.png"),
         ("s/left/x", root / "s/left/x_left.png", root / "s/left/x_right.png"),
@@ -996,5 +1004,7 @@ def test_camera_folders_pair_names_with_left_and_right_by_their_number(
         "d/left/a_left_5.png",
         "d/left/b_left_5.png",
         "d/right/right_5.png",
+        "k/image_2/000000_11.png",
+        "k/image_3/000001_11.png",
         "s/left/left_0002.png",
     ]

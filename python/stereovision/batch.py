@@ -179,7 +179,8 @@ def find_pairs(
       one folder holds several such rigs, the name keeps the left camera's folder
       (``00/image_2/000000``). Images with ``left`` or ``right`` in their names are paired by
       name as above; the images left over (and those named so without the other beside them)
-      by the number in their names, in the same sub-folder (``seq/left/left_0001.png`` +
+      by the number in their names, in the same sub-folder, the names otherwise the same
+      but for ``left`` / ``right`` (``seq/left/left_0001.png`` +
       ``seq/right/right_0001.png`` -> ``seq/0001``); an image without the other is not a pair
       (reported as above). Only
       ``calib`` applies to these pairs (no ``calib.txt`` is looked for).
@@ -403,16 +404,25 @@ def _lone_named_images(folder: Path) -> set[str]:
 
 def _by_number(lefts: set[str], rights: set[str]) -> list[tuple[str, str]]:
     """Images of two camera folders paired by the number in their names (the frame number,
-    :func:`stereovision.calibrate._file_number`), in the same sub-folder; a number two images
-    of one side carry is not paired (which of them is meant is not guessed)."""
+    :func:`stereovision.calibrate._file_number`), in the same sub-folder, whose names are
+    otherwise the same but for ``left`` / ``right`` and separators (``left_0001.png`` +
+    ``right_1.png``; not ``000000_11.png`` + ``000001_11.png``, other frames of a KITTI pair);
+    a number two images of one side carry is not paired (which is meant is not guessed)."""
     from stereovision.calibrate import _file_number
 
-    def index(files: set[str]) -> dict[tuple[str, int], str]:
-        found: dict[tuple[str, int], list[str]] = {}
+    def rest(f: str) -> str:
+        stem = Path(f).stem
+        m = _last_left(stem) or _last(_RIGHT_RE, stem)
+        if m is not None:
+            stem = stem[: m.start()] + stem[m.end() :]
+        return re.sub(r"[-_. ]", "", re.sub(r"\d+(?!.*\d)", "", stem))
+
+    def index(files: set[str]) -> dict[tuple[str, str, int], str]:
+        found: dict[tuple[str, str, int], list[str]] = {}
         for f in files:
             k = _file_number(f)
             if k is not None:
-                found.setdefault((Path(f).parent.as_posix(), k), []).append(f)
+                found.setdefault((Path(f).parent.as_posix(), rest(f), k), []).append(f)
         return {key: v[0] for key, v in found.items() if len(v) == 1}
 
     il, ir = index(lefts), index(rights)
