@@ -336,6 +336,9 @@ def test_app_controllers_report_errors_and_compute(tmp_path, monkeypatch):
     assert app.state.error == "path outside the allowed folders: ../../../../etc"
     assert [s["title"] for s in app.state.scenes] == ["data/cones"]
 
+    # computed by hand below (a spawned computation as well would supersede these)
+    app._spawn = lambda coro: coro.close()
+
     async def run() -> None:
         app._lock = asyncio.Lock()
         app.state.method = "opencv-bm"
@@ -410,6 +413,7 @@ def test_files_at_another_resolution_keep_the_calibration_and_the_view_mode(data
         cones,
         calib=Calibration.from_file(cones / "calib.txt"),
     )
+    app._spawn = lambda coro: coro.close()  # computed by hand below
 
     async def load(prefix: str) -> None:
         app._lock = asyncio.Lock()
@@ -610,6 +614,47 @@ def test_a_failed_scene_choice_puts_the_list_back(tmp_path):
         assert app.state.computations == 1, bad
     # the good scene is still the one the app works on
     assert app.pair[0].shape == (375, 450, 3)
+
+
+def test_a_scene_chosen_during_a_computation_is_not_shown_the_previous_result(tmp_path):
+    """A scene chosen while another was computing: the running computation recorded the new
+    scene's pair as the one on show, and put its (previous) result under the new scene's name.
+    When the new scene then failed, the app kept its pair (Check rows worked on it) and the list
+    and label named it, while the page showed the other scene's disparity."""
+    import asyncio
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    for name in ("first", "second"):
+        shutil.copytree(bundled_data_dir() / "cones", tmp_path / name)
+    (tmp_path / "tiny").mkdir()  # loads, then fails to compute
+    for side in ("left", "right"):
+        cv2.imwrite(str(tmp_path / "tiny" / f"{side}.png"), np.zeros((8, 8, 3), np.uint8))
+    app = _scene_app("test-scene-during-compute", [tmp_path])
+    tasks: list = []
+
+    def choose(name: str) -> None:
+        app.state.scene = str(tmp_path / name)
+        app._on_scene(scene=str(tmp_path / name))
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        choose("first")
+        await asyncio.gather(*tasks)
+        choose("second")
+        await asyncio.sleep(0)  # its computation is running in the worker
+        choose("tiny")
+        await asyncio.gather(*tasks)
+
+    asyncio.run(run())
+    first = app.folders.label((tmp_path / "first").resolve())
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.source_label == f"scene {first}"
+    assert app.state.scene == str(tmp_path / "first")
+    assert app.pair[0].shape == (375, 450, 3) and app._scene == str(tmp_path / "first")
+    assert app.state.computations == 1  # the superseded "second" was not put on the page
 
 
 def test_buttons_before_a_pair_say_so():

@@ -710,6 +710,9 @@ class StereoApp:
             if gen != self._generation:
                 return  # a newer request is queued behind us
             loop = asyncio.get_running_loop()
+            # What this computation works on, taken now: a scene chosen while it runs replaces
+            # self.pair at once, and this result must not be recorded as that scene's.
+            computed = self._inputs()
             left, right = self.pair
             calib, d_max = self.calib, self.max_disparity
             method = self.state.method
@@ -746,6 +749,8 @@ class StereoApp:
                 # MemoryError: the census map's check refused a pair too large for this machine;
                 # cv2.error: an OpenCV reference method on a pair it cannot take.
                 self._computing = False
+                if gen != self._generation:
+                    return  # superseded: the newer request computes (and reports) its own pair
                 self._fail(exc)
                 shown = self._shown
                 if shown is not None and shown["pair"] is not self.pair:
@@ -760,16 +765,26 @@ class StereoApp:
                 return
             finally:
                 self._computing = False
-            self._shown = {
-                "pair": self.pair,
-                "raw_pair": self.raw_pair,
-                "calib": self.calib,
-                "max_disparity": self.max_disparity,
-                "homographies": self.homographies,
-                "source_label": self.state.source_label,
-                "_scene": self._scene,
-            }
+            if gen != self._generation:
+                # Superseded while it ran (another scene, files, method): showing it now would
+                # put the previous pair's disparity under the new pair's name; the newer
+                # request, queued behind this one, shows its own.
+                return
+            self._shown = computed
             self._publish(view)
+
+    def _inputs(self) -> dict[str, Any]:
+        """The pair a computation works on, with what the page says of it (kept as
+        ``_shown`` once its result is on the page)."""
+        return {
+            "pair": self.pair,
+            "raw_pair": self.raw_pair,
+            "calib": self.calib,
+            "max_disparity": self.max_disparity,
+            "homographies": self.homographies,
+            "source_label": self.state.source_label,
+            "_scene": self._scene,
+        }
 
     def check_rows_clicked(self) -> None:
         """The page's "Check rows" button."""
