@@ -837,6 +837,46 @@ def test_capture_averages_still_frames_when_asked(data_dir):
     assert app.state.source_label.endswith("(8.0 frames averaged)")
 
 
+def test_cameras_that_cannot_be_paired_leave_the_open_ones_in_use(tmp_path):
+    """Two videos of different sizes open, but give no pair: "Open" closed the cameras in use
+    and kept the unusable pair, so every later Capture failed (and a capture was labelled with
+    the names typed in the fields, not those of the cameras it came from). The open cameras
+    now stay until new ones have given a pair."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.sources import open_stereo_source
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    lv = _write_video(tmp_path / "l.avi", left)
+    rv = _write_video(tmp_path / "r.avi", right)
+    small = _write_video(tmp_path / "small.avi", cv2.resize(right, (400, 300)))
+
+    lonely = _scene_app("test-cameras-unpaired-none", [tmp_path])
+    lonely.state.cam_left, lonely.state.cam_right = str(lv), str(small)
+    lonely.open_cameras()
+    assert lonely.state.error.startswith("right source") and "400x300" in lonely.state.error
+    assert lonely.source is None and lonely.state.live is False and lonely.pair is None
+
+    app = _scene_app(
+        "test-cameras-unpaired",
+        [tmp_path],
+        source=open_stereo_source(str(lv), str(rv)),
+        source_names=(str(lv), str(rv)),
+    )
+    app._grab()
+    assert app.state.source_label == "cameras l.avi / r.avi"
+    app.state.cam_right = str(small)
+    app.open_cameras()
+    assert app.state.error.startswith("right source") and "400x300" in app.state.error
+    assert app.state.error.endswith("(the cameras in use are unchanged)")
+    app.state.error = ""
+    app.capture()  # from the cameras still open
+    assert app.state.error == "" and app.state.captures == 1
+    assert app.state.source_label == "cameras l.avi / r.avi"
+    assert app.pair[0].shape == app.pair[1].shape and app.pair[0].shape[1] == 450
+    app.source.close()
+
+
 def test_open_cameras_asks_the_chosen_pixel_format(data_dir, monkeypatch):
     """The camera row's "format" select, in-process: "MJPG" and "YUYV" reach the cameras as
     ``StereoCamera(..., fourcc=)`` (what ``capture --fourcc`` asks), "driver" asks nothing, and

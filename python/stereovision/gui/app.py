@@ -402,6 +402,9 @@ class StereoApp:
         self.source = source
         self.source_calib = calib
         self._source_label = source_label
+        #: The open cameras' sources as typed (their label's names; the fields may since hold
+        #: others that failed to open).
+        self._source_names = source_names
         #: The pair's rectification from its features ("Rectify" button), kept for the
         #: cameras' next pairs; None when the pair is used as it comes.
         self.homographies: Any = None
@@ -552,7 +555,7 @@ class StereoApp:
         self._other_source()
         self.calib = self.source_calib
         self.max_disparity = None
-        names = (Path(str(n)).name or str(n) for n in (self.state.cam_left, self.state.cam_right))
+        names = (Path(str(n)).name or str(n) for n in self._source_names)
         self.state.source_label = (self._source_label or "cameras " + " / ".join(names)) + averaged
         self.state.rows_label = ""
         rect = self.homographies
@@ -619,7 +622,11 @@ class StereoApp:
         self._spawn(self.recompute())
 
     def open_cameras(self) -> None:
-        """Open the camera sources typed on the page (device index or allowed file)."""
+        """Open the camera sources typed on the page (device index or allowed file).
+
+        The new cameras replace the open ones only once they gave a pair: sources that open
+        but cannot be paired (frames of two sizes) leave the open cameras in use, and say so.
+        """
         try:
             left = self._camera_source(self.state.cam_left)
             right = self._camera_source(self.state.cam_right)
@@ -628,14 +635,27 @@ class StereoApp:
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
             return
-        if self.source is not None:
-            self.source.close()
+        before = (self.source, self.homographies, self._source_label, self._source_names)
         self.source = source
         self.homographies = None
         self._source_label = None  # the cameras typed on the page, named by their fields
+        self._source_names = (str(self.state.cam_left), str(self.state.cam_right))
+        try:
+            self._grab()  # sets the pair only once both frames came and fit together
+        except (ValueError, OSError, RuntimeError) as exc:
+            source.close()
+            self.source, self.homographies, self._source_label, self._source_names = before
+            if self.source is not None:
+                said = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+                exc = OSError(f"{said} (the cameras in use are unchanged)")
+            self._fail(exc)
+            return
+        if before[0] is not None:
+            before[0].close()
         self.state.live = True
         self.state.error = ""
-        self.capture()
+        self.state.captures += 1
+        self._spawn(self.recompute())
 
     def load_files(self) -> None:
         """Use the chosen left / right image files (calibration: ``--calib`` if its size fits)."""
