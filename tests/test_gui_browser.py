@@ -431,6 +431,10 @@ def test_files_at_another_resolution_keep_the_calibration_and_the_view_mode(data
     assert shown.GetNumberOfPolys() == 0 and shown.GetNumberOfPoints() > 1000  # points, no faces
     asyncio.run(load("wide"))
     assert app.calib is None and "another aspect ratio" in app.state.rows_label
+    # --calib was given: the 3-D panel says it does not fit (it said "give --calib")
+    assert app.state.message_3d == (
+        "No calibration: the --calib calibration does not fit these images (disparity only)."
+    )
 
 
 def test_a_later_success_clears_an_error_and_a_scene_can_be_chosen_again(data_dir):
@@ -655,6 +659,35 @@ def test_a_scene_chosen_during_a_computation_is_not_shown_the_previous_result(tm
     assert app.state.scene == str(tmp_path / "first")
     assert app.pair[0].shape == (375, 450, 3) and app._scene == str(tmp_path / "first")
     assert app.state.computations == 1  # the superseded "second" was not put on the page
+
+
+def test_a_scene_without_calibration_is_not_told_to_give_calib(tmp_path):
+    """A scene without calib.txt: the 3-D panel and Find floor said "give --calib", but a
+    scene's calibration is its own calib.txt (--calib is for cameras and files), so a restart
+    with --calib changed nothing. They now name the missing file."""
+    from stereovision.gui import bundled_data_dir
+
+    scene = tmp_path / "nocalib"
+    scene.mkdir()
+    for side in ("left", "right"):
+        (scene / f"{side}.png").write_bytes(
+            (bundled_data_dir() / "cones" / f"{side}.png").read_bytes()
+        )
+    app = _scene_app("test-scene-no-calib", [tmp_path])
+    app._load_scene(scene)
+    _run(app, app.recompute)
+    label = app.folders.label(scene.resolve())
+    assert app.state.error == "" and app.state.computations == 1
+    assert (
+        app.state.message_3d == f"No calibration: scene {label} has no calib.txt (disparity only)."
+    )
+    _run(app, app.find_floor)
+    assert app.state.floor_label == (
+        f"finding the floor needs a calibration (scene {label} has no calib.txt)"
+    )
+    app._load_scene(bundled_data_dir() / "cones")  # with its calib.txt: depth and 3-D
+    _run(app, app.recompute)
+    assert app.state.message_3d == "" and "median depth" in app.state.stats
 
 
 def test_buttons_before_a_pair_say_so():

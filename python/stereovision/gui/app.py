@@ -412,6 +412,9 @@ class StereoApp:
         # the pair as the source gave it, before "Rectify" (which starts from it again)
         self.raw_pair: tuple[np.ndarray, np.ndarray] | None = None
         self.calib: Any = None
+        #: Why the pair has no calibration when ``--calib`` would not help (a scene without
+        #: calib.txt, files another calibration does not fit); None: "give --calib".
+        self._no_calib: str | None = None
         self.max_disparity: int | None = None
         self.view: ViewData | None = None
         #: The point-cloud file on show ("Open") and its caption: it stays in the 3-D view
@@ -532,7 +535,10 @@ class StereoApp:
         self.calib = scene.calib
         self.max_disparity = scene.max_disparity
         self.homographies = None  # another rig
-        self.state.source_label = f"scene {self.folders.label(scene_dir)}"
+        label = self.folders.label(scene_dir)
+        # a scene's calibration is its own calib.txt (--calib is for cameras and files)
+        self._no_calib = None if scene.calib is not None else f"scene {label} has no calib.txt"
+        self.state.source_label = f"scene {label}"
         self.state.rows_label = ""
 
     def _grab(self) -> None:
@@ -554,6 +560,7 @@ class StereoApp:
         self.pair = self.raw_pair = (left, right)
         self._other_source()
         self.calib = self.source_calib
+        self._no_calib = None
         self.max_disparity = None
         names = (Path(str(n)).name or str(n) for n in self._source_names)
         self.state.source_label = (self._source_label or "cameras " + " / ".join(names)) + averaged
@@ -681,6 +688,7 @@ class StereoApp:
             except ValueError as exc:
                 c, note = None, f"{exc}: disparity only"
         self.calib = c
+        self._no_calib = "the --calib calibration does not fit these images" if note else None
         self.max_disparity = None
         self.state.source_label = "files"
         self.state.rows_label = note
@@ -791,6 +799,8 @@ class StereoApp:
                 # request, queued behind this one, shows its own.
                 return
             self._shown = computed
+            if view.result.depth is None and computed["_no_calib"] is not None:
+                view.message_3d = f"No calibration: {computed['_no_calib']} (disparity only)."
             self._publish(view)
 
     def _inputs(self) -> dict[str, Any]:
@@ -800,6 +810,7 @@ class StereoApp:
             "pair": self.pair,
             "raw_pair": self.raw_pair,
             "calib": self.calib,
+            "_no_calib": self._no_calib,
             "max_disparity": self.max_disparity,
             "homographies": self.homographies,
             "source_label": self.state.source_label,
@@ -889,8 +900,9 @@ class StereoApp:
             return
         res = view.result
         if res.depth is None or getattr(res, "calibration", None) is None:
+            why = (self._shown or {}).get("_no_calib") or "--calib"
             with self.state:
-                self.state.floor_label = "finding the floor needs a calibration (--calib)"
+                self.state.floor_label = f"finding the floor needs a calibration ({why})"
             return
 
         def run() -> tuple[str, str]:
