@@ -661,6 +661,62 @@ def test_a_scene_chosen_during_a_computation_is_not_shown_the_previous_result(tm
     assert app.state.computations == 1  # the superseded "second" was not put on the page
 
 
+def test_a_new_pair_does_not_show_the_previous_pairs_results_while_it_computes(tmp_path):
+    """While a newly chosen scene computed (23 s for a 1850 px pair), the page showed the
+    previous scene's images, disparity, depth and floor under the new scene's name. The new
+    pair's images now show at once, the previous results are cleared (the 3-D caption says the
+    view is the previous pair's), and they come back if the new pair fails."""
+    import asyncio
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import PENDING_3D, PENDING_FLOOR, _data_url
+
+    shutil.copytree(bundled_data_dir() / "cones", tmp_path / "cones")
+    shutil.copytree(bundled_data_dir() / "cones", tmp_path / "swapped")
+    for side, other in (("left", "right"), ("right", "left")):  # another pair, same size
+        src = bundled_data_dir() / "cones" / f"{other}.png"
+        (tmp_path / "swapped" / f"{side}.png").write_bytes(src.read_bytes())
+    (tmp_path / "tiny").mkdir()  # loads, then fails to compute
+    for side in ("left", "right"):
+        cv2.imwrite(str(tmp_path / "tiny" / f"{side}.png"), np.zeros((8, 8, 3), np.uint8))
+    app = _scene_app("test-new-pair-pending", [tmp_path])
+    tasks: list = []
+    seen: dict = {}
+
+    def choose(name: str) -> None:
+        app.state.scene = str(tmp_path / name)
+        app._on_scene(scene=str(tmp_path / name))
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        choose("cones")
+        await asyncio.gather(*tasks)
+        await app.find_floor()
+        seen["page"] = {k: app.state[k] for k in ("img_disparity", "stats", "floor_label")}
+        for name in ("swapped", "tiny"):
+            choose(name)
+            await asyncio.sleep(0)  # its computation is running in the worker
+            seen[name] = {k: app.state[k] for k in ("img_left", "img_disparity", "stats")}
+            seen[name]["message_3d"] = app.state.message_3d
+            await app.find_floor()
+            seen[name]["floor_label"] = app.state.floor_label
+            await asyncio.gather(*tasks)
+
+    asyncio.run(run())
+    swapped = seen["swapped"]
+    assert swapped["img_left"] == _data_url(cv2.imread(str(tmp_path / "swapped" / "left.png")))
+    assert swapped["img_disparity"] == "" and swapped["stats"] == ""
+    assert swapped["message_3d"] == PENDING_3D and swapped["floor_label"] == PENDING_FLOOR
+    assert seen["tiny"]["img_disparity"] == "" and seen["tiny"]["stats"] == ""
+    # "tiny" failed: the page shows the swapped pair's results again, as the error says
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.computations == 2 and app.state.stats.startswith("fast · 450×375")
+    assert app.state.img_disparity not in ("", seen["page"]["img_disparity"])
+    assert app.state.img_left == swapped["img_left"] and app.state.message_3d == ""
+
+
 def test_a_scene_without_calibration_is_not_told_to_give_calib(tmp_path):
     """A scene without calib.txt: the 3-D panel and Find floor said "give --calib", but a
     scene's calibration is its own calib.txt (--calib is for cameras and files), so a restart

@@ -90,6 +90,24 @@ TRANSLATION_RANGE = 5.0
 
 _CONTROL_NAMES = ("roll", "pitch", "yaw", "forward", "up", "right")
 
+#: What the page shows of a computed pair: cleared while a new pair computes (the previous
+#: pair's disparity stayed under the new pair's name), put back if the new pair fails.
+_RESULT_KEYS = (
+    "img_left",
+    "img_right",
+    "img_disparity",
+    "img_depth",
+    "img_matches",
+    "img_floor",
+    "floor_label",
+    "stats",
+    "message_3d",
+)
+#: The 3-D caption while a new pair computes (the view keeps the previous pair until then).
+PENDING_3D = "computing the new pair: the 3-D view still shows the previous one"
+#: What Find floor says while a new pair computes (the depth on hand is the previous pair's).
+PENDING_FLOOR = "the new pair is being computed: find its floor once its depth is shown"
+
 
 def _data_url(image: npt.NDArray[np.uint8], width: int = DISPLAY_WIDTH) -> str:
     """A BGR image as a JPEG ``data:`` URL, scaled down to ``width`` pixels."""
@@ -424,6 +442,8 @@ class StereoApp:
         # what the page shows came from: put back when a new pair fails to compute, so that
         # Check rows and Find floor never work on a pair the page does not show
         self._shown: dict[str, Any] | None = None
+        # the page's results of the shown pair while a new pair computes (None otherwise)
+        self._page_before: dict[str, Any] | None = None
         #: The scene list's value the current pair came from ("" for any other source): what
         #: the list goes back to when another choice fails.
         self._scene = ""
@@ -746,10 +766,19 @@ class StereoApp:
             method = self.state.method
             res = self.state.resolution
             width = None if res == "full" else int(res)
+            fresh = self._shown is None or self._shown["pair"] is not self.pair
             with self.state:
-                self.state.busy = True
-                self.state.progress = 1
-                self.state.status = f"computing ({method})"
+                st = self.state
+                st.busy = True
+                st.progress = 1
+                st.status = f"computing ({method})"
+                if fresh:  # another pair: its images now, no result of the previous pair
+                    if self._page_before is None:
+                        self._page_before = {k: st[k] for k in _RESULT_KEYS}
+                    st.img_left, st.img_right = _data_url(left), _data_url(right)
+                    st.img_disparity = st.img_depth = st.img_matches = st.img_floor = ""
+                    st.floor_label = st.stats = ""
+                    st.message_3d = PENDING_3D if self.view is not None else ""
 
             def progress(pct: int, text: str) -> None:
                 loop.call_soon_threadsafe(self._set_progress, pct, text)
@@ -780,6 +809,11 @@ class StereoApp:
                 if gen != self._generation:
                     return  # superseded: the newer request computes (and reports) its own pair
                 self._fail(exc)
+                page, self._page_before = self._page_before, None
+                if page is not None:
+                    with self.state:
+                        for name, value in page.items():
+                            self.state[name] = value
                 shown = self._shown
                 if shown is not None and shown["pair"] is not self.pair:
                     for name, value in shown.items():
@@ -898,6 +932,10 @@ class StereoApp:
         if view is None:
             self._fail(ValueError(NO_PAIR))
             return
+        if self._page_before is not None:  # self.view is the previous pair's
+            with self.state:
+                self.state.floor_label = PENDING_FLOOR
+            return
         res = view.result
         if res.depth is None or getattr(res, "calibration", None) is None:
             why = (self._shown or {}).get("_no_calib") or "--calib"
@@ -925,6 +963,7 @@ class StereoApp:
 
     def _publish(self, view: ViewData) -> None:
         self.view = view
+        self._page_before = None
         self._cloud = None  # the new pair's scene replaces an opened cloud file
         if view.mesh is not None:  # drawn as the points / surface toggle shows
             self._show_geometry(self._geometry_for_mode(), view.intrinsics)
