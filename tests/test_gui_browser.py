@@ -717,6 +717,34 @@ def test_a_new_pair_does_not_show_the_previous_pairs_results_while_it_computes(t
     assert app.state.img_left == swapped["img_left"] and app.state.message_3d == ""
 
 
+def test_a_failed_method_puts_the_toggle_back_to_the_result_on_show(monkeypatch):
+    """A method that fails on the pair on show (fused refused for memory, when fast fits):
+    the toggle stayed on the failed method above the previous method's disparity. It goes back
+    to the method on show, without computing it again, and the error says what is shown."""
+    from stereovision import _core
+    from stereovision.gui import bundled_data_dir
+    from stereovision.matching import sgm
+
+    app = _scene_app("test-method-back", [bundled_data_dir()])
+    spawned: list = []
+    app._spawn = lambda coro: (spawned.append(coro), coro.close())
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    assert app.state.stats.startswith("fast · ") and app.state.computations == 1
+    app.state.ready()  # from here the toggles' listeners run at each flush, as on the server
+    monkeypatch.setattr(sgm, "_available_bytes", lambda: 1000)
+    monkeypatch.setattr(_core, "kept_memory", lambda: ((0, 0), 0))
+    app.state.method = "fused"
+    spawned.clear()
+    _run(app, app.recompute)
+    assert app.state.error.startswith("the census semi-global map needs about")
+    assert app.state.error.endswith("(the page still shows fast at full resolution)")
+    assert app.state.method == "fast" and app.state.stats.startswith("fast · ")
+    # one computation asked: the click's (its listener ran at the first flush); the toggle's
+    # return to "fast" asks none
+    assert len(spawned) == 1 and app.state.computations == 1
+
+
 def test_a_scene_without_calibration_is_not_told_to_give_calib(tmp_path):
     """A scene without calib.txt: the 3-D panel and Find floor said "give --calib", but a
     scene's calibration is its own calib.txt (--calib is for cameras and files), so a restart

@@ -444,6 +444,10 @@ class StereoApp:
         self._shown: dict[str, Any] | None = None
         # the page's results of the shown pair while a new pair computes (None otherwise)
         self._page_before: dict[str, Any] | None = None
+        #: The method and resolution of the result on show, and the flag that keeps their
+        #: toggles' return to them (after a failed change) from computing it again.
+        self._shown_settings: tuple[str, str] | None = None
+        self._settings_back = False
         #: The scene list's value the current pair came from ("" for any other source): what
         #: the list goes back to when another choice fails.
         self._scene = ""
@@ -619,6 +623,8 @@ class StereoApp:
         self._spawn(self.recompute())
 
     def _on_method(self, **_: Any) -> None:
+        if self._settings_back:  # put back after a failure: the page shows their result
+            return
         if self.pair is not None:
             self._spawn(self.recompute())
         elif self._lock is not None:  # the page is up: a click, not the start-up state
@@ -824,6 +830,17 @@ class StereoApp:
                         # the failed choice can be made again
                         self.state.scene = self._scene or None
                         self.state.error += " (the page still shows the previous pair)"
+                elif self._shown_settings not in (None, (method, res)):
+                    # the same pair with another method / resolution failed: the toggles go
+                    # back to what the page shows (they named the failed one above its result)
+                    self._settings_back = True
+                    try:
+                        with self.state:
+                            self.state.method, self.state.resolution = self._shown_settings
+                            m, r = self._shown_settings
+                            self.state.error += f" (the page still shows {m} at {r} resolution)"
+                    finally:
+                        self._settings_back = False
                 return
             finally:
                 self._computing = False
@@ -833,6 +850,7 @@ class StereoApp:
                 # request, queued behind this one, shows its own.
                 return
             self._shown = computed
+            self._shown_settings = (method, res)
             if view.result.depth is None and computed["_no_calib"] is not None:
                 view.message_3d = f"No calibration: {computed['_no_calib']} (disparity only)."
             self._publish(view)
