@@ -1173,6 +1173,20 @@ def test_page_has_three_panels_and_images(page):
     _shot(page, "gui-start.png")
 
 
+def test_camera_format_select_shows_its_choice(page):
+    """The camera row gave the format select a sixth of the panel: it showed "d" for "driver"
+    under an "f." label. Its choice and label are now shown whole, beside the Open button."""
+    _wait_computations(page, 1)
+    clipped = page.evaluate(
+        """() => {
+          const field = document.querySelector('#cam-fourcc').closest('.v-field');
+          return [field.querySelector('.v-select__selection-text'), field.querySelector('.v-label')]
+            .map(e => [e.innerText, e.scrollWidth - e.clientWidth]);
+        }"""
+    )
+    assert clipped == [["driver", 0], ["format", 0]]
+
+
 def test_capture_changes_images(page):
     _wait_computations(page, 1)
     n = _computations(page)

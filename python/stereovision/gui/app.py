@@ -1211,8 +1211,10 @@ class StereoApp:
                         _file_picker("Right image", "right_file", "images", "right-file")
                     with v3.VCol(cols=2):
                         v3.VBtn("Load", click=self.ctrl.load_files, id="load-files", block=True)
+                # two rows: in one, a sixth of it for the format showed "d" for "driver"
+                # under an "f." label (and less for the cameras clipped their labels)
                 with v3.VRow(dense=True, classes="mt-1"):
-                    with v3.VCol(cols=4):
+                    with v3.VCol(cols=6):
                         v3.VTextField(
                             label="Left camera",
                             v_model=("cam_left",),
@@ -1220,7 +1222,7 @@ class StereoApp:
                             hide_details=True,
                             id="cam-left",
                         )
-                    with v3.VCol(cols=4):
+                    with v3.VCol(cols=6):
                         v3.VTextField(
                             label="Right camera",
                             v_model=("cam_right",),
@@ -1228,7 +1230,8 @@ class StereoApp:
                             hide_details=True,
                             id="cam-right",
                         )
-                    with v3.VCol(cols=2):
+                with v3.VRow(dense=True, classes="mt-1"):
+                    with v3.VCol(cols=4):
                         v3.VSelect(
                             label="format",
                             v_model=("fourcc",),
