@@ -290,6 +290,25 @@ def test_scaled_calibration_and_compute_view():
     assert (canvas[60, 100] != np.hstack([res.left_rectified, right])[60, 100]).any()
 
 
+@pytest.mark.parametrize(
+    ("shape", "method", "said"),
+    [
+        ((300, 2, 3), "opencv-sgbm", "disparity range 16 is not smaller than the image width 2"),
+        ((2, 300, 3), "opencv-bm", "opencv-bm cannot match this 300x2 pair: (-211:"),
+    ],
+)
+def test_opencv_methods_on_a_pair_they_cannot_take_say_why(shape, method, said):
+    """An OpenCV reference method on a pair too small for it: the page showed OpenCV's own
+    message, "OpenCV(5.x) /io/opencv/modules/core/src/alloc.cpp:73: error: (-4:Insufficient
+    memory) Failed to allocate 18446744073709551600 bytes" for a 2 px wide pair."""
+    from stereovision.gui.app import compute_view
+
+    img = np.random.default_rng(0).integers(0, 255, shape, dtype=np.uint8)
+    with pytest.raises(ValueError) as err:
+        compute_view(img, img, None, method)
+    assert str(err.value).startswith(said) and "/opencv/" not in str(err.value)
+
+
 def test_compute_view_shows_the_swapped_warning(data_dir):
     """A swapped pair: the page's statistics line carries the library's warning (once), and the
     pair given the right way round carries none."""

@@ -206,7 +206,15 @@ def _opencv_result(method: str, left: np.ndarray, right: np.ndarray, calib: Any,
         left, right = calib.rectify(left, right)
         calib = calib.rectified_calibration()
     fn = baselines.opencv_sgbm if method == "opencv-sgbm" else baselines.opencv_bm
-    disp = np.ascontiguousarray(fn(left, right, d_max), dtype=np.float32)
+    w, h = left.shape[1], left.shape[0]
+    if d_max >= w:  # as depth_map says it (OpenCV failed to allocate 18446744073709 GB)
+        raise ValueError(f"disparity range {d_max:g} is not smaller than the image width {w}")
+    try:
+        disp = np.ascontiguousarray(fn(left, right, d_max), dtype=np.float32)
+    except cv2.error as exc:
+        # OpenCV's message starts with its version and a source path: the page says its reason
+        reason = str(exc).split("error: ", 1)[-1].strip().splitlines()[0]
+        raise ValueError(f"{method} cannot match this {w}x{h} pair: {reason}") from None
     valid = np.isfinite(disp)
     depth = None
     points = np.zeros((0, 3), np.float32)
