@@ -309,6 +309,31 @@ def test_opencv_methods_on_a_pair_they_cannot_take_say_why(shape, method, said):
     assert str(err.value).startswith(said) and "/opencv/" not in str(err.value)
 
 
+def test_the_depth_picture_says_the_distances_of_its_colours():
+    """The depth picture had no key ("depth (near = warm)"), and its colour scale changes with
+    every pair: its caption now gives the distances at its two ends, those of its colour map
+    (1st and 99th percentile of 1 / depth), so that a colour can be read in metres."""
+    from stereovision.calibration import Calibration
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import DEPTH_CAPTION, compute_view
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    view = compute_view(left, right, Calibration.from_file(cones / "calib.txt"), "fast")
+    got = re.fullmatch(r"depth: red ([0-9.]+) m … blue ([0-9.]+) m", view.depth_caption)
+    assert got is not None, view.depth_caption
+    inv = 1.0 / view.result.depth[np.isfinite(view.result.depth)]
+    near, far = 1.0 / np.percentile(inv, 99), 1.0 / np.percentile(inv, 1)
+    assert float(got.group(1)) == pytest.approx(near, abs=0.006) and near < 3.0
+    assert float(got.group(2)) == pytest.approx(far, abs=0.006) and far > 4.0
+    assert compute_view(left, right, None, "fast").depth_caption == DEPTH_CAPTION  # no depth
+
+    app = _scene_app("test-depth-caption", [bundled_data_dir()])
+    app._load_scene(cones)
+    _run(app, app.recompute)
+    assert app.state.depth_caption == view.depth_caption
+
+
 def test_compute_view_shows_the_swapped_warning(data_dir):
     """A swapped pair: the page's statistics line carries the library's warning (once), and the
     pair given the right way round carries none."""

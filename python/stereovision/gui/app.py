@@ -84,6 +84,9 @@ MAX_MESH_VERTICES = 120_000
 #: Progress (per cent) reached at each stage reported by ``depth_map``.
 _STAGE_PROGRESS = {"rectify": 10, "prepare": 20, "match": 75, "fill": 85, "triangulate": 90}
 
+#: The depth picture's caption when it has no depth to scale (no calibration, no match).
+DEPTH_CAPTION = "depth (near = warm)"
+
 #: Camera slider ranges: degrees for the rotations, metres for the translations.
 ANGLE_RANGE = 90.0
 TRANSLATION_RANGE = 5.0
@@ -93,6 +96,7 @@ _CONTROL_NAMES = ("roll", "pitch", "yaw", "forward", "up", "right")
 #: What the page shows of a computed pair: cleared while a new pair computes (the previous
 #: pair's disparity stayed under the new pair's name), put back if the new pair fails.
 _RESULT_KEYS = (
+    "depth_caption",
     "img_left",
     "img_right",
     "img_disparity",
@@ -175,6 +179,8 @@ class ViewData:
     intrinsics: Any
     stats: str
     message_3d: str
+    #: The depth picture's caption: the distances its colour scale runs between.
+    depth_caption: str = DEPTH_CAPTION
 
 
 def floor_view(result: Any) -> tuple[str, str]:
@@ -313,10 +319,19 @@ def compute_view(
     shown_left = result.left_rectified if result.left_rectified is not None else left_s
     disparity_url = _data_url(colorize(result.disparity, lo=0.0))
     depth_img = np.zeros_like(shown_left)
+    depth_caption = DEPTH_CAPTION
     if result.depth is not None:
         with np.errstate(divide="ignore", invalid="ignore"):
             inv = np.where(np.isfinite(result.depth), 1.0 / result.depth, np.nan)
-        depth_img = colorize(inv)
+        finite = inv[np.isfinite(inv)]
+        if finite.size:
+            # colorize's own range (1st-99th percentile of 1 / depth), said in metres: the
+            # picture had no key, and its scale changes with every pair
+            lo, hi = (float(np.percentile(finite, q)) for q in (1, 99))
+            depth_img = colorize(inv, lo=lo, hi=hi)
+            near = f"{1.0 / hi:.2f} m" if hi > 0 else "∞"
+            far = f"{1.0 / lo:.2f} m" if lo > 0 else "∞"
+            depth_caption = f"depth: red {near} … blue {far}"  # one line above the picture
     matches_url = ""
     if method in SPARSE_METHODS or result.density < SPARSE_DENSITY:
         matches_url = _data_url(draw_matches(left_s, right_s, result.disparity), 2 * DISPLAY_WIDTH)
@@ -352,6 +367,7 @@ def compute_view(
         intrinsics=intr,
         stats=stats,
         message_3d=message_3d,
+        depth_caption=depth_caption,
     )
 
 
@@ -483,6 +499,7 @@ class StereoApp:
         st.fourcc = FOURCCS[0]
         st.img_left = st.img_right = st.img_disparity = st.img_depth = st.img_matches = ""
         st.stats = ""
+        st.depth_caption = DEPTH_CAPTION
         st.message_3d = ""
         st.source_label = ""
         st.rows_label = ""
@@ -792,6 +809,7 @@ class StereoApp:
                     st.img_left, st.img_right = _data_url(left), _data_url(right)
                     st.img_disparity = st.img_depth = st.img_matches = st.img_floor = ""
                     st.floor_label = st.stats = ""
+                    st.depth_caption = DEPTH_CAPTION
                     st.message_3d = PENDING_3D if self.view is not None else ""
 
             def progress(pct: int, text: str) -> None:
@@ -1003,6 +1021,7 @@ class StereoApp:
             st.img_left, st.img_right = view.left_url, view.right_url
             st.img_disparity, st.img_depth = view.disparity_url, view.depth_url
             st.img_matches = view.matches_url
+            st.depth_caption = view.depth_caption
             st.stats = view.stats
             st.message_3d = view.message_3d
             st.progress = 100
@@ -1271,7 +1290,7 @@ class StereoApp:
                         html.Div("disparity", classes="text-caption")
                         html.Img(id="img-disparity", src=("img_disparity",), style=img_style)
                     with v3.VCol(cols=6):
-                        html.Div("depth (near = warm)", classes="text-caption")
+                        html.Div("{{ depth_caption }}", id="depth-caption", classes="text-caption")
                         html.Img(id="img-depth", src=("img_depth",), style=img_style)
                 with html.Div(v_if="img_matches", classes="mt-2"):
                     html.Div("matches", classes="text-caption")
