@@ -334,6 +334,23 @@ def test_the_depth_picture_says_the_distances_of_its_colours():
     assert app.state.depth_caption == view.depth_caption
 
 
+@pytest.mark.parametrize("method", ["gabor", "fused"])
+def test_progress_goes_forward_and_says_what_runs(method):
+    """The status read "prepare done" during the whole matching (most of the time: it looked
+    stalled), and gabor's refinement, missing from the stages' table, put the bar back from
+    75 % to 50 %."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import compute_view
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    said: list = []
+    compute_view(left, right, None, method, progress=lambda pct, text: said.append((pct, text)))
+    percents = [p for p, _ in said]
+    assert percents == sorted(percents) and percents[-1] == 92, said
+    assert (20, f"{method}: prepare done, matching…") in said
+
+
 def test_compute_view_shows_the_swapped_warning(data_dir):
     """A swapped pair: the page's statistics line carries the library's warning (once), and the
     pair given the right way round carries none."""

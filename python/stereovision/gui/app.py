@@ -82,7 +82,24 @@ JPEG_QUALITY = 85
 MAX_MESH_VERTICES = 120_000
 
 #: Progress (per cent) reached at each stage reported by ``depth_map``.
-_STAGE_PROGRESS = {"rectify": 10, "prepare": 20, "match": 75, "fill": 85, "triangulate": 90}
+_STAGE_PROGRESS = {
+    "rectify": 10,
+    "prepare": 20,
+    "match": 75,
+    "refine": 80,  # it was missing: 50, the bar went back after "match"
+    "fill": 85,
+    "triangulate": 90,
+}
+#: What runs after each stage ``depth_map`` reports done (the status said "prepare done" for
+#: the whole matching, most of the time, which looked like a stall).
+_NEXT_STEP = {
+    "rectify": "preparing",
+    "prepare": "matching",
+    "match": "refining and filling",
+    "refine": "filling",
+    "fill": "triangulating",
+    "triangulate": "drawing",
+}
 
 #: The depth picture's caption when it has no depth to scale (no calibration, no match).
 DEPTH_CAPTION = "depth (near = warm)"
@@ -309,7 +326,11 @@ def compute_view(
         else:
 
             def stage(name: str) -> None:
-                report(_STAGE_PROGRESS.get(name, 50), f"{method}: {name} done")
+                step = _NEXT_STEP.get(name)
+                report(
+                    _STAGE_PROGRESS.get(name, 50),
+                    f"{method}: {name} done, {step}…" if step else f"{method}: {name} done",
+                )
 
             result = depth_map(
                 left_s, right_s, calib_s, method=method, max_disparity=d_max, progress=stage
