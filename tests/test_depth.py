@@ -583,8 +583,8 @@ def test_a_fractional_range_is_reported_as_searched(tmp_path: Path) -> None:
 @pytest.mark.parametrize(("method", "max_disparity"), [("fused", 37), ("gabor", 37.5)])
 def test_the_map_stays_in_the_range_searched(method: str, max_disparity: float) -> None:
     """The fused map ran past a range set below the scene's (cones with 37: 13897 pixels up to
-    38.6, from its Gabor input and the plane fills) and below 0 on real scenes (teddyH's
-    bad-2.0 6.49 -> 6.40 % with the values out of range made holes, then filled in range)."""
+    38.6, from its Gabor input and the plane fills): values more than half a pixel out are
+    holes (then filled), the map is clipped to the range."""
     s = load_scene(Path(sv.__file__).parent / "data" / "cones")
     res = sv.depth_map(s.left, s.right, s.calib, method=method, max_disparity=max_disparity)
     d = res.disparity

@@ -86,6 +86,11 @@ _SIGMA_REFINED = (0.405, -0.221, 0.18)
 _SIGMA_FILLED = 0.63
 
 
+# How far past the range searched a value may lie and still count as measured: a sub-pixel
+# vertex of a cost peak at the range's end is within half a pixel of it.
+_RANGE_TOL = 0.5
+
+
 def _whole_or_float(value: float) -> float:
     """``value`` as an int when it is a whole number of pixels (64, not 64.0), else a float."""
     v = float(value)
@@ -1040,13 +1045,15 @@ def depth_map(
     )
     disp = np.ascontiguousarray(disp, dtype=np.float32)
     conf = np.ascontiguousarray(conf, dtype=np.float32)
-    # The range searched (the census map's reaches the next whole pixel above a fractional
-    # one): the fused map's Gabor input and plane fills ran past it (cones with 37: up to
-    # 38.6), values no matcher measured there. Out of it is a hole, as match() drops them.
     hi = float(max_disparity) if method == "gabor" else float(math.ceil(max_disparity))
     lo = float(min_disparity)
+    # The range searched (the census map's reaches the next whole pixel above a fractional
+    # one). The fused map's Gabor input ran past it (cones with 37: up to 38.6, its surfaces at
+    # 55 px), values no matcher measured: holes, as match() drops them. Within half a pixel
+    # they are kept (TartanAir's sky at -0.47 px is right; as a hole or clipped to the floor
+    # it became an enclosed far region and the fill lost 0.3 point of bad-2.0 there).
     with np.errstate(invalid="ignore"):
-        out = (disp < lo) | (disp > hi)
+        out = (disp < lo - _RANGE_TOL) | (disp > hi + _RANGE_TOL)
     if out.any():  # a new array: disp may be a channel's own output, kept in ``channels``
         disp = np.where(out, np.float32(np.nan), disp)
     measured = np.isfinite(disp)
@@ -1082,11 +1089,13 @@ def depth_map(
     if fill:
         fused = method != "gabor"  # the fused map's fill suits the census map too
         disp, far = fill_holes(disp, left_bgr, fused=fused, floor=float(min_disparity), grey=gl)
-        np.clip(disp, lo, hi, out=disp)  # a plane may run past the range at a hole's far end
         if far is not None:
             measured_disp[far] = np.nan  # fused_dense's own array, as is conf
             conf[far] = 0
         stage("fill")
+    # the map in the range (a plane may run past it at a hole's far end; the half pixel kept
+    # above); a new array: unfilled, disp is still measured_disp
+    disp = np.clip(disp, lo, hi)
     depth = None
     depth_sigma = None
     points = np.zeros((0, 3), np.float32)
