@@ -437,3 +437,46 @@ def test_load_scene_errors(tmp_path: Path) -> None:
     (tmp_path / "gt_disp.pfm").unlink()
     s = load_scene(tmp_path)
     assert s.gt is None and s.max_disparity == 16
+
+
+def test_load_scene_reads_q_dat_when_there_is_no_calib_txt(data_dir: Path) -> None:
+    """middeval3/teddyH ships only OpenCV's Q (f 3000 px, 1/B 12.5 per metre, cx 398, cy 375):
+    it was loaded without a calibration, so no depth, no 3-D and no metric figures."""
+    scene = load_scene(data_dir / "middeval3/teddyH")
+    assert scene.calib is not None
+    assert scene.calib.unit == "m"
+    assert scene.calib.focal_px == 3000.0
+    assert scene.calib.baseline_m == pytest.approx(0.08)
+    assert scene.calib.doffs_px == 0.0
+    assert scene.calib.K1[0, 2] == 398.0 and scene.calib.K1[1, 2] == 375.0
+    assert scene.calib.image_size == (900, 750)
+    q_file = np.loadtxt(data_dir / "middeval3/teddyH/Q.dat")
+    np.testing.assert_allclose(scene.calib.Q, q_file, rtol=1e-12)
+    # Z = f B / d: a GT disparity of 60 px lies at 3000 * 0.08 / 60 = 4 m
+    z = scene.calib.depth_from_disparity(np.array([[60.0]], dtype=np.float32))
+    assert float(z[0, 0]) == pytest.approx(4.0, rel=1e-6)
+
+
+def test_load_scene_prefers_calib_txt_over_q_dat(data_dir: Path) -> None:
+    """TartanAir has both; its calib.txt (mm) wins, and the two describe the same rig."""
+    d = data_dir / "tartanair/oldtown_easy_p000_001116"
+    scene = load_scene(d)
+    assert scene.calib is not None and scene.calib.unit == "mm"
+    from_q = Calibration.from_q(d / "Q.dat", scene.calib.image_size)
+    assert from_q.baseline_m == pytest.approx(scene.calib.baseline_m)
+    assert from_q.focal_px == scene.calib.focal_px
+
+
+def test_load_scene_refuses_a_q_dat_that_is_not_a_q_matrix(tmp_path: Path) -> None:
+    img = np.full((8, 10, 3), 100, np.uint8)
+    cv2.imwrite(str(tmp_path / "left.png"), img)
+    cv2.imwrite(str(tmp_path / "right.png"), img)
+    (tmp_path / "Q.dat").write_text("1 0 0 -5\n0 1 0 -4\n0 0 0 100\n0 0 -4 0\n")
+    with pytest.raises(ValueError, match=r"Q\[3,2\] \(1/baseline -4\) must be positive"):
+        load_scene(tmp_path)
+    (tmp_path / "Q.dat").write_text("1 2 3\n")
+    with pytest.raises(ValueError, match="16 finite numbers expected, got 3"):
+        load_scene(tmp_path)
+    (tmp_path / "Q.dat").write_text("1 0 0 -5\n0 1 0 -4\n0 0 1 100\n0 0 4 0\n")
+    with pytest.raises(ValueError, match=r"Q\[2,2\] = 1, expected 0"):
+        load_scene(tmp_path)

@@ -1237,6 +1237,73 @@ class Calibration:
         )
 
     @classmethod
+    def from_q(cls, q_file: PathLike, image_size: tuple[int, int]) -> Calibration:
+        """Rectified calibration from a ``Q.dat``: OpenCV's 4x4 disparity-to-depth matrix.
+
+        The text file holds the 16 numbers of ``Q`` (``cv2.stereoRectify``'s output, as in
+        the MiddEval3/TartanAir/KITTI samples of huyaoyu/Tutorial2020_Stereo)::
+
+            1 0 0   -cx
+            0 1 0   -cy
+            0 0 0    f
+            0 0 1/B  (cx' - cx)/B
+
+        ``B`` is read in metres (the samples' convention: TartanAir's gives 0.25 m, its
+        ``calib.txt`` 250 mm; KITTI's 0.533 m). The result has unit ``"m"``, ``R = I``,
+        ``T = (-B, 0, 0)``, equal focal lengths, ``doffs = cx' - cx``.
+
+        Parameters
+        ----------
+        q_file : str or os.PathLike
+            The ``Q.dat`` file.
+        image_size : tuple of int
+            ``(width, height)`` of the images it belongs to (``Q`` does not say).
+
+        Raises
+        ------
+        FileNotFoundError
+            If the file does not exist.
+        ValueError
+            If it does not hold 16 finite numbers of that form (the offending entry named).
+        """
+        p, text = cls._read_text(q_file)
+        try:
+            q = np.array([float(t) for t in text.split()], dtype=np.float64)
+        except ValueError:
+            raise ValueError(f"{p}: not a Q matrix (16 numbers expected)") from None
+        if q.size != 16 or not np.isfinite(q).all():
+            raise ValueError(f"{p}: not a Q matrix (16 finite numbers expected, got {q.size})")
+        q = q.reshape(4, 4)
+        expect = {(0, 0): 1.0, (1, 1): 1.0, (0, 1): 0.0, (0, 2): 0.0, (1, 0): 0.0}
+        expect.update({(1, 2): 0.0, (2, 0): 0.0, (2, 1): 0.0, (2, 2): 0.0})
+        expect.update({(3, 0): 0.0, (3, 1): 0.0})
+        for (i, j), want in expect.items():
+            if q[i, j] != want:
+                raise ValueError(
+                    f"{p}: not a rectified Q matrix: Q[{i},{j}] = {q[i, j]:g}, expected {want:g}"
+                )
+        f, inv_b = float(q[2, 3]), float(q[3, 2])
+        if f <= 0 or inv_b <= 0:
+            raise ValueError(
+                f"{p}: Q[2,3] (focal length {f:g} px) and Q[3,2] (1/baseline {inv_b:g}) must be "
+                "positive: this Q does not give positive depths for positive disparities"
+            )
+        cx, cy = -float(q[0, 3]), -float(q[1, 3])
+        cx_right = cx + float(q[3, 3]) / inv_b
+        w, h = (_pixels(v, f"image size for {p}") for v in image_size)
+        return cls(
+            K1=np.array([[f, 0.0, cx], [0.0, f, cy], [0.0, 0.0, 1.0]]),
+            D1=np.zeros(5),
+            K2=np.array([[f, 0.0, cx_right], [0.0, f, cy], [0.0, 0.0, 1.0]]),
+            D2=np.zeros(5),
+            R=np.eye(3),
+            T=np.array([-1.0 / inv_b, 0.0, 0.0]),
+            image_size=(w, h),
+            unit="m",
+            rectified=True,
+        )
+
+    @classmethod
     def from_kitti(
         cls, calib_file: PathLike, image_size: tuple[int, int] | None = None
     ) -> Calibration:

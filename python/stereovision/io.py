@@ -9,6 +9,7 @@ Scene layout (evaluation.md)::
     <scene>/left.png  right.png   rectified pair, 8-bit
     <scene>/gt_disp.pfm           GT disparity of the left image (pixels, +inf = unknown)
     <scene>/calib.txt             Middlebury-style calibration (optional)
+    <scene>/Q.dat                 else OpenCV's 4x4 Q matrix, baseline in metres (optional)
 """
 
 from __future__ import annotations
@@ -702,7 +703,8 @@ class Scene:
         ``(H, W)`` ``float32`` GT disparity of the left image in pixels, NaN where unknown
         (the files' ``+inf``); None when the scene has no ``gt_disp.pfm``.
     calib : Calibration or None
-        From ``calib.txt`` (Middlebury format, unit mm) when present.
+        From ``calib.txt`` (Middlebury format, unit mm) when present, else from ``Q.dat``
+        (OpenCV's ``Q``, unit m); None without either.
     max_disparity : int
         Disparity search range for every method (multiple of 16): ``1.1 x`` the largest finite
         GT disparity rounded up; without GT the calibration's ``ndisp`` rounded up, else a
@@ -760,7 +762,11 @@ def scene_max_disparity(
 
 
 def load_scene(directory: PathLike) -> Scene:
-    """Load one scene directory (``left.png``, ``right.png``, optional GT and ``calib.txt``).
+    """Load one scene directory (``left.png``, ``right.png``, optional GT and calibration).
+
+    The calibration is ``calib.txt`` (Middlebury format, :meth:`Calibration.from_middlebury`),
+    else ``Q.dat`` (OpenCV's 4x4 ``Q`` matrix, baseline in metres,
+    :meth:`Calibration.from_q`), else none.
 
     Parameters
     ----------
@@ -776,8 +782,8 @@ def load_scene(directory: PathLike) -> Scene:
     FileNotFoundError
         If the directory, ``left.png`` or ``right.png`` is missing.
     ValueError
-        If an image cannot be decoded, the pair sizes differ, or the GT size differs from the
-        left image.
+        If an image cannot be decoded, the pair sizes differ, the GT size differs from the
+        left image, or the calibration file is invalid.
     """
     from stereovision.calibration import Calibration, parse_middlebury_calib
 
@@ -805,6 +811,8 @@ def load_scene(directory: PathLike) -> Scene:
     if calib_path.exists():
         calib = Calibration.from_middlebury(calib_path)
         ndisp = parse_middlebury_calib(calib_path).get("ndisp")
+    elif (d / "Q.dat").exists():
+        calib = Calibration.from_q(d / "Q.dat", (left.shape[1], left.shape[0]))
     return Scene(
         name=f"{d.parent.name}/{d.name}",
         left=left,
