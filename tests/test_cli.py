@@ -621,3 +621,22 @@ def test_eval_of_an_image_file_says_it_is_a_file(data_dir: Path) -> None:
         f"stereovision: error: {img}: is a file; give a scene folder (holding left.png, "
         "right.png)\n"
     )
+
+
+def test_info_on_a_scene_folder_reads_its_calibration(
+    data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A scene folder said "folder without left.yaml and right.yaml": its calib.txt (else its
+    Q.dat, sized by its left.png) is the rig's calibration."""
+    assert main(["info", str(data_dir / "eth3d" / "playground")]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("941x490 px, rectified pair: baseline 6.0 cm (59.5549 mm)")
+    assert main(["info", str(data_dir / "middeval3" / "teddyH")]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("900x750 px, rectified pair: baseline 8.0 cm (0.08 m), focal length")
+    assert main(["info", str(data_dir / "chessboard")]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: calibration path {data_dir / 'chessboard'} is a folder without "
+        "left.yaml and right.yaml (ROS camera_info), calib.txt or Q.dat; pass a calibration "
+        "file\n"
+    )

@@ -1113,7 +1113,9 @@ class Calibration:
         (:meth:`from_ros`): a folder holding ``left.yaml`` and ``right.yaml``, ROS
         ``camera_calibration``'s ``calibrationdata.tar.gz``, or one of the two files when the
         other lies beside it (``left`` and ``right`` swapped in its name), and Kalibr's
-        ``camchain.yaml`` (:meth:`from_kalibr`, ``cam0`` and ``cam1``).
+        ``camchain.yaml`` (:meth:`from_kalibr`, ``cam0`` and ``cam1``). A scene folder
+        (:func:`stereovision.io.load_scene`) gives its ``calib.txt``, else its ``Q.dat``
+        (:meth:`from_q`, sized by ``image_size`` or the folder's ``left.png``).
 
         Raises
         ------
@@ -1125,12 +1127,16 @@ class Calibration:
         p = Path(path)
         if p.is_dir():
             pair = _ros_pair_from_folder(p)
-            if pair is None:
-                raise ValueError(
-                    f"calibration path {p} is a folder without left.yaml and right.yaml "
-                    "(ROS camera_info); pass a calibration file"
-                )
-            return cls.from_ros(*pair)
+            if pair is not None:
+                return cls.from_ros(*pair)
+            if (p / "calib.txt").is_file():
+                return cls.from_file(p / "calib.txt", image_size=image_size)
+            if (p / "Q.dat").is_file():
+                return cls.from_q(p / "Q.dat", image_size or _scene_image_size(p))
+            raise ValueError(
+                f"calibration path {p} is a folder without left.yaml and right.yaml "
+                "(ROS camera_info), calib.txt or Q.dat; pass a calibration file"
+            )
         if p.is_file() and p.name.lower().endswith((".tar.gz", ".tgz", ".tar")):
             ltext, rtext = _read_ros_tar(p)
             return cls._from_ros_texts(ltext, rtext, f"{p}:left.yaml", f"{p}:right.yaml")
@@ -1987,6 +1993,19 @@ def _ros_yaml(name: str, size: tuple[int, int], K: F64, D: F64, R: F64, P: F64, 
         + mat("distortion_coefficients", D)
         + mat("rectification_matrix", R)
         + mat("projection_matrix", P)
+    )
+
+
+def _scene_image_size(folder: Path) -> tuple[int, int]:
+    """``(width, height)`` of a scene folder's left image (for its ``Q.dat``)."""
+    for name in ("left.png", "left.jpg"):
+        if (folder / name).is_file():
+            from stereovision.io import imread
+
+            h, w = imread(folder / name).shape[:2]
+            return w, h
+    raise ValueError(
+        f"{folder / 'Q.dat'} does not give the image size and there is no left.png beside it"
     )
 
 
