@@ -640,3 +640,24 @@ def test_info_on_a_scene_folder_reads_its_calibration(
         "left.yaml and right.yaml (ROS camera_info), calib.txt or Q.dat; pass a calibration "
         "file\n"
     )
+
+
+def test_info_on_an_image_list_says_it_is_not_a_calibration(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """OpenCV's stereo_calib.xml lists the chessboard pairs: info said it "lacks field
+    'image_width'"; it now says what the file is and how to get a calibration from it."""
+    xml = data_dir / "chessboard" / "stereo_calib.xml"
+    assert main(["info", str(xml)]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: {xml} is not a calibration but a list of images (26 file names "
+        "under 'imagelist'): calibrate the rig from those images with `stereovision calibrate "
+        "--left ... --right ... --square SIZE -o calib.yaml`\n"
+    )
+    other = tmp_path / "other.yaml"
+    other.write_text("%YAML:1.0\n---\nframe_count: 3\nfps: 30.\n")
+    assert main(["info", str(other)]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: {other} is not a calibration: it has none of the fields "
+        "image_width, K1, K2, R, T (it holds: frame_count, fps)\n"
+    )

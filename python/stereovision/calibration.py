@@ -217,6 +217,34 @@ def _first_line(exc: BaseException) -> str:
     return text.splitlines()[0] if text else type(exc).__name__
 
 
+#: Fields of which an OpenCV YAML/XML calibration has at least one.
+_CALIBRATION_FIELDS = ("image_width", "image_height", "K1", "M1", "K2", "M2", "R", "T")
+
+
+def _not_a_calibration(fs: Any, source: str) -> str:
+    """Why an OpenCV YAML/XML file without any calibration field is not one: an image list
+    (OpenCV's ``stereo_calib.xml`` sample names its chessboard pairs) or which fields it has."""
+    root = fs.root()
+    keys = [str(k) for k in root.keys()] if root.isMap() else []
+    for key in keys:
+        node = fs.getNode(key)
+        if (
+            node.isSeq()
+            and node.size() > 0
+            and all(node.at(i).isString() for i in range(node.size()))
+        ):
+            return (
+                f"{source} is not a calibration but a list of images ({node.size()} file names "
+                f"under {key!r}): calibrate the rig from those images with `stereovision "
+                "calibrate --left ... --right ... --square SIZE -o calib.yaml`"
+            )
+    held = ", ".join(keys) if keys else "nothing"
+    return (
+        f"{source} is not a calibration: it has none of the fields image_width, K1, K2, R, T "
+        f"(it holds: {held})"
+    )
+
+
 def _pixels(value: object, what: str) -> int:
     """A file's image width or height: a positive whole number of pixels (``1242.0`` is read as
     1242; ``inf``, ``nan``, ``-5`` and ``713.7`` are refused, naming the field and the file)."""
@@ -1049,6 +1077,8 @@ class Calibration:
             return _node_matrix(node, key, source)
 
         try:
+            if all(fs.getNode(k).isNone() for k in _CALIBRATION_FIELDS):
+                raise ValueError(_not_a_calibration(fs, source))
             return cls._from_mapping(get, source)
         finally:
             fs.release()
