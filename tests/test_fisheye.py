@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 from pathlib import Path
 from typing import Any
 
@@ -291,3 +292,29 @@ def test_field_check_and_correction_on_a_fisheye_rig(data_dir: Path) -> None:
     assert after.ok is True and fixed.model == "fisheye"
     angle = math.degrees(float(np.linalg.norm(cv2.Rodrigues(fixed.R @ ROT.T)[0])))
     assert angle < 0.03
+
+
+@pytest.mark.parametrize("t_y", [-0.10, 0.10])
+def test_a_vertical_fisheye_rig_is_refused_like_a_pinhole_one(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], t_y: float
+) -> None:
+    """cv2.fisheye.stereoRectify lays any baseline along the rows by turning both views about
+    90 degrees: a vertical fisheye rig came out turned (info's field of view swapped, depth
+    rotated) where the pinhole path refuses a vertical rig."""
+    from stereovision.cli import main
+
+    vertical = dataclasses.replace(TRUTH, T=np.array([0.001, t_y, 0.002]))
+    with pytest.raises(ValueError) as err:
+        vertical.rectified_calibration()
+    assert re.fullmatch(
+        r"R, T: the rig is vertical \(fisheye stereoRectify turned the views (89|90|91) degrees "
+        r"to lay its baseline along the rows\); only horizontal rigs are supported",
+        str(err.value),
+    )
+    pinhole = dataclasses.replace(vertical, model="pinhole", D1=np.zeros(5), D2=np.zeros(5))
+    with pytest.raises(ValueError, match=r"^R, T: the rig is vertical .* only horizontal rigs"):
+        pinhole.rectified_calibration()
+    path = vertical.save(tmp_path / "vertical.yaml")
+    assert main(["info", str(path)]) == 2
+    assert capsys.readouterr().err == f"stereovision: error: {err.value}\n"
+    assert TRUTH.rectified_calibration().image_size == SIZE  # a horizontal one still works

@@ -713,18 +713,27 @@ class Calibration:
         Raises
         ------
         ValueError
-            For a vertical rig (OpenCV rectifies it to columns, which this package does not
-            handle) or a right camera to the left of the left one.
+            For a vertical rig (OpenCV rectifies a pinhole one to columns and turns a fisheye
+            one's views by 90 degrees, neither of which this package handles) or a right camera
+            to the left of the left one.
         """
         if self.rectified:
             return self
         key = ("rectified_calibration", float(alpha))
         if key not in self._cache:
-            _, _, p1, p2, _ = self._stereo_rectify(alpha)
+            r1, _, p1, p2, _ = self._stereo_rectify(alpha)
             if abs(p2[1, 3]) > abs(p2[0, 3]):
                 raise ValueError(
                     "R, T: the rig is vertical (stereoRectify produced a vertical baseline); "
                     "only horizontal rigs are supported"
+                )
+            if abs(r1[0, 1]) > abs(r1[0, 0]):
+                # cv2.fisheye.stereoRectify always puts the baseline along x: for a vertical
+                # rig it turns both views by about 90 degrees instead (width and height swap)
+                raise ValueError(
+                    "R, T: the rig is vertical (fisheye stereoRectify turned the views "
+                    f"{abs(math.degrees(math.atan2(r1[0, 1], r1[0, 0]))):.0f} degrees to lay its "
+                    "baseline along the rows); only horizontal rigs are supported"
                 )
             token = _DERIVING.set(True)
             try:
