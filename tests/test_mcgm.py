@@ -271,6 +271,41 @@ def test_bad_input_of_the_stage_functions() -> None:
         mcgm.curves(ok, t_high=3)
 
 
+def test_edge_filters_refuse_matches_that_are_not_of_the_pair() -> None:
+    """A NaN coordinate or a point outside the images was kept when the filters were switched
+    off and dropped when on: no answer either way. Both are now a caller's error, named."""
+    g = np.random.default_rng(0).random((30, 50), dtype=np.float32)
+    off = {"sides": False, "disc": False, "zncc_check": False}
+    inside = np.array([[25, 15, 22, 15], [0, 0, -0.5, 29.5], [49.5, 15, 45, 15]], np.float32)
+    assert mcgm.edge_filters(g, g, inside, max_disparity=8, **off).tolist() == [True] * 3
+    cases = [
+        (
+            [[25, 15, 22, 15], [np.nan, 15, 22, 15]],
+            "1 of 2 rows have a NaN or infinite "
+            "coordinate (row 1: (xl, yl, xr, yr) = (nan, 15, 22, 15))",
+        ),
+        (
+            [[25, 15, np.inf, 15]],
+            "1 of 1 rows have a NaN or infinite coordinate (row 0: "
+            "(xl, yl, xr, yr) = (25, 15, inf, 15))",
+        ),
+        (
+            [[60, 15, 55, 15], [25, 15, -3, 15]],
+            "2 of 2 rows lie outside the 50x30 images (row 0: (xl, yl, xr, yr) = (60, 15, 55, 15))",
+        ),
+        (
+            [[25, 15, 22, 15], [25, 30, 22, 30]],
+            "1 of 2 rows lie outside the 50x30 images (row 1: (xl, yl, xr, yr) = (25, 30, 22, 30))",
+        ),
+    ]
+    for rows, message in cases:
+        arr = np.array(rows, np.float32)
+        for kw in (off, {}):
+            with pytest.raises(ValueError) as err:
+                mcgm.edge_filters(g, g, arr, max_disparity=8, **kw)
+            assert str(err.value) == f"matches: {message}"
+
+
 # --- API ---
 
 

@@ -323,16 +323,45 @@ def edge_filters(
     numpy.ndarray
         ``(N,)`` bool, True = kept.
 
+    Notes
+    -----
+    A match whose windows do not fit in the images (within a few pixels of the border) is not
+    kept: the filters cannot check it.
+
     Raises
     ------
     ValueError
-        Bad images, a matches array not of shape ``(N, 4)``, an unknown parameter.
+        Bad images, a matches array not of shape ``(N, 4)``, an unknown parameter, or a match
+        that is no match of this pair: a NaN or infinite coordinate, or a point outside the
+        images (beyond the outer pixels' edges, ``-0.5 .. W - 0.5`` and ``-0.5 .. H - 0.5``).
+        The filters used to keep such rows when switched off and drop them otherwise.
     """
     gl, gr = check_pair(left, right)
     arr = np.ascontiguousarray(matches, dtype=np.float32)
     if arr.ndim != 2 or arr.shape[1] != 4:
         raise ValueError(f"matches: expected shape (N, 4), got {arr.shape}")
+    h, w = gl.shape
+    bad = ~np.isfinite(arr).all(axis=1)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ValueError(
+            f"matches: {int(bad.sum())} of {len(arr)} rows have a NaN or infinite coordinate "
+            f"(row {i}: {_row(arr[i])})"
+        )
+    x, y = arr[:, [0, 2]], arr[:, [1, 3]]
+    out = ((x < -0.5) | (x > w - 0.5) | (y < -0.5) | (y > h - 0.5)).any(axis=1)
+    if out.any():
+        i = int(np.argmax(out))
+        raise ValueError(
+            f"matches: {int(out.sum())} of {len(arr)} rows lie outside the {w}x{h} images "
+            f"(row {i}: {_row(arr[i])})"
+        )
     return _core.mcgm_filter(gl, gr, arr, _params(max_disparity, min_disparity, params))
+
+
+def _row(m: npt.NDArray[np.float32]) -> str:
+    """One ``[xl, yl, xr, yr]`` row for a message."""
+    return "(xl, yl, xr, yr) = (" + ", ".join(f"{float(v):g}" for v in m) + ")"
 
 
 #: ZNCC window half-size of the reference (7x7, as the Hopfield channel's candidates).
