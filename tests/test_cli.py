@@ -661,3 +661,17 @@ def test_info_on_an_image_list_says_it_is_not_a_calibration(
         f"stereovision: error: {other} is not a calibration: it has none of the fields "
         "image_width, K1, K2, R, T (it holds: frame_count, fps)\n"
     )
+
+
+def test_check_warns_of_one_file_given_twice(
+    data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check LEFT LEFT`` said "rectification ok" without a word about the pair being one
+    file."""
+    left = data_dir / "middlebury2003" / "cones" / "left.png"
+    assert main(["check", str(left), str(left)]) == 0
+    err = capsys.readouterr().err
+    assert err == (
+        f"stereovision: warning: {left} and {left} are the same file: every disparity comes "
+        "out 0 (two views of the scene are needed)\n"
+    )

@@ -1401,3 +1401,29 @@ def test_open_stereo_source_loops_video_files(tmp_path):
     assert np.abs(frames[0].astype(int) - frames[VIDEO_FRAMES]).mean() < 3  # started again
     with pytest.raises(OSError, match="7"):
         sources.open_stereo_source(7, 8)
+
+
+def test_loading_files_names_sizes_and_warns_of_one_file_twice(tmp_path):
+    """The files' size mismatch said "left (375, 450, 3) and right (288, 384, 3) differ in
+    size"; the same file as left and right computed a flat 0 disparity without a word."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-files-twice", [bundled_data_dir(), tmp_path])
+    cv2.imwrite(str(tmp_path / "small.png"), np.full((288, 384, 3), 50, np.uint8))
+    app.state.left_file, app.state.right_file = "cones/left.png", str(tmp_path / "small.png")
+    app.load_files()
+    assert app.state.error == (
+        f"data/cones/left.png is 450x375 (colour), {tmp_path.name}/small.png is 384x288 "
+        "(colour): the two images of a pair have one size"
+    )
+    app.state.error = ""
+    app.state.left_file = app.state.right_file = "cones/left.png"
+    app.load_files()
+    assert app.state.error == ""
+    assert app.state.rows_label == (
+        "warning: data/cones/left.png and data/cones/left.png are the same file: every "
+        "disparity comes out 0 (two views of the scene are needed)"
+    )
+    app.state.right_file = "cones/right.png"
+    app.load_files()
+    assert app.state.rows_label == ""

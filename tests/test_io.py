@@ -428,7 +428,9 @@ def test_load_scene_errors(tmp_path: Path) -> None:
     img = np.zeros((4, 6, 3), np.uint8)
     cv2.imwrite(str(tmp_path / "left.png"), img)
     cv2.imwrite(str(tmp_path / "right.png"), img[:, :5])
-    with pytest.raises(ValueError, match="differ in size"):
+    with pytest.raises(
+        ValueError, match=r"right\.png is .*: the two images of a pair have one size"
+    ):
         load_scene(tmp_path)
     cv2.imwrite(str(tmp_path / "right.png"), img)
     write_pfm(tmp_path / "gt_disp.pfm", np.zeros((3, 6), np.float32))
@@ -480,3 +482,38 @@ def test_load_scene_refuses_a_q_dat_that_is_not_a_q_matrix(tmp_path: Path) -> No
     (tmp_path / "Q.dat").write_text("1 0 0 -5\n0 1 0 -4\n0 0 1 100\n0 0 4 0\n")
     with pytest.raises(ValueError, match=r"Q\[2,2\] = 1, expected 0"):
         load_scene(tmp_path)
+
+
+def test_pair_size_messages_give_sizes_not_numpy_shapes(tmp_path: Path) -> None:
+    """A size mismatch said "left.png (375, 450, 3) and right.png (288, 384, 3) differ in
+    size": numpy shapes, height first. It now says 450x375 (colour) as the rest of the
+    project; one file (or one image) given twice is a warning."""
+    from stereovision.io import check_pair_files, image_size_text
+
+    assert image_size_text(np.zeros((375, 450, 3), np.uint8)) == "450x375 (colour)"
+    assert image_size_text(np.zeros((375, 450), np.uint8)) == "450x375 (grey)"
+    assert image_size_text(np.zeros((2, 3, 4), np.uint8)) == "3x2 (4 channels)"
+    a, b = np.zeros((375, 450, 3), np.uint8), np.full((288, 384, 3), 9, np.uint8)
+    with pytest.raises(ValueError) as err:
+        check_pair_files(a, b, "l.png", "r.png")
+    assert str(err.value) == (
+        "l.png is 450x375 (colour), r.png is 384x288 (colour): the two images of a pair have "
+        "one size"
+    )
+    cv2.imwrite(str(tmp_path / "left.png"), a)
+    cv2.imwrite(str(tmp_path / "right.png"), b)
+    with pytest.raises(ValueError) as err:
+        load_scene(tmp_path)
+    assert str(err.value) == (
+        f"scene {tmp_path}: left.png is 450x375 (colour), right.png is 384x288 (colour): the "
+        "two images of a pair have one size"
+    )
+    f = tmp_path / "left.png"
+    assert check_pair_files(a, a.copy(), f, f, names=("L", "R")) == (
+        "L and R are the same file: every disparity comes out 0 (two views of the scene are needed)"
+    )
+    assert check_pair_files(a, a.copy(), f, tmp_path / "right.png") == (
+        f"{f} and {tmp_path / 'right.png'} are the same image: every disparity comes out 0 "
+        "(two views of the scene are needed)"
+    )
+    assert check_pair_files(a, a + 1, f, tmp_path / "right.png") is None

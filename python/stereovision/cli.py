@@ -424,11 +424,16 @@ def _ground_outputs(
 def cmd_check(args: argparse.Namespace) -> int:
     """``stereovision check LEFT RIGHT [--calib F] [--fix OUT]``: is the pair (still)
     rectified? With ``--fix``, the rig's rotation corrected from the pair is written to OUT."""
-    from stereovision.io import imread
+    from stereovision.io import check_pair_files, imread
     from stereovision.rectification_check import check_rectification
 
     left = imread(args.left)
     right = imread(args.right)
+    same = (
+        None if left.shape != right.shape else check_pair_files(left, right, args.left, args.right)
+    )
+    if same:
+        warnings.warn(same, stacklevel=1)
     calib = _load_calibration(args.calib)
     fix = Path(args.fix) if args.fix else None
     if fix is not None:
@@ -511,11 +516,16 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     """``stereovision rectify LEFT RIGHT -o DIR [--calib F] [--force]``: the rectified pair,
     and with no calibration the homographies found from the pair's features (a pair already
     rectified is written as given, unless ``--force``)."""
-    from stereovision.io import imread, make_folder
+    from stereovision.io import check_pair_files, imread, make_folder
     from stereovision.rectification_check import check_rectification, draw_rectification_check
 
     left = imread(args.left)
     right = imread(args.right)
+    same = (
+        None if left.shape != right.shape else check_pair_files(left, right, args.left, args.right)
+    )
+    if same:
+        warnings.warn(same, stacklevel=1)
     calib = _load_calibration(args.calib)
     out = Path(args.output)
     if out.exists() and not out.is_dir():

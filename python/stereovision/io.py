@@ -195,6 +195,80 @@ def _describe(a: np.ndarray) -> str:
     return f"shape {a.shape} dtype {a.dtype}"
 
 
+def image_size_text(image: np.ndarray) -> str:
+    """An image's size as the project writes it: ``"450x375 (colour)"``, ``"(grey)"`` for one
+    channel, ``"(4 channels)"`` otherwise.
+
+    Parameters
+    ----------
+    image : numpy.ndarray
+        ``(H, W)`` or ``(H, W, C)`` image.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> image_size_text(np.zeros((375, 450, 3), np.uint8))
+    '450x375 (colour)'
+    >>> image_size_text(np.zeros((2, 3), np.uint8))
+    '3x2 (grey)'
+    """
+    h, w = image.shape[:2]
+    c = image.shape[2] if image.ndim == 3 else 1
+    kind = "grey" if c == 1 else "colour" if c == 3 else f"{c} channels"
+    return f"{w}x{h} ({kind})"
+
+
+def check_pair_files(
+    left: np.ndarray,
+    right: np.ndarray,
+    left_path: PathLike,
+    right_path: PathLike,
+    names: tuple[str, str] | None = None,
+) -> str | None:
+    """Check a pair read from two files: the same size, and not one file (or image) twice.
+
+    Parameters
+    ----------
+    left, right : numpy.ndarray
+        The two images as read.
+    left_path, right_path : str or os.PathLike
+        The files they came from (named in the messages).
+    names : tuple of str, optional
+        How to name the two files instead (e.g. the GUI's short labels).
+
+    Returns
+    -------
+    str or None
+        A warning when both are the same file or the same pixels (every disparity would come
+        out 0), else None. The caller shows it (the CLI as a warning, the GUI on the page).
+
+    Raises
+    ------
+    ValueError
+        If their sizes differ, e.g. ``"left.png is 450x375 (colour), right.png is 384x288
+        (colour): the two images of a pair have one size"``.
+    """
+    ln, rn = names if names is not None else (str(left_path), str(right_path))
+    if left.shape != right.shape:
+        raise ValueError(
+            f"{ln} is {image_size_text(left)}, {rn} is {image_size_text(right)}: the two "
+            "images of a pair have one size"
+        )
+    try:
+        same_file = os.path.samefile(left_path, right_path)
+    except OSError:
+        same_file = False
+    if same_file or np.array_equal(left, right):
+        return (
+            f"{ln} and {rn} are the same {'file' if same_file else 'image'}: every disparity "
+            "comes out 0 (two views of the scene are needed)"
+        )
+    return None
+
+
 def _existing_file(path: PathLike, what: str) -> Path:
     p = Path(path)
     if not p.exists():
@@ -794,7 +868,8 @@ def load_scene(directory: PathLike) -> Scene:
     right = imread(d / "right.png")
     if left.shape != right.shape:
         raise ValueError(
-            f"scene {d}: left.png {left.shape} and right.png {right.shape} differ in size"
+            f"scene {d}: left.png is {image_size_text(left)}, right.png is "
+            f"{image_size_text(right)}: the two images of a pair have one size"
         )
     gt: npt.NDArray[np.float32] | None = None
     gt_path = d / "gt_disp.pfm"
@@ -802,7 +877,8 @@ def load_scene(directory: PathLike) -> Scene:
         gt = read_pfm(gt_path)
         if gt.shape != left.shape[:2]:
             raise ValueError(
-                f"scene {d}: gt_disp.pfm has shape {gt.shape}, left.png {left.shape[:2]}"
+                f"scene {d}: gt_disp.pfm is {gt.shape[1]}x{gt.shape[0]}, left.png "
+                f"{left.shape[1]}x{left.shape[0]}"
             )
         gt[~np.isfinite(gt)] = np.nan
     calib: Calibration | None = None

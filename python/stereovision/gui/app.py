@@ -616,7 +616,12 @@ class StereoApp:
             raise OSError("no camera open: give --left/--right or open cameras below")
         left, right = self.source.read()
         if left.shape != right.shape:
-            raise ValueError(f"the cameras give different sizes: {left.shape} and {right.shape}")
+            from stereovision.io import image_size_text
+
+            raise ValueError(
+                f"the cameras give different sizes: left {image_size_text(left)}, right "
+                f"{image_size_text(right)}"
+            )
         averaged = ""
         if self.state.average:
             from stereovision.temporal import TemporalFilter
@@ -738,13 +743,14 @@ class StereoApp:
 
     def load_files(self) -> None:
         """Use the chosen left / right image files (calibration: ``--calib`` if its size fits)."""
-        from stereovision.io import imread
+        from stereovision.io import check_pair_files, imread
 
         try:  # an emptied field sends None
-            left = imread(self.folders.resolve(self.state.left_file or ""))
-            right = imread(self.folders.resolve(self.state.right_file or ""))
-            if left.shape != right.shape:
-                raise ValueError(f"left {left.shape} and right {right.shape} differ in size")
+            lpath = self.folders.resolve(self.state.left_file or "")
+            rpath = self.folders.resolve(self.state.right_file or "")
+            left, right = imread(lpath), imread(rpath)
+            labels = (self.folders.label(lpath), self.folders.label(rpath))
+            same = check_pair_files(left, right, lpath, rpath, names=labels)
         except (ValueError, OSError) as exc:
             self._fail(exc)
             return
@@ -763,7 +769,9 @@ class StereoApp:
         self._no_calib = "the --calib calibration does not fit these images" if note else None
         self.max_disparity = None
         self.state.source_label = "files"
-        self.state.rows_label = note
+        self.state.rows_label = "; ".join(
+            n for n in (f"warning: {same}" if same else "", note) if n
+        )
         self._spawn(self.recompute())
 
     def open_cloud(self) -> None:
