@@ -151,7 +151,7 @@ def gabor_disparity(
             continue
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 0 <= v < 2**31:
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
-    # The kernel checks both radii in one test and names research_radius for either.
+    # Older kernels checked both radii in one test and named research_radius for either.
     if kw["search_pool_radius"] > 16:
         raise ValueError(
             f"search_pool_radius must be at most 16 px, got {kw['search_pool_radius']!r}"

@@ -181,7 +181,10 @@ pub fn grey_from_u8(
             format!("must be 1, 3 or 4, got {channels}"),
         ));
     }
-    if width == 0 || height == 0 || data.len() != width * height * channels {
+    if width == 0 || height == 0 {
+        return Err(CoreError::EmptyImage { width, height });
+    }
+    if data.len() != width * height * channels {
         return Err(CoreError::param(
             "image",
             format!(
@@ -241,5 +244,29 @@ mod tests {
             Err(CoreError::SizeMismatch { .. })
         ));
         assert_eq!(Image::new(2, 1, vec![0.25, 0.5]).unwrap().at(1, 0), 0.5);
+    }
+
+    #[test]
+    fn an_empty_8_bit_image_is_an_empty_image() {
+        // It said "buffer of 0 bytes does not hold 0x5x3".
+        let w = [1.0 / 3.0; 3];
+        assert_eq!(
+            grey_from_u8(&[], 5, 0, 3, w),
+            Err(CoreError::EmptyImage {
+                width: 5,
+                height: 0
+            })
+        );
+        assert_eq!(
+            grey_from_u8(&[], 0, 4, 1, w),
+            Err(CoreError::EmptyImage {
+                width: 0,
+                height: 4
+            })
+        );
+        assert!(matches!(
+            grey_from_u8(&[0; 5], 2, 2, 1, w),
+            Err(CoreError::InvalidParameter { name: "image", .. })
+        ));
     }
 }

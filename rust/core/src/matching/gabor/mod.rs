@@ -231,11 +231,13 @@ impl GaborParams {
         if !(self.stability_tau.is_finite() && self.stability_tau > 0.0) {
             return Err(CoreError::param("stability_tau", "must be finite and > 0"));
         }
-        if self.research_radius > 16 || self.search_pool_radius > 16 {
-            return Err(CoreError::param(
-                "research_radius",
-                "radii must be <= 16 px",
-            ));
+        for (name, r) in [
+            ("research_radius", self.research_radius),
+            ("search_pool_radius", self.search_pool_radius),
+        ] {
+            if r > 16 {
+                return Err(CoreError::param(name, format!("must be <= 16 px, got {r}")));
+            }
         }
         if let Some(s) = self.smooth_sigma {
             if !(s.is_finite() && s > 0.0 && s <= 16.0) {

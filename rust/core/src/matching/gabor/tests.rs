@@ -142,6 +142,31 @@ fn bad_parameters_are_errors() {
             "{p:?}"
         );
     }
+    // Each radius check names its own parameter (both said `research_radius`).
+    for (p, name) in [
+        (
+            GaborParams {
+                research_radius: 17,
+                ..GaborParams::default()
+            },
+            "research_radius",
+        ),
+        (
+            GaborParams {
+                search_pool_radius: 17,
+                ..GaborParams::default()
+            },
+            "search_pool_radius",
+        ),
+    ] {
+        match gabor_disparity(&a, &a, &p) {
+            Err(CoreError::InvalidParameter { name: got, reason }) => {
+                assert_eq!(got, name);
+                assert_eq!(reason, "must be <= 16 px, got 17");
+            }
+            other => panic!("{name}: {other:?}"),
+        }
+    }
     let b = Image::filled(17, 16, 0.5);
     assert!(matches!(
         gabor_disparity(&a, &b, &GaborParams::default()),
