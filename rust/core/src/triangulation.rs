@@ -38,13 +38,23 @@ pub fn depth_rectified(
 ) -> Result<(Vec<f32>, Vec<f32>)> {
     check_map_pair(disp, conf, w, h)?;
     let n = w * h;
-    for (name, v) in [("fb", fb), ("doffs", doffs), ("s0", sigma.s0)] {
+    for (name, v) in [
+        ("fb", fb),
+        ("doffs", doffs),
+        ("s0", sigma.s0),
+        ("slope", sigma.slope),
+        ("s_min", sigma.s_min),
+        ("s_fill", sigma.s_fill),
+    ] {
         if !v.is_finite() {
             return Err(CoreError::param(name, format!("must be finite, got {v}")));
         }
     }
-    if fb <= 0.0 {
-        return Err(CoreError::param("fb", format!("must be > 0, got {fb}")));
+    // A sigma of zero or below made every pixel's sigma_d (hence its depth sigma) <= 0.
+    for (name, v) in [("fb", fb), ("s_min", sigma.s_min), ("s_fill", sigma.s_fill)] {
+        if v <= 0.0 {
+            return Err(CoreError::param(name, format!("must be > 0, got {v}")));
+        }
     }
     let mut depth = vec![0f32; n];
     let mut sig = vec![0f32; n];
@@ -56,10 +66,12 @@ pub fn depth_rectified(
         for x in 0..w {
             let denom = d[x] + doffs;
             let z = fb / denom;
-            let sd = if c[x] < 0.0 {
+            // A NaN confidence counts as 0 (it got s_min, the smallest sigma, through `max`).
+            let cx = if c[x].is_nan() { 0.0 } else { c[x] };
+            let sd = if cx < 0.0 {
                 sigma.s_fill
             } else {
-                (sigma.s0 + sigma.slope * c[x].clamp(0.0, 1.0)).max(sigma.s_min)
+                (sigma.s0 + sigma.slope * cx.clamp(0.0, 1.0)).max(sigma.s_min)
             };
             let ok = denom > 0.0 && denom > sd && z.is_finite();
             zrow[x] = if ok { z } else { f32::NAN };
@@ -123,5 +135,63 @@ mod tests {
         assert!(depth_rectified(&[1.0; 4], &[1.0; 4], 2, 2, 0.0, 0.0, M).is_err());
         assert!(depth_rectified(&[1.0; 4], &[1.0; 4], 2, 2, f32::NAN, 0.0, M).is_err());
         assert!(depth_rectified(&[1.0; 4], &[1.0; 3], 2, 2, 1.0, 0.0, M).is_err());
+    }
+
+    #[test]
+    fn rejects_bad_sigma_models() {
+        let bad = [
+            ("s0", SigmaModel { s0: f32::NAN, ..M }),
+            (
+                "slope",
+                SigmaModel {
+                    slope: f32::INFINITY,
+                    ..M
+                },
+            ),
+            (
+                "s_min",
+                SigmaModel {
+                    s_min: f32::NAN,
+                    ..M
+                },
+            ),
+            ("s_min", SigmaModel { s_min: -0.2, ..M }),
+            ("s_min", SigmaModel { s_min: 0.0, ..M }),
+            ("s_fill", SigmaModel { s_fill: -0.9, ..M }),
+            (
+                "s_fill",
+                SigmaModel {
+                    s_fill: f32::NAN,
+                    ..M
+                },
+            ),
+        ];
+        for (name, m) in bad {
+            match depth_rectified(&[8.0; 4], &[0.5; 4], 2, 2, 50.0, 0.0, m) {
+                Err(CoreError::InvalidParameter { name: got, .. }) => assert_eq!(got, name),
+                other => panic!("{name}: {other:?}"),
+            }
+        }
+        // A negative s0 alone is fine: s_min bounds sigma_d from below.
+        let (_, s) = depth_rectified(
+            &[8.0],
+            &[0.0],
+            1,
+            1,
+            50.0,
+            0.0,
+            SigmaModel { s0: -1.0, ..M },
+        )
+        .unwrap();
+        assert!((s[0] - 6.25 * 0.2 / 8.0).abs() < 1e-7);
+    }
+
+    #[test]
+    fn a_nan_confidence_counts_as_zero() {
+        // It got s_min (0.2), the smallest sigma; confidence 0 gives s0 = 0.74.
+        let (z, s) = depth_rectified(&[8.0, 8.0], &[f32::NAN, 0.0], 2, 1, 50.0, 2.0, M).unwrap();
+        assert_eq!(z[0], 5.0);
+        assert_eq!(s[0], s[1]);
+        assert!((s[0] - 5.0 * 0.74 / 10.0).abs() < 1e-7);
     }
 }
