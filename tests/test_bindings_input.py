@@ -3,11 +3,17 @@ an internal error from a panic, nor a result computed from garbage without a wor
 
 from __future__ import annotations
 
+import os
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+if sys.platform == "linux":
+    import resource
 
 import stereovision as sv
 from stereovision import _core
@@ -193,3 +199,67 @@ def test_mcgm_sides_best_margin_is_checked(
     assert len(sv.match(*crop, method="mcgm", max_disparity=32).xl) > 50
     with pytest.raises(ValueError, match="sides_best_margin"):
         sv.match(*crop, method="mcgm", max_disparity=32, sides_best_margin=value)
+
+
+#: Run under ``ulimit -v`` (RLIMIT_AS) in a child: a failed allocation aborted the whole
+#: process (SIGABRT, exit -6) instead of raising MemoryError.
+_OOM_SCRIPT = """
+import numpy as np
+from stereovision import _core
+from stereovision.matching import sgm
+case = {case!r}
+try:
+    if case == "sgm":
+        a = np.random.default_rng(0).random((1500, 2000), dtype=np.float32)
+        _core.sgm_disparity(a, a, 0, 2047, 8, 96, 16.0, 5, 1, 4)
+    elif case == "broadcast":
+        _core.gabor_responses(np.broadcast_to(np.float32(0.5), (100_000, 100_000)))
+    elif case == "available":
+        print("available", sgm._available_bytes())
+        raise MemoryError("none")
+except MemoryError as e:
+    print("MemoryError:", e)
+"""
+
+
+def _under_address_limit(case: str, limit: int) -> subprocess.CompletedProcess[str]:
+    def limit_address_space() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    return subprocess.run(
+        [sys.executable, "-c", _OOM_SCRIPT.format(case=case)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+        preexec_fn=limit_address_space,
+    )
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+@pytest.mark.parametrize(
+    ("case", "message"),
+    [
+        (
+            "sgm",
+            "out of memory: the census matcher's cost volume needs 5.72 GiB (6144000000 bytes)",
+        ),
+        ("broadcast", "out of memory: a copy of img needs 37.25 GiB (40000000000 bytes)"),
+    ],
+)
+def test_a_failed_allocation_is_a_memory_error(case: str, message: str) -> None:
+    out = _under_address_limit(case, 3_000_000 * 1024)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    assert f"MemoryError: {message} and the allocation failed" in out.stdout, out.stdout
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+def test_the_census_memory_check_counts_the_address_space_limit() -> None:
+    """``_available_bytes`` read MemAvailable and cgroups only: under ``ulimit -v`` the check
+    passed and the kernel's allocation failed."""
+    limit = 3_000_000 * 1024
+    out = _under_address_limit("available", limit)
+    assert out.returncode == 0, out.stderr[-2000:]
+    avail = int(out.stdout.split()[1])
+    assert 0 < avail < limit

@@ -50,9 +50,30 @@ _ROWS_IN_FLIGHT_3 = 8 + 3
 _MAX_LEVELS = 2048  # the kernel's limit
 
 
+def _address_space_room() -> int | None:
+    """Bytes of address space left under the process's ``RLIMIT_AS`` (``ulimit -v``): the soft
+    limit less the current ``VmSize``; None without a limit or where either cannot be read."""
+    try:
+        import resource
+    except ImportError:  # not on Windows
+        return None
+    try:
+        soft, _ = resource.getrlimit(resource.RLIMIT_AS)
+        if soft == resource.RLIM_INFINITY:
+            return None
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith("VmSize:"):
+                    return max(soft - int(line.split()[1]) * 1024, 0)
+    except (OSError, ValueError):
+        pass
+    return None
+
+
 def _available_bytes() -> int | None:
     """Memory this process can still take: Linux's MemAvailable, lowered by a cgroup v2 limit
-    (a container's ``memory.max``) when one is set; None where neither can be read."""
+    (a container's ``memory.max``) and by the address space left under ``RLIMIT_AS``
+    (``ulimit -v``) when they are set; None where none can be read."""
     avail: int | None = None
     try:
         with open("/proc/meminfo") as f:
@@ -71,6 +92,9 @@ def _available_bytes() -> int | None:
             avail = room if avail is None else min(avail, room)
     except (OSError, ValueError):
         pass
+    as_room = _address_space_room()
+    if as_room is not None:
+        avail = as_room if avail is None else min(avail, as_room)
     return avail
 
 
@@ -128,7 +152,8 @@ def sgm_disparity(
         parameter out of its range.
     MemoryError
         When the kernel's peak (3 bytes per pixel and disparity level) exceeds the memory
-        available (Linux's MemAvailable, or a container's cgroup limit), before allocating it.
+        available (Linux's MemAvailable, a container's cgroup limit, or the address space left
+        under ``ulimit -v``), before allocating it; or when an allocation fails anyway.
     """
     unknown = sorted(set(params) - set(DEFAULTS))
     if unknown:

@@ -16,6 +16,8 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::Mutex;
 
+use crate::error::{CoreError, Result};
+
 /// Smallest block kept (bytes): below glibc's default mmap threshold blocks are cheap to get.
 pub const MIN_CACHED: usize = 128 * 1024;
 /// Most bytes kept in all.
@@ -211,9 +213,102 @@ unsafe impl GlobalAlloc for BlockCache {
     }
 }
 
+/// `bytes` for a message: "6.00 GiB (6442450944 bytes)".
+pub fn human_bytes(bytes: usize) -> String {
+    let (v, unit) = if bytes >= 1 << 30 {
+        (bytes as f64 / (1u64 << 30) as f64, "GiB")
+    } else if bytes >= 1 << 20 {
+        (bytes as f64 / (1u64 << 20) as f64, "MiB")
+    } else {
+        return format!("{bytes} bytes");
+    };
+    format!("{v:.2} {unit} ({bytes} bytes)")
+}
+
+/// Types whose all-zero bit pattern is the value zero (so a zeroed allocation holds zeros).
+///
+/// # Safety
+/// Every bit pattern of zeros must be a valid value of the type.
+pub unsafe trait ZeroBits: Copy {}
+// SAFETY: plain integers and IEEE floats: all-zero bits are 0 / +0.0.
+unsafe impl ZeroBits for u8 {}
+// SAFETY: as above.
+unsafe impl ZeroBits for u16 {}
+// SAFETY: as above.
+unsafe impl ZeroBits for u32 {}
+// SAFETY: as above.
+unsafe impl ZeroBits for u64 {}
+// SAFETY: as above.
+unsafe impl ZeroBits for i16 {}
+// SAFETY: as above.
+unsafe impl ZeroBits for i32 {}
+// SAFETY: as above.
+unsafe impl ZeroBits for f32 {}
+
+/// `vec![T::zero; n]` that returns [`CoreError::OutOfMemory`] instead of aborting the process
+/// when the allocation fails. The same zeroed allocation as `vec!` (pages the system hands out
+/// zeroed are not written).
+pub fn try_zeroed<T: ZeroBits>(n: usize, what: &'static str) -> Result<Vec<T>> {
+    let size = std::mem::size_of::<T>();
+    if n == 0 || size == 0 {
+        return Ok(Vec::new());
+    }
+    let layout = Layout::array::<T>(n).map_err(|_| CoreError::oom(n.saturating_mul(size), what))?;
+    // SAFETY: `layout` has a non-zero size.
+    let p = unsafe { std::alloc::alloc_zeroed(layout) }.cast::<T>();
+    if p.is_null() {
+        return Err(CoreError::oom(layout.size(), what));
+    }
+    // SAFETY: `p` comes from the global allocator with `Layout::array::<T>(n)`, the layout a
+    // `Vec<T>` of capacity `n` has, and holds `n` zeroed (valid, by `ZeroBits`) values.
+    Ok(unsafe { Vec::from_raw_parts(p, n, n) })
+}
+
+/// `vec![value; n]` that returns [`CoreError::OutOfMemory`] instead of aborting the process.
+pub fn try_filled<T: Clone>(n: usize, value: T, what: &'static str) -> Result<Vec<T>> {
+    let mut v = Vec::new();
+    try_reserve_len(&mut v, n, what)?;
+    v.resize(n, value);
+    Ok(v)
+}
+
+/// Makes room in `v` for `n` values in all (not `n` more), or returns
+/// [`CoreError::OutOfMemory`]; the values are not changed.
+pub fn try_reserve_len<T>(v: &mut Vec<T>, n: usize, what: &'static str) -> Result<()> {
+    let more = n.saturating_sub(v.len());
+    v.try_reserve_exact(more)
+        .map_err(|_| CoreError::oom(n.saturating_mul(std::mem::size_of::<T>()), what))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fallible_allocations_fail_with_the_size() {
+        // Far more than any address space holds: an error naming the size, not an abort.
+        let n = usize::MAX / 4;
+        let e = try_zeroed::<u16>(n, "the test buffer").unwrap_err();
+        assert_eq!(e, CoreError::oom(n * 2, "the test buffer"));
+        assert!(e
+            .to_string()
+            .starts_with("out of memory: the test buffer needs "));
+        let e = try_zeroed::<u64>(n, "x").unwrap_err();
+        assert_eq!(e, CoreError::oom(usize::MAX, "x"));
+        assert!(matches!(
+            try_filled(1usize << 60, 1.0f32, "y"),
+            Err(CoreError::OutOfMemory { what: "y", .. })
+        ));
+        let mut v = vec![1u8; 3];
+        assert!(try_reserve_len(&mut v, usize::MAX, "z").is_err());
+        assert_eq!(v, [1, 1, 1]);
+        // Success: the same values as `vec!`.
+        assert_eq!(try_zeroed::<f32>(5, "a").unwrap(), vec![0.0f32; 5]);
+        assert_eq!(try_zeroed::<u8>(0, "a").unwrap(), Vec::<u8>::new());
+        assert_eq!(try_filled(4, f32::NAN, "b").unwrap().len(), 4);
+        assert_eq!(human_bytes(3 << 30), "3.00 GiB (3221225472 bytes)");
+        assert_eq!(human_bytes(512), "512 bytes");
+    }
 
     #[test]
     fn reuses_exact_layouts_and_keeps_the_bounds() {

@@ -30,6 +30,10 @@ pub enum CoreError {
     /// A parameter is out of its valid range.
     #[error("invalid parameter `{name}`: {reason}")]
     InvalidParameter { name: &'static str, reason: String },
+    /// A buffer could not be allocated (the binding raises `MemoryError` instead of the
+    /// process aborting).
+    #[error("out of memory: {what} needs {} and the allocation failed", crate::alloc::human_bytes(*.bytes))]
+    OutOfMemory { bytes: usize, what: &'static str },
 }
 
 /// Result alias used across the core.
@@ -42,5 +46,10 @@ impl CoreError {
             name,
             reason: reason.into(),
         }
+    }
+
+    /// Convenience constructor for [`CoreError::OutOfMemory`].
+    pub fn oom(bytes: usize, what: &'static str) -> Self {
+        CoreError::OutOfMemory { bytes, what }
     }
 }

@@ -2,7 +2,7 @@
 
 use std::borrow::Cow;
 
-use numpy::ndarray::{Array2, Dimension};
+use numpy::ndarray::{Array2, ArrayView, Dimension};
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -20,24 +20,39 @@ pub fn c_slice<'a, T: numpy::Element, D: Dimension>(
     }
 }
 
-/// The array's values in row-major order: its own buffer when C-contiguous, else a copy.
+/// The view's values in row-major order in a new vector; a failed allocation is a
+/// `MemoryError` naming the size (a huge broadcast array aborted the process).
+fn copy_row_major<T: Copy, D: Dimension>(
+    view: ArrayView<'_, T, D>,
+    what: &str,
+) -> PyResult<Vec<T>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(view.len())
+        .map_err(|_| crate::errors::copy_oom::<T>(view.len(), what))?;
+    match view.as_slice() {
+        Some(s) => v.extend_from_slice(s),
+        None => v.extend(view.iter().copied()),
+    }
+    Ok(v)
+}
+
+/// The array's values in row-major order: its own buffer when C-contiguous, else a copy
+/// (`what` names the array in a `MemoryError`).
 pub fn row_major<'a, T: numpy::Element + Copy, D: Dimension>(
     a: &'a PyReadonlyArray<'_, T, D>,
-) -> Cow<'a, [T]> {
-    match c_slice(a) {
+    what: &str,
+) -> PyResult<Cow<'a, [T]>> {
+    Ok(match c_slice(a) {
         Some(s) => Cow::Borrowed(s),
-        None => Cow::Owned(a.as_array().iter().copied().collect()),
-    }
+        None => Cow::Owned(copy_row_major(a.as_array(), what)?),
+    })
 }
 
 /// Copies a 2-D float32 array into a core [`Image`] (validated: non-empty, finite).
 pub fn image_from_numpy(arr: &PyReadonlyArray2<'_, f32>, what: &str) -> PyResult<Image> {
     let view = arr.as_array();
     let (h, w) = view.dim();
-    let data: Vec<f32> = match view.as_slice() {
-        Some(s) => s.to_vec(),
-        None => view.iter().copied().collect(),
-    };
+    let data = copy_row_major(view, what)?;
     Image::new(w, h, data).map_err(|e| PyValueError::new_err(format!("{what}: {e}")))
 }
 
@@ -82,11 +97,12 @@ pub fn image_to_numpy<'py>(py: Python<'py>, img: Image) -> PyResult<Bound<'py, P
 pub fn map_copy_in_place<'py, R: Send>(
     py: Python<'py>,
     map: &PyReadonlyArray2<'py, f32>,
+    what: &str,
     kernel: impl FnOnce(&mut [f32], usize, usize) -> R + Send,
 ) -> PyResult<(Bound<'py, PyArray2<f32>>, R)> {
     let a = map.as_array();
     let (h, w) = a.dim();
-    let mut d: Vec<f32> = a.iter().copied().collect();
+    let mut d = copy_row_major(a, what)?;
     let r = crate::workers::detach(py, || kernel(&mut d, w, h));
     Ok((vec_to_numpy(py, (h, w), d)?, r))
 }

@@ -1,6 +1,6 @@
 //! One place that maps core errors (and stray panics) to Python exceptions.
 
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::PyErr;
 use stereovision_core::CoreError;
 
@@ -12,7 +12,17 @@ pub fn to_pyerr(err: CoreError) -> PyErr {
         | CoreError::SizeMismatch { .. }
         | CoreError::NonFinite { .. }
         | CoreError::InvalidParameter { .. } => PyValueError::new_err(err.to_string()),
+        CoreError::OutOfMemory { .. } => PyMemoryError::new_err(err.to_string()),
     }
+}
+
+/// `MemoryError` for a copy of `n` values of `T` the binding could not allocate.
+pub fn copy_oom<T>(n: usize, what: &str) -> PyErr {
+    let bytes = n.saturating_mul(std::mem::size_of::<T>());
+    PyMemoryError::new_err(format!(
+        "out of memory: a copy of {what} needs {} and the allocation failed",
+        stereovision_core::alloc::human_bytes(bytes)
+    ))
 }
 
 /// Runs a kernel, turning a panic into a `RuntimeError` so no `PanicException` (a

@@ -15,7 +15,7 @@ pub fn row_fill<'py>(
     py: Python<'py>,
     disp: PyReadonlyArray2<'py, f32>,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let (out, done) = map_copy_in_place(py, &disp, |d, w, _| {
+    let (out, done) = map_copy_in_place(py, &disp, "disp", |d, w, _| {
         guard("row_fill", || {
             core_row_fill(d, w);
             Ok(())
@@ -42,8 +42,8 @@ pub fn side_fill<'py>(
             lab.shape()
         )));
     }
-    let lab = row_major(&lab);
-    let (out, done) = map_copy_in_place(py, &disp, |d, w, _| {
+    let lab = row_major(&lab, "lab")?;
+    let (out, done) = map_copy_in_place(py, &disp, "disp", |d, w, _| {
         guard("side_fill", || {
             core_side_fill(d, &lab, w, tau);
             Ok(())
@@ -73,7 +73,7 @@ pub fn fattened<'py>(
             guide.as_array().dim()
         )));
     }
-    let (d, g) = (row_major(&disp), row_major(&guide));
+    let (d, g) = (row_major(&disp, "disp")?, row_major(&guide, "guide")?);
     let p = FattenParams {
         radius,
         ratio,

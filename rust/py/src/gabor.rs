@@ -292,7 +292,7 @@ pub fn gabor_remove_speckles<'py>(
             Ok(())
         })
     };
-    let (out, done) = crate::convert::map_copy_in_place(py, &disp, kernel)?;
+    let (out, done) = crate::convert::map_copy_in_place(py, &disp, "disp", kernel)?;
     done?;
     Ok(out)
 }

@@ -33,7 +33,7 @@ pub fn graph_segments<'py>(
     if a.iter().any(|v| !v.is_finite()) {
         return Err(PyValueError::new_err("image: contains NaN or inf"));
     }
-    let img = row_major(&image);
+    let img = row_major(&image, "image")?;
     let labels = crate::workers::detach(py, || {
         guard("graph_segments", || {
             Ok(core_segments(&img, w, h, c, k, min_size))
@@ -76,7 +76,7 @@ pub fn plane_fill<'py>(
             "lo and hi: expected lo <= hi, got lo = {lo}, hi = {hi}"
         )));
     }
-    let l = row_major(&labels);
+    let l = row_major(&labels, "labels")?;
     // The kernel sizes its tables by the largest label: one per pixel at most.
     if l.iter().any(|&v| v as usize >= h * w) {
         return Err(PyValueError::new_err(format!(
@@ -84,7 +84,7 @@ pub fn plane_fill<'py>(
             h * w
         )));
     }
-    let (out, s) = map_copy_in_place(py, &disp, |d, w, _| {
+    let (out, s) = map_copy_in_place(py, &disp, "disp", |d, w, _| {
         guard("plane_fill", || {
             Ok(core_plane_fill(d, &l, w, min_pixels, max_residual, lo, hi))
         })
@@ -114,7 +114,7 @@ pub fn quantised_regions<'py>(
             "step must be in 1-255 and offset in 0-255, got step={step}, offset={offset}"
         )));
     }
-    let img = row_major(&image);
+    let img = row_major(&image, "image")?;
     let labels = crate::workers::detach(py, || {
         guard("quantised_regions", || {
             Ok(core_regions(&img, w, h, c, step, offset))
@@ -148,8 +148,8 @@ pub fn fill_planes<'py>(
         )));
     }
     non_negative("max_residual", max_residual)?;
-    let img = row_major(&image);
-    let (out, done) = map_copy_in_place(py, &disp, |d, w, _| {
+    let img = row_major(&image, "image")?;
+    let (out, done) = map_copy_in_place(py, &disp, "disp", |d, w, _| {
         guard("fill_planes", || {
             core_fill_planes(d, &img, w, c, &passes, max_residual);
             Ok(())

@@ -31,6 +31,7 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
+use crate::alloc::{try_filled, try_reserve_len, try_zeroed};
 use crate::error::{CoreError, Result};
 use crate::image::ImageView;
 use crate::simd::simd_fn;
@@ -727,18 +728,34 @@ pub fn sgm_disparity(
     }
     let (w, h) = (left.width, left.height);
     if p.paths == 3 {
-        return Ok(sgm_three_paths(left, right, i64::from(d_min), n, p));
+        return sgm_three_paths(left, right, i64::from(d_min), n, p);
     }
+    let mut out = try_filled(w * h, f32::NAN, "the census matcher's disparity map")?;
     let (cl, cr) = rayon::join(|| census(left), || census(right));
     let (mut c, rows) = kept::take(w * n);
+    // The cost volume (w h n bytes) is the largest buffer: a failed allocation is an error,
+    // not an abort of the process.
+    try_reserve_len(&mut c, cl.len() * n, "the census matcher's cost volume")?;
     cost_volume_into(&cl, &cr, w, i64::from(d_min), n, &mut c);
     drop((cl, cr));
     // Row buffers of `w * n` sums: the kept ones first, then fresh ones; a row's buffer goes
     // back to this list once both passes have added into it.
     let free = Mutex::new(rows);
-    let fresh = || {
+    // Set when a row buffer could not be allocated: the passes then run on (their sums are
+    // dropped, not parked) and the call returns the error.
+    let starved = std::sync::atomic::AtomicBool::new(false);
+    let fresh = || -> Option<Vec<u16>> {
         let kept = free.lock().unwrap_or_else(|e| e.into_inner()).pop();
-        kept.unwrap_or_else(|| vec![0u16; w * n])
+        match kept {
+            Some(r) => Some(r),
+            None => {
+                let r = try_zeroed(w * n, "the census matcher's row sums").ok();
+                if r.is_none() {
+                    starved.store(true, std::sync::atomic::Ordering::Relaxed);
+                }
+                r
+            }
+        }
     };
     // The two passes meet row by row: whichever reaches a row first leaves its sum there; the
     // second adds its own and selects the row. One volume of sums is held at most (the rows
@@ -759,7 +776,9 @@ pub fn sgm_disparity(
                 match slot.take() {
                     Some(other) => other,
                     None => {
-                        *slot = Some(std::mem::replace(row, fresh()));
+                        if let Some(next) = fresh() {
+                            *slot = Some(std::mem::replace(row, next));
+                        }
                         return;
                     }
                 }
@@ -770,14 +789,21 @@ pub fn sgm_disparity(
             select_row(row, w, n, i64::from(d_min), p, &mut o);
             done.push((y, o));
         };
-        let mut row = fresh();
+        let Some(mut row) = fresh() else {
+            return done;
+        };
         pass(&c, left.data, w, h, n, p, forward, &mut row, &mut emit);
         free.lock().unwrap_or_else(|e| e.into_inner()).push(row);
         done
     };
     let (a, b) = rayon::join(|| meet(true), || meet(false));
     kept::put(c, free.into_inner().unwrap_or_else(|e| e.into_inner()));
-    let mut out = vec![f32::NAN; w * h];
+    if starved.into_inner() {
+        return Err(CoreError::oom(
+            h.saturating_mul(w * n * 2),
+            "the census matcher's row sums",
+        ));
+    }
     for (y, o) in a.into_iter().chain(b) {
         out[y * w..(y + 1) * w].copy_from_slice(&o);
     }
@@ -989,7 +1015,7 @@ fn sgm_three_paths(
     d_min: i64,
     n: usize,
     p: &SgmParams,
-) -> Vec<f32> {
+) -> Result<Vec<f32>> {
     let lut = p2_table(p);
     if u8_fits(&lut) {
         three_paths_as::<u8>(left, right, d_min, n, p, &lut, horizontal_u8, vertical_u8)
@@ -1043,7 +1069,7 @@ fn three_paths_as<T: PathCost + Send>(
     lut: &[u16],
     horizontal: HorizontalFn<T>,
     vertical: VerticalFn<T>,
-) -> Vec<f32> {
+) -> Result<Vec<f32>> {
     use std::sync::{Condvar, Mutex, MutexGuard};
     fn lock(m: &Mutex<Flight>) -> MutexGuard<'_, Flight> {
         // Moves of whole rows only: a panic cannot leave it inconsistent.
@@ -1052,7 +1078,7 @@ fn three_paths_as<T: PathCost + Send>(
     let (w, h) = (left.width, left.height);
     let (cl, cr) = rayon::join(|| census(left), || census(right));
     let img = left.data;
-    let mut out = vec![f32::NAN; w * h];
+    let mut out = try_filled(w * h, f32::NAN, "the census matcher's disparity map")?;
     // The rows kept from the last call of this size first (a video's next frame).
     let flight = Mutex::new(Flight {
         ready: Default::default(),
@@ -1126,7 +1152,7 @@ fn three_paths_as<T: PathCost + Send>(
     rayon::join(first, second);
     drop(state);
     kept::put_pairs(flight.into_inner().unwrap_or_else(|e| e.into_inner()).free);
-    out
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -1350,8 +1376,9 @@ mod tests {
             .map(|(i, v)| if i % 13 < 2 { 1.0 } else { *v })
             .collect();
         let sv = ImageView::new(w, h, &spiky).unwrap();
-        let a = three_paths_as::<u8>(sv, rv, -3, 19, &p, &lut, horizontal_u8, vertical_u8);
-        let b = three_paths_as::<u16>(sv, rv, -3, 19, &p, &lut, horizontal_u16, vertical_u16);
+        let a = three_paths_as::<u8>(sv, rv, -3, 19, &p, &lut, horizontal_u8, vertical_u8).unwrap();
+        let b =
+            three_paths_as::<u16>(sv, rv, -3, 19, &p, &lut, horizontal_u16, vertical_u16).unwrap();
         assert_eq!(bits(&a), bits(&b));
         assert!(a.iter().filter(|v| v.is_finite()).count() > w * h / 3);
     }
