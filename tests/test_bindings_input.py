@@ -7,6 +7,7 @@ import os
 import re
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -199,6 +200,41 @@ def test_mcgm_sides_best_margin_is_checked(
     assert len(sv.match(*crop, method="mcgm", max_disparity=32).xl) > 50
     with pytest.raises(ValueError, match="sides_best_margin"):
         sv.match(*crop, method="mcgm", max_disparity=32, sides_best_margin=value)
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (
+            lambda a: _core.sgm_disparity(a.astype(np.float64), a, 0, 4, 8, 96, 16.0, 5, 1, 4),
+            "left: expected a float32 array, got float64",
+        ),
+        (
+            lambda a: _core.sgm_disparity(a, a.astype(np.float64), 0, 4, 8, 96, 16.0, 5, 1, 4),
+            "right: expected a float32 array, got float64",
+        ),
+        (
+            lambda a: _core.gray_u8(a, LUMA_WEIGHTS_BGR),
+            "image: expected a uint8 array, got float32",
+        ),
+        (
+            lambda a: _core.depth_rectified(a, a[None], 1.0, 0.0, 0.7, -0.5, 0.2, 0.9),
+            "conf: expected a 2-D float32 array, got 3 dimensions",
+        ),
+        (
+            lambda a: _core.depth_rectified(a.tolist(), a, 1.0, 0.0, 0.7, -0.5, 0.2, 0.9),
+            "disp: expected a float32 array, got list",
+        ),
+    ],
+)
+def test_a_wrong_array_type_names_the_argument(
+    call: Callable[[np.ndarray], object], message: str
+) -> None:
+    """The extension said only "type mismatch: from=float64, to=float32", naming neither the
+    argument nor (for a caller's eyes) what it expects."""
+    a = np.random.default_rng(0).random((12, 16), dtype=np.float32)
+    with pytest.raises(TypeError, match=re.escape(message)):
+        call(a)
 
 
 #: Run under ``ulimit -v`` (RLIMIT_AS) in a child: a failed allocation aborted the whole

@@ -3,8 +3,11 @@
 use std::borrow::Cow;
 
 use numpy::ndarray::{Array2, ArrayView, Dimension};
-use numpy::{IntoPyArray, PyArray2, PyReadonlyArray, PyReadonlyArray2, PyUntypedArrayMethods};
-use pyo3::exceptions::PyValueError;
+use numpy::{
+    IntoPyArray, PyArray2, PyArrayDescrMethods, PyReadonlyArray, PyReadonlyArray2,
+    PyReadwriteArray, PyUntypedArray, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use stereovision_core::{Image, ImageView};
 
@@ -17,6 +20,65 @@ pub fn c_slice<'a, T: numpy::Element, D: Dimension>(
         a.as_slice().ok()
     } else {
         None
+    }
+}
+
+/// The argument `name` as a read-only array of `T` and `D`'s dimensions. A wrong dtype or
+/// number of dimensions is a `TypeError` naming the argument and what it should be
+/// ("left: expected a float32 array, got float64"), not NumPy's bare "type mismatch".
+pub fn array_arg<'py, T: numpy::Element, D: Dimension>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+) -> PyResult<PyReadonlyArray<'py, T, D>> {
+    let err = match obj.extract::<PyReadonlyArray<'py, T, D>>() {
+        Ok(a) => return Ok(a),
+        Err(e) => e,
+    };
+    Err(describe_mismatch::<T, D>(obj, name).unwrap_or(err))
+}
+
+/// [`array_arg`] for an array the kernel writes into.
+pub fn array_arg_rw<'py, T: numpy::Element, D: Dimension>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+) -> PyResult<PyReadwriteArray<'py, T, D>> {
+    let err = match obj.extract::<PyReadwriteArray<'py, T, D>>() {
+        Ok(a) => return Ok(a),
+        Err(e) => e,
+    };
+    Err(describe_mismatch::<T, D>(obj, name).unwrap_or(err))
+}
+
+/// The `TypeError` for `obj` not being an array of `T` with `D`'s dimensions; None when it is
+/// one (the extraction failed for another reason, e.g. a borrow conflict, which then stands).
+fn describe_mismatch<T: numpy::Element, D: Dimension>(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+) -> Option<PyErr> {
+    let py = obj.py();
+    let want = numpy::dtype::<T>(py);
+    let Ok(arr) = obj.cast::<PyUntypedArray>() else {
+        let got = obj
+            .get_type()
+            .name()
+            .map_or_else(|_| "another type".to_string(), |n| n.to_string());
+        return Some(PyTypeError::new_err(format!(
+            "{name}: expected a {want} array, got {got}"
+        )));
+    };
+    let got = arr.dtype();
+    if !got.is_equiv_to(&want) {
+        return Some(PyTypeError::new_err(format!(
+            "{name}: expected a {want} array, got {got}"
+        )));
+    }
+    match D::NDIM {
+        Some(nd) if nd != arr.ndim() => Some(PyTypeError::new_err(format!(
+            "{name}: expected a {nd}-D {want} array, got {} dimensions (shape {:?})",
+            arr.ndim(),
+            arr.shape()
+        ))),
+        _ => None,
     }
 }
 
@@ -177,9 +239,10 @@ pub fn luma_weights(weights: (f32, f32, f32)) -> PyResult<[f32; 3]> {
 #[pyo3(signature = (image, weights))]
 pub fn gray_u8<'py>(
     py: Python<'py>,
-    image: numpy::PyReadonlyArrayDyn<'py, u8>,
+    image: &Bound<'py, PyAny>,
     weights: (f32, f32, f32),
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let image: numpy::PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(image, "image")?;
     let (h, w, c, data) = u8_layout(&image, "image")?;
     let wts = luma_weights(weights)?;
     let grey = crate::workers::detach(py, || {

@@ -13,8 +13,9 @@ use stereovision_core::fill::{row_fill as core_row_fill, side_fill as core_side_
 #[pyfunction]
 pub fn row_fill<'py>(
     py: Python<'py>,
-    disp: PyReadonlyArray2<'py, f32>,
+    disp: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     let (out, done) = map_copy_in_place(py, &disp, "disp", |d, w, _| {
         guard("row_fill", || {
             core_row_fill(d, w);
@@ -30,10 +31,12 @@ pub fn row_fill<'py>(
 #[pyo3(signature = (disp, lab, tau))]
 pub fn side_fill<'py>(
     py: Python<'py>,
-    disp: PyReadonlyArray2<'py, f32>,
-    lab: PyReadonlyArray3<'py, f32>,
+    disp: &Bound<'py, PyAny>,
+    lab: &Bound<'py, PyAny>,
     tau: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
+    let lab: PyReadonlyArray3<'py, f32> = crate::convert::array_arg(lab, "lab")?;
     non_negative("tau", tau)?;
     let (h, w) = disp.as_array().dim();
     if lab.shape() != [h, w, 3] {
@@ -58,12 +61,14 @@ pub fn side_fill<'py>(
 #[pyo3(signature = (disp, guide, radius, ratio, jump))]
 pub fn fattened<'py>(
     py: Python<'py>,
-    disp: PyReadonlyArray2<'py, f32>,
-    guide: PyReadonlyArray2<'py, f32>,
+    disp: &Bound<'py, PyAny>,
+    guide: &Bound<'py, PyAny>,
     radius: usize,
     ratio: f32,
     jump: f32,
 ) -> PyResult<Bound<'py, PyArray2<bool>>> {
+    let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
+    let guide: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(guide, "guide")?;
     non_negative("ratio", ratio)?;
     non_negative("jump", jump)?;
     let (h, w) = disp.as_array().dim();

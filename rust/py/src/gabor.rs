@@ -92,8 +92,8 @@ fn to_image(w: usize, h: usize, data: Vec<f32>) -> Image {
 #[allow(clippy::too_many_arguments)]
 pub fn gabor_disparity<'py>(
     py: Python<'py>,
-    left: PyReadonlyArray2<'py, f32>,
-    right: PyReadonlyArray2<'py, f32>,
+    left: &Bound<'py, PyAny>,
+    right: &Bound<'py, PyAny>,
     d_min: f32,
     d_max: f32,
     freq: f32,
@@ -119,6 +119,8 @@ pub fn gabor_disparity<'py>(
     speckle_size: usize,
     speckle_range: f32,
 ) -> PyResult<Pair<'py>> {
+    let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
+    let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
     // The NumPy buffers themselves (no copy of the pair); read-only borrows held across the call.
     let (lg, rg) = (
         grey_from_numpy(&left, "left")?,
@@ -163,12 +165,13 @@ pub fn gabor_disparity<'py>(
 #[pyo3(signature = (img, freq=0.25, theta_deg=0.0, bandwidth_oct=1.5, aspect=1.0))]
 pub fn gabor_responses<'py>(
     py: Python<'py>,
-    img: PyReadonlyArray2<'py, f32>,
+    img: &Bound<'py, PyAny>,
     freq: f32,
     theta_deg: f32,
     bandwidth_oct: f32,
     aspect: f32,
 ) -> PyResult<Pair<'py>> {
+    let img: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(img, "img")?;
     // The core checks the angle as one of `orientations_deg`, the name its error gave here.
     if !(theta_deg.is_finite() && theta_deg.abs() < 90.0) {
         return Err(pyo3::exceptions::PyValueError::new_err(format!(
@@ -199,9 +202,9 @@ pub fn gabor_responses<'py>(
 #[allow(clippy::too_many_arguments)]
 pub fn gabor_newton_step<'py>(
     py: Python<'py>,
-    left: PyReadonlyArray2<'py, f32>,
-    right: PyReadonlyArray2<'py, f32>,
-    disp: PyReadonlyArray2<'py, f32>,
+    left: &Bound<'py, PyAny>,
+    right: &Bound<'py, PyAny>,
+    disp: &Bound<'py, PyAny>,
     freq: f32,
     orientations_deg: Option<Vec<f32>>,
     bandwidth_oct: f32,
@@ -209,6 +212,9 @@ pub fn gabor_newton_step<'py>(
     amp_rel_thresh: f32,
     stability_tau: f32,
 ) -> PyResult<Pair<'py>> {
+    let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
+    let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
+    let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     // The core names the second image of a size mismatch "right"; here it may be the map.
     let (map_dim, img_dim) = (disp.as_array().dim(), left.as_array().dim());
     if map_dim != img_dim {
@@ -244,10 +250,13 @@ pub fn gabor_newton_step<'py>(
 #[pyo3(signature = (disp_left, disp_right, tol=1.0))]
 pub fn gabor_lr_check<'py>(
     py: Python<'py>,
-    disp_left: PyReadonlyArray2<'py, f32>,
-    disp_right: PyReadonlyArray2<'py, f32>,
+    disp_left: &Bound<'py, PyAny>,
+    disp_right: &Bound<'py, PyAny>,
     tol: f32,
 ) -> PyResult<Bound<'py, PyArray2<bool>>> {
+    let disp_left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp_left, "disp_left")?;
+    let disp_right: PyReadonlyArray2<'py, f32> =
+        crate::convert::array_arg(disp_right, "disp_right")?;
     // A negative or NaN tolerance passed no pixel, without a word; infinity passes every
     // finite one.
     if tol.is_nan() || tol < 0.0 {
@@ -281,10 +290,11 @@ pub fn gabor_lr_check<'py>(
 #[pyo3(signature = (disp, min_size, max_diff))]
 pub fn gabor_remove_speckles<'py>(
     py: Python<'py>,
-    disp: PyReadonlyArray2<'py, f32>,
+    disp: &Bound<'py, PyAny>,
     min_size: usize,
     max_diff: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     crate::params::non_negative("max_diff", max_diff)?;
     let kernel = |d: &mut [f32], w, h| {
         guard("gabor_remove_speckles", || {

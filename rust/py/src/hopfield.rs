@@ -125,7 +125,7 @@ fn params(d: &Bound<'_, PyDict>) -> PyResult<HopfieldParams> {
 #[allow(clippy::type_complexity)]
 pub fn hopfield_interest<'py>(
     py: Python<'py>,
-    img: PyReadonlyArray2<'py, f32>,
+    img: &Bound<'py, PyAny>,
     rel_threshold: f32,
     nms_half: usize,
     tile: usize,
@@ -135,6 +135,7 @@ pub fn hopfield_interest<'py>(
     Bound<'py, PyArray2<i32>>,
     Bound<'py, PyArray1<f32>>,
 )> {
+    let img: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(img, "img")?;
     let im = grey_from_numpy(&img, "image")?;
     let im = im.view();
     let unit = |v: f32| v.is_finite() && (0.0..=1.0).contains(&v);
@@ -208,10 +209,12 @@ fn output<'py>(py: Python<'py>, out: HopfieldOutput) -> PyResult<MatchOut<'py>> 
 #[pyo3(signature = (left, right, params))]
 pub fn hopfield_match<'py>(
     py: Python<'py>,
-    left: PyReadonlyArray2<'py, f32>,
-    right: PyReadonlyArray2<'py, f32>,
+    left: &Bound<'py, PyAny>,
+    right: &Bound<'py, PyAny>,
     params: &Bound<'py, PyDict>,
 ) -> PyResult<MatchOut<'py>> {
+    let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
+    let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
     // The arrays' own buffers (no copy: the wrappers pass C-contiguous arrays).
     let (l, r) = (
         grey_from_numpy(&left, "left")?,
@@ -227,11 +230,13 @@ pub fn hopfield_match<'py>(
 #[pyo3(signature = (left, right, weights, params))]
 pub fn hopfield_match_u8<'py>(
     py: Python<'py>,
-    left: numpy::PyReadonlyArrayDyn<'py, u8>,
-    right: numpy::PyReadonlyArrayDyn<'py, u8>,
+    left: &Bound<'py, PyAny>,
+    right: &Bound<'py, PyAny>,
     weights: (f32, f32, f32),
     params: &Bound<'py, PyDict>,
 ) -> PyResult<MatchOut<'py>> {
+    let left: numpy::PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(left, "left")?;
+    let right: numpy::PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(right, "right")?;
     let (h, w, c, ld) = u8_layout(&left, "left")?;
     let (hr, wr, cr, rd) = u8_layout(&right, "right")?;
     if (hr, wr, cr) != (h, w, c) {
@@ -317,10 +322,12 @@ fn run_match<'py>(
 #[pyo3(signature = (left, right, params))]
 pub fn hopfield_candidates<'py>(
     py: Python<'py>,
-    left: PyReadonlyArray2<'py, f32>,
-    right: PyReadonlyArray2<'py, f32>,
+    left: &Bound<'py, PyAny>,
+    right: &Bound<'py, PyAny>,
     params: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
+    let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
     // The arrays' own buffers (no copy: the wrappers pass C-contiguous arrays).
     let (l, r) = (
         grey_from_numpy(&left, "left")?,

@@ -133,9 +133,10 @@ fn matches_array<'py>(py: Python<'py>, ms: &[Match]) -> PyResult<Bound<'py, PyAr
 #[pyo3(signature = (img, sigma))]
 pub fn mcgm_log<'py>(
     py: Python<'py>,
-    img: PyReadonlyArray2<'py, f32>,
+    img: &Bound<'py, PyAny>,
     sigma: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let img: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(img, "img")?;
     let im = image_from_numpy(&img, "image")?;
     if !(sigma.is_finite() && (0.3..=64.0).contains(&sigma)) {
         return Err(PyValueError::new_err(format!(
@@ -238,9 +239,10 @@ fn curves_dict<'py>(py: Python<'py>, c: ChannelCurves) -> PyResult<Bound<'py, Py
 #[pyo3(signature = (img, params))]
 pub fn mcgm_curves<'py>(
     py: Python<'py>,
-    img: PyReadonlyArray2<'py, f32>,
+    img: &Bound<'py, PyAny>,
     params: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyList>> {
+    let img: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(img, "img")?;
     let im = image_from_numpy(&img, "image")?;
     let p = self::params(params)?;
     let chans = crate::workers::detach(py, || guard("mcgm_curves", || image_curves(&im, &p)))?;
@@ -264,10 +266,12 @@ type MatchOut<'py> = (
 #[pyo3(signature = (left, right, params))]
 pub fn mcgm_match<'py>(
     py: Python<'py>,
-    left: PyReadonlyArray2<'py, f32>,
-    right: PyReadonlyArray2<'py, f32>,
+    left: &Bound<'py, PyAny>,
+    right: &Bound<'py, PyAny>,
     params: &Bound<'py, PyDict>,
 ) -> PyResult<MatchOut<'py>> {
+    let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
+    let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
     let l = image_from_numpy(&left, "left")?;
     let r = image_from_numpy(&right, "right")?;
     let p = self::params(params)?;
@@ -340,11 +344,14 @@ pub fn mcgm_match<'py>(
 #[pyo3(signature = (left, right, matches, params))]
 pub fn mcgm_filter<'py>(
     py: Python<'py>,
-    left: PyReadonlyArray2<'py, f32>,
-    right: PyReadonlyArray2<'py, f32>,
-    matches: PyReadonlyArray2<'py, f32>,
+    left: &Bound<'py, PyAny>,
+    right: &Bound<'py, PyAny>,
+    matches: &Bound<'py, PyAny>,
     params: &Bound<'py, PyDict>,
 ) -> PyResult<Bound<'py, PyArray1<bool>>> {
+    let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
+    let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
+    let matches: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(matches, "matches")?;
     let l = image_from_numpy(&left, "left")?;
     let r = image_from_numpy(&right, "right")?;
     let p = self::params(params)?;

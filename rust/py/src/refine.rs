@@ -17,10 +17,10 @@ type Refined<'py> = (Bound<'py, PyArray2<f32>>, Bound<'py, PyArray2<f32>>, usize
 #[allow(clippy::too_many_arguments)]
 pub fn refine_disparity<'py>(
     py: Python<'py>,
-    left: PyReadonlyArray2<'py, f32>,
-    right: PyReadonlyArray2<'py, f32>,
-    disp: PyReadonlyArray2<'py, f32>,
-    conf: PyReadonlyArray2<'py, f32>,
+    left: &Bound<'py, PyAny>,
+    right: &Bound<'py, PyAny>,
+    disp: &Bound<'py, PyAny>,
+    conf: &Bound<'py, PyAny>,
     d_min: f32,
     d_max: f32,
     base_sigma: f32,
@@ -36,6 +36,10 @@ pub fn refine_disparity<'py>(
     fill_plane: bool,
     fill_max_residual: f32,
 ) -> PyResult<Refined<'py>> {
+    let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
+    let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
+    let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
+    let conf: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(conf, "conf")?;
     let l = grey_from_numpy(&left, "left")?;
     let r = grey_from_numpy(&right, "right")?;
     let (w, h) = (l.view().width, l.view().height);

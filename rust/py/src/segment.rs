@@ -18,10 +18,11 @@ use crate::params::non_negative;
 #[pyo3(signature = (image, k, min_size))]
 pub fn graph_segments<'py>(
     py: Python<'py>,
-    image: PyReadonlyArray3<'py, f32>,
+    image: &Bound<'py, PyAny>,
     k: f32,
     min_size: usize,
 ) -> PyResult<Bound<'py, PyArray2<u32>>> {
+    let image: PyReadonlyArray3<'py, f32> = crate::convert::array_arg(image, "image")?;
     non_negative("k", k)?;
     let a = image.as_array();
     let (h, w, c) = a.dim();
@@ -49,13 +50,15 @@ pub fn graph_segments<'py>(
 #[allow(clippy::type_complexity)]
 pub fn plane_fill<'py>(
     py: Python<'py>,
-    disp: PyReadonlyArray2<'py, f32>,
-    labels: PyReadonlyArray2<'py, u32>,
+    disp: &Bound<'py, PyAny>,
+    labels: &Bound<'py, PyAny>,
     min_pixels: usize,
     max_residual: f32,
     lo: f32,
     hi: f32,
 ) -> PyResult<(Bound<'py, PyArray2<f32>>, usize, usize)> {
+    let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
+    let labels: PyReadonlyArray2<'py, u32> = crate::convert::array_arg(labels, "labels")?;
     let a = disp.as_array();
     let (h, w) = a.dim();
     if labels.as_array().dim() != (h, w) {
@@ -99,10 +102,11 @@ pub fn plane_fill<'py>(
 #[pyo3(signature = (image, step, offset))]
 pub fn quantised_regions<'py>(
     py: Python<'py>,
-    image: PyReadonlyArray3<'py, u8>,
+    image: &Bound<'py, PyAny>,
     step: u32,
     offset: u32,
 ) -> PyResult<Bound<'py, PyArray2<u32>>> {
+    let image: PyReadonlyArray3<'py, u8> = crate::convert::array_arg(image, "image")?;
     let (h, w, c) = (image.shape()[0], image.shape()[1], image.shape()[2]);
     if !(1..=3).contains(&c) || h == 0 || w == 0 {
         return Err(PyValueError::new_err(format!(
@@ -129,11 +133,13 @@ pub fn quantised_regions<'py>(
 #[pyo3(signature = (disp, image, passes, max_residual))]
 pub fn fill_planes<'py>(
     py: Python<'py>,
-    disp: PyReadonlyArray2<'py, f32>,
-    image: PyReadonlyArray3<'py, u8>,
+    disp: &Bound<'py, PyAny>,
+    image: &Bound<'py, PyAny>,
     passes: Vec<(u32, usize)>,
     max_residual: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
+    let image: PyReadonlyArray3<'py, u8> = crate::convert::array_arg(image, "image")?;
     let (h, w, c) = (image.shape()[0], image.shape()[1], image.shape()[2]);
     if disp.as_array().dim() != (h, w) || !(1..=3).contains(&c) {
         return Err(PyValueError::new_err(format!(

@@ -14,8 +14,8 @@ use crate::errors::guard;
 #[allow(clippy::too_many_arguments)]
 pub fn sgm_disparity<'py>(
     py: Python<'py>,
-    left: PyReadonlyArray2<'py, f32>,
-    right: PyReadonlyArray2<'py, f32>,
+    left: &Bound<'py, PyAny>,
+    right: &Bound<'py, PyAny>,
     d_min: i32,
     d_max: i32,
     p1: u16,
@@ -26,6 +26,8 @@ pub fn sgm_disparity<'py>(
     edge_margin: u32,
     paths: u8,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
+    let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
     let l = grey_from_numpy(&left, "left")?;
     let r = grey_from_numpy(&right, "right")?;
     let (w, h) = (l.view().width, l.view().height);

@@ -31,9 +31,11 @@ fn mean_slice<'a>(
 #[pyfunction]
 pub fn temporal_grey_difference<'py>(
     py: Python<'py>,
-    frame: PyReadonlyArrayDyn<'py, u8>,
-    mean: PyReadonlyArrayDyn<'py, f32>,
+    frame: &Bound<'py, PyAny>,
+    mean: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let frame: PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(frame, "frame")?;
+    let mean: PyReadonlyArrayDyn<'py, f32> = crate::convert::array_arg(mean, "mean")?;
     let (h, w, c, f) = u8_layout(&frame, "frame")?;
     let m = mean_slice(&mean, frame.shape())?;
     let d = crate::workers::detach(py, || {
@@ -50,13 +52,17 @@ pub fn temporal_grey_difference<'py>(
 #[pyo3(signature = (frame, mean, count, diff, ks, max_frames))]
 pub fn temporal_running_mean<'py>(
     py: Python<'py>,
-    frame: PyReadonlyArrayDyn<'py, u8>,
-    mut mean: PyReadwriteArrayDyn<'py, f32>,
-    mut count: PyReadwriteArray2<'py, u8>,
-    diff: PyReadonlyArray2<'py, f32>,
+    frame: &Bound<'py, PyAny>,
+    mean: &Bound<'py, PyAny>,
+    count: &Bound<'py, PyAny>,
+    diff: &Bound<'py, PyAny>,
     ks: f32,
     max_frames: u8,
 ) -> PyResult<Bound<'py, PyArrayDyn<u8>>> {
+    let mut mean: PyReadwriteArrayDyn<'py, f32> = crate::convert::array_arg_rw(mean, "mean")?;
+    let mut count: PyReadwriteArray2<'py, u8> = crate::convert::array_arg_rw(count, "count")?;
+    let frame: PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(frame, "frame")?;
+    let diff: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(diff, "diff")?;
     let (h, w, c, f) = u8_layout(&frame, "frame")?;
     let shape = frame.shape().to_vec();
     if mean.shape() != shape.as_slice() {

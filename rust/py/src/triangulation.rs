@@ -20,8 +20,8 @@ type Pair<'py> = (
 #[allow(clippy::too_many_arguments)]
 pub fn depth_rectified<'py>(
     py: Python<'py>,
-    disp: PyReadonlyArray2<'py, f32>,
-    conf: PyReadonlyArray2<'py, f32>,
+    disp: &Bound<'py, PyAny>,
+    conf: &Bound<'py, PyAny>,
     fb: f32,
     doffs: f32,
     s0: f32,
@@ -29,6 +29,8 @@ pub fn depth_rectified<'py>(
     s_min: f32,
     s_fill: f32,
 ) -> PyResult<Pair<'py>> {
+    let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
+    let conf: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(conf, "conf")?;
     let (h, w) = disp.as_array().dim();
     let (d, c) = map_and_confidence(&disp, &conf, (h, w))?;
     let m = SigmaModel {
