@@ -237,6 +237,49 @@ def test_a_wrong_array_type_names_the_argument(
         call(a)
 
 
+def test_an_empty_8_bit_image_is_called_empty() -> None:
+    """It said "buffer of 0 bytes does not hold 0x5x3"."""
+    with pytest.raises(ValueError, match=re.escape("image is empty: got 5x0 pixels")):
+        _core.gray_u8(np.zeros((0, 5, 3), np.uint8), LUMA_WEIGHTS_BGR)
+
+
+@pytest.mark.parametrize(
+    ("name", "args"),
+    [
+        ("s_min", (0.74, -0.52, -0.2, 0.9)),
+        ("s_min", (0.74, -0.52, 0.0, 0.9)),
+        ("s_fill", (0.74, -0.52, 0.2, -0.9)),
+        ("s_fill", (0.74, -0.52, 0.2, float("nan"))),
+        ("slope", (0.74, float("inf"), 0.2, 0.9)),
+    ],
+)
+def test_depth_sigma_model_is_checked(name: str, args: tuple[float, ...]) -> None:
+    """A negative s_min or s_fill gave negative depth sigmas; a NaN one, NaN sigmas."""
+    d = np.full((2, 3), 8.0, np.float32)
+    c = np.array([[0.5, -1.0, 0.0], [1.0, 0.5, 0.5]], np.float32)
+    with pytest.raises(ValueError, match=f"`{name}`"):
+        _core.depth_rectified(d, c, 50.0, 0.0, *args)
+
+
+def test_a_nan_confidence_gets_the_sigma_of_confidence_zero() -> None:
+    """A NaN confidence went through ``max`` to ``s_min``: the smallest sigma, as if the match
+    were the surest in the map."""
+    d = np.full((1, 3), 8.0, np.float32)
+    c = np.array([[np.nan, 0.0, 1.0]], np.float32)
+    z, s = _core.depth_rectified(d, c, 50.0, 2.0, 0.74, -0.52, 0.2, 0.9)
+    assert z.tolist() == [[5.0, 5.0, 5.0]]
+    assert s[0, 0] == s[0, 1] == np.float32(5.0 * 0.74 / 10.0)
+    assert s[0, 2] < s[0, 0]
+
+
+@pytest.mark.parametrize("name", ["research_radius", "search_pool_radius"])
+def test_the_kernel_names_the_radius_out_of_range(name: str) -> None:
+    """The kernel checked both radii in one test and named ``research_radius`` for either."""
+    a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    with pytest.raises(ValueError, match=f"`{name}`: must be <= 16 px, got 17"):
+        _core.gabor_disparity(a, a, 0.0, 8.0, **{name: 17})
+
+
 #: Run under ``ulimit -v`` (RLIMIT_AS) in a child: a failed allocation aborted the whole
 #: process (SIGABRT, exit -6) instead of raising MemoryError.
 _OOM_SCRIPT = """
