@@ -905,6 +905,60 @@ def test_find_floor_controller_on_kitti(data_dir):
     assert app.state.img_floor == ""
 
 
+def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_path):
+    """The page had no way to keep a result. "Save" writes the pair on show with the depth
+    command's writer (disparity PNG + PFM, 16-bit depth PNG in mm, cloud.ply) into a folder
+    inside --data; a folder already holding one of those files is refused, naming it, and
+    the file is left as it was; a folder outside --data is refused."""
+    from stereovision.export import read_depth_png
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import NO_PAIR, SAVED_DEPTH_FILES, SAVED_FILES
+    from stereovision.io import read_pfm
+
+    app = _scene_app("test-save", [bundled_data_dir(), tmp_path])
+    assert app.state.save_dir == str(tmp_path.resolve() / "saved")
+    _run(app, app.save)
+    assert app.state.error == NO_PAIR
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    out = tmp_path / "saved"
+    assert app.state.error == ""
+    assert sorted(p.name for p in out.iterdir()) == sorted(SAVED_FILES + SAVED_DEPTH_FILES)
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/saved: ")
+    res = app.view.result
+    np.testing.assert_array_equal(read_pfm(out / "disparity.pfm"), res.disparity)
+    depth = read_depth_png(out / "depth_mm.png")
+    ok = np.isfinite(res.depth) & (res.depth < 60)
+    assert np.nanmax(np.abs(depth[ok] - res.depth[ok])) < 0.001
+    # again into the same folder: refused, nothing replaced
+    (out / "cloud.ply").write_text("mine")
+    (out / "disparity.pfm").unlink()
+    app.state.save_label = ""
+    _run(app, app.save)
+    assert app.state.error == (
+        f"save: {tmp_path.name}/saved already holds disparity.png, depth.png, depth.npy, "
+        "depth_mm.png, cloud.ply; nothing was overwritten: choose another folder"
+    )
+    assert (out / "cloud.ply").read_text() == "mine" and not (out / "disparity.pfm").exists()
+    for outside in ("../elsewhere", "/tmp", str(bundled_data_dir() / "x")):
+        app.state.save_dir = outside
+        _run(app, app.save)
+        assert app.state.error == f"folder outside the --data folders: {outside}", outside
+    app.state.save_dir = "second"  # relative: inside the first --data folder
+    _run(app, app.save)
+    assert app.state.error == "" and (tmp_path / "second" / "cloud.ply").stat().st_size > 1000
+    # only the bundled data: nowhere to write, said so
+    bare = _scene_app("test-save-bare", [bundled_data_dir()])
+    bare.view = app.view
+    assert bare.state.save_dir == ""
+    _run(bare, bare.save)
+    assert bare.state.error == "empty or invalid folder"
+    bare.state.save_dir = "x"
+    _run(bare, bare.save)
+    assert bare.state.error == "no folder to write into: start the GUI with --data DIR"
+
+
 def test_rectify_controller_without_a_calibration(data_dir):
     """The acquisition panel's "Rectify", in-process, on StereoPi's raw pair (rows 0.59 px
     apart): rectified from its features, the rows check passes, and the cameras' next pair

@@ -23,6 +23,7 @@ import base64
 import concurrent.futures
 import logging
 import math
+import os
 import time
 import warnings
 from dataclasses import dataclass
@@ -104,6 +105,12 @@ _NEXT_STEP = {
 #: The depth picture's caption when it has no depth to scale (no calibration, no match).
 DEPTH_CAPTION = "depth (near = warm)"
 
+#: What "Save" writes (``stereovision depth``'s own files, by its writer): always, and with depth.
+SAVED_FILES = ("disparity.png", "disparity.pfm")
+SAVED_DEPTH_FILES = ("depth.png", "depth.npy", "depth_mm.png", "cloud.ply")
+#: The save folder offered at start-up, inside the first ``--data`` folder.
+SAVE_FOLDER = "saved"
+
 #: Camera slider ranges: degrees for the rotations, metres for the translations.
 ANGLE_RANGE = 90.0
 TRANSLATION_RANGE = 5.0
@@ -128,6 +135,8 @@ _RESULT_KEYS = (
 PENDING_3D = "computing the new pair: the 3-D view still shows the previous one"
 #: What Find floor says while a new pair computes (the depth on hand is the previous pair's).
 PENDING_FLOOR = "the new pair is being computed: find its floor once its depth is shown"
+#: What Save says while a new pair computes.
+PENDING_SAVE = "the new pair is being computed: save it once its results are shown"
 
 
 def _data_url(image: npt.NDArray[np.uint8], width: int = DISPLAY_WIDTH) -> str:
@@ -503,6 +512,11 @@ class StereoApp:
         self.plotter = make_plotter((640, 480))
         self._remote_view: Any = None
         self._clip_tag: int | None = None
+        from stereovision.gui import bundled_data_dir
+
+        # "Save" writes only inside the --data folders (not into the installed package's data)
+        bundled = bundled_data_dir().resolve()
+        self._save_roots = [r for r in folders.roots if r != bundled]
 
         st = self.state
         st.methods = [*METHODS, *EXTRA_METHODS]
@@ -536,6 +550,8 @@ class StereoApp:
         st.left_file = st.right_file = ""
         st.images = []
         st.view_mode = "surface"
+        st.save_dir = str(self._save_roots[0] / SAVE_FOLDER) if self._save_roots else ""
+        st.save_label = ""
         for name in _CONTROL_NAMES:
             st[name] = 0.0
         self._refresh_file_lists()
@@ -1029,6 +1045,58 @@ class StereoApp:
             self.state.floor_label = text
             self.state.img_floor = url
 
+    def save_clicked(self) -> None:
+        """The page's "Save" button."""
+        self._spawn(self.save())
+
+    async def save(self) -> None:
+        """Write the pair on show as ``stereovision depth -o`` does (its writer and file names:
+        disparity PNG and PFM, depth PNGs and .npy, cloud.ply) into the page's save folder.
+
+        A folder that already holds one of those files is refused, naming them: nothing the
+        user wrote is replaced (``depth`` replaces its own earlier outputs, the GUI cannot ask).
+        """
+        from stereovision.cli import CliError, write_depth_outputs
+        from stereovision.io import check_output_folder
+
+        view = self.view
+        if view is None:
+            self._fail(ValueError(NO_PAIR))
+            return
+        if self._page_before is not None:  # self.view is the previous pair's
+            with self.state:
+                self.state.save_label = PENDING_SAVE
+            return
+        result = view.result
+        names = SAVED_FILES + (SAVED_DEPTH_FILES if result.depth is not None else ())
+        try:
+            folder = self.folders.resolve_output(self.state.save_dir or "", self._save_roots)
+            label = self.folders.label(folder)
+            taken = [n for n in names if os.path.lexists(folder / n)]
+            if taken:
+                raise FileExistsError(
+                    f"save: {label} already holds {', '.join(taken)}; nothing was overwritten: "
+                    "choose another folder"
+                )
+            check_output_folder(folder, "save folder")
+        except (ValueError, OSError) as exc:
+            self._fail(exc)
+            return
+
+        def run() -> dict[str, Path]:
+            return write_depth_outputs(result, folder)
+
+        try:
+            written = await asyncio.get_running_loop().run_in_executor(self._executor, run)
+        except (ValueError, OSError, RuntimeError, CliError) as exc:
+            self._fail(exc)
+            return
+        self._done()
+        h, w = result.disparity.shape
+        without = "" if result.depth is not None else " (no calibration: disparity only)"
+        with self.state:
+            self.state.save_label = f"saved {w}×{h} to {label}: {', '.join(written)}{without}"
+
     def _set_progress(self, pct: int, text: str) -> None:
         with self.state:
             self.state.progress = pct
@@ -1058,6 +1126,7 @@ class StereoApp:
             st.status = "ready"
             st.error = ""
             st.floor_label = st.img_floor = ""  # a new depth map: its floor is not found yet
+            st.save_label = ""
             st.computations += 1
 
     # ------------------------------------------------------------------------- 3-D view
@@ -1337,6 +1406,18 @@ class StereoApp:
                 with html.Div(v_if="img_floor", classes="mt-1"):
                     html.Div("floor (green), obstacles 0.15-2 m (red)", classes="text-caption")
                     html.Img(id="img-floor", src=("img_floor",), style=img_style)
+                with v3.VRow(dense=True, align="center", classes="mt-1"):
+                    with v3.VCol(cols=9):
+                        v3.VTextField(
+                            label="Save folder (inside a --data folder)",
+                            v_model=("save_dir",),
+                            density="compact",
+                            hide_details=True,
+                            id="save-dir",
+                        )
+                    with v3.VCol(cols=3):
+                        v3.VBtn("Save", click=self.save_clicked, id="save-btn", block=True)
+                html.Div("{{ save_label }}", id="save-label", classes="text-caption")
 
     def _camera_controls(self, v3: Any, html: Any) -> None:
         with v3.VRow(dense=True, classes="mt-2", align="center"):

@@ -106,6 +106,38 @@ class AllowedFolders:
             raise FileNotFoundError(f"no such file: {text}")
         return real
 
+    def resolve_output(
+        self, path: str | os.PathLike[str], roots: Sequence[Path] | None = None
+    ) -> Path:
+        """The real path of a folder the page writes into (it need not exist yet).
+
+        Parameters
+        ----------
+        path : path
+            As typed on the page; relative to the first of ``roots``.
+        roots : sequence of Path, optional
+            The folders writing is allowed in (default: all of :attr:`roots`).
+
+        Raises
+        ------
+        ValueError
+            Empty, outside every one of ``roots`` (symbolic links and ``..`` resolved), or no
+            such root at all.
+        """
+        allowed = tuple(self.roots if roots is None else roots)
+        text = os.fspath(path) if path is not None else ""
+        if not text.strip() or "\x00" in text:
+            raise ValueError("empty or invalid folder")
+        if not allowed:
+            raise ValueError("no folder to write into: start the GUI with --data DIR")
+        p = Path(text.strip()).expanduser()
+        if not p.is_absolute():
+            p = allowed[0] / p
+        real = p.resolve()  # the existing part's links resolved, the rest as written
+        if not any(real == r or real.is_relative_to(r) for r in allowed):
+            raise ValueError(f"folder outside the --data folders: {text}")
+        return real
+
     def contains(self, path: str | os.PathLike[str]) -> bool:
         """True if :meth:`resolve` accepts ``path``."""
         try:
