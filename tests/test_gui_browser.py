@@ -334,6 +334,41 @@ def test_the_depth_picture_says_the_distances_of_its_colours():
     assert app.state.depth_caption == view.depth_caption
 
 
+def test_the_unit_toggle_shows_lengths_in_feet():
+    """Depth was shown in metres only. The unit toggle (metres by default) shows the depth
+    caption, the median depth and the 3-D translation sliders in feet; the sliders' values are
+    converted, so the view does not move, and back in metres they read as before."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-units", [bundled_data_dir()])
+    assert app.state.unit == "m"
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    metres = app.state.depth_caption, app.state.stats
+    near_m, far_m = (float(v) for v in re.findall(r"([0-9.]+) m", metres[0]))
+    median_m = float(re.search(r"median depth ([0-9.]+) m", metres[1]).group(1))
+    app.state.forward = 1.0
+    app._apply_camera()
+    pose = app.plotter.camera.position
+    app._on_unit(unit="ft")
+    got = re.fullmatch(r"depth: red ([0-9.]+) ft … blue ([0-9.]+) ft", app.state.depth_caption)
+    assert got is not None, app.state.depth_caption
+    assert float(got.group(1)) == pytest.approx(near_m / 0.3048, abs=0.02)
+    assert float(got.group(2)) == pytest.approx(far_m / 0.3048, abs=0.02)
+    median_ft = float(re.search(r"median depth ([0-9.]+) ft", app.state.stats).group(1))
+    assert median_ft == pytest.approx(median_m / 0.3048, abs=0.02)
+    assert not re.search(r"[0-9] m\b", app.state.stats)
+    assert app.state.forward == pytest.approx(3.281) and app.state.translation_range == 16.4
+    np.testing.assert_allclose(app.plotter.camera.position, pose, atol=1e-3)  # did not move
+    _run(app, app.recompute)  # a new result comes in the unit on show
+    assert " ft … " in app.state.depth_caption
+    app._on_unit(unit="m")
+    assert app.state.depth_caption == metres[0] and app.state.forward == pytest.approx(1.0)
+    app._on_unit(unit="furlong")
+    assert app.state.error == "unit: expected one of ['m', 'ft'], got 'furlong'"
+    assert app.state.unit == "m"
+
+
 @pytest.mark.parametrize("method", ["gabor", "fused"])
 def test_progress_goes_forward_and_says_what_runs(method):
     """The status read "prepare done" during the whole matching (most of the time: it looked

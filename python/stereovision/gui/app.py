@@ -111,9 +111,16 @@ SAVED_DEPTH_FILES = ("depth.png", "depth.npy", "depth_mm.png", "cloud.ply")
 #: The save folder offered at start-up, inside the first ``--data`` folder.
 SAVE_FOLDER = "saved"
 
-#: Camera slider ranges: degrees for the rotations, metres for the translations.
+#: Length units the page can show (the unit toggle; metres by default), as
+#: :data:`stereovision.calibration.UNIT_TO_METRES` names them.
+UNITS = ("m", "ft")
+
+#: Camera slider ranges: degrees for the rotations, metres for the translations (shown in the
+#: page's unit: the range and step of the feet sliders are these in feet).
 ANGLE_RANGE = 90.0
 TRANSLATION_RANGE = 5.0
+TRANSLATION_STEP = 0.05
+_TRANSLATIONS = ("forward", "up", "right")
 
 _CONTROL_NAMES = ("roll", "pitch", "yaw", "forward", "up", "right")
 
@@ -207,6 +214,54 @@ class ViewData:
     message_3d: str
     #: The depth picture's caption: the distances its colour scale runs between.
     depth_caption: str = DEPTH_CAPTION
+    #: The distances (metres; inf for none) at the near (red) and far (blue) ends of the depth
+    #: picture's colours, the median depth, and the statistics line before and after it: what
+    #: :meth:`texts` says in another unit.
+    depth_ends: tuple[float, float] | None = None
+    median_depth: float | None = None
+    stats_parts: tuple[str, str] | None = None
+
+    def texts(self, unit: str = "m") -> tuple[str, str]:
+        """The depth caption and the statistics line with their lengths in ``unit``.
+
+        Parameters
+        ----------
+        unit : {"m", "ft"}
+            One of :data:`UNITS`.
+
+        Returns
+        -------
+        (str, str)
+            ``(depth_caption, stats)``; in metres they are :attr:`depth_caption` and
+            :attr:`stats`.
+
+        Raises
+        ------
+        ValueError
+            An unknown unit.
+        """
+        if unit not in UNITS:
+            raise ValueError(f"unit: expected one of {list(UNITS)}, got {unit!r}")
+        caption, stats = self.depth_caption, self.stats
+        if self.depth_ends is not None:
+            near, far = (_length(v, unit) for v in self.depth_ends)
+            caption = f"depth: red {near} … blue {far}"
+        if self.stats_parts is not None:
+            head, tail = self.stats_parts
+            median = ""
+            if self.median_depth is not None:
+                median = f" · median depth {_length(self.median_depth, unit)}"
+            stats = head + median + tail
+        return caption, stats
+
+
+def _length(metres: float, unit: str) -> str:
+    """A length in ``unit`` with two decimals (∞ for an infinite one)."""
+    from stereovision.calibration import UNIT_TO_METRES
+
+    if not math.isfinite(metres):
+        return "∞"
+    return f"{metres / UNIT_TO_METRES[unit]:.2f} {unit}"
 
 
 def floor_view(result: Any) -> tuple[str, str]:
@@ -350,6 +405,7 @@ def compute_view(
     disparity_url = _data_url(colorize(result.disparity, lo=0.0))
     depth_img = np.zeros_like(shown_left)
     depth_caption = DEPTH_CAPTION
+    depth_ends = None
     if result.depth is not None:
         with np.errstate(divide="ignore", invalid="ignore"):
             inv = np.where(np.isfinite(result.depth), 1.0 / result.depth, np.nan)
@@ -359,8 +415,8 @@ def compute_view(
             # picture had no key, and its scale changes with every pair
             lo, hi = (float(np.percentile(finite, q)) for q in (1, 99))
             depth_img = colorize(inv, lo=lo, hi=hi)
-            near = f"{1.0 / hi:.2f} m" if hi > 0 else "∞"
-            far = f"{1.0 / lo:.2f} m" if lo > 0 else "∞"
+            depth_ends = (1.0 / hi if hi > 0 else math.inf, 1.0 / lo if lo > 0 else math.inf)
+            near, far = (_length(v, "m") for v in depth_ends)
             depth_caption = f"depth: red {near} … blue {far}"  # one line above the picture
     matches_url = ""
     if method in SPARSE_METHODS or result.density < SPARSE_DENSITY:
@@ -377,15 +433,17 @@ def compute_view(
         step = max(1, math.ceil(math.sqrt(len(result.points) / MAX_MESH_VERTICES)))
         mesh = surface_mesh(result, step=step)
         intr = Intrinsics.from_result(result)
-    stats = (
+    head = (
         f"{method} · {left_s.shape[1]}×{left_s.shape[0]} · disparities 0–{result.max_disparity}"
         f" px · density {100 * result.density:.0f} % · {elapsed:.2f} s"
     )
+    median_depth = None
     if result.depth is not None and len(result.points):
-        stats += f" · median depth {float(np.median(result.points[:, 2])):.2f} m"
+        median_depth = float(np.median(result.points[:, 2]))
     said = notes + [str(c.message) for c in caught if issubclass(c.category, UserWarning)]
-    for msg in dict.fromkeys(said):  # once each, in order
-        stats += f" · warning: {msg}"
+    tail = "".join(f" · warning: {msg}" for msg in dict.fromkeys(said))  # once each, in order
+    median = "" if median_depth is None else f" · median depth {_length(median_depth, 'm')}"
+    stats = head + median + tail
     return ViewData(
         result=result,
         left_url=_data_url(shown_left),
@@ -398,6 +456,9 @@ def compute_view(
         stats=stats,
         message_3d=message_3d,
         depth_caption=depth_caption,
+        depth_ends=depth_ends,
+        median_depth=median_depth,
+        stats_parts=(head, tail),
     )
 
 
@@ -550,6 +611,11 @@ class StereoApp:
         st.left_file = st.right_file = ""
         st.images = []
         st.view_mode = "surface"
+        st.units = list(UNITS)
+        st.unit = UNITS[0]
+        #: The unit the translation sliders' values are in (they are converted when it changes).
+        self._unit = UNITS[0]
+        st.translation_range, st.translation_step = TRANSLATION_RANGE, TRANSLATION_STEP
         st.save_dir = str(self._save_roots[0] / SAVE_FOLDER) if self._save_roots else ""
         st.save_label = ""
         for name in _CONTROL_NAMES:
@@ -559,6 +625,7 @@ class StereoApp:
         st.change(*_CONTROL_NAMES)(self._on_controls)
         st.change("method", "resolution")(self._on_method)
         st.change("view_mode")(self._on_view_mode)
+        st.change("unit")(self._on_unit)
         st.change("scene")(self._on_scene)
         self.ctrl.on_server_ready.add(self._on_ready)
 
@@ -891,6 +958,8 @@ class StereoApp:
                     with self.state:
                         for name, value in page.items():
                             self.state[name] = value
+                        if self.view is not None:  # in the unit on show now
+                            self.state.depth_caption, self.state.stats = self.view.texts(self._unit)
                 shown = self._shown
                 if shown is not None and shown["pair"] is not self.pair:
                     for name, value in shown.items():
@@ -1118,8 +1187,7 @@ class StereoApp:
             st.img_left, st.img_right = view.left_url, view.right_url
             st.img_disparity, st.img_depth = view.disparity_url, view.depth_url
             st.img_matches = view.matches_url
-            st.depth_caption = view.depth_caption
-            st.stats = view.stats
+            st.depth_caption, st.stats = view.texts(self._unit)
             st.message_3d = view.message_3d
             st.progress = 100
             st.busy = False
@@ -1155,10 +1223,17 @@ class StereoApp:
         self._apply_camera()
 
     def _apply_camera(self) -> None:
+        from stereovision.calibration import UNIT_TO_METRES
         from stereovision.render import CameraControls, apply_camera
 
+        metres = UNIT_TO_METRES[self._unit]  # the translations are in the page's unit
         try:
-            controls = CameraControls(**{n: float(self.state[n]) for n in _CONTROL_NAMES})
+            controls = CameraControls(
+                **{
+                    n: float(self.state[n]) * (metres if n in _TRANSLATIONS else 1.0)
+                    for n in _CONTROL_NAMES
+                }
+            )
         except (TypeError, ValueError) as exc:
             self._fail(exc)
             return
@@ -1175,6 +1250,30 @@ class StereoApp:
             self._remote_view.update()
 
     def _on_controls(self, **_: Any) -> None:
+        self._apply_camera()
+
+    def _on_unit(self, unit: str = "m", **_: Any) -> None:
+        """The unit toggle: the depth caption, the statistics and the translation sliders (their
+        values converted, so that the view stays where it was) in metres or feet."""
+        from stereovision.calibration import UNIT_TO_METRES
+
+        if unit not in UNITS:
+            self._fail(ValueError(f"unit: expected one of {list(UNITS)}, got {unit!r}"))
+            with self.state:
+                self.state.unit = self._unit
+            return
+        if unit == self._unit:
+            return
+        factor = UNIT_TO_METRES[self._unit] / UNIT_TO_METRES[unit]
+        self._unit = unit
+        with self.state:
+            st = self.state
+            st.translation_range = round(TRANSLATION_RANGE / UNIT_TO_METRES[unit], 1)
+            st.translation_step = TRANSLATION_STEP if unit == "m" else 0.1
+            for name in _TRANSLATIONS:
+                st[name] = round(float(st[name]) * factor, 3)
+            if self.view is not None and self._page_before is None:
+                st.depth_caption, st.stats = self.view.texts(unit)
         self._apply_camera()
 
     def _on_view_mode(self, **_: Any) -> None:
@@ -1383,6 +1482,17 @@ class StereoApp:
                 ):
                     for m in self.state.methods:
                         v3.VBtn(m, value=m, id=f"method-{m}", size="small")
+                with v3.VBtnToggle(
+                    v_model=("unit",),
+                    mandatory=True,
+                    density="compact",
+                    divided=True,
+                    variant="outlined",
+                    id="unit-toggle",
+                    classes="ml-2",
+                ):
+                    for u in UNITS:
+                        v3.VBtn(u, value=u, id=f"unit-{u}", size="small")
                 with v3.VRow(dense=True, classes="mt-2"):
                     with v3.VCol(cols=6):
                         html.Div("disparity", classes="text-caption")
@@ -1440,21 +1550,19 @@ class StereoApp:
                     id="reset-camera",
                     block=True,
                 )
-        sliders = [
-            ("roll", "roll (°)", ANGLE_RANGE, 1.0),
-            ("pitch", "pitch (°)", ANGLE_RANGE, 1.0),
-            ("yaw", "yaw (°)", ANGLE_RANGE, 1.0),
-            ("forward", "forward (m)", TRANSLATION_RANGE, 0.05),
-            ("up", "up (m)", TRANSLATION_RANGE, 0.05),
-            ("right", "right (m)", TRANSLATION_RANGE, 0.05),
-        ]
-        for name, label, rng, step in sliders:
+        for name in _CONTROL_NAMES:
+            if name in _TRANSLATIONS:  # in the page's unit
+                label: Any = (f"'{name} (' + unit + ')'",)
+                rng: Any = ("-translation_range",), ("translation_range",)
+                step: Any = ("translation_step",)
+            else:
+                label, rng, step = f"{name} (°)", (-ANGLE_RANGE, ANGLE_RANGE), 1.0
             with html.Div(id=f"slider-{name}"):
                 v3.VSlider(
                     v_model=(name,),
                     label=label,
-                    min=-rng,
-                    max=rng,
+                    min=rng[0],
+                    max=rng[1],
                     step=step,
                     density="compact",
                     hide_details=True,
