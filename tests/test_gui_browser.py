@@ -369,6 +369,57 @@ def test_the_unit_toggle_shows_lengths_in_feet():
     assert app.state.unit == "m"
 
 
+def test_the_max_disparity_field_is_applied_and_checked():
+    """The disparity range could not be set on the page. Its field is empty for automatic (the
+    pair's own range, shown as its hint); a number is applied on Enter, and a bad one is said
+    on the page without computing anything."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import parse_max_disparity
+
+    app = _scene_app("test-max-disp", [bundled_data_dir()])
+    spawned: list = []
+    app._spawn = spawned.append
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    auto = app.max_disparity
+    assert app.state.max_disp_hint == f"auto: {auto} px, the pair's range"
+    assert f"disparities 0–{auto} px" in app.state.stats
+    for typed, said in (
+        (
+            "abc",
+            "max disparity: expected a whole number of pixels above 0 (empty: automatic), "
+            "got 'abc'",
+        ),
+        (
+            "-5",
+            "max disparity: expected a whole number of pixels above 0 (empty: automatic), got '-5'",
+        ),
+        (
+            "2.5",
+            "max disparity: expected a whole number of pixels above 0 (empty: automatic), "
+            "got '2.5'",
+        ),
+        ("450", "max disparity 450 px is not smaller than the pair's width 450 px"),
+    ):
+        app.state.max_disp = typed
+        app.apply_max_disparity()
+        assert app.state.error == said and spawned == [], typed
+    app.state.max_disp = " 32 "
+    app.apply_max_disparity(True)  # focused: nothing yet
+    assert spawned == []
+    app.apply_max_disparity(False)  # left the field
+    assert app.state.error == "" and len(spawned) == 1
+    _run(app, spawned.pop)
+    assert "disparities 0–32 px" in app.state.stats and app.state.computations == 2
+    app.apply_max_disparity()  # Enter again: the same value, nothing to compute
+    assert spawned == []
+    app.state.max_disp = "auto"
+    app.apply_max_disparity()
+    _run(app, spawned.pop)
+    assert f"disparities 0–{auto} px" in app.state.stats
+    assert parse_max_disparity(None, 10) is None
+
+
 @pytest.mark.parametrize("method", ["gabor", "fused"])
 def test_progress_goes_forward_and_says_what_runs(method):
     """The status read "prepare done" during the whole matching (most of the time: it looked

@@ -47,7 +47,7 @@ from stereovision.gui.sources import (
     scaled_calibration,
 )
 
-__all__ = ["EXTRA_METHODS", "RESOLUTIONS", "StereoApp", "compute_view"]
+__all__ = ["EXTRA_METHODS", "RESOLUTIONS", "StereoApp", "compute_view", "parse_max_disparity"]
 
 log = logging.getLogger(__name__)
 #: What a button that needs a pair says before there is one (it did nothing).
@@ -101,6 +101,9 @@ _NEXT_STEP = {
     "fill": "triangulating",
     "triangulate": "drawing",
 }
+
+#: The max-disparity field's hint when the pair has no range of its own.
+AUTO_HINT = "auto: estimated from the images"
 
 #: The depth picture's caption when it has no depth to scale (no calibration, no match).
 DEPTH_CAPTION = "depth (near = warm)"
@@ -462,6 +465,49 @@ def compute_view(
     )
 
 
+def parse_max_disparity(text: str | None, width: int) -> int | None:
+    """The page's max-disparity field: None for automatic (empty or "auto"), else its pixels.
+
+    Parameters
+    ----------
+    text : str or None
+        As typed.
+    width : int
+        The pair's width in pixels (at the size it comes in).
+
+    Returns
+    -------
+    int or None
+
+    Raises
+    ------
+    ValueError
+        Not a whole number of pixels above 0, or not smaller than ``width``.
+
+    Examples
+    --------
+    >>> parse_max_disparity(" auto ", 450), parse_max_disparity("64", 450)
+    (None, 64)
+    """
+    said = "" if text is None else str(text).strip()
+    if said.lower() in ("", "auto"):
+        return None
+    try:
+        value = int(said)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise ValueError(
+            "max disparity: expected a whole number of pixels above 0 (empty: automatic), "
+            f"got {said!r}"
+        )
+    if value >= width:
+        raise ValueError(
+            f"max disparity {value} px is not smaller than the pair's width {width} px"
+        )
+    return value
+
+
 def _button_and_answer(
     v3: Any, html: Any, text: str, button_id: str, click: Any, answer: str, answer_id: str
 ) -> None:
@@ -549,6 +595,9 @@ class StereoApp:
         #: calib.txt, files another calibration does not fit); None: "give --calib".
         self._no_calib: str | None = None
         self.max_disparity: int | None = None
+        #: The page's max-disparity field, applied (None: automatic, the scene's range or one
+        #: estimated from the images).
+        self.chosen_max_disparity: int | None = None
         self.view: ViewData | None = None
         #: The point-cloud file on show ("Open") and its caption: it stays in the 3-D view
         #: whichever way the surface / points toggle is set, until the next computed pair.
@@ -611,6 +660,8 @@ class StereoApp:
         st.left_file = st.right_file = ""
         st.images = []
         st.view_mode = "surface"
+        st.max_disp = ""
+        st.max_disp_hint = AUTO_HINT
         st.units = list(UNITS)
         st.unit = UNITS[0]
         #: The unit the translation sliders' values are in (they are converted when it changes).
@@ -905,7 +956,9 @@ class StereoApp:
             # self.pair at once, and this result must not be recorded as that scene's.
             computed = self._inputs()
             left, right = self.pair
-            calib, d_max = self.calib, self.max_disparity
+            calib = self.calib
+            chosen = self.chosen_max_disparity
+            d_max = chosen if chosen is not None else self.max_disparity
             method = self.state.method
             res = self.state.resolution
             width = None if res == "full" else int(res)
@@ -915,6 +968,11 @@ class StereoApp:
                 st.busy = True
                 st.progress = 1
                 st.status = f"computing ({method})"
+                st.max_disp_hint = (
+                    AUTO_HINT
+                    if self.max_disparity is None
+                    else f"auto: {self.max_disparity} px, the pair's range"
+                )
                 if fresh:  # another pair: its images now, no result of the previous pair
                     if self._page_before is None:
                         self._page_before = {k: st[k] for k in _RESULT_KEYS}
@@ -1078,6 +1136,24 @@ class StereoApp:
             self.state.rows_label = rect.describe()
             self.state.source_label += " (rectified from features)"
         await self.recompute()
+
+    def apply_max_disparity(self, *_: Any) -> None:
+        """The max-disparity field, on Enter or when it loses focus: checked (a bad value is
+        said on the page, the result on show stays), then the pair computed with it."""
+        if _ and _[0] is True:  # focused, not left
+            return
+        try:
+            width = self.pair[0].shape[1] if self.pair is not None else math.inf
+            chosen = parse_max_disparity(self.state.max_disp, int(min(width, 2**31)))
+        except ValueError as exc:
+            self._fail(exc)
+            return
+        if chosen == self.chosen_max_disparity:
+            return
+        self.chosen_max_disparity = chosen
+        self._done()
+        if self.pair is not None:
+            self._spawn(self.recompute())
 
     def find_floor_clicked(self) -> None:
         """The page's "Find floor" button."""
@@ -1482,17 +1558,31 @@ class StereoApp:
                 ):
                     for m in self.state.methods:
                         v3.VBtn(m, value=m, id=f"method-{m}", size="small")
-                with v3.VBtnToggle(
-                    v_model=("unit",),
-                    mandatory=True,
-                    density="compact",
-                    divided=True,
-                    variant="outlined",
-                    id="unit-toggle",
-                    classes="ml-2",
-                ):
-                    for u in UNITS:
-                        v3.VBtn(u, value=u, id=f"unit-{u}", size="small")
+                with v3.VRow(dense=True, align="center", classes="mt-1"):
+                    with v3.VCol(cols=8):
+                        v3.VTextField(
+                            label="max disparity (px; Enter)",
+                            v_model=("max_disp",),
+                            placeholder=("max_disp_hint",),
+                            persistent_placeholder=True,
+                            density="compact",
+                            hide_details=True,
+                            id="max-disparity",
+                            __events=[("keyup_enter", "keyup.enter")],
+                            keyup_enter=self.apply_max_disparity,
+                            update_focused=(self.apply_max_disparity, "[$event]"),
+                        )
+                    with v3.VCol(cols=4):
+                        with v3.VBtnToggle(
+                            v_model=("unit",),
+                            mandatory=True,
+                            density="compact",
+                            divided=True,
+                            variant="outlined",
+                            id="unit-toggle",
+                        ):
+                            for u in UNITS:
+                                v3.VBtn(u, value=u, id=f"unit-{u}", size="small")
                 with v3.VRow(dense=True, classes="mt-2"):
                     with v3.VCol(cols=6):
                         html.Div("disparity", classes="text-caption")
