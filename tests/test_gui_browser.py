@@ -334,6 +334,33 @@ def test_the_depth_picture_says_the_distances_of_its_colours():
     assert app.state.depth_caption == view.depth_caption
 
 
+def test_the_disparity_picture_says_the_pixels_of_its_colours():
+    """The disparity picture was captioned "disparity", with no key to its colours (0 px to the
+    99th percentile, which changes with every pair). Its caption now gives both ends; the
+    picture itself is the one it was."""
+    from stereovision.cli import colorize
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import DISPARITY_CAPTION, _data_url, compute_view
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    view = compute_view(left, right, None, "fast")
+    got = re.fullmatch(r"disparity: blue 0 px … red ([0-9.]+) px", view.disparity_caption)
+    assert got is not None, view.disparity_caption
+    d = view.result.disparity
+    assert float(got.group(1)) == pytest.approx(np.percentile(d[np.isfinite(d)], 99), abs=0.05)
+    assert 40 < float(got.group(1)) < 70  # cones: up to about 55 px
+    assert view.disparity_url == _data_url(colorize(d, lo=0.0))
+    empty = compute_view(np.zeros((60, 80, 3), np.uint8), np.zeros((60, 80, 3), np.uint8),
+                         None, "opencv-bm", max_disparity=16)  # fmt: skip
+    assert empty.disparity_caption == DISPARITY_CAPTION
+
+    app = _scene_app("test-disparity-caption", [bundled_data_dir()])
+    app._load_scene(cones)
+    _run(app, app.recompute)
+    assert app.state.disparity_caption.startswith("disparity: blue 0 px … red ")
+
+
 def test_the_unit_toggle_shows_lengths_in_feet():
     """Depth was shown in metres only. The unit toggle (metres by default) shows the depth
     caption, the median depth and the 3-D translation sliders in feet; the sliders' values are

@@ -105,6 +105,9 @@ _NEXT_STEP = {
 #: The max-disparity field's hint when the pair has no range of its own.
 AUTO_HINT = "auto: estimated from the images"
 
+#: The disparity picture's caption when it has no disparity to scale (nothing matched).
+DISPARITY_CAPTION = "disparity"
+
 #: The depth picture's caption when it has no depth to scale (no calibration, no match).
 DEPTH_CAPTION = "depth (near = warm)"
 
@@ -131,6 +134,7 @@ _CONTROL_NAMES = ("roll", "pitch", "yaw", "forward", "up", "right")
 #: pair's disparity stayed under the new pair's name), put back if the new pair fails.
 _RESULT_KEYS = (
     "depth_caption",
+    "disparity_caption",
     "img_left",
     "img_right",
     "img_disparity",
@@ -217,6 +221,8 @@ class ViewData:
     message_3d: str
     #: The depth picture's caption: the distances its colour scale runs between.
     depth_caption: str = DEPTH_CAPTION
+    #: The disparity picture's caption: the pixels its colour scale runs between.
+    disparity_caption: str = DISPARITY_CAPTION
     #: The distances (metres; inf for none) at the near (red) and far (blue) ends of the depth
     #: picture's colours, the median depth, and the statistics line before and after it: what
     #: :meth:`texts` says in another unit.
@@ -405,7 +411,15 @@ def compute_view(
     elapsed = time.perf_counter() - t0
     report(92, "drawing")
     shown_left = result.left_rectified if result.left_rectified is not None else left_s
-    disparity_url = _data_url(colorize(result.disparity, lo=0.0))
+    disparity_caption = DISPARITY_CAPTION
+    disp_known = result.disparity[np.isfinite(result.disparity)]
+    disp_hi = None
+    if disp_known.size:
+        # colorize's own top (99th percentile; the bottom is 0), said in pixels: the picture had
+        # no key, as the depth picture had none
+        disp_hi = float(np.percentile(disp_known, 99))
+        disparity_caption = f"disparity: blue 0 px … red {disp_hi:.1f} px"
+    disparity_url = _data_url(colorize(result.disparity, lo=0.0, hi=disp_hi))
     depth_img = np.zeros_like(shown_left)
     depth_caption = DEPTH_CAPTION
     depth_ends = None
@@ -459,6 +473,7 @@ def compute_view(
         stats=stats,
         message_3d=message_3d,
         depth_caption=depth_caption,
+        disparity_caption=disparity_caption,
         depth_ends=depth_ends,
         median_depth=median_depth,
         stats_parts=(head, tail),
@@ -645,6 +660,7 @@ class StereoApp:
         st.img_left = st.img_right = st.img_disparity = st.img_depth = st.img_matches = ""
         st.stats = ""
         st.depth_caption = DEPTH_CAPTION
+        st.disparity_caption = DISPARITY_CAPTION
         st.message_3d = ""
         st.source_label = ""
         st.rows_label = ""
@@ -980,6 +996,7 @@ class StereoApp:
                     st.img_disparity = st.img_depth = st.img_matches = st.img_floor = ""
                     st.floor_label = st.stats = ""
                     st.depth_caption = DEPTH_CAPTION
+                    st.disparity_caption = DISPARITY_CAPTION
                     st.message_3d = PENDING_3D if self.view is not None else ""
 
             def progress(pct: int, text: str) -> None:
@@ -1264,6 +1281,7 @@ class StereoApp:
             st.img_disparity, st.img_depth = view.disparity_url, view.depth_url
             st.img_matches = view.matches_url
             st.depth_caption, st.stats = view.texts(self._unit)
+            st.disparity_caption = view.disparity_caption
             st.message_3d = view.message_3d
             st.progress = 100
             st.busy = False
@@ -1585,7 +1603,11 @@ class StereoApp:
                                 v3.VBtn(u, value=u, id=f"unit-{u}", size="small")
                 with v3.VRow(dense=True, classes="mt-2"):
                     with v3.VCol(cols=6):
-                        html.Div("disparity", classes="text-caption")
+                        html.Div(
+                            "{{ disparity_caption }}",
+                            id="disparity-caption",
+                            classes="text-caption",
+                        )
                         html.Img(id="img-disparity", src=("img_disparity",), style=img_style)
                     with v3.VCol(cols=6):
                         html.Div("{{ depth_caption }}", id="depth-caption", classes="text-caption")
