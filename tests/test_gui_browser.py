@@ -1138,6 +1138,47 @@ def test_rectify_controller_without_a_calibration(data_dir):
     assert app.state.rows_label == "this pair has a calibration: it is rectified with it"
 
 
+def test_rectify_uses_a_pair_already_rectified_as_given(data_dir):
+    """ "Rectify" on a pair whose rows already agree (cones, a rectified dataset) warped it by
+    homographies fitted to those rows: resampled, 455x378 px instead of 450x375. As `rectify`
+    without --calib, the rows check now says it is rectified and the pair is used as given."""
+    cones = data_dir / "middlebury2003" / "cones"
+    raw = (cv2.imread(str(cones / "left.png")), cv2.imread(str(cones / "right.png")))
+
+    class Cameras:
+        def read(self):
+            return raw
+
+        def close(self):
+            pass
+
+    app = _scene_app("test-rectify-given", [data_dir], source=Cameras())
+    app._grab()
+    _run(app, app.recompute)
+    assert app.state.computations == 1
+    _run(app, app.rectify_from_features)
+    assert app.state.error == ""
+    got = re.fullmatch(
+        r"already rectified \(rows median \|dy\| (0\.[0-9]+) px over ([0-9]+) matches, "
+        r"tolerance 0\.5\): used as given",
+        app.state.rows_label,
+    )
+    assert got is not None, app.state.rows_label
+    assert float(got.group(1)) < 0.5 and int(got.group(2)) >= 30
+    assert app.homographies is None and app.pair[0] is raw[0] and app.pair[0].shape == (375, 450, 3)
+    assert app.state.computations == 1  # the result on show is this pair's: nothing to compute
+    assert "rectified from features" not in app.state.source_label
+    # a pair warped earlier (its homographies kept) goes back to the pair as it comes
+    from stereovision.uncalibrated import rectify_uncalibrated
+
+    app.homographies = rectify_uncalibrated(*raw)
+    app._grab()
+    assert app.pair[0].shape != raw[0].shape
+    _run(app, app.rectify_from_features)
+    assert app.homographies is None and app.pair[0] is raw[0]
+    assert app.state.computations == 2 and " · 450×375 · " in app.state.stats
+
+
 def test_capture_averages_still_frames_when_asked(data_dir):
     """The acquisition panel's "average 8 still frames", in-process: cameras giving venus with
     fresh noise of 8 grey levels on every read. Off, a capture is one noisy frame; on, it is

@@ -517,7 +517,11 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     and with no calibration the homographies found from the pair's features (a pair already
     rectified is written as given, unless ``--force``)."""
     from stereovision.io import check_pair_files, imread, make_folder
-    from stereovision.rectification_check import check_rectification, draw_rectification_check
+    from stereovision.rectification_check import (
+        already_rectified,
+        check_rectification,
+        draw_rectification_check,
+    )
 
     left = imread(args.left)
     right = imread(args.right)
@@ -550,9 +554,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
             # A pair whose features already lie on common rows (a rectified dataset, a camera
             # that rectifies on board): warping it by homographies fitted to those same rows
             # only resamples it, and changes its size.
-            first = check_rectification(left, right)
-            if first.ok is True and not first.swapped:
-                given = first
+            given = already_rectified(left, right)
         if given is None:
             rect = rectify_uncalibrated(left, right, model=args.model)
             lr, rr = rect.rectify(left, right)
@@ -579,8 +581,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         )
     if given is not None:
         print(
-            f"already rectified (rows median |dy| {given.median_dy:.2f} px over {given.matches} "
-            f"matches, tolerance {given.tolerance:g}): written as given, not warped (--force "
+            f"already rectified ({given.rows_agree()}): written as given, not warped (--force "
             "rectifies it from its features anyway)"
         )
     else:

@@ -24,6 +24,7 @@ from stereovision._validate import require as _require_type
 __all__ = [
     "RectificationCheck",
     "align_rows",
+    "already_rectified",
     "check_rectification",
     "draw_rectification_check",
     "refine_rectification",
@@ -92,6 +93,14 @@ class RectificationCheck:
             if f.name != "points":
                 out[f.name] = None if isinstance(v, float) and not np.isfinite(v) else v
         return out
+
+    def rows_agree(self) -> str:
+        """How the rows agree, for a pair used as given (:func:`already_rectified`):
+        ``"rows median |dy| 0.08 px over 412 matches, tolerance 0.5"``."""
+        return (
+            f"rows median |dy| {self.median_dy:.2f} px over {self.matches} matches, tolerance "
+            f"{self.tolerance:g}"
+        )
 
     def summary(self) -> str:
         """One line for a log or a terminal."""
@@ -283,6 +292,28 @@ def check_rectification(
         swapped=swapped,
         points=quad,
     )
+
+
+def already_rectified(left: npt.ArrayLike, right: npt.ArrayLike) -> RectificationCheck | None:
+    """The pair's own rows check when its features already lie on common rows, else None.
+
+    Such a pair (a rectified dataset, a camera that rectifies on board) needs no rectification
+    from its features: homographies fitted to those same rows only resample it and change its
+    size. ``stereovision rectify`` without ``--calib`` and the GUI's "Rectify" use it as given.
+
+    Parameters
+    ----------
+    left, right : array_like
+        The pair as it comes (no calibration).
+
+    Returns
+    -------
+    RectificationCheck or None
+        The passing check (:func:`check_rectification`); None when the rows are apart, there
+        is too little texture to tell, or the images look swapped.
+    """
+    check = check_rectification(left, right)
+    return check if check.ok is True and not check.swapped else None
 
 
 def draw_rectification_check(

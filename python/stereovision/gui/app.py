@@ -1128,22 +1128,39 @@ class StereoApp:
             with self.state:
                 self.state.rows_label = "this pair has a calibration: it is rectified with it"
             return
+        from stereovision.rectification_check import already_rectified
         from stereovision.uncalibrated import rectify_uncalibrated
 
         left, right = self.pair
-        if self.homographies is not None and self.raw_pair is not None:
+        before = self.homographies
+        if before is not None and self.raw_pair is not None:
             # pressed again: estimate again from the raw pair, not from the rectified one (its
             # homographies would not fit the cameras' next frames)
             left, right = self.raw_pair
-            self.state.source_label = self.state.source_label.replace(
-                " (rectified from features)", ""
-            )
+
+        def run() -> Any:
+            # as `rectify` without --calib: a pair whose rows already agree is used as given
+            # (homographies fitted to those rows only resampled it, and changed its size)
+            given = already_rectified(left, right)
+            return given if given is not None else rectify_uncalibrated(left, right)
+
         try:
-            rect = await asyncio.get_running_loop().run_in_executor(
-                self._executor, lambda: rectify_uncalibrated(left, right)
-            )
+            rect = await asyncio.get_running_loop().run_in_executor(self._executor, run)
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
+            return
+        self.state.source_label = self.state.source_label.replace(" (rectified from features)", "")
+        if not hasattr(rect, "rectify"):  # the rows check: already rectified
+            self.homographies = None
+            self.raw_pair = (left, right)
+            with self.state:
+                self.state.rows_label = f"already rectified ({rect.rows_agree()}): used as given"
+            if before is not None:  # the pair on show was warped: the one as it comes now
+                self.pair = (left, right)
+                self.max_disparity = None
+                await self.recompute()
+            else:
+                self._done()
             return
         self.homographies = rect
         self.raw_pair = (left, right)
