@@ -1179,6 +1179,66 @@ def test_rectify_uses_a_pair_already_rectified_as_given(data_dir):
     assert app.state.computations == 2 and " · 450×375 · " in app.state.stats
 
 
+def test_an_image_folder_plays_its_pairs_one_per_capture(tmp_path):
+    """The page could open two files or a scene, not a folder of pairs (what `capture` saves,
+    or left/ + right/ camera folders). "Play" takes a folder's pairs as `batch` finds them,
+    one per Capture, starting again after the last; a scene's calib.txt comes with its pair;
+    a folder without pairs, or whose images lead outside --data, says so."""
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    data, outside = tmp_path / "data", tmp_path / "outside"
+    seq, rig = data / "seq", data / "rig"
+    for d in (seq, rig / "left", rig / "right", outside, data / "empty"):
+        d.mkdir(parents=True)
+    for k, scale in ((1, 1.0), (2, 0.5)):
+        for side, img in (("left", left), ("right", right)):
+            cv2.imwrite(str(seq / f"{side}_{k:04d}.png"), cv2.resize(img, None, fx=scale, fy=scale))
+    for side, img in (("left", left), ("right", right)):
+        cv2.imwrite(str(rig / side / "0001.png"), img)
+        cv2.imwrite(str(outside / f"{side}.png"), img)
+    shutil.copytree(cones, data / "scenes" / "cones")
+    (data / "escape").mkdir()
+    (data / "escape" / "left_0001.png").symlink_to(outside / "left.png")
+    (data / "escape" / "right_0001.png").symlink_to(outside / "right.png")
+
+    app = _scene_app("test-pair-folder", [data])
+    assert str(seq.resolve()) in [i["value"] for i in app.state.pair_folders]
+    app.state.pair_folder = str(seq)
+    app.open_pair_folder()
+    assert app.state.error == "" and app.state.live
+    assert app.state.source_label == "folder data/seq: pair 0001 (1 of 2)"
+    np.testing.assert_array_equal(app.pair[0], left)
+    assert app.calib is None
+    app.capture()
+    assert app.state.source_label == "folder data/seq: pair 0002 (2 of 2)"
+    assert app.pair[0].shape == (188, 225, 3)
+    app.capture()  # after the last, the first again
+    assert app.state.source_label == "folder data/seq: pair 0001 (1 of 2)"
+    app.state.pair_folder = str(rig)
+    app.open_pair_folder()
+    assert app.state.source_label.startswith("folder data/rig: pair ")
+    assert app.state.source_label.endswith(" (1 of 1)")
+    np.testing.assert_array_equal(app.pair[1], right)
+    app.state.pair_folder = str(data / "scenes")
+    app.open_pair_folder()
+    assert app.state.error == "" and app.calib is not None  # the scene's calib.txt
+    for bad in ("empty", "escape"):
+        app.state.pair_folder = str(data / bad)
+        app.open_pair_folder()
+        assert app.state.error == (
+            f"no image pairs in data/{bad} (left_0001.png + right_0001.png, left/ + right/ "
+            "folders, or scene folders with left.png + right.png)"
+        ), bad
+    app.state.pair_folder = str(seq / "left_0001.png")
+    app.open_pair_folder()
+    assert app.state.error == "not a folder: data/seq/left_0001.png"
+    assert app.state.source_label.startswith("folder data/scenes: pair ")  # still in use
+
+
 def test_capture_averages_still_frames_when_asked(data_dir):
     """The acquisition panel's "average 8 still frames", in-process: cameras giving venus with
     fresh noise of 8 grey levels on every read. Off, a capture is one noisy frame; on, it is

@@ -40,6 +40,7 @@ from stereovision.gui.sources import (
     CLOUD_SUFFIXES,
     IMAGE_SUFFIXES,
     AllowedFolders,
+    FolderPairs,
     StereoSource,
     open_stereo_source,
     parse_source,
@@ -674,6 +675,8 @@ class StereoApp:
         st.cloud_path = ""
         st.clouds = []
         st.left_file = st.right_file = ""
+        st.pair_folder = ""
+        st.pair_folders = []
         st.images = []
         st.view_mode = "surface"
         st.max_disp = ""
@@ -707,6 +710,7 @@ class StereoApp:
         self.state.images = [
             {"title": f.label(p), "value": str(p)} for p in f.files(IMAGE_SUFFIXES)
         ]
+        self.state.pair_folders = [{"title": f.label(p), "value": str(p)} for p in f.folders()]
 
     def _fail(self, exc: BaseException) -> None:
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
@@ -765,15 +769,23 @@ class StereoApp:
         if self.source is None:
             raise OSError("no camera open: give --left/--right or open cameras below")
         left, right = self.source.read()
+        folder = self.source if isinstance(self.source, FolderPairs) else None
         if left.shape != right.shape:
             from stereovision.io import image_size_text
 
+            what = folder.describe() if folder else "the cameras give different sizes"
             raise ValueError(
-                f"the cameras give different sizes: left {image_size_text(left)}, right "
-                f"{image_size_text(right)}"
+                f"{what}: left {image_size_text(left)}, right {image_size_text(right)}"
             )
         averaged = ""
-        if self.state.average:
+        calib = self.source_calib
+        if folder:  # one pair after another, not frames of one view: nothing to average
+            job = folder.current
+            if job.calib is not None:  # a scene's calib.txt
+                from stereovision.calibration import Calibration
+
+                calib = Calibration.from_file(job.calib)
+        elif self.state.average:
             from stereovision.temporal import TemporalFilter
 
             tf = TemporalFilter(max_frames=AVERAGE_FRAMES)
@@ -784,11 +796,12 @@ class StereoApp:
             averaged = f" ({tf.mean_frames():.1f} frames averaged{moved})"
         self.pair = self.raw_pair = (left, right)
         self._other_source()
-        self.calib = self.source_calib
+        self.calib = calib
         self._no_calib = None
         self.max_disparity = None
         names = (Path(str(n)).name or str(n) for n in self._source_names)
-        self.state.source_label = (self._source_label or "cameras " + " / ".join(names)) + averaged
+        label = self._source_label or "cameras " + " / ".join(names)
+        self.state.source_label = (folder.describe() if folder else label) + averaged
         self.state.rows_label = ""
         rect = self.homographies
         if rect is not None and rect.input_size == (left.shape[1], left.shape[0]):
@@ -869,11 +882,29 @@ class StereoApp:
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
             return
+        self._switch_source(source, (str(self.state.cam_left), str(self.state.cam_right)))
+
+    def open_pair_folder(self) -> None:
+        """Play the pairs of the chosen image folder (as ``batch`` pairs them), one per
+        Capture, starting again after the last."""
+        try:
+            folder = self.folders.resolve(self.state.pair_folder or "")
+            label = self.folders.label(folder)
+            if not folder.is_dir():
+                raise NotADirectoryError(f"not a folder: {label}")
+            source = FolderPairs(folder, label, keep=self.folders.contains)
+        except (ValueError, OSError) as exc:
+            self._fail(exc)
+            return
+        self._switch_source(source, ("", ""))
+
+    def _switch_source(self, source: StereoSource, names: tuple[str, str]) -> None:
+        """Use ``source`` once it gave a pair (else the source in use stays, and says so)."""
         before = (self.source, self.homographies, self._source_label, self._source_names)
         self.source = source
         self.homographies = None
         self._source_label = None  # the cameras typed on the page, named by their fields
-        self._source_names = (str(self.state.cam_left), str(self.state.cam_right))
+        self._source_names = names
         try:
             self._grab()  # sets the pair only once both frames came and fit together
         except (ValueError, OSError, RuntimeError) as exc:
@@ -1546,6 +1577,14 @@ class StereoApp:
                         _file_picker("Right image", "right_file", "images", "right-file")
                     with v3.VCol(cols=2):
                         v3.VBtn("Load", click=self.ctrl.load_files, id="load-files", block=True)
+                with v3.VRow(dense=True, classes="mt-1"):
+                    with v3.VCol(cols=10):
+                        label = "Image folder (its pairs, one per Capture)"
+                        _file_picker(label, "pair_folder", "pair_folders", "pair-folder")
+                    with v3.VCol(cols=2):
+                        v3.VBtn(
+                            "Play", click=self.open_pair_folder, id="pair-folder-open", block=True
+                        )
                 # two rows: in one, a sixth of it for the format showed "d" for "driver"
                 # under an "f." label (and less for the cameras clipped their labels)
                 with v3.VRow(dense=True, classes="mt-1"):

@@ -26,6 +26,7 @@ __all__ = [
     "IMAGE_SUFFIXES",
     "MAX_LISTED",
     "AllowedFolders",
+    "FolderPairs",
     "StereoSource",
     "VideoPair",
     "open_bag_source",
@@ -185,6 +186,21 @@ class AllowedFolders:
                         return sorted(found)
         return sorted(found)
 
+    def folders(self) -> list[Path]:
+        """The roots and the folders directly in them (an image folder to play), sorted, at
+        most :data:`MAX_LISTED`."""
+        found: list[Path] = []
+        for root in self.roots:
+            found.append(root)
+            try:
+                subs = sorted(
+                    p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".")
+                )
+            except OSError:
+                continue
+            found += [p for p in subs if self.contains(p)]
+        return found[:MAX_LISTED]
+
     def label(self, path: Path) -> str:
         """Short display name: ``<root name>/<relative path>``."""
         for r in self.roots:
@@ -332,6 +348,70 @@ class _CaptureAdapter:
             if callable(fn):
                 fn()
                 return
+
+
+class FolderPairs:
+    """The left/right pairs of an image folder, one per read, starting again after the last.
+
+    The pairs are those ``stereovision batch`` finds (:func:`stereovision.batch.find_pairs`):
+    ``left_0001.png`` + ``right_0001.png`` as ``capture`` saves them, ``left/`` + ``right/``
+    (or ``image_2/`` + ``image_3/``, ``cam0/`` + ``cam1/``) camera folders, scene folders.
+
+    Parameters
+    ----------
+    folder : path
+        The folder (any depth below it is searched).
+    name : str
+        What the page calls the folder.
+    keep : callable, optional
+        Keeps a pair only if it returns True for each of its files (the GUI: inside the allowed
+        folders, so that a symbolic link cannot lead out).
+
+    Raises
+    ------
+    FileNotFoundError, NotADirectoryError
+        No such folder.
+    ValueError
+        No pair in it.
+    """
+
+    def __init__(self, folder: str | os.PathLike[str], name: str, keep: Any = None) -> None:
+        from stereovision.batch import find_pairs
+
+        jobs = find_pairs(folder)
+        if keep is not None:
+            jobs = [j for j in jobs if all(keep(p) for p in (j.left, j.right, j.calib) if p)]
+        if not jobs:
+            raise ValueError(
+                f"no image pairs in {name} (left_0001.png + right_0001.png, left/ + right/ "
+                "folders, or scene folders with left.png + right.png)"
+            )
+        self.jobs = jobs
+        self.name = name
+        self.index = -1
+
+    @property
+    def current(self) -> Any:
+        """The :class:`~stereovision.batch.PairJob` last read (None before the first read)."""
+        return self.jobs[self.index] if self.index >= 0 else None
+
+    def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
+        """The next pair (BGR), after the last one the first again."""
+        from stereovision.io import imread
+
+        self.index = (self.index + 1) % len(self.jobs)
+        job = self.jobs[self.index]
+        return imread(job.left), imread(job.right)
+
+    def describe(self) -> str:
+        """``folder data/seq: pair 0002 (2 of 20)``."""
+        job = self.current
+        if job is None:
+            return f"folder {self.name}"
+        return f"folder {self.name}: pair {job.name} ({self.index + 1} of {len(self.jobs)})"
+
+    def close(self) -> None:
+        """Nothing to release (files are read per pair)."""
 
 
 def open_stereo_source(
