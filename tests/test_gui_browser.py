@@ -1656,6 +1656,43 @@ def test_bad_inputs_show_errors_and_page_stays_usable(page, gui_data):
     page.wait_for_selector("#error-alert", state="detached")
 
 
+def test_save_units_range_and_colour_keys_on_the_page(page, gui_data):
+    """The stereo panel's new controls in the browser: the disparity caption's colour key, the
+    unit toggle (feet in the depth caption and statistics), the max-disparity field (a bad
+    value said in the alert, a good one applied on Enter) and Save (a second Save into the same
+    folder refused)."""
+    _wait_computations(page, 1)
+    assert re.fullmatch(
+        r"disparity: blue 0 px … red [0-9.]+ px", page.inner_text("#disparity-caption").strip()
+    )
+    page.click("#unit-ft")
+    page.wait_for_function("document.querySelector('#depth-caption')?.textContent.includes(' ft')")
+    assert re.search(r"median depth [0-9.]+ ft", page.inner_text("#stats"))
+    page.click("#unit-m")
+    page.wait_for_function("document.querySelector('#depth-caption')?.textContent.includes(' m')")
+    page.fill("#max-disparity", "lots")
+    page.press("#max-disparity", "Enter")
+    assert "max disparity: expected a whole number of pixels" in _wait_error(page, "max disparity")
+    page.click("#error-alert button")
+    n = _computations(page)
+    page.fill("#max-disparity", "32")
+    page.press("#max-disparity", "Enter")
+    _wait_computations(page, n + 1)
+    assert " · disparities 0–32 px · " in page.inner_text("#stats")
+    page.fill("#max-disparity", "")
+    page.press("#max-disparity", "Enter")  # automatic again, for the tests after this one
+    _wait_computations(page, n + 2)
+    page.fill("#save-dir", str(gui_data / "saved"))
+    page.click("#save-btn")
+    page.wait_for_function("document.querySelector('#save-label')?.textContent.includes('saved ')")
+    assert (gui_data / "saved" / "cloud.ply").is_file()
+    assert (gui_data / "saved" / "disparity.pfm").is_file()
+    _shot(page, "gui-save.png")
+    page.click("#save-btn")
+    assert "nothing was overwritten" in _wait_error(page, "already holds")
+    page.click("#error-alert button")
+
+
 def test_open_stereo_source_loops_video_files(tmp_path):
     img = syn.left_image()
     lv = _write_video(tmp_path / "l.avi", img)

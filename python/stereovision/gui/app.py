@@ -1202,11 +1202,22 @@ class StereoApp:
             self.state.source_label += " (rectified from features)"
         await self.recompute()
 
-    def apply_max_disparity(self, *_: Any) -> None:
+    def apply_max_disparity(self, focused: bool = False, text: str | None = None) -> None:
         """The max-disparity field, on Enter or when it loses focus: checked (a bad value is
-        said on the page, the result on show stays), then the pair computed with it."""
-        if _ and _[0] is True:  # focused, not left
+        said on the page, the result on show stays), then the pair computed with it.
+
+        Parameters
+        ----------
+        focused : bool
+            The field's focus after the event (True: it was entered, nothing to apply yet).
+        text : str, optional
+            The field's text as the page has it (its state may not have reached the server
+            before the key did); default: the state's.
+        """
+        if focused is True:
             return
+        if text is not None:
+            self.state.max_disp = text
         try:
             width = self.pair[0].shape[1] if self.pair is not None else math.inf
             chosen = parse_max_disparity(self.state.max_disp, int(min(width, 2**31)))
@@ -1643,8 +1654,8 @@ class StereoApp:
                             hide_details=True,
                             id="max-disparity",
                             __events=[("keyup_enter", "keyup.enter")],
-                            keyup_enter=self.apply_max_disparity,
-                            update_focused=(self.apply_max_disparity, "[$event]"),
+                            keyup_enter=(self.apply_max_disparity, "[false, max_disp]"),
+                            update_focused=(self.apply_max_disparity, "[$event, max_disp]"),
                         )
                     with v3.VCol(cols=4):
                         with v3.VBtnToggle(
@@ -1656,7 +1667,9 @@ class StereoApp:
                             id="unit-toggle",
                         ):
                             for u in UNITS:
-                                v3.VBtn(u, value=u, id=f"unit-{u}", size="small")
+                                v3.VBtn(
+                                    u, value=u, id=f"unit-{u}", size="small", classes="text-none"
+                                )
                 with v3.VRow(dense=True, classes="mt-2"):
                     with v3.VCol(cols=6):
                         html.Div(
