@@ -829,7 +829,7 @@ def depth_map(
         to sub-pixel, its speckles and edge-fattened pixels dropped as in the fused map, then
         filled: about 2.2 times faster than ``"fused"`` (median over the 17 GT scenes) and as
         accurate on average, but worse where the census cost is fooled (a periodic texture on
-        ETH3D playground: bad-2.0 0.85 x SGBM-3WAY + fill's, ``"fused"`` 0.53 x; README
+        ETH3D playground: bad-2.0 0.85 x SGBM-3WAY + fill's, ``"fused"`` 0.52 x; README
         "Choosing a mode"). ``"fast"``: ``"census"`` over three aggregation paths (left to right,
         right to left, top to bottom: OpenCV SGBM-3WAY's set) in one pass with no cost volume
         (``paths=3``), not re-measured (``refine=False`` unless asked), checked and filled the
