@@ -2,7 +2,7 @@
 
 A camera in low light is noisy, and noise is what the matchers handle worst (docs/robotics.md,
 "Cameras that expose differently"): 8 grey levels of it take the default map on wood2 from
-0.64 to 19.32 % bad-2.0. A rig that holds still (a fixed mount over a work cell, a robot that
+0.63 to 19.32 % bad-2.0. A rig that holds still (a fixed mount over a work cell, a robot that
 stops to look) sees the same scene frame after frame, and the mean of ``n`` frames has
 ``1 / sqrt(n)`` of one frame's noise. :class:`TemporalFilter` keeps a running mean of each
 camera's frames while the scene holds still and starts again where it does not:
