@@ -1732,3 +1732,30 @@ def test_loading_files_names_sizes_and_warns_of_one_file_twice(tmp_path):
     app.state.right_file = "cones/right.png"
     app.load_files()
     assert app.state.rows_label == ""
+
+
+@pytest.mark.parametrize(
+    ("method", "calibrated", "steps"),
+    [
+        ("fused", False, ["preparing", "matching", "filling", "drawing"]),
+        ("gabor", False, ["preparing", "matching", "refining", "drawing"]),
+        ("fast", True, ["preparing", "matching", "filling", "triangulating", "drawing"]),
+    ],
+)
+def test_progress_names_the_step_that_really_follows(method, calibrated, steps, data_dir):
+    """The status named a fixed next step: "refining and filling" after fused's match (it only
+    fills), "filling" after gabor's refinement (it does not fill) and "triangulating" without a
+    calibration (nothing is triangulated)."""
+    from stereovision.gui.app import compute_view
+    from stereovision.io import load_scene
+
+    name = "tartanair/oldtown_easy_p000_001116" if calibrated else "middlebury2001/tsukuba"
+    sc = load_scene(data_dir / name)
+    assert (sc.calib is not None) == calibrated
+    said: list = []
+    compute_view(
+        sc.left, sc.right, sc.calib, method, width=320, progress=lambda p, t: said.append(t)
+    )
+    done = [t for t in said if " done, " in t]
+    assert [t.split(", ", 1)[1] for t in done] == [f"{s}…" for s in steps], said
+    assert said.index("drawing") == said.index(done[-1]) + 1

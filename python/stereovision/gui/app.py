@@ -92,15 +92,16 @@ _STAGE_PROGRESS = {
     "fill": 85,
     "triangulate": 90,
 }
-#: What runs after each stage ``depth_map`` reports done (the status said "prepare done" for
-#: the whole matching, most of the time, which looked like a stall).
-_NEXT_STEP = {
-    "rectify": "preparing",
-    "prepare": "matching",
-    "match": "refining and filling",
-    "refine": "filling",
-    "fill": "triangulating",
-    "triangulate": "drawing",
+#: What each stage ``depth_map`` reports is called while it runs: the status names the step
+#: that follows the one done (it said "prepare done" for the whole matching, which looked
+#: like a stall).
+_STEP_NAME = {
+    "rectify": "rectifying",
+    "prepare": "preparing",
+    "match": "matching",
+    "refine": "refining",
+    "fill": "filling",
+    "triangulate": "triangulating",
 }
 
 #: The max-disparity field's hint when the pair has no range of its own.
@@ -108,6 +109,25 @@ AUTO_HINT = "auto: estimated from the images"
 
 #: The disparity picture's caption when it has no disparity to scale (nothing matched).
 DISPARITY_CAPTION = "disparity"
+
+
+def _planned_stages(method: str, calibrated: bool) -> list[str]:
+    """The stages ``depth_map`` reports, in order, for ``method`` with its default ``fill`` and
+    ``refine`` (as :func:`compute_view` calls it): the re-measure only for a method that is not
+    dense by default (``"gabor"``), the fill only for the dense ones, and the triangulation only
+    with a calibration. A fixed table said "refining and filling" after fused's match (it only
+    fills) and "triangulating" without a calibration (nothing is triangulated)."""
+    from stereovision.depth import _DENSE_METHODS, _REFINED_BY_DEFAULT
+
+    stages = ["rectify", "prepare", "match"]
+    if method in _REFINED_BY_DEFAULT and method not in _DENSE_METHODS:
+        stages.append("refine")
+    if method in _DENSE_METHODS:
+        stages.append("fill")
+    if calibrated:
+        stages.append("triangulate")
+    return stages
+
 
 #: The depth picture's caption when it has no depth to scale (no calibration, no match).
 DEPTH_CAPTION = "depth (near = warm)"
@@ -398,13 +418,14 @@ def compute_view(
             d = d_max or estimate_max_disparity(left_s, right_s)
             result = _opencv_result(method, left_s, right_s, calib_s, d)
         else:
+            planned = _planned_stages(method, calib_s is not None)
 
             def stage(name: str) -> None:
-                step = _NEXT_STEP.get(name)
-                report(
-                    _STAGE_PROGRESS.get(name, 50),
-                    f"{method}: {name} done, {step}…" if step else f"{method}: {name} done",
-                )
+                text = f"{method}: {name} done"
+                if name in planned:  # the step that follows, the picture after the last one
+                    later = planned[planned.index(name) + 1 :]
+                    text += f", {_STEP_NAME[later[0]] if later else 'drawing'}…"
+                report(_STAGE_PROGRESS.get(name, 50), text)
 
             result = depth_map(
                 left_s, right_s, calib_s, method=method, max_disparity=d_max, progress=stage
