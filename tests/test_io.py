@@ -320,10 +320,16 @@ def test_ascii_ply_and_float_colours(tmp_path: Path) -> None:
     assert pts.dtype == np.float32 and np.isnan(pts[2, 0])
     assert cols is not None and cols.tolist() == [[255, 0, 10], [1, 2, 3], [0, 0, 0]]
     (tmp_path / "f.ply").write_text(
-        head.format(t="float") + body.format("1 0 0.5", "0.2 1.5 -1", "0 0 0")
+        head.format(t="float") + body.format("1 0 0.5", "0.2 1 -1", "0 0 0")
     )
     _, cols = read_ply(tmp_path / "f.ply")
     assert cols is not None and cols.tolist() == [[255, 0, 128], [51, 255, 0], [0, 0, 0]]
+    # float colours of 0-255 (Open3D reads every float colour so): as 0-1 they were all white
+    (tmp_path / "f255.ply").write_text(
+        head.format(t="float") + body.format("255 128 0.4", "12 300 -1", "0 0 0")
+    )
+    _, cols = read_ply(tmp_path / "f255.ply")
+    assert cols is not None and cols.tolist() == [[255, 128, 0], [12, 255, 0], [0, 0, 0]]
     # binary with float colours, and MeshLab's diffuse_ names
     rec = np.zeros(
         1, [("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("r", "<f4"), ("g", "<f4"), ("b", "<f4")]

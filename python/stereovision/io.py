@@ -638,7 +638,7 @@ def read_ply(
     Reads the files :func:`write_ply` writes and other ASCII or binary (little- or big-endian)
     PLY files whose first element is ``vertex`` with scalar properties (further elements are
     ignored). Colours of a floating-point type are taken as 0-1 (as some tools write them) and
-    scaled to 0-255.
+    scaled to 0-255, or as 0-255 when any of them is above 1.
 
     Parameters
     ----------
@@ -727,8 +727,12 @@ def read_ply(
     )
     if prefix is not None:  # "diffuse_red": MeshLab's and Blender's older name
         rgb = np.stack([rec[f"{prefix}{c}"] for c in ("red", "green", "blue")], axis=1)
-        if rgb.dtype.kind == "f":  # 0-1 (a uint8 cast made every colour 0 or 1: black)
-            rgb = np.rint(np.clip(np.nan_to_num(rgb), 0.0, 1.0) * 255.0)
+        if rgb.dtype.kind == "f":
+            rgb = np.nan_to_num(rgb)
+            # 0-1 (a uint8 cast made every colour 0 or 1: black), unless a value is above 1:
+            # 0-255 then, as Open3D reads float colours (as 0-1 they all came out white)
+            top = 1.0 if rgb.size == 0 or float(rgb.max()) <= 1.0 else 255.0
+            rgb = np.rint(np.clip(rgb, 0.0, top) * (255.0 / top))
         cols = rgb.astype(np.uint8)
     return pts, cols
 
