@@ -243,6 +243,18 @@ def test_fill_planes_edge_cases_and_bad_input() -> None:
         fill_planes(full, np.zeros((8, 8, 4), np.uint8))
 
 
+def test_plane_fill_takes_a_boolean_mask_as_two_segments() -> None:
+    """A boolean mask (a floor / obstacle split) was cast to segments 0 and 1 exactly before
+    eef0a41, which refused it as "expected integer labels, got dtype bool"."""
+    yy, xx = np.mgrid[0:20, 0:30].astype(np.float32)
+    d = np.where(yy >= 10, 12.0, 5 + 0.1 * xx).astype(np.float32)
+    holed = d.copy()
+    holed[5, 5] = holed[15, 20] = np.nan
+    got = plane_fill(holed, yy >= 10, min_pixels=5)
+    np.testing.assert_allclose(got, d, atol=1e-4)
+    np.testing.assert_array_equal(got, plane_fill(holed, (yy >= 10).astype(np.int32), min_pixels=5))
+
+
 @pytest.mark.parametrize(
     "labels",
     [np.full((8, 8), 0.7), np.full((8, 8), 2**32, np.int64), np.full((8, 8), -1, np.int64)],

@@ -178,7 +178,7 @@ def plane_fill(
     Raises
     ------
     ValueError
-        ``disp`` not 2-D, ``labels`` of another shape, not integers or not in
+        ``disp`` not 2-D, ``labels`` of another shape, not integers (or booleans) or not in
         ``0 .. H * W - 1``, a negative ``min_pixels`` or ``max_residual``, ``lo`` above ``hi``.
     """
     from stereovision import _core
@@ -191,7 +191,7 @@ def plane_fill(
         raise ValueError(f"labels: expected shape {d.shape} like disp, got {raw.shape}")
     # The cast to uint32 truncated float labels (0.7 -> 0) and wrapped wide ones (2**32 -> 0):
     # segments merged without a word.
-    if raw.dtype.kind not in "iu":
+    if raw.dtype.kind not in "biu":  # a boolean mask is two segments, 0 and 1, cast exactly
         raise ValueError(f"labels: expected integer labels, got dtype {raw.dtype}")
     if raw.size and not 0 <= int(raw.min()) <= int(raw.max()) < raw.size:
         raise ValueError(
