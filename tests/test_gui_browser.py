@@ -1239,6 +1239,53 @@ def test_an_image_folder_plays_its_pairs_one_per_capture(tmp_path):
     assert app.state.source_label.startswith("folder data/scenes: pair ")  # still in use
 
 
+def test_rectify_and_check_rows_of_a_pair_replaced_meanwhile_are_dropped(data_dir, monkeypatch):
+    """A scene chosen while "Rectify" or "Check rows" ran on the cameras' pair: their results
+    were put on the new scene (its label read "(rectified from features)" above the cameras'
+    rectified pair, its rows line was the cameras' verdict). The newer choice wins."""
+    import asyncio
+    import threading
+
+    import stereovision.rectification_check as rc
+
+    sp = data_dir / "stereopi_rig" / "scene_photo"
+    raw = (cv2.imread(str(sp / "left.png")), cv2.imread(str(sp / "right.png")))
+    venus = data_dir / "middlebury2001" / "venus"
+    app = _still_cameras_app("test-superseded-buttons", data_dir, raw)
+    real = rc.check_rectification
+    started, gate = threading.Event(), threading.Event()
+
+    def held(*args: Any, **kwargs: Any) -> Any:
+        started.set()
+        gate.wait(60)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(rc, "check_rectification", held)
+    tasks: list = []
+
+    async def pressed_then_scene(action: Any) -> None:
+        started.clear()
+        gate.clear()
+        tasks.clear()
+        app._lock = asyncio.Lock()  # one per event loop
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        app._grab()
+        running = asyncio.ensure_future(action())
+        await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
+        app._on_scene(scene=str(venus))  # chosen while the button's work runs
+        gate.set()
+        await running
+        await asyncio.gather(*tasks)
+
+    label = f"scene {app.folders.label(app.folders.resolve(str(venus)))}"
+    for action in (app.rectify_from_features, app.check_rows):
+        asyncio.run(pressed_then_scene(action))
+        assert app.state.error == "" and app.homographies is None
+        assert app.pair[0].shape == (383, 434, 3) and app.state.source_label == label
+        assert app.state.rows_label == ""
+        assert app.view is not None and app.view.result.disparity.shape == (383, 434)
+
+
 def test_capture_averages_still_frames_when_asked(data_dir):
     """The acquisition panel's "average 8 still frames", in-process: cameras giving venus with
     fresh noise of 8 grey levels on every read. Off, a capture is one noisy frame; on, it is

@@ -1148,7 +1148,8 @@ class StereoApp:
         from stereovision.calibration import fit_to_frames
         from stereovision.rectification_check import check_rectification
 
-        left, right = self.pair
+        pair = self.pair
+        left, right = pair
         calib = self.calib
 
         def run() -> str:
@@ -1160,8 +1161,11 @@ class StereoApp:
         try:
             text = await asyncio.get_running_loop().run_in_executor(self._executor, run)
         except (ValueError, OSError, RuntimeError) as exc:
-            self._fail(exc)
+            if self.pair is pair:  # else another pair came meanwhile: not its failure
+                self._fail(exc)
             return
+        if self.pair is not pair:
+            return  # another pair came meanwhile: this verdict is not of the pair on show
         self._done()
         with self.state:
             self.state.rows_label = text
@@ -1183,7 +1187,10 @@ class StereoApp:
         from stereovision.rectification_check import already_rectified
         from stereovision.uncalibrated import rectify_uncalibrated
 
-        left, right = self.pair
+        # the pair pressed on: a pair chosen while this runs wins (the homographies of this one
+        # were put on it, under its name)
+        pressed = self.pair
+        left, right = pressed
         before = self.homographies
         if before is not None and self.raw_pair is not None:
             # pressed again: estimate again from the raw pair, not from the rectified one (its
@@ -1199,7 +1206,10 @@ class StereoApp:
         try:
             rect = await asyncio.get_running_loop().run_in_executor(self._executor, run)
         except (ValueError, OSError, RuntimeError) as exc:
-            self._fail(exc)
+            if self.pair is pressed:
+                self._fail(exc)
+            return
+        if self.pair is not pressed:
             return
         self.state.source_label = self.state.source_label.replace(" (rectified from features)", "")
         if not hasattr(rect, "rectify"):  # the rows check: already rectified
