@@ -1286,6 +1286,54 @@ def test_rectify_and_check_rows_of_a_pair_replaced_meanwhile_are_dropped(data_di
         assert app.view is not None and app.view.result.disparity.shape == (383, 434)
 
 
+def test_a_floor_found_for_a_pair_replaced_meanwhile_is_dropped(data_dir, monkeypatch):
+    """Find floor on a scene, then another scene chosen while the fit ran: the first scene's
+    floor picture and height were put on the page under the new scene's name while it computed
+    (its images shown, the previous results cleared), until its own depth map came."""
+    import asyncio
+    import threading
+
+    import stereovision.gui.app as app_mod
+
+    first = data_dir / "tartanair" / "oldtown_easy_p000_001116"
+    venus = data_dir / "middlebury2001" / "venus"
+    app = _scene_app("test-floor-superseded", [data_dir])
+    real = app_mod.floor_view
+    started, gate = threading.Event(), threading.Event()
+
+    def held(res: Any) -> Any:
+        started.set()
+        gate.wait(60)
+        return real(res)
+
+    monkeypatch.setattr(app_mod, "floor_view", held)
+    tasks: list = []
+
+    def choose(scene: Path) -> None:
+        app.state.scene = str(scene)
+        app._on_scene(scene=str(scene))
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        choose(first)
+        await asyncio.gather(*tasks)
+        floor = asyncio.ensure_future(app.find_floor())
+        await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
+        choose(venus)  # chosen while the floor is fitted
+        await asyncio.sleep(0)
+        gate.set()
+        await floor
+        # venus computes: its images are on the page, no result of the previous scene
+        assert app.state.img_floor == "" and app.state.floor_label == ""
+        await asyncio.gather(*tasks)
+
+    asyncio.run(run())
+    assert app.state.error == "" and app.state.source_label.endswith("venus")
+    assert app.view is not None and app.view.result.disparity.shape == (383, 434)
+    assert app.state.img_floor == "" and app.state.floor_label == ""
+
+
 def test_capture_averages_still_frames_when_asked(data_dir):
     """The acquisition panel's "average 8 still frames", in-process: cameras giving venus with
     fresh noise of 8 grey levels on every read. Off, a capture is one noisy frame; on, it is

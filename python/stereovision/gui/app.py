@@ -1290,7 +1290,12 @@ class StereoApp:
         try:
             text, url = await asyncio.get_running_loop().run_in_executor(self._executor, run)
         except (ValueError, OSError, RuntimeError) as exc:
-            self._fail(exc)
+            if self.view is view and self._page_before is None:
+                self._fail(exc)
+            return
+        if self.view is not view or self._page_before is not None:
+            # another pair came while the floor was fitted: this floor is not the one of the
+            # pair on the page (its images show while it computes)
             return
         self._done()
         with self.state:
