@@ -284,12 +284,13 @@ def test_cli_check_fix(data_dir: Path, tmp_path: Path) -> None:
 def test_cli_check_cannot_tell(tmp_path: Path) -> None:
     """A pair too plain to judge: exit 3 (not 1, a verdict on the rig, nor 2, an error), with
     and without --fix; --fix says in one line that it wrote nothing, and writes nothing."""
-    flat = tmp_path / "flat.png"
+    flat, flat_r = tmp_path / "flat.png", tmp_path / "flat_r.png"  # one file twice warns
     cv2.imwrite(str(flat), np.full((375, 450), 128, np.uint8))
+    cv2.imwrite(str(flat_r), np.full((375, 450), 130, np.uint8))
     rig = _rig(450, 375, (0.3, 0.0, 0.0)).save(tmp_path / "rig.yaml")
     fixed = tmp_path / "fixed.yaml"
     for extra in ([], ["--fix", str(fixed)], ["--json", "--fix", str(fixed)]):
-        run = subprocess.run([*SV, "check", str(flat), str(flat), "--calib", str(rig), *extra],
+        run = subprocess.run([*SV, "check", str(flat), str(flat_r), "--calib", str(rig), *extra],
                              capture_output=True, text=True, timeout=120)  # fmt: skip
         assert run.returncode == 3, (extra, run.stderr)
         out = json.loads(run.stdout) if "--json" in extra else run.stdout
