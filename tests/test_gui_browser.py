@@ -17,6 +17,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -1072,19 +1073,12 @@ def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_pat
     assert bare.state.error == "no folder to write into: start the GUI with --data DIR"
 
 
-def test_rectify_controller_without_a_calibration(data_dir):
-    """The acquisition panel's "Rectify", in-process, on StereoPi's raw pair (rows 0.59 px
-    apart): rectified from its features, the rows check passes, and the cameras' next pair
-    goes through the same homographies; with a calibration, a sentence saying so."""
-    import asyncio
-
+def _still_cameras_app(name: str, data_dir: Path, raw: tuple) -> Any:
+    """A :class:`StereoApp` (demo scene cones) whose cameras give ``raw`` on every read."""
     pytest.importorskip("trame")
     from trame.app import get_server
 
     from stereovision.gui.app import StereoApp
-
-    sp = data_dir / "stereopi_rig" / "scene_photo"
-    raw = (cv2.imread(str(sp / "left.png")), cv2.imread(str(sp / "right.png")))
 
     class Cameras:
         def read(self):
@@ -1093,12 +1087,23 @@ def test_rectify_controller_without_a_calibration(data_dir):
         def close(self):
             pass
 
-    app = StereoApp(
-        get_server("test-rectify", client_type="vue3"),
+    return StereoApp(
+        get_server(name, client_type="vue3"),
         AllowedFolders([data_dir]),
         data_dir / "middlebury2003" / "cones",
         source=Cameras(),
     )
+
+
+def test_rectify_controller_without_a_calibration(data_dir):
+    """The acquisition panel's "Rectify", in-process, on StereoPi's raw pair (rows 0.59 px
+    apart): rectified from its features, the rows check passes, and the cameras' next pair
+    goes through the same homographies; with a calibration, a sentence saying so."""
+    import asyncio
+
+    sp = data_dir / "stereopi_rig" / "scene_photo"
+    raw = (cv2.imread(str(sp / "left.png")), cv2.imread(str(sp / "right.png")))
+    app = _still_cameras_app("test-rectify", data_dir, raw)
 
     async def run() -> None:
         app._lock = asyncio.Lock()
