@@ -7,6 +7,7 @@ import argparse
 import hashlib
 import json
 import re
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -927,3 +928,31 @@ def test_numbers_shifted_by_a_constant_are_paired_in_order() -> None:
     gap_r = [f"cams/right_{i:04d}.png" for i in range(11, 31) if i != 25]
     with pytest.raises(ValueError, match=r"18 image\(s\) have no partner with the same number"):
         calmod._pair_by_number(gap_l, gap_r)
+
+
+def test_runs_mostly_sharing_their_numbers_are_paired_by_number() -> None:
+    """left_0001..0020 with right_0002..0021 (an end file deleted on each side): 19 numbers
+    shared, more than half, so the pairs are made on the numbers and the two images without a
+    partner are refused by name. a134ba8's shift pairing took them as a counter offset and paired
+    every image with its neighbour's partner (only a warning; the stereo calibration then failed
+    at RMS 45.7 px, 'mis-paired?'). Runs sharing half their numbers or fewer keep the shift."""
+    lefts = [f"cams/left_{i:04d}.png" for i in range(1, 21)]
+    rights = [f"cams/right_{i:04d}.png" for i in range(2, 22)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(
+            ValueError,
+            match=r"2 image\(s\) have no partner with the same number: left_0001\.png \(no "
+            r"right\), right_0021\.png \(no left\); remove them or restore their partners",
+        ):
+            calmod._pair_by_number(lefts, rights)
+    # the calibration's own check of the names: the numbers differ in every pair
+    assert calmod._numbers_differ(lefts, rights, lefts) == lefts
+    # half shared (right_0011..0030) or none (right_0101..0120): each camera's own counter
+    for first in (11, 101):
+        shifted = [f"cams/right_{i:04d}.png" for i in range(first, first + 20)]
+        with pytest.warns(UserWarning, match="paired in order"):
+            assert calmod._pair_by_number(lefts, shifted) == shifted
+    # 11 of 20 shared (right_0010..0029): by number
+    with pytest.raises(ValueError, match=r"18 image\(s\) have no partner"):
+        calmod._pair_by_number(lefts, [f"cams/right_{i:04d}.png" for i in range(10, 30)])

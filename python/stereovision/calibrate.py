@@ -1146,13 +1146,21 @@ def _file_number(name: str | None) -> int | None:
 
 def _constant_shift(kl: Sequence[int | None], kr: Sequence[int | None]) -> int | None:
     """``d`` when the right numbers are the left ones + ``d`` (``d != 0``), both an unbroken
-    run of as many numbers (``left_0001..0020`` and ``right_0101..0120``, in any order); else
-    None."""
+    run of as many numbers (``left_0001..0020`` and ``right_0101..0120``, in any order) that
+    share at most half their numbers; else None.
+
+    The rule: runs sharing more than half their numbers (``left_0001..0020`` with
+    ``right_0002..0021``, 19 shared) are one run with an end file deleted on each side, paired
+    by number; runs sharing half or fewer (``right_0011..0030``, 10 shared; ``right_0101..
+    0120``, none) are each camera's counter started elsewhere, paired in order.
+    """
     if len(kl) < 2 or len(kl) != len(kr) or None in kl or None in kr:
         return None
     nl, nr = sorted(k for k in kl if k is not None), sorted(k for k in kr if k is not None)
     if nl != list(range(nl[0], nl[0] + len(nl))) or nr != list(range(nr[0], nr[0] + len(nr))):
         return None
+    if 2 * len(set(nl) & set(nr)) > len(nl):
+        return None  # mostly the same numbers: an end file deleted on each side, not an offset
     return nr[0] - nl[0] or None
 
 
@@ -2318,8 +2326,11 @@ def _pair_by_number(lefts: list[str], rights: list[str]) -> list[str]:
     sides, the pairs are made on them and an image without a partner is refused by name (unless
     the sorted position already pairs every shared number with itself: partners whose numbers
     differ, such as each camera's capture second). Two unbroken runs of as many numbers that
-    differ by a constant (``left_0001..0020`` with ``right_0101..0120`` or ``right_0011..0030``:
-    each camera's counter started elsewhere) are paired in order, said in one UserWarning.
+    differ by a constant and share at most half their numbers (``left_0001..0020`` with
+    ``right_0101..0120`` or ``right_0011..0030``: each camera's counter started elsewhere) are
+    paired in order, said in one UserWarning; runs sharing more than half (``left_0001..0020``
+    with ``right_0002..0021``: an end file deleted on each side) are paired by number, their
+    images without a partner refused by name.
     Names whose numbers do not correspond (timestamps taken by each camera) keep the
     position pairing.
 
