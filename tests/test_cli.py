@@ -522,9 +522,9 @@ def test_rectify_with_calib_removes_an_earlier_runs_homographies(
     assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
     assert not (out / "rectification.json").exists()
     said = capsys.readouterr().out.splitlines()
-    assert (
-        said[-1]
-        == "  removed rectification.json of an earlier run without --calib (not this pair's)"
+    assert said[-1] == (
+        "  removed rectification.json of an earlier run (its homographies do not fit the images "
+        "written now: rectified by --calib)"
     )
     (out / "rectification.json").write_text('{"mine": 1}')
     assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
@@ -558,11 +558,23 @@ def test_rectify_writes_a_rectified_pair_as_given(
     assert capsys.readouterr().out.startswith("rectified without a calibration")
     assert (out / "rectification.json").is_file()
     assert cv2.imread(str(out / "left_rect.png")).shape != cv2.imread(pair[0]).shape
-    # the homographies of the forced run are not this pair's any more: removed, and said
+    # the forced run's homographies were this pair's (the line said 'not this pair's'), but
+    # they do not fit the pair written as given now: removed, and said so
     assert main(["rectify", *pair, "-o", str(out)]) == 0
     assert not (out / "rectification.json").exists()
     assert capsys.readouterr().out.splitlines()[-1] == (
-        "  removed rectification.json of an earlier run (not this pair's: it is rectified already)"
+        "  removed rectification.json of an earlier run (its homographies do not fit the images "
+        "written now: the pair as given)"
+    )
+    # an explicit --model on a pair written as given was dropped without a word: now named
+    assert main(["rectify", *pair, "--model", "projective", "-o", str(out)]) == 0
+    assert (
+        capsys.readouterr()
+        .out.splitlines()[0]
+        .endswith(
+            "tolerance 0.5): written as given, not warped, --model projective not used (--force "
+            "rectifies it from its features anyway)"
+        )
     )
     terrace = data_dir / "eth3d" / "terrace"
     calib = ["--calib", str(terrace / "calib.txt")]

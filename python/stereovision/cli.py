@@ -580,9 +580,11 @@ def cmd_rectify(args: argparse.Namespace) -> int:
             f"{summary.max_disparity} -o OUT"
         )
     if given is not None:
+        # an explicit --model is not applied to a pair written as given: said, not dropped
+        unused = f", --model {args.model} not used" if args.model != "auto" else ""
         print(
-            f"already rectified ({given.rows_agree()}): written as given, not warped (--force "
-            "rectifies it from its features anyway)"
+            f"already rectified ({given.rows_agree()}): written as given, not warped{unused} "
+            "(--force rectifies it from its features anyway)"
         )
     else:
         print(check.summary())
@@ -590,9 +592,11 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         print(f"  {name:19s} {path}")
     stale = out / "rectification.json"
     if summary is None and stale.is_file() and not stale.is_symlink():
-        # An earlier run without --calib wrote it: kept, `depth --rectification` would warp
-        # these calibrated images by its homographies. A file of that name that is not one of
-        # ours stays.
+        # An earlier run without --calib (or with --force) wrote it: kept, `depth
+        # --rectification` would warp the images written now (calibrated, or the pair as
+        # given) by its homographies. It may have been this very pair's (a --force run before
+        # a plain one): the line says why it goes, not whose it was. A file of that name that
+        # is not one of ours stays.
         from stereovision.uncalibrated import UncalibratedRectification
 
         try:
@@ -601,11 +605,10 @@ def cmd_rectify(args: argparse.Namespace) -> int:
             pass
         else:
             stale.unlink()
+            now = "the pair as given" if given is not None else "rectified by --calib"
             print(
-                f"  removed {stale.name} of an earlier run (not this pair's: it is rectified "
-                "already)"
-                if given is not None
-                else f"  removed {stale.name} of an earlier run without --calib (not this pair's)"
+                f"  removed {stale.name} of an earlier run (its homographies do not fit the "
+                f"images written now: {now})"
             )
     return 0
 
@@ -1085,7 +1088,8 @@ def build_parser() -> argparse.ArgumentParser:
         default="auto",
         choices=("auto", "quasi-euclidean", "projective"),
         help="without --calib: turned cameras (quasi-euclidean), Hartley's homographies of F "
-        "(projective), or the first when it fits (auto, the default)",
+        "(projective), or the first when it fits (auto, the default); a pair already rectified "
+        "is written as given all the same (said), --force warps it with the model",
     )
     d.add_argument(
         "--force",
