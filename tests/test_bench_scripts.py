@@ -13,6 +13,7 @@ import subprocess
 import sys
 from functools import cache
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -121,6 +122,43 @@ def test_accuracy_times_are_medians_of_the_repeats(data_dir: Path, script: str, 
     assert row["case"] == "accuracy" and row["repeats"] == 5
     assert row[ours]["ms"] > 0 and row["reference"]["ms"] > 0
     assert row[ours]["count"] > 1000 and row[ours]["p1"] > 97
+
+
+def test_accuracy_times_come_from_as_many_timed_runs(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The test above reads ``repeats: 5`` off the line, which a script can print after one
+    run; here the functions bench_hopfield hands to ``_common.interleaved_runs`` are counted:
+    a warm-up and 5 timed runs of each side (network, reference)."""
+    import runpy
+
+    assert (data_dir / "middlebury2001" / "tsukuba").is_dir()
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import _common
+
+    real = _common.interleaved_runs
+    counts: list[list[int]] = []
+
+    def counting(fns: Any, repeats: int) -> Any:
+        ran = [0] * len(fns)
+
+        def counted(i: int) -> Any:
+            def run() -> Any:
+                ran[i] += 1
+                return fns[i]()
+
+            return run
+
+        counts.append(ran)
+        return real([counted(i) for i in range(len(fns))], repeats)
+
+    monkeypatch.setattr(_common, "interleaved_runs", counting)
+    argv = ["bench_hopfield.py", "--scenes", "middlebury2001/tsukuba", "--no-speed"]
+    monkeypatch.setattr(sys, "argv", [*argv, "--repeats", "5"])
+    runpy.run_path(str(BENCHES / "bench_hopfield.py"), run_name="__main__")
+    row = json.loads(capsys.readouterr().out.splitlines()[-1])
+    assert row["repeats"] == 5
+    assert counts == [[6, 6]]  # one scene: 1 warm-up + 5 timed runs, network and reference
 
 
 def test_eval_gabor_scenes_times_ours_beside_sgbm(data_dir: Path) -> None:
