@@ -437,6 +437,13 @@ def test_pair_and_calibration_mistakes_are_named() -> None:
     half = dataclasses.replace(s.calib, image_size=(900, 750))
     with pytest.raises(ValueError, match=r"calib.scaled_to\(\(450, 375\)\)"):
         sv.depth_map(s.left, s.right, half)
+    # match() checks the rig as depth_map does (one helper): its size error had no hint
+    with pytest.raises(ValueError, match=r"450x375 \(width and height swapped\? image_size is"):
+        sv.match(s.left, s.right, swapped, method="best")
+    with pytest.raises(
+        ValueError, match=r"Calibration \(or an UncalibratedRectification\), got str"
+    ):
+        sv.match(s.left, s.right, "calib.yaml", method="best")  # type: ignore[arg-type]
 
 
 def test_a_whole_result_or_a_wrong_unit_is_named(tmp_path: Path) -> None:

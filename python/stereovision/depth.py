@@ -15,7 +15,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import cv2
 import numpy as np
@@ -28,6 +28,8 @@ from stereovision.calibration import Calibration
 from stereovision.uncalibrated import UncalibratedRectification
 
 __all__ = ["METHODS", "DepthResult", "depth_map", "disparity_sigma", "estimate_max_disparity"]
+
+_D = TypeVar("_D", int, float)  # a max_disparity: match's int, depth_map's float
 
 #: Matchers ``depth_map`` knows, by name; the first is its default.
 METHODS = ("fused", "gabor", "census", "fast")
@@ -100,6 +102,46 @@ def _whole_or_float(value: float) -> float:
 #: A pair whose brightest grey value is below this share of the full range (64 of 255 grey levels)
 #: is stretched by one gain for the automatic range's features (12-bit data in 16 bits: 1/16).
 _DARK_PAIR = 0.25
+
+
+def _rig_to_warp_by(
+    calib: Calibration | UncalibratedRectification | None,
+    width: int,
+    height: int,
+    max_disparity: _D | None,
+) -> tuple[Calibration | UncalibratedRectification | None, Calibration | None, _D | int | None]:
+    """What ``calib`` asks of a ``width`` x ``height`` pair (:func:`depth_map`'s and
+    ``match``'s): ``(rig, calibration, max_disparity)``, ``rig`` the rectification to warp the
+    pair by (None: matched as given), ``calibration`` the rig's calibration (None for an
+    :class:`UncalibratedRectification`, whose search range then stands in for a
+    ``max_disparity`` of None).
+
+    Raises
+    ------
+    ValueError
+        ``calib`` of another type, or a calibration for another image size (with a hint).
+    """
+    if isinstance(calib, UncalibratedRectification):
+        # a rig without a calibration: its pair through the homographies, disparity only
+        return calib, None, calib.max_disparity if max_disparity is None else max_disparity
+    if calib is None:
+        return None, None, max_disparity
+    if not isinstance(calib, Calibration):
+        raise ValueError(
+            "calib must be a stereovision.Calibration (or an UncalibratedRectification), "
+            f"got {type(calib).__name__}"
+        )
+    if tuple(calib.image_size) != (width, height):
+        cw, ch = calib.image_size
+        w, h = width, height
+        if (cw, ch) == (h, w):
+            hint = "width and height swapped? image_size is (width, height)"
+        elif cw * h == ch * w:
+            hint = f"images resized, not cropped: calib.scaled_to(({w}, {h}))"
+        else:
+            hint = "another aspect ratio: another camera mode or camera, or cropped images"
+        raise ValueError(f"calibration is for {cw}x{ch} images, got {w}x{h} ({hint})")
+    return (None if calib.rectified else calib), calib, max_disparity
 
 
 def _rectify_grey(
@@ -956,7 +998,6 @@ def depth_map(
         # the result keeps the left image (its cloud's colours, exports): not the caller's
         # buffer, which a camera loop refills (cap.read(frame)) before the cloud is written
         left_bgr = left_bgr.copy()
-    from stereovision.uncalibrated import UncalibratedRectification
 
     # A 16-bit or float pair is matched on its own grey levels, rectified as they are: the 8-bit
     # BGR copy (for colours and the fill) keeps 8 bits of them (a dark 13-bit exposure of ETH3D
@@ -964,37 +1005,15 @@ def depth_map(
     # levels). An 8-bit pair keeps its path (grey levels of the rectified BGR images).
     deep = np.asarray(left).dtype != np.uint8 or np.asarray(right).dtype != np.uint8
     grey: tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]] | None = None
-    if isinstance(calib, UncalibratedRectification):
-        # a rig without a calibration: its pair through the homographies, disparity only
+    h, w = left_bgr.shape[:2]
+    rig, calib, max_disparity = _rig_to_warp_by(calib, w, h, max_disparity)
+    if rig is not None:
         if deep:
-            grey = _rectify_grey(calib, left, right)
-        left_bgr, right_bgr = calib.rectify(left_bgr, right_bgr)
+            grey = _rectify_grey(rig, left, right)
+        left_bgr, right_bgr = rig.rectify(left_bgr, right_bgr)
         left, right = left_bgr, right_bgr
-        max_disparity = calib.max_disparity if max_disparity is None else max_disparity
-        calib = None
-    if calib is not None:
-        if not isinstance(calib, Calibration):
-            raise ValueError(
-                "calib must be a stereovision.Calibration (or an UncalibratedRectification), "
-                f"got {type(calib).__name__}"
-            )
-        h, w = left_bgr.shape[:2]
-        if tuple(calib.image_size) != (w, h):
-            cw, ch = calib.image_size
-            if (cw, ch) == (h, w):
-                hint = "width and height swapped? image_size is (width, height)"
-            elif cw * h == ch * w:
-                hint = f"images resized, not cropped: calib.scaled_to(({w}, {h}))"
-            else:
-                hint = "another aspect ratio: another camera mode or camera, or cropped images"
-            raise ValueError(f"calibration is for {cw}x{ch} images, got {w}x{h} ({hint})")
-        if not calib.rectified:
-            if deep:
-                grey = _rectify_grey(calib, left, right)
-            left_bgr, right_bgr = calib.rectify(left_bgr, right_bgr)
+        if calib is not None:
             calib = calib.rectified_calibration()
-            left = left_bgr
-            right = right_bgr
     stage("rectify")
     if grey is not None:
         gl, gr = grey

@@ -9,7 +9,7 @@ import numpy.typing as npt
 
 from stereovision._validate import as_bgr_uint8, check_pair
 from stereovision.calibration import Calibration
-from stereovision.depth import _rectify_grey, estimate_max_disparity
+from stereovision.depth import _rectify_grey, _rig_to_warp_by, estimate_max_disparity
 from stereovision.matches import Matches
 from stereovision.matching import hopfield as _hopfield
 from stereovision.matching import mcgm as _mcgm
@@ -83,33 +83,15 @@ def match(
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
     gl, gr = check_pair(left, right)
     uint8 = np.asarray(left).dtype == np.uint8 and np.asarray(right).dtype == np.uint8
-    if isinstance(calib, UncalibratedRectification):
-        # a rig without a calibration: its pair through the homographies, as depth_map does
+    h, w = gl.shape
+    # a calibrated rig not yet rectified, or an uncalibrated one: as depth_map does
+    rig, _, max_disparity = _rig_to_warp_by(calib, w, h, max_disparity)
+    if rig is not None:
         if uint8:
-            lb, rb = calib.rectify(as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right"))
+            lb, rb = rig.rectify(as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right"))
             gl, gr = check_pair(lb, rb)
         else:
-            gl, gr = _rectify_grey(calib, gl, gr)
-        max_disparity = calib.max_disparity if max_disparity is None else max_disparity
-        calib = None
-    if calib is not None:
-        if not isinstance(calib, Calibration):
-            raise ValueError(
-                "calib must be a stereovision.Calibration (or an UncalibratedRectification), "
-                f"got {type(calib).__name__}"
-            )
-        h, w = gl.shape
-        if tuple(calib.image_size) != (w, h):
-            raise ValueError(
-                f"calibration is for {calib.image_size[0]}x{calib.image_size[1]} images, "
-                f"got {w}x{h}"
-            )
-        if not calib.rectified:
-            if uint8:
-                lb, rb = calib.rectify(as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right"))
-                gl, gr = check_pair(lb, rb)
-            else:
-                gl, gr = _rectify_grey(calib, gl, gr)  # as depth_map does
+            gl, gr = _rectify_grey(rig, gl, gr)
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
     if method == "mcgm":
