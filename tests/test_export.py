@@ -187,6 +187,16 @@ def test_empty_ascii_pcd_is_an_empty_cloud(tmp_path):
         assert pts.shape == (1, 0, 3) and cols is not None and cols.shape == (1, 0, 3)
         with pytest.raises(ValueError, match=rf"empty point cloud: .*empty_{mode}\.pcd has no"):
             export.load_cloud(path)
+    # POINTS 3 and no rows: the count is named (it was "rows of 1 values, FIELDS has 4" after
+    # NumPy's "input contained no data" warning; read_ply's and read_pcd's ASCII reading is one)
+    path = tmp_path / "no_rows.pcd"
+    path.write_text(
+        head.replace("WIDTH 0", "WIDTH 3").replace("POINTS 0", "POINTS 3").format("ascii")
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"no_rows\.pcd: expected 3 points, got 0$"):
+            export.read_pcd(path)
 
 
 def test_bundle_without_calibration_says_so(result, tmp_path):

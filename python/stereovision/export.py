@@ -35,7 +35,7 @@ from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.depth import DepthResult
-from stereovision.io import atomic_write, make_folder, read_ply, write_ply
+from stereovision.io import _ascii_table, atomic_write, make_folder, read_ply, write_ply
 
 if TYPE_CHECKING:
     import pyvista as pv
@@ -372,14 +372,7 @@ def read_pcd(
             raise ValueError(f"truncated PCD file {p}: expected {n} points")
         rec = np.frombuffer(raw, dtype=dtype, count=n, offset=pos)
     elif mode == "ascii":
-        try:
-            if n == 0 and not raw[pos:].strip():
-                # no rows: numpy would warn "input contained no data" and give a (0, 1) table
-                table = np.zeros((0, sum(counts)))
-            else:
-                table = np.loadtxt(_io.BytesIO(raw[pos:]), dtype=np.float64, ndmin=2)
-        except ValueError as exc:  # a short or damaged row: NumPy's words, with the file's name
-            raise ValueError(f"damaged PCD file {p}: {str(exc).splitlines()[0]}") from None
+        table = _ascii_table(raw[pos:], p, "PCD", sum(counts))
         # A field of COUNT c takes c columns (PCL's FPFH histograms: 33, padding "_": 4).
         if table.shape[1] < sum(counts):
             raise ValueError(

@@ -737,29 +737,54 @@ def read_ply(
     return pts, cols
 
 
+def _ascii_table(
+    body: bytes,
+    path: Path,
+    kind: str,
+    columns: int,
+    *,
+    rows: int | None = None,
+    first: bool = False,
+) -> npt.NDArray[np.float64]:
+    """The numbers of an ASCII point file's body, a row a line, as a 2-D ``float64`` table
+    (``read_ply``'s and ``export.read_pcd``'s): ``rows`` rows at the most (None: all), the
+    ``first`` ``columns`` of each only (else every column). An empty body is ``(0, columns)``
+    (NumPy warned "input contained no data" and gave ``(0, 1)``).
+
+    Raises
+    ------
+    ValueError
+        A short or damaged row: NumPy's words, with ``kind`` ("PLY", "PCD") and the file's name.
+    """
+    import io as _io
+
+    if not body.strip():
+        return np.zeros((0, columns))
+    try:
+        return np.loadtxt(
+            _io.BytesIO(body),
+            dtype=np.float64,
+            ndmin=2,
+            max_rows=rows,
+            usecols=range(columns) if first else None,
+        )
+    except ValueError as exc:  # a short or damaged row: NumPy's words, with the file's name
+        raise ValueError(f"damaged {kind} file {path}: {str(exc).splitlines()[0]}") from None
+
+
 def _ascii_ply_vertices(
     body: bytes, dtype: np.dtype[Any], count: int, path: Path
 ) -> npt.NDArray[Any]:
     """The first ``count`` rows of an ASCII PLY body as records of ``dtype`` (one value per
     property; rows of later elements, faces, are not read)."""
-    import io as _io
-
     rec = np.empty(count, dtype=dtype)
     if count == 0:
         return rec
-    try:
-        table = np.loadtxt(
-            _io.BytesIO(body),
-            dtype=np.float64,
-            ndmin=2,
-            max_rows=count,
-            usecols=range(len(dtype.names or ())),
-        )
-    except ValueError as exc:  # a short or damaged row: NumPy's words, with the file's name
-        raise ValueError(f"damaged PLY file {path}: {str(exc).splitlines()[0]}") from None
+    names = dtype.names or ()
+    table = _ascii_table(body, path, "PLY", len(names), rows=count, first=True)
     if table.shape[0] < count:
         raise ValueError(f"truncated PLY file {path}: expected {count} vertices")
-    for i, name in enumerate(dtype.names or ()):
+    for i, name in enumerate(names):
         rec[name] = table[:, i]
     return rec
 
