@@ -147,11 +147,17 @@ class _Unpaired:
         return f"no {self.missing.name} beside {self.present}"
 
 
+def _stem_without(stem: str, m: re.Match[str]) -> str:
+    """``0001`` for ``left_0001``: ``stem`` without the word ``m`` and the separators around it
+    (empty for ``left``)."""
+    before, after = stem[: m.start()].rstrip("_-. "), stem[m.end() :].lstrip("_-. ")
+    return "_".join(x for x in (before, after) if x)
+
+
 def _pair_name(p: Path, m: re.Match[str], rel: str, root: Path) -> str:
     """``seq/0001`` for ``seq/left_0001.png``: the folder and the stem without the word ``m``
     (and separators around it); the folder alone for ``left.jpg``, like a scene."""
-    before, after = p.stem[: m.start()].rstrip("_-. "), p.stem[m.end() :].lstrip("_-. ")
-    short = "_".join(x for x in (before, after) if x)
+    short = _stem_without(p.stem, m)
     if not short:
         return rel if rel != "." else root.resolve().name
     return short if rel == "." else f"{rel}/{short}"
@@ -435,8 +441,7 @@ def _without_side(sub: str) -> str:
     m = _last_left(p.stem)
     if m is None:
         return sub
-    before, after = p.stem[: m.start()].rstrip("_-. "), p.stem[m.end() :].lstrip("_-. ")
-    short = "_".join(x for x in (before, after) if x) or p.stem
+    short = _stem_without(p.stem, m) or p.stem
     return (p.parent / (short + p.suffix)).as_posix()
 
 
