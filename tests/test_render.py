@@ -464,9 +464,22 @@ def test_view_refuses_to_write_over_the_scene_it_shows(tmp_path):
     before = (scene / "left.png").read_bytes()
     for name in ("left.png", "right.png"):
         args = _view_args(scene, scene / name)
-        with pytest.raises(ValueError, match=rf"-o .*{name}: is the input .*{name}; the screen"):
+        side = name.split(".")[0]
+        with pytest.raises(ValueError, match=rf"-o .*{name}: is the scene's {side} image \("):
             args.func(args)
     assert (scene / "left.png").read_bytes() == before
+
+
+def test_view_refuses_a_screenshot_folder_it_cannot_write_in(tmp_path):
+    """``view SCENE -o /proc/shot.png`` computed the depth map and rendered it before the
+    writer failed; the folder is checked first, as ``io.check_output_folder`` checks others."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.render import _check_screenshot_path
+
+    if not Path("/proc").is_dir():
+        pytest.skip("needs /proc")
+    with pytest.raises(PermissionError, match=r"^-o /proc/shot\.png: cannot write in /proc \("):
+        _check_screenshot_path("/proc/shot.png", bundled_data_dir() / "cones")
 
 
 @pytest.mark.skipif(

@@ -41,31 +41,13 @@ class CliError(Exception):
 
 
 def _refuse_an_input(flag: str, output: Path, inputs: dict[str, str | None]) -> None:
-    """Refuse an output path that names one of the run's input files.
+    """:func:`stereovision.io.refuse_an_input`, its refusal a :class:`CliError`."""
+    from stereovision.io import refuse_an_input
 
-    Parameters
-    ----------
-    flag : str
-        The option that names ``output`` (``--plot``), for the message.
-    output : pathlib.Path
-        The file about to be written.
-    inputs : dict
-        What each input is (``"the left image"``) -> its path as given (None: not given).
-
-    Raises
-    ------
-    CliError
-        If ``output`` is one of ``inputs`` (the same file, through any link or spelling).
-    """
-    for what, given in inputs.items():
-        if not given:
-            continue
-        try:
-            same = os.path.samefile(output, given)
-        except OSError:  # one of them does not exist (yet): compare the spelled-out paths
-            same = output.resolve() == Path(given).resolve()
-        if same:
-            raise CliError(f"{flag} {output}: is {what} ({given}); give another file name")
+    try:
+        refuse_an_input(flag, output, inputs)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
 
 
 def _atomic_write_bytes(path: Path, data: bytes) -> None:

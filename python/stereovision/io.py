@@ -86,6 +86,34 @@ def make_folder(path: PathLike) -> Path:
     return folder
 
 
+def refuse_an_input(flag: str, output: Path, inputs: dict[str, str | None]) -> None:
+    """Refuse an output path that names one of the run's input files.
+
+    Parameters
+    ----------
+    flag : str
+        The option that names ``output`` (``--plot``), for the message.
+    output : pathlib.Path
+        The file about to be written.
+    inputs : dict
+        What each input is (``"the left image"``) -> its path as given (None: not given).
+
+    Raises
+    ------
+    ValueError
+        If ``output`` is one of ``inputs`` (the same file, through any link or spelling).
+    """
+    for what, given in inputs.items():
+        if not given:
+            continue
+        try:
+            same = os.path.samefile(output, given)
+        except OSError:  # one of them does not exist (yet): compare the spelled-out paths
+            same = output.resolve() == Path(given).resolve()
+        if same:
+            raise ValueError(f"{flag} {output}: is {what} ({given}); give another file name")
+
+
 def check_output_folder(folder: PathLike, flag: str) -> None:
     """A folder a command will create (or fill), checked before its work: refused if a file
     stands in its way or the nearest existing folder above it is not writable.

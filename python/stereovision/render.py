@@ -902,7 +902,11 @@ def _check_screenshot_path(output: str | os.PathLike[str], source: str | os.Path
         The folder of ``output`` does not exist.
     IsADirectoryError, NotADirectoryError
         ``output`` is a folder, or its folder is a file.
+    PermissionError
+        No file can be made in the folder of ``output`` (the system's reason).
     """
+    from stereovision.io import cannot_write_in, refuse_an_input
+
     out = Path(output)
     if out.suffix.lower() not in SCREENSHOT_SUFFIXES:
         raise ValueError(f"{out}: a screenshot is written as .png, .jpg or .bmp")
@@ -913,14 +917,15 @@ def _check_screenshot_path(output: str | os.PathLike[str], source: str | os.Path
         raise NotADirectoryError(f"-o {out}: {parent} is a file, not a folder")
     if not parent.exists():
         raise FileNotFoundError(f"output folder does not exist: {parent}")
+    why = cannot_write_in(parent)
+    if why:  # found after the depth map and the render, by the writer
+        raise PermissionError(f"-o {out}: cannot write in {parent} ({why})")
     src = Path(source)
-    inputs = [src / "left.png", src / "right.png"] if src.is_dir() else [src]
-    for inp in inputs:
-        if out.exists() and inp.exists() and os.path.samefile(out, inp):
-            raise ValueError(
-                f"-o {out}: is the input {inp}; the screenshot would replace it (choose "
-                "another name)"
-            )
+    if src.is_dir():
+        inputs = {f"the scene's {side} image": src / f"{side}.png" for side in ("left", "right")}
+    else:
+        inputs = {"the cloud shown": src}
+    refuse_an_input("-o", out, {what: str(p) for what, p in inputs.items() if p.exists()})
     return out
 
 
