@@ -1262,6 +1262,20 @@ class StereoApp:
         if self.pair is not None:
             self._spawn(self.recompute())
 
+    def _view_on_show(self, label: str, pending: str) -> ViewData | None:
+        """The pair on show for a button that works on its results (Find floor, Save), or
+        None, said: no pair (an error), or a new pair still computing (``pending`` in the
+        state's ``label``: ``self.view`` is the previous pair's)."""
+        view = self.view
+        if view is None:
+            self._fail(ValueError(NO_PAIR))
+            return None
+        if self._page_before is not None:
+            with self.state:
+                setattr(self.state, label, pending)
+            return None
+        return view
+
     def find_floor_clicked(self) -> None:
         """The page's "Find floor" button."""
         self._spawn(self.find_floor())
@@ -1269,13 +1283,8 @@ class StereoApp:
     async def find_floor(self) -> None:
         """Fit the floor of the depth map on show: the camera's height, pitch and roll, and a
         picture with the floor in green and what stands 0.15-2 m on it in red."""
-        view = self.view
+        view = self._view_on_show("floor_label", PENDING_FLOOR)
         if view is None:
-            self._fail(ValueError(NO_PAIR))
-            return
-        if self._page_before is not None:  # self.view is the previous pair's
-            with self.state:
-                self.state.floor_label = PENDING_FLOOR
             return
         res = view.result
         if res.depth is None or getattr(res, "calibration", None) is None:
@@ -1316,13 +1325,8 @@ class StereoApp:
         from stereovision.cli import CliError, write_depth_outputs
         from stereovision.io import check_output_folder
 
-        view = self.view
+        view = self._view_on_show("save_label", PENDING_SAVE)
         if view is None:
-            self._fail(ValueError(NO_PAIR))
-            return
-        if self._page_before is not None:  # self.view is the previous pair's
-            with self.state:
-                self.state.save_label = PENDING_SAVE
             return
         result = view.result
         names = SAVED_FILES + (SAVED_DEPTH_FILES if result.depth is not None else ())
