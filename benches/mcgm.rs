@@ -89,18 +89,18 @@ fn bench(c: &mut Criterion) {
                 |b, l| b.iter(|| log_filter(l, sigma)),
             );
         }
-        let lg = log_filter(&l, 1.0);
+        let lg = log_filter(&l, 1.0).expect("memory");
         g.bench_function(BenchmarkId::new("zero_crossings", &id), |b| {
             b.iter(|| zero_crossings(&lg, w, h))
         });
-        let zc = zero_crossings(&lg, w, h);
+        let zc = zero_crossings(&lg, w, h).expect("memory");
         g.bench_function(BenchmarkId::new("track", &id), |b| {
             b.iter(|| track(&zc, &p.track))
         });
         // R-tables (B.4 step 6) of the finest channel's segments, then the GHT votes of every
         // left segment against the right segments in its rows over the whole range (step 8).
-        let cl = channel_curves(&l, p.sigmas[p.sigmas.len() - 1], 1, &p);
-        let cr = channel_curves(&r, p.sigmas[p.sigmas.len() - 1], 1, &p);
+        let cl = channel_curves(&l, p.sigmas[p.sigmas.len() - 1], 1, &p).expect("memory");
+        let cr = channel_curves(&r, p.sigmas[p.sigmas.len() - 1], 1, &p).expect("memory");
         g.bench_function(BenchmarkId::new("rtables", &id), |b| {
             b.iter(|| {
                 cl.curves

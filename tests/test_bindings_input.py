@@ -342,3 +342,74 @@ def test_the_census_memory_check_counts_the_address_space_limit() -> None:
     assert out.returncode == 0, out.stderr[-2000:]
     avail = int(out.stdout.split()[1])
     assert 0 < avail < limit
+
+
+#: Runs a matcher on a large flat image under ``ulimit -v`` set just above what the process
+#: holds (plus the bindings' copies of the pair, when they copy it), so that the kernel's own
+#: first large buffer fails. The matcher runs once on a small pair first: its worker threads and
+#: their heaps exist before the limit.
+_KERNEL_OOM_SCRIPT = """
+import resource
+import sys
+
+import numpy as np
+from stereovision import _core
+
+case, side, copies = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+
+
+def run(a):
+    if case == "gabor":
+        _core.gabor_disparity(a, a, 0.0, 8.0)
+    elif case == "gabor-one-way":
+        _core.gabor_disparity(a, a, 0.0, 8.0, lr_check=False)
+    elif case == "mcgm":
+        _core.mcgm_match(a, a, {})
+    else:
+        _core.hopfield_match(a, a, {})
+
+
+run(np.random.default_rng(0).random((64, 96), dtype=np.float32))
+a = np.zeros((side, side), np.float32)
+with open("/proc/self/status") as f:
+    held = next(int(line.split()[1]) * 1024 for line in f if line.startswith("VmSize:"))
+limit = held + copies * a.nbytes + (256 << 20)
+resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+try:
+    run(a)
+except MemoryError as e:
+    print("MemoryError:", e)
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+@pytest.mark.parametrize(
+    ("case", "side", "copies", "matcher"),
+    [
+        ("gabor", 16384, 0, "Gabor matcher"),
+        # Without the left-right check no mirrored pair: the pooled planes come first.
+        ("gabor-one-way", 16384, 0, "Gabor matcher"),
+        ("mcgm", 8192, 2, "MCGM matcher"),
+        ("hopfield", 16384, 0, "Hopfield matcher"),
+    ],
+)
+def test_a_matcher_that_runs_out_of_memory_raises_memory_error(
+    case: str, side: int, copies: int, matcher: str
+) -> None:
+    """The Gabor, MCGM and Hopfield kernels allocated their image-sized planes with ``vec!``:
+    a failed allocation aborted the whole process (SIGABRT, exit -6). The kernel's own buffer
+    is named, with its size."""
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    out = subprocess.run(
+        [sys.executable, "-c", _KERNEL_OOM_SCRIPT, case, str(side), str(copies)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    pattern = (
+        rf"MemoryError: out of memory: [^\n]*{matcher}[^\n]* needs \d+\.\d\d [MG]iB "
+        r"\(\d+ bytes\) and the allocation failed"
+    )
+    assert re.search(pattern, out.stdout), out.stdout

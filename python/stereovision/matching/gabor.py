@@ -129,6 +129,9 @@ def gabor_disparity(
     ValueError
         If an image is not 2-D, empty, not floating point, non-finite, the shapes differ, a
         parameter is unknown or out of range.
+    MemoryError
+        When an image-sized buffer of the kernel cannot be allocated (the message names it and
+        its size); the process is not aborted.
     """
     refuse_unknown("Gabor parameter", params, DEFAULTS, "stereovision.matching.gabor.DEFAULTS")
     lft = _as_grey(left, "left")

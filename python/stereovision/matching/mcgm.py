@@ -264,6 +264,9 @@ def mcgm_match(
     ValueError
         Bad images (shape, dtype, empty, NaN, mismatched sizes), an unknown parameter or a value
         out of range.
+    MemoryError
+        When an image-sized buffer of the kernel cannot be allocated (the message names it and
+        its size); the process is not aborted.
 
     Examples
     --------

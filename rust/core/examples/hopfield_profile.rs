@@ -73,7 +73,7 @@ fn main() {
     let mut t = [(); 6].map(|_| Vec::new());
     for _ in 0..9 {
         let s = Instant::now();
-        interest_points(&l, &p.interest);
+        interest_points(&l, &p.interest).expect("memory");
         t[0].push(ms(s));
         let s = Instant::now();
         let (_, neurons) = candidate_neurons(&l, &r, &p).expect("valid input");

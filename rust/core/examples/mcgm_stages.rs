@@ -31,13 +31,13 @@ fn best_ms(runs: usize, mut f: impl FnMut()) -> f64 {
 }
 
 fn curves(l: &Image, p: &McgmParams) {
-    let half = log::decimate2(l);
+    let half = log::decimate2(l).expect("memory");
     for (sig, img) in [(1.0f32, l), (2.0, l), (2.0, &half)] {
         let (w, h) = img.size();
-        let lg = log::log_filter(img, sig);
-        let zc = zerocross::zero_crossings(&lg, w, h);
+        let lg = log::log_filter(img, sig).expect("memory");
+        let zc = zerocross::zero_crossings(&lg, w, h).expect("memory");
         let tp = p.track_params(sig);
-        let c = tracking::track(&zc, &tp);
+        let c = tracking::track(&zc, &tp).expect("memory");
         let t_log = best_ms(9, || drop(log::log_filter(img, sig)));
         let t_zc = best_ms(9, || drop(zerocross::zero_crossings(&lg, w, h)));
         let t_track = best_ms(9, || drop(tracking::track(&zc, &tp)));
@@ -88,7 +88,7 @@ fn filters(l: &Image, r: &Image, p: &McgmParams, d: usize) {
 }
 
 fn graph(l: &Image, p: &McgmParams) {
-    let cc = channel_curves(l, 1.0, 1, p);
+    let cc = channel_curves(l, 1.0, 1, p).expect("memory");
     let segs = &cc.curves.segments;
     let edges: usize = knn_graph(segs, p.knn, p.r_graph).iter().map(Vec::len).sum();
     let t = best_ms(9, || drop(knn_graph(segs, p.knn, p.r_graph)));
@@ -101,7 +101,8 @@ fn graph(l: &Image, p: &McgmParams) {
 fn count(l: &Image, p: &McgmParams) {
     let (w, h) = l.size();
     for sig in [1.0f32, 2.0] {
-        let zc = zerocross::zero_crossings(&log::log_filter(l, sig), w, h);
+        let zc = zerocross::zero_crossings(&log::log_filter(l, sig).expect("memory"), w, h)
+            .expect("memory");
         let t_low = p.track.low_ratio * tracking::high_threshold(&zc, p.track.high_quantile);
         let marked = zc.mark.iter().filter(|&&m| m != 0).count();
         let free = zc
@@ -111,7 +112,7 @@ fn count(l: &Image, p: &McgmParams) {
             .filter(|&(&s, &m)| m != 0 && s >= t_low)
             .count();
         let tp = p.track_params(sig);
-        let c = tracking::track(&zc, &tp);
+        let c = tracking::track(&zc, &tp).expect("memory");
         let kept: usize = c.segments.iter().map(|s| s.pixels.len()).sum();
         println!(
             "sigma {sig}: marked {marked}, candidates {free}, in {} segments {kept}",

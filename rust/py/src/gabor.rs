@@ -278,7 +278,7 @@ pub fn gabor_lr_check<'py>(
     let dl: Vec<f32> = a.iter().copied().collect();
     let dr: Vec<f32> = b.iter().copied().collect();
     let ok = crate::workers::detach(py, || {
-        guard("gabor_lr_check", || Ok(lr_check(&dl, &dr, w, h, tol)))
+        guard("gabor_lr_check", || lr_check(&dl, &dr, w, h, tol))
     })?;
     crate::convert::vec_to_numpy(py, (h, w), ok)
 }
@@ -298,8 +298,7 @@ pub fn gabor_remove_speckles<'py>(
     crate::params::non_negative("max_diff", max_diff)?;
     let kernel = |d: &mut [f32], w, h| {
         guard("gabor_remove_speckles", || {
-            remove_speckles(d, w, h, min_size, max_diff);
-            Ok(())
+            remove_speckles(d, w, h, min_size, max_diff)
         })
     };
     let (out, done) = crate::convert::map_copy_in_place(py, &disp, "disp", kernel)?;

@@ -144,7 +144,7 @@ pub fn mcgm_log<'py>(
         )));
     }
     let (w, h) = im.size();
-    let data = crate::workers::detach(py, || guard("mcgm_log", || Ok(log_filter(&im, sigma))))?;
+    let data = crate::workers::detach(py, || guard("mcgm_log", || log_filter(&im, sigma)))?;
     image_to_numpy(
         py,
         Image {

@@ -12,7 +12,8 @@
 // and the one LLVM vectorises once the slices are re-bounded to the row length.
 #![allow(clippy::needless_range_loop)]
 
-use super::pool::Buf;
+use super::pool::{Buf, WHAT};
+use crate::alloc::try_zeroed;
 use crate::error::{CoreError, Result};
 use crate::parallel::for_each_row;
 use crate::simd::simd_fn;
@@ -195,14 +196,14 @@ thread_local! {
 }
 
 /// Real separable convolution with reflect-101 borders (symmetric taps, so conv = correlation).
-pub fn blur_real(src: &[f32], w: usize, h: usize, gx: &[f32], gy: &[f32]) -> Buf {
-    let mut tmp = Buf::scratch(w * h);
+pub fn blur_real(src: &[f32], w: usize, h: usize, gx: &[f32], gy: &[f32]) -> Result<Buf> {
+    let mut tmp = Buf::scratch(w * h)?;
     for_each_row(&mut tmp, w, |y, out| {
         real_row_pass(&src[y * w..(y + 1) * w], gx, out)
     });
-    let mut dst = Buf::scratch(w * h);
+    let mut dst = Buf::scratch(w * h)?;
     for_each_row(&mut dst, w, |y, out| real_col_pass(&tmp, w, h, y, gy, out));
-    dst
+    Ok(dst)
 }
 
 simd_fn! {
@@ -302,10 +303,10 @@ pub struct Responses {
 
 /// Filters `img` (`w` x `h`, row-major) with every channel. All channels must share the same
 /// envelope (same frequency, bandwidth and aspect), which the bank guarantees.
-pub fn filter_bank(img: &[f32], w: usize, h: usize, chans: &[Channel]) -> Responses {
+pub fn filter_bank(img: &[f32], w: usize, h: usize, chans: &[Channel]) -> Result<Responses> {
     let lowpass = match chans.first() {
-        Some(c) => blur_real(img, w, h, &c.gx, &c.gy).into_vec(),
-        None => vec![0.0; w * h],
+        Some(c) => blur_real(img, w, h, &c.gx, &c.gy)?.into_vec(),
+        None => try_zeroed(w * h, WHAT)?,
     };
     // Row passes are shared by channels with identical x taps (+-theta).
     let mut groups: Vec<OwnedRowGroup> = Vec::new();
@@ -314,7 +315,7 @@ pub fn filter_bank(img: &[f32], w: usize, h: usize, chans: &[Channel]) -> Respon
         if let Some(g) = groups.iter().position(|(hx, _, _)| *hx == c.hx) {
             group_of.push(g);
         } else {
-            let (re, im) = row_pass(img, w, h, &c.hx);
+            let (re, im) = row_pass(img, w, h, &c.hx)?;
             groups.push((c.hx.clone(), re, im));
             group_of.push(groups.len() - 1);
         }
@@ -323,8 +324,8 @@ pub fn filter_bank(img: &[f32], w: usize, h: usize, chans: &[Channel]) -> Respon
     let mut im_out = Vec::with_capacity(chans.len());
     for (c, &g) in chans.iter().zip(&group_of) {
         let (_, hre, him) = &groups[g];
-        let mut re = vec![0f32; w * h];
-        let mut im = vec![0f32; w * h];
+        let mut re = try_zeroed::<f32>(w * h, WHAT)?;
+        let mut im = try_zeroed::<f32>(w * h, WHAT)?;
         crate::parallel::for_each_row2(&mut re, &mut im, w, |y, ore, oim| {
             complex_col_pass(hre, him, w, h, y, &c.hy, ore, oim)
         });
@@ -337,23 +338,23 @@ pub fn filter_bank(img: &[f32], w: usize, h: usize, chans: &[Channel]) -> Respon
         re_out.push(re);
         im_out.push(im);
     }
-    Responses {
+    Ok(Responses {
         w,
         h,
         re: re_out,
         im: im_out,
         lowpass,
-    }
+    })
 }
 
 /// Complex row pass of a real image: `H(x) = sum_t hx(t) I(x - t)`.
-pub fn row_pass(img: &[f32], w: usize, h: usize, hx: &[[f32; 2]]) -> (Buf, Buf) {
-    let mut re = Buf::scratch(w * h);
-    let mut im = Buf::scratch(w * h);
+pub fn row_pass(img: &[f32], w: usize, h: usize, hx: &[[f32; 2]]) -> Result<(Buf, Buf)> {
+    let mut re = Buf::scratch(w * h)?;
+    let mut im = Buf::scratch(w * h)?;
     crate::parallel::for_each_row2(&mut re, &mut im, w, |y, ore, oim| {
         complex_row_pass(&img[y * w..(y + 1) * w], hx, ore, oim)
     });
-    (re, im)
+    Ok((re, im))
 }
 
 simd_fn! {
@@ -454,18 +455,18 @@ simd_fn! {
 }
 
 /// Gaussian pyramid level: blur with `sigma = 1` and keep even pixels (`ceil(n / 2)`).
-pub fn pyr_down(img: &[f32], w: usize, h: usize) -> (Vec<f32>, usize, usize) {
+pub fn pyr_down(img: &[f32], w: usize, h: usize) -> Result<(Vec<f32>, usize, usize)> {
     let g = gaussian_taps(PYR_SIGMA, radius_for(PYR_SIGMA));
-    let b = blur_real(img, w, h, &g, &g);
+    let b = blur_real(img, w, h, &g, &g)?;
     let (w2, h2) = (w.div_ceil(2), h.div_ceil(2));
-    let mut out = vec![0f32; w2 * h2];
+    let mut out = try_zeroed::<f32>(w2 * h2, WHAT)?;
     for_each_row(&mut out, w2, |y, row| {
         let src = &b[(2 * y) * w..(2 * y + 1) * w];
         for (x, v) in row.iter_mut().enumerate() {
             *v = src[2 * x];
         }
     });
-    (out, w2, h2)
+    Ok((out, w2, h2))
 }
 
 /// Anti-alias blur of the pyramid (algorithms.md A.5 step 1).
@@ -486,7 +487,7 @@ mod tests {
             let c = Channel::new(0.25, th, 1.0, 1.0).unwrap();
             // Response to a constant image must vanish.
             let img = vec![0.7f32; 40 * 30];
-            let r = filter_bank(&img, 40, 30, std::slice::from_ref(&c));
+            let r = filter_bank(&img, 40, 30, std::slice::from_ref(&c)).unwrap();
             let m = r.re[0]
                 .iter()
                 .chain(&r.im[0])
@@ -504,7 +505,7 @@ mod tests {
             .map(|i| 0.5 + 0.3 * (k * (i % w) as f32).cos())
             .collect();
         let c = Channel::new(0.25, 0.0, 1.0, 1.0).unwrap();
-        let r = filter_bank(&img, w, h, std::slice::from_ref(&c));
+        let r = filter_bank(&img, w, h, std::slice::from_ref(&c)).unwrap();
         let p = |x: usize| r.im[0][4 * w + x].atan2(r.re[0][4 * w + x]);
         let step = (p(31) - p(30) + 3.0 * PI) % (2.0 * PI) - PI;
         assert!((step - k).abs() < 1e-3, "phase step {step}");

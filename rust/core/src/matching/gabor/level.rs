@@ -17,6 +17,8 @@ use super::fastmath::{atan2, floor_fast, ln, round_fast, sincos};
 use super::filter::{blur_real, complex_col_pass, row_pass, Channel};
 use super::gather::gather_lerp;
 use super::pool::Buf;
+use crate::alloc::try_zeroed;
+use crate::error::Result;
 use crate::parallel::{for_each_row, for_each_row_pair, ROWS_PER_TASK};
 use crate::simd::simd_fn;
 use rayon::prelude::*;
@@ -92,10 +94,10 @@ pub fn level_data(
     chans: &[Channel],
     tau: f32,
     right: bool,
-) -> LevelData {
+) -> Result<LevelData> {
     let lowpass = match chans.first() {
-        Some(c) => blur_real(img, w, h, &c.gx, &c.gy),
-        None => Buf::zeroed(w * h),
+        Some(c) => blur_real(img, w, h, &c.gx, &c.gy)?,
+        None => Buf::zeroed(w * h)?,
     };
     // Row passes are shared by channels with identical x taps (+-theta).
     let mut groups: Vec<RowGroup<'_>> = Vec::new();
@@ -104,23 +106,23 @@ pub fn level_data(
         if let Some(g) = groups.iter().position(|(hx, _, _)| *hx == c.hx.as_slice()) {
             group_of.push(g);
         } else {
-            let (re, im) = row_pass(img, w, h, &c.hx);
+            let (re, im) = row_pass(img, w, h, &c.hx)?;
             groups.push((&c.hx, re, im));
             group_of.push(groups.len() - 1);
         }
     }
     let mut chan = Vec::with_capacity(chans.len());
-    let mut stable = vec![0u8; w * h];
+    let mut stable = try_zeroed::<u8>(w * h, "the Gabor matcher's stability mask")?;
     let mut amp2_samples = Vec::with_capacity(chans.len());
     let mut colph = Vec::with_capacity(chans.len());
     let mut rowph = Vec::with_capacity(chans.len());
-    let mut amp2 = Buf::scratch(w * h);
-    let mut energy = Buf::zeroed(w * h);
+    let mut amp2 = Buf::scratch(w * h)?;
+    let mut energy = Buf::zeroed(w * h)?;
     for (ci, (c, &g)) in chans.iter().zip(&group_of).enumerate() {
         let (_, hre, him) = &groups[g];
         let cph = phasors(c.kx, w);
         let rph = phasors(c.ky, h);
-        let mut out = Buf::scratch(SUBROWS * w * h);
+        let mut out = Buf::scratch(SUBROWS * w * h)?;
         for_each_row_pair(&mut out, SUBROWS * w, &mut amp2, w, |y, orow, arow| {
             build_row(
                 hre, him, w, h, y, &c.hy, c.dc, &lowpass, &cph.0, &cph.1, rph.0[y], rph.1[y],
@@ -146,7 +148,7 @@ pub fn level_data(
         colph.push(cph);
         rowph.push(rph);
     }
-    LevelData {
+    Ok(LevelData {
         w,
         h,
         chan,
@@ -156,7 +158,7 @@ pub fn level_data(
         colph,
         rowph,
         energy,
-    }
+    })
 }
 
 simd_fn! {
@@ -606,10 +608,15 @@ simd_fn! {
 
 /// One Newton step at every pixel. Returns `(delta, c)`: the WLS phase update (clamped to half
 /// the shortest carrier wavelength) and the mean channel confidence in [0, 1].
-pub fn newton_step(l: &LevelData, r: &LevelData, cc: &[ChanConst], disp: &[f32]) -> (Buf, Buf) {
+pub fn newton_step(
+    l: &LevelData,
+    r: &LevelData,
+    cc: &[ChanConst],
+    disp: &[f32],
+) -> Result<(Buf, Buf)> {
     let (w, h) = (l.w, l.h);
-    let mut delta = Buf::scratch(w * h);
-    let mut conf = Buf::scratch(w * h);
+    let mut delta = Buf::scratch(w * h)?;
+    let mut conf = Buf::scratch(w * h)?;
     let slots = kx_slots(cc);
     let max_delta = cc
         .iter()
@@ -639,5 +646,5 @@ pub fn newton_step(l: &LevelData, r: &LevelData, cc: &[ChanConst], disp: &[f32])
                 )
             }
         });
-    (delta, conf)
+    Ok((delta, conf))
 }

@@ -337,8 +337,8 @@ fn gabor_disparity_hot(
         }
     };
     let (fwd, bwd) = if params.lr_check {
-        let fl = post::flip_x(right.data, w, h);
-        let fr = post::flip_x(left.data, w, h);
+        let fl = post::flip_x(right.data, w, h)?;
+        let fr = post::flip_x(left.data, w, h)?;
         let back = if params.lr_light {
             GaborParams {
                 orientations_finest: params.orientations_finest.min(LIGHT_ORIENTATIONS),
@@ -353,10 +353,10 @@ fn gabor_disparity_hot(
             || one_direction(left.data, right.data, w, h, params, &chans, 0),
             || one_direction(&fl, &fr, w, h, &back, &chans, params.lr_coarse_levels),
         );
-        (a, Some(b))
+        (a?, Some(b?))
     } else {
         (
-            one_direction(left.data, right.data, w, h, params, &chans, 0),
+            one_direction(left.data, right.data, w, h, params, &chans, 0)?,
             None,
         )
     };
@@ -371,7 +371,7 @@ fn gabor_disparity_hot(
         post::validity_row(drow, crow, brow, params.conf_min, params.lr_tol)
     });
     wall("lr check");
-    post::remove_speckles(&mut disp, w, h, params.speckle_size, params.speckle_range);
+    post::remove_speckles(&mut disp, w, h, params.speckle_size, params.speckle_range)?;
     wall("speckles");
     crate::parallel::for_each_row(&mut conf, w, |y, crow| {
         for (c, d) in crow.iter_mut().zip(&disp[y * w..(y + 1) * w]) {
@@ -409,7 +409,7 @@ fn one_direction(
     p: &GaborParams,
     all_chans: &[Channel],
     finest: usize,
-) -> Direction {
+) -> Result<Direction> {
     let n_levels = p.levels_for(w, h).max(finest + 1);
     // Level 0 borrows the input images (no full-resolution copies).
     let mut pyr: Vec<PyrLevel<'_>> = vec![(Cow::Borrowed(l), Cow::Borrowed(r), w, h)];
@@ -420,8 +420,8 @@ fn one_direction(
         if *pw < 2 || *ph < 2 {
             break;
         }
-        let (nl, nw, nh) = filter::pyr_down(pl, *pw, *ph);
-        let (nr, _, _) = filter::pyr_down(pr, *pw, *ph);
+        let (nl, nw, nh) = filter::pyr_down(pl, *pw, *ph)?;
+        let (nr, _, _) = filter::pyr_down(pr, *pw, *ph)?;
         pyr.push((Cow::Owned(nl), Cow::Owned(nr), nw, nh));
     }
     let tau = p.stability_tau;
@@ -457,26 +457,27 @@ fn one_direction(
             || level_data(il, lw, lh, chans, tau, false),
             || level_data(ir, lw, lh, chans, tau, true),
         );
+        let (ld, rd) = (ld?, rd?);
         let cc = chan_consts(chans, &ld, &rd, p.amp_rel_thresh);
         lap("filter", lvl);
         let (mut disp, mut conf_max) = match state.take() {
             None => {
-                let mut init = Buf::scratch(lw * lh);
+                let mut init = Buf::scratch(lw * lh)?;
                 init.iter_mut().for_each(|v| *v = p.d_min * scale);
                 let n = ((p.d_max - p.d_min) * scale).ceil().max(0.0) as usize;
                 let offs: Vec<f32> = (0..=n).map(|k| k as f32).collect();
                 (
-                    search(&ld, &rd, &init, &offs, p.search_pool_radius),
-                    Buf::zeroed(lw * lh),
+                    search(&ld, &rd, &init, &offs, p.search_pool_radius)?,
+                    Buf::zeroed(lw * lh)?,
                 )
             }
             Some((d, c, sw, sh)) => {
-                let d = post::upsample(&d, sw, sh, lw, lh, 2.0);
-                let c = post::upsample(&c, sw, sh, lw, lh, 1.0);
+                let d = post::upsample(&d, sw, sh, lw, lh, 2.0)?;
+                let c = post::upsample(&c, sw, sh, lw, lh, 1.0)?;
                 let rr = p.research_radius as i32;
                 let d = if rr > 0 && (lvl > 0 || p.research_finest) {
                     let offs: Vec<f32> = (-rr..=rr).map(|k| k as f32).collect();
-                    search(&ld, &rd, &d, &offs, p.search_pool_radius)
+                    search(&ld, &rd, &d, &offs, p.search_pool_radius)?
                 } else {
                     d
                 };
@@ -493,12 +494,12 @@ fn one_direction(
             p.iters_per_level
         };
         for _ in 0..iters {
-            let (delta, c) = newton_step(&ld, &rd, &cc, &disp);
+            let (delta, c) = newton_step(&ld, &rd, &cc, &disp)?;
             lap("newton", lvl);
-            let (dbar, cbar) = post::normalized_conv(&delta, &c, lw, lh, sigma_s);
+            let (dbar, cbar) = post::normalized_conv(&delta, &c, lw, lh, sigma_s)?;
             post::apply_update(&mut disp, &dbar, &cbar, p.conf_min, lo, hi, lw);
             lap("nc", lvl);
-            disp = post::median5(&disp, lw, lh);
+            disp = post::median5(&disp, lw, lh)?;
             post::max_into(&mut conf_max, &cbar);
             lap("median", lvl);
         }
@@ -509,19 +510,19 @@ fn one_direction(
             // Up-sample a map that stopped above full resolution, level by level.
             for lvl in (0..finest).rev() {
                 let (_, _, lw, lh) = pyr[lvl];
-                disp = post::upsample(&disp, sw, sh, lw, lh, 2.0);
-                conf = post::upsample(&conf, sw, sh, lw, lh, 1.0);
+                disp = post::upsample(&disp, sw, sh, lw, lh, 2.0)?;
+                conf = post::upsample(&conf, sw, sh, lw, lh, 1.0)?;
                 (sw, sh) = (lw, lh);
             }
-            Direction { disp, conf }
+            Ok(Direction { disp, conf })
         }
         None => {
-            let mut disp = Buf::zeroed(w * h);
+            let mut disp = Buf::zeroed(w * h)?;
             disp.iter_mut().for_each(|v| *v = f32::NAN);
-            Direction {
+            Ok(Direction {
                 disp,
-                conf: Buf::zeroed(w * h),
-            }
+                conf: Buf::zeroed(w * h)?,
+            })
         }
     }
 }
@@ -536,7 +537,7 @@ pub fn gabor_responses(
     aspect: f32,
 ) -> Result<(Vec<f32>, Vec<f32>)> {
     let c = Channel::new(freq, theta_deg, bandwidth_oct, aspect)?;
-    let r = filter::filter_bank(&img.data, img.width, img.height, std::slice::from_ref(&c));
+    let r = filter::filter_bank(&img.data, img.width, img.height, std::slice::from_ref(&c))?;
     let (mut re, mut im) = (r.re, r.im);
     Ok((re.pop().unwrap_or_default(), im.pop().unwrap_or_default()))
 }
@@ -554,10 +555,10 @@ pub fn gabor_newton_step(
     params.validate()?;
     let chans = params.channels()?;
     let (w, h) = left.size();
-    let ld = level_data(&left.data, w, h, &chans, params.stability_tau, false);
-    let rd = level_data(&right.data, w, h, &chans, params.stability_tau, true);
+    let ld = level_data(&left.data, w, h, &chans, params.stability_tau, false)?;
+    let rd = level_data(&right.data, w, h, &chans, params.stability_tau, true)?;
     let cc = chan_consts(&chans, &ld, &rd, params.amp_rel_thresh);
-    let (delta, conf) = newton_step(&ld, &rd, &cc, &disp.data);
+    let (delta, conf) = newton_step(&ld, &rd, &cc, &disp.data)?;
     Ok((delta.into_vec(), conf.into_vec()))
 }
 

@@ -9,6 +9,12 @@
 use std::ops::{Deref, DerefMut};
 use std::sync::Mutex;
 
+use crate::alloc::try_zeroed;
+use crate::error::Result;
+
+/// Names a plane in an out-of-memory error.
+pub const WHAT: &str = "a plane of the Gabor matcher";
+
 /// Buffers smaller than this (in f32) are not worth pooling (malloc serves them from its heap).
 const MIN_POOLED: usize = 16 * 1024;
 /// Upper bound of the memory the pool keeps between uses (bytes): enough for the working set of
@@ -35,15 +41,16 @@ pub struct Buf {
 
 impl Buf {
     /// `n` zeros, reusing the smallest pooled buffer that is large enough.
-    pub fn zeroed(n: usize) -> Buf {
-        let mut b = Buf::scratch(n);
+    /// A failed allocation is [`crate::CoreError::OutOfMemory`], not an abort.
+    pub fn zeroed(n: usize) -> Result<Buf> {
+        let mut b = Buf::scratch(n)?;
         b.iter_mut().for_each(|v| *v = 0.0);
-        b
+        Ok(b)
     }
 
     /// `n` values with unspecified (but initialised) contents, for outputs the caller overwrites
     /// entirely: skips the zero fill of a reused buffer.
-    pub fn scratch(n: usize) -> Buf {
+    pub fn scratch(n: usize) -> Result<Buf> {
         if n >= MIN_POOLED {
             let taken = {
                 let mut p = lock();
@@ -56,17 +63,20 @@ impl Buf {
                 best.map(|i| p.swap_remove(i))
             };
             if let Some(v) = taken {
-                return Buf { v, n };
+                return Ok(Buf { v, n });
             }
         }
-        Buf { v: vec![0.0; n], n }
+        Ok(Buf {
+            v: try_zeroed(n, WHAT)?,
+            n,
+        })
     }
 
     /// A pooled copy of `src`.
-    pub fn from_slice(src: &[f32]) -> Buf {
-        let mut b = Buf::scratch(src.len());
+    pub fn from_slice(src: &[f32]) -> Result<Buf> {
+        let mut b = Buf::scratch(src.len())?;
         b.copy_from_slice(src);
-        b
+        Ok(b)
     }
 
     /// Takes the buffer out of the pool's custody (it will be freed normally).
@@ -126,14 +136,17 @@ mod tests {
     fn reused_buffers_are_zeroed() {
         let n = 100_000;
         {
-            let mut a = Buf::zeroed(n);
+            let mut a = Buf::zeroed(n).unwrap();
             a.iter_mut().for_each(|v| *v = 3.0);
         }
-        let b = Buf::zeroed(n - 10);
+        let b = Buf::zeroed(n - 10).unwrap();
         assert_eq!(b.len(), n - 10);
         assert!(b.iter().all(|&v| v == 0.0));
         drop(b);
-        assert_eq!(Buf::scratch(n + 5).len(), n + 5);
-        assert_eq!(Buf::from_slice(&[1.0, 2.0]).into_vec(), vec![1.0, 2.0]);
+        assert_eq!(Buf::scratch(n + 5).unwrap().len(), n + 5);
+        assert_eq!(
+            Buf::from_slice(&[1.0, 2.0]).unwrap().into_vec(),
+            vec![1.0, 2.0]
+        );
     }
 }

@@ -6,28 +6,36 @@
 
 use super::filter::{blur_real, gaussian_taps, radius_for};
 use super::pool::Buf;
+use crate::alloc::{try_filled, try_zeroed};
+use crate::error::Result;
 use crate::parallel::for_each_row;
 use crate::simd::simd_fn;
 
 /// Normalised-convolution smoothing (A.5 step 3h): `cbar = G * c`, `dbar = G * (c d) / cbar`.
-pub fn normalized_conv(delta: &[f32], conf: &[f32], w: usize, h: usize, sigma: f32) -> (Buf, Buf) {
+pub fn normalized_conv(
+    delta: &[f32],
+    conf: &[f32],
+    w: usize,
+    h: usize,
+    sigma: f32,
+) -> Result<(Buf, Buf)> {
     let g = gaussian_taps(sigma, radius_for(sigma));
     // The pointwise passes run in row bands too (serial, they idled the other core).
-    let mut cd = Buf::scratch(w * h);
+    let mut cd = Buf::scratch(w * h)?;
     for_each_row(&mut cd, w, |y, row| {
         let (d, c) = (&delta[y * w..(y + 1) * w], &conf[y * w..(y + 1) * w]);
         for ((o, d), c) in row.iter_mut().zip(d).zip(c) {
             *o = d * c;
         }
     });
-    let cbar = blur_real(conf, w, h, &g, &g);
-    let mut dbar = blur_real(&cd, w, h, &g, &g);
+    let cbar = blur_real(conf, w, h, &g, &g)?;
+    let mut dbar = blur_real(&cd, w, h, &g, &g)?;
     for_each_row(&mut dbar, w, |y, row| {
         for (n, c) in row.iter_mut().zip(&cbar[y * w..(y + 1) * w]) {
             *n = if *c > NC_EPS { *n / c } else { 0.0 };
         }
     });
-    (dbar, cbar)
+    Ok((dbar, cbar))
 }
 
 /// Denominator floor of the normalised convolution (A.5 step 3h).
@@ -56,12 +64,12 @@ fn med5(mut a: f32, mut b: f32, mut c: f32, mut d: f32, mut e: f32) -> f32 {
 /// Separable 5x5 median (5x1 median of the 1x5 medians), clamped borders. Cheaper than the exact
 /// 5x5 median (two 5-networks instead of a 25-sort) with the same job here: removing isolated
 /// disparity outliers after each Newton step.
-pub fn median5(src: &[f32], w: usize, h: usize) -> Buf {
-    let mut tmp = Buf::scratch(w * h);
+pub fn median5(src: &[f32], w: usize, h: usize) -> Result<Buf> {
+    let mut tmp = Buf::scratch(w * h)?;
     for_each_row(&mut tmp, w, |y, row| {
         median5_h(&src[y * w..(y + 1) * w], row)
     });
-    let mut out = Buf::scratch(w * h);
+    let mut out = Buf::scratch(w * h)?;
     for_each_row(&mut out, w, |y, row| {
         let r = |dy: isize| {
             let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
@@ -69,7 +77,7 @@ pub fn median5(src: &[f32], w: usize, h: usize) -> Buf {
         };
         median5_v([r(-2), r(-1), r(0), r(1), r(2)], row)
     });
-    out
+    Ok(out)
 }
 
 /// Radius of the median window (5 taps).
@@ -109,11 +117,11 @@ simd_fn! {
 /// multiplying values by `scale` (2 for disparities, 1 for confidences). Bilinear, clamped to the
 /// coarse image: fine pixels fall on coarse samples or half-way between two, so each output row
 /// blends two x-interpolated coarse rows with the weights 0 or 1/2 (no per-pixel `floor`).
-pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f32) -> Buf {
-    let mut out = Buf::scratch(w * h);
+pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f32) -> Result<Buf> {
+    let mut out = Buf::scratch(w * h)?;
     if sw == 0 || sh == 0 {
         out.iter_mut().for_each(|v| *v = 0.0);
-        return out;
+        return Ok(out);
     }
     for_each_row(&mut out, w, |y, row| {
         let y0 = (y / 2).min(sh - 1);
@@ -131,7 +139,7 @@ pub fn upsample(src: &[f32], sw: usize, sh: usize, w: usize, h: usize, scale: f3
             row,
         )
     });
-    out
+    Ok(out)
 }
 
 simd_fn! {
@@ -166,8 +174,8 @@ simd_fn! {
 
 /// Left-right consistency (A.5 step 5): left pixel `x` keeps its value only if the right map at
 /// `round(x - d)` agrees within `tol` px. `dr` is on the right grid, in `x_L - x_R` convention.
-pub fn lr_check(dl: &[f32], dr: &[f32], w: usize, h: usize, tol: f32) -> Vec<bool> {
-    let mut ok = vec![false; w * h];
+pub fn lr_check(dl: &[f32], dr: &[f32], w: usize, h: usize, tol: f32) -> Result<Vec<bool>> {
+    let mut ok = try_filled(w * h, false, "the left-right check's mask")?;
     for_each_row(&mut ok, w, |y, row| {
         for (x, v) in row.iter_mut().enumerate() {
             let d = dl[y * w + x];
@@ -178,7 +186,7 @@ pub fn lr_check(dl: &[f32], dr: &[f32], w: usize, h: usize, tol: f32) -> Vec<boo
                 && (d - dr[y * w + xr as usize]).abs() <= tol;
         }
     });
-    ok
+    Ok(ok)
 }
 
 simd_fn! {
@@ -212,14 +220,14 @@ simd_fn! {
 }
 
 /// Mirrors a row-major image left-right.
-pub fn flip_x(src: &[f32], w: usize, h: usize) -> Vec<f32> {
-    let mut out = vec![0f32; w * h];
+pub fn flip_x(src: &[f32], w: usize, h: usize) -> Result<Vec<f32>> {
+    let mut out = try_zeroed::<f32>(w * h, "a mirrored image of the Gabor matcher")?;
     for_each_row(&mut out, w, |y, row| {
         for (x, v) in row.iter_mut().enumerate() {
             *v = src[y * w + (w - 1 - x)];
         }
     });
-    out
+    Ok(out)
 }
 
 /// Rows per band of the speckle labelling (each band is labelled by one task).
@@ -234,13 +242,22 @@ const NO_LABEL: u32 = u32::MAX;
 /// that connect across a band boundary are merged. The regions are the connected components of
 /// a fixed graph, so the result does not depend on the band split or the thread count (it
 /// equals the sequential flood fill, which left the other core idle for 5 % of the matcher).
-pub fn remove_speckles(disp: &mut [f32], w: usize, h: usize, min_size: usize, max_diff: f32) {
+///
+/// A failed allocation of the label image is [`crate::CoreError::OutOfMemory`] (`disp`
+/// unchanged).
+pub fn remove_speckles(
+    disp: &mut [f32],
+    w: usize,
+    h: usize,
+    min_size: usize,
+    max_diff: f32,
+) -> Result<()> {
     use rayon::prelude::*;
     if min_size == 0 || w == 0 || h == 0 {
-        return;
+        return Ok(());
     }
     let joins = |a: f32, b: f32| a.is_finite() && b.is_finite() && (a - b).abs() <= max_diff;
-    let mut labels = vec![NO_LABEL; w * h];
+    let mut labels = try_filled(w * h, NO_LABEL, "the speckle filter's labels")?;
     // Per band: local labels 0..n, their union-find parents and pixel counts.
     let bands: Vec<(Vec<u32>, Vec<u32>)> = labels
         .par_chunks_mut(w * SPECKLE_BAND)
@@ -316,6 +333,7 @@ pub fn remove_speckles(disp: &mut [f32], w: usize, h: usize, min_size: usize, ma
                 }
             }
         });
+    Ok(())
 }
 
 /// Union-find root with path halving.

@@ -18,6 +18,7 @@ use super::fastmath::floor_fast;
 use super::gather::gather;
 use super::level::{LevelData, SUBROWS};
 use super::pool::Buf;
+use crate::error::Result;
 use crate::simd::simd_fn;
 use rayon::prelude::*;
 
@@ -26,7 +27,13 @@ use rayon::prelude::*;
 const SEARCH_BAND: usize = 32;
 
 /// Per-pixel argmax of the pooled normalised energy over `base + offs` (see the module docs).
-pub fn search(l: &LevelData, r: &LevelData, base: &[f32], offs: &[f32], pool: usize) -> Buf {
+pub fn search(
+    l: &LevelData,
+    r: &LevelData,
+    base: &[f32],
+    offs: &[f32],
+    pool: usize,
+) -> Result<Buf> {
     search_impl(l, r, base, offs, pool, true)
 }
 
@@ -38,11 +45,11 @@ pub(crate) fn search_impl(
     offs: &[f32],
     pool: usize,
     allow_fused: bool,
-) -> Buf {
+) -> Result<Buf> {
     let (w, h) = (l.w, l.h);
-    let mut out = Buf::from_slice(base);
+    let mut out = Buf::from_slice(base)?;
     if w == 0 || h == 0 || offs.is_empty() {
-        return out;
+        return Ok(out);
     }
     if pool == 0 {
         out.par_chunks_mut(w * SEARCH_BAND)
@@ -80,7 +87,7 @@ pub(crate) fn search_impl(
                     );
                 }
             });
-        return out;
+        return Ok(out);
     }
     let ring = 2 * pool + 1;
     let k = offs.len();
@@ -142,7 +149,7 @@ pub(crate) fn search_impl(
                 }
             }
         });
-    out
+    Ok(out)
 }
 
 /// Row buffers of one band.

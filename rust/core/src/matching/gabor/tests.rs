@@ -215,7 +215,7 @@ fn speckle_removal_drops_only_small_regions() {
     for (x, y) in [(3, 2), (4, 2), (3, 3), (4, 3)] {
         d[y * w + x] = 9.0;
     }
-    post::remove_speckles(&mut d, w, h, 10, 1.0);
+    post::remove_speckles(&mut d, w, h, 10, 1.0).unwrap();
     assert!(
         d[2 * w + 3].is_nan() && d[3 * w + 4].is_nan(),
         "4 px blob removed"
@@ -254,7 +254,7 @@ fn parallel_speckle_labelling_equals_the_flood_fill() {
         }
         let mut a = d.clone();
         let mut b = d.clone();
-        post::remove_speckles(&mut a, w, h, min_size, 1.0);
+        post::remove_speckles(&mut a, w, h, min_size, 1.0).unwrap();
         post::remove_speckles_flood(&mut b, w, h, min_size, 1.0);
         let dropped = a
             .iter()
@@ -285,8 +285,8 @@ fn fused_search_row_equals_the_generic_one() {
                 .iter()
                 .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
                 .collect();
-            let ld = level_data(&left.data, w, h, &chans, 1.25, false);
-            let rd = level_data(&right.data, w, h, &chans, 1.25, true);
+            let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
+            let rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
             let base: Vec<f32> = (0..w * h)
                 .map(|i| {
                     let x = (i % w) as f32;
@@ -300,8 +300,8 @@ fn fused_search_row_equals_the_generic_one() {
                 .collect();
             for offs in [(-3..=3).collect::<Vec<i32>>(), (0..=20).collect()] {
                 let offs: Vec<f32> = offs.into_iter().map(|k| k as f32).collect();
-                let a = search::search_impl(&ld, &rd, &base, &offs, 0, true);
-                let b = search::search_impl(&ld, &rd, &base, &offs, 0, false);
+                let a = search::search_impl(&ld, &rd, &base, &offs, 0, true).unwrap();
+                let b = search::search_impl(&ld, &rd, &base, &offs, 0, false).unwrap();
                 let same = a
                     .iter()
                     .zip(b.iter())
@@ -331,8 +331,8 @@ fn validity_row_applies_the_lr_check_rule() {
     dl[17] = 60.0;
     let dr: Vec<f32> = (0..w * h).map(|i| dl[i] + 3.0 * (rnd() - 0.5)).collect();
     let conf: Vec<f32> = (0..w * h).map(|_| rnd()).collect();
-    let ok = post::lr_check(&dl, &dr, w, h, 1.0);
-    let mirrored = post::flip_x(&dr, w, h);
+    let ok = post::lr_check(&dl, &dr, w, h, 1.0).unwrap();
+    let mirrored = post::flip_x(&dr, w, h).unwrap();
     let mut kept = 0;
     for y in 0..h {
         let row = y * w..(y + 1) * w;

@@ -7,6 +7,8 @@
 
 use rayon::prelude::*;
 
+use crate::alloc::try_zeroed;
+use crate::error::Result;
 use crate::image::ImageView;
 use crate::simd::simd_fn;
 
@@ -107,12 +109,14 @@ fn min_row(hs: &[[&[f32]; RING]; 4], out: &mut [f32]) {
 /// The Moravec interest map `M` (f32, row-major `(H, W)`); 0 within [`BORDER`] px of the edge.
 /// Row bands in parallel; every value is computed in the fixed order of the module docs, so the
 /// map does not depend on the thread count.
-pub fn moravec<'a>(img: impl Into<ImageView<'a>>) -> Vec<f32> {
+///
+/// A failed allocation of the map is [`crate::CoreError::OutOfMemory`].
+pub fn moravec<'a>(img: impl Into<ImageView<'a>>) -> Result<Vec<f32>> {
     let img = &img.into();
     let (w, h) = img.size();
-    let mut out = vec![0.0f32; w * h];
+    let mut out = try_zeroed::<f32>(w * h, "the Hopfield matcher's interest map")?;
     if w < 2 * BORDER + 1 || h < 2 * BORDER + 1 {
-        return out;
+        return Ok(out);
     }
     let r = MORAVEC_HALF;
     let row = |y: usize| &img.data[y * w..(y + 1) * w];
@@ -149,7 +153,7 @@ pub fn moravec<'a>(img: impl Into<ImageView<'a>>) -> Vec<f32> {
                 }
             },
         );
-    out
+    Ok(out)
 }
 
 /// Interest points of `img`: local maxima of [`moravec`] over a `(2 nms_half + 1)^2`
@@ -159,11 +163,11 @@ pub fn moravec<'a>(img: impl Into<ImageView<'a>>) -> Vec<f32> {
 pub fn interest_points<'a>(
     img: impl Into<ImageView<'a>>,
     p: &InterestParams,
-) -> Vec<InterestPoint> {
+) -> Result<Vec<InterestPoint>> {
     let img = img.into();
-    let m = moravec(img);
+    let m = moravec(img)?;
     let (w, h) = img.size();
-    select_points(&m, w, h, p)
+    Ok(select_points(&m, w, h, p))
 }
 
 /// Image rows per parallel task of [`select_points`].

@@ -285,14 +285,14 @@ fn validate(left: &ImageView<'_>, right: &ImageView<'_>, p: &HopfieldParams) -> 
 }
 
 /// Rows of the right image holding right interest points (points mode).
-fn right_rows(right: &ImageView<'_>, p: &HopfieldParams) -> HashMap<usize, Vec<usize>> {
+fn right_rows(right: &ImageView<'_>, p: &HopfieldParams) -> Result<HashMap<usize, Vec<usize>>> {
     let mut rows: HashMap<usize, Vec<usize>> = HashMap::new();
     if p.candidates == CandidateMode::Points {
-        for rp in interest_points(right, &p.interest) {
+        for rp in interest_points(right, &p.interest)? {
             rows.entry(rp.y as usize).or_default().push(rp.x as usize);
         }
     }
-    rows
+    Ok(rows)
 }
 
 /// Parabola vertex offset through `(d-1, a), (d, b), (d+1, c)`, clamped to +-0.5.
@@ -428,8 +428,8 @@ fn candidates(
     right: &ImageView<'_>,
     pts: &[InterestPoint],
     p: &HopfieldParams,
-) -> Vec<Neuron> {
-    let rows = right_rows(right, p);
+) -> Result<Vec<Neuron>> {
+    let rows = right_rows(right, p)?;
     // Tasks: bands of image rows, each with its own right-image statistics (the rows its
     // points search, +- dy_window in points mode).
     let band_of = |pt: &InterestPoint| pt.y as usize / ROWS_PER_TASK;
@@ -461,7 +461,7 @@ fn candidates(
             },
         )
         .collect();
-    per_task.concat()
+    Ok(per_task.concat())
 }
 
 /// Median (mean of the two middle values for an even count; 0 if empty), by selection: the
@@ -855,8 +855,8 @@ pub fn candidate_neurons<'a>(
 ) -> Result<(Vec<InterestPoint>, Vec<Neuron>)> {
     let (left, right) = (&left.into(), &right.into());
     validate(left, right, p)?;
-    let pts = interest_points(left, &p.interest);
-    let neurons = candidates(left, right, &pts, p);
+    let pts = interest_points(left, &p.interest)?;
+    let neurons = candidates(left, right, &pts, p)?;
     Ok((pts, neurons))
 }
 

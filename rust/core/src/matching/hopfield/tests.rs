@@ -177,10 +177,10 @@ fn moravec_corner_and_edges() {
         }
     }
     let img = Image::new(30, 30, data).expect("valid");
-    let m = moravec(&img);
+    let m = moravec(&img).unwrap();
     assert!(m[15 * 30 + 15] > 0.0);
     assert_eq!(m[25 * 30 + 15], 0.0); // vertical edge: the vertical direction sees nothing
-    let pts = interest_points(&img, &InterestParams::default());
+    let pts = interest_points(&img, &InterestParams::default()).unwrap();
     assert!(pts
         .iter()
         .any(|p| p.x.abs_diff(15) <= 2 && p.y.abs_diff(15) <= 2));
@@ -204,7 +204,7 @@ fn results_do_not_depend_on_the_thread_count() {
                     csr.indptr,
                     csr.indices,
                     csr.data,
-                    interest_points(&l, &p.interest),
+                    interest_points(&l, &p.interest).unwrap(),
                 )
             })
     };

@@ -10,6 +10,8 @@
 // Row kernels index equally long rows in lockstep; index loops are the form LLVM vectorises.
 #![allow(clippy::needless_range_loop)]
 
+use crate::alloc::try_zeroed;
+use crate::error::Result;
 use crate::image::Image;
 use crate::parallel::for_each_row;
 use crate::simd::simd_fn;
@@ -99,13 +101,15 @@ simd_fn! {
 }
 
 /// `L = I (*) K_sigma` (float32, same size as the image).
-pub fn log_filter(img: &Image, sigma: f32) -> Vec<f32> {
+///
+/// A failed allocation of its planes is [`crate::CoreError::OutOfMemory`].
+pub fn log_filter(img: &Image, sigma: f32) -> Result<Vec<f32>> {
     let (w, h) = img.size();
     let (g, a) = log_kernels(sigma);
     let r = g.len() / 2;
     // Row passes: hg = I *_x g, ha = I *_x a.
-    let mut hg = vec![0.0f32; w * h];
-    let mut ha = vec![0.0f32; w * h];
+    let mut hg = try_zeroed::<f32>(w * h, "a LoG plane of the MCGM matcher")?;
+    let mut ha = try_zeroed::<f32>(w * h, "a LoG plane of the MCGM matcher")?;
     crate::parallel::for_each_row2(&mut hg, &mut ha, w, |y, og, oa| {
         let src = &img.data[y * w..(y + 1) * w];
         let p: Vec<f32> = (-(r as isize)..(w + r) as isize)
@@ -114,7 +118,7 @@ pub fn log_filter(img: &Image, sigma: f32) -> Vec<f32> {
         row_pass(&p, &g, &a, og, oa);
     });
     // Column pass: L = ha *_y g + hg *_y a.
-    let mut out = vec![0.0f32; w * h];
+    let mut out = try_zeroed::<f32>(w * h, "a LoG plane of the MCGM matcher")?;
     for_each_row(&mut out, w, |y, o| {
         let rows = |i: isize| {
             let yy = reflect(i, h);
@@ -129,15 +133,15 @@ pub fn log_filter(img: &Image, sigma: f32) -> Vec<f32> {
             col_tap(o, a[r + j], &hg[rows(ylo)], &hg[rows(yhi)]);
         }
     });
-    out
+    Ok(out)
 }
 
 /// 2x2 mean decimation (floor of odd sizes; at least 1x1): pixel `(i, j)` of the result is the
 /// mean of full-resolution pixels `(2i..2i+1, 2j..2j+1)`, centred at `(2i + 0.5, 2j + 0.5)`.
-pub fn decimate2(img: &Image) -> Image {
+pub fn decimate2(img: &Image) -> Result<Image> {
     let (w, h) = img.size();
     let (w2, h2) = ((w / 2).max(1), (h / 2).max(1));
-    let mut data = vec![0.0f32; w2 * h2];
+    let mut data = try_zeroed::<f32>(w2 * h2, "the MCGM matcher's half-resolution image")?;
     for_each_row(&mut data, w2, |y, o| {
         let y0 = (2 * y).min(h - 1);
         let y1 = (2 * y + 1).min(h - 1);
@@ -147,9 +151,9 @@ pub fn decimate2(img: &Image) -> Image {
             *v = 0.25 * (img.at(x0, y0) + img.at(x1, y0) + img.at(x0, y1) + img.at(x1, y1));
         }
     });
-    Image {
+    Ok(Image {
         width: w2,
         height: h2,
         data,
-    }
+    })
 }

@@ -403,7 +403,12 @@ fn needs_half(p: &McgmParams) -> bool {
 
 /// The curves of nominal channel `sigma` of an image (`half`: its decimation, when some
 /// channel needs it).
-fn curves_at(img: &Image, half: Option<&Image>, sigma: f32, p: &McgmParams) -> ChannelCurves {
+fn curves_at(
+    img: &Image,
+    half: Option<&Image>,
+    sigma: f32,
+    p: &McgmParams,
+) -> Result<ChannelCurves> {
     let (sig, scale) = channel_geometry(sigma, p);
     let src = match (half, scale) {
         (Some(h), 2) => h,
@@ -413,18 +418,25 @@ fn curves_at(img: &Image, half: Option<&Image>, sigma: f32, p: &McgmParams) -> C
 }
 
 /// LoG, zero crossings, curves and R-tables of `img` (already at the channel's resolution).
-pub fn channel_curves(img: &Image, sigma: f32, scale: usize, p: &McgmParams) -> ChannelCurves {
+///
+/// A failed allocation of a per-pixel plane is [`CoreError::OutOfMemory`].
+pub fn channel_curves(
+    img: &Image,
+    sigma: f32,
+    scale: usize,
+    p: &McgmParams,
+) -> Result<ChannelCurves> {
     let (w, h) = img.size();
-    let log = log::log_filter(img, sigma);
-    let zc = zero_crossings(&log, w, h);
+    let log = log::log_filter(img, sigma)?;
+    let zc = zero_crossings(&log, w, h)?;
     let tp = p.track_params(sigma);
-    let curves = track(&zc, &tp);
+    let curves = track(&zc, &tp)?;
     let rtables = curves
         .segments
         .iter()
         .map(|s| build_rtable(s, &zc.theta, w, p.cand.n_bins))
         .collect();
-    ChannelCurves {
+    Ok(ChannelCurves {
         sigma,
         scale,
         width: w,
@@ -433,17 +445,17 @@ pub fn channel_curves(img: &Image, sigma: f32, scale: usize, p: &McgmParams) -> 
         zc,
         curves,
         rtables,
-    }
+    })
 }
 
 /// Curves of every channel of one image (the debugging / GUI view of `curves(image)`).
 pub fn image_curves(img: &Image, p: &McgmParams) -> Result<Vec<ChannelCurves>> {
     validate_params(p)?;
-    let half = needs_half(p).then(|| log::decimate2(img));
-    Ok(p.sigmas
+    let half = needs_half(p).then(|| log::decimate2(img)).transpose()?;
+    p.sigmas
         .par_iter()
         .map(|&s| curves_at(img, half.as_ref(), s, p))
-        .collect())
+        .collect()
 }
 
 /// Fixed neighbour order of the prior spreading (ties go to the first filled neighbour).
@@ -481,12 +493,13 @@ pub struct SpreadPrior<'a> {
 impl<'a> SpreadPrior<'a> {
     /// The distance transform of `map` (`w x h`, NaN = no value), capped at `radius + 1`
     /// (`radius <= 0`: no spread).
-    pub fn new(map: &'a [f32], w: usize, h: usize, radius: i32) -> Self {
+    ///
+    /// A failed allocation of its planes is [`CoreError::OutOfMemory`].
+    pub fn new(map: &'a [f32], w: usize, h: usize, radius: i32) -> Result<Self> {
         let far = radius.clamp(0, u16::MAX as i32 - 1) as u16 + 1;
-        let mut dist: Vec<u16> = map
-            .iter()
-            .map(|v| if v.is_finite() { 0 } else { far })
-            .collect();
+        let mut dist: Vec<u16> = Vec::new();
+        crate::alloc::try_reserve_len(&mut dist, map.len(), "the MCGM prior's distances")?;
+        dist.extend(map.iter().map(|v| if v.is_finite() { 0 } else { far }));
         // Forward pass (neighbours above and to the left), then backward (below and right): each
         // row takes its vertical and diagonal terms from the row before, then the chain along x.
         for pass in 0..2 {
@@ -539,7 +552,7 @@ impl<'a> SpreadPrior<'a> {
         // The first closer neighbour of every pixel inside the border, for all directions at
         // once (rows in parallel, compares without branches): the last match in reverse order
         // is the first in SPREAD_ORDER.
-        let mut parent = vec![0u8; w * h];
+        let mut parent = crate::alloc::try_zeroed::<u8>(w * h, "the MCGM prior's directions")?;
         if w >= 3 && h >= 3 {
             let dist = &dist;
             crate::parallel::for_each_row(&mut parent, w, |y, out| {
@@ -560,14 +573,14 @@ impl<'a> SpreadPrior<'a> {
                 }
             });
         }
-        SpreadPrior {
+        Ok(SpreadPrior {
             map,
             dist,
             parent,
             w,
             h,
             far,
-        }
+        })
     }
 
     /// The spread value at `(x, y)` (beyond the radius: the map's own value, NaN or infinite).
@@ -604,9 +617,12 @@ impl<'a> SpreadPrior<'a> {
 }
 
 /// The whole spread map of [`SpreadPrior`] (`radius <= 0`: `map` itself).
-pub fn spread_prior(map: &[f32], w: usize, h: usize, radius: i32) -> Vec<f32> {
-    let sp = SpreadPrior::new(map, w, h, radius);
-    (0..w * h).map(|i| sp.at(i % w, i / w)).collect()
+pub fn spread_prior(map: &[f32], w: usize, h: usize, radius: i32) -> Result<Vec<f32>> {
+    let sp = SpreadPrior::new(map, w, h, radius)?;
+    let mut out = Vec::new();
+    crate::alloc::try_reserve_len(&mut out, w * h, "the MCGM prior")?;
+    out.extend((0..w * h).map(|i| sp.at(i % w, i / w)));
+    Ok(out)
 }
 
 /// Median (lower of the two middle values for even counts: a value that exists).
@@ -1520,7 +1536,7 @@ fn match_channel(
     prior: &mut Option<Vec<f32>>,
     (fw, fh): (usize, usize),
     p: &McgmParams,
-) -> ChannelResult {
+) -> Result<ChannelResult> {
     let s = l.scale as f32;
     // No disparity reaches past the image width: a huge max_disparity must not size the
     // GHT accumulators.
@@ -1533,7 +1549,8 @@ fn match_channel(
     };
     let spread = prior
         .as_deref()
-        .map(|m| SpreadPrior::new(m, fw, fh, radius));
+        .map(|m| SpreadPrior::new(m, fw, fh, radius))
+        .transpose()?;
     let win = windows(
         l,
         spread.as_ref(),
@@ -1563,7 +1580,14 @@ fn match_channel(
     let sol = solve(&cands, &csr, l.curves.segments.len(), &p.solver);
     let matches = decompose(l, r, &cands, &sol.chosen, p.horiz_skip_deg, ci as u8);
     // Prior for the finer channels: this channel's disparities over the coarser ones'.
-    let map = prior.get_or_insert_with(|| vec![f32::NAN; fw * fh]);
+    if prior.is_none() {
+        *prior = Some(crate::alloc::try_filled(
+            fw * fh,
+            f32::NAN,
+            "the MCGM matcher's prior map",
+        )?);
+    }
+    let map = prior.get_or_insert_with(Vec::new);
     for m in &matches {
         let (x, y) = (m.xl.round() as i64, m.yl.round() as i64);
         if x >= 0 && y >= 0 && (x as usize) < fw && (y as usize) < fh {
@@ -1579,7 +1603,7 @@ fn match_channel(
                 .map(move |&j| (i as u32, j))
         })
         .collect();
-    ChannelResult {
+    Ok(ChannelResult {
         sigma: l.sigma,
         scale: l.scale,
         n_left: l.curves.segments.len(),
@@ -1593,7 +1617,7 @@ fn match_channel(
         sweeps: sol.sweeps,
         converged: sol.converged,
         matches,
-    }
+    })
 }
 
 /// Drops exact repeats of a correspondence (the same `xl, yl, xr, yr` bits), keeping the first:
@@ -1636,29 +1660,40 @@ fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
     // assembly) would otherwise leave the other worker idle. Each channel's work and output is
     // the same as computed in order.
     let n = p.sigmas.len();
-    let half =
-        needs_half(p).then(|| rayon::join(|| log::decimate2(left), || log::decimate2(right)));
+    // A failed allocation of any per-pixel plane is CoreError::OutOfMemory (the binding's
+    // MemoryError), not an abort of the process.
+    let half = match needs_half(p)
+        .then(|| rayon::join(|| log::decimate2(left), || log::decimate2(right)))
+    {
+        Some((l, r)) => Some((l?, r?)),
+        None => None,
+    };
     let (half_l, half_r) = (half.as_ref().map(|h| &h.0), half.as_ref().map(|h| &h.1));
-    let curves_of = |ci: usize| {
+    let curves_of = |ci: usize| -> Result<(ChannelCurves, ChannelCurves)> {
         let s = p.sigmas[ci];
-        rayon::join(
+        let (l, r) = rayon::join(
             || curves_at(left, half_l, s, p),
             || curves_at(right, half_r, s, p),
-        )
+        );
+        Ok((l?, r?))
     };
-    let (finest, (mut channels, mut prior)) = rayon::join(
+    let (finest, coarse) = rayon::join(
         || curves_of(n - 1),
-        || {
-            let coarse: Vec<_> = (0..n - 1).into_par_iter().map(curves_of).collect();
+        || -> Result<(Vec<ChannelResult>, Option<Vec<f32>>)> {
+            let coarse: Vec<_> = (0..n - 1)
+                .into_par_iter()
+                .map(curves_of)
+                .collect::<Result<_>>()?;
             let mut prior: Option<Vec<f32>> = None;
             let channels: Vec<ChannelResult> = coarse
                 .iter()
                 .enumerate()
                 .map(|(ci, (l, r))| match_channel(ci, l, r, &mut prior, (fw, fh), p))
-                .collect();
-            (channels, prior)
+                .collect::<Result<_>>()?;
+            Ok((channels, prior))
         },
     );
+    let (finest, (mut channels, mut prior)) = (finest?, coarse?);
     channels.push(match_channel(
         n - 1,
         &finest.0,
@@ -1666,9 +1701,9 @@ fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
         &mut prior,
         (fw, fh),
         p,
-    ));
+    )?);
     // Combination: finest full-resolution channel first; coarser ones fill empty places.
-    let mut taken = vec![false; fw * fh];
+    let mut taken = crate::alloc::try_filled(fw * fh, false, "the MCGM matcher's taken mask")?;
     let mut combined: Vec<Match> = Vec::new();
     for ch in channels.iter().rev().filter(|c| c.scale == 1) {
         let mut mine: Vec<(usize, usize)> = Vec::new();

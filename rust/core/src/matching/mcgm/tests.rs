@@ -61,7 +61,7 @@ fn log_kernel_sums_to_zero_and_flat_images_give_nothing() {
         assert_eq!(g.len(), 2 * (4.0 * sigma).ceil() as usize + 1);
     }
     let flat = Image::filled(40, 30, 0.8);
-    let l = log_filter(&flat, 2.0);
+    let l = log_filter(&flat, 2.0).unwrap();
     assert!(l.iter().all(|v| v.abs() < 1e-5));
     let out = mcgm_match(&flat, &flat, &McgmParams::default()).expect("valid input");
     assert!(out.matches.is_empty());
@@ -75,8 +75,8 @@ fn step_edge_gives_one_pixel_thick_crossing_at_the_edge() {
         .map(|i| if i % w >= 20 { 0.8 } else { 0.2 })
         .collect();
     let img = Image::new(w, h, data).expect("valid image");
-    let l = log_filter(&img, 1.0);
-    let zc = zero_crossings(&l, w, h);
+    let l = log_filter(&img, 1.0).unwrap();
+    let zc = zero_crossings(&l, w, h).unwrap();
     let smax = zc.strength.iter().copied().fold(0.0f32, f32::max);
     for y in 2..h - 2 {
         // The truncated kernel's far tails add crossings of negligible strength.
@@ -95,7 +95,8 @@ fn step_edge_gives_one_pixel_thick_crossing_at_the_edge() {
             min_len: 8,
             ..McgmParams::default().track
         },
-    );
+    )
+    .unwrap();
     // Interior rows only are marked; one straight segment covers them all.
     let long: Vec<_> = curves
         .segments
@@ -112,7 +113,7 @@ fn ght_of_a_translated_contour_scores_one_at_the_translation() {
     let (w, h) = (120, 80);
     let l = blobs(w, h, 0.0);
     let p = McgmParams::default();
-    let cl = channel_curves(&l, 2.0, 1, &p);
+    let cl = channel_curves(&l, 2.0, 1, &p).unwrap();
     // The right contour is the left one moved by (-7, 0): its pixels q = p - (7, 0).
     let seg = cl
         .curves
@@ -153,8 +154,8 @@ fn ght_by_rows_equals_ght_by_bins() {
     // score and translation, bit for bit.
     let (w, h) = (160, 100);
     let p = McgmParams::default();
-    let cl = channel_curves(&blobs(w, h, 0.0), 1.0, 1, &p);
-    let cr = channel_curves(&blobs(w, h, 3.4), 1.0, 1, &p);
+    let cl = channel_curves(&blobs(w, h, 0.0), 1.0, 1, &p).unwrap();
+    let cr = channel_curves(&blobs(w, h, 3.4), 1.0, 1, &p).unwrap();
     let (mut acc, mut acc2) = (Vec::new(), Vec::new());
     let mut compared = 0;
     for (a, rt) in cl.curves.segments.iter().zip(&cl.rtables).take(40) {
@@ -359,7 +360,7 @@ fn spread_prior_equals_the_dilations() {
             })
             .collect();
         let want = spread_by_dilations(&map, w, h, radius);
-        let got = spread_prior(&map, w, h, radius);
+        let got = spread_prior(&map, w, h, radius).unwrap();
         let same = want
             .iter()
             .zip(&got)

@@ -5,6 +5,11 @@
 use std::f64::consts::{PI, TAU};
 
 use super::zerocross::ZeroCrossings;
+use crate::alloc::{try_filled, try_zeroed};
+use crate::error::Result;
+
+/// Names the tracker's per-pixel buffers in an out-of-memory error.
+const WHAT: &str = "a tracking plane of the MCGM matcher";
 
 /// 8-neighbour offsets in the fixed scan order that breaks exact ties.
 const NEIGHBOURS: [(i32, i32); 8] = [
@@ -136,8 +141,8 @@ fn tangent(theta: f32) -> (f64, f64) {
 /// Sorts `keys` ascending by their upper 32 bits, equal ones keeping their order (LSD radix
 /// sort, 11 + 11 + 10 bits): for keys `(k << 32) | i` listed by ascending `i`, the order of
 /// a full sort, several times faster on the 10^5 seeds of a channel.
-fn radix_sort_upper(keys: &mut Vec<u64>) {
-    let mut tmp = vec![0u64; keys.len()];
+fn radix_sort_upper(keys: &mut Vec<u64>) -> Result<()> {
+    let mut tmp = try_zeroed::<u64>(keys.len(), WHAT)?;
     for (shift, bits) in [(32u32, 11u32), (43, 11), (54, 10)] {
         let mask = (1u64 << bits) - 1;
         let mut count = vec![0usize; (1 << bits) + 1];
@@ -157,10 +162,11 @@ fn radix_sort_upper(keys: &mut Vec<u64>) {
         }
         std::mem::swap(keys, &mut tmp);
     }
+    Ok(())
 }
 
 /// Tracks the crossings into segments.
-pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
+pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
     let (w, h) = (zc.width, zc.height);
     let n = w * h;
     let t_high = high_threshold(zc, p.high_quantile);
@@ -169,7 +175,7 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
     // already used), 0 = not a candidate. One byte array instead of three passes over the image.
     const FREE: u8 = 1;
     const TAKEN: u8 = 2;
-    let mut state = vec![0u8; n];
+    let mut state = try_zeroed::<u8>(n, WHAT)?;
     // (Images narrower than 3 pixels have no interior.)
     for y in (1..h.saturating_sub(1)).filter(|_| w >= 3) {
         let r = y * w + 1..(y + 1) * w - 1;
@@ -182,16 +188,16 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
     // Seeds by decreasing strength, then index: one key each, `!bits(s) << 32 | i` (strengths
     // are > 0, so their bit patterns order as the values do), listed by index (branch-free)
     // and radix-sorted on the upper half.
-    let mut keys = vec![0u64; n];
+    let mut keys = try_zeroed::<u64>(n, WHAT)?;
     let mut n_seeds = 0;
     for (i, (&st, &s)) in state.iter().zip(&zc.strength).enumerate() {
         keys[n_seeds] = (u64::from(!s.to_bits()) << 32) | i as u64;
         n_seeds += usize::from((st == FREE) & (s >= t_high));
     }
     keys.truncate(n_seeds);
-    radix_sort_upper(&mut keys);
+    radix_sort_upper(&mut keys)?;
     let max_turn = (p.max_turn_deg as f64).to_radians();
-    let mut labels = vec![-1i32; n];
+    let mut labels = try_filled(n, -1i32, WHAT)?;
     let mut segments = Vec::new();
     // Grows from `start` (tangent `t0`) along `sign * t0`, appending the pixels taken and their
     // tangents to `out`.
@@ -296,12 +302,12 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Curves {
         let id = segments.len() as i32;
         segments.push(make_segment(w, &pixels, &mut labels, id));
     }
-    Curves {
+    Ok(Curves {
         segments,
         labels,
         t_high,
         t_low,
-    }
+    })
 }
 
 /// The segment of `pixels` (with their tangents `(-sin theta, cos theta)`), labelled `id`.

@@ -3,6 +3,12 @@
 
 use std::f32::consts::TAU;
 
+use crate::alloc::{try_filled, try_zeroed};
+use crate::error::Result;
+
+/// Names the crossing planes in an out-of-memory error.
+const WHAT: &str = "a zero-crossing plane of the MCGM matcher";
+
 /// Mark bit: the pixel holds a crossing found by the horizontal scan (along x).
 pub const ZC_H: u8 = 1;
 /// Mark bit: the pixel holds a crossing found by the vertical scan (along y).
@@ -44,10 +50,10 @@ impl ZeroCrossings {
 
 /// Finds the crossings of `l` (`w x h`). Only interior pixels (1 px from the border) are marked,
 /// so the central differences are always defined.
-pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
+pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> Result<ZeroCrossings> {
     let n = w * h;
-    let mut mark = vec![0u8; n];
-    let mut xsub = vec![f32::NAN; n];
+    let mut mark = try_zeroed::<u8>(n, WHAT)?;
+    let mut xsub = try_filled(n, f32::NAN, WHAT)?;
     let inside = |x: usize, y: usize| x >= 1 && y >= 1 && x + 1 < w && y + 1 < h;
     // Horizontal scan: the crossing between p and p + (1, 0) is marked on the pixel with the
     // smaller |L| (ties: p); a pixel with L = 0 exactly is marked if its neighbours differ in sign.
@@ -112,8 +118,8 @@ pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
             }
         }
     }
-    let mut strength = vec![0.0f32; n];
-    let mut theta = vec![0.0f32; n];
+    let mut strength = try_zeroed::<f32>(n, WHAT)?;
+    let mut theta = try_zeroed::<f32>(n, WHAT)?;
     let mut on: Vec<u32> = vec![0; w + 1];
     for y in 0..h {
         let mut c = 0;
@@ -162,12 +168,12 @@ pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
             }
         }
     }
-    ZeroCrossings {
+    Ok(ZeroCrossings {
         width: w,
         height: h,
         mark,
         xsub,
         strength,
         theta,
-    }
+    })
 }
