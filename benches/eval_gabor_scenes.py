@@ -87,8 +87,8 @@ def main() -> None:
             verdict = "  BEATS-BM" if row["bm"] > row["fill"] else "  LOSES-TO-BM"
         print(
             f"{name:38s} {row['fill']:6.1f} {row['unf']:6.1f} {row['dens']:5.1f} "
-            f"{row.get('bm', np.nan):6.1f} {row.get('sgbm', np.nan):6.1f} {ms:6.0f} "
-            f"{row.get('sgbm_ms', np.nan):6.0f} {ms / row.get('sgbm_ms', np.nan):5.2f}{verdict}"
+            f"{row.get('bm', np.nan):6.1f} {row.get('sgbm', np.nan):6.1f} {ms:6.1f} "
+            f"{row.get('sgbm_ms', np.nan):6.1f} {ms / row.get('sgbm_ms', np.nan):5.2f}{verdict}"
         )
     mean = {k: float(np.mean([r[k] for r in rows])) for k in ("fill", "unf", "dens", "ms")}
     line = f"{'MEAN':38s} {mean['fill']:6.1f} {mean['unf']:6.1f} {mean['dens']:5.1f}"

@@ -171,4 +171,5 @@ def test_eval_gabor_scenes_times_ours_beside_sgbm(data_dir: Path) -> None:
     cells = row.split()
     assert cells[0] == "middlebury2001/tsukuba" and cells[1:3] == ["7.3", "17.7"]
     ms, sgbm_ms, ratio = (float(c) for c in cells[6:9])
-    assert ratio == pytest.approx(ms / sgbm_ms, abs=0.05 + 0.02 * ratio)
+    # the times are printed to 0.1 ms: the ratio of the printed times is within their rounding
+    assert ratio == pytest.approx(ms / sgbm_ms, abs=0.006 + 0.05 * (1 + ratio) / sgbm_ms)
