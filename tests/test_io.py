@@ -523,3 +523,18 @@ def test_pair_size_messages_give_sizes_not_numpy_shapes(tmp_path: Path) -> None:
         "(two views of the scene are needed)"
     )
     assert check_pair_files(a, a + 1, f, tmp_path / "right.png") is None
+
+
+def test_from_q_reads_a_multiple_of_q_as_q(data_dir: Path, tmp_path: Path) -> None:
+    """Q acts on homogeneous coordinates: ROS image_geometry's StereoCameraModel writes it
+    times -f B (Q[0,0] = f Tx, Q[3,2] = -f). Such a Q was refused as 'Q[0,0] = -240, expected
+    1'; it is now the same calibration as OpenCV's Q."""
+    q = np.loadtxt(data_dir / "middeval3/teddyH/Q.dat")
+    plain = Calibration.from_q(data_dir / "middeval3/teddyH/Q.dat", (900, 750))
+    (tmp_path / "Q.dat").write_text(
+        "\n".join(" ".join(repr(float(v)) for v in r) for r in q * -240.0)
+    )
+    scaled = Calibration.from_q(tmp_path / "Q.dat", (900, 750))
+    assert scaled.focal_px == 3000.0 and scaled.baseline_m == pytest.approx(0.08)
+    np.testing.assert_allclose(scaled.Q, plain.Q, rtol=1e-12)
+    np.testing.assert_allclose(scaled.K2, plain.K2, rtol=1e-12)

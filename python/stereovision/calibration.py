@@ -1297,6 +1297,10 @@ class Calibration:
         ``calib.txt`` 250 mm; KITTI's 0.533 m). The result has unit ``"m"``, ``R = I``,
         ``T = (-B, 0, 0)``, equal focal lengths, ``doffs = cx' - cx``.
 
+        ``Q`` acts on homogeneous coordinates, so any multiple of it is the same matrix: one
+        scaled by ``Q[0,0]`` (ROS ``image_geometry``'s ``StereoCameraModel`` writes it times
+        ``-f B``) is read as that matrix divided by ``Q[0,0]``.
+
         Parameters
         ----------
         q_file : str or os.PathLike
@@ -1319,6 +1323,8 @@ class Calibration:
         if q.size != 16 or not np.isfinite(q).all():
             raise ValueError(f"{p}: not a Q matrix (16 finite numbers expected, got {q.size})")
         q = q.reshape(4, 4)
+        if q[0, 0] != 0.0:  # a multiple of Q is the same Q (homogeneous coordinates)
+            q = q / q[0, 0]
         expect = {(0, 0): 1.0, (1, 1): 1.0, (0, 1): 0.0, (0, 2): 0.0, (1, 0): 0.0}
         expect.update({(1, 2): 0.0, (2, 0): 0.0, (2, 1): 0.0, (2, 2): 0.0})
         expect.update({(3, 0): 0.0, (3, 1): 0.0})
