@@ -1008,3 +1008,29 @@ def test_camera_folders_pair_names_with_left_and_right_by_their_number(
         "k/image_3/000001_11.png",
         "s/left/left_0002.png",
     ]
+
+
+def test_a_scene_with_only_q_dat_is_calibrated_as_load_scene_calibrates_it(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """load_scene reads a scene's Q.dat when it has no calib.txt (middeval3/teddyH), but batch
+    (and the GUI's image-folder source, which pairs as batch does) took the scene as
+    uncalibrated: no depth, no cloud. Its Q.dat is now the pair's calibration; calib.txt still
+    wins when both are there (TartanAir)."""
+    from stereovision.io import load_scene
+
+    teddy = data_dir / "middeval3" / "teddyH"
+    scene = tmp_path / "teddyH"
+    scene.mkdir()
+    for name in ("left.png", "right.png", "Q.dat"):
+        shutil.copy(teddy / name, scene / name)
+    tartan = data_dir / "tartanair" / "oldtown_easy_p000_001116"
+    (job,) = find_pairs(scene)
+    assert job.calib == scene / "Q.dat"
+    calib = Calibration.from_file(job.calib)
+    expected = load_scene(teddy).calib
+    assert expected is not None and calib.image_size == (900, 750)
+    np.testing.assert_allclose(calib.Q, expected.Q, rtol=1e-12)
+    assert calib.baseline_m == pytest.approx(0.08) and calib.unit == "m"
+    (job,) = find_pairs(tartan)
+    assert job.calib == tartan / "calib.txt"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import struct
 from pathlib import Path
 
@@ -538,3 +539,17 @@ def test_from_q_reads_a_multiple_of_q_as_q(data_dir: Path, tmp_path: Path) -> No
     assert scaled.focal_px == 3000.0 and scaled.baseline_m == pytest.approx(0.08)
     np.testing.assert_allclose(scaled.Q, plain.Q, rtol=1e-12)
     np.testing.assert_allclose(scaled.K2, plain.K2, rtol=1e-12)
+
+
+def test_a_q_dat_file_is_a_calibration_file(data_dir: Path, tmp_path: Path) -> None:
+    """--calib Q.dat (the file, not its scene folder) said 'unrecognised calibration format'.
+    It is read as OpenCV's Q, sized by image_size or the left.png beside it."""
+    q = data_dir / "middeval3/teddyH/Q.dat"
+    assert Calibration.from_file(q).image_size == (900, 750)
+    alone = tmp_path / "rig_q.txt"
+    shutil.copy(q, alone)
+    assert Calibration.from_file(alone, image_size=(640, 480)).focal_px == 3000.0
+    with pytest.raises(
+        ValueError, match=r"rig_q\.txt does not give the image size and there is no"
+    ):
+        Calibration.from_file(alone)

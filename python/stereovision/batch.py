@@ -74,7 +74,7 @@ CONNECT_TIMEOUT = "10s"
 _SUMMARY_VERSION = 1
 _LEFT_RE = re.compile(r"left", re.IGNORECASE)
 _RIGHT_RE = re.compile(r"right", re.IGNORECASE)
-_SCENE_CALIB = "calib.txt"
+_SCENE_CALIBS = ("calib.txt", "Q.dat")
 #: Sibling folders holding a rig's two cameras, left one first (matched without case): images
 #: of the same path under both are a pair (``left/0001.png`` + ``right/0001.png``; KITTI's
 #: ``image_2``/``image_3`` colour and ``image_0``/``image_1`` grey; EuRoC's ``cam0/data`` +
@@ -171,7 +171,7 @@ def find_pairs(
 
     * A folder holding ``left.png`` and ``right.png`` (evaluation.md's scene layout) is one pair,
       named by its path relative to ``root`` (``root``'s own name when ``root`` is the scene);
-      its ``calib.txt`` is used when present.
+      its ``calib.txt`` is used when present, else its ``Q.dat``.
     * Any other image whose name contains ``left`` (``left_0001.png`` as ``stereovision capture``
       saves them, ``cam_left.jpg``, ``0001_Left.png``) pairs with the file named with ``right``
       in its place; the pair is named by its folder and the file name without ``left`` (and
@@ -246,7 +246,8 @@ def _scan(
         names = set(files)
         paired: set[str] = set()
         if "left.png" in names and "right.png" in names:
-            scene_cal = here / _SCENE_CALIB if _SCENE_CALIB in names else None
+            # as load_scene: calib.txt, else OpenCV's Q (sized by the scene's left.png)
+            scene_cal = next((here / n for n in _SCENE_CALIBS if n in names), None)
             found.append(
                 PairJob(
                     rel if rel != "." else r.resolve().name,

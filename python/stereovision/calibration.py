@@ -1154,7 +1154,9 @@ class Calibration:
         other lies beside it (``left`` and ``right`` swapped in its name), and Kalibr's
         ``camchain.yaml`` (:meth:`from_kalibr`, ``cam0`` and ``cam1``). A scene folder
         (:func:`stereovision.io.load_scene`) gives its ``calib.txt``, else its ``Q.dat``
-        (:meth:`from_q`, sized by ``image_size`` or the folder's ``left.png``).
+        (:meth:`from_q`, sized by ``image_size`` or the folder's ``left.png``); so does a
+        ``Q.dat`` file itself (16 numbers, sized by ``image_size`` or the ``left.png`` beside
+        it).
 
         Raises
         ------
@@ -1171,7 +1173,7 @@ class Calibration:
             if (p / "calib.txt").is_file():
                 return cls.from_file(p / "calib.txt", image_size=image_size)
             if (p / "Q.dat").is_file():
-                return cls.from_q(p / "Q.dat", image_size or _scene_image_size(p))
+                return cls.from_q(p / "Q.dat", image_size or _scene_image_size(p / "Q.dat"))
             raise ValueError(
                 f"calibration path {p} is a folder without left.yaml and right.yaml "
                 "(ROS camera_info), calib.txt or Q.dat; pass a calibration file"
@@ -1198,9 +1200,12 @@ class Calibration:
             return cls.from_middlebury(p)
         if re.search(r"^\s*(P_rect_02|P2)\s*:", text, re.MULTILINE):
             return cls.from_kitti(p, image_size=image_size)
+        if _q_numbers(text):  # a Q.dat: OpenCV's Q, sized like load_scene sizes it
+            return cls.from_q(p, image_size or _scene_image_size(p))
         raise ValueError(
             f"unrecognised calibration format in {p}: expected OpenCV YAML/XML, JSON, "
-            "Middlebury calib.txt, KITTI calibration, ROS camera_info or Kalibr camchain"
+            "Middlebury calib.txt, KITTI calibration, ROS camera_info, Kalibr camchain or "
+            "OpenCV's Q matrix (Q.dat)"
         )
 
     # ------------------------------------------------------------------ dataset formats
@@ -2041,17 +2046,28 @@ def _ros_yaml(name: str, size: tuple[int, int], K: F64, D: F64, R: F64, P: F64, 
     )
 
 
-def _scene_image_size(folder: Path) -> tuple[int, int]:
-    """``(width, height)`` of a scene folder's left image (for its ``Q.dat``)."""
+def _q_numbers(text: str) -> bool:
+    """Whether a text is 16 numbers and nothing else (OpenCV's 4x4 ``Q`` as a ``Q.dat``)."""
+    tokens = text.split()
+    if len(tokens) != 16:
+        return False
+    try:
+        [float(t) for t in tokens]
+    except ValueError:
+        return False
+    return True
+
+
+def _scene_image_size(q_file: Path) -> tuple[int, int]:
+    """``(width, height)`` of the left image beside a ``Q.dat`` (a scene folder's)."""
+    folder = q_file.parent
     for name in ("left.png", "left.jpg"):
         if (folder / name).is_file():
             from stereovision.io import imread
 
             h, w = imread(folder / name).shape[:2]
             return w, h
-    raise ValueError(
-        f"{folder / 'Q.dat'} does not give the image size and there is no left.png beside it"
-    )
+    raise ValueError(f"{q_file} does not give the image size and there is no left.png beside it")
 
 
 def _ros_pair_from_folder(folder: Path) -> tuple[Path, Path] | None:
