@@ -448,6 +448,36 @@ def test_the_max_disparity_field_is_applied_and_checked():
     assert parse_max_disparity(None, 10) is None
 
 
+def test_a_max_disparity_the_field_takes_is_one_the_pair_can_be_searched_with():
+    """449 px at width 450 passed the field, then the search (rounded up to 464 px) failed:
+    'disparity range 464 is not smaller than the image width 450'. 440 px at full size
+    failed at width 320 (scaled and rounded up to 320 px). The field now checks the value as
+    searched, and a range scaled down past the width is searched as the widest that fits,
+    said in the statistics."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import parse_max_disparity
+
+    with pytest.raises(ValueError, match=r"^max disparity 449 px is searched as 464 px \(a mult"):
+        parse_max_disparity("449", 450)
+    assert parse_max_disparity("448", 450) == 448
+    app = _scene_app("test-max-disp-fits", [bundled_data_dir()])
+    spawned: list = []
+    app._spawn = spawned.append
+    app._load_scene(bundled_data_dir() / "cones")
+    app.state.max_disp = "449"
+    app.apply_max_disparity()
+    assert app.state.error.startswith("max disparity 449 px is searched as 464 px") and not spawned
+    app.state.max_disp = "440"
+    app.apply_max_disparity()
+    _run(app, spawned.pop)
+    assert app.state.error == "" and "disparities 0–448 px" in app.state.stats
+    app.state.resolution = "320"
+    _run(app, app.recompute)
+    assert app.state.error == "" and app.view.result.disparity.shape[1] == 320
+    assert "disparities 0–304 px" in app.state.stats
+    assert "warning: max disparity 320 px at width 320 searched as 304 px" in app.state.stats
+
+
 @pytest.mark.parametrize("method", ["gabor", "fused"])
 def test_progress_goes_forward_and_says_what_runs(method):
     """The status read "prepare done" during the whole matching (most of the time: it looked

@@ -409,6 +409,15 @@ def compute_view(
     left_s, right_s, s = scale_pair(left, right, width)
     calib_s = scaled_calibration(calib, s, (left_s.shape[1], left_s.shape[0]))
     d_max = None if max_disparity is None else max(16, math.ceil(max_disparity * s / 16) * 16)
+    widest = (left_s.shape[1] - 1) // 16 * 16  # the range must stay below the width
+    if d_max is not None and d_max > widest >= 16:
+        # a range that fits the pair at its size, scaled down and rounded up, can reach the
+        # smaller width (440 px at full size searched 320 px at width 320: refused)
+        notes.append(
+            f"max disparity {d_max} px at width {left_s.shape[1]} searched as {widest} px "
+            "(the range must stay below the width)"
+        )
+        d_max = widest
     t0 = time.perf_counter()
     report(5, f"{method}: matching {left_s.shape[1]}x{left_s.shape[0]}")
     # The library's warnings (a pair that looks swapped) go on the page, not the server's log.
@@ -519,7 +528,8 @@ def parse_max_disparity(text: str | None, width: int) -> int | None:
     Raises
     ------
     ValueError
-        Not a whole number of pixels above 0, or not smaller than ``width``.
+        Not a whole number of pixels above 0, or not smaller than ``width`` once rounded up
+        to the multiple of 16 px the pair is searched with (449 px at width 450: 464 px).
 
     Examples
     --------
@@ -541,6 +551,12 @@ def parse_max_disparity(text: str | None, width: int) -> int | None:
     if value >= width:
         raise ValueError(
             f"max disparity {value} px is not smaller than the pair's width {width} px"
+        )
+    searched = math.ceil(value / 16) * 16  # as compute_view searches it
+    if searched >= width:
+        raise ValueError(
+            f"max disparity {value} px is searched as {searched} px (a multiple of 16), not "
+            f"smaller than the pair's width {width} px"
         )
     return value
 
