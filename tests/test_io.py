@@ -539,6 +539,12 @@ def test_from_q_reads_a_multiple_of_q_as_q(data_dir: Path, tmp_path: Path) -> No
     assert scaled.focal_px == 3000.0 and scaled.baseline_m == pytest.approx(0.08)
     np.testing.assert_allclose(scaled.Q, plain.Q, rtol=1e-12)
     np.testing.assert_allclose(scaled.K2, plain.K2, rtol=1e-12)
+    # an entry out of place is named as read after the division, which is said
+    (tmp_path / "Q.dat").write_text("2 0 0 -5\n0 2 0 -4\n0 0 2 100\n0 0 4 0\n")
+    with pytest.raises(
+        ValueError, match=r"Q\[2,2\] = 1, expected 0 \(the matrix divided by its Q\[0,0\] = 2\)$"
+    ):
+        Calibration.from_q(tmp_path / "Q.dat", (10, 8))
 
 
 def test_a_q_dat_file_is_a_calibration_file(data_dir: Path, tmp_path: Path) -> None:

@@ -1328,7 +1328,9 @@ class Calibration:
         if q.size != 16 or not np.isfinite(q).all():
             raise ValueError(f"{p}: not a Q matrix (16 finite numbers expected, got {q.size})")
         q = q.reshape(4, 4)
-        if q[0, 0] != 0.0:  # a multiple of Q is the same Q (homogeneous coordinates)
+        scaled = ""
+        if q[0, 0] not in (0.0, 1.0):  # a multiple of Q is the same Q (homogeneous coordinates)
+            scaled = f" (the matrix divided by its Q[0,0] = {q[0, 0]:g})"
             q = q / q[0, 0]
         expect = {(0, 0): 1.0, (1, 1): 1.0, (0, 1): 0.0, (0, 2): 0.0, (1, 0): 0.0}
         expect.update({(1, 2): 0.0, (2, 0): 0.0, (2, 1): 0.0, (2, 2): 0.0})
@@ -1336,13 +1338,14 @@ class Calibration:
         for (i, j), want in expect.items():
             if q[i, j] != want:
                 raise ValueError(
-                    f"{p}: not a rectified Q matrix: Q[{i},{j}] = {q[i, j]:g}, expected {want:g}"
+                    f"{p}: not a rectified Q matrix: Q[{i},{j}] = {q[i, j]:g}, expected "
+                    f"{want:g}{scaled}"
                 )
         f, inv_b = float(q[2, 3]), float(q[3, 2])
         if f <= 0 or inv_b <= 0:
             raise ValueError(
                 f"{p}: Q[2,3] (focal length {f:g} px) and Q[3,2] (1/baseline {inv_b:g}) must be "
-                "positive: this Q does not give positive depths for positive disparities"
+                f"positive: this Q does not give positive depths for positive disparities{scaled}"
             )
         cx, cy = -float(q[0, 3]), -float(q[1, 3])
         cx_right = cx + float(q[3, 3]) / inv_b
