@@ -1103,6 +1103,52 @@ def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_pat
     assert bare.state.error == "no folder to write into: start the GUI with --data DIR"
 
 
+def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkeypatch):
+    """Save pressed twice (or again after a new pair came) while the first still wrote: the
+    second found none of the files yet, wrote too, and replaced the first's files without a
+    word. The folder being written is now refused like one that holds the files."""
+    import asyncio
+    import threading
+
+    import stereovision.cli as cli
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-save-twice", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    real = cli.write_depth_outputs
+    started, gate = threading.Event(), threading.Event()
+    calls: list = []
+
+    def held(result, folder):
+        calls.append(folder)
+        started.set()
+        gate.wait(60)
+        return real(result, folder)
+
+    monkeypatch.setattr(cli, "write_depth_outputs", held)
+
+    async def twice() -> None:
+        app._lock = asyncio.Lock()
+        first = asyncio.ensure_future(app.save())
+        await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
+        await app.save()  # the first is still writing
+        assert app.state.error == (
+            f"save: {tmp_path.name}/saved is being written by the previous Save; nothing was "
+            "overwritten: choose another folder"
+        )
+        gate.set()
+        await first
+
+    asyncio.run(twice())
+    assert len(calls) == 1
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/saved: ")
+    app._done()
+    app.state.save_label = ""
+    _run(app, app.save)  # and once written, the folder holds the files: refused as before
+    assert app.state.error.startswith(f"save: {tmp_path.name}/saved already holds disparity.png")
+
+
 def _still_cameras_app(name: str, data_dir: Path, raw: tuple) -> Any:
     """A :class:`StereoApp` (demo scene cones) whose cameras give ``raw`` on every read."""
     pytest.importorskip("trame")

@@ -680,6 +680,8 @@ class StereoApp:
         # "Save" writes only inside the --data folders (not into the installed package's data)
         bundled = bundled_data_dir().resolve()
         self._save_roots = [r for r in folders.roots if r != bundled]
+        #: Folders a "Save" is writing into now (a second Save there would replace its files).
+        self._saving_into: set[Path] = set()
 
         st = self.state
         st.methods = [*METHODS, *EXTRA_METHODS]
@@ -1349,6 +1351,11 @@ class StereoApp:
         try:
             folder = self.folders.resolve_output(self.state.save_dir or "", self._save_roots)
             label = self.folders.label(folder)
+            if folder in self._saving_into:  # its files are not there yet: not "taken" below
+                raise FileExistsError(
+                    f"save: {label} is being written by the previous Save; nothing was "
+                    "overwritten: choose another folder"
+                )
             taken = [n for n in names if os.path.lexists(folder / n)]
             if taken:
                 raise FileExistsError(
@@ -1363,11 +1370,14 @@ class StereoApp:
         def run() -> dict[str, Path]:
             return write_depth_outputs(result, folder)
 
+        self._saving_into.add(folder)
         try:
             written = await asyncio.get_running_loop().run_in_executor(self._executor, run)
         except (ValueError, OSError, RuntimeError, CliError) as exc:
             self._fail(exc)
             return
+        finally:
+            self._saving_into.discard(folder)
         self._done()
         h, w = result.disparity.shape
         without = "" if result.depth is not None else " (no calibration: disparity only)"
