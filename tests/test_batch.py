@@ -1034,3 +1034,26 @@ def test_a_scene_with_only_q_dat_is_calibrated_as_load_scene_calibrates_it(
     assert calib.baseline_m == pytest.approx(0.08) and calib.unit == "m"
     (job,) = find_pairs(tartan)
     assert job.calib == tartan / "calib.txt"
+
+
+def test_a_scene_with_only_q_dat_is_batched_with_depth(data_dir: Path, tmp_path: Path) -> None:
+    """The worker got the scene's Q.dat alone, in a temporary folder without the left.png
+    that sizes it: every such pair failed ('Q.dat does not give the image size and there is
+    no left.png beside it'). It is shipped as the calibration read beside its images."""
+    from stereovision.batch import _task, process_pair
+    from stereovision.io import load_scene
+
+    teddy = data_dir / "middeval3" / "teddyH"
+    scene = tmp_path / "teddyH"
+    scene.mkdir()
+    for name in ("left.png", "right.png", "Q.dat"):
+        shutil.copy(teddy / name, scene / name)
+    (job,) = find_pairs(scene)
+    task = _task(job, {"method": "fast", "max_disparity": 64, "fill": None})
+    out = process_pair(task)
+    assert task["calib"][0] == "calib.json"
+    ref = load_scene(teddy)
+    expected = depth_map(ref.left, ref.right, ref.calib, method="fast", max_disparity=64)
+    assert expected.depth is not None
+    depth = np.load(io.BytesIO(out["files"]["depth.npy"]))
+    np.testing.assert_array_equal(depth, expected.depth)

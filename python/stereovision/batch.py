@@ -846,11 +846,14 @@ class _Dask:
 
 def _calib_payload(path: Path) -> tuple[str, bytes]:
     """A calibration as one file's name and bytes for a worker: a ROS camera_info folder
-    (left.yaml, right.yaml) is read here and shipped as this package's JSON."""
-    if path.is_file():
-        return path.name, path.read_bytes()
-    from stereovision.calibration import Calibration
+    (left.yaml, right.yaml) is read here and shipped as this package's JSON, and so is a
+    ``Q.dat`` (sized by the ``left.png`` beside it, which the worker's copy has not)."""
+    from stereovision.calibration import Calibration, _q_numbers
 
+    if path.is_file():
+        data = path.read_bytes()
+        if not _q_numbers(data.decode("utf-8", errors="replace")):
+            return path.name, data
     with tempfile.TemporaryDirectory(prefix="stereovision-calib-") as tmp:
         out = Calibration.from_file(path).save(Path(tmp) / "calib.json")
         return out.name, out.read_bytes()
