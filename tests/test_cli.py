@@ -687,3 +687,43 @@ def test_check_warns_of_one_file_given_twice(
         f"stereovision: warning: {left} and {left} are the same file: every disparity comes "
         "out 0 (two views of the scene are needed)\n"
     )
+
+
+def test_depth_takes_a_q_dat_apart_from_its_scene_sized_by_the_pair(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--calib Q.dat (4951e4c) was sized only by a left.png beside it: a Q.dat kept elsewhere
+    was refused ('does not give the image size and there is no left.png beside it') though
+    the pair given with it has a size. It is sized by the pair; beside a left.png, by that."""
+    from stereovision.calibration import Calibration
+    from stereovision.depth import depth_map
+    from stereovision.io import load_scene
+
+    teddy = data_dir / "middeval3" / "teddyH"
+    q = tmp_path / "rig" / "Q.dat"
+    q.parent.mkdir()
+    q.write_bytes((teddy / "Q.dat").read_bytes())
+    pair = [str(teddy / "left.png"), str(teddy / "right.png")]
+    out = tmp_path / "out"
+    args = ["--calib", str(q), "--method", "fast", "--max-disparity", "64", "-o", str(out)]
+    assert main(["depth", *pair, *args]) == 0
+    scene = load_scene(teddy)
+    ref = depth_map(scene.left, scene.right, scene.calib, method="fast", max_disparity=64)
+    assert ref.depth is not None
+    np.testing.assert_array_equal(np.load(out / "depth.npy"), ref.depth)
+    # info has no pair: still refused, in one line
+    assert main(["info", str(q)]) == 2
+    assert (
+        capsys.readouterr()
+        .err.strip()
+        .endswith("Q.dat does not give the image size and there is no left.png beside it")
+    )
+    # a left.png beside the Q.dat still sizes it (a half-size pair is refused with the hint)
+    half = cv2.resize(cv2.imread(pair[0]), None, fx=0.5, fy=0.5)
+    cv2.imwrite(str(q.parent / "left.png"), cv2.imread(pair[0]))
+    assert Calibration.from_file(q).image_size == (900, 750)
+    small = [str(tmp_path / "l.png"), str(tmp_path / "r.png")]
+    cv2.imwrite(small[0], half)
+    cv2.imwrite(small[1], half)
+    assert main(["depth", *small, *args]) == 2
+    assert "calibration is for 900x750 images, got 450x375" in capsys.readouterr().err

@@ -2061,6 +2061,26 @@ def _q_numbers(text: str) -> bool:
     return True
 
 
+def _unsized_q(path: PathLike) -> bool:
+    """Whether :meth:`Calibration.from_file` reads ``path`` as a ``Q.dat`` (the file, or a
+    folder's without ``calib.txt``) with no ``left.png`` beside it to size it."""
+    p = Path(path)
+    if p.is_dir():
+        if _ros_pair_from_folder(p) is not None or (p / "calib.txt").is_file():
+            return False
+        q = p / "Q.dat"
+        if not q.is_file():
+            return False
+    else:
+        q = p
+        try:
+            if not q.is_file() or q.stat().st_size > 4096 or not _q_numbers(q.read_text()):
+                return False
+        except (OSError, UnicodeDecodeError):
+            return False
+    return not any((q.parent / n).is_file() for n in ("left.png", "left.jpg"))
+
+
 def _scene_image_size(q_file: Path) -> tuple[int, int]:
     """``(width, height)`` of the left image beside a ``Q.dat`` (a scene folder's)."""
     folder = q_file.parent

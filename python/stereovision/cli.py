@@ -137,12 +137,15 @@ def write_depth_outputs(result: Any, out_dir: Path, voxel: float | None = None) 
 # ----------------------------------------------------------------------------- commands
 
 
-def _load_calibration(path: str | None) -> Any:
+def _load_calibration(path: str | None, pair: np.ndarray | None = None) -> Any:
+    """``--calib``'s calibration; a ``Q.dat`` with no ``left.png`` beside it is sized by
+    ``pair`` (the run's left image), the images it is given with."""
     if path is None:
         return None
-    from stereovision.calibration import Calibration
+    from stereovision.calibration import Calibration, _unsized_q
 
-    return Calibration.from_file(path)
+    size = None if pair is None or not _unsized_q(path) else (pair.shape[1], pair.shape[0])
+    return Calibration.from_file(path, image_size=size)
 
 
 def depth_outputs(
@@ -306,7 +309,7 @@ def cmd_depth(args: argparse.Namespace) -> int:
             "(two views of the scene are needed)",
             stacklevel=1,
         )
-    calib = _load_calibration(args.calib)
+    calib = _load_calibration(args.calib, left)
     max_disparity = args.max_disparity
     if args.rectification:
         from stereovision.uncalibrated import UncalibratedRectification
@@ -416,7 +419,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     )
     if same:
         warnings.warn(same, stacklevel=1)
-    calib = _load_calibration(args.calib)
+    calib = _load_calibration(args.calib, left)
     fix = Path(args.fix) if args.fix else None
     if fix is not None:
         if calib is None:
@@ -512,7 +515,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     )
     if same:
         warnings.warn(same, stacklevel=1)
-    calib = _load_calibration(args.calib)
+    calib = _load_calibration(args.calib, left)
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise CliError(f"-o {args.output}: is a file; give a folder")
