@@ -545,6 +545,13 @@ def test_from_q_reads_a_multiple_of_q_as_q(data_dir: Path, tmp_path: Path) -> No
         ValueError, match=r"Q\[2,2\] = 1, expected 0 \(the matrix divided by its Q\[0,0\] = 2\)$"
     ):
         Calibration.from_q(tmp_path / "Q.dat", (10, 8))
+    # Q[0,0] = 0 is the one value refused there: 'expected 1' alone was wrong since c6850a6
+    (tmp_path / "Q.dat").write_text("0 0 0 -5\n0 1 0 -4\n0 0 0 100\n0 0 4 0\n")
+    with pytest.raises(
+        ValueError,
+        match=r"Q\[0,0\] = 0, expected 1 \(or any value but 0: a multiple of Q is read as Q\)$",
+    ):
+        Calibration.from_q(tmp_path / "Q.dat", (10, 8))
 
 
 def test_a_q_dat_file_is_a_calibration_file(data_dir: Path, tmp_path: Path) -> None:

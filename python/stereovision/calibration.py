@@ -1337,9 +1337,11 @@ class Calibration:
         expect.update({(3, 0): 0.0, (3, 1): 0.0})
         for (i, j), want in expect.items():
             if q[i, j] != want:
+                # Q[0,0] gets here at 0 only (any other value divides the matrix to 1)
+                also = " (or any value but 0: a multiple of Q is read as Q)" if i == j == 0 else ""
                 raise ValueError(
                     f"{p}: not a rectified Q matrix: Q[{i},{j}] = {q[i, j]:g}, expected "
-                    f"{want:g}{scaled}"
+                    f"{want:g}{also}{scaled}"
                 )
         f, inv_b = float(q[2, 3]), float(q[3, 2])
         if f <= 0 or inv_b <= 0:
