@@ -819,6 +819,12 @@ class _Dask:
                 threads_per_worker=1,
                 processes=True,
                 dashboard_address=None,
+                # The scheduler serves its HTTP routes (health, metrics) even without the
+                # dashboard, on port 8787 unless told otherwise: where that port was taken (a
+                # Jupyter or another cluster's dashboard) it warned "Port 8787 is already in
+                # use" and left the socket of its failed bind unclosed (a ResourceWarning),
+                # two lines beside the CLI's one. Any free port, on this machine only.
+                scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
                 silence_logs=logging.CRITICAL,  # failures are reported per pair
                 env=env,
             )
