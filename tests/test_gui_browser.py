@@ -1049,6 +1049,46 @@ def test_find_floor_controller_on_kitti(data_dir):
     assert app.state.img_floor == ""
 
 
+def test_find_floor_says_its_heights_in_the_unit_on_show(data_dir):
+    """With feet chosen, Find floor still said "camera 1.62 m above it" (the ground module's
+    line) under a picture captioned "obstacles 0.15-2 m". Both follow the unit toggle now: a
+    floor found in metres is said again in feet, one found in feet is said in feet, and back
+    in metres the line is the library's own."""
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui.app import StereoApp
+
+    scene = data_dir / "kitti2015" / "000005_10"
+    app = StereoApp(
+        get_server("test-floor-ft", client_type="vue3"), AllowedFolders([data_dir]), scene
+    )
+    app._spawn = lambda coro: coro.close()
+    assert app.state.floor_caption == "floor (green), obstacles 0.15-2 m (red)"
+    app._load_scene(scene)
+    _run(app, app.recompute)
+    _run(app, app.find_floor)
+    metres = app.state.floor_label
+    assert metres == app.view.floor.describe()
+    height_m = float(re.search(r"camera ([0-9.]+) m above it", metres).group(1))
+    app._on_unit(unit="ft")
+    assert app.state.floor_caption == "floor (green), obstacles 0.49-6.56 ft (red)"
+    height_ft = float(re.search(r"camera ([0-9.]+) ft above it", app.state.floor_label).group(1))
+    assert height_ft == pytest.approx(height_m / 0.3048, abs=0.002)
+    assert not re.search(r"[0-9] m\b", app.state.floor_label)
+    assert app.state.floor_label.replace(f"{height_ft:.3f} ft", f"{height_m:.3f} m") == metres
+    _run(app, app.recompute)  # a new depth map: its floor is found in feet
+    assert app.state.floor_label == ""
+    _run(app, app.find_floor)
+    assert re.search(r"camera [0-9.]+ ft above it", app.state.floor_label)
+    app._on_unit(unit="m")
+    assert app.state.floor_label == metres
+    assert app.state.floor_caption == "floor (green), obstacles 0.15-2 m (red)"
+    from stereovision.gui.app import floor_text
+
+    assert floor_text(None, "ft").startswith("ground plane: none found")
+
+
 def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_path):
     """The page had no way to keep a result. "Save" writes the pair on show with the depth
     command's writer (disparity PNG + PFM, 16-bit depth PNG in mm, cloud.ply) into a folder

@@ -250,6 +250,9 @@ class ViewData:
     depth_ends: tuple[float, float] | None = None
     median_depth: float | None = None
     stats_parts: tuple[str, str] | None = None
+    #: The floor Find floor found on this pair (None: not found, or not looked for yet), said
+    #: again in another unit when the toggle changes.
+    floor: Any = None
 
     def texts(self, unit: str = "m") -> tuple[str, str]:
         """The depth caption and the statistics line with their lengths in ``unit``.
@@ -294,24 +297,66 @@ def _length(metres: float, unit: str) -> str:
     return f"{metres / UNIT_TO_METRES[unit]:.2f} {unit}"
 
 
-def floor_view(result: Any) -> tuple[str, str]:
-    """The floor of a depth result: a line of text and a picture (data URL; "" when none)."""
+#: What Find floor says when the depth map has no floor.
+NO_FLOOR = "ground plane: none found (no near-level plane holds 3 % of the pixels)"
+#: The heights above the floor (metres) that Find floor paints as obstacles.
+OBSTACLE_HEIGHTS = (0.15, 2.0)
+
+
+def floor_caption(unit: str = "m") -> str:
+    """The floor picture's caption, its obstacle heights in ``unit`` (one of :data:`UNITS`).
+
+    Examples
+    --------
+    >>> floor_caption(), floor_caption("ft")
+    ('floor (green), obstacles 0.15-2 m (red)', 'floor (green), obstacles 0.49-6.56 ft (red)')
+    """
+    from stereovision.calibration import UNIT_TO_METRES
+
+    lo, hi = (round(h / UNIT_TO_METRES[unit], 2) for h in OBSTACLE_HEIGHTS)
+    return f"floor (green), obstacles {lo:g}-{hi:g} {unit} (red)"
+
+
+def floor_text(plane: Any, unit: str = "m") -> str:
+    """Find floor's line for a ground plane (None: none found), its height in ``unit``.
+
+    The line is the library's ``GroundPlane.describe()`` (in metres), its camera height said
+    in ``unit`` instead.
+    """
+    from stereovision.calibration import UNIT_TO_METRES
+
+    if plane is None:
+        return NO_FLOOR
+    text = str(plane.describe())
+    if unit == "m":
+        return text
+    metres = f"camera {plane.height:.3f} m above it"
+    said = f"camera {plane.height / UNIT_TO_METRES[unit]:.3f} {unit} above it"
+    if metres in text:
+        return text.replace(metres, said, 1)
+    return f"{text} ({said})"  # the library's wording changed: the height is said anyway
+
+
+def floor_view(result: Any) -> tuple[Any, str]:
+    """The floor of a depth result: the ground plane (None when none is found) and a picture
+    of it, its obstacles in red (data URL; "" when none). :func:`floor_text` says the plane."""
     from stereovision.ground import fit_ground_plane, obstacle_mask
 
     calib = result.calibration
     plane = fit_ground_plane(result.disparity, calib)
     if plane is None:
-        return "ground plane: none found (no near-level plane holds 3 % of the pixels)", ""
+        return None, ""
     img = result.left_rectified if result.left_rectified is not None else None
     if img is None:
-        return plane.describe(), ""
+        return plane, ""
     out = np.array(img, np.uint8)
     if out.ndim == 2:
         out = np.repeat(out[..., None], 3, axis=2)
-    obstacles = obstacle_mask(result.point_image(filled=True), plane)
+    lo, hi = OBSTACLE_HEIGHTS
+    obstacles = obstacle_mask(result.point_image(filled=True), plane, min_height=lo, max_height=hi)
     for mask, colour in ((plane.inliers, (60, 200, 60)), (obstacles, (40, 40, 230))):
         out[mask] = (0.5 * out[mask] + 0.5 * np.array(colour)).astype(np.uint8)
-    return plane.describe(), _data_url(out)
+    return plane, _data_url(out)
 
 
 def _opencv_result(method: str, left: np.ndarray, right: np.ndarray, calib: Any, d_max: int) -> Any:
@@ -706,6 +751,7 @@ class StereoApp:
         st.rows_label = ""
         st.floor_label = ""
         st.img_floor = ""
+        st.floor_caption = floor_caption()
         st.cam_left, st.cam_right = source_names
         st.live = source is not None
         # None, not "": the select shows "" as a chosen, empty entry (its label raised above it)
@@ -1105,6 +1151,8 @@ class StereoApp:
                             self.state[name] = value
                         if self.view is not None:  # in the unit on show now
                             self.state.depth_caption, self.state.stats = self.view.texts(self._unit)
+                            if self.state.floor_label and self.view.floor is not None:
+                                self.state.floor_label = floor_text(self.view.floor, self._unit)
                 shown = self._shown
                 if shown is not None and shown["pair"] is not self.pair:
                     for name, value in shown.items():
@@ -1300,7 +1348,8 @@ class StereoApp:
 
     async def find_floor(self) -> None:
         """Fit the floor of the depth map on show: the camera's height, pitch and roll, and a
-        picture with the floor in green and what stands 0.15-2 m on it in red."""
+        picture with the floor in green and what stands :data:`OBSTACLE_HEIGHTS` on it in red
+        (the height in the page's unit)."""
         view = self._view_on_show("floor_label", PENDING_FLOOR)
         if view is None:
             return
@@ -1311,11 +1360,11 @@ class StereoApp:
                 self.state.floor_label = f"finding the floor needs a calibration ({why})"
             return
 
-        def run() -> tuple[str, str]:
+        def run() -> tuple[Any, str]:
             return floor_view(res)
 
         try:
-            text, url = await asyncio.get_running_loop().run_in_executor(self._executor, run)
+            plane, url = await asyncio.get_running_loop().run_in_executor(self._executor, run)
         except (ValueError, OSError, RuntimeError) as exc:
             if self.view is view and self._page_before is None:
                 self._fail(exc)
@@ -1325,8 +1374,9 @@ class StereoApp:
             # pair on the page (its images show while it computes)
             return
         self._done()
+        view.floor = plane
         with self.state:
-            self.state.floor_label = text
+            self.state.floor_label = floor_text(plane, self._unit)
             self.state.img_floor = url
 
     def save_clicked(self) -> None:
@@ -1472,8 +1522,9 @@ class StereoApp:
         self._apply_camera()
 
     def _on_unit(self, unit: str = "m", **_: Any) -> None:
-        """The unit toggle: the depth caption, the statistics and the translation sliders (their
-        values converted, so that the view stays where it was) in metres or feet."""
+        """The unit toggle: the depth caption, the statistics, the floor's height and obstacle
+        heights and the translation sliders (their values converted, so that the view stays
+        where it was) in metres or feet."""
         from stereovision.calibration import UNIT_TO_METRES
 
         if unit not in UNITS:
@@ -1491,8 +1542,11 @@ class StereoApp:
             st.translation_step = TRANSLATION_STEP if unit == "m" else 0.1
             for name in _TRANSLATIONS:
                 st[name] = round(float(st[name]) * factor, 3)
+            st.floor_caption = floor_caption(unit)
             if self.view is not None and self._page_before is None:
                 st.depth_caption, st.stats = self.view.texts(unit)
+                if st.floor_label and self.view.floor is not None:
+                    st.floor_label = floor_text(self.view.floor, unit)
         self._apply_camera()
 
     def _on_view_mode(self, **_: Any) -> None:
@@ -1761,7 +1815,7 @@ class StereoApp:
                     "floor-label",
                 )
                 with html.Div(v_if="img_floor", classes="mt-1"):
-                    html.Div("floor (green), obstacles 0.15-2 m (red)", classes="text-caption")
+                    html.Div("{{ floor_caption }}", id="floor-caption", classes="text-caption")
                     html.Img(id="img-floor", src=("img_floor",), style=img_style)
                 with v3.VRow(dense=True, align="center", classes="mt-1"):
                     with v3.VCol(cols=9):
