@@ -1115,10 +1115,11 @@ def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_pat
     depth = read_depth_png(out / "depth_mm.png")
     ok = np.isfinite(res.depth) & (res.depth < 60)
     assert np.nanmax(np.abs(depth[ok] - res.depth[ok])) < 0.001
-    # again into the same folder: refused, nothing replaced
+    # typed into a folder that holds the files: refused, nothing replaced
     (out / "cloud.ply").write_text("mine")
     (out / "disparity.pfm").unlink()
     app.state.save_label = ""
+    app.state.save_dir = "saved"
     _run(app, app.save)
     assert app.state.error == (
         f"save: {tmp_path.name}/saved already holds disparity.png, depth.png, depth.npy, "
@@ -1143,10 +1144,45 @@ def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_pat
     assert bare.state.error == "no folder to write into: start the GUI with --data DIR"
 
 
+def test_saves_into_the_offered_folder_go_to_a_new_numbered_folder_each(tmp_path):
+    """Each Save after the first was refused ("saved already holds ...") until a new folder was
+    typed: saving several pairs meant typing a folder for each. Left as offered (or emptied),
+    the field now sends each Save to the first of saved, saved-2, saved-3, ... that is new or
+    empty, and the page says which; nothing is overwritten."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SAVED_DEPTH_FILES, SAVED_FILES
+
+    app = _scene_app("test-save-numbered", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    (tmp_path / "saved-2").mkdir()
+    (tmp_path / "saved-2" / "notes.txt").write_text("mine")  # not empty: skipped
+    (tmp_path / "saved-4").mkdir()  # empty: taken in turn
+    said = []
+    for _ in range(3):
+        app.state.save_label = ""
+        _run(app, app.save)
+        assert app.state.error == ""
+        said.append(app.state.save_label.split(":")[0])
+    assert said == [
+        f"saved 450×375 to {tmp_path.name}/{n}" for n in ("saved", "saved-3", "saved-4")
+    ]
+    for name in ("saved", "saved-3", "saved-4"):
+        assert sorted(p.name for p in (tmp_path / name).iterdir()) == sorted(
+            SAVED_FILES + SAVED_DEPTH_FILES
+        )
+    assert [p.name for p in (tmp_path / "saved-2").iterdir()] == ["notes.txt"]
+    app.state.save_dir = "  "  # emptied: as offered
+    _run(app, app.save)
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/saved-5: ")
+    assert app.state.save_dir == "  "  # the field is left as the user left it
+
+
 def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkeypatch):
     """Save pressed twice (or again after a new pair came) while the first still wrote: the
     second found none of the files yet, wrote too, and replaced the first's files without a
-    word. The folder being written is now refused like one that holds the files."""
+    word. A typed folder being written is now refused like one that holds the files; the
+    offered folder sends the second Save to the next numbered one."""
     import asyncio
     import threading
 
@@ -1154,6 +1190,7 @@ def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkey
     from stereovision.gui import bundled_data_dir
 
     app = _scene_app("test-save-twice", [bundled_data_dir(), tmp_path])
+    app.state.save_dir = "saved"  # typed
     app._load_scene(bundled_data_dir() / "cones")
     _run(app, app.recompute)
     real = cli.write_depth_outputs
@@ -1187,6 +1224,23 @@ def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkey
     app.state.save_label = ""
     _run(app, app.save)  # and once written, the folder holds the files: refused as before
     assert app.state.error.startswith(f"save: {tmp_path.name}/saved already holds disparity.png")
+    # the offered folder, pressed twice: the second Save goes to the next numbered folder
+    app._done()
+    app.state.save_dir = app._offered_save_dir
+    calls.clear()
+    started.clear()
+    gate.clear()
+
+    async def twice_offered() -> None:
+        first = asyncio.ensure_future(app.save())
+        await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
+        gate.set()
+        await app.save()
+        await first
+
+    asyncio.run(twice_offered())
+    assert app.state.error == ""
+    assert calls == [(tmp_path / "saved-2").resolve(), (tmp_path / "saved-3").resolve()]
 
 
 def _still_cameras_app(name: str, data_dir: Path, raw: tuple) -> Any:
@@ -1898,11 +1952,11 @@ def test_save_units_range_and_colour_keys_on_the_page(page, gui_data):
     page.fill("#max-disparity", "")
     page.press("#max-disparity", "Enter")  # automatic again, for the tests after this one
     _wait_computations(page, n + 2)
-    page.fill("#save-dir", str(gui_data / "saved"))
+    page.fill("#save-dir", str(gui_data / "kept"))  # typed: the second Save there is refused
     page.click("#save-btn")
     page.wait_for_function("document.querySelector('#save-label')?.textContent.includes('saved ')")
-    assert (gui_data / "saved" / "cloud.ply").is_file()
-    assert (gui_data / "saved" / "disparity.pfm").is_file()
+    assert (gui_data / "kept" / "cloud.ply").is_file()
+    assert (gui_data / "kept" / "disparity.pfm").is_file()
     _shot(page, "gui-save.png")
     page.click("#save-btn")
     assert "nothing was overwritten" in _wait_error(page, "already holds")

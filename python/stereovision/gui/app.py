@@ -21,6 +21,7 @@ from __future__ import annotations
 import asyncio
 import base64
 import concurrent.futures
+import itertools
 import logging
 import math
 import os
@@ -771,7 +772,10 @@ class StereoApp:
         #: The unit the translation sliders' values are in (they are converted when it changes).
         self._unit = UNITS[0]
         st.translation_range, st.translation_step = TRANSLATION_RANGE, TRANSLATION_STEP
-        st.save_dir = str(self._save_roots[0] / SAVE_FOLDER) if self._save_roots else ""
+        #: The save folder the page offers; left as offered (or emptied), each Save takes the
+        #: first of it, ``saved-2``, ``saved-3``, ... that is new or empty.
+        self._offered_save_dir = str(self._save_roots[0] / SAVE_FOLDER) if self._save_roots else ""
+        st.save_dir = self._offered_save_dir
         st.save_label = ""
         for name in _CONTROL_NAMES:
             st[name] = 0.0
@@ -1387,8 +1391,11 @@ class StereoApp:
         """Write the pair on show as ``stereovision depth -o`` does (its writer and file names:
         disparity PNG and PFM, depth PNGs and .npy, cloud.ply) into the page's save folder.
 
-        A folder that already holds one of those files is refused, naming them: nothing the
-        user wrote is replaced (``depth`` replaces its own earlier outputs, the GUI cannot ask).
+        The folder as offered (or an empty field) is a new one each time: the first of
+        ``saved``, ``saved-2``, ``saved-3``, ... that does not exist or is empty, so several
+        pairs can be saved one after the other; the page says which. A folder the user typed
+        that already holds one of those files is refused, naming them: nothing the user wrote
+        is replaced (``depth`` replaces its own earlier outputs, the GUI cannot ask).
         """
         from stereovision.cli import CliError, write_depth_outputs
         from stereovision.io import check_output_folder
@@ -1398,8 +1405,12 @@ class StereoApp:
             return
         result = view.result
         names = SAVED_FILES + (SAVED_DEPTH_FILES if result.depth is not None else ())
+        typed = str(self.state.save_dir or "").strip()
         try:
-            folder = self.folders.resolve_output(self.state.save_dir or "", self._save_roots)
+            if self._save_roots and typed in ("", self._offered_save_dir):
+                folder = self._next_save_folder()
+            else:
+                folder = self.folders.resolve_output(typed, self._save_roots)
             label = self.folders.label(folder)
             if folder in self._saving_into:  # its files are not there yet: not "taken" below
                 raise FileExistsError(
@@ -1433,6 +1444,18 @@ class StereoApp:
         without = "" if result.depth is not None else " (no calibration: disparity only)"
         with self.state:
             self.state.save_label = f"saved {w}×{h} to {label}: {', '.join(written)}{without}"
+
+    def _next_save_folder(self) -> Path:
+        """The first of ``saved``, ``saved-2``, ``saved-3``, ... in the first ``--data``
+        folder that does not exist or is an empty folder, and no Save is writing into."""
+        for n in itertools.count(1):
+            name = SAVE_FOLDER if n == 1 else f"{SAVE_FOLDER}-{n}"
+            folder = self.folders.resolve_output(name, self._save_roots)
+            if folder in self._saving_into:
+                continue
+            if not os.path.lexists(folder) or (folder.is_dir() and not any(folder.iterdir())):
+                return folder
+        raise AssertionError("unreachable")  # pragma: no cover
 
     def _set_progress(self, pct: int, text: str) -> None:
         with self.state:
@@ -1820,7 +1843,10 @@ class StereoApp:
                 with v3.VRow(dense=True, align="center", classes="mt-1"):
                     with v3.VCol(cols=9):
                         v3.VTextField(
-                            label="Save folder (inside a --data folder)",
+                            label=(
+                                "Save folder (inside a --data folder; as offered: saved, "
+                                "saved-2, ... a new one each Save)"
+                            ),
                             v_model=("save_dir",),
                             density="compact",
                             hide_details=True,
