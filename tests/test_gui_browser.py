@@ -1176,6 +1176,14 @@ def test_saves_into_the_offered_folder_go_to_a_new_numbered_folder_each(tmp_path
     _run(app, app.save)
     assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/saved-5: ")
     assert app.state.save_dir == "  "  # the field is left as the user left it
+    # a folder typed just before the click, not yet in the server's state: the click's own
+    # copy of the field is the one saved into (the page's test saved into "saved" instead)
+    app.state.save_dir = app._offered_save_dir
+    pending: list = []
+    app._spawn = pending.append
+    app.save_clicked("typed")
+    _run(app, pending.pop)
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/typed: ")
 
 
 def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkeypatch):

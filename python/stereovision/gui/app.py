@@ -1383,8 +1383,17 @@ class StereoApp:
             self.state.floor_label = floor_text(plane, self._unit)
             self.state.img_floor = url
 
-    def save_clicked(self) -> None:
-        """The page's "Save" button."""
+    def save_clicked(self, folder: str | None = None) -> None:
+        """The page's "Save" button.
+
+        Parameters
+        ----------
+        folder : str, optional
+            The folder field's text as the page has it: a folder typed just before the click
+            may not have reached the server's state yet (the Save went to the folder offered).
+        """
+        if folder is not None:
+            self.state.save_dir = folder
         self._spawn(self.save())
 
     async def save(self) -> None:
@@ -1853,7 +1862,12 @@ class StereoApp:
                             id="save-dir",
                         )
                     with v3.VCol(cols=3):
-                        v3.VBtn("Save", click=self.save_clicked, id="save-btn", block=True)
+                        v3.VBtn(
+                            "Save",
+                            click=(self.save_clicked, "[save_dir]"),
+                            id="save-btn",
+                            block=True,
+                        )
                 html.Div("{{ save_label }}", id="save-label", classes="text-caption")
 
     def _camera_controls(self, v3: Any, html: Any) -> None:
