@@ -448,34 +448,44 @@ def test_the_max_disparity_field_is_applied_and_checked():
     assert parse_max_disparity(None, 10) is None
 
 
-def test_a_max_disparity_the_field_takes_is_one_the_pair_can_be_searched_with():
-    """449 px at width 450 passed the field, then the search (rounded up to 464 px) failed:
-    'disparity range 464 is not smaller than the image width 450'. 440 px at full size
-    failed at width 320 (scaled and rounded up to 320 px). The field now checks the value as
-    searched, and a range scaled down past the width is searched as the widest that fits,
-    said in the statistics."""
+def test_the_max_disparity_field_is_searched_as_typed():
+    """The page rounded the field up to a multiple of 16 px (40 searched 48 px) although
+    depth_map searches any range: a rounding from the GUI's first commit that only OpenCV's
+    matchers need. The library's methods now search the value as typed (scaled to a lower
+    resolution, up to a whole pixel, kept below the width and said so); the OpenCV reference
+    methods still round up, said in the statistics. 449 px at width 450 is taken."""
     from stereovision.gui import bundled_data_dir
     from stereovision.gui.app import parse_max_disparity
 
-    with pytest.raises(ValueError, match=r"^max disparity 449 px is searched as 464 px \(a mult"):
-        parse_max_disparity("449", 450)
-    assert parse_max_disparity("448", 450) == 448
-    app = _scene_app("test-max-disp-fits", [bundled_data_dir()])
+    app = _scene_app("test-max-disp-typed", [bundled_data_dir()])
     spawned: list = []
     app._spawn = spawned.append
     app._load_scene(bundled_data_dir() / "cones")
-    app.state.max_disp = "449"
-    app.apply_max_disparity()
-    assert app.state.error.startswith("max disparity 449 px is searched as 464 px") and not spawned
-    app.state.max_disp = "440"
+    app.state.max_disp = "40"
     app.apply_max_disparity()
     _run(app, spawned.pop)
-    assert app.state.error == "" and "disparities 0–448 px" in app.state.stats
-    app.state.resolution = "320"
+    assert app.state.error == "" and app.view.result.max_disparity == 40
+    assert " · disparities 0–40 px · " in app.state.stats and "warning" not in app.state.stats
+    app.state.method = "opencv-bm"
+    _run(app, app.recompute)
+    assert app.state.error == "" and " · disparities 0–48 px · " in app.state.stats
+    assert (
+        "warning: max disparity 40 px searched as 48 px (OpenCV's matchers take multiples of "
+        "16 px)" in app.state.stats
+    )
+    assert parse_max_disparity("449", 450) == 449
+    with pytest.raises(ValueError, match=r"^max disparity 450 px is not smaller than the pair"):
+        parse_max_disparity("450", 450)
+    app.state.method = "fast"
+    app.state.max_disp = "449"
+    app.apply_max_disparity()
+    _run(app, spawned.pop)
+    assert app.state.error == "" and "disparities 0–449 px" in app.state.stats
+    app.state.resolution = "320"  # 449 x 320 / 450 = 319.3: up to 320, the width
     _run(app, app.recompute)
     assert app.state.error == "" and app.view.result.disparity.shape[1] == 320
-    assert "disparities 0–304 px" in app.state.stats
-    assert "warning: max disparity 320 px at width 320 searched as 304 px" in app.state.stats
+    assert "disparities 0–319 px" in app.state.stats
+    assert "warning: max disparity 320 px at width 320 searched as 319 px" in app.state.stats
 
 
 @pytest.mark.parametrize("method", ["gabor", "fused"])
@@ -1963,7 +1973,7 @@ def test_save_units_range_and_colour_keys_on_the_page(page, gui_data):
     page.fill("#save-dir", str(gui_data / "kept"))  # typed: the second Save there is refused
     page.click("#save-btn")
     page.wait_for_function("document.querySelector('#save-label')?.textContent.includes('saved ')")
-    assert (gui_data / "kept" / "cloud.ply").is_file()
+    assert (gui_data / "kept" / "cloud.ply").is_file(), page.inner_text("#save-label")
     assert (gui_data / "kept" / "disparity.pfm").is_file()
     _shot(page, "gui-save.png")
     page.click("#save-btn")

@@ -105,6 +105,9 @@ _STEP_NAME = {
     "triangulate": "triangulating",
 }
 
+#: Why an OpenCV reference method searches more than the max-disparity field says.
+_BY_16 = "(OpenCV's matchers take multiples of 16 px)"
+
 #: The max-disparity field's hint when the pair has no range of its own.
 AUTO_HINT = "auto: estimated from the images"
 
@@ -437,6 +440,7 @@ def compute_view(
     ValueError
         Unknown method, calibration for another image size, bad images.
     """
+    from stereovision.baselines import round_up16
     from stereovision.cli import colorize
     from stereovision.depth import METHODS, depth_map, estimate_max_disparity
     from stereovision.render import Intrinsics, surface_mesh
@@ -454,13 +458,21 @@ def compute_view(
         notes += [] if note is None else [note]
     left_s, right_s, s = scale_pair(left, right, width)
     calib_s = scaled_calibration(calib, s, (left_s.shape[1], left_s.shape[0]))
-    d_max = None if max_disparity is None else max(16, math.ceil(max_disparity * s / 16) * 16)
-    widest = (left_s.shape[1] - 1) // 16 * 16  # the range must stay below the width
-    if d_max is not None and d_max > widest >= 16:
+    # depth_map searches any range: the one given, at a lower resolution scaled and rounded
+    # up to a whole pixel; OpenCV's matchers only multiples of 16 (baselines.round_up16), said
+    opencv = method in EXTRA_METHODS
+    d_max = None if max_disparity is None else max(1, math.ceil(max_disparity * s))
+    if opencv and d_max is not None and d_max % 16:
+        notes.append(f"max disparity {d_max} px searched as {round_up16(d_max)} px " + _BY_16)
+        d_max = round_up16(d_max)
+    w_s = left_s.shape[1]
+    widest = (w_s - 1) // 16 * 16 if opencv else w_s - 1  # the range must stay below the width
+    if d_max is not None and d_max > widest and w_s > 16:
         # a range that fits the pair at its size, scaled down and rounded up, can reach the
-        # smaller width (440 px at full size searched 320 px at width 320: refused)
+        # smaller width (440 px at full size searched 320 px at width 320: refused); a pair
+        # 16 px wide or less is depth_map's to refuse
         notes.append(
-            f"max disparity {d_max} px at width {left_s.shape[1]} searched as {widest} px "
+            f"max disparity {d_max} px at width {w_s} searched as {widest} px "
             "(the range must stay below the width)"
         )
         d_max = widest
@@ -574,8 +586,9 @@ def parse_max_disparity(text: str | None, width: int) -> int | None:
     Raises
     ------
     ValueError
-        Not a whole number of pixels above 0, or not smaller than ``width`` once rounded up
-        to the multiple of 16 px the pair is searched with (449 px at width 450: 464 px).
+        Not a whole number of pixels above 0, or not smaller than ``width`` (``depth_map``
+        searches the range as typed; the OpenCV reference methods round it up to a multiple
+        of 16 px, kept below the width, said in the statistics).
 
     Examples
     --------
@@ -597,12 +610,6 @@ def parse_max_disparity(text: str | None, width: int) -> int | None:
     if value >= width:
         raise ValueError(
             f"max disparity {value} px is not smaller than the pair's width {width} px"
-        )
-    searched = math.ceil(value / 16) * 16  # as compute_view searches it
-    if searched >= width:
-        raise ValueError(
-            f"max disparity {value} px is searched as {searched} px (a multiple of 16), not "
-            f"smaller than the pair's width {width} px"
         )
     return value
 
