@@ -1094,3 +1094,21 @@ def test_a_scene_with_only_q_dat_is_batched_with_depth(data_dir: Path, tmp_path:
     assert expected.depth is not None
     depth = np.load(io.BytesIO(out["files"]["depth.npy"]))
     np.testing.assert_array_equal(depth, expected.depth)
+
+
+def test_a_scene_with_a_bad_q_dat_fails_that_pair_alone(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A scene's Q.dat is read before its pair is sent (8ab621e): one that is not a Q matrix
+    stopped the whole run ('error: .../b/Q.dat: not a rectified Q matrix', exit 2, pair a left
+    pending). It fails pair b alone, naming the file; a is done."""
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
+    (root / "b" / "Q.dat").write_text("0 0 0 -5\n0 1 0 -4\n0 0 0 100\n0 0 4 0\n")
+    assert main(["batch", str(root), "-o", str(out), "--workers", "1"]) == 1
+    err = capsys.readouterr().err
+    q = root / "b" / "Q.dat"
+    assert f"failed b: ValueError: {q}: not a rectified Q matrix: Q[0,0] = 0, expected 1" in err
+    pairs = _summary(out)["pairs"]
+    assert pairs["a"]["status"] == "done" and pairs["b"]["status"] == "failed"
+    assert (out / "a" / "disparity.pfm").is_file() and not (out / "b").exists()

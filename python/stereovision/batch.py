@@ -1266,7 +1266,8 @@ def _run_jobs(
                 return False
             try:
                 task = _task(job, opts)
-            except OSError as exc:  # unreadable input: a failed pair, not a failed run
+            except (OSError, ValueError) as exc:  # unreadable input or calibration (a scene's
+                # Q.dat is read here): a failed pair, not a failed run
                 record_failure(job, exc)
                 return True
             fut = client.submit(process_pair, task, key=f"stereovision-{uuid.uuid4().hex}")
