@@ -488,6 +488,21 @@ def test_the_max_disparity_field_is_searched_as_typed():
     assert "warning: max disparity 320 px at width 320 searched as 319 px" in app.state.stats
 
 
+def test_a_max_disparity_scaled_to_a_whole_pixel_is_not_rounded_up_past_it():
+    """159 px at width 424 is 120 px at width 320 exactly; scaled in floats it was
+    120.00000000000001 px, searched as 121 px (and said as '121 px searched as 128 px' by
+    the OpenCV methods)."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import compute_view
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png"))[:, :424] for s in ("left", "right"))
+    view = compute_view(left, right, None, "fast", width=320, max_disparity=159)
+    assert view.result.max_disparity == 120
+    view = compute_view(left, right, None, "opencv-bm", width=320, max_disparity=159)
+    assert "warning: max disparity 120 px searched as 128 px" in view.stats
+
+
 @pytest.mark.parametrize("method", ["gabor", "fused"])
 def test_progress_goes_forward_and_says_what_runs(method):
     """The status read "prepare done" during the whole matching (most of the time: it looked

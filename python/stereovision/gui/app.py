@@ -461,11 +461,13 @@ def compute_view(
     # depth_map searches any range: the one given, at a lower resolution scaled and rounded
     # up to a whole pixel; OpenCV's matchers only multiples of 16 (baselines.round_up16), said
     opencv = method in EXTRA_METHODS
-    d_max = None if max_disparity is None else max(1, math.ceil(max_disparity * s))
+    # in whole numbers: max_disparity * s in floats can land above an exact product
+    # (159 px x 320 / 424 = 120.00000000000001, searched as 121 px)
+    w_in, w_s = left.shape[1], left_s.shape[1]
+    d_max = None if max_disparity is None else max(1, -(-max_disparity * w_s // w_in))
     if opencv and d_max is not None and d_max % 16:
         notes.append(f"max disparity {d_max} px searched as {round_up16(d_max)} px " + _BY_16)
         d_max = round_up16(d_max)
-    w_s = left_s.shape[1]
     widest = (w_s - 1) // 16 * 16 if opencv else w_s - 1  # the range must stay below the width
     if d_max is not None and d_max > widest and w_s > 16:
         # a range that fits the pair at its size, scaled down and rounded up, can reach the
