@@ -731,6 +731,23 @@ def _scene_app(name: str, folders: list[Path], **kw):
     return app
 
 
+def _tiny_scene(folder: Path) -> None:
+    """An 8x8 black pair in ``folder``: it loads, then fails to compute."""
+    folder.mkdir()
+    for side in ("left", "right"):
+        cv2.imwrite(str(folder / f"{side}.png"), np.zeros((8, 8, 3), np.uint8))
+
+
+def _chooser(app: Any, root: Path) -> Any:
+    """``choose(name)``: the scene ``root/name`` chosen in the page's scene list."""
+
+    def choose(name: str) -> None:
+        app.state.scene = str(root / name)
+        app._on_scene(scene=str(root / name))
+
+    return choose
+
+
 def test_the_demo_scene_is_the_scene_list_choice_at_start_up(tmp_path):
     """At start-up the page showed "scene data/cones" above a scene list whose choice was an
     empty entry (the state's "" is a chosen value to the select). The demo's entry is now the
@@ -862,15 +879,10 @@ def test_a_scene_chosen_during_a_computation_is_not_shown_the_previous_result(tm
 
     for name in ("first", "second"):
         shutil.copytree(bundled_data_dir() / "cones", tmp_path / name)
-    (tmp_path / "tiny").mkdir()  # loads, then fails to compute
-    for side in ("left", "right"):
-        cv2.imwrite(str(tmp_path / "tiny" / f"{side}.png"), np.zeros((8, 8, 3), np.uint8))
+    _tiny_scene(tmp_path / "tiny")
     app = _scene_app("test-scene-during-compute", [tmp_path])
     tasks: list = []
-
-    def choose(name: str) -> None:
-        app.state.scene = str(tmp_path / name)
-        app._on_scene(scene=str(tmp_path / name))
+    choose = _chooser(app, tmp_path)
 
     async def run() -> None:
         app._lock = asyncio.Lock()
@@ -907,16 +919,11 @@ def test_a_new_pair_does_not_show_the_previous_pairs_results_while_it_computes(t
     for side, other in (("left", "right"), ("right", "left")):  # another pair, same size
         src = bundled_data_dir() / "cones" / f"{other}.png"
         (tmp_path / "swapped" / f"{side}.png").write_bytes(src.read_bytes())
-    (tmp_path / "tiny").mkdir()  # loads, then fails to compute
-    for side in ("left", "right"):
-        cv2.imwrite(str(tmp_path / "tiny" / f"{side}.png"), np.zeros((8, 8, 3), np.uint8))
+    _tiny_scene(tmp_path / "tiny")
     app = _scene_app("test-new-pair-pending", [tmp_path])
     tasks: list = []
     seen: dict = {}
-
-    def choose(name: str) -> None:
-        app.state.scene = str(tmp_path / name)
-        app._on_scene(scene=str(tmp_path / name))
+    choose = _chooser(app, tmp_path)
 
     async def run() -> None:
         app._lock = asyncio.Lock()

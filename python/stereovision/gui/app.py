@@ -644,6 +644,35 @@ def _file_picker(label: str, model: str, items: str, element_id: str) -> None:
     )
 
 
+def _toggle(
+    model: str,
+    values: Any,
+    element_id: str,
+    button_ids: str | None = None,
+    classes: str | None = None,
+    button_classes: str | None = None,
+) -> None:
+    """A row of buttons choosing one of ``values`` (state variable ``model``); each button's id
+    is ``button_ids-VALUE`` when ``button_ids`` is given."""
+    from trame.widgets import vuetify3 as v3
+
+    extra = {} if classes is None else {"classes": classes}
+    with v3.VBtnToggle(
+        v_model=(model,),
+        mandatory=True,
+        density="compact",
+        divided=True,
+        variant="outlined",
+        id=element_id,
+        **extra,
+    ):
+        for v in values:
+            kw: dict[str, Any] = {} if button_ids is None else {"id": f"{button_ids}-{v}"}
+            if button_classes is not None:
+                kw["classes"] = button_classes
+            v3.VBtn(v, value=v, size="small", **kw)
+
+
 class StereoApp:
     """The trame application: state, controllers, layout and the worker thread.
 
@@ -1723,16 +1752,7 @@ class StereoApp:
                         )
                     with v3.VCol(cols=6):
                         html.Div("resolution", classes="text-caption")
-                        with v3.VBtnToggle(
-                            v_model=("resolution",),
-                            mandatory=True,
-                            density="compact",
-                            divided=True,
-                            variant="outlined",
-                            id="resolution-toggle",
-                        ):
-                            for r in RESOLUTIONS:
-                                v3.VBtn(r, value=r, id=f"resolution-{r}", size="small")
+                        _toggle("resolution", RESOLUTIONS, "resolution-toggle", "resolution")
                 v3.VSelect(
                     label="Scene folder",
                     v_model=("scene",),
@@ -1793,17 +1813,9 @@ class StereoApp:
         with v3.VCard(id="panel-stereo", classes="fill-height"):
             v3.VCardTitle("2 · Stereo output")
             with v3.VCardText():
-                with v3.VBtnToggle(
-                    v_model=("method",),
-                    mandatory=True,
-                    density="compact",
-                    divided=True,
-                    variant="outlined",
-                    id="method-toggle",
-                    classes="flex-wrap",
-                ):
-                    for m in self.state.methods:
-                        v3.VBtn(m, value=m, id=f"method-{m}", size="small")
+                _toggle(
+                    "method", self.state.methods, "method-toggle", "method", classes="flex-wrap"
+                )
                 with v3.VRow(dense=True, align="center", classes="mt-1"):
                     with v3.VCol(cols=8):
                         v3.VTextField(
@@ -1819,18 +1831,7 @@ class StereoApp:
                             update_focused=(self.apply_max_disparity, "[$event, max_disp]"),
                         )
                     with v3.VCol(cols=4):
-                        with v3.VBtnToggle(
-                            v_model=("unit",),
-                            mandatory=True,
-                            density="compact",
-                            divided=True,
-                            variant="outlined",
-                            id="unit-toggle",
-                        ):
-                            for u in UNITS:
-                                v3.VBtn(
-                                    u, value=u, id=f"unit-{u}", size="small", classes="text-none"
-                                )
+                        _toggle("unit", UNITS, "unit-toggle", "unit", button_classes="text-none")
                 with v3.VRow(dense=True, classes="mt-2"):
                     with v3.VCol(cols=6):
                         html.Div(
@@ -1882,16 +1883,7 @@ class StereoApp:
     def _camera_controls(self, v3: Any, html: Any) -> None:
         with v3.VRow(dense=True, classes="mt-2", align="center"):
             with v3.VCol(cols=8):
-                with v3.VBtnToggle(
-                    v_model=("view_mode",),
-                    mandatory=True,
-                    density="compact",
-                    divided=True,
-                    variant="outlined",
-                    id="view-mode",
-                ):
-                    v3.VBtn("surface", value="surface", size="small")
-                    v3.VBtn("points", value="points", size="small")
+                _toggle("view_mode", ("surface", "points"), "view-mode")
             with v3.VCol(cols=4):
                 v3.VBtn(
                     "Reset",
