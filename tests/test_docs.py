@@ -44,3 +44,89 @@ def test_quick_start_has_the_two_commands() -> None:
     block = re.search(r"```\n(.*?)```", quick, re.S)
     assert block is not None
     assert block.group(1).split("\n")[:-1] == ["make demo", "make test"]
+
+
+ARCH = ROOT / "docs" / "architecture.md"
+TREE_ROOTS = ("rust/core/src/", "rust/py/src/", "python/stereovision/", "tests/", "benches/")
+SNAKE = re.compile(r"\b[a-z][a-z0-9]*(?:_[a-z0-9]+)+\b")
+
+
+def _tree() -> list[tuple[str, str]]:
+    """architecture.md's file tree as (path, description) entries: a top-level line names a file
+    or, ending in ``/``, the folder of the indented entries below it; a line indented deeper is
+    the description going on."""
+    block = ARCH.read_text().split("```\n", 2)[1]
+    entries: list[tuple[str, str]] = []
+    folder = ""
+    for line in block.splitlines():
+        indent = len(line) - len(line.lstrip())
+        if indent > 2:  # a description going on
+            path, text = entries[-1]
+            entries[-1] = (path, f"{text} {line.strip()}")
+            continue
+        name, _, text = line.strip().partition("  ")
+        if indent == 0:
+            folder = name if name.endswith("/") else ""
+        for part in name.split(","):
+            part = part.strip()
+            if part:
+                entries.append((part if indent == 0 else folder + part, text.strip()))
+    return entries
+
+
+def test_architecture_tree_names_only_what_exists() -> None:
+    missing = [p for p, _ in _tree() if not list(ROOT.glob(p.rstrip("/")))]
+    assert not missing, f"architecture.md names paths that do not exist: {missing}"
+
+
+def test_architecture_tree_names_every_source_file() -> None:
+    """Every Rust source (unit-test modules aside) and every Python module is in the tree, by
+    its own line or named in its folder's line."""
+    entries = _tree()
+    named = {p for p, _ in entries}
+    in_folder = {p: text for p, text in entries if p.endswith("/")}
+    sources = [
+        *ROOT.glob("rust/core/src/**/*.rs"),
+        *ROOT.glob("rust/py/src/**/*.rs"),
+        *ROOT.glob("python/stereovision/**/*.py"),
+    ]
+    unnamed = []
+    for f in sources:
+        rel = f.relative_to(ROOT).as_posix()
+        if f.name == "tests.rs" or "/data/" in rel:
+            continue
+        parent = rel.rsplit("/", 1)[0] + "/"
+        if rel not in named and not re.search(rf"\b{re.escape(f.name)}", in_folder.get(parent, "")):
+            unnamed.append(rel)
+    assert not unnamed, f"architecture.md does not name: {unnamed}"
+
+
+def test_architecture_names_are_in_their_files() -> None:
+    """A function, type or constant the tree names (snake_case or CamelCase) occurs in the file
+    it is named under (or is the package's public API), so a renamed or moved one is caught."""
+    camel = re.compile(r"\b[A-Z][a-z0-9]+[A-Z][a-z]\w*\b")
+    public = (ROOT / "python/stereovision/__init__.py").read_text()  # named across files
+    wrong = []
+    for path, text in _tree():
+        if not path.startswith(TREE_ROOTS[:3]) or path.endswith("/") or "*" in path:
+            continue
+        source = (ROOT / path).read_text()
+        for name in {*SNAKE.findall(text), *camel.findall(text)}:
+            if name not in source and name not in public:
+                wrong.append(f"{path}: {name}")
+    assert not wrong, f"architecture.md names what its file does not hold: {wrong}"
+
+
+def test_architecture_lists_every_binding() -> None:
+    """Every function the extension registers is named in the line of the file defining it
+    (``hopfield_match (and _u8)`` names ``hopfield_match_u8``)."""
+    lib = (ROOT / "rust/py/src/lib.rs").read_text()
+    texts = dict(_tree())
+    unnamed = []
+    for module, name in re.findall(r"wrap_pyfunction!\((?:(\w+)::)?(\w+)", lib):
+        path = f"rust/py/src/{module or 'lib'}.rs"
+        words = set(re.findall(r"\w+", texts.get(path, "")))
+        stem, _, tail = name.rpartition("_")
+        if name not in words and not (stem in words and f"_{tail}" in words):
+            unnamed.append(f"{path}: {name}")
+    assert not unnamed, f"architecture.md does not list these bindings: {unnamed}"
