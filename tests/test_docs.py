@@ -3,6 +3,9 @@ exists, every in-page anchor names a heading, and the Quick start has its two co
 
 from __future__ import annotations
 
+import importlib
+import inspect
+import pkgutil
 import re
 from pathlib import Path
 
@@ -130,3 +133,48 @@ def test_architecture_lists_every_binding() -> None:
         if name not in words and not (stem in words and f"_{tail}" in words):
             unnamed.append(f"{path}: {name}")
     assert not unnamed, f"architecture.md does not list these bindings: {unnamed}"
+
+
+def _resolves(dotted: str) -> bool:
+    """Whether ``stereovision.a.b.c`` names a module, then attributes (or dataclass fields)."""
+    parts = dotted.split(".")
+    for i in range(len(parts), 0, -1):
+        try:
+            obj: object = importlib.import_module(".".join(parts[:i]))
+        except ImportError:
+            continue
+        for name in parts[i:]:
+            fields = {
+                **getattr(obj, "__dataclass_fields__", {}),
+                **getattr(obj, "__annotations__", {}),
+            }
+            if hasattr(obj, name):
+                obj = getattr(obj, name)
+            elif name in fields and name == parts[-1]:
+                return True
+            else:
+                return False
+        return True
+    return False
+
+
+def test_docstring_cross_references_resolve() -> None:
+    """Every ``:func:`` / ``:class:`` / ... reference written with its full ``stereovision.``
+    path, in the package's sources, names something that exists (a renamed function leaves
+    none behind)."""
+    import stereovision
+
+    role = re.compile(r":(?:func|class|meth|mod|data|attr|exc):`~?(stereovision\.[\w.]+)`")
+    broken = []
+    for info in pkgutil.walk_packages(stereovision.__path__, "stereovision."):
+        if info.name.endswith("__main__"):
+            continue
+        try:
+            module = importlib.import_module(info.name)
+            source = inspect.getsource(module)
+        except (ImportError, OSError):  # an optional extra not installed; the compiled _core
+            continue
+        broken += [
+            f"{info.name}: {n}" for n in sorted(set(role.findall(source))) if not _resolves(n)
+        ]
+    assert not broken, f"docstrings refer to names that do not exist: {broken}"

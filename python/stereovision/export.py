@@ -128,7 +128,7 @@ def write_cloud_ply(path: PathLike, result: DepthResult) -> Path:
         File to write (atomically: an existing file is replaced only once the new one is whole).
     result : DepthResult
         A :func:`stereovision.depth_map` result computed with a calibration; one computed with
-        ``cloud=False`` (as :func:`stereovision.stream.run` gives them) is written with the
+        ``cloud=False`` (as :func:`stereovision.stream.run_stream` gives them) is written with the
         cloud its depth map gives, the same points as with ``cloud=True``.
 
     Returns
