@@ -178,3 +178,41 @@ def test_docstring_cross_references_resolve() -> None:
             f"{info.name}: {n}" for n in sorted(set(role.findall(source))) if not _resolves(n)
         ]
     assert not broken, f"docstrings refer to names that do not exist: {broken}"
+
+
+def test_help_texts_state_the_defaults() -> None:
+    """An option with a default value (a folder, a number, a name) says it in its --help; a
+    zero (no move, no offset) goes without saying."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    unsaid = []
+    for command, sub in commands.choices.items():
+        for action in sub._actions:
+            default = action.default
+            if isinstance(default, bool) or not isinstance(default, (str, int, float)):
+                continue
+            if default == argparse.SUPPRESS or (not isinstance(default, str) and default == 0):
+                continue
+            text = action.help or ""
+            said = f"{default:g}" if isinstance(default, float) else str(default)
+            if said not in text and not (default == "auto" and "default" in text):
+                unsaid.append(f"{command} {action.option_strings[0]} (default {default!r})")
+    assert not unsaid, f"--help does not say these defaults: {unsaid}"
+
+
+def test_batch_help_names_both_scene_calibrations() -> None:
+    """batch reads a scene's calib.txt, else its Q.dat (batch.md); its --help says both."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    batch = commands.choices["batch"]
+    calib = next(a for a in batch._actions if "--calib" in a.option_strings)
+    assert "Q.dat" in (batch.description or "")
+    assert "calib.txt or Q.dat" in (calib.help or "")

@@ -1422,15 +1422,14 @@ def add_cli(subparsers: Any) -> None:
         "batch",
         help="depth outputs of every pair under a folder, on Dask (local or a cluster)",
         description="Process every pair under INPUT into OUT/<name>/ (the files `stereovision "
-        "depth` writes): scene folders (left.png + right.png, with calib.txt), image files named "
-        "...left.../...right... (seq/0001_left.png + seq/0001_right.png -> seq/0001), and images "
-        "of the same name in sibling camera folders: left/ + right/, L/ + R/, KITTI's image_2/ + "
-        "image_3/ (image_0/ + image_1/), EuRoC's cam0/ + cam1/ (seq/left/0001.png + "
-        "seq/right/0001.png -> seq/0001; mav0/cam0/data/1.png -> mav0/data/1). An image without "
-        "the other of its pair is a failed pair. Pairs are "
-        "recorded in OUT/summary.json; a re-run skips finished pairs. Exit status 1 when a pair "
-        "failed (its error is in the summary), 2 on errors, 130 when interrupted (Ctrl-C), 143 "
-        "when terminated (SIGTERM).",
+        "depth` writes): scene folders (left.png + right.png, with calib.txt or Q.dat), image "
+        "files named ...left.../...right... (seq/0001_left.png + seq/0001_right.png -> seq/0001), "
+        "and images of the same name in sibling camera folders: left/ + right/, L/ + R/, KITTI's "
+        "image_2/ + image_3/ (image_0/ + image_1/), EuRoC's cam0/ + cam1/ (seq/left/0001.png + "
+        "seq/right/0001.png -> seq/0001; mav0/cam0/data/1.png -> mav0/data/1). An image "
+        "without the other of its pair is a failed pair. Pairs are recorded in OUT/summary.json; a "
+        "re-run skips finished pairs. Exit status 1 when a pair failed (its error is in the "
+        "summary), 2 on errors, 130 when interrupted (Ctrl-C), 143 when terminated (SIGTERM).",
     )
     p.add_argument(
         "input", help="folder with scene folders, left/right image pairs or camera folders"
@@ -1452,7 +1451,7 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument(
         "--calib",
         help="calibration for every pair, a file or a ROS camera_info folder (default: each "
-        "scene's calib.txt)",
+        "scene's calib.txt or Q.dat)",
     )
     p.add_argument(
         "--fill", action="store_const", const=True, help="fill holes (default: the method's)"

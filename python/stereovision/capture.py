@@ -1646,7 +1646,9 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument(
         "--dictionary", default="auto", help="--charuco: ArUco dictionary (default: found)"
     )
-    p.add_argument("--every", type=int, default=1, help="without a board: save every Nth pair")
+    p.add_argument(
+        "--every", type=int, default=1, help="without a board: save every Nth pair (default 1)"
+    )
     p.add_argument(
         "--temporal",
         type=int,

@@ -966,7 +966,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     d = sub.add_parser("demo", help="run the pipeline on the bundled Middlebury scene")
-    d.add_argument("-o", "--output", default="demo_output", help="output folder")
+    d.add_argument(
+        "-o", "--output", default="demo_output", help="output folder (default demo_output)"
+    )
     d.add_argument("--method", default=METHODS[0], choices=METHODS, help=_METHOD_HELP)
     d.set_defaults(func=cmd_demo)
 
