@@ -216,3 +216,30 @@ def test_batch_help_names_both_scene_calibrations() -> None:
     calib = next(a for a in batch._actions if "--calib" in a.option_strings)
     assert "Q.dat" in (batch.description or "")
     assert "calib.txt or Q.dat" in (calib.help or "")
+
+
+def test_readme_pipeline_table_matches_the_tree() -> None:
+    """README's "pipeline, by folder" table names only files that exist, and every stage's
+    source: every Python module and every Rust kernel file (the crate's plumbing aside)."""
+    text = (ROOT / "README.md").read_text()
+    table = text.split("## The pipeline, by folder", 1)[1].strip().split("\n\n", 1)[0]
+    rust, python = set(), set()
+    for row in table.splitlines()[2:]:
+        cells = row.split("|")
+        rust |= set(re.findall(r"`([^`]+)`", cells[2]))
+        python |= set(re.findall(r"`([^`]+)`", cells[3]))
+    core, pkg = ROOT / "rust/core/src", ROOT / "python/stereovision"
+    missing = [n for n in rust if not (core / n).exists()]
+    missing += [n for n in python if not (pkg / n).exists()]
+    assert not missing, f"README's pipeline table names files that do not exist: {missing}"
+    plumbing = {"lib.rs", "alloc.rs", "parallel.rs", "simd.rs", "matching/mod.rs"}
+    unnamed = [
+        f.relative_to(core).as_posix()
+        for f in core.rglob("*.rs")
+        if f.parent == core or f.parent.name == "matching"
+    ]
+    unnamed = [n for n in unnamed if n not in rust | plumbing]
+    modules = [f.relative_to(pkg).as_posix() for f in pkg.rglob("*.py") if "gui" not in f.parts]
+    unnamed += [m for m in modules if not m.rsplit("/", 1)[-1].startswith("__")]
+    unnamed = [n for n in unnamed if n not in python | rust | plumbing | {"_interrupt.py"}]
+    assert not unnamed, f"README's pipeline table leaves out: {unnamed}"
