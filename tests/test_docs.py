@@ -243,3 +243,16 @@ def test_readme_pipeline_table_matches_the_tree() -> None:
     unnamed += [m for m in modules if not m.rsplit("/", 1)[-1].startswith("__")]
     unnamed = [n for n in unnamed if n not in python | rust | plumbing | {"_interrupt.py"}]
     assert not unnamed, f"README's pipeline table leaves out: {unnamed}"
+
+
+def test_depth_module_docstring_names_every_method() -> None:
+    """The entry point's module docstring (the first thing `help(stereovision.depth)` shows) names
+    each method and which is the default, as the signature has it."""
+    from stereovision import depth
+
+    signature = inspect.signature(depth.depth_map)
+    default = signature.parameters["method"].default
+    doc = depth.__doc__ or ""
+    unnamed = [m for m in depth.METHODS if f'``"{m}"``' not in doc]
+    assert not unnamed, f"stereovision.depth's docstring leaves out: {unnamed}"
+    assert f'``"{default}"`` (the default' in doc

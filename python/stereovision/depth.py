@@ -1,8 +1,12 @@
 """The main entry point: a stereo pair (and its calibration) in, a metric depth map out.
 
-``depth_map`` runs one matcher on the rectified pair, refines its disparity to sub-pixel precision
-(:mod:`stereovision.refine`), then triangulates with the rectified shortcut (algorithms.md E.3):
-``Z = f * B / (d + doffs)``, in metres.
+``depth_map`` runs one of :data:`METHODS` on the rectified pair: ``"fused"`` (the default: the
+Gabor, graph-matching and Hopfield channels' valid members on the Gabor map, checked and completed
+by a census semi-global map, algorithms.md D), ``"gabor"`` (the Gabor channel alone), ``"census"``
+(the census semi-global map alone) or ``"fast"`` (that map over three paths in one pass). It
+re-measures the disparity to sub-pixel precision (:mod:`stereovision.refine`; not for
+``"fast"`` unless asked), fills holes (not for ``"gabor"`` unless asked), then triangulates with
+the rectified shortcut (algorithms.md E.3): ``Z = f * B / (d + doffs)``, in metres.
 """
 
 from __future__ import annotations
