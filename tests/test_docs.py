@@ -256,3 +256,30 @@ def test_depth_module_docstring_names_every_method() -> None:
     unnamed = [m for m in depth.METHODS if f'``"{m}"``' not in doc]
     assert not unnamed, f"stereovision.depth's docstring leaves out: {unnamed}"
     assert f'``"{default}"`` (the default' in doc
+
+
+def test_commands_in_code_blocks_parse() -> None:
+    """Every `stereovision ...` line of a code block in the README and docs/ (what a reader
+    pastes) is accepted by the command line's parser: no renamed option or command left behind.
+    Synopses (with ``[`` or ``|``) are skipped; a one-letter placeholder (N, M) stands for 64."""
+    import shlex
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    rejected = []
+    for page in PAGES:
+        for block in re.findall(r"```[a-z]*\n(.*?)```", page.read_text(), re.S):
+            for line in block.replace("\\\n", " ").splitlines():
+                m = re.match(r"\s*(?:\w+\$ )?stereovision (.*)", line)
+                if not m:
+                    continue
+                command = re.split(r"\s+#", m.group(1))[0]
+                if "[" in command or "|" in command:
+                    continue
+                words = ["64" if re.fullmatch(r"[A-Z]", w) else w for w in shlex.split(command)]
+                try:
+                    parser.parse_args(words)
+                except SystemExit:
+                    rejected.append(f"{page.name}: stereovision {command}")
+    assert not rejected, f"commands the parser refuses: {rejected}"
