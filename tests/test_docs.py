@@ -283,3 +283,18 @@ def test_commands_in_code_blocks_parse() -> None:
                 except SystemExit:
                     rejected.append(f"{page.name}: stereovision {command}")
     assert not rejected, f"commands the parser refuses: {rejected}"
+
+
+def test_unit_options_list_the_units_accepted() -> None:
+    """calibrate's and board's --unit help names every unit a calibration takes (feet too)."""
+    import argparse
+
+    from stereovision.calibration import UNIT_TO_METRES
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    for command in ("calibrate", "board"):
+        unit = next(a for a in commands.choices[command]._actions if "--unit" in a.option_strings)
+        words = set(re.findall(r"\w+", unit.help or ""))
+        assert set(UNIT_TO_METRES) <= words, f"{command} --unit: {unit.help}"

@@ -2647,7 +2647,9 @@ def _add_board_options(p: argparse.ArgumentParser) -> None:
         help="chessboard: inner corners COLSxROWS (default 9x6); charuco: squares COLSxROWS",
     )
     p.add_argument("--square", required=True, type=float, help="square side in --unit")
-    p.add_argument("--unit", default="m", help="length unit of --square (default m)")
+    p.add_argument(
+        "--unit", default="m", help="length unit of --square: m (default), mm, cm, ft or in"
+    )
     p.add_argument("--marker", type=float, help="charuco: marker side in --unit")
 
 
