@@ -298,3 +298,17 @@ def test_unit_options_list_the_units_accepted() -> None:
         unit = next(a for a in commands.choices[command]._actions if "--unit" in a.option_strings)
         words = set(re.findall(r"\w+", unit.help or ""))
         assert set(UNIT_TO_METRES) <= words, f"{command} --unit: {unit.help}"
+
+
+def test_architecture_lists_every_command() -> None:
+    """The tree's cli.py line lists the command line's commands, no more, no fewer."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    text = dict(_tree())["python/stereovision/cli.py"]
+    listed = re.search(r"`stereovision ([^`]+)`", text)
+    assert listed is not None
+    assert [c.strip() for c in listed.group(1).split("|")] == list(commands.choices)
