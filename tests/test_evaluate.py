@@ -145,12 +145,18 @@ def test_table1_given_points_hand_computed() -> None:
     d = r.as_dict()
     json.dumps(d)  # JSON-ready
     assert d["rmse_ft"] == pytest.approx(r.rmse / 0.3048)
+    # every figure format() prints in feet is in the dict too
+    assert d["mean_abs_error_ft"] == pytest.approx(r.mean_abs_error / 0.3048)
+    assert d["points"][1]["error_ft"] == pytest.approx(0.1 / 0.3048)
     assert d["points"][1] == {
         "x": 1,
         "y": 0,
         "estimated_m": 3.1,
         "ground_truth_m": 3.0,
         "error_m": pytest.approx(0.1),
+        "estimated_ft": pytest.approx(3.1 / 0.3048),
+        "ground_truth_ft": pytest.approx(3.0 / 0.3048),
+        "error_ft": pytest.approx(0.1 / 0.3048),
     }
     text = r.format()
     assert "RMSE: 0.082 m (0.268 ft)" in text  # sqrt(0.02/3) = 0.0816 m = 0.2679 ft

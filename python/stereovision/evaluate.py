@@ -335,6 +335,7 @@ class Table1Report:
             "rmse_pct": self.rmse_pct,
             "mean_distance_m": self.mean_distance,
             "mean_error_ft": self.mean_error * _FT_PER_M,
+            "mean_abs_error_ft": self.mean_abs_error * _FT_PER_M,
             "rmse_ft": self.rmse * _FT_PER_M,
             "mean_distance_ft": self.mean_distance * _FT_PER_M,
             "points": [
@@ -344,6 +345,9 @@ class Table1Report:
                     "estimated_m": float(e),
                     "ground_truth_m": float(g),
                     "error_m": float(e - g),
+                    "estimated_ft": float(e) * _FT_PER_M,
+                    "ground_truth_ft": float(g) * _FT_PER_M,
+                    "error_ft": float(e - g) * _FT_PER_M,
                 }
                 for x, y, e, g in zip(
                     self.x, self.y, self.estimated, self.ground_truth, strict=True
