@@ -574,6 +574,51 @@ def test_view_via_cli_main(tmp_path, capsys):
     assert "stereovision: error: not a PLY file" in capsys.readouterr().err
 
 
+def test_display_subset_is_evenly_spaced_and_deterministic():
+    pts = np.arange(30, dtype=np.float32).reshape(10, 3)
+    cols = np.arange(30, dtype=np.uint8).reshape(10, 3)
+    sub, sub_c = render.display_subset(pts, cols, max_points=4)
+    assert sub[:, 0].tolist() == [0.0, 6.0, 15.0, 21.0]  # rows 0, 2, 5, 7: floor(i * 10 / 4)
+    assert sub_c[:, 0].tolist() == [0, 6, 15, 21]
+    same, _ = render.display_subset(pts, cols, max_points=4)
+    np.testing.assert_array_equal(same, sub)
+    for cap in (None, 0, 10, 11):  # no cap, or not more points than the cap: all of them
+        assert render.display_subset(pts, cols, max_points=cap)[0] is pts
+    for bad in (-1, 2.5, True):
+        with pytest.raises(ValueError, match="max_points: expected a whole number"):
+            render.display_subset(pts, cols, max_points=bad)
+
+
+def test_view_shows_a_big_cloud_decimated_and_leaves_the_file(tmp_path, capsys):
+    """A cloud above --max-points is shown as a subset, said in one note; the file is unchanged."""
+    from stereovision import cli
+    from stereovision.io import write_ply
+
+    rng = np.random.default_rng(3)
+    pts = rng.uniform([-1, -1, 3], [1, 1, 5], (1000, 3)).astype(np.float32)
+    ply = write_ply(tmp_path / "big.ply", pts, rng.integers(0, 255, (1000, 3), dtype=np.uint8))
+    before = ply.read_bytes()
+    shot = tmp_path / "shot.png"
+    assert cli.main(["view", str(ply), "-o", str(shot), "--max-points", "100"]) == 0
+    io = capsys.readouterr()
+    assert io.out == f"100 of 1000 points shown -> {shot}\n"
+    assert io.err.count("\n") == 1
+    assert "note: showing 100 of the 1000 points" in io.err and "--max-points 0" in io.err
+    assert ply.read_bytes() == before
+    assert not render.is_blank(cv2.imread(str(shot))[..., ::-1], min_fraction=1e-4)
+    geometry, _ = render.load_view_source(ply, max_points=100)
+    np.testing.assert_array_equal(geometry.points, pts[(np.arange(100) * 1000) // 100])
+    assert int(geometry.field_data[render.POINTS_IN_SOURCE][0]) == 1000
+    # 0 shows every point, without a note
+    assert cli.main(["view", str(ply), "-o", str(shot), "--max-points", "0"]) == 0
+    io = capsys.readouterr()
+    assert io.out == f"1000 points -> {shot}\n" and "note" not in io.err
+    assert cli.main(["view", str(ply), "-o", str(shot), "--max-points", "-5"]) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: --max-points: expected 0 (all) or more, got -5\n"
+    )
+
+
 # ----------------------------------------------------------------------------- real scene
 
 

@@ -45,6 +45,7 @@ __all__ = [
     "CameraControls",
     "apply_camera",
     "camera_pose",
+    "display_subset",
     "orbit_controls",
     "point_cloud",
     "points_in_view",
@@ -501,6 +502,68 @@ def point_cloud(points: npt.ArrayLike, colors: npt.ArrayLike | None = None) -> p
     return cloud
 
 
+#: Most points ``stereovision view`` shows by default (``--max-points``). A cloud of tens of
+#: millions (a KITTI-size map at full resolution, several merged clouds) is shown as an evenly
+#: spaced subset of this many: 15 M points took 66 s and 2.4 GB to render offscreen here, the
+#: subset a few seconds; 2 M points still fill a 1024-pixel window several times over.
+VIEW_MAX_POINTS = 2_000_000
+
+#: Key of ``field_data`` in which :func:`load_view_source` keeps the cloud's point count when it
+#: shows a subset of it.
+POINTS_IN_SOURCE = "points_in_source"
+
+
+def display_subset(
+    points: npt.ArrayLike,
+    colors: npt.ArrayLike | None = None,
+    max_points: int | None = VIEW_MAX_POINTS,
+) -> tuple[npt.NDArray[Any], npt.NDArray[Any] | None]:
+    """At most ``max_points`` of ``points`` (and their colours), evenly spaced, for display.
+
+    Point ``floor(i * N / max_points)`` for ``i = 0 .. max_points - 1``: deterministic (the
+    same cloud always shows the same points), in the cloud's own order, a point of every part
+    of a cloud written region by region. For showing only: files are never decimated.
+
+    Parameters
+    ----------
+    points : array_like, (N, 3)
+    colors : array_like, (N, 3), optional
+    max_points : int or None
+        The cap; None or 0 keeps every point.
+
+    Returns
+    -------
+    tuple
+        ``(points, colors)``, the input arrays themselves when ``N <= max_points``.
+
+    Raises
+    ------
+    ValueError
+        ``max_points`` negative or not an integer.
+
+    Examples
+    --------
+    >>> pts, _ = display_subset(np.arange(30.0).reshape(10, 3), max_points=4)
+    >>> pts[:, 0].tolist()
+    [0.0, 6.0, 15.0, 21.0]
+    """
+    if max_points is not None and (
+        isinstance(max_points, bool)
+        or not isinstance(max_points, (int, np.integer))
+        or max_points < 0
+    ):
+        raise ValueError(
+            f"max_points: expected a whole number of points (0 = all), got {max_points!r}"
+        )
+    pts = np.asarray(points)
+    cols = None if colors is None else np.asarray(colors)
+    n = len(pts)
+    if not max_points or n <= max_points:
+        return pts, cols
+    idx = (np.arange(int(max_points), dtype=np.int64) * n) // int(max_points)
+    return pts[idx], None if cols is None else cols[idx]
+
+
 # ----------------------------------------------------------------------------- rendering
 
 
@@ -807,7 +870,9 @@ def _has_display() -> bool:
     return bool(x or os.environ.get("WAYLAND_DISPLAY"))
 
 
-def load_view_source(path: str | os.PathLike[str]) -> tuple[pv.PolyData, Intrinsics | None]:
+def load_view_source(
+    path: str | os.PathLike[str], max_points: int | None = VIEW_MAX_POINTS
+) -> tuple[pv.PolyData, Intrinsics | None]:
     """Geometry to show for ``stereovision view``: a cloud file, an output folder or a scene.
 
     Parameters
@@ -817,6 +882,10 @@ def load_view_source(path: str | os.PathLike[str]) -> tuple[pv.PolyData, Intrins
         folder with ``cloud.ply`` (``stereovision depth`` output); or a scene folder with
         ``left.png``, ``right.png`` and ``calib.txt`` (depth is computed and the textured surface
         shown).
+    max_points : int or None
+        A cloud of more finite points is shown as an evenly spaced subset of this many
+        (:func:`display_subset`); its full count is then in
+        ``geometry.field_data[POINTS_IN_SOURCE]``. None or 0: every point. The file is only read.
 
     Returns
     -------
@@ -858,7 +927,11 @@ def load_view_source(path: str | os.PathLike[str]) -> tuple[pv.PolyData, Intrins
                 f"{p}: no cloud.ply and no scene (left.png + right.png) in this folder"
             )
     points, colors = load_cloud(p)
-    return point_cloud(points, colors), None
+    shown, shown_colors = display_subset(points, colors, max_points)
+    cloud = point_cloud(shown, shown_colors)
+    if len(shown) < len(points):
+        cloud.field_data[POINTS_IN_SOURCE] = np.array([len(points)], dtype=np.int64)
+    return cloud, None
 
 
 #: Screenshot formats of ``view -o`` (OpenCV writes each by its suffix; none: PNG).
@@ -943,7 +1016,17 @@ def cmd_view(args: argparse.Namespace) -> int:
     )
     # the screenshot's name is checked before the work (a scene folder computes its depth)
     out = None if args.output is None else _check_screenshot_path(args.output, args.source)
-    geometry, intr = load_view_source(args.source)
+    max_points = getattr(args, "max_points", VIEW_MAX_POINTS)
+    if max_points is not None and max_points < 0:
+        raise ValueError(f"--max-points: expected 0 (all) or more, got {max_points}")
+    geometry, intr = load_view_source(args.source, max_points)
+    if POINTS_IN_SOURCE in geometry.field_data:
+        total = int(geometry.field_data[POINTS_IN_SOURCE][0])
+        print(
+            f"note: showing {geometry.n_points} of the {total} points (evenly spaced, for "
+            "display only; --max-points 0 shows all)",
+            file=sys.stderr,
+        )
     if out is None and _has_display():
         plotter = make_plotter((1024, 768), off_screen=False)
         add_geometry(plotter, geometry)
@@ -988,9 +1071,13 @@ def cmd_view(args: argparse.Namespace) -> int:
     with atomic_write(out) as fh:
         fh.write(buf.tobytes())
     # a cloud's cells are its points: "N points, N cells" read as if it were a mesh
-    what = f"{geometry.n_points} points" + (
-        f", {geometry.n_faces} triangles" if geometry.n_faces else ""
-    )
+    shown = geometry.n_points
+    if POINTS_IN_SOURCE in geometry.field_data:
+        total = int(geometry.field_data[POINTS_IN_SOURCE][0])
+        what = f"{shown} of {total} points shown"
+    else:
+        what = f"{shown} points"
+    what += f", {geometry.n_faces} triangles" if geometry.n_faces else ""
     print(f"{what} -> {out}", file=sys.stdout)
     return 0
 
@@ -1016,6 +1103,14 @@ def add_cli(subparsers: Any) -> None:
             default=0.0,
             help=f"move the camera {name}, metres (along the left camera's {axis})",
         )
+    p.add_argument(
+        "--max-points",
+        type=int,
+        default=VIEW_MAX_POINTS,
+        metavar="N",
+        help="show a cloud of more points as an evenly spaced subset of N "
+        f"(default {VIEW_MAX_POINTS}; 0 shows all); the file is not changed",
+    )
     p.add_argument(
         "-o",
         "--output",
