@@ -26,6 +26,7 @@ def test_cloud_ply_read_by_pyvista(result, tmp_path):
     header = path.read_bytes()[:200]
     assert b"format binary_little_endian 1.0" in header
     assert b"property uchar red" in header
+    assert b"comment stereovision point cloud (metres, X right, Y down, Z forward)\n" in header
 
 
 def test_mesh_ply_read_by_pyvista(result, tmp_path):

@@ -292,6 +292,22 @@ def test_ply_round_trip_with_colours(tmp_path: Path) -> None:
     assert (x, y, z) == tuple(pts[0].tolist()) and (r, g, b) == tuple(cols[0].tolist())
 
 
+def test_ply_header_gives_units_and_frame(tmp_path: Path) -> None:
+    """The header said "stereovision point cloud" only: metres or millimetres, which frame?"""
+    pts = np.array([[0.5, -0.25, 2.0]], np.float32)
+    write_ply(tmp_path / "c.ply", pts)
+    header = (tmp_path / "c.ply").read_bytes().split(b"end_header\n")[0].decode("ascii")
+    assert "comment stereovision point cloud (metres, X right, Y down, Z forward)\n" in header
+    write_ply(tmp_path / "mm.ply", pts * 1000, comment="robot map (millimetres, ROS base_link)")
+    header = (tmp_path / "mm.ply").read_bytes().split(b"end_header\n")[0].decode("ascii")
+    assert "\ncomment robot map (millimetres, ROS base_link)\n" in header
+    np.testing.assert_array_equal(read_ply(tmp_path / "mm.ply")[0], pts * 1000)
+    for bad in ("two\nlines", "m\u00e8tres"):  # would break the header
+        with pytest.raises(ValueError, match="comment: expected one line of printable ASCII"):
+            write_ply(tmp_path / "bad.ply", pts, comment=bad)
+    assert not (tmp_path / "bad.ply").exists()
+
+
 def test_ply_without_colours_and_image_shaped(tmp_path: Path) -> None:
     pts = np.arange(2 * 3 * 3, dtype=np.float64).reshape(2, 3, 3)
     write_ply(tmp_path / "p.ply", pts)

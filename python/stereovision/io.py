@@ -36,6 +36,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "MAX_DISPARITY_MARGIN",
+    "PLY_CLOUD_COMMENT",
     "Scene",
     "atomic_write",
     "decode_image",
@@ -576,15 +577,23 @@ _PLY_TYPES: dict[str, str] = {
 }
 
 
+#: Comment of :func:`write_ply`'s header: the units and frame of the project's clouds.
+PLY_CLOUD_COMMENT = "stereovision point cloud (metres, X right, Y down, Z forward)"
+
+
 def write_ply(
     path: PathLike,
     points: npt.ArrayLike,
     colors: npt.ArrayLike | None = None,
     drop_invalid: bool = True,
+    *,
+    comment: str | None = None,
 ) -> Path:
     """Write a point cloud as a binary little-endian PLY file, atomically.
 
-    Vertex properties: ``float x, y, z`` and, with colours, ``uchar red, green, blue``.
+    Vertex properties: ``float x, y, z`` and, with colours, ``uchar red, green, blue``. The
+    header's comment gives the units and frame (:data:`PLY_CLOUD_COMMENT` by default, the
+    project's convention), as the mesh and PCD writers' headers do.
 
     Parameters
     ----------
@@ -599,6 +608,9 @@ def write_ply(
         with ``img[..., ::-1]``).
     drop_invalid : bool
         Skip points with a non-finite coordinate (NaN = no depth). When False they are written.
+    comment : str, optional
+        The header's comment line, for points in another unit or frame (one line of printable
+        ASCII); default :data:`PLY_CLOUD_COMMENT`.
 
     Returns
     -------
@@ -608,11 +620,15 @@ def write_ply(
     Raises
     ------
     ValueError
-        If ``points`` is not ``(..., 3)`` real, or ``colors`` does not match it or is not
-        ``uint8``.
+        If ``points`` is not ``(..., 3)`` real, ``colors`` does not match it or is not
+        ``uint8``, or ``comment`` is not one line of printable ASCII.
     FileNotFoundError
         If the folder of ``path`` does not exist.
     """
+    if comment is None:
+        comment = PLY_CLOUD_COMMENT
+    if not (isinstance(comment, str) and comment.isascii() and comment.isprintable()):
+        raise ValueError(f"comment: expected one line of printable ASCII, got {comment!r}")
     pts = np.asarray(points)
     if pts.dtype.kind not in "iuf" or pts.ndim < 2 or pts.shape[-1] != 3:
         raise ValueError(f"points: expected a real (N, 3) array, got {_describe(pts)}")
@@ -641,7 +657,7 @@ def write_ply(
     lines = [
         "ply",
         "format binary_little_endian 1.0",
-        "comment stereovision point cloud",
+        f"comment {comment}",
         f"element vertex {len(pts)}",
         "property float x",
         "property float y",
