@@ -69,7 +69,9 @@ def test_warnings_are_one_line(tmp_path: Path, data_dir: Path) -> None:
     assert lines[0].startswith("stereovision: warning: the left and right images look swapped")
 
 
-def test_depth_command_on_metric_scene(tmp_path: Path, data_dir: Path) -> None:
+def test_depth_command_on_metric_scene(
+    tmp_path: Path, data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     scene = data_dir / "eth3d" / "terrace"
     out = tmp_path / "o"
     rc = main(
@@ -106,8 +108,14 @@ def test_depth_command_on_metric_scene(tmp_path: Path, data_dir: Path) -> None:
     assert len(pts) == np.isfinite(near).sum() and pts[:, 2].max() <= med + 1e-3
     assert main([*argv, "--max-depth", "0"]) == 2
     # --voxel: one point per 5 cm cube in cloud.ply, the depth maps whole
+    capsys.readouterr()
     assert main([*argv, "--voxel", "0.05"]) == 0
     vox, _ = read_ply(tmp_path / "near" / "cloud.ply")
+    # the summary gave the result's point count only, read as cloud.ply's (8x too many)
+    summary = capsys.readouterr().out.splitlines()[0]
+    n = int(np.isfinite(depth).sum())
+    assert summary.endswith(f" {n} points ({len(vox)} in cloud.ply, one per 0.05 m cube), "
+                            + summary.rsplit(", ", 1)[1])  # fmt: skip
     assert 0 < len(vox) < 0.2 * np.isfinite(depth).sum()
     cells = np.floor(vox / 0.05)
     assert len(np.unique(cells, axis=0)) == len(vox)

@@ -340,6 +340,12 @@ def cmd_depth(args: argparse.Namespace) -> int:
         if res.depth is not None
         else "disparity only (no depth or cloud without --calib)"
     )
+    if args.voxel is not None and "cloud.ply" in written:
+        # the cloud.ply of --voxel holds fewer points than the result: "N points" read as its
+        from stereovision.io import read_ply
+
+        kept = len(read_ply(written["cloud.ply"])[0])
+        cloud += f" ({kept} in cloud.ply, one per {args.voxel:g} m cube)"
     print(
         f"{args.method}: max_disparity {res.max_disparity} px, density {100 * res.density:.1f} %,"
         f" {cloud}, {sum(res.timings.values()):.2f} s"
