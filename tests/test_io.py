@@ -308,6 +308,27 @@ def test_ply_header_gives_units_and_frame(tmp_path: Path) -> None:
     assert not (tmp_path / "bad.ply").exists()
 
 
+def test_ply_writer_holds_no_extra_copies_of_a_big_cloud(tmp_path: Path) -> None:
+    """A map of millions of points: the writer held the cloud four times over (a float32 copy,
+    the finite points, the records and their bytes), 46 bytes a point for a 15-byte record."""
+    import tracemalloc
+
+    n = 200_000
+    rng = np.random.default_rng(0)
+    pts = rng.uniform(-5, 5, (n, 3)).astype(np.float32)
+    cols = rng.integers(0, 256, (n, 3), dtype=np.uint8)
+    tracemalloc.start()
+    try:
+        write_ply(tmp_path / "big.ply", pts, cols)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 2 * 15 * n  # the records (15 bytes a point) and a mask, not four copies
+    got_p, got_c = read_ply(tmp_path / "big.ply")
+    np.testing.assert_array_equal(got_p, pts)
+    np.testing.assert_array_equal(got_c, cols)
+
+
 def test_ply_without_colours_and_image_shaped(tmp_path: Path) -> None:
     pts = np.arange(2 * 3 * 3, dtype=np.float64).reshape(2, 3, 3)
     write_ply(tmp_path / "p.ply", pts)

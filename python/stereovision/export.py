@@ -558,8 +558,10 @@ def load_cloud(
     keep = np.isfinite(pts).all(axis=1)
     if not keep.any():
         raise ValueError(f"empty point cloud: {p} has no finite 3-D point")
-    cols = None if cols is None else cols.reshape(-1, 3)[keep]
-    return np.ascontiguousarray(pts[keep]), cols
+    cols = None if cols is None else cols.reshape(-1, 3)
+    if keep.all():  # no filtered copy of a cloud without NaN (2 s of 5 for 15 M points)
+        return np.ascontiguousarray(pts), None if cols is None else np.ascontiguousarray(cols)
+    return np.ascontiguousarray(pts[keep]), None if cols is None else cols[keep]
 
 
 # --------------------------------------------------------------------------- voxel grid

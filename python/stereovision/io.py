@@ -632,7 +632,9 @@ def write_ply(
     pts = np.asarray(points)
     if pts.dtype.kind not in "iuf" or pts.ndim < 2 or pts.shape[-1] != 3:
         raise ValueError(f"points: expected a real (N, 3) array, got {_describe(pts)}")
-    pts = pts.reshape(-1, 3).astype(np.float32)
+    # no copy of float32 points, no filtered copy when every point is finite: a 15 M point map
+    # held four copies of itself on the way to the file
+    pts = pts.reshape(-1, 3).astype(np.float32, copy=False)
     cols: np.ndarray | None = None
     if colors is not None:
         cols = np.asarray(colors)
@@ -646,9 +648,10 @@ def write_ply(
         cols = cols.reshape(-1, 3)
     if drop_invalid:
         keep = np.isfinite(pts).all(axis=1)
-        pts = pts[keep]
-        if cols is not None:
-            cols = cols[keep]
+        if not keep.all():
+            pts = pts[keep]
+            if cols is not None:
+                cols = cols[keep]
     fields: list[tuple[str, str]] = [("x", "<f4"), ("y", "<f4"), ("z", "<f4")]
     if cols is not None:
         fields += [("red", "u1"), ("green", "u1"), ("blue", "u1")]
@@ -669,7 +672,7 @@ def write_ply(
     lines.append("end_header")
     with atomic_write(path) as fh:
         fh.write(("\n".join(lines) + "\n").encode("ascii"))
-        fh.write(rec.tobytes())
+        fh.write(rec.view(np.uint8))  # the records' bytes, not a copy of them (tobytes)
     return Path(path)
 
 
@@ -764,7 +767,7 @@ def read_ply(
         )
     else:
         rec = np.frombuffer(raw, dtype=dtype, count=count, offset=start)
-    pts = np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float32)
+    pts = np.stack([rec["x"], rec["y"], rec["z"]], axis=1).astype(np.float32, copy=False)
     cols: npt.NDArray[np.uint8] | None = None
     prefix = next(
         (q for q in ("", "diffuse_") if {f"{q}red", f"{q}green", f"{q}blue"} <= set(names)), None
