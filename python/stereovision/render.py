@@ -504,8 +504,9 @@ def point_cloud(points: npt.ArrayLike, colors: npt.ArrayLike | None = None) -> p
 
 #: Most points ``stereovision view`` shows by default (``--max-points``). A cloud of tens of
 #: millions (a KITTI-size map at full resolution, several merged clouds) is shown as an evenly
-#: spaced subset of this many: 15 M points took 66 s and 2.4 GB to render offscreen here, the
-#: subset a few seconds; 2 M points still fill a 1024-pixel window several times over.
+#: spaced subset of this many: a 15 M point PLY took 66 s and 2.4 GB to screenshot on a 2-core
+#: machine, 13 s and 0.75 GB (mostly reading the file) with the subset; 2 M points still fill a
+#: 1024-pixel window several times over.
 VIEW_MAX_POINTS = 2_000_000
 
 #: Key of ``field_data`` in which :func:`load_view_source` keeps the cloud's point count when it
