@@ -1250,9 +1250,9 @@ def _run_jobs(
     futures: dict[Any, PairJob] = {}
     dask = _Dask()
     try:
+        dask.start(scheduler, n_workers)  # first: without Dask it names the extra to install
         from distributed import as_completed
 
-        dask.start(scheduler, n_workers)
         client = dask.client
         run["scheduler"] = dask.desc
         n_live = len(client.scheduler_info().get("workers", {})) or n_workers
