@@ -160,28 +160,6 @@ def test_concurrent_decodes_put_the_log_level_back() -> None:
     assert log.getLogLevel() == before
 
 
-def test_decode_on_opencv_4_8_silences_with_its_top_level_log_functions(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    """OpenCV 4.8, the oldest the package allows (``opencv-python-headless>=4.8``), has no
-    ``cv2.utils.logging``, only ``cv2.getLogLevel`` / ``cv2.setLogLevel``: a decode there failed
-    with "AttributeError: module 'cv2.utils' has no attribute 'logging'" (the first image of
-    ``stereovision demo``). Now it silences with those, and puts the level back."""
-    import cv2
-
-    from stereovision.io import decode_image
-
-    ok, png = cv2.imencode(".png", np.full((8, 12, 3), 9, np.uint8))
-    assert ok
-    levels = [3]  # OpenCV's default, WARNING
-    monkeypatch.delattr(cv2.utils, "logging", raising=False)
-    monkeypatch.setattr(cv2, "getLogLevel", lambda: levels[-1], raising=False)
-    monkeypatch.setattr(cv2, "setLogLevel", levels.append, raising=False)
-    img = decode_image(png.tobytes())
-    assert img is not None and img.shape == (8, 12, 3) and int(img[0, 0, 0]) == 9
-    assert levels == [3, 0, 3]  # silent (0) for the decode, then WARNING again
-
-
 # ---------------------------------------------------------------------------------------- PFM
 
 

@@ -19,7 +19,7 @@ import os
 import re
 import tempfile
 import threading
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -340,23 +340,13 @@ _QUIET_LOCK = threading.Lock()
 _quiet = {"depth": 0, "level": 0}
 
 
-def _opencv_log() -> tuple[Callable[[], int], Callable[[int], Any], int]:
-    """OpenCV's log level getter, setter and its silent level. ``cv2.utils.logging`` is newer
-    than 4.8, the oldest OpenCV the package allows (``opencv-python-headless>=4.8``), where the
-    same functions are ``cv2.getLogLevel`` / ``cv2.setLogLevel`` (silent = 0)."""
-    log = getattr(cv2.utils, "logging", None)
-    if log is not None:
-        return log.getLogLevel, log.setLogLevel, int(log.LOG_LEVEL_SILENT)
-    return cv2.getLogLevel, cv2.setLogLevel, 0  # type: ignore[attr-defined]
-
-
 @contextmanager
 def _opencv_quiet() -> Iterator[None]:
-    get_level, set_level, silent = _opencv_log()
+    log = cv2.utils.logging  # type: ignore[attr-defined]
     with _QUIET_LOCK:
         if _quiet["depth"] == 0:
-            _quiet["level"] = get_level()
-            set_level(silent)
+            _quiet["level"] = log.getLogLevel()
+            log.setLogLevel(log.LOG_LEVEL_SILENT)
         _quiet["depth"] += 1
     try:
         yield
@@ -364,7 +354,7 @@ def _opencv_quiet() -> Iterator[None]:
         with _QUIET_LOCK:
             _quiet["depth"] -= 1
             if _quiet["depth"] == 0:
-                set_level(_quiet["level"])
+                log.setLogLevel(_quiet["level"])
 
 
 #: Files a first run passes where one image per camera is wanted (``depth LEFT RIGHT``).
