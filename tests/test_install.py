@@ -99,15 +99,18 @@ def _minimum(dist: metadata.Distribution, name: str) -> tuple[int, ...]:
 
 def test_declared_minimums_are_versions_the_package_runs_on() -> None:
     """Measured in a venv holding each lower bound (``stereovision demo`` and ``view``, no
-    display): pyvista 0.44 (the old minimum) comes with VTK 9.3, whose render aborted the demo
-    (exit 134, at render.png); pyvista 0.46 and 0.47 raise AttributeError on
-    ``PolyData.n_faces``, which render.py reads; 0.48 with VTK 9.4 runs it. OpenCV 4.8 and
-    NumPy 1.24 run it too."""
+    display; tests/test_io.py, test_rosbag.py, test_rosbag_read.py): pyvista 0.44 (the old
+    minimum) comes with VTK 9.3, whose render aborted the demo (exit 134, at render.png);
+    pyvista 0.46 and 0.47 raise AttributeError on ``PolyData.n_faces``, which render.py reads;
+    OpenCV 4.8 (the old minimum) to 4.14 have no ``criteria`` in ``cv2.undistortPoints``
+    (calibrate) and 4.8-4.12 no ``cv2.utils.logging`` (every image decode); with OpenCV 5.0
+    ``import stereovision`` fails (no ``cv2.fisheye.CALIB_RECOMPUTE_EXTRINSIC``). OpenCV 5.1,
+    numpy 2.0, pyvista 0.48 and VTK 9.4 run them."""
     dist = _distribution()
     assert _minimum(dist, "pyvista") >= (0, 48)
     assert _minimum(dist, "vtk") >= (9, 4)
-    assert _minimum(dist, "opencv-python-headless") >= (4, 8)
-    assert _minimum(dist, "numpy") >= (1, 24)
+    assert _minimum(dist, "opencv-python-headless") >= (5, 1)
+    assert _minimum(dist, "numpy") >= (2, 0)  # OpenCV 5 needs it
 
 
 def test_ros_extra_asks_for_a_rosbags_that_reads_bags_in_a_thread() -> None:
