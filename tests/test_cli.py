@@ -312,6 +312,21 @@ def test_info_describes_the_rig(data_dir: Path, capsys: pytest.CaptureFixture[st
     assert main(["info", str(data_dir / "nowhere.txt")]) == 2
 
 
+def test_info_on_paper_refuses_a_bad_value_in_one_line(capsys: pytest.CaptureFixture[str]) -> None:
+    """``info --size 1280x720 --hfov 180 --baseline 0.1`` printed the rig's heading on stdout,
+    then 'hfov_deg: ...', the Python argument's name, on stderr; the error is now the one line,
+    naming the option."""
+    assert main(["info", "--size", "1280x720", "--hfov", "180", "--baseline", "0.1"]) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err.strip().splitlines() == [
+        "stereovision: error: --hfov: expected a field of view in (0, 180) degrees, got 180.0"
+    ]
+    assert main(["info", "--size", "1280x720", "--hfov", "90", "--baseline", "-1"]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.startswith("stereovision: error: --baseline: expected a positive")
+
+
 def test_version_and_python_m() -> None:
     """``stereovision --version`` names the package's version; ``python -m stereovision`` is
     the same command line."""

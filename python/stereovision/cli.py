@@ -621,8 +621,13 @@ def cmd_info(args: argparse.Namespace) -> int:
 
         size = parse_size(args.size)
         assert size is not None
+        try:  # the rig before its heading: a bad value is the one line said, in the CLI's words
+            rig = Calibration.ideal(size, args.hfov, args.baseline)
+        except ValueError as exc:
+            text = str(exc).replace("hfov_deg:", "--hfov:").replace("baseline_m:", "--baseline:")
+            raise CliError(text) from None
         print("a rig on paper (two ideal cameras, rectified):")
-        print(Calibration.ideal(size, args.hfov, args.baseline).describe())
+        print(rig.describe())
         return 0
     if design != (None, None, None):
         raise CliError("--size, --hfov and --baseline describe a rig on paper: give no calibration")
