@@ -463,6 +463,35 @@ def test_cli_end_to_end(
             "--pattern", "nine", "--square", "1", "-o", str(out))  # fmt: skip
 
 
+def test_cli_keeps_the_calibration_it_replaces(
+    synthetic: tuple[list[np.ndarray], list[np.ndarray], list[str]],
+    chessboard: tuple[Calibration, CalibrationReport],
+    cached_corners: None,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``calibrate -o rig.yaml`` run again replaced the earlier calibration without a word (a
+    session with worse pairs lost the good rig); the earlier file is kept as
+    ``rig.previous.yaml`` and the line says so."""
+    left, right, _ = synthetic
+    for i, (a, b) in enumerate(zip(left[:SYN_GOOD_PAIRS], right[:SYN_GOOD_PAIRS], strict=True)):
+        cv2.imwrite(str(tmp_path / f"L{i:02d}.png"), a)
+        cv2.imwrite(str(tmp_path / f"R{i:02d}.png"), b)
+    out = chessboard[0].save(tmp_path / "rig.yaml")  # the earlier rig
+    before = out.read_bytes()
+    args = _parser().parse_args(
+        ["calibrate", "--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "R*.png"),
+         "--pattern", "9x6", "--square", str(SYN_SQUARE), "-o", str(out)]
+    )  # fmt: skip
+    assert args.func(args) == 0
+    kept = tmp_path / "rig.previous.yaml"
+    lines = capsys.readouterr().out.splitlines()
+    assert f"calibration written to {out} (the one it replaced kept as {kept})" in lines
+    assert kept.read_bytes() == before
+    assert Calibration.load(kept).baseline == pytest.approx(chessboard[0].baseline, rel=1e-12)
+    assert Calibration.load(out).baseline != pytest.approx(chessboard[0].baseline, rel=0.1)
+
+
 # ------------------------------------------------------------------------ mis-paired images
 
 

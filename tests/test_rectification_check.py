@@ -402,3 +402,30 @@ def test_an_unrectified_pair_is_not_called_swapped(data_dir: Path) -> None:
     # a rectified pair given the other way round still is
     cones_l, cones_r = _pair(data_dir, "middlebury2003/cones")
     assert check_rectification(cones_r, cones_l).swapped
+
+
+def test_cli_check_fix_keeps_the_calibration_it_replaces(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check --fix OUT`` onto an existing calibration replaced it without a word; the
+    earlier file is now kept as OUT's ``.previous`` copy, and the line says so."""
+    from stereovision.cli import main
+
+    cones = data_dir / "middlebury2003" / "cones"
+    img = cv2.imread(str(cones / "left.png"))
+    bumped = _rig(img.shape[1], img.shape[0], (0.3, 0.0, 0.0)).save(tmp_path / "rig.yaml")
+    earlier = _rig(img.shape[1], img.shape[0], (0.1, 0.0, 0.0)).save(tmp_path / "rig2.yaml")
+    before = earlier.read_bytes()
+    pair = [str(cones / "left.png"), str(cones / "right.png")]
+    assert main(["check", *pair, "--calib", str(bumped), "--fix", str(earlier)]) == 0
+    kept = tmp_path / "rig2.previous.yaml"
+    out = capsys.readouterr().out.splitlines()
+    assert (
+        out[-1]
+        == f"corrected calibration written to {earlier} (the one it replaced kept as {kept})"
+    )
+    assert kept.read_bytes() == before and earlier.read_bytes() != before
+    fresh = tmp_path / "rig3.yaml"
+    assert main(["check", *pair, "--calib", str(bumped), "--fix", str(fresh)]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == f"corrected calibration written to {fresh}"
+    assert not (tmp_path / "rig3.previous.yaml").exists()

@@ -2544,10 +2544,15 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
                 seen.add(text)
                 warnings.warn(text, w.category, stacklevel=1)
     rep.warnings[:] = [_cli_words(w) for w in rep.warnings]  # the report in the CLI's words
+    from stereovision.io import keep_previous
+
+    kept = keep_previous(out)
     cal.save(out)
     print(rep.summary(drop_option=DROP_OUTLIERS_CLI))
     print(cal.describe())
-    print(f"calibration written to {out}")
+    print(
+        f"calibration written to {out}" + (f" (the one it replaced kept as {kept})" if kept else "")
+    )
     if ros_dir is not None:
         try:
             left_yaml, right_yaml = cal.save_ros(ros_dir)

@@ -497,9 +497,15 @@ def cmd_check(args: argparse.Namespace) -> int:
     if not after.ok:
         print("stereovision: the corrected calibration still fails: not written", file=sys.stderr)
         return 1
+    from stereovision.io import keep_previous
+
+    kept = keep_previous(fix)
     fixed.save(fix)
+    replaced = f" (the one it replaced kept as {kept})" if kept else ""
     if not args.json:
-        print(f"corrected calibration written to {fix}")
+        print(f"corrected calibration written to {fix}{replaced}")
+    elif kept:  # stdout is the one JSON object
+        print(f"stereovision: {fix} replaced; the earlier file is {kept}", file=sys.stderr)
     return 0
 
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import shutil
 import tempfile
 import threading
 from collections.abc import Iterator
@@ -168,6 +169,33 @@ def cannot_write_in(folder: PathLike) -> str | None:
     os.close(fd)
     os.remove(probe)
     return None
+
+
+def keep_previous(path: PathLike) -> Path | None:
+    """Copy an existing file aside as ``NAME.previous.EXT`` before a command replaces it.
+
+    A calibration written again under the same name (``calibrate -o rig.yaml`` run twice,
+    ``check --fix rig2.yaml``) replaced the earlier one without a word; its copy is kept, so a
+    worse calibration can be undone. It is a copy, not a rename: should the new file fail to be
+    written, the earlier one is still in place. An earlier ``.previous`` copy is replaced.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The file about to be written.
+
+    Returns
+    -------
+    pathlib.Path or None
+        The copy, or None when ``path`` held no file.
+    """
+    p = Path(path)
+    if not p.is_file():
+        return None
+    kept = p.with_name(f"{p.stem}.previous{p.suffix}")
+    with p.open("rb") as src, atomic_write(kept) as dst:
+        shutil.copyfileobj(src, dst)
+    return kept
 
 
 @contextmanager
