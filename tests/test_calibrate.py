@@ -470,24 +470,32 @@ def test_cli_keeps_the_calibration_it_replaces(
     tmp_path: Path,
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """``calibrate -o rig.yaml`` run again replaced the earlier calibration without a word (a
-    session with worse pairs lost the good rig); the earlier file is kept as
-    ``rig.previous.yaml`` and the line says so."""
+    """``calibrate -o rig.yaml --ros ros`` run again replaced the earlier calibration and its
+    ROS files without a word (a session with worse pairs lost the good rig); the earlier files
+    are kept as ``rig.previous.yaml``, ``ros/left.previous.yaml`` ... and the lines say so."""
     left, right, _ = synthetic
     for i, (a, b) in enumerate(zip(left[:SYN_GOOD_PAIRS], right[:SYN_GOOD_PAIRS], strict=True)):
         cv2.imwrite(str(tmp_path / f"L{i:02d}.png"), a)
         cv2.imwrite(str(tmp_path / f"R{i:02d}.png"), b)
     out = chessboard[0].save(tmp_path / "rig.yaml")  # the earlier rig
     before = out.read_bytes()
+    ros = tmp_path / "ros"
+    ros_before = [p.read_bytes() for p in chessboard[0].save_ros(ros)]
     args = _parser().parse_args(
         ["calibrate", "--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "R*.png"),
-         "--pattern", "9x6", "--square", str(SYN_SQUARE), "-o", str(out)]
+         "--pattern", "9x6", "--square", str(SYN_SQUARE), "-o", str(out), "--ros", str(ros)]
     )  # fmt: skip
     assert args.func(args) == 0
     kept = tmp_path / "rig.previous.yaml"
     lines = capsys.readouterr().out.splitlines()
     assert f"calibration written to {out} (the one it replaced kept as {kept})" in lines
     assert kept.read_bytes() == before
+    assert lines[-1] == (
+        f"ROS camera_info written to {ros / 'left.yaml'} and {ros / 'right.yaml'} (the ones "
+        f"they replaced kept as {ros / 'left.previous.yaml'} and {ros / 'right.previous.yaml'})"
+    )
+    assert (ros / "left.previous.yaml").read_bytes() == ros_before[0]
+    assert (ros / "right.previous.yaml").read_bytes() == ros_before[1]
     assert Calibration.load(kept).baseline == pytest.approx(chessboard[0].baseline, rel=1e-12)
     assert Calibration.load(out).baseline != pytest.approx(chessboard[0].baseline, rel=0.1)
 

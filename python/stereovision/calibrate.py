@@ -2555,12 +2555,21 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     )
     if ros_dir is not None:
         try:
+            cal.to_ros()  # refused (a rig ROS cannot hold) before the earlier files are copied
+            ros_kept = [k for n in ("left", "right") if (k := keep_previous(ros_dir / f"{n}.yaml"))]
             left_yaml, right_yaml = cal.save_ros(ros_dir)
         except ValueError as exc:
             raise ValueError(
                 f"calibration written to {out}, but not as ROS camera_info: {exc}"
             ) from None
-        print(f"ROS camera_info written to {left_yaml} and {right_yaml}")
+        print(
+            f"ROS camera_info written to {left_yaml} and {right_yaml}"
+            + (
+                f" (the ones they replaced kept as {' and '.join(map(str, ros_kept))})"
+                if ros_kept
+                else ""
+            )
+        )
     if args.report:
         paths = rep.write(args.report)
         print(f"report written to {paths['html']}")
