@@ -429,3 +429,20 @@ def test_cli_check_fix_keeps_the_calibration_it_replaces(
     assert main(["check", *pair, "--calib", str(bumped), "--fix", str(fresh)]) == 0
     assert capsys.readouterr().out.splitlines()[-1] == f"corrected calibration written to {fresh}"
     assert not (tmp_path / "rig3.previous.yaml").exists()
+
+
+def test_cli_check_names_a_bad_tolerance_before_the_work(
+    data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check L R --tolerance -1`` read (and rectified) the pair, then said 'tolerance: ...',
+    the Python argument's name; it is refused first, naming the option."""
+    from stereovision.cli import main
+
+    cones = data_dir / "middlebury2003" / "cones"
+    pair = [str(cones / "left.png"), str(cones / "right.png")]
+    for bad in ("-1", "0", "nan"):
+        assert main(["check", *pair, "--tolerance", bad]) == 2
+        out, err = capsys.readouterr()
+        assert out == "" and err == (
+            f"stereovision: error: --tolerance: expected a positive number of pixels, got {bad}\n"
+        )

@@ -418,6 +418,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     from stereovision.io import check_pair_files, imread
     from stereovision.rectification_check import check_rectification
 
+    if not (math.isfinite(args.tolerance) and args.tolerance > 0):  # before reading the pair
+        raise CliError(f"--tolerance: expected a positive number of pixels, got {args.tolerance:g}")
     left = imread(args.left)
     right = imread(args.right)
     same = (
