@@ -531,3 +531,16 @@ def test_a_wrong_dictionary_of_a_family_with_the_same_prefix_is_named() -> None:
             rf"board's dictionary \(e\.g\. dictionary='{printed}'\)",
         ):
             calibrate(left, right, board=CharucoBoard("10x7", 0.03, 0.022, given))
+
+
+def test_an_odd_rowed_board_is_not_described_as_a_legacy_layout() -> None:
+    """OpenCV's legacy layout differs only with an even number of rows; ``board --legacy
+    --pattern 9x7`` printed the same image as without it, yet said '(legacy layout)' (and the
+    calibration's report after it), as if the print needed --legacy to be read."""
+    odd = CharucoBoard("9x7", 0.03, 0.022, "DICT_5X5_50", legacy=True)
+    assert odd.describe("m") == (
+        "ChArUco 9x7 squares (8x6 inner corners), square 0.03 m, marker 0.022 m, DICT_5X5_50"
+    )
+    assert np.array_equal(odd.image(40), CharucoBoard("9x7", 0.03, 0.022, "DICT_5X5_50").image(40))
+    even = CharucoBoard("10x8", 0.03, 0.022, "DICT_5X5_50", legacy=True)
+    assert even.describe().endswith("DICT_5X5_50 (legacy layout)")

@@ -222,7 +222,9 @@ class CharucoBoard:
         """One line: squares, corners, sizes, dictionary and layout."""
         u = f" {unit}" if unit else ""
         c, r = self.inner
-        layout = " (legacy layout)" if self.legacy else ""
+        # OpenCV's two layouts differ only with an even number of rows: an odd-rowed board
+        # printed with legacy=True is the same board, not a "legacy layout" to look for
+        layout = " (legacy layout)" if self.legacy and self.squares[1] % 2 == 0 else ""
         return (
             f"ChArUco {self.squares[0]}x{self.squares[1]} squares ({c}x{r} inner corners), "
             f"square {self.square_size:g}{u}, marker {self.marker_size:g}{u}, "
