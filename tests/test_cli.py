@@ -327,6 +327,20 @@ def test_info_on_paper_refuses_a_bad_value_in_one_line(capsys: pytest.CaptureFix
     assert out == "" and err.startswith("stereovision: error: --baseline: expected a positive")
 
 
+def test_info_on_paper_says_the_baseline_is_in_metres(capsys: pytest.CaptureFixture[str]) -> None:
+    """``info ... --baseline 120`` (meant as mm) was warned about in the library's words: 'are T
+    (or the board's square size) in another unit than unit='m'? With unit='mm' it would be
+    12.0 cm', none of which the command takes; the warning names --baseline and its metres."""
+    argv = ["info", "--size", "1280x720", "--hfov", "90", "--baseline", "120"]
+    assert main(argv) == 0
+    out, err = capsys.readouterr()
+    assert err.splitlines() == [
+        "stereovision: warning: --baseline 120: 120 m is longer than a robot's rig (5 m); "
+        "--baseline is in metres (120 mm is --baseline 0.12)"
+    ]
+    assert "baseline 120.00 m (120 m)" in out
+
+
 def test_version_and_python_m() -> None:
     """``stereovision --version`` names the package's version; ``python -m stereovision`` is
     the same command line."""

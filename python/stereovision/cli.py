@@ -11,6 +11,7 @@ import contextlib
 import json
 import math
 import os
+import re
 import signal
 import sys
 import threading
@@ -612,6 +613,28 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     return 0
 
 
+def _paper_baseline_words(text: str, baseline: float) -> str:
+    """The implausible-baseline warning of a rig on paper in ``info``'s words: its ``--baseline``
+    is in metres, and the user gave no ``T``, square size or ``unit=`` that the library's
+    warning asks about (``--baseline 120`` for 120 mm: "With unit='mm' it would be 12.0 cm")."""
+    from stereovision.calibration import PLAUSIBLE_BASELINE_M, UNIT_TO_METRES
+
+    found = re.match(r"baseline \S+ m = \S+ m, (.*?): are T ", text)
+    if found is None:
+        return text
+    lo, hi = PLAUSIBLE_BASELINE_M
+    other = next(
+        (u for u, k in UNIT_TO_METRES.items() if u != "m" and lo <= baseline * k <= hi), None
+    )
+    hint = (
+        f" ({baseline:g} {other} is --baseline {baseline * UNIT_TO_METRES[other]:g})"
+        if other
+        else ""
+    )
+    why = found.group(1)
+    return f"--baseline {baseline:g}: {baseline:g} m is {why}; --baseline is in metres{hint}"
+
+
 def cmd_info(args: argparse.Namespace) -> int:
     """``stereovision info CALIB``: what the rig can measure; ``info BAG``: what a recording
     holds (its topics, the stereo pair found) and, from its ``camera_info``, what its rig can
@@ -630,10 +653,14 @@ def cmd_info(args: argparse.Namespace) -> int:
         size = parse_size(args.size)
         assert size is not None
         try:  # the rig before its heading: a bad value is the one line said, in the CLI's words
-            rig = Calibration.ideal(size, args.hfov, args.baseline)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                rig = Calibration.ideal(size, args.hfov, args.baseline)
         except ValueError as exc:
             text = str(exc).replace("hfov_deg:", "--hfov:").replace("baseline_m:", "--baseline:")
             raise CliError(text) from None
+        for w in caught:
+            warnings.warn(_paper_baseline_words(str(w.message), args.baseline), w.category, 1)
         print("a rig on paper (two ideal cameras, rectified):")
         print(rig.describe())
         return 0
