@@ -19,6 +19,7 @@ import yaml
 from stereovision import calibrate as calmod
 from stereovision.calibrate import (
     CalibrationReport,
+    _cli_words,
     add_cli,
     board_object_points,
     board_pose_params,
@@ -498,6 +499,27 @@ def test_cli_keeps_the_calibration_it_replaces(
     assert (ros / "right.previous.yaml").read_bytes() == ros_before[1]
     assert Calibration.load(kept).baseline == pytest.approx(chessboard[0].baseline, rel=1e-12)
     assert Calibration.load(out).baseline != pytest.approx(chessboard[0].baseline, rel=0.1)
+
+
+def test_squares_counted_for_the_inner_corners_are_named(
+    synthetic: tuple[list[np.ndarray], list[np.ndarray], list[str]], cached_corners: None
+) -> None:
+    """pattern=(10, 7) for a board of 10x7 squares (9x6 inner corners), the most common slip,
+    was answered 'found in both images of only 0 of 4 pairs' with no word of why; the first
+    image's board is tried one fewer each way and named, in the CLI's words too."""
+    left, right, _ = synthetic
+    with pytest.raises(ValueError) as err:
+        calibrate(left[:4], right[:4], pattern=(10, 7), square_size=SYN_SQUARE)
+    text = str(err.value)
+    assert text.startswith("the chessboard 10x7 inner corners was found in both images of only 0")
+    assert (
+        "left_images[0] shows a board of 9x6 inner corners: the pattern counts the points where "
+        "four squares meet, one fewer each way than the squares (pattern=(9, 6))"
+    ) in text
+    assert _cli_words(text).count("(--pattern 9x6)") == 1
+    with pytest.raises(ValueError) as err:  # no board one fewer each way either: no hint
+        calibrate(left[:4], right[:4], pattern=(11, 7), square_size=SYN_SQUARE)
+    assert "shows a board" not in str(err.value)
 
 
 # ------------------------------------------------------------------------ mis-paired images

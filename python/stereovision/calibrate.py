@@ -1480,6 +1480,19 @@ def calibrate(
         and all(c is None for c in (*corners_l, *corners_r))
     ):
         board_hint = _charuco_hint(board, first_gray, first_name)
+    elif (
+        board is None
+        and first_gray is not None
+        and len(used) < MIN_PAIRS
+        and min(pat) > 3  # one fewer each way is still a pattern
+        and all(c is None for c in (*corners_l, *corners_r))
+        and find_corners(first_gray, (pat[0] - 1, pat[1] - 1)) is not None
+    ):  # the squares counted (10x7) for the inner corners (9x6): the most common slip
+        board_hint = (
+            f"{first_name} shows a board of {pat[0] - 1}x{pat[1] - 1} inner corners: the "
+            "pattern counts the points where four squares meet, one fewer each way than the "
+            f"squares (pattern=({pat[0] - 1}, {pat[1] - 1}))"
+        )
     if board is not None and not board.resolved:
         squares = f"{board.squares[0]}x{board.squares[1]}"
         if board_hint:
