@@ -26,6 +26,7 @@ __all__ = [
     "as_gray_uint8",
     "as_image_array",
     "check_pair",
+    "check_unit_range",
     "disparity_range",
     "finite_number",
     "float_sized",
@@ -323,6 +324,46 @@ def check_pair(
             f"right {rarr.shape}"
         )
     return as_gray_float(larr, "left"), as_gray_float(rarr, "right")
+
+
+def check_unit_range(img: npt.NDArray[np.float32], name: str) -> None:
+    """Check that a float grey image's finite values lie in ``[0, 1]``.
+
+    For the matchers that take a float32 grey image as it is (no scaling): the kernels refuse
+    NaN and inf themselves, but read any finite value, and one large one (``1e30``, whose square
+    is infinite in float32) spoilt the whole map without a word (the refinement's NaN
+    everywhere, a quarter of the Gabor map NaN).
+
+    Parameters
+    ----------
+    img : numpy.ndarray
+        Float image.
+    name : str
+        Argument name used in the error message.
+
+    Raises
+    ------
+    ValueError
+        If a finite value lies outside ``[0, 1]`` (NaN and inf are left to the kernel's own
+        message).
+
+    Examples
+    --------
+    >>> check_unit_range(np.array([[0.0, 1.0]], np.float32), "left")
+    >>> check_unit_range(np.array([[0.0, 255.0]], np.float32), "left")
+    Traceback (most recent call last):
+    ...
+    ValueError: left: float image values must lie in [0, 1], got range [0, 255] ...
+    """
+    lo, hi = float(img.min()), float(img.max())
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        # NaN or inf: the kernel names them (with their count)
+        return
+    if lo < 0.0 or hi > 1.0:
+        raise ValueError(
+            f"{name}: float image values must lie in [0, 1], got range [{lo:g}, {hi:g}] "
+            "(divide 8-bit data by 255)"
+        )
 
 
 def u8_pair(left: object, right: object) -> tuple[np.ndarray, np.ndarray] | None:

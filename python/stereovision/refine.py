@@ -25,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import disparity_range
+from stereovision._validate import check_unit_range, disparity_range
 
 __all__ = ["DEFAULTS", "RefineResult", "refine_disparity"]
 
@@ -138,13 +138,16 @@ def refine_disparity(
     Raises
     ------
     ValueError
-        Shapes differ, an image is empty or not finite, a confidence is NaN or outside
-        ``[0, 1]`` where the disparity has a value, a parameter is unknown or out of range.
+        Shapes differ, an image is empty, not finite or has values outside ``[0, 1]``, a
+        confidence is NaN or outside ``[0, 1]`` where the disparity has a value, a parameter is
+        unknown or out of range.
     """
     unknown = set(params) - set(DEFAULTS)
     if unknown:
         raise ValueError(f"unknown refinement parameter(s): {sorted(unknown)}")
     lft, rgt, dsp = _grey(left, "left"), _grey(right, "right"), _grey(disparity, "disparity")
+    check_unit_range(lft, "left")
+    check_unit_range(rgt, "right")
     if not lft.shape == rgt.shape == dsp.shape:
         raise ValueError(
             f"left {lft.shape}, right {rgt.shape} and disparity {dsp.shape} differ in shape"

@@ -18,7 +18,12 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import disparity_range, float_sized, refuse_unknown
+from stereovision._validate import (
+    check_unit_range,
+    disparity_range,
+    float_sized,
+    refuse_unknown,
+)
 
 __all__ = ["DEFAULTS", "GaborResult", "gabor_disparity", "gabor_responses"]
 
@@ -89,7 +94,9 @@ def _as_grey(img: object, name: str) -> npt.NDArray[np.float32]:
         raise ValueError(f"{name} is empty: shape {arr.shape}")
     if not np.issubdtype(arr.dtype, np.floating):
         raise ValueError(f"{name} must be float32 grey levels in [0, 1], got dtype {arr.dtype}")
-    return np.ascontiguousarray(arr, dtype=np.float32)
+    out = np.ascontiguousarray(arr, dtype=np.float32)
+    check_unit_range(out, name)
+    return out
 
 
 def gabor_disparity(
@@ -127,8 +134,8 @@ def gabor_disparity(
     Raises
     ------
     ValueError
-        If an image is not 2-D, empty, not floating point, non-finite, the shapes differ, a
-        parameter is unknown or out of range.
+        If an image is not 2-D, empty, not floating point, non-finite or has values outside
+        ``[0, 1]``, the shapes differ, a parameter is unknown or out of range.
     MemoryError
         When an image-sized buffer of the kernel cannot be allocated (the message names it and
         its size); the process is not aborted.

@@ -1,0 +1,181 @@
+"""Numerical and shape edge cases of the entry points that reach the Rust kernels: tiny and
+constant images, non-finite and huge values, memory layouts, and integer arguments beyond their
+type. Each gives a correct result or a ValueError / TypeError naming the problem: never a panic,
+a hang, an ``OverflowError`` naming nothing, or a map spoilt without a word.
+
+Parameters out of range through the Python wrappers are tests/test_bad_params.py's; wrong
+array types and allocation failures given to the extension, tests/test_bindings_input.py's.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pytest
+
+import stereovision as sv
+from stereovision import _core, refine
+from stereovision.matching import fusion, gabor
+
+RNG = np.random.default_rng(0)
+LEFT = RNG.random((40, 60), dtype=np.float32)
+RIGHT = np.roll(LEFT, -3, axis=1)  # every pixel 3 px closer on the right image
+
+DEPTH_METHODS = ["fused", "gabor", "census", "fast"]
+MATCH_METHODS = ["hopfield", "best", "mcgm", "fused", "gabor"]
+
+
+# --- images ------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("shape", [(1, 40), (5, 5), (9, 9), (12, 12)])
+@pytest.mark.parametrize("method", DEPTH_METHODS)
+def test_depth_map_of_tiny_images_has_their_shape(shape: tuple[int, int], method: str) -> None:
+    left = RNG.random(shape, dtype=np.float32)
+    res = sv.depth_map(left, np.roll(left, -1, axis=1), method=method, max_disparity=4)
+    assert res.disparity.shape == res.confidence.shape == shape
+    d = res.disparity[np.isfinite(res.disparity)]
+    assert ((d >= 0) & (d <= 4)).all()
+
+
+@pytest.mark.parametrize("shape", [(40, 1), (2, 2), (3, 3)])
+@pytest.mark.parametrize("method", DEPTH_METHODS)
+def test_depth_map_narrower_than_the_range_is_refused(shape: tuple[int, int], method: str) -> None:
+    left = RNG.random(shape, dtype=np.float32)
+    with pytest.raises(ValueError, match="disparity range 4 is not smaller than the image width"):
+        sv.depth_map(left, left, method=method, max_disparity=4)
+
+
+@pytest.mark.parametrize("shape", [(1, 40), (40, 1), (1, 1), (2, 2), (3, 3), (5, 5)])
+@pytest.mark.parametrize("method", MATCH_METHODS)
+def test_matches_of_tiny_images_are_none(shape: tuple[int, int], method: str) -> None:
+    left = RNG.random(shape, dtype=np.float32)
+    assert len(sv.match(left, left, method=method, max_disparity=4)) == 0
+
+
+def test_constant_images_give_no_measurement() -> None:
+    flat = np.full((40, 60), 0.5, np.float32)
+    for method in DEPTH_METHODS:
+        res = sv.depth_map(flat, flat, method=method, max_disparity=8)
+        assert np.isnan(res.disparity).all(), method
+    for method in MATCH_METHODS:
+        assert len(sv.match(flat, flat, method=method, max_disparity=8)) == 0, method
+
+
+@pytest.mark.parametrize("value", [np.nan, np.inf, -np.inf])
+def test_one_non_finite_pixel_is_named(value: float) -> None:
+    left = LEFT.copy()
+    left[20, 30] = value
+    says = "left: float image contains 1 NaN/inf value"
+    with pytest.raises(ValueError, match=says):
+        sv.depth_map(left, RIGHT, method="gabor", max_disparity=8)
+    with pytest.raises(ValueError, match=says):
+        sv.match(left, RIGHT, max_disparity=8)
+    kernel = "left: image contains non-finite values (NaN or inf) at 1 pixels"
+    for call in (
+        lambda: _core.gabor_disparity(left, RIGHT, 0.0, 8.0),
+        lambda: _core.sgm_disparity(left, RIGHT, 0, 8, 8, 96, 16.0, 5, 1, 4),
+        lambda: _core.hopfield_match(left, RIGHT, {"max_disparity": 8}),
+        lambda: _core.mcgm_match(left, RIGHT, {"max_disparity": 8}),
+    ):
+        with pytest.raises(ValueError, match=re.escape(kernel)):
+            call()
+
+
+#: The wrappers that hand a float grey image to a kernel as it is (no scaling).
+UNSCALED: dict[str, Callable[[np.ndarray], object]] = {
+    "gabor_disparity": lambda a: gabor.gabor_disparity(a, RIGHT, max_disparity=8),
+    "gabor_responses": lambda a: gabor.gabor_responses(a),
+    "refine_disparity": lambda a: refine.refine_disparity(
+        a, RIGHT, np.full(a.shape, 3.0, np.float32), max_disparity=8
+    ),
+    "remeasure": lambda a: fusion.remeasure(
+        a, RIGHT, np.full(a.shape, 3.0, np.float32), np.ones(a.shape, np.float32), max_disparity=8
+    ),
+}
+
+
+@pytest.mark.parametrize("what", list(UNSCALED))
+@pytest.mark.parametrize("value", [1e30, 255.0, -0.5])
+def test_float_grey_levels_outside_0_1_are_refused(what: str, value: float) -> None:
+    """One pixel of 1e30 (its square is infinite in float32) made the whole refined map NaN and a
+    quarter of the Gabor map, without a word; an 8-bit image passed as float was read as is."""
+    UNSCALED[what](LEFT)
+    left = LEFT.copy()
+    left[20, 30] = value
+    with pytest.raises(ValueError, match=r"left|img") as exc:
+        UNSCALED[what](left)
+    assert "float image values must lie in [0, 1], got range" in str(exc.value)
+
+
+def test_the_refinement_keeps_its_map_for_grey_levels_in_range() -> None:
+    d = np.full(LEFT.shape, 3.0, np.float32)
+    r = refine.refine_disparity(LEFT, RIGHT, d, max_disparity=8)
+    assert np.nanmedian(np.abs(r.disparity - 3.0)) < 0.05
+    assert np.isfinite(r.disparity).mean() > 0.8
+
+
+@pytest.mark.parametrize(
+    "layout",
+    [
+        np.copy,
+        lambda a: np.ascontiguousarray(a[::-1, ::-1])[::-1, ::-1],  # negative strides
+        np.asfortranarray,
+        lambda a: np.pad(a, ((0, 0), (0, 7)))[:, :60],  # a view with a row stride
+    ],
+)
+def test_any_memory_layout_gives_the_same_result(layout: Callable[[np.ndarray], Any]) -> None:
+    left, right = layout(LEFT), layout(RIGHT)
+    for a in (left, right):
+        a.flags.writeable = False  # read-only buffers are read only
+    np.testing.assert_array_equal(left, LEFT)
+    want = _core.gabor_disparity(LEFT, RIGHT, 0.0, 8.0)
+    got = _core.gabor_disparity(left, right, 0.0, 8.0)
+    for g, w in zip(got, want, strict=True):
+        np.testing.assert_array_equal(g, w)
+    np.testing.assert_array_equal(
+        _core.sgm_disparity(left, right, 0, 8, 8, 96, 16.0, 5, 1, 4),
+        _core.sgm_disparity(LEFT, RIGHT, 0, 8, 8, 96, 16.0, 5, 1, 4),
+    )
+    m, _, _ = _core.mcgm_match(left, right, {"max_disparity": 8})
+    np.testing.assert_array_equal(m, _core.mcgm_match(LEFT, RIGHT, {"max_disparity": 8})[0])
+    got_m = sv.match(left, right, max_disparity=8)
+    want_m = sv.match(LEFT, RIGHT, max_disparity=8)
+    assert len(want_m) > 50
+    np.testing.assert_array_equal(got_m.xl, want_m.xl)
+    np.testing.assert_array_equal(got_m.xr, want_m.xr)
+
+
+# --- ranges ------------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("max_disparity", "says"),
+    [
+        (0, r"max_disparity \(0\) must be larger than min_disparity"),
+        (-1, r"max_disparity \(-1\) must be larger than min_disparity"),
+        (60, "disparity range 60 is not smaller than the image width 60"),
+        (float("nan"), "max_disparity: expected a finite number, got nan"),
+        (True, "max_disparity: expected a number of pixels, got True"),
+    ],
+)
+@pytest.mark.parametrize("method", DEPTH_METHODS)
+def test_depth_map_range_edges(max_disparity: object, says: str, method: str) -> None:
+    with pytest.raises((ValueError, TypeError), match=says):
+        sv.depth_map(LEFT, RIGHT, method=method, max_disparity=max_disparity)
+
+
+@pytest.mark.parametrize("method", DEPTH_METHODS)
+def test_depth_map_min_above_max_is_refused(method: str) -> None:
+    with pytest.raises(ValueError, match=r"max_disparity \(8\) must be larger than min_disparity"):
+        sv.depth_map(LEFT, RIGHT, method=method, max_disparity=8, min_disparity=10)
+
+
+@pytest.mark.parametrize("method", DEPTH_METHODS)
+def test_depth_map_over_a_fractional_range(method: str) -> None:
+    res = sv.depth_map(LEFT, RIGHT, method=method, max_disparity=4.5)
+    d = res.disparity[np.isfinite(res.disparity)]
+    assert d.size > 0.5 * LEFT.size and abs(float(np.median(d)) - 3.0) < 0.1
