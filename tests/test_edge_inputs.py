@@ -179,3 +179,25 @@ def test_depth_map_over_a_fractional_range(method: str) -> None:
     res = sv.depth_map(LEFT, RIGHT, method=method, max_disparity=4.5)
     d = res.disparity[np.isfinite(res.disparity)]
     assert d.size > 0.5 * LEFT.size and abs(float(np.median(d)) - 3.0) < 0.1
+
+
+# --- the extension's kernels on extreme arguments ----------------------------------------------
+
+
+def test_a_fattening_radius_beyond_the_map_is_the_whole_map() -> None:
+    """A radius of 2**31 px looped over every offset (minutes on a 40 x 60 map), and one of
+    2**63 or more wrapped to a negative radius in the kernel: other pixels marked."""
+    d = np.where(np.arange(60) < 30, 2.0, 9.0).astype(np.float32)[None].repeat(40, 0)
+    g = np.where(np.arange(60) < 36, 0.2, 0.8).astype(np.float32)[None].repeat(40, 0)
+    whole = _core.fattened(d, g, 60, 2.0, 2.0)
+    assert whole.sum() == 40 * 6  # columns 30-35: the foreground carried to the colour edge
+    for radius in (61, 2**64 - 1, 2**63, 2**31):
+        np.testing.assert_array_equal(_core.fattened(d, g, radius, 2.0, 2.0), whole)
+
+
+def test_an_infinite_disparity_has_no_depth() -> None:
+    """+inf gave depth 0 and sigma 0 (a point on the camera); ``depth_from_disparity`` gives NaN."""
+    d = np.array([[np.inf, -np.inf, 8.0]], np.float32)
+    z, s = _core.depth_rectified(d, np.full_like(d, 0.5), 50.0, 2.0, 0.74, -0.52, 0.2, 0.9)
+    assert np.isnan(z[0, :2]).all() and np.isnan(s[0, :2]).all()
+    assert z[0, 2] == 5.0

@@ -207,8 +207,8 @@ def fattened(
 ) -> npt.NDArray[np.bool_]:
     """The pixels between a disparity jump (> ``jump``, on the row-filled map) and the strongest
     step of ``guide`` within ``radius`` on its background side, if that step is ``ratio`` times
-    the one at the jump; along rows and along columns. ``ValueError``: shapes differ, or a
-    negative ``ratio`` / ``jump``."""
+    the one at the jump; along rows and along columns (a ``radius`` beyond the map: the whole
+    row or column). ``ValueError``: shapes differ, or a negative ``ratio`` / ``jump``."""
 
 # --- Triangulation (rust/py/src/triangulation.rs) ------------------------------------------------
 
@@ -223,8 +223,8 @@ def depth_rectified(
     s_fill: float,
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
     """``(Z, sigma_Z)``: ``fb / (d + doffs)``, ``Z max(s0 + slope clip(c), s_min) / (d+doffs)``
-    (``Z s_fill / (d + doffs)`` where ``c < 0``); NaN where ``d + doffs`` is not above that
-    ``sigma_d``."""
+    (``Z s_fill / (d + doffs)`` where ``c < 0``); NaN where ``d`` is not finite or ``d + doffs``
+    is not above that ``sigma_d``."""
 
 def refine_disparity(
     left: npt.NDArray[np.float32],

@@ -108,7 +108,9 @@ fn mark_row(
         step[x] = (g[x] - g[x - 1]).abs();
     }
     marks.fill(0);
-    let r = p.radius as isize;
+    // A radius beyond the row reaches its ends as the row's length does (the columns are
+    // clipped): 2**31 px took minutes, and one of 2**63 or more wrapped to a negative isize.
+    let r = p.radius.min(w) as isize;
     for j in 1..w {
         // NaN (a row with no value) is no jump.
         let is_jump = (f[j] - f[j - 1]).abs() > p.jump;
@@ -180,5 +182,23 @@ mod tests {
         let g: Vec<f32> = (0..h).map(|y| if y < 6 { 0.2 } else { 0.8 }).collect();
         let m = fattened(&d, &g, 1, h, &P);
         assert_eq!((0..h).filter(|&y| m[y]).collect::<Vec<_>>(), vec![3, 4, 5]);
+    }
+
+    #[test]
+    fn a_radius_beyond_the_image_is_the_whole_row() {
+        // It looped over every offset of the radius: 2**31 px took minutes on a 10 px row,
+        // and a radius of 2**63 or more wrapped to a negative one.
+        let w = 10;
+        let d: Vec<f32> = (0..w).map(|x| if x < 3 { 1.0 } else { 9.0 }).collect();
+        let g: Vec<f32> = (0..w).map(|x| if x < 6 { 0.2 } else { 0.8 }).collect();
+        let whole = FattenParams { radius: w, ..P };
+        let want = fattened(&d, &g, w, 1, &whole);
+        assert_eq!(
+            (0..w).filter(|&x| want[x]).collect::<Vec<_>>(),
+            vec![3, 4, 5]
+        );
+        for radius in [w + 1, 1 << 40, usize::MAX] {
+            assert_eq!(fattened(&d, &g, w, 1, &FattenParams { radius, ..P }), want);
+        }
     }
 }

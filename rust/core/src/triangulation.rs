@@ -25,7 +25,7 @@ pub struct SigmaModel {
 }
 
 /// `(depth, sigma)` of a `w` x `h` rectified disparity map: `fb = f B` (px times the output
-/// unit), `doffs` the principal-point offset (px). NaN where the disparity is NaN, where
+/// unit), `doffs` the principal-point offset (px). NaN where the disparity is not finite, where
 /// `d + doffs <= sigma_d` (or `<= 0`), or where the depth is not finite.
 pub fn depth_rectified(
     disp: &[f32],
@@ -73,7 +73,8 @@ pub fn depth_rectified(
             } else {
                 (sigma.s0 + sigma.slope * cx.clamp(0.0, 1.0)).max(sigma.s_min)
             };
-            let ok = denom > 0.0 && denom > sd && z.is_finite();
+            // An infinite disparity gave the depth 0 and sigma 0: a point on the camera.
+            let ok = denom.is_finite() && denom > 0.0 && denom > sd && z.is_finite();
             zrow[x] = if ok { z } else { f32::NAN };
             srow[x] = if ok { z * sd / denom } else { f32::NAN };
         }
@@ -113,6 +114,16 @@ mod tests {
         );
         assert!((s[6] - 5.0 * 0.9 / 10.0).abs() < 1e-7, "negative: a fill");
         assert!((s[7] - 5.0 * 0.48 / 10.0).abs() < 1e-7);
+    }
+
+    #[test]
+    fn no_depth_for_an_infinite_disparity() {
+        // +inf gave the depth 0 and sigma 0 (a point on the camera), as a finite 1e30 does not.
+        let disp = [f32::INFINITY, f32::NEG_INFINITY, 1e30, 8.0];
+        let (z, s) = depth_rectified(&disp, &[0.5; 4], 4, 1, 50.0, 2.0, M).unwrap();
+        assert!(z[0].is_nan() && s[0].is_nan() && z[1].is_nan() && s[1].is_nan());
+        assert!(z[2] > 0.0 && z[2] < 1e-28);
+        assert_eq!(z[3], 5.0);
     }
 
     #[test]
