@@ -181,7 +181,88 @@ def test_depth_map_over_a_fractional_range(method: str) -> None:
     assert d.size > 0.5 * LEFT.size and abs(float(np.median(d)) - 3.0) < 0.1
 
 
-# --- the extension's kernels on extreme arguments ----------------------------------------------
+# --- the extension's integer arguments ---------------------------------------------------------
+
+D = LEFT * 5
+U8 = (RNG.random((20, 30, 3)) * 255).astype(np.uint8)
+
+
+def _refine(**kw: Any) -> object:
+    args: dict[str, Any] = {
+        "d_min": 0.0,
+        "d_max": 8.0,
+        "base_sigma": 1.0,
+        "win_sigma": 1.5,
+        "win_radius": 3,
+        "search": 2,
+        "step": 0.25,
+        "fill_search": 2,
+        "fill_step": 0.5,
+        "var_floor": 1e-4,
+        "fills": [(1.0, 0.5)],
+        "fill_confidence": 0.1,
+        "fill_plane": True,
+        "fill_max_residual": 1.0,
+    }
+    args.update(kw)
+    return _core.refine_disparity(LEFT, RIGHT, D, np.full_like(D, 0.5), *args.values())
+
+
+def _sgm(**kw: Any) -> object:
+    args: dict[str, Any] = {"d_min": 0, "d_max": 8, "p1": 8, "p2": 96, "gamma": 16.0}
+    args.update({"uniqueness": 5, "lr_tol": 1, "edge_margin": 4, "paths": 8})
+    args.update(kw)
+    return _core.sgm_disparity(LEFT, RIGHT, *args.values())
+
+
+#: (name, lowest, highest, call with that argument): an integer outside the range was a bare
+#: OverflowError ("can't convert negative int to unsigned", "out of range integral type
+#: conversion attempted", "int too big to convert") that named nothing.
+U64 = 2**64 - 1
+INTS: list[tuple[str, int, int, Callable[[Any], object]]] = [
+    ("radius", 0, U64, lambda v: _core.fattened(D, LEFT, v, 2.0, 2.0)),
+    ("min_size", 0, U64, lambda v: _core.gabor_remove_speckles(D, v, 1.0)),
+    ("min_pixels", 0, U64, lambda v: _core.plane_fill(D, np.zeros(D.shape, np.uint32), v, 1, 0, 5)),
+    ("min_size", 0, U64, lambda v: _core.graph_segments(U8.astype(np.float32), 1.0, v)),
+    ("step", 0, 2**32 - 1, lambda v: _core.quantised_regions(U8, v, 0)),
+    ("offset", 0, 2**32 - 1, lambda v: _core.quantised_regions(U8, 16, v)),
+    ("nms_half", 0, U64, lambda v: _core.hopfield_interest(LEFT, nms_half=v)),
+    ("tile", 0, U64, lambda v: _core.hopfield_interest(LEFT, tile=v)),
+    ("n_levels", 0, U64, lambda v: _core.gabor_disparity(LEFT, RIGHT, 0.0, 8.0, n_levels=v)),
+    ("speckle_size", 0, U64, lambda v: _core.gabor_disparity(LEFT, RIGHT, 0, 8, speckle_size=v)),
+    ("fine_levels", 0, U64, lambda v: _core.gabor_disparity(LEFT, RIGHT, 0, 8, fine_levels=v)),
+    ("win_radius", 0, U64, lambda v: _refine(win_radius=v)),
+    ("fill_search", 0, U64, lambda v: _refine(fill_search=v)),
+    ("d_max", -(2**31), 2**31 - 1, lambda v: _sgm(d_max=v)),
+    ("p2", 0, 2**16 - 1, lambda v: _sgm(p2=v)),
+    ("edge_margin", 0, 2**32 - 1, lambda v: _sgm(edge_margin=v)),
+    ("paths", 0, 255, lambda v: _sgm(paths=v)),
+    (
+        "max_frames",
+        0,
+        255,
+        lambda v: _core.temporal_running_mean(
+            U8, np.zeros(U8.shape, np.float32), np.zeros((20, 30), np.uint8), D[:20, :30], 2, v
+        ),
+    ),
+]
+
+
+@pytest.mark.parametrize("case", range(len(INTS)), ids=[f"{c[0]}-{i}" for i, c in enumerate(INTS)])
+def test_an_integer_beyond_its_type_names_the_argument(case: int) -> None:
+    name, lo, hi, call = INTS[case]
+    says = f"invalid parameter `{name}`: expected " + ("None or " if name == "n_levels" else "")
+    says += f"an integer from {lo} to {hi}, got "
+    for value in (lo - 1, hi + 1, 2**70):
+        with pytest.raises(ValueError, match=re.escape(says + str(value))):
+            call(value)
+    with pytest.raises(TypeError, match=f"invalid parameter `{name}`: .*float"):
+        call(2.5)
+
+
+def test_fill_planes_passes_beyond_their_types_are_named() -> None:
+    with pytest.raises(ValueError, match=r"invalid parameter `passes`: expected a list of \(step"):
+        _core.fill_planes(D, U8, [(16, -1)], 1.0)
 
 
 def test_a_fattening_radius_beyond_the_map_is_the_whole_map() -> None:

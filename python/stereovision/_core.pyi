@@ -1,4 +1,8 @@
-"""Typed stub of the Rust extension ``stereovision._core`` (see rust/py/src)."""
+"""Typed stub of the Rust extension ``stereovision._core`` (see rust/py/src).
+
+An integer argument outside its Rust type's range (a negative count, ``2**64``) is a
+``ValueError`` naming the argument and the range; one that is no integer, a ``TypeError``.
+"""
 
 from collections.abc import Sequence
 from typing import Any

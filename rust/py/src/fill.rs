@@ -63,7 +63,7 @@ pub fn fattened<'py>(
     py: Python<'py>,
     disp: &Bound<'py, PyAny>,
     guide: &Bound<'py, PyAny>,
-    radius: usize,
+    #[pyo3(from_py_with = radius_arg)] radius: usize,
     ratio: f32,
     jump: f32,
 ) -> PyResult<Bound<'py, PyArray2<bool>>> {
@@ -88,4 +88,8 @@ pub fn fattened<'py>(
         guard("fattened", || Ok(core_fattened(&d, &g, w, h, &p)))
     })?;
     vec_to_numpy(py, (h, w), mask)
+}
+
+crate::named_ints! {
+    radius_arg: usize = "radius";
 }

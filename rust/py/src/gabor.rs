@@ -100,23 +100,23 @@ pub fn gabor_disparity<'py>(
     orientations_deg: Option<Vec<f32>>,
     bandwidth_oct: f32,
     aspect: f32,
-    n_levels: Option<usize>,
-    iters_per_level: usize,
+    #[pyo3(from_py_with = n_levels_arg)] n_levels: Option<usize>,
+    #[pyo3(from_py_with = iters_per_level_arg)] iters_per_level: usize,
     amp_rel_thresh: f32,
     stability_tau: f32,
     smooth_sigma: Option<f32>,
     conf_min: f32,
-    research_radius: usize,
-    search_pool_radius: usize,
+    #[pyo3(from_py_with = research_radius_arg)] research_radius: usize,
+    #[pyo3(from_py_with = search_pool_radius_arg)] search_pool_radius: usize,
     lr_check: bool,
     lr_tol: f32,
-    lr_coarse_levels: usize,
-    iters_finest: usize,
+    #[pyo3(from_py_with = lr_coarse_levels_arg)] lr_coarse_levels: usize,
+    #[pyo3(from_py_with = iters_finest_arg)] iters_finest: usize,
     research_finest: bool,
-    orientations_finest: usize,
-    fine_levels: usize,
+    #[pyo3(from_py_with = orientations_finest_arg)] orientations_finest: usize,
+    #[pyo3(from_py_with = fine_levels_arg)] fine_levels: usize,
     lr_light: bool,
-    speckle_size: usize,
+    #[pyo3(from_py_with = speckle_size_arg)] speckle_size: usize,
     speckle_range: f32,
 ) -> PyResult<Pair<'py>> {
     let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
@@ -291,7 +291,7 @@ pub fn gabor_lr_check<'py>(
 pub fn gabor_remove_speckles<'py>(
     py: Python<'py>,
     disp: &Bound<'py, PyAny>,
-    min_size: usize,
+    #[pyo3(from_py_with = gabor_remove_speckles_min_size)] min_size: usize,
     max_diff: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
@@ -304,4 +304,17 @@ pub fn gabor_remove_speckles<'py>(
     let (out, done) = crate::convert::map_copy_in_place(py, &disp, "disp", kernel)?;
     done?;
     Ok(out)
+}
+
+crate::named_ints! {
+    n_levels_arg: Option<usize> = "n_levels";
+    iters_per_level_arg: usize = "iters_per_level";
+    research_radius_arg: usize = "research_radius";
+    search_pool_radius_arg: usize = "search_pool_radius";
+    lr_coarse_levels_arg: usize = "lr_coarse_levels";
+    iters_finest_arg: usize = "iters_finest";
+    orientations_finest_arg: usize = "orientations_finest";
+    fine_levels_arg: usize = "fine_levels";
+    speckle_size_arg: usize = "speckle_size";
+    gabor_remove_speckles_min_size: usize = "min_size";
 }

@@ -127,8 +127,8 @@ pub fn hopfield_interest<'py>(
     py: Python<'py>,
     img: &Bound<'py, PyAny>,
     rel_threshold: f32,
-    nms_half: usize,
-    tile: usize,
+    #[pyo3(from_py_with = nms_half_arg)] nms_half: usize,
+    #[pyo3(from_py_with = tile_arg)] tile: usize,
     floor_rel: f32,
 ) -> PyResult<(
     Bound<'py, PyArray2<f32>>,
@@ -354,4 +354,9 @@ pub fn hopfield_candidates<'py>(
     let arr = Array2::from_shape_vec((neurons.len(), 6), flat)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(arr.into_pyarray(py))
+}
+
+crate::named_ints! {
+    nms_half_arg: usize = "nms_half";
+    tile_arg: usize = "tile";
 }

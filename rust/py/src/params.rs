@@ -49,3 +49,72 @@ pub fn non_negative(name: &str, v: f32) -> PyResult<()> {
         )))
     }
 }
+
+/// The integer types of the functions' integer arguments, with the range their error names.
+pub trait IntRange {
+    /// `"from MIN to MAX"`, or what the argument holds when it is not a plain integer.
+    fn range() -> String;
+}
+
+macro_rules! int_range {
+    ($($t:ty),*) => {$(
+        impl IntRange for $t {
+            fn range() -> String {
+                format!("an integer from {} to {}", <$t>::MIN, <$t>::MAX)
+            }
+        }
+    )*};
+}
+int_range!(u8, u16, u32, i32, usize);
+
+impl<T: IntRange> IntRange for Option<T> {
+    fn range() -> String {
+        format!("None or {}", T::range())
+    }
+}
+
+impl IntRange for Vec<(u32, usize)> {
+    fn range() -> String {
+        format!(
+            "a list of (step, min_pixels) pairs, {} and {}",
+            u32::range(),
+            usize::range()
+        )
+    }
+}
+
+/// The integer argument `name` of a function: an integer outside its Rust type's range was a
+/// bare `OverflowError` ("can't convert negative int to unsigned", "int too big to convert")
+/// naming neither the argument nor its range; it is a `ValueError` naming both now, and a value
+/// that is no integer a `TypeError` naming the argument.
+pub fn int_arg<'py, T>(ob: &Bound<'py, PyAny>, name: &str) -> PyResult<T>
+where
+    T: pyo3::conversion::FromPyObjectOwned<'py> + IntRange,
+{
+    ob.extract::<T>().map_err(|e| {
+        let e: PyErr = e.into();
+        let py = ob.py();
+        let got = ob
+            .repr()
+            .map_or_else(|_| "?".to_string(), |r| r.to_string());
+        if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(py) {
+            PyValueError::new_err(format!(
+                "invalid parameter `{name}`: expected {}, got {got}",
+                T::range()
+            ))
+        } else {
+            PyTypeError::new_err(format!("invalid parameter `{name}`: {}", e.value(py)))
+        }
+    })
+}
+
+/// Named extractors for `#[pyo3(from_py_with = ...)]` (which takes a path, not a closure):
+/// `named_ints!(radius_arg: usize = "radius");` defines `radius_arg(ob) -> PyResult<usize>`.
+#[macro_export]
+macro_rules! named_ints {
+    ($($f:ident: $t:ty = $name:literal;)*) => {$(
+        fn $f(ob: &pyo3::Bound<'_, pyo3::PyAny>) -> pyo3::PyResult<$t> {
+            $crate::params::int_arg(ob, $name)
+        }
+    )*};
+}

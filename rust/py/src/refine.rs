@@ -25,10 +25,10 @@ pub fn refine_disparity<'py>(
     d_max: f32,
     base_sigma: f32,
     win_sigma: f32,
-    win_radius: usize,
-    search: usize,
+    #[pyo3(from_py_with = win_radius_arg)] win_radius: usize,
+    #[pyo3(from_py_with = search_arg)] search: usize,
     step: f32,
-    fill_search: usize,
+    #[pyo3(from_py_with = fill_search_arg)] fill_search: usize,
     fill_step: f32,
     var_floor: f32,
     fills: Vec<(f32, f32)>,
@@ -77,4 +77,10 @@ pub fn refine_disparity<'py>(
         image_to_numpy(py, img(oc))?,
         filled,
     ))
+}
+
+crate::named_ints! {
+    win_radius_arg: usize = "win_radius";
+    search_arg: usize = "search";
+    fill_search_arg: usize = "fill_search";
 }

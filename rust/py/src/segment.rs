@@ -20,7 +20,7 @@ pub fn graph_segments<'py>(
     py: Python<'py>,
     image: &Bound<'py, PyAny>,
     k: f32,
-    min_size: usize,
+    #[pyo3(from_py_with = graph_segments_min_size)] min_size: usize,
 ) -> PyResult<Bound<'py, PyArray2<u32>>> {
     let image: PyReadonlyArray3<'py, f32> = crate::convert::array_arg(image, "image")?;
     non_negative("k", k)?;
@@ -52,7 +52,7 @@ pub fn plane_fill<'py>(
     py: Python<'py>,
     disp: &Bound<'py, PyAny>,
     labels: &Bound<'py, PyAny>,
-    min_pixels: usize,
+    #[pyo3(from_py_with = min_pixels_arg)] min_pixels: usize,
     max_residual: f32,
     lo: f32,
     hi: f32,
@@ -103,8 +103,8 @@ pub fn plane_fill<'py>(
 pub fn quantised_regions<'py>(
     py: Python<'py>,
     image: &Bound<'py, PyAny>,
-    step: u32,
-    offset: u32,
+    #[pyo3(from_py_with = step_arg)] step: u32,
+    #[pyo3(from_py_with = offset_arg)] offset: u32,
 ) -> PyResult<Bound<'py, PyArray2<u32>>> {
     let image: PyReadonlyArray3<'py, u8> = crate::convert::array_arg(image, "image")?;
     let (h, w, c) = (image.shape()[0], image.shape()[1], image.shape()[2]);
@@ -135,7 +135,7 @@ pub fn fill_planes<'py>(
     py: Python<'py>,
     disp: &Bound<'py, PyAny>,
     image: &Bound<'py, PyAny>,
-    passes: Vec<(u32, usize)>,
+    #[pyo3(from_py_with = passes_arg)] passes: Vec<(u32, usize)>,
     max_residual: f32,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
@@ -163,4 +163,12 @@ pub fn fill_planes<'py>(
     })?;
     done?;
     Ok(out)
+}
+
+crate::named_ints! {
+    graph_segments_min_size: usize = "min_size";
+    min_pixels_arg: usize = "min_pixels";
+    step_arg: u32 = "step";
+    offset_arg: u32 = "offset";
+    passes_arg: Vec<(u32, usize)> = "passes";
 }

@@ -16,15 +16,15 @@ pub fn sgm_disparity<'py>(
     py: Python<'py>,
     left: &Bound<'py, PyAny>,
     right: &Bound<'py, PyAny>,
-    d_min: i32,
-    d_max: i32,
-    p1: u16,
-    p2: u16,
+    #[pyo3(from_py_with = d_min_arg)] d_min: i32,
+    #[pyo3(from_py_with = d_max_arg)] d_max: i32,
+    #[pyo3(from_py_with = p1_arg)] p1: u16,
+    #[pyo3(from_py_with = p2_arg)] p2: u16,
     gamma: f32,
-    uniqueness: u32,
-    lr_tol: u32,
-    edge_margin: u32,
-    paths: u8,
+    #[pyo3(from_py_with = uniqueness_arg)] uniqueness: u32,
+    #[pyo3(from_py_with = lr_tol_arg)] lr_tol: u32,
+    #[pyo3(from_py_with = edge_margin_arg)] edge_margin: u32,
+    #[pyo3(from_py_with = paths_arg)] paths: u8,
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let left: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(left, "left")?;
     let right: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(right, "right")?;
@@ -52,4 +52,15 @@ pub fn sgm_disparity<'py>(
             data: out,
         },
     )
+}
+
+crate::named_ints! {
+    d_min_arg: i32 = "d_min";
+    d_max_arg: i32 = "d_max";
+    p1_arg: u16 = "p1";
+    p2_arg: u16 = "p2";
+    uniqueness_arg: u32 = "uniqueness";
+    lr_tol_arg: u32 = "lr_tol";
+    edge_margin_arg: u32 = "edge_margin";
+    paths_arg: u8 = "paths";
 }

@@ -57,7 +57,7 @@ pub fn temporal_running_mean<'py>(
     count: &Bound<'py, PyAny>,
     diff: &Bound<'py, PyAny>,
     ks: f32,
-    max_frames: u8,
+    #[pyo3(from_py_with = max_frames_arg)] max_frames: u8,
 ) -> PyResult<Bound<'py, PyArrayDyn<u8>>> {
     let mut mean: PyReadwriteArrayDyn<'py, f32> = crate::convert::array_arg_rw(mean, "mean")?;
     let mut count: PyReadwriteArray2<'py, u8> = crate::convert::array_arg_rw(count, "count")?;
@@ -95,4 +95,8 @@ pub fn temporal_running_mean<'py>(
     let out = ArrayD::from_shape_vec(IxDyn(&shape), out)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(out.into_pyarray(py))
+}
+
+crate::named_ints! {
+    max_frames_arg: u8 = "max_frames";
 }
