@@ -1218,6 +1218,37 @@ def test_saves_into_the_offered_folder_go_to_a_new_numbered_folder_each(tmp_path
     assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/typed: ")
 
 
+def test_the_offered_save_folder_skips_a_link_named_saved(tmp_path):
+    """A ``saved`` in --data that was a symbolic link leading outside it made every Save as
+    offered fail with "folder outside the --data folders: saved", a folder the user never
+    typed. A link is now skipped, whatever it leads to (nothing is written through it), and the
+    page says so; a link the user types is still refused."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SAVED_DEPTH_FILES, SAVED_FILES
+
+    data, outside = tmp_path / "mine", tmp_path / "outside"
+    data.mkdir()
+    outside.mkdir()
+    (data / "saved").symlink_to(outside, target_is_directory=True)
+    app = _scene_app("test-save-link", [bundled_data_dir(), data])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.startswith("saved 450×375 to mine/saved-2: ")
+    assert app.state.save_label.endswith(
+        " (saved: a symbolic link, not a folder of --data: left alone)"
+    )
+    assert sorted(p.name for p in (data / "saved-2").iterdir()) == sorted(
+        SAVED_FILES + SAVED_DEPTH_FILES
+    )
+    assert list(outside.iterdir()) == []
+    app.state.save_dir = "saved"  # typed: refused, nothing written
+    _run(app, app.save)
+    assert app.state.error == "folder outside the --data folders: saved"
+    assert list(outside.iterdir()) == []
+
+
 def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkeypatch):
     """Save pressed twice (or again after a new pair came) while the first still wrote: the
     second found none of the files yet, wrote too, and replaced the first's files without a
@@ -1405,7 +1436,7 @@ def test_an_image_folder_plays_its_pairs_one_per_capture(tmp_path):
 
     cones = bundled_data_dir() / "cones"
     left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
-    data, outside = tmp_path / "data", tmp_path / "outside"
+    data, outside = tmp_path / "mine", tmp_path / "outside"
     seq, rig = data / "seq", data / "rig"
     for d in (seq, rig / "left", rig / "right", outside, data / "empty"):
         d.mkdir(parents=True)

@@ -1453,9 +1453,10 @@ class StereoApp:
         result = view.result
         names = SAVED_FILES + (SAVED_DEPTH_FILES if result.depth is not None else ())
         typed = str(self.state.save_dir or "").strip()
+        skipped: list[str] = []
         try:
             if self._save_roots and typed in ("", self._offered_save_dir):
-                folder = self._next_save_folder()
+                folder = self._next_save_folder(skipped)
             else:
                 folder = self.folders.resolve_output(typed, self._save_roots)
             label = self.folders.label(folder)
@@ -1489,14 +1490,26 @@ class StereoApp:
         self._done()
         h, w = result.disparity.shape
         without = "" if result.depth is not None else " (no calibration: disparity only)"
+        if skipped:
+            links = ", ".join(skipped)
+            without += f" ({links}: a symbolic link, not a folder of --data: left alone)"
         with self.state:
             self.state.save_label = f"saved {w}×{h} to {label}: {', '.join(written)}{without}"
 
-    def _next_save_folder(self) -> Path:
+    def _next_save_folder(self, skipped: list[str] | None = None) -> Path:
         """The first of ``saved``, ``saved-2``, ``saved-3``, ... in the first ``--data``
-        folder that does not exist or is an empty folder, and no Save is writing into."""
+        folder that does not exist or is an empty folder, and no Save is writing into.
+
+        A name that is a symbolic link is skipped (its name appended to ``skipped``): it may
+        lead outside ``--data`` (the Save was refused as "outside the --data folders", naming
+        a folder the user never typed) or into a folder the user made for something else.
+        """
         for n in itertools.count(1):
             name = SAVE_FOLDER if n == 1 else f"{SAVE_FOLDER}-{n}"
+            if os.path.islink(self._save_roots[0] / name):
+                if skipped is not None:
+                    skipped.append(name)
+                continue
             folder = self.folders.resolve_output(name, self._save_roots)
             if folder in self._saving_into:
                 continue
