@@ -1971,6 +1971,50 @@ def test_3d_view_not_blank_and_follows_sliders(page):
     _shot(page, "gui-3d.png")
 
 
+def test_3d_sliders_line_up_and_show_their_values(page):
+    """Each 3-D slider's track started where its name ended ("up (m)" short, "forward (m)"
+    long): the six thumbs at zero stood at six places, and a value showed only while its thumb
+    was dragged. The tracks now line up, and each slider's value is written at its end, in the
+    page's unit."""
+    _wait_computations(page, 1)
+    tracks = page.evaluate(
+        """() => [...document.querySelectorAll('[id^=slider-] .v-slider-track')].map(t => {
+              const r = t.getBoundingClientRect(); return [r.left, r.right]; })"""
+    )
+    assert len(tracks) == 6
+    assert max(t[0] for t in tracks) - min(t[0] for t in tracks) < 1, tracks
+    assert max(t[1] for t in tracks) - min(t[1] for t in tracks) < 1, tracks
+
+    def values() -> list[str]:
+        return [page.inner_text(f"#slider-{n} .slider-value") for n in ("yaw", "right")]
+
+    page.click("#reset-camera")  # the test before turned and moved the view
+    page.wait_for_function(
+        "document.querySelector('#slider-right .slider-value')?.textContent.trim() === '0.00 m'"
+    )
+    assert values() == ["0°", "0.00 m"]
+    page.focus("#slider-yaw [role=slider]")
+    for _ in range(3):
+        page.keyboard.press("ArrowLeft")
+    page.focus("#slider-right [role=slider]")
+    page.keyboard.press("ArrowRight")
+    page.wait_for_function(
+        "document.querySelector('#slider-right .slider-value')?.textContent.trim() === '0.05 m'"
+    )
+    assert values() == ["-3°", "0.05 m"]
+    assert page.inner_text("#slider-right .slider-name") == "right (m)"
+    page.click("#unit-ft")
+    page.wait_for_function(
+        "document.querySelector('#slider-right .slider-value')?.textContent.trim() === '0.16 ft'"
+    )
+    assert page.inner_text("#slider-right .slider-name") == "right (ft)"
+    page.click("#unit-m")
+    page.click("#reset-camera")
+    page.wait_for_function(
+        "document.querySelector('#slider-yaw .slider-value')?.textContent.trim() === '0°'"
+    )
+
+
 def test_bad_inputs_show_errors_and_page_stays_usable(page, gui_data):
     _wait_computations(page, 1)
     cases = [

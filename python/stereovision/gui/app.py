@@ -152,6 +152,9 @@ ANGLE_RANGE = 90.0
 TRANSLATION_RANGE = 5.0
 TRANSLATION_STEP = 0.05
 _TRANSLATIONS = ("forward", "up", "right")
+#: The 3-D sliders' name and value columns (one width each, so that the six tracks line up).
+SLIDER_NAME_STYLE = "width: 6.5em; white-space: nowrap;"
+SLIDER_VALUE_STYLE = "width: 4.5em; text-align: right; white-space: nowrap;"
 
 _CONTROL_NAMES = ("roll", "pitch", "yaw", "forward", "up", "right")
 
@@ -1905,24 +1908,32 @@ class StereoApp:
                     id="reset-camera",
                     block=True,
                 )
+        # Each slider's name in a column of one width and its value at its end: with the name
+        # as the slider's label, each track started where its name ended, so the six thumbs
+        # at zero stood at six places, and a value showed only while its thumb was dragged.
         for name in _CONTROL_NAMES:
             if name in _TRANSLATIONS:  # in the page's unit
-                label: Any = (f"'{name} (' + unit + ')'",)
+                label = f"{name} ({{{{ unit }}}})"
+                value = f"{{{{ Number({name}).toFixed(2) }}}} {{{{ unit }}}}"
                 rng: Any = ("-translation_range",), ("translation_range",)
                 step: Any = ("translation_step",)
             else:
                 label, rng, step = f"{name} (°)", (-ANGLE_RANGE, ANGLE_RANGE), 1.0
+                value = f"{{{{ Number({name}).toFixed(0) }}}}°"
             with html.Div(id=f"slider-{name}"):
-                v3.VSlider(
+                with v3.VSlider(
                     v_model=(name,),
-                    label=label,
                     min=rng[0],
                     max=rng[1],
                     step=step,
                     density="compact",
                     hide_details=True,
                     thumb_label=True,
-                )
+                ):
+                    with v3.Template(v_slot_prepend=True):
+                        html.Div(label, classes="slider-name", style=SLIDER_NAME_STYLE)
+                    with v3.Template(v_slot_append=True):
+                        html.Div(value, classes="slider-value", style=SLIDER_VALUE_STYLE)
         with v3.VRow(dense=True, classes="mt-1"):
             with v3.VCol(cols=9):
                 label = "Point cloud file (PLY / PCD / NPZ)"
