@@ -1169,6 +1169,7 @@ def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_pat
     bare = _scene_app("test-save-bare", [bundled_data_dir()])
     bare.view = app.view
     assert bare.state.save_dir == ""
+    assert bare.state.save_hint == "Save writes into a --data folder: start the GUI with --data DIR"
     _run(bare, bare.save)
     assert bare.state.error == "empty or invalid folder"
     bare.state.save_dir = "x"
@@ -1855,6 +1856,33 @@ def test_camera_format_select_shows_its_choice(page):
         }"""
     )
     assert clipped == [["driver", 0], ["format", 0]]
+
+
+def test_method_buttons_and_save_field_are_shown_whole(page):
+    """The six method buttons wrapped onto two rows inside a group one row high: each was
+    squeezed to 16 px of the other toggles' 36. The Save folder field's label was cut at "as
+    offered: saved, sa...". Each wrapped row is now a whole row, and the field's label is
+    short, its explanation written under it."""
+    _wait_computations(page, 1)
+    sizes = page.evaluate(
+        """() => ['#method-toggle', '#unit-toggle'].map(s => {
+              const g = document.querySelector(s).getBoundingClientRect();
+              return [g.top, g.bottom, [...document.querySelectorAll(s + ' button')].map(b => {
+                const r = b.getBoundingClientRect(); return [r.top, r.bottom]; })]; })"""
+    )
+    (top, bottom, methods), (_, _, units) = sizes
+    unit_height = units[0][1] - units[0][0]
+    assert unit_height >= 30
+    assert [b - t for t, b in methods] == [unit_height] * len(methods)
+    assert all(top <= t and b <= bottom for t, b in methods)
+    label = page.evaluate(
+        """() => { const l = document.querySelector('#save-dir').closest('.v-field')
+              .querySelector('.v-label'); return [l.innerText, l.scrollWidth - l.clientWidth]; }"""
+    )
+    assert label == ["Save folder", 0]
+    assert page.inner_text("#save-hint") == (
+        "in a --data folder; as offered, a new one each Save (saved, saved-2, ...)"
+    )
 
 
 def test_capture_changes_images(page):

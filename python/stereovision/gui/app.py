@@ -141,6 +141,11 @@ SAVED_FILES = ("disparity.png", "disparity.pfm")
 SAVED_DEPTH_FILES = ("depth.png", "depth.npy", "depth_mm.png", "cloud.ply")
 #: The save folder offered at start-up, inside the first ``--data`` folder.
 SAVE_FOLDER = "saved"
+#: Height of a button of a toggle row (Vuetify's compact button group).
+TOGGLE_HEIGHT_PX = 36
+#: What the page says under the Save folder field (with and without a --data folder).
+SAVE_HINT = "in a --data folder; as offered, a new one each Save (saved, saved-2, ...)"
+NO_SAVE_HINT = "Save writes into a --data folder: start the GUI with --data DIR"
 
 #: Length units the page can show (the unit toggle; metres by default), as
 #: :data:`stereovision.calibration.UNIT_TO_METRES` names them.
@@ -654,11 +659,16 @@ def _toggle(
     button_ids: str | None = None,
     classes: str | None = None,
     button_classes: str | None = None,
+    wrap: bool = False,
 ) -> None:
     """A row of buttons choosing one of ``values`` (state variable ``model``); each button's id
-    is ``button_ids-VALUE`` when ``button_ids`` is given."""
+    is ``button_ids-VALUE`` when ``button_ids`` is given. With ``wrap``, buttons that do not
+    fit go on to further rows of the same height (a wrapped group kept one row's height and
+    squeezed its buttons to half of it)."""
     from trame.widgets import vuetify3 as v3
 
+    if wrap:
+        classes = " ".join(c for c in (classes, "flex-wrap h-auto") if c)
     extra = {} if classes is None else {"classes": classes}
     with v3.VBtnToggle(
         v_model=(model,),
@@ -673,6 +683,8 @@ def _toggle(
             kw: dict[str, Any] = {} if button_ids is None else {"id": f"{button_ids}-{v}"}
             if button_classes is not None:
                 kw["classes"] = button_classes
+            if wrap:
+                kw["style"] = f"height: {TOGGLE_HEIGHT_PX}px;"
             v3.VBtn(v, value=v, size="small", **kw)
 
 
@@ -817,6 +829,7 @@ class StereoApp:
         #: first of it, ``saved-2``, ``saved-3``, ... that is new or empty.
         self._offered_save_dir = str(self._save_roots[0] / SAVE_FOLDER) if self._save_roots else ""
         st.save_dir = self._offered_save_dir
+        st.save_hint = SAVE_HINT if self._save_roots else NO_SAVE_HINT
         st.save_label = ""
         for name in _CONTROL_NAMES:
             st[name] = 0.0
@@ -1829,9 +1842,7 @@ class StereoApp:
         with v3.VCard(id="panel-stereo", classes="fill-height"):
             v3.VCardTitle("2 · Stereo output")
             with v3.VCardText():
-                _toggle(
-                    "method", self.state.methods, "method-toggle", "method", classes="flex-wrap"
-                )
+                _toggle("method", self.state.methods, "method-toggle", "method", wrap=True)
                 with v3.VRow(dense=True, align="center", classes="mt-1"):
                     with v3.VCol(cols=8):
                         v3.VTextField(
@@ -1877,11 +1888,10 @@ class StereoApp:
                     html.Img(id="img-floor", src=("img_floor",), style=img_style)
                 with v3.VRow(dense=True, align="center", classes="mt-1"):
                     with v3.VCol(cols=9):
+                        # The label alone (its explanation below): the field cut the long
+                        # label at "as offered: saved, sa...", unreadable even when focused.
                         v3.VTextField(
-                            label=(
-                                "Save folder (inside a --data folder; as offered: saved, "
-                                "saved-2, ... a new one each Save)"
-                            ),
+                            label="Save folder",
                             v_model=("save_dir",),
                             density="compact",
                             hide_details=True,
@@ -1894,6 +1904,9 @@ class StereoApp:
                             id="save-btn",
                             block=True,
                         )
+                html.Div(
+                    "{{ save_hint }}", id="save-hint", classes="text-caption text-medium-emphasis"
+                )
                 html.Div("{{ save_label }}", id="save-label", classes="text-caption")
 
     def _camera_controls(self, v3: Any, html: Any) -> None:
