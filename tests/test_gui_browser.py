@@ -1250,6 +1250,25 @@ def test_the_offered_save_folder_skips_a_link_named_saved(tmp_path):
     assert list(outside.iterdir()) == []
 
 
+def test_a_saved_cloud_is_offered_in_the_point_cloud_list(tmp_path):
+    """The file lists were walked once, at start-up: the cloud.ply a Save had just written was
+    not in the 3-D panel's point-cloud list (to be shown, its path had to be typed). Each Save
+    now refreshes the lists, and its cloud opens in the 3-D view."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-save-list", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    assert app.state.clouds == []
+    _run(app, app.save)
+    saved = str((tmp_path / "saved" / "cloud.ply").resolve())
+    assert [c["value"] for c in app.state.clouds] == [saved]
+    assert app.state.clouds[0]["title"] == f"{tmp_path.name}/saved/cloud.ply"
+    app.state.cloud_path = saved
+    app.open_cloud()
+    assert app.state.error == "" and app._cloud is not None
+
+
 def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkeypatch):
     """Save pressed twice (or again after a new pair came) while the first still wrote: the
     second found none of the files yet, wrote too, and replaced the first's files without a

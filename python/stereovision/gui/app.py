@@ -1511,6 +1511,8 @@ class StereoApp:
             without += f" ({links}: a symbolic link, not a folder of --data: left alone)"
         with self.state:
             self.state.save_label = f"saved {w}×{h} to {label}: {', '.join(written)}{without}"
+            # the lists offer what was just written: its cloud.ply to Show in the 3-D view
+            self._refresh_file_lists()
 
     def _next_save_folder(self, skipped: list[str] | None = None) -> Path:
         """The first of ``saved``, ``saved-2``, ``saved-3``, ... in the first ``--data``
