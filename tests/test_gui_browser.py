@@ -1456,7 +1456,7 @@ def test_an_image_folder_plays_its_pairs_one_per_capture(tmp_path):
 
     cones = bundled_data_dir() / "cones"
     left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
-    data, outside = tmp_path / "mine", tmp_path / "outside"
+    data, outside = tmp_path / "data", tmp_path / "outside"
     seq, rig = data / "seq", data / "rig"
     for d in (seq, rig / "left", rig / "right", outside, data / "empty"):
         d.mkdir(parents=True)
