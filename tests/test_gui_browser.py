@@ -196,6 +196,45 @@ def _gui_process(*args: str) -> subprocess.Popen:
     return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
+def test_a_page_closed_mid_message_prints_no_traceback():
+    """Closing the browser tab while the 3-D view streamed a frame printed about 40 lines of
+    wslink and aiohttp tracebacks in the terminal. They are filtered now; any other error of
+    those libraries still prints its name and trace."""
+    import logging
+
+    from stereovision.gui import SERVER_LOGGERS, quiet_closed_pages
+
+    flt = quiet_closed_pages()
+    try:
+        assert quiet_closed_pages() is flt  # once only
+        seen: list[str] = []
+
+        class Keep(logging.Handler):
+            def emit(self, record: logging.LogRecord) -> None:
+                seen.append(record.getMessage())
+
+        keep = Keep()
+        wslink, aiohttp = (logging.getLogger(n) for n in SERVER_LOGGERS)
+        for lg in (wslink, aiohttp):
+            lg.addHandler(keep)
+        try:
+            closed = ConnectionResetError("Cannot write to closing transport")
+            wslink.error("Exception raised")
+            wslink.error("ClientConnectionResetError('Cannot write to closing transport')")
+            wslink.error("Traceback ...\nClientConnectionResetError: Cannot write to closing")
+            aiohttp.error("Error handling request from 127.0.0.1", exc_info=closed)
+            wslink.error("Exception raised")
+            wslink.error("ValueError('bad')")
+            aiohttp.error("Error handling request from 127.0.0.1", exc_info=ValueError("x"))
+        finally:
+            for lg in (wslink, aiohttp):
+                lg.removeHandler(keep)
+        assert seen == ["ValueError('bad')", "Error handling request from 127.0.0.1"]
+    finally:
+        for n in SERVER_LOGGERS:
+            logging.getLogger(n).removeFilter(flt)
+
+
 def test_gui_port_0_announces_the_port_it_got():
     """``gui --port 0`` printed ``http://127.0.0.1:0/``: the address was printed before the
     server bound. It is now printed once the server listens, with the port the system chose."""

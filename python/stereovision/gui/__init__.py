@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import errno
+import logging
 import sys
 from collections.abc import Sequence
 from importlib import resources
@@ -106,6 +107,47 @@ def url_for(host: str, port: int) -> str:
     return f"http://[{host}]:{port}/" if ":" in host else f"http://{host}:{port}/"
 
 
+#: What the server's libraries log when a page is closed while a message to it is being sent.
+_CLOSED_PAGE = ("ClientConnectionResetError", "Cannot write to closing transport")
+
+
+class ClosedPageFilter(logging.Filter):
+    """Drops the server libraries' tracebacks of a page closed mid-message.
+
+    Closing the browser tab while the 3-D view streamed a frame printed about 40 lines of
+    tracebacks in the terminal (wslink's "Exception raised", its repr and trace, then
+    aiohttp's "Error handling request"), for nothing that went wrong. wslink's bare
+    "Exception raised" line is dropped for every exception: its next two lines name the
+    exception and its trace, and they stay for any other one.
+    """
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        exc = record.exc_info[1] if record.exc_info else None
+        if isinstance(exc, ConnectionResetError):
+            return False
+        msg = record.getMessage()
+        if msg == "Exception raised":
+            return False
+        return not any(s in msg for s in _CLOSED_PAGE)
+
+
+#: The loggers :class:`ClosedPageFilter` is put on by :func:`cmd_gui`.
+SERVER_LOGGERS = ("wslink.protocol", "aiohttp.server")
+
+
+def quiet_closed_pages() -> ClosedPageFilter:
+    """Put one :class:`ClosedPageFilter` on each of :data:`SERVER_LOGGERS` (again: no second
+    one) and return it."""
+    for name in SERVER_LOGGERS:
+        for f in logging.getLogger(name).filters:
+            if isinstance(f, ClosedPageFilter):
+                return f
+    flt = ClosedPageFilter()
+    for name in SERVER_LOGGERS:
+        logging.getLogger(name).addFilter(flt)
+    return flt
+
+
 def cmd_gui(args: argparse.Namespace) -> int:
     """``stereovision gui``: build the app and serve it until interrupted.
 
@@ -119,6 +161,7 @@ def cmd_gui(args: argparse.Namespace) -> int:
         program holds the port, the system's reason otherwise.
     """
     app = build_app(args)
+    quiet_closed_pages()
     bound = []
 
     def announce(**_: Any) -> None:
