@@ -659,3 +659,33 @@ def test_a_stream_stopped_before_its_first_frame_leaves_no_empty_bag(
     assert main(["stream", *argv, "--calib", str(videos["calib"])]) == 0
     with Reader(bag) as reader:
         assert {c.topic: c.msgcount for c in reader.connections}["/stereo/depth"] == 2
+
+
+def test_a_source_failing_mid_stream_keeps_the_summary(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A right frame of another shape in pair 4: the stream printed the error alone (exit 2),
+    the figures of the three pairs done lost. Now it ends there: the summary of those pairs,
+    ``ended`` "source failed" with the error, then the error line, exit 2."""
+    scene = data_dir / "middlebury2003" / "cones"
+    for side in ("left", "right"):
+        img = cv2.imread(str(scene / f"{side}.png"))
+        for n in range(5):
+            rows = 64 if side == "left" or n != 3 else 80
+            cv2.imwrite(str(tmp_path / f"{side}_{n:03d}.png"), img[100 : 100 + rows, 100:196])
+    argv = ["stream", "--left", str(tmp_path / "left_%03d.png"), "--no-display", "--no-check"]
+    argv += ["--right", str(tmp_path / "right_%03d.png"), "--max-disparity", "16"]
+    assert main(argv) == 2
+    cap = capsys.readouterr()
+    assert cap.out.splitlines()[-1].startswith("3 pairs in ")
+    assert " s (source failed): " in cap.out
+    err = cap.err.strip().splitlines()
+    assert err[-1].startswith("stereovision: error: right source ") and "96x80 in pair 4" in err[-1]
+    assert main([*argv, "--json"]) == 2
+    summary = _json_lines(capsys.readouterr().out)[-1]
+    assert summary["summary"] and summary["frames"] == 3
+    assert summary["ended"] == "source failed" and "96x80 in pair 4" in summary["error"]
+    cam = StereoCamera(str(tmp_path / "left_%03d.png"), str(tmp_path / "right_%03d.png"))
+    with cam:
+        rep = run_stream(cam, method="gabor", max_disparity=16, pipelined=False, check=False)
+    assert (rep.frames, rep.ended) == (3, "source failed") and "pair 4" in (rep.error or "")

@@ -142,8 +142,10 @@ class StreamReport:
     pipelined : bool
         Whether grab/rectify ran in the producer thread.
     ended : str
-        ``"frames"`` (the ``frames`` limit), ``"end of stream"``, ``"interrupted"`` (Ctrl-C)
-        or ``"terminated"`` (SIGTERM, under the CLI).
+        ``"frames"`` (the ``frames`` limit), ``"end of stream"``, ``"interrupted"`` (Ctrl-C),
+        ``"terminated"`` (SIGTERM, under the CLI) or ``"source failed"`` (a source failed
+        after the first pair: a frame that does not decode or of another shape; see
+        :attr:`error`).
     rectification : dict or None
         :func:`~stereovision.rectification_check.check_rectification` of the first pair, as a
         dict (None when ``check=False`` or no pair came).
@@ -160,6 +162,8 @@ class StreamReport:
         With a :class:`~stereovision.temporal.TemporalFilter`: ``frames_averaged`` (mean over
         the pairs of the frames in a pixel's mean), ``restarts`` (pairs on which the rig or
         scene moved) and ``noise_sigma`` (its last noise estimate, grey levels).
+    error : str or None
+        With ``ended == "source failed"``: the source's error (None otherwise).
     """
 
     frames: int
@@ -179,6 +183,7 @@ class StreamReport:
     grounds: list[dict[str, Any]] = field(default_factory=list, repr=False)
     temporal: dict[str, float] | None = None
     noise_sigma: float = math.nan
+    error: str | None = None
 
     def as_dict(self) -> dict[str, Any]:
         """The JSON summary object (``"summary": true``)."""
@@ -200,6 +205,7 @@ class StreamReport:
             "grounds": self.grounds,
             "temporal": self.temporal,
             "noise_sigma": round(self.noise_sigma, 3),
+            "error": self.error,
         }
 
 
@@ -644,7 +650,9 @@ def run_stream(
     Raises
     ------
     SourceError
-        If a source delivers no first frame.
+        If a source delivers no first frame, or fails on the first pair. A failure after it
+        (a frame that does not decode or of another shape) ends the stream instead: the pairs
+        done are reported, with ``ended`` ``"source failed"`` and the error in ``error``.
     ValueError
         If ``frames`` is not positive, or the calibration does not fit the frames.
     """
@@ -705,13 +713,23 @@ def run_stream(
     reports: list[dict[str, Any]] = []
     md = max_disparity
     ended = "end of stream"
+    error: str | None = None
     t_begin = time.perf_counter()
     t_window = t_begin
     t_last = t_begin
     try:
         while True:
             t_wait = time.perf_counter()
-            pair = next_pair()
+            try:
+                pair = next_pair()
+            except SourceError as exc:
+                # a source that fails after pairs were done (a frame that does not decode or of
+                # another shape): those pairs' figures (and a --bag of them) are the run's; it
+                # raised past them, and the CLI printed the error without the summary
+                if tally.n == 0:
+                    raise
+                ended, error = "source failed", str(exc)
+                break
             if pair is None:
                 break
             t_got = time.perf_counter()
@@ -798,6 +816,7 @@ def run_stream(
         checks=checks,
         grounds=grounds,
         noise_sigma=noise,
+        error=error,
         temporal=None
         if temporal is None
         else {
@@ -1029,6 +1048,12 @@ def cmd_stream(args: argparse.Namespace) -> int:
                 ),
                 file=out,
             )
+    if report.error is not None:
+        # the summary and the bag are out; the failure is said last, as the CLI's errors are
+        print(f"stereovision: error: {report.error.splitlines()[0]}", file=log)
+        from stereovision.cli import EXIT_ERROR
+
+        return EXIT_ERROR
     # the summary and the bag are out; the exit status still tells a script it was cut short
     return {"interrupted": 130, "terminated": 143}.get(report.ended, 0)
 
