@@ -275,6 +275,11 @@ def test_depth_warns_about_one_image_given_twice(data_dir: Path, tmp_path: Path)
             "--max-disparity: expected a whole number of pixels above 0, got 'abc'",
         ),
         (["stream", "--method", "sgbm"], "stereovision stream: error: argument --method"),
+        # named as the option, not as run_stream's parameter ("frames: expected ...")
+        (["stream", "--frames", "0"], "argument --frames: expected a whole number above 0"),
+        (["stream", "--check-every", "0"], "argument --check-every: expected a whole number"),
+        (["stream", "--serve", "70000"], "argument --serve: expected a port 0 to 65535"),
+        (["capture", "-o", "x", "--every", "0"], "argument --every: expected a whole number"),
     ],
 )
 def test_usage_errors_are_one_line(argv: list[str], says: str) -> None:

@@ -1646,8 +1646,13 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument(
         "--dictionary", default="auto", help="--charuco: ArUco dictionary (default: found)"
     )
+    from stereovision.cli import positive_count
+
     p.add_argument(
-        "--every", type=int, default=1, help="without a board: save every Nth pair (default 1)"
+        "--every",
+        type=positive_count,
+        default=1,
+        help="without a board: save every Nth pair (default 1)",
     )
     p.add_argument(
         "--temporal",

@@ -980,6 +980,32 @@ def positive_pixels(text: str) -> int:
     return value
 
 
+def positive_count(text: str) -> int:
+    """argparse type of a count (``--frames``, ``--every``, ``--check-every``): a whole number
+    above 0, refused in the option's name (the library's parameter name, ``frames:`` or
+    ``check_every:``, was what the CLI said)."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number above 0, got {text!r}")
+    return value
+
+
+def port_number(text: str) -> int:
+    """argparse type of ``--serve``: a TCP port, 0 (any free one) to 65535."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(
+            f"expected a port 0 to 65535 (0: any free one), got {text!r}"
+        )
+    return value
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse with its errors in one line, as the command's own (not the usage block)."""
 

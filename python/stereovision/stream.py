@@ -1060,7 +1060,8 @@ def cmd_stream(args: argparse.Namespace) -> int:
 
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision stream`` on the CLI's sub-parsers."""
-    from stereovision.cli import positive_pixels  # cli builds its parser with this
+    # cli builds its parser with these
+    from stereovision.cli import port_number, positive_count, positive_pixels
     from stereovision.depth import METHODS
 
     p = subparsers.add_parser(
@@ -1100,7 +1101,9 @@ def add_cli(subparsers: Any) -> None:
         choices=METHODS,
         help="matcher (default: gabor, the quickest; fast --no-fill: half its wrong pixels)",
     )
-    p.add_argument("--frames", type=int, help="stop after N pairs (default: until a source ends)")
+    p.add_argument(
+        "--frames", type=positive_count, help="stop after N pairs (default: until a source ends)"
+    )
     p.add_argument(
         "--refine", action="store_true", help="sub-pixel refinement per frame (2-3x the time)"
     )
@@ -1113,7 +1116,7 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument("--no-display", action="store_true", help="headless: do not serve the view")
     p.add_argument(
         "--serve",
-        type=int,
+        type=port_number,
         default=DEFAULT_PORT,
         metavar="PORT",
         help=f"view port (default {DEFAULT_PORT})",
@@ -1127,7 +1130,7 @@ def add_cli(subparsers: Any) -> None:
     )
     p.add_argument(
         "--check-every",
-        type=int,
+        type=positive_count,
         metavar="N",
         help="also check the rows of every N-th pair (a rig bumped while running)",
     )
@@ -1139,7 +1142,7 @@ def add_cli(subparsers: Any) -> None:
     )
     p.add_argument(
         "--ground-every",
-        type=int,
+        type=positive_count,
         metavar="N",
         help="fit the floor on every N-th pair and warn when the camera's height, pitch or roll "
         "moves (a mount that slipped); needs --calib",
