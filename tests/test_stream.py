@@ -691,3 +691,37 @@ def test_a_source_failing_mid_stream_keeps_the_summary(
     with cam:
         rep = run_stream(cam, method="gabor", max_disparity=16, pipelined=False, check=False)
     assert (rep.frames, rep.ended) == (3, "source failed") and "pair 4" in (rep.error or "")
+
+
+def test_stream_averages_frames_before_enlarging_them(data_dir: Path, tmp_path: Path) -> None:
+    """160x120 sources of a still noisy view (8 grey levels) asked for at 320x240: the filter
+    averaged the enlarged frames, whose interpolated noise (0.5 grey levels read) its motion
+    test took for motion: 5 restarts of 6 pairs, nothing averaged, and the noise hint read the
+    enlarged frame. Averaged as delivered, then enlarged: as at the sources' own size."""
+    from stereovision.temporal import TemporalFilter
+    from tests.test_exposure import noisy
+
+    rng = np.random.default_rng(0)
+    for side in ("left", "right"):
+        img = cv2.imread(str(data_dir / "middlebury2003" / "cones" / f"{side}.png"))
+        small = cv2.resize(img, (160, 120), interpolation=cv2.INTER_AREA)
+        for i in range(6):
+            cv2.imwrite(str(tmp_path / f"{side}_{i:02d}.png"), noisy(small, 8.0, rng))
+    src = (str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png"))
+    shapes: list[tuple[int, ...]] = []
+    with warnings.catch_warnings(record=True) as caught, StereoCamera(*src, size="320x240") as cam:
+        warnings.simplefilter("always")
+        rep = run_stream(
+            cam,
+            method="gabor",
+            max_disparity=16,
+            pipelined=False,
+            check=False,
+            temporal=TemporalFilter(max_frames=4),
+            on_result=lambda left, res: shapes.append(left.shape),
+        )
+    assert not [w for w in caught if "temporal averaging" in str(w.message)]
+    assert rep.temporal is not None and rep.temporal["restarts"] == 0
+    assert rep.temporal["frames_averaged"] > 2.9  # (1 + 2 + 3 + 4 + 4 + 4) / 6 = 3
+    assert 4.8 < rep.noise_sigma < 7.0 and 4.8 < rep.temporal["noise_sigma"] < 7.0
+    assert shapes == [(240, 320, 3)] * 6

@@ -79,7 +79,9 @@ __all__ = [
     "parse_size",
     "parse_source",
     "remove_stale_temps",
+    "resize_frame",
     "save_pair",
+    "temporal_average",
 ]
 
 PathLike = str | os.PathLike[str]
@@ -263,6 +265,10 @@ class StereoFrame:
         0-based pair counter of the camera.
     pos_left_ms, pos_right_ms : float
         The sources' own timestamps (``CAP_PROP_POS_MSEC``; a video file's media time).
+    delivered : tuple of numpy.ndarray or None
+        The two frames as the sources delivered them, when either was resized to the output
+        size (None when neither was): what a :class:`~stereovision.temporal.TemporalFilter`
+        averages, before the resize's interpolation spreads their noise.
     """
 
     left: np.ndarray
@@ -272,6 +278,7 @@ class StereoFrame:
     index: int
     pos_left_ms: float = math.nan
     pos_right_ms: float = math.nan
+    delivered: tuple[np.ndarray, np.ndarray] | None = None
 
     @property
     def skew_ms(self) -> float:
@@ -782,8 +789,7 @@ class StereoCamera(PairSource):
                 UserWarning,
                 stacklevel=3,
             )
-        interp = cv2.INTER_AREA if w > self.size[0] else cv2.INTER_LINEAR
-        return np.asarray(cv2.resize(frame, self.size, interpolation=interp))
+        return resize_frame(frame, self.size)
 
     def read(self) -> StereoFrame:
         """Grab both sources, then retrieve both; return the timestamped pair.
@@ -808,12 +814,16 @@ class StereoCamera(PairSource):
             t_r = time.monotonic()
         if not (ok_l and ok_r):
             raise self._ended({"left": ok_l, "right": ok_r})
-        frames = {}
+        frames, delivered = {}, {}
         for side in ("left", "right"):
             ok, img = caps[side].retrieve()
             if not ok or img is None:
                 raise self._fail(side, "could not decode a frame")
+            if img.ndim == 2:
+                img = cv2.cvtColor(img, cv2.COLOR_GRAY2BGR)
+            delivered[side] = img
             frames[side] = self._fit(side, img)
+        resized = any(frames[side] is not delivered[side] for side in frames)
         frame = StereoFrame(
             left=frames["left"],
             right=frames["right"],
@@ -822,6 +832,7 @@ class StereoCamera(PairSource):
             index=self.count,
             pos_left_ms=_media_ms(caps["left"]),
             pos_right_ms=_media_ms(caps["right"]),
+            delivered=(delivered["left"], delivered["right"]) if resized else None,
         )
         self.count += 1
         self.skews_ms.append(frame.skew_ms)
@@ -895,6 +906,38 @@ class StereoCamera(PairSource):
 
     def __enter__(self) -> StereoCamera:
         return self
+
+
+def resize_frame(frame: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """``frame`` at ``size`` (``(width, height)``) as the pair sources resize their frames:
+    ``INTER_AREA`` to shrink, ``INTER_LINEAR`` to enlarge; the frame itself at its own size."""
+    h, w = frame.shape[:2]
+    if (w, h) == tuple(size):
+        return frame
+    interp = cv2.INTER_AREA if w > size[0] else cv2.INTER_LINEAR
+    return np.asarray(cv2.resize(frame, tuple(size), interpolation=interp))
+
+
+def _averaged_before_resize(frame: StereoFrame) -> bool:
+    """Whether :func:`temporal_average` averages ``frame`` as delivered: it was resized, and
+    both sources delivered frames of one shape (the filter's means are of one shape)."""
+    d = frame.delivered
+    return d is not None and d[0].shape == d[1].shape
+
+
+def temporal_average(tf: Any, frame: StereoFrame) -> tuple[np.ndarray, np.ndarray]:
+    """``tf(left, right)`` (a :class:`~stereovision.temporal.TemporalFilter`) of a pair, on
+    the frames as delivered when the source resized them (:attr:`StereoFrame.delivered`), the
+    means then resized to the pair's size: a resize (an enlargement) spreads each pixel's noise
+    over its neighbours, which the filter's motion test took for motion (every pair of a still
+    rig restarted, nothing averaged)."""
+    if not _averaged_before_resize(frame):
+        left, right = tf(frame.left, frame.right)
+        return left, right
+    assert frame.delivered is not None
+    size = (frame.left.shape[1], frame.left.shape[0])
+    left, right = tf(*frame.delivered)
+    return resize_frame(left, size), resize_frame(right, size)
 
 
 # ---------------------------------------------------------------------------- CLI sources
@@ -1402,8 +1445,8 @@ def capture(
         averaged = None
         if tf is not None:
             if tf.frames == 0:
-                warn_resampled_for_temporal(camera, stacklevel=2)
-            left, right = tf(frame.left, frame.right)
+                warn_resampled_for_temporal(camera, stacklevel=2, frame=frame)
+            left, right = temporal_average(tf, frame)
             averaged = tf.mean_frames()
             # Every pixel's mean full but a few that something crossed (or noise beyond 3
             # sigmas started again).
@@ -1481,12 +1524,16 @@ def _reads_own_output(sources: Any, out: PathLike, ext: str = ".png") -> str | N
     return None
 
 
-def warn_resampled_for_temporal(camera: Any, stacklevel: int = 1) -> None:
+def warn_resampled_for_temporal(
+    camera: Any, stacklevel: int = 1, frame: StereoFrame | None = None
+) -> None:
     """Warn once when ``camera``'s frames reach a :class:`~stereovision.temporal.TemporalFilter`
-    already resampled: a bag's rectified topics, or frames enlarged to the size asked. Their
-    interpolation spreads each pixel's noise over its neighbours, which the filter's motion test
-    takes for motion (every pair of a still rig restarted: nothing averaged, and ``capture
-    --temporal`` saved no pair). Call it after the first pair is read (its size is known then).
+    already resampled: a bag's rectified topics, or frames enlarged to the size asked that
+    :func:`temporal_average` cannot average as delivered (the two sources deliver frames of
+    different sizes). Their interpolation spreads each pixel's noise over its neighbours, which
+    the filter's motion test takes for motion (every pair of a still rig restarted: nothing
+    averaged, and ``capture --temporal`` saved no pair). Call it after the first pair is read
+    (its size is known then).
 
     Parameters
     ----------
@@ -1494,6 +1541,9 @@ def warn_resampled_for_temporal(camera: Any, stacklevel: int = 1) -> None:
         The source, after its first :meth:`read`.
     stacklevel : int
         Of the warning, counted from the caller.
+    frame : StereoFrame, optional
+        That first pair: when :func:`temporal_average` averages it as delivered, an
+        enlargement is not said (None: it is).
     """
     topics = getattr(camera, "topics", None)
     why: tuple[str, str] | None = None
@@ -1503,6 +1553,8 @@ def warn_resampled_for_temporal(camera: Any, stacklevel: int = 1) -> None:
             "give the raw image topics (--left-topic, --right-topic)",
         )
     size = getattr(camera, "size", None)
+    if frame is not None and _averaged_before_resize(frame):
+        size = None  # averaged before the resize
     for side, (w, h) in sorted(getattr(camera, "delivered_size", {}).items()):
         if why is None and size is not None and size[0] > w:
             why = (

@@ -77,7 +77,7 @@ import cv2
 import numpy as np
 
 from stereovision._interrupt import HeldInterrupts
-from stereovision.capture import PairSource, SourceError, StereoFrame
+from stereovision.capture import PairSource, SourceError, StereoFrame, resize_frame
 
 __all__ = [
     "DEFAULT_FRAME_ID",
@@ -916,8 +916,7 @@ class BagCamera(PairSource):
                 UserWarning,
                 stacklevel=4,
             )
-        interp = cv2.INTER_AREA if w > self.size[0] else cv2.INTER_LINEAR
-        return np.asarray(cv2.resize(img, self.size, interpolation=interp))
+        return resize_frame(img, self.size)
 
     def read(self) -> StereoFrame:
         """The next pair, as a :class:`~stereovision.capture.StereoFrame`.
@@ -948,9 +947,11 @@ class BagCamera(PairSource):
                 raise ValueError(f"{self.topics[side]} at stamp {stamp} ns: {exc}") from None
         left, right = to_8bit(*imgs)
         start = self._reader.start_time
+        fitted = (self._fit("left", left, sl), self._fit("right", right, sr))
         frame = StereoFrame(
-            left=self._fit("left", left, sl),
-            right=self._fit("right", right, sr),
+            left=fitted[0],
+            right=fitted[1],
+            delivered=None if fitted[0] is left and fitted[1] is right else (left, right),
             t_left=sl / 1e9,
             t_right=sr / 1e9,
             index=self.count,
