@@ -769,3 +769,19 @@ def test_depth_takes_a_q_dat_apart_from_its_scene_sized_by_the_pair(
     cv2.imwrite(small[1], half)
     assert main(["depth", *small, *args]) == 2
     assert "calibration is for 900x750 images, got 450x375" in capsys.readouterr().err
+
+
+def test_ctrl_c_while_the_commands_load_is_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Ctrl-C in the first second of `stereovision stream ...`, while the parser imports the
+    commands' modules (0.2 s), printed a traceback of that import (measured: a SIGINT 0.7 s
+    after the start); it is one line and status 130, as during the command."""
+    from stereovision import cli
+
+    def interrupted() -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "build_parser", interrupted)
+    assert cli.main(["stream", "--left", "0", "--right", "1"]) == 130
+    assert capsys.readouterr().err == "stereovision: interrupted\n"
