@@ -725,3 +725,20 @@ def test_stream_averages_frames_before_enlarging_them(data_dir: Path, tmp_path: 
     assert rep.temporal["frames_averaged"] > 2.9  # (1 + 2 + 3 + 4 + 4 + 4) / 6 = 3
     assert 4.8 < rep.noise_sigma < 7.0 and 4.8 < rep.temporal["noise_sigma"] < 7.0
     assert shapes == [(240, 320, 3)] * 6
+
+
+@pytest.mark.parametrize("command", ["stream", "capture"])
+def test_size_help_says_what_another_shape_does(
+    command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stream --help` said "frames are resized if needed", but a source of another shape
+    keeps its own size (a resize would stretch it; tests/test_capture.py): said now, in both
+    commands."""
+    with pytest.raises(SystemExit) as info:
+        main([command, "--help"])
+    assert info.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert (
+        "--size SIZE requested size WIDTHxHEIGHT (frames of the same shape are resized if "
+        "needed; another shape keeps its own size, with a warning)"
+    ) in text

@@ -1682,7 +1682,8 @@ def add_cli(subparsers: Any) -> None:
     add_source_args(p)
     p.add_argument(
         "--size",
-        help="requested size WIDTHxHEIGHT (frames of the same shape are resized if needed)",
+        help="requested size WIDTHxHEIGHT (frames of the same shape are resized if needed; "
+        "another shape keeps its own size, with a warning)",
     )
     p.add_argument("--fps", type=float, help="requested frame rate")
     p.add_argument("-o", "--output", required=True, help="output directory")

@@ -1090,7 +1090,11 @@ def add_cli(subparsers: Any) -> None:
         help="a rig without a calibration: the homographies `stereovision rectify` found "
         "(disparity only)",
     )
-    p.add_argument("--size", help="requested size WIDTHxHEIGHT (frames are resized if needed)")
+    p.add_argument(
+        "--size",
+        help="requested size WIDTHxHEIGHT (frames of the same shape are resized if needed; "
+        "another shape keeps its own size, with a warning)",
+    )
     p.add_argument(
         "--max-disparity",
         type=positive_pixels,
