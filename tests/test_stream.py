@@ -9,6 +9,7 @@ import urllib.error
 import urllib.request
 import warnings
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
@@ -742,3 +743,29 @@ def test_size_help_says_what_another_shape_does(
         "--size SIZE requested size WIDTHxHEIGHT (frames of the same shape are resized if "
         "needed; another shape keeps its own size, with a warning)"
     ) in text
+
+
+def test_stream_asks_the_cameras_for_a_frame_rate(
+    videos: dict[str, Path], monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stream` had --size and --fourcc but no --fps (docs/robotics.md: "capture and stream ask
+    for a format ... before the size and rate"): webcams ran at their default rate. It is asked
+    now, as `capture --fps` asks it; a bag has none to ask."""
+    from stereovision import capture as capmod
+
+    asked: list[float | None] = []
+    real = capmod.StereoCamera
+
+    def camera(*args: Any, **kw: Any) -> StereoCamera:
+        asked.append(kw.get("fps"))
+        return real(*args, **kw)
+
+    monkeypatch.setattr(capmod, "StereoCamera", camera)
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--max-disparity", "16", "--no-display", "--no-check", "--frames", "1"]
+    assert main([*argv, "--fps", "15"]) == 0
+    assert asked == [15.0]
+    assert main(["stream", "--from-bag", "x", "--fps", "15", "--no-display"]) == 2
+    assert capsys.readouterr().err.strip().splitlines()[-1] == (
+        "stereovision: error: --fps: a bag is read as recorded, it has no frame rate to ask for"
+    )

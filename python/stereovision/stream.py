@@ -928,7 +928,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
         if not 2 <= args.temporal <= 255:
             raise ValueError(f"--temporal: expected 2-255 pairs to average, got {args.temporal}")
         temporal = TemporalFilter(max_frames=args.temporal)
-    cam = open_source(args)
+    cam = open_source(args, fps=args.fps)
     if hasattr(cam, "stamps_ns"):  # a recording: its results keep the frames' stamps
         if calib is None and homographies is None:
             try:
@@ -1094,6 +1094,12 @@ def add_cli(subparsers: Any) -> None:
         "--size",
         help="requested size WIDTHxHEIGHT (frames of the same shape are resized if needed; "
         "another shape keeps its own size, with a warning)",
+    )
+    p.add_argument(
+        "--fps",
+        type=float,
+        help="requested frame rate of the cameras (asked with the size and format; a file or "
+        "a bag is read as it is)",
     )
     p.add_argument(
         "--max-disparity",
