@@ -859,3 +859,35 @@ def test_temporal_averaging_of_rectified_topics_is_said(cones: Any, tmp_path: Pa
     with BagCamera(bag) as cam, warnings.catch_warnings():
         warnings.simplefilter("error")
         assert len(capture(cam, tmp_path / "raw_pairs", temporal=2).saved) == 3
+
+
+def test_cli_stream_keeps_its_summary_when_a_recorded_frame_does_not_decode(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """The right frame of pair 3 recorded as a depth image (32FC1): the stream stopped with the
+    error alone, the figures of the two pairs done lost. Now it ends there with their summary
+    ("source failed", the topic and stamp named) and exits 2, as for a video."""
+    from rosbags.rosbag2 import Reader, Writer
+
+    left, right = cones.left[100:196, 100:228], cones.right[100:196, 100:228]
+    stamps = [T0 + k * PERIOD_NS for k in range(4)]
+    good = write_bag(tmp_path / "good", [(s, left, s, right) for s in stamps])
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    with Reader(good) as r, Writer(tmp_path / "rig", version=9) as w:
+        conns: dict[str, Any] = {}
+        for conn, recorded, raw in r.messages():
+            msg = ts.deserialize_cdr(raw, conn.msgtype)
+            if conn.topic == RIGHT and recorded == stamps[2] + 2_000_000:
+                msg.encoding = "32FC1"
+            if conn.topic not in conns:
+                conns[conn.topic] = w.add_connection(conn.topic, conn.msgtype, typestore=ts)
+            w.write(conns[conn.topic], recorded, ts.serialize_cdr(msg, conn.msgtype))
+    code, out, err = run("stream", "--from-bag", str(tmp_path / "rig"), "--no-display",
+                         "--json", "--method", "gabor", "--max-disparity", "16",
+                         "--no-check")  # fmt: skip
+    assert code == 2
+    summary = json.loads(out.strip().splitlines()[-1])
+    assert summary["frames"] == 2 and summary["ended"] == "source failed"
+    said = f"{RIGHT} at stamp {stamps[2]} ns: image encoding '32FC1'"
+    assert summary["error"].startswith(said)
+    assert err.strip().splitlines()[-1].startswith(f"stereovision: error: {said}")

@@ -409,6 +409,13 @@ def _pairs(
             if getattr(exc, "ended_early", False):
                 warnings.warn(str(exc), UserWarning, stacklevel=2)
             return
+        except ValueError as exc:
+            # a recording's frame that does not decode (BagCamera names its topic and stamp):
+            # after the first pair, a failure of the source that ends the stream with its
+            # summary (run_stream), as a video frame that does not decode does
+            if camera.count == 0:
+                raise
+            raise SourceError(str(exc), end=False, frames=camera.count) from exc
         t1 = time.perf_counter()
         recorded = getattr(camera, "stamps_ns", None)
         if recorded:  # a recording (BagCamera): the stamp of the pair just read
