@@ -861,12 +861,9 @@ def test_temporal_averaging_of_rectified_topics_is_said(cones: Any, tmp_path: Pa
         assert len(capture(cam, tmp_path / "raw_pairs", temporal=2).saved) == 3
 
 
-def test_cli_stream_keeps_its_summary_when_a_recorded_frame_does_not_decode(
-    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
-) -> None:
-    """The right frame of pair 3 recorded as a depth image (32FC1): the stream stopped with the
-    error alone, the figures of the two pairs done lost. Now it ends there with their summary
-    ("source failed", the topic and stamp named) and exits 2, as for a video."""
+def _bag_with_a_bad_third_pair(cones: Any, tmp_path: Path) -> list[int]:
+    """``tmp_path / "rig"``: four 128x96 pairs, the right frame of the third recorded as a
+    depth image (32FC1); returns the pairs' stamps."""
     from rosbags.rosbag2 import Reader, Writer
 
     left, right = cones.left[100:196, 100:228], cones.right[100:196, 100:228]
@@ -882,6 +879,16 @@ def test_cli_stream_keeps_its_summary_when_a_recorded_frame_does_not_decode(
             if conn.topic not in conns:
                 conns[conn.topic] = w.add_connection(conn.topic, conn.msgtype, typestore=ts)
             w.write(conns[conn.topic], recorded, ts.serialize_cdr(msg, conn.msgtype))
+    return stamps
+
+
+def test_cli_stream_keeps_its_summary_when_a_recorded_frame_does_not_decode(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """The right frame of pair 3 recorded as a depth image (32FC1): the stream stopped with the
+    error alone, the figures of the two pairs done lost. Now it ends there with their summary
+    ("source failed", the topic and stamp named) and exits 2, as for a video."""
+    stamps = _bag_with_a_bad_third_pair(cones, tmp_path)
     code, out, err = run("stream", "--from-bag", str(tmp_path / "rig"), "--no-display",
                          "--json", "--method", "gabor", "--max-disparity", "16",
                          "--no-check")  # fmt: skip
@@ -891,3 +898,19 @@ def test_cli_stream_keeps_its_summary_when_a_recorded_frame_does_not_decode(
     said = f"{RIGHT} at stamp {stamps[2]} ns: image encoding '32FC1'"
     assert summary["error"].startswith(said)
     assert err.strip().splitlines()[-1].startswith(f"stereovision: error: {said}")
+
+
+def test_cli_capture_says_its_pairs_are_kept_when_a_recorded_frame_does_not_decode(
+    cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """The same bag captured: the error named the frame but not the two pairs saved before it,
+    as a video's failing frame has it said; now it says they are kept."""
+    stamps = _bag_with_a_bad_third_pair(cones, tmp_path)
+    out_dir = tmp_path / "pairs"
+    code, _out, err = run("capture", "--from-bag", str(tmp_path / "rig"), "-o", str(out_dir))
+    assert code == 2
+    said = err.strip().splitlines()[-1]
+    assert said.startswith(f"stereovision: error: {RIGHT} at stamp {stamps[2]} ns: image ")
+    assert said.endswith(f"; 2 pairs were saved in {out_dir} and are kept")
+    assert sorted(p.name for p in out_dir.iterdir()) == [
+        "left_0001.png", "left_0002.png", "right_0001.png", "right_0002.png"]  # fmt: skip

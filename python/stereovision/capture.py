@@ -1389,7 +1389,8 @@ def capture(
     ValueError
         For an invalid ``count``, ``every``, ``temporal`` or pattern, a ``directory`` that is a
         file (or below one), or one whose saved pairs an image-sequence source would read as
-        its next frames (``--left 'pairs/left_%04d.png' -o pairs``).
+        its next frames (``--left 'pairs/left_%04d.png' -o pairs``); a recorded frame that
+        does not decode (a bag), its message saying how many pairs were saved and are kept.
     PermissionError
         If ``directory`` cannot be written.
     """
@@ -1442,6 +1443,13 @@ def capture(
                 break
             kept = f"{len(saved)} of {count}" if count is not None else f"{len(saved)}"
             raise exc.with_message(f"{exc}; {kept} pairs were saved in {out} and are kept") from exc
+        except ValueError as exc:
+            # a recording's frame that does not decode (BagCamera names its topic and stamp):
+            # the pairs saved before it stay, and are said as for a video's failing frame
+            if not saved:
+                raise
+            kept = f"{len(saved)} of {count}" if count is not None else f"{len(saved)}"
+            raise ValueError(f"{exc}; {kept} pairs were saved in {out} and are kept") from exc
         averaged = None
         if tf is not None:
             if tf.frames == 0:
