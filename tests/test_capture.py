@@ -1276,3 +1276,26 @@ def test_temporal_capture_averages_frames_before_enlarging_them(
     one = rms(cv2.resize(cv2.imread(lpat % 0), big, interpolation=cv2.INTER_LINEAR))
     errors = [rms(cv2.imread(str(p))) for pair in result.saved for p in pair]
     assert all(e < 0.6 * one for e in errors), (errors, one)
+
+
+def test_the_same_source_on_both_sides_is_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--left l.avi --right ./l.avi` (a typo): every pair was one view twice, saved or matched
+    (every disparity 0) without a word; now one warning says so. `--left 0 --right 0` failed
+    on the second open with a hint about another program using the camera; now it says both
+    are camera 0, before opening either."""
+    from stereovision.cli import main
+
+    left, _right = _videos(tmp_path, 3, 3)
+    same = ["--left", str(left), "--right", str(tmp_path / "." / left.name)]
+    assert main(["capture", *same, "-o", str(tmp_path / "pairs"), "--count", "1"]) == 0
+    warned = [ln for ln in capsys.readouterr().err.splitlines() if "same source" in ln]
+    assert warned == [
+        f"stereovision: warning: --left and --right are the same source {str(left)!r}: every "
+        "pair is one view twice and every disparity comes out 0 (two cameras' views are needed)"
+    ]
+    assert main(["capture", "--left", "7", "--right", "7", "-o", str(tmp_path / "x")]) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: --left and --right are both camera 7: give the rig's two cameras\n"
+    )

@@ -968,6 +968,19 @@ def add_source_args(p: argparse.ArgumentParser) -> None:
     add_bag_args(p, "read the pairs from a recorded ROS 1 bag or ROS 2 bag folder instead")
 
 
+def _same_path(left: object, right: object) -> bool:
+    """Whether two file, pattern or URL sources name the same thing."""
+    if not (isinstance(left, (str, os.PathLike)) and isinstance(right, (str, os.PathLike))):
+        return False
+    a, b = os.fspath(left), os.fspath(right)
+    if a == b:
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # a pattern, a URL, a missing file: the text decides
+        return os.path.normpath(a) == os.path.normpath(b)
+
+
 def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
     """The :class:`StereoCamera` or :class:`~stereovision.rosbag.BagCamera` the options name.
 
@@ -1000,13 +1013,21 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
         raise ValueError("--left-topic, --right-topic and --max-skew-ms are for --from-bag")
     if args.left is None or args.right is None:
         raise ValueError("give the two cameras (--left and --right) or a recording (--from-bag)")
-    return StereoCamera(
-        parse_source(args.left),
-        parse_source(args.right),
-        size=size,
-        fps=fps,
-        fourcc=getattr(args, "fourcc", None),
-    )
+    left, right = parse_source(args.left), parse_source(args.right)
+    if isinstance(left, int) and left == right:
+        # the second open failed with a hint about another program using the camera
+        raise ValueError(f"--left and --right are both camera {left}: give the rig's two cameras")
+    cam = StereoCamera(left, right, size=size, fps=fps, fourcc=getattr(args, "fourcc", None))
+    if _same_path(left, right):
+        # a typo: every pair is one view twice, every disparity 0, and nothing said it (said
+        # once the source opens: a missing one is said as such)
+        warnings.warn(
+            f"--left and --right are the same source {str(left)!r}: every pair is one "
+            "view twice and every disparity comes out 0 (two cameras' views are needed)",
+            UserWarning,
+            stacklevel=2,
+        )
+    return cam
 
 
 # ---------------------------------------------------------------------------------- saving
