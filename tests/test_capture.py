@@ -1299,3 +1299,19 @@ def test_the_same_source_on_both_sides_is_said(
     assert capsys.readouterr().err == (
         "stereovision: error: --left and --right are both camera 7: give the rig's two cameras\n"
     )
+
+
+def test_every_with_a_board_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """`--chessboard 9x6 --every 10` ignored --every (the board's poses choose the pairs) and
+    said nothing; it is refused in one line, nothing opened or saved."""
+    from stereovision.cli import main
+
+    left, right = _videos(tmp_path, 2, 2)
+    src = ["capture", "--left", str(left), "--right", str(right), "-o", str(tmp_path / "p")]
+    for board in (["--chessboard", "9x6"], ["--charuco", "5x7", "--square", "4", "--marker", "3"]):
+        assert main([*src, *board, "--every", "10"]) == 2
+        assert capsys.readouterr().err == (
+            "stereovision: error: --every is for a capture without a board: --chessboard and "
+            "--charuco save a pair for each new pose of the board\n"
+        )
+    assert not (tmp_path / "p").exists()

@@ -1649,6 +1649,12 @@ def cmd_capture(args: argparse.Namespace) -> int:
         raise ValueError(f"--count: expected a positive number, got {args.count}")
     if args.temporal is not None and not 2 <= args.temporal <= 255:
         raise ValueError(f"--temporal: expected 2-255 frames a pair, got {args.temporal}")
+    if args.every != 1 and (pattern is not None or board is not None):
+        # ignored before: the board's pose chooses the pairs (collector), not their number
+        raise ValueError(
+            "--every is for a capture without a board: --chessboard and --charuco save a pair "
+            "for each new pose of the board"
+        )
     if args.temporal is not None and args.every != 1:
         raise ValueError(
             "--every and --temporal: give one (--temporal saves a pair per still view)"
