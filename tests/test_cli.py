@@ -785,3 +785,16 @@ def test_ctrl_c_while_the_commands_load_is_one_line(
     monkeypatch.setattr(cli, "build_parser", interrupted)
     assert cli.main(["stream", "--left", "0", "--right", "1"]) == 130
     assert capsys.readouterr().err == "stereovision: interrupted\n"
+
+
+def test_demo_checks_its_output_folder_first(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`demo -o FILE` matched and evaluated the scene (its figures printed) before it found
+    the file in the way; now one line first, nothing computed."""
+    (tmp_path / "notes").write_text("mine")
+    assert main(["demo", "-o", str(tmp_path / "notes")]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == f"stereovision: error: -o {tmp_path / 'notes'}: is a file, not a folder\n"
+    assert (tmp_path / "notes").read_text() == "mine"

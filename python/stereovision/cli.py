@@ -696,8 +696,10 @@ def cmd_demo(args: argparse.Namespace) -> int:
     """``stereovision demo``: the bundled Middlebury scene, end to end, with an evaluation line."""
     from stereovision.depth import depth_map
     from stereovision.evaluate import dense_metrics, depth_metrics, gt_depth
-    from stereovision.io import load_scene
+    from stereovision.io import check_output_folder, load_scene
 
+    # before the work: a file named as -o was said after the scene was matched and evaluated
+    check_output_folder(args.output, "-o")
     scene_dir = _demo_scene_dir()
     scene = load_scene(scene_dir)
     if scene.gt is None:
