@@ -280,6 +280,8 @@ def test_depth_warns_about_one_image_given_twice(data_dir: Path, tmp_path: Path)
         (["stream", "--check-every", "0"], "argument --check-every: expected a whole number"),
         (["stream", "--serve", "70000"], "argument --serve: expected a port 0 to 65535"),
         (["capture", "-o", "x", "--every", "0"], "argument --every: expected a whole number"),
+        (["capture", "-o", "x", "--fps", "0"], "argument --fps: expected a frame rate above 0"),
+        (["stream", "--fps", "nan"], "argument --fps: expected a frame rate above 0, got 'nan'"),
     ],
 )
 def test_usage_errors_are_one_line(argv: list[str], says: str) -> None:

@@ -1708,6 +1708,8 @@ def cmd_capture(args: argparse.Namespace) -> int:
 
 def add_cli(subparsers: Any) -> None:
     """Register the ``capture`` subcommand on an ``argparse`` subparsers object."""
+    from stereovision.cli import positive_count, positive_rate  # cli builds its parser with these
+
     p = subparsers.add_parser(
         "capture",
         help="capture stereo pairs from two cameras (or videos / image sequences / a ROS bag)",
@@ -1720,7 +1722,7 @@ def add_cli(subparsers: Any) -> None:
         help="requested size WIDTHxHEIGHT (frames of the same shape are resized if needed; "
         "another shape keeps its own size, with a warning)",
     )
-    p.add_argument("--fps", type=float, help="requested frame rate")
+    p.add_argument("--fps", type=positive_rate, help="requested frame rate")
     p.add_argument("-o", "--output", required=True, help="output directory")
     p.add_argument("--count", type=int, help="pairs to save (default: until a source ends)")
     p.add_argument("--chessboard", metavar="COLSxROWS", help="auto-capture distinct board poses")
@@ -1734,8 +1736,6 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument(
         "--dictionary", default="auto", help="--charuco: ArUco dictionary (default: found)"
     )
-    from stereovision.cli import positive_count
-
     p.add_argument(
         "--every",
         type=positive_count,

@@ -995,6 +995,18 @@ def positive_count(text: str) -> int:
     return value
 
 
+def positive_rate(text: str) -> float:
+    """argparse type of ``--fps``: a finite number above 0, refused in the option's name (it
+    was the library's ``fps: expected a positive number``, after the parsing)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = 0.0
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"expected a frame rate above 0, got {text!r}")
+    return value
+
+
 def port_number(text: str) -> int:
     """argparse type of ``--serve``: a TCP port, 0 (any free one) to 65535."""
     try:

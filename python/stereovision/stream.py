@@ -1070,7 +1070,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision stream`` on the CLI's sub-parsers."""
     # cli builds its parser with these
-    from stereovision.cli import port_number, positive_count, positive_pixels
+    from stereovision.cli import port_number, positive_count, positive_pixels, positive_rate
     from stereovision.depth import METHODS
 
     p = subparsers.add_parser(
@@ -1104,7 +1104,7 @@ def add_cli(subparsers: Any) -> None:
     )
     p.add_argument(
         "--fps",
-        type=float,
+        type=positive_rate,
         help="requested frame rate of the cameras (asked with the size and format; a file or "
         "a bag is read as it is)",
     )
