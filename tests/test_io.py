@@ -603,3 +603,27 @@ def test_a_q_dat_file_is_a_calibration_file(data_dir: Path, tmp_path: Path) -> N
         ValueError, match=r"rig_q\.txt does not give the image size and there is no"
     ):
         Calibration.from_file(alone)
+
+
+def test_keep_previous_never_replaces_an_earlier_copy(tmp_path):
+    """``calibrate -o rig.yaml`` run three times (a good rig, then two worse ones): the third
+    run's copy replaced ``rig.previous.yaml``, the good rig, so no file held it any more. An
+    earlier copy is kept now: the next one goes to ``rig.previous.2.yaml``, and a file already
+    kept byte for byte is not copied twice."""
+    from stereovision.io import keep_previous
+
+    rig = tmp_path / "rig.yaml"
+    assert keep_previous(rig) is None  # nothing to keep
+    rig.write_bytes(b"good")
+    assert keep_previous(rig) == tmp_path / "rig.previous.yaml"
+    rig.write_bytes(b"worse")
+    assert keep_previous(rig) == tmp_path / "rig.previous.2.yaml"
+    assert (tmp_path / "rig.previous.yaml").read_bytes() == b"good"
+    assert (tmp_path / "rig.previous.2.yaml").read_bytes() == b"worse"
+    # the same bytes again (a run that changed nothing): no third copy
+    assert keep_previous(rig) == tmp_path / "rig.previous.2.yaml"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "rig.previous.2.yaml",
+        "rig.previous.yaml",
+        "rig.yaml",
+    ]

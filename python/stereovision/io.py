@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 import os
 import re
-import shutil
 import tempfile
 import threading
 from collections.abc import Iterator
@@ -177,7 +176,10 @@ def keep_previous(path: PathLike) -> Path | None:
     A calibration written again under the same name (``calibrate -o rig.yaml`` run twice,
     ``check --fix rig2.yaml``) replaced the earlier one without a word; its copy is kept, so a
     worse calibration can be undone. It is a copy, not a rename: should the new file fail to be
-    written, the earlier one is still in place. An earlier ``.previous`` copy is replaced.
+    written, the earlier one is still in place. An earlier copy is never replaced (a third run
+    with worse pairs would otherwise lose the good rig of the first): when ``NAME.previous.EXT``
+    holds other bytes, the copy is ``NAME.previous.2.EXT`` (``.3``, ...: the first free name);
+    a file already kept byte for byte is not copied again, its copy is returned.
 
     Parameters
     ----------
@@ -192,9 +194,17 @@ def keep_previous(path: PathLike) -> Path | None:
     p = Path(path)
     if not p.is_file():
         return None
-    kept = p.with_name(f"{p.stem}.previous{p.suffix}")
-    with p.open("rb") as src, atomic_write(kept) as dst:
-        shutil.copyfileobj(src, dst)
+    data = p.read_bytes()  # a calibration or camera_info file: small
+    n = 1
+    while True:
+        kept = p.with_name(f"{p.stem}.previous{'' if n == 1 else f'.{n}'}{p.suffix}")
+        if not kept.exists():
+            break
+        if kept.is_file() and kept.read_bytes() == data:
+            return kept  # already kept: nothing to copy
+        n += 1
+    with atomic_write(kept) as dst:
+        dst.write(data)
     return kept
 
 
