@@ -275,3 +275,26 @@ def test_int_in_range_names_the_parameter_of_a_huge_int(value: int, shown: str) 
     with pytest.raises(ValueError) as info:
         int_in_range(value, "nms_half", 1, 2**31 - 1)
     assert str(info.value) == f"nms_half: expected an integer from 1 to 2147483647, got {shown}"
+
+
+def test_a_float_range_error_shows_the_values_that_are_outside() -> None:
+    """A grey level of 1.0000001 (one float32 step above 1) was refused as 'must lie in [0, 1],
+    got range [0, 1] (divide 8-bit data by 255)': the range rounded into [0, 1] and the advice
+    for another mistake. The range is shown to float32 precision and the advice fits it, in
+    as_gray_float and check_unit_range (the matchers' check) alike."""
+    from stereovision._validate import check_unit_range
+
+    above = np.float32([[0.0, np.nextafter(np.float32(1), np.float32(2))]])
+    cases = [
+        (above, r"got range \[0, 1\.00000012\] \(clip an overshoot of resampling"),
+        (np.float32([[-0.2, 1.2]]), r"got range \[-0\.2\d*, 1\.2\d*\] \(clip an overshoot"),
+        (np.float32([[0.0, 255.0]]), r"got range \[0, 255\] \(divide 8-bit data by 255"),
+        (np.float32([[0.0, 4095.0]]), r"got range \[0, 4095\] \(divide 16-bit data by 65535"),
+    ]
+    for img, message in cases:
+        with pytest.raises(ValueError, match=r"left: float image values must lie in \[0, 1\], "):
+            as_gray_float(img)
+        with pytest.raises(ValueError, match=message):
+            as_gray_float(img)
+        with pytest.raises(ValueError, match=message):
+            check_unit_range(img, "left")

@@ -139,6 +139,27 @@ def _warn_low_uint16(arr: np.ndarray, name: str) -> None:
         )
 
 
+def _unit_range_error(lo: float, hi: float, name: str) -> str | None:
+    """The error of a float image whose finite values span ``[lo, hi]``, or None when that lies
+    in ``[0, 1]``: one message for :func:`as_gray_float` and :func:`check_unit_range`. The range
+    is given to float32 precision (with ``:g``, ``1.0000001`` was shown as ``1``: "must lie in
+    [0, 1], got range [0, 1]"), and the advice fits the values: 8-bit data is divided by 255, an
+    overshoot of resampling (a bicubic remap reaches about -0.2 and 1.2) is clipped."""
+    if lo >= 0.0 and hi <= 1.0:
+        return None
+    if lo >= -0.5 and hi <= 1.5:
+        advice = "clip an overshoot of resampling with numpy.clip(img, 0, 1)"
+    elif lo >= 0.0 and hi <= 255.0:
+        advice = "divide 8-bit data by 255, or pass the uint8 array itself"
+    elif lo >= 0.0 and hi <= 65535.0:
+        advice = "divide 16-bit data by 65535, or pass the uint16 array itself"
+    else:
+        advice = "scale both images of the pair to [0, 1] alike"
+    return (
+        f"{name}: float image values must lie in [0, 1], got range [{lo:.9g}, {hi:.9g}] ({advice})"
+    )
+
+
 def _to_unit_float(arr: np.ndarray, name: str, warn: bool = True) -> npt.NDArray[np.float32]:
     """Scale a validated image array to float32 in [0, 1] (channels untouched); ``warn=False``
     for an image whose low-values warning its caller has given already."""
@@ -153,14 +174,11 @@ def _to_unit_float(arr: np.ndarray, name: str, warn: bool = True) -> npt.NDArray
             f"{name}: float image contains {n_bad} NaN/inf value(s); expected finite grey levels "
             "in [0, 1]"
         )
-    lo, hi = float(arr.min()), float(arr.max())
-    if lo < 0.0 or hi > 1.0:
-        # Rescaling by the maximum would give the two images of a pair different scales, so a
-        # float image outside [0, 1] is an error rather than a guess.
-        raise ValueError(
-            f"{name}: float image values must lie in [0, 1], got range [{lo:g}, {hi:g}] "
-            "(divide 8-bit data by 255, or pass the uint8 array itself)"
-        )
+    # Rescaling by the maximum would give the two images of a pair different scales, so a
+    # float image outside [0, 1] is an error rather than a guess.
+    err = _unit_range_error(float(arr.min()), float(arr.max()), name)
+    if err is not None:
+        raise ValueError(err)
     return arr.astype(np.float32)
 
 
@@ -359,11 +377,9 @@ def check_unit_range(img: npt.NDArray[np.float32], name: str) -> None:
     if not (math.isfinite(lo) and math.isfinite(hi)):
         # NaN or inf: the kernel names them (with their count)
         return
-    if lo < 0.0 or hi > 1.0:
-        raise ValueError(
-            f"{name}: float image values must lie in [0, 1], got range [{lo:g}, {hi:g}] "
-            "(divide 8-bit data by 255)"
-        )
+    err = _unit_range_error(lo, hi, name)
+    if err is not None:
+        raise ValueError(err)
 
 
 def u8_pair(left: object, right: object) -> tuple[np.ndarray, np.ndarray] | None:
