@@ -278,15 +278,15 @@ def test_int_in_range_names_the_parameter_of_a_huge_int(value: int, shown: str) 
 
 
 def test_a_float_range_error_shows_the_values_that_are_outside() -> None:
-    """A grey level of 1.0000001 (one float32 step above 1) was refused as 'must lie in [0, 1],
-    got range [0, 1] (divide 8-bit data by 255)': the range rounded into [0, 1] and the advice
+    """A grey level of 1.000002 was refused as 'must lie in [0, 1], got range [0, 1] (divide
+    8-bit data by 255)': the range rounded into [0, 1] and the advice
     for another mistake. The range is shown to float32 precision and the advice fits it, in
     as_gray_float and check_unit_range (the matchers' check) alike."""
     from stereovision._validate import check_unit_range
 
-    above = np.float32([[0.0, np.nextafter(np.float32(1), np.float32(2))]])
+    above = np.float32([[0.0, 1.000002]])  # past the float rounding read as 1
     cases = [
-        (above, r"got range \[0, 1\.00000012\] \(clip an overshoot of resampling"),
+        (above, r"got range \[0, 1\.00000203\] \(clip an overshoot of resampling"),
         (np.float32([[-0.2, 1.2]]), r"got range \[-0\.2\d*, 1\.2\d*\] \(clip an overshoot"),
         (np.float32([[0.0, 255.0]]), r"got range \[0, 255\] \(divide 8-bit data by 255"),
         (np.float32([[0.0, 4095.0]]), r"got range \[0, 4095\] \(divide 16-bit data by 65535"),
@@ -298,3 +298,24 @@ def test_a_float_range_error_shows_the_values_that_are_outside() -> None:
             as_gray_float(img)
         with pytest.raises(ValueError, match=message):
             check_unit_range(img, "left")
+
+
+def test_float_rounding_just_outside_0_1_is_read_not_refused() -> None:
+    """A float image one float32 step above 1 or below 0 (1.0000001, -6e-8: the rounding of a
+    luma sum or a blend of a [0, 1] image) was refused by as_gray_float and by the matchers'
+    check_unit_range as if it had the wrong scale. Within UNIT_RANGE_TOL it is read now,
+    as_gray_float clipping it to the documented range; past it, refused as before."""
+    from stereovision._validate import UNIT_RANGE_TOL, check_unit_range
+    from stereovision.matching.gabor import gabor_disparity
+
+    one_up = np.nextafter(np.float32(1), np.float32(2))
+    img = np.tile(np.float32([[0.25, one_up, -6e-8, 0.5]]), (24, 8))
+    out = as_gray_float(img)
+    assert out.min() == 0.0 and out.max() == 1.0
+    np.testing.assert_array_equal(out, np.clip(img, 0, 1))
+    check_unit_range(img, "left")  # no error
+    assert gabor_disparity(img, img, max_disparity=4).disparity.shape == img.shape
+    with pytest.raises(ValueError, match="must lie in"):
+        as_gray_float(np.float32([[0.0, 1.0 + 3 * UNIT_RANGE_TOL]]))
+    with pytest.raises(ValueError, match="must lie in"):
+        check_unit_range(np.float32([[-3 * UNIT_RANGE_TOL, 1.0]]), "left")

@@ -21,6 +21,7 @@ from stereovision import _core
 
 __all__ = [
     "LUMA_WEIGHTS_BGR",
+    "UNIT_RANGE_TOL",
     "as_bgr_uint8",
     "as_gray_float",
     "as_gray_uint8",
@@ -139,13 +140,20 @@ def _warn_low_uint16(arr: np.ndarray, name: str) -> None:
         )
 
 
+#: How far a float grey level may lie outside ``[0, 1]`` and still be read (clipped by
+#: :func:`as_gray_float`): float rounding of an image's own arithmetic (a luma sum, a blend), some
+#: float32 steps of 1.19e-7, is no mistake of scale to refuse.
+UNIT_RANGE_TOL = 1e-6
+
+
 def _unit_range_error(lo: float, hi: float, name: str) -> str | None:
     """The error of a float image whose finite values span ``[lo, hi]``, or None when that lies
-    in ``[0, 1]``: one message for :func:`as_gray_float` and :func:`check_unit_range`. The range
-    is given to float32 precision (with ``:g``, ``1.0000001`` was shown as ``1``: "must lie in
-    [0, 1], got range [0, 1]"), and the advice fits the values: 8-bit data is divided by 255, an
-    overshoot of resampling (a bicubic remap reaches about -0.2 and 1.2) is clipped."""
-    if lo >= 0.0 and hi <= 1.0:
+    in ``[0, 1]`` (within :data:`UNIT_RANGE_TOL`): one message for :func:`as_gray_float` and
+    :func:`check_unit_range`. The range is given to float32 precision (with ``:g``, ``1.000002``
+    was shown as ``1``: "must lie in [0, 1], got range [0, 1]"), and the advice fits the values:
+    8-bit data is divided by 255, an overshoot of resampling (a bicubic remap reaches about -0.2
+    and 1.2) is clipped."""
+    if lo >= -UNIT_RANGE_TOL and hi <= 1.0 + UNIT_RANGE_TOL:
         return None
     if lo >= -0.5 and hi <= 1.5:
         advice = "clip an overshoot of resampling with numpy.clip(img, 0, 1)"
@@ -176,9 +184,12 @@ def _to_unit_float(arr: np.ndarray, name: str, warn: bool = True) -> npt.NDArray
         )
     # Rescaling by the maximum would give the two images of a pair different scales, so a
     # float image outside [0, 1] is an error rather than a guess.
-    err = _unit_range_error(float(arr.min()), float(arr.max()), name)
+    lo, hi = float(arr.min()), float(arr.max())
+    err = _unit_range_error(lo, hi, name)
     if err is not None:
         raise ValueError(err)
+    if lo < 0.0 or hi > 1.0:  # float rounding: the documented range, exactly
+        return np.clip(arr.astype(np.float32), 0.0, 1.0)
     return arr.astype(np.float32)
 
 
@@ -187,7 +198,8 @@ def as_gray_float(img: object, name: str = "left", *, warn: bool = True) -> npt.
 
     Scaling: ``uint8`` is divided by 255, ``uint16`` by 65535. Floating point images must already
     be finite and lie in ``[0, 1]`` (they are not rescaled: rescaling by the maximum would put the
-    two images of a pair on different scales). Colour images (BGR or BGRA, OpenCV order) are
+    two images of a pair on different scales); an excursion of float rounding, up to
+    :data:`UNIT_RANGE_TOL`, is clipped. Colour images (BGR or BGRA, OpenCV order) are
     converted with the BT.601 luma weights :data:`LUMA_WEIGHTS_BGR` in floating point; alpha is
     ignored.
 
@@ -362,8 +374,8 @@ def check_unit_range(img: npt.NDArray[np.float32], name: str) -> None:
     Raises
     ------
     ValueError
-        If a finite value lies outside ``[0, 1]`` (NaN and inf are left to the kernel's own
-        message).
+        If a finite value lies outside ``[0, 1]`` by more than :data:`UNIT_RANGE_TOL` (float
+        rounding; NaN and inf are left to the kernel's own message).
 
     Examples
     --------
