@@ -286,8 +286,9 @@ def test_a_float_range_error_shows_the_values_that_are_outside() -> None:
 
     above = np.float32([[0.0, 1.000002]])  # past the float rounding read as 1
     cases = [
-        (above, r"got range \[0, 1\.00000203\] \(clip an overshoot of resampling"),
-        (np.float32([[-0.2, 1.2]]), r"got range \[-0\.2\d*, 1\.2\d*\] \(clip an overshoot"),
+        (above, r"got range \[0, 1\.000002\] \(clip an overshoot of resampling"),
+        (np.float32([[-0.2, 1.2]]), r"got range \[-0\.2, 1\.2\] \(clip an overshoot"),
+        (np.float32([[1e30, 0.00018996]]), r"got range \[0\.00018996, 1e\+30\] \(scale both"),
         (np.float32([[0.0, 255.0]]), r"got range \[0, 255\] \(divide 8-bit data by 255"),
         (np.float32([[0.0, 4095.0]]), r"got range \[0, 4095\] \(divide 16-bit data by 65535"),
     ]

@@ -146,13 +146,25 @@ def _warn_low_uint16(arr: np.ndarray, name: str) -> None:
 UNIT_RANGE_TOL = 1e-6
 
 
+def _grey_level(v: float) -> str:
+    """``v`` in its shortest form that reads back as ``v``: ``:g`` (``255``, ``1e+300``), else
+    the float32's shortest (``1.000002``, ``1e+30``: a float32 image's values), else 9 figures."""
+    short = f"{v:g}"
+    if float(short) == v:
+        return short
+    f32 = np.float32(v)
+    if np.isfinite(f32) and float(f32) == v:
+        return str(f32)
+    return f"{v:.9g}"
+
+
 def _unit_range_error(lo: float, hi: float, name: str) -> str | None:
     """The error of a float image whose finite values span ``[lo, hi]``, or None when that lies
     in ``[0, 1]`` (within :data:`UNIT_RANGE_TOL`): one message for :func:`as_gray_float` and
-    :func:`check_unit_range`. The range is given to float32 precision (with ``:g``, ``1.000002``
-    was shown as ``1``: "must lie in [0, 1], got range [0, 1]"), and the advice fits the values:
-    8-bit data is divided by 255, an overshoot of resampling (a bicubic remap reaches about -0.2
-    and 1.2) is clipped."""
+    :func:`check_unit_range`. The range's figures read back as the values (with ``:g``,
+    ``1.000002`` was shown as ``1``: "must lie in [0, 1], got range [0, 1]"), and the advice
+    fits them: 8-bit data is divided by 255, an overshoot of resampling (a bicubic remap reaches
+    about -0.2 and 1.2) is clipped."""
     if lo >= -UNIT_RANGE_TOL and hi <= 1.0 + UNIT_RANGE_TOL:
         return None
     if lo >= -0.5 and hi <= 1.5:
@@ -163,9 +175,8 @@ def _unit_range_error(lo: float, hi: float, name: str) -> str | None:
         advice = "divide 16-bit data by 65535, or pass the uint16 array itself"
     else:
         advice = "scale both images of the pair to [0, 1] alike"
-    return (
-        f"{name}: float image values must lie in [0, 1], got range [{lo:.9g}, {hi:.9g}] ({advice})"
-    )
+    got = f"[{_grey_level(lo)}, {_grey_level(hi)}]"
+    return f"{name}: float image values must lie in [0, 1], got range {got} ({advice})"
 
 
 def _to_unit_float(arr: np.ndarray, name: str, warn: bool = True) -> npt.NDArray[np.float32]:
