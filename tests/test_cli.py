@@ -343,9 +343,16 @@ def test_info_on_paper_says_the_baseline_is_in_metres(capsys: pytest.CaptureFixt
     out, err = capsys.readouterr()
     assert err.splitlines() == [
         "stereovision: warning: --baseline 120: 120 m is longer than a robot's rig (5 m); "
-        "--baseline is in metres (120 mm is --baseline 0.12)"
+        "--baseline is in metres (120 mm is --baseline 0.12, 120 cm is --baseline 1.2)"
     ]
     assert "baseline 120.00 m (120 m)" in out
+    # 12 may be mm, cm or inches: each is named, not the first unit alone (12 mm)
+    assert main(["info", "--size", "1280x720", "--hfov", "90", "--baseline", "12"]) == 0
+    assert capsys.readouterr().err.splitlines() == [
+        "stereovision: warning: --baseline 12: 12 m is longer than a robot's rig (5 m); "
+        "--baseline is in metres (12 mm is --baseline 0.012, 12 cm is --baseline 0.12, "
+        "12 in is --baseline 0.3048)"
+    ]
 
 
 def test_version_and_python_m() -> None:

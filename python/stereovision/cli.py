@@ -623,14 +623,14 @@ def _paper_baseline_words(text: str, baseline: float) -> str:
     if found is None:
         return text
     lo, hi = PLAUSIBLE_BASELINE_M
-    other = next(
-        (u for u, k in UNIT_TO_METRES.items() if u != "m" and lo <= baseline * k <= hi), None
-    )
-    hint = (
-        f" ({baseline:g} {other} is --baseline {baseline * UNIT_TO_METRES[other]:g})"
-        if other
-        else ""
-    )
+    # every unit that makes it a plausible rig: 12 may be mm, cm or in (the first alone, mm,
+    # was named: "12 mm is --baseline 0.012" for what is most likely a 12 cm rig)
+    others = [
+        f"{baseline:g} {u} is --baseline {baseline * k:g}"
+        for u, k in UNIT_TO_METRES.items()
+        if u != "m" and lo <= baseline * k <= hi
+    ]
+    hint = f" ({', '.join(others)})" if others else ""
     why = found.group(1)
     return f"--baseline {baseline:g}: {baseline:g} m is {why}; --baseline is in metres{hint}"
 
