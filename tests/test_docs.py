@@ -268,6 +268,7 @@ def test_commands_in_code_blocks_parse() -> None:
 
     parser = build_parser()
     rejected = []
+    checked = 0
     for page in PAGES:
         for block in re.findall(r"```[a-z]*\n(.*?)```", page.read_text(), re.S):
             for line in block.replace("\\\n", " ").splitlines():
@@ -278,11 +279,15 @@ def test_commands_in_code_blocks_parse() -> None:
                 if "[" in command or "|" in command:
                     continue
                 words = ["64" if re.fullmatch(r"[A-Z]", w) else w for w in shlex.split(command)]
+                checked += 1
                 try:
                     parser.parse_args(words)
                 except SystemExit:
                     rejected.append(f"{page.name}: stereovision {command}")
     assert not rejected, f"commands the parser refuses: {rejected}"
+    # 36 lines on 2026-12-04: a code-block or prompt format the pattern no longer reads (a
+    # "$ stereovision" prompt, ```shell-session fences) left nothing checked, and the test passed
+    assert checked >= 30, f"only {checked} command lines found in the code blocks"
 
 
 def test_unit_options_list_the_units_accepted() -> None:
