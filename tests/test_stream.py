@@ -769,3 +769,36 @@ def test_stream_asks_the_cameras_for_a_frame_rate(
     assert capsys.readouterr().err.strip().splitlines()[-1] == (
         "stereovision: error: --fps: a bag is read as recorded, it has no frame rate to ask for"
     )
+
+
+def test_the_noise_hint_reads_the_frames_matched_when_the_source_shrinks_them(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """320x240 sources with noise 8 asked for at 160x120: the hint read the frames as delivered
+    (6.0 grey levels) and warned that the depth maps suffered, but the halved frames matched
+    read 4.2 (INTER_AREA averages the noise): no hint, as before StereoFrame.delivered. Frames
+    the source enlarges are still read as delivered (their spread noise reads low)."""
+    from tests.test_exposure import noisy
+
+    rng = np.random.default_rng(0)
+    scene = data_dir / "middlebury2003" / "cones"
+    for side in ("left", "right"):
+        img = cv2.imread(str(scene / f"{side}.png"))
+        for size, name in (((320, 240), "big"), ((160, 120), "small")):
+            small = cv2.resize(img, size, interpolation=cv2.INTER_AREA)
+            for i in range(2):
+                cv2.imwrite(str(tmp_path / f"{name}_{side}_{i:02d}.png"), noisy(small, 8.0, rng))
+
+    def stream(name: str, size: str) -> tuple[float, list[str]]:
+        argv = ["stream", "--left", str(tmp_path / f"{name}_left_%02d.png"), "--right"]
+        argv += [str(tmp_path / f"{name}_right_%02d.png"), "--size", size, "--json"]
+        argv += ["--max-disparity", "16", "--no-display", "--no-check"]
+        assert main(argv) == 0
+        cap = capsys.readouterr()
+        hints = [ln for ln in cap.err.splitlines() if "the cameras are noisy" in ln]
+        return _json_lines(cap.out)[-1]["noise_sigma"], hints
+
+    sigma, hints = stream("big", "160x120")
+    assert 3.5 < sigma < 4.5 and hints == []
+    sigma, hints = stream("small", "320x240")  # enlarged: read as delivered
+    assert sigma > 4.5 and len(hints) == 1

@@ -43,6 +43,7 @@ from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import (
     SourceError,
     StereoCamera,
+    StereoFrame,
     add_source_args,
     open_source,
     temporal_average,
@@ -457,10 +458,21 @@ def _pairs(
             temporal_s=t2 - t1,
             averaged=averaged,
             stamp_ns=stamp_ns,
-            # as delivered: a resize (enlargement) hides most of the noise (0.5 of 6.4 grey)
-            raw_left=(fr.left if fr.delivered is None else fr.delivered[0]) if n == 0 else None,
+            raw_left=_noise_frame(fr) if n == 0 else None,
         )
         n += 1
+
+
+def _noise_frame(fr: StereoFrame) -> np.ndarray:
+    """The left frame whose noise the hint measures: as delivered when the source enlarged it
+    (the enlargement spreads the noise, which then reads 0.5 of 6.4 grey levels), the frame
+    matched otherwise (a shrink averages the noise away: cones at 320x240, noise 8, halved
+    read 4.2 grey levels, and the hint on the delivered frames' 6.0 warned that the depth maps
+    of the halved ones suffered)."""
+    d = fr.delivered
+    if d is not None and d[0].shape[1] < fr.left.shape[1]:
+        return d[0]
+    return fr.left
 
 
 class _Producer(threading.Thread):
