@@ -1117,8 +1117,8 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument(
         "--fps",
         type=positive_rate,
-        help="requested frame rate of the cameras (asked with the size and format; a file or "
-        "a bag is read as it is)",
+        help="requested frame rate of the cameras (asked with the size and format; a file is "
+        "read as it is; refused with --from-bag, a bag has no rate to ask)",
     )
     p.add_argument(
         "--max-disparity",
