@@ -1315,3 +1315,32 @@ def test_every_with_a_board_is_refused(tmp_path: Path, capsys: pytest.CaptureFix
             "--charuco save a pair for each new pose of the board\n"
         )
     assert not (tmp_path / "p").exists()
+
+
+def test_temporal_average_of_shrunk_frames_runs_at_the_size_asked(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """size half the sources': 319faa6 averaged every resized pair as delivered, so a 1080p
+    camera streamed at 640x360 ran the filter at 1920x1080 (243 ms a pair in the grab thread,
+    against 21 ms). A shrink (INTER_AREA) leaves no spread noise: the filter gets the frames
+    at the size asked, the still view restarts on none, and an enlargement is still averaged
+    as delivered."""
+    from stereovision.temporal import TemporalFilter
+
+    lpat, rpat = _still_noisy_sequence(data_dir, tmp_path / "still", 4)  # 320x240
+
+    class Spy(TemporalFilter):
+        shapes: list[tuple[int, ...]]
+
+        def __call__(self, left: Any, right: Any) -> Any:
+            self.shapes.append(np.asarray(left).shape)
+            return super().__call__(left, right)
+
+    for size, fed in (((160, 120), (120, 160, 3)), ((640, 480), (240, 320, 3))):
+        tf = Spy(max_frames=4)
+        tf.shapes = []
+        with StereoCamera(lpat, rpat, size=size) as cam:
+            out = [capmod.temporal_average(tf, cam.read()) for _ in range(4)]
+        assert tf.shapes == [fed] * 4, size
+        assert all(left.shape == (size[1], size[0], 3) for left, _ in out)
+        assert tf.restarts == 0 and tf.mean_frames() > capmod._TEMPORAL_FULL * 4
