@@ -1456,6 +1456,11 @@ def capture(
     saved: list[tuple[Path, Path]] = []
     ended = "count reached"
     last_index = -1  # the frame index of the pair saved last
+
+    def kept_note() -> str:
+        kept = f"{len(saved)} of {count}" if count is not None else f"{len(saved)}"
+        return f"{kept} pairs were saved in {out} and are kept"
+
     while count is None or len(saved) < count:
         try:
             frame = camera.read()
@@ -1465,15 +1470,13 @@ def capture(
             if count is None and exc.end and camera.count > 0:
                 ended = _end_reason(exc, saved, last_index)
                 break
-            kept = f"{len(saved)} of {count}" if count is not None else f"{len(saved)}"
-            raise exc.with_message(f"{exc}; {kept} pairs were saved in {out} and are kept") from exc
+            raise exc.with_message(f"{exc}; {kept_note()}") from exc
         except ValueError as exc:
             # a recording's frame that does not decode (BagCamera names its topic and stamp):
             # the pairs saved before it stay, and are said as for a video's failing frame
             if not saved:
                 raise
-            kept = f"{len(saved)} of {count}" if count is not None else f"{len(saved)}"
-            raise ValueError(f"{exc}; {kept} pairs were saved in {out} and are kept") from exc
+            raise ValueError(f"{exc}; {kept_note()}") from exc
         averaged = None
         if tf is not None:
             if tf.frames == 0:
