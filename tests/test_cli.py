@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 import subprocess
 import sys
@@ -476,6 +477,62 @@ def test_depth_keeps_same_named_files_it_did_not_write(
     assert "removed" not in capsys.readouterr().out
     for name, text in own.items():
         assert (out / name).read_text() == text, name
+
+
+def test_depth_refuses_to_replace_a_file_it_did_not_write(
+    tmp_path: Path, data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``-o`` naming a folder holding the user's own ``cloud.ply`` (or ``disparity.png``): the
+    run replaced it silently; it now refuses before the matching, in one line naming the file,
+    and writes nothing. Its own earlier outputs (listed in its manifest) are replaced."""
+    scene = data_dir / "eth3d" / "terrace"
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "cloud.ply").write_text("my scan")
+    argv = ["depth", str(scene / "left.png"), str(scene / "right.png"), "--max-disparity", "32"]
+    argv += ["--calib", str(scene / "calib.txt"), "-o", str(out)]
+    capsys.readouterr()
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == (
+        f"stereovision: error: -o {out}: {out / 'cloud.ply'} was not written by stereovision "
+        "and would be replaced: give another -o folder, or move or remove that file\n"
+    )
+    assert (out / "cloud.ply").read_text() == "my scan"
+    assert sorted(p.name for p in out.iterdir()) == ["cloud.ply"]  # refused before any work
+    (out / "cloud.ply").unlink()
+    assert main(argv) == 0
+    first = (out / "cloud.ply").stat().st_mtime_ns
+    assert main(argv) == 0  # its own folder again: its files are replaced
+    assert (out / "cloud.ply").stat().st_mtime_ns >= first
+    assert "cloud.ply" in json.loads((out / ".stereovision-depth.json").read_text())
+
+
+def test_demo_refuses_to_replace_a_file_it_did_not_write(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``demo -o DIR`` overwrote the user's disparity.png in DIR and wrote no manifest: it now
+    refuses up front, in one line; it records what it wrote, and a rerun into its own folder
+    replaces its files."""
+    out = tmp_path / "d"
+    out.mkdir()
+    (out / "disparity.png").write_text("my disparity")
+    capsys.readouterr()
+    assert main(["demo", "-o", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""  # before any work
+    assert captured.err == (
+        f"stereovision: error: -o {out}: {out / 'disparity.png'} was not written by stereovision "
+        "and would be replaced: give another -o folder, or move or remove that file\n"
+    )
+    assert (out / "disparity.png").read_text() == "my disparity"
+    (out / "disparity.png").unlink()
+    assert main(["demo", "-o", str(out)]) == 0
+    listed = json.loads((out / ".stereovision-depth.json").read_text())
+    names = ["cloud.ply", "depth.npy", "depth.png", "depth_mm.png", "disparity.pfm"]
+    assert listed == [*names, "disparity.png", "render.png"]
+    assert main(["demo", "-o", str(out)]) == 0  # again: its own files
+    assert cv2.imread(str(out / "disparity.png")) is not None
 
 
 def test_a_12_bit_pair_gets_one_warning_line_per_image(tmp_path: Path, data_dir: Path) -> None:

@@ -175,7 +175,9 @@ def depth_outputs(
     calib : Calibration or None
         Without it only the disparity outputs are written.
     out_dir : pathlib.Path
-        Output folder (created if missing); every file is replaced atomically.
+        Output folder (created if missing); every file is replaced atomically. A file there
+        under one of the output names that :data:`DEPTH_MANIFEST` does not list (not an earlier
+        run's) is refused before the matching (:func:`refuse_foreign_outputs`).
     method : str, optional
         Matcher; None = :func:`stereovision.depth.depth_map`'s default.
     max_disparity : int, optional
@@ -208,6 +210,8 @@ def depth_outputs(
     from stereovision.render import render_outputs
 
     check_output_folder(out_dir, "-o")  # before the matching, not after it
+    names = planned_depth_outputs(calib is not None, ground, grid is not None)
+    earlier = refuse_foreign_outputs(out_dir, names)  # before the matching, too
     if calib is None and (max_depth is not None or max_sigma is not None):
         raise CliError("--max-depth and --max-sigma need --calib (no depth without one)")
     if ground and calib is None:
@@ -225,6 +229,8 @@ def depth_outputs(
     res = depth_map(left, right, calib, max_disparity=max_disparity, fill=fill, refine=refine, **kw)
     if max_depth is not None or max_sigma is not None:
         res = res.filtered(max_depth=max_depth, max_sigma=max_sigma)
+    # recorded before the first file is written: a run stopped halfway leaves them claimed
+    record_outputs(out_dir, earlier | set(names))
     written = write_depth_outputs(res, out_dir, voxel)
     written.update(render_outputs(res, out_dir))
     if ground:
@@ -249,9 +255,94 @@ DEPTH_OUTPUTS = (
 )
 
 
-#: What ``stereovision depth`` wrote into its ``-o`` folder on its last run there (JSON list of
-#: file names): the only files a later run removes.
+#: What ``stereovision depth`` (or ``demo``) wrote into its ``-o`` folder on its last run there
+#: (JSON list of file names): the only files a later run replaces or removes. It is written
+#: before a run's first output (its earlier files and the ones it may write) and again at the end
+#: (what it wrote).
 DEPTH_MANIFEST = ".stereovision-depth.json"
+
+
+def planned_depth_outputs(calib: bool, ground: bool = False, grid: bool = False) -> tuple[str, ...]:
+    """The files ``stereovision depth`` (or ``demo``) may write into its ``-o`` folder.
+
+    Parameters
+    ----------
+    calib : bool
+        Whether the run has a calibration (depth maps, cloud and render).
+    ground, grid : bool
+        ``--ground`` given (floor, obstacles, scan); ``--grid`` given (occupancy grid).
+
+    Returns
+    -------
+    tuple of str
+        File names, a subset of :data:`DEPTH_OUTPUTS` in its order.
+    """
+    names = {"disparity.png", "disparity.pfm"}
+    if calib:
+        names |= {"depth.png", "depth.npy", "depth_mm.png", "cloud.ply", "render.png"}
+    if ground:
+        names |= {"ground.json", "obstacles.png", "scan.json"}
+    if grid:
+        names |= {"map.png", "map.yaml"}
+    return tuple(n for n in DEPTH_OUTPUTS if n in names)
+
+
+def _manifest_names(out_dir: Path) -> set[str]:
+    """The file names :data:`DEPTH_MANIFEST` in ``out_dir`` lists (none when missing or
+    unreadable)."""
+    try:
+        earlier = json.loads((out_dir / DEPTH_MANIFEST).read_text(encoding="utf-8"))
+    except (OSError, ValueError):  # none (a folder this command never wrote), or unreadable
+        return set()
+    if not isinstance(earlier, list):
+        return set()
+    return {n for n in earlier if isinstance(n, str)}
+
+
+def refuse_foreign_outputs(out_dir: Path, names: Sequence[str]) -> set[str]:
+    """Refuse, before any work, to replace a file of ``out_dir`` that this tool did not write.
+
+    A file (or anything else) under one of ``names`` in ``out_dir`` is this tool's only when
+    :data:`DEPTH_MANIFEST` lists it: an earlier ``depth`` or ``demo`` run into the folder wrote
+    it, and a rerun replaces it. Any other, e.g. the user's own ``cloud.ply`` in a folder given
+    as ``-o``, would be replaced silently.
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        The ``-o`` folder (it need not exist).
+    names : sequence of str
+        The files this run may write (:func:`planned_depth_outputs`).
+
+    Returns
+    -------
+    set of str
+        What the manifest lists (the earlier runs' files).
+
+    Raises
+    ------
+    FileExistsError
+        Naming the first such file, and what to do.
+    """
+    earlier = _manifest_names(out_dir)
+    for name in names:
+        path = out_dir / name
+        if name not in earlier and (path.exists() or path.is_symlink()):
+            raise FileExistsError(
+                f"-o {out_dir}: {path} was not written by stereovision and would be replaced: "
+                "give another -o folder, or move or remove that file"
+            )
+    return earlier
+
+
+def record_outputs(out_dir: Path, names: set[str]) -> None:
+    """Write :data:`DEPTH_MANIFEST` in ``out_dir`` (created if missing): ``names`` are this
+    tool's files there (those in :data:`DEPTH_OUTPUTS`)."""
+    from stereovision.io import atomic_write, make_folder
+
+    make_folder(out_dir)
+    with atomic_write(out_dir / DEPTH_MANIFEST, "w") as fh:
+        json.dump(sorted(n for n in names if n in DEPTH_OUTPUTS), fh)
 
 
 def remove_stale_outputs(out_dir: Path, written: dict[str, Path]) -> list[Path]:
@@ -277,23 +368,14 @@ def remove_stale_outputs(out_dir: Path, written: dict[str, Path]) -> list[Path]:
     list of pathlib.Path
         The files removed.
     """
-    from stereovision.io import atomic_write
-
-    manifest = out_dir / DEPTH_MANIFEST
-    try:
-        earlier = json.loads(manifest.read_text(encoding="utf-8"))
-    except (OSError, ValueError):  # none (a folder this command never wrote), or unreadable
-        earlier = []
-    if not isinstance(earlier, list):
-        earlier = []
+    earlier = _manifest_names(out_dir)
     removed = []
     for name in DEPTH_OUTPUTS:
         path = out_dir / name
         if name in earlier and name not in written and path.is_file() and not path.is_symlink():
             path.unlink()
             removed.append(path)
-    with atomic_write(manifest, "w") as fh:
-        json.dump(sorted(n for n in written if n in DEPTH_OUTPUTS), fh)
+    record_outputs(out_dir, set(written))
     return removed
 
 
@@ -698,8 +780,12 @@ def cmd_demo(args: argparse.Namespace) -> int:
     from stereovision.evaluate import dense_metrics, depth_metrics, gt_depth
     from stereovision.io import check_output_folder, load_scene
 
-    # before the work: a file named as -o was said after the scene was matched and evaluated
-    check_output_folder(args.output, "-o")
+    # before the work: a file named as -o, or a file of the user's under an output name, was
+    # said after the scene was matched and evaluated
+    out_dir = Path(args.output)
+    check_output_folder(out_dir, "-o")
+    names = planned_depth_outputs(calib=True)
+    earlier = refuse_foreign_outputs(out_dir, names)
     scene_dir = _demo_scene_dir()
     scene = load_scene(scene_dir)
     if scene.gt is None:
@@ -712,7 +798,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     res = depth_map(
         scene.left, scene.right, scene.calib, method=args.method, max_disparity=scene.max_disparity
     )
-    out_dir = Path(args.output)
+    record_outputs(out_dir, earlier | set(names))
     written = write_depth_outputs(res, out_dir)
     from stereovision.render import render_outputs
 
@@ -754,6 +840,8 @@ def cmd_demo(args: argparse.Namespace) -> int:
     print(f"outputs in {out_dir.resolve()}:")
     for name, path in written.items():
         print(f"  {name:14s} {path}")
+    for path in remove_stale_outputs(out_dir, written):
+        print(f"  removed {path.name} of an earlier run (not written by this one)")
     return 0
 
 
