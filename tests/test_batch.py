@@ -762,8 +762,8 @@ def test_batch_refuses_to_replace_the_outputs_of_another_input(
     assert err == [
         f"stereovision: error: output folder {out} holds the outputs of 2 pair(s) of the same "
         f"names made from other images (e.g. seq/0000 from "
-        f"{one / 'seq/0000_left.png'}); give another output folder, or remove "
-        f"{out / SUMMARY_NAME} to replace them"
+        f"{one / 'seq/0000_left.png'}); give another output folder, or remove those pairs' "
+        "folders to replace them"
     ]
     assert _tree(out) == before and _summary(out)["input"] == str(one)
     os.utime(one / "seq/0001_left.png", ns=(1, 1))  # the same input, an image changed
@@ -772,6 +772,34 @@ def test_batch_refuses_to_replace_the_outputs_of_another_input(
     shutil.move(one, tmp_path / "moved")  # the input moved: its pairs are done, skipped
     assert main(["batch", str(tmp_path / "moved"), "-o", str(out), *args]) == 0
     assert _summary(out)["run"]["skipped"] == 2
+
+
+def test_batch_refuses_to_replace_a_file_it_did_not_write(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A pair's output folder holding the user's own disparity.png (no run recorded writing it):
+    it was replaced silently; now refused before any work, one line naming it, exit 2. A rerun
+    over the pair's own outputs (recorded in the summary) still replaces them."""
+    src, out = tmp_path / "drive", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png")
+    (out / "a").mkdir(parents=True)
+    (out / "a" / "disparity.png").write_text("mine")
+    args = ["--workers", "1", "--max-disparity", "16"]
+    capsys.readouterr()
+    assert main(["batch", str(src), "-o", str(out), *args]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: error: output folder {out}: {out / 'a' / 'disparity.png'} was not "
+        "written by stereovision and would be replaced: give another output folder, or move or "
+        "remove that file"
+    ]
+    assert (out / "a" / "disparity.png").read_text() == "mine"
+    assert sorted(p.name for p in (out / "a").iterdir()) == ["disparity.png"]
+    (out / "a" / "disparity.png").unlink()
+    assert main(["batch", str(src), "-o", str(out), *args]) == 0
+    os.utime(src / "a/left.png", ns=(1, 1))  # changed: redone over its own outputs
+    assert main(["batch", str(src), "-o", str(out), *args]) == 0
+    assert _summary(out)["run"]["processed"] == 1
+    assert cv2.imread(str(out / "a" / "disparity.png")) is not None
 
 
 def test_batch_redoes_a_changed_pair_of_its_input_after_a_run_over_another_one(

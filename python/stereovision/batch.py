@@ -545,6 +545,25 @@ def _same_file(recorded: Any, path: Path) -> bool:
     return False
 
 
+def _foreign_output(
+    dest: Path, job: PairJob, opts: dict[str, Any], recorded: list[str] | None
+) -> Path | None:
+    """The first file in the pair's folder ``dest`` under a name this run may write for it
+    that no earlier run recorded writing (``recorded``, from the summary), else None."""
+    from stereovision.cli import planned_depth_outputs
+
+    if not dest.is_dir():
+        return None
+    names = planned_depth_outputs(
+        job.calib is not None, bool(opts.get("ground")), opts.get("grid") is not None
+    )
+    for name in names:
+        path = dest / name
+        if name not in (recorded or []) and (path.exists() or path.is_symlink()):
+            return path
+    return None
+
+
 def _commit_pair(
     out: Path, name: str, files: dict[str, bytes], previous: list[str] | None = None
 ) -> Path:
@@ -1032,6 +1051,7 @@ def run_batch(
         redone: list[str] = []
         changes: set[str] = set()
         others: list[tuple[str, str]] = []  # done from another input folder's images: (name, image)
+        foreign: Path | None = None  # a file under an output name no run recorded writing
         for job in jobs:
             fp = _fingerprint(job)
             entry = summary.pairs.get(job.name)
@@ -1074,6 +1094,8 @@ def run_batch(
                 # failing it) keeps them listed, so the next one removes those it does not write
                 summary.pairs[job.name]["outputs"] = previous[job.name]
             todo.append(job)
+            if foreign is None:
+                foreign = _foreign_output(out / job.name, job, opts, previous.get(job.name))
         if others:
             # a second drive under the same pair names replaced the first one's outputs, unsaid
             name, image = others[0]
@@ -1081,7 +1103,12 @@ def run_batch(
                 f"output folder {out} holds the outputs of {len(others)} pair(s) of the same names "
                 # the example's image names its folder: the last run's input may be another one
                 f"made from other images (e.g. {name} from {image}); give "
-                f"another output folder, or remove {out / SUMMARY_NAME} to replace them"
+                f"another output folder, or remove those pairs' folders to replace them"
+            )
+        if foreign is not None:  # the user's own file in a pair's folder: replaced, unsaid
+            raise FileExistsError(
+                f"output folder {out}: {foreign} was not written by stereovision and would be "
+                "replaced: give another output folder, or move or remove that file"
             )
         if redone and log is not None:
             shown = sorted(changes)[:3] + (["..."] if len(changes) > 3 else [])
