@@ -30,8 +30,9 @@ topic (``prefix`` = ``/stereo``)  type                              content
                                                                     in ``scan_frame_id``
 ================================  ================================  ===============================
 
-The bag is written with the pure-Python ``rosbags`` library (``pip install rosbags``, or the
-``ros`` extra), as a ROS 2 bag (sqlite3, CDR) that ``ros2 bag play`` reads.
+The bag is written with the pure-Python ``rosbags`` library (the ``ros`` extra:
+``pip install 'stereovision-rs[ros]'``), as a ROS 2 bag (sqlite3, CDR) that ``ros2 bag play``
+reads.
 
 :class:`BagCamera` goes the other way: it reads a recorded rig -- a ROS 1 bag (or a folder of
 them, split), or a ROS 2 bag (sqlite3 or MCAP) -- as synchronised pairs, with the same interface
@@ -106,8 +107,7 @@ def _rosbags() -> tuple[Any, Any]:
         from rosbags.typesys import Stores, get_typestore
     except ImportError:
         raise ImportError(
-            "writing ROS 2 bags needs the rosbags package: pip install rosbags (or the package's "
-            "'ros' extra)"
+            "writing ROS 2 bags needs rosbags: pip install 'stereovision-rs[ros]'"
         ) from None
     return Writer, get_typestore(Stores.ROS2_HUMBLE)
 
@@ -511,8 +511,7 @@ def _open_reader(path: Path) -> Any:
         from rosbags.typesys import Stores, get_typestore
     except ImportError:
         raise ImportError(
-            "reading ROS bags needs the rosbags package: pip install rosbags (or the package's "
-            "'ros' extra)"
+            "reading ROS bags needs rosbags: pip install 'stereovision-rs[ros]'"
         ) from None
     reader = AnyReader(_bag_paths(path), default_typestore=get_typestore(Stores.ROS2_HUMBLE))
     reader.open()
