@@ -317,3 +317,14 @@ def test_architecture_lists_every_command() -> None:
     listed = re.search(r"`stereovision ([^`]+)`", text)
     assert listed is not None
     assert [c.strip() for c in listed.group(1).split("|")] == list(commands.choices)
+
+
+def test_the_readme_names_the_opencv_the_package_requires() -> None:
+    """The README said the baselines' parameters were 'set through OpenCV 4' after the floor
+    became opencv-python-headless>=5.1: every version it gives for the OpenCV in use is the
+    pyproject's floor."""
+    floor = re.search(r'"opencv-python-headless>=([\d.]+)"', (ROOT / "pyproject.toml").read_text())
+    assert floor is not None
+    text = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    assert "set through OpenCV 4" not in text
+    assert f"set through the current OpenCV API, {floor.group(1)} or later" in text

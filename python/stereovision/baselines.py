@@ -13,8 +13,8 @@ And, for ``benches/bench_tools.py``, the matchers robotics users run as their to
 * :func:`ros_stereo_image_proc` -- ROS 2 ``stereo_image_proc``'s disparity node (BM or SGBM) with
   the node's default parameters;
 * :func:`stereovision_1_0` -- the ``StereoVision`` 1.0.4 package on PyPI (2017, Python 2 and
-  OpenCV 2: it no longer imports with OpenCV 4) with its ``StereoBM`` / ``StereoSGBM`` defaults,
-  set through OpenCV 4's API.
+  OpenCV 2: it no longer imports with the OpenCV of today) with its ``StereoBM`` /
+  ``StereoSGBM`` defaults, set through the current API (OpenCV 5.1 or later, as required).
 
 Outputs follow the project's convention: ``float32`` disparity in pixels, ``d = x_left - x_right``
 at left-image pixels, NaN for "no estimate" (OpenCV's 16x fixed point divided by 16, negative
@@ -254,8 +254,9 @@ def stereovision_1_0(
     of its ``blockmatchers.StereoBM`` / ``StereoSGBM`` classes.
 
     That package is Python 2 and OpenCV 2 code (``cv2.STEREO_BM_BASIC_PRESET``,
-    ``cv2.StereoSGBM()``) and does not import with OpenCV 4; this sets the same parameters
-    through OpenCV 4's API. BM: ``window_size`` 21 on the grey pair, the rest OpenCV's BM
+    ``cv2.StereoSGBM()``) and does not import with the OpenCV of today; this sets the same
+    parameters through the current API (OpenCV 5.1 or later, as the package requires).
+    BM: ``window_size`` 21 on the grey pair, the rest OpenCV's BM
     defaults (prefilter 9 / 31, texture 10, uniqueness 15, no speckle filter) -- what OpenCV 2's
     basic preset set. SGBM on the pair as given (BGR): ``sad_window_size`` 3, ``uniqueness`` 10,
     ``speckle_window_size`` 100, ``speckle_range`` 32, ``p1`` 216, ``p2`` 864,
