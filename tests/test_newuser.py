@@ -3,13 +3,24 @@ mistakes (a video for an image, a range of 0) named in the command line's words.
 
 from __future__ import annotations
 
+from importlib import resources
 from pathlib import Path
 
 import pytest
 
+import stereovision
 from stereovision.cli import main
 
-CONES = Path(__file__).resolve().parents[1] / "python" / "stereovision" / "data" / "cones"
+# The sample as installed with the package (what a new user has), not the source tree's copy.
+CONES = Path(str(resources.files("stereovision") / "data" / "cones"))
+
+
+def test_the_sample_is_the_installed_packages() -> None:
+    """These runs read the sample the package ships (they read ``python/stereovision/data`` of
+    the source tree, which a wheel missing the sample would not have shown)."""
+    assert CONES.is_relative_to(Path(stereovision.__file__).resolve().parent)
+    assert sorted(p.name for p in CONES.glob("*.png")) == ["left.png", "right.png"]
+    assert (CONES / "calib.txt").is_file() and (CONES / "gt_disp.pfm").is_file()
 
 
 def test_eval_table_labels_sit_over_their_numbers(capsys: pytest.CaptureFixture[str]) -> None:
