@@ -194,8 +194,9 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
     face["i"] = tris
     with atomic_write(path) as fh:
         fh.write(("\n".join(header) + "\n").encode("ascii"))
-        fh.write(vert.tobytes())
-        fh.write(face.tobytes())
+        # the records' bytes, not a copy of them (tobytes): a big mesh held its records twice
+        fh.write(vert.view(np.uint8))
+        fh.write(face.view(np.uint8))
     return Path(path)
 
 
@@ -277,7 +278,7 @@ def write_pcd(path: PathLike, result: DepthResult) -> Path:
     )
     with atomic_write(path) as fh:
         fh.write(header.encode("ascii"))
-        fh.write(rec.tobytes())
+        fh.write(rec.view(np.uint8))  # the records' bytes, not a copy of them (tobytes)
     return Path(path)
 
 
