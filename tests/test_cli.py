@@ -644,6 +644,41 @@ def test_rectify_with_calib_removes_an_earlier_runs_homographies(
     assert (out / "rectification.json").read_text() == '{"mine": 1}'
 
 
+def test_rectify_refuses_to_replace_a_file_it_did_not_write(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``rectify -o DIR`` replaced the user's own left_rect.png (or, without --calib, their
+    rectification.json) silently: refused before any work, one line naming it; the command's
+    own earlier outputs (its manifest's) are replaced by a rerun."""
+    scene = data_dir / "eth3d" / "terrace"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    calib = ["--calib", str(scene / "calib.txt")]
+    out = tmp_path / "rect"
+    out.mkdir()
+    for name, argv in (("left_rect.png", calib), ("rectification.json", ["--force"])):
+        (out / name).write_text("mine")
+        capsys.readouterr()
+        assert main(["rectify", *pair, *argv, "-o", str(out)]) == 2
+        assert capsys.readouterr().err == (
+            f"stereovision: error: -o {out}: {out / name} was not written by stereovision and "
+            "would be replaced: give another -o folder, or move or remove that file\n"
+        )
+        assert sorted(p.name for p in out.iterdir()) == [name]  # nothing written
+        assert (out / name).read_text() == "mine"
+        (out / name).unlink()
+    assert main(["rectify", *pair, "--force", "-o", str(out)]) == 0
+    assert json.loads((out / ".stereovision-rectify.json").read_text()) == [
+        "check.png",
+        "left_rect.png",
+        "rectification.json",
+        "right_rect.png",
+    ]
+    assert main(["rectify", *pair, *calib, "-o", str(out)]) == 0  # its own files: replaced
+    assert not (out / "rectification.json").exists()
+    assert main(["rectify", *pair, "--force", "-o", str(out)]) == 0
+    assert (out / "rectification.json").is_file()
+
+
 def test_rectify_writes_a_rectified_pair_as_given(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -287,11 +287,11 @@ def planned_depth_outputs(calib: bool, ground: bool = False, grid: bool = False)
     return tuple(n for n in DEPTH_OUTPUTS if n in names)
 
 
-def _manifest_names(out_dir: Path) -> set[str]:
-    """The file names :data:`DEPTH_MANIFEST` in ``out_dir`` lists (none when missing or
-    unreadable)."""
+def _manifest_names(out_dir: Path, manifest: str = DEPTH_MANIFEST) -> set[str]:
+    """The file names the manifest (:data:`DEPTH_MANIFEST`, or ``rectify``'s
+    :data:`RECTIFY_MANIFEST`) in ``out_dir`` lists (none when missing or unreadable)."""
     try:
-        earlier = json.loads((out_dir / DEPTH_MANIFEST).read_text(encoding="utf-8"))
+        earlier = json.loads((out_dir / manifest).read_text(encoding="utf-8"))
     except (OSError, ValueError):  # none (a folder this command never wrote), or unreadable
         return set()
     if not isinstance(earlier, list):
@@ -299,7 +299,9 @@ def _manifest_names(out_dir: Path) -> set[str]:
     return {n for n in earlier if isinstance(n, str)}
 
 
-def refuse_foreign_outputs(out_dir: Path, names: Sequence[str]) -> set[str]:
+def refuse_foreign_outputs(
+    out_dir: Path, names: Sequence[str], manifest: str = DEPTH_MANIFEST
+) -> set[str]:
     """Refuse, before any work, to replace a file of ``out_dir`` that this tool did not write.
 
     A file (or anything else) under one of ``names`` in ``out_dir`` is this tool's only when
@@ -313,6 +315,9 @@ def refuse_foreign_outputs(out_dir: Path, names: Sequence[str]) -> set[str]:
         The ``-o`` folder (it need not exist).
     names : sequence of str
         The files this run may write (:func:`planned_depth_outputs`).
+    manifest : str
+        The manifest's file name: :data:`DEPTH_MANIFEST` (``depth``, ``demo``) or
+        :data:`RECTIFY_MANIFEST`.
 
     Returns
     -------
@@ -324,7 +329,7 @@ def refuse_foreign_outputs(out_dir: Path, names: Sequence[str]) -> set[str]:
     FileExistsError
         Naming the first such file, and what to do.
     """
-    earlier = _manifest_names(out_dir)
+    earlier = _manifest_names(out_dir, manifest)
     for name in names:
         path = out_dir / name
         if name not in earlier and (path.exists() or path.is_symlink()):
@@ -335,14 +340,20 @@ def refuse_foreign_outputs(out_dir: Path, names: Sequence[str]) -> set[str]:
     return earlier
 
 
-def record_outputs(out_dir: Path, names: set[str]) -> None:
-    """Write :data:`DEPTH_MANIFEST` in ``out_dir`` (created if missing): ``names`` are this
-    tool's files there (those in :data:`DEPTH_OUTPUTS`)."""
+def record_outputs(
+    out_dir: Path,
+    names: set[str],
+    manifest: str = DEPTH_MANIFEST,
+    known: Sequence[str] = DEPTH_OUTPUTS,
+) -> None:
+    """Write the manifest (:data:`DEPTH_MANIFEST` by default) in ``out_dir`` (created if
+    missing): ``names`` are this tool's files there (those of them in ``known``, the command's
+    output names)."""
     from stereovision.io import atomic_write, make_folder
 
     make_folder(out_dir)
-    with atomic_write(out_dir / DEPTH_MANIFEST, "w") as fh:
-        json.dump(sorted(n for n in names if n in DEPTH_OUTPUTS), fh)
+    with atomic_write(out_dir / manifest, "w") as fh:
+        json.dump(sorted(n for n in names if n in known), fh)
 
 
 def remove_stale_outputs(out_dir: Path, written: dict[str, Path]) -> list[Path]:
@@ -594,6 +605,14 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Every file ``stereovision rectify`` may write into its ``-o`` folder.
+RECTIFY_OUTPUTS = ("left_rect.png", "right_rect.png", "check.png", "rectification.json")
+
+#: What ``stereovision rectify`` wrote into its ``-o`` folder (JSON list of file names, as
+#: :data:`DEPTH_MANIFEST`): the files a later run may replace.
+RECTIFY_MANIFEST = ".stereovision-rectify.json"
+
+
 def cmd_rectify(args: argparse.Namespace) -> int:
     """``stereovision rectify LEFT RIGHT -o DIR [--calib F] [--force]``: the rectified pair,
     and with no calibration the homographies found from the pair's features (a pair already
@@ -618,8 +637,11 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         raise CliError(f"-o {args.output}: is a file; give a folder")
     inputs = {"the left image": args.left, "the right image": args.right,
               "the calibration": args.calib}  # fmt: skip
-    for name in ("left_rect.png", "right_rect.png", "check.png", "rectification.json"):
+    for name in RECTIFY_OUTPUTS:
         _refuse_an_input("-o", out / name, inputs)  # rectifying rect/*.png again into rect/
+    # a left_rect.png of the user's is not replaced; this command's own (its manifest's) are
+    names = RECTIFY_OUTPUTS if calib is None else RECTIFY_OUTPUTS[:3]
+    earlier = refuse_foreign_outputs(out, names, RECTIFY_MANIFEST)
     written: dict[str, Path] = {}
     given = None  # the pair's own check, when it is already rectified: written as given
     if calib is not None:
@@ -645,6 +667,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
             lr, rr = left, right
             summary = None
     make_folder(out)
+    record_outputs(out, earlier | set(names), RECTIFY_MANIFEST, RECTIFY_OUTPUTS)
     check = given if given is not None else check_rectification(lr, rr)
     for name, img in (
         ("left_rect.png", lr),
@@ -692,6 +715,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
                 f"  removed {stale.name} of an earlier run (its homographies do not fit the "
                 f"images written now: {now})"
             )
+    record_outputs(out, set(written), RECTIFY_MANIFEST, RECTIFY_OUTPUTS)
     return 0
 
 
