@@ -671,6 +671,60 @@ def test_cli_outputs_that_collide_or_cannot_be_written_are_refused_first(
         run("-o", str(tmp_path / "rig.yaml"))
 
 
+def test_cli_ros_and_report_files_of_the_users_are_not_replaced(
+    cached_corners: None, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--ros DIR holding another rig's left.yaml, or --report DIR a report.html of the user's:
+    calibrate replaced them silently. Refused before any corner is looked for, naming the file;
+    the files an earlier calibrate wrote there (its manifest's) are replaced by a rerun."""
+    left, right = _chessboard_paths()
+    base = ["calibrate", "--left", str(left[0].parent / "left*.jpg"), "--right",
+            str(right[0].parent / "right*.jpg"), "--square", "0.025",
+            "-o", str(tmp_path / "rig.yaml")]  # fmt: skip
+
+    def run(*argv: str) -> int:
+        a = _parser().parse_args([*base, *argv])
+        return int(a.func(a))
+
+    ros, rep = tmp_path / "ros", tmp_path / "rep"
+    ros.mkdir()
+    rep.mkdir()
+    (ros / "right.yaml").write_text("another rig\n")
+    (rep / "report.html").write_text("mine\n")
+    real = calmod.find_corners
+
+    def no_work(*_: Any, **__: Any) -> Any:
+        raise AssertionError("the corners were looked for before the outputs were checked")
+
+    monkeypatch.setattr(calmod, "find_corners", no_work)
+    for flag, folder, name in (("--ros", ros, "right.yaml"), ("--report", rep, "report.html")):
+        with pytest.raises(FileExistsError) as info:
+            run(flag, str(folder))
+        assert str(info.value) == (
+            f"{flag} {folder}: {folder / name} was not written by stereovision and would be "
+            f"replaced: give another {flag} folder, or move or remove that file"
+        )
+    assert (ros / "right.yaml").read_text() == "another rig\n"
+    assert (rep / "report.html").read_text() == "mine\n"
+    assert not (tmp_path / "rig.yaml").exists()
+    monkeypatch.setattr(calmod, "find_corners", real)
+    (ros / "right.yaml").unlink()
+    (rep / "report.html").unlink()
+    for _ in range(2):  # the second run replaces the first one's files
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            assert run("--ros", str(ros), "--report", str(rep)) == 0
+    assert Calibration.load(tmp_path / "rig.yaml") is not None
+    assert "camera_name" in (ros / "right.yaml").read_text()
+    manifest = ".stereovision-calibrate.json"
+    assert json.loads((ros / manifest).read_text()) == ["left.yaml", "right.yaml"]
+    assert json.loads((rep / manifest).read_text()) == [
+        "report.html",
+        "report.json",
+        "report.yaml",
+    ]
+
+
 def test_patterns_too_small_or_not_integers_are_refused(tmp_path: Path) -> None:
     """2x2 and 2x5 reached OpenCV ("internal error" from cv2.error), 9 said "'int' object is not
     iterable", and (9.5, 6) was truncated to (9, 6)."""

@@ -2495,6 +2495,15 @@ def _calibrate_source(
     return calibrate(lefts, rights, **common)
 
 
+#: The files ``stereovision calibrate`` writes into its ``--ros`` (the first two) and
+#: ``--report`` folders.
+CALIBRATE_OUTPUTS = ("left.yaml", "right.yaml", "report.html", "report.yaml", "report.json")
+
+#: What ``stereovision calibrate`` wrote into its ``--ros`` / ``--report`` folder (JSON list of
+#: file names, as ``depth``'s manifest): the files a later run replaces.
+CALIBRATE_MANIFEST = ".stereovision-calibrate.json"
+
+
 def cmd_calibrate(args: argparse.Namespace) -> int:
     """``stereovision calibrate --left GLOB --right GLOB --pattern 9x6 --square S -o FILE``
     (``--board charuco --marker M`` for a ChArUco board; ``--ros DIR`` also writes ROS
@@ -2533,6 +2542,18 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     for flag, folder in (("--ros", args.ros), ("--report", args.report)):
         if folder:
             check_output_folder(folder, flag)
+    # A left.yaml or report.html of the user's (another rig's camera_info) is not replaced; the
+    # files an earlier calibrate wrote there (listed in its manifest) are.
+    from stereovision.cli import record_outputs, refuse_foreign_outputs
+
+    claims: dict[Path, set[str]] = {}
+    for flag, folder, names in (
+        ("--ros", args.ros, CALIBRATE_OUTPUTS[:2]),
+        ("--report", args.report, CALIBRATE_OUTPUTS[2:]),
+    ):
+        if folder:
+            earlier = refuse_foreign_outputs(Path(folder), names, CALIBRATE_MANIFEST, flag)
+            claims.setdefault(Path(folder).resolve(), set(earlier)).update(names)
     board = _cli_board(args, printing=False)
     common: dict[str, Any] = {
         "pattern": parse_pattern(args.pattern or "9x6", "--pattern"),
@@ -2560,6 +2581,8 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     from stereovision.io import keep_previous
 
     kept = keep_previous(out)
+    for folder, claimed in claims.items():  # before the files: a run stopped keeps them its own
+        record_outputs(folder, claimed, CALIBRATE_MANIFEST, CALIBRATE_OUTPUTS)
     cal.save(out)
     print(rep.summary(drop_option=DROP_OUTLIERS_CLI))
     print(cal.describe())

@@ -300,7 +300,7 @@ def _manifest_names(out_dir: Path, manifest: str = DEPTH_MANIFEST) -> set[str]:
 
 
 def refuse_foreign_outputs(
-    out_dir: Path, names: Sequence[str], manifest: str = DEPTH_MANIFEST
+    out_dir: Path, names: Sequence[str], manifest: str = DEPTH_MANIFEST, flag: str = "-o"
 ) -> set[str]:
     """Refuse, before any work, to replace a file of ``out_dir`` that this tool did not write.
 
@@ -317,7 +317,10 @@ def refuse_foreign_outputs(
         The files this run may write (:func:`planned_depth_outputs`).
     manifest : str
         The manifest's file name: :data:`DEPTH_MANIFEST` (``depth``, ``demo``) or
-        :data:`RECTIFY_MANIFEST`.
+        :data:`RECTIFY_MANIFEST` (or ``calibrate``'s, in its ``--ros`` and ``--report``
+        folders).
+    flag : str
+        How the user gave the folder, for the message.
 
     Returns
     -------
@@ -334,8 +337,8 @@ def refuse_foreign_outputs(
         path = out_dir / name
         if name not in earlier and (path.exists() or path.is_symlink()):
             raise FileExistsError(
-                f"-o {out_dir}: {path} was not written by stereovision and would be replaced: "
-                "give another -o folder, or move or remove that file"
+                f"{flag} {out_dir}: {path} was not written by stereovision and would be "
+                f"replaced: give another {flag} folder, or move or remove that file"
             )
     return earlier
 
