@@ -802,6 +802,27 @@ def test_batch_refuses_to_replace_a_file_it_did_not_write(
     assert cv2.imread(str(out / "a" / "disparity.png")) is not None
 
 
+def test_batch_refuses_to_replace_a_summary_json_it_did_not_write(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """-o naming a folder with the user's own summary.json (not a batch summary): it was read
+    as unreadable and replaced by the run's. Refused before any work, one line naming it."""
+    src, out = tmp_path / "drive", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png")
+    out.mkdir()
+    for text in ("my notes", '{"mine": 1}'):
+        (out / SUMMARY_NAME).write_text(text)
+        capsys.readouterr()
+        assert main(["batch", str(src), "-o", str(out), "--workers", "1"]) == 2
+        assert capsys.readouterr().err.splitlines() == [
+            f"stereovision: error: output folder {out}: {out / SUMMARY_NAME} is not a batch "
+            "summary and would be replaced: give another output folder, or move or remove that "
+            "file"
+        ]
+        assert (out / SUMMARY_NAME).read_text() == text
+        assert sorted(p.name for p in out.iterdir()) == [SUMMARY_NAME]
+
+
 def test_batch_redoes_a_changed_pair_of_its_input_after_a_run_over_another_one(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

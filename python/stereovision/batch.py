@@ -681,13 +681,18 @@ class _Summary:
         self._cost = 0.0  # seconds the last save took
         self._saved_at = -math.inf  # time.monotonic() at its end
         self.data: dict[str, Any] = {"version": _SUMMARY_VERSION, "pairs": {}}
-        if self.path.is_file():
+        if self.path.exists() or self.path.is_symlink():
             try:
                 old = json.loads(self.path.read_text(encoding="utf-8"))
             except (OSError, ValueError):
-                old = None  # unreadable: start afresh (the outputs are simply redone)
-            if isinstance(old, dict) and isinstance(old.get("pairs"), dict):
-                self.data = old
+                old = None
+            if not (isinstance(old, dict) and isinstance(old.get("pairs"), dict)):
+                # the user's summary.json (no batch run writes another): it was replaced
+                raise FileExistsError(
+                    f"output folder {out}: {self.path} is not a batch summary and would be "
+                    "replaced: give another output folder, or move or remove that file"
+                )
+            self.data = old
 
     @property
     def pairs(self) -> dict[str, Any]:
