@@ -674,9 +674,10 @@ def test_cli_outputs_that_collide_or_cannot_be_written_are_refused_first(
 def test_cli_ros_and_report_files_of_the_users_are_not_replaced(
     cached_corners: None, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """--ros DIR holding another rig's left.yaml, or --report DIR a report.html of the user's:
-    calibrate replaced them silently. Refused before any corner is looked for, naming the file;
-    the files an earlier calibrate wrote there (its manifest's) are replaced by a rerun."""
+    """--report DIR holding a report.html of the user's: calibrate replaced it silently. Refused
+    before any corner is looked for, naming the file; the files an earlier calibrate wrote there
+    (its manifest's) are replaced by a rerun. (--ros's files are kept as left.previous.yaml ...:
+    test_cli_keeps_the_calibration_it_replaces.)"""
     left, right = _chessboard_paths()
     base = ["calibrate", "--left", str(left[0].parent / "left*.jpg"), "--right",
             str(right[0].parent / "right*.jpg"), "--square", "0.025",
@@ -687,9 +688,7 @@ def test_cli_ros_and_report_files_of_the_users_are_not_replaced(
         return int(a.func(a))
 
     ros, rep = tmp_path / "ros", tmp_path / "rep"
-    ros.mkdir()
     rep.mkdir()
-    (ros / "right.yaml").write_text("another rig\n")
     (rep / "report.html").write_text("mine\n")
     real = calmod.find_corners
 
@@ -697,18 +696,16 @@ def test_cli_ros_and_report_files_of_the_users_are_not_replaced(
         raise AssertionError("the corners were looked for before the outputs were checked")
 
     monkeypatch.setattr(calmod, "find_corners", no_work)
-    for flag, folder, name in (("--ros", ros, "right.yaml"), ("--report", rep, "report.html")):
+    for flag, folder, name in (("--report", rep, "report.html"),):
         with pytest.raises(FileExistsError) as info:
             run(flag, str(folder))
         assert str(info.value) == (
             f"{flag} {folder}: {folder / name} was not written by stereovision and would be "
             f"replaced: give another {flag} folder, or move or remove that file"
         )
-    assert (ros / "right.yaml").read_text() == "another rig\n"
     assert (rep / "report.html").read_text() == "mine\n"
     assert not (tmp_path / "rig.yaml").exists()
     monkeypatch.setattr(calmod, "find_corners", real)
-    (ros / "right.yaml").unlink()
     (rep / "report.html").unlink()
     for _ in range(2):  # the second run replaces the first one's files
         with warnings.catch_warnings():
@@ -716,8 +713,8 @@ def test_cli_ros_and_report_files_of_the_users_are_not_replaced(
             assert run("--ros", str(ros), "--report", str(rep)) == 0
     assert Calibration.load(tmp_path / "rig.yaml") is not None
     assert "camera_name" in (ros / "right.yaml").read_text()
+    assert "camera_name" in (ros / "right.previous.yaml").read_text()  # the first run's
     manifest = ".stereovision-calibrate.json"
-    assert json.loads((ros / manifest).read_text()) == ["left.yaml", "right.yaml"]
     assert json.loads((rep / manifest).read_text()) == [
         "report.html",
         "report.json",

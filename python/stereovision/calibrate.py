@@ -2542,15 +2542,13 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     for flag, folder in (("--ros", args.ros), ("--report", args.report)):
         if folder:
             check_output_folder(folder, flag)
-    # A left.yaml or report.html of the user's (another rig's camera_info) is not replaced; the
-    # files an earlier calibrate wrote there (listed in its manifest) are.
+    # A report.html of the user's is not replaced; the files an earlier calibrate wrote there
+    # (listed in its manifest) are. --ros's left.yaml / right.yaml (another rig's camera_info)
+    # need no refusal: whatever they are, they are kept as left.previous.yaml ... (keep_previous).
     from stereovision.cli import record_outputs, refuse_foreign_outputs
 
     claims: dict[Path, set[str]] = {}
-    for flag, folder, names in (
-        ("--ros", args.ros, CALIBRATE_OUTPUTS[:2]),
-        ("--report", args.report, CALIBRATE_OUTPUTS[2:]),
-    ):
+    for flag, folder, names in (("--report", args.report, CALIBRATE_OUTPUTS[2:]),):
         if folder:
             earlier = refuse_foreign_outputs(Path(folder), names, CALIBRATE_MANIFEST, flag)
             claims.setdefault(Path(folder).resolve(), set(earlier)).update(names)
