@@ -700,8 +700,8 @@ def test_cli_ros_and_report_files_of_the_users_are_not_replaced(
         with pytest.raises(FileExistsError) as info:
             run(flag, str(folder))
         assert str(info.value) == (
-            f"{flag} {folder}: {folder / name} was not written by stereovision and would be "
-            f"replaced: give another {flag} folder, or move or remove that file"
+            f"{flag} {folder}: {folder / name} is not listed as an earlier run's output there "
+            f"and would be replaced: give another {flag} folder, or move or remove that file"
         )
     assert (rep / "report.html").read_text() == "mine\n"
     assert not (tmp_path / "rig.yaml").exists()

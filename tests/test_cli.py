@@ -500,8 +500,8 @@ def test_depth_refuses_to_replace_a_file_it_did_not_write(
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert err == (
-        f"stereovision: error: -o {out}: {out / 'cloud.ply'} was not written by stereovision "
-        "and would be replaced: give another -o folder, or move or remove that file\n"
+        f"stereovision: error: -o {out}: {out / 'cloud.ply'} is not listed as an earlier run's "
+        "output there and would be replaced: give another -o folder, or move or remove that file\n"
     )
     assert (out / "cloud.ply").read_text() == "my scan"
     assert sorted(p.name for p in out.iterdir()) == ["cloud.ply"]  # refused before any work
@@ -513,31 +513,43 @@ def test_depth_refuses_to_replace_a_file_it_did_not_write(
     assert "cloud.ply" in json.loads((out / ".stereovision-depth.json").read_text())
 
 
-def test_demo_refuses_to_replace_a_file_it_did_not_write(
+def test_demo_keeps_a_file_it_did_not_write(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """``demo -o DIR`` overwrote the user's disparity.png in DIR and wrote no manifest: it now
-    refuses up front, in one line; it records what it wrote, and a rerun into its own folder
-    replaces its files."""
+    """``demo -o DIR`` overwrote the user's disparity.png in DIR and wrote no manifest: the file
+    is copied aside as disparity.previous.png (said), not refused, so ``make demo`` still runs
+    into a demo_output of a version before the manifest; it records what it wrote, and a rerun
+    into its own folder replaces its files without copies. A folder under an output name is
+    refused up front."""
     out = tmp_path / "d"
     out.mkdir()
     (out / "disparity.png").write_text("my disparity")
     capsys.readouterr()
-    assert main(["demo", "-o", str(out)]) == 2
-    captured = capsys.readouterr()
-    assert captured.out == ""  # before any work
-    assert captured.err == (
-        f"stereovision: error: -o {out}: {out / 'disparity.png'} was not written by stereovision "
-        "and would be replaced: give another -o folder, or move or remove that file\n"
-    )
-    assert (out / "disparity.png").read_text() == "my disparity"
-    (out / "disparity.png").unlink()
     assert main(["demo", "-o", str(out)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    kept = out / "disparity.previous.png"
+    assert (
+        lines[-1]
+        == f"  the disparity.png that was there (no earlier run's output) is kept as {kept}"
+    )
+    assert kept.read_text() == "my disparity"
+    assert cv2.imread(str(out / "disparity.png")) is not None
     listed = json.loads((out / ".stereovision-depth.json").read_text())
     names = ["cloud.ply", "depth.npy", "depth.png", "depth_mm.png", "disparity.pfm"]
     assert listed == [*names, "disparity.png", "render.png"]
-    assert main(["demo", "-o", str(out)]) == 0  # again: its own files
-    assert cv2.imread(str(out / "disparity.png")) is not None
+    assert main(["demo", "-o", str(out)]) == 0  # again: its own files, no copy
+    assert "kept as" not in capsys.readouterr().out
+    assert sorted(p.name for p in out.glob("*.previous*")) == ["disparity.previous.png"]
+    other = tmp_path / "e"
+    (other / "cloud.ply").mkdir(parents=True)
+    assert main(["demo", "-o", str(other)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""  # before any work
+    assert captured.err == (
+        f"stereovision: error: -o {other}: {other / 'cloud.ply'} is not listed as an earlier "
+        "run's output there and would be replaced: give another -o folder, or move or remove "
+        "that file\n"
+    )
 
 
 def test_a_12_bit_pair_gets_one_warning_line_per_image(tmp_path: Path, data_dir: Path) -> None:
@@ -660,8 +672,8 @@ def test_rectify_refuses_to_replace_a_file_it_did_not_write(
         capsys.readouterr()
         assert main(["rectify", *pair, *argv, "-o", str(out)]) == 2
         assert capsys.readouterr().err == (
-            f"stereovision: error: -o {out}: {out / name} was not written by stereovision and "
-            "would be replaced: give another -o folder, or move or remove that file\n"
+            f"stereovision: error: -o {out}: {out / name} is not listed as an earlier run's output "
+            "there and would be replaced: give another -o folder, or move or remove that file\n"
         )
         assert sorted(p.name for p in out.iterdir()) == [name]  # nothing written
         assert (out / name).read_text() == "mine"

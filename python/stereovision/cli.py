@@ -337,8 +337,8 @@ def refuse_foreign_outputs(
         path = out_dir / name
         if name not in earlier and (path.exists() or path.is_symlink()):
             raise FileExistsError(
-                f"{flag} {out_dir}: {path} was not written by stereovision and would be "
-                f"replaced: give another {flag} folder, or move or remove that file"
+                f"{flag} {out_dir}: {path} is not listed as an earlier run's output there and "
+                f"would be replaced: give another {flag} folder, or move or remove that file"
             )
     return earlier
 
@@ -807,12 +807,20 @@ def cmd_demo(args: argparse.Namespace) -> int:
     from stereovision.evaluate import dense_metrics, depth_metrics, gt_depth
     from stereovision.io import check_output_folder, load_scene
 
-    # before the work: a file named as -o, or a file of the user's under an output name, was
-    # said after the scene was matched and evaluated
+    # before the work: a file named as -o was said after the scene was matched and evaluated
     out_dir = Path(args.output)
     check_output_folder(out_dir, "-o")
     names = planned_depth_outputs(calib=True)
-    earlier = refuse_foreign_outputs(out_dir, names)
+    # A file under an output name that no earlier run listed (the user's, or a demo folder of a
+    # version before the manifest: `make demo` after an update) is copied aside, not refused:
+    # the Quick start's command keeps working and nothing is lost.
+    earlier = _manifest_names(out_dir)
+    foreign = [n for n in names if n not in earlier and (out_dir / n).exists()]
+    if any(not (out_dir / n).is_file() or (out_dir / n).is_symlink() for n in foreign):
+        refuse_foreign_outputs(out_dir, names)  # a folder or link under an output name
+    from stereovision.io import keep_previous
+
+    kept_aside = [(n, keep_previous(out_dir / n)) for n in foreign]
     scene_dir = _demo_scene_dir()
     scene = load_scene(scene_dir)
     if scene.gt is None:
@@ -869,6 +877,8 @@ def cmd_demo(args: argparse.Namespace) -> int:
         print(f"  {name:14s} {path}")
     for path in remove_stale_outputs(out_dir, written):
         print(f"  removed {path.name} of an earlier run (not written by this one)")
+    for name, kept in kept_aside:
+        print(f"  the {name} that was there (no earlier run's output) is kept as {kept}")
     return 0
 
 
