@@ -1098,25 +1098,23 @@ def positive_pixels(text: str) -> int:
     Refused by argparse in the option's name (``argument --max-disparity: ...``), not later by
     ``depth_map`` in its parameter's.
     """
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number of pixels above 0, got {text!r}")
-    return value
+    return _whole_above_zero(text, "a whole number of pixels above 0")
 
 
 def positive_count(text: str) -> int:
     """argparse type of a count (``--frames``, ``--every``, ``--check-every``): a whole number
     above 0, refused in the option's name (the library's parameter name, ``frames:`` or
     ``check_every:``, was what the CLI said)."""
+    return _whole_above_zero(text, "a whole number above 0")
+
+
+def _whole_above_zero(text: str, what: str) -> int:
     try:
         value = int(text)
     except ValueError:
         value = 0
     if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a whole number above 0, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
     return value
 
 
