@@ -84,6 +84,11 @@ JPEG_QUALITY = 85
 #: The 3-D surface uses every ``step``-th pixel so that it has at most this many vertices.
 MAX_MESH_VERTICES = 120_000
 
+#: Most points the 3-D view draws of a cloud (an opened file, a computed pair in "points"
+#: mode): more are shown as an evenly spaced subset of this many (``stereovision view``'s
+#: cap, :func:`stereovision.render.display_subset`), said in the caption. Files are only read.
+MAX_SHOWN_POINTS = 2_000_000
+
 #: Progress (per cent) reached at each stage reported by ``depth_map``.
 _STAGE_PROGRESS = {
     "rectify": 10,
@@ -196,6 +201,40 @@ def _data_url(image: npt.NDArray[np.uint8], width: int = DISPLAY_WIDTH) -> str:
     if not ok:
         raise OSError("could not encode an image for the page")
     return "data:image/jpeg;base64," + base64.b64encode(buf.tobytes()).decode("ascii")
+
+
+def shown_cloud(points: npt.ArrayLike, colors: npt.ArrayLike | None = None) -> tuple[Any, str]:
+    """The cloud the 3-D view draws of ``points``, and what to say of its count.
+
+    At most :data:`MAX_SHOWN_POINTS`, evenly spaced (:func:`~stereovision.render.display_subset`):
+    a cloud of millions of points took the server tens of seconds per frame.
+
+    Parameters
+    ----------
+    points : array_like, (N, 3)
+    colors : array_like, (N, 3), optional
+
+    Returns
+    -------
+    (pyvista.PolyData, str)
+        The cloud drawn and its count: ``"N points"``, or ``"2,000,000 of 15,000,000 points
+        shown"`` when a subset is drawn.
+
+    Examples
+    --------
+    >>> cloud, said = shown_cloud(np.ones((5, 3)))
+    >>> cloud.n_points, said
+    (5, '5 points')
+    """
+    from stereovision.render import display_subset, point_cloud
+
+    pts, cols = display_subset(points, colors, MAX_SHOWN_POINTS)
+    total = len(np.asarray(points))
+    if len(pts) < total:
+        said = f"{len(pts):,} of {total:,} points shown, evenly spaced"
+    else:
+        said = f"{total} points"
+    return point_cloud(pts, cols), said
 
 
 def draw_matches(
@@ -755,6 +794,8 @@ class StereoApp:
         #: whichever way the surface / points toggle is set, until the next computed pair.
         self._cloud: Any = None
         self._cloud_caption = ""
+        #: The 3-D caption's count of the computed pair's points when a subset is drawn.
+        self._points_note = ""
         # what the page shows came from: put back when a new pair fails to compute, so that
         # Check rows and Find floor never work on a pair the page does not show
         self._shown: dict[str, Any] | None = None
@@ -1101,17 +1142,17 @@ class StereoApp:
     def open_cloud(self) -> None:
         """Show a point-cloud file (PLY / PCD / NPZ) from the allowed folders in the 3-D view."""
         from stereovision.export import load_cloud
-        from stereovision.render import point_cloud
 
         try:
             path = self.folders.resolve(self.state.cloud_path or "")
             pts, cols = load_cloud(path)
-            cloud = point_cloud(pts, cols)
+            cloud, count = shown_cloud(pts, cols)
+            del pts, cols  # the drawn subset is a copy: the file's arrays can go
         except (ValueError, OSError) as exc:
             self._fail(exc)
             return
         self._cloud = cloud
-        self._cloud_caption = f"{self.folders.label(path)}: {cloud.n_points} points"
+        self._cloud_caption = f"{self.folders.label(path)}: {count}"
         self._show_geometry(cloud, None)
         self._done()
         with self.state:
@@ -1547,6 +1588,7 @@ class StereoApp:
         if view.mesh is not None:  # drawn as the points / surface toggle shows
             self._show_geometry(self._geometry_for_mode(), view.intrinsics)
         else:
+            self._points_note = ""
             actor = self.plotter.actors.get("scene")
             if actor is not None:
                 self.plotter.renderer.remove_actor(actor)
@@ -1558,7 +1600,7 @@ class StereoApp:
             st.img_matches = view.matches_url
             st.depth_caption, st.stats = view.texts(self._unit)
             st.disparity_caption = view.disparity_caption
-            st.message_3d = view.message_3d
+            st.message_3d = self._scene_message()
             st.progress = 100
             st.busy = False
             st.status = "ready"
@@ -1570,16 +1612,24 @@ class StereoApp:
     # ------------------------------------------------------------------------- 3-D view
 
     def _geometry_for_mode(self) -> Any:
-        from stereovision.render import point_cloud
-
+        self._points_note = ""
         if self._cloud is not None:
             return self._cloud  # an opened file: points in either mode
         v = self.view
         if v is None or v.mesh is None:
             return None
         if self.state.view_mode == "points":
-            return point_cloud(v.result.points, v.result.colors)
+            cloud, count = shown_cloud(v.result.points, v.result.colors)
+            if cloud.n_points < len(v.result.points):
+                self._points_note = count
+            return cloud
         return v.mesh
+
+    def _scene_message(self) -> str:
+        """The 3-D caption of the computed pair on show: its own, and in "points" mode the
+        count of a subset drawn."""
+        said = self.view.message_3d if self.view is not None else ""
+        return f"{said} {self._points_note}".strip() if self._points_note else said
 
     def _show_geometry(self, geometry: Any, intrinsics: Any) -> None:
         from stereovision.render import add_geometry, keep_robust_clipping, median_depth
@@ -1658,6 +1708,9 @@ class StereoApp:
         geometry = self._geometry_for_mode()
         if geometry is not None:
             self._show_geometry(geometry, self.view.intrinsics if self.view else None)
+            if self._page_before is None:  # not while a new pair computes (its caption stays)
+                with self.state:
+                    self.state.message_3d = self._scene_message()
 
     # ------------------------------------------------------------------------- layout
 
