@@ -2009,6 +2009,21 @@ def test_average_switch_reports_the_frames(page):
     page.click("#average-switch")  # off again for the tests that follow
 
 
+def test_the_average_switch_label_is_one_line(page):
+    """The switch sat under the Capture button, in half the panel: its label wrapped onto two
+    lines. It has a row of its own now, its label on one line."""
+    _wait_computations(page, 1)
+    label, height, line = page.evaluate(
+        """() => { const l = document.querySelector('#average-switch').closest('.v-switch')
+              .querySelector('label');
+              const text = document.createRange(); text.selectNodeContents(l);
+              return [l.innerText, text.getBoundingClientRect().height,
+                      parseFloat(getComputedStyle(l).lineHeight)]; }"""
+    )
+    assert label == "average 8 still frames (low light)"
+    assert height < 1.5 * line, (height, line)  # the text's own box: one line high
+
+
 def test_method_switch_updates_disparity(page):
     from stereovision.depth import METHODS
 

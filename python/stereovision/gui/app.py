@@ -1825,18 +1825,20 @@ class StereoApp:
                             disabled=("!live",),
                             prepend_icon="mdi-camera",
                         )
-                        v3.VSwitch(
-                            label=f"average {AVERAGE_FRAMES} still frames (low light)",
-                            v_model=("average",),
-                            density="compact",
-                            hide_details=True,
-                            color="primary",
-                            disabled=("!live",),
-                            id="average-switch",
-                        )
                     with v3.VCol(cols=6):
                         html.Div("resolution", classes="text-caption")
                         _toggle("resolution", RESOLUTIONS, "resolution-toggle", "resolution")
+                # a row of its own: under the Capture button, in half the panel, its label
+                # wrapped onto two lines
+                v3.VSwitch(
+                    label=f"average {AVERAGE_FRAMES} still frames (low light)",
+                    v_model=("average",),
+                    density="compact",
+                    hide_details=True,
+                    color="primary",
+                    disabled=("!live",),
+                    id="average-switch",
+                )
                 v3.VSelect(
                     label="Scene folder",
                     v_model=("scene",),
