@@ -1857,6 +1857,15 @@ def gui_data(tmp_path_factory):
     from stereovision.io import write_ply
 
     write_ply(d / "empty.ply", np.zeros((0, 3), np.float32))
+    # a wide scene (450 x 150, KITTI's shape): rows 110-259 of the cones pair
+    (d / "wide").mkdir()
+    for side in ("left", "right"):
+        cv2.imwrite(
+            str(d / "wide" / f"{side}.png"), cv2.imread(str(CONES / f"{side}.png"))[110:260]
+        )
+    (d / "wide" / "calib.txt").write_text(
+        calib.replace("187;", f"{187 - 110};").replace(f"height={left.shape[0]}", "height=150")
+    )
     return d
 
 
@@ -2218,6 +2227,46 @@ def test_save_units_range_and_colour_keys_on_the_page(page, gui_data):
     page.click("#save-btn")
     assert "nothing was overwritten" in _wait_error(page, "already holds")
     page.click("#error-alert button")
+
+
+def test_a_wide_scene_is_shown_whole_in_the_3d_view(page, gui_data):
+    """The 3-D view was 360 px high whatever the scene: a KITTI scene's view, as high as its
+    image, showed 40 % of its width, both sides cut off; and its two images, side by side, were
+    60 px high. The view now takes the image's shape (at zero controls it is the left image,
+    whole), and a pair more than twice as wide as high shows its images one above the other.
+    Runs last of the page's tests: it leaves the cameras for a scene."""
+    page.wait_for_function("Number(document.querySelector('#computations')?.textContent) >= 1")
+    n = _computations(page)  # (the status may be the error of the test before: not waited for)
+    page.locator(".v-select:has(#scene-select) .v-field").click()
+    page.locator(".v-overlay .v-list-item", has_text="wide").first.click()
+    _wait_computations(page, n + 1)
+    assert page.inner_text("#source-label").endswith("/wide")
+    boxes = page.evaluate(
+        """() => ['#view-3d', '#img-left', '#img-right', '#img-disparity', '#img-depth',
+                  '#panel-acquisition'].map(s => {
+              const r = document.querySelector(s).getBoundingClientRect();
+              return [r.left, r.top, r.width, r.height]; })"""
+    )
+    view, left, right, disparity, depth, panel = boxes
+    assert view[2] / view[3] == pytest.approx(3.0, rel=0.02)  # the image's 450 x 150
+    assert right[1] >= left[1] + left[3] and depth[1] >= disparity[1] + disparity[3]
+    assert left[2] > 0.8 * panel[2]  # a row each: the panel's width, not half of it
+    # at zero controls the view is the left image: its whole width, not the middle of it
+    # (the surface's pixels against the image's: 0.69 here, 0.20 against its middle 42 %)
+    from stereovision.render import BACKGROUND
+
+    page.click("#reset-camera")
+    image = cv2.imread(str(gui_data / "wide" / "left.png"), cv2.IMREAD_GRAYSCALE)
+    deadline = time.monotonic() + PAGE_TIMEOUT_MS / 1000
+    corr = -1.0
+    while time.monotonic() < deadline and corr < 0.5:  # until the new frame has arrived
+        shot = _view_image(page)
+        drawn = np.abs(shot - np.array(BACKGROUND[::-1])).max(axis=-1) > 10
+        gray = cv2.cvtColor(shot.astype(np.uint8), cv2.COLOR_BGR2GRAY)
+        ref = cv2.resize(image, (gray.shape[1], gray.shape[0]), interpolation=cv2.INTER_AREA)
+        corr = float(np.corrcoef(gray[drawn], ref[drawn])[0, 1]) if drawn.mean() > 0.5 else -1
+    assert corr >= 0.5, corr
+    _shot(page, "gui-wide.png")
 
 
 def test_open_stereo_source_loops_video_files(tmp_path):

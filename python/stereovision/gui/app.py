@@ -84,6 +84,16 @@ JPEG_QUALITY = 85
 #: The 3-D surface uses every ``step``-th pixel so that it has at most this many vertices.
 MAX_MESH_VERTICES = 120_000
 
+#: The 3-D view's width : height when it shows no camera's view (an opened cloud file); with
+#: one it takes the camera image's own, so that the whole image is in view (a fixed 360 px
+#: high view cut off both sides of a KITTI scene: 40 % of its width was shown).
+VIEW_ASPECT = 4 / 3
+#: The 3-D view is at most this high (px); a portrait image's view is then wider than the image.
+VIEW_MAX_HEIGHT_PX = 480
+#: A pair wider than this (width / height) shows its two images one above the other: side by
+#: side, a KITTI pair (1242 x 375) was two pictures 60 px high.
+WIDE_ASPECT = 2.0
+
 #: Most points the 3-D view draws of a cloud (an opened file, a computed pair in "points"
 #: mode): more are shown as an evenly spaced subset of this many (``stereovision view``'s
 #: cap, :func:`stereovision.render.display_subset`), said in the caption. Files are only read.
@@ -118,6 +128,14 @@ AUTO_HINT = "auto: estimated from the images"
 
 #: The disparity picture's caption when it has no disparity to scale (nothing matched).
 DISPARITY_CAPTION = "disparity"
+
+
+#: The 3-D view's box: the camera image's shape (``view_aspect``), at most
+#: :data:`VIEW_MAX_HEIGHT_PX` high (a JavaScript expression of the page's state).
+VIEW_STYLE = (
+    "`position: relative; width: 100%; aspect-ratio: ${view_aspect}; "
+    f"max-height: {VIEW_MAX_HEIGHT_PX}px;`"
+)
 
 
 def _planned_stages(method: str, calibrated: bool) -> list[str]:
@@ -182,6 +200,7 @@ _RESULT_KEYS = (
     "floor_label",
     "stats",
     "message_3d",
+    "wide_pair",
 )
 #: The 3-D caption while a new pair computes (the view keeps the previous pair until then).
 PENDING_3D = "computing the new pair: the 3-D view still shows the previous one"
@@ -859,6 +878,8 @@ class StereoApp:
         st.pair_folders = []
         st.images = []
         st.view_mode = "surface"
+        st.view_aspect = VIEW_ASPECT
+        st.wide_pair = False
         st.max_disp = ""
         st.max_disp_hint = AUTO_HINT
         st.units = list(UNITS)
@@ -1208,6 +1229,7 @@ class StereoApp:
                     if self._page_before is None:
                         self._page_before = {k: st[k] for k in _RESULT_KEYS}
                     st.img_left, st.img_right = _data_url(left), _data_url(right)
+                    st.wide_pair = left.shape[1] > WIDE_ASPECT * left.shape[0]
                     st.img_disparity = st.img_depth = st.img_matches = st.img_floor = ""
                     st.floor_label = st.stats = ""
                     st.depth_caption = DEPTH_CAPTION
@@ -1598,6 +1620,8 @@ class StereoApp:
             st.img_left, st.img_right = view.left_url, view.right_url
             st.img_disparity, st.img_depth = view.disparity_url, view.depth_url
             st.img_matches = view.matches_url
+            h, w = view.result.disparity.shape[:2]
+            st.wide_pair = w > WIDE_ASPECT * h
             st.depth_caption, st.stats = view.texts(self._unit)
             st.disparity_caption = view.disparity_caption
             st.message_3d = self._scene_message()
@@ -1635,6 +1659,9 @@ class StereoApp:
         from stereovision.render import add_geometry, keep_robust_clipping, median_depth
 
         self._intrinsics = intrinsics
+        aspect = VIEW_ASPECT if intrinsics is None else intrinsics.width / intrinsics.height
+        with self.state:  # the view's shape: the camera image's, so that all of it is in view
+            self.state.view_aspect = round(aspect, 4)
         self._focal = median_depth(geometry)
         add_geometry(self.plotter, geometry)
         if self._clip_tag is not None:
@@ -1765,9 +1792,7 @@ class StereoApp:
                             with v3.VCard(id="panel-3d", classes="fill-height"):
                                 v3.VCardTitle("3 · 3-D view")
                                 with v3.VCardText():
-                                    with html.Div(
-                                        id="view-3d", style="height: 360px; position: relative;"
-                                    ):
+                                    with html.Div(id="view-3d", style=(VIEW_STYLE,)):
                                         self._remote_view = plotter_ui(
                                             self.plotter,
                                             mode="server",
@@ -1808,10 +1833,10 @@ class StereoApp:
                             title="no calibration: rectify the pair from its own features",
                         )
                 with v3.VRow(dense=True):
-                    with v3.VCol(cols=6):
+                    with v3.VCol(cols=("wide_pair ? 12 : 6",)):
                         html.Div("left", classes="text-caption")
                         html.Img(id="img-left", src=("img_left",), style=img_style)
-                    with v3.VCol(cols=6):
+                    with v3.VCol(cols=("wide_pair ? 12 : 6",)):
                         html.Div("right", classes="text-caption")
                         html.Img(id="img-right", src=("img_right",), style=img_style)
                 with v3.VRow(dense=True, classes="mt-2", align="center"):
@@ -1917,14 +1942,14 @@ class StereoApp:
                     with v3.VCol(cols=4):
                         _toggle("unit", UNITS, "unit-toggle", "unit", button_classes="text-none")
                 with v3.VRow(dense=True, classes="mt-2"):
-                    with v3.VCol(cols=6):
+                    with v3.VCol(cols=("wide_pair ? 12 : 6",)):
                         html.Div(
                             "{{ disparity_caption }}",
                             id="disparity-caption",
                             classes="text-caption",
                         )
                         html.Img(id="img-disparity", src=("img_disparity",), style=img_style)
-                    with v3.VCol(cols=6):
+                    with v3.VCol(cols=("wide_pair ? 12 : 6",)):
                         html.Div("{{ depth_caption }}", id="depth-caption", classes="text-caption")
                         html.Img(id="img-depth", src=("img_depth",), style=img_style)
                 with html.Div(v_if="img_matches", classes="mt-2"):
