@@ -723,6 +723,20 @@ def test_a_rig_whose_baseline_runs_along_a_view_is_not_rectified(tmp_path: Path)
     assert main(["info", str(path)]) == 2
 
 
+def test_describe_lists_no_step_past_the_farthest_depth() -> None:
+    """doffs +100 px (cx2 = cx1 + 100): the farthest depth is fB / 101 = 0.50 m, yet depth
+    steps at 1, 2, 5 and 10 m were listed as if reachable. fB = 50 m px."""
+    K2 = np.array([[500.0, 0.0, 260.0], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]])
+    text = rect_calib(K2=K2).describe()
+    assert "farthest depth, at a disparity of 1 px: 49.5 cm" in text
+    assert (
+        "depth step per pixel of disparity: at 1 m none, at 2 m none, at 5 m none, at 10 m none "
+        "(none: beyond the farthest depth) (a 0.1 px error: a tenth of it)"
+    ) in text
+    near = rect_calib().describe()  # doffs 0: farthest 50 m, every step listed
+    assert " none" not in near.splitlines()[4]
+
+
 @pytest.mark.parametrize(
     ("cx2", "far", "near"),
     [

@@ -805,17 +805,26 @@ class Calibration:
         )
         if not near:  # doffs <= -256: every range ends before a disparity gives a depth
             near = f"none (a depth needs a disparity above {-doffs:.2f} px)"
-        steps = ", ".join(f"at {z:g} m {length(float(self.depth_step(z)))}" for z in depths)
         # d + doffs <= 0 is at or beyond infinity: with doffs <= -1 (cx2 < cx1 - 1) a disparity
         # of 1 px has no depth, and the farthest is one pixel above infinity's -doffs (it said
         # "inf m").
         if 1 + doffs > 0:
-            far = f"farthest depth, at a disparity of 1 px: {length(f * b / (1 + doffs))}"
+            far_m = f * b / (1 + doffs)
+            far = f"farthest depth, at a disparity of 1 px: {length(far_m)}"
         else:
+            far_m = f * b
             far = (
                 f"farthest depth, at a disparity of {1 - doffs:.2f} px (1 px above infinity's "
-                f"{-doffs:.2f} px): {length(f * b)}"
+                f"{-doffs:.2f} px): {length(far_m)}"
             )
+        # a depth past the farthest has no step (doffs 100 px: farthest 0.5 m, yet steps at 5
+        # and 10 m were listed)
+        steps = ", ".join(
+            f"at {z:g} m {length(float(self.depth_step(z)))}" if z <= far_m else f"at {z:g} m none"
+            for z in depths
+        )
+        if any(z > far_m for z in depths):
+            steps += " (none: beyond the farthest depth)"
         kind = (
             "rectified pair"
             if self.rectified
