@@ -9,7 +9,9 @@
 - ``gui``: ``docs/images/gui-3d.png`` and ``gui-methods.png``, screenshots of ``stereovision
   gui`` on the bundled cones in headless chromium (Debian's ``/usr/bin/chromium``, driven by
   Playwright): the page after Check rows with the 3-D view turned 15 degrees right and moved
-  1 m left, then the page after the Gabor method button.
+  1 m left, then the page after the Gabor method button and Save. The GUI is started as the
+  README tells users to, with ``--data`` on a folder holding a copy of the cones (in a
+  temporary folder), so that its Save field offers a folder to write into.
 
 Every picture is written as an optimised PNG, with a dithered 256-colour palette where the
 full-colour file is larger than :data:`MAX_BYTES`, undithered if that is still larger (then
@@ -198,12 +200,36 @@ def _free_port() -> int:
         return int(s.getsockname()[1])
 
 
+#: The ``--data`` folder of the GUI pictures, relative to the server's working folder (a
+#: temporary one): it holds a copy of the bundled cones, as the README's ``--data ~/scenes``.
+GUI_DATA = "scenes"
+
+
+def gui_command(workdir: Path, port: int) -> list[str]:
+    """The ``stereovision gui`` command of the pictures, run in ``workdir``.
+
+    Copies the bundled cones into ``workdir/scenes/cones`` and gives ``--data scenes``, as the
+    README tells users to start the GUI: its Save field offers ``scenes/saved`` (shown as the
+    folder's full path, which :func:`draw_gui` keeps short).
+    """
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    shutil.copytree(bundled_data_dir() / "cones", workdir / GUI_DATA / "cones")
+    gui = [sys.executable, "-m", "stereovision.gui", "--port", str(port), "--no-browser"]
+    return [*gui, "--data", GUI_DATA]
+
+
 @contextmanager
-def gui_server() -> Iterator[str]:
-    """``stereovision gui`` on the bundled cones on a free local port; yields its URL."""
+def gui_server(workdir: Path) -> Iterator[str]:
+    """``stereovision gui --data scenes`` (:func:`gui_command`) in ``workdir`` on a free local
+    port; yields its URL."""
     port = _free_port()
-    cmd = [sys.executable, "-m", "stereovision.gui", "--port", str(port), "--no-browser"]
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    cmd = gui_command(workdir, port)
+    proc = subprocess.Popen(
+        cmd, cwd=workdir, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+    )
     try:
         end = time.monotonic() + TIMEOUT_S
         while True:
@@ -268,7 +294,12 @@ def draw_gui(out_dir: Path) -> None:
 
     if not CHROMIUM.exists():
         raise FileNotFoundError(f"{CHROMIUM} not found (apt-get install -y chromium)")
-    with gui_server() as url, sync_playwright() as p:
+    # a short folder name: the Save field shows the --data folder's full path
+    with (
+        tempfile.TemporaryDirectory(prefix="sv-") as work,
+        gui_server(Path(work)) as url,
+        sync_playwright() as p,
+    ):
         browser = p.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
         pg = browser.new_page(viewport=VIEWPORT)
         pg.set_default_timeout(TIMEOUT_S * 1000)
@@ -292,6 +323,10 @@ def draw_gui(out_dir: Path) -> None:
         pg.click("#method-gabor")
         _wait_ready(pg, 2)
         _wait_view_change(pg, turned)  # back at the left camera, the Gabor map's surface
+        pg.click("#save-btn")  # into the offered folder: scenes/saved
+        pg.wait_for_function(
+            "document.querySelector('#save-label')?.textContent.startsWith('saved ')"
+        )
         pg.locator("body").click(position={"x": 5, "y": 5})
         save_png(Image.open(io.BytesIO(pg.screenshot())), out_dir / "gui-methods.png")
         browser.close()

@@ -189,3 +189,33 @@ def test_docs_pictures_script_redraws_the_demo_pictures(tmp_path: Path) -> None:
         img = cv2.imread(str(tmp_path / name))
         assert img is not None and img.shape == (375, 450, 3), name
         assert (tmp_path / name).stat().st_size < 300_000, name
+
+
+def test_docs_pictures_gui_offers_a_save_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The README's GUI pictures showed the Save field empty, "start the GUI with --data DIR":
+    the script started the GUI without ``--data``. It starts it as the README tells users to,
+    ``--data scenes`` on a copy of the cones in its working folder: the page offers
+    ``scenes/saved``."""
+    pytest.importorskip("trame")
+    import argparse
+
+    from stereovision.gui import add_arguments, build_app, bundled_data_dir
+    from stereovision.gui.app import SAVE_HINT
+
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import plot_docs_pictures
+
+    cmd = plot_docs_pictures.gui_command(tmp_path, 8123)
+    assert cmd[1:3] == ["-m", "stereovision.gui"]
+    assert cmd[cmd.index("--data") + 1] == "scenes"
+    cones = bundled_data_dir() / "cones"
+    for name in ("left.png", "right.png", "calib.txt"):
+        assert (tmp_path / "scenes" / "cones" / name).read_bytes() == (cones / name).read_bytes()
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    monkeypatch.chdir(tmp_path)  # the server's working folder
+    app = build_app(parser.parse_args(cmd[3:]))
+    assert app.state.save_dir == str(tmp_path.resolve() / "scenes" / "saved")
+    assert app.state.save_hint == SAVE_HINT
