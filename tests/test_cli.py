@@ -656,6 +656,31 @@ def test_rectify_with_calib_removes_an_earlier_runs_homographies(
     assert (out / "rectification.json").read_text() == '{"mine": 1}'
 
 
+def test_rectify_with_calib_keeps_homographies_it_did_not_write(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A rectification.json of the user's (homographies found elsewhere, copied in) in the -o
+    folder of a run with --calib was deleted as an earlier run's, though the manifest did not
+    list it: it is kept now, and the line says its homographies do not fit the images."""
+    scene = data_dir / "eth3d" / "terrace"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    elsewhere = tmp_path / "elsewhere"
+    assert main(["rectify", *pair, "--force", "-o", str(elsewhere)]) == 0
+    mine = (elsewhere / "rectification.json").read_bytes()
+    out = tmp_path / "rect"
+    out.mkdir()
+    (out / "rectification.json").write_bytes(mine)
+    capsys.readouterr()
+    assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
+    assert (out / "rectification.json").read_bytes() == mine
+    assert capsys.readouterr().out.splitlines()[-1] == (
+        f"  kept {out / 'rectification.json'} (not listed as an earlier run's output there), "
+        "but its homographies do not fit the images written now (rectified by --calib): do not "
+        "give it to depth --rectification with them"
+    )
+    assert "rectification.json" not in json.loads((out / ".stereovision-rectify.json").read_text())
+
+
 def test_rectify_refuses_to_replace_a_file_it_did_not_write(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

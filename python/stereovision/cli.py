@@ -704,7 +704,8 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         # --rectification` would warp the images written now (calibrated, or the pair as
         # given) by its homographies. It may have been this very pair's (a --force run before
         # a plain one): the line says why it goes, not whose it was. A file of that name that
-        # is not one of ours stays.
+        # the manifest does not list is the user's (homographies of theirs, or of an earlier
+        # version's run): it stays, and the line says they do not fit.
         from stereovision.uncalibrated import UncalibratedRectification
 
         try:
@@ -712,12 +713,19 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         except (OSError, ValueError):
             pass
         else:
-            stale.unlink()
             now = "the pair as given" if given is not None else "rectified by --calib"
-            print(
-                f"  removed {stale.name} of an earlier run (its homographies do not fit the "
-                f"images written now: {now})"
-            )
+            if stale.name in earlier:
+                stale.unlink()
+                print(
+                    f"  removed {stale.name} of an earlier run (its homographies do not fit the "
+                    f"images written now: {now})"
+                )
+            else:
+                print(
+                    f"  kept {stale} (not listed as an earlier run's output there), but its "
+                    f"homographies do not fit the images written now ({now}): do not give it "
+                    "to depth --rectification with them"
+                )
     record_outputs(out, set(written), RECTIFY_MANIFEST, RECTIFY_OUTPUTS)
     return 0
 
