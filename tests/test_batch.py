@@ -802,6 +802,29 @@ def test_batch_refuses_to_replace_a_file_it_did_not_write(
     assert cv2.imread(str(out / "a" / "disparity.png")) is not None
 
 
+def test_batch_resumes_a_pair_written_by_a_run_killed_before_recording_it(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A run killed after writing a pair's folder but before its summary recorded it (record()
+    holds writes back; SIGKILL, the OOM killer) leaves the pair "pending" with no outputs
+    listed: the rerun refused the pair's own disparity.png as a file it did not write, exit 2.
+    The run that left it pending had checked the folder before it began, so the files under
+    the names it would write are its own: the pair is redone over them."""
+    src, out = tmp_path / "drive", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png")
+    args = ["--workers", "1", "--max-disparity", "16"]
+    assert main(["batch", str(src), "-o", str(out), *args]) == 0
+    data = _summary(out)
+    entry = data["pairs"]["a"]
+    killed = {k: entry[k] for k in ("left", "right", "calib", "options", "fingerprint")}
+    data["pairs"]["a"] = {"status": "pending", **killed}  # as saved before the pair was written
+    (out / SUMMARY_NAME).write_text(json.dumps(data))
+    capsys.readouterr()
+    assert main(["batch", str(src), "-o", str(out), *args]) == 0, capsys.readouterr().err
+    assert _summary(out)["run"]["processed"] == 1
+    assert _summary(out)["pairs"]["a"]["outputs"] == sorted(DISPARITY_FILES)
+
+
 def test_batch_refuses_to_replace_a_summary_json_it_did_not_write(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -564,6 +564,23 @@ def _foreign_output(
     return None
 
 
+def _pending_outputs(entry: dict[str, Any]) -> list[str]:
+    """The files the run that left ``entry`` (a summary record still ``"pending"``) may have
+    written into the pair's folder, from the calibration and options it recorded."""
+    from stereovision.cli import planned_depth_outputs
+
+    options = entry.get("options")
+    if not isinstance(options, dict):
+        return []
+    return list(
+        planned_depth_outputs(
+            entry.get("calib") is not None,
+            bool(options.get("ground")),
+            options.get("grid") is not None,
+        )
+    )
+
+
 def _commit_pair(
     out: Path, name: str, files: dict[str, bytes], previous: list[str] | None = None
 ) -> Path:
@@ -1100,7 +1117,13 @@ def run_batch(
                 summary.pairs[job.name]["outputs"] = previous[job.name]
             todo.append(job)
             if foreign is None:
-                foreign = _foreign_output(out / job.name, job, opts, previous.get(job.name))
+                recorded = list(previous.get(job.name) or [])
+                if entry is not None and entry.get("status") == "pending":
+                    # a run stopped before recording the pair (killed, or its summary held back
+                    # by record()) may have written it: that run found no file under these names
+                    # that was not its own before it began, so what is there now is its output
+                    recorded += _pending_outputs(entry)
+                foreign = _foreign_output(out / job.name, job, opts, recorded)
         if others:
             # a second drive under the same pair names replaced the first one's outputs, unsaid
             name, image = others[0]
