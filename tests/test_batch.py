@@ -788,9 +788,9 @@ def test_batch_refuses_to_replace_a_file_it_did_not_write(
     capsys.readouterr()
     assert main(["batch", str(src), "-o", str(out), *args]) == 2
     assert capsys.readouterr().err.splitlines() == [
-        f"stereovision: error: output folder {out}: {out / 'a' / 'disparity.png'} was not "
-        "written by stereovision and would be replaced: give another output folder, or move or "
-        "remove that file"
+        f"stereovision: error: output folder {out}: {out / 'a' / 'disparity.png'} is not "
+        "listed as an earlier run's output there and would be replaced: give another output "
+        "folder, or move or remove that file"
     ]
     assert (out / "a" / "disparity.png").read_text() == "mine"
     assert sorted(p.name for p in (out / "a").iterdir()) == ["disparity.png"]

@@ -1135,8 +1135,8 @@ def run_batch(
             )
         if foreign is not None:  # the user's own file in a pair's folder: replaced, unsaid
             raise FileExistsError(
-                f"output folder {out}: {foreign} was not written by stereovision and would be "
-                "replaced: give another output folder, or move or remove that file"
+                f"output folder {out}: {foreign} is not listed as an earlier run's output there "
+                "and would be replaced: give another output folder, or move or remove that file"
             )
         if redone and log is not None:
             shown = sorted(changes)[:3] + (["..."] if len(changes) > 3 else [])
