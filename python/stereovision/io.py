@@ -170,6 +170,20 @@ def cannot_write_in(folder: PathLike) -> str | None:
     return None
 
 
+def _same_bytes(a: Path, b: Path, chunk: int = 1 << 20) -> bool:
+    """Whether files ``a`` and ``b`` hold the same bytes, read a chunk at a time (no cache, as
+    :func:`filecmp.cmp` keeps by size and modification time)."""
+    if a.stat().st_size != b.stat().st_size:
+        return False
+    with open(a, "rb") as fa, open(b, "rb") as fb:
+        while True:
+            x, y = fa.read(chunk), fb.read(chunk)
+            if x != y:
+                return False
+            if not x:
+                return True
+
+
 def keep_previous(path: PathLike) -> Path | None:
     """Copy an existing file aside as ``NAME.previous.EXT`` before a command replaces it.
 
@@ -191,20 +205,23 @@ def keep_previous(path: PathLike) -> Path | None:
     pathlib.Path or None
         The copy, or None when ``path`` held no file.
     """
+    import shutil
+
     p = Path(path)
     if not p.is_file():
         return None
-    data = p.read_bytes()  # a calibration or camera_info file: small
+    # compared and copied in chunks, not read whole: besides calibrations, `demo` keeps a
+    # cloud.ply of any size aside this way
     n = 1
     while True:
         kept = p.with_name(f"{p.stem}.previous{'' if n == 1 else f'.{n}'}{p.suffix}")
         if not kept.exists():
             break
-        if kept.is_file() and kept.read_bytes() == data:
+        if kept.is_file() and _same_bytes(kept, p):
             return kept  # already kept: nothing to copy
         n += 1
-    with atomic_write(kept) as dst:
-        dst.write(data)
+    with open(p, "rb") as src, atomic_write(kept) as dst:
+        shutil.copyfileobj(src, dst, 1 << 20)
     return kept
 
 
