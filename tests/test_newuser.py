@@ -18,7 +18,9 @@ CONES = Path(str(resources.files("stereovision") / "data" / "cones"))
 def test_the_sample_is_the_installed_packages() -> None:
     """These runs read the sample the package ships (they read ``python/stereovision/data`` of
     the source tree, which a wheel missing the sample would not have shown)."""
-    assert CONES.is_relative_to(Path(stereovision.__file__).resolve().parent)
+    # both resolved: a package imported through a symlinked folder (macOS's /tmp, a venv on a
+    # linked disk) gives resources.files() the link's path and __file__.resolve() the target's
+    assert CONES.resolve().is_relative_to(Path(stereovision.__file__).resolve().parent)
     assert sorted(p.name for p in CONES.glob("*.png")) == ["left.png", "right.png"]
     assert (CONES / "calib.txt").is_file() and (CONES / "gt_disp.pfm").is_file()
 
