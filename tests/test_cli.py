@@ -552,6 +552,27 @@ def test_demo_keeps_a_file_it_did_not_write(
     )
 
 
+def test_demo_refuses_a_broken_link_under_an_output_name(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A link under an output name is refused by demo as by depth, but a link whose target is
+    gone (exists() False) was neither copied aside nor refused: the run replaced it silently.
+    It is refused up front now, in depth's line."""
+    out = tmp_path / "d"
+    out.mkdir()
+    (out / "cloud.ply").symlink_to(tmp_path / "on_a_drive_not_mounted.ply")
+    assert main(["demo", "-o", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""  # before any work
+    assert captured.err == (
+        f"stereovision: error: -o {out}: {out / 'cloud.ply'} is not listed as an earlier "
+        "run's output there and would be replaced: give another -o folder, or move or remove "
+        "that file\n"
+    )
+    assert (out / "cloud.ply").is_symlink()
+    assert sorted(p.name for p in out.iterdir()) == ["cloud.ply"]
+
+
 def test_a_12_bit_pair_gets_one_warning_line_per_image(tmp_path: Path, data_dir: Path) -> None:
     """A 12-bit pair in 16-bit PNGs printed four warning lines, two per image (the 8-bit copy's
     and the grey image's conversions each warned)."""

@@ -823,7 +823,11 @@ def cmd_demo(args: argparse.Namespace) -> int:
     # version before the manifest: `make demo` after an update) is copied aside, not refused:
     # the Quick start's command keeps working and nothing is lost.
     earlier = _manifest_names(out_dir)
-    foreign = [n for n in names if n not in earlier and (out_dir / n).exists()]
+    foreign = [
+        n
+        for n in names
+        if n not in earlier and ((out_dir / n).exists() or (out_dir / n).is_symlink())
+    ]
     if any(not (out_dir / n).is_file() or (out_dir / n).is_symlink() for n in foreign):
         refuse_foreign_outputs(out_dir, names)  # a folder or link under an output name
     from stereovision.io import keep_previous
