@@ -2499,8 +2499,9 @@ def _calibrate_source(
 #: ``--report`` folders.
 CALIBRATE_OUTPUTS = ("left.yaml", "right.yaml", "report.html", "report.yaml", "report.json")
 
-#: What ``stereovision calibrate`` wrote into its ``--ros`` / ``--report`` folder (JSON list of
-#: file names, as ``depth``'s manifest): the files a later run replaces.
+#: What ``stereovision calibrate`` wrote into its ``--report`` folder (JSON list of file names,
+#: as ``depth``'s manifest): the files a later run replaces. ``--ros`` keeps none: its earlier
+#: ``left.yaml`` / ``right.yaml`` are kept aside (:func:`stereovision.io.keep_previous`).
 CALIBRATE_MANIFEST = ".stereovision-calibrate.json"
 
 

@@ -304,10 +304,10 @@ def refuse_foreign_outputs(
 ) -> set[str]:
     """Refuse, before any work, to replace a file of ``out_dir`` that this tool did not write.
 
-    A file (or anything else) under one of ``names`` in ``out_dir`` is this tool's only when
-    :data:`DEPTH_MANIFEST` lists it: an earlier ``depth`` or ``demo`` run into the folder wrote
-    it, and a rerun replaces it. Any other, e.g. the user's own ``cloud.ply`` in a folder given
-    as ``-o``, would be replaced silently.
+    A file (or anything else, a link or a folder) under one of ``names`` in ``out_dir`` is this
+    tool's only when ``manifest`` there lists it: an earlier run of the command into the folder
+    wrote it, and a rerun replaces it. Any other, e.g. the user's own ``cloud.ply`` in a folder
+    given as ``-o``, would be replaced silently.
 
     Parameters
     ----------
