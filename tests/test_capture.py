@@ -945,6 +945,12 @@ def test_cli_capture(
     assert "3 pairs saved" in text and "skew mean" in text and "320x240" in text
     assert len(list(out.glob("left_*.png"))) == 3
     args = _parser().parse_args(
+        ["capture", "--left", str(left), "--right", str(right), "--count", "1",
+         "-o", str(tmp_path / "one")]
+    )  # fmt: skip
+    assert args.func(args) == 0
+    assert f"1 pair saved in {tmp_path / 'one'} (count reached)" in capsys.readouterr().out
+    args = _parser().parse_args(
         ["capture", "--left", str(board_videos[0]), "--right", str(board_videos[1]),
          "--chessboard", "9x6", "-o", str(tmp_path / "cb")]
     )  # fmt: skip
@@ -1339,7 +1345,10 @@ def test_temporal_average_of_shrunk_frames_runs_at_the_size_asked(
     for size, fed in (((160, 120), (120, 160, 3)), ((640, 480), (240, 320, 3))):
         tf = Spy(max_frames=4)
         tf.shapes = []
-        with StereoCamera(lpat, rpat, size=size) as cam:
+        with (
+            pytest.warns(UserWarning, match="its frames are resized"),
+            StereoCamera(lpat, rpat, size=size) as cam,
+        ):
             out = [capmod.temporal_average(tf, cam.read()) for _ in range(4)]
         assert tf.shapes == [fed] * 4, size
         assert all(left.shape == (size[1], size[0], 3) for left, _ in out)

@@ -1458,8 +1458,11 @@ def capture(
     last_index = -1  # the frame index of the pair saved last
 
     def kept_note() -> str:
-        kept = f"{len(saved)} of {count}" if count is not None else f"{len(saved)}"
-        return f"{kept} pairs were saved in {out} and are kept"
+        if count is not None:
+            return f"{len(saved)} of {count} pairs were saved in {out} and are kept"
+        if len(saved) == 1:
+            return f"1 pair was saved in {out} and is kept"
+        return f"{len(saved)} pairs were saved in {out} and are kept"
 
     while count is None or len(saved) < count:
         try:
@@ -1696,7 +1699,8 @@ def cmd_capture(args: argparse.Namespace) -> int:
         what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
         n = saved[0]  # the pair being saved is saved whole, and said
         print(
-            f"stereovision: {what}: {n} pairs saved in {args.output} this run are kept; run "
+            f"stereovision: {what}: {_pairs(n)} saved in {args.output} this run "
+            f"{'is' if n == 1 else 'are'} kept; run "
             "again to add more",
             file=sys.stderr,
         )
@@ -1705,11 +1709,16 @@ def cmd_capture(args: argparse.Namespace) -> int:
         cam.close()
     sk = result.skew
     print(
-        f"{len(result.saved)} pairs saved in {args.output} ({result.ended}); "
+        f"{_pairs(len(result.saved))} saved in {args.output} ({result.ended}); "
         f"{result.frames_read} pairs read; delivered {cam.describe()}; "
         f"skew mean {sk['mean_ms']:.2f} ms, max {sk['max_ms']:.2f} ms"
     )
     return 0
+
+
+def _pairs(n: int) -> str:
+    """``1 pair``, ``2 pairs``: the CLI's counts ("1 pairs saved" read badly)."""
+    return f"{n} pair" if n == 1 else f"{n} pairs"
 
 
 def add_cli(subparsers: Any) -> None:
