@@ -694,6 +694,10 @@ def test_baseline_implausible_for_its_unit_is_warned_once_and_printed_readably()
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         raw_calib(T=np.array([-4.0, 0.0, 0.0]), unit="mm")  # an endoscope's 4 mm
+    # one range for the warning and the unit it suggests: 4000 "m" would be a 4 m rig in mm,
+    # which is taken without a warning, so it is suggested (the hint's 5 mm .. 2 m left it out)
+    with pytest.warns(UserWarning, match=r"\(5 m\): .* With unit='mm' it would be 4(\.0+)? m\.$"):
+        raw_calib(T=np.array([-4000.0, 0.0, 0.0]))
 
 
 def test_a_rig_whose_baseline_runs_along_a_view_is_not_rectified(tmp_path: Path) -> None:

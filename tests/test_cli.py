@@ -344,7 +344,8 @@ def test_info_on_paper_says_the_baseline_is_in_metres(capsys: pytest.CaptureFixt
     out, err = capsys.readouterr()
     assert err.splitlines() == [
         "stereovision: warning: --baseline 120: 120 m is longer than a robot's rig (5 m); "
-        "--baseline is in metres (120 mm is --baseline 0.12, 120 cm is --baseline 1.2)"
+        "--baseline is in metres (120 mm is --baseline 0.12, 120 cm is --baseline 1.2, "
+        "120 in is --baseline 3.048)"
     ]
     assert "baseline 120.00 m (120 m)" in out
     # 12 may be mm, cm or inches: each is named, not the first unit alone (12 mm)
@@ -352,7 +353,14 @@ def test_info_on_paper_says_the_baseline_is_in_metres(capsys: pytest.CaptureFixt
     assert capsys.readouterr().err.splitlines() == [
         "stereovision: warning: --baseline 12: 12 m is longer than a robot's rig (5 m); "
         "--baseline is in metres (12 mm is --baseline 0.012, 12 cm is --baseline 0.12, "
-        "12 in is --baseline 0.3048)"
+        "12 ft is --baseline 3.6576, 12 in is --baseline 0.3048)"
+    ]
+    # the hint's range is the warning's (1 mm .. 5 m): a 4 m rig given in mm is named (the
+    # hint used 5 mm .. 2 m and named nothing for 4000, though 4 m is taken without a word)
+    assert main(["info", "--size", "1280x720", "--hfov", "90", "--baseline", "4000"]) == 0
+    assert capsys.readouterr().err.splitlines() == [
+        "stereovision: warning: --baseline 4000: 4000 m is longer than a robot's rig (5 m); "
+        "--baseline is in metres (4000 mm is --baseline 4)"
     ]
 
 

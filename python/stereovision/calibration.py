@@ -93,17 +93,16 @@ def _as_float_array(value: object, name: str, shapes: tuple[tuple[int, ...], ...
     return arr
 
 
-#: Baselines above this (metres) get a warning: almost always T, or the calibration board's
-#: square size, given in millimetres with the default unit "m" (83 m for a 8 cm rig). Long-range
-#: rigs on vehicles reach 1-2 m.
-LONG_BASELINE_M = 5.0
-#: Baselines below this (metres) get a warning too: the square size given in metres with
-#: unit="mm" (a 0.083 mm "rig" for 8.3 cm). The smallest stereo rigs (endoscopes) have a few
-#: millimetres.
-SHORT_BASELINE_M = 1e-3
-#: The baseline range (metres) a suggested other unit should bring the baseline into: from a
-#: phone's or an endoscope's rig to a car's.
-PLAUSIBLE_BASELINE_M = (0.005, 2.0)
+#: The plausible stereo baseline (metres), the one range every baseline message uses: a
+#: baseline outside it is warned about, and a unit suggested instead must bring it inside.
+#: Below: the square size given in metres with unit="mm" (a 0.083 mm "rig" for 8.3 cm); the
+#: smallest stereo rigs (endoscopes) have a few millimetres. Above: almost always T, or the
+#: calibration board's square size, given in millimetres with the default unit "m" (83 m for
+#: a 8 cm rig); long-range rigs on vehicles reach 1-2 m. (The unit hints used 5 mm .. 2 m while
+#: the warning used 1 mm .. 5 m, so 4000 with unit "m" was warned about without the hint that
+#: 4000 mm is a 4 m rig, a baseline the library takes without a word.)
+PLAUSIBLE_BASELINE_M = (1e-3, 5.0)
+SHORT_BASELINE_M, LONG_BASELINE_M = PLAUSIBLE_BASELINE_M
 #: Largest camera-matrix skew (px) taken without a warning: OpenCV's calibration writes 0, and
 #: a converted or hand-written file may carry rounding dust.
 SKEW_IGNORED_PX = 1e-6
