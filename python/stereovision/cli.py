@@ -102,11 +102,19 @@ def _npy_bytes(arr: np.ndarray) -> bytes:
     return bio.getvalue()
 
 
-def write_depth_outputs(result: Any, out_dir: Path, voxel: float | None = None) -> dict[str, Path]:
+def write_depth_outputs(
+    result: Any,
+    out_dir: Path,
+    voxel: float | None = None,
+    *,
+    counts: dict[str, int] | None = None,
+) -> dict[str, Path]:
     """Write disparity.png, disparity.pfm, depth.png, depth.npy, depth_mm.png (16-bit,
     millimetres) and cloud.ply (one point per ``voxel`` cube when given) into ``out_dir``.
 
-    Everything is encoded in memory first, then each file is replaced atomically.
+    Everything is encoded in memory first, then each file is replaced atomically. When
+    ``counts`` is given, ``counts["cloud.ply"]`` is set to the number of points written there
+    (``depth --voxel`` reports it without reading the file back).
     """
     from stereovision.io import make_folder, write_pfm, write_ply
 
@@ -132,6 +140,8 @@ def write_depth_outputs(result: Any, out_dir: Path, voxel: float | None = None) 
 
             points, colors = voxel_downsample(points, colors, voxel)
         written["cloud.ply"] = Path(write_ply(out_dir / "cloud.ply", points, colors))
+        if counts is not None:
+            counts["cloud.ply"] = len(points)
     return written
 
 
@@ -165,6 +175,7 @@ def depth_outputs(
     ground: bool = False,
     grid: float | None = None,
     log: Any = None,
+    counts: dict[str, int] | None = None,
 ) -> tuple[Any, dict[str, Path]]:
     """What ``stereovision depth`` computes and writes for one pair (``batch`` writes the same).
 
@@ -199,6 +210,9 @@ def depth_outputs(
         ``map.yaml``).
     log : callable, optional
         Receives the floor's one-line description.
+    counts : dict, optional
+        Receives ``"cloud.ply"``: the number of points written there
+        (:func:`write_depth_outputs`).
 
     Returns
     -------
@@ -231,7 +245,7 @@ def depth_outputs(
         res = res.filtered(max_depth=max_depth, max_sigma=max_sigma)
     # recorded before the first file is written: a run stopped halfway leaves them claimed
     record_outputs(out_dir, earlier | set(names))
-    written = write_depth_outputs(res, out_dir, voxel)
+    written = write_depth_outputs(res, out_dir, voxel, counts=counts)
     written.update(render_outputs(res, out_dir))
     if ground:
         written.update(_ground_outputs(res, calib, out_dir, grid, log))
@@ -416,6 +430,7 @@ def cmd_depth(args: argparse.Namespace) -> int:
         rect = UncalibratedRectification.load(args.rectification)
         left, right = rect.rectify(left, right)
         max_disparity = max_disparity or rect.max_disparity
+    counts: dict[str, int] = {}
     res, written = depth_outputs(
         left,
         right,
@@ -431,6 +446,7 @@ def cmd_depth(args: argparse.Namespace) -> int:
         ground=args.ground,
         grid=args.grid,
         log=print,
+        counts=counts,
     )
     cloud = (
         f"{len(res.points)} points"
@@ -439,10 +455,8 @@ def cmd_depth(args: argparse.Namespace) -> int:
     )
     if args.voxel is not None and "cloud.ply" in written:
         # the cloud.ply of --voxel holds fewer points than the result: "N points" read as its
-        from stereovision.io import read_ply
-
-        kept = len(read_ply(written["cloud.ply"])[0])
-        cloud += f" ({kept} in cloud.ply, one per {args.voxel:g} m cube)"
+        # (the count comes from the writer: the file was read back whole to count its points)
+        cloud += f" ({counts['cloud.ply']} in cloud.ply, one per {args.voxel:g} m cube)"
     print(
         f"{args.method}: max_disparity {res.max_disparity} px, density {100 * res.density:.1f} %,"
         f" {cloud}, {sum(res.timings.values()):.2f} s"
