@@ -1305,6 +1305,19 @@ def test_the_same_source_on_both_sides_is_said(
     assert capsys.readouterr().err == (
         "stereovision: error: --left and --right are both camera 7: give the rig's two cameras\n"
     )
+    # one camera named two ways: an index and its device node, or a link to the node
+    argv = ["capture", "--left", "7", "--right", "/dev/video7", "-o", str(tmp_path / "x")]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: --left '7' and --right '/dev/video7' are both camera /dev/video7: "
+        "give the rig's two cameras\n"
+    )
+    link = tmp_path / "by-id-cam"
+    link.symlink_to("/dev/video7")
+    argv = ["stream", "--left", "/dev/video7", "--right", str(link), "--no-display"]
+    assert main([*argv, "--frames", "1"]) == 2
+    assert capsys.readouterr().err.startswith("stereovision: error: --left '/dev/video7' and")
+    assert not (tmp_path / "x").exists()
 
 
 def test_every_with_a_board_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

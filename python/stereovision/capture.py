@@ -984,13 +984,29 @@ def _same_path(left: object, right: object) -> bool:
         return os.path.normpath(a) == os.path.normpath(b)
 
 
+_VIDEO_NODE_RE = re.compile(r"^/dev/video\d+$")
+
+
+def _camera_device(src: object) -> str | None:
+    """The V4L2 device node a camera source opens (``0`` -> ``/dev/video0``; a path such as
+    ``/dev/video0`` or a ``/dev/v4l/by-id/...`` link -> the node it resolves to), or None for
+    a file, pattern or URL."""
+    if isinstance(src, (int, np.integer)) and not isinstance(src, bool):
+        return os.path.realpath(f"/dev/video{int(src)}")
+    if isinstance(src, str) and "://" not in src:
+        node = os.path.realpath(src)
+        return node if _VIDEO_NODE_RE.match(node) else None
+    return None
+
+
 def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
     """The :class:`StereoCamera` or :class:`~stereovision.rosbag.BagCamera` the options name.
 
     Raises
     ------
     ValueError
-        If both or neither source kind is given, or a bag option comes without ``--from-bag``.
+        If both or neither source kind is given, a bag option comes without ``--from-bag``,
+        or ``--left`` and ``--right`` name one camera (``0`` and ``/dev/video0``).
     """
     size = parse_size(args.size)
     if args.from_bag:
@@ -1020,6 +1036,14 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
     if isinstance(left, int) and left == right:
         # the second open failed with a hint about another program using the camera
         raise ValueError(f"--left and --right are both camera {left}: give the rig's two cameras")
+    device = _camera_device(left)
+    if device is not None and device == _camera_device(right):
+        # one camera named two ways (--left 0 --right /dev/video0, or a /dev/v4l link): the
+        # second open failed with a hint about another program using the camera
+        raise ValueError(
+            f"--left {str(left)!r} and --right {str(right)!r} are both camera {device}: give "
+            "the rig's two cameras"
+        )
     cam = StereoCamera(left, right, size=size, fps=fps, fourcc=getattr(args, "fourcc", None))
     if _same_path(left, right):
         # a typo: every pair is one view twice, every disparity 0, and nothing said it (said
