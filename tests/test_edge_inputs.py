@@ -265,6 +265,33 @@ def test_fill_planes_passes_beyond_their_types_are_named() -> None:
         _core.fill_planes(D, U8, [(16, -1)], 1.0)
 
 
+def test_matcher_parameter_dicts_name_an_integer_range() -> None:
+    """A negative ``min_disparity`` in the MCGM or Hopfield dict was "parameter `min_disparity`:
+    OverflowError: can't convert negative int to unsigned"; it names the range now, and
+    ``mcgm_filter`` refuses a range that ``mcgm_match`` refuses (it returned flags)."""
+    none = np.zeros((0, 4), np.float32)
+    for call in (
+        lambda p: _core.mcgm_filter(LEFT, LEFT, none, p),
+        lambda p: _core.mcgm_match(LEFT, LEFT, p),
+        lambda p: _core.hopfield_match(LEFT, LEFT, p),
+    ):
+        for key in ("min_disparity", "max_disparity"):
+            for bad in (-1, 2**64):
+                says = f"invalid parameter `{key}`: expected an integer from 0 to {U64}, got {bad}"
+                with pytest.raises(ValueError, match=re.escape(says)):
+                    call({key: bad})
+    with pytest.raises(
+        ValueError, match=re.escape("invalid parameter `seed`: expected an integer from 0 to")
+    ):
+        _core.mcgm_filter(LEFT, LEFT, none, {"seed": -1})
+    wrong = {"min_disparity": 9, "max_disparity": 4}
+    says = "invalid parameter `max_disparity`: must be >= min_disparity (9), got 4"
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.mcgm_filter(LEFT, LEFT, none, wrong)
+    with pytest.raises(ValueError, match=re.escape("max_disparity")):
+        _core.mcgm_match(LEFT, LEFT, wrong)
+
+
 def test_a_fattening_radius_beyond_the_map_is_the_whole_map() -> None:
     """A radius of 2**31 px looped over every offset (minutes on a 40 x 60 map), and one of
     2**63 or more wrapped to a negative radius in the kernel: other pixels marked."""

@@ -355,6 +355,14 @@ pub fn mcgm_filter<'py>(
     let l = image_from_numpy(&left, "left")?;
     let r = image_from_numpy(&right, "right")?;
     let p = self::params(params)?;
+    // mcgm_match refuses this range (core validate_params); the filter used it as given and
+    // returned flags for an empty range without a word.
+    if p.d_max < p.d_min {
+        return Err(PyValueError::new_err(format!(
+            "invalid parameter `max_disparity`: must be >= min_disparity ({}), got {}",
+            p.d_min, p.d_max
+        )));
+    }
     let view = matches.as_array();
     if view.ncols() != 4 {
         return Err(PyValueError::new_err(format!(

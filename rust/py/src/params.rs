@@ -25,6 +25,9 @@ pub fn check_keys(d: &Bound<'_, PyDict>, known: &[&str], what: &str) -> PyResult
 }
 
 /// Overwrites `slot` with `d[key]` when present; a wrong type is a `ValueError` naming the key.
+/// An integer outside the slot's type (a negative `min_disparity`) was "parameter
+/// `min_disparity`: OverflowError: can't convert negative int to unsigned"; it names the
+/// allowed range now, as [`int_arg`] does.
 pub fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
     d: &Bound<'py, PyDict>,
     key: &str,
@@ -33,10 +36,35 @@ pub fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
     if let Some(v) = d.get_item(key)? {
         *slot = v.extract::<T>().map_err(|e| {
             let e: PyErr = e.into();
-            PyValueError::new_err(format!("parameter `{key}`: {e}"))
+            let py = v.py();
+            match int_range_of::<T>() {
+                Some(range) if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(py) => {
+                    let got = v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
+                    PyValueError::new_err(format!(
+                        "invalid parameter `{key}`: expected {range}, got {got}"
+                    ))
+                }
+                _ => PyValueError::new_err(format!("parameter `{key}`: {e}")),
+            }
         })?;
     }
     Ok(())
+}
+
+/// The range [`IntRange`] names for `T` when `T` is one of the integer types of the
+/// parameter dicts, else `None`.
+fn int_range_of<T>() -> Option<String> {
+    let name = std::any::type_name::<T>();
+    Some(match name {
+        "u8" => u8::range(),
+        "u16" => u16::range(),
+        "u32" => u32::range(),
+        "u64" => u64::range(),
+        "usize" => usize::range(),
+        "i32" => i32::range(),
+        "i64" => i64::range(),
+        _ => return None,
+    })
 }
 
 /// `Ok` when `v` is a finite number >= 0, else a `ValueError` naming it.
@@ -65,7 +93,7 @@ macro_rules! int_range {
         }
     )*};
 }
-int_range!(u8, u16, u32, i32, usize);
+int_range!(u8, u16, u32, u64, i32, i64, usize);
 
 impl<T: IntRange> IntRange for Option<T> {
     fn range() -> String {
