@@ -236,7 +236,6 @@ INTS: list[tuple[str, int, int, Callable[[Any], object]]] = [
     ("d_max", -(2**31), 2**31 - 1, lambda v: _sgm(d_max=v)),
     ("p2", 0, 2**16 - 1, lambda v: _sgm(p2=v)),
     ("edge_margin", 0, 2**32 - 1, lambda v: _sgm(edge_margin=v)),
-    ("paths", 0, 255, lambda v: _sgm(paths=v)),
     (
         "max_frames",
         0,
@@ -260,9 +259,41 @@ def test_an_integer_beyond_its_type_names_the_argument(case: int) -> None:
         call(2.5)
 
 
-def test_fill_planes_passes_beyond_their_types_are_named() -> None:
-    with pytest.raises(ValueError, match=r"invalid parameter `passes`: expected a list of \(step"):
+def test_fill_planes_passes_name_the_bad_element() -> None:
+    """A bad element of ``passes`` was named by the whole list ("expected a list of (step,
+    min_pixels) pairs, ...") or by its step alone ("every step must be in 1-255, got 0"); the
+    error names the element's index and value and what is wrong with it."""
+    says = "invalid parameter `passes`: element "
+    with pytest.raises(
+        ValueError,
+        match=re.escape(says + f"0 ((16, -1)): min_pixels must be an integer from 0 to {U64}"),
+    ):
         _core.fill_planes(D, U8, [(16, -1)], 1.0)
+    for bad in (0, 256, -1, 2**70):
+        with pytest.raises(
+            ValueError, match=re.escape(says + f"1 (({bad}, 5)): step must be an integer in 1-255")
+        ):
+            _core.fill_planes(D, U8, [(16, 5), (bad, 5)], 1.0)
+    for bad in (7, (3,), (1, 2, 3), "ab"):
+        with pytest.raises(
+            ValueError, match=re.escape(says + f"1 ({bad!r}): expected a (step, min_pixels) pair")
+        ):
+            _core.fill_planes(D, U8, [(16, 5), bad], 1.0)
+    with pytest.raises(TypeError, match=r"`passes`: expected a sequence of .*, got 'ab'"):
+        _core.fill_planes(D, U8, "ab", 1.0)
+
+
+def test_sgm_paths_names_what_the_kernel_takes() -> None:
+    """``paths`` outside a byte said "expected an integer from 0 to 255", though the kernel
+    takes 8 or 3 only; every other integer is answered with what it takes."""
+    for bad in (-1, 0, 4, 255, 256, 2**70):
+        with pytest.raises(
+            ValueError, match=re.escape(f"invalid parameter `paths`: expected 8 or 3, got {bad}")
+        ):
+            _sgm(paths=bad)
+    with pytest.raises(TypeError, match=r"invalid parameter `paths`: .*float"):
+        _sgm(paths=2.5)
+    assert _sgm(paths=3).shape == _sgm(paths=8).shape == LEFT.shape
 
 
 def test_matcher_parameter_dicts_name_an_integer_range() -> None:

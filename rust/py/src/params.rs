@@ -101,16 +101,6 @@ impl<T: IntRange> IntRange for Option<T> {
     }
 }
 
-impl IntRange for Vec<(u32, usize)> {
-    fn range() -> String {
-        format!(
-            "a list of (step, min_pixels) pairs, {} and {}",
-            u32::range(),
-            usize::range()
-        )
-    }
-}
-
 /// The integer argument `name` of a function: an integer outside its Rust type's range was a
 /// bare `OverflowError` ("can't convert negative int to unsigned", "int too big to convert")
 /// naming neither the argument nor its range; it is a `ValueError` naming both now, and a value

@@ -10,7 +10,7 @@ use stereovision_core::segment::{
 
 use crate::convert::{map_copy_in_place, row_major, vec_to_numpy};
 use crate::errors::guard;
-use crate::params::non_negative;
+use crate::params::{non_negative, IntRange};
 
 /// Felzenszwalb-Huttenlocher segments of an `(H, W, C)` float32 image: `(H, W)` uint32 labels
 /// numbered in raster order of each segment's first pixel.
@@ -148,11 +148,6 @@ pub fn fill_planes<'py>(
             disp.as_array().dim()
         )));
     }
-    if let Some(&(step, _)) = passes.iter().find(|(s, _)| *s == 0 || *s > 255) {
-        return Err(PyValueError::new_err(format!(
-            "passes: every step must be in 1-255, got {step}"
-        )));
-    }
     non_negative("max_residual", max_residual)?;
     let img = row_major(&image, "image")?;
     let (out, done) = map_copy_in_place(py, &disp, "disp", |d, w, _| {
@@ -170,5 +165,45 @@ crate::named_ints! {
     min_pixels_arg: usize = "min_pixels";
     step_arg: u32 = "step";
     offset_arg: u32 = "offset";
-    passes_arg: Vec<(u32, usize)> = "passes";
+}
+
+/// `passes`, a sequence of `(step, min_pixels)` pairs: a bad element was named by the whole
+/// list ("expected a list of (step, min_pixels) pairs, ...") or by its step alone; the error
+/// names the element's index and value now, and the range of the part that is wrong.
+fn passes_arg(ob: &Bound<'_, PyAny>) -> PyResult<Vec<(u32, usize)>> {
+    let repr = |o: &Bound<'_, PyAny>| o.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
+    if ob.is_instance_of::<pyo3::types::PyString>() {
+        return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+            "invalid parameter `passes`: expected a sequence of (step, min_pixels) pairs, got {}",
+            repr(ob)
+        )));
+    }
+    let items = ob.try_iter().map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "invalid parameter `passes`: expected a sequence of (step, min_pixels) pairs, got {}",
+            repr(ob)
+        ))
+    })?;
+    let mut out = Vec::new();
+    for (i, item) in items.enumerate() {
+        let item = item?;
+        let bad = |what: String| {
+            PyValueError::new_err(format!(
+                "invalid parameter `passes`: element {i} ({}): {what}",
+                repr(&item)
+            ))
+        };
+        let (step, min_pixels): (Bound<'_, PyAny>, Bound<'_, PyAny>) = item
+            .extract()
+            .map_err(|_| bad("expected a (step, min_pixels) pair".to_string()))?;
+        let step = match step.extract::<u32>() {
+            Ok(s) if (1..=255).contains(&s) => s,
+            _ => return Err(bad("step must be an integer in 1-255".to_string())),
+        };
+        let min_pixels = min_pixels
+            .extract::<usize>()
+            .map_err(|_| bad(format!("min_pixels must be {}", usize::range())))?;
+        out.push((step, min_pixels));
+    }
+    Ok(out)
 }

@@ -62,5 +62,24 @@ crate::named_ints! {
     uniqueness_arg: u32 = "uniqueness";
     lr_tol_arg: u32 = "lr_tol";
     edge_margin_arg: u32 = "edge_margin";
-    paths_arg: u8 = "paths";
+}
+
+/// `paths`: the kernel takes 8 or 3; any other integer (-1, 256, 4) is a `ValueError` saying
+/// so (a value outside `u8` named "an integer from 0 to 255", which the kernel does not take).
+fn paths_arg(ob: &Bound<'_, PyAny>) -> PyResult<u8> {
+    let py = ob.py();
+    let bad = || {
+        let got = ob
+            .repr()
+            .map_or_else(|_| "?".to_string(), |r| r.to_string());
+        pyo3::exceptions::PyValueError::new_err(format!(
+            "invalid parameter `paths`: expected 8 or 3, got {got}"
+        ))
+    };
+    match crate::params::int_arg::<u8>(ob, "paths") {
+        Ok(v) if v == 3 || v == 8 => Ok(v),
+        Ok(_) => Err(bad()),
+        Err(e) if e.is_instance_of::<pyo3::exceptions::PyValueError>(py) => Err(bad()),
+        Err(e) => Err(e),
+    }
 }
