@@ -760,3 +760,56 @@ def test_describe_with_a_negative_doffs(cx2: float, far: str, near: str) -> None
     assert f"depth Z = 50.000 m px / (d - {doffs:.2f} px)" in text
     assert far in text and "inf m" not in text
     assert f"nearest depth a disparity range reaches: {near}\n" in text
+
+
+def _opencv_stereo_calib(folder: Path) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Write what OpenCV's stereo_calib sample writes: intrinsics.yml (M1 D1 M2 D2) and
+    extrinsics.yml (R T R1 R2 P1 P2 Q), T in the board's square unit (here mm)."""
+    K1 = np.array([[700.0, 0, 330], [0, 702, 238], [0, 0, 1]])
+    K2 = np.array([[705.0, 0, 318], [0, 704, 242], [0, 0, 1]])
+    D = np.array([[0.05, -0.1, 0.001, 0.0, 0.0]])
+    R = cv2.Rodrigues(np.array([0.01, -0.02, 0.005]))[0]
+    T = np.array([[-120.0], [1.5], [0.8]])
+    fs = cv2.FileStorage(str(folder / "intrinsics.yml"), cv2.FILE_STORAGE_WRITE)
+    for name, value in (("M1", K1), ("D1", D), ("M2", K2), ("D2", D)):
+        fs.write(name, value)
+    fs.release()
+    R1, R2, P1, P2, Q, _, _ = cv2.stereoRectify(K1, D, K2, D, (640, 480), R, T)
+    fs = cv2.FileStorage(str(folder / "extrinsics.yml"), cv2.FILE_STORAGE_WRITE)
+    for name, value in (("R", R), ("T", T), ("R1", R1), ("R2", R2), ("P1", P1), ("P2", P2)):
+        fs.write(name, value)
+    fs.write("Q", Q)
+    fs.release()
+    return K1, R, T
+
+
+@pytest.mark.parametrize("which", [".", "intrinsics.yml", "extrinsics.yml"])
+def test_from_file_reads_opencv_stereo_calib_output(tmp_path: Path, which: str) -> None:
+    K1, R, T = _opencv_stereo_calib(tmp_path)
+    calib = Calibration.from_file(tmp_path / which, image_size=(640, 480), unit="mm")
+    np.testing.assert_array_equal(calib.K1, K1)
+    np.testing.assert_array_equal(calib.R, R)
+    np.testing.assert_array_equal(calib.T, T.ravel())
+    assert calib.image_size == (640, 480)
+    assert calib.unit == "mm"
+    assert calib.baseline_m == pytest.approx(np.linalg.norm(T) / 1000)
+    assert not calib.rectified
+
+
+def test_opencv_stereo_calib_output_needs_image_size_and_unit(tmp_path: Path) -> None:
+    _opencv_stereo_calib(tmp_path)
+    with pytest.raises(ValueError, match=r"stereo_calib output .*pass image_size=.* and unit="):
+        Calibration.from_file(tmp_path / "intrinsics.yml")
+    with pytest.raises(ValueError, match=r"the unit of T .*: pass unit="):
+        Calibration.from_file(tmp_path, image_size=(640, 480))
+
+
+def test_opencv_stereo_calib_missing_field_is_named(tmp_path: Path) -> None:
+    _opencv_stereo_calib(tmp_path)
+    fs = cv2.FileStorage(str(tmp_path / "extrinsics.yml"), cv2.FILE_STORAGE_WRITE)
+    fs.write("R", np.eye(3))
+    fs.release()
+    with pytest.raises(ValueError, match=r"extrinsics.yml lacks field 'T'"):
+        Calibration.from_opencv_stereo_calib(
+            tmp_path / "intrinsics.yml", tmp_path / "extrinsics.yml", (640, 480), "mm"
+        )

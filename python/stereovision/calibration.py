@@ -1151,7 +1151,12 @@ class Calibration:
         raise ValueError(f"not a stereovision calibration file (OpenCV YAML/XML or JSON): {p}")
 
     @classmethod
-    def from_file(cls, path: PathLike, image_size: tuple[int, int] | None = None) -> Calibration:
+    def from_file(
+        cls,
+        path: PathLike,
+        image_size: tuple[int, int] | None = None,
+        unit: str | None = None,
+    ) -> Calibration:
         """Read any supported calibration, detecting the format from the content.
 
         OpenCV YAML/XML and JSON (:meth:`load`), Middlebury ``calib.txt``
@@ -1164,16 +1169,50 @@ class Calibration:
         (:func:`stereovision.io.load_scene`) gives its ``calib.txt``, else its ``Q.dat``
         (:meth:`from_q`, sized by ``image_size`` or the folder's ``left.png``); so does a
         ``Q.dat`` file itself (16 numbers, sized by ``image_size`` or the ``left.png`` beside
-        it).
+        it). OpenCV's ``stereo_calib`` sample output (:meth:`from_opencv_stereo_calib`): a
+        folder holding ``intrinsics.yml`` and ``extrinsics.yml``, or one of the two with the
+        other beside it; those files hold neither the image size nor the unit of ``T``, so
+        ``image_size`` and ``unit`` must be given.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The calibration file or folder.
+        image_size : tuple of int, optional
+            ``(width, height)`` in pixels, for the formats that do not hold it (KITTI, Q.dat,
+            OpenCV's ``stereo_calib`` output).
+        unit : str, optional
+            Length unit of ``T`` (``"m"``, ``"mm"``, ...), for OpenCV's ``stereo_calib`` output
+            only (the unit of the board's square size); the other formats state theirs.
+
+        Returns
+        -------
+        Calibration
+            The calibration the file holds.
 
         Raises
         ------
         FileNotFoundError
             If ``path`` does not exist.
         ValueError
-            If the format is not recognised or the content is invalid.
+            If the format is not recognised or the content is invalid, or ``image_size`` or
+            ``unit`` is missing where the format needs it.
         """
         p = Path(path)
+        opencv_pair = _opencv_stereo_calib_pair(p)
+        if opencv_pair is not None:
+            if image_size is None or unit is None:
+                missing = " and ".join(
+                    f"{name}=" + ("(width, height)" if name == "image_size" else "'m'/'mm'/...")
+                    for name, v in (("image_size", image_size), ("unit", unit))
+                    if v is None
+                )
+                raise ValueError(
+                    f"{p} is OpenCV stereo_calib output ({opencv_pair[0].name} + "
+                    f"{opencv_pair[1].name}), which holds neither the image size nor the unit "
+                    f"of T (the board's square size): pass {missing}"
+                )
+            return cls.from_opencv_stereo_calib(*opencv_pair, image_size=image_size, unit=unit)
         if p.is_dir():
             pair = _ros_pair_from_folder(p)
             if pair is not None:
@@ -1214,6 +1253,73 @@ class Calibration:
             f"unrecognised calibration format in {p}: expected OpenCV YAML/XML, JSON, "
             "Middlebury calib.txt, KITTI calibration, ROS camera_info, Kalibr camchain or "
             "OpenCV's Q matrix (Q.dat)"
+        )
+
+    @classmethod
+    def from_opencv_stereo_calib(
+        cls,
+        intrinsics: PathLike,
+        extrinsics: PathLike,
+        image_size: tuple[int, int],
+        unit: str,
+    ) -> Calibration:
+        """Read OpenCV's ``stereo_calib`` sample output: ``intrinsics.yml`` and
+        ``extrinsics.yml``.
+
+        ``intrinsics`` holds ``M1``, ``D1``, ``M2``, ``D2``; ``extrinsics`` holds ``R`` and
+        ``T`` (its ``R1``, ``R2``, ``P1``, ``P2`` and ``Q`` are recomputed, not read). Neither
+        holds the image size nor the unit of ``T``, which is the unit of the board's square
+        size given to the sample.
+
+        Parameters
+        ----------
+        intrinsics, extrinsics : str or os.PathLike
+            The two files (OpenCV YAML or XML).
+        image_size : tuple of int
+            ``(width, height)`` of the calibration images, in pixels.
+        unit : str
+            Length unit of ``T``: ``"m"``, ``"mm"``, ``"cm"``, ``"ft"`` or ``"in"``.
+
+        Returns
+        -------
+        Calibration
+            The unrectified rig.
+
+        Raises
+        ------
+        FileNotFoundError
+            If a file does not exist.
+        ValueError
+            If a file cannot be parsed, lacks a field (named), or holds invalid values.
+        """
+        fields: dict[str, Any] = {}
+        for path, keys in ((intrinsics, ("M1", "D1", "M2", "D2")), (extrinsics, ("R", "T"))):
+            p, text = cls._read_text(path)
+            try:
+                fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
+            except (cv2.error, SystemError) as exc:
+                raise ValueError(
+                    f"cannot parse {p} as OpenCV YAML/XML: {_first_line(exc)}"
+                ) from None
+            try:
+                if not fs.isOpened():
+                    raise ValueError(f"cannot parse {p} as OpenCV YAML/XML")
+                for key in keys:
+                    node = fs.getNode(key)
+                    if node.isNone():
+                        raise ValueError(f"OpenCV stereo_calib file {p} lacks field {key!r}")
+                    fields[key] = _node_matrix(node, key, str(p))
+            finally:
+                fs.release()
+        return cls(
+            K1=fields["M1"],
+            D1=fields["D1"],
+            K2=fields["M2"],
+            D2=fields["D2"],
+            R=fields["R"],
+            T=fields["T"],
+            image_size=image_size,
+            unit=unit,
         )
 
     # ------------------------------------------------------------------ dataset formats
@@ -2101,6 +2207,27 @@ def _scene_image_size(q_file: Path) -> tuple[int, int]:
             h, w = imread(folder / name).shape[:2]
             return w, h
     raise ValueError(f"{q_file} does not give the image size and there is no left.png beside it")
+
+
+_OPENCV_EXTS = (".yml", ".yaml", ".xml")
+
+
+def _opencv_stereo_calib_pair(path: Path) -> tuple[Path, Path] | None:
+    """OpenCV ``stereo_calib``'s ``(intrinsics, extrinsics)`` files: in the folder ``path``, or
+    ``path`` itself (named ``intrinsics.*`` or ``extrinsics.*``) with its partner beside it."""
+    if path.is_dir():
+        for ext in _OPENCV_EXTS:
+            pair = path / f"intrinsics{ext}", path / f"extrinsics{ext}"
+            if pair[0].is_file() and pair[1].is_file():
+                return pair
+        return None
+    stem, ext = path.stem.lower(), path.suffix.lower()
+    if not path.is_file() or ext not in _OPENCV_EXTS or stem not in ("intrinsics", "extrinsics"):
+        return None
+    other = path.with_name(("extrinsics" if stem == "intrinsics" else "intrinsics") + path.suffix)
+    if not other.is_file():
+        return None
+    return (path, other) if stem == "intrinsics" else (other, path)
 
 
 def _ros_pair_from_folder(folder: Path) -> tuple[Path, Path] | None:
