@@ -813,3 +813,27 @@ def test_opencv_stereo_calib_missing_field_is_named(tmp_path: Path) -> None:
         Calibration.from_opencv_stereo_calib(
             tmp_path / "intrinsics.yml", tmp_path / "extrinsics.yml", (640, 480), "mm"
         )
+
+
+def test_repr_is_one_line_summary_not_the_arrays(tmp_path: Path) -> None:
+    rect = Calibration(
+        K1=[[542.0, 0, 541.8], [0, 542.0, 255.2], [0, 0, 1]],
+        D1=np.zeros(5),
+        K2=[[542.0, 0, 541.8], [0, 542.0, 255.2], [0, 0, 1]],
+        D2=np.zeros(5),
+        R=np.eye(3),
+        T=[-59.55, 0, 0],
+        image_size=(941, 490),
+        unit="mm",
+        rectified=True,
+    )
+    assert repr(rect) == (
+        "Calibration(941x490 px; pinhole; rectified; baseline 59.55 mm (0.05955 m); focal 542 px)"
+    )
+    _opencv_stereo_calib(tmp_path)
+    raw = Calibration.from_file(tmp_path, image_size=(640, 480), unit="mm")
+    assert repr(raw) == (
+        "Calibration(640x480 px; pinhole; unrectified; baseline 120 mm (0.12 m); focal left "
+        "700/702 px, right 705/704 px; R 1.31 deg from identity; distorted)"
+    )
+    assert str(raw) == repr(raw)

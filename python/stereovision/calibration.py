@@ -428,6 +428,27 @@ class Calibration:
 
     # ----------------------------------------------------------------------------- equality
 
+    def __repr__(self) -> str:
+        # A one-line summary, not the dataclass's five arrays (3 lines each at a prompt):
+        # the numbers are the fields, describe() says what they mean.
+        w, h = self.image_size
+        parts = [f"{w}x{h} px", self.model, "rectified" if self.rectified else "unrectified"]
+        metres = "" if self.unit == "m" else f" ({self.baseline_m:.4g} m)"
+        parts.append(f"baseline {self.baseline:.4g} {self.unit}{metres}")
+        f1 = (float(self.K1[0, 0]), float(self.K1[1, 1]))
+        f2 = (float(self.K2[0, 0]), float(self.K2[1, 1]))
+        if f1[0] == f1[1] == f2[0] == f2[1]:
+            parts.append(f"focal {f1[0]:.5g} px")
+        else:
+            parts.append(f"focal left {f1[0]:.5g}/{f1[1]:.5g} px, right {f2[0]:.5g}/{f2[1]:.5g} px")
+        if not self.rectified:
+            angle = float(np.degrees(np.arccos(np.clip((np.trace(self.R) - 1) / 2, -1.0, 1.0))))
+            parts.append(f"R {angle:.3g} deg from identity")
+            parts.append("distorted" if np.any(self.D1) or np.any(self.D2) else "no distortion")
+        elif self.doffs_px:
+            parts.append(f"doffs {self.doffs_px:.4g} px")
+        return "Calibration(" + "; ".join(parts) + ")"
+
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Calibration):
             return NotImplemented
