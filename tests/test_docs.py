@@ -328,3 +328,73 @@ def test_the_readme_names_the_opencv_the_package_requires() -> None:
     text = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
     assert "set through OpenCV 4" not in text
     assert f"set through the current OpenCV API, {floor.group(1)} or later" in text
+
+
+_SECTION = re.compile(r"^([A-Z][A-Za-z ]+)\n-{3,}$", re.M)
+
+
+def _numpydoc_sections(doc: str) -> dict[str, str]:
+    marks = list(_SECTION.finditer(doc))
+    return {
+        m.group(1): doc[m.end() : marks[i + 1].start() if i + 1 < len(marks) else len(doc)]
+        for i, m in enumerate(marks)
+    }
+
+
+def _public_api() -> list[tuple[str, object]]:
+    """The functions a script calls: ``stereovision``'s exports (and their classes' public
+    methods) and the public functions of ``export``, ``io`` and ``evaluate``."""
+    import stereovision as sv
+
+    out: list[tuple[str, object]] = []
+    for name in sv.__all__:
+        obj = getattr(sv, name)
+        if inspect.isfunction(obj):
+            out.append((name, obj))
+        elif inspect.isclass(obj):
+            for attr, value in vars(obj).items():
+                if isinstance(value, (classmethod, staticmethod)):
+                    value = value.__func__
+                if not attr.startswith("_") and inspect.isfunction(value):
+                    out.append((f"{name}.{attr}", value))
+    for mod_name in ("stereovision.export", "stereovision.io", "stereovision.evaluate"):
+        mod = importlib.import_module(mod_name)
+        for attr, value in vars(mod).items():
+            if not attr.startswith("_") and inspect.isfunction(value):
+                if value.__module__ == mod_name:
+                    out.append((f"{mod_name}.{attr}", value))
+    return out
+
+
+def test_public_functions_document_their_parameters_and_returns() -> None:
+    """numpydoc: a public function taking arguments has a Parameters section naming exactly
+    its signature's parameters, and a Returns (or Yields) section when it returns a value."""
+    problems = []
+    for name, func in _public_api():
+        doc = inspect.getdoc(func) or ""
+        sig = inspect.signature(func)  # type: ignore[arg-type]
+        params = [p for p in sig.parameters if p not in ("self", "cls")]
+        if not doc:
+            problems.append(f"{name}: no docstring")
+            continue
+        if not params:
+            continue
+        sections = _numpydoc_sections(doc)
+        if "Parameters" not in sections:
+            problems.append(f"{name}: no Parameters section for {params}")
+        else:
+            documented = {
+                part.strip().lstrip("*")
+                for line in sections["Parameters"].splitlines()
+                if line and not line[0].isspace()
+                for part in line.split(" : ")[0].split(",")
+            }
+            if documented != set(params):
+                problems.append(f"{name}: Parameters {sorted(documented)} != {params}")
+        returns = sig.return_annotation
+        if returns not in (None, "None", inspect.Signature.empty) and not (
+            {"Returns", "Yields"} & set(sections)
+        ):
+            problems.append(f"{name}: no Returns section")
+    assert len(_public_api()) > 60
+    assert not problems, "\n".join(problems)

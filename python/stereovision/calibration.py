@@ -730,6 +730,17 @@ class Calibration:
         ``R = I``, ``T = (P2[0, 3] / P2[0, 0], 0, 0) = (-B, 0, 0)``, ``rectified=True``. A
         rectified calibration returns itself.
 
+        Parameters
+        ----------
+        alpha : float
+            ``cv2.stereoRectify`` free scaling, as given to :meth:`rectify`: 0 keeps only valid
+            pixels, 1 keeps all pixels.
+
+        Returns
+        -------
+        Calibration
+            The rectified pair's calibration (``rectified=True``).
+
         Raises
         ------
         ValueError
@@ -959,6 +970,18 @@ class Calibration:
 
         ``Z = f B / (d + doffs)``; ``d <= -doffs`` or NaN gives NaN. See
         :func:`stereovision.triangulation.depth_from_disparity`.
+
+        Parameters
+        ----------
+        disp : array_like
+            Disparity in pixels, left rectified image (NaN where none).
+        unit : str
+            Length unit of the result: ``"m"``, ``"mm"``, ``"cm"``, ``"ft"`` or ``"in"``.
+
+        Returns
+        -------
+        ndarray, float32
+            Depth ``Z``, the shape of ``disp``, NaN where none.
         """
         from stereovision.triangulation import _depth_from_disparity
 
@@ -969,6 +992,18 @@ class Calibration:
         X right, Y down, Z forward).
 
         See :func:`stereovision.triangulation.reproject`.
+
+        Parameters
+        ----------
+        disp : array_like
+            ``(H, W)`` disparity in pixels, left rectified image (NaN where none).
+        unit : str
+            Length unit of the result: ``"m"``, ``"mm"``, ``"cm"``, ``"ft"`` or ``"in"``.
+
+        Returns
+        -------
+        ndarray, float32
+            ``(H, W, 3)`` points ``X, Y, Z``, NaN where ``disp`` has no depth.
         """
         from stereovision.triangulation import _reproject
 
@@ -1004,6 +1039,16 @@ class Calibration:
         any language: matrices ``K1 D1 K2 D2 R T``, ``image_width``, ``image_height``, ``unit``,
         ``rectified``, ``doffs``); ``.json`` holds the same fields as nested lists. Both round
         trip every float64 bit-identically.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Destination, ``.yaml``, ``.yml``, ``.xml`` or ``.json``.
+
+        Returns
+        -------
+        pathlib.Path
+            The path written.
 
         Raises
         ------
@@ -1154,6 +1199,16 @@ class Calibration:
 
         The format is recognised from the content. ``M1``/``M2`` (OpenCV's ``stereo_calib``
         sample names) are accepted for ``K1``/``K2``.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            A file written by :meth:`save` (or OpenCV YAML/XML / JSON with the same fields).
+
+        Returns
+        -------
+        Calibration
+            The calibration the file holds.
 
         Raises
         ------
@@ -1352,6 +1407,20 @@ class Calibration:
         at the centres). To compare rig designs before buying cameras
         (``stereovision info --size 1280x720 --hfov 90 --baseline 0.12``).
 
+        Parameters
+        ----------
+        image_size : tuple of int
+            ``(width, height)`` in pixels.
+        hfov_deg : float
+            Horizontal field of view in degrees, in (0, 180).
+        baseline_m : float
+            Distance between the optical centres, metres.
+
+        Returns
+        -------
+        Calibration
+            A rectified calibration, unit ``"m"``.
+
         Raises
         ------
         ValueError
@@ -1392,6 +1461,16 @@ class Calibration:
         ``cam0``/``cam1`` give K1/K2, ``baseline`` (mm) gives ``T = (-baseline, 0, 0)``,
         ``doffs`` is kept, ``width``/``height`` give ``image_size``; unit ``"mm"``,
         ``R = I``, no distortion, ``rectified=True``.
+
+        Parameters
+        ----------
+        calib_txt : str or os.PathLike
+            The Middlebury ``calib.txt``.
+
+        Returns
+        -------
+        Calibration
+            The rectified calibration, unit ``"mm"``.
 
         Raises
         ------
@@ -1447,6 +1526,11 @@ class Calibration:
             The ``Q.dat`` file.
         image_size : tuple of int
             ``(width, height)`` of the images it belongs to (``Q`` does not say).
+
+        Returns
+        -------
+        Calibration
+            The rectified calibration, unit ``"m"``.
 
         Raises
         ------
@@ -1513,6 +1597,18 @@ class Calibration:
 
         The image size comes from ``S_rect_02``, else from ``image_size``, else from a
         ``left.png``/``image_2.png`` next to the file.
+
+        Parameters
+        ----------
+        calib_file : str or os.PathLike
+            KITTI's ``calib_cam_to_cam.txt`` or an object/odometry ``calib`` file.
+        image_size : tuple of int, optional
+            ``(width, height)``, used when the file has no ``S_rect_02``.
+
+        Returns
+        -------
+        Calibration
+            The rectified calibration of cameras 2 and 3, unit ``"m"``.
 
         Raises
         ------

@@ -545,6 +545,16 @@ class DepthResult:
     def to_ply(self, path: str | Path) -> Path:
         """Write the coloured point cloud as a binary PLY (metres), atomically.
 
+        Parameters
+        ----------
+        path : str or os.PathLike
+            Destination ``.ply`` file.
+
+        Returns
+        -------
+        pathlib.Path
+            The path written.
+
         Raises
         ------
         ValueError

@@ -159,6 +159,11 @@ def write_mesh_ply(path: PathLike, mesh: pv.PolyData) -> Path:
         E.g. :func:`stereovision.render.surface_mesh`; triangles only; colours from point data
         ``"RGB"`` when present.
 
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
     Raises
     ------
     ValueError

@@ -145,7 +145,18 @@ class GroundPlane:
         return math.degrees(math.atan2(float(self.normal[0]), -float(self.normal[1])))
 
     def height_of(self, points: npt.ArrayLike) -> npt.NDArray[np.float64]:
-        """Signed height above the floor of ``(..., 3)`` points (metres; NaN stays NaN)."""
+        """Signed height above the floor of ``(..., 3)`` points (metres; NaN stays NaN).
+
+        Parameters
+        ----------
+        points : array_like
+            ``(..., 3)`` points in the camera frame the plane was fitted in, metres.
+
+        Returns
+        -------
+        ndarray, float64
+            ``(...)`` heights, metres.
+        """
         pts = np.asarray(points, np.float64)
         if pts.ndim == 0 or pts.shape[-1] != 3:
             raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
@@ -217,7 +228,20 @@ class GroundPlane:
         self, parent: str = "base_footprint", child: str = "stereo_left_optical"
     ) -> str:
         """The ``ros2 run tf2_ros static_transform_publisher`` command publishing
-        :meth:`camera_in_floor` (the camera's optical frame under ``parent``)."""
+        :meth:`camera_in_floor` (the camera's optical frame under ``parent``).
+
+        Parameters
+        ----------
+        parent : str
+            The floor-level frame the camera hangs under.
+        child : str
+            The camera's optical frame.
+
+        Returns
+        -------
+        str
+            The command, one line.
+        """
         rot = floor_frame(self)  # floor <- camera: its columns are the camera's axes
         x, y, z, w = _quaternion(rot)
         return (

@@ -71,6 +71,16 @@ def make_folder(path: PathLike) -> Path:
     """``mkdir -p``, with an error that names the file in the way (``mkdir`` says only
     "[Errno 17] File exists" with the file's name, or "Not a directory").
 
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The folder to create, with any missing folders above it.
+
+    Returns
+    -------
+    pathlib.Path
+        The folder.
+
     Raises
     ------
     NotADirectoryError
