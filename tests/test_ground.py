@@ -699,3 +699,30 @@ def test_scan_bad_input() -> None:
     # angles given: 0.25 degree beams by default; an empty cloud sees nothing
     empty = laser_scan(np.full((5, 3), np.nan), plane, angle_min=-0.5, angle_max=0.5)
     assert len(empty.ranges) == 230 and np.isnan(empty.ranges).all()
+
+
+def test_reprs_are_summaries_not_arrays() -> None:
+    from stereovision.ground import GroundPlane, LaserScan, OccupancyGrid
+
+    plane = GroundPlane(
+        normal=np.array([0.0, -math.cos(0.1), -math.sin(0.1)]),
+        height=1.5,
+        disparity_plane=(0.0, 0.05, -10.0),
+        inliers=np.zeros((480, 640), bool),
+        inlier_share=0.3,
+        rms_px=0.4,
+    )
+    assert repr(plane) == (
+        "GroundPlane(camera 1.500 m above it, pitch +5.73 deg, roll +0.00 deg (30 % of the "
+        "pixels, RMS 0.40 px); mask 640x480)"
+    )
+    ranges = np.array([2.5, np.inf, np.nan, 1.25, np.inf], np.float32)
+    scan = LaserScan(-0.5, 0.5, 0.25, 0.0, 20.0, ranges)
+    assert repr(scan) == (
+        "LaserScan(5 beams, -28.6 to +28.6 deg, range 0-20 m; 2 hit an obstacle, nearest "
+        "1.25 m, 2 free, 1 unseen)"
+    )
+    grid = OccupancyGrid(np.array([[0, 100], [-1, -1]], np.int8), 0.05, (0.0, -0.05))
+    assert repr(grid) == (
+        "OccupancyGrid(2x2 cells of 0.05 m, origin (0, -0.05) m; 1 free, 1 occupied, 2 unknown)"
+    )

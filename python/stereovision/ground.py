@@ -264,6 +264,11 @@ class GroundPlane:
             "camera_in_floor": self.camera_in_floor().tolist(),
         }
 
+    def __repr__(self) -> str:
+        # describe()'s line, not the (H, W) inlier mask the dataclass repr printed.
+        h, w = self.inliers.shape[:2]
+        return f"GroundPlane({self.describe().removeprefix('ground plane: ')}; mask {w}x{h})"
+
     def describe(self) -> str:
         """One line for a terminal."""
         text = (
@@ -558,6 +563,16 @@ class OccupancyGrid:
     resolution: float
     origin: tuple[float, float]
 
+    def __repr__(self) -> str:
+        # A summary, not the (rows, cols) cells the dataclass repr printed.
+        rows, cols = self.data.shape[:2]
+        counts = {v: int((self.data == v).sum()) for v in (0, 100, -1)}
+        return (
+            f"OccupancyGrid({cols}x{rows} cells of {self.resolution:g} m, origin "
+            f"({self.origin[0]:g}, {self.origin[1]:g}) m; {counts[0]} free, {counts[100]} "
+            f"occupied, {counts[-1]} unknown)"
+        )
+
     def cell_of(self, x: float, y: float) -> tuple[int, int]:
         """``(row, col)`` of the cell holding floor point ``(x, y)``."""
         return (
@@ -724,6 +739,18 @@ class LaserScan:
     range_min: float
     range_max: float
     ranges: npt.NDArray[np.float32]
+
+    def __repr__(self) -> str:
+        # A summary, not the (n,) ranges the dataclass repr printed.
+        r = self.ranges
+        hit = r[np.isfinite(r)]
+        nearest = f", nearest {float(hit.min()):.3g} m" if hit.size else ""
+        return (
+            f"LaserScan({len(r)} beams, {math.degrees(self.angle_min):+.1f} to "
+            f"{math.degrees(self.angle_max):+.1f} deg, range {self.range_min:g}-"
+            f"{self.range_max:g} m; {hit.size} hit an obstacle{nearest}, "
+            f"{int(np.isposinf(r).sum())} free, {int(np.isnan(r).sum())} unseen)"
+        )
 
     @property
     def angles(self) -> F64:
