@@ -837,3 +837,12 @@ def test_repr_is_one_line_summary_not_the_arrays(tmp_path: Path) -> None:
         "700/702 px, right 705/704 px; R 1.31 deg from identity; distorted)"
     )
     assert str(raw) == repr(raw)
+
+
+def test_from_file_refuses_an_image_size_the_file_contradicts(data_dir: Path) -> None:
+    calib_txt = data_dir / "eth3d" / "playground" / "calib.txt"
+    if not calib_txt.is_file():
+        pytest.skip(f"{calib_txt} not found")
+    assert Calibration.from_file(calib_txt, image_size=(941, 490)).image_size == (941, 490)
+    with pytest.raises(ValueError, match=r"941x490 images, not of the image_size \(1280, 720\)"):
+        Calibration.from_file(calib_txt, image_size=(1280, 720))

@@ -1256,7 +1256,8 @@ class Calibration:
             The calibration file or folder.
         image_size : tuple of int, optional
             ``(width, height)`` in pixels, for the formats that do not hold it (KITTI, Q.dat,
-            OpenCV's ``stereo_calib`` output).
+            OpenCV's ``stereo_calib`` output); for the others a check: a file of another size
+            is refused (:meth:`scaled_to` resizes a calibration), not silently kept.
         unit : str, optional
             Length unit of ``T`` (``"m"``, ``"mm"``, ...), for OpenCV's ``stereo_calib`` output
             only (the unit of the board's square size); the other formats state theirs.
@@ -1271,9 +1272,24 @@ class Calibration:
         FileNotFoundError
             If ``path`` does not exist.
         ValueError
-            If the format is not recognised or the content is invalid, or ``image_size`` or
-            ``unit`` is missing where the format needs it.
+            If the format is not recognised or the content is invalid, if ``image_size`` or
+            ``unit`` is missing where the format needs it, or if ``image_size`` is given and
+            the file states another size.
         """
+        calib = cls._read_any(path, image_size, unit)
+        if image_size is not None and calib.image_size != cls._check_size(image_size):
+            w, h = calib.image_size
+            raise ValueError(
+                f"{path} is a calibration of {w}x{h} images, not of the image_size "
+                f"{tuple(image_size)} given: leave image_size out, or resize the calibration "
+                f"with .scaled_to({tuple(image_size)}) if the images were resized"
+            )
+        return calib
+
+    @classmethod
+    def _read_any(
+        cls, path: PathLike, image_size: tuple[int, int] | None, unit: str | None
+    ) -> Calibration:
         p = Path(path)
         opencv_pair = _opencv_stereo_calib_pair(p)
         if opencv_pair is not None:
