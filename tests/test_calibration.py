@@ -804,6 +804,24 @@ def test_opencv_stereo_calib_output_needs_image_size_and_unit(tmp_path: Path) ->
         Calibration.from_file(tmp_path, image_size=(640, 480))
 
 
+@pytest.mark.parametrize("own", ["calib.txt", "Q.dat"])
+def test_folder_calibration_wins_over_stereo_calib_files_beside_it(
+    tmp_path: Path, data_dir: Path, own: str
+) -> None:
+    """A scene folder holding its calib.txt or Q.dat and, beside them, OpenCV stereo_calib's
+    intrinsics.yml + extrinsics.yml was read as the stereo_calib pair and refused for lacking
+    image_size and unit, where it loaded its own calibration before that format was read."""
+    import shutil
+
+    scene = next(p.parent for p in sorted(data_dir.rglob(own)) if (p.parent / "left.png").is_file())
+    shutil.copy(scene / own, tmp_path / own)
+    shutil.copy(scene / "left.png", tmp_path / "left.png")
+    _opencv_stereo_calib(tmp_path)
+    calib = Calibration.from_file(tmp_path)
+    assert calib == Calibration.from_file(tmp_path / own)
+    assert calib.rectified
+
+
 def test_opencv_stereo_calib_missing_field_is_named(tmp_path: Path) -> None:
     _opencv_stereo_calib(tmp_path)
     fs = cv2.FileStorage(str(tmp_path / "extrinsics.yml"), cv2.FILE_STORAGE_WRITE)

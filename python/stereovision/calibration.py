@@ -1246,9 +1246,10 @@ class Calibration:
         (:meth:`from_q`, sized by ``image_size`` or the folder's ``left.png``); so does a
         ``Q.dat`` file itself (16 numbers, sized by ``image_size`` or the ``left.png`` beside
         it). OpenCV's ``stereo_calib`` sample output (:meth:`from_opencv_stereo_calib`): a
-        folder holding ``intrinsics.yml`` and ``extrinsics.yml``, or one of the two with the
-        other beside it; those files hold neither the image size nor the unit of ``T``, so
-        ``image_size`` and ``unit`` must be given.
+        folder holding ``intrinsics.yml`` and ``extrinsics.yml`` (and none of the folder
+        calibrations above), or one of the two with the other beside it; those files hold
+        neither the image size nor the unit of ``T``, so ``image_size`` and ``unit`` must be
+        given.
 
         Parameters
         ----------
@@ -1291,7 +1292,14 @@ class Calibration:
         cls, path: PathLike, image_size: tuple[int, int] | None, unit: str | None
     ) -> Calibration:
         p = Path(path)
-        opencv_pair = _opencv_stereo_calib_pair(p)
+        # a folder's own calibration (ROS pair, calib.txt, Q.dat) comes first: one that also
+        # holds stereo_calib's two files loaded before they were read, and still does
+        folder_calib = p.is_dir() and (
+            _ros_pair_from_folder(p) is not None
+            or (p / "calib.txt").is_file()
+            or (p / "Q.dat").is_file()
+        )
+        opencv_pair = None if folder_calib else _opencv_stereo_calib_pair(p)
         if opencv_pair is not None:
             if image_size is None or unit is None:
                 missing = " and ".join(
