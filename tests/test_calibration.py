@@ -864,3 +864,12 @@ def test_from_file_refuses_an_image_size_the_file_contradicts(data_dir: Path) ->
     assert Calibration.from_file(calib_txt, image_size=(941, 490)).image_size == (941, 490)
     with pytest.raises(ValueError, match=r"941x490 images, not of the image_size \(1280, 720\)"):
         Calibration.from_file(calib_txt, image_size=(1280, 720))
+    # a size taken from an array (img.shape, a camera's settings) is said as numbers, not as
+    # "(np.int64(1280), np.int64(720))"
+    with pytest.raises(ValueError) as info:
+        Calibration.from_file(calib_txt, image_size=np.array([1280, 720]))
+    assert str(info.value) == (
+        f"{calib_txt} is a calibration of 941x490 images, not of the image_size (1280, 720) "
+        "given: leave image_size out, or resize the calibration with .scaled_to((1280, 720)) if "
+        "the images were resized"
+    )

@@ -1278,12 +1278,14 @@ class Calibration:
             the file states another size.
         """
         calib = cls._read_any(path, image_size, unit)
-        if image_size is not None and calib.image_size != cls._check_size(image_size):
+        # the checked size in the message: an array's tuple() read "(np.int64(1280), ...)"
+        given = None if image_size is None else cls._check_size(image_size)
+        if given is not None and calib.image_size != given:
             w, h = calib.image_size
             raise ValueError(
                 f"{path} is a calibration of {w}x{h} images, not of the image_size "
-                f"{tuple(image_size)} given: leave image_size out, or resize the calibration "
-                f"with .scaled_to({tuple(image_size)}) if the images were resized"
+                f"{given} given: leave image_size out, or resize the calibration "
+                f"with .scaled_to({given}) if the images were resized"
             )
         return calib
 
