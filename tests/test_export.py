@@ -540,8 +540,16 @@ def test_pcd_and_mesh_writers_write_the_records_without_copying_them(result, tmp
     pcd_path = export.write_pcd(tmp_path / "c.pcd", result)
     raw = pcd_path.read_bytes()
     body = raw[raw.index(b"DATA binary\n") + len(b"DATA binary\n") :]
-    xyz = np.frombuffer(body, np.float32).reshape(-1, 4)[:, :3]
-    np.testing.assert_array_equal(xyz, export.organised_points(result)[0].reshape(-1, 3))
+    pts, cols = export.organised_points(result)
+    h, w = pts.shape[:2]
+    assert raw.startswith(b"# .PCD v0.7") and f"WIDTH {w}\nHEIGHT {h}\n".encode() in raw
+    assert b"FIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\n" in raw
+    rec = np.frombuffer(body, np.float32).reshape(-1, 4)
+    assert len(rec) == h * w
+    np.testing.assert_array_equal(rec[:, :3], pts.reshape(-1, 3))
+    rgb = rec[:, 3].view(np.uint32)  # PCL's packed 0x00RRGGBB
+    flat = cols.reshape(-1, 3).astype(np.uint32)
+    np.testing.assert_array_equal(rgb, (flat[:, 0] << 16) | (flat[:, 1] << 8) | flat[:, 2])
     files = []
 
     @contextlib.contextmanager
