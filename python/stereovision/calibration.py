@@ -202,6 +202,19 @@ def _node_matrix(node: Any, key: str, source: str) -> npt.NDArray[np.float64]:
     return np.array(values, dtype=np.float64).reshape(r, c)
 
 
+def _open_filestorage(text: str, source: str) -> Any:
+    """``cv2.FileStorage`` reading ``text`` (OpenCV YAML/XML), opened, or a ValueError naming
+    ``source``. A damaged file makes OpenCV's parser raise cv2.error (or, from the constructor,
+    a SystemError wrapping it): both are the file's fault."""
+    try:
+        fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
+    except (cv2.error, SystemError) as exc:
+        raise ValueError(f"cannot parse {source} as OpenCV YAML/XML: {_first_line(exc)}") from None
+    if not fs.isOpened():
+        raise ValueError(f"cannot parse {source} as OpenCV YAML/XML")
+    return fs
+
+
 def _first_line(exc: BaseException) -> str:
     """OpenCV's own words from a cv2.error (``... error: (-215:Assertion failed) WHAT in
     function ...``: WHAT), also through the SystemError its constructors wrap it in."""
@@ -1136,16 +1149,7 @@ class Calibration:
 
     @classmethod
     def _from_filestorage_text(cls, text: str, source: str) -> Calibration:
-        # A damaged file makes OpenCV's parser raise cv2.error (or, from the constructor, a
-        # SystemError wrapping it): both are the file's fault, so a ValueError naming it.
-        try:
-            fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
-        except (cv2.error, SystemError) as exc:
-            raise ValueError(
-                f"cannot parse {source} as OpenCV YAML/XML: {_first_line(exc)}"
-            ) from None
-        if not fs.isOpened():
-            raise ValueError(f"cannot parse {source} as OpenCV YAML/XML")
+        fs = _open_filestorage(text, source)
 
         def get(key: str) -> Any:
             node = fs.getNode(key)
@@ -1397,15 +1401,8 @@ class Calibration:
         fields: dict[str, Any] = {}
         for path, keys in ((intrinsics, ("M1", "D1", "M2", "D2")), (extrinsics, ("R", "T"))):
             p, text = cls._read_text(path)
+            fs = _open_filestorage(text, str(p))
             try:
-                fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
-            except (cv2.error, SystemError) as exc:
-                raise ValueError(
-                    f"cannot parse {p} as OpenCV YAML/XML: {_first_line(exc)}"
-                ) from None
-            try:
-                if not fs.isOpened():
-                    raise ValueError(f"cannot parse {p} as OpenCV YAML/XML")
                 for key in keys:
                     node = fs.getNode(key)
                     if node.isNone():
