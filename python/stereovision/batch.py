@@ -550,18 +550,14 @@ def _foreign_output(
 ) -> Path | None:
     """The first file in the pair's folder ``dest`` under a name this run may write for it
     that no earlier run recorded writing (``recorded``, from the summary), else None."""
-    from stereovision.cli import planned_depth_outputs
+    from stereovision.cli import foreign_outputs, planned_depth_outputs
 
     if not dest.is_dir():
         return None
     names = planned_depth_outputs(
         job.calib is not None, bool(opts.get("ground")), opts.get("grid") is not None
     )
-    for name in names:
-        path = dest / name
-        if name not in (recorded or []) and (path.exists() or path.is_symlink()):
-            return path
-    return None
+    return next(iter(foreign_outputs(dest, names, recorded or [])), None)
 
 
 def _pending_outputs(entry: dict[str, Any]) -> list[str]:

@@ -17,7 +17,7 @@ import sys
 import threading
 import time
 import warnings
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from importlib import resources
 from pathlib import Path
 from typing import Any, NoReturn
@@ -347,14 +347,24 @@ def refuse_foreign_outputs(
         Naming the first such file, and what to do.
     """
     earlier = _manifest_names(out_dir, manifest)
-    for name in names:
-        path = out_dir / name
-        if name not in earlier and (path.exists() or path.is_symlink()):
-            raise FileExistsError(
-                f"{flag} {out_dir}: {path} is not listed as an earlier run's output there and "
-                f"would be replaced: give another {flag} folder, or move or remove that file"
-            )
+    foreign = foreign_outputs(out_dir, names, earlier)
+    if foreign:
+        raise FileExistsError(
+            f"{flag} {out_dir}: {foreign[0]} is not listed as an earlier run's output there and "
+            f"would be replaced: give another {flag} folder, or move or remove that file"
+        )
     return earlier
+
+
+def foreign_outputs(out_dir: Path, names: Sequence[str], listed: Collection[str]) -> list[Path]:
+    """What stands in ``out_dir`` under one of ``names`` (a file, a folder, a link, a broken
+    one too) that ``listed`` (an earlier run's recorded outputs) does not name, in the order of
+    ``names``: what a run would replace that it did not write."""
+    return [
+        out_dir / n
+        for n in names
+        if n not in listed and ((out_dir / n).exists() or (out_dir / n).is_symlink())
+    ]
 
 
 def record_outputs(
@@ -837,16 +847,12 @@ def cmd_demo(args: argparse.Namespace) -> int:
     # version before the manifest: `make demo` after an update) is copied aside, not refused:
     # the Quick start's command keeps working and nothing is lost.
     earlier = _manifest_names(out_dir)
-    foreign = [
-        n
-        for n in names
-        if n not in earlier and ((out_dir / n).exists() or (out_dir / n).is_symlink())
-    ]
-    if any(not (out_dir / n).is_file() or (out_dir / n).is_symlink() for n in foreign):
+    foreign = foreign_outputs(out_dir, names, earlier)
+    if any(not p.is_file() or p.is_symlink() for p in foreign):
         refuse_foreign_outputs(out_dir, names)  # a folder or link under an output name
     from stereovision.io import keep_previous
 
-    kept_aside = [(n, keep_previous(out_dir / n)) for n in foreign]
+    kept_aside = [(p.name, keep_previous(p)) for p in foreign]
     scene_dir = _demo_scene_dir()
     scene = load_scene(scene_dir)
     if scene.gt is None:
