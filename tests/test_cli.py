@@ -518,10 +518,7 @@ def test_depth_refuses_to_replace_a_file_it_did_not_write(
     capsys.readouterr()
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert err == (
-        f"stereovision: error: -o {out}: {out / 'cloud.ply'} is not listed as an earlier run's "
-        "output there and would be replaced: give another -o folder, or move or remove that file\n"
-    )
+    assert err == _not_ours(out, "cloud.ply")
     assert (out / "cloud.ply").read_text() == "my scan"
     assert sorted(p.name for p in out.iterdir()) == ["cloud.ply"]  # refused before any work
     (out / "cloud.ply").unlink()
@@ -564,11 +561,7 @@ def test_demo_keeps_a_file_it_did_not_write(
     assert main(["demo", "-o", str(other)]) == 2
     captured = capsys.readouterr()
     assert captured.out == ""  # before any work
-    assert captured.err == (
-        f"stereovision: error: -o {other}: {other / 'cloud.ply'} is not listed as an earlier "
-        "run's output there and would be replaced: give another -o folder, or move or remove "
-        "that file\n"
-    )
+    assert captured.err == _not_ours(other, "cloud.ply")
 
 
 def test_demo_refuses_a_broken_link_under_an_output_name(
@@ -583,11 +576,7 @@ def test_demo_refuses_a_broken_link_under_an_output_name(
     assert main(["demo", "-o", str(out)]) == 2
     captured = capsys.readouterr()
     assert captured.out == ""  # before any work
-    assert captured.err == (
-        f"stereovision: error: -o {out}: {out / 'cloud.ply'} is not listed as an earlier "
-        "run's output there and would be replaced: give another -o folder, or move or remove "
-        "that file\n"
-    )
+    assert captured.err == _not_ours(out, "cloud.ply")
     assert (out / "cloud.ply").is_symlink()
     assert sorted(p.name for p in out.iterdir()) == ["cloud.ply"]
 
@@ -667,6 +656,14 @@ def test_eval_with_no_scene_to_evaluate_fails(data_dir: Path, tmp_path: Path) ->
     ]
 
 
+def _not_ours(out: Path, name: str) -> str:
+    """The CLI's line refusing to replace ``out / name``, which no earlier run listed."""
+    return (
+        f"stereovision: error: -o {out}: {out / name} is not listed as an earlier run's output "
+        "there and would be replaced: give another -o folder, or move or remove that file\n"
+    )
+
+
 def _no_constant(name: str) -> float:
     raise ValueError(f"not JSON: {name}")
 
@@ -736,10 +733,7 @@ def test_rectify_refuses_to_replace_a_file_it_did_not_write(
         (out / name).write_text("mine")
         capsys.readouterr()
         assert main(["rectify", *pair, *argv, "-o", str(out)]) == 2
-        assert capsys.readouterr().err == (
-            f"stereovision: error: -o {out}: {out / name} is not listed as an earlier run's output "
-            "there and would be replaced: give another -o folder, or move or remove that file\n"
-        )
+        assert capsys.readouterr().err == _not_ours(out, name)
         assert sorted(p.name for p in out.iterdir()) == [name]  # nothing written
         assert (out / name).read_text() == "mine"
         (out / name).unlink()
