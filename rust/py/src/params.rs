@@ -28,7 +28,7 @@ pub fn check_keys(d: &Bound<'_, PyDict>, known: &[&str], what: &str) -> PyResult
 /// An integer outside the slot's type (a negative `min_disparity`) was "parameter
 /// `min_disparity`: OverflowError: can't convert negative int to unsigned"; it names the
 /// allowed range now, as [`int_arg`] does.
-pub fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
+pub fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py> + Slot>(
     d: &Bound<'py, PyDict>,
     key: &str,
     slot: &mut T,
@@ -37,7 +37,7 @@ pub fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
         *slot = v.extract::<T>().map_err(|e| {
             let e: PyErr = e.into();
             let py = v.py();
-            match int_range_of::<T>() {
+            match T::int_range() {
                 Some(range) if e.is_instance_of::<pyo3::exceptions::PyOverflowError>(py) => {
                     let got = v.repr().map_or_else(|_| "?".to_string(), |r| r.to_string());
                     PyValueError::new_err(format!(
@@ -51,21 +51,32 @@ pub fn get<'py, T: pyo3::conversion::FromPyObjectOwned<'py>>(
     Ok(())
 }
 
-/// The range [`IntRange`] names for `T` when `T` is one of the integer types of the
-/// parameter dicts, else `None`.
-fn int_range_of<T>() -> Option<String> {
-    let name = std::any::type_name::<T>();
-    Some(match name {
-        "u8" => u8::range(),
-        "u16" => u16::range(),
-        "u32" => u32::range(),
-        "u64" => u64::range(),
-        "usize" => usize::range(),
-        "i32" => i32::range(),
-        "i64" => i64::range(),
-        _ => return None,
-    })
+/// The types of the parameter dicts' slots. An integer slot names its range in the error for
+/// a value outside it; this was read off `std::any::type_name`, whose text Rust does not
+/// promise, so a trait says it now and a slot type without an impl does not compile.
+pub trait Slot {
+    /// The range an integer slot's error names; `None` for other types.
+    fn int_range() -> Option<String> {
+        None
+    }
 }
+
+macro_rules! int_slot {
+    ($($t:ty),*) => {$(
+        impl Slot for $t {
+            fn int_range() -> Option<String> {
+                Some(<$t as IntRange>::range())
+            }
+        }
+    )*};
+}
+int_slot!(u8, u16, u32, u64, i32, i64, usize);
+
+impl Slot for f32 {}
+impl Slot for f64 {}
+impl Slot for bool {}
+impl Slot for String {}
+impl Slot for Vec<f32> {}
 
 /// `Ok` when `v` is a finite number >= 0, else a `ValueError` naming it.
 pub fn non_negative(name: &str, v: f32) -> PyResult<()> {
