@@ -1,0 +1,79 @@
+"""``stereovision eval``: timing runs, strict JSON, one-line refusals (evaluation.md)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from stereovision.cli import main
+
+SV = [sys.executable, "-m", "stereovision.cli"]
+TIME_KEYS = ("ours_ms", "bm_ms", "sgbm_ms", "runs")
+
+
+def _rows(out: str) -> list[dict[str, Any]]:
+    return [json.loads(line) for line in out.splitlines() if line.strip()]
+
+
+def test_eval_runs_reports_the_count_and_keeps_accuracy(
+    data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--runs N` times every method N times (the median is reported, `runs` says N); every
+    accuracy figure (dense, depth, Table-1, validated matches) is the same as with one run."""
+    terrace = str(data_dir / "eth3d" / "terrace")
+    assert main(["eval", terrace, "--json"]) == 0
+    (one,) = _rows(capsys.readouterr().out)
+    assert main(["eval", terrace, "--json", "--runs", "3"]) == 0
+    (three,) = _rows(capsys.readouterr().out)
+    assert (one["runs"], three["runs"]) == (1, 3)
+    for row in (one, three):
+        assert all(row[k] > 0 for k in ("ours_ms", "bm_ms", "sgbm_ms"))
+    strip = [{k: v for k, v in r.items() if k not in TIME_KEYS} for r in (one, three)]
+    assert strip[0] == strip[1]
+    # the figures are there, not two empty rows
+    assert strip[0]["ours"]["n_gt"] == 164541
+    assert {"depth", "sgbm_depth", "table1", "members_depth"} <= set(strip[0])
+
+
+def test_eval_runs_interleaves_ours_and_opencv(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The runs go A, B, C, A, B, C (evaluation.md "Speed"), not A, A, A, B, B, B."""
+    from stereovision import baselines, depth
+    from stereovision.cli import _eval_scene
+    from stereovision.io import load_scene
+
+    calls: list[str] = []
+
+    def spy(name: str, fn: Any) -> Any:
+        def wrapped(*a: Any, **k: Any) -> Any:
+            calls.append(name)
+            return fn(*a, **k)
+
+        return wrapped
+
+    monkeypatch.setattr(depth, "depth_map", spy("ours", depth.depth_map))
+    monkeypatch.setattr(baselines, "opencv_bm", spy("bm", baselines.opencv_bm))
+    monkeypatch.setattr(baselines, "opencv_sgbm", spy("sgbm", baselines.opencv_sgbm))
+    scene = load_scene(data_dir / "middlebury2001" / "tsukuba")
+    row = _eval_scene(scene, "fast", True, runs=3)
+    assert calls == ["ours", "bm", "sgbm"] * 3
+    assert row["runs"] == 3
+
+
+@pytest.mark.parametrize("value", ["0", "-2", "two"])
+def test_eval_refuses_a_bad_runs_in_one_line(data_dir: Path, value: str) -> None:
+    tsukuba = str(data_dir / "middlebury2001" / "tsukuba")
+    proc = subprocess.run(
+        [*SV, "eval", tsukuba, f"--runs={value}"], capture_output=True, text=True, check=False
+    )
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        "stereovision eval: error: argument --runs: expected a whole number above 0, "
+        f"got {value!r} (see stereovision eval --help)"
+    ]
