@@ -77,3 +77,46 @@ def test_eval_refuses_a_bad_runs_in_one_line(data_dir: Path, value: str) -> None
         "stereovision eval: error: argument --runs: expected a whole number above 0, "
         f"got {value!r} (see stereovision eval --help)"
     ]
+
+
+def _eval(*argv: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run([*SV, "eval", *argv], capture_output=True, text=True, check=False)
+
+
+def test_eval_of_a_scene_without_gt_prints_no_table_header(data_dir: Path) -> None:
+    """The table's two header lines went to stdout before the one-line error of a lone scene
+    without ground truth: a table of nothing above the error."""
+    photo = data_dir / "stereopi_rig" / "scene_photo"
+    proc = _eval(str(photo), "--method", "fast", "--no-opencv")
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        f"stereovision: error: {photo}: no ground truth (gt_disp.pfm) to evaluate against"
+    ]
+
+
+def test_eval_of_a_folder_without_a_scene_names_what_is_missing(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """'no scene (left.png + right.png) under X' for a folder holding left.png alone, or a
+    JPEG pair: it did not say which file was missing or that the pair was not PNG."""
+    tsukuba = data_dir / "middlebury2001" / "tsukuba"
+    half = tmp_path / "half"
+    half.mkdir()
+    (half / "left.png").write_bytes((tsukuba / "left.png").read_bytes())
+    proc = _eval(str(half))
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        f"stereovision: error: {half}: has left.png but no right.png (a scene folder holds both)"
+    ]
+    books = data_dir / "opencv_uncalibrated" / "books"
+    proc = _eval(str(books))
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        f"stereovision: error: no scene (left.png + right.png) under {books} "
+        "(left.jpg, right.jpg found: a scene's images are PNG)"
+    ]
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    assert _eval(str(empty)).stderr.splitlines() == [
+        f"stereovision: error: no scene (left.png + right.png) under {empty}"
+    ]

@@ -1016,6 +1016,22 @@ def _fmt_dense(m: dict[str, Any]) -> str:
     return f"{m['bad_2.0']:6.1f} {m['bad_1.0']:6.1f} {m['density']:6.1f}"
 
 
+def _no_scene_under(folder: Path, given: str) -> str:
+    """The one line for a folder holding no scene, naming what is missing from it."""
+    pair = ("left.png", "right.png")
+    have = [n for n in pair if (folder / n).is_file()]
+    if len(have) == 1:
+        missing = pair[1 - pair.index(have[0])]
+        return f"{given}: has {have[0]} but no {missing} (a scene folder holds both)"
+    others = sorted(
+        q.name
+        for q in folder.iterdir()
+        if q.is_file() and q.stem.lower() in ("left", "right") and q.name not in pair
+    )
+    found = f" ({', '.join(others)} found: a scene's images are PNG)" if others else ""
+    return f"no scene (left.png + right.png) under {given}{found}"
+
+
 def cmd_eval(args: argparse.Namespace) -> int:
     """``stereovision eval SCENE_DIR...``: evaluation.md metrics, ours beside OpenCV."""
     from tqdm import tqdm
@@ -1031,7 +1047,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
             raise CliError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
         found = find_scenes(p)
         if not found:
-            raise CliError(f"no scene (left.png + right.png) under {d}")
+            raise CliError(_no_scene_under(p, d))
         dirs.extend(found)
     # a scene named twice (its folder and a folder holding it) is evaluated once: twice, it
     # counted twice in the mean line
@@ -1052,9 +1068,6 @@ def cmd_eval(args: argparse.Namespace) -> int:
     # each column's three labels over its three numbers (_fmt_dense: 6 characters each)
     labels = f"{'bad-2':>6s} {'bad-1':>6s} {'dens':>6s}"
     sub = f"{'':38s} {'':>4s} | " + " | ".join([labels] * 5)
-    if not args.json:
-        print(header)
-        print(sub)
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
     failed: list[str] = []
     skipped = 0
@@ -1088,6 +1101,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
         if args.json:
             print(_json_line({k: v for k, v in row.items() if not k.startswith("_")}))
             continue
+        if len(rows) == 1:  # the header over the first row: none over an error alone
+            tqdm.write(header)
+            tqdm.write(sub)
         cells = [_fmt_dense(row["ours"]), _fmt_dense(row["ours+fill"])]
         for key in ("bm", "sgbm", "sgbm+fill"):
             cells.append(_fmt_dense(row[key]) if key in row else " " * 20)
