@@ -271,3 +271,16 @@ def test_count_at_precision_hand_computed() -> None:
     assert count_at_precision(xl[:0], yl[:0], xr[:0], score[:0], gt, 50.0) == 0
     with pytest.raises(ValueError, match="equal length"):
         count_at_precision(xl, yl, xr, score[:2], gt, 50.0)
+
+
+def test_dense_metrics_keys_keep_every_threshold() -> None:
+    """as_dict named thresholds with one decimal: 0.25 came out as ``bad_0.2``, and with 0.2
+    beside it one of the two figures was lost under the shared key."""
+    m = dense_metrics(np.array([[1.0, 1.22]]), np.ones((1, 2)), thresholds=(0.2, 0.25, 2.0))
+    d = m.as_dict()
+    assert [k for k in d if k.startswith("bad_")] == ["bad_0.2", "bad_0.25", "bad_2.0"]
+    assert (d["bad_0.2"], d["bad_0.25"], d["bad_2.0"]) == (50.0, 0.0, 0.0)
+    # the default keys (tracked figures) are unchanged
+    assert [k for k in dense_metrics(np.ones((1, 1)), np.ones((1, 1))).as_dict()][:4] == [
+        "bad_0.5", "bad_1.0", "bad_2.0", "bad_4.0"
+    ]  # fmt: skip

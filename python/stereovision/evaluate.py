@@ -77,6 +77,12 @@ def _unit_factor(unit: str) -> float:
         raise ValueError(f"unit: expected one of {sorted(_TO_METRES)}, got {unit!r}") from None
 
 
+def _threshold_text(t: float) -> str:
+    """``2.0`` -> ``"2.0"`` (the tracked keys), ``0.25`` -> ``"0.25"`` (not ``"0.2"``)."""
+    one = f"{t:.1f}"
+    return one if float(one) == t else repr(float(t))
+
+
 def _pct(num: float, den: float) -> float:
     return 100.0 * num / den if den else math.nan
 
@@ -110,8 +116,12 @@ class DenseMetrics:
     n_both: int
 
     def as_dict(self) -> dict[str, float | int]:
-        """Flat dict: ``bad_0.5``, ``bad_1.0``, ..., ``density``, ``avgerr``, ``rms``, counts."""
-        out: dict[str, float | int] = {f"bad_{t:.1f}": v for t, v in self.bad.items()}
+        """Flat dict: ``bad_0.5``, ``bad_1.0``, ..., ``density``, ``avgerr``, ``rms``, counts.
+
+        A threshold with more than one decimal keeps them all (``bad_0.25``), so that two
+        thresholds never share a key.
+        """
+        out: dict[str, float | int] = {f"bad_{_threshold_text(t)}": v for t, v in self.bad.items()}
         out.update(
             density=self.density,
             avgerr=self.avgerr,
