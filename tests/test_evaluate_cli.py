@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from stereovision.cli import main
@@ -120,3 +121,36 @@ def test_eval_of_a_folder_without_a_scene_names_what_is_missing(
     assert _eval(str(empty)).stderr.splitlines() == [
         f"stereovision: error: no scene (left.png + right.png) under {empty}"
     ]
+
+
+def test_eval_of_a_scene_where_ours_has_no_gt_depth(data_dir: Path, tmp_path: Path) -> None:
+    """A metric scene whose GT is known only where our depth map has holes: the Table-1 draw
+    raised 'no pixel has both an estimated and a ground-truth distance' (without the scene's
+    name) and the whole scene was refused, its valid dense figures with it."""
+    import shutil
+
+    from stereovision.depth import depth_map
+    from stereovision.io import load_scene, read_pfm, write_pfm
+
+    scene_dir = tmp_path / "terrace"
+    shutil.copytree(data_dir / "eth3d" / "terrace", scene_dir)
+    gt_path = scene_dir / "gt_disp.pfm"
+    scene_dir.chmod(0o755)
+    gt_path.chmod(0o644)
+    gt = np.full_like(read_pfm(gt_path), np.inf)
+    gt[:, 0] = 10.0  # max_disparity 16 for the scene
+    write_pfm(gt_path, gt)
+    scene = load_scene(scene_dir)
+    res = depth_map(scene.left, scene.right, scene.calib, method="fast", max_disparity=16)
+    holes = ~np.isfinite(res.depth)
+    assert 0 < holes.sum() < holes.size
+    write_pfm(gt_path, np.where(holes, np.float32(10.0), np.float32(np.inf)))
+    argv = [str(scene_dir), "--method", "fast", "--no-opencv"]
+    proc = _eval(*argv, "--json")
+    assert proc.returncode == 0, proc.stderr
+    (row,) = _rows(proc.stdout)
+    assert row["ours"]["n_gt"] == int(holes.sum()) and row["depth"]["n"] == 0
+    assert row["depth"]["median_rel"] is None and "table1" not in row
+    text = _eval(*argv)
+    assert text.returncode == 0, text.stderr
+    assert f"{row['scene']}: depth: none of our pixels has a GT depth" in text.stdout.splitlines()
