@@ -65,6 +65,8 @@ def test_eval_runs_interleaves_ours_and_opencv(
     row = _eval_scene(scene, "fast", True, runs=3)
     assert calls == ["ours", "bm", "sgbm"] * 3
     assert row["runs"] == 3
+    with pytest.raises(ValueError, match=r"^runs must be >= 1, got 0$"):
+        _eval_scene(scene, "fast", True, runs=0)
 
 
 @pytest.mark.parametrize("value", ["0", "-2", "two"])
