@@ -975,3 +975,45 @@ def test_demo_checks_its_output_folder_first(
     assert cap.out == ""
     assert cap.err == f"stereovision: error: -o {tmp_path / 'notes'}: is a file, not a folder\n"
     assert (tmp_path / "notes").read_text() == "mine"
+
+
+@pytest.mark.parametrize(
+    ("extra", "says"),
+    [
+        (["--max-depth", "-1"], "--max-depth: expected a positive finite number, got -1.0"),
+        (["--voxel", "0"], "--voxel: expected a positive finite number, got 0.0"),
+        (["--grid", "0.1"], "--grid needs --ground"),
+        (["--max-disparity", "5000"], "disparity range 5000 is not smaller than the image width"),
+        (["--right", "tsukuba"], "left and right images must have the same shape"),
+        (["--calib", "tsukuba"], "calibration is for 713x434 images, got 384x288"),
+        (["--no-calib", "--max-sigma", "0.1"], "--max-depth and --max-sigma need --calib"),
+    ],
+)
+def test_depth_says_a_usage_error_before_a_file_it_did_not_write(
+    tmp_path: Path,
+    data_dir: Path,
+    capsys: pytest.CaptureFixture[str],
+    extra: list[str],
+    says: str,
+) -> None:
+    """A usage error that needs no work is said first (it was hidden behind the refusal of a
+    user's file under an output name, and said only once that file was moved), then that
+    file, then the work."""
+    terrace, tsukuba = data_dir / "eth3d" / "terrace", data_dir / "middlebury2001" / "tsukuba"
+    left, right, calib = terrace / "left.png", terrace / "right.png", terrace / "calib.txt"
+    if extra[:2] == ["--right", "tsukuba"]:
+        right, extra = tsukuba / "right.png", extra[2:]
+    elif extra[:2] == ["--calib", "tsukuba"]:
+        left, right, extra = tsukuba / "left.png", tsukuba / "right.png", extra[2:]
+    argv = ["depth", str(left), str(right), "-o", str(tmp_path / "o"), *extra]
+    if extra[:1] == ["--no-calib"]:
+        argv.remove("--no-calib")
+    else:
+        argv += ["--calib", str(calib)]
+    (tmp_path / "o").mkdir()
+    (tmp_path / "o" / "disparity.png").write_bytes(b"mine")
+    capsys.readouterr()
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("stereovision: error: ") and says in err, err
+    assert (tmp_path / "o" / "disparity.png").read_bytes() == b"mine"

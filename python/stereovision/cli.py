@@ -159,6 +159,26 @@ def _load_calibration(path: str | None, pair: np.ndarray | None = None) -> Any:
     return Calibration.from_file(path, image_size=size)
 
 
+def _check_pair(left: np.ndarray, right: np.ndarray, calib: Any, max_disparity: Any) -> None:
+    """What :func:`stereovision.depth.depth_map` refuses of the pair before any work, in its
+    words, checked before :func:`refuse_foreign_outputs` speaks of a file in the ``-o`` folder:
+    images of two sizes, a calibration for another size, a ``max_disparity`` not below the
+    width."""
+    from stereovision.depth import _rig_to_warp_by
+
+    if np.shape(left)[:2] != np.shape(right)[:2]:
+        raise ValueError(
+            f"left and right images must have the same shape, got left {np.shape(left)} and "
+            f"right {np.shape(right)}"
+        )
+    h, w = np.shape(left)[:2]
+    _rig_to_warp_by(calib, w, h, max_disparity)  # a calibration for another image size
+    if max_disparity is not None and max_disparity >= w:
+        raise ValueError(
+            f"disparity range {max_disparity:g} is not smaller than the image width {w}"
+        )
+
+
 def depth_outputs(
     left: np.ndarray,
     right: np.ndarray,
@@ -224,8 +244,8 @@ def depth_outputs(
     from stereovision.render import render_outputs
 
     check_output_folder(out_dir, "-o")  # before the matching, not after it
-    names = planned_depth_outputs(calib is not None, ground, grid is not None)
-    earlier = refuse_foreign_outputs(out_dir, names)  # before the matching, too
+    # Every usage error that needs no work first, then a file of the user's under an output
+    # name, then the work: a wrong --max-depth was reported as that file, then as itself.
     if calib is None and (max_depth is not None or max_sigma is not None):
         raise CliError("--max-depth and --max-sigma need --calib (no depth without one)")
     if ground and calib is None:
@@ -239,6 +259,9 @@ def depth_outputs(
     for value, flag in ((max_depth, "--max-depth"), (max_sigma, "--max-sigma"), (voxel, "--voxel")):
         if value is not None:
             positive_finite(value, flag)
+    _check_pair(left, right, calib, max_disparity)
+    names = planned_depth_outputs(calib is not None, ground, grid is not None)
+    earlier = refuse_foreign_outputs(out_dir, names)  # before the matching, too
     kw: dict[str, Any] = {} if method is None else {"method": method}
     res = depth_map(left, right, calib, max_disparity=max_disparity, fill=fill, refine=refine, **kw)
     if max_depth is not None or max_sigma is not None:
