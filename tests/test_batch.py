@@ -31,7 +31,7 @@ from stereovision.depth import depth_map
 from stereovision.io import imread, read_pfm, read_ply
 
 SCALE = 0.5  # half-size copies keep the cluster run short
-DISPARITY_FILES = {"disparity.png", "disparity.pfm"}
+DISPARITY_FILES = {"disparity.png", "disparity.pfm", "overview.png"}
 DEPTH_FILES = DISPARITY_FILES | {
     "depth.png",
     "depth.npy",

@@ -32,6 +32,7 @@ def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
     assert ours and sgbm, proc.stdout
     assert float(ours.group(1)) < 0.8 * float(sgbm.group(1))
     names = ("disparity.png", "depth.png", "disparity.pfm", "depth.npy", "depth_mm.png")
+    names += ("overview.png",)  # and in the manifest: a rerun replaces it
     for name in (*names, "cloud.ply"):
         assert (out / name).stat().st_size > 0, name
     disp = read_pfm(out / "disparity.pfm")
@@ -41,6 +42,7 @@ def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
     assert img is not None and img.shape == (375, 450, 3) and img.std() > 10
     pts, _ = read_ply(out / "cloud.ply")
     assert len(pts) > 10000
+    assert "overview.png" in json.loads((out / ".stereovision-depth.json").read_text())
 
 
 def test_closed_pipe_stops_quietly(tmp_path: Path) -> None:
@@ -477,6 +479,7 @@ def test_depth_removes_its_own_outputs_of_an_earlier_run(
         "disparity.pfm",
         "disparity.png",
         "notes.txt",
+        "overview.png",
         "scan.json",
     ]
     assert (out / "notes.txt").read_text() == "mine"
@@ -552,7 +555,7 @@ def test_demo_keeps_a_file_it_did_not_write(
     assert cv2.imread(str(out / "disparity.png")) is not None
     listed = json.loads((out / ".stereovision-depth.json").read_text())
     names = ["cloud.ply", "depth.npy", "depth.png", "depth_mm.png", "disparity.pfm"]
-    assert listed == [*names, "disparity.png", "render.png"]
+    assert listed == [*names, "disparity.png", "overview.png", "render.png"]
     assert main(["demo", "-o", str(out)]) == 0  # again: its own files, no copy
     assert "kept as" not in capsys.readouterr().out
     assert sorted(p.name for p in out.glob("*.previous*")) == ["disparity.previous.png"]

@@ -507,6 +507,7 @@ def process_pair(task: dict[str, Any]) -> dict[str, Any]:
             fill=task.get("fill"),
             ground=bool(task.get("ground", False)),
             grid=task.get("grid"),
+            name=str(task.get("name", "pair")),
         )
         files = {name: Path(p).read_bytes() for name, p in written.items()}
     return {

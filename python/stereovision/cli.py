@@ -73,17 +73,13 @@ def colorize(values: np.ndarray, *, lo: float | None = None, hi: float | None = 
     ndarray, uint8 (H, W, 3)
         BGR image.
     """
-    finite = np.isfinite(values)
-    out = np.zeros((*values.shape, 3), np.uint8)
-    if not finite.any():
-        return out
-    v = values[finite]
-    lo = float(np.percentile(v, 1)) if lo is None else lo
-    hi = float(np.percentile(v, 99)) if hi is None else hi
-    scale = 255.0 / max(hi - lo, 1e-9)
-    u8 = np.clip((np.nan_to_num(values, nan=lo) - lo) * scale, 0, 255).astype(np.uint8)
-    out = cv2.applyColorMap(u8, cv2.COLORMAP_TURBO)
-    out[~finite] = 0
+    from stereovision.overview import colour_levels, colour_range
+
+    ends = colour_range(values, lo, hi)  # overview.png's colour bars use the same ends
+    if ends is None:
+        return np.zeros((*values.shape, 3), np.uint8)
+    out = cv2.applyColorMap(colour_levels(values, *ends), cv2.COLORMAP_TURBO)
+    out[~np.isfinite(values)] = 0
     return out
 
 
@@ -145,6 +141,25 @@ def write_depth_outputs(
     return written
 
 
+def write_overview(result: Any, out_dir: Path, name: str) -> dict[str, Path]:
+    """Write ``overview.png`` into ``out_dir``: the left image, the disparity, the depth (with
+    a calibration) and the confidence, downscaled side by side, each map with a labelled colour
+    bar (:func:`stereovision.overview.overview_image`), under a title naming the pair
+    (``name``), the method, the range searched and the density.
+
+    Returns
+    -------
+    dict
+        ``{"overview.png": path}``.
+    """
+    from stereovision.overview import overview_image, overview_title
+
+    picture = overview_image(result, overview_title(name, result))
+    path = out_dir / "overview.png"
+    _atomic_write_bytes(path, _png_bytes(picture.image))
+    return {"overview.png": path}
+
+
 # ----------------------------------------------------------------------------- commands
 
 
@@ -196,6 +211,7 @@ def depth_outputs(
     grid: float | None = None,
     log: Any = None,
     counts: dict[str, int] | None = None,
+    name: str = "pair",
 ) -> tuple[Any, dict[str, Path]]:
     """What ``stereovision depth`` computes and writes for one pair (``batch`` writes the same).
 
@@ -233,6 +249,8 @@ def depth_outputs(
     counts : dict, optional
         Receives ``"cloud.ply"``: the number of points written there
         (:func:`write_depth_outputs`).
+    name : str
+        The pair's name in ``overview.png``'s title (:func:`write_overview`).
 
     Returns
     -------
@@ -270,6 +288,7 @@ def depth_outputs(
     record_outputs(out_dir, earlier | set(names))
     written = write_depth_outputs(res, out_dir, voxel, counts=counts)
     written.update(render_outputs(res, out_dir))
+    written.update(write_overview(res, out_dir, name))
     if ground:
         written.update(_ground_outputs(res, calib, out_dir, grid, log))
     return res, written
@@ -284,6 +303,7 @@ DEPTH_OUTPUTS = (
     "depth_mm.png",
     "cloud.ply",
     "render.png",
+    "overview.png",
     "ground.json",
     "obstacles.png",
     "scan.json",
@@ -314,7 +334,7 @@ def planned_depth_outputs(calib: bool, ground: bool = False, grid: bool = False)
     tuple of str
         File names, a subset of :data:`DEPTH_OUTPUTS` in its order.
     """
-    names = {"disparity.png", "disparity.pfm"}
+    names = {"disparity.png", "disparity.pfm", "overview.png"}
     if calib:
         names |= {"depth.png", "depth.npy", "depth_mm.png", "cloud.ply", "render.png"}
     if ground:
@@ -440,6 +460,13 @@ def remove_stale_outputs(out_dir: Path, written: dict[str, Path]) -> list[Path]:
     return removed
 
 
+def _pair_name(left: str) -> str:
+    """A pair's name for ``overview.png``'s title: its left image's folder and file name
+    (``terrace/left.png``)."""
+    path = Path(left)
+    return f"{path.parent.name}/{path.name}" if path.parent.name else path.name
+
+
 def cmd_depth(args: argparse.Namespace) -> int:
     """``stereovision depth LEFT RIGHT -o DIR``."""
     from stereovision.io import read_image
@@ -480,6 +507,7 @@ def cmd_depth(args: argparse.Namespace) -> int:
         grid=args.grid,
         log=print,
         counts=counts,
+        name=_pair_name(args.left),
     )
     cloud = (
         f"{len(res.points)} points"
@@ -893,6 +921,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     from stereovision.render import render_outputs
 
     written.update(render_outputs(res, out_dir))
+    written.update(write_overview(res, out_dir, "cones (Middlebury 2003, the demo scene)"))
     raw = dense_metrics(res.disparity, scene.gt)
     from stereovision.baselines import opencv_sgbm, row_fill
 

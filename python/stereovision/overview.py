@@ -1,0 +1,281 @@
+"""``overview.png``: a run's pictures on one page, each colour map with a labelled colour bar.
+
+``disparity.png`` and ``depth.png`` are colour-mapped at the input's size (to overlay on it) and
+carry no scale. The overview puts the left image, the disparity map, the depth map (when there
+is one) and the matcher's confidence side by side, downscaled, each map with a colour bar
+whose ticks are labelled in its unit, under a one-line title (pair, method, range, density).
+The maps are coloured exactly as ``disparity.png`` and ``depth.png`` are (:func:`colour_range`):
+the disparity from 0 px to its 99th percentile, the depth on its inverse (near = warm) from the
+1st to the 99th percentile of ``1 / Z``, so the depth bar's ticks are not evenly spaced.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import cv2
+import numpy as np
+import numpy.typing as npt
+
+#: Widest panel (px); a larger image is downscaled by one factor for every panel.
+PANEL_WIDTH = 640
+
+_MARGIN = 10
+_TITLE_H = 34
+_CAPTION_H = 22
+_BAR_GAP = 8
+_BAR_W = 16
+_LABEL_W = 64
+_TICK_SPACING = 16  # px between two labelled ticks at least
+_FONT = cv2.FONT_HERSHEY_SIMPLEX
+_WHITE = (255, 255, 255)
+_GREY = (40, 40, 40)
+
+
+def colour_range(
+    values: npt.NDArray[Any], lo: float | None = None, hi: float | None = None
+) -> tuple[float, float] | None:
+    """The values mapped to the ends of the colour map by ``stereovision.cli.colorize``.
+
+    Parameters
+    ----------
+    values : ndarray, float
+        The map (NaN = none).
+    lo, hi : float, optional
+        Given ends; a missing one is the 1st (``lo``) or 99th (``hi``) percentile of the finite
+        values.
+
+    Returns
+    -------
+    tuple of float or None
+        ``(lo, hi)``; None when no value is finite (the map is black).
+    """
+    finite = np.isfinite(values)
+    if not finite.any():
+        return None
+    v = values[finite]
+    lo = float(np.percentile(v, 1)) if lo is None else float(lo)
+    hi = float(np.percentile(v, 99)) if hi is None else float(hi)
+    return lo, hi
+
+
+def colour_levels(values: npt.NDArray[Any], lo: float, hi: float) -> npt.NDArray[np.uint8]:
+    """The colour map's level (0-255) of each value, as ``colorize`` computes it."""
+    scale = 255.0 / max(hi - lo, 1e-9)
+    return np.clip((np.nan_to_num(values, nan=lo) - lo) * scale, 0, 255).astype(np.uint8)
+
+
+@dataclass
+class ColourBar:
+    """One labelled colour bar of an overview.
+
+    Attributes
+    ----------
+    box : tuple of int
+        ``(x, y, width, height)`` of the bar in the overview; its top row is the colour map's
+        level 255, its bottom row level 0.
+    ticks : list of tuple
+        ``(value, label, y)``: a labelled value and the row of the overview it is drawn at.
+    """
+
+    box: tuple[int, int, int, int]
+    ticks: list[tuple[float, str, int]] = field(default_factory=list)
+
+
+@dataclass
+class Overview:
+    """An overview picture and where its parts are.
+
+    Attributes
+    ----------
+    image : ndarray, uint8 (H, W, 3)
+        BGR picture.
+    title : str
+        Its one-line title.
+    panels : dict
+        Panel name (``"left"``, ``"disparity"``, ``"depth"``, ``"confidence"``) ->
+        ``(x, y, width, height)`` of the downscaled picture.
+    bars : dict
+        Panel name -> its :class:`ColourBar` (maps only).
+    scale : float
+        Downscaling factor of every panel (1 for images up to :data:`PANEL_WIDTH` wide).
+    """
+
+    image: npt.NDArray[np.uint8]
+    title: str
+    panels: dict[str, tuple[int, int, int, int]]
+    bars: dict[str, ColourBar]
+    scale: float
+
+
+def _label(value: float) -> str:
+    return f"{value:.3g}" if abs(value) < 1000 else f"{value:.0f}"
+
+
+def _nice_values(lo: float, hi: float) -> list[float]:
+    """1-2-5 steps of every decade between ``lo`` and ``hi`` (both > 0), ascending."""
+    out: list[float] = []
+    for e in range(math.floor(math.log10(lo)) - 1, math.ceil(math.log10(hi)) + 1):
+        for m in (1.0, 2.0, 5.0):
+            v = float(f"{m * 10.0**e:.12g}")
+            if lo <= v <= hi:
+                out.append(v)
+    return out
+
+
+def _linear_ticks(lo: float, hi: float, n: int = 5) -> list[float]:
+    """About ``n`` round values in ``[lo, hi]``, evenly spaced."""
+    raw = (hi - lo) / max(n, 1)
+    if raw <= 0:
+        return [lo]
+    mag = 10.0 ** math.floor(math.log10(raw))
+    step = next(m * mag for m in (1, 2, 5, 10) if m * mag >= raw)
+    first = math.ceil(lo / step - 1e-9) * step
+    count = math.floor((hi - first) / step + 1e-9) + 1
+    return [float(f"{first + i * step:.12g}") for i in range(count)]
+
+
+def _bar(
+    img: npt.NDArray[np.uint8],
+    x: int,
+    y: int,
+    height: int,
+    lo: float,
+    hi: float,
+    to_mapped: Callable[[float], float],
+    values: list[float],
+) -> ColourBar:
+    """Draw a vertical colour bar at ``(x, y)`` and label ``values`` where their colour is.
+
+    ``to_mapped`` turns a labelled value into the colour-mapped one (the identity, or
+    ``1 / Z`` for the depth).
+    """
+    rows = np.arange(height, dtype=np.float64)
+    levels = np.clip(np.rint(255.0 * (height - 1 - rows) / max(height - 1, 1)), 0, 255)
+    strip = cv2.applyColorMap(levels.astype(np.uint8)[:, None], cv2.COLORMAP_TURBO)
+    img[y : y + height, x : x + _BAR_W] = strip
+    cv2.rectangle(img, (x - 1, y - 1), (x + _BAR_W, y + height), _WHITE, 1)
+    bar = ColourBar(box=(x, y, _BAR_W, height))
+    last_y: int | None = None
+    span = max(hi - lo, 1e-9)
+    # from the top (the map's high end) down, each tick clear of the one above it
+    placed = []
+    for value in values:
+        level = (to_mapped(value) - lo) * 255.0 / span
+        if not 0.0 <= level <= 255.0:
+            continue
+        placed.append((value, y + round((height - 1) * (1.0 - level / 255.0))))
+    for value, ty in sorted(placed, key=lambda t: t[1]):
+        if last_y is not None and ty - last_y < _TICK_SPACING:
+            continue
+        text = _label(value)
+        cv2.line(img, (x + _BAR_W, ty), (x + _BAR_W + 4, ty), _WHITE, 1)
+        cv2.putText(img, text, (x + _BAR_W + 7, ty + 4), _FONT, 0.4, _WHITE, 1, cv2.LINE_AA)
+        bar.ticks.append((value, text, ty))
+        last_y = ty
+    return bar
+
+
+def overview_image(result: Any, title: str) -> Overview:
+    """The overview of a :class:`~stereovision.depth.DepthResult`.
+
+    Parameters
+    ----------
+    result : DepthResult
+        Its left (rectified) image, disparity, depth (None without calibration) and confidence.
+    title : str
+        The one-line title (ASCII; scaled down to fit).
+
+    Returns
+    -------
+    Overview
+        The picture (2 x 2 panels: left, disparity; depth, confidence; without a depth map
+        left, disparity; confidence) and where its panels and bars are.
+    """
+    disparity = np.asarray(result.disparity, np.float32)
+    h, w = disparity.shape[:2]
+    scale = min(1.0, PANEL_WIDTH / w)
+    pw, ph = max(1, round(w * scale)), max(1, round(h * scale))
+    left = result.left_rectified
+    if left is None:
+        left = np.zeros((h, w, 3), np.uint8)
+    elif left.ndim == 2:
+        left = cv2.cvtColor(left, cv2.COLOR_GRAY2BGR)
+    valid = np.isfinite(disparity)
+    confidence = np.where(valid, np.asarray(result.confidence, np.float32), np.nan)
+    # name, values as mapped, fixed ends, caption, labelled value -> mapped value, tick values
+    maps: list[tuple[str, Any, Any, str, Callable[[float], float], str]] = [
+        ("disparity", disparity, (0.0, None), "disparity (px)", lambda v: v, "linear")
+    ]
+    if result.depth is not None:
+        depth = np.asarray(result.depth, np.float32)
+        with np.errstate(divide="ignore"):
+            inv = np.where(np.isfinite(depth), 1.0 / depth, np.nan)
+        maps.append(("depth", inv, (None, None), "depth (m)", lambda z: 1.0 / z, "inverse"))
+    maps.append(("confidence", confidence, (0.0, 1.0), "confidence (0-1)", lambda v: v, "linear"))
+    cell_w = pw + _BAR_GAP + _BAR_W + _LABEL_W
+    cell_h = _CAPTION_H + ph
+    cells = 1 + len(maps)
+    cols = 2
+    rows = (cells + cols - 1) // cols
+    width = _MARGIN + cols * (cell_w + _MARGIN)
+    height = _TITLE_H + rows * (cell_h + _MARGIN)
+    img = np.full((height, width, 3), _GREY, np.uint8)
+
+    def origin(i: int) -> tuple[int, int]:
+        return _MARGIN + (i % cols) * (cell_w + _MARGIN), _TITLE_H + (i // cols) * (
+            cell_h + _MARGIN
+        )
+
+    def caption(text: str, x: int, y: int) -> None:
+        cv2.putText(img, text, (x, y + _CAPTION_H - 7), _FONT, 0.5, _WHITE, 1, cv2.LINE_AA)
+
+    panels: dict[str, tuple[int, int, int, int]] = {}
+    bars: dict[str, ColourBar] = {}
+    x, y = origin(0)
+    caption("left image", x, y)
+    img[y + _CAPTION_H : y + cell_h, x : x + pw] = cv2.resize(
+        left, (pw, ph), interpolation=cv2.INTER_AREA
+    )
+    panels["left"] = (x, y + _CAPTION_H, pw, ph)
+    for i, (name, values, ends, text, to_mapped, kind) in enumerate(maps, start=1):
+        x, y = origin(i)
+        caption(text, x, y)
+        rng = colour_range(values, *ends)
+        coloured: npt.NDArray[Any] = np.zeros((h, w, 3), np.uint8)
+        if rng is not None:
+            coloured = cv2.applyColorMap(colour_levels(values, *rng), cv2.COLORMAP_TURBO)
+            coloured[~np.isfinite(values)] = 0
+        # nearest: every pixel keeps a colour of the map (a blend of two is on no bar)
+        img[y + _CAPTION_H : y + cell_h, x : x + pw] = cv2.resize(
+            coloured, (pw, ph), interpolation=cv2.INTER_NEAREST
+        )
+        panels[name] = (x, y + _CAPTION_H, pw, ph)
+        if rng is None:
+            continue
+        lo, hi = rng
+        if kind == "inverse":
+            near, far = 1.0 / max(hi, 1e-12), min(1.0 / lo if lo > 0 else 1e6, 1e6)
+            # a range within a decade in even steps of depth (2.5, 3, 3.5 m), a wider one
+            # in 1-2-5 steps of each decade (1, 2, 5, 10, 20 m)
+            ticks = _linear_ticks(near, far, 6) if far < 10 * near else _nice_values(near, far)
+        else:
+            ticks = _linear_ticks(lo, hi)
+        bars[name] = _bar(img, x + pw + _BAR_GAP, y + _CAPTION_H, ph, lo, hi, to_mapped, ticks)
+    font_scale = 0.6
+    (tw, _), _ = cv2.getTextSize(title, _FONT, font_scale, 1)
+    if tw > width - 2 * _MARGIN:
+        font_scale *= (width - 2 * _MARGIN) / tw
+    cv2.putText(img, title, (_MARGIN, 23), _FONT, font_scale, _WHITE, 1, cv2.LINE_AA)
+    return Overview(image=img, title=title, panels=panels, bars=bars, scale=scale)
+
+
+def overview_title(name: str, result: Any) -> str:
+    """``"NAME | METHOD | max_disparity N px | density D %"``, the overview's title."""
+    md = result.max_disparity
+    return (
+        f"{name} | {result.method} | max_disparity {md:g} px | density {100 * result.density:.1f} %"
+    )
