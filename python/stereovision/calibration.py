@@ -22,7 +22,7 @@ import re
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, cast
+from typing import Any, cast, overload
 
 import cv2
 import numpy as np
@@ -797,21 +797,26 @@ class Calibration:
         cal: Calibration = self._cache[key]
         return cal
 
-    def depth_step(self, depth_m: npt.ArrayLike, disparity_step: float = 1.0) -> F64:
+    @overload
+    def depth_step(self, depth_m: float, disparity_step: float = 1.0) -> float: ...
+    @overload
+    def depth_step(self, depth_m: npt.ArrayLike, disparity_step: float = 1.0) -> F64: ...
+    def depth_step(self, depth_m: npt.ArrayLike, disparity_step: float = 1.0) -> float | F64:
         """Depth change (metres) that a disparity change of ``disparity_step`` px makes at
         ``depth_m``: ``Z^2 dd / (f B)``, the rig's depth resolution.
 
         Parameters
         ----------
-        depth_m : array_like
-            Depths in metres.
+        depth_m : float or array_like
+            Depth or depths in metres.
         disparity_step : float
             Disparity change in pixels (1 for a whole pixel; a matcher's sub-pixel error).
 
         Returns
         -------
-        numpy.ndarray
-            float64, the shape of ``depth_m``.
+        float or numpy.ndarray
+            For one depth (a number) a float (``numpy.float64``, a ``float``); else float64,
+            the shape of ``depth_m``.
         """
         z = np.asarray(depth_m, dtype=np.float64)
         fb = self.focal_px * self.baseline_m

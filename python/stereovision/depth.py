@@ -291,6 +291,12 @@ def _coarse_top(gl: npt.NDArray[np.uint8], gr: npt.NDArray[np.uint8]) -> float |
     return float(np.percentile(d, _AUTO_COARSE_PERCENTILE)) * s
 
 
+_NO_DEPTH = (
+    "no {what}: depth_map was called without a calibration (or with an "
+    "UncalibratedRectification, which has no metric scale); pass calib=Calibration.from_file(...)"
+)
+
+
 @dataclass(eq=False)  # array fields: == by identity (it raised on the arrays' truth value)
 class DepthResult:
     """Output of :func:`depth_map`.
@@ -400,6 +406,44 @@ class DepthResult:
         if self.timings:
             parts.append(f"{1e3 * sum(self.timings.values()):.0f} ms")
         return f"DepthResult({'; '.join(parts)})"
+
+    def require_depth(self) -> npt.NDArray[np.float32]:
+        """``depth``, typed as an array: for code that passed a calibration and wants no None.
+
+        ``depth`` is None when :func:`depth_map` had no metric calibration (none given, or an
+        :class:`~stereovision.uncalibrated.UncalibratedRectification`), so a type checker sees
+        ``ndarray | None``; this returns the same array (not a copy) or says why there is none.
+
+        Returns
+        -------
+        ndarray
+            float32 ``(H, W)`` metres, NaN where none: ``depth`` itself.
+
+        Raises
+        ------
+        ValueError
+            A result without depth (no calibration).
+        """
+        if self.depth is None:
+            raise ValueError(_NO_DEPTH.format(what="depth"))
+        return self.depth
+
+    def require_depth_sigma(self) -> npt.NDArray[np.float32]:
+        """``depth_sigma``, typed as an array, as :meth:`require_depth` gives ``depth``.
+
+        Returns
+        -------
+        ndarray
+            float32 ``(H, W)`` one-sigma depth uncertainty in metres: ``depth_sigma`` itself.
+
+        Raises
+        ------
+        ValueError
+            A result without depth (no calibration).
+        """
+        if self.depth_sigma is None:
+            raise ValueError(_NO_DEPTH.format(what="depth uncertainty"))
+        return self.depth_sigma
 
     def point_image(self, *, filled: bool = False) -> npt.NDArray[np.float32]:
         """``(H, W, 3)`` float32 points in metres, NaN where the pixel has none.

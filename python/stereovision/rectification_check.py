@@ -20,6 +20,7 @@ import numpy.typing as npt
 
 from stereovision._validate import as_gray_uint8, as_image_array, remap_image
 from stereovision._validate import require as _require_type
+from stereovision.calibration import Calibration
 
 __all__ = [
     "RectificationCheck",
@@ -180,7 +181,7 @@ def _robust_fit(
 def check_rectification(
     left: npt.ArrayLike,
     right: npt.ArrayLike,
-    calib: Any = None,
+    calib: Calibration | None = None,
     *,
     tolerance: float = DEFAULT_TOLERANCE_PX,
     alpha: float = 0.0,
@@ -388,12 +389,12 @@ def _turn_rows(
 def refine_rectification(
     left: npt.ArrayLike,
     right: npt.ArrayLike,
-    calib: Any,
+    calib: Calibration,
     *,
     tolerance: float = DEFAULT_TOLERANCE_PX,
     alpha: float = 0.0,
     check: RectificationCheck | None = None,
-) -> tuple[Any, RectificationCheck]:
+) -> tuple[Calibration, RectificationCheck]:
     """Correct a rig's rotation from one textured pair, so that its rows line up again.
 
     A bump or heat turns a camera by a fraction of a degree: its pitch and roll relative to the

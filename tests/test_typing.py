@@ -1,0 +1,101 @@
+"""The typed public API, as a user with ``mypy --strict`` meets it.
+
+``typed_user_script.py`` does what the README's "Using it" does, every value annotated with the
+type the README promises; mypy checks it against the package that ``import stereovision`` finds
+(the installed one in CI), with no configuration of this repository's.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import site
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import stereovision as sv
+
+SCRIPT = Path(__file__).with_name("typed_user_script.py")
+
+
+def _mypy_strict(source: Path, cwd: Path) -> subprocess.CompletedProcess[str]:
+    """``mypy --strict`` on ``source``, finding ``stereovision`` where Python does: through its
+    ``py.typed`` in site-packages, or (a source checkout on PYTHONPATH) through MYPYPATH, which
+    mypy refuses to point at site-packages. The package's own modules are checked, not reported:
+    a user's mypy reports the user's code."""
+    package_root = Path(sv.__file__).resolve().parents[1]
+    env = dict(os.environ)
+    sites = {Path(p).resolve() for p in [*site.getsitepackages(), site.getusersitepackages()]}
+    if package_root not in sites:
+        env["MYPYPATH"] = str(package_root)
+    cache = Path(tempfile.gettempdir()) / f"stereovision-mypy-strict-{os.getuid()}"
+    return subprocess.run(
+        [sys.executable, "-m", "mypy", "--strict", "--follow-imports=silent",
+         "--no-error-summary", "--cache-dir", str(cache), str(source)],
+        capture_output=True, text=True, timeout=600, cwd=cwd, env=env,
+    )  # fmt: skip
+
+
+def test_the_readme_script_passes_mypy_strict(tmp_path: Path) -> None:
+    """It failed on ``res.depth`` and ``res.depth_sigma`` (``ndarray | None`` even with a
+    calibration: now ``require_depth()`` / ``require_depth_sigma()``) and on
+    ``calib.depth_step(5.0)`` (an array for one number: now a float)."""
+    run = _mypy_strict(SCRIPT, tmp_path)
+    assert run.stdout + run.stderr == ""
+    assert run.returncode == 0
+
+
+def test_mypy_strict_sees_the_optional_depth(tmp_path: Path) -> None:
+    """The check above would pass if mypy saw nothing of the package (``Any`` everywhere): a
+    script that uses ``res.depth`` as an array unguarded is refused, naming the None."""
+    script = tmp_path / "unguarded.py"
+    script.write_text(
+        "import numpy as np\nimport numpy.typing as npt\nimport stereovision as sv\n\n\n"
+        "def depth(res: sv.DepthResult) -> npt.NDArray[np.float32]:\n    return res.depth\n"
+    )
+    run = _mypy_strict(script, tmp_path)
+    assert run.returncode == 1
+    assert 'Incompatible return value type (got "ndarray[' in run.stdout
+    assert '| None", expected "ndarray[' in run.stdout
+
+
+def test_the_readme_script_runs(data_dir: Path, tmp_path: Path) -> None:
+    spec = importlib.util.spec_from_file_location("typed_user_script", SCRIPT)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    got = module.run(data_dir / "eth3d" / "terrace", tmp_path)
+    calib = sv.Calibration.from_file(data_dir / "eth3d" / "terrace" / "calib.txt")
+    assert isinstance(got["step_5m"], float)
+    assert got["step_5m"] == pytest.approx(25.0 / (calib.focal_px * calib.baseline_m))
+    assert got["steps"] == pytest.approx(5.0 / (calib.focal_px * calib.baseline_m))
+    assert 0.5 < got["depth_m"] < 20.0 and 0 < got["sigma_m"] < 1.0
+    assert got["points"] == got["colors"] == got["image_points"] > 10_000
+    assert 0 < got["near_points"] < got["points"]
+    assert got["files"] == 1.0 and got["released"] == 1.0
+    assert got["matches"] == got["read_back"] > 100 and 0 < got["strong_xyz"] <= got["matches"]
+
+
+def test_require_depth_returns_depth_or_says_why_there_is_none() -> None:
+    rng = np.random.default_rng(0)
+    left = rng.random((64, 96), dtype=np.float32)
+    right = np.roll(left, -4, axis=1)
+    bare = sv.depth_map(left, right, max_disparity=16)
+    for accessor, what in ((bare.require_depth, "depth"),
+                           (bare.require_depth_sigma, "depth uncertainty")):  # fmt: skip
+        with pytest.raises(ValueError) as err:
+            accessor()
+        assert str(err.value).startswith(f"no {what}: depth_map was called without a calibration")
+        assert "calib=Calibration.from_file(...)" in str(err.value)
+    calib = sv.Calibration.ideal((96, 64), 90.0, 0.1)
+    res = sv.depth_map(left, right, calib, max_disparity=16)
+    assert res.require_depth() is res.depth
+    assert res.require_depth_sigma() is res.depth_sigma
+    assert float(np.nanmedian(res.require_depth())) == pytest.approx(
+        calib.focal_px * 0.1 / 4, rel=0.05
+    )
