@@ -218,6 +218,11 @@ class GroundPlane:
         The floor fixes the height, pitch and roll; the robot's heading and position are not
         seen, so ``x`` is the optical axis laid on the floor and the camera sits at ``(0, 0,
         height)``.
+
+        Returns
+        -------
+        ndarray
+            float64 ``(4, 4)`` homogeneous transform, camera to floor frame.
         """
         out: F64 = np.eye(4)
         out[:3, :3] = floor_frame(self)
@@ -251,7 +256,14 @@ class GroundPlane:
         )
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-ready figures (no masks)."""
+        """JSON-ready figures (no masks).
+
+        Returns
+        -------
+        dict
+            ``normal``, ``height_m``, ``pitch_deg``, ``roll_deg``, ``disparity_plane``,
+            ``inlier_share``, ``rms_px``, ``below_share`` and ``camera_in_floor`` (4 x 4 rows).
+        """
         return {
             "normal": [float(v) for v in self.normal],
             "height_m": self.height,
@@ -270,7 +282,14 @@ class GroundPlane:
         return f"GroundPlane({self.describe().removeprefix('ground plane: ')}; mask {w}x{h})"
 
     def describe(self) -> str:
-        """One line for a terminal."""
+        """One line for a terminal.
+
+        Returns
+        -------
+        str
+            Height, pitch, roll, inlier share and RMS, and a warning when many points lie below
+            the plane.
+        """
         text = (
             f"ground plane: camera {self.height:.3f} m above it, pitch {self.pitch_deg:+.2f} deg, "
             f"roll {self.roll_deg:+.2f} deg ({100 * self.inlier_share:.0f} % of the pixels, "
@@ -761,7 +780,13 @@ class LaserScan:
         return out
 
     def endpoints(self) -> F64:
-        """``(m, 2)`` floor-frame ``(x, y)`` of the beams that hit an obstacle (metres)."""
+        """Where the beams that hit an obstacle ended.
+
+        Returns
+        -------
+        ndarray
+            float64 ``(m, 2)`` floor-frame ``(x, y)`` in metres, one row per finite range.
+        """
         hit = np.isfinite(self.ranges)
         r, a = self.ranges[hit].astype(np.float64), self.angles[hit]
         out: F64 = np.stack([r * np.cos(a), r * np.sin(a)], axis=1)
@@ -769,7 +794,14 @@ class LaserScan:
 
     def as_dict(self) -> dict[str, Any]:
         """The ``sensor_msgs/LaserScan`` fields, JSON-ready: JSON has no NaN or infinity, so
-        a NaN range is ``null`` and ``+inf`` the string ``"inf"``."""
+        a NaN range is ``null`` and ``+inf`` the string ``"inf"``.
+
+        Returns
+        -------
+        dict
+            ``sensor_msgs/LaserScan``'s field names (``time_increment`` and ``scan_time`` 0) to
+            their values, ``ranges`` a list.
+        """
         ranges: list[Any] = [
             None if math.isnan(v) else ("inf" if math.isinf(v) else round(float(v), 4))
             for v in self.ranges

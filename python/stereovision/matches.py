@@ -209,7 +209,13 @@ class Matches:
         return self._raster(self.yl - self.yr)
 
     def to_array(self) -> F32:
-        """``(N, 4)`` float32 array of ``[x, y, x', y']`` (left then right position) per match."""
+        """The matches as one array, the paper's list.
+
+        Returns
+        -------
+        ndarray
+            float32 ``(N, 4)``, ``[x, y, x', y']`` (left then right position) per match.
+        """
         return np.stack([self.xl, self.yl, self.xr, self.yr], axis=1).astype(np.float32)
 
     def save_csv(self, path: str | os.PathLike[str]) -> Path:

@@ -221,7 +221,13 @@ class TemporalFilter:
         self._means = []
 
     def mean_frames(self) -> float:
-        """Mean number of frames in a pixel's mean over both images (0 before the first pair)."""
+        """How many frames a pixel's running mean holds, on average.
+
+        Returns
+        -------
+        float
+            Mean number of frames in a pixel's mean over both images (0 before the first pair).
+        """
         if not self._means:
             return 0.0
         return float(np.mean([m.count.mean() for m in self._means]))
