@@ -99,3 +99,38 @@ def test_require_depth_returns_depth_or_says_why_there_is_none() -> None:
     assert float(np.nanmedian(res.require_depth())) == pytest.approx(
         calib.focal_px * 0.1 / 4, rel=0.05
     )
+
+
+def test_calibration_methods_take_disparity_like_the_functions() -> None:
+    """``Calibration.depth_from_disparity`` / ``.reproject`` called it ``disp``, the functions of
+    the same name ``disparity``: the methods say ``disparity`` now, ``disp=`` still works with a
+    DeprecationWarning at the caller's line, and both at once is a TypeError."""
+    import inspect
+    import warnings
+
+    from stereovision import triangulation
+
+    calib = sv.Calibration.ideal((64, 48), 90.0, 0.1)
+    d = np.full((48, 64), 8.0, dtype=np.float32)
+    for method, function in ((sv.Calibration.depth_from_disparity, sv.depth_from_disparity),
+                             (sv.Calibration.reproject, triangulation.reproject)):  # fmt: skip
+        assert list(inspect.signature(method).parameters)[1:] == ["disparity", "unit"]
+        assert list(inspect.signature(function).parameters)[:2] == ["disparity", "calib"]
+        name = method.__name__
+        bound = getattr(calib, name)
+        want = function(d, calib)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            np.testing.assert_array_equal(bound(d), want)
+            np.testing.assert_array_equal(bound(disparity=d, unit="m"), want)
+        with pytest.warns(DeprecationWarning) as caught:
+            old = bound(disp=d)
+        np.testing.assert_array_equal(old, want)
+        assert str(caught[0].message) == (
+            f"Calibration.{name}(): the keyword disp= is now disparity= (disp= will be removed)"
+        )
+        assert caught[0].filename == __file__
+        with pytest.raises(TypeError, match=f"^Calibration.{name}\\(\\) got disp= and disparity="):
+            bound(d, disp=d)
+        with pytest.raises(TypeError, match="disp= and disparity="):
+            bound(disparity=d, disp=d)

@@ -11,8 +11,12 @@ luma weights.
 
 from __future__ import annotations
 
+import functools
+import inspect
 import math
-from typing import Any, TypeVar
+import warnings
+from collections.abc import Callable
+from typing import Any, TypeVar, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -37,6 +41,7 @@ __all__ = [
 ]
 
 _T = TypeVar("_T")
+_F = TypeVar("_F", bound=Callable[..., Any])
 
 #: ITU-R BT.601 luma weights in OpenCV's B, G, R channel order (the weights ``cv2.cvtColor``
 #: uses for ``COLOR_BGR2GRAY``), applied here in floating point without intermediate rounding.
@@ -680,3 +685,46 @@ def remap_image(img: np.ndarray, *args: Any, **kwargs: Any) -> np.ndarray:
         work = img.astype(np.float64)
     out = np.asarray(cv2.remap(work, *args, **kwargs))
     return out if out.dtype == img.dtype else out.astype(img.dtype)
+
+
+def renamed_keyword(old: str, new: str) -> Callable[[_F], _F]:
+    """Keep a renamed parameter's old keyword working, with a :class:`DeprecationWarning`.
+
+    The decorated function's signature (what ``help``, ``inspect.signature`` and type checkers
+    see) has the new name only; a call with ``old=`` is passed on as ``new=``, warned about at
+    the caller's line. The wrapper is one more frame: a warning the function itself gives with
+    a ``stacklevel`` counts it.
+
+    Parameters
+    ----------
+    old : str
+        The parameter's former name.
+    new : str
+        Its name now.
+
+    Returns
+    -------
+    callable
+        A decorator.
+    """
+
+    def decorate(func: _F) -> _F:
+        signature = inspect.signature(func)
+
+        @functools.wraps(func)
+        def call(*args: Any, **kwargs: Any) -> Any:
+            if old in kwargs:
+                name = func.__qualname__
+                if new in kwargs or new in signature.bind_partial(*args).arguments:
+                    raise TypeError(f"{name}() got {old}= and {new}=: {old} is {new}'s old name")
+                warnings.warn(
+                    f"{name}(): the keyword {old}= is now {new}= ({old}= will be removed)",
+                    DeprecationWarning,
+                    stacklevel=2,
+                )
+                kwargs[new] = kwargs.pop(old)
+            return func(*args, **kwargs)
+
+        return cast(_F, call)
+
+    return decorate

@@ -28,7 +28,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_image_array, positive_finite, xy_points
+from stereovision._validate import as_image_array, positive_finite, renamed_keyword, xy_points
 
 __all__ = [
     "CAMERA_MODELS",
@@ -982,7 +982,10 @@ class Calibration:
 
     # ------------------------------------------------------------------------------- depth
 
-    def depth_from_disparity(self, disp: npt.ArrayLike, unit: str = "m") -> npt.NDArray[np.float32]:
+    @renamed_keyword("disp", "disparity")
+    def depth_from_disparity(
+        self, disparity: npt.ArrayLike, unit: str = "m"
+    ) -> npt.NDArray[np.float32]:
         """Depth from a rectified-frame disparity map (algorithms.md E.3), in metres unless
         ``unit`` says otherwise (as :func:`stereovision.depth_from_disparity`).
 
@@ -991,21 +994,23 @@ class Calibration:
 
         Parameters
         ----------
-        disp : array_like
-            Disparity in pixels, left rectified image (NaN where none).
+        disparity : array_like
+            Disparity in pixels, left rectified image (NaN where none). The keyword ``disp=``,
+            its former name, still works, with a DeprecationWarning.
         unit : str
             Length unit of the result: ``"m"``, ``"mm"``, ``"cm"``, ``"ft"`` or ``"in"``.
 
         Returns
         -------
         ndarray, float32
-            Depth ``Z``, the shape of ``disp``, NaN where none.
+            Depth ``Z``, the shape of ``disparity``, NaN where none.
         """
         from stereovision.triangulation import _depth_from_disparity
 
-        return _depth_from_disparity(disp, self, unit, 2)
+        return _depth_from_disparity(disparity, self, unit, 3)  # 3: renamed_keyword's frame
 
-    def reproject(self, disp: npt.ArrayLike, unit: str = "m") -> npt.NDArray[np.float32]:
+    @renamed_keyword("disp", "disparity")
+    def reproject(self, disparity: npt.ArrayLike, unit: str = "m") -> npt.NDArray[np.float32]:
         """``(H, W, 3)`` points in metres unless ``unit`` says otherwise (left rectified frame:
         X right, Y down, Z forward).
 
@@ -1013,19 +1018,20 @@ class Calibration:
 
         Parameters
         ----------
-        disp : array_like
-            ``(H, W)`` disparity in pixels, left rectified image (NaN where none).
+        disparity : array_like
+            ``(H, W)`` disparity in pixels, left rectified image (NaN where none). The keyword
+            ``disp=``, its former name, still works, with a DeprecationWarning.
         unit : str
             Length unit of the result: ``"m"``, ``"mm"``, ``"cm"``, ``"ft"`` or ``"in"``.
 
         Returns
         -------
         ndarray, float32
-            ``(H, W, 3)`` points ``X, Y, Z``, NaN where ``disp`` has no depth.
+            ``(H, W, 3)`` points ``X, Y, Z``, NaN where ``disparity`` has no depth.
         """
         from stereovision.triangulation import _reproject
 
-        return _reproject(disp, self, unit, 2)
+        return _reproject(disparity, self, unit, 3)  # 3: renamed_keyword's frame
 
     # ------------------------------------------------------------------------------ saving
 
