@@ -398,3 +398,37 @@ def test_public_functions_document_their_parameters_and_returns() -> None:
             problems.append(f"{name}: no Returns section")
     assert len(_public_api()) > 60
     assert not problems, "\n".join(problems)
+
+
+#: The modules whose classes and functions a user's script meets beyond ``_public_api``'s:
+#: what ``depth_map``, ``check_rectification``, ``rectify_uncalibrated``, ``occupancy_grid`` and
+#: the evaluation return, and the 3-D view's camera.
+RETURNS_MODULES = ("depth", "matches", "ground", "calibration", "triangulation", "evaluate",
+                   "rectification_check", "uncalibrated", "refine", "temporal", "render",
+                   "export", "io")  # fmt: skip
+
+
+def test_every_returned_value_is_documented() -> None:
+    """numpydoc's Returns (or Yields) section on every function and public method of those
+    modules' ``__all__`` annotated to return a value (``as_dict``, ``describe``, ``summary``
+    had none)."""
+    missing = []
+    for short in RETURNS_MODULES:
+        module = importlib.import_module(f"stereovision.{short}")
+        for attr in module.__all__:
+            obj = getattr(module, attr)
+            funcs = [(attr, obj)] if inspect.isfunction(obj) else []
+            if inspect.isclass(obj):
+                for name, value in vars(obj).items():
+                    if isinstance(value, (classmethod, staticmethod)):
+                        value = value.__func__
+                    if not name.startswith("_") and inspect.isfunction(value):
+                        funcs.append((f"{attr}.{name}", value))
+            for name, func in funcs:
+                returns = inspect.signature(func).return_annotation
+                if returns in (None, "None", inspect.Signature.empty):
+                    continue
+                sections = _numpydoc_sections(inspect.getdoc(func) or "")
+                if not {"Returns", "Yields"} & set(sections):
+                    missing.append(f"stereovision.{short}.{name}")
+    assert not missing, f"no Returns section: {missing}"

@@ -120,6 +120,11 @@ class DenseMetrics:
 
         A threshold with more than one decimal keeps them all (``bad_0.25``), so that two
         thresholds never share a key.
+
+        Returns
+        -------
+        dict
+            ``bad_<t>`` per threshold, ``density``, ``avgerr``, ``rms``, ``n_gt``, ``n_both``.
         """
         out: dict[str, float | int] = {f"bad_{_threshold_text(t)}": v for t, v in self.bad.items()}
         out.update(
@@ -222,7 +227,13 @@ class DepthMetrics:
     density: float
 
     def as_dict(self) -> dict[str, float | int]:
-        """The fields as a flat dict."""
+        """The fields as a flat dict.
+
+        Returns
+        -------
+        dict
+            Field name to value.
+        """
         return asdict(self)
 
 
@@ -336,7 +347,13 @@ class Table1Report:
         object.__setattr__(self, "n_points", len(self.x))
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-ready dict: summary figures in metres and feet plus the per-point rows."""
+        """JSON-ready dict: summary figures in metres and feet plus the per-point rows.
+
+        Returns
+        -------
+        dict
+            The summary figures by name and the per-point rows.
+        """
         return {
             "n_points": self.n_points,
             "mean_error_m": self.mean_error,
@@ -366,7 +383,13 @@ class Table1Report:
         }
 
     def format(self) -> str:
-        """Plain-text table (per point, then the summary), in metres and feet."""
+        """Plain-text table (per point, then the summary), in metres and feet.
+
+        Returns
+        -------
+        str
+            Lines joined by newlines.
+        """
         head = (
             f"{'#':>3} {'x':>5} {'y':>5} {'est m':>9} {'GT m':>9} {'err m':>8} "
             f"{'est ft':>9} {'GT ft':>9} {'err ft':>8}"
@@ -504,7 +527,13 @@ class SparseMetrics:
     coverage: int
 
     def as_dict(self) -> dict[str, float | int]:
-        """Flat dict: ``precision@0.5``, ``precision@1.0``, ``precision@2.0``, counts."""
+        """Flat dict: ``precision@0.5``, ``precision@1.0``, ``precision@2.0``, counts.
+
+        Returns
+        -------
+        dict
+            ``precision@<t>`` per threshold, ``count``, ``n_matches``, ``coverage``.
+        """
         out: dict[str, float | int] = {f"precision@{t:.1f}": v for t, v in self.precision.items()}
         out.update(count=self.count, n_matches=self.n_matches, coverage=self.coverage)
         return out

@@ -593,7 +593,18 @@ class OccupancyGrid:
         )
 
     def cell_of(self, x: float, y: float) -> tuple[int, int]:
-        """``(row, col)`` of the cell holding floor point ``(x, y)``."""
+        """``(row, col)`` of the cell holding floor point ``(x, y)``.
+
+        Parameters
+        ----------
+        x, y : float
+            Floor-frame coordinates in metres (``x`` forward, ``y`` left).
+
+        Returns
+        -------
+        tuple of int
+            ``(row, col)``; outside the grid when the point is (negative or past its size).
+        """
         return (
             math.floor((y - self.origin[1]) / self.resolution),
             math.floor((x - self.origin[0]) / self.resolution),
@@ -602,7 +613,13 @@ class OccupancyGrid:
     def image(self) -> npt.NDArray[np.uint8]:
         """map_server's picture: occupied 0 (black), free 254, unknown 205. As map_server reads
         it, the picture's columns run along ``x`` (forward, to the right) and its rows along
-        ``y`` from the top (left) down: the grid's rows flipped."""
+        ``y`` from the top (left) down: the grid's rows flipped.
+
+        Returns
+        -------
+        ndarray
+            uint8 ``(H, W)`` grey levels 0, 205 or 254.
+        """
         img = np.full(self.data.shape, 205, np.uint8)
         img[self.data == FREE] = 254
         img[self.data == OCCUPIED] = 0
@@ -640,7 +657,19 @@ class OccupancyGrid:
 
 def floor_frame(plane: GroundPlane) -> F64:
     """``(3, 3)`` rows: the floor frame's ``x`` (forward), ``y`` (left), ``z`` (up) axes in the
-    camera frame (REP 103)."""
+    camera frame (REP 103).
+
+    Parameters
+    ----------
+    plane : GroundPlane
+        The floor, as :func:`fit_ground_plane` found it.
+
+    Returns
+    -------
+    ndarray
+        float64 ``(3, 3)``, one axis per row: a camera-frame vector ``v`` is ``R @ v`` in the
+        floor frame.
+    """
     up = plane.normal
     forward = np.array([0.0, 0.0, 1.0]) - up * up[2]  # the optical axis laid on the floor
     norm = float(np.linalg.norm(forward))

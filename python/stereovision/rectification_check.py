@@ -87,7 +87,13 @@ class RectificationCheck:
     )
 
     def as_dict(self) -> dict[str, Any]:
-        """The fields as a JSON-ready dict (NaN as None)."""
+        """The fields as a JSON-ready dict (NaN as None).
+
+        Returns
+        -------
+        dict
+            Field name to value, ``points`` left out.
+        """
         out: dict[str, Any] = {}
         for f in fields(self):
             v = getattr(self, f.name)
@@ -97,14 +103,26 @@ class RectificationCheck:
 
     def rows_agree(self) -> str:
         """How the rows agree, for a pair used as given (:func:`already_rectified`):
-        ``"rows median |dy| 0.08 px over 412 matches, tolerance 0.5"``."""
+        ``"rows median |dy| 0.08 px over 412 matches, tolerance 0.5"``.
+
+        Returns
+        -------
+        str
+            One line.
+        """
         return (
             f"rows median |dy| {self.median_dy:.2f} px over {self.matches} matches, tolerance "
             f"{self.tolerance:g}"
         )
 
     def summary(self) -> str:
-        """One line for a log or a terminal."""
+        """One line for a log or a terminal.
+
+        Returns
+        -------
+        str
+            The verdict (ok, NOT rectified, swapped, cannot tell) and the figures behind it.
+        """
         if self.ok is None:
             return (
                 f"rectification: cannot tell, {self.matches} consistent feature matches "

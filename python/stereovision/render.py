@@ -118,7 +118,13 @@ class CameraControls:
                 raise ValueError(f"camera control {f.name} must be a finite number, got {value!r}")
 
     def pose(self) -> npt.NDArray[np.float64]:
-        """4x4 camera-to-left-camera pose of these controls (see :func:`camera_pose`)."""
+        """4x4 camera-to-left-camera pose of these controls (see :func:`camera_pose`).
+
+        Returns
+        -------
+        ndarray
+            float64 ``(4, 4)``.
+        """
         return camera_pose(
             roll=self.roll,
             pitch=self.pitch,

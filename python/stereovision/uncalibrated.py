@@ -323,6 +323,18 @@ class UncalibratedRectification:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Warp a pair of this rig (input size) into its rectified pair (black outside).
 
+        Parameters
+        ----------
+        left, right : array_like
+            The raw pair, of :attr:`input_size`.
+        interpolation : int
+            OpenCV interpolation flag (default ``cv2.INTER_LINEAR``).
+
+        Returns
+        -------
+        tuple of ndarray
+            The rectified left and right images, of :attr:`size`, the input's dtype.
+
         Raises
         ------
         ValueError
@@ -366,7 +378,13 @@ class UncalibratedRectification:
         return _apply(self.H1 if side == "left" else self.H2, xy_points(points))
 
     def as_dict(self) -> dict[str, Any]:
-        """JSON-ready: the homographies, ``F`` and the figures."""
+        """JSON-ready: the homographies, ``F`` and the figures.
+
+        Returns
+        -------
+        dict
+            Field name to value, arrays as nested lists.
+        """
         return {
             "H1": self.H1.tolist(),
             "H2": self.H2.tolist(),
@@ -384,7 +402,18 @@ class UncalibratedRectification:
         }
 
     def save(self, path: str | os.PathLike[str]) -> Path:
-        """Write :meth:`as_dict` as JSON (atomically)."""
+        """Write :meth:`as_dict` as JSON (atomically).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file to write.
+
+        Returns
+        -------
+        Path
+            ``path``.
+        """
         from stereovision.io import atomic_write
 
         p = Path(path)
@@ -395,6 +424,16 @@ class UncalibratedRectification:
     @classmethod
     def load(cls, path: str | os.PathLike[str]) -> UncalibratedRectification:
         """Read a file written by :meth:`save`.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The file.
+
+        Returns
+        -------
+        UncalibratedRectification
+            The rectification it holds.
 
         Raises
         ------
@@ -429,7 +468,13 @@ class UncalibratedRectification:
             raise ValueError(f"{p} is not an uncalibrated rectification: {what}") from None
 
     def describe(self) -> str:
-        """One line for a terminal."""
+        """One line for a terminal.
+
+        Returns
+        -------
+        str
+            The model, the matches, the rows' agreement, the disparity range and the size.
+        """
         return (
             f"rectified without a calibration ({self.model}) from {self.matches} feature "
             "matches: rows "
