@@ -50,18 +50,34 @@ def test_the_readme_script_passes_mypy_strict(tmp_path: Path) -> None:
     assert run.returncode == 0
 
 
-def test_mypy_strict_sees_the_optional_depth(tmp_path: Path) -> None:
+def test_mypy_strict_refuses_what_fails_at_run_time(tmp_path: Path) -> None:
     """The check above would pass if mypy saw nothing of the package (``Any`` everywhere): a
-    script that uses ``res.depth`` as an array unguarded is refused, naming the None."""
-    script = tmp_path / "unguarded.py"
+    script that uses ``res.depth`` unguarded is refused, naming the None, and so is a file name
+    where a Calibration is meant (a TypeError at run time; ``Matches.to_points``'s and
+    ``check_rectification``'s ``calib`` were ``Any``)."""
+    script = tmp_path / "wrong.py"
     script.write_text(
         "import numpy as np\nimport numpy.typing as npt\nimport stereovision as sv\n\n\n"
-        "def depth(res: sv.DepthResult) -> npt.NDArray[np.float32]:\n    return res.depth\n"
+        "def depth(res: sv.DepthResult) -> npt.NDArray[np.float32]:\n    return res.depth\n\n\n"
+        "def points(m: sv.Matches) -> npt.NDArray[np.float32]:\n"
+        "    return m.to_points('rig.yaml')\n\n\n"
+        "def check(a: npt.NDArray[np.uint8]) -> bool | None:\n"
+        "    return sv.check_rectification(a, a, 'rig.yaml').ok\n"
     )
     run = _mypy_strict(script, tmp_path)
     assert run.returncode == 1
-    assert 'Incompatible return value type (got "ndarray[' in run.stdout
-    assert '| None", expected "ndarray[' in run.stdout
+    lines = run.stdout.splitlines()
+    assert len(lines) == 3, run.stdout
+    assert 'wrong.py:7: error: Incompatible return value type (got "ndarray[' in lines[0]
+    assert '| None", expected "ndarray[' in lines[0]
+    assert lines[1].endswith(
+        'wrong.py:11: error: Argument 1 to "to_points" of "Matches" has incompatible type '
+        '"str"; expected "Calibration"  [arg-type]'
+    )
+    assert lines[2].endswith(
+        'wrong.py:15: error: Argument 3 to "check_rectification" has incompatible type "str"; '
+        'expected "Calibration | None"  [arg-type]'
+    )
 
 
 def test_the_readme_script_runs(data_dir: Path, tmp_path: Path) -> None:

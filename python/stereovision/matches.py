@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from stereovision.calibration import Calibration
 from stereovision.io import atomic_write
 
 __all__ = ["Matches"]
@@ -115,7 +116,7 @@ class Matches:
             dict(self.stats),
         )
 
-    def to_points(self, calib: Any, unit: str = "m") -> npt.NDArray[np.float32]:
+    def to_points(self, calib: Calibration, unit: str = "m") -> npt.NDArray[np.float32]:
         """``(N, 3)`` float32 points of the matches, in the left rectified camera frame (X right,
         Y down, Z forward), metres unless ``unit`` says otherwise.
 
