@@ -67,7 +67,7 @@ def test_dense_metrics_empty_and_errors() -> None:
     assert m.bad[0.5] == 100.0 and m.density == 0.0 and math.isnan(m.rms)
     with pytest.raises(ValueError, match=r"same shape.*\(2, 2\).*\(2, 3\)"):
         dense_metrics(np.ones((2, 2)), np.ones((2, 3)))
-    with pytest.raises(ValueError, match="disp"):
+    with pytest.raises(ValueError, match=r"^disparity: expected a real \(H, W\) array"):
         dense_metrics(np.ones(4), np.ones(4))
     with pytest.raises(ValueError, match="thresholds"):
         dense_metrics(np.ones((2, 2)), np.ones((2, 2)), thresholds=(0.0,))
@@ -284,3 +284,23 @@ def test_dense_metrics_keys_keep_every_threshold() -> None:
     assert [k for k in dense_metrics(np.ones((1, 1)), np.ones((1, 1))).as_dict()][:4] == [
         "bad_0.5", "bad_1.0", "bad_2.0", "bad_4.0"
     ]  # fmt: skip
+
+
+def test_dense_metrics_takes_disparity_and_still_disp() -> None:
+    """Its estimate was ``disp`` where the rest of the API says ``disparity``: ``disparity=`` now,
+    ``disp=`` still works with a DeprecationWarning at the caller's line."""
+    import inspect
+    import warnings
+
+    est, gt = np.array([[1.0, NAN, 5.0]]), np.array([[1.5, 2.0, 2.0]])
+    assert list(inspect.signature(dense_metrics).parameters)[:2] == ["disparity", "gt"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        new = dense_metrics(disparity=est, gt=gt)
+    with pytest.warns(DeprecationWarning) as caught:
+        old = dense_metrics(disp=est, gt=gt)
+    assert old == new and new.bad[1.0] == pytest.approx(200 / 3)
+    assert str(caught[0].message) == (
+        "dense_metrics(): the keyword disp= is now disparity= (disp= will be removed)"
+    )
+    assert caught[0].filename == __file__

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import renamed_keyword
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -137,8 +138,9 @@ class DenseMetrics:
         return out
 
 
+@renamed_keyword("disp", "disparity")
 def dense_metrics(
-    disp: npt.ArrayLike,
+    disparity: npt.ArrayLike,
     gt: npt.ArrayLike,
     thresholds: tuple[float, ...] = DEFAULT_THRESHOLDS,
     mask: npt.ArrayLike | None = None,
@@ -147,8 +149,9 @@ def dense_metrics(
 
     Parameters
     ----------
-    disp : array_like
-        ``(H, W)`` estimated disparity (px), NaN = no estimate.
+    disparity : array_like
+        ``(H, W)`` estimated disparity (px), NaN = no estimate. The keyword ``disp=``, its
+        former name, still works, with a DeprecationWarning.
     gt : array_like
         ``(H, W)`` GT disparity (px), non-finite = unknown.
     thresholds : tuple of float
@@ -171,9 +174,9 @@ def dense_metrics(
     >>> m.bad[1.0], round(m.density, 2), m.avgerr
     (66.66666666666667, 66.67, 1.75)
     """
-    d = _real_2d(disp, "disp")
+    d = _real_2d(disparity, "disparity")
     g = _real_2d(gt, "gt")
-    _same_shape(d, g, "disp", "gt")
+    _same_shape(d, g, "disparity", "gt")
     if any(not (t > 0 and math.isfinite(t)) for t in thresholds):
         raise ValueError(f"thresholds must be positive and finite, got {thresholds}")
     known = np.isfinite(g)
