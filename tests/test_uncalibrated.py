@@ -425,3 +425,39 @@ def test_rectify_points_refuses_other_layouts() -> None:
         rect.rectify_points(pts.T)
     with pytest.raises(ValueError, match=r"expected shape \(N, 2\) of \(x, y\), got \(3, 3\)$"):
         rect.rectify_points(np.column_stack([pts, np.ones(3)]))
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("H1", [[float("nan")] * 3] * 3, "H1 has a NaN or infinite entry"),
+        ("H2", [[0.0] * 3] * 3, "H2 is singular"),
+        ("size", [0, -5], "size 0x-5 px"),
+        ("input_size", [612, 0], "input_size 612x0 px"),
+        ("max_disparity", -3, "max_disparity -3"),
+        ("model", "banana", "model 'banana'"),
+    ],
+)
+def test_a_damaged_rectification_file_is_refused(
+    data_dir: Path, tmp_path: Path, field: str, value: object, message: str
+) -> None:
+    """A file whose homographies are NaN or singular, or whose sizes are 0 or less, was read
+    without a word: ``depth --rectification`` warped the pair to black and wrote its disparity
+    map (exit 0). Now the file and what is wrong with it are named, and the CLI exits 1."""
+    books = data_dir / "opencv_uncalibrated" / "books"
+    left, right = (cv2.imread(str(books / f"{s}.jpg")) for s in ("left", "right"))
+    good = rectify_uncalibrated(left, right).save(tmp_path / "good.json")
+    data = json.loads(good.read_text())
+    data[field] = value
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps(data))
+    expected = f"usable uncalibrated rectification: {re.escape(message)}"
+    with pytest.raises(ValueError, match=expected):
+        UncalibratedRectification.load(bad)
+    run = subprocess.run(
+        [sys.executable, "-m", "stereovision.cli", "depth", str(books / "left.jpg"),
+         str(books / "right.jpg"), "--rectification", str(bad), "-o", str(tmp_path / "out")],
+        capture_output=True, text=True,
+    )  # fmt: skip
+    assert run.returncode != 0 and "Traceback" not in run.stderr
+    assert message in run.stderr and not (tmp_path / "out" / "disparity.pfm").exists()

@@ -440,7 +440,8 @@ class UncalibratedRectification:
         FileNotFoundError
             If it does not exist.
         ValueError
-            If it is not such a file (the field named).
+            If it is not such a file (the field named), or its values cannot rectify a pair
+            (NaN or singular homographies, sizes of 0 or less, an unknown model).
         """
         p = Path(path)
         if not p.is_file():
@@ -448,7 +449,7 @@ class UncalibratedRectification:
         try:
             d = json.loads(p.read_text())
             mats = {k: np.asarray(d[k], np.float64).reshape(3, 3) for k in ("H1", "H2", "F")}
-            return cls(
+            out = cls(
                 mats["H1"],
                 mats["H2"],
                 (int(d["size"][0]), int(d["size"][1])),
@@ -466,6 +467,10 @@ class UncalibratedRectification:
         except (ValueError, KeyError, TypeError, IndexError) as exc:
             what = f"field {exc}" if isinstance(exc, KeyError) else str(exc)
             raise ValueError(f"{p} is not an uncalibrated rectification: {what}") from None
+        problem = _damaged(out)
+        if problem:
+            raise ValueError(f"{p} is not a usable uncalibrated rectification: {problem}")
+        return out
 
     def describe(self) -> str:
         """One line for a terminal.
@@ -483,6 +488,32 @@ class UncalibratedRectification:
             f"{self.max_disparity}); {self.size[0]}x{self.size[1]} px, skew "
             f"{max(self.skew_deg):.2f} deg, aspect {self.aspect[0]:.3f} / {self.aspect[1]:.3f}"
         )
+
+
+def _damaged(rect: UncalibratedRectification) -> str | None:
+    """What makes a read rectification unusable (a damaged or hand-edited file), or None.
+
+    NaN or singular homographies warp every pixel to black and ``depth --rectification``
+    went on to write a disparity map of the black pair; a size of 0 or less made OpenCV fall
+    back to the input's size.
+    """
+    for name in ("H1", "H2", "F"):
+        if not np.isfinite(getattr(rect, name)).all():
+            return f"{name} has a NaN or infinite entry"
+    for name in ("H1", "H2"):
+        hom = getattr(rect, name)
+        top = float(np.abs(hom).max())
+        if not (top > 0 and abs(float(np.linalg.det(hom / top))) > 1e-12):
+            return f"{name} is singular (no homography)"
+    for name in ("size", "input_size"):
+        w, h = getattr(rect, name)
+        if not (0 < w <= 100_000 and 0 < h <= 100_000):
+            return f"{name} {w}x{h} px: expected positive sizes up to 100000"
+    if rect.max_disparity < 1:
+        return f"max_disparity {rect.max_disparity}: expected at least 1"
+    if rect.model not in MODELS[1:]:
+        return f"model {rect.model!r}: expected one of {', '.join(MODELS[1:])}"
+    return None
 
 
 #: The rectification models :func:`rectify_uncalibrated` offers.
