@@ -30,6 +30,23 @@ def test_noise_sigma_measures_sensor_noise(data_dir: Path) -> None:
         noise_sigma(np.zeros((2, 5), np.uint8))
 
 
+def test_noise_of_a_16_bit_image_and_images_it_cannot_read(data_dir: Path) -> None:
+    """A 16-bit frame (read_image's uint16 of a 16-bit PNG) counted every pixel over 255 as
+    clipped and read noise 0; it is measured in 8-bit grey levels now, as the same frame in 8
+    bits. Two or five channels raised OpenCV's own cv2.error, bool and complex images read 0."""
+    img = noisy(load_scene(data_dir / VENUS).left, 8.0, np.random.default_rng(0))
+    eight = noise_sigma(img)
+    sixteen = noise_sigma(img.astype(np.uint16) * np.uint16(257))  # 8 bits spread over 16
+    # 5.700 and 5.718: the 8-bit grey image is rounded to whole levels, the 16-bit one is not
+    assert sixteen == pytest.approx(eight, rel=0.01) and 4.8 < sixteen < 6.5
+    for channels in (2, 5):
+        with pytest.raises(ValueError, match=f"expected 1, 3 or 4 channels, got {channels}"):
+            noise_sigma(np.zeros((8, 8, channels), np.uint8))
+    for dtype in (bool, complex):
+        with pytest.raises(ValueError, match="expected grey levels"):
+            noise_sigma(np.ones((8, 8), dtype))
+
+
 def test_a_black_border_is_no_noiseless_image(data_dir: Path) -> None:
     """Venus with noise 8 and a black border over its left 46 % (a fisheye's corners, a
     rectified frame's border): the noise reads as without the border. The border's pixels were

@@ -115,7 +115,9 @@ def noise_sigma(image: npt.ArrayLike) -> float:
     Parameters
     ----------
     image : array_like
-        ``(H, W)`` grey or ``(H, W, 3|4)`` BGR(A) image, 0-255 (``uint8`` or float).
+        ``(H, W)`` grey or ``(H, W, 1|3|4)`` BGR(A) image, 0-255 (``uint8`` or float), or
+        ``uint16`` (0-65535, measured in 8-bit grey levels: divided by 257, as
+        :func:`stereovision.depth_map` scales it).
 
     Returns
     -------
@@ -127,13 +129,24 @@ def noise_sigma(image: npt.ArrayLike) -> float:
     Raises
     ------
     ValueError
-        If the image is not 2-D grey or 3-D colour, or smaller than 3 x 3.
+        If the image is not 2-D grey or 3-D colour of 1, 3 or 4 channels, is smaller than
+        3 x 3, or is not of numbers (bool, complex).
     """
     img = np.asarray(image)
     if img.ndim not in (2, 3) or img.shape[0] < 3 or img.shape[1] < 3:
         raise ValueError(
             f"image: expected an (H, W) or (H, W, C) image of at least 3 x 3, got {img.shape}"
         )
+    if img.ndim == 3 and img.shape[2] not in (1, 3, 4):
+        # OpenCV's colour conversion raised its own error (cv2.error, not a ValueError)
+        raise ValueError(f"image: expected 1, 3 or 4 channels, got {img.shape[2]}")
+    if img.dtype == np.bool_ or not (
+        np.issubdtype(img.dtype, np.integer) or np.issubdtype(img.dtype, np.floating)
+    ):
+        raise ValueError(f"image: expected grey levels (uint8, uint16 or float), got {img.dtype}")
+    if img.dtype == np.uint16:
+        # 0-65535: every pixel over 255 counted as clipped, and the noise came out 0
+        img = img.astype(np.float32) / np.float32(257.0)
     g = _grey(img)
     lap = np.array([[1, -2, 1], [-2, 4, -2], [1, -2, 1]], np.float32)
     resp = np.abs(cv2.filter2D(g, -1, lap))[1:-1, 1:-1]
