@@ -412,6 +412,19 @@ def test_voxel_downsample_against_a_plain_reference(result):
         export.voxel_downsample(pts[:, :2])
 
 
+def test_voxel_downsample_refuses_colours_it_would_wrap() -> None:
+    """Colours are averaged and cast to uint8: 300 came out 44 and NaN 0 (a cast warning),
+    silently. Colours 0-255 of any numeric type are averaged as before; others are refused."""
+    pts = np.zeros((3, 3))
+    _down, dc = export.voxel_downsample(pts, np.array([[10.0, 20, 30], [20, 30, 40], [30, 40, 50]]))
+    assert dc is not None and dc.tolist() == [[20, 30, 40]]
+    for bad in (np.full((3, 3), 300.0), np.full((3, 3), np.nan), np.full((3, 3), -1)):
+        with pytest.raises(ValueError, match=r"colors: expected colours 0-255, got 3 point\(s\)"):
+            export.voxel_downsample(pts, bad)
+    with pytest.raises(ValueError, match="expected uint8 colours 0-255, got bool"):
+        export.voxel_downsample(pts, np.ones((3, 3), bool))
+
+
 def test_point_image_without_the_cloud(result, tmp_path):
     """``cloud=False`` results (the live rate) still give their image-shaped points and an
     organised PCD: from the depth map, as the cloud would have them."""

@@ -600,8 +600,8 @@ def voxel_downsample(
     Raises
     ------
     ValueError
-        If ``points`` is not ``(N, 3)``, ``colors`` does not match it, or ``voxel`` is not a
-        positive number.
+        If ``points`` is not ``(N, 3)``, ``colors`` does not match it or holds values outside
+        0-255, or ``voxel`` is not a positive number.
     """
     from stereovision._validate import not_a_result
 
@@ -616,6 +616,18 @@ def voxel_downsample(
         cols = np.asarray(colors)
         if cols.shape != pts.shape:
             raise ValueError(f"colors: expected shape {pts.shape}, got {cols.shape}")
+        if cols.dtype != np.uint8:
+            # cast to uint8 after the mean, 300 came out 44 and NaN 0 (with a cast warning)
+            if cols.dtype == np.bool_ or not (
+                np.issubdtype(cols.dtype, np.integer) or np.issubdtype(cols.dtype, np.floating)
+            ):
+                raise ValueError(f"colors: expected uint8 colours 0-255, got {cols.dtype}")
+            bad = ~(np.isfinite(cols) & (cols >= 0) & (cols <= 255))
+            if bad.any():
+                raise ValueError(
+                    f"colors: expected colours 0-255, got {int(bad.any(axis=1).sum())} point(s) "
+                    "with values outside (or NaN)"
+                )
     keep = np.isfinite(pts).all(axis=1)
     pts = pts[keep]
     if cols is not None:
