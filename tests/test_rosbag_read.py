@@ -148,6 +148,14 @@ def test_bad_image_messages(cones: Any) -> None:
         decode_image(_Msg(**{**f, "step": 100}))
     with pytest.raises(ValueError, match="data bytes do not hold it"):
         decode_image(_Msg(**{**f, "data": f["data"][:-1]}))
+    # 4:2:2 of an odd width (two pixels share a chroma pair): OpenCV's cv2.error escaped
+    odd = _image_fields(cones.left[:, :-1], "yuv422")
+    assert odd["width"] % 2 == 1
+    for enc in ("yuv422", "yuv422_yuy2"):
+        with pytest.raises(
+            ValueError, match=f"{enc} image of 449x375 px: 4:2:2 data needs an even"
+        ):
+            decode_image(_Msg(**{**odd, "encoding": enc}))
 
 
 # --------------------------------------------------------------------------------- topics

@@ -535,7 +535,8 @@ def decode_image(msg: Any) -> np.ndarray:
     ------
     ValueError
         For an encoding that is not one of :data:`ENCODINGS` (named), a ``compressedDepth``
-        image, data that does not decode, or a size, ``step`` and data length that disagree.
+        image, data that does not decode, a size, ``step`` and data length that disagree, or a
+        4:2:2 (``yuv422``, ``uyvy``, ``yuyv``) image of an odd width.
     """
     if hasattr(msg, "format"):  # CompressedImage
         fmt = str(msg.format)
@@ -566,6 +567,9 @@ def decode_image(msg: Any) -> np.ndarray:
             f"{enc} image of {w}x{h} px: step {step} and {data.size} data bytes do not hold it "
             f"({row} bytes per row needed)"
         )
+    if code in (cv2.COLOR_YUV2BGR_UYVY, cv2.COLOR_YUV2BGR_YUY2) and w % 2:
+        # two pixels share one chroma pair: OpenCV's assertion (cv2.error) escaped BagCamera
+        raise ValueError(f"{enc} image of {w}x{h} px: 4:2:2 data needs an even width")
     rows = np.ascontiguousarray(data[: step * h].reshape(h, step)[:, :row])
     arr: np.ndarray = rows
     if nbytes == 2:
