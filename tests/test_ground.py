@@ -271,6 +271,10 @@ def test_support_refuses_a_map_of_another_size() -> None:
     assert plane is not None and plane.support(floor, RIG) == 1.0
     with pytest.raises(ValueError, match="map is 240x180, the calibration's images are 480x360"):
         plane.support(floor[::2, ::2], RIG)
+    # a tolerance of 0, below 0 or NaN held no pixel: support 0.0, read as "the camera moved"
+    for tol in (0.0, -1.0, math.nan):
+        with pytest.raises(ValueError, match="inlier_px"):
+            plane.support(floor, RIG, inlier_px=tol)
 
 
 @pytest.mark.parametrize("doffs", [0.0, 15.0])

@@ -191,9 +191,14 @@ class GroundPlane:
         Raises
         ------
         ValueError
-            If ``disparity`` is not 2-D, or its size is not the calibration's and the plane's.
+            If ``disparity`` is not 2-D, or its size is not the calibration's and the plane's, or
+            ``inlier_px`` is not a positive number.
         """
         _require_type(calib, "Calibration", "calib")
+        from stereovision._validate import positive_finite
+
+        # 0, a negative or NaN tolerance held no pixel: support 0, "the camera moved"
+        tol = positive_finite(inlier_px, "inlier_px")
         disp = np.asarray(disparity, np.float64)
         if disp.ndim != 2:
             raise ValueError(f"disparity: expected a (H, W) map, got shape {disp.shape}")
@@ -209,7 +214,7 @@ class GroundPlane:
         if len(vv) == 0:
             return 0.0
         a, b, c = self.disparity_plane
-        return float(np.mean(np.abs(a * uu + b * vv + c - disp[known]) < inlier_px))
+        return float(np.mean(np.abs(a * uu + b * vv + c - disp[known]) < tol))
 
     def camera_in_floor(self) -> F64:
         """``(4, 4)`` pose of the camera in the floor frame (ROS REP 103: ``x`` forward, ``y``
