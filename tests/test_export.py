@@ -288,6 +288,25 @@ def test_load_cloud_errors(tmp_path):
         export.load_cloud(bad_npz)
 
 
+@pytest.mark.parametrize(
+    ("depth", "k", "message"),
+    [
+        (np.ones(4), np.eye(3), r"its depth has shape \(4,\), expected \(H, W\)"),
+        (np.ones((4, 4)), np.ones(3), r"its K has shape \(3,\), expected \(3, 3\)"),
+        (np.ones((4, 4)), np.zeros((3, 3)), "its K has focal lengths 0 and 0, expected positive"),
+        (np.array(["a", "b"]), np.eye(3), "its depth is not numbers"),
+    ],
+)
+def test_a_foreign_npz_bundle_is_named(tmp_path, depth, k, message):
+    """A bundle of another writer: a 1-D depth or K raised an unpacking error or an IndexError
+    ("too many indices"), a K of zeros said "empty point cloud" (after divide-by-zero
+    warnings). The file and what is wrong with it are named."""
+    path = tmp_path / "other.npz"
+    np.savez(path, depth=depth, K=k)
+    with pytest.raises(ValueError, match=f"other.npz: {message}"):
+        export.load_cloud(path)
+
+
 def test_damaged_pcd_and_npz_are_value_errors(result, tmp_path):
     """A garbled PCD type letter (a KeyError before) and a bundle whose compressed data is
     damaged (zlib.error before) are ValueErrors naming the file."""

@@ -500,13 +500,29 @@ def read_npz(path: PathLike) -> dict[str, Any]:
 
 
 def _points_from_bundle(data: dict[str, Any], path: Path) -> npt.NDArray[np.float32]:
-    depth = np.asarray(data["depth"], dtype=np.float64)
-    k = np.asarray(data["K"], dtype=np.float64)
+    # A bundle of another writer, or a hand-made one: its depth and K named, not an IndexError
+    # ("too many indices"), an unpacking error, or "empty point cloud" for a K of zeros.
+    raw_depth, raw_k = np.asarray(data["depth"]), np.asarray(data["K"])
+    for name, arr in (("depth", raw_depth), ("K", raw_k)):
+        if arr.dtype == np.bool_ or not (
+            np.issubdtype(arr.dtype, np.integer) or np.issubdtype(arr.dtype, np.floating)
+        ):
+            raise ValueError(f"{path}: its {name} is not numbers ({arr.dtype})")
+    if raw_depth.ndim != 2:
+        raise ValueError(f"{path}: its depth has shape {raw_depth.shape}, expected (H, W)")
+    if raw_k.shape != (3, 3):
+        raise ValueError(f"{path}: its K has shape {raw_k.shape}, expected (3, 3)")
+    depth = raw_depth.astype(np.float64)
+    k = raw_k.astype(np.float64)
     if not np.isfinite(k).all():
         # write_npz of a result without calibration: K and depth all NaN ("empty point cloud"
         # named no cause)
         raise ValueError(
             f"{path}: a depth bundle without calibration (no intrinsics): no metric 3-D points"
+        )
+    if not (k[0, 0] > 0 and k[1, 1] > 0):
+        raise ValueError(
+            f"{path}: its K has focal lengths {k[0, 0]:g} and {k[1, 1]:g}, expected positive ones"
         )
     h, w = depth.shape
     ys, xs = np.mgrid[0:h, 0:w]
