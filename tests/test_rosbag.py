@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -168,6 +169,14 @@ def test_bag_errors(kitti: tuple, tmp_path: Path, data_dir: Path) -> None:
             bag.write(no_depth, 0)
         with pytest.raises(ValueError, match="stamp_ns"):
             bag.write(kitti[0], -5)
+        # int() took True as 1 ns and time.time() (seconds) as a stamp in 1970; NaN, inf,
+        # "abc" and a stamp past 2**31 s raised int()'s, OverflowError's or struct's messages
+        with pytest.raises(ValueError, match=r"whole nanoseconds, got 1733000000\.5 \(seconds\?"):
+            bag.write(kitti[0], 1733000000.5)
+        for bad in (True, "abc", math.nan, math.inf, 2**70):
+            with pytest.raises(ValueError, match="stamp_ns: expected"):
+                bag.write(kitti[0], bad)
+        assert bag.messages == 0  # nothing of the refused frames was written
 
 
 def test_bag_scan_topic(kitti: tuple, tmp_path: Path, data_dir: Path) -> None:

@@ -112,6 +112,32 @@ def _rosbags() -> tuple[Any, Any]:
     return Writer, get_typestore(Stores.ROS2_HUMBLE)
 
 
+def _stamp(stamp_ns: Any) -> int:
+    """``stamp_ns`` as whole nanoseconds in ROS 2's range, or a ValueError naming it.
+
+    ``int()`` alone took ``True`` as 1 ns and ``time.time()`` (seconds, with a fraction) as a
+    stamp in January 1970, and gave ``int()``'s or OverflowError's message for ``"abc"``, NaN
+    or infinity, and ``struct.error`` for a stamp past 2038 (``sec`` is an int32).
+    """
+    if isinstance(stamp_ns, (bool, np.bool_)) or not isinstance(
+        stamp_ns, (int, float, np.integer, np.floating)
+    ):
+        raise ValueError(f"stamp_ns: expected a time in nanoseconds, got {stamp_ns!r}")
+    value = float(stamp_ns)
+    if not math.isfinite(value) or value != math.floor(value):
+        raise ValueError(
+            f"stamp_ns: expected whole nanoseconds, got {stamp_ns!r}"
+            + (" (seconds? multiply by 1e9)" if math.isfinite(value) and value < 1e12 else "")
+        )
+    stamp = int(stamp_ns)
+    if not 0 <= stamp < 2**31 * 1_000_000_000:
+        raise ValueError(
+            f"stamp_ns: expected a time in nanoseconds from 0 to 2**31 s (ROS 2's int32 "
+            f"seconds), got {stamp_ns!r}"
+        )
+    return stamp
+
+
 class BagWriter:
     """Write depth results into a new ROS 2 bag folder.
 
@@ -333,16 +359,15 @@ ros2_static_transform>`.
         Raises
         ------
         ValueError
-            For a result without depth (computed without a calibration), a negative stamp, or
+            For a result without depth (computed without a calibration), a stamp that is not
+            whole nanoseconds from 0 to ROS 2's last second (2**31 s: ``sec`` is an int32), or
             a closed bag.
         OSError
             When the bag's database cannot be written (a full disk), naming the bag.
         """
         if result.depth is None or result.calibration is None:
             raise ValueError("a bag holds depth: compute the result with a calibration")
-        stamp = int(stamp_ns)
-        if stamp < 0:
-            raise ValueError(f"stamp_ns: expected a time in nanoseconds >= 0, got {stamp_ns!r}")
+        stamp = _stamp(stamp_ns)
         if self._writer is None:
             raise ValueError(f"bag {self.path} is closed")
         try:
