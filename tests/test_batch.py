@@ -1184,3 +1184,71 @@ def test_a_scene_with_a_bad_q_dat_fails_that_pair_alone(
     pairs = _summary(out)["pairs"]
     assert pairs["a"]["status"] == "done" and pairs["b"]["status"] == "failed"
     assert (out / "a" / "disparity.pfm").is_file() and not (out / "b").exists()
+
+
+def test_batch_redoes_pairs_an_older_batch_left_without_an_outputs_list(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A summary.json of a batch before ed0f5f2 (version 1): a pair done, then redone on a
+    damaged image, was recorded failed without its outputs list, and a pair whose right image
+    went missing was too, their folders still holding the done run's files. Rerun with the
+    images mended, the pairs' own disparity.png was refused as not listed, exit 2: a user
+    upgrading could not go on in their output folder. The standard output names in such an
+    entry's folder count as listed now; a user's file in a folder no entry records is still
+    refused."""
+    src, out = tmp_path / "drive", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
+    for name in ("a", "b"):  # the done run's files, as an older batch wrote them
+        (out / name).mkdir(parents=True)
+        for f in DISPARITY_FILES:
+            (out / name / f).write_text("old")
+    old = {"status": "failed", "finished": "2026-11-30T10:00:00+00:00", "this_run": "failed"}
+    summary = {  # as batch wrote it before ed0f5f2
+        "version": 1,
+        "pairs": {
+            "a": {
+                **old,
+                "left": str(src / "a/left.png"),
+                "right": str(src / "a/right.png"),
+                "calib": None,
+                "options": {"method": None, "max_disparity": 16, "fill": None},
+                "fingerprint": {"left": [10, 1], "right": [10, 1]},
+                "error": "ValueError: cannot decode .../a/right.png as an image",
+            },
+            "b": {
+                **old,
+                "left": str(src / "b/left.png"),
+                "right": str(src / "b/right.png"),
+                "calib": None,
+                "error": f"unpaired image: no right.png beside {src / 'b/left.png'}",
+            },
+        },
+        "input": str(src.resolve()),
+        "output": str(out.resolve()),
+        "run": {"started": "2026-11-30T10:00:00+00:00", "pairs": 2, "processed": 0,
+                "skipped": 0, "skipped_failed": 0, "failed": 2, "interrupted": False},
+        "counts": {"done": 0, "failed": 2, "pending": 0},
+    }  # fmt: skip
+    (out / SUMMARY_NAME).write_text(json.dumps(summary, indent=1))
+    _tiny(src, data_dir, "c/left.png", "c/right.png")
+    (out / "c").mkdir()
+    (out / "c" / "disparity.png").write_text("mine")  # the user's, in a folder no run wrote
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    capsys.readouterr()
+    assert main(args) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: error: output folder {out}: {out / 'c' / 'disparity.png'} is not "
+        "listed as an earlier run's output there and would be replaced: give another output "
+        "folder, or move or remove that file"
+    ]
+    assert json.loads((out / SUMMARY_NAME).read_text()) == summary  # untouched
+    (out / "c" / "disparity.png").unlink()
+    assert main(args) == 0, capsys.readouterr().err
+    s = _summary(out)
+    assert s["run"]["processed"] == 3 and s["counts"] == {"done": 3, "failed": 0, "pending": 0}
+    for name in ("a", "b", "c"):
+        assert s["pairs"][name]["outputs"] == sorted(DISPARITY_FILES)
+        assert {p.name for p in (out / name).iterdir()} == DISPARITY_FILES
+        assert read_pfm(out / name / "disparity.pfm").shape == (64, 96)
+    assert main(args) == 0
+    assert _summary(out)["run"]["skipped"] == 3

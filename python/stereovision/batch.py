@@ -71,7 +71,9 @@ PROGRESS_SECONDS = 10.0
 SAVE_COST_RATIO = 10.0
 #: Seconds to wait for an existing scheduler.
 CONNECT_TIMEOUT = "10s"
-_SUMMARY_VERSION = 1
+#: 2: every pair whose folder holds outputs of a run lists them (``outputs``); a version 1
+#: summary's failed pairs did not when a redo failed or lost an image (before ed0f5f2).
+_SUMMARY_VERSION = 2
 _LEFT_RE = re.compile(r"left", re.IGNORECASE)
 _RIGHT_RE = re.compile(r"right", re.IGNORECASE)
 _SCENE_CALIBS = ("calib.txt", "Q.dat")
@@ -707,6 +709,9 @@ class _Summary:
                     "replaced: give another output folder, or move or remove that file"
                 )
             self.data = old
+            if old.get("version") == 1:
+                _list_legacy_outputs(out, self.pairs)
+            self.data["version"] = _SUMMARY_VERSION
 
     @property
     def pairs(self) -> dict[str, Any]:
@@ -750,6 +755,31 @@ class _Summary:
         self._dirty = False
         self._saved_at = time.monotonic()
         self._cost = self._saved_at - t0
+
+
+def _list_legacy_outputs(out: Path, pairs: dict[str, Any]) -> None:
+    """List, in each entry of a version 1 summary without ``outputs``, the files under the
+    standard output names (:data:`stereovision.cli.DEPTH_OUTPUTS`) in the pair's folder.
+
+    A batch before ed0f5f2 recorded a pair redone on a damaged image, or whose other image had
+    gone, as failed without the outputs its folder still held from the run that did it: a
+    rerun with the images mended refused those files as not listed (exit 2), and a user
+    upgrading could not go on in the output folder. Only regular files are taken (a folder or
+    a link under such a name is still refused); the other files are not touched."""
+    from stereovision.cli import DEPTH_OUTPUTS
+
+    for name, entry in pairs.items():
+        if not isinstance(entry, dict) or isinstance(entry.get("outputs"), list):
+            continue
+        folder = out / name
+        with contextlib.suppress(OSError, ValueError):
+            if not folder.is_dir() or folder.is_symlink():
+                continue
+            found = sorted(
+                f for f in DEPTH_OUTPUTS if (folder / f).is_file() and not (folder / f).is_symlink()
+            )
+            if found:
+                entry["outputs"] = found
 
 
 def _unchanged(entry: dict[str, Any] | None, fp: dict[str, Any], opts: dict[str, Any]) -> bool:
