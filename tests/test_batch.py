@@ -1252,3 +1252,30 @@ def test_batch_redoes_pairs_an_older_batch_left_without_an_outputs_list(
         assert read_pfm(out / name / "disparity.pfm").shape == (64, 96)
     assert main(args) == 0
     assert _summary(out)["run"]["skipped"] == 3
+
+
+def test_a_pair_gone_from_the_input_is_not_recorded_as_processed_this_run(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A pair removed from the input (or of another input folder run into the same -o) kept
+    its record's "this_run": "processed" from the run that did it, so a script reading the
+    summary took it for one of this run's pairs. It says "not in input" now; its record and
+    outputs are kept."""
+    src, out = tmp_path / "drive", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    shutil.rmtree(src / "b")
+    capsys.readouterr()
+    assert main(args) == 0
+    assert capsys.readouterr().out.startswith("0 processed, 1 skipped (done before), 0 failed")
+    s = _summary(out)
+    assert s["run"]["pairs"] == 1
+    assert s["pairs"]["a"]["this_run"] == "skipped"
+    b = s["pairs"]["b"]
+    assert b["this_run"] == "not in input" and b["status"] == "done"
+    assert b["outputs"] == sorted(DISPARITY_FILES)
+    assert {p.name for p in (out / "b").iterdir()} == DISPARITY_FILES
+    _tiny(src, data_dir, "b/left.png", "b/right.png")  # back (new files): redone
+    assert main(args) == 0
+    assert _summary(out)["pairs"]["b"]["this_run"] == "processed"

@@ -1190,6 +1190,12 @@ def run_batch(
             failed.append(u.name)
             if log is not None:
                 log(f"failed {u.name}: {u.error}")
+        # the records of pairs not under this input (removed since, or another input's) are
+        # kept with their outputs; they said what the run that saw them last did to them
+        here = {j.name for j in jobs} | {u.name for u in unpaired}
+        for name, entry in summary.pairs.items():
+            if name not in here and isinstance(entry, dict):
+                entry["this_run"] = "not in input"
         # no more worker processes than pairs to do: each starts Python, NumPy and OpenCV (a 64-core
         # machine started 64 for 2 pairs), and the cores go to the kernels' own threads instead
         n_workers = max(1, min(workers or os.cpu_count() or 1, len(todo)))
