@@ -1279,3 +1279,26 @@ def test_a_pair_gone_from_the_input_is_not_recorded_as_processed_this_run(
     _tiny(src, data_dir, "b/left.png", "b/right.png")  # back (new files): redone
     assert main(args) == 0
     assert _summary(out)["pairs"]["b"]["this_run"] == "processed"
+
+
+def test_a_changed_pair_is_redone_from_another_working_directory(
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The summary recorded a pair's images as given (``drive/a/left.png`` for ``batch drive``),
+    and read them against the working directory of the next run: after a run over another
+    input into the same -o, the first input's changed pair, run from another directory (a
+    service, cron), was refused as 'made from other images (e.g. a from drive/a/left.png)',
+    exit 2. The summary records absolute paths now."""
+    _tiny(tmp_path, data_dir, "drive/a/left.png", "drive/a/right.png")
+    _tiny(tmp_path, data_dir, "other/b/left.png", "other/b/right.png")
+    args = ["-o", "out", "--workers", "1", "--max-disparity", "16"]
+    monkeypatch.chdir(tmp_path)
+    assert main(["batch", "drive", *args]) == 0
+    assert _summary(tmp_path / "out")["pairs"]["a"]["left"] == str(tmp_path / "drive/a/left.png")
+    assert main(["batch", "other", *args]) == 0
+    os.utime(tmp_path / "drive/a/left.png", ns=(1, 1))  # changed: to be redone
+    (tmp_path / "elsewhere").mkdir()
+    monkeypatch.chdir(tmp_path / "elsewhere")
+    assert main(["batch", str(tmp_path / "drive"), "-o", str(tmp_path / "out"), *args[2:]]) == 0
+    s = _summary(tmp_path / "out")
+    assert s["run"]["processed"] == 1 and s["pairs"]["a"]["this_run"] == "processed"

@@ -539,6 +539,12 @@ def _fingerprint(job: PairJob) -> dict[str, Any]:
     return fp
 
 
+def _recorded(path: Path) -> str:
+    """``path`` as the summary records it: absolute (a path relative to one run's working
+    directory named another file, or none, for a run from another one)."""
+    return os.path.abspath(path)
+
+
 def _same_file(recorded: Any, path: Path) -> bool:
     """Whether ``recorded`` (an image path a summary holds) names the file ``path``."""
     if not isinstance(recorded, str):
@@ -1132,9 +1138,9 @@ def run_batch(
                 previous[job.name] = [str(f) for f in entry["outputs"]]
             summary.pairs[job.name] = {
                 "status": "pending",
-                "left": str(job.left),
-                "right": str(job.right),
-                "calib": None if job.calib is None else str(job.calib),
+                "left": _recorded(job.left),
+                "right": _recorded(job.right),
+                "calib": None if job.calib is None else _recorded(job.calib),
                 "options": opts,
                 "fingerprint": fp,
             }
@@ -1178,8 +1184,8 @@ def run_batch(
             earlier = summary.pairs.get(u.name) or {}
             summary.pairs[u.name] = {
                 "status": "failed",
-                "left": str(left),
-                "right": str(right),
+                "left": _recorded(left),
+                "right": _recorded(right),
                 "calib": None,
                 "error": u.error,
                 "finished": _now(),
