@@ -1302,3 +1302,26 @@ def test_a_changed_pair_is_redone_from_another_working_directory(
     assert main(["batch", str(tmp_path / "drive"), "-o", str(tmp_path / "out"), *args[2:]]) == 0
     s = _summary(tmp_path / "out")
     assert s["run"]["processed"] == 1 and s["pairs"]["a"]["this_run"] == "processed"
+
+
+def test_the_progress_lines_estimate_the_time_left_from_the_pairs_pace(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The time left counted the cluster's start as the first pair's time: 20 s to start the
+    workers and 2 s a pair said 'about 66 s left' after the first of 4 pairs (6 s were left).
+    The elapsed time still counts from the start."""
+    import stereovision.batch as batch
+
+    clock = [100.0]
+    monkeypatch.setattr(batch.time, "monotonic", lambda: clock[0])
+    bar = batch._Progress(4, enabled=True)  # stderr is not a terminal here: plain lines
+    clock[0] += 20.0
+    bar.started()
+    for _ in range(2):
+        clock[0] += 2.0
+        bar.update()
+    bar.close()
+    assert capsys.readouterr().err.splitlines() == [
+        "batch: 1/4 pairs, 22 s, about 6 s left",
+        "batch: 2/4 pairs, 24 s, about 4 s left",
+    ]

@@ -1299,7 +1299,13 @@ class _Progress:
         self.plain = enabled and not tty
         self.total, self.n, self.failed = total, 0, 0
         self.step = max(1, math.ceil(total / 10))
-        self.t0 = self.last = time.monotonic()
+        self.t0 = self.last = self.t_work = time.monotonic()
+
+    def started(self) -> None:
+        """The workers are up: the time left is estimated from the pairs' pace since (the
+        cluster's start, seconds on a loaded machine, made the first lines' estimate a multiple
+        of the run's remaining time)."""
+        self.t_work = time.monotonic()
 
     def update(self, failed: bool = False) -> None:
         self.bar.update(1)
@@ -1311,11 +1317,11 @@ class _Progress:
         if self.n % self.step and now - self.last < PROGRESS_SECONDS:
             return
         self.last = now
-        spent = now - self.t0
+        spent, pace = now - self.t0, (now - self.t_work) / self.n
         fails = f", {self.failed} failed" if self.failed else ""
         print(
             f"batch: {self.n}/{self.total} pairs{fails}, {spent:.0f} s, about "
-            f"{spent / self.n * (self.total - self.n):.0f} s left",
+            f"{pace * (self.total - self.n):.0f} s left",
             file=sys.stderr,
             flush=True,
         )
@@ -1345,6 +1351,7 @@ def _run_jobs(
     dask = _Dask()
     try:
         dask.start(scheduler, n_workers)  # first: without Dask it names the extra to install
+        bar.started()
         from distributed import as_completed
 
         client = dask.client
