@@ -1325,3 +1325,29 @@ def test_the_progress_lines_estimate_the_time_left_from_the_pairs_pace(
         "batch: 1/4 pairs, 22 s, about 6 s left",
         "batch: 2/4 pairs, 24 s, about 4 s left",
     ]
+
+
+def test_scene_folders_linked_into_the_input_are_batched(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A drive's scenes linked into the input folder (in/b -> /data/b, camera folders too) were
+    not entered: their pairs were left out without a word ('1 processed ... 0 failed', exit 0).
+    They are batched now, named by the link; a link to a folder of the input (an alias) or to
+    one holding it (a loop) is not entered."""
+    root, data = tmp_path / "in", tmp_path / "data"
+    _tiny(root, data_dir, "a/left.png", "a/right.png")
+    _tiny(data, data_dir, "b/left.png", "b/right.png", "cams/left/7.png", "cams/right/7.png")
+    (root / "b").symlink_to(data / "b")
+    (root / "seq").mkdir()
+    (root / "seq/left").symlink_to(data / "cams/left")
+    (root / "seq/right").symlink_to(data / "cams/right")
+    (root / "alias").symlink_to(root / "a")
+    (root / "a/loop").symlink_to(root)
+    (root / "up").symlink_to(tmp_path)
+    assert [j.name for j in find_pairs(root)] == ["a", "b", "seq/7"]
+    assert find_pairs(root)[1].left == root / "b/left.png"
+    out = tmp_path / "out"
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    assert capsys.readouterr().out.startswith("3 processed, 0 skipped (done before), 0 failed")
+    assert {p.name for p in (out / "b").iterdir()} == DISPARITY_FILES

@@ -193,6 +193,9 @@ def find_pairs(
       (reported as above). Only
       ``calib`` applies to these pairs (no ``calib.txt`` is looked for).
 
+    Folders linked into ``root`` from elsewhere are searched too, each once, their pairs named
+    by the link; a link to a folder under ``root`` (an alias) or holding it (a loop) is not.
+
     Parameters
     ----------
     root : path
@@ -240,7 +243,7 @@ def _scan(
     cam_found: list[PairJob] = []  # in sibling camera folders
     cam_unpaired: list[_Unpaired] = []
     cam_taken: set[Path] = set()  # named images paired across camera folders, by number
-    for d, _dirs, files in os.walk(r):
+    for d, _dirs, files in _walk(r):
         dirs = sorted(_dirs)
         _dirs[:] = [x for x in dirs if not x.startswith(".")]
         here = Path(d)
@@ -314,6 +317,32 @@ def _scan(
     return unique, named
 
 
+def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str]]]:
+    """:func:`os.walk` (top-down) that also enters links to folders outside ``top``, each once.
+
+    A drive's scene folders linked into the input (``in/tsukuba -> /data/tsukuba``) were not
+    entered and their pairs left out without a word. A link to a folder inside ``top``, or to
+    one holding it, or to one entered already, is an alias (or a loop): not entered."""
+    top_real = os.path.realpath(top)
+    seen = {top_real}
+    for d, dirs, files in os.walk(top, followlinks=True):
+        keep = []
+        for x in dirs:
+            p = os.path.join(d, x)
+            if os.path.islink(p):
+                real = os.path.realpath(p)
+                try:
+                    inside = os.path.commonpath([real, top_real]) in (real, top_real)
+                except ValueError:  # another drive (Windows)
+                    inside = False
+                if inside or real in seen:
+                    continue
+                seen.add(real)
+            keep.append(x)
+        dirs[:] = keep
+        yield d, dirs, files
+
+
 def _camera_folders(dirs: list[str]) -> list[tuple[str, str]]:
     """The pairs of :data:`CAMERA_FOLDERS` among the (non-hidden) sub-folders ``dirs``, as
     spelt there; a folder name matching two spellings (``left`` and ``Left``) is not guessed."""
@@ -338,7 +367,7 @@ def _camera_images(folder: Path) -> set[str]:
     """The images under ``folder`` (any depth, hidden ones excepted) not paired by their name,
     as POSIX paths relative to it."""
     images: set[str] = set()
-    for d, dirs, files in os.walk(folder):
+    for d, dirs, files in _walk(folder):
         dirs[:] = [x for x in dirs if not x.startswith(".")]
         sub = Path(d).relative_to(folder)
         for f in files:
@@ -395,7 +424,7 @@ def _lone_named_images(folder: Path) -> set[str]:
     (``left`` or ``right`` in the name) without the other beside them, as POSIX paths relative
     to it."""
     lone: set[str] = set()
-    for d, dirs, files in os.walk(folder):
+    for d, dirs, files in _walk(folder):
         dirs[:] = [x for x in dirs if not x.startswith(".")]
         sub, names = Path(d).relative_to(folder), set(files)
         for f in files:
