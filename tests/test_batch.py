@@ -1351,3 +1351,26 @@ def test_scene_folders_linked_into_the_input_are_batched(
     assert main(args) == 0
     assert capsys.readouterr().out.startswith("3 processed, 0 skipped (done before), 0 failed")
     assert {p.name for p in (out / "b").iterdir()} == DISPARITY_FILES
+
+
+def test_a_run_killed_while_writing_a_pair_leaves_no_temporary_folder_for_good(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """A run killed (SIGKILL, the OOM killer) while writing a pair left its hidden temporary
+    folder (.a.partial-1a2b3c4d, the pair's outputs) beside the pair's folder, and no run
+    removed it. The next run over the pair removes those of its pairs; other hidden folders
+    stay."""
+    src, out = tmp_path / "drive", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png", "s/b/left.png", "s/b/right.png")
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    for partial in (".a.partial-1a2b3c4d", "s/.b.partial-00ff00ff"):
+        (out / partial).mkdir(parents=True)
+        (out / partial / "cloud.ply").write_text("half written")
+    mine = [out / ".a.partial-notmine", out / ".c.partial-1a2b3c4d", out / ".mine"]
+    for p in mine:
+        p.mkdir()
+    assert main(args) == 0
+    assert sorted(p.name for p in out.iterdir()) == sorted(
+        [".a.partial-notmine", ".c.partial-1a2b3c4d", ".mine", "a", "s", SUMMARY_NAME]
+    )
+    assert sorted(p.name for p in (out / "s").iterdir()) == ["b"]

@@ -661,6 +661,29 @@ def _commit_pair(
     return dest
 
 
+_PARTIAL_RE = re.compile(r"\.(.+)\.partial-[0-9a-f]{8}")
+
+
+def _remove_partials(out: Path, names: list[str]) -> None:
+    """Remove the temporary folders (``.NAME.partial-1a2b3c4d`` beside ``OUT/NAME``) that a
+    run killed while writing those pairs left (SIGKILL, the OOM killer, a power cut: its
+    ``finally`` did not run); each held a pair's outputs and stayed, hidden, for good. Only
+    folders of that pattern for the pairs ``names`` are touched, under the run's lock."""
+    by_parent: dict[Path, set[str]] = {}
+    for name in names:
+        dest = out / name
+        by_parent.setdefault(dest.parent, set()).add(dest.name)
+    for parent, pairs in by_parent.items():
+        try:
+            entries = list(os.scandir(parent))
+        except OSError:  # not made yet
+            continue
+        for e in entries:
+            m = _PARTIAL_RE.fullmatch(e.name)
+            if m and m.group(1) in pairs and e.is_dir(follow_symlinks=False):
+                shutil.rmtree(e.path, ignore_errors=True)
+
+
 def _error_line(exc: BaseException) -> str:
     msg = str(exc).splitlines()[0] if str(exc) else ""
     return f"{type(exc).__name__}: {msg}" if msg else type(exc).__name__
@@ -1200,6 +1223,7 @@ def run_batch(
                 f"output folder {out}: {foreign} is not listed as an earlier run's output there "
                 "and would be replaced: give another output folder, or move or remove that file"
             )
+        _remove_partials(out, [j.name for j in jobs])
         if redone and log is not None:
             shown = sorted(changes)[:3] + (["..."] if len(changes) > 3 else [])
             log(
