@@ -1374,3 +1374,29 @@ def test_a_run_killed_while_writing_a_pair_leaves_no_temporary_folder_for_good(
         [".a.partial-notmine", ".c.partial-1a2b3c4d", ".mine", "a", "s", SUMMARY_NAME]
     )
     assert sorted(p.name for p in (out / "s").iterdir()) == ["b"]
+
+
+def test_an_image_that_cannot_be_read_fails_its_pair_alone(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A pair's image that is a broken link (a drive not mounted, a sync not finished) stopped
+    the whole run before any pair, '[Errno 2] No such file or directory: ...', exit 2. That
+    pair alone fails now, its error in one line and in the summary, the others are done, exit
+    1; it is tried again on the next run and done once the image is there."""
+    src, out = tmp_path / "drive", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "b/left.png", "b/right.png")
+    (src / "a/right.png").symlink_to(tmp_path / "not-mounted/right.png")
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    capsys.readouterr()
+    assert main(args) == 1
+    said = capsys.readouterr()
+    error = f"FileNotFoundError: [Errno 2] No such file or directory: '{src / 'a/right.png'}'"
+    assert f"failed a: {error}" in said.err.splitlines()
+    assert said.out.startswith("1 processed, 0 skipped (done before), 1 failed in ")
+    s = _summary(out)
+    assert s["pairs"]["a"]["status"] == "failed" and s["pairs"]["a"]["error"] == error
+    assert s["pairs"]["b"]["status"] == "done" and s["run"]["failed"] == 1
+    _tiny(tmp_path, data_dir, "not-mounted/right.png")  # mounted
+    assert main(args) == 0
+    assert capsys.readouterr().out.startswith("1 processed, 1 skipped (done before), 0 failed")
+    assert _summary(out)["pairs"]["a"]["outputs"] == sorted(DISPARITY_FILES)

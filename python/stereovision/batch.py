@@ -1159,8 +1159,13 @@ def run_batch(
         changes: set[str] = set()
         others: list[tuple[str, str]] = []  # done from another input folder's images: (name, image)
         foreign: Path | None = None  # a file under an output name no run recorded writing
+        unreadable: list[tuple[PairJob, str]] = []  # an image or calibration not there
         for job in jobs:
-            fp = _fingerprint(job)
+            try:
+                fp = _fingerprint(job)
+            except OSError as exc:  # a broken link, an unmounted drive: this pair alone fails
+                unreadable.append((job, _error_line(exc)))
+                continue
             entry = summary.pairs.get(job.name)
             if _skip(entry, fp, opts, out, job.name, retry_failed):
                 assert entry is not None
@@ -1249,6 +1254,22 @@ def run_batch(
             failed.append(u.name)
             if log is not None:
                 log(f"failed {u.name}: {u.error}")
+        for job, error in unreadable:  # tried again every run, as its files may come back
+            earlier = summary.pairs.get(job.name) or {}
+            summary.pairs[job.name] = {
+                "status": "failed",
+                "left": _recorded(job.left),
+                "right": _recorded(job.right),
+                "calib": None if job.calib is None else _recorded(job.calib),
+                "error": error,
+                "finished": _now(),
+                "this_run": "failed",
+            }
+            if isinstance(earlier.get("outputs"), list):  # an earlier run's, still in its folder
+                summary.pairs[job.name]["outputs"] = earlier["outputs"]
+            failed.append(job.name)
+            if log is not None:
+                log(f"failed {job.name}: {error}")
         # the records of pairs not under this input (removed since, or another input's) are
         # kept with their outputs; they said what the run that saw them last did to them
         here = {j.name for j in jobs} | {u.name for u in unpaired}
