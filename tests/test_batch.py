@@ -1333,7 +1333,7 @@ def test_scene_folders_linked_into_the_input_are_batched(
     """A drive's scenes linked into the input folder (in/b -> /data/b, camera folders too) were
     not entered: their pairs were left out without a word ('1 processed ... 0 failed', exit 0).
     They are batched now, named by the link; a link to a folder of the input (an alias) or to
-    one holding it (a loop) is not entered."""
+    one holding it (a loop) is not entered, but camera folders linked in are paired as before."""
     root, data = tmp_path / "in", tmp_path / "data"
     _tiny(root, data_dir, "a/left.png", "a/right.png")
     _tiny(data, data_dir, "b/left.png", "b/right.png", "cams/left/7.png", "cams/right/7.png")
@@ -1344,12 +1344,17 @@ def test_scene_folders_linked_into_the_input_are_batched(
     (root / "alias").symlink_to(root / "a")
     (root / "a/loop").symlink_to(root)
     (root / "up").symlink_to(tmp_path)
-    assert [j.name for j in find_pairs(root)] == ["a", "b", "seq/7"]
+    # camera folders named left/ and right/ by links to folders of the input: a pair there
+    _tiny(root, data_dir, "raw/cam_l/9.png", "raw/cam_r/9.png")
+    (root / "seq2").mkdir()
+    (root / "seq2/left").symlink_to(root / "raw/cam_l")
+    (root / "seq2/right").symlink_to(root / "raw/cam_r")
+    assert [j.name for j in find_pairs(root)] == ["a", "b", "seq/7", "seq2/9"]
     assert find_pairs(root)[1].left == root / "b/left.png"
     out = tmp_path / "out"
     args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
-    assert capsys.readouterr().out.startswith("3 processed, 0 skipped (done before), 0 failed")
+    assert capsys.readouterr().out.startswith("4 processed, 0 skipped (done before), 0 failed")
     assert {p.name for p in (out / "b").iterdir()} == DISPARITY_FILES
 
 

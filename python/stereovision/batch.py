@@ -243,7 +243,7 @@ def _scan(
     cam_found: list[PairJob] = []  # in sibling camera folders
     cam_unpaired: list[_Unpaired] = []
     cam_taken: set[Path] = set()  # named images paired across camera folders, by number
-    for d, _dirs, files in _walk(r):
+    for d, _dirs, files, listed in _walk(r):
         dirs = sorted(_dirs)
         _dirs[:] = [x for x in dirs if not x.startswith(".")]
         here = Path(d)
@@ -282,7 +282,8 @@ def _scan(
             lp = _swap(p, m, "left")
             if lp.name not in names:
                 unpaired.append(_Unpaired(_pair_name(p, m, rel, r), p, lp, "right"))
-        cams = _camera_folders(_dirs)
+        # links not entered included: camera folders named by links to the input's own
+        cams = _camera_folders(sorted(x for x in listed if not x.startswith(".")))
         for left_dir, right_dir in cams:
             # several rigs in one folder (KITTI's grey image_0/1 and colour image_2/3): each
             # pair's name keeps its left camera's folder, so that they do not take each other's
@@ -317,15 +318,19 @@ def _scan(
     return unique, named
 
 
-def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str]]]:
-    """:func:`os.walk` (top-down) that also enters links to folders outside ``top``, each once.
+def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str], list[str]]]:
+    """:func:`os.walk` (top-down) that also enters links to folders outside ``top``, each once;
+    also yields each folder's sub-folders as listed, links not entered included.
 
     A drive's scene folders linked into the input (``in/tsukuba -> /data/tsukuba``) were not
     entered and their pairs left out without a word. A link to a folder inside ``top``, or to
-    one holding it, or to one entered already, is an alias (or a loop): not entered."""
+    one holding it, or to one entered already, is an alias (or a loop): not entered (camera
+    folders named by such links, ``seq/left -> ../raw/cam_l``, are still paired: their
+    search is their own)."""
     top_real = os.path.realpath(top)
     seen = {top_real}
     for d, dirs, files in os.walk(top, followlinks=True):
+        listed = list(dirs)
         keep = []
         for x in dirs:
             p = os.path.join(d, x)
@@ -340,7 +345,7 @@ def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str]]]:
                 seen.add(real)
             keep.append(x)
         dirs[:] = keep
-        yield d, dirs, files
+        yield d, dirs, files, listed
 
 
 def _camera_folders(dirs: list[str]) -> list[tuple[str, str]]:
@@ -367,7 +372,7 @@ def _camera_images(folder: Path) -> set[str]:
     """The images under ``folder`` (any depth, hidden ones excepted) not paired by their name,
     as POSIX paths relative to it."""
     images: set[str] = set()
-    for d, dirs, files in _walk(folder):
+    for d, dirs, files, _ in _walk(folder):
         dirs[:] = [x for x in dirs if not x.startswith(".")]
         sub = Path(d).relative_to(folder)
         for f in files:
@@ -424,7 +429,7 @@ def _lone_named_images(folder: Path) -> set[str]:
     (``left`` or ``right`` in the name) without the other beside them, as POSIX paths relative
     to it."""
     lone: set[str] = set()
-    for d, dirs, files in _walk(folder):
+    for d, dirs, files, _ in _walk(folder):
         dirs[:] = [x for x in dirs if not x.startswith(".")]
         sub, names = Path(d).relative_to(folder), set(files)
         for f in files:
