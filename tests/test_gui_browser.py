@@ -1257,6 +1257,43 @@ def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_pat
     assert bare.state.error == "no folder to write into: start the GUI with --data DIR"
 
 
+def test_the_save_field_shows_the_data_folder_short_and_saves_where_it_says(tmp_path, monkeypatch):
+    """The save field showed the --data folder's absolute path (the README's picture: a
+    temporary /tmp/sv-.../scenes/saved). It shows it relative to the current directory when
+    it is under it, else ~-abbreviated, else absolute, the whole path in its tooltip; a path
+    typed as the field shows them (relative to the current directory) is saved there, a bare
+    name still in the first --data folder."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.sources import display_path
+
+    data = tmp_path / "scenes"
+    data.mkdir()
+    monkeypatch.chdir(tmp_path)
+    app = _scene_app("test-save-shown", [bundled_data_dir(), data])
+    assert app.state.save_dir == "scenes/saved"
+    full = str(data.resolve() / "saved")
+    assert app.state.save_dir_title == f"{full} (or the next new saved-N)"
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.error == "" and (data / "saved" / "cloud.ply").is_file()
+    for typed, where in (("scenes/mine", data / "mine"), ("other", data / "other")):
+        app._on_save_dir(typed)
+        assert app.state.save_dir_title == str(where.resolve()), typed
+        app.state.save_dir = typed
+        _run(app, app.save)
+        assert app.state.error == "" and (where / "cloud.ply").is_file(), typed
+    assert not (data / "scenes").exists()
+    app._on_save_dir("../outside")
+    assert app.state.save_dir_title == ""
+    # under the home folder, not the current directory: ~/...
+    monkeypatch.setenv("HOME", str(tmp_path))
+    monkeypatch.chdir("/")
+    home_app = _scene_app("test-save-home", [bundled_data_dir(), data])
+    assert home_app.state.save_dir == "~/scenes/saved"
+    assert display_path(data, cwd=Path("/nowhere"), home=Path("/nohome")) == str(data)
+
+
 def test_saves_into_the_offered_folder_go_to_a_new_numbered_folder_each(tmp_path):
     """Each Save after the first was refused ("saved already holds ...") until a new folder was
     typed: saving several pairs meant typing a folder for each. Left as offered (or emptied),

@@ -43,6 +43,7 @@ from stereovision.gui.sources import (
     AllowedFolders,
     FolderPairs,
     StereoSource,
+    display_path,
     open_stereo_source,
     parse_source,
     scale_pair,
@@ -889,8 +890,13 @@ class StereoApp:
         st.translation_range, st.translation_step = TRANSLATION_RANGE, TRANSLATION_STEP
         #: The save folder the page offers; left as offered (or emptied), each Save takes the
         #: first of it, ``saved-2``, ``saved-3``, ... that is new or empty.
-        self._offered_save_dir = str(self._save_roots[0] / SAVE_FOLDER) if self._save_roots else ""
+        #: It is shown relative to the current directory (or ``~/...``), its whole path in the
+        #: field's tooltip (the README's picture showed a temporary ``/tmp/sv-.../scenes/saved``).
+        self._offered_save_dir = (
+            display_path(self._save_roots[0] / SAVE_FOLDER) if self._save_roots else ""
+        )
         st.save_dir = self._offered_save_dir
+        st.save_dir_title = self._save_title(self._offered_save_dir)
         st.save_hint = SAVE_HINT if self._save_roots else NO_SAVE_HINT
         st.save_label = ""
         for name in _CONTROL_NAMES:
@@ -902,6 +908,7 @@ class StereoApp:
         st.change("view_mode")(self._on_view_mode)
         st.change("unit")(self._on_unit)
         st.change("scene")(self._on_scene)
+        st.change("save_dir")(self._on_save_dir)
         self.ctrl.on_server_ready.add(self._on_ready)
 
     # ------------------------------------------------------------------------- helpers
@@ -916,6 +923,39 @@ class StereoApp:
             {"title": f.label(p), "value": str(p)} for p in f.files(IMAGE_SUFFIXES)
         ]
         self.state.pair_folders = [{"title": f.label(p), "value": str(p)} for p in f.folders()]
+
+    def _typed_save_folder(self, typed: str) -> Path:
+        """The folder a Save goes to for the save field's text (not the offered one).
+
+        A relative path is read as the field shows paths, relative to the current directory,
+        when that lands inside a ``--data`` folder; else relative to the first ``--data``
+        folder (a bare name such as ``mine``).
+
+        Raises
+        ------
+        ValueError
+            Empty, or outside the ``--data`` folders.
+        """
+        text = typed.strip()
+        p = Path(text).expanduser() if text else None
+        if p is not None and "\x00" not in text and not p.is_absolute():
+            here = (Path.cwd() / p).resolve()
+            if any(here == r or here.is_relative_to(r) for r in self._save_roots):
+                return here
+        return self.folders.resolve_output(typed, self._save_roots)
+
+    def _save_title(self, typed: str | None) -> str:
+        """The save field's tooltip: the whole path a Save would write into ("" for none)."""
+        text = str(typed or "").strip()
+        if self._save_roots and text in ("", self._offered_save_dir):
+            return str(self._save_roots[0] / SAVE_FOLDER) + " (or the next new saved-N)"
+        try:
+            return str(self._typed_save_folder(text))
+        except (ValueError, OSError):
+            return ""
+
+    def _on_save_dir(self, save_dir: str | None = None, **_: Any) -> None:
+        self.state.save_dir_title = self._save_title(save_dir)
 
     def _fail(self, exc: BaseException) -> None:
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
@@ -1537,7 +1577,7 @@ class StereoApp:
             if self._save_roots and typed in ("", self._offered_save_dir):
                 folder = self._next_save_folder(skipped)
             else:
-                folder = self.folders.resolve_output(typed, self._save_roots)
+                folder = self._typed_save_folder(typed)
             label = self.folders.label(folder)
             if folder in self._saving_into:  # its files are not there yet: not "taken" below
                 raise FileExistsError(
@@ -1978,6 +2018,7 @@ class StereoApp:
                             density="compact",
                             hide_details=True,
                             id="save-dir",
+                            title=("save_dir_title",),
                         )
                     with v3.VCol(cols=3):
                         v3.VBtn(

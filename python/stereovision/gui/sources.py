@@ -29,6 +29,7 @@ __all__ = [
     "FolderPairs",
     "StereoSource",
     "VideoPair",
+    "display_path",
     "open_bag_source",
     "open_stereo_source",
     "parse_source",
@@ -41,6 +42,49 @@ VIDEO_SUFFIXES = frozenset({".avi", ".mp4", ".mkv", ".mov", ".webm"})
 
 #: At most this many files / scenes are listed per kind (a huge folder must not stall the page).
 MAX_LISTED = 500
+
+
+def display_path(
+    path: str | os.PathLike[str], cwd: Path | None = None, home: Path | None = None
+) -> str:
+    """How the page shows a folder or file: relative to the current directory when it is
+    under it, else ``~``-abbreviated when it is under the home folder, else absolute.
+
+    The save field showed the whole absolute path of the ``--data`` folder (a temporary
+    ``/tmp/sv-ee05_o5h/scenes/saved`` in the README's picture).
+
+    Parameters
+    ----------
+    path : path
+        Absolute (a relative one is taken as relative to ``cwd``).
+    cwd, home : Path, optional
+        Default: the current directory and the user's home folder.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> display_path("/srv/scenes/saved", cwd=Path("/srv"), home=Path("/home/me"))
+    'scenes/saved'
+    >>> display_path("/home/me/scenes", cwd=Path("/srv"), home=Path("/home/me"))
+    '~/scenes'
+    >>> display_path("/mnt/x", cwd=Path("/srv"), home=Path("/home/me"))
+    '/mnt/x'
+    """
+    cwd = Path.cwd() if cwd is None else cwd
+    p = Path(os.path.abspath(cwd / Path(path)))
+    if p.is_relative_to(cwd) and cwd != Path(cwd.anchor):  # not "tmp/..." from "/"
+        return p.relative_to(cwd).as_posix()
+    try:
+        home = Path.home() if home is None else home
+    except RuntimeError:  # no home folder known
+        return str(p)
+    if p.is_relative_to(home) and home != Path(home.anchor):
+        rel = p.relative_to(home).as_posix()
+        return "~" if rel == "." else f"~/{rel}"
+    return str(p)
 
 
 class AllowedFolders:
