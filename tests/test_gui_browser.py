@@ -360,7 +360,7 @@ def test_the_depth_picture_says_the_distances_of_its_colours():
     cones = bundled_data_dir() / "cones"
     left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
     view = compute_view(left, right, Calibration.from_file(cones / "calib.txt"), "fast")
-    got = re.fullmatch(r"depth: red ([0-9.]+) m … blue ([0-9.]+) m", view.depth_caption)
+    got = re.fullmatch(r"depth: red ([0-9.]+)\xa0m … blue ([0-9.]+)\xa0m", view.depth_caption)
     assert got is not None, view.depth_caption
     inv = 1.0 / view.result.depth[np.isfinite(view.result.depth)]
     near, far = 1.0 / np.percentile(inv, 99), 1.0 / np.percentile(inv, 1)
@@ -385,7 +385,7 @@ def test_the_disparity_picture_says_the_pixels_of_its_colours():
     cones = bundled_data_dir() / "cones"
     left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
     view = compute_view(left, right, None, "fast")
-    got = re.fullmatch(r"disparity: blue 0 px … red ([0-9.]+) px", view.disparity_caption)
+    got = re.fullmatch(r"disparity: blue 0\xa0px … red ([0-9.]+)\xa0px", view.disparity_caption)
     assert got is not None, view.disparity_caption
     d = view.result.disparity
     assert float(got.group(1)) == pytest.approx(np.percentile(d[np.isfinite(d)], 99), abs=0.05)
@@ -398,7 +398,27 @@ def test_the_disparity_picture_says_the_pixels_of_its_colours():
     app = _scene_app("test-disparity-caption", [bundled_data_dir()])
     app._load_scene(cones)
     _run(app, app.recompute)
-    assert app.state.disparity_caption.startswith("disparity: blue 0 px … red ")
+    assert app.state.disparity_caption.startswith("disparity: blue 0\xa0px … red ")
+
+
+def test_a_number_and_its_unit_are_never_broken_apart():
+    """On a narrow page the statistics line broke "median depth 3.50 m" as "3.50" at the end
+    of a line and "m" alone on the next. The page's texts hold a non-breaking space between
+    each number and its unit (the captions, the statistics, their warnings, in both units)."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import compute_view, nowrap_units
+    from stereovision.io import load_scene
+
+    scene = load_scene(bundled_data_dir() / "cones")
+    view = compute_view(scene.left, scene.right, scene.calib, "opencv-bm", max_disparity=40)
+    breakable = re.compile(r"[0-9∞] (px|m|ft|s|%)(?![A-Za-z])")
+    for unit in ("m", "ft"):
+        caption, stats = view.texts(unit)
+        for text in (caption, stats, view.disparity_caption):
+            assert not breakable.search(text), text
+    assert f"median depth {view.median_depth:.2f}\xa0m" in view.texts("m")[1]
+    assert "searched as 48\xa0px" in view.stats
+    assert nowrap_units("2 matches in 3 s, 1 m") == "2 matches in 3\xa0s, 1\xa0m"
 
 
 def test_the_unit_toggle_shows_lengths_in_feet():
@@ -412,23 +432,25 @@ def test_the_unit_toggle_shows_lengths_in_feet():
     app._load_scene(bundled_data_dir() / "cones")
     _run(app, app.recompute)
     metres = app.state.depth_caption, app.state.stats
-    near_m, far_m = (float(v) for v in re.findall(r"([0-9.]+) m", metres[0]))
-    median_m = float(re.search(r"median depth ([0-9.]+) m", metres[1]).group(1))
+    near_m, far_m = (float(v) for v in re.findall(r"([0-9.]+)\xa0m", metres[0]))
+    median_m = float(re.search(r"median depth ([0-9.]+)\xa0m", metres[1]).group(1))
     app.state.forward = 1.0
     app._apply_camera()
     pose = app.plotter.camera.position
     app._on_unit(unit="ft")
-    got = re.fullmatch(r"depth: red ([0-9.]+) ft … blue ([0-9.]+) ft", app.state.depth_caption)
+    got = re.fullmatch(
+        r"depth: red ([0-9.]+)\xa0ft … blue ([0-9.]+)\xa0ft", app.state.depth_caption
+    )
     assert got is not None, app.state.depth_caption
     assert float(got.group(1)) == pytest.approx(near_m / 0.3048, abs=0.02)
     assert float(got.group(2)) == pytest.approx(far_m / 0.3048, abs=0.02)
-    median_ft = float(re.search(r"median depth ([0-9.]+) ft", app.state.stats).group(1))
+    median_ft = float(re.search(r"median depth ([0-9.]+)\xa0ft", app.state.stats).group(1))
     assert median_ft == pytest.approx(median_m / 0.3048, abs=0.02)
-    assert not re.search(r"[0-9] m\b", app.state.stats)
+    assert not re.search(r"[0-9][ \xa0]m\b", app.state.stats)
     assert app.state.forward == pytest.approx(3.281) and app.state.translation_range == 16.4
     np.testing.assert_allclose(app.plotter.camera.position, pose, atol=1e-3)  # did not move
     _run(app, app.recompute)  # a new result comes in the unit on show
-    assert " ft … " in app.state.depth_caption
+    assert "\xa0ft … " in app.state.depth_caption
     app._on_unit(unit="m")
     assert app.state.depth_caption == metres[0] and app.state.forward == pytest.approx(1.0)
     app._on_unit(unit="furlong")
@@ -450,7 +472,7 @@ def test_the_max_disparity_field_is_applied_and_checked():
     _run(app, app.recompute)
     auto = app.max_disparity
     assert app.state.max_disp_hint == f"auto: {auto} px, the pair's range"
-    assert f"disparities 0–{auto} px" in app.state.stats
+    assert f"disparities 0–{auto}\xa0px" in app.state.stats
     for typed, said in (
         (
             "abc",
@@ -477,13 +499,13 @@ def test_the_max_disparity_field_is_applied_and_checked():
     app.apply_max_disparity(False)  # left the field
     assert app.state.error == "" and len(spawned) == 1
     _run(app, spawned.pop)
-    assert "disparities 0–32 px" in app.state.stats and app.state.computations == 2
+    assert "disparities 0–32\xa0px" in app.state.stats and app.state.computations == 2
     app.apply_max_disparity()  # Enter again: the same value, nothing to compute
     assert spawned == []
     app.state.max_disp = "auto"
     app.apply_max_disparity()
     _run(app, spawned.pop)
-    assert f"disparities 0–{auto} px" in app.state.stats
+    assert f"disparities 0–{auto}\xa0px" in app.state.stats
     assert parse_max_disparity(None, 10) is None
 
 
@@ -504,13 +526,13 @@ def test_the_max_disparity_field_is_searched_as_typed():
     app.apply_max_disparity()
     _run(app, spawned.pop)
     assert app.state.error == "" and app.view.result.max_disparity == 40
-    assert " · disparities 0–40 px · " in app.state.stats and "warning" not in app.state.stats
+    assert " · disparities 0–40\xa0px · " in app.state.stats and "warning" not in app.state.stats
     app.state.method = "opencv-bm"
     _run(app, app.recompute)
-    assert app.state.error == "" and " · disparities 0–48 px · " in app.state.stats
+    assert app.state.error == "" and " · disparities 0–48\xa0px · " in app.state.stats
     assert (
-        "warning: max disparity 40 px searched as 48 px (OpenCV's matchers take multiples of "
-        "16 px)" in app.state.stats
+        "warning: max disparity 40\xa0px searched as 48\xa0px (OpenCV's matchers take multiples of "
+        "16\xa0px)" in app.state.stats
     )
     assert parse_max_disparity("449", 450) == 449
     with pytest.raises(ValueError, match=r"^max disparity 450 px is not smaller than the pair"):
@@ -519,12 +541,12 @@ def test_the_max_disparity_field_is_searched_as_typed():
     app.state.max_disp = "449"
     app.apply_max_disparity()
     _run(app, spawned.pop)
-    assert app.state.error == "" and "disparities 0–449 px" in app.state.stats
+    assert app.state.error == "" and "disparities 0–449\xa0px" in app.state.stats
     app.state.resolution = "320"  # 449 x 320 / 450 = 319.3: up to 320, the width
     _run(app, app.recompute)
     assert app.state.error == "" and app.view.result.disparity.shape[1] == 320
-    assert "disparities 0–319 px" in app.state.stats
-    assert "warning: max disparity 320 px at width 320 searched as 319 px" in app.state.stats
+    assert "disparities 0–319\xa0px" in app.state.stats
+    assert "warning: max disparity 320\xa0px at width 320 searched as 319\xa0px" in app.state.stats
 
 
 def test_a_max_disparity_scaled_to_a_whole_pixel_is_not_rounded_up_past_it():
@@ -539,7 +561,7 @@ def test_a_max_disparity_scaled_to_a_whole_pixel_is_not_rounded_up_past_it():
     view = compute_view(left, right, None, "fast", width=320, max_disparity=159)
     assert view.result.max_disparity == 120
     view = compute_view(left, right, None, "opencv-bm", width=320, max_disparity=159)
-    assert "warning: max disparity 120 px searched as 128 px" in view.stats
+    assert "warning: max disparity 120\xa0px searched as 128\xa0px" in view.stats
 
 
 @pytest.mark.parametrize("method", ["gabor", "fused"])
@@ -1145,7 +1167,7 @@ def test_find_floor_controller_on_kitti(data_dir):
     asyncio.run(run())
     assert app.state.error == ""
     text = app.state.floor_label
-    height = float(re.search(r"camera ([0-9.]+) m above it", text).group(1))
+    height = float(re.search(r"camera ([0-9.]+)\xa0m above it", text).group(1))
     assert height == pytest.approx(1.62, abs=0.05)
     assert app.state.img_floor.startswith("data:image/jpeg;base64,")
     picture = _decode(app.state.img_floor)
@@ -1169,33 +1191,33 @@ def test_find_floor_says_its_heights_in_the_unit_on_show(data_dir):
     pytest.importorskip("trame")
     from trame.app import get_server
 
-    from stereovision.gui.app import StereoApp
+    from stereovision.gui.app import StereoApp, nowrap_units
 
     scene = data_dir / "kitti2015" / "000005_10"
     app = StereoApp(
         get_server("test-floor-ft", client_type="vue3"), AllowedFolders([data_dir]), scene
     )
     app._spawn = lambda coro: coro.close()
-    assert app.state.floor_caption == "floor (green), obstacles 0.15-2 m (red)"
+    assert app.state.floor_caption == "floor (green), obstacles 0.15-2\xa0m (red)"
     app._load_scene(scene)
     _run(app, app.recompute)
     _run(app, app.find_floor)
     metres = app.state.floor_label
-    assert metres == app.view.floor.describe()
-    height_m = float(re.search(r"camera ([0-9.]+) m above it", metres).group(1))
+    assert metres == nowrap_units(app.view.floor.describe())
+    height_m = float(re.search(r"camera ([0-9.]+)\xa0m above it", metres).group(1))
     app._on_unit(unit="ft")
-    assert app.state.floor_caption == "floor (green), obstacles 0.49-6.56 ft (red)"
-    height_ft = float(re.search(r"camera ([0-9.]+) ft above it", app.state.floor_label).group(1))
+    assert app.state.floor_caption == "floor (green), obstacles 0.49-6.56\xa0ft (red)"
+    height_ft = float(re.search(r"camera ([0-9.]+)\xa0ft above it", app.state.floor_label).group(1))
     assert height_ft == pytest.approx(height_m / 0.3048, abs=0.002)
-    assert not re.search(r"[0-9] m\b", app.state.floor_label)
-    assert app.state.floor_label.replace(f"{height_ft:.3f} ft", f"{height_m:.3f} m") == metres
+    assert not re.search(r"[0-9][ \xa0]m\b", app.state.floor_label)
+    assert app.state.floor_label.replace(f"{height_ft:.3f}\xa0ft", f"{height_m:.3f}\xa0m") == metres
     _run(app, app.recompute)  # a new depth map: its floor is found in feet
     assert app.state.floor_label == ""
     _run(app, app.find_floor)
-    assert re.search(r"camera [0-9.]+ ft above it", app.state.floor_label)
+    assert re.search(r"camera [0-9.]+\xa0ft above it", app.state.floor_label)
     app._on_unit(unit="m")
     assert app.state.floor_label == metres
-    assert app.state.floor_caption == "floor (green), obstacles 0.15-2 m (red)"
+    assert app.state.floor_caption == "floor (green), obstacles 0.15-2\xa0m (red)"
     from stereovision.gui.app import floor_text
 
     assert floor_text(None, "ft").startswith("ground plane: none found")
@@ -2236,13 +2258,18 @@ def test_save_units_range_and_colour_keys_on_the_page(page, gui_data):
     folder refused)."""
     _wait_computations(page, 1)
     assert re.fullmatch(
-        r"disparity: blue 0 px … red [0-9.]+ px", page.inner_text("#disparity-caption").strip()
+        r"disparity: blue 0\xa0px … red [0-9.]+\xa0px",
+        page.inner_text("#disparity-caption").strip(),
     )
     page.click("#unit-ft")
-    page.wait_for_function("document.querySelector('#depth-caption')?.textContent.includes(' ft')")
-    assert re.search(r"median depth [0-9.]+ ft", page.inner_text("#stats"))
+    page.wait_for_function(
+        "document.querySelector('#depth-caption')?.textContent.includes('\xa0ft')"
+    )
+    assert re.search(r"median depth [0-9.]+\xa0ft", page.inner_text("#stats"))
     page.click("#unit-m")
-    page.wait_for_function("document.querySelector('#depth-caption')?.textContent.includes(' m')")
+    page.wait_for_function(
+        "document.querySelector('#depth-caption')?.textContent.includes('\xa0m')"
+    )
     page.fill("#max-disparity", "lots")
     page.press("#max-disparity", "Enter")
     assert "max disparity: expected a whole number of pixels" in _wait_error(page, "max disparity")
@@ -2251,7 +2278,7 @@ def test_save_units_range_and_colour_keys_on_the_page(page, gui_data):
     page.fill("#max-disparity", "32")
     page.press("#max-disparity", "Enter")
     _wait_computations(page, n + 1)
-    assert " · disparities 0–32 px · " in page.inner_text("#stats")
+    assert " · disparities 0–32\xa0px · " in page.inner_text("#stats")
     page.fill("#max-disparity", "")
     page.press("#max-disparity", "Enter")  # automatic again, for the tests after this one
     _wait_computations(page, n + 2)

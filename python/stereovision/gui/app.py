@@ -25,6 +25,7 @@ import itertools
 import logging
 import math
 import os
+import re
 import time
 import warnings
 from dataclasses import dataclass
@@ -50,7 +51,14 @@ from stereovision.gui.sources import (
     scaled_calibration,
 )
 
-__all__ = ["EXTRA_METHODS", "RESOLUTIONS", "StereoApp", "compute_view", "parse_max_disparity"]
+__all__ = [
+    "EXTRA_METHODS",
+    "RESOLUTIONS",
+    "StereoApp",
+    "compute_view",
+    "nowrap_units",
+    "parse_max_disparity",
+]
 
 log = logging.getLogger(__name__)
 #: What a button that needs a pair says before there is one (it did nothing).
@@ -356,7 +364,26 @@ class ViewData:
             if self.median_depth is not None:
                 median = f" · median depth {_length(self.median_depth, unit)}"
             stats = head + median + tail
-        return caption, stats
+        return nowrap_units(caption), nowrap_units(stats)
+
+
+#: The space between a number and its unit (px, m, ft, s, %, °): one the page does not break.
+NBSP = "\u00a0"
+_NUMBER_UNIT = re.compile(r"(?<=[0-9∞]) (?=(?:px|m|ft|s|%|°)(?![A-Za-z0-9]))")
+
+
+def nowrap_units(text: str) -> str:
+    """``text`` with the space between each number and its unit made non-breaking.
+
+    On a narrow page the statistics line broke "median depth 3.50 m" as "3.50" at the end of
+    one line and "m" alone on the next.
+
+    Examples
+    --------
+    >>> nowrap_units("0–64 px · density 100 % · 0.29 s · median depth 3.50 m, 2 matches")
+    '0–64\\xa0px · density 100\\xa0% · 0.29\\xa0s · median depth 3.50\\xa0m, 2 matches'
+    """
+    return _NUMBER_UNIT.sub(NBSP, text)
 
 
 def _length(metres: float, unit: str) -> str:
@@ -365,7 +392,7 @@ def _length(metres: float, unit: str) -> str:
 
     if not math.isfinite(metres):
         return "∞"
-    return f"{metres / UNIT_TO_METRES[unit]:.2f} {unit}"
+    return f"{metres / UNIT_TO_METRES[unit]:.2f}{NBSP}{unit}"
 
 
 #: What Find floor says when the depth map has no floor.
@@ -379,13 +406,15 @@ def floor_caption(unit: str = "m") -> str:
 
     Examples
     --------
-    >>> floor_caption(), floor_caption("ft")
-    ('floor (green), obstacles 0.15-2 m (red)', 'floor (green), obstacles 0.49-6.56 ft (red)')
+    >>> floor_caption()
+    'floor (green), obstacles 0.15-2\\xa0m (red)'
+    >>> floor_caption("ft")
+    'floor (green), obstacles 0.49-6.56\\xa0ft (red)'
     """
     from stereovision.calibration import UNIT_TO_METRES
 
     lo, hi = (round(h / UNIT_TO_METRES[unit], 2) for h in OBSTACLE_HEIGHTS)
-    return f"floor (green), obstacles {lo:g}-{hi:g} {unit} (red)"
+    return f"floor (green), obstacles {lo:g}-{hi:g}{NBSP}{unit} (red)"
 
 
 def floor_text(plane: Any, unit: str = "m") -> str:
@@ -400,12 +429,13 @@ def floor_text(plane: Any, unit: str = "m") -> str:
         return NO_FLOOR
     text = str(plane.describe())
     if unit == "m":
-        return text
+        return nowrap_units(text)
     metres = f"camera {plane.height:.3f} m above it"
     said = f"camera {plane.height / UNIT_TO_METRES[unit]:.3f} {unit} above it"
     if metres in text:
-        return text.replace(metres, said, 1)
-    return f"{text} ({said})"  # the library's wording changed: the height is said anyway
+        return nowrap_units(text.replace(metres, said, 1))
+    # the library's wording changed: the height is said anyway
+    return nowrap_units(f"{text} ({said})")
 
 
 def floor_view(result: Any) -> tuple[Any, str]:
@@ -628,10 +658,10 @@ def compute_view(
         matches_url=matches_url,
         mesh=mesh,
         intrinsics=intr,
-        stats=stats,
+        stats=nowrap_units(stats),
         message_3d=message_3d,
-        depth_caption=depth_caption,
-        disparity_caption=disparity_caption,
+        depth_caption=nowrap_units(depth_caption),
+        disparity_caption=nowrap_units(disparity_caption),
         depth_ends=depth_ends,
         median_depth=median_depth,
         stats_parts=(head, tail),
@@ -1395,7 +1425,7 @@ class StereoApp:
             return  # another pair came meanwhile: this verdict is not of the pair on show
         self._done()
         with self.state:
-            self.state.rows_label = text
+            self.state.rows_label = nowrap_units(text)
 
     def rectify_clicked(self) -> None:
         """The page's "Rectify" button."""
@@ -1456,7 +1486,7 @@ class StereoApp:
         self.pair = rect.rectify(left, right)
         self.max_disparity = rect.max_disparity
         with self.state:
-            self.state.rows_label = rect.describe()
+            self.state.rows_label = nowrap_units(rect.describe())
             self.state.source_label += " (rectified from features)"
         await self.recompute()
 
