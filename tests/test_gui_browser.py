@@ -2399,3 +2399,26 @@ def test_progress_names_the_step_that_really_follows(method, calibrated, steps, 
     done = [t for t in said if " done, " in t]
     assert [t.split(", ", 1)[1] for t in done] == [f"{s}…" for s in steps], said
     assert said.index("drawing") == said.index(done[-1]) + 1
+
+
+def test_a_pair_rectified_by_its_calibration_is_shown_rectified_on_both_sides():
+    """With a calibration of unrectified cameras, the acquisition panel showed the rectified
+    left image (the one the disparity belongs to) beside the right image as the cameras gave
+    it, and the matches were drawn on the raw pair. Both images are the rectified pair now."""
+    import dataclasses
+
+    from stereovision.calibration import Calibration
+    from stereovision.gui.app import _data_url, compute_view
+
+    left, right = (cv2.imread(str(CONES / f"{s}.png")) for s in ("left", "right"))
+    ideal = Calibration.ideal((450, 375), 60, 0.16)
+    turned = cv2.Rodrigues(np.array([0.0, 0.03, 0.02]))[0]
+    calib = dataclasses.replace(ideal, R=turned, rectified=False)
+    rect_left, rect_right = calib.rectify(left, right)
+    view = compute_view(left, right, calib, "fast")
+    np.testing.assert_array_equal(view.result.left_rectified, rect_left)
+    assert view.left_url == _data_url(rect_left)
+    assert view.right_url == _data_url(rect_right) != _data_url(right)
+    # a rectified calibration's pair is shown as it comes
+    plain = compute_view(left, right, ideal, "fast")
+    assert (plain.left_url, plain.right_url) == (_data_url(left), _data_url(right))

@@ -599,6 +599,12 @@ def compute_view(
     elapsed = time.perf_counter() - t0
     report(92, "drawing")
     shown_left = result.left_rectified if result.left_rectified is not None else left_s
+    shown_right = right_s
+    if calib_s is not None and not calib_s.rectified:
+        # the left image shown is the rectified one the disparity belongs to: the right one
+        # too (it was shown as the cameras gave it, beside a rectified left, and the matches
+        # were drawn on the raw pair, off the rows they were found on)
+        shown_right = calib_s.rectify(left_s, right_s)[1]
     disparity_caption = DISPARITY_CAPTION
     disp_known = result.disparity[np.isfinite(result.disparity)]
     disp_hi = None
@@ -625,7 +631,9 @@ def compute_view(
             depth_caption = f"depth: red {near} … blue {far}"  # one line above the picture
     matches_url = ""
     if method in SPARSE_METHODS or result.density < SPARSE_DENSITY:
-        matches_url = _data_url(draw_matches(left_s, right_s, result.disparity), 2 * DISPLAY_WIDTH)
+        matches_url = _data_url(
+            draw_matches(shown_left, shown_right, result.disparity), 2 * DISPLAY_WIDTH
+        )
     mesh = None
     intr = None
     message_3d = ""
@@ -652,7 +660,7 @@ def compute_view(
     return ViewData(
         result=result,
         left_url=_data_url(shown_left),
-        right_url=_data_url(right_s),
+        right_url=_data_url(shown_right),
         disparity_url=disparity_url,
         depth_url=_data_url(depth_img),
         matches_url=matches_url,
