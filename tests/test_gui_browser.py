@@ -2422,3 +2422,28 @@ def test_a_pair_rectified_by_its_calibration_is_shown_rectified_on_both_sides():
     # a rectified calibration's pair is shown as it comes
     plain = compute_view(left, right, ideal, "fast")
     assert (plain.left_url, plain.right_url) == (_data_url(left), _data_url(right))
+
+
+def test_a_pair_that_fails_takes_its_files_warning_with_it(tmp_path):
+    """Files that load but cannot be matched (8 px wide) put the page back on the previous
+    pair, but the acquisition panel kept the failed files' warning ("... are the same image")
+    above the previous pair's images, and its Check rows verdict was gone. The previous
+    pair's line comes back with it."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-files-fail-rows", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.check_rows)
+    verdict = app.state.rows_label
+    assert verdict.startswith("rectification ok"), verdict
+    tiny = np.random.default_rng(0).integers(0, 255, (8, 8, 3)).astype(np.uint8)
+    cv2.imwrite(str(tmp_path / "tiny.png"), tiny)
+    app.state.left_file = app.state.right_file = str(tmp_path / "tiny.png")
+    app.load_files()
+    assert app.state.rows_label.startswith("warning: ")  # said while it is tried
+    _run(app, app.recompute)
+    assert app.state.error.startswith("image too narrow for stereo matching")
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.source_label == "scene data/cones"
+    assert app.state.rows_label == verdict

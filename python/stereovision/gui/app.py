@@ -1355,10 +1355,12 @@ class StereoApp:
                 shown = self._shown
                 if shown is not None and shown["pair"] is not self.pair:
                     for name, value in shown.items():
-                        if name != "source_label":
+                        if name not in ("source_label", "rows_label"):
                             setattr(self, name, value)
                     with self.state:
                         self.state.source_label = shown["source_label"]
+                        # the failed pair's line (its files' warning) went with it
+                        self.state.rows_label = shown["rows_label"]
                         # the failed choice can be made again
                         self.state.scene = self._scene or None
                         self.state.error += " (the page still shows the previous pair)"
@@ -1398,6 +1400,7 @@ class StereoApp:
             "max_disparity": self.max_disparity,
             "homographies": self.homographies,
             "source_label": self.state.source_label,
+            "rows_label": self.state.rows_label,
             "_scene": self._scene,
         }
 
@@ -1432,8 +1435,11 @@ class StereoApp:
         if self.pair is not pair:
             return  # another pair came meanwhile: this verdict is not of the pair on show
         self._done()
+        text = nowrap_units(text)
+        if self._shown is not None and self._shown["pair"] is pair:
+            self._shown["rows_label"] = text  # what a failed next pair puts back
         with self.state:
-            self.state.rows_label = nowrap_units(text)
+            self.state.rows_label = text
 
     def rectify_clicked(self) -> None:
         """The page's "Rectify" button."""
