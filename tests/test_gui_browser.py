@@ -419,6 +419,8 @@ def test_a_number_and_its_unit_are_never_broken_apart():
     assert f"median depth {view.median_depth:.2f}\xa0m" in view.texts("m")[1]
     assert "searched as 48\xa0px" in view.stats
     assert nowrap_units("2 matches in 3 s, 1 m") == "2 matches in 3\xa0s, 1\xa0m"
+    # Find floor's line: its angles too ("pitch -0.40" then "deg" alone on a narrow page)
+    assert nowrap_units("pitch -0.40 deg, roll 2 degrees") == "pitch -0.40\xa0deg, roll 2 degrees"
 
 
 def test_the_unit_toggle_shows_lengths_in_feet():

@@ -367,9 +367,10 @@ class ViewData:
         return nowrap_units(caption), nowrap_units(stats)
 
 
-#: The space between a number and its unit (px, m, ft, s, %, °): one the page does not break.
+#: The space between a number and its unit (px, m, ft, s, %, °, deg): one the page does not
+#: break.
 NBSP = "\u00a0"
-_NUMBER_UNIT = re.compile(r"(?<=[0-9∞]) (?=(?:px|m|ft|s|%|°)(?![A-Za-z0-9]))")
+_NUMBER_UNIT = re.compile(r"(?<=[0-9∞]) (?=(?:px|m|ft|s|%|°|deg)(?![A-Za-z0-9]))")
 
 
 def nowrap_units(text: str) -> str:
