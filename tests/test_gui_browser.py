@@ -2449,3 +2449,30 @@ def test_a_pair_that_fails_takes_its_files_warning_with_it(tmp_path):
     assert app.state.error.endswith("(the page still shows the previous pair)")
     assert app.state.source_label == "scene data/cones"
     assert app.state.rows_label == verdict
+
+
+def test_the_average_switch_is_offered_only_for_sources_it_averages(tmp_path):
+    """With an image folder playing, the "average 8 still frames" switch was enabled and did
+    nothing (a folder's pairs are one view after another, never averaged). It is enabled for
+    cameras (and recordings) only."""
+    left, right = (cv2.imread(str(CONES / f"{s}.png")) for s in ("left", "right"))
+    for side, img in (("left", left), ("right", right)):
+        cv2.imwrite(str(tmp_path / f"{side}_0001.png"), img)
+
+    class Cameras:
+        def read(self):
+            return left.copy(), right.copy()
+
+        def close(self):
+            pass
+
+    app = _scene_app("test-average-offered", [tmp_path])
+    assert not app.state.live and not app.state.can_average  # the demo scene
+    app.state.pair_folder = str(tmp_path)
+    app.open_pair_folder()
+    assert app.state.error == "" and app.state.live and not app.state.can_average
+    app._switch_source(Cameras(), ("0", "1"))
+    assert app.state.error == "" and app.state.can_average
+    app.state.average = True
+    app.capture()
+    assert app.state.source_label.endswith("(8.0 frames averaged)")

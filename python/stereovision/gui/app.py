@@ -908,6 +908,9 @@ class StereoApp:
         st.floor_caption = floor_caption()
         st.cam_left, st.cam_right = source_names
         st.live = source is not None
+        #: The average switch works on cameras (and recordings), not on a folder's pairs: one
+        #: pair after another, never averaged (the switch was on and did nothing).
+        st.can_average = st.live and not isinstance(source, FolderPairs)
         # None, not "": the select shows "" as a chosen, empty entry (its label raised above it)
         st.scene = None
         st.scenes = []
@@ -1202,6 +1205,7 @@ class StereoApp:
         if before[0] is not None:
             before[0].close()
         self.state.live = True
+        self.state.can_average = not isinstance(source, FolderPairs)
         self.state.error = ""
         self.state.captures += 1
         self._spawn(self.recompute())
@@ -1946,7 +1950,7 @@ class StereoApp:
                     density="compact",
                     hide_details=True,
                     color="primary",
-                    disabled=("!live",),
+                    disabled=("!can_average",),
                     id="average-switch",
                 )
                 v3.VSelect(
