@@ -209,8 +209,8 @@ def gui_command(workdir: Path, port: int) -> list[str]:
     """The ``stereovision gui`` command of the pictures, run in ``workdir``.
 
     Copies the bundled cones into ``workdir/scenes/cones`` and gives ``--data scenes``, as the
-    README tells users to start the GUI: its Save field offers ``scenes/saved`` (shown as the
-    folder's full path, which :func:`draw_gui` keeps short).
+    README tells users to start the GUI: its Save field offers ``scenes/saved`` (relative to
+    the working folder, as the page shows a folder under it).
     """
     import shutil
 
@@ -294,7 +294,7 @@ def draw_gui(out_dir: Path) -> None:
 
     if not CHROMIUM.exists():
         raise FileNotFoundError(f"{CHROMIUM} not found (apt-get install -y chromium)")
-    # a short folder name: the Save field shows the --data folder's full path
+    # the Save field shows scenes/saved, relative to this working folder
     with (
         tempfile.TemporaryDirectory(prefix="sv-") as work,
         gui_server(Path(work)) as url,

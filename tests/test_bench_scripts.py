@@ -217,5 +217,6 @@ def test_docs_pictures_gui_offers_a_save_folder(
     add_arguments(parser)
     monkeypatch.chdir(tmp_path)  # the server's working folder
     app = build_app(parser.parse_args(cmd[3:]))
-    assert app.state.save_dir == str(tmp_path.resolve() / "scenes" / "saved")
+    assert app.state.save_dir == "scenes/saved"  # as the README tells it, not /tmp/sv-...
+    assert app.state.save_dir_title.startswith(str(tmp_path.resolve() / "scenes" / "saved"))
     assert app.state.save_hint == SAVE_HINT
