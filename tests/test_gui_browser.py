@@ -971,6 +971,31 @@ def test_a_failed_scene_choice_puts_the_list_back(tmp_path):
     assert app.pair[0].shape == (375, 450, 3)
 
 
+def test_a_pair_that_fails_takes_its_files_warning_with_it(tmp_path):
+    """Files that load but cannot be matched (8 px wide) put the page back on the previous
+    pair, but the acquisition panel kept the failed files' warning ("... are the same image")
+    above the previous pair's images, and its Check rows verdict was gone. The previous
+    pair's line comes back with it."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-files-fail-rows", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.check_rows)
+    verdict = app.state.rows_label
+    assert verdict.startswith("rectification ok"), verdict
+    tiny = np.random.default_rng(0).integers(0, 255, (8, 8, 3)).astype(np.uint8)
+    cv2.imwrite(str(tmp_path / "tiny.png"), tiny)
+    app.state.left_file = app.state.right_file = str(tmp_path / "tiny.png")
+    app.load_files()
+    assert app.state.rows_label.startswith("warning: ")  # said while it is tried
+    _run(app, app.recompute)
+    assert app.state.error.startswith("image too narrow for stereo matching")
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.source_label == "scene data/cones"
+    assert app.state.rows_label == verdict
+
+
 def test_a_scene_chosen_during_a_computation_is_not_shown_the_previous_result(tmp_path):
     """A scene chosen while another was computing: the running computation recorded the new
     scene's pair as the one on show, and put its (previous) result under the new scene's name.
@@ -2424,31 +2449,6 @@ def test_a_pair_rectified_by_its_calibration_is_shown_rectified_on_both_sides():
     # a rectified calibration's pair is shown as it comes
     plain = compute_view(left, right, ideal, "fast")
     assert (plain.left_url, plain.right_url) == (_data_url(left), _data_url(right))
-
-
-def test_a_pair_that_fails_takes_its_files_warning_with_it(tmp_path):
-    """Files that load but cannot be matched (8 px wide) put the page back on the previous
-    pair, but the acquisition panel kept the failed files' warning ("... are the same image")
-    above the previous pair's images, and its Check rows verdict was gone. The previous
-    pair's line comes back with it."""
-    from stereovision.gui import bundled_data_dir
-
-    app = _scene_app("test-files-fail-rows", [bundled_data_dir(), tmp_path])
-    app._load_scene(bundled_data_dir() / "cones")
-    _run(app, app.recompute)
-    _run(app, app.check_rows)
-    verdict = app.state.rows_label
-    assert verdict.startswith("rectification ok"), verdict
-    tiny = np.random.default_rng(0).integers(0, 255, (8, 8, 3)).astype(np.uint8)
-    cv2.imwrite(str(tmp_path / "tiny.png"), tiny)
-    app.state.left_file = app.state.right_file = str(tmp_path / "tiny.png")
-    app.load_files()
-    assert app.state.rows_label.startswith("warning: ")  # said while it is tried
-    _run(app, app.recompute)
-    assert app.state.error.startswith("image too narrow for stereo matching")
-    assert app.state.error.endswith("(the page still shows the previous pair)")
-    assert app.state.source_label == "scene data/cones"
-    assert app.state.rows_label == verdict
 
 
 def test_the_average_switch_is_offered_only_for_sources_it_averages(tmp_path):
