@@ -2079,6 +2079,26 @@ def test_method_buttons_and_save_field_are_shown_whole(page):
     )
 
 
+def test_every_toggle_button_is_inside_its_panel_on_a_narrow_page(page):
+    """At 1000 px wide (a laptop's half screen) the resolution toggle ran out of the
+    acquisition panel: its "320" button was cut in half by the panel's edge. A toggle that
+    does not fit wraps onto a further row, inside its panel."""
+    _wait_computations(page, 1)
+    page.set_viewport_size({"width": 1000, "height": 950})
+    try:
+        page.wait_for_timeout(300)
+        out = page.evaluate(
+            """() => [...document.querySelectorAll('.v-btn-group .v-btn')].map(b => {
+                  const c = b.closest('.v-card').getBoundingClientRect();
+                  const r = b.getBoundingClientRect();
+                  return [b.innerText.trim(), r.left >= c.left - 0.5 && r.right <= c.right + 0.5];
+              }).filter(([, inside]) => !inside).map(([t]) => t)"""
+        )
+    finally:
+        page.set_viewport_size({"width": 1500, "height": 950})
+    assert out == []
+
+
 def test_capture_changes_images(page):
     _wait_computations(page, 1)
     n = _computations(page)

@@ -1941,7 +1941,10 @@ class StereoApp:
                         )
                     with v3.VCol(cols=6):
                         html.Div("resolution", classes="text-caption")
-                        _toggle("resolution", RESOLUTIONS, "resolution-toggle", "resolution")
+                        # wraps: at 1000 px its "320" ran out of the panel, cut in half
+                        _toggle(
+                            "resolution", RESOLUTIONS, "resolution-toggle", "resolution", wrap=True
+                        )
                 # a row of its own: under the Capture button, in half the panel, its label
                 # wrapped onto two lines
                 v3.VSwitch(
