@@ -2099,6 +2099,25 @@ def test_every_toggle_button_is_inside_its_panel_on_a_narrow_page(page):
     assert out == []
 
 
+def test_button_labels_fit_their_buttons_on_a_narrow_page(page):
+    """At 1000 px wide "CHECK ROWS" and "FIND FLOOR" stood out of both sides of their
+    buttons (a quarter of the row, whatever their label). The buttons are as wide as their
+    labels, the line they answer takes the rest of the row."""
+    _wait_computations(page, 1)
+    page.set_viewport_size({"width": 1000, "height": 950})
+    try:
+        page.wait_for_timeout(300)
+        out = page.evaluate(
+            """() => ['#check-rows-btn', '#rectify-btn', '#floor-btn'].map(s => {
+                  const b = document.querySelector(s).getBoundingClientRect();
+                  const t = document.querySelector(s + ' .v-btn__content').getBoundingClientRect();
+                  return [s, t.left >= b.left && t.right <= b.right]; })"""
+        )
+    finally:
+        page.set_viewport_size({"width": 1500, "height": 950})
+    assert [s for s, inside in out if not inside] == []
+
+
 def test_capture_changes_images(page):
     _wait_computations(page, 1)
     n = _computations(page)
