@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from stereovision import baselines
@@ -91,3 +92,38 @@ def test_bench_cli_folder_without_scenes(
     (tmp_path / "empty").mkdir()
     assert main(["bench", str(tmp_path / "empty")]) == 2
     assert "no scene" in capsys.readouterr().err
+
+
+def _strict_json(line: str) -> dict[str, object]:
+    def refuse(token: str) -> object:
+        raise ValueError(f"not JSON: {token}")
+
+    out = json.loads(line, parse_constant=refuse)
+    assert isinstance(out, dict)
+    return out
+
+
+def test_bench_cli_json_is_strict_without_gt_pixels(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A scene whose GT is all +inf (no known pixel): every accuracy figure has nothing to
+    # measure. bench --json wrote them as NaN, which no strict JSON parser reads; eval --json
+    # already wrote null.
+    import cv2
+
+    from stereovision.io import write_pfm
+
+    scene = tmp_path / "no_gt_pixels"
+    scene.mkdir()
+    for name in ("left.png", "right.png"):
+        img = cv2.imread(str(data_dir / SCENE / name))
+        assert cv2.imwrite(str(scene / name), img[100:164, 100:196])
+    write_pfm(scene / "gt_disp.pfm", np.full((64, 96), np.inf, np.float32))
+    assert main(["bench", "--runs", "5", "--json", str(scene)]) == 0
+    lines = [_strict_json(ln) for ln in capsys.readouterr().out.splitlines() if ln.strip()]
+    by = {ln["case"]: ln for ln in lines}
+    assert by["SGBM-3WAY"]["bad_2.0"] is None and by["SGBM-3WAY"]["density"] is None
+    assert by["pipeline"]["bad_2.0_filled"] is None
+    sparse = [ln for ln in lines if ln["kind"] == "sparse"]
+    assert sparse and all(ln["precision@1.0"] is None for ln in sparse)
+    assert all(isinstance(ln["ms"], float) and ln["ms"] > 0 for ln in lines)

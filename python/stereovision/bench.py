@@ -14,13 +14,13 @@ time of each is reported with its ratio to OpenCV StereoSGBM 3-way's, beside its
 * ``StereoBM`` and ``SGBM-3WAY``: :mod:`stereovision.baselines`, evaluation.md's configuration.
 
 All use every core (OpenCV's and rayon's default thread pools). A table is printed, then one JSON
-object per case (``--json``: only those).
+object per case (``--json``: only those); a figure with nothing to measure (a scene without a
+known GT pixel, a sparse method without a match on GT) is ``null`` there, as in ``eval --json``.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import statistics
 import sys
@@ -248,6 +248,9 @@ def cmd_bench(args: argparse.Namespace) -> int:
     """``stereovision bench [SCENE_DIR...]``."""
     from tqdm import tqdm
 
+    # eval --json's: a figure with nothing to measure (NaN: no GT pixel, no sparse match on GT)
+    # is null, so each line is strict JSON
+    from stereovision.cli import _json_line
     from stereovision.io import load_scene
 
     if args.runs < MIN_RUNS:
@@ -260,11 +263,11 @@ def cmd_bench(args: argparse.Namespace) -> int:
         all_cases.extend(cases)
         if args.json:
             for c in cases:
-                print(json.dumps(c.as_dict()), flush=True)
+                print(_json_line(c.as_dict()), flush=True)
     if not args.json:
         print(format_table(all_cases))
         for c in all_cases:
-            print(json.dumps(c.as_dict()))
+            print(_json_line(c.as_dict()))
     return 0
 
 
