@@ -150,3 +150,92 @@ def test_calibration_methods_take_disparity_like_the_functions() -> None:
             bound(d, disp=d)
         with pytest.raises(TypeError, match="disp= and disparity="):
             bound(disparity=d, disp=d)
+
+
+def test_mypy_strict_types_ranges_channels_and_steps_as_they_are(tmp_path: Path) -> None:
+    """``match(max_disparity=res.max_disparity)`` (a float, as depth_map's) was refused
+    (``int | None``), ``res.channels[...]`` was ``Any``, and ``depth_step(np.float32(5))`` an
+    array: the first script passes, the second is refused where it is wrong."""
+    right = tmp_path / "right.py"
+    right.write_text(
+        "import numpy as np\nimport numpy.typing as npt\nimport stereovision as sv\n"
+        "from stereovision.depth import DepthChannels\n"
+        "from stereovision.matching.fusion import FusionResult\n"
+        "from stereovision.matching.gabor import GaborResult\n\n\n"
+        "def rematch(a: npt.NDArray[np.uint8], res: sv.DepthResult) -> sv.Matches:\n"
+        "    return sv.match(a, a, max_disparity=res.max_disparity)\n\n\n"
+        "def members(res: sv.DepthResult) -> FusionResult | None:\n"
+        "    ch = res.channels\n"
+        "    return None if ch is None or 'members' not in ch else ch['members']\n\n\n"
+        "def gabor(ch: DepthChannels) -> GaborResult:\n    return ch['gabor']\n\n\n"
+        "def sgm(ch: DepthChannels) -> npt.NDArray[np.float32]:\n    return ch['sgm']\n\n\n"
+        "def step(calib: sv.Calibration) -> float:\n"
+        "    return calib.depth_step(np.float32(5.0)) + calib.depth_step(np.int64(5))\n"
+    )
+    run = _mypy_strict(right, tmp_path)
+    assert run.stdout + run.stderr == ""
+    assert run.returncode == 0
+    wrong = tmp_path / "wrong.py"
+    wrong.write_text(
+        "import numpy as np\nimport numpy.typing as npt\n"
+        "from stereovision.depth import DepthChannels\n\n\n"
+        "def sgm(ch: DepthChannels) -> npt.NDArray[np.float32]:\n    return ch['census']\n"
+    )
+    run = _mypy_strict(wrong, tmp_path)
+    assert run.returncode == 1
+    lines = run.stdout.splitlines()
+    assert all(ln.startswith("wrong.py:7: error: ") for ln in lines), run.stdout
+    assert 'wrong.py:7: error: TypedDict "DepthChannels" has no key "census"  [typeddict-item]' in (
+        lines
+    )
+
+
+def test_channels_hold_the_keys_and_types_depth_channels_names() -> None:
+    from stereovision.depth import DepthChannels
+    from stereovision.matching.fusion import FusionResult
+    from stereovision.matching.gabor import GaborResult
+
+    rng = np.random.default_rng(0)
+    left = rng.random((64, 96), dtype=np.float32)
+    right = np.roll(left, -4, axis=1)
+    want = {
+        "fused": {"gabor", "gabor_remeasured", "mcgm", "hopfield", "members", "sgm"},
+        "gabor": {"gabor"},
+        "census": {"sgm"},
+        "fast": {"sgm"},
+    }
+    assert set(want) == set(sv.depth.METHODS)
+    assert DepthChannels.__optional_keys__ == want["fused"]
+    kinds: dict[str, type] = {"gabor": GaborResult, "members": FusionResult}
+    kinds |= {"mcgm": sv.Matches, "hopfield": sv.Matches}
+    kinds |= {"gabor_remeasured": np.ndarray, "sgm": np.ndarray}
+    for method, keys in want.items():
+        ch = sv.depth_map(left, right, method=method, max_disparity=16, return_channels=True)
+        assert ch.channels is not None and set(ch.channels) == keys, method
+        for k, v in ch.channels.items():
+            assert isinstance(v, kinds[k]), (method, k)
+            if isinstance(v, np.ndarray):
+                assert v.dtype == np.float32 and v.shape == (64, 96)
+
+
+def test_match_takes_a_fractional_range_as_documented() -> None:
+    """A true shift of 17 px with ``max_disparity=16.5``: the whole-pixel searchers search up to
+    17 and the matches above 16.5 are dropped (counted); gabor searches up to 16.5."""
+    rng = np.random.default_rng(1)
+    left = rng.random((80, 128), dtype=np.float32)
+    right = np.roll(left, -17, axis=1)
+    for method in ("hopfield", "best", "mcgm"):
+        whole = sv.match(left, right, method=method, max_disparity=17)
+        assert len(whole) > 50 and np.median(whole.xl - whole.xr) == pytest.approx(17, abs=0.2)
+        frac = sv.match(left, right, method=method, max_disparity=16.5)
+        d = frac.xl - frac.xr
+        assert np.all(d <= 16.5), method
+        assert frac.stats["n_out_of_range"] >= int(np.count_nonzero(whole.xl - whole.xr > 16.5))
+        assert len(frac) < len(whole) / 2, method
+    for method in ("gabor", "fused"):
+        frac = sv.match(left, right, method=method, max_disparity=16.5)
+        assert np.all(frac.xl - frac.xr <= 16.5), method
+    assert (
+        sv.match(left, right, method="best", max_disparity=np.float64(16.5)).stats["n_out_of_range"]
+        == sv.match(left, right, method="best", max_disparity=16.5).stats["n_out_of_range"]
+    )

@@ -798,7 +798,9 @@ class Calibration:
         return cal
 
     @overload
-    def depth_step(self, depth_m: float, disparity_step: float = 1.0) -> float: ...
+    def depth_step(
+        self, depth_m: float | np.floating[Any] | np.integer[Any], disparity_step: float = 1.0
+    ) -> float: ...
     @overload
     def depth_step(self, depth_m: npt.ArrayLike, disparity_step: float = 1.0) -> F64: ...
     def depth_step(self, depth_m: npt.ArrayLike, disparity_step: float = 1.0) -> float | F64:
@@ -815,8 +817,8 @@ class Calibration:
         Returns
         -------
         float or numpy.ndarray
-            For one depth (a number) a float (``numpy.float64``, a ``float``); else float64,
-            the shape of ``depth_m``.
+            For one depth (a Python or NumPy number, e.g. ``np.float32(5)``) a float
+            (``numpy.float64``, a ``float``); else float64, the shape of ``depth_m``.
         """
         z = np.asarray(depth_m, dtype=np.float64)
         fb = self.focal_px * self.baseline_m

@@ -19,7 +19,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, TypedDict, TypeVar, cast
 
 import cv2
 import numpy as np
@@ -29,11 +29,21 @@ from stereovision._validate import as_bgr_uint8, as_gray_float, check_pair, fini
 from stereovision.calibration import Calibration
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
+from stereovision.matches import Matches
+from stereovision.matching.fusion import FusionResult
+from stereovision.matching.gabor import GaborResult
 from stereovision.uncalibrated import UncalibratedRectification
 
-__all__ = ["METHODS", "DepthResult", "depth_map", "disparity_sigma", "estimate_max_disparity"]
+__all__ = [
+    "METHODS",
+    "DepthChannels",
+    "DepthResult",
+    "depth_map",
+    "disparity_sigma",
+    "estimate_max_disparity",
+]
 
-_D = TypeVar("_D", int, float)  # a max_disparity: match's int, depth_map's float
+_D = TypeVar("_D", int, float)  # a max_disparity (match and depth_map take a float)
 
 #: Matchers ``depth_map`` knows, by name; the first is its default.
 METHODS = ("fused", "gabor", "census", "fast")
@@ -297,6 +307,36 @@ _NO_DEPTH = (
 )
 
 
+class DepthChannels(TypedDict, total=False):
+    """Each channel's own output, :attr:`DepthResult.channels` (``return_channels=True``).
+
+    Which keys are there depends on the method (``depth_map``'s ``method``):
+
+    Attributes
+    ----------
+    gabor : GaborResult
+        The Gabor phase channel's map (``"gabor"`` and ``"fused"``).
+    gabor_remeasured : numpy.ndarray
+        ``(H, W)`` float32: the re-measured Gabor map the vote used (``"fused"`` with
+        ``refine``, :func:`stereovision.matching.fusion.remeasure`).
+    mcgm, hopfield : Matches
+        The graph-matching and Hopfield channels' matches (``"fused"``).
+    members : FusionResult
+        The valid members with their ``count`` and ``sources``, checked against the census map
+        as ``match(method="fused")`` gives them (``"fused"``).
+    sgm : numpy.ndarray
+        ``(H, W)`` float32: the census semi-global disparity map (``"fused"``, ``"census"``,
+        ``"fast"``; NaN = none).
+    """
+
+    gabor: GaborResult
+    gabor_remeasured: npt.NDArray[np.float32]
+    mcgm: Matches
+    hopfield: Matches
+    members: FusionResult
+    sgm: npt.NDArray[np.float32]
+
+
 @dataclass(eq=False)  # array fields: == by identity (it raised on the arrays' truth value)
 class DepthResult:
     """Output of :func:`depth_map`.
@@ -343,7 +383,7 @@ class DepthResult:
         one ``sigma_d``: 0.29 px when re-measured (``"census"``'s default), 0.63 px, as filled
         pixels, when not (``"fast"``'s default, and ``refine=False``): their census values are
         pixel-locked.
-    channels : dict or None
+    channels : DepthChannels or None
         With ``return_channels=True``: each channel's own output by name (``"gabor"``: a
         :class:`~stereovision.matching.gabor.GaborResult`; with ``method="fused"`` also
         ``"mcgm"`` and ``"hopfield"`` :class:`~stereovision.Matches`, ``"members"``, the
@@ -368,7 +408,7 @@ class DepthResult:
     left_rectified: npt.NDArray[np.uint8] | None = field(default=None, repr=False)
     timings: dict[str, float] = field(default_factory=dict)
     depth_sigma: npt.NDArray[np.float32] | None = None
-    channels: dict[str, Any] | None = field(default=None, repr=False)
+    channels: DepthChannels | None = field(default=None, repr=False)
     limits: dict[str, float] = field(default_factory=dict, repr=False)
 
     @property
@@ -674,7 +714,7 @@ def _run_matcher(
     d_min: float,
     d_max: float,
     params: dict,
-    channels: dict[str, Any] | None = None,
+    channels: DepthChannels | None = None,
     remeasure: bool = True,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """``(disparity, confidence, coarse)``: ``coarse`` marks the pixels whose value has a
@@ -719,7 +759,9 @@ def _run_matcher(
             # the checked ones, as ``match(method="fused")`` gives them.
             sgm = fr.channel_outputs.get("sgm")
             members = fusion.census_clear(fr, sgm) if sgm is not None else fr
-            channels.update(fr.channel_outputs, members=members)
+            # channel_outputs holds the keys of DepthChannels (fuse_pair's "gabor", "mcgm",
+            # "hopfield", "gabor_remeasured", "sgm"), typed as a plain dict there
+            channels.update(cast(DepthChannels, {**fr.channel_outputs, "members": members}))
         return disp, conf, only_second
     if method in ("census", "fast"):
         from stereovision.matching import fusion
@@ -1105,7 +1147,7 @@ def depth_map(
             f"width {gl.shape[1]}"
         )
     stage("prepare")
-    channels: dict[str, Any] | None = {} if return_channels else None
+    channels: DepthChannels | None = {} if return_channels else None
     if refine is None:
         refine = method in _REFINED_BY_DEFAULT
     # "gabor" refines its output below; "fused" re-measures the Gabor map before the vote (its

@@ -30,7 +30,7 @@ def match(
     calib: Calibration | UncalibratedRectification | None = None,
     *,
     method: str = "hopfield",
-    max_disparity: int | None = None,
+    max_disparity: float | None = None,
     **params: Any,
 ) -> Matches:
     """Match interest points between the two images of a stereo pair.
@@ -57,11 +57,16 @@ def match(
         ``stats``); ``"gabor"``: every pixel the Gabor phase channel is confident about
         (:func:`stereovision.matching.gabor.gabor_disparity`, dense: one match per pixel,
         ``xr = xl - d``, ``yr = yl``, ``score`` its confidence in ``[0, 1]``).
-    max_disparity : int, optional
-        Largest disparity searched (px). None estimates it from the pair
-        (:func:`stereovision.estimate_max_disparity`), or takes an uncalibrated
-        rectification's. Every match returned has ``min_disparity <= xl - xr <= max_disparity``
-        (sub-pixel estimates that left the range are dropped and counted in
+    max_disparity : float, optional
+        Largest disparity searched (px), as :func:`~stereovision.depth_map`'s (e.g. a
+        :attr:`DepthResult.max_disparity <stereovision.DepthResult.max_disparity>`). None
+        estimates it from the pair (:func:`stereovision.estimate_max_disparity`), or takes an
+        uncalibrated rectification's. ``"gabor"`` searches up to it as given;
+        ``"hopfield"``, ``"best"`` and ``"mcgm"`` search whole pixels, up to its ceiling (17 for
+        16.5), and ``"fused"`` runs its Gabor channel up to it, its other channels up to its
+        ceiling. Either way every match returned has ``min_disparity <= xl - xr <= max_disparity``
+        (sub-pixel estimates that left the range, and the integer searchers' matches between
+        ``max_disparity`` and its ceiling, are dropped and counted in
         ``stats["n_out_of_range"]``).
     **params
         Matcher parameters (:data:`stereovision.matching.hopfield.DEFAULTS`,
@@ -72,12 +77,15 @@ def match(
     Returns
     -------
     Matches
+        The matches, in the (rectified) pair's pixel coordinates, with the matcher's ``stats``
+        and ``stats["n_out_of_range"]``.
 
     Raises
     ------
     ValueError
         Bad images (shape, dtype, empty, NaN, mismatched sizes), a calibration or rectification
-        for another image size, a ``calib`` of another type, an unknown method or parameter.
+        for another image size, a ``calib`` of another type, an unknown method or parameter, a
+        ``max_disparity`` that is not a finite number >= 0 (or not above ``min_disparity``).
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")

@@ -164,7 +164,7 @@ def moravec(image: npt.ArrayLike) -> npt.NDArray[np.float32]:
     return interest_points(image).response
 
 
-def _params(max_disparity: int, min_disparity: int, params: dict[str, Any]) -> dict[str, Any]:
+def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:
     refuse_unknown(
         "Hopfield parameter", params, DEFAULTS, "stereovision.matching.hopfield.DEFAULTS"
     )
@@ -186,8 +186,8 @@ def _run(
     method: str,
     left: npt.ArrayLike,
     right: npt.ArrayLike,
-    max_disparity: int,
-    min_disparity: int,
+    max_disparity: float,
+    min_disparity: float,
     params: dict[str, Any],
 ) -> Matches:
     pair = u8_pair(left, right)
@@ -220,8 +220,8 @@ def hopfield_match(
     left: npt.ArrayLike,
     right: npt.ArrayLike,
     *,
-    max_disparity: int,
-    min_disparity: int = 0,
+    max_disparity: float,
+    min_disparity: float = 0,
     **params: Any,
 ) -> Matches:
     """Match interest points of a rectified pair with the Hopfield network.
@@ -231,10 +231,11 @@ def hopfield_match(
     left, right : array_like
         Rectified pair, ``(H, W)`` grey or ``(H, W, 3)`` BGR, uint8, uint16 or float in
         ``[0, 1]``, same shape.
-    max_disparity : int
-        Largest disparity searched (px).
-    min_disparity : int, optional
-        Smallest disparity searched (px, default 0).
+    max_disparity : float
+        Largest disparity searched (px). The network searches whole pixels: a fractional value
+        searches up to its ceiling (:func:`stereovision.match` then drops the matches above it).
+    min_disparity : float, optional
+        Smallest disparity searched (px, default 0; a fractional value: from its floor).
     **params
         Overrides of :data:`DEFAULTS` (each documented there): ``rel_threshold``, ``nms_half``,
         ``tile`` (px), ``floor_rel``,
@@ -280,8 +281,8 @@ def best_match(
     left: npt.ArrayLike,
     right: npt.ArrayLike,
     *,
-    max_disparity: int,
-    min_disparity: int = 0,
+    max_disparity: float,
+    min_disparity: float = 0,
     **params: Any,
 ) -> Matches:
     """The reference without the network: best ZNCC candidate per point, same points and filters.
@@ -296,8 +297,8 @@ def hopfield_candidates(
     left: npt.ArrayLike,
     right: npt.ArrayLike,
     *,
-    max_disparity: int,
-    min_disparity: int = 0,
+    max_disparity: float,
+    min_disparity: float = 0,
     **params: Any,
 ) -> npt.NDArray[np.float32]:
     """Candidate neurons ``(M, 6)`` float32 ``[point, xl, yl, xr, yr, zncc]`` (parity tests)."""
