@@ -74,7 +74,16 @@ class BenchCase:
     accuracy: dict[str, float]
 
     def as_dict(self) -> dict[str, Any]:
-        """The JSON object of the case."""
+        """The JSON object of the case.
+
+        Returns
+        -------
+        dict
+            ``bench`` (``"vs_opencv"``), ``scene``, ``case``, ``kind``, ``width``, ``height``,
+            ``max_disparity``, ``runs``, ``ms`` and ``ratio_sgbm`` (rounded), then the
+            :attr:`accuracy` figures (rounded to 3 decimals; NaN where there is nothing to
+            measure).
+        """
         return {
             "bench": "vs_opencv",
             "scene": self.scene,
@@ -102,7 +111,19 @@ def _dense_accuracy(disp: np.ndarray, gt: np.ndarray | None) -> dict[str, float]
 
 
 def sparse_name(method: str) -> str:
-    """Case name of a sparse method (``fused`` is also a dense method: ``fused-sparse``)."""
+    """Case name of a sparse method.
+
+    Parameters
+    ----------
+    method : str
+        A method of :data:`stereovision.match.METHODS`.
+
+    Returns
+    -------
+    str
+        ``method``, or ``method + "-sparse"`` for one that is also a dense method of
+        :data:`stereovision.depth.METHODS` (``fused-sparse``).
+    """
     from stereovision.depth import METHODS
 
     return f"{method}-sparse" if method in METHODS else method
@@ -204,7 +225,19 @@ def _fmt(v: float | None, spec: str) -> str:
 
 
 def format_table(cases: Sequence[BenchCase]) -> str:
-    """A text table: one row per case, scenes separated by their header."""
+    """A text table of the cases.
+
+    Parameters
+    ----------
+    cases : sequence of BenchCase
+        As :func:`bench_scene` returns them (several scenes' in turn).
+
+    Returns
+    -------
+    str
+        A header line, then one line per case (the scene, size and range on its first case
+        only; ``-`` for a figure without a value).
+    """
     lines = [
         f"{'scene':34s} {'size':>9s} {'D':>4s} {'case':12s} {'ms':>8s} {'x SGBM':>7s}"
         f" {'bad-2':>6s} {'+fill':>6s} {'dens':>6s} {'p@1':>6s} {'count':>6s}"
@@ -245,7 +278,25 @@ def _scene_dirs(paths: Sequence[str]) -> list[Path]:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    """``stereovision bench [SCENE_DIR...]``."""
+    """``stereovision bench [SCENE_DIR...]``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line: ``scenes``, ``runs``, ``json``.
+
+    Returns
+    -------
+    int
+        0 (the exit status); errors are raised, for the CLI to print as one line.
+
+    Raises
+    ------
+    ValueError
+        If ``runs`` < :data:`MIN_RUNS`, or a folder holds no scene.
+    FileNotFoundError
+        If a scene folder does not exist.
+    """
     from tqdm import tqdm
 
     # eval --json's: a figure with nothing to measure (NaN: no GT pixel, no sparse match on GT)

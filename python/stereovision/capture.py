@@ -176,7 +176,18 @@ class SourceError(OSError):
         }
 
     def with_message(self, message: str) -> SourceError:
-        """The same error with another message (its attributes kept)."""
+        """The same error with another message (its attributes kept).
+
+        Parameters
+        ----------
+        message : str
+            The new message.
+
+        Returns
+        -------
+        SourceError
+            A new error; ``self`` is unchanged.
+        """
         return SourceError(message, **self._kwargs())
 
     def __reduce__(self) -> tuple[Any, ...]:
@@ -191,7 +202,18 @@ def _source_error(message: str, kwargs: dict[str, Any]) -> SourceError:
 
 
 def parse_source(text: str | int) -> int | str:
-    """A device index for an all-digit string (``"0"`` -> ``0``), else the text (file/pattern)."""
+    """A device index for an all-digit string (``"0"`` -> ``0``), else the text (file/pattern).
+
+    Parameters
+    ----------
+    text : str or int
+        ``--left`` / ``--right`` as given.
+
+    Returns
+    -------
+    int or str
+        The device index, or ``text`` unchanged (a video file, an image pattern, a URL).
+    """
     if isinstance(text, int):
         return text
     return int(text) if text.strip().isdigit() else text
@@ -203,6 +225,16 @@ MAX_SIDE = 16384
 
 def parse_size(text: str | tuple[int, int] | None) -> tuple[int, int] | None:
     """Parse ``"1280x720"`` to ``(1280, 720)``.
+
+    Parameters
+    ----------
+    text : str or tuple of int or None
+        ``"WIDTHxHEIGHT"``, a ``(width, height)`` tuple (checked the same way), or None.
+
+    Returns
+    -------
+    tuple of int or None
+        ``(width, height)`` in pixels, or None for None.
 
     Raises
     ------
@@ -232,6 +264,16 @@ def parse_size(text: str | tuple[int, int] | None) -> tuple[int, int] | None:
 def parse_fourcc(text: str | None) -> str | None:
     """A pixel format's four-character code (``"MJPG"``, ``"YUYV"``), checked; None stays None.
 
+    Parameters
+    ----------
+    text : str or None
+        The code as given (``--fourcc``).
+
+    Returns
+    -------
+    str or None
+        ``text`` itself, or None for None.
+
     Raises
     ------
     ValueError
@@ -245,7 +287,19 @@ def parse_fourcc(text: str | None) -> str | None:
 
 
 def fourcc_text(code: float) -> str:
-    """``CAP_PROP_FOURCC``'s number as its four characters (``""`` for 0 or unprintable)."""
+    """``CAP_PROP_FOURCC``'s number as its four characters.
+
+    Parameters
+    ----------
+    code : float
+        The number OpenCV's ``get(CAP_PROP_FOURCC)`` returns.
+
+    Returns
+    -------
+    str
+        Four characters (``"MJPG"``), or ``""`` for 0, a non-finite number or unprintable
+        characters.
+    """
     n = int(code) if math.isfinite(code) and code > 0 else 0
     text = "".join(chr((n >> (8 * k)) & 0xFF) for k in range(4))
     return text if n and all(" " <= c <= "~" for c in text) else ""
@@ -410,7 +464,14 @@ class SkewStats(Sequence[float]):
         return self._sum / self.n if self.n else math.nan
 
     def median_ms(self) -> float:
-        """Median of every skew appended (NaN for none)."""
+        """Median of every skew appended.
+
+        Returns
+        -------
+        float
+            Milliseconds (NaN for none): exact over the recent window, else from the
+            logarithmic histogram of every skew.
+        """
         if self.n == 0:
             return math.nan
         if self.n <= (self.recent.maxlen or 0):
@@ -426,7 +487,13 @@ class SkewStats(Sequence[float]):
         return float(statistics.fmean(values))
 
     def report(self) -> dict[str, float]:
-        """``n``, ``mean_ms``, ``median_ms``, ``max_ms`` over every skew appended."""
+        """Summary of every skew appended.
+
+        Returns
+        -------
+        dict of str to float
+            ``n``, ``mean_ms``, ``median_ms``, ``max_ms`` (milliseconds; NaN for none).
+        """
         return {
             "n": self.n,
             "mean_ms": self.mean_ms,
@@ -475,7 +542,18 @@ class PairSource:
         return "; ".join(parts)
 
     def read(self) -> StereoFrame:
-        """The next pair (:class:`SourceError` at the end)."""
+        """The next pair.
+
+        Returns
+        -------
+        StereoFrame
+            The left and right frames with their timestamps.
+
+        Raises
+        ------
+        SourceError
+            At the end of the source (``end`` True), or for a frame that cannot be used.
+        """
         raise NotImplementedError
 
     def close(self) -> None:
@@ -484,7 +562,18 @@ class PairSource:
 
     def frames(self, *, stop_at_end: bool = True) -> Iterator[StereoFrame]:
         """Iterate over pairs; the end of a source ends the iteration when ``stop_at_end``
-        (another :class:`SourceError`, such as a frame of another shape, is raised)."""
+        (another :class:`SourceError`, such as a frame of another shape, is raised).
+
+        Parameters
+        ----------
+        stop_at_end : bool
+            End the iteration at the source's end (else its :class:`SourceError` is raised).
+
+        Yields
+        ------
+        StereoFrame
+            Each pair, as :meth:`read` returns it.
+        """
         while True:
             try:
                 frame = self.read()
@@ -495,7 +584,13 @@ class PairSource:
             yield frame
 
     def skew_report(self) -> dict[str, float]:
-        """Skew over the pairs read: ``n``, ``mean_ms``, ``median_ms``, ``max_ms``."""
+        """Skew between the left and right grabs over the pairs read.
+
+        Returns
+        -------
+        dict of str to float
+            ``n`` (pairs), ``mean_ms``, ``median_ms``, ``max_ms`` (NaN without pairs).
+        """
         s = self.skews_ms
         if isinstance(s, SkewStats):
             return s.report()
@@ -794,6 +889,12 @@ class StereoCamera(PairSource):
     def read(self) -> StereoFrame:
         """Grab both sources, then retrieve both; return the timestamped pair.
 
+        Returns
+        -------
+        StereoFrame
+            The pair (at the requested size, if any), with each grab's time (``t_left``,
+            ``t_right``), its index and, for a file, each frame's position in it.
+
         Raises
         ------
         SourceError
@@ -885,7 +986,13 @@ class StereoCamera(PairSource):
         )
 
     def describe(self) -> str:
-        """One line: requested vs delivered size and fps of each source."""
+        """Requested vs delivered size, fps and pixel format of each source.
+
+        Returns
+        -------
+        str
+            One line for a terminal or a log.
+        """
         req = self.requested_size
         asked = f"asked {req[0]}x{req[1]}" if req else "native size"
         if self.requested_fourcc:
@@ -909,8 +1016,21 @@ class StereoCamera(PairSource):
 
 
 def resize_frame(frame: np.ndarray, size: tuple[int, int]) -> np.ndarray:
-    """``frame`` at ``size`` (``(width, height)``) as the pair sources resize their frames:
-    ``INTER_AREA`` to shrink, ``INTER_LINEAR`` to enlarge; the frame itself at its own size."""
+    """``frame`` at ``size`` as the pair sources resize their frames: ``INTER_AREA`` to shrink,
+    ``INTER_LINEAR`` to enlarge.
+
+    Parameters
+    ----------
+    frame : numpy.ndarray
+        ``(H, W)`` or ``(H, W, 3)`` image.
+    size : tuple of int
+        ``(width, height)`` in pixels.
+
+    Returns
+    -------
+    numpy.ndarray
+        The resized frame, of ``frame``'s dtype; ``frame`` itself when it is already that size.
+    """
     h, w = frame.shape[:2]
     if (w, h) == tuple(size):
         return frame
@@ -933,7 +1053,20 @@ def temporal_average(tf: Any, frame: StereoFrame) -> tuple[np.ndarray, np.ndarra
     the frames as delivered when the source enlarged them (:attr:`StereoFrame.delivered`), the
     means then enlarged to the pair's size: an enlargement spreads each pixel's noise over its
     neighbours, which the filter's motion test took for motion (every pair of a still rig
-    restarted, nothing averaged). Frames the source shrank are averaged as shrunk."""
+    restarted, nothing averaged). Frames the source shrank are averaged as shrunk.
+
+    Parameters
+    ----------
+    tf : stereovision.temporal.TemporalFilter
+        The filter (its running means are updated).
+    frame : StereoFrame
+        The pair.
+
+    Returns
+    -------
+    left, right : numpy.ndarray
+        The filter's running means (uint8), at the pair's size.
+    """
     if not _averaged_before_resize(frame):
         left, right = tf(frame.left, frame.right)
         return left, right
@@ -1001,6 +1134,19 @@ def _camera_device(src: object) -> str | None:
 
 def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
     """The :class:`StereoCamera` or :class:`~stereovision.rosbag.BagCamera` the options name.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (``--left``/``--right``, or ``--from-bag`` and its options;
+        ``--size``, ``--fourcc``).
+    fps : float, optional
+        Frame rate to request of the cameras.
+
+    Returns
+    -------
+    StereoCamera or stereovision.rosbag.BagCamera
+        The source, opened (the caller closes it).
 
     Raises
     ------
@@ -1116,7 +1262,18 @@ def remove_stale_temps(directory: PathLike) -> list[str]:
     """Remove the temporary files of :func:`save_pair` that a killed capture left in
     ``directory`` (``.left_0003.png.1234-9f2c.tmp``: a capture ended by SIGKILL, or SIGTERM
     without a handler, has no chance to remove its own); those of a process still running are
-    kept. Returns the names removed, sorted."""
+    kept.
+
+    Parameters
+    ----------
+    directory : str or os.PathLike
+        The capture's output folder (a missing one: nothing to remove).
+
+    Returns
+    -------
+    list of str
+        The file names removed, sorted.
+    """
     d = Path(directory)
     removed: list[str] = []
     if not d.is_dir():
@@ -1316,7 +1473,20 @@ class ChessboardCollector:
             return str(exc)
 
     def consider(self, frame: StereoFrame) -> Decision:
-        """Decide whether ``frame`` is worth saving; a kept pose is remembered."""
+        """Decide whether ``frame`` is worth saving; a kept pose is remembered.
+
+        Parameters
+        ----------
+        frame : StereoFrame
+            The pair to judge.
+
+        Returns
+        -------
+        Decision
+            ``save`` True for a new pose (then remembered), else False with the ``reason`` (no
+            board in a view, too few corners, a pose too close to a kept one); ``params`` the
+            pose's ``(x, y, size, skew)`` when the board was found.
+        """
         if self.board is not None:
             pose = self._charuco_pose(frame)
             if isinstance(pose, str):
@@ -1338,7 +1508,13 @@ class ChessboardCollector:
         return Decision(True, "new pose", p)
 
     def progress(self) -> dict[str, float]:
-        """Coverage of each parameter in [0, 1]: span of the kept values / ROS's target span."""
+        """Coverage of each pose parameter: span of the kept values / ROS's target span.
+
+        Returns
+        -------
+        dict of str to float
+            By parameter name (:data:`POSE_PARAM_NAMES`), in ``[0, 1]`` (0 before any pose).
+        """
         out = {}
         for k, (name, span) in enumerate(zip(POSE_PARAM_NAMES, POSE_PARAM_RANGES, strict=True)):
             vals = [p[k] for p in self.kept]
@@ -1346,7 +1522,13 @@ class ChessboardCollector:
         return out
 
     def format_progress(self) -> str:
-        """``x [#####-----]  50%  y [...] ...`` as ROS's calibrator shows it."""
+        """:meth:`progress` as bars, as ROS's calibrator shows it.
+
+        Returns
+        -------
+        str
+            One line: ``x [#####-----]  50%  y [...] ...``.
+        """
         parts = []
         for name, v in self.progress().items():
             n = round(v * PROGRESS_BAR_WIDTH)

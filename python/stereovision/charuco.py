@@ -219,7 +219,19 @@ class CharucoBoard:
         return self.dictionary != "auto" and (self.legacy is not None or self.squares[1] % 2 == 1)
 
     def describe(self, unit: str = "") -> str:
-        """One line: squares, corners, sizes, dictionary and layout."""
+        """The board in one line: squares, inner corners, sizes, dictionary and layout.
+
+        Parameters
+        ----------
+        unit : str
+            Unit written after the sizes (``"m"``, ``"mm"``; default none).
+
+        Returns
+        -------
+        str
+            E.g. ``ChArUco 7x5 squares (6x4 inner corners), square 0.04 m, marker 0.03 m,
+            DICT_5X5_100``.
+        """
         u = f" {unit}" if unit else ""
         c, r = self.inner
         # OpenCV's two layouts differ only with an even number of rows: an odd-rowed board
@@ -232,7 +244,18 @@ class CharucoBoard:
         )
 
     def cv_board(self) -> Any:
-        """The ``cv2.aruco.CharucoBoard`` (the dictionary must be resolved)."""
+        """The board as OpenCV's object.
+
+        Returns
+        -------
+        cv2.aruco.CharucoBoard
+            With this board's squares, sizes, dictionary and layout.
+
+        Raises
+        ------
+        ValueError
+            If the dictionary is not known yet (``dictionary="auto"``: :meth:`resolve` first).
+        """
         if self.dictionary == "auto":
             raise ValueError("the board's dictionary is not known yet (dictionary='auto')")
         return _cv_board(
@@ -313,6 +336,12 @@ class CharucoBoard:
         ----------
         image : array_like
             Grey or BGR image showing the board.
+
+        Returns
+        -------
+        CharucoBoard or None
+            A copy with ``dictionary`` and ``legacy`` decided (``self`` itself when both were
+            known), or None if the image shows too few markers or corners to decide.
         """
         from stereovision._validate import as_gray_uint8
 
@@ -359,7 +388,21 @@ def _detector(board: CharucoBoard) -> Any:
 
 
 def corners_span_plane(board: CharucoBoard, ids: npt.NDArray[np.int64]) -> bool:
-    """True if the corners ``ids`` of ``board`` are not all on one line of the board."""
+    """Whether the corners ``ids`` of ``board`` are not all on one line of the board.
+
+    Parameters
+    ----------
+    board : CharucoBoard
+        The board.
+    ids : numpy.ndarray
+        Inner-corner ids (int64), as :func:`find_charuco_corners` gives them.
+
+    Returns
+    -------
+    bool
+        True for at least three corners spanning the board's plane (a homography or pose can
+        be fitted to them); False for fewer, or all on one row, column or diagonal.
+    """
     pts = board.object_points(ids)[:, :2].astype(np.float64)
     if len(pts) < 3:
         return False

@@ -188,7 +188,15 @@ class StreamReport:
     error: str | None = None
 
     def as_dict(self) -> dict[str, Any]:
-        """The JSON summary object (``"summary": true``)."""
+        """The JSON summary object (``"summary": true``).
+
+        Returns
+        -------
+        dict
+            The report's fields by name (times rounded: ``seconds``, ``fps``, ``stage_ms``,
+            ``latency_ms``, ``wait_ms``, ``skew_ms``, ``density``, ``noise_sigma``), with
+            ``"summary": True``.
+        """
         return {
             "summary": True,
             "frames": self.frames,
@@ -357,13 +365,34 @@ class FrameServer:
         return bytes(buf.tobytes())
 
     def latest_jpeg(self) -> bytes | None:
-        """The latest frame as JPEG bytes, None before the first :meth:`update`."""
+        """The latest frame as JPEG.
+
+        Returns
+        -------
+        bytes or None
+            The encoded frame, or None before the first :meth:`update`.
+        """
         with self._cond:
             item = self._latest
         return None if item is None else self._encode(item)
 
     def wait_jpeg(self, seen: int, timeout: float) -> tuple[bytes | None, int]:
-        """Wait for a frame newer than ``seen``; ``(jpeg or None on timeout, its number)``."""
+        """Wait for a frame newer than ``seen``.
+
+        Parameters
+        ----------
+        seen : int
+            Number of the last frame the caller has (0 for none).
+        timeout : float
+            Longest wait, seconds.
+
+        Returns
+        -------
+        jpeg : bytes or None
+            The newer frame encoded, or None on timeout.
+        number : int
+            Its number (``seen`` on timeout), for the next call.
+        """
         with self._cond:
             if self._seq == seen or self._latest is None:
                 self._cond.wait(timeout)
@@ -928,7 +957,20 @@ def _format_report(rep: dict[str, Any]) -> str:
 
 
 def cmd_stream(args: argparse.Namespace) -> int:
-    """``stereovision stream --left SRC --right SRC``."""
+    """``stereovision stream --left SRC --right SRC``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (:func:`add_cli`'s options).
+
+    Returns
+    -------
+    int
+        The exit status: 0; 130 or 143 when SIGINT or SIGTERM cut the stream short (the
+        summary is still written); 2 (the CLI's error status) when a pair failed, after the
+        summary.
+    """
     calib = Calibration.from_file(args.calib) if args.calib else None
     out = sys.stdout
     log = sys.stderr

@@ -160,7 +160,18 @@ def interest_points(
 
 
 def moravec(image: npt.ArrayLike) -> npt.NDArray[np.float32]:
-    """The Moravec interest map ``M`` of :func:`interest_points`, ``(H, W)`` float32."""
+    """The Moravec interest map ``M`` of :func:`interest_points`.
+
+    Parameters
+    ----------
+    image : array_like
+        ``(H, W)`` grey or ``(H, W, 3)`` BGR image, uint8, uint16 or float in ``[0, 1]``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(H, W)`` float32, ``min(S_h, S_v, S_d, S_a)`` at every pixel.
+    """
     return interest_points(image).response
 
 
@@ -287,8 +298,28 @@ def best_match(
 ) -> Matches:
     """The reference without the network: best ZNCC candidate per point, same points and filters.
 
-    Parameters and return value as :func:`hopfield_match` (the network parameters are ignored;
-    ``energy_trace`` is empty).
+    The network parameters (``A``, ``B``, ``D``, ``theta``, ...) are ignored.
+
+    Parameters
+    ----------
+    left, right : array_like
+        Rectified pair, as :func:`hopfield_match`'s.
+    max_disparity : float
+        Largest disparity searched (px; a fractional value: up to its ceiling).
+    min_disparity : float, optional
+        Smallest disparity searched (px, default 0).
+    **params
+        Overrides of :data:`DEFAULTS`, as :func:`hopfield_match`'s.
+
+    Returns
+    -------
+    Matches
+        As :func:`hopfield_match`'s, with an empty ``energy_trace``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`hopfield_match`.
     """
     return _run("best", left, right, max_disparity, min_disparity, params)
 
@@ -301,6 +332,23 @@ def hopfield_candidates(
     min_disparity: float = 0,
     **params: Any,
 ) -> npt.NDArray[np.float32]:
-    """Candidate neurons ``(M, 6)`` float32 ``[point, xl, yl, xr, yr, zncc]`` (parity tests)."""
+    """The candidate neurons the network starts from (for parity tests).
+
+    Parameters
+    ----------
+    left, right : array_like
+        Rectified pair, as :func:`hopfield_match`'s.
+    max_disparity : float
+        Largest disparity searched (px; a fractional value: up to its ceiling).
+    min_disparity : float, optional
+        Smallest disparity searched (px, default 0).
+    **params
+        Overrides of :data:`DEFAULTS`, as :func:`hopfield_match`'s.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(M, 6)`` float32, one row per candidate: ``[point, xl, yl, xr, yr, zncc]``.
+    """
     gl, gr = check_pair(left, right)
     return _core.hopfield_candidates(gl, gr, _params(max_disparity, min_disparity, params))

@@ -143,7 +143,19 @@ class ChannelCurves:
         return int(self.centroids.shape[0])
 
     def segment(self, k: int) -> npt.NDArray[np.int32]:
-        """``(n_k, 2)`` int32 ``(x, y)`` pixels of segment ``k``, in curve order."""
+        """The pixels of one segment.
+
+        Parameters
+        ----------
+        k : int
+            Segment index, ``0 <= k < len(self)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(n_k, 2)`` int32 ``(x, y)`` pixels of segment ``k``, in curve order (a view of
+            ``seg_pixels``).
+        """
         return self.seg_pixels[self.seg_offsets[k] : self.seg_offsets[k + 1]]
 
 
