@@ -382,6 +382,24 @@ def test_from_kitti_raw_and_object_formats(tmp_path: Path) -> None:
         Calibration.from_kitti(tmp_path / "inf.txt")
 
 
+def test_from_kitti_refuses_an_image_size_its_s_rect_02_contradicts(tmp_path: Path) -> None:
+    """from_kitti kept S_rect_02's 1242x375 and dropped a contradicting image_size silently
+    (from_file refused it, from_kitti did not); a file with a broken S_rect_02 was sized by the
+    image_size or a left.png instead, as if it had none."""
+    p2 = "7.2e+02 0 6.1e+02 4.5e+01 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    p3 = "7.2e+02 0 6.1e+02 -3.6e+02 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    cam = tmp_path / "calib_cam_to_cam.txt"
+    cam.write_text(f"S_rect_02: 1.242000e+03 3.750000e+02\nP_rect_02: {p2}\nP_rect_03: {p3}\n")
+    assert Calibration.from_kitti(cam, image_size=(1242, 375)).image_size == (1242, 375)
+    with pytest.raises(
+        ValueError, match=r"1242x375 images \(S_rect_02\), not of the image_size \(621, 188\)"
+    ):
+        Calibration.from_kitti(cam, image_size=(621, 188))
+    cam.write_text(f"S_rect_02: 1242\nP_rect_02: {p2}\nP_rect_03: {p3}\n")
+    with pytest.raises(ValueError, match=r"S_rect_02 has 1 values, not 2"):
+        Calibration.from_kitti(cam, image_size=(1242, 375))
+
+
 # ------------------------------------------------------------------------------------ Q, rectify
 
 

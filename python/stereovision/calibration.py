@@ -1639,7 +1639,8 @@ class Calibration:
         calib_file : str or os.PathLike
             KITTI's ``calib_cam_to_cam.txt`` or an object/odometry ``calib`` file.
         image_size : tuple of int, optional
-            ``(width, height)``, used when the file has no ``S_rect_02``.
+            ``(width, height)``, used when the file has no ``S_rect_02``; else a check: a
+            file of another size is refused.
 
         Returns
         -------
@@ -1651,7 +1652,8 @@ class Calibration:
         FileNotFoundError
             If the file does not exist.
         ValueError
-            If the projection matrices or the image size are missing.
+            If the projection matrices or the image size are missing, or ``image_size``
+            contradicts ``S_rect_02``.
         """
         p, _ = cls._read_text(calib_file)
         v = parse_kitti_calib(p)
@@ -1671,13 +1673,26 @@ class Calibration:
             raise ValueError(f"KITTI calibration {p}: {k2} focal length {f:g} is not positive")
         baseline = (p2[0, 3] - p3[0, 3]) / f
         size: tuple[int, int] | None = None
-        if "S_rect_02" in v and v["S_rect_02"].size == 2:
+        given = None if image_size is None else cls._check_size(image_size)
+        if "S_rect_02" in v:
+            if v["S_rect_02"].size != 2:
+                raise ValueError(
+                    f"KITTI calibration {p}: S_rect_02 has {v['S_rect_02'].size} values, not 2 "
+                    "(width height)"
+                )
             size = (
                 _pixels(v["S_rect_02"][0], f"S_rect_02 width in {p}"),
                 _pixels(v["S_rect_02"][1], f"S_rect_02 height in {p}"),
             )
-        elif image_size is not None:
-            size = image_size
+            if given is not None and given != size:
+                # as from_file refuses it: the file's own size was kept, the given one dropped
+                raise ValueError(
+                    f"{p} is a calibration of {size[0]}x{size[1]} images (S_rect_02), not of "
+                    f"the image_size {given} given: leave image_size out, or resize the "
+                    f"calibration with .scaled_to({given}) if the images were resized"
+                )
+        elif given is not None:
+            size = given
         else:
             for name in ("left.png", "image_2.png"):
                 img = p.parent / name
