@@ -822,6 +822,37 @@ def test_opencv_stereo_calib_output_needs_image_size_and_unit(tmp_path: Path) ->
         Calibration.from_file(tmp_path, image_size=(640, 480))
 
 
+def test_from_file_refuses_a_unit_the_file_contradicts(data_dir: Path) -> None:
+    """unit was read for stereo_calib output only and dropped silently for every other
+    format: a Middlebury calib.txt (mm) with unit="m" came back in mm as if agreed."""
+    calib_txt = data_dir / "eth3d" / "playground" / "calib.txt"
+    if not calib_txt.is_file():
+        pytest.skip(f"{calib_txt} not found")
+    assert Calibration.from_file(calib_txt, unit="mm").unit == "mm"
+    with pytest.raises(
+        ValueError, match=r"calib\.txt states its lengths in 'mm', not in the unit 'm'"
+    ):
+        Calibration.from_file(calib_txt, unit="m")
+    with pytest.raises(
+        ValueError, match=r"unit: expected one of \['m', 'mm', 'cm', 'ft', 'in'\], got 'yd'"
+    ):
+        Calibration.from_file(calib_txt, unit="yd")
+
+
+def test_from_file_reads_a_q_dat_in_the_unit_given(data_dir: Path) -> None:
+    """A Q.dat does not state the unit of its baseline: it was read in metres whatever unit was
+    given; the unit given is its unit now (metres still by default)."""
+    q = next(p for p in sorted(data_dir.rglob("Q.dat")) if (p.parent / "left.png").is_file())
+    in_m = Calibration.from_file(q)
+    with pytest.warns(UserWarning, match=r"in another unit than unit='mm'\? With unit='m'"):
+        in_mm = Calibration.from_file(q, unit="mm")  # a sample's B in metres, read as mm
+    assert (in_m.unit, in_mm.unit) == ("m", "mm")
+    assert in_mm.baseline == in_m.baseline
+    assert in_mm.baseline_m == pytest.approx(in_m.baseline_m / 1000, rel=1e-12)
+    with pytest.warns(UserWarning, match="unit='mm'"):
+        assert Calibration.from_file(q.parent, unit="mm") == in_mm
+
+
 @pytest.mark.parametrize("own", ["calib.txt", "Q.dat"])
 def test_folder_calibration_wins_over_stereo_calib_files_beside_it(
     tmp_path: Path, data_dir: Path, own: str

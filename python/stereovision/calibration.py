@@ -1277,8 +1277,10 @@ class Calibration:
             OpenCV's ``stereo_calib`` output); for the others a check: a file of another size
             is refused (:meth:`scaled_to` resizes a calibration), not silently kept.
         unit : str, optional
-            Length unit of ``T`` (``"m"``, ``"mm"``, ...), for OpenCV's ``stereo_calib`` output
-            only (the unit of the board's square size); the other formats state theirs.
+            Length unit of ``T`` (``"m"``, ``"mm"``, ...) for the formats that do not state it:
+            OpenCV's ``stereo_calib`` output (the unit of the board's square size; needed) and
+            ``Q.dat`` (default ``"m"``, :meth:`from_q`). For the others a check: a file that
+            states another unit is refused, not silently kept.
 
         Returns
         -------
@@ -1291,10 +1293,20 @@ class Calibration:
             If ``path`` does not exist.
         ValueError
             If the format is not recognised or the content is invalid, if ``image_size`` or
-            ``unit`` is missing where the format needs it, or if ``image_size`` is given and
-            the file states another size.
+            ``unit`` is missing where the format needs it, if ``unit`` is not a known unit, or
+            if ``image_size`` or ``unit`` is given and the file states another.
         """
+        if unit is not None and unit not in UNIT_TO_METRES:
+            raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
         calib = cls._read_any(path, image_size, unit)
+        if unit is not None and calib.unit != unit:
+            # a unit the file states (calib.txt's mm, KITTI's and ROS's m, a saved file's own)
+            # wins over a given one that disagrees: said, not kept silently or converted
+            raise ValueError(
+                f"{path} states its lengths in {calib.unit!r}, not in the unit {unit!r} given: "
+                "leave unit out (it is for files that do not state theirs: OpenCV stereo_calib "
+                "output, Q.dat)"
+            )
         # the checked size in the message: an array's tuple() read "(np.int64(1280), ...)"
         given = None if image_size is None else cls._check_size(image_size)
         if given is not None and calib.image_size != given:
@@ -1339,7 +1351,8 @@ class Calibration:
             if (p / "calib.txt").is_file():
                 return cls.from_file(p / "calib.txt", image_size=image_size)
             if (p / "Q.dat").is_file():
-                return cls.from_q(p / "Q.dat", image_size or _scene_image_size(p / "Q.dat"))
+                q = p / "Q.dat"
+                return cls.from_q(q, image_size or _scene_image_size(q), unit=unit or "m")
             raise ValueError(
                 f"calibration path {p} is a folder without left.yaml and right.yaml "
                 "(ROS camera_info), calib.txt or Q.dat; pass a calibration file"
@@ -1367,7 +1380,7 @@ class Calibration:
         if re.search(r"^\s*(P_rect_02|P2)\s*:", text, re.MULTILINE):
             return cls.from_kitti(p, image_size=image_size)
         if _q_numbers(text):  # a Q.dat: OpenCV's Q, sized like load_scene sizes it
-            return cls.from_q(p, image_size or _scene_image_size(p))
+            return cls.from_q(p, image_size or _scene_image_size(p), unit=unit or "m")
         raise ValueError(
             f"unrecognised calibration format in {p}: expected OpenCV YAML/XML, JSON, "
             "Middlebury calib.txt, KITTI calibration, ROS camera_info, Kalibr camchain or "
@@ -1537,7 +1550,7 @@ class Calibration:
         )
 
     @classmethod
-    def from_q(cls, q_file: PathLike, image_size: tuple[int, int]) -> Calibration:
+    def from_q(cls, q_file: PathLike, image_size: tuple[int, int], unit: str = "m") -> Calibration:
         """Rectified calibration from a ``Q.dat``: OpenCV's 4x4 disparity-to-depth matrix.
 
         The text file holds the 16 numbers of ``Q`` (``cv2.stereoRectify``'s output, as in
@@ -1548,8 +1561,9 @@ class Calibration:
             0 0 0    f
             0 0 1/B  (cx' - cx)/B
 
-        ``B`` is read in metres (the samples' convention: TartanAir's gives 0.25 m, its
-        ``calib.txt`` 250 mm; KITTI's 0.533 m). The result has unit ``"m"``, ``R = I``,
+        ``Q`` does not say the unit of ``B`` (it is the unit of the board's square size);
+        ``unit`` says it, by default metres (the samples' convention: TartanAir's gives 0.25 m,
+        its ``calib.txt`` 250 mm; KITTI's 0.533 m). The result has that unit, ``R = I``,
         ``T = (-B, 0, 0)``, equal focal lengths, ``doffs = cx' - cx``.
 
         ``Q`` acts on homogeneous coordinates, so any multiple of it is the same matrix: one
@@ -1562,11 +1576,13 @@ class Calibration:
             The ``Q.dat`` file.
         image_size : tuple of int
             ``(width, height)`` of the images it belongs to (``Q`` does not say).
+        unit : str, optional
+            Length unit of ``B``: ``"m"`` (default), ``"mm"``, ``"cm"``, ``"ft"`` or ``"in"``.
 
         Returns
         -------
         Calibration
-            The rectified calibration, unit ``"m"``.
+            The rectified calibration, in ``unit``.
 
         Raises
         ------
@@ -1615,7 +1631,7 @@ class Calibration:
             R=np.eye(3),
             T=np.array([-1.0 / inv_b, 0.0, 0.0]),
             image_size=(w, h),
-            unit="m",
+            unit=unit,
             rectified=True,
         )
 
