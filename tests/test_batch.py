@@ -1405,3 +1405,35 @@ def test_an_image_that_cannot_be_read_fails_its_pair_alone(
     assert main(args) == 0
     assert capsys.readouterr().out.startswith("1 processed, 1 skipped (done before), 0 failed")
     assert _summary(out)["pairs"]["a"]["outputs"] == sorted(DISPARITY_FILES)
+
+
+def test_calib_unit_reaches_the_workers(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--calib had no unit to go with it: a Q.dat (which states none) was read in metres, and
+    the worker read the file shipped to it again without one. The unit given is the unit of
+    the calibration the worker gets; a file stating another is refused before a pair runs."""
+    from stereovision.batch import _task
+    from stereovision.cli import main
+
+    teddy = data_dir / "middeval3" / "teddyH"
+    scene = tmp_path / "teddyH"
+    scene.mkdir()
+    for name in ("left.png", "right.png", "Q.dat"):
+        shutil.copy(teddy / name, scene / name)
+    (job,) = find_pairs(scene, calib=scene / "Q.dat")
+    with pytest.warns(UserWarning, match="unit='cm'"):  # teddyH's B is 0.08 (m): 0.8 mm in cm
+        name, data = _task(job, {"method": None, "max_disparity": None, "fill": None,
+                                 "calib_unit": "cm"})["calib"]  # fmt: skip
+    shipped = json.loads(data)
+    assert (name, shipped["unit"], shipped["T"][0]) == ("calib.json", "cm", pytest.approx(-0.08))
+    calib_txt = data_dir / "eth3d" / "terrace" / "calib.txt"
+    out = tmp_path / "out"
+    args = ["batch", str(scene), "-o", str(out), "--calib", str(calib_txt), "--calib-unit", "m"]
+    assert main(args) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: {calib_txt} states its lengths in 'mm', not in --calib-unit m: "
+        "leave --calib-unit out (it is for files that do not state theirs: OpenCV stereo_calib "
+        "output, Q.dat)\n"
+    )
+    assert not out.exists()

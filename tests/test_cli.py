@@ -1020,3 +1020,66 @@ def test_depth_says_a_usage_error_before_a_file_it_did_not_write(
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("stereovision: error: ") and says in err, err
     assert (tmp_path / "o" / "disparity.png").read_bytes() == b"mine"
+
+
+def test_calib_unit_reads_opencv_stereo_calib_output(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """OpenCV stereo_calib's intrinsics.yml + extrinsics.yml hold no unit of T and no image
+    size: every command refused them with "pass image_size=(width, height) and unit='m'/'mm'/...",
+    a Python call no option of the CLI could make. --calib-unit says the unit, the run's images
+    the size (info: --size)."""
+    from test_calibration import _opencv_stereo_calib
+
+    rig = tmp_path / "rig"
+    rig.mkdir()
+    _opencv_stereo_calib(rig)  # T (-120, 1.5, 0.8) mm, 640x480
+    assert main(["info", str(rig)]) == 2
+    assert capsys.readouterr().err.endswith(
+        "(the board's square size): pass --size WxH and --calib-unit (m, mm, cm, ft or in)\n"
+    )
+    assert main(["info", str(rig), "--calib-unit", "mm", "--size", "640x480"]) == 0
+    assert capsys.readouterr().out.startswith(
+        "640x480 px, raw rig, rectified with alpha 0: baseline 12.0 cm (120.012 mm)"
+    )
+    left, right = (str(data_dir / "chessboard" / f"{s}01.jpg") for s in ("left", "right"))
+    out = tmp_path / "out"
+    assert main(["rectify", left, right, "--calib", str(rig), "-o", str(out)]) == 2
+    assert capsys.readouterr().err.endswith(
+        "(the board's square size): pass --calib-unit (m, mm, cm, ft or in)\n"
+    )
+    assert not out.exists()
+    assert (
+        main(["rectify", left, right, "--calib", str(rig), "--calib-unit", "mm", "-o", str(out)])
+        == 0
+    )
+    assert cv2.imread(str(out / "left_rect.png")).shape == (480, 640, 3)
+
+
+def test_calib_unit_refuses_a_file_of_another_unit_and_no_file(
+    data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    calib_txt = data_dir / "eth3d" / "playground" / "calib.txt"
+    assert main(["info", str(calib_txt), "--calib-unit", "m"]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: {calib_txt} states its lengths in 'mm', not in --calib-unit m: "
+        "leave --calib-unit out (it is for files that do not state theirs: OpenCV stereo_calib "
+        "output, Q.dat)\n"
+    )
+    assert main(["info", str(calib_txt), "--calib-unit", "mm"]) == 0
+    assert "baseline 6.0 cm (59.5549 mm)" in capsys.readouterr().out
+    scene = calib_txt.parent
+    left, right = str(scene / "left.png"), str(scene / "right.png")
+    assert main(["check", left, right, "--calib-unit", "mm"]) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: --calib-unit is the unit of --calib's file: give --calib too\n"
+    )
+
+
+@pytest.mark.parametrize("command", ["depth", "check", "rectify", "info", "stream", "gui", "batch"])
+def test_every_command_that_loads_a_calibration_takes_calib_unit(
+    command: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    assert "--calib-unit {m,mm,cm,ft,in}" in capsys.readouterr().out

@@ -219,7 +219,9 @@ def find_pairs(
 
 
 def _scan(
-    root: str | os.PathLike[str], calib: str | os.PathLike[str] | None = None
+    root: str | os.PathLike[str],
+    calib: str | os.PathLike[str] | None = None,
+    calib_unit: str | None = None,
 ) -> tuple[list[PairJob], list[_Unpaired]]:
     """:func:`find_pairs`, and the images named as one of a pair without the other: a ``left``
     image without its ``right`` one, a ``right`` image (no ``left`` in its name) without its
@@ -237,7 +239,7 @@ def _scan(
         # now, not one failed pair per scene.
         from stereovision.calibration import Calibration
 
-        Calibration.from_file(cal)
+        Calibration.from_file(cal, unit=calib_unit)
     found: list[PairJob] = []
     unpaired: list[_Unpaired] = []
     cam_found: list[PairJob] = []  # in sibling camera folders
@@ -981,18 +983,19 @@ class _Dask:
                 pass
 
 
-def _calib_payload(path: Path) -> tuple[str, bytes]:
+def _calib_payload(path: Path, unit: str | None = None) -> tuple[str, bytes]:
     """A calibration as one file's name and bytes for a worker: a ROS camera_info folder
     (left.yaml, right.yaml) is read here and shipped as this package's JSON, and so is a
-    ``Q.dat`` (sized by the ``left.png`` beside it, which the worker's copy has not)."""
+    ``Q.dat`` (sized by the ``left.png`` beside it, which the worker's copy has not) and a file
+    read in the ``unit`` given (the JSON states it; the worker reads the file without it)."""
     from stereovision.calibration import Calibration, _q_numbers
 
-    if path.is_file():
+    if path.is_file() and unit is None:
         data = path.read_bytes()
         if not _q_numbers(data.decode("utf-8", errors="replace")):
             return path.name, data
     with tempfile.TemporaryDirectory(prefix="stereovision-calib-") as tmp:
-        out = Calibration.from_file(path).save(Path(tmp) / "calib.json")
+        out = Calibration.from_file(path, unit=unit).save(Path(tmp) / "calib.json")
         return out.name, out.read_bytes()
 
 
@@ -1001,7 +1004,7 @@ def _task(job: PairJob, opts: dict[str, Any]) -> dict[str, Any]:
         "name": job.name,
         "left": (str(job.left), job.left.read_bytes()),
         "right": (str(job.right), job.right.read_bytes()),
-        "calib": None if job.calib is None else _calib_payload(job.calib),
+        "calib": None if job.calib is None else _calib_payload(job.calib, opts.get("calib_unit")),
         **opts,
     }
 
@@ -1054,6 +1057,7 @@ def run_batch(
     max_disparity: int | None = None,
     fill: bool | None = None,
     calib: str | os.PathLike[str] | None = None,
+    calib_unit: str | None = None,
     retry_failed: bool = False,
     ground: bool = False,
     grid: float | None = None,
@@ -1079,6 +1083,10 @@ def run_batch(
         Fill the holes (:func:`depth_map`'s ``fill``); None = the method's default.
     calib : path, optional
         Calibration for every pair (else each scene's ``calib.txt``).
+    calib_unit : str, optional
+        Length unit of ``calib``'s ``T`` when the file does not state it (a ``Q.dat``; OpenCV
+        ``stereo_calib`` output, which also needs an image size, cannot be read here);
+        :meth:`~stereovision.calibration.Calibration.from_file`'s ``unit``.
     ground : bool
         Also write each pair's floor (``ground.json``, ``obstacles.png``, ``scan.json``;
         :func:`stereovision.ground.fit_ground_plane`, :func:`~stereovision.ground.laser_scan`).
@@ -1128,7 +1136,9 @@ def run_batch(
     from stereovision.io import check_output_folder
 
     t0 = time.perf_counter()
-    jobs, unpaired = _scan(input_dir, calib)
+    if calib_unit is not None and calib is None:
+        raise ValueError("calib_unit is the unit of calib's file: give calib too")
+    jobs, unpaired = _scan(input_dir, calib, calib_unit)
     # a file in the way, or a folder that cannot be written: said as such, before a cluster
     # starts (it was "[Errno 17] File exists" or "[Errno 2] No such file or directory")
     check_output_folder(output_dir, "output folder")
@@ -1152,6 +1162,8 @@ def run_batch(
         opts: dict[str, Any] = {"method": method, "max_disparity": max_disparity, "fill": fill}
         if ground:  # only when asked: outputs of earlier runs without it stay valid
             opts.update(ground=True, grid=grid)
+        if calib_unit is not None:  # as ground: only when given
+            opts["calib_unit"] = calib_unit
         summary.data.update(
             input=str(Path(input_dir).resolve()),
             output=str(out.resolve()),
@@ -1534,6 +1546,11 @@ def cmd_batch(args: argparse.Namespace) -> int:
             term = signal.signal(signal.SIGTERM, raise_terminated)
     from stereovision.io import check_output_folder
 
+    if args.calib_unit is not None or (args.calib is not None and Path(args.calib).exists()):
+        from stereovision.cli import load_calibration
+
+        # refused in the CLI's words (--calib-unit), before a cluster starts
+        load_calibration(args.calib, args.calib_unit)
     check_output_folder(args.output, "-o")
     try:
         res = run_batch(
@@ -1545,6 +1562,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
             max_disparity=args.max_disparity,
             fill=args.fill,
             calib=args.calib,
+            calib_unit=args.calib_unit,
             retry_failed=args.retry_failed,
             ground=args.ground,
             grid=args.grid,
@@ -1595,7 +1613,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision batch`` on the CLI's sub-parsers."""
-    from stereovision.cli import positive_pixels  # cli builds its parser with this
+    from stereovision.cli import add_calib_unit, positive_pixels  # cli builds its parser
     from stereovision.depth import METHODS
 
     p = subparsers.add_parser(
@@ -1633,6 +1651,7 @@ def add_cli(subparsers: Any) -> None:
         help="calibration for every pair, a file or a ROS camera_info folder (default: each "
         "scene's calib.txt or Q.dat)",
     )
+    add_calib_unit(p)
     p.add_argument(
         "--fill", action="store_const", const=True, help="fill holes (default: the method's)"
     )

@@ -1323,14 +1323,7 @@ class Calibration:
         cls, path: PathLike, image_size: tuple[int, int] | None, unit: str | None
     ) -> Calibration:
         p = Path(path)
-        # a folder's own calibration (ROS pair, calib.txt, Q.dat) comes first: one that also
-        # holds stereo_calib's two files loaded before they were read, and still does
-        folder_calib = p.is_dir() and (
-            _ros_pair_from_folder(p) is not None
-            or (p / "calib.txt").is_file()
-            or (p / "Q.dat").is_file()
-        )
-        opencv_pair = None if folder_calib else _opencv_stereo_calib_pair(p)
+        opencv_pair = _stereo_calib_files(p)
         if opencv_pair is not None:
             if image_size is None or unit is None:
                 missing = " and ".join(
@@ -2412,6 +2405,24 @@ def _opencv_stereo_calib_pair(path: Path) -> tuple[Path, Path] | None:
     if not other.is_file():
         return None
     return (path, other) if stem == "intrinsics" else (other, path)
+
+
+def _stereo_calib_files(path: Path) -> tuple[Path, Path] | None:
+    """:func:`_opencv_stereo_calib_pair` as :meth:`Calibration.from_file` reads ``path``: a
+    folder's own calibration (ROS pair, calib.txt, Q.dat) comes first (one that also holds
+    stereo_calib's two files loaded before that format was read, and still does)."""
+    folder_calib = path.is_dir() and (
+        _ros_pair_from_folder(path) is not None
+        or (path / "calib.txt").is_file()
+        or (path / "Q.dat").is_file()
+    )
+    return None if folder_calib else _opencv_stereo_calib_pair(path)
+
+
+def _sizeless(path: PathLike) -> bool:
+    """Whether :meth:`Calibration.from_file` needs an ``image_size`` for ``path``: a ``Q.dat``
+    with no ``left.png`` beside it, or OpenCV ``stereo_calib`` output (neither holds one)."""
+    return _unsized_q(path) or _stereo_calib_files(Path(path)) is not None
 
 
 def _ros_pair_from_folder(folder: Path) -> tuple[Path, Path] | None:

@@ -163,15 +163,81 @@ def write_overview(result: Any, out_dir: Path, name: str) -> dict[str, Path]:
 # ----------------------------------------------------------------------------- commands
 
 
-def _load_calibration(path: str | None, pair: np.ndarray | None = None) -> Any:
-    """``--calib``'s calibration; a ``Q.dat`` with no ``left.png`` beside it is sized by
-    ``pair`` (the run's left image), the images it is given with."""
-    if path is None:
-        return None
-    from stereovision.calibration import Calibration, _unsized_q
+#: ``--calib-unit``'s help, the same on every command that loads a calibration.
+CALIB_UNIT_HELP = (
+    "length unit of the calibration's T (baseline) when the file does not state it: OpenCV "
+    "stereo_calib's intrinsics.yml + extrinsics.yml (the unit of the board's square size; "
+    "needed) or a Q.dat (default m). A file that states its unit (YAML/JSON, calib.txt, KITTI, "
+    "ROS, Kalibr) is refused when it disagrees"
+)
 
-    size = None if pair is None or not _unsized_q(path) else (pair.shape[1], pair.shape[0])
-    return Calibration.from_file(path, image_size=size)
+
+def add_calib_unit(parser: argparse.ArgumentParser) -> None:
+    """Add ``--calib-unit`` (the unit of a ``--calib`` file that does not state it) to a
+    command that loads a calibration; :func:`load_calibration` reads it."""
+    from stereovision.calibration import UNIT_TO_METRES
+
+    parser.add_argument("--calib-unit", choices=list(UNIT_TO_METRES), help=CALIB_UNIT_HELP)
+
+
+def load_calibration(
+    path: str | os.PathLike[str] | None,
+    unit: str | None = None,
+    pair: np.ndarray | None = None,
+    size: tuple[int, int] | None = None,
+    size_words: str | None = None,
+) -> Any:
+    """A command's calibration, its refusals in the CLI's words.
+
+    Parameters
+    ----------
+    path : str or os.PathLike or None
+        The calibration (``--calib``); None gives None.
+    unit : str, optional
+        ``--calib-unit``: the unit of a file that does not state its own (OpenCV
+        ``stereo_calib`` output, ``Q.dat``); checked against a file that does.
+    pair : numpy.ndarray, optional
+        The run's left image: it sizes a calibration that holds no image size (a ``Q.dat``
+        with no ``left.png`` beside it, ``stereo_calib`` output), the images it is given with.
+    size : tuple of int, optional
+        ``(width, height)`` the user gave (``info --size``): passed on as ``image_size``.
+    size_words : str, optional
+        How the command's user gives an image size, for the refusal of a calibration that
+        holds none when there is no ``pair`` (default: the Python call that converts it).
+
+    Returns
+    -------
+    Calibration or None
+        The calibration.
+
+    Raises
+    ------
+    ValueError
+        As :meth:`~stereovision.calibration.Calibration.from_file`, said with
+        ``--calib-unit`` for ``unit``; ``unit`` without ``path``.
+    """
+    if path is None:
+        if unit is not None:
+            raise ValueError("--calib-unit is the unit of --calib's file: give --calib too")
+        return None
+    from stereovision.calibration import Calibration, _sizeless
+
+    if size is None and pair is not None and _sizeless(path):
+        size = (pair.shape[1], pair.shape[0])
+    try:
+        return Calibration.from_file(path, image_size=size, unit=unit)
+    except ValueError as exc:
+        text = str(exc)
+        text = text.replace("unit='m'/'mm'/...", "--calib-unit (m, mm, cm, ft or in)")
+        text = re.sub(r"the unit '(\w+)' given", r"--calib-unit \1", text)
+        text = text.replace("leave unit out", "leave --calib-unit out")
+        how = size_words or (
+            "the image size: this command cannot read it from its images, so save the rig once "
+            "in Python with Calibration.from_file(path, image_size=(width, height), "
+            "unit=...).save('rig.yaml') and give rig.yaml"
+        )
+        text = text.replace("image_size=(width, height)", how)
+        raise ValueError(text) from None
 
 
 def _check_pair(left: np.ndarray, right: np.ndarray, calib: Any, max_disparity: Any) -> None:
@@ -480,7 +546,7 @@ def cmd_depth(args: argparse.Namespace) -> int:
             "(two views of the scene are needed)",
             stacklevel=1,
         )
-    calib = _load_calibration(args.calib, left)
+    calib = load_calibration(args.calib, args.calib_unit, left)
     max_disparity = args.max_disparity
     if args.rectification:
         from stereovision.uncalibrated import UncalibratedRectification
@@ -599,7 +665,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     )
     if same:
         warnings.warn(same, stacklevel=1)
-    calib = _load_calibration(args.calib, left)
+    calib = load_calibration(args.calib, args.calib_unit, left)
     fix = Path(args.fix) if args.fix else None
     if fix is not None:
         if calib is None:
@@ -709,7 +775,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     )
     if same:
         warnings.warn(same, stacklevel=1)
-    calib = _load_calibration(args.calib, left)
+    calib = load_calibration(args.calib, args.calib_unit, left)
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise CliError(f"-o {args.output}: is a file; give a folder")
@@ -835,6 +901,8 @@ def cmd_info(args: argparse.Namespace) -> int:
 
     design = (args.size, args.hfov, args.baseline)
     if args.calib is None:
+        if args.calib_unit is not None:
+            raise CliError("--calib-unit is the unit of a calibration file: give one, or none")
         if None in design:
             raise CliError(
                 "give a calibration (or a bag), or a rig on paper: --size, --hfov and --baseline"
@@ -856,14 +924,23 @@ def cmd_info(args: argparse.Namespace) -> int:
         print("a rig on paper (two ideal cameras, rectified):")
         print(rig.describe())
         return 0
-    if design != (None, None, None):
-        raise CliError("--size, --hfov and --baseline describe a rig on paper: give no calibration")
+    if (args.hfov, args.baseline) != (None, None):
+        raise CliError("--hfov and --baseline describe a rig on paper: give no calibration")
     topics = (args.left_topic, args.right_topic)
     if not is_bag(args.calib):
         if topics != (None, None):
             raise CliError("--left-topic and --right-topic are for a bag")
-        print(_load_calibration(args.calib).describe())
+        from stereovision.capture import parse_size
+
+        # --size with a calibration: the image size of one that holds none (stereo_calib
+        # output, a Q.dat alone), a check of the size of one that does
+        calib = load_calibration(
+            args.calib, args.calib_unit, size=parse_size(args.size), size_words="--size WxH"
+        )
+        print(calib.describe())
         return 0
+    if args.size is not None or args.calib_unit is not None:
+        raise CliError("--size and --calib-unit are for a calibration file, not a bag")
     from stereovision.rosbag import BagCamera
 
     with BagCamera(args.calib, left_topic=topics[0], right_topic=topics[1]) as cam:
@@ -1314,9 +1391,11 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("right", help="right image, the same size")
     d.add_argument(
         "--calib",
-        help="YAML/JSON calibration, Middlebury calib.txt, KITTI calib, Kalibr camchain, or a "
-        "ROS camera_info folder (left.yaml, right.yaml)",
+        help="YAML/JSON calibration, Middlebury calib.txt, KITTI calib, Kalibr camchain, a "
+        "ROS camera_info folder (left.yaml, right.yaml), OpenCV stereo_calib output "
+        "(intrinsics.yml + extrinsics.yml, with --calib-unit) or a Q.dat",
     )
+    add_calib_unit(d)
     d.add_argument(
         "--max-disparity",
         type=positive_pixels,
@@ -1385,6 +1464,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("left", help="left image: raw with --calib, else rectified")
     d.add_argument("right", help="right image, the same size")
     d.add_argument("--calib", help="the rig's calibration (omit for a rectified pair)")
+    add_calib_unit(d)
     d.add_argument("--tolerance", type=float, default=0.5, help="median |dy| in px (default 0.5)")
     d.add_argument("--json", action="store_true", help="one JSON object instead of a line")
     d.add_argument("--plot", metavar="PNG", help="draw the rectified pair and its matches")
@@ -1407,6 +1487,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("left", help="left camera's raw image")
     d.add_argument("right", help="right camera's raw image, the same size")
     d.add_argument("--calib", help="the rig's calibration (default: none, from the features)")
+    add_calib_unit(d)
     d.add_argument(
         "--model",
         default="auto",
@@ -1433,7 +1514,13 @@ def build_parser() -> argparse.ArgumentParser:
         nargs="?",
         help="calibration file, ROS camera_info folder, or a ROS 1 / ROS 2 bag",
     )
-    d.add_argument("--size", metavar="WxH", help="a rig on paper: image size, e.g. 1280x720")
+    d.add_argument(
+        "--size",
+        metavar="WxH",
+        help="a rig on paper: image size, e.g. 1280x720; with a calibration that holds none "
+        "(stereo_calib output, a Q.dat alone), its image size",
+    )
+    add_calib_unit(d)
     d.add_argument("--hfov", type=float, metavar="DEG", help="a rig on paper: horizontal FOV")
     d.add_argument("--baseline", type=float, metavar="M", help="a rig on paper: baseline (m)")
     d.add_argument("--left-topic", help="a bag: its left image topic (default: found)")

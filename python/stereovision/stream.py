@@ -971,7 +971,9 @@ def cmd_stream(args: argparse.Namespace) -> int:
         summary is still written); 2 (the CLI's error status) when a pair failed, after the
         summary.
     """
-    calib = Calibration.from_file(args.calib) if args.calib else None
+    from stereovision.cli import load_calibration
+
+    calib = load_calibration(args.calib or None, args.calib_unit)
     out = sys.stdout
     log = sys.stderr
     server: FrameServer | None = None
@@ -1124,7 +1126,13 @@ def cmd_stream(args: argparse.Namespace) -> int:
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision stream`` on the CLI's sub-parsers."""
     # cli builds its parser with these
-    from stereovision.cli import port_number, positive_count, positive_pixels, positive_rate
+    from stereovision.cli import (
+        add_calib_unit,
+        port_number,
+        positive_count,
+        positive_pixels,
+        positive_rate,
+    )
     from stereovision.depth import METHODS
 
     p = subparsers.add_parser(
@@ -1139,6 +1147,7 @@ def add_cli(subparsers: Any) -> None:
         help="calibration of the rig (YAML/JSON, Middlebury, KITTI, Kalibr, ROS folder); "
         "--from-bag: default the bag's camera_info",
     )
+    add_calib_unit(p)
     p.add_argument(
         "--realtime",
         action="store_true",

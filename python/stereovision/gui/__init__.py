@@ -61,9 +61,9 @@ def build_app(args: argparse.Namespace) -> Any:
     folders = AllowedFolders([bundled_data_dir(), *(args.data or [])])
     calib = None
     if args.calib is not None:
-        from stereovision.calibration import Calibration
+        from stereovision.cli import load_calibration
 
-        calib = Calibration.from_file(args.calib)
+        calib = load_calibration(args.calib, args.calib_unit)
     source = None
     label = None
     names = (str(args.left or ""), str(args.right or ""))
@@ -225,6 +225,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--calib",
         help="calibration of the camera pair (YAML/JSON, calib.txt, KITTI, Kalibr, ROS folder)",
     )
+    from stereovision.cli import add_calib_unit
+
+    add_calib_unit(p)
     p.add_argument(
         "--data",
         action="append",
