@@ -1083,3 +1083,26 @@ def test_every_command_that_loads_a_calibration_takes_calib_unit(
     with pytest.raises(SystemExit):
         main([command, "--help"])
     assert "--calib-unit {m,mm,cm,ft,in}" in capsys.readouterr().out
+
+
+def test_kitti_object_calibration_is_sized_by_the_pair(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A KITTI object/odometry calib file (P0..P3, no S_rect_02) with no image beside it was
+    refused by depth/check/rectify with "pass image_size=(width, height)", a Python argument,
+    though the pair given is the images it belongs to (as a Q.dat alone is sized by it)."""
+    scene = data_dir / "kitti2015" / "000005_10"
+    raw = (scene / "calib_kitti.txt").read_text()
+    p2, p3 = (" ".join(m.split()) for m in re.findall(r"P_rect_0[23]:([^A-Z]*)", raw))
+    calib = tmp_path / "000005.txt"
+    calib.write_text(f"P2: {p2}\nP3: {p3}\n")
+    left, right = str(scene / "left.png"), str(scene / "right.png")
+    assert main(["check", left, right, "--calib", str(calib), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["ok"] is True
+    assert main(["info", str(calib)]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: image_size: KITTI calibration {calib} has no S_rect_02 and no "
+        "image next to it; pass --size WxH\n"
+    )
+    assert main(["info", str(calib), "--size", "1242x375"]) == 0
+    assert capsys.readouterr().out.startswith("1242x375 px, rectified pair: baseline 53.3 cm")

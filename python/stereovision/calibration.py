@@ -2419,10 +2419,30 @@ def _stereo_calib_files(path: Path) -> tuple[Path, Path] | None:
     return None if folder_calib else _opencv_stereo_calib_pair(path)
 
 
+def _unsized_kitti(path: Path) -> bool:
+    """Whether :meth:`Calibration.from_file` reads ``path`` as a KITTI calibration without
+    ``S_rect_02`` (the object/odometry ``calib`` files) and no image beside it to size it."""
+    try:
+        if not path.is_file() or path.stat().st_size > 65536:
+            return False
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return False
+    if text.lstrip().startswith(("%YAML", "<?xml", "<opencv", "{")) or re.search(
+        r"^\s*cam0\s*=", text, re.MULTILINE
+    ):
+        return False  # read as another format before KITTI's (as _read_any orders them)
+    if not re.search(r"^\s*(P_rect_02|P2)\s*:", text, re.MULTILINE) or "S_rect_02" in text:
+        return False
+    return not any((path.parent / n).is_file() for n in ("left.png", "image_2.png"))
+
+
 def _sizeless(path: PathLike) -> bool:
     """Whether :meth:`Calibration.from_file` needs an ``image_size`` for ``path``: a ``Q.dat``
-    with no ``left.png`` beside it, or OpenCV ``stereo_calib`` output (neither holds one)."""
-    return _unsized_q(path) or _stereo_calib_files(Path(path)) is not None
+    with no ``left.png`` beside it, OpenCV ``stereo_calib`` output, or a KITTI calibration
+    without ``S_rect_02`` and no image beside it (none of them holds one)."""
+    p = Path(path)
+    return _unsized_q(p) or _stereo_calib_files(p) is not None or _unsized_kitti(p)
 
 
 def _ros_pair_from_folder(folder: Path) -> tuple[Path, Path] | None:
