@@ -1056,7 +1056,7 @@ def test_calib_unit_reads_opencv_stereo_calib_output(
     assert cv2.imread(str(out / "left_rect.png")).shape == (480, 640, 3)
 
 
-def test_calib_unit_refuses_a_file_of_another_unit_and_no_file(
+def test_calib_unit_and_size_refuse_what_the_file_states_and_need_a_file(
     data_dir: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     calib_txt = data_dir / "eth3d" / "playground" / "calib.txt"
@@ -1068,6 +1068,14 @@ def test_calib_unit_refuses_a_file_of_another_unit_and_no_file(
     )
     assert main(["info", str(calib_txt), "--calib-unit", "mm"]) == 0
     assert "baseline 6.0 cm (59.5549 mm)" in capsys.readouterr().out
+    # --size for a calibration that states its size: a check, said in the CLI's words (it
+    # read "not of the image_size (1280, 720) given: leave image_size out, or resize the
+    # calibration with .scaled_to((1280, 720))")
+    assert main(["info", str(calib_txt), "--size", "1280x720"]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: {calib_txt} is a calibration of 941x490 images, not of --size "
+        "1280x720: leave --size out (it sizes a calibration that holds no size)\n"
+    )
     scene = calib_txt.parent
     left, right = str(scene / "left.png"), str(scene / "right.png")
     assert main(["check", left, right, "--calib-unit", "mm"]) == 2

@@ -237,6 +237,12 @@ def load_calibration(
             "unit=...).save('rig.yaml') and give rig.yaml"
         )
         text = text.replace("image_size=(width, height)", how)
+        if size is not None:  # info --size for a calibration that states another size
+            text = re.sub(
+                r"the image_size \((\d+), (\d+)\) given: leave image_size out, .*",
+                r"--size \1x\2: leave --size out (it sizes a calibration that holds no size)",
+                text,
+            )
         raise ValueError(text) from None
 
 
