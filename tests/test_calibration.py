@@ -922,3 +922,21 @@ def test_from_file_refuses_an_image_size_the_file_contradicts(data_dir: Path) ->
         "given: leave image_size out, or resize the calibration with .scaled_to((1280, 720)) if "
         "the images were resized"
     )
+
+
+def test_a_saved_file_with_a_bad_value_is_named(tmp_path: Path) -> None:
+    """A value the class refuses in a saved (or hand-edited) YAML/JSON file was said without
+    the file: "unit: expected one of [...], got 'meters'"."""
+    import json
+
+    path = Calibration.ideal((640, 480), 60.0, 0.1).save(tmp_path / "rig.json")
+    record = json.loads(path.read_text())
+    path.write_text(json.dumps({**record, "unit": "meters"}))
+    with pytest.raises(ValueError, match=r"^calibration file \S+rig\.json: unit: expected one of "):
+        Calibration.from_file(path)
+    yaml = Calibration.ideal((640, 480), 60.0, 0.1).save(tmp_path / "rig.yaml")
+    yaml.write_text(yaml.read_text().replace("image_width: 640", "image_width: 0"))
+    with pytest.raises(
+        ValueError, match=r"^calibration file \S+rig\.yaml: image_size: expected positive integers"
+    ):
+        Calibration.from_file(yaml)

@@ -1146,19 +1146,27 @@ class Calibration:
         ):
             raise ValueError(f"calibration file {source}: doffs must be a number, got {doffs!r}")
         model = get("model")
-        return cls(
-            K1=need("K1", "M1"),
-            D1=need("D1"),
-            K2=need("K2", "M2"),
-            D2=need("D2"),
-            R=need("R"),
-            T=need("T"),
-            image_size=(width, height),
-            unit=str(need("unit")),
-            rectified=bool(rectified),
-            doffs=None if doffs is None else float(doffs),
-            model="pinhole" if model is None else str(model),
-        )
+        fields = {
+            "K1": need("K1", "M1"),
+            "D1": need("D1"),
+            "K2": need("K2", "M2"),
+            "D2": need("D2"),
+            "R": need("R"),
+            "T": need("T"),
+            "unit": str(need("unit")),
+        }
+        try:
+            return cls(
+                **fields,
+                image_size=(width, height),
+                rectified=bool(rectified),
+                doffs=None if doffs is None else float(doffs),
+                model="pinhole" if model is None else str(model),
+            )
+        except ValueError as exc:
+            # a value refused by the class ("unit: expected one of [...], got 'meters'") named
+            # no file: a hand-edited one among several said nothing of which
+            raise ValueError(f"calibration file {source}: {exc}") from None
 
     @classmethod
     def _from_filestorage_text(cls, text: str, source: str) -> Calibration:
