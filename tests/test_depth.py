@@ -632,3 +632,66 @@ def test_auto_max_disparity_of_a_10_bit_pair_in_16_bits(data_dir: Path, scene: s
     assert expected in (112, 128)
     got = sv.estimate_max_disparity(left.astype(np.uint16) * 4, right.astype(np.uint16) * 4)
     assert got == expected
+
+
+def _known_depth_result(calib: Calibration | None) -> sv.DepthResult:
+    """A result with hand-set depths (1 m, 2 m, none, 0.3048 m) and two points."""
+    depth = np.array([[1.0, 2.0], [np.nan, 0.3048]], np.float32)
+    return sv.DepthResult(
+        disparity=np.ones((2, 2), np.float32),
+        confidence=np.ones((2, 2), np.float32),
+        depth=depth if calib is not None else None,
+        points=np.array([[0.5, -1.0, 1.0], [0.0, 0.0, 0.3048]], np.float32),
+        colors=np.zeros((2, 3), np.uint8),
+        pixels=np.array([[0, 0], [1, 1]], np.int32),
+        method="fused",
+        max_disparity=16,
+        calibration=calib,
+        depth_sigma=depth / 10 if calib is not None else None,
+    )
+
+
+def test_depth_and_points_in_feet_and_other_units_against_hand_values() -> None:
+    """1 m = 3.28084 ft = 1000 mm = 100 cm = 39.3701 in; the result itself stays in metres."""
+    res = _known_depth_result(_rect_calib(2, 2))
+    ft = res.depth_in("ft")
+    np.testing.assert_allclose(ft, [[3.28084, 6.56168], [np.nan, 1.0]], rtol=1e-6)
+    assert ft.dtype == np.float32 and ft is not res.depth
+    np.testing.assert_allclose(res.depth_sigma_in("ft"), ft / 10, rtol=1e-6)
+    np.testing.assert_allclose(
+        res.points_in("ft"), [[1.64042, -3.28084, 3.28084], [0.0, 0.0, 1.0]], rtol=1e-6
+    )
+    np.testing.assert_allclose(res.depth_in("mm")[0], [1000.0, 2000.0], rtol=1e-6)
+    np.testing.assert_allclose(res.depth_in("cm")[0], [100.0, 200.0], rtol=1e-6)
+    np.testing.assert_allclose(res.depth_in("in")[0], [39.3701, 78.7402], rtol=1e-6)
+    m = res.depth_in()  # metres: a copy, equal
+    np.testing.assert_array_equal(m, res.depth)
+    m[0, 0] = 5.0
+    assert res.depth[0, 0] == 1.0 and res.points[0, 2] == 1.0  # the result is untouched
+
+
+def test_depth_in_agrees_with_triangulations_unit() -> None:
+    """One unit table: depth_map's depth in feet is depth_from_disparity(unit="ft")'s."""
+    h, w = 64, 96
+    left = _texture(h, w, seed=2)
+    calib = _rect_calib(w, h)
+    res = sv.depth_map(left, _shift(left, 5.0), calib, max_disparity=16)
+    z = sv.triangulation.depth_from_disparity(res.disparity, calib, unit="ft")
+    known = np.isfinite(res.require_depth())
+    np.testing.assert_allclose(res.depth_in("ft")[known], z[known], rtol=1e-5)
+
+
+def test_depth_in_an_unknown_unit_or_without_depth_is_named() -> None:
+    res = _known_depth_result(_rect_calib(2, 2))
+    for method in (res.depth_in, res.depth_sigma_in, res.points_in):
+        with pytest.raises(ValueError, match=r"^unit: expected one of \['m', 'mm', 'cm', 'ft', "
+                           r"'in'\], got 'feet'$"):  # fmt: skip
+            method("feet")
+        with pytest.raises(ValueError, match=r"^unit: expected one of"):
+            method(None)  # type: ignore[arg-type]
+    bare = _known_depth_result(None)
+    for method, what in ((bare.depth_in, "depth"), (bare.depth_sigma_in, "depth uncertainty"),
+                         (bare.points_in, "depth")):  # fmt: skip
+        with pytest.raises(ValueError) as err:
+            method("ft")
+        assert str(err.value).startswith(f"no {what}: depth_map was called without a calibration")

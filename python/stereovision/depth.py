@@ -337,6 +337,18 @@ class DepthChannels(TypedDict, total=False):
     sgm: npt.NDArray[np.float32]
 
 
+def _in_unit(metres: npt.NDArray[np.float32], unit: str) -> npt.NDArray[np.float32]:
+    """A float32 copy of ``metres`` in ``unit`` (a key of ``UNIT_TO_METRES``, as
+    :func:`~stereovision.triangulation.triangulate` takes)."""
+    from stereovision.calibration import UNIT_TO_METRES
+
+    if not isinstance(unit, str) or unit not in UNIT_TO_METRES:
+        raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+    if unit == "m":
+        return np.array(metres, dtype=np.float32)
+    return (np.asarray(metres, np.float64) / UNIT_TO_METRES[unit]).astype(np.float32)
+
+
 @dataclass(eq=False)  # array fields: == by identity (it raised on the arrays' truth value)
 class DepthResult:
     """Output of :func:`depth_map`.
@@ -484,6 +496,71 @@ class DepthResult:
         if self.depth_sigma is None:
             raise ValueError(_NO_DEPTH.format(what="depth uncertainty"))
         return self.depth_sigma
+
+    def depth_in(self, unit: str = "m") -> npt.NDArray[np.float32]:
+        """``depth`` in ``unit``: a converted copy (the result itself stays in metres).
+
+        Parameters
+        ----------
+        unit : str
+            ``"m"`` (default), ``"ft"``, ``"mm"``, ``"cm"`` or ``"in"``: the units
+            :func:`~stereovision.triangulation.triangulate` takes
+            (:data:`~stereovision.calibration.UNIT_TO_METRES`).
+
+        Returns
+        -------
+        ndarray
+            float32 ``(H, W)`` depth in ``unit``, NaN where none (1 m = 3.28084 ft).
+
+        Raises
+        ------
+        ValueError
+            An unknown unit (the message names the allowed ones), or a result without depth
+            (no calibration; :meth:`require_depth`'s message).
+        """
+        return _in_unit(self.require_depth(), unit)
+
+    def depth_sigma_in(self, unit: str = "m") -> npt.NDArray[np.float32]:
+        """``depth_sigma`` in ``unit``, as :meth:`depth_in` gives ``depth``.
+
+        Parameters
+        ----------
+        unit : str
+            One of :data:`~stereovision.calibration.UNIT_TO_METRES` (default ``"m"``).
+
+        Returns
+        -------
+        ndarray
+            float32 ``(H, W)`` one-sigma depth uncertainty in ``unit``, NaN where none.
+
+        Raises
+        ------
+        ValueError
+            An unknown unit, or a result without depth (no calibration).
+        """
+        return _in_unit(self.require_depth_sigma(), unit)
+
+    def points_in(self, unit: str = "m") -> npt.NDArray[np.float32]:
+        """``points`` in ``unit``, as :meth:`depth_in` gives ``depth``.
+
+        Parameters
+        ----------
+        unit : str
+            One of :data:`~stereovision.calibration.UNIT_TO_METRES` (default ``"m"``).
+
+        Returns
+        -------
+        ndarray
+            float32 ``(N, 3)`` points in ``unit``, in the left rectified camera's frame (empty
+            for a ``depth_map(cloud=False)`` result, as ``points`` is).
+
+        Raises
+        ------
+        ValueError
+            An unknown unit, or a result without depth (no calibration).
+        """
+        self.require_depth()  # no calibration: said as require_depth says it
+        return _in_unit(self.points, unit)
 
     def point_image(self, *, filled: bool = False) -> npt.NDArray[np.float32]:
         """``(H, W, 3)`` float32 points in metres, NaN where the pixel has none.
