@@ -110,3 +110,127 @@ def test_overview_is_an_output_of_depth_and_demo(
     assert main([*argv[:-1], str(mine)]) == 2
     assert "overview.png is not listed as an earlier run's output" in capsys.readouterr().err
     assert (mine / "overview.png").read_bytes() == b"my picture"
+
+
+FT_PER_M = 3.28084  # 1 m in feet (1 ft = 0.3048 m)
+
+
+def test_depth_unit_ft_labels_the_bar_and_the_summary_and_leaves_the_files(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``depth --unit ft``: overview.png's depth bar and the printed depths in feet, read back
+    against depth.npy x 3.28084 (and the floor's lines against ground.json and scan.json);
+    every other file byte for byte the metres run's, the overview's
+    pictures too (only the bar's labels and the caption change)."""
+    scene = data_dir / "eth3d" / "terrace"
+    argv = ["depth", str(scene / "left.png"), str(scene / "right.png"), "--calib"]
+    argv += [str(scene / "calib.txt"), "--method", "fast", "--max-disparity", "32", "--ground"]
+    outs = {}
+    for unit in ("m", "ft"):
+        outs[unit] = tmp_path / unit
+        extra = [] if unit == "m" else ["--unit", "ft"]
+        capsys.readouterr()
+        assert main([*argv, *extra, "-o", str(outs[unit])]) == 0
+        lines = capsys.readouterr().out.splitlines()
+        summary = next(line for line in lines if line.startswith("fast: "))
+        # the floor's height and the nearest obstacle of the scan in the unit too
+        scale = FT_PER_M if unit == "ft" else 1.0
+        height = json.loads((outs[unit] / "ground.json").read_text())["height_m"] * scale
+        assert lines[0].startswith(f"ground plane: camera {height:.3f} {unit} above it, pitch")
+        ranges = json.loads((outs[unit] / "scan.json").read_text())["ranges"]
+        nearest = min(r for r in ranges if isinstance(r, float)) * scale  # not None, "inf"
+        scan = next(line for line in lines if line.startswith("scan: "))
+        assert f", the nearest {nearest:.2f} {unit} away at " in scan
+        depth = np.load(outs[unit] / "depth.npy")
+        z = depth[np.isfinite(depth)] * scale
+        lo, hi, mid = z.min(), z.max(), np.median(z)
+        assert f", depth {lo:.3g}-{hi:.3g} {unit} (median {mid:.3g} {unit}), " in summary
+    files = sorted(p.name for p in outs["m"].iterdir())
+    assert files == sorted(p.name for p in outs["ft"].iterdir()) and "depth.npy" in files
+    for name in files:
+        if name != "overview.png":
+            assert (outs["m"] / name).read_bytes() == (outs["ft"] / name).read_bytes(), name
+    img_m = cv2.imread(str(outs["m"] / "overview.png"))
+    img = cv2.imread(str(outs["ft"] / "overview.png"))
+    depth = np.load(outs["ft"] / "depth.npy")
+    res = _result_of(outs["ft"], depth)
+    ov = overview_image(res, overview_title("terrace/left.png", res), "ft")
+    # the file's depth cell (caption, map, bar and labels) is this one's
+    px, py, _, ph = ov.panels["depth"]
+    cell = np.s_[py - 22 : py + ph, px : ov.bars["depth"].box[0] + 16 + 64]
+    np.testing.assert_array_equal(img[cell], ov.image[cell])
+    assert not np.array_equal(img[cell], img_m[cell])  # the labels are not the metres run's
+    for x, y, w, h in ov.panels.values():  # the same pictures, the same colours
+        np.testing.assert_array_equal(img[y : y + h, x : x + w], img_m[y : y + h, x : x + w])
+    # the bar's labels are feet: each tick's colour is the one depth.png gives that many feet
+    inv = 1.0 / (depth[np.isfinite(depth)] * FT_PER_M)
+    lo, hi = float(np.percentile(inv, 1)), float(np.percentile(inv, 99))
+    bar = ov.bars["depth"]
+    assert len(bar.ticks) >= 3, bar.ticks
+    x = bar.box[0] + bar.box[2] // 2
+    depth_png = cv2.imread(str(outs["ft"] / "depth.png"))
+    feet = depth * FT_PER_M
+    for value, label, y in bar.ticks:
+        assert float(label) == pytest.approx(value, rel=1e-3)
+        want = (1 / value - lo) * 255.0 / (hi - lo)
+        assert abs(_level(img[y, x]) - want) <= 1.5, (label, want)
+        same = np.all(depth_png == _TURBO[_level(img[y, x])], axis=2) & np.isfinite(depth)
+        assert same.sum() > 20, label
+        step = (hi - lo) / 255.0
+        z = float(np.median(feet[same]))
+        assert 1 / (1 / value + 2 * step) <= z <= 1 / (1 / value - 2 * step), (label, z)
+    # in metres the labels were metres: the same tick colours would read 3.28 x smaller
+    assert "depth (ft)" not in ov.title
+    metres_ticks = overview_image(res, "t").bars["depth"].ticks
+    assert [t[1] for t in metres_ticks] != [t[1] for t in bar.ticks]
+
+
+def _result_of(out: Path, depth: np.ndarray) -> object:
+    """The run's DepthResult as its files hold it (disparity.pfm, depth.npy), for
+    overview_image: the same maps the CLI drew."""
+    import stereovision as sv
+
+    disp = read_pfm(out / "disparity.pfm")
+    return sv.DepthResult(
+        disparity=disp,
+        confidence=np.zeros_like(disp),
+        depth=depth,
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+        method="fast",
+        max_disparity=32,
+    )
+
+
+def test_depth_unit_unknown_is_one_line_and_exit_2(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    scene = data_dir / "eth3d" / "terrace"
+    argv = ["depth", str(scene / "left.png"), str(scene / "right.png"), "--unit", "feet"]
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as stop:
+        main([*argv, "-o", str(tmp_path / "o")])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    choices = "'m', 'mm', 'cm', 'ft', 'in'"
+    assert f"argument --unit: invalid choice: 'feet' (choose from {choices})" in err
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(ValueError, match=r"^unit: expected one of \['m', 'mm', 'cm', 'ft', 'in'\]"):
+        overview_image(_result_without_depth(), "t", "feet")
+
+
+def _result_without_depth() -> object:
+    import stereovision as sv
+
+    return sv.DepthResult(
+        disparity=np.ones((4, 4), np.float32),
+        confidence=np.ones((4, 4), np.float32),
+        depth=None,
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+        method="fast",
+        max_disparity=16,
+    )

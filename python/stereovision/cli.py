@@ -141,11 +141,11 @@ def write_depth_outputs(
     return written
 
 
-def write_overview(result: Any, out_dir: Path, name: str) -> dict[str, Path]:
+def write_overview(result: Any, out_dir: Path, name: str, unit: str = "m") -> dict[str, Path]:
     """Write ``overview.png`` into ``out_dir``: the left image, the disparity, the depth (with
     a calibration) and the confidence, downscaled side by side, each map with a labelled colour
-    bar (:func:`stereovision.overview.overview_image`), under a title naming the pair
-    (``name``), the method, the range searched and the density.
+    bar (:func:`stereovision.overview.overview_image`; the depth bar labelled in ``unit``),
+    under a title naming the pair (``name``), the method, the range searched and the density.
 
     Returns
     -------
@@ -154,7 +154,7 @@ def write_overview(result: Any, out_dir: Path, name: str) -> dict[str, Path]:
     """
     from stereovision.overview import overview_image, overview_title
 
-    picture = overview_image(result, overview_title(name, result))
+    picture = overview_image(result, overview_title(name, result), unit)
     path = out_dir / "overview.png"
     _atomic_write_bytes(path, _png_bytes(picture.image))
     return {"overview.png": path}
@@ -284,6 +284,7 @@ def depth_outputs(
     log: Any = None,
     counts: dict[str, int] | None = None,
     name: str = "pair",
+    unit: str = "m",
 ) -> tuple[Any, dict[str, Path]]:
     """What ``stereovision depth`` computes and writes for one pair (``batch`` writes the same).
 
@@ -323,6 +324,11 @@ def depth_outputs(
         (:func:`write_depth_outputs`).
     name : str
         The pair's name in ``overview.png``'s title (:func:`write_overview`).
+    unit : str
+        The unit of ``overview.png``'s depth bar and of the lengths ``log`` receives (a key of
+        :data:`stereovision.calibration.UNIT_TO_METRES`); the files' own units do not change
+        (``depth.npy`` and the cloud in metres, ``depth_mm.png`` in millimetres), nor do the
+        options' (``max_depth``, ``max_sigma``, ``voxel``, ``grid``: metres).
 
     Returns
     -------
@@ -334,6 +340,10 @@ def depth_outputs(
     from stereovision.render import render_outputs
 
     check_output_folder(out_dir, "-o")  # before the matching, not after it
+    from stereovision.calibration import UNIT_TO_METRES
+
+    if unit not in UNIT_TO_METRES:
+        raise CliError(f"--unit: expected one of {', '.join(UNIT_TO_METRES)}, got {unit!r}")
     # Every usage error that needs no work first, then a file of the user's under an output
     # name, then the work: a wrong --max-depth was reported as that file, then as itself.
     if calib is None and (max_depth is not None or max_sigma is not None):
@@ -360,9 +370,9 @@ def depth_outputs(
     record_outputs(out_dir, earlier | set(names))
     written = write_depth_outputs(res, out_dir, voxel, counts=counts)
     written.update(render_outputs(res, out_dir))
-    written.update(write_overview(res, out_dir, name))
+    written.update(write_overview(res, out_dir, name, unit))
     if ground:
-        written.update(_ground_outputs(res, calib, out_dir, grid, log))
+        written.update(_ground_outputs(res, calib, out_dir, grid, log, unit))
     return res, written
 
 
@@ -580,9 +590,10 @@ def cmd_depth(args: argparse.Namespace) -> int:
         log=print,
         counts=counts,
         name=_pair_name(args.left),
+        unit=args.unit,
     )
     cloud = (
-        f"{len(res.points)} points"
+        f"{_depth_range(res.depth, args.unit)}, {len(res.points)} points"
         if res.depth is not None
         else "disparity only (no depth or cloud without --calib)"
     )
@@ -601,8 +612,32 @@ def cmd_depth(args: argparse.Namespace) -> int:
     return 0
 
 
+def _length(metres: float, unit: str, digits: int) -> str:
+    """``metres`` said in ``unit`` (a key of ``UNIT_TO_METRES``) with ``digits`` decimals."""
+    from stereovision.calibration import UNIT_TO_METRES
+
+    return f"{metres / UNIT_TO_METRES[unit]:.{digits}f} {unit}"
+
+
+def _depth_range(depth: np.ndarray, unit: str) -> str:
+    """The summary's depth figures in ``unit``: ``depth 1.2-34.5 m (median 4.6 m)``, the
+    depths the result keeps (``depth.npy``'s finite values)."""
+    from stereovision.calibration import UNIT_TO_METRES
+
+    z = depth[np.isfinite(depth)] / UNIT_TO_METRES[unit]
+    if not z.size:
+        return "no depth"
+    lo, hi, mid = float(z.min()), float(z.max()), float(np.median(z))
+    return f"depth {lo:.3g}-{hi:.3g} {unit} (median {mid:.3g} {unit})"
+
+
 def _ground_outputs(
-    res: Any, calib: Any, out: Path, grid: float | None = None, log: Any = None
+    res: Any,
+    calib: Any,
+    out: Path,
+    grid: float | None = None,
+    log: Any = None,
+    unit: str = "m",
 ) -> dict[str, Path]:
     """``depth --ground``: the floor's plane (``ground.json``), what stands on it
     (``obstacles.png``: 255 between 0.15 and 2 m above the floor) and its planar scan
@@ -622,7 +657,11 @@ def _ground_outputs(
             log("ground plane: none found (no near-level plane holds 3 % of the pixels)")
         return {}
     if log is not None:
-        log(plane.describe())
+        text = plane.describe()
+        if unit != "m":  # the camera's height in the unit asked for (the line is in metres)
+            metres = f"camera {plane.height:.3f} m above it"
+            text = text.replace(metres, f"camera {_length(plane.height, unit, 3)} above it")
+        log(text)
         log("the camera on the floor, for ROS 2: " + plane.ros2_static_transform())
     rc = calib if calib.rectified else calib.rectified_calibration()
     points = res.point_image(filled=True)  # once, for the obstacles, the scan and the grid
@@ -645,7 +684,8 @@ def _ground_outputs(
             i = int(np.nanargmin(np.where(hits, scan.ranges, np.nan)))
             log(
                 f"scan: {int(hits.sum())} of {len(hits)} beams on an obstacle, the nearest "
-                f"{float(scan.ranges[i]):.2f} m away at {math.degrees(scan.angles[i]):+.1f} deg"
+                f"{_length(float(scan.ranges[i]), unit, 2)} away at "
+                f"{math.degrees(scan.angles[i]):+.1f} deg"
             )
         else:
             log(f"scan: no obstacle on any of the {len(hits)} beams")
@@ -1370,6 +1410,7 @@ _METHOD_HELP = (
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the ``stereovision`` command."""
+    from stereovision.calibration import UNIT_TO_METRES
     from stereovision.depth import METHODS
 
     p = _Parser(
@@ -1453,6 +1494,14 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="JSON",
         help="a raw pair of a rig rectified without a calibration: the homographies "
         "`stereovision rectify` wrote (rectification.json); disparity only",
+    )
+    d.add_argument(
+        "--unit",
+        default="m",
+        choices=tuple(UNIT_TO_METRES),
+        help="unit of the printed depths and of overview.png's depth bar: m (default), ft, mm, "
+        "cm or in; the files keep theirs (depth.npy and cloud.ply in metres, depth_mm.png in "
+        "millimetres) and --max-depth, --max-sigma, --voxel and --grid stay in metres",
     )
     d.add_argument("-o", "--output", required=True, help="output folder")
     d.set_defaults(func=cmd_depth)

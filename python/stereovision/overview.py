@@ -179,7 +179,7 @@ def _bar(
     return bar
 
 
-def overview_image(result: Any, title: str) -> Overview:
+def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     """The overview of a :class:`~stereovision.depth.DepthResult`.
 
     Parameters
@@ -188,13 +188,27 @@ def overview_image(result: Any, title: str) -> Overview:
         Its left (rectified) image, disparity, depth (None without calibration) and confidence.
     title : str
         The one-line title (ASCII; scaled down to fit).
+    unit : str
+        The depth bar's unit (its caption and tick labels): ``"m"`` (default), ``"ft"``,
+        ``"mm"``, ``"cm"`` or ``"in"`` (:data:`~stereovision.calibration.UNIT_TO_METRES`). The
+        depth panel's colours do not depend on it (they are ``depth.png``'s).
 
     Returns
     -------
     Overview
         The picture (2 x 2 panels: left, disparity; depth, confidence; without a depth map
         left, disparity; confidence) and where its panels and bars are.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``unit`` (the message names the allowed ones).
     """
+    from stereovision.calibration import UNIT_TO_METRES
+
+    if not isinstance(unit, str) or unit not in UNIT_TO_METRES:
+        raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+    size = UNIT_TO_METRES[unit]  # metres in one unit
     disparity = np.asarray(result.disparity, np.float32)
     h, w = disparity.shape[:2]
     scale = min(1.0, PANEL_WIDTH / w)
@@ -214,7 +228,11 @@ def overview_image(result: Any, title: str) -> Overview:
         depth = np.asarray(result.depth, np.float32)
         with np.errstate(divide="ignore"):
             inv = np.where(np.isfinite(depth), 1.0 / depth, np.nan)
-        maps.append(("depth", inv, (None, None), "depth (m)", lambda z: 1.0 / z, "inverse"))
+        # coloured on 1 / Z in metres, as depth.png is; labelled in the unit asked for
+        caption_text = f"depth ({unit})"
+        maps.append(
+            ("depth", inv, (None, None), caption_text, lambda z: 1.0 / (z * size), "inverse")
+        )
     maps.append(("confidence", confidence, (0.0, 1.0), "confidence (0-1)", lambda v: v, "linear"))
     cell_w = pw + _BAR_GAP + _BAR_W + _LABEL_W
     cell_h = _CAPTION_H + ph
@@ -259,6 +277,7 @@ def overview_image(result: Any, title: str) -> Overview:
         lo, hi = rng
         if kind == "inverse":
             near, far = 1.0 / max(hi, 1e-12), min(1.0 / lo if lo > 0 else 1e6, 1e6)
+            near, far = near / size, far / size  # in the bar's unit
             # a range within a decade in even steps of depth (2.5, 3, 3.5 m), a wider one
             # in 1-2-5 steps of each decade (1, 2, 5, 10, 20 m)
             ticks = _linear_ticks(near, far, 6) if far < 10 * near else _nice_values(near, far)
