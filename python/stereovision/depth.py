@@ -361,6 +361,8 @@ class DepthResult:
         Matcher confidence in [0, 1]; 0 where there is no estimate.
     depth : ndarray, float32 (H, W) or None
         Depth ``Z`` along the optical axis in metres (NaN where none); None without calibration.
+        :meth:`depth_in`, :meth:`points_in` and :meth:`depth_sigma_in` give copies in feet (or
+        mm, cm, in).
         NaN also where the disparity is not above its predicted uncertainty ``sigma_d``
         (``depth_sigma``): such a depth's one-sigma interval reaches infinity (the far sky, a
         wrong lock at the range's floor).
