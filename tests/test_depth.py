@@ -461,7 +461,7 @@ def test_a_whole_result_or_a_wrong_unit_is_named(tmp_path: Path) -> None:
     res = sv.depth_map(s.left, s.right, s.calib, method="fast")
     with pytest.raises(TypeError, match=r"disparity: got a DepthResult; pass its array, result.d"):
         fit_ground_plane(res, s.calib)
-    with pytest.raises(TypeError, match=r"disp: got a DepthResult; pass its array, result.disp"):
+    with pytest.raises(TypeError, match=r"disparity: got a DepthResult; pass its array, result.d"):
         dense_metrics(res, s.gt)
     with pytest.raises(TypeError, match=r"points: got a DepthResult; pass its array, result.poi"):
         export.voxel_downsample(res, 0.05)
