@@ -633,11 +633,11 @@ def test_eval_json_lines_are_strict_json() -> None:
     """Figures with nothing to measure (no pixel with both depths) are NaN: null in JSON."""
     import json
 
-    from stereovision.cli import _json_line
+    from stereovision._jsonout import json_line
     from stereovision.evaluate import depth_metrics
 
     row = {"depth": depth_metrics(np.full((2, 2), np.nan), np.ones((2, 2))).as_dict(), "x": [1.5]}
-    back = json.loads(_json_line(row))
+    back = json.loads(json_line(row))
     assert back == {"depth": {"median_rel": None, "share_off_5": None, "rmse_pct": None,
                               "rmse": None, "n": 0, "density": 0.0}, "x": [1.5]}  # fmt: skip
 

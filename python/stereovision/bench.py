@@ -33,6 +33,8 @@ from typing import Any
 
 import numpy as np
 
+from stereovision._jsonout import json_line
+
 __all__ = ["BenchCase", "add_cli", "bench_scene", "cmd_bench", "format_table", "sparse_name"]
 
 #: evaluation.md "Speed": the median of at least this many timed runs (fewer is noise on the
@@ -299,9 +301,6 @@ def cmd_bench(args: argparse.Namespace) -> int:
     """
     from tqdm import tqdm
 
-    # eval --json's: a figure with nothing to measure (NaN: no GT pixel, no sparse match on GT)
-    # is null, so each line is strict JSON
-    from stereovision.cli import _json_line
     from stereovision.io import load_scene
 
     if args.runs < MIN_RUNS:
@@ -314,11 +313,11 @@ def cmd_bench(args: argparse.Namespace) -> int:
         all_cases.extend(cases)
         if args.json:
             for c in cases:
-                print(_json_line(c.as_dict()), flush=True)
+                print(json_line(c.as_dict()), flush=True)
     if not args.json:
         print(format_table(all_cases))
         for c in all_cases:
-            print(_json_line(c.as_dict()))
+            print(json_line(c.as_dict()))
     return 0
 
 

@@ -26,6 +26,7 @@ import cv2
 import numpy as np
 
 from stereovision._interrupt import Terminated, raise_terminated
+from stereovision._jsonout import json_line
 
 EXIT_ERROR = 2
 EXIT_CANNOT_TELL = 3  # `check`: too little texture to tell whether the rows agree
@@ -1174,22 +1175,6 @@ def _eval_scene(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> di
     return row
 
 
-def _json_ready(value: Any) -> Any:
-    """``value`` with every non-finite float (NaN, inf) as None, recursively."""
-    if isinstance(value, dict):
-        return {k: _json_ready(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_json_ready(v) for v in value]
-    if isinstance(value, (float, np.floating)):
-        return float(value) if math.isfinite(value) else None
-    return value
-
-
-def _json_line(row: dict[str, Any]) -> str:
-    """One line of strict JSON (a figure with nothing to measure, NaN, is ``null``)."""
-    return json.dumps(_json_ready(row), allow_nan=False)
-
-
 def _fmt_dense(m: dict[str, Any]) -> str:
     return f"{m['bad_2.0']:6.1f} {m['bad_1.0']:6.1f} {m['density']:6.1f}"
 
@@ -1277,7 +1262,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
             continue
         rows.append(row)
         if args.json:
-            print(_json_line({k: v for k, v in row.items() if not k.startswith("_")}))
+            print(json_line({k: v for k, v in row.items() if not k.startswith("_")}))
             continue
         if len(rows) == 1:  # the header over the first row: none over an error alone
             tqdm.write(header)

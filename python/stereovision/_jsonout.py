@@ -1,0 +1,63 @@
+"""Strict JSON output lines, shared by ``eval --json`` and ``bench --json``.
+
+A figure with nothing to measure (NaN: no ground-truth pixel, no sparse match on GT) or an
+infinite one is written as ``null``, so every line parses with a strict JSON parser. This
+module imports nothing from the package (only the standard library and numpy), so the CLI
+and the commands it registers can both use it without a circular import.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+import numpy as np
+
+__all__ = ["json_line", "json_ready"]
+
+
+def json_ready(value: Any) -> Any:
+    """``value`` with every non-finite float (NaN, inf) as None, recursively.
+
+    Parameters
+    ----------
+    value : Any
+        A dict, list, tuple, float (Python or numpy) or any other JSON-serialisable value.
+
+    Returns
+    -------
+    Any
+        The same structure, dicts and lists rebuilt (tuples as lists), each finite float as a
+        Python float and each non-finite one as None; other values as given.
+    """
+    if isinstance(value, dict):
+        return {k: json_ready(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [json_ready(v) for v in value]
+    if isinstance(value, (float, np.floating)):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def json_line(row: dict[str, Any]) -> str:
+    """One line of strict JSON (a figure with nothing to measure, NaN, is ``null``).
+
+    Parameters
+    ----------
+    row : dict of str to Any
+        The object to write.
+
+    Returns
+    -------
+    str
+        ``row`` as JSON, without a newline.
+
+    Raises
+    ------
+    ValueError
+        If a value is still not representable in strict JSON (never for floats).
+    TypeError
+        If a value is not JSON-serialisable.
+    """
+    return json.dumps(json_ready(row), allow_nan=False)
