@@ -730,3 +730,54 @@ def test_reprs_are_summaries_not_arrays() -> None:
     assert repr(grid) == (
         "OccupancyGrid(2x2 cells of 0.05 m, origin (0, -0.05) m; 1 free, 1 occupied, 2 unknown)"
     )
+
+
+def _fail_on(monkeypatch: pytest.MonkeyPatch, name: str, when: object) -> None:
+    """``os.NAME`` raises OSError on the calls for which ``when(call_number, *args)`` is true."""
+    import os
+
+    real = getattr(os, name)
+    calls = [0]
+
+    def flaky(*args: object, **kwargs: object) -> object:
+        calls[0] += 1
+        if when(calls[0], *args):  # type: ignore[operator]
+            raise OSError(28, "No space left on device")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(os, name, flaky)
+
+
+@pytest.mark.parametrize(
+    ("name", "when"),
+    [
+        ("fsync", lambda n, *a: n == 2),  # writing the second file (the YAML) fails
+        ("replace", lambda n, src, dst: str(dst).endswith(".yaml")),  # the picture is in place
+    ],
+    ids=["second-write", "yaml-rename"],
+)
+def test_occupancy_grid_save_is_all_or_nothing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, name: str, when: object
+) -> None:
+    """A save that fails half-way leaves the previous map.png/map.yaml pair byte for byte and
+    no temporary file; into an empty folder it leaves nothing. (The old code replaced the
+    picture, then failed on the YAML: a new picture with the old YAML.)"""
+    from stereovision.ground import OccupancyGrid
+
+    old = OccupancyGrid(np.array([[0, 100], [-1, -1]], np.int8), 0.05, (0.0, -0.05))
+    png, yml = old.save(tmp_path)
+    before = {p.name: p.read_bytes() for p in (png, yml)}
+    new = OccupancyGrid(np.full((3, 4), 100, np.int8), 0.1, (1.0, -2.0))
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    for folder in (tmp_path, empty):
+        _fail_on(monkeypatch, name, when)
+        with pytest.raises(OSError, match="No space left"):
+            new.save(folder)
+        monkeypatch.undo()
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before
+    assert list(empty.iterdir()) == []
+    assert new.save(tmp_path) == (png, yml)  # and a save that works replaces both
+    assert cv2.imread(str(png), cv2.IMREAD_GRAYSCALE).shape == (3, 4)
+    assert "resolution: 0.1\n" in yml.read_text() and "origin: [1.0, -2.0, 0.0]" in yml.read_text()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["empty", "map.png", "map.yaml"]

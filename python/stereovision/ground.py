@@ -634,14 +634,31 @@ class OccupancyGrid:
     def save(self, directory: str | Path, name: str = "map") -> tuple[Path, Path]:
         """Write ``NAME.png`` and ``NAME.yaml`` for ROS ``map_server`` (nav2 loads them).
 
+        The two files are written as a pair: both go to temporary files in ``directory`` first,
+        then the picture and, last, the YAML replace the destinations. If anything fails, the
+        temporary files are removed and a previous ``NAME.png``/``NAME.yaml`` pair is left as
+        it was (never a new picture with an old YAML, nor the reverse).
+
+        Parameters
+        ----------
+        directory : str or pathlib.Path
+            The folder to write into; created if missing.
+        name : str
+            The files' stem.
+
         Returns
         -------
         tuple of pathlib.Path
             The picture and the YAML file.
+
+        Raises
+        ------
+        RuntimeError
+            If the grid could not be encoded as PNG.
+        OSError
+            If a file could not be written; the previous pair is then intact.
         """
         import cv2
-
-        from stereovision.io import atomic_write
 
         d = Path(str(directory))
         d.mkdir(parents=True, exist_ok=True)
@@ -649,15 +666,76 @@ class OccupancyGrid:
         ok, buf = cv2.imencode(".png", self.image())
         if not ok:
             raise RuntimeError("could not encode the occupancy grid as PNG")
-        with atomic_write(png) as fh:
-            fh.write(buf.tobytes())
-        with atomic_write(yml, "w") as fh:
-            fh.write(
-                f"image: {png.name}\nmode: trinary\nresolution: {self.resolution!r}\n"
-                f"origin: [{self.origin[0]!r}, {self.origin[1]!r}, 0.0]\nnegate: 0\n"
-                "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
-            )
+        text = (
+            f"image: {png.name}\nmode: trinary\nresolution: {self.resolution!r}\n"
+            f"origin: [{self.origin[0]!r}, {self.origin[1]!r}, 0.0]\nnegate: 0\n"
+            "occupied_thresh: 0.65\nfree_thresh: 0.196\n"
+        )
+        _replace_pair([(png, buf.tobytes()), (yml, text.encode("utf-8"))])
         return png, yml
+
+
+def _replace_pair(files: list[tuple[Path, bytes]]) -> None:
+    """Write files that belong together (a map's picture and YAML) all or nothing.
+
+    Every file is written and synced to a temporary file next to its destination; then each
+    replaces its destination in order (the last one commits the set), a copy of each previous
+    destination being kept under a temporary name until the last is in place. On any failure the
+    destinations already replaced get their previous contents back (or are removed if they did
+    not exist) and every temporary file is removed.
+
+    Parameters
+    ----------
+    files : list of (pathlib.Path, bytes)
+        Destinations and their contents, in the order they are to replace the destinations.
+    """
+    import os
+    import shutil
+    import tempfile
+
+    from stereovision.io import _current_umask
+
+    temps: list[Path] = []  # the new contents, not yet in place
+    kept: list[tuple[Path, Path | None]] = []  # (destination, its previous contents or None)
+    try:
+        for dest, data in files:
+            fd, name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=dest.parent)
+            temps.append(Path(name))
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.chmod(name, 0o666 & ~_current_umask())  # mkstemp's 0600 -> a plain open()'s
+        for (dest, _), new in zip(files, temps, strict=True):
+            previous: Path | None = None
+            if dest.is_file():
+                fd, name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".old", dir=dest.parent)
+                os.close(fd)
+                previous = Path(name)
+                shutil.copy2(dest, previous)  # dest stays in place meanwhile
+            kept.append((dest, previous))
+            os.replace(new, dest)
+    except BaseException:
+        for dest, previous in reversed(kept):
+            try:
+                if previous is not None:
+                    os.replace(previous, dest)
+                elif dest.exists():
+                    os.unlink(dest)
+            except OSError:
+                pass
+        for left_over in temps + [p for _, p in kept if p is not None]:
+            try:
+                os.unlink(left_over)
+            except FileNotFoundError:
+                pass
+        raise
+    for _, previous in kept:
+        if previous is not None:
+            try:
+                os.unlink(previous)
+            except FileNotFoundError:
+                pass
 
 
 def floor_frame(plane: GroundPlane) -> F64:
