@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
+import cv2
 import numpy as np
 import pytest
 import synthetic_scene as syn
@@ -367,6 +369,34 @@ def test_depth_png_in_millimetres(result, tmp_path):
     with pytest.raises(ValueError, match=r"\(H, W\) array"):
         export.write_depth_png(tmp_path / "n.png", np.zeros(5))
     assert not (tmp_path / "n.png").exists()
+
+
+@pytest.mark.parametrize(
+    ("scale", "error", "message"),
+    [
+        ("1000", TypeError, "scale: expected a number (units per metre), got str '1000'"),
+        (True, TypeError, "scale: expected a number (units per metre), got bool True"),
+        (None, TypeError, "scale: expected a number (units per metre), got NoneType None"),
+        (0, ValueError, "scale: expected a positive finite number, got 0"),
+        (-1000.0, ValueError, "scale: expected a positive finite number, got -1000.0"),
+        (math.nan, ValueError, "scale: expected a positive finite number, got nan"),
+        (math.inf, ValueError, "scale: expected a positive finite number, got inf"),
+    ],
+)
+def test_encode_depth_png_refuses_a_bad_scale(scale, error, message):
+    """A bad scale is an error naming ``scale`` (a string failed inside numpy's isfinite)."""
+    with pytest.raises(error) as info:
+        export.encode_depth_png(np.ones((2, 2)), scale=scale)
+    assert str(info.value) == message
+
+
+def test_encode_depth_png_takes_any_real_scale():
+    """Ints and numpy scalars are numbers: 1.2344 m at 5000 units per metre is 6172."""
+    z = np.array([[1.2344, np.nan]])
+    for scale in (5000, 5000.0, np.float32(5000), np.int64(5000)):
+        png = export.encode_depth_png(z, scale=scale)
+        raw = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_UNCHANGED)
+        assert raw.tolist() == [[6172, 0]]
 
 
 def test_disparity_png_kitti_format(data_dir, result, tmp_path):

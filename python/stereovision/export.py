@@ -20,6 +20,8 @@ Every writer replaces its file atomically (:func:`stereovision.io.atomic_write`)
 from __future__ import annotations
 
 import io as _io
+import math
+import numbers
 import os
 import warnings
 import zipfile
@@ -717,13 +719,25 @@ def encode_depth_png(depth: npt.ArrayLike, scale: float = DEPTH_PNG_SCALE) -> by
     -------
     bytes
         A single-channel 16-bit PNG.
+
+    Raises
+    ------
+    TypeError
+        If ``scale`` is not a real number (a string, a bool).
+    ValueError
+        If ``scale`` is not positive and finite, or ``depth`` is not a non-empty 2-D map.
     """
     return _png16_bytes(_scaled_u16(depth, scale, "depth"), "depth")
 
 
 def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.float64]:
-    if not (np.isfinite(scale) and scale > 0):
-        raise ValueError(f"scale: expected a positive number, got {scale!r}")
+    if isinstance(scale, (bool, np.bool_)) or not isinstance(scale, numbers.Real):
+        # a string (scale="1000") failed inside numpy with "ufunc 'isfinite' not supported"
+        raise TypeError(
+            f"scale: expected a number (units per metre), got {type(scale).__name__} {scale!r}"
+        )
+    if not (math.isfinite(scale) and scale > 0):
+        raise ValueError(f"scale: expected a positive finite number, got {scale!r}")
     a = np.asarray(arr, dtype=np.float64)
     if a.ndim != 2 or a.size == 0:
         raise ValueError(f"{name}: expected a non-empty (H, W) array, got shape {a.shape}")
@@ -770,7 +784,10 @@ def write_depth_png(
     Raises
     ------
     ValueError
-        A result without calibration (no depth), a map that is not 2-D, or a bad ``scale``.
+        A result without calibration (no depth), a map that is not 2-D, or a ``scale`` that is
+        not positive and finite.
+    TypeError
+        A ``scale`` that is not a real number (a string, a bool).
     """
     from stereovision.depth import DepthResult
 
