@@ -16,6 +16,7 @@ and at most ``MATCH_DIFF_SHARE`` of them differ.
 from __future__ import annotations
 
 import csv
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -127,6 +128,39 @@ def test_zero_crossings_and_tracking_equal_reference(scene: str, crop: tuple[sli
             assert (px[:, 1] * w + px[:, 0]).tolist() == tr["segments"][k]
             # Consecutive pixels are 8-neighbours (an ordered chain).
             assert np.abs(np.diff(px, axis=0)).max() <= 1
+
+
+def _three_segments() -> mcgm.ChannelCurves:
+    """A channel of 3 segments of 2, 1 and 3 pixels (x = 10 * segment + i)."""
+    f32, i32 = np.zeros((2, 2), np.float32), np.zeros((2, 2), np.int32)
+    return mcgm.ChannelCurves(
+        sigma=1.0, scale=1, log=f32, mark=np.zeros((2, 2), np.uint8), xsub=f32, strength=f32,
+        theta=f32, labels=i32, seg_offsets=np.array([0, 2, 3, 6], np.int64),
+        seg_pixels=np.array([[0, 0], [1, 0], [10, 1], [20, 2], [21, 2], [22, 2]], np.int32),
+        centroids=np.zeros((3, 2), np.float32), mean_theta=np.zeros(3, np.float32),
+        rtable_offsets=np.zeros((3, 2), np.int32), rtable_vecs=np.zeros((6, 2), np.float32),
+        t_high=1.0, t_low=0.5,
+    )  # fmt: skip
+
+
+def test_segment_index_is_checked_and_negative_counts_from_the_end() -> None:
+    """k past the end was a bare IndexError from numpy; k = -1 gave an empty array and -2 the
+    last segment (off by one). Negative k now counts from the end, as in a list."""
+    c = _three_segments()
+    assert [c.segment(k)[:, 0].tolist() for k in range(3)] == [[0, 1], [10], [20, 21, 22]]
+    assert c.segment(np.int64(1))[:, 0].tolist() == [10]
+    for k in (-1, -2, -3):
+        np.testing.assert_array_equal(c.segment(k), c.segment(3 + k))
+    rule = r"this channel has 3 segments \(0 to 2, or -3 to -1 from the end\)"
+    for k in (3, 4, -4):
+        with pytest.raises(IndexError, match=rf"^k: segment {k} out of range; {rule}$"):
+            c.segment(k)
+    for k in (1.0, True, "1"):
+        with pytest.raises(TypeError, match=r"^k: expected an integer segment index, got "):
+            c.segment(k)  # type: ignore[arg-type]
+    none = dataclasses.replace(c, seg_offsets=c.seg_offsets[:1], centroids=c.centroids[:0])
+    with pytest.raises(IndexError, match=r"^k: segment 0 out of range; this channel has no "):
+        none.segment(0)
 
 
 @pytest.mark.parametrize(("scene", "crop"), CROPS)

@@ -148,15 +148,34 @@ class ChannelCurves:
         Parameters
         ----------
         k : int
-            Segment index, ``0 <= k < len(self)``.
+            Segment index, ``0 <= k < n_segments``; a negative ``k`` counts from the end as in
+            a Python list (``-1`` is the last segment).
 
         Returns
         -------
         numpy.ndarray
             ``(n_k, 2)`` int32 ``(x, y)`` pixels of segment ``k``, in curve order (a view of
             ``seg_pixels``).
+
+        Raises
+        ------
+        TypeError
+            If ``k`` is not an integer.
+        IndexError
+            If ``k`` is outside ``-n_segments <= k < n_segments``.
         """
-        return self.seg_pixels[self.seg_offsets[k] : self.seg_offsets[k + 1]]
+        if isinstance(k, (bool, np.bool_)) or not isinstance(k, (int, np.integer)):
+            raise TypeError(f"k: expected an integer segment index, got {type(k).__name__} {k!r}")
+        n = self.n_segments
+        if not -n <= k < n:
+            raise IndexError(
+                f"k: segment {int(k)} out of range; this channel has {n} segment"
+                f"{'' if n == 1 else 's'} (0 to {n - 1}, or -{n} to -1 from the end)"
+                if n
+                else f"k: segment {int(k)} out of range; this channel has no segment"
+            )
+        i = int(k) % n
+        return self.seg_pixels[self.seg_offsets[i] : self.seg_offsets[i + 1]]
 
 
 def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:
