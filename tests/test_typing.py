@@ -190,6 +190,50 @@ def test_mypy_strict_types_ranges_channels_and_steps_as_they_are(tmp_path: Path)
     )
 
 
+def test_mypy_strict_types_channel_outputs(tmp_path: Path) -> None:
+    """``FusionResult.channel_outputs`` was ``dict[str, Any]``: any key passed and every value
+    was ``Any``. It is the TypedDict ``ChannelOutputs`` (whose keys ``DepthChannels`` shares):
+    the right reads pass, a key it never holds is refused."""
+    script = tmp_path / "outputs.py"
+    script.write_text(
+        "import numpy as np\nimport numpy.typing as npt\n"
+        "from stereovision.depth import DepthChannels\n"
+        "from stereovision.matches import Matches\n"
+        "from stereovision.matching.fusion import ChannelOutputs, FusionResult\n"
+        "from stereovision.matching.gabor import GaborResult\n\n\n"
+        "def gabor(fr: FusionResult) -> GaborResult:\n    return fr.channel_outputs['gabor']\n\n\n"
+        "def mcgm(out: ChannelOutputs) -> Matches | None:\n    return out.get('mcgm')\n\n\n"
+        "def keep(fr: FusionResult, ch: DepthChannels) -> None:\n"
+        "    ch.update({**fr.channel_outputs, 'members': fr})\n\n\n"
+        "def sgm(fr: FusionResult) -> npt.NDArray[np.float32]:\n"
+        "    return fr.channel_outputs['census']\n"
+    )
+    run = _mypy_strict(script, tmp_path)
+    assert run.returncode == 1
+    lines = run.stdout.splitlines()
+    assert all(ln.startswith("outputs.py:22: error: ") for ln in lines), run.stdout  # only sgm
+    refused = 'TypedDict "ChannelOutputs" has no key "census"  [typeddict-item]'
+    assert f"outputs.py:22: error: {refused}" in lines, run.stdout
+
+
+def test_fuse_pair_channel_outputs_are_channel_outputs_keys() -> None:
+    """What fuse_pair fills is what ChannelOutputs names, with those types."""
+    import typing
+
+    from stereovision.depth import DepthChannels
+    from stereovision.matching.fusion import ChannelOutputs, fuse_pair
+
+    hints = typing.get_type_hints(ChannelOutputs)
+    assert set(hints) == {"gabor", "gabor_remeasured", "mcgm", "hopfield", "sgm"}
+    assert DepthChannels.__optional_keys__ == set(hints) | {"members"}
+    rng = np.random.default_rng(0)
+    left = rng.random((64, 96), dtype=np.float32)
+    fr = fuse_pair(left, np.roll(left, -4, axis=1), max_disparity=16, dense_sgm=True)
+    assert set(fr.channel_outputs) == set(hints)
+    for k, v in fr.channel_outputs.items():
+        assert isinstance(v, typing.get_origin(hints[k]) or hints[k]), k
+
+
 def test_channels_hold_the_keys_and_types_depth_channels_names() -> None:
     from stereovision.depth import DepthChannels
     from stereovision.matching.fusion import FusionResult

@@ -19,7 +19,7 @@ import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, TypedDict, TypeVar, cast
+from typing import Any, TypeVar
 
 import cv2
 import numpy as np
@@ -29,9 +29,7 @@ from stereovision._validate import as_bgr_uint8, as_gray_float, check_pair, fini
 from stereovision.calibration import Calibration
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
-from stereovision.matches import Matches
-from stereovision.matching.fusion import FusionResult
-from stereovision.matching.gabor import GaborResult
+from stereovision.matching.fusion import ChannelOutputs, FusionResult
 from stereovision.uncalibrated import UncalibratedRectification
 
 __all__ = [
@@ -307,7 +305,7 @@ _NO_DEPTH = (
 )
 
 
-class DepthChannels(TypedDict, total=False):
+class DepthChannels(ChannelOutputs, total=False):
     """Each channel's own output, :attr:`DepthResult.channels` (``return_channels=True``).
 
     Which keys are there depends on the method (``depth_map``'s ``method``):
@@ -327,14 +325,12 @@ class DepthChannels(TypedDict, total=False):
     sgm : numpy.ndarray
         ``(H, W)`` float32: the census semi-global disparity map (``"fused"``, ``"census"``,
         ``"fast"``; NaN = none).
+
+    The keys but ``members`` are :class:`~stereovision.matching.fusion.ChannelOutputs`'s,
+    :attr:`FusionResult.channel_outputs <stereovision.matching.fusion.FusionResult>`.
     """
 
-    gabor: GaborResult
-    gabor_remeasured: npt.NDArray[np.float32]
-    mcgm: Matches
-    hopfield: Matches
     members: FusionResult
-    sgm: npt.NDArray[np.float32]
 
 
 def _in_unit(metres: npt.NDArray[np.float32], unit: str) -> npt.NDArray[np.float32]:
@@ -838,9 +834,7 @@ def _run_matcher(
             # the checked ones, as ``match(method="fused")`` gives them.
             sgm = fr.channel_outputs.get("sgm")
             members = fusion.census_clear(fr, sgm) if sgm is not None else fr
-            # channel_outputs holds the keys of DepthChannels (fuse_pair's "gabor", "mcgm",
-            # "hopfield", "gabor_remeasured", "sgm"), typed as a plain dict there
-            channels.update(cast(DepthChannels, {**fr.channel_outputs, "members": members}))
+            channels.update({**fr.channel_outputs, "members": members})
         return disp, conf, only_second
     if method in ("census", "fast"):
         from stereovision.matching import fusion

@@ -23,7 +23,7 @@ import time
 from collections.abc import Callable, Mapping
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -31,11 +31,15 @@ import numpy.typing as npt
 from stereovision._validate import finite_number, refuse_unknown
 from stereovision.matches import Matches
 
+# at run time too, so that typing.get_type_hints resolves ChannelOutputs (and DepthChannels)
+from stereovision.matching.gabor import GaborResult
+
 __all__ = [
     "CHANNEL_BITS",
     "DEFAULTS",
     "DENSE_DEFAULTS",
     "MEMBER_MCGM",
+    "ChannelOutputs",
     "FusionResult",
     "census_clear",
     "fill_enclosed_far",
@@ -70,6 +74,30 @@ DEFAULTS = {
 }
 
 
+class ChannelOutputs(TypedDict, total=False):
+    """What each channel returned, :attr:`FusionResult.channel_outputs` (:func:`fuse_pair`
+    fills it; which keys are there depends on its ``channels`` and options).
+
+    Attributes
+    ----------
+    gabor : GaborResult
+        The Gabor phase channel's map.
+    gabor_remeasured : numpy.ndarray
+        ``(H, W)`` float32: the Gabor map the vote used, when :func:`fuse_pair` re-measured it
+        (:func:`remeasure`).
+    mcgm, hopfield : Matches
+        The graph-matching and Hopfield channels' matches.
+    sgm : numpy.ndarray
+        ``(H, W)`` float32: the census semi-global map (``dense_sgm=True``; NaN = none).
+    """
+
+    gabor: GaborResult
+    gabor_remeasured: F32
+    mcgm: Matches
+    hopfield: Matches
+    sgm: F32
+
+
 @dataclass(frozen=True, eq=False)
 class FusionResult:
     """The valid members of the channels' agreement.
@@ -88,11 +116,11 @@ class FusionResult:
         ``(H, W)`` uint8 rasters of ``count`` and ``sources`` (0 off the members).
     channels : tuple of str
         The channels that took part, in bit order.
-    channel_outputs : dict
+    channel_outputs : ChannelOutputs
         What each channel returned, by name (:func:`fuse_pair` fills it: ``"gabor"`` a
         :class:`~stereovision.matching.gabor.GaborResult`, the sparse ones :class:`Matches`),
         and ``"gabor_remeasured"``, the Gabor map the vote used (:func:`remeasure`), when
-        :func:`fuse_pair` re-measured it.
+        :func:`fuse_pair` re-measured it; ``"sgm"`` the census map when asked for.
     """
 
     matches: Matches
@@ -103,7 +131,7 @@ class FusionResult:
     count_map: npt.NDArray[np.uint8]
     sources_map: npt.NDArray[np.uint8]
     channels: tuple[str, ...]
-    channel_outputs: dict[str, Any] = field(default_factory=dict)
+    channel_outputs: ChannelOutputs = field(default_factory=lambda: ChannelOutputs())
 
     def __len__(self) -> int:
         return len(self.matches)
@@ -472,7 +500,7 @@ def fuse_pair(
         "sgm": sgm_disparity,
     }
 
-    outputs: dict[str, Any] = {}
+    outputs: ChannelOutputs = {}
 
     def timed(name: str) -> tuple[Any, float]:
         t0 = time.perf_counter()
@@ -493,7 +521,7 @@ def fuse_pair(
         done = dict(zip(names, pool.map(timed, names), strict=True))
     seconds: dict[str, float] = {n: done[n][1] for n in names}
     sgm_map = done.pop("sgm")[0] if "sgm" in done else None
-    if dense_sgm:
+    if dense_sgm and sgm_map is not None:  # not None: dense_sgm ran it
         outputs["sgm"] = sgm_map
     dense = None
     if "gabor" in done:
@@ -519,7 +547,11 @@ def fuse_pair(
     if census_members and sgm_map is not None:
         res = census_clear(res, sgm_map)
     seconds["fuse"] = time.perf_counter() - t
-    res.channel_outputs.update(outputs, **sparse)
+    res.channel_outputs.update(outputs)
+    if "mcgm" in sparse:
+        res.channel_outputs["mcgm"] = sparse["mcgm"]
+    if "hopfield" in sparse:
+        res.channel_outputs["hopfield"] = sparse["hopfield"]
     res.matches.stats.update(
         channel_matches={k: len(v) for k, v in sparse.items()}, seconds=seconds
     )
