@@ -383,10 +383,15 @@ def test_depth_png_in_millimetres(result, tmp_path):
         (math.inf, ValueError, "scale: expected a positive finite number, got inf"),
     ],
 )
-def test_encode_depth_png_refuses_a_bad_scale(scale, error, message):
-    """A bad scale is an error naming ``scale`` (a string failed inside numpy's isfinite)."""
+def test_encode_depth_png_refuses_a_bad_scale(scale, error, message, tmp_path):
+    """A bad scale is an error naming ``scale`` (a string failed inside numpy's isfinite), for
+    the writer and the reader alike (read_depth_png's check had the same numpy failure)."""
     with pytest.raises(error) as info:
         export.encode_depth_png(np.ones((2, 2)), scale=scale)
+    assert str(info.value) == message
+    png = export.write_depth_png(tmp_path / "d.png", np.ones((2, 2)))
+    with pytest.raises(error) as info:
+        export.read_depth_png(png, scale=scale)
     assert str(info.value) == message
 
 

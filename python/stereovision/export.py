@@ -730,7 +730,8 @@ def encode_depth_png(depth: npt.ArrayLike, scale: float = DEPTH_PNG_SCALE) -> by
     return _png16_bytes(_scaled_u16(depth, scale, "depth"), "depth")
 
 
-def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.float64]:
+def _check_scale(scale: float) -> None:
+    """A 16-bit PNG's ``scale`` (units per metre): a positive finite number, else named."""
     if isinstance(scale, (bool, np.bool_)) or not isinstance(scale, numbers.Real):
         # a string (scale="1000") failed inside numpy with "ufunc 'isfinite' not supported"
         raise TypeError(
@@ -738,6 +739,10 @@ def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.f
         )
     if not (math.isfinite(scale) and scale > 0):
         raise ValueError(f"scale: expected a positive finite number, got {scale!r}")
+
+
+def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.float64]:
+    _check_scale(scale)
     a = np.asarray(arr, dtype=np.float64)
     if a.ndim != 2 or a.size == 0:
         raise ValueError(f"{name}: expected a non-empty (H, W) array, got shape {a.shape}")
@@ -861,11 +866,12 @@ def read_depth_png(path: PathLike, scale: float = DEPTH_PNG_SCALE) -> npt.NDArra
     ------
     FileNotFoundError
         If the file does not exist.
+    TypeError
+        If ``scale`` is not a number.
     ValueError
-        If it is not a single-channel 16-bit PNG, or ``scale`` is not positive.
+        If it is not a single-channel 16-bit PNG, or ``scale`` is not positive and finite.
     """
-    if not (np.isfinite(scale) and scale > 0):
-        raise ValueError(f"scale: expected a positive number, got {scale!r}")
+    _check_scale(scale)
     return _read_png16(path, scale, "depth PNG")
 
 
