@@ -271,14 +271,14 @@ def sgm_disparity(
 def gray_u8(
     image: npt.NDArray[np.uint8], weights: tuple[float, float, float]
 ) -> npt.NDArray[np.float32]:
-    """Grey ``float32`` in ``[0, 1]`` of a C-contiguous ``(H, W)`` or ``(H, W, 1|3|4)`` uint8
-    image (BGR order), bit-identical to ``as_gray_float``'s NumPy path."""
+    """Grey ``float32`` in ``[0, 1]`` of an ``(H, W)`` or ``(H, W, 1|3|4)`` uint8 image (BGR
+    order, any memory layout), bit-identical to ``as_gray_float``'s NumPy path."""
 
 def temporal_grey_difference(
     frame: npt.NDArray[np.uint8], mean: npt.NDArray[np.float32]
 ) -> npt.NDArray[np.float32]:
     """``(H, W)`` grey value of ``frame - mean`` (channel weights B 0.114, G 0.587, R 0.299;
-    alpha 0), both C-contiguous ``(H, W)`` or ``(H, W, 1|3|4)``."""
+    alpha 0), both ``(H, W)`` or ``(H, W, 1|3|4)``."""
 
 def temporal_running_mean(
     frame: npt.NDArray[np.uint8],
@@ -288,9 +288,10 @@ def temporal_running_mean(
     ks: float,
     max_frames: int,
 ) -> npt.NDArray[np.uint8]:
-    """One more frame into ``mean`` and ``count``, in place (both C-contiguous); returns the
-    mean rounded to uint8. A pixel with ``|diff| <= ks sqrt(1 + 1/count)`` keeps averaging
-    (``count`` up to ``max_frames``), any other starts again from the frame."""
+    """One more frame into ``mean`` and ``count``, in place (both C-contiguous, else a
+    ``ValueError`` naming the one that is not); returns the mean rounded to uint8. A pixel
+    with ``|diff| <= ks sqrt(1 + 1/count)`` keeps averaging (``count`` up to ``max_frames``),
+    any other starts again from the frame."""
 
 def release_memory() -> int:
     """Return the memory the extension keeps for the next call to the system; bytes released."""

@@ -180,14 +180,19 @@ pub fn vec_to_numpy<'py, T: numpy::Element>(
     Ok(arr.into_pyarray(py))
 }
 
-/// The buffers of a disparity map and its confidence, both checked to be `(h, w)` and
-/// C-contiguous (the Python wrappers make them so); the error names the array.
+/// Row-major values: an array's own buffer, or a copy.
+pub type RowMajor<'a, T> = Cow<'a, [T]>;
+
+/// The values of a disparity map and its confidence in row-major order, both checked to be
+/// `(h, w)`: their own buffers when C-contiguous (the Python wrappers make them so), else
+/// copies (a strided, reversed or Fortran-ordered view was refused with "must be
+/// C-contiguous"); the error names the array.
 pub fn map_and_confidence<'a>(
     disp: &'a PyReadonlyArray2<'_, f32>,
     conf: &'a PyReadonlyArray2<'_, f32>,
     (h, w): (usize, usize),
-) -> PyResult<(&'a [f32], &'a [f32])> {
-    let slice = |a: &'a PyReadonlyArray2<'_, f32>, name: &str| -> PyResult<&'a [f32]> {
+) -> PyResult<(RowMajor<'a, f32>, RowMajor<'a, f32>)> {
+    let values = |a: &'a PyReadonlyArray2<'_, f32>, name: &str| -> PyResult<Cow<'a, [f32]>> {
         if a.as_array().dim() != (h, w) {
             return Err(PyValueError::new_err(format!(
                 "{name} shape {:?} differs from the expected shape {:?}",
@@ -195,16 +200,19 @@ pub fn map_and_confidence<'a>(
                 (h, w)
             )));
         }
-        c_slice(a).ok_or_else(|| PyValueError::new_err(format!("{name} must be C-contiguous")))
+        row_major(a, name)
     };
-    Ok((slice(disp, "disparity")?, slice(conf, "confidence")?))
+    Ok((values(disp, "disparity")?, values(conf, "confidence")?))
 }
 
-/// `(H, W, C, data)` of an 8-bit image array `(H, W)` (C = 1) or `(H, W, C)`, C-contiguous.
+/// `(H, W, C, data)` of an 8-bit image array `(H, W)` (C = 1) or `(H, W, C)`, its values in
+/// row-major order: its own buffer when C-contiguous, else a copy (a strided, reversed or
+/// Fortran-ordered view, e.g. one channel of a colour image, was refused with "must be
+/// C-contiguous").
 pub fn u8_layout<'a>(
     a: &'a numpy::PyReadonlyArrayDyn<'_, u8>,
     what: &str,
-) -> PyResult<(usize, usize, usize, &'a [u8])> {
+) -> PyResult<(usize, usize, usize, Cow<'a, [u8]>)> {
     let shape = a.shape().to_vec();
     let (h, w, c) = match shape.as_slice() {
         [h, w] => (*h, *w, 1),
@@ -215,9 +223,7 @@ pub fn u8_layout<'a>(
             )))
         }
     };
-    let data =
-        c_slice(a).ok_or_else(|| PyValueError::new_err(format!("{what} must be C-contiguous")))?;
-    Ok((h, w, c, data))
+    Ok((h, w, c, row_major(a, what)?))
 }
 
 /// The B, G, R grey weights as an array, checked to be finite and non-negative (a NaN weight
@@ -234,7 +240,8 @@ pub fn luma_weights(weights: (f32, f32, f32)) -> PyResult<[f32; 3]> {
 }
 
 /// `stereovision._validate.as_gray_float` for 8-bit images, in Rust: `(H, W)` grey or
-/// `(H, W, C)` with `C` in 1, 3, 4 (BGR order), C-contiguous; bit-identical to the NumPy path.
+/// `(H, W, C)` with `C` in 1, 3, 4 (BGR order), any memory layout; bit-identical to the NumPy
+/// path.
 #[pyfunction]
 #[pyo3(signature = (image, weights))]
 pub fn gray_u8<'py>(
@@ -247,7 +254,7 @@ pub fn gray_u8<'py>(
     let wts = luma_weights(weights)?;
     let grey = crate::workers::detach(py, || {
         crate::errors::guard("gray_u8", || {
-            stereovision_core::image::grey_from_u8(data, w, h, c, wts)
+            stereovision_core::image::grey_from_u8(&data, w, h, c, wts)
         })
     })?;
     image_to_numpy(

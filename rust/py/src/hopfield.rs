@@ -223,7 +223,7 @@ pub fn hopfield_match<'py>(
     run_match(py, l.view(), r.view(), params)
 }
 
-/// [`hopfield_match`] on 8-bit images (`(H, W)` grey or `(H, W, C)` BGR/BGRA, C-contiguous):
+/// [`hopfield_match`] on 8-bit images (`(H, W)` grey or `(H, W, C)` BGR/BGRA, any layout):
 /// the grey conversion (`weights`: BGR luma weights, bit-identical to `_validate.as_gray_float`)
 /// runs in the same call, without NumPy intermediates.
 #[pyfunction]
@@ -253,7 +253,7 @@ pub fn hopfield_match_u8<'py>(
     let out = crate::workers::detach(py, || {
         guard("hopfield_match_u8", || {
             run_hot(|| {
-                let (lg, rg) = stereovision_core::image::grey_pair_from_u8(ld, rd, w, h, c, wts)?;
+                let (lg, rg) = stereovision_core::image::grey_pair_from_u8(&ld, &rd, w, h, c, wts)?;
                 // Finite by construction (levels / 255): no check needed.
                 let image = |data| Image {
                     width: w,

@@ -64,7 +64,7 @@ pub fn refine_disparity<'py>(
     let (lv, rv) = (l.view(), r.view());
     let (out, oc, filled) = crate::workers::detach(py, || {
         guard("refine_disparity", || {
-            core_refine(lv, rv, d, c, d_min, d_max, &p)
+            core_refine(lv, rv, &d, &c, d_min, d_max, &p)
         })
     })?;
     let img = |data| Image {

@@ -1,5 +1,7 @@
 //! Binding of `stereovision_core::temporal`.
 
+use std::borrow::Cow;
+
 use numpy::ndarray::{ArrayD, IxDyn};
 use numpy::{
     IntoPyArray, PyArray2, PyArrayDyn, PyReadonlyArray2, PyReadonlyArrayDyn, PyReadwriteArray2,
@@ -9,14 +11,15 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use stereovision_core::temporal::{grey_difference, running_mean};
 
-use crate::convert::{c_slice, u8_layout, vec_to_numpy};
+use crate::convert::{row_major, u8_layout, vec_to_numpy};
 use crate::errors::guard;
 
-/// The mean's buffer, checked to have the frame's shape and to be C-contiguous.
-fn mean_slice<'a>(
+/// The mean's values in row-major order, checked to have the frame's shape: its own buffer
+/// when C-contiguous, else a copy.
+fn mean_values<'a>(
     mean: &'a PyReadonlyArrayDyn<'_, f32>,
     frame_shape: &[usize],
-) -> PyResult<&'a [f32]> {
+) -> PyResult<Cow<'a, [f32]>> {
     if mean.shape() != frame_shape {
         return Err(PyValueError::new_err(format!(
             "mean shape {:?} differs from the frame's {:?}",
@@ -24,7 +27,7 @@ fn mean_slice<'a>(
             frame_shape
         )));
     }
-    c_slice(mean).ok_or_else(|| PyValueError::new_err("mean must be C-contiguous"))
+    row_major(mean, "mean")
 }
 
 /// Grey value of `frame - mean` per pixel, `(H, W)` float32 (module docs of the core).
@@ -37,10 +40,10 @@ pub fn temporal_grey_difference<'py>(
     let frame: PyReadonlyArrayDyn<'py, u8> = crate::convert::array_arg(frame, "frame")?;
     let mean: PyReadonlyArrayDyn<'py, f32> = crate::convert::array_arg(mean, "mean")?;
     let (h, w, c, f) = u8_layout(&frame, "frame")?;
-    let m = mean_slice(&mean, frame.shape())?;
+    let m = mean_values(&mean, frame.shape())?;
     let d = crate::workers::detach(py, || {
         guard("temporal_grey_difference", || {
-            grey_difference(f, m, h * w, c)
+            grey_difference(&f, &m, h * w, c)
         })
     })?;
     vec_to_numpy(py, (h, w), d)
@@ -80,16 +83,25 @@ pub fn temporal_running_mean<'py>(
             )));
         }
     }
-    let d = c_slice(&diff).ok_or_else(|| PyValueError::new_err("diff must be C-contiguous"))?;
-    let contiguous = mean.is_c_contiguous() && count.is_c_contiguous();
-    let m = mean.as_slice_mut().ok().filter(|_| contiguous);
-    let n = count.as_slice_mut().ok().filter(|_| contiguous);
-    let (Some(m), Some(n)) = (m, n) else {
+    let d = row_major(&diff, "diff")?;
+    // `mean` and `count` are written in place: no copy can stand for them. The error names
+    // the one that is not C-contiguous (it named both).
+    for (name, ok) in [
+        ("mean", mean.is_c_contiguous()),
+        ("count", count.is_c_contiguous()),
+    ] {
+        if !ok {
+            return Err(PyValueError::new_err(format!(
+                "{name} must be C-contiguous: it is updated in place"
+            )));
+        }
+    }
+    let (Ok(m), Ok(n)) = (mean.as_slice_mut(), count.as_slice_mut()) else {
         return Err(PyValueError::new_err("mean and count must be C-contiguous"));
     };
     let out = crate::workers::detach(py, || {
         guard("temporal_running_mean", || {
-            running_mean(f, m, n, d, c, ks, max_frames)
+            running_mean(&f, m, n, &d, c, ks, max_frames)
         })
     })?;
     let out = ArrayD::from_shape_vec(IxDyn(&shape), out)

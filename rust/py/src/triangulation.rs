@@ -40,7 +40,7 @@ pub fn depth_rectified<'py>(
         s_fill,
     };
     let (z, s) = crate::workers::detach(py, || {
-        guard("depth_rectified", || core_depth(d, c, w, h, fb, doffs, m))
+        guard("depth_rectified", || core_depth(&d, &c, w, h, fb, doffs, m))
     })?;
     let img = |data| Image {
         width: w,
