@@ -161,6 +161,37 @@ def test_mcgm_filter_checks_its_parameters(bad: dict[str, int]) -> None:
         _core.mcgm_filter(g, g, ms, {"max_disparity": 8, **bad})
 
 
+@pytest.mark.parametrize("column", [0, 1, 2, 3])
+@pytest.mark.parametrize("value", [2.0**31, 1e10, -1e30, -5.0, 160.0])
+def test_mcgm_filter_refuses_matches_outside_the_images(
+    column: int, value: float, crop: tuple[np.ndarray, np.ndarray]
+) -> None:
+    """A coordinate of 2**31 or more overflowed the filters' window arithmetic (``RuntimeError:
+    internal error in mcgm_filter: index out of bounds``); a point just outside was dropped
+    without a word. Both are refused, as ``matching.mcgm.filter_matches`` refuses them."""
+    gl, gr = (as_gray_float(a) for a in crop)
+    ms = np.array([[80, 50, 70, 50], [40, 30, 28, 30]], np.float32)
+    keep = _core.mcgm_filter(gl, gr, ms, {"max_disparity": 32})
+    assert keep.dtype == np.bool_ and keep.shape == (2,)
+    bad = ms.copy()
+    bad[1, column] = value
+    says = "matches: 1 of 2 rows lie outside the 160x100 images (row 1: (xl, yl, xr, yr) = ("
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.mcgm_filter(gl, gr, bad, {"max_disparity": 32})
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), -float("inf")])
+def test_mcgm_filter_refuses_non_finite_matches(
+    value: float, crop: tuple[np.ndarray, np.ndarray]
+) -> None:
+    """They were dropped without a word."""
+    gl, gr = (as_gray_float(a) for a in crop)
+    ms = np.array([[80, 50, 70, 50], [40, 30, 28, value]], np.float32)
+    says = "matches: 1 of 2 rows have a NaN or infinite coordinate (row 1: (xl, yl, xr, yr) = ("
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.mcgm_filter(gl, gr, ms, {"max_disparity": 32})
+
+
 @pytest.mark.parametrize("theta", [90.0, -95.0, float("nan")])
 def test_gabor_responses_names_theta_deg(theta: float) -> None:
     """An angle out of range was blamed on ``orientations_deg``, a parameter this function

@@ -3,7 +3,7 @@
 //! Parameters travel as one `params` dict (keys = the Python names, documented in
 //! `stereovision.matching.mcgm.DEFAULTS`); unknown keys and wrong types are `ValueError`s.
 
-use numpy::ndarray::{Array1, Array2};
+use numpy::ndarray::{Array1, Array2, ArrayView2};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -370,6 +370,7 @@ pub fn mcgm_filter<'py>(
             view.shape()
         )));
     }
+    check_match_rows(&view, l.width, l.height)?;
     let ms: Vec<Match> = view
         .rows()
         .into_iter()
@@ -394,4 +395,43 @@ pub fn mcgm_filter<'py>(
         })
     })?;
     Ok(Array1::from_vec(keep).into_pyarray(py))
+}
+
+/// `matches` rows are matches of this pair: finite, and within the images (beyond the outer
+/// pixels' edges, `-0.5 .. W - 0.5` and `-0.5 .. H - 0.5`), as `matching.mcgm.filter_matches`
+/// checks. The kernel's window arithmetic overflowed on a coordinate of 2**31 or more
+/// (`RuntimeError: internal error in mcgm_filter: index out of bounds`); a NaN or another
+/// point outside was dropped without a word.
+fn check_match_rows(view: &ArrayView2<'_, f32>, w: usize, h: usize) -> PyResult<()> {
+    let row = |i: usize| {
+        let v: Vec<String> = view.row(i).iter().map(|x| format!("{x}")).collect();
+        format!("(xl, yl, xr, yr) = ({})", v.join(", "))
+    };
+    let n = view.nrows();
+    let bad: Vec<usize> = (0..n)
+        .filter(|&i| view.row(i).iter().any(|v| !v.is_finite()))
+        .collect();
+    if let Some(&i) = bad.first() {
+        return Err(PyValueError::new_err(format!(
+            "matches: {} of {n} rows have a NaN or infinite coordinate (row {i}: {})",
+            bad.len(),
+            row(i)
+        )));
+    }
+    let (wf, hf) = (w as f64 - 0.5, h as f64 - 0.5);
+    let outside = |i: usize| {
+        let r = view.row(i);
+        let x_out = |x: f32| (x as f64) < -0.5 || (x as f64) > wf;
+        let y_out = |y: f32| (y as f64) < -0.5 || (y as f64) > hf;
+        x_out(r[0]) || x_out(r[2]) || y_out(r[1]) || y_out(r[3])
+    };
+    let out: Vec<usize> = (0..n).filter(|&i| outside(i)).collect();
+    if let Some(&i) = out.first() {
+        return Err(PyValueError::new_err(format!(
+            "matches: {} of {n} rows lie outside the {w}x{h} images (row {i}: {})",
+            out.len(),
+            row(i)
+        )));
+    }
+    Ok(())
 }
