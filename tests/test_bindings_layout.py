@@ -1,14 +1,17 @@
 """The extension reads NumPy buffers in row-major order whatever the array's memory layout.
 
 A Fortran-ordered array is contiguous too, but its buffer holds the transpose; a strided or
-reversed view has no contiguous buffer at all. The bindings read such an array through a
-row-major copy, never as if its buffer were row-major: every kernel gives the result of the
-array's contiguous copy. Only the arrays a kernel updates in place (``temporal_running_mean``'s
-``mean`` and ``count``) must be C-contiguous, and the error names the one that is not.
+reversed view has no contiguous buffer at all; a field of a packed structured array has items
+that are not aligned and strides that are no multiple of the item size. The bindings read such
+an array through a row-major copy, never as if its buffer were row-major: every kernel gives
+the result of the array's contiguous copy. Only the arrays a kernel updates in place
+(``temporal_running_mean``'s ``mean`` and ``count``) must be C-contiguous and aligned, and the
+error names the one that is not.
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -57,7 +60,17 @@ LAYOUTS: dict[str, Callable[[np.ndarray], np.ndarray]] = {
     "reversed": lambda a: np.ascontiguousarray(a[::-1, ::-1])[::-1, ::-1],
     "every_other": lambda a: np.repeat(np.repeat(a, 2, axis=0), 3, axis=1)[::2, ::3],
     "row_stride": lambda a: np.pad(a, [(0, 0), (0, 5)] + [(0, 0)] * (a.ndim - 2))[:, : a.shape[1]],
+    "packed_field": lambda a: _packed_field(a),
 }
+
+
+def _packed_field(a: np.ndarray) -> np.ndarray:
+    """``a`` as the field of a packed structured array after one byte: items not aligned, and
+    strides (5 bytes for float32) no multiple of the item size."""
+    rec = np.zeros(a.shape, dtype=[("pad", "u1"), ("v", a.dtype)])
+    rec["v"] = a
+    return rec["v"]
+
 
 #: Per kernel: its call on named arrays, and the role of each array (``"u8"``: the crop's BGR
 #: image, ``"grey"``/``"grey_r"``: the grey pair, ``"disp"``/``"conf"``: a map with holes and
@@ -162,7 +175,9 @@ def test_every_kernel_gives_the_contiguous_result_for_any_layout(
     ``gray_u8``, ``temporal_grey_difference`` and ``temporal_running_mean`` (their 8-bit
     frames, ``mean`` and ``diff``) refused any array that was not C-contiguous ("disparity must
     be C-contiguous"), one channel of a colour image included; they copy it now, as the other
-    kernels did."""
+    kernels did. A float field of a packed structured array (``packed_field``) was read with
+    its 5-byte strides rounded down to one item by every kernel: other pixels than the
+    array's, without a word; it is read through NumPy's copy now."""
     call = KERNELS[kernel]
     want = call(arrays)
     viewed = {}
@@ -185,3 +200,11 @@ def test_arrays_updated_in_place_must_be_c_contiguous(arrays: dict[str, np.ndarr
     with pytest.raises(ValueError, match=r"^mean must be C-contiguous: it is updated in place$"):
         _core.temporal_running_mean(u8, mean[:, ::-1], count, diff, 16.0, 8)
     np.testing.assert_array_equal(mean, arrays["mean"])  # nothing written before the refusal
+    packed = _packed_field(mean)
+    says = (
+        "mean must be an aligned array whose strides are whole items (it is updated in place), "
+        "got strides [2100, 15, 5] for items of 4 bytes"
+    )
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.temporal_running_mean(u8, packed, count, diff, 16.0, 8)
+    np.testing.assert_array_equal(packed, arrays["mean"])

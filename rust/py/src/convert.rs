@@ -26,27 +26,52 @@ pub fn c_slice<'a, T: numpy::Element, D: Dimension>(
 /// The argument `name` as a read-only array of `T` and `D`'s dimensions. A wrong dtype or
 /// number of dimensions is a `TypeError` naming the argument and what it should be
 /// ("left: expected a float32 array, got float64"), not NumPy's bare "type mismatch".
+///
+/// An array whose items are not aligned, or whose strides are no multiple of the item size
+/// (a float field of a packed structured array, a buffer read at an odd offset), comes back
+/// as NumPy's C-ordered copy of it: the views read it as if each stride were rounded down to
+/// whole items, and the kernels computed from other pixels than the array's without a word.
 pub fn array_arg<'py, T: numpy::Element, D: Dimension>(
     obj: &Bound<'py, PyAny>,
     name: &str,
 ) -> PyResult<PyReadonlyArray<'py, T, D>> {
     let err = match obj.extract::<PyReadonlyArray<'py, T, D>>() {
-        Ok(a) => return Ok(a),
+        Ok(a) if whole_items::<T>(a.is_aligned(), a.strides()) => return Ok(a),
+        Ok(_) => {
+            let copy = obj.call_method1("copy", ("C",))?;
+            return copy.extract::<PyReadonlyArray<'py, T, D>>();
+        }
         Err(e) => e,
     };
     Err(describe_mismatch::<T, D>(obj, name).unwrap_or(err))
 }
 
-/// [`array_arg`] for an array the kernel writes into.
+/// [`array_arg`] for an array the kernel writes into: no copy can stand for it, so one that
+/// is not aligned or whose strides are no multiple of the item size is a `ValueError`.
 pub fn array_arg_rw<'py, T: numpy::Element, D: Dimension>(
     obj: &Bound<'py, PyAny>,
     name: &str,
 ) -> PyResult<PyReadwriteArray<'py, T, D>> {
     let err = match obj.extract::<PyReadwriteArray<'py, T, D>>() {
-        Ok(a) => return Ok(a),
+        Ok(a) if whole_items::<T>(a.is_aligned(), a.strides()) => return Ok(a),
+        Ok(a) => {
+            return Err(PyValueError::new_err(format!(
+                "{name} must be an aligned array whose strides are whole items (it is updated \
+                 in place), got strides {:?} for items of {} bytes",
+                a.strides(),
+                std::mem::size_of::<T>()
+            )))
+        }
         Err(e) => e,
     };
     Err(describe_mismatch::<T, D>(obj, name).unwrap_or(err))
+}
+
+/// Whether the array's items are aligned and its strides whole items: what rust-numpy's views
+/// need to read it as NumPy does.
+fn whole_items<T>(aligned: bool, strides: &[isize]) -> bool {
+    let size = std::mem::size_of::<T>() as isize;
+    aligned && strides.iter().all(|s| s % size == 0)
 }
 
 /// The `TypeError` for `obj` not being an array of `T` with `D`'s dimensions; None when it is
