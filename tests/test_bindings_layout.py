@@ -208,3 +208,27 @@ def test_arrays_updated_in_place_must_be_c_contiguous(arrays: dict[str, np.ndarr
     with pytest.raises(ValueError, match=re.escape(says)):
         _core.temporal_running_mean(u8, packed, count, diff, 16.0, 8)
     np.testing.assert_array_equal(packed, arrays["mean"])
+
+
+def test_an_in_place_array_that_cannot_be_written_is_named(
+    arrays: dict[str, np.ndarray],
+) -> None:
+    """A read-only ``mean``, or a ``diff`` that is a view of ``mean``, gave NumPy's bare
+    ``TypeError: The given array is not writeable`` / ``already borrowed``, naming neither."""
+    u8, diff = arrays["u8"], arrays["diff"]
+    mean, count = arrays["mean"].copy(), np.full(diff.shape, 3, np.uint8)
+    frozen = mean.copy()
+    frozen.flags.writeable = False
+    says = (
+        "mean: The given array is not writeable (it is updated in place: it must be writeable "
+        "and share no memory with another argument)"
+    )
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.temporal_running_mean(u8, frozen, count, diff, 16.0, 8)
+    says = (
+        "diff: The given array is already borrowed (it shares memory with an array this call "
+        "updates in place)"
+    )
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.temporal_running_mean(u8, mean, count, mean[..., 0], 16.0, 8)
+    np.testing.assert_array_equal(mean, arrays["mean"])

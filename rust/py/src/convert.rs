@@ -43,7 +43,14 @@ pub fn array_arg<'py, T: numpy::Element, D: Dimension>(
         }
         Err(e) => e,
     };
-    Err(describe_mismatch::<T, D>(obj, name).unwrap_or(err))
+    // An array of the right type that cannot be read: this call writes it through another
+    // argument (NumPy's bare "The given array is already borrowed" named neither).
+    Err(describe_mismatch::<T, D>(obj, name).unwrap_or_else(|| {
+        PyValueError::new_err(format!(
+            "{name}: {} (it shares memory with an array this call updates in place)",
+            err.value(obj.py())
+        ))
+    }))
 }
 
 /// [`array_arg`] for an array the kernel writes into: no copy can stand for it, so one that
@@ -64,7 +71,15 @@ pub fn array_arg_rw<'py, T: numpy::Element, D: Dimension>(
         }
         Err(e) => e,
     };
-    Err(describe_mismatch::<T, D>(obj, name).unwrap_or(err))
+    // An array of the right type that cannot be written: read-only, or shared with another
+    // argument ("The given array is not writeable" named no argument).
+    Err(describe_mismatch::<T, D>(obj, name).unwrap_or_else(|| {
+        PyValueError::new_err(format!(
+            "{name}: {} (it is updated in place: it must be writeable and share no memory \
+             with another argument)",
+            err.value(obj.py())
+        ))
+    }))
 }
 
 /// Whether the array's items are aligned and its strides whole items: what rust-numpy's views
@@ -75,7 +90,7 @@ fn whole_items<T>(aligned: bool, strides: &[isize]) -> bool {
 }
 
 /// The `TypeError` for `obj` not being an array of `T` with `D`'s dimensions; None when it is
-/// one (the extraction failed for another reason, e.g. a borrow conflict, which then stands).
+/// one (the extraction failed for another reason: a borrow conflict, a read-only array).
 fn describe_mismatch<T: numpy::Element, D: Dimension>(
     obj: &Bound<'_, PyAny>,
     name: &str,
