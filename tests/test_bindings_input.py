@@ -86,6 +86,8 @@ def test_every_kernel_lets_other_python_threads_run(crop: tuple[np.ndarray, np.n
     gl, gr = (np.ascontiguousarray(np.tile(as_gray_float(a), (6, 6))) for a in crop)
     bgr = np.ascontiguousarray(np.tile(crop[0], (6, 6, 1)))
     d, conf = np.full_like(gl, 5.0), np.full_like(gl, 0.5)
+    holes = d.copy()
+    holes[::7, ::5] = np.nan
     kernels = {
         "sgm_disparity": lambda: _core.sgm_disparity(gl, gr, 0, 127, 8, 32, 1.0, 10, 1, 0),
         "gabor_disparity": lambda: _core.gabor_disparity(gl, gr, 0.0, 64.0),
@@ -95,6 +97,14 @@ def test_every_kernel_lets_other_python_threads_run(crop: tuple[np.ndarray, np.n
         "mcgm_match": lambda: _core.mcgm_match(gl, gr, {"max_disparity": 32}),
         "refine_disparity": lambda: _core.refine_disparity(gl, gr, d, conf, *REFINE_ARGS),
         "graph_segments": lambda: _core.graph_segments(bgr.astype(np.float32), 1.0, 20),
+        "gabor_newton_step": lambda: _core.gabor_newton_step(gl, gr, d),
+        "hopfield_match": lambda: _core.hopfield_match(gl, gr, {"max_disparity": 64}),
+        "hopfield_candidates": lambda: _core.hopfield_candidates(gl, gr, {"max_disparity": 64}),
+        "mcgm_curves": lambda: _core.mcgm_curves(gl, {"max_disparity": 32}),
+        "fill_planes": lambda: _core.fill_planes(holes, bgr, [(16, 5)], 1.0),
+        "temporal_running_mean": lambda: _core.temporal_running_mean(
+            bgr, bgr.astype(np.float32), np.ones(gl.shape, np.uint8), conf, 2.0, 8
+        ),
     }
     count = [0]
     stop = threading.Event()
