@@ -154,7 +154,9 @@ def mcgm_filter(
     matches: npt.NDArray[np.float32],
     params: dict[str, Any],
 ) -> npt.NDArray[np.bool_]:
-    """B.8 occlusion filters on ``(N, 4)`` matches: kept flags."""
+    """B.8 occlusion filters on ``(N, 4)`` matches: kept flags. ``ValueError``: a row with a
+    NaN or infinite coordinate, or a point outside the images (``-0.5 .. W - 0.5``,
+    ``-0.5 .. H - 0.5``)."""
 
 # --- Hole fills (rust/py/src/fill.rs, segment.rs) -------------------------------------------------
 
