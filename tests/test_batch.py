@@ -1186,6 +1186,47 @@ def test_a_scene_with_a_bad_q_dat_fails_that_pair_alone(
     assert (out / "a" / "disparity.pfm").is_file() and not (out / "b").exists()
 
 
+def test_an_older_batch_summary_does_not_make_a_users_overview_png_ours(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A version 1 summary's entry without an outputs list takes the standard output names
+    in its folder as its own, but no version 1 batch wrote overview.png (4715e5e came after
+    version 2): the user's overview.png there was taken for ours and replaced by the rerun
+    without a word. It is refused as not listed, the file untouched."""
+    src, out = tmp_path / "drive", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png")
+    (out / "a").mkdir(parents=True)
+    (out / "a" / "disparity.png").write_text("old")  # the older batch's
+    (out / "a" / "overview.png").write_text("mine")  # the user's: a name it never wrote
+    summary = {
+        "version": 1,
+        "pairs": {
+            "a": {
+                "status": "failed",
+                "finished": "2026-11-30T10:00:00+00:00",
+                "this_run": "failed",
+                "left": str(src / "a/left.png"),
+                "right": str(src / "a/right.png"),
+                "calib": None,
+                "error": "ValueError: cannot decode .../a/right.png as an image",
+            }
+        },
+        "input": str(src.resolve()),
+        "output": str(out.resolve()),
+    }
+    (out / SUMMARY_NAME).write_text(json.dumps(summary, indent=1))
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    capsys.readouterr()
+    assert main(args) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: error: output folder {out}: {out / 'a' / 'overview.png'} is not "
+        "listed as an earlier run's output there and would be replaced: give another output "
+        "folder, or move or remove that file"
+    ]
+    assert (out / "a" / "overview.png").read_text() == "mine"
+    assert json.loads((out / SUMMARY_NAME).read_text()) == summary  # untouched
+
+
 def test_batch_redoes_pairs_an_older_batch_left_without_an_outputs_list(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -1200,7 +1241,7 @@ def test_batch_redoes_pairs_an_older_batch_left_without_an_outputs_list(
     _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
     for name in ("a", "b"):  # the done run's files, as an older batch wrote them
         (out / name).mkdir(parents=True)
-        for f in DISPARITY_FILES:
+        for f in DISPARITY_FILES - {"overview.png"}:  # no version 1 batch wrote overview.png
             (out / name / f).write_text("old")
     old = {"status": "failed", "finished": "2026-11-30T10:00:00+00:00", "this_run": "failed"}
     summary = {  # as batch wrote it before ed0f5f2

@@ -74,6 +74,9 @@ CONNECT_TIMEOUT = "10s"
 #: 2: every pair whose folder holds outputs of a run lists them (``outputs``); a version 1
 #: summary's failed pairs did not when a redo failed or lost an image (before ed0f5f2).
 _SUMMARY_VERSION = 2
+#: Output names added after summary version 1 (4715e5e): no version 1 batch wrote them, so a
+#: file under one in a version 1 pair's folder is the user's.
+_NAMES_SINCE_V2 = ("overview.png",)
 _LEFT_RE = re.compile(r"left", re.IGNORECASE)
 _RIGHT_RE = re.compile(r"right", re.IGNORECASE)
 _SCENE_CALIBS = ("calib.txt", "Q.dat")
@@ -830,9 +833,12 @@ def _list_legacy_outputs(out: Path, pairs: dict[str, Any]) -> None:
     gone, as failed without the outputs its folder still held from the run that did it: a
     rerun with the images mended refused those files as not listed (exit 2), and a user
     upgrading could not go on in the output folder. Only regular files are taken (a folder or
-    a link under such a name is still refused); the other files are not touched."""
+    a link under such a name is still refused); the other files are not touched. Names a
+    version 1 batch never wrote (:data:`_NAMES_SINCE_V2`: ``overview.png``) are not taken: a
+    file under one is the user's, and is refused as not listed, not replaced."""
     from stereovision.cli import DEPTH_OUTPUTS
 
+    legacy = [f for f in DEPTH_OUTPUTS if f not in _NAMES_SINCE_V2]
     for name, entry in pairs.items():
         if not isinstance(entry, dict) or isinstance(entry.get("outputs"), list):
             continue
@@ -841,7 +847,7 @@ def _list_legacy_outputs(out: Path, pairs: dict[str, Any]) -> None:
             if not folder.is_dir() or folder.is_symlink():
                 continue
             found = sorted(
-                f for f in DEPTH_OUTPUTS if (folder / f).is_file() and not (folder / f).is_symlink()
+                f for f in legacy if (folder / f).is_file() and not (folder / f).is_symlink()
             )
             if found:
                 entry["outputs"] = found
