@@ -12,7 +12,6 @@ import os
 import site
 import subprocess
 import sys
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -23,17 +22,25 @@ import stereovision as sv
 SCRIPT = Path(__file__).with_name("typed_user_script.py")
 
 
-def _mypy_strict(source: Path, cwd: Path) -> subprocess.CompletedProcess[str]:
+@pytest.fixture(scope="session")
+def mypy_cache(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """This test session's own mypy cache, shared by its mypy runs only: mypy's cache is not
+    safe for concurrent runs (one reads another's half-written data and crashes, or an SQLite
+    cache is locked), and a fixed folder in the temporary directory was one for every run of
+    every checkout on the machine at once (worktrees, ``pytest -n``)."""
+    return tmp_path_factory.mktemp("mypy-cache")
+
+
+def _mypy_strict(source: Path, cwd: Path, cache: Path) -> subprocess.CompletedProcess[str]:
     """``mypy --strict`` on ``source``, finding ``stereovision`` where Python does: through its
     ``py.typed`` in site-packages, or (a source checkout on PYTHONPATH) through MYPYPATH, which
     mypy refuses to point at site-packages. The package's own modules are checked, not reported:
-    a user's mypy reports the user's code."""
+    a user's mypy reports the user's code. ``cache``: :func:`mypy_cache`."""
     package_root = Path(sv.__file__).resolve().parents[1]
     env = dict(os.environ)
     sites = {Path(p).resolve() for p in [*site.getsitepackages(), site.getusersitepackages()]}
     if package_root not in sites:
         env["MYPYPATH"] = str(package_root)
-    cache = Path(tempfile.gettempdir()) / f"stereovision-mypy-strict-{os.getuid()}"
     return subprocess.run(
         [sys.executable, "-m", "mypy", "--strict", "--follow-imports=silent",
          "--no-error-summary", "--cache-dir", str(cache), str(source)],
@@ -41,16 +48,38 @@ def _mypy_strict(source: Path, cwd: Path) -> subprocess.CompletedProcess[str]:
     )  # fmt: skip
 
 
-def test_the_readme_script_passes_mypy_strict(tmp_path: Path) -> None:
+def test_mypy_runs_with_this_sessions_own_cache(
+    tmp_path: Path,
+    tmp_path_factory: pytest.TempPathFactory,
+    mypy_cache: Path,
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The cache was ``$TMPDIR/stereovision-mypy-strict-UID``, one folder for every concurrent
+    run on the machine (other checkouts' and ``pytest -n`` workers'), which mypy does not
+    support; it is under this session's base temporary folder now."""
+    seen: list[list[str]] = []
+
+    def fake_run(argv: list[str], **kwargs: object) -> subprocess.CompletedProcess[str]:
+        seen.append(argv)
+        return subprocess.CompletedProcess(argv, 0, "", "")
+
+    monkeypatch.setattr(subprocess, "run", fake_run)
+    _mypy_strict(SCRIPT, tmp_path, mypy_cache)
+    cache = Path(seen[0][seen[0].index("--cache-dir") + 1])
+    assert cache == mypy_cache
+    assert cache.is_relative_to(tmp_path_factory.getbasetemp())
+
+
+def test_the_readme_script_passes_mypy_strict(tmp_path: Path, mypy_cache: Path) -> None:
     """It failed on ``res.depth`` and ``res.depth_sigma`` (``ndarray | None`` even with a
     calibration: now ``require_depth()`` / ``require_depth_sigma()``) and on
     ``calib.depth_step(5.0)`` (an array for one number: now a float)."""
-    run = _mypy_strict(SCRIPT, tmp_path)
+    run = _mypy_strict(SCRIPT, tmp_path, mypy_cache)
     assert run.stdout + run.stderr == ""
     assert run.returncode == 0
 
 
-def test_mypy_strict_refuses_what_fails_at_run_time(tmp_path: Path) -> None:
+def test_mypy_strict_refuses_what_fails_at_run_time(tmp_path: Path, mypy_cache: Path) -> None:
     """The check above would pass if mypy saw nothing of the package (``Any`` everywhere): a
     script that uses ``res.depth`` unguarded is refused, naming the None, and so is a file name
     where a Calibration is meant (a TypeError at run time; ``Matches.to_points``'s and
@@ -64,7 +93,7 @@ def test_mypy_strict_refuses_what_fails_at_run_time(tmp_path: Path) -> None:
         "def check(a: npt.NDArray[np.uint8]) -> bool | None:\n"
         "    return sv.check_rectification(a, a, 'rig.yaml').ok\n"
     )
-    run = _mypy_strict(script, tmp_path)
+    run = _mypy_strict(script, tmp_path, mypy_cache)
     assert run.returncode == 1
     lines = run.stdout.splitlines()
     assert len(lines) == 3, run.stdout
@@ -152,7 +181,9 @@ def test_calibration_methods_take_disparity_like_the_functions() -> None:
             bound(disparity=d, disp=d)
 
 
-def test_mypy_strict_types_ranges_channels_and_steps_as_they_are(tmp_path: Path) -> None:
+def test_mypy_strict_types_ranges_channels_and_steps_as_they_are(
+    tmp_path: Path, mypy_cache: Path
+) -> None:
     """``match(max_disparity=res.max_disparity)`` (a float, as depth_map's) was refused
     (``int | None``), ``res.channels[...]`` was ``Any``, and ``depth_step(np.float32(5))`` an
     array: the first script passes, the second is refused where it is wrong."""
@@ -172,7 +203,7 @@ def test_mypy_strict_types_ranges_channels_and_steps_as_they_are(tmp_path: Path)
         "def step(calib: sv.Calibration) -> float:\n"
         "    return calib.depth_step(np.float32(5.0)) + calib.depth_step(np.int64(5))\n"
     )
-    run = _mypy_strict(right, tmp_path)
+    run = _mypy_strict(right, tmp_path, mypy_cache)
     assert run.stdout + run.stderr == ""
     assert run.returncode == 0
     wrong = tmp_path / "wrong.py"
@@ -181,7 +212,7 @@ def test_mypy_strict_types_ranges_channels_and_steps_as_they_are(tmp_path: Path)
         "from stereovision.depth import DepthChannels\n\n\n"
         "def sgm(ch: DepthChannels) -> npt.NDArray[np.float32]:\n    return ch['census']\n"
     )
-    run = _mypy_strict(wrong, tmp_path)
+    run = _mypy_strict(wrong, tmp_path, mypy_cache)
     assert run.returncode == 1
     lines = run.stdout.splitlines()
     assert all(ln.startswith("wrong.py:7: error: ") for ln in lines), run.stdout
