@@ -781,3 +781,19 @@ def test_occupancy_grid_save_is_all_or_nothing(
     assert cv2.imread(str(png), cv2.IMREAD_GRAYSCALE).shape == (3, 4)
     assert "resolution: 0.1\n" in yml.read_text() and "origin: [1.0, -2.0, 0.0]" in yml.read_text()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["empty", "map.png", "map.yaml"]
+
+
+def test_describe_says_the_cameras_height_in_the_unit_asked_for() -> None:
+    """The depth command's --unit (and the GUI's unit) said the height by replacing describe()'s
+    metre phrase, each with its own copy of it; describe(unit) says it, the rest unchanged."""
+    plane = fit_ground_plane(_floor_disparity(12.0, FLAT), RIG)
+    assert plane is not None
+    metres = plane.describe()
+    assert metres.startswith(f"ground plane: camera {plane.height:.3f} m above it, pitch ")
+    feet = plane.describe("ft")
+    assert feet == metres.replace(
+        f"camera {plane.height:.3f} m above", f"camera {plane.height / 0.3048:.3f} ft above"
+    )
+    assert plane.describe("mm").startswith(f"ground plane: camera {plane.height * 1000:.3f} mm ")
+    with pytest.raises(ValueError, match=r"^unit: expected one of \['m', 'mm', 'cm', 'ft', 'in'\]"):
+        plane.describe("feet")

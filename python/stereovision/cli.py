@@ -658,11 +658,7 @@ def _ground_outputs(
             log("ground plane: none found (no near-level plane holds 3 % of the pixels)")
         return {}
     if log is not None:
-        text = plane.describe()
-        if unit != "m":  # the camera's height in the unit asked for (the line is in metres)
-            metres = f"camera {plane.height:.3f} m above it"
-            text = text.replace(metres, f"camera {_length(plane.height, unit, 3)} above it")
-        log(text)
+        log(plane.describe(unit))
         log("the camera on the floor, for ROS 2: " + plane.ros2_static_transform())
     rc = calib if calib.rectified else calib.rectified_calibration()
     points = res.point_image(filled=True)  # once, for the obstacles, the scan and the grid

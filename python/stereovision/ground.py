@@ -30,7 +30,7 @@ import numpy.typing as npt
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
-from stereovision.calibration import Calibration
+from stereovision.calibration import UNIT_TO_METRES, Calibration
 
 __all__ = [
     "GROUND_INLIER_PX",
@@ -286,17 +286,31 @@ class GroundPlane:
         h, w = self.inliers.shape[:2]
         return f"GroundPlane({self.describe().removeprefix('ground plane: ')}; mask {w}x{h})"
 
-    def describe(self) -> str:
+    def describe(self, unit: str = "m") -> str:
         """One line for a terminal.
+
+        Parameters
+        ----------
+        unit : str, optional
+            Unit of the camera's height (a key of
+            :data:`stereovision.calibration.UNIT_TO_METRES`; default metres).
 
         Returns
         -------
         str
             Height, pitch, roll, inlier share and RMS, and a warning when many points lie below
             the plane.
+
+        Raises
+        ------
+        ValueError
+            If ``unit`` is not a known unit.
         """
+        if unit not in UNIT_TO_METRES:
+            raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+        height = self.height / UNIT_TO_METRES[unit]
         text = (
-            f"ground plane: camera {self.height:.3f} m above it, pitch {self.pitch_deg:+.2f} deg, "
+            f"ground plane: camera {height:.3f} {unit} above it, pitch {self.pitch_deg:+.2f} deg, "
             f"roll {self.roll_deg:+.2f} deg ({100 * self.inlier_share:.0f} % of the pixels, "
             f"RMS {self.rms_px:.2f} px)"
         )
