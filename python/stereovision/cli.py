@@ -1090,8 +1090,9 @@ def _eval_scene(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> di
     """One scene's ``eval`` row; every ``*_ms`` is the median of ``runs`` interleaved runs.
 
     Ours, StereoBM and SGBM-3WAY run in turn (A, B, C, A, B, C, ...: evaluation.md "Speed"),
-    ``runs`` times; the accuracy figures are those of the first run's outputs, so they do not
-    depend on ``runs``.
+    ``runs`` times, after one untimed warm-up round when ``runs`` > 1 (evaluation.md: "median
+    of >= 5 runs after a warm-up"; ``runs`` = 1 is one timed round, as before); the accuracy
+    figures are those of the first round's outputs, so they do not depend on ``runs``.
     """
     from stereovision import baselines
     from stereovision.depth import depth_map
@@ -1107,10 +1108,12 @@ def _eval_scene(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> di
     def timed(name: str, run: Any) -> None:
         t = time.perf_counter()
         out = run()
-        times[name].append(1000 * (time.perf_counter() - t))
-        outputs.setdefault(name, out)  # the first run's output is the one evaluated
+        if warm:  # the warm-up round's time (first calls: thread pools, caches) is not kept
+            times[name].append(1000 * (time.perf_counter() - t))
+        outputs.setdefault(name, out)  # the first round's output is the one evaluated
 
-    for _ in range(runs):
+    warm = runs == 1
+    for _ in range(runs if warm else runs + 1):
         timed(
             "ours",
             lambda: depth_map(
@@ -1125,6 +1128,7 @@ def _eval_scene(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> di
         if with_opencv:
             timed("bm", lambda: baselines.opencv_bm(scene.left, scene.right, md))
             timed("sgbm", lambda: baselines.opencv_sgbm(scene.left, scene.right, md))
+        warm = True
     res = outputs["ours"]
     row: dict[str, Any] = {"scene": scene.name, "max_disparity": md, "method": method}
     row["ours"] = dense_metrics(res.disparity, scene.gt).as_dict()
