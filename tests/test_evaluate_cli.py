@@ -161,3 +161,35 @@ def test_eval_of_a_scene_where_ours_has_no_gt_depth(data_dir: Path, tmp_path: Pa
     text = _eval(*argv)
     assert text.returncode == 0, text.stderr
     assert f"{row['scene']}: depth: none of our pixels has a GT depth" in text.stdout.splitlines()
+
+
+def test_eval_text_says_when_sgbm_or_the_members_have_no_gt_depth(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """SGBM-3WAY without a pixel on GT (a textureless pair: all invalid) and validated matches
+    none of which has a GT depth printed 'SGBM-3WAY over 0: nan %, nan %' and 'with GT depth:
+    0, RMSE nan % ...; SGBM-3WAY's RMSE nan %'; each says it has none, as ours does (0d1ed26)."""
+    from types import SimpleNamespace
+
+    from stereovision import baselines
+    from stereovision.matching import fusion
+
+    def no_sgbm(left: Any, right: Any, md: int) -> np.ndarray:
+        return np.full(left.shape[:2], np.nan, np.float32)
+
+    real_fuse = fusion.fuse_pair
+
+    def no_members(*a: Any, **k: Any) -> Any:
+        fused = real_fuse(*a, **k)
+        return SimpleNamespace(dispx=np.full_like(fused.dispx, np.nan))
+
+    monkeypatch.setattr(baselines, "opencv_sgbm", no_sgbm)
+    monkeypatch.setattr(fusion, "fuse_pair", no_members)
+    capsys.readouterr()
+    assert main(["eval", str(data_dir / "eth3d" / "terrace"), "--method", "fast"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert "nan" not in "\n".join(lines)
+    depth = next(line for line in lines if line.startswith("eth3d/terrace: depth over our "))
+    assert depth.endswith("; SGBM-3WAY: none of its pixels has a GT depth")
+    members = "eth3d/terrace: validated matches (>= 2 of Gabor, MCGM, Hopfield agree)"
+    assert f"{members}: none has a GT depth" in lines

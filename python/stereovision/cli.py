@@ -1306,18 +1306,21 @@ def cmd_eval(args: argparse.Namespace) -> int:
                 s = r["sgbm_depth"]
                 line += (
                     f"; SGBM-3WAY over {s['n']}: {s['median_rel']:.2f} %, {s['share_off_5']:.1f} %"
+                    if s["n"]
+                    else "; SGBM-3WAY: none of its pixels has a GT depth"
                 )
             print(line)
             if "_table1_text" in r:
                 print(r["_table1_text"])
         if "members_depth" in r:
             m = r["members_depth"]
-            line = (
-                f"{r['scene']}: validated matches (>= 2 of Gabor, MCGM, Hopfield agree)"
+            line = f"{r['scene']}: validated matches (>= 2 of Gabor, MCGM, Hopfield agree)" + (
                 f" with GT depth: {m['n']}, RMSE {m['rmse_pct']:.2f} % of the mean depth,"
                 f" median |dZ|/Z {m['median_rel']:.2f} %"
+                if m["n"]
+                else ": none has a GT depth"
             )
-            if "sgbm_depth" in r:
+            if "sgbm_depth" in r and r["sgbm_depth"]["n"]:  # else said on the depth line
                 line += f"; SGBM-3WAY's RMSE {r['sgbm_depth']['rmse_pct']:.2f} %"
             print(line)
             if "_members_table1_text" in r:
