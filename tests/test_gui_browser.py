@@ -473,7 +473,7 @@ def test_the_max_disparity_field_is_applied_and_checked():
     app._load_scene(bundled_data_dir() / "cones")
     _run(app, app.recompute)
     auto = app.max_disparity
-    assert app.state.max_disp_hint == f"auto: {auto} px, the pair's range"
+    assert app.state.max_disp_hint == f"auto: {auto} px at full size, the pair's range"
     assert f"disparities 0–{auto}\xa0px" in app.state.stats
     for typed, said in (
         (
@@ -1896,6 +1896,72 @@ def test_open_cameras_asks_the_chosen_pixel_format(data_dir, monkeypatch):
         build_app(parser.parse_args(["--left", "0", "--right", "1", "--fourcc", "MJPEG"]))
     with pytest.raises(ValueError, match="--fourcc asks the cameras for a format"):
         build_app(parser.parse_args(["--fourcc", "MJPG"]))
+
+
+def test_a_one_point_cloud_is_captioned_1_point(tmp_path):
+    """A cloud file of one point was captioned "1 points"."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import shown_cloud
+    from stereovision.io import write_ply
+
+    assert shown_cloud(np.ones((1, 3)))[1] == "1 point"
+    assert shown_cloud(np.ones((2, 3)))[1] == "2 points"
+    write_ply(tmp_path / "one.ply", np.array([[0.1, 0.2, 2.0]], np.float32))
+    app = _scene_app("test-one-point", [bundled_data_dir(), tmp_path])
+    app.state.view_mode = "points"
+    app.state.cloud_path = str(tmp_path / "one.ply")
+    app.open_cloud()
+    label = app.folders.label((tmp_path / "one.ply").resolve())
+    assert app.state.error == "" and app.state.message_3d == f"{label}: 1 point"
+
+
+def test_cloud_and_save_errors_show_short_paths(tmp_path, monkeypatch):
+    """A point-cloud file or a Save folder that failed was named by its whole absolute path
+    (/tmp/.../data/bad.ply) where the page shows paths short (the Save field: data/saved);
+    the errors show them as the Save field does (display_path)."""
+    from stereovision.gui import bundled_data_dir
+
+    data = tmp_path / "data"
+    data.mkdir()
+    (data / "bad.ply").write_text("not a cloud at all\n")
+    (data / "afile").write_text("mine")
+    monkeypatch.chdir(tmp_path)
+    app = _scene_app("test-short-paths", [bundled_data_dir(), data])
+    assert app.state.save_dir == "data/saved"
+    app.state.cloud_path = str(data / "bad.ply")
+    app.open_cloud()
+    assert app.state.error == "not a PLY file: data/bad.ply"
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.save_dir = "data/afile"
+    _run(app, app.save)
+    assert app.state.error == "save folder data/afile: is a file, not a folder"
+    app.state.save_dir = "data/afile/inside"
+    _run(app, app.save)
+    assert app.state.error == "save folder data/afile/inside: data/afile is a file, not a folder"
+    assert (data / "afile").read_text() == "mine"
+    assert str(tmp_path) not in app.state.error
+
+
+def test_the_max_disparity_hint_says_full_size_and_the_processing_width():
+    """At 320 the max-disparity field's hint gave the full-size range alone (64 px on the
+    450 px cones, 46 px searched). The field is in full-size pixels: the hint says so, and the
+    range searched at the processing width."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-max-disp-hint", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    auto = app.max_disparity
+    app.state.resolution = "320"
+    _run(app, app.recompute)
+    searched = -(-auto * 320 // 450)
+    assert app.state.max_disp_hint == (
+        f"auto: {auto} px at full size ({searched} px at width 320), the pair's range"
+    )
+    assert f"disparities 0–{searched}\xa0px" in app.state.stats
+    app.state.resolution = "full"
+    _run(app, app.recompute)
+    assert app.state.max_disp_hint == f"auto: {auto} px at full size, the pair's range"
 
 
 # ----------------------------------------------------------------------------- browser

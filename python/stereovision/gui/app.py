@@ -56,8 +56,10 @@ __all__ = [
     "RESOLUTIONS",
     "StereoApp",
     "compute_view",
+    "max_disparity_hint",
     "nowrap_units",
     "parse_max_disparity",
+    "short_paths",
 ]
 
 log = logging.getLogger(__name__)
@@ -245,14 +247,16 @@ def shown_cloud(points: npt.ArrayLike, colors: npt.ArrayLike | None = None) -> t
     Returns
     -------
     (pyvista.PolyData, str)
-        The cloud drawn and its count: ``"N points"``, or ``"2,000,000 of 15,000,000 points
-        shown"`` when a subset is drawn.
+        The cloud drawn and its count: ``"N points"`` (``"1 point"``), or ``"2,000,000 of
+        15,000,000 points shown"`` when a subset is drawn.
 
     Examples
     --------
     >>> cloud, said = shown_cloud(np.ones((5, 3)))
     >>> cloud.n_points, said
     (5, '5 points')
+    >>> shown_cloud(np.ones((1, 3)))[1]
+    '1 point'
     """
     from stereovision.render import display_subset, point_cloud
 
@@ -261,7 +265,7 @@ def shown_cloud(points: npt.ArrayLike, colors: npt.ArrayLike | None = None) -> t
     if len(pts) < total:
         said = f"{len(pts):,} of {total:,} points shown, evenly spaced"
     else:
-        said = f"{total} points"
+        said = "1 point" if total == 1 else f"{total} points"
     return point_cloud(pts, cols), said
 
 
@@ -385,6 +389,29 @@ def nowrap_units(text: str) -> str:
     '0–64\\xa0px · density 100\\xa0% · 0.29\\xa0s · median depth 3.50\\xa0m, 2 matches'
     """
     return _NUMBER_UNIT.sub(NBSP, text)
+
+
+def short_paths(message: str, path: str | os.PathLike[str]) -> str:
+    """``message`` with ``path`` and its parent folders written as the page shows paths
+    (:func:`~stereovision.gui.sources.display_path`: relative to the current folder, else
+    ``~/...``).
+
+    A point-cloud file or a Save folder that failed was named by its whole absolute path
+    (``/tmp/sv-.../scenes/x.ply``) where the page shows short paths.
+
+    Examples
+    --------
+    >>> import os
+    >>> short_paths(f"not a PLY file: {os.getcwd()}/scenes/x.ply", Path("scenes/x.ply").resolve())
+    'not a PLY file: scenes/x.ply'
+    """
+    p = Path(os.path.abspath(path))
+    for folder in (p, *p.parents):
+        if len(folder.parts) > 1 and str(folder) in message:
+            shown = display_path(folder)
+            if shown != str(folder):
+                message = message.replace(str(folder), shown)
+    return message
 
 
 def _length(metres: float, unit: str) -> str:
@@ -675,6 +702,41 @@ def compute_view(
         median_depth=median_depth,
         stats_parts=(head, tail),
     )
+
+
+def max_disparity_hint(auto: int | None, full_width: int, width: int | None) -> str:
+    """The max-disparity field's hint: the pair's own range at full size (the field is in
+    full-size pixels), and what is searched at the processing width when it is smaller.
+
+    At 320 the hint said the full-size range alone (64 px on a 450 px pair, 46 px searched).
+
+    Parameters
+    ----------
+    auto : int or None
+        The pair's range at full size (None: estimated from the images, :data:`AUTO_HINT`).
+    full_width : int
+        The pair's width at full size.
+    width : int or None
+        The processing width (None: full size).
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> max_disparity_hint(64, 450, None)
+    "auto: 64 px at full size, the pair's range"
+    >>> max_disparity_hint(64, 450, 320)
+    "auto: 64 px at full size (46 px at width 320), the pair's range"
+    """
+    if auto is None:
+        return AUTO_HINT
+    said = f"auto: {auto} px at full size"
+    if width is not None and width < full_width:
+        # as compute_view scales the range: rounded up to a whole pixel
+        said += f" ({max(1, -(-auto * width // full_width))} px at width {width})"
+    return said + ", the pair's range"
 
 
 def parse_max_disparity(text: str | None, width: int) -> int | None:
@@ -1003,8 +1065,12 @@ class StereoApp:
     def _on_save_dir(self, save_dir: str | None = None, **_: Any) -> None:
         self.state.save_dir_title = self._save_title(save_dir)
 
-    def _fail(self, exc: BaseException) -> None:
+    def _fail(self, exc: BaseException, path: Path | None = None) -> None:
+        """Say ``exc`` on the page (its first line), ``path`` in it as the page shows paths
+        (:func:`short_paths`) when given."""
         msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        if path is not None:
+            msg = short_paths(msg, path)
         log.info("gui error: %s", msg)
         with self.state:
             self.state.error = msg
@@ -1251,13 +1317,15 @@ class StereoApp:
         """Show a point-cloud file (PLY / PCD / NPZ) from the allowed folders in the 3-D view."""
         from stereovision.export import load_cloud
 
+        path: Path | None = None
         try:
             path = self.folders.resolve(self.state.cloud_path or "")
             pts, cols = load_cloud(path)
             cloud, count = shown_cloud(pts, cols)
             del pts, cols  # the drawn subset is a copy: the file's arrays can go
         except (ValueError, OSError) as exc:
-            self._fail(exc)
+            # the file as the page shows paths, not its whole absolute path
+            self._fail(exc, path)
             return
         self._cloud = cloud
         self._cloud_caption = f"{self.folders.label(path)}: {count}"
@@ -1307,11 +1375,7 @@ class StereoApp:
                 st.busy = True
                 st.progress = 1
                 st.status = f"computing ({method})"
-                st.max_disp_hint = (
-                    AUTO_HINT
-                    if self.max_disparity is None
-                    else f"auto: {self.max_disparity} px, the pair's range"
-                )
+                st.max_disp_hint = max_disparity_hint(self.max_disparity, left.shape[1], width)
                 if fresh:  # another pair: its images now, no result of the previous pair
                     if self._page_before is None:
                         self._page_before = {k: st[k] for k in _RESULT_KEYS}
@@ -1626,6 +1690,7 @@ class StereoApp:
         names = SAVED_FILES + (SAVED_DEPTH_FILES if result.depth is not None else ())
         typed = str(self.state.save_dir or "").strip()
         skipped: list[str] = []
+        folder: Path | None = None
         try:
             if self._save_roots and typed in ("", self._offered_save_dir):
                 folder = self._next_save_folder(skipped)
@@ -1645,7 +1710,7 @@ class StereoApp:
                 )
             check_output_folder(folder, "save folder")
         except (ValueError, OSError) as exc:
-            self._fail(exc)
+            self._fail(exc, folder)
             return
 
         def run() -> dict[str, Path]:
@@ -1655,7 +1720,7 @@ class StereoApp:
         try:
             written = await asyncio.get_running_loop().run_in_executor(self._executor, run)
         except (ValueError, OSError, RuntimeError, CliError) as exc:
-            self._fail(exc)
+            self._fail(exc, folder)
             return
         finally:
             self._saving_into.discard(folder)
