@@ -1964,6 +1964,77 @@ def test_the_max_disparity_hint_says_full_size_and_the_processing_width():
     assert app.state.max_disp_hint == f"auto: {auto} px at full size, the pair's range"
 
 
+@pytest.mark.parametrize("method", ["mcgm", "hopfield"])
+def test_the_sparse_channels_are_offered_and_their_matches_drawn(method):
+    """The page offered fused, gabor, census, fast and the OpenCV references: MCGM and Hopfield,
+    the paper's other channels, were not on it (its list was depth_map's methods; the sparse
+    drawing path named them but was never reached). They are offered: the matches on show are
+    stereovision.match's on the same scaled pair, the statistics give their count and their
+    precision@1 against the scene's GT, and the 3-D view shows their points in either mode."""
+    from stereovision import match
+    from stereovision.evaluate import sparse_metrics
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.sources import scale_pair, scaled_calibration
+    from stereovision.io import load_scene
+
+    app = _scene_app(f"test-sparse-{method}", [bundled_data_dir()])
+    assert method in app.state.methods
+    cones = bundled_data_dir() / "cones"
+    app._load_scene(cones)
+    app.state.method, app.state.resolution = method, "320"
+    _run(app, app.recompute)
+    assert app.state.error == ""
+    view = app.view
+    scene = load_scene(cones)
+    left_s, right_s, s = scale_pair(scene.left, scene.right, 320)
+    calib_s = scaled_calibration(scene.calib, s, (left_s.shape[1], left_s.shape[0]))
+    d_max = -(-scene.max_disparity * 320 // 450)
+    assert view.result.max_disparity == d_max
+    expected = match(left_s, right_s, calib_s, method=method, max_disparity=d_max)
+    assert len(expected) > 500 and len(view.matches) == len(expected)
+    np.testing.assert_array_equal(view.matches.to_array(), expected.to_array())
+    np.testing.assert_array_equal(view.result.disparity, expected.dispx)
+    h_s, w_s = left_s.shape[:2]
+    gt_s = cv2.resize(scene.gt, (w_s, h_s), interpolation=cv2.INTER_NEAREST) * (w_s / 450)
+    m = sparse_metrics(expected.xl, expected.yl, expected.xr, gt_s)
+    assert m.precision[1.0] > 90
+    said = (
+        f"{len(expected)} matches, precision@1 {m.precision[1.0]:.1f}\xa0% of the {m.count} on GT"
+    )
+    assert said in app.state.stats and "density" not in app.state.stats
+    n = len(view.result.points)
+    assert n == np.isfinite(expected.dispx).sum()
+    for mode in ("surface", "points"):
+        app.state.view_mode = mode
+        app._on_view_mode()
+        poly = app.plotter.actors["scene"].GetMapper().GetInput()
+        assert (poly.GetNumberOfPoints(), poly.GetNumberOfPolys()) == (n, 0), mode
+        assert app.state.message_3d == (
+            f"{method} is sparse: no dense map, its {n} points shown as points"
+        )
+    # after Rectify (or for another pair) the scene's GT is not that pair's: no precision said
+    app._scene_gt = (None, scene.gt)
+    _run(app, app.recompute)
+    assert f"{len(expected)} matches ·" in app.state.stats and "precision" not in app.state.stats
+
+
+def test_draw_sparse_colours_each_match_by_its_value():
+    """A sparse method's picture: each matched pixel in the colour colorize gives its value on
+    the dense pictures' scale, the rest the image dimmed in grey."""
+    from stereovision.cli import colorize
+    from stereovision.gui.app import draw_sparse
+
+    image = np.full((40, 60, 3), 200, np.uint8)
+    values = np.full((40, 60), np.nan, np.float32)
+    values[10, 10], values[30, 50] = 2.0, 30.0
+    out = draw_sparse(image, values, 0.0, 32.0)
+    ramp = colorize(np.array([[2.0, 30.0]], np.float32), lo=0.0, hi=32.0)[0]
+    np.testing.assert_array_equal(out[10, 10], ramp[0])
+    np.testing.assert_array_equal(out[30, 50], ramp[1])
+    np.testing.assert_array_equal(out[0, 0], [100, 100, 100])
+    assert not np.array_equal(ramp[0], ramp[1])
+
+
 # ----------------------------------------------------------------------------- browser
 
 

@@ -53,9 +53,11 @@ from stereovision.gui.sources import (
 
 __all__ = [
     "EXTRA_METHODS",
+    "MATCH_METHODS",
     "RESOLUTIONS",
     "StereoApp",
     "compute_view",
+    "draw_sparse",
     "max_disparity_hint",
     "nowrap_units",
     "parse_max_disparity",
@@ -79,8 +81,15 @@ AVERAGE_FRAMES = 8
 #: OpenCV references offered beside the package's matchers (evaluation.md baselines).
 EXTRA_METHODS = ("opencv-sgbm", "opencv-bm")
 
+#: The paper's sparse channels, offered beside ``depth_map``'s methods: their matches
+#: (:func:`stereovision.match`) are drawn on the left image, coloured by disparity (and by
+#: depth), and the 3-D view shows their points. They were never on the page: its list was
+#: ``depth_map``'s methods, which has no sparse one (this path's names never reached it).
+#: ``"best"`` (Hopfield's reference without the network) is an ablation, not offered.
+MATCH_METHODS = ("mcgm", "hopfield")
+
 #: Methods whose output is sparse: their matches are drawn on the image pair.
-SPARSE_METHODS = frozenset({"mcgm", "hopfield"})
+SPARSE_METHODS = frozenset(MATCH_METHODS)
 
 #: A result with fewer valid pixels than this fraction is treated as sparse (matches drawn).
 SPARSE_DENSITY = 0.2
@@ -309,6 +318,45 @@ def draw_matches(
     return canvas
 
 
+def draw_sparse(
+    image: npt.NDArray[np.uint8],
+    values: npt.NDArray[np.floating[Any]],
+    lo: float | None,
+    hi: float | None,
+) -> npt.NDArray[np.uint8]:
+    """A sparse method's matches on its left image: a dot at each matched pixel, coloured by
+    ``values`` there (disparity, or 1 / depth) as the dense pictures colour theirs.
+
+    Parameters
+    ----------
+    image : ndarray, uint8 (H, W, 3)
+        BGR left (rectified) image, shown dimmed in grey under the dots.
+    values : ndarray, float (H, W)
+        NaN where there is no match.
+    lo, hi : float or None
+        The ends of the colour map (:func:`stereovision.cli.colorize`'s).
+
+    Returns
+    -------
+    ndarray, uint8 (H, W, 3)
+        The picture; a dot's centre has the colour ``colorize`` gives its value.
+    """
+    from stereovision.cli import colorize
+
+    grey = cv2.cvtColor(np.ascontiguousarray(image, dtype=np.uint8), cv2.COLOR_BGR2GRAY)
+    out: npt.NDArray[np.uint8] = np.repeat((grey // 2)[..., None], 3, axis=2).astype(np.uint8)
+    ys, xs = np.nonzero(np.isfinite(values))
+    if len(xs) == 0:
+        return out
+    colours = colorize(np.asarray(values, np.float32)[ys, xs][None, :], lo=lo, hi=hi)[0]
+    # a dot about 2 px across on the page, whatever the pair's size (shown DISPLAY_WIDTH wide)
+    radius = max(1, round(image.shape[1] / DISPLAY_WIDTH))
+    for x, y, c in zip(xs.tolist(), ys.tolist(), colours.tolist(), strict=True):
+        cv2.circle(out, (x, y), radius, tuple(c), -1)
+    out[ys, xs] = colours  # each centre its own colour, where dots overlap too
+    return out
+
+
 @dataclass
 class ViewData:
     """Everything the page shows for one computed pair (built in the worker thread)."""
@@ -336,6 +384,9 @@ class ViewData:
     #: The floor Find floor found on this pair (None: not found, or not looked for yet), said
     #: again in another unit when the toggle changes.
     floor: Any = None
+    #: A sparse method's matches (:func:`stereovision.match`'s output; None for a dense one):
+    #: drawn on the left image, and the 3-D view shows their points whatever its mode.
+    matches: Any = None
 
     def texts(self, unit: str = "m") -> tuple[str, str]:
         """The depth caption and the statistics line with their lengths in ``unit``.
@@ -491,7 +542,6 @@ def floor_view(result: Any) -> tuple[Any, str]:
 def _opencv_result(method: str, left: np.ndarray, right: np.ndarray, calib: Any, d_max: int) -> Any:
     """A ``DepthResult`` from an OpenCV reference matcher (for comparison in the GUI)."""
     from stereovision import baselines
-    from stereovision.depth import DepthResult
 
     if calib is not None and not calib.rectified:
         left, right = calib.rectify(left, right)
@@ -506,6 +556,33 @@ def _opencv_result(method: str, left: np.ndarray, right: np.ndarray, calib: Any,
         # OpenCV's message starts with its version and a source path: the page says its reason
         reason = str(exc).split("error: ", 1)[-1].strip().splitlines()[0]
         raise ValueError(f"{method} cannot match this {w}x{h} pair: {reason}") from None
+    return _result_from_disparity(method, disp, left, calib, d_max)
+
+
+def _sparse_result(
+    method: str, left: np.ndarray, right: np.ndarray, calib: Any, d_max: int | None
+) -> tuple[Any, Any]:
+    """A sparse method's matches (:func:`stereovision.match`) on the pair, and a ``DepthResult``
+    of them: their disparity at the matched left pixels (:attr:`Matches.dispx`), NaN elsewhere,
+    with the depth and points there."""
+    from stereovision.depth import estimate_max_disparity
+    from stereovision.match import match
+
+    if calib is not None and not calib.rectified:
+        left, right = calib.rectify(left, right)
+        calib = calib.rectified_calibration()
+    d = d_max if d_max is not None else estimate_max_disparity(left, right)
+    matches = match(left, right, calib, method=method, max_disparity=d)
+    disp = np.ascontiguousarray(matches.dispx, dtype=np.float32)
+    return _result_from_disparity(method, disp, left, calib, d), matches
+
+
+def _result_from_disparity(
+    method: str, disp: np.ndarray, left: np.ndarray, calib: Any, d_max: int
+) -> Any:
+    """A ``DepthResult`` of a disparity map (NaN: none) of the rectified ``left`` image."""
+    from stereovision.depth import DepthResult
+
     valid = np.isfinite(disp)
     depth = None
     points = np.zeros((0, 3), np.float32)
@@ -542,6 +619,7 @@ def compute_view(
     width: int | None = None,
     max_disparity: int | None = None,
     progress: Any = None,
+    gt: npt.NDArray[np.float32] | None = None,
 ) -> ViewData:
     """Depth of one pair and every picture the page shows of it (runs in the worker thread).
 
@@ -552,13 +630,19 @@ def compute_view(
     calib : Calibration or None
         For the input size; scaled with the images.
     method : str
-        A name of ``stereovision.depth.METHODS`` or :data:`EXTRA_METHODS`.
+        A name of ``stereovision.depth.METHODS``, :data:`MATCH_METHODS` (sparse: the matches
+        are drawn on the left image, their count said) or :data:`EXTRA_METHODS`.
     width : int, optional
         Processing width (images scaled down to it).
     max_disparity : int, optional
         At the input size; scaled with the images (None: chosen from the images).
     progress : callable, optional
         Called with ``(percent, text)``.
+    gt : ndarray, float32 (H, W), optional
+        The left image's GT disparity at the input size (NaN: unknown), of a pair used as
+        given (no calibration, or a rectified one): a sparse method's statistics then say its
+        precision@1 (the share of its matches with GT within 1 px of it, at the size computed:
+        the GT scaled with the images).
 
     Raises
     ------
@@ -574,7 +658,7 @@ def compute_view(
         if progress is not None:
             progress(pct, text)
 
-    if method not in METHODS and method not in EXTRA_METHODS:
+    if method not in METHODS and method not in EXTRA_METHODS and method not in MATCH_METHODS:
         raise ValueError(f"unknown method {method!r}")
     notes: list[str] = []
     if calib is not None:
@@ -608,9 +692,12 @@ def compute_view(
     # The library's warnings (a pair that looks swapped) go on the page, not the server's log.
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        matches = None
         if method in EXTRA_METHODS:
             d = d_max or estimate_max_disparity(left_s, right_s)
             result = _opencv_result(method, left_s, right_s, calib_s, d)
+        elif method in MATCH_METHODS:
+            result, matches = _sparse_result(method, left_s, right_s, calib_s, d_max)
         else:
             planned = _planned_stages(method, calib_s is not None)
 
@@ -641,7 +728,11 @@ def compute_view(
         # no key, as the depth picture had none
         disp_hi = float(np.percentile(disp_known, 99))
         disparity_caption = f"disparity: blue 0 px … red {disp_hi:.1f} px"
-    disparity_url = _data_url(colorize(result.disparity, lo=0.0, hi=disp_hi))
+    sparse = matches is not None
+    if sparse:
+        disparity_url = _data_url(draw_sparse(shown_left, result.disparity, 0.0, disp_hi))
+    else:
+        disparity_url = _data_url(colorize(result.disparity, lo=0.0, hi=disp_hi))
     depth_img = np.zeros_like(shown_left)
     depth_caption = DEPTH_CAPTION
     depth_ends = None
@@ -653,7 +744,10 @@ def compute_view(
             # colorize's own range (1st-99th percentile of 1 / depth), said in metres: the
             # picture had no key, and its scale changes with every pair
             lo, hi = (float(np.percentile(finite, q)) for q in (1, 99))
-            depth_img = colorize(inv, lo=lo, hi=hi)
+            if sparse:
+                depth_img = draw_sparse(shown_left, inv, lo, hi)
+            else:
+                depth_img = colorize(inv, lo=lo, hi=hi)
             depth_ends = (1.0 / hi if hi > 0 else math.inf, 1.0 / lo if lo > 0 else math.inf)
             near, far = (_length(v, "m") for v in depth_ends)
             depth_caption = f"depth: red {near} … blue {far}"  # one line above the picture
@@ -669,14 +763,23 @@ def compute_view(
         message_3d = "No calibration: give --calib to see the scene in 3-D."
     elif len(result.points) == 0:
         message_3d = "Empty point cloud: the matcher found no depth in this pair."
+    elif sparse:
+        # no dense map to draw a surface of: the matched points, in either mode
+        mesh, count = shown_cloud(result.points, result.colors)
+        intr = Intrinsics.from_result(result)
+        message_3d = f"{method} is sparse: no dense map, its {count} shown as points"
     else:
         report(95, "building the 3-D surface")
         step = max(1, math.ceil(math.sqrt(len(result.points) / MAX_MESH_VERTICES)))
         mesh = surface_mesh(result, step=step)
         intr = Intrinsics.from_result(result)
+    if matches is not None:
+        amount = f"{len(matches)} matches" + _sparse_precision(matches, gt, left, left_s)
+    else:
+        amount = f"density {100 * result.density:.0f} %"
     head = (
         f"{method} · {left_s.shape[1]}×{left_s.shape[0]} · disparities 0–{result.max_disparity}"
-        f" px · density {100 * result.density:.0f} % · {elapsed:.2f} s"
+        f" px · {amount} · {elapsed:.2f} s"
     )
     median_depth = None
     if result.depth is not None and len(result.points):
@@ -701,7 +804,26 @@ def compute_view(
         depth_ends=depth_ends,
         median_depth=median_depth,
         stats_parts=(head, tail),
+        matches=matches,
     )
+
+
+def _sparse_precision(matches: Any, gt: Any, left: np.ndarray, left_s: np.ndarray) -> str:
+    """What the statistics say of a sparse method's matches against the left image's GT
+    (``gt`` at the size of ``left``; scaled to that of ``left_s`` as the images were): ""
+    without GT."""
+    from stereovision.evaluate import sparse_metrics
+
+    if gt is None or np.shape(gt) != left.shape[:2]:
+        return ""
+    g = np.asarray(gt, np.float32)
+    (h, w), (h_s, w_s) = left.shape[:2], left_s.shape[:2]
+    if (h_s, w_s) != (h, w):  # the nearest GT pixel, its disparity in the scaled pair's pixels
+        g = np.asarray(cv2.resize(g, (w_s, h_s), interpolation=cv2.INTER_NEAREST)) * (w_s / w)
+    m = sparse_metrics(matches.xl, matches.yl, matches.xr, g)
+    if m.count == 0:
+        return ", none on GT"
+    return f", precision@1 {m.precision[1.0]:.1f} % of the {m.count} on GT"
 
 
 def max_disparity_hint(auto: int | None, full_width: int, width: int | None) -> str:
@@ -907,6 +1029,7 @@ class StereoApp:
         # the pair as the source gave it, before "Rectify" (which starts from it again)
         self.raw_pair: tuple[np.ndarray, np.ndarray] | None = None
         self.calib: Any = None
+        self._scene_gt: tuple[Any, Any] = (None, None)
         #: Why the pair has no calibration when ``--calib`` would not help (a scene without
         #: calib.txt, files another calibration does not fit); None: "give --calib".
         self._no_calib: str | None = None
@@ -949,7 +1072,7 @@ class StereoApp:
         self._saving_into: set[Path] = set()
 
         st = self.state
-        st.methods = [*METHODS, *EXTRA_METHODS]
+        st.methods = [*METHODS, *MATCH_METHODS, *EXTRA_METHODS]
         st.method = METHODS[0]
         st.resolutions = list(RESOLUTIONS)
         st.resolution = RESOLUTIONS[0]
@@ -1113,6 +1236,9 @@ class StereoApp:
         scene_dir = self.folders.resolve(path) if Path(path) != self.demo_scene else Path(path)
         scene = load_scene(scene_dir)
         self.pair = self.raw_pair = (scene.left, scene.right)
+        #: The scene's GT disparity and the pair it belongs to (a sparse method's precision is
+        #: said while that pair is computed as given: not after Rectify, nor for another pair).
+        self._scene_gt = (self.pair, scene.gt)
         self.calib = scene.calib
         self.max_disparity = scene.max_disparity
         self.homographies = None  # another rig
@@ -1366,6 +1492,9 @@ class StereoApp:
             calib = self.calib
             chosen = self.chosen_max_disparity
             d_max = chosen if chosen is not None else self.max_disparity
+            gt = None
+            if self._scene_gt[0] is self.pair and (calib is None or calib.rectified):
+                gt = self._scene_gt[1]
             method = self.state.method
             res = self.state.resolution
             width = None if res == "full" else int(res)
@@ -1400,6 +1529,7 @@ class StereoApp:
                         width=width,
                         max_disparity=d_max,
                         progress=progress,
+                        gt=gt,
                     )
                 finally:
                     # A click is no frame loop: hand the extension's kept buffers and the C
@@ -1800,6 +1930,8 @@ class StereoApp:
         v = self.view
         if v is None or v.mesh is None:
             return None
+        if v.matches is not None:
+            return v.mesh  # a sparse method's points: no surface to draw
         if self.state.view_mode == "points":
             cloud, count = shown_cloud(v.result.points, v.result.colors)
             if cloud.n_points < len(v.result.points):
