@@ -473,7 +473,7 @@ def test_the_max_disparity_field_is_applied_and_checked():
     app._load_scene(bundled_data_dir() / "cones")
     _run(app, app.recompute)
     auto = app.max_disparity
-    assert app.state.max_disp_hint == f"auto: {auto} px at full size, the pair's range"
+    assert app.state.max_disp_hint == f"auto: {auto} px at full size"
     assert f"disparities 0–{auto}\xa0px" in app.state.stats
     for typed, said in (
         (
@@ -1955,13 +1955,11 @@ def test_the_max_disparity_hint_says_full_size_and_the_processing_width():
     app.state.resolution = "320"
     _run(app, app.recompute)
     searched = -(-auto * 320 // 450)
-    assert app.state.max_disp_hint == (
-        f"auto: {auto} px at full size ({searched} px at width 320), the pair's range"
-    )
+    assert app.state.max_disp_hint == (f"auto: {auto} px at full size ({searched} at 320)")
     assert f"disparities 0–{searched}\xa0px" in app.state.stats
     app.state.resolution = "full"
     _run(app, app.recompute)
-    assert app.state.max_disp_hint == f"auto: {auto} px at full size, the pair's range"
+    assert app.state.max_disp_hint == f"auto: {auto} px at full size"
 
 
 @pytest.mark.parametrize("method", ["mcgm", "hopfield"])
@@ -2534,6 +2532,29 @@ def test_a_wide_scene_is_shown_whole_in_the_3d_view(page, gui_data):
         corr = float(np.corrcoef(gray[drawn], ref[drawn])[0, 1]) if drawn.mean() > 0.5 else -1
     assert corr >= 0.5, corr
     _shot(page, "gui-wide.png")
+
+
+def test_the_max_disparity_hint_fits_its_field(page):
+    """The hint "auto: 64 px at full size, the pair's range" was cut at "the pair's rang" by
+    the field's edge. It fits, at full size and at 320 (where it says both ranges). After the
+    wide scene's test: a scene has a range of its own (the cameras' pairs have none)."""
+    assert page.inner_text("#source-label").endswith("/wide")
+    n = _computations(page)
+    for res in ("320", "full"):
+        page.click(f"#resolution-{res}")
+        n += 1
+        _wait_computations(page, n)
+        hint, text_px, room_px = page.evaluate(
+            """() => { const i = document.querySelector('#max-disparity');
+                  const st = getComputedStyle(i); const c = document.createElement('canvas')
+                  .getContext('2d'); c.font = st.font;
+                  return [i.placeholder, c.measureText(i.placeholder).width,
+                          i.clientWidth - parseFloat(st.paddingLeft)
+                          - parseFloat(st.paddingRight)]; }"""
+        )
+        assert text_px <= room_px, (hint, text_px, room_px)
+        assert re.fullmatch(r"auto: \d+ px at full size", hint.split(" (")[0]), hint
+        assert hint.endswith(" at 320)") == (res == "320"), hint
 
 
 def test_open_stereo_source_loops_video_files(tmp_path):

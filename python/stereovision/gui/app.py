@@ -831,6 +831,7 @@ def max_disparity_hint(auto: int | None, full_width: int, width: int | None) -> 
     full-size pixels), and what is searched at the processing width when it is smaller.
 
     At 320 the hint said the full-size range alone (64 px on a 450 px pair, 46 px searched).
+    It is short enough for the field (it was cut at "the pair's rang" on a 1500 px page).
 
     Parameters
     ----------
@@ -848,17 +849,17 @@ def max_disparity_hint(auto: int | None, full_width: int, width: int | None) -> 
     Examples
     --------
     >>> max_disparity_hint(64, 450, None)
-    "auto: 64 px at full size, the pair's range"
+    'auto: 64 px at full size'
     >>> max_disparity_hint(64, 450, 320)
-    "auto: 64 px at full size (46 px at width 320), the pair's range"
+    'auto: 64 px at full size (46 at 320)'
     """
     if auto is None:
         return AUTO_HINT
     said = f"auto: {auto} px at full size"
     if width is not None and width < full_width:
         # as compute_view scales the range: rounded up to a whole pixel
-        said += f" ({max(1, -(-auto * width // full_width))} px at width {width})"
-    return said + ", the pair's range"
+        said += f" ({max(1, -(-auto * width // full_width))} at {width})"
+    return said
 
 
 def parse_max_disparity(text: str | None, width: int) -> int | None:
