@@ -497,24 +497,11 @@ def floor_caption(unit: str = "m") -> str:
 
 
 def floor_text(plane: Any, unit: str = "m") -> str:
-    """Find floor's line for a ground plane (None: none found), its height in ``unit``.
-
-    The line is the library's ``GroundPlane.describe()`` (in metres), its camera height said
-    in ``unit`` instead.
-    """
-    from stereovision.calibration import UNIT_TO_METRES
-
+    """Find floor's line for a ground plane (None: none found), its height in ``unit``:
+    ``GroundPlane.describe(unit)``, numbers kept with their units."""
     if plane is None:
         return NO_FLOOR
-    text = str(plane.describe())
-    if unit == "m":
-        return nowrap_units(text)
-    metres = f"camera {plane.height:.3f} m above it"
-    said = f"camera {plane.height / UNIT_TO_METRES[unit]:.3f} {unit} above it"
-    if metres in text:
-        return nowrap_units(text.replace(metres, said, 1))
-    # the library's wording changed: the height is said anyway
-    return nowrap_units(f"{text} ({said})")
+    return nowrap_units(str(plane.describe(unit)))
 
 
 def floor_view(result: Any) -> tuple[Any, str]:
