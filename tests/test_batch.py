@@ -1102,7 +1102,7 @@ def test_camera_folders_pair_names_with_left_and_right_by_their_number(
             "k/R/right_07.png",
         ),
     )
-    jobs, unpaired = batch._scan(root)
+    jobs, unpaired, _ = batch._scan(root)
     assert [(j.name, j.left, j.right) for j in jobs] == [
         ("k/L/7", root / "k/L/Left-7.png", root / "k/R/right_07.png"),
         ("s/0001", root / "s/left/left_0001.png", root / "s/right/right_0001.png"),
@@ -1478,3 +1478,41 @@ def test_calib_unit_reaches_the_workers(
         "output, Q.dat)\n"
     )
     assert not out.exists()
+
+
+def test_batch_sizes_opencv_stereo_calib_output_by_the_first_pair(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """OpenCV stereo_calib's intrinsics.yml + extrinsics.yml hold no image size: batch refused
+    them ("this command cannot read it from its images, so save the rig once in Python ..."),
+    exit 2. The first pair's left image sizes them now; a pair of another size fails with
+    depth's own message, the others are done with the rig (metric outputs)."""
+    from test_calibration import _opencv_stereo_calib
+
+    rig, root, out = tmp_path / "rig", tmp_path / "in", tmp_path / "out"
+    rig.mkdir()
+    root.mkdir()
+    _opencv_stereo_calib(rig)  # 640x480, T in mm
+    for n in ("01", "02"):
+        for side in ("left", "right"):
+            shutil.copy(data_dir / "chessboard" / f"{side}{n}.jpg", root / f"{side}{n}.jpg")
+            small = cv2.resize(cv2.imread(str(root / f"{side}{n}.jpg")), (320, 240))
+            cv2.imwrite(str(root / f"{side}9{n}.png"), small)  # another size: pairs 901, 902
+    (root / "right902.png").unlink()  # one small pair only
+    (root / "left902.png").unlink()
+    args = ["batch", str(root), "-o", str(out), "--calib", str(rig), "--workers", "1"]
+    args += ["--max-disparity", "16", "--calib-unit", "mm"]
+    capsys.readouterr()
+    assert main(args) == 1
+    said = capsys.readouterr()
+    assert said.out.startswith("2 processed, 0 skipped (done before), 1 failed in ")
+    pairs = _summary(out)["pairs"]
+    assert [pairs[n]["status"] for n in ("01", "02", "901")] == ["done", "done", "failed"]
+    assert pairs["901"]["error"].startswith(
+        "ValueError: calibration is for 640x480 images, got 320x240"
+    )
+    assert pairs["01"]["options"]["calib_size"] == [640, 480]
+    assert set(pairs["01"]["outputs"]) == DEPTH_FILES
+    assert np.load(out / "01" / "depth.npy").shape == (480, 640)
+    assert main(args) == 1  # the same run again: nothing redone
+    assert capsys.readouterr().out.startswith("0 processed, 2 skipped (done before), 1 skipped")

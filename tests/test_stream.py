@@ -808,3 +808,45 @@ def test_the_noise_hint_reads_the_frames_matched_when_the_source_shrinks_them(
     assert 3.5 < sigma < 4.5 and hints == []
     sigma, hints = stream("small", "320x240")  # enlarged: read as delivered
     assert sigma > 4.5 and len(hints) == 1
+
+
+def test_stream_sizes_opencv_stereo_calib_output_by_the_frames(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """OpenCV stereo_calib's intrinsics.yml + extrinsics.yml hold no image size: stream refused
+    them ("this command cannot read it from its images, so save the rig once in Python ..."),
+    exit 2. The frames size them now (an image sequence's 640x480)."""
+    from test_calibration import _opencv_stereo_calib
+
+    import stereovision.stream as stream
+
+    rig = tmp_path / "rig"
+    rig.mkdir()
+    _opencv_stereo_calib(rig)  # 640x480, T (-120, 1.5, 0.8) mm
+    for n in ("01", "02"):
+        for side in ("left", "right"):
+            shutil.copy(data_dir / "chessboard" / f"{side}{n}.jpg", tmp_path / f"{side}{n}.jpg")
+    got: list[Calibration] = []
+    real = stream.run_stream
+
+    def spy(camera: Any, calib: Any = None, **kw: Any) -> Any:
+        got.append(calib)
+        return real(camera, calib, **kw)
+
+    monkeypatch.setattr(stream, "run_stream", spy)
+    argv = ["stream", "--left", str(tmp_path / "left%02d.jpg"), "--right"]
+    argv += [str(tmp_path / "right%02d.jpg"), "--calib", str(rig), "--no-display", "--no-check"]
+    argv += ["--max-disparity", "16", "--json"]
+    capsys.readouterr()
+    assert main(argv) == 2  # the unit is still needed, said with the option
+    assert capsys.readouterr().err.endswith(
+        "(the board's square size): pass --calib-unit (m, mm, cm, ft or in)\n"
+    )
+    assert main([*argv, "--calib-unit", "mm"]) == 0
+    assert _json_lines(capsys.readouterr().out)[-1]["frames"] == 2
+    (calib,) = got
+    assert calib.image_size == (640, 480) and calib.unit == "mm"
+    assert calib.baseline_m == pytest.approx(np.linalg.norm([120.0, 1.5, 0.8]) / 1000)

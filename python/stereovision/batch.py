@@ -225,10 +225,11 @@ def _scan(
     root: str | os.PathLike[str],
     calib: str | os.PathLike[str] | None = None,
     calib_unit: str | None = None,
-) -> tuple[list[PairJob], list[_Unpaired]]:
+) -> tuple[list[PairJob], list[_Unpaired], tuple[int, int] | None]:
     """:func:`find_pairs`, and the images named as one of a pair without the other: a ``left``
     image without its ``right`` one, a ``right`` image (no ``left`` in its name) without its
-    ``left`` one; named as their pair would be, after the pairs' names."""
+    ``left`` one; named as their pair would be, after the pairs' names. Also the image size
+    ``calib`` is read at when it holds none (:func:`_calib_size`), else None."""
     r = Path(root)
     if not r.exists():
         raise FileNotFoundError(f"input folder not found: {r}")
@@ -237,12 +238,6 @@ def _scan(
     cal = Path(calib) if calib is not None else None
     if cal is not None and not cal.exists():
         raise FileNotFoundError(f"calibration file not found: {cal}")
-    if cal is not None:
-        # One calibration for every pair: read it once here, so that a bad file is one error
-        # now, not one failed pair per scene.
-        from stereovision.calibration import Calibration
-
-        Calibration.from_file(cal, unit=calib_unit)
     found: list[PairJob] = []
     unpaired: list[_Unpaired] = []
     cam_found: list[PairJob] = []  # in sibling camera folders
@@ -320,7 +315,35 @@ def _scan(
             name = f"{u.name}~{n}"
         taken.add(name)
         named.append(_Unpaired(name, u.present, u.missing, u.side))
-    return unique, named
+    size = _calib_size(cal, unique)
+    if cal is not None and (size is not None or not _sizeless(cal)):
+        # One calibration for every pair: read it once here, so that a bad file is one error
+        # now, not one failed pair per scene. (One that holds no size, without a pair whose
+        # left image decodes to size it, is each pair's error.)
+        from stereovision.calibration import Calibration
+
+        Calibration.from_file(cal, image_size=size, unit=calib_unit)
+    return unique, named, size
+
+
+def _sizeless(cal: Path) -> bool:
+    from stereovision.calibration import _sizeless as sizeless
+
+    return sizeless(cal)
+
+
+def _calib_size(cal: Path | None, jobs: list[PairJob]) -> tuple[int, int] | None:
+    """The image size to read ``cal`` at when the file holds none (OpenCV ``stereo_calib``
+    output, a ``Q.dat`` alone, a KITTI file without ``S_rect_02``): the size of the first
+    pair's left image (the first one that can be read and decoded); None for a calibration
+    that holds its size, or when no left image can be read."""
+    if cal is None or not _sizeless(cal):
+        return None
+    for job in jobs:
+        with contextlib.suppress(OSError, ValueError):
+            img = _decode(str(job.left), job.left.read_bytes())
+            return int(img.shape[1]), int(img.shape[0])
+    return None
 
 
 def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str], list[str]]]:
@@ -989,19 +1012,24 @@ class _Dask:
                 pass
 
 
-def _calib_payload(path: Path, unit: str | None = None) -> tuple[str, bytes]:
+def _calib_payload(
+    path: Path, unit: str | None = None, size: tuple[int, int] | list[int] | None = None
+) -> tuple[str, bytes]:
     """A calibration as one file's name and bytes for a worker: a ROS camera_info folder
     (left.yaml, right.yaml) is read here and shipped as this package's JSON, and so is a
-    ``Q.dat`` (sized by the ``left.png`` beside it, which the worker's copy has not) and a file
-    read in the ``unit`` given (the JSON states it; the worker reads the file without it)."""
+    ``Q.dat`` (sized by the ``left.png`` beside it, which the worker's copy has not), a file
+    read in the ``unit`` given (the JSON states it; the worker reads the file without it) and
+    one that holds no image size, read at ``size`` (OpenCV ``stereo_calib`` output)."""
     from stereovision.calibration import Calibration, _q_numbers
 
-    if path.is_file() and unit is None:
+    if path.is_file() and unit is None and size is None:
         data = path.read_bytes()
         if not _q_numbers(data.decode("utf-8", errors="replace")):
             return path.name, data
+    image_size = None if size is None else (int(size[0]), int(size[1]))
     with tempfile.TemporaryDirectory(prefix="stereovision-calib-") as tmp:
-        out = Calibration.from_file(path, unit=unit).save(Path(tmp) / "calib.json")
+        calib = Calibration.from_file(path, image_size=image_size, unit=unit)
+        out = calib.save(Path(tmp) / "calib.json")
         return out.name, out.read_bytes()
 
 
@@ -1010,7 +1038,9 @@ def _task(job: PairJob, opts: dict[str, Any]) -> dict[str, Any]:
         "name": job.name,
         "left": (str(job.left), job.left.read_bytes()),
         "right": (str(job.right), job.right.read_bytes()),
-        "calib": None if job.calib is None else _calib_payload(job.calib, opts.get("calib_unit")),
+        "calib": None
+        if job.calib is None
+        else _calib_payload(job.calib, opts.get("calib_unit"), opts.get("calib_size")),
         **opts,
     }
 
@@ -1090,9 +1120,11 @@ def run_batch(
     calib : path, optional
         Calibration for every pair (else each scene's ``calib.txt``).
     calib_unit : str, optional
-        Length unit of ``calib``'s ``T`` when the file does not state it (a ``Q.dat``; OpenCV
-        ``stereo_calib`` output, which also needs an image size, cannot be read here);
-        :meth:`~stereovision.calibration.Calibration.from_file`'s ``unit``.
+        Length unit of ``calib``'s ``T`` when the file does not state it (a ``Q.dat``, OpenCV
+        ``stereo_calib`` output); :meth:`~stereovision.calibration.Calibration.from_file`'s
+        ``unit``. A ``calib`` that holds no image size (``stereo_calib`` output, a ``Q.dat``
+        alone) is read at the size of the first pair's left image; a pair of another size
+        fails ("calibration is for WxH images, got ...").
     ground : bool
         Also write each pair's floor (``ground.json``, ``obstacles.png``, ``scan.json``;
         :func:`stereovision.ground.fit_ground_plane`, :func:`~stereovision.ground.laser_scan`).
@@ -1144,7 +1176,7 @@ def run_batch(
     t0 = time.perf_counter()
     if calib_unit is not None and calib is None:
         raise ValueError("calib_unit is the unit of calib's file: give calib too")
-    jobs, unpaired = _scan(input_dir, calib, calib_unit)
+    jobs, unpaired, calib_size = _scan(input_dir, calib, calib_unit)
     # a file in the way, or a folder that cannot be written: said as such, before a cluster
     # starts (it was "[Errno 17] File exists" or "[Errno 2] No such file or directory")
     check_output_folder(output_dir, "output folder")
@@ -1170,6 +1202,8 @@ def run_batch(
             opts.update(ground=True, grid=grid)
         if calib_unit is not None:  # as ground: only when given
             opts["calib_unit"] = calib_unit
+        if calib_size is not None:  # a calibration without a size, sized by the first pair
+            opts["calib_size"] = list(calib_size)
         summary.data.update(
             input=str(Path(input_dir).resolve()),
             output=str(out.resolve()),
@@ -1555,8 +1589,15 @@ def cmd_batch(args: argparse.Namespace) -> int:
     if args.calib_unit is not None or (args.calib is not None and Path(args.calib).exists()):
         from stereovision.cli import load_calibration
 
-        # refused in the CLI's words (--calib-unit), before a cluster starts
-        load_calibration(args.calib, args.calib_unit)
+        # refused in the CLI's words (--calib-unit), before a cluster starts; one that holds
+        # no image size (OpenCV stereo_calib output) read at run_batch's: the first pair's
+        sizeless = args.calib is not None and _sizeless(Path(args.calib))
+        size = None
+        if sizeless:
+            with contextlib.suppress(OSError):  # no input folder: run_batch says so
+                size = _calib_size(Path(args.calib), _scan(args.input)[0])
+        if size is not None or not sizeless:
+            load_calibration(args.calib, args.calib_unit, size=size)
     check_output_folder(args.output, "-o")
     try:
         res = run_batch(

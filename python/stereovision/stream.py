@@ -956,6 +956,29 @@ def _format_report(rep: dict[str, Any]) -> str:
     )
 
 
+def _sized_calibration(path: str, unit: str | None, camera: Any) -> Calibration:
+    """The calibration at ``path``, which holds no image size, read at the size of the frames
+    of ``camera`` (opened): ``--size``, else what its left source delivers (a video's or image
+    sequence's first frame, a camera's mode), the size :func:`run_stream` fits a calibration
+    to.
+
+    Raises
+    ------
+    ValueError
+        As :func:`stereovision.cli.load_calibration`; one asking for ``--size`` when the
+        source states no size before its first frame (a bag).
+    """
+    from stereovision.cli import load_calibration
+
+    size = camera.size or camera.delivered_size.get("left")
+    return load_calibration(  # type: ignore[no-any-return]
+        path,
+        unit,
+        size=size,
+        size_words="the image size: --size WxH (this source states none before its frames)",
+    )
+
+
 def cmd_stream(args: argparse.Namespace) -> int:
     """``stereovision stream --left SRC --right SRC``.
 
@@ -971,9 +994,13 @@ def cmd_stream(args: argparse.Namespace) -> int:
         summary is still written); 2 (the CLI's error status) when a pair failed, after the
         summary.
     """
+    from stereovision.calibration import _sizeless
     from stereovision.cli import load_calibration
 
-    calib = load_calibration(args.calib or None, args.calib_unit)
+    # one that holds no image size (OpenCV stereo_calib output, a Q.dat alone) is read at the
+    # size of the frames, once the sources are open
+    sizeless = bool(args.calib) and not args.rectification and _sizeless(args.calib)
+    calib = None if sizeless else load_calibration(args.calib or None, args.calib_unit)
     out = sys.stdout
     log = sys.stderr
     server: FrameServer | None = None
@@ -992,6 +1019,12 @@ def cmd_stream(args: argparse.Namespace) -> int:
             raise ValueError(f"--temporal: expected 2-255 pairs to average, got {args.temporal}")
         temporal = TemporalFilter(max_frames=args.temporal)
     cam = open_source(args, fps=args.fps)
+    if sizeless:
+        try:
+            calib = _sized_calibration(args.calib, args.calib_unit, cam)
+        except BaseException:
+            cam.close()
+            raise
     if hasattr(cam, "stamps_ns"):  # a recording: its results keep the frames' stamps
         if calib is None and homographies is None:
             try:
