@@ -507,6 +507,15 @@ def _tiny(root: Path, data_dir: Path, *names: str) -> None:
         cv2.imwrite(str(p), crops["left" if "left" in p.name.lower() else "right"])
 
 
+def _change(path: Path) -> None:
+    """A new version of the image: one pixel changed (a new modification time alone, with the
+    same bytes, is not a change: the pair is not redone)."""
+    img = cv2.imread(str(path))
+    img[0, 0] = 255 - img[0, 0]
+    cv2.imwrite(str(path), img)
+    os.utime(path, ns=(1, 1))
+
+
 def test_batch_reports_an_image_without_its_pair(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -674,7 +683,7 @@ def test_batch_never_deletes_what_an_output_folder_already_holds(
     assert (root / "a/notes.txt").read_text() == "mine"
     assert {p.name for p in (root / "a/b").iterdir()} == {"left.png", "right.png", *DISPARITY_FILES}
     # `a` redone (its image changed): the outputs of `a/b`, nested in its folder, stay
-    os.utime(root / "a/left.png", ns=(1, 1))
+    _change(root / "a/left.png")
     assert main(args) == 0
     s = _summary(root)
     assert s["run"]["processed"] == 1 and s["run"]["skipped"] == 1 and s["run"]["missing"] == 0
@@ -753,6 +762,7 @@ def test_batch_refuses_to_replace_the_outputs_of_another_input(
     _tiny(one, data_dir, *names)
     _tiny(two, data_dir, *names)
     cv2.imwrite(str(two / "seq/0001_left.png"), np.zeros((64, 96, 3), np.uint8))
+    _change(two / "seq/0000_left.png")  # other images (the same bytes are the same pair)
     args = ["--workers", "1", "--max-disparity", "16"]
     assert main(["batch", str(one), "-o", str(out), *args]) == 0
     before = _tree(out)
@@ -766,7 +776,7 @@ def test_batch_refuses_to_replace_the_outputs_of_another_input(
         "folders to replace them"
     ]
     assert _tree(out) == before and _summary(out)["input"] == str(one)
-    os.utime(one / "seq/0001_left.png", ns=(1, 1))  # the same input, an image changed
+    _change(one / "seq/0001_left.png")  # the same input, an image changed
     assert main(["batch", str(one), "-o", str(out), *args]) == 0
     assert _summary(out)["run"]["processed"] == 1
     shutil.move(one, tmp_path / "moved")  # the input moved: its pairs are done, skipped
@@ -796,7 +806,7 @@ def test_batch_refuses_to_replace_a_file_it_did_not_write(
     assert sorted(p.name for p in (out / "a").iterdir()) == ["disparity.png"]
     (out / "a" / "disparity.png").unlink()
     assert main(["batch", str(src), "-o", str(out), *args]) == 0
-    os.utime(src / "a/left.png", ns=(1, 1))  # changed: redone over its own outputs
+    _change(src / "a/left.png")  # changed: redone over its own outputs
     assert main(["batch", str(src), "-o", str(out), *args]) == 0
     assert _summary(out)["run"]["processed"] == 1
     assert cv2.imread(str(out / "a" / "disparity.png")) is not None
@@ -858,7 +868,7 @@ def test_batch_redoes_a_changed_pair_of_its_input_after_a_run_over_another_one(
     args = ["--workers", "1", "--max-disparity", "16"]
     assert main(["batch", str(one), "-o", str(out), *args]) == 0
     assert main(["batch", str(two), "-o", str(out), *args]) == 0
-    os.utime(one / "a/left.png", ns=(1, 1))
+    _change(one / "a/left.png")
     capsys.readouterr()
     assert main(["batch", str(one), "-o", str(out), *args]) == 0, capsys.readouterr().err
     summary = _summary(out)
@@ -1317,7 +1327,10 @@ def test_a_pair_gone_from_the_input_is_not_recorded_as_processed_this_run(
     assert b["this_run"] == "not in input" and b["status"] == "done"
     assert b["outputs"] == sorted(DISPARITY_FILES)
     assert {p.name for p in (out / "b").iterdir()} == DISPARITY_FILES
-    _tiny(src, data_dir, "b/left.png", "b/right.png")  # back (new files): redone
+    _tiny(src, data_dir, "b/left.png", "b/right.png")  # back, new times, the same bytes
+    assert main(args) == 0
+    assert _summary(out)["pairs"]["b"]["this_run"] == "skipped"
+    _change(src / "b/left.png")  # another image: redone
     assert main(args) == 0
     assert _summary(out)["pairs"]["b"]["this_run"] == "processed"
 
@@ -1337,7 +1350,7 @@ def test_a_changed_pair_is_redone_from_another_working_directory(
     assert main(["batch", "drive", *args]) == 0
     assert _summary(tmp_path / "out")["pairs"]["a"]["left"] == str(tmp_path / "drive/a/left.png")
     assert main(["batch", "other", *args]) == 0
-    os.utime(tmp_path / "drive/a/left.png", ns=(1, 1))  # changed: to be redone
+    _change(tmp_path / "drive/a/left.png")  # changed: to be redone
     (tmp_path / "elsewhere").mkdir()
     monkeypatch.chdir(tmp_path / "elsewhere")
     assert main(["batch", str(tmp_path / "drive"), "-o", str(tmp_path / "out"), *args[2:]]) == 0
@@ -1516,3 +1529,58 @@ def test_batch_sizes_opencv_stereo_calib_output_by_the_first_pair(
     assert np.load(out / "01" / "depth.npy").shape == (480, 640)
     assert main(args) == 1  # the same run again: nothing redone
     assert capsys.readouterr().out.startswith("0 processed, 2 skipped (done before), 1 skipped")
+
+
+def test_a_copy_without_its_times_is_up_to_date_and_a_changed_byte_is_redone(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A dataset copied without its modification times (cp -r) and run into the same -o was
+    refused as 'made from other images' (size + time only), exit 2. The summary records each
+    input's sha256; a time that differs is checked against it: the same bytes are up to date
+    (their new times recorded), one byte changed redoes that pair. A pair recorded without
+    hashes (a version 2 summary) is redone on a new time, as before, and records them."""
+    import hashlib
+
+    src, copy, out = tmp_path / "drive", tmp_path / "copy", tmp_path / "out"
+    _tiny(src, data_dir, *(f"seq/{i:04d}_{s}.bmp" for i in range(2) for s in ("left", "right")))
+    args = ["-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(["batch", str(src), *args]) == 0
+    entry = _summary(out)["pairs"]["seq/0000"]
+    left = src / "seq/0000_left.bmp"
+    assert entry["hashes"]["left"] == hashlib.sha256(left.read_bytes()).hexdigest()
+    assert _summary(out)["version"] == 3
+    shutil.copytree(src, copy, copy_function=shutil.copyfile)  # times not kept
+    for p in copy.rglob("*.bmp"):
+        os.utime(p, ns=(10**18, 10**18))
+    before = _tree(out)
+    capsys.readouterr()
+    assert main(["batch", str(copy), *args]) == 0, capsys.readouterr().err
+    assert capsys.readouterr().out.startswith("0 processed, 2 skipped (done before), 0 failed")
+    assert _tree(out) == before  # nothing rewritten
+    entry = _summary(out)["pairs"]["seq/0000"]
+    assert entry["fingerprint"]["left"][1] == 10**18
+    assert entry["left"] == str(copy / "seq/0000_left.bmp")
+    changed = copy / "seq/0001_left.bmp"
+    data = bytearray(changed.read_bytes())
+    data[-1] ^= 1  # a pixel of the last row: the size kept, the image still decodes
+    changed.write_bytes(bytes(data))
+    os.utime(changed, ns=(10**18, 10**18))  # even the time kept: the copy's
+    os.utime(copy / "seq/0000_left.bmp", ns=(2 * 10**18, 2 * 10**18))  # bytes kept
+    assert main(["batch", str(copy), *args]) == 0
+    s = _summary(out)
+    assert s["run"]["processed"] == 0 and s["run"]["skipped"] == 2  # the same time: as before
+    os.utime(changed, ns=(3 * 10**18, 3 * 10**18))
+    assert main(["batch", str(copy), *args]) == 0
+    s = _summary(out)
+    assert s["run"]["processed"] == 1 and s["run"]["skipped"] == 1
+    assert s["pairs"]["seq/0001"]["this_run"] == "processed"
+    assert s["pairs"]["seq/0001"]["hashes"]["left"] == hashlib.sha256(data).hexdigest()
+    # a record without hashes (version 2): a new time is a change, and the hashes are recorded
+    for e in s["pairs"].values():
+        del e["hashes"]
+    (out / SUMMARY_NAME).write_text(json.dumps({**s, "version": 2}))
+    os.utime(copy / "seq/0000_left.bmp", ns=(4 * 10**18, 4 * 10**18))
+    assert main(["batch", str(copy), *args]) == 0
+    s = _summary(out)
+    assert s["run"]["processed"] == 1 and s["pairs"]["seq/0000"]["this_run"] == "processed"
+    assert "hashes" in s["pairs"]["seq/0000"] and "hashes" not in s["pairs"]["seq/0001"]

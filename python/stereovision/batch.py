@@ -9,8 +9,9 @@ into a folder already there, each file renamed over its own name, the rest of th
 and records it in ``OUT/summary.json`` (itself replaced atomically after every pair, or at most a
 tenth of the time for a large one).
 
-A re-run skips the pairs the summary records as done whose inputs (size, modification time) and
-options are unchanged and whose folder still exists, without starting a cluster when nothing is
+A re-run skips the pairs the summary records as done whose inputs (size, modification time; for
+a time alone that differs, the content: a copy without timestamps) and options are unchanged and
+whose folder still exists, without starting a cluster when nothing is
 left to do. A pair that fails (an unreadable image, sizes that differ, ...) is recorded with its
 error and the others go on; a re-run tries it again once its files (or the options) change, or
 with ``retry_failed``. Ctrl-C (or SIGTERM, for the CLI) cancels what is running, keeps
@@ -23,6 +24,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import datetime as _dt
+import hashlib
 import json
 import math
 import os
@@ -73,7 +75,10 @@ SAVE_COST_RATIO = 10.0
 CONNECT_TIMEOUT = "10s"
 #: 2: every pair whose folder holds outputs of a run lists them (``outputs``); a version 1
 #: summary's failed pairs did not when a redo failed or lost an image (before ed0f5f2).
-_SUMMARY_VERSION = 2
+#: 3: a pair sent to the workers records its input files' sha256 (``hashes``), so that a
+#: copy of them without their times is known as the same; pairs of older summaries have none
+#: until they are done again (a time that differs is then a change, as before).
+_SUMMARY_VERSION = 3
 #: Output names added after summary version 1 (4715e5e): no version 1 batch wrote them, so a
 #: file under one in a version 1 pair's folder is the user's.
 _NAMES_SINCE_V2 = ("overview.png",)
@@ -599,6 +604,49 @@ def _fingerprint(job: PairJob) -> dict[str, Any]:
         st = p.stat()
         fp[key] = [st.st_size, st.st_mtime_ns]
     return fp
+
+
+def _sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def _hashes(job: PairJob, task: dict[str, Any]) -> dict[str, str]:
+    """The sha256 of the pair's input files (of the bytes ``task`` ships for its images, read
+    once for both; of ``job.calib`` when it is a file)."""
+    hashes = {side: hashlib.sha256(task[side][1]).hexdigest() for side in ("left", "right")}
+    if job.calib is not None and job.calib.is_file():
+        hashes["calib"] = _sha256(job.calib)
+    return hashes
+
+
+def _same_content(entry: dict[str, Any], fp: dict[str, Any], job: PairJob) -> bool:
+    """Whether ``job``'s files are those ``entry`` recorded though their modification times
+    differ (a copy that did not keep them: ``cp -r``, a sync, a restore): the same files with
+    the same sizes, each whose time differs holding the bytes of the sha256 recorded for it
+    (read only then). A record without hashes (a summary before version 3) vouches for none."""
+    old, hashes = entry.get("fingerprint"), entry.get("hashes")
+    if not isinstance(old, dict) or not isinstance(hashes, dict) or old.keys() != fp.keys():
+        return False
+    paths = {"left": job.left, "right": job.right, "calib": job.calib}
+    for key, (size, mtime) in fp.items():
+        rec = old[key]
+        if not isinstance(rec, list) or len(rec) != 2 or rec[0] != size:
+            return False
+        if rec[1] == mtime:
+            continue
+        path, digest = paths[key], hashes.get(key)
+        if path is None or not isinstance(digest, str) or not path.is_file():
+            return False
+        try:
+            if _sha256(path) != digest:
+                return False
+        except OSError:
+            return False
+    return True
 
 
 def _recorded(path: Path) -> str:
@@ -1224,6 +1272,19 @@ def run_batch(
                 unreadable.append((job, _error_line(exc)))
                 continue
             entry = summary.pairs.get(job.name)
+            if (
+                entry is not None
+                and entry.get("fingerprint") != fp
+                and _same_content(entry, fp, job)
+            ):
+                # copied without its times (cp -r, a sync): the same bytes, so what was done (or
+                # failed) on them stands; the record names these files and their times now
+                entry.update(
+                    fingerprint=fp,
+                    left=_recorded(job.left),
+                    right=_recorded(job.right),
+                    calib=None if job.calib is None else _recorded(job.calib),
+                )
             if _skip(entry, fp, opts, out, job.name, retry_failed):
                 assert entry is not None
                 entry["this_run"] = "skipped"
@@ -1502,6 +1563,8 @@ def _run_jobs(
                 # Q.dat is read here): a failed pair, not a failed run
                 record_failure(job, exc)
                 return True
+            # read from the bytes shipped: a copy of these files without their times is known
+            summary.pairs[job.name]["hashes"] = _hashes(job, task)
             fut = client.submit(process_pair, task, key=f"stereovision-{uuid.uuid4().hex}")
             futures[fut] = job
             ac.add(fut)
