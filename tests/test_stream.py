@@ -850,3 +850,23 @@ def test_stream_sizes_opencv_stereo_calib_output_by_the_frames(
     (calib,) = got
     assert calib.image_size == (640, 480) and calib.unit == "mm"
     assert calib.baseline_m == pytest.approx(np.linalg.norm([120.0, 1.5, 0.8]) / 1000)
+
+
+def test_a_source_without_a_size_asks_for_one_for_stereo_calib_output(tmp_path: Path) -> None:
+    """A source that states no size before its frames (a bag) cannot size a calibration that
+    holds none: the error asks for --size, not for a Python call."""
+    from types import SimpleNamespace
+
+    from test_calibration import _opencv_stereo_calib
+
+    from stereovision.stream import _sized_calibration
+
+    _opencv_stereo_calib(tmp_path)
+    with pytest.raises(ValueError) as err:
+        _sized_calibration(str(tmp_path), "mm", SimpleNamespace(size=None, delivered_size={}))
+    assert str(err.value).endswith(
+        "(the board's square size): pass the image size: --size WxH (this source states none "
+        "before its frames)"
+    )
+    sized = SimpleNamespace(size=(320, 240), delivered_size={"left": (640, 480)})
+    assert _sized_calibration(str(tmp_path), "mm", sized).image_size == (320, 240)
