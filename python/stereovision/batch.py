@@ -1355,39 +1355,31 @@ def run_batch(
             )
         processed: list[str] = []
         failed: list[str] = []
-        for u in unpaired:  # a failed pair, every run until the missing image is there
-            left, right = (u.present, u.missing) if u.side == "left" else (u.missing, u.present)
-            earlier = summary.pairs.get(u.name) or {}
-            summary.pairs[u.name] = {
+
+        def record_failed(
+            name: str, left: Path, right: Path, calib: Path | None, error: str
+        ) -> None:
+            earlier = summary.pairs.get(name) or {}
+            summary.pairs[name] = {
                 "status": "failed",
                 "left": _recorded(left),
                 "right": _recorded(right),
-                "calib": None,
-                "error": u.error,
-                "finished": _now(),
-                "this_run": "failed",
-            }
-            if isinstance(earlier.get("outputs"), list):  # an earlier run's, still in its folder
-                summary.pairs[u.name]["outputs"] = earlier["outputs"]
-            failed.append(u.name)
-            if log is not None:
-                log(f"failed {u.name}: {u.error}")
-        for job, error in unreadable:  # tried again every run, as its files may come back
-            earlier = summary.pairs.get(job.name) or {}
-            summary.pairs[job.name] = {
-                "status": "failed",
-                "left": _recorded(job.left),
-                "right": _recorded(job.right),
-                "calib": None if job.calib is None else _recorded(job.calib),
+                "calib": None if calib is None else _recorded(calib),
                 "error": error,
                 "finished": _now(),
                 "this_run": "failed",
             }
             if isinstance(earlier.get("outputs"), list):  # an earlier run's, still in its folder
-                summary.pairs[job.name]["outputs"] = earlier["outputs"]
-            failed.append(job.name)
+                summary.pairs[name]["outputs"] = earlier["outputs"]
+            failed.append(name)
             if log is not None:
-                log(f"failed {job.name}: {error}")
+                log(f"failed {name}: {error}")
+
+        for u in unpaired:  # a failed pair, every run until the missing image is there
+            left, right = (u.present, u.missing) if u.side == "left" else (u.missing, u.present)
+            record_failed(u.name, left, right, None, u.error)
+        for job, error in unreadable:  # tried again every run, as its files may come back
+            record_failed(job.name, job.left, job.right, job.calib, error)
         # the records of pairs not under this input (removed since, or another input's) are
         # kept with their outputs; they said what the run that saw them last did to them
         here = {j.name for j in jobs} | {u.name for u in unpaired}
