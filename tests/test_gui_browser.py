@@ -1284,7 +1284,7 @@ def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_pat
     _run(app, app.save)
     assert app.state.error == (
         f"save: {tmp_path.name}/saved already holds disparity.png, depth.png, depth.npy, "
-        "depth_mm.png, cloud.ply; nothing was overwritten: choose another folder"
+        "depth_mm.png, cloud.ply, overview.png; nothing was overwritten: choose another folder"
     )
     assert (out / "cloud.ply").read_text() == "mine" and not (out / "disparity.pfm").exists()
     for outside in ("../elsewhere", "/tmp", str(bundled_data_dir() / "x")):
@@ -1304,6 +1304,44 @@ def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_pat
     bare.state.save_dir = "x"
     _run(bare, bare.save)
     assert bare.state.error == "no folder to write into: start the GUI with --data DIR"
+
+
+def test_save_writes_the_overview_as_depth_does_in_the_pages_unit(tmp_path):
+    """Save said it wrote the pair "as depth -o does", but not overview.png (the pictures with
+    their labelled colour bars), which depth, demo and batch write. It is written by the same
+    writer: its title names the pair as the page does, its depth bar is in the page's unit; a
+    folder that holds a user's overview.png is refused, the file left as it was."""
+    from stereovision.cli import write_overview
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import overview_name
+
+    app = _scene_app("test-save-overview", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app._on_unit(unit="ft")
+    _run(app, app.save)
+    assert app.state.error == "" and "overview.png" in app.state.save_label
+    assert overview_name(app.state.source_label) == "scene data/cones"
+    reference = tmp_path / "reference"
+    reference.mkdir()
+    write_overview(app.view.result, reference, "scene data/cones", "ft")
+    saved = cv2.imread(str(tmp_path / "saved" / "overview.png"))
+    np.testing.assert_array_equal(saved, cv2.imread(str(reference / "overview.png")))
+    # in feet, not the metres of the default: another picture
+    write_overview(app.view.result, reference, "scene data/cones", "m")
+    assert not np.array_equal(saved, cv2.imread(str(reference / "overview.png")))
+    assert overview_name("folder seq: pair 2 · 640×480 …") == "folder seq: pair 2 | 640x480 ..."
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "overview.png").write_bytes(b"my picture")
+    app.state.save_dir = "mine"
+    _run(app, app.save)
+    assert app.state.error == (
+        f"save: {tmp_path.name}/mine already holds overview.png; nothing was overwritten: "
+        "choose another folder"
+    )
+    assert sorted(p.name for p in mine.iterdir()) == ["overview.png"]
+    assert (mine / "overview.png").read_bytes() == b"my picture"
 
 
 def test_the_save_field_shows_the_data_folder_short_and_saves_where_it_says(tmp_path, monkeypatch):

@@ -179,8 +179,8 @@ def _planned_stages(method: str, calibrated: bool) -> list[str]:
 #: The depth picture's caption when it has no depth to scale (no calibration, no match).
 DEPTH_CAPTION = "depth (near = warm)"
 
-#: What "Save" writes (``stereovision depth``'s own files, by its writer): always, and with depth.
-SAVED_FILES = ("disparity.png", "disparity.pfm")
+#: What "Save" writes (``stereovision depth``'s own files, by its writers): always, and with depth.
+SAVED_FILES = ("disparity.png", "disparity.pfm", "overview.png")
 SAVED_DEPTH_FILES = ("depth.png", "depth.npy", "depth_mm.png", "cloud.ply")
 #: The save folder offered at start-up, inside the first ``--data`` folder.
 SAVE_FOLDER = "saved"
@@ -811,6 +811,29 @@ def _sparse_precision(matches: Any, gt: Any, left: np.ndarray, left_s: np.ndarra
     if m.count == 0:
         return ", none on GT"
     return f", precision@1 {m.precision[1.0]:.1f} % of the {m.count} on GT"
+
+
+#: Characters of the page's labels that ``overview.png``'s title (OpenCV's ASCII font) says
+#: otherwise; any other non-ASCII character is drawn as "?".
+_ASCII_FOR = {"×": "x", "…": "...", "–": "-", "—": "-", "·": "|", "\u00a0": " "}
+
+
+def overview_name(source_label: str) -> str:
+    """The pair's name in a saved ``overview.png``'s title: what the page calls it (its source
+    label: ``scene data/cones``, ``files``, ``folder data/seq: pair 0002 (2 of 20)``, the
+    cameras), in the ASCII the picture's font draws.
+
+    Parameters
+    ----------
+    source_label : str
+        The page's label of the pair on show ("" when it has none: ``"pair"``).
+
+    Returns
+    -------
+    str
+    """
+    text = "".join(_ASCII_FOR.get(c, c) for c in source_label.strip()) or "pair"
+    return text.encode("ascii", "replace").decode("ascii")
 
 
 def max_disparity_hint(auto: int | None, full_width: int, width: int | None) -> str:
@@ -1789,8 +1812,10 @@ class StereoApp:
         self._spawn(self.save())
 
     async def save(self) -> None:
-        """Write the pair on show as ``stereovision depth -o`` does (its writer and file names:
-        disparity PNG and PFM, depth PNGs and .npy, cloud.ply) into the page's save folder.
+        """Write the pair on show as ``stereovision depth -o`` does (its writers and file names:
+        disparity PNG and PFM, depth PNGs and .npy, cloud.ply, and ``overview.png``, its depth
+        bar in the page's unit and its title naming the pair as the page does) into the page's
+        save folder.
 
         The folder as offered (or an empty field) is a new one each time: the first of
         ``saved``, ``saved-2``, ``saved-3``, ... that does not exist or is empty, so several
@@ -1798,7 +1823,7 @@ class StereoApp:
         that already holds one of those files is refused, naming them: nothing the user wrote
         is replaced (``depth`` replaces its own earlier outputs, the GUI cannot ask).
         """
-        from stereovision.cli import CliError, write_depth_outputs
+        from stereovision.cli import DEPTH_OUTPUTS, CliError, write_depth_outputs, write_overview
         from stereovision.io import check_output_folder
 
         view = self._view_on_show("save_label", PENDING_SAVE)
@@ -1806,6 +1831,9 @@ class StereoApp:
             return
         result = view.result
         names = SAVED_FILES + (SAVED_DEPTH_FILES if result.depth is not None else ())
+        names = tuple(sorted(names, key=DEPTH_OUTPUTS.index))  # in the order depth writes them
+        shown = self._shown["source_label"] if self._shown else self.state.source_label
+        title, unit = overview_name(shown), self._unit
         typed = str(self.state.save_dir or "").strip()
         skipped: list[str] = []
         folder: Path | None = None
@@ -1832,7 +1860,9 @@ class StereoApp:
             return
 
         def run() -> dict[str, Path]:
-            return write_depth_outputs(result, folder)
+            written = write_depth_outputs(result, folder)
+            written.update(write_overview(result, folder, title, unit))
+            return written
 
         self._saving_into.add(folder)
         try:
