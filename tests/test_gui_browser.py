@@ -2054,6 +2054,37 @@ def test_the_sparse_channels_are_offered_and_their_matches_drawn(method):
     assert f"{len(expected)} matches ·" in app.state.stats and "precision" not in app.state.stats
 
 
+@pytest.mark.parametrize("method", ["fast", "opencv-bm"])
+def test_a_dense_method_says_its_bad_2_and_density_on_the_scenes_gt(method):
+    """The sparse methods' statistics said their precision@1 against the scene's GT, the dense
+    ones no GT figure at all. They say the map's bad-2.0 (holes counted as errors) and density
+    over the GT pixels (evaluation.md), dense_metrics' on the scaled map and the GT scaled as
+    the images were; after Rectify (or for another pair) they say none."""
+    from stereovision.evaluate import dense_metrics
+    from stereovision.gui import bundled_data_dir
+    from stereovision.io import load_scene
+
+    app = _scene_app(f"test-dense-gt-{method}", [bundled_data_dir()])
+    cones = bundled_data_dir() / "cones"
+    app._load_scene(cones)
+    app.state.method, app.state.resolution = method, "320"
+    _run(app, app.recompute)
+    assert app.state.error == ""
+    scene = load_scene(cones)
+    disparity = app.view.result.disparity
+    h_s, w_s = disparity.shape
+    assert w_s == 320
+    gt_s = cv2.resize(scene.gt, (w_s, h_s), interpolation=cv2.INTER_NEAREST) * (w_s / 450)
+    m = dense_metrics(disparity, gt_s)
+    assert 0 < m.bad[2.0] < 60 and 50 < m.density <= 100
+    said = f", on GT bad-2.0 {m.bad[2.0]:.1f}\xa0% (holes count) at density {m.density:.1f}\xa0%"
+    assert said in app.state.stats
+    app._scene_gt = (None, scene.gt)
+    _run(app, app.recompute)
+    assert app.state.error == "" and "bad-2.0" not in app.state.stats
+    assert "density" in app.state.stats
+
+
 def test_draw_sparse_colours_each_match_by_its_value():
     """A sparse method's picture: each matched pixel in the colour colorize gives its value on
     the dense pictures' scale, the rest the image dimmed in grey."""

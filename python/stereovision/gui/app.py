@@ -628,8 +628,9 @@ def compute_view(
     gt : ndarray, float32 (H, W), optional
         The left image's GT disparity at the input size (NaN: unknown), of a pair used as
         given (no calibration, or a rectified one): a sparse method's statistics then say its
-        precision@1 (the share of its matches with GT within 1 px of it, at the size computed:
-        the GT scaled with the images).
+        precision@1 (the share of its matches with GT within 1 px of it), a dense one's its
+        bad-2.0 (holes counted as errors) and density over the pixels with GT, at the size
+        computed (the GT scaled with the images, :func:`scaled_gt`).
 
     Raises
     ------
@@ -764,6 +765,7 @@ def compute_view(
         amount = f"{len(matches)} matches" + _sparse_precision(matches, gt, left, left_s)
     else:
         amount = f"density {100 * result.density:.0f} %"
+        amount += _dense_gt_text(result.disparity, gt, left, left_s)
     head = (
         f"{method} · {left_s.shape[1]}×{left_s.shape[0]} · disparities 0–{result.max_disparity}"
         f" px · {amount} · {elapsed:.2f} s"
@@ -795,18 +797,43 @@ def compute_view(
     )
 
 
+def scaled_gt(gt: Any, left: np.ndarray, left_s: np.ndarray) -> npt.NDArray[np.float32] | None:
+    """The left image's GT disparity (``gt``, at the size of ``left``) at the size of
+    ``left_s`` as the images were scaled: the nearest GT pixel, its disparity in the scaled
+    pair's pixels. None without GT (or GT of another size)."""
+    if gt is None or np.shape(gt) != left.shape[:2]:
+        return None
+    g = np.asarray(gt, np.float32)
+    (h, w), (h_s, w_s) = left.shape[:2], left_s.shape[:2]
+    if (h_s, w_s) != (h, w):
+        g = np.asarray(cv2.resize(g, (w_s, h_s), interpolation=cv2.INTER_NEAREST)) * (w_s / w)
+    return g
+
+
+def _dense_gt_text(disparity: np.ndarray, gt: Any, left: np.ndarray, left_s: np.ndarray) -> str:
+    """What the statistics say of a dense map (at the size of ``left_s``) against the left
+    image's GT (evaluation.md: bad-2.0, holes counted as errors, and the density, over the
+    pixels with GT): "" without GT."""
+    from stereovision.evaluate import dense_metrics
+
+    g = scaled_gt(gt, left, left_s)
+    if g is None or g.shape != np.shape(disparity):
+        return ""
+    m = dense_metrics(disparity, g)
+    if m.n_gt == 0:
+        return ", no GT pixel"
+    return f", on GT bad-2.0 {m.bad[2.0]:.1f} % (holes count) at density {m.density:.1f} %"
+
+
 def _sparse_precision(matches: Any, gt: Any, left: np.ndarray, left_s: np.ndarray) -> str:
     """What the statistics say of a sparse method's matches against the left image's GT
     (``gt`` at the size of ``left``; scaled to that of ``left_s`` as the images were): ""
     without GT."""
     from stereovision.evaluate import sparse_metrics
 
-    if gt is None or np.shape(gt) != left.shape[:2]:
+    g = scaled_gt(gt, left, left_s)
+    if g is None:
         return ""
-    g = np.asarray(gt, np.float32)
-    (h, w), (h_s, w_s) = left.shape[:2], left_s.shape[:2]
-    if (h_s, w_s) != (h, w):  # the nearest GT pixel, its disparity in the scaled pair's pixels
-        g = np.asarray(cv2.resize(g, (w_s, h_s), interpolation=cv2.INTER_NEAREST)) * (w_s / w)
     m = sparse_metrics(matches.xl, matches.yl, matches.xr, g)
     if m.count == 0:
         return ", none on GT"
@@ -1247,8 +1274,9 @@ class StereoApp:
         scene_dir = self.folders.resolve(path) if Path(path) != self.demo_scene else Path(path)
         scene = load_scene(scene_dir)
         self.pair = self.raw_pair = (scene.left, scene.right)
-        #: The scene's GT disparity and the pair it belongs to (a sparse method's precision is
-        #: said while that pair is computed as given: not after Rectify, nor for another pair).
+        #: The scene's GT disparity and the pair it belongs to (a sparse method's precision, a
+        #: dense one's bad-2.0, are said while that pair is computed as given: not after
+        #: Rectify, nor for another pair).
         self._scene_gt = (self.pair, scene.gt)
         self.calib = scene.calib
         self.max_disparity = scene.max_disparity
