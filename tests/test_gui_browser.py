@@ -2048,6 +2048,7 @@ def test_the_sparse_channels_are_offered_and_their_matches_drawn(method):
         assert app.state.message_3d == (
             f"{method} is sparse: no dense map, its {n} points shown as points"
         )
+        assert app.state.view_mode == "points" and app.state.points_only, mode
     # after Rectify (or for another pair) the scene's GT is not that pair's: no precision said
     app._scene_gt = (None, scene.gt)
     _run(app, app.recompute)
@@ -2083,6 +2084,75 @@ def test_a_dense_method_says_its_bad_2_and_density_on_the_scenes_gt(method):
     _run(app, app.recompute)
     assert app.state.error == "" and "bad-2.0" not in app.state.stats
     assert "density" in app.state.stats
+
+
+def test_the_view_mode_toggle_says_points_for_a_sparse_method():
+    """For mcgm and hopfield the 3-D view shows points in either mode, and the surface / points
+    toggle still said "surface". It says "points" and is disabled while a sparse method's
+    matches are on show; a dense method's result is drawn again as the user had chosen (the
+    toggle enabled, back to it)."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-sparse-toggle", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    app.state.resolution = "320"
+    _run(app, app.recompute)
+    assert (app.state.view_mode, app.state.points_only) == ("surface", False)
+    dense = app.plotter.actors["scene"].GetMapper().GetInput()
+    assert dense.GetNumberOfPolys() > 0  # the surface
+    app.state.method = "mcgm"
+    _run(app, app.recompute)
+    assert app.state.error == ""
+    assert (app.state.view_mode, app.state.points_only) == ("points", True)
+    app.state.view_mode = "surface"  # a change from the page while it is disabled: put back
+    app._on_view_mode()
+    assert app.state.view_mode == "points"
+    poly = app.plotter.actors["scene"].GetMapper().GetInput()
+    assert poly.GetNumberOfPolys() == 0 and poly.GetNumberOfPoints() == len(app.view.result.points)
+    app.state.method = "fast"
+    _run(app, app.recompute)
+    assert (app.state.view_mode, app.state.points_only) == ("surface", False)
+    assert app.plotter.actors["scene"].GetMapper().GetInput().GetNumberOfPolys() > 0
+    app.state.view_mode = "points"  # the user's points, kept through a sparse method and back
+    app._on_view_mode()
+    assert app.plotter.actors["scene"].GetMapper().GetInput().GetNumberOfPolys() == 0
+    app.state.method = "hopfield"
+    _run(app, app.recompute)
+    assert (app.state.view_mode, app.state.points_only) == ("points", True)
+    app.state.method = "fast"
+    _run(app, app.recompute)
+    assert (app.state.view_mode, app.state.points_only) == ("points", False)
+    assert app.plotter.actors["scene"].GetMapper().GetInput().GetNumberOfPolys() == 0
+
+
+def test_the_lines_between_the_images_are_coloured_by_disparity():
+    """The matches' lines between the two images were coloured by their index (a hue ramp over
+    the list: two matches of one disparity in two colours). Each line and its end dots have
+    the colour of its disparity on the disparity picture's scale, as the dots of draw_sparse."""
+    from stereovision.cli import colorize
+    from stereovision.gui.app import draw_matches, draw_sparse
+
+    left = np.zeros((40, 200, 3), np.uint8)
+    right = np.zeros_like(left)
+    disparity = np.full((40, 200), np.nan, np.float32)
+    disparity[5, 150], disparity[20, 60], disparity[35, 180] = 30.0, 30.0, 10.0
+    canvas = draw_matches(left, right, disparity, lo=0.0, hi=32.0)
+    ramp = colorize(np.array([[30.0, 10.0]], np.float32), lo=0.0, hi=32.0)[0]
+    for (y, x), c in zip(((5, 150), (20, 60), (35, 180)), (ramp[0], ramp[0], ramp[1]), strict=True):
+        xr = 200 + x - round(float(disparity[y, x]))
+        np.testing.assert_array_equal(canvas[y, x], c)  # the left end
+        np.testing.assert_array_equal(canvas[y, xr], c)  # the right end
+        # the line between, antialiased: its colour a little darker
+        line = canvas[y, (x + xr) // 2].astype(float)
+        k = line[np.argmax(c)] / c.max()
+        assert 0.8 < k <= 1 and np.allclose(line, k * c, atol=2), (line, c)
+    # the dots of the sparse picture have the same colours
+    dots = draw_sparse(left, disparity, 0.0, 32.0)
+    np.testing.assert_array_equal(dots[20, 60], canvas[20, 60])
+    # by default the ends are the disparity picture's: 0 px and the map's 99th percentile
+    np.testing.assert_array_equal(
+        draw_matches(left, right, disparity)[35, 180], colorize(disparity, lo=0.0)[35, 180]
+    )
 
 
 def test_draw_sparse_colours_each_match_by_its_value():
@@ -2379,6 +2449,40 @@ def test_method_switch_updates_disparity(page):
     page.click(f"#method-{METHODS[0]}")  # and back
     _wait_computations(page, n + 2)
     assert page.inner_text("#stats").startswith(METHODS[0])
+
+
+def test_the_view_mode_toggle_is_points_and_disabled_for_mcgm_in_the_browser(page):
+    """In the page: with mcgm on show the surface / points toggle shows "points" chosen and
+    cannot be clicked; back on the default method it is enabled on "surface" again."""
+    from stereovision.depth import METHODS
+
+    def toggle() -> dict[str, Any]:
+        return page.evaluate(
+            """() => Object.fromEntries(['surface', 'points'].map(v => {
+                const b = document.querySelector('#view-mode-' + v);
+                return [v, {active: b.classList.contains('v-btn--active'),
+                            disabled: b.disabled}];
+            }))"""
+        )
+
+    _wait_computations(page, 1)
+    n = _computations(page)
+    assert toggle() == {
+        "surface": {"active": True, "disabled": False},
+        "points": {"active": False, "disabled": False},
+    }
+    page.click("#method-mcgm")
+    _wait_computations(page, n + 1)
+    assert page.inner_text("#stats").startswith("mcgm")
+    page.wait_for_function("document.querySelector('#view-mode-surface').disabled")
+    assert toggle() == {
+        "surface": {"active": False, "disabled": True},
+        "points": {"active": True, "disabled": True},
+    }
+    page.click(f"#method-{METHODS[0]}")  # and back
+    _wait_computations(page, n + 2)
+    page.wait_for_function("!document.querySelector('#view-mode-surface').disabled")
+    assert toggle()["surface"] == {"active": True, "disabled": False}
 
 
 def test_check_rows_button(page):

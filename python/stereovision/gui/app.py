@@ -283,8 +283,13 @@ def draw_matches(
     right: npt.NDArray[np.uint8],
     disparity: npt.NDArray[np.float32],
     max_matches: int = MAX_DRAWN_MATCHES,
+    *,
+    lo: float | None = 0.0,
+    hi: float | None = None,
 ) -> npt.NDArray[np.uint8]:
-    """The pair side by side with lines from each matched left pixel to ``x - d`` on the right.
+    """The pair side by side with lines from each matched left pixel to ``x - d`` on the right,
+    each line and its end dots in the colour of its disparity on the disparity picture's scale
+    (:func:`stereovision.cli.colorize`, as :func:`draw_sparse` colours the dots).
 
     Parameters
     ----------
@@ -294,24 +299,27 @@ def draw_matches(
         NaN where there is no match.
     max_matches : int
         Evenly sampled subset drawn.
+    lo, hi : float or None
+        The disparities at the ends of the colour map: the disparity picture's (0 px and,
+        when None, the map's 99th percentile).
 
     Returns
     -------
     ndarray, uint8 (H, 2W, 3)
     """
+    from stereovision.cli import colorize
+
     w = disparity.shape[1]
     canvas = np.hstack([left, right]).copy()
     ys, xs = np.nonzero(np.isfinite(disparity))
     if len(xs) == 0:
         return canvas
+    colours = colorize(np.asarray(disparity, np.float32), lo=lo, hi=hi)[ys, xs]
     pick = np.linspace(0, len(xs) - 1, min(max_matches, len(xs))).astype(int)
     for i in pick:
         x, y = int(xs[i]), int(ys[i])
         xr = round(x - float(disparity[y, x])) + w
-        hue = int(179 * i / max(1, len(xs)))
-        hsv = np.array([[[hue, 255, 255]]], dtype=np.uint8)
-        colour = np.asarray(cv2.cvtColor(hsv, cv2.COLOR_HSV2BGR))[0, 0]
-        c = tuple(int(v) for v in colour)
+        c = tuple(int(v) for v in colours[i])
         cv2.line(canvas, (x, y), (xr, y), c, 1, cv2.LINE_AA)
         cv2.circle(canvas, (x, y), 2, c, -1)
         cv2.circle(canvas, (xr, y), 2, c, -1)
@@ -742,7 +750,8 @@ def compute_view(
     matches_url = ""
     if method in SPARSE_METHODS or result.density < SPARSE_DENSITY:
         matches_url = _data_url(
-            draw_matches(shown_left, shown_right, result.disparity), 2 * DISPLAY_WIDTH
+            draw_matches(shown_left, shown_right, result.disparity, lo=0.0, hi=disp_hi),
+            2 * DISPLAY_WIDTH,
         )
     mesh = None
     intr = None
@@ -984,16 +993,20 @@ def _toggle(
     classes: str | None = None,
     button_classes: str | None = None,
     wrap: bool = False,
+    disabled: str | None = None,
 ) -> None:
     """A row of buttons choosing one of ``values`` (state variable ``model``); each button's id
     is ``button_ids-VALUE`` when ``button_ids`` is given. With ``wrap``, buttons that do not
     fit go on to further rows of the same height (a wrapped group kept one row's height and
-    squeezed its buttons to half of it)."""
+    squeezed its buttons to half of it). ``disabled`` names a state variable that, true,
+    disables the row."""
     from trame.widgets import vuetify3 as v3
 
     if wrap:
         classes = " ".join(c for c in (classes, "flex-wrap h-auto") if c)
-    extra = {} if classes is None else {"classes": classes}
+    extra: dict[str, Any] = {} if classes is None else {"classes": classes}
+    if disabled is not None:
+        extra["disabled"] = (disabled,)
     with v3.VBtnToggle(
         v_model=(model,),
         mandatory=True,
@@ -1148,6 +1161,12 @@ class StereoApp:
         st.pair_folders = []
         st.images = []
         st.view_mode = "surface"
+        #: The 3-D view shows points whatever the toggle (a sparse method's matches): the
+        #: toggle says "points" and is disabled; the user's own choice comes back after.
+        st.points_only = False
+        self._chosen_view_mode = "surface"
+        #: The mode the computed pair's geometry on show was drawn for (None: none drawn).
+        self._drawn_mode: str | None = None
         st.view_aspect = VIEW_ASPECT
         st.wide_pair = False
         st.max_disp = ""
@@ -1941,6 +1960,13 @@ class StereoApp:
         self.view = view
         self._page_before = None
         self._cloud = None  # the new pair's scene replaces an opened cloud file
+        # a sparse method's matches are points in either mode: the toggle says so
+        points_only = view.matches is not None
+        if not self.state.points_only:  # the toggle is the user's: their choice
+            self._chosen_view_mode = self.state.view_mode
+        mode = "points" if points_only else self._chosen_view_mode
+        self.state.view_mode, self.state.points_only = mode, points_only  # flushed below
+        self._drawn_mode = mode
         if view.mesh is not None:  # drawn as the points / surface toggle shows
             self._show_geometry(self._geometry_for_mode(), view.intrinsics)
         else:
@@ -2064,12 +2090,21 @@ class StereoApp:
         self._apply_camera()
 
     def _on_view_mode(self, **_: Any) -> None:
+        if self.state.points_only:
+            # the toggle is disabled while points are all there is to show: it says "points"
+            if self.state.view_mode != "points":
+                with self.state:
+                    self.state.view_mode = "points"
+            return
         if self._cloud is not None:  # the opened file stays; only its caption changes
             with self.state:
                 self.state.message_3d = self._cloud_message()
             return
+        if self.state.view_mode == self._drawn_mode:
+            return  # drawn so already (the mode _publish set)
         geometry = self._geometry_for_mode()
         if geometry is not None:
+            self._drawn_mode = self.state.view_mode
             self._show_geometry(geometry, self.view.intrinsics if self.view else None)
             if self._page_before is None:  # not while a new pair computes (its caption stays)
                 with self.state:
@@ -2334,7 +2369,14 @@ class StereoApp:
     def _camera_controls(self, v3: Any, html: Any) -> None:
         with v3.VRow(dense=True, classes="mt-2", align="center"):
             with v3.VCol(cols=8):
-                _toggle("view_mode", ("surface", "points"), "view-mode")
+                # a sparse method's matches have no surface: "points", disabled
+                _toggle(
+                    "view_mode",
+                    ("surface", "points"),
+                    "view-mode",
+                    button_ids="view-mode",
+                    disabled="points_only",
+                )
             with v3.VCol(cols=4):
                 v3.VBtn(
                     "Reset",
