@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -193,3 +194,26 @@ def test_eval_text_says_when_sgbm_or_the_members_have_no_gt_depth(
     assert depth.endswith("; SGBM-3WAY: none of its pixels has a GT depth")
     members = "eth3d/terrace: validated matches (>= 2 of Gabor, MCGM, Hopfield agree)"
     assert f"{members}: none has a GT depth" in lines
+
+
+def test_eval_runs_prints_the_times_it_measured(
+    data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`eval --runs N` without --json timed every method N times and printed none of it (the
+    medians were in the --json line only); now a line per scene says them, and a run without
+    --runs prints the table as before, with no time line."""
+    tsukuba = str(data_dir / "middlebury2001" / "tsukuba")
+    assert main(["eval", tsukuba, "--method", "fast", "--runs", "2"]) == 0
+    out = capsys.readouterr().out
+    timed = [line for line in out.splitlines() if ": time, " in line]
+    assert len(timed) == 1
+    assert re.fullmatch(
+        r"middlebury2001/tsukuba: time, median of 2 runs after a warm-up: ours [0-9.]+ ms, "
+        r"StereoBM [0-9.]+ ms, SGBM-3WAY [0-9.]+ ms \(ours [0-9.]+ x SGBM-3WAY\)",
+        timed[0],
+    ), timed[0]
+    assert main(["eval", tsukuba, "--method", "fast", "--no-opencv", "--runs", "1"]) == 0
+    (line,) = [x for x in capsys.readouterr().out.splitlines() if ": time, " in x]
+    assert re.fullmatch(r"middlebury2001/tsukuba: time, one run, no warm-up: ours [0-9.]+ ms", line)
+    assert main(["eval", tsukuba, "--method", "fast"]) == 0
+    assert ": time, " not in capsys.readouterr().out
