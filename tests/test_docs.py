@@ -436,3 +436,28 @@ def test_every_returned_value_is_documented() -> None:
                 if not {"Returns", "Yields"} & set(sections):
                     missing.append(f"stereovision.{short}.{name}")
     assert not missing, f"no Returns section: {missing}"
+
+
+def test_calib_unit_commands_are_the_ones_the_docs_list() -> None:
+    """README and robotics.md list the commands that take --calib-unit; the list is the CLI's."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    taking = {
+        name
+        for name, sub in commands.choices.items()
+        if any("--calib-unit" in a.option_strings for a in sub._actions)
+    }
+    readme = (ROOT / "README.md").read_text()
+    robotics = (ROOT / "docs" / "robotics.md").read_text()
+    said = {
+        "README.md": re.search(r"on every command that loads a calibration: ([^)]*)\)", readme),
+        "robotics.md": re.search(r"every command that loads a calibration \(([^)]*)\)", robotics),
+    }
+    for page, found in said.items():
+        assert found is not None, f"{page} no longer lists the commands taking --calib-unit"
+        listed = set(re.findall(r"`([a-z]+)`", " ".join(found.group(1).split())))
+        assert listed == taking, f"{page}: lists {sorted(listed)}, the CLI {sorted(taking)}"
