@@ -1,7 +1,8 @@
 """Redraw the README and docs pictures that come from the demo, the refinement and the GUI.
 
-- ``demo``: ``docs/images/demo_disparity.png`` and ``demo_render.png``, the ``disparity.png``
-  and ``render.png`` of ``stereovision demo`` (the bundled cones, as ``make demo`` writes them).
+- ``demo``: ``docs/images/demo_disparity.png``, ``demo_render.png`` and ``demo_overview.png``,
+  the ``disparity.png``, ``render.png`` and ``overview.png`` of ``stereovision demo`` (the
+  bundled cones, as ``make demo`` writes them; the overview, 1106 x 848 px, as a palette PNG).
 - ``refine``: ``docs/images/refine_depth_error.png``, ``|dZ|/Z`` per pixel against the GT on
   ETH3D terrace and KITTI 2015 000005 (``../shared/data``) for ``method="gabor",
   refine=False`` (the Gabor channel as it comes), ``method="gabor"`` (refined, its default) and
@@ -86,13 +87,14 @@ def save_png(image: Any, out: Path) -> Path:
 
 
 def draw_demo(out_dir: Path) -> None:
-    """``stereovision demo``'s disparity.png and render.png, as the demo writes them."""
+    """``stereovision demo``'s disparity.png, render.png and overview.png, as the demo writes
+    them."""
     from PIL import Image
 
     with tempfile.TemporaryDirectory() as tmp:
         cmd = [sys.executable, "-m", "stereovision", "demo", "-o", tmp]
         subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
-        for name in ("disparity", "render"):
+        for name in ("disparity", "render", "overview"):
             save_png(Image.open(Path(tmp) / f"{name}.png"), out_dir / f"demo_{name}.png")
 
 
