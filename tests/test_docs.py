@@ -461,3 +461,30 @@ def test_calib_unit_commands_are_the_ones_the_docs_list() -> None:
         assert found is not None, f"{page} no longer lists the commands taking --calib-unit"
         listed = set(re.findall(r"`([a-z]+)`", " ".join(found.group(1).split())))
         assert listed == taking, f"{page}: lists {sorted(listed)}, the CLI {sorted(taking)}"
+
+
+def test_quick_start_names_the_files_make_demo_prints(tmp_path: Path) -> None:
+    """The Quick start's `demo_output/{...}` is the folder `make demo` writes into and the list
+    of files `stereovision demo` prints as written (overview.png among them), the same set."""
+    import subprocess
+    import sys
+
+    text = (ROOT / "README.md").read_text()
+    quick = text.split("## Quick start", 1)[1].split("\n## ", 1)[0]
+    said = re.search(r"`demo_output/\{([^}]*)\}`", quick)
+    assert said is not None, "the Quick start no longer lists demo_output's files"
+    listed = {name.strip() for name in said.group(1).split(",")}
+    target = re.search(r"^demo:.*\n\t(.*)$", (ROOT / "Makefile").read_text(), re.M)
+    assert target is not None and target.group(1).endswith("stereovision demo -o demo_output")
+    out = tmp_path / "demo_output"
+    proc = subprocess.run(
+        [sys.executable, "-m", "stereovision", "demo", "-o", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stderr
+    written = proc.stdout.split(f"outputs in {out}:\n", 1)[1].splitlines()
+    printed = {line.split()[0] for line in written if line.startswith("  ")}
+    assert "overview.png" in printed
+    assert printed == listed, f"README {sorted(listed)}, printed {sorted(printed)}"
