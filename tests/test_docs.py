@@ -488,3 +488,32 @@ def test_quick_start_names_the_files_make_demo_prints(tmp_path: Path) -> None:
     printed = {line.split()[0] for line in written if line.startswith("  ")}
     assert "overview.png" in printed
     assert printed == listed, f"README {sorted(listed)}, printed {sorted(printed)}"
+
+
+def test_readme_synopsis_names_every_option() -> None:
+    """The README's command-line synopsis (demo, depth, eval, check) names every option each
+    command's --help lists: `depth --rectification` and `demo --method` were left out."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    text = (ROOT / "README.md").read_text()
+    block = re.search(r"```\n(stereovision demo .*?)```", text, re.S)
+    assert block is not None, "the README's synopsis block is gone"
+    usage: dict[str, str] = {}
+    command = ""
+    for line in block.group(1).splitlines():
+        start = re.match(r"stereovision (\w+)", line)
+        command = start.group(1) if start else command
+        usage[command] = usage.get(command, "") + line.split("  #", 1)[0]
+    assert set(usage) == {"demo", "depth", "eval", "check"}
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    unnamed = [
+        f"{command} {action.option_strings[-1]}"
+        for command, said in usage.items()
+        for action in commands.choices[command]._actions
+        if action.option_strings and "--help" not in action.option_strings
+        if not any(re.search(re.escape(o) + r"(?![\w-])", said) for o in action.option_strings)
+    ]
+    assert not unnamed, f"README's synopsis leaves out: {unnamed}"
