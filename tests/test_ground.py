@@ -16,7 +16,7 @@ import pytest
 
 import stereovision as sv
 from stereovision.calibration import Calibration
-from stereovision.ground import fit_ground_plane, obstacle_mask
+from stereovision.ground import BELOW_WARN_SHARE, fit_ground_plane, obstacle_mask
 from stereovision.io import load_scene, read_pfm
 from stereovision.synthetic import render_plane
 
@@ -121,10 +121,10 @@ def test_a_rendered_floor_gives_the_cameras_height_pitch_and_roll(scene: dict) -
 
 
 def test_kitti_road_agrees_with_its_gt(data_dir: Path) -> None:
-    """On KITTI the road found in our depth map is the one in the LiDAR GT (measured: 0.07
-    degrees apart, heights 1.621 m both; KITTI's camera is mounted about 1.65 m up), and the
-    obstacles (cars, walls, 0.15-2 m above the road) agree on 99.0 % / 97.5 % of the pixels
-    (precision / recall, on the pixels with GT)."""
+    """On KITTI the road found in our depth map is the one in the LiDAR GT (measured: 0.25
+    degrees apart, heights 1.618 m both, for every seed; KITTI's camera is mounted about 1.65 m
+    up), and the obstacles (cars, walls, 0.15-2 m above the road) agree on 98.4 % / 97.4 % of
+    the pixels (precision / recall, on the pixels with GT)."""
     sc = load_scene(data_dir / "kitti2015" / "000005_10")
     assert sc.calib is not None and sc.gt is not None
     gt = fit_ground_plane(sc.gt, sc.calib)
@@ -147,15 +147,38 @@ def test_kitti_road_agrees_with_its_gt(data_dir: Path) -> None:
 
 
 def test_terraced_ground_is_said_not_to_be_one_floor(data_dir: Path) -> None:
-    """ETH3D terrace: the plane found has 32 % of the points measurably below it (more than
-    0.15 m and than their disparity noise; KITTI's road 0.3 %), and its description says the
-    ground is not one flat floor."""
+    """ETH3D terrace: the plane found has 10 % of the points measurably below it (more than
+    0.15 m and than their disparity noise; 7-42 % over seeds 0-11, the terraces give many
+    planes of about as many pixels; KITTI's road 0.2 %), and its description says the ground is
+    not one flat floor."""
     sc = load_scene(data_dir / "eth3d" / "terrace")
     assert sc.calib is not None
     res = sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity)
     plane = fit_ground_plane(res.disparity, sc.calib)
-    assert plane is not None and plane.below_share > 0.2
+    assert plane is not None and plane.below_share > 0.05
     assert plane.describe().endswith("the ground is not one flat floor")
+
+
+@pytest.mark.parametrize(
+    ("scene", "height"),
+    [("eth3d/playground", 1.705), ("tartanair/oldtown_easy_p000_001116", 8.231)],
+)
+def test_the_floor_does_not_depend_on_the_seed(data_dir: Path, scene: str, height: float) -> None:
+    """RANSAC's seed picked among planes holding about as many pixels: on ETH3D playground's GT
+    seeds 0-3 found the floor (1.69-1.73 m, 1 % of the points below it) and seeds 4 and 5 a
+    slope through the walls (3.58 and 3.27 m, 32 degrees off, 13 % below it); on TartanAir's
+    street the seeds spread over 7.7 degrees and 8.23-9.05 m. Now every seed's candidates are
+    refined until their inliers settle, and the same floor comes out."""
+    sc = load_scene(data_dir / scene)
+    assert sc.calib is not None and sc.gt is not None
+    planes = [fit_ground_plane(sc.gt, sc.calib, seed=seed) for seed in range(6)]
+    assert all(p is not None for p in planes)
+    normals = np.array([p.normal for p in planes if p is not None])
+    spread = np.degrees(np.arccos(np.clip(normals @ normals.T, -1.0, 1.0))).max()
+    assert spread < 0.2
+    for p in planes:
+        assert p is not None and p.height == pytest.approx(height, rel=0.005)
+        assert p.below_share < BELOW_WARN_SHARE
 
 
 def _floor_disparity(
@@ -369,12 +392,13 @@ def test_kittis_road_under_the_live_maps(data_dir: Path) -> None:
     """The live maps measure 58-67 % of KITTI's pixels and the road holds 10-12 % of them: three
     random pixels rarely all lie on it, and the first search settled on a plane 19.5 degrees
     off (the Gabor channel, camera 3.93 m up) or 32 degrees off (fast, unfilled). The local
-    hypotheses find the road (measured: 1.633 and 1.626 m, 0.25 and 0.24 degrees from the GT's
-    plane; GT 1.621 m); the default map's fit is unchanged (its first plane holds as many)."""
+    hypotheses find the road (measured: 1.637 and 1.631 m, 0.24 and 0.33 degrees from the GT's
+    plane, seeds 0-3 alike; GT 1.618 m for every seed, KITTI's camera is mounted about 1.65 m
+    up: the 1.621 m asserted here before was seed 0's pick among 1.615-1.625 m)."""
     sc = load_scene(data_dir / "kitti2015" / "000005_10")
     assert sc.calib is not None and sc.gt is not None
     gt = fit_ground_plane(sc.gt, sc.calib)
-    assert gt is not None and gt.height == pytest.approx(1.621, abs=0.002)
+    assert gt is not None and gt.height == pytest.approx(1.618, abs=0.002)
     for kw in ({"method": "gabor", "refine": False}, {"method": "fast", "fill": False}):
         res = sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity,
                            cloud=False, **kw)  # fmt: skip
