@@ -821,3 +821,37 @@ def test_describe_says_the_cameras_height_in_the_unit_asked_for() -> None:
     assert plane.describe("mm").startswith(f"ground plane: camera {plane.height * 1000:.3f} mm ")
     with pytest.raises(ValueError, match=r"^unit: expected one of \['m', 'mm', 'cm', 'ft', 'in'\]"):
         plane.describe("feet")
+
+
+def test_occupancy_grid_save_keeps_a_previous_file_it_could_not_put_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The YAML's rename fails, then so does putting the previous picture back: the new picture
+    is in place and the copy of the previous one was removed with the temporaries, the user's
+    map.png lost without a word. That copy is kept and the exception's notes name it."""
+    import os
+
+    from stereovision.ground import OccupancyGrid
+
+    png, _ = OccupancyGrid(np.array([[0, 100], [-1, -1]], np.int8), 0.05, (0.0, -0.05)).save(
+        tmp_path
+    )
+    old_png = png.read_bytes()
+    real = os.replace
+
+    def flaky(src: object, dst: object) -> None:
+        if str(dst).endswith(".yaml") or str(src).endswith(".old"):
+            raise OSError(5, "Input/output error")
+        real(src, dst)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(os, "replace", flaky)
+    new = OccupancyGrid(np.full((3, 4), 100, np.int8), 0.1, (1.0, -2.0))
+    with pytest.raises(OSError, match="Input/output error") as info:
+        new.save(tmp_path)
+    monkeypatch.undo()
+    kept = [p for p in tmp_path.iterdir() if p.name.endswith(".old")]
+    assert len(kept) == 1 and kept[0].read_bytes() == old_png
+    assert info.value.__notes__ == [
+        f"{png} could not be restored: its previous contents are in {kept[0]}"
+    ]
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]

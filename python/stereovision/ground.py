@@ -776,7 +776,8 @@ class OccupancyGrid:
         RuntimeError
             If the grid could not be encoded as PNG.
         OSError
-            If a file could not be written; the previous pair is then intact.
+            If a file could not be written; the previous pair is then intact (should putting a
+            previous file back fail too, its copy is kept and named in the exception's notes).
         """
         import cv2
 
@@ -802,7 +803,8 @@ def _replace_pair(files: list[tuple[Path, bytes]]) -> None:
     replaces its destination in order (the last one commits the set), a copy of each previous
     destination being kept under a temporary name until the last is in place. On any failure the
     destinations already replaced get their previous contents back (or are removed if they did
-    not exist) and every temporary file is removed.
+    not exist) and every temporary file is removed, except a copy of previous contents that could
+    not be put back: it is kept, and the exception's notes name it and its destination.
 
     Parameters
     ----------
@@ -817,6 +819,7 @@ def _replace_pair(files: list[tuple[Path, bytes]]) -> None:
 
     temps: list[Path] = []  # the new contents, not yet in place
     kept: list[tuple[Path, Path | None]] = []  # (destination, its previous contents or None)
+    replaced = 0  # how many of kept's destinations hold their new contents
     try:
         for dest, data in files:
             fd, name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=dest.parent)
@@ -835,20 +838,29 @@ def _replace_pair(files: list[tuple[Path, bytes]]) -> None:
                 shutil.copy2(dest, previous)  # dest stays in place meanwhile
             kept.append((dest, previous))
             os.replace(new, dest)
-    except BaseException:
-        for dest, previous in reversed(kept):
+            replaced += 1
+    except BaseException as exc:
+        stranded: list[tuple[Path, Path]] = []  # (destination, the only copy of its old contents)
+        # (a destination whose own replacement failed still holds its previous contents)
+        for dest, previous in reversed(kept[:replaced]):
             try:
                 if previous is not None:
                     os.replace(previous, dest)
                 elif dest.exists():
                     os.unlink(dest)
             except OSError:
-                pass
+                if previous is not None:
+                    # not removed below: it holds the previous contents, the destination the new
+                    stranded.append((dest, previous))
         for left_over in temps + [p for _, p in kept if p is not None]:
+            if any(left_over == copy for _, copy in stranded):
+                continue
             try:
                 os.unlink(left_over)
             except FileNotFoundError:
                 pass
+        for dest, copy in stranded:
+            exc.add_note(f"{dest} could not be restored: its previous contents are in {copy}")
         raise
     for _, previous in kept:
         if previous is not None:
