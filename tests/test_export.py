@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from fractions import Fraction
 
 import cv2
 import numpy as np
@@ -396,12 +397,26 @@ def test_encode_depth_png_refuses_a_bad_scale(scale, error, message, tmp_path):
 
 
 def test_encode_depth_png_takes_any_real_scale():
-    """Ints and numpy scalars are numbers: 1.2344 m at 5000 units per metre is 6172."""
+    """Ints, numpy scalars and fractions are numbers (a Fraction made numpy's rint fail on an
+    object array): 1.2344 m at 5000 units per metre is 6172."""
     z = np.array([[1.2344, np.nan]])
-    for scale in (5000, 5000.0, np.float32(5000), np.int64(5000)):
+    for scale in (5000, 5000.0, np.float32(5000), np.int64(5000), Fraction(5000)):
         png = export.encode_depth_png(z, scale=scale)
         raw = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_UNCHANGED)
         assert raw.tolist() == [[6172, 0]]
+
+
+def test_a_scale_too_large_for_a_float_is_named():
+    """An int of 10**400 units per metre failed inside math.isfinite ('int too large to convert
+    to float', no argument named); it is not a finite number."""
+    for call in (
+        lambda: export.encode_depth_png(np.ones((2, 2)), scale=10**400),
+        lambda: export.read_depth_png("unused.png", scale=10**400),
+    ):
+        with pytest.raises(
+            ValueError, match=r"^scale: expected a positive finite number, got 1000"
+        ):
+            call()
 
 
 def test_disparity_png_kitti_format(data_dir, result, tmp_path):

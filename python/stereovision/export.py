@@ -730,19 +730,27 @@ def encode_depth_png(depth: npt.ArrayLike, scale: float = DEPTH_PNG_SCALE) -> by
     return _png16_bytes(_scaled_u16(depth, scale, "depth"), "depth")
 
 
-def _check_scale(scale: float) -> None:
-    """A 16-bit PNG's ``scale`` (units per metre): a positive finite number, else named."""
+def _check_scale(scale: float) -> float:
+    """A 16-bit PNG's ``scale`` (units per metre), checked to be a positive finite number (else
+    named), as a float: another real number (a ``fractions.Fraction``) made an object array in
+    numpy ("loop of ufunc does not support argument 0 of type float"), and an int too large
+    for a float failed in ``math.isfinite`` naming no argument."""
     if isinstance(scale, (bool, np.bool_)) or not isinstance(scale, numbers.Real):
         # a string (scale="1000") failed inside numpy with "ufunc 'isfinite' not supported"
         raise TypeError(
             f"scale: expected a number (units per metre), got {type(scale).__name__} {scale!r}"
         )
-    if not (math.isfinite(scale) and scale > 0):
+    try:
+        value = float(scale)
+    except OverflowError:
+        value = math.inf
+    if not (math.isfinite(value) and value > 0):
         raise ValueError(f"scale: expected a positive finite number, got {scale!r}")
+    return value
 
 
 def _scaled_u16(arr: npt.ArrayLike, scale: float, name: str) -> npt.NDArray[np.float64]:
-    _check_scale(scale)
+    scale = _check_scale(scale)
     a = np.asarray(arr, dtype=np.float64)
     if a.ndim != 2 or a.size == 0:
         raise ValueError(f"{name}: expected a non-empty (H, W) array, got shape {a.shape}")
@@ -871,8 +879,7 @@ def read_depth_png(path: PathLike, scale: float = DEPTH_PNG_SCALE) -> npt.NDArra
     ValueError
         If it is not a single-channel 16-bit PNG, or ``scale`` is not positive and finite.
     """
-    _check_scale(scale)
-    return _read_png16(path, scale, "depth PNG")
+    return _read_png16(path, _check_scale(scale), "depth PNG")
 
 
 def read_disparity_png(path: PathLike) -> npt.NDArray[np.float32]:
