@@ -1584,3 +1584,26 @@ def test_a_copy_without_its_times_is_up_to_date_and_a_changed_byte_is_redone(
     s = _summary(out)
     assert s["run"]["processed"] == 1 and s["pairs"]["seq/0000"]["this_run"] == "processed"
     assert "hashes" in s["pairs"]["seq/0000"] and "hashes" not in s["pairs"]["seq/0001"]
+
+
+def test_one_cameras_ros_file_reaches_the_workers_with_its_partner(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--calib ros/left.yaml (its right.yaml beside it, as calibration reads it) was checked
+    here and then shipped alone: every pair failed in the worker with 'its partner (left/right
+    swapped in the name) is not beside it'. It is read here and shipped as the rig's JSON."""
+    from test_calibration import _opencv_stereo_calib
+
+    rig, ros, root, out = (tmp_path / n for n in ("rig", "ros", "in", "out"))
+    rig.mkdir()
+    root.mkdir()
+    _opencv_stereo_calib(rig)
+    Calibration.from_file(rig, image_size=(640, 480), unit="mm").save_ros(ros)
+    for side in ("left", "right"):
+        shutil.copy(data_dir / "chessboard" / f"{side}01.jpg", root / f"{side}01.jpg")
+    args = ["batch", str(root), "-o", str(out), "--calib", str(ros / "left.yaml")]
+    capsys.readouterr()
+    assert main([*args, "--workers", "1", "--max-disparity", "16"]) == 0, capsys.readouterr().err
+    pair = _summary(out)["pairs"]["01"]
+    assert pair["status"] == "done" and set(pair["outputs"]) == DEPTH_FILES
+    assert np.load(out / "01" / "depth.npy").shape == (480, 640)

@@ -1067,16 +1067,27 @@ def _calib_payload(
     (left.yaml, right.yaml) is read here and shipped as this package's JSON, and so is a
     ``Q.dat`` (sized by the ``left.png`` beside it, which the worker's copy has not), a file
     read in the ``unit`` given (the JSON states it; the worker reads the file without it) and
-    one that holds no image size, read at ``size`` (OpenCV ``stereo_calib`` output)."""
-    from stereovision.calibration import Calibration, _q_numbers
+    one that holds no image size, read at ``size`` (OpenCV ``stereo_calib`` output).
 
-    if path.is_file() and unit is None and size is None:
-        data = path.read_bytes()
-        if not _q_numbers(data.decode("utf-8", errors="replace")):
-            return path.name, data
+    A file is shipped as it is only when a lone copy of it reads as the same calibration: one
+    camera's ROS camera_info (``left.yaml``, its partner beside it) or a KITTI file sized by
+    the image beside it was shipped alone, and every pair failed in the worker ("its partner
+    ... is not beside it")."""
+    from stereovision.calibration import Calibration
+
     image_size = None if size is None else (int(size[0]), int(size[1]))
+    calib = Calibration.from_file(path, image_size=image_size, unit=unit)
     with tempfile.TemporaryDirectory(prefix="stereovision-calib-") as tmp:
-        calib = Calibration.from_file(path, image_size=image_size, unit=unit)
+        if path.is_file() and unit is None and size is None:
+            data = path.read_bytes()
+            alone = Path(tmp) / path.name
+            alone.write_bytes(data)
+            try:
+                same = Calibration.from_file(alone) == calib
+            except (OSError, ValueError):  # it needs a file beside it (a Q.dat, a ROS partner)
+                same = False
+            if same:
+                return path.name, data
         out = calib.save(Path(tmp) / "calib.json")
         return out.name, out.read_bytes()
 
