@@ -1607,3 +1607,40 @@ def test_one_cameras_ros_file_reaches_the_workers_with_its_partner(
     pair = _summary(out)["pairs"]["01"]
     assert pair["status"] == "done" and set(pair["outputs"]) == DEPTH_FILES
     assert np.load(out / "01" / "depth.npy").shape == (480, 640)
+
+
+def test_a_calibration_file_rewritten_in_its_folder_redoes_the_pairs(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--calib rig/ (OpenCV stereo_calib's two files): the folder's own size and time were the
+    calibration's fingerprint, and a file rewritten in place in it (a baseline of 240 mm for
+    120) changes neither: the pair was skipped as done, its depth that of the old rig. The
+    files read are fingerprinted; the same bytes with new times (a copy) are still up to date."""
+    from test_calibration import _opencv_stereo_calib
+
+    rig, root, out = tmp_path / "rig", tmp_path / "in", tmp_path / "out"
+    rig.mkdir()
+    root.mkdir()
+    _opencv_stereo_calib(rig)  # T = (-120, 1.5, 0.8) mm
+    for side in ("left", "right"):
+        shutil.copy(data_dir / "chessboard" / f"{side}01.jpg", root / f"{side}01.jpg")
+    args = ["batch", str(root), "-o", str(out), "--calib", str(rig), "--calib-unit", "mm"]
+    args += ["--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    z120 = np.load(out / "01" / "depth.npy")
+    extrinsics = rig / "extrinsics.yml"
+    text = extrinsics.read_text()
+    os.utime(extrinsics, ns=(1, 1))  # the same bytes, another time: nothing redone
+    assert main(args) == 0
+    assert _summary(out)["pairs"]["01"]["this_run"] == "skipped"
+    folder_time = rig.stat().st_mtime_ns
+    with open(extrinsics, "w") as fh:  # in place: the folder's time does not change
+        fh.write(text.replace("-120.", "-240."))
+    assert rig.stat().st_mtime_ns == folder_time
+    capsys.readouterr()
+    assert main(args) == 0
+    assert capsys.readouterr().out.startswith("1 processed, 0 skipped")
+    z240 = np.load(out / "01" / "depth.npy")
+    both = np.isfinite(z120) & np.isfinite(z240)
+    assert both.sum() > 1000
+    np.testing.assert_allclose(np.median(z240[both] / z120[both]), 2.0, rtol=0.02)

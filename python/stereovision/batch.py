@@ -596,11 +596,35 @@ def _now() -> str:
     return _dt.datetime.now(_dt.timezone.utc).isoformat(timespec="seconds")
 
 
+def _calib_inputs(calib: Path | None) -> dict[str, Path]:
+    """The files :meth:`~stereovision.calibration.Calibration.from_file` reads for ``calib``,
+    by their fingerprint keys: ``calib`` for the file itself, ``calib:NAME`` for a file it reads
+    in a folder (``rig/`` of OpenCV ``stereo_calib``: its intrinsics.yml and extrinsics.yml; a
+    ROS camera_info folder's left.yaml and right.yaml) or beside it (``left.yaml``'s
+    ``right.yaml``). A folder's own time and size were its fingerprint, and a file rewritten
+    in it (a new T in extrinsics.yml) changes neither: its pairs were skipped as done."""
+    from stereovision.calibration import _ros_pair_from_folder, _ros_sibling, _stereo_calib_files
+
+    if calib is None:
+        return {}
+    files: tuple[Path, ...] = ()
+    pair = _stereo_calib_files(calib)
+    if pair is not None:
+        files = pair
+    elif calib.is_dir():
+        ros = _ros_pair_from_folder(calib)
+        own = [f for f in (calib / "calib.txt", calib / "Q.dat") if f.is_file()]
+        files = ros if ros is not None else tuple(own[:1])
+    elif calib.suffix.lower() in (".yaml", ".yml"):
+        files = _ros_sibling(calib) or ()
+    inputs = {} if files and calib.is_dir() else {"calib": calib}
+    inputs.update({f"calib:{f.name}": f for f in files if f != calib})
+    return inputs
+
+
 def _fingerprint(job: PairJob) -> dict[str, Any]:
     fp: dict[str, Any] = {}
-    for key, p in (("left", job.left), ("right", job.right), ("calib", job.calib)):
-        if p is None:
-            continue
+    for key, p in (("left", job.left), ("right", job.right), *_calib_inputs(job.calib).items()):
         st = p.stat()
         fp[key] = [st.st_size, st.st_mtime_ns]
     return fp
@@ -616,10 +640,11 @@ def _sha256(path: Path) -> str:
 
 def _hashes(job: PairJob, task: dict[str, Any]) -> dict[str, str]:
     """The sha256 of the pair's input files (of the bytes ``task`` ships for its images, read
-    once for both; of ``job.calib`` when it is a file)."""
+    once for both; of each calibration file read, :func:`_calib_inputs`)."""
     hashes = {side: hashlib.sha256(task[side][1]).hexdigest() for side in ("left", "right")}
-    if job.calib is not None and job.calib.is_file():
-        hashes["calib"] = _sha256(job.calib)
+    for key, path in _calib_inputs(job.calib).items():
+        if path.is_file():
+            hashes[key] = _sha256(path)
     return hashes
 
 
@@ -631,14 +656,15 @@ def _same_content(entry: dict[str, Any], fp: dict[str, Any], job: PairJob) -> bo
     old, hashes = entry.get("fingerprint"), entry.get("hashes")
     if not isinstance(old, dict) or not isinstance(hashes, dict) or old.keys() != fp.keys():
         return False
-    paths = {"left": job.left, "right": job.right, "calib": job.calib}
+    paths: dict[str, Path | None] = {"left": job.left, "right": job.right}
+    paths.update(_calib_inputs(job.calib))
     for key, (size, mtime) in fp.items():
         rec = old[key]
         if not isinstance(rec, list) or len(rec) != 2 or rec[0] != size:
             return False
         if rec[1] == mtime:
             continue
-        path, digest = paths[key], hashes.get(key)
+        path, digest = paths.get(key), hashes.get(key)
         if path is None or not isinstance(digest, str) or not path.is_file():
             return False
         try:
