@@ -808,14 +808,19 @@ def compute_view(
 
 def scaled_gt(gt: Any, left: np.ndarray, left_s: np.ndarray) -> npt.NDArray[np.float32] | None:
     """The left image's GT disparity (``gt``, at the size of ``left``) at the size of
-    ``left_s`` as the images were scaled: the nearest GT pixel, its disparity in the scaled
-    pair's pixels. None without GT (or GT of another size)."""
+    ``left_s`` as the images were scaled: the GT pixel at each scaled pixel's centre (the
+    centre of the area the images' ``INTER_AREA`` averages; never an interpolation, so an
+    unknown NaN / inf stays unknown), its disparity in the scaled pair's pixels (times the
+    width ratio). None without GT (or GT of another size)."""
     if gt is None or np.shape(gt) != left.shape[:2]:
         return None
     g = np.asarray(gt, np.float32)
     (h, w), (h_s, w_s) = left.shape[:2], left_s.shape[:2]
     if (h_s, w_s) != (h, w):
-        g = np.asarray(cv2.resize(g, (w_s, h_s), interpolation=cv2.INTER_NEAREST)) * (w_s / w)
+        # INTER_NEAREST takes the first source pixel a scaled one covers (floor(x * w / w_s)):
+        # half a scaled pixel left of and above the images' pixels
+        nearest = cv2.resize(g, (w_s, h_s), interpolation=cv2.INTER_NEAREST_EXACT)
+        g = np.asarray(np.asarray(nearest) * (w_s / w), np.float32)
     return g
 
 
