@@ -1936,6 +1936,81 @@ def test_open_cameras_asks_the_chosen_pixel_format(data_dir, monkeypatch):
         build_app(parser.parse_args(["--fourcc", "MJPG"]))
 
 
+def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
+    data_dir, tmp_path, capsys
+):
+    """OpenCV stereo_calib's intrinsics.yml + extrinsics.yml hold no image size: `gui --calib`
+    refused them ("this command cannot read it from its images, so save the rig once in Python
+    ..."), while depth, batch and stream take the size from their pairs. The first pair the
+    calibration is used with sizes it: the cameras' first frames, an image folder's first
+    pair, files (a scene has its own calib.txt); a pair of another size is refused in depth's
+    words, the pair on show stays. --calib-unit is still asked for in one line."""
+    from test_calibration import _opencv_stereo_calib
+
+    from stereovision.gui import add_arguments, build_app, main
+
+    rig, data = tmp_path / "rig", tmp_path / "data"
+    rig.mkdir()
+    _opencv_stereo_calib(rig)  # 640x480, T (-120, 1.5, 0.8) mm
+    for d in ("big", "small", "seq"):
+        (data / d).mkdir(parents=True)
+    for n in ("01", "02"):
+        for side in ("left", "right"):
+            img = cv2.imread(str(data_dir / "chessboard" / f"{side}{n}.jpg"))
+            assert img.shape == (480, 640, 3)
+            cv2.imwrite(str(data / "big" / f"{side}_00{n}.png"), img)
+            cv2.imwrite(str(data / "small" / f"{side}_00{n}.png"), cv2.resize(img, (320, 240)))
+            cv2.imwrite(str(data / "seq" / f"{side}{n}.png"), img)
+    assert main(["--calib", str(rig), "--data", str(data)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.endswith(
+        "(the board's square size): pass --calib-unit (m, mm, cm, ft or in)\n"
+    )
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    args = ["--calib", str(rig), "--calib-unit", "mm", "--data", str(data)]
+    app = build_app(parser.parse_args(args))
+    app._spawn = lambda coro: coro.close()
+    app._on_ready()  # the demo scene, with its own calibration
+    assert app.state.error == "" and app.calib.image_size == (450, 375)
+    app.state.pair_folder = str(data / "big")
+    app.open_pair_folder()
+    assert app.state.error == ""
+    assert app.calib.image_size == (640, 480) and app.calib.unit == "mm"
+    assert app.calib.baseline_m == pytest.approx(np.linalg.norm([120.0, 1.5, 0.8]) / 1000)
+    said = "calibration is for 640x480 images, got 320x240 (images resized, not cropped: "
+    said += "calib.scaled_to((320, 240)))"
+    app.state.left_file = str(data / "small" / "left_0001.png")
+    app.state.right_file = str(data / "small" / "right_0001.png")
+    app.load_files()
+    assert app.state.error == said
+    assert app.pair[0].shape == (480, 640, 3)  # the pair on show stays
+    app.state.pair_folder = str(data / "small")
+    app.open_pair_folder()
+    assert app.state.error == f"{said} (the cameras in use are unchanged)"
+    assert app.state.source_label.endswith("data/big: pair 0001 (1 of 2)")
+    app.state.left_file = str(data / "big" / "left_0002.png")
+    app.state.right_file = str(data / "big" / "right_0002.png")
+    app.state.error = ""  # (a computation clears it: none runs here)
+    app.load_files()
+    assert app.state.error == "" and app.calib is app.source_calib
+    assert app.state.source_label == "files"
+    assert app.state.rows_label == ""  # no "does not fit" note
+
+    # files first; cameras (an image sequence) sized by their first frames
+    app = build_app(parser.parse_args(args))
+    app._spawn = lambda coro: coro.close()
+    app.state.left_file = str(data / "small" / "left_0002.png")
+    app.state.right_file = str(data / "small" / "right_0002.png")
+    app.load_files()
+    assert app.state.error == "" and app.calib.image_size == (320, 240)
+    seq = ["--left", str(data / "seq" / "left%02d.png"), "--right"]
+    app = build_app(parser.parse_args([*args, *seq, str(data / "seq" / "right%02d.png")]))
+    app._spawn = lambda coro: coro.close()
+    app._on_ready()
+    assert app.state.error == "" and app.calib.image_size == (640, 480)
+
+
 def test_a_one_point_cloud_is_captioned_1_point(tmp_path):
     """A cloud file of one point was captioned "1 points"."""
     from stereovision.gui import bundled_data_dir

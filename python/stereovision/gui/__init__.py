@@ -60,10 +60,19 @@ def build_app(args: argparse.Namespace) -> Any:
         raise ValueError(f"--port must be in 0..65535, got {args.port}")
     folders = AllowedFolders([bundled_data_dir(), *(args.data or [])])
     calib = None
+    sizeless = None
     if args.calib is not None:
+        from stereovision.calibration import _sizeless
         from stereovision.cli import load_calibration
 
-        calib = load_calibration(args.calib, args.calib_unit)
+        if Path(args.calib).exists() and _sizeless(args.calib):
+            # OpenCV stereo_calib output (a Q.dat alone, a KITTI file without S_rect_02) holds
+            # no image size: the first pair it is used with sizes it (as batch's first pair,
+            # stream's frames); read now at a stand-in size only to refuse a bad file or unit
+            load_calibration(args.calib, args.calib_unit, size=(640, 480))
+            sizeless = (str(args.calib), args.calib_unit)
+        else:
+            calib = load_calibration(args.calib, args.calib_unit)
     source = None
     label = None
     names = (str(args.left or ""), str(args.right or ""))
@@ -75,7 +84,7 @@ def build_app(args: argparse.Namespace) -> Any:
         source, bag_calib, topics = open_bag_source(
             from_bag, getattr(args, "left_topic", None), getattr(args, "right_topic", None)
         )
-        calib = calib if calib is not None else bag_calib
+        calib = calib if calib is not None or sizeless is not None else bag_calib
         label = f"bag {Path(from_bag).name}: {topics[0]} / {topics[1]}"
     from trame.app import get_server
 
@@ -91,6 +100,7 @@ def build_app(args: argparse.Namespace) -> Any:
         calib=calib,
         source_names=names,
         source_label=label,
+        sizeless_calib=sizeless,
     )
 
 

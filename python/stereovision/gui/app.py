@@ -1049,6 +1049,11 @@ class StereoApp:
         The two camera sources as typed (shown in the page's camera fields).
     source_label : str, optional
         What the page calls the opened source (default: "cameras" and the sources' names).
+    sizeless_calib : tuple of str, optional
+        ``(path, unit)`` of a ``--calib`` that holds no image size (OpenCV ``stereo_calib``
+        output, a ``Q.dat`` alone), given instead of ``calib``: the first pair it is used with
+        (the cameras' or an image folder's first pair, files) sizes it; a pair of another size
+        is then refused as ``depth`` refuses it ("calibration is for WxH images, got ...").
     """
 
     def __init__(
@@ -1060,6 +1065,7 @@ class StereoApp:
         calib: Any = None,
         source_names: tuple[str, str] = ("", ""),
         source_label: str | None = None,
+        sizeless_calib: tuple[str, str | None] | None = None,
     ) -> None:
         import pyvista as pv
 
@@ -1074,6 +1080,10 @@ class StereoApp:
         self.demo_scene = demo_scene
         self.source = source
         self.source_calib = calib
+        #: ``--calib`` that holds no image size, until the first pair it is used with sizes it
+        #: (:meth:`_calib_for`); then the size it was read at, which every pair must have.
+        self._sizeless_calib = sizeless_calib
+        self._calib_sized_by: tuple[int, int] | None = None
         self._source_label = source_label
         #: The open cameras' sources as typed (their label's names; the fields may since hold
         #: others that failed to open).
@@ -1324,13 +1334,14 @@ class StereoApp:
                 f"{what}: left {image_size_text(left)}, right {image_size_text(right)}"
             )
         averaged = ""
-        calib = self.source_calib
+        calib = None
+        own = False  # the pair comes with its own calibration (a scene's calib.txt)
         if folder:  # one pair after another, not frames of one view: nothing to average
             job = folder.current
             if job.calib is not None:  # a scene's calib.txt
                 from stereovision.calibration import Calibration
 
-                calib = Calibration.from_file(job.calib)
+                calib, own = Calibration.from_file(job.calib), True
         elif self.state.average:
             from stereovision.temporal import TemporalFilter
 
@@ -1340,6 +1351,8 @@ class StereoApp:
                 left, right = tf(*self.source.read())
             moved = f", {tf.restarts} restarts: the view moved" if tf.restarts else ""
             averaged = f" ({tf.mean_frames():.1f} frames averaged{moved})"
+        if not own:  # --calib (one without an image size: sized by this pair, or refusing it)
+            calib = self._calib_for(left)
         self.pair = self.raw_pair = (left, right)
         self._other_source()
         self.calib = calib
@@ -1356,6 +1369,30 @@ class StereoApp:
             self.pair = rect.rectify(left, right)
             self.max_disparity = rect.max_disparity
             self.state.source_label += " (rectified from features)"
+
+    def _calib_for(self, left: np.ndarray) -> Any:
+        """``--calib`` for a pair whose left image is ``left``. One that holds no image size
+        is read at the size of the first pair it is used with, as ``batch`` reads it at its
+        first pair's; a pair of another size is then refused in ``depth``'s words.
+
+        Raises
+        ------
+        ValueError
+            A pair of another size than the one that sized such a calibration.
+        """
+        from stereovision.depth import _rig_to_warp_by
+
+        if self._sizeless_calib is not None:
+            from stereovision.cli import load_calibration
+
+            path, unit = self._sizeless_calib
+            self.source_calib = load_calibration(path, unit, pair=left)
+            self._sizeless_calib = None
+            self._calib_sized_by = (left.shape[1], left.shape[0])
+        if self._calib_sized_by is not None:
+            # "calibration is for 640x480 images, got 320x240 (...)", as depth and batch say
+            _rig_to_warp_by(self.source_calib, left.shape[1], left.shape[0], None)
+        return self.source_calib
 
     def _camera_source(self, text: str) -> int | str:
         src = parse_source(text)
@@ -1470,7 +1507,9 @@ class StereoApp:
         self._spawn(self.recompute())
 
     def load_files(self) -> None:
-        """Use the chosen left / right image files (calibration: ``--calib`` if its size fits)."""
+        """Use the chosen left / right image files (calibration: ``--calib`` if its size fits;
+        one that holds no size is sized by the first pair it is used with, and refuses files of
+        another size: :meth:`_calib_for`)."""
         from stereovision.io import check_pair_files, imread
 
         try:  # an emptied field sends None
@@ -1479,14 +1518,14 @@ class StereoApp:
             left, right = imread(lpath), imread(rpath)
             labels = (self.folders.label(lpath), self.folders.label(rpath))
             same = check_pair_files(left, right, lpath, rpath, names=labels)
+            c, note = self._calib_for(left), ""
         except (ValueError, OSError) as exc:
             self._fail(exc)
             return
         self.pair = self.raw_pair = (left, right)
         self._other_source()
         self.homographies = None
-        c, note = self.source_calib, ""
-        if c is not None:
+        if c is not None and self._calib_sized_by is None:
             from stereovision.calibration import fit_to_frames
 
             try:  # another resolution of the same shape is scaled when the view is computed
