@@ -2011,6 +2011,19 @@ def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
     assert app.state.error == "" and app.calib.image_size == (640, 480)
 
 
+def test_calib_unit_without_calib_is_refused():
+    """`gui --calib-unit mm` without --calib started the page with the option ignored; it is
+    refused in the other commands' words (cli.load_calibration)."""
+    pytest.importorskip("trame")
+    from stereovision.gui import add_arguments, build_app
+
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    with pytest.raises(ValueError) as err:
+        build_app(parser.parse_args(["--calib-unit", "mm"]))
+    assert str(err.value) == "--calib-unit is the unit of --calib's file: give --calib too"
+
+
 def test_a_one_point_cloud_is_captioned_1_point(tmp_path):
     """A cloud file of one point was captioned "1 points"."""
     from stereovision.gui import bundled_data_dir

@@ -73,6 +73,10 @@ def build_app(args: argparse.Namespace) -> Any:
             sizeless = (str(args.calib), args.calib_unit)
         else:
             calib = load_calibration(args.calib, args.calib_unit)
+    elif args.calib_unit is not None:  # refused as the other commands refuse it (it was ignored)
+        from stereovision.cli import load_calibration
+
+        load_calibration(None, args.calib_unit)
     source = None
     label = None
     names = (str(args.left or ""), str(args.right or ""))
