@@ -320,3 +320,30 @@ def test_float_rounding_just_outside_0_1_is_read_not_refused() -> None:
         as_gray_float(np.float32([[0.0, 1.0 + 3 * UNIT_RANGE_TOL]]))
     with pytest.raises(ValueError, match="must lie in"):
         check_unit_range(np.float32([[-3 * UNIT_RANGE_TOL, 1.0]]), "left")
+
+
+def test_none_from_imread_says_the_path_was_not_read(data_dir: Path, tmp_path: Path) -> None:
+    """cv2.imread's None for a path it cannot read was refused as "expected an image array
+    ..., got None"; every public entry point now says what probably happened."""
+    import stereovision as sv
+
+    right = cv2.imread(str(data_dir / "middlebury2001" / "tsukuba" / "right.png"))
+    left = cv2.imread(str(tmp_path / "no_such_left.png"))  # a typo in the path
+    assert left is None
+    calls = {
+        "depth_map": lambda: sv.depth_map(left, right),
+        "match": lambda: sv.match(left, right),
+        "estimate_max_disparity": lambda: sv.estimate_max_disparity(left, right),
+        "check_rectification": lambda: sv.check_rectification(left, right),
+    }
+    want = (
+        "left: got None, not an image (cv2.imread returns None for a file it cannot read: "
+        "check the path)"
+    )
+    for what, call in calls.items():
+        with pytest.raises(ValueError) as err:
+            call()
+        assert str(err.value) == want, what
+    with pytest.raises(ValueError) as err:
+        sv.depth_map(right, None)
+    assert str(err.value) == want.replace("left:", "right:")

@@ -80,11 +80,16 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
     Raises
     ------
     ValueError
-        If ``img`` is not array-like, has the wrong number of dimensions or channels, is empty,
+        If ``img`` is None (what ``cv2.imread`` returns for a file it cannot read: the message
+        says so), is not array-like, has the wrong number of dimensions or channels, is empty,
         or has an unsupported dtype (bool, signed integer, complex, object, strings, ...).
     """
     if img is None:
-        raise ValueError(f"{name}: expected an image array (H, W) or (H, W, 3), got None")
+        # most often cv2.imread's answer for a path it could not read: say so
+        raise ValueError(
+            f"{name}: got None, not an image (cv2.imread returns None for a file it cannot "
+            "read: check the path)"
+        )
     try:
         arr = np.asarray(img)
     except (ValueError, TypeError) as exc:  # ragged nested sequences and the like
