@@ -990,6 +990,9 @@ def test_demo_checks_its_output_folder_first(
         (["--right", "tsukuba"], "left and right images must have the same shape"),
         (["--calib", "tsukuba"], "calibration is for 713x434 images, got 384x288"),
         (["--no-calib", "--max-sigma", "0.1"], "--max-depth and --max-sigma need --calib"),
+        # accepted with no effect (no depth, no cloud) before
+        (["--no-calib", "--unit", "ft"], "--unit needs --calib (no depth to say in it without"),
+        (["--no-calib", "--voxel", "0.1"], "--voxel needs --calib (no cloud.ply without one)"),
     ],
 )
 def test_depth_says_a_usage_error_before_a_file_it_did_not_write(

@@ -554,6 +554,14 @@ def cmd_depth(args: argparse.Namespace) -> int:
     """``stereovision depth LEFT RIGHT -o DIR``."""
     from stereovision.io import read_image
 
+    if args.calib is None:
+        # no depth without a calibration: these would be accepted and do nothing, as
+        # --max-depth and --ground are refused (depth_outputs, which batch shares)
+        if args.unit is not None:
+            raise CliError("--unit needs --calib (no depth to say in it without one)")
+        if args.voxel is not None:
+            raise CliError("--voxel needs --calib (no cloud.ply without one)")
+    unit = "m" if args.unit is None else args.unit
     # 16-bit files keep their 16 bits (imread's 8-bit copy kept the top 8 of them)
     left = read_image(args.left)
     right = read_image(args.right)
@@ -591,10 +599,10 @@ def cmd_depth(args: argparse.Namespace) -> int:
         log=print,
         counts=counts,
         name=_pair_name(args.left),
-        unit=args.unit,
+        unit=unit,
     )
     cloud = (
-        f"{_depth_range(res.depth, args.unit)}, {len(res.points)} points"
+        f"{_depth_range(res.depth, unit)}, {len(res.points)} points"
         if res.depth is not None
         else "disparity only (no depth or cloud without --calib)"
     )
@@ -1490,7 +1498,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="keep depths whose one-sigma uncertainty is at most M metres",
     )
     d.add_argument(
-        "--voxel", type=float, metavar="M", help="cloud.ply with one point per M-metre cube"
+        "--voxel",
+        type=float,
+        metavar="M",
+        help="with --calib: cloud.ply with one point per M-metre cube",
     )
     d.add_argument(
         "--ground",
@@ -1513,11 +1524,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     d.add_argument(
         "--unit",
-        default="m",
         choices=tuple(UNIT_TO_METRES),
-        help="unit of the printed depths and of overview.png's depth bar: m (default), ft, mm, "
-        "cm or in; the files keep theirs (depth.npy and cloud.ply in metres, depth_mm.png in "
-        "millimetres) and --max-depth, --max-sigma, --voxel and --grid stay in metres",
+        help="with --calib: unit of the printed depths and of overview.png's depth bar: m "
+        "(default), ft, mm, cm or in; the files keep theirs (depth.npy and cloud.ply in metres, "
+        "depth_mm.png in millimetres) and --max-depth, --max-sigma, --voxel and --grid stay in "
+        "metres",
     )
     d.add_argument("-o", "--output", required=True, help="output folder")
     d.set_defaults(func=cmd_depth)
