@@ -940,3 +940,53 @@ def test_a_saved_file_with_a_bad_value_is_named(tmp_path: Path) -> None:
         ValueError, match=r"^calibration file \S+rig\.yaml: image_size: expected positive integers"
     ):
         Calibration.from_file(yaml)
+
+
+def test_opencv_stereo_calib_reads_1d_vectors_saved_by_filestorage(
+    tmp_path: Path, data_dir: Path
+) -> None:
+    """A distortion vector or T saved by cv2.FileStorage from a 1-D array is an
+    !!opencv-nd-matrix (sizes [n]): it was refused as "field 'D1' is not a matrix"; it is read
+    as the vector it is (the StereoPi rig's own calibration), and a wrong length or a matrix
+    field saved 1-D is still refused."""
+    ref = data_dir / "stereopi_rig" / "reference_calib_result"
+    K1, K2 = np.load(ref / "cam_mats_left.npy"), np.load(ref / "cam_mats_right.npy")
+    D1, D2 = np.load(ref / "dist_coefs_left.npy").ravel(), np.load(ref / "dist_coefs_right.npy")
+    E = np.load(ref / "e_mat.npy")
+    Ra, Rb, t = cv2.decomposeEssentialMat(E)  # the rig's R (the one near I) and T (|E| / sqrt 2)
+    R = max((Ra, Rb), key=lambda r: float(np.trace(r)))
+    T = t.ravel() * np.linalg.norm(E) / np.sqrt(2)
+    T = -T if T[0] > 0 else T  # the right camera on the right: T's x is negative
+    np.testing.assert_allclose(np.cross(T, R, axisb=0, axisc=0), E, atol=1e-6)  # E = [T]x R
+
+    def write(intr: dict[str, np.ndarray], extr: dict[str, np.ndarray]) -> None:
+        for name, fields in (("intrinsics.yml", intr), ("extrinsics.yml", extr)):
+            fs = cv2.FileStorage(str(tmp_path / name), cv2.FILE_STORAGE_WRITE)
+            for key, value in fields.items():
+                fs.write(key, value)
+            fs.release()
+
+    write({"M1": K1, "D1": D1, "M2": K2, "D2": D2.ravel()}, {"R": R, "T": T})
+    text = (tmp_path / "intrinsics.yml").read_text()
+    assert "D1: !!opencv-nd-matrix" in text and "sizes: [ 5 ]" in text
+    calib = Calibration.from_file(tmp_path, image_size=(320, 240), unit="cm")
+    np.testing.assert_array_equal(calib.D1, D1)
+    np.testing.assert_array_equal(calib.D2, D2.ravel())
+    np.testing.assert_array_equal(calib.T, T)
+    np.testing.assert_array_equal(calib.K1, K1)
+    assert calib.baseline_m == pytest.approx(0.0540, abs=1e-4)  # the tutorial's 5.40 cm
+    # a 2-D (1, 5) D2 beside them still reads the same
+    write({"M1": K1, "D1": D1, "M2": K2, "D2": D2}, {"R": R, "T": T})
+    assert Calibration.from_file(tmp_path, image_size=(320, 240), unit="cm") == calib
+    # a vector of the wrong length: refused by its length, as the constructor refuses it
+    write({"M1": K1, "D1": np.append(D1, 0.0), "M2": K2, "D2": D2}, {"R": R, "T": T})
+    with pytest.raises(ValueError, match=r"^D1: expected shape \(4,\) or \(5,\).*got \(6,\)$"):
+        Calibration.from_file(tmp_path, image_size=(320, 240), unit="cm")
+    # a matrix saved 1-D is not a matrix
+    write({"M1": K1.ravel(), "D1": D1, "M2": K2, "D2": D2}, {"R": R, "T": T})
+    with pytest.raises(
+        ValueError,
+        match=r"intrinsics\.yml: field 'M1' is not a matrix: a !!opencv-nd-matrix \(sizes, no "
+        r"rows and cols\) where a matrix is expected$",
+    ):
+        Calibration.from_file(tmp_path, image_size=(320, 240), unit="cm")

@@ -172,8 +172,13 @@ def _close(a: float, b: float, rel: float = RECTIFIED_REL_TOL) -> bool:
     return abs(a - b) <= rel * max(abs(a), abs(b), 1.0)
 
 
-def _node_matrix(node: Any, key: str, source: str) -> npt.NDArray[np.float64]:
+def _node_matrix(node: Any, key: str, source: str, vector: bool = False) -> npt.NDArray[np.float64]:
     """An ``!!opencv-matrix`` node read number by number, checked before anything is sized.
+
+    With ``vector``, a one-dimensional ``!!opencv-nd-matrix`` (``sizes: [n]``, what
+    ``cv2.FileStorage`` writes for a 1-D NumPy array, such as distortion coefficients saved
+    from ``dist.ravel()``) is read too, as an ``(n,)`` array; elsewhere it is refused as not
+    a matrix.
 
     Not ``FileNode.mat()``: on a damaged matrix (``rows`` or ``cols`` missing, ``data`` shorter
     than ``rows x cols``) OpenCV 5.1 sizes the matrix before its own check fails and writes past
@@ -185,21 +190,32 @@ def _node_matrix(node: Any, key: str, source: str) -> npt.NDArray[np.float64]:
 
     if not node.isMap():
         raise bad("expected rows, cols and data")
-    rows, cols, data = (node.getNode(k) for k in ("rows", "cols", "data"))
-    if not (rows.isInt() and cols.isInt()):
-        raise bad("rows and cols must be integers")
+    sizes = node.getNode("sizes")
+    data = node.getNode("data")
+    if not sizes.isNone():
+        # !!opencv-nd-matrix: FileStorage's form of an array that is not 2-D
+        if not vector:
+            raise bad("a !!opencv-nd-matrix (sizes, no rows and cols) where a matrix is expected")
+        if not (sizes.isSeq() and sizes.size() == 1 and sizes.at(0).isInt()):
+            raise bad("expected a vector: sizes must be one integer, [n]")
+        shape: tuple[int, ...] = (int(sizes.at(0).real()),)
+    else:
+        rows, cols = node.getNode("rows"), node.getNode("cols")
+        if not (rows.isInt() and cols.isInt()):
+            raise bad("rows and cols must be integers")
+        shape = (int(rows.real()), int(cols.real()))
     if not data.isSeq():
         raise bad("data must be a list of numbers")
-    r, c, n = int(rows.real()), int(cols.real()), int(data.size())
-    if r < 0 or c < 0 or n != r * c:
-        raise bad(f"data holds {n} numbers for {r} x {c}")
+    n, want = int(data.size()), math.prod(shape)
+    if min(shape) < 0 or n != want:
+        raise bad(f"data holds {n} numbers for {' x '.join(map(str, shape))}")
     values = []
     for i in range(n):
         v = data.at(i)
         if not (v.isReal() or v.isInt()):
             raise bad(f"element {i} of data is not a number")
         values.append(v.real())
-    return np.array(values, dtype=np.float64).reshape(r, c)
+    return np.array(values, dtype=np.float64).reshape(shape)
 
 
 def _open_filestorage(text: str, source: str) -> Any:
@@ -1402,7 +1418,9 @@ class Calibration:
         ``intrinsics`` holds ``M1``, ``D1``, ``M2``, ``D2``; ``extrinsics`` holds ``R`` and
         ``T`` (its ``R1``, ``R2``, ``P1``, ``P2`` and ``Q`` are recomputed, not read). Neither
         holds the image size nor the unit of ``T``, which is the unit of the board's square
-        size given to the sample.
+        size given to the sample. ``D1``, ``D2`` and ``T`` may also be 1-D (the
+        ``!!opencv-nd-matrix`` ``cv2.FileStorage`` writes for a 1-D NumPy array); their
+        lengths are checked as the constructor's.
 
         Parameters
         ----------
@@ -1434,7 +1452,9 @@ class Calibration:
                     node = fs.getNode(key)
                     if node.isNone():
                         raise ValueError(f"OpenCV stereo_calib file {p} lacks field {key!r}")
-                    fields[key] = _node_matrix(node, key, str(p))
+                    # D1, D2, T: also a 1-D array's !!opencv-nd-matrix
+                    vector = key in ("D1", "D2", "T")
+                    fields[key] = _node_matrix(node, key, str(p), vector=vector)
             finally:
                 fs.release()
         return cls(
