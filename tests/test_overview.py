@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 from pathlib import Path
 
@@ -12,7 +13,7 @@ import pytest
 from stereovision.calibration import Calibration
 from stereovision.cli import depth_outputs, main
 from stereovision.io import read_pfm
-from stereovision.overview import PANEL_WIDTH, overview_image, overview_title
+from stereovision.overview import PANEL_WIDTH, ColourBar, overview_image, overview_title
 
 _TURBO = cv2.applyColorMap(np.arange(256, dtype=np.uint8)[:, None], cv2.COLORMAP_TURBO)[:, 0]
 
@@ -55,13 +56,18 @@ def test_overview_bars_read_the_values_of_the_written_maps(terrace_run: tuple) -
     depth_png = cv2.imread(str(out / "depth.png"))
     for name, (lo, hi, mapped) in ends.items():
         bar = ov.bars[name]
-        assert len(bar.ticks) >= 3, (name, bar.ticks)
+        assert len(bar.ticks) >= 4, (name, bar.ticks)
         x = bar.box[0] + bar.box[2] // 2
+        # both ends are labelled (they were not: the range could not be read), with the unit
+        top, bottom = (1 / hi, 1 / lo) if name == "depth" else (hi, lo)
+        unit = {"disparity": " px", "depth": " m", "confidence": ""}[name]
+        _check_ends(bar, top, bottom, unit)
         for value, label, y in bar.ticks:
-            assert float(label) == pytest.approx(value, rel=1e-3)
+            assert _number(label) == pytest.approx(value, rel=5e-3)
             want = (mapped(value) - lo) * 255.0 / (hi - lo)
             assert abs(_level(img[y, x]) - want) <= 1.5, (name, label, want)
-            if name == "depth":
+            if name == "depth" and (value, label, y) not in (bar.ticks[0], bar.ticks[-1]):
+                # (not the ends: their colours hold every depth beyond them too)
                 # the depth.png pixels of that colour lie at that depth (within a colour step)
                 level = _level(img[y, x])
                 same = np.all(depth_png == _TURBO[level], axis=2) & np.isfinite(depth)
@@ -69,10 +75,29 @@ def test_overview_bars_read_the_values_of_the_written_maps(terrace_run: tuple) -
                 step = (hi - lo) / 255.0
                 z = np.median(depth[same])
                 assert 1 / (1 / value + 2 * step) <= z <= 1 / (1 / value - 2 * step), (label, z)
-    assert ov.bars["disparity"].ticks[-1][0] == 0.0  # 0 px at the bottom
+    assert ov.bars["disparity"].ticks[-1][:2] == (0.0, "0 px")  # 0 px at the bottom
+    assert ov.bars["confidence"].ticks[0][:2] == (1.0, "1")
     assert "depth (m)" not in ov.title and ov.title == (
         f"terrace | fast | max_disparity 32 px | density {100 * res.density:.1f} %"
     )
+
+
+def _number(label: str) -> float:
+    """The number of a bar's label (``"52.2 px"``, ``"20"``)."""
+    return float(label.split()[0])
+
+
+def _check_ends(bar: ColourBar, top: float, bottom: float, unit: str) -> None:
+    """The bar's first and last labels are at its top and bottom rows and say the colour
+    range's ends as printed, with the unit; no inner label is closer to another than 16 px
+    (one that would overlap an end is left out)."""
+    _, y, _, h = bar.box
+    (v0, label0, y0), (v1, label1, y1) = bar.ticks[0], bar.ticks[-1]
+    assert (y0, y1) == (y, y + h - 1)
+    assert (label0, label1) == (f"{top:.3g}{unit}", f"{bottom:.3g}{unit}")
+    assert (v0, v1) == (pytest.approx(top, rel=1e-5), pytest.approx(bottom, rel=1e-5))
+    rows = [t[2] for t in bar.ticks]
+    assert all(b - a >= 16 for a, b in itertools.pairwise(rows)), rows
 
 
 def test_overview_left_panel_is_the_input_downscaled(terrace_run: tuple) -> None:
@@ -166,14 +191,17 @@ def test_depth_unit_ft_labels_the_bar_and_the_summary_and_leaves_the_files(
     inv = 1.0 / (depth[np.isfinite(depth)] * FT_PER_M)
     lo, hi = float(np.percentile(inv, 1)), float(np.percentile(inv, 99))
     bar = ov.bars["depth"]
-    assert len(bar.ticks) >= 3, bar.ticks
+    assert len(bar.ticks) >= 4, bar.ticks
+    _check_ends(bar, 1 / hi, 1 / lo, " ft")  # the near and far ends in feet
     x = bar.box[0] + bar.box[2] // 2
     depth_png = cv2.imread(str(outs["ft"] / "depth.png"))
     feet = depth * FT_PER_M
     for value, label, y in bar.ticks:
-        assert float(label) == pytest.approx(value, rel=1e-3)
+        assert _number(label) == pytest.approx(value, rel=5e-3)
         want = (1 / value - lo) * 255.0 / (hi - lo)
         assert abs(_level(img[y, x]) - want) <= 1.5, (label, want)
+        if (value, label, y) in (bar.ticks[0], bar.ticks[-1]):
+            continue  # the ends' colours hold every depth beyond them too
         same = np.all(depth_png == _TURBO[_level(img[y, x])], axis=2) & np.isfinite(depth)
         assert same.sum() > 20, label
         step = (hi - lo) / 255.0

@@ -3,7 +3,8 @@
 ``disparity.png`` and ``depth.png`` are colour-mapped at the input's size (to overlay on it) and
 carry no scale. The overview puts the left image, the disparity map, the depth map (when there
 is one) and the matcher's confidence side by side, downscaled, each map with a colour bar
-whose ticks are labelled in its unit, under a one-line title (pair, method, range, density).
+whose two ends are labelled with their values and unit (the range the colours span) and round
+values between them, under a one-line title (pair, method, range, density).
 The maps are coloured exactly as ``disparity.png`` and ``depth.png`` are (:func:`colour_range`):
 the disparity from 0 px to its 99th percentile, the depth on its inverse (near = warm) from the
 1st to the 99th percentile of ``1 / Z``, so the depth bar's ticks are not evenly spaced.
@@ -78,11 +79,17 @@ class ColourBar:
         ``(x, y, width, height)`` of the bar in the overview; its top row is the colour map's
         level 255, its bottom row level 0.
     ticks : list of tuple
-        ``(value, label, y)``: a labelled value and the row of the overview it is drawn at.
+        ``(value, label, y)``: a labelled value and the row of the overview it is drawn at,
+        from the top down. The first and the last are the bar's ends (the colour range's ends,
+        their labels with the unit: ``"52.3 px"``, ``"2.07 m"``), the others round values
+        between them (the number only).
+    unit : str
+        The unit the end labels name (``"px"``, the depth's unit; ``""`` for the confidence).
     """
 
     box: tuple[int, int, int, int]
     ticks: list[tuple[float, str, int]] = field(default_factory=list)
+    unit: str = ""
 
 
 @dataclass
@@ -147,36 +154,51 @@ def _bar(
     hi: float,
     to_mapped: Callable[[float], float],
     values: list[float],
+    ends: tuple[float, float],
+    unit: str,
 ) -> ColourBar:
     """Draw a vertical colour bar at ``(x, y)`` and label ``values`` where their colour is.
 
     ``to_mapped`` turns a labelled value into the colour-mapped one (the identity, or
-    ``1 / Z`` for the depth).
+    ``1 / Z`` for the depth). ``ends`` are the labelled values of the top and bottom rows
+    (the colour range's ends), labelled with ``unit``; an inner value closer to one of them
+    than :data:`_TICK_SPACING` is left out.
     """
     rows = np.arange(height, dtype=np.float64)
     levels = np.clip(np.rint(255.0 * (height - 1 - rows) / max(height - 1, 1)), 0, 255)
     strip = cv2.applyColorMap(levels.astype(np.uint8)[:, None], cv2.COLORMAP_TURBO)
     img[y : y + height, x : x + _BAR_W] = strip
     cv2.rectangle(img, (x - 1, y - 1), (x + _BAR_W, y + height), _WHITE, 1)
-    bar = ColourBar(box=(x, y, _BAR_W, height))
-    last_y: int | None = None
+    bar = ColourBar(box=(x, y, _BAR_W, height), unit=unit)
     span = max(hi - lo, 1e-9)
-    # from the top (the map's high end) down, each tick clear of the one above it
-    placed = []
+    top, bottom = y, y + height - 1
+    # the ends first (a bar too short for two labels keeps its top one), then the values
+    # between them, from the top down, each clear of the labels above and below it
+    placed: list[tuple[float, str, int]] = [(ends[0], _end_label(ends[0], unit), top)]
+    if bottom - top >= _TICK_SPACING:
+        placed.append((ends[1], _end_label(ends[1], unit), bottom))
+    inner = []
     for value in values:
         level = (to_mapped(value) - lo) * 255.0 / span
         if not 0.0 <= level <= 255.0:
             continue
-        placed.append((value, y + round((height - 1) * (1.0 - level / 255.0))))
-    for value, ty in sorted(placed, key=lambda t: t[1]):
-        if last_y is not None and ty - last_y < _TICK_SPACING:
+        inner.append((value, y + round((height - 1) * (1.0 - level / 255.0))))
+    last_y = top
+    for value, ty in sorted(inner, key=lambda t: t[1]):
+        if ty - last_y < _TICK_SPACING or bottom - ty < _TICK_SPACING:
             continue
-        text = _label(value)
+        placed.append((value, _label(value), ty))
+        last_y = ty
+    for value, text, ty in sorted(placed, key=lambda t: t[2]):
         cv2.line(img, (x + _BAR_W, ty), (x + _BAR_W + 4, ty), _WHITE, 1)
         cv2.putText(img, text, (x + _BAR_W + 7, ty + 4), _FONT, 0.4, _WHITE, 1, cv2.LINE_AA)
         bar.ticks.append((value, text, ty))
-        last_y = ty
     return bar
+
+
+def _end_label(value: float, unit: str) -> str:
+    """An end of a bar: its value as the ticks print theirs, and the unit (``"52.3 px"``)."""
+    return f"{_label(value)} {unit}" if unit else _label(value)
 
 
 def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
@@ -221,8 +243,8 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     valid = np.isfinite(disparity)
     confidence = np.where(valid, np.asarray(result.confidence, np.float32), np.nan)
     # name, values as mapped, fixed ends, caption, labelled value -> mapped value, tick values
-    maps: list[tuple[str, Any, Any, str, Callable[[float], float], str]] = [
-        ("disparity", disparity, (0.0, None), "disparity (px)", lambda v: v, "linear")
+    maps: list[tuple[str, Any, Any, str, Callable[[float], float], str, str]] = [
+        ("disparity", disparity, (0.0, None), "disparity (px)", lambda v: v, "linear", "px")
     ]
     if result.depth is not None:
         depth = np.asarray(result.depth, np.float32)
@@ -231,9 +253,11 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         # coloured on 1 / Z in metres, as depth.png is; labelled in the unit asked for
         caption_text = f"depth ({unit})"
         maps.append(
-            ("depth", inv, (None, None), caption_text, lambda z: 1.0 / (z * size), "inverse")
+            ("depth", inv, (None, None), caption_text, lambda z: 1.0 / (z * size), "inverse", unit)
         )
-    maps.append(("confidence", confidence, (0.0, 1.0), "confidence (0-1)", lambda v: v, "linear"))
+    maps.append(
+        ("confidence", confidence, (0.0, 1.0), "confidence (0-1)", lambda v: v, "linear", "")
+    )
     cell_w = pw + _BAR_GAP + _BAR_W + _LABEL_W
     cell_h = _CAPTION_H + ph
     cells = 1 + len(maps)
@@ -259,7 +283,7 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         left, (pw, ph), interpolation=cv2.INTER_AREA
     )
     panels["left"] = (x, y + _CAPTION_H, pw, ph)
-    for i, (name, values, ends, text, to_mapped, kind) in enumerate(maps, start=1):
+    for i, (name, values, ends, text, to_mapped, kind, bar_unit) in enumerate(maps, start=1):
         x, y = origin(i)
         caption(text, x, y)
         rng = colour_range(values, *ends)
@@ -281,9 +305,13 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
             # a range within a decade in even steps of depth (2.5, 3, 3.5 m), a wider one
             # in 1-2-5 steps of each decade (1, 2, 5, 10, 20 m)
             ticks = _linear_ticks(near, far, 6) if far < 10 * near else _nice_values(near, far)
+            bar_ends = (near, far)  # near (warm) at the top
         else:
             ticks = _linear_ticks(lo, hi)
-        bars[name] = _bar(img, x + pw + _BAR_GAP, y + _CAPTION_H, ph, lo, hi, to_mapped, ticks)
+            bar_ends = (hi, lo)
+        bars[name] = _bar(
+            img, x + pw + _BAR_GAP, y + _CAPTION_H, ph, lo, hi, to_mapped, ticks, bar_ends, bar_unit
+        )
     font_scale = 0.6
     (tw, _), _ = cv2.getTextSize(title, _FONT, font_scale, 1)
     if tw > width - 2 * _MARGIN:
