@@ -297,7 +297,7 @@ def test_cli_check_cannot_tell(tmp_path: Path) -> None:
         if "--json" in extra:
             assert out["ok"] is None and out["matches"] == 0
         else:
-            assert out.startswith("rectification: cannot tell, 0 consistent feature matches")
+            assert out.startswith("rectification: cannot tell, only 0 feature matches")
         if extra:
             assert run.stderr == (
                 f"stereovision: not corrected, nothing written to {fixed}: too little texture "

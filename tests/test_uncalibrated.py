@@ -461,3 +461,41 @@ def test_a_damaged_rectification_file_is_refused(
     )  # fmt: skip
     assert run.returncode != 0 and "Traceback" not in run.stderr
     assert message in run.stderr and not (tmp_path / "out" / "disparity.pfm").exists()
+
+
+def test_cli_rectify_books_one_verdict(data_dir: Path, tmp_path: Path) -> None:
+    """OpenCV's hand-held books pair: the report said the rows agree to 0.25 px over 91 matches,
+    then "rectification: cannot tell, 18 consistent feature matches" (SIFT run anew on the
+    warped pair, whose right image the projective homographies squeeze and shear). The check
+    now judges the raw pair's matches moved by the homographies, by check_rectification's rule:
+    one verdict, its counts said."""
+    books = data_dir / "opencv_uncalibrated" / "books"
+    left, right = cv2.imread(str(books / "left.jpg")), cv2.imread(str(books / "right.jpg"))
+    rect = rectify_uncalibrated(left, right)
+    res = rect.check(left, right)
+    assert res.ok is True and 60 <= res.matches <= rect.matches  # measured 87 of 91
+    assert res.median_dy < 0.3 and abs(res.offset) < 0.5  # 0.23 px, -0.12 px
+    w, h = rect.size
+    assert (res.points[:, [0, 2]] < w).all() and (res.points[:, [1, 3]] < h).all()
+    with pytest.raises(ValueError, match="this rectification is for 612x459"):
+        rect.check(left[:100], right[:100])
+    run = subprocess.run(
+        [sys.executable, "-m", "stereovision.cli", "rectify", str(books / "left.jpg"),
+         str(books / "right.jpg"), "-o", str(tmp_path / "u")],
+        capture_output=True, text=True, timeout=180,
+    )  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert "cannot tell" not in run.stdout
+    line = next(ln for ln in run.stdout.splitlines() if ln.startswith("rectification"))
+    assert line.startswith("rectification ok: median |dy| 0.2")
+    said = f"{rect.matches} fit one fundamental matrix, {res.matches} lie on one row model"
+    assert said in run.stdout
+
+
+def test_too_few_matches_are_not_called_consistent() -> None:
+    """The "cannot tell" line counted every feature match as a "consistent" one."""
+    from stereovision.rectification_check import RectificationCheck
+
+    nan = float("nan")
+    line = RectificationCheck(18, nan, nan, nan, nan, nan, None, 0.5).summary()
+    assert line.startswith("rectification: cannot tell, only 18 feature matches (at least 30")

@@ -125,7 +125,7 @@ class RectificationCheck:
         """
         if self.ok is None:
             return (
-                f"rectification: cannot tell, {self.matches} consistent feature matches "
+                f"rectification: cannot tell, only {self.matches} feature matches "
                 f"(at least {MIN_MATCHES} needed: point the cameras at something textured)"
             )
         if self.swapped:
@@ -256,11 +256,21 @@ def check_rectification(
         if dl is not None and dr is not None and len(pl) >= 2 and len(pr) >= 2
         else np.zeros((0, 2), dtype=np.intp)
     )
-    nan = float("nan")
-    if len(pairs) < MIN_MATCHES:
-        return RectificationCheck(len(pairs), nan, nan, nan, nan, nan, None, tol)
     xl, yl = pl[pairs[:, 0]].T
     xr, yr = pr[pairs[:, 1]].T
+    return _judge_rows(np.column_stack([xl, yl, xr, yr]), w, h, tol)
+
+
+def _judge_rows(quad: npt.NDArray[np.float64], w: int, h: int, tol: float) -> RectificationCheck:
+    """The check's rule on matched points ``[x_left, y_left, x_right, y_right]`` of a rectified
+    ``w`` x ``h`` pair: fewer than :data:`MIN_MATCHES` cannot tell; matches near their rows at a
+    disparity not well below zero are fitted one row-offset model, whose inliers (within 1 px)
+    give the verdict; swapped when most lie on common rows at negative disparities."""
+    quad = np.asarray(quad, np.float64).reshape(-1, 4)
+    nan = float("nan")
+    if len(quad) < MIN_MATCHES:
+        return RectificationCheck(len(quad), nan, nan, nan, nan, nan, None, tol)
+    xl, yl, xr, yr = quad.T
     dy, dx = yl - yr, xl - xr
     # A rectified side-by-side rig: a match far off its row, or with a disparity well below
     # zero, is a wrong match, not drift, unless most matches are like that.
@@ -281,7 +291,7 @@ def check_rectification(
     if keep.sum() >= MIN_MATCHES:
         coef, fit_inl = _robust_fit(a[keep], dy[keep])
         inl[np.flatnonzero(keep)[fit_inl]] = True
-    quad = np.column_stack([xl, yl, xr, yr]).astype(np.float32)
+    pts = quad.astype(np.float32)
     if inl.sum() >= MIN_MATCHES and not swapped:
         ady = np.abs(dy[inl])
         med = float(np.median(ady))
@@ -294,13 +304,13 @@ def check_rectification(
             float(coef[2]),
             med <= tol,
             tol,
-            points=quad[inl],
+            points=pts[inl],
         )
     # Plenty of matches, but not on a common row model (a pair far from rectified, or not a
     # side-by-side pair at all) or mostly at negative disparities: not rectified.
     ady = np.abs(dy)
     return RectificationCheck(
-        len(pairs),
+        len(quad),
         float(np.median(ady)),
         float(np.percentile(ady, 95)),
         nan,
@@ -309,7 +319,7 @@ def check_rectification(
         False,
         tol,
         swapped=swapped,
-        points=quad,
+        points=pts,
     )
 
 
