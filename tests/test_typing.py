@@ -221,7 +221,7 @@ def test_mypy_strict_types_ranges_channels_and_steps_as_they_are(
     )
 
 
-def test_mypy_strict_types_channel_outputs(tmp_path: Path) -> None:
+def test_mypy_strict_types_channel_outputs(tmp_path: Path, mypy_cache: Path) -> None:
     """``FusionResult.channel_outputs`` was ``dict[str, Any]``: any key passed and every value
     was ``Any``. It is the TypedDict ``ChannelOutputs`` (whose keys ``DepthChannels`` shares):
     the right reads pass, a key it never holds is refused."""
@@ -239,7 +239,7 @@ def test_mypy_strict_types_channel_outputs(tmp_path: Path) -> None:
         "def sgm(fr: FusionResult) -> npt.NDArray[np.float32]:\n"
         "    return fr.channel_outputs['census']\n"
     )
-    run = _mypy_strict(script, tmp_path)
+    run = _mypy_strict(script, tmp_path, mypy_cache)
     assert run.returncode == 1
     lines = run.stdout.splitlines()
     assert all(ln.startswith("outputs.py:22: error: ") for ln in lines), run.stdout  # only sgm
