@@ -990,3 +990,55 @@ def test_opencv_stereo_calib_reads_1d_vectors_saved_by_filestorage(
         r"rows and cols\) where a matrix is expected$",
     ):
         Calibration.from_file(tmp_path, image_size=(320, 240), unit="cm")
+
+
+@pytest.mark.parametrize("suffix", [".yaml", ".xml"])
+def test_opencv_calibration_file_reads_1d_vectors_saved_by_filestorage(
+    tmp_path: Path, data_dir: Path, suffix: str
+) -> None:
+    """The general OpenCV YAML/XML reader (K1/D1/K2/D2/R/T, image size, unit) refused D1, D2 and
+    T saved by cv2.FileStorage from 1-D arrays (!!opencv-nd-matrix) as "field 'D1' is not a
+    matrix", though the stereo_calib reader takes them; it reads them as the vectors they are,
+    and still refuses a wrong length and a matrix saved 1-D."""
+    ref = data_dir / "stereopi_rig" / "reference_calib_result"
+    K1, K2 = np.load(ref / "cam_mats_left.npy"), np.load(ref / "cam_mats_right.npy")
+    D1 = np.load(ref / "dist_coefs_left.npy").ravel()
+    D2 = np.load(ref / "dist_coefs_right.npy").ravel()
+    E = np.load(ref / "e_mat.npy")
+    Ra, Rb, t = cv2.decomposeEssentialMat(E)
+    R = max((Ra, Rb), key=lambda r: float(np.trace(r)))
+    T = t.ravel() * np.linalg.norm(E) / np.sqrt(2)
+    T = -T if T[0] > 0 else T
+    path = tmp_path / f"rig{suffix}"
+
+    def write(**over: np.ndarray) -> None:
+        fields = {"K1": K1, "D1": D1, "K2": K2, "D2": D2, "R": R, "T": T, **over}
+        fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_WRITE)
+        for key, value in fields.items():
+            fs.write(key, value)
+        fs.write("image_width", 320)
+        fs.write("image_height", 240)
+        fs.write("unit", "cm")
+        fs.release()
+
+    write()
+    text = path.read_text()
+    assert ("D1: !!opencv-nd-matrix" in text) if suffix == ".yaml" else ("opencv-nd-matrix" in text)
+    for calib in (Calibration.from_file(path), Calibration.load(path)):
+        np.testing.assert_array_equal(calib.D1, D1)
+        np.testing.assert_array_equal(calib.D2, D2)
+        np.testing.assert_array_equal(calib.T, T)
+        np.testing.assert_array_equal(calib.K1, K1)
+        assert calib.baseline_m == pytest.approx(0.0540, abs=1e-4)  # the tutorial's 5.40 cm
+    # a vector of the wrong length: refused by its length, naming the file
+    write(T=np.append(T, 0.0))
+    with pytest.raises(ValueError, match=r"rig\.(yaml|xml): T: expected shape \(3,\).*got \(4,\)"):
+        Calibration.from_file(path)
+    # a matrix saved 1-D is not a matrix
+    write(R=R.ravel())
+    with pytest.raises(
+        ValueError,
+        match=r"rig\.(yaml|xml): field 'R' is not a matrix: a !!opencv-nd-matrix \(sizes, no "
+        r"rows and cols\) where a matrix is expected$",
+    ):
+        Calibration.from_file(path)

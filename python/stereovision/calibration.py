@@ -172,10 +172,15 @@ def _close(a: float, b: float, rel: float = RECTIFIED_REL_TOL) -> bool:
     return abs(a - b) <= rel * max(abs(a), abs(b), 1.0)
 
 
+#: Fields that are vectors, read also from a 1-D array's ``!!opencv-nd-matrix`` (what
+#: ``cv2.FileStorage`` writes for a 1-D NumPy array); the matrices K1/M1, K2/M2 and R are not.
+_VECTOR_FIELDS = frozenset({"D1", "D2", "T"})
+
+
 def _node_matrix(node: Any, key: str, source: str, vector: bool = False) -> npt.NDArray[np.float64]:
     """An ``!!opencv-matrix`` node read number by number, checked before anything is sized.
 
-    With ``vector``, a one-dimensional ``!!opencv-nd-matrix`` (``sizes: [n]``, what
+    With ``vector``, a one-dimensional ``!!opencv-nd-matrix`` (``sizes: [n]``; in XML, ``n``; what
     ``cv2.FileStorage`` writes for a 1-D NumPy array, such as distortion coefficients saved
     from ``dist.ravel()``) is read too, as an ``(n,)`` array; elsewhere it is refused as not
     a matrix.
@@ -196,9 +201,12 @@ def _node_matrix(node: Any, key: str, source: str, vector: bool = False) -> npt.
         # !!opencv-nd-matrix: FileStorage's form of an array that is not 2-D
         if not vector:
             raise bad("a !!opencv-nd-matrix (sizes, no rows and cols) where a matrix is expected")
-        if not (sizes.isSeq() and sizes.size() == 1 and sizes.at(0).isInt()):
+        # YAML writes sizes as [n]; XML's "<sizes>n</sizes>" reads back as a bare integer
+        if sizes.isSeq() and sizes.size() == 1:
+            sizes = sizes.at(0)
+        if not sizes.isInt():
             raise bad("expected a vector: sizes must be one integer, [n]")
-        shape: tuple[int, ...] = (int(sizes.at(0).real()),)
+        shape: tuple[int, ...] = (int(sizes.real()),)
     else:
         rows, cols = node.getNode("rows"), node.getNode("cols")
         if not (rows.isInt() and cols.isInt()):
@@ -1198,7 +1206,7 @@ class Calibration:
                 return int(node.real())
             if node.isReal():
                 return node.real()
-            return _node_matrix(node, key, source)
+            return _node_matrix(node, key, source, vector=key in _VECTOR_FIELDS)
 
         try:
             if all(fs.getNode(k).isNone() for k in _CALIBRATION_FIELDS):
@@ -1452,8 +1460,7 @@ class Calibration:
                     node = fs.getNode(key)
                     if node.isNone():
                         raise ValueError(f"OpenCV stereo_calib file {p} lacks field {key!r}")
-                    # D1, D2, T: also a 1-D array's !!opencv-nd-matrix
-                    vector = key in ("D1", "D2", "T")
+                    vector = key in _VECTOR_FIELDS
                     fields[key] = _node_matrix(node, key, str(p), vector=vector)
             finally:
                 fs.release()
