@@ -642,6 +642,39 @@ def test_eval_json_lines_are_strict_json() -> None:
                               "rmse": None, "n": 0, "density": 0.0}, "x": [1.5]}  # fmt: skip
 
 
+def test_json_line_converts_numpy_scalars_and_0d_arrays() -> None:
+    """NumPy integers and bools (a count from ``np.count_nonzero``, a mask's ``.any()``) were
+    passed through as they were and json.dumps raised TypeError; NumPy scalars and 0-d arrays
+    are written as JSON numbers, booleans and null (a NaN)."""
+    import json
+
+    from stereovision._jsonout import json_line, json_ready
+
+    row = {
+        "i64": np.int64(7),
+        "i32": np.int32(-3),
+        "u8": np.uint8(255),
+        "yes": np.bool_(True),
+        "no": np.bool_(False),
+        "f32": np.float32(0.5),
+        "nan": np.float64("nan"),
+        "inf": np.float32("inf"),
+        "a0_int": np.array(4),
+        "a0_float": np.array(2.25),
+        "a0_nan": np.array(np.nan),
+        "a0_bool": np.array(True),
+        "nested": [(np.int64(1), np.bool_(False))],
+    }
+    assert json.loads(json_line(row)) == {
+        "i64": 7, "i32": -3, "u8": 255, "yes": True, "no": False, "f32": 0.5, "nan": None,
+        "inf": None, "a0_int": 4, "a0_float": 2.25, "a0_nan": None, "a0_bool": True,
+        "nested": [[1, False]],
+    }  # fmt: skip
+    ready = json_ready(row)
+    kinds = [type(ready[k]).__name__ for k in ("i64", "yes", "f32", "a0_int", "a0_bool")]
+    assert kinds == ["int", "bool", "float", "int", "bool"]
+
+
 def test_eval_with_no_scene_to_evaluate_fails(data_dir: Path, tmp_path: Path) -> None:
     """Two scenes without ground truth: both skipped, nothing evaluated, and the exit status
     was 0 (an empty table)."""

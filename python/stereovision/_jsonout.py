@@ -18,23 +18,32 @@ __all__ = ["json_line", "json_ready"]
 
 
 def json_ready(value: Any) -> Any:
-    """``value`` with every non-finite float (NaN, inf) as None, recursively.
+    """``value`` with every non-finite float (NaN, inf) as None and NumPy scalars as Python's,
+    recursively.
 
     Parameters
     ----------
     value : Any
-        A dict, list, tuple, float (Python or numpy) or any other JSON-serialisable value.
+        A dict, list, tuple, number or bool (Python or NumPy, a 0-d array included) or any
+        other JSON-serialisable value.
 
     Returns
     -------
     Any
-        The same structure, dicts and lists rebuilt (tuples as lists), each finite float as a
-        Python float and each non-finite one as None; other values as given.
+        The same structure, dicts and lists rebuilt (tuples as lists); a NumPy integer or bool
+        (or a 0-d array of one) as a Python int or bool; each finite float as a Python float
+        and each non-finite one as None; other values as given.
     """
     if isinstance(value, dict):
         return {k: json_ready(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [json_ready(v) for v in value]
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]  # the NumPy scalar it holds
+    if isinstance(value, np.bool_):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
     if isinstance(value, (float, np.floating)):
         return float(value) if math.isfinite(value) else None
     return value
