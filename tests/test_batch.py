@@ -1644,3 +1644,38 @@ def test_a_calibration_file_rewritten_in_its_folder_redoes_the_pairs(
     both = np.isfinite(z120) & np.isfinite(z240)
     assert both.sum() > 1000
     np.testing.assert_allclose(np.median(z240[both] / z120[both]), 2.0, rtol=0.02)
+
+
+def test_a_rerun_keeps_the_size_its_summary_recorded_for_a_sizeless_calibration(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """OpenCV stereo_calib output is sized by the first pair by name: a pair of another size
+    added later that sorts first (00 before 01) changed calib_size for every pair, so all were
+    redone and all but it failed ('calibration is for 320x240 images'). A rerun into the same
+    output folder keeps the size its summary recorded for the same calibration: the new pair
+    fails alone, the others are skipped as done."""
+    from test_calibration import _opencv_stereo_calib
+
+    rig, root, out = tmp_path / "rig", tmp_path / "in", tmp_path / "out"
+    rig.mkdir()
+    root.mkdir()
+    _opencv_stereo_calib(rig)  # 640x480, T in mm
+    for n in ("01", "02"):
+        for side in ("left", "right"):
+            shutil.copy(data_dir / "chessboard" / f"{side}{n}.jpg", root / f"{side}{n}.jpg")
+    args = ["batch", str(root), "-o", str(out), "--calib", str(rig), "--workers", "1"]
+    args += ["--max-disparity", "16", "--calib-unit", "mm"]
+    assert main(args) == 0
+    for side in ("left", "right"):
+        small = cv2.resize(cv2.imread(str(root / f"{side}01.jpg")), (320, 240))
+        cv2.imwrite(str(root / f"{side}00.png"), small)  # sorts first, another size
+    capsys.readouterr()
+    assert main(args) == 1
+    assert capsys.readouterr().out.startswith("0 processed, 2 skipped (done before), 1 failed")
+    pairs = _summary(out)["pairs"]
+    assert [pairs[n]["status"] for n in ("00", "01", "02")] == ["failed", "done", "done"]
+    assert pairs["00"]["error"].startswith(
+        "ValueError: calibration is for 640x480 images, got 320x240"
+    )
+    assert pairs["00"]["options"]["calib_size"] == [640, 480]
+    assert np.load(out / "01" / "depth.npy").shape == (480, 640)

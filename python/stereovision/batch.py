@@ -351,6 +351,47 @@ def _calib_size(cal: Path | None, jobs: list[PairJob]) -> tuple[int, int] | None
     return None
 
 
+def _recorded_calib_size(pairs: dict[str, Any], calib: Path) -> tuple[int, int] | None:
+    """The ``calib_size`` an earlier run recorded for ``calib`` (a calibration that holds no
+    image size), else None.
+
+    Parameters
+    ----------
+    pairs : dict
+        The summary's pair records.
+    calib : Path
+        The calibration given to this run.
+
+    Returns
+    -------
+    tuple of int or None
+        The ``(width, height)`` most pairs done with the same calibration (the same path,
+        its files' sizes and times unchanged) were done at; None when no pair was done with it
+        (a size under which every pair failed is not kept).
+    """
+    try:
+        now = {k: [p.stat().st_size, p.stat().st_mtime_ns] for k, p in _calib_inputs(calib).items()}
+    except OSError:
+        return None
+    counts: dict[tuple[int, int], int] = {}
+    for entry in pairs.values():
+        if not isinstance(entry, dict) or entry.get("status") != "done":
+            continue
+        size = (entry.get("options") or {}).get("calib_size")
+        fp = entry.get("fingerprint") or {}
+        if (
+            entry.get("calib") != _recorded(calib)
+            or not isinstance(size, list)
+            or len(size) != 2
+            or not all(isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in size)
+            or {k: v for k, v in fp.items() if k.startswith("calib")} != now
+        ):
+            continue
+        key = (size[0], size[1])
+        counts[key] = counts.get(key, 0) + 1
+    return max(counts, key=lambda k: counts[k]) if counts else None
+
+
 def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str], list[str]]]:
     """:func:`os.walk` (top-down) that also enters links to folders outside ``top``, each once;
     also yields each folder's sub-folders as listed, links not entered included.
@@ -1288,6 +1329,11 @@ def run_batch(
         if calib_unit is not None:  # as ground: only when given
             opts["calib_unit"] = calib_unit
         if calib_size is not None:  # a calibration without a size, sized by the first pair
+            # ... or by the pairs an earlier run into OUT did with it: a pair of another size
+            # added since that sorts first changed the size of every pair (all redone, all but
+            # it failed); it fails alone now, as any pair of the wrong size does
+            assert calib is not None
+            calib_size = _recorded_calib_size(summary.pairs, Path(calib)) or calib_size
             opts["calib_size"] = list(calib_size)
         summary.data.update(
             input=str(Path(input_dir).resolve()),
