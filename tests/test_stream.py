@@ -870,3 +870,80 @@ def test_a_source_without_a_size_asks_for_one_for_stereo_calib_output(tmp_path: 
     )
     sized = SimpleNamespace(size=(320, 240), delivered_size={"left": (640, 480)})
     assert _sized_calibration(str(tmp_path), "mm", sized).image_size == (320, 240)
+
+
+class _ModeCap:
+    """A webcam stand-in whose driver reports one mode (640x480) and delivers another: its
+    frames are ``images``, read in turn until they run out."""
+
+    def __init__(self, images: list[np.ndarray]) -> None:
+        self.images = list(images)
+        self.frame: np.ndarray | None = None
+
+    def isOpened(self) -> bool:
+        return True
+
+    def grab(self) -> bool:
+        self.frame = self.images.pop(0) if self.images else None
+        return self.frame is not None
+
+    def retrieve(self) -> tuple[bool, np.ndarray | None]:
+        return self.frame is not None, self.frame
+
+    def get(self, prop: int) -> float:
+        return {cv2.CAP_PROP_FRAME_WIDTH: 640.0, cv2.CAP_PROP_FRAME_HEIGHT: 480.0}.get(prop, 0.0)
+
+    def set(self, prop: int, value: float) -> bool:
+        return False
+
+    def release(self) -> None:
+        pass
+
+
+def test_stream_sizes_stereo_calib_output_by_the_frames_delivered_not_the_mode_reported(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A calibration that holds no image size (OpenCV stereo_calib output) was sized by the
+    camera's reported mode: a driver that reports 640x480 and delivers 320x240 failed every
+    pair with 'calibration is for 640x480 images, got 320x240'. Without --size it is sized by
+    the first pair delivered; --size still wins."""
+    from test_calibration import _opencv_stereo_calib
+
+    import stereovision.stream as stream
+
+    rig = tmp_path / "rig"
+    rig.mkdir()
+    _opencv_stereo_calib(rig)
+    small = {
+        side: [
+            cv2.resize(cv2.imread(str(data_dir / "chessboard" / f"{side}{n}.jpg")), (320, 240))
+            for n in ("01", "02")
+        ]
+        for side in ("left", "right")
+    }
+
+    def cameras(args: Any, fps: float | None = None) -> StereoCamera:
+        return StereoCamera(_ModeCap(small["left"]), _ModeCap(small["right"]), size=args.size)
+
+    got: list[Calibration] = []
+    real = stream.run_stream
+
+    def spy(camera: Any, calib: Any = None, **kw: Any) -> Any:
+        got.append(calib)
+        return real(camera, calib, **kw)
+
+    monkeypatch.setattr(stream, "open_source", cameras)
+    monkeypatch.setattr(stream, "run_stream", spy)
+    argv = ["stream", "--left", "0", "--right", "1", "--calib", str(rig), "--calib-unit", "mm"]
+    argv += ["--no-display", "--no-check", "--max-disparity", "16", "--json"]
+    capsys.readouterr()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(argv) == 0, capsys.readouterr().err
+        assert _json_lines(capsys.readouterr().out)[-1]["frames"] == 2
+        assert got[-1].image_size == (320, 240)
+        assert main([*argv, "--size", "160x120"]) == 0, capsys.readouterr().err
+    assert got[-1].image_size == (160, 120)

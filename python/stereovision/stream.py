@@ -716,7 +716,7 @@ def run_stream(
         max_disparity = max_disparity or homographies.max_disparity
     if max_disparity is not None and max_disparity <= 0:
         raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
-    size = camera.size or camera.delivered_size.get("left")
+    size = _frame_size(camera)
     if calib is not None and size is not None:
         calib, note = fit_to_frames(calib, size)
         if note is not None:
@@ -956,11 +956,43 @@ def _format_report(rep: dict[str, Any]) -> str:
     )
 
 
+def _frame_size(camera: Any) -> tuple[int, int] | None:
+    """The size of ``camera``'s frames as known now: its output size (requested, or fixed by
+    a pair read), else the size its left source reports (a video's or image sequence's first
+    frame, a camera's mode); None when it states none (a bag before its first pair)."""
+    size: tuple[int, int] | None = camera.size or camera.delivered_size.get("left")
+    return size
+
+
+class _FirstPairRead:
+    """``camera`` with its first pair read already, to size a calibration by the frames it
+    delivers (a driver may report one mode and deliver another): :meth:`read` returns that
+    pair first, then the camera's next ones; every other attribute is the camera's.
+
+    Raises
+    ------
+    SourceError, ValueError
+        As the camera's ``read`` of the first pair (no first frame, one that does not decode).
+    """
+
+    def __init__(self, camera: Any) -> None:
+        self._camera = camera
+        self._first: StereoFrame | None = camera.read()
+
+    def read(self) -> StereoFrame:
+        """The first pair (read at construction), then the camera's next ones."""
+        first, self._first = self._first, None
+        return first if first is not None else self._camera.read()  # type: ignore[no-any-return]
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._camera, name)
+
+
 def _sized_calibration(path: str, unit: str | None, camera: Any) -> Calibration:
     """The calibration at ``path``, which holds no image size, read at the size of the frames
-    of ``camera`` (opened): ``--size``, else what its left source delivers (a video's or image
-    sequence's first frame, a camera's mode), the size :func:`run_stream` fits a calibration
-    to.
+    of ``camera`` (opened; :func:`_frame_size`): ``--size``, else the first pair's when it was
+    read (:class:`_FirstPairRead`, as :func:`cmd_stream` does), else what its left source
+    reports; the size :func:`run_stream` fits a calibration to.
 
     Raises
     ------
@@ -970,7 +1002,7 @@ def _sized_calibration(path: str, unit: str | None, camera: Any) -> Calibration:
     """
     from stereovision.cli import load_calibration
 
-    size = camera.size or camera.delivered_size.get("left")
+    size = _frame_size(camera)
     return load_calibration(  # type: ignore[no-any-return]
         path,
         unit,
@@ -1021,6 +1053,10 @@ def cmd_stream(args: argparse.Namespace) -> int:
     cam = open_source(args, fps=args.fps)
     if sizeless:
         try:
+            if getattr(cam, "requested_size", None) is None:
+                # sized by the first pair delivered, not by the mode the driver reports (one
+                # that reports 640x480 and delivers 320x240 failed every pair); --size wins
+                cam = _FirstPairRead(cam)
             calib = _sized_calibration(args.calib, args.calib_unit, cam)
         except BaseException:
             cam.close()
