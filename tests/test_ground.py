@@ -855,3 +855,28 @@ def test_occupancy_grid_save_keeps_a_previous_file_it_could_not_put_back(
         f"{png} could not be restored: its previous contents are in {kept[0]}"
     ]
     assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_occupancy_grid_save_removes_a_copy_that_failed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Copying the previous map.png aside failing (a full disk) left its half-written
+    ``.map.png.*.old`` temporary in the user's folder: it was made before it was listed for
+    removal. The previous pair stays byte for byte and no temporary is left."""
+    import shutil
+
+    from stereovision.ground import OccupancyGrid
+
+    png, yml = OccupancyGrid(np.array([[0, 100], [-1, -1]], np.int8), 0.05, (0.0, -0.05)).save(
+        tmp_path
+    )
+    before = {p.name: p.read_bytes() for p in (png, yml)}
+
+    def full(src: object, dst: object) -> None:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(shutil, "copy2", full)
+    with pytest.raises(OSError, match="No space left"):
+        OccupancyGrid(np.full((3, 4), 100, np.int8), 0.1, (1.0, -2.0)).save(tmp_path)
+    monkeypatch.undo()
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before

@@ -835,8 +835,10 @@ def _replace_pair(files: list[tuple[Path, bytes]]) -> None:
                 fd, name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".old", dir=dest.parent)
                 os.close(fd)
                 previous = Path(name)
-                shutil.copy2(dest, previous)  # dest stays in place meanwhile
+            # listed before the copy: a copy failing half-way (a full disk) is removed below
             kept.append((dest, previous))
+            if previous is not None:
+                shutil.copy2(dest, previous)  # dest stays in place meanwhile
             os.replace(new, dest)
             replaced += 1
     except BaseException as exc:
