@@ -517,3 +517,16 @@ def test_readme_synopsis_names_every_option() -> None:
         if not any(re.search(re.escape(o) + r"(?![\w-])", said) for o in action.option_strings)
     ]
     assert not unnamed, f"README's synopsis leaves out: {unnamed}"
+
+
+def test_readme_says_how_each_command_sizes_stereo_calib_output() -> None:
+    """README's --calib-unit paragraph said to save stereo_calib output once as YAML for batch,
+    stream and gui, which all size it from their pairs (docs/robotics.md); it names how each
+    command taking --calib-unit sizes it."""
+    text = " ".join((ROOT / "README.md").read_text().split())
+    said = re.search(r"`stereo_calib` output holds no image size either: (.*?)\(\[docs/", text)
+    assert said is not None, "README no longer says how stereo_calib output is sized"
+    sentence = said.group(1)
+    assert "YAML" not in sentence, sentence
+    for command in ("depth", "check", "rectify", "info", "batch", "stream", "gui"):
+        assert f"`{command}`" in sentence, command
