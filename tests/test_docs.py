@@ -530,3 +530,25 @@ def test_readme_says_how_each_command_sizes_stereo_calib_output() -> None:
     assert "YAML" not in sentence, sentence
     for command in ("depth", "check", "rectify", "info", "batch", "stream", "gui"):
         assert f"`{command}`" in sentence, command
+
+
+def test_robotics_quotes_kittis_floor_as_the_fit_finds_it(data_dir: Path) -> None:
+    """robotics.md quotes KITTI 000005's floor under the default depth map (its pipeline's 3b,
+    and describe(unit="ft")); the seed-robust fit (a705382) moved it from 1.618 m (5.309 ft)
+    to 1.625 m (5.331 ft), which `stereovision depth --ground --unit ft` prints, and the page
+    still said the old figures."""
+    import cv2
+
+    import stereovision as sv
+
+    kitti = data_dir / "kitti2015" / "000005_10"
+    calib = sv.Calibration.from_file(kitti / "calib.txt")
+    left, right = cv2.imread(str(kitti / "left.png")), cv2.imread(str(kitti / "right.png"))
+    plane = sv.fit_ground_plane(sv.depth_map(left, right, calib).disparity, calib)
+    assert plane is not None
+    page = (ROOT / "docs" / "robotics.md").read_text()
+    metres = re.search(r"camera \S+ m above it", plane.describe())
+    feet = re.search(r"camera \S+ ft above it", plane.describe("ft"))
+    assert metres is not None and feet is not None
+    assert f"# KITTI: {metres.group(0)}, pitch" in page
+    assert f"`{feet.group(0)}` on KITTI" in page
