@@ -89,6 +89,15 @@ def _tree(out: Path) -> dict[str, float]:
     }
 
 
+def _not_ours(out: Path, pair: str, name: str) -> str:
+    """batch's line refusing to replace ``out / pair / name``, which no earlier run listed."""
+    return (
+        f"stereovision: error: output folder {out}: {out / pair / name} is not listed as an "
+        "earlier run's output there and would be replaced: give another output folder, or "
+        "move or remove that file"
+    )
+
+
 def test_batch_runs_skips_and_records_failures(
     scenes: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -797,11 +806,7 @@ def test_batch_refuses_to_replace_a_file_it_did_not_write(
     args = ["--workers", "1", "--max-disparity", "16"]
     capsys.readouterr()
     assert main(["batch", str(src), "-o", str(out), *args]) == 2
-    assert capsys.readouterr().err.splitlines() == [
-        f"stereovision: error: output folder {out}: {out / 'a' / 'disparity.png'} is not "
-        "listed as an earlier run's output there and would be replaced: give another output "
-        "folder, or move or remove that file"
-    ]
+    assert capsys.readouterr().err.splitlines() == [_not_ours(out, "a", "disparity.png")]
     assert (out / "a" / "disparity.png").read_text() == "mine"
     assert sorted(p.name for p in (out / "a").iterdir()) == ["disparity.png"]
     (out / "a" / "disparity.png").unlink()
@@ -1228,11 +1233,7 @@ def test_an_older_batch_summary_does_not_make_a_users_overview_png_ours(
     args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     capsys.readouterr()
     assert main(args) == 2
-    assert capsys.readouterr().err.splitlines() == [
-        f"stereovision: error: output folder {out}: {out / 'a' / 'overview.png'} is not "
-        "listed as an earlier run's output there and would be replaced: give another output "
-        "folder, or move or remove that file"
-    ]
+    assert capsys.readouterr().err.splitlines() == [_not_ours(out, "a", "overview.png")]
     assert (out / "a" / "overview.png").read_text() == "mine"
     assert json.loads((out / SUMMARY_NAME).read_text()) == summary  # untouched
 
@@ -1287,11 +1288,7 @@ def test_batch_redoes_pairs_an_older_batch_left_without_an_outputs_list(
     args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
     capsys.readouterr()
     assert main(args) == 2
-    assert capsys.readouterr().err.splitlines() == [
-        f"stereovision: error: output folder {out}: {out / 'c' / 'disparity.png'} is not "
-        "listed as an earlier run's output there and would be replaced: give another output "
-        "folder, or move or remove that file"
-    ]
+    assert capsys.readouterr().err.splitlines() == [_not_ours(out, "c", "disparity.png")]
     assert json.loads((out / SUMMARY_NAME).read_text()) == summary  # untouched
     (out / "c" / "disparity.png").unlink()
     assert main(args) == 0, capsys.readouterr().err
