@@ -89,6 +89,24 @@ def _tree(out: Path) -> dict[str, float]:
     }
 
 
+def _stereo_calib_input(
+    tmp_path: Path, data_dir: Path, pairs: tuple[str, ...]
+) -> tuple[Path, Path, Path]:
+    """``rig`` (OpenCV stereo_calib's intrinsics.yml + extrinsics.yml: 640x480, T in mm), ``in``
+    holding the chessboard pairs ``pairs`` (``left01.jpg`` + ``right01.jpg``, ...) and ``out``
+    (not created), under ``tmp_path``."""
+    from test_calibration import _opencv_stereo_calib
+
+    rig, root, out = tmp_path / "rig", tmp_path / "in", tmp_path / "out"
+    rig.mkdir()
+    root.mkdir()
+    _opencv_stereo_calib(rig)
+    for n in pairs:
+        for side in ("left", "right"):
+            shutil.copy(data_dir / "chessboard" / f"{side}{n}.jpg", root / f"{side}{n}.jpg")
+    return rig, root, out
+
+
 def _not_ours(out: Path, pair: str, name: str) -> str:
     """batch's line refusing to replace ``out / pair / name``, which no earlier run listed."""
     return (
@@ -1497,15 +1515,9 @@ def test_batch_sizes_opencv_stereo_calib_output_by_the_first_pair(
     them ("this command cannot read it from its images, so save the rig once in Python ..."),
     exit 2. The first pair's left image sizes them now; a pair of another size fails with
     depth's own message, the others are done with the rig (metric outputs)."""
-    from test_calibration import _opencv_stereo_calib
-
-    rig, root, out = tmp_path / "rig", tmp_path / "in", tmp_path / "out"
-    rig.mkdir()
-    root.mkdir()
-    _opencv_stereo_calib(rig)  # 640x480, T in mm
+    rig, root, out = _stereo_calib_input(tmp_path, data_dir, ("01", "02"))
     for n in ("01", "02"):
         for side in ("left", "right"):
-            shutil.copy(data_dir / "chessboard" / f"{side}{n}.jpg", root / f"{side}{n}.jpg")
             small = cv2.resize(cv2.imread(str(root / f"{side}{n}.jpg")), (320, 240))
             cv2.imwrite(str(root / f"{side}9{n}.png"), small)  # another size: pairs 901, 902
     (root / "right902.png").unlink()  # one small pair only
@@ -1589,15 +1601,9 @@ def test_one_cameras_ros_file_reaches_the_workers_with_its_partner(
     """--calib ros/left.yaml (its right.yaml beside it, as calibration reads it) was checked
     here and then shipped alone: every pair failed in the worker with 'its partner (left/right
     swapped in the name) is not beside it'. It is read here and shipped as the rig's JSON."""
-    from test_calibration import _opencv_stereo_calib
-
-    rig, ros, root, out = (tmp_path / n for n in ("rig", "ros", "in", "out"))
-    rig.mkdir()
-    root.mkdir()
-    _opencv_stereo_calib(rig)
+    rig, root, out = _stereo_calib_input(tmp_path, data_dir, ("01",))
+    ros = tmp_path / "ros"
     Calibration.from_file(rig, image_size=(640, 480), unit="mm").save_ros(ros)
-    for side in ("left", "right"):
-        shutil.copy(data_dir / "chessboard" / f"{side}01.jpg", root / f"{side}01.jpg")
     args = ["batch", str(root), "-o", str(out), "--calib", str(ros / "left.yaml")]
     capsys.readouterr()
     assert main([*args, "--workers", "1", "--max-disparity", "16"]) == 0, capsys.readouterr().err
@@ -1613,14 +1619,7 @@ def test_a_calibration_file_rewritten_in_its_folder_redoes_the_pairs(
     calibration's fingerprint, and a file rewritten in place in it (a baseline of 240 mm for
     120) changes neither: the pair was skipped as done, its depth that of the old rig. The
     files read are fingerprinted; the same bytes with new times (a copy) are still up to date."""
-    from test_calibration import _opencv_stereo_calib
-
-    rig, root, out = tmp_path / "rig", tmp_path / "in", tmp_path / "out"
-    rig.mkdir()
-    root.mkdir()
-    _opencv_stereo_calib(rig)  # T = (-120, 1.5, 0.8) mm
-    for side in ("left", "right"):
-        shutil.copy(data_dir / "chessboard" / f"{side}01.jpg", root / f"{side}01.jpg")
+    rig, root, out = _stereo_calib_input(tmp_path, data_dir, ("01",))  # T (-120, 1.5, 0.8) mm
     args = ["batch", str(root), "-o", str(out), "--calib", str(rig), "--calib-unit", "mm"]
     args += ["--workers", "1", "--max-disparity", "16"]
     assert main(args) == 0
@@ -1651,15 +1650,7 @@ def test_a_rerun_keeps_the_size_its_summary_recorded_for_a_sizeless_calibration(
     redone and all but it failed ('calibration is for 320x240 images'). A rerun into the same
     output folder keeps the size its summary recorded for the same calibration: the new pair
     fails alone, the others are skipped as done."""
-    from test_calibration import _opencv_stereo_calib
-
-    rig, root, out = tmp_path / "rig", tmp_path / "in", tmp_path / "out"
-    rig.mkdir()
-    root.mkdir()
-    _opencv_stereo_calib(rig)  # 640x480, T in mm
-    for n in ("01", "02"):
-        for side in ("left", "right"):
-            shutil.copy(data_dir / "chessboard" / f"{side}{n}.jpg", root / f"{side}{n}.jpg")
+    rig, root, out = _stereo_calib_input(tmp_path, data_dir, ("01", "02"))
     args = ["batch", str(root), "-o", str(out), "--calib", str(rig), "--workers", "1"]
     args += ["--max-disparity", "16", "--calib-unit", "mm"]
     assert main(args) == 0
