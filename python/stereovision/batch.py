@@ -1159,14 +1159,25 @@ def _calib_payload(
         return out.name, out.read_bytes()
 
 
-def _task(job: PairJob, opts: dict[str, Any]) -> dict[str, Any]:
+def _task(
+    job: PairJob, opts: dict[str, Any], payloads: dict[Path, tuple[str, bytes]] | None = None
+) -> dict[str, Any]:
+    """A pair's task for a worker. ``payloads`` holds the run's calibrations already made
+    ready (:func:`_calib_payload`): a ``--calib`` shared by every pair is read once a run,
+    not once a pair."""
+    if payloads is None:
+        payloads = {}
+    calib = None
+    if job.calib is not None:
+        calib = payloads.get(job.calib)
+        if calib is None:
+            calib = _calib_payload(job.calib, opts.get("calib_unit"), opts.get("calib_size"))
+            payloads[job.calib] = calib
     return {
         "name": job.name,
         "left": (str(job.left), job.left.read_bytes()),
         "right": (str(job.right), job.right.read_bytes()),
-        "calib": None
-        if job.calib is None
-        else _calib_payload(job.calib, opts.get("calib_unit"), opts.get("calib_size")),
+        "calib": calib,
         **opts,
     }
 
@@ -1627,13 +1638,14 @@ def _run_jobs(
         limit = max(1, IN_FLIGHT_PER_WORKER * n_live)
         queue: Iterator[PairJob] = iter(todo)
         ac = as_completed()
+        payloads: dict[Path, tuple[str, bytes]] = {}
 
         def submit_next() -> bool:
             job = next(queue, None)
             if job is None:
                 return False
             try:
-                task = _task(job, opts)
+                task = _task(job, opts, payloads)
             except (OSError, ValueError) as exc:  # unreadable input or calibration (a scene's
                 # Q.dat is read here): a failed pair, not a failed run
                 record_failure(job, exc)
