@@ -120,9 +120,7 @@ def test_batch_runs_skips_and_records_failures(
     scenes: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     out = tmp_path / "out"
-    t = time.perf_counter()
     rc = main(["batch", str(scenes), "-o", str(out), "--workers", "2"])
-    first = time.perf_counter() - t
     assert rc == 1  # one pair failed; the others completed
     s = _summary(out)
     pairs = s["pairs"]
@@ -157,9 +155,7 @@ def test_batch_runs_skips_and_records_failures(
 
     # Second run: everything is skipped, nothing rewritten, no cluster started.
     before = _tree(out)
-    t = time.perf_counter()
     rc = main(["batch", str(scenes), "-o", str(out), "--workers", "2"])
-    second = time.perf_counter() - t
     assert rc == 1  # the corrupt pair still has no outputs
     said = capsys.readouterr().out
     assert "0 failed in" in said and "exit status 1: 1 pair(s) still without outputs" in said
@@ -168,7 +164,6 @@ def test_batch_runs_skips_and_records_failures(
     assert s["run"]["skipped_failed"] == 1 and s["run"]["scheduler"] is None
     assert all(p["this_run"] == "skipped" for p in s["pairs"].values())
     assert _tree(out) == before
-    assert second < min(10.0, first / 2)
 
     # The image is repaired: the next run, on an existing scheduler, redoes that pair only.
     shutil.copy(scenes / "middlebury2001/tsukuba/right.png", scenes / "seq/right_0001.png")
