@@ -53,6 +53,7 @@ __all__ = [
     "render_outputs",
     "render_view",
     "surface_mesh",
+    "write_render",
 ]
 
 #: A triangle is dropped when its largest vertex depth exceeds its smallest by more than this
@@ -798,14 +799,39 @@ def render_outputs(result: DepthResult, out_dir: str | os.PathLike[str]) -> dict
     dict
         ``{"render.png": path}``, or ``{}`` when there is nothing to render.
     """
+    if result.depth is None or result.calibration is None or len(result.points) == 0:
+        return {}
+    return write_render(render_result(result), out_dir)
+
+
+def write_render(image: npt.NDArray[np.uint8], out_dir: str | os.PathLike[str]) -> dict[str, Path]:
+    """Write ``image`` (a render, RGB) as ``render.png`` into ``out_dir``.
+
+    The writer of :func:`render_outputs`, for a view rendered otherwise (the GUI's Save: the
+    3-D view's own pose).
+
+    Parameters
+    ----------
+    image : ndarray, uint8 (H, W, 3)
+        RGB, as :func:`render_view` returns it.
+    out_dir : path
+        Output folder (created if missing). The file is replaced atomically.
+
+    Returns
+    -------
+    dict
+        ``{"render.png": path}``.
+
+    Raises
+    ------
+    OSError
+        The image could not be encoded or written.
+    """
     import cv2
 
     from stereovision.io import atomic_write
 
-    if result.depth is None or result.calibration is None or len(result.points) == 0:
-        return {}
-    img = render_result(result)
-    ok, buf = cv2.imencode(".png", img[..., ::-1])
+    ok, buf = cv2.imencode(".png", np.ascontiguousarray(image[..., ::-1]))
     if not ok:
         raise OSError("could not encode render.png")
     out = Path(out_dir)
