@@ -1284,7 +1284,8 @@ def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_pat
     _run(app, app.save)
     assert app.state.error == (
         f"save: {tmp_path.name}/saved already holds disparity.png, depth.png, depth.npy, "
-        "depth_mm.png, cloud.ply, overview.png; nothing was overwritten: choose another folder"
+        "depth_mm.png, cloud.ply, render.png, overview.png; nothing was overwritten: choose "
+        "another folder"
     )
     assert (out / "cloud.ply").read_text() == "mine" and not (out / "disparity.pfm").exists()
     for outside in ("../elsewhere", "/tmp", str(bundled_data_dir() / "x")):
@@ -1342,6 +1343,79 @@ def test_save_writes_the_overview_as_depth_does_in_the_pages_unit(tmp_path):
     )
     assert sorted(p.name for p in mine.iterdir()) == ["overview.png"]
     assert (mine / "overview.png").read_bytes() == b"my picture"
+
+
+def test_save_writes_render_png_of_the_3d_view_from_the_sliders_pose(tmp_path, monkeypatch):
+    """Save wrote depth's files but not render.png, the 3-D view. It is now written too: the
+    view on show seen from the pose the sliders set (translations in the page's unit), at the
+    pair's size. A render that fails, or a pair without calibration, is said at the end of the
+    Save's line; the other files are written all the same; a user's render.png is kept."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SAVED_DEPTH_FILES, SAVED_FILES
+
+    app = _scene_app("test-save-render", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app._on_unit(unit="ft")
+    app.state.yaw, app.state.right = 15.0, -1.0  # 1 ft to the left
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.endswith(", overview.png, render.png")
+    png = cv2.imread(str(tmp_path / "saved" / "render.png"), cv2.IMREAD_UNCHANGED)
+    assert png.shape == (375, 450, 3) and png.dtype == np.uint8
+    assert png.astype(np.float64).std() > 20.0  # a picture, not a blank window
+    assert not render.is_blank(png[..., ::-1], min_fraction=0.5)
+    view = app.view
+    posed = render.CameraControls(yaw=15.0, right=-0.3048)
+    expected = render.render_view(view.mesh, posed, intrinsics=view.intrinsics)
+    assert np.abs(png[..., ::-1].astype(np.int16) - expected).mean() < 1.0
+    default = render.render_view(view.mesh, intrinsics=view.intrinsics)
+    assert np.abs(png[..., ::-1].astype(np.int16) - default).mean() > 10.0  # the pose counts
+    # the user's render.png in a typed folder: refused, kept
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "render.png").write_bytes(b"my render")
+    app.state.save_dir = "mine"
+    _run(app, app.save)
+    assert app.state.error == (
+        f"save: {tmp_path.name}/mine already holds render.png; nothing was overwritten: "
+        "choose another folder"
+    )
+    assert (mine / "render.png").read_bytes() == b"my render"
+
+    # a render that fails: said in the line, the other files written
+    def broken(*args: Any, **kw: Any) -> Any:
+        raise RuntimeError("the offscreen render returned no image\nline 2")
+
+    monkeypatch.setattr(render, "render_view", broken)
+    app.state.save_dir = "broken"
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/broken: ")
+    assert app.state.save_label.endswith(
+        ", overview.png (render.png not written: the offscreen render returned no image)"
+    )
+    assert sorted(p.name for p in (tmp_path / "broken").iterdir()) == sorted(
+        n for n in SAVED_FILES + SAVED_DEPTH_FILES if n != "render.png"
+    )
+    # no calibration: no depth, said
+    scene = tmp_path / "nocalib"
+    scene.mkdir()
+    for side in ("left", "right"):
+        (scene / f"{side}.png").write_bytes(
+            (bundled_data_dir() / "cones" / f"{side}.png").read_bytes()
+        )
+    app._load_scene(scene)
+    _run(app, app.recompute)
+    app.state.save_dir = "nocalib-out"
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label == (
+        f"saved 450×375 to {tmp_path.name}/nocalib-out: disparity.png, disparity.pfm, "
+        "overview.png (no calibration: disparity only; no depth, cloud.ply or render.png)"
+    )
+    assert sorted(p.name for p in (tmp_path / "nocalib-out").iterdir()) == sorted(SAVED_FILES)
 
 
 def test_the_save_field_shows_the_data_folder_short_and_saves_where_it_says(tmp_path, monkeypatch):
@@ -2772,6 +2846,10 @@ def test_save_units_range_and_colour_keys_on_the_page(page, gui_data):
     page.wait_for_function("document.querySelector('#save-label')?.textContent.includes('saved ')")
     assert (gui_data / "kept" / "cloud.ply").is_file(), page.inner_text("#save-label")
     assert (gui_data / "kept" / "disparity.pfm").is_file()
+    # the 3-D view, rendered by the page's server itself (the thread of its own view)
+    shot = cv2.imread(str(gui_data / "kept" / "render.png"))
+    assert shot is not None and shot.std() > 20.0, page.inner_text("#save-label")
+    assert page.inner_text("#save-label").rstrip().endswith("overview.png, render.png")
     _shot(page, "gui-save.png")
     page.click("#save-btn")
     assert "nothing was overwritten" in _wait_error(page, "already holds")

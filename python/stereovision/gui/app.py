@@ -181,7 +181,7 @@ DEPTH_CAPTION = "depth (near = warm)"
 
 #: What "Save" writes (``stereovision depth``'s own files, by its writers): always, and with depth.
 SAVED_FILES = ("disparity.png", "disparity.pfm", "overview.png")
-SAVED_DEPTH_FILES = ("depth.png", "depth.npy", "depth_mm.png", "cloud.ply")
+SAVED_DEPTH_FILES = ("depth.png", "depth.npy", "depth_mm.png", "cloud.ply", "render.png")
 #: The save folder offered at start-up, inside the first ``--data`` folder.
 SAVE_FOLDER = "saved"
 #: Height of a button of a toggle row (Vuetify's compact button group).
@@ -448,6 +448,19 @@ def nowrap_units(text: str) -> str:
     '0–64\\xa0px · density 100\\xa0% · 0.29\\xa0s · median depth 3.50\\xa0m, 2 matches'
     """
     return _NUMBER_UNIT.sub(NBSP, text)
+
+
+def first_line(exc: BaseException) -> str:
+    """What the page says of ``exc``: its message's first line (its type's name if empty).
+
+    Examples
+    --------
+    >>> first_line(RuntimeError("the offscreen render returned no image\\nat line 2"))
+    'the offscreen render returned no image'
+    >>> first_line(MemoryError())
+    'MemoryError'
+    """
+    return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
 
 
 def short_paths(message: str, path: str | os.PathLike[str]) -> str:
@@ -1263,7 +1276,7 @@ class StereoApp:
     def _fail(self, exc: BaseException, path: Path | None = None) -> None:
         """Say ``exc`` on the page (its first line), ``path`` in it as the page shows paths
         (:func:`short_paths`) when given."""
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        msg = first_line(exc)
         if path is not None:
             msg = short_paths(msg, path)
         log.info("gui error: %s", msg)
@@ -1904,9 +1917,13 @@ class StereoApp:
 
     async def save(self) -> None:
         """Write the pair on show as ``stereovision depth -o`` does (its writers and file names:
-        disparity PNG and PFM, depth PNGs and .npy, cloud.ply, and ``overview.png``, its depth
-        bar in the page's unit and its title naming the pair as the page does) into the page's
-        save folder.
+        disparity PNG and PFM, depth PNGs and .npy, cloud.ply, ``overview.png``, its depth
+        bar in the page's unit and its title naming the pair as the page does, and
+        ``render.png``, the 3-D view from the pose the sliders set: :meth:`_render_for_save`)
+        into the page's save folder.
+
+        A render that fails (or a pair with no 3-D point to render) is said in the Save's line
+        on the page, after the files written: the others are written all the same.
 
         The folder as offered (or an empty field) is a new one each time: the first of
         ``saved``, ``saved-2``, ``saved-3``, ... that does not exist or is empty, so several
@@ -1916,6 +1933,7 @@ class StereoApp:
         """
         from stereovision.cli import DEPTH_OUTPUTS, CliError, write_depth_outputs, write_overview
         from stereovision.io import check_output_folder
+        from stereovision.render import write_render
 
         view = self._view_on_show("save_label", PENDING_SAVE)
         if view is None:
@@ -1950,9 +1968,20 @@ class StereoApp:
             self._fail(exc, folder)
             return
 
+        # The 3-D view rendered here, in the thread that renders the page's view (VTK's
+        # windows are not to be used from two threads); a failure is said after the files.
+        image, no_render = None, ""
+        if result.depth is not None:
+            try:
+                image = self._render_for_save(view)
+            except (ValueError, RuntimeError, MemoryError) as exc:
+                no_render = f"render.png not written: {first_line(exc)}"
+
         def run() -> dict[str, Path]:
             written = write_depth_outputs(result, folder)
             written.update(write_overview(result, folder, title, unit))
+            if image is not None:
+                written.update(write_render(image, folder))
             return written
 
         self._saving_into.add(folder)
@@ -1965,7 +1994,10 @@ class StereoApp:
             self._saving_into.discard(folder)
         self._done()
         h, w = result.disparity.shape
-        without = "" if result.depth is not None else " (no calibration: disparity only)"
+        if result.depth is None:
+            without = " (no calibration: disparity only; no depth, cloud.ply or render.png)"
+        else:
+            without = f" ({no_render})" if no_render else ""
         if skipped:
             links = ", ".join(skipped)
             without += f" ({links}: a symbolic link, not a folder of --data: left alone)"
@@ -1973,6 +2005,34 @@ class StereoApp:
             self.state.save_label = f"saved {w}×{h} to {label}: {', '.join(written)}{without}"
             # the lists offer what was just written: its cloud.ply to Show in the 3-D view
             self._refresh_file_lists()
+
+    def _render_for_save(self, view: ViewData) -> npt.NDArray[np.uint8]:
+        """``render.png`` of the pair on show: its 3-D view (the surface, or points in the
+        points mode or for a sparse method) from the pose the sliders set, through the pair's
+        intrinsics at most :data:`~stereovision.render.RENDER_MAX_SIDE` pixels wide or high.
+
+        Returns
+        -------
+        ndarray, uint8 (H, W, 3)
+            RGB, as :func:`~stereovision.render.render_view` renders it.
+
+        Raises
+        ------
+        ValueError
+            No 3-D point to render, or a slider's value that is not a number.
+        RuntimeError
+            The offscreen render failed.
+        """
+        from stereovision.render import RENDER_MAX_SIDE, render_view
+
+        res, intr = view.result, view.intrinsics
+        if view.mesh is None or intr is None or len(res.points) == 0:
+            raise ValueError("no 3-D point to render")
+        geometry = view.mesh
+        if view.matches is None and self.state.view_mode == "points":
+            geometry = shown_cloud(res.points, res.colors)[0]
+        scale = min(1.0, RENDER_MAX_SIDE / max(intr.width, intr.height))
+        return render_view(geometry, self._controls(), intrinsics=intr.scaled(scale))
 
     def _next_save_folder(self, skipped: list[str] | None = None) -> Path:
         """The first of ``saved``, ``saved-2``, ``saved-3``, ... in the first ``--data``
@@ -2075,19 +2135,39 @@ class StereoApp:
         self._clip_tag = keep_robust_clipping(self.plotter, geometry.points)
         self._apply_camera()
 
-    def _apply_camera(self) -> None:
+    def _controls(self) -> Any:
+        """The 3-D view's pose as the page's sliders set it (translations from the page's
+        unit to metres).
+
+        Returns
+        -------
+        stereovision.render.CameraControls
+
+        Raises
+        ------
+        ValueError
+            A slider's value that is not a finite number.
+        """
         from stereovision.calibration import UNIT_TO_METRES
-        from stereovision.render import CameraControls, apply_camera
+        from stereovision.render import CameraControls
 
         metres = UNIT_TO_METRES[self._unit]  # the translations are in the page's unit
         try:
-            controls = CameraControls(
+            return CameraControls(
                 **{
                     n: float(self.state[n]) * (metres if n in _TRANSLATIONS else 1.0)
                     for n in _CONTROL_NAMES
                 }
             )
-        except (TypeError, ValueError) as exc:
+        except TypeError as exc:  # float(None): a slider emptied (said as before)
+            raise ValueError(str(exc)) from None
+
+    def _apply_camera(self) -> None:
+        from stereovision.render import apply_camera
+
+        try:
+            controls = self._controls()
+        except ValueError as exc:
             self._fail(exc)
             return
         apply_camera(
