@@ -1352,7 +1352,7 @@ def test_save_writes_render_png_of_the_3d_view_from_the_sliders_pose(tmp_path, m
     Save's line; the other files are written all the same; a user's render.png is kept."""
     from stereovision import render
     from stereovision.gui import bundled_data_dir
-    from stereovision.gui.app import SAVED_DEPTH_FILES, SAVED_FILES
+    from stereovision.gui.app import SAVED_DEPTH_FILES, SAVED_FILES, shown_cloud
 
     app = _scene_app("test-save-render", [bundled_data_dir(), tmp_path])
     app._load_scene(bundled_data_dir() / "cones")
@@ -1372,6 +1372,16 @@ def test_save_writes_render_png_of_the_3d_view_from_the_sliders_pose(tmp_path, m
     assert np.abs(png[..., ::-1].astype(np.int16) - expected).mean() < 1.0
     default = render.render_view(view.mesh, intrinsics=view.intrinsics)
     assert np.abs(png[..., ::-1].astype(np.int16) - default).mean() > 10.0  # the pose counts
+    # the points mode on show: its points, from the same pose
+    app.state.view_mode, app.state.save_dir = "points", "points"
+    _run(app, app.save)
+    assert app.state.error == ""
+    points = cv2.imread(str(tmp_path / "points" / "render.png"))
+    cloud = shown_cloud(view.result.points, view.result.colors)[0]
+    expected = render.render_view(cloud, posed, intrinsics=view.intrinsics)
+    assert np.abs(points[..., ::-1].astype(np.int16) - expected).mean() < 1.0
+    assert np.abs(points.astype(np.int16) - png).mean() > 3.0
+    app.state.view_mode = "surface"
     # the user's render.png in a typed folder: refused, kept
     mine = tmp_path / "mine"
     mine.mkdir()
