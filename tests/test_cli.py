@@ -43,6 +43,18 @@ def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
     pts, _ = read_ply(out / "cloud.ply")
     assert len(pts) > 10000
     assert "overview.png" in json.loads((out / ".stereovision-depth.json").read_text())
+    # depth.npy's holes where disparity.pfm has values (16 %) were said nowhere: counted, with
+    # their reason (all filled pixels, guesses that get no depth)
+    said = re.search(
+        r"\n  depth on ([\d.]+) % of the pixels \(disparity on 100\.0 %\): none on (\d+) "
+        r"filled \([\d.]+ %, guesses, not measured\) nor on 0 measured \(0\.0 %\) within "
+        r"sigma_d of d = 0\n",
+        proc.stdout,
+    )
+    assert said, proc.stdout
+    depth = np.load(out / "depth.npy")
+    assert float(said.group(1)) == round(100 * np.isfinite(depth).mean(), 1)
+    assert int(said.group(2)) == int((np.isfinite(disp) & ~np.isfinite(depth)).sum()) > 0
 
 
 def test_closed_pipe_stops_quietly(tmp_path: Path) -> None:
@@ -108,6 +120,19 @@ def test_depth_command_on_metric_scene(
     argv += [str(scene / "calib.txt"), "--max-disparity", "32", "-o", str(tmp_path / "near")]
     assert main([*argv, "--max-depth", f"{med:.3f}"]) == 0
     near = np.load(tmp_path / "near" / "depth.npy")
+    # the pixels with a disparity but no depth are counted with their reason: the filled ones
+    # (as many in both runs), and the measured ones past --max-depth (terrace: none within
+    # sigma_d of d = 0)
+    full, cut = (ln for ln in capsys.readouterr().out.splitlines() if "  depth on " in ln)
+    filled = re.search(r"none on (\d+) filled", full)
+    assert filled and int(filled.group(1)) > 0 and f" {filled.group(0)} (" in cut
+    assert full.startswith(f"  depth on {100 * np.isfinite(depth).mean():.1f} % of the pixels")
+    assert full.endswith(" nor on 0 measured (0.0 %) within sigma_d of d = 0")
+    beyond = int((np.isfinite(depth) & ~np.isfinite(near)).sum())
+    assert cut.startswith(f"  depth on {100 * np.isfinite(near).mean():.1f} % of the pixels")
+    assert f" nor on {beyond} measured (" in cut and cut.endswith(
+        ") outside the limits or within sigma_d of d = 0"
+    )
     with np.errstate(invalid="ignore"):
         np.testing.assert_array_equal(np.isfinite(near), depth <= round(med, 3))
     pts, _ = read_ply(tmp_path / "near" / "cloud.ply")

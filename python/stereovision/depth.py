@@ -359,9 +359,11 @@ class DepthResult:
         Depth ``Z`` along the optical axis in metres (NaN where none); None without calibration.
         :meth:`depth_in`, :meth:`points_in` and :meth:`depth_sigma_in` give copies in feet (or
         mm, cm, in).
-        NaN also where the disparity is not above its predicted uncertainty ``sigma_d``
-        (``depth_sigma``): such a depth's one-sigma interval reaches infinity (the far sky, a
-        wrong lock at the range's floor).
+        NaN on the pixels the fill completed (confidence 0: their disparity is a guess from
+        their neighbours, not a measurement; 16 % of the demo scene's pixels), and where the
+        disparity is not above its predicted uncertainty ``sigma_d`` (``depth_sigma``): such a
+        depth's one-sigma interval reaches infinity (the far sky, a wrong lock at the range's
+        floor). :meth:`depth_counts` counts both.
     points : ndarray, float32 (N, 3)
         3-D points in metres in the left rectified camera frame (X right, Y down, Z forward), one
         per pixel with a depth, in row-major pixel order. Empty without calibration or with
@@ -430,6 +432,39 @@ class DepthResult:
     def density(self) -> float:
         """Fraction of pixels with a disparity estimate."""
         return float(self.valid.mean())
+
+    def depth_counts(self) -> dict[str, int]:
+        """How many pixels have a disparity, how many a depth, and why the others have none.
+
+        A pixel with a disparity gets no depth when its disparity was filled (confidence 0: a
+        guess from its neighbours, see ``depth``) or, measured, when it is not above its
+        uncertainty ``sigma_d`` (its one-sigma depth interval reaches infinity) or lies outside
+        the :attr:`limits` of :meth:`filtered`.
+
+        Returns
+        -------
+        dict of str to int
+            ``"pixels"`` (all), ``"disparity"`` (with a disparity), ``"depth"`` (with a depth),
+            ``"filled"`` (a filled disparity, no depth) and ``"dropped"`` (a measured disparity,
+            no depth: within ``sigma_d`` of ``d + doffs = 0``, or outside the limits);
+            ``disparity == depth + filled + dropped``.
+
+        Raises
+        ------
+        ValueError
+            A result without depth (no calibration).
+        """
+        depth = self.require_depth()
+        has_disp = np.isfinite(self.disparity)
+        lost = has_disp & ~np.isfinite(depth)
+        filled = int(np.count_nonzero(lost & (self.confidence == 0)))
+        return {
+            "pixels": int(depth.size),
+            "disparity": int(np.count_nonzero(has_disp)),
+            "depth": int(np.count_nonzero(np.isfinite(depth))),
+            "filled": filled,
+            "dropped": int(np.count_nonzero(lost)) - filled,
+        }
 
     def __repr__(self) -> str:
         # A summary, not the arrays (the dataclass repr printed 3.5 kB of them at a prompt).
