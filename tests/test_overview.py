@@ -262,3 +262,24 @@ def _result_without_depth() -> object:
         method="fast",
         max_disparity=16,
     )
+
+
+def test_the_depth_caption_says_where_there_is_depth(terrace_run: tuple) -> None:
+    """The demo's depth panel had holes on 16 % of the pixels under a title saying "density
+    100.0 %" (the disparity's): the depth caption gives the share with a depth and why the
+    rest has none; a panel too narrow for the reason keeps the share."""
+    _, res, _, _ = terrace_run
+    share = 100 * float(np.isfinite(res.depth).mean())
+    assert share < 95.0  # the fast map's filled pixels have no depth
+    ov = overview_image(res, "terrace")
+    assert ov.captions == {
+        "left": "left image",
+        "disparity": "disparity (px)",
+        "depth": f"depth (m) on {share:.1f} %, none where filled",
+        "confidence": "confidence (0-1)",
+    }
+    small = res.filtered(max_depth=float(np.nanmax(res.depth)))  # the same depths, a copy
+    small.disparity, small.confidence = res.disparity[:40, :60], res.confidence[:40, :60]
+    small.depth, small.left_rectified = res.depth[:40, :60], None
+    part = 100 * float(np.isfinite(small.depth).mean())
+    assert overview_image(small, "t", "ft").captions["depth"] == f"depth (ft) on {part:.1f} %"

@@ -109,6 +109,10 @@ class Overview:
         Panel name -> its :class:`ColourBar` (maps only).
     scale : float
         Downscaling factor of every panel (1 for images up to :data:`PANEL_WIDTH` wide).
+    captions : dict
+        Panel name -> the caption above it; the depth panel's says on what share of the pixels
+        there is a depth (``"depth (m) on 83.8 %, none where filled"``: the disparity's filled
+        pixels get none, so its holes are not the disparity's).
     """
 
     image: npt.NDArray[np.uint8]
@@ -116,6 +120,7 @@ class Overview:
     panels: dict[str, tuple[int, int, int, int]]
     bars: dict[str, ColourBar]
     scale: float
+    captions: dict[str, str] = field(default_factory=dict)
 
 
 def _label(value: float) -> str:
@@ -251,7 +256,12 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         with np.errstate(divide="ignore"):
             inv = np.where(np.isfinite(depth), 1.0 / depth, np.nan)
         # coloured on 1 / Z in metres, as depth.png is; labelled in the unit asked for
-        caption_text = f"depth ({unit})"
+        # the depth map has holes where the disparity map was filled (guesses get no depth):
+        # said with the share, shortened where the panel is too narrow for the reason
+        share = f"depth ({unit}) on {100 * float(np.isfinite(depth).mean()):.1f} %"
+        caption_text = f"{share}, none where filled"
+        if cv2.getTextSize(caption_text, _FONT, 0.5, 1)[0][0] > pw + _BAR_GAP + _BAR_W + _LABEL_W:
+            caption_text = share
         maps.append(
             ("depth", inv, (None, None), caption_text, lambda z: 1.0 / (z * size), "inverse", unit)
         )
@@ -277,6 +287,7 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
 
     panels: dict[str, tuple[int, int, int, int]] = {}
     bars: dict[str, ColourBar] = {}
+    captions = {"left": "left image"}
     x, y = origin(0)
     caption("left image", x, y)
     img[y + _CAPTION_H : y + cell_h, x : x + pw] = cv2.resize(
@@ -286,6 +297,7 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     for i, (name, values, ends, text, to_mapped, kind, bar_unit) in enumerate(maps, start=1):
         x, y = origin(i)
         caption(text, x, y)
+        captions[name] = text
         rng = colour_range(values, *ends)
         coloured: npt.NDArray[Any] = np.zeros((h, w, 3), np.uint8)
         if rng is not None:
@@ -317,7 +329,9 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     if tw > width - 2 * _MARGIN:
         font_scale *= (width - 2 * _MARGIN) / tw
     cv2.putText(img, title, (_MARGIN, 23), _FONT, font_scale, _WHITE, 1, cv2.LINE_AA)
-    return Overview(image=img, title=title, panels=panels, bars=bars, scale=scale)
+    return Overview(
+        image=img, title=title, panels=panels, bars=bars, scale=scale, captions=captions
+    )
 
 
 def overview_title(name: str, result: Any) -> str:
