@@ -437,9 +437,10 @@ class DepthResult:
         """How many pixels have a disparity, how many a depth, and why the others have none.
 
         A pixel with a disparity gets no depth when its disparity was filled (confidence 0: a
-        guess from its neighbours, see ``depth``) or, measured, when it is not above its
-        uncertainty ``sigma_d`` (its one-sigma depth interval reaches infinity) or lies outside
-        the :attr:`limits` of :meth:`filtered`.
+        guess from its neighbours, see ``depth``; also an enclosed far region the fill took
+        over, as 1992 pixels of TartanAir's sky measured at 0 px) or, measured, when it is not
+        above its uncertainty ``sigma_d`` (its one-sigma depth interval reaches infinity) or
+        lies outside the :attr:`limits` of :meth:`filtered`.
 
         Returns
         -------
