@@ -267,7 +267,10 @@ def test_stream_scales_a_calibration_made_at_another_resolution(
     videos: dict[str, Path], capsys: pytest.CaptureFixture[str]
 ) -> None:
     """--size 320x240 with the scene's 640x480 calibration: the frames and the calibration are
-    halved (one warning line each), and depth is computed at the lower resolution."""
+    halved (one warning line each), and depth is computed at the lower resolution. --size
+    320x180 of the same 640x480 videos: another shape, so the frames are kept at 640x480 and
+    the calibration fits them as it is (it was fitted to the 320x180 asked, and refused as of
+    "another aspect ratio" frames it was made for)."""
     argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
     argv += ["--calib", str(videos["calib"]), "--size", "320x240", "--max-disparity", "32"]
     argv += ["--no-display", "--json", "--frames", "2"]
@@ -279,8 +282,10 @@ def test_stream_scales_a_calibration_made_at_another_resolution(
     notes = [ln for ln in cap.err.splitlines() if "calibration is for 640x480" in ln]
     assert len(notes) == 1 and "frames are 320x240: scaled" in notes[0]
     argv[argv.index("320x240")] = "320x180"
-    assert main(argv) == 2
-    assert "another aspect ratio" in capsys.readouterr().err
+    assert main(argv) == 0
+    cap = capsys.readouterr()
+    assert _json_lines(cap.out)[-1]["frames"] == 2
+    assert "frames are kept at 640x480" in cap.err and "calibration is for" not in cap.err
 
 
 def test_stream_checks_every_nth_pair_and_warns_once_when_the_rows_drift(
@@ -947,3 +952,52 @@ def test_stream_sizes_stereo_calib_output_by_the_frames_delivered_not_the_mode_r
         assert got[-1].image_size == (320, 240)
         assert main([*argv, "--size", "160x120"]) == 0, capsys.readouterr().err
     assert got[-1].image_size == (160, 120)
+
+
+def test_stream_fits_a_calibration_to_the_frames_delivered_not_the_mode_reported(
+    data_dir: Path,
+) -> None:
+    """A calibration made at 640x480 was fitted to the camera's reported mode (640x480, so left
+    as is) while the driver delivered 320x240: the first pair failed. It is fitted to the first
+    pair delivered now (halved), each depth map is the halved pair's with the halved
+    calibration, and one line says the camera delivers another size than it reports."""
+    scene = data_dir / SCENE
+    calib = Calibration.from_file(scene / "calib.txt")
+    assert calib.image_size == (640, 480)
+    small = {
+        side: cv2.resize(cv2.imread(str(scene / f"{side}.png")), (320, 240), cv2.INTER_AREA)
+        for side in ("left", "right")
+    }
+    got: list[np.ndarray] = []
+    for pipelined in (True, False):
+        got.clear()
+        cam = StereoCamera(_ModeCap([small["left"]] * 2), _ModeCap([small["right"]] * 2))
+        with cam, warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            rep = run_stream(
+                cam,
+                calib,
+                max_disparity=32,
+                check=False,
+                pipelined=pipelined,
+                on_result=lambda left, res: got.append(res.disparity),
+            )
+        assert rep.frames == 2 and rep.ended == "end of stream" and rep.error is None
+        said = [str(w.message) for w in caught]
+        assert said == [
+            "the calibration is for 640x480 and the frames are 320x240: scaled to them (a "
+            "camera mode that crops instead of scaling needs its own calibration)",
+            "the left camera reports 640x480 but delivers 320x240: the calibration is fitted "
+            "to the frames delivered",
+        ]
+        ref = depth_map(
+            small["left"],
+            small["right"],
+            calib.scaled_to((320, 240)),
+            method="gabor",
+            max_disparity=32,
+            refine=False,
+        ).disparity
+        assert len(got) == 2
+        for disp in got:
+            np.testing.assert_array_equal(disp, ref)

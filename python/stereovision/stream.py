@@ -428,6 +428,7 @@ def _pairs(
     n = 0
     while frames is None or n < frames:
         t0 = time.perf_counter()
+        grabbed = getattr(camera, "grabbed", None) if isinstance(camera, _FirstPairRead) else None
         try:
             fr = camera.read()
         except SourceError as exc:
@@ -447,6 +448,9 @@ def _pairs(
                 raise
             raise SourceError(str(exc), end=False, frames=camera.count) from exc
         t1 = time.perf_counter()
+        grab_s = t1 - t0
+        if n == 0 and grabbed is not None:  # read ahead to size the calibration: its own grab
+            t0, grab_s = grabbed[0], grabbed[1] - grabbed[0]
         recorded = getattr(camera, "stamps_ns", None)
         if recorded:  # a recording (BagCamera): the stamp of the pair just read
             stamp_ns = int(recorded[-1])
@@ -479,7 +483,7 @@ def _pairs(
             right,
             fr.index,
             t0,
-            t1 - t0,
+            grab_s,
             t3 - t2,
             fr.skew_ms,
             checked,
@@ -633,7 +637,9 @@ def run_stream(
         Rig calibration. A raw rig calibration is applied by the producer (rectification); a
         rectified one (Middlebury, KITTI) is used as is. Without one, only disparity is
         computed. One made at another resolution of the same aspect ratio is scaled to the
-        frames (:meth:`~stereovision.calibration.Calibration.scaled_to`), with a warning.
+        frames (:meth:`~stereovision.calibration.Calibration.scaled_to`), with a warning. The
+        frames are the first pair delivered (read before the pipeline starts), not the mode a
+        camera reports: when they differ, a warning says so too.
     method : str
         Matcher (:data:`stereovision.depth.METHODS`). ``"gabor"`` by default: a live view wants
         the rate, and it is 3-4 times faster than ``depth_map``'s default ``"fused"``.
@@ -716,11 +722,19 @@ def run_stream(
         max_disparity = max_disparity or homographies.max_disparity
     if max_disparity is not None and max_disparity <= 0:
         raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
+    if calib is not None and getattr(camera, "count", None) == 0:
+        # fitted to the first pair delivered, not to the mode the driver reports (a driver
+        # that reports 640x480 and delivers 320x240 failed every pair), as batch and gui fit
+        # a calibration to the images they read
+        camera = _FirstPairRead(camera)  # type: ignore[assignment]
     size = _frame_size(camera)
     if calib is not None and size is not None:
         calib, note = fit_to_frames(calib, size)
         if note is not None:
             warnings.warn(note, stacklevel=2)
+        said = _mode_note(camera, size) if isinstance(camera, _FirstPairRead) else None
+        if said is not None:
+            warnings.warn(said, stacklevel=2)
     rect_calib = None
     if calib is not None:
         rect_calib = calib if calib.rectified else calib.rectified_calibration()
@@ -969,6 +983,15 @@ class _FirstPairRead:
     delivers (a driver may report one mode and deliver another): :meth:`read` returns that
     pair first, then the camera's next ones; every other attribute is the camera's.
 
+    Attributes
+    ----------
+    reported : tuple of int or None
+        The size the left source reported before its first frame (a camera's mode; None
+        when it reported none).
+    grabbed : tuple of float or None
+        ``perf_counter`` at the start and the end of the first pair's grab, until that pair
+        is handed out (the grab stage and the latency of pair 0).
+
     Raises
     ------
     SourceError, ValueError
@@ -977,15 +1000,35 @@ class _FirstPairRead:
 
     def __init__(self, camera: Any) -> None:
         self._camera = camera
+        self.reported: tuple[int, int] | None = getattr(camera, "delivered_size", {}).get("left")
+        t0 = time.perf_counter()
         self._first: StereoFrame | None = camera.read()
+        self.grabbed: tuple[float, float] | None = (t0, time.perf_counter())
 
     def read(self) -> StereoFrame:
         """The first pair (read at construction), then the camera's next ones."""
         first, self._first = self._first, None
-        return first if first is not None else self._camera.read()  # type: ignore[no-any-return]
+        if first is not None:
+            return first
+        self.grabbed = None
+        return self._camera.read()  # type: ignore[no-any-return]
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._camera, name)
+
+
+def _mode_note(camera: _FirstPairRead, size: tuple[int, int]) -> str | None:
+    """One line when the left source delivered frames of another size than the mode it
+    reported (the calibration is fitted to the frames, ``size``); None when they agree."""
+    got = getattr(camera, "delivered_size", {}).get("left")
+    if camera.reported is None or got is None or tuple(got) == tuple(camera.reported):
+        return None
+    (rw, rh), (w, h) = camera.reported, got
+    resized = "" if tuple(got) == tuple(size) else f", resized to {size[0]}x{size[1]}"
+    return (
+        f"the left camera reports {rw}x{rh} but delivers {w}x{h}{resized}: the calibration is "
+        "fitted to the frames delivered"
+    )
 
 
 def _sized_calibration(path: str, unit: str | None, camera: Any) -> Calibration:
