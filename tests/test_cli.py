@@ -700,6 +700,51 @@ def test_json_line_converts_numpy_scalars_and_0d_arrays() -> None:
     assert kinds == ["int", "bool", "float", "int", "bool"]
 
 
+def test_json_line_writes_arrays_paths_and_numpy_keys_nested() -> None:
+    """A NumPy array of one or more dimensions (a point, a matrix, a histogram) or a path
+    inside a row, at any depth, made json.dumps raise TypeError ("Object of type ndarray is
+    not JSON serializable"); arrays are written as (nested) lists, their NaN and inf as null,
+    paths as strings, NumPy dict keys as their values."""
+    import json
+    from pathlib import Path, PurePosixPath
+
+    from stereovision._jsonout import json_line, json_ready
+
+    row = {
+        "point": np.array([1.5, np.nan, -np.inf], dtype=np.float32),
+        "K": np.array([[500, 0, 320], [0, 500, 240], [0, 0, 1]], dtype=np.int64),
+        "mask": np.array([True, False]),
+        "empty": np.zeros((0, 3)),
+        "nested": {
+            "pairs": [(np.float64(2.0), np.array([np.int16(3), np.int16(4)]))],
+            "deep": ({"h": np.array([[np.nan], [0.25]])},),
+            "objs": np.array([Path("a/b.png"), np.float64("nan")], dtype=object),
+        },
+        "where": PurePosixPath("/data/scene/left.png"),
+        np.int64(5): "numpy key",
+        np.str_("s"): np.str_("text"),
+    }
+    back = json.loads(json_line(row))
+    assert back == {
+        "point": [1.5, None, None],
+        "K": [[500, 0, 320], [0, 500, 240], [0, 0, 1]],
+        "mask": [True, False],
+        "empty": [],
+        "nested": {
+            "pairs": [[2.0, [3, 4]]],
+            "deep": [{"h": [[None], [0.25]]}],
+            "objs": ["a/b.png", None],
+        },
+        "where": "/data/scene/left.png",
+        "5": "numpy key",
+        "s": "text",
+    }
+    ready = json_ready(row)
+    assert [type(v).__name__ for v in ready["K"][0]] == ["int", "int", "int"]
+    assert type(ready["mask"][0]) is bool and type(ready["point"][0]) is float
+    assert json_ready(np.array([[1, 2]]).T) == [[1], [2]]
+
+
 def test_eval_with_no_scene_to_evaluate_fails(data_dir: Path, tmp_path: Path) -> None:
     """Two scenes without ground truth: both skipped, nothing evaluated, and the exit status
     was 0 (an empty table)."""

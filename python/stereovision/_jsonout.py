@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from typing import Any
 
 import numpy as np
@@ -18,28 +19,33 @@ __all__ = ["json_line", "json_ready"]
 
 
 def json_ready(value: Any) -> Any:
-    """``value`` with every non-finite float (NaN, inf) as None and NumPy scalars as Python's,
-    recursively.
+    """``value`` with every non-finite float (NaN, inf) as None, NumPy scalars as Python's,
+    NumPy arrays as (nested) lists and paths as strings, recursively.
 
     Parameters
     ----------
     value : Any
-        A dict, list, tuple, number or bool (Python or NumPy, a 0-d array included) or any
-        other JSON-serialisable value.
+        A dict, list, tuple, number or bool (Python or NumPy), a NumPy array of any shape
+        (0-d included), an :class:`os.PathLike` path, or any other JSON-serialisable value.
 
     Returns
     -------
     Any
-        The same structure, dicts and lists rebuilt (tuples as lists); a NumPy integer or bool
-        (or a 0-d array of one) as a Python int or bool; each finite float as a Python float
-        and each non-finite one as None; other values as given.
+        The same structure, dicts and lists rebuilt (tuples as lists); a NumPy array as the
+        nested lists of its ``tolist`` (a 0-d one as its value), each element converted as a
+        value is; a NumPy integer or bool as a Python int or bool; each finite float as a
+        Python float and each non-finite one as None; a path as its string; a dict key that is
+        a NumPy scalar as its Python value, a path key as its string; other values as given.
     """
     if isinstance(value, dict):
-        return {k: json_ready(v) for k, v in value.items()}
+        return {_json_key(k): json_ready(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [json_ready(v) for v in value]
-    if isinstance(value, np.ndarray) and value.ndim == 0:
-        value = value[()]  # the NumPy scalar it holds
+    if isinstance(value, np.ndarray):
+        # nested lists of Python scalars (a 0-d array: its value), NaN and inf still floats
+        return json_ready(value.tolist())
+    if isinstance(value, os.PathLike):
+        return os.fspath(value)
     if isinstance(value, np.bool_):
         return bool(value)
     if isinstance(value, np.integer):
@@ -47,6 +53,16 @@ def json_ready(value: Any) -> Any:
     if isinstance(value, (float, np.floating)):
         return float(value) if math.isfinite(value) else None
     return value
+
+
+def _json_key(key: Any) -> Any:
+    """A dict key json.dumps takes: a NumPy scalar as its Python value, a path as its string
+    (json.dumps raised TypeError for both)."""
+    if isinstance(key, np.generic):
+        return key.item()
+    if isinstance(key, os.PathLike):
+        return os.fspath(key)
+    return key
 
 
 def json_line(row: dict[str, Any]) -> str:
