@@ -1662,3 +1662,74 @@ def test_a_rerun_keeps_the_size_its_summary_recorded_for_a_sizeless_calibration(
     )
     assert pairs["00"]["options"]["calib_size"] == [640, 480]
     assert np.load(out / "01" / "depth.npy").shape == (480, 640)
+
+
+def test_the_image_sizing_a_calibration_is_fingerprinted_as_its_files_are(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--calib rig/Q.dat is sized by the rig/left.png beside it (a Q matrix holds no image
+    size), which was not fingerprinted: another image there (192x128 for 96x64) changed the
+    calibration read, and the pair was skipped as done. It is fingerprinted as a calibration
+    file; a rewritten Q.dat redoes the pair too (depth doubled with the focal length)."""
+    root, out, rig = tmp_path / "in", tmp_path / "out", tmp_path / "rig"
+    _tiny(root, data_dir, "a/left.png", "a/right.png", "rig/left.png")
+    shutil.move(root / "rig", rig)
+    q = rig / "Q.dat"
+    q.write_text("1 0 0 -48\n0 1 0 -32\n0 0 0 100\n0 0 10 0\n")
+    args = ["batch", str(root), "-o", str(out), "--calib", str(q), "--workers", "1"]
+    args += ["--max-disparity", "16"]
+    assert main(args) == 0
+    z100 = np.load(out / "a" / "depth.npy")
+    fp = _summary(out)["pairs"]["a"]["fingerprint"]
+    assert sorted(fp) == ["calib", "calib:left.png", "left", "right"]
+    q.write_text("1 0 0 -48\n0 1 0 -32\n0 0 0 200\n0 0 10 0\n")
+    capsys.readouterr()
+    assert main(args) == 0
+    assert capsys.readouterr().out.startswith("1 processed, 0 skipped")
+    z200 = np.load(out / "a" / "depth.npy")
+    both = np.isfinite(z100) & np.isfinite(z200)
+    assert both.sum() > 1000
+    np.testing.assert_allclose(z200[both], 2 * z100[both], rtol=1e-5)
+    big = cv2.resize(cv2.imread(str(rig / "left.png")), (192, 128))
+    cv2.imwrite(str(rig / "left.png"), big)
+    assert main(args) == 1
+    assert capsys.readouterr().out.startswith("0 processed, 0 skipped (done before), 1 failed")
+    pair = _summary(out)["pairs"]["a"]
+    assert pair["status"] == "failed"
+    assert pair["error"].startswith("ValueError: calibration is for 192x128 images, got 96x64")
+
+
+def test_the_calibration_inputs_fingerprinted_are_those_read(tmp_path: Path) -> None:
+    """The image read to size a calibration: a folder's Q.dat's left.png, a KITTI file's
+    image_2.png (no S_rect_02); none for a scene's Q.dat (its left.png is the pair's own, the
+    keys an earlier run recorded) nor for a KITTI file that states its size."""
+    from stereovision.batch import _fingerprint
+
+    rig = tmp_path / "rig"
+    rig.mkdir()
+    (rig / "Q.dat").write_text("1 0 0 -48\n0 1 0 -32\n0 0 0 100\n0 0 10 0\n")
+    for name in ("left.png", "image_2.png", "l.png", "r.png"):
+        (rig / name).write_bytes(b"x")
+    kitti = tmp_path / "kitti"
+    kitti.mkdir()
+    p2 = "P2: 100 0 48 0 0 100 32 0 0 0 1 0\nP3: 100 0 48 -50 0 100 32 0 0 0 1 0\n"
+    (kitti / "calib.txt").write_text(p2)
+    shutil.copy(rig / "image_2.png", kitti / "image_2.png")
+    sized = tmp_path / "sized.txt"
+    sized.write_text(p2 + "S_rect_02: 96 64\n")
+    shutil.copy(rig / "left.png", tmp_path / "left.png")
+    lp, rp = rig / "l.png", rig / "r.png"
+    keys = {
+        "folder": sorted(_fingerprint(PairJob("a", lp, rp, rig))),
+        "kitti": sorted(_fingerprint(PairJob("a", lp, rp, kitti / "calib.txt"))),
+        "kitti folder": sorted(_fingerprint(PairJob("a", lp, rp, kitti))),
+        "scene": sorted(_fingerprint(PairJob("a", rig / "left.png", rp, rig / "Q.dat"))),
+        "sized": sorted(_fingerprint(PairJob("a", lp, rp, sized))),
+    }
+    assert keys == {
+        "folder": ["calib:Q.dat", "calib:left.png", "left", "right"],
+        "kitti": ["calib", "calib:image_2.png", "left", "right"],
+        "kitti folder": ["calib:calib.txt", "calib:image_2.png", "left", "right"],
+        "scene": ["calib", "left", "right"],
+        "sized": ["calib", "left", "right"],
+    }

@@ -643,8 +643,16 @@ def _calib_inputs(calib: Path | None) -> dict[str, Path]:
     in a folder (``rig/`` of OpenCV ``stereo_calib``: its intrinsics.yml and extrinsics.yml; a
     ROS camera_info folder's left.yaml and right.yaml) or beside it (``left.yaml``'s
     ``right.yaml``). A folder's own time and size were its fingerprint, and a file rewritten
-    in it (a new T in extrinsics.yml) changes neither: its pairs were skipped as done."""
-    from stereovision.calibration import _ros_pair_from_folder, _ros_sibling, _stereo_calib_files
+    in it (a new T in extrinsics.yml) changes neither: its pairs were skipped as done. The
+    image that sizes a calibration holding no size (the ``left.png`` beside a ``Q.dat``, the
+    image beside a KITTI file without ``S_rect_02``) is one too, ``calib:NAME``: another one
+    there changed the calibration read, and its pairs were skipped as done."""
+    from stereovision.calibration import (
+        _ros_pair_from_folder,
+        _ros_sibling,
+        _sizing_images,
+        _stereo_calib_files,
+    )
 
     if calib is None:
         return {}
@@ -660,12 +668,24 @@ def _calib_inputs(calib: Path | None) -> dict[str, Path]:
         files = _ros_sibling(calib) or ()
     inputs = {} if files and calib.is_dir() else {"calib": calib}
     inputs.update({f"calib:{f.name}": f for f in files if f != calib})
+    inputs.update({f"calib:{f.name}": f for f in _sizing_images(calib)})
+    return inputs
+
+
+def _inputs(job: PairJob) -> dict[str, Path]:
+    """The files a pair is made of, by their fingerprint keys: ``left``, ``right`` and its
+    calibration's (:func:`_calib_inputs`) but the pair's own images (a scene's ``Q.dat`` is
+    sized by its ``left.png``, already ``left``)."""
+    inputs = {"left": job.left, "right": job.right}
+    for key, path in _calib_inputs(job.calib).items():
+        if path not in (job.left, job.right):
+            inputs[key] = path
     return inputs
 
 
 def _fingerprint(job: PairJob) -> dict[str, Any]:
     fp: dict[str, Any] = {}
-    for key, p in (("left", job.left), ("right", job.right), *_calib_inputs(job.calib).items()):
+    for key, p in _inputs(job).items():
         st = p.stat()
         fp[key] = [st.st_size, st.st_mtime_ns]
     return fp
@@ -683,8 +703,8 @@ def _hashes(job: PairJob, task: dict[str, Any]) -> dict[str, str]:
     """The sha256 of the pair's input files (of the bytes ``task`` ships for its images, read
     once for both; of each calibration file read, :func:`_calib_inputs`)."""
     hashes = {side: hashlib.sha256(task[side][1]).hexdigest() for side in ("left", "right")}
-    for key, path in _calib_inputs(job.calib).items():
-        if path.is_file():
+    for key, path in _inputs(job).items():
+        if key not in hashes and path.is_file():
             hashes[key] = _sha256(path)
     return hashes
 
@@ -697,8 +717,7 @@ def _same_content(entry: dict[str, Any], fp: dict[str, Any], job: PairJob) -> bo
     old, hashes = entry.get("fingerprint"), entry.get("hashes")
     if not isinstance(old, dict) or not isinstance(hashes, dict) or old.keys() != fp.keys():
         return False
-    paths: dict[str, Path | None] = {"left": job.left, "right": job.right}
-    paths.update(_calib_inputs(job.calib))
+    paths: dict[str, Path | None] = dict(_inputs(job))
     for key, (size, mtime) in fp.items():
         rec = old[key]
         if not isinstance(rec, list) or len(rec) != 2 or rec[0] != size:

@@ -2389,24 +2389,45 @@ def _q_numbers(text: str) -> bool:
     return True
 
 
+def _q_file(path: Path) -> Path | None:
+    """The ``Q.dat`` :meth:`Calibration.from_file` reads for ``path`` (the file itself, or a
+    folder's without a ROS pair or ``calib.txt``), else None."""
+    if path.is_dir():
+        if _ros_pair_from_folder(path) is not None or (path / "calib.txt").is_file():
+            return None
+        q = path / "Q.dat"
+        return q if q.is_file() else None
+    try:
+        if not path.is_file() or path.stat().st_size > 4096 or not _q_numbers(path.read_text()):
+            return None
+    except (OSError, UnicodeDecodeError):
+        return None
+    return path
+
+
 def _unsized_q(path: PathLike) -> bool:
     """Whether :meth:`Calibration.from_file` reads ``path`` as a ``Q.dat`` (the file, or a
     folder's without ``calib.txt``) with no ``left.png`` beside it to size it."""
+    q = _q_file(Path(path))
+    return q is not None and not any((q.parent / n).is_file() for n in ("left.png", "left.jpg"))
+
+
+def _sizing_images(path: PathLike) -> tuple[Path, ...]:
+    """The images beside a calibration that :meth:`Calibration.from_file` reads for its image
+    size when none is given: a ``Q.dat``'s ``left.png`` (else ``left.jpg``), the ``left.png``
+    and ``image_2.png`` beside a KITTI file without ``S_rect_02`` (a folder: those of the file
+    it reads); none for a calibration that holds its size."""
     p = Path(path)
+    q = _q_file(p)
+    if q is not None:
+        return tuple(f for f in (q.parent / "left.png", q.parent / "left.jpg") if f.is_file())[:1]
     if p.is_dir():
-        if _ros_pair_from_folder(p) is not None or (p / "calib.txt").is_file():
-            return False
-        q = p / "Q.dat"
-        if not q.is_file():
-            return False
-    else:
-        q = p
-        try:
-            if not q.is_file() or q.stat().st_size > 4096 or not _q_numbers(q.read_text()):
-                return False
-        except (OSError, UnicodeDecodeError):
-            return False
-    return not any((q.parent / n).is_file() for n in ("left.png", "left.jpg"))
+        if _ros_pair_from_folder(p) is not None:
+            return ()
+        p = p / "calib.txt"
+    if not _sizeless_kitti_text(p):
+        return ()
+    return tuple(f for f in (p.parent / "left.png", p.parent / "image_2.png") if f.is_file())
 
 
 def _scene_image_size(q_file: Path) -> tuple[int, int]:
@@ -2454,9 +2475,9 @@ def _stereo_calib_files(path: Path) -> tuple[Path, Path] | None:
     return None if folder_calib else _opencv_stereo_calib_pair(path)
 
 
-def _unsized_kitti(path: Path) -> bool:
+def _sizeless_kitti_text(path: Path) -> bool:
     """Whether :meth:`Calibration.from_file` reads ``path`` as a KITTI calibration without
-    ``S_rect_02`` (the object/odometry ``calib`` files) and no image beside it to size it."""
+    ``S_rect_02`` (the object/odometry ``calib`` files), sized by an image beside it if any."""
     try:
         if not path.is_file() or path.stat().st_size > 65536:
             return False
@@ -2467,7 +2488,15 @@ def _unsized_kitti(path: Path) -> bool:
         r"^\s*cam0\s*=", text, re.MULTILINE
     ):
         return False  # read as another format before KITTI's (as _read_any orders them)
-    if not re.search(r"^\s*(P_rect_02|P2)\s*:", text, re.MULTILINE) or "S_rect_02" in text:
+    return bool(re.search(r"^\s*(P_rect_02|P2)\s*:", text, re.MULTILINE)) and (
+        "S_rect_02" not in text
+    )
+
+
+def _unsized_kitti(path: Path) -> bool:
+    """Whether :meth:`Calibration.from_file` reads ``path`` as a KITTI calibration without
+    ``S_rect_02`` (the object/odometry ``calib`` files) and no image beside it to size it."""
+    if not _sizeless_kitti_text(path):
         return False
     return not any((path.parent / n).is_file() for n in ("left.png", "image_2.png"))
 
