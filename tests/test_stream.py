@@ -1001,3 +1001,32 @@ def test_stream_fits_a_calibration_to_the_frames_delivered_not_the_mode_reported
         assert len(got) == 2
         for disp in got:
             np.testing.assert_array_equal(disp, ref)
+
+
+def test_a_stream_interrupted_before_its_first_pair_writes_strict_json(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C before the first pair was done: the --json summary's figures with nothing to
+    measure were written as NaN, which a strict JSON parser refuses; they are null now."""
+    import stereovision.stream as stream
+
+    class _Interrupted(_ModeCap):
+        def grab(self) -> bool:
+            raise KeyboardInterrupt
+
+    def cameras(args: Any, fps: float | None = None) -> StereoCamera:
+        return StereoCamera(_Interrupted([]), _Interrupted([]))
+
+    monkeypatch.setattr(stream, "open_source", cameras)
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--json"]
+    argv += ["--max-disparity", "16"]
+    assert main(argv) == 130
+
+    def refuse(word: str) -> None:
+        raise ValueError(f"not strict JSON: {word}")
+
+    (line,) = capsys.readouterr().out.splitlines()
+    summary = json.loads(line, parse_constant=refuse)
+    assert (summary["frames"], summary["ended"]) == (0, "interrupted")
+    assert summary["density"] is None and summary["noise_sigma"] is None
+    assert summary["latency_ms"] is None and set(summary["stage_ms"].values()) == {None}

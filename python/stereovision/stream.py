@@ -21,7 +21,6 @@ asks for them. ``--no-display`` turns the server off (headless robots).
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import queue
 import statistics
@@ -39,6 +38,7 @@ import cv2
 import numpy as np
 
 from stereovision._interrupt import Terminated
+from stereovision._jsonout import json_line
 from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import (
     SourceError,
@@ -1144,7 +1144,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
 
         def on_report(rep: dict[str, Any]) -> None:
             if args.json:
-                print(json.dumps(rep), file=out, flush=True)
+                print(json_line(rep), file=out, flush=True)
             else:
                 print(_format_report(rep), file=out, flush=True)
 
@@ -1192,7 +1192,8 @@ def cmd_stream(args: argparse.Namespace) -> int:
     if bag is not None:
         print(f"ROS 2 bag written to {bag.path} ({bag.messages} messages)", file=log)
     if args.json:
-        print(json.dumps(summary), file=out, flush=True)
+        # strict JSON: a figure with nothing to measure (no pair done: NaN) is null
+        print(json_line(summary), file=out, flush=True)
     else:
         st = report.stage_ms
         print(
