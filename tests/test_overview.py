@@ -13,7 +13,13 @@ import pytest
 from stereovision.calibration import Calibration
 from stereovision.cli import depth_outputs, main
 from stereovision.io import read_pfm
-from stereovision.overview import PANEL_WIDTH, ColourBar, overview_image, overview_title
+from stereovision.overview import (
+    PANEL_WIDTH,
+    ColourBar,
+    Overview,
+    overview_image,
+    overview_title,
+)
 
 _TURBO = cv2.applyColorMap(np.arange(256, dtype=np.uint8)[:, None], cv2.COLORMAP_TURBO)[:, 0]
 
@@ -283,3 +289,109 @@ def test_the_depth_caption_says_where_there_is_depth(terrace_run: tuple) -> None
     small.depth, small.left_rectified = res.depth[:40, :60], None
     part = 100 * float(np.isfinite(small.depth).mean())
     assert overview_image(small, "t", "ft").captions["depth"] == f"depth (ft) on {part:.1f} %"
+
+
+def _label_boxes(ov: Overview) -> list[tuple[str, str, tuple[int, int, int, int]]]:
+    """``(bar, label, (x0, y0, x1, y1))`` of every bar label as drawn: 7 px right of its bar,
+    its baseline 4 rows below its tick, as large as ``cv2.getTextSize`` says (0.4 HERSHEY)."""
+    out = []
+    for name, bar in ov.bars.items():
+        x0 = bar.box[0] + bar.box[2] + 7
+        for _, label, y in bar.ticks:
+            (tw, th), base = cv2.getTextSize(label, cv2.FONT_HERSHEY_SIMPLEX, 0.4, 1)
+            out.append((name, label, (x0, y + 4 - th, x0 + tw, y + 4 + base)))
+    return out
+
+
+def _result_with_depth(h: int, w: int, near: float, far: float) -> object:
+    """A DepthResult ``h`` x ``w`` whose depths (metres) span ``near`` to ``far`` with 1 / Z
+    uniform, 3 % of the pixels at each end: the depth bar's ends are ``near`` and ``far``."""
+    import stereovision as sv
+
+    rng = np.random.default_rng(0)
+    inv = rng.uniform(1 / far, 1 / near, h * w)
+    k = max(1, h * w * 3 // 100)
+    inv[:k], inv[k : 2 * k] = 1 / near, 1 / far
+    inv = rng.permutation(inv).reshape(h, w)
+    return sv.DepthResult(
+        disparity=(60 * inv).astype(np.float32),
+        confidence=rng.uniform(0, 1, (h, w)).astype(np.float32),
+        depth=(1 / inv).astype(np.float32),
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+        method="fast",
+        max_disparity=64,
+    )
+
+
+def _kitti_gt_result(data_dir: Path) -> object:
+    """KITTI 000005_10's ground-truth disparity and its depth (f B / d) as a DepthResult."""
+    import stereovision as sv
+
+    scene = data_dir / "kitti2015" / "000005_10"
+    calib = Calibration.from_file(scene / "calib.txt")
+    disp = read_pfm(scene / "gt_disp.pfm").astype(np.float32)
+    disp[~(np.isfinite(disp) & (disp > 0))] = np.nan  # the pfm's inf: no ground truth
+    return sv.DepthResult(
+        disparity=disp,
+        confidence=np.where(np.isfinite(disp), 1.0, 0.0).astype(np.float32),
+        depth=(calib.focal_px * calib.baseline_m / disp).astype(np.float32),
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+        method="fast",
+        max_disparity=192,
+    )
+
+
+def _check_labels_inside_their_cells(ov: Overview) -> None:
+    """Every label box lies inside the picture and inside its cell: it ends at least the
+    figure's 10 px margin before the picture's right edge and before any panel right of it
+    (the label column was 64 px: '12500 mm' ran 2 px into the margin, '116123 mm' to 1 px
+    of the next panel, '2000000 mm' over it); no two label boxes overlap."""
+    height, width = ov.image.shape[:2]
+    boxes = _label_boxes(ov)
+    lefts = [x for x, _, _, _ in ov.panels.values()]
+    for name, label, (x0, y0, x1, y1) in boxes:
+        right = min([x - 10 for x in lefts if x > x0] + [width - 10])
+        assert 0 <= y0 and y1 <= height and x1 <= right, (name, label, (x0, x1), right)
+    for (n1, t1, a), (n2, t2, b) in itertools.combinations(boxes, 2):
+        overlap = a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+        assert not overlap, (n1, t1, a, n2, t2, b)
+
+
+@pytest.mark.parametrize("unit", ["m", "mm", "cm", "ft", "in"])
+def test_overview_long_labels_fit_their_column_kitti(data_dir: Path, unit: str) -> None:
+    """KITTI's ground truth reaches 70 m: its depth bar's far end in mm is 6 characters and
+    the unit; the label column is as wide as it, the metres figure as wide as before."""
+    res = _kitti_gt_result(data_dir)
+    ov = overview_image(res, "000005_10", unit)
+    _check_labels_inside_their_cells(ov)
+    widest = max(x1 - x0 for _, _, (x0, _, x1, _) in _label_boxes(ov))
+    pw = ov.panels["left"][2]
+    # 10 + 2 x (panel + 8 + bar 16 + label column + 10), the column 7 px + the widest label
+    assert ov.image.shape[1] == 30 + 2 * (pw + 24 + max(64, 7 + widest))
+    if unit == "m":
+        assert ov.image.shape[1] == 30 + 2 * (pw + 24 + 64)
+    far = ov.bars["depth"].ticks[-1][1]
+    assert far.endswith(f" {unit}") and (unit != "mm" or len(far) >= len("12345 mm")), far
+
+
+@pytest.mark.parametrize("unit", ["m", "mm", "cm", "ft", "in"])
+@pytest.mark.parametrize("size", [(60, 80), (288, 384), (375, 1242)])
+@pytest.mark.parametrize("ends", [(0.4, 3.0), (1.5, 12.5), (4.0, 116.0), (0.3, 2000.0)])
+def test_overview_labels_inside_their_cells(
+    unit: str, size: tuple[int, int], ends: tuple[float, float]
+) -> None:
+    ov = overview_image(_result_with_depth(*size, *ends), "t", unit)
+    _check_labels_inside_their_cells(ov)
+    # the ends are the depths given, in the unit
+    from stereovision.calibration import UNIT_TO_METRES
+
+    ticks = ov.bars["depth"].ticks
+    near, far = (e / UNIT_TO_METRES[unit] for e in ends)
+    assert (ticks[0][0], ticks[-1][0]) == (
+        pytest.approx(near, rel=1e-3),
+        pytest.approx(far, rel=1e-3),
+    )

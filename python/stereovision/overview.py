@@ -4,7 +4,9 @@
 carry no scale. The overview puts the left image, the disparity map, the depth map (when there
 is one) and the matcher's confidence side by side, downscaled, each map with a colour bar
 whose two ends are labelled with their values and unit (the range the colours span) and round
-values between them, under a one-line title (pair, method, range, density).
+values between them, under a one-line title (pair, method, range, density). The label column
+beside the bars is as wide as its longest label (``cv2.getTextSize``; ``"116123 mm"``), 64 px at
+least.
 The maps are coloured exactly as ``disparity.png`` and ``depth.png`` are (:func:`colour_range`):
 the disparity from 0 px to its 99th percentile, the depth on its inverse (near = warm) from the
 1st to the 99th percentile of ``1 / Z``, so the depth bar's ticks are not evenly spaced.
@@ -29,7 +31,9 @@ _TITLE_H = 34
 _CAPTION_H = 22
 _BAR_GAP = 8
 _BAR_W = 16
-_LABEL_W = 64
+_LABEL_W = 64  # the label column right of a bar at least; wider when a label needs it
+_LABEL_X = 7  # from the bar's right edge to its labels' left edge
+_LABEL_SCALE = 0.4
 _TICK_SPACING = 16  # px between two labelled ticks at least
 _FONT = cv2.FONT_HERSHEY_SIMPLEX
 _WHITE = (255, 255, 255)
@@ -150,10 +154,15 @@ def _linear_ticks(lo: float, hi: float, n: int = 5) -> list[float]:
     return [float(f"{first + i * step:.12g}") for i in range(count)]
 
 
-def _bar(
-    img: npt.NDArray[np.uint8],
-    x: int,
-    y: int,
+def _text_box(text: str, x: int, row: int) -> tuple[int, int, int, int]:
+    """``(x0, y0, x1, y1)`` of a bar label whose tick is at ``row`` and whose bar's right edge is
+    at ``x``, as ``cv2.getTextSize`` measures it (the rows above and below its baseline)."""
+    (tw, th), base = cv2.getTextSize(text, _FONT, _LABEL_SCALE, 1)
+    x0, baseline = x + _LABEL_X, row + 4
+    return x0, baseline - th, x0 + tw, baseline + base
+
+
+def _place_ticks(
     height: int,
     lo: float,
     hi: float,
@@ -161,22 +170,17 @@ def _bar(
     values: list[float],
     ends: tuple[float, float],
     unit: str,
-) -> ColourBar:
-    """Draw a vertical colour bar at ``(x, y)`` and label ``values`` where their colour is.
+) -> list[tuple[float, str, int]]:
+    """The labelled ticks of a bar ``height`` rows tall: ``(value, label, row)``, rows from
+    the bar's top, sorted.
 
     ``to_mapped`` turns a labelled value into the colour-mapped one (the identity, or
     ``1 / Z`` for the depth). ``ends`` are the labelled values of the top and bottom rows
-    (the colour range's ends), labelled with ``unit``; an inner value closer to one of them
-    than :data:`_TICK_SPACING` is left out.
+    (the colour range's ends), labelled with ``unit``; an inner value closer to the one above
+    it or to the bottom than :data:`_TICK_SPACING` is left out.
     """
-    rows = np.arange(height, dtype=np.float64)
-    levels = np.clip(np.rint(255.0 * (height - 1 - rows) / max(height - 1, 1)), 0, 255)
-    strip = cv2.applyColorMap(levels.astype(np.uint8)[:, None], cv2.COLORMAP_TURBO)
-    img[y : y + height, x : x + _BAR_W] = strip
-    cv2.rectangle(img, (x - 1, y - 1), (x + _BAR_W, y + height), _WHITE, 1)
-    bar = ColourBar(box=(x, y, _BAR_W, height), unit=unit)
     span = max(hi - lo, 1e-9)
-    top, bottom = y, y + height - 1
+    top, bottom = 0, height - 1
     # the ends first (a bar too short for two labels keeps its top one), then the values
     # between them, from the top down, each clear of the labels above and below it
     placed: list[tuple[float, str, int]] = [(ends[0], _end_label(ends[0], unit), top)]
@@ -187,16 +191,42 @@ def _bar(
         level = (to_mapped(value) - lo) * 255.0 / span
         if not 0.0 <= level <= 255.0:
             continue
-        inner.append((value, y + round((height - 1) * (1.0 - level / 255.0))))
+        inner.append((value, round((height - 1) * (1.0 - level / 255.0))))
     last_y = top
     for value, ty in sorted(inner, key=lambda t: t[1]):
         if ty - last_y < _TICK_SPACING or bottom - ty < _TICK_SPACING:
             continue
         placed.append((value, _label(value), ty))
         last_y = ty
-    for value, text, ty in sorted(placed, key=lambda t: t[2]):
+    return sorted(placed, key=lambda t: t[2])
+
+
+def _label_width(ticks: list[tuple[float, str, int]]) -> int:
+    """The label column a bar's ``ticks`` need: from the bar's right edge to the widest
+    label's right edge (``cv2.getTextSize``)."""
+    return max(_text_box(text, 0, 0)[2] for _, text, _ in ticks)
+
+
+def _bar(
+    img: npt.NDArray[np.uint8],
+    x: int,
+    y: int,
+    height: int,
+    ticks: list[tuple[float, str, int]],
+    unit: str,
+) -> ColourBar:
+    """Draw a vertical colour bar at ``(x, y)`` and its ``ticks`` (:func:`_place_ticks`)."""
+    rows = np.arange(height, dtype=np.float64)
+    levels = np.clip(np.rint(255.0 * (height - 1 - rows) / max(height - 1, 1)), 0, 255)
+    strip = cv2.applyColorMap(levels.astype(np.uint8)[:, None], cv2.COLORMAP_TURBO)
+    img[y : y + height, x : x + _BAR_W] = strip
+    cv2.rectangle(img, (x - 1, y - 1), (x + _BAR_W, y + height), _WHITE, 1)
+    bar = ColourBar(box=(x, y, _BAR_W, height), unit=unit)
+    for value, text, row in ticks:
+        ty = y + row
+        x0, _, _, _ = _text_box(text, x + _BAR_W, ty)
         cv2.line(img, (x + _BAR_W, ty), (x + _BAR_W + 4, ty), _WHITE, 1)
-        cv2.putText(img, text, (x + _BAR_W + 7, ty + 4), _FONT, 0.4, _WHITE, 1, cv2.LINE_AA)
+        cv2.putText(img, text, (x0, ty + 4), _FONT, _LABEL_SCALE, _WHITE, 1, cv2.LINE_AA)
         bar.ticks.append((value, text, ty))
     return bar
 
@@ -268,7 +298,28 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     maps.append(
         ("confidence", confidence, (0.0, 1.0), "confidence (0-1)", lambda v: v, "linear", "")
     )
-    cell_w = pw + _BAR_GAP + _BAR_W + _LABEL_W
+    # each map's colour range and labelled ticks first: the label column is as wide as the
+    # widest label needs (64 px at least), the same beside every bar
+    placed: list[tuple[Any, tuple[float, float] | None, list[tuple[float, str, int]]]] = []
+    for _, values, ends, _, to_mapped, kind, bar_unit in maps:
+        rng = colour_range(values, *ends)
+        ticks: list[tuple[float, str, int]] = []
+        if rng is not None:
+            lo, hi = rng
+            if kind == "inverse":
+                near, far = 1.0 / max(hi, 1e-12), min(1.0 / lo if lo > 0 else 1e6, 1e6)
+                near, far = near / size, far / size  # in the bar's unit
+                # a range within a decade in even steps of depth (2.5, 3, 3.5 m), a wider one
+                # in 1-2-5 steps of each decade (1, 2, 5, 10, 20 m)
+                steps = _linear_ticks(near, far, 6) if far < 10 * near else _nice_values(near, far)
+                bar_ends = (near, far)  # near (warm) at the top
+            else:
+                steps = _linear_ticks(lo, hi)
+                bar_ends = (hi, lo)
+            ticks = _place_ticks(ph, lo, hi, to_mapped, steps, bar_ends, bar_unit)
+        placed.append((values, rng, ticks))
+    label_w = max([_LABEL_W] + [_label_width(ticks) for _, _, ticks in placed if ticks])
+    cell_w = pw + _BAR_GAP + _BAR_W + label_w
     cell_h = _CAPTION_H + ph
     cells = 1 + len(maps)
     cols = 2
@@ -294,11 +345,12 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         left, (pw, ph), interpolation=cv2.INTER_AREA
     )
     panels["left"] = (x, y + _CAPTION_H, pw, ph)
-    for i, (name, values, ends, text, to_mapped, kind, bar_unit) in enumerate(maps, start=1):
+    for i, ((name, _, _, text, _, _, bar_unit), (values, rng, ticks)) in enumerate(
+        zip(maps, placed, strict=True), start=1
+    ):
         x, y = origin(i)
         caption(text, x, y)
         captions[name] = text
-        rng = colour_range(values, *ends)
         coloured: npt.NDArray[Any] = np.zeros((h, w, 3), np.uint8)
         if rng is not None:
             coloured = cv2.applyColorMap(colour_levels(values, *rng), cv2.COLORMAP_TURBO)
@@ -310,20 +362,7 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         panels[name] = (x, y + _CAPTION_H, pw, ph)
         if rng is None:
             continue
-        lo, hi = rng
-        if kind == "inverse":
-            near, far = 1.0 / max(hi, 1e-12), min(1.0 / lo if lo > 0 else 1e6, 1e6)
-            near, far = near / size, far / size  # in the bar's unit
-            # a range within a decade in even steps of depth (2.5, 3, 3.5 m), a wider one
-            # in 1-2-5 steps of each decade (1, 2, 5, 10, 20 m)
-            ticks = _linear_ticks(near, far, 6) if far < 10 * near else _nice_values(near, far)
-            bar_ends = (near, far)  # near (warm) at the top
-        else:
-            ticks = _linear_ticks(lo, hi)
-            bar_ends = (hi, lo)
-        bars[name] = _bar(
-            img, x + pw + _BAR_GAP, y + _CAPTION_H, ph, lo, hi, to_mapped, ticks, bar_ends, bar_unit
-        )
+        bars[name] = _bar(img, x + pw + _BAR_GAP, y + _CAPTION_H, ph, ticks, bar_unit)
     font_scale = 0.6
     (tw, _), _ = cv2.getTextSize(title, _FONT, font_scale, 1)
     if tw > width - 2 * _MARGIN:
