@@ -368,6 +368,7 @@ def test_overview_long_labels_fit_their_column_kitti(data_dir: Path, unit: str) 
     res = _kitti_gt_result(data_dir)
     ov = overview_image(res, "000005_10", unit)
     _check_labels_inside_their_cells(ov)
+    _check_clear_of_the_ends(ov)
     widest = max(x1 - x0 for _, _, (x0, _, x1, _) in _label_boxes(ov))
     pw = ov.panels["left"][2]
     # 10 + 2 x (panel + 8 + bar 16 + label column + 10), the column 7 px + the widest label
@@ -386,6 +387,7 @@ def test_overview_labels_inside_their_cells(
 ) -> None:
     ov = overview_image(_result_with_depth(*size, *ends), "t", unit)
     _check_labels_inside_their_cells(ov)
+    _check_clear_of_the_ends(ov)
     # the ends are the depths given, in the unit
     from stereovision.calibration import UNIT_TO_METRES
 
@@ -395,3 +397,29 @@ def test_overview_labels_inside_their_cells(
         pytest.approx(near, rel=1e-3),
         pytest.approx(far, rel=1e-3),
     )
+
+
+def _check_clear_of_the_ends(ov: Overview) -> None:
+    """Between each end's label box and its neighbour's, 6 blank rows at least (8 between the
+    inks, about a digit's height)."""
+    boxes = _label_boxes(ov)
+    for name in ov.bars:
+        rows = [box for bar, _, box in boxes if bar == name]
+        labels = [label for bar, label, _ in boxes if bar == name]
+        if len(rows) < 3:
+            continue
+        assert rows[1][1] - rows[0][3] >= 6, (name, labels[:2], rows[:2])
+        assert rows[-1][1] - rows[-2][3] >= 6, (name, labels[-2:], rows[-2:])
+
+
+def test_overview_inner_label_next_to_an_end_is_left_out() -> None:
+    """The demo's depth bar (cones, 2.17-6.5 m, 375 rows) had "6" 16 rows over "6.5 m": 4 blank
+    rows between their boxes, read as one label; it is left out, the others stay where they
+    were."""
+    ov = overview_image(_result_with_depth(375, 450, 2.17, 6.5), "t")
+    bar = ov.bars["depth"]
+    ticks = [(label, y - bar.box[1]) for _, label, y in bar.ticks]
+    assert ticks == [("2.17 m", 0), ("3", 155), ("4", 257), ("5", 318), ("6.5 m", 374)]
+    _check_clear_of_the_ends(ov)
+    # the disparity and confidence bars' ticks are where they were (no label near an end)
+    assert [t[1] for t in ov.bars["confidence"].ticks] == ["1", "0.8", "0.6", "0.4", "0.2", "0"]

@@ -6,7 +6,7 @@ is one) and the matcher's confidence side by side, downscaled, each map with a c
 whose two ends are labelled with their values and unit (the range the colours span) and round
 values between them, under a one-line title (pair, method, range, density). The label column
 beside the bars is as wide as its longest label (``cv2.getTextSize``; ``"116123 mm"``), 64 px at
-least.
+least; an inner label keeps a digit's height of blank rows from an end's (:data:`_END_GAP`).
 The maps are coloured exactly as ``disparity.png`` and ``depth.png`` are (:func:`colour_range`):
 the disparity from 0 px to its 99th percentile, the depth on its inverse (near = warm) from the
 1st to the 99th percentile of ``1 / Z``, so the depth bar's ticks are not evenly spaced.
@@ -35,6 +35,11 @@ _LABEL_W = 64  # the label column right of a bar at least; wider when a label ne
 _LABEL_X = 7  # from the bar's right edge to its labels' left edge
 _LABEL_SCALE = 0.4
 _TICK_SPACING = 16  # px between two labelled ticks at least
+#: Blank rows between an end's label box and an inner label's at least (``cv2.getTextSize``
+#: boxes; 6 leaves 8 blank rows between the inks, about a digit's 9): ticks 16 rows apart leave
+#: 4 (6 between the inks), and an inner label read as part of the end one (``"6"`` right over
+#: ``"6.5 m"`` at the bottom of the demo's depth bar).
+_END_GAP = 6
 _FONT = cv2.FONT_HERSHEY_SIMPLEX
 _WHITE = (255, 255, 255)
 _GREY = (40, 40, 40)
@@ -177,7 +182,8 @@ def _place_ticks(
     ``to_mapped`` turns a labelled value into the colour-mapped one (the identity, or
     ``1 / Z`` for the depth). ``ends`` are the labelled values of the top and bottom rows
     (the colour range's ends), labelled with ``unit``; an inner value closer to the one above
-    it or to the bottom than :data:`_TICK_SPACING` is left out.
+    it or to the bottom row than :data:`_TICK_SPACING` is left out, and so is one whose label
+    would come within :data:`_END_GAP` rows of an end's label (boxes of ``cv2.getTextSize``).
     """
     span = max(hi - lo, 1e-9)
     top, bottom = 0, height - 1
@@ -186,6 +192,7 @@ def _place_ticks(
     placed: list[tuple[float, str, int]] = [(ends[0], _end_label(ends[0], unit), top)]
     if bottom - top >= _TICK_SPACING:
         placed.append((ends[1], _end_label(ends[1], unit), bottom))
+    end_boxes = [_text_box(text, 0, row) for _, text, row in placed]
     inner = []
     for value in values:
         level = (to_mapped(value) - lo) * 255.0 / span
@@ -196,7 +203,11 @@ def _place_ticks(
     for value, ty in sorted(inner, key=lambda t: t[1]):
         if ty - last_y < _TICK_SPACING or bottom - ty < _TICK_SPACING:
             continue
-        placed.append((value, _label(value), ty))
+        text = _label(value)
+        _, y0, _, y1 = _text_box(text, 0, ty)
+        if any(y0 - _END_GAP < e1 and e0 < y1 + _END_GAP for _, e0, _, e1 in end_boxes):
+            continue
+        placed.append((value, text, ty))
         last_y = ty
     return sorted(placed, key=lambda t: t[2])
 
