@@ -423,3 +423,17 @@ def test_overview_inner_label_next_to_an_end_is_left_out() -> None:
     _check_clear_of_the_ends(ov)
     # the disparity and confidence bars' ticks are where they were (no label near an end)
     assert [t[1] for t in ov.bars["confidence"].ticks] == ["1", "0.8", "0.6", "0.4", "0.2", "0"]
+
+
+def test_colour_levels_of_infinities_without_an_overflow() -> None:
+    """KITTI's gt_disp.pfm stores "no ground truth" as inf: it became float32's largest value
+    and the scaling overflowed (a RuntimeWarning); the levels are the same, warning-free."""
+    import warnings
+
+    from stereovision.overview import colour_levels
+
+    values = np.array([np.inf, -np.inf, np.nan, 1.0, 3.0, 2.0], np.float32)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        levels = colour_levels(values, 1.0, 3.0)
+    assert levels.tolist() == [255, 0, 0, 0, 255, 127]

@@ -73,9 +73,11 @@ def colour_range(
 
 
 def colour_levels(values: npt.NDArray[Any], lo: float, hi: float) -> npt.NDArray[np.uint8]:
-    """The colour map's level (0-255) of each value, as ``colorize`` computes it."""
+    """The colour map's level (0-255) of each value, as ``colorize`` computes it: NaN at
+    level 0, +inf at 255 and -inf at 0, without an overflow on the way."""
     scale = 255.0 / max(hi - lo, 1e-9)
-    return np.clip((np.nan_to_num(values, nan=lo) - lo) * scale, 0, 255).astype(np.uint8)
+    finite = np.nan_to_num(values, nan=lo, posinf=hi, neginf=lo)
+    return np.clip((finite - lo) * scale, 0, 255).astype(np.uint8)
 
 
 @dataclass
