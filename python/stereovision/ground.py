@@ -33,6 +33,7 @@ from stereovision._validate import require as _require_type
 from stereovision.calibration import UNIT_TO_METRES, Calibration
 
 __all__ = [
+    "GROUND_FOCAL_PX",
     "GROUND_INLIER_PX",
     "MAX_TILT_DEG",
     "GroundPlane",
@@ -47,8 +48,20 @@ __all__ = [
 
 F64 = npt.NDArray[np.float64]
 
-#: A pixel lies on the plane when its disparity is within this many pixels of the plane's.
+#: A pixel lies on the plane when its disparity is within this many pixels of the plane's, on a
+#: rig whose rectified focal length is at least :data:`GROUND_FOCAL_PX` pixels; below it the
+#: tolerance scales with the focal length (``GROUND_INLIER_PX * f / GROUND_FOCAL_PX``), the same
+#: angle of disparity (``d / f = B / Z``), so that a rig run at a lower resolution keeps the band
+#: of the scene it had. A fixed 1 px was four times as wide in the scene on images a quarter of
+#: the size, and tilted planes through whatever stands in the view outvoted the floor: KITTI
+#: 000005 matched at the GUI's 320 px width put the camera 8.10 m above the road (1.62 m at full
+#: size). The rigs the fit was measured on have 320 (TartanAir) to 721 px (KITTI) at full size,
+#: and keep their 1 px; so does the rendered floor of ``tests/test_ground.py`` (400 px), whose
+#: 0.2-0.5 px of noise a tolerance of 0.56 px (1 px at 720) counted off the floor. The matchers'
+#: noise does not shrink with the image (about 0.5 px at any size), so the tolerance is not
+#: scaled further: ETH3D playground at half size (271 px) still finds a slope through its walls.
 GROUND_INLIER_PX = 1.0
+GROUND_FOCAL_PX = 320.0
 #: The floor's normal may lean this far from the camera's "up" (-Y): the camera's own pitch and
 #: roll on its mount. Planes tilted further (walls, ramps seen head-on) are not the floor. (At
 #: 45 degrees, sloping structures of ETH3D playground outvote its floor.)
@@ -186,7 +199,7 @@ class GroundPlane:
         return out
 
     def support(
-        self, disparity: npt.ArrayLike, calib: Calibration, *, inlier_px: float = GROUND_INLIER_PX
+        self, disparity: npt.ArrayLike, calib: Calibration, *, inlier_px: float | None = None
     ) -> float:
         """Share of the pixels with a disparity in ``disparity`` that lie on this plane, counted
         as :attr:`inlier_share` counts them: does this floor still hold in another frame?
@@ -202,8 +215,10 @@ class GroundPlane:
             ``(H, W)`` disparity of another frame of the same rig; NaN where unknown.
         calib : Calibration
             The rig.
-        inlier_px : float
-            Disparity tolerance (pixels), as :func:`fit_ground_plane`'s.
+        inlier_px : float, optional
+            Disparity tolerance (pixels), as :func:`fit_ground_plane`'s; by default
+            :data:`GROUND_INLIER_PX`, scaled down with the rig's focal length below
+            :data:`GROUND_FOCAL_PX`.
 
         Returns
         -------
@@ -220,7 +235,11 @@ class GroundPlane:
         from stereovision._validate import positive_finite
 
         # 0, a negative or NaN tolerance held no pixel: support 0, "the camera moved"
-        tol = positive_finite(inlier_px, "inlier_px")
+        tol = (
+            _inlier_tolerance(calib)
+            if inlier_px is None
+            else positive_finite(inlier_px, "inlier_px")
+        )
         disp = np.asarray(disparity, np.float64)
         if disp.ndim != 2:
             raise ValueError(f"disparity: expected a (H, W) map, got shape {disp.shape}")
@@ -376,6 +395,31 @@ def _rig(calib: Calibration) -> tuple[float, float, float, float, float]:
     )
 
 
+def _inlier_tolerance(calib: Calibration) -> float:
+    """The default disparity tolerance of the floor (pixels): :data:`GROUND_INLIER_PX`, scaled
+    down with the rig's rectified focal length below :data:`GROUND_FOCAL_PX`."""
+    return GROUND_INLIER_PX * min(1.0, _rig(calib)[0] / GROUND_FOCAL_PX)
+
+
+def _below_weight(calib: Calibration) -> float:
+    """How much a point measurably below a plane counts against it (a pixel on it counts 1):
+    ``1 - f / GROUND_FOCAL_PX`` below :data:`GROUND_FOCAL_PX`, else 0.
+
+    The tolerance scaled down with the focal length keeps the band of the scene, but the
+    matchers' noise does not shrink with the image (about 0.5 px at any size): the narrower
+    the band in pixels, the more of the floor's pixels the noise puts off it, and the less the
+    pixels on a plane tell the floor from a plane tilted through whatever stands in the view.
+    Points below a plane tell it (there is no ground under the floor), and count the more, the
+    narrower the band. KITTI 000005 at 320 px wide (f 186 px: tolerance 0.58 px, weight 0.42):
+    planes tilted 25-33 degrees held 17 % of the pixels with 20 % of the points below them, the
+    road 11 % with 3 %; ranked by the pixels alone the road was not among those near the most
+    (:data:`NEAR_BEST`), and the camera came out 8.1 m above a plane 31 degrees off (it is found
+    at weights of 0.15 to 1). At full size (f at least :data:`GROUND_FOCAL_PX`) nothing changes:
+    with a weight of 0.25 there, ETH3D terrace's pick among its terraces turned 7 degrees from
+    its GT's and spread over 20 degrees across seeds (9.9 without)."""
+    return max(0.0, 1.0 - _rig(calib)[0] / GROUND_FOCAL_PX)
+
+
 def _plane_3d(
     coef: npt.ArrayLike, rig: tuple[float, float, float, float, float]
 ) -> tuple[F64, float]:
@@ -427,19 +471,22 @@ def _refine(
 
 
 def _select_floor(
-    hypotheses: list[tuple[int, F64]],
+    hypotheses: list[tuple[float, F64]],
     a_s: F64,
     d_s: F64,
     pts_s: F64,
     rig: Any,
     tol: float,
     cos_max: float,
+    below_weight: float,
 ) -> F64 | None:
-    """The floor among the RANSAC hypotheses ``(pixels on it, coefficients)`` (see
-    :data:`CANDIDATES`), or None."""
+    """The floor among the RANSAC hypotheses ``(score, coefficients)`` (see :data:`CANDIDATES`;
+    the score: pixels on it less ``below_weight`` per point below it, :func:`_below_weight`), or
+    None."""
     taken: list[tuple[F64, float]] = []
-    # (pixels on it, pixels below it, normal, height, coefficients, stopped by the cone)
-    cands: list[tuple[int, int, F64, float, F64, bool]] = []
+    # (score: pixels on it less below_weight per point below it, points below it, normal,
+    # height, coefficients, stopped by the cone)
+    cands: list[tuple[float, int, F64, float, F64, bool]] = []
     same = math.cos(math.radians(SAME_PLANE_DEG))
     refined = 0
     for _count, coef0 in sorted(hypotheses, key=lambda t: -t[0]):
@@ -465,7 +512,7 @@ def _select_floor(
         if int(on.sum()) < 3:
             continue
         below = int(np.count_nonzero((pts_s @ normal + height < -BELOW_M) & (short > tol)))
-        cands.append((int(on.sum()), below, normal, height, coef, clipped))
+        cands.append((int(on.sum()) - below_weight * below, below, normal, height, coef, clipped))
     if not cands:
         return None
     top = max(c[0] for c in cands)
@@ -491,7 +538,7 @@ def fit_ground_plane(
     disparity: npt.ArrayLike,
     calib: Calibration,
     *,
-    inlier_px: float = GROUND_INLIER_PX,
+    inlier_px: float | None = None,
     max_tilt_deg: float = MAX_TILT_DEG,
     seed: int = 0,
 ) -> GroundPlane | None:
@@ -504,8 +551,12 @@ def fit_ground_plane(
         unknown.
     calib : Calibration
         The rig (rectified or raw: its rectified geometry is used).
-    inlier_px : float
-        Disparity tolerance of the plane (pixels).
+    inlier_px : float, optional
+        Disparity tolerance of the plane (pixels). By default :data:`GROUND_INLIER_PX`, scaled
+        down with the rig's rectified focal length below :data:`GROUND_FOCAL_PX`: a rig run at a
+        lower resolution keeps the band of the scene (KITTI 000005's road at 1242, 621 and 320
+        px wide: the camera 1.620, 1.626 and 1.677 m above it, 0.05 and 0.33 degrees from the
+        full size's; 8.10 m at 320 px under 1 px and the pixels on a plane alone).
     max_tilt_deg : float
         Largest angle between the floor's normal and the camera's up axis.
     seed : int
@@ -543,7 +594,7 @@ def fit_ground_plane(
             f"disparity: map is {disp.shape[1]}x{disp.shape[0]}, the calibration's images are "
             f"{w0}x{h0}"
         )
-    tol = positive_finite(inlier_px, "inlier_px")
+    tol = _inlier_tolerance(calib) if inlier_px is None else positive_finite(inlier_px, "inlier_px")
     tilt = positive_finite(max_tilt_deg, "max_tilt_deg")
     if tilt >= 90:
         raise ValueError(f"max_tilt_deg: expected less than 90 degrees, got {max_tilt_deg!r}")
@@ -561,21 +612,27 @@ def fit_ground_plane(
     f, cx, cy, b, doffs = rig
     z_s = f * b / (d_s + doffs)
     pts_s = np.column_stack([(a_s[:, 0] - cx) * z_s / f, (a_s[:, 1] - cy) * z_s / f, z_s])
-    hypotheses: list[tuple[int, F64]] = []  # (sample pixels on it, coefficients)
+    # (sample pixels on it less below_weight per sample point below it, coefficients)
+    below_weight = _below_weight(calib)
+    hypotheses: list[tuple[float, F64]] = []
 
-    def score(pick: Any) -> int:
+    def score(pick: Any) -> float:
         try:
             coef = np.linalg.solve(a_s[pick], d_s[pick])
         except np.linalg.LinAlgError:
-            return 0
-        normal, _ = _plane_3d(coef, rig)
+            return 0.0
+        normal, height = _plane_3d(coef, rig)
         if -normal[1] < cos_max:  # not a floor (the normal must point up, within the tilt)
-            return 0
-        count = int(np.count_nonzero(np.abs(a_s @ coef - d_s) < tol))
-        hypotheses.append((count, coef))
-        return count
+            return 0.0
+        short = a_s @ coef - d_s
+        value = float(np.count_nonzero(np.abs(short) < tol))
+        if below_weight > 0:  # points below it count against it (a rig below GROUND_FOCAL_PX)
+            below = (short > tol) & (pts_s @ normal + height < -BELOW_M)
+            value -= below_weight * int(np.count_nonzero(below))
+        hypotheses.append((value, coef))
+        return value
 
-    best_count = 0
+    best_count = 0.0
     for _ in range(RANSAC_ITERATIONS):
         best_count = max(best_count, score(rng.choice(len(d_s), 3, replace=False)))
     if best_count < LOCAL_SHARE * len(d_s):
@@ -593,7 +650,7 @@ def fit_ground_plane(
                 continue
             j, k = near_rng.choice(near, 2, replace=False)
             score([i, j, k])
-    best = _select_floor(hypotheses, a_s, d_s, pts_s, rig, tol, cos_max)
+    best = _select_floor(hypotheses, a_s, d_s, pts_s, rig, tol, cos_max, below_weight)
     if best is None:
         return None
     # least squares on all pixels (those near the plane: it moves little from the sample's)
