@@ -314,3 +314,28 @@ def test_match_takes_a_fractional_range_as_documented() -> None:
         sv.match(left, right, method="best", max_disparity=np.float64(16.5)).stats["n_out_of_range"]
         == sv.match(left, right, method="best", max_disparity=16.5).stats["n_out_of_range"]
     )
+
+
+def test_mypy_strict_types_voxel_downsample_colors_by_what_was_given(
+    tmp_path: Path, mypy_cache: Path
+) -> None:
+    """``pts, rgb = export.voxel_downsample(res.points, res.colors)`` (the README's) typed
+    ``rgb`` as ``ndarray | None``, so a typed user's ``rgb[:, 0]`` was refused: colours given
+    come back as an array, none given as None, an optional one as optional."""
+    script = tmp_path / "voxels.py"
+    script.write_text(
+        "import numpy as np\nimport numpy.typing as npt\nimport stereovision as sv\n"
+        "from stereovision import export\n\n\n"
+        "def given(res: sv.DepthResult) -> npt.NDArray[np.uint8]:\n"
+        "    return export.voxel_downsample(res.points, res.colors, voxel=0.05)[1]\n\n\n"
+        "def none(res: sv.DepthResult) -> None:\n"
+        "    return export.voxel_downsample(res.points)[1]\n\n\n"
+        "def maybe(res: sv.DepthResult, c: npt.NDArray[np.uint8] | None) -> npt.NDArray[np.uint8]:"
+        "\n    return export.voxel_downsample(res.points, c)[1]\n"
+    )
+    run = _mypy_strict(script, tmp_path, mypy_cache)
+    assert run.returncode == 1
+    lines = run.stdout.splitlines()
+    assert len(lines) == 1, run.stdout  # only the optional colours stay optional
+    assert lines[0].startswith("voxels.py:16: error: Incompatible return value type (got ")
+    assert '| None", expected "ndarray[' in lines[0]

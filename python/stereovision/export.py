@@ -28,7 +28,7 @@ import zipfile
 import zlib
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -591,6 +591,18 @@ def load_cloud(
 # --------------------------------------------------------------------------- voxel grid
 
 
+@overload
+def voxel_downsample(
+    points: npt.ArrayLike, colors: None = None, voxel: float = 0.05
+) -> tuple[npt.NDArray[np.float32], None]: ...
+@overload
+def voxel_downsample(
+    points: npt.ArrayLike, colors: npt.ArrayLike, voxel: float = 0.05
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8]]: ...
+@overload
+def voxel_downsample(
+    points: npt.ArrayLike, colors: npt.ArrayLike | None = None, voxel: float = 0.05
+) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]: ...
 def voxel_downsample(
     points: npt.ArrayLike, colors: npt.ArrayLike | None = None, voxel: float = 0.05
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.uint8] | None]:
@@ -613,7 +625,8 @@ def voxel_downsample(
     Returns
     -------
     tuple
-        ``(points float32 (M, 3), colors uint8 (M, 3) or None)``.
+        ``(points float32 (M, 3), colors uint8 (M, 3))``; the colours are None when
+        ``colors`` is (typed so: given colours come back as an array, no None check needed).
 
     Raises
     ------
