@@ -1,8 +1,9 @@
 """The typed public API, as a user with ``mypy --strict`` meets it.
 
-``typed_user_script.py`` does what the README's "Using it" does, every value annotated with the
-type the README promises; mypy checks it against the package that ``import stereovision`` finds
-(the installed one in CI), with no configuration of this repository's.
+``typed_user_script.py`` does what the README's "Using it" and docs/robotics.md's pipeline do,
+every value annotated with the type the README promises; mypy checks it against the package
+that ``import stereovision`` finds (the installed one in CI), with no configuration of this
+repository's.
 """
 
 from __future__ import annotations
@@ -124,6 +125,30 @@ def test_the_readme_script_runs(data_dir: Path, tmp_path: Path) -> None:
     assert 0 < got["near_points"] < got["points"]
     assert got["files"] == 1.0 and got["released"] == 1.0
     assert got["matches"] == got["read_back"] > 100 and 0 < got["strong_xyz"] <= got["matches"]
+    assert got["optional_same"] == 1.0 and got["described"] > 100
+    assert got["depth_ft"] == pytest.approx(got["depth_m"] / 0.3048, rel=1e-5)
+    assert got["sigma_ft"] == pytest.approx(got["sigma_m"] / 0.3048, rel=1e-5)
+    assert got["points_ft"] > 0
+    assert got["camera_points"] == got["points"] and got["camera_dtype_f32"] == 1.0
+    assert got["image_filled_points"] >= got["image_points"]
+    assert 0 < got["voxels"] == got["voxel_colors"] < got["points"]
+    assert got["live_points"] == 0.0  # cloud=False
+    assert got["dispx"] == got["dispy"] > 0
+
+
+def test_the_robotics_pipeline_runs(data_dir: Path, tmp_path: Path) -> None:
+    """docs/robotics.md's snippet, as typed_user_script.robot, on KITTI (a floor in view)."""
+    spec = importlib.util.spec_from_file_location("typed_user_script", SCRIPT)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    scene = data_dir / "kitti2015" / "000005_10"
+    left, right = module._read(scene / "left.png"), module._read(scene / "right.png")
+    got = module.robot(left, right, scene / "calib.txt", tmp_path)
+    assert got["saved"] == 0.0 and not (tmp_path / "rig_fixed.yaml").exists()  # still rectified
+    assert got["described"] > 100 and got["files"] == 1.0
+    assert got["points"] > 10_000 and got["obstacles"] > 0
+    assert 0 < got["voxels"] == got["voxel_colors"] < got["points"]
 
 
 def test_require_depth_returns_depth_or_says_why_there_is_none() -> None:
