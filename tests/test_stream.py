@@ -1030,3 +1030,31 @@ def test_a_stream_interrupted_before_its_first_pair_writes_strict_json(
     assert (summary["frames"], summary["ended"]) == (0, "interrupted")
     assert summary["density"] is None and summary["noise_sigma"] is None
     assert summary["latency_ms"] is None and set(summary["stage_ms"].values()) == {None}
+
+
+def test_a_calibrated_streams_seconds_count_from_its_first_grab(data_dir: Path) -> None:
+    """With a calibration the first pair is read before the pipeline (to fit the calibration to
+    it), and the run's time started after that grab: a camera taking 0.3 s for it streamed one
+    pair in 0.05 s (fps 20 for 2.5) with a latency of 0.35 s. It counts from the first grab, as
+    a run without a calibration does."""
+    scene = data_dir / SCENE
+    calib = Calibration.from_file(scene / "calib.txt").scaled_to((160, 120))
+    imgs = {
+        side: cv2.resize(cv2.imread(str(scene / f"{side}.png")), (160, 120), cv2.INTER_AREA)
+        for side in ("left", "right")
+    }
+
+    class _SlowFirst(_ModeCap):
+        def grab(self) -> bool:
+            if len(self.images) == 1:
+                time.sleep(0.3)
+            return super().grab()
+
+    for c in (None, calib):
+        cam = StereoCamera(_SlowFirst([imgs["left"]]), _SlowFirst([imgs["right"]]))
+        with cam, warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the mode reported (640x480) is not the frames'
+            rep = run_stream(cam, c, max_disparity=8, check=False, pipelined=False, frames=1)
+        assert rep.frames == 1 and rep.stage_ms["grab"] >= 300
+        assert rep.seconds >= 0.3 and 1e3 * rep.seconds >= rep.latency_ms - 1e-6
+        assert rep.fps == pytest.approx(1 / rep.seconds)

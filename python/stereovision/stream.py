@@ -727,6 +727,8 @@ def run_stream(
         # that reports 640x480 and delivers 320x240 failed every pair), as batch and gui fit
         # a calibration to the images they read
         camera = _FirstPairRead(camera)  # type: ignore[assignment]
+    # the run's time starts at the first grab, also when that pair was read ahead
+    grabbed = camera.grabbed if isinstance(camera, _FirstPairRead) else None
     size = _frame_size(camera)
     if calib is not None and size is not None:
         calib, note = fit_to_frames(calib, size)
@@ -778,7 +780,7 @@ def run_stream(
     md = max_disparity
     ended = "end of stream"
     error: str | None = None
-    t_begin = time.perf_counter()
+    t_begin = grabbed[0] if grabbed is not None else time.perf_counter()
     t_window = t_begin
     t_last = t_begin
     try:
@@ -990,7 +992,8 @@ class _FirstPairRead:
         when it reported none).
     grabbed : tuple of float or None
         ``perf_counter`` at the start and the end of the first pair's grab, until that pair
-        is handed out (the grab stage and the latency of pair 0).
+        is handed out (the grab stage and the latency of pair 0, the start of the run's
+        ``seconds``).
 
     Raises
     ------
