@@ -1058,3 +1058,42 @@ def test_a_calibrated_streams_seconds_count_from_its_first_grab(data_dir: Path) 
         assert rep.frames == 1 and rep.stage_ms["grab"] >= 300
         assert rep.seconds >= 0.3 and 1e3 * rep.seconds >= rep.latency_ms - 1e-6
         assert rep.fps == pytest.approx(1 / rep.seconds)
+
+
+def test_a_calibrated_stream_interrupted_before_its_first_pair_writes_its_summary(
+    data_dir: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With a calibration the first pair is read before the pipeline: Ctrl-C (or SIGTERM) while
+    the camera had not delivered it left run_stream with the KeyboardInterrupt, and the CLI said
+    'interrupted' without the summary a stream without a calibration writes. It is the summary
+    of no pair now, ended 'interrupted' ('terminated'), exit 130."""
+    import stereovision.stream as stream
+    from stereovision._interrupt import Terminated
+
+    calib = Calibration.from_file(data_dir / SCENE / "calib.txt")
+    for signal, ended in ((KeyboardInterrupt, "interrupted"), (Terminated, "terminated")):
+
+        class _Stopped(_ModeCap):
+            raised: type[BaseException] = signal
+
+            def grab(self) -> bool:
+                raise self.raised
+
+        rep = run_stream(StereoCamera(_Stopped([]), _Stopped([])), calib, max_disparity=16)
+        assert (rep.frames, rep.ended, rep.error) == (0, ended, None)
+
+    class _Interrupted(_ModeCap):
+        def grab(self) -> bool:
+            raise KeyboardInterrupt
+
+    def cameras(args: Any, fps: float | None = None) -> StereoCamera:
+        return StereoCamera(_Interrupted([]), _Interrupted([]))
+
+    monkeypatch.setattr(stream, "open_source", cameras)
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--json"]
+    argv += ["--max-disparity", "16", "--calib", str(data_dir / SCENE / "calib.txt")]
+    assert main(argv) == 130
+    cap = capsys.readouterr()
+    (line,) = cap.out.splitlines()
+    summary = json.loads(line)
+    assert (summary["frames"], summary["ended"], summary["latency_ms"]) == (0, "interrupted", None)

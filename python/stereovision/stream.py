@@ -722,14 +722,19 @@ def run_stream(
         max_disparity = max_disparity or homographies.max_disparity
     if max_disparity is not None and max_disparity <= 0:
         raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
+    stopped: str | None = None  # Ctrl-C or SIGTERM while the first pair was read ahead
     if calib is not None and getattr(camera, "count", None) == 0:
         # fitted to the first pair delivered, not to the mode the driver reports (a driver
         # that reports 640x480 and delivers 320x240 failed every pair), as batch and gui fit
         # a calibration to the images they read
-        camera = _FirstPairRead(camera)  # type: ignore[assignment]
+        try:
+            camera = _FirstPairRead(camera)  # type: ignore[assignment]
+        except KeyboardInterrupt as exc:
+            # as during the stream's own first grab: the summary of no pair, not an error
+            stopped = "terminated" if isinstance(exc, Terminated) else "interrupted"
     # the run's time starts at the first grab, also when that pair was read ahead
     grabbed = camera.grabbed if isinstance(camera, _FirstPairRead) else None
-    size = _frame_size(camera)
+    size = None if stopped else _frame_size(camera)
     if calib is not None and size is not None:
         calib, note = fit_to_frames(calib, size)
         if note is not None:
@@ -750,8 +755,12 @@ def run_stream(
             )
         if rect_calib is None:
             raise ValueError("ground_every: the floor is found in metres; give a calibration")
-    source = _pairs(
-        camera, calib, frames, (check_every or 0) if check else None, homographies, temporal
+    source: Iterator[_Pair] = (
+        iter(())
+        if stopped
+        else _pairs(
+            camera, calib, frames, (check_every or 0) if check else None, homographies, temporal
+        )
     )
     producer: _Producer | None = None
     q: queue.Queue[Any] = queue.Queue()
@@ -778,7 +787,7 @@ def run_stream(
     window: list[_Done] = []
     reports: list[dict[str, Any]] = []
     md = max_disparity
-    ended = "end of stream"
+    ended = stopped or "end of stream"
     error: str | None = None
     t_begin = grabbed[0] if grabbed is not None else time.perf_counter()
     t_window = t_begin
