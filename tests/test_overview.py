@@ -437,3 +437,22 @@ def test_colour_levels_of_infinities_without_an_overflow() -> None:
         warnings.simplefilter("error")
         levels = colour_levels(values, 1.0, 3.0)
     assert levels.tolist() == [255, 0, 0, 0, 255, 127]
+
+
+def test_the_depth_caption_names_the_limits_and_no_fill_it_did_not_make(terrace_run: tuple) -> None:
+    """The caption said "none where filled" whatever made the holes: with --max-depth most of
+    the depth panel's holes are the depths cut beyond it (not filled pixels), and a map with
+    nothing filled (the Gabor channel's) has no filled pixels to blame. The reason names the
+    limits when the result has them, and is left out when nothing was filled."""
+    import dataclasses
+
+    _, res, _, _ = terrace_run
+    near = res.filtered(max_depth=float(np.nanmedian(res.depth)))
+    share = 100 * float(np.isfinite(near.depth).mean())
+    assert share < 60.0
+    assert overview_image(near, "terrace").captions["depth"] == (
+        f"depth (m) on {share:.1f} %, none where filled or beyond the limits"
+    )
+    unfilled = dataclasses.replace(res, confidence=np.ones_like(res.confidence))
+    share = 100 * float(np.isfinite(res.depth).mean())
+    assert overview_image(unfilled, "terrace").captions["depth"] == f"depth (m) on {share:.1f} %"

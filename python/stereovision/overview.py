@@ -123,7 +123,9 @@ class Overview:
     captions : dict
         Panel name -> the caption above it; the depth panel's says on what share of the pixels
         there is a depth (``"depth (m) on 83.8 %, none where filled"``: the disparity's filled
-        pixels get none, so its holes are not the disparity's).
+        pixels get none, so its holes are not the disparity's; ``"... none where filled or
+        beyond the limits"`` for a :meth:`~stereovision.depth.DepthResult.filtered` result;
+        the share alone when nothing was filled nor cut).
     """
 
     image: npt.NDArray[np.uint8]
@@ -299,10 +301,16 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         with np.errstate(divide="ignore"):
             inv = np.where(np.isfinite(depth), 1.0 / depth, np.nan)
         # coloured on 1 / Z in metres, as depth.png is; labelled in the unit asked for
-        # the depth map has holes where the disparity map was filled (guesses get no depth):
-        # said with the share, shortened where the panel is too narrow for the reason
-        share = f"depth ({unit}) on {100 * float(np.isfinite(depth).mean()):.1f} %"
-        caption_text = f"{share}, none where filled"
+        # the depth map has holes where the disparity map was filled (guesses get no depth)
+        # and, filtered, beyond the limits: said with the share, the reasons that apply (none
+        # for a map with nothing filled nor cut), shortened where the panel is too narrow
+        has_depth = np.isfinite(depth)
+        share = f"depth ({unit}) on {100 * float(has_depth.mean()):.1f} %"
+        filled = valid & ~has_depth & (np.asarray(result.confidence) == 0)
+        why = ["filled"] if filled.any() else []
+        if getattr(result, "limits", None):
+            why.append("beyond the limits")
+        caption_text = f"{share}, none where {' or '.join(why)}" if why else share
         if cv2.getTextSize(caption_text, _FONT, 0.5, 1)[0][0] > pw + _BAR_GAP + _BAR_W + _LABEL_W:
             caption_text = share
         maps.append(
