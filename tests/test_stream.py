@@ -1097,3 +1097,19 @@ def test_a_calibrated_stream_interrupted_before_its_first_pair_writes_its_summar
     (line,) = cap.out.splitlines()
     summary = json.loads(line)
     assert (summary["frames"], summary["ended"], summary["latency_ms"]) == (0, "interrupted", None)
+
+
+def test_run_streams_usage_errors_come_before_the_first_grab(data_dir: Path) -> None:
+    """With a calibration the first pair is read before the pipeline; check_every and
+    ground_every were checked after it: a usage error took a pair off the camera first (and a
+    camera with no frame said that instead). They are refused before any grab now."""
+    calib = Calibration.from_file(data_dir / SCENE / "calib.txt")
+    img = cv2.imread(str(data_dir / SCENE / "left.png"))
+    for kw, said in (
+        ({"check_every": 0}, "check_every: expected a positive number of pairs, got 0"),
+        ({"ground_every": -1}, "ground_every: expected a positive number of pairs, got -1"),
+    ):
+        cam = StereoCamera(_ModeCap([img]), _ModeCap([img]))
+        with cam, pytest.raises(ValueError) as err:
+            run_stream(cam, calib, max_disparity=16, **kw)
+        assert str(err.value) == said and cam.count == 0

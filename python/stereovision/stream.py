@@ -722,6 +722,16 @@ def run_stream(
         max_disparity = max_disparity or homographies.max_disparity
     if max_disparity is not None and max_disparity <= 0:
         raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
+    # usage errors before the first grab (the read ahead below takes a pair off the camera)
+    if check_every is not None and (isinstance(check_every, bool) or check_every <= 0):
+        raise ValueError(f"check_every: expected a positive number of pairs, got {check_every}")
+    if ground_every is not None:
+        if isinstance(ground_every, bool) or ground_every <= 0:
+            raise ValueError(
+                f"ground_every: expected a positive number of pairs, got {ground_every}"
+            )
+        if calib is None:
+            raise ValueError("ground_every: the floor is found in metres; give a calibration")
     stopped: str | None = None  # Ctrl-C or SIGTERM while the first pair was read ahead
     if calib is not None and getattr(camera, "count", None) == 0:
         # fitted to the first pair delivered, not to the mode the driver reports (a driver
@@ -746,15 +756,6 @@ def run_stream(
     if calib is not None:
         rect_calib = calib if calib.rectified else calib.rectified_calibration()
     kw: dict[str, Any] = {"refine": refine, "method": method, "fill": fill}
-    if check_every is not None and (isinstance(check_every, bool) or check_every <= 0):
-        raise ValueError(f"check_every: expected a positive number of pairs, got {check_every}")
-    if ground_every is not None:
-        if isinstance(ground_every, bool) or ground_every <= 0:
-            raise ValueError(
-                f"ground_every: expected a positive number of pairs, got {ground_every}"
-            )
-        if rect_calib is None:
-            raise ValueError("ground_every: the floor is found in metres; give a calibration")
     source: Iterator[_Pair] = (
         iter(())
         if stopped
