@@ -1220,3 +1220,27 @@ def test_kitti_object_calibration_is_sized_by_the_pair(
     )
     assert main(["info", str(calib), "--size", "1242x375"]) == 0
     assert capsys.readouterr().out.startswith("1242x375 px, rectified pair: baseline 53.3 cm")
+
+
+def test_json_line_writes_a_non_finite_key_as_a_string() -> None:
+    """A dict key that is a NaN or infinite float (a histogram keyed by its bins' edges) made
+    json_line raise ValueError ("Out of range float values are not JSON compliant", the key
+    unnamed), though its docstring says never for floats: a key is a string in JSON, so it is
+    written as json.dumps writes it ("NaN", "Infinity", "-Infinity"), a strict JSON string."""
+    import json
+
+    from stereovision._jsonout import json_line
+
+    row = {float("nan"): 1, np.float32(np.inf): 2, -float("inf"): 3, 0.5: np.nan}
+
+    def refuse(word: str) -> None:
+        raise ValueError(f"not strict JSON: {word}")
+
+    line = json_line(row)
+    assert line == '{"NaN": 1, "Infinity": 2, "-Infinity": 3, "0.5": null}'
+    assert json.loads(line, parse_constant=refuse) == {
+        "NaN": 1,
+        "Infinity": 2,
+        "-Infinity": 3,
+        "0.5": None,
+    }

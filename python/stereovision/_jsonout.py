@@ -35,7 +35,8 @@ def json_ready(value: Any) -> Any:
         nested lists of its ``tolist`` (a 0-d one as its value), each element converted as a
         value is; a NumPy integer or bool as a Python int or bool; each finite float as a
         Python float and each non-finite one as None; a path as its string; a dict key that is
-        a NumPy scalar as its Python value, a path key as its string; other values as given.
+        a NumPy scalar as its Python value, a path key as its string, a NaN or infinite float
+        key as ``"NaN"``, ``"Infinity"`` or ``"-Infinity"``; other values as given.
     """
     if isinstance(value, dict):
         return {_json_key(k): json_ready(v) for k, v in value.items()}
@@ -57,11 +58,15 @@ def json_ready(value: Any) -> Any:
 
 def _json_key(key: Any) -> Any:
     """A dict key json.dumps takes: a NumPy scalar as its Python value, a path as its string
-    (json.dumps raised TypeError for both)."""
+    (json.dumps raised TypeError for both), a NaN or infinite float as the string json.dumps
+    writes for it, ``"NaN"``, ``"Infinity"`` or ``"-Infinity"`` (a key is a string in JSON;
+    strict json.dumps raised ValueError)."""
     if isinstance(key, np.generic):
-        return key.item()
+        key = key.item()
     if isinstance(key, os.PathLike):
         return os.fspath(key)
+    if isinstance(key, float) and not math.isfinite(key):
+        return "NaN" if math.isnan(key) else ("Infinity" if key > 0 else "-Infinity")
     return key
 
 
