@@ -48,7 +48,7 @@ def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
     said = re.search(
         r"\n  depth on ([\d.]+) % of the pixels \(disparity on 100\.0 %\): none on (\d+) "
         r"filled \([\d.]+ %, guesses, not measured\) nor on 0 measured \(0\.0 %\) within "
-        r"sigma_d of d = 0\n",
+        r"sigma_d of infinite depth\n",
         proc.stdout,
     )
     assert said, proc.stdout
@@ -122,16 +122,16 @@ def test_depth_command_on_metric_scene(
     near = np.load(tmp_path / "near" / "depth.npy")
     # the pixels with a disparity but no depth are counted with their reason: the filled ones
     # (as many in both runs), and the measured ones past --max-depth (terrace: none within
-    # sigma_d of d = 0)
+    # sigma_d of infinite depth)
     full, cut = (ln for ln in capsys.readouterr().out.splitlines() if "  depth on " in ln)
     filled = re.search(r"none on (\d+) filled", full)
     assert filled and int(filled.group(1)) > 0 and f" {filled.group(0)} (" in cut
     assert full.startswith(f"  depth on {100 * np.isfinite(depth).mean():.1f} % of the pixels")
-    assert full.endswith(" nor on 0 measured (0.0 %) within sigma_d of d = 0")
+    assert full.endswith(" nor on 0 measured (0.0 %) within sigma_d of infinite depth")
     beyond = int((np.isfinite(depth) & ~np.isfinite(near)).sum())
     assert cut.startswith(f"  depth on {100 * np.isfinite(near).mean():.1f} % of the pixels")
     assert f" nor on {beyond} measured (" in cut and cut.endswith(
-        ") outside the limits or within sigma_d of d = 0"
+        ") outside the limits or within sigma_d of infinite depth"
     )
     with np.errstate(invalid="ignore"):
         np.testing.assert_array_equal(np.isfinite(near), depth <= round(med, 3))

@@ -700,7 +700,7 @@ def test_depth_in_an_unknown_unit_or_without_depth_is_named() -> None:
 def test_depth_counts_say_why_a_pixel_with_a_disparity_has_no_depth() -> None:
     """The demo's depth panel had holes on 16 % of the pixels where the disparity map had none,
     with no count or reason given: depth_counts() splits them into filled pixels (confidence 0,
-    guesses) and measured ones dropped (within sigma_d of d = 0, or outside the limits)."""
+    guesses) and measured ones dropped (within sigma_d of infinite depth, or outside the limits)."""
     nan = np.nan
     res = sv.DepthResult(
         disparity=np.array([[10, 10, 10], [nan, 0.2, 10]], np.float32),

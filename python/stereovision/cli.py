@@ -627,7 +627,7 @@ def _depth_coverage(res: Any) -> str:
     """Where the depth is and why the other pixels with a disparity have none (counts).
 
     ``depth on 83.8 % of the pixels (disparity on 100.0 %): none on 27278 filled (16.2 %,
-    guesses, not measured) nor on 0 measured (0.0 %) within sigma_d of d = 0``: the depth
+    guesses, not measured) nor on 0 measured (0.0 %) within sigma_d of infinite depth``: the depth
     map's holes where the disparity map has none, said with their reason.
     """
     c = res.depth_counts()
@@ -639,7 +639,7 @@ def _depth_coverage(res: Any) -> str:
     return (
         f"depth on {pct('depth')} of the pixels (disparity on {pct('disparity')}): none on "
         f"{c['filled']} filled ({pct('filled')}, guesses, not measured) nor on "
-        f"{c['dropped']} measured ({pct('dropped')}) {why} sigma_d of d = 0"
+        f"{c['dropped']} measured ({pct('dropped')}) {why} sigma_d of infinite depth"
     )
 
 
