@@ -697,8 +697,9 @@ def renamed_keyword(old: str, new: str) -> Callable[[_F], _F]:
 
     The decorated function's signature (what ``help``, ``inspect.signature`` and type checkers
     see) has the new name only; a call with ``old=`` is passed on as ``new=``, warned about at
-    the caller's line. The wrapper is one more frame: a warning the function itself gives with
-    a ``stacklevel`` counts it.
+    the caller's line; a call with both is a :class:`TypeError` naming both. The wrapper is one
+    more frame: a warning the function itself gives with a ``stacklevel`` counts it. Stacked
+    (one decorator per renamed parameter) they still make one wrapper, so one frame.
 
     Parameters
     ----------
@@ -714,22 +715,35 @@ def renamed_keyword(old: str, new: str) -> Callable[[_F], _F]:
     """
 
     def decorate(func: _F) -> _F:
+        renames: dict[str, str] = {old: new}
+        inner = getattr(func, "_renamed_keywords", None)
+        if inner is not None:  # another renamed_keyword below: one wrapper for both
+            renames.update(inner)
+            func = func.__wrapped__  # type: ignore[attr-defined]
         signature = inspect.signature(func)
+        for now in renames.values():
+            if now not in signature.parameters:
+                raise TypeError(f"{func.__qualname__}() has no parameter {now}= to rename to")
+        name = func.__qualname__
+        if name.endswith(".__init__"):  # a class: called by its own name
+            name = name[: -len(".__init__")]
 
         @functools.wraps(func)
         def call(*args: Any, **kwargs: Any) -> Any:
-            if old in kwargs:
-                name = func.__qualname__
-                if new in kwargs or new in signature.bind_partial(*args).arguments:
-                    raise TypeError(f"{name}() got {old}= and {new}=: {old} is {new}'s old name")
+            for was, now in renames.items():
+                if was not in kwargs:
+                    continue
+                if now in kwargs or now in signature.bind_partial(*args).arguments:
+                    raise TypeError(f"{name}() got {was}= and {now}=: {was} is {now}'s old name")
                 warnings.warn(
-                    f"{name}(): the keyword {old}= is now {new}= ({old}= will be removed)",
+                    f"{name}(): the keyword {was}= is now {now}= ({was}= will be removed)",
                     DeprecationWarning,
                     stacklevel=2,
                 )
-                kwargs[new] = kwargs.pop(old)
+                kwargs[now] = kwargs.pop(was)
             return func(*args, **kwargs)
 
+        call._renamed_keywords = renames  # type: ignore[attr-defined]
         return cast(_F, call)
 
     return decorate

@@ -54,10 +54,10 @@ _FT_PER_M = 1.0 / 0.3048
 _TO_METRES = {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "ft": 0.3048, "in": 0.0254}
 
 
-def _real_2d(a: object, name: str) -> npt.NDArray[np.float64]:
+def _real_2d(a: object, name: str, field: str = "disparity") -> npt.NDArray[np.float64]:
     from stereovision._validate import not_a_result
 
-    not_a_result(a, name, "depth" if "depth" in name else "disparity")
+    not_a_result(a, name, field)
     arr = np.asarray(a)
     if arr.ndim != 2 or arr.dtype.kind not in "iuf":
         raise ValueError(
@@ -245,13 +245,16 @@ def _depth_valid(z: np.ndarray) -> npt.NDArray[np.bool_]:
         return np.isfinite(z) & (z > 0)
 
 
-def depth_metrics(depth_est: npt.ArrayLike, depth_gt: npt.ArrayLike) -> DepthMetrics:
+@renamed_keyword("depth_gt", "gt")
+def depth_metrics(depth_est: npt.ArrayLike, gt: npt.ArrayLike) -> DepthMetrics:
     """Median relative error, share off by > 5 % and RMSE % over pixels with both depths.
 
     Parameters
     ----------
-    depth_est, depth_gt : array_like
-        Same-shape depth maps in the same unit; non-finite or ``<= 0`` = missing.
+    depth_est, gt : array_like
+        Same-shape estimated and ground-truth depth maps in the same unit; non-finite or
+        ``<= 0`` = missing. The keyword ``depth_gt=``, ``gt``'s former name, still works, with
+        a DeprecationWarning.
 
     Returns
     -------
@@ -264,10 +267,10 @@ def depth_metrics(depth_est: npt.ArrayLike, depth_gt: npt.ArrayLike) -> DepthMet
         On mismatched shapes or non-real input.
     """
     e = np.asarray(depth_est)
-    g = np.asarray(depth_gt)
+    g = np.asarray(gt)
     if e.dtype.kind not in "iuf" or g.dtype.kind not in "iuf":
         raise ValueError(f"depth maps must be real arrays, got {e.dtype} and {g.dtype}")
-    _same_shape(e, g, "depth_est", "depth_gt")
+    _same_shape(e, g, "depth_est", "gt")
     e = e.astype(np.float64)
     g = g.astype(np.float64)
     both = _depth_valid(e) & _depth_valid(g)
@@ -287,15 +290,17 @@ def depth_metrics(depth_est: npt.ArrayLike, depth_gt: npt.ArrayLike) -> DepthMet
     )
 
 
-def gt_depth(gt_disp: npt.ArrayLike, calib: Calibration) -> npt.NDArray[np.float32]:
+@renamed_keyword("gt_disp", "gt")
+def gt_depth(gt: npt.ArrayLike, calib: Calibration) -> npt.NDArray[np.float32]:
     """GT depth in metres from a GT disparity map and a rectified calibration.
 
     ``Z = f * B / (d + doffs)`` (algorithms.md E.3); unknown or ``d <= -doffs`` gives NaN.
 
     Parameters
     ----------
-    gt_disp : array_like
-        ``(H, W)`` GT disparity in pixels (non-finite = unknown).
+    gt : array_like
+        ``(H, W)`` GT disparity in pixels (non-finite = unknown). The keyword ``gt_disp=``, its
+        former name, still works, with a DeprecationWarning.
     calib : Calibration
         Calibration of the (rectified) pair.
 
@@ -307,7 +312,7 @@ def gt_depth(gt_disp: npt.ArrayLike, calib: Calibration) -> npt.NDArray[np.float
     _require_type(calib, "Calibration", "calib")
     from stereovision.triangulation import depth_from_disparity
 
-    return depth_from_disparity(gt_disp, calib)
+    return depth_from_disparity(gt, calib)
 
 
 # -------------------------------------------------------------------------------------- Table 1
@@ -418,9 +423,10 @@ class Table1Report:
         return "\n".join(lines)
 
 
+@renamed_keyword("depth_gt", "gt")
 def table1_report(
     depth_est: npt.ArrayLike,
-    depth_gt: npt.ArrayLike,
+    gt: npt.ArrayLike,
     n_points: int = 10,
     seed: int = 0,
     points: npt.ArrayLike | None = None,
@@ -434,8 +440,10 @@ def table1_report(
 
     Parameters
     ----------
-    depth_est, depth_gt : array_like
-        ``(H, W)`` distances in ``unit``; non-finite or ``<= 0`` = missing.
+    depth_est, gt : array_like
+        ``(H, W)`` estimated and ground-truth distances in ``unit``; non-finite or ``<= 0`` =
+        missing. The keyword ``depth_gt=``, ``gt``'s former name, still works, with a
+        DeprecationWarning.
     n_points : int
         Number of random points (all valid pixels if fewer exist). Ignored with ``points``.
     seed : int
@@ -457,9 +465,9 @@ def table1_report(
         On mismatched shapes, ``n_points < 1``, no pixel with both distances, or a given point
         outside the image or without both distances.
     """
-    e = _real_2d(depth_est, "depth_est")
-    g = _real_2d(depth_gt, "depth_gt")
-    _same_shape(e, g, "depth_est", "depth_gt")
+    e = _real_2d(depth_est, "depth_est", "depth")
+    g = _real_2d(gt, "gt", "depth")
+    _same_shape(e, g, "depth_est", "gt")
     factor = _unit_factor(unit)
     both = _depth_valid(e) & _depth_valid(g)
     if points is None:

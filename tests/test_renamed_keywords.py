@@ -1,0 +1,96 @@
+"""One name per concept across the public API (the renames of 2026-12-04).
+
+Each renamed keyword: the new name works without a warning, the old one gives the same value
+with a DeprecationWarning naming both names at the caller's line, and both at once is a
+TypeError naming both.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pytest
+
+from stereovision.calibration import Calibration
+from stereovision.evaluate import depth_metrics, gt_depth, table1_report
+
+NAN = np.nan
+_DISP = np.array([[1.0, NAN, 5.0, 8.0], [2.0, 4.0, NAN, 6.0]], dtype=np.float32)
+_GT_DISP = np.array([[1.5, 2.0, 2.0, NAN], [2.0, 4.5, 3.0, 6.0]], dtype=np.float32)
+_DEPTH = np.array([[1.0, 2.0, NAN, 4.0], [5.0, 6.0, 7.0, 8.0]])
+_GT_DEPTH = np.array([[1.1, 2.0, 3.0, 4.4], [NAN, 6.6, 7.0, 8.0]])
+
+
+def _calib() -> Calibration:
+    return Calibration.ideal((4, 2), 60.0, 0.1)
+
+
+@dataclass
+class Rename:
+    """``func(*args, **kwargs, <name>=value)`` called with ``new`` and with ``old``."""
+
+    func: Callable[..., Any]
+    old: str
+    new: str
+    value: Callable[[], Any]
+    args: Callable[[], tuple[Any, ...]] = tuple
+    kwargs: dict[str, Any] = field(default_factory=dict)
+    # the deprecation message names the callable as this (a method: Class.method)
+    called: str = ""
+
+    def __str__(self) -> str:
+        return f"{self.called or self.func.__name__}:{self.old}->{self.new}"
+
+
+RENAMES = [
+    # ground truth: gt (as dense_metrics, sparse_metrics, count_at_precision, io.Scene.gt)
+    Rename(gt_depth, "gt_disp", "gt", lambda: _GT_DISP, kwargs={"calib": _calib()}),
+    Rename(depth_metrics, "depth_gt", "gt", lambda: _GT_DEPTH, lambda: (_DEPTH,)),
+    Rename(table1_report, "depth_gt", "gt", lambda: _GT_DEPTH, lambda: (_DEPTH,)),
+]
+
+
+def _same(a: Any, b: Any) -> None:
+    """``a`` and ``b`` are the same value: arrays (NaN where NaN), dataclasses field by field."""
+    if isinstance(a, np.ndarray):
+        np.testing.assert_array_equal(a, b)
+    elif hasattr(a, "__dataclass_fields__"):
+        assert type(a) is type(b)
+        for name in a.__dataclass_fields__:
+            _same(getattr(a, name), getattr(b, name))
+    elif isinstance(a, (tuple, list)):
+        assert len(a) == len(b)
+        for x, y in zip(a, b, strict=True):
+            _same(x, y)
+    elif isinstance(a, float) and np.isnan(a):
+        assert isinstance(b, float) and np.isnan(b)
+    else:
+        assert a == b
+
+
+@pytest.mark.parametrize("case", RENAMES, ids=str)
+def test_old_keyword_warns_and_gives_the_same_value(case: Rename) -> None:
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        new = case.func(*case.args(), **case.kwargs, **{case.new: case.value()})
+    with pytest.warns(DeprecationWarning) as caught:
+        old = case.func(*case.args(), **case.kwargs, **{case.old: case.value()})
+    _same(old, new)
+    name = case.called or case.func.__name__
+    assert len(caught) == 1
+    assert str(caught[0].message) == (
+        f"{name}(): the keyword {case.old}= is now {case.new}= ({case.old}= will be removed)"
+    )
+    assert caught[0].filename == __file__
+
+
+@pytest.mark.parametrize("case", RENAMES, ids=str)
+def test_old_and_new_keyword_together_is_a_type_error(case: Rename) -> None:
+    name = case.called or case.func.__name__
+    both = {case.new: case.value(), case.old: case.value()}
+    with pytest.raises(TypeError, match=rf"^{name}\(\) got {case.old}= and {case.new}="):
+        case.func(*case.args(), **case.kwargs, **both)
