@@ -15,14 +15,20 @@ from typing import Any
 import numpy as np
 import pytest
 
+from stereovision.baselines import row_fill
 from stereovision.calibration import Calibration
 from stereovision.evaluate import depth_metrics, gt_depth, table1_report
+from stereovision.matching.planes import fill_planes, plane_fill, side_fill
 
 NAN = np.nan
 _DISP = np.array([[1.0, NAN, 5.0, 8.0], [2.0, 4.0, NAN, 6.0]], dtype=np.float32)
 _GT_DISP = np.array([[1.5, 2.0, 2.0, NAN], [2.0, 4.5, 3.0, 6.0]], dtype=np.float32)
 _DEPTH = np.array([[1.0, 2.0, NAN, 4.0], [5.0, 6.0, 7.0, 8.0]])
 _GT_DEPTH = np.array([[1.1, 2.0, 3.0, 4.4], [NAN, 6.6, 7.0, 8.0]])
+# a sloped disparity with holes and its image (a ramp): the plane fills have work to do
+_RAMP = np.tile(np.arange(40, dtype=np.float32) / 4 + 5, (30, 1))
+_HOLED = np.where(np.add.outer(np.arange(30), np.arange(40)) % 7 == 0, np.float32(NAN), _RAMP)
+_IMAGE = np.tile(np.arange(40, dtype=np.uint8) * 6, (30, 1))
 
 
 def _calib() -> Calibration:
@@ -51,6 +57,13 @@ RENAMES = [
     Rename(gt_depth, "gt_disp", "gt", lambda: _GT_DISP, kwargs={"calib": _calib()}),
     Rename(depth_metrics, "depth_gt", "gt", lambda: _GT_DEPTH, lambda: (_DEPTH,)),
     Rename(table1_report, "depth_gt", "gt", lambda: _GT_DEPTH, lambda: (_DEPTH,)),
+    # disparity: disparity (as depth_from_disparity, dense_metrics, DepthResult.disparity)
+    Rename(row_fill, "disp", "disparity", lambda: _DISP),
+    Rename(fill_planes, "disp", "disparity", lambda: _HOLED, kwargs={"image": _IMAGE}),
+    Rename(side_fill, "disp", "disparity", lambda: _HOLED, kwargs={"image": _IMAGE}),
+    Rename(
+        plane_fill, "disp", "disparity", lambda: _HOLED, kwargs={"labels": np.zeros((30, 40), int)}
+    ),
 ]
 
 

@@ -29,7 +29,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_bgr_uint8, as_gray_uint8, as_image_array
+from stereovision._validate import as_bgr_uint8, as_gray_uint8, as_image_array, renamed_keyword
 
 __all__ = [
     "BM_BLOCK_SIZE",
@@ -306,7 +306,8 @@ def stereovision_1_0(
     return _from_opencv(sg.compute(as_bgr_uint8(la, "left"), as_bgr_uint8(ra, "right")))
 
 
-def row_fill(disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
+@renamed_keyword("disp", "disparity")
+def row_fill(disparity: npt.ArrayLike) -> npt.NDArray[np.float32]:
     """The reference hole fill of evaluation.md (a Rust kernel; rows in parallel).
 
     Along each row, a hole (NaN) takes the smaller (background) of the nearest valid disparity
@@ -315,8 +316,9 @@ def row_fill(disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
 
     Parameters
     ----------
-    disp : array_like
+    disparity : array_like
         ``(H, W)`` disparity, NaN (or any non-finite value) = hole.
+        The keyword ``disp=``, its former name, still works, with a DeprecationWarning.
 
     Returns
     -------
@@ -326,16 +328,18 @@ def row_fill(disp: npt.ArrayLike) -> npt.NDArray[np.float32]:
     Raises
     ------
     ValueError
-        If ``disp`` is not a 2-D real array.
+        If ``disparity`` is not a 2-D real array.
 
     Examples
     --------
     >>> row_fill(np.array([[np.nan, 3, np.nan, np.nan, 1, np.nan]]))
     array([[3., 3., 1., 1., 1., 1.]], dtype=float32)
     """
-    d = np.asarray(disp)
+    d = np.asarray(disparity)
     if d.ndim != 2 or d.dtype.kind not in "iuf":
-        raise ValueError(f"disp: expected a real (H, W) array, got shape {d.shape} dtype {d.dtype}")
+        raise ValueError(
+            f"disparity: expected a real (H, W) array, got shape {d.shape} dtype {d.dtype}"
+        )
     if d.size == 0:
         return d.astype(np.float32)
     from stereovision import _core

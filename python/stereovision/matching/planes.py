@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import finite_number, float_sized, int_in_range
+from stereovision._validate import finite_number, float_sized, int_in_range, renamed_keyword
 
 __all__ = ["DEFAULTS", "fill_planes", "plane_fill", "segments", "side_fill"]
 
@@ -147,8 +147,9 @@ def _blurred(im: npt.NDArray[Any], blur: float) -> npt.NDArray[np.uint8]:
     return np.asarray(cv2.GaussianBlur(u8, (0, 0), float(blur)), np.uint8)
 
 
+@renamed_keyword("disp", "disparity")
 def plane_fill(
-    disp: npt.ArrayLike,
+    disparity: npt.ArrayLike,
     labels: npt.ArrayLike,
     *,
     min_pixels: int = _MIN_PIXELS,
@@ -156,12 +157,13 @@ def plane_fill(
     lo: float = -np.inf,
     hi: float = np.inf,
 ) -> F32:
-    """The holes of ``disp`` filled with the plane of their segment (see the module docs).
+    """The holes of ``disparity`` filled with the plane of their segment (see the module docs).
 
     Parameters
     ----------
-    disp : array_like
+    disparity : array_like
         ``(H, W)`` disparity, NaN = hole.
+        The keyword ``disp=``, its former name, still works, with a DeprecationWarning.
     labels : array_like
         ``(H, W)`` segment labels (:func:`segments`).
     min_pixels, max_residual : int, float
@@ -178,17 +180,17 @@ def plane_fill(
     Raises
     ------
     ValueError
-        ``disp`` not 2-D, ``labels`` of another shape, not integers (or booleans) or not in
+        ``disparity`` not 2-D, ``labels`` of another shape, not integers (or booleans) or not in
         ``0 .. H * W - 1``, a negative ``min_pixels`` or ``max_residual``, ``lo`` above ``hi``.
     """
     from stereovision import _core
 
-    d = np.ascontiguousarray(disp, dtype=np.float32)
+    d = np.ascontiguousarray(disparity, dtype=np.float32)
     raw = np.asarray(labels)
     if d.ndim != 2:
-        raise ValueError(f"disp: expected an (H, W) array, got {d.shape}")
+        raise ValueError(f"disparity: expected an (H, W) array, got {d.shape}")
     if raw.shape != d.shape:
-        raise ValueError(f"labels: expected shape {d.shape} like disp, got {raw.shape}")
+        raise ValueError(f"labels: expected shape {d.shape} like disparity, got {raw.shape}")
     # The cast to uint32 truncated float labels (0.7 -> 0) and wrapped wide ones (2**32 -> 0):
     # segments merged without a word.
     if raw.dtype.kind not in "biu":  # a boolean mask is two segments, 0 and 1, cast exactly
@@ -209,8 +211,9 @@ def plane_fill(
     return out
 
 
+@renamed_keyword("disp", "disparity")
 def fill_planes(
-    disp: npt.ArrayLike,
+    disparity: npt.ArrayLike,
     image: npt.ArrayLike,
     *,
     passes: tuple[tuple[int, int], ...] = _PASSES,
@@ -226,8 +229,9 @@ def fill_planes(
 
     Parameters
     ----------
-    disp : array_like
+    disparity : array_like
         ``(H, W)`` disparity, NaN = hole.
+        The keyword ``disp=``, its former name, still works, with a DeprecationWarning.
     image : array_like
         The left image, ``(H, W)`` or ``(H, W, C)`` with 1-3 channels, 0-255 (uint8; other
         types are clipped to 0-255 and truncated).
@@ -241,24 +245,24 @@ def fill_planes(
     -------
     numpy.ndarray
         ``(H, W)`` float32: the holes a plane filled, within the range of the measured values;
-        the rest as in ``disp``.
+        the rest as in ``disparity``.
 
     Raises
     ------
     ValueError
-        ``disp`` not 2-D, an image of another size, with more than 3 channels, not real or
+        ``disparity`` not 2-D, an image of another size, with more than 3 channels, not real or
         with NaN/inf, ``passes`` not pairs of a step in 1-255 and a count in 0 to 2**31 - 1, a
         ``blur`` outside [0, 64] px or a negative or non-finite ``max_residual`` (checked also
-        when ``disp`` has no hole).
+        when ``disparity`` has no hole).
     """
     from stereovision import _core
 
-    d = np.ascontiguousarray(disp, dtype=np.float32)
+    d = np.ascontiguousarray(disparity, dtype=np.float32)
     if d.ndim != 2:
-        raise ValueError(f"disp: expected an (H, W) array, got {d.shape}")
+        raise ValueError(f"disparity: expected an (H, W) array, got {d.shape}")
     im = np.asarray(image)
     if im.shape[:2] != d.shape:
-        raise ValueError(f"image: expected {d.shape} pixels like disp, got {im.shape[:2]}")
+        raise ValueError(f"image: expected {d.shape} pixels like disparity, got {im.shape[:2]}")
     if im.ndim == 3 and not 1 <= im.shape[2] <= 3:
         raise ValueError(f"image: expected 1-3 channels, got {im.shape[2]}")
     try:
@@ -289,8 +293,9 @@ SIDE_TAU = 5.0  # CIE Lab units (OpenCV's 8-bit scale): how much closer the left
 SIDE_BLUR = 1.0  # px: Gaussian sigma of the left image before its colours are compared
 
 
+@renamed_keyword("disp", "disparity")
 def side_fill(
-    disp: npt.ArrayLike,
+    disparity: npt.ArrayLike,
     image: npt.ArrayLike,
     *,
     tau: float = SIDE_TAU,
@@ -312,8 +317,9 @@ def side_fill(
 
     Parameters
     ----------
-    disp : array_like
+    disparity : array_like
         ``(H, W)`` disparity, NaN (or any non-finite value) = hole.
+        The keyword ``disp=``, its former name, still works, with a DeprecationWarning.
     image : array_like
         The left image, ``(H, W)`` grey or ``(H, W, 3)`` BGR, uint8 (other types are clipped to
         0-255).
@@ -331,17 +337,17 @@ def side_fill(
     Raises
     ------
     ValueError
-        ``disp`` not 2-D, an image of another size, with a channel count other than 1 or 3,
+        ``disparity`` not 2-D, an image of another size, with a channel count other than 1 or 3,
         not real or with NaN/inf, a negative or non-finite ``tau`` or a ``blur`` outside
-        [0, 64] px (the parameters checked also when ``disp`` has no hole).
+        [0, 64] px (the parameters checked also when ``disparity`` has no hole).
     """
     import cv2
 
     from stereovision import _core
 
-    d = np.ascontiguousarray(disp, dtype=np.float32)
+    d = np.ascontiguousarray(disparity, dtype=np.float32)
     if d.ndim != 2:
-        raise ValueError(f"disp: expected an (H, W) array, got {d.shape}")
+        raise ValueError(f"disparity: expected an (H, W) array, got {d.shape}")
     im = np.asarray(image)
     if (
         im.shape[:2] != d.shape
