@@ -95,7 +95,7 @@ def test_depth_metrics_hand_computed() -> None:
 def test_depth_metrics_no_overlap() -> None:
     m = depth_metrics(np.full((2, 2), NAN), np.ones((2, 2)))
     assert m.n == 0 and math.isnan(m.median_rel)
-    with pytest.raises(ValueError, match="depth_est and gt"):
+    with pytest.raises(ValueError, match="depth and gt"):
         depth_metrics(np.ones((2, 2)), np.ones((3, 2)))
 
 

@@ -57,6 +57,9 @@ RENAMES = [
     Rename(gt_depth, "gt_disp", "gt", lambda: _GT_DISP, kwargs={"calib": _calib()}),
     Rename(depth_metrics, "depth_gt", "gt", lambda: _GT_DEPTH, lambda: (_DEPTH,)),
     Rename(table1_report, "depth_gt", "gt", lambda: _GT_DEPTH, lambda: (_DEPTH,)),
+    # an estimate is named by its quantity (as dense_metrics' disparity): depth
+    Rename(depth_metrics, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
+    Rename(table1_report, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
     # disparity: disparity (as depth_from_disparity, dense_metrics, DepthResult.disparity)
     Rename(row_fill, "disp", "disparity", lambda: _DISP),
     Rename(fill_planes, "disp", "disparity", lambda: _HOLED, kwargs={"image": _IMAGE}),
@@ -107,3 +110,23 @@ def test_old_and_new_keyword_together_is_a_type_error(case: Rename) -> None:
     both = {case.new: case.value(), case.old: case.value()}
     with pytest.raises(TypeError, match=rf"^{name}\(\) got {case.old}= and {case.new}="):
         case.func(*case.args(), **case.kwargs, **both)
+
+
+def test_two_renames_of_one_function_are_one_wrapper() -> None:
+    """depth_metrics lost depth_est= and depth_gt=: both old names at once still work, each
+    warned about at the caller's line (one wrapper frame, not one per rename)."""
+    import inspect
+
+    assert list(inspect.signature(depth_metrics).parameters) == ["depth", "gt"]
+    new = depth_metrics(depth=_DEPTH, gt=_GT_DEPTH)
+    with pytest.warns(DeprecationWarning) as caught:
+        old = depth_metrics(depth_est=_DEPTH, depth_gt=_GT_DEPTH)
+    _same(old, new)
+    assert new.n == 6 and new.median_rel == pytest.approx(100 / 22)  # rel. errors 0, 0, 0, 1/11 x3
+    assert sorted(str(w.message).split(":")[1] for w in caught) == [
+        " the keyword depth_est= is now depth= (depth_est= will be removed)",
+        " the keyword depth_gt= is now gt= (depth_gt= will be removed)",
+    ]
+    assert {w.filename for w in caught} == {__file__}
+    with pytest.raises(TypeError, match=r"^depth_metrics\(\) got depth_gt= and gt="):
+        depth_metrics(_DEPTH, _GT_DEPTH, depth_gt=_GT_DEPTH)

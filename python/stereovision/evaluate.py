@@ -245,16 +245,17 @@ def _depth_valid(z: np.ndarray) -> npt.NDArray[np.bool_]:
         return np.isfinite(z) & (z > 0)
 
 
+@renamed_keyword("depth_est", "depth")
 @renamed_keyword("depth_gt", "gt")
-def depth_metrics(depth_est: npt.ArrayLike, gt: npt.ArrayLike) -> DepthMetrics:
+def depth_metrics(depth: npt.ArrayLike, gt: npt.ArrayLike) -> DepthMetrics:
     """Median relative error, share off by > 5 % and RMSE % over pixels with both depths.
 
     Parameters
     ----------
-    depth_est, gt : array_like
+    depth, gt : array_like
         Same-shape estimated and ground-truth depth maps in the same unit; non-finite or
-        ``<= 0`` = missing. The keyword ``depth_gt=``, ``gt``'s former name, still works, with
-        a DeprecationWarning.
+        ``<= 0`` = missing. The keywords ``depth_est=`` and ``depth_gt=``, their former names,
+        still work, with a DeprecationWarning.
 
     Returns
     -------
@@ -266,11 +267,11 @@ def depth_metrics(depth_est: npt.ArrayLike, gt: npt.ArrayLike) -> DepthMetrics:
     ValueError
         On mismatched shapes or non-real input.
     """
-    e = np.asarray(depth_est)
+    e = np.asarray(depth)
     g = np.asarray(gt)
     if e.dtype.kind not in "iuf" or g.dtype.kind not in "iuf":
         raise ValueError(f"depth maps must be real arrays, got {e.dtype} and {g.dtype}")
-    _same_shape(e, g, "depth_est", "gt")
+    _same_shape(e, g, "depth", "gt")
     e = e.astype(np.float64)
     g = g.astype(np.float64)
     both = _depth_valid(e) & _depth_valid(g)
@@ -423,9 +424,10 @@ class Table1Report:
         return "\n".join(lines)
 
 
+@renamed_keyword("depth_est", "depth")
 @renamed_keyword("depth_gt", "gt")
 def table1_report(
-    depth_est: npt.ArrayLike,
+    depth: npt.ArrayLike,
     gt: npt.ArrayLike,
     n_points: int = 10,
     seed: int = 0,
@@ -440,10 +442,10 @@ def table1_report(
 
     Parameters
     ----------
-    depth_est, gt : array_like
+    depth, gt : array_like
         ``(H, W)`` estimated and ground-truth distances in ``unit``; non-finite or ``<= 0`` =
-        missing. The keyword ``depth_gt=``, ``gt``'s former name, still works, with a
-        DeprecationWarning.
+        missing. The keywords ``depth_est=`` and ``depth_gt=``, their former names, still work,
+        with a DeprecationWarning.
     n_points : int
         Number of random points (all valid pixels if fewer exist). Ignored with ``points``.
     seed : int
@@ -465,9 +467,9 @@ def table1_report(
         On mismatched shapes, ``n_points < 1``, no pixel with both distances, or a given point
         outside the image or without both distances.
     """
-    e = _real_2d(depth_est, "depth_est", "depth")
+    e = _real_2d(depth, "depth", "depth")
     g = _real_2d(gt, "gt", "depth")
-    _same_shape(e, g, "depth_est", "gt")
+    _same_shape(e, g, "depth", "gt")
     factor = _unit_factor(unit)
     both = _depth_valid(e) & _depth_valid(g)
     if points is None:
