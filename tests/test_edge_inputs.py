@@ -106,7 +106,7 @@ def test_float_grey_levels_outside_0_1_are_refused(what: str, value: float) -> N
     UNSCALED[what](LEFT)
     left = LEFT.copy()
     left[20, 30] = value
-    with pytest.raises(ValueError, match=r"left|img") as exc:
+    with pytest.raises(ValueError, match=r"left|image") as exc:
         UNSCALED[what](left)
     assert "float image values must lie in [0, 1], got range" in str(exc.value)
 

@@ -18,6 +18,7 @@ import pytest
 from stereovision.baselines import row_fill
 from stereovision.calibration import Calibration
 from stereovision.evaluate import depth_metrics, gt_depth, table1_report
+from stereovision.matching.gabor import gabor_responses
 from stereovision.matching.planes import fill_planes, plane_fill, side_fill
 
 NAN = np.nan
@@ -60,6 +61,8 @@ RENAMES = [
     # an estimate is named by its quantity (as dense_metrics' disparity): depth
     Rename(depth_metrics, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
     Rename(table1_report, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
+    # an image: image (as find_corners, noise_sigma, fill_planes, interest_points)
+    Rename(gabor_responses, "img", "image", lambda: _IMAGE / np.float32(255), kwargs={"freq": 0.2}),
     # disparity: disparity (as depth_from_disparity, dense_metrics, DepthResult.disparity)
     Rename(row_fill, "disp", "disparity", lambda: _DISP),
     Rename(fill_planes, "disp", "disparity", lambda: _HOLED, kwargs={"image": _IMAGE}),

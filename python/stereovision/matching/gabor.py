@@ -23,6 +23,7 @@ from stereovision._validate import (
     disparity_range,
     float_sized,
     refuse_unknown,
+    renamed_keyword,
 )
 
 __all__ = ["DEFAULTS", "GaborResult", "gabor_disparity", "gabor_responses"]
@@ -174,8 +175,9 @@ def gabor_disparity(
     return GaborResult(disparity=disp, confidence=conf)
 
 
+@renamed_keyword("img", "image")
 def gabor_responses(
-    img: npt.ArrayLike,
+    image: npt.ArrayLike,
     freq: float = 0.25,
     theta_deg: float = 0.0,
     bandwidth_oct: float = 1.5,
@@ -185,8 +187,9 @@ def gabor_responses(
 
     Parameters
     ----------
-    img : array_like
+    image : array_like
         ``(H, W)`` float32 grey image.
+        The keyword ``img=``, its former name, still works, with a DeprecationWarning.
     freq : float
         Centre frequency (cycles/px).
     theta_deg : float
@@ -199,7 +202,7 @@ def gabor_responses(
     Returns
     -------
     numpy.ndarray
-        ``(H, W)`` complex64 response ``y = h * img`` (true convolution, reflect-101 borders).
+        ``(H, W)`` complex64 response ``y = h * image`` (true convolution, reflect-101 borders).
     """
-    re, im = _core.gabor_responses(_as_grey(img, "img"), freq, theta_deg, bandwidth_oct, aspect)
+    re, im = _core.gabor_responses(_as_grey(image, "image"), freq, theta_deg, bandwidth_oct, aspect)
     return (re + 1j * im).astype(np.complex64)
