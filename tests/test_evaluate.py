@@ -267,7 +267,7 @@ def test_count_at_precision_hand_computed() -> None:
     assert count_at_precision(xl, yl, xr, score, gt, 60.0) == 4
     assert count_at_precision(xl, yl, xr, score, gt, 76.0) == 1
     # A looser tolerance counts b as right: all four at 100 %.
-    assert count_at_precision(xl, yl, xr, score, gt, 100.0, tol=3.0) == 4
+    assert count_at_precision(xl, yl, xr, score, gt, 100.0, tolerance=3.0) == 4
     assert count_at_precision(xl[:0], yl[:0], xr[:0], score[:0], gt, 50.0) == 0
     with pytest.raises(ValueError, match="equal length"):
         count_at_precision(xl, yl, xr, score[:2], gt, 50.0)

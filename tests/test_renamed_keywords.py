@@ -17,7 +17,7 @@ import pytest
 
 from stereovision.baselines import row_fill
 from stereovision.calibration import Calibration
-from stereovision.evaluate import depth_metrics, gt_depth, table1_report
+from stereovision.evaluate import count_at_precision, depth_metrics, gt_depth, table1_report
 from stereovision.matching.gabor import gabor_responses
 from stereovision.matching.planes import fill_planes, plane_fill, side_fill
 
@@ -61,6 +61,16 @@ RENAMES = [
     # an estimate is named by its quantity (as dense_metrics' disparity): depth
     Rename(depth_metrics, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
     Rename(table1_report, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
+    # a bound in pixels: tolerance (as check_rectification, refine_rectification and
+    # RectificationCheck.tolerance; triangulate's solver tol, with max_iter, stays scipy's)
+    Rename(
+        count_at_precision,
+        "tol",
+        "tolerance",
+        lambda: 3.0,
+        lambda: ([1.0, 2.0, 3.0, 0.0], [0.0, 1.0, 1.0, 0.0], [0.5, -1.0, 2.5, -1.9]),
+        {"score": [4.0, 3.0, 2.0, 1.0], "gt": _GT_DISP, "target": 100.0},
+    ),
     # an image: image (as find_corners, noise_sigma, fill_planes, interest_points)
     Rename(gabor_responses, "img", "image", lambda: _IMAGE / np.float32(255), kwargs={"freq": 0.2}),
     # disparity: disparity (as depth_from_disparity, dense_metrics, DepthResult.disparity)

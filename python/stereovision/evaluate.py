@@ -602,6 +602,7 @@ def sparse_metrics(
     return SparseMetrics(precision=precision, count=count, n_matches=len(x), coverage=coverage)
 
 
+@renamed_keyword("tol", "tolerance")
 def count_at_precision(
     xl: npt.ArrayLike,
     yl: npt.ArrayLike,
@@ -609,13 +610,13 @@ def count_at_precision(
     score: npt.ArrayLike,
     gt: npt.ArrayLike,
     target: float,
-    tol: float = 1.0,
+    tolerance: float = 1.0,
 ) -> int:
     """How many matches with GT a matcher keeps at a given precision, taken best score first.
 
     The matches are ranked by decreasing ``score`` (stable) and cut to the longest prefix whose
-    precision@``tol`` over its matches with GT is still >= ``target`` percent; the count with
-    GT of that prefix is returned (0 if none qualifies). It compares two matchers at equal
+    precision@``tolerance`` over its matches with GT is still >= ``target`` percent; the count
+    with GT of that prefix is returned (0 if none qualifies). It compares two matchers at equal
     precision ("more matches than the other would give at that precision").
 
     Parameters
@@ -627,8 +628,9 @@ def count_at_precision(
         :func:`sparse_metrics`).
     target : float
         Precision to hold, percent.
-    tol : float
+    tolerance : float
         Error bound of the precision (px).
+        The keyword ``tol=``, its former name, still works, with a DeprecationWarning.
 
     Returns
     -------
@@ -654,7 +656,7 @@ def count_at_precision(
     gv[inside] = g[yi[inside].astype(np.int64), xi[inside].astype(np.int64)]
     has = np.isfinite(gv)
     order = np.argsort(-s[has], kind="stable")
-    good = (np.abs((x - x2)[has] - gv[has]) <= tol)[order]
+    good = (np.abs((x - x2)[has] - gv[has]) <= tolerance)[order]
     prec = 100.0 * np.cumsum(good) / np.arange(1, len(good) + 1)
     ok = np.nonzero(prec >= target - 1e-9)[0]
     return int(ok[-1] + 1) if len(ok) else 0
