@@ -10,11 +10,14 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+import synthetic_scene as syn
 
+from stereovision import export
 from stereovision.baselines import row_fill
 from stereovision.calibration import Calibration
 from stereovision.evaluate import count_at_precision, depth_metrics, gt_depth, table1_report
@@ -48,6 +51,9 @@ class Rename:
     kwargs: dict[str, Any] = field(default_factory=dict)
     # the deprecation message names the callable as this (a method: Class.method)
     called: str = ""
+    # value is a folder to write in: a new one each call (value is then tmp_path / "new" or
+    # "old"), the results compared by the files' names and contents
+    folder: bool = False
 
     def __str__(self) -> str:
         return f"{self.called or self.func.__name__}:{self.old}->{self.new}"
@@ -61,6 +67,16 @@ RENAMES = [
     # an estimate is named by its quantity (as dense_metrics' disparity): depth
     Rename(depth_metrics, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
     Rename(table1_report, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
+    # a folder to write in: directory (as Calibration.save_ros, CalibrationReport.write,
+    # capture.capture, OccupancyGrid.save)
+    Rename(
+        export.export_result,
+        "out_dir",
+        "directory",
+        tuple,
+        lambda: (syn.depth_result(),),
+        folder=True,
+    ),
     # a bound in pixels: tolerance (as check_rectification, refine_rectification and
     # RectificationCheck.tolerance; triangulate's solver tol, with max_iter, stays scipy's)
     Rename(
@@ -83,6 +99,19 @@ RENAMES = [
 ]
 
 
+def _same_files(a: dict[str, Path], b: dict[str, Path]) -> None:
+    """Two ``{name: path}`` of files written: the same names, the same contents."""
+    assert a.keys() == b.keys() and a
+    for name in a:
+        if name.endswith(".npz"):  # a zip: its entries' times may differ
+            with np.load(a[name]) as x, np.load(b[name]) as y:
+                assert x.files == y.files
+                for k in x.files:
+                    _same(x[k], y[k])
+        else:
+            assert a[name].read_bytes() == b[name].read_bytes(), name
+
+
 def _same(a: Any, b: Any) -> None:
     """``a`` and ``b`` are the same value: arrays (NaN where NaN), dataclasses field by field."""
     if isinstance(a, np.ndarray):
@@ -102,13 +131,16 @@ def _same(a: Any, b: Any) -> None:
 
 
 @pytest.mark.parametrize("case", RENAMES, ids=str)
-def test_old_keyword_warns_and_gives_the_same_value(case: Rename) -> None:
+def test_old_keyword_warns_and_gives_the_same_value(case: Rename, tmp_path: Path) -> None:
+    def value(which: str) -> Any:
+        return tmp_path / which if case.folder else case.value()
+
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        new = case.func(*case.args(), **case.kwargs, **{case.new: case.value()})
+        new = case.func(*case.args(), **case.kwargs, **{case.new: value("new")})
     with pytest.warns(DeprecationWarning) as caught:
-        old = case.func(*case.args(), **case.kwargs, **{case.old: case.value()})
-    _same(old, new)
+        old = case.func(*case.args(), **case.kwargs, **{case.old: value("old")})
+    (_same_files if case.folder else _same)(old, new)
     name = case.called or case.func.__name__
     assert len(caught) == 1
     assert str(caught[0].message) == (
@@ -118,11 +150,13 @@ def test_old_keyword_warns_and_gives_the_same_value(case: Rename) -> None:
 
 
 @pytest.mark.parametrize("case", RENAMES, ids=str)
-def test_old_and_new_keyword_together_is_a_type_error(case: Rename) -> None:
+def test_old_and_new_keyword_together_is_a_type_error(case: Rename, tmp_path: Path) -> None:
     name = case.called or case.func.__name__
-    both = {case.new: case.value(), case.old: case.value()}
+    value = tmp_path if case.folder else case.value()
+    both = {case.new: value, case.old: value}
     with pytest.raises(TypeError, match=rf"^{name}\(\) got {case.old}= and {case.new}="):
         case.func(*case.args(), **case.kwargs, **both)
+    assert not any(tmp_path.iterdir())  # refused before anything was written
 
 
 def test_two_renames_of_one_function_are_one_wrapper() -> None:

@@ -33,6 +33,7 @@ from typing import TYPE_CHECKING, Any, overload
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import renamed_keyword
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -918,19 +919,21 @@ def read_disparity_png(path: PathLike) -> npt.NDArray[np.float32]:
     return _read_png16(path, DISPARITY_PNG_SCALE, "disparity PNG")
 
 
+@renamed_keyword("out_dir", "directory")
 def export_result(
     result: DepthResult,
-    out_dir: PathLike,
+    directory: PathLike,
     formats: tuple[str, ...] = tuple(EXPORT_FORMATS),
 ) -> dict[str, Path]:
-    """Write the result in the chosen formats into ``out_dir`` (:data:`EXPORT_FORMATS`).
+    """Write the result in the chosen formats into ``directory`` (:data:`EXPORT_FORMATS`).
 
     Parameters
     ----------
     result : DepthResult
         A :func:`stereovision.depth_map` result.
-    out_dir : path
+    directory : path
         Folder, created if missing; each file is written atomically.
+        The keyword ``out_dir=``, its former name, still works, with a DeprecationWarning.
     formats : tuple of str
         Any of ``"ply"``, ``"pcd"``, ``"npz"``, ``"depth16"`` (millimetres, 16-bit PNG) and
         ``"disp16"`` (KITTI's 16-bit disparity PNG); default: all.
@@ -950,7 +953,7 @@ def export_result(
         raise ValueError(
             f"unknown export format(s) {sorted(unknown)}: expected {list(EXPORT_FORMATS)}"
         )
-    out = Path(out_dir)
+    out = Path(directory)
     make_folder(out)
     writers: dict[str, Callable[[Path, DepthResult], Path]] = {
         "ply": write_cloud_ply,
