@@ -342,7 +342,7 @@ class _FormatCap(_FakeCap):
 def test_pixel_format_asked_first_and_reported() -> None:
     log: list[str] = []
     caps = [_FormatCap(n, log, ("YUYV", "MJPG")) for n in "LR"]
-    cam = StereoCamera(*caps, size=(320, 240), fps=30, fourcc="MJPG")
+    cam = StereoCamera(*caps, image_size=(320, 240), fps=30, fourcc="MJPG")
     # The format before the size and the rate (the camera's sizes depend on it), for each side.
     assert log == [
         f"{n}.set {p}"
@@ -391,7 +391,7 @@ def test_frames_of_another_shape_are_not_stretched(tmp_path: Path) -> None:
     shape than the left's is refused."""
     left, right = _videos(tmp_path, 3, 3, size=(160, 120))
     with pytest.warns(UserWarning, match=r"delivers 160x120, not 320x180: another shape") as rec:
-        with StereoCamera(left, right, size=(320, 180)) as cam:
+        with StereoCamera(left, right, image_size=(320, 180)) as cam:
             frame = cam.read()
             assert cam.size == (160, 120)
     assert len(rec) == 1  # the right source then matches the size kept
@@ -406,7 +406,7 @@ def test_frames_of_another_shape_are_not_stretched(tmp_path: Path) -> None:
 def test_resolution_request_and_resize_warning(tmp_path: Path) -> None:
     left, right = _videos(tmp_path, 3, 3, size=(160, 120))
     with pytest.warns(UserWarning, match=r"delivers 160x120, not 320x240") as rec:
-        with StereoCamera(left, right, size=(320, 240), fps=30) as cam:
+        with StereoCamera(left, right, image_size=(320, 240), fps=30) as cam:
             frame = cam.read()
             cam.read()
             assert cam.delivered_size == {"left": (160, 120), "right": (160, 120)}
@@ -419,7 +419,7 @@ def test_resolution_request_and_resize_warning(tmp_path: Path) -> None:
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        with StereoCamera(left, right, size="160x120") as cam:
+        with StereoCamera(left, right, image_size="160x120") as cam:
             assert cam.read().left.shape == (120, 160, 3)
     assert parse_size("1280x720") == (1280, 720)
     for bad in ("big", "0x5", "12x"):
@@ -1223,14 +1223,17 @@ def test_capture_into_a_folder_replaced_by_a_file_stops(
 
 
 def test_a_frame_resized_after_a_dropped_size_is_said(tmp_path: Path) -> None:
-    """size=(320, 180) of a 4:3 sequence is dropped (its frames kept at 320x240, one warning);
+    """image_size=(320, 180) of a 4:3 sequence is dropped (its frames kept at 320x240, one warning);
     a later frame of half that size is then resized to it: one more warning says so (the
     warning about the dropped size took the side's only warning, and the resize was silent)."""
     frames = [_numbered(i) for i in range(3)]
     frames[1] = cv2.resize(frames[1], (160, 120), interpolation=cv2.INTER_AREA)
     lpat = _write_sequence(tmp_path, "left", frames)
     rpat = _write_sequence(tmp_path, "right", [_numbered(i) for i in range(3)])
-    with pytest.warns(UserWarning) as caught, StereoCamera(lpat, rpat, size=(320, 180)) as cam:
+    with (
+        pytest.warns(UserWarning) as caught,
+        StereoCamera(lpat, rpat, image_size=(320, 180)) as cam,
+    ):
         got = list(cam.frames())
     assert [str(w.message) for w in caught] == [
         f"left source {lpat!r} delivers 320x240, not 320x180: another shape, so its frames are "
@@ -1241,13 +1244,16 @@ def test_a_frame_resized_after_a_dropped_size_is_said(tmp_path: Path) -> None:
 
 
 def test_temporal_averaging_of_enlarged_frames_is_said(tmp_path: Path) -> None:
-    """size=(320, 240) of a 160x120 left and a 320x240 right source: the left frames are
+    """image_size=(320, 240) of a 160x120 left and a 320x240 right source: the left frames are
     enlarged before the filter (whose means are of one shape), whose motion test takes their
     interpolated noise for motion; one warning says so (none did)."""
     frames = [_numbered(0, (160, 120)) for _ in range(4)]
     lpat = _write_sequence(tmp_path / "in", "left", frames)
     rpat = _write_sequence(tmp_path / "in", "right", [_numbered(0, (320, 240))] * 4)
-    with pytest.warns(UserWarning) as caught, StereoCamera(lpat, rpat, size=(320, 240)) as cam:
+    with (
+        pytest.warns(UserWarning) as caught,
+        StereoCamera(lpat, rpat, image_size=(320, 240)) as cam,
+    ):
         capture(cam, tmp_path / "pairs", temporal=2)
     said = [str(w.message) for w in caught if str(w.message).startswith("temporal")]
     assert said == [
@@ -1268,7 +1274,10 @@ def test_temporal_capture_averages_frames_before_enlarging_them(
     lpat, rpat = _still_noisy_sequence(data_dir, tmp_path / "still", 8)
     big = (2 * SMALL[0], 2 * SMALL[1])
     lines: list[str] = []
-    with warnings.catch_warnings(record=True) as caught, StereoCamera(lpat, rpat, size=big) as cam:
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        StereoCamera(lpat, rpat, image_size=big) as cam,
+    ):
         warnings.simplefilter("always")
         result = capture(cam, tmp_path / "pairs", temporal=4, log=lines.append)
     assert not [w for w in caught if str(w.message).startswith("temporal")]
@@ -1360,7 +1369,7 @@ def test_temporal_average_of_shrunk_frames_runs_at_the_size_asked(
         tf.shapes = []
         with (
             pytest.warns(UserWarning, match="its frames are resized"),
-            StereoCamera(lpat, rpat, size=size) as cam,
+            StereoCamera(lpat, rpat, image_size=size) as cam,
         ):
             out = [capmod.temporal_average(tf, cam.read()) for _ in range(4)]
         assert tf.shapes == [fed] * 4, size

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 import pytest
 import synthetic_scene as syn
@@ -20,9 +21,11 @@ import synthetic_scene as syn
 from stereovision import export
 from stereovision.baselines import row_fill
 from stereovision.calibration import Calibration
+from stereovision.capture import StereoCamera
 from stereovision.evaluate import count_at_precision, depth_metrics, gt_depth, table1_report
 from stereovision.matching.gabor import gabor_responses
 from stereovision.matching.planes import fill_planes, plane_fill, side_fill
+from stereovision.rosbag import BagCamera
 
 NAN = np.nan
 _DISP = np.array([[1.0, NAN, 5.0, 8.0], [2.0, 4.0, NAN, 6.0]], dtype=np.float32)
@@ -47,56 +50,61 @@ class Rename:
     old: str
     new: str
     value: Callable[[], Any]
-    args: Callable[[], tuple[Any, ...]] = tuple
+    # the other positional arguments, given a folder of the test's own
+    args: Callable[[Path], tuple[Any, ...]] = lambda _: ()
     kwargs: dict[str, Any] = field(default_factory=dict)
     # the deprecation message names the callable as this (a method: Class.method)
     called: str = ""
     # value is a folder to write in: a new one each call (value is then tmp_path / "new" or
     # "old"), the results compared by the files' names and contents
     folder: bool = False
+    # how the two results are compared (default: _same, or _same_files for a folder)
+    same: Callable[[Any, Any], None] | None = None
 
     def __str__(self) -> str:
         return f"{self.called or self.func.__name__}:{self.old}->{self.new}"
 
 
-RENAMES = [
-    # ground truth: gt (as dense_metrics, sparse_metrics, count_at_precision, io.Scene.gt)
-    Rename(gt_depth, "gt_disp", "gt", lambda: _GT_DISP, kwargs={"calib": _calib()}),
-    Rename(depth_metrics, "depth_gt", "gt", lambda: _GT_DEPTH, lambda: (_DEPTH,)),
-    Rename(table1_report, "depth_gt", "gt", lambda: _GT_DEPTH, lambda: (_DEPTH,)),
-    # an estimate is named by its quantity (as dense_metrics' disparity): depth
-    Rename(depth_metrics, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
-    Rename(table1_report, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
-    # a folder to write in: directory (as Calibration.save_ros, CalibrationReport.write,
-    # capture.capture, OccupancyGrid.save)
-    Rename(
-        export.export_result,
-        "out_dir",
-        "directory",
-        tuple,
-        lambda: (syn.depth_result(),),
-        folder=True,
-    ),
-    # a bound in pixels: tolerance (as check_rectification, refine_rectification and
-    # RectificationCheck.tolerance; triangulate's solver tol, with max_iter, stays scipy's)
-    Rename(
-        count_at_precision,
-        "tol",
-        "tolerance",
-        lambda: 3.0,
-        lambda: ([1.0, 2.0, 3.0, 0.0], [0.0, 1.0, 1.0, 0.0], [0.5, -1.0, 2.5, -1.9]),
-        {"score": [4.0, 3.0, 2.0, 1.0], "gt": _GT_DISP, "target": 100.0},
-    ),
-    # an image: image (as find_corners, noise_sigma, fill_planes, interest_points)
-    Rename(gabor_responses, "img", "image", lambda: _IMAGE / np.float32(255), kwargs={"freq": 0.2}),
-    # disparity: disparity (as depth_from_disparity, dense_metrics, DepthResult.disparity)
-    Rename(row_fill, "disp", "disparity", lambda: _DISP),
-    Rename(fill_planes, "disp", "disparity", lambda: _HOLED, kwargs={"image": _IMAGE}),
-    Rename(side_fill, "disp", "disparity", lambda: _HOLED, kwargs={"image": _IMAGE}),
-    Rename(
-        plane_fill, "disp", "disparity", lambda: _HOLED, kwargs={"labels": np.zeros((30, 40), int)}
-    ),
-]
+class _Cap:
+    """A VideoCapture stand-in of 160x120 frames."""
+
+    def isOpened(self) -> bool:
+        return True
+
+    def grab(self) -> bool:
+        return True
+
+    def retrieve(self) -> tuple[bool, np.ndarray]:
+        return True, np.full((120, 160, 3), 90, np.uint8)
+
+    def get(self, prop: int) -> float:
+        return {cv2.CAP_PROP_FRAME_WIDTH: 160.0, cv2.CAP_PROP_FRAME_HEIGHT: 120.0}.get(prop, 0.0)
+
+    def set(self, prop: int, value: float) -> bool:
+        return False
+
+    def release(self) -> None:
+        pass
+
+
+def _bag(folder: Path) -> tuple[Path]:
+    """A ROS 2 bag of one 160x120 pair (written with test_rosbag_read's writer)."""
+    pytest.importorskip("rosbags")
+    from test_rosbag_read import T0, write_bag
+
+    if (folder / "rig").exists():  # the test's second call
+        return (folder / "rig",)
+    frame = np.tile(np.arange(160, dtype=np.uint8)[None, :, None], (120, 1, 3))
+    return (write_bag(folder / "rig", [(T0, frame, T0, frame)]),)
+
+
+def _same_camera(a: Any, b: Any) -> None:
+    """Two cameras asked the same size, whose first pairs are the same."""
+    with a, b:
+        assert a.requested_size == b.requested_size is not None
+        fa, fb = a.read(), b.read()
+        _same(fa.left, fb.left)
+        _same(fa.right, fb.right)
 
 
 def _same_files(a: dict[str, Path], b: dict[str, Path]) -> None:
@@ -130,6 +138,57 @@ def _same(a: Any, b: Any) -> None:
         assert a == b
 
 
+RENAMES = [
+    # ground truth: gt (as dense_metrics, sparse_metrics, count_at_precision, io.Scene.gt)
+    Rename(gt_depth, "gt_disp", "gt", lambda: _GT_DISP, kwargs={"calib": _calib()}),
+    Rename(depth_metrics, "depth_gt", "gt", lambda: _GT_DEPTH, lambda _: (_DEPTH,)),
+    Rename(table1_report, "depth_gt", "gt", lambda: _GT_DEPTH, lambda _: (_DEPTH,)),
+    # an estimate is named by its quantity (as dense_metrics' disparity): depth
+    Rename(depth_metrics, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
+    Rename(table1_report, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
+    # a folder to write in: directory (as Calibration.save_ros, CalibrationReport.write,
+    # capture.capture, OccupancyGrid.save)
+    Rename(
+        export.export_result,
+        "out_dir",
+        "directory",
+        tuple,
+        lambda _: (syn.depth_result(),),
+        folder=True,
+    ),
+    # (width, height) of an image: image_size (as Calibration, Calibration.from_file, from_q,
+    # from_kitti, ideal, scaled_to, render_plane, render_charuco)
+    Rename(
+        StereoCamera,
+        "size",
+        "image_size",
+        lambda: "160x120",
+        lambda _: (_Cap(), _Cap()),
+        same=_same_camera,
+    ),
+    Rename(BagCamera, "size", "image_size", lambda: (80, 60), _bag, same=_same_camera),
+    # a bound in pixels: tolerance (as check_rectification, refine_rectification and
+    # RectificationCheck.tolerance; triangulate's solver tol, with max_iter, stays scipy's)
+    Rename(
+        count_at_precision,
+        "tol",
+        "tolerance",
+        lambda: 3.0,
+        lambda _: ([1.0, 2.0, 3.0, 0.0], [0.0, 1.0, 1.0, 0.0], [0.5, -1.0, 2.5, -1.9]),
+        {"score": [4.0, 3.0, 2.0, 1.0], "gt": _GT_DISP, "target": 100.0},
+    ),
+    # an image: image (as find_corners, noise_sigma, fill_planes, interest_points)
+    Rename(gabor_responses, "img", "image", lambda: _IMAGE / np.float32(255), kwargs={"freq": 0.2}),
+    # disparity: disparity (as depth_from_disparity, dense_metrics, DepthResult.disparity)
+    Rename(row_fill, "disp", "disparity", lambda: _DISP),
+    Rename(fill_planes, "disp", "disparity", lambda: _HOLED, kwargs={"image": _IMAGE}),
+    Rename(side_fill, "disp", "disparity", lambda: _HOLED, kwargs={"image": _IMAGE}),
+    Rename(
+        plane_fill, "disp", "disparity", lambda: _HOLED, kwargs={"labels": np.zeros((30, 40), int)}
+    ),
+]
+
+
 @pytest.mark.parametrize("case", RENAMES, ids=str)
 def test_old_keyword_warns_and_gives_the_same_value(case: Rename, tmp_path: Path) -> None:
     def value(which: str) -> Any:
@@ -137,10 +196,10 @@ def test_old_keyword_warns_and_gives_the_same_value(case: Rename, tmp_path: Path
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        new = case.func(*case.args(), **case.kwargs, **{case.new: value("new")})
+        new = case.func(*case.args(tmp_path), **case.kwargs, **{case.new: value("new")})
     with pytest.warns(DeprecationWarning) as caught:
-        old = case.func(*case.args(), **case.kwargs, **{case.old: value("old")})
-    (_same_files if case.folder else _same)(old, new)
+        old = case.func(*case.args(tmp_path), **case.kwargs, **{case.old: value("old")})
+    (case.same or (_same_files if case.folder else _same))(old, new)
     name = case.called or case.func.__name__
     assert len(caught) == 1
     assert str(caught[0].message) == (
@@ -152,11 +211,13 @@ def test_old_keyword_warns_and_gives_the_same_value(case: Rename, tmp_path: Path
 @pytest.mark.parametrize("case", RENAMES, ids=str)
 def test_old_and_new_keyword_together_is_a_type_error(case: Rename, tmp_path: Path) -> None:
     name = case.called or case.func.__name__
-    value = tmp_path if case.folder else case.value()
+    value = tmp_path / "out" if case.folder else case.value()
+    args = case.args(tmp_path)
+    before = sorted(tmp_path.rglob("*"))
     both = {case.new: value, case.old: value}
     with pytest.raises(TypeError, match=rf"^{name}\(\) got {case.old}= and {case.new}="):
-        case.func(*case.args(), **case.kwargs, **both)
-    assert not any(tmp_path.iterdir())  # refused before anything was written
+        case.func(*args, **case.kwargs, **both)
+    assert sorted(tmp_path.rglob("*")) == before  # refused before anything was written
 
 
 def test_two_renames_of_one_function_are_one_wrapper() -> None:

@@ -341,7 +341,7 @@ def test_mono16_pairs_share_one_shift_and_resize(cones: Any, tmp_path: Path) -> 
         f = cam.read()
     np.testing.assert_array_equal(f.left[..., 0], (gl >> 4).astype(np.uint8))
     np.testing.assert_array_equal(f.right[..., 0], (gr >> 4).astype(np.uint8))
-    with BagCamera(bag, size="225x188") as cam:
+    with BagCamera(bag, image_size="225x188") as cam:
         assert cam.read().left.shape == (188, 225, 3)
 
 
@@ -800,7 +800,7 @@ def test_a_size_of_another_shape_does_not_stretch_a_recording(cones: Any, tmp_pa
     (`capture --size`: "frames of the same shape are resized"); they were stretched."""
     bag = write_bag(tmp_path / "rig", [(T0, cones.left, T0, cones.right)], encoding="png")
     with (
-        BagCamera(bag, size="450x200") as cam,
+        BagCamera(bag, image_size="450x200") as cam,
         pytest.warns(
             UserWarning,
             match=r"size 450x200 is another shape than the recording's "
@@ -819,7 +819,7 @@ def test_frames_resized_after_a_dropped_size_are_said(cones: Any, tmp_path: Path
     half = cv2.resize(cones.right, (225, 188), interpolation=cv2.INTER_AREA)
     frames = [(T0 + k * PERIOD_NS, cones.left, T0 + k * PERIOD_NS, half) for k in range(3)]
     bag = write_bag(tmp_path / "rig", frames, encoding="png")
-    with pytest.warns(UserWarning) as caught, BagCamera(bag, size="450x200") as cam:
+    with pytest.warns(UserWarning) as caught, BagCamera(bag, image_size="450x200") as cam:
         got = list(cam.frames())
     assert [str(w.message) for w in caught] == [
         "size 450x200 is another shape than the recording's 450x375: its frames are kept at "

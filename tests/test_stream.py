@@ -715,7 +715,10 @@ def test_stream_averages_frames_before_enlarging_them(data_dir: Path, tmp_path: 
             cv2.imwrite(str(tmp_path / f"{side}_{i:02d}.png"), noisy(small, 8.0, rng))
     src = (str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png"))
     shapes: list[tuple[int, ...]] = []
-    with warnings.catch_warnings(record=True) as caught, StereoCamera(*src, size="320x240") as cam:
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        StereoCamera(*src, image_size="320x240") as cam,
+    ):
         warnings.simplefilter("always")
         rep = run_stream(
             cam,
@@ -931,7 +934,7 @@ def test_stream_sizes_stereo_calib_output_by_the_frames_delivered_not_the_mode_r
     }
 
     def cameras(args: Any, fps: float | None = None) -> StereoCamera:
-        return StereoCamera(_ModeCap(small["left"]), _ModeCap(small["right"]), size=args.size)
+        return StereoCamera(_ModeCap(small["left"]), _ModeCap(small["right"]), image_size=args.size)
 
     got: list[Calibration] = []
     real = stream.run_stream

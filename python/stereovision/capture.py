@@ -51,6 +51,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import renamed_keyword
 from stereovision.calibrate import (
     POSE_PARAM_NAMES,
     POSE_PARAM_RANGES,
@@ -619,13 +620,15 @@ class StereoCamera(PairSource):
         Device index, video file, image-sequence pattern (``frames/left_%03d.png``, read with
         OpenCV's image reader so that each frame comes at its own size), or an object with the
         ``cv2.VideoCapture`` methods ``isOpened grab retrieve get set release``.
-    size : tuple of int, optional
-        Requested ``(width, height)``, asked of the sources with ``CAP_PROP_FRAME_WIDTH`` /
-        ``CAP_PROP_FRAME_HEIGHT``. Frames that come in another size (a file cannot be asked) are
-        resized to it, with one :class:`UserWarning` per camera; frames of another shape (4:3
+    image_size : tuple of int or str, optional
+        Requested ``(width, height)`` (or ``"WxH"``), asked of the sources with
+        ``CAP_PROP_FRAME_WIDTH`` / ``CAP_PROP_FRAME_HEIGHT``. Frames that come in another size
+        (a file cannot be asked) are resized to it, with one :class:`UserWarning` per camera;
+        frames of another shape (4:3
         for 16:9) are kept at their own size instead, as a resize would stretch them, and a
         right source whose shape differs from the left's raises :class:`SourceError`. Default:
-        the left source's size.
+        the left source's size. The keyword ``size=``, its former name, still works, with a
+        DeprecationWarning (the attribute stays :attr:`size`).
     fps : float, optional
         Requested frame rate (``CAP_PROP_FPS``); what the source reports is in
         :attr:`delivered_fps`.
@@ -661,20 +664,21 @@ class StereoCamera(PairSource):
     SourceError
         If a source cannot be opened (the message names it).
     ValueError
-        If ``size``, ``fps`` or ``fourcc`` is invalid.
+        If ``image_size``, ``fps`` or ``fourcc`` is invalid.
     """
 
+    @renamed_keyword("size", "image_size")
     def __init__(
         self,
         left: Source,
         right: Source,
         *,
-        size: tuple[int, int] | str | None = None,
+        image_size: tuple[int, int] | str | None = None,
         fps: float | None = None,
         fourcc: str | None = None,
     ) -> None:
         self.sources = {"left": left, "right": right}
-        self.requested_size = parse_size(size)
+        self.requested_size = parse_size(image_size)
         if fps is not None and not (math.isfinite(fps) and fps > 0):
             raise ValueError(f"fps: expected a positive number, got {fps!r}")
         self.requested_fourcc = parse_fourcc(fourcc)
@@ -1169,7 +1173,7 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
             left_topic=args.left_topic,
             right_topic=args.right_topic,
             max_skew_ms=args.max_skew_ms,
-            size=size,
+            image_size=size,
             realtime=bool(getattr(args, "realtime", False)),
         )
     if getattr(args, "realtime", False):
@@ -1190,7 +1194,7 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
             f"--left {str(left)!r} and --right {str(right)!r} are both camera {device}: give "
             "the rig's two cameras"
         )
-    cam = StereoCamera(left, right, size=size, fps=fps, fourcc=getattr(args, "fourcc", None))
+    cam = StereoCamera(left, right, image_size=size, fps=fps, fourcc=getattr(args, "fourcc", None))
     if _same_path(left, right):
         # a typo: every pair is one view twice, every disparity 0, and nothing said it (said
         # once the source opens: a missing one is said as such)

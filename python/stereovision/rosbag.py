@@ -78,6 +78,7 @@ import cv2
 import numpy as np
 
 from stereovision._interrupt import HeldInterrupts
+from stereovision._validate import renamed_keyword
 from stereovision.capture import PairSource, SourceError, StereoFrame, resize_frame
 
 __all__ = [
@@ -720,10 +721,11 @@ class BagCamera(PairSource):
     max_skew_ms : float, optional
         Largest stamp difference of a pair. Default: half the frame period of the faster topic
         (from the first :data:`PERIOD_SAMPLE` frames' stamps), so a frame pairs at most once.
-    size : tuple of int or str, optional
-        Resize the frames to ``(width, height)``; a size of another shape than the recording's
-        is not applied (a resize would stretch the frames), with a warning. Default: as
-        recorded.
+    image_size : tuple of int or str, optional
+        Resize the frames to ``(width, height)`` (or ``"WxH"``); a size of another shape than the
+        recording's is not applied (a resize would stretch the frames), with a warning. Default:
+        as recorded. The keyword ``size=``, its former name, still works, with a
+        DeprecationWarning (the attribute stays :attr:`size`).
     realtime : bool
         Play the recording at its own pace, as a live camera would deliver it: each read waits
         for the next pair's time, and gives the newest pair whose time has come, skipping those
@@ -753,6 +755,7 @@ class BagCamera(PairSource):
         Without the ``rosbags`` package.
     """
 
+    @renamed_keyword("size", "image_size")
     def __init__(
         self,
         path: str | os.PathLike[str],
@@ -760,7 +763,7 @@ class BagCamera(PairSource):
         left_topic: str | None = None,
         right_topic: str | None = None,
         max_skew_ms: float | None = None,
-        size: tuple[int, int] | str | None = None,
+        image_size: tuple[int, int] | str | None = None,
         realtime: bool = False,
     ) -> None:
         from stereovision.capture import parse_size
@@ -774,7 +777,7 @@ class BagCamera(PairSource):
             raise ValueError("give both the left and the right topic, or neither")
         if max_skew_ms is not None and not (math.isfinite(max_skew_ms) and max_skew_ms >= 0):
             raise ValueError(f"max_skew_ms: expected a number >= 0, got {max_skew_ms!r}")
-        self.requested_size = parse_size(size)
+        self.requested_size = parse_size(image_size)
         try:
             reader = _open_reader(self.path)
         except ImportError:

@@ -488,7 +488,7 @@ def open_stereo_source(
         return VideoPair(left, right, size)
     code = parse_fourcc(fourcc)
     files = isinstance(left, str) and isinstance(right, str)
-    return _CaptureAdapter(lambda: StereoCamera(left, right, size=size, fourcc=code), files)
+    return _CaptureAdapter(lambda: StereoCamera(left, right, image_size=size, fourcc=code), files)
 
 
 def scale_pair(
