@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 import synthetic_scene as syn
 
+import stereovision
 from stereovision import export
 from stereovision.baselines import row_fill
 from stereovision.calibration import Calibration
@@ -49,7 +50,7 @@ class Rename:
     func: Callable[..., Any]
     old: str
     new: str
-    value: Callable[[], Any]
+    value: Callable[[Path], Any]  # given a folder of the test's own
     # the other positional arguments, given a folder of the test's own
     args: Callable[[Path], tuple[Any, ...]] = lambda _: ()
     kwargs: dict[str, Any] = field(default_factory=dict)
@@ -107,6 +108,29 @@ def _same_camera(a: Any, b: Any) -> None:
         _same(fa.right, fb.right)
 
 
+def _written(name: str, text: str) -> Callable[[Path], Path]:
+    """A file ``name`` of ``text`` in the test's folder."""
+
+    def write(folder: Path) -> Path:
+        (folder / name).write_text(text)
+        return folder / name
+
+    return write
+
+
+_P2 = "7.2e+02 0 6.1e+02 4.5e+01 0 7.2e+02 1.7e+02 0 0 0 1 0"
+_P3 = "7.2e+02 0 6.1e+02 -3.6e+02 0 7.2e+02 1.7e+02 0 0 0 1 0"
+_CAM = (
+    "  camera_model: pinhole\n  distortion_coeffs: [-0.1, 0.05, 0.001, 0.0]\n"
+    "  distortion_model: radtan\n  intrinsics: [500.0, 500.0, 320.0, 240.0]\n"
+    "  resolution: [640, 480]\n"
+)
+_CAMCHAIN = (
+    f"cam0:\n{_CAM}cam1:\n  T_cn_cnm1:\n  - [1.0, 0.0, 0.0, -0.12]\n  - [0.0, 1.0, 0.0, 0.0]\n"
+    f"  - [0.0, 0.0, 1.0, 0.0]\n  - [0.0, 0.0, 0.0, 1.0]\n{_CAM}"
+)
+
+
 def _same_files(a: dict[str, Path], b: dict[str, Path]) -> None:
     """Two ``{name: path}`` of files written: the same names, the same contents."""
     assert a.keys() == b.keys() and a
@@ -140,12 +164,12 @@ def _same(a: Any, b: Any) -> None:
 
 RENAMES = [
     # ground truth: gt (as dense_metrics, sparse_metrics, count_at_precision, io.Scene.gt)
-    Rename(gt_depth, "gt_disp", "gt", lambda: _GT_DISP, kwargs={"calib": _calib()}),
-    Rename(depth_metrics, "depth_gt", "gt", lambda: _GT_DEPTH, lambda _: (_DEPTH,)),
-    Rename(table1_report, "depth_gt", "gt", lambda: _GT_DEPTH, lambda _: (_DEPTH,)),
+    Rename(gt_depth, "gt_disp", "gt", lambda _: _GT_DISP, kwargs={"calib": _calib()}),
+    Rename(depth_metrics, "depth_gt", "gt", lambda _: _GT_DEPTH, lambda _: (_DEPTH,)),
+    Rename(table1_report, "depth_gt", "gt", lambda _: _GT_DEPTH, lambda _: (_DEPTH,)),
     # an estimate is named by its quantity (as dense_metrics' disparity): depth
-    Rename(depth_metrics, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
-    Rename(table1_report, "depth_est", "depth", lambda: _DEPTH, kwargs={"gt": _GT_DEPTH}),
+    Rename(depth_metrics, "depth_est", "depth", lambda _: _DEPTH, kwargs={"gt": _GT_DEPTH}),
+    Rename(table1_report, "depth_est", "depth", lambda _: _DEPTH, kwargs={"gt": _GT_DEPTH}),
     # a folder to write in: directory (as Calibration.save_ros, CalibrationReport.write,
     # capture.capture, OccupancyGrid.save)
     Rename(
@@ -162,29 +186,67 @@ RENAMES = [
         StereoCamera,
         "size",
         "image_size",
-        lambda: "160x120",
+        lambda _: "160x120",
         lambda _: (_Cap(), _Cap()),
         same=_same_camera,
     ),
-    Rename(BagCamera, "size", "image_size", lambda: (80, 60), _bag, same=_same_camera),
+    Rename(BagCamera, "size", "image_size", lambda _: (80, 60), _bag, same=_same_camera),
+    # a file to read: path (as Calibration.from_file, Calibration.load, Matches.from_csv,
+    # BagCamera, io.imread, export.read_depth_png)
+    Rename(
+        Calibration.from_middlebury,
+        "calib_txt",
+        "path",
+        lambda _: Path(stereovision.__file__).parent / "data" / "cones" / "calib.txt",
+        called="Calibration.from_middlebury",
+    ),
+    Rename(
+        Calibration.from_q,
+        "q_file",
+        "path",
+        _written("Q.dat", "1 0 0 -32\n0 1 0 -24\n0 0 0 50\n0 0 10 0\n"),
+        kwargs={"image_size": (64, 48)},
+        called="Calibration.from_q",
+    ),
+    Rename(
+        Calibration.from_kitti,
+        "calib_file",
+        "path",
+        _written("000000.txt", f"P0: {_P2}\nP1: {_P3}\nP2: {_P2}\nP3: {_P3}\n"),
+        kwargs={"image_size": (1242, 375)},
+        called="Calibration.from_kitti",
+    ),
+    Rename(
+        Calibration.from_kalibr,
+        "camchain",
+        "path",
+        _written("camchain.yaml", _CAMCHAIN),
+        called="Calibration.from_kalibr",
+    ),
     # a bound in pixels: tolerance (as check_rectification, refine_rectification and
     # RectificationCheck.tolerance; triangulate's solver tol, with max_iter, stays scipy's)
     Rename(
         count_at_precision,
         "tol",
         "tolerance",
-        lambda: 3.0,
+        lambda _: 3.0,
         lambda _: ([1.0, 2.0, 3.0, 0.0], [0.0, 1.0, 1.0, 0.0], [0.5, -1.0, 2.5, -1.9]),
         {"score": [4.0, 3.0, 2.0, 1.0], "gt": _GT_DISP, "target": 100.0},
     ),
     # an image: image (as find_corners, noise_sigma, fill_planes, interest_points)
-    Rename(gabor_responses, "img", "image", lambda: _IMAGE / np.float32(255), kwargs={"freq": 0.2}),
-    # disparity: disparity (as depth_from_disparity, dense_metrics, DepthResult.disparity)
-    Rename(row_fill, "disp", "disparity", lambda: _DISP),
-    Rename(fill_planes, "disp", "disparity", lambda: _HOLED, kwargs={"image": _IMAGE}),
-    Rename(side_fill, "disp", "disparity", lambda: _HOLED, kwargs={"image": _IMAGE}),
     Rename(
-        plane_fill, "disp", "disparity", lambda: _HOLED, kwargs={"labels": np.zeros((30, 40), int)}
+        gabor_responses, "img", "image", lambda _: _IMAGE / np.float32(255), kwargs={"freq": 0.2}
+    ),
+    # disparity: disparity (as depth_from_disparity, dense_metrics, DepthResult.disparity)
+    Rename(row_fill, "disp", "disparity", lambda _: _DISP),
+    Rename(fill_planes, "disp", "disparity", lambda _: _HOLED, kwargs={"image": _IMAGE}),
+    Rename(side_fill, "disp", "disparity", lambda _: _HOLED, kwargs={"image": _IMAGE}),
+    Rename(
+        plane_fill,
+        "disp",
+        "disparity",
+        lambda _: _HOLED,
+        kwargs={"labels": np.zeros((30, 40), int)},
     ),
 ]
 
@@ -192,7 +254,7 @@ RENAMES = [
 @pytest.mark.parametrize("case", RENAMES, ids=str)
 def test_old_keyword_warns_and_gives_the_same_value(case: Rename, tmp_path: Path) -> None:
     def value(which: str) -> Any:
-        return tmp_path / which if case.folder else case.value()
+        return tmp_path / which if case.folder else case.value(tmp_path)
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -211,7 +273,7 @@ def test_old_keyword_warns_and_gives_the_same_value(case: Rename, tmp_path: Path
 @pytest.mark.parametrize("case", RENAMES, ids=str)
 def test_old_and_new_keyword_together_is_a_type_error(case: Rename, tmp_path: Path) -> None:
     name = case.called or case.func.__name__
-    value = tmp_path / "out" if case.folder else case.value()
+    value = tmp_path / "out" if case.folder else case.value(tmp_path)
     args = case.args(tmp_path)
     before = sorted(tmp_path.rglob("*"))
     both = {case.new: value, case.old: value}

@@ -1532,7 +1532,8 @@ class Calibration:
         )
 
     @classmethod
-    def from_middlebury(cls, calib_txt: PathLike) -> Calibration:
+    @renamed_keyword("calib_txt", "path")
+    def from_middlebury(cls, path: PathLike) -> Calibration:
         """Rectified calibration from a Middlebury ``calib.txt``.
 
         ``cam0``/``cam1`` give K1/K2, ``baseline`` (mm) gives ``T = (-baseline, 0, 0)``,
@@ -1541,8 +1542,9 @@ class Calibration:
 
         Parameters
         ----------
-        calib_txt : str or os.PathLike
+        path : str or os.PathLike
             The Middlebury ``calib.txt``.
+            The keyword ``calib_txt=``, its former name, still works, with a DeprecationWarning.
 
         Returns
         -------
@@ -1556,7 +1558,7 @@ class Calibration:
         ValueError
             If a key is missing (named) or a value is invalid.
         """
-        p, _ = cls._read_text(calib_txt)
+        p, _ = cls._read_text(path)
         v = parse_middlebury_calib(p)
         for key in ("cam0", "cam1", "baseline", "width", "height"):
             if key not in v:
@@ -1578,7 +1580,8 @@ class Calibration:
         )
 
     @classmethod
-    def from_q(cls, q_file: PathLike, image_size: tuple[int, int], unit: str = "m") -> Calibration:
+    @renamed_keyword("q_file", "path")
+    def from_q(cls, path: PathLike, image_size: tuple[int, int], unit: str = "m") -> Calibration:
         """Rectified calibration from a ``Q.dat``: OpenCV's 4x4 disparity-to-depth matrix.
 
         The text file holds the 16 numbers of ``Q`` (``cv2.stereoRectify``'s output, as in
@@ -1600,8 +1603,9 @@ class Calibration:
 
         Parameters
         ----------
-        q_file : str or os.PathLike
+        path : str or os.PathLike
             The ``Q.dat`` file.
+            The keyword ``q_file=``, its former name, still works, with a DeprecationWarning.
         image_size : tuple of int
             ``(width, height)`` of the images it belongs to (``Q`` does not say).
         unit : str, optional
@@ -1619,7 +1623,7 @@ class Calibration:
         ValueError
             If it does not hold 16 finite numbers of that form (the offending entry named).
         """
-        p, text = cls._read_text(q_file)
+        p, text = cls._read_text(path)
         try:
             q = np.array([float(t) for t in text.split()], dtype=np.float64)
         except ValueError:
@@ -1664,9 +1668,8 @@ class Calibration:
         )
 
     @classmethod
-    def from_kitti(
-        cls, calib_file: PathLike, image_size: tuple[int, int] | None = None
-    ) -> Calibration:
+    @renamed_keyword("calib_file", "path")
+    def from_kitti(cls, path: PathLike, image_size: tuple[int, int] | None = None) -> Calibration:
         """Rectified calibration of KITTI's colour pair (cameras 2 and 3), metres.
 
         Reads ``P_rect_02``/``P_rect_03`` (raw ``calib_cam_to_cam.txt``, also when each matrix
@@ -1680,8 +1683,9 @@ class Calibration:
 
         Parameters
         ----------
-        calib_file : str or os.PathLike
+        path : str or os.PathLike
             KITTI's ``calib_cam_to_cam.txt`` or an object/odometry ``calib`` file.
+            The keyword ``calib_file=``, its former name, still works, with a DeprecationWarning.
         image_size : tuple of int, optional
             ``(width, height)``, used when the file has no ``S_rect_02``; else a check: a
             file of another size is refused.
@@ -1699,7 +1703,7 @@ class Calibration:
             If the projection matrices or the image size are missing, or ``image_size``
             contradicts ``S_rect_02``.
         """
-        p, _ = cls._read_text(calib_file)
+        p, _ = cls._read_text(path)
         v = parse_kitti_calib(p)
         for k2, k3 in (("P_rect_02", "P_rect_03"), ("P2", "P3")):
             if k2 in v and k3 in v:
@@ -1864,8 +1868,9 @@ class Calibration:
         )
 
     @classmethod
+    @renamed_keyword("camchain", "path")
     def from_kalibr(
-        cls, camchain: PathLike, cameras: tuple[str, str] = ("cam0", "cam1")
+        cls, path: PathLike, cameras: tuple[str, str] = ("cam0", "cam1")
     ) -> Calibration:
         """A rig from Kalibr's ``camchain.yaml`` (or ``camchain-imucam.yaml``), metres.
 
@@ -1878,8 +1883,9 @@ class Calibration:
 
         Parameters
         ----------
-        camchain : str or os.PathLike
+        path : str or os.PathLike
             The YAML file.
+            The keyword ``camchain=``, its former name, still works, with a DeprecationWarning.
         cameras : tuple of str
             The left and right camera's keys (the left one earlier in the chain).
 
@@ -1900,7 +1906,7 @@ class Calibration:
         """
         import yaml
 
-        p, text = cls._read_text(camchain)
+        p, text = cls._read_text(path)
         try:
             doc = yaml.safe_load(text)
         except yaml.YAMLError as exc:
