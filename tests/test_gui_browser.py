@@ -1987,7 +1987,7 @@ def test_open_cameras_asks_the_chosen_pixel_format(data_dir, monkeypatch):
     frame = cv2.imread(str(data_dir / "middlebury2001" / "venus" / "left.png"))
 
     class Cameras:
-        def __init__(self, left, right, *, size=None, fourcc=None):
+        def __init__(self, left, right, *, image_size=None, fourcc=None):
             asked.append(fourcc)
 
         def read(self):
