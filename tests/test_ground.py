@@ -283,6 +283,23 @@ def test_no_floor_no_plane() -> None:
     assert fit_ground_plane(sparse, RIG) is None
 
 
+def test_a_map_of_noise_at_a_low_focal_length_is_no_floor() -> None:
+    """Below GROUND_FOCAL_PX the points below a plane count against it, and on a map of noise
+    (a camera seeing nothing it could match) every candidate plane scored below 0: none was
+    within NEAR_BEST of the best, and the fit raised 'max() arg is an empty sequence'. Noise
+    holds no floor: None, at f = 60, 100 and 150 px."""
+    size = (320, 240)
+    for f in (60.0, 100.0, 150.0):
+        k = [[f, 0, 159.5], [0, f, 119.5], [0, 0, 1]]
+        rig = Calibration(
+            K1=k, D1=np.zeros(5), K2=k, D2=np.zeros(5), R=np.eye(3), T=[-0.12, 0, 0],
+            image_size=size, rectified=True,
+        )  # fmt: skip
+        for seed in range(3):
+            noise = np.random.default_rng(seed).uniform(1.0, 20.0, (size[1], size[0]))
+            assert fit_ground_plane(noise, rig) is None, (f, seed)
+
+
 def test_a_floor_seen_along_a_line_is_no_plane() -> None:
     """One row of a floor fixes the plane along that row only: any plane through it fits it
     exactly. The fit returned one (row 300 of this 800 x 360 rig: the camera 2.32 m above it,

@@ -516,7 +516,10 @@ def _select_floor(
     if not cands:
         return None
     top = max(c[0] for c in cands)
-    strong = [c for c in cands if c[0] >= NEAR_BEST * top]
+    # within (1 - NEAR_BEST) of the best score: NEAR_BEST * top alone kept none when every score
+    # was negative (more points below each plane than on it, weighted: a noisy map at f << 320)
+    bound = NEAR_BEST * top if top >= 0 else (2 - NEAR_BEST) * top
+    strong = [c for c in cands if c[0] >= bound]
     # a plane the tilt cone stopped is the cone's, not the data's: the others first
     strong = [c for c in strong if not c[5]] or strong
     floor = max(strong, key=lambda c: c[0])
