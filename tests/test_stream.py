@@ -1116,3 +1116,19 @@ def test_run_streams_usage_errors_come_before_the_first_grab(data_dir: Path) -> 
         with cam, pytest.raises(ValueError) as err:
             run_stream(cam, calib, max_disparity=16, **kw)
         assert str(err.value) == said and cam.count == 0
+
+
+def test_an_unknown_method_is_refused_before_the_first_grab(data_dir: Path) -> None:
+    """run_stream left the method to depth_map, on the first pair: an unknown one took a pair
+    off the camera first (read ahead with a calibration, grabbed by the pipeline without), and
+    a camera with no frame said that instead. It is refused before any grab now."""
+    calib = Calibration.from_file(data_dir / SCENE / "calib.txt")
+    img = cv2.imread(str(data_dir / SCENE / "left.png"))
+    for rig in (calib, None):
+        cam = StereoCamera(_ModeCap([img]), _ModeCap([img]))
+        with cam, pytest.raises(ValueError) as err:
+            run_stream(cam, rig, max_disparity=16, method="bogus")
+        assert (
+            str(err.value) == ("unknown method 'bogus': expected one of fused, gabor, census, fast")
+            and cam.count == 0
+        ), rig

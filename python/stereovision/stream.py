@@ -710,9 +710,10 @@ def run_stream(
         (a frame that does not decode or of another shape) ends the stream instead: the pairs
         done are reported, with ``ended`` ``"source failed"`` and the error in ``error``.
     ValueError
-        If ``frames`` is not positive, or the calibration does not fit the frames.
+        If ``frames`` is not positive, ``method`` is unknown (before any grab), or the
+        calibration does not fit the frames.
     """
-    from stereovision.depth import depth_map, estimate_max_disparity
+    from stereovision.depth import METHODS, depth_map, estimate_max_disparity
 
     if frames is not None and frames <= 0:
         raise ValueError(f"frames: expected a positive number, got {frames}")
@@ -723,6 +724,8 @@ def run_stream(
     if max_disparity is not None and max_disparity <= 0:
         raise ValueError(f"max_disparity: expected a positive number, got {max_disparity}")
     # usage errors before the first grab (the read ahead below takes a pair off the camera)
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
     if check_every is not None and (isinstance(check_every, bool) or check_every <= 0):
         raise ValueError(f"check_every: expected a positive number of pairs, got {check_every}")
     if ground_every is not None:
