@@ -225,6 +225,29 @@ def test_zero_pose_render_reproduces_left_image(result, mesh):
     assert err < 0.5 * err_shifted
 
 
+def test_a_camera_state_renders_the_view_it_was_read_from(result, mesh):
+    """:class:`render.CameraState` (the GUI's view as the mouse left it, for render.png): read
+    back from a camera the controls placed, it renders their picture; turned, another one."""
+    intr = render.Intrinsics.from_result(result)
+    controls = CameraControls(yaw=8.0, pitch=-4.0, right=0.05)
+    plotter = render.make_plotter((intr.width, intr.height))
+    try:
+        render.add_geometry(plotter, mesh)
+        render.apply_camera(plotter, controls, intrinsics=intr, focal_distance=1.0)
+        state = render.CameraState.of(plotter.camera)
+        plotter.camera.Azimuth(20.0)
+        turned = render.CameraState.of(plotter.camera)
+    finally:
+        plotter.close()
+    assert state.same_view(state) and not state.same_view(turned)
+    posed = render.render_view(mesh, controls, intrinsics=intr).astype(np.int16)
+    again = render.render_view(mesh, intrinsics=intr, camera=state)
+    assert np.abs(again - posed).mean() < 0.5
+    assert np.abs(render.render_view(mesh, intrinsics=intr, camera=turned) - posed).mean() > 10.0
+    with pytest.raises(ValueError, match="give controls or camera, not both"):
+        render.render_view(mesh, controls, camera=state)
+
+
 def test_render_outputs_and_rotated_view_differ(result, tmp_path):
     written = render.render_outputs(result, tmp_path)
     assert set(written) == {"render.png"}

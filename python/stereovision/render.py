@@ -43,6 +43,7 @@ __all__ = [
     "DEFAULT_FOV_DEG",
     "MAX_RELATIVE_DEPTH_JUMP",
     "CameraControls",
+    "CameraState",
     "apply_camera",
     "camera_pose",
     "display_subset",
@@ -371,6 +372,90 @@ def pose_from_camera(camera: Any) -> npt.NDArray[np.float64]:
     return pose
 
 
+@dataclass(frozen=True)
+class CameraState:
+    """A VTK camera's view as it stands: where it is, what it looks at, which way is up, how
+    wide it sees and where its image centre is. It holds what the mouse changes in an
+    interactive view (which :class:`CameraControls` does not follow), so that the view can be
+    rendered again elsewhere (:func:`render_view`).
+
+    Attributes
+    ----------
+    position, focal_point, up : tuple of float
+        Metres, left camera frame (``up``: the view-up direction).
+    view_angle : float
+        Vertical field of view, degrees.
+    window_center : tuple of float
+        VTK's window centre (the principal point's shift, :func:`apply_camera`).
+    """
+
+    position: tuple[float, float, float]
+    focal_point: tuple[float, float, float]
+    up: tuple[float, float, float]
+    view_angle: float
+    window_center: tuple[float, float] = (0.0, 0.0)
+
+    @classmethod
+    def of(cls, camera: Any) -> CameraState:
+        """The state of a pyvista / VTK ``camera`` now.
+
+        Parameters
+        ----------
+        camera : pyvista.Camera or vtkCamera
+
+        Returns
+        -------
+        CameraState
+        """
+
+        def floats(values: Any) -> tuple[float, ...]:
+            return tuple(float(v) for v in values)
+
+        return cls(
+            floats(camera.GetPosition()),  # type: ignore[arg-type]
+            floats(camera.GetFocalPoint()),  # type: ignore[arg-type]
+            floats(camera.GetViewUp()),  # type: ignore[arg-type]
+            float(camera.GetViewAngle()),
+            floats(camera.GetWindowCenter()),  # type: ignore[arg-type]
+        )
+
+    def same_view(self, other: CameraState, tol: float = 1e-9) -> bool:
+        """Whether ``other`` is this view (each number within ``tol`` of this one's, relative
+        to its size).
+
+        Returns
+        -------
+        bool
+        """
+        return bool(np.allclose(self._numbers(), other._numbers(), rtol=tol, atol=tol))
+
+    def _numbers(self) -> npt.NDArray[np.float64]:
+        return np.array(
+            [*self.position, *self.focal_point, *self.up, self.view_angle, *self.window_center]
+        )
+
+    def apply(self, plotter: pv.Plotter, points: npt.ArrayLike | None = None) -> None:
+        """Give ``plotter``'s camera this view.
+
+        Parameters
+        ----------
+        plotter : pyvista.Plotter
+        points : array_like (N, 3), optional
+            The scene's points, for a robust clipping range (as :func:`apply_camera`).
+        """
+        cam = plotter.camera
+        cam.position = self.position
+        cam.focal_point = self.focal_point
+        cam.up = self.up
+        cam.view_angle = self.view_angle
+        cam.SetWindowCenter(*self.window_center)
+        if points is not None:
+            cam.clipping_range = robust_clipping_range(points, self.position)
+        else:
+            plotter.reset_camera_clipping_range()
+        plotter.camera_set = True
+
+
 # ----------------------------------------------------------------------------- geometry
 
 
@@ -657,8 +742,9 @@ def render_view(
     *,
     intrinsics: Intrinsics | None = None,
     size: tuple[int, int] | None = None,
+    camera: CameraState | None = None,
 ) -> npt.NDArray[np.uint8]:
-    """Render ``geometry`` offscreen from the camera of ``controls``.
+    """Render ``geometry`` offscreen from the camera of ``controls`` (or ``camera``).
 
     Parameters
     ----------
@@ -671,12 +757,23 @@ def render_view(
         size. Without intrinsics a :data:`DEFAULT_FOV_DEG` view of ``size`` (default 800x600).
     size : (int, int), optional
         ``(width, height)`` of the picture; with intrinsics they are scaled to fit it.
+    camera : CameraState, optional
+        A view to render instead of the controls' pose (an interactive view's camera as the
+        mouse left it): its position, focal point, view-up, view angle and window centre;
+        ``intrinsics`` then give only the picture's size.
 
     Returns
     -------
     ndarray, uint8 (height, width, 3)
         RGB screenshot.
+
+    Raises
+    ------
+    ValueError
+        Both ``controls`` and ``camera`` given.
     """
+    if camera is not None and controls is not None:
+        raise ValueError("render_view: give controls or camera, not both")
     controls = controls or CameraControls()
     if intrinsics is not None:
         if size is not None:
@@ -686,13 +783,16 @@ def render_view(
     plotter = make_plotter(size)
     try:
         add_geometry(plotter, geometry)
-        apply_camera(
-            plotter,
-            controls,
-            intrinsics=intrinsics,
-            focal_distance=median_depth(geometry),
-            points=geometry.points,
-        )
+        if camera is not None:
+            camera.apply(plotter, points=geometry.points)
+        else:
+            apply_camera(
+                plotter,
+                controls,
+                intrinsics=intrinsics,
+                focal_distance=median_depth(geometry),
+                points=geometry.points,
+            )
         img = plotter.screenshot(return_img=True)
     finally:
         plotter.close()
