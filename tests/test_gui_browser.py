@@ -1428,6 +1428,54 @@ def test_save_writes_render_png_of_the_3d_view_from_the_sliders_pose(tmp_path, m
     assert sorted(p.name for p in (tmp_path / "nocalib-out").iterdir()) == sorted(SAVED_FILES)
 
 
+def test_save_renders_the_3d_view_as_the_mouse_left_it(tmp_path):
+    """render.png was the view from the sliders' pose even after the view was dragged with the
+    mouse (the sliders do not follow it): not what the page showed. The page's view is rendered
+    on the server, whose camera the mouse moves: render.png is now that camera's view, said in
+    the Save's line, until a slider puts the view back on the sliders' pose."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-save-mouse", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.yaw = 10.0
+    app._on_controls()
+    view = app.view
+    posed = render.render_view(
+        view.mesh, render.CameraControls(yaw=10.0), intrinsics=view.intrinsics
+    )
+    # what the trackball style does on a drag: turn about the focal point
+    cam = app.plotter.camera
+    cam.Azimuth(-25.0)
+    cam.Elevation(12.0)
+    cam.OrthogonalizeViewUp()
+    dragged = render.CameraState.of(cam)
+    app.state.save_dir = "dragged"
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.endswith(
+        ", overview.png, render.png (render.png: the 3-D view as the mouse left it, not the "
+        "sliders' pose)"
+    )
+    png = cv2.imread(str(tmp_path / "dragged" / "render.png"))[..., ::-1].astype(np.int16)
+    assert png.shape == (375, 450, 3)
+    expected = render.render_view(view.mesh, intrinsics=view.intrinsics, camera=dragged)
+    assert np.abs(png - expected).mean() < 1.0
+    assert np.abs(png - posed).mean() > 10.0
+    # a slider moved after the drag: the view is on the sliders' pose again, and render.png
+    app.state.yaw = 5.0
+    app._on_controls()
+    app.state.save_dir = "slid"
+    _run(app, app.save)
+    assert app.state.save_label.endswith(", overview.png, render.png")
+    png = cv2.imread(str(tmp_path / "slid" / "render.png"))[..., ::-1].astype(np.int16)
+    expected = render.render_view(
+        view.mesh, render.CameraControls(yaw=5.0), intrinsics=view.intrinsics
+    )
+    assert np.abs(png - expected).mean() < 1.0
+
+
 def test_the_save_field_shows_the_data_folder_short_and_saves_where_it_says(tmp_path, monkeypatch):
     """The save field showed the --data folder's absolute path (the README's picture: a
     temporary /tmp/sv-.../scenes/saved). It shows it relative to the current directory when
@@ -2864,6 +2912,74 @@ def test_save_units_range_and_colour_keys_on_the_page(page, gui_data):
     page.click("#save-btn")
     assert "nothing was overwritten" in _wait_error(page, "already holds")
     page.click("#error-alert button")
+
+
+def _steady_view(pg, unlike: np.ndarray | None = None) -> np.ndarray:
+    """The 3-D view once its frames stop changing (and, with ``unlike``, differ from it)."""
+    deadline = time.monotonic() + PAGE_TIMEOUT_MS / 1000
+    last = _view_image(pg)
+    while time.monotonic() < deadline:
+        shot = _view_image(pg)
+        moved = unlike is None or np.abs(shot - unlike).mean() > VIEW_CHANGE
+        drawn = shot.std() > 20  # the scene, not the empty view before the first frame
+        if drawn and moved and shot.shape == last.shape and np.abs(shot - last).mean() < 0.5:
+            return shot
+        last = shot
+    raise AssertionError("the 3-D view did not settle")
+
+
+def _saved_render(pg, folder: Path) -> np.ndarray:
+    """Save into ``folder`` (typed) and read its render.png (BGR, int16)."""
+    pg.fill("#save-dir", str(folder))
+    pg.click("#save-btn")
+    pg.wait_for_function(
+        "document.querySelector('#save-label')?.textContent.includes("
+        + repr(f"/{folder.name}: ")
+        + ")"
+    )
+    png = cv2.imread(str(folder / "render.png"))
+    assert png is not None, pg.inner_text("#save-label")
+    return png.astype(np.int16)
+
+
+def test_save_renders_the_3d_view_as_dragged_with_the_mouse(page, gui_data):
+    """render.png was the sliders' pose after the user dragged the 3-D view with the mouse: not
+    the view the page showed. It is now the view as dragged (the server's camera, which the
+    mouse moves): like the page's view, unlike the sliders' pose."""
+    # (the status may be the error of the test before, the second Save refused: not waited for)
+    page.wait_for_function("Number(document.querySelector('#computations')?.textContent) >= 1")
+    page.click("#reset-camera")
+    page.wait_for_function(
+        "document.querySelector('#slider-yaw .slider-value')?.textContent.trim() === '0°'"
+    )
+    page.wait_for_function(
+        "[...document.querySelectorAll('#view-3d img')].some(i => i.src && i.naturalWidth > 0)"
+    )
+    before = _steady_view(page)
+    posed = _saved_render(page, gui_data / "posed")
+    assert "mouse" not in page.inner_text("#save-label")
+    box = page.locator("#view-3d").bounding_box()
+    assert box is not None
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x + box["width"] / 10, y + box["height"] / 20, steps=10)  # about 20°
+    page.mouse.up()
+    after = _steady_view(page, unlike=before)
+    dragged = _saved_render(page, gui_data / "dragged")
+    assert "as the mouse left it" in page.inner_text("#save-label")
+    assert np.abs(dragged - posed).mean() > 10.0
+
+    def like(shot: np.ndarray, png: np.ndarray) -> float:
+        h, w = png.shape[:2]
+        return float(np.abs(cv2.resize(shot, (w, h), interpolation=cv2.INTER_AREA) - png).mean())
+
+    # the page's view (the server's camera) like the render of its camera, the sliders' pose
+    # unlike it; before the drag the other way round (about 8 and 10 here against 50)
+    assert like(after, dragged) < 0.5 * like(after, posed)
+    assert like(before, posed) < 0.5 * like(before, dragged)
+    _shot(page, "gui-dragged.png")
+    page.click("#reset-camera")
 
 
 def test_a_wide_scene_is_shown_whole_in_the_3d_view(page, gui_data):

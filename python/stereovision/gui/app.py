@@ -226,6 +226,9 @@ _RESULT_KEYS = (
 PENDING_3D = "computing the new pair: the 3-D view still shows the previous one"
 #: What Find floor says while a new pair computes (the depth on hand is the previous pair's).
 PENDING_FLOOR = "the new pair is being computed: find its floor once its depth is shown"
+#: What Save adds when render.png is the 3-D view as the mouse left it (the sliders' pose
+#: is another).
+MOUSE_RENDER = "render.png: the 3-D view as the mouse left it, not the sliders' pose"
 #: What Save says while a new pair computes.
 PENDING_SAVE = "the new pair is being computed: save it once its results are shown"
 
@@ -1142,6 +1145,10 @@ class StereoApp:
         self.plotter = make_plotter((640, 480))
         self._remote_view: Any = None
         self._clip_tag: int | None = None
+        #: The 3-D view's camera as the sliders last placed it: the mouse moves the view's
+        #: camera on the server (the page's view is rendered there), not the sliders, so a
+        #: camera that differs from it is one the mouse moved (None: not placed yet).
+        self._slider_camera: Any = None
         from stereovision.gui import bundled_data_dir
 
         # "Save" writes only inside the --data folders (not into the installed package's data)
@@ -1919,7 +1926,8 @@ class StereoApp:
         """Write the pair on show as ``stereovision depth -o`` does (its writers and file names:
         disparity PNG and PFM, depth PNGs and .npy, cloud.ply, ``overview.png``, its depth
         bar in the page's unit and its title naming the pair as the page does, and
-        ``render.png``, the 3-D view from the pose the sliders set: :meth:`_render_for_save`)
+        ``render.png``, the 3-D view as the page shows it: from the pose the sliders set, or
+        from its camera as the mouse left it, said in the Save's line: :meth:`_render_for_save`)
         into the page's save folder.
 
         A render that fails (or a pair with no 3-D point to render) is said in the Save's line
@@ -1970,10 +1978,11 @@ class StereoApp:
 
         # The 3-D view rendered here, in the thread that renders the page's view (VTK's
         # windows are not to be used from two threads); a failure is said after the files.
-        image, no_render = None, ""
+        image, no_render, mouse_camera = None, "", None
         if result.depth is not None:
+            mouse_camera = self._mouse_camera()
             try:
-                image = self._render_for_save(view)
+                image = self._render_for_save(view, mouse_camera)
             except (ValueError, RuntimeError, MemoryError) as exc:
                 no_render = f"render.png not written: {first_line(exc)}"
 
@@ -1998,6 +2007,8 @@ class StereoApp:
             without = " (no calibration: disparity only; no depth, cloud.ply or render.png)"
         else:
             without = f" ({no_render})" if no_render else ""
+            if mouse_camera is not None and not no_render:
+                without += f" ({MOUSE_RENDER})"
         if skipped:
             links = ", ".join(skipped)
             without += f" ({links}: a symbolic link, not a folder of --data: left alone)"
@@ -2006,10 +2017,21 @@ class StereoApp:
             # the lists offer what was just written: its cloud.ply to Show in the 3-D view
             self._refresh_file_lists()
 
-    def _render_for_save(self, view: ViewData) -> npt.NDArray[np.uint8]:
+    def _render_for_save(self, view: ViewData, camera: Any = None) -> npt.NDArray[np.uint8]:
         """``render.png`` of the pair on show: its 3-D view (the surface, or points in the
-        points mode or for a sparse method) from the pose the sliders set, through the pair's
+        points mode or for a sparse method) from the pose the sliders set, or from ``camera``
+        (the view's camera as the mouse left it, :meth:`_mouse_camera`), through the pair's
         intrinsics at most :data:`~stereovision.render.RENDER_MAX_SIDE` pixels wide or high.
+
+        It rendered the sliders' pose after the view was dragged with the mouse (the sliders
+        do not follow the mouse): not the view the page showed.
+
+        Parameters
+        ----------
+        view : ViewData
+            The pair on show.
+        camera : stereovision.render.CameraState, optional
+            The view to render instead of the sliders' pose.
 
         Returns
         -------
@@ -2032,6 +2054,8 @@ class StereoApp:
         if view.matches is None and self.state.view_mode == "points":
             geometry = shown_cloud(res.points, res.colors)[0]
         scale = min(1.0, RENDER_MAX_SIDE / max(intr.width, intr.height))
+        if camera is not None:
+            return render_view(geometry, intrinsics=intr.scaled(scale), camera=camera)
         return render_view(geometry, self._controls(), intrinsics=intr.scaled(scale))
 
     def _next_save_folder(self, skipped: list[str] | None = None) -> Path:
@@ -2176,7 +2200,30 @@ class StereoApp:
             intrinsics=getattr(self, "_intrinsics", None),
             focal_distance=getattr(self, "_focal", 1.0),
         )
+        from stereovision.render import CameraState
+
+        self._slider_camera = CameraState.of(self.plotter.camera)
         self._update_view()
+
+    def _mouse_camera(self) -> Any:
+        """The 3-D view's camera when the mouse moved it away from the sliders' pose, else
+        None.
+
+        The page's view is rendered on the server (``plotter_ui(mode="server")``): the mouse's
+        events drive this plotter's camera, which is therefore the view the page shows. The
+        sliders do not follow the mouse; the next slider change puts the view back on their
+        pose (:meth:`_apply_camera`).
+
+        Returns
+        -------
+        stereovision.render.CameraState or None
+        """
+        from stereovision.render import CameraState
+
+        now = CameraState.of(self.plotter.camera)
+        if self._slider_camera is None or now.same_view(self._slider_camera):
+            return None
+        return now
 
     def _update_view(self) -> None:
         if self._remote_view is not None:
