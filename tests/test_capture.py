@@ -131,8 +131,13 @@ def test_video_files_count_order_and_skew(tmp_path: Path) -> None:
     assert all(f.t_right >= f.t_left for f in frames)
     assert all(b.t_left >= a.t_right for a, b in itertools.pairwise(frames))
     assert report["n"] == 12
-    assert report["max_ms"] == pytest.approx(max(f.skew_ms for f in frames))
-    assert 0.0 <= report["mean_ms"] <= report["max_ms"] < 250.0
+    # The skew is the host time between the two grabs, in ms (no wall-clock bound: a loaded
+    # machine may pause between them; speed belongs in benches/).
+    skews = [1000.0 * (f.t_right - f.t_left) for f in frames]
+    assert [f.skew_ms for f in frames] == pytest.approx(skews)
+    assert report["max_ms"] == pytest.approx(max(skews))
+    assert report["mean_ms"] == pytest.approx(sum(skews) / 12)
+    assert 0.0 <= report["mean_ms"] <= report["max_ms"]
 
 
 def test_videos_of_different_rates_drift_apart_once(tmp_path: Path) -> None:
@@ -688,13 +693,18 @@ def test_no_partial_file_visible_to_a_concurrent_reader(tmp_path: Path) -> None:
     checked = {"n": 0}
 
     def reader() -> None:
-        while not stop.is_set():
+        # At least one pass after the last pair is saved: a loaded machine may not run this
+        # thread at all while the 20 pairs are written, and no file checked proves nothing.
+        while True:
+            last = stop.is_set()
             for p in out.glob("*.png"):
                 data = p.read_bytes()
                 decoded = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_COLOR)
                 checked["n"] += 1
                 if decoded is None or decoded.shape != img.shape:
                     bad.append(p.name)
+            if last:
+                return
 
     t = threading.Thread(target=reader)
     t.start()
@@ -704,7 +714,7 @@ def test_no_partial_file_visible_to_a_concurrent_reader(tmp_path: Path) -> None:
     finally:
         stop.set()
         t.join()
-    assert bad == [] and checked["n"] > 0
+    assert bad == [] and checked["n"] >= 40
     assert len(list(out.iterdir())) == 40
 
 
