@@ -75,7 +75,9 @@ def test_stream_json_reports(videos: dict[str, Path], capsys: pytest.CaptureFixt
         assert r["stage_ms"]["fill"] == 0  # the Gabor channel leaves its holes
         # A pair's latency covers at least its own grab and matching.
         assert r["latency_ms"] >= r["stage_ms"]["match"] + r["stage_ms"]["grab"] - 1e-6
-        assert 0 <= r["skew_ms"]["mean"] <= r["skew_ms"]["max"] < 1000
+        # Each pair's skew lies within its grab (no wall-clock bound: speed belongs in benches/).
+        assert 0 <= r["skew_ms"]["mean"] <= r["skew_ms"]["max"]
+        assert r["skew_ms"]["mean"] <= r["stage_ms"]["grab"] + 1e-3
         assert r["max_disparity"] == 64
         assert r["pipelined"] is True
         assert 0.6 < r["density"] <= 1.0  # a real scene: the matcher measures most pixels
@@ -190,7 +192,7 @@ def test_stream_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixtur
 
 def _get(url: str) -> tuple[int, str, bytes]:
     try:
-        with urllib.request.urlopen(url, timeout=5) as r:
+        with urllib.request.urlopen(url, timeout=60) as r:
             return r.status, r.headers["Content-Type"], r.read()
     except urllib.error.HTTPError as e:
         return e.code, e.headers["Content-Type"], e.read()
@@ -223,7 +225,7 @@ def test_frame_server_serves_left_and_disparity() -> None:
         expected = cv2.applyColorMap(np.array([[64]], np.uint8), cv2.COLORMAP_TURBO)[0, 0]
         assert np.abs(img[8:40, 104:120].astype(int) - expected).max() < 16  # 16 / 64 of TURBO
         # The MJPEG stream delivers the same frame as a multipart part.
-        with urllib.request.urlopen(base + "stream.mjpg", timeout=5) as r:
+        with urllib.request.urlopen(base + "stream.mjpg", timeout=60) as r:
             assert r.headers["Content-Type"].startswith("multipart/x-mixed-replace")
             head = r.read(200)
         assert head.startswith(b"--frame\r\nContent-Type: image/jpeg\r\n")
