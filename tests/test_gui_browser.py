@@ -2418,24 +2418,40 @@ def test_draw_sparse_colours_each_match_by_its_value():
 # ----------------------------------------------------------------------------- browser
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
+def _serve(cmd: list[str]) -> tuple[subprocess.Popen, int]:
+    """Start the gui server of ``cmd`` (which passes ``--port 0``); return it and the port it
+    announced. A free port chosen here and passed in could be taken by another program before
+    the server bound it; the system's own choice cannot. Its output is read all along, as a
+    full pipe would stop the server mid-test."""
+    import threading
 
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    lines: list[str] = []
+    port: list[int] = []
+    announced = threading.Event()
 
-def _wait_port(port: int, proc: subprocess.Popen, deadline_s: float) -> None:
-    end = time.monotonic() + deadline_s
-    while time.monotonic() < end:
-        if proc.poll() is not None:
-            raise RuntimeError(
-                f"gui server exited early:\n{proc.stdout.read() if proc.stdout else ''}"
+    def drain() -> None:
+        assert proc.stdout is not None
+        for line in proc.stdout:
+            lines.append(line)
+            m = re.fullmatch(
+                r"stereovision gui on http://127\.0\.0\.1:(\d+)/ \(Ctrl\+C to stop\)\n", line
             )
-        with socket.socket() as s:
-            if s.connect_ex(("127.0.0.1", port)) == 0:
-                return
-        time.sleep(0.1)  # polling a condition, not a fixed delay
-    raise TimeoutError(f"gui server did not listen on {port} within {deadline_s} s")
+            if m and not port:
+                port.append(int(m.group(1)))
+                announced.set()
+        announced.set()  # the server exited
+
+    threading.Thread(target=drain, daemon=True).start()
+    announced.wait(STARTUP_TIMEOUT_S)
+    if not port:
+        proc.kill()
+        proc.wait()
+        raise RuntimeError(
+            f"gui server did not announce its port within {STARTUP_TIMEOUT_S} s "
+            f"(exit {proc.returncode}):\n{''.join(lines)}"
+        )
+    return proc, port[0]
 
 
 def _decode(data_url: str) -> np.ndarray:
@@ -2477,16 +2493,14 @@ def page(gui_data):
     pw = pytest.importorskip("playwright.sync_api")
     if not CHROMIUM.exists():
         pytest.skip("chromium not installed (apt-get install -y chromium)")
-    port = _free_port()
     cmd = [
         sys.executable, "-m", "stereovision.gui",
         "--left", str(gui_data / "left.avi"), "--right", str(gui_data / "right.avi"),
         "--calib", str(gui_data / "calib.txt"), "--data", str(gui_data),
-        "--port", str(port), "--no-browser",
+        "--port", "0", "--no-browser",
     ]  # fmt: skip
-    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc, port = _serve(cmd)
     try:
-        _wait_port(port, proc, STARTUP_TIMEOUT_S)
         with pw.sync_playwright() as p:
             browser = p.chromium.launch(executable_path=str(CHROMIUM), args=CHROMIUM_ARGS)
             pg = browser.new_page(viewport={"width": 1500, "height": 950})
