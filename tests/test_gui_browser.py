@@ -2989,9 +2989,16 @@ def test_save_renders_the_3d_view_as_dragged_with_the_mouse(page, gui_data):
         return float(np.abs(cv2.resize(shot, (w, h), interpolation=cv2.INTER_AREA) - png).mean())
 
     # the page's view (the server's camera) like the render of its camera, the sliders' pose
-    # unlike it; before the drag the other way round (about 8 and 10 here against 50)
-    assert like(after, dragged) < 0.5 * like(after, posed)
+    # unlike it; before the drag the other way round (about 8 and 10 here against 50). The
+    # view's last frame may come after a steady one on a loaded machine (a frame from the
+    # drag, shown twice): the view is looked at until it settles on the dragged render.
     assert like(before, posed) < 0.5 * like(before, dragged)
+    deadline = time.monotonic() + PAGE_TIMEOUT_MS / 1000
+    while not (shown := like(after, dragged) < 0.5 * like(after, posed)):
+        if time.monotonic() > deadline:
+            break
+        after = _view_image(page)
+    assert shown, (like(after, dragged), like(after, posed))
     _shot(page, "gui-dragged.png")
     page.click("#reset-camera")
 
