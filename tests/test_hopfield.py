@@ -10,6 +10,7 @@ sets are compared with a small bounded share of such differences.
 from __future__ import annotations
 
 import csv
+import re
 from pathlib import Path
 
 import cv2
@@ -351,3 +352,17 @@ def test_unknown_parameter_names_the_valid_ones() -> None:
         ValueError, match=r"\['k_cnd'\] \(did you mean 'k_cand'\?\): expected one of .*s_min"
     ):
         sv.match(ok, ok, method="hopfield", max_disparity=8, k_cnd=3)
+
+
+@pytest.mark.parametrize("method", ["hopfield", "best"])
+@pytest.mark.parametrize(
+    ("lo", "shown"), [(32.5, "32.5"), (1e300, "1e+300"), (2**70, "1180591620717411303424")]
+)
+def test_min_disparity_above_max_is_refused_as_given(method: str, lo: float, shown: str) -> None:
+    # The check compared the rounded and clipped range: 32.5 over 32 (floor 32 <= ceil 32) ran
+    # and dropped every match without a word; 1e300 was named by its clip, 2147483647.
+    ok = np.random.default_rng(0).random((40, 60), dtype=np.float32)
+    with pytest.raises(
+        ValueError, match=re.escape(f"max_disparity (32) must be >= min_disparity ({shown})")
+    ):
+        sv.match(ok, np.roll(ok, -3, axis=1), method=method, max_disparity=32, min_disparity=lo)

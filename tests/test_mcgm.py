@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import re
 from pathlib import Path
 
 import numpy as np
@@ -528,3 +529,18 @@ def test_dispx_keeps_the_best_scored_match_of_a_pixel() -> None:
         idx = np.nonzero(key == k)[0]
         best = idx[np.argmax(m.score[idx] + 1e-6 * np.arange(len(idx)))]  # later on a tie
         assert dx[yi[best], xi[best]] == d[best]
+
+
+@pytest.mark.parametrize(
+    ("lo", "shown"), [(32.5, "32.5"), (1e300, "1e+300"), (2**70, "1180591620717411303424")]
+)
+def test_min_disparity_above_max_is_refused_as_given(lo: float, shown: str) -> None:
+    # The check compared the rounded and clipped range: 32.5 over 32 (floor 32 <= ceil 32) ran
+    # and dropped every match without a word; 1e300 was named by its clip, 2147483647.
+    ok = np.random.default_rng(0).random((40, 60), dtype=np.float32)
+    with pytest.raises(
+        ValueError, match=re.escape(f"max_disparity (32) must be >= min_disparity ({shown})")
+    ):
+        sv.match(ok, np.roll(ok, -3, axis=1), method="mcgm", max_disparity=32, min_disparity=lo)
+    with pytest.raises(ValueError, match=re.escape(f"min_disparity ({shown})")):
+        mcgm.mcgm_match(ok, ok, max_disparity=32, min_disparity=lo)

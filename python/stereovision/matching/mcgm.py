@@ -193,8 +193,12 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
     big = 2**31 - 1
     lo = math.floor(min(min_disparity, big))
     hi = math.ceil(min(max_disparity, big))
-    if hi < lo:
-        raise ValueError(f"max_disparity ({max_disparity}) must be >= min_disparity ({lo})")
+    # the range as given, not as rounded and clipped: min_disparity 32.5 over a max_disparity of 32
+    # (lo 32 <= hi 32) gave no match without a word, and 1e300 was shown as its clip 2147483647
+    if max_disparity < min_disparity:
+        raise ValueError(
+            f"max_disparity ({max_disparity!r}) must be >= min_disparity ({min_disparity!r})"
+        )
     kw = {**DEFAULTS, **params, "min_disparity": lo, "max_disparity": hi}
     sig = kw["sigmas"]
     for s in sig if isinstance(sig, (list, tuple)) else [sig]:
