@@ -307,3 +307,26 @@ def test_match_with_the_gabor_channel(data_dir: Path) -> None:
     assert sm.precision[2.0] > 97.0 and sm.count > 100_000  # 98.25 % of 129271 measured
     with pytest.raises(ValueError, match="expected one of hopfield, best, mcgm, fused, gabor"):
         sv.match(sc.left, sc.right, method="census", max_disparity=32)
+
+
+@pytest.mark.parametrize(
+    ("lo", "hi", "says"),
+    [
+        (0.0, 1e300, "got 1e+300 - 0.0"),  # float32's inf in the kernel: "`d_max` must be finite"
+        (0.0, 2**70, "got 1180591620717411303424 - 0.0"),
+        (0.0, 8193.0, "got 8193.0 - 0.0"),
+        (-1e300, 8.0, "got 8.0 - -1e+300"),
+    ],
+)
+def test_a_range_beyond_the_kernel_names_the_arguments(lo: float, hi: float, says: str) -> None:
+    # The kernel's own message named its `d_max` (and `d_min`), not the caller's arguments.
+    ok = np.random.default_rng(0).random((40, 60), dtype=np.float32)
+    with pytest.raises(ValueError, match=r"max_disparity - min_disparity: .* at most 8192 px") as e:
+        gabor_disparity(ok, ok, min_disparity=lo, max_disparity=hi)
+    assert says in str(e.value) and "d_max" not in str(e.value)
+
+
+def test_the_widest_range_is_searched() -> None:
+    ok = np.random.default_rng(0).random((40, 60), dtype=np.float32)
+    res = gabor_disparity(ok, np.roll(ok, -3, axis=1), max_disparity=8192.0)
+    assert float(np.nanmedian(res.disparity)) == pytest.approx(3.0, abs=0.05)

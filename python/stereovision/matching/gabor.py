@@ -72,6 +72,9 @@ class GaborResult:
     confidence: npt.NDArray[np.float32]
 
 
+#: Widest search range ``max_disparity - min_disparity`` (px) of the kernel.
+MAX_RANGE = 8192
+
 # Parameters the kernel takes as counts (usize): a negative or fractional value is a ValueError
 # naming the key here, not an OverflowError from the binding.
 _COUNT_KEYS = (
@@ -146,7 +149,17 @@ def gabor_disparity(
     rgt = _as_grey(right, "right")
     if lft.shape != rgt.shape:
         raise ValueError(f"left {lft.shape} and right {rgt.shape} images differ in shape")
-    disparity_range(min_disparity, max_disparity)
+    lo, hi = disparity_range(min_disparity, max_disparity)
+    # the kernel's limits, in the caller's names (they were its own: "invalid parameter `d_max`:
+    # must be finite, got inf" for 1e300, float32's inf)
+    if hi - lo > MAX_RANGE:
+        raise ValueError(
+            f"max_disparity - min_disparity: the Gabor search range is at most {MAX_RANGE} px, "
+            f"got {max_disparity!r} - {min_disparity!r}"
+        )
+    for name, v in (("min_disparity", lo), ("max_disparity", hi)):
+        if abs(v) > float(np.finfo(np.float32).max):
+            raise ValueError(f"{name}: {v!r} is beyond float32's range")
     kw: dict[str, Any] = {**DEFAULTS, **params}
     for name, default in DEFAULTS.items():
         if isinstance(default, float) or default is None:
