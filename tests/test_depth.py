@@ -745,3 +745,24 @@ def test_the_demo_scenes_missing_depth_is_its_filled_pixels() -> None:
     assert c["disparity"] == c["pixels"] == 450 * 375
     assert c["filled"] == unmeasured and 0.1 < unmeasured / c["pixels"] < 0.25
     assert c["dropped"] == 0 and c["depth"] == c["pixels"] - unmeasured
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "says"),
+    [
+        ("return_channels", "no", "return_channels: expected True or False, got 'no'"),
+        ("return_channels", 1, "return_channels: expected True or False, got 1"),
+        ("cloud", None, "cloud: expected True or False, got None"),
+        ("cloud", "x", "cloud: expected True or False, got 'x'"),
+        ("progress", 3, "progress: expected a callable taking a stage name, or None, got 3"),
+    ],
+)
+def test_output_switches_and_callback_are_checked(key: str, value: object, says: str) -> None:
+    # "no" returned the channels and None dropped the cloud without a word; progress=3 failed
+    # after the rectification with "'int' object is not callable"
+    rng = np.random.default_rng(0)
+    left = rng.random((40, 60), dtype=np.float32)
+    with pytest.raises(TypeError, match=re.escape(says)):
+        sv.depth_map(
+            left, np.roll(left, -3, axis=1), method="gabor", max_disparity=8, **{key: value}
+        )

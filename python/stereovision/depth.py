@@ -1186,6 +1186,15 @@ def depth_map(
     for name, flag in (("fill", fill), ("refine", refine)):
         if flag is not None and not isinstance(flag, (bool, np.bool_)):
             raise TypeError(f"{name}: expected True, False or None, got {flag!r}")
+    # so too the output switches ("no" returned the channels, None dropped the cloud) and the
+    # callback (3 failed after the rectification, "'int' object is not callable")
+    for name, flag in (("return_channels", return_channels), ("cloud", cloud)):
+        if not isinstance(flag, (bool, np.bool_)):
+            raise TypeError(f"{name}: expected True or False, got {flag!r}")
+    if progress is not None and not callable(progress):
+        raise TypeError(
+            f"progress: expected a callable taking a stage name, or None, got {progress!r}"
+        )
     numbers = (int, float, np.integer, np.floating)
     for name, value in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
         if value is None and name == "max_disparity":
