@@ -544,3 +544,25 @@ def test_min_disparity_above_max_is_refused_as_given(lo: float, shown: str) -> N
         sv.match(ok, np.roll(ok, -3, axis=1), method="mcgm", max_disparity=32, min_disparity=lo)
     with pytest.raises(ValueError, match=re.escape(f"min_disparity ({shown})")):
         mcgm.mcgm_match(ok, ok, max_disparity=32, min_disparity=lo)
+
+
+@pytest.mark.parametrize(
+    "sigmas", [True, "2", b"2", None, (2.0, True), ["2", 1.0], [[1.0, 2.0]], {2.0}]
+)
+def test_sigmas_that_are_not_numbers_are_named(sigmas: object) -> None:
+    # NumPy's conversion read True and "2" as sigmas 1 and 2, None as NaN ("got NaN"); a nested
+    # list or a set was a TypeError naming nothing
+    ok = np.random.default_rng(0).random((40, 60), dtype=np.float32)
+    says = re.escape(f"sigmas: expected a number of pixels or a list of them, got {sigmas!r}")
+    with pytest.raises(ValueError, match=says):
+        mcgm.curves(ok, sigmas=sigmas)
+    with pytest.raises(ValueError, match=says):
+        sv.match(ok, ok, method="mcgm", max_disparity=8, sigmas=sigmas)
+
+
+@pytest.mark.parametrize("sigmas", [2, np.float32(2.0), [2, 1.0], np.array([2.0, 1.0])])
+def test_sigmas_as_numbers_are_read(sigmas: object) -> None:
+    ok = np.random.default_rng(0).random((40, 60), dtype=np.float32)
+    got = [c.n_segments for c in mcgm.curves(ok, sigmas=sigmas)]
+    want = [c.n_segments for c in mcgm.curves(ok, sigmas=np.atleast_1d(sigmas).tolist())]
+    assert got == want and len(got) == np.size(sigmas)

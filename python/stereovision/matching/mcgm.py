@@ -18,6 +18,7 @@ pixels, left-right check, the same filters).
 from __future__ import annotations
 
 import math
+import reprlib
 from dataclasses import dataclass
 from typing import Any
 
@@ -178,6 +179,27 @@ class ChannelCurves:
         return self.seg_pixels[self.seg_offsets[i] : self.seg_offsets[i + 1]]
 
 
+def _sigmas(sig: object) -> list[float]:
+    """``sigmas`` (one number or a 1-D sequence of them) as floats, after a ``ValueError`` naming
+    it for anything else: NumPy's conversion read ``True`` and ``"2"`` as sigmas 1 and 2, None
+    as NaN ("got NaN"), and a nested list or a set was a TypeError naming nothing."""
+    if isinstance(sig, np.ndarray) and sig.ndim <= 1:
+        items = list(sig.reshape(-1))
+    elif isinstance(sig, (list, tuple)):
+        items = list(sig)
+    else:
+        items = [sig]
+    for s in items:
+        if isinstance(s, (bool, np.bool_)) or not isinstance(
+            s, (int, float, np.integer, np.floating)
+        ):
+            raise ValueError(
+                f"sigmas: expected a number of pixels or a list of them, got {reprlib.repr(sig)}"
+            )
+        float_sized(s, "sigmas")
+    return [float(s) for s in items]
+
+
 def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:
     refuse_unknown("MCGM parameter", params, DEFAULTS, "stereovision.matching.mcgm.DEFAULTS")
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
@@ -200,10 +222,7 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
             f"max_disparity ({max_disparity!r}) must be >= min_disparity ({min_disparity!r})"
         )
     kw = {**DEFAULTS, **params, "min_disparity": lo, "max_disparity": hi}
-    sig = kw["sigmas"]
-    for s in sig if isinstance(sig, (list, tuple)) else [sig]:
-        float_sized(s, "sigmas")
-    kw["sigmas"] = [float(s) for s in np.atleast_1d(np.asarray(sig, dtype=np.float64))]
+    kw["sigmas"] = _sigmas(kw["sigmas"])
     return kw
 
 
