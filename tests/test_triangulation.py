@@ -371,3 +371,21 @@ def test_points_of_a_wrong_dtype_are_not_told_to_transpose(dtype: type) -> None:
     assert "transpose" not in str(exc.value)
     with pytest.raises(ValueError, match="transpose"):
         triangulate(np.zeros((2, 5)), np.zeros((2, 5)), raw_calib())
+
+
+def test_matches_of_a_resized_pair_warn_as_a_map_does() -> None:
+    # half-size matches read with the full-size calibration gave twice the depth without a word
+    from stereovision.matches import Matches
+
+    full = Calibration.ideal((256, 128), 60.0, 0.1)
+    half = full.scaled_to((128, 64))
+    m = Matches(xl=[60.0], yl=[30.0], xr=[55.0], yr=[30.0], score=[1.0], image_shape=(64, 128))
+    with pytest.warns(UserWarning, match=r"128x64 px, the calibration's images 256x128") as rec:
+        far = m.to_points(full)
+    assert rec[0].filename == __file__  # pointed at the caller's line
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        near = m.to_points(half)  # the right calibration: no warning
+        crop = m.to_points(Calibration.ideal((640, 480), 60.0, 0.1))  # a crop: read as one
+    assert float(far[0, 2]) == pytest.approx(2 * float(near[0, 2]), rel=1e-6)
+    assert np.isfinite(crop).all()

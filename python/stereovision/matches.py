@@ -168,11 +168,21 @@ class Matches:
             If ``calib`` is not a :class:`~stereovision.Calibration`.
         ValueError
             An unknown ``unit``.
+
+        Warns
+        -----
+        UserWarning
+            When ``image_shape`` is the calibration's image size scaled by one factor (matches
+            of a resized pair: their depths would be off by that factor, use
+            :meth:`Calibration.scaled_to`), as :func:`stereovision.depth_from_disparity`.
         """
         from stereovision._validate import require
-        from stereovision.triangulation import depth_from_disparity
+        from stereovision.triangulation import _warn_if_resized, depth_from_disparity
 
         require(calib, "Calibration", "calib")
+        # matches of a resized pair read with the full-size calibration were off by the factor
+        # without a word (half-size matches, 2 x the depths), which depth_from_disparity warns of
+        _warn_if_resized(self.image_shape, calib, 2)
         cal = calib if calib.rectified else calib.rectified_calibration()
         z = depth_from_disparity((self.xl - self.xr)[None, :], cal, unit)[0].astype(np.float64)
         k = cal.K1
