@@ -766,3 +766,22 @@ def test_output_switches_and_callback_are_checked(key: str, value: object, says:
         sv.depth_map(
             left, np.roll(left, -3, axis=1), method="gabor", max_disparity=8, **{key: value}
         )
+
+
+@pytest.mark.parametrize("key", ["min_depth", "max_depth", "max_sigma", "max_relative_sigma"])
+def test_filtered_limits_beyond_64_bits(key: str) -> None:
+    # np.isfinite(2**70) was NumPy's TypeError "ufunc 'isfinite' not supported for the input
+    # types", naming no limit; 2**70 is a limit as 1e300 is, 10**400 beyond a float is refused
+    rng = np.random.default_rng(0)
+    left = rng.random((40, 60), dtype=np.float32)
+    calib = Calibration.ideal((60, 40), 60.0, 0.1)
+    res = sv.depth_map(left, np.roll(left, -3, axis=1), calib, method="gabor", max_disparity=8)
+
+    def kept(**limit: float) -> int:
+        return int(np.isfinite(res.filtered(**limit).depth_in("m")).sum())
+
+    want = 0 if key == "min_depth" else kept()  # nothing is that far; everything that close
+    assert kept(**{key: 2**70}) == kept(**{key: 1e300}) == want
+    assert kept() > 1000
+    with pytest.raises(ValueError, match=f"^{key}: expected a positive number, got 1000"):
+        res.filtered(**{key: 10**400})

@@ -291,3 +291,10 @@ def test_bgra_and_grey_frames(data_dir: Path) -> None:
         assert out[0].shape == left.shape
         if convert == cv2.COLOR_BGR2BGRA:
             assert (out[0][..., 3] == 255).all()
+
+
+def test_k_beyond_64_bits() -> None:
+    # np.isfinite(2**70) was NumPy's TypeError "ufunc 'isfinite' not supported", naming no k
+    assert TemporalFilter(k=2**70).k == 2**70
+    with pytest.raises(ValueError, match=r"^k: expected a positive number of sigmas, got 1000"):
+        TemporalFilter(k=10**400)

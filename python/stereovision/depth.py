@@ -175,6 +175,15 @@ def _round_up(value: float, step: int = _DISPARITY_STEP) -> int:
     return int(max(step, int(np.ceil(value / step)) * step))
 
 
+def _finite(v: float) -> bool:
+    """Whether a real number is finite: ``np.isfinite`` of a Python int beyond 64 bits (2**70) was
+    NumPy's TypeError "ufunc 'isfinite' not supported", one beyond a float's range is not."""
+    try:
+        return math.isfinite(v)
+    except OverflowError:
+        return False
+
+
 def estimate_max_disparity(left: npt.ArrayLike, right: npt.ArrayLike) -> int:
     """Choose a disparity search range from the pair itself.
 
@@ -689,7 +698,7 @@ class DepthResult:
                 v, bool
             )
             if v is not None and not (
-                ok_number and np.isfinite(v) and (v > 0 or (name == "min_depth" and v == 0))
+                ok_number and _finite(v) and (v > 0 or (name == "min_depth" and v == 0))
             ):
                 raise ValueError(f"{name}: expected a positive number, got {v!r}")
         if min_depth is not None and max_depth is not None and min_depth > max_depth:
@@ -698,7 +707,9 @@ class DepthResult:
             )
         z = self.depth
         keep = np.isfinite(z)
-        with np.errstate(invalid="ignore"):
+        # a limit beyond float32 (1e300, 2**200) is its inf in the comparison, which reads it
+        # right; the cast's RuntimeWarning "overflow encountered in cast" is noise
+        with np.errstate(invalid="ignore", over="ignore"):
             if min_depth is not None:
                 keep &= z >= min_depth
             if max_depth is not None:

@@ -31,6 +31,7 @@ frame of a still rig for a moving one.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from dataclasses import dataclass, field
 
@@ -226,7 +227,12 @@ class TemporalFilter:
             self.k, (int, float, np.integer, np.floating)
         ):
             raise ValueError(f"k: expected a positive number of sigmas, got {self.k!r}")
-        if not (np.isfinite(self.k) and self.k > 0):
+        # math, not np.isfinite: 2**70 was NumPy's TypeError "ufunc 'isfinite' not supported"
+        try:
+            finite = math.isfinite(self.k)
+        except OverflowError:  # an int beyond a float
+            finite = False
+        if not (finite and self.k > 0):
             raise ValueError(f"k: expected a positive number of sigmas, got {self.k!r}")
 
     def reset(self) -> None:
