@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 from pathlib import Path
 
 import cv2
@@ -1042,3 +1043,36 @@ def test_opencv_calibration_file_reads_1d_vectors_saved_by_filestorage(
         r"rows and cols\) where a matrix is expected$",
     ):
         Calibration.from_file(path)
+
+
+@pytest.mark.parametrize("alpha", ["1", None, True, [0.5]])
+def test_alpha_that_is_not_a_number_is_named(alpha: object) -> None:
+    # "1" and None were a TypeError from the comparison ("'<=' not supported between instances
+    # of 'float' and 'str'"), True was read as 1, and rectified_calibration took any of them
+    c = raw_calib()
+    pts = np.array([[10.0, 20.0]])
+    img = np.zeros((SIZE[1], SIZE[0]), np.uint8)
+    says = re.escape(f"alpha: expected a value in [0, 1], got {alpha!r}")
+    for call in (
+        lambda: c.valid_roi(alpha),  # type: ignore[arg-type]
+        lambda: c.rectify(img, img, alpha=alpha),  # type: ignore[arg-type]
+        lambda: c.rectify_points(pts, alpha=alpha),  # type: ignore[arg-type]
+        lambda: c.to_ros(alpha=alpha),  # type: ignore[arg-type]
+    ):
+        with pytest.raises(ValueError, match=says):
+            call()
+    with pytest.raises(
+        ValueError, match=re.escape(f"alpha: expected a finite number, got {alpha!r}")
+    ):
+        c.rectified_calibration(alpha)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    "alpha", [float("nan"), float("inf"), 10**400], ids=["nan", "inf", "1e400"]
+)
+def test_rectified_calibration_alpha_must_be_finite(alpha: float) -> None:
+    # NaN went to cv2.stereoRectify; OpenCV's -1 (its default scaling) stays accepted
+    c = raw_calib()
+    with pytest.raises(ValueError, match=r"^alpha: expected a finite number, got (nan|inf|1000)"):
+        c.rectified_calibration(alpha)
+    assert c.rectified_calibration(-1).rectified

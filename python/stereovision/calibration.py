@@ -290,6 +290,25 @@ def _pixels(value: object, what: str) -> int:
     return round(v)
 
 
+def _check_alpha(alpha: object, *, any_finite: bool = False) -> None:
+    """A ``ValueError`` naming ``alpha`` unless it is a real number in ``[0, 1]`` (any finite
+    one with ``any_finite``: :meth:`Calibration.rectified_calibration` passes OpenCV's -1, its
+    default scaling): ``"1"`` and None were a TypeError from the comparison ("'<=' not supported
+    between instances of 'float' and 'str'"), True was read as 1."""
+    real = isinstance(alpha, (int, float, np.integer, np.floating)) and not isinstance(
+        alpha, (bool, np.bool_)
+    )
+    if any_finite:
+        try:
+            finite = real and math.isfinite(alpha)  # type: ignore[arg-type]
+        except OverflowError:  # an int beyond a float
+            finite = False
+        if not finite:
+            raise ValueError(f"alpha: expected a finite number, got {alpha!r}")
+    elif not (real and 0.0 <= alpha <= 1.0):  # type: ignore[operator]
+        raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
+
+
 @dataclass(eq=False, frozen=True)
 class Calibration:
     """Intrinsics and extrinsics of a stereo pair (OpenCV conventions, see module docstring).
@@ -637,8 +656,7 @@ class Calibration:
         w, h = self.image_size
         if self.rectified:
             return (0, 0, w, h), (0, 0, w, h)
-        if not 0.0 <= alpha <= 1.0:
-            raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
+        _check_alpha(alpha)
         self._stereo_rectify(alpha)
         if ("roi", float(alpha)) not in self._cache:  # fisheye: OpenCV gives none; from the maps
             m1x, m1y, m2x, m2y = self._maps(alpha)
@@ -705,8 +723,7 @@ class Calibration:
                 )
         if self.rectified:
             return la, ra
-        if not 0.0 <= alpha <= 1.0:
-            raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
+        _check_alpha(alpha)
         m1x, m1y, m2x, m2y = self._maps(alpha)
         from stereovision._validate import remap_image
 
@@ -748,8 +765,7 @@ class Calibration:
             raise ValueError(f"side: expected 'left' or 'right', got {side!r}")
         if self.rectified or len(pts) == 0:
             return pts.copy()
-        if not 0.0 <= alpha <= 1.0:
-            raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
+        _check_alpha(alpha)
         r1, r2, p1, p2, _ = self._stereo_rectify(alpha)
         K, D, r, p = (self.K1, self.D1, r1, p1) if side == "left" else (self.K2, self.D2, r2, p2)
         src = pts.reshape(-1, 1, 2)
@@ -787,6 +803,7 @@ class Calibration:
         """
         if self.rectified:
             return self
+        _check_alpha(alpha, any_finite=True)  # float() read "1" and True as 1, NaN went to OpenCV
         key = ("rectified_calibration", float(alpha))
         if key not in self._cache:
             r1, _, p1, p2, _ = self._stereo_rectify(alpha)
@@ -1979,8 +1996,7 @@ class Calibration:
             has 12 or 14 coefficients with the thin-prism or tilt terms in use (ROS has no
             model for them).
         """
-        if not 0.0 <= alpha <= 1.0:
-            raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
+        _check_alpha(alpha)
         if not (
             isinstance(names, (tuple, list))
             and len(names) == 2
