@@ -1076,3 +1076,27 @@ def test_rectified_calibration_alpha_must_be_finite(alpha: float) -> None:
     with pytest.raises(ValueError, match=r"^alpha: expected a finite number, got (nan|inf|1000)"):
         c.rectified_calibration(alpha)
     assert c.rectified_calibration(-1).rectified
+
+
+@pytest.mark.parametrize(
+    ("depth", "step", "says"),
+    [
+        ("5", 1.0, "depth_m: expected depths in metres (real numbers), got str '5'"),
+        (None, 1.0, "depth_m: expected depths in metres (real numbers), got NoneType None"),
+        (True, 1.0, "depth_m: expected depths in metres (real numbers), got bool True"),
+        (5.0, 0.0, "disparity_step: expected a positive finite number, got 0.0"),
+        (5.0, -1.0, "disparity_step: expected a positive finite number, got -1.0"),
+        (5.0, float("nan"), "disparity_step: expected a positive finite number, got nan"),
+        (5.0, "1", "disparity_step: expected a positive finite number, got str '1'"),
+    ],
+)
+def test_depth_step_refuses_what_is_not_a_depth_or_a_step(
+    depth: object, step: object, says: str
+) -> None:
+    # NumPy read "5" as 5 m, None as NaN and True as 1; a step of 0, -1 or NaN gave 0, a
+    # negative resolution or NaN
+    c = rect_calib()
+    assert c.depth_step(5.0) == pytest.approx(25.0 / (c.focal_px * c.baseline_m))
+    assert np.isnan(c.depth_step(np.array([np.nan, 5.0]))[0])  # a map's pixels without depth
+    with pytest.raises(ValueError, match=re.escape(says)):
+        c.depth_step(depth, step)  # type: ignore[arg-type]

@@ -19,6 +19,7 @@ import json
 import math
 import os
 import re
+import reprlib
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -859,11 +860,27 @@ class Calibration:
         -------
         float or numpy.ndarray
             For one depth (a Python or NumPy number, e.g. ``np.float32(5)``) a float
-            (``numpy.float64``, a ``float``); else float64, the shape of ``depth_m``.
+            (``numpy.float64``, a ``float``); else float64, the shape of ``depth_m``
+            (NaN where ``depth_m`` is: a depth map's pixels without depth).
+
+        Raises
+        ------
+        ValueError
+            If ``depth_m`` is not real numbers or ``disparity_step`` not a positive finite
+            number.
         """
-        z = np.asarray(depth_m, dtype=np.float64)
+        # NumPy's conversions read "5" as 5 m, None as NaN and True as 1 without a word, and a
+        # step of 0, -1 or NaN gave a resolution of 0, a negative one or NaN
+        raw = np.asarray(depth_m)
+        if raw.dtype.kind not in "iuf":
+            raise ValueError(
+                f"depth_m: expected depths in metres (real numbers), got {type(depth_m).__name__} "
+                f"{reprlib.repr(depth_m)} (dtype {raw.dtype})"
+            )
+        step = positive_finite(disparity_step, "disparity_step")
+        z = raw.astype(np.float64)
         fb = self.focal_px * self.baseline_m
-        out: F64 = z * z * float(disparity_step) / fb
+        out: F64 = z * z * step / fb
         return out
 
     def describe(self, depths: tuple[float, ...] = (1.0, 2.0, 5.0, 10.0)) -> str:
