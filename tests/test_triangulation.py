@@ -3,6 +3,7 @@ OpenCV oracles (undistortPoints, triangulatePoints, reprojectImageTo3D), degener
 
 from __future__ import annotations
 
+import re
 import warnings
 from pathlib import Path
 
@@ -389,3 +390,26 @@ def test_matches_of_a_resized_pair_warn_as_a_map_does() -> None:
         crop = m.to_points(Calibration.ideal((640, 480), 60.0, 0.1))  # a crop: read as one
     assert float(far[0, 2]) == pytest.approx(2 * float(near[0, 2]), rel=1e-6)
     assert np.isfinite(crop).all()
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "says"),
+    [
+        ("max_iter", 0, "max_iter: expected an integer from 1 to 2147483647, got 0"),
+        ("max_iter", -5, "max_iter: expected an integer from 1 to 2147483647, got -5"),
+        ("max_iter", 2.5, "max_iter: expected an integer from 1 to 2147483647, got 2.5"),
+        ("max_iter", True, "max_iter: expected an integer from 1 to 2147483647, got True"),
+        ("tol", 0.0, "tol: expected a positive finite number, got 0.0"),
+        ("tol", -1.0, "tol: expected a positive finite number, got -1.0"),
+        ("tol", float("nan"), "tol: expected a positive finite number, got nan"),
+        ("tol", "1", "tol: expected a positive finite number, got str '1'"),
+    ],
+)
+def test_undistortion_limits_are_checked(key: str, value: object, says: str) -> None:
+    # 0 or -5 iterations, a tol of 0, -1 or NaN gave every point NaN without a word ("did not
+    # converge"); "1" was NumPy's UFuncTypeError from the comparison
+    c = raw_calib()
+    xl, xr = project(c, scene_points(5))
+    assert triangulate(xl, xr, c).valid.all()
+    with pytest.raises(ValueError, match=re.escape(says)):
+        triangulate(xl, xr, c, **{key: value})

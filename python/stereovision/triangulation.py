@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import int_in_range, positive_finite
 from stereovision._validate import require as _require_type
 from stereovision.calibration import UNIT_TO_METRES, Calibration
 
@@ -251,7 +252,8 @@ def triangulate(
     Raises
     ------
     ValueError
-        If ``xl``/``xr`` are not ``(N, 2)`` of equal length or ``unit`` is unknown.
+        If ``xl``/``xr`` are not ``(N, 2)`` of equal length, ``unit`` is unknown, ``max_iter``
+        is not an integer >= 1 or ``tol`` not a positive finite number.
     """
     _require_type(calib, "Calibration", "calib")
     pl = _points(xl, "xl")
@@ -259,6 +261,10 @@ def triangulate(
     if pl.shape != pr.shape:
         raise ValueError(f"xl and xr must have the same shape, got {pl.shape} and {pr.shape}")
     scale = _unit_scale(calib, unit)
+    # 0 or -5 iterations, a tol of 0, -1 or NaN made every point NaN without a word (never
+    # converged); "1" was NumPy's UFuncTypeError from the comparison
+    max_iter = int_in_range(max_iter, "max_iter", 1, 2**31 - 1)
+    tol = positive_finite(tol, "tol")
     # The fisheye model's four coefficients are k1..k4 of the equidistant model, not the
     # pinhole model's k1, k2, p1, p2 (read as those, a fisheye rig's points were metres off).
     normalise = _undistort_fisheye if calib.model == "fisheye" else undistort_normalized
