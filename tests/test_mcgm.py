@@ -566,3 +566,21 @@ def test_sigmas_as_numbers_are_read(sigmas: object) -> None:
     got = [c.n_segments for c in mcgm.curves(ok, sigmas=sigmas)]
     want = [c.n_segments for c in mcgm.curves(ok, sigmas=np.atleast_1d(sigmas).tolist())]
     assert got == want and len(got) == np.size(sigmas)
+
+
+@pytest.mark.parametrize(
+    "shape", [None, (64,), "64x128", (64.5, 128), (True, 128), (0, 5), (64, 128, 3)]
+)
+def test_matches_image_shape_must_be_two_positive_integers(tmp_path: Path, shape: object) -> None:
+    # int() of each entry read 64.5 as 64 and True as 1; None, (64,) and "64x128" were a
+    # TypeError or an unpacking error naming nothing
+    a = np.zeros(2, np.float32)
+    says = re.escape(f"image_shape must be positive (H, W) integers, got {shape!r}")
+    with pytest.raises(ValueError, match=says):
+        sv.Matches(xl=a, yl=a, xr=a, yr=a, score=a, image_shape=shape)  # type: ignore[arg-type]
+    path = sv.Matches(xl=a, yl=a, xr=a, yr=a, score=a, image_shape=(64, 128)).save_csv(
+        tmp_path / "m.csv"
+    )
+    with pytest.raises(ValueError, match=says):
+        sv.Matches.from_csv(path, shape)  # type: ignore[arg-type]
+    assert sv.Matches.from_csv(path, (np.int64(64), 128)).image_shape == (64, 128)

@@ -73,9 +73,17 @@ class Matches:
             )
         for n, a in zip(names, arrs, strict=True):
             object.__setattr__(self, n, a)
-        h, w = (int(v) for v in self.image_shape)
-        if h <= 0 or w <= 0:
-            raise ValueError(f"image_shape must be positive (H, W), got {self.image_shape}")
+        # int() of each entry read 64.5 as 64 and True as 1; None and (64,) were a TypeError
+        # or an unpacking error naming nothing
+        shape = self.image_shape
+        dims = tuple(shape) if isinstance(shape, (tuple, list, np.ndarray)) else ()
+        ok = len(dims) == 2 and all(
+            isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_)) and v > 0
+            for v in dims
+        )
+        if not ok:
+            raise ValueError(f"image_shape must be positive (H, W) integers, got {shape!r}")
+        h, w = int(dims[0]), int(dims[1])
         object.__setattr__(self, "image_shape", (h, w))
         object.__setattr__(
             self, "energy_trace", np.asarray(self.energy_trace, dtype=np.float64).reshape(-1)
