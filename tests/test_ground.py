@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -16,7 +17,13 @@ import pytest
 
 import stereovision as sv
 from stereovision.calibration import Calibration
-from stereovision.ground import BELOW_WARN_SHARE, fit_ground_plane, obstacle_mask
+from stereovision.ground import (
+    BELOW_WARN_SHARE,
+    GroundPlane,
+    fit_ground_plane,
+    laser_scan,
+    obstacle_mask,
+)
 from stereovision.io import load_scene, read_pfm
 from stereovision.synthetic import render_plane
 
@@ -926,3 +933,44 @@ def test_occupancy_grid_save_removes_a_copy_that_failed(
         OccupancyGrid(np.full((3, 4), 100, np.int8), 0.1, (1.0, -2.0)).save(tmp_path)
     monkeypatch.undo()
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def _level_floor() -> tuple[GroundPlane, np.ndarray]:
+    """A level camera 1 m above a flat floor, and a 4 x 4 point image: points 0.5 m above the
+    floor at 2 m, and one on it."""
+    plane = GroundPlane(
+        normal=np.array([0, -1.0, 0]),
+        height=1.0,
+        disparity_plane=(0.0, 0.0, 0.0),
+        inliers=np.zeros((4, 4), bool),
+        inlier_share=1.0,
+        rms_px=0.0,
+    )
+    pts = np.zeros((4, 4, 3))
+    pts[..., 0] = np.linspace(-0.5, 0.5, 4)[None, :]
+    pts[..., 1] = 0.5  # 0.5 m below the camera: 0.5 m above the floor
+    pts[..., 2] = 2.0
+    pts[0, 0, 1] = 1.0  # on the floor
+    return plane, pts
+
+
+@pytest.mark.parametrize("value", ["1", True, None, [1.0]])
+@pytest.mark.parametrize("key", ["min_height", "max_height", "max_range"])
+def test_obstacle_mask_limits_must_be_numbers(key: str, value: object) -> None:
+    # float() read "1" as 1 m and True as 1 without a word (None was float()'s TypeError)
+    plane, pts = _level_floor()
+    assert int(obstacle_mask(pts, plane).sum()) == 15
+    with pytest.raises(ValueError, match=re.escape(f"{key}: expected a number, got {value!r}")):
+        obstacle_mask(pts, plane, **{key: value})
+
+
+@pytest.mark.parametrize("value", ["1", True, [1.0]])
+@pytest.mark.parametrize(
+    "key", ["min_height", "max_height", "range_min", "range_max", "angle_min", "angle_max"]
+)
+def test_laser_scan_limits_must_be_numbers(key: str, value: object) -> None:
+    plane, pts = _level_floor()
+    angles = {"angle_min": -0.5, "angle_max": 0.5}
+    assert int(np.isfinite(laser_scan(pts, plane, **angles).ranges).sum()) > 0
+    with pytest.raises(ValueError, match=re.escape(f"{key}: expected a number, got {value!r}")):
+        laser_scan(pts, plane, **{**angles, key: value})

@@ -690,6 +690,20 @@ def fit_ground_plane(
     )
 
 
+def _number(value: object, name: str) -> float:
+    """``value`` as a float, after a ``ValueError`` naming ``name`` for what is not a real number:
+    ``float()`` read ``"1"`` as 1 m and True as 1 without a word. An int beyond a float's range
+    is an infinity of its sign (the range checks then name it)."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(
+        value, (int, float, np.integer, np.floating)
+    ):
+        raise ValueError(f"{name}: expected a number, got {value!r}")
+    try:
+        return float(value)
+    except OverflowError:
+        return math.inf if value > 0 else -math.inf
+
+
 def obstacle_mask(
     points: npt.ArrayLike,
     plane: GroundPlane,
@@ -729,16 +743,17 @@ def obstacle_mask(
     pts = np.asarray(points, np.float64)
     if pts.ndim != 3 or pts.shape[2] != 3:
         raise ValueError(f"points: expected shape (H, W, 3), got {pts.shape}")
-    lo, hi = float(min_height), float(max_height)
+    lo, hi = _number(min_height, "min_height"), _number(max_height, "max_height")
     if not (math.isfinite(lo) and lo >= 0 and hi > lo):
         raise ValueError(
             f"min_height, max_height: expected 0 <= min_height < max_height, got {lo!r}, {hi!r}"
         )
-    if not float(max_range) > 0:
+    far = _number(max_range, "max_range")
+    if not far > 0:
         raise ValueError(f"max_range: expected a positive distance, got {max_range!r}")
     with np.errstate(invalid="ignore"):
         h = plane.height_of(pts)
-        out: npt.NDArray[np.bool_] = (h > lo) & (h < hi) & (pts[..., 2] < float(max_range))
+        out: npt.NDArray[np.bool_] = (h > lo) & (h < hi) & (pts[..., 2] < far)
     return out
 
 
@@ -1014,7 +1029,7 @@ def occupancy_grid(
     cols, rows = math.ceil((x1 - x0) / res), math.ceil((y1 - y0) / res)
     if cols > 4096 or rows > 4096:
         raise ValueError(f"resolution: a {cols} x {rows} grid is over 4096 cells a side")
-    lo, hi = float(min_height), float(max_height)
+    lo, hi = _number(min_height, "min_height"), _number(max_height, "max_height")
     if not (math.isfinite(lo) and lo >= 0 and hi > lo):
         raise ValueError(
             f"min_height, max_height: expected 0 <= min_height < max_height, got {lo!r}, {hi!r}"
@@ -1202,12 +1217,12 @@ def laser_scan(
     pts = np.asarray(points, np.float64)
     if pts.ndim == 0 or pts.shape[-1] != 3:
         raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
-    lo, hi = float(min_height), float(max_height)
+    lo, hi = _number(min_height, "min_height"), _number(max_height, "max_height")
     if not (math.isfinite(lo) and lo >= 0 and hi > lo):
         raise ValueError(
             f"min_height, max_height: expected 0 <= min_height < max_height, got {lo!r}, {hi!r}"
         )
-    r0, r1 = float(range_min), float(range_max)
+    r0, r1 = _number(range_min, "range_min"), _number(range_max, "range_max")
     if not (math.isfinite(r0) and r0 >= 0 and r1 > r0):
         raise ValueError(
             f"range_min, range_max: expected 0 <= range_min < range_max, got {r0!r}, {r1!r}"
@@ -1219,11 +1234,11 @@ def laser_scan(
         if calib is None:
             raise ValueError("laser_scan: give calib (the image's field of view) or the angles")
         a0, a1, n_cols = _beam_span(calib, axes)
-        a0 = a0 if angle_min is None else float(angle_min)
-        a1 = a1 if angle_max is None else float(angle_max)
+        a0 = a0 if angle_min is None else _number(angle_min, "angle_min")
+        a1 = a1 if angle_max is None else _number(angle_max, "angle_max")
         inc = (a1 - a0) / max(n_cols - 1, 1) if angle_increment is None else angle_increment
     else:
-        a0, a1 = float(angle_min), float(angle_max)
+        a0, a1 = _number(angle_min, "angle_min"), _number(angle_max, "angle_max")
         inc = math.radians(0.25) if angle_increment is None else angle_increment
     inc = positive_finite(inc, "angle_increment")
     if not (math.isfinite(a0) and math.isfinite(a1) and a1 > a0):
