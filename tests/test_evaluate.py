@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -304,3 +305,60 @@ def test_dense_metrics_takes_disparity_and_still_disp() -> None:
         "dense_metrics(): the keyword disp= is now disparity= (disp= will be removed)"
     )
     assert caught[0].filename == __file__
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "says"),
+    [
+        ("n_points", float("nan"), "n_points must be an integer >= 1, got nan"),
+        ("n_points", 2.5, "n_points must be an integer >= 1, got 2.5"),
+        ("n_points", True, "n_points must be an integer >= 1, got True"),
+        ("n_points", "3", "n_points must be an integer >= 1, got '3'"),
+        ("seed", -5, "seed must be an integer >= 0, got -5"),
+        ("seed", float("nan"), "seed must be an integer >= 0, got nan"),
+        ("seed", "0", "seed must be an integer >= 0, got '0'"),
+    ],
+)
+def test_table1_report_names_a_bad_count_or_seed(key: str, value: object, says: str) -> None:
+    # NumPy's messages named neither ("negative dimensions are not allowed", "expected
+    # non-negative integer"), and 2.5 or True points were drawn
+    est = np.full((20, 30), 2.0, np.float32)
+    gt = np.full((20, 30), 2.5, np.float32)
+    assert table1_report(est, gt, n_points=4, seed=np.int64(1)).n_points == 4
+    with pytest.raises(ValueError, match="^" + re.escape(says)):
+        table1_report(est, gt, **{key: value})  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "says"),
+    [
+        ("target", float("nan"), "target: expected a precision in percent, 0 to 100, got nan"),
+        ("target", 101.0, "target: expected a precision in percent, 0 to 100, got 101.0"),
+        ("target", -1.0, "target: expected a precision in percent, 0 to 100, got -1.0"),
+        ("target", True, "target: expected a precision in percent, 0 to 100, got True"),
+        ("tol", 0.0, "tol: expected a positive finite number of pixels, got 0.0"),
+        ("tol", float("nan"), "tol: expected a positive finite number of pixels, got nan"),
+        ("tol", "1", "tol: expected a positive finite number of pixels, got '1'"),
+        ("tol", 10**400, "tol: expected a positive finite number of pixels, got 1000"),
+    ],
+)
+def test_count_at_precision_names_a_bad_target_or_tol(key: str, value: object, says: str) -> None:
+    # NaN or 101 % counted 0 matches, -1 % all of them, a tol of 0 or NaN none, without a word
+    gt = np.full((4, 6), 5.0)
+    xl = np.array([1.0, 2.0, 3.0])
+    yl = np.ones(3)
+    xr = xl - np.array([5.0, 8.0, 5.0])
+    score = np.array([0.9, 0.8, 0.7])
+    assert count_at_precision(xl, yl, xr, score, gt, 50.0, np.float32(1.0)) == 3
+    kw: dict[str, object] = {"target": 50.0, "tol": 1.0, key: value}
+    with pytest.raises(ValueError, match="^" + re.escape(says)):
+        count_at_precision(xl, yl, xr, score, gt, **kw)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("thresholds", [2.0, (True,), ("2",), (2.0, 10**400)])
+def test_dense_metrics_thresholds_must_be_a_sequence_of_numbers(thresholds: object) -> None:
+    # 2.0 was "'float' object is not iterable", True a 1 px threshold, "2" a TypeError
+    disp = np.zeros((3, 4), np.float32)
+    assert dense_metrics(disp, disp + 1.5, thresholds=[np.float32(1.0), 2]).bad[2.0] == 0.0
+    with pytest.raises(ValueError, match=r"^thresholds must be positive and finite, got "):
+        dense_metrics(disp, disp, thresholds=thresholds)  # type: ignore[arg-type]

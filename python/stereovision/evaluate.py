@@ -138,6 +138,23 @@ class DenseMetrics:
         return out
 
 
+def _real(value: object) -> bool:
+    """Whether ``value`` is a real number (a bool is not one, nor a numeric string)."""
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(
+        value, (bool, np.bool_)
+    )
+
+
+def _positive_finite(value: object) -> bool:
+    """Whether ``value`` is a real number above 0 within a float's range."""
+    if not _real(value):
+        return False
+    try:
+        return bool(value > 0 and math.isfinite(value))  # type: ignore[operator, arg-type]
+    except OverflowError:  # an int beyond a float
+        return False
+
+
 @renamed_keyword("disp", "disparity")
 def dense_metrics(
     disparity: npt.ArrayLike,
@@ -177,8 +194,12 @@ def dense_metrics(
     d = _real_2d(disparity, "disparity")
     g = _real_2d(gt, "gt")
     _same_shape(d, g, "disparity", "gt")
-    if any(not (t > 0 and math.isfinite(t)) for t in thresholds):
-        raise ValueError(f"thresholds must be positive and finite, got {thresholds}")
+    # a single number was "'float' object is not iterable", True a threshold of 1 px and "2"
+    # a TypeError from the comparison
+    if not isinstance(thresholds, (tuple, list, np.ndarray)) or not all(
+        _positive_finite(t) for t in thresholds
+    ):
+        raise ValueError(f"thresholds must be positive and finite, got {thresholds!r}")
     known = np.isfinite(g)
     if mask is not None:
         m = np.asarray(mask, dtype=bool)
@@ -473,8 +494,18 @@ def table1_report(
     factor = _unit_factor(unit)
     both = _depth_valid(e) & _depth_valid(g)
     if points is None:
+        # NumPy's messages named neither (n_points NaN: "negative dimensions are not allowed",
+        # seed -5: "expected non-negative integer"), and n_points 2.5 or True was taken
+        if isinstance(n_points, (bool, np.bool_)) or not isinstance(n_points, (int, np.integer)):
+            raise ValueError(f"n_points must be an integer >= 1, got {n_points!r}")
         if n_points < 1:
             raise ValueError(f"n_points must be >= 1, got {n_points}")
+        if (
+            isinstance(seed, (bool, np.bool_))
+            or not isinstance(seed, (int, np.integer))
+            or seed < 0
+        ):
+            raise ValueError(f"seed must be an integer >= 0, got {seed!r}")
         flat = np.flatnonzero(both)
         if flat.size == 0:
             raise ValueError("no pixel has both an estimated and a ground-truth distance")
@@ -641,6 +672,12 @@ def count_at_precision(
     ValueError
         As :func:`sparse_metrics`, or if ``score`` has another length.
     """
+    # a target of NaN or above 100 % counted 0 matches, one below 0 all of them, a tol of 0,
+    # -1 or NaN none, without a word ("1" was NumPy's UFuncTypeError)
+    if not (_real(target) and 0.0 <= target <= 100.0):
+        raise ValueError(f"target: expected a precision in percent, 0 to 100, got {target!r}")
+    if not _positive_finite(tol):
+        raise ValueError(f"tol: expected a positive finite number of pixels, got {tol!r}")
     g = _real_2d(gt, "gt")
     x, y, x2, s = (np.asarray(a, dtype=np.float64) for a in (xl, yl, xr, score))
     if any(a.ndim != 1 for a in (x, y, x2, s)) or len({a.shape for a in (x, y, x2, s)}) != 1:
