@@ -785,3 +785,17 @@ def test_filtered_limits_beyond_64_bits(key: str) -> None:
     assert kept() > 1000
     with pytest.raises(ValueError, match=f"^{key}: expected a positive number, got 1000"):
         res.filtered(**{key: 10**400})
+
+
+@pytest.mark.parametrize("filled", ["no", None, 1])
+def test_point_image_filled_must_be_a_switch(filled: object) -> None:
+    # "no" (true) gave the filled pixels and None (false) left them out without a word
+    rng = np.random.default_rng(0)
+    left = rng.random((40, 60), dtype=np.float32)
+    calib = Calibration.ideal((60, 40), 60.0, 0.1)
+    res = sv.depth_map(left, np.roll(left, -3, axis=1), calib, method="gabor", max_disparity=8)
+    assert res.point_image(filled=np.bool_(True)).shape == (40, 60, 3)
+    with pytest.raises(
+        TypeError, match=re.escape(f"filled: expected True or False, got {filled!r}")
+    ):
+        res.point_image(filled=filled)  # type: ignore[arg-type]

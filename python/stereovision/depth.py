@@ -632,7 +632,12 @@ class DepthResult:
         ------
         ValueError
             A result without depth (no calibration).
+        TypeError
+            If ``filled`` is not True or False.
         """
+        if not isinstance(filled, (bool, np.bool_)):
+            # "no" (true) gave the filled pixels, None (false) left them out, without a word
+            raise TypeError(f"filled: expected True or False, got {filled!r}")
         if self.depth is None or self.calibration is None:
             raise ValueError("no 3-D points: depth_map was called without a calibration")
         pts = self.calibration.reproject(self.disparity)
