@@ -974,3 +974,17 @@ def test_laser_scan_limits_must_be_numbers(key: str, value: object) -> None:
     assert int(np.isfinite(laser_scan(pts, plane, **angles).ranges).sum()) > 0
     with pytest.raises(ValueError, match=re.escape(f"{key}: expected a number, got {value!r}")):
         laser_scan(pts, plane, **{**angles, key: value})
+
+
+@pytest.mark.parametrize("count", [np.int64(2), np.int32(2), 2**70])
+def test_laser_scan_min_points_of_any_integer_type(count: int) -> None:
+    # a NumPy integer was refused as "not an integer"; 2**70 was NumPy's OverflowError
+    plane, pts = _level_floor()
+    angles = {"angle_min": -0.5, "angle_max": 0.5}
+    want = laser_scan(pts, plane, **angles, min_points=2 if count < 2**62 else 10**6)
+    got = laser_scan(pts, plane, **angles, min_points=count)
+    np.testing.assert_array_equal(got.ranges, want.ranges)
+    if count == 2**70:
+        assert not np.isfinite(got.ranges).any()  # no beam has that many points
+    else:
+        assert np.isfinite(got.ranges).any()

@@ -1227,8 +1227,15 @@ def laser_scan(
         raise ValueError(
             f"range_min, range_max: expected 0 <= range_min < range_max, got {r0!r}, {r1!r}"
         )
-    if isinstance(min_points, bool) or not isinstance(min_points, int) or min_points < 1:
+    # a NumPy integer (a count from an array) was refused as not an integer, and 2**70 was
+    # NumPy's OverflowError "Python int too large to convert to C long" further on
+    if (
+        isinstance(min_points, (bool, np.bool_))
+        or not isinstance(min_points, (int, np.integer))
+        or min_points < 1
+    ):
         raise ValueError(f"min_points: expected an integer >= 1, got {min_points!r}")
+    min_points = min(int(min_points), 2**62)  # more than any cloud's points: no beam returns
     axes = floor_frame(plane)
     if angle_min is None or angle_max is None:
         if calib is None:
