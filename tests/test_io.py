@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import struct
 from pathlib import Path
@@ -652,3 +653,29 @@ def test_keep_previous_copies_a_large_file_in_chunks(tmp_path):
     assert peak < 8 << 20, peak
     assert kept.read_bytes() == data
     assert keep_previous(cloud) == kept  # the same bytes: not copied again
+
+
+@pytest.mark.parametrize(
+    ("data", "says"),
+    [
+        (None, "got NoneType"),
+        ("abc", "got str"),
+        ([1, 2, 3], "got list"),
+        (np.zeros((2, 2), np.uint8), "got array of shape (2, 2) dtype uint8"),
+        (np.zeros(4, np.float32), "got array of shape (4,) dtype float32"),
+    ],
+)
+def test_decode_image_names_what_is_not_bytes(data: object, says: str) -> None:
+    # None, a str and a list were an AttributeError ("has no attribute 'size'"), a 2-D array
+    # OpenCV's "(-215:Assertion failed) buf.checkVector(1, CV_8U) > 0"
+    from stereovision.io import decode_image
+
+    ok, png = cv2.imencode(".png", np.full((4, 6, 3), 7, np.uint8))
+    assert ok
+    for good in (png, png.tobytes(), bytearray(png.tobytes())):
+        img = decode_image(good)  # type: ignore[arg-type]
+        assert img is not None and img.shape == (4, 6, 3) and int(img.max()) == 7
+    with pytest.raises(TypeError, match=r"^data: expected the file's bytes or a 1-D uint8 array, "):
+        decode_image(data)  # type: ignore[arg-type]
+    with pytest.raises(TypeError, match=re.escape(says)):
+        decode_image(data)  # type: ignore[arg-type]

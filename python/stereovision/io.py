@@ -389,8 +389,24 @@ def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] |
     -------
     numpy.ndarray or None
         ``uint8`` ``(H, W, 3)`` BGR; None if the bytes are empty or not a readable image.
+
+    Raises
+    ------
+    TypeError
+        If ``data`` is neither bytes nor a 1-D ``uint8`` array (None and a str were an
+        AttributeError, a 2-D array OpenCV's "buf.checkVector(1, CV_8U) > 0").
     """
-    buf = np.frombuffer(data, np.uint8) if isinstance(data, bytes) else data
+    if isinstance(data, (bytes, bytearray, memoryview)):
+        buf = np.frombuffer(data, np.uint8)
+    elif isinstance(data, np.ndarray) and data.dtype == np.uint8 and data.ndim == 1:
+        buf = data
+    else:
+        what = (
+            f"array of shape {data.shape} dtype {data.dtype}"
+            if isinstance(data, np.ndarray)
+            else type(data).__name__
+        )
+        raise TypeError(f"data: expected the file's bytes or a 1-D uint8 array, got {what}")
     if buf.size == 0:
         return None
     with _opencv_quiet():
