@@ -679,3 +679,23 @@ def test_decode_image_names_what_is_not_bytes(data: object, says: str) -> None:
         decode_image(data)  # type: ignore[arg-type]
     with pytest.raises(TypeError, match=re.escape(says)):
         decode_image(data)  # type: ignore[arg-type]
+
+
+def test_write_pfm_refuses_what_it_would_change(tmp_path: Path) -> None:
+    # a finite 1e300 was written as inf, and little_endian="no" (true) a little-endian file
+    arr = np.array([[1.0, np.nan], [np.inf, -3.5e38]])  # -3.5e38 is beyond float32 too
+    with pytest.raises(
+        ValueError,
+        match=re.escape(
+            "arr: 1 finite value(s) beyond float32's range (e.g. -3.5e+38) would be written as inf"
+        ),
+    ):
+        write_pfm(tmp_path / "a.pfm", arr)
+    with pytest.raises(
+        TypeError, match=re.escape("little_endian: expected True or False, got 'no'")
+    ):
+        write_pfm(tmp_path / "b.pfm", arr[:1], little_endian="no")  # type: ignore[arg-type]
+    assert not (tmp_path / "a.pfm").exists() and not (tmp_path / "b.pfm").exists()
+    big = np.array([[1e30, -2.0], [np.inf, np.nan]])  # within float32, and non-finite: kept
+    write_pfm(tmp_path / "c.pfm", big, little_endian=np.bool_(False))
+    np.testing.assert_array_equal(read_pfm(tmp_path / "c.pfm"), big.astype(np.float32))

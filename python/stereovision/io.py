@@ -617,13 +617,28 @@ def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) ->
     Raises
     ------
     ValueError
-        If ``arr`` has the wrong shape or a non-real dtype.
+        If ``arr`` has the wrong shape or a non-real dtype, or finite values beyond float32's
+        range (they would be written as inf).
+    TypeError
+        If ``little_endian`` is not True or False.
     """
+    if not isinstance(little_endian, (bool, np.bool_)):
+        # "no" was true: a little-endian file where the caller asked for the other order
+        raise TypeError(f"little_endian: expected True or False, got {little_endian!r}")
     a = np.asarray(arr)
     if a.dtype.kind not in "iuf" or a.size == 0:
         raise ValueError(f"arr: expected a non-empty real array, got {_describe(a)}")
     if not (a.ndim == 2 or (a.ndim == 3 and a.shape[2] == 3)):
         raise ValueError(f"arr: expected shape (H, W) or (H, W, 3), got {a.shape}")
+    if a.dtype.kind == "f" and a.dtype.itemsize > 4:
+        # the cast made a finite 1e300 an inf without a word (no integer reaches float32's max)
+        with np.errstate(invalid="ignore"):
+            big = np.isfinite(a) & (np.abs(a) > float(np.finfo(np.float32).max))
+        if big.any():
+            raise ValueError(
+                f"arr: {int(big.sum())} finite value(s) beyond float32's range (e.g. "
+                f"{float(a[big][0])!r}) would be written as inf"
+            )
     height, width = a.shape[:2]
     magic = b"PF" if a.ndim == 3 else b"Pf"
     dtype = np.dtype("<f4") if little_endian else np.dtype(">f4")
