@@ -335,3 +335,20 @@ def test_fast_mode_unfilled_beats_the_gabor_channel_live(data_dir: Path) -> None
     (g_dens, g_bad), (f_dens, f_bad) = figures
     assert f_dens > g_dens + 0.03, figures
     assert f_bad < 0.5 * g_bad, figures
+
+
+@pytest.mark.parametrize(("lo", "hi", "levels"), [(0, 2048, 2049), (-100, 8191.5, 8293)])
+def test_a_range_beyond_the_kernel_names_the_arguments(lo: float, hi: float, levels: int) -> None:
+    # the kernel's message named its `d_max` ("the range holds 8192 levels; at most 2048 are
+    # supported"), which match(method="fused", max_disparity=8191) passed on
+    import re
+
+    import stereovision as sv
+
+    ok = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    assert sgm_disparity(ok, ok, max_disparity=2047).shape == (20, 30)  # 2048 levels: taken
+    says = f"max_disparity - min_disparity: the census search range {lo!r} to {hi!r} holds {levels}"
+    with pytest.raises(ValueError, match="^" + re.escape(says)):
+        sgm_disparity(ok, ok, min_disparity=lo, max_disparity=hi)
+    with pytest.raises(ValueError, match=r"census search range .* at most 2048 are supported"):
+        sv.match(ok, ok, method="fused", max_disparity=8191)

@@ -182,8 +182,15 @@ def sgm_disparity(
         raise ValueError(f"paths: expected 8 or 3, got {p['paths']!r}")
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
     levels = math.ceil(max_disparity) - math.floor(min_disparity) + 1
-    if levels <= _MAX_LEVELS:  # beyond it the kernel's own range error is the clearer one
-        _check_memory(gl.shape[1], gl.shape[0], levels, int(p["paths"]))
+    if levels > _MAX_LEVELS:
+        # the kernel's own message named its `d_max` ("the range holds 8192 levels; at most
+        # 2048 are supported"), not the caller's arguments (match "fused" over 8191 px)
+        raise ValueError(
+            f"max_disparity - min_disparity: the census search range {min_disparity!r} to "
+            f"{max_disparity!r} holds {levels} disparity levels; at most {_MAX_LEVELS} are "
+            "supported"
+        )
+    _check_memory(gl.shape[1], gl.shape[0], levels, int(p["paths"]))
     return _core.sgm_disparity(
         np.ascontiguousarray(gl),
         np.ascontiguousarray(gr),
