@@ -699,3 +699,16 @@ def test_write_pfm_refuses_what_it_would_change(tmp_path: Path) -> None:
     big = np.array([[1e30, -2.0], [np.inf, np.nan]])  # within float32, and non-finite: kept
     write_pfm(tmp_path / "c.pfm", big, little_endian=np.bool_(False))
     np.testing.assert_array_equal(read_pfm(tmp_path / "c.pfm"), big.astype(np.float32))
+
+
+@pytest.mark.parametrize("flag", ["no", None, 0])
+def test_write_ply_drop_invalid_must_be_a_switch(tmp_path: Path, flag: object) -> None:
+    # "no" (true) dropped the NaN points the caller meant to keep, without a word
+    pts = np.array([[0.0, 0.0, 1.0], [np.nan, 0.0, 1.0]], np.float32)
+    write_ply(tmp_path / "keep.ply", pts, drop_invalid=np.bool_(False))
+    assert len(read_ply(tmp_path / "keep.ply")[0]) == 2
+    with pytest.raises(
+        TypeError, match=re.escape(f"drop_invalid: expected True or False, got {flag!r}")
+    ):
+        write_ply(tmp_path / "x.ply", pts, drop_invalid=flag)  # type: ignore[arg-type]
+    assert not (tmp_path / "x.ply").exists()

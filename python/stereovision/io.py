@@ -720,7 +720,12 @@ def write_ply(
         ``uint8``, or ``comment`` is not one line of printable ASCII.
     FileNotFoundError
         If the folder of ``path`` does not exist.
+    TypeError
+        If ``drop_invalid`` is not True or False.
     """
+    if not isinstance(drop_invalid, (bool, np.bool_)):
+        # "no" (true) dropped the NaN points the caller meant to keep, None kept them
+        raise TypeError(f"drop_invalid: expected True or False, got {drop_invalid!r}")
     if comment is None:
         comment = PLY_CLOUD_COMMENT
     if not (isinstance(comment, str) and comment.isascii() and comment.isprintable()):
