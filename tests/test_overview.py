@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import itertools
 import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import cv2
@@ -456,3 +459,34 @@ def test_the_depth_caption_names_the_limits_and_no_fill_it_did_not_make(terrace_
     unfilled = dataclasses.replace(res, confidence=np.ones_like(res.confidence))
     share = 100 * float(np.isfinite(res.depth).mean())
     assert overview_image(unfilled, "terrace").captions["depth"] == f"depth (m) on {share:.1f} %"
+
+
+def test_depth_of_a_pair_in_a_non_utf8_folder_writes_its_overview(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """A folder name with a byte that is not UTF-8 (a lone surrogate in the title) crashed
+    ``cv2.getTextSize`` with a segmentation fault (exit -11, no output); the title draws it as
+    ``?``. In a subprocess: the old crash would take pytest down with it."""
+    scene = data_dir / "middlebury2001" / "tsukuba"
+    folder = os.fsencode(tmp_path) + b"/pair\xff"
+    os.mkdir(folder)
+    for side in ("left", "right"):
+        with open(folder + f"/{side}.png".encode(), "wb") as f:
+            f.write((scene / f"{side}.png").read_bytes())
+    out = tmp_path / "o"
+    pair = [os.fsdecode(folder + b"/left.png"), os.fsdecode(folder + b"/right.png")]
+    argv = ["depth", *pair, "--method", "fast", "--max-disparity", "16", "-o", str(out)]
+    proc = subprocess.run(
+        [sys.executable, "-m", "stereovision", *argv],
+        capture_output=True,
+        check=False,
+    )
+    assert proc.returncode == 0, proc.stderr.decode(errors="replace")
+    img = cv2.imread(str(out / "overview.png"))
+    assert img is not None and img.shape[1] > 2 * 384
+
+
+def test_overview_title_outside_ascii_is_drawn_as_question_marks(terrace_run: tuple) -> None:
+    """The title keeps its ASCII and shows every other character as one ``?``."""
+    picture = overview_image(terrace_run[1], "caf\u00e9 | x")
+    assert picture.title == "caf? | x"

@@ -251,6 +251,16 @@ def _end_label(value: float, unit: str) -> str:
     return f"{_label(value)} {unit}" if unit else _label(value)
 
 
+def _drawable(text: str) -> str:
+    """``text`` as OpenCV's Hershey fonts can draw it: every non-ASCII character as ``?``.
+
+    The fonts have glyphs for ASCII only, and a lone surrogate --
+    a file name's non-UTF-8 byte as Python decodes it (``os.fsdecode``) -- crashes
+    ``cv2.getTextSize`` and ``cv2.putText`` (a segmentation fault, not an exception).
+    """
+    return text.encode("ascii", "replace").decode("ascii")
+
+
 def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     """The overview of a :class:`~stereovision.depth.DepthResult`.
 
@@ -259,7 +269,8 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     result : DepthResult
         Its left (rectified) image, disparity, depth (None without calibration) and confidence.
     title : str
-        The one-line title (ASCII; scaled down to fit).
+        The one-line title (scaled down to fit; a character outside ASCII is drawn, and kept
+        in :attr:`Overview.title`, as ``?``).
     unit : str
         The depth bar's unit (its caption and tick labels): ``"m"`` (default), ``"ft"``,
         ``"mm"``, ``"cm"`` or ``"in"`` (:data:`~stereovision.calibration.UNIT_TO_METRES`). The
@@ -385,6 +396,7 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
             continue
         bars[name] = _bar(img, x + pw + _BAR_GAP, y + _CAPTION_H, ph, ticks, bar_unit)
     font_scale = 0.6
+    title = _drawable(title)
     (tw, _), _ = cv2.getTextSize(title, _FONT, font_scale, 1)
     if tw > width - 2 * _MARGIN:
         font_scale *= (width - 2 * _MARGIN) / tw
