@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
+import os
 import re
 import warnings
 from pathlib import Path
@@ -1066,3 +1067,33 @@ def test_runs_mostly_sharing_their_numbers_are_paired_by_number() -> None:
     # 11 of 20 shared (right_0010..0029): by number
     with pytest.raises(ValueError, match=r"18 image\(s\) have no partner"):
         calmod._pair_by_number(lefts, [f"cams/right_{i:04d}.png" for i in range(10, 30)])
+
+
+def test_calibrate_report_of_images_with_non_utf8_names(tmp_path: Path) -> None:
+    """Board images whose names hold a byte that is not UTF-8 (lone surrogates in the report's
+    names): the error chart's labels crashed ``cv2.getTextSize`` (a segmentation fault, exit
+    -11), then report.html could not be encoded (``'utf-8' codec can't encode character``). The
+    chart draws the byte as ``?`` and the page shows it as ``\\udcff``, as Python names it. In a
+    subprocess: the old crash would take pytest down with it."""
+    import subprocess
+    import sys
+
+    src = os.fsencode(tmp_path / "img")
+    os.mkdir(src)
+    left, right = [], []
+    for i in ("01", "02", "03", "04", "05", "06"):
+        for side, names in (("left", left), ("right", right)):
+            name = src + f"/{side[0]}".encode() + b"\xff" + f"{i}.jpg".encode()
+            with open(name, "wb") as f:
+                f.write((DATA / f"{side}{i}.jpg").read_bytes())
+            names.append(os.fsdecode(name))
+    rep = tmp_path / "rep"
+    argv = ["calibrate", "--left", *left, "--right", *right, "--square", "1"]
+    argv += ["-o", str(tmp_path / "cal.yaml"), "--report", str(rep)]
+    proc = subprocess.run(
+        [sys.executable, "-m", "stereovision", *argv], capture_output=True, check=False
+    )
+    assert proc.returncode == 0, proc.stderr.decode(errors="replace")
+    page = (rep / "report.html").read_text(encoding="utf-8")
+    assert "l\\udcff01.jpg" in page
+    assert (rep / "report.json").is_file() and (tmp_path / "cal.yaml").is_file()

@@ -59,6 +59,7 @@ import numpy.typing as npt
 # at run time too, so that typing.get_type_hints resolves the public signatures
 from stereovision.calibration import Calibration
 from stereovision.charuco import CharucoBoard
+from stereovision.overview import cv2_text
 
 __all__ = [
     "DISTORTION_MODELS",
@@ -736,8 +737,10 @@ class CalibrationReport:
         paths = {"html": d / "report.html", "yaml": d / "report.yaml", "json": d / "report.json"}
         self.save(paths["yaml"])
         self.save(paths["json"])
-        with atomic_write(paths["html"], "w") as fh:
-            fh.write(page)
+        # a file name's non-UTF-8 byte (a lone surrogate, os.fsdecode) as "\udcff", as Python
+        # shows it: UTF-8 cannot encode a surrogate
+        with atomic_write(paths["html"], "wb") as fh:
+            fh.write(page.encode("utf-8", "backslashreplace"))
         return paths
 
 
@@ -1892,7 +1895,7 @@ def _png_b64(img: np.ndarray) -> str:
 def _text(
     img: np.ndarray, s: str, org: tuple[int, int], scale: float = 0.45, color: Any = _BLACK
 ) -> None:
-    cv2.putText(img, s, org, _FONT, scale, color, 1, cv2.LINE_AA)
+    cv2.putText(img, cv2_text(s), org, _FONT, scale, color, 1, cv2.LINE_AA)
 
 
 def _label(
@@ -1905,6 +1908,7 @@ def _label(
 ) -> tuple[int, int, int, int]:
     """``s`` at ``org`` (its baseline's left end) on a ``background`` box, so that bars and lines
     under it cannot hide it; returns the box ``(x0, y0, x1, y1)``, ends included."""
+    s = cv2_text(s)
     (tw, th), base = cv2.getTextSize(s, _FONT, scale, 1)
     x0, y0 = max(org[0] - 2, 0), max(org[1] - th - 2, 0)
     x1 = min(org[0] + tw + 2, img.shape[1] - 1)
@@ -1957,7 +1961,7 @@ def _error_chart(rep: CalibrationReport) -> np.ndarray:
         color_r = _RED if n in rep.outlier_pairs else _ORANGE
         cv2.rectangle(img, (x0, ypix(el[k])), (x0 + bw, top + plot_h), color_l, -1)
         cv2.rectangle(img, (x0 + bw, ypix(er[k])), (x0 + 2 * bw, top + plot_h), color_r, -1)
-        label = n.split(" / ")[0]  # the left file's name: both do not fit the axis
+        label = cv2_text(n.split(" / ")[0])  # the left file's name: both do not fit the axis
         label = label if len(label) <= 16 else label[:15] + "~"
         (tw, th), _ = cv2.getTextSize(label, _FONT, 0.4, 1)
         tag = np.full((th + 6, tw + 4, 3), 255, np.uint8)

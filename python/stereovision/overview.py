@@ -251,7 +251,7 @@ def _end_label(value: float, unit: str) -> str:
     return f"{_label(value)} {unit}" if unit else _label(value)
 
 
-def _drawable(text: str) -> str:
+def cv2_text(text: str) -> str:
     """``text`` as OpenCV's Hershey fonts can draw it: every non-ASCII character as ``?``.
 
     The fonts have glyphs for ASCII only, and a lone surrogate --
@@ -396,7 +396,7 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
             continue
         bars[name] = _bar(img, x + pw + _BAR_GAP, y + _CAPTION_H, ph, ticks, bar_unit)
     font_scale = 0.6
-    title = _drawable(title)
+    title = cv2_text(title)
     (tw, _), _ = cv2.getTextSize(title, _FONT, font_scale, 1)
     if tw > width - 2 * _MARGIN:
         font_scale *= (width - 2 * _MARGIN) / tw
