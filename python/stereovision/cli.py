@@ -758,9 +758,17 @@ def cmd_check(args: argparse.Namespace) -> int:
         left, right = calib.rectify(left, right)
     res = check_rectification(left, right, tolerance=args.tolerance)
     if args.plot:
+        from stereovision.io import keep_previous
         from stereovision.rectification_check import draw_rectification_check
 
-        _atomic_write_bytes(Path(args.plot), _png_bytes(draw_rectification_check(left, right, res)))
+        # a file already there (an earlier plot, or the user's own picture) is copied aside
+        plot = Path(args.plot)
+        kept_plot = keep_previous(plot)
+        _atomic_write_bytes(plot, _png_bytes(draw_rectification_check(left, right, res)))
+        if kept_plot is not None:  # on stderr: with --json stdout is the one JSON object
+            print(
+                f"stereovision: {plot} replaced; the earlier file is {kept_plot}", file=sys.stderr
+            )
     print(json.dumps(res.as_dict()) if args.json else res.summary())
     if res.ok is False and not res.swapped and not args.json and fix is None:
         print(
