@@ -544,3 +544,16 @@ def test_an_odd_rowed_board_is_not_described_as_a_legacy_layout() -> None:
     assert np.array_equal(odd.image(40), CharucoBoard("9x7", 0.03, 0.022, "DICT_5X5_50").image(40))
     even = CharucoBoard("10x8", 0.03, 0.022, "DICT_5X5_50", legacy=True)
     assert even.describe().endswith("DICT_5X5_50 (legacy layout)")
+
+
+def test_cli_board_keeps_a_file_it_replaces(tmp_path: Path) -> None:
+    """``board -o board.png`` over an existing file (another board printed earlier, the user's
+    picture) replaced it without a word; it is copied aside as board.previous.png, said."""
+    out = tmp_path / "board.png"
+    out.write_bytes(b"my picture")
+    run = _cli("board", "-o", str(out), "--pattern", "9x6", "--square", "0.03")
+    assert run.returncode == 0, run.stderr
+    kept = tmp_path / "board.previous.png"
+    assert kept.read_bytes() == b"my picture"
+    assert run.stdout.splitlines()[0].endswith(f"(the one it replaced kept as {kept})")
+    assert cv2.imread(str(out)) is not None

@@ -2671,12 +2671,15 @@ def cmd_board(args: argparse.Namespace) -> int:
         pat = parse_pattern(args.pattern or "9x6", "--pattern")
         data, (w, h) = board_png(pat, square * UNIT_TO_METRES[args.unit], dpi)
         what = f"chessboard {pat[0]}x{pat[1]} inner corners, square {square:g} {args.unit}"
+    from stereovision.io import keep_previous
+
+    kept = keep_previous(out)  # a board.png already there (another board, a picture) stays
     with atomic_write(out) as fh:
         fh.write(data)
     # the PNG's resolution makes the whole-pixel square its exact size (_board_scale)
     pix, ppm = _board_scale(square * UNIT_TO_METRES[args.unit], dpi)
     mm = 1000 / ppm
-    print(f"{out}: {what}")
+    print(f"{out}: {what}" + (f" (the one it replaced kept as {kept})" if kept else ""))
     print(
         f"{w}x{h} px at {ppm} px/m ({ppm * 0.0254:.2f} dpi: {pix} px per square at {dpi:g} "
         f"dpi); printed at 100 % scale it is {w * mm:.1f} x {h * mm:.1f} mm with "
