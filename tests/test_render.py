@@ -635,7 +635,10 @@ def test_view_shows_a_big_cloud_decimated_and_leaves_the_file(tmp_path, capsys):
     # 0 shows every point, without a note
     assert cli.main(["view", str(ply), "-o", str(shot), "--max-points", "0"]) == 0
     io = capsys.readouterr()
-    assert io.out == f"1000 points -> {shot}\n" and "note" not in io.err
+    # the first run's shot, replaced, is kept aside (said)
+    kept = tmp_path / "shot.previous.png"
+    assert io.out == f"1000 points -> {shot} (the one it replaced kept as {kept})\n"
+    assert "note" not in io.err
     assert cli.main(["view", str(ply), "-o", str(shot), "--max-points", "-5"]) == 2
     assert capsys.readouterr().err == (
         "stereovision: error: --max-points: expected 0 (all) or more, got -5\n"
@@ -730,3 +733,19 @@ def test_terrace_render_not_blank_and_rotation_differs(terrace):
     assert not render.is_blank(rotated, min_fraction=0.5)
     changed = np.abs(shot.astype(np.int16) - rotated.astype(np.int16)).max(axis=-1) > 30
     assert changed.mean() > 0.3
+
+
+def test_view_keeps_a_file_its_screenshot_replaces(result, tmp_path, capsys):
+    """``view -o shot.png`` over an existing file (the user's picture, an earlier shot) replaced
+    it without a word; it is copied aside as shot.previous.png and the line names the copy."""
+    from stereovision.export import write_cloud_ply
+
+    write_cloud_ply(tmp_path / "cloud.ply", result)
+    shot = tmp_path / "shot.png"
+    shot.write_bytes(b"my picture")
+    args = _view_args(tmp_path, shot, yaw=5.0)
+    assert args.func(args) == 0
+    kept = tmp_path / "shot.previous.png"
+    assert kept.read_bytes() == b"my picture"
+    assert capsys.readouterr().out.endswith(f"-> {shot} (the one it replaced kept as {kept})\n")
+    assert cv2.imread(str(shot)) is not None

@@ -1199,8 +1199,9 @@ def cmd_view(args: argparse.Namespace) -> int:
     ok, buf = cv2.imencode(out.suffix.lower() or ".png", img[..., ::-1])
     if not ok:
         raise OSError(f"could not encode {out}")
-    from stereovision.io import atomic_write
+    from stereovision.io import atomic_write, keep_previous
 
+    kept = keep_previous(out)  # a file already there (an earlier shot, a picture) stays
     with atomic_write(out) as fh:
         fh.write(buf.tobytes())
     # a cloud's cells are its points: "N points, N cells" read as if it were a mesh
@@ -1211,7 +1212,8 @@ def cmd_view(args: argparse.Namespace) -> int:
     else:
         what = f"{shown} points"
     what += f", {geometry.n_faces} triangles" if geometry.n_faces else ""
-    print(f"{what} -> {out}", file=sys.stdout)
+    replaced = f" (the one it replaced kept as {kept})" if kept else ""
+    print(f"{what} -> {out}{replaced}", file=sys.stdout)
     return 0
 
 
