@@ -1097,3 +1097,25 @@ def test_calibrate_report_of_images_with_non_utf8_names(tmp_path: Path) -> None:
     page = (rep / "report.html").read_text(encoding="utf-8")
     assert "l\\udcff01.jpg" in page
     assert (rep / "report.json").is_file() and (tmp_path / "cal.yaml").is_file()
+
+
+def test_images_too_small_for_a_board_have_none(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Images below 15 px a side failed an OpenCV assertion in the classic detector (calibrate
+    on 1x1 px images: 'internal error: OpenCV ... adaptiveThreshold (please report this)'); no
+    board is found in them, and calibrate names the pairs it rejected."""
+    from stereovision.cli import main
+
+    rng = np.random.default_rng(0)
+    for shape in [(1, 1), (14, 640), (640, 14), (3, 3, 3)]:
+        assert find_corners(rng.integers(0, 256, shape, dtype=np.uint8)) is None
+    tiny = rng.integers(0, 256, (1, 1, 3), dtype=np.uint8)
+    cv2.imwrite(str(tmp_path / "l1.png"), tiny)
+    cv2.imwrite(str(tmp_path / "r1.png"), tiny)
+    argv = ["calibrate", "--left", str(tmp_path / "l1.png"), "--right", str(tmp_path / "r1.png")]
+    assert main([*argv, "--square", "1", "-o", str(tmp_path / "c.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "internal error" not in err
+    assert "found in both images of only 0 of 1 pairs" in err and "l1.png / r1.png" in err
+    assert not (tmp_path / "c.yaml").exists()

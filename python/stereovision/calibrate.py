@@ -83,6 +83,10 @@ F64 = npt.NDArray[np.float64]
 
 # ------------------------------------------------------------------------------ named constants
 
+#: Shortest image side the classic chessboard detector takes: below 15 px its adaptive threshold
+#: failed an OpenCV assertion (``blockSize % 2 == 1 && blockSize > 1``: an "internal error" of
+#: ``calibrate`` on a 1x1 px image); no board of 4x4 squares fits there anyway.
+MIN_BOARD_IMAGE_SIDE = 15
 #: Flag sets tried in turn with ``findChessboardCornersSB``. ``ACCURACY`` asks for its sub-pixel
 #: mode; ``NORMALIZE_IMAGE`` equalises the histogram first, which finds all 26 boards of OpenCV's
 #: sample set; ``EXHAUSTIVE`` is slower and only a fallback (alone it misses one sample board).
@@ -440,6 +444,8 @@ def find_corners(image: npt.ArrayLike, pattern: tuple[int, int] = (9, 6)) -> F64
 
     pattern = parse_pattern(pattern)
     gray = as_gray_uint8(image, "image")
+    if min(gray.shape[:2]) < MIN_BOARD_IMAGE_SIDE:
+        return None  # no board fits (and the classic detector fails an assertion there)
     found: npt.NDArray[np.float32] | None = None
     # checkChessboard (~2 ms) is a quick look for a board: it saw all 26 sample boards; when it
     # sees none, only the first flag set is tried (each SB call on a board-less image is ~0.5 s).
