@@ -751,6 +751,24 @@ def test_patterns_too_small_or_not_integers_are_refused(tmp_path: Path) -> None:
     assert not (tmp_path / "b.png").exists()
 
 
+def test_patterns_too_large_are_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """``--pattern 99999x99999`` ended in "Unable to allocate 74.5 GiB for an array"; a count
+    above 4096 (4 px squares across a 16384 px image) is refused by name."""
+    from stereovision.cli import main
+
+    assert parse_pattern("4096x3") == (4096, 3)
+    for bad in ("4097x6", (9, 4097)):
+        with pytest.raises(ValueError, match=r"a chessboard has at most 4096 each way"):
+            parse_pattern(bad)
+    left, right = _chessboard_paths()
+    argv = ["calibrate", "--left", str(left[0]), "--right", str(right[0]), "--square", "1"]
+    assert main([*argv, "--pattern", "99999x99999", "-o", str(tmp_path / "c.yaml")]) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: --pattern: 99999x99999 inner corners; a chessboard has at most "
+        "4096 each way (4 px squares across a 16384 px image)\n"
+    )
+
+
 def test_the_triangulated_square_is_not_claimed_as_a_check_of_the_given_one(
     chessboard: tuple[Calibration, CalibrationReport], cached_corners: None
 ) -> None:

@@ -98,6 +98,9 @@ SB_FLAG_SETS: tuple[int, ...] = (
 #: Fewest inner corners of a chessboard each way: OpenCV's detectors refuse fewer (2x5 was an
 #: "internal error" from cv2.error).
 MIN_PATTERN_CORNERS = 3
+#: Most inner corners of a chessboard each way: a 16384 px image side (the largest the CLI
+#: takes) over 4 px squares. ``--pattern 99999x99999`` ended in "Unable to allocate 74.5 GiB".
+MAX_PATTERN_CORNERS = 4096
 #: Flags of the classic detector, the last resort.
 CLASSIC_FLAGS = cv2.CALIB_CB_ADAPTIVE_THRESH | cv2.CALIB_CB_NORMALIZE_IMAGE
 #: ``cornerSubPix`` half-window as a fraction of the smallest corner spacing in the image.
@@ -219,7 +222,7 @@ def parse_pattern(text: str | Sequence[int], name: str = "pattern") -> tuple[int
     Returns
     -------
     tuple of int
-        ``(cols, rows)``, both >= :data:`MIN_PATTERN_CORNERS`.
+        ``(cols, rows)``, both from :data:`MIN_PATTERN_CORNERS` to :data:`MAX_PATTERN_CORNERS`.
 
     Raises
     ------
@@ -227,7 +230,8 @@ def parse_pattern(text: str | Sequence[int], name: str = "pattern") -> tuple[int
         If ``text`` is neither a string nor a pair of integers (``9``, ``(9.5, 6)``).
     ValueError
         If the text is not two integers separated by ``x``, or a count is below
-        :data:`MIN_PATTERN_CORNERS` (OpenCV's detectors need a corner inside each side).
+        :data:`MIN_PATTERN_CORNERS` (OpenCV's detectors need a corner inside each side) or
+        above :data:`MAX_PATTERN_CORNERS`.
     """
     if isinstance(text, str):
         parts = text.lower().replace("*", "x").split("x")
@@ -262,6 +266,11 @@ def parse_pattern(text: str | Sequence[int], name: str = "pattern") -> tuple[int
         raise ValueError(
             f"{name}: {vals[0]}x{vals[1]} inner corners; a chessboard needs at least "
             f"{MIN_PATTERN_CORNERS} each way (e.g. 9x6 for a board of 10x7 squares)"
+        )
+    if max(vals) > MAX_PATTERN_CORNERS:
+        raise ValueError(
+            f"{name}: {vals[0]}x{vals[1]} inner corners; a chessboard has at most "
+            f"{MAX_PATTERN_CORNERS} each way (4 px squares across a 16384 px image)"
         )
     return vals[0], vals[1]
 
