@@ -336,21 +336,27 @@ def test_table1_report_names_a_bad_count_or_seed(key: str, value: object, says: 
         ("target", 101.0, "target: expected a precision in percent, 0 to 100, got 101.0"),
         ("target", -1.0, "target: expected a precision in percent, 0 to 100, got -1.0"),
         ("target", True, "target: expected a precision in percent, 0 to 100, got True"),
-        ("tol", 0.0, "tol: expected a positive finite number of pixels, got 0.0"),
-        ("tol", float("nan"), "tol: expected a positive finite number of pixels, got nan"),
-        ("tol", "1", "tol: expected a positive finite number of pixels, got '1'"),
-        ("tol", 10**400, "tol: expected a positive finite number of pixels, got 1000"),
+        ("tolerance", 0.0, "tolerance: expected a positive finite number of pixels, got 0.0"),
+        (
+            "tolerance",
+            float("nan"),
+            "tolerance: expected a positive finite number of pixels, got nan",
+        ),
+        ("tolerance", "1", "tolerance: expected a positive finite number of pixels, got '1'"),
+        ("tolerance", 10**400, "tolerance: expected a positive finite number of pixels, got 1000"),
     ],
 )
-def test_count_at_precision_names_a_bad_target_or_tol(key: str, value: object, says: str) -> None:
-    # NaN or 101 % counted 0 matches, -1 % all of them, a tol of 0 or NaN none, without a word
+def test_count_at_precision_names_a_bad_target_or_tolerance(
+    key: str, value: object, says: str
+) -> None:
+    # NaN or 101 % counted 0 matches, -1 % all of them, a tolerance of 0 or NaN none, without a word
     gt = np.full((4, 6), 5.0)
     xl = np.array([1.0, 2.0, 3.0])
     yl = np.ones(3)
     xr = xl - np.array([5.0, 8.0, 5.0])
     score = np.array([0.9, 0.8, 0.7])
     assert count_at_precision(xl, yl, xr, score, gt, 50.0, np.float32(1.0)) == 3
-    kw: dict[str, object] = {"target": 50.0, "tol": 1.0, key: value}
+    kw: dict[str, object] = {"target": 50.0, "tolerance": 1.0, key: value}
     with pytest.raises(ValueError, match="^" + re.escape(says)):
         count_at_precision(xl, yl, xr, score, gt, **kw)  # type: ignore[arg-type]
 

@@ -672,12 +672,14 @@ def count_at_precision(
     ValueError
         As :func:`sparse_metrics`, or if ``score`` has another length.
     """
-    # a target of NaN or above 100 % counted 0 matches, one below 0 all of them, a tol of 0,
+    # a target of NaN or above 100 % counted 0 matches, one below 0 all of them, a tolerance of 0,
     # -1 or NaN none, without a word ("1" was NumPy's UFuncTypeError)
     if not (_real(target) and 0.0 <= target <= 100.0):
         raise ValueError(f"target: expected a precision in percent, 0 to 100, got {target!r}")
-    if not _positive_finite(tol):
-        raise ValueError(f"tol: expected a positive finite number of pixels, got {tol!r}")
+    if not _positive_finite(tolerance):
+        raise ValueError(
+            f"tolerance: expected a positive finite number of pixels, got {tolerance!r}"
+        )
     g = _real_2d(gt, "gt")
     x, y, x2, s = (np.asarray(a, dtype=np.float64) for a in (xl, yl, xr, score))
     if any(a.ndim != 1 for a in (x, y, x2, s)) or len({a.shape for a in (x, y, x2, s)}) != 1:
