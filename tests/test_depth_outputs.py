@@ -2,14 +2,18 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import cv2
 import numpy as np
 import pytest
 
+from stereovision import cli
+from stereovision._interrupt import Terminated
 from stereovision.calibration import Calibration
-from stereovision.cli import depth_outputs
+from stereovision.cli import depth_outputs, main
 from stereovision.io import read_pfm, read_ply
 
 
@@ -59,3 +63,121 @@ def test_depth_files_are_the_filtered_results(data_dir: Path, tmp_path: Path, na
     np.testing.assert_array_equal(got, want)
     pts, _ = read_ply(written["cloud.ply"])
     assert len(pts) == len(res.points) and pts[:, 2].max() <= 4.0
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    """Every entry of ``folder`` (hidden ones too) by name: its bytes (a folder: b"<dir>")."""
+    return {p.name: (b"<dir>" if p.is_dir() else p.read_bytes()) for p in sorted(folder.iterdir())}
+
+
+def _terrace_argv(
+    data_dir: Path, out: Path, calib: bool = True, max_disparity: int = 32
+) -> list[str]:
+    scene = data_dir / "eth3d" / "terrace"
+    argv = ["depth", str(scene / "left.png"), str(scene / "right.png")]
+    argv += ["--max-disparity", str(max_disparity)]
+    if calib:
+        argv += ["--calib", str(scene / "calib.txt")]
+    return [*argv, "-o", str(out)]
+
+
+@pytest.mark.parametrize(
+    ("exc", "status"),
+    [(OSError("disk full"), 2), (KeyboardInterrupt(), 130), (Terminated("signal 15"), 143)],
+)
+def test_a_run_failing_midway_leaves_the_earlier_outputs_whole(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    exc: BaseException,
+    status: int,
+) -> None:
+    """A run into a folder of an earlier run that fails (or is interrupted) in a later writer
+    left its new disparity and depth files beside the earlier run's overview.png, render.png
+    and cloud.ply, without a word. The files are written into a hidden folder first and moved in
+    at the end: the earlier set stays byte for byte, manifest included, and no temporary
+    folder is left."""
+    out = tmp_path / "o"
+    assert main(_terrace_argv(data_dir, out)) == 0
+    before = _files(out)
+    assert "cloud.ply" in before and "overview.png" in before
+
+    def fails(*args: object, **kwargs: object) -> None:
+        raise exc
+
+    monkeypatch.setattr(cli, "write_overview", fails)  # after the maps, the cloud, the render
+    capsys.readouterr()
+    # another run: no calibration, another range (other disparity bytes), a stale cloud.ply
+    assert main(_terrace_argv(data_dir, out, calib=False, max_disparity=48)) == status
+    assert capsys.readouterr().err.startswith("stereovision: ")
+    assert _files(out) == before
+
+
+def test_a_new_folder_is_not_left_behind_by_a_failing_run(
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The -o folder a failing run created is removed with its temporary folder (it was left,
+    holding the files written before the error)."""
+    out = tmp_path / "new" / "o"
+
+    def fails(*args: object, **kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "write_overview", fails)
+    assert main(_terrace_argv(data_dir, out)) == 130
+    assert not out.exists()
+
+
+def test_a_complete_run_replaces_the_whole_earlier_set(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A run that completes leaves exactly its own files, those a run into an empty folder
+    writes, byte for byte: the earlier run's files it did not write removed (said), a file of
+    the user's kept, no temporary folder."""
+    out, fresh = tmp_path / "o", tmp_path / "fresh"
+    assert main(_terrace_argv(data_dir, out)) == 0
+    (out / "notes.txt").write_text("mine")
+    argv = _terrace_argv(data_dir, out, calib=False)
+    capsys.readouterr()
+    assert main(argv) == 0
+    said = capsys.readouterr().out
+    assert main(_terrace_argv(data_dir, fresh, calib=False)) == 0
+    got = _files(out)
+    assert got.pop("notes.txt") == b"mine"
+    assert got == _files(fresh)
+    assert sorted(got) == [
+        ".stereovision-depth.json", "disparity.pfm", "disparity.png", "overview.png"
+    ]  # fmt: skip
+    for name in ("cloud.ply", "depth.npy", "depth.png", "depth_mm.png", "render.png"):
+        assert f"  removed {name} of an earlier run (not written by this one)" in said
+
+
+_SIGTERM_MIDWAY = """
+import os, signal, sys
+import stereovision.cli as cli
+real = cli.write_overview
+def write_overview(*args, **kwargs):
+    os.kill(os.getpid(), signal.SIGTERM)  # the CLI's handler raises in here
+    return real(*args, **kwargs)
+cli.write_overview = write_overview
+sys.exit(cli.main(sys.argv[1:]))
+"""
+
+
+def test_sigterm_while_writing_leaves_the_earlier_outputs_whole(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """SIGTERM (kill, a container's stop) arriving while the files are written (another
+    range: other disparity bytes; no calibration: a stale cloud.ply): one line, exit 143, the
+    earlier run's set as it was and no temporary folder."""
+    out = tmp_path / "o"
+    assert main(_terrace_argv(data_dir, out)) == 0
+    before = _files(out)
+    proc = subprocess.run(
+        [sys.executable, "-c", _SIGTERM_MIDWAY, *_terrace_argv(data_dir, out, False, 48)],
+        capture_output=True, text=True, check=False, timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 143, proc.stderr
+    assert proc.stderr == "stereovision: terminated (SIGTERM)\n"
+    assert _files(out) == before

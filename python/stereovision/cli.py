@@ -17,7 +17,7 @@ import sys
 import threading
 import time
 import warnings
-from collections.abc import Collection, Sequence
+from collections.abc import Callable, Collection, Iterator, Sequence
 from importlib import resources
 from pathlib import Path
 from typing import Any, NoReturn
@@ -286,6 +286,7 @@ def depth_outputs(
     counts: dict[str, int] | None = None,
     name: str = "pair",
     unit: str = "m",
+    removed: list[Path] | None = None,
 ) -> tuple[Any, dict[str, Path]]:
     """What ``stereovision depth`` computes and writes for one pair (``batch`` writes the same).
 
@@ -296,9 +297,12 @@ def depth_outputs(
     calib : Calibration or None
         Without it only the disparity outputs are written.
     out_dir : pathlib.Path
-        Output folder (created if missing); every file is replaced atomically. A file there
-        under one of the output names that :data:`DEPTH_MANIFEST` does not list (not an earlier
-        run's) is refused before the matching (:func:`refuse_foreign_outputs`).
+        Output folder (created if missing). The run's files are written into a hidden folder
+        inside it (:func:`staged_outputs`) and moved in together at the end, the earlier run's
+        files this run did not write then removed (:func:`commit_outputs`): an error or an
+        interrupt before that leaves the earlier run's files as they were. A file there under
+        one of the output names that :data:`DEPTH_MANIFEST` does not list (not an earlier run's)
+        is refused before the matching (:func:`refuse_foreign_outputs`).
     method : str, optional
         Matcher; None = :func:`stereovision.depth.depth_map`'s default.
     max_disparity : int, optional
@@ -330,6 +334,8 @@ def depth_outputs(
         :data:`stereovision.calibration.UNIT_TO_METRES`); the files' own units do not change
         (``depth.npy`` and the cloud in metres, ``depth_mm.png`` in millimetres), nor do the
         options' (``max_depth``, ``max_sigma``, ``voxel``, ``grid``: metres).
+    removed : list, optional
+        Receives the earlier run's files that were removed, not rewritten by this run.
 
     Returns
     -------
@@ -367,13 +373,18 @@ def depth_outputs(
     res = depth_map(left, right, calib, max_disparity=max_disparity, fill=fill, refine=refine, **kw)
     if max_depth is not None or max_sigma is not None:
         res = res.filtered(max_depth=max_depth, max_sigma=max_sigma)
-    # recorded before the first file is written: a run stopped halfway leaves them claimed
-    record_outputs(out_dir, earlier | set(names))
-    written = write_depth_outputs(res, out_dir, voxel, counts=counts)
-    written.update(render_outputs(res, out_dir))
-    written.update(write_overview(res, out_dir, name, unit))
-    if ground:
-        written.update(_ground_outputs(res, calib, out_dir, grid, log, unit))
+    # Every file is written into a hidden folder inside out_dir first and moved in only when
+    # all are there: an error or interrupt in a later writer left the new disparity files
+    # beside the earlier run's overview.png, depth.npy and cloud.ply, without a word.
+    with staged_outputs(out_dir) as stage:
+        staged = write_depth_outputs(res, stage, voxel, counts=counts)
+        staged.update(render_outputs(res, stage))
+        staged.update(write_overview(res, stage, name, unit))
+        if ground:
+            staged.update(_ground_outputs(res, calib, stage, grid, log, unit))
+        written, gone = commit_outputs(out_dir, staged, earlier)
+    if removed is not None:
+        removed.extend(gone)
     return res, written
 
 
@@ -509,38 +520,116 @@ def record_outputs(
         json.dump(sorted(n for n in names if n in known), fh)
 
 
-def remove_stale_outputs(out_dir: Path, written: dict[str, Path]) -> list[Path]:
-    """Remove the depth outputs of an earlier run that this run did not rewrite.
+#: The hidden folder a run writes its files into, inside its ``-o`` folder (the same file
+#: system, so that each file moves in atomically), followed by a random suffix.
+STAGING_PREFIX = ".stereovision-partial-"
 
-    A folder that held ``cloud.ply`` from a run with a calibration would otherwise keep it after
-    a run without one, and ``stereovision view DIR`` would show the earlier scene. Only files
-    the earlier run listed in :data:`DEPTH_MANIFEST` as its own are touched (and of those only
-    names in :data:`DEPTH_OUTPUTS`, regular files): a ``cloud.ply`` or ``map.png`` of the user's
-    in a folder given as ``-o`` stays, as does everything in a folder without the manifest
-    (an earlier version's outputs included). This run's outputs are then written as the new
-    manifest.
+
+@contextlib.contextmanager
+def staged_outputs(out_dir: Path) -> Iterator[Path]:
+    """A hidden temporary folder inside ``out_dir`` (created if missing) to write a run's files
+    into before :func:`commit_outputs` moves them in.
+
+    The folder is removed when the block ends, however it ends (an error, Ctrl-C, SIGTERM as
+    the CLI raises it); ``out_dir`` too when the block created it and fails with it empty.
 
     Parameters
     ----------
     out_dir : pathlib.Path
         The ``-o`` folder.
-    written : dict
-        What this run wrote: file name -> path.
+
+    Yields
+    ------
+    pathlib.Path
+        The temporary folder (``.stereovision-partial-XXXXXXXX``).
+    """
+    import shutil
+    import tempfile
+
+    from stereovision.io import make_folder
+
+    made = not out_dir.exists()
+    make_folder(out_dir)
+    stage = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out_dir))
+    try:
+        yield stage
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        if made:
+            with contextlib.suppress(OSError):  # only when empty: nothing else is touched
+                out_dir.rmdir()
+        raise
+    shutil.rmtree(stage, ignore_errors=True)
+
+
+def commit_outputs(
+    out_dir: Path,
+    staged: dict[str, Path],
+    earlier: Collection[str],
+    manifest: str = DEPTH_MANIFEST,
+    known: Sequence[str] = DEPTH_OUTPUTS,
+    stale: Callable[[Path], bool] | None = None,
+) -> tuple[dict[str, Path], list[Path]]:
+    """Move a run's files from :func:`staged_outputs`'s folder into ``out_dir``, then remove
+    the earlier run's files that this run did not write, and record the run's in ``manifest``.
+
+    Each file is moved with one rename (atomic); Ctrl-C and SIGTERM are held until all are in
+    and the earlier run's are gone (:class:`~stereovision._interrupt.HeldInterrupts`), so the
+    folder holds one run's files, the earlier run's or this one's. A folder where a file goes
+    is refused before any file moves.
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        The ``-o`` folder.
+    staged : dict
+        The run's files: name -> path in the temporary folder.
+    earlier : collection of str
+        The earlier run's files there (its manifest's: :func:`refuse_foreign_outputs`). Of
+        those, the regular files in ``known`` that this run did not write are removed, and
+        only they: a file of the user's stays.
+    manifest : str
+        :data:`DEPTH_MANIFEST` or :data:`RECTIFY_MANIFEST`.
+    known : sequence of str
+        The command's output names (:data:`DEPTH_OUTPUTS`, :data:`RECTIFY_OUTPUTS`).
+    stale : callable, optional
+        Whether an earlier run's file this run did not write is to go (default: each does).
 
     Returns
     -------
-    list of pathlib.Path
-        The files removed.
+    tuple
+        ``({name: path in out_dir}, [files removed])``.
+
+    Raises
+    ------
+    IsADirectoryError
+        A folder under one of the names; nothing is moved.
     """
-    earlier = _manifest_names(out_dir)
-    removed = []
-    for name in DEPTH_OUTPUTS:
-        path = out_dir / name
-        if name in earlier and name not in written and path.is_file() and not path.is_symlink():
-            path.unlink()
-            removed.append(path)
-    record_outputs(out_dir, set(written))
-    return removed
+    from stereovision._interrupt import HeldInterrupts
+
+    for name in staged:
+        target = out_dir / name
+        if target.is_dir() and not target.is_symlink():
+            raise IsADirectoryError(
+                f"{target} is a folder, where the run's {name} goes: move it away (the earlier "
+                "outputs are kept as they were)"
+            )
+    written: dict[str, Path] = {}
+    removed: list[Path] = []
+    with HeldInterrupts():
+        # claimed before the first move: should the process die halfway, a rerun replaces them
+        record_outputs(out_dir, set(earlier) | set(staged), manifest, known)
+        for name, path in staged.items():
+            os.replace(path, out_dir / name)
+            written[name] = out_dir / name
+        for name in known:
+            path = out_dir / name
+            if name in earlier and name not in written and path.is_file() and not path.is_symlink():
+                if stale is None or stale(path):
+                    path.unlink()
+                    removed.append(path)
+        record_outputs(out_dir, set(written), manifest, known)
+    return written, removed
 
 
 def _pair_name(left: str) -> str:
@@ -582,6 +671,7 @@ def cmd_depth(args: argparse.Namespace) -> int:
         left, right = rect.rectify(left, right)
         max_disparity = max_disparity or rect.max_disparity
     counts: dict[str, int] = {}
+    removed: list[Path] = []
     res, written = depth_outputs(
         left,
         right,
@@ -600,6 +690,7 @@ def cmd_depth(args: argparse.Namespace) -> int:
         counts=counts,
         name=_pair_name(args.left),
         unit=unit,
+        removed=removed,
     )
     cloud = (
         f"{_depth_range(res.depth, unit)}, {len(res.points)} points"
@@ -618,7 +709,7 @@ def cmd_depth(args: argparse.Namespace) -> int:
         print(f"  {_depth_coverage(res)}")
     for name, path in written.items():
         print(f"  {name:14s} {path}")
-    for path in remove_stale_outputs(Path(args.output), written):
+    for path in removed:
         print(f"  removed {path.name} of an earlier run (not written by this one)")
     return 0
 
@@ -1088,12 +1179,13 @@ def cmd_demo(args: argparse.Namespace) -> int:
     res = depth_map(
         scene.left, scene.right, scene.calib, method=args.method, max_disparity=scene.max_disparity
     )
-    record_outputs(out_dir, earlier | set(names))
-    written = write_depth_outputs(res, out_dir)
     from stereovision.render import render_outputs
 
-    written.update(render_outputs(res, out_dir))
-    written.update(write_overview(res, out_dir, "cones (Middlebury 2003, the demo scene)"))
+    with staged_outputs(out_dir) as stage:  # moved in together, as depth's (depth_outputs)
+        staged = write_depth_outputs(res, stage)
+        staged.update(render_outputs(res, stage))
+        staged.update(write_overview(res, stage, "cones (Middlebury 2003, the demo scene)"))
+        written, removed = commit_outputs(out_dir, staged, earlier)
     raw = dense_metrics(res.disparity, scene.gt)
     from stereovision.baselines import opencv_sgbm, row_fill
 
@@ -1132,7 +1224,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     print(f"outputs in {out_dir.resolve()}:")
     for name, path in written.items():
         print(f"  {name:14s} {path}")
-    for path in remove_stale_outputs(out_dir, written):
+    for path in removed:
         print(f"  removed {path.name} of an earlier run (not written by this one)")
     for name, kept in kept_aside:
         print(f"  the {name} that was there (no earlier run's output) is kept as {kept}")
