@@ -592,6 +592,29 @@ def test_demo_keeps_a_file_it_did_not_write(
     assert captured.err == _not_ours(other, "cloud.ply")
 
 
+def test_demo_interrupted_midway_leaves_the_earlier_outputs_whole(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Ctrl-C while ``demo -o DIR`` writes into the folder of an earlier demo (here: another
+    method): its new disparity and depth files stood beside the earlier overview.png. The files
+    are moved in together at the end: the earlier set stays byte for byte, and no temporary
+    folder is left."""
+    from stereovision import cli
+
+    out = tmp_path / "d"
+    assert main(["demo", "--method", "fast", "-o", str(out)]) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+
+    def interrupted(*args: object, **kwargs: object) -> None:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "write_overview", interrupted)
+    capsys.readouterr()
+    assert main(["demo", "-o", str(out)]) == 130
+    assert capsys.readouterr().err == "stereovision: interrupted\n"
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+
+
 def test_demo_refuses_a_broken_link_under_an_output_name(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -797,6 +820,35 @@ def test_rectify_with_calib_removes_an_earlier_runs_homographies(
     (out / "rectification.json").write_text('{"mine": 1}')
     assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == 0
     assert (out / "rectification.json").read_text() == '{"mine": 1}'
+
+
+@pytest.mark.parametrize("exc", [OSError("disk full"), KeyboardInterrupt()])
+def test_rectify_failing_midway_leaves_the_earlier_outputs_whole(
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, exc: BaseException
+) -> None:
+    """rectify --calib into the folder of a --force run, failing (or interrupted) at
+    check.png: the new left_rect.png and right_rect.png stood beside the earlier check.png and
+    rectification.json (whose homographies do not fit them). The files are moved in together
+    at the end: the earlier set stays byte for byte, and no temporary folder is left."""
+    from stereovision import cli
+
+    scene = data_dir / "eth3d" / "terrace"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    out = tmp_path / "rect"
+    assert main(["rectify", *pair, "--force", "-o", str(out)]) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    assert "rectification.json" in before
+    real = cli._atomic_write_bytes
+
+    def fails_at_check(path: Path, data: bytes) -> None:
+        if path.name == "check.png":
+            raise exc
+        real(path, data)
+
+    monkeypatch.setattr(cli, "_atomic_write_bytes", fails_at_check)
+    status = 2 if isinstance(exc, OSError) else 130
+    assert main(["rectify", *pair, "--calib", str(scene / "calib.txt"), "-o", str(out)]) == status
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
 
 
 def test_rectify_with_calib_keeps_homographies_it_did_not_write(

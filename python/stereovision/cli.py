@@ -933,7 +933,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     """``stereovision rectify LEFT RIGHT -o DIR [--calib F] [--force]``: the rectified pair,
     and with no calibration the homographies found from the pair's features (a pair already
     rectified is written as given, unless ``--force``)."""
-    from stereovision.io import check_pair_files, imread, make_folder
+    from stereovision.io import check_pair_files, imread
     from stereovision.rectification_check import (
         already_rectified,
         check_rectification,
@@ -958,7 +958,6 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     # a left_rect.png of the user's is not replaced; this command's own (its manifest's) are
     names = RECTIFY_OUTPUTS if calib is None else RECTIFY_OUTPUTS[:3]
     earlier = refuse_foreign_outputs(out, names, RECTIFY_MANIFEST)
-    written: dict[str, Path] = {}
     given = None  # the pair's own check, when it is already rectified: written as given
     if calib is not None:
         if args.model != "auto":
@@ -982,8 +981,6 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         else:
             lr, rr = left, right
             summary = None
-    make_folder(out)
-    record_outputs(out, earlier | set(names), RECTIFY_MANIFEST, RECTIFY_OUTPUTS)
     # Without a calibration the raw pair's own matches, moved by the homographies, are judged
     # (check_rectification's rule): SIFT on the warped pair matched 18 of the books' 107 and
     # said "cannot tell" under a line saying the rows agree to 0.25 px.
@@ -994,15 +991,30 @@ def cmd_rectify(args: argparse.Namespace) -> int:
         if summary is not None
         else check_rectification(lr, rr)
     )
-    for name, img in (
-        ("left_rect.png", lr),
-        ("right_rect.png", rr),
-        ("check.png", draw_rectification_check(lr, rr, check)),
-    ):
-        written[name] = out / name
-        _atomic_write_bytes(written[name], _png_bytes(img))
+    # Written into a hidden folder and moved in together, as depth's (commit_outputs): an
+    # error or an interrupt halfway left new left_rect.png beside an earlier right_rect.png.
+    # An earlier run's rectification.json (without --calib, or with --force) that this run
+    # does not rewrite goes with the move: `depth --rectification` would warp the images
+    # written now (calibrated, or the pair as given) by its homographies. It may have been
+    # this very pair's (a --force run before a plain one): the line says why it goes, not
+    # whose it was. A file of that name that the manifest does not list is the user's
+    # (homographies of theirs, or of an earlier version's run): it stays, and the line says
+    # they do not fit.
+    with staged_outputs(out) as stage:
+        staged: dict[str, Path] = {}
+        for name, img in (
+            ("left_rect.png", lr),
+            ("right_rect.png", rr),
+            ("check.png", draw_rectification_check(lr, rr, check)),
+        ):
+            staged[name] = stage / name
+            _atomic_write_bytes(staged[name], _png_bytes(img))
+        if summary is not None:
+            staged["rectification.json"] = summary.save(stage / "rectification.json")
+        written, removed = commit_outputs(
+            out, staged, earlier, RECTIFY_MANIFEST, RECTIFY_OUTPUTS, stale=_homographies
+        )
     if summary is not None:
-        written["rectification.json"] = summary.save(out / "rectification.json")
         print(summary.describe())
         print(
             f"  disparity, not depth: for depth in metres calibrate the rig. Next: stereovision "
@@ -1025,36 +1037,37 @@ def cmd_rectify(args: argparse.Namespace) -> int:
             )
     for name, path in written.items():
         print(f"  {name:19s} {path}")
-    stale = out / "rectification.json"
-    if summary is None and stale.is_file() and not stale.is_symlink():
-        # An earlier run without --calib (or with --force) wrote it: kept, `depth
-        # --rectification` would warp the images written now (calibrated, or the pair as
-        # given) by its homographies. It may have been this very pair's (a --force run before
-        # a plain one): the line says why it goes, not whose it was. A file of that name that
-        # the manifest does not list is the user's (homographies of theirs, or of an earlier
-        # version's run): it stays, and the line says they do not fit.
-        from stereovision.uncalibrated import UncalibratedRectification
-
-        try:
-            UncalibratedRectification.load(stale)
-        except (OSError, ValueError):
-            pass
-        else:
-            now = "the pair as given" if given is not None else "rectified by --calib"
-            if stale.name in earlier:
-                stale.unlink()
-                print(
-                    f"  removed {stale.name} of an earlier run (its homographies do not fit the "
-                    f"images written now: {now})"
-                )
-            else:
-                print(
-                    f"  kept {stale} (not listed as an earlier run's output there), but its "
-                    f"homographies do not fit the images written now ({now}): do not give it "
-                    "to depth --rectification with them"
-                )
-    record_outputs(out, set(written), RECTIFY_MANIFEST, RECTIFY_OUTPUTS)
+    now = "the pair as given" if given is not None else "rectified by --calib"
+    for path in removed:
+        print(
+            f"  removed {path.name} of an earlier run (its homographies do not fit the "
+            f"images written now: {now})"
+        )
+    mine = out / "rectification.json"
+    if (
+        summary is None
+        and mine.name not in earlier
+        and mine.is_file()
+        and not mine.is_symlink()
+        and _homographies(mine)
+    ):
+        print(
+            f"  kept {mine} (not listed as an earlier run's output there), but its "
+            f"homographies do not fit the images written now ({now}): do not give it "
+            "to depth --rectification with them"
+        )
     return 0
+
+
+def _homographies(path: Path) -> bool:
+    """Whether ``path`` holds homographies ``depth --rectification`` would load."""
+    from stereovision.uncalibrated import UncalibratedRectification
+
+    try:
+        UncalibratedRectification.load(path)
+    except (OSError, ValueError):
+        return False
+    return True
 
 
 def _paper_baseline_words(text: str, baseline: float) -> str:
