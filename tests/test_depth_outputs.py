@@ -181,3 +181,23 @@ def test_sigterm_while_writing_leaves_the_earlier_outputs_whole(
     assert proc.returncode == 143, proc.stderr
     assert proc.stderr == "stereovision: terminated (SIGTERM)\n"
     assert _files(out) == before
+
+
+def test_a_folder_under_a_listed_output_name_is_refused_before_any_file_moves(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An earlier run's cloud.ply replaced by a folder of that name: the rerun wrote the new
+    disparity and depth files, then failed at the cloud, leaving a mix. It is refused in one
+    line naming the folder, before any file moves in."""
+    out = tmp_path / "o"
+    assert main(_terrace_argv(data_dir, out)) == 0
+    (out / "cloud.ply").unlink()
+    (out / "cloud.ply").mkdir()
+    before = _files(out)
+    capsys.readouterr()
+    assert main(_terrace_argv(data_dir, out, max_disparity=48)) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: {out / 'cloud.ply'} is a folder, where the run's cloud.ply goes: "
+        "move it away (the earlier outputs are kept as they were)\n"
+    )
+    assert _files(out) == before
