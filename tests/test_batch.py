@@ -191,6 +191,32 @@ def test_batch_runs_skips_and_records_failures(
     assert s["counts"] == {"done": 4, "failed": 0, "pending": 0}
 
 
+def test_unreachable_scheduler_leaves_no_new_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A run whose scheduler cannot be reached never starts: it left the folder it had just
+    made holding a summary with every pair pending. Nothing it made is left now; an output
+    folder that was there stays."""
+    import stereovision.batch as batch
+
+    monkeypatch.setattr(batch, "CONNECT_TIMEOUT", "1s")
+    scene = tmp_path / "in" / "scene"
+    scene.mkdir(parents=True)
+    img = np.random.default_rng(0).integers(0, 255, (32, 48, 3), np.uint8)
+    for side in ("left", "right"):
+        cv2.imwrite(str(scene / f"{side}.png"), img)
+    out = tmp_path / "new" / "out"
+    rc = main(["batch", str(tmp_path / "in"), "-o", str(out), "--scheduler", "tcp://127.0.0.1:1"])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert rc == 2
+    assert len(err) == 1 and "cannot reach the Dask scheduler at tcp://127.0.0.1:1" in err[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]
+    kept = tmp_path / "kept"
+    kept.mkdir()
+    rc = main(["batch", str(tmp_path / "in"), "-o", str(kept), "--scheduler", "tcp://127.0.0.1:1"])
+    assert rc == 2 and kept.is_dir()
+
+
 def test_find_pairs_names(tmp_path: Path) -> None:
     img = np.zeros((8, 8, 3), np.uint8)
     files = [

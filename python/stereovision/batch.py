@@ -1348,6 +1348,7 @@ def run_batch(
             f"folders left/ + right/, L/ + R/, image_2/ + image_3/, cam0/ + cam1/){alone}"
         )
     out = Path(output_dir)
+    made = _missing_folders(out)  # removed again if the run never starts
     out.mkdir(parents=True, exist_ok=True)
     with _output_lock(out):  # a second run into OUT would drop this one's records
         summary = _Summary(out, log)
@@ -1536,6 +1537,12 @@ def run_batch(
         except KeyboardInterrupt as exc:
             interrupted = True
             cause = exc
+        except Exception:
+            # the scheduler not reached, Dask not installed: a run that never started left its
+            # summary (every pair pending) in a folder it had just made; nothing of it is left
+            if run["scheduler"] is None:  # set once Dask is up
+                _remove_unstarted(out, made)
+            raise
         with HeldInterrupts(replay=False) as held:  # the record of the run is written whole
             gone = _outputs_gone(out, summary, [j.name for j in jobs])
             seconds = time.perf_counter() - t0
@@ -1567,6 +1574,28 @@ def run_batch(
         if interrupted:
             raise BatchInterrupted(result) from cause
         return result
+
+
+def _missing_folders(out: Path) -> list[Path]:
+    """The folders ``out.mkdir(parents=True)`` would make, ``out`` first."""
+    missing = []
+    folder = out.absolute()
+    while not folder.exists() and not folder.is_symlink() and folder != folder.parent:
+        missing.append(folder)
+        folder = folder.parent
+    return missing
+
+
+def _remove_unstarted(out: Path, made: list[Path]) -> None:
+    """Remove the summary of a run that never started and the folders it made for it, when
+    ``out`` is one of them and holds nothing else (an output folder that was there is kept)."""
+    if not made:
+        return
+    with contextlib.suppress(OSError):
+        if {p.name for p in out.iterdir()} <= {SUMMARY_NAME}:
+            (out / SUMMARY_NAME).unlink(missing_ok=True)
+        for folder in made:  # out first, then the parents it needed
+            folder.rmdir()  # an OSError (not empty: something else in it) stops here
 
 
 def _outputs_gone(out: Path, summary: _Summary, names: list[str]) -> list[str]:
