@@ -769,6 +769,26 @@ def test_patterns_too_large_are_refused(tmp_path: Path, capsys: pytest.CaptureFi
     )
 
 
+def test_max_pairs_below_the_minimum_is_refused_for_images_too(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--max-pairs 0`` (or -1) was checked for videos and bags only: with images it was
+    ignored without a word. It is refused in one line, before any work, for every source."""
+    from stereovision.cli import main
+
+    left, right = _chessboard_paths()
+    argv = ["calibrate", "--left", str(left[0]), "--right", str(right[0]), "--square", "1"]
+    for bad in ("0", "-1", "2"):
+        assert main([*argv, "--max-pairs", bad, "-o", str(tmp_path / "c.yaml")]) == 2
+        assert capsys.readouterr().err == (
+            f"stereovision: error: --max-pairs: expected an integer of at least 3, got {bad}\n"
+        )
+    bag = ["calibrate", "--from-bag", str(tmp_path / "none.bag"), "--square", "1"]
+    assert main([*bag, "--max-pairs", "0", "-o", str(tmp_path / "c.yaml")]) == 2
+    assert "--max-pairs: expected an integer of at least 3, got 0" in capsys.readouterr().err
+    assert not (tmp_path / "c.yaml").exists()
+
+
 def test_the_triangulated_square_is_not_claimed_as_a_check_of_the_given_one(
     chessboard: tuple[Calibration, CalibrationReport], cached_corners: None
 ) -> None:

@@ -2528,6 +2528,11 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     """``stereovision calibrate --left GLOB --right GLOB --pattern 9x6 --square S -o FILE``
     (``--board charuco --marker M`` for a ChArUco board; ``--ros DIR`` also writes ROS
     ``camera_info`` files)."""
+    # checked for every source: with images it was ignored without a word (0 or -1 included)
+    if args.max_pairs < MIN_PAIRS:
+        raise ValueError(
+            f"--max-pairs: expected an integer of at least {MIN_PAIRS}, got {args.max_pairs}"
+        )
     if args.from_bag:
         if args.left or args.right:
             raise ValueError("--from-bag replaces --left and --right: give one source")
