@@ -303,6 +303,28 @@ def test_depth_warns_about_one_image_given_twice(data_dir: Path, tmp_path: Path)
     assert "are the same image: every disparity comes out 0" in proc.stderr
 
 
+def test_depth_on_a_pair_too_small_says_only_that(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A 1x1 px pair (both images alike, as such tiny images are) printed "... are the same
+    image" before the size error: the size error is now the only line, and nothing is written."""
+    img = np.full((1, 1, 3), 7, np.uint8)
+    for name in ("l.png", "r.png"):
+        assert cv2.imwrite(str(tmp_path / name), img)
+    argv = ["depth", str(tmp_path / "l.png"), str(tmp_path / "r.png"), "-o", str(tmp_path / "o")]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: image too narrow for stereo matching: 1 px wide, and the automatic "
+        "disparity range (at least 16 px) needs images at least 17 px wide; give a max_disparity "
+        "below 1 to match it\n"
+    )
+    assert main([*argv, "--max-disparity", "16"]) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: disparity range 16 is not smaller than the image width 1\n"
+    )
+    assert not (tmp_path / "o").exists()
+
+
 @pytest.mark.parametrize(
     ("argv", "says"),
     [

@@ -251,8 +251,8 @@ def _check_pair(left: np.ndarray, right: np.ndarray, calib: Any, max_disparity: 
     """What :func:`stereovision.depth.depth_map` refuses of the pair before any work, in its
     words, checked before :func:`refuse_foreign_outputs` speaks of a file in the ``-o`` folder:
     images of two sizes, a calibration for another size, a ``max_disparity`` not below the
-    width."""
-    from stereovision.depth import _rig_to_warp_by
+    width, or a pair too narrow for the automatic range (16 px wide or less)."""
+    from stereovision.depth import _DISPARITY_STEP, _rig_to_warp_by, _too_narrow
 
     if np.shape(left)[:2] != np.shape(right)[:2]:
         raise ValueError(
@@ -265,6 +265,8 @@ def _check_pair(left: np.ndarray, right: np.ndarray, calib: Any, max_disparity: 
         raise ValueError(
             f"disparity range {max_disparity:g} is not smaller than the image width {w}"
         )
+    if max_disparity is None and w <= _DISPARITY_STEP:  # the automatic range is 16 px there
+        raise _too_narrow(w, _DISPARITY_STEP)
 
 
 def depth_outputs(
@@ -654,6 +656,9 @@ def cmd_depth(args: argparse.Namespace) -> int:
     # 16-bit files keep their 16 bits (imread's 8-bit copy kept the top 8 of them)
     left = read_image(args.left)
     right = read_image(args.right)
+    if not args.rectification:  # (rectified, the pair may change size)
+        # a pair depth_map refuses is said alone: a 1x1 px pair was "the same image" first
+        _check_pair(left, right, None, args.max_disparity)
     if left.shape == right.shape and np.array_equal(left, right):
         warnings.warn(
             f"{args.left} and {args.right} are the same image: every disparity comes out 0 "

@@ -184,6 +184,17 @@ def _finite(v: float) -> bool:
         return False
 
 
+def _too_narrow(width: int, automatic_range: float, min_disparity: float = 0) -> ValueError:
+    """The error of a pair narrower than the disparity range chosen for it (never below
+    ``_DISPARITY_STEP``: a pair at most 16 px wide is always refused)."""
+    need = math.floor(automatic_range) + 1
+    return ValueError(
+        f"image too narrow for stereo matching: {width} px wide, and the automatic "
+        f"disparity range (at least {_DISPARITY_STEP} px) needs images at least {need} px "
+        f"wide; give a max_disparity below {width + min_disparity:g} to match it"
+    )
+
+
 def estimate_max_disparity(left: npt.ArrayLike, right: npt.ArrayLike) -> int:
     """Choose a disparity search range from the pair itself.
 
@@ -1269,12 +1280,7 @@ def depth_map(
     if max_disparity - min_disparity >= gl.shape[1] and automatic:
         # a range the caller never gave: the image is the problem (the automatic range is at
         # least 16 px, so 16 px wide images and narrower are refused)
-        need = math.floor(max_disparity - min_disparity) + 1
-        raise ValueError(
-            f"image too narrow for stereo matching: {gl.shape[1]} px wide, and the automatic "
-            f"disparity range (at least {_DISPARITY_STEP} px) needs images at least {need} px "
-            f"wide; give a max_disparity below {gl.shape[1] + min_disparity:g} to match it"
-        )
+        raise _too_narrow(gl.shape[1], max_disparity - min_disparity, min_disparity)
     if max_disparity - min_disparity >= gl.shape[1]:
         raise ValueError(
             f"disparity range {max_disparity - min_disparity:g} is not smaller than the image "
