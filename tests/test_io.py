@@ -431,6 +431,31 @@ def test_scene_max_disparity_rule() -> None:
     assert scene_max_disparity(np.full((2, 2), np.nan), width=320) == 80
 
 
+def test_scene_max_disparity_refuses_a_bad_width_or_ndisp(data_dir: Path, tmp_path: Path) -> None:
+    """A width of 0 gave 16, an ndisp of NaN or -5 (from calib.txt too) the width's range,
+    without a word: each is a ValueError naming the argument, or the file and the key."""
+    for width in (0, -4, 2.5, True):
+        with pytest.raises(ValueError, match=r"^width: expected the image width in pixels"):
+            scene_max_disparity(None, width=width)  # type: ignore[arg-type]
+    for ndisp in (float("nan"), -5.0, 0.0, float("inf")):
+        with pytest.raises(ValueError, match=r"^ndisp: expected a positive finite number"):
+            scene_max_disparity(None, width=100, ndisp=ndisp)
+    scene = tmp_path / "terrace"
+    shutil.copytree(data_dir / "eth3d" / "terrace", scene)
+    assert load_scene(scene).max_disparity == 32  # from its GT
+    calib = scene / "calib.txt"
+    good = calib.read_text()
+    assert "ndisp=713\n" in good
+    for bad in ("nan", "-5", "0"):
+        calib.write_text(good.replace("ndisp=713\n", f"ndisp={bad}\n"))
+        with pytest.raises(ValueError) as info:
+            load_scene(scene)
+        assert str(info.value) == (
+            f"{calib}: ndisp={float(bad):g}: expected the disparity range in pixels, a positive "
+            "finite number"
+        )
+
+
 def test_find_scenes(data_dir: Path) -> None:
     scenes = find_scenes(data_dir)
     names = [f"{p.parent.name}/{p.name}" for p in scenes]

@@ -1002,12 +1002,30 @@ def scene_max_disparity(
     int
         ``round_up16(1.1 * max finite GT)``; without usable GT ``round_up16(ndisp)``, else
         ``round_up16(width // 4)``.
+
+    Raises
+    ------
+    ValueError
+        If ``width`` is not a positive integer, or ``ndisp`` is given and is not a positive
+        finite number (a width of 0 gave 16, an ndisp of NaN or -5 the width's range).
     """
+    from stereovision._validate import positive_finite
+
+    if (
+        isinstance(width, (bool, np.bool_))
+        or not isinstance(width, (int, np.integer))
+        or width <= 0
+    ):
+        raise ValueError(
+            f"width: expected the image width in pixels (a positive integer), got {width!r}"
+        )
+    if ndisp is not None:
+        ndisp = positive_finite(ndisp, "ndisp")
     if gt is not None:
         finite = gt[np.isfinite(gt)]
         if finite.size and float(finite.max()) > 0:
             return round_up16(MAX_DISPARITY_MARGIN * float(finite.max()))
-    if ndisp is not None and ndisp > 0:
+    if ndisp is not None:
         return round_up16(ndisp)
     return round_up16(width // _WIDTH_FRACTION)
 
@@ -1034,7 +1052,8 @@ def load_scene(directory: PathLike) -> Scene:
         If the directory, ``left.png`` or ``right.png`` is missing.
     ValueError
         If an image cannot be decoded, the pair sizes differ, the GT size differs from the
-        left image, or the calibration file is invalid.
+        left image, or the calibration file is invalid (an ``ndisp`` of NaN, 0 or below
+        included).
     """
     from stereovision.calibration import Calibration, parse_middlebury_calib
 
@@ -1064,6 +1083,12 @@ def load_scene(directory: PathLike) -> Scene:
     if calib_path.exists():
         calib = Calibration.from_middlebury(calib_path)
         ndisp = parse_middlebury_calib(calib_path).get("ndisp")
+        if ndisp is not None and not (math.isfinite(ndisp) and ndisp > 0):
+            # NaN, -5 or 0 were taken as no ndisp (the width's range), without a word
+            raise ValueError(
+                f"{calib_path}: ndisp={ndisp:g}: expected the disparity range in pixels, a "
+                "positive finite number"
+            )
     elif (d / "Q.dat").exists():
         calib = Calibration.from_q(d / "Q.dat", (left.shape[1], left.shape[0]))
     return Scene(
