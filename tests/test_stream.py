@@ -910,6 +910,18 @@ class _ModeCap:
         pass
 
 
+class _Interrupted(_ModeCap):
+    """A camera pressed Ctrl-C on before it delivered a frame."""
+
+    def grab(self) -> bool:
+        raise KeyboardInterrupt
+
+
+def _interrupted_cameras(args: Any, fps: float | None = None) -> StereoCamera:
+    """``open_source`` of two cameras interrupted before their first frame."""
+    return StereoCamera(_Interrupted([]), _Interrupted([]))
+
+
 def test_stream_sizes_stereo_calib_output_by_the_frames_delivered_not_the_mode_reported(
     data_dir: Path,
     tmp_path: Path,
@@ -1015,14 +1027,7 @@ def test_a_stream_interrupted_before_its_first_pair_writes_strict_json(
     measure were written as NaN, which a strict JSON parser refuses; they are null now."""
     import stereovision.stream as stream
 
-    class _Interrupted(_ModeCap):
-        def grab(self) -> bool:
-            raise KeyboardInterrupt
-
-    def cameras(args: Any, fps: float | None = None) -> StereoCamera:
-        return StereoCamera(_Interrupted([]), _Interrupted([]))
-
-    monkeypatch.setattr(stream, "open_source", cameras)
+    monkeypatch.setattr(stream, "open_source", _interrupted_cameras)
     argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--json"]
     argv += ["--max-disparity", "16"]
     assert main(argv) == 130
@@ -1087,14 +1092,7 @@ def test_a_calibrated_stream_interrupted_before_its_first_pair_writes_its_summar
         rep = run_stream(StereoCamera(_Stopped([]), _Stopped([])), calib, max_disparity=16)
         assert (rep.frames, rep.ended, rep.error) == (0, ended, None)
 
-    class _Interrupted(_ModeCap):
-        def grab(self) -> bool:
-            raise KeyboardInterrupt
-
-    def cameras(args: Any, fps: float | None = None) -> StereoCamera:
-        return StereoCamera(_Interrupted([]), _Interrupted([]))
-
-    monkeypatch.setattr(stream, "open_source", cameras)
+    monkeypatch.setattr(stream, "open_source", _interrupted_cameras)
     argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--json"]
     argv += ["--max-disparity", "16", "--calib", str(data_dir / SCENE / "calib.txt")]
     assert main(argv) == 130
