@@ -6,6 +6,7 @@ The benches run as scripts (``python benches/bench_x.py``), so this folder is on
 from __future__ import annotations
 
 import argparse
+import math
 import statistics
 import time
 from collections.abc import Callable, Sequence
@@ -14,7 +15,7 @@ from typing import TypeVar
 
 import numpy as np
 
-from stereovision.evaluate import sparse_metrics
+from stereovision.evaluate import count_at_precision, sparse_metrics
 from stereovision.matches import Matches
 
 DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
@@ -54,6 +55,17 @@ def sparse_row(m: Matches, gt: np.ndarray) -> dict[str, float | int]:
         "count": sm.count,
         "coverage": sm.coverage,
     }
+
+
+def count_at(m: Matches, gt: np.ndarray, target: float, tolerance: float = 1.0) -> int | None:
+    """:func:`~stereovision.evaluate.count_at_precision` of ``m`` (ranked by its score) at the
+    precision ``target`` of another matcher, or None (JSON null) when that precision is NaN:
+    :func:`~stereovision.evaluate.sparse_metrics` gives NaN when no match has GT, and there is
+    no count to hold at it (``count_at_precision`` refuses a NaN target, which crashed the bench
+    on such a scene)."""
+    if math.isnan(target):
+        return None
+    return count_at_precision(m.xl, m.yl, m.xr, m.score, gt, target, tolerance)
 
 
 def interleaved_ms(fns: Sequence[Callable[[], object]], repeats: int) -> list[float]:

@@ -20,10 +20,10 @@ import argparse
 import json
 from pathlib import Path
 
-from _common import DATA
+from _common import DATA, count_at
 
 from stereovision._validate import as_gray_float
-from stereovision.evaluate import count_at_precision, sparse_metrics
+from stereovision.evaluate import sparse_metrics
 from stereovision.io import find_scenes, load_scene
 from stereovision.match import METHODS
 from stereovision.matching.fusion import CHANNEL_BITS, fuse_pair
@@ -68,14 +68,18 @@ def main() -> None:
         line += f" {fm.coverage:2d}/16"
         for name, m in chans.items():
             cm = sparse_metrics(m.xl, m.yl, m.xr, sc.gt)
-            at = count_at_precision(m.xl, m.yl, m.xr, m.score, sc.gt, fm.precision[tol], tol)
+            # None (null, "-") when the members have no match with GT (their precision is NaN)
+            at = count_at(m, sc.gt, fm.precision[tol], tol)
             row[name] = {
                 "precision": round(cm.precision[tol], 2),
                 "count": cm.count,
                 "coverage": cm.coverage,
                 "count_at_members_precision": at,
             }
-            line += f" | {name} {cm.precision[tol]:6.2f} % {cm.count:6d} (at members' p: {at:6d})"
+            shown = "-" if at is None else str(at)
+            line += (
+                f" | {name} {cm.precision[tol]:6.2f} % {cm.count:6d} (at members' p: {shown:>6})"
+            )
         print(line, flush=True)
         print(json.dumps(row), flush=True)
 

@@ -19,12 +19,19 @@ import argparse
 import json
 from functools import partial
 
-from _common import DATA, gt_scenes, interleaved_ms, interleaved_runs, sparse_row, timed_runs
+from _common import (
+    DATA,
+    count_at,
+    gt_scenes,
+    interleaved_ms,
+    interleaved_runs,
+    sparse_row,
+    timed_runs,
+)
 
 from stereovision import io
 from stereovision._validate import as_gray_float
 from stereovision.baselines import opencv_sgbm
-from stereovision.evaluate import count_at_precision
 from stereovision.matching.hopfield import best_match, hopfield_match
 
 SPEED_SCENES = ("middlebury2006/cloth3", "middeval3/teddyH")
@@ -51,9 +58,8 @@ def accuracy(scenes: list[str], repeats: int) -> None:
             "network": {**mn, "ms": round(ms_net, 1)},
             "reference": {**mr, "ms": round(ms_ref, 1)},
             "repeats": repeats,
-            "ref_count_at_net_precision": count_at_precision(
-                ref.xl, ref.yl, ref.xr, ref.score, sc.gt, float(mn["p1"])
-            ),
+            # null when the network has no match with GT (its precision is NaN)
+            "ref_count_at_net_precision": count_at(ref, sc.gt, float(mn["p1"])),
             "sweeps": net.stats["sweeps"],
             "converged": net.stats["converged"],
             "n_points": net.stats["n_points"],

@@ -21,13 +21,20 @@ import argparse
 import json
 from functools import partial
 
-from _common import DATA, gt_scenes, interleaved_ms, interleaved_runs, sparse_row, timed_runs
+from _common import (
+    DATA,
+    count_at,
+    gt_scenes,
+    interleaved_ms,
+    interleaved_runs,
+    sparse_row,
+    timed_runs,
+)
 
 import stereovision as sv
 from stereovision import io
 from stereovision._validate import as_gray_float
 from stereovision.baselines import opencv_sgbm
-from stereovision.evaluate import count_at_precision
 from stereovision.matching.mcgm import zncc_reference
 
 SPEED_SCENES = ("middlebury2006/cloth3", "middeval3/teddyH")
@@ -55,9 +62,8 @@ def accuracy(scenes: list[str], repeats: int) -> None:
             "mcgm": {**mm, "ms": round(ms_m, 1)},
             "reference": {**mz, "ms": round(ms_z, 1)},
             "repeats": repeats,
-            "ref_count_at_mcgm_precision": count_at_precision(
-                z.xl, z.yl, z.xr, z.score, sc.gt, float(mm["p1"])
-            ),
+            # null when the channel has no match with GT (its precision is NaN)
+            "ref_count_at_mcgm_precision": count_at(z, sc.gt, float(mm["p1"])),
             "as_precise_as_reference": mm["p1"] >= mz["p1"],
             "n_candidates": m.stats["n_candidates"],
             "n_pairs": m.stats["n_pairs"],

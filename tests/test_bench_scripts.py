@@ -15,7 +15,10 @@ from functools import cache
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
+
+from stereovision.matches import Matches
 
 ROOT = Path(__file__).resolve().parents[1]
 BENCHES = ROOT / "benches"
@@ -159,6 +162,39 @@ def test_accuracy_times_come_from_as_many_timed_runs(
     row = json.loads(capsys.readouterr().out.splitlines()[-1])
     assert row["repeats"] == 5
     assert counts == [[6, 6]]  # one scene: 1 warm-up + 5 timed runs, network and reference
+
+
+def test_a_matcher_without_matches_is_a_null_count_not_a_crash(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A scene where the network keeps no match with GT: its precision is NaN, and the bench
+    handed it to count_at_precision, which refuses a NaN target (ValueError, the bench ended
+    there); the reference's count at that precision is now null."""
+    import runpy
+
+    import stereovision.matching.hopfield as hopfield
+
+    monkeypatch.syspath_prepend(str(BENCHES))
+    import _common
+
+    gt = np.full((4, 6), 5.0)
+    none = Matches(*(np.zeros(0, np.float32) for _ in range(5)), image_shape=(4, 6))
+    assert _common.count_at(none, gt, float("nan")) is None
+    one = np.ones(2, np.float32)
+    xl = np.array([1.0, 2.0], np.float32)
+    some = Matches(
+        xl, one, xl - np.array([5.0, 8.0], np.float32), one, np.array([0.9, 0.8]), (4, 6)
+    )
+    assert _common.count_at(some, gt, 100.0) == 1  # the first (5 px) is right, the second not
+
+    real = hopfield.hopfield_match
+    monkeypatch.setattr(hopfield, "hopfield_match", lambda *a, **k: real(*a, **k)[:0])
+    argv = ["bench_hopfield.py", "--scenes", "middlebury2001/tsukuba", "--no-speed"]
+    monkeypatch.setattr(sys, "argv", [*argv, "--repeats", "5"])
+    runpy.run_path(str(BENCHES / "bench_hopfield.py"), run_name="__main__")
+    row = json.loads(capsys.readouterr().out.splitlines()[-1])
+    assert row["network"]["count"] == 0 and row["ref_count_at_net_precision"] is None
+    assert row["reference"]["count"] > 0
 
 
 def test_eval_gabor_scenes_times_ours_beside_sgbm(data_dir: Path) -> None:
