@@ -706,6 +706,18 @@ def test_decode_image_names_what_is_not_bytes(data: object, says: str) -> None:
         decode_image(data)  # type: ignore[arg-type]
 
 
+def test_decode_image_takes_a_column_or_row_of_bytes() -> None:
+    # OpenCV 4's cv2.imencode gives its bytes as an (N, 1) array; decode_image read it (and a
+    # (1, N) row) until the check above refused any 2-D array: now a vector is taken, flattened
+    from stereovision.io import decode_image
+
+    ok, png = cv2.imencode(".png", np.full((4, 6, 3), 7, np.uint8))
+    assert ok
+    for good in (png.reshape(-1, 1), png.reshape(1, -1)):
+        img = decode_image(good)
+        assert img is not None and img.shape == (4, 6, 3) and int(img.max()) == 7
+
+
 def test_write_pfm_refuses_what_it_would_change(tmp_path: Path) -> None:
     # a finite 1e300 was written as inf, and little_endian="no" (true) a little-endian file
     arr = np.array([[1.0, np.nan], [np.inf, -3.5e38]])  # -3.5e38 is beyond float32 too

@@ -383,7 +383,8 @@ def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] |
     Parameters
     ----------
     data : ndarray of uint8 or bytes
-        The encoded file's bytes (PNG, JPEG, PPM/PGM, ...).
+        The encoded file's bytes (PNG, JPEG, PPM/PGM, ...): bytes, a bytearray or memoryview,
+        or a ``uint8`` array of shape ``(N,)``, ``(N, 1)`` or ``(1, N)``.
 
     Returns
     -------
@@ -393,13 +394,18 @@ def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] |
     Raises
     ------
     TypeError
-        If ``data`` is neither bytes nor a 1-D ``uint8`` array (None and a str were an
-        AttributeError, a 2-D array OpenCV's "buf.checkVector(1, CV_8U) > 0").
+        If ``data`` is neither bytes nor a ``uint8`` vector (None and a str were an
+        AttributeError, an image-shaped array OpenCV's "buf.checkVector(1, CV_8U) > 0").
     """
     if isinstance(data, (bytes, bytearray, memoryview)):
         buf = np.frombuffer(data, np.uint8)
-    elif isinstance(data, np.ndarray) and data.dtype == np.uint8 and data.ndim == 1:
-        buf = data
+    elif (
+        isinstance(data, np.ndarray)
+        and data.dtype == np.uint8
+        and (data.ndim == 1 or (data.ndim == 2 and 1 in data.shape))
+    ):
+        # a row or a column too: OpenCV 4's cv2.imencode gives its bytes as (N, 1)
+        buf = data.reshape(-1)
     else:
         what = (
             f"array of shape {data.shape} dtype {data.dtype}"
