@@ -314,9 +314,9 @@ def test_dense_metrics_takes_disparity_and_still_disp() -> None:
         ("n_points", 2.5, "n_points must be an integer >= 1, got 2.5"),
         ("n_points", True, "n_points must be an integer >= 1, got True"),
         ("n_points", "3", "n_points must be an integer >= 1, got '3'"),
-        ("seed", -5, "seed must be an integer >= 0, got -5"),
-        ("seed", float("nan"), "seed must be an integer >= 0, got nan"),
-        ("seed", "0", "seed must be an integer >= 0, got '0'"),
+        ("seed", -5, "seed must be an integer >= 0 or None, got -5"),
+        ("seed", float("nan"), "seed must be an integer >= 0 or None, got nan"),
+        ("seed", "0", "seed must be an integer >= 0 or None, got '0'"),
     ],
 )
 def test_table1_report_names_a_bad_count_or_seed(key: str, value: object, says: str) -> None:
@@ -327,6 +327,15 @@ def test_table1_report_names_a_bad_count_or_seed(key: str, value: object, says: 
     assert table1_report(est, gt, n_points=4, seed=np.int64(1)).n_points == 4
     with pytest.raises(ValueError, match="^" + re.escape(says)):
         table1_report(est, gt, **{key: value})  # type: ignore[arg-type]
+
+
+def test_table1_report_seed_none_is_a_fresh_draw() -> None:
+    # numpy.random.default_rng(None), the draw's documented generator, takes None for fresh
+    # entropy, and table1_report did until the seed check above refused it as not an integer
+    est = np.full((20, 30), 2.0, np.float32)
+    gt = np.full((20, 30), 2.5, np.float32)
+    r = table1_report(est, gt, n_points=4, seed=None)
+    assert r.n_points == 4 and np.all((r.x >= 0) & (r.x < 30)) and np.all((r.y >= 0) & (r.y < 20))
 
 
 @pytest.mark.parametrize(

@@ -451,7 +451,7 @@ def table1_report(
     depth: npt.ArrayLike,
     gt: npt.ArrayLike,
     n_points: int = 10,
-    seed: int = 0,
+    seed: int | None = 0,
     points: npt.ArrayLike | None = None,
     unit: str = "m",
 ) -> Table1Report:
@@ -469,8 +469,9 @@ def table1_report(
         with a DeprecationWarning.
     n_points : int
         Number of random points (all valid pixels if fewer exist). Ignored with ``points``.
-    seed : int
-        Seed of the random draw.
+    seed : int or None
+        Seed of the random draw (an integer >= 0); None draws from fresh entropy, as
+        ``numpy.random.default_rng(None)``.
     points : array_like, optional
         ``(N, 2)`` integer ``(x, y)`` pixels to use instead of a random draw; each must lie in
         the image and have both distances.
@@ -500,12 +501,12 @@ def table1_report(
             raise ValueError(f"n_points must be an integer >= 1, got {n_points!r}")
         if n_points < 1:
             raise ValueError(f"n_points must be >= 1, got {n_points}")
-        if (
+        if seed is not None and (
             isinstance(seed, (bool, np.bool_))
             or not isinstance(seed, (int, np.integer))
             or seed < 0
         ):
-            raise ValueError(f"seed must be an integer >= 0, got {seed!r}")
+            raise ValueError(f"seed must be an integer >= 0 or None, got {seed!r}")
         flat = np.flatnonzero(both)
         if flat.size == 0:
             raise ValueError("no pixel has both an estimated and a ground-truth distance")
