@@ -584,3 +584,14 @@ def test_matches_image_shape_must_be_two_positive_integers(tmp_path: Path, shape
     with pytest.raises(ValueError, match=says):
         sv.Matches.from_csv(path, shape)  # type: ignore[arg-type]
     assert sv.Matches.from_csv(path, (np.int64(64), 128)).image_shape == (64, 128)
+
+
+@pytest.mark.parametrize("shape", [(64.0, 128.0), (np.float64(64), 128), np.array([64.0, 128])])
+def test_matches_image_shape_of_whole_floats_is_read(tmp_path: Path, shape: object) -> None:
+    # int() of each entry read (64.0, 128.0) as (64, 128), and the project takes a whole float
+    # as a count (int_in_range, a calibration's image_width 1242.0); 5478200's check refused it
+    a = np.zeros(2, np.float32)
+    m = sv.Matches(xl=a, yl=a, xr=a, yr=a, score=a, image_shape=shape)  # type: ignore[arg-type]
+    assert m.image_shape == (64, 128) and all(type(v) is int for v in m.image_shape)
+    path = m.save_csv(tmp_path / "m.csv")
+    assert sv.Matches.from_csv(path, shape).image_shape == (64, 128)  # type: ignore[arg-type]

@@ -7,6 +7,7 @@ y_right`` (about 0 on rectified pairs), stored at the rounded left-image positio
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,6 +31,18 @@ def _f32_1d(a: npt.ArrayLike, name: str) -> F32:
     if arr.ndim != 1:
         raise ValueError(f"{name}: expected a 1-D array, got shape {arr.shape}")
     return arr
+
+
+def _whole_positive(v: object) -> bool:
+    """Whether ``v`` is a positive whole number: an integer (not a bool) or a finite whole
+    float (``64.0``; not ``64.5``)."""
+    if isinstance(v, (bool, np.bool_)):
+        return False
+    if isinstance(v, (int, np.integer)):
+        return bool(v > 0)
+    if isinstance(v, (float, np.floating)):
+        return bool(math.isfinite(v) and v == math.floor(v) and v > 0)
+    return False
 
 
 @dataclass(frozen=True, eq=False)
@@ -74,13 +87,10 @@ class Matches:
         for n, a in zip(names, arrs, strict=True):
             object.__setattr__(self, n, a)
         # int() of each entry read 64.5 as 64 and True as 1; None and (64,) were a TypeError
-        # or an unpacking error naming nothing
+        # or an unpacking error naming nothing. A whole float (64.0) is a count, as elsewhere.
         shape = self.image_shape
         dims = tuple(shape) if isinstance(shape, (tuple, list, np.ndarray)) else ()
-        ok = len(dims) == 2 and all(
-            isinstance(v, (int, np.integer)) and not isinstance(v, (bool, np.bool_)) and v > 0
-            for v in dims
-        )
+        ok = len(dims) == 2 and all(_whole_positive(v) for v in dims)
         if not ok:
             raise ValueError(f"image_shape must be positive (H, W) integers, got {shape!r}")
         h, w = int(dims[0]), int(dims[1])
