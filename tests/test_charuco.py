@@ -557,3 +557,14 @@ def test_cli_board_keeps_a_file_it_replaces(tmp_path: Path) -> None:
     assert kept.read_bytes() == b"my picture"
     assert run.stdout.splitlines()[0].endswith(f"(the one it replaced kept as {kept})")
     assert cv2.imread(str(out)) is not None
+
+
+def test_cli_board_written_again_keeps_no_copy_of_itself(tmp_path: Path) -> None:
+    """The same ``board -o board.png`` run twice made board.previous.png, the new board byte
+    for byte, and said it kept "the one it replaced": the same bytes again replace nothing."""
+    out = tmp_path / "board.png"
+    for _ in range(2):
+        run = _cli("board", "-o", str(out), "--pattern", "9x6", "--square", "0.03")
+        assert run.returncode == 0, run.stderr
+        assert run.stdout.splitlines()[0] == f"{out}: chessboard 9x6 inner corners, square 0.03 m"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["board.png"]

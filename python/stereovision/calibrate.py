@@ -2693,7 +2693,8 @@ def cmd_board(args: argparse.Namespace) -> int:
         what = f"chessboard {pat[0]}x{pat[1]} inner corners, square {square:g} {args.unit}"
     from stereovision.io import keep_previous
 
-    kept = keep_previous(out)  # a board.png already there (another board, a picture) stays
+    # a board.png already there (another board, a picture) stays; the same board again is no loss
+    kept = keep_previous(out, data)
     with atomic_write(out) as fh:
         fh.write(data)
     # the PNG's resolution makes the whole-pixel square its exact size (_board_scale)

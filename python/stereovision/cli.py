@@ -859,8 +859,9 @@ def cmd_check(args: argparse.Namespace) -> int:
 
         # a file already there (an earlier plot, or the user's own picture) is copied aside
         plot = Path(args.plot)
-        kept_plot = keep_previous(plot)
-        _atomic_write_bytes(plot, _png_bytes(draw_rectification_check(left, right, res)))
+        png = _png_bytes(draw_rectification_check(left, right, res))
+        kept_plot = keep_previous(plot, png)  # the same plot again replaces nothing
+        _atomic_write_bytes(plot, png)
         if kept_plot is not None:  # on stderr: with --json stdout is the one JSON object
             print(
                 f"stereovision: {plot} replaced; the earlier file is {kept_plot}", file=sys.stderr

@@ -194,7 +194,7 @@ def _same_bytes(a: Path, b: Path, chunk: int = 1 << 20) -> bool:
                 return True
 
 
-def keep_previous(path: PathLike) -> Path | None:
+def keep_previous(path: PathLike, new: bytes | None = None) -> Path | None:
     """Copy an existing file aside as ``NAME.previous.EXT`` before a command replaces it.
 
     A calibration written again under the same name (``calibrate -o rig.yaml`` run twice,
@@ -209,17 +209,22 @@ def keep_previous(path: PathLike) -> Path | None:
     ----------
     path : str or os.PathLike
         The file about to be written.
+    new : bytes, optional
+        The bytes about to be written: when ``path`` already holds exactly these (the same
+        board or plot written again), nothing is replaced, so nothing is copied.
 
     Returns
     -------
     pathlib.Path or None
-        The copy, or None when ``path`` held no file.
+        The copy, or None when ``path`` held no file or already held ``new``.
     """
     import shutil
 
     p = Path(path)
     if not p.is_file():
         return None
+    if new is not None and p.stat().st_size == len(new) and p.read_bytes() == new:
+        return None  # rewriting the same bytes loses nothing: no NAME.previous clutter
     # compared and copied in chunks, not read whole: besides calibrations, `demo` keeps a
     # cloud.ply of any size aside this way
     n = 1

@@ -1201,9 +1201,10 @@ def cmd_view(args: argparse.Namespace) -> int:
         raise OSError(f"could not encode {out}")
     from stereovision.io import atomic_write, keep_previous
 
-    kept = keep_previous(out)  # a file already there (an earlier shot, a picture) stays
+    data = buf.tobytes()
+    kept = keep_previous(out, data)  # a file already there (an earlier shot, a picture) stays
     with atomic_write(out) as fh:
-        fh.write(buf.tobytes())
+        fh.write(data)
     # a cloud's cells are its points: "N points, N cells" read as if it were a mesh
     shown = geometry.n_points
     if POINTS_IN_SOURCE in geometry.field_data:
