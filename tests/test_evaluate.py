@@ -370,6 +370,18 @@ def test_count_at_precision_names_a_bad_target_or_tolerance(
         count_at_precision(xl, yl, xr, score, gt, **kw)  # type: ignore[arg-type]
 
 
+def test_dense_metrics_thresholds_may_be_any_collection_of_numbers() -> None:
+    # a range and a set were read until the check above took only a tuple, list or array; a
+    # generator was used up by the check and gave no bad-t figure at all
+    disp = np.zeros((3, 4), np.float32)
+    want = {1.0: 100.0, 2.0: 0.0}
+    assert dense_metrics(disp, disp + 1.5, thresholds=range(1, 3)).bad == want
+    assert dense_metrics(disp, disp + 1.5, thresholds={2.0, 1.0}).bad == want
+    assert dense_metrics(disp, disp + 1.5, thresholds=(t for t in (1.0, 2.0))).bad == want
+    with pytest.raises(ValueError, match=r"^thresholds must be positive and finite, got '12'"):
+        dense_metrics(disp, disp, thresholds="12")  # type: ignore[arg-type]
+
+
 @pytest.mark.parametrize("thresholds", [2.0, (True,), ("2",), (2.0, 10**400)])
 def test_dense_metrics_thresholds_must_be_a_sequence_of_numbers(thresholds: object) -> None:
     # 2.0 was "'float' object is not iterable", True a 1 px threshold, "2" a TypeError

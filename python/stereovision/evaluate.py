@@ -15,6 +15,7 @@ missing when not finite or ``<= 0``. All percentages are in ``[0, 100]``.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -171,8 +172,8 @@ def dense_metrics(
         former name, still works, with a DeprecationWarning.
     gt : array_like
         ``(H, W)`` GT disparity (px), non-finite = unknown.
-    thresholds : tuple of float
-        bad-t thresholds in px.
+    thresholds : iterable of float
+        bad-t thresholds in px (a tuple, list, array, range, set, ...).
     mask : array_like of bool, optional
         ``(H, W)``; restrict the evaluation to these pixels (e.g. non-occluded).
 
@@ -195,10 +196,10 @@ def dense_metrics(
     g = _real_2d(gt, "gt")
     _same_shape(d, g, "disparity", "gt")
     # a single number was "'float' object is not iterable", True a threshold of 1 px and "2"
-    # a TypeError from the comparison
-    if not isinstance(thresholds, (tuple, list, np.ndarray)) or not all(
-        _positive_finite(t) for t in thresholds
-    ):
+    # a TypeError from the comparison; any collection of numbers is read (a range, a set), once
+    # (a generator, used up by the check, gave no bad-t figure at all)
+    ts = tuple(thresholds) if isinstance(thresholds, Iterable) else None
+    if isinstance(thresholds, (str, bytes)) or ts is None or not all(map(_positive_finite, ts)):
         raise ValueError(f"thresholds must be positive and finite, got {thresholds!r}")
     known = np.isfinite(g)
     if mask is not None:
@@ -209,7 +210,7 @@ def dense_metrics(
     est = np.isfinite(d) & known
     err = np.abs(d[est] - g[est])
     n_both = int(est.sum())
-    bad = {float(t): _pct(n_gt - int(np.count_nonzero(err <= t)), n_gt) for t in thresholds}
+    bad = {float(t): _pct(n_gt - int(np.count_nonzero(err <= t)), n_gt) for t in ts}
     return DenseMetrics(
         bad=bad,
         density=_pct(n_both, n_gt),
