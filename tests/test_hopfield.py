@@ -243,7 +243,7 @@ def test_match_api_and_matches_type(tmp_path: Path) -> None:
     assert np.nanmax(np.abs(m.dispy)) == 0.0  # rectified: row candidates
     path = tmp_path / "m.csv"
     m.save_csv(path)
-    rows = list(csv.reader(path.open()))
+    rows = list(csv.reader(path.read_text().splitlines()))
     assert rows[0] == ["x_left", "y_left", "x_right", "y_right", "score"]
     assert len(rows) == len(m) + 1
     assert float(rows[1][2]) == pytest.approx(float(m.xr[0]), abs=1e-4)

@@ -372,7 +372,7 @@ def test_match_api_curves_and_graph(tmp_path: Path) -> None:
         assert c["edges"].shape[1] == 2 and len(c["edges"]) > 0
     path = tmp_path / "m.csv"
     assert m.save_csv(path) == path  # a Path, as the other writers return
-    rows = list(csv.reader(path.open()))
+    rows = list(csv.reader(path.read_text().splitlines()))
     assert rows[0] == ["x_left", "y_left", "x_right", "y_right", "score"]
     assert len(rows) == len(m) + 1
     cv = mcgm.curves(sc.left)
@@ -483,7 +483,7 @@ def test_save_csv_round_trips_exactly(tmp_path: Path) -> None:
     sc = _scene("middlebury2001/tsukuba")
     m = sv.match(sc.left, sc.right, method="mcgm", max_disparity=16)
     path = m.save_csv(tmp_path / "m.csv")
-    rows = list(csv.reader(path.open()))
+    rows = list(csv.reader(path.read_text().splitlines()))
     assert rows[0] == ["x_left", "y_left", "x_right", "y_right", "score"]
     assert all(np.float32(float(r[2])) == x for r, x in zip(rows[1:], m.xr, strict=True))
     back = sv.Matches.from_csv(path, image_shape=m.image_shape)
