@@ -300,3 +300,38 @@ def test_two_renames_of_one_function_are_one_wrapper() -> None:
     assert {w.filename for w in caught} == {__file__}
     with pytest.raises(TypeError, match=r"^depth_metrics\(\) got depth_gt= and gt="):
         depth_metrics(_DEPTH, _GT_DEPTH, depth_gt=_GT_DEPTH)
+
+
+class _NoFormatCapture:
+    """A source with the ``cv2.VideoCapture`` methods that reports no pixel format."""
+
+    def isOpened(self) -> bool:
+        return True
+
+    def grab(self) -> bool:
+        return True
+
+    def retrieve(self) -> tuple[bool, np.ndarray]:
+        return True, np.zeros((24, 32, 3), np.uint8)
+
+    def get(self, _prop: int) -> float:
+        return 0.0
+
+    def set(self, _prop: int, _value: float) -> bool:
+        return False
+
+    def release(self) -> None:
+        pass
+
+
+def test_a_warning_of_a_renamed_init_is_at_the_callers_line() -> None:
+    """StereoCamera's __init__ is wrapped for size= -> image_size=: the fourcc it did not get was
+    said at the wrapper's line in _validate.py, not at the caller's (stacklevel counted one
+    frame less)."""
+    with pytest.warns(UserWarning, match="delivers no reported format") as caught:
+        StereoCamera(_NoFormatCapture(), _NoFormatCapture(), fourcc="MJPG").close()
+    assert [w.filename for w in caught] == [__file__, __file__]
+    assert [str(w.message) for w in caught] == [
+        f"{side} source _NoFormatCapture delivers no reported format, not 'MJPG'"
+        for side in ("left", "right")
+    ]

@@ -743,7 +743,7 @@ class StereoCamera(PairSource):
                 f"{side} source {_describe_source(src)} delivers "
                 f"{repr(got) if got else 'no reported format'}, not {self.requested_fourcc!r}",
                 UserWarning,
-                stacklevel=3,
+                stacklevel=4,  # _open, __init__, renamed_keyword's wrapper, the caller
             )
         return cap
 
