@@ -335,3 +335,20 @@ def test_a_warning_of_a_renamed_init_is_at_the_callers_line() -> None:
         f"{side} source _NoFormatCapture delivers no reported format, not 'MJPG'"
         for side in ("left", "right")
     ]
+
+
+@pytest.mark.parametrize("size", [(0, 240), "320 by 240", (20000, 240)])
+@pytest.mark.parametrize("keyword", ["image_size", "size"])
+def test_a_bad_image_size_is_named_image_size(size: Any, keyword: str, tmp_path: Path) -> None:
+    """StereoCamera's and BagCamera's requested size is image_size= now: a bad one was still
+    called size (parse_size's name for the command line's --size), also when given as size=."""
+    bag = tmp_path / "x.bag"
+    bag.write_bytes(b"")  # the size is checked before the bag is read
+    for open_it in (
+        lambda: StereoCamera(_NoFormatCapture(), _NoFormatCapture(), **{keyword: size}),
+        lambda: BagCamera(bag, **{keyword: size}),
+    ):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)  # size=: tested above
+            with pytest.raises(ValueError, match=r"^image_size: (expected WIDTHxHEIGHT|at most)"):
+                open_it()

@@ -224,13 +224,15 @@ def parse_source(text: str | int) -> int | str:
 MAX_SIDE = 16384
 
 
-def parse_size(text: str | tuple[int, int] | None) -> tuple[int, int] | None:
+def parse_size(text: str | tuple[int, int] | None, name: str = "size") -> tuple[int, int] | None:
     """Parse ``"1280x720"`` to ``(1280, 720)``.
 
     Parameters
     ----------
     text : str or tuple of int or None
         ``"WIDTHxHEIGHT"``, a ``(width, height)`` tuple (checked the same way), or None.
+    name : str
+        What the messages call it (the parameter or option it came from).
 
     Returns
     -------
@@ -251,11 +253,11 @@ def parse_size(text: str | tuple[int, int] | None) -> tuple[int, int] | None:
     else:
         vals = (int(text[0]), int(text[1])) if len(text) == 2 else (0, 0)
     if min(vals) <= 0:
-        raise ValueError(f"size: expected WIDTHxHEIGHT with positive integers, got {text!r}")
+        raise ValueError(f"{name}: expected WIDTHxHEIGHT with positive integers, got {text!r}")
     # Frames of another size are resized to this one: 100000x100000 made OpenCV fail to
     # allocate 30 GB per frame, an internal error instead of a word about the size.
     if max(vals) > MAX_SIDE:
-        raise ValueError(f"size: at most {MAX_SIDE} px per side, got {vals[0]}x{vals[1]}")
+        raise ValueError(f"{name}: at most {MAX_SIDE} px per side, got {vals[0]}x{vals[1]}")
     return vals
 
 
@@ -678,7 +680,7 @@ class StereoCamera(PairSource):
         fourcc: str | None = None,
     ) -> None:
         self.sources = {"left": left, "right": right}
-        self.requested_size = parse_size(image_size)
+        self.requested_size = parse_size(image_size, "image_size")
         if fps is not None and not (math.isfinite(fps) and fps > 0):
             raise ValueError(f"fps: expected a positive number, got {fps!r}")
         self.requested_fourcc = parse_fourcc(fourcc)

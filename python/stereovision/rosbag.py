@@ -777,7 +777,7 @@ class BagCamera(PairSource):
             raise ValueError("give both the left and the right topic, or neither")
         if max_skew_ms is not None and not (math.isfinite(max_skew_ms) and max_skew_ms >= 0):
             raise ValueError(f"max_skew_ms: expected a number >= 0, got {max_skew_ms!r}")
-        self.requested_size = parse_size(image_size)
+        self.requested_size = parse_size(image_size, "image_size")
         try:
             reader = _open_reader(self.path)
         except ImportError:
