@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import os
 import subprocess
@@ -246,6 +247,39 @@ def test_a_camera_state_renders_the_view_it_was_read_from(result, mesh):
     assert np.abs(render.render_view(mesh, intrinsics=intr, camera=turned) - posed).mean() > 10.0
     with pytest.raises(ValueError, match="give controls or camera, not both"):
         render.render_view(mesh, controls, camera=state)
+
+
+def test_a_camera_state_keeps_a_parallel_projection(result, mesh):
+    """A view in parallel projection (orthographic, zoomed by its parallel scale alone) was read
+    as a perspective one: rendered in perspective, and a zoom of it was the same view."""
+    intr = render.Intrinsics.from_result(result)
+    size = (intr.width, intr.height)
+    plotter = render.make_plotter(size)
+    try:
+        render.add_geometry(plotter, mesh)
+        render.apply_camera(
+            plotter,
+            CameraControls(yaw=5.0),
+            intrinsics=intr,
+            focal_distance=1.0,
+            points=mesh.points,
+        )
+        plotter.camera.SetParallelProjection(True)
+        plotter.camera.SetParallelScale(0.3)
+        shown = plotter.screenshot(return_img=True).astype(np.int16)
+        state = render.CameraState.of(plotter.camera)
+        plotter.camera.SetParallelScale(0.6)  # a zoom: nothing else of the camera moves
+        zoomed = render.CameraState.of(plotter.camera)
+    finally:
+        plotter.close()
+    assert state.parallel_projection and state.parallel_scale == pytest.approx(0.3)
+    assert not state.same_view(zoomed)
+    again = render.render_view(mesh, intrinsics=intr, camera=state)
+    assert np.abs(again - shown).mean() < 0.5
+    perspective = render.render_view(
+        mesh, intrinsics=intr, camera=dataclasses.replace(state, parallel_projection=False)
+    )
+    assert np.abs(perspective - shown).mean() > 5.0
 
 
 def test_render_outputs_and_rotated_view_differ(result, tmp_path):

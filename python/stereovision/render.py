@@ -387,6 +387,10 @@ class CameraState:
         Vertical field of view, degrees.
     window_center : tuple of float
         VTK's window centre (the principal point's shift, :func:`apply_camera`).
+    parallel_projection : bool
+        An orthographic view (VTK's parallel projection) instead of a perspective one.
+    parallel_scale : float
+        Half the height of an orthographic view, metres (its zoom; VTK's parallel scale).
     """
 
     position: tuple[float, float, float]
@@ -394,6 +398,8 @@ class CameraState:
     up: tuple[float, float, float]
     view_angle: float
     window_center: tuple[float, float] = (0.0, 0.0)
+    parallel_projection: bool = False
+    parallel_scale: float = 1.0
 
     @classmethod
     def of(cls, camera: Any) -> CameraState:
@@ -417,6 +423,8 @@ class CameraState:
             floats(camera.GetViewUp()),  # type: ignore[arg-type]
             float(camera.GetViewAngle()),
             floats(camera.GetWindowCenter()),  # type: ignore[arg-type]
+            bool(camera.GetParallelProjection()),
+            float(camera.GetParallelScale()),
         )
 
     def same_view(self, other: CameraState, tol: float = 1e-9) -> bool:
@@ -431,7 +439,15 @@ class CameraState:
 
     def _numbers(self) -> npt.NDArray[np.float64]:
         return np.array(
-            [*self.position, *self.focal_point, *self.up, self.view_angle, *self.window_center]
+            [
+                *self.position,
+                *self.focal_point,
+                *self.up,
+                self.view_angle,
+                *self.window_center,
+                float(self.parallel_projection),
+                self.parallel_scale,
+            ]
         )
 
     def apply(self, plotter: pv.Plotter, points: npt.ArrayLike | None = None) -> None:
@@ -449,6 +465,8 @@ class CameraState:
         cam.up = self.up
         cam.view_angle = self.view_angle
         cam.SetWindowCenter(*self.window_center)
+        cam.SetParallelProjection(bool(self.parallel_projection))
+        cam.SetParallelScale(self.parallel_scale)
         if points is not None:
             cam.clipping_range = robust_clipping_range(points, self.position)
         else:
@@ -759,8 +777,8 @@ def render_view(
         ``(width, height)`` of the picture; with intrinsics they are scaled to fit it.
     camera : CameraState, optional
         A view to render instead of the controls' pose (an interactive view's camera as the
-        mouse left it): its position, focal point, view-up, view angle and window centre;
-        ``intrinsics`` then give only the picture's size.
+        mouse left it): its position, focal point, view-up, view angle, window centre and
+        projection; ``intrinsics`` then give only the picture's size.
 
     Returns
     -------
