@@ -1476,6 +1476,31 @@ def test_save_renders_the_3d_view_as_the_mouse_left_it(tmp_path):
     assert np.abs(png - expected).mean() < 1.0
 
 
+def test_save_says_a_3d_view_it_cannot_render_and_writes_the_rest(tmp_path):
+    """A view's camera CameraState refuses (its up along the view direction) stopped the Save
+    before any file was written; it is said as a failed render, the other files written."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SAVED_DEPTH_FILES, SAVED_FILES
+
+    app = _scene_app("test-save-bad-camera", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    cam = app.plotter.camera
+    cam.SetViewUp(*cam.GetDirectionOfProjection())
+    app.state.save_dir = "bad"
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/bad: ")
+    assert re.search(
+        r", overview\.png \(render\.png not written: CameraState: up \([^)]+\) is along the "
+        r"view direction \(or zero\): no way is up\)$",
+        app.state.save_label,
+    ), app.state.save_label
+    assert sorted(p.name for p in (tmp_path / "bad").iterdir()) == sorted(
+        n for n in SAVED_FILES + SAVED_DEPTH_FILES if n != "render.png"
+    )
+
+
 def test_the_save_field_shows_the_data_folder_short_and_saves_where_it_says(tmp_path, monkeypatch):
     """The save field showed the --data folder's absolute path (the README's picture: a
     temporary /tmp/sv-.../scenes/saved). It shows it relative to the current directory when

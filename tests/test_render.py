@@ -282,6 +282,40 @@ def test_a_camera_state_keeps_a_parallel_projection(result, mesh):
     assert np.abs(perspective - shown).mean() > 5.0
 
 
+_VIEW = {"position": (0, 0, 0), "focal_point": (0, 0, 1), "up": (0, -1, 0), "view_angle": 40}
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"focal_point": (0, 0, 0)}, r"the focal point is the position, \(0\.0, 0\.0, 0\.0\)"),
+        ({"up": (0, 0, 2)}, r"up \(0\.0, 0\.0, 2\.0\) is along the view direction"),
+        ({"up": (0, 0, 0)}, "is along the view direction"),
+        ({"view_angle": float("nan")}, "view_angle: expected a finite number"),
+        ({"view_angle": 0.0}, "view_angle: expected 0-180 degrees, got 0"),
+        ({"view_angle": 180}, "view_angle: expected 0-180 degrees, got 180"),
+        ({"position": (0, 0)}, r"position: expected 3 numbers, got \(0, 0\)"),
+        ({"position": (0, math.inf, 0)}, "position: expected a finite number"),
+        ({"window_center": (0.0,)}, r"window_center: expected 2 numbers, got \(0\.0,\)"),
+        ({"parallel_scale": 0.0}, "parallel_scale: expected > 0, got 0"),
+    ],
+)
+def test_a_camera_state_that_sees_nothing_is_refused(change, message):
+    """A CameraState with NaN, a zero view angle or its camera on its focal point rendered an
+    empty (or arbitrary) picture without a word; a window centre of one number raised VTK's
+    'SetWindowCenter() takes exactly 2 arguments' at the render."""
+    with pytest.raises(ValueError, match=rf"^CameraState: .*{message}"):
+        render.CameraState(**{**_VIEW, **change})
+
+
+def test_a_camera_state_holds_floats():
+    state = render.CameraState([0, 0, 1], [0, 0, 2], [0, -1, 0], 40, [0.5, 0], 1, 2)
+    assert state == render.CameraState(
+        (0.0, 0.0, 1.0), (0.0, 0.0, 2.0), (0.0, -1.0, 0.0), 40.0, (0.5, 0.0), True, 2.0
+    )
+    assert hash(state) == hash(dataclasses.replace(state))  # tuples, not the lists given
+
+
 def test_render_outputs_and_rotated_view_differ(result, tmp_path):
     written = render.render_outputs(result, tmp_path)
     assert set(written) == {"render.png"}

@@ -391,6 +391,13 @@ class CameraState:
         An orthographic view (VTK's parallel projection) instead of a perspective one.
     parallel_scale : float
         Half the height of an orthographic view, metres (its zoom; VTK's parallel scale).
+
+    Raises
+    ------
+    ValueError
+        A number that is not finite, a vector of another length, a view angle outside
+        0-180 degrees, a parallel scale <= 0, a focal point at the position, or an ``up``
+        along the view direction (or zero).
     """
 
     position: tuple[float, float, float]
@@ -400,6 +407,46 @@ class CameraState:
     window_center: tuple[float, float] = (0.0, 0.0)
     parallel_projection: bool = False
     parallel_scale: float = 1.0
+
+    def __post_init__(self) -> None:
+        # a NaN, a zero view angle or a camera on its focal point rendered an empty or
+        # arbitrary picture without a word
+        from stereovision._validate import finite_number
+
+        def numbers(name: str, count: int) -> tuple[float, ...]:
+            value = getattr(self, name)
+            try:
+                if len(value) != count:
+                    raise TypeError
+            except TypeError:
+                raise ValueError(
+                    f"CameraState: {name}: expected {count} numbers, got {value!r}"
+                ) from None
+            got = tuple(finite_number(v, f"CameraState: {name}") for v in value)
+            object.__setattr__(self, name, got)
+            return got
+
+        position, focal_point, up = (numbers(n, 3) for n in ("position", "focal_point", "up"))
+        numbers("window_center", 2)
+        angle = finite_number(self.view_angle, "CameraState: view_angle")
+        if not 0 < angle < 180:
+            raise ValueError(f"CameraState: view_angle: expected 0-180 degrees, got {angle:g}")
+        scale = finite_number(self.parallel_scale, "CameraState: parallel_scale")
+        if scale <= 0:
+            raise ValueError(f"CameraState: parallel_scale: expected > 0, got {scale:g}")
+        object.__setattr__(self, "view_angle", angle)
+        object.__setattr__(self, "parallel_scale", scale)
+        object.__setattr__(self, "parallel_projection", bool(self.parallel_projection))
+        ahead = np.subtract(focal_point, position)
+        distance = float(np.linalg.norm(ahead))
+        if not distance > 0:
+            raise ValueError(f"CameraState: the focal point is the position, {position}")
+        # up's part across the view direction: none (or none to speak of) leaves no way up
+        across = float(np.linalg.norm(np.cross(ahead / distance, up)))
+        if not across > 1e-6 * float(np.linalg.norm(up)):
+            raise ValueError(
+                f"CameraState: up {up} is along the view direction (or zero): no way is up"
+            )
 
     @classmethod
     def of(cls, camera: Any) -> CameraState:

@@ -1980,8 +1980,8 @@ class StereoApp:
         # windows are not to be used from two threads); a failure is said after the files.
         image, no_render, mouse_camera = None, "", None
         if result.depth is not None:
-            mouse_camera = self._mouse_camera()
             try:
+                mouse_camera = self._mouse_camera()
                 image = self._render_for_save(view, mouse_camera)
             except (ValueError, RuntimeError, MemoryError) as exc:
                 no_render = f"render.png not written: {first_line(exc)}"
