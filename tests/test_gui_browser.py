@@ -1476,6 +1476,45 @@ def test_save_renders_the_3d_view_as_the_mouse_left_it(tmp_path):
     assert np.abs(png - expected).mean() < 1.0
 
 
+def test_the_unit_toggle_and_the_view_mode_keep_the_view_the_mouse_left(tmp_path):
+    """The unit toggle (which converts the translation sliders so that their pose stays) and the
+    surface/points toggle put the view back on the sliders' pose: a view dragged with the mouse
+    was lost, and render.png was the sliders' pose again. The dragged view now stays."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import MOUSE_RENDER
+
+    app = _scene_app("test-save-mouse-unit", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.right = 0.123
+    app._on_controls()
+    cam = app.plotter.camera
+    cam.Azimuth(-25.0)
+    cam.Elevation(12.0)
+    cam.OrthogonalizeViewUp()
+    dragged = render.CameraState.of(cam)
+    app.state.unit = "ft"
+    app._on_unit("ft")
+    assert app.state.right == pytest.approx(0.404)  # 0.123 m in feet, rounded as the slider
+    assert render.CameraState.of(app.plotter.camera).same_view(dragged)
+    app.state.view_mode = "points"
+    app._on_view_mode()
+    assert render.CameraState.of(app.plotter.camera).same_view(dragged)
+    app.state.save_dir = "ft"
+    _run(app, app.save)
+    assert app.state.save_label.endswith(f", overview.png, render.png ({MOUSE_RENDER})")
+    # not dragged: the toggle leaves the view on the sliders' pose (no mouse view said)
+    app.reset_camera()
+    app.state.right = 0.5
+    app._on_controls()
+    app.state.unit = "m"
+    app._on_unit("m")
+    app.state.save_dir = "m"
+    _run(app, app.save)
+    assert app.state.save_label.endswith(", overview.png, render.png")
+
+
 def test_save_says_a_3d_view_it_cannot_render_and_writes_the_rest(tmp_path):
     """A view's camera CameraState refuses (its up along the view direction) stopped the Save
     before any file was written; it is said as a failed render, the other files written."""

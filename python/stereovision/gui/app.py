@@ -28,6 +28,7 @@ import os
 import re
 import time
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -2225,6 +2226,19 @@ class StereoApp:
             return None
         return now
 
+    def _keeping_mouse_view(self, change: Callable[[], None]) -> None:
+        """``change()`` (which puts the view on the sliders' pose), then the view the mouse left,
+        if it left one: the unit toggle and the surface/points toggle are no slider move, and a
+        dragged view was lost to them (and render.png with it)."""
+        try:
+            mouse = self._mouse_camera()
+        except ValueError:  # a camera CameraState refuses: the sliders' pose, as before
+            mouse = None
+        change()
+        if mouse is not None:
+            mouse.apply(self.plotter)
+            self._update_view()
+
     def _update_view(self) -> None:
         if self._remote_view is not None:
             self._remote_view.update()
@@ -2258,7 +2272,7 @@ class StereoApp:
                 st.depth_caption, st.stats = self.view.texts(unit)
                 if st.floor_label and self.view.floor is not None:
                     st.floor_label = floor_text(self.view.floor, unit)
-        self._apply_camera()
+        self._keeping_mouse_view(self._apply_camera)
 
     def _on_view_mode(self, **_: Any) -> None:
         if self.state.points_only:
@@ -2276,7 +2290,8 @@ class StereoApp:
         geometry = self._geometry_for_mode()
         if geometry is not None:
             self._drawn_mode = self.state.view_mode
-            self._show_geometry(geometry, self.view.intrinsics if self.view else None)
+            intrinsics = self.view.intrinsics if self.view else None
+            self._keeping_mouse_view(lambda: self._show_geometry(geometry, intrinsics))
             if self._page_before is None:  # not while a new pair computes (its caption stays)
                 with self.state:
                     self.state.message_3d = self._scene_message()
