@@ -1515,6 +1515,37 @@ def test_the_unit_toggle_and_the_view_mode_keep_the_view_the_mouse_left(tmp_path
     assert app.state.save_label.endswith(", overview.png, render.png")
 
 
+def test_save_of_the_pair_ignores_a_drag_of_an_opened_cloud_file(tmp_path):
+    """With a point-cloud file shown in the 3-D view, a drag moves the view of that file (another
+    scene, framed without the pair's intrinsics), yet Save rendered the pair from that camera
+    and said it was the 3-D view as the mouse left it: render.png is the pair's from the
+    sliders' pose, as when nothing was dragged."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import MOUSE_RENDER
+
+    app = _scene_app("test-save-cloud-drag", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.save_dir = "first"
+    _run(app, app.save)
+    app.state.cloud_path = str((tmp_path / "first" / "cloud.ply").resolve())
+    app.open_cloud()
+    assert app.state.error == "" and app._cloud is not None
+    cam = app.plotter.camera
+    cam.Azimuth(-25.0)
+    cam.OrthogonalizeViewUp()
+    app.state.save_dir = "second"
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert MOUSE_RENDER not in app.state.save_label
+    assert app.state.save_label.endswith(", overview.png, render.png")
+    png = cv2.imread(str(tmp_path / "second" / "render.png"))[..., ::-1].astype(np.int16)
+    view = app.view
+    posed = render.render_view(view.mesh, render.CameraControls(), intrinsics=view.intrinsics)
+    assert np.abs(png - posed).mean() < 1.0
+
+
 def test_save_says_a_3d_view_it_cannot_render_and_writes_the_rest(tmp_path):
     """A view's camera CameraState refuses (its up along the view direction) stopped the Save
     before any file was written; it is said as a failed render, the other files written."""

@@ -1982,7 +1982,7 @@ class StereoApp:
         image, no_render, mouse_camera = None, "", None
         if result.depth is not None:
             try:
-                mouse_camera = self._mouse_camera()
+                mouse_camera = self._mouse_view_of_pair()
                 image = self._render_for_save(view, mouse_camera)
             except (ValueError, RuntimeError, MemoryError) as exc:
                 no_render = f"render.png not written: {first_line(exc)}"
@@ -2225,6 +2225,17 @@ class StereoApp:
         if self._slider_camera is None or now.same_view(self._slider_camera):
             return None
         return now
+
+    def _mouse_view_of_pair(self) -> Any:
+        """:meth:`_mouse_camera` when the 3-D view shows the pair on show, else None: with a
+        point-cloud file shown, the mouse moved the view of that file (another scene, framed
+        without the pair's intrinsics), which is no view of the pair Save renders.
+
+        Returns
+        -------
+        stereovision.render.CameraState or None
+        """
+        return None if self._cloud is not None else self._mouse_camera()
 
     def _keeping_mouse_view(self, change: Callable[[], None]) -> None:
         """``change()`` (which puts the view on the sliders' pose), then the view the mouse left,
