@@ -308,6 +308,22 @@ def test_a_camera_state_that_sees_nothing_is_refused(change, message):
         render.CameraState(**{**_VIEW, **change})
 
 
+def test_same_view_takes_a_tolerance_as_the_api_names_it():
+    """same_view's bound was tol=, the name count_at_precision's tolerance= replaced in the same
+    batch (one name per concept); a negative one said nothing (allclose: never the same)."""
+    import inspect
+
+    a = render.CameraState(**_VIEW)
+    b = dataclasses.replace(a, view_angle=40.001)
+    assert list(inspect.signature(a.same_view).parameters) == ["other", "tolerance"]
+    assert a.same_view(b, tolerance=1e-4) and not a.same_view(b, tolerance=1e-6)
+    assert not a.same_view(b)
+    with pytest.raises(ValueError, match=r"^tolerance: expected >= 0, got -1"):
+        a.same_view(a, tolerance=-1.0)
+    with pytest.raises(ValueError, match=r"^tolerance: expected a finite number"):
+        a.same_view(a, tolerance=math.nan)
+
+
 def test_a_camera_state_holds_floats():
     state = render.CameraState([0, 0, 1], [0, 0, 2], [0, -1, 0], 40, [0.5, 0], 1, 2)
     assert state == render.CameraState(

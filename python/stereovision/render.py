@@ -474,14 +474,31 @@ class CameraState:
             float(camera.GetParallelScale()),
         )
 
-    def same_view(self, other: CameraState, tol: float = 1e-9) -> bool:
-        """Whether ``other`` is this view (each number within ``tol`` of this one's, relative
-        to its size).
+    def same_view(self, other: CameraState, tolerance: float = 1e-9) -> bool:
+        """Whether ``other`` is this view (each number within ``tolerance`` of this one's,
+        relative to its size).
+
+        Parameters
+        ----------
+        other : CameraState
+            The view to compare.
+        tolerance : float
+            Relative (and, near zero, absolute) difference allowed per number, >= 0.
 
         Returns
         -------
         bool
+
+        Raises
+        ------
+        ValueError
+            A negative or non-finite ``tolerance``.
         """
+        from stereovision._validate import finite_number
+
+        tol = finite_number(tolerance, "tolerance")
+        if tol < 0:
+            raise ValueError(f"tolerance: expected >= 0, got {tol:g}")
         return bool(np.allclose(self._numbers(), other._numbers(), rtol=tol, atol=tol))
 
     def _numbers(self) -> npt.NDArray[np.float64]:
