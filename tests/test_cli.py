@@ -325,6 +325,37 @@ def test_depth_on_a_pair_too_small_says_only_that(
     assert not (tmp_path / "o").exists()
 
 
+def test_depth_rectification_on_a_pair_too_small_says_only_that(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """With --rectification the early size check was skipped (rectifying may change the size),
+    so a 1x1 px pair printed "... are the same image" before the size error: the rectified
+    pair is now checked before that warning, and the error is the only line. An image not of
+    the rectification's input size is likewise refused alone."""
+    img = np.full((1, 1, 3), 7, np.uint8)
+    for name in ("l.png", "r.png"):
+        assert cv2.imwrite(str(tmp_path / name), img)
+    eye = np.eye(3).tolist()
+    rect = {"H1": eye, "H2": eye, "size": [1, 1], "input_size": [1, 1]}
+    rect |= {"F": [[0, 0, 0], [0, 0, -1], [0, 1, 0]], "matches": 40, "median_dy": 0.1}
+    rect |= {"p95_dy": 0.3, "disparity_range": [0, 1], "max_disparity": 16}
+    rect |= {"skew_deg": [0, 0], "aspect": [1, 1], "model": "projective"}
+    (tmp_path / "rect.json").write_text(json.dumps(rect))
+    argv = ["depth", str(tmp_path / "l.png"), str(tmp_path / "r.png"), "-o", str(tmp_path / "o")]
+    argv += ["--rectification", str(tmp_path / "rect.json")]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: disparity range 16 is not smaller than the image width 1\n"
+    )
+    rect["input_size"] = [640, 480]
+    (tmp_path / "rect.json").write_text(json.dumps(rect))
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("stereovision: error: ") and "640x480" in err
+    assert not (tmp_path / "o").exists()
+
+
 @pytest.mark.parametrize(
     ("argv", "says"),
     [

@@ -656,15 +656,10 @@ def cmd_depth(args: argparse.Namespace) -> int:
     # 16-bit files keep their 16 bits (imread's 8-bit copy kept the top 8 of them)
     left = read_image(args.left)
     right = read_image(args.right)
-    if not args.rectification:  # (rectified, the pair may change size)
+    if not args.rectification:  # (rectified, the pair may change size: checked below)
         # a pair depth_map refuses is said alone: a 1x1 px pair was "the same image" first
         _check_pair(left, right, None, args.max_disparity)
-    if left.shape == right.shape and np.array_equal(left, right):
-        warnings.warn(
-            f"{args.left} and {args.right} are the same image: every disparity comes out 0 "
-            "(two views of the scene are needed)",
-            stacklevel=1,
-        )
+    same = left.shape == right.shape and np.array_equal(left, right)
     calib = load_calibration(args.calib, args.calib_unit, left)
     max_disparity = args.max_disparity
     if args.rectification:
@@ -675,6 +670,14 @@ def cmd_depth(args: argparse.Namespace) -> int:
         rect = UncalibratedRectification.load(args.rectification)
         left, right = rect.rectify(left, right)
         max_disparity = max_disparity or rect.max_disparity
+        # the pair as it is matched, refused alone (before the same-image warning below)
+        _check_pair(left, right, None, max_disparity)
+    if same:
+        warnings.warn(
+            f"{args.left} and {args.right} are the same image: every disparity comes out 0 "
+            "(two views of the scene are needed)",
+            stacklevel=1,
+        )
     counts: dict[str, int] = {}
     removed: list[Path] = []
     res, written = depth_outputs(
