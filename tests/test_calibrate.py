@@ -789,6 +789,32 @@ def test_max_pairs_below_the_minimum_is_refused_for_images_too(
     assert not (tmp_path / "c.yaml").exists()
 
 
+def test_max_pairs_applies_to_images_spread_over_the_list(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--max-pairs N`` with images was ignored without a word (its help said videos and bags
+    only): it now keeps N pairs spread evenly over the list (the first and the last among them)
+    and says how many of how many; without it every pair is used, as before."""
+    from stereovision.cli import main
+
+    left, right = _chessboard_paths()
+    assert len(left) == 13
+    argv = ["calibrate", "--left", *map(str, left), "--right", *map(str, right), "--square", "1"]
+    argv += ["--report", str(tmp_path / "rep")]
+    assert main([*argv, "--max-pairs", "5", "-o", str(tmp_path / "c.yaml")]) == 0
+    out = capsys.readouterr().out
+    assert out.splitlines()[0] == (
+        "--max-pairs 5: 5 of the 13 image pairs kept, spread evenly over the list"
+    )
+    assert out.splitlines()[1].startswith("5/5 pairs used (")
+    used = json.loads((tmp_path / "rep" / "report.json").read_text())["used_pairs"]
+    ids = [CHESSBOARD_IDS[i] for i in (0, 3, 6, 9, 12)]
+    assert used == [f"left{i}.jpg / right{i}.jpg" for i in ids]  # 01, 05, 08, 12, 14
+    assert main([*argv, "--max-pairs", "13", "-o", str(tmp_path / "d.yaml")]) == 0
+    out = capsys.readouterr().out
+    assert out.splitlines()[0].startswith("13/13 pairs used (")
+
+
 def test_the_triangulated_square_is_not_claimed_as_a_check_of_the_given_one(
     chessboard: tuple[Calibration, CalibrationReport], cached_corners: None
 ) -> None:

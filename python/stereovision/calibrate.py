@@ -2503,15 +2503,49 @@ def _calibrate_source(
             left_topic=args.left_topic,
             right_topic=args.right_topic,
             max_skew_ms=args.max_skew_ms,
-            max_pairs=args.max_pairs,
+            max_pairs=MAX_VIDEO_PAIRS if args.max_pairs is None else args.max_pairs,
             log=print,
             **common,
         )
     if video:
         return calibrate_from_video(
-            args.left[0], args.right[0], max_pairs=args.max_pairs, log=print, **common
+            args.left[0],
+            args.right[0],
+            max_pairs=MAX_VIDEO_PAIRS if args.max_pairs is None else args.max_pairs,
+            log=print,
+            **common,
         )
+    if args.max_pairs is not None and args.max_pairs < len(lefts):
+        keep = _spread(len(lefts), args.max_pairs)
+        print(
+            f"--max-pairs {args.max_pairs}: {len(keep)} of the {len(lefts)} image pairs kept, "
+            "spread evenly over the list"
+        )
+        lefts = [lefts[i] for i in keep]
+        rights = [rights[i] for i in keep]
     return calibrate(lefts, rights, **common)
+
+
+def _spread(n: int, k: int) -> list[int]:
+    """``k`` indices of ``range(n)`` spread evenly, the first and the last among them
+    (``_spread(13, 5)`` is ``[0, 3, 6, 9, 12]``); all of them when ``k >= n``.
+
+    Parameters
+    ----------
+    n : int
+        How many items there are.
+    k : int
+        How many to keep (at least 2).
+
+    Returns
+    -------
+    list of int
+        Increasing, distinct indices.
+    """
+    if k >= n:
+        return list(range(n))
+    # round half up of i (n - 1) / (k - 1), in integers: steps of 1 or more stay distinct
+    return [(2 * i * (n - 1) + (k - 1)) // (2 * (k - 1)) for i in range(k)]
 
 
 #: The files ``stereovision calibrate`` writes into its ``--ros`` (the first two) and
@@ -2529,7 +2563,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     (``--board charuco --marker M`` for a ChArUco board; ``--ros DIR`` also writes ROS
     ``camera_info`` files)."""
     # checked for every source: with images it was ignored without a word (0 or -1 included)
-    if args.max_pairs < MIN_PAIRS:
+    if args.max_pairs is not None and args.max_pairs < MIN_PAIRS:
         raise ValueError(
             f"--max-pairs: expected an integer of at least {MIN_PAIRS}, got {args.max_pairs}"
         )
@@ -2753,8 +2787,9 @@ def add_cli(subparsers: Any) -> None:
     p.add_argument(
         "--max-pairs",
         type=int,
-        default=MAX_VIDEO_PAIRS,
-        help=f"videos, bags: keep at most N distinct board poses (default {MAX_VIDEO_PAIRS})",
+        default=None,
+        help="keep at most N board poses: videos and bags, the first N distinct ones (default "
+        f"{MAX_VIDEO_PAIRS}); images, N pairs spread evenly over the list (default: all)",
     )
     _add_board_options(p)
     p.add_argument(
