@@ -2788,6 +2788,7 @@ def add_cli(subparsers: Any) -> None:
         "--max-pairs",
         type=int,
         default=None,
+        metavar="N",
         help="keep at most N board poses: videos and bags, the first N distinct ones (default "
         f"{MAX_VIDEO_PAIRS}); images, N pairs spread evenly over the list (default: all)",
     )
