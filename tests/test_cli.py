@@ -325,6 +325,24 @@ def test_depth_on_a_pair_too_small_says_only_that(
     assert not (tmp_path / "o").exists()
 
 
+def test_depth_same_image_with_a_calibration_for_another_size_says_only_that(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One image given twice with a calibration for another image size printed "... are the
+    same image" before the calibration's size error: the error is now the only line (depth_map
+    refuses the pair), and nothing is written."""
+    img = str(data_dir / "middlebury2003" / "cones" / "left.png")
+    calib = str(data_dir / "kitti2015" / "000005_10" / "calib.txt")
+    argv = ["depth", img, img, "--calib", calib, "-o", str(tmp_path / "o")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.splitlines() == [
+        "stereovision: error: calibration is for 1242x375 images, got 450x375 (another aspect "
+        "ratio: another camera mode or camera, or cropped images)"
+    ]
+    assert not (tmp_path / "o").exists()
+
+
 def test_depth_rectification_on_a_pair_too_small_says_only_that(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

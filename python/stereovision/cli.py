@@ -672,6 +672,8 @@ def cmd_depth(args: argparse.Namespace) -> int:
         max_disparity = max_disparity or rect.max_disparity
         # the pair as it is matched, refused alone (before the same-image warning below)
         _check_pair(left, right, None, max_disparity)
+    elif calib is not None:  # a calibration for another image size, refused alone too
+        _check_pair(left, right, calib, max_disparity)
     if same:
         warnings.warn(
             f"{args.left} and {args.right} are the same image: every disparity comes out 0 "
