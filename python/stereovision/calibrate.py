@@ -2790,7 +2790,8 @@ def add_cli(subparsers: Any) -> None:
         default=None,
         metavar="N",
         help="keep at most N board poses: videos and bags, the first N distinct ones (default "
-        f"{MAX_VIDEO_PAIRS}); images, N pairs spread evenly over the list (default: all)",
+        f"{MAX_VIDEO_PAIRS}); images, N pairs spread evenly over the list, before the board "
+        "is looked for in them (default: all)",
     )
     _add_board_options(p)
     p.add_argument(
