@@ -127,6 +127,12 @@ def test_a_new_folder_is_not_left_behind_by_a_failing_run(
     monkeypatch.setattr(cli, "write_overview", fails)
     assert main(_terrace_argv(data_dir, out)) == 130
     assert not out.exists()
+    # the folders above it that the run made go too (new/ was left): tmp_path as it was
+    assert not (tmp_path / "new").exists()
+    # a path through ".." (mkdir -p makes new2/ and b/, not "new2/..")
+    out = tmp_path / "new2" / ".." / "b"
+    assert main(_terrace_argv(data_dir, out)) == 130
+    assert not (tmp_path / "new2").exists() and not (tmp_path / "b").exists()
 
 
 def test_a_complete_run_replaces_the_whole_earlier_set(

@@ -533,7 +533,8 @@ def staged_outputs(out_dir: Path) -> Iterator[Path]:
     into before :func:`commit_outputs` moves them in.
 
     The folder is removed when the block ends, however it ends (an error, Ctrl-C, SIGTERM as
-    the CLI raises it); ``out_dir`` too when the block created it and fails with it empty.
+    the CLI raises it); ``out_dir`` and the folders above it that the block created too, when
+    it fails with them empty (:func:`stereovision.io.missing_folders`).
 
     Parameters
     ----------
@@ -548,18 +549,17 @@ def staged_outputs(out_dir: Path) -> Iterator[Path]:
     import shutil
     import tempfile
 
-    from stereovision.io import make_folder
+    from stereovision.io import make_folder, missing_folders, remove_empty_folders
 
-    made = not out_dir.exists()
+    made = missing_folders(out_dir)  # out_dir and the folders above it that it needs
     make_folder(out_dir)
     stage = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out_dir))
     try:
         yield stage
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
-        if made:
-            with contextlib.suppress(OSError):  # only when empty: nothing else is touched
-                out_dir.rmdir()
+        # only while empty: nothing else is touched (-o new/o left new/ behind)
+        remove_empty_folders(made)
         raise
     shutil.rmtree(stage, ignore_errors=True)
 

@@ -19,7 +19,7 @@ import os
 import re
 import tempfile
 import threading
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
@@ -95,6 +95,44 @@ def make_folder(path: PathLike) -> Path:
             f"cannot make the folder {folder}: {blocker} is a file, not a folder"
         ) from None
     return folder
+
+
+def missing_folders(path: PathLike) -> list[Path]:
+    """The folders :func:`make_folder` would create for ``path``, ``path`` first, each as an
+    absolute path: a command that fails before writing anything removes them again (deepest
+    first, each only when empty) and leaves no empty folder behind.
+
+    A ``..`` is not a folder ``mkdir -p`` makes (``new/../out`` makes ``new`` and ``out``), so
+    it is skipped, and removing one (``rmdir new/..``) would fail and keep ``new``.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        The folder about to be made.
+
+    Returns
+    -------
+    list of pathlib.Path
+        The folders that do not exist yet.
+    """
+    missing = []
+    folder = Path(path).absolute()
+    while not folder.exists() and not folder.is_symlink() and folder != folder.parent:
+        if folder.name != "..":
+            missing.append(folder)
+        folder = folder.parent
+    return missing
+
+
+def remove_empty_folders(folders: Sequence[Path]) -> None:
+    """Remove ``folders`` (:func:`missing_folders`' list, deepest first) while each is empty:
+    the first that holds anything, and every folder above it, stay."""
+    for folder in folders:
+        try:
+            folder.rmdir()
+        except OSError:  # not empty (something else in it), or gone already
+            if folder.exists():
+                return
 
 
 def refuse_an_input(flag: str, output: Path, inputs: dict[str, str | None]) -> None:
