@@ -211,6 +211,11 @@ def test_unreachable_scheduler_leaves_no_new_folder(
     assert rc == 2
     assert len(err) == 1 and "cannot reach the Dask scheduler at tcp://127.0.0.1:1" in err[0]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]
+    # through "..": mkdir -p made new2/ and out2/, both go (new2/ was left)
+    out = tmp_path / "new2" / ".." / "out2"
+    rc = main(["batch", str(tmp_path / "in"), "-o", str(out), "--scheduler", "tcp://127.0.0.1:1"])
+    assert rc == 2
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]
     kept = tmp_path / "kept"
     kept.mkdir()
     rc = main(["batch", str(tmp_path / "in"), "-o", str(kept), "--scheduler", "tcp://127.0.0.1:1"])

@@ -1348,7 +1348,10 @@ def run_batch(
             f"folders left/ + right/, L/ + R/, image_2/ + image_3/, cam0/ + cam1/){alone}"
         )
     out = Path(output_dir)
-    made = _missing_folders(out)  # removed again if the run never starts
+    from stereovision.io import missing_folders
+
+    # removed again if the run never starts (io.missing_folders: new/../OUT left new/ behind)
+    made = missing_folders(out)
     out.mkdir(parents=True, exist_ok=True)
     with _output_lock(out):  # a second run into OUT would drop this one's records
         summary = _Summary(out, log)
@@ -1576,26 +1579,17 @@ def run_batch(
         return result
 
 
-def _missing_folders(out: Path) -> list[Path]:
-    """The folders ``out.mkdir(parents=True)`` would make, ``out`` first."""
-    missing = []
-    folder = out.absolute()
-    while not folder.exists() and not folder.is_symlink() and folder != folder.parent:
-        missing.append(folder)
-        folder = folder.parent
-    return missing
-
-
 def _remove_unstarted(out: Path, made: list[Path]) -> None:
     """Remove the summary of a run that never started and the folders it made for it, when
     ``out`` is one of them and holds nothing else (an output folder that was there is kept)."""
+    from stereovision.io import remove_empty_folders
+
     if not made:
         return
     with contextlib.suppress(OSError):
         if {p.name for p in out.iterdir()} <= {SUMMARY_NAME}:
             (out / SUMMARY_NAME).unlink(missing_ok=True)
-        for folder in made:  # out first, then the parents it needed
-            folder.rmdir()  # an OSError (not empty: something else in it) stops here
+    remove_empty_folders(made)  # out first, then the parents it needed, while empty
 
 
 def _outputs_gone(out: Path, summary: _Summary, names: list[str]) -> list[str]:
