@@ -220,6 +220,8 @@ def test_unreachable_scheduler_leaves_no_new_folder(
     kept.mkdir()
     rc = main(["batch", str(tmp_path / "in"), "-o", str(kept), "--scheduler", "tcp://127.0.0.1:1"])
     assert rc == 2 and kept.is_dir()
+    # the summary it wrote there (every pair pending, of a run that never started) goes too
+    assert list(kept.iterdir()) == []
 
 
 def test_find_pairs_names(tmp_path: Path) -> None:

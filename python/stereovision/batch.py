@@ -1352,6 +1352,8 @@ def run_batch(
 
     # removed again if the run never starts (io.missing_folders: new/../OUT left new/ behind)
     made = missing_folders(out)
+    # a summary this run writes into a folder that had none is its own, removed with it too
+    fresh = not os.path.lexists(out / SUMMARY_NAME)
     out.mkdir(parents=True, exist_ok=True)
     with _output_lock(out):  # a second run into OUT would drop this one's records
         summary = _Summary(out, log)
@@ -1544,7 +1546,7 @@ def run_batch(
             # the scheduler not reached, Dask not installed: a run that never started left its
             # summary (every pair pending) in a folder it had just made; nothing of it is left
             if run["scheduler"] is None:  # set once Dask is up
-                _remove_unstarted(out, made)
+                _remove_unstarted(out, made, fresh)
             raise
         with HeldInterrupts(replay=False) as held:  # the record of the run is written whole
             gone = _outputs_gone(out, summary, [j.name for j in jobs])
@@ -1579,15 +1581,14 @@ def run_batch(
         return result
 
 
-def _remove_unstarted(out: Path, made: list[Path]) -> None:
-    """Remove the summary of a run that never started and the folders it made for it, when
-    ``out`` is one of them and holds nothing else (an output folder that was there is kept)."""
+def _remove_unstarted(out: Path, made: list[Path], fresh: bool) -> None:
+    """Remove the summary of a run that never started when the folder had none before it
+    (``fresh``: an output folder that was there, empty, kept it, every pair pending), and the
+    folders it made for it while empty (an output folder that was there is kept)."""
     from stereovision.io import remove_empty_folders
 
-    if not made:
-        return
-    with contextlib.suppress(OSError):
-        if {p.name for p in out.iterdir()} <= {SUMMARY_NAME}:
+    if fresh:
+        with contextlib.suppress(OSError):
             (out / SUMMARY_NAME).unlink(missing_ok=True)
     remove_empty_folders(made)  # out first, then the parents it needed, while empty
 
