@@ -207,3 +207,29 @@ def test_a_folder_under_a_listed_output_name_is_refused_before_any_file_moves(
         "move it away (the earlier outputs are kept as they were)\n"
     )
     assert _files(out) == before
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="no flock: the folders are left there")
+def test_a_killed_runs_hidden_folder_is_removed_by_the_next_run(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """A run killed outright (SIGKILL, power loss) left its .stereovision-partial-* folder,
+    4 MB of half-written files, in -o for good: no later run removed it. The next run removes
+    such a folder that no running process holds; one a run in progress holds stays."""
+    import fcntl
+    import os
+
+    out = tmp_path / "o"
+    orphan = out / f"{cli.STAGING_PREFIX}dead1234"
+    orphan.mkdir(parents=True)
+    (orphan / "disparity.png").write_bytes(b"half")
+    busy = out / f"{cli.STAGING_PREFIX}busy1234"
+    busy.mkdir()
+    fd = os.open(busy, os.O_RDONLY)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # as a run in progress holds its own
+        assert main(_terrace_argv(data_dir, out)) == 0
+        hidden = sorted(p.name for p in out.iterdir() if p.name.startswith(cli.STAGING_PREFIX))
+        assert hidden == [busy.name]
+    finally:
+        os.close(fd)

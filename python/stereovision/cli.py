@@ -534,7 +534,8 @@ def staged_outputs(out_dir: Path) -> Iterator[Path]:
 
     The folder is removed when the block ends, however it ends (an error, Ctrl-C, SIGTERM as
     the CLI raises it); ``out_dir`` and the folders above it that the block created too, when
-    it fails with them empty (:func:`stereovision.io.missing_folders`).
+    it fails with them empty (:func:`stereovision.io.missing_folders`). Such a folder of a run
+    killed outright (SIGKILL) that no running process holds is removed.
 
     Parameters
     ----------
@@ -554,14 +555,57 @@ def staged_outputs(out_dir: Path) -> Iterator[Path]:
     made = missing_folders(out_dir)  # out_dir and the folders above it that it needs
     make_folder(out_dir)
     stage = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out_dir))
+    held = _hold_folder(stage)  # held while the run lives: the next run removes it otherwise
     try:
+        _remove_orphan_stages(out_dir, stage)
         yield stage
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
         # only while empty: nothing else is touched (-o new/o left new/ behind)
         remove_empty_folders(made)
         raise
+    finally:
+        if held is not None:
+            os.close(held)
     shutil.rmtree(stage, ignore_errors=True)
+
+
+def _hold_folder(folder: Path) -> int | None:
+    """An exclusive ``flock`` on ``folder`` (its descriptor), released when the process ends,
+    killed or not; None where the system or filesystem cannot lock (Windows) or another
+    process holds it."""
+    try:
+        import fcntl
+    except ImportError:  # Windows
+        return None
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return None
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError:
+        os.close(fd)
+        return None
+    return fd
+
+
+def _remove_orphan_stages(out_dir: Path, own: Path) -> None:
+    """Remove the :func:`staged_outputs` folders in ``out_dir`` of runs killed outright
+    (SIGKILL, power loss: no ``finally`` ran), which stayed there for good: those no running
+    process holds (:func:`_hold_folder`). Where nothing can be locked none is touched."""
+    import shutil
+
+    for folder in out_dir.glob(f"{STAGING_PREFIX}*"):
+        if folder == own or folder.is_symlink() or not folder.is_dir():
+            continue
+        fd = _hold_folder(folder)
+        if fd is None:  # a run in progress holds it (or no locks here)
+            continue
+        try:
+            shutil.rmtree(folder, ignore_errors=True)
+        finally:
+            os.close(fd)
 
 
 def commit_outputs(
