@@ -126,7 +126,13 @@ def missing_folders(path: PathLike) -> list[Path]:
 
 def remove_empty_folders(folders: Sequence[Path]) -> None:
     """Remove ``folders`` (:func:`missing_folders`' list, deepest first) while each is empty:
-    the first that holds anything, and every folder above it, stay."""
+    the first that holds anything, and every folder above it, stay.
+
+    Parameters
+    ----------
+    folders : sequence of pathlib.Path
+        The folders a command made, deepest first.
+    """
     for folder in folders:
         try:
             folder.rmdir()
