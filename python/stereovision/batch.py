@@ -1215,24 +1215,15 @@ def _output_lock(out: Path) -> Iterator[None]:
     ValueError
         If another run holds the folder.
     """
+    from stereovision.io import lock_folder
+
+    fd, busy = lock_folder(out)
+    if busy:
+        raise ValueError(
+            f"output folder {out} is in use by another stereovision batch run; wait "
+            "for it to end, or give another output folder"
+        )
     try:
-        import fcntl
-    except ImportError:  # Windows
-        fcntl = None  # type: ignore[assignment]
-    fd = None
-    with contextlib.suppress(OSError):
-        fd = os.open(out, os.O_RDONLY)
-    try:
-        if fcntl is not None and fd is not None:
-            try:
-                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            except BlockingIOError:
-                raise ValueError(
-                    f"output folder {out} is in use by another stereovision batch run; wait "
-                    "for it to end, or give another output folder"
-                ) from None
-            except OSError:  # no locks on this filesystem
-                pass
         yield
     finally:
         if fd is not None:

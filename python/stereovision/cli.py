@@ -550,12 +550,12 @@ def staged_outputs(out_dir: Path) -> Iterator[Path]:
     import shutil
     import tempfile
 
-    from stereovision.io import make_folder, missing_folders, remove_empty_folders
+    from stereovision.io import lock_folder, make_folder, missing_folders, remove_empty_folders
 
     made = missing_folders(out_dir)  # out_dir and the folders above it that it needs
     make_folder(out_dir)
     stage = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=out_dir))
-    held = _hold_folder(stage)  # held while the run lives: the next run removes it otherwise
+    held, _ = lock_folder(stage)  # held while the run lives: the next run removes it otherwise
     try:
         _remove_orphan_stages(out_dir, stage)
         yield stage
@@ -570,36 +570,19 @@ def staged_outputs(out_dir: Path) -> Iterator[Path]:
     shutil.rmtree(stage, ignore_errors=True)
 
 
-def _hold_folder(folder: Path) -> int | None:
-    """An exclusive ``flock`` on ``folder`` (its descriptor), released when the process ends,
-    killed or not; None where the system or filesystem cannot lock (Windows) or another
-    process holds it."""
-    try:
-        import fcntl
-    except ImportError:  # Windows
-        return None
-    try:
-        fd = os.open(folder, os.O_RDONLY)
-    except OSError:
-        return None
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except OSError:
-        os.close(fd)
-        return None
-    return fd
-
-
 def _remove_orphan_stages(out_dir: Path, own: Path) -> None:
     """Remove the :func:`staged_outputs` folders in ``out_dir`` of runs killed outright
     (SIGKILL, power loss: no ``finally`` ran), which stayed there for good: those no running
-    process holds (:func:`_hold_folder`). Where nothing can be locked none is touched."""
+    process holds (:func:`stereovision.io.lock_folder`). Where nothing can be locked none is
+    touched."""
     import shutil
+
+    from stereovision.io import lock_folder
 
     for folder in out_dir.glob(f"{STAGING_PREFIX}*"):
         if folder == own or folder.is_symlink() or not folder.is_dir():
             continue
-        fd = _hold_folder(folder)
+        fd, _ = lock_folder(folder)
         if fd is None:  # a run in progress holds it (or no locks here)
             continue
         try:

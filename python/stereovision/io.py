@@ -124,6 +124,39 @@ def missing_folders(path: PathLike) -> list[Path]:
     return missing
 
 
+def lock_folder(folder: PathLike) -> tuple[int | None, bool]:
+    """An exclusive ``flock`` on ``folder`` itself (no file is left in it; the system releases
+    it when the process ends, killed or not), without waiting.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The folder to lock.
+
+    Returns
+    -------
+    fd : int or None
+        The locked descriptor (closing it releases the lock); None when not locked.
+    busy : bool
+        True when another process holds the lock; False when it is ours, or when the system or
+        filesystem cannot lock (Windows, some network filesystems: ``fd`` None).
+    """
+    try:
+        import fcntl
+    except ImportError:  # Windows
+        return None, False
+    try:
+        fd = os.open(folder, os.O_RDONLY)
+    except OSError:
+        return None, False
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as exc:
+        os.close(fd)
+        return None, isinstance(exc, BlockingIOError)
+    return fd, False
+
+
 def remove_empty_folders(folders: Sequence[Path]) -> None:
     """Remove ``folders`` (:func:`missing_folders`' list, deepest first) while each is empty:
     the first that holds anything, and every folder above it, stay.
