@@ -890,8 +890,9 @@ def overview_name(source_label: str) -> str:
     -------
     str
     """
-    text = "".join(_ASCII_FOR.get(c, c) for c in source_label.strip()) or "pair"
-    return text.encode("ascii", "replace").decode("ascii")
+    from stereovision.overview import cv2_text
+
+    return cv2_text("".join(_ASCII_FOR.get(c, c) for c in source_label.strip()) or "pair")
 
 
 def max_disparity_hint(auto: int | None, full_width: int, width: int | None) -> str:
