@@ -1762,7 +1762,73 @@ def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkey
 
     asyncio.run(twice_offered())
     assert app.state.error == ""
-    assert calls == [(tmp_path / "saved-2").resolve(), (tmp_path / "saved-3").resolve()]
+    # each written in its own staging folder beside it, then moved into place
+    assert [c.name for c in calls] == ["saved-2", "saved-3"]
+    assert all(c.parent.parent == tmp_path.resolve() for c in calls)
+    assert all(c.parent.name.startswith(".stereovision-partial-") for c in calls)
+    assert (tmp_path / "saved-2" / "cloud.ply").is_file()
+    assert (tmp_path / "saved-3" / "cloud.ply").is_file()
+    assert not list(tmp_path.glob(".stereovision-partial-*"))
+
+
+def test_a_save_whose_writer_fails_leaves_no_partial_folder_and_names_the_file(
+    tmp_path, monkeypatch
+):
+    """Save wrote its files one by one into the folder: a writer that failed midway (disk full)
+    left a partial set there. A Save is now all or nothing: written into a staging folder and
+    moved into place once every file is; a failure leaves the folder as it was (absent when it
+    was), no staging folder behind, and the Save's line names the file that failed."""
+    import contextlib
+    import errno
+
+    import stereovision.io as svio
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SAVE_WRITE_ORDER, SAVED_DEPTH_FILES, SAVED_FILES
+
+    assert sorted(SAVE_WRITE_ORDER) == sorted(SAVED_FILES + SAVED_DEPTH_FILES)
+    app = _scene_app("test-save-all-or-nothing", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    real = svio.atomic_write
+    failing = [""]
+
+    @contextlib.contextmanager
+    def full_disk(path, mode="wb"):
+        if Path(path).name == failing[0]:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        with real(path, mode) as fh:
+            yield fh
+
+    monkeypatch.setattr(svio, "atomic_write", full_disk)
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("mine")
+    for name in SAVE_WRITE_ORDER:
+        failing[0] = name
+        for typed, folder in (("", "saved"), ("mine", "mine"), ("new/deeper", "new/deeper")):
+            app.state.save_dir = typed or app._offered_save_dir
+            app.state.save_label = ""
+            _run(app, app.save)
+            said = (
+                f"save: {name} could not be written ([Errno 28] No space left on device); "
+                f"nothing was saved in {tmp_path.name}/{folder}"
+            )
+            assert app.state.save_label == said, (name, typed)
+            assert app.state.error == said
+            assert not (tmp_path / "saved").exists() and not (tmp_path / "new").exists()
+            assert [p.name for p in (tmp_path / "mine").iterdir()] == ["notes.txt"]
+            assert not list(tmp_path.glob(".*")), (name, typed)
+    # the disk has room again: the same Saves write every file
+    failing[0] = ""
+    for typed in ("", "mine", "new/deeper"):
+        app.state.save_dir = typed or app._offered_save_dir
+        _run(app, app.save)
+        assert app.state.error == ""
+    for folder in ("saved", "new/deeper"):
+        assert sorted(p.name for p in (tmp_path / folder).iterdir()) == sorted(SAVE_WRITE_ORDER)
+    assert sorted(p.name for p in (tmp_path / "mine").iterdir()) == sorted(
+        ("notes.txt", *SAVE_WRITE_ORDER)
+    )
+    assert not list(tmp_path.glob(".*")) and not list((tmp_path / "mine").glob(".*"))
 
 
 def _still_cameras_app(name: str, data_dir: Path, raw: tuple) -> Any:

@@ -183,6 +183,19 @@ DEPTH_CAPTION = "depth (near = warm)"
 #: What "Save" writes (``stereovision depth``'s own files, by its writers): always, and with depth.
 SAVED_FILES = ("disparity.png", "disparity.pfm", "overview.png")
 SAVED_DEPTH_FILES = ("depth.png", "depth.npy", "depth_mm.png", "cloud.ply", "render.png")
+#: The order Save's writers write its files in (``write_depth_outputs``' own order, then
+#: ``overview.png`` and ``render.png``): of a Save that failed, the first not written is the one
+#: that failed.
+SAVE_WRITE_ORDER = (
+    "disparity.png",
+    "depth.png",
+    "depth.npy",
+    "depth_mm.png",
+    "disparity.pfm",
+    "cloud.ply",
+    "overview.png",
+    "render.png",
+)
 #: The save folder offered at start-up, inside the first ``--data`` folder.
 SAVE_FOLDER = "saved"
 #: Height of a button of a toggle row (Vuetify's compact button group).
@@ -232,6 +245,68 @@ PENDING_FLOOR = "the new pair is being computed: find its floor once its depth i
 MOUSE_RENDER = "render.png: the 3-D view as the mouse left it, not the sliders' pose"
 #: What Save says while a new pair computes.
 PENDING_SAVE = "the new pair is being computed: save it once its results are shown"
+
+
+class SaveFailed(OSError):
+    """A Save's writer failed: the message names the file (nothing was moved into place)."""
+
+
+def save_all_or_nothing(write: Callable[[Path], None], folder: Path) -> dict[str, Path]:
+    """Run a Save's writers into a staging folder and move their files into ``folder`` only
+    once every one is written.
+
+    The staging folder is ``stereovision depth -o``'s (:func:`stereovision.cli.staged_outputs`:
+    hidden, locked while the Save runs, removed however it ends, and one a killed process
+    left is removed by the next). It is made beside ``folder`` when ``folder`` does not exist
+    (the whole folder then appears at once, by one rename), else inside it (its files then
+    move in one by one, each by one rename, after checking that none is there).
+
+    Parameters
+    ----------
+    write : callable
+        Writes the Save's files into the folder it is given (that folder exists).
+    folder : pathlib.Path
+        Where the files go (it need not exist; the folders above it are made as needed).
+
+    Returns
+    -------
+    dict
+        ``{name: path in folder}``, in :data:`SAVE_WRITE_ORDER`.
+
+    Raises
+    ------
+    SaveFailed
+        A writer failed, naming the first file of :data:`SAVE_WRITE_ORDER` it did not write;
+        ``folder`` is as it was (absent if it was), the folders made above it removed again.
+    FileExistsError
+        One of the files appeared in ``folder`` while the Save wrote (nothing was replaced).
+    """
+    from stereovision.cli import CliError, staged_outputs
+
+    exists = os.path.isdir(folder)
+    with staged_outputs(folder if exists else folder.parent) as stage:
+        inner = stage / folder.name
+        inner.mkdir()  # the mode a plain mkdir gives (the staging folder's is 0700)
+        try:
+            write(inner)
+        except (ValueError, OSError, RuntimeError, CliError) as exc:
+            done = {p.name for p in inner.iterdir()}
+            failed = next((n for n in SAVE_WRITE_ORDER if n not in done), "a file")
+            why = first_line(exc).replace(str(inner), str(folder))  # its path as it would be
+            raise SaveFailed(f"{failed} could not be written ({why})") from exc
+        names = [n for n in SAVE_WRITE_ORDER if (inner / n).is_file()]
+        if not exists:
+            os.rename(inner, folder)  # fails (nothing replaced) if a folder with files came
+        else:
+            came = [n for n in names if os.path.lexists(folder / n)]
+            if came:
+                raise FileExistsError(
+                    f"save: {', '.join(came)} appeared in {folder} while the Save wrote; "
+                    "nothing was overwritten: choose another folder"
+                )
+            for name in names:
+                os.replace(inner / name, folder / name)
+    return {n: folder / n for n in names}
 
 
 def _data_url(image: npt.NDArray[np.uint8], width: int = DISPLAY_WIDTH) -> str:
@@ -1935,6 +2010,11 @@ class StereoApp:
         A render that fails (or a pair with no 3-D point to render) is said in the Save's line
         on the page, after the files written: the others are written all the same.
 
+        A Save is all or nothing (:func:`save_all_or_nothing`): its files are written into a
+        staging folder and moved into place once all of them are; a writer that fails (disk
+        full, no permission) leaves the folder as it was (or absent), and the Save's line names
+        the file that failed.
+
         The folder as offered (or an empty field) is a new one each time: the first of
         ``saved``, ``saved-2``, ``saved-3``, ... that does not exist or is empty, so several
         pairs can be saved one after the other; the page says which. A folder the user typed
@@ -1988,21 +2068,29 @@ class StereoApp:
             except (ValueError, RuntimeError, MemoryError) as exc:
                 no_render = f"render.png not written: {first_line(exc)}"
 
-        def run() -> dict[str, Path]:
-            written = write_depth_outputs(result, folder)
-            written.update(write_overview(result, folder, title, unit))
+        def write(into: Path) -> None:
+            write_depth_outputs(result, into)
+            write_overview(result, into, title, unit)
             if image is not None:
-                written.update(write_render(image, folder))
-            return written
+                write_render(image, into)
 
-        self._saving_into.add(folder)
+        target = folder
+        self._saving_into.add(target)
         try:
-            written = await asyncio.get_running_loop().run_in_executor(self._executor, run)
+            written = await asyncio.get_running_loop().run_in_executor(
+                self._executor, save_all_or_nothing, write, target
+            )
+        except SaveFailed as exc:
+            msg = short_paths(f"save: {exc}; nothing was saved in {label}", target)
+            self._fail(ValueError(msg))
+            with self.state:
+                self.state.save_label = msg
+            return
         except (ValueError, OSError, RuntimeError, CliError) as exc:
-            self._fail(exc, folder)
+            self._fail(exc, target)
             return
         finally:
-            self._saving_into.discard(folder)
+            self._saving_into.discard(target)
         self._done()
         h, w = result.disparity.shape
         if result.depth is None:
