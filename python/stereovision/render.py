@@ -46,6 +46,7 @@ __all__ = [
     "CameraState",
     "apply_camera",
     "camera_pose",
+    "controls_from_pose",
     "display_subset",
     "orbit_controls",
     "point_cloud",
@@ -189,6 +190,67 @@ def camera_pose(
     pose[:3, :3] = rot
     pose[:3, 3] = [right, -up, forward]
     return pose
+
+
+#: Below this, ``cos(pitch)`` is taken as 0 by :func:`controls_from_pose` (gimbal lock).
+_GIMBAL_LOCK_COS = 1e-12
+
+
+def controls_from_pose(pose: npt.ArrayLike) -> CameraControls:
+    """The controls whose :func:`camera_pose` is ``pose``: its inverse.
+
+    ``R = R_y(yaw) @ R_x(pitch) @ R_z(roll)`` gives ``pitch = atan2(-R[1, 2], |R[(0, 2), 2]|)``
+    in [-90, 90], ``yaw = atan2(R[0, 2], R[2, 2])`` and ``roll = atan2(R[1, 0], R[1, 1])`` in
+    (-180, 180].
+    Controls with ``|pitch| < 90`` and yaw and roll within +-90 (the GUI sliders' ranges) come
+    back as they were, read back from a VTK camera too (measured: 1e-10 degrees up to 0.001
+    degree off the vertical, 1e-7 at 1e-9 degree off; ``tests/test_render.py``), and the pose
+    of the controls read back is ``pose`` (1e-15). Looking straight up or down (gimbal lock)
+    only ``yaw - roll`` (up) or ``yaw + roll`` (down) is determined: roll is said 0. A camera
+    turned past the sliders' range (a mouse drag around the scene: yaw 150) gives angles
+    outside +-90, which the GUI's sliders cannot show.
+
+    Parameters
+    ----------
+    pose : array_like, (4, 4)
+        Camera-to-left-camera transform (:func:`camera_pose`, :func:`pose_from_camera`); its
+        rotation part must be a rotation.
+
+    Returns
+    -------
+    CameraControls
+
+    Raises
+    ------
+    ValueError
+        A pose that is not 4x4 or not finite.
+
+    Examples
+    --------
+    >>> c = controls_from_pose(camera_pose(roll=10.0, pitch=-20.0, yaw=30.0, up=1.5))
+    >>> round(c.roll, 9), round(c.pitch, 9), round(c.yaw, 9), round(c.up, 9)
+    (10.0, -20.0, 30.0, 1.5)
+    """
+    m = np.asarray(pose, dtype=np.float64)
+    if m.shape != (4, 4) or not np.isfinite(m).all():
+        raise ValueError(f"controls_from_pose: expected a finite 4x4 pose, got shape {m.shape}")
+    rot, t = m[:3, :3], m[:3, 3]
+    cos_pitch = math.hypot(rot[0, 2], rot[2, 2])
+    # atan2, not asin(-R[1, 2]): asin near 1 lost half the digits (1e-8 off the vertical)
+    pitch = math.degrees(math.atan2(-rot[1, 2], cos_pitch))
+    if cos_pitch < _GIMBAL_LOCK_COS:  # looking straight up or down
+        yaw, roll = math.degrees(math.atan2(-rot[2, 0], rot[0, 0])), 0.0
+    else:
+        yaw = math.degrees(math.atan2(rot[0, 2], rot[2, 2]))
+        roll = math.degrees(math.atan2(rot[1, 0], rot[1, 1]))
+    return CameraControls(
+        roll=roll,
+        pitch=pitch,
+        yaw=yaw,
+        forward=float(t[2]),
+        up=float(-t[1]),
+        right=float(t[0]),
+    )
 
 
 def orbit_controls(yaw: float, pitch: float, center_depth: float) -> CameraControls:
