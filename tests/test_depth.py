@@ -799,3 +799,21 @@ def test_point_image_filled_must_be_a_switch(filled: object) -> None:
         TypeError, match=re.escape(f"filled: expected True or False, got {filled!r}")
     ):
         res.point_image(filled=filled)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("min_disparity", [0, 5])
+def test_one_px_wide_pair_is_told_the_width_it_needs_not_an_impossible_range(
+    min_disparity: int,
+) -> None:
+    """A 1 px wide pair, no range given: no max_disparity can match it (a range of a whole pixel
+    needs 2 px), so the error names the widths needed, not "a max_disparity below 1" (or below
+    ``min_disparity + 1``), which no range of a pixel or more fits."""
+    rng = np.random.default_rng(5)
+    left = (rng.random((12, 1)) * 255).astype(np.uint8)
+    with pytest.raises(
+        ValueError,
+        match=r"^image too narrow for stereo matching: 1 px wide, and the automatic disparity "
+        r"range \(at least 16 px\) needs images at least 1[27] px wide; a max_disparity of your "
+        r"own needs images at least 2 px wide$",
+    ):
+        sv.depth_map(left, left.copy(), min_disparity=min_disparity)

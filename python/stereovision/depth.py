@@ -186,13 +186,17 @@ def _finite(v: float) -> bool:
 
 def _too_narrow(width: int, automatic_range: float, min_disparity: float = 0) -> ValueError:
     """The error of a pair narrower than the disparity range chosen for it (never below
-    ``_DISPARITY_STEP``: a pair at most 16 px wide is always refused)."""
+    ``_DISPARITY_STEP``: a pair at most 16 px wide is always refused). A pair 2 px wide or more
+    is told the ``max_disparity`` that fits it; a 1 px wide one, which no range of a pixel or
+    more fits (the range must be below the width), the width such a range needs."""
     need = math.floor(automatic_range) + 1
-    return ValueError(
+    text = (
         f"image too narrow for stereo matching: {width} px wide, and the automatic "
-        f"disparity range (at least {_DISPARITY_STEP} px) needs images at least {need} px "
-        f"wide; give a max_disparity below {width + min_disparity:g} to match it"
+        f"disparity range (at least {_DISPARITY_STEP} px) needs images at least {need} px wide"
     )
+    if width < 2:
+        return ValueError(f"{text}; a max_disparity of your own needs images at least 2 px wide")
+    return ValueError(f"{text}; give a max_disparity below {width + min_disparity:g} to match it")
 
 
 def estimate_max_disparity(left: npt.ArrayLike, right: npt.ArrayLike) -> int:
