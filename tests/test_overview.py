@@ -490,3 +490,36 @@ def test_overview_title_outside_ascii_is_drawn_as_question_marks(terrace_run: tu
     """The title keeps its ASCII and shows every other character as one ``?``."""
     picture = overview_image(terrace_run[1], "caf\u00e9 | x")
     assert picture.title == "caf? | x"
+
+
+def _boxes_overlap(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+@pytest.mark.parametrize("width", [1, 2, 8, 17, 33, 64, 99, 120, 230, 300])
+@pytest.mark.parametrize("unit", ["m", "mm"])
+def test_overview_captions_clear_of_the_bar_labels_on_narrow_images(width: int, unit: str) -> None:
+    """Under about 120 px wide the captions ("disparity (px)", "confidence (0-1)", the depth's)
+    reach over their bar's label column and were drawn over its top label ("52.3 px"); a
+    caption box (``cv2.getTextSize``, where the caption's ink is) overlaps no label box, no
+    panel and no other caption, and lies inside the picture, the depth's with the units'."""
+    res = _result_with_depth(24, width, 0.5, 4.0)
+    res.confidence[:, : max(1, width // 3)] = 0.0  # filled: "none where filled" when it fits
+    res.depth[:, : max(1, width // 3)] = np.nan
+    ov = overview_image(res, "t", unit)
+    img_w = ov.image.shape[1]
+    assert set(ov.caption_boxes) == set(ov.captions) == set(ov.panels)
+    labels = _label_boxes(ov)
+    for name, box in ov.caption_boxes.items():
+        (tw, th), base = cv2.getTextSize(ov.captions[name], cv2.FONT_HERSHEY_SIMPLEX, 0.5, 1)
+        assert (box[2] - box[0], box[3] - box[1]) == (tw, th + base)
+        assert 0 <= box[0] and box[2] <= img_w - 10 and 34 <= box[1], (name, box, img_w)
+        ink = ov.image[box[1] : box[3], box[0] : box[2]].max(axis=2) > 200
+        assert ink.any(), name  # the caption is drawn there
+        for bar, label, lbox in labels:
+            assert not _boxes_overlap(box, lbox), (name, box, bar, label, lbox)
+        for panel, (x, y, pw, ph) in ov.panels.items():
+            assert not _boxes_overlap(box, (x, y, x + pw, y + ph)), (name, panel)
+        for other, obox in ov.caption_boxes.items():
+            assert other == name or not _boxes_overlap(box, obox), (name, other)
+    _check_labels_inside_their_cells(ov)

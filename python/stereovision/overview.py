@@ -28,7 +28,12 @@ PANEL_WIDTH = 640
 
 _MARGIN = 10
 _TITLE_H = 34
-_CAPTION_H = 22
+_CAPTION_H = 22  # the caption band above a panel; taller where a caption reaches a bar's label
+_CAPTION_BASELINE = _CAPTION_H - 7  # a caption's baseline, from its cell's top
+_CAPTION_SCALE = 0.5
+#: Blank rows between a caption's box and the top label's box of its bar, where the caption is
+#: wide enough to reach over the label column (panels under about 120 px wide)
+_CAPTION_GAP = 3
 _BAR_GAP = 8
 _BAR_W = 16
 _LABEL_W = 64  # the label column right of a bar at least; wider when a label needs it
@@ -120,6 +125,9 @@ class Overview:
         Panel name -> its :class:`ColourBar` (maps only).
     scale : float
         Downscaling factor of every panel (1 for images up to :data:`PANEL_WIDTH` wide).
+    caption_boxes : dict
+        Panel name -> ``(x0, y0, x1, y1)`` of its caption as drawn (``cv2.getTextSize``'s box,
+        the rows below the baseline included): clear of every bar label, inside its cell.
     captions : dict
         Panel name -> the caption above it; the depth panel's says on what share of the pixels
         there is a depth (``"depth (m) on 83.8 %, none where filled"``: the disparity's filled
@@ -134,6 +142,7 @@ class Overview:
     bars: dict[str, ColourBar]
     scale: float
     captions: dict[str, str] = field(default_factory=dict)
+    caption_boxes: dict[str, tuple[int, int, int, int]] = field(default_factory=dict)
 
 
 def _label(value: float) -> str:
@@ -322,7 +331,9 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         if getattr(result, "limits", None):
             why.append("beyond the limits")
         caption_text = f"{share}, none where {' or '.join(why)}" if why else share
-        if cv2.getTextSize(caption_text, _FONT, 0.5, 1)[0][0] > pw + _BAR_GAP + _BAR_W + _LABEL_W:
+        # the reasons where the caption stays clear of the bar's labels (left of their column)
+        reach = pw + _BAR_GAP + _BAR_W + _LABEL_X
+        if cv2.getTextSize(caption_text, _FONT, _CAPTION_SCALE, 1)[0][0] > reach:
             caption_text = share
         maps.append(
             ("depth", inv, (None, None), caption_text, lambda z: 1.0 / (z * size), "inverse", unit)
@@ -351,8 +362,19 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
             ticks = _place_ticks(ph, lo, hi, to_mapped, steps, bar_ends, bar_unit)
         placed.append((values, rng, ticks))
     label_w = max([_LABEL_W] + [_label_width(ticks) for _, _, ticks in placed if ticks])
-    cell_w = pw + _BAR_GAP + _BAR_W + label_w
-    cell_h = _CAPTION_H + ph
+    texts = ["left image"] + [m[3] for m in maps]
+    sizes = [cv2.getTextSize(t, _FONT, _CAPTION_SCALE, 1) for t in texts]
+    # a cell as wide as its caption at least (a panel of a few px had captions running over the
+    # next cell's and out of the picture)
+    cell_w = max([pw + _BAR_GAP + _BAR_W + label_w] + [tw for (tw, _), _ in sizes])
+    # a caption reaching the label column of its bar (a panel under about 120 px wide) ends
+    # _CAPTION_GAP rows above the bar's top label: the panel comes down (it was drawn over it)
+    caption_h = _CAPTION_H
+    for ((tw, _), base), (_, _, ticks) in zip(sizes[1:], placed, strict=True):
+        if ticks and tw > pw + _BAR_GAP + _BAR_W + _LABEL_X:
+            top = _text_box(ticks[0][1], 0, ticks[0][2])[1]  # its label's top, from the panel's
+            caption_h = max(caption_h, _CAPTION_BASELINE + base + _CAPTION_GAP - top)
+    cell_h = caption_h + ph
     cells = 1 + len(maps)
     cols = 2
     rows = (cells + cols - 1) // cols
@@ -365,36 +387,41 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
             cell_h + _MARGIN
         )
 
-    def caption(text: str, x: int, y: int) -> None:
-        cv2.putText(img, text, (x, y + _CAPTION_H - 7), _FONT, 0.5, _WHITE, 1, cv2.LINE_AA)
+    caption_boxes: dict[str, tuple[int, int, int, int]] = {}
+
+    def caption(name: str, text: str, x: int, y: int) -> None:
+        baseline = y + _CAPTION_BASELINE
+        (tw, th), base = cv2.getTextSize(text, _FONT, _CAPTION_SCALE, 1)
+        cv2.putText(img, text, (x, baseline), _FONT, _CAPTION_SCALE, _WHITE, 1, cv2.LINE_AA)
+        caption_boxes[name] = (x, baseline - th, x + tw, baseline + base)
 
     panels: dict[str, tuple[int, int, int, int]] = {}
     bars: dict[str, ColourBar] = {}
     captions = {"left": "left image"}
     x, y = origin(0)
-    caption("left image", x, y)
-    img[y + _CAPTION_H : y + cell_h, x : x + pw] = cv2.resize(
+    caption("left", "left image", x, y)
+    img[y + caption_h : y + cell_h, x : x + pw] = cv2.resize(
         left, (pw, ph), interpolation=cv2.INTER_AREA
     )
-    panels["left"] = (x, y + _CAPTION_H, pw, ph)
+    panels["left"] = (x, y + caption_h, pw, ph)
     for i, ((name, _, _, text, _, _, bar_unit), (values, rng, ticks)) in enumerate(
         zip(maps, placed, strict=True), start=1
     ):
         x, y = origin(i)
-        caption(text, x, y)
+        caption(name, text, x, y)
         captions[name] = text
         coloured: npt.NDArray[Any] = np.zeros((h, w, 3), np.uint8)
         if rng is not None:
             coloured = cv2.applyColorMap(colour_levels(values, *rng), cv2.COLORMAP_TURBO)
             coloured[~np.isfinite(values)] = 0
         # nearest: every pixel keeps a colour of the map (a blend of two is on no bar)
-        img[y + _CAPTION_H : y + cell_h, x : x + pw] = cv2.resize(
+        img[y + caption_h : y + cell_h, x : x + pw] = cv2.resize(
             coloured, (pw, ph), interpolation=cv2.INTER_NEAREST
         )
-        panels[name] = (x, y + _CAPTION_H, pw, ph)
+        panels[name] = (x, y + caption_h, pw, ph)
         if rng is None:
             continue
-        bars[name] = _bar(img, x + pw + _BAR_GAP, y + _CAPTION_H, ph, ticks, bar_unit)
+        bars[name] = _bar(img, x + pw + _BAR_GAP, y + caption_h, ph, ticks, bar_unit)
     font_scale = 0.6
     title = cv2_text(title)
     (tw, _), _ = cv2.getTextSize(title, _FONT, font_scale, 1)
@@ -402,7 +429,13 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
         font_scale *= (width - 2 * _MARGIN) / tw
     cv2.putText(img, title, (_MARGIN, 23), _FONT, font_scale, _WHITE, 1, cv2.LINE_AA)
     return Overview(
-        image=img, title=title, panels=panels, bars=bars, scale=scale, captions=captions
+        image=img,
+        title=title,
+        panels=panels,
+        bars=bars,
+        scale=scale,
+        captions=captions,
+        caption_boxes=caption_boxes,
     )
 
 
