@@ -749,3 +749,22 @@ def test_write_ply_drop_invalid_must_be_a_switch(tmp_path: Path, flag: object) -
     ):
         write_ply(tmp_path / "x.ply", pts, drop_invalid=flag)  # type: ignore[arg-type]
     assert not (tmp_path / "x.ply").exists()
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (1, 17), (1, 64), (3, 1), (2, 2)])
+def test_read_pfm_of_a_single_row_is_writable(tmp_path: Path, shape: tuple[int, int]) -> None:
+    """A single-row PFM came back as a read-only view of the file's bytes (its rows reversed
+    were already contiguous, so nothing was copied): ``load_scene`` then failed with
+    "assignment destination is read-only", ``eval`` of a 1 px tall scene said only that."""
+    arr = np.arange(shape[0] * shape[1], dtype=np.float32).reshape(shape)
+    arr.flat[0] = np.inf
+    write_pfm(tmp_path / "gt_disp.pfm", arr)
+    got = read_pfm(tmp_path / "gt_disp.pfm")
+    assert got.flags.writeable and got.flags.c_contiguous and got.dtype == np.float32
+    np.testing.assert_array_equal(got, arr)
+    left = np.full((*shape, 3), 128, np.uint8)
+    cv2.imwrite(str(tmp_path / "left.png"), left)
+    cv2.imwrite(str(tmp_path / "right.png"), left)
+    scene = load_scene(tmp_path)
+    assert scene.gt is not None and np.isnan(scene.gt.flat[0])
+    np.testing.assert_array_equal(scene.gt.flat[1:], arr.flat[1:])

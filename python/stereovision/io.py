@@ -680,8 +680,9 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
         )
     data = np.frombuffer(raw, dtype=dtype, count=count, offset=start)
     shape = (height, width, 3) if channels == 3 else (height, width)
-    arr = data.reshape(shape)[::-1]
-    return np.ascontiguousarray(arr, dtype=np.float32)
+    # a copy, always: of a single row, ascontiguousarray kept the read-only view of ``raw``
+    # (load_scene's ``gt[...] = nan`` was "assignment destination is read-only")
+    return np.array(data.reshape(shape)[::-1], dtype=np.float32, order="C")
 
 
 def write_pfm(path: PathLike, arr: npt.ArrayLike, little_endian: bool = True) -> Path:
