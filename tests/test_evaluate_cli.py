@@ -217,3 +217,30 @@ def test_eval_runs_prints_the_times_it_measured(
     assert re.fullmatch(r"middlebury2001/tsukuba: time, one run, no warm-up: ours [0-9.]+ ms", line)
     assert main(["eval", tsukuba, "--method", "fast"]) == 0
     assert ": time, " not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("height", "width"), [(1, 1), (3, 8), (1, 16), (64, 2)])
+def test_eval_of_a_scene_narrower_than_its_range_names_the_width_needed(
+    tmp_path: Path, height: int, width: int
+) -> None:
+    """A scene at most 16 px wide: its range (evaluation.md's, 16 at least) was named as if
+    given ("disparity range 16 is not smaller than the image width 8"); the error names the
+    images' width and the width a scene needs, one line, nothing on stdout."""
+    import cv2
+
+    from stereovision.io import write_pfm
+
+    rng = np.random.default_rng(0)
+    row = (rng.random((height, width + 2)) * 255).astype(np.uint8)
+    scene = tmp_path / "tiny"
+    scene.mkdir()
+    cv2.imwrite(str(scene / "left.png"), row[:, :width])
+    cv2.imwrite(str(scene / "right.png"), row[:, 2:])
+    write_pfm(scene / "gt_disp.pfm", np.full((height, width), 2.0, np.float32))
+    proc = _eval(str(scene), "--no-opencv", "--method", "fast")
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.splitlines() == [
+        f"stereovision: error: {scene}: images {width} px wide, not wider than the scene's "
+        "disparity range (16 px, evaluation.md's rule: 16 at least): a scene needs images at "
+        "least 17 px wide"
+    ]
