@@ -320,7 +320,8 @@ def test_depth_on_a_pair_too_small_says_only_that(
     )
     assert main([*argv, "--max-disparity", "16"]) == 2
     assert capsys.readouterr().err == (
-        "stereovision: error: disparity range 16 is not smaller than the image width 1\n"
+        "stereovision: error: disparity range 16 is not smaller than the image width 1: it needs "
+        "images at least 17 px wide (a range of a pixel or more needs 2 px)\n"
     )
     assert not (tmp_path / "o").exists()
 
@@ -363,7 +364,8 @@ def test_depth_rectification_on_a_pair_too_small_says_only_that(
     argv += ["--rectification", str(tmp_path / "rect.json")]
     assert main(argv) == 2
     assert capsys.readouterr().err == (
-        "stereovision: error: disparity range 16 is not smaller than the image width 1\n"
+        "stereovision: error: disparity range 16 is not smaller than the image width 1: it needs "
+        "images at least 17 px wide (a range of a pixel or more needs 2 px)\n"
     )
     rect["input_size"] = [640, 480]
     (tmp_path / "rect.json").write_text(json.dumps(rect))

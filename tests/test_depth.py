@@ -817,3 +817,29 @@ def test_one_px_wide_pair_is_told_the_width_it_needs_not_an_impossible_range(
         r"own needs images at least 2 px wide$",
     ):
         sv.depth_map(left, left.copy(), min_disparity=min_disparity)
+
+
+@pytest.mark.parametrize(
+    ("width", "max_disparity", "min_disparity", "says"),
+    [
+        (1, 1, 0, "1: it needs images at least 2 px wide (a range of a pixel or more needs 2 px)"),
+        (3, 4, 0, "3: it needs images at least 5 px wide, or give a max_disparity below 3"),
+        (8, 16.5, 2, "8: it needs images at least 15 px wide, or give a max_disparity below 10"),
+    ],
+)
+def test_a_range_given_wider_than_the_pair_names_the_width_it_needs(
+    width: int, max_disparity: float, min_disparity: int, says: str
+) -> None:
+    """A range the caller gave that is not below the width: the error said only that ("disparity
+    range 4 is not smaller than the image width 3"), not the width the range needs nor the
+    max_disparity this pair takes."""
+    rng = np.random.default_rng(5)
+    left = (rng.random((12, width)) * 255).astype(np.uint8)
+    span = max_disparity - min_disparity
+    with pytest.raises(
+        ValueError,
+        match="^"
+        + re.escape(f"disparity range {span:g} is not smaller than the image width {says}")
+        + "$",
+    ):
+        sv.depth_map(left, left.copy(), max_disparity=max_disparity, min_disparity=min_disparity)

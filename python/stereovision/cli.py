@@ -252,7 +252,12 @@ def _check_pair(left: np.ndarray, right: np.ndarray, calib: Any, max_disparity: 
     words, checked before :func:`refuse_foreign_outputs` speaks of a file in the ``-o`` folder:
     images of two sizes, a calibration for another size, a ``max_disparity`` not below the
     width, or a pair too narrow for the automatic range (16 px wide or less)."""
-    from stereovision.depth import _DISPARITY_STEP, _rig_to_warp_by, _too_narrow
+    from stereovision.depth import (
+        _DISPARITY_STEP,
+        _range_too_wide,
+        _rig_to_warp_by,
+        _too_narrow,
+    )
 
     if np.shape(left)[:2] != np.shape(right)[:2]:
         raise ValueError(
@@ -262,9 +267,7 @@ def _check_pair(left: np.ndarray, right: np.ndarray, calib: Any, max_disparity: 
     h, w = np.shape(left)[:2]
     _rig_to_warp_by(calib, w, h, max_disparity)  # a calibration for another image size
     if max_disparity is not None and max_disparity >= w:
-        raise ValueError(
-            f"disparity range {max_disparity:g} is not smaller than the image width {w}"
-        )
+        raise _range_too_wide(max_disparity, w)
     if max_disparity is None and w <= _DISPARITY_STEP:  # the automatic range is 16 px there
         raise _too_narrow(w, _DISPARITY_STEP)
 

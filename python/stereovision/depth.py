@@ -199,6 +199,18 @@ def _too_narrow(width: int, automatic_range: float, min_disparity: float = 0) ->
     return ValueError(f"{text}; give a max_disparity below {width + min_disparity:g} to match it")
 
 
+def _range_too_wide(span: float, width: int, min_disparity: float = 0) -> ValueError:
+    """The error of a disparity range the caller gave that is not below the pair's width: the
+    width it needs, and the ``max_disparity`` that fits this pair (none for a 1 px wide one)."""
+    text = (
+        f"disparity range {span:g} is not smaller than the image width {width}: it needs images "
+        f"at least {math.floor(span) + 1} px wide"
+    )
+    if width < 2:
+        return ValueError(f"{text} (a range of a pixel or more needs 2 px)")
+    return ValueError(f"{text}, or give a max_disparity below {width + min_disparity:g}")
+
+
 def estimate_max_disparity(left: npt.ArrayLike, right: npt.ArrayLike) -> int:
     """Choose a disparity search range from the pair itself.
 
@@ -1286,10 +1298,7 @@ def depth_map(
         # least 16 px, so 16 px wide images and narrower are refused)
         raise _too_narrow(gl.shape[1], max_disparity - min_disparity, min_disparity)
     if max_disparity - min_disparity >= gl.shape[1]:
-        raise ValueError(
-            f"disparity range {max_disparity - min_disparity:g} is not smaller than the image "
-            f"width {gl.shape[1]}"
-        )
+        raise _range_too_wide(max_disparity - min_disparity, gl.shape[1], min_disparity)
     stage("prepare")
     channels: DepthChannels | None = {} if return_channels else None
     if refine is None:
