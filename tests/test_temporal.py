@@ -298,3 +298,22 @@ def test_k_beyond_64_bits() -> None:
     assert TemporalFilter(k=2**70).k == 2**70
     with pytest.raises(ValueError, match=r"^k: expected a positive number of sigmas, got 1000"):
         TemporalFilter(k=10**400)
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (1, 64), (2, 2), (64, 2), (2, 8, 3)])
+def test_frames_too_small_name_the_pair_and_the_size_needed(shape: tuple[int, ...]) -> None:
+    """Frames under 3 x 3 px were refused in noise_sigma's words ("image: expected an (H, W) or
+    (H, W, C) image of at least 3 x 3"), naming an argument the caller never gave; the error
+    names the pair, its size and the size needed, and the filter keeps no frame."""
+    frame = np.full(shape, 100, np.uint8)
+    filt = TemporalFilter()
+    w, h = shape[1], shape[0]
+    with pytest.raises(
+        ValueError,
+        match=rf"^left and right: {w}x{h} px, too small to measure their noise: images of at "
+        r"least 3 x 3 px are needed$",
+    ):
+        filt(frame, frame.copy())
+    assert filt.frames == 0
+    out_l, _ = filt(np.full((3, 3), 100, np.uint8), np.full((3, 3), 100, np.uint8))
+    assert out_l.shape == (3, 3) and filt.frames == 1

@@ -279,6 +279,13 @@ class TemporalFilter:
             raise ValueError(f"left and right differ in shape: {imgs[0].shape} and {imgs[1].shape}")
         if imgs[0].ndim not in (2, 3) or (imgs[0].ndim == 3 and imgs[0].shape[2] not in (1, 3, 4)):
             raise ValueError(f"expected (H, W) or (H, W, 1|3|4) images, got shape {imgs[0].shape}")
+        if min(imgs[0].shape[:2]) < 3:
+            # noise_sigma's words named an "image" the caller never passed
+            h, w = imgs[0].shape[:2]
+            raise ValueError(
+                f"left and right: {w}x{h} px, too small to measure their noise: images of at "
+                "least 3 x 3 px are needed"
+            )
         imgs = [np.ascontiguousarray(img) for img in imgs]
         self.frames += 1
         self._sigmas.append(noise_sigma(imgs[0]))
