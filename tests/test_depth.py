@@ -813,8 +813,9 @@ def test_one_px_wide_pair_is_told_the_width_it_needs_not_an_impossible_range(
     with pytest.raises(
         ValueError,
         match=r"^image too narrow for stereo matching: 1 px wide, and the automatic disparity "
-        r"range \(at least 16 px\) needs images at least 1[27] px wide; a max_disparity of your "
-        r"own needs images at least 2 px wide$",
+        r"range \((at least 16 px|5 to 16 px: 11 px, its max_disparity at least 16)\) needs "
+        r"images at least 1[27] px wide; a max_disparity of your own needs images at least 2 px "
+        r"wide$",
     ):
         sv.depth_map(left, left.copy(), min_disparity=min_disparity)
 
@@ -843,3 +844,18 @@ def test_a_range_given_wider_than_the_pair_names_the_width_it_needs(
         + "$",
     ):
         sv.depth_map(left, left.copy(), max_disparity=max_disparity, min_disparity=min_disparity)
+
+
+def test_too_narrow_with_a_min_disparity_names_the_range_it_searched() -> None:
+    """With a min_disparity the automatic range is shorter than its max_disparity (at least 16):
+    the error said "(at least 16 px) needs images at least 12 px wide"; it names the range's
+    ends and length, whose width is the one needed."""
+    rng = np.random.default_rng(5)
+    left = (rng.random((12, 8)) * 255).astype(np.uint8)
+    with pytest.raises(ValueError) as err:
+        sv.depth_map(left, left.copy(), min_disparity=5)
+    assert str(err.value) == (
+        "image too narrow for stereo matching: 8 px wide, and the automatic disparity range "
+        "(5 to 16 px: 11 px, its max_disparity at least 16) needs images at least 12 px wide; "
+        "give a max_disparity below 13 to match it"
+    )

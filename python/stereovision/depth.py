@@ -190,9 +190,17 @@ def _too_narrow(width: int, automatic_range: float, min_disparity: float = 0) ->
     is told the ``max_disparity`` that fits it; a 1 px wide one, which no range of a pixel or
     more fits (the range must be below the width), the width such a range needs."""
     need = math.floor(automatic_range) + 1
+    # with a min_disparity the range is shorter than the automatic max_disparity (at least 16):
+    # "(at least 16 px) needs images at least 12 px wide" contradicted itself
+    what = (
+        f"(at least {_DISPARITY_STEP} px)"
+        if min_disparity == 0
+        else f"({min_disparity:g} to {automatic_range + min_disparity:g} px: "
+        f"{automatic_range:g} px, its max_disparity at least {_DISPARITY_STEP})"
+    )
     text = (
         f"image too narrow for stereo matching: {width} px wide, and the automatic "
-        f"disparity range (at least {_DISPARITY_STEP} px) needs images at least {need} px wide"
+        f"disparity range {what} needs images at least {need} px wide"
     )
     if width < 2:
         return ValueError(f"{text}; a max_disparity of your own needs images at least 2 px wide")
