@@ -859,3 +859,21 @@ def test_too_narrow_with_a_min_disparity_names_the_range_it_searched() -> None:
         "(5 to 16 px: 11 px, its max_disparity at least 16) needs images at least 12 px wide; "
         "give a max_disparity below 13 to match it"
     )
+
+
+def test_min_disparity_above_the_automatic_range_names_the_estimate() -> None:
+    """A min_disparity not below the estimated max_disparity was refused as "max_disparity (16)
+    must be larger than min_disparity (20)", a max_disparity the caller never gave; the error
+    says it is the estimate's, and what to give; a max_disparity given runs."""
+    rng = np.random.default_rng(5)
+    left = (rng.random((32, 64)) * 255).astype(np.uint8)
+    right = np.roll(left, -2, axis=1)
+    assert sv.estimate_max_disparity(left, right) == 16
+    with pytest.raises(ValueError) as err:
+        sv.depth_map(left, right, min_disparity=20)
+    assert str(err.value) == (
+        "min_disparity (20) is not below the automatic max_disparity (16, estimated from the "
+        "pair): give a max_disparity above 20"
+    )
+    res = sv.depth_map(left, right, min_disparity=20, max_disparity=24, method="census")
+    assert res.disparity.shape == (32, 64)

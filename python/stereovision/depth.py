@@ -1297,6 +1297,13 @@ def depth_map(
     # TypeError "ufunc 'isfinite' not supported")
     finite_number(min_disparity, "min_disparity")
     finite_number(max_disparity, "max_disparity")
+    if max_disparity <= min_disparity and automatic:
+        # "max_disparity (16) must be larger than min_disparity (20)" named a value never given
+        raise ValueError(
+            f"min_disparity ({min_disparity:g}) is not below the automatic max_disparity "
+            f"({max_disparity:g}, estimated from the pair): give a max_disparity above "
+            f"{min_disparity:g}"
+        )
     if max_disparity <= min_disparity:
         raise ValueError(
             f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"
