@@ -1132,3 +1132,44 @@ def test_an_unknown_method_is_refused_before_the_first_grab(data_dir: Path) -> N
             str(err.value) == ("unknown method 'bogus': expected one of fused, gabor, census, fast")
             and cam.count == 0
         ), rig
+
+
+def test_a_stream_sized_by_its_first_pair_interrupted_before_it_writes_its_summary(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A calibration that holds no image size (OpenCV stereo_calib output) is sized by the
+    first pair, read before the stream starts: Ctrl-C (or SIGTERM) before the cameras delivered
+    it gave 'interrupted' and no summary, unlike every other interrupt. It is the summary of no
+    pair now, ended 'interrupted' (exit 130) or 'terminated' (exit 143)."""
+    from test_calibration import _opencv_stereo_calib
+
+    import stereovision.stream as stream
+    from stereovision._interrupt import Terminated
+
+    _opencv_stereo_calib(tmp_path)
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--max-disparity", "16"]
+    argv += ["--calib", str(tmp_path), "--calib-unit", "mm"]
+    for raised, ended, status in (
+        (KeyboardInterrupt, "interrupted", 130),
+        (Terminated, "terminated", 143),
+    ):
+
+        class _Stopped(_ModeCap):
+            signal: type[KeyboardInterrupt] = raised
+
+            def grab(self) -> bool:
+                raise self.signal("signal")
+
+        monkeypatch.setattr(
+            stream,
+            "open_source",
+            lambda args, fps=None: StereoCamera(_Stopped([]), _Stopped([])),
+        )
+        assert main([*argv, "--json"]) == status
+        cap = capsys.readouterr()
+        (line,) = cap.out.splitlines()
+        summary = json.loads(line)
+        assert (summary["frames"], summary["ended"], summary["max_disparity"]) == (0, ended, 16)
+        assert summary["latency_ms"] is None and cap.err == ""
+        assert main(argv) == status
+        assert capsys.readouterr().out.startswith(f"0 pairs in 0.00 s ({ended}): 0.0 fps;")

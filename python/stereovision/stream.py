@@ -1033,6 +1033,23 @@ class _FirstPairRead:
         return getattr(self._camera, name)
 
 
+class _StoppedCamera:
+    """``camera`` whose first pair Ctrl-C (SIGTERM) stopped while it was read ahead: :meth:`read`
+    raises that interrupt again, without touching the camera, so that :func:`run_stream` ends
+    with the summary of no pair; every other attribute is the camera's."""
+
+    def __init__(self, camera: Any, interrupt: KeyboardInterrupt) -> None:
+        self._camera = camera
+        self._interrupt = interrupt
+
+    def read(self) -> StereoFrame:
+        """Raise the interrupt that stopped the first pair."""
+        raise self._interrupt
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._camera, name)
+
+
 def _mode_note(camera: _FirstPairRead, size: tuple[int, int]) -> str | None:
     """One line when the left source delivered frames of another size than the mode it
     reported (the calibration is fitted to the frames, ``size``); None when they agree."""
@@ -1110,18 +1127,26 @@ def cmd_stream(args: argparse.Namespace) -> int:
             raise ValueError(f"--temporal: expected 2-255 pairs to average, got {args.temporal}")
         temporal = TemporalFilter(max_frames=args.temporal)
     cam = open_source(args, fps=args.fps)
+    stopped = False  # Ctrl-C or SIGTERM while the first pair was read to size the calibration
     if sizeless:
         try:
             if getattr(cam, "requested_size", None) is None:
                 # sized by the first pair delivered, not by the mode the driver reports (one
                 # that reports 640x480 and delivers 320x240 failed every pair); --size wins
-                cam = _FirstPairRead(cam)
-            calib = _sized_calibration(args.calib, args.calib_unit, cam)
+                try:
+                    cam = _FirstPairRead(cam)
+                except KeyboardInterrupt as exc:
+                    # the summary of no pair, as an interrupt anywhere else in the stream
+                    # gives (it said 'interrupted' alone): run_stream meets it again at once
+                    cam = _StoppedCamera(cam, exc)
+                    stopped = True
+            if not stopped:
+                calib = _sized_calibration(args.calib, args.calib_unit, cam)
         except BaseException:
             cam.close()
             raise
     if hasattr(cam, "stamps_ns"):  # a recording: its results keep the frames' stamps
-        if calib is None and homographies is None:
+        if calib is None and homographies is None and not stopped:
             try:
                 calib = cam.calibration()
             except BaseException:
@@ -1131,14 +1156,14 @@ def cmd_stream(args: argparse.Namespace) -> int:
                 print(f"calibration: the bag's {' and '.join(cam.info_topics.values())}", file=log)
     bag = None
     try:
-        if args.bag and calib is None:
+        if args.bag and calib is None and not stopped:
             raise ValueError("--bag: a bag holds depth; give --calib")
-        if args.bag:
+        if args.bag and not stopped:
             from stereovision.rosbag import BagWriter
 
             bag = BagWriter(args.bag)
         sinks: list[Callable[[np.ndarray, Any], None]] = []
-        if not args.no_display:
+        if not args.no_display and not stopped:
             server = FrameServer(args.host, args.serve)
             print(f"serving the live view on {server.url}", file=log, flush=True)
             srv = server
@@ -1178,7 +1203,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             on_stamped_result=to_bag if bag is not None else None,
             check=not args.no_check,
             check_every=args.check_every,
-            ground_every=args.ground_every,
+            ground_every=None if stopped else args.ground_every,  # (it needs the calibration)
             on_ground=(lambda plane: floor.__setitem__(0, plane)) if bag is not None else None,
             homographies=homographies,
             temporal=temporal,
