@@ -1385,3 +1385,41 @@ def test_check_plot_keeps_a_file_it_replaces(data_dir: Path, tmp_path: Path) -> 
     assert kept.read_bytes() == b"my picture"
     assert run.stderr == f"stereovision: {plot} replaced; the earlier file is {kept}\n"
     assert cv2.imread(str(plot)) is not None
+
+
+def test_json_line_refuses_keys_written_alike() -> None:
+    """A dict holding a NaN key and the string "NaN" (or 1 and "1", True and "true", None and
+    "null") lost one value without a word: json_ready wrote both as "NaN" (one dict entry) and
+    json.dumps wrote the others twice under one name (a parser keeps the last). It is a
+    ValueError naming both keys now; distinct keys are written as before."""
+    from stereovision._jsonout import json_line, json_ready
+
+    for a, b, text in (
+        (float("nan"), "NaN", "NaN"),
+        (np.float64("inf"), "Infinity", "Infinity"),
+        (1, "1", "1"),
+        (np.int64(7), "7", "7"),
+        (True, "true", "true"),
+        (None, "null", "null"),
+        (0.5, "0.5", "0.5"),
+    ):
+        shown = {"Infinity": "inf", "7": "7"}.get(b, repr(a))  # NumPy keys as Python's
+        for row, first, second in (
+            ({a: 1, b: 2}, shown, repr(b)),
+            ({"deep": [{b: 1, a: 2}]}, repr(b), shown),
+        ):
+            with pytest.raises(ValueError) as err:
+                json_line(row)
+            assert str(err.value) == (
+                f"JSON object keys {first} and {second} are both written as {text!r}: one "
+                "value would be lost"
+            )
+        with pytest.raises(ValueError):
+            json_ready({a: 1, b: 2})
+    two_nans = {float("nan"): 1, float("nan"): 2}
+    with pytest.raises(ValueError, match="both written as 'NaN'"):
+        json_line(two_nans)
+    row = {1: "a", "2": "b", False: "c", None: "d", float("nan"): "e", "nan": "f", 2.5: "g"}
+    assert json_line(row) == (
+        '{"1": "a", "2": "b", "false": "c", "null": "d", "NaN": "e", "nan": "f", "2.5": "g"}'
+    )

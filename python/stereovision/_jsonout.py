@@ -37,9 +37,29 @@ def json_ready(value: Any) -> Any:
         Python float and each non-finite one as None; a path as its string; a dict key that is
         a NumPy scalar as its Python value, a path key as its string, a NaN or infinite float
         key as ``"NaN"``, ``"Infinity"`` or ``"-Infinity"``; other values as given.
+
+    Raises
+    ------
+    ValueError
+        If two keys of one dict would be written as the same JSON string (a NaN key and
+        ``"NaN"``, ``1`` and ``"1"``, ``True`` and ``"true"``, ``None`` and ``"null"``, two NaN
+        keys): one value would be lost. The message names both keys.
     """
     if isinstance(value, dict):
-        return {_json_key(k): json_ready(v) for k, v in value.items()}
+        ready: dict[Any, Any] = {}
+        seen: dict[str, Any] = {}  # the JSON text of each key -> the key as given
+        for k, v in value.items():
+            key = _json_key(k)
+            text = _key_text(key)
+            if text is not None:
+                if text in seen:
+                    raise ValueError(
+                        f"JSON object keys {_shown(seen[text])} and {_shown(k)} are both "
+                        f"written as {text!r}: one value would be lost"
+                    )
+                seen[text] = k
+            ready[key] = json_ready(v)
+        return ready
     if isinstance(value, (list, tuple)):
         return [json_ready(v) for v in value]
     if isinstance(value, np.ndarray):
@@ -70,6 +90,25 @@ def _json_key(key: Any) -> Any:
     return key
 
 
+def _key_text(key: Any) -> str | None:
+    """The string json.dumps writes for a key :func:`_json_key` gave (None for a key it
+    refuses, whose TypeError it raises itself)."""
+    if isinstance(key, str):
+        return key
+    if key is None or isinstance(key, bool):
+        return {None: "null", True: "true", False: "false"}[key]
+    if isinstance(key, int):
+        return int.__repr__(key)
+    if isinstance(key, float):
+        return float.__repr__(key)
+    return None
+
+
+def _shown(key: Any) -> str:
+    """A key as the collision message names it (a NumPy scalar as its Python value)."""
+    return repr(key.item() if isinstance(key, np.generic) else key)
+
+
 def json_line(row: dict[str, Any]) -> str:
     """One line of strict JSON (a figure with nothing to measure, NaN, is ``null``).
 
@@ -86,7 +125,8 @@ def json_line(row: dict[str, Any]) -> str:
     Raises
     ------
     ValueError
-        If a value is still not representable in strict JSON (never for floats).
+        If a value is still not representable in strict JSON (never for floats), or two keys
+        of one dict would be written alike (:func:`json_ready`).
     TypeError
         If a value is not JSON-serialisable.
     """
