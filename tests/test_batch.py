@@ -1770,3 +1770,53 @@ def test_the_calibration_inputs_fingerprinted_are_those_read(tmp_path: Path) -> 
         "scene": ["calib", "left", "right"],
         "sized": ["calib", "left", "right"],
     }
+
+
+def test_a_full_output_disk_names_the_pair_and_closes_the_record(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The output disk full (a robot's SD card) while the third pair was written: the run
+    stopped with "stereovision: error: [Errno 28] No space left on device", naming neither the
+    pair nor the folder, and its summary's record of the run was left without its end. The
+    line names both and what is kept; the record is closed with the error; a re-run resumes."""
+    import errno
+
+    import stereovision.batch as batch
+
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, *(f"seq/{i:04d}_{s}.png" for i in range(4) for s in ("left", "right")))
+    commit = batch._commit_pair
+    tried: list[str] = []
+
+    def fill_the_disk(out_dir: Path, name: str, files: dict[str, bytes], *more: Any) -> Path:
+        tried.append(name)
+        if len(tried) == 3:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return commit(out_dir, name, files, *more)
+
+    monkeypatch.setattr(batch, "_commit_pair", fill_the_disk)
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == (
+        f"stereovision: error: cannot write the outputs of {tried[2]} into {out / tried[2]}: "
+        f"No space left on device; 2 of 4 pairs finished this run, kept in {out} and "
+        f"recorded in {out / SUMMARY_NAME}; run again to continue"
+    )
+    s = _summary(out)
+    assert s["counts"] == {"done": 2, "failed": 0, "pending": 2}
+    assert s["run"]["processed"] == 2 and s["run"]["interrupted"] is False
+    assert s["run"]["error"] == (
+        f"OSError: cannot write the outputs of {tried[2]} into {out / tried[2]}: No space left "
+        "on device"
+    )
+    assert "finished" in s["run"] and s["run"]["seconds"] > 0
+    assert s["pairs"][tried[2]]["status"] == "pending"
+    assert sorted(f"seq/{p.name}" for p in (out / "seq").iterdir()) == sorted(tried[:2])
+    monkeypatch.setattr(batch, "_commit_pair", commit)
+    assert main(args) == 0
+    s = _summary(out)
+    assert (s["run"]["processed"], s["run"]["skipped"]) == (2, 2) and "error" not in s["run"]

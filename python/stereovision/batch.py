@@ -1533,12 +1533,33 @@ def run_batch(
         except KeyboardInterrupt as exc:
             interrupted = True
             cause = exc
-        except Exception:
+        except Exception as exc:
             # the scheduler not reached, Dask not installed: a run that never started left its
             # summary (every pair pending) in a folder it had just made; nothing of it is left
             if run["scheduler"] is None:  # set once Dask is up
                 _remove_unstarted(out, made, fresh)
-            raise
+                raise
+            # an error once pairs went to the workers (the output disk full): the pairs finished
+            # are kept and recorded; the record of the run was left without its end, it is
+            # closed with the error, as an interrupted run's is
+            with HeldInterrupts(replay=False):
+                run.update(
+                    finished=_now(),
+                    seconds=round(time.perf_counter() - t0, 3),
+                    error=_error_line(exc),
+                )
+                with contextlib.suppress(OSError):  # the disk that is full, maybe
+                    summary.save()
+            if not isinstance(exc, OSError):
+                raise
+            done = len(processed) + len(failed)
+            to_do = sum(1 for j in todo if j.name not in processed and j.name not in failed)
+            said = OSError(
+                f"{exc}; {done} of {done + to_do} pairs finished this run, kept in {out} and "
+                f"recorded in {summary.path}; run again to continue"
+            )
+            said.errno = exc.errno
+            raise said from exc
         with HeldInterrupts(replay=False) as held:  # the record of the run is written whole
             gone = _outputs_gone(out, summary, [j.name for j in jobs])
             seconds = time.perf_counter() - t0
@@ -1721,6 +1742,16 @@ def _run_jobs(
                     while len(futures) < limit and submit_next():
                         pass
                     continue
+                except OSError as err:
+                    # the output disk full, a folder turned read-only: every pair to come would
+                    # fail alike, so the run stops; it said "[Errno 28] No space left on device"
+                    # alone, naming neither the pair nor the folder
+                    why = err.strerror or str(err)
+                    stop = OSError(
+                        f"cannot write the outputs of {job.name} into {out / job.name}: {why}"
+                    )
+                    stop.errno = err.errno
+                    raise stop from err
                 entry = summary.pairs[job.name]
                 entry.update(
                     status="done",
