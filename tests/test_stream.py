@@ -1173,3 +1173,27 @@ def test_a_stream_sized_by_its_first_pair_interrupted_before_it_writes_its_summa
         assert summary["latency_ms"] is None and cap.err == ""
         assert main(argv) == status
         assert capsys.readouterr().out.startswith(f"0 pairs in 0.00 s ({ended}): 0.0 fps;")
+
+
+def test_a_temporal_stream_stopped_before_its_first_pair_measured_no_noise(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--temporal, Ctrl-C before the first pair: the summary's temporal noise said 0.0 grey
+    levels, a measurement of frames never seen (the filter's starting value). It is null (NaN)
+    now, as the summary's own noise_sigma is; the frames averaged too."""
+    import stereovision.stream as stream
+    from stereovision.temporal import TemporalFilter
+
+    rep = run_stream(_interrupted_cameras(None), max_disparity=16, temporal=TemporalFilter())
+    assert rep.frames == 0 and rep.ended == "interrupted"
+    assert rep.temporal is not None and rep.temporal["restarts"] == 0
+    assert np.isnan(rep.temporal["noise_sigma"]) and np.isnan(rep.temporal["frames_averaged"])
+    monkeypatch.setattr(stream, "open_source", _interrupted_cameras)
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--json", "--temporal", "8"]
+    assert main([*argv, "--max-disparity", "16"]) == 130
+    (line,) = capsys.readouterr().out.splitlines()
+    assert json.loads(line)["temporal"] == {
+        "frames_averaged": None,
+        "restarts": 0,
+        "noise_sigma": None,
+    }

@@ -163,7 +163,8 @@ class StreamReport:
     temporal : dict or None
         With a :class:`~stereovision.temporal.TemporalFilter`: ``frames_averaged`` (mean over
         the pairs of the frames in a pixel's mean), ``restarts`` (pairs on which the rig or
-        scene moved) and ``noise_sigma`` (its last noise estimate, grey levels).
+        scene moved) and ``noise_sigma`` (its last noise estimate, grey levels; NaN when it
+        saw no frame).
     error : str or None
         With ``ended == "source failed"``: the source's error (None otherwise).
     """
@@ -901,7 +902,8 @@ def run_stream(
         else {
             "frames_averaged": round(tally.mean("averaged"), 3),
             "restarts": temporal.restarts,
-            "noise_sigma": round(temporal.sigma, 3),
+            # its starting 0.0 before any frame: a noise never measured (NaN, JSON null)
+            "noise_sigma": round(temporal.sigma, 3) if temporal.frames else math.nan,
         },
     )
 
