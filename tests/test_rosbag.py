@@ -223,3 +223,20 @@ def test_a_full_disk_is_named_and_committed_frames_stay(
     storage.conn.close()  # the process dies here; no metadata.yaml
     with sqlite3.connect(tmp_path / "run" / "run.db3") as db:
         assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 7  # one frame
+
+
+def test_a_bag_where_it_cannot_go_is_said_as_such(tmp_path: Path) -> None:
+    """--bag under a file said "bag folder's parent does not exist: FILE" (it does: it is a
+    file), and under a folder that cannot be written (/proc, a read-only mount) rosbags' own
+    "[Errno 2] No such file or directory: '/proc/bag'"; both say what is in the way now."""
+    from stereovision.rosbag import BagWriter
+
+    (tmp_path / "afile").write_text("mine")
+    with pytest.raises(NotADirectoryError) as err:
+        BagWriter(tmp_path / "afile" / "bag")
+    assert str(err.value) == f"bag folder's parent is a file, not a folder: {tmp_path / 'afile'}"
+    assert (tmp_path / "afile").read_text() == "mine"
+    with pytest.raises(OSError) as err2:
+        BagWriter("/proc/stereovision-bag")
+    assert str(err2.value).startswith("cannot write the bag folder /proc/stereovision-bag: ")
+    assert not Path("/proc/stereovision-bag").exists()

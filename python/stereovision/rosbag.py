@@ -161,6 +161,10 @@ ros2_static_transform>`.
     ------
     FileExistsError
         If ``path`` exists.
+    FileNotFoundError, NotADirectoryError
+        If its parent folder does not exist or is a file.
+    OSError
+        If the folder cannot be made there (a read-only mount), naming it.
     ImportError
         Without the ``rosbags`` package.
 
@@ -182,6 +186,11 @@ ros2_static_transform>`.
         self.path = Path(path)
         if self.path.exists():
             raise FileExistsError(f"bag folder already exists: {self.path} (choose a new one)")
+        if self.path.parent.exists() and not self.path.parent.is_dir():
+            # it said "does not exist" of the user's file
+            raise NotADirectoryError(
+                f"bag folder's parent is a file, not a folder: {self.path.parent}"
+            )
         if not self.path.parent.is_dir():
             raise FileNotFoundError(f"bag folder's parent does not exist: {self.path.parent}")
         writer_cls, self._types = _rosbags()
@@ -191,7 +200,14 @@ ros2_static_transform>`.
         self.scan_frame_id = str(scan_frame_id)
         self.messages = 0
         self._writer = writer_cls(self.path, version=9)
-        self._writer.open()
+        try:
+            self._writer.open()
+        except OSError as exc:
+            # a folder that cannot be written (a read-only mount): rosbags' "[Errno 2] No such
+            # file or directory: 'PATH'" named no cause
+            err = OSError(f"cannot write the bag folder {self.path}: {exc.strerror or exc}")
+            err.errno = exc.errno
+            raise err from None
         self._conns: dict[str, Any] = {}
         self._committed = time.monotonic()
 
