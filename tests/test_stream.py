@@ -1197,3 +1197,37 @@ def test_a_temporal_stream_stopped_before_its_first_pair_measured_no_noise(
         "restarts": 0,
         "noise_sigma": None,
     }
+
+
+def test_a_bag_that_cannot_be_written_mid_stream_keeps_the_summary(
+    videos: dict[str, Path], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--bag on a disk that filled after two pairs: the stream printed the error alone (exit 2),
+    no summary (with --json nothing at all on stdout), the figures of the pairs done lost, where
+    a failing source keeps them. It ends there now as that does: the summary of the pairs done,
+    ``ended`` "output failed" with the error, then the error line, exit 2."""
+    import stereovision.rosbag as rosbag
+
+    class _FullDisk:
+        def __init__(self, path: Any) -> None:
+            self.path, self.messages = Path(path), 0
+
+        def write(self, res: Any, stamp_ns: int, **kw: Any) -> None:
+            if self.messages == 14:  # two pairs of 7 messages
+                raise OSError(f"bag {self.path}: database or disk is full")
+            self.messages += 7
+
+        def close(self) -> None:
+            pass
+
+    monkeypatch.setattr(rosbag, "BagWriter", _FullDisk)
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"]), "--json"]
+    argv += ["--calib", str(videos["calib"]), "--no-display", "--no-check", "--max-disparity", "16"]
+    assert main([*argv, "--bag", "b"]) == 2
+    cap = capsys.readouterr()
+    summary = _json_lines(cap.out)[-1]
+    assert (summary["summary"], summary["frames"], summary["ended"]) == (True, 2, "output failed")
+    assert summary["error"] == "bag b: database or disk is full"
+    err = cap.err.strip().splitlines()
+    assert err[-1] == "stereovision: error: bag b: database or disk is full"
+    assert "ROS 2 bag written to b (14 messages)" in cap.err

@@ -145,9 +145,10 @@ class StreamReport:
         Whether grab/rectify ran in the producer thread.
     ended : str
         ``"frames"`` (the ``frames`` limit), ``"end of stream"``, ``"interrupted"`` (Ctrl-C),
-        ``"terminated"`` (SIGTERM, under the CLI) or ``"source failed"`` (a source failed
+        ``"terminated"`` (SIGTERM, under the CLI), ``"source failed"`` (a source failed
         after the first pair: a frame that does not decode or of another shape; see
-        :attr:`error`).
+        :attr:`error`) or ``"output failed"`` (``on_result`` or ``on_stamped_result`` raised
+        an OSError, e.g. a bag on a full disk: that pair is not counted; see :attr:`error`).
     rectification : dict or None
         :func:`~stereovision.rectification_check.check_rectification` of the first pair, as a
         dict (None when ``check=False`` or no pair came).
@@ -166,7 +167,7 @@ class StreamReport:
         scene moved) and ``noise_sigma`` (its last noise estimate, grey levels; NaN when it
         saw no frame).
     error : str or None
-        With ``ended == "source failed"``: the source's error (None otherwise).
+        With ``ended`` ``"source failed"`` or ``"output failed"``: the error (None otherwise).
     """
 
     frames: int
@@ -709,7 +710,9 @@ def run_stream(
     SourceError
         If a source delivers no first frame, or fails on the first pair. A failure after it
         (a frame that does not decode or of another shape) ends the stream instead: the pairs
-        done are reported, with ``ended`` ``"source failed"`` and the error in ``error``.
+        done are reported, with ``ended`` ``"source failed"`` and the error in ``error``; an
+        OSError of ``on_result`` or ``on_stamped_result`` (an output that cannot be written)
+        ends it likewise, ``ended`` ``"output failed"``.
     ValueError
         If ``frames`` is not positive, ``method`` is unknown (before any grab), or the
         calibration does not fit the frames.
@@ -847,12 +850,19 @@ def run_stream(
                 density=res.density,
                 averaged=pair.averaged,
             )
+            try:
+                if on_result is not None:
+                    on_result(pair.left, res)
+                if on_stamped_result is not None:
+                    on_stamped_result(pair.left, res, pair.stamp_ns)
+            except OSError as exc:
+                # an output that cannot be written (--bag on a full disk): the pairs written
+                # before are the run's, reported as a failing source's are; it raised past
+                # them, and the CLI printed the error without the summary
+                ended, error = "output failed", str(exc)
+                break
             tally.add(d)
             window.append(d)
-            if on_result is not None:
-                on_result(pair.left, res)
-            if on_stamped_result is not None:
-                on_stamped_result(pair.left, res, pair.stamp_ns)
             if t_last - t_window >= report_period:
                 rep = _window_report(
                     window, t_last - t_window, tally.n, t_last - t_begin, md, pipelined
