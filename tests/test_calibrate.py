@@ -809,10 +809,49 @@ def test_max_pairs_applies_to_images_spread_over_the_list(
     assert out.splitlines()[1].startswith("5/5 pairs used (")
     used = json.loads((tmp_path / "rep" / "report.json").read_text())["used_pairs"]
     ids = [CHESSBOARD_IDS[i] for i in (0, 3, 6, 9, 12)]
-    assert used == [f"left{i}.jpg / right{i}.jpg" for i in ids]  # 01, 05, 08, 12, 14
+    assert used == [f"left{i}.jpg / right{i}.jpg" for i in ids]  # 01, 04, 07, 11, 14
     assert main([*argv, "--max-pairs", "13", "-o", str(tmp_path / "d.yaml")]) == 0
     out = capsys.readouterr().out
     assert out.splitlines()[0].startswith("13/13 pairs used (")
+
+
+def test_max_pairs_records_the_pairs_it_left_out(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--max-pairs`` with images left pairs out before the board was looked for, and neither
+    report.json, report.html nor the summary named them: afterwards no one could tell which
+    images fed the rig. report.json records the names, the count and the rule; the summary has
+    a line with them and the HTML page's pair table a row each."""
+    from stereovision.cli import main
+
+    left, right = _chessboard_paths()
+    argv = ["calibrate", "--left", *map(str, left), "--right", *map(str, right), "--square", "1"]
+    argv += ["--report", str(tmp_path / "rep"), "--max-pairs", "5", "-o", str(tmp_path / "c.yaml")]
+    assert main(argv) == 0
+    out = capsys.readouterr().out.splitlines()
+    rep = json.loads((tmp_path / "rep" / "report.json").read_text())
+    gone = [f"left{i}.jpg / right{i}.jpg" for i in ("02", "03", "05", "06", "08", "09", "12", "13")]
+    assert rep["pair_selection"] == {
+        "option": "--max-pairs 5",
+        "rule": "spread evenly over the list, the first and the last kept, before the board was "
+        "looked for",
+        "given": 13,
+        "kept": 5,
+        "left_out_count": 8,
+        "left_out": gone,
+    }
+    assert not set(gone) & set(rep["used_pairs"]) and len(rep["used_pairs"]) == 5
+    assert out[5] == (
+        "left out by --max-pairs 5 (spread evenly over the list, the first and the last kept, "
+        "before the board was looked for): 8 of the 13 pairs given, "
+        + ", ".join(gone[:6])
+        + " and 2 more"
+    )
+    page = (tmp_path / "rep" / "report.html").read_text()
+    assert page.count("left out by --max-pairs 5") == 8
+    # every pair kept: nothing recorded, no line
+    assert main([*argv[:-4], "--max-pairs", "13", "-o", str(tmp_path / "d.yaml")]) == 0
+    assert "left out by" not in capsys.readouterr().out
 
 
 def test_the_triangulated_square_is_not_claimed_as_a_check_of_the_given_one(

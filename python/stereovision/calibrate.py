@@ -608,6 +608,11 @@ class CalibrationReport:
     warnings : list of str
         The warnings :func:`calibrate` gave about this calibration (a lens the model does not
         fit, a model that folds the image, file numbers that differ), also on the HTML page.
+    pair_selection : dict
+        The pairs given but left out before the board was looked for, and why (empty when every
+        pair given was looked at): ``option`` (``"--max-pairs 5"``), ``rule`` (in words),
+        ``given`` and ``kept`` (counts), ``left_out`` (the pairs' names, as in ``used_pairs``) and
+        ``left_out_count``. ``stereovision calibrate --max-pairs N`` fills it for image lists.
     """
 
     rms: float
@@ -638,6 +643,7 @@ class CalibrationReport:
     board: str = "chessboard"
     corners_used: int = 0
     warnings: list[str] = field(default_factory=list)
+    pair_selection: dict[str, Any] = field(default_factory=dict)
     # Data for the pictures; not part of the serialised report.
     _calibration: Any = field(default=None, repr=False, compare=False)
     _corners: dict[str, tuple[F64, F64]] = field(default_factory=dict, repr=False, compare=False)
@@ -698,6 +704,14 @@ class CalibrationReport:
             f"coverage left {100 * self.coverage_left:.0f} %, "
             f"right {100 * self.coverage_right:.0f} %",
         ]
+        sel = self.pair_selection
+        if sel:
+            gone = sel["left_out"]
+            more = f" and {len(gone) - LEFT_OUT_SHOWN} more" if len(gone) > LEFT_OUT_SHOWN else ""
+            lines.append(
+                f"left out by {sel['option']} ({sel['rule']}): {sel['left_out_count']} of the "
+                f"{sel['given']} pairs given, {', '.join(gone[:LEFT_OUT_SHOWN])}{more}"
+            )
         for name, reason in self.rejected_pairs.items():
             lines.append(f"  rejected {name}: {reason}")
         for name in self.outlier_pairs:
@@ -2190,6 +2204,11 @@ def _render_html(rep: CalibrationReport) -> str:
         for n in rep.used_pairs
     ]
     pairs += [(n, "", "", "", f"rejected: {r}") for n, r in rep.rejected_pairs.items()]
+    sel = rep.pair_selection
+    pairs += [
+        (n, "", "", "", f"left out by {sel['option']} ({sel['rule']})")
+        for n in sel.get("left_out", [])
+    ]
     figures: list[tuple[str, np.ndarray | None]] = [
         ("Per-pair reprojection error", _error_chart(rep)),
         ("Corner coverage", _coverage_picture(rep)),
@@ -2515,15 +2534,32 @@ def _calibrate_source(
             log=print,
             **common,
         )
+    selection: dict[str, Any] = {}
     if args.max_pairs is not None and args.max_pairs < len(lefts):
         keep = _spread(len(lefts), args.max_pairs)
         print(
             f"--max-pairs {args.max_pairs}: {len(keep)} of the {len(lefts)} image pairs kept, "
             "spread evenly over the list"
         )
+        # named as calibrate names the pairs it uses (the file names, "left02.jpg / right02.jpg")
+        names = _pair_names(
+            [os.path.basename(f) for f in lefts], [os.path.basename(f) for f in rights], None
+        )
+        gone = [names[i] for i in range(len(lefts)) if i not in set(keep)]
+        selection = {
+            "option": f"--max-pairs {args.max_pairs}",
+            "rule": "spread evenly over the list, the first and the last kept, before the board "
+            "was looked for",
+            "given": len(lefts),
+            "kept": len(keep),
+            "left_out_count": len(gone),
+            "left_out": gone,
+        }
         lefts = [lefts[i] for i in keep]
         rights = [rights[i] for i in keep]
-    return calibrate(lefts, rights, **common)
+    cal, rep = calibrate(lefts, rights, **common)
+    rep.pair_selection = selection
+    return cal, rep
 
 
 def _spread(n: int, k: int) -> list[int]:
@@ -2547,6 +2583,9 @@ def _spread(n: int, k: int) -> list[int]:
     # round half up of i (n - 1) / (k - 1), in integers: steps of 1 or more stay distinct
     return [(2 * i * (n - 1) + (k - 1)) // (2 * (k - 1)) for i in range(k)]
 
+
+#: How many of the pairs ``--max-pairs`` left out the summary names (report.json has them all).
+LEFT_OUT_SHOWN = 6
 
 #: The files ``stereovision calibrate`` writes into its ``--ros`` (the first two) and
 #: ``--report`` folders.
