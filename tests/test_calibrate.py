@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import hashlib
 import json
+import math
 import os
 import re
 import warnings
@@ -190,6 +191,44 @@ def test_chessboard_all_pairs_used_and_rms(
     assert cal.T[0] == pytest.approx(-3.33, abs=0.05)
     assert cal.K1[0, 0] == pytest.approx(535, abs=10)
     assert cal.image_size == (640, 480)
+
+
+def test_the_per_camera_rms_printed_beside_the_stereo_rms_is_said_to_be_each_camera_alone(
+    chessboard: tuple[Calibration, CalibrationReport],
+) -> None:
+    """The summary read "stereo RMS 0.197 px (left 0.179, right 0.186 ...)" and the HTML page
+    "left camera RMS 0.179 px" beside the stereo solution's per-pair errors, whose left ones
+    come to 0.195 px: 0.179 / 0.186 are each camera calibrated alone. Each camera's share of the
+    stereo solution is now given (as OpenCV's stereoCalibrate, re-run on the report's corners
+    and intrinsics, has it) and the single-camera figures are said to be that."""
+    cal, rep = chessboard
+    names = rep.used_pairs
+    obj = board_object_points((9, 6), 1.0)
+    out = cv2.stereoCalibrateExtended(
+        [obj] * len(names),
+        [rep._corners[n][0].astype(np.float32) for n in names],
+        [rep._corners[n][1].astype(np.float32) for n in names],
+        cal.K1.copy(), cal.D1.copy(), cal.K2.copy(), cal.D2.copy(), cal.image_size,
+        cal.R.copy(), cal.T.reshape(3, 1).copy(),
+        flags=cv2.CALIB_FIX_INTRINSIC | cv2.CALIB_USE_EXTRINSIC_GUESS,
+    )  # fmt: skip
+    per_view = np.asarray(out[-1]).reshape(-1, 2)
+    assert out[0] == pytest.approx(rep.rms, abs=1e-6)
+    left = [rep.per_pair_errors_left[n] for n in names]
+    assert left == pytest.approx(per_view[:, 0].tolist(), abs=1e-6)
+    assert rep.stereo_rms_left == pytest.approx(math.sqrt(np.mean(per_view[:, 0] ** 2)), abs=1e-6)
+    assert rep.stereo_rms_right == pytest.approx(math.sqrt(np.mean(per_view[:, 1] ** 2)), abs=1e-6)
+    assert math.hypot(rep.stereo_rms_left, rep.stereo_rms_right) / math.sqrt(2) == pytest.approx(
+        rep.rms, abs=1e-9
+    )
+    assert rep.summary().splitlines()[0] == (
+        "13/13 pairs used (702 corners, chessboard 9x6 inner corners); stereo RMS 0.197 px "
+        "(left 0.195, right 0.200; each camera calibrated alone 0.179 / 0.186; model k1k2p1p2)"
+    )
+    page = calmod._render_html(rep)
+    assert "<td>stereo RMS</td><td>0.197 px (left camera 0.195 px, right camera 0.200 px)" in page
+    assert "<td>left camera RMS, calibrated alone</td><td>0.179 px</td>" in page
+    assert json.loads(json.dumps(rep.as_dict()))["stereo_rms_right"] == rep.stereo_rms_right
 
 
 def test_chessboard_independent_rectification_dy(
@@ -848,7 +887,10 @@ def test_max_pairs_records_the_pairs_it_left_out(
         + " and 2 more"
     )
     page = (tmp_path / "rep" / "report.html").read_text()
-    assert page.count("left out by --max-pairs 5") == 8
+    assert page.count("<td>left out by --max-pairs 5") == 8
+    assert (
+        "<td>pairs used</td><td>5 of 5 (8 more of the 13 given left out by --max-pairs 5)" in page
+    )
     # every pair kept: nothing recorded, no line
     assert main([*argv[:-4], "--max-pairs", "13", "-o", str(tmp_path / "d.yaml")]) == 0
     assert "left out by" not in capsys.readouterr().out

@@ -570,7 +570,8 @@ class CalibrationReport:
     rms : float
         Stereo reprojection RMS over both cameras and all used pairs (px).
     rms_left, rms_right : float
-        Single-camera calibration RMS of each camera (px).
+        RMS of each camera calibrated alone (px), before the stereo solve: lower than its share
+        of the stereo solution (``stereo_rms_left``, ``stereo_rms_right``).
     per_pair_errors : dict of str to float
         RMS reprojection error of each used pair in the stereo solution (px), both cameras.
     per_pair_errors_left, per_pair_errors_right : dict of str to float
@@ -608,6 +609,10 @@ class CalibrationReport:
     warnings : list of str
         The warnings :func:`calibrate` gave about this calibration (a lens the model does not
         fit, a model that folds the image, file numbers that differ), also on the HTML page.
+    stereo_rms_left, stereo_rms_right : float
+        Each camera's share of the stereo solution (px), over all its corners: the RMS of the
+        ``per_pair_errors_left`` (``_right``) weighted by each pair's corners, ``rms`` their
+        quadratic mean.
     pair_selection : dict
         The pairs given but left out before the board was looked for, and why (empty when every
         pair given was looked at): ``option`` (``"--max-pairs 5"``), ``rule`` (in words),
@@ -644,6 +649,8 @@ class CalibrationReport:
     corners_used: int = 0
     warnings: list[str] = field(default_factory=list)
     pair_selection: dict[str, Any] = field(default_factory=dict)
+    stereo_rms_left: float = math.nan
+    stereo_rms_right: float = math.nan
     # Data for the pictures; not part of the serialised report.
     _calibration: Any = field(default=None, repr=False, compare=False)
     _corners: dict[str, tuple[F64, F64]] = field(default_factory=dict, repr=False, compare=False)
@@ -693,7 +700,8 @@ class CalibrationReport:
         lines = [
             f"{n}/{total} pairs used ({self.corners_used} corners, {self.board}); "
             f"stereo RMS {self.rms:.3f} px "
-            f"(left {self.rms_left:.3f}, right {self.rms_right:.3f}; "
+            f"(left {self.stereo_rms_left:.3f}, right {self.stereo_rms_right:.3f}; each camera "
+            f"calibrated alone {self.rms_left:.3f} / {self.rms_right:.3f}; "
             f"model {self.distortion_model})",
             f"rectified epipolar error |dy|: mean {self.epipolar_mean_dy:.3f} px, "
             f"max {self.epipolar_max_dy:.3f} px",
@@ -1712,12 +1720,34 @@ def calibrate(
         board=board_text,
         corners_used=sum(len(ix) for ix in used_ids),
         warnings=notes,
+        stereo_rms_left=_weighted_rms(sol.per_view[:, 0], [len(ix) for ix in used_ids]),
+        stereo_rms_right=_weighted_rms(sol.per_view[:, 1], [len(ix) for ix in used_ids]),
         _calibration=cal,
         _corners={pair_names[i]: (corners_l[i], corners_r[i]) for i in used},  # type: ignore[misc]
         _ids={pair_names[i]: corner_ids[i] for i in used},  # type: ignore[misc]
         _sample=None if sample is None else (pair_names[sample[0]], sample[1], sample[2]),
     )
     return cal, report
+
+
+def _weighted_rms(per_view: npt.ArrayLike, counts: Sequence[int]) -> float:
+    """The RMS over all points of views whose own RMS are ``per_view``, ``counts`` points each.
+
+    Parameters
+    ----------
+    per_view : array_like
+        Each view's RMS (px).
+    counts : sequence of int
+        Each view's number of points.
+
+    Returns
+    -------
+    float
+        ``sqrt(sum(n_i e_i^2) / sum(n_i))``.
+    """
+    e = np.asarray(per_view, np.float64)
+    n = np.asarray(counts, np.float64)
+    return float(math.sqrt(np.sum(n * e**2) / np.sum(n)))
 
 
 def calibrate_from_video(
@@ -2157,10 +2187,23 @@ def _render_html(rep: CalibrationReport) -> str:
     """The self-contained HTML page (pictures as data: URIs, no external resources)."""
     u = rep.unit
     key = [
-        ("stereo RMS", f"{rep.rms:.3f} px"),
-        ("left camera RMS", f"{rep.rms_left:.3f} px"),
-        ("right camera RMS", f"{rep.rms_right:.3f} px"),
-        ("pairs used", f"{len(rep.used_pairs)} of {len(rep.used_pairs) + len(rep.rejected_pairs)}"),
+        (
+            "stereo RMS",
+            f"{rep.rms:.3f} px (left camera {rep.stereo_rms_left:.3f} px, right camera "
+            f"{rep.stereo_rms_right:.3f} px)",
+        ),
+        ("left camera RMS, calibrated alone", f"{rep.rms_left:.3f} px"),
+        ("right camera RMS, calibrated alone", f"{rep.rms_right:.3f} px"),
+        (
+            "pairs used",
+            f"{len(rep.used_pairs)} of {len(rep.used_pairs) + len(rep.rejected_pairs)}"
+            + (
+                f" ({sel['left_out_count']} more of the {sel['given']} given left out by "
+                f"{sel['option']})"
+                if (sel := rep.pair_selection)
+                else ""
+            ),
+        ),
         ("rectified |dy| mean", f"{rep.epipolar_mean_dy:.3f} px"),
         ("rectified |dy| max", f"{rep.epipolar_max_dy:.3f} px"),
         (
