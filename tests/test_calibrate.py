@@ -336,6 +336,27 @@ def test_synthetic_rejected_and_outlier_dropped(
     assert rep.used_pairs == [f"good{i:02d}" for i in range(SYN_GOOD_PAIRS)]
 
 
+def test_a_pair_with_the_board_in_neither_image_is_not_said_to_miss_it_in_both(
+    cached_corners: None,
+) -> None:
+    """A pair whose images both lack the board was rejected as "board not found in both
+    images", which reads as found in one of them (the pair a board in one image only gives);
+    it says "either image" now, beside "left" / "right" for the one-sided ones."""
+    left, right = _chessboard_paths()
+    blank = np.full((480, 640), 128, np.uint8)
+    _, rep = calibrate(
+        [*left[:3], blank, blank],
+        [*right[:3], blank, cv2.imread(str(right[4]), cv2.IMREAD_GRAYSCALE)],
+        square_size=1.0,
+        names=["a", "b", "c", "neither", "right only"],
+    )
+    assert rep.rejected_pairs == {
+        "neither": "board not found in either image",
+        "right only": "board not found in left",
+    }
+    assert "  rejected neither: board not found in either image" in rep.summary().splitlines()
+
+
 def test_outlier_reported_but_kept_without_drop(
     synthetic: tuple[list[np.ndarray], list[np.ndarray], list[str]],
     synthetic_dropped: tuple[Calibration, CalibrationReport],

@@ -579,7 +579,8 @@ class CalibrationReport:
     used_pairs : list of str
         Names of the pairs the final solution uses.
     rejected_pairs : dict of str to str
-        Pairs not used and why (``"board not found in left"``, ``"outlier: ..."``).
+        Pairs not used and why (``"board not found in left"`` (``right``, ``either image``),
+        ``"outlier: ..."``).
     outlier_pairs : list of str
         Pairs flagged as outliers (dropped or not, see ``drop_outliers``).
     epipolar_mean_dy, epipolar_max_dy : float
@@ -1502,8 +1503,9 @@ def calibrate(
         if i in short:
             rejected[pair_names[i]] = short[i]
         elif cl is None or cr is None or corner_ids[i] is None:
+            # "not found in both images" read as found in one of them
             where = (
-                "both images" if cl is None and cr is None else "left" if cl is None else "right"
+                "either image" if cl is None and cr is None else "left" if cl is None else "right"
             )
             rejected[pair_names[i]] = f"board not found in {where}"
         else:
