@@ -4,6 +4,7 @@ image edges, errors, the printable board and the CLI."""
 
 from __future__ import annotations
 
+import json
 import math
 import re
 import struct
@@ -475,6 +476,51 @@ def test_calibrate_from_two_videos(rig: dict[str, Any], tmp_path: Path) -> None:
         calibrate_from_video(tmp_path / "none.avi", right, board=BOARD)
     with pytest.raises(ValueError, match="max_pairs"):
         calibrate_from_video(str(left), str(right), board=BOARD, max_pairs=2)
+
+
+def test_a_recording_cut_short_by_max_pairs_is_said_and_recorded(
+    rig: dict[str, Any], tmp_path: Path
+) -> None:
+    """``max_pairs`` (``--max-pairs``, 60 by default) stops reading a recording once that many
+    poses are kept; the line said "3 of 3 frame pairs kept" and the report nothing, so a run cut
+    short looked like a short recording. The line and report.json's ``pair_selection`` say where
+    the reading stopped."""
+    from stereovision.calibrate import calibrate_from_video
+
+    left = _write_video(tmp_path / "l.avi", rig["left"][:8])
+    right = _write_video(tmp_path / "r.avi", rig["right"][:8])
+    lines: list[str] = []
+    _, rep = calibrate_from_video(left, right, board=BOARD, max_pairs=3, log=lines.append)
+    last = max([*rep.used_pairs, *rep.rejected_pairs])
+    read = int(last.split("_")[1]) + 1
+    assert lines == [
+        f"3 of {read} frame pairs kept (a quick look saw the board in both views, in a new "
+        f"pose); max_pairs=3 reached: what follows {last} was not read"
+    ]
+    assert rep.pair_selection == {
+        "option": "max_pairs=3",
+        "rule": f"the first 3 distinct board poses in the recording's order; what follows {last} "
+        "was not read",
+        "frames_read": read,
+        "kept": 3,
+        "last_frame_read": last,
+    }
+    assert rep.summary().splitlines()[4] == (
+        f"reading stopped by max_pairs=3 (the first 3 distinct board poses in the recording's "
+        f"order; what follows {last} was not read)"
+    )
+    board_args = ["--board", "charuco", "--pattern", "10x7", "--square", "0.03"]
+    board_args += ["--marker", "0.022", "--max-pairs", "3", "--report", str(tmp_path / "rep")]
+    run = _cli("calibrate", "--left", str(left), "--right", str(right), *board_args,
+               "-o", str(tmp_path / "rig.yaml"))  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert f"; --max-pairs 3 reached: what follows {last} was not read\n" in run.stdout
+    assert "reading stopped by --max-pairs 3 (the first 3 " in run.stdout
+    saved = json.loads((tmp_path / "rep" / "report.json").read_text())["pair_selection"]
+    assert saved == {**rep.pair_selection, "option": "--max-pairs 3"}
+    # all of a recording read: nothing recorded
+    _, rep = calibrate_from_video(left, right, board=BOARD, max_pairs=60)
+    assert rep.pair_selection == {}
 
 
 def test_a_wrong_dictionary_or_squares_is_named_from_the_markers_seen(

@@ -618,7 +618,9 @@ class CalibrationReport:
         The pairs given but left out before the board was looked for, and why (empty when every
         pair given was looked at): ``option`` (``"--max-pairs 5"``), ``rule`` (in words),
         ``given`` and ``kept`` (counts), ``left_out`` (the pairs' names, as in ``used_pairs``) and
-        ``left_out_count``. ``stereovision calibrate --max-pairs N`` fills it for image lists.
+        ``left_out_count``. ``stereovision calibrate --max-pairs N`` fills it for image lists;
+        :func:`calibrate_from_video` and :func:`calibrate_from_bag` when ``max_pairs`` stopped
+        the reading (``option``, ``rule``, ``frames_read``, ``kept``, ``last_frame_read``).
     """
 
     rms: float
@@ -714,7 +716,9 @@ class CalibrationReport:
             f"right {100 * self.coverage_right:.0f} %",
         ]
         sel = self.pair_selection
-        if sel:
+        if sel and "left_out" not in sel:  # a recording, read up to max_pairs poses
+            lines.append(f"reading stopped by {sel['option']} ({sel['rule']})")
+        elif sel:
             gone = sel["left_out"]
             more = f" and {len(gone) - LEFT_OUT_SHOWN} more" if len(gone) > LEFT_OUT_SHOWN else ""
             lines.append(
@@ -1900,6 +1904,7 @@ def _calibrate_from_camera(
     rights: list[np.ndarray] = []
     names: list[str] = []
     read = 0
+    last = ""  # the last frame read
     try:
         pat = board.inner if board is not None else parse_pattern(pattern)
         collector = ChessboardCollector(
@@ -1913,10 +1918,11 @@ def _calibrate_from_camera(
                     raise  # a frame that does not decode or of another shape: not an end
                 break  # the end of a recording
             read += 1
+            last = f"frame_{frame.index:05d}"
             if collector.consider(frame).save:
                 lefts.append(frame.left)
                 rights.append(frame.right)
-                names.append(f"frame_{frame.index:05d}")
+                names.append(last)
     finally:
         cam.close()
     what = board.describe() if board is not None else f"chessboard {pat[0]}x{pat[1]} inner corners"
@@ -1925,15 +1931,30 @@ def _calibrate_from_camera(
             f"no frame pair of the {read} read shows the {what} in both views"
             + (" (none read: an empty recording)" if read == 0 else "")
         )
+    # The limit reached, the rest of the recording was not read: said, and kept in the report.
+    selection: dict[str, Any] = {}
+    if len(lefts) >= max_pairs:
+        selection = {
+            "option": f"max_pairs={max_pairs}",
+            "rule": f"the first {max_pairs} distinct board poses in the recording's order; what "
+            f"follows {last} was not read",
+            "frames_read": read,
+            "kept": len(lefts),
+            "last_frame_read": last,
+        }
     if log is not None:
         # The live detector's quick look; calibrate's own detector then has the last word.
         log(f"{len(lefts)} of {read} frame pairs kept (a quick look saw the board in both views, "
-            "in a new pose)")  # fmt: skip
+            "in a new pose)"
+            + (f"; max_pairs={max_pairs} reached: what follows {last} was not read"
+               if selection else ""))  # fmt: skip
     if board is not None and collector.board is not None and collector.board.resolved:
         board = collector.board  # the dictionary found while reading
-    return calibrate(
+    cal, rep = calibrate(
         lefts, rights, pattern=pattern, square_size=square_size, board=board, names=names, **kwargs
     )
+    rep.pair_selection = selection
+    return cal, rep
 
 
 # ---------------------------------------------------------------------------------- pictures
@@ -2200,10 +2221,12 @@ def _render_html(rep: CalibrationReport) -> str:
             "pairs used",
             f"{len(rep.used_pairs)} of {len(rep.used_pairs) + len(rep.rejected_pairs)}"
             + (
-                f" ({sel['left_out_count']} more of the {sel['given']} given left out by "
+                ""
+                if not (sel := rep.pair_selection)
+                else f" ({sel['left_out_count']} more of the {sel['given']} given left out by "
                 f"{sel['option']})"
-                if (sel := rep.pair_selection)
-                else ""
+                if "left_out" in sel
+                else f" (reading stopped by {sel['option']}: {sel['rule']})"
             ),
         ),
         ("rectified |dy| mean", f"{rep.epipolar_mean_dy:.3f} px"),
@@ -2550,6 +2573,7 @@ def _cli_words(text: str) -> str:
     text = re.sub(r"\bdictionary='(\w+)'", r"--dictionary \1", text)
     text = re.sub(r"\bpattern=\((\d+), (\d+)\)", r"--pattern \1x\2", text)
     text = re.sub(r"\bdistortion='(\w+)'", r"--distortion \1", text)
+    text = re.sub(r"\bmax_pairs=(\d+)", r"--max-pairs \1", text)
     return re.sub(r"\bunit='(\w+)'", r"--unit \1", text)
 
 
@@ -2568,7 +2592,7 @@ def _calibrate_source(
             right_topic=args.right_topic,
             max_skew_ms=args.max_skew_ms,
             max_pairs=MAX_VIDEO_PAIRS if args.max_pairs is None else args.max_pairs,
-            log=print,
+            log=lambda line: print(_cli_words(line)),
             **common,
         )
     if video:
@@ -2576,7 +2600,7 @@ def _calibrate_source(
             args.left[0],
             args.right[0],
             max_pairs=MAX_VIDEO_PAIRS if args.max_pairs is None else args.max_pairs,
-            log=print,
+            log=lambda line: print(_cli_words(line)),
             **common,
         )
     selection: dict[str, Any] = {}
@@ -2719,6 +2743,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
                 seen.add(text)
                 warnings.warn(text, w.category, stacklevel=1)
     rep.warnings[:] = [_cli_words(w) for w in rep.warnings]  # the report in the CLI's words
+    for key in ("option", "rule"):
+        if key in rep.pair_selection:
+            rep.pair_selection[key] = _cli_words(rep.pair_selection[key])
     from stereovision.io import keep_previous
 
     kept = keep_previous(out)
