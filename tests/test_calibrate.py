@@ -917,6 +917,29 @@ def test_max_pairs_records_the_pairs_it_left_out(
     assert "left out by" not in capsys.readouterr().out
 
 
+def test_too_few_boards_among_the_pairs_max_pairs_kept_names_the_ones_it_left_out(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--max-pairs 3`` of 13 pairs, one of the three kept without the board: the error said
+    "found in both images of only 2 of 3 pairs", as if 3 pairs had been given; it adds that
+    --max-pairs left 10 of the 13 out unseen."""
+    from stereovision.cli import main
+
+    left, right = _chessboard_paths()
+    blank = tmp_path / "right07.jpg"
+    cv2.imwrite(str(blank), np.full((480, 640), 128, np.uint8))
+    right = [blank if p.name == "right07.jpg" else p for p in right]
+    argv = ["calibrate", "--left", *map(str, left), "--right", *map(str, right), "--square", "1"]
+    assert main([*argv, "--max-pairs", "3", "-o", str(tmp_path / "c.yaml")]) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: the chessboard 9x6 inner corners was found in both images of only "
+        "2 of 3 pairs; at least 3 are needed (rejected: left07.jpg / right07.jpg); --max-pairs 3 "
+        "left out 10 of the 13 pairs given before the board was looked for (a larger --max-pairs "
+        "looks at them)\n"
+    )
+    assert not (tmp_path / "c.yaml").exists()
+
+
 def test_the_triangulated_square_is_not_claimed_as_a_check_of_the_given_one(
     chessboard: tuple[Calibration, CalibrationReport], cached_corners: None
 ) -> None:

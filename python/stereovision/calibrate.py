@@ -2626,7 +2626,16 @@ def _calibrate_source(
         }
         lefts = [lefts[i] for i in keep]
         rights = [rights[i] for i in keep]
-    cal, rep = calibrate(lefts, rights, **common)
+    try:
+        cal, rep = calibrate(lefts, rights, **common)
+    except ValueError as exc:
+        if selection and f"at least {MIN_PAIRS} are" in str(exc):  # too few: the rest unseen
+            raise ValueError(
+                f"{exc}; --max-pairs {args.max_pairs} left out {selection['left_out_count']} of "
+                f"the {selection['given']} pairs given before the board was looked for (a larger "
+                "--max-pairs looks at them)"
+            ) from None
+        raise
     rep.pair_selection = selection
     return cal, rep
 
