@@ -329,9 +329,16 @@ def test_synthetic_rig_recovered(
 def test_synthetic_rejected_and_outlier_dropped(
     synthetic_dropped: tuple[Calibration, CalibrationReport],
 ) -> None:
+    """The dropped pair's reason gives the error and limit of the solve it was in (the report's
+    chart draws the final solve's limit, far lower when the outlier pulled the median up), and
+    says so."""
     _, rep = synthetic_dropped
     assert rep.rejected_pairs["blank"] == "board not found in left"
-    assert rep.rejected_pairs["shifted"].startswith("outlier: error ")
+    assert re.fullmatch(
+        r"outlier: error \d+\.\d{3} px > \d+\.\d{3} px \(3 x median, at least 0\.5 px\) in the "
+        r"solve that included it",
+        rep.rejected_pairs["shifted"],
+    )
     assert rep.outlier_pairs == ["shifted"]
     assert rep.used_pairs == [f"good{i:02d}" for i in range(SYN_GOOD_PAIRS)]
 

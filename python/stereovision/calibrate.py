@@ -1609,8 +1609,10 @@ def calibrate(
             break
         for k in bad:
             rejected[pair_names[used[k]]] = (
+                # the figures of the solve the pair was in (the chart's limit is the final one's)
                 f"outlier: error {pair_err[k]:.3f} px > {limit:.3f} px "
-                f"({OUTLIER_FACTOR:g} x median, at least {OUTLIER_MIN_PX:g} px)"
+                f"({OUTLIER_FACTOR:g} x median, at least {OUTLIER_MIN_PX:g} px) in the solve "
+                "that included it"
             )
         used = [i for k, i in enumerate(used) if k not in set(bad)]
     _check_pairing(
