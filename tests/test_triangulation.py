@@ -413,3 +413,73 @@ def test_undistortion_limits_are_checked(key: str, value: object, says: str) -> 
     assert triangulate(xl, xr, c).valid.all()
     with pytest.raises(ValueError, match=re.escape(says)):
         triangulate(xl, xr, c, **{key: value})
+
+
+# ------------------------------------------------------------------ mutation audit (value tests)
+
+
+def test_noisy_correspondences_give_the_midpoint_of_the_closest_points() -> None:
+    """With noise the rays miss each other: the point is the midpoint of their closest points
+    (E.2), not the left ray's end. Reference: the two ray lengths by least squares, in the left
+    frame, from OpenCV's undistortion."""
+    c = raw_calib()
+    pts = scene_points(30, seed=8)
+    xl, xr = project(c, pts)
+    rng = np.random.default_rng(9)
+    xl = xl + rng.normal(0, 0.7, xl.shape)
+    xr = xr + rng.normal(0, 0.7, xr.shape)
+    res = triangulate(xl, xr, c)
+    crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 200, 1e-15)
+    nl = cv2.undistortPoints(xl.reshape(-1, 1, 2), c.K1, c.D1, criteria=crit).reshape(-1, 2)
+    nr = cv2.undistortPoints(xr.reshape(-1, 1, 2), c.K2, c.D2, criteria=crit).reshape(-1, 2)
+    centre_r = -c.R.T @ c.T  # right camera centre in the left frame
+    want = []
+    for a, b in zip(nl, nr, strict=True):
+        dl, dr = np.r_[a, 1.0], c.R.T @ np.r_[b, 1.0]
+        (zl, zr), *_ = np.linalg.lstsq(np.column_stack([dl, -dr]), centre_r, rcond=None)
+        want.append(0.5 * (zl * dl + centre_r + zr * dr))
+    assert res.valid.all()
+    np.testing.assert_allclose(res.XL, np.array(want), rtol=1e-7, atol=1e-9)
+    # the noise is visible at this tolerance: the midpoint is not the left ray's point
+    assert np.abs(res.XL - pts).max() > 1e-3
+
+
+def test_nearly_parallel_rays_are_invalid() -> None:
+    """A disparity of 1e-5 px (rays 1.4e-8 rad apart) is no measurement: invalid, not a
+    point 8400 km away."""
+    c = rect_calib()
+    xl = np.array([[400.0, 250.0], [400.0, 250.0]])
+    xr = np.array([[400.0 - 1e-5, 250.0], [380.0, 250.0]])
+    res = triangulate(xl, xr, c)
+    assert res.valid.tolist() == [False, True]
+    assert np.isnan(res.XL[0]).all()
+
+
+def test_reproject_uses_fy_for_y_on_a_rectified_rig_with_non_square_pixels() -> None:
+    """``Y = (y - cy) Z / fy`` (E.3): a rectified rig given with fx != fy (anisotropic pixels)
+    had its Y scaled by fy / fx if fx were used."""
+    K = np.array([[700.0, 0.0, 330.0], [0.0, 760.0, 240.0], [0.0, 0.0, 1.0]])
+    c = Calibration(
+        K1=K, D1=np.zeros(5), K2=K.copy(), D2=np.zeros(5), R=np.eye(3),
+        T=np.array([-120.0, 0.0, 0.0]), image_size=SIZE, unit="mm", rectified=True,
+    )  # fmt: skip
+    disp = np.full((480, 640), 35.0)
+    pts = reproject(disp, c)
+    z = 700 * 0.12 / 35  # 2.4 m
+    assert pts[400, 100].tolist() == pytest.approx(
+        [(100 - 330) * z / 700, (400 - 240) * z / 760, z], rel=1e-6
+    )
+
+
+def test_undistortion_without_distortion_flags_nan_points() -> None:
+    K = np.array([[600.0, 0.0, 321.5], [0.0, 603.0, 238.2], [0.0, 0.0, 1.0]])
+    xy, ok = undistort_normalized(np.array([[np.nan, 5.0], [321.5, 238.2]]), K, np.zeros(5))
+    assert ok.tolist() == [False, True]
+    assert xy[1].tolist() == [0.0, 0.0]
+
+
+def test_a_tilted_sensor_is_refused_for_either_tilt_term() -> None:
+    K = np.eye(3)
+    for tilt in ([0.01, 0.0], [0.0, 0.01]):
+        with pytest.raises(ValueError, match="tilted-sensor"):
+            undistort_normalized(np.zeros((1, 2)), K, np.r_[np.zeros(12), tilt])
