@@ -659,3 +659,86 @@ def test_pcd_and_mesh_writers_write_the_records_without_copying_them(result, tmp
         tracemalloc.stop()
     records = 15 * big.n_points + 13 * big.n_cells  # vertex and face records
     assert peak < 1.9 * records  # 2.2 with the copies; the int32 indices are the rest
+
+
+# ------------------------------------------------------------------ mutation audit (value tests)
+
+
+def test_pcd_header_has_every_pcl_line_in_order(result, tmp_path):
+    """PCL's reader wants VERSION, FIELDS, SIZE, TYPE, COUNT, WIDTH, HEIGHT, VIEWPOINT, POINTS,
+    DATA in that order (parsed back by hand)."""
+    raw = export.write_pcd(tmp_path / "c.pcd", result).read_bytes()
+    head = raw[: raw.index(b"DATA binary\n") + len(b"DATA binary\n")].decode("ascii")
+    lines = [ln.split() for ln in head.splitlines() if not ln.startswith("#")]
+    assert [ln[0] for ln in lines] == [
+        "VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS",
+        "DATA",
+    ]  # fmt: skip
+    meta = {ln[0]: ln[1:] for ln in lines}
+    assert meta["COUNT"] == ["1"] * 4 and meta["VIEWPOINT"] == ["0", "0", "0", "1", "0", "0", "0"]
+    assert meta["POINTS"] == [str(syn.W * syn.H)]
+
+
+def test_npz_bundle_of_a_millimetre_rig_with_doffs(result, tmp_path):
+    """The bundle's baseline is in metres and its doffs the calibration's, whatever the unit the
+    rig was calibrated in; its maps are float32 and its scalars Python values."""
+    c = syn.calibration()
+    K2 = c.K2.copy()
+    K2[0, 2] += 4.5  # the right camera's principal point 4.5 px further right
+    mm = replace(c, K2=K2, T=c.T * 1000.0, unit="mm", doffs=4.5)
+    data = export.read_npz(export.write_npz(tmp_path / "mm.npz", replace(result, calibration=mm)))
+    assert data["baseline"] == pytest.approx(syn.B) and isinstance(data["baseline"], float)
+    assert data["doffs"] == 4.5 and isinstance(data["doffs"], float)
+    assert isinstance(data["method"], str) and data["method"] == "gabor"
+    for key in ("depth", "depth_sigma", "confidence", "disparity"):
+        assert data[key].dtype == np.float32, key
+
+
+def test_bundle_cloud_uses_fy_for_y(tmp_path):
+    """``Y = (y - cy) Z / fy`` for a bundle whose K has fx != fy (closed form)."""
+    depth = np.full((4, 6), 2.0)
+    k = np.array([[100.0, 0.0, 2.5], [0.0, 80.0, 1.5], [0.0, 0.0, 1.0]])
+    np.savez(tmp_path / "k.npz", depth=depth, K=k)
+    pts, _ = export.load_cloud(tmp_path / "k.npz")
+    ys, xs = np.mgrid[0:4, 0:6]
+    want = np.stack([(xs - 2.5) * 2 / 100, (ys - 1.5) * 2 / 80, depth], -1).reshape(-1, 3)
+    np.testing.assert_allclose(pts, want, rtol=1e-6)
+    np.savez(tmp_path / "f.npz", depth=depth, K=np.diag([100.0, 0.0, 1.0]))
+    with pytest.raises(ValueError, match="focal lengths 100 and 0, expected positive"):
+        export.load_cloud(tmp_path / "f.npz")
+
+
+def test_load_cloud_drops_partly_nan_points_and_pcd_refuses_a_negative_height(tmp_path):
+    path = tmp_path / "p.pcd"
+    head = (
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+        "WIDTH 3\nHEIGHT {}\nPOINTS 3\nDATA ascii\n"
+    )
+    path.write_text(head.format(1) + "1 2 3\n4 nan 6\n7 8 9\n")
+    pts, _ = export.load_cloud(path)
+    assert pts.tolist() == [[1, 2, 3], [7, 8, 9]]
+    path.write_text(head.format(-1) + "1 2 3\n")
+    with pytest.raises(ValueError, match=r"negative WIDTH or HEIGHT \(3 x -1\)"):
+        export.read_pcd(path)
+
+
+def test_export_result_pngs_hold_depth_and_disparity(result, tmp_path):
+    """depth_mm.png holds the depth in millimetres and disparity_16.png KITTI's disparity."""
+    written = export.export_result(result, tmp_path / "out", ("depth16", "disp16"))
+    z = export.read_depth_png(written["depth_mm.png"])
+    np.testing.assert_allclose(z, result.depth, atol=0.0005 + 1e-7)
+    d = export.read_disparity_png(written["disparity_16.png"])
+    ok = np.isfinite(result.disparity) & (result.disparity > 0)
+    np.testing.assert_allclose(d[ok], result.disparity[ok], atol=1 / 512 + 1e-6)
+
+
+def test_organised_points_colours_without_the_left_image(result):
+    """Without the left image the colours are the cloud's, each at its own pixel (x, y)."""
+    _, cols = export.organised_points(replace(result, left_rectified=None))
+    x, y = result.pixels[:, 0], result.pixels[:, 1]
+    np.testing.assert_array_equal(cols[y, x], result.colors)
+
+
+def test_voxel_of_true_is_refused():
+    with pytest.raises(ValueError, match="voxel: expected a positive cube side, got True"):
+        export.voxel_downsample(np.zeros((3, 3)), voxel=True)
