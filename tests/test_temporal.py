@@ -3,6 +3,7 @@ seeded sensor noise, still, drifting, or with something moving through the view.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import cv2
@@ -317,3 +318,68 @@ def test_frames_too_small_name_the_pair_and_the_size_needed(shape: tuple[int, ..
     assert filt.frames == 0
     out_l, _ = filt(np.full((3, 3), 100, np.uint8), np.full((3, 3), 100, np.uint8))
     assert out_l.shape == (3, 3) and filt.frames == 1
+
+
+# ------------------------------------------------------------------ mutation audit (value tests)
+
+
+def test_a_view_of_another_brightness_restarts_and_is_counted() -> None:
+    """A gain outside 0.5-2 (a third of the brightness) is another view: the frame passes
+    through, both means start again, and the restart is counted."""
+    rng = np.random.default_rng(10)
+    base = rng.integers(60, 200, (40, 40)).astype(np.uint8)
+    tf = TemporalFilter()
+    tf(base, base)
+    tf(base, base)
+    dim = base // 3
+    out = tf(dim, dim)
+    assert np.array_equal(out[0], dim) and np.array_equal(out[1], dim)
+    assert tf.restarts == 1 and tf.relit == 0 and tf.mean_frames() == 1.0
+
+
+def test_a_nearly_black_still_view_keeps_averaging() -> None:
+    """Grey levels 0-5 leave nothing to fit a light's change to: the gain is 1, not another view
+    (a dark room restarted on every frame)."""
+    dark = np.random.default_rng(11).integers(0, 6, (40, 40)).astype(np.uint8)
+    tf = TemporalFilter()
+    for _ in range(3):
+        out = tf(dark, dark)
+    assert tf.restarts == 0 and tf.mean_frames() == 3.0 and np.array_equal(out[0], dark)
+
+
+def test_a_rig_that_moves_after_holding_still_starts_again(data_dir: Path) -> None:
+    """Six still noisy frames, then the view shifts by 1 px: the motion test's expected noise
+    is that of a frame minus a 6-frame mean (sqrt(1 + 1/n)), and the shift is caught."""
+    sc = load_scene(data_dir / VENUS)
+    rng = np.random.default_rng(12)
+    h, w = sc.left.shape[:2]
+    tf = TemporalFilter()
+    for _ in range(6):
+        tf(noisy(sc.left, 8.0, rng), noisy(sc.right, 8.0, rng))
+    assert tf.restarts == 0
+    shift = np.float32([[1, 0, 1], [0, 1, 0]])
+    left, right = (
+        noisy(cv2.warpAffine(i, shift, (w, h), borderMode=cv2.BORDER_REPLICATE), 8.0, rng)
+        for i in (sc.left, sc.right)
+    )
+    out = tf(left, right)
+    assert tf.restarts == 1 and np.array_equal(out[0], left)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "says"),
+    [
+        ({"max_frames": 256}, "max_frames: expected at least 1 and at most 255, got 256"),
+        ({"max_frames": True}, "max_frames: expected an integer, got True"),
+    ],
+)
+def test_max_frames_fits_the_uint8_count(kwargs: dict, says: str) -> None:
+    with pytest.raises(ValueError, match=re.escape(says)):
+        TemporalFilter(**kwargs)
+    assert TemporalFilter(max_frames=255).max_frames == 255
+
+
+def test_two_channel_frames_are_named() -> None:
+    two = np.zeros((8, 8, 2), np.uint8)
+    with pytest.raises(ValueError, match=re.escape("expected (H, W) or (H, W, 1|3|4) images")):
+        TemporalFilter()(two, two)
