@@ -483,3 +483,16 @@ def test_a_tilted_sensor_is_refused_for_either_tilt_term() -> None:
     for tilt in ([0.01, 0.0], [0.0, 0.01]):
         with pytest.raises(ValueError, match="tilted-sensor"):
             undistort_normalized(np.zeros((1, 2)), K, np.r_[np.zeros(12), tilt])
+
+
+def test_a_point_behind_the_right_camera_is_invalid() -> None:
+    """A wrong match (rows 384 px apart): the left ray's closest point is 2.6 cm ahead, the
+    right ray's 5 mm behind its camera (Z_R < 0) while the midpoint lies in front of both:
+    no point, as E.2 asks of both depths."""
+    c = raw_calib()
+    good_l, good_r = project(c, scene_points(1))
+    res = triangulate(
+        np.vstack([[505.68, 424.24], good_l]), np.vstack([[452.53, 40.44], good_r]), c
+    )
+    assert res.valid.tolist() == [False, True]
+    assert np.isnan(res.XL[0]).all() and np.isnan(res.XR[0]).all()
