@@ -383,3 +383,23 @@ def test_two_channel_frames_are_named() -> None:
     two = np.zeros((8, 8, 2), np.uint8)
     with pytest.raises(ValueError, match=re.escape("expected (H, W) or (H, W, 1|3|4) images")):
         TemporalFilter()(two, two)
+
+
+def test_the_noise_is_the_median_of_the_recent_frames_estimates(data_dir: Path) -> None:
+    """One frame of a far noisier burst (noise 40 against 8) does not move the noise estimate:
+    it is the median of the last 8 frames' own estimates (the docstring's), not the latest or
+    the largest."""
+    sc = load_scene(data_dir / VENUS)
+    rng = np.random.default_rng(13)
+    tf = TemporalFilter()
+    each = []
+    for _ in range(5):
+        left = noisy(sc.left, 8.0, rng)
+        each.append(noise_sigma(left))
+        tf(left, noisy(sc.right, 8.0, rng))
+    assert tf.sigma == pytest.approx(float(np.median(each)), rel=1e-12)
+    burst = noisy(sc.left, 40.0, rng)
+    tf(burst, burst)
+    assert noise_sigma(burst) > 3 * tf.sigma
+    assert tf.sigma == pytest.approx(float(np.median([*each, noise_sigma(burst)])), rel=1e-12)
+    assert tf.sigma < 1.1 * max(each)
