@@ -400,7 +400,9 @@ def reproject(
     ``Z`` as :func:`depth_from_disparity`, ``X = (x - cx) Z / fx``, ``Y = (y - cy) Z / fy``
     with ``(x, y)`` the pixel column and row (left rectified camera frame: X right, Y down,
     Z forward). Equals ``cv2.reprojectImageTo3D(disparity, calib.Q)`` times
-    ``calib.to_metres_factor`` where valid. As there, a map of another size than the
+    ``calib.to_metres_factor`` where valid when ``fx == fy`` (as ``cv2.stereoRectify`` gives);
+    ``Q`` holds one focal length, so for ``fx != fy`` OpenCV scales ``Y`` by ``fx`` where this
+    uses ``fy``, the pixel's own ray. As there, a map of another size than the
     calibration's images is read as their top-left corner (a map of a resized pair needs
     :meth:`Calibration.scaled_to`).
 
