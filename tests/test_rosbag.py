@@ -240,3 +240,83 @@ def test_a_bag_where_it_cannot_go_is_said_as_such(tmp_path: Path) -> None:
         BagWriter("/proc/stereovision-bag")
     assert str(err2.value).startswith("cannot write the bag folder /proc/stereovision-bag: ")
     assert not Path("/proc/stereovision-bag").exists()
+
+
+@pytest.mark.parametrize("fail_at", range(1, 8))
+def test_a_frame_cut_by_a_full_disk_is_not_in_the_bag(
+    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, fail_at: int
+) -> None:
+    """A full disk while a frame was written kept that frame's messages written before it:
+    the finished bag ended with a whole frame and part of the next (a depth image without its
+    cloud), and metadata.yaml counted them. Now a frame is all or nothing: the bag holds the
+    whole frames only, readable, with its metadata's counts those of its database; and the
+    writer goes on when the disk has room again."""
+    import errno
+    import sqlite3
+
+    from rosbags.highlevel import AnyReader
+
+    from stereovision.rosbag import BagWriter
+
+    res, _ = kitti
+    bag = BagWriter(tmp_path / "run")
+    bag.write(res, 1)
+    storage = bag._writer.storage
+    real_write = storage.write
+    calls = [0]
+
+    def full_at_k(*args: object) -> None:
+        calls[0] += 1
+        if calls[0] == fail_at:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real_write(*args)
+
+    monkeypatch.setattr(storage, "write", full_at_k)
+    with pytest.raises(OSError) as err:
+        bag.write(res, 2)
+    assert err.value.errno == errno.ENOSPC
+    assert str(err.value) == f"bag {tmp_path / 'run'}: No space left on device"
+    assert bag.messages == 7  # the first frame's
+    monkeypatch.setattr(storage, "write", real_write)  # room again
+    bag.write(res, 3)
+    bag.close()
+    assert bag.messages == 14
+    with AnyReader([tmp_path / "run"]) as reader:
+        stamps: dict[str, list[int]] = {}
+        for conn, stamp, _raw in reader.messages():
+            stamps.setdefault(conn.topic, []).append(stamp)
+        meta = {t: info.msgcount for t, info in reader.topics.items()}
+    assert len(stamps) == 7
+    assert all(s == [1, 3] for s in stamps.values()), stamps
+    assert meta == {t: 2 for t in stamps}
+    with sqlite3.connect(tmp_path / "run" / "run.db3") as db:
+        assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 14
+
+
+def test_a_database_that_fills_mid_frame_keeps_the_metadata_true(
+    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """sqlite's own "database or disk is full" (here its page limit) part-way through a frame
+    rolls back what it chooses; metadata.yaml counted every message handed to it, the ones
+    rolled back too, so a reader was promised messages the database did not have."""
+    from rosbags.highlevel import AnyReader
+
+    from stereovision import rosbag
+
+    res, _ = kitti
+    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 0.0)  # the first frame committed
+    bag = rosbag.BagWriter(tmp_path / "run")
+    bag.write(res, 1)
+    conn = bag._writer.storage.conn
+    pages, size = (conn.execute(f"PRAGMA {p}").fetchone()[0] for p in ("page_count", "page_size"))
+    conn.execute(f"PRAGMA max_page_count = {pages + 2_500_000 // size}")  # 1 or 2 messages
+    with pytest.raises(OSError, match=r"^bag .*run: database or disk is full$"):
+        bag.write(res, 2)
+    bag.close()
+    assert bag.messages == 7
+    with AnyReader([tmp_path / "run"]) as reader:
+        got = [(conn.topic, stamp) for conn, stamp, _ in reader.messages()]
+        meta = {t: info.msgcount for t, info in reader.topics.items()}
+        assert reader.message_count == 7
+    assert len(got) == 7 and {s for _, s in got} == {1}
+    assert meta == {t: 1 for t, _ in got}

@@ -209,6 +209,7 @@ ros2_static_transform>`.
             err.errno = exc.errno
             raise err from None
         self._conns: dict[str, Any] = {}
+        self._pending: list[tuple[str, str, Any, int]] = []  # the frame being made, serialised
         self._committed = time.monotonic()
 
     # ------------------------------------------------------------------------------ helpers
@@ -228,9 +229,57 @@ ros2_static_transform>`.
         return t["std_msgs/msg/Header"](stamp=stamp, frame_id=self.frame_id)
 
     def _put(self, topic: str, msgtype: str, msg: Any, stamp_ns: int) -> None:
-        data = self._types.serialize_cdr(msg, msgtype)
-        self._writer.write(self._conn(topic, msgtype), stamp_ns, data)
-        self.messages += 1
+        """Serialise one message of the frame being made; :meth:`_flush` writes them."""
+        self._pending.append((topic, msgtype, self._types.serialize_cdr(msg, msgtype), stamp_ns))
+
+    def _flush(self) -> None:
+        """Write the frame's messages as one: a failure part-way (a full disk, a second Ctrl-C)
+        rolls back those written, so the bag never holds part of a frame; the writer's counts
+        (its metadata.yaml) and :attr:`messages` are then read back from the database."""
+        pending, self._pending = self._pending, []
+        conn = getattr(getattr(self._writer, "storage", None), "conn", None)
+        if not isinstance(conn, sqlite3.Connection):  # another storage: no rollback
+            for topic, msgtype, data, stamp in pending:
+                self._writer.write(self._conn(topic, msgtype), stamp, data)
+                self.messages += 1
+            return
+        if not conn.in_transaction:
+            conn.execute("BEGIN")  # else the savepoint's release would commit at every frame
+        conn.execute("SAVEPOINT frame")
+        try:
+            for topic, msgtype, data, stamp in pending:
+                self._writer.write(self._conn(topic, msgtype), stamp, data)
+            conn.execute("RELEASE frame")
+        except BaseException:
+            try:
+                conn.execute("ROLLBACK TO frame")
+                conn.execute("RELEASE frame")
+            except sqlite3.Error:  # sqlite rolled the transaction back itself (or cannot undo)
+                try:
+                    conn.rollback()
+                except sqlite3.Error:
+                    pass
+            self._resync(conn)
+            raise
+        self.messages += len(pending)
+
+    def _resync(self, conn: sqlite3.Connection) -> None:
+        """The writer's connections, message counts and time span as the database holds them
+        after a rollback (metadata.yaml is written from them)."""
+        w = self._writer
+        topics = {row[0] for row in conn.execute("SELECT id FROM topics")}
+        w.connections = [c for c in w.connections if c.id in topics]
+        self._conns = {k: c for k, c in self._conns.items() if c.id in topics}
+        w.added_types = {
+            row[0] for row in conn.execute("SELECT topic_type FROM message_definitions")
+        }
+        counts = dict.fromkeys(topics, 0)
+        counts |= dict(conn.execute("SELECT topic_id, COUNT(*) FROM messages GROUP BY topic_id"))
+        w.counts = counts
+        lo, hi = conn.execute("SELECT MIN(timestamp), MAX(timestamp) FROM messages").fetchone()
+        w.min_timestamp = 2**63 - 1 if lo is None else lo
+        w.max_timestamp = 0 if hi is None else hi
+        self.messages = sum(counts.values())
 
     def _image(self, header: Any, img: np.ndarray, encoding: str) -> Any:
         arr = np.ascontiguousarray(img)
@@ -380,7 +429,10 @@ ros2_static_transform>`.
             whole nanoseconds from 0 to ROS 2's last second (2**31 s: ``sec`` is an int32), or
             a closed bag.
         OSError
-            When the bag's database cannot be written (a full disk), naming the bag.
+            When the bag's database cannot be written (a full disk), naming the bag. None of
+            the frame's messages is then in the bag (a frame is all or nothing), nor the frames
+            since the last commit when sqlite rolls its transaction back; the writer's counts
+            (and so metadata.yaml and :attr:`messages`) are those the database holds.
         """
         if result.depth is None or result.calibration is None:
             raise ValueError("a bag holds depth: compute the result with a calibration")
@@ -389,17 +441,27 @@ ros2_static_transform>`.
             raise ValueError(f"bag {self.path} is closed")
         try:
             with HeldInterrupts():
-                self._write_frame(result, stamp, scan, ground)
+                self._pending = []
+                self._write_frame(result, stamp, scan, ground)  # serialised, not written
+                self._flush()
                 if time.monotonic() - self._committed >= COMMIT_PERIOD_S:
                     self._commit()
         except sqlite3.Error as exc:  # e.g. "database or disk is full"
             raise OSError(f"bag {self.path}: {exc}") from exc
+        except OSError as exc:
+            err = OSError(f"bag {self.path}: {exc.strerror or exc}")
+            err.errno = exc.errno
+            raise err from exc
 
     def _commit(self) -> None:
         """Commit the frames written so far (rosbags keeps one transaction until close)."""
         conn = getattr(getattr(self._writer, "storage", None), "conn", None)
         if isinstance(conn, sqlite3.Connection):
-            conn.commit()
+            try:
+                conn.commit()
+            except sqlite3.Error:
+                self._resync(conn)  # sqlite may have rolled the frames since the last one back
+                raise
         self._committed = time.monotonic()
 
     def _write_frame(self, result: Any, stamp: int, scan: Any, ground: Any) -> None:
