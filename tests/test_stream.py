@@ -1231,3 +1231,29 @@ def test_a_bag_that_cannot_be_written_mid_stream_keeps_the_summary(
     err = cap.err.strip().splitlines()
     assert err[-1] == "stereovision: error: bag b: database or disk is full"
     assert "ROS 2 bag written to b (14 messages)" in cap.err
+
+
+def test_the_text_summary_of_no_pair_says_so_not_nan(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A stream stopped before its first pair printed "nan ms" for every stage, the latency
+    and the skew, and "nan frames averaged ... noise nan grey levels" with --temporal. The text
+    says no pair was processed now; --json keeps its nulls."""
+    import stereovision.stream as stream
+
+    monkeypatch.setattr(stream, "open_source", _interrupted_cameras)
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--max-disparity", "16"]
+    assert main([*argv, "--temporal", "8"]) == 130
+    out = capsys.readouterr().out
+    assert out.splitlines() == [
+        "0 pairs in 0.00 s (interrupted): 0.0 fps; no pair processed; max_disparity 16",
+        "temporal: no pair filtered, 0 restarts",
+    ]
+    assert "nan" not in out
+    assert main(argv) == 130
+    assert capsys.readouterr().out.splitlines() == [
+        "0 pairs in 0.00 s (interrupted): 0.0 fps; no pair processed; max_disparity 16"
+    ]
+    assert main([*argv, "--json"]) == 130
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["stage_ms"]["match"] is None and summary["latency_ms"] is None

@@ -1249,16 +1249,23 @@ def cmd_stream(args: argparse.Namespace) -> int:
         print(json_line(summary), file=out, flush=True)
     else:
         st = report.stage_ms
-        print(
-            f"{report.frames} pairs in {report.seconds:.2f} s ({report.ended}): "
-            f"{report.fps:.1f} fps; median per pair "
+        # no pair: no time to say (each figure is NaN, "nan ms" in every stage)
+        timings = (
+            "median per pair "
             + ", ".join(f"{k} {st[k]:.1f}" for k in STAGES)
             + f" ms; latency {report.latency_ms:.0f} ms; skew mean"
-            f" {report.skew_ms['mean']:.2f} ms, max {report.skew_ms['max']:.2f} ms;"
-            f" max_disparity {report.max_disparity}",
+            f" {report.skew_ms['mean']:.2f} ms, max {report.skew_ms['max']:.2f} ms"
+            if report.frames
+            else "no pair processed"
+        )
+        print(
+            f"{report.frames} pairs in {report.seconds:.2f} s ({report.ended}): "
+            f"{report.fps:.1f} fps; {timings}; max_disparity {report.max_disparity}",
             file=out,
         )
-        if report.temporal is not None:
+        if report.temporal is not None and not report.frames:
+            print(f"temporal: no pair filtered, {report.temporal['restarts']} restarts", file=out)
+        elif report.temporal is not None:
             tp = report.temporal
             print(
                 f"temporal: {tp['frames_averaged']:.1f} frames averaged per pixel on average,"
