@@ -1257,3 +1257,21 @@ def test_the_text_summary_of_no_pair_says_so_not_nan(
     assert main([*argv, "--json"]) == 130
     summary = json.loads(capsys.readouterr().out)
     assert summary["stage_ms"]["match"] is None and summary["latency_ms"] is None
+
+
+def test_a_bag_of_no_frame_is_not_said_written(
+    videos: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """--bag, stopped before the first pair: the empty bag folder is removed (so the next run
+    can use it), yet the summary said "ROS 2 bag written to DIR (0 messages)"."""
+    import stereovision.stream as stream
+
+    monkeypatch.setattr(stream, "open_source", _interrupted_cameras)
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--max-disparity", "16"]
+    argv += ["--calib", str(videos["calib"]), "--bag", str(tmp_path / "b")]
+    assert main(argv) == 130
+    assert capsys.readouterr().err == f"no ROS 2 bag written to {tmp_path / 'b'}: no frame in it\n"
+    assert not (tmp_path / "b").exists()

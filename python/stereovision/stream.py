@@ -1242,8 +1242,10 @@ def cmd_stream(args: argparse.Namespace) -> int:
             "(--realtime)",
             file=log,
         )
-    if bag is not None:
+    if bag is not None and bag.messages:
         print(f"ROS 2 bag written to {bag.path} ({bag.messages} messages)", file=log)
+    elif bag is not None:  # it said "written to DIR (0 messages)" of the folder removed above
+        print(f"no ROS 2 bag written to {bag.path}: no frame in it", file=log)
     if args.json:
         # strict JSON: a figure with nothing to measure (no pair done: NaN) is null
         print(json_line(summary), file=out, flush=True)
