@@ -199,6 +199,8 @@ def test_constant_pair_gives_nan_not_error() -> None:
         ({"win_radius": 2.5}, "whole number"),
         ({"fill_confidence": 2.0}, "fill_confidence"),
         ({"fill_max_residual": 0.0}, "fill_max_residual"),
+        ({"win_sigma": True}, "win_sigma must be a number"),
+        ({"search": True}, "search must be a number"),
     ],
 )
 def test_bad_parameters_raise(kwargs: dict, match: str) -> None:
@@ -211,6 +213,8 @@ def test_bad_inputs_raise() -> None:
     a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
     with pytest.raises(ValueError, match="differ in shape"):
         refine_disparity(a, a[:, :20], a, max_disparity=8)
+    with pytest.raises(ValueError, match=r"disparity \(20, 20\) differ in shape"):
+        refine_disparity(a, a, a[:, :20], max_disparity=8)
     with pytest.raises(ValueError, match="2-D"):
         refine_disparity(a[0], a[0], a[0], max_disparity=8)
     bad = a.copy()
@@ -222,6 +226,37 @@ def test_bad_inputs_raise() -> None:
     with pytest.raises(ValueError, match="finite number"):
         refine_disparity(a, a, a, max_disparity=float("nan"))
     assert set(DEFAULTS) >= {"fills", "win_sigma", "search"}
+
+
+def test_a_right_image_outside_zero_one_is_named() -> None:
+    """The right image's [0, 1] check, like the left's: 8-bit levels given as floats (0-255)
+    were otherwise correlated as they are and gave a refined map without a word."""
+    a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    with pytest.raises(ValueError, match=r"right: float image values must lie in \[0, 1\]"):
+        refine_disparity(a, a * 255, a, max_disparity=8)
+    with pytest.raises(ValueError, match=r"left: float image values must lie in \[0, 1\]"):
+        refine_disparity(a * 255, a, a, max_disparity=8)
+
+
+@pytest.mark.parametrize(
+    "params",
+    [
+        {"search": 3, "fill_search": 1},
+        {"search": 1, "fill_search": 3, "step": 0.4, "fill_step": 0.75},
+    ],
+)
+def test_parity_with_the_reference_at_other_search_settings(data_dir: Path, params: dict) -> None:
+    """The keyword overrides reach the kernel's own slots: at the defaults ``search`` and
+    ``fill_search`` are both 2, so the default parity test could not tell them apart."""
+    left, right, disp, conf, dmax = _crop_inputs(data_dir)
+    out = refine_disparity(left, right, disp, conf, max_disparity=dmax, **params)
+    ref = refine_ref.refine_disparity(left, right, disp, conf, 0.0, dmax, **params)
+    c = _compare(ref, out)
+    assert _within(c), c
+    assert abs(out.n_filled - ref[2]) <= 0.001 * disp.size
+    swapped = {**params, "search": params["fill_search"], "fill_search": params["search"]}
+    c = _compare(refine_ref.refine_disparity(left, right, disp, conf, 0.0, dmax, **swapped), out)
+    assert not _within(c), c
 
 
 def test_a_confidence_outside_zero_one_is_named_and_nan_holes_are_allowed(data_dir: Path) -> None:
