@@ -499,3 +499,36 @@ def test_too_few_matches_are_not_called_consistent() -> None:
     nan = float("nan")
     line = RectificationCheck(18, nan, nan, nan, nan, nan, None, 0.5).summary()
     assert line.startswith("rectification: cannot tell, only 18 feature matches (at least 30")
+
+
+def test_a_saved_rectification_reads_back_field_by_field(tmp_path: Path) -> None:
+    """Every field survives save/load, each compared on its own (an ``as_dict() == as_dict()``
+    comparison cannot see a field both leave out), and the JSON, read by ``json`` alone, holds
+    each under its name: a file without ``model`` came back "projective" for a quasi-Euclidean
+    rectification."""
+    h1 = np.array([[1.0, 0.01, 5.0], [0.002, 1.0, -3.0], [1e-5, 0.0, 1.0]])
+    h2 = np.array([[0.99, -0.02, -7.0], [0.001, 1.01, 2.0], [-2e-5, 1e-5, 1.0]])
+    fm = np.array([[0.0, -1e-4, 0.01], [1e-4, 0.0, -0.3], [-0.02, 0.3, 1.0]])
+    rect = UncalibratedRectification(
+        h1, h2, (640, 360), (600, 400), fm, 123, 0.11, 0.42, (3.5, 41.25), 48, (0.02, 0.03),
+        (1.001, 0.998), "quasi-euclidean",
+    )  # fmt: skip
+    path = rect.save(tmp_path / "r.json")
+    raw = json.loads(path.read_text())
+    assert raw["model"] == "quasi-euclidean" and raw["size"] == [640, 360]
+    assert raw["input_size"] == [600, 400] and raw["max_disparity"] == 48
+    np.testing.assert_array_equal(np.array(raw["H1"]), h1)
+    np.testing.assert_array_equal(np.array(raw["H2"]), h2)
+    np.testing.assert_array_equal(np.array(raw["F"]), fm)
+    back = UncalibratedRectification.load(path)
+    np.testing.assert_array_equal(back.H1, h1)
+    np.testing.assert_array_equal(back.H2, h2)
+    np.testing.assert_array_equal(back.F, fm)
+    assert back.size == (640, 360) and back.input_size == (600, 400)
+    assert (back.matches, back.median_dy, back.p95_dy) == (123, 0.11, 0.42)
+    assert back.disparity_range == (3.5, 41.25) and back.max_disparity == 48
+    assert back.skew_deg == (0.02, 0.03) and back.aspect == (1.001, 0.998)
+    assert back.model == "quasi-euclidean"
+    # a point of the right image goes through H2 (OpenCV's perspectiveTransform as the judge)
+    moved = cv2.perspectiveTransform(np.float64([[[10.0, 20.0]]]), h2)[0]
+    np.testing.assert_allclose(back.rectify_points([[10.0, 20.0]], "right"), moved)
