@@ -435,6 +435,7 @@ def test_rectify_points_refuses_other_layouts() -> None:
         ("size", [0, -5], "size 0x-5 px"),
         ("input_size", [612, 0], "input_size 612x0 px"),
         ("max_disparity", -3, "max_disparity -3"),
+        ("max_disparity", 0, "max_disparity 0"),
         ("model", "banana", "model 'banana'"),
     ],
 )
@@ -532,3 +533,22 @@ def test_a_saved_rectification_reads_back_field_by_field(tmp_path: Path) -> None
     # a point of the right image goes through H2 (OpenCV's perspectiveTransform as the judge)
     moved = cv2.perspectiveTransform(np.float64([[[10.0, 20.0]]]), h2)[0]
     np.testing.assert_allclose(back.rectify_points([[10.0, 20.0]], "right"), moved)
+
+
+def test_check_with_identity_homographies_is_the_plain_check(data_dir: Path) -> None:
+    """Homographies that move nothing, on a pair already rectified: :meth:`check` keeps every
+    match (all lie in the image) and gives :func:`check_rectification`'s verdict and counts on
+    the same pair exactly. cones is 450 x 375: a check that read the size as (height, width)
+    dropped the matches right of x = 374."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    w, h = sc.left.shape[1], sc.left.shape[0]
+    assert w - h > 50
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (w, h), (w, h), np.zeros((3, 3)), 100, 0.1, 0.2, (1.0, 60.0), 64,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    got, want = rect.check(sc.left, sc.right), check_rectification(sc.left, sc.right)
+    assert want.ok is True and want.matches >= 100
+    assert got.matches == want.matches and got.ok == want.ok
+    np.testing.assert_array_equal(got.points, want.points)
+    assert (got.median_dy, got.offset) == (want.median_dy, want.offset)
