@@ -988,3 +988,50 @@ def test_laser_scan_min_points_of_any_integer_type(count: int) -> None:
         assert not np.isfinite(got.ranges).any()  # no beam has that many points
     else:
         assert np.isfinite(got.ranges).any()
+
+
+def _matrix_of_quaternion(x: float, y: float, z: float, w: float) -> np.ndarray:
+    """The rotation matrix of a unit quaternion (Hamilton, ROS's order x, y, z, w)."""
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+@pytest.mark.parametrize(
+    "rotvec",
+    [(0.3, -0.2, 0.1), (-0.1, 0.4, -0.25), (3.0, 0.2, -0.1), (0.1, -3.0, 0.2), (0.2, 0.1, 3.0)],
+)
+def test_quaternion_against_the_axis_angle(rotvec: tuple[float, float, float]) -> None:
+    """``_quaternion`` of OpenCV's Rodrigues matrix is ``(axis sin(t/2), cos(t/2))`` (``w >= 0``),
+    on both of Shepperd's branches (small turns: trace > 0; turns near 180 degrees about each
+    axis: the largest diagonal entry). The pose test's rotation takes only the second branch."""
+    from stereovision.ground import _quaternion
+
+    r = np.asarray(rotvec, np.float64)
+    t = float(np.linalg.norm(r))
+    want = np.r_[r / t * math.sin(t / 2), math.cos(t / 2)]
+    got = np.array(_quaternion(cv2.Rodrigues(r)[0]))
+    np.testing.assert_allclose(got, want, atol=1e-12)
+
+
+def test_the_ros2_commands_quaternion_is_the_cameras_rotation() -> None:
+    """The numbers the ROS 2 command prints, read back, are camera_in_floor's rotation and
+    height (each of --qx --qy --qz --qw in its place), for a camera pitched and rolled."""
+    n_true = _camera_rotation(8.0, -5.0) @ np.array([0.0, -1.0, 0.0])
+    v, u = np.mgrid[0 : SIZE[1], 0 : SIZE[0]].astype(np.float64)
+    rays = np.stack([(u - 239.5) / F, (v - 179.5) / F, np.ones_like(u)], axis=-1)
+    z = -1.3 / (rays @ n_true)
+    plane = fit_ground_plane(np.where(z > 0, F * 0.12 / z, np.nan), RIG)
+    assert plane is not None
+    cmd = plane.ros2_static_transform("base_link", "cam")
+    got = {k: float(v) for k, v in re.findall(r"--(x|y|z|qx|qy|qz|qw) (\S+)", cmd)}
+    assert (got["x"], got["y"], got["z"]) == (0.0, 0.0, 1.3)
+    q = np.array([got["qx"], got["qy"], got["qz"], got["qw"]])
+    assert abs(np.linalg.norm(q) - 1) < 1e-5 and q[3] >= 0
+    pose = plane.camera_in_floor()
+    np.testing.assert_allclose(_matrix_of_quaternion(*q), pose[:3, :3], atol=1e-5)
+    assert cmd.endswith("--frame-id base_link --child-frame-id cam")
