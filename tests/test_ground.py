@@ -372,7 +372,17 @@ def test_plane_geometry_round_trips(doffs: float) -> None:
     assert plane.height == pytest.approx(1.3, rel=1e-9)
     assert plane.pitch_deg == pytest.approx(8.0, abs=1e-6)
     assert plane.roll_deg == pytest.approx(-5.0, abs=1e-6)
-    assert json.loads(json.dumps(plane.as_dict()))["height_m"] == pytest.approx(1.3)
+    saved = json.loads(json.dumps(plane.as_dict()))
+    assert saved["height_m"] == pytest.approx(1.3)
+    # every documented field, each the attribute it names (ground.json is this dict)
+    assert set(saved) == {"normal", "height_m", "pitch_deg", "roll_deg", "disparity_plane",
+                          "inlier_share", "rms_px", "below_share", "camera_in_floor"}  # fmt: skip
+    np.testing.assert_allclose(saved["normal"], n_true, atol=1e-9)
+    assert (saved["pitch_deg"], saved["roll_deg"]) == (plane.pitch_deg, plane.roll_deg)
+    assert saved["disparity_plane"] == list(plane.disparity_plane)
+    assert (saved["inlier_share"], saved["rms_px"]) == (plane.inlier_share, plane.rms_px)
+    assert saved["below_share"] == plane.below_share == 0.0
+    np.testing.assert_array_equal(saved["camera_in_floor"], plane.camera_in_floor())
 
 
 def test_the_cameras_pose_on_the_floor_and_its_ros2_transform() -> None:

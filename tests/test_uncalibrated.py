@@ -560,3 +560,6 @@ def test_check_with_identity_homographies_is_the_plain_check(data_dir: Path) -> 
     assert got.matches == want.matches and got.ok == want.ok
     np.testing.assert_array_equal(got.points, want.points)
     assert (got.median_dy, got.offset) == (want.median_dy, want.offset)
+    for bad in (0, -0.5, float("nan"), True):
+        with pytest.raises(ValueError, match="tolerance: expected a positive number of pixels"):
+            rect.check(sc.left, sc.right, tolerance=bad)
