@@ -242,6 +242,8 @@ def test_bad_pairs_are_named(data_dir: Path, tmp_path: Path) -> None:
     rx = cv2.perspectiveTransform(np.float64([np.c_[xs - d, ys]]), rect.H2)[0][:, 0]
     np.testing.assert_allclose(rect.disparity_range, np.percentile(lx - rx, [5, 95]), atol=5.0)
     assert rect.disparity_range[1] <= rect.max_disparity
+    # the rows' figures: the median and the 95th percentile of the matches' |dy| in order
+    assert 0 < rect.median_dy < rect.p95_dy < 1.0
     with pytest.raises(ValueError, match="this rectification is for 450x375"):
         rect.rectify(sc.left[:100], sc.right)
     with pytest.raises(ValueError, match="side"):
