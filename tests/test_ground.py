@@ -1045,3 +1045,18 @@ def test_the_ros2_commands_quaternion_is_the_cameras_rotation() -> None:
     pose = plane.camera_in_floor()
     np.testing.assert_allclose(_matrix_of_quaternion(*q), pose[:3, :3], atol=1e-5)
     assert cmd.endswith("--frame-id base_link --child-frame-id cam")
+
+
+def test_obstacle_mask_max_range_and_band() -> None:
+    """``max_range`` keeps the points nearer than it along the optical axis; the band keeps
+    those between min_height and max_height (the level floor's points stand 0.5 m high)."""
+    plane, pts = _level_floor()
+    pts[2:, :, 2] = 6.0  # the two lower rows 6 m ahead
+    want = np.ones((4, 4), bool)
+    want[0, 0] = False  # on the floor
+    np.testing.assert_array_equal(obstacle_mask(pts, plane), want)
+    near = want.copy()
+    near[2:] = False
+    np.testing.assert_array_equal(obstacle_mask(pts, plane, max_range=5.0), near)
+    assert not obstacle_mask(pts, plane, min_height=0.6).any()
+    assert not obstacle_mask(pts, plane, max_height=0.4).any()

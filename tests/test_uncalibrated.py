@@ -565,3 +565,16 @@ def test_check_with_identity_homographies_is_the_plain_check(data_dir: Path) -> 
     for bad in (0, -0.5, float("nan"), True):
         with pytest.raises(ValueError, match="tolerance: expected a positive number of pixels"):
             rect.check(sc.left, sc.right, tolerance=bad)
+
+
+@pytest.mark.parametrize("degrees", [10.0, -10.0])
+def test_shape_of_a_shear_in_closed_form(degrees: float) -> None:
+    """``_shape`` of a shear ``x' = x + tan(t) y``: the vertical middle line leans by ``t``,
+    so the middle lines are ``|t|`` off perpendicular (either way), and the vertical one is
+    ``1 / cos t`` longer: the length ratio against the input's is ``cos t``."""
+    t = math.radians(degrees)
+    shear = np.array([[1.0, math.tan(t), 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    skew, aspect = _shape(shear, 640, 480)
+    assert skew == pytest.approx(abs(degrees), abs=1e-9)
+    assert aspect == pytest.approx(math.cos(t), abs=1e-12)
+    assert _shape(np.diag([2.0, 1.0, 1.0]), 640, 480) == pytest.approx((0.0, 2.0), abs=1e-12)
