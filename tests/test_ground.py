@@ -1060,3 +1060,28 @@ def test_obstacle_mask_max_range_and_band() -> None:
     np.testing.assert_array_equal(obstacle_mask(pts, plane, max_range=5.0), near)
     assert not obstacle_mask(pts, plane, min_height=0.6).any()
     assert not obstacle_mask(pts, plane, max_height=0.4).any()
+
+
+def test_occupancy_grid_files_as_map_server_reads_them(tmp_path: Path) -> None:
+    """map_server's reading of NAME.png and NAME.yaml (cv2.imread and a line parser, not the
+    package): the picture's bottom row is the grid's row 0 (the smallest y, to the right), a
+    cell at (x, y) is at picture column (x - x0) / res and row from the bottom (y - y0) / res,
+    occupied black, free 254, unknown 205; the YAML gives the origin as (x, y, yaw) and
+    ``negate: 0``."""
+    from stereovision.ground import OccupancyGrid
+
+    data = np.full((3, 4), -1, np.int8)
+    data[0, 1] = 100  # x in [1.1, 1.2), y in [-2.0, -1.9): the grid's first row, to the right
+    data[2, 3] = 0
+    grid = OccupancyGrid(data, 0.1, (1.0, -2.0))
+    assert grid.cell_of(1.15, -1.95) == (0, 1)
+    png, yml = grid.save(tmp_path, "m")
+    img = cv2.imread(str(png), cv2.IMREAD_UNCHANGED)
+    assert img.shape == (3, 4) and img.dtype == np.uint8
+    assert img[2, 1] == 0 and img[0, 3] == 254  # occupied bottom row, free top row
+    assert (img == 205).sum() == 10
+    fields = dict(line.split(": ", 1) for line in yml.read_text().splitlines())
+    assert fields["image"] == "m.png" and fields["mode"] == "trinary"
+    assert float(fields["resolution"]) == 0.1 and fields["negate"] == "0"
+    assert [float(v) for v in fields["origin"].strip("[]").split(",")] == [1.0, -2.0, 0.0]
+    assert (float(fields["occupied_thresh"]), float(fields["free_thresh"])) == (0.65, 0.196)
