@@ -1085,3 +1085,62 @@ def test_occupancy_grid_files_as_map_server_reads_them(tmp_path: Path) -> None:
     assert float(fields["resolution"]) == 0.1 and fields["negate"] == "0"
     assert [float(v) for v in fields["origin"].strip("[]").split(",")] == [1.0, -2.0, 0.0]
     assert (float(fields["occupied_thresh"]), float(fields["free_thresh"])) == (0.65, 0.196)
+
+
+def _camera_points(floor_xyh: list[tuple[float, float, float]]) -> np.ndarray:
+    """Points given on _level_floor's floor frame (x forward, y left, height) in the camera
+    frame (X right, Y down, Z forward; the camera 1 m above the floor)."""
+    return np.array([[-y, 1.0 - hh, x] for x, y, hh in floor_xyh])
+
+
+def test_occupancy_grid_cells_by_hand() -> None:
+    """Hand-placed points in a 0.5 m grid: three obstacle points make a cell occupied
+    (MIN_OBSTACLE_POINTS), two do not, a floor point makes its cell free, and a point 1 m
+    below the floor (a hole, a reflection) is not floor: its cell stays unknown."""
+    from stereovision.ground import occupancy_grid
+
+    plane, _ = _level_floor()
+    pts = _camera_points(
+        [
+            (2.1, 0.6, 0.5),
+            (2.2, 0.7, 0.6),
+            (2.3, 0.8, 0.7),  # cell row 5, column 4
+            (3.2, -1.2, 0.5),
+            (3.3, -1.3, 0.5),  # only two: row 1, column 6
+            (1.2, 0.0, 0.0),  # floor: row 4, column 2
+            (0.7, 0.0, -1.0),
+        ]
+    )
+    grid = occupancy_grid(pts, plane, resolution=0.5, forward=(0, 4), lateral=(-2, 2))
+    want = np.full((8, 8), -1, np.int8)
+    want[5, 4], want[4, 2] = 100, 0
+    np.testing.assert_array_equal(grid.data, want)
+
+
+def test_laser_scan_beams_by_hand() -> None:
+    """Hand-placed points, five beams from -0.5 to 0.5 rad: a beam's range is its third
+    nearest obstacle point, a point goes to the nearest beam, floor seen without an obstacle
+    is +inf, a point 1 m below the floor is no floor (NaN), and the endpoints lie at
+    ``r (cos a, sin a)``."""
+    from stereovision.ground import laser_scan
+
+    plane, _ = _level_floor()
+    a4 = 0.5
+    pts = _camera_points(
+        [
+            (2.0, 0.0, 0.5),
+            (2.5, 0.0, 0.5),
+            (3.0, 0.0, 0.5),
+            (4.0, 0.0, 0.5),  # beam 2
+            (2 * math.cos(0.2), 2 * math.sin(0.2), 0.0),  # floor at 0.2 rad: beam 3 (0.25)
+            (2 * math.cos(-0.25), 2 * math.sin(-0.25), -1.0),
+        ]  # 1 m under the floor: beam 1
+        + [(r * math.cos(a4), r * math.sin(a4), 0.4) for r in (1.0, 1.5, 2.0)]
+    )
+    scan = laser_scan(pts, plane, angle_min=-0.5, angle_max=0.5, angle_increment=0.25)
+    assert (scan.angle_min, scan.angle_max, scan.angle_increment) == (-0.5, 0.5, 0.25)
+    np.testing.assert_array_equal(scan.ranges, np.float32([np.nan, np.nan, 3.0, np.inf, 2.0]))
+    np.testing.assert_allclose(
+        scan.endpoints(), [[3.0, 0.0], [2 * math.cos(a4), 2 * math.sin(a4)]], atol=1e-6
+    )
+    assert scan.as_dict()["ranges"] == [None, None, 3.0, "inf", 2.0]
