@@ -1166,3 +1166,7 @@ def test_below_share_is_the_documented_rule() -> None:
     want = float(np.mean((below & (short > band))[known]))
     assert plane.below_share == pytest.approx(want, abs=2e-3)
     assert 0.06 < plane.below_share < 0.09
+    # rms_px is the root mean square of the inliers' residuals, inlier_share their share
+    res = short[plane.inliers]
+    assert plane.rms_px == pytest.approx(math.sqrt(float(np.mean(res**2))), rel=1e-9)
+    assert plane.inlier_share == pytest.approx(plane.inliers.sum() / known.sum(), rel=1e-12)
