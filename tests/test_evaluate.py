@@ -3,6 +3,7 @@ scenes against the reference figures of evaluation.md."""
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 import re
@@ -389,3 +390,99 @@ def test_dense_metrics_thresholds_must_be_a_sequence_of_numbers(thresholds: obje
     assert dense_metrics(disp, disp + 1.5, thresholds=[np.float32(1.0), 2]).bad[2.0] == 0.0
     with pytest.raises(ValueError, match=r"^thresholds must be positive and finite, got "):
         dense_metrics(disp, disp, thresholds=thresholds)  # type: ignore[arg-type]
+
+
+# ------------------------------------------------------------- mutation audit (values the
+# tests above did not pin: each of these failed on a one-line bug that every other test passed)
+
+
+def test_dense_metrics_mask_leaves_out_the_estimates_it_masks() -> None:
+    # the masked-out pixel has both a GT and a (wrong) estimate: it must not reach n_both,
+    # density, avgerr or rms (an occlusion mask that only trimmed n_gt let it in)
+    gt = np.array([[4.0, 4.0, 4.0]])
+    disp = np.array([[4.5, 10.0, NAN]])
+    m = dense_metrics(disp, gt, mask=np.array([[True, False, True]]))
+    assert (m.n_gt, m.n_both) == (2, 1)
+    assert m.density == 50.0 and m.avgerr == 0.5 and m.rms == 0.5
+    assert m.bad == {0.5: 50.0, 1.0: 50.0, 2.0: 50.0, 4.0: 50.0}
+
+
+def test_dense_metrics_takes_a_0_255_mask_image() -> None:
+    # a mask read from a PNG (Middlebury's nonocc masks are 0/255 uint8) is a mask, as bool
+    gt = np.array([[4.0, 4.0, 4.0]])
+    disp = np.array([[4.5, 10.0, NAN]])
+    want = dense_metrics(disp, gt, mask=np.array([[True, False, True]]))
+    got = dense_metrics(disp, gt, mask=np.array([[255, 0, 255]], dtype=np.uint8))
+    assert got == want
+
+
+@pytest.mark.parametrize(("unit", "metres"), [("cm", 2.5), ("in", 250 * 0.0254), ("mm", 0.25)])
+def test_table1_report_converts_every_unit_to_metres(unit: str, metres: float) -> None:
+    est = np.full((2, 2), 250.0)
+    gt = np.full((2, 2), 200.0)
+    r = table1_report(est, gt, points=np.array([[1, 0]]), unit=unit)
+    assert r.estimated[0] == pytest.approx(metres, rel=1e-12)
+    assert r.ground_truth[0] == pytest.approx(metres * 0.8, rel=1e-12)
+    assert r.as_dict()["rmse_ft"] == pytest.approx(metres * 0.2 / 0.3048, rel=1e-12)
+
+
+def test_table1_random_points_are_ten_in_row_major_order() -> None:
+    h, w = 20, 30
+    est = np.full((h, w), 2.0)
+    gt = np.full((h, w), 2.5)
+    r = table1_report(est, gt, seed=1)
+    assert r.n_points == 10  # the documented default
+    r = table1_report(est, gt, n_points=50, seed=1)
+    flat = r.y * w + r.x
+    assert len(set(flat.tolist())) == 50 and np.all(np.diff(flat) > 0)
+
+
+def test_table1_format_rows_give_feet_of_the_right_column() -> None:
+    est = np.array([[3.048, 6.096]])
+    gt = np.array([[3.3528, 6.096]])  # 11 ft and 20 ft
+    r = table1_report(est, gt, points=np.array([[0, 0], [1, 0]]))
+    rows = [line.split() for line in r.format().splitlines()[3:5]]
+    # '#', x, y, est m, GT m, err m, est ft, GT ft, err ft
+    assert rows[0] == ["1", "0", "0", "3.048", "3.353", "-0.305", "10.000", "11.000", "-1.000"]
+    assert rows[1] == ["2", "1", "0", "6.096", "6.096", "+0.000", "20.000", "20.000", "+0.000"]
+
+
+def test_sparse_coverage_of_a_wide_image_uses_columns_for_x() -> None:
+    gt = np.ones((4, 40))
+    xl = np.array([5.0, 15.0, 25.0, 35.0])
+    m = sparse_metrics(xl, np.zeros(4), xl - 1.0, gt)
+    assert m.coverage == 4 and m.count == 4 and m.precision[0.5] == 100.0
+    m = sparse_metrics(np.array([5.0, 5.0]), np.array([0.0, 3.0]), np.array([4.0, 4.0]), gt)
+    assert m.coverage == 2
+
+
+def test_sparse_metrics_leaves_out_missing_and_off_image_matches() -> None:
+    gt = np.ones((4, 6))
+    # a match with no right column (NaN), and one whose row rounds to 4, past the last row
+    xl = np.array([2.0, 3.0, 2.0])
+    yl = np.array([1.0, 1.0, 3.6])
+    xr = np.array([1.0, NAN, 1.0])
+    m = sparse_metrics(xl, yl, xr, gt)
+    assert (m.count, m.n_matches) == (1, 3)
+    assert m.precision == {0.5: 100.0, 1.0: 100.0, 2.0: 100.0}
+    # the same rule in count_at_precision
+    assert count_at_precision(xl, yl, xr, np.ones(3), gt, 100.0) == 1
+
+
+def test_count_at_precision_keeps_the_given_order_among_equal_scores() -> None:
+    # quantised scores tie; the ranking is stable (the docstring's promise), so equal scores
+    # stay in the caller's order: the first 300 of the best-scored group are right, the rest
+    # wrong, and 100 % precision keeps exactly those 300 (an unstable sort mixed them)
+    n = 2000
+    score = np.random.default_rng(0).integers(0, 3, n).astype(np.float64)
+    best = np.flatnonzero(score == 2.0)
+    good = np.zeros(n, dtype=bool)
+    good[best[:300]] = True
+    xr = np.where(good, -1.0, -5.0)  # GT disparity 1 at (0, 0): error 0 or 4 px
+    zeros = np.zeros(n)
+    assert count_at_precision(zeros, zeros, xr, score, np.ones((1, 1)), 100.0) == 300
+    # 75 %: by hand over the same order (best score first, then the given order)
+    order = sorted(range(n), key=lambda i: (-score[i], i))
+    hits = list(itertools.accumulate(int(good[i]) for i in order))
+    want = max(k for k in range(1, n + 1) if 100.0 * hits[k - 1] / k >= 75.0)
+    assert count_at_precision(zeros, zeros, xr, score, np.ones((1, 1)), 75.0) == want
