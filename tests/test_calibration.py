@@ -1100,3 +1100,24 @@ def test_depth_step_refuses_what_is_not_a_depth_or_a_step(
     assert np.isnan(c.depth_step(np.array([np.nan, 5.0]))[0])  # a map's pixels without depth
     with pytest.raises(ValueError, match=re.escape(says)):
         c.depth_step(depth, step)  # type: ignore[arg-type]
+
+
+def test_middlebury_calib_with_blank_lines_and_without_a_baseline(tmp_path: Path) -> None:
+    # blank lines (a file edited by hand, a trailing empty line) are no key=value error
+    (tmp_path / "calib.txt").write_text(
+        "\ncam0=[700 0 300; 0 700 200; 0 0 1]\n\ncam1=[700 0 310; 0 700 200; 0 0 1]\n"
+        "doffs=10\n  \nbaseline=160\nwidth=640\nheight=480\nndisp=64\n\n\n"
+    )
+    v = parse_middlebury_calib(tmp_path / "calib.txt")
+    assert sorted(v) == ["baseline", "cam0", "cam1", "doffs", "height", "ndisp", "width"]
+    assert v["cam1"][0, 2] == 310.0 and v["baseline"] == 160.0
+    c = Calibration.from_middlebury(tmp_path / "calib.txt")
+    assert c.image_size == (640, 480) and c.doffs == 10.0
+    assert c.T.tolist() == [-160.0, 0.0, 0.0]
+    # a missing baseline is named (it was a bare KeyError: 'baseline')
+    (tmp_path / "nobase.txt").write_text(
+        "cam0=[700 0 300; 0 700 200; 0 0 1]\ncam1=[700 0 310; 0 700 200; 0 0 1]\n"
+        "width=640\nheight=480\n"
+    )
+    with pytest.raises(ValueError, match=r"nobase\.txt lacks 'baseline'"):
+        Calibration.from_middlebury(tmp_path / "nobase.txt")

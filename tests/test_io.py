@@ -768,3 +768,30 @@ def test_read_pfm_of_a_single_row_is_writable(tmp_path: Path, shape: tuple[int, 
     scene = load_scene(tmp_path)
     assert scene.gt is not None and np.isnan(scene.gt.flat[0])
     np.testing.assert_array_equal(scene.gt.flat[1:], arr.flat[1:])
+
+
+# ------------------------------------------------------------- mutation audit (values the
+# tests above did not pin: each of these failed on a one-line bug that every other test passed)
+
+
+def test_read_pfm_refuses_a_zero_scale(tmp_path: Path) -> None:
+    # the scale's sign is the byte order: 0 has none (it was read as big-endian data)
+    (tmp_path / "zero.pfm").write_bytes(b"Pf\n1 1\n0\n" + struct.pack("<f", 1.0))
+    with pytest.raises(ValueError, match=r"scale 0\.0 \(expected positive sizes and a non-zero"):
+        read_pfm(tmp_path / "zero.pfm")
+
+
+def test_find_scenes_needs_both_images(tmp_path: Path) -> None:
+    for name in ("a/pair", "a/left_only"):
+        (tmp_path / name).mkdir(parents=True)
+        (tmp_path / name / "left.png").write_bytes(b"")
+    (tmp_path / "a/pair/right.png").write_bytes(b"")
+    (tmp_path / "a/left_only/right.png").mkdir()  # a folder is not an image
+    assert find_scenes(tmp_path) == [tmp_path / "a/pair"]
+
+
+def test_scene_max_disparity_ignores_a_gt_without_positive_disparity() -> None:
+    # an all-zero (or negative) GT gives no range: the calibration's ndisp, else the width's
+    zero = np.zeros((2, 2), np.float32)
+    assert scene_max_disparity(zero, width=100, ndisp=100) == 112
+    assert scene_max_disparity(-zero - 3.0, width=200) == 64  # 200 // 4 = 50 -> 64
