@@ -17,6 +17,7 @@ from stereovision.calibration import Calibration
 from stereovision.io import imread
 from stereovision.rectification_check import (
     MIN_MATCHES,
+    _judge_rows,
     check_rectification,
     refine_rectification,
 )
@@ -446,3 +447,92 @@ def test_cli_check_names_a_bad_tolerance_before_the_work(
         assert out == "" and err == (
             f"stereovision: error: --tolerance: expected a positive number of pixels, got {bad}\n"
         )
+
+
+# ------------------------------------------------------------- mutation audit: the rule on
+# matched points (_judge_rows, shared with stereovision.uncalibrated) against closed forms
+
+
+def _quad(xl: np.ndarray, yl: np.ndarray, dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """Matches [x_left, y_left, x_right, y_right] with disparity dx and row offset dy."""
+    return np.column_stack([xl, yl, xl - dx, yl - dy])
+
+
+def test_row_model_figures_are_the_closed_form_fit() -> None:
+    w, h = 640, 480
+    i = np.arange(60, dtype=np.float64)
+    xl = 10 + 10 * i
+    yl = 10 + (37 * i) % 460
+    # dy = 0.3 + 2.0 (x - cx) / 1000 - 1.0 (y - cy) / 1000, cx, cy the image centre
+    dy = 0.3 + 2.0 * (xl - 319.5) / 1000 - 1.0 * (yl - 239.5) / 1000
+    r = _judge_rows(_quad(xl, yl, np.full(60, 20.0), dy), w, h, 0.5)
+    assert r.matches == 60 and r.ok is True and r.swapped is False
+    assert r.offset == pytest.approx(0.3, abs=1e-9)
+    assert r.slope_x == pytest.approx(2.0, abs=1e-9)
+    assert r.slope_y == pytest.approx(-1.0, abs=1e-9)
+    ady = np.sort(np.abs(dy))
+    assert r.median_dy == pytest.approx((ady[29] + ady[30]) / 2, abs=1e-12)
+    # 95th percentile, linear between order statistics: rank 0.95 * 59 = 56.05
+    assert r.p95_dy == pytest.approx(ady[56] + 0.05 * (ady[57] - ady[56]), abs=1e-12)
+    assert r.summary().startswith("rectification ok: median |dy| ")
+    assert "offset +0.30 px, roll +2.00 px per 1000 px" in r.summary()
+
+
+def test_row_rule_boundaries() -> None:
+    w, h = 640, 480
+    i = np.arange(60, dtype=np.float64)
+    xl, yl = 20 + 10 * i, 10 + (37 * i) % 460  # not on one line: the model's plane is fixed
+    dx = np.full(60, 20.0)
+    # a median |dy| of exactly the tolerance passes
+    r = _judge_rows(_quad(xl, yl, dx, np.full(60, 0.5)), w, h, 0.5)
+    assert r.ok is True and r.median_dy == 0.5
+    # 30 matches give a verdict, 29 cannot tell (and the unknown figures are None in as_dict)
+    assert _judge_rows(_quad(xl, yl, dx, np.zeros(60))[:30], w, h, 0.5).ok is True
+    few = _judge_rows(_quad(xl, yl, dx, np.zeros(60))[:29], w, h, 0.5)
+    assert few.ok is None and few.matches == 29
+    assert few.as_dict()["offset"] is None and few.as_dict()["median_dy"] is None
+    # an inlier is within 1 px of the model: 10 matches 1.8 px off are not
+    dy = np.where(np.arange(60) % 6 == 5, 1.8, 0.0)
+    assert _judge_rows(_quad(xl, yl, dx, dy), w, h, 0.5).matches == 50
+    # matches at a disparity well below zero (-20 px < -max(8, 2 % of 640)) are not fitted
+    dx2 = np.where(np.arange(60) < 40, 20.0, -20.0)
+    r = _judge_rows(_quad(xl, yl, dx2, np.zeros(60)), w, h, 0.5)
+    assert (r.matches, r.ok, r.swapped) == (40, True, False)
+
+
+def test_swapped_needs_more_than_half_on_common_rows() -> None:
+    w, h = 640, 480
+    i = np.arange(60, dtype=np.float64)
+    xl, yl = 20 + 10 * i, 10 + (37 * i) % 460  # not on one line: the model's plane is fixed
+    # exactly half at negative disparities: not swapped, the other half is the verdict
+    dx = np.where(np.arange(60) < 30, 20.0, -20.0)
+    r = _judge_rows(_quad(xl, yl, dx, np.zeros(60)), w, h, 0.5)
+    assert (r.matches, r.ok, r.swapped) == (30, True, False)
+    # most at negative disparities but scattered over +-8 rows: an unrectified pair, not swapped
+    dx = np.where(np.arange(60) < 10, 20.0, -20.0)
+    scatter = np.random.default_rng(0).uniform(-8.0, 8.0, 60)
+    r = _judge_rows(_quad(xl, yl, dx, scatter), w, h, 0.5)
+    assert (r.ok, r.swapped) == (False, False)
+    # a wide, low image: "near a row" is 10 % of the height (10 px), not of the width, so 50
+    # matches 30 rows apart at negative disparities do not make the pair look swapped
+    w, h = 1000, 100
+    i = np.arange(90, dtype=np.float64)
+    xl, yl = 20 + 10 * i, 5 + (37 * i) % 90
+    dx = np.where(np.arange(90) < 40, 10.0, -20.0)
+    dy = np.where(np.arange(90) < 40, 0.0, 30.0)
+    r = _judge_rows(_quad(xl, yl, dx, dy), w, h, 0.5)
+    assert (r.matches, r.ok, r.swapped) == (40, True, False)
+
+
+def test_default_tolerance_is_half_a_pixel() -> None:
+    # a textured pair 0.7 px apart in rows (and 12 px in columns): the default tolerance,
+    # 0.5 px, calls it not rectified, and the fit finds the 0.7 px offset
+    rng = np.random.default_rng(3)
+    left = cv2.GaussianBlur(rng.integers(0, 256, (240, 320), dtype=np.uint8), (0, 0), 1.5)
+    left = cv2.normalize(left, None, 0, 255, cv2.NORM_MINMAX)
+    shift = np.float32([[1, 0, -12], [0, 1, -0.7]])  # right(x, y) = left(x + 12, y + 0.7)
+    right = cv2.warpAffine(left, shift, (320, 240), flags=cv2.INTER_CUBIC,
+                           borderMode=cv2.BORDER_REFLECT)  # fmt: skip
+    r = check_rectification(left, right)
+    assert r.tolerance == 0.5 and r.ok is False and r.matches >= 100
+    assert r.offset == pytest.approx(0.7, abs=0.05) and r.median_dy == pytest.approx(0.7, abs=0.05)
