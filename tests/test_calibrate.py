@@ -947,6 +947,38 @@ def test_too_few_boards_among_the_pairs_max_pairs_kept_names_the_ones_it_left_ou
     assert not (tmp_path / "c.yaml").exists()
 
 
+def test_max_pairs_names_kept_and_left_out_pairs_by_one_numbering(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Two sessions' images of the same file names (``a/left01.jpg``, ``b/left01.jpg``) are
+    told apart by their place in the list (``13:left01.jpg / right01.jpg``). ``--max-pairs``
+    numbered the pairs it left out over the list given but the pairs kept over the pairs kept:
+    report.json's ``used_pairs`` had "02:left01.jpg / right01.jpg" (the 14th pair given) and
+    ``left_out`` "02:left03.jpg / right03.jpg" (the 3rd). Both are numbered over the list given."""
+    from stereovision.cli import main
+
+    left, right = _chessboard_paths()
+    lefts: list[str] = []
+    rights: list[str] = []
+    for session in ("a", "b"):
+        (tmp_path / session).mkdir()
+        for files, into in ((left, lefts), (right, rights)):
+            for f in files:
+                link = tmp_path / session / f.name
+                link.symlink_to(f)
+                into.append(str(link))
+    argv = ["calibrate", "--left", *lefts, "--right", *rights, "--square", "1"]
+    argv += ["--report", str(tmp_path / "rep"), "--max-pairs", "5", "-o", str(tmp_path / "c.yaml")]
+    assert main(argv) == 0
+    capsys.readouterr()
+    rep = json.loads((tmp_path / "rep" / "report.json").read_text())
+    ids = CHESSBOARD_IDS + CHESSBOARD_IDS
+    named = [f"{i:02d}:left{ids[i]}.jpg / right{ids[i]}.jpg" for i in range(26)]
+    kept = (0, 6, 13, 19, 25)  # spread evenly over the 26 pairs
+    assert rep["used_pairs"] == [named[i] for i in kept]
+    assert rep["pair_selection"]["left_out"] == [n for i, n in enumerate(named) if i not in kept]
+
+
 def test_the_triangulated_square_is_not_claimed_as_a_check_of_the_given_one(
     chessboard: tuple[Calibration, CalibrationReport], cached_corners: None
 ) -> None:

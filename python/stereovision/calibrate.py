@@ -2628,8 +2628,14 @@ def _calibrate_source(
         }
         lefts = [lefts[i] for i in keep]
         rights = [rights[i] for i in keep]
+        # the pairs kept keep their names in the list given: files of one name in two folders
+        # are numbered by their place in it ("13:left01.jpg / right01.jpg"), and numbered over
+        # the pairs kept they took the numbers of pairs left out
+        kept_names: list[str] | None = [names[i] for i in keep]
+    else:
+        kept_names = None
     try:
-        cal, rep = calibrate(lefts, rights, **common)
+        cal, rep = calibrate(lefts, rights, names=kept_names, **common)
     except ValueError as exc:
         if selection and f"at least {MIN_PAIRS} are" in str(exc):  # too few: the rest unseen
             raise ValueError(
