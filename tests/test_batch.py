@@ -955,6 +955,39 @@ def test_batch_a_file_where_a_pair_folder_goes_fails_that_pair_alone(
     assert pairs["a"]["status"] == "failed" and pairs["b"]["status"] == "done"
 
 
+def test_batch_a_folder_where_an_output_file_goes_fails_that_pair_alone(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A rerun where OUT/a/disparity.pfm is a user's folder: the run stopped there ("cannot
+    write the outputs of a ...: Is a directory; ... run again to continue", exit 2, as for a
+    full disk, though a rerun meets it again and the pairs to come could be written), pair b
+    undone, and a's earlier disparity.png already replaced by the new one. As a file where a
+    pair's folder goes, pair a fails naming the folder, its files as they were; b is done."""
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    (out / "a" / "disparity.pfm").unlink()
+    (out / "a" / "disparity.pfm").mkdir()
+    (out / "a" / "disparity.pfm" / "notes.txt").write_text("mine")
+    before = (out / "a" / "disparity.png").read_bytes()
+    _change(root / "a/left.png")
+    _change(root / "b/left.png")
+    b_before = (out / "b" / "disparity.png").read_bytes()
+    capsys.readouterr()
+    assert main(args) == 1
+    err = capsys.readouterr().err
+    assert (
+        f"failed a: IsADirectoryError: {out / 'a' / 'disparity.pfm'} is a folder, where the "
+        f"pair's disparity.pfm goes: move it away (the pair's earlier outputs are kept)"
+    ) in err
+    assert (out / "a" / "disparity.pfm" / "notes.txt").read_text() == "mine"
+    assert (out / "a" / "disparity.png").read_bytes() == before
+    assert (out / "b" / "disparity.png").read_bytes() != b_before
+    pairs = _summary(out)["pairs"]
+    assert pairs["a"]["status"] == "failed" and pairs["b"]["status"] == "done"
+
+
 def test_batch_reads_16_bit_files_as_depth_does(data_dir: Path, tmp_path: Path) -> None:
     """A 12-bit camera's pair in 16-bit PNGs: batch's disparity is the one `stereovision depth`
     writes for it (batch decoded the top 8 bits of each pixel, 0-15 of 0-4095, while depth

@@ -792,7 +792,9 @@ def _commit_pair(
     of the pairs nested in it, a user's files, the input images of an output folder given as
     the input folder): each file is renamed over its own name, and of the files an earlier run
     recorded (``previous``) those this run did not write are removed. A file where the folder
-    goes is a :class:`NotADirectoryError` naming it (the pair fails, the file is kept).
+    goes is a :class:`NotADirectoryError` naming it (the pair fails, the file is kept); a folder
+    where one of the files goes an :class:`IsADirectoryError` naming it, before any file moves
+    (the pair fails, its earlier files and the folder are kept).
     """
     from stereovision.cli import DEPTH_OUTPUTS
 
@@ -803,6 +805,15 @@ def _commit_pair(
         if folder.exists() and not folder.is_dir():
             raise NotADirectoryError(
                 f"{folder} is a file, where the pair's output folder {dest} goes: move it away"
+            )
+    for fname in files:
+        # checked before any file moves: the files renamed over theirs before the folder was
+        # met were the new run's, the others the earlier run's
+        target = dest / fname
+        if target.is_dir() and not target.is_symlink():
+            raise IsADirectoryError(
+                f"{target} is a folder, where the pair's {fname} goes: move it away (the "
+                "pair's earlier outputs are kept)"
             )
     dest.parent.mkdir(parents=True, exist_ok=True)
     tmp = dest.parent / f".{dest.name}.partial-{uuid.uuid4().hex[:8]}"
@@ -1736,7 +1747,9 @@ def _run_jobs(
                 summary.ensure_folder()
                 try:
                     _commit_pair(out, job.name, res["files"], (previous or {}).get(job.name))
-                except NotADirectoryError as err:  # a file in the way: this pair alone fails
+                except (NotADirectoryError, IsADirectoryError) as err:
+                    # a file where its folder goes, a folder where one of its files goes: this
+                    # pair alone fails (a rerun meets it again; the pairs to come can be written)
                     record_failure(job, err)
                     fut.release()
                     while len(futures) < limit and submit_next():
