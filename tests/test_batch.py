@@ -1853,3 +1853,51 @@ def test_a_full_output_disk_names_the_pair_and_closes_the_record(
     assert main(args) == 0
     s = _summary(out)
     assert (s["run"]["processed"], s["run"]["skipped"]) == (2, 2) and "error" not in s["run"]
+
+
+def test_a_full_output_disk_that_the_summary_cannot_be_written_to_is_said(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The disk full while the third pair was written, and summary.json (a long run's, written
+    every few pairs) not writable either: the summary's own "[Errno 28] No space left on
+    device", raised from the run's last flush, took the place of the error naming the pair,
+    and the line said the pairs finished were "recorded in OUT/summary.json", where none of
+    them was. The line names the pair and says the summary could not be updated."""
+    import errno
+
+    import stereovision.batch as batch
+
+    root, out = tmp_path / "in", tmp_path / "out"
+    _tiny(root, data_dir, *(f"seq/{i:04d}_{s}.png" for i in range(4) for s in ("left", "right")))
+    commit, save = batch._commit_pair, batch._Summary.save
+    tried: list[str] = []
+    full = [False]
+
+    def fill_the_disk(out_dir: Path, name: str, files: dict[str, bytes], *more: Any) -> Path:
+        tried.append(name)
+        if len(tried) == 3:
+            full[0] = True
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return commit(out_dir, name, files, *more)
+
+    def save_unless_full(self: Any) -> None:
+        if full[0]:
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        save(self)
+
+    monkeypatch.setattr(batch, "_commit_pair", fill_the_disk)
+    monkeypatch.setattr(batch._Summary, "save", save_unless_full)
+    monkeypatch.setattr(batch, "SAVE_COST_RATIO", 1e12)  # a long run's: written now and then
+    args = ["batch", str(root), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == (
+        f"stereovision: error: cannot write the outputs of {tried[2]} into {out / tried[2]}: "
+        f"No space left on device; 2 of 4 pairs finished this run, kept in {out}; "
+        f"{out / SUMMARY_NAME} could not be updated (No space left on device): the pairs "
+        "finished since it was last written are not recorded in it; run again to continue"
+    )
+    assert _summary(out)["counts"] == {"done": 0, "failed": 0, "pending": 4}

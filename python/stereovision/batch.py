@@ -1559,15 +1559,27 @@ def run_batch(
                     seconds=round(time.perf_counter() - t0, 3),
                     error=_error_line(exc),
                 )
-                with contextlib.suppress(OSError):  # the disk that is full, maybe
+                unsaved = ""
+                try:
                     summary.save()
+                except OSError as err:  # the disk that is full, maybe
+                    unsaved = err.strerror or str(err)
             if not isinstance(exc, OSError):
                 raise
             done = len(processed) + len(failed)
-            to_do = sum(1 for j in todo if j.name not in processed and j.name not in failed)
+            ended = set(processed) | set(failed)
+            to_do = sum(1 for j in todo if j.name not in ended)
+            # "recorded in summary.json" of a summary that could not be written (a long run's
+            # is written every few pairs: those finished since are not in it)
+            kept_said = (
+                f"kept in {out}; {summary.path} could not be updated ({unsaved}): the pairs "
+                "finished since it was last written are not recorded in it"
+                if unsaved
+                else f"kept in {out} and recorded in {summary.path}"
+            )
             said = OSError(
-                f"{exc}; {done} of {done + to_do} pairs finished this run, kept in {out} and "
-                f"recorded in {summary.path}; run again to continue"
+                f"{exc}; {done} of {done + to_do} pairs finished this run, {kept_said}; run again "
+                "to continue"
             )
             said.errno = exc.errno
             raise said from exc
@@ -1785,10 +1797,18 @@ def _run_jobs(
             fut.release()
             while len(futures) < limit and submit_next():
                 pass
-    finally:
+    except BaseException:
         bar.close()
         dask.close(list(futures))
-        summary.flush()  # what record() held back, whatever stopped the run
+        # what record() held back; on the disk that is full this fails too, and its bare
+        # "[Errno 28] No space left on device" took the place of the error naming the pair
+        # (run_batch writes the summary again, and says when it cannot)
+        with contextlib.suppress(OSError):
+            summary.flush()
+        raise
+    bar.close()
+    dask.close(list(futures))
+    summary.flush()  # what record() held back
 
 
 # ---------------------------------------------------------------------------------------- CLI
