@@ -1771,6 +1771,49 @@ def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkey
     assert not list(tmp_path.glob(".stereovision-partial-*"))
 
 
+def test_a_save_folder_made_by_someone_else_while_the_save_wrote(tmp_path):
+    """The Save's folder did not exist and another program made it while the files were
+    written: the rename of the staging folder onto it failed with "[Errno 39] Directory not
+    empty: '.../.stereovision-partial-.../saved' -> '.../saved'", naming a hidden folder the
+    user never saw, where a folder that existed at the start gets its files moved in one by
+    one, or "disparity.png appeared in ... while the Save wrote". The folder come meanwhile is
+    treated as one that existed: a file of the Save's there is refused by name, nothing
+    replaced; otherwise the files join the other program's."""
+    pytest.importorskip("trame")
+    from stereovision.gui.app import save_all_or_nothing
+
+    folder = tmp_path / "saved"
+
+    def write(notes: str, into: Path) -> None:
+        (into / "disparity.png").write_bytes(b"png")
+        (into / "overview.png").write_bytes(b"overview")
+        folder.mkdir()
+        (folder / notes).write_text("theirs")
+
+    with pytest.raises(FileExistsError) as info:
+        save_all_or_nothing(lambda into: write("disparity.png", into), folder)
+    assert str(info.value) == (
+        f"save: disparity.png appeared in {folder} while the Save wrote; nothing was "
+        "overwritten: choose another folder"
+    )
+    assert [p.name for p in folder.iterdir()] == ["disparity.png"]
+    assert (folder / "disparity.png").read_text() == "theirs"
+    (folder / "disparity.png").unlink()
+    folder.rmdir()
+    written = save_all_or_nothing(lambda into: write("notes.txt", into), folder)
+    assert written == {
+        "disparity.png": folder / "disparity.png",
+        "overview.png": folder / "overview.png",
+    }
+    assert sorted(p.name for p in folder.iterdir()) == [
+        "disparity.png",
+        "notes.txt",
+        "overview.png",
+    ]
+    assert (folder / "notes.txt").read_text() == "theirs"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["saved"]  # no staging folder left
+
+
 def test_a_save_whose_writer_fails_leaves_no_partial_folder_and_names_the_file(
     tmp_path, monkeypatch
 ):

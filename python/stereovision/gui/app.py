@@ -21,6 +21,7 @@ from __future__ import annotations
 import asyncio
 import base64
 import concurrent.futures
+import errno
 import itertools
 import logging
 import math
@@ -259,7 +260,8 @@ def save_all_or_nothing(write: Callable[[Path], None], folder: Path) -> dict[str
     hidden, locked while the Save runs, removed however it ends, and one a killed process
     left is removed by the next). It is made beside ``folder`` when ``folder`` does not exist
     (the whole folder then appears at once, by one rename), else inside it (its files then
-    move in one by one, each by one rename, after checking that none is there).
+    move in one by one, each by one rename, after checking that none is there; so too into a
+    folder another program made while the Save wrote).
 
     Parameters
     ----------
@@ -295,9 +297,18 @@ def save_all_or_nothing(write: Callable[[Path], None], folder: Path) -> dict[str
             why = first_line(exc).replace(str(inner), str(folder))  # its path as it would be
             raise SaveFailed(f"{failed} could not be written ({why})") from exc
         names = [n for n in SAVE_WRITE_ORDER if (inner / n).is_file()]
+        moved = False
         if not exists:
-            os.rename(inner, folder)  # fails (nothing replaced) if a folder with files came
-        else:
+            try:
+                os.rename(inner, folder)  # fails (nothing replaced) if a folder with files came
+                moved = True
+            except OSError as exc:
+                # another program made the folder meanwhile: it said "Directory not empty:
+                # '.../.stereovision-partial-.../saved' -> ...", a folder the user never saw;
+                # it is now one that existed, its files moved in as below
+                if exc.errno not in (errno.ENOTEMPTY, errno.EEXIST) or not folder.is_dir():
+                    raise
+        if not moved:
             came = [n for n in names if os.path.lexists(folder / n)]
             if came:
                 raise FileExistsError(
