@@ -301,7 +301,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     """
     from tqdm import tqdm
 
-    from stereovision.io import load_scene
+    from stereovision.io import load_scene, scene_too_narrow
 
     if args.runs < MIN_RUNS:
         raise ValueError(f"--runs: {_runs_rule(args.runs)}")
@@ -309,7 +309,13 @@ def cmd_bench(args: argparse.Namespace) -> int:
     all_cases: list[BenchCase] = []
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
     for d in tqdm(dirs, desc="scenes", file=sys.stderr, disable=quiet):
-        cases = bench_scene(load_scene(d), runs=args.runs)
+        scene = load_scene(d)
+        narrow = scene_too_narrow(scene)
+        if narrow:
+            # as eval says it: "disparity range 16 is not smaller than the image width 8 ...;
+            # give a max_disparity below 8" named a range and an option bench has not
+            raise ValueError(f"{d}: {narrow}")
+        cases = bench_scene(scene, runs=args.runs)
         all_cases.extend(cases)
         if args.json:
             for c in cases:

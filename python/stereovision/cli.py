@@ -1424,7 +1424,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
     """``stereovision eval SCENE_DIR...``: evaluation.md metrics, ours beside OpenCV."""
     from tqdm import tqdm
 
-    from stereovision.io import find_scenes, load_scene
+    from stereovision.io import find_scenes, load_scene, scene_too_narrow
 
     dirs: list[Path] = []
     for d in args.scenes:
@@ -1477,15 +1477,11 @@ def cmd_eval(args: argparse.Namespace) -> int:
                 tqdm.write(f"skipped {d}: {why}", file=sys.stderr)
                 skipped += 1
                 continue
-            md, width = scene.max_disparity, scene.left.shape[1]
-            if md >= width:
+            narrow = scene_too_narrow(scene)
+            if narrow:
                 # the range is evaluation.md's, never the caller's: "disparity range 16 is not
                 # smaller than the image width 8" named a range nobody gave
-                raise ValueError(
-                    f"{d}: images {width} px wide, not wider than the scene's disparity range "
-                    f"({md} px, evaluation.md's rule: 16 at least): a scene needs images at "
-                    f"least {md + 1} px wide"
-                )
+                raise ValueError(f"{d}: {narrow}")
             row = _eval_scene(scene, args.method, not args.no_opencv, args.runs or 1)
         except (ValueError, OSError, RuntimeError) as e:
             if len(dirs) == 1:

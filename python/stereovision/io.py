@@ -47,6 +47,7 @@ __all__ = [
     "read_pfm",
     "read_ply",
     "scene_max_disparity",
+    "scene_too_narrow",
     "write_pfm",
     "write_ply",
 ]
@@ -1068,6 +1069,30 @@ class Scene:
             f"gt={'yes' if self.gt is not None else 'no'}, "
             f"calib={'yes' if self.calib is not None else 'no'})"
         )
+
+
+def scene_too_narrow(scene: Scene) -> str | None:
+    """Why a scene cannot be matched over its own range, or None: images not wider than its
+    ``max_disparity`` (:func:`scene_max_disparity`, 16 px at least). ``eval`` and ``bench`` say
+    it in these words: the range is the scene's, never the caller's.
+
+    Parameters
+    ----------
+    scene : Scene
+        A scene :func:`load_scene` loaded.
+
+    Returns
+    -------
+    str or None
+        The reason, naming the images' width, the scene's range and the width it needs.
+    """
+    md, width = scene.max_disparity, scene.left.shape[1]
+    if md < width:
+        return None
+    return (
+        f"images {width} px wide, not wider than the scene's disparity range ({md} px, "
+        f"evaluation.md's rule: 16 at least): a scene needs images at least {md + 1} px wide"
+    )
 
 
 def scene_max_disparity(
