@@ -897,3 +897,28 @@ def test_view_keeps_a_file_its_screenshot_replaces(result, tmp_path, capsys):
     assert kept.read_bytes() == b"my picture"
     assert capsys.readouterr().out.endswith(f"-> {shot} (the one it replaced kept as {kept})\n")
     assert cv2.imread(str(shot)) is not None
+
+
+def test_view_of_a_scene_narrower_than_its_range_names_the_width_needed(tmp_path):
+    """``view SCENE`` of a scene 8 px wide said "disparity range 16 is not smaller than the
+    image width 8 ...; give a max_disparity below 8": a range nobody gave, an option view has
+    not. It says it as eval and bench do (the scene's range, evaluation.md's rule)."""
+    from stereovision.io import write_pfm
+
+    rng = np.random.default_rng(0)
+    row = (rng.random((3, 10)) * 255).astype(np.uint8)
+    scene = tmp_path / "tiny"
+    scene.mkdir()
+    cv2.imwrite(str(scene / "left.png"), row[:, :8])
+    cv2.imwrite(str(scene / "right.png"), row[:, 2:])
+    write_pfm(scene / "gt_disp.pfm", np.full((3, 8), 2.0, np.float32))
+    (scene / "calib.txt").write_text(
+        "cam0=[10 0 4; 0 10 1.5; 0 0 1]\ncam1=[10 0 4; 0 10 1.5; 0 0 1]\ndoffs=0\n"
+        "baseline=100\nwidth=8\nheight=3\nndisp=16\n"
+    )
+    with pytest.raises(ValueError) as info:
+        render.load_view_source(scene)
+    assert str(info.value) == (
+        f"scene {scene}: images 8 px wide, not wider than the scene's disparity range (16 px, "
+        "evaluation.md's rule: 16 at least): a scene needs images at least 17 px wide"
+    )

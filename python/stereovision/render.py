@@ -1172,7 +1172,8 @@ def load_view_source(
     Raises
     ------
     FileNotFoundError, ValueError
-        Missing path, not a point cloud file, an empty cloud, a folder with nothing to show.
+        Missing path, not a point cloud file, an empty cloud, a folder with nothing to show, a
+        scene too narrow for its disparity range.
     """
     from stereovision.export import load_cloud
 
@@ -1184,11 +1185,14 @@ def load_view_source(
             p = p / "cloud.ply"
         elif (p / "left.png").is_file() and (p / "right.png").is_file():
             from stereovision.depth import depth_map
-            from stereovision.io import load_scene
+            from stereovision.io import load_scene, scene_too_narrow
 
             scene = load_scene(p)
             if scene.calib is None:
                 raise ValueError(f"scene {p} has no calib.txt: no metric 3-D points to show")
+            narrow = scene_too_narrow(scene)
+            if narrow:  # as eval says it: the range is the scene's, view has no max_disparity
+                raise ValueError(f"scene {p}: {narrow}")
             result = depth_map(
                 scene.left, scene.right, scene.calib, max_disparity=scene.max_disparity
             )
