@@ -1771,6 +1771,47 @@ def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkey
     assert not list(tmp_path.glob(".stereovision-partial-*"))
 
 
+def test_a_failed_save_of_a_pair_without_depth_names_the_file_that_failed(tmp_path, monkeypatch):
+    """A pair without a calibration: its Save writes disparity.png, disparity.pfm and
+    overview.png. One that failed at disparity.pfm or overview.png said "depth.png could not
+    be written", the first file of the full write order not written, a file that Save never
+    writes; it names the file that failed."""
+    import contextlib
+    import errno
+    import shutil
+
+    import stereovision.io as svio
+    from stereovision.gui import bundled_data_dir
+
+    scene = tmp_path / "cones-uncalibrated"
+    scene.mkdir()
+    for side in ("left", "right"):
+        shutil.copy(bundled_data_dir() / "cones" / f"{side}.png", scene / f"{side}.png")
+    app = _scene_app("test-save-without-depth", [tmp_path])
+    app._load_scene(scene)
+    _run(app, app.recompute)
+    assert app.view.result.depth is None
+    real = svio.atomic_write
+    failing = [""]
+
+    @contextlib.contextmanager
+    def full_disk(path, mode="wb"):
+        if Path(path).name == failing[0]:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        with real(path, mode) as fh:
+            yield fh
+
+    monkeypatch.setattr(svio, "atomic_write", full_disk)
+    for name in ("disparity.png", "disparity.pfm", "overview.png"):
+        failing[0] = name
+        app.state.save_dir = app._offered_save_dir
+        _run(app, app.save)
+        assert app.state.save_label.startswith(
+            f"save: {name} could not be written ([Errno 28] No space left on device); "
+        ), name
+        assert not (tmp_path / "saved").exists()
+
+
 def test_a_save_folder_made_by_someone_else_while_the_save_wrote(tmp_path):
     """The Save's folder did not exist and another program made it while the files were
     written: the rename of the staging folder onto it failed with "[Errno 39] Directory not

@@ -29,7 +29,7 @@ import os
 import re
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -252,7 +252,9 @@ class SaveFailed(OSError):
     """A Save's writer failed: the message names the file (nothing was moved into place)."""
 
 
-def save_all_or_nothing(write: Callable[[Path], None], folder: Path) -> dict[str, Path]:
+def save_all_or_nothing(
+    write: Callable[[Path], None], folder: Path, files: Sequence[str] = SAVE_WRITE_ORDER
+) -> dict[str, Path]:
     """Run a Save's writers into a staging folder and move their files into ``folder`` only
     once every one is written.
 
@@ -269,6 +271,9 @@ def save_all_or_nothing(write: Callable[[Path], None], folder: Path) -> dict[str
         Writes the Save's files into the folder it is given (that folder exists).
     folder : pathlib.Path
         Where the files go (it need not exist; the folders above it are made as needed).
+    files : sequence of str
+        The files ``write`` writes, in the order it writes them (default
+        :data:`SAVE_WRITE_ORDER`, all of them: a pair without depth writes three).
 
     Returns
     -------
@@ -278,7 +283,7 @@ def save_all_or_nothing(write: Callable[[Path], None], folder: Path) -> dict[str
     Raises
     ------
     SaveFailed
-        A writer failed, naming the first file of :data:`SAVE_WRITE_ORDER` it did not write;
+        A writer failed, naming the first of ``files`` it did not write;
         ``folder`` is as it was (absent if it was), the folders made above it removed again.
     FileExistsError
         One of the files appeared in ``folder`` while the Save wrote (nothing was replaced).
@@ -293,7 +298,9 @@ def save_all_or_nothing(write: Callable[[Path], None], folder: Path) -> dict[str
             write(inner)
         except (ValueError, OSError, RuntimeError, CliError) as exc:
             done = {p.name for p in inner.iterdir()}
-            failed = next((n for n in SAVE_WRITE_ORDER if n not in done), "a file")
+            # of the files this Save writes: a pair without depth that failed at disparity.pfm
+            # said "depth.png could not be written", a file it never writes
+            failed = next((n for n in files if n not in done), "a file")
             why = first_line(exc).replace(str(inner), str(folder))  # its path as it would be
             raise SaveFailed(f"{failed} could not be written ({why})") from exc
         names = [n for n in SAVE_WRITE_ORDER if (inner / n).is_file()]
@@ -2088,8 +2095,11 @@ class StereoApp:
         target = folder
         self._saving_into.add(target)
         try:
+            order = [n for n in SAVE_WRITE_ORDER if n in names]
+            if image is None:  # no render to write
+                order = [n for n in order if n != "render.png"]
             written = await asyncio.get_running_loop().run_in_executor(
-                self._executor, save_all_or_nothing, write, target
+                self._executor, save_all_or_nothing, write, target, order
             )
         except SaveFailed as exc:
             msg = short_paths(f"save: {exc}; nothing was saved in {label}", target)
