@@ -151,8 +151,13 @@ def test_controls_from_pose_says_a_camera_past_the_sliders_range():
     assert (c.yaw, c.pitch, c.roll) == pytest.approx((150.0, -80.0, 0.0), abs=1e-9)
     with pytest.raises(ValueError, match="4x4"):
         render.controls_from_pose(np.eye(3))
-    with pytest.raises(ValueError, match="finite"):
+    # a NaN pose was told "expected a finite 4x4 pose, got shape (4, 4)": its shape was right
+    with pytest.raises(ValueError, match=r"^controls_from_pose: the pose holds 16 NaN or infinite"):
         render.controls_from_pose(np.full((4, 4), np.nan))
+    pose = np.eye(4)
+    pose[0, 3] = np.inf
+    with pytest.raises(ValueError, match=r"holds 1 NaN or infinite values$"):
+        render.controls_from_pose(pose)
 
 
 def test_bad_controls_rejected():

@@ -232,8 +232,11 @@ def controls_from_pose(pose: npt.ArrayLike) -> CameraControls:
     (10.0, -20.0, 30.0, 1.5)
     """
     m = np.asarray(pose, dtype=np.float64)
-    if m.shape != (4, 4) or not np.isfinite(m).all():
-        raise ValueError(f"controls_from_pose: expected a finite 4x4 pose, got shape {m.shape}")
+    if m.shape != (4, 4):
+        raise ValueError(f"controls_from_pose: expected a 4x4 pose, got shape {m.shape}")
+    if not np.isfinite(m).all():
+        bad = int((~np.isfinite(m)).sum())
+        raise ValueError(f"controls_from_pose: the pose holds {bad} NaN or infinite values")
     rot, t = m[:3, :3], m[:3, 3]
     cos_pitch = math.hypot(rot[0, 2], rot[2, 2])
     # atan2, not asin(-R[1, 2]): asin near 1 lost half the digits (1e-8 off the vertical)
