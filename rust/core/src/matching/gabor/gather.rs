@@ -43,7 +43,9 @@ pub(crate) mod win {
     /// ... and two loads.
     pub const WIDE: i32 = 15;
 
-    /// `(min, idx - min, max - min)` of 8 non-negative indices.
+    /// `(min, idx - min, max - min)` of 8 indices; the spread `max - min` saturates at
+    /// `i32::MAX` (it overflowed i32 for indices of both signs: a wrapped, negative spread
+    /// would pass as a window). `idx - min` wraps, but only its low 3 bits are used.
     ///
     /// # Safety
     /// AVX2.
@@ -57,7 +59,11 @@ pub(crate) mod win {
         let hi = _mm256_max_epi32(hi, _mm256_shuffle_epi32::<0b01_00_11_10>(hi));
         let hi = _mm256_max_epi32(hi, _mm256_shuffle_epi32::<0b10_11_00_01>(hi));
         let (m, x) = (_mm256_cvtsi256_si32(lo), _mm256_cvtsi256_si32(hi));
-        (m, _mm256_sub_epi32(iv, _mm256_set1_epi32(m)), x - m)
+        (
+            m,
+            _mm256_sub_epi32(iv, _mm256_set1_epi32(m)),
+            x.saturating_sub(m),
+        )
     }
 
     /// `p[rel]` for 8 offsets `rel` in `0..=spread` (`spread <= WIDE`): one load and a

@@ -335,7 +335,9 @@ simd_fn! {
         for &off in offs {
             let oi = off as i32;
             for x in 0..w {
-                let j = j0[x] - oi;
+                // Saturating: `j0` saturates to i32::MIN / i32::MAX for shifts off the i32
+                // range, where `j0 - oi` overflowed (0..w is left out either way).
+                let j = j0[x].saturating_sub(oi);
                 let v = j >= 0 && j < w as i32;
                 valid[x] = if v { 1.0 } else { 0.0 };
                 si[x] = if v { j as u32 } else { 0 };
@@ -457,7 +459,9 @@ mod avx2 {
         for x in 0..w {
             j0[x] = super::floor_fast(x as f32 - drow[x] + 0.5) as i32;
         }
-        let nch = l.chan.len();
+        // Channels present in both levels (as `channel_dot` zips them): `rrows[c]` below is
+        // read for every c < nch.
+        let nch = l.chan.len().min(r.chan.len());
         // Per channel: the left (re, im) rows and the right (re, im) rows of row y.
         let lrows: Vec<(&[f32], &[f32])> = l
             .chan
@@ -476,11 +480,19 @@ mod avx2 {
         let two = _mm256_set1_ps(2.0);
         let one = _mm256_set1_ps(1.0);
         let lastv = _mm256_set1_epi32(wi - 1);
+        debug_assert!(lrows.len() >= nch && rrows.len() >= nch);
+        debug_assert!(lrows
+            .iter()
+            .chain(&rrows)
+            .all(|(a, b)| a.len() == w && b.len() == w));
         let mut x = 0;
         while x + LANES <= w {
             // SAFETY (whole block): x + 8 <= w bounds every 8-lane load and store at x of the
-            // row slices (all of length w). Window loads at `base` are made only when
-            // 0 <= base and base + 8 <= w; gathers use indices clamped to 0..=w-1.
+            // row slices (all of length w); `lrows` and `rrows` hold `nch` channels. Window
+            // loads at `base` are made only when 0 <= base and base + reach <= w (tested in i64:
+            // `j0` saturates to i32::MIN / i32::MAX for shifts off the i32 range, where the i32
+            // `first - oi` and `base + reach` overflowed and could pass the test); gathers use
+            // indices clamped to 0..=w-1.
             unsafe {
                 let jv = _mm256_loadu_si256(j0.as_ptr().add(x) as *const __m256i);
                 let (first, rel, spread) = win::window(jv);
@@ -491,8 +503,10 @@ mod avx2 {
                 let lev = _mm256_loadu_ps(le.as_ptr().add(x));
                 for (k, &off) in offs.iter().enumerate() {
                     let oi = o0 + k as i32;
-                    let base = first - oi;
-                    let in_window = window && base >= 0 && base + reach <= wi;
+                    let base = i64::from(first) - i64::from(oi);
+                    let in_window = window && base >= 0 && base + i64::from(reach) <= i64::from(wi);
+                    // Only used (as a pointer offset) when in_window: then 0 <= base < w.
+                    let base = base as i32;
                     // Shifted positions, their validity (0 <= j < w) and clamped indices.
                     let j = _mm256_sub_epi32(jv, _mm256_set1_epi32(oi));
                     let (v, idx) = if in_window {
@@ -536,7 +550,8 @@ mod avx2 {
             let mut best = f32::NEG_INFINITY;
             let mut cur = out[x];
             for (k, &off) in offs.iter().enumerate() {
-                let j = j0[x] - (o0 + k as i32);
+                // Saturating: `j0` may be i32::MIN / i32::MAX (see above); out of 0..w either way.
+                let j = j0[x].saturating_sub(o0 + k as i32);
                 let valid = j >= 0 && j < wi;
                 let v = if valid { 1.0 } else { 0.0 };
                 let jj = if valid { j as usize } else { 0 };

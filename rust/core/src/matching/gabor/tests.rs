@@ -408,3 +408,34 @@ fn the_envelope_is_bounded() {
     assert!(Channel::new(0.25, 0.0, 1.5, 10.0).is_ok());
     assert!(Channel::new(0.03, 0.0, 1.5, 10.0).is_err());
 }
+
+#[test]
+fn fused_search_survives_shifts_beyond_i32() {
+    // A disparity range far off the image (d_min = +-3e10 passes validation: finite, range
+    // <= MAX_RANGE) puts every shifted position at i32::MIN / i32::MAX. The window test of the
+    // fused kernel computed `first - o` and `base + reach` in i32: they overflowed (a panic in
+    // debug builds, in release a wrapped `base` that passed the test and a load ~8 GiB off the
+    // row). Every candidate is outside the image: both kernels keep the first offset.
+    let (w, h) = (24usize, 3usize);
+    let (left, right) = (texture(w, h, 0.0, 3), texture(w, h, 4.3, 3));
+    let chans = [filter::Channel::new(0.25, DEFAULT_ORIENTATIONS[0], 1.5, 1.0).unwrap()];
+    let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
+    let rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
+    for d in [3e10f32, -3e10, 2.2e9, -2.2e9] {
+        let base = vec![d; w * h];
+        for offs in [(0..=20).collect::<Vec<i32>>(), (-9..=9).collect()] {
+            let offs: Vec<f32> = offs.into_iter().map(|k| k as f32).collect();
+            let a = search::search_impl(&ld, &rd, &base, &offs, 0, true).unwrap();
+            let b = search::search_impl(&ld, &rd, &base, &offs, 0, false).unwrap();
+            let first = d + offs[0];
+            assert!(
+                a.iter().all(|&v| v.to_bits() == first.to_bits()),
+                "fused, d = {d}"
+            );
+            assert!(
+                b.iter().all(|&v| v.to_bits() == first.to_bits()),
+                "generic, d = {d}"
+            );
+        }
+    }
+}
