@@ -276,4 +276,42 @@ mod tests {
         super::gather_lerp(&[2.5], &[0; 9], &[0.5; 9], &mut out);
         assert!(out.iter().all(|&v| v == 2.5));
     }
+
+    #[test]
+    fn every_size_equals_the_scalar_loops() {
+        // Rows of 1..=70 samples and around 128; index rows of 0..=70 (and 127..=129) entries,
+        // `out` shorter, equal and longer; patterns: runs at the left and right ends, spreads
+        // 0..=21 (one-load, two-load and gather chunks), indices past the end (clamped). Bit
+        // equality with the scalar loops, and `out` untouched past the indices.
+        let pats: [fn(usize, usize) -> u32; 7] = [
+            |x, _| x as u32,
+            |x, len| (len - 1 - x % len) as u32,
+            |x, len| (len + 3).saturating_sub(x % 11) as u32,
+            |x, _| (x % 8) as u32,
+            |x, _| (2 * x) as u32,
+            |x, _| (3 * x + x % 5) as u32,
+            |x, len| ((x * 7919) % (len + 9)) as u32,
+        ];
+        for len in (1..=70usize).chain([127, 128, 129]) {
+            let src: Vec<f32> = (0..len).map(|i| (i as f32 * 0.37).sin() + 0.01).collect();
+            let t: Vec<f32> = (0..140).map(|i| (i % 13) as f32 / 12.0).collect();
+            for n in (0..=70usize).chain([127, 128, 129]) {
+                for (p, pat) in pats.iter().enumerate() {
+                    let idx: Vec<u32> = (0..n).map(|x| pat(x, len)).collect();
+                    for n_out in [n.saturating_sub(3), n, n + 5] {
+                        let (mut a, mut b) = (vec![-7.0f32; n_out], vec![-7.0f32; n_out]);
+                        super::gather(&src, &idx, &mut a);
+                        super::gather_scalar(&src, &idx, &mut b, 0);
+                        assert_eq!(a, b, "gather len {len} n {n} out {n_out} pattern {p}");
+                        let tt = &t[..n.min(t.len())];
+                        let (mut a, mut b) = (vec![-7.0f32; n_out], vec![-7.0f32; n_out]);
+                        super::gather_lerp(&src, &idx, tt, &mut a);
+                        super::gather_lerp_scalar(&src, &idx, tt, &mut b, 0);
+                        let same = a.iter().zip(&b).all(|(u, v)| u.to_bits() == v.to_bits());
+                        assert!(same, "gather_lerp len {len} n {n} out {n_out} pattern {p}");
+                    }
+                }
+            }
+        }
+    }
 }

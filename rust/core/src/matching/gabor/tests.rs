@@ -439,3 +439,54 @@ fn fused_search_survives_shifts_beyond_i32() {
         }
     }
 }
+
+#[test]
+fn fused_search_equals_the_generic_one_on_every_size() {
+    // Widths 1..=70 and around 128, heights 1..=5, offset ranges around the 8- and 16-sample
+    // window loads; base maps whose shifted positions sit at the left border (j0 = 0), at the
+    // right one (j0 = w - 1), in smooth runs, in runs of spread 14 (two loads) and 16+ (the
+    // gather), per 8-pixel chunk and per row. Bit equality with the generic kernel.
+    let chans = [filter::Channel::new(0.25, DEFAULT_ORIENTATIONS[0], 1.5, 1.0).unwrap()];
+    let offsets: [(i32, i32); 9] = [
+        (0, 0),
+        (0, 7),
+        (0, 8),
+        (-4, 4),
+        (-8, 8),
+        (0, 15),
+        (-1, 16),
+        (-17, 17),
+        (0, 33),
+    ];
+    for w in (1..=70usize).chain([127, 128, 129]) {
+        for h in 1..=5usize {
+            let (left, right) = (texture(w, h, 0.0, 5), texture(w, h, 2.7, 5));
+            let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
+            let rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
+            let base: Vec<f32> = (0..w * h)
+                .map(|i| {
+                    let (x, y) = (i % w, i / w);
+                    let xf = x as f32;
+                    match (y + x / 8) % 6 {
+                        0 => xf,                      // j0 = 0
+                        1 => xf - (w as f32 - 1.0),   // j0 = w - 1
+                        2 => 0.5 * xf + 1.3,          // spread 3-4
+                        3 => -xf - 2.2,               // spread 14
+                        4 => -2.0 * xf,               // spread 21: gather
+                        _ => 3.7 + 0.01 * (y as f32), // constant
+                    }
+                })
+                .collect();
+            for &(lo, hi) in &offsets {
+                let offs: Vec<f32> = (lo..=hi).map(|k| k as f32).collect();
+                let a = search::search_impl(&ld, &rd, &base, &offs, 0, true).unwrap();
+                let b = search::search_impl(&ld, &rd, &base, &offs, 0, false).unwrap();
+                let same = a
+                    .iter()
+                    .zip(b.iter())
+                    .all(|(p, q)| p.to_bits() == q.to_bits());
+                assert!(same, "{w}x{h}, offsets {lo}..={hi}");
+            }
+        }
+    }
+}

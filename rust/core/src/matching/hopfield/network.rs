@@ -1607,4 +1607,37 @@ mod tests {
             }
         }
     }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn window_counts_agree_for_every_point_count() {
+        // 1..=70 points (ranges ending 0..=7 lanes before the padding), clustered so that a
+        // window's range holds up to all of them, points at the grid's edges; the AVX2 count
+        // (8 lanes, the tail masked) against the portable one.
+        if !has_avx2() {
+            return;
+        }
+        let mut rng = SplitMix64::new(17);
+        for n in 1..=70usize {
+            for spread in [3u64, 12, 40] {
+                let pxy: Vec<(i32, i32)> = (0..n)
+                    .map(|_| {
+                        let x = (rng.next_u64() % spread) as i32;
+                        (x, (rng.next_u64() % spread) as i32)
+                    })
+                    .collect();
+                for half in [1, 4, 9] {
+                    let grid = PointGrid::new(&pxy, half);
+                    let vals = grid.values_in_grid_order(|t| (t % 5) as i32);
+                    for &(x, y) in pxy.iter().chain(&[(0, 0), (spread as i32, spread as i32)]) {
+                        let want = count_portable(&grid, &vals, (x, y, half, 2, 1));
+                        // SAFETY: AVX2 is present; `PointGrid::new` pads xs and ys, and `vals`
+                        // is padded like them.
+                        let got = unsafe { count_avx2(&grid, &vals, (x, y, half, 2, 1)) };
+                        assert_eq!(got, want, "n {n} spread {spread} half {half} at ({x}, {y})");
+                    }
+                }
+            }
+        }
+    }
 }

@@ -849,6 +849,50 @@ mod tests {
     }
 
     #[test]
+    fn avx2_and_portable_curves_agree_on_every_size() {
+        // Images 7..=70 (and 127..=129) wide, 7 and 9 high; points at both window borders
+        // (x = 3, x = W - 4) and inside; every d_hi from 0 to x - 3 (1..=8 blocks: full and
+        // partial last blocks, CHUNK boundaries at 128+; spans read in place and from the
+        // zero-padded copy at the image's end). Bit equality of all five curves.
+        if !has_avx2() {
+            return; // nothing to compare on this CPU
+        }
+        let mut s = 0x5851_f42d_4c95_7f2du64;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let (mut a, mut b) = (Curves::default(), Curves::default());
+        for w in (7..=70usize).chain([127, 128, 129, 140]) {
+            for h in [7usize, 9] {
+                let left = Image::new(w, h, (0..w * h).map(|_| next()).collect()).expect("valid");
+                let right = Image::new(w, h, (0..w * h).map(|_| next()).collect()).expect("valid");
+                let (left, right) = (left.view(), right.view());
+                let stats = RightStats::new(&right);
+                let mut xs = vec![SIM_RADIUS, w - 1 - SIM_RADIUS, w / 2];
+                xs.dedup();
+                for &x in &xs {
+                    for y in SIM_RADIUS..h - SIM_RADIUS {
+                        for d_hi in 0..=x - SIM_RADIUS {
+                            curves_with(true, &left, &right, &stats, x, y, y, d_hi, &mut a);
+                            curves_with(false, &left, &right, &stats, x, y, y, d_hi, &mut b);
+                            for k in 0..N_REGIONS {
+                                let same = a.curve[k][..=d_hi]
+                                    .iter()
+                                    .zip(&b.curve[k][..=d_hi])
+                                    .all(|(u, v)| u.to_bits() == v.to_bits());
+                                assert!(same, "w {w} h {h} x {x} y {y} d_hi {d_hi} region {k}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn row_peaks_match_the_scalar_definition() {
         let mut s = 0x9e37_79b9_7f4a_7c15u64;
         let mut next = || {
@@ -858,7 +902,9 @@ mod tests {
             (s >> 40) as f32 / (1u64 << 24) as f32
         };
         let mut got = Vec::new();
-        for len in [1, 2, 3, 9, 10, 11, 17, 33, 97, 130] {
+        // Every length 1..=70 (the 8-wide interior tests: 10 = LANES + 2 and up) and a few
+        // longer ones.
+        for len in (1..=70).chain([97, 130]) {
             // Coarse values: plateaus and exact ties with s_min occur.
             let full: Vec<f32> = (0..len + 3).map(|_| (next() * 8.0).floor() / 8.0).collect();
             for (d_min, s_min) in [(0, 0.5), (1, 0.0), (2, 0.875), (0, 2.0)] {

@@ -404,6 +404,69 @@ fn both_sides_avx2_blocks_equal_the_portable_sums() {
     }
 }
 
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn both_sides_avx2_masks_equal_the_portable_ones_at_the_row_ends() {
+    // Rows of J + 1 ..= J + 40 samples, 1..=9 elements whose J + 1 samples start at 0 (the
+    // left end) and end at the row's last sample (the right end), every start in between:
+    // the AVX2 masks (8 and 32 lanes) against the portable sums' masks, thresholds at and one
+    // ulp above each lane's value.
+    if !crate::simd::has_avx2() {
+        return;
+    }
+    fn check<const J: usize>(r: &[f32], els: &[(usize, f32, f32)], j0: usize, what: &str) {
+        let n = els.len() as f32;
+        for mean_free in [false, true] {
+            let sums = sads_scalar::<J>(r, els, j0, n, mean_free);
+            for (t, &s) in sums.iter().enumerate() {
+                let v = s / n + 0.01;
+                for here in [v, v.next_up()] {
+                    let want = sums
+                        .iter()
+                        .enumerate()
+                        .fold(0u32, |m, (q, &a)| m | (u32::from(a / n + 0.01 < here) << q));
+                    let m =
+                        unsafe { sads_fit_mask_avx2::<J>(r, els, j0, n, mean_free, (here, 0.01)) };
+                    assert_eq!(m, want, "{what} lane {t} mean_free {mean_free}");
+                }
+            }
+        }
+    }
+    let mut rng = crate::matching::hopfield::network::SplitMix64::new(5);
+    let mut unit = || (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32;
+    // Element e reads r[o_e + j0 ..= o_e + j0 + J]: element 0 from `start` (the row's end at the
+    // largest start), element 1 from j0 (the row's start when j0 = 0), the others in between.
+    let mut els_at = |start: usize, j0: usize, n_els: usize| -> Vec<(usize, f32, f32)> {
+        (0..n_els)
+            .map(|e| {
+                let o = match e {
+                    0 => start - j0,
+                    1 => 0,
+                    _ => (e * 7) % (start - j0 + 1),
+                };
+                (o, unit(), unit())
+            })
+            .collect()
+    };
+    for len in 33..=72usize {
+        let r: Vec<f32> = (0..len)
+            .map(|i| ((i * 7919) % 257) as f32 / 256.0)
+            .collect();
+        for n_els in [1usize, 2, 9] {
+            for start in 0..=len - 33 {
+                let j0 = start.min(2);
+                let els = els_at(start, j0, n_els);
+                check::<32>(&r, &els, j0, &format!("J 32 len {len} start {start}"));
+            }
+            for start in 0..=len - 9 {
+                let j0 = start.min(3);
+                let els = els_at(start, j0, n_els);
+                check::<8>(&r, &els, j0, &format!("J 8 len {len} start {start}"));
+            }
+        }
+    }
+}
+
 /// Every lane's mean absolute deviation of one half-window, as [`half_better`] defines it
 /// (the portable sums, no bound): `(k, value)` for the `k` in `ks` whose samples lie inside
 /// the row and `|k| > 1`.
