@@ -333,7 +333,10 @@ unsafe fn count_avx2(
     );
     let (vh, vt) = (_mm256_set1_epi32(half), _mm256_set1_epi32(tol));
     let (mut near, mut agree) = (0u32, 0u32);
+    debug_assert!(g.ys.len() == g.xs.len() && vals.len() == g.xs.len());
     for (s, e) in g.ranges(x, y) {
+        // SAFETY: the 8-lane loads at k < e read up to k + 7 < e + LANES <= xs.len() (the
+        // grid pads xs and ys by LANES; `vals` is as long, asserted by the caller).
         debug_assert!(e + LANES <= g.xs.len());
         for k in (s..e).step_by(LANES) {
             let valid = (1u32 << (e - k).min(LANES)) - 1;
@@ -598,6 +601,17 @@ unsafe fn lane_weights_avx2(
     e: usize,
 ) -> (std::arch::x86_64::__m256, std::arch::x86_64::__m256i) {
     use std::arch::x86_64::*;
+    // SAFETY: the loads read j0..j0 + 8 of arrays padded by LANES past every range end
+    // (`Network::new`); the gather index is (r << shift) + q with r in 0..=half (coordinates
+    // are non-negative, so the distances are) and q in 0..stride (unsigned minimum), below
+    // (half + 1) * stride = lut.len() as stride = 1 << shift; the i32 index cannot wrap while
+    // the table has fewer than 2^31 entries.
+    debug_assert!(j0 + LANES <= c.x.len());
+    debug_assert!(
+        k.stride == 1 << k.shift
+            && lut.len() >= (k.half as usize + 1) * k.stride
+            && lut.len() <= i32::MAX as usize
+    );
     let ld = |v: &[i32]| _mm256_loadu_si256(v.as_ptr().add(j0) as *const __m256i);
     let ldu = |v: &[u32]| _mm256_loadu_si256(v.as_ptr().add(j0) as *const __m256i);
     let stride = k.stride as i32;
@@ -707,6 +721,17 @@ unsafe fn window_input_avx2<const POS: bool>(
     use std::arch::x86_64::*;
     let (mut lo, mut hi) = (_mm256_setzero_pd(), _mm256_setzero_pd());
     let mut n = 0usize;
+    // SAFETY: `on` is padded like `cells` (its 8-lane loads at j0 < e stay inside); the push
+    // buffer `buf[j0 - base..j0 - base + 8]` is in bounds when it reaches LANES past every
+    // non-empty range's end (minus base) and no range starts below base (checked here in
+    // debug builds).
+    debug_assert!(on.len() >= c.x.len());
+    debug_assert!(match &push {
+        Some((buf, base)) => ranges
+            .iter()
+            .all(|&(s, e)| s >= e || (s >= *base && e - base + LANES <= buf.len())),
+        None => true,
+    });
     let (bp, base) = match push {
         Some((buf, base)) => (buf.as_mut_ptr(), base),
         None => (std::ptr::null_mut(), 0),

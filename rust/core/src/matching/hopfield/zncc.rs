@@ -49,6 +49,16 @@ fn region_n(k: usize) -> usize {
     ((x1 - x0 + 1) * (y1 - y0 + 1)) as usize
 }
 
+// `blocks_avx2` starts each band's cells at rows 0, SIM_RADIUS and SIM_RADIUS + 1 and reads
+// them uninitialised otherwise: those must be the first rows of bands 0, 1 and 2.
+const _: () = assert!(
+    part_of(0) == 0
+        && part_of(SIM_RADIUS - 1) == 0
+        && part_of(SIM_RADIUS) == 1
+        && part_of(SIM_RADIUS + 1) == 2
+        && part_of(SIDE - 1) == 2
+);
+
 /// Band (rows) or group (columns) of a window offset `0..SIDE`: 0 = before the centre, 1 = the
 /// centre, 2 = after.
 #[inline(always)]
@@ -722,6 +732,9 @@ unsafe fn blocks_avx2(
     ];
     let rev = _mm256_setr_epi32(7, 6, 5, 4, 3, 2, 1, 0);
     // cells[b][3 * band + group]; every entry is written (first row of its band) before read.
+    // SAFETY: `acc.read()` below happens only for rows after their band's first one, which
+    // wrote the block's three cells of that band (`first`; checked against `part_of` at compile
+    // time above); the array of __m256 is 32-byte aligned, so the reads and writes are too.
     let mut cells = std::mem::MaybeUninit::<[[__m256; 9]; CHUNK]>::uninit();
     let cp = cells.as_mut_ptr().cast::<__m256>();
     let base = src.as_ptr();

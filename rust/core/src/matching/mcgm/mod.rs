@@ -1137,6 +1137,8 @@ unsafe fn sads_fit_mask_avx2<const J: usize>(
     debug_assert!(q <= MAXQ);
     let mut off = [_mm256_setzero_ps(); MAXQ];
     let mut acc = [_mm256_setzero_ps(); MAXQ];
+    // SAFETY: every `p` below starts a bounds-checked slice of J + 1 samples, and `diff` reads
+    // p[8 v..8 v + 9] for v < q = J / 8, so at most p[J]: inside the slice.
     let diff = |p: *const f32, lv: __m256, fr: __m256| {
         let a = _mm256_loadu_ps(p);
         let b = _mm256_loadu_ps(p.add(1));
