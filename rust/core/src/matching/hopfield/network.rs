@@ -665,11 +665,28 @@ fn window_input<const POS: bool>(
     on: &[f32],
     push: Option<(&mut [f64], usize)>,
 ) -> (f64, usize) {
+    // Checked on every call (a compare per row): `Network::support` hands in a caller's `on`,
+    // and the AVX2 body reads 8 lanes at each step unchecked.
+    assert!(
+        on.len() >= c.x.len(),
+        "`on` holds {} values, the padded cells {} (see Network::lane_state)",
+        on.len(),
+        c.x.len()
+    );
+    if let Some((buf, base)) = &push {
+        for &(s, e) in ranges.iter().filter(|r| r.0 < r.1) {
+            assert!(
+                s >= *base && e - base + LANES <= buf.len(),
+                "push buffer of {} values from {base} does not reach {e} + LANES",
+                buf.len()
+            );
+        }
+    }
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
-        // SAFETY: AVX2 is present; `cells` and `on` are padded by LANES and `lut` holds
-        // (half + 1) * stride values (built so in `Network::new`); `buf` reaches LANES past
-        // every range end (minus base).
+        // SAFETY: AVX2 is present; `cells` is padded by LANES past every range and `on` is as
+        // long (asserted above); `lut` holds (half + 1) * stride values (built so in
+        // `Network::new`); `buf` reaches LANES past every range end (minus base, asserted).
         return unsafe { window_input_avx2::<POS>(c, lut, k, ranges, on, push) };
     }
     window_input_portable::<POS>(c, lut, k, ranges, on, push)
@@ -773,9 +790,16 @@ fn window_add(
     sign: f64,
     u: &mut [f64],
 ) {
+    // `Weights::add_row` is safe and takes the caller's `u`: checked on every call.
+    assert!(
+        u.len() >= c.idx.len(),
+        "`u` holds {} values, the padded cells {} (see Weights::slots)",
+        u.len(),
+        c.idx.len()
+    );
     #[cfg(target_arch = "x86_64")]
     if has_avx2() {
-        // SAFETY: as in `window_input`.
+        // SAFETY: as in `window_input`; `u` is as long as the padded cells (asserted above).
         return unsafe { window_add_avx2(c, lut, k, ranges, sign, u) };
     }
     window_add_portable(c, lut, k, ranges, sign, u)
@@ -1664,5 +1688,32 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn short_buffers_are_refused_not_read_past() {
+        // `Network::support` and `Weights::add_row` are safe public functions: an `on` or `u`
+        // shorter than the padded cells was read and written past its end by the AVX2 row
+        // kernels (they only checked it in debug builds, or not at all). Now a panic naming
+        // the buffer, on every CPU.
+        let neurons = random_neurons(2);
+        let net = Network::new(&neurons, &EnergyWeights::default());
+        let state = vec![1u8; neurons.len()];
+        let on = net.lane_state(&state);
+        let a = (0..neurons.len())
+            .max_by_key(|&a| net.window_ranges(a).iter().map(|r| r.1).max())
+            .unwrap();
+        let full = net.support(a, &state, &on);
+        assert!(full > 0.0);
+        let short = std::panic::catch_unwind(|| net.support(a, &state, &on[..on.len() - LANES]));
+        let msg = short.unwrap_err();
+        let msg = msg.downcast_ref::<String>().unwrap();
+        assert!(msg.contains("`on` holds"), "{msg}");
+        let mut u = vec![0.0f64; net.slots() - LANES];
+        let short =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| net.add_row(a, 1.0, &mut u)));
+        let msg = short.unwrap_err();
+        let msg = msg.downcast_ref::<String>().unwrap();
+        assert!(msg.contains("`u` holds"), "{msg}");
     }
 }
