@@ -490,3 +490,26 @@ fn fused_search_equals_the_generic_one_on_every_size() {
         }
     }
 }
+
+#[test]
+fn fused_search_reads_only_the_channels_both_levels_have() {
+    // `search` is public: levels filtered with different channel counts were zipped by the
+    // generic kernel, while the fused one read the right level's channel list unchecked
+    // (`get_unchecked`) for every left channel. Both now use the channels both levels have.
+    let (w, h) = (37usize, 4usize);
+    let (left, right) = (texture(w, h, 0.0, 3), texture(w, h, 2.0, 3));
+    let chans: Vec<_> = DEFAULT_ORIENTATIONS[..3]
+        .iter()
+        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
+        .collect();
+    let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
+    let rd = level_data(&right.data, w, h, &chans[..1], 1.25, true).unwrap();
+    let base = vec![1.5f32; w * h];
+    let offs: Vec<f32> = (0..=6).map(|k| k as f32).collect();
+    let a = search::search_impl(&ld, &rd, &base, &offs, 0, true).unwrap();
+    let b = search::search_impl(&ld, &rd, &base, &offs, 0, false).unwrap();
+    assert!(a
+        .iter()
+        .zip(b.iter())
+        .all(|(p, q)| p.to_bits() == q.to_bits()));
+}
