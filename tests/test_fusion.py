@@ -448,6 +448,10 @@ def test_census_clear_drops_members_near_a_lower_census_region() -> None:
     # NaN pixels, which do not count. The background member (3, 10) has nothing lower.
     assert kept == {(15.0, 5.0), (25.0, 17.0), (25.0, 8.0), (3.0, 10.0)}
     assert np.count_nonzero(np.isfinite(out.dispx)) == len(out) == np.count_nonzero(out.count_map)
+    # Every raster forgets the dropped members: dispy and sources_map too.
+    np.testing.assert_array_equal(np.isfinite(out.dispy), np.isfinite(out.dispx))
+    np.testing.assert_array_equal(out.sources_map != 0, np.isfinite(out.dispx))
+    assert out.sources_map[5, 15] == 6 and out.sources_map[5, 9] == 0 and np.isnan(out.dispy[5, 9])
     assert out.matches.stats["members_before_census"] == len(pts)
     assert len(census_clear(fr, census, radius=0)) == len(pts)  # its own pixel only
     assert len(census_clear(fr, census, radius=7, jump=20.0)) == len(pts)
@@ -680,3 +684,86 @@ def test_match_fused_drops_count_and_sources_with_out_of_range_members(data_dir:
     assert len(m.stats["count"]) == len(m.stats["sources"]) == len(m) == np.count_nonzero(keep)
     np.testing.assert_array_equal(m.stats["count"], res.count[keep])
     np.testing.assert_array_equal(m.stats["sources"], res.sources[keep])
+
+
+def test_vote_bounds_are_inclusive() -> None:
+    """algorithms.md D.4: Gabor takes part where ``A_conf >= a_conf_min``; two values agree
+    where ``|ddx| <= tau_dx`` and ``|ddy| <= tau_dy`` (values exact in binary: no rounding)."""
+    hop = _m([(5, 5, 11.0)])
+    res = fuse(_dense(10.0, 0.25), {"hopfield": hop}, a_conf_min=0.25)
+    assert len(res) == 1 and res.sources[0] == 1 | 4
+    # Weighted mean (0.25 * 10 + 1 * 11) / 1.25.
+    assert res.dispx[5, 5] == pytest.approx(10.8)
+    assert len(fuse(_dense(10.0, 0.25), {"hopfield": hop}, a_conf_min=0.5)) == 0
+    res = fuse(None, {"mcgm": _m([(4, 4, 9.0)], dy=0.0), "hopfield": _m([(4, 4, 9.0)], dy=1.0)})
+    assert len(res) == 1 and res.dispy[4, 4] == pytest.approx(0.5)
+
+
+def test_tau_dy_alone_bounds_the_y_disparity() -> None:
+    """``tau_dy`` (not ``tau_dx``) decides on y: 1.5 px apart vertically, same x-disparity."""
+    sparse = {"mcgm": _m([(4, 4, 9.0)], dy=0.0), "hopfield": _m([(4, 4, 9.0)], dy=1.5)}
+    assert len(fuse(None, sparse, tau_dx=1.0, tau_dy=2.0)) == 1
+    assert len(fuse(None, sparse, tau_dx=3.0, tau_dy=1.0)) == 0
+
+
+def test_members_carry_the_weighted_mean_y_disparity() -> None:
+    """dispy is the agreeing subset's weighted mean with Gabor's vertical disparity taken as 0,
+    and ``yr = yl - dispy`` (the Matches convention)."""
+    mcgm = _m([(6, 8, 12.0)], dy=0.5)
+    hop = _m([(6, 8, 12.0)], dy=1.0)
+    res = fuse(_dense(12.0, 1.0), {"mcgm": mcgm, "hopfield": hop})
+    assert len(res) == 1 and res.count[0] == 3
+    # (1 * 0 + 1 * 0.5 + 1 * 1.0) / 3 = 0.5
+    assert res.dispy[8, 6] == pytest.approx(0.5)
+    assert res.matches.yr[0] == pytest.approx(8.0 - 0.5)
+    assert np.isnan(res.dispy[0, 0])
+
+
+def test_score_is_the_share_of_the_available_channels() -> None:
+    """``score`` = agreeing / available: where Gabor has no value, two sparse channels that
+    agree score 1; where all three are there and two agree, 2/3."""
+    d, c = _dense(20.0)
+    d[3, 3] = np.nan
+    mcgm = _m([(3, 3, 10.0), (9, 3, 10.0)])
+    hop = _m([(3, 3, 10.5), (9, 3, 10.5)])
+    res = fuse((d, c), {"mcgm": mcgm, "hopfield": hop})
+    np.testing.assert_array_equal(res.matches.xl, [3, 9])
+    np.testing.assert_allclose(res.matches.score, [1.0, 2 / 3])
+    np.testing.assert_array_equal(res.count, [2, 2])
+
+
+def test_a_channel_measured_at_the_candidate_gives_its_own_value() -> None:
+    """D.2's nearest value: a sparse channel measured at the candidate pixel itself takes part
+    with that value, not with a neighbour's within ``r_spatial`` (here one row above)."""
+    mcgm = _m([(10, 10, 7.0), (10, 9, 9.0)])
+    hop = _m([(10, 10, 7.2)])
+    res = fuse(None, {"mcgm": mcgm, "hopfield": hop})
+    # (10, 9): MCGM's 9.0 against Hopfield's 7.2 one pixel down: no member there.
+    np.testing.assert_array_equal(res.matches.xl, [10])
+    np.testing.assert_array_equal(res.matches.yl, [10])
+    assert res.dispx[10, 10] == pytest.approx(7.1)
+
+
+def test_fused_dense_veto_radius_is_inclusive() -> None:
+    """Step 2: a Gabor pixel exactly ``radius`` px from a member (5 px along a row: the
+    distance transform's straight steps are exact) that differs by more than ``tau`` is
+    dropped; one pixel farther it stays."""
+    d = np.full((H, W), 10.0, np.float32)
+    c = np.full((H, W), 0.5, np.float32)
+    members = np.full((H, W), np.nan, np.float32)
+    members[10, 10] = 20.0
+    out, conf = fused_dense(d, c, members, radius=5.0, tau=2.0, fill_radius=0.0)
+    assert np.isnan(out[10, 15]) and np.isnan(out[10, 5]) and conf[10, 15] == 0.0
+    assert out[10, 16] == 10.0 and out[10, 4] == 10.0 and conf[10, 16] == 0.5
+
+
+def test_enclosed_far_takes_the_surround_median() -> None:
+    """The filled region takes its surround's median: a strip of 30 in the ring (a nearer
+    post beside the window) does not pull it up as a mean would (to about 10)."""
+    d = np.full((60, 80), 6.0, np.float32)
+    g = np.full((60, 80), 0.6, np.float32)
+    d[20:30, 10:25], g[20:30, 10:25] = 0.2, 0.1  # dark, at the floor, enclosed
+    d[20:30, 25:27] = 30.0  # part of the 3 px surround, on its right
+    out, filled = fill_enclosed_far(d, g)
+    assert filled.sum() == 150
+    assert np.all(out[20:30, 10:25] == 6.0)
