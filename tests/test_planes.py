@@ -352,3 +352,45 @@ def test_segments_names_a_nan_step_or_offset(bad: dict[str, float]) -> None:
     image ("image: contains NaN or inf")."""
     with pytest.raises(ValueError, match=next(iter(bad))):
         segments(np.zeros((8, 8), np.uint8), blur=0, **bad)
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.float32])
+def test_segments_bins_value_plus_offset(dtype: type) -> None:
+    """A pixel's bin is ``(value + offset) // step``, on the uint8 fast path and the float path
+    alike: with step 16 and offset 4, 2-10 share bin 0 and 14-20 share bin 1 (offset 0 would
+    put 10 and 14 together, -4 would split 2 from 6)."""
+    row = np.array([2, 2, 6, 6, 10, 10, 14, 14, 20, 20], dtype)
+    img = np.tile(row, (4, 1))
+    got = segments(img, blur=0, step=16, offset=4)
+    want = np.tile(np.array([0] * 6 + [1] * 4, np.uint32), (4, 1))
+    np.testing.assert_array_equal(got, want)
+
+
+def test_segments_clips_float_values_to_0_255_before_the_blur() -> None:
+    """Values above 255 count as 255 and below 0 as 0 (the documented clip), not wrapped by
+    the uint8 cast (300 -> 44): one segment each side of nothing."""
+    img = np.full((6, 12), 255.0, np.float32)
+    img[:, 6:] = 300.0
+    np.testing.assert_array_equal(segments(img, blur=1.0), np.zeros((6, 12), np.uint32))
+    low = np.zeros((6, 12), np.float32)
+    low[:, 6:] = -10.0
+    np.testing.assert_array_equal(segments(low, blur=1.0), np.zeros((6, 12), np.uint32))
+
+
+def test_plane_fill_refuses_a_label_equal_to_the_pixel_count_and_a_negative_min_pixels() -> None:
+    d = np.ones((8, 8), np.float32)
+    with pytest.raises(ValueError, match=r"below H \* W = 64, .*got 64 \.\. 64"):
+        plane_fill(d, np.full((8, 8), 64, np.uint32))
+    with pytest.raises(ValueError, match="min_pixels: expected a non-negative count, got -1"):
+        plane_fill(d, np.zeros((8, 8), np.uint32), min_pixels=-1)
+
+
+@pytest.mark.parametrize("fill", ["fill_planes", "side_fill"])
+def test_a_map_without_holes_comes_back_as_a_new_array(fill: str) -> None:
+    """Nothing to fill: the result is a copy, so writing to it leaves the caller's map alone."""
+    d = np.full((8, 8), 3.0, np.float32)
+    img = np.zeros((8, 8), np.uint8)
+    out = fill_planes(d, img) if fill == "fill_planes" else side_fill(d, img)
+    np.testing.assert_array_equal(out, d)
+    out[0, 0] = 99.0
+    assert d[0, 0] == 3.0
