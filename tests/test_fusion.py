@@ -755,6 +755,35 @@ def test_fused_dense_veto_radius_is_inclusive() -> None:
     out, conf = fused_dense(d, c, members, radius=5.0, tau=2.0, fill_radius=0.0)
     assert np.isnan(out[10, 15]) and np.isnan(out[10, 5]) and conf[10, 15] == 0.0
     assert out[10, 16] == 10.0 and out[10, 4] == 10.0 and conf[10, 16] == 0.5
+    # "More than tau": a value exactly tau from the member stays.
+    d[10, 13] = 18.0
+    out, _ = fused_dense(d, c, members, radius=5.0, tau=2.0, fill_radius=0.0)
+    assert out[10, 13] == 18.0
+
+
+def test_fused_dense_keeps_anchor_fills_where_second_is_silent() -> None:
+    """Step 5 drops a lone Gabor value above the row fill, but not a hole an anchor filled
+    (step 3): here the fill at column 3 (the member's 12) stands 7 px above its row fill (5)."""
+    nan = np.float32(np.nan)
+    d = np.array([[5, 5, 5, nan, 5, 5, 5, 5]], np.float32)
+    members = np.array([[nan, nan, 12, nan, nan, nan, nan, nan]], np.float32)
+    second = np.array([[5, 5, nan, nan, 5, 5, 5, 5]], np.float32)
+    conf = np.full(d.shape, 0.8, np.float32)
+    out, c = fused_dense(d, conf, members, radius=0.0, fill_radius=1.0, second=second)
+    np.testing.assert_array_equal(out, np.array([[5, 5, 12, 12, 5, 5, 5, 5]], np.float32))
+    np.testing.assert_allclose(c, [[0.8, 0.8, 1.0, 0.25, 0.8, 0.8, 0.8, 0.8]])
+
+
+def test_enclosed_far_leaves_a_region_touching_any_border() -> None:
+    """A dark floor region that touches the right border is open (kept); the same region one
+    pixel from that border is enclosed (filled)."""
+    d = np.full((40, 50), 6.0, np.float32)
+    g = np.full((40, 50), 0.6, np.float32)
+    d[10:20, 40:50], g[10:20, 40:50] = 0.0, 0.1
+    assert not fill_enclosed_far(d, g)[1].any()
+    d[10:20, 49], g[10:20, 49] = 6.0, 0.6
+    out, filled = fill_enclosed_far(d, g)
+    assert filled.sum() == 90 and np.all(out[10:20, 40:49] == 6.0)
 
 
 def test_enclosed_far_takes_the_surround_median() -> None:
