@@ -394,3 +394,41 @@ def test_a_map_without_holes_comes_back_as_a_new_array(fill: str) -> None:
     np.testing.assert_array_equal(out, d)
     out[0, 0] = 99.0
     assert d[0, 0] == 3.0
+
+
+def test_the_residual_bound_is_the_callers() -> None:
+    """``max_residual`` reaches the kernels: a 0/9 checkerboard (median residual 4.5 px about
+    its plane 4.5) is no plane at the default 0.7 px, one at 5 px."""
+    yy, xx = np.mgrid[0:20, 0:20]
+    d = np.where((xx + yy) % 2 == 0, 0.0, 9.0).astype(np.float32)
+    d[5, 15] = np.nan
+    lab = np.zeros((20, 20), np.uint32)
+    assert np.isnan(plane_fill(d, lab)[5, 15])
+    assert plane_fill(d, lab, max_residual=5.0)[5, 15] == pytest.approx(4.5, abs=0.3)
+    img = np.full((20, 20), 128, np.uint8)
+    assert np.isnan(fill_planes(d, img)[5, 15])
+    assert fill_planes(d, img, max_residual=5.0)[5, 15] == pytest.approx(4.5, abs=0.3)
+
+
+def test_fill_planes_blur_is_the_callers() -> None:
+    """With ``blur=0`` a hole next to a sharp image edge belongs to its side's segment (20);
+    the default blur (2 px) would mix the edge column into a segment of its own."""
+    d = np.where(np.arange(20)[None, :] < 10, 5.0, 20.0) * np.ones((20, 1))
+    d = d.astype(np.float32)
+    d[10, 10] = np.nan
+    img = np.where(np.arange(20)[None, :] < 10, 0, 255).astype(np.uint8) * np.ones(
+        (20, 1), np.uint8
+    )
+    assert fill_planes(d, img, blur=0)[10, 10] == pytest.approx(20.0)
+
+
+def test_side_fill_tau_and_one_channel_image() -> None:
+    """``tau`` is the caller's: at 200 (more than grey 100 and 0 are apart in Lab) no pixel is
+    closer enough to the left colour and the run takes the right value; an (H, W, 1) image is
+    grey like an (H, W) one."""
+    nan = np.nan
+    d = np.array([[5, 5, nan, nan, nan, 2]], np.float32)
+    img = np.zeros((1, 6), np.uint8)
+    img[0, :4] = 100
+    np.testing.assert_array_equal(side_fill(d, img, blur=0, tau=200)[0], [5, 5, 2, 2, 2, 2])
+    np.testing.assert_array_equal(side_fill(d, img[:, :, None], blur=0), side_fill(d, img, blur=0))
