@@ -796,3 +796,21 @@ def test_enclosed_far_takes_the_surround_median() -> None:
     out, filled = fill_enclosed_far(d, g)
     assert filled.sum() == 150
     assert np.all(out[20:30, 10:25] == 6.0)
+
+
+def test_fuse_result_dtypes_follow_the_docs() -> None:
+    """dispx / dispy float32, count / sources and their rasters uint8 (FusionResult's docs)."""
+    res = fuse(_dense(10.0, 0.5), {"hopfield": _m([(5, 5, 10.4)])})
+    assert res.dispx.dtype == res.dispy.dtype == np.float32
+    assert res.count.dtype == res.sources.dtype == np.uint8
+    assert res.count_map.dtype == res.sources_map.dtype == np.uint8
+    assert res.matches.xl.dtype == res.matches.xr.dtype == np.float32
+
+
+def test_fused_dense_gives_holes_no_confidence() -> None:
+    """A Gabor hole that nothing fills keeps confidence 0, whatever the confidence map says."""
+    d = np.full((H, W), 10.0, np.float32)
+    d[4, 4] = np.nan
+    c = np.full((H, W), 0.5, np.float32)
+    out, conf = fused_dense(d, c, np.full((H, W), np.nan, np.float32))
+    assert np.isnan(out[4, 4]) and conf[4, 4] == 0.0 and conf[5, 5] == 0.5
