@@ -61,7 +61,7 @@ def test_bag_holds_the_results_values(kitti: tuple, tmp_path: Path) -> None:
     with BagWriter(tmp_path / "run") as bag:
         bag.write(res, 1_700_000_000_123_456_789)
         bag.write(lean, 1_700_000_000_223_456_789)
-    assert bag.messages == 14
+    assert (bag.messages, bag.frames) == (14, 2)
     topics = _read(tmp_path / "run")
     assert sorted(topics) == ["/stereo/camera_info", "/stereo/depth", "/stereo/disparity",
                               "/stereo/left/camera_info", "/stereo/left/image_rect_color",
@@ -276,11 +276,11 @@ def test_a_frame_cut_by_a_full_disk_is_not_in_the_bag(
         bag.write(res, 2)
     assert err.value.errno == errno.ENOSPC
     assert str(err.value) == f"bag {tmp_path / 'run'}: No space left on device"
-    assert bag.messages == 7  # the first frame's
+    assert (bag.messages, bag.frames) == (7, 1)  # the first frame's
     monkeypatch.setattr(storage, "write", real_write)  # room again
     bag.write(res, 3)
     bag.close()
-    assert bag.messages == 14
+    assert (bag.messages, bag.frames) == (14, 2)
     with AnyReader([tmp_path / "run"]) as reader:
         stamps: dict[str, list[int]] = {}
         for conn, stamp, _raw in reader.messages():
@@ -320,3 +320,34 @@ def test_a_database_that_fills_mid_frame_keeps_the_metadata_true(
         assert reader.message_count == 7
     assert len(got) == 7 and {s for _, s in got} == {1}
     assert meta == {t: 1 for t, _ in got}
+
+
+def test_the_frames_a_full_disk_rolled_back_are_counted_out(
+    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A full disk lets sqlite undo its whole open transaction: every frame since the last
+    commit. The writer counted messages only, so no one could say how many frames the bag
+    still held; :attr:`BagWriter.frames` is the whole frames in its database."""
+    import sqlite3
+
+    from stereovision import rosbag
+
+    res, _ = kitti
+    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 0.0)
+    bag = rosbag.BagWriter(tmp_path / "run")
+    bag.write(res, 1)  # committed
+    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 3600.0)
+    bag.write(res, 2)
+    bag.write(res, 3)  # both in the open transaction
+    assert (bag.frames, bag.messages) == (3, 21)
+    conn = bag._writer.storage.conn
+    conn.execute(f"PRAGMA max_page_count = {conn.execute('PRAGMA page_count').fetchone()[0]}")
+    with pytest.raises(OSError, match=r"^bag .*run: database or disk is full$"):
+        bag.write(res, 4)
+    # sqlite undid frames 2 and 3 with frame 4: the committed frame 1 is the bag's one frame
+    stamps = conn.execute("SELECT DISTINCT timestamp FROM messages").fetchall()
+    assert stamps == [(1,)]
+    assert (bag.frames, bag.messages) == (1, 7)
+    bag.close()
+    with sqlite3.connect(tmp_path / "run" / "run.db3") as db:
+        assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 7

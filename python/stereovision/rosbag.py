@@ -199,6 +199,8 @@ ros2_static_transform>`.
         self.points = bool(points)
         self.scan_frame_id = str(scan_frame_id)
         self.messages = 0
+        #: Whole frames the bag holds (as :attr:`messages`, read back after a rollback).
+        self.frames = 0
         self._writer = writer_cls(self.path, version=9)
         try:
             self._writer.open()
@@ -242,6 +244,7 @@ ros2_static_transform>`.
             for topic, msgtype, data, stamp in pending:
                 self._writer.write(self._conn(topic, msgtype), stamp, data)
                 self.messages += 1
+            self.frames += 1
             return
         if not conn.in_transaction:
             conn.execute("BEGIN")  # else the savepoint's release would commit at every frame
@@ -262,10 +265,12 @@ ros2_static_transform>`.
             self._resync(conn)
             raise
         self.messages += len(pending)
+        self.frames += 1
 
     def _resync(self, conn: sqlite3.Connection) -> None:
         """The writer's connections, message counts and time span as the database holds them
-        after a rollback (metadata.yaml is written from them)."""
+        after a rollback (metadata.yaml is written from them), and :attr:`frames`: the depth
+        images it holds (one a frame, and a frame is all or nothing)."""
         w = self._writer
         topics = {row[0] for row in conn.execute("SELECT id FROM topics")}
         w.connections = [c for c in w.connections if c.id in topics]
@@ -280,6 +285,8 @@ ros2_static_transform>`.
         w.min_timestamp = 2**63 - 1 if lo is None else lo
         w.max_timestamp = 0 if hi is None else hi
         self.messages = sum(counts.values())
+        depth = self._conns.get("depth")
+        self.frames = 0 if depth is None else counts.get(depth.id, 0)
 
     def _image(self, header: Any, img: np.ndarray, encoding: str) -> Any:
         arr = np.ascontiguousarray(img)
@@ -432,7 +439,8 @@ ros2_static_transform>`.
             When the bag's database cannot be written (a full disk), naming the bag. None of
             the frame's messages is then in the bag (a frame is all or nothing), nor the frames
             since the last commit when sqlite rolls its transaction back; the writer's counts
-            (and so metadata.yaml and :attr:`messages`) are those the database holds.
+            (and so metadata.yaml, :attr:`messages` and :attr:`frames`) are those the database
+            holds.
         """
         if result.depth is None or result.calibration is None:
             raise ValueError("a bag holds depth: compute the result with a calibration")
