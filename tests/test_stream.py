@@ -1210,12 +1210,13 @@ def test_a_bag_that_cannot_be_written_mid_stream_keeps_the_summary(
 
     class _FullDisk:
         def __init__(self, path: Any) -> None:
-            self.path, self.messages = Path(path), 0
+            self.path, self.messages, self.frames = Path(path), 0, 0
 
         def write(self, res: Any, stamp_ns: int, **kw: Any) -> None:
             if self.messages == 14:  # two pairs of 7 messages
                 raise OSError(f"bag {self.path}: database or disk is full")
             self.messages += 7
+            self.frames += 1
 
         def close(self) -> None:
             pass
@@ -1230,7 +1231,7 @@ def test_a_bag_that_cannot_be_written_mid_stream_keeps_the_summary(
     assert summary["error"] == "bag b: database or disk is full"
     err = cap.err.strip().splitlines()
     assert err[-1] == "stereovision: error: bag b: database or disk is full"
-    assert "ROS 2 bag written to b (14 messages)" in cap.err
+    assert "ROS 2 bag written to b (2 of the 2 pairs processed, 14 messages)" in cap.err
 
 
 def test_the_text_summary_of_no_pair_says_so_not_nan(
@@ -1275,3 +1276,51 @@ def test_a_bag_of_no_frame_is_not_said_written(
     assert main(argv) == 130
     assert capsys.readouterr().err == f"no ROS 2 bag written to {tmp_path / 'b'}: no frame in it\n"
     assert not (tmp_path / "b").exists()
+
+
+@pytest.mark.parametrize("committed", [0, 1])
+def test_the_frames_a_full_disk_undid_are_said(
+    videos: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    committed: int,
+) -> None:
+    """--bag on a disk that filled at the fourth pair: SQLite undid every frame since the bag's
+    last commit, and the stream said "3 pairs ... (output failed)" and "no ROS 2 bag written:
+    no frame in it" (or a bag of fewer frames) without saying the pairs processed were lost.
+    The bag line says how many of them the bag holds, and that the disk undid the rest."""
+    import stereovision.rosbag as rosbag
+
+    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 3600.0)  # no commit but those made here
+    real = rosbag.BagWriter
+
+    class _FillingBag(real):  # type: ignore[misc,valid-type]
+        def write(self, res: Any, stamp_ns: int, **kw: Any) -> None:
+            if self.frames == committed:
+                self._commit()
+            if self.frames == 3:  # a real full database: sqlite rolls its transaction back
+                conn = self._writer.storage.conn
+                pages = conn.execute("PRAGMA page_count").fetchone()[0]
+                conn.execute(f"PRAGMA max_page_count = {pages}")
+            super().write(res, stamp_ns, **kw)
+
+    monkeypatch.setattr(rosbag, "BagWriter", _FillingBag)
+    bag = tmp_path / "b"
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--calib", str(videos["calib"]), "--no-display", "--no-check", "--no-pipeline"]
+    assert main([*argv, "--max-disparity", "16", "--bag", str(bag)]) == 2
+    cap = capsys.readouterr()
+    assert "3 pairs in " in cap.out and "(output failed)" in cap.out
+    err = cap.err.strip().splitlines()
+    lost = "the disk filled and SQLite undid the frames since the bag's last commit"
+    if committed:
+        assert err[-2] == (
+            f"ROS 2 bag written to {bag} (1 of the 3 pairs processed, 7 messages); {lost} "
+            "(2 frames lost)"
+        )
+    else:
+        none = f"no ROS 2 bag written to {bag}: none of the 3 pairs processed"
+        assert err[-2] == f"{none}; {lost} (3 frames lost)"
+        assert not bag.exists()
+    assert err[-1] == f"stereovision: error: bag {bag}: database or disk is full"

@@ -1242,10 +1242,8 @@ def cmd_stream(args: argparse.Namespace) -> int:
             "(--realtime)",
             file=log,
         )
-    if bag is not None and bag.messages:
-        print(f"ROS 2 bag written to {bag.path} ({bag.messages} messages)", file=log)
-    elif bag is not None:  # it said "written to DIR (0 messages)" of the folder removed above
-        print(f"no ROS 2 bag written to {bag.path}: no frame in it", file=log)
+    if bag is not None:
+        print(_bag_line(bag, report.frames), file=log)
     if args.json:
         # strict JSON: a figure with nothing to measure (no pair done: NaN) is null
         print(json_line(summary), file=out, flush=True)
@@ -1296,6 +1294,28 @@ def cmd_stream(args: argparse.Namespace) -> int:
         return EXIT_ERROR
     # the summary and the bag are out; the exit status still tells a script it was cut short
     return {"interrupted": 130, "terminated": 143}.get(report.ended, 0)
+
+
+def _bag_line(bag: Any, pairs: int) -> str:
+    """The stream's last word on its ``--bag``: how many of the ``pairs`` processed it holds.
+
+    A full disk lets SQLite undo every frame since the bag's last commit (each
+    :data:`~stereovision.rosbag.COMMIT_PERIOD_S`): the bag then holds fewer frames than pairs,
+    which is said with the number lost (it said "2 pairs ... (output failed)" beside a bag of
+    none, or of fewer, as if the pairs done were in it).
+    """
+    frames = int(bag.frames)
+    lost = (
+        f"the disk filled and SQLite undid the frames since the bag's last commit "
+        f"({pairs - frames} frames lost)"
+    )
+    if not bag.messages:  # the folder was removed (it said "written to DIR (0 messages)")
+        if not pairs:
+            return f"no ROS 2 bag written to {bag.path}: no frame in it"
+        return f"no ROS 2 bag written to {bag.path}: none of the {pairs} pairs processed; " + lost
+    held = f"{frames} of the {pairs} pairs processed" if frames <= pairs else f"{frames} frames"
+    line = f"ROS 2 bag written to {bag.path} ({held}, {bag.messages} messages)"
+    return line + "; " + lost if frames < pairs else line
 
 
 def add_cli(subparsers: Any) -> None:
