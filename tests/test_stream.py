@@ -1324,3 +1324,37 @@ def test_the_frames_a_full_disk_undid_are_said(
         assert err[-2] == f"{none}; {lost} (3 frames lost)"
         assert not bag.exists()
     assert err[-1] == f"stereovision: error: bag {bag}: database or disk is full"
+
+
+@pytest.mark.parametrize("pipelined", [False, True])
+def test_the_temporal_figures_are_those_of_the_pairs_counted(
+    videos: dict[str, Path], pipelined: bool
+) -> None:
+    """An output that failed at the third pair (a full disk): the summary counted 2 pairs, but
+    its temporal restarts and noise came from the filter, which had also taken the third (and,
+    pipelined, those grabbed ahead): 2 restarts or more of 2 pairs on the videos' moving view,
+    where each pair after the first restarts. They are those of the pairs counted now."""
+    from stereovision.temporal import TemporalFilter
+
+    calls = [0]
+
+    def full_at_3(left: np.ndarray, res: Any, stamp_ns: int) -> None:
+        calls[0] += 1
+        if calls[0] == 3:
+            raise OSError("bag b: database or disk is full")
+
+    tf = TemporalFilter()
+    with StereoCamera(str(videos["left"]), str(videos["right"])) as cam:
+        rep = run_stream(
+            cam,
+            max_disparity=16,
+            pipelined=pipelined,
+            check=False,
+            temporal=tf,
+            on_stamped_result=full_at_3,
+        )
+    assert (rep.frames, rep.ended) == (2, "output failed")
+    assert rep.temporal is not None
+    assert rep.temporal["restarts"] == 1  # the second pair's, of the pairs counted
+    assert rep.temporal["frames_averaged"] == 1.0
+    assert tf.frames >= 3 and tf.restarts >= 2  # the filter itself took the third pair too

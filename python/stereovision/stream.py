@@ -105,6 +105,9 @@ class _Pair:
     averaged: float = 1.0  # mean frames in a pixel's temporal mean (1: not averaged)
     stamp_ns: int = 0  # the grab's time, ns since the epoch (a recording: its own stamp)
     raw_left: np.ndarray | None = None  # the first pair's left frame as grabbed (its noise)
+    # the temporal filter's (frames, restarts, sigma) once it took this pair: the summary's
+    # figures are those of the last pair counted, not of pairs it took and never counted
+    filtered: tuple[int, int, float] | None = None
 
 
 @dataclass
@@ -165,7 +168,9 @@ class StreamReport:
         With a :class:`~stereovision.temporal.TemporalFilter`: ``frames_averaged`` (mean over
         the pairs of the frames in a pixel's mean), ``restarts`` (pairs on which the rig or
         scene moved) and ``noise_sigma`` (its last noise estimate, grey levels; NaN when it
-        saw no frame).
+        saw no frame), as of the last pair counted in :attr:`frames`. The filter itself also
+        took the pairs that were not: the one whose output failed, and those grabbed ahead
+        when pipelined (its own ``frames`` and ``restarts`` can be higher).
     error : str or None
         With ``ended`` ``"source failed"`` or ``"output failed"``: the error (None otherwise).
     """
@@ -465,11 +470,13 @@ def _pairs(
         # blurs into its neighbours (a half-pixel shift read 1.1 instead of 5.7 grey levels),
         # and its motion test then took every pair of a still raw rig for a moving one.
         averaged = 1.0
+        filtered = None
         if temporal is not None:
             if n == 0:
                 warn_resampled_for_temporal(camera, stacklevel=2, frame=fr)
             left, right = temporal_average(temporal, fr)
             averaged = temporal.mean_frames()
+            filtered = (temporal.frames, temporal.restarts, float(temporal.sigma))
         t2 = time.perf_counter()
         if calib is not None and not calib.rectified:
             left, right = calib.rectify(left, right)
@@ -494,6 +501,7 @@ def _pairs(
             averaged=averaged,
             stamp_ns=stamp_ns,
             raw_left=_noise_frame(fr) if n == 0 else None,
+            filtered=filtered,
         )
         n += 1
 
@@ -789,6 +797,8 @@ def run_stream(
 
     tally = _Tally()
     noise = math.nan  # the first left frame's noise
+    # the temporal filter as of the last pair counted (before the first: as it came)
+    filtered = None if temporal is None else (temporal.frames, temporal.restarts, temporal.sigma)
     checks: list[dict[str, Any]] = []
     grounds: list[dict[str, Any]] = []
     first_plane: list[Any] = []  # the first floor found, for the mount check
@@ -862,6 +872,8 @@ def run_stream(
                 ended, error = "output failed", str(exc)
                 break
             tally.add(d)
+            if pair.filtered is not None:
+                filtered = pair.filtered
             window.append(d)
             if t_last - t_window >= report_period:
                 rep = _window_report(
@@ -908,12 +920,12 @@ def run_stream(
         noise_sigma=noise,
         error=error,
         temporal=None
-        if temporal is None
+        if filtered is None
         else {
             "frames_averaged": round(tally.mean("averaged"), 3),
-            "restarts": temporal.restarts,
+            "restarts": filtered[1],
             # its starting 0.0 before any frame: a noise never measured (NaN, JSON null)
-            "noise_sigma": round(temporal.sigma, 3) if temporal.frames else math.nan,
+            "noise_sigma": round(filtered[2], 3) if filtered[0] else math.nan,
         },
     )
 
