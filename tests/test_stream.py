@@ -1278,7 +1278,7 @@ def test_a_bag_of_no_frame_is_not_said_written(
     assert not (tmp_path / "b").exists()
 
 
-@pytest.mark.parametrize("committed", [0, 1])
+@pytest.mark.parametrize("committed", [0, 1, 2])
 def test_the_frames_a_full_disk_undid_are_said(
     videos: dict[str, Path],
     tmp_path: Path,
@@ -1314,10 +1314,11 @@ def test_the_frames_a_full_disk_undid_are_said(
     assert "3 pairs in " in cap.out and "(output failed)" in cap.out
     err = cap.err.strip().splitlines()
     lost = "the disk filled and SQLite undid the frames since the bag's last commit"
-    if committed:
+    if committed:  # one frame lost is said so ("(1 frames lost)" before)
+        n_lost = 3 - committed
         assert err[-2] == (
-            f"ROS 2 bag written to {bag} (1 of the 3 pairs processed, 7 messages); {lost} "
-            "(2 frames lost)"
+            f"ROS 2 bag written to {bag} ({committed} of the 3 pairs processed, "
+            f"{7 * committed} messages); {lost} ({n_lost} frame{'s' if n_lost > 1 else ''} lost)"
         )
     else:
         none = f"no ROS 2 bag written to {bag}: none of the 3 pairs processed"

@@ -1317,9 +1317,10 @@ def _bag_line(bag: Any, pairs: int) -> str:
     none, or of fewer, as if the pairs done were in it).
     """
     frames = int(bag.frames)
+    n_lost = pairs - frames
     lost = (
         f"the disk filled and SQLite undid the frames since the bag's last commit "
-        f"({pairs - frames} frames lost)"
+        f"({n_lost} frame{'' if n_lost == 1 else 's'} lost)"
     )
     if not bag.messages:  # the folder was removed (it said "written to DIR (0 messages)")
         if not pairs:
