@@ -1121,3 +1121,39 @@ def test_middlebury_calib_with_blank_lines_and_without_a_baseline(tmp_path: Path
     )
     with pytest.raises(ValueError, match=r"nobase\.txt lacks 'baseline'"):
         Calibration.from_middlebury(tmp_path / "nobase.txt")
+
+
+def test_scaled_to_a_different_aspect_scales_x_and_y_apart() -> None:
+    """A mutation audit found ``scaled_to`` checked at one scale for both axes only: ``c_y``
+    scaled by ``s_x`` (or the skew by ``s_y``) went unseen. 320x240 run at 640x360 (s_x = 2,
+    s_y = 1.5): points project where the resized image puts them, ``x' = (x + 0.5) s_x - 0.5``,
+    ``y' = (y + 0.5) s_y - 0.5`` (cv2.projectPoints both ways; it ignores the skew, which
+    scales as ``x``: ``s' = s_x s``)."""
+    skewed = np.array([[300.0, 4.0, 161.3], [0.0, 302.0, 118.7], [0.0, 0.0, 1.0]])
+    with pytest.warns(UserWarning, match="skew"):
+        c = raw_calib(K1=skewed)
+        wide = c.scaled_to((640, 360))
+    pts = np.array([[0.1, -0.05, 1.5], [-0.3, 0.2, 2.5], [0.2, 0.25, 4.0]])
+    scale = np.array([2.0, 1.5])
+    for cam, rvec, tvec in (("1", np.zeros(3), np.zeros(3)), ("2", cv2.Rodrigues(c.R)[0], c.T)):
+        k, d = getattr(c, "K" + cam), getattr(c, "D" + cam)
+        small = cv2.projectPoints(pts, rvec, tvec, k, d)[0].reshape(-1, 2)
+        large = cv2.projectPoints(pts, rvec, tvec, getattr(wide, "K" + cam), d)[0].reshape(-1, 2)
+        np.testing.assert_allclose(large, (small + 0.5) * scale - 0.5, atol=1e-9)
+    assert wide.K1[0, 1] == 2.0 * 4.0
+
+
+def test_saved_yaml_holds_opencvs_shapes_and_every_field(tmp_path: Path) -> None:
+    """The YAML is for OpenCV readers in any language: T a 3x1 column and D1/D2 rows, as
+    OpenCV's stereo_calib writes them (a mutation audit found T written as a row unseen: this
+    package's own reader takes either). Read back with cv2.FileStorage alone."""
+    c = raw_calib()
+    fs = cv2.FileStorage(str(c.save(tmp_path / "c.yaml")), cv2.FILE_STORAGE_READ)
+    try:
+        assert fs.getNode("T").mat().shape == (3, 1) and fs.getNode("R").mat().shape == (3, 3)
+        assert fs.getNode("D1").mat().shape == (1, 5) and fs.getNode("K2").mat().shape == (3, 3)
+        np.testing.assert_array_equal(fs.getNode("T").mat().ravel(), c.T)
+        assert (fs.getNode("image_width").real(), fs.getNode("image_height").real()) == SIZE
+        assert fs.getNode("unit").string() == "m" and fs.getNode("rectified").real() == 0
+    finally:
+        fs.release()

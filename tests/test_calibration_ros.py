@@ -390,3 +390,15 @@ def test_kalibr_camera_choice_errors(tmp_path: Path) -> None:
     path.write_text(_camchain([*cams, {**cams[0]}]))  # cam1 without its pose
     with pytest.raises(ValueError, match="lacks field 'T_cn_cnm1'"):
         Calibration.from_file(path)
+
+
+def test_a_four_coefficient_pinhole_rig_is_written_as_five_plumb_bob_ones() -> None:
+    """ROS's plumb_bob model has five coefficients (k1 k2 p1 p2 k3): a rig calibrated with four
+    is written with k3 = 0 (a mutation audit found the padding unchecked). Parsed back with
+    yaml.safe_load."""
+    c = raw_calib(D1=np.array([-0.12, 0.05, 0.001, -0.0005]), D2=np.array([-0.1, 0.03, 0.0, 0.0]))
+    for text, d in zip(c.to_ros(), (c.D1, c.D2), strict=True):
+        doc = yaml.safe_load(text)
+        assert doc["distortion_model"] == "plumb_bob"
+        assert doc["distortion_coefficients"]["cols"] == 5
+        assert doc["distortion_coefficients"]["data"] == [*d[:4].tolist(), 0.0]

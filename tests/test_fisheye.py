@@ -318,3 +318,25 @@ def test_a_vertical_fisheye_rig_is_refused_like_a_pinhole_one(
     assert main(["info", str(path)]) == 2
     assert capsys.readouterr().err == f"stereovision: error: {err.value}\n"
     assert TRUTH.rectified_calibration().image_size == SIZE  # a horizontal one still works
+
+
+@pytest.mark.parametrize("alpha", [0.0, 1.0])
+def test_fisheye_alpha_is_the_balance_and_the_roi_holds_valid_pixels(alpha: float) -> None:
+    """A mutation audit found a fisheye rig's ``alpha`` unchecked (``balance=0`` whatever the
+    alpha went unseen) and its ``valid_roi`` (drawn from the maps, OpenCV gives none) unchecked
+    against the maps (x and y maps swapped went unseen). Against cv2.fisheye.stereoRectify and
+    initUndistortRectifyMap on the same rig: the rectified focal length is ``P1``'s, and the
+    left ROI holds only pixels mapped from inside the image, spanning the valid centre row
+    and column."""
+    r1, _, p1, _, _ = cv2.fisheye.stereoRectify(
+        K1, D1, K2, D2, SIZE, ROT, T.reshape(3, 1),
+        flags=cv2.fisheye.CALIB_ZERO_DISPARITY, newImageSize=SIZE, balance=alpha, fov_scale=1.0,
+    )  # fmt: skip
+    np.testing.assert_allclose(TRUTH.rectified_calibration(alpha).K1, p1[:, :3], rtol=1e-9)
+    mx, my = cv2.fisheye.initUndistortRectifyMap(K1, D1, r1, p1, SIZE, cv2.CV_32FC1)
+    w, h = SIZE
+    valid = (mx >= 0) & (mx <= w - 1) & (my >= 0) & (my <= h - 1)
+    x, y, rw, rh = TRUTH.valid_roi(alpha)[0]
+    assert rw > 0 and rh > 0 and valid[y : y + rh, x : x + rw].all()
+    cy, cx = y + rh // 2, x + rw // 2
+    assert rw >= 0.9 * np.count_nonzero(valid[cy]) and rh >= 0.9 * np.count_nonzero(valid[:, cx])
