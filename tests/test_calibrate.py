@@ -1347,3 +1347,141 @@ def test_images_too_small_for_a_board_have_none(
     assert err.count("\n") == 1 and "internal error" not in err
     assert "found in both images of only 0 of 1 pairs" in err and "l1.png / r1.png" in err
     assert not (tmp_path / "c.yaml").exists()
+
+
+@pytest.mark.parametrize("turn", [0.0, math.pi])
+def test_find_corners_starts_at_the_corner_nearest_the_top_left(turn: float) -> None:
+    """find_corners promises the first corner nearest the image's top-left (x + y smallest of
+    the grid's two ends); a mutation audit found that unchecked (the projection test reorders
+    its truth to fit). A board turned 0 or 180 degrees in its plane: the first corner is the
+    end of the projected grid (cv2.projectPoints) with the smaller x + y, the last the other."""
+    rv = cv2.Rodrigues(
+        cv2.Rodrigues(np.array([0.3, -0.2, 0.0]))[0] @ cv2.Rodrigues(np.array([0, 0, turn]))[0]
+    )[0].ravel()
+    obj = board_object_points(SYN_PATTERN, SYN_SQUARE).astype(np.float64)
+    centre = obj.mean(axis=0)
+    tv = np.array([0.0, 0.0, 0.5]) - cv2.Rodrigues(rv)[0] @ centre
+    img = render_chessboard(
+        SYN_K1, SYN_D1, rv, tv, pattern=SYN_PATTERN, square_size=SYN_SQUARE, image_size=SYN_SIZE
+    )
+    corners = find_corners(img, SYN_PATTERN)
+    assert corners is not None
+    truth = cv2.projectPoints(obj, rv, tv, SYN_K1, SYN_D1)[0].reshape(-1, 2)
+    first, last = sorted((truth[0], truth[-1]), key=lambda p: float(p.sum()))
+    assert np.linalg.norm(corners[0] - first) < 0.5 and np.linalg.norm(corners[-1] - last) < 0.5
+
+
+def _inside_convex(points: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    """Pixels (centres) of an image of ``size`` inside the convex hull of ``points``."""
+    hull = cv2.convexHull(points.astype(np.float32)).reshape(-1, 2).astype(np.float64)
+    ys, xs = np.mgrid[0 : size[1], 0 : size[0]]
+    turn = 1.0 if cv2.contourArea(hull.astype(np.float32), True) > 0 else -1.0
+    inside = np.ones(xs.shape, bool)
+    for a, b in zip(hull, np.roll(hull, -1, axis=0), strict=True):
+        inside &= turn * ((b[0] - a[0]) * (ys - a[1]) - (b[1] - a[1]) * (xs - a[0])) >= 0
+    return inside
+
+
+def test_report_coverage_and_row_figures_match_an_independent_count(
+    chessboard: tuple[Calibration, CalibrationReport],
+) -> None:
+    """A mutation audit found the report's coverage and epipolar figures held to loose ranges
+    only: the right camera given the left one's coverage, a board quadrilateral drawn as a bow
+    tie, or |dy| without its absolute value went unseen. Coverage: the fraction of pixels inside
+    a used board's corners (a point-in-hull count at full resolution; the report counts 4x4
+    cells, hence 0.01). Rows: cv2.stereoRectify and cv2.undistortPoints on the used corners."""
+    cal, rep = chessboard
+    for k, side in enumerate(("left", "right")):
+        covered = np.zeros((cal.image_size[1], cal.image_size[0]), bool)
+        for name in rep.used_pairs:
+            covered |= _inside_convex(rep._corners[name][k], cal.image_size)
+        assert getattr(rep, f"coverage_{side}") == pytest.approx(covered.mean(), abs=0.01)
+    R1, R2, P1, P2, *_ = cv2.stereoRectify(
+        cal.K1, cal.D1, cal.K2, cal.D2, cal.image_size, cal.R, cal.T.reshape(3, 1),
+        flags=cv2.CALIB_ZERO_DISPARITY, alpha=0,
+    )  # fmt: skip
+    crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 40, 1e-12)
+    dys = []
+    for name in rep.used_pairs:
+        cl, cr = rep._corners[name]
+        ul = cv2.undistortPoints(cl.reshape(-1, 1, 2), cal.K1, cal.D1, R=R1, P=P1, criteria=crit)
+        ur = cv2.undistortPoints(cr.reshape(-1, 1, 2), cal.K2, cal.D2, R=R2, P=P2, criteria=crit)
+        dys.append(np.abs(ul - ur).reshape(-1, 2)[:, 1])
+    dy = np.concatenate(dys)
+    assert rep.epipolar_mean_dy == pytest.approx(dy.mean(), abs=1e-6)
+    assert rep.epipolar_max_dy == pytest.approx(dy.max(), abs=1e-6)
+
+
+def test_spread_rounds_half_up() -> None:
+    """``--max-pairs`` keeps the pairs at ``i (n - 1) / (k - 1)`` rounded half up (its
+    docstring); a mutation audit found only a case without rounding checked (13 pairs, 5 kept)
+    and rounding down went unseen. Against exact fractions, for every n < 30 and 2 <= k <= n."""
+    from fractions import Fraction
+
+    for n in range(2, 30):
+        for k in range(2, n + 1):
+            exact = [math.floor(Fraction(i * (n - 1), k - 1) + Fraction(1, 2)) for i in range(k)]
+            assert calmod._spread(n, k) == exact, (n, k)
+    assert calmod._spread(8, 3) == [0, 4, 7] and calmod._spread(4, 9) == [0, 1, 2, 3]
+
+
+def test_board_pose_params_of_a_known_parallelogram() -> None:
+    """(x, y, size, skew) in closed form, for a board that is a parallelogram of 3x2 corners
+    at 80 degrees in a 400x200 image (a mutation audit found them held to [0, 1] only: y over
+    the width, or the skew's factor 2 dropped, went unseen)."""
+    angle = math.radians(80.0)
+    u, v = np.array([40.0, 0.0]), 30.0 * np.array([math.cos(angle), math.sin(angle)])
+    origin = np.array([100.0, 50.0])
+    corners = np.array([origin + i * u + j * v for j in range(2) for i in range(3)])
+    x, y, size, skew = board_pose_params(corners, (3, 2), (400, 200))
+    centre = origin + u + v / 2
+    assert x == pytest.approx(centre[0] / 400) and y == pytest.approx(centre[1] / 200)
+    assert size == pytest.approx(math.sqrt(80.0 * 30.0 * math.sin(angle) / (400 * 200)))
+    assert skew == pytest.approx(2 * math.radians(10.0))
+
+
+def test_report_names_each_cameras_figures_and_the_model_selection(
+    chessboard: tuple[Calibration, CalibrationReport],
+) -> None:
+    """A mutation audit found the report's right focal length (given the left one's) and the
+    model selection (skipped with 13 views, the selection's minimum being 6) unchecked."""
+    cal, rep = chessboard
+    assert rep.focal_left == cal.K1[0, 0] and rep.focal_right == cal.K2[0, 0]
+    assert rep.baseline == pytest.approx(float(np.linalg.norm(cal.T)), rel=1e-12)
+    assert len(rep.used_pairs) >= calmod.MODEL_SELECTION_MIN_VIEWS
+    assert sorted(rep.model_selection) == sorted(calmod.AUTO_CANDIDATES)
+    assert all(0 < e < 1 for e in rep.model_selection.values())
+
+
+def test_without_refinement_the_intrinsics_are_each_cameras_own(cached_corners: None) -> None:
+    """refine=False keeps each camera's own calibration (cv2.calibrateCamera on its corners):
+    the stereo solve only finds R and T (a mutation audit found the stereo solve's
+    CALIB_FIX_INTRINSIC unchecked). The right camera's coverage counts its own boards: the
+    right images shrunk to 60 % (a camera of 0.6 x the focal length) cover about 0.36 of what
+    the left ones do, counted independently (pixels in each board's corners' hull)."""
+    left, right = _chessboard_paths()
+    shrunk = []
+    for p in right[:7]:
+        img = cv2.resize(cv2.imread(str(p), cv2.IMREAD_GRAYSCALE), None, fx=0.6, fy=0.6)
+        canvas = np.full((480, 640), 128, np.uint8)
+        canvas[: img.shape[0], : img.shape[1]] = img
+        shrunk.append(canvas)
+    cal, rep = calibrate(left[:7], shrunk, square_size=1.0, distortion="k1k2p1p2", refine=False)
+    assert not rep.refined
+    obj = board_object_points((9, 6), 1.0)
+    for k, K, D in ((0, cal.K1, cal.D1), (1, cal.K2, cal.D2)):
+        pts = [rep._corners[n][k].astype(np.float32) for n in rep.used_pairs]
+        flags = calmod.DISTORTION_MODELS["k1k2p1p2"]
+        out = cv2.calibrateCamera(
+            [obj] * len(pts), pts, cal.image_size, None, None, flags=flags,
+            criteria=calmod.SOLVER_CRITERIA,
+        )  # fmt: skip
+        np.testing.assert_allclose(K, out[1], rtol=1e-9)
+        np.testing.assert_allclose(D, out[2].ravel(), rtol=1e-9, atol=1e-12)
+        covered = np.zeros((480, 640), bool)
+        for name in rep.used_pairs:
+            covered |= _inside_convex(rep._corners[name][k], cal.image_size)
+        assert getattr(rep, ("coverage_left", "coverage_right")[k]) == pytest.approx(
+            covered.mean(), abs=0.01
+        )
+    assert rep.coverage_right < 0.5 * rep.coverage_left

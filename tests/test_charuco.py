@@ -614,3 +614,34 @@ def test_cli_board_written_again_keeps_no_copy_of_itself(tmp_path: Path) -> None
         assert run.returncode == 0, run.stderr
         assert run.stdout.splitlines()[0] == f"{out}: chessboard 9x6 inner corners, square 0.03 m"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["board.png"]
+
+
+def test_each_cameras_stereo_rms_pools_every_corner(rig: dict[str, Any]) -> None:
+    """Each camera's share of the stereo RMS is over all its corners, so a view of a cut board
+    (fewer corners) weighs less; a mutation audit found it checked on whole boards only, where
+    the mean of the views' RMS is the same. Independently: cv2.stereoCalibrateExtended, re-run
+    from the solution, gives each view's board pose; cv2.projectPoints the pooled residuals."""
+    from stereovision.calibrate import board_object_points
+
+    cal, rep = calibrate(rig["left"][:6], rig["right"][:6], board=BOARD)
+    names = rep.used_pairs
+    assert len({len(rep._ids[n]) for n in names}) > 1  # views with different corner counts
+    grid = board_object_points(BOARD.inner, BOARD.square_size)
+    obj = [grid[rep._ids[n]] for n in names]
+    left = [rep._corners[n][0].astype(np.float32) for n in names]
+    right = [rep._corners[n][1].astype(np.float32) for n in names]
+    out = cv2.stereoCalibrateExtended(
+        obj, left, right, cal.K1.copy(), cal.D1.copy(), cal.K2.copy(), cal.D2.copy(),
+        cal.image_size, cal.R.copy(), cal.T.reshape(3, 1).copy(),
+        flags=cv2.CALIB_FIX_INTRINSIC | cv2.CALIB_USE_EXTRINSIC_GUESS,
+    )  # fmt: skip
+    rvecs, tvecs = out[9], out[10]
+    for side, K, D, pts in (("left", cal.K1, cal.D1, left), ("right", cal.K2, cal.D2, right)):
+        sq: list[np.ndarray] = []
+        for o, p, rv, tv in zip(obj, pts, rvecs, tvecs, strict=True):
+            if side == "right":
+                rv, tv = cv2.composeRT(rv, tv, cv2.Rodrigues(cal.R)[0], cal.T.reshape(3, 1))[:2]
+            proj = cv2.projectPoints(o.astype(np.float64), rv, tv, K, D)[0].reshape(-1, 2)
+            sq.append(np.sum((proj - p) ** 2, axis=1))
+        pooled = math.sqrt(float(np.mean(np.concatenate(sq))))
+        assert getattr(rep, f"stereo_rms_{side}") == pytest.approx(pooled, rel=1e-4)
