@@ -877,3 +877,67 @@ def test_min_disparity_above_the_automatic_range_names_the_estimate() -> None:
     )
     res = sv.depth_map(left, right, min_disparity=20, max_disparity=24, method="census")
     assert res.disparity.shape == (32, 64)
+
+
+@pytest.mark.parametrize("method", sv.depth.METHODS)
+@pytest.mark.parametrize(
+    ("min_disparity", "max_disparity", "shown"),
+    [(48, 64, "48"), (100, 116, "100"), (3e10, 3e10 + 16, "30000000000")],
+)
+def test_a_min_disparity_not_below_the_width_is_refused(
+    method: str, min_disparity: float, max_disparity: float, shown: str
+) -> None:
+    """No pixel of a 48 px wide pair has a match 48 px or more to its left: such a range returned
+    an all-NaN map without a word, or for 3e10 (float32 rounds 3e10 + 16 to 3e10) the kernel's
+    "invalid parameter `d_max`: must be > d_min"; the error names min_disparity, the width and
+    what works."""
+    rng = np.random.default_rng(0)
+    left = rng.integers(0, 256, (24, 48), dtype=np.uint8)
+    with pytest.raises(ValueError) as err:
+        sv.depth_map(
+            left,
+            left.copy(),
+            method=method,
+            min_disparity=min_disparity,
+            max_disparity=max_disparity,
+        )
+    assert str(err.value) == (
+        f"min_disparity ({shown}) is not below the image width 48: no pixel has a match that far "
+        "to its left in the right image; give a min_disparity below 48"
+    )
+
+
+def test_a_max_disparity_not_above_minus_the_width_is_refused() -> None:
+    """The Gabor map searches negative disparities too: a range at minus the width or below
+    (-100 to -84 on a 48 px wide pair) returned an all-NaN map without a word."""
+    rng = np.random.default_rng(0)
+    left = rng.integers(0, 256, (24, 48), dtype=np.uint8)
+    with pytest.raises(ValueError) as err:
+        sv.depth_map(left, left.copy(), method="gabor", min_disparity=-100, max_disparity=-84)
+    assert str(err.value) == (
+        "max_disparity (-84) is not above minus the image width (-48): no pixel has a match that "
+        "far to its right in the right image; give a max_disparity above -48"
+    )
+
+
+def test_a_range_just_below_the_width_still_runs() -> None:
+    """min_disparity 47 on a 48 px wide pair is a range a pixel can match in: not refused (the
+    pair, l == r, has none there, so the map is NaN)."""
+    rng = np.random.default_rng(0)
+    left = rng.integers(0, 256, (24, 48), dtype=np.uint8)
+    res = sv.depth_map(left, left.copy(), method="gabor", min_disparity=47, max_disparity=63)
+    assert res.disparity.shape == (24, 48)
+    assert res.min_disparity == 47.0
+
+
+def test_range_errors_show_every_digit_of_a_whole_number() -> None:
+    """``:g`` printed -3e10 + 48 as "-3e+10" (and the range 3e10 + 10 as "3e+10"): the max_disparity
+    to give was not the number it names."""
+    rng = np.random.default_rng(0)
+    left = rng.integers(0, 256, (24, 48), dtype=np.uint8)
+    with pytest.raises(ValueError) as err:
+        sv.depth_map(left, left.copy(), method="gabor", min_disparity=-3e10, max_disparity=10)
+    assert str(err.value) == (
+        "disparity range 30000000010 is not smaller than the image width 48: it needs images at "
+        "least 30000000011 px wide, or give a max_disparity below -29999999952"
+    )

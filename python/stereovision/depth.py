@@ -184,6 +184,35 @@ def _finite(v: float) -> bool:
         return False
 
 
+def _px(value: float) -> str:
+    """A number of pixels for a message: every digit of a whole number up to 12 digits
+    (``:g`` showed 3e10 + 48 as "3e+10"), a fraction as given (16.5), beyond that 12 digits."""
+    return f"{value:.12g}"
+
+
+def _unreachable_range(min_disparity: float, max_disparity: float, width: int) -> ValueError | None:
+    """The error of a range no pixel of a ``width`` px wide pair can match in, or None.
+
+    A match ``xr = xl - d`` needs both columns in the image, so ``|d| < width``: a
+    ``min_disparity`` at the width or above (or a ``max_disparity`` at minus the width or
+    below) searched nothing and returned an all-NaN map, or a float32 kernel parameter error
+    ("invalid parameter `d_max`") for a range beyond float32's resolution (3e10 to 3e10 + 16).
+    """
+    if min_disparity >= width:
+        return ValueError(
+            f"min_disparity ({_px(min_disparity)}) is not below the image width {width}: no "
+            f"pixel has a match that far to its left in the right image; give a min_disparity "
+            f"below {width}"
+        )
+    if max_disparity <= -width:
+        return ValueError(
+            f"max_disparity ({_px(max_disparity)}) is not above minus the image width "
+            f"(-{width}): no pixel has a match that far to its right in the right image; give "
+            f"a max_disparity above -{width}"
+        )
+    return None
+
+
 def _too_narrow(width: int, automatic_range: float, min_disparity: float = 0) -> ValueError:
     """The error of a pair narrower than the disparity range chosen for it (never below
     ``_DISPARITY_STEP``: a pair at most 16 px wide is always refused). A pair 2 px wide or more
@@ -195,8 +224,8 @@ def _too_narrow(width: int, automatic_range: float, min_disparity: float = 0) ->
     what = (
         f"(at least {_DISPARITY_STEP} px)"
         if min_disparity == 0
-        else f"({min_disparity:g} to {automatic_range + min_disparity:g} px: "
-        f"{automatic_range:g} px, its max_disparity at least {_DISPARITY_STEP})"
+        else f"({_px(min_disparity)} to {_px(automatic_range + min_disparity)} px: "
+        f"{_px(automatic_range)} px, its max_disparity at least {_DISPARITY_STEP})"
     )
     text = (
         f"image too narrow for stereo matching: {width} px wide, and the automatic "
@@ -204,19 +233,21 @@ def _too_narrow(width: int, automatic_range: float, min_disparity: float = 0) ->
     )
     if width < 2:
         return ValueError(f"{text}; a max_disparity of your own needs images at least 2 px wide")
-    return ValueError(f"{text}; give a max_disparity below {width + min_disparity:g} to match it")
+    return ValueError(
+        f"{text}; give a max_disparity below {_px(width + min_disparity)} to match it"
+    )
 
 
 def _range_too_wide(span: float, width: int, min_disparity: float = 0) -> ValueError:
     """The error of a disparity range the caller gave that is not below the pair's width: the
     width it needs, and the ``max_disparity`` that fits this pair (none for a 1 px wide one)."""
     text = (
-        f"disparity range {span:g} is not smaller than the image width {width}: it needs images "
-        f"at least {math.floor(span) + 1} px wide"
+        f"disparity range {_px(span)} is not smaller than the image width {width}: it needs "
+        f"images at least {_px(math.floor(span) + 1)} px wide"
     )
     if width < 2:
         return ValueError(f"{text} (a range of a pixel or more needs 2 px)")
-    return ValueError(f"{text}, or give a max_disparity below {width + min_disparity:g}")
+    return ValueError(f"{text}, or give a max_disparity below {_px(width + min_disparity)}")
 
 
 def estimate_max_disparity(left: npt.ArrayLike, right: npt.ArrayLike) -> int:
@@ -1300,9 +1331,9 @@ def depth_map(
     if max_disparity <= min_disparity and automatic:
         # "max_disparity (16) must be larger than min_disparity (20)" named a value never given
         raise ValueError(
-            f"min_disparity ({min_disparity:g}) is not below the automatic max_disparity "
-            f"({max_disparity:g}, estimated from the pair): give a max_disparity above "
-            f"{min_disparity:g}"
+            f"min_disparity ({_px(min_disparity)}) is not below the automatic max_disparity "
+            f"({_px(max_disparity)}, estimated from the pair): give a max_disparity above "
+            f"{_px(min_disparity)}"
         )
     if max_disparity <= min_disparity:
         raise ValueError(
@@ -1312,6 +1343,9 @@ def depth_map(
         # a range the caller never gave: the image is the problem (the automatic range is at
         # least 16 px, so 16 px wide images and narrower are refused)
         raise _too_narrow(gl.shape[1], max_disparity - min_disparity, min_disparity)
+    unreachable = _unreachable_range(min_disparity, max_disparity, gl.shape[1])
+    if unreachable is not None:
+        raise unreachable
     if max_disparity - min_disparity >= gl.shape[1]:
         raise _range_too_wide(max_disparity - min_disparity, gl.shape[1], min_disparity)
     stage("prepare")
