@@ -340,3 +340,38 @@ def test_an_infinite_disparity_has_no_depth() -> None:
     z, s = _core.depth_rectified(d, np.full_like(d, 0.5), 50.0, 2.0, 0.74, -0.52, 0.2, 0.9)
     assert np.isnan(z[0, :2]).all() and np.isnan(s[0, :2]).all()
     assert z[0, 2] == 5.0
+
+
+@pytest.mark.parametrize("method", MATCH_METHODS)
+@pytest.mark.parametrize(
+    ("min_disparity", "max_disparity", "shown"),
+    [(48, 64, "48"), (100, 116, "100"), (3e10, 3e10 + 16, "30000000000")],
+)
+def test_match_refuses_a_min_disparity_not_below_the_width(
+    method: str, min_disparity: float, max_disparity: float, shown: str
+) -> None:
+    """No pixel of a 48 px wide pair has a match 48 px or more to its left: match() returned 0
+    matches without a word (or for 3e10, which float32 does not tell from 3e10 + 16, the kernel's
+    "invalid parameter `d_max`"); it says what depth_map says."""
+    left = np.random.default_rng(0).integers(0, 256, (24, 48), dtype=np.uint8)
+    with pytest.raises(ValueError) as err:
+        sv.match(
+            left,
+            left.copy(),
+            method=method,
+            min_disparity=min_disparity,
+            max_disparity=max_disparity,
+        )
+    assert str(err.value) == (
+        f"min_disparity ({shown}) is not below the image width 48: no pixel has a match that far "
+        "to its left in the right image; give a min_disparity below 48"
+    )
+    assert "d_max" not in str(err.value)
+
+
+@pytest.mark.parametrize("method", MATCH_METHODS)
+def test_match_of_a_flat_pair_in_a_reachable_range_is_still_empty(method: str) -> None:
+    """The refusal is of the range, not of the pair: a pair with no edges, in a range it can
+    match in (up to the width minus one), has zero matches, not an error."""
+    flat = np.full((24, 48), 0.5, np.float32)
+    assert len(sv.match(flat, flat, method=method, min_disparity=47, max_disparity=63)) == 0

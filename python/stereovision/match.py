@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -9,7 +10,12 @@ import numpy.typing as npt
 
 from stereovision._validate import as_bgr_uint8, check_pair
 from stereovision.calibration import Calibration
-from stereovision.depth import _rectify_grey, _rig_to_warp_by, estimate_max_disparity
+from stereovision.depth import (
+    _rectify_grey,
+    _rig_to_warp_by,
+    _unreachable_range,
+    estimate_max_disparity,
+)
 from stereovision.matches import Matches
 from stereovision.matching import hopfield as _hopfield
 from stereovision.matching import mcgm as _mcgm
@@ -85,7 +91,9 @@ def match(
     ValueError
         Bad images (shape, dtype, empty, NaN, mismatched sizes), a calibration or rectification
         for another image size, a ``calib`` of another type, an unknown method or parameter, a
-        ``max_disparity`` that is not a finite number >= 0 (or not above ``min_disparity``).
+        ``max_disparity`` that is not a finite number >= 0 (or not above ``min_disparity``), a
+        ``min_disparity`` not below the image width (no pixel has a match that far: a pair with
+        no edges in a range it can match in still returns zero matches, not an error).
     """
     if method not in METHODS:
         raise ValueError(f"unknown method {method!r}: expected one of {', '.join(METHODS)}")
@@ -102,6 +110,7 @@ def match(
             gl, gr = _rectify_grey(rig, gl, gr)
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
+    _refuse_unreachable(params.get("min_disparity", 0), max_disparity, gl.shape[1])
     if method == "mcgm":
         m = _mcgm.mcgm_match(gl, gr, max_disparity=max_disparity, **params)
     elif method == "fused":
@@ -120,6 +129,26 @@ def match(
         run = _hopfield.hopfield_match if method == "hopfield" else _hopfield.best_match
         m = run(gl, gr, max_disparity=max_disparity, **params)
     return _keep(m, _in_range(m, float(params.get("min_disparity", 0)), max_disparity))
+
+
+def _refuse_unreachable(min_disparity: object, max_disparity: object, width: int) -> None:
+    """Refuse a range no pixel can match in (:func:`stereovision.depth_map`'s rule): a
+    ``min_disparity`` at the width or above returned 0 matches without a word (or, beyond
+    float32's resolution, the kernel's "invalid parameter `d_max`"). Values that are not finite
+    numbers are left to the matchers' own checks, which name them."""
+    numbers = (int, float, np.integer, np.floating)
+    pair = (min_disparity, max_disparity)
+    if any(isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers) for v in pair):
+        return
+    try:
+        lo, hi = float(min_disparity), float(max_disparity)  # type: ignore[arg-type]
+    except OverflowError:  # an int beyond a float: the matchers name it
+        return
+    if not (math.isfinite(lo) and math.isfinite(hi)) or hi <= lo:
+        return
+    err = _unreachable_range(lo, hi, width)
+    if err is not None:
+        raise err
 
 
 def _gabor_matches(
