@@ -375,3 +375,43 @@ def test_match_of_a_flat_pair_in_a_reachable_range_is_still_empty(method: str) -
     match in (up to the width minus one), has zero matches, not an error."""
     flat = np.full((24, 48), 0.5, np.float32)
     assert len(sv.match(flat, flat, method=method, min_disparity=47, max_disparity=63)) == 0
+
+
+_PAIR = np.random.default_rng(1).random((24, 48), dtype=np.float32)
+_DISP = np.full((24, 48), 10.0, np.float32)
+_CONF = np.full((24, 48), 0.9, np.float32)
+
+
+@pytest.mark.parametrize(
+    "run",
+    [
+        lambda lo, hi: gabor.gabor_disparity(_PAIR, _PAIR, min_disparity=lo, max_disparity=hi),
+        lambda lo, hi: refine.refine_disparity(
+            _PAIR, _PAIR, _DISP, _CONF, min_disparity=lo, max_disparity=hi
+        ),
+        lambda lo, hi: fusion.fuse_pair(_PAIR, _PAIR, min_disparity=lo, max_disparity=hi),
+        lambda lo, hi: fusion.remeasure(
+            _PAIR, _PAIR, _DISP, _CONF, min_disparity=lo, max_disparity=hi
+        ),
+        lambda lo, hi: sv.depth_map(
+            _PAIR, _PAIR, method="gabor", min_disparity=lo, max_disparity=hi
+        ),
+        lambda lo, hi: sv.depth_map(
+            _PAIR, _PAIR, method="fused", min_disparity=lo, max_disparity=hi
+        ),
+        lambda lo, hi: sv.match(_PAIR, _PAIR, method="gabor", min_disparity=lo, max_disparity=hi),
+        lambda lo, hi: sv.match(_PAIR, _PAIR, method="fused", min_disparity=lo, max_disparity=hi),
+    ],
+)
+def test_a_range_float32_cannot_tell_apart_is_named_in_the_callers_words(
+    run: Callable[[float, float], object],
+) -> None:
+    """10 to 10.0000001 is one float32 number: the kernels said "invalid parameter `d_max`: must
+    be > d_min (10), got 10" (or "`range`: need finite d_min < d_max"), words the caller never
+    used; the error names max_disparity and min_disparity."""
+    with pytest.raises(ValueError) as err:
+        run(10, 10.0000001)
+    assert str(err.value) == (
+        "empty disparity range in float32, the matchers' precision: max_disparity (10.0000001) "
+        "and min_disparity (10) are the same float32 number (10); give a wider range"
+    )

@@ -564,6 +564,11 @@ def finite_number(value: object, name: str) -> float:
     return out
 
 
+def _whole(v: float) -> str:
+    """``v`` as Python writes it, a whole number without ".0" (10, not 10.0; 10.0000001)."""
+    return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)
+
+
 def disparity_range(min_disparity: object, max_disparity: object) -> tuple[float, float]:
     """Check a disparity search range ``[min_disparity, max_disparity]``: both finite numbers
     (:func:`finite_number`), the maximum the larger; the kernels' own messages named their
@@ -577,6 +582,10 @@ def disparity_range(min_disparity: object, max_disparity: object) -> tuple[float
     Traceback (most recent call last):
     ...
     ValueError: empty disparity range: max_disparity (32) must be larger than min_disparity (32)
+    >>> disparity_range(10, 10.0000001)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    ValueError: empty disparity range in float32, ... are the same float32 number (10); ...
     """
     lo = finite_number(min_disparity, "min_disparity")
     hi = finite_number(max_disparity, "max_disparity")
@@ -584,6 +593,15 @@ def disparity_range(min_disparity: object, max_disparity: object) -> tuple[float
         raise ValueError(
             "empty disparity range: "
             f"max_disparity ({max_disparity}) must be larger than min_disparity ({min_disparity})"
+        )
+    # the kernels take float32: 10 to 10.0000001 (or 1e8 to 1e8 + 1) is one float32 number, and
+    # their own "invalid parameter `d_max`: must be > d_min (10), got 10" named neither argument
+    top = float(np.finfo(np.float32).max)
+    if abs(lo) <= top and abs(hi) <= top and not np.float32(hi) > np.float32(lo):
+        raise ValueError(
+            "empty disparity range in float32, the matchers' precision: max_disparity "
+            f"({_whole(hi)}) and min_disparity ({_whole(lo)}) are the same float32 number "
+            f"({float(np.float32(lo)):.9g}); give a wider range"
         )
     return lo, hi
 
