@@ -941,3 +941,16 @@ def test_range_errors_show_every_digit_of_a_whole_number() -> None:
         "disparity range 30000000010 is not smaller than the image width 48: it needs images at "
         "least 30000000011 px wide, or give a max_disparity below -29999999952"
     )
+
+
+def test_a_min_disparity_not_below_the_width_with_the_automatic_range_says_so() -> None:
+    """With no max_disparity, min_disparity 100 on a 48 px wide pair was told "give a
+    max_disparity above 100", which only led to the refusal of a min_disparity no pixel reaches:
+    the error says that at once."""
+    left = np.random.default_rng(0).integers(0, 256, (24, 48), dtype=np.uint8)
+    with pytest.raises(ValueError) as err:
+        sv.depth_map(left, left.copy(), min_disparity=100)
+    assert str(err.value) == (
+        "min_disparity (100) is not below the image width 48: no pixel has a match that far to "
+        "its left in the right image; give a min_disparity below 48"
+    )

@@ -1329,7 +1329,12 @@ def depth_map(
     finite_number(min_disparity, "min_disparity")
     finite_number(max_disparity, "max_disparity")
     if max_disparity <= min_disparity and automatic:
-        # "max_disparity (16) must be larger than min_disparity (20)" named a value never given
+        # "max_disparity (16) must be larger than min_disparity (20)" named a value never given;
+        # "give a max_disparity above 100" to a min_disparity no pixel reaches sent the caller
+        # to the error below
+        unreachable = _unreachable_range(min_disparity, math.inf, gl.shape[1])
+        if unreachable is not None:
+            raise unreachable
         raise ValueError(
             f"min_disparity ({_px(min_disparity)}) is not below the automatic max_disparity "
             f"({_px(max_disparity)}, estimated from the pair): give a max_disparity above "
