@@ -415,3 +415,16 @@ def test_a_range_float32_cannot_tell_apart_is_named_in_the_callers_words(
         "empty disparity range in float32, the matchers' precision: max_disparity (10.0000001) "
         "and min_disparity (10) are the same float32 number (10); give a wider range"
     )
+
+
+@pytest.mark.parametrize("method", MATCH_METHODS)
+def test_match_with_the_automatic_range_refuses_a_min_disparity_not_below_the_width(
+    method: str,
+) -> None:
+    """With no max_disparity, min_disparity 100 on a 48 px wide pair was told the estimate (24)
+    "must be >= min_disparity (100)"; a larger max_disparity only led to the refusal of a
+    min_disparity no pixel reaches: the error says that at once."""
+    left = np.random.default_rng(0).integers(0, 256, (24, 48), dtype=np.uint8)
+    with pytest.raises(ValueError) as err:
+        sv.match(left, left.copy(), method=method, min_disparity=100)
+    assert str(err.value).startswith("min_disparity (100) is not below the image width 48")

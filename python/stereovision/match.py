@@ -108,9 +108,10 @@ def match(
             gl, gr = check_pair(lb, rb)
         else:
             gl, gr = _rectify_grey(rig, gl, gr)
+    automatic = max_disparity is None
     if max_disparity is None:
         max_disparity = estimate_max_disparity(gl, gr)
-    _refuse_unreachable(params.get("min_disparity", 0), max_disparity, gl.shape[1])
+    _refuse_unreachable(params.get("min_disparity", 0), max_disparity, gl.shape[1], automatic)
     if method == "mcgm":
         m = _mcgm.mcgm_match(gl, gr, max_disparity=max_disparity, **params)
     elif method == "fused":
@@ -131,11 +132,15 @@ def match(
     return _keep(m, _in_range(m, float(params.get("min_disparity", 0)), max_disparity))
 
 
-def _refuse_unreachable(min_disparity: object, max_disparity: object, width: int) -> None:
+def _refuse_unreachable(
+    min_disparity: object, max_disparity: object, width: int, automatic: bool
+) -> None:
     """Refuse a range no pixel can match in (:func:`stereovision.depth_map`'s rule): a
     ``min_disparity`` at the width or above returned 0 matches without a word (or, beyond
     float32's resolution, the kernel's "invalid parameter `d_max`"). Values that are not finite
-    numbers are left to the matchers' own checks, which name them."""
+    numbers, and a max_disparity the caller gave not above min_disparity, are left to the
+    matchers' own checks, which name them; an estimated one (``automatic``) below such a
+    min_disparity is not the problem, the min_disparity is."""
     numbers = (int, float, np.integer, np.floating)
     pair = (min_disparity, max_disparity)
     if any(isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers) for v in pair):
@@ -144,7 +149,7 @@ def _refuse_unreachable(min_disparity: object, max_disparity: object, width: int
         lo, hi = float(min_disparity), float(max_disparity)  # type: ignore[arg-type]
     except OverflowError:  # an int beyond a float: the matchers name it
         return
-    if not (math.isfinite(lo) and math.isfinite(hi)) or hi <= lo:
+    if not (math.isfinite(lo) and math.isfinite(hi)) or (hi <= lo and not automatic):
         return
     err = _unreachable_range(lo, hi, width)
     if err is not None:
