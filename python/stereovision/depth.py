@@ -1232,7 +1232,10 @@ def depth_map(
     Raises
     ------
     ValueError
-        Bad images (shape, dtype, empty, NaN, mismatched sizes), a bad range or unknown method.
+        Bad images (shape, dtype, empty, NaN, mismatched sizes), a bad range or unknown method;
+        a range no pixel can match in (``min_disparity`` not below the image width, or
+        ``max_disparity`` not above minus it) or one float32 cannot tell apart (10 to
+        10.0000001).
     MemoryError
         With ``method="fused"`` or ``"census"``, before the census semi-global map allocates
         more than the memory available (3 bytes per pixel and disparity level: about 14 GiB for
