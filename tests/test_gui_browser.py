@@ -333,7 +333,13 @@ def test_scaled_calibration_and_compute_view():
 @pytest.mark.parametrize(
     ("shape", "method", "said"),
     [
-        ((300, 2, 3), "opencv-sgbm", "disparity range 16 is not smaller than the image width 2"),
+        (
+            (300, 2, 3),
+            "opencv-sgbm",
+            # depth_map's words: the width needed and the range that fits (it said neither)
+            "disparity range 16 is not smaller than the image width 2: it needs images at least "
+            "17 px wide, or give a max_disparity below 2",
+        ),
         ((2, 300, 3), "opencv-bm", "opencv-bm cannot match this 300x2 pair: (-211:"),
     ],
 )

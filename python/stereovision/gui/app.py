@@ -653,8 +653,10 @@ def _opencv_result(method: str, left: np.ndarray, right: np.ndarray, calib: Any,
         calib = calib.rectified_calibration()
     fn = baselines.opencv_sgbm if method == "opencv-sgbm" else baselines.opencv_bm
     w, h = left.shape[1], left.shape[0]
-    if d_max >= w:  # as depth_map says it (OpenCV failed to allocate 18446744073709 GB)
-        raise ValueError(f"disparity range {d_max:g} is not smaller than the image width {w}")
+    if d_max >= w:  # depth_map's words (OpenCV failed to allocate 18446744073709 GB)
+        from stereovision.depth import _range_too_wide
+
+        raise _range_too_wide(d_max, w)
     try:
         disp = np.ascontiguousarray(fn(left, right, d_max), dtype=np.float32)
     except cv2.error as exc:
