@@ -351,3 +351,56 @@ def test_the_frames_a_full_disk_rolled_back_are_counted_out(
     bag.close()
     with sqlite3.connect(tmp_path / "run" / "run.db3") as db:
         assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 7
+
+
+def test_an_interrupt_while_a_cut_frame_is_undone_leaves_no_part_of_it(
+    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A second Ctrl-C cuts a frame (its messages are undone) and a third one, no longer held,
+    cut the undoing: the frame's savepoint stayed open, the bag's close committed the part of
+    the frame written (a depth image without its cloud) and metadata.yaml counted it. Now the
+    writer undoes an unfinished frame before it writes the next one or closes."""
+    import sqlite3
+
+    from rosbags.highlevel import AnyReader
+
+    from stereovision import rosbag
+
+    class Interrupted(sqlite3.Connection):
+        cut = True
+
+        def execute(self, sql: str, *args: object) -> sqlite3.Cursor:  # type: ignore[override]
+            if sql == "ROLLBACK TO frame" and self.cut:
+                self.cut = False
+                raise KeyboardInterrupt  # the third Ctrl-C
+            return super().execute(sql, *args)
+
+    res, _ = kitti
+    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 0.0)
+    bag = rosbag.BagWriter(tmp_path / "run")
+    bag.write(res, 1)  # committed
+    storage = bag._writer.storage
+    storage.conn.close()
+    storage.conn = sqlite3.connect(storage.path, factory=Interrupted)
+    storage.cursor = storage.conn.cursor()
+    real_write = storage.write
+    calls = [0]
+
+    def second_ctrl_c(*args: object) -> None:
+        calls[0] += 1
+        if calls[0] == 3:
+            raise KeyboardInterrupt
+        real_write(*args)
+
+    monkeypatch.setattr(storage, "write", second_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        bag.write(res, 2)
+    bag.close()  # as `with BagWriter(...)` does on the way out
+    assert (bag.messages, bag.frames) == (7, 1)
+    with AnyReader([tmp_path / "run"]) as reader:
+        stamps = sorted({stamp for _, stamp, _ in reader.messages()})
+        meta = {t: info.msgcount for t, info in reader.topics.items()}
+    assert stamps == [1]
+    assert meta == {t: 1 for t in meta} and len(meta) == 7
+    with sqlite3.connect(tmp_path / "run" / "run.db3") as db:
+        assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 7

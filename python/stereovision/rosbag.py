@@ -212,6 +212,9 @@ ros2_static_transform>`.
             raise err from None
         self._conns: dict[str, Any] = {}
         self._pending: list[tuple[str, str, Any, int]] = []  # the frame being made, serialised
+        # a frame's savepoint taken and the frame not yet released or undone and counted: an
+        # interrupt (a Ctrl-C no longer held) cut it, see :meth:`_settle`
+        self._unsettled = False
         self._committed = time.monotonic()
 
     # ------------------------------------------------------------------------------ helpers
@@ -248,6 +251,7 @@ ros2_static_transform>`.
             return
         if not conn.in_transaction:
             conn.execute("BEGIN")  # else the savepoint's release would commit at every frame
+        self._unsettled = True
         conn.execute("SAVEPOINT frame")
         try:
             for topic, msgtype, data, stamp in pending:
@@ -263,9 +267,30 @@ ros2_static_transform>`.
                 except sqlite3.Error:
                     pass
             self._resync(conn)
+            self._unsettled = False
             raise
         self.messages += len(pending)
         self.frames += 1
+        self._unsettled = False
+
+    def _settle(self) -> None:
+        """Undo a frame an interrupt left unfinished, before the next frame or the close.
+
+        A Ctrl-C that is no longer held (the third) can cut :meth:`_flush` anywhere, the undoing
+        of a cut frame too: its savepoint then stayed open and the close's commit kept the part
+        of the frame written. The savepoint is rolled back when it is still open (a frame
+        released already is whole and stays), and the counts are read back from the database.
+        """
+        conn = getattr(getattr(self._writer, "storage", None), "conn", None)
+        if not self._unsettled or not isinstance(conn, sqlite3.Connection):
+            return
+        try:
+            conn.execute("ROLLBACK TO frame")
+            conn.execute("RELEASE frame")
+        except sqlite3.Error:  # "no such savepoint": released (whole) or undone by sqlite
+            pass
+        self._resync(conn)
+        self._unsettled = False
 
     def _resync(self, conn: sqlite3.Connection) -> None:
         """The writer's connections, message counts and time span as the database holds them
@@ -449,6 +474,7 @@ ros2_static_transform>`.
             raise ValueError(f"bag {self.path} is closed")
         try:
             with HeldInterrupts():
+                self._settle()
                 self._pending = []
                 self._write_frame(result, stamp, scan, ground)  # serialised, not written
                 self._flush()
@@ -526,11 +552,15 @@ ros2_static_transform>`.
             When the bag cannot be finished (a full disk): the frames committed before are in
             its ``.db3`` and ``ros2 bag reindex`` rebuilds its metadata.
         """
-        writer, self._writer = self._writer, None
+        writer = self._writer
         if writer is None:
             return
         try:
             with HeldInterrupts():
+                try:
+                    self._settle()  # not to commit part of a frame
+                finally:
+                    self._writer = None
                 writer.close()
         except sqlite3.Error as exc:
             storage = getattr(writer, "storage", None)
