@@ -404,3 +404,48 @@ def test_an_interrupt_while_a_cut_frame_is_undone_leaves_no_part_of_it(
     assert meta == {t: 1 for t in meta} and len(meta) == 7
     with sqlite3.connect(tmp_path / "run" / "run.db3") as db:
         assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 7
+
+
+def test_an_interrupt_as_a_frame_is_released_keeps_the_frames(
+    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A second Ctrl-C landing just as a frame's savepoint was released (the frame whole) was
+    taken for a cut frame: undoing it found no savepoint and rolled the whole transaction back,
+    the frames since the last commit with it (here frames 2 and 3 of 3). Now a frame released
+    stays, and the counts are read back from the database."""
+    import sqlite3
+
+    from rosbags.highlevel import AnyReader
+
+    from stereovision import rosbag
+
+    class Interrupted(sqlite3.Connection):
+        releases = 0
+
+        def execute(self, sql: str, *args: object) -> sqlite3.Cursor:  # type: ignore[override]
+            cur = super().execute(sql, *args)
+            if sql == "RELEASE frame":
+                self.releases += 1
+                if self.releases == 2:
+                    raise KeyboardInterrupt  # the frame is whole, its count not yet taken
+            return cur
+
+    res, _ = kitti
+    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 0.0)
+    bag = rosbag.BagWriter(tmp_path / "run")
+    bag.write(res, 1)  # committed
+    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 3600.0)
+    storage = bag._writer.storage
+    storage.conn.close()
+    storage.conn = sqlite3.connect(storage.path, factory=Interrupted)
+    storage.cursor = storage.conn.cursor()
+    bag.write(res, 2)
+    with pytest.raises(KeyboardInterrupt):
+        bag.write(res, 3)
+    bag.close()
+    assert (bag.messages, bag.frames) == (21, 3)
+    with AnyReader([tmp_path / "run"]) as reader:
+        stamps = sorted({stamp for _, stamp, _ in reader.messages()})
+        meta = {t: info.msgcount for t, info in reader.topics.items()}
+    assert stamps == [1, 2, 3]
+    assert meta == {t: 3 for t in meta} and len(meta) == 7

@@ -256,7 +256,6 @@ ros2_static_transform>`.
         try:
             for topic, msgtype, data, stamp in pending:
                 self._writer.write(self._conn(topic, msgtype), stamp, data)
-            conn.execute("RELEASE frame")
         except BaseException:
             try:
                 conn.execute("ROLLBACK TO frame")
@@ -269,6 +268,10 @@ ros2_static_transform>`.
             self._resync(conn)
             self._unsettled = False
             raise
+        # Out of the try: an interrupt landing as the frame is released (whole) was taken for a
+        # cut frame, and the undoing, finding no savepoint, rolled back every frame since the
+        # last commit. Cut here, the frame stays unsettled: :meth:`_settle` keeps and counts it.
+        conn.execute("RELEASE frame")
         self.messages += len(pending)
         self.frames += 1
         self._unsettled = False
