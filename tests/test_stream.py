@@ -1359,3 +1359,114 @@ def test_the_temporal_figures_are_those_of_the_pairs_counted(
     assert rep.temporal["restarts"] == 1  # the second pair's, of the pairs counted
     assert rep.temporal["frames_averaged"] == 1.0
     assert tf.frames >= 3 and tf.restarts >= 2  # the filter itself took the third pair too
+
+
+def _unclosable_bag(fail_write_at: int | None = None) -> type:
+    """A BagWriter whose close raises as a disk still full at its last commit does (and whose
+    write fails at frame ``fail_write_at``)."""
+
+    class _Unclosable:
+        def __init__(self, path: Any) -> None:
+            self.path, self.messages, self.frames = Path(path), 0, 0
+
+        def write(self, res: Any, stamp_ns: int, **kw: Any) -> None:
+            if self.frames == fail_write_at:
+                raise OSError(f"bag {self.path}: database or disk is full")
+            self.messages += 7
+            self.frames += 1
+
+        def close(self) -> None:
+            raise OSError(
+                f"bag {self.path} could not be finished (database or disk is full): the frames "
+                f"committed before are in its .db3; `ros2 bag reindex {self.path}` rebuilds its "
+                "metadata.yaml"
+            )
+
+    return _Unclosable
+
+
+CLOSE_ERROR = (
+    "stereovision: error: bag b could not be finished (database or disk is full): the frames "
+    "committed before are in its .db3; `ros2 bag reindex b` rebuilds its metadata.yaml"
+)
+
+
+def test_a_bag_that_cannot_be_finished_keeps_the_summary(
+    videos: dict[str, Path], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--bag whose close failed (the disk still full at its last commit): the OSError raised
+    from the ``finally`` past the summary, the user left with the error alone (nothing on
+    stdout with --json). The run ends as an output failing mid-stream does: the summary of the
+    pairs processed (``ended`` "output failed", its error), the bag line, then the error line
+    naming the bag and ``ros2 bag reindex``, exit 2."""
+    import stereovision.rosbag as rosbag
+
+    monkeypatch.setattr(rosbag, "BagWriter", _unclosable_bag())
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--calib", str(videos["calib"]), "--no-display", "--no-check", "--max-disparity", "16"]
+    argv += ["--frames", "2", "--bag", "b"]
+    assert main([*argv, "--json"]) == 2
+    cap = capsys.readouterr()
+    summary = _json_lines(cap.out)[-1]
+    assert (summary["summary"], summary["frames"], summary["ended"]) == (True, 2, "output failed")
+    assert summary["error"] == CLOSE_ERROR.removeprefix("stereovision: error: ")
+    err = cap.err.strip().splitlines()
+    assert err[-2:] == [
+        "ROS 2 bag written to b (2 of the 2 pairs processed, 14 messages)",
+        CLOSE_ERROR,
+    ]
+    assert main(argv) == 2
+    cap = capsys.readouterr()
+    last = cap.out.splitlines()[-1]
+    assert last.startswith("2 pairs in ") and " s (output failed): " in last
+    assert cap.err.strip().splitlines()[-1] == CLOSE_ERROR
+
+
+def test_a_bag_that_cannot_be_finished_does_not_replace_an_earlier_error(
+    videos: dict[str, Path], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A bag whose close failed after an earlier failure: the close's OSError replaced it (a
+    write that failed, an interrupt's exit 130, an error raised out of the stream). Both are
+    said now, the first one's first, and the first one's exit status is kept."""
+    import stereovision.rosbag as rosbag
+    import stereovision.stream as stream
+
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--calib", str(videos["calib"]), "--no-display", "--no-check", "--max-disparity", "16"]
+    argv += ["--bag", "b"]
+    # a write failed at the third pair, then the close
+    monkeypatch.setattr(rosbag, "BagWriter", _unclosable_bag(fail_write_at=2))
+    assert main([*argv, "--json"]) == 2
+    cap = capsys.readouterr()
+    summary = _json_lines(cap.out)[-1]
+    assert (summary["frames"], summary["ended"]) == (2, "output failed")
+    assert summary["error"] == "bag b: database or disk is full"
+    err = cap.err.strip().splitlines()
+    assert err[-2:] == ["stereovision: error: bag b: database or disk is full", CLOSE_ERROR]
+    # Ctrl-C: the summary says it was interrupted, with the close's error; still exit 130
+    monkeypatch.setattr(rosbag, "BagWriter", _unclosable_bag())
+    monkeypatch.setattr(stream, "open_source", _interrupted_cameras)
+    assert main([*argv, "--json"]) == 130
+    cap = capsys.readouterr()
+    summary = json.loads(cap.out)
+    assert (summary["frames"], summary["ended"]) == (0, "interrupted")
+    assert summary["error"] == CLOSE_ERROR.removeprefix("stereovision: error: ")
+    assert cap.err.strip().splitlines()[-1] == CLOSE_ERROR
+
+    # an error or interrupt raised out of the stream: said after the close's, its status kept
+    def raising(exc: BaseException) -> Any:
+        def run(*a: Any, **kw: Any) -> Any:
+            raise exc
+
+        return run
+
+    monkeypatch.setattr(stream, "open_source", lambda args, fps=None: _interrupted_cameras(args))
+    for exc, status, last in (
+        (RuntimeError("matcher failed"), 2, "stereovision: error: matcher failed"),
+        (KeyboardInterrupt(), 130, "stereovision: interrupted"),
+    ):
+        monkeypatch.setattr(stream, "run_stream", raising(exc))
+        assert main(argv) == status
+        cap = capsys.readouterr()
+        assert cap.out == ""
+        assert cap.err.strip().splitlines() == [CLOSE_ERROR, last]

@@ -1124,7 +1124,10 @@ def cmd_stream(args: argparse.Namespace) -> int:
     int
         The exit status: 0; 130 or 143 when SIGINT or SIGTERM cut the stream short (the
         summary is still written); 2 (the CLI's error status) when a pair failed, after the
-        summary.
+        summary. A ``--bag`` that cannot be finished (a full disk) is said as its writes
+        failing are: the summary (its ``error``; ``ended`` ``"output failed"`` unless a signal
+        stopped it), then the error line, 2; after an earlier failure or a signal, both are
+        said and the first's status kept.
     """
     from stereovision.calibration import _sizeless
     from stereovision.cli import load_calibration
@@ -1179,6 +1182,8 @@ def cmd_stream(args: argparse.Namespace) -> int:
             if calib is not None:
                 print(f"calibration: the bag's {' and '.join(cam.info_topics.values())}", file=log)
     bag = None
+    report: StreamReport | None = None  # None after the try: an error or interrupt is raised
+    close_error: str | None = None  # the bag could not be finished (a full disk)
     try:
         if args.bag and calib is None and not stopped:
             raise ValueError("--bag: a bag holds depth; give --calib")
@@ -1237,7 +1242,15 @@ def cmd_stream(args: argparse.Namespace) -> int:
         if server is not None:
             server.close()
         if bag is not None:
-            bag.close()  # a bag cut short by Ctrl-C or an error is still a valid bag
+            try:
+                bag.close()  # a bag cut short by Ctrl-C or an error is still a valid bag
+            except OSError as exc:
+                # the disk still full at the last commit or metadata.yaml: it raised past the
+                # summary (the record of the run lost), or over the error already raised
+                close_error = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+                if report is None:  # an error or interrupt is on its way out: it is said
+                    # after this, and its exit status kept
+                    print(f"stereovision: error: {close_error}", file=log)
             if bag.messages == 0:
                 # a run stopped before its first frame (a calibration for other frames, a
                 # source that does not open) left an empty bag in the way: the next run with the
@@ -1245,6 +1258,14 @@ def cmd_stream(args: argparse.Namespace) -> int:
                 import shutil
 
                 shutil.rmtree(bag.path, ignore_errors=True)
+    if close_error is not None and report.error is None:
+        # said in the summary as an output that failed while streaming is; a stream that ended
+        # by itself ended with its output failing, an interrupted one keeps its end (and 130)
+        from dataclasses import replace
+
+        ended = report.ended if report.ended in ("interrupted", "terminated") else "output failed"
+        report = replace(report, ended=ended, error=close_error)
+        close_error = None
     summary = report.as_dict()
     skipped = getattr(cam, "skipped", 0)
     if skipped:
@@ -1298,14 +1319,18 @@ def cmd_stream(args: argparse.Namespace) -> int:
                 ),
                 file=out,
             )
+    from stereovision.cli import EXIT_ERROR
+
+    cut = {"interrupted": 130, "terminated": 143}.get(report.ended)
     if report.error is not None:
         # the summary and the bag are out; the failure is said last, as the CLI's errors are
         print(f"stereovision: error: {report.error.splitlines()[0]}", file=log)
-        from stereovision.cli import EXIT_ERROR
-
-        return EXIT_ERROR
-    # the summary and the bag are out; the exit status still tells a script it was cut short
-    return {"interrupted": 130, "terminated": 143}.get(report.ended, 0)
+    if close_error is not None:  # after a failure of its own: both said, the first's status
+        print(f"stereovision: error: {close_error}", file=log)
+    if cut is not None:
+        # the summary and the bag are out; the exit status still tells a script it was cut short
+        return cut
+    return EXIT_ERROR if report.error is not None else 0
 
 
 def _bag_line(bag: Any, pairs: int) -> str:
