@@ -225,6 +225,37 @@ def test_a_full_disk_is_named_and_committed_frames_stay(
         assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 7  # one frame
 
 
+def test_a_bag_that_cannot_be_finished_keeps_the_error_of_its_block(
+    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``with BagWriter(...)``: a block that failed, then a close that failed too (the disk
+    still full at the last commit): the close's OSError replaced the block's error. The
+    block's error is raised now, the close's message added to it as a note; a block that
+    ended well still gets the close's error."""
+    import sqlite3
+
+    from stereovision import rosbag
+
+    res, _ = kitti
+
+    def full(*_a: object) -> None:
+        raise sqlite3.OperationalError("database or disk is full")
+
+    with pytest.raises(ValueError, match=r"^the block's own error") as err:
+        with rosbag.BagWriter(tmp_path / "a") as bag:
+            bag.write(res, 1)
+            monkeypatch.setattr(bag._writer, "close", full)
+            raise ValueError("the block's own error")
+    assert str(err.value) == "the block's own error"
+    (note,) = err.value.__notes__
+    assert note.startswith(f"bag {tmp_path / 'a'} could not be finished (database or disk is full)")
+    assert f"`ros2 bag reindex {tmp_path / 'a'}`" in note
+    with pytest.raises(OSError, match=r"^bag .*b could not be finished \(database or disk"):
+        with rosbag.BagWriter(tmp_path / "b") as bag:
+            bag.write(res, 1)
+            monkeypatch.setattr(bag._writer, "close", full)
+
+
 def test_a_bag_where_it_cannot_go_is_said_as_such(tmp_path: Path) -> None:
     """--bag under a file said "bag folder's parent does not exist: FILE" (it does: it is a
     file), and under a folder that cannot be written (/proc, a read-only mount) rosbags' own

@@ -579,8 +579,23 @@ ros2_static_transform>`.
     def __enter__(self) -> BagWriter:
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    def __exit__(self, exc_type: object, exc: BaseException | None, tb: object) -> None:
+        """Close the bag; an error that ended the ``with`` block stays the one raised.
+
+        A bag that cannot be finished on the way out of a failing block (the disk still full)
+        replaced that block's error with its own; its message is added to the block's error
+        now (a note, in Python 3.11+; a :class:`RuntimeWarning` before), and raised alone when
+        the block ended well.
+        """
+        try:
+            self.close()
+        except OSError as close_exc:
+            if exc is None:
+                raise
+            if hasattr(exc, "add_note"):
+                exc.add_note(str(close_exc))
+            else:  # Python 3.10
+                warnings.warn(str(close_exc), RuntimeWarning, stacklevel=2)
 
 
 # ==================================================================================== reading
