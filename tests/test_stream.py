@@ -1470,3 +1470,42 @@ def test_a_bag_that_cannot_be_finished_does_not_replace_an_earlier_error(
         cap = capsys.readouterr()
         assert cap.out == ""
         assert cap.err.strip().splitlines() == [CLOSE_ERROR, last]
+
+
+def test_a_camera_that_fails_to_close_still_lets_the_bag_be_finished(
+    videos: dict[str, Path],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The stream closed the camera (and the live view's server) before the bag in one
+    ``finally``: a camera whose close raised left the bag unfinished, no metadata.yaml (a bag
+    ``ros2 bag play`` refuses until reindexed). The bag is finished whatever the camera does."""
+    pytest.importorskip("rosbags")
+    from rosbags.rosbag2 import Reader
+
+    import stereovision.stream as stream
+
+    real_open = stream.open_source
+
+    def _opens_a_camera_that_fails_to_close(*a: Any, **kw: Any) -> Any:
+        cam = real_open(*a, **kw)
+        closing = cam.close
+
+        def close() -> None:
+            closing()
+            raise RuntimeError("camera: the driver did not let go of /dev/video0")
+
+        cam.close = close
+        return cam
+
+    monkeypatch.setattr(stream, "open_source", _opens_a_camera_that_fails_to_close)
+    bag = tmp_path / "b"
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--calib", str(videos["calib"]), "--no-display", "--no-check", "--frames", "2"]
+    assert main([*argv, "--max-disparity", "16", "--bag", str(bag)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == "stereovision: error: camera: the driver did not let go of /dev/video0"
+    assert (bag / "metadata.yaml").is_file()
+    with Reader(bag) as reader:
+        assert {c.msgcount for c in reader.connections} == {2}

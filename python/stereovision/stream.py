@@ -1238,26 +1238,28 @@ def cmd_stream(args: argparse.Namespace) -> int:
             temporal=temporal,
         )
     finally:
-        cam.close()
-        if server is not None:
-            server.close()
-        if bag is not None:
-            try:
-                bag.close()  # a bag cut short by Ctrl-C or an error is still a valid bag
-            except OSError as exc:
-                # the disk still full at the last commit or metadata.yaml: it raised past the
-                # summary (the record of the run lost), or over the error already raised
-                close_error = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-                if report is None:  # an error or interrupt is on its way out: it is said
-                    # after this, and its exit status kept
-                    print(f"stereovision: error: {close_error}", file=log)
-            if bag.messages == 0:
-                # a run stopped before its first frame (a calibration for other frames, a
-                # source that does not open) left an empty bag in the way: the next run with the
-                # same --bag was refused ("bag folder already exists")
-                import shutil
+        try:
+            cam.close()
+            if server is not None:
+                server.close()
+        finally:  # a camera or server that fails to close still lets the bag be finished
+            if bag is not None:
+                try:
+                    bag.close()  # a bag cut short by Ctrl-C or an error is still a valid bag
+                except OSError as exc:
+                    # the disk still full at the last commit or metadata.yaml: it raised past the
+                    # summary (the record of the run lost), or over the error already raised
+                    close_error = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+                    if report is None:  # an error or interrupt is on its way out: it is said
+                        # after this, and its exit status kept
+                        print(f"stereovision: error: {close_error}", file=log)
+                if bag.messages == 0:
+                    # a run stopped before its first frame (a calibration for other frames, a
+                    # source that does not open) left an empty bag in the way: the next run with the
+                    # same --bag was refused ("bag folder already exists")
+                    import shutil
 
-                shutil.rmtree(bag.path, ignore_errors=True)
+                    shutil.rmtree(bag.path, ignore_errors=True)
     if close_error is not None and report.error is None:
         # said in the summary as an output that failed while streaming is; a stream that ended
         # by itself ended with its output failing, an interrupted one keeps its end (and 130)
