@@ -1385,3 +1385,98 @@ def test_temporal_average_of_shrunk_frames_runs_at_the_size_asked(
         assert tf.shapes == [fed] * 4, size
         assert all(left.shape == (size[1], size[0], 3) for left, _ in out)
         assert tf.restarts == 0 and tf.mean_frames() > capmod._TEMPORAL_FULL * 4
+
+
+# ------------------------------------------------------------- values the mutation audit found
+
+
+def test_an_image_sequence_has_no_media_time(tmp_path: Path) -> None:
+    """OpenCV's image reader has no media time (POS_MSEC -1): the frames say NaN, not a time of
+    0 ms that reads as the start of a video."""
+    lpat = _write_sequence(tmp_path / "f", "left", [_numbered(i) for i in range(3)])
+    rpat = _write_sequence(tmp_path / "f", "right", [_numbered(i, shade=160) for i in range(3)])
+    with StereoCamera(lpat, rpat) as cam:
+        frames = [cam.read() for _ in range(3)]
+    assert all(np.isnan(f.pos_left_ms) and np.isnan(f.pos_right_ms) for f in frames)
+
+
+def test_skew_median_beyond_the_window_averages_the_two_middle_skews() -> None:
+    """Past the window the median comes from the histogram: for an even count it is the mean
+    of the two middle skews (1..6 ms: 3.5 ms), within the bins' 0.5 %."""
+    import statistics
+
+    stats = capmod.SkewStats(window=4)
+    values = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
+    for v in values:
+        stats.append(v)
+    assert stats.n == 6 and len(stats) == 4
+    assert stats.median_ms() == pytest.approx(statistics.median(values), rel=0.005)  # 3.5
+
+
+def test_collector_default_distance_is_ros_good_sample_threshold() -> None:
+    """ROS camera_calibration keeps a view whose (x, y, size, skew) differ from every kept one
+    by more than 0.2 in sum: 0.15 away is refused, 0.25 away kept, with the default."""
+    img = _board(POSE_A, 0, False)
+    frame = capmod.StereoFrame(img, img, 0.0, 0.0, 0)
+    corners = detect_board_live(img, (9, 6))
+    assert corners is not None
+    p = board_pose_params(corners, (9, 6), BOARD_SIZE)
+    for shift, save in ((0.15, False), (0.25, True)):
+        col = ChessboardCollector((9, 6))
+        col.kept = [(p[0] + shift, p[1], p[2], p[3])]
+        d = col.consider(frame)
+        assert d.save is save, (shift, d.reason)
+        if not save:
+            assert d.reason == f"pose too close to a saved one ({shift:.3f})"
+
+
+def test_live_board_corners_are_in_full_resolution_pixels() -> None:
+    """A frame wider than DETECT_MAX_WIDTH is detected scaled down; the corners come back in
+    the frame's own pixels (against OpenCV's detector on the full frame)."""
+    big = cv2.resize(_board(POSE_A, 0, False), (1280, 960), interpolation=cv2.INTER_LINEAR)
+    got = detect_board_live(big, (9, 6))
+    gray = cv2.cvtColor(big, cv2.COLOR_BGR2GRAY)
+    ok, ref = cv2.findChessboardCorners(gray, (9, 6))
+    assert got is not None and ok
+    ref = ref.reshape(-1, 2).astype(np.float64)
+    if ref[0].sum() > ref[-1].sum():
+        ref = ref[::-1]
+    assert got.shape == (54, 2)
+    assert np.abs(got - ref).max() < 2.0
+
+
+def test_a_shape_five_percent_off_is_not_stretched(tmp_path: Path) -> None:
+    """Asked 160x128 (5:4) of a 160x120 (4:3) source: 6.7 % another shape, beyond the 1 %
+    tolerance, so the frames stay 160x120 (a resize would stretch them by 6.7 %)."""
+    left, right = _videos(tmp_path, 2, 2, size=(160, 120))
+    with pytest.warns(UserWarning, match=r"delivers 160x120, not 160x128: another shape"):
+        with StereoCamera(left, right, image_size=(160, 128)) as cam:
+            frame = cam.read()
+    assert frame.left.shape == frame.right.shape == (120, 160, 3)
+
+
+def test_a_frame_count_estimated_one_too_many_is_no_truncation(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A container without an index estimates its frame count (off by one or so): 20 frames
+    read of 21 announced is the end of the stream; of 23 announced, a file that ended early."""
+    left, right = _videos(tmp_path, 20, 20)
+    for announced, early in ((21, False), (23, True)):
+        monkeypatch.setattr(StereoCamera, "_announced", lambda self, side, n=announced: n)
+        with StereoCamera(left, right) as cam:
+            result = capture(cam, tmp_path / f"p{announced}", every=100)
+        assert result.frames_read == 20
+        if early:
+            assert "ended after 20 of the 23 frames its header announces" in result.ended
+        else:
+            assert result.ended == "end of stream"
+
+
+def test_cli_count_is_checked_before_the_cameras_open(tmp_path: Path) -> None:
+    """--count 0 is said as the option, before any source opens (a missing file is not met)."""
+    args = _parser().parse_args(
+        ["capture", "--left", str(tmp_path / "none.avi"), "--right", str(tmp_path / "no.avi"),
+         "--count", "0", "-o", str(tmp_path / "out")]
+    )  # fmt: skip
+    with pytest.raises(ValueError, match=r"^--count: expected a positive number, got 0$"):
+        args.func(args)
