@@ -261,6 +261,23 @@ def test_find_pairs_names(tmp_path: Path) -> None:
     assert [(j.name, j.calib) for j in solo] == [("scene1", tmp_path / "rig.yaml")]
 
 
+def test_find_pairs_keeps_the_case_of_left_and_takes_the_last_left(tmp_path: Path) -> None:
+    """``000_LEFT.png`` pairs with ``000_RIGHT.png`` (the case of the word kept, as
+    ``000_Left`` with ``000_Right``); in ``cleft_left_0001.png`` the ``left`` replaced is the
+    last one (``cleft_right_0001.png``), and the pair is named without it."""
+    img = np.zeros((8, 8, 3), np.uint8)
+    for f in ("up/000_LEFT.png", "up/000_RIGHT.png", "c/cleft_left_0001.png",
+              "c/cleft_right_0001.png"):  # fmt: skip
+        p = tmp_path / f
+        p.parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(p), img)
+    jobs = find_pairs(tmp_path)
+    assert [(j.name, j.left.name, j.right.name) for j in jobs] == [
+        ("c/cleft_0001", "cleft_left_0001.png", "cleft_right_0001.png"),
+        ("up/000", "000_LEFT.png", "000_RIGHT.png"),
+    ]
+
+
 def test_batch_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["batch", str(tmp_path / "missing"), "-o", str(tmp_path / "o")]) == 2
     assert main(["batch", str(tmp_path), "-o", str(tmp_path / "o")]) == 2
@@ -374,6 +391,37 @@ def test_batch_ground_outputs(data_dir: Path, tmp_path: Path) -> None:
     with pytest.raises(Exception, match="--ground needs --calib"):
         process_pair(_task(job, {"method": "gabor", "max_disparity": 16, "fill": None,
                                  "ground": True}))  # fmt: skip
+
+
+def test_batch_max_disparity_zero_is_refused(tmp_path: Path) -> None:
+    """max_disparity=0 is no disparity range (0 is not "estimated"): refused by name, before
+    the input is searched."""
+    from stereovision.batch import run_batch
+
+    with pytest.raises(ValueError, match=r"^max_disparity: expected a positive number, got 0$"):
+        run_batch(tmp_path / "missing", tmp_path / "o", max_disparity=0)
+
+
+def test_batch_redoes_the_pairs_when_the_grid_cell_changes(data_dir: Path, tmp_path: Path) -> None:
+    """--grid is one of the options a pair was done with: a run with another cell side redoes
+    it (it was skipped as done, its map.yaml still of the old cell), said as grid 0.2 -> 0.5."""
+    from stereovision.batch import run_batch
+
+    root, out = tmp_path / "in", tmp_path / "out"
+    shutil.copytree(data_dir / "kitti2015" / "000005_10", root / "k")
+    first = run_batch(root, out, workers=1, ground=True, grid=0.2, progress=False)
+    assert first.processed == ["k"]
+    lines: list[str] = []
+    again = run_batch(root, out, workers=1, ground=True, grid=0.5, progress=False, log=lines.append)
+    assert again.processed == ["k"] and again.redone == ["k"] and again.skipped == []
+    assert "grid: 0.2 -> 0.5" in lines[0]
+    assert _summary(out)["pairs"]["k"]["options"]["grid"] == 0.5
+    meta = dict(
+        line.split(":", 1)
+        for line in (out / "k" / "map.yaml").read_text().splitlines()
+        if ":" in line
+    )
+    assert float(meta["resolution"]) == pytest.approx(0.5)
 
 
 # --------------------------------------------------------------------- interrupts (SIGINT, SIGTERM)
@@ -1413,6 +1461,24 @@ def test_a_pair_gone_from_the_input_is_not_recorded_as_processed_this_run(
     _change(src / "b/left.png")  # another image: redone
     assert main(args) == 0
     assert _summary(out)["pairs"]["b"]["this_run"] == "processed"
+
+
+def test_a_pair_whose_outputs_were_deleted_between_runs_is_redone(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A pair recorded as done whose folder the user deleted since: the next run redoes it (it
+    is not skipped as done), and its outputs are there again."""
+    src, out = tmp_path / "in", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    shutil.rmtree(out / "b")
+    capsys.readouterr()
+    assert main(args) == 0
+    assert capsys.readouterr().out.startswith("1 processed, 1 skipped (done before), 0 failed")
+    s = _summary(out)
+    assert s["pairs"]["a"]["this_run"] == "skipped" and s["pairs"]["b"]["this_run"] == "processed"
+    assert {p.name for p in (out / "b").iterdir()} == DISPARITY_FILES
 
 
 def test_a_changed_pair_is_redone_from_another_working_directory(
