@@ -139,6 +139,19 @@ def _stamp(stamp_ns: Any) -> int:
     return stamp
 
 
+def _sqlite(writer: Any) -> sqlite3.Connection | None:
+    """A rosbags writer's database connection (its sqlite storage), None for another storage."""
+    conn = getattr(getattr(writer, "storage", None), "conn", None)
+    return conn if isinstance(conn, sqlite3.Connection) else None
+
+
+def _os_error(what: str, exc: OSError) -> OSError:
+    """``exc`` said of ``what`` (the bag), keeping its errno: rosbags' own words named no bag."""
+    err = OSError(f"{what}: {exc.strerror or exc}")
+    err.errno = exc.errno
+    return err
+
+
 class BagWriter:
     """Write depth results into a new ROS 2 bag folder.
 
@@ -207,9 +220,7 @@ ros2_static_transform>`.
         except OSError as exc:
             # a folder that cannot be written (a read-only mount): rosbags' "[Errno 2] No such
             # file or directory: 'PATH'" named no cause
-            err = OSError(f"cannot write the bag folder {self.path}: {exc.strerror or exc}")
-            err.errno = exc.errno
-            raise err from None
+            raise _os_error(f"cannot write the bag folder {self.path}", exc) from None
         self._conns: dict[str, Any] = {}
         self._pending: list[tuple[str, str, Any, int]] = []  # the frame being made, serialised
         # a frame's savepoint taken and the frame not yet released or undone and counted: an
@@ -242,8 +253,8 @@ ros2_static_transform>`.
         rolls back those written, so the bag never holds part of a frame; the writer's counts
         (its metadata.yaml) and :attr:`messages` are then read back from the database."""
         pending, self._pending = self._pending, []
-        conn = getattr(getattr(self._writer, "storage", None), "conn", None)
-        if not isinstance(conn, sqlite3.Connection):  # another storage: no rollback
+        conn = _sqlite(self._writer)
+        if conn is None:  # another storage: no rollback
             for topic, msgtype, data, stamp in pending:
                 self._writer.write(self._conn(topic, msgtype), stamp, data)
                 self.messages += 1
@@ -284,8 +295,8 @@ ros2_static_transform>`.
         of the frame written. The savepoint is rolled back when it is still open (a frame
         released already is whole and stays), and the counts are read back from the database.
         """
-        conn = getattr(getattr(self._writer, "storage", None), "conn", None)
-        if not self._unsettled or not isinstance(conn, sqlite3.Connection):
+        conn = _sqlite(self._writer)
+        if not self._unsettled or conn is None:
             return
         try:
             conn.execute("ROLLBACK TO frame")
@@ -486,14 +497,12 @@ ros2_static_transform>`.
         except sqlite3.Error as exc:  # e.g. "database or disk is full"
             raise OSError(f"bag {self.path}: {exc}") from exc
         except OSError as exc:
-            err = OSError(f"bag {self.path}: {exc.strerror or exc}")
-            err.errno = exc.errno
-            raise err from exc
+            raise _os_error(f"bag {self.path}", exc) from exc
 
     def _commit(self) -> None:
         """Commit the frames written so far (rosbags keeps one transaction until close)."""
-        conn = getattr(getattr(self._writer, "storage", None), "conn", None)
-        if isinstance(conn, sqlite3.Connection):
+        conn = _sqlite(self._writer)
+        if conn is not None:
             try:
                 conn.commit()
             except sqlite3.Error:
@@ -566,9 +575,8 @@ ros2_static_transform>`.
                     self._writer = None
                 writer.close()
         except sqlite3.Error as exc:
-            storage = getattr(writer, "storage", None)
-            conn = getattr(storage, "conn", None)
-            if isinstance(conn, sqlite3.Connection):
+            conn = _sqlite(writer)
+            if conn is not None:
                 conn.close()
             raise OSError(
                 f"bag {self.path} could not be finished ({exc}): the frames committed before "
