@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_bgr_uint8, check_pair
+from stereovision._validate import as_bgr_uint8, check_pair, finite_number
 from stereovision.calibration import Calibration
 from stereovision.depth import (
     _rectify_grey,
@@ -141,15 +140,12 @@ def _refuse_unreachable(
     numbers, and a max_disparity the caller gave not above min_disparity, are left to the
     matchers' own checks, which name them; an estimated one (``automatic``) below such a
     min_disparity is not the problem, the min_disparity is."""
-    numbers = (int, float, np.integer, np.floating)
-    pair = (min_disparity, max_disparity)
-    if any(isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers) for v in pair):
-        return
     try:
-        lo, hi = float(min_disparity), float(max_disparity)  # type: ignore[arg-type]
-    except OverflowError:  # an int beyond a float: the matchers name it
+        lo = finite_number(min_disparity, "min_disparity")
+        hi = finite_number(max_disparity, "max_disparity")
+    except ValueError:  # not a finite number: the matchers name it
         return
-    if not (math.isfinite(lo) and math.isfinite(hi)) or (hi <= lo and not automatic):
+    if hi <= lo and not automatic:
         return
     err = _unreachable_range(lo, hi, width)
     if err is not None:
