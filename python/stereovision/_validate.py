@@ -535,6 +535,30 @@ def _shown(value: object) -> str:
     return repr(value)
 
 
+def first_line(exc: BaseException) -> str:
+    """What a one-line error message says of ``exc``: its message's first line (its type's
+    name if empty), as the CLI, the GUI and the stream print errors.
+
+    Parameters
+    ----------
+    exc : BaseException
+        The error.
+
+    Returns
+    -------
+    str
+        One line.
+
+    Examples
+    --------
+    >>> first_line(RuntimeError("the offscreen render returned no image\\nat line 2"))
+    'the offscreen render returned no image'
+    >>> first_line(MemoryError())
+    'MemoryError'
+    """
+    return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+
+
 def finite_number(value: object, name: str) -> float:
     """``value`` as a finite Python float.
 

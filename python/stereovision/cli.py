@@ -27,6 +27,7 @@ import numpy as np
 
 from stereovision._interrupt import Terminated, raise_terminated
 from stereovision._jsonout import json_line
+from stereovision._validate import first_line
 
 EXIT_ERROR = 2
 EXIT_CANNOT_TELL = 3  # `check`: too little texture to tell whether the rows agree
@@ -1887,8 +1888,7 @@ def _run(args: argparse.Namespace) -> int:
         return EXIT_BROKEN_PIPE
     # ImportError: an optional package missing (trame, rosbags, dask), said with its pip line
     except (CliError, ValueError, OSError, RuntimeError, MemoryError, ImportError) as exc:
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        print(f"stereovision: error: {msg}", file=sys.stderr)
+        print(f"stereovision: error: {first_line(exc)}", file=sys.stderr)
         return EXIT_ERROR
     except Exception as exc:  # a bug of ours: still one line, never a traceback
         msg = str(exc).splitlines()[0] if str(exc) else ""

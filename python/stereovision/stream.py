@@ -39,6 +39,7 @@ import numpy as np
 
 from stereovision._interrupt import Terminated
 from stereovision._jsonout import json_line
+from stereovision._validate import first_line
 from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import (
     SourceError,
@@ -1249,7 +1250,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
                 except OSError as exc:
                     # the disk still full at the last commit or metadata.yaml: it raised past the
                     # summary (the record of the run lost), or over the error already raised
-                    close_error = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+                    close_error = first_line(exc)
                     if report is None:  # an error or interrupt is on its way out: it is said
                         # after this, and its exit status kept
                         print(f"stereovision: error: {close_error}", file=log)

@@ -270,6 +270,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         return 130
     except (ValueError, OSError, RuntimeError) as exc:
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        print(f"stereovision: error: {msg}", file=sys.stderr)
+        from stereovision._validate import first_line
+
+        print(f"stereovision: error: {first_line(exc)}", file=sys.stderr)
         return 2

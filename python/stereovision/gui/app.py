@@ -39,6 +39,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import release_memory
+from stereovision._validate import first_line
 from stereovision.calibration import fit_to_frames
 from stereovision.gui.sources import (
     CLOUD_SUFFIXES,
@@ -545,19 +546,6 @@ def nowrap_units(text: str) -> str:
     '0–64\\xa0px · density 100\\xa0% · 0.29\\xa0s · median depth 3.50\\xa0m, 2 matches'
     """
     return _NUMBER_UNIT.sub(NBSP, text)
-
-
-def first_line(exc: BaseException) -> str:
-    """What the page says of ``exc``: its message's first line (its type's name if empty).
-
-    Examples
-    --------
-    >>> first_line(RuntimeError("the offscreen render returned no image\\nat line 2"))
-    'the offscreen render returned no image'
-    >>> first_line(MemoryError())
-    'MemoryError'
-    """
-    return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
 
 
 def short_paths(message: str, path: str | os.PathLike[str]) -> str:
@@ -1611,7 +1599,7 @@ class StereoApp:
             source.close()
             self.source, self.homographies, self._source_label, self._source_names = before
             if self.source is not None:
-                said = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+                said = first_line(exc)
                 exc = OSError(f"{said} (the cameras in use are unchanged)")
             self._fail(exc)
             return
