@@ -2616,7 +2616,8 @@ def _calibrate_source(
         names = _pair_names(
             [os.path.basename(f) for f in lefts], [os.path.basename(f) for f in rights], None
         )
-        gone = [names[i] for i in range(len(lefts)) if i not in set(keep)]
+        kept = set(keep)
+        gone = [names[i] for i in range(len(lefts)) if i not in kept]
         selection = {
             "option": f"--max-pairs {args.max_pairs}",
             "rule": "spread evenly over the list, the first and the last kept, before the board "
