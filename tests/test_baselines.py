@@ -254,3 +254,70 @@ def test_reference_table_reproduced(data_dir: Path, name: str) -> None:
     assert dense_metrics(row_fill(sgbm), s.gt).bad[2.0] == pytest.approx(fill_b2, abs=0.051)
     bm = dense_metrics(opencv_bm(s.left, s.right, s.max_disparity), s.gt)
     assert bm.bad[2.0] == pytest.approx(bm_b2, abs=0.051)
+
+
+def _colour_pair(shift: int) -> tuple[np.ndarray, np.ndarray]:
+    """A BGR pair whose channels differ (so grey and colour matching give different maps)."""
+    rng = np.random.default_rng(5)
+    tex = cv2.GaussianBlur(rng.integers(0, 256, (60, 160 + shift, 3), dtype=np.uint8), (3, 3), 0)
+    return np.ascontiguousarray(tex[:, :-shift]), np.ascontiguousarray(tex[:, shift:])
+
+
+def _raw(matcher: cv2.StereoMatcher, left: np.ndarray, right: np.ndarray) -> np.ndarray:
+    raw = matcher.compute(left, right)
+    out = raw.astype(np.float32) / 16
+    out[raw < 0] = np.nan
+    return out
+
+
+def test_references_equal_opencv_configured_as_documented() -> None:
+    # every parameter written out from the docstrings (evaluation.md's SGBM-3WAY, the ROS node's
+    # defaults, StereoVision 1.0's): one changed in the code changes the map
+    left, right = _colour_pair(6)
+    gl, gr = (cv2.cvtColor(x, cv2.COLOR_BGR2GRAY) for x in (left, right))
+    sgbm = cv2.StereoSGBM.create(
+        minDisparity=0, numDisparities=32, blockSize=5, P1=8 * 3 * 25, P2=32 * 3 * 25,
+        disp12MaxDiff=1, uniquenessRatio=10, speckleWindowSize=100, speckleRange=2,
+        mode=cv2.STEREO_SGBM_MODE_SGBM_3WAY,
+    )  # fmt: skip
+    np.testing.assert_array_equal(opencv_sgbm(left, right, 20), _raw(sgbm, left, right))
+    bm = cv2.StereoBM.create(32, 15)
+    bm.setPreFilterSize(9)
+    bm.setPreFilterCap(31)
+    bm.setUniquenessRatio(15)
+    bm.setSpeckleWindowSize(100)
+    bm.setSpeckleRange(4)
+    np.testing.assert_array_equal(ros_stereo_image_proc(left, right, 20), _raw(bm, gl, gr))
+    sg = cv2.StereoSGBM.create(
+        minDisparity=0, numDisparities=32, blockSize=15, P1=200, P2=400, disp12MaxDiff=0,
+        preFilterCap=31, uniquenessRatio=15, speckleWindowSize=100, speckleRange=4,
+        mode=cv2.STEREO_SGBM_MODE_SGBM,
+    )  # fmt: skip
+    np.testing.assert_array_equal(
+        ros_stereo_image_proc(left, right, 20, algorithm="sgbm"), _raw(sg, gl, gr)
+    )
+    bm21 = cv2.StereoBM.create(32, 21)
+    np.testing.assert_array_equal(stereovision_1_0(left, right, 20), _raw(bm21, gl, gr))
+    sg3 = cv2.StereoSGBM.create(
+        minDisparity=0, numDisparities=32, blockSize=3, P1=216, P2=864, disp12MaxDiff=1,
+        uniquenessRatio=10, speckleWindowSize=100, speckleRange=32, mode=cv2.STEREO_SGBM_MODE_SGBM,
+    )  # fmt: skip
+    np.testing.assert_array_equal(
+        stereovision_1_0(left, right, 20, algorithm="sgbm"), _raw(sg3, left, right)
+    )
+
+
+def test_a_zero_disparity_is_a_value_not_a_hole() -> None:
+    # OpenCV's "no match" is minDisparity - 1 = -1 px; 0 px (a point at infinity) is a match
+    left, _ = _shifted_pair(4)
+    for fn in (opencv_bm, opencv_sgbm):
+        inner = fn(left, left, 16)[10:-10, 40:-10]
+        assert np.isfinite(inner).mean() > 0.9
+        assert np.nanmax(np.abs(inner)) == 0.0
+
+
+def test_row_fill_refuses_bool_and_returns_float32_when_empty() -> None:
+    with pytest.raises(ValueError, match="dtype bool"):
+        row_fill(np.zeros((2, 3), bool))
+    out = row_fill(np.zeros((0, 3), np.float64))
+    assert out.dtype == np.float32 and out.shape == (0, 3)
