@@ -347,3 +347,93 @@ def test_none_from_imread_says_the_path_was_not_read(data_dir: Path, tmp_path: P
     with pytest.raises(ValueError) as err:
         sv.depth_map(right, None)
     assert str(err.value) == want.replace("left:", "right:")
+
+
+def test_boundaries_of_the_low_uint16_warning_and_the_float_range() -> None:
+    import warnings
+
+    from stereovision._validate import LOW_UINT16_MAX, as_gray_uint8
+
+    with pytest.warns(UserWarning, match="largest value is 4095"):
+        as_gray_float(np.full((2, 2), LOW_UINT16_MAX - 1, np.uint16))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        as_gray_float(np.full((2, 2), LOW_UINT16_MAX, np.uint16))  # 12 bits and one: no warning
+    # float rounding above 1 is clipped to exactly 1, on both sides of the range
+    top = np.float32(1.0) + np.float32(5e-7)
+    out = as_gray_float(np.array([[0.5, top]], np.float32))
+    assert out[0, 1] == 1.0
+    # an infinity is named as such, not as a range
+    with pytest.raises(ValueError, match="1 NaN/inf"):
+        as_gray_float(np.array([[0.5, np.inf]], np.float32))
+    # 16-bit grey to 8 bits rounds to nearest: 32768 / 257 = 127.5 -> 128
+    assert as_gray_uint8(np.array([[32768, 65535]], np.uint16))[0, 0] == 128
+
+
+def test_big_endian_and_the_right_image_named() -> None:
+    img = np.arange(12, dtype=np.uint16).reshape(3, 4) * 5000
+    np.testing.assert_array_equal(as_gray_float(img.astype(">u2")), as_gray_float(img))
+    good = np.zeros((2, 2), np.float32)
+    with pytest.raises(ValueError, match=r"^right: float image"):
+        check_pair(good, np.full((2, 2), 2.0, np.float32))
+
+
+def test_check_unit_range_and_u8_pair() -> None:
+    from stereovision._validate import check_unit_range, u8_pair
+
+    check_unit_range(np.array([[np.nan, 0.5]], np.float32), "left")  # NaN: the kernel's to say
+    a, b = np.zeros((2, 3), np.uint8), np.zeros((3, 2), np.uint8)
+    assert u8_pair(a, b) is None
+    assert u8_pair(a, a.copy()) is not None
+
+
+def test_number_validators_at_their_boundaries() -> None:
+    from stereovision._validate import (
+        disparity_range,
+        finite_number,
+        float_sized,
+        int_in_range,
+        xy_points,
+    )
+
+    assert int_in_range(5, "n", 0, 5) == 5 and int_in_range(5.0, "n", 0, 5) == 5
+    for bad in (2.5, True, 6, -1):
+        with pytest.raises(ValueError, match="n: expected an integer from 0 to 5"):
+            int_in_range(bad, "n", 0, 5)
+    with pytest.raises(ValueError, match="positive finite"):
+        positive_finite(1 + 0j, "f")
+    with pytest.raises(ValueError, match="gamma: an integer of 1329 bits"):
+        float_sized(10**400, "gamma")
+    for bad in (True, 10**400, float("inf")):
+        with pytest.raises(ValueError, match="blur: expected a finite number"):
+            finite_number(bad, "blur")
+    with pytest.raises(ValueError, match=r"max_disparity \(32\) must be larger"):
+        disparity_range(32, 32)
+    with pytest.raises(ValueError, match=r"max_disparity \(10.0000001\) and min_disparity \(10\)"):
+        disparity_range(10, 10.0000001)
+    with pytest.raises(ValueError, match=r"got \(4, 3\)$"):
+        xy_points(np.zeros((4, 3)))
+    with pytest.raises(ValueError, match=r"got \(2, 3\) \(transpose"):
+        xy_points(np.zeros((2, 3)))
+
+
+def test_first_line_and_renamed_keyword() -> None:
+    from stereovision._validate import first_line, renamed_keyword
+
+    assert first_line(ValueError("a\nb")) == "a"
+
+    @renamed_keyword("disp", "disparity")
+    def f(disparity: int) -> int:
+        return disparity
+
+    with pytest.warns(DeprecationWarning, match="disp= is now disparity="):
+        assert f(disp=3) == 3
+    with pytest.raises(TypeError, match="got disp= and disparity="):
+        f(1, disp=3)
+
+
+def test_none_and_objects_are_named_for_what_they_are() -> None:
+    with pytest.raises(ValueError, match=r"left: got None, not an image \(cv2.imread"):
+        as_gray_float(None)
+    with pytest.raises(ValueError, match="expected a numeric image array, got ndarray"):
+        as_gray_float(np.array([[1, None]], dtype=object))
