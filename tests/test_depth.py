@@ -954,3 +954,103 @@ def test_a_min_disparity_not_below_the_width_with_the_automatic_range_says_so() 
         "min_disparity (100) is not below the image width 48: no pixel has a match that far to "
         "its left in the right image; give a min_disparity below 48"
     )
+
+
+def _hand_result() -> sv.DepthResult:
+    """A 2x3 result built by hand (f B = 50 m px): depth 5, 2 and 1 m measured, a filled pixel
+    (confidence 0, 2.5 m as a guess), a dropped one (confidence 0.2) and a hole."""
+    nan = np.nan
+    disp = np.array([[10, 20, 25], [nan, 50, 5]], np.float32)
+    return sv.DepthResult(
+        disparity=disp,
+        confidence=np.array([[0.5, 0, 0.5], [0, 0.5, 0.2]], np.float32),
+        depth=np.array([[5, nan, 2], [nan, 1, nan]], np.float32),
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+        method="fused",
+        max_disparity=64,
+        calibration=_rect_calib(3, 2),
+        depth_sigma=np.array([[0.5, nan, 0.1], [nan, 0.05, nan]], np.float32),
+    )
+
+
+def _kept(depth: np.ndarray) -> list[float]:
+    return sorted(float(z) for z in depth[np.isfinite(depth)])
+
+
+def test_a_hand_made_result_counts_filters_and_converts_by_hand_values(tmp_path: Path) -> None:
+    r = _hand_result()
+    counts = r.depth_counts()
+    assert counts == {"pixels": 6, "disparity": 5, "depth": 3, "filled": 1, "dropped": 1}
+    # the limits are inclusive
+    assert _kept(r.filtered(min_depth=2).require_depth()) == [2, 5]
+    assert _kept(r.filtered(max_depth=5).require_depth()) == [1, 2, 5]
+    assert _kept(r.filtered(min_depth=2, max_depth=2).require_depth()) == [2]
+    assert _kept(r.filtered(max_sigma=0.1).require_depth()) == [1, 2]
+    # relative: sigma <= 0.06 z keeps 0.1 at 2 m and 0.05 at 1 m, not 0.5 at 5 m
+    assert _kept(r.filtered(max_relative_sigma=0.06).require_depth()) == [1, 2]
+    with pytest.raises(ValueError, match="max_depth: expected a positive number, got 0"):
+        r.filtered(max_depth=0)
+    # filtering twice keeps the tighter of each limit
+    twice = r.filtered(min_depth=1, max_depth=5).filtered(min_depth=2, max_depth=10)
+    assert twice.limits == {"min_depth": 2.0, "max_depth": 5.0}
+    # point_image: measured pixels; with filled=True also the guess, inside the range (inclusive)
+    # and never under a sigma limit (a guess has none); max_depth=5 leaves the dropped pixel out
+    z = r.point_image()[..., 2]
+    assert _kept(z) == [1, 2, 5]
+    assert _kept(r.filtered(max_depth=5).point_image(filled=True)[..., 2]) == [1, 2, 2.5, 5]
+    near = r.filtered(min_depth=2.5, max_depth=5)
+    assert _kept(near.point_image(filled=True)[..., 2]) == [2.5, 5]
+    trusted = r.filtered(max_depth=5, max_relative_sigma=1.0)
+    assert _kept(trusted.point_image(filled=True)[..., 2]) == [1, 2, 5]
+    with pytest.raises(ValueError, match="unit: expected one of"):
+        r.depth_in(["m"])  # type: ignore[arg-type]
+    no_sigma = dataclasses.replace(r, depth_sigma=None)
+    with pytest.raises(ValueError, match="no depth uncertainty"):
+        no_sigma.require_depth_sigma()
+    assert read_ply(r.to_ply(tmp_path / "cloud.PLY"))[0].shape == (3, 3)
+
+
+def test_depth_uses_doffs_and_points_use_fx_and_fy_and_rgb_colours() -> None:
+    h, w, d = 96, 160, 6.5
+    tex = _texture(h, w)
+    left = np.dstack([tex, 0.5 * tex, 0.2 * tex])  # BGR, channels apart
+    right = np.dstack([_shift(tex, d), 0.5 * _shift(tex, d), 0.2 * _shift(tex, d)])
+    k1 = np.array([[500, 0, 79.5], [0, 600, 47.5], [0, 0, 1]], np.float64)
+    k2 = k1.copy()
+    k2[0, 2] = 82.5  # doffs = 3 px
+    calib = Calibration(
+        K1=k1, D1=np.zeros(5), K2=k2, D2=np.zeros(5), R=np.eye(3),
+        T=np.array([-100.0, 0.0, 0.0]), image_size=(w, h), unit="mm", rectified=True,
+    )  # fmt: skip
+    assert calib.doffs_px == 3.0
+    res = sv.depth_map(left, right, calib, max_disparity=16, min_disparity=0)
+    ok = np.isfinite(res.require_depth())
+    assert ok.mean() > 0.5
+    np.testing.assert_allclose(res.depth[ok], 50.0 / (res.disparity[ok] + 3.0), rtol=1e-5)
+    x, y = res.pixels[:, 0], res.pixels[:, 1]
+    z = res.points[:, 2]
+    np.testing.assert_allclose(res.points[:, 0], (x - 79.5) / 500 * z, rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(res.points[:, 1], (y - 47.5) / 600 * z, rtol=1e-5, atol=1e-6)
+    bgr = res.left_rectified
+    assert bgr is not None
+    np.testing.assert_array_equal(res.colors, bgr[y, x][:, ::-1])
+
+
+def test_an_empty_or_unreachable_range_given_is_named() -> None:
+    left = _texture(32, 64)
+    with pytest.raises(ValueError, match=r"max_disparity \(16\) must be larger than min_disparity"):
+        sv.depth_map(left, left, max_disparity=16, min_disparity=16)
+    with pytest.raises(ValueError, match=r"max_disparity \(-64\) is not above minus the image"):
+        sv.depth_map(left, left, max_disparity=-64, min_disparity=-80)
+
+
+def test_the_automatic_range_is_clamped_to_half_the_width() -> None:
+    from stereovision.depth import estimate_max_disparity
+
+    tex = _texture(128, 128, seed=2)
+    # 60 px x 1.15 headroom is 69, rounded up 80: past half the width, so 64
+    assert estimate_max_disparity(tex, _shift(tex, 60)) == 64
+    flat = np.zeros((128, 96), np.float32)
+    assert estimate_max_disparity(flat, flat) == 16  # no features: width / 8, at least 16
