@@ -1054,3 +1054,14 @@ def test_the_automatic_range_is_clamped_to_half_the_width() -> None:
     assert estimate_max_disparity(tex, _shift(tex, 60)) == 64
     flat = np.zeros((128, 96), np.float32)
     assert estimate_max_disparity(flat, flat) == 16  # no features: width / 8, at least 16
+
+
+def test_a_dark_12_bit_pair_gets_the_range_of_its_full_scale_copy() -> None:
+    from stereovision.depth import estimate_max_disparity
+
+    tex = _texture(128, 128, seed=2)
+    right = _shift(tex, 20)
+    full = estimate_max_disparity(tex, right)
+    dark = [(x * 4095).astype(np.uint16) for x in (tex, right)]  # 12-bit data in 16 bits
+    assert full == 32
+    assert estimate_max_disparity(*dark) == full  # cut to 8 bits unstretched it found 16
