@@ -1065,3 +1065,23 @@ def test_a_dark_12_bit_pair_gets_the_range_of_its_full_scale_copy() -> None:
     dark = [(x * 4095).astype(np.uint16) for x in (tex, right)]  # 12-bit data in 16 bits
     assert full == 32
     assert estimate_max_disparity(*dark) == full  # cut to 8 bits unstretched it found 16
+
+
+def test_values_past_the_range_are_holes_beyond_half_a_pixel() -> None:
+    # a plane at 6.5 px: searched from 7.2, the Gabor channel measures it 0.7 px below the range
+    # (holes); the census map locks at 7 px, 0.2 below (kept, clipped to 7.2). Searched up to
+    # 5.6: 0.9 px past the Gabor range (holes), within half a pixel of the census map's 6.
+    left = _texture(96, 160)
+    right = _shift(left, 6.5)
+    kw = {"fill": False, "refine": False}
+    for method, lo, hi, top, dense in (
+        ("gabor", 7.2, 16, 16, False),
+        ("census", 7.2, 16, 16, True),
+        ("gabor", 0, 5.6, 5.6, False),
+        ("census", 0, 5.6, 6, True),
+    ):
+        res = sv.depth_map(left, right, method=method, max_disparity=hi, min_disparity=lo, **kw)
+        valid = res.valid
+        assert (valid.mean() > 0.9) if dense else (valid.mean() < 0.3), (method, lo, hi)
+        assert lo <= np.nanmin(res.disparity) and np.nanmax(res.disparity) <= top
+        assert (res.confidence[~valid] == 0).all()  # no confidence without a disparity
