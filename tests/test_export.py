@@ -527,11 +527,22 @@ def test_point_image_filled_keeps_the_guesses_within_the_working_range(result):
     z = np.where(np.isfinite(result.disparity), result.depth, np.nan)
     guess = np.zeros(result.disparity.shape, bool)
     guess[70:90, 20:100] = True  # pretend these were filled: no depth, a disparity (box and wall)
-    filled = replace(result, depth=np.where(guess, np.nan, z).astype(np.float32))
+    # and these dropped: measured (confidence > 0), no depth (within sigma_d of infinity)
+    dropped = np.zeros_like(guess)
+    dropped[30:40, 20:100] = True
+    assert (result.confidence[dropped] > 0).all() and np.isfinite(result.depth[dropped]).all()
+    filled = replace(
+        result,
+        depth=np.where(guess | dropped, np.nan, z).astype(np.float32),
+        confidence=np.where(guess, 0, result.confidence).astype(np.float32),
+    )
     assert np.isnan(filled.point_image()[guess]).all()
     both = filled.point_image(filled=True)
     np.testing.assert_allclose(both[guess], result.point_image()[guess], atol=1e-5)
     np.testing.assert_array_equal(both[~guess], filled.point_image()[~guess])
+    # a dropped pixel is not a guess: it stayed out ("also the filled pixels", not every one
+    # without a depth; a far point's depth interval reaches infinity)
+    assert np.isnan(both[dropped]).all()
     box, wall = float(syn.BOX_Z), float(syn.WALL_Z)
     assert box < wall
     assert filled.limits == {}

@@ -682,8 +682,9 @@ class DepthResult:
         Parameters
         ----------
         filled : bool
-            False: the pixels with a depth only (the cloud's). True: also the filled pixels,
-            guesses from their neighbours that get no depth of their own, within the working
+            False: the pixels with a depth only (the cloud's). True: also the filled pixels
+            (confidence 0), guesses from their neighbours that get no depth of their own (not
+            the measured pixels dropped within ``sigma_d`` of infinity), within the working
             range of :meth:`filtered` (none when it asked for a ``max_sigma`` or
             ``max_relative_sigma``: a guess has no uncertainty to pass). For obstacles the
             filled pixels count: on KITTI the obstacle recall is 0.975 with them and 0.65
@@ -711,7 +712,9 @@ class DepthResult:
         lim = self.limits
         if filled and "max_sigma" not in lim and "max_relative_sigma" not in lim:
             z = pts[..., 2]
-            guess = ~keep & np.isfinite(z)
+            # confidence 0 marks a filled disparity; a measured one without a depth was dropped
+            # (within sigma_d of infinity, or outside the limits) and stays out
+            guess = ~keep & np.isfinite(z) & (self.confidence == 0)
             with np.errstate(invalid="ignore"):
                 if "min_depth" in lim:
                     guess &= z >= lim["min_depth"]
