@@ -930,3 +930,343 @@ def test_view_of_a_scene_narrower_than_its_range_names_the_width_needed(tmp_path
         f"scene {scene}: images 8 px wide, not wider than the scene's disparity range (16 px, "
         "evaluation.md's rule: 16 at least): a scene needs images at least 17 px wide"
     )
+
+
+# ----------------------------------------------------------------------------- mutation audit
+# Each test below asserts a behaviour a one-line change of render.py broke without any test
+# failing (a wrong sign, a dropped check, the wrong reference point).
+
+
+def test_controls_refuse_what_is_not_a_number():
+    """A text or None slider value raised math.isfinite's TypeError, not the ValueError naming
+    the control, if the type check goes."""
+    for bad in ("5", None, [1.0]):
+        with pytest.raises(ValueError, match=r"^camera control yaw must be a finite number"):
+            CameraControls(yaw=bad)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("depth", [math.nan, math.inf, -1.0])
+def test_orbit_refuses_a_centre_that_is_no_distance(depth):
+    with pytest.raises(ValueError, match=r"^center_depth must be a positive distance"):
+        render.orbit_controls(10.0, 5.0, depth)
+
+
+def test_intrinsics_scaled_keeps_pixel_centres():
+    """Scaling by 2/3 maps pixel centre c to (c + 0.5) * 2/3 - 0.5 and rounds the size."""
+    k = render.Intrinsics(150.0, 79.5, 40.0, 160, 121).scaled(2 / 3)
+    assert k.f == pytest.approx(100.0)
+    assert (k.cx, k.cy) == (pytest.approx(80 * 2 / 3 - 0.5), pytest.approx(40.5 * 2 / 3 - 0.5))
+    assert (k.width, k.height) == (107, 81)  # 106.7 and 80.7 rounded, not truncated
+
+
+def _lit_centroids(img: np.ndarray, expected: np.ndarray) -> np.ndarray:
+    """Centroid of the lit pixels in a 9x9 window around each expected (x, y)."""
+    lit = img[..., 0] > 200
+    found = []
+    for ex, ey in expected:
+        y0, x0 = round(ey), round(ex)
+        wy, wx = np.nonzero(lit[y0 - 4 : y0 + 5, x0 - 4 : x0 + 5])
+        assert len(wx), f"no point drawn near ({ex:.1f}, {ey:.1f})"
+        found.append((wx.mean() + x0 - 4, wy.mean() + y0 - 4))
+    return np.array(found)
+
+
+def test_render_projects_with_an_off_centre_principal_point():
+    """The synthetic rig's principal point is the image centre, where VTK's window-centre shift
+    is 0 whatever its sign; real calibrations are off centre (x right of, y above)."""
+    pts = np.array([[0.0, 0.0, 4.0], [0.8, 0.5, 4.0], [-0.9, -0.6, 5.0]])
+    intr = render.Intrinsics(150.0, 100.0, 40.0, syn.W, syn.H)
+    plotter = render.make_plotter((syn.W, syn.H))
+    try:
+        for p in pts:
+            plotter.add_mesh(pv.PolyData(p[None].astype(np.float32)), color="white",
+                             point_size=3, style="points", lighting=False)  # fmt: skip
+        render.apply_camera(plotter, CameraControls(), intrinsics=intr, focal_distance=4.0)
+        img = plotter.screenshot(return_img=True)
+    finally:
+        plotter.close()
+    expected = np.stack(
+        [150.0 * pts[:, 0] / pts[:, 2] + 100.0, 150.0 * pts[:, 1] / pts[:, 2] + 40.0], 1
+    )
+    np.testing.assert_allclose(_lit_centroids(img, expected), expected, atol=1.0)
+
+
+def test_apply_camera_without_intrinsics_resets_the_window_centre():
+    """The GUI's plotter shows a calibrated scene (window centre shifted to its principal
+    point), then a bare PLY: the shift of the scene before must not stay."""
+    plotter = render.make_plotter((64, 48))
+    try:
+        intr = render.Intrinsics(50.0, 40.0, 10.0, 64, 48)
+        render.apply_camera(plotter, CameraControls(), intrinsics=intr)
+        assert plotter.camera.GetWindowCenter() != (0.0, 0.0)
+        render.apply_camera(plotter, CameraControls())
+        assert plotter.camera.GetWindowCenter() == (0.0, 0.0)
+        assert plotter.camera.view_angle == render.DEFAULT_FOV_DEG
+    finally:
+        plotter.close()
+
+
+def test_apply_camera_survives_the_window_being_shown():
+    """``view``'s window: pyvista's show() resets a camera not marked as set to the scene's
+    bounds, throwing the controls' pose away."""
+    pts = np.random.default_rng(0).uniform([-1, -1, 3], [1, 1, 5], (500, 3))
+    plotter = render.make_plotter((80, 60))
+    try:
+        render.add_geometry(plotter, render.point_cloud(pts))
+        controls = CameraControls(yaw=10.0, forward=0.5)
+        render.apply_camera(plotter, controls, focal_distance=4.0)
+        plotter.show(auto_close=False)
+        np.testing.assert_allclose(render.pose_from_camera(plotter.camera), controls.pose(),
+                                   atol=1e-9)  # fmt: skip
+    finally:
+        plotter.close()
+
+
+def _cluster(n: int = 2000) -> np.ndarray:
+    return np.random.default_rng(8).uniform([-1, -1, 4], [1, 1, 5], (n, 3))
+
+
+def test_clipping_range_is_measured_from_the_camera():
+    """The robust range is of the distances from where the camera is, not from the left
+    camera's origin: moved 3 m forward, the scene is 1-2 m away (apply_camera, the window's
+    observer and CameraState.apply alike)."""
+    pts = _cluster()
+    controls = CameraControls(forward=3.0)
+    expected = render.robust_clipping_range(pts, [0.0, 0.0, 3.0])
+    assert expected[0] < 0.6  # from the origin it would be about 2
+    plotter = render.make_plotter((64, 48))
+    try:
+        render.apply_camera(plotter, controls, focal_distance=1.0, points=pts)
+        np.testing.assert_allclose(plotter.camera.clipping_range, expected)
+        state = dataclasses.replace(render.CameraState.of(plotter.camera), focal_point=(0, 0, 9))
+        render.apply_camera(plotter, CameraControls(), focal_distance=1.0, points=pts)
+        state.apply(plotter, points=pts)
+        np.testing.assert_allclose(plotter.camera.clipping_range, expected)
+        render.add_geometry(plotter, render.point_cloud(pts))
+        render.keep_robust_clipping(plotter, pts)
+        render.apply_camera(plotter, controls, focal_distance=1.0)
+        plotter.screenshot(return_img=True)
+        np.testing.assert_allclose(plotter.camera.clipping_range, expected)
+    finally:
+        plotter.close()
+
+
+def test_clipping_range_values():
+    """Near: NEAR_FACTOR x the 0.5th percentile distance (a few points almost on the camera
+    do not pull it in); NaN distances are left out; no finite point at all: 0.01-10 m."""
+    pts = _cluster()
+    pts[:5] = [0.0, 0.0, 0.05]  # 0.25 % of the points, 5 cm away
+    dist = np.linalg.norm(pts, axis=1)
+    near, far = render.robust_clipping_range(pts, [0, 0, 0])
+    assert near == pytest.approx(render.NEAR_FACTOR * np.percentile(dist, 0.5))
+    assert near > 1.0
+    with_nan = np.concatenate([pts, np.full((50, 3), np.nan)])
+    assert render.robust_clipping_range(with_nan, [0, 0, 0]) == (near, far)
+    assert render.robust_clipping_range(np.full((4, 3), np.nan), [0, 0, 0]) == (0.01, 10.0)
+
+
+def test_camera_state_applied_is_the_state_read_back():
+    """CameraState.apply gives the camera every number of the state, the window centre of an
+    off-centre principal point too."""
+    state = render.CameraState(
+        (0.1, -0.2, 0.3), (0.5, 0.0, 4.0), (0.0, -1.0, 0.1), 35.0, (0.3, -0.2), False, 1.0
+    )
+    plotter = render.make_plotter((64, 48))
+    try:
+        state.apply(plotter)
+        back = render.CameraState.of(plotter.camera)
+    finally:
+        plotter.close()
+    assert back.window_center == pytest.approx((0.3, -0.2))
+    assert back.same_view(
+        dataclasses.replace(state, up=back.up)  # VTK orthogonalises the view-up
+    )
+
+
+def test_camera_state_refuses_an_up_almost_along_the_view():
+    with pytest.raises(ValueError, match="is along the view direction"):
+        render.CameraState(**{**_VIEW, "up": (0.0, 1e-9, 1.0)})
+
+
+def test_same_view_is_absolute_near_zero():
+    """A position of 1e-12 m read back for 0 is the same view (the tolerance is absolute near
+    zero, as documented)."""
+    a = render.CameraState(**_VIEW)
+    b = dataclasses.replace(a, position=(1e-12, 0.0, 0.0))
+    assert a.same_view(b)
+
+
+def test_surface_mesh_max_jump_bound_and_refusals(result):
+    """A triangle whose depths differ by exactly max_jump is kept (box 2 m, wall 4 m: a jump of
+    1.0); a max_jump of 0, below or NaN is refused."""
+    mesh = render.surface_mesh(result, max_jump=1.0)
+    assert mesh.n_cells == _oracle_triangle_count(result.depth, 1.0)
+    assert mesh.n_cells > render.surface_mesh(result).n_cells
+    for bad in (0.0, -0.1, math.nan):
+        with pytest.raises(ValueError, match=r"^max_jump must be positive"):
+            render.surface_mesh(result, max_jump=bad)
+
+
+def test_surface_mesh_without_texture_is_coloured_per_vertex(result):
+    """A result without its left image renders its mesh in the points' RGB, not in white."""
+    from dataclasses import replace
+
+    bare = render.surface_mesh(replace(result, left_rectified=None))
+    assert render.texture_of(bare) is None
+    img = render.render_view(bare, intrinsics=render.Intrinsics.from_result(result))
+    left = result.left_rectified[..., ::-1].astype(np.float64)
+    covered = ~np.isclose(img, render.BACKGROUND, atol=8).all(axis=-1)
+    assert covered.mean() > 0.9
+    assert np.abs(img - left)[covered].mean() < 12.0
+
+
+def test_point_cloud_drops_partly_non_finite_rows_and_checks_its_inputs():
+    pts = np.array([[0, 0, 1], [np.nan, 0, 2], [0, np.inf, 3], [1, 1, 4]], np.float32)
+    cols = np.array([[1, 1, 1], [2, 2, 2], [3, 3, 3], [4, 4, 4]], np.uint8)
+    cloud = render.point_cloud(pts, cols)
+    np.testing.assert_array_equal(cloud.points, pts[[0, 3]])
+    np.testing.assert_array_equal(cloud.point_data["RGB"], cols[[0, 3]])
+    with pytest.raises(ValueError, match=r"^colors: expected uint8 shape \(4, 3\), got float64"):
+        render.point_cloud(pts, cols.astype(np.float64))
+    with pytest.raises(ValueError, match=r"^points: expected shape \(N, 3\), got \(4, 2\)"):
+        render.point_cloud(pts[:, :2])
+
+
+def test_depth_colours_span_the_1st_to_99th_percentile_and_a_flat_cloud_one_metre():
+    z = np.concatenate([np.linspace(3.0, 5.0, 990), np.full(10, 500.0)])  # 1 % far outliers
+    pts = np.stack([np.zeros_like(z), np.zeros_like(z), z], 1)
+    plotter = render.make_plotter((64, 48))
+    try:
+        actor = render.add_geometry(plotter, render.point_cloud(pts))
+        lo, hi = np.percentile(z, [1, 99])
+        assert actor.mapper.scalar_range == pytest.approx((lo, hi))
+        assert hi < 10.0
+        flat = pts.copy()
+        flat[:, 2] = 4.0
+        actor = render.add_geometry(plotter, render.point_cloud(flat))
+        assert actor.mapper.scalar_range == pytest.approx((3.5, 4.5))
+    finally:
+        plotter.close()
+
+
+def test_median_depth_ignores_points_behind_the_camera():
+    cloud = render.point_cloud(np.array([[0, 0, -9.0], [0, 0, -8.0], [0, 0, 2.0], [0, 0, 3.0]]))
+    assert render.median_depth(cloud) == 2.5
+
+
+def test_render_view_sizes(mesh, result):
+    intr = render.Intrinsics.from_result(result)
+    assert render.render_view(mesh, intrinsics=intr, size=(80, 60)).shape == (60, 80, 3)
+    cloud = render.point_cloud(result.points[::50])
+    assert render.render_view(cloud).shape == (600, 800, 3)  # no intrinsics, no size: 800x600
+
+
+def test_points_in_view_edges_and_a_scaled_render():
+    """A point counts when it projects inside the picture's outer pixel edges (-0.5 .. W-0.5),
+    and intrinsics are scaled to the picture's width."""
+    f = 300 / math.tan(math.radians(30.0))
+    cx, cy = 399.5, 299.5
+    xs = np.array([-0.45, 799.45, -0.55, 799.55])
+    pts = np.stack([(xs - cx) / f, np.zeros(4), np.ones(4)], 1)
+    hits = [render.points_in_view(p[None], CameraControls(), (800, 600)) for p in pts]
+    assert hits == [1, 1, 0, 0]
+    ys = np.array([-0.45, 599.45, -0.55, 599.55])
+    pts = np.stack([np.zeros(4), (ys - cy) / f, np.ones(4)], 1)
+    hits = [render.points_in_view(p[None], CameraControls(), (800, 600)) for p in pts]
+    assert hits == [1, 1, 0, 0]
+    intr = render.Intrinsics(150.0, 79.5, 59.5, 160, 120)
+    p = np.array([[(100 - 79.5) / 150, 0.0, 1.0]])  # x = 100 of 160, x = 49.75 of 80
+    assert render.points_in_view(p, CameraControls(), (80, 60), intr) == 1
+
+
+def test_render_result_max_side_bounds_the_longer_side(result):
+    """max_side bounds the longer side of the picture (the height of a portrait one)."""
+    from dataclasses import replace
+
+    keep = result.pixels[:, 0] < 100
+    tall = replace(
+        result,
+        disparity=result.disparity[:, :100],
+        depth=result.depth[:, :100],
+        confidence=result.confidence[:, :100],
+        points=result.points[keep],
+        colors=result.colors[keep],
+        pixels=result.pixels[keep],
+        left_rectified=result.left_rectified[:, :100],
+    )
+    assert render.render_result(tall, max_side=60).shape == (60, 50, 3)
+    with pytest.raises(ValueError, match=r"^max_side: expected at least 16 pixels, got 15"):
+        render.render_result(result, max_side=15)
+
+
+def test_render_outputs_writes_nothing_for_an_empty_cloud(result, tmp_path):
+    from dataclasses import replace
+
+    empty = replace(
+        result,
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+    )
+    assert render.render_outputs(empty, tmp_path) == {}
+    assert not (tmp_path / "render.png").exists()
+
+
+def test_render_png_and_view_screenshots_keep_red_red(tmp_path):
+    """render.png and view's screenshot are RGB renders written by OpenCV (BGR): red stays red."""
+    from stereovision.io import write_ply
+
+    red = np.zeros((8, 8, 3), np.uint8)
+    red[..., 0] = 255
+    path = render.write_render(red, tmp_path)["render.png"]
+    assert cv2.imread(str(path))[0, 0].tolist() == [0, 0, 255]
+    pts = np.random.default_rng(2).uniform([-1, -1, 3], [1, 1, 5], (3000, 3)).astype(np.float32)
+    write_ply(tmp_path / "red.ply", pts, np.tile(np.array([[255, 0, 0]], np.uint8), (3000, 1)))
+    args = _view_args(tmp_path / "red.ply", tmp_path / "shot.PNG")  # any case of the suffix
+    assert args.func(args) == 0
+    bgr = cv2.imread(str(tmp_path / "shot.PNG")).astype(int)
+    drawn = bgr[np.abs(bgr[..., ::-1] - render.BACKGROUND).max(axis=-1) > 8]
+    assert len(drawn) > 100
+    b, g, r = np.median(drawn, axis=0)  # point edges blend with the background
+    assert r > 150 and b < 60 and g < 60, (b, g, r)
+
+
+def test_view_passes_each_control_flag_to_its_control(tmp_path, monkeypatch):
+    from stereovision.io import write_ply
+
+    write_ply(tmp_path / "c.ply", np.array([[0, 0, 3.0]], np.float32))
+    seen = []
+
+    def fake_render(geometry, controls, **kwargs):
+        seen.append(controls)
+        return np.zeros((60, 80, 3), np.uint8)
+
+    monkeypatch.setattr(render, "render_view", fake_render)
+    flags = {"roll": 1.0, "pitch": 2.0, "yaw": 3.0, "forward": 4.0, "up": 5.0, "right": 6.0}
+    args = _view_args(tmp_path / "c.ply", tmp_path / "shot.png", **flags)
+    with pytest.warns(UserWarning, match="none of the 1 points is in view"):
+        assert args.func(args) == 0
+    assert seen == [CameraControls(**flags)]
+
+
+def test_view_does_not_warn_for_a_cloud_at_the_side_of_a_landscape_shot(tmp_path):
+    """The in-view count is of the 800x600 picture written (width, height), not 600x800: a
+    cloud at x = 700 of 800 is in view, without a warning."""
+    import warnings
+
+    from stereovision.io import write_ply
+
+    x = (700 - 399.5) / (300 / math.tan(math.radians(30.0)))
+    pts = np.random.default_rng(9).normal([x * 4, 0, 4], 0.01, (200, 3)).astype(np.float32)
+    write_ply(tmp_path / "side.ply", pts, np.full((200, 3), 255, np.uint8))
+    args = _view_args(tmp_path / "side.ply", tmp_path / "side.png")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert args.func(args) == 0
+
+
+def test_free_name_skips_a_dangling_link(tmp_path):
+    """A view.png that is a broken symlink is taken (exists() is False for it): the screenshot
+    would be written through or over the link."""
+    (tmp_path / "view.png").symlink_to(tmp_path / "nowhere.png")
+    assert render._free_name(tmp_path / "view.png") == tmp_path / "view-2.png"
