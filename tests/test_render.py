@@ -1270,3 +1270,14 @@ def test_free_name_skips_a_dangling_link(tmp_path):
     would be written through or over the link."""
     (tmp_path / "view.png").symlink_to(tmp_path / "nowhere.png")
     assert render._free_name(tmp_path / "view.png") == tmp_path / "view-2.png"
+
+
+def test_controls_take_numpy_numbers_and_refuse_bools():
+    """A yaw of np.float32(5.0) (a value read out of a float32 array) was refused as "must be
+    a finite number"; True was taken for 1 degree and 2**1100 raised OverflowError."""
+    c = CameraControls(yaw=np.float32(5.0), up=np.int64(2))
+    assert (c.yaw, c.up) == (5.0, 2.0) and type(c.yaw) is float and type(c.up) is float
+    np.testing.assert_array_equal(c.pose(), camera_pose(yaw=5.0, up=2.0))
+    for bad in (True, 2**1100):
+        with pytest.raises(ValueError, match=r"^camera control roll must be a finite number"):
+            CameraControls(roll=bad)

@@ -115,10 +115,18 @@ class CameraControls:
     right: float = 0.0
 
     def __post_init__(self) -> None:
+        from stereovision._validate import finite_number
+
         for f in fields(self):
             value = getattr(self, f.name)
-            if not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise ValueError(f"camera control {f.name} must be a finite number, got {value!r}")
+            # NumPy numbers (np.float32 is no float) are numbers; a bool is not an angle
+            try:
+                number = finite_number(value, f.name)
+            except ValueError:
+                raise ValueError(
+                    f"camera control {f.name} must be a finite number, got {value!r}"
+                ) from None
+            object.__setattr__(self, f.name, number)
 
     def pose(self) -> npt.NDArray[np.float64]:
         """4x4 camera-to-left-camera pose of these controls (see :func:`camera_pose`).
