@@ -945,10 +945,15 @@ def test_controls_refuse_what_is_not_a_number():
             CameraControls(yaw=bad)  # type: ignore[arg-type]
 
 
-@pytest.mark.parametrize("depth", [math.nan, math.inf, -1.0])
+@pytest.mark.parametrize("depth", [math.nan, math.inf, -1.0, 0, "3", None, True])
 def test_orbit_refuses_a_centre_that_is_no_distance(depth):
     with pytest.raises(ValueError, match=r"^center_depth must be a positive distance"):
         render.orbit_controls(10.0, 5.0, depth)
+
+
+def test_orbit_takes_numpy_depths():
+    c = render.orbit_controls(10.0, 5.0, np.float32(4.0))
+    assert c == render.orbit_controls(10.0, 5.0, 4.0)
 
 
 def test_intrinsics_scaled_keeps_pixel_centres():

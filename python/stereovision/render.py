@@ -281,8 +281,15 @@ def orbit_controls(yaw: float, pitch: float, center_depth: float) -> CameraContr
     -------
     CameraControls
     """
-    if not math.isfinite(center_depth) or center_depth <= 0:
-        raise ValueError(f"center_depth must be a positive distance, got {center_depth}")
+    from stereovision._validate import finite_number
+
+    try:  # a text or None raised math.isfinite's TypeError, not this ValueError
+        depth = finite_number(center_depth, "center_depth")
+    except ValueError:
+        depth = math.nan
+    if not depth > 0:
+        raise ValueError(f"center_depth must be a positive distance, got {center_depth!r}")
+    center_depth = depth
     rot = camera_pose(yaw=yaw, pitch=pitch)[:3, :3]
     center = np.array([0.0, 0.0, center_depth])
     position = center - center_depth * rot[:, 2]
@@ -911,7 +918,9 @@ def render_view(
         Camera model (e.g. :meth:`Intrinsics.from_result`); the render size defaults to its image
         size. Without intrinsics a :data:`DEFAULT_FOV_DEG` view of ``size`` (default 800x600).
     size : (int, int), optional
-        ``(width, height)`` of the picture; with intrinsics they are scaled to fit it.
+        ``(width, height)`` of the picture. With intrinsics only the width counts: they are
+        scaled to it and keep their aspect ratio (the picture is ``width`` wide, as tall as the
+        scaled intrinsics).
     camera : CameraState, optional
         A view to render instead of the controls' pose (an interactive view's camera as the
         mouse left it): its position, focal point, view-up, view angle, window centre and
