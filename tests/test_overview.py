@@ -523,3 +523,13 @@ def test_overview_captions_clear_of_the_bar_labels_on_narrow_images(width: int, 
         for other, obox in ov.caption_boxes.items():
             assert other == name or not _boxes_overlap(box, obox), (name, other)
     _check_labels_inside_their_cells(ov)
+
+
+def test_end_labels_just_under_1000_are_not_written_in_exponent() -> None:
+    """A depth bar's near end of 999.6 mm was labelled "1e+03 mm" (``.3g`` rounds it to 1000,
+    written with an exponent); it reads "1000 mm", as 1000 mm does."""
+    for near in (0.9996, 1.0):
+        ov = overview_image(_result_with_depth(60, 80, near, 3.0), "t", "mm")
+        assert ov.bars["depth"].ticks[0][1] == "1000 mm"
+    ov = overview_image(_result_with_depth(60, 80, 0.9994, 3.0), "t", "mm")
+    assert ov.bars["depth"].ticks[0][1] == "999 mm"

@@ -146,7 +146,8 @@ class Overview:
 
 
 def _label(value: float) -> str:
-    return f"{value:.3g}" if abs(value) < 1000 else f"{value:.0f}"
+    # 999.5 and over: ``.3g`` rounds them to 1000 and writes "1e+03"
+    return f"{value:.3g}" if abs(value) < 999.5 else f"{value:.0f}"
 
 
 def _nice_values(lo: float, hi: float) -> list[float]:
