@@ -525,6 +525,85 @@ def test_overview_captions_clear_of_the_bar_labels_on_narrow_images(width: int, 
     _check_labels_inside_their_cells(ov)
 
 
+def _small_result(h: int, w: int) -> object:
+    """A DepthResult ``h`` x ``w`` with disparities 1-40 px, its depth 40 / d m and a hole
+    (NaN disparity and depth, confidence 0.7) in its top-left quarter."""
+    import stereovision as sv
+
+    rng = np.random.default_rng(5)
+    disp = rng.uniform(1, 40, (h, w)).astype(np.float32)
+    disp[: h // 2, : w // 2] = np.nan
+    conf = rng.uniform(0, 1, (h, w)).astype(np.float32)
+    conf[: h // 2, : w // 2] = 0.7
+    return sv.DepthResult(
+        disparity=disp,
+        confidence=conf,
+        depth=(40.0 / disp).astype(np.float32),
+        points=np.zeros((0, 3), np.float32),
+        colors=np.zeros((0, 3), np.uint8),
+        pixels=np.zeros((0, 2), np.int32),
+        method="fast",
+        max_disparity=64,
+    )
+
+
+def test_map_panels_are_black_without_a_value_and_turbo_elsewhere() -> None:
+    """A mutation audit found nothing asserting the maps' panels: the pixels without a
+    disparity are black in the disparity, depth and confidence panels (the confidence of a
+    pixel without a disparity is not shown), and a map downscaled to the panel keeps only
+    colours of the map (nearest, not a blend that lies on no bar)."""
+    res = _small_result(40, 2 * PANEL_WIDTH)
+    ov = overview_image(res, "t")
+    assert ov.scale == 0.5
+    turbo = {tuple(c) for c in _TURBO.tolist()}
+    for name in ("disparity", "depth", "confidence"):
+        x, y, w, h = ov.panels[name]
+        panel = ov.image[y : y + h, x : x + w]
+        assert not panel[: h // 2, : w // 2].any(), name  # the hole: black
+        rest = panel[h // 2 :].reshape(-1, 3)
+        assert all(tuple(c) in turbo for c in rest.tolist()), name
+
+
+def test_a_grey_left_image_is_drawn_grey() -> None:
+    res = _small_result(30, 40)
+    res.left_rectified = np.arange(30 * 40, dtype=np.uint32).reshape(30, 40).astype(np.uint8)
+    ov = overview_image(res, "t")
+    x, y, w, h = ov.panels["left"]
+    drawn = ov.image[y : y + h, x : x + w]
+    np.testing.assert_array_equal(drawn, np.repeat(res.left_rectified[:, :, None], 3, axis=2))
+
+
+def test_holes_of_the_disparity_are_not_called_filled() -> None:
+    """The depth's "none where filled" is for pixels with a disparity (confidence 0) but no
+    depth; where the disparity itself is missing nothing was filled."""
+    res = _small_result(30, 300)  # wide enough for the reason in the caption
+    res.confidence[:15, :150] = 0.0  # no disparity there: not a filled pixel
+    share = 100 * float(np.isfinite(res.depth).mean())
+    assert overview_image(res, "t").captions["depth"] == f"depth (m) on {share:.1f} %"
+
+
+def test_a_unit_that_is_not_a_string_is_a_value_error() -> None:
+    with pytest.raises(ValueError, match=r"^unit: expected one of"):
+        overview_image(_small_result(8, 8), "t", ["m"])  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(("rows", "labels"), [(16, 1), (17, 2)])
+def test_a_bar_labels_its_bottom_end_from_17_rows(rows: int, labels: int) -> None:
+    """Two labels 16 rows apart are far enough (as for the inner ticks): a bar of 17 rows
+    labels both ends, one of 16 its top only."""
+    ov = overview_image(_small_result(rows, 40), "t")
+    for bar in ov.bars.values():
+        assert len(bar.ticks) == labels, bar.ticks
+
+
+def test_bar_runs_from_level_255_at_its_top_to_0_at_its_bottom() -> None:
+    ov = overview_image(_small_result(60, 80), "t")
+    for bar in ov.bars.values():
+        x, y, w, h = bar.box
+        assert _level(ov.image[y, x + w // 2]) == 255
+        assert _level(ov.image[y + h - 1, x + w // 2]) == 0
+
+
 def test_end_labels_just_under_1000_are_not_written_in_exponent() -> None:
     """A depth bar's near end of 999.6 mm was labelled "1e+03 mm" (``.3g`` rounds it to 1000,
     written with an exponent); it reads "1000 mm", as 1000 mm does."""
@@ -533,3 +612,20 @@ def test_end_labels_just_under_1000_are_not_written_in_exponent() -> None:
         assert ov.bars["depth"].ticks[0][1] == "1000 mm"
     ov = overview_image(_result_with_depth(60, 80, 0.9994, 3.0), "t", "mm")
     assert ov.bars["depth"].ticks[0][1] == "999 mm"
+
+
+def test_a_long_title_is_scaled_into_the_picture() -> None:
+    ov = overview_image(_small_result(20, 20), "x" * 60)
+    width = ov.image.shape[1]
+    title_rows = ov.image[:34].max(axis=2) > 40  # the background is (40, 40, 40)
+    assert title_rows[:, : width // 2].any() and not title_rows[:, width - 10 :].any()
+
+
+def test_infinite_depths_leave_the_depth_bar_alone() -> None:
+    """Infinite depths (a disparity of 0) have no colour on the depth bar: its ends are those
+    of the finite depths."""
+    res = _result_with_depth(60, 80, 0.5, 4.0)
+    before = overview_image(res, "t").bars["depth"].ticks
+    res.depth[:10] = np.inf
+    after = overview_image(res, "t").bars["depth"].ticks
+    assert (after[0][1], after[-1][1]) == (before[0][1], before[-1][1]) == ("0.5 m", "4 m")
