@@ -645,3 +645,103 @@ def test_each_cameras_stereo_rms_pools_every_corner(rig: dict[str, Any]) -> None
             sq.append(np.sum((proj - p) ** 2, axis=1))
         pooled = math.sqrt(float(np.mean(np.concatenate(sq))))
         assert getattr(rep, f"stereo_rms_{side}") == pytest.approx(pooled, rel=1e-4)
+
+
+def test_board_limits_are_inclusive() -> None:
+    """A mutation audit found the limits unasserted at their edges: a board of exactly 2320
+    markers (the largest dictionary's size) and one of exactly a dictionary's size are boards;
+    an odd count of squares has ``cols * rows // 2`` markers, as OpenCV's board."""
+    assert CharucoBoard("80x58", 0.03, 0.02).n_markers == 2320
+    full = CharucoBoard("10x10", 0.03, 0.02, "DICT_4X4_50")
+    assert full.n_markers == 50 and full.dictionary == "DICT_4X4_50"
+    odd = CharucoBoard("7x5", 0.03, 0.02, "DICT_4X4_50")
+    assert odd.n_markers == len(odd.cv_board().getIds()) == 17
+    assert odd.n_corners == 24 and odd.inner == (6, 4)
+
+
+def test_dictionary_auto_takes_the_smallest_that_holds_the_board() -> None:
+    """A 10x10 board has 50 markers: DICT_4X4_50 holds them all (not DICT_4X4_100)."""
+    img = CharucoBoard("10x10", 0.03, 0.02, "DICT_4X4_50").image(40)
+    found = CharucoBoard("10x10", 0.03, 0.02).resolve(img)
+    assert found is not None and found.dictionary == "DICT_4X4_50"
+
+
+def test_the_legacy_layout_is_told_by_the_rows_not_the_columns() -> None:
+    """Only an even number of rows has two layouts: 9x8 is described as legacy, 8x7 not."""
+    even_rows = CharucoBoard("9x8", 0.03, 0.02, "DICT_4X4_50", legacy=True)
+    odd_rows = CharucoBoard("8x7", 0.03, 0.02, "DICT_4X4_50", legacy=True)
+    assert even_rows.describe().endswith("DICT_4X4_50 (legacy layout)")
+    assert odd_rows.describe().endswith("marker 0.02, DICT_4X4_50")
+
+
+def test_board_image_size_and_its_limits() -> None:
+    """The default margin is one square; a marker of exactly its dictionary's bits and
+    border (7 px for 5x5) is drawn, a smaller one is refused by name, and so is an image
+    over MAX_IMAGE_PIXELS."""
+    board = CharucoBoard("7x5", 0.03, 0.02, "DICT_4X4_50")
+    assert board.image(40).shape == (5 * 40 + 80, 7 * 40 + 80)
+    assert board.image(40, margin=0).shape == (200, 280)
+    assert CharucoBoard("5x5", 1.0, 0.7, "DICT_5X5_50").image(10).shape == (70, 70)
+    with pytest.raises(ValueError, match=r"is 6.9 px at 10 px per square; DICT_5X5_50's "):
+        CharucoBoard("5x5", 1.0, 0.69, "DICT_5X5_50").image(10)
+    with pytest.raises(ValueError, match=r"a 19200x14400 image is over 2.5e\+08 pixels"):
+        CharucoBoard("10x7", 0.03, 0.022, "DICT_5X5_50").image(1600)
+
+
+def test_corners_on_one_line_do_not_span_the_board() -> None:
+    from stereovision.charuco import corners_span_plane
+
+    assert not corners_span_plane(BOARD, np.arange(9))  # one row
+    assert not corners_span_plane(BOARD, np.array([0, 10, 20, 30]))  # a diagonal
+    assert corners_span_plane(BOARD, np.array([0, 1, 9]))
+    assert not corners_span_plane(BOARD, np.array([3]))
+    assert not corners_span_plane(BOARD, np.array([], np.int64))
+    # a strip of the board with its first row of corners: nine corners on one line, no view
+    img = CharucoBoard("10x7", 0.03, 0.022, "DICT_5X5_50").image(40)
+    assert find_charuco_corners(np.ascontiguousarray(img[:130]), BOARD) is None
+
+
+def test_printed_chessboard_starts_black_and_refuses_a_huge_one() -> None:
+    """The chessboard's first square (top left, inside the one-square margin) is black, as
+    OpenCV's pattern; one over MAX_IMAGE_PIXELS is refused before it is drawn."""
+    data, (w, h) = board_png((9, 6), 0.01, dpi=254)  # 100 px squares
+    img = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_GRAYSCALE)
+    assert (w, h) == (1200, 900)
+    assert img[100:200, 100:200].max() == 0 and img[100:200, 200:300].min() == 255
+    assert img[:100].min() == 255  # the margin
+    with pytest.raises(ValueError, match="a 60x40 chessboard at 354 px per square is too large"):
+        board_png((60, 40), 0.03)
+
+
+def test_the_layout_of_an_even_rowed_board_is_found_whatever_its_columns() -> None:
+    """A 7x8 board (odd columns, even rows) printed in the legacy layout, given with its
+    dictionary but not its layout: the layout is looked for (the rows decide), all corners."""
+    printed = CharucoBoard("7x8", 0.03, 0.02, "DICT_4X4_50", legacy=True)
+    given = CharucoBoard("7x8", 0.03, 0.02, "DICT_4X4_50")
+    assert not given.resolved
+    found = find_charuco_corners(printed.image(40), given)
+    assert found is not None and len(found[0]) == printed.n_corners == 42
+
+
+def test_markers_seen_counts_the_boards_ids_and_two_settle_the_dictionary() -> None:
+    """A 10x7 board's image shows 35 markers; a 7x5 board counts the 17 with its ids (0-16).
+    A corner of the image with two of them (AUTO_MIN_MARKERS) settles the dictionary, one
+    does not."""
+    img = CharucoBoard("10x7", 0.03, 0.022, "DICT_5X5_50").image(40)
+    assert CharucoBoard("7x5", 0.03, 0.02).markers_seen(img) == ("DICT_5X5_50", 17)
+    auto = CharucoBoard("10x7", 0.03, 0.022)
+    two, one = np.ascontiguousarray(img[:200, :100]), np.ascontiguousarray(img[:180, :100])
+    assert auto.markers_seen(two) == ("DICT_5X5_50", 2)
+    resolved = auto.resolve(two)
+    assert resolved is not None and resolved.dictionary == "DICT_5X5_50"
+    assert auto.markers_seen(one) == ("DICT_5X5_50", 1) and auto.resolve(one) is None
+
+
+def test_six_corners_are_enough_and_four_are_not() -> None:
+    """MIN_CORNERS (6) corners are found; 4 are not a view. The ids are those of the board's
+    top-left corner, at their printed pixels (one margin and one square in: 80 px)."""
+    img = CharucoBoard("10x7", 0.03, 0.022, "DICT_5X5_50").image(40)
+    six = find_charuco_corners(np.ascontiguousarray(img[:160, :200]), BOARD)
+    assert six is not None and six[0].tolist() == [0, 1, 2, 9, 10, 11]
+    np.testing.assert_allclose(six[1][4], (120 - 0.5, 120 - 0.5), atol=0.2)
+    assert find_charuco_corners(np.ascontiguousarray(img[:160, :160]), BOARD) is None
