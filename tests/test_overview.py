@@ -629,3 +629,17 @@ def test_infinite_depths_leave_the_depth_bar_alone() -> None:
     res.depth[:10] = np.inf
     after = overview_image(res, "t").bars["depth"].ticks
     assert (after[0][1], after[-1][1]) == (before[0][1], before[-1][1]) == ("0.5 m", "4 m")
+
+
+@pytest.mark.parametrize("width", [1, 8, 33, 64])
+def test_a_caption_over_the_label_column_keeps_3_rows_above_the_top_label(width: int) -> None:
+    """_CAPTION_GAP: where a caption reaches over its bar's label column, 3 blank rows at least
+    separate its box from the top label's (boxes of ``cv2.getTextSize``)."""
+    ov = overview_image(_result_with_depth(24, width, 0.5, 4.0), "t")
+    tops = {name: box for name, _, box in reversed(_label_boxes(ov))}  # the first of each bar
+    reaching = 0
+    for name, (_, _, x1, y1) in ov.caption_boxes.items():
+        if name in tops and x1 > tops[name][0]:
+            reaching += 1
+            assert tops[name][1] - y1 >= 3, (name, ov.caption_boxes[name], tops[name])
+    assert reaching >= 1
