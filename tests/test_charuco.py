@@ -713,8 +713,8 @@ def test_printed_chessboard_starts_black_and_refuses_a_huge_one() -> None:
         board_png((60, 40), 0.03)
     # 10 px per square is the least: a 25.4 mm square at 10 dpi is one
     assert board_png((3, 3), 0.0254, dpi=10)[1] == (60, 60)
-    with pytest.raises(ValueError, match="giving 10 to 20000 px per square"):
-        board_png((3, 3), 0.0254, dpi=9.99)
+    with pytest.raises(ValueError, match=r"is 9\.99 px; .*giving 10 to 20000 px per square"):
+        board_png((3, 3), 0.0254, dpi=9.99)  # it said "is 10.0 px" of a square it refused
 
 
 def test_the_layout_of_an_even_rowed_board_is_found_whatever_its_columns() -> None:

@@ -537,7 +537,7 @@ def _board_scale(square_metres: float, dpi: float) -> tuple[int, int]:
     p = positive_finite(square_metres, "square_metres") / 0.0254 * positive_finite(dpi, "dpi")
     if not 10 <= p <= 20000:
         raise ValueError(
-            f"a {square_metres * 1000:g} mm square at {dpi:g} dpi is {p:.1f} px; use a square "
+            f"a {square_metres * 1000:g} mm square at {dpi:g} dpi is {p:.6g} px; use a square "
             "and dpi giving 10 to 20000 px per square"
         )
     pix = round(p)
