@@ -480,3 +480,157 @@ def test_an_interrupt_as_a_frame_is_released_keeps_the_frames(
         meta = {t: info.msgcount for t, info in reader.topics.items()}
     assert stamps == [1, 2, 3]
     assert meta == {t: 3 for t in meta} and len(meta) == 7
+
+
+def test_bag_topics_flags_and_fields_a_reader_relies_on(kitti: tuple, tmp_path: Path) -> None:
+    """Mutation audit: the prefix given is normalised (one leading slash, none trailing; an
+    empty one puts the topics at the root), ``points=False`` writes no cloud, a mono left image
+    is ``mono8``, the images are little-endian, the camera_info's model ``plumb_bob``, the
+    cloud's ``row_step`` its whole row and the disparity's ``valid_window`` the box of the
+    pixels with a depth; a stamp of 2**31 s (past ``sec``'s int32) is refused, one ns less is
+    not."""
+    import dataclasses
+
+    import cv2
+
+    from stereovision.rosbag import BagWriter
+
+    res, _ = kitti
+    grey = dataclasses.replace(res, left_rectified=cv2.cvtColor(res.left_rectified,
+                                                                cv2.COLOR_BGR2GRAY))  # fmt: skip
+    last = 2**31 * 1_000_000_000
+    with BagWriter(tmp_path / "a", prefix="robot/stereo/") as bag:
+        with pytest.raises(ValueError, match="2\\*\\*31 s"):
+            bag.write(res, last)
+        bag.write(res, last - 1)
+    a = _read(tmp_path / "a")
+    assert "/robot/stereo/depth" in a and len(a) == 7
+    assert a["/robot/stereo/depth"][0][0] == last - 1
+    depth = a["/robot/stereo/depth"][0][1]
+    assert (
+        depth.is_bigendian == 0 and a["/robot/stereo/left/image_rect_color"][0][1].is_bigendian == 0
+    )
+    assert a["/robot/stereo/left/camera_info"][0][1].distortion_model == "plumb_bob"
+    cloud = a["/robot/stereo/points"][0][1]
+    assert cloud.row_step == 16 * cloud.width == len(cloud.data)
+    disp = a["/robot/stereo/disparity"][0][1]
+    rows, cols = np.nonzero(np.isfinite(res.depth))
+    win = disp.valid_window
+    assert (win.x_offset, win.y_offset) == (cols.min(), rows.min())
+    assert (win.width, win.height) == (cols.max() - cols.min() + 1, rows.max() - rows.min() + 1)
+    with BagWriter(tmp_path / "b", prefix="/", points=False) as bag:
+        bag.write(grey, 1)
+    b = _read(tmp_path / "b")
+    assert sorted(b) == ["/camera_info", "/depth", "/disparity", "/left/camera_info",
+                         "/left/image_rect_color", "/right/camera_info"]  # fmt: skip
+    img = b["/left/image_rect_color"][0][1]
+    assert img.encoding == "mono8" and img.step == img.width
+    np.testing.assert_array_equal(img.data.reshape(img.height, img.width), grey.left_rectified)
+
+
+def test_a_closed_bag_refuses_frames(kitti: tuple, tmp_path: Path) -> None:
+    """Mutation audit: a frame written after close is a ValueError naming the bag (not
+    rosbags' own error, nor written), and closing again does nothing."""
+    from stereovision.rosbag import BagWriter
+
+    bag = BagWriter(tmp_path / "run")
+    bag.write(kitti[0], 1)
+    bag.close()
+    bag.close()
+    with pytest.raises(ValueError, match=r"^bag .*run is closed$"):
+        bag.write(kitti[0], 2)
+    assert (bag.messages, bag.frames) == (7, 1)
+    assert {s for msgs in _read(tmp_path / "run").values() for s, _ in msgs} == {1}
+
+
+def test_a_first_frame_cut_by_a_full_disk_leaves_a_readable_bag(
+    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Mutation audit: a full disk in the very first frame rolls back the topics that frame
+    made; the next frame makes them again and metadata.yaml's time span is its own (the
+    rolled back frames' stamps are not the bag's start nor end)."""
+    import errno
+
+    from rosbags.highlevel import AnyReader
+
+    from stereovision.rosbag import BagWriter
+
+    res, _ = kitti
+    bag = BagWriter(tmp_path / "run")
+    storage = bag._writer.storage
+    real_write = storage.write
+    calls = [0]
+
+    def full_at_3_and_20(*args: object) -> None:
+        calls[0] += 1
+        if calls[0] in (3, 20):  # in the first frame and in the fourth
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real_write(*args)
+
+    monkeypatch.setattr(storage, "write", full_at_3_and_20)
+    with pytest.raises(OSError, match="No space left"):
+        bag.write(res, 5_000)
+    assert (bag.messages, bag.frames) == (0, 0)
+    bag.write(res, 7_000)
+    bag.write(res, 9_000)
+    with pytest.raises(OSError, match="No space left"):
+        bag.write(res, 11_000)
+    bag.close()
+    assert (bag.messages, bag.frames) == (14, 2)
+    with AnyReader([tmp_path / "run"]) as reader:
+        stamps = sorted({stamp for _, stamp, _ in reader.messages()})
+        meta = {t: info.msgcount for t, info in reader.topics.items()}
+        span = (reader.start_time, reader.end_time)
+    assert stamps == [7_000, 9_000]
+    assert meta == {t: 2 for t in meta} and len(meta) == 7
+    assert span == (7_000, 9_001)
+
+
+def test_the_frame_after_an_interrupted_undo_is_kept(
+    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Mutation audit: a frame cut by a Ctrl-C whose undoing was cut too is undone before the
+    next frame is written; written inside its open savepoint, that next frame was rolled back
+    with it at the close."""
+    import sqlite3
+
+    from rosbags.highlevel import AnyReader
+
+    from stereovision import rosbag
+
+    class Interrupted(sqlite3.Connection):
+        cut = True
+
+        def execute(self, sql: str, *args: object) -> sqlite3.Cursor:  # type: ignore[override]
+            if sql == "ROLLBACK TO frame" and self.cut:
+                self.cut = False
+                raise KeyboardInterrupt  # the third Ctrl-C
+            return super().execute(sql, *args)
+
+    res, _ = kitti
+    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 0.0)
+    bag = rosbag.BagWriter(tmp_path / "run")
+    bag.write(res, 1)  # committed
+    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 3600.0)
+    storage = bag._writer.storage
+    storage.conn.close()
+    storage.conn = sqlite3.connect(storage.path, factory=Interrupted)
+    storage.cursor = storage.conn.cursor()
+    real_write = storage.write
+    calls = [0]
+
+    def second_ctrl_c(*args: object) -> None:
+        calls[0] += 1
+        if calls[0] == 3:
+            raise KeyboardInterrupt
+        real_write(*args)
+
+    monkeypatch.setattr(storage, "write", second_ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        bag.write(res, 2)
+    bag.write(res, 3)
+    bag.close()
+    assert (bag.messages, bag.frames) == (14, 2)
+    with AnyReader([tmp_path / "run"]) as reader:
+        stamps = sorted({stamp for _, stamp, _ in reader.messages()})
+    assert stamps == [1, 3]
