@@ -922,3 +922,19 @@ def test_cli_capture_says_its_pairs_are_kept_when_a_recorded_frame_does_not_deco
     assert said.endswith(f"; 2 pairs were saved in {out_dir} and are kept")
     assert sorted(p.name for p in out_dir.iterdir()) == [
         "left_0001.png", "left_0002.png", "right_0001.png", "right_0002.png"]  # fmt: skip
+
+
+def test_rgba8_and_rgb16_decode_with_their_channel_order(cones: Any) -> None:
+    """Mutation audit: ``rgba8`` and ``rgb16`` were not read in the tests (red and blue
+    exchanged, or the alpha taken for a colour, went unseen)."""
+    bgr = cones.left
+    h, w = bgr.shape[:2]
+    rgba = np.ascontiguousarray(np.dstack([bgr[..., ::-1], np.full((h, w), 255, np.uint8)]))
+    msg = _Msg(height=h, width=w, encoding="rgba8", is_bigendian=0, step=4 * w,
+               data=rgba.reshape(-1))  # fmt: skip
+    np.testing.assert_array_equal(decode_image(msg), bgr)
+    c16 = (bgr.astype(np.uint16) << 8) | 7
+    rgb16 = np.ascontiguousarray(c16[..., ::-1]).astype("<u2")
+    msg = _Msg(height=h, width=w, encoding="rgb16", is_bigendian=0, step=6 * w,
+               data=rgb16.view(np.uint8).reshape(-1))  # fmt: skip
+    np.testing.assert_array_equal(decode_image(msg), c16)
