@@ -938,3 +938,36 @@ def test_rgba8_and_rgb16_decode_with_their_channel_order(cones: Any) -> None:
     msg = _Msg(height=h, width=w, encoding="rgb16", is_bigendian=0, step=6 * w,
                data=rgb16.view(np.uint8).reshape(-1))  # fmt: skip
     np.testing.assert_array_equal(decode_image(msg), c16)
+
+
+def test_stamps_rates_and_the_skew_limit_itself(cones: Any, tmp_path: Path) -> None:
+    """Mutation audit: a header stamp left 0 by the driver is the recording time (one of 1 ns
+    is not); n messages over a span are n - 1 periods; a pair exactly ``max_skew_ms`` apart
+    (either way) is paired, and ``max_skew_ms=0`` (exact stamps only) is accepted."""
+    from stereovision.rosbag import _rate, _stamp_ns
+
+    def header(sec: int, nanosec: int) -> Any:
+        return _Msg(header=_Msg(stamp=_Msg(sec=sec, nanosec=nanosec)))
+
+    assert _stamp_ns(header(0, 0), 123) == 123
+    assert _stamp_ns(header(0, 1), 123) == 1
+    assert _stamp_ns(header(2, 5), 123) == 2_000_000_005
+    assert _rate(31, _Msg(duration=1_000_000_000)) == pytest.approx(30.0)
+    assert _rate(1, _Msg(duration=1_000_000_000)) == 0.0
+    left, right = cones.left[:64, :96], cones.right[:64, :96]
+    frames = [
+        (T0, left, T0 + 2_000_000, right),  # right 2 ms late
+        (T0 + PERIOD_NS, left, T0 + PERIOD_NS - 2_000_000, right),  # 2 ms early
+        (T0 + 2 * PERIOD_NS, left, T0 + 2 * PERIOD_NS, right),  # exact
+    ]
+    bag = write_bag(tmp_path / "rig", frames)
+    with BagCamera(bag, max_skew_ms=2.0) as cam:
+        list(cam.frames())
+    assert cam.stamps_ns == [T0, T0 + PERIOD_NS, T0 + 2 * PERIOD_NS]
+    assert cam.dropped == {"left": 0, "right": 0}
+    with BagCamera(bag, max_skew_ms=0) as cam:
+        list(cam.frames())
+    assert cam.stamps_ns == [T0 + 2 * PERIOD_NS]
+    assert cam.dropped == {"left": 2, "right": 2}
+    with pytest.raises(ValueError, match="max_skew_ms: expected a number >= 0"):
+        BagCamera(bag, max_skew_ms=-1)

@@ -1001,7 +1001,9 @@ class BagCamera(PairSource):
         tol = self._tol_ns
         while lefts:
             sl = lefts[0][0]
-            while rights and rights[0][0] < sl - tol:
+            # differences of int stamps: sl +- tol in floats (stamps near 1.7e18 ns, a 256 ns
+            # step) refused a pair exactly max_skew_ms apart
+            while rights and sl - rights[0][0] > tol:
                 rights.popleft()
                 self.dropped["right"] += 1
             waiting = not rights or rights[-1][0] < sl
@@ -1009,7 +1011,7 @@ class BagCamera(PairSource):
                 return  # a nearer right frame may still come
             best = None
             for i, (sr, _) in enumerate(rights):
-                if sr > sl + tol:
+                if sr - sl > tol:
                     break
                 if best is None or abs(sr - sl) < abs(rights[best][0] - sl):
                     best = i
