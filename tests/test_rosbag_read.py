@@ -971,3 +971,31 @@ def test_stamps_rates_and_the_skew_limit_itself(cones: Any, tmp_path: Path) -> N
     assert cam.dropped == {"left": 2, "right": 2}
     with pytest.raises(ValueError, match="max_skew_ms: expected a number >= 0"):
         BagCamera(bag, max_skew_ms=-1)
+
+
+def test_bgra16_transport_suffixes_and_positions(cones: Any, tmp_path: Path) -> None:
+    """Mutation audit: ``bgra16`` keeps its channel order, every image_transport suffix
+    (``zstd`` too) is taken off a topic, and a frame's ``pos_*_ms`` are milliseconds."""
+    from stereovision.rosbag import _base_topic
+
+    bgr = cones.left[:32, :48]
+    h, w = bgr.shape[:2]
+    c16 = (bgr.astype(np.uint16) << 8) | 3
+    bgra = np.ascontiguousarray(np.dstack([c16, np.full((h, w), 65535, np.uint16)])).astype("<u2")
+    msg = _Msg(height=h, width=w, encoding="bgra16", is_bigendian=0, step=8 * w,
+               data=bgra.view(np.uint8).reshape(-1))  # fmt: skip
+    np.testing.assert_array_equal(decode_image(msg), c16)
+    for suffix in ("compressed", "theora", "ffmpeg", "zstd"):
+        assert _base_topic(f"/cam/image_raw/{suffix}") == "/cam/image_raw"
+    left, right = cones.left[:64, :96], cones.right[:64, :96]
+    bag = write_bag(tmp_path / "rig", [(T0 + k * PERIOD_NS, left, T0 + k * PERIOD_NS, right)
+                                       for k in range(3)])  # fmt: skip
+    with BagCamera(bag) as cam:
+        got = list(cam.frames())
+    # the bag starts at the first message's recording time, 2 ms after its stamp
+    assert [f.pos_left_ms for f in got] == pytest.approx(
+        [-2 + k * PERIOD_NS / 1e6 for k in range(3)]
+    )
+    assert [f.pos_right_ms for f in got] == pytest.approx(
+        [-2 + k * PERIOD_NS / 1e6 for k in range(3)]
+    )
