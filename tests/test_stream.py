@@ -1509,3 +1509,115 @@ def test_a_camera_that_fails_to_close_still_lets_the_bag_be_finished(
     assert (bag / "metadata.yaml").is_file()
     with Reader(bag) as reader:
         assert {c.msgcount for c in reader.connections} == {2}
+
+
+class _FakeRig:
+    """A stereo camera stand-in: ``read`` hands out ``pairs`` (a StereoFrame or an exception
+    to raise) in turn; ``stamps_ns`` (a recording's stamps) grows by one per pair when given."""
+
+    def __init__(self, pairs: list[Any], stamps_ns: list[int] | None = None) -> None:
+        self._pairs = list(pairs)
+        self.count = 0
+        self.size = None
+        self.delivered_size: dict[str, tuple[int, int]] = {}
+        self._stamps = stamps_ns
+        if stamps_ns is not None:
+            self.stamps_ns: list[int] = []
+
+    def read(self) -> Any:
+        from stereovision.capture import SourceError
+
+        if not self._pairs:
+            raise SourceError("ended", end=True)
+        item = self._pairs.pop(0)
+        if isinstance(item, BaseException):
+            raise item
+        if self._stamps is not None:
+            self.stamps_ns.append(self._stamps[self.count])
+        self.count += 1
+        return item
+
+
+def _frame(index: int, t_left: float | None = None, t_right: float | None = None) -> Any:
+    from stereovision.capture import StereoFrame
+
+    rng = np.random.default_rng(index)
+    # smooth texture: no noise warning
+    left = cv2.GaussianBlur(rng.integers(0, 255, (48, 64, 3), dtype=np.uint8), (7, 7), 2.0)
+    now = time.monotonic()
+    return StereoFrame(left, np.roll(left, -2, axis=1), now if t_left is None else t_left,
+                       now if t_right is None else t_right, index)  # fmt: skip
+
+
+def test_run_stream_refuses_no_frames() -> None:
+    """frames=0 (nothing to do) is a usage error, as a negative count is."""
+    with pytest.raises(ValueError, match="frames: expected a positive number, got 0"):
+        run_stream(_FakeRig([_frame(0)]), max_disparity=8, frames=0)  # type: ignore[arg-type]
+
+
+def test_a_first_pair_that_does_not_decode_is_a_value_error() -> None:
+    """A recording's first frame that does not decode raises its ValueError as it is; only a
+    later one becomes the source failing (SourceError, the stream's summary)."""
+    bad = ValueError("frame 0 does not decode")
+    with pytest.raises(ValueError, match="does not decode") as err:
+        run_stream(_FakeRig([bad]), max_disparity=8, pipelined=False, check=False)  # type: ignore[arg-type]
+    assert type(err.value) is ValueError
+    rep = run_stream(_FakeRig([_frame(0), ValueError("frame 1 does not decode")]),  # type: ignore[arg-type]
+                     max_disparity=8, pipelined=False, check=False)  # fmt: skip
+    assert (rep.frames, rep.ended, rep.error) == (1, "source failed", "frame 1 does not decode")
+
+
+def test_a_recordings_results_carry_each_pairs_own_stamp() -> None:
+    """A recording's pair is stamped with its own stamp (the latest read), not its first's."""
+    stamps = [1_000_000_000, 1_033_000_000, 1_066_000_000]
+    seen: list[int] = []
+    run_stream(_FakeRig([_frame(i) for i in range(3)], stamps_ns=stamps),  # type: ignore[arg-type]
+               max_disparity=8, pipelined=False, check=False,
+               on_stamped_result=lambda left, res, ns: seen.append(ns))  # fmt: skip
+    assert seen == stamps
+
+
+def test_a_live_pair_is_stamped_between_its_two_grabs() -> None:
+    """A live pair's stamp is the middle of its left and right grabs (host monotonic times)."""
+    now = time.monotonic()
+    seen: list[tuple[int, int]] = []
+
+    def on_stamped(left: np.ndarray, res: object, ns: int) -> None:
+        seen.append((ns, time.time_ns()))
+
+    rig: Any = _FakeRig([_frame(0, t_left=now - 2.0, t_right=now)])
+    run_stream(rig, max_disparity=8, pipelined=False, check=False, on_stamped_result=on_stamped)
+    ((stamp, called),) = seen
+    ago_s = (called - stamp) / 1e9
+    assert 1.0 <= ago_s < 1.5  # the left grab 2 s, the right 0 s before the stamp was taken
+
+
+def test_the_text_report_names_averaged_frames_only_when_averaging() -> None:
+    """A report line says "frames averaged" only when pairs were averaged (more than one)."""
+    from stereovision.stream import _format_report
+
+    rep = {"fps": 10.0, "stage_ms": dict.fromkeys(STAGES, 1.0), "latency_ms": 5.0,
+           "wait_ms": 0.0, "skew_ms": {"mean": 0.1}, "density": 0.5}  # fmt: skip
+    assert "averaged" not in _format_report({**rep, "frames_averaged": 1.0})
+    assert _format_report({**rep, "frames_averaged": 2.5}).endswith("| 2.5 frames averaged")
+
+
+def test_run_stream_refuses_no_disparity_range_and_a_bool_check_every() -> None:
+    """max_disparity=0 and check_every=True are usage errors, refused before any grab."""
+    for kw, said in (
+        ({"max_disparity": 0}, "max_disparity: expected a positive number, got 0"),
+        ({"max_disparity": 8, "check_every": True}, "check_every: expected a positive number"),
+    ):
+        rig = _FakeRig([_frame(0)])
+        with pytest.raises(ValueError, match=said):
+            run_stream(rig, **kw)  # type: ignore[arg-type]
+        assert rig.count == 0
+
+
+def test_a_window_reports_its_own_pairs_per_second() -> None:
+    """A per-second report's fps is its window's pairs over its length, not the run's total."""
+    from stereovision.stream import _Done, _window_report
+
+    done = [_Done(dict.fromkeys(STAGES, 0.001), 0.01, 0.0, 0.1, 0.5) for _ in range(2)]
+    rep = _window_report(done, 0.5, 10, 5.0, 8, False)
+    assert (rep["frames"], rep["total_frames"], rep["fps"]) == (2, 10, 4.0)
