@@ -595,3 +595,79 @@ def test_matches_image_shape_of_whole_floats_is_read(tmp_path: Path, shape: obje
     assert m.image_shape == (64, 128) and all(type(v) is int for v in m.image_shape)
     path = m.save_csv(tmp_path / "m.csv")
     assert sv.Matches.from_csv(path, shape).image_shape == (64, 128)  # type: ignore[arg-type]
+
+
+# --- Matches without the shared data (the tests above that use it are skipped without it) ---
+
+
+def _three() -> sv.Matches:
+    return sv.Matches(
+        xl=[10.0, 20.0, 30.0],
+        yl=[5.0, 6.0, 7.0],
+        xr=[7.5, 18.0, 30.0],
+        yr=[5.0, 5.5, 7.25],
+        score=[0.9, 0.5, 1.0],
+        image_shape=(12, 40),
+        energy_trace=[3.0, 2.0],
+        stats={"n": 3},
+    )
+
+
+def test_matches_arrays_are_checked_and_kept_as_given() -> None:
+    m = _three()
+    np.testing.assert_array_equal(
+        m.to_array(), [[10, 5, 7.5, 5], [20, 6, 18, 5.5], [30, 7, 30, 7.25]]
+    )
+    assert m.energy_trace.dtype == np.float64 and m.energy_trace.tolist() == [3.0, 2.0]
+    a = np.zeros(3, np.float32)
+    with pytest.raises(ValueError, match=r"xl: expected a 1-D array, got shape \(3, 1\)"):
+        sv.Matches(xl=a[:, None], yl=a, xr=a, yr=a, score=a, image_shape=(4, 4))
+    with pytest.raises(ValueError, match=r"must have one length, got \[3, 3, 2, 3, 3\]"):
+        sv.Matches(xl=a, yl=a, xr=a[:2], yr=a, score=a, image_shape=(4, 4))
+
+
+def test_matches_rasters_are_left_minus_right_at_the_rounded_left_pixel() -> None:
+    m = _three()
+    assert (m.dispx[5, 10], m.dispx[6, 20], m.dispx[7, 30]) == (2.5, 2.0, 0.0)
+    assert (m.dispy[5, 10], m.dispy[6, 20], m.dispy[7, 30]) == (0.0, 0.5, -0.25)
+    assert np.count_nonzero(np.isfinite(m.dispx)) == 3
+    # a left position rounding to column W (or row H) is outside the image: left out
+    edge = sv.Matches(
+        xl=[39.6, 5.0], yl=[5.0, 11.6], xr=[30.0, 1.0], yr=[5.0, 11.6], score=[1.0, 1.0],
+        image_shape=(12, 40),
+    )  # fmt: skip
+    assert np.isnan(edge.dispx).all() and np.isnan(edge.dispy).all()
+
+
+def test_matches_selection_keeps_trace_and_copies_stats() -> None:
+    m = _three()
+    sub = m[m.score > 0.6]
+    assert sub.xl.tolist() == [10.0, 30.0] and sub.energy_trace.tolist() == [3.0, 2.0]
+    sub.stats["n"] = 2
+    assert m.stats["n"] == 3  # the selection's stats are its own
+    with pytest.raises(IndexError, match=r"expected a 1-D index or mask, got shape \(1, 2\)"):
+        m[np.array([[0, 1]])]
+
+
+def test_matches_to_points_use_fy_and_cy_for_y() -> None:
+    k1 = np.array([[100.0, 0, 80], [0, 200, 60], [0, 0, 1]])
+    cal = sv.Calibration(
+        K1=k1, D1=np.zeros(5), K2=k1, D2=np.zeros(5), R=np.eye(3), T=np.array([-0.1, 0, 0]),
+        image_size=(160, 120), rectified=True,
+    )  # fmt: skip
+    m = sv.Matches(xl=[90.0], yl=[70.0], xr=[80.0], yr=[70.0], score=[1.0], image_shape=(120, 160))
+    np.testing.assert_allclose(m.to_points(cal), [[0.1, 0.05, 1.0]], rtol=1e-6)
+
+
+def test_matches_csv_text_and_bad_files(tmp_path: Path) -> None:
+    path = _three().save_csv(tmp_path / "m.csv")
+    assert path.read_text().splitlines()[1] == "10.0,5.0,7.5,5.0,0.9"  # shortest float32 text
+    header = "x_left,y_left,x_right,y_right,score"
+    (tmp_path / "empty.csv").write_text(header + "\n")
+    assert len(sv.Matches.from_csv(tmp_path / "empty.csv", (4, 4))) == 0
+    (tmp_path / "long.csv").write_text(f"{header}\n1,2,3,4,1,9\n")
+    with pytest.raises(ValueError, match="line 2 has 6 values, expected 5"):
+        sv.Matches.from_csv(tmp_path / "long.csv", (4, 4))
+    (tmp_path / "word.csv").write_text(f"{header}\n1,2,x,4,1\n")
+    with pytest.raises(ValueError, match=r"word\.csv: could not convert"):
+        sv.Matches.from_csv(tmp_path / "word.csv", (4, 4))
