@@ -366,3 +366,23 @@ def test_min_disparity_above_max_is_refused_as_given(method: str, lo: float, sho
         ValueError, match=re.escape(f"max_disparity (32) must be >= min_disparity ({shown})")
     ):
         sv.match(ok, np.roll(ok, -3, axis=1), method=method, max_disparity=32, min_disparity=lo)
+
+
+def test_match_best_is_the_reference_without_the_network() -> None:
+    rng = np.random.default_rng(0)
+    left = rng.random((60, 80), dtype=np.float32)
+    right = np.roll(left, -5, axis=1)
+    m = sv.match(left, right, method="best", max_disparity=16)
+    ref = hp.best_match(left, right, max_disparity=16)
+    assert len(m) > 100 and len(m.energy_trace) == 0
+    np.testing.assert_array_equal(m.to_array(), ref.to_array())
+    assert len(sv.match(left, right, method="hopfield", max_disparity=16).energy_trace) > 0
+
+
+def test_match_fused_keeps_count_and_sources_per_member_in_range() -> None:
+    # a member dropped out of range takes its count and sources along
+    sc = _scene("middlebury2001/tsukuba")
+    m = sv.match(sc.left, sc.right, method="fused", max_disparity=8.5, min_disparity=6)
+    d = m.xl - m.xr
+    assert m.stats["n_out_of_range"] > 0 and float(d.min()) >= 6.0 and float(d.max()) <= 8.5
+    assert len(m.stats["count"]) == len(m.stats["sources"]) == len(m) > 100
