@@ -1521,6 +1521,104 @@ def test_the_unit_toggle_and_the_view_mode_keep_the_view_the_mouse_left(tmp_path
     assert app.state.save_label.endswith(", overview.png, render.png")
 
 
+def _mouse_drag(app: Any, path: list[tuple[float, float]]) -> None:
+    """A left-button drag of the 3-D view along ``path`` (fractions of the view), sent as the
+    page's server-side view sends the browser's mouse events (trame-vtk's mouse handler)."""
+    from vtkmodules.vtkWebCore import vtkWebApplication, vtkWebInteractionEvent
+
+    iren = app.plotter.iren.interactor
+    iren.Initialize()  # the served page's view has it; the app alone does not
+    iren.Enable()
+    web = vtkWebApplication()
+    for i, (x, y) in enumerate(path):
+        event = vtkWebInteractionEvent()
+        down = i < len(path) - 1  # the last point: the button released
+        event.SetButtons(vtkWebInteractionEvent.LEFT_BUTTON if down else 0)
+        event.SetX(x)
+        event.SetY(y)
+        assert web.HandleInteractionEvent(app.plotter.render_window, event)
+
+
+def test_sliders_from_pose_clamps_values_past_the_sliders_range():
+    """The pose the mouse leaves can be past the sliders' range (yaw 150 after orbiting the
+    scene, 7 m forward after zooming): each value is clamped to its slider's range, in the
+    page's unit for the translations, and said so."""
+    from stereovision import render
+    from stereovision.gui.app import sliders_from_pose
+
+    pose = render.camera_pose(roll=10.0, pitch=-20.0, yaw=30.0, forward=1.5, up=0.2, right=-0.3)
+    values, clamped = sliders_from_pose(pose)
+    assert not clamped
+    expected = {"roll": 10.0, "pitch": -20.0, "yaw": 30.0, "forward": 1.5, "up": 0.2}
+    assert values == pytest.approx({**expected, "right": -0.3}, abs=1e-9)
+    values, clamped = sliders_from_pose(pose, "ft")
+    assert not clamped
+    assert values["forward"] == pytest.approx(1.5 / 0.3048) and values["yaw"] == pytest.approx(30)
+    values, clamped = sliders_from_pose(render.camera_pose(yaw=150.0, pitch=5.0, forward=7.0))
+    assert clamped
+    assert values["yaw"] == 90.0 and values["forward"] == 5.0
+    assert values["pitch"] == pytest.approx(5.0) and values["roll"] == pytest.approx(0.0)
+    values, clamped = sliders_from_pose(render.camera_pose(roll=-120.0, right=-7.0), "ft")
+    assert clamped and values["roll"] == -90.0 and values["right"] == -16.4  # the page's range
+    with pytest.raises(ValueError, match="unit"):
+        sliders_from_pose(pose, "yd")
+
+
+def test_the_sliders_follow_the_view_the_mouse_left(tmp_path):
+    """The sliders stayed where they were when the 3-D view was dragged with the mouse, so the
+    next slider move put the view back on their old pose: the drag was undone. The end of a
+    drag now sets the sliders from the view's camera, and a slider moved next continues from
+    the dragged view."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-follow-mouse", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.yaw = 10.0
+    app._on_controls()
+    _mouse_drag(app, [(0.5, 0.5), (0.55, 0.52), (0.6, 0.55), (0.6, 0.55)])
+    dragged = render.controls_from_pose(render.pose_from_camera(app.plotter.camera))
+    assert abs(dragged.yaw - 10.0) > 5.0 and abs(dragged.pitch) > 5.0  # the drag turned it
+    names = ("roll", "pitch", "yaw", "forward", "up", "right")
+    assert {n: app.state[n] for n in names} == pytest.approx(
+        {n: getattr(dragged, n) for n in names}, abs=1e-9
+    )
+    assert app._mouse_camera() is None  # the view is the sliders' pose: Save renders it
+    app.state.yaw = dragged.yaw + 5.0
+    app._on_controls()
+    moved = render.controls_from_pose(render.pose_from_camera(app.plotter.camera))
+    assert moved.yaw == pytest.approx(dragged.yaw + 5.0)
+    assert moved.pitch == pytest.approx(dragged.pitch) and moved.up == pytest.approx(dragged.up)
+    # a click (nothing moved) leaves the sliders alone
+    before = {n: app.state[n] for n in names}
+    _mouse_drag(app, [(0.3, 0.3), (0.3, 0.3)])
+    assert {n: app.state[n] for n in names} == before
+
+
+def test_a_drag_past_the_sliders_range_clamps_them_and_keeps_the_view(tmp_path):
+    """A drag that turns the view past the sliders' +-90 degrees sets them clamped; the view
+    stays as the mouse left it (Save says so) until a slider moves it from the clamped pose."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-follow-mouse-clamped", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    cam = app.plotter.camera
+    cam.Azimuth(-130.0)  # orbiting the scene: the camera turns right past yaw 90
+    cam.OrthogonalizeViewUp()
+    app.plotter.iren.interactor.InvokeEvent("EndInteractionEvent")
+    dragged = render.CameraState.of(cam)
+    assert app.state.yaw == 90.0
+    assert render.CameraState.of(app.plotter.camera).same_view(dragged)
+    assert app._mouse_camera() is not None  # not the sliders' pose: Save renders this view
+    app.state.pitch = 3.0
+    app._on_controls()
+    moved = render.controls_from_pose(render.pose_from_camera(app.plotter.camera))
+    assert moved.yaw == pytest.approx(90.0) and moved.pitch == pytest.approx(3.0)
+
+
 def test_save_of_the_pair_ignores_a_drag_of_an_opened_cloud_file(tmp_path):
     """With a point-cloud file shown in the 3-D view, a drag moves the view of that file (another
     scene, framed without the pair's intrinsics), yet Save rendered the pair from that camera
@@ -3232,7 +3330,8 @@ def test_save_renders_the_3d_view_as_dragged_with_the_mouse(page, gui_data):
     page.mouse.up()
     after = _steady_view(page, unlike=before)
     dragged = _saved_render(page, gui_data / "dragged")
-    assert "as the mouse left it" in page.inner_text("#save-label")
+    # the sliders followed the drag (follow_mouse): the view is their pose, no mouse view said
+    assert "mouse" not in page.inner_text("#save-label")
     assert np.abs(dragged - posed).mean() > 10.0
 
     def like(shot: np.ndarray, png: np.ndarray) -> float:
@@ -3251,6 +3350,49 @@ def test_save_renders_the_3d_view_as_dragged_with_the_mouse(page, gui_data):
         after = _view_image(page)
     assert shown, (like(after, dragged), like(after, posed))
     _shot(page, "gui-dragged.png")
+    page.click("#reset-camera")
+
+
+def test_a_slider_moved_after_a_drag_continues_from_the_dragged_view(page):
+    """The sliders did not follow a mouse drag of the 3-D view: the next slider step put the
+    view back on the sliders' pose, the drag undone. The sliders now take the dragged view's
+    pose when the drag ends, and yaw steps turn the dragged view by as many degrees."""
+    page.wait_for_function("Number(document.querySelector('#computations')?.textContent) >= 1")
+    page.click("#reset-camera")
+    yaw = "document.querySelector('#slider-yaw [role=slider]').getAttribute('aria-valuenow')"
+    page.wait_for_function(f"{yaw} === '0'")
+    page.wait_for_function(
+        "[...document.querySelectorAll('#view-3d img')].some(i => i.src && i.naturalWidth > 0)"
+    )
+    before = _steady_view(page)
+    box = page.locator("#view-3d").bounding_box()
+    assert box is not None
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x - box["width"] / 8, y - box["height"] / 12, steps=10)
+    page.mouse.up()
+    page.wait_for_function(f"Math.abs(Number({yaw})) > 5")  # the sliders took the drag's yaw
+    dragged = _steady_view(page, unlike=before)  # (the server has had the drag's end)
+    dragged_yaw = float(page.evaluate(yaw))
+    page.focus("#slider-yaw [role=slider]")
+    for _ in range(5):
+        page.keyboard.press("ArrowRight")
+    page.wait_for_function(f"Number({yaw}) >= {dragged_yaw + 4}")
+
+    def off(a: np.ndarray, b: np.ndarray) -> float:
+        return float(np.abs(a - b).mean())
+
+    # the view turned a few degrees from the dragged one, far from the view before the drag
+    # (about 20 and 55 here; before the fix, the other way round): frames of the steps come
+    # one after another (later on a loaded machine), looked at until one is so
+    deadline = time.monotonic() + PAGE_TIMEOUT_MS / 1000
+    while True:
+        shot = _view_image(page)
+        near = off(shot, dragged) > 1.0 and off(shot, dragged) < 0.5 * off(shot, before)
+        if near or time.monotonic() > deadline:
+            break
+    assert near, (off(shot, dragged), off(shot, before))
     page.click("#reset-camera")
 
 

@@ -216,7 +216,8 @@ def controls_from_pose(pose: npt.ArrayLike) -> CameraControls:
     of the controls read back is ``pose`` (1e-15). Looking straight up or down (gimbal lock)
     only ``yaw - roll`` (up) or ``yaw + roll`` (down) is determined: roll is said 0. A camera
     turned past the sliders' range (a mouse drag around the scene: yaw 150) gives angles
-    outside +-90, which the GUI's sliders cannot show.
+    outside +-90, which the GUI's sliders cannot show (it clamps them:
+    :func:`stereovision.gui.app.sliders_from_pose`).
 
     Parameters
     ----------

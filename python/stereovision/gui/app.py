@@ -253,6 +253,57 @@ class SaveFailed(OSError):
     """A Save's writer failed: the message names the file (nothing was moved into place)."""
 
 
+def sliders_from_pose(pose: npt.ArrayLike, unit: str = "m") -> tuple[dict[str, float], bool]:
+    """The 3-D view's six slider values for a camera ``pose``, each clamped to its slider's
+    range, and whether any was (:func:`~stereovision.render.controls_from_pose`).
+
+    A mouse drag can turn the camera past the rotation sliders' +-:data:`ANGLE_RANGE` degrees
+    (yaw 150 after orbiting the scene) or move it past the translation sliders' range: those
+    values are clamped, not wrapped. Wrapping has no pose to offer here: the other Euler
+    triple of a rotation (``roll + 180, 180 - pitch, yaw + 180``) has ``|pitch| >= 90``, so
+    a yaw of 150 taken to -30 would look the other way. A clamped value leaves the sliders at
+    the nearest pose they can show, per slider, not the pose the mouse left.
+
+    Parameters
+    ----------
+    pose : array_like, (4, 4)
+        Camera-to-left-camera transform (:func:`~stereovision.render.pose_from_camera`).
+    unit : str
+        The page's length unit (:data:`UNITS`): the translations' values are in it.
+
+    Returns
+    -------
+    values : dict of str to float
+        Slider name to value (degrees, or lengths in ``unit``).
+    clamped : bool
+        True when a value was outside its slider's range (the sliders' pose is then another).
+
+    Raises
+    ------
+    ValueError
+        A pose that is not 4x4 or not finite, or an unknown unit.
+    """
+    from stereovision.calibration import UNIT_TO_METRES
+    from stereovision.render import controls_from_pose
+
+    if unit not in UNITS:
+        raise ValueError(f"unit: expected one of {list(UNITS)}, got {unit!r}")
+    controls = controls_from_pose(pose)
+    metres = UNIT_TO_METRES[unit]
+    values, clamped = {}, False
+    for name in _CONTROL_NAMES:
+        value = float(getattr(controls, name))
+        if name in _TRANSLATIONS:
+            value /= metres
+            limit = round(TRANSLATION_RANGE / metres, 1)  # the range the page shows (_on_unit)
+        else:
+            limit = ANGLE_RANGE
+        kept = min(max(value, -limit), limit)
+        clamped |= kept != value
+        values[name] = kept
+    return values, clamped
+
+
 def save_all_or_nothing(
     write: Callable[[Path], None], folder: Path, files: Sequence[str] = SAVE_WRITE_ORDER
 ) -> dict[str, Path]:
@@ -1234,6 +1285,10 @@ class StereoApp:
         #: camera on the server (the page's view is rendered there), not the sliders, so a
         #: camera that differs from it is one the mouse moved (None: not placed yet).
         self._slider_camera: Any = None
+        #: True while the sliders are set from the view the mouse left (no slider move).
+        self._following_mouse = False
+        if self.plotter.iren is not None:  # the page's mouse events drive it (mode="server")
+            self.plotter.iren.interactor.AddObserver("EndInteractionEvent", self._on_mouse_end)
         from stereovision.gui import bundled_data_dir
 
         # "Save" writes only inside the --data folders (not into the installed package's data)
@@ -2125,7 +2180,7 @@ class StereoApp:
         intrinsics at most :data:`~stereovision.render.RENDER_MAX_SIDE` pixels wide or high.
 
         It rendered the sliders' pose after the view was dragged with the mouse (the sliders
-        do not follow the mouse): not the view the page showed.
+        did not follow the mouse then): not the view the page showed.
 
         Parameters
         ----------
@@ -2312,8 +2367,9 @@ class StereoApp:
 
         The page's view is rendered on the server (``plotter_ui(mode="server")``): the mouse's
         events drive this plotter's camera, which is therefore the view the page shows. The
-        sliders do not follow the mouse; the next slider change puts the view back on their
-        pose (:meth:`_apply_camera`).
+        sliders follow it when a drag ends (:meth:`follow_mouse`): the view differs from their
+        pose during a drag, after a drag past their range (clamped), or after a camera move
+        that was no mouse event.
 
         Returns
         -------
@@ -2355,7 +2411,45 @@ class StereoApp:
             self._remote_view.update()
 
     def _on_controls(self, **_: Any) -> None:
-        self._apply_camera()
+        if not self._following_mouse:
+            self._apply_camera()
+
+    def _on_mouse_end(self, _obj: Any = None, _event: str = "") -> None:
+        """The end of a mouse drag or wheel turn of the 3-D view (the server's interactor)."""
+        self.follow_mouse()
+
+    def follow_mouse(self) -> None:
+        """Set the six sliders from the 3-D view's camera as the mouse left it.
+
+        The sliders stayed where they were while the mouse moved the view, so the next slider
+        move put the view back on their old pose (the drag undone, plus the move). They now
+        take the view's pose (:func:`sliders_from_pose`), and a slider moved next continues
+        from the view.
+
+        A value past its slider's range is clamped, not wrapped (:func:`sliders_from_pose`):
+        the view then stays as the mouse left it (Save renders it and says so), and the next
+        slider move goes from the clamped pose. A click that moved nothing changes nothing.
+        """
+        from stereovision.render import CameraState, pose_from_camera
+
+        try:
+            mouse = self._mouse_camera()
+            if mouse is None:
+                return
+            values, clamped = sliders_from_pose(pose_from_camera(self.plotter.camera), self._unit)
+        except ValueError:  # a camera with no pose (on its focal point): the sliders stay
+            return
+        self._following_mouse = True  # the view is not to be put on the sliders' pose here
+        try:
+            with self.state:
+                for name, value in values.items():
+                    self.state[name] = value
+        finally:
+            self._following_mouse = False
+        if clamped:  # the sliders' pose is another view: the mouse's stays on show
+            self._keeping_mouse_view(self._apply_camera)
+        else:  # the view is the sliders' pose; its focal point (the mouse's pivot) is kept
+            self._slider_camera = CameraState.of(self.plotter.camera)
 
     def _on_unit(self, unit: str = "m", **_: Any) -> None:
         """The unit toggle: the depth caption, the statistics, the floor's height and obstacle
