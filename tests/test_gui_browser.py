@@ -1594,6 +1594,11 @@ def test_the_sliders_follow_the_view_the_mouse_left(tmp_path):
     before = {n: app.state[n] for n in names}
     _mouse_drag(app, [(0.3, 0.3), (0.3, 0.3)])
     assert {n: app.state[n] for n in names} == before
+    # the wheel (as the page's view sends it: the interactor's wheel event) moves forward
+    app.plotter.iren.interactor.MouseWheelForwardEvent()
+    zoomed = render.controls_from_pose(render.pose_from_camera(app.plotter.camera))
+    assert zoomed.forward > before["forward"] + 0.1
+    assert app.state.forward == pytest.approx(zoomed.forward, abs=1e-9)
 
 
 def test_a_drag_past_the_sliders_range_clamps_them_and_keeps_the_view(tmp_path):
