@@ -1,0 +1,535 @@
+"""The GUI's sources without a browser: allowed folders, camera pairs, image folders, scaling.
+
+test_gui_browser.py holds the first tests of these (and needs chromium for the rest); these
+pin down what a mutation audit of ``stereovision.gui.sources`` found unasserted.
+"""
+
+from __future__ import annotations
+
+import sys
+import types
+from pathlib import Path
+from typing import Any, ClassVar
+
+import cv2
+import numpy as np
+import pytest
+
+from stereovision.gui import sources
+from stereovision.gui.sources import AllowedFolders, FolderPairs, VideoPair, display_path
+
+# ----------------------------------------------------------------------------- display_path
+
+
+def test_display_path_relative_home_and_absolute() -> None:
+    cwd, home = Path("/srv/work"), Path("/home/me")
+    assert display_path("/srv/work/a/b.png", cwd=cwd, home=home) == "a/b.png"
+    assert display_path("a/../c", cwd=cwd, home=home) == "c"  # relative: from cwd
+    assert display_path("/home/me", cwd=cwd, home=home) == "~"
+    assert display_path("/home/me/x/y", cwd=cwd, home=home) == "~/x/y"
+    assert display_path("/home/meow", cwd=cwd, home=home) == "/home/meow"
+    # From "/" (or a home of "/") every path is under it: absolute, not "tmp/..." or "~/tmp".
+    assert display_path("/tmp/x", cwd=Path("/"), home=home) == "/tmp/x"
+    assert display_path("/tmp/x", cwd=cwd, home=Path("/")) == "/tmp/x"
+
+
+def test_display_path_without_a_home_folder(monkeypatch: pytest.MonkeyPatch) -> None:
+    def no_home() -> Path:
+        raise RuntimeError("no home")
+
+    monkeypatch.setattr(Path, "home", staticmethod(no_home))
+    assert display_path("/mnt/x", cwd=Path("/srv")) == "/mnt/x"
+    assert display_path("/srv/y", cwd=Path("/srv")) == "y"
+
+
+# ----------------------------------------------------------------------------- AllowedFolders
+
+
+@pytest.fixture
+def data(tmp_path: Path) -> Path:
+    """data/ with a scene, a hidden folder, files of several kinds and a link out."""
+    d = tmp_path / "data"
+    (d / "scene").mkdir(parents=True)
+    for n in ("left.png", "right.png"):
+        (d / "scene" / n).write_bytes(b"png")
+    (d / ".hidden").mkdir()
+    (d / ".hidden" / "h.ply").write_text("x")
+    (d / "b.PLY").write_text("x")
+    (d / "a.ply").write_text("x")
+    (d / "notes.txt").write_text("x")
+    out = tmp_path / "outside"
+    out.mkdir()
+    (out / "o.ply").write_text("x")
+    (d / "out.ply").symlink_to(out / "o.ply")
+    (d / "outdir").symlink_to(out)
+    return d
+
+
+def test_roots_are_resolved_deduplicated_and_checked(data: Path, tmp_path: Path) -> None:
+    (tmp_path / "alias").symlink_to(data)
+    folders = AllowedFolders([data, tmp_path / "alias", data / "scene" / ".."])
+    assert folders.roots == (data.resolve(),)
+    with pytest.raises(FileNotFoundError, match=r"^data folder not found: .*a\.ply$"):
+        AllowedFolders([data / "a.ply"])  # a file, not a folder
+
+
+def test_resolve_accepts_the_root_and_refuses_nul_and_rootless(data: Path) -> None:
+    folders = AllowedFolders([data])
+    assert folders.resolve(data) == data.resolve()
+    assert folders.resolve("scene") == (data / "scene").resolve()
+    two = AllowedFolders([data / "scene", data])
+    assert two.resolve("left.png") == (data / "scene" / "left.png").resolve()  # the first root
+    with pytest.raises(FileNotFoundError, match="no such file"):
+        two.resolve("a.ply")  # in the second root only
+    with pytest.raises(ValueError, match="empty or invalid path"):
+        folders.resolve("a\x00.ply")
+    with pytest.raises(ValueError, match=r"^path outside the allowed folders: a\.ply$"):
+        AllowedFolders([]).resolve("a.ply")
+    with pytest.raises(ValueError, match=r"^path outside the allowed folders: /"):
+        AllowedFolders([]).resolve(str(data / "a.ply"))
+    with pytest.raises(FileNotFoundError, match=r"^no such file: nope\.ply$"):
+        folders.resolve("nope.ply")
+    assert folders.contains("a.ply") and not folders.contains("out.ply")
+    assert not folders.contains("nope.ply") and not folders.contains("")
+
+
+def test_resolve_output(data: Path, tmp_path: Path) -> None:
+    folders = AllowedFolders([data, tmp_path / "outside"])
+    # Relative to the first root, stripped, need not exist.
+    assert folders.resolve_output("  new/sub ") == data.resolve() / "new" / "sub"
+    assert folders.resolve_output(data) == data.resolve()
+    assert folders.resolve_output(tmp_path / "outside" / "x") == (tmp_path / "outside" / "x")
+    for bad in ("", "   ", None, "a\x00b"):
+        with pytest.raises(ValueError, match=r"^empty or invalid folder$"):
+            folders.resolve_output(bad)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^folder outside the --data folders: \.\./elsewhere$"):
+        folders.resolve_output("../elsewhere")
+    with pytest.raises(ValueError, match=r"^folder outside the --data folders: outdir/x$"):
+        folders.resolve_output("outdir/x", roots=[data.resolve()])  # a link out of the roots
+    # roots=: only those; relative to the first of them.
+    only = [(tmp_path / "outside").resolve()]
+    assert folders.resolve_output("y", roots=only) == only[0] / "y"
+    with pytest.raises(ValueError, match="folder outside"):
+        folders.resolve_output(data / "z", roots=only)
+    with pytest.raises(ValueError, match=r"^no folder to write into: start the GUI with --data"):
+        folders.resolve_output("x", roots=[])
+    with pytest.raises(ValueError, match=r"^no folder to write into"):
+        AllowedFolders([]).resolve_output("x")
+
+
+def test_files_are_sorted_case_blind_inside_and_visible(data: Path) -> None:
+    folders = AllowedFolders([data])
+    assert folders.files(sources.CLOUD_SUFFIXES) == [data / "a.ply", data / "b.PLY"]
+    assert folders.files(sources.IMAGE_SUFFIXES) == [
+        data / "scene" / "left.png",
+        data / "scene" / "right.png",
+    ]
+
+
+@pytest.mark.parametrize("limit", [2, 3])
+def test_files_stop_at_max_listed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, limit: int
+) -> None:
+    monkeypatch.setattr(sources, "MAX_LISTED", limit)
+    for k in range(4):
+        (tmp_path / f"{k}.ply").write_text("x")
+    listed = AllowedFolders([tmp_path]).files(sources.CLOUD_SUFFIXES)
+    assert listed == [tmp_path / f"{k}.ply" for k in range(limit)]
+
+
+def test_files_and_scenes_of_two_roots(tmp_path: Path) -> None:
+    a, b = tmp_path / "a", tmp_path / "b"
+    for d in (a, b):
+        (d / "s").mkdir(parents=True)
+        for n in ("left.png", "right.png"):
+            (d / "s" / n).write_bytes(b"png")
+        (d / "c.ply").write_text("x")
+    folders = AllowedFolders([b, a])
+    assert folders.files(sources.CLOUD_SUFFIXES) == [b / "c.ply", a / "c.ply"]  # root order
+    assert folders.scenes() == [a / "s", b / "s"]  # sorted
+
+
+def test_scenes_skip_hidden_links_out_and_stop_at_max_listed(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    for name in (".h", "z"):
+        (data / name).mkdir()
+        for n in ("left.png", "right.png"):
+            (data / name / n).write_bytes(b"png")
+    (tmp_path / "outside" / "right.png").write_bytes(b"png")
+    (data / "half").mkdir()
+    (data / "half" / "left.png").write_bytes(b"png")
+    (data / "half" / "right.png").symlink_to(tmp_path / "outside" / "right.png")
+    folders = AllowedFolders([data])
+    assert folders.scenes() == [data / "scene", data / "z"]
+    monkeypatch.setattr(sources, "MAX_LISTED", 1)
+    assert folders.scenes() == [data / "scene"]
+
+
+def test_folders_lists_roots_and_their_visible_subfolders(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    (data / "b").mkdir()
+    (data / "scene" / "deeper").mkdir()
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    folders = AllowedFolders([data, gone])
+    gone.rmdir()  # a root removed while the GUI runs is skipped, not an error
+    assert folders.folders() == [data.resolve(), data / "b", data / "scene", gone]
+    monkeypatch.setattr(sources, "MAX_LISTED", 2)
+    assert folders.folders() == [data.resolve(), data / "b"]
+
+
+def test_label(data: Path, tmp_path: Path) -> None:
+    folders = AllowedFolders([data])
+    assert folders.label(data.resolve()) == "data"
+    assert folders.label(data.resolve() / "scene" / "left.png") == "data/scene/left.png"
+    assert folders.label(tmp_path / "outside" / "o.ply") == "o.ply"
+    # Three roots of one name, two of them alike one level up as well.
+    roots = [tmp_path / p / "x" / "data" for p in ("p", "q")] + [tmp_path / "r" / "data"]
+    for r in roots:
+        r.mkdir(parents=True)
+    three = AllowedFolders(roots)
+    assert [three.label(r) for r in roots] == ["p/x/data", "q/x/data", "r/data"]
+
+
+# ----------------------------------------------------------------------------- parse_source
+
+
+def test_parse_source() -> None:
+    assert sources.parse_source(3) == 3
+    assert sources.parse_source(-1) == -1  # OpenCV's "any camera": an int stays an int
+    assert sources.parse_source(" 12 ") == 12
+    assert sources.parse_source(" cam.avi ") == "cam.avi"
+    assert sources.parse_source("img_%03d.png") == "img_%03d.png"
+    with pytest.raises(ValueError, match=r"^empty camera source$"):
+        sources.parse_source("")
+
+
+# ----------------------------------------------------------------------------- VideoPair
+
+
+class FakeCap:
+    """A cv2.VideoCapture stand-in: ``frames`` in order, then no frame (until rewound)."""
+
+    made: ClassVar[list[FakeCap]] = []
+    opened = True
+    frames: ClassVar[list[np.ndarray]] = []
+
+    def __init__(self, src: Any) -> None:
+        self.src = src
+        self.pos = 0
+        self.released = False
+        self.props: dict[int, float] = {}
+        self.own = list(type(self).frames)
+        FakeCap.made.append(self)
+
+    def isOpened(self) -> bool:
+        return type(self).opened
+
+    def set(self, prop: int, value: float) -> bool:
+        self.props[prop] = value
+        if prop == cv2.CAP_PROP_POS_FRAMES:
+            self.pos = int(value)
+        return True
+
+    def read(self) -> tuple[bool, np.ndarray | None]:
+        if self.pos >= len(self.own):
+            return False, None
+        self.pos += 1
+        return True, self.own[self.pos - 1]
+
+    def release(self) -> None:
+        self.released = True
+
+
+@pytest.fixture
+def fake_cap(monkeypatch: pytest.MonkeyPatch) -> type[FakeCap]:
+    FakeCap.made = []
+    FakeCap.opened = True
+    FakeCap.frames = [np.full((4, 6, 3), k, np.uint8) for k in (10, 20)]
+    monkeypatch.setattr(cv2, "VideoCapture", FakeCap)
+    return FakeCap
+
+
+def test_video_pair_asks_devices_not_files_for_the_size(
+    fake_cap: type[FakeCap], tmp_path: Path
+) -> None:
+    f = tmp_path / "r.avi"
+    f.write_bytes(b"")
+    pair = VideoPair("0", str(f), size=(640, 480))
+    dev, file = fake_cap.made
+    assert dev.src == 0 and file.src == str(f)
+    assert dev.props == {cv2.CAP_PROP_FRAME_WIDTH: 640, cv2.CAP_PROP_FRAME_HEIGHT: 480}
+    assert file.props == {}
+    assert pair.sources == ("0", str(f))
+    # The file starts again at its end; the device that ends says so.
+    reads = [pair._grab(1)[0, 0, 0] for _ in range(3)]
+    assert reads == [10, 20, 10]
+    dev.pos = 2
+    with pytest.raises(OSError, match=r"^camera '0' gave no frame$"):
+        pair.read()
+    pair.close()
+    assert dev.released and file.released
+    with pytest.raises(OSError, match=r"^camera pair is closed$"):
+        pair.read()
+
+
+def test_video_pair_without_size_sets_nothing(fake_cap: type[FakeCap]) -> None:
+    pair = VideoPair(0, 1)
+    assert [c.props for c in fake_cap.made] == [{}, {}]
+    left, right = pair.read()
+    assert left[0, 0, 0] == right[0, 0, 0] == 10
+    pair.close()
+
+
+def test_video_pair_grey_frames_become_bgr(fake_cap: type[FakeCap]) -> None:
+    fake_cap.frames = [np.arange(24, dtype=np.uint8).reshape(4, 6)]
+    pair = VideoPair(0, 1)
+    left, _ = pair.read()
+    assert left.shape == (4, 6, 3) and left.dtype == np.uint8 and left.flags.c_contiguous
+    np.testing.assert_array_equal(left[..., 2], fake_cap.frames[0])
+    pair.close()
+
+
+def test_video_pair_that_cannot_open_releases_what_it_opened(
+    fake_cap: type[FakeCap], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    f = tmp_path / "l.avi"
+    f.write_bytes(b"")
+    with pytest.raises(FileNotFoundError, match=r"^right camera source not found: .*none\.avi$"):
+        VideoPair(str(f), str(tmp_path / "none.avi"))
+    assert len(fake_cap.made) == 1 and fake_cap.made[0].released
+    fake_cap.opened = False
+    with pytest.raises(OSError, match=r"^cannot open camera 'x%d\.png' \(left\)$"):
+        VideoPair("x%d.png", 0)  # a pattern is not looked for as a file
+    assert fake_cap.made[-1].released
+
+
+def test_video_pair_plays_an_image_sequence_again_after_the_last(tmp_path: Path) -> None:
+    for k in range(2):
+        img = np.full((8, 10), 50 + 100 * k, np.uint8)
+        cv2.imwrite(str(tmp_path / f"img_{k:03d}.png"), img)
+    pattern = str(tmp_path / "img_%03d.png")
+    pair = VideoPair(pattern, pattern)
+    try:
+        got = [pair.read()[0][0, 0, 0] for _ in range(3)]
+    finally:
+        pair.close()
+    assert got == [50, 150, 50]
+
+
+# ----------------------------------------------------------------------------- _CaptureAdapter
+
+
+class FakeCamera:
+    """Gives ``results`` in order (an exception is raised; the list is shared by the cameras
+    a factory makes, as a file reopened goes on from its start); logs closes."""
+
+    def __init__(self, results: list[Any], log: list[str]) -> None:
+        self.results = results
+        self.log = log
+
+    def read(self) -> Any:
+        got = self.results.pop(0)
+        if isinstance(got, BaseException):
+            raise got
+        return got
+
+    def close(self) -> None:
+        self.log.append("close")
+
+    def release(self) -> None:
+        self.log.append("release")
+
+
+def _frame(v: int) -> np.ndarray:
+    return np.full((2, 3, 3), v, np.uint8)
+
+
+def test_capture_adapter_reads_every_shape_of_pair() -> None:
+    frame = types.SimpleNamespace(left=_frame(5), right=_frame(6))
+    results = [(_frame(1), _frame(2)), (True, _frame(3), _frame(4)), frame]
+    ad = sources._CaptureAdapter(lambda: FakeCamera(results, []), files=False)
+    assert [tuple(int(x[0, 0, 0]) for x in ad.read()) for _ in range(3)] == [(1, 2), (3, 4), (5, 6)]
+
+
+def test_capture_adapter_reopens_files_not_cameras() -> None:
+    log: list[str] = []
+    made: list[FakeCamera] = []
+
+    def factory(results: list[Any]) -> Any:
+        def make() -> FakeCamera:
+            made.append(FakeCamera(results, log))
+            return made[-1]
+
+        return make
+
+    cams = sources._CaptureAdapter(factory([(False, None, None)]), files=False)
+    with pytest.raises(OSError, match=r"^camera pair gave no frame$"):
+        cams.read()
+    assert len(made) == 1 and log == []
+    made.clear()
+    files = sources._CaptureAdapter(factory([OSError("end"), (_frame(7), _frame(8))]), files=True)
+    left, _ = files.read()
+    assert left[0, 0, 0] == 7 and len(made) == 2 and log == ["close"]  # close, not also release
+    with pytest.raises(ValueError):  # only an ended source is reopened
+        sources._CaptureAdapter(factory([ValueError("bad")]), files=True).read()
+
+    class ReleaseOnly:
+        def __init__(self) -> None:
+            self.released = False
+
+        def release(self) -> None:
+            self.released = True
+
+    cam = ReleaseOnly()
+    sources._CaptureAdapter(lambda: cam, files=False).close()
+    assert cam.released
+
+
+# ----------------------------------------------------------------------------- open_stereo_source
+
+
+def test_open_stereo_source_hands_size_fourcc_and_file_flag(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import stereovision.capture as capture
+
+    made: list[tuple[Any, ...]] = []
+
+    def fake_camera(left: Any, right: Any, *, image_size: Any, fourcc: Any) -> FakeCamera:
+        made.append((left, right, image_size, fourcc))
+        return FakeCamera([], [])
+
+    monkeypatch.setattr(capture, "StereoCamera", fake_camera)
+    src = sources.open_stereo_source(" 1", "2 ", size=(320, 240), fourcc="YUYV")
+    assert made == [(1, 2, (320, 240), "YUYV")]
+    assert isinstance(src, sources._CaptureAdapter) and src._files is False
+    assert sources.open_stereo_source("a.avi", "b.avi")._files is True  # type: ignore[attr-defined]
+    assert made[-1] == ("a.avi", "b.avi", None, None)
+    assert sources.open_stereo_source("a.avi", 0)._files is False  # type: ignore[attr-defined]
+    with pytest.raises(ValueError, match=r"^fourcc: expected four characters"):
+        sources.open_stereo_source(0, 1, fourcc="MJPEG")  # checked before a camera opens
+    assert len(made) == 3
+
+
+def test_open_stereo_source_falls_back_to_opencv(
+    fake_cap: type[FakeCap], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setitem(sys.modules, "stereovision.capture", None)  # import fails
+    src = sources.open_stereo_source("0", 1, size=(8, 6), fourcc="MJPG")
+    assert isinstance(src, VideoPair) and [c.src for c in fake_cap.made] == [0, 1]
+    assert fake_cap.made[0].props[cv2.CAP_PROP_FRAME_WIDTH] == 8
+    src.close()
+
+
+# ----------------------------------------------------------------------------- FolderPairs
+
+
+def _pairs_folder(root: Path, n: int) -> Path:
+    seq = root / "seq"
+    seq.mkdir(parents=True)
+    for k in range(1, n + 1):
+        for side, v in (("left", k), ("right", 100 + k)):
+            cv2.imwrite(str(seq / f"{side}_{k:04d}.png"), np.full((4, 5, 3), v, np.uint8))
+    return seq
+
+
+def test_folder_pairs_play_in_order_and_again(tmp_path: Path) -> None:
+    seq = _pairs_folder(tmp_path, 3)
+    fp = FolderPairs(seq, "data/seq")
+    assert fp.current is None and fp.describe() == "folder data/seq"
+    got = [tuple(int(x[0, 0, 0]) for x in fp.read()) for _ in range(4)]
+    assert got == [(1, 101), (2, 102), (3, 103), (1, 101)]
+    assert fp.current is not None and fp.current.left.name == "left_0001.png"
+    assert fp.describe() == "folder data/seq: pair 0001 (1 of 3)"
+    fp.read()
+    assert fp.describe() == "folder data/seq: pair 0002 (2 of 3)"
+    fp.close()  # nothing to release; reading goes on
+    assert fp.read()[0][0, 0, 0] == 3
+
+
+def test_folder_pairs_keep_and_no_pairs(tmp_path: Path) -> None:
+    seq = _pairs_folder(tmp_path, 2)
+    fp = FolderPairs(seq, "s", keep=lambda p: "0002" not in p.name)
+    assert [j.name for j in fp.jobs] == ["0001"]
+    one_side = FolderPairs(seq, "s", keep=lambda p: p.name != "right_0002.png")
+    assert [j.name for j in one_side.jobs] == ["0001"]  # a pair is kept only whole
+    with pytest.raises(ValueError, match=r"^no image pairs in s \(left_0001\.png"):
+        FolderPairs(seq, "s", keep=lambda p: False)
+    (tmp_path / "empty").mkdir()
+    with pytest.raises(ValueError, match=r"^no image pairs in e "):
+        FolderPairs(tmp_path / "empty", "e")
+
+
+# ----------------------------------------------------------------------------- scaling
+
+
+def test_scale_pair_never_enlarges_and_rounds_the_height() -> None:
+    left = np.zeros((7, 10, 3), np.uint8)
+    right = np.ones((7, 10, 3), np.uint8)
+    for width in (None, 10, 11):
+        l2, r2, s = sources.scale_pair(left, right, width)
+        assert l2 is left and r2 is right and s == 1.0
+    l2, r2, s = sources.scale_pair(left, right, 5)
+    assert l2.shape == r2.shape == (4, 5, 3) and s == 0.5  # 3.5 rounds to 4
+    assert r2[0, 0, 0] == 1 and l2.dtype == np.uint8
+    l2, _, s = sources.scale_pair(left, right, 1)
+    assert l2.shape == (1, 1, 3) and s == pytest.approx(0.1)
+    wide = np.zeros((1, 40, 3), np.uint8)
+    assert sources.scale_pair(wide, wide, 4)[0].shape == (1, 4, 3)  # height 0.1: one row
+
+
+def test_scaled_calibration_passes_none_and_unscaled_through() -> None:
+    asked: list[Any] = []
+
+    class Calib:
+        def scaled_to(self, size: Any) -> str:
+            asked.append(size)
+            return "scaled"
+
+    c = Calib()
+    assert sources.scaled_calibration(None, 0.5, (1, 1)) is None
+    assert sources.scaled_calibration(c, 1.0, (9, 9)) is c
+    assert sources.scaled_calibration(c, 0.5, (np.int64(80), 60.0)) == "scaled"  # type: ignore[arg-type]
+    assert asked == [(80, 60)] and all(type(v) is int for v in asked[0])
+
+
+# ----------------------------------------------------------------------------- bags
+
+
+def test_open_bag_source_probes_then_plays_from_the_start(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    rosbag = pytest.importorskip("stereovision.rosbag")
+    made: list[Any] = []
+
+    class FakeBag:
+        def __init__(self, path: Any, left_topic: Any = None, right_topic: Any = None) -> None:
+            self.args = (path, left_topic, right_topic)
+            self.topics = {"left": "/l/image", "right": "/r/image"}
+            self.closed = False
+            made.append(self)
+
+        def __enter__(self) -> FakeBag:
+            return self
+
+        def __exit__(self, *exc: object) -> None:
+            self.closed = True
+
+        def calibration(self) -> str:
+            return "calib"
+
+        def read(self) -> Any:
+            return (_frame(1), _frame(2))
+
+        def close(self) -> None:
+            self.closed = True
+
+    monkeypatch.setattr(rosbag, "BagCamera", FakeBag)
+    src, calib, names = sources.open_bag_source(tmp_path / "b.bag", "/l", "/r")
+    assert calib == "calib" and names == ("/l/image", "/r/image")
+    assert len(made) == 2 and made[0].closed and not made[1].closed  # the probe is closed
+    assert made[1].args == (tmp_path / "b.bag", "/l", "/r")
+    assert src._files is True  # type: ignore[attr-defined]
