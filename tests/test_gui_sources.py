@@ -533,3 +533,20 @@ def test_open_bag_source_probes_then_plays_from_the_start(
     assert len(made) == 2 and made[0].closed and not made[1].closed  # the probe is closed
     assert made[1].args == (tmp_path / "b.bag", "/l", "/r")
     assert src._files is True  # type: ignore[attr-defined]
+
+
+def test_a_data_folder_at_the_top_of_the_disk_is_labelled_with_one_slash(tmp_path: Path) -> None:
+    """``--data /data`` beside the bundled ``.../stereovision/data``: the root's name took the
+    anchor as a part of its own and joined it with "/" again, so the page listed "//data/...";
+    a ``--data /`` listed "//etc/...". Both now read as the path they are."""
+    top = Path("/tmp").resolve()
+    if len(top.parts) != 2:
+        pytest.skip("/tmp is not a folder directly under /")
+    (tmp_path / top.name).mkdir()
+    both = AllowedFolders([tmp_path / top.name, top])
+    assert both.label(top) == "/tmp"
+    assert both.label(top / "x.png") == "/tmp/x.png"
+    assert both.label(tmp_path / top.name / "y") == f"{tmp_path.name}/tmp/y"
+    root = AllowedFolders(["/"])
+    assert root.label(Path("/")) == "/"
+    assert root.label(Path("/etc/hosts")) == "/etc/hosts"

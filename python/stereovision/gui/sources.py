@@ -121,7 +121,8 @@ class AllowedFolders:
                 and sum(o.parts[-depth:] == r.parts[-depth:] for o in self.roots) > 1
             ):
                 depth += 1
-            self._names[r] = "/".join(r.parts[-depth:])
+            # Path(), not "/".join: a root at the top keeps its anchor ("/data", not "//data").
+            self._names[r] = Path(*r.parts[-depth:]).as_posix()
 
     def resolve(self, path: str | os.PathLike[str]) -> Path:
         """The real path of ``path`` if it lies inside an allowed folder.
@@ -250,7 +251,7 @@ class AllowedFolders:
         for r in self.roots:
             if path == r or path.is_relative_to(r):
                 rel, name = path.relative_to(r), self._names[r]
-                return f"{name}/{rel}" if str(rel) != "." else name
+                return (Path(name) / rel).as_posix()  # "/" + "etc": "/etc", not "//etc"
         return path.name
 
 
