@@ -263,10 +263,13 @@ def test_video_pair_asks_devices_not_files_for_the_size(
     assert dev.props == {cv2.CAP_PROP_FRAME_WIDTH: 640, cv2.CAP_PROP_FRAME_HEIGHT: 480}
     assert file.props == {}
     assert pair.sources == ("0", str(f))
-    # The file starts again at its end; the device that ends says so.
-    reads = [pair._grab(1)[0, 0, 0] for _ in range(3)]
-    assert reads == [10, 20, 10]
-    dev.pos = 2
+    # The file starts again at its end (the device is read on, not rewound); the device
+    # that ends says so.
+    dev.own = [np.full((4, 6, 3), k, np.uint8) for k in range(1, 6)]
+    reads = [tuple(int(x[0, 0, 0]) for x in pair.read()) for _ in range(3)]
+    assert reads == [(1, 10), (2, 20), (4, 10)]  # 3 went with the file's end
+    assert cv2.CAP_PROP_POS_FRAMES not in dev.props and file.pos == 1
+    dev.pos = 5
     with pytest.raises(OSError, match=r"^camera '0' gave no frame$"):
         pair.read()
     pair.close()
@@ -550,3 +553,36 @@ def test_a_data_folder_at_the_top_of_the_disk_is_labelled_with_one_slash(tmp_pat
     root = AllowedFolders(["/"])
     assert root.label(Path("/")) == "/"
     assert root.label(Path("/etc/hosts")) == "/etc/hosts"
+
+
+def test_video_pair_of_unequal_lengths_starts_both_again_together(tmp_path: Path) -> None:
+    """Each file started again on its own: a 2-frame left and a 3-frame right gave left 0 with
+    right 2 on the third read, and every pair after it out of step (StereoCamera, the usual
+    path, opens the pair again as one). Both files now start again when either ends."""
+    for side, n in (("l", 2), ("r", 3)):
+        for k in range(n):
+            img = np.full((8, 10), 50 + 50 * k, np.uint8)
+            cv2.imwrite(str(tmp_path / f"{side}_{k:03d}.png"), img)
+    pair = VideoPair(str(tmp_path / "l_%03d.png"), str(tmp_path / "r_%03d.png"))
+    try:
+        got = [tuple(int(x[0, 0, 0]) for x in pair.read()) for _ in range(5)]
+    finally:
+        pair.close()
+    assert got == [(50, 50), (100, 100), (50, 50), (100, 100), (50, 50)]
+
+
+def test_video_pair_of_a_file_without_frames_names_it(
+    fake_cap: type[FakeCap], tmp_path: Path
+) -> None:
+    f = tmp_path / "empty.avi"
+    f.write_bytes(b"")
+    pair = VideoPair(0, str(f))
+    fake_cap.made[1].own = []  # no frame, even from the start
+    with pytest.raises(OSError, match=r"^camera '.*empty\.avi' gave no frame$"):
+        pair.read()
+    fake_cap.made[1].own = list(fake_cap.frames)
+    fake_cap.made[0].pos = 2  # a device that gives no frame fails at once
+    with pytest.raises(OSError, match=r"^camera 0 gave no frame$"):
+        pair.read()
+    assert fake_cap.made[1].pos == 0  # the file was neither read nor started again for it
+    pair.close()

@@ -284,8 +284,9 @@ class VideoPair:
     """Two :class:`cv2.VideoCapture` sources read together (fallback when ``stereovision.capture``
     is not available).
 
-    Video files and image sequences start again from their first frame when they end, so a
-    recorded pair behaves like a camera that never stops.
+    Video files and image sequences start again from their first frame when one of them ends
+    (both together, so files of unequal lengths stay in step), so a recorded pair behaves like a
+    camera that never stops.
 
     Parameters
     ----------
@@ -328,13 +329,12 @@ class VideoPair:
             raise
         self.sources = (left, right)
 
-    def _grab(self, i: int) -> npt.NDArray[np.uint8]:
-        cap = self._caps[i]
-        ok, frame = cap.read()
-        if not ok and self._files[i]:
-            cap.set(cv2.CAP_PROP_POS_FRAMES, 0)
-            ok, frame = cap.read()
+    def _grab(self, i: int) -> npt.NDArray[np.uint8] | None:
+        """Source ``i``'s next frame; None when it is a file that ended."""
+        ok, frame = self._caps[i].read()
         if not ok or frame is None:
+            if self._files[i]:
+                return None
             raise OSError(f"camera {self.sources[i]!r} gave no frame")
         if frame.ndim == 2:
             frame = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)
@@ -344,7 +344,19 @@ class VideoPair:
         """Grab both, then decode both (keeps the pair as close in time as OpenCV allows)."""
         if not self._caps:
             raise OSError("camera pair is closed")
-        return self._grab(0), self._grab(1)
+        left, right = self._grab(0), self._grab(1)
+        if left is None or right is None:
+            # Every file starts again when one ends: files of unequal lengths, each started
+            # again on its own, paired frames of different times from then on.
+            for cap, is_file in zip(self._caps, self._files, strict=True):
+                if is_file:
+                    cap.set(cv2.CAP_PROP_POS_FRAMES, 0)
+            left, right = self._grab(0), self._grab(1)
+        if left is None:
+            raise OSError(f"camera {self.sources[0]!r} gave no frame")
+        if right is None:
+            raise OSError(f"camera {self.sources[1]!r} gave no frame")
+        return left, right
 
     def close(self) -> None:
         """Release both captures."""
