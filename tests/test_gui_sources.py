@@ -213,6 +213,7 @@ class FakeCap:
     """A cv2.VideoCapture stand-in: ``frames`` in order, then no frame (until rewound)."""
 
     made: ClassVar[list[FakeCap]] = []
+    calls: ClassVar[list[str]] = []
     opened = True
     frames: ClassVar[list[np.ndarray]] = []
 
@@ -234,10 +235,22 @@ class FakeCap:
         return True
 
     def read(self) -> tuple[bool, np.ndarray | None]:
+        self.calls.append(f"read {self.src}")
         if self.pos >= len(self.own):
             return False, None
         self.pos += 1
         return True, self.own[self.pos - 1]
+
+    def grab(self) -> bool:
+        self.calls.append(f"grab {self.src}")
+        if self.pos >= len(self.own):
+            return False
+        self.pos += 1
+        return True
+
+    def retrieve(self) -> tuple[bool, np.ndarray | None]:
+        self.calls.append(f"retrieve {self.src}")
+        return (True, self.own[self.pos - 1]) if self.pos else (False, None)
 
     def release(self) -> None:
         self.released = True
@@ -246,6 +259,7 @@ class FakeCap:
 @pytest.fixture
 def fake_cap(monkeypatch: pytest.MonkeyPatch) -> type[FakeCap]:
     FakeCap.made = []
+    FakeCap.calls = []
     FakeCap.opened = True
     FakeCap.frames = [np.full((4, 6, 3), k, np.uint8) for k in (10, 20)]
     monkeypatch.setattr(cv2, "VideoCapture", FakeCap)
@@ -581,8 +595,20 @@ def test_video_pair_of_a_file_without_frames_names_it(
     with pytest.raises(OSError, match=r"^camera '.*empty\.avi' gave no frame$"):
         pair.read()
     fake_cap.made[1].own = list(fake_cap.frames)
+    fake_cap.made[1].props.clear()
     fake_cap.made[0].pos = 2  # a device that gives no frame fails at once
     with pytest.raises(OSError, match=r"^camera 0 gave no frame$"):
         pair.read()
-    assert fake_cap.made[1].pos == 0  # the file was neither read nor started again for it
+    assert fake_cap.made[1].props == {}  # the file was not started again for it
+    pair.close()
+
+
+def test_video_pair_grabs_both_before_it_decodes_either(fake_cap: type[FakeCap]) -> None:
+    """read() said "grab both, then decode both" and read (grabbed and decoded) one camera
+    after the other: the right camera's frame was taken a whole decode later than the left's.
+    Both are now grabbed first, as StereoCamera does."""
+    pair = VideoPair(0, 1)
+    left, right = pair.read()
+    assert fake_cap.calls == ["grab 0", "grab 1", "retrieve 0", "retrieve 1"]
+    assert left[0, 0, 0] == right[0, 0, 0] == 10
     pair.close()

@@ -329,9 +329,9 @@ class VideoPair:
             raise
         self.sources = (left, right)
 
-    def _grab(self, i: int) -> npt.NDArray[np.uint8] | None:
-        """Source ``i``'s next frame; None when it is a file that ended."""
-        ok, frame = self._caps[i].read()
+    def _decode(self, i: int, grabbed: bool) -> npt.NDArray[np.uint8] | None:
+        """Source ``i``'s grabbed frame; None when it is a file that ended."""
+        ok, frame = self._caps[i].retrieve() if grabbed else (False, None)
         if not ok or frame is None:
             if self._files[i]:
                 return None
@@ -340,18 +340,24 @@ class VideoPair:
             frame = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)
         return np.ascontiguousarray(frame, dtype=np.uint8)
 
+    def _pair(self) -> tuple[npt.NDArray[np.uint8] | None, npt.NDArray[np.uint8] | None]:
+        # Both grabbed before either is decoded: read() one after the other took the right
+        # frame a whole decode later than the left.
+        grabbed = [cap.grab() for cap in self._caps]
+        return self._decode(0, grabbed[0]), self._decode(1, grabbed[1])
+
     def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
         """Grab both, then decode both (keeps the pair as close in time as OpenCV allows)."""
         if not self._caps:
             raise OSError("camera pair is closed")
-        left, right = self._grab(0), self._grab(1)
+        left, right = self._pair()
         if left is None or right is None:
             # Every file starts again when one ends: files of unequal lengths, each started
             # again on its own, paired frames of different times from then on.
             for cap, is_file in zip(self._caps, self._files, strict=True):
                 if is_file:
                     cap.set(cv2.CAP_PROP_POS_FRAMES, 0)
-            left, right = self._grab(0), self._grab(1)
+            left, right = self._pair()
         if left is None:
             raise OSError(f"camera {self.sources[0]!r} gave no frame")
         if right is None:
