@@ -33,6 +33,16 @@ def test_display_path_relative_home_and_absolute() -> None:
     assert display_path("/tmp/x", cwd=cwd, home=Path("/")) == "/tmp/x"
 
 
+def test_display_path_defaults_to_the_current_and_home_folders(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    (tmp_path / "w").mkdir()
+    monkeypatch.chdir(tmp_path / "w")
+    monkeypatch.setenv("HOME", str(tmp_path))
+    assert display_path(tmp_path / "w" / "a.png") == "a.png"
+    assert display_path(tmp_path / "b.png") == "~/b.png"
+
+
 def test_display_path_without_a_home_folder(monkeypatch: pytest.MonkeyPatch) -> None:
     def no_home() -> Path:
         raise RuntimeError("no home")
@@ -135,6 +145,29 @@ def test_files_stop_at_max_listed(
         (tmp_path / f"{k}.ply").write_text("x")
     listed = AllowedFolders([tmp_path]).files(sources.CLOUD_SUFFIXES)
     assert listed == [tmp_path / f"{k}.ply" for k in range(limit)]
+
+
+def test_files_stop_at_max_listed_across_folders(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(sources, "MAX_LISTED", 2)
+    (tmp_path / "sub").mkdir()
+    for name in ("a.ply", "b.ply", "sub/c.ply"):
+        (tmp_path / name).write_text("x")
+    assert AllowedFolders([tmp_path]).files(sources.CLOUD_SUFFIXES) == [
+        tmp_path / "a.ply",
+        tmp_path / "b.ply",
+    ]
+
+
+def test_home_relative_paths_are_expanded(
+    data: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("HOME", str(tmp_path))
+    folders = AllowedFolders(["~/data"])
+    assert folders.roots == (data.resolve(),)
+    assert folders.resolve("~/data/a.ply") == (data / "a.ply").resolve()
+    assert folders.resolve_output(" ~/data/new") == data.resolve() / "new"
 
 
 def test_files_and_scenes_of_two_roots(tmp_path: Path) -> None:
@@ -496,6 +529,16 @@ def test_scale_pair_never_enlarges_and_rounds_the_height() -> None:
     assert l2.shape == (1, 1, 3) and s == pytest.approx(0.1)
     wide = np.zeros((1, 40, 3), np.uint8)
     assert sources.scale_pair(wide, wide, 4)[0].shape == (1, 4, 3)  # height 0.1: one row
+
+
+def test_scale_pair_averages_the_pixels_it_merges() -> None:
+    """INTER_AREA: a fine checkerboard halved is its mean grey (nearest-neighbour would keep
+    one colour of it, and alias)."""
+    board = np.indices((8, 8)).sum(axis=0) % 2 * 200
+    img = np.repeat(board[..., None], 3, axis=2).astype(np.uint8)
+    small, small_r, _ = sources.scale_pair(img, img, 4)
+    np.testing.assert_array_equal(small, np.full((4, 4, 3), 100, np.uint8))
+    np.testing.assert_array_equal(small_r, small)
 
 
 def test_scaled_calibration_passes_none_and_unscaled_through() -> None:
