@@ -655,3 +655,16 @@ def test_video_pair_grabs_both_before_it_decodes_either(fake_cap: type[FakeCap])
     assert fake_cap.calls == ["grab 0", "grab 1", "retrieve 0", "retrieve 1"]
     assert left[0, 0, 0] == right[0, 0, 0] == 10
     pair.close()
+
+
+def test_a_data_folder_inside_another_is_listed_once(data: Path) -> None:
+    """``--data`` naming a folder that holds another allowed folder (the bundled data inside
+    a checkout given as ``--data .``): each file below both was offered twice in the page's
+    lists, and the inner folder twice among the folders to play."""
+    folders = AllowedFolders([data / "scene", data])
+    assert folders.files(sources.IMAGE_SUFFIXES) == [
+        data / "scene" / "left.png",
+        data / "scene" / "right.png",
+    ]
+    assert folders.folders() == [data / "scene", data.resolve()]
+    assert folders.scenes() == [data / "scene"]

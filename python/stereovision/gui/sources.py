@@ -194,13 +194,17 @@ class AllowedFolders:
 
     def _walk(self, suffixes: frozenset[str]) -> list[Path]:
         found: list[Path] = []
+        seen: set[Path] = set()
         for root in self.roots:
             for dirpath, dirnames, filenames in os.walk(root):
                 dirnames[:] = sorted(d for d in dirnames if not d.startswith("."))
                 for name in sorted(filenames):
                     if Path(name).suffix.lower() in suffixes:
                         p = Path(dirpath) / name
-                        if self.contains(p):  # a symlink may point outside
+                        # Not twice: a root may lie inside another (``--data .`` of a checkout
+                        # holds the bundled data).
+                        if p not in seen and self.contains(p):  # a symlink may point outside
+                            seen.add(p)
                             found.append(p)
                             if len(found) >= MAX_LISTED:
                                 return found
@@ -244,7 +248,8 @@ class AllowedFolders:
             except OSError:
                 continue
             found += [p for p in subs if self.contains(p)]
-        return found[:MAX_LISTED]
+        # A root inside another is also one of its sub-folders: listed once, where first met.
+        return list(dict.fromkeys(found))[:MAX_LISTED]
 
     def label(self, path: Path) -> str:
         """Short display name: ``<root name>/<relative path>``."""
