@@ -48,9 +48,12 @@ class HeldInterrupts:
         if not self.received:
             self.received.append(signum)
             return
-        self._restore()  # a second signal: acted on now
+        # the caller's handler, looked up before _restore forgets it (a second SIGTERM was
+        # KeyboardInterrupt's, not the CLI's Terminated): a second signal is acted on now
+        handler = self._old.get(signum, signal.default_int_handler)
+        self._restore()
         self._gone = True
-        self._old.get(signum, signal.default_int_handler)(signum, frame)
+        handler(signum, frame)
 
     def _restore(self) -> None:
         for sig, handler in self._old.items():

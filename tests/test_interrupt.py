@@ -1,0 +1,93 @@
+"""HeldInterrupts: the first Ctrl-C or SIGTERM waits for the block's end, a second does not."""
+
+from __future__ import annotations
+
+import os
+import signal
+import time
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+from stereovision._interrupt import HeldInterrupts, Terminated, raise_terminated
+
+
+@pytest.fixture
+def counted() -> Iterator[list[int]]:
+    """SIGINT handled by a handler that counts its calls (and raises KeyboardInterrupt)."""
+    calls: list[int] = []
+
+    def handler(signum: int, frame: Any) -> None:
+        calls.append(signum)
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGINT, handler)
+    try:
+        yield calls
+    finally:
+        signal.signal(signal.SIGINT, old)
+
+
+def _kill(sig: int) -> None:
+    os.kill(os.getpid(), sig)
+    time.sleep(0.05)  # a handler would have run here
+
+
+def test_a_second_signal_is_acted_on_at_once_and_the_first_not_replayed(
+    counted: list[int],
+) -> None:
+    done = []
+    with pytest.raises(KeyboardInterrupt):
+        with HeldInterrupts():
+            _kill(signal.SIGINT)
+            done.append("held")
+            _kill(signal.SIGINT)
+            done.append("not reached")
+    assert done == ["held"]
+    assert counted == [signal.SIGINT]  # the caller's handler, once: no replay on top
+    assert getattr(signal.getsignal(signal.SIGINT), "__name__", None) == "handler"
+
+
+def test_a_second_sigterm_is_the_callers_terminated_not_a_keyboard_interrupt() -> None:
+    """The second signal called KeyboardInterrupt's handler whatever the signal: the handlers
+    were put back (and forgotten) before the one to call was looked up, so a second SIGTERM
+    was "interrupted", exit 130, not "terminated", 143."""
+    old = signal.signal(signal.SIGTERM, raise_terminated)
+    try:
+        with pytest.raises(KeyboardInterrupt) as caught:
+            with HeldInterrupts():
+                _kill(signal.SIGTERM)
+                _kill(signal.SIGTERM)
+    finally:
+        signal.signal(signal.SIGTERM, old)
+    assert caught.type is Terminated
+
+
+def test_without_replay_the_signal_is_only_recorded(counted: list[int]) -> None:
+    with HeldInterrupts(replay=False) as held:
+        _kill(signal.SIGINT)
+    assert held.received == [signal.SIGINT] and counted == []
+
+
+def test_sigterm_is_held_when_python_handles_it() -> None:
+    old = signal.signal(signal.SIGTERM, raise_terminated)
+    done = []
+    try:
+        with pytest.raises(Terminated):
+            with HeldInterrupts():
+                _kill(signal.SIGTERM)
+                done.append("frame")
+    finally:
+        signal.signal(signal.SIGTERM, old)
+    assert done == ["frame"]
+
+
+def test_an_ignored_or_default_signal_is_left_alone() -> None:
+    old = signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    try:
+        with HeldInterrupts():
+            assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN
+        assert signal.getsignal(signal.SIGTERM) is signal.SIG_IGN
+    finally:
+        signal.signal(signal.SIGTERM, old)
