@@ -795,3 +795,109 @@ def test_scene_max_disparity_ignores_a_gt_without_positive_disparity() -> None:
     zero = np.zeros((2, 2), np.float32)
     assert scene_max_disparity(zero, width=100, ndisp=100) == 112
     assert scene_max_disparity(-zero - 3.0, width=200) == 64  # 200 // 4 = 50 -> 64
+
+
+# ------------------------------------------------------------- mutation audit: writers, readers
+
+
+def test_atomic_write_cleans_up_after_an_interrupt_and_writes_text_as_utf8(tmp_path: Path) -> None:
+    """A Ctrl-C in the body (not an Exception) must also leave the old file and no temporary
+    one; text mode is UTF-8 whatever the locale."""
+    dest = tmp_path / "f.txt"
+    dest.write_bytes(b"old")
+    with pytest.raises(KeyboardInterrupt), atomic_write(dest, "w") as fh:
+        fh.write("new")
+        raise KeyboardInterrupt
+    assert dest.read_bytes() == b"old" and os.listdir(tmp_path) == ["f.txt"]
+    with atomic_write(dest, "w") as fh:
+        fh.write("z = 2.5 \u00b5m")
+    assert dest.read_bytes() == "z = 2.5 \u00b5m".encode()
+
+
+def test_pfm_sizes_and_range_limits(tmp_path: Path) -> None:
+    """A PFM of width 0 or an infinite scale is refused; an empty array is not written; a
+    float64 holding exactly float32's largest value is written as that value, not refused."""
+    (tmp_path / "w0.pfm").write_bytes(b"Pf\n0 2\n-1.0\n")
+    with pytest.raises(ValueError, match="bad PFM header"):
+        read_pfm(tmp_path / "w0.pfm")
+    (tmp_path / "inf.pfm").write_bytes(b"Pf\n1 1\n-1e999\n" + b"\0" * 4)
+    with pytest.raises(ValueError, match="bad PFM header"):
+        read_pfm(tmp_path / "inf.pfm")
+    with pytest.raises(ValueError, match="non-empty"):
+        write_pfm(tmp_path / "e.pfm", np.zeros((0, 3), np.float32))
+    assert not (tmp_path / "e.pfm").exists()
+    top = float(np.finfo(np.float32).max)
+    write_pfm(tmp_path / "top.pfm", np.array([[top, -top]], np.float64))
+    assert read_pfm(tmp_path / "top.pfm").tolist() == [[top, -top]]
+
+
+def test_write_ply_drops_a_point_with_one_nan_coordinate(tmp_path: Path) -> None:
+    pts = np.array([[1, 2, 3], [1, np.nan, 2], [np.inf, 0, 1], [4, 5, 6]], np.float32)
+    cols = np.array([[1, 1, 1], [2, 2, 2], [3, 3, 3], [4, 4, 4]], np.uint8)
+    write_ply(tmp_path / "c.ply", pts, cols)
+    got, got_c = read_ply(tmp_path / "c.ply")
+    assert got.tolist() == [[1, 2, 3], [4, 5, 6]]
+    assert got_c is not None and got_c.tolist() == [[1, 1, 1], [4, 4, 4]]
+
+
+def _ply(fmt: str, props: str, count: int) -> bytes:
+    return f"ply\nformat {fmt} 1.0\nelement vertex {count}\n{props}end_header\n".encode("ascii")
+
+
+def test_read_ply_big_endian_and_every_scalar_type(tmp_path: Path) -> None:
+    """Big-endian data was read as little-endian; each type name maps to its own width and
+    signedness (char -1 is not 255, ushort 40000 is not -25536, double is 8 bytes)."""
+    props = "property char x\nproperty ushort y\nproperty double z\nproperty uint red\n"
+    props += "property uchar green\nproperty uchar blue\n"
+    fields = [("x", "i1"), ("y", "u2"), ("z", "f8"), ("r", "u4"), ("g", "u1"), ("b", "u1")]
+    for fmt, order in (("binary_big_endian", ">"), ("binary_little_endian", "<")):
+        rec = np.array(
+            [(-1, 40000, 0.1, 200, 7, 9), (5, 3, -2.5, 1, 2, 3)],
+            [(n, order + t) for n, t in fields],
+        )
+        (tmp_path / "t.ply").write_bytes(_ply(fmt, props, 2) + rec.tobytes())
+        pts, cols = read_ply(tmp_path / "t.ply")
+        assert pts.tolist() == [[-1, 40000, np.float32(0.1)], [5, 3, -2.5]], fmt
+        assert cols is not None and cols.tolist() == [[200, 7, 9], [1, 2, 3]], fmt
+
+
+def test_read_ply_header_and_truncation_errors(tmp_path: Path) -> None:
+    """A file not starting with "ply", one vertex short (binary or ASCII), no vertex element
+    or a vertex element without a count: each a ValueError saying so."""
+    xyz = "property float x\nproperty float y\nproperty float z\n"
+    good = _ply("ascii", xyz, 1) + b"1 2 3\n"
+    (tmp_path / "n.ply").write_bytes(b"xyz" + good[3:])
+    with pytest.raises(ValueError, match="not a PLY file"):
+        read_ply(tmp_path / "n.ply")
+    (tmp_path / "b.ply").write_bytes(_ply("binary_little_endian", xyz, 3) + b"\0" * 24)
+    with pytest.raises(ValueError, match=r"truncated PLY file .*expected 3 vertices of 12"):
+        read_ply(tmp_path / "b.ply")
+    (tmp_path / "a.ply").write_bytes(_ply("ascii", xyz, 3) + b"1 2 3\n4 5 6\n")
+    with pytest.raises(ValueError, match=r"truncated PLY file .*expected 3 vertices"):
+        read_ply(tmp_path / "a.ply")
+    (tmp_path / "nv.ply").write_bytes(b"ply\nformat ascii 1.0\nend_header\n")
+    with pytest.raises(ValueError, match="no format or vertex element"):
+        read_ply(tmp_path / "nv.ply")
+    (tmp_path / "nc.ply").write_bytes(b"ply\nformat ascii 1.0\nelement vertex\n" + xyz.encode())
+    (tmp_path / "nc.ply").write_bytes((tmp_path / "nc.ply").read_bytes() + b"end_header\n")
+    with pytest.raises(ValueError, match="first element"):
+        read_ply(tmp_path / "nc.ply")
+
+
+def test_read_ply_float_colours_with_nan_and_none(tmp_path: Path) -> None:
+    """A NaN float colour is 0 and does not make the others 0-255; an empty cloud with float
+    colours is read (the maximum of no colour was asked for)."""
+    props = "property float x\nproperty float y\nproperty float z\n"
+    props += "property float red\nproperty float green\nproperty float blue\n"
+    (tmp_path / "f.ply").write_bytes(_ply("ascii", props, 1) + b"0 0 1 0.5 nan 1\n")
+    _, cols = read_ply(tmp_path / "f.ply")
+    assert cols is not None and cols.tolist() == [[128, 0, 255]]
+    (tmp_path / "e.ply").write_bytes(_ply("binary_little_endian", props, 0))
+    pts, cols = read_ply(tmp_path / "e.ply")
+    assert pts.shape == (0, 3) and cols is not None and cols.shape == (0, 3)
+    # plain names win over MeshLab's diffuse_ ones when a file has both
+    both = props + "property uchar diffuse_red\nproperty uchar diffuse_green\n"
+    both += "property uchar diffuse_blue\n"
+    (tmp_path / "d.ply").write_bytes(_ply("ascii", both, 1) + b"0 0 1 1 1 1 5 6 7\n")
+    _, cols = read_ply(tmp_path / "d.ply")
+    assert cols is not None and cols.tolist() == [[255, 255, 255]]
