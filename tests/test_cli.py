@@ -1423,3 +1423,15 @@ def test_json_line_refuses_keys_written_alike() -> None:
     assert json_line(row) == (
         '{"1": "a", "2": "b", "false": "c", "null": "d", "NaN": "e", "nan": "f", "2.5": "g"}'
     )
+
+
+def test_json_ready_writes_a_path_key_as_its_string() -> None:
+    """A path as a dict key (a scene's folder) is its string: json.dumps refused it."""
+    import os
+
+    from stereovision._jsonout import json_line, json_ready
+
+    assert json_ready({Path("a") / "b": 1}) == {os.path.join("a", "b"): 1}
+    assert json.loads(json_line({"per_scene": {Path("s"): float("nan")}})) == {
+        "per_scene": {"s": None}
+    }
