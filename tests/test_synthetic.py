@@ -1,0 +1,94 @@
+"""render_plane against geometry worked out by hand: a fronto-parallel plane whose texture is
+a ramp, so each pixel's value is the texture coordinate its centre sees."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from stereovision.synthetic import render_plane
+
+# f = 100 px, plane at Z = 1, 0.01 units per texture pixel: one texture pixel per image pixel.
+# The principal point (-5, -3) puts image pixel (u, v) on texture pixel (u + 4.5, v + 2.5)
+# (texture pixel centres sit half a pixel in from the origin).
+K = np.array([[100.0, 0.0, -5.0], [0.0, 100.0, -3.0], [0.0, 0.0, 1.0]])
+D = np.zeros(5)
+TEX = np.zeros((60, 80, 3), np.float32)
+TEX[..., 0] = np.arange(80)[None, :]  # column ramp
+TEX[..., 1] = np.arange(60)[:, None]  # row ramp
+TEX[..., 2] = 7.0
+
+
+@pytest.mark.parametrize(("ss", "z", "s"), [(1, 1.0, 0.01), (3, 1.0, 0.01), (3, 2.0, 0.02)])
+def test_a_fronto_parallel_ramp_lands_where_the_geometry_says(ss: int, z: float, s: float) -> None:
+    """Twice as far with texture pixels twice as large: the same image (the ray's plane point
+    is divided by its depth)."""
+    out = render_plane(TEX, s, K, D, np.zeros(3), [0, 0, z], image_size=(20, 12), supersample=ss)
+    assert out.shape == (12, 20, 3) and out.dtype == np.float32
+    u, v = np.meshgrid(np.arange(20), np.arange(12))
+    np.testing.assert_allclose(out[..., 0], u + 4.5, atol=1e-3)
+    np.testing.assert_allclose(out[..., 1], v + 2.5, atol=1e-3)
+    np.testing.assert_allclose(out[..., 2], 7.0, atol=1e-4)
+
+
+def test_the_origin_moves_the_texture_and_integers_are_rounded() -> None:
+    tex = np.tile(np.arange(80, dtype=np.uint8)[None, :], (60, 1))
+    out = render_plane(
+        tex, 0.01, K, D, np.zeros(3), [0, 0, 1.0], image_size=(20, 12), origin_px=(2.0, 0.0)
+    )
+    assert out.dtype == np.uint8
+    u = np.arange(20)
+    # coordinate u + 7 = u + 4.5 + 2.5 shifts columns only; u + 4.5 + 2 would be u + 6.5
+    np.testing.assert_array_equal(out, np.tile(u + 7, (12, 1)))
+    rows = render_plane(
+        TEX, 0.01, K, D, np.zeros(3), [0, 0, 1.0], image_size=(20, 12), origin_px=(2.0, 0.0)
+    )[..., 1]
+    np.testing.assert_allclose(rows, np.tile(np.arange(12)[:, None] + 3.0, (1, 20)), atol=1e-3)
+    half = render_plane(
+        tex, 0.01, K, D, np.zeros(3), [0, 0, 1.0], image_size=(20, 12), origin_px=(1.75, 0.0)
+    )
+    np.testing.assert_array_equal(half, np.tile(u + 7, (12, 1)))  # u + 6.75 rounded, not cut
+
+
+def test_off_the_plane_and_behind_the_camera_is_background_in_every_channel() -> None:
+    out = render_plane(
+        TEX, 0.01, K, D, np.zeros(3), [0, 0, 1.0], image_size=(100, 12), background=33.0
+    )
+    np.testing.assert_allclose(out[:, 90:], 33.0)  # columns past the texture's 80
+    # the plane at Z = -1, where these rays, taken backwards, would meet it on the texture
+    k_left = np.array([[100.0, 0.0, 25.0], [0.0, 100.0, 15.0], [0.0, 0.0, 1.0]])
+    behind = render_plane(
+        TEX, 0.01, k_left, D, np.zeros(3), [0, 0, -1.0], image_size=(20, 12), background=33.0
+    )
+    np.testing.assert_allclose(behind, 33.0)
+
+
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"model": "fish"}, "model"),
+        ({"supersample": 9}, "supersample"),
+        ({"supersample": 0}, "supersample"),
+        ({"image_size": (0, 10)}, "image_size"),
+    ],
+)
+def test_bad_arguments_are_named(kw: dict, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        render_plane(TEX, 0.01, K, D, np.zeros(3), [0, 0, 1.0], **kw)
+
+
+@pytest.mark.parametrize("s", [0.0, -0.01, float("nan"), float("inf")])
+def test_units_per_pixel_must_be_positive(s: float) -> None:
+    with pytest.raises(ValueError, match="units_per_pixel"):
+        render_plane(TEX, s, K, D, np.zeros(3), [0, 0, 1.0])
+
+
+def test_fisheye_and_pinhole_rays_of_one_camera_are_not_shared() -> None:
+    """The equidistant model puts pixel u at angle (u - cx) / f, so the plane at Z = 1 is read
+    at tan((u + 5) / 100) * 100 - 0.5; the pinhole rays were cached under the same camera."""
+    kw = {"image_size": (20, 12)}
+    pin = render_plane(TEX, 0.01, K, np.zeros(4), np.zeros(3), [0, 0, 1.0], **kw)
+    fish = render_plane(TEX, 0.01, K, np.zeros(4), np.zeros(3), [0, 0, 1.0], model="fisheye", **kw)
+    u = np.arange(20)
+    np.testing.assert_allclose(pin[0, :, 0], u + 4.5, atol=1e-3)
+    np.testing.assert_allclose(fish[0, :, 0], np.tan((u + 5) / 100) * 100 - 0.5, atol=0.02)
