@@ -753,3 +753,25 @@ def test_organised_points_colours_without_the_left_image(result):
 def test_voxel_of_true_is_refused():
     with pytest.raises(ValueError, match="voxel: expected a positive cube side, got True"):
         export.voxel_downsample(np.zeros((3, 3)), voxel=True)
+
+
+def test_depth_png_refuses_what_it_cannot_read_or_write(tmp_path) -> None:
+    """An 8-bit or a 3-channel 16-bit PNG is not a depth image; an empty map is named; ".PNG"
+    is a PNG; a map with no positive depth (all 0, no value at all) is not warned about."""
+    import warnings
+
+    cv2.imwrite(str(tmp_path / "u8.png"), np.full((2, 3), 7, np.uint8))
+    cv2.imwrite(str(tmp_path / "c16.png"), np.full((2, 3, 3), 700, np.uint16))
+    for name, got in (
+        ("u8.png", r"uint8 with shape \(2, 3\)"),
+        ("c16.png", r"uint16 with shape \(2, 3, 3\)"),
+    ):
+        with pytest.raises(ValueError, match=rf"expected a single-channel 16-bit PNG, got {got}"):
+            export.read_depth_png(tmp_path / name)
+    with pytest.raises(ValueError, match=r"depth: expected a non-empty \(H, W\) array"):
+        export.write_depth_png(tmp_path / "e.png", np.zeros((0, 4)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        export.write_depth_png(tmp_path / "z.PNG", np.zeros((2, 3)))
+    assert export.read_depth_png(tmp_path / "z.PNG").shape == (2, 3)
+    assert np.isnan(export.read_depth_png(tmp_path / "z.PNG")).all()
