@@ -901,3 +901,17 @@ def test_read_ply_float_colours_with_nan_and_none(tmp_path: Path) -> None:
     (tmp_path / "d.ply").write_bytes(_ply("ascii", both, 1) + b"0 0 1 1 1 1 5 6 7\n")
     _, cols = read_ply(tmp_path / "d.ply")
     assert cols is not None and cols.tolist() == [[255, 255, 255]]
+
+
+def test_write_ply_refuses_a_transposed_colour_image(tmp_path: Path) -> None:
+    """(W, H, 3) colours of (H, W, 3) points have the same size: each point got another
+    pixel's colour. Two images must have one shape; a flat (N, 3) side pairs by count."""
+    pts = np.arange(2 * 3 * 3, dtype=np.float32).reshape(2, 3, 3)
+    img = np.arange(2 * 3 * 3, dtype=np.uint8).reshape(2, 3, 3)
+    with pytest.raises(ValueError, match=r"colors: expected shape \(2, 3, 3\).*got \(3, 2, 3\)"):
+        write_ply(tmp_path / "t.ply", pts, img.transpose(1, 0, 2))
+    for p, c in ((pts, img), (pts.reshape(-1, 3), img), (pts, img.reshape(-1, 3))):
+        back, cols = read_ply(write_ply(tmp_path / "ok.ply", p, c))
+        np.testing.assert_array_equal(back, pts.reshape(-1, 3))
+        assert cols is not None
+        np.testing.assert_array_equal(cols, img.reshape(-1, 3))

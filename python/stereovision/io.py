@@ -831,7 +831,11 @@ def write_ply(
         cols = np.asarray(colors)
         if cols.dtype != np.uint8:
             raise ValueError(f"colors: expected dtype uint8, got {cols.dtype}")
-        if cols.ndim < 2 or cols.shape[-1] != 3 or cols.size != pts.size:
+        shape = np.shape(points)
+        # a flat (N, 3) side pairs by count; two images by their shape (a transposed
+        # (W, H, 3) colour image of (H, W, 3) points paired each point with another's colour)
+        mismatch = len(shape) > 2 and cols.ndim > 2 and cols.shape != shape
+        if cols.ndim < 2 or cols.shape[-1] != 3 or cols.size != pts.size or mismatch:
             raise ValueError(
                 f"colors: expected shape {np.asarray(points).shape} (RGB per point), "
                 f"got {cols.shape}"
