@@ -915,3 +915,15 @@ def test_write_ply_refuses_a_transposed_colour_image(tmp_path: Path) -> None:
         np.testing.assert_array_equal(back, pts.reshape(-1, 3))
         assert cols is not None
         np.testing.assert_array_equal(cols, img.reshape(-1, 3))
+
+
+def test_read_ply_header_ends_at_the_end_header_line(tmp_path: Path) -> None:
+    """A comment holding the words "end_header" cut the header there: the vertex element
+    after it was never read ("no vertex element")."""
+    pts = np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], np.float32)
+    path = write_ply(tmp_path / "c.ply", pts, comment="written before end_header")
+    back, _ = read_ply(path)
+    np.testing.assert_array_equal(back, pts)
+    (tmp_path / "n.ply").write_bytes(b"ply\nformat ascii 1.0\ncomment end_header\n")
+    with pytest.raises(ValueError, match="not a PLY file"):
+        read_ply(tmp_path / "n.ply")

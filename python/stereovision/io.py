@@ -904,7 +904,9 @@ def read_ply(
     """
     p = _existing_file(path, "PLY file")
     raw = p.read_bytes()
-    end = raw.find(b"end_header")
+    # the line that is "end_header", not the first "end_header" (a comment may hold one)
+    found = re.search(rb"(?m)^end_header[ \t\r]*$", raw) if raw.startswith(b"ply") else None
+    end = found.start() if found else -1
     if not raw.startswith(b"ply") or end < 0:
         raise ValueError(f"not a PLY file: {p}")
     nl = raw.find(b"\n", end)
