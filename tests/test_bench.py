@@ -155,3 +155,138 @@ def test_bench_of_a_scene_narrower_than_its_range_names_the_width_needed(
         "range (16 px, evaluation.md's rule: 16 at least): a scene needs images at least 17 px "
         "wide"
     ]
+
+
+class _Clock:
+    """A fake ``time.perf_counter``: only the fake matchers below move it."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def perf_counter(self) -> float:
+        return self.now
+
+
+def _fake(clock: _Clock, base_s: float, out: object, calls: list[int]) -> object:
+    """A matcher taking 1 s on its first call (the warm-up), then ``base_s`` times 1, 3, 2, 50,
+    2, 1 (median 2 ``base_s``, mean 59/6 of it), returning ``out``."""
+    pattern = [1, 3, 2, 50, 2, 1]
+
+    def run(*_a: object, **_k: object) -> object:
+        clock.now += 1.0 if not calls else base_s * pattern[len(calls) - 1]
+        calls.append(1)
+        return out
+
+    return run
+
+
+def _fake_bench(
+    monkeypatch: pytest.MonkeyPatch, gt: np.ndarray | None
+) -> tuple[list[object], dict[str, list[int]], np.ndarray]:
+    """bench_scene(runs=6) on an 8x32 pair with every matcher faked (timed by the fake clock)."""
+    import sys
+    import types
+
+    import stereovision.bench as bench_mod
+    import stereovision.depth as depth_mod
+
+    match_mod = sys.modules["stereovision.match"]  # the package's `match` is the function
+
+    clock = _Clock()
+    monkeypatch.setattr(bench_mod, "time", types.SimpleNamespace(perf_counter=clock.perf_counter))
+    disp = np.full((8, 32), 2.0, np.float32)
+    disp[3, 10] = np.nan  # a hole: bad before the row fill, not after
+    calls: dict[str, list[int]] = {k: [] for k in ("pipeline", "bm", "sgbm")}
+    pipe = types.SimpleNamespace(disparity=disp)
+    sparse = types.SimpleNamespace(xl=np.array([5.0]), yl=np.array([1.0]), xr=np.array([3.0]))
+    monkeypatch.setattr(depth_mod, "_run_matcher", lambda *a, **k: (disp, None))
+    monkeypatch.setattr(depth_mod, "depth_map", _fake(clock, 0.010, pipe, calls["pipeline"]))
+    monkeypatch.setattr(match_mod, "match", lambda *a, **k: sparse)
+    monkeypatch.setattr(baselines, "opencv_bm", _fake(clock, 0.001, disp, calls["bm"]))
+    monkeypatch.setattr(baselines, "opencv_sgbm", _fake(clock, 0.002, disp, calls["sgbm"]))
+    rng = np.random.default_rng(0)
+    img = (rng.random((8, 32, 3)) * 255).astype(np.uint8)
+    scene = types.SimpleNamespace(
+        name="fake", left=img, right=img, gt=gt, max_disparity=4, calib=None
+    )
+    return bench_scene(scene, runs=6), calls, disp  # type: ignore[return-value]
+
+
+def test_bench_reports_the_median_of_the_timed_runs_after_a_warm_up(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """evaluation.md "Speed": one untimed warm-up per case, then the median (not the mean) of
+    the ``runs`` timed runs in milliseconds, and each case's ratio to SGBM-3WAY's median."""
+    gt = np.full((8, 32), 2.0, np.float32)
+    cases, calls, disp = _fake_bench(monkeypatch, gt)
+    by = {c.case: c for c in cases}  # type: ignore[attr-defined]
+    assert len(calls["sgbm"]) == len(calls["pipeline"]) == 7  # the warm-up and 6 timed runs
+    # SGBM: 2, 6, 4, 100, 4, 2 ms (the warm-up's 1 s not among them): median 4 ms
+    assert by["SGBM-3WAY"].ms == pytest.approx(4.0)
+    assert by["pipeline"].ms == pytest.approx(20.0) and by["StereoBM"].ms == pytest.approx(2.0)
+    assert by["pipeline"].ratio == pytest.approx(5.0)
+    assert by["StereoBM"].ratio == pytest.approx(0.5)
+    out = by["pipeline"].as_dict()
+    assert (out["ms"], out["ratio_sgbm"], out["runs"]) == (20.0, 5.0, 6)
+    assert (out["width"], out["height"], out["max_disparity"]) == (32, 8, 4)
+    # the pipeline's map has one hole: bad before the row fill, none after
+    raw = dense_metrics(disp, gt)
+    assert out["bad_2.0"] == round(raw.bad[2.0], 3) and raw.bad[2.0] > 0  # rounded to 3
+    assert out["bad_2.0_filled"] == 0.0 and out["density"] == round(raw.density, 3)
+    sparse = [c for c in cases if c.kind == "sparse"]  # type: ignore[attr-defined]
+    assert sparse and all(c.accuracy == {"precision@1.0": 100.0, "count": 1} for c in sparse)
+
+
+def test_bench_without_gt_reports_times_only(monkeypatch: pytest.MonkeyPatch) -> None:
+    cases, _, _ = _fake_bench(monkeypatch, None)
+    assert cases and all(c.accuracy == {} for c in cases)  # type: ignore[attr-defined]
+    assert "bad_2.0" not in cases[0].as_dict()  # type: ignore[attr-defined]
+
+
+def test_format_table_names_a_scene_once_and_shows_no_figure_as_a_dash() -> None:
+    from stereovision.bench import BenchCase
+
+    acc = {"bad_2.0": float("nan"), "bad_2.0_filled": 1.25, "density": 50.0}
+    cases = [
+        BenchCase("a", "census", "method", 32, 8, 4, 5, 2.0, 0.5, acc),
+        BenchCase("a", "SGBM-3WAY", "opencv", 32, 8, 4, 5, 4.0, 1.0, {}),
+        BenchCase("b", "SGBM-3WAY", "opencv", 16, 4, 2, 5, 3.0, 1.0, {}),
+    ]
+    lines = format_table(cases).splitlines()
+    assert len(lines) == 4
+    assert lines[1].split() == [
+        "a",
+        "32x8",
+        "4",
+        "census",
+        "2.0",
+        "0.50",
+        "-",
+        "1.2",
+        "50.0",
+        "-",
+        "-",
+    ]
+    assert lines[2].startswith(" " * 49 + " SGBM-3WAY")  # the scene said on its first case only
+    assert lines[3].split()[:3] == ["b", "16x4", "2"]
+    assert "nan" not in "\n".join(lines)
+
+
+def test_bench_cli_prints_the_table_then_the_json_lines(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import cv2
+
+    scene = tmp_path / "crop"
+    scene.mkdir()
+    for name in ("left.png", "right.png"):
+        img = cv2.imread(str(data_dir / SCENE / name))
+        assert cv2.imwrite(str(scene / name), img[100:164, 100:196])
+    assert main(["bench", str(scene)]) == 0
+    cap = capsys.readouterr()
+    lines = cap.out.splitlines()
+    n = (len(lines) - 1) // 2
+    assert lines[0].split()[:4] == ["scene", "size", "D", "case"]
+    table, objects = lines[1 : 1 + n], [json.loads(ln) for ln in lines[1 + n :]]
+    assert len(objects) == n and [o["case"] for o in objects][-1] == "SGBM-3WAY"
+    assert [ln.split()[0] for ln in table[1:]] == [o["case"] for o in objects][1:]
