@@ -1214,6 +1214,9 @@ def test_demo_checks_its_output_folder_first(
         (["--max-depth", "-1"], "--max-depth: expected a positive finite number, got -1.0"),
         (["--voxel", "0"], "--voxel: expected a positive finite number, got 0.0"),
         (["--grid", "0.1"], "--grid needs --ground"),
+        (["--ground", "--grid", "11"], "--grid: expected a cell side from 0.01 to 10 m, got 11.0"),
+        # a range as wide as the image is refused too (terrace: 713 px)
+        (["--max-disparity", "713"], "disparity range 713 is not smaller than the image width 713"),
         (["--max-disparity", "5000"], "disparity range 5000 is not smaller than the image width"),
         (["--right", "tsukuba"], "left and right images must have the same shape"),
         (["--calib", "tsukuba"], "calibration is for 713x434 images, got 384x288"),
@@ -1435,3 +1438,102 @@ def test_json_ready_writes_a_path_key_as_its_string() -> None:
     assert json.loads(json_line({"per_scene": {Path("s"): float("nan")}})) == {
         "per_scene": {"s": None}
     }
+@pytest.mark.parametrize(("text", "port"), [("0", 0), ("65535", 65535)])
+def test_port_number_takes_0_to_65535(text: str, port: int) -> None:
+    from stereovision.cli import port_number
+
+    assert port_number(text) == port
+
+
+@pytest.mark.parametrize("text", ["-1", "65536", "80.5"])
+def test_port_number_refuses_what_is_no_port(text: str) -> None:
+    import argparse
+
+    from stereovision.cli import port_number
+
+    with pytest.raises(argparse.ArgumentTypeError, match="expected a port 0 to 65535"):
+        port_number(text)
+
+
+def test_a_bug_of_ours_is_one_line_on_stderr_and_exit_2(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An exception no command raises on purpose (an AttributeError) is a bug: one line on
+    stderr naming it (its message's first line), exit 2, no traceback, nothing on stdout."""
+    import stereovision.cli as cli
+
+    def broken(args: object) -> int:
+        raise AttributeError("boom\nsecond line")
+
+    monkeypatch.setattr(cli, "cmd_info", broken)
+    assert main(["info", "--size", "640x480", "--hfov", "60", "--baseline", "0.1"]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == "stereovision: error: internal AttributeError: boom (please report this)\n"
+
+
+def test_depth_of_a_pair_16_px_wide_is_refused_without_a_range(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """16 px is the automatic range's least: a pair that wide has no room for it."""
+    rng = np.random.default_rng(0)
+    img = (rng.random((8, 16, 3)) * 255).astype(np.uint8)
+    assert cv2.imwrite(str(tmp_path / "l.png"), img)
+    assert cv2.imwrite(str(tmp_path / "r.png"), img[:, ::-1])
+    argv = ["depth", str(tmp_path / "l.png"), str(tmp_path / "r.png"), "-o", str(tmp_path / "o")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("stereovision: error: image too narrow for stereo matching: 16 px wide")
+    assert not (tmp_path / "o").exists()
+
+
+def test_eval_time_line_says_ours_over_sgbm() -> None:
+    from stereovision.cli import _eval_time_line
+
+    row = {"scene": "s", "runs": 5, "ours_ms": 30.0, "bm_ms": 2.0, "sgbm_ms": 12.0}
+    assert _eval_time_line(row) == (
+        "s: time, median of 5 runs after a warm-up: ours 30.0 ms, StereoBM 2.0 ms, "
+        "SGBM-3WAY 12.0 ms (ours 2.5 x SGBM-3WAY)"
+    )
+    assert _eval_time_line({"scene": "s", "runs": 1, "ours_ms": 30.0}) == (
+        "s: time, one run, no warm-up: ours 30.0 ms"
+    )
+
+
+def test_eval_times_are_the_medians_of_the_timed_runs(monkeypatch: pytest.MonkeyPatch) -> None:
+    """_eval_scene: one untimed warm-up round, then the median (not the mean) of each
+    method's ``runs`` times, in milliseconds; accuracy from the first round's outputs."""
+    import types
+
+    import stereovision.cli as cli
+    import stereovision.depth as depth_mod
+    from stereovision import baselines
+
+    now = [0.0]
+    monkeypatch.setattr(cli, "time", types.SimpleNamespace(perf_counter=lambda: now[0]))
+    disp = np.full((8, 32), 2.0, np.float32)
+
+    def fake(base_s: float, out: object) -> object:
+        calls: list[int] = []
+
+        def run(*_a: object, **_k: object) -> object:
+            # 1 s warm-up, then base times 1, 3, 2, 50, 2: median 2 base, mean 11.6 base
+            now[0] += 1.0 if not calls else base_s * [1, 3, 2, 50, 2][len(calls) - 1]
+            calls.append(1)
+            return out
+
+        return run
+
+    res = types.SimpleNamespace(disparity=disp, depth=None, channels=None)
+    monkeypatch.setattr(depth_mod, "depth_map", fake(0.010, res))
+    monkeypatch.setattr(baselines, "opencv_bm", fake(0.001, disp))
+    monkeypatch.setattr(baselines, "opencv_sgbm", fake(0.002, disp))
+    img = np.zeros((8, 32, 3), np.uint8)
+    gt = np.full((8, 32), 2.0, np.float32)
+    scene = types.SimpleNamespace(
+        name="fake", left=img, right=img, gt=gt, max_disparity=4, calib=None
+    )
+    row = cli._eval_scene(scene, "census", True, runs=5)
+    times = (row["ours_ms"], row["bm_ms"], row["sgbm_ms"])
+    assert times == pytest.approx((20.0, 2.0, 4.0)) and row["runs"] == 5
+    assert row["ours"]["bad_2.0"] == 0.0 and row["sgbm"]["density"] == 100.0
