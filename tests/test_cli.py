@@ -1224,6 +1224,7 @@ def test_demo_checks_its_output_folder_first(
         # accepted with no effect (no depth, no cloud) before
         (["--no-calib", "--unit", "ft"], "--unit needs --calib (no depth to say in it without"),
         (["--no-calib", "--voxel", "0.1"], "--voxel needs --calib (no cloud.ply without one)"),
+        (["--no-calib", "--ground"], "--ground needs --calib (the floor is found in metres)"),
     ],
 )
 def test_depth_says_a_usage_error_before_a_file_it_did_not_write(
@@ -1537,3 +1538,100 @@ def test_eval_times_are_the_medians_of_the_timed_runs(monkeypatch: pytest.Monkey
     times = (row["ours_ms"], row["bm_ms"], row["sgbm_ms"])
     assert times == pytest.approx((20.0, 2.0, 4.0)) and row["runs"] == 5
     assert row["ours"]["bad_2.0"] == 0.0 and row["sgbm"]["density"] == 100.0
+
+
+def test_eval_of_a_missing_folder_names_it(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["eval", "/no/such/scene"]) == 2
+    assert (
+        capsys.readouterr().err == "stereovision: error: scene folder not found: /no/such/scene\n"
+    )
+
+
+def test_depth_refuses_rectification_and_calib_together(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    terrace = data_dir / "eth3d" / "terrace"
+    (tmp_path / "r.json").write_text("{}")
+    argv = [
+        "depth",
+        str(terrace / "left.png"),
+        str(terrace / "right.png"),
+        "-o",
+        str(tmp_path / "o"),
+    ]
+    argv += ["--calib", str(terrace / "calib.txt"), "--rectification", str(tmp_path / "r.json")]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: --rectification and --calib: give one way to rectify the pair\n"
+    )
+    assert not (tmp_path / "o").exists()
+
+
+def test_sigterm_is_exit_143_and_its_handler_restored(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import signal
+
+    import stereovision.cli as cli
+    from stereovision._interrupt import Terminated
+
+    def terminated(args: object) -> int:
+        raise Terminated()
+
+    def mine(signum: int, frame: object) -> None:  # the caller's own handler
+        pass
+
+    kept = signal.signal(signal.SIGTERM, mine)
+    try:
+        monkeypatch.setattr(cli, "cmd_info", terminated)
+        assert main(["info"]) == 143
+        assert capsys.readouterr().err == "stereovision: terminated (SIGTERM)\n"
+        assert signal.getsignal(signal.SIGTERM) is mine  # main's own handler is gone again
+    finally:
+        signal.signal(signal.SIGTERM, kept)
+
+
+def test_eval_of_three_scenes_one_header_and_the_mean_of_their_figures(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The table's two header lines over the first row only; the mean line the mean (not the
+    median) of the scenes' bad-2.0."""
+    from stereovision.io import read_pfm, write_pfm
+
+    tsukuba = data_dir / "middlebury2001" / "tsukuba"
+    gt = read_pfm(tsukuba / "gt_disp.pfm")
+    for i, (y, x) in enumerate([(20, 30), (120, 150), (200, 260)]):
+        scene = tmp_path / f"s{i}"
+        scene.mkdir()
+        for name in ("left.png", "right.png"):
+            img = cv2.imread(str(tsukuba / name))
+            assert cv2.imwrite(str(scene / name), img[y : y + 64, x : x + 96])
+        write_pfm(scene / "gt_disp.pfm", gt[y : y + 64, x : x + 96])
+    assert main(["eval", "--no-opencv", "--method", "census", "--json", str(tmp_path)]) == 0
+    bad = [json.loads(ln)["ours"]["bad_2.0"] for ln in capsys.readouterr().out.splitlines()]
+    assert len(bad) == 3 and abs(np.mean(bad) - np.median(bad)) > 0.1
+    assert main(["eval", "--no-opencv", "--method", "census", str(tmp_path)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert sum(ln.startswith("scene ") for ln in lines) == 1 and len(lines) == 6
+    mean = re.fullmatch(r"mean bad-2\.0: ours ([\d.]+) %, ours\+fill ([\d.]+) %", lines[5])
+    assert mean is not None and float(mean[1]) == pytest.approx(np.mean(bad), abs=0.051)
+
+
+def test_depth_with_a_folder_under_an_output_name_moves_nothing(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A folder where one of the run's files goes (overview.png, listed as an earlier run's)
+    is refused before any file moves in: the earlier run's disparity.png stays as it was."""
+    from stereovision.cli import DEPTH_MANIFEST
+
+    tsukuba = data_dir / "middlebury2001" / "tsukuba"
+    out = tmp_path / "o"
+    (out / "overview.png").mkdir(parents=True)
+    (out / "disparity.png").write_bytes(b"earlier")
+    (out / DEPTH_MANIFEST).write_text('["disparity.png", "overview.png"]')
+    argv = ["depth", str(tsukuba / "left.png"), str(tsukuba / "right.png"), "-o", str(out)]
+    assert main([*argv, "--method", "fast", "--max-disparity", "16"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{out / 'overview.png'} is a folder" in err, err
+    assert (out / "disparity.png").read_bytes() == b"earlier"
+    assert not (out / "disparity.pfm").exists()
