@@ -578,3 +578,22 @@ def test_shape_of_a_shear_in_closed_form(degrees: float) -> None:
     assert skew == pytest.approx(abs(degrees), abs=1e-9)
     assert aspect == pytest.approx(math.cos(t), abs=1e-12)
     assert _shape(np.diag([2.0, 1.0, 1.0]), 640, 480) == pytest.approx((0.0, 2.0), abs=1e-12)
+
+
+def test_the_search_range_starts_low_disparity_px_above_zero(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Cones, bumped, with the features' span alone (no coarse probe) and no margin beyond it:
+    the output is shifted so that the span's low end lands at ``+_LOW_DISPARITY`` px, not below
+    zero, and the suggested range reaches ``_LOW_DISPARITY`` past both ends (measured: 2.0 to
+    30.28 px, max_disparity 33; the margin's sign flipped gives -2.0 or 29)."""
+    import stereovision.uncalibrated as uc
+
+    monkeypatch.setattr(uc, "_dense_span", lambda *args: None)
+    monkeypatch.setattr(uc, "_RANGE_MARGIN", 0.0)
+    sc, _, right = perturbed_scene(data_dir, "middlebury2003/cones")
+    rect = rectify_uncalibrated(sc.left, right)
+    lo, hi = rect.disparity_range
+    assert lo == pytest.approx(uc._LOW_DISPARITY, abs=1e-9)
+    assert hi > 20
+    assert rect.max_disparity == math.ceil(hi - lo + 2 * uc._LOW_DISPARITY)
