@@ -403,3 +403,52 @@ def test_the_noise_is_the_median_of_the_recent_frames_estimates(data_dir: Path) 
     assert noise_sigma(burst) > 3 * tf.sigma
     assert tf.sigma == pytest.approx(float(np.median([*each, noise_sigma(burst)])), rel=1e-12)
     assert tf.sigma < 1.1 * max(each)
+
+
+def test_the_light_fit_on_clipped_rounded_and_other_views() -> None:
+    """``_brightness_change`` on a synthetic mean and frame: pixels the brighter light clips at
+    255 are left out (measured 1.29990 for 1.3; with them 1.2986, with 250-254 counted as
+    unclipped 1.2946); a noiseless camera's rounding to whole levels is within the fit's noise
+    floor of 1 (with sigma 0 the fit held no pixel: another view); another view of the same
+    brightness fits under half of the pixels (the gain of sums was 1.003); nine lit pixels are
+    nothing to fit (gain 1), not another view."""
+    from stereovision.temporal import _brightness_change
+
+    rng = np.random.default_rng(20)
+    mean = rng.uniform(20, 254, (64, 64)).astype(np.float32)
+    clipped = np.clip(np.round(1.3 * mean), 0, 255).astype(np.float32)
+    assert (clipped == 255).mean() > 0.2
+    assert _brightness_change(clipped - mean, mean, 1.0) == pytest.approx(1.3, abs=3e-4)
+    rounded = np.round(1.3 * mean).astype(np.float32)  # not clipped: a float frame
+    assert _brightness_change(rounded - mean, mean, 0.0) == pytest.approx(1.3, abs=3e-4)
+    other = rng.uniform(20, 230, (64, 64)).astype(np.float32)
+    assert _brightness_change(other - mean, mean, 2.0) is None
+    dark = np.zeros((64, 64), np.float32)
+    dark[::4, ::4][:3, :3] = 100  # 9 of the 256 pixels the fit samples
+    assert _brightness_change(np.zeros_like(dark), dark, 1.0) == 1.0
+
+
+def test_an_overexposed_window_stays_out_of_the_motion_test(data_dir: Path) -> None:
+    """Venus (grey, noise 4) with its left 40 % clipped at 255 (a window), then the light
+    dimmed by 10 %: the window stays 255 while its relit mean reads 229.5, so it is left out of
+    the motion test (under half of the view) and the rig is not taken for moving (measured: no
+    restart, the window's pixels restart alone, 3.4 frames a pixel; with the window counted, or
+    250-254 taken as unclipped, the rig restarted)."""
+    grey = cv2.cvtColor(load_scene(data_dir / VENUS).left, cv2.COLOR_BGR2GRAY).astype(np.float32)
+    rng = np.random.default_rng(20)
+    cut = int(0.4 * grey.shape[1])
+
+    def frame(gain: float) -> np.ndarray:
+        f = np.clip(gain * grey + rng.normal(0, 4, grey.shape), 0, 255)
+        f[:, :cut] = 255
+        return f.astype(np.uint8)
+
+    tf = TemporalFilter()
+    for _ in range(4):
+        f = frame(1.0)
+        tf(f, f)
+    assert tf.restarts == 0 and tf.relit == 0
+    f = frame(0.9)
+    tf(f, f)
+    assert tf.restarts == 0 and tf.relit == 2
+    assert tf.mean_frames() == pytest.approx(0.6 * 5 + 0.4 * 1, abs=0.01)
