@@ -634,3 +634,38 @@ def test_the_frame_after_an_interrupted_undo_is_kept(
     with AnyReader([tmp_path / "run"]) as reader:
         stamps = sorted({stamp for _, stamp, _ in reader.messages()})
     assert stamps == [1, 3]
+
+
+def test_bag_of_a_rig_with_doffs_and_its_own_right_camera(data_dir: Path, tmp_path: Path) -> None:
+    """KITTI's rig with the right principal point 20 px further right (``doffs`` 20, ``K2`` !=
+    ``K1``; every scene in the data has 0 and ``K1 == K2``): the disparity topic carries ``d +
+    doffs`` (so ``f t / d`` is the depth image), its range ``doffs + min`` to ``doffs + max``
+    (measured 20 and 132 for 0-112), and the right ``camera_info`` carries ``K2``."""
+    import dataclasses
+
+    from stereovision.rosbag import BagWriter
+
+    sc = load_scene(data_dir / "kitti2015" / "000005_10")
+    k2 = sc.calib.K2.copy()
+    k2[0, 2] += 20.0
+    cal = dataclasses.replace(sc.calib, K2=k2, doffs=20.0)
+    res = sv.depth_map(sc.left, sc.right, cal, max_disparity=sc.max_disparity, cloud=False)
+    assert (res.min_disparity, res.max_disparity) == (0, 112)
+    with BagWriter(tmp_path / "run") as bag:
+        bag.write(res, 1)
+    topics = _read(tmp_path / "run")
+    disp = topics["/stereo/disparity"][0][1]
+    dimg = np.frombuffer(disp.image.data.tobytes(), "<f4").reshape(disp.image.height, -1)
+    ok = np.isfinite(res.depth)
+    assert ok.mean() > 0.5
+    np.testing.assert_array_equal(dimg >= disp.min_disparity, ok)
+    np.testing.assert_array_equal(dimg[ok], res.disparity[ok] + np.float32(20.0))
+    assert (dimg[~ok] == 19.0).all()  # below min_disparity: none
+    assert (disp.min_disparity, disp.max_disparity) == (20.0, 132.0)
+    np.testing.assert_allclose(disp.f * disp.t / dimg[ok], res.depth[ok], rtol=1e-5)
+    left = topics["/stereo/left/camera_info"][0][1]
+    right = topics["/stereo/right/camera_info"][0][1]
+    np.testing.assert_array_equal(right.k.reshape(3, 3), k2)
+    np.testing.assert_array_equal(right.p.reshape(3, 4)[:, :3], k2)
+    np.testing.assert_array_equal(left.k.reshape(3, 3), sc.calib.K1)
+    assert right.p[2] - left.p[2] == pytest.approx(20.0)
