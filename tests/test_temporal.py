@@ -452,3 +452,17 @@ def test_an_overexposed_window_stays_out_of_the_motion_test(data_dir: Path) -> N
     tf(f, f)
     assert tf.restarts == 0 and tf.relit == 2
     assert tf.mean_frames() == pytest.approx(0.6 * 5 + 0.4 * 1, abs=0.01)
+
+
+def test_a_view_three_times_brighter_restarts_too() -> None:
+    """The gain's upper bound: a frame three times as bright as the mean (over 2) is another
+    view, as a third is (with the bound at 5 it was relit, both images, and averaged on)."""
+    rng = np.random.default_rng(14)
+    base = rng.integers(30, 80, (40, 40)).astype(np.uint8)
+    tf = TemporalFilter()
+    tf(base, base)
+    tf(base, base)
+    bright = base * np.uint8(3)
+    out = tf(bright, bright)
+    assert np.array_equal(out[0], bright) and np.array_equal(out[1], bright)
+    assert tf.restarts == 1 and tf.relit == 0 and tf.mean_frames() == 1.0
