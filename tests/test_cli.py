@@ -1441,6 +1441,8 @@ def test_json_ready_writes_a_path_key_as_its_string() -> None:
     assert json.loads(json_line({"per_scene": {Path("s"): float("nan")}})) == {
         "per_scene": {"s": None}
     }
+
+
 @pytest.mark.parametrize(("text", "port"), [("0", 0), ("65535", 65535)])
 def test_port_number_takes_0_to_65535(text: str, port: int) -> None:
     from stereovision.cli import port_number
