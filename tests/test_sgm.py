@@ -352,3 +352,19 @@ def test_a_range_beyond_the_kernel_names_the_arguments(lo: float, hi: float, lev
         sgm_disparity(ok, ok, min_disparity=lo, max_disparity=hi)
     with pytest.raises(ValueError, match=r"census search range .* at most 2048 are supported"):
         sv.match(ok, ok, method="fused", max_disparity=8191)
+
+
+@pytest.mark.parametrize("name", ["max_disparity", "min_disparity"])
+@pytest.mark.parametrize("value", [1e300, 10**30, -1e300, 2**31 - 1])
+def test_a_huge_finite_range_is_named_outside_the_kernels_int32(name: str, value: float) -> None:
+    """1e300 is finite: it was refused as 'expected a finite number of pixels'. The kernel takes
+    32-bit levels; the message says so and names the limit."""
+    ok = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    kw = {"max_disparity": 8.0, "min_disparity": 0.0, name: value}
+    with pytest.raises(ValueError, match=f"^{name}: .* is outside the census kernel's 32-bit") as e:
+        sgm_disparity(ok, ok, **kw)
+    assert "finite" not in str(e.value) and "2147483647" in str(e.value)
+    with pytest.raises(ValueError, match=f"^{name}: expected a finite number of pixels, got nan"):
+        sgm_disparity(ok, ok, **{**kw, name: float("nan")})
+    with pytest.raises(ValueError, match=f"^{name}: expected a finite number of pixels, got -inf"):
+        sgm_disparity(ok, ok, **{**kw, name: float("-inf")})

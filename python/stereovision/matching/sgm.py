@@ -48,6 +48,7 @@ _BYTES_PER_CELL = 3
 # path, one is being filled and one selected; the census codes take 16 bytes a pixel.
 _ROWS_IN_FLIGHT_3 = 8 + 3
 _MAX_LEVELS = 2048  # the kernel's limit
+_I32_LIMIT = 2**31 - 1  # |min_disparity|, |max_disparity| below it: the kernel's i32 levels
 
 
 def _address_space_room() -> int | None:
@@ -160,9 +161,14 @@ def sgm_disparity(
         raise ValueError(f"unknown SGM option(s) {unknown}: expected {sorted(DEFAULTS)}")
     p = {**DEFAULTS, **params}
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
-        # The kernel takes i32 levels (and at most 2048 of them).
-        if not math.isfinite(float_sized(v, name)) or abs(v) >= 2**31 - 1:
+        # The kernel takes i32 levels (and at most 2048 of them); 1e300 is finite, only too big.
+        if not math.isfinite(float_sized(v, name)):
             raise ValueError(f"{name}: expected a finite number of pixels, got {v}")
+        if abs(v) >= _I32_LIMIT:
+            raise ValueError(
+                f"{name}: {v} is outside the census kernel's 32-bit integer levels "
+                f"(|{name}| must be below {_I32_LIMIT})"
+            )
     if max_disparity < min_disparity:
         raise ValueError(
             f"max_disparity ({max_disparity}) is smaller than min_disparity ({min_disparity})"
