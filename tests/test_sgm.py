@@ -368,3 +368,33 @@ def test_a_huge_finite_range_is_named_outside_the_kernels_int32(name: str, value
         sgm_disparity(ok, ok, **{**kw, name: float("nan")})
     with pytest.raises(ValueError, match=f"^{name}: expected a finite number of pixels, got -inf"):
         sgm_disparity(ok, ok, **{**kw, name: float("-inf")})
+
+
+def test_a_one_level_range_and_the_p2_width() -> None:
+    """max_disparity == min_disparity is a one-level search, not an error; p2 past the kernel's
+    u16 (65536) is refused naming it, not an OverflowError from the binding (the kernel itself
+    takes up to 4000)."""
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    shifted = np.roll(img, -3, axis=1)
+    d = sgm_disparity(img, shifted, max_disparity=3, min_disparity=3)
+    assert np.nanmin(d) >= 2.5 and np.nanmax(d) <= 3.5 and np.isfinite(d[:, 10:]).mean() > 0.5
+    assert sgm_disparity(img, shifted, max_disparity=8, p2=4000).shape == img.shape
+    with pytest.raises(ValueError, match=r"^p2: expected an integer in \[0, 65535\], got 65536"):
+        sgm_disparity(img, shifted, max_disparity=8, p2=2**16)
+
+
+def test_memory_kept_from_the_last_call_counts_as_available(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Buffers the allocator and the pools kept are reused: with MemAvailable one byte short,
+    the kept bytes make up for it and the call runs."""
+    from stereovision.matching import sgm
+
+    img = np.random.default_rng(0).random((30, 40)).astype(np.float32)
+    need = 3 * 40 * 30 * 9  # levels 0..8
+    monkeypatch.setattr(sgm, "_available_bytes", lambda: need - 2)
+    monkeypatch.setattr(sgm._core, "kept_memory", lambda: ((0, 1), 1))
+    assert sgm_disparity(img, img, max_disparity=8).shape == img.shape
+    monkeypatch.setattr(sgm._core, "kept_memory", lambda: ((0, 1), 0))
+    with pytest.raises(MemoryError, match="40x30 pair over 9 disparity levels"):
+        sgm_disparity(img, img, max_disparity=8)
