@@ -137,15 +137,17 @@ def _refuse_unreachable(
     """Refuse a range no pixel can match in (:func:`stereovision.depth_map`'s rule): a
     ``min_disparity`` at the width or above returned 0 matches without a word (or, beyond
     float32's resolution, the kernel's "invalid parameter `d_max`"). Values that are not finite
-    numbers, and a max_disparity the caller gave not above min_disparity, are left to the
-    matchers' own checks, which name them; an estimated one (``automatic``) below such a
-    min_disparity is not the problem, the min_disparity is."""
+    numbers, and a max_disparity the caller gave below min_disparity, are left to the
+    matchers' own checks, which name them (one equal to it is a one-level search, which
+    hopfield, best and mcgm run: at the width it returned 0 matches without a word); an
+    estimated one (``automatic``) below such a min_disparity is not the problem, the
+    min_disparity is."""
     try:
         lo = finite_number(min_disparity, "min_disparity")
         hi = finite_number(max_disparity, "max_disparity")
     except ValueError:  # not a finite number: the matchers name it
         return
-    if hi <= lo and not automatic:
+    if hi < lo and not automatic:
         return
     err = _unreachable_range(lo, hi, width)
     if err is not None:
