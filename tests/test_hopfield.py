@@ -386,3 +386,47 @@ def test_match_fused_keeps_count_and_sources_per_member_in_range() -> None:
     d = m.xl - m.xr
     assert m.stats["n_out_of_range"] > 0 and float(d.min()) >= 6.0 and float(d.max()) <= 8.5
     assert len(m.stats["count"]) == len(m.stats["sources"]) == len(m) > 100
+
+
+def _stereopi_raw(data_dir: Path) -> tuple[np.ndarray, np.ndarray, sv.Calibration]:
+    """The StereoPi rig's raw (unrectified, distorted) scene pair and its calibration."""
+    from tests.test_calibration import stereopi_calib
+
+    sp = data_dir / "stereopi_rig" / "scene_photo"
+    left, right = (cv2.imread(str(sp / f"{side}.png")) for side in ("left", "right"))
+    return left, right, stereopi_calib(data_dir)
+
+
+@pytest.mark.parametrize("method", ["hopfield", "mcgm"])
+def test_match_with_a_raw_rig_is_the_match_of_the_pair_rectified_by_hand(
+    data_dir: Path, method: str
+) -> None:
+    """match(l, r, raw_calib) is match() of calib.rectify(l, r): an 8-bit pair through its 8-bit
+    copy, a float (or mixed uint8/float) pair through its own grey levels, the automatic range
+    estimated on the rectified pair (48 px here). A pair rectified with its images swapped, a
+    float pair not rectified at all, a mixed pair through the 8-bit copy, or a fixed 64 px range
+    survived the tests."""
+    from stereovision._validate import as_gray_float
+
+    left, right, cal = _stereopi_raw(data_dir)
+    assert not cal.rectified
+    lr, rr = cal.rectify(left, right)
+    got = sv.match(left, right, cal, method=method, max_disparity=40)
+    want = sv.match(lr, rr, method=method, max_disparity=40)
+    assert len(got) > 200
+    np.testing.assert_array_equal(got.to_array(), want.to_array())
+    # float and mixed pairs: the grey images, rectified, clipped to [0, 1]
+    rf = right.astype(np.float32) / 255
+    for lf in (left.astype(np.float32) / 255, left):
+        got = sv.match(lf, rf, cal, method=method, max_disparity=40)
+        gl, gr = cal.rectify(as_gray_float(lf, "left"), as_gray_float(rf, "right"))
+        want = sv.match(np.clip(gl, 0, 1), np.clip(gr, 0, 1), method=method, max_disparity=40)
+        assert len(got) > 200
+        np.testing.assert_array_equal(got.to_array(), want.to_array())
+    # no max_disparity: estimated on the rectified pair
+    est = sv.estimate_max_disparity(lr, rr)
+    assert est == 48
+    auto = sv.match(left, right, cal, method=method)
+    np.testing.assert_array_equal(
+        auto.to_array(), sv.match(lr, rr, method=method, max_disparity=est).to_array()
+    )
