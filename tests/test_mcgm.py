@@ -671,3 +671,21 @@ def test_matches_csv_text_and_bad_files(tmp_path: Path) -> None:
     (tmp_path / "word.csv").write_text(f"{header}\n1,2,x,4,1\n")
     with pytest.raises(ValueError, match=r"word\.csv: could not convert"):
         sv.Matches.from_csv(tmp_path / "word.csv", (4, 4))
+
+
+def test_matches_to_points_read_a_raw_rig_through_its_rectified_geometry() -> None:
+    """Matches are in rectified pixels: a raw rig's calibration is read through
+    rectified_calibration() (its raw K1 put the points off: another f and principal point)."""
+    from tests.test_calibration import SIZE, raw_calib
+
+    raw = raw_calib()
+    rect = raw.rectified_calibration()
+    assert not raw.rectified and not np.allclose(raw.K1, rect.K1)
+    w, h = SIZE
+    m = sv.Matches(
+        xl=[40.0, 200.0, 300.0], yl=[30.0, 120.0, 200.0], xr=[30.0, 188.0, 295.0],
+        yr=[30.0, 120.0, 200.0], score=[1.0, 1.0, 1.0], image_shape=(h, w),
+    )  # fmt: skip
+    got = m.to_points(raw)
+    np.testing.assert_array_equal(got, m.to_points(rect))
+    assert np.isfinite(got).all()
