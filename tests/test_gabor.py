@@ -330,3 +330,31 @@ def test_the_widest_range_is_searched() -> None:
     ok = np.random.default_rng(0).random((40, 60), dtype=np.float32)
     res = gabor_disparity(ok, np.roll(ok, -3, axis=1), max_disparity=8192.0)
     assert float(np.nanmedian(res.disparity)) == pytest.approx(3.0, abs=0.05)
+
+
+def test_the_wrappers_own_checks_name_the_argument() -> None:
+    """Checks the wrapper makes before the kernel, each in the caller's words: a range 8192.5 px
+    wide, a search_pool_radius of 17, a count of None (only n_levels means automatic), a uint8
+    image, images differing only in width, a switch that is not a bool (TypeError)."""
+    img = np.random.default_rng(0).random((24, 40)).astype(np.float32)
+    cases: list[tuple[dict[str, object], str]] = [
+        (
+            {"max_disparity": 8192.5},
+            r"max_disparity - min_disparity: the Gabor search range is at most 8192 px, got "
+            r"8192\.5 - 0",
+        ),
+        ({"search_pool_radius": 17}, "search_pool_radius must be at most 16 px, got 17"),
+        ({"iters_per_level": None}, "iters_per_level must be a non-negative integer, got None"),
+    ]
+    for kw, says in cases:
+        with pytest.raises(ValueError, match="^" + says):
+            gabor_disparity(img, img, **{"max_disparity": 8, **kw})
+    assert gabor_disparity(img, img, max_disparity=8, n_levels=None).disparity.shape == img.shape
+    with pytest.raises(
+        ValueError, match=r"^left must be float32 grey levels in \[0, 1\], got dtype uint8"
+    ):
+        gabor_disparity((img > 0.5).astype(np.uint8), img, max_disparity=8)
+    with pytest.raises(ValueError, match=r"^left \(24, 40\) and right \(24, 41\) images differ"):
+        gabor_disparity(img, np.zeros((24, 41), np.float32), max_disparity=8)
+    with pytest.raises(TypeError, match=r"^lr_check: expected True or False, got 1"):
+        gabor_disparity(img, img, max_disparity=8, lr_check=1)

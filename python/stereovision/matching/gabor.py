@@ -140,6 +140,8 @@ def gabor_disparity(
     ValueError
         If an image is not 2-D, empty, not floating point, non-finite or has values outside
         ``[0, 1]``, the shapes differ, a parameter is unknown or out of range.
+    TypeError
+        If a switch (``lr_check``, ``research_finest``, ``lr_light``) is not True or False.
     MemoryError
         When an image-sized buffer of the kernel cannot be allocated (the message names it and
         its size); the process is not aborted.
