@@ -430,3 +430,32 @@ def test_match_with_a_raw_rig_is_the_match_of_the_pair_rectified_by_hand(
     np.testing.assert_array_equal(
         auto.to_array(), sv.match(lr, rr, method=method, max_disparity=est).to_array()
     )
+
+
+def _blurred_pair(shift: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """A smooth random texture and itself shifted ``shift`` px left (disparity ``shift``)."""
+    img = cv2.GaussianBlur(
+        np.random.default_rng(0).random((48, 80)).astype(np.float32), (0, 0), 1.5
+    )
+    img = (img - img.min()) / (img.max() - img.min())
+    return img, np.ascontiguousarray(np.roll(img, -shift, axis=1))
+
+
+def test_the_range_is_rounded_outwards_and_one_level_is_searched() -> None:
+    """min_disparity 2.5 searches from level 2 (floor: the same matches as 2), max == min is a
+    one-level search, not an error; rel_threshold/floor_rel above 1 and nms_half 0 are refused."""
+    left, right = _blurred_pair()
+    half = hp.hopfield_match(left, right, max_disparity=8, min_disparity=2.5)
+    assert len(half) > 50
+    np.testing.assert_array_equal(
+        half.to_array(),
+        hp.hopfield_match(left, right, max_disparity=8, min_disparity=2).to_array(),
+    )
+    assert len(hp.hopfield_match(left, right, max_disparity=3, min_disparity=3)) > 0
+    for kw, says in (
+        ({"rel_threshold": 1.5}, r"rel_threshold must lie in \[0, 1\], got 1.5"),
+        ({"floor_rel": 1.0001}, r"floor_rel must lie in \[0, 1\], got 1.0001"),
+        ({"nms_half": 0}, "nms_half: expected an integer from 1 to 2147483647, got 0"),
+    ):
+        with pytest.raises(ValueError, match="^" + says):
+            hp.interest_points(left, **kw)

@@ -20,6 +20,7 @@ import dataclasses
 import re
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pytest
 
@@ -689,3 +690,33 @@ def test_matches_to_points_read_a_raw_rig_through_its_rectified_geometry() -> No
     got = m.to_points(raw)
     np.testing.assert_array_equal(got, m.to_points(rect))
     assert np.isfinite(got).all()
+
+
+def _blurred_pair(shift: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """A smooth random texture and itself shifted ``shift`` px left (disparity ``shift``)."""
+    img = cv2.GaussianBlur(
+        np.random.default_rng(0).random((48, 80)).astype(np.float32), (0, 0), 1.5
+    )
+    img = (img - img.min()) / (img.max() - img.min())
+    return img, np.ascontiguousarray(np.roll(img, -shift, axis=1))
+
+
+def test_mcgm_range_rounding_negative_values_debug_and_the_last_row() -> None:
+    """min_disparity 2.5 searches from level 2 (floor), a negative min_disparity is refused,
+    the per-channel stats come only with debug=True, and edge_filters takes a match on the
+    last row's lower half-pixel (y = h - 0.5) but not below it."""
+    left, right = _blurred_pair()
+    half = mcgm.mcgm_match(left, right, max_disparity=8, min_disparity=2.5)
+    assert len(half) > 50 and "channels" not in half.stats
+    whole = mcgm.mcgm_match(left, right, max_disparity=8, min_disparity=2, debug=True)
+    np.testing.assert_array_equal(half.to_array(), whole.to_array())
+    assert len(whole.stats["channels"]) > 0
+    with pytest.raises(ValueError, match=r"^min_disparity must be a non-negative number of pixels"):
+        mcgm.mcgm_match(left, right, max_disparity=8, min_disparity=-1)
+    h = left.shape[0]
+    edge = np.array([[40.0, h - 0.5, 38.0, h - 0.5]], np.float32)
+    assert mcgm.edge_filters(left, right, edge, max_disparity=8).shape == (1,)
+    below = edge.copy()
+    below[0, [1, 3]] += 0.25
+    with pytest.raises(ValueError, match=r"^matches: 1 of 1 rows lie outside the 80x48 images"):
+        mcgm.edge_filters(left, right, below, max_disparity=8)
