@@ -398,3 +398,57 @@ def test_memory_kept_from_the_last_call_counts_as_available(
     monkeypatch.setattr(sgm._core, "kept_memory", lambda: ((0, 1), 0))
     with pytest.raises(MemoryError, match="40x30 pair over 9 disparity levels"):
         sgm_disparity(img, img, max_disparity=8)
+
+
+def test_the_range_reaches_the_kernel_rounded_outwards() -> None:
+    """min_disparity 2.5 searches from level 2 and max_disparity 2.5 up to level 3 (a pair
+    shifted 2 or 3 px is found as with whole numbers); a bool is no penalty."""
+    img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
+    two, three = (np.roll(img, -s, axis=1) for s in (2, 3))
+    for sh, lo, hi, whole in ((two, 2.5, 8, (2, 8)), (three, 0, 2.5, (0, 3))):
+        got = sgm_disparity(img, sh, min_disparity=lo, max_disparity=hi)
+        want = sgm_disparity(img, sh, min_disparity=whole[0], max_disparity=whole[1])
+        assert np.isfinite(want[:, 10:]).mean() > 0.5
+        np.testing.assert_array_equal(got, want)
+    with pytest.raises(ValueError, match=r"^p1: expected an integer in \[0, 65535\], got True"):
+        sgm_disparity(img, img, max_disparity=8, p1=True)
+
+
+def test_available_memory_takes_the_least_of_its_limits(monkeypatch: pytest.MonkeyPatch) -> None:
+    """MemAvailable, lowered by a cgroup v2 memory.max less memory.current, lowered by the
+    address space left under RLIMIT_AS; 'max' (no cgroup limit) leaves MemAvailable."""
+    import io as _io
+
+    from stereovision.matching import sgm
+
+    gib = 2**30
+    files = {
+        "/proc/meminfo": f"MemTotal: {16 * gib // 1024} kB\nMemAvailable: {8 * gib // 1024} kB\n",
+        "/sys/fs/cgroup/memory.max": f"{3 * gib}\n",
+        "/sys/fs/cgroup/memory.current": f"{gib}\n",
+    }
+    monkeypatch.setattr(sgm, "open", lambda p, *a, **k: _io.StringIO(files[p]), raising=False)
+    monkeypatch.setattr(sgm, "_address_space_room", lambda: None)
+    assert sgm._available_bytes() == 2 * gib
+    monkeypatch.setattr(sgm, "_address_space_room", lambda: gib)
+    assert sgm._available_bytes() == gib
+    files["/sys/fs/cgroup/memory.max"] = "max\n"
+    monkeypatch.setattr(sgm, "_address_space_room", lambda: None)
+    assert sgm._available_bytes() == 8 * gib
+
+
+def test_address_space_room_is_the_limit_less_vmsize_in_bytes(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """RLIMIT_AS's soft limit less VmSize, which /proc/self/status gives in kB."""
+    resource = pytest.importorskip("resource")
+    from stereovision.matching import sgm
+
+    if not Path("/proc/self/status").exists():
+        pytest.skip("no /proc/self/status")
+    limit = 2**45
+    monkeypatch.setattr(resource, "getrlimit", lambda _: (limit, resource.RLIM_INFINITY))
+    room = sgm._address_space_room()
+    with open("/proc/self/status") as f:
+        vm = next(int(line.split()[1]) for line in f if line.startswith("VmSize:")) * 1024
+    assert room is not None and abs(room - (limit - vm)) < 2**26  # VmSize moves a little
