@@ -429,3 +429,23 @@ def test_match_with_the_automatic_range_refuses_a_min_disparity_not_below_the_wi
     with pytest.raises(ValueError) as err:
         sv.match(left, left.copy(), method=method, min_disparity=100)
     assert str(err.value).startswith("min_disparity (100) is not below the image width 48")
+
+
+@pytest.mark.parametrize("method", ["hopfield", "best", "mcgm"])
+def test_match_with_a_huge_max_disparity_searches_the_whole_width(method: str) -> None:
+    """hopfield, best and mcgm clip the range to the image, but match()'s final range cut
+    compared the float32 disparities with the bound itself: 10**400 was an OverflowError ("int
+    too large to convert to float"), 1e300 NumPy's RuntimeWarning "overflow encountered in
+    cast". Either now gives what a bound beyond the width gives."""
+    import warnings
+
+    from tests.test_mcgm import _blurred_pair
+
+    left, right = _blurred_pair()
+    want = sv.match(left, right, method=method, max_disparity=1000).to_array()
+    assert len(want) > 50
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for big in (10**400, 1e300, 2**70):
+            got = sv.match(left, right, method=method, max_disparity=big)
+            np.testing.assert_array_equal(got.to_array(), want)

@@ -117,7 +117,7 @@ def match(
         from stereovision.matching.fusion import fuse_pair
 
         res = fuse_pair(gl, gr, max_disparity=max_disparity, **params)
-        keep = _in_range(res.matches, float(params.get("min_disparity", 0)), max_disparity)
+        keep = _in_range(res.matches, params.get("min_disparity", 0), max_disparity)
         m = _keep(res.matches, keep)
         # per member, as the matches: a member dropped out of range takes its entries along
         # (they were left whole, longer than the matches)
@@ -128,7 +128,7 @@ def match(
     else:
         run = _hopfield.hopfield_match if method == "hopfield" else _hopfield.best_match
         m = run(gl, gr, max_disparity=max_disparity, **params)
-    return _keep(m, _in_range(m, float(params.get("min_disparity", 0)), max_disparity))
+    return _keep(m, _in_range(m, params.get("min_disparity", 0), max_disparity))
 
 
 def _refuse_unreachable(
@@ -177,6 +177,11 @@ def _gabor_matches(
     )
 
 
+#: Beyond any image's width: a bound clipped to it cuts the same matches, and stays comparable
+#: with float32 (10**400 was an OverflowError, 1e300 NumPy's "overflow encountered in cast").
+_BOUND_CLIP = 2**31 - 1
+
+
 def _in_range(m: Matches, lo: float, hi: float) -> npt.NDArray[np.bool_]:
     """Which matches have a disparity ``xl - xr`` in ``[lo, hi]``.
 
@@ -186,6 +191,9 @@ def _in_range(m: Matches, lo: float, hi: float) -> npt.NDArray[np.bool_]:
     (a working volume, a near limit) gets no match outside it.
     """
     d = m.xl - m.xr
+    # lo as a Python float, as before (a NumPy float64 would compare in float64)
+    lo = float(min(max(lo, -_BOUND_CLIP), _BOUND_CLIP))
+    hi = min(max(hi, -_BOUND_CLIP), _BOUND_CLIP)
     return (d >= lo) & (d <= hi)
 
 
