@@ -449,3 +449,17 @@ def test_match_with_a_huge_max_disparity_searches_the_whole_width(method: str) -
         for big in (10**400, 1e300, 2**70):
             got = sv.match(left, right, method=method, max_disparity=big)
             np.testing.assert_array_equal(got.to_array(), want)
+
+
+@pytest.mark.parametrize("method", ["hopfield", "best", "mcgm"])
+def test_match_drops_the_integer_searchs_matches_above_a_fractional_max(method: str) -> None:
+    """max_disparity 2.5 is searched up to level 3: a pair shifted 3 px has its matches there,
+    and every one is dropped (counted in n_out_of_range), none kept up to the ceiling."""
+    from tests.test_mcgm import _blurred_pair
+
+    left, right = _blurred_pair(3)
+    whole = sv.match(left, right, method=method, max_disparity=3)
+    assert np.count_nonzero(whole.xl - whole.xr > 2.5) > 20
+    cut = sv.match(left, right, method=method, max_disparity=2.5)
+    assert (cut.xl - cut.xr <= 2.5).all()
+    assert cut.stats["n_out_of_range"] >= np.count_nonzero(whole.xl - whole.xr > 2.5)
