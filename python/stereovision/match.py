@@ -90,7 +90,8 @@ def match(
     ValueError
         Bad images (shape, dtype, empty, NaN, mismatched sizes), a calibration or rectification
         for another image size, a ``calib`` of another type, an unknown method or parameter, a
-        ``max_disparity`` that is not a finite number >= 0 (or not above ``min_disparity``), a
+        ``max_disparity`` that is not a finite number >= 0 (or below ``min_disparity``; equal
+        to it, ``"gabor"`` and ``"fused"`` refuse it, the others search that one level), a
         ``min_disparity`` not below the image width (no pixel has a match that far: a pair with
         no edges in a range it can match in still returns zero matches, not an error).
     """
