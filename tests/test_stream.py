@@ -1621,3 +1621,63 @@ def test_a_window_reports_its_own_pairs_per_second() -> None:
     done = [_Done(dict.fromkeys(STAGES, 0.001), 0.01, 0.0, 0.1, 0.5) for _ in range(2)]
     rep = _window_report(done, 0.5, 10, 5.0, 8, False)
     assert (rep["frames"], rep["total_frames"], rep["fps"]) == (2, 10, 4.0)
+
+
+def test_a_temporal_stream_warns_once_of_frames_resampled_before_it() -> None:
+    """With ``temporal``, a source whose frames come resampled (a bag's rectified topics) is
+    said once, on the first pair: the filter takes the spread noise for motion."""
+    from stereovision.temporal import TemporalFilter
+
+    rig: Any = _FakeRig([_frame(0), _frame(0)])
+    rig.rectified_topics, rig.topics = True, {"left": "/l/rect", "right": "/r/rect"}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rep = run_stream(rig, max_disparity=8, pipelined=False, check=False,
+                         temporal=TemporalFilter(max_frames=4))  # fmt: skip
+    said = [str(w.message) for w in caught if "temporal averaging" in str(w.message)]
+    assert rep.frames == 2
+    assert len(said) == 1 and said[0].startswith(
+        "temporal averaging: the topics /l/rect and /r/rect are rectified"
+    )
+
+
+class _Homographies:
+    """An UncalibratedRectification stand-in: pairs as they are, a search range of 32 px."""
+
+    max_disparity = 32
+
+    def rectify(self, left: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return left, right
+
+
+def test_an_explicit_disparity_range_wins_over_the_homographies() -> None:
+    """With ``homographies``, their range is the default: a ``max_disparity`` given is kept."""
+    for given, used in ((None, 32), (8, 8)):
+        rep = run_stream(_FakeRig([_frame(0)]), max_disparity=given,  # type: ignore[arg-type]
+                         pipelined=False, check=False, homographies=_Homographies())  # fmt: skip
+        assert (rep.frames, rep.max_disparity) == (1, used)
+
+
+@pytest.mark.parametrize("pipelined", [False, True])
+def test_a_source_failing_on_the_first_pair_is_raised(pipelined: bool) -> None:
+    """A source that fails on pair 0 (a frame of another shape) raises its SourceError: no
+    pair done, no summary of a "source failed" run of nothing."""
+    from stereovision.capture import SourceError
+
+    bad = SourceError("right source: frame 0 is 64x40, not 64x48", end=False)
+    with pytest.raises(SourceError, match="frame 0 is 64x40") as err:
+        run_stream(_FakeRig([bad]), max_disparity=8, pipelined=pipelined)  # type: ignore[arg-type]
+    assert err.value is bad
+
+
+def test_a_bag_without_a_calibration_is_refused(
+    videos: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--bag`` records depth, which needs ``--calib``: refused in one line, no bag made."""
+    bag = tmp_path / "b"
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--no-display", "--no-check", "--frames", "1", "--max-disparity", "16"]
+    assert main([*argv, "--bag", str(bag)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["stereovision: error: --bag: a bag holds depth; give --calib"]
+    assert not bag.exists()
