@@ -203,6 +203,9 @@ def test_frame_server_refuses_a_port_out_of_range() -> None:
     for port in (-1, 65536, 99999):
         with pytest.raises(ValueError, match=rf"port: expected 0 to 65535 .*got {port}"):
             FrameServer("127.0.0.1", port)
+    # a bool is an int: True bound port 1
+    with pytest.raises(ValueError, match=r"port: expected 0 to 65535 .*got True"):
+        FrameServer("127.0.0.1", True)
 
 
 def test_frame_server_serves_left_and_disparity() -> None:
@@ -1681,3 +1684,100 @@ def test_a_bag_without_a_calibration_is_refused(
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["stereovision: error: --bag: a bag holds depth; give --calib"]
     assert not bag.exists()
+
+
+def test_the_prepare_stage_counts_depth_maps_input_conversion(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``prepare`` is depth_map's ``rectify`` (input conversion of a rectified pair) and its
+    ``prepare``: the time spent before matching, not half of it."""
+    import stereovision.depth as depth
+
+    real = depth.depth_map
+
+    def timed(*args: Any, **kw: Any) -> Any:
+        res = real(*args, **kw)
+        res.timings.update(rectify=0.25, prepare=0.125)
+        return res
+
+    monkeypatch.setattr(depth, "depth_map", timed)
+    rep = run_stream(_FakeRig([_frame(0)]), max_disparity=8, pipelined=False, check=False)  # type: ignore[arg-type]
+    assert rep.stage_ms["prepare"] == 375.0
+    assert rep.reports[-1]["stage_ms"]["prepare"] == 375.0
+
+
+def test_a_one_pair_source_ends_its_stream() -> None:
+    """A source read to its end after a single pair ends the stream (its summary), as after
+    more pairs; only a source without a first pair is an error."""
+    from stereovision.capture import SourceError
+
+    rep = run_stream(_FakeRig([_frame(0)]), max_disparity=8, pipelined=False, check=False)  # type: ignore[arg-type]
+    assert (rep.frames, rep.ended, rep.error) == (1, "end of stream", None)
+    with pytest.raises(SourceError, match="ended"):
+        run_stream(_FakeRig([]), max_disparity=8, pipelined=False, check=False)  # type: ignore[arg-type]
+
+
+def test_the_mode_note_says_a_resize_to_the_size_asked() -> None:
+    """A camera delivering another size than the mode it reports is said; the frames then
+    resized to another size (``--size``) are said too, and only then."""
+    from types import SimpleNamespace
+
+    from stereovision.stream import _mode_note
+
+    cam: Any = SimpleNamespace(reported=(640, 480), delivered_size={"left": (320, 240)})
+    said = "the left camera reports 640x480 but delivers 320x240{}: the calibration is fitted"
+    assert _mode_note(cam, (320, 240)) == said.format("") + " to the frames delivered"
+    assert _mode_note(cam, (480, 360)) == said.format(", resized to 480x360") + (
+        " to the frames delivered"
+    )
+    cam.delivered_size = {"left": (640, 480)}
+    assert _mode_note(cam, (480, 360)) is None
+
+
+class _SkippingRig(_FakeRig):
+    """A ``--realtime`` recording stand-in that skipped 3 pairs a slow matcher missed."""
+
+    skipped = 3
+
+    def close(self) -> None:
+        pass
+
+
+def test_the_pairs_a_realtime_stream_skipped_are_said(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The recorded pairs a slower matcher skipped are said (stderr) and in the summary."""
+    import stereovision.stream as stream
+
+    monkeypatch.setattr(stream, "open_source", lambda args, fps=None: _SkippingRig([_frame(0)]))
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--no-check"]
+    assert main([*argv, "--max-disparity", "8", "--json"]) == 0
+    cap = capsys.readouterr()
+    summary = _json_lines(cap.out)[-1]
+    assert (summary["frames"], summary["skipped"]) == (1, 3)
+    assert cap.err.strip().splitlines()[-1] == (
+        "3 recorded pairs skipped: the matcher was slower than the recording (--realtime)"
+    )
+
+
+def test_the_live_view_is_given_every_pair(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Without ``--no-display`` every pair's left image and disparity reach the served view."""
+    import stereovision.stream as stream
+
+    got: list[tuple[tuple[int, ...], tuple[int, ...], float]] = []
+
+    class _Watched(FrameServer):
+        def update(self, left: np.ndarray, disparity: np.ndarray, max_disparity: float) -> None:
+            got.append((left.shape, disparity.shape, max_disparity))
+            super().update(left, disparity, max_disparity)
+
+    rig = _SkippingRig([_frame(0), _frame(1)])
+    rig.skipped = 0
+    monkeypatch.setattr(stream, "open_source", lambda args, fps=None: rig)
+    monkeypatch.setattr(stream, "FrameServer", _Watched)
+    argv = ["stream", "--left", "0", "--right", "1", "--serve", "0", "--no-check"]
+    assert main([*argv, "--max-disparity", "8"]) == 0
+    assert got == [((48, 64, 3), (48, 64), 8.0)] * 2
+    assert "serving the live view on http://127.0.0.1:" in capsys.readouterr().err
