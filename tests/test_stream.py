@@ -1767,8 +1767,13 @@ def test_the_live_view_is_given_every_pair(
     import stereovision.stream as stream
 
     got: list[tuple[tuple[int, ...], tuple[int, ...], float]] = []
+    made: list[FrameServer] = []
 
     class _Watched(FrameServer):
+        def __init__(self, host: str, port: int) -> None:
+            super().__init__(host, port)
+            made.append(self)
+
         def update(self, left: np.ndarray, disparity: np.ndarray, max_disparity: float) -> None:
             got.append((left.shape, disparity.shape, max_disparity))
             super().update(left, disparity, max_disparity)
@@ -1780,4 +1785,69 @@ def test_the_live_view_is_given_every_pair(
     argv = ["stream", "--left", "0", "--right", "1", "--serve", "0", "--no-check"]
     assert main([*argv, "--max-disparity", "8"]) == 0
     assert got == [((48, 64, 3), (48, 64), 8.0)] * 2
+    assert len(made) == 1 and made[0].closed  # its port let go of
     assert "serving the live view on http://127.0.0.1:" in capsys.readouterr().err
+
+
+def test_the_view_colours_the_whole_range_and_waits_for_a_new_frame() -> None:
+    """A disparity at or above the top of the range is the colour map's end, not black; a
+    client that has the latest frame waits for the next one (None and its own number after
+    the timeout) instead of spinning."""
+    from stereovision.stream import _compose
+
+    left = np.zeros((4, 4, 3), np.uint8)
+    disp = np.full((4, 4), 64.0, np.float32)
+    disp[:, 2:] = 80.0  # beyond the range (a sub-pixel refinement's): clipped to its top
+    img = _compose(left, disp, 64.0)
+    top = cv2.applyColorMap(np.array([[255]], np.uint8), cv2.COLORMAP_TURBO)[0, 0]
+    assert img.shape == (4, 8, 3) and (img[:, 4:] == top).all() and top.any()
+    srv = FrameServer("127.0.0.1", 0)
+    try:
+        srv.update(left, np.zeros((4, 4), np.float32), 8.0)
+        jpg, seen = srv.wait_jpeg(0, timeout=1.0)
+        assert jpg is not None and seen == 1
+        t0 = time.monotonic()
+        assert srv.wait_jpeg(seen, timeout=0.3) == (None, 1)
+        assert time.monotonic() - t0 >= 0.25
+    finally:
+        srv.close()
+
+
+def test_a_window_reports_its_largest_skew_and_the_bag_line_its_frames() -> None:
+    """A report's skew ``max`` is its pairs' largest; the bag line says the frames it holds,
+    with the frames lost only when it holds fewer than the pairs processed."""
+    from types import SimpleNamespace
+
+    from stereovision.stream import _bag_line, _Done, _window_report
+
+    done = [_Done(dict.fromkeys(STAGES, 0.001), 0.01, 0.0, s, 0.5) for s in (0.5, 2.0)]
+    assert _window_report(done, 1.0, 2, 1.0, 8, False)["skew_ms"] == {"mean": 1.25, "max": 2.0}
+    bag: Any = SimpleNamespace(frames=3, messages=12, path="b")
+    assert _bag_line(bag, 3) == "ROS 2 bag written to b (3 of the 3 pairs processed, 12 messages)"
+    assert _bag_line(bag, 2) == "ROS 2 bag written to b (3 frames, 12 messages)"
+
+
+def test_a_calibration_is_sized_by_the_size_asked_before_the_size_delivered() -> None:
+    """The frames' size is the size asked (``--size``: the frames are resized to it), not the
+    size the source delivers before that resize."""
+    from types import SimpleNamespace
+
+    from stereovision.stream import _frame_size
+
+    cam = SimpleNamespace(size=(480, 360), delivered_size={"left": (320, 240)})
+    assert _frame_size(cam) == (480, 360)
+    cam.size = None
+    assert _frame_size(cam) == (320, 240)
+
+
+def test_a_temporal_stream_averages_up_to_255_pairs(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--temporal 255``, the largest count the filter takes, is accepted."""
+    import stereovision.stream as stream
+
+    monkeypatch.setattr(stream, "open_source", lambda args, fps=None: _SkippingRig([_frame(0)]))
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--no-check"]
+    assert main([*argv, "--max-disparity", "8", "--temporal", "255", "--json"]) == 0
+    summary = _json_lines(capsys.readouterr().out)[-1]
+    assert summary["frames"] == 1 and summary["temporal"]["frames_averaged"] == 1.0
