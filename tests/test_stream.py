@@ -20,7 +20,7 @@ from stereovision.capture import StereoCamera
 from stereovision.cli import main
 from stereovision.depth import depth_map
 from stereovision.io import load_scene
-from stereovision.stream import STAGES, FrameServer, run_stream
+from stereovision.stream import STAGES, FrameServer, StreamReport, run_stream
 
 SCENE = "tartanair/oldtown_easy_p000_001116"  # 640x480, metric rectified calibration
 N_FRAMES = 6
@@ -1851,3 +1851,52 @@ def test_a_temporal_stream_averages_up_to_255_pairs(
     assert main([*argv, "--max-disparity", "8", "--temporal", "255", "--json"]) == 0
     summary = _json_lines(capsys.readouterr().out)[-1]
     assert summary["frames"] == 1 and summary["temporal"]["frames_averaged"] == 1.0
+
+
+def test_run_stream_refuses_a_bool_ground_every_and_two_ways_to_rectify() -> None:
+    """``ground_every=True`` and homographies with a calibration are usage errors, said as
+    such before any grab."""
+    rig = _FakeRig([_frame(0)])
+    with pytest.raises(ValueError, match="ground_every: expected a positive number of pairs"):
+        run_stream(rig, max_disparity=8, ground_every=True)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="homographies and calib: give one way"):
+        run_stream(rig, object(), max_disparity=8, homographies=_Homographies())  # type: ignore[arg-type]
+    assert rig.count == 0
+
+
+def test_each_floor_fit_reaches_on_ground(data_dir: Path) -> None:
+    """With ``ground_every``, every fit (None: no floor found) is handed to ``on_ground``."""
+    calib = Calibration.from_file(data_dir / SCENE / "calib.txt").scaled_to((64, 48))
+    seen: list[Any] = []
+    rig: Any = _FakeRig([_frame(i) for i in range(3)])
+    rep = run_stream(rig, calib, max_disparity=8, pipelined=False, check=False,
+                     ground_every=2, on_ground=seen.append)  # fmt: skip
+    assert rep.frames == 3 and [g["pair"] for g in rep.grounds] == [0, 2]
+    assert [p is not None for p in seen] == [g["found"] for g in rep.grounds]
+
+
+def test_the_stream_command_passes_its_options_on(
+    videos: dict[str, Path], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``--refine`` and ``--ground-every`` reach run_stream; ``--rectification`` with
+    ``--calib`` is refused in one line."""
+    import stereovision.stream as stream
+
+    calls: list[dict[str, Any]] = []
+    real = stream.run_stream
+
+    def recorded(*args: Any, **kw: Any) -> StreamReport:
+        calls.append(kw)
+        return real(*args, **kw)
+
+    monkeypatch.setattr(stream, "run_stream", recorded)
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--calib", str(videos["calib"]), "--no-display", "--no-check", "--frames", "1"]
+    assert main([*argv, "--max-disparity", "16", "--refine", "--ground-every", "1"]) == 0
+    assert (calls[0]["refine"], calls[0]["ground_every"]) == (True, 1)
+    assert capsys.readouterr().out.splitlines()[-1].startswith("floor: ")
+    assert main([*argv, "--rectification", "h.json"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        "stereovision: error: --rectification and --calib: give one way to rectify the pairs"
+    ]
