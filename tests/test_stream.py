@@ -1900,3 +1900,33 @@ def test_the_stream_command_passes_its_options_on(
     assert err == [
         "stereovision: error: --rectification and --calib: give one way to rectify the pairs"
     ]
+
+
+def test_a_raw_rigs_pairs_are_rectified_once() -> None:
+    """A raw rig's pairs, rectified in the grab stage, are matched as they are: the depth of
+    the frames rectified once, not warped again by the raw calibration."""
+    k = np.array([[32.0, 0, 32], [0, 32.0, 24], [0, 0, 1]])
+    rig = Calibration(K1=k, D1=np.zeros(5), K2=k, D2=np.zeros(5),
+                      R=cv2.Rodrigues(np.array([0.0, 0.05, 0.0]))[0], T=np.array([-0.25, 0.0, 0.0]),
+                      image_size=(64, 48), unit="m")  # fmt: skip
+    fr = _frame(0)
+    got: list[np.ndarray] = []
+    run_stream(_FakeRig([fr]), rig, max_disparity=8, pipelined=False, check=False,  # type: ignore[arg-type]
+               on_result=lambda left, res: got.append(res.disparity))  # fmt: skip
+    ref = depth_map(fr.left, fr.right, rig, method="gabor", max_disparity=8, refine=False)
+    np.testing.assert_array_equal(got[0], ref.disparity)
+
+
+def test_the_wait_is_for_the_pair_not_its_matching(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``wait_ms`` is the time the matcher waited for its pair, not that and the matching."""
+    import stereovision.depth as depth
+
+    real = depth.depth_map
+
+    def slow(*args: Any, **kw: Any) -> Any:
+        time.sleep(0.2)
+        return real(*args, **kw)
+
+    monkeypatch.setattr(depth, "depth_map", slow)
+    rep = run_stream(_FakeRig([_frame(0)]), max_disparity=8, pipelined=False, check=False)  # type: ignore[arg-type]
+    assert rep.latency_ms >= 200 and rep.wait_ms < 100
