@@ -1624,6 +1624,31 @@ def test_a_drag_past_the_sliders_range_clamps_them_and_keeps_the_view(tmp_path):
     assert moved.yaw == pytest.approx(90.0) and moved.pitch == pytest.approx(3.0)
 
 
+def test_a_toggle_after_a_followed_drag_keeps_the_view_and_its_pivot(tmp_path):
+    """Once the sliders followed a drag, the unit and surface/points toggles put the view on
+    the sliders' pose again: the focal point (the centre of the next drag, 1.35 m ahead after
+    the wheel) went back to the scene's median depth (3.5 m) and the feet slider's rounding
+    moved the camera. The view the mouse left now stays whole, still the sliders' pose."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-follow-mouse-toggle", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _mouse_drag(app, [(0.5, 0.5), (0.55, 0.52), (0.6, 0.55), (0.6, 0.55)])
+    for _ in range(5):
+        app.plotter.iren.interactor.MouseWheelForwardEvent()
+    dragged = render.CameraState.of(app.plotter.camera)
+    assert app.plotter.camera.GetDistance() < 2.0  # the wheel brought the pivot nearer
+    app.state.unit = "ft"
+    app._on_unit("ft")
+    assert render.CameraState.of(app.plotter.camera).same_view(dragged)
+    app.state.view_mode = "points"
+    app._on_view_mode()
+    assert render.CameraState.of(app.plotter.camera).same_view(dragged)
+    assert app._mouse_camera() is None  # still the sliders' pose: Save says no mouse view
+
+
 def test_save_of_the_pair_ignores_a_drag_of_an_opened_cloud_file(tmp_path):
     """With a point-cloud file shown in the 3-D view, a drag moves the view of that file (another
     scene, framed without the pair's intrinsics), yet Save rendered the pair from that camera

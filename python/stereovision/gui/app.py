@@ -2396,14 +2396,23 @@ class StereoApp:
     def _keeping_mouse_view(self, change: Callable[[], None]) -> None:
         """``change()`` (which puts the view on the sliders' pose), then the view the mouse left,
         if it left one: the unit toggle and the surface/points toggle are no slider move, and a
-        dragged view was lost to them (and render.png with it)."""
+        dragged view was lost to them (and render.png with it).
+
+        A view on the sliders' pose stays whole too: after the sliders followed a drag
+        (:meth:`follow_mouse`) ``change()`` reset its focal point (the next drag's pivot) to
+        the scene's median depth, and the feet sliders' rounding moved it."""
+        from stereovision.render import CameraState
+
         try:
             mouse = self._mouse_camera()
+            shown = mouse or CameraState.of(self.plotter.camera)
         except ValueError:  # a camera CameraState refuses: the sliders' pose, as before
-            mouse = None
+            mouse = shown = None
         change()
-        if mouse is not None:
-            mouse.apply(self.plotter)
+        if shown is not None:
+            shown.apply(self.plotter)
+            if mouse is None:  # the sliders' pose (to their rounding): no mouse view to say
+                self._slider_camera = CameraState.of(self.plotter.camera)
             self._update_view()
 
     def _update_view(self) -> None:
