@@ -999,3 +999,23 @@ def test_bgra16_transport_suffixes_and_positions(cones: Any, tmp_path: Path) -> 
     assert [f.pos_right_ms for f in got] == pytest.approx(
         [-2 + k * PERIOD_NS / 1e6 for k in range(3)]
     )
+
+
+def test_a_pair_exactly_max_skew_ms_apart_is_paired_for_any_decimal_value(
+    cones: Any, tmp_path: Path
+) -> None:
+    """``max_skew_ms * 1e6`` in floats is 4099999.9999999995 ns for 4.1 ms (and just under
+    the value for 33.3, 2.01, 1.001, ... ms), so a pair exactly 4.1 ms apart was still refused;
+    the tolerance is the whole nanoseconds of the value given."""
+    left, right = cones.left[:64, :96], cones.right[:64, :96]
+    frames = [
+        (T0, left, T0 + 4_100_000, right),  # right 4.1 ms late
+        (T0 + PERIOD_NS, left, T0 + PERIOD_NS - 4_100_000, right),  # 4.1 ms early
+        (T0 + 2 * PERIOD_NS, left, T0 + 2 * PERIOD_NS + 4_100_001, right),  # 1 ns past it
+    ]
+    bag = write_bag(tmp_path / "rig", frames)
+    with BagCamera(bag, max_skew_ms=4.1) as cam:
+        list(cam.frames())
+    assert cam.stamps_ns == [T0, T0 + PERIOD_NS]
+    assert cam.dropped == {"left": 1, "right": 1}
+    assert cam.max_skew_ms == 4.1

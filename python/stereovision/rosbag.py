@@ -975,7 +975,11 @@ class BagCamera(PairSource):
         self.count = 0
         self.dropped = {"left": 0, "right": 0}
         self.max_skew_ms = max_skew_ms
-        self._tol_ns: float | None = None if max_skew_ms is None else max_skew_ms * 1e6
+        # whole nanoseconds of the value given (stamps are ints): 4.1 * 1e6 is 4099999.9999999995
+        # in floats, which refused a pair exactly 4.1 ms apart (33.3 ms, 2.01 ms, ... alike)
+        self._tol_ns: float | None = (
+            None if max_skew_ms is None else math.floor(round(max_skew_ms * 1e6, 6))
+        )
         self._first: dict[str, list[int]] = {"left": [], "right": []}
         self._pairs = self._pair_iter()
 
