@@ -951,6 +951,16 @@ def test_orbit_refuses_a_centre_that_is_no_distance(depth):
         render.orbit_controls(10.0, 5.0, depth)
 
 
+@pytest.mark.parametrize("angle", ["10", None, True, math.nan])
+def test_orbit_refuses_an_angle_that_is_no_number(angle):
+    """A text or None yaw or pitch raised math.radians' TypeError ("must be real number, not
+    str", no name) before CameraControls could say which control it was."""
+    with pytest.raises(ValueError, match=r"^camera control yaw must be a finite number"):
+        render.orbit_controls(angle, 5.0, 3.0)
+    with pytest.raises(ValueError, match=r"^camera control pitch must be a finite number"):
+        render.orbit_controls(10.0, angle, 3.0)
+
+
 def test_orbit_takes_numpy_depths():
     c = render.orbit_controls(10.0, 5.0, np.float32(4.0))
     assert c == render.orbit_controls(10.0, 5.0, 4.0)

@@ -281,6 +281,12 @@ def orbit_controls(yaw: float, pitch: float, center_depth: float) -> CameraContr
     Returns
     -------
     CameraControls
+
+    Raises
+    ------
+    ValueError
+        An angle that is not a finite number, or a ``center_depth`` that is no positive
+        distance.
     """
     from stereovision._validate import finite_number
 
@@ -291,6 +297,10 @@ def orbit_controls(yaw: float, pitch: float, center_depth: float) -> CameraContr
     if not depth > 0:
         raise ValueError(f"center_depth must be a positive distance, got {center_depth!r}")
     center_depth = depth
+    # the angles checked first (CameraControls names them): math.radians of a text or None
+    # raised a TypeError naming neither
+    angles = CameraControls(yaw=yaw, pitch=pitch)
+    yaw, pitch = angles.yaw, angles.pitch
     rot = camera_pose(yaw=yaw, pitch=pitch)[:3, :3]
     center = np.array([0.0, 0.0, center_depth])
     position = center - center_depth * rot[:, 2]
