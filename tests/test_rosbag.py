@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -384,16 +385,12 @@ def test_the_frames_a_full_disk_rolled_back_are_counted_out(
         assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 7
 
 
-def test_an_interrupt_while_a_cut_frame_is_undone_leaves_no_part_of_it(
-    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """A second Ctrl-C cuts a frame (its messages are undone) and a third one, no longer held,
-    cut the undoing: the frame's savepoint stayed open, the bag's close committed the part of
-    the frame written (a depth image without its cloud) and metadata.yaml counted it. Now the
-    writer undoes an unfinished frame before it writes the next one or closes."""
+def _frame_cut_while_undone(
+    res: object, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, commit_period_s: float
+) -> Any:
+    """A bag whose frame 1 is committed and whose frame 2 a second Ctrl-C cut (its third
+    message) while a third one cut the undoing (``ROLLBACK TO frame``)."""
     import sqlite3
-
-    from rosbags.highlevel import AnyReader
 
     from stereovision import rosbag
 
@@ -406,10 +403,10 @@ def test_an_interrupt_while_a_cut_frame_is_undone_leaves_no_part_of_it(
                 raise KeyboardInterrupt  # the third Ctrl-C
             return super().execute(sql, *args)
 
-    res, _ = kitti
     monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 0.0)
     bag = rosbag.BagWriter(tmp_path / "run")
     bag.write(res, 1)  # committed
+    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", commit_period_s)
     storage = bag._writer.storage
     storage.conn.close()
     storage.conn = sqlite3.connect(storage.path, factory=Interrupted)
@@ -426,6 +423,22 @@ def test_an_interrupt_while_a_cut_frame_is_undone_leaves_no_part_of_it(
     monkeypatch.setattr(storage, "write", second_ctrl_c)
     with pytest.raises(KeyboardInterrupt):
         bag.write(res, 2)
+    return bag
+
+
+def test_an_interrupt_while_a_cut_frame_is_undone_leaves_no_part_of_it(
+    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A second Ctrl-C cuts a frame (its messages are undone) and a third one, no longer held,
+    cut the undoing: the frame's savepoint stayed open, the bag's close committed the part of
+    the frame written (a depth image without its cloud) and metadata.yaml counted it. Now the
+    writer undoes an unfinished frame before it writes the next one or closes."""
+    import sqlite3
+
+    from rosbags.highlevel import AnyReader
+
+    res, _ = kitti
+    bag = _frame_cut_while_undone(res, tmp_path, monkeypatch, 0.0)
     bag.close()  # as `with BagWriter(...)` does on the way out
     assert (bag.messages, bag.frames) == (7, 1)
     with AnyReader([tmp_path / "run"]) as reader:
@@ -592,42 +605,10 @@ def test_the_frame_after_an_interrupted_undo_is_kept(
     """Mutation audit: a frame cut by a Ctrl-C whose undoing was cut too is undone before the
     next frame is written; written inside its open savepoint, that next frame was rolled back
     with it at the close."""
-    import sqlite3
-
     from rosbags.highlevel import AnyReader
 
-    from stereovision import rosbag
-
-    class Interrupted(sqlite3.Connection):
-        cut = True
-
-        def execute(self, sql: str, *args: object) -> sqlite3.Cursor:  # type: ignore[override]
-            if sql == "ROLLBACK TO frame" and self.cut:
-                self.cut = False
-                raise KeyboardInterrupt  # the third Ctrl-C
-            return super().execute(sql, *args)
-
     res, _ = kitti
-    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 0.0)
-    bag = rosbag.BagWriter(tmp_path / "run")
-    bag.write(res, 1)  # committed
-    monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 3600.0)
-    storage = bag._writer.storage
-    storage.conn.close()
-    storage.conn = sqlite3.connect(storage.path, factory=Interrupted)
-    storage.cursor = storage.conn.cursor()
-    real_write = storage.write
-    calls = [0]
-
-    def second_ctrl_c(*args: object) -> None:
-        calls[0] += 1
-        if calls[0] == 3:
-            raise KeyboardInterrupt
-        real_write(*args)
-
-    monkeypatch.setattr(storage, "write", second_ctrl_c)
-    with pytest.raises(KeyboardInterrupt):
-        bag.write(res, 2)
+    bag = _frame_cut_while_undone(res, tmp_path, monkeypatch, 3600.0)
     bag.write(res, 3)
     bag.close()
     assert (bag.messages, bag.frames) == (14, 2)
