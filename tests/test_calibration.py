@@ -1073,7 +1073,10 @@ def test_alpha_that_is_not_a_number_is_named(alpha: object) -> None:
 def test_rectified_calibration_alpha_must_be_finite(alpha: float) -> None:
     # NaN went to cv2.stereoRectify; OpenCV's -1 (its default scaling) stays accepted
     c = raw_calib()
-    with pytest.raises(ValueError, match=r"^alpha: expected a finite number, got (nan|inf|1000)"):
+    with pytest.raises(
+        ValueError,
+        match=r"^alpha: expected a finite number, got (nan|inf|an integer of 401 digits \(too)",
+    ):
         c.rectified_calibration(alpha)
     assert c.rectified_calibration(-1).rectified
 

@@ -437,3 +437,61 @@ def test_none_and_objects_are_named_for_what_they_are() -> None:
         as_gray_float(None)
     with pytest.raises(ValueError, match="expected a numeric image array, got ndarray"):
         as_gray_float(np.array([[1, None]], dtype=object))
+
+
+@pytest.mark.parametrize(
+    ("value", "says"),
+    [
+        (10**400, "an integer of 401 digits (too large for a float)"),
+        (10**400 - 1, "an integer of 400 digits (too large for a float)"),
+        (-(10**400), "a negative integer of 401 digits (too large for a float)"),
+        (10**5000, "an integer of 5001 digits (too large for a float)"),
+    ],
+    ids=["10**400", "10**400-1", "-10**400", "10**5000"],
+)
+def test_a_number_too_large_for_a_float_is_said_to_be_so(value: int, says: str) -> None:
+    """An int beyond a float's range was refused as "expected a finite number, got 1000...0"
+    (400 digits on one line), or "got an integer of 1329 bits": it is finite, only too large
+    for a float. Every check of a finite number says so, by its number of digits."""
+    import numpy as np
+
+    from stereovision import export, refine
+    from stereovision._validate import finite_number, positive_finite
+    from stereovision.evaluate import count_at_precision
+    from stereovision.render import CameraControls
+    from tests.test_calibration import raw_calib
+
+    one = np.ones(1)
+    checks = [
+        ("blur: expected a finite number, got ", lambda: finite_number(value, "blur")),
+        ("f: expected a positive finite number, got ", lambda: positive_finite(value, "f")),
+        ("alpha: expected a finite number, got ", lambda: raw_calib().rectified_calibration(value)),
+        (
+            "scale: expected a positive finite number, got ",
+            lambda: export.encode_depth_png(np.ones((2, 2)), scale=value),
+        ),
+        (
+            "tolerance: expected a positive finite number of pixels, got ",
+            lambda: count_at_precision(one, one, one, one, np.ones((2, 2)), 50.0, value),
+        ),
+        (
+            "camera control roll must be a finite number, got ",
+            lambda: CameraControls(roll=value),
+        ),
+    ]
+    checks.append(
+        (
+            "step must be a finite number, got ",
+            lambda: refine.refine_disparity(
+                np.zeros((4, 4), np.float32),
+                np.zeros((4, 4), np.float32),
+                np.zeros((4, 4), np.float32),
+                max_disparity=2,
+                step=value,
+            ),
+        )
+    )
+    for prefix, call in checks:
+        with pytest.raises(ValueError) as info:
+            call()
+        assert str(info.value) == prefix + says

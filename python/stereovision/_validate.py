@@ -470,6 +470,8 @@ def positive_finite(value: object, name: str) -> float:
     """
     if isinstance(value, (bool, np.bool_)):
         raise ValueError(f"{name}: expected a positive finite number, got bool {value!r}")
+    if too_large_for_float(value):  # np.asarray made it an object array: its 400 digits shown
+        raise ValueError(f"{name}: expected a positive finite number, got {number_shown(value)}")
     try:
         arr = np.asarray(value)
         if arr.size != 1 or arr.dtype.kind not in "iuf":
@@ -535,6 +537,43 @@ def _shown(value: object) -> str:
     return repr(value)
 
 
+def too_large_for_float(value: object) -> str | None:
+    """What a message says of ``value`` when it is an int beyond a float's range (``10**400``),
+    else None: its number of digits, never the digits themselves (one line; an int of over 4300
+    digits has no ``str``), and why it is refused though it is finite.
+
+    Examples
+    --------
+    >>> too_large_for_float(10**400)
+    'an integer of 401 digits (too large for a float)'
+    >>> too_large_for_float(-(10**400))
+    'a negative integer of 401 digits (too large for a float)'
+    >>> too_large_for_float(2**70) is None
+    True
+    """
+    if not isinstance(value, int) or isinstance(value, bool):
+        return None  # NumPy integers all fit a float
+    try:
+        float(value)
+        return None
+    except OverflowError:
+        pass
+    size = abs(value)
+    digits = int(math.log10(size)) + 1  # log10 of a big int is a float: corrected exactly
+    if size < 10 ** (digits - 1):
+        digits -= 1
+    elif size >= 10**digits:
+        digits += 1
+    sign = "a negative" if value < 0 else "an"
+    return f"{sign} integer of {digits} digits (too large for a float)"
+
+
+def number_shown(value: object) -> str:
+    """``repr(value)`` for a message, or :func:`too_large_for_float`'s words for an int beyond a
+    float's range."""
+    return too_large_for_float(value) or _shown(value)
+
+
 def first_line(exc: BaseException) -> str:
     """What a one-line error message says of ``exc``: its message's first line (its type's
     name if empty), as the CLI, the GUI and the stream print errors.
@@ -562,9 +601,9 @@ def first_line(exc: BaseException) -> str:
 def finite_number(value: object, name: str) -> float:
     """``value`` as a finite Python float.
 
-    An integer too large for a float (``2**1100``), NaN, an infinity or a non-number is a
-    ``ValueError`` naming ``name``, not an OverflowError or NumPy's "ufunc 'isfinite' not
-    supported" (which a Python int beyond 64 bits gave).
+    An integer too large for a float (``2**1100``: its number of digits is shown), NaN, an
+    infinity or a non-number is a ``ValueError`` naming ``name``, not an OverflowError or
+    NumPy's "ufunc 'isfinite' not supported" (which a Python int beyond 64 bits gave).
 
     Examples
     --------
@@ -581,8 +620,8 @@ def finite_number(value: object, name: str) -> float:
         raise ValueError(f"{name}: expected a finite number, got {_shown(value)}")
     try:
         out = float(value)
-    except OverflowError:
-        out = math.inf
+    except OverflowError:  # finite, only too large for a float: say so, not its digits
+        raise ValueError(f"{name}: expected a finite number, got {number_shown(value)}") from None
     if not math.isfinite(out):
         raise ValueError(f"{name}: expected a finite number, got {_shown(value)}")
     return out

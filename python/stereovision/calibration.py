@@ -29,7 +29,13 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_image_array, positive_finite, renamed_keyword, xy_points
+from stereovision._validate import (
+    as_image_array,
+    number_shown,
+    positive_finite,
+    renamed_keyword,
+    xy_points,
+)
 
 __all__ = [
     "CAMERA_MODELS",
@@ -305,7 +311,7 @@ def _check_alpha(alpha: object, *, any_finite: bool = False) -> None:
         except OverflowError:  # an int beyond a float
             finite = False
         if not finite:
-            raise ValueError(f"alpha: expected a finite number, got {alpha!r}")
+            raise ValueError(f"alpha: expected a finite number, got {number_shown(alpha)}")
     elif not (real and 0.0 <= alpha <= 1.0):  # type: ignore[operator]
         raise ValueError(f"alpha: expected a value in [0, 1], got {alpha!r}")
 

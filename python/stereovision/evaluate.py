@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import renamed_keyword
+from stereovision._validate import number_shown, renamed_keyword
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -680,7 +680,7 @@ def count_at_precision(
         raise ValueError(f"target: expected a precision in percent, 0 to 100, got {target!r}")
     if not _positive_finite(tolerance):
         raise ValueError(
-            f"tolerance: expected a positive finite number of pixels, got {tolerance!r}"
+            f"tolerance: expected a positive finite number of pixels, got {number_shown(tolerance)}"
         )
     g = _real_2d(gt, "gt")
     x, y, x2, s = (np.asarray(a, dtype=np.float64) for a in (xl, yl, xr, score))

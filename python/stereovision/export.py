@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any, overload
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import renamed_keyword
+from stereovision._validate import number_shown, renamed_keyword
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -759,7 +759,7 @@ def _check_scale(scale: float) -> float:
     except OverflowError:
         value = math.inf
     if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"scale: expected a positive finite number, got {scale!r}")
+        raise ValueError(f"scale: expected a positive finite number, got {number_shown(scale)}")
     return value
 
 

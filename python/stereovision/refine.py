@@ -25,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import check_unit_range, disparity_range
+from stereovision._validate import check_unit_range, disparity_range, number_shown
 
 __all__ = ["DEFAULTS", "RefineResult", "refine_disparity"]
 
@@ -86,7 +86,7 @@ def _number(v: object, name: str, whole: bool = False) -> float:
     try:
         out = float(v)
     except OverflowError:  # an int beyond a float's range (2**1100)
-        raise ValueError(f"{name} must be a finite number, got {v!r}") from None
+        raise ValueError(f"{name} must be a finite number, got {number_shown(v)}") from None
     # Whole numbers are the kernel's counts and radii (usize).
     if whole and not (math.isfinite(out) and 0 <= v < 2**31 and int(v) == v):
         raise ValueError(f"{name} must be a non-negative whole number, got {v!r}")

@@ -115,7 +115,7 @@ class CameraControls:
     right: float = 0.0
 
     def __post_init__(self) -> None:
-        from stereovision._validate import finite_number
+        from stereovision._validate import finite_number, number_shown
 
         for f in fields(self):
             value = getattr(self, f.name)
@@ -124,7 +124,7 @@ class CameraControls:
                 number = finite_number(value, f.name)
             except ValueError:
                 raise ValueError(
-                    f"camera control {f.name} must be a finite number, got {value!r}"
+                    f"camera control {f.name} must be a finite number, got {number_shown(value)}"
                 ) from None
             object.__setattr__(self, f.name, number)
 
