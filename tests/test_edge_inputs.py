@@ -431,6 +431,24 @@ def test_match_with_the_automatic_range_refuses_a_min_disparity_not_below_the_wi
     assert str(err.value).startswith("min_disparity (100) is not below the image width 48")
 
 
+@pytest.mark.parametrize("method", MATCH_METHODS)
+@pytest.mark.parametrize("max_disparity", [10**401, None], ids=["10**401", "automatic"])
+def test_match_refuses_a_min_disparity_too_large_for_a_float(
+    method: str, max_disparity: int | None
+) -> None:
+    """min_disparity 10**400 (to 10**401) returned 0 matches without a word from hopfield, best
+    and mcgm: the check of an unreachable range skipped a value beyond a float. It is refused
+    as any min_disparity not below the width, its size shown, not its 401 digits."""
+    left = np.random.default_rng(0).integers(0, 256, (24, 48), dtype=np.uint8)
+    with pytest.raises(ValueError) as err:
+        sv.match(
+            left, left.copy(), method=method, min_disparity=10**400, max_disparity=max_disparity
+        )
+    assert str(err.value).startswith(
+        "min_disparity (an integer of 401 digits) is not below the image width 48: "
+    )
+
+
 @pytest.mark.parametrize("method", ["hopfield", "best", "mcgm"])
 def test_match_with_a_huge_max_disparity_searches_the_whole_width(method: str) -> None:
     """hopfield, best and mcgm clip the range to the image, but match()'s final range cut

@@ -537,10 +537,10 @@ def _shown(value: object) -> str:
     return repr(value)
 
 
-def too_large_for_float(value: object) -> str | None:
+def too_large_for_float(value: object, *, why: bool = True) -> str | None:
     """What a message says of ``value`` when it is an int beyond a float's range (``10**400``),
     else None: its number of digits, never the digits themselves (one line; an int of over 4300
-    digits has no ``str``), and why it is refused though it is finite.
+    digits has no ``str``), and (``why``) why it is refused though it is finite.
 
     Examples
     --------
@@ -548,6 +548,8 @@ def too_large_for_float(value: object) -> str | None:
     'an integer of 401 digits (too large for a float)'
     >>> too_large_for_float(-(10**400))
     'a negative integer of 401 digits (too large for a float)'
+    >>> too_large_for_float(10**400, why=False)
+    'an integer of 401 digits'
     >>> too_large_for_float(2**70) is None
     True
     """
@@ -565,7 +567,7 @@ def too_large_for_float(value: object) -> str | None:
     elif size >= 10**digits:
         digits += 1
     sign = "a negative" if value < 0 else "an"
-    return f"{sign} integer of {digits} digits (too large for a float)"
+    return f"{sign} integer of {digits} digits" + (" (too large for a float)" if why else "")
 
 
 def number_shown(value: object) -> str:

@@ -25,7 +25,13 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_bgr_uint8, as_gray_float, check_pair, finite_number
+from stereovision._validate import (
+    as_bgr_uint8,
+    as_gray_float,
+    check_pair,
+    finite_number,
+    too_large_for_float,
+)
 from stereovision.calibration import Calibration
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -186,8 +192,10 @@ def _finite(v: float) -> bool:
 
 def _px(value: float) -> str:
     """A number of pixels for a message: every digit of a whole number up to 12 digits
-    (``:g`` showed 3e10 + 48 as "3e+10"), a fraction as given (16.5), beyond that 12 digits."""
-    return f"{value:.12g}"
+    (``:g`` showed 3e10 + 48 as "3e+10"), a fraction as given (16.5), beyond that 12 digits; an
+    int beyond a float's range (match's min_disparity of 10**400) by its size: ``:g`` of it is an
+    OverflowError."""
+    return too_large_for_float(value, why=False) or f"{value:.12g}"
 
 
 def _unreachable_range(min_disparity: float, max_disparity: float, width: int) -> ValueError | None:

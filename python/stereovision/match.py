@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_bgr_uint8, check_pair, finite_number
+from stereovision._validate import as_bgr_uint8, check_pair, finite_number, too_large_for_float
 from stereovision.calibration import Calibration
 from stereovision.depth import (
     _rectify_grey,
@@ -142,10 +142,12 @@ def _refuse_unreachable(
     matchers' own checks, which name them (one equal to it is a one-level search, which
     hopfield, best and mcgm run: at the width it returned 0 matches without a word); an
     estimated one (``automatic``) below such a min_disparity is not the problem, the
-    min_disparity is."""
+    min_disparity is. An int beyond a float's range is compared as it is: a min_disparity of
+    10**400 returned 0 matches without a word (hopfield, best, mcgm), a max_disparity of
+    10**400 searches the whole width."""
     try:
-        lo = finite_number(min_disparity, "min_disparity")
-        hi = finite_number(max_disparity, "max_disparity")
+        lo = _bound(min_disparity, "min_disparity")
+        hi = _bound(max_disparity, "max_disparity")
     except ValueError:  # not a finite number: the matchers name it
         return
     if hi < lo and not automatic:
@@ -153,6 +155,14 @@ def _refuse_unreachable(
     err = _unreachable_range(lo, hi, width)
     if err is not None:
         raise err
+
+
+def _bound(value: object, name: str) -> float:
+    """``value`` as a finite float (:func:`finite_number`), or an int beyond a float's range as
+    it is (exact comparisons with the width; :func:`_unreachable_range` shows its size)."""
+    if too_large_for_float(value):
+        return value  # type: ignore[return-value]
+    return finite_number(value, name)
 
 
 def _gabor_matches(
