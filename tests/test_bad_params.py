@@ -338,3 +338,24 @@ def test_wrong_objects_are_type_errors_naming_the_argument(tmp_path: Path) -> No
         with pytest.raises(TypeError, match=says):
             call()
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "run", [hopfield.hopfield_match, hopfield.best_match, mcgm.mcgm_match], ids=lambda f: f.__name__
+)
+def test_a_range_beyond_a_float_is_named_by_its_size(run: Any, ctx: dict[str, Any]) -> None:
+    """A max_disparity of -10**400, or one of 10**400 below a min_disparity of 10**401, was
+    refused with all 400 digits on the error's one line; its size is shown."""
+    gl, gr = ctx["gl"], ctx["gr"]
+    with pytest.raises(ValueError) as err:
+        run(gl, gr, max_disparity=-(10**400))
+    assert str(err.value) == (
+        "max_disparity must be a non-negative number of pixels, got a negative integer of 401 "
+        "digits"
+    )
+    with pytest.raises(ValueError) as err:
+        run(gl, gr, min_disparity=10**401, max_disparity=10**400)
+    assert str(err.value) == (
+        "max_disparity (an integer of 401 digits) must be >= min_disparity (an integer of 402 "
+        "digits)"
+    )

@@ -30,6 +30,7 @@ from stereovision._validate import (
     int_in_range,
     luma_weights,
     refuse_unknown,
+    too_large_for_float,
     u8_pair,
 )
 from stereovision.matches import Matches
@@ -175,6 +176,11 @@ def moravec(image: npt.ArrayLike) -> npt.NDArray[np.float32]:
     return interest_points(image).response
 
 
+def _shown(v: object) -> str:
+    """``repr(v)``, or the size of an int beyond a float (10**400: not its 401 digits)."""
+    return too_large_for_float(v, why=False) or repr(v)
+
+
 def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:
     refuse_unknown(
         "Hopfield parameter", params, DEFAULTS, "stereovision.matching.hopfield.DEFAULTS"
@@ -183,7 +189,7 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
             if isinstance(v, (float, np.floating)) and np.isfinite(v) and v >= 0:
                 continue
-            raise ValueError(f"{name} must be a non-negative number of pixels, got {v!r}")
+            raise ValueError(f"{name} must be a non-negative number of pixels, got {_shown(v)}")
     # The kernel clips the range to the image; the clip here keeps it within its integers (2**70
     # was the binding's "OverflowError: int too big to convert").
     big = 2**31 - 1
@@ -192,7 +198,8 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
     # (lo 32 <= hi 32) gave no match without a word, and 1e300 was shown as its clip 2147483647
     if max_disparity < min_disparity:
         raise ValueError(
-            f"max_disparity ({max_disparity!r}) must be >= min_disparity ({min_disparity!r})"
+            f"max_disparity ({_shown(max_disparity)}) must be >= min_disparity "
+            f"({_shown(min_disparity)})"
         )
     return {**DEFAULTS, **params, "min_disparity": lo, "max_disparity": hi}
 

@@ -26,7 +26,13 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import as_gray_float, check_pair, float_sized, refuse_unknown
+from stereovision._validate import (
+    as_gray_float,
+    check_pair,
+    float_sized,
+    refuse_unknown,
+    too_large_for_float,
+)
 from stereovision.matches import Matches
 
 __all__ = [
@@ -200,6 +206,11 @@ def _sigmas(sig: object) -> list[float]:
     return [float(s) for s in items]
 
 
+def _shown(v: object) -> str:
+    """``repr(v)``, or the size of an int beyond a float (10**400: not its 401 digits)."""
+    return too_large_for_float(v, why=False) or repr(v)
+
+
 def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:
     refuse_unknown("MCGM parameter", params, DEFAULTS, "stereovision.matching.mcgm.DEFAULTS")
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
@@ -209,7 +220,7 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
             or (isinstance(v, (float, np.floating)) and not math.isfinite(v))
             or v < 0
         ):
-            raise ValueError(f"{name} must be a non-negative number of pixels, got {v!r}")
+            raise ValueError(f"{name} must be a non-negative number of pixels, got {_shown(v)}")
     # The kernel clips the range to the image; the clip here keeps it within its integers
     # (without a float of an int beyond a float's range: 2**1100 was an OverflowError).
     big = 2**31 - 1
@@ -219,7 +230,8 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
     # (lo 32 <= hi 32) gave no match without a word, and 1e300 was shown as its clip 2147483647
     if max_disparity < min_disparity:
         raise ValueError(
-            f"max_disparity ({max_disparity!r}) must be >= min_disparity ({min_disparity!r})"
+            f"max_disparity ({_shown(max_disparity)}) must be >= min_disparity "
+            f"({_shown(min_disparity)})"
         )
     kw = {**DEFAULTS, **params, "min_disparity": lo, "max_disparity": hi}
     kw["sigmas"] = _sigmas(kw["sigmas"])
