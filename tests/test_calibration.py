@@ -110,6 +110,12 @@ def test_bad_values_name_the_field(field: str, value: object, message: str) -> N
         ({"K2": np.array([[510.0, 0, 160], [0, 500, 120], [0, 0, 1]])}, "K2: fx"),
         ({"doffs": 4.0}, r"doffs: 4.0 differs from cx2 - cx1 = 0.0"),
         ({"doffs": float("nan")}, "doffs: expected a finite number"),
+        # an OverflowError naming no field ("int too large to convert to float")
+        (
+            {"doffs": 10**400},
+            r"^doffs: expected a finite number of pixels, got an integer of 401 digits "
+            r"\(too large for a float\)$",
+        ),
     ],
 )
 def test_bad_rectified_values(overrides: dict[str, object], message: str) -> None:

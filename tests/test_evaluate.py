@@ -392,8 +392,13 @@ def test_dense_metrics_thresholds_must_be_a_sequence_of_numbers(thresholds: obje
     # 2.0 was "'float' object is not iterable", True a 1 px threshold, "2" a TypeError
     disp = np.zeros((3, 4), np.float32)
     assert dense_metrics(disp, disp + 1.5, thresholds=[np.float32(1.0), 2]).bad[2.0] == 0.0
-    with pytest.raises(ValueError, match=r"^thresholds must be positive and finite, got "):
+    with pytest.raises(ValueError, match=r"^thresholds must be positive and finite, got ") as err:
         dense_metrics(disp, disp, thresholds=thresholds)  # type: ignore[arg-type]
+    if thresholds == (2.0, 10**400):  # its 401 digits were the error's one line
+        assert str(err.value) == (
+            "thresholds must be positive and finite, got (2.0, an integer of 401 digits "
+            "(too large for a float))"
+        )
 
 
 # ------------------------------------------------------------- mutation audit (values the

@@ -397,9 +397,14 @@ class Calibration:
             raise ValueError(f"rectified: expected a bool, got {self.rectified!r}")
         object.__setattr__(self, "rectified", bool(self.rectified))
         if self.doffs is not None:
-            d = float(self.doffs)
+            try:
+                d = float(self.doffs)
+            except OverflowError:  # an int beyond a float: named, not "int too large to convert"
+                d = math.nan
             if not math.isfinite(d):
-                raise ValueError(f"doffs: expected a finite number of pixels, got {self.doffs!r}")
+                raise ValueError(
+                    f"doffs: expected a finite number of pixels, got {number_shown(self.doffs)}"
+                )
             if not self.rectified:
                 raise ValueError("doffs: only applies to a rectified calibration")
             object.__setattr__(self, "doffs", d)

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import number_shown, renamed_keyword
+from stereovision._validate import number_shown, renamed_keyword, too_large_for_float
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -200,7 +200,10 @@ def dense_metrics(
     # (a generator, used up by the check, gave no bad-t figure at all)
     ts = tuple(thresholds) if isinstance(thresholds, Iterable) else None
     if isinstance(thresholds, (str, bytes)) or ts is None or not all(map(_positive_finite, ts)):
-        raise ValueError(f"thresholds must be positive and finite, got {thresholds!r}")
+        shown = repr(thresholds)
+        if ts is not None and any(map(too_large_for_float, ts)):  # not the 401 digits of 10**400
+            shown = f"({', '.join(map(number_shown, ts))})"
+        raise ValueError(f"thresholds must be positive and finite, got {shown}")
     known = np.isfinite(g)
     if mask is not None:
         m = np.asarray(mask, dtype=bool)
