@@ -520,7 +520,7 @@ def float_sized(value: _T, name: str) -> _T:
     >>> float_sized(10**400, "gamma")
     Traceback (most recent call last):
     ...
-    ValueError: gamma: an integer of 1329 bits is beyond a float's range
+    ValueError: gamma: an integer of 401 digits is beyond a float's range
     """
     if isinstance(value, int) and not isinstance(value, bool):
         try:
@@ -531,10 +531,9 @@ def float_sized(value: _T, name: str) -> _T:
 
 
 def _shown(value: object) -> str:
-    """``repr(value)``, or for an int beyond a float its size (10**5000 has no repr)."""
-    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 1024:
-        return f"an integer of {value.bit_length()} bits"
-    return repr(value)
+    """``repr(value)``, or for an int beyond a float its size (10**5000 has no repr), in
+    :func:`too_large_for_float`'s words (one wording for every message)."""
+    return too_large_for_float(value, why=False) or repr(value)
 
 
 def too_large_for_float(value: object, *, why: bool = True) -> str | None:
