@@ -466,6 +466,26 @@ def test_the_unit_toggle_shows_lengths_in_feet():
     assert app.state.unit == "m"
 
 
+def test_the_unit_toggle_keeps_the_translations_inside_the_feet_sliders_range():
+    """The translation sliders' +-5 m are shown as +-16.4 ft, yet the toggle converted 5 m to
+    16.404 ft (4.999 m to 16.401 ft): values past the feet sliders' range, the thumb stuck at
+    its end. They are clamped to the range shown, as :func:`sliders_from_pose` clamps, and the
+    view does not move (the 1.3 mm the clamp takes is no camera move)."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-units-range", [bundled_data_dir()])
+    app.state.forward, app.state.up, app.state.right = 5.0, -4.999, 4.998
+    app._apply_camera()
+    pose = app.plotter.camera.position
+    app._on_unit(unit="ft")
+    assert app.state.translation_range == 16.4
+    assert (app.state.forward, app.state.up, app.state.right) == (16.4, -16.4, 16.398)
+    np.testing.assert_allclose(app.plotter.camera.position, pose, atol=1e-9)  # did not move
+    app._on_unit(unit="m")
+    assert app.state.translation_range == 5.0
+    assert (app.state.forward, app.state.up, app.state.right) == (4.999, -4.999, 4.998)
+
+
 def test_the_max_disparity_field_is_applied_and_checked():
     """The disparity range could not be set on the page. Its field is empty for automatic (the
     pair's own range, shown as its hint); a number is applied on Enter, and a bad one is said

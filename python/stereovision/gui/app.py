@@ -249,6 +249,31 @@ MOUSE_RENDER = "render.png: the 3-D view as the mouse left it, not the sliders' 
 PENDING_SAVE = "the new pair is being computed: save it once its results are shown"
 
 
+def translation_range(unit: str = "m") -> float:
+    """The translation sliders' range (+-) as the page shows it in ``unit``:
+    :data:`TRANSLATION_RANGE` metres, rounded to the feet sliders' 0.1 ft step (16.4 ft).
+
+    The range is rounded down (5 m is 16.404 ft), so values converted into it are clamped to it
+    (:meth:`StereoApp._on_unit`, :func:`sliders_from_pose`). The other way, a range rounded up
+    to hold 16.404 ft (16.5 ft = 5.03 m) would in turn hold values past the metres sliders'
+    5 m, and an unrounded one (16.404...) puts the slider's steps, counted from its minimum,
+    off the round numbers; the clamp costs at most 1.3 mm, and the view stays where it was.
+
+    Parameters
+    ----------
+    unit : str
+        The page's length unit (:data:`UNITS`).
+
+    Returns
+    -------
+    float
+        The sliders' largest value (their smallest is its negative), in ``unit``.
+    """
+    from stereovision.calibration import UNIT_TO_METRES
+
+    return round(TRANSLATION_RANGE / UNIT_TO_METRES[unit], 1)
+
+
 class SaveFailed(OSError):
     """A Save's writer failed: the message names the file (nothing was moved into place)."""
 
@@ -295,7 +320,7 @@ def sliders_from_pose(pose: npt.ArrayLike, unit: str = "m") -> tuple[dict[str, f
         value = float(getattr(controls, name))
         if name in _TRANSLATIONS:
             value /= metres
-            limit = round(TRANSLATION_RANGE / metres, 1)  # the range the page shows (_on_unit)
+            limit = translation_range(unit)  # the range the page shows (_on_unit)
         else:
             limit = ANGLE_RANGE
         kept = min(max(value, -limit), limit)
@@ -1350,7 +1375,7 @@ class StereoApp:
         st.unit = UNITS[0]
         #: The unit the translation sliders' values are in (they are converted when it changes).
         self._unit = UNITS[0]
-        st.translation_range, st.translation_step = TRANSLATION_RANGE, TRANSLATION_STEP
+        st.translation_range, st.translation_step = translation_range(), TRANSLATION_STEP
         #: The save folder the page offers; left as offered (or emptied), each Save takes the
         #: first of it, ``saved-2``, ``saved-3``, ... that is new or empty.
         #: It is shown relative to the current directory (or ``~/...``), its whole path in the
@@ -2477,10 +2502,13 @@ class StereoApp:
         self._unit = unit
         with self.state:
             st = self.state
-            st.translation_range = round(TRANSLATION_RANGE / UNIT_TO_METRES[unit], 1)
+            st.translation_range = limit = translation_range(unit)
             st.translation_step = TRANSLATION_STEP if unit == "m" else 0.1
             for name in _TRANSLATIONS:
-                st[name] = round(float(st[name]) * factor, 3)
+                # clamped to the range shown: 5 m is 16.404 ft, past the feet sliders' 16.4
+                # (their thumb stuck at the end); the view is kept below
+                value = round(float(st[name]) * factor, 3)
+                st[name] = min(max(value, -limit), limit)
             st.floor_caption = floor_caption(unit)
             if self.view is not None and self._page_before is None:
                 st.depth_caption, st.stats = self.view.texts(unit)
