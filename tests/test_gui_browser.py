@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import base64
+import math
 import os
 import re
 import socket
@@ -478,12 +479,27 @@ def test_the_unit_toggle_keeps_the_translations_inside_the_feet_sliders_range():
     app._apply_camera()
     pose = app.plotter.camera.position
     app._on_unit(unit="ft")
-    assert app.state.translation_range == 16.4
+    assert (app.state.translation_range, app.state.translation_step) == (16.4, 0.1)
     assert (app.state.forward, app.state.up, app.state.right) == (16.4, -16.4, 16.398)
     np.testing.assert_allclose(app.plotter.camera.position, pose, atol=1e-9)  # did not move
     app._on_unit(unit="m")
-    assert app.state.translation_range == 5.0
+    assert (app.state.translation_range, app.state.translation_step) == (5.0, 0.05)
     assert (app.state.forward, app.state.up, app.state.right) == (4.999, -4.999, 4.998)
+
+
+def test_view_texts_say_no_far_end_as_infinity_and_refuse_an_unknown_unit():
+    """The depth caption's far end is infinite when the colours reach no depth: it reads
+    "∞", not "inf ft"; an unknown unit is a ValueError naming it, with or without depths."""
+    from stereovision.gui.app import ViewData
+
+    view = ViewData(
+        None, "", "", "", "", "", None, None, "0.3 s", "", depth_ends=(0.6096, math.inf)
+    )
+    assert view.texts("ft")[0] == "depth: red 2.00\xa0ft … blue ∞"
+    assert view.texts()[0] == "depth: red 0.61\xa0m … blue ∞"
+    for v in (view, ViewData(None, "", "", "", "", "", None, None, "0.3 s", "")):
+        with pytest.raises(ValueError, match="unit: expected one of \\['m', 'ft'\\], got 'yd'"):
+            v.texts("yd")
 
 
 def test_the_max_disparity_field_is_applied_and_checked():
@@ -2007,6 +2023,32 @@ def test_a_save_folder_made_by_someone_else_while_the_save_wrote(tmp_path):
     ]
     assert (folder / "notes.txt").read_text() == "theirs"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["saved"]  # no staging folder left
+
+
+def test_save_all_or_nothing_says_a_failure_in_one_line_with_the_folders_path(tmp_path):
+    """What a failed writer said is told in its first line, its staging path
+    (``.stereovision-partial-...``, a folder the user never saw) written as the folder's; the
+    files written are listed in the write order, not as the writer wrote them."""
+    pytest.importorskip("trame")
+    from stereovision.gui.app import SaveFailed, save_all_or_nothing
+
+    folder = tmp_path / "saved"
+
+    def failing(into: Path) -> None:
+        (into / "disparity.png").write_bytes(b"png")
+        raise OSError(f"cannot write {into / 'depth.png'}\nsecond line of the reason")
+
+    with pytest.raises(SaveFailed) as info:
+        save_all_or_nothing(failing, folder)
+    assert str(info.value) == f"depth.png could not be written (cannot write {folder}/depth.png)"
+    assert not folder.exists() and sorted(p.name for p in tmp_path.iterdir()) == []
+
+    def backwards(into: Path) -> None:
+        for name in ("overview.png", "depth.png", "disparity.png"):
+            (into / name).write_bytes(b"x")
+
+    written = save_all_or_nothing(backwards, folder)
+    assert list(written) == ["disparity.png", "depth.png", "overview.png"]  # SAVE_WRITE_ORDER's
 
 
 def test_a_save_whose_writer_fails_leaves_no_partial_folder_and_names_the_file(
