@@ -2661,6 +2661,32 @@ def test_the_max_disparity_hint_says_full_size_and_the_processing_width():
     assert app.state.max_disp_hint == f"auto: {auto} px at full size"
 
 
+def test_the_max_disparity_field_and_the_overview_name_edge_values():
+    """At full processing width the hint says the full-size range once (no "(64 at 450)"),
+    "auto" is read in any case, as the field's hint writes it, and a pair with no label is
+    called "pair" in a saved overview's title."""
+    from stereovision.gui.app import max_disparity_hint, overview_name, parse_max_disparity
+
+    assert max_disparity_hint(64, 450, 450) == "auto: 64 px at full size"
+    assert max_disparity_hint(None, 450, 320) == "auto: estimated from the images"
+    assert [parse_max_disparity(t, 450) for t in ("AUTO", "Auto", " 63 ")] == [None, None, 63]
+    assert overview_name("  ") == "pair"
+
+
+def test_the_progress_plan_names_only_the_stages_depth_map_runs():
+    """The status's stages are those ``depth_map`` runs for the method: gabor re-measures and
+    fills nothing, the dense methods fill (fast does not re-measure), and nothing is
+    triangulated without a calibration."""
+    from stereovision.gui.app import _planned_stages
+
+    base = ["rectify", "prepare", "match"]
+    assert _planned_stages("gabor", False) == [*base, "refine"]
+    assert _planned_stages("gabor", True) == [*base, "refine", "triangulate"]
+    assert _planned_stages("fused", True) == [*base, "fill", "triangulate"]
+    assert _planned_stages("census", False) == [*base, "fill"]
+    assert _planned_stages("fast", False) == [*base, "fill"]
+
+
 @pytest.mark.parametrize("method", ["mcgm", "hopfield"])
 def test_the_sparse_channels_are_offered_and_their_matches_drawn(method):
     """The page offered fused, gabor, census, fast and the OpenCV references: MCGM and Hopfield,
