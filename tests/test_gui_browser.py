@@ -1941,26 +1941,14 @@ def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkey
     assert not list(tmp_path.glob(".stereovision-partial-*"))
 
 
-def test_a_failed_save_of_a_pair_without_depth_names_the_file_that_failed(tmp_path, monkeypatch):
-    """A pair without a calibration: its Save writes disparity.png, disparity.pfm and
-    overview.png. One that failed at disparity.pfm or overview.png said "depth.png could not
-    be written", the first file of the full write order not written, a file that Save never
-    writes; it names the file that failed."""
+def _disk_full_at(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """Make ``stereovision.io.atomic_write`` fail as a full disk does (ENOSPC) for the file
+    whose name is the returned list's one item (set it before each Save; "" fails none)."""
     import contextlib
     import errno
-    import shutil
 
     import stereovision.io as svio
-    from stereovision.gui import bundled_data_dir
 
-    scene = tmp_path / "cones-uncalibrated"
-    scene.mkdir()
-    for side in ("left", "right"):
-        shutil.copy(bundled_data_dir() / "cones" / f"{side}.png", scene / f"{side}.png")
-    app = _scene_app("test-save-without-depth", [tmp_path])
-    app._load_scene(scene)
-    _run(app, app.recompute)
-    assert app.view.result.depth is None
     real = svio.atomic_write
     failing = [""]
 
@@ -1972,6 +1960,27 @@ def test_a_failed_save_of_a_pair_without_depth_names_the_file_that_failed(tmp_pa
             yield fh
 
     monkeypatch.setattr(svio, "atomic_write", full_disk)
+    return failing
+
+
+def test_a_failed_save_of_a_pair_without_depth_names_the_file_that_failed(tmp_path, monkeypatch):
+    """A pair without a calibration: its Save writes disparity.png, disparity.pfm and
+    overview.png. One that failed at disparity.pfm or overview.png said "depth.png could not
+    be written", the first file of the full write order not written, a file that Save never
+    writes; it names the file that failed."""
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    scene = tmp_path / "cones-uncalibrated"
+    scene.mkdir()
+    for side in ("left", "right"):
+        shutil.copy(bundled_data_dir() / "cones" / f"{side}.png", scene / f"{side}.png")
+    app = _scene_app("test-save-without-depth", [tmp_path])
+    app._load_scene(scene)
+    _run(app, app.recompute)
+    assert app.view.result.depth is None
+    failing = _disk_full_at(monkeypatch)
     for name in ("disparity.png", "disparity.pfm", "overview.png"):
         failing[0] = name
         app.state.save_dir = app._offered_save_dir
@@ -2058,10 +2067,7 @@ def test_a_save_whose_writer_fails_leaves_no_partial_folder_and_names_the_file(
     left a partial set there. A Save is now all or nothing: written into a staging folder and
     moved into place once every file is; a failure leaves the folder as it was (absent when it
     was), no staging folder behind, and the Save's line names the file that failed."""
-    import contextlib
-    import errno
 
-    import stereovision.io as svio
     from stereovision.gui import bundled_data_dir
     from stereovision.gui.app import SAVE_WRITE_ORDER, SAVED_DEPTH_FILES, SAVED_FILES
 
@@ -2069,17 +2075,7 @@ def test_a_save_whose_writer_fails_leaves_no_partial_folder_and_names_the_file(
     app = _scene_app("test-save-all-or-nothing", [bundled_data_dir(), tmp_path])
     app._load_scene(bundled_data_dir() / "cones")
     _run(app, app.recompute)
-    real = svio.atomic_write
-    failing = [""]
-
-    @contextlib.contextmanager
-    def full_disk(path, mode="wb"):
-        if Path(path).name == failing[0]:
-            raise OSError(errno.ENOSPC, "No space left on device")
-        with real(path, mode) as fh:
-            yield fh
-
-    monkeypatch.setattr(svio, "atomic_write", full_disk)
+    failing = _disk_full_at(monkeypatch)
     (tmp_path / "mine").mkdir()
     (tmp_path / "mine" / "notes.txt").write_text("mine")
     for name in SAVE_WRITE_ORDER:
