@@ -7,6 +7,8 @@ a rectified rig with focal ``F`` px and baseline ``B`` m.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from stereovision.calibration import Calibration
@@ -71,3 +73,20 @@ def depth_result(seed: int = 0) -> DepthResult:
         calibration=calibration(),
         left_rectified=left,
     )
+
+
+def narrow_scene(folder: Path, height: int = 3, width: int = 8) -> Path:
+    """A scene folder ``folder/tiny`` (left.png, right.png 2 px apart, gt_disp.pfm of 2 px)
+    of ``width`` px: too narrow for evaluation.md's range of 16 px at least."""
+    import cv2
+
+    from stereovision.io import write_pfm
+
+    rng = np.random.default_rng(0)
+    row = (rng.random((height, width + 2)) * 255).astype(np.uint8)
+    scene = folder / "tiny"
+    scene.mkdir()
+    cv2.imwrite(str(scene / "left.png"), row[:, :width])
+    cv2.imwrite(str(scene / "right.png"), row[:, 2:])
+    write_pfm(scene / "gt_disp.pfm", np.full((height, width), 2.0, np.float32))
+    return scene

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import synthetic_scene as syn
 
 from stereovision import baselines
 from stereovision.bench import bench_scene, format_table, sparse_name
@@ -136,17 +137,8 @@ def test_bench_of_a_scene_narrower_than_its_range_names_the_width_needed(
     ...; give a max_disparity below 8", a range nobody gave and an option bench does not have,
     naming no scene; eval says it in the scene's words (evaluation.md's range), and so does
     bench now."""
-    import cv2
 
-    from stereovision.io import write_pfm
-
-    rng = np.random.default_rng(0)
-    row = (rng.random((3, 10)) * 255).astype(np.uint8)
-    scene = tmp_path / "tiny"
-    scene.mkdir()
-    cv2.imwrite(str(scene / "left.png"), row[:, :8])
-    cv2.imwrite(str(scene / "right.png"), row[:, 2:])
-    write_pfm(scene / "gt_disp.pfm", np.full((3, 8), 2.0, np.float32))
+    scene = syn.narrow_scene(tmp_path)
     assert main(["bench", str(scene)]) == 2
     cap = capsys.readouterr()
     assert cap.out == ""

@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+import synthetic_scene as syn
 
 from stereovision.cli import main
 
@@ -226,17 +227,8 @@ def test_eval_of_a_scene_narrower_than_its_range_names_the_width_needed(
     """A scene at most 16 px wide: its range (evaluation.md's, 16 at least) was named as if
     given ("disparity range 16 is not smaller than the image width 8"); the error names the
     images' width and the width a scene needs, one line, nothing on stdout."""
-    import cv2
 
-    from stereovision.io import write_pfm
-
-    rng = np.random.default_rng(0)
-    row = (rng.random((height, width + 2)) * 255).astype(np.uint8)
-    scene = tmp_path / "tiny"
-    scene.mkdir()
-    cv2.imwrite(str(scene / "left.png"), row[:, :width])
-    cv2.imwrite(str(scene / "right.png"), row[:, 2:])
-    write_pfm(scene / "gt_disp.pfm", np.full((height, width), 2.0, np.float32))
+    scene = syn.narrow_scene(tmp_path, height, width)
     proc = _eval(str(scene), "--no-opencv", "--method", "fast")
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr.splitlines() == [

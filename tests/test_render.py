@@ -911,15 +911,8 @@ def test_view_of_a_scene_narrower_than_its_range_names_the_width_needed(tmp_path
     """``view SCENE`` of a scene 8 px wide said "disparity range 16 is not smaller than the
     image width 8 ...; give a max_disparity below 8": a range nobody gave, an option view has
     not. It says it as eval and bench do (the scene's range, evaluation.md's rule)."""
-    from stereovision.io import write_pfm
 
-    rng = np.random.default_rng(0)
-    row = (rng.random((3, 10)) * 255).astype(np.uint8)
-    scene = tmp_path / "tiny"
-    scene.mkdir()
-    cv2.imwrite(str(scene / "left.png"), row[:, :8])
-    cv2.imwrite(str(scene / "right.png"), row[:, 2:])
-    write_pfm(scene / "gt_disp.pfm", np.full((3, 8), 2.0, np.float32))
+    scene = syn.narrow_scene(tmp_path)
     (scene / "calib.txt").write_text(
         "cam0=[10 0 4; 0 10 1.5; 0 0 1]\ncam1=[10 0 4; 0 10 1.5; 0 0 1]\ndoffs=0\n"
         "baseline=100\nwidth=8\nheight=3\nndisp=16\n"
