@@ -495,3 +495,104 @@ def test_count_at_precision_keeps_the_given_order_among_equal_scores() -> None:
     hits = list(itertools.accumulate(int(good[i]) for i in order))
     want = max(k for k in range(1, n + 1) if 100.0 * hits[k - 1] / k >= 75.0)
     assert count_at_precision(zeros, zeros, xr, score, np.ones((1, 1)), 75.0) == want
+
+
+# ------------------------------------------- mutation audit, second round (each failed on a
+# one-line bug in evaluate.py that every test above passed)
+
+
+def test_dense_metrics_counts_an_infinite_estimate_as_a_hole() -> None:
+    # the module's rule: an estimate is missing when not finite; an inf read as an estimate
+    # raised the density and made avgerr and rms inf
+    gt = np.array([[4.0, 4.0, 4.0]])
+    m = dense_metrics(np.array([[4.5, INF, -INF]]), gt)
+    assert (m.n_gt, m.n_both) == (3, 1)
+    assert m.density == pytest.approx(100 / 3)
+    assert (m.avgerr, m.rms) == (0.5, 0.5)
+    assert m.bad[2.0] == pytest.approx(200 / 3)
+
+
+def test_dense_metrics_refuses_bytes_for_thresholds() -> None:
+    # b"12" iterates as the integers 49 and 50: read, it gave bad-49 and bad-50 figures
+    disp = np.zeros((2, 2))
+    with pytest.raises(ValueError, match=r"^thresholds must be positive and finite, got b'12'$"):
+        dense_metrics(disp, disp, thresholds=b"12")  # type: ignore[arg-type]
+
+
+def test_depth_metrics_density_without_overlap_is_zero_percent() -> None:
+    # no pixel with both depths: 0 % of the pixels, a figure, not an unknown (NaN)
+    m = depth_metrics(np.full((2, 3), NAN), np.ones((2, 3)))
+    assert m.n == 0 and m.density == 0.0
+    assert all(math.isnan(v) for v in (m.median_rel, m.share_off_5, m.rmse_pct, m.rmse))
+
+
+@pytest.mark.parametrize("point", [[0, -1], [-1, 0]])
+def test_table1_report_refuses_a_negative_point(point: list[int]) -> None:
+    # -1 indexed the last row or column: a point of the far edge measured without a word
+    ones = np.ones((3, 3))
+    with pytest.raises(ValueError, match=re.escape(f"points: [{point}] lie outside the 3x3")):
+        table1_report(ones, ones, points=np.array([point]))
+
+
+def test_table1_report_refuses_float_points() -> None:
+    ones = np.ones((3, 3))
+    with pytest.raises(ValueError, match=r"^points: expected a non-empty integer \(N, 2\)"):
+        table1_report(ones, ones, points=np.array([[1.0, 0.0]]))
+
+
+def test_table1_summary_in_metres_and_feet() -> None:
+    # 10 ft and 20 ft measured, 11 ft and 18 ft true: errors -1 and +2 ft, so the average
+    # error (+0.5 ft) differs from the mean |error| (1.5 ft); RMSE sqrt(2.5) = 1.581 ft
+    ft = 0.3048
+    r = table1_report(
+        np.array([[10 * ft, 20 * ft]]),
+        np.array([[11 * ft, 18 * ft]]),
+        points=np.array([[0, 0], [1, 0]]),
+    )
+    d = r.as_dict()
+    assert d["mean_error_m"] == pytest.approx(0.5 * ft)
+    assert d["mean_error_ft"] == pytest.approx(0.5)
+    assert d["mean_abs_error_ft"] == pytest.approx(1.5)
+    assert d["mean_distance_m"] == pytest.approx(14.5 * ft)
+    assert d["mean_distance_ft"] == pytest.approx(14.5)
+    assert d["rmse_ft"] == pytest.approx(math.sqrt(2.5))
+    assert d["rmse_pct"] == pytest.approx(100 * math.sqrt(2.5) / 14.5)
+    assert r.format().splitlines()[-3:] == [
+        "points: 2   mean distance: 4.420 m (14.500 ft)",
+        "average error: +0.152 m (+0.500 ft)   mean |error|: 0.457 m (1.500 ft)",
+        "RMSE: 0.482 m (1.581 ft) = 10.90 % of the mean distance",
+    ]
+
+
+def test_sparse_metrics_rounds_half_to_even() -> None:
+    # the documented look-up: (2.5, 0.5) -> (2, 0), (3.5, 0) -> (4, 0); half up gave (3, 1)
+    # and (4, 0), one match on unknown GT
+    gt = np.full((2, 6), NAN)
+    gt[0, 2] = gt[0, 4] = 1.0
+    xl = np.array([2.5, 3.5])
+    m = sparse_metrics(xl, np.array([0.5, 0.0]), xl - 1.0, gt)
+    assert m.count == 2 and m.precision[0.5] == 100.0 and m.coverage == 2
+
+
+def test_count_at_precision_edges_of_the_target() -> None:
+    gt = np.full((2, 8), 5.0)
+    xl = np.arange(6.0) + 1
+    yl = np.ones(6)
+    score = -np.arange(6.0)  # best first: the given order
+    right = np.array([1, 1, 1, 1, 1, 0], bool)
+    xr = xl - np.where(right, 5.0, 9.0)
+    # prefix precisions 100 x 5, then 5/6; a target of 5/6*100 (83.33333333333334) is the
+    # 6-prefix's 100*5/6 (83.33333333333333) up to rounding, and holds it
+    assert count_at_precision(xl, yl, xr, score, gt, 5 / 6 * 100) == 6
+    # target 0 keeps every match with GT; the range is 0 to 100
+    assert count_at_precision(xl, yl, xr, score, gt, 0) == 6
+    # no prefix qualifies (the best-scored match is wrong): 0, not all of them
+    assert count_at_precision(xl, yl, xr, -score, gt, 100.0) == 0
+
+
+def test_count_at_precision_leaves_out_a_match_without_a_right_column() -> None:
+    # the best-scored match has no right column (NaN): it is no match, not a wrong one
+    gt = np.full((2, 4), 5.0)
+    xl = np.array([1.0, 2.0])
+    xr = np.array([NAN, 2.0 - 5.0])
+    assert count_at_precision(xl, np.ones(2), xr, np.array([0.9, 0.5]), gt, 100.0) == 1
