@@ -596,3 +596,39 @@ def test_count_at_precision_leaves_out_a_match_without_a_right_column() -> None:
     xl = np.array([1.0, 2.0])
     xr = np.array([NAN, 2.0 - 5.0])
     assert count_at_precision(xl, np.ones(2), xr, np.array([0.9, 0.5]), gt, 100.0) == 1
+
+
+def test_depth_metrics_refuses_a_bool_map() -> None:
+    # a validity mask passed for a depth map was read as depths of 1 and 0
+    with pytest.raises(ValueError, match=r"^depth maps must be real arrays, got bool and float64"):
+        depth_metrics(np.ones((2, 2), bool), np.ones((2, 2)))
+
+
+def test_dense_metrics_refuses_a_mask_of_another_shape() -> None:
+    # a one-row mask was broadcast over every row, without a word
+    gt = np.ones((2, 3))
+    with pytest.raises(ValueError, match=r"^mask and gt must have the same shape, got \(1, 3\)"):
+        dense_metrics(gt, gt, mask=np.ones((1, 3), bool))
+
+
+def test_dense_metrics_a_gt_of_zero_is_known() -> None:
+    # evaluation.md: unknown GT is inf or NaN (KITTI's 0 is converted when the scene is made);
+    # a 0 px GT (a far point) counts: a hole there is an error
+    gt = np.array([[0.0, 0.0, 2.0]])
+    m = dense_metrics(np.array([[0.0, NAN, 2.0]]), gt)
+    assert (m.n_gt, m.n_both) == (3, 2)
+    assert m.bad[0.5] == pytest.approx(100 / 3)
+
+
+def test_metrics_dicts_carry_each_figure_under_its_own_name() -> None:
+    gt = np.array([[10.0, 10.0, 10.0]])
+    m = dense_metrics(np.array([[11.0, 13.0, NAN]]), gt)  # errors 1 and 3
+    d = m.as_dict()
+    assert (d["avgerr"], d["rms"]) == (2.0, math.sqrt(5.0))
+    assert (d["n_gt"], d["n_both"]) == (3, 2)
+    s = sparse_metrics([0.0, 1.0, 2.0], [0.0, 0.0, 0.0], [-9.0, 0.0, NAN], np.ones((1, 3)))
+    assert {k: s.as_dict()[k] for k in ("count", "n_matches", "coverage")} == {
+        "count": 2,
+        "n_matches": 3,
+        "coverage": 2,
+    }
