@@ -632,3 +632,14 @@ def test_metrics_dicts_carry_each_figure_under_its_own_name() -> None:
         "n_matches": 3,
         "coverage": 2,
     }
+
+
+@pytest.mark.parametrize("shape", [(0, 3), (3, 0)])
+def test_sparse_metrics_on_an_empty_gt_counts_no_match(shape: tuple[int, int]) -> None:
+    # every match lies outside an empty map, as in count_at_precision and dense_metrics (no
+    # figure, NaN precision); the look-up at (0, 0) put in for them was an IndexError
+    gt = np.zeros(shape)
+    m = sparse_metrics([1.0, 2.0], [1.0, 0.0], [0.0, 1.0], gt)
+    assert (m.count, m.n_matches, m.coverage) == (0, 2, 0)
+    assert all(math.isnan(v) for v in m.precision.values())
+    assert count_at_precision([1.0], [1.0], [0.0], [1.0], gt, 50.0) == 0

@@ -627,7 +627,9 @@ def sparse_metrics(
         inside = np.isfinite(x2) & (xi >= 0) & (xi < w) & (yi >= 0) & (yi < h)
     xi = np.where(inside, xi, 0).astype(np.int64)
     yi = np.where(inside, yi, 0).astype(np.int64)
-    gv = np.where(inside, g[yi, xi], np.nan)
+    # only the matches inside are looked up (an empty map has no (0, 0) to stand in for the rest)
+    gv = np.full(len(x), np.nan)
+    gv[inside] = g[yi[inside], xi[inside]]
     has_gt = np.isfinite(gv)
     count = int(has_gt.sum())
     err = np.abs((x - x2)[has_gt] - gv[has_gt])
