@@ -643,3 +643,30 @@ def test_sparse_metrics_on_an_empty_gt_counts_no_match(shape: tuple[int, int]) -
     assert (m.count, m.n_matches, m.coverage) == (0, 2, 0)
     assert all(math.isnan(v) for v in m.precision.values())
     assert count_at_precision([1.0], [1.0], [0.0], [1.0], gt, 50.0) == 0
+
+
+def test_maps_must_be_real_arrays() -> None:
+    # a bool mask passed for a disparity or GT distance map was read as 1 and 0 px (or m)
+    ones = np.ones((2, 2))
+    with pytest.raises(
+        ValueError, match=r"^disparity: expected a real \(H, W\) array, got .* bool"
+    ):
+        dense_metrics(ones > 0, ones)
+    with pytest.raises(ValueError, match=r"^gt: expected a real \(H, W\) array, got .* bool"):
+        table1_report(ones, ones > 0)
+
+
+def test_table1_report_refuses_a_bool_seed() -> None:
+    ones = np.ones((3, 3))
+    with pytest.raises(ValueError, match=r"^seed must be an integer >= 0 or None, got True"):
+        table1_report(ones, ones, seed=True)
+
+
+def test_match_coordinates_must_be_1d() -> None:
+    # a (1, N) row of matches was read as N matches in sparse_metrics, count_at_precision
+    row = np.array([[1.0, 2.0]])
+    gt = np.ones((4, 4))
+    with pytest.raises(ValueError, match=r"^xl, yl, xr: expected 1-D arrays of equal length"):
+        sparse_metrics(row, row, row - 1, gt)
+    with pytest.raises(ValueError, match=r"^xl, yl, xr, score: expected 1-D arrays of equal len"):
+        count_at_precision(row, row, row - 1, row, gt, 50.0)
