@@ -265,6 +265,16 @@ def test_depth_from_disparity_hand_computed() -> None:
         depth_from_disparity(np.zeros(3), c)
 
 
+def test_depth_from_disparity_refuses_a_bool_map() -> None:
+    # a validity mask passed for the disparity was read as 1 px and 0 px: 700 px * 0.12 m / 7 px
+    # and / 6 px, depths where nothing was measured (gt_depth, the Table-1 GT, reads through it)
+    c = rect_calib(doffs=6.0)
+    with pytest.raises(
+        ValueError, match=r"^disparity: expected a real \(H, W\) array, got .* bool"
+    ):
+        depth_from_disparity(np.ones((2, 2), bool), c)
+
+
 def test_a_map_of_the_pair_resized_is_warned_about() -> None:
     """A half-size map read with the full-size calibration gave twice the depths, silently."""
     c = rect_calib(doffs=12.5)  # 640x480, f 700 px, B 0.12 m
