@@ -372,15 +372,35 @@ def test_a_huge_finite_range_is_named_outside_the_kernels_int32(name: str, value
 
 def test_a_one_level_range_and_the_p2_width() -> None:
     """max_disparity == min_disparity is a one-level search, not an error; p2 past the kernel's
-    u16 (65536) is refused naming it, not an OverflowError from the binding (the kernel itself
-    takes up to 4000)."""
+    u16 (65536) is refused naming the kernel's real limit (4000), not an OverflowError from the
+    binding."""
     img = np.random.default_rng(0).random((40, 60)).astype(np.float32)
     shifted = np.roll(img, -3, axis=1)
     d = sgm_disparity(img, shifted, max_disparity=3, min_disparity=3)
     assert np.nanmin(d) >= 2.5 and np.nanmax(d) <= 3.5 and np.isfinite(d[:, 10:]).mean() > 0.5
     assert sgm_disparity(img, shifted, max_disparity=8, p2=4000).shape == img.shape
-    with pytest.raises(ValueError, match=r"^p2: expected an integer in \[0, 65535\], got 65536"):
+    with pytest.raises(ValueError, match=r"^p2: expected an integer in \[2, 4000\], got 65536"):
         sgm_disparity(img, shifted, max_disparity=8, p2=2**16)
+
+
+def test_p1_p2_are_refused_with_the_kernels_limits() -> None:
+    """p2 4001..65535 passed the Python check and came back as the kernel's own message
+    ("invalid parameter `p2`: expected at most 4000"); one check names each range, and
+    0 < p1 < p2 as p1's."""
+    img = np.random.default_rng(0).random((30, 40)).astype(np.float32)
+    bad = (
+        ({"p2": 4001}, r"^p2: expected an integer in \[2, 4000\], got 4001$"),
+        ({"p2": 65535}, r"^p2: expected an integer in \[2, 4000\], got 65535$"),
+        ({"p2": 1}, r"^p2: expected an integer in \[2, 4000\], got 1$"),
+        ({"p1": 0}, r"^p1: expected an integer in \[1, 3999\], got 0$"),
+        ({"p1": 4000}, r"^p1: expected an integer in \[1, 3999\], got 4000$"),
+        ({"p1": 96}, r"^p1: expected p1 < p2, got p1 = 96, p2 = 96$"),
+        ({"p1": 100, "p2": 50}, r"^p1: expected p1 < p2, got p1 = 100, p2 = 50$"),
+    )
+    for kw, msg in bad:
+        with pytest.raises(ValueError, match=msg):
+            sgm_disparity(img, img, max_disparity=8, **kw)
+    assert sgm_disparity(img, img, max_disparity=8, p1=3999, p2=4000).shape == img.shape
 
 
 def test_memory_kept_from_the_last_call_counts_as_available(
@@ -410,7 +430,7 @@ def test_the_range_reaches_the_kernel_rounded_outwards() -> None:
         want = sgm_disparity(img, sh, min_disparity=whole[0], max_disparity=whole[1])
         assert np.isfinite(want[:, 10:]).mean() > 0.5
         np.testing.assert_array_equal(got, want)
-    with pytest.raises(ValueError, match=r"^p1: expected an integer in \[0, 65535\], got True"):
+    with pytest.raises(ValueError, match=r"^p1: expected an integer in \[1, 3999\], got True"):
         sgm_disparity(img, img, max_disparity=8, p1=True)
 
 

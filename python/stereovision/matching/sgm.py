@@ -48,6 +48,9 @@ _BYTES_PER_CELL = 3
 # path, one is being filled and one selected; the census codes take 16 bytes a pixel.
 _ROWS_IN_FLIGHT_3 = 8 + 3
 _MAX_LEVELS = 2048  # the kernel's limit
+# The kernel's P2 limit (`MAX_P2` in sgm.rs: eight path costs of OUTSIDE + p2 fit a u16 sum); it
+# also wants 0 < p1 < p2, so p1 is at most MAX_P2 - 1 and p2 at least 2.
+_MAX_P2 = 4000
 _I32_LIMIT = 2**31 - 1  # |min_disparity|, |max_disparity| below it: the kernel's i32 levels
 
 
@@ -173,17 +176,20 @@ def sgm_disparity(
         raise ValueError(
             f"max_disparity ({max_disparity}) is smaller than min_disparity ({min_disparity})"
         )
-    # The kernel's integer widths: P1/P2 are u16, the rest u32.
-    for name, top in (
-        ("p1", 2**16 - 1),
-        ("p2", 2**16 - 1),
-        ("uniqueness", 2**32 - 1),
-        ("lr_tol", 2**32 - 1),
-        ("edge_margin", 2**32 - 1),
+    # P1/P2: the kernel's own limits (named here, not as its "invalid parameter `p2`"); the
+    # rest: the kernel's u32 widths.
+    for name, bottom, top in (
+        ("p1", 1, _MAX_P2 - 1),
+        ("p2", 2, _MAX_P2),
+        ("uniqueness", 0, 2**32 - 1),
+        ("lr_tol", 0, 2**32 - 1),
+        ("edge_margin", 0, 2**32 - 1),
     ):
         v = p[name]
-        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not 0 <= v <= top:
-            raise ValueError(f"{name}: expected an integer in [0, {top}], got {v!r}")
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not bottom <= v <= top:
+            raise ValueError(f"{name}: expected an integer in [{bottom}, {top}], got {v!r}")
+    if p["p1"] >= p["p2"]:
+        raise ValueError(f"p1: expected p1 < p2, got p1 = {p['p1']}, p2 = {p['p2']}")
     if isinstance(p["paths"], bool) or p["paths"] not in (3, 8):
         raise ValueError(f"paths: expected 8 or 3, got {p['paths']!r}")
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
