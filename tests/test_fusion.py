@@ -224,6 +224,24 @@ def test_fused_dense_veto_replace_and_fill() -> None:
     np.testing.assert_array_equal(same, d)
 
 
+def test_second_confidence_zero_is_refused() -> None:
+    """Confidence 0 marks a filled disparity (depth_counts' "filled", point_image(filled=True)):
+    second_confidence=0 gave every census-only pixel that mark (on eth3d/terrace, method="census":
+    278214 pixels with a depth and confidence 0, none at 0.5), so it is refused; 1 is allowed."""
+    import re
+
+    d = np.full((H, W), np.nan, np.float32)
+    none = np.full((H, W), np.nan, np.float32)
+    second = np.full((H, W), 7.0, np.float32)
+    for bad in (0.0, -0.5, 1.5):
+        says = re.escape(f"second_confidence: expected a value in (0, 1], got {bad}")
+        with pytest.raises(ValueError, match=f"^{says}$"):
+            fused_dense(d, d, none, second=second, second_confidence=bad)
+    out, conf = fused_dense(d, d, none, second=second, second_confidence=1.0, speckle_area=0.0)
+    np.testing.assert_array_equal(out, second)
+    np.testing.assert_array_equal(conf, np.ones((H, W), np.float32))
+
+
 def test_nearest_member_labels_are_row_major() -> None:
     """The nearest-member map agrees with a brute-force search (OpenCV's label order)."""
     from stereovision.matching.fusion import _nearest_member

@@ -230,6 +230,8 @@ def test_census_mode_rejects_unknown_options() -> None:
         sv.depth_map(img, img, max_disparity=8, method="census", radius=3.0)
     with pytest.raises(ValueError, match="second_confidence"):
         sv.depth_map(img, img, max_disparity=8, method="census", second_confidence=2.0)
+    with pytest.raises(ValueError, match=r"^second_confidence: expected a value in \(0, 1\]"):
+        sv.depth_map(img, img, max_disparity=8, method="census", second_confidence=0)
     r = sv.depth_map(img, np.roll(img, -3, axis=1), max_disparity=8, method="census", p2=120)
     assert abs(float(np.nanmedian(r.disparity[:, 10:])) - 3.0) < 0.05
 

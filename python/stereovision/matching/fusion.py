@@ -893,7 +893,8 @@ def fused_dense(
     Raises
     ------
     ValueError
-        Maps of different shapes, or a non-positive radius / tolerance.
+        Maps of different shapes, a negative radius / tolerance, ``fill_confidence`` outside
+        [0, 1] or ``second_confidence`` outside (0, 1] (0 is the filled pixels' mark).
     """
     d = _check_map(disparity, "disparity", None)
     shape = (int(d.shape[0]), int(d.shape[1]))
@@ -914,9 +915,12 @@ def fused_dense(
     ):
         if finite_number(v, name) < 0:
             raise ValueError(f"{name}: expected a non-negative number, got {v}")
-    for name, v in (("fill_confidence", fill_confidence), ("second_confidence", second_confidence)):
-        if not 0 <= v <= 1:
-            raise ValueError(f"{name}: expected a value in [0, 1], got {v}")
+    if not 0 <= fill_confidence <= 1:
+        raise ValueError(f"fill_confidence: expected a value in [0, 1], got {fill_confidence}")
+    # Confidence 0 marks a filled disparity (DepthResult.depth_counts, point_image(filled=True)):
+    # 0 here would mark every pixel only the census map measured as filled.
+    if not 0 < second_confidence <= 1:
+        raise ValueError(f"second_confidence: expected a value in (0, 1], got {second_confidence}")
     out = d.copy()
     conf = np.where(np.isfinite(d), c, 0.0).astype(np.float32)
     has = np.isfinite(a)
