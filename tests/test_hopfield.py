@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import re
+from collections.abc import Callable
 from pathlib import Path
 
 import cv2
@@ -459,3 +460,27 @@ def test_the_range_is_rounded_outwards_and_one_level_is_searched() -> None:
     ):
         with pytest.raises(ValueError, match="^" + says):
             hp.interest_points(left, **kw)
+
+
+@pytest.mark.parametrize("run", [hp.hopfield_match, hp.best_match])
+def test_direct_call_refuses_an_unreachable_range_as_match_does(
+    run: Callable[..., sv.Matches],
+) -> None:
+    """min_disparity at the width or above: no pixel has a match there. match() refused it; the
+    direct call returned 0 matches without a word. Both now raise match()'s ValueError."""
+    rng = np.random.default_rng(0)
+    left = rng.random((60, 80), dtype=np.float32)
+    right = np.roll(left, -5, axis=1)
+    method = "hopfield" if run is hp.hopfield_match else "best"
+    for lo in (80, 81.5, 10**400):
+        with pytest.raises(ValueError) as want:
+            sv.match(left, right, method=method, max_disparity=lo, min_disparity=lo)
+        assert str(want.value).startswith("min_disparity (")
+        with pytest.raises(ValueError, match=f"^{re.escape(str(want.value))}$"):
+            run(left, right, max_disparity=lo, min_disparity=lo)
+    # 8-bit frames take the kernel's own grey conversion: the same refusal
+    l8, r8 = ((255 * im).astype(np.uint8) for im in (left, right))
+    with pytest.raises(ValueError, match=r"^min_disparity \(80\) is not below the image width 80"):
+        run(l8, r8, max_disparity=80, min_disparity=80)
+    # one column short of the width is searched: nothing there, 0 matches and no error
+    assert len(run(left, right, max_disparity=79, min_disparity=79, min_agree=0)) == 0

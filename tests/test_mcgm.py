@@ -720,3 +720,19 @@ def test_mcgm_range_rounding_negative_values_debug_and_the_last_row() -> None:
     below[0, [1, 3]] += 0.25
     with pytest.raises(ValueError, match=r"^matches: 1 of 1 rows lie outside the 80x48 images"):
         mcgm.edge_filters(left, right, below, max_disparity=8)
+
+
+def test_direct_call_refuses_an_unreachable_range_as_match_does() -> None:
+    """min_disparity at the width or above: no pixel has a match there. match() refused it;
+    mcgm_match returned 0 matches without a word. It now raises match()'s ValueError."""
+    rng = np.random.default_rng(0)
+    left = rng.random((60, 80), dtype=np.float32)
+    right = np.roll(left, -5, axis=1)
+    for lo in (80, 81.5, 10**400):
+        with pytest.raises(ValueError) as want:
+            sv.match(left, right, method="mcgm", max_disparity=lo, min_disparity=lo)
+        assert str(want.value).startswith("min_disparity (")
+        with pytest.raises(ValueError, match=f"^{re.escape(str(want.value))}$"):
+            mcgm.mcgm_match(left, right, max_disparity=lo, min_disparity=lo)
+    # one column short of the width is searched: nothing there, 0 matches and no error
+    assert len(mcgm.mcgm_match(left, right, max_disparity=79, min_disparity=79)) == 0

@@ -328,8 +328,9 @@ def mcgm_match(
     Raises
     ------
     ValueError
-        Bad images (shape, dtype, empty, NaN, mismatched sizes), an unknown parameter or a value
-        out of range.
+        Bad images (shape, dtype, empty, NaN, mismatched sizes), an unknown parameter, a value
+        out of range, or a ``min_disparity`` not below the image width (as
+        :func:`stereovision.match`: no pixel has a match that far).
     MemoryError
         When an image-sized buffer of the kernel cannot be allocated (the message names it and
         its size); the process is not aborted.
@@ -346,6 +347,13 @@ def mcgm_match(
     """
     gl, gr = check_pair(left, right)
     kw = _params(max_disparity, min_disparity, params)
+    # match()'s ValueError for a range no pixel can match in (the kernel clipped it to the
+    # image and returned 0 matches without a word); depth imports the matchers, hence here
+    from stereovision.depth import _unreachable_range
+
+    err = _unreachable_range(min_disparity, max_disparity, gl.shape[1])
+    if err is not None:
+        raise err
     m, stats, chans = _core.mcgm_match(gl, gr, kw)
     st: dict[str, Any] = dict(stats)
     st["channel"] = m[:, 5].astype(np.int64)
