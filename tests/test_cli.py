@@ -1639,3 +1639,102 @@ def test_depth_with_a_folder_under_an_output_name_moves_nothing(
     assert err.count("\n") == 1 and f"{out / 'overview.png'} is a folder" in err, err
     assert (out / "disparity.png").read_bytes() == b"earlier"
     assert not (out / "disparity.pfm").exists()
+
+
+def _tsukuba_depth_argv(data_dir: Path, out: Path) -> list[str]:
+    tsukuba = data_dir / "middlebury2001" / "tsukuba"
+    argv = ["depth", str(tsukuba / "left.png"), str(tsukuba / "right.png"), "-o", str(out)]
+    return [*argv, "--method", "fast", "--max-disparity", "16"]
+
+
+def test_depth_failing_while_staging_removes_only_the_folders_it_made(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A writer failing inside the staging folder: the -o folders the run made (new/sub) are
+    removed again, empty; an -o folder that was there before is kept, as it was (empty)."""
+    from stereovision import cli
+
+    def no_room(*_: object, **__: object) -> dict[str, Path]:
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(cli, "write_overview", no_room)
+    made = tmp_path / "new" / "sub"
+    assert main(_tsukuba_depth_argv(data_dir, made)) == 2
+    assert capsys.readouterr().err == "stereovision: error: [Errno 28] No space left on device\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    there = tmp_path / "there"
+    there.mkdir()
+    assert main(_tsukuba_depth_argv(data_dir, there)) == 2
+    assert there.is_dir() and list(there.iterdir()) == []
+
+
+def test_depth_records_the_manifest_before_moving_a_file_in(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The manifest lists the earlier run's files and this run's before the first file moves in:
+    a run that dies after moving disparity.png leaves it listed, and the rerun replaces it
+    instead of refusing it as the user's; at the end the manifest lists what was written."""
+    import os
+
+    from stereovision import cli
+
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "depth.npy").write_bytes(b"earlier")  # an earlier run's (with --calib), not rewritten
+    (out / cli.DEPTH_MANIFEST).write_text('["depth.npy"]')
+    real_replace = os.replace
+    seen: list[tuple[str, list[str]]] = []
+
+    def replace(src: str | os.PathLike[str], dst: str | os.PathLike[str]) -> None:
+        if cli.STAGING_PREFIX in str(src) and Path(dst).parent == out:
+            seen.append((Path(dst).name, json.loads((out / cli.DEPTH_MANIFEST).read_text())))
+            if len(seen) == 2:
+                raise OSError(5, "Input/output error")
+        real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    assert main(_tsukuba_depth_argv(data_dir, out)) == 2
+    assert capsys.readouterr().err == "stereovision: error: [Errno 5] Input/output error\n"
+    want = ["depth.npy", "disparity.pfm", "disparity.png", "overview.png"]
+    assert seen == [("disparity.png", want), ("disparity.pfm", want)]
+    assert json.loads((out / cli.DEPTH_MANIFEST).read_text()) == want
+    assert sorted(p.name for p in out.iterdir()) == [
+        cli.DEPTH_MANIFEST,
+        "depth.npy",
+        "disparity.png",
+    ]
+    monkeypatch.setattr(os, "replace", real_replace)
+    assert main(_tsukuba_depth_argv(data_dir, out)) == 0
+    capsys.readouterr()
+    assert json.loads((out / cli.DEPTH_MANIFEST).read_text()) == want[1:]
+    assert not (out / "depth.npy").exists()  # the earlier run's, removed at the end
+
+
+def test_depth_rectification_takes_an_explicit_max_disparity(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--rectification's saved max_disparity (40) is the default; --max-disparity 24 overrides
+    it (the line says 24), and without it the saved one is searched (40)."""
+    rng = np.random.default_rng(0)
+    tex = cv2.resize(rng.integers(0, 255, (24, 40), np.uint8), (160, 96))
+    left, right = tex, np.roll(tex, -6, axis=1)
+    for name, img in (("l.png", left), ("r.png", right)):
+        assert cv2.imwrite(str(tmp_path / name), img)
+    eye = np.eye(3).tolist()
+    rect = {"H1": eye, "H2": eye, "size": [160, 96], "input_size": [160, 96]}
+    rect |= {"F": [[0, 0, 0], [0, 0, -1], [0, 1, 0]], "matches": 40, "median_dy": 0.1}
+    rect |= {"p95_dy": 0.3, "disparity_range": [0, 12], "max_disparity": 40}
+    rect |= {"skew_deg": [0, 0], "aspect": [1, 1], "model": "projective"}
+    (tmp_path / "rect.json").write_text(json.dumps(rect))
+    argv = ["depth", str(tmp_path / "l.png"), str(tmp_path / "r.png"), "--method", "fast"]
+    argv += ["--rectification", str(tmp_path / "rect.json")]
+    assert main([*argv, "-o", str(tmp_path / "a"), "--max-disparity", "24"]) == 0
+    assert "fast: max_disparity 24 px," in capsys.readouterr().out
+    assert main([*argv, "-o", str(tmp_path / "b")]) == 0
+    assert "fast: max_disparity 40 px," in capsys.readouterr().out
