@@ -1738,3 +1738,40 @@ def test_depth_rectification_takes_an_explicit_max_disparity(
     assert "fast: max_disparity 24 px," in capsys.readouterr().out
     assert main([*argv, "-o", str(tmp_path / "b")]) == 0
     assert "fast: max_disparity 40 px," in capsys.readouterr().out
+
+
+def test_depth_failing_before_its_first_move_leaves_no_folder_and_the_old_manifest(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The first move into -o failing: the manifest written just before it listed this run's
+    files, none of which came in, and kept the folder the run made (new/sub, empty to `ls`)
+    alive. Nothing moved in: a folder the run made is removed, and an earlier manifest is
+    as it was, byte for byte."""
+    import os
+
+    from stereovision import cli
+
+    real_replace = os.replace
+
+    def replace(src: str | os.PathLike[str], dst: str | os.PathLike[str]) -> None:
+        # a move out of the staging folder (not a write inside it)
+        stage = Path(src).parent
+        if stage.name.startswith(cli.STAGING_PREFIX) and Path(dst).parent != stage:
+            raise OSError(5, "Input/output error")
+        real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", replace)
+    assert main(_tsukuba_depth_argv(data_dir, tmp_path / "new" / "sub")) == 2
+    assert capsys.readouterr().err == "stereovision: error: [Errno 5] Input/output error\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == []
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "depth.npy").write_bytes(b"earlier")
+    (out / cli.DEPTH_MANIFEST).write_text('[ "depth.npy" ]')
+    assert main(_tsukuba_depth_argv(data_dir, out)) == 2
+    capsys.readouterr()
+    assert (out / cli.DEPTH_MANIFEST).read_text() == '[ "depth.npy" ]'
+    assert sorted(p.name for p in out.iterdir()) == [cli.DEPTH_MANIFEST, "depth.npy"]

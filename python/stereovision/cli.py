@@ -609,7 +609,9 @@ def commit_outputs(
     Each file is moved with one rename (atomic); Ctrl-C and SIGTERM are held until all are in
     and the earlier run's are gone (:class:`~stereovision._interrupt.HeldInterrupts`), so the
     folder holds one run's files, the earlier run's or this one's. A folder where a file goes
-    is refused before any file moves.
+    is refused before any file moves. The manifest lists this run's files before the first
+    move; a failure before any file moved in puts the earlier manifest back (or none), so that
+    a folder the run made is left empty and removed (:func:`staged_outputs`).
 
     Parameters
     ----------
@@ -649,12 +651,28 @@ def commit_outputs(
             )
     written: dict[str, Path] = {}
     removed: list[Path] = []
+    listed = out_dir / manifest
+    try:
+        before: bytes | None = listed.read_bytes()
+    except OSError:  # none yet (or unreadable: replaced below all the same)
+        before = None
     with HeldInterrupts():
         # claimed before the first move: should the process die halfway, a rerun replaces them
         record_outputs(out_dir, set(earlier) | set(staged), manifest, known)
-        for name, path in staged.items():
-            os.replace(path, out_dir / name)
-            written[name] = out_dir / name
+        try:
+            for name, path in staged.items():
+                os.replace(path, out_dir / name)
+                written[name] = out_dir / name
+        except BaseException:
+            if not written:
+                # nothing moved in: the earlier manifest back (or none), so that the folder is
+                # as it was, and a folder the run made is empty and removed (staged_outputs)
+                with contextlib.suppress(OSError):
+                    if before is None:
+                        listed.unlink()
+                    else:
+                        _atomic_write_bytes(listed, before)
+            raise
         for name in known:
             path = out_dir / name
             if name in earlier and name not in written and path.is_file() and not path.is_symlink():
