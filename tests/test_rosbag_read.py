@@ -183,13 +183,14 @@ def test_topic_discovery() -> None:
 # ------------------------------------------------------------------------------- the bags
 
 
-def _info_fields(cam: dict, ros1: bool, binning: int = 0) -> dict:
+def _info_fields(cam: dict, ros1: bool, binning: int | tuple[int, int] = 0) -> dict:
     names = ("D", "K", "R", "P") if ros1 else ("d", "k", "r", "p")
+    bx, by = binning if isinstance(binning, tuple) else (binning, binning)
     return {
         "height": cam["image_size"][1], "width": cam["image_size"][0],
         "distortion_model": cam["distortion_model"],
         names[0]: cam["D"], names[1]: cam["K"].ravel(), names[2]: cam["R"].ravel(),
-        names[3]: cam["P"].ravel(), "binning_x": binning, "binning_y": binning,
+        names[3]: cam["P"].ravel(), "binning_x": bx, "binning_y": by,
     }  # fmt: skip
 
 
@@ -201,11 +202,14 @@ def write_bag(
     encoding: str = "bgr8",
     topics: tuple[str, str] = (LEFT, RIGHT),
     infos: tuple[dict, dict] | None = None,
-    binning: int = 0,
+    binning: int | tuple[int, int] = 0,
+    roi: tuple[int, int, int, int] = (0, 0, 0, 0),
 ) -> Path:
     """A bag of ``(stamp_left, left, stamp_right, right)`` frames (a None stamp: not recorded),
     each message recorded 2 ms after its stamp, in recording order; ``infos``: the two cameras'
-    parsed camera_info, published beside the image topics once per left frame."""
+    parsed camera_info, published beside the image topics once per left frame, with
+    ``binning`` (both axes, or ``(x, y)``) and ``roi`` ``(x_offset, y_offset, width,
+    height)``."""
     ros1 = flavour == "ros1"
     ts = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
     t = ts.types
@@ -227,10 +231,11 @@ def write_bag(
                 msgs.append((stamp + 2_000_000, topic, "sensor_msgs/msg/Image", msg))
             if infos is not None:
                 cam = infos[0] if topic == topics[0] else infos[1]
-                roi = t["sensor_msgs/msg/RegionOfInterest"](
-                    x_offset=0, y_offset=0, height=0, width=0, do_rectify=False)  # fmt: skip
+                box = t["sensor_msgs/msg/RegionOfInterest"](
+                    x_offset=roi[0], y_offset=roi[1], width=roi[2], height=roi[3],
+                    do_rectify=False)  # fmt: skip
                 info = t["sensor_msgs/msg/CameraInfo"](
-                    header=header, roi=roi, **_info_fields(cam, ros1, binning))  # fmt: skip
+                    header=header, roi=box, **_info_fields(cam, ros1, binning))  # fmt: skip
                 info_topic = topic.rsplit("/", 1)[0] + "/camera_info"
                 msgs.append((stamp + 2_000_001, info_topic, "sensor_msgs/msg/CameraInfo", info))
     msgs.sort(key=lambda m: m[0])
@@ -1019,3 +1024,59 @@ def test_a_pair_exactly_max_skew_ms_apart_is_paired_for_any_decimal_value(
     assert cam.stamps_ns == [T0, T0 + PERIOD_NS]
     assert cam.dropped == {"left": 1, "right": 1}
     assert cam.max_skew_ms == 4.1
+
+
+def test_a_camera_info_with_a_region_of_interest_is_refused(cones: Any, tmp_path: Path) -> None:
+    """A camera_info whose roi is a part of the image (a cropped camera) is refused, naming
+    the topic and the region; a zero roi (unset) and one of the whole image are the camera's."""
+    cams = tuple(parse_ros_camera_info(t) for t in _raw_rig().to_ros())
+    frames = [(T0, cones.left, T0, cones.right)]
+    bag = write_bag(tmp_path / "crop", frames, infos=cams, roi=(10, 20, 200, 100))
+    with BagCamera(bag) as cam, pytest.raises(ValueError) as err:
+        cam.calibration()
+    assert str(err.value) == (
+        "/stereo/left/camera_info: camera_info has a region of interest (200x100 at 10,20); "
+        "cropped cameras are not supported"
+    )
+    for name, roi in (("whole", (0, 0, 450, 375)), ("unset", (0, 0, 0, 0))):
+        with BagCamera(write_bag(tmp_path / name, frames, infos=cams, roi=roi)) as cam:
+            assert cam.calibration().image_size == (450, 375)
+
+
+def test_the_default_tolerance_is_half_the_faster_topics_period(cones: Any, tmp_path: Path) -> None:
+    """Left at 25 fps, right at 16.7 fps: max_skew_ms is half the left's 40 ms period (the
+    median of the first PERIOD_SAMPLE steps: a frame 5 ms late and a missing one, an 80 ms
+    step, do not move it); a right frame exactly 20 ms from its left one pairs, one 40 ms away
+    does not."""
+    left, right = cones.left[:64, :96], cones.right[:64, :96]
+    ms = 1_000_000
+    lefts = [T0 + k * 40 * ms for k in range(13) if k != 5]  # frame 5 (200 ms) lost
+    lefts[3] += 5 * ms  # one late frame among the first eight
+    rights = [T0 + k * 60 * ms for k in range(8)]
+    frames = [(sl, left, None, right) for sl in lefts] + [(None, left, sr, right) for sr in rights]
+    bag = write_bag(tmp_path / "rates", frames)
+    with BagCamera(bag) as cam:
+        list(cam.frames())
+    assert cam.max_skew_ms == 20.0
+    # lefts 0, 40, 80, 125, 160, 240, ... ms; rights 0, 60, 120, ...: 40-60 (20 ms) pairs, 80
+    # has none within 20 ms (60 taken, 120 40 ms away), 125-120, 160-180, 240-240, 280-300,
+    # 320 none, 360-360, 400-420, 440 and 480 none
+    assert cam.stamps_ns == [lefts[k] for k in (0, 1, 3, 4, 5, 6, 8, 9)]
+    assert cam.skews_ms == pytest.approx([0, 20, 5, 20, 0, 20, 0, 20], abs=1e-3)
+    assert cam.dropped == {"left": 4, "right": 0}
+
+
+def test_an_equal_distance_tie_takes_the_earlier_right_frame(cones: Any, tmp_path: Path) -> None:
+    """A left frame 2 ms from two right frames pairs with the earlier: the later one stays for
+    the next left frame (2 pairs); taking the later one would leave the earlier unpaired and
+    the next left frame without a partner (1 pair)."""
+    left, right = cones.left[:64, :96], cones.right[:64, :96]
+    ms = 1_000_000
+    frames = [(T0, left, T0 - 2 * ms, right), (T0 + 4 * ms, left, T0 + 2 * ms, right)]
+    with BagCamera(write_bag(tmp_path / "tie", frames), max_skew_ms=2) as cam:
+        got = list(cam.frames())
+    assert [(f.t_left, f.t_right) for f in got] == [
+        ((T0) / 1e9, (T0 - 2 * ms) / 1e9),
+        ((T0 + 4 * ms) / 1e9, (T0 + 2 * ms) / 1e9),
+    ]
+    assert cam.dropped == {"left": 0, "right": 0}
