@@ -1026,6 +1026,27 @@ def test_a_pair_exactly_max_skew_ms_apart_is_paired_for_any_decimal_value(
     assert cam.max_skew_ms == 4.1
 
 
+def test_binning_scales_each_axis_by_its_own_factor(cones: Any, tmp_path: Path) -> None:
+    """binning_y alone (1 x 2) halves the rows only; a binned pixel is the centre of its b
+    sensor pixels: f' = f / b, c' = (c + 0.5) / b - 0.5 on each axis. 375 rows binned by 2 are
+    187, and the scale was taken as 187 / 375 (fy 419.8 -> 209.34, not 209.9; cy 0.25 px
+    off) instead of 1 / 2."""
+    raw = _raw_rig()
+    cams = tuple(parse_ros_camera_info(t) for t in raw.to_ros())
+    frames = [(T0, cones.left, T0, cones.right)]
+    for name, binning, b in (("y2", (1, 2), (1, 2)), ("x3y2", (3, 2), (3, 2)), ("zero", 0, (1, 1))):
+        bag = write_bag(tmp_path / name, frames, infos=cams, binning=binning)
+        with BagCamera(bag) as cam:
+            got = cam.calibration()
+        assert got.image_size == (450 // b[0], 375 // b[1])
+        for k_got, k_raw in ((got.K1, raw.K1), (got.K2, raw.K2)):
+            np.testing.assert_allclose(k_got[0, 0], k_raw[0, 0] / b[0], rtol=1e-12)
+            np.testing.assert_allclose(k_got[1, 1], k_raw[1, 1] / b[1], rtol=1e-12)
+            np.testing.assert_allclose(k_got[0, 2], (k_raw[0, 2] + 0.5) / b[0] - 0.5, rtol=1e-12)
+            np.testing.assert_allclose(k_got[1, 2], (k_raw[1, 2] + 0.5) / b[1] - 0.5, rtol=1e-12)
+        np.testing.assert_allclose(got.T, raw.T, atol=1e-9)  # the rig is the same
+
+
 def test_a_camera_info_with_a_region_of_interest_is_refused(cones: Any, tmp_path: Path) -> None:
     """A camera_info whose roi is a part of the image (a cropped camera) is refused, naming
     the topic and the region; a zero roi (unset) and one of the whole image are the camera's."""

@@ -989,7 +989,11 @@ class Calibration:
         size = self._check_size(image_size)
         if size == self.image_size:
             return self
-        sx, sy = size[0] / self.image_size[0], size[1] / self.image_size[1]
+        return self._scaled(size, size[0] / self.image_size[0], size[1] / self.image_size[1])
+
+    def _scaled(self, size: tuple[int, int], sx: float, sy: float) -> Calibration:
+        """:meth:`scaled_to` with its pixel scales given: a camera binning b pixels into one
+        scales by exactly 1 / b, while its ``size`` (``W // b``) drops the rest of a row."""
 
         def scale(k: F64) -> F64:
             out = k.copy()
