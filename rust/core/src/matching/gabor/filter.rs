@@ -518,4 +518,124 @@ mod tests {
         assert_eq!(mirror(-7, 5), 1);
         assert_eq!(mirror(3, 1), 0);
     }
+
+    /// A deterministic pseudo-random image in [0, 1].
+    fn noise(w: usize, h: usize, seed: u32) -> Vec<f32> {
+        let mut s = seed;
+        (0..w * h)
+            .map(|_| {
+                s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                (s >> 8) as f32 / (1u32 << 24) as f32
+            })
+            .collect()
+    }
+
+    /// The response by its definition, in f64: `y(x, y) = sum_{t, s} h(t, s) I(x - t, y - s)` with
+    /// `h(t, s) = hx(t) hy(s) - dc gx(t) gy(s)` and reflect-101 borders.
+    fn direct_response(img: &[f32], w: usize, h: usize, c: &Channel) -> (Vec<f64>, Vec<f64>) {
+        let (rx, ry) = ((c.hx.len() / 2) as isize, (c.hy.len() / 2) as isize);
+        let (mut re, mut im) = (vec![0f64; w * h], vec![0f64; w * h]);
+        for y in 0..h {
+            for x in 0..w {
+                let (mut a, mut b) = (0f64, 0f64);
+                for (ks, hy) in c.hy.iter().enumerate() {
+                    let yy = mirror(y as isize - (ks as isize - ry), h);
+                    for (kt, hx) in c.hx.iter().enumerate() {
+                        let v = img[yy * w + mirror(x as isize - (kt as isize - rx), w)] as f64;
+                        let (hxr, hxi, hyr, hyi) =
+                            (hx[0] as f64, hx[1] as f64, hy[0] as f64, hy[1] as f64);
+                        let g = c.gx[kt] as f64 * c.gy[ks] as f64;
+                        a += (hxr * hyr - hxi * hyi - c.dc[0] as f64 * g) * v;
+                        b += (hxr * hyi + hxi * hyr - c.dc[1] as f64 * g) * v;
+                    }
+                }
+                re[y * w + x] = a;
+                im[y * w + x] = b;
+            }
+        }
+        (re, im)
+    }
+
+    #[test]
+    fn filter_bank_equals_the_direct_convolution() {
+        // 37 px: two register blocks of 16 and a tail of 5; 13 rows, fewer than a kernel's taps
+        // with the narrow bandwidth (the borders mirror more than once). A real-tap channel
+        // (0 degrees) and complex-tap ones; +-60 share their row pass.
+        let (w, h) = (37, 13);
+        let img = noise(w, h, 7);
+        for (bw, aspect) in [(1.5, 1.0), (0.6, 1.5)] {
+            let chans: Vec<Channel> = [0.0, 60.0, -60.0]
+                .iter()
+                .map(|&t| Channel::new(0.25, t, bw, aspect).unwrap())
+                .collect();
+            let r = filter_bank(&img, w, h, &chans).unwrap();
+            for (ci, c) in chans.iter().enumerate() {
+                let (re, im) = direct_response(&img, w, h, c);
+                for i in 0..w * h {
+                    let (dr, di) = (r.re[ci][i] as f64 - re[i], r.im[ci][i] as f64 - im[i]);
+                    assert!(
+                        dr.abs() < 2e-6 && di.abs() < 2e-6,
+                        "bw {bw} theta {} pixel ({}, {}): ({}, {}) vs ({re_i}, {im_i})",
+                        c.theta_deg,
+                        i % w,
+                        i / w,
+                        r.re[ci][i],
+                        r.im[ci][i],
+                        re_i = re[i],
+                        im_i = im[i]
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn channel_geometry_follows_the_formulas() {
+        // sigma = sqrt(ln 2 / 2) / pi * (2^b + 1) / ((2^b - 1) F): 0.18739 * 3 / 0.25 at b = 1.
+        let s = sigma_from_bandwidth(0.25, 1.0);
+        assert!((s - 2.248_686).abs() < 1e-5, "{s}");
+        // Radius ceil(3 sigma): 6.75 -> 7 taps each side.
+        assert_eq!(radius_for(s), 7);
+        assert_eq!(radius_for(2.0), 6);
+        let c = Channel::new(0.25, 60.0, 1.0, 2.0).unwrap();
+        // sigma_x = aspect * sigma along x, sigma along y.
+        assert!((c.sigma_x - 2.0 * s).abs() < 1e-5 && (c.sigma_y - s).abs() < 1e-6);
+        assert_eq!((c.gx.len(), c.gy.len()), (2 * 14 + 1, 2 * 7 + 1));
+        // The frequency vector at +60 degrees: (k cos 60, k sin 60), k = 2 pi F.
+        let k = angular(0.25);
+        assert!((c.kx - 0.5 * k).abs() < 1e-6);
+        assert!((c.ky - 0.75f32.sqrt() * k).abs() < 1e-6);
+        // Gaussian taps: sum 1, exp(-t^2 / (2 sigma^2)) profile.
+        let g = gaussian_taps(2.0, 6);
+        assert!((g.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        assert!((g[6 + 2] / g[6] - (-0.5f32).exp()).abs() < 1e-6);
+        // The carrier's dc coefficient is real (the taps' imaginary parts cancel in pairs).
+        assert!(c.dc[1].abs() < 1e-7);
+    }
+
+    #[test]
+    fn pyr_down_keeps_the_even_pixels_of_the_sigma_1_blur() {
+        // Odd sizes: ceil(n / 2) samples each way, the last from the last (even) row / column.
+        let (w, h) = (37, 11);
+        let img = noise(w, h, 3);
+        let (out, w2, h2) = pyr_down(&img, w, h).unwrap();
+        assert_eq!((w2, h2), (19, 6));
+        let g = gaussian_taps(PYR_SIGMA, radius_for(PYR_SIGMA));
+        let r = (g.len() / 2) as isize;
+        for y2 in 0..h2 {
+            for x2 in 0..w2 {
+                let (x, y) = ((2 * x2) as isize, (2 * y2) as isize);
+                let mut v = 0f64;
+                for (i, gy) in g.iter().enumerate() {
+                    for (j, gx) in g.iter().enumerate() {
+                        let (yy, xx) =
+                            (mirror(y + i as isize - r, h), mirror(x + j as isize - r, w));
+                        v += (*gy as f64) * (*gx as f64) * img[yy * w + xx] as f64;
+                    }
+                }
+                let got = out[y2 * w2 + x2] as f64;
+                assert!((got - v).abs() < 1e-6, "({x2}, {y2}): {got} vs {v}");
+            }
+        }
+    }
 }
