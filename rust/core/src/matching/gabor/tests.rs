@@ -513,3 +513,553 @@ fn fused_search_reads_only_the_channels_both_levels_have() {
         .zip(b.iter())
         .all(|(p, q)| p.to_bits() == q.to_bits()));
 }
+
+/// The search by its definition (module docs of `search`), in f64: per pixel, the first offset
+/// maximising the box-pooled `sum 2 Re(y_l conj y_r) / sum (|y_l|^2 + |y_r|^2)` (terms zero where
+/// `floor(x - base + 0.5) - o` leaves the row; box clamped to the image). Returns the choice and
+/// its lead over the best other candidate value (ties within rounding are not compared).
+fn direct_search(
+    l: &level::LevelData,
+    r: &level::LevelData,
+    base: &[f32],
+    offs: &[f32],
+    p: usize,
+) -> (Vec<f32>, Vec<f64>) {
+    let (w, h) = (l.w, l.h);
+    let term = |x: usize, y: usize, o: f32| -> (f64, f64) {
+        let s = (x as f32 - base[y * w + x] + 0.5).floor() - o;
+        if !(s >= 0.0 && s <= (w - 1) as f32) {
+            return (0.0, 0.0);
+        }
+        let (s, ro) = (s as usize, level::SUBROWS * y * w);
+        let mut num = 0f64;
+        for (lc, rc) in l.chan.iter().zip(&r.chan) {
+            num += lc[ro + 4 * w + x] as f64 * rc[ro + 4 * w + s] as f64
+                + lc[ro + 5 * w + x] as f64 * rc[ro + 5 * w + s] as f64;
+        }
+        (
+            2.0 * num,
+            l.energy[y * w + x] as f64 + r.energy[y * w + s] as f64,
+        )
+    };
+    let (mut out, mut lead) = (base.to_vec(), vec![f64::INFINITY; w * h]);
+    let p = p as isize;
+    for y in 0..h {
+        for x in 0..w {
+            let e: Vec<f64> = offs
+                .iter()
+                .map(|&o| {
+                    let (mut n, mut d) = (0f64, 0f64);
+                    for dy in -p..=p {
+                        for dx in -p..=p {
+                            let yy = (y as isize + dy).clamp(0, h as isize - 1) as usize;
+                            let xx = (x as isize + dx).clamp(0, w as isize - 1) as usize;
+                            let (a, b) = term(xx, yy, o);
+                            n += a;
+                            d += b;
+                        }
+                    }
+                    if d > 0.0 {
+                        n / d
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            let k = (0..e.len()).fold(0, |k, i| if e[i] > e[k] { i } else { k });
+            out[y * w + x] = base[y * w + x] + offs[k];
+            // Every candidate off the row: exact zeros, and the first offset stays.
+            lead[y * w + x] = if e.iter().all(|&v| v == 0.0) {
+                f64::INFINITY
+            } else {
+                (0..e.len())
+                    .filter(|&i| i != k)
+                    .map(|i| e[k] - e[i])
+                    .fold(f64::INFINITY, f64::min)
+            };
+        }
+    }
+    (out, lead)
+}
+
+#[test]
+fn search_equals_its_definition_pooled_or_not() {
+    // 45 x 37: two 32-row bands (pooled rows at the band boundary and the image's last row),
+    // three channels, base maps with smooth runs, jumps and shifts that leave the image, the
+    // re-search offsets and a top-level range; both kernels of the unpooled search.
+    let (w, h) = (45usize, 37usize);
+    let (left, right) = (texture(w, h, 0.0, 5), texture(w, h, 3.4, 5));
+    let chans: Vec<_> = DEFAULT_ORIENTATIONS
+        .iter()
+        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
+        .collect();
+    let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
+    let rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
+    let base: Vec<f32> = (0..w * h)
+        .map(|i| {
+            let x = (i % w) as f32;
+            match (i / 11) % 5 {
+                0 => 3.4 + 0.01 * x,
+                1 => 2.0 + ((i * 13) % 9) as f32 * 0.7,
+                2 => x - 0.4,  // the re-search reaches past the left edge
+                3 => -2.2,     // ... and past the right one
+                _ => x + 20.0, // every candidate off the row
+            }
+        })
+        .collect();
+    for offs in [(-3..=3).collect::<Vec<i32>>(), (0..=9).collect()] {
+        let offs: Vec<f32> = offs.into_iter().map(|k| k as f32).collect();
+        for pool in [0usize, 1, 2] {
+            let (want, lead) = direct_search(&ld, &rd, &base, &offs, pool);
+            let fused = [true, false];
+            for &allow in if pool == 0 { &fused[..] } else { &fused[..1] } {
+                let got = search::search_impl(&ld, &rd, &base, &offs, pool, allow).unwrap();
+                let mut compared = 0;
+                for i in 0..w * h {
+                    if lead[i] > 1e-5 {
+                        compared += 1;
+                        assert_eq!(
+                            got[i],
+                            want[i],
+                            "pool {pool} fused {allow} offsets {offs:?} pixel ({}, {})",
+                            i % w,
+                            i / w
+                        );
+                    }
+                }
+                assert!(compared > w * h * 9 / 10, "{compared} compared");
+            }
+        }
+    }
+}
+
+#[test]
+fn median5_is_the_5x1_median_of_the_1x5_medians() {
+    // Clamped borders both ways; few distinct values, so ties too.
+    let (w, h) = (23usize, 9usize);
+    let src: Vec<f32> = (0..w * h).map(|i| ((i * 7919) % 13) as f32 * 0.5).collect();
+    let out = post::median5(&src, w, h).unwrap();
+    let med = |mut v: [f32; 5]| {
+        v.sort_by(|a, b| a.total_cmp(b));
+        v[2]
+    };
+    let at = |x: isize, y: isize| {
+        let (x, y) = (x.clamp(0, w as isize - 1), y.clamp(0, h as isize - 1));
+        src[y as usize * w + x as usize]
+    };
+    for y in 0..h as isize {
+        for x in 0..w as isize {
+            let row = |yy: isize| med(std::array::from_fn(|k| at(x + k as isize - 2, yy)));
+            let want = med(std::array::from_fn(|k| row(y + k as isize - 2)));
+            assert_eq!(out[y as usize * w + x as usize], want, "({x}, {y})");
+        }
+    }
+}
+
+#[test]
+fn upsample_is_bilinear_at_half_the_coordinates() {
+    // Fine pixel (x, y) reads the coarse map at (x / 2, y / 2), clamped to the coarse image;
+    // fine sizes 2n - 1, 2n, beyond (columns and rows past the last coarse sample) and below.
+    let (sw, sh) = (5usize, 4usize);
+    let src: Vec<f32> = (0..sw * sh).map(|i| ((i * 37) % 11) as f32 - 3.0).collect();
+    for (w, h) in [(9usize, 7usize), (10, 8), (13, 11), (7, 5)] {
+        for scale in [1.0f32, 2.0] {
+            let out = post::upsample(&src, sw, sh, w, h, scale).unwrap();
+            for y in 0..h {
+                for x in 0..w {
+                    let (fx, fy) = (
+                        (x as f64 / 2.0).min((sw - 1) as f64),
+                        (y as f64 / 2.0).min((sh - 1) as f64),
+                    );
+                    let (x0, y0) = (fx.floor() as usize, fy.floor() as usize);
+                    let (x1, y1) = ((x0 + 1).min(sw - 1), (y0 + 1).min(sh - 1));
+                    let (tx, ty) = (fx - x0 as f64, fy - y0 as f64);
+                    let s = |xx: usize, yy: usize| src[yy * sw + xx] as f64;
+                    let a = s(x0, y0) + tx * (s(x1, y0) - s(x0, y0));
+                    let b = s(x0, y1) + tx * (s(x1, y1) - s(x0, y1));
+                    let want = scale as f64 * (a + ty * (b - a));
+                    let got = out[y * w + x] as f64;
+                    assert!(
+                        (got - want).abs() < 1e-6,
+                        "{w}x{h} ({x}, {y}): {got} vs {want}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn normalized_conv_divides_the_blurred_products_by_the_blurred_confidence() {
+    // cbar = G * c, dbar = G * (c d) / cbar (0 where cbar <= 1e-6), reflect-101 borders; the
+    // right part has a confidence too small to divide by.
+    let (w, h, sigma) = (21usize, 6usize, 1.2f32);
+    let d: Vec<f32> = (0..w * h)
+        .map(|i| ((i * 31) % 17) as f32 * 0.25 - 2.0)
+        .collect();
+    let c: Vec<f32> = (0..w * h)
+        .map(|i| {
+            if i % w >= 15 {
+                1e-9
+            } else {
+                ((i * 7) % 5) as f32 * 0.2
+            }
+        })
+        .collect();
+    let d: Vec<f32> = d
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| if i % w >= 15 { 1e6 } else { v })
+        .collect();
+    let (dbar, cbar) = post::normalized_conv(&d, &c, w, h, sigma).unwrap();
+    let g = filter::gaussian_taps(sigma, filter::radius_for(sigma));
+    let r = (g.len() / 2) as isize;
+    let blur = |f: &dyn Fn(usize) -> f64, x: usize, y: usize| {
+        let mut s = 0f64;
+        for (i, gy) in g.iter().enumerate() {
+            for (j, gx) in g.iter().enumerate() {
+                let yy = filter::mirror(y as isize + i as isize - r, h);
+                let xx = filter::mirror(x as isize + j as isize - r, w);
+                s += *gy as f64 * *gx as f64 * f(yy * w + xx);
+            }
+        }
+        s
+    };
+    for y in 0..h {
+        for x in 0..w {
+            let cb = blur(&|i| c[i] as f64, x, y);
+            let num = blur(&|i| c[i] as f64 * d[i] as f64, x, y);
+            let want = if cb > 1e-6 { num / cb } else { 0.0 };
+            let i = y * w + x;
+            assert!((cbar[i] as f64 - cb).abs() < 1e-6, "cbar ({x}, {y})");
+            assert!(
+                (dbar[i] as f64 - want).abs() < 1e-5 * (1.0 + want.abs()),
+                "dbar ({x}, {y}): {} vs {want}",
+                dbar[i]
+            );
+        }
+    }
+}
+
+#[test]
+fn update_max_and_flip_helpers() {
+    // apply_update: only where cbar >= conf_min (equal counts), clamped to [lo, hi].
+    let mut disp = vec![0.0f32, 0.0, 0.0, 1.0];
+    post::apply_update(
+        &mut disp,
+        &[1.0, 5.0, -5.0, 0.5],
+        &[0.2, 0.1, 0.15, 0.9],
+        0.15,
+        -1.0,
+        2.0,
+        2,
+    );
+    assert_eq!(disp, vec![1.0, 0.0, -1.0, 1.5]);
+    let mut m = vec![1.0f32, 5.0, -2.0];
+    post::max_into(&mut m, &[3.0, 2.0, -1.0]);
+    assert_eq!(m, vec![3.0, 5.0, -1.0]);
+    assert_eq!(
+        post::flip_x(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0], 3, 2).unwrap(),
+        vec![3.0, 2.0, 1.0, 6.0, 5.0, 4.0]
+    );
+}
+
+#[test]
+fn speckle_size_and_range_limits_are_inclusive_where_opencv_s_are() {
+    // A region of exactly min_size pixels stays (only smaller ones go), and neighbours exactly
+    // max_diff apart join.
+    let (w, h) = (6usize, 3usize);
+    let mut d = vec![f32::NAN; w * h];
+    // 4 px region at 1.0 / 1.5 (0.5 apart: one region with max_diff 0.5), and a 3 px one.
+    for (x, v) in [(0, 1.0), (1, 1.5), (2, 1.0), (3, 1.5)] {
+        d[x] = v;
+    }
+    for x in 0..3 {
+        d[2 * w + x] = 7.0;
+    }
+    post::remove_speckles(&mut d, w, h, 4, 0.5).unwrap();
+    assert_eq!(&d[..4], &[1.0, 1.5, 1.0, 1.5]);
+    assert!(d[2 * w..2 * w + 3].iter().all(|v| v.is_nan()));
+}
+
+#[test]
+fn validity_and_lr_check_on_a_hand_made_row() {
+    // x - d at 0 and at w - 1 (both inside), a confidence equal to conf_min (kept), right
+    // values exactly tol away (kept), 1.2 px away (dropped) and a low confidence (dropped).
+    let w = 5;
+    let dl = [0.0f32, 1.0, -2.0, 2.5, 4.0];
+    let dr = [0.0f32, 3.7, 7.0, 7.0, -2.5];
+    assert_eq!(
+        post::lr_check(&dl, &dr, w, 1, 1.0).unwrap(),
+        vec![true, true, true, false, false]
+    );
+    let mut d = dl.to_vec();
+    let mirrored = post::flip_x(&dr, w, 1).unwrap();
+    post::validity_row(&mut d, &[0.5, 0.3, 0.5, 0.5, 0.29], &mirrored, 0.3, 1.0);
+    assert_eq!(&d[..3], &[0.0, 1.0, -2.0]);
+    assert!(d[3].is_nan() && d[4].is_nan());
+}
+
+#[test]
+fn level_data_holds_the_responses_demodulated_and_their_frequency_phasors() {
+    // Per channel and pixel: y = the filter bank's response (bit for bit), the left's
+    // beta = exp(-j k.x) y, the right's baseband exp(-j k.x) (y + c L), the phasor
+    // f = y(x+1) conj y(x) + y(x) conj y(x-1) (columns clamped), the energy sum_c |y_c|^2 and
+    // every third |y|^2 as the percentile sample.
+    let (w, h) = (29usize, 7usize);
+    let img = texture(w, h, 0.0, 11);
+    let chans: Vec<_> = [0.0f32, 60.0, -60.0]
+        .iter()
+        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
+        .collect();
+    let fb = filter::filter_bank(&img.data, w, h, &chans).unwrap();
+    for right in [false, true] {
+        let ld = level_data(&img.data, w, h, &chans, 1.25, right).unwrap();
+        let mut energy = vec![0f64; w * h];
+        for (ci, c) in chans.iter().enumerate() {
+            let ch = &ld.chan[ci];
+            let (yre, yim) = (&fb.re[ci], &fb.im[ci]);
+            for y in 0..h {
+                let o = level::SUBROWS * y * w;
+                for x in 0..w {
+                    let i = y * w + x;
+                    assert_eq!(ch[o + 4 * w + x].to_bits(), yre[i].to_bits());
+                    assert_eq!(ch[o + 5 * w + x].to_bits(), yim[i].to_bits());
+                    let (mut pr, mut pi) = (yre[i] as f64, yim[i] as f64);
+                    if right {
+                        pr += (c.dc[0] * fb.lowpass[i]) as f64;
+                        pi += (c.dc[1] * fb.lowpass[i]) as f64;
+                    }
+                    let a = -(c.kx as f64 * x as f64 + c.ky as f64 * y as f64);
+                    let (qr, qi) = (a.cos(), a.sin());
+                    let (br, bi) = (pr * qr - pi * qi, pr * qi + pi * qr);
+                    let tol = 1e-5 * (1.0 + pr.hypot(pi));
+                    assert!(
+                        (ch[o + x] as f64 - br).abs() < tol,
+                        "re ch {ci} ({x}, {y}) right {right}"
+                    );
+                    assert!(
+                        (ch[o + w + x] as f64 - bi).abs() < tol,
+                        "im ch {ci} ({x}, {y}) right {right}"
+                    );
+                    let yv = |xx: usize| (yre[y * w + xx] as f64, yim[y * w + xx] as f64);
+                    let (a0, a1, a2) = (yv(x.saturating_sub(1)), yv(x), yv((x + 1).min(w - 1)));
+                    let fr = a2.0 * a1.0 + a2.1 * a1.1 + a1.0 * a0.0 + a1.1 * a0.1;
+                    let fi = a2.1 * a1.0 - a2.0 * a1.1 + a1.1 * a0.0 - a1.0 * a0.1;
+                    assert!(
+                        (ch[o + 2 * w + x] as f64 - fr).abs() < 1e-5,
+                        "f re ch {ci} ({x}, {y})"
+                    );
+                    assert!(
+                        (ch[o + 3 * w + x] as f64 - fi).abs() < 1e-5,
+                        "f im ch {ci} ({x}, {y})"
+                    );
+                    energy[i] += a1.0 * a1.0 + a1.1 * a1.1;
+                }
+            }
+            let want: Vec<f32> = yre
+                .iter()
+                .zip(yim)
+                .step_by(3)
+                .map(|(a, b)| a * a + b * b)
+                .collect();
+            assert_eq!(ld.amp2_samples[ci], want);
+        }
+        for (i, (&got, want)) in ld.energy.iter().zip(&energy).enumerate() {
+            assert!((got as f64 - want).abs() < 1e-5, "energy {i}");
+        }
+    }
+}
+
+#[test]
+fn stability_bits_follow_the_fleet_jepson_test() {
+    // Bit c where |psi - j k0| <= tau / sigma_x and Im psi >= k0 / 2, with Im psi = arg f and
+    // Re psi = (ln |y(x+1)|^2 - ln |y(x-1)|^2) / 4; never on the first and last columns.
+    let (w, h) = (40usize, 6usize);
+    let img = texture(w, h, 0.0, 21);
+    let chans: Vec<_> = [0.0f32, 60.0]
+        .iter()
+        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
+        .collect();
+    let tau = 0.6;
+    let ld = level_data(&img.data, w, h, &chans, tau, false).unwrap();
+    let (mut set, mut clear) = (0, 0);
+    for (ci, c) in chans.iter().enumerate() {
+        let lim = (tau / c.sigma_x) as f64;
+        for y in 0..h {
+            let o = level::SUBROWS * y * w;
+            let ch = &ld.chan[ci];
+            let amp2 = |x: usize| {
+                let (a, b) = (ch[o + 4 * w + x] as f64, ch[o + 5 * w + x] as f64);
+                a * a + b * b
+            };
+            for x in 0..w {
+                let bit = ld.stable[y * w + x] >> ci & 1 == 1;
+                if x == 0 || x == w - 1 {
+                    assert!(!bit, "border ({x}, {y})");
+                    continue;
+                }
+                let im = (ch[o + 3 * w + x] as f64).atan2(ch[o + 2 * w + x] as f64);
+                let re = 0.25 * ((amp2(x + 1) + 1e-30).ln() - (amp2(x - 1) + 1e-30).ln());
+                let dk = im - c.kx as f64;
+                let r = (re * re + dk * dk).sqrt();
+                let kmin = 0.5 * c.kx as f64;
+                // Skip pixels within rounding of either threshold.
+                if (r - lim).abs() < 1e-3 || (im - kmin).abs() < 1e-3 {
+                    continue;
+                }
+                let want = r <= lim && im >= kmin;
+                assert_eq!(
+                    bit, want,
+                    "channel {ci} ({x}, {y}): r {r} lim {lim} im {im}"
+                );
+                if want {
+                    set += 1;
+                } else {
+                    clear += 1;
+                }
+            }
+        }
+    }
+    assert!(set > 20 && clear > 20, "{set} set, {clear} clear");
+}
+
+#[test]
+fn newton_step_equals_its_definition() {
+    // Per pixel and channel, the right data read at s = x - d (linear interpolation of the
+    // baseband, the lowpass and the frequency phasor between columns min(floor s, w - 2) and the
+    // next; stability of the left pixel and of the right one at round(s), none where s leaves
+    // the row), rotated back by exp(-j kx d) less the zero-DC term; then
+    // z = y_r conj beta_l, m = 2 |z| / (|beta_l|^2 + |y_r|^2) where usable, k = arg(f_l + f_r)
+    // and delta = sum m k dphi / sum m k^2, clamped to pi / max kx, c = mean m. In f64 with
+    // libm; pixels within rounding of a threshold are skipped.
+    let (w, h) = (31usize, 6usize);
+    let (left, right) = (texture(w, h, 0.0, 8), texture(w, h, 2.6, 8));
+    let chans: Vec<_> = [0.0f32, 60.0, -60.0]
+        .iter()
+        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
+        .collect();
+    let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
+    let rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
+    let cc = level::chan_consts(&chans, &ld, &rd, 0.4);
+    // Near the truth, off by up to 1.9 px, and shifted out of the row at both ends.
+    let disp: Vec<f32> = (0..w * h)
+        .map(|i| match i % w {
+            x if x < 2 => 3.0,
+            x if x >= 29 => -1.5,
+            x => 2.6 + 1.9 * ((x * 7 % 5) as f32 - 2.0) / 2.0,
+        })
+        .collect();
+    let (delta, conf) = level::newton_step(&ld, &rd, &cc, &disp).unwrap();
+    let max_delta = cc
+        .iter()
+        .map(|c| std::f64::consts::PI / c.kx as f64)
+        .fold(f64::INFINITY, f64::min);
+    let lerp = |v: &[f32], i: usize, t: f64| v[i] as f64 + t * (v[i + 1] as f64 - v[i] as f64);
+    let (mut checked, mut moved) = (0, 0);
+    for y in 0..h {
+        'px: for x in 0..w {
+            let i = y * w + x;
+            let d = disp[i] as f64;
+            let s = x as f64 - d;
+            let inside = s >= 0.0 && s <= (w - 1) as f64;
+            let sc = s.clamp(0.0, (w - 1) as f64);
+            let i0 = (sc.floor() as usize).min(w - 2);
+            let t = sc - i0 as f64;
+            let near = sc.round() as usize;
+            let o = level::SUBROWS * y * w;
+            let lp = lerp(&rd.lowpass[y * w..(y + 1) * w], i0, t);
+            let (mut num, mut den, mut csum) = (0f64, 0f64, 0f64);
+            for (ci, c) in cc.iter().enumerate() {
+                let (lc, rc) = (&ld.chan[ci], &rd.chan[ci]);
+                let sub = |k: usize| &rc[o + k * w..o + (k + 1) * w];
+                let (br, bi) = (lerp(sub(0), i0, t), lerp(sub(1), i0, t));
+                let (gr, gi) = (lerp(sub(2), i0, t), lerp(sub(3), i0, t));
+                let a = c.kx as f64 * d;
+                let (wr, wi) = (br * a.cos() + bi * a.sin(), bi * a.cos() - br * a.sin());
+                let q = -(c.kx as f64 * x as f64 + c.ky as f64 * y as f64);
+                let (dr, di) = (c.dc[0] as f64 * lp, c.dc[1] as f64 * lp);
+                let (yr, yi) = (
+                    wr - (dr * q.cos() - di * q.sin()),
+                    wi - (dr * q.sin() + di * q.cos()),
+                );
+                let (lr, li) = (lc[o + x] as f64, lc[o + w + x] as f64);
+                let (zr, zi) = (yr * lr + yi * li, yi * lr - yr * li);
+                let (pl, pw) = (lr * lr + li * li, yr * yr + yi * yi);
+                let k = (lc[o + 3 * w + x] as f64 + gi).atan2(lc[o + 2 * w + x] as f64 + gr);
+                let stable = inside
+                    && (ld.stable[i] >> ci) & 1 == 1
+                    && (rd.stable[y * w + near] >> ci) & 1 == 1;
+                let (amp, kmin) = (pl.min(pw), 0.5 * c.kx as f64);
+                if stable
+                    && ((amp - c.thr2 as f64).abs() < 1e-4 * c.thr2 as f64
+                        || (k - kmin).abs() < 1e-3
+                        || zi.atan2(zr).abs() > 3.1)
+                {
+                    continue 'px;
+                }
+                if stable && amp >= c.thr2 as f64 && k >= kmin {
+                    let m = 2.0 * zr.hypot(zi) / (pl + pw);
+                    num += m * k * zi.atan2(zr);
+                    den += m * k * k;
+                    csum += m;
+                }
+            }
+            let want = if den > 0.0 { num / den } else { 0.0 }.clamp(-max_delta, max_delta);
+            let want_c = csum / cc.len() as f64;
+            assert!(
+                (delta[i] as f64 - want).abs() < 1e-3,
+                "delta ({x}, {y}): {} vs {want}",
+                delta[i]
+            );
+            assert!(
+                (conf[i] as f64 - want_c).abs() < 1e-4,
+                "conf ({x}, {y}): {} vs {want_c}",
+                conf[i]
+            );
+            checked += 1;
+            moved += usize::from(want != 0.0);
+        }
+    }
+    assert!(
+        checked > w * h * 8 / 10 && moved > w * h / 2,
+        "{checked} checked, {moved} moved"
+    );
+}
+
+#[test]
+fn amplitude_thresholds_are_relative_to_the_95th_percentile() {
+    // thr = max(amp_rel * P95(|y|) over both images' samples, AMP_ABS_FLOOR), stored squared;
+    // +-60 degrees share a kx slot.
+    let (w, h) = (30usize, 8usize);
+    let (left, right) = (texture(w, h, 0.0, 4), texture(w, h, 1.0, 4));
+    let chans: Vec<_> = [0.0f32, 60.0, -60.0]
+        .iter()
+        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
+        .collect();
+    let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
+    let rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
+    let cc = level::chan_consts(&chans, &ld, &rd, 0.3);
+    for (ci, c) in cc.iter().enumerate() {
+        let all: Vec<f32> = ld.amp2_samples[ci]
+            .iter()
+            .chain(&rd.amp2_samples[ci])
+            .copied()
+            .collect();
+        let thr = 0.3 * level::percentile(&all, 0.95).sqrt();
+        assert!(thr > level::AMP_ABS_FLOOR);
+        assert_eq!(c.thr2, thr * thr, "channel {ci}");
+    }
+    assert_eq!(
+        cc.iter().map(|c| c.kx_slot).collect::<Vec<_>>(),
+        vec![0, 1, 1]
+    );
+    // A flat pair: the absolute floor.
+    let flat = vec![0.5f32; w * h];
+    let lf = level_data(&flat, w, h, &chans, 1.25, false).unwrap();
+    let rf = level_data(&flat, w, h, &chans, 1.25, true).unwrap();
+    let floor2 = level::AMP_ABS_FLOOR * level::AMP_ABS_FLOOR;
+    assert!(level::chan_consts(&chans, &lf, &rf, 0.3)
+        .iter()
+        .all(|c| c.thr2 == floor2));
+}
