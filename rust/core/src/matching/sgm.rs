@@ -1457,4 +1457,319 @@ mod tests {
             assert_eq!(sgm_disparity(col, col, 0, 0, &p).unwrap().len(), 6);
         }
     }
+
+    /// A deterministic pseudo-random image in [0, 1] on a coarse grey scale (ties too).
+    fn noise(w: usize, h: usize, seed: u32) -> Vec<f32> {
+        let mut s = seed;
+        (0..w * h)
+            .map(|_| {
+                s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+                ((s >> 24) % 6) as f32 / 5.0
+            })
+            .collect()
+    }
+
+    #[test]
+    fn census_equals_its_definition() {
+        // Bit k (the 9 x 7 window row-major, centre skipped) where the neighbour, at clamped
+        // coordinates, is darker than the centre; widths below and above the window.
+        for (w, h) in [(23usize, 9usize), (6, 4)] {
+            let img = noise(w, h, 5);
+            let c = census(ImageView::new(w, h, &img).unwrap());
+            for y in 0..h as isize {
+                for x in 0..w as isize {
+                    let at = |xx: isize, yy: isize| {
+                        let (xx, yy) = (xx.clamp(0, w as isize - 1), yy.clamp(0, h as isize - 1));
+                        img[yy as usize * w + xx as usize]
+                    };
+                    let mut want = 0u64;
+                    let mut bit = 0;
+                    for dy in -(RY as isize)..=RY as isize {
+                        for dx in -(RX as isize)..=RX as isize {
+                            if (dx, dy) == (0, 0) {
+                                continue;
+                            }
+                            want |= u64::from(at(x + dx, y + dy) < at(x, y)) << bit;
+                            bit += 1;
+                        }
+                    }
+                    assert_eq!(c[y as usize * w + x as usize], want, "{w}x{h} ({x}, {y})");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn costs_outside_the_right_image_follow_the_best_inside_level() {
+        // Levels whose right pixel x - d_min - k leaves the image cost the best inside level
+        // plus OUTSIDE_MARGIN (at most OUTSIDE), or the best itself where all inside levels cost
+        // the same; with no level inside, OUTSIDE.
+        let w = 6;
+        // Left codes of 62 bits; the right ones 61, 62, 57, 62, 62, 62 bits away from them.
+        let cl = vec![(1u64 << 62) - 1; w];
+        let cr: Vec<u64> = [1u64, 0, 0b11111, 0, 0, 0].to_vec();
+        let n = 4;
+        let vol = cost_volume(&cl, &cr, w, -1, n);
+        let cell = |x: usize| &vol[x * n..(x + 1) * n];
+        // x 0: levels 0..=1 read right pixels 1 and 0 (62, 61): the others 61 + 5 = 66 -> 63.
+        assert_eq!(cell(0), &[62, 61, OUTSIDE, OUTSIDE]);
+        // x 2: levels read right 3, 2, 1, 0: 62, 57, 62, 61; all inside.
+        assert_eq!(cell(2), &[62, 57, 62, 61]);
+        // x 5: level 0 reads right 6 (outside), then 5, 4, 3: all 62, so the outside one too.
+        assert_eq!(cell(5), &[62, 62, 62, 62]);
+        // x 4: right 5, 4, 3, 2 -> 62, 62, 62, 57.
+        assert_eq!(cell(4), &[62, 62, 62, 57]);
+        // The right band: x 5, d_min -1, level 0 reads right 6 (outside), the others right 5,
+        // 4, 3 (52, 62, 62): 52 + 5.
+        let cr2: Vec<u64> = [0u64, 0, 0, 0, 0, (1 << 10) - 1].to_vec();
+        let vol = cost_volume(&cl, &cr2, w, -1, n);
+        assert_eq!(&vol[5 * n..6 * n], &[57, 52, 62, 62]);
+        // d_min 0, the right codes against themselves: x 0 has one inside level (0, so the
+        // outside ones tie with it); x 1 has 0 and 1 inside, the outside one 0 + 5.
+        let vol = cost_volume(&cr, &cr, w, 0, 3);
+        assert_eq!(
+            (&vol[..3], &vol[3..6]),
+            (&[0u8, 0, 0][..], &[0u8, 1, 5][..])
+        );
+    }
+
+    #[test]
+    fn p2_shrinks_with_the_intensity_step() {
+        // p2 / (1 + floor(|dI| / gamma)), at least p1 + 1, |dI| in grey levels.
+        let lut = p2_table(&SgmParams::default());
+        assert_eq!(lut, vec![96, 48, 32, 24, 19, 16, 13, 12, 10, 9, 9, 9]);
+        let g = |a: f32, b: f32| p2_at(a / 255.0, b / 255.0, 16.0, &lut);
+        assert_eq!(
+            (g(0.0, 15.9), g(0.0, 16.1), g(100.0, 60.0), g(0.0, 255.0)),
+            (96, 48, 32, 9)
+        );
+    }
+
+    /// One path's costs by the recurrence, in i64: `L(p, k) = C(p, k) + min(L(q, k),
+    /// L(q, k +- 1) + p1, min L(q) + P2(p, q)) - min L(q)` with `q = p + r` its predecessor
+    /// (`L = C` where `q` leaves the image), P2 from the grey step between `p` and `q`.
+    fn direct_path(
+        c: &[u8],
+        img: &[f32],
+        w: usize,
+        h: usize,
+        n: usize,
+        p: &SgmParams,
+        r: (isize, isize),
+    ) -> Vec<i64> {
+        let lut = p2_table(p);
+        let mut l = vec![0i64; w * h * n];
+        // Visit predecessors first: rows in the direction of r's y, columns of r's x.
+        let ys: Vec<usize> = if r.1 < 0 {
+            (0..h).collect()
+        } else {
+            (0..h).rev().collect()
+        };
+        let xs: Vec<usize> = if r.0 < 0 {
+            (0..w).collect()
+        } else {
+            (0..w).rev().collect()
+        };
+        for &y in &ys {
+            for &x in &xs {
+                let (qx, qy) = (x as isize + r.0, y as isize + r.1);
+                let i = y * w + x;
+                if qx < 0 || qy < 0 || qx >= w as isize || qy >= h as isize {
+                    for k in 0..n {
+                        l[i * n + k] = i64::from(c[i * n + k]);
+                    }
+                    continue;
+                }
+                let q = qy as usize * w + qx as usize;
+                let lq = &l[q * n..(q + 1) * n].to_vec();
+                let m = *lq.iter().min().unwrap();
+                let p2 = i64::from(p2_at(img[i], img[q], p.gamma, &lut));
+                for k in 0..n {
+                    let mut best = lq[k].min(m + p2);
+                    if k > 0 {
+                        best = best.min(lq[k - 1] + i64::from(p.p1));
+                    }
+                    if k + 1 < n {
+                        best = best.min(lq[k + 1] + i64::from(p.p1));
+                    }
+                    l[i * n + k] = i64::from(c[i * n + k]) + best - m;
+                }
+            }
+        }
+        l
+    }
+
+    /// The matcher by its definition (module docs) on the summed path costs `s`.
+    fn direct_select(
+        s: &[i64],
+        w: usize,
+        h: usize,
+        n: usize,
+        d_min: i64,
+        p: &SgmParams,
+    ) -> Vec<f32> {
+        let d_max = d_min + n as i64 - 1;
+        let mut out = vec![f32::NAN; w * h];
+        for y in 0..h {
+            let at = |x: usize, k: usize| s[(y * w + x) * n + k];
+            // The right view's winner at xr: the first level j minimising S(xr + d_min + j, j)
+            // over the left pixels in the image.
+            let rk: Vec<usize> = (0..w as i64)
+                .map(|xr| {
+                    let cands: Vec<(i64, usize)> = (0..n)
+                        .filter_map(|j| {
+                            let xl = xr + d_min + j as i64;
+                            (xl >= 0 && xl < w as i64).then(|| (at(xl as usize, j), j))
+                        })
+                        .collect();
+                    cands.iter().min().map_or(0, |c| c.1)
+                })
+                .collect();
+            for x in 0..w {
+                // Levels landing in the right image (x - d in 0..w); the right band is dropped.
+                if x as i64 - d_min >= w as i64 || x as i64 - d_min < 0 {
+                    continue;
+                }
+                let inside = ((x as i64 - d_min + 1) as usize).min(n);
+                let cell: Vec<i64> = (0..inside).map(|k| at(x, k)).collect();
+                let best = *cell.iter().min().unwrap();
+                let k = cell.iter().position(|&v| v == best).unwrap();
+                let xr = x as i64 - d_min - k as i64;
+                if (x as i64) < d_max && xr < i64::from(p.edge_margin) {
+                    continue;
+                }
+                let other = (0..inside)
+                    .filter(|&j| j.abs_diff(k) > 1)
+                    .map(|j| cell[j])
+                    .min()
+                    .unwrap_or(i64::from(u16::MAX));
+                let unique = 100 * other > (100 + i64::from(p.uniqueness)) * best;
+                let consistent = rk[xr as usize].abs_diff(k) <= p.lr_tol as usize;
+                if !(unique && consistent) {
+                    continue;
+                }
+                let mut frac = 0.0f64;
+                if k > 0 && k + 1 < inside {
+                    let (sm, sp) = (cell[k - 1] as f64, cell[k + 1] as f64);
+                    let den = sm + sp - 2.0 * best as f64;
+                    if den > 0.0 {
+                        frac = (sm - sp) / (2.0 * den);
+                    }
+                }
+                out[y * w + x] = ((d_min + k as i64) as f64 + frac) as f32;
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn both_matchers_equal_their_definition() {
+        // 8 paths (horizontal, vertical and both diagonals, each way) and 3 (left to right,
+        // right to left, top to bottom) on a shifted pair with sharp steps (every P2 level),
+        // ranges with d_min 0 and negative, more than 16 levels (argmin's blocks), and
+        // parameters off their defaults.
+        let (w, h) = (46usize, 13usize);
+        let l: Vec<f32> = ramp(w, h, 0.0)
+            .iter()
+            .zip(noise(w, h, 9))
+            .enumerate()
+            .map(|(i, (v, z))| match (i % w, i / w) {
+                // A flat patch: cost ties between levels.
+                (20..=31, 0..=4) => 0.5,
+                _ if i % 11 < 2 => z,
+                _ => *v,
+            })
+            .collect();
+        let r = ramp(w, h, 5.0);
+        let (lv, rv) = (
+            ImageView::new(w, h, &l).unwrap(),
+            ImageView::new(w, h, &r).unwrap(),
+        );
+        let loose = SgmParams {
+            p1: 5,
+            p2: 150,
+            gamma: 9.0,
+            uniqueness: 0,
+            lr_tol: 2,
+            edge_margin: 0,
+            paths: 8,
+        };
+        for (d_min, d_max) in [(0i32, 8i32), (-3, 17)] {
+            let n = (d_max - d_min + 1) as usize;
+            let c = cost_volume(&census(lv), &census(rv), w, i64::from(d_min), n);
+            for base in [SgmParams::default(), loose] {
+                for paths in [8u8, 3] {
+                    let p = SgmParams { paths, ..base };
+                    let dirs: &[(isize, isize)] = if paths == 8 {
+                        &[
+                            (-1, 0),
+                            (1, 0),
+                            (0, -1),
+                            (0, 1),
+                            (-1, -1),
+                            (1, -1),
+                            (-1, 1),
+                            (1, 1),
+                        ]
+                    } else {
+                        &[(-1, 0), (1, 0), (0, -1)]
+                    };
+                    let mut s = vec![0i64; w * h * n];
+                    for &dir in dirs {
+                        for (a, b) in s.iter_mut().zip(direct_path(&c, &l, w, h, n, &p, dir)) {
+                            *a += b;
+                        }
+                    }
+                    let want = direct_select(&s, w, h, n, i64::from(d_min), &p);
+                    let got = sgm_disparity(lv, rv, d_min, d_max, &p).unwrap();
+                    for i in 0..w * h {
+                        assert_eq!(
+                            got[i].to_bits(),
+                            want[i].to_bits(),
+                            "{paths} paths, {d_min}..={d_max}, {p:?}: ({}, {}) {} vs {}",
+                            i % w,
+                            i / w,
+                            got[i],
+                            want[i]
+                        );
+                    }
+                    let found = want.iter().filter(|v| v.is_finite()).count();
+                    assert!(found > w * h / 3, "{found} found");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn parameter_limits_are_exact() {
+        // 0 < p1 < p2 <= MAX_P2, uniqueness <= 100, at most 2048 levels.
+        let img = vec![0.5f32; 64];
+        let v = ImageView::new(8, 8, &img).unwrap();
+        let d = SgmParams::default();
+        let run = |p: SgmParams, d_max: i32| sgm_disparity(v, v, 0, d_max, &p);
+        assert!(run(SgmParams { p1: 96, ..d }, 4).is_err());
+        assert!(run(SgmParams { p1: 95, ..d }, 4).is_ok());
+        assert!(run(SgmParams { p2: MAX_P2, ..d }, 4).is_ok());
+        assert!(run(
+            SgmParams {
+                uniqueness: 101,
+                ..d
+            },
+            4
+        )
+        .is_err());
+        assert!(run(
+            SgmParams {
+                uniqueness: 100,
+                ..d
+            },
+            4
+        )
+        .is_ok());
+        assert!(run(d, 2047).is_ok());
+        assert!(matches!(
+            run(d, 2048).unwrap_err(),
+            CoreError::InvalidParameter { name: "d_max", .. }
+        ));
+    }
 }
