@@ -179,4 +179,52 @@ mod tests {
         assert!(e.to_string().contains("`max_frames`"));
         assert!(grey_difference(&[], &[], 0, 1).is_err());
     }
+
+    #[test]
+    fn grey_difference_weights_b_g_r_and_spans_blocks() {
+        // BT.601 in B, G, R order (OpenCV's BGR2GRAY); alpha counts 0; grey frames count 1.
+        let d = grey_difference(&[100, 0, 0, 0, 100, 0, 0, 0, 100], &[0.0; 9], 3, 3).unwrap();
+        for (v, want) in d.iter().zip([11.4, 58.7, 29.9]) {
+            assert!((v - want).abs() < 1e-4, "{v} vs {want}");
+        }
+        let d = grey_difference(&[0, 0, 0, 200], &[0.0, 0.0, 0.0, 0.0], 1, 4).unwrap();
+        assert_eq!(d, vec![0.0]);
+        assert_eq!(grey_difference(&[7], &[2.5], 1, 1).unwrap(), vec![4.5]);
+        // Past the first 4096-pixel block every pixel still reads its own frame and mean.
+        let n = 5000;
+        let frame: Vec<u8> = (0..n).map(|i| (i % 251) as u8).collect();
+        let mean: Vec<f32> = (0..n).map(|i| (i % 7) as f32).collect();
+        let d = grey_difference(&frame, &mean, n, 1).unwrap();
+        assert!((0..n).all(|i| d[i] == frame[i] as f32 - mean[i]));
+    }
+
+    #[test]
+    fn the_limit_is_the_old_count_s_and_inclusive() {
+        // n = 1: limit ks sqrt(2) = 4.24 at ks 3 (n = 2's would be 3.67): a difference of 4
+        // keeps averaging.
+        let (mut mean, mut count) = (vec![10.0f32], vec![1u8]);
+        running_mean(&[14], &mut mean, &mut count, &[4.0], 1, 3.0, 8).unwrap();
+        assert_eq!((count[0], mean[0]), (2, 12.0));
+        // A difference exactly at the limit keeps averaging too.
+        let lim = 2.0f32 * (1.0f32 + 1.0 / 3.0).sqrt();
+        let (mut mean, mut count) = (vec![10.0f32], vec![3u8]);
+        running_mean(&[14], &mut mean, &mut count, &[lim], 1, 2.0, 8).unwrap();
+        assert_eq!((count[0], mean[0]), (4, 11.0));
+        // ks 0 is allowed: only an exact match keeps averaging.
+        let (mut mean, mut count) = (vec![10.0f32, 10.0], vec![2u8, 2]);
+        running_mean(&[10, 11], &mut mean, &mut count, &[0.0, 1.0], 1, 0.0, 8).unwrap();
+        assert_eq!(count, vec![3, 1]);
+        assert_eq!(mean, vec![10.0, 11.0]);
+    }
+
+    #[test]
+    fn a_zero_count_averages_with_count_1_s_limit_and_restarts_at_1() {
+        // Count 0 (never in a filter's state) reads count 1's limit: a difference at it keeps
+        // averaging (n' = 1), a larger one restarts, also at n' = 1.
+        let (mut mean, mut count) = (vec![10.0f32, 10.0], vec![0u8, 0]);
+        let lim1 = 3.0f32 * 2f32.sqrt();
+        running_mean(&[14, 50], &mut mean, &mut count, &[lim1, 40.0], 1, 3.0, 8).unwrap();
+        assert_eq!(count, vec![1, 1]);
+        assert_eq!(mean, vec![14.0, 50.0]);
+    }
 }
