@@ -196,6 +196,11 @@ mod tests {
         let mean: Vec<f32> = (0..n).map(|i| (i % 7) as f32).collect();
         let d = grey_difference(&frame, &mean, n, 1).unwrap();
         assert!((0..n).all(|i| d[i] == frame[i] as f32 - mean[i]));
+        // ... in BGR too (grey pixels: the weights sum to 1).
+        let frame3: Vec<u8> = frame.iter().flat_map(|&v| [v; 3]).collect();
+        let mean3: Vec<f32> = mean.iter().flat_map(|&v| [v; 3]).collect();
+        let d = grey_difference(&frame3, &mean3, n, 3).unwrap();
+        assert!((0..n).all(|i| (d[i] - (frame[i] as f32 - mean[i])).abs() < 1e-3));
     }
 
     #[test]
