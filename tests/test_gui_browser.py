@@ -1646,6 +1646,9 @@ def test_a_drag_past_the_sliders_range_clamps_them_and_keeps_the_view(tmp_path):
     app = _scene_app("test-follow-mouse-clamped", [bundled_data_dir(), tmp_path])
     app._load_scene(bundled_data_dir() / "cones")
     _run(app, app.recompute)
+    # the sliders' listeners run at each flush, as on the server: setting the sliders from the
+    # view must not put the view on their (clamped) pose
+    app.state.ready()
     cam = app.plotter.camera
     cam.Azimuth(-130.0)  # orbiting the scene: the camera turns right past yaw 90
     cam.OrthogonalizeViewUp()
@@ -2876,6 +2879,234 @@ def test_draw_sparse_colours_each_match_by_its_value():
     np.testing.assert_array_equal(out[30, 50], ramp[1])
     np.testing.assert_array_equal(out[0, 0], [100, 100, 100])
     assert not np.array_equal(ramp[0], ramp[1])
+
+
+# ----------------------------------------------------------------------------- page events
+
+
+def test_the_scene_list_after_start_up_cameras_and_a_choice_put_back(tmp_path):
+    """The scene list's choice and what it says: a failed choice after start-up goes back to
+    the demo scene, choosing the scene on show (the list put back) computes nothing, another
+    scene drops the previous pair's Check rows verdict, and a camera pair clears the choice so
+    that choosing the scene again reloads it."""
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    shutil.copytree(bundled_data_dir() / "cones", tmp_path / "other")
+    (tmp_path / "odd").mkdir()  # fails to load: the two images differ in size
+    cv2.imwrite(str(tmp_path / "odd" / "left.png"), np.zeros((40, 50, 3), np.uint8))
+    cv2.imwrite(str(tmp_path / "odd" / "right.png"), np.zeros((40, 60, 3), np.uint8))
+    app = _scene_app("test-scene-list-events", [bundled_data_dir(), tmp_path])
+    spawned: list = []
+    app._spawn = lambda coro: (spawned.append(coro), coro.close())
+    app._on_ready()
+    demo = str((bundled_data_dir() / "cones").resolve())
+    choose = _chooser(app, tmp_path)
+    choose("odd")
+    assert app.state.error != "" and app.state.scene == demo
+    spawned.clear()
+    app._on_scene(scene=demo)  # the list put back on the scene on show
+    assert spawned == [] and app.state.source_label == "scene data/cones"
+    _run(app, app.check_rows)
+    assert app.state.rows_label.startswith("rectification ok")
+    choose("other")
+    assert app.state.rows_label == "" and len(spawned) == 1
+
+    left, right = app.pair
+
+    class Cameras:
+        def read(self):
+            return left.copy(), right.copy()
+
+        def close(self):
+            pass
+
+    app._switch_source(Cameras(), ("0", "1"))
+    assert app.state.scene is None and app.state.source_label == "cameras 0 / 1"
+    app._on_scene(scene=str(tmp_path / "other"))
+    assert app.state.source_label.startswith("scene ") and app.state.source_label.endswith("other")
+
+
+def test_cameras_after_a_scene_count_captures_close_the_old_and_use_their_own_range():
+    """A camera pair after a scene: the scene's disparity range (cones: 64) is not the cameras',
+    the previous cameras are closed, each pair counts as a capture, and homographies the
+    features gave another rig's pair are not put on the cameras' next pairs after a scene or
+    files were shown."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-cameras-after-scene", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    assert app.max_disparity == 64
+    left, right = app.pair
+    closed: list = []
+
+    class Cameras:
+        def __init__(self, name: str) -> None:
+            self.name = name
+
+        def read(self):
+            return left.copy(), right.copy()
+
+        def close(self):
+            closed.append(self.name)
+
+    class Rectified:  # the features' homographies of a 450x375 pair
+        input_size = (450, 375)
+        max_disparity = 50
+
+        def rectify(self, a, b):
+            return a, b
+
+    app._switch_source(Cameras("a"), ("0", "1"))
+    assert app.max_disparity is None and app.state.captures == 1 and closed == []
+    app._switch_source(Cameras("b"), ("2", "3"))
+    assert closed == ["a"] and app.state.captures == 2
+    app.capture()
+    assert app.state.captures == 3
+    for other in ("scene", "files"):
+        app.homographies = Rectified()
+        if other == "scene":
+            app._load_scene(bundled_data_dir() / "cones")
+        else:
+            app.state.left_file, app.state.right_file = "cones/left.png", "cones/right.png"
+            app.load_files()
+        app.capture()
+        assert app.state.error == "", other
+        assert app.state.source_label == "cameras 2 / 3", other
+        assert app.max_disparity is None, other
+
+
+def test_the_computations_a_page_asks_and_what_they_are_given(monkeypatch):
+    """What each computation is given and how many run: the max-disparity field wins over the
+    scene's range, the same value applied again computes nothing, three quick requests compute
+    the first and the newest only, and the first pair's 3-D caption does not speak of a
+    previous pair while it computes."""
+    import asyncio
+
+    from stereovision.gui import app as gui_app
+    from stereovision.gui import bundled_data_dir
+
+    real = gui_app.compute_view
+    calls: list = []
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        calls.append((kwargs["max_disparity"], app.state.message_3d))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(gui_app, "compute_view", spy)
+    app = _scene_app("test-computations-asked", [bundled_data_dir()])
+    spawned: list = []
+    app._spawn = lambda coro: (spawned.append(coro), coro.close())
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    assert calls == [(64, "")]  # the scene's range; no previous pair to speak of
+    app.apply_max_disparity(text="40")
+    assert app.state.error == "" and len(spawned) == 1
+    _run(app, app.recompute)
+    assert calls[-1][0] == 40
+    app.apply_max_disparity(text="40")
+    assert len(spawned) == 1  # unchanged: nothing to compute
+    calls.clear()
+
+    async def three() -> None:
+        await asyncio.gather(app.recompute(), app.recompute(), app.recompute())
+
+    _run(app, three)
+    assert len(calls) == 2 and app.state.computations == 3
+
+
+def test_toggles_during_a_computation_and_a_failure_keep_the_unit(tmp_path):
+    """The unit and surface/points toggles while a new pair computes leave its cleared results
+    and its 3-D caption alone (they put the previous pair's statistics under the new pair's
+    images); when the pair then fails, the previous pair's statistics and floor come back in
+    the unit chosen meanwhile. An unknown unit is refused and the toggle put back."""
+    import asyncio
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import PENDING_3D
+
+    shutil.copytree(bundled_data_dir() / "cones", tmp_path / "cones")
+    _tiny_scene(tmp_path / "tiny")
+    app = _scene_app("test-toggles-while-computing", [tmp_path])
+    app.state.unit = "yd"  # as the page sends it
+    app._on_unit(unit="yd")
+    assert app.state.error.startswith("unit: expected one of") and app.state.unit == "m"
+    tasks: list = []
+    seen: dict = {}
+    choose = _chooser(app, tmp_path)
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        choose("cones")
+        await asyncio.gather(*tasks)
+        await app.find_floor()
+        seen["floor"] = app.state.floor_label
+        choose("tiny")
+        await asyncio.sleep(0)  # its computation is running in the worker
+        app.state.unit = "ft"
+        app._on_unit(unit="ft")
+        app.state.view_mode = "points"
+        app._on_view_mode()
+        seen["during"] = (app.state.stats, app.state.message_3d)
+        await asyncio.gather(*tasks)
+
+    asyncio.run(run())
+    assert "\xa0m above it" in seen["floor"]
+    assert seen["during"] == ("", PENDING_3D)
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.stats == app.view.texts("ft")[1] and "\xa0ft" in app.state.stats
+    assert "\xa0ft above it" in app.state.floor_label
+
+
+def test_a_new_pair_clears_the_previous_saves_line(tmp_path):
+    """The Save's line ("saved 450×375 to ...") named the previous pair's folder under the next
+    computed pair: it goes with the pair it was said of."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-save-line-cleared", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.save_label.startswith("saved 450×375 to ")
+    _run(app, app.recompute)
+    assert app.state.error == "" and app.state.save_label == ""
+
+
+def test_check_rows_that_fails_on_a_pair_replaced_meanwhile_says_nothing(monkeypatch):
+    """Check rows that failed after another scene was chosen put its error over the new
+    scene's page: the failure was of a pair no longer on show."""
+    import asyncio
+    import threading
+
+    import stereovision.rectification_check as rc
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-rows-fail-replaced", [bundled_data_dir()])
+    started, gate = threading.Event(), threading.Event()
+
+    def fails(*args: Any, **kwargs: Any) -> Any:
+        started.set()
+        gate.wait(60)
+        raise ValueError("no features to check")
+
+    monkeypatch.setattr(rc, "check_rectification", fails)
+
+    async def pressed_then_scene() -> None:
+        app._lock = asyncio.Lock()
+        app._load_scene(bundled_data_dir() / "cones")
+        running = asyncio.ensure_future(app.check_rows())
+        await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
+        app._load_scene(bundled_data_dir() / "cones")  # another pair, chosen meanwhile
+        gate.set()
+        await running
+
+    asyncio.run(pressed_then_scene())
+    assert app.state.error == ""
+    _run(app, app.check_rows)  # on the pair on show it is said
+    assert app.state.error == "no features to check"
 
 
 # ----------------------------------------------------------------------------- browser
