@@ -3109,6 +3109,34 @@ def test_check_rows_that_fails_on_a_pair_replaced_meanwhile_says_nothing(monkeyp
     assert app.state.error == "no features to check"
 
 
+def test_a_cloud_opened_after_a_failed_start_up_clears_the_error_status(tmp_path):
+    """Cameras that gave no pair at start-up left the toolbar on "error"; a point-cloud file
+    then opened cleared the message but the toolbar still said "error" above a page with no
+    error on it (the status went back to "ready" only once a pair was on show)."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.io import write_ply
+
+    class NoFrames:
+        def read(self):
+            raise OSError("camera 0 gave no frame")
+
+        def close(self):
+            pass
+
+    write_ply(tmp_path / "blob.ply", np.random.default_rng(2).uniform(1, 3, (50, 3)))
+    app = _scene_app(
+        "test-cloud-after-failed-start", [bundled_data_dir(), tmp_path], source=NoFrames()
+    )
+    app._on_ready()
+    assert app.state.status == "error" and app.state.error == "camera 0 gave no frame"
+    app.state.cloud_path = str(tmp_path / "blob.ply")
+    app.open_cloud()
+    assert app.state.error == "" and app.state.status == "ready"
+    assert app.state.message_3d.endswith(
+        ": 50 points (a point cloud has no surface: shown as points)"
+    )
+
+
 # ----------------------------------------------------------------------------- browser
 
 

@@ -1463,7 +1463,9 @@ class StereoApp:
         stayed until the next computed pair)."""
         with self.state:
             self.state.error = ""
-            if not self._computing and self.view is not None:
+            # without a pair on show too: the toolbar said "error" above a page with no error
+            # on it (cameras that failed at start-up, then a point-cloud file opened)
+            if not self._computing and (self.view is not None or self.state.status == "error"):
                 self.state.status = "ready"
 
     def _other_source(self) -> None:
