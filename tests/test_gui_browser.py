@@ -2218,6 +2218,7 @@ def test_rectify_uses_a_pair_already_rectified_as_given(data_dir):
     assert app.pair[0].shape != raw[0].shape
     _run(app, app.rectify_from_features)
     assert app.homographies is None and app.pair[0] is raw[0]
+    assert app.max_disparity is None  # the homographies' range went with them
     assert app.state.computations == 2 and " · 450×375 · " in app.state.stats
 
 
@@ -2958,7 +2959,15 @@ def test_cameras_after_a_scene_count_captures_close_the_old_and_use_their_own_ra
         def rectify(self, a, b):
             return a, b
 
+    class NoFrames(Cameras):
+        def read(self):
+            raise OSError("camera 9 gave no frame")
+
+    app._switch_source(NoFrames("none"), ("9", "9"))
+    assert app.state.error == "camera 9 gave no frame" and closed == ["none"]
+    closed.clear()
     app._switch_source(Cameras("a"), ("0", "1"))
+    assert app.state.error == ""
     assert app.max_disparity is None and app.state.captures == 1 and closed == []
     app._switch_source(Cameras("b"), ("2", "3"))
     assert closed == ["a"] and app.state.captures == 2
@@ -3135,6 +3144,84 @@ def test_a_cloud_opened_after_a_failed_start_up_clears_the_error_status(tmp_path
     assert app.state.message_3d.endswith(
         ": 50 points (a point cloud has no surface: shown as points)"
     )
+
+
+def test_reset_puts_all_six_sliders_back_to_zero():
+    """The 3-D view's Reset: every slider at 0 (the left camera's pose), the view with them."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import _CONTROL_NAMES
+
+    app = _scene_app("test-reset-sliders", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    for k, name in enumerate(_CONTROL_NAMES):
+        app.state[name] = 0.5 + k
+    app._on_controls()
+    app.reset_camera()
+    assert {n: app.state[n] for n in _CONTROL_NAMES} == dict.fromkeys(_CONTROL_NAMES, 0.0)
+    pose = render.controls_from_pose(render.pose_from_camera(app.plotter.camera))
+    assert [getattr(pose, n) for n in _CONTROL_NAMES] == pytest.approx([0.0] * 6, abs=1e-6)
+
+
+def test_a_pair_superseded_while_it_fails_leaves_the_newer_choice_and_the_page(tmp_path):
+    """A scene that failed after a newer one was chosen put its failure on the page and the
+    previous pair back in the app, so the newer choice computed the previous pair; a new pair
+    queued behind a superseded one took the blank page as the one to put back on failure."""
+    import asyncio
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    for name in ("cones", "other"):
+        shutil.copytree(bundled_data_dir() / "cones", tmp_path / name)
+    _tiny_scene(tmp_path / "tiny")
+    app = _scene_app("test-superseded-failure", [tmp_path])
+    tasks: list = []
+    choose = _chooser(app, tmp_path)
+    seen: dict = {}
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        choose("cones")
+        await asyncio.gather(*tasks)
+        choose("tiny")  # fails, but "other" is chosen while it runs
+        await asyncio.sleep(0)
+        choose("other")
+        await asyncio.gather(*tasks)
+        seen["other"] = (app.state.error, app.state.source_label, app.state.computations)
+        seen["page"] = (app.state.stats, app.state.img_disparity)
+        choose("cones")  # queued behind "tiny", which is superseded: both then fail
+        choose("tiny")
+        await asyncio.gather(*tasks)
+
+    asyncio.run(run())
+    other = app.folders.label((tmp_path / "other").resolve())
+    assert seen["other"] == ("", f"scene {other}", 2)
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.source_label == f"scene {other}" and app.state.computations == 2
+    assert seen["page"][1] != "" and (app.state.stats, app.state.img_disparity) == seen["page"]
+
+
+def test_an_image_sequence_typed_as_a_camera_is_opened_by_its_folder(tmp_path):
+    """A camera field may hold an image sequence (``seq/left%02d.png``): its folder is checked
+    against --data, the pattern is no file of its own."""
+    from stereovision.gui import bundled_data_dir
+
+    left, right = (cv2.imread(str(CONES / f"{s}.png")) for s in ("left", "right"))
+    (tmp_path / "seq").mkdir()
+    for k in range(2):
+        cv2.imwrite(str(tmp_path / "seq" / f"left{k:02d}.png"), left)
+        cv2.imwrite(str(tmp_path / "seq" / f"right{k:02d}.png"), right)
+    app = _scene_app("test-camera-sequence", [bundled_data_dir(), tmp_path])
+    app.state.cam_left = str(tmp_path / "seq" / "left%02d.png")
+    app.state.cam_right = str(tmp_path / "seq" / "right%02d.png")
+    app.open_cameras()
+    assert app.state.error == ""
+    assert app.state.source_label == "cameras left%02d.png / right%02d.png"
+    assert app.pair[0].shape == (375, 450, 3)
+    app.source.close()
 
 
 # ----------------------------------------------------------------------------- browser
