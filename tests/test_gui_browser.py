@@ -2139,6 +2139,8 @@ def test_rectify_controller_without_a_calibration(data_dir):
     import asyncio
 
     sp = data_dir / "stereopi_rig" / "scene_photo"
+    from stereovision.gui.app import nowrap_units
+
     raw = (cv2.imread(str(sp / "left.png")), cv2.imread(str(sp / "right.png")))
     app = _still_cameras_app("test-rectify", data_dir, raw)
 
@@ -2148,11 +2150,15 @@ def test_rectify_controller_without_a_calibration(data_dir):
         await app.check_rows()
         assert "NOT rectified" in app.state.rows_label
         await app.rectify_from_features()
+        said.append(app.state.rows_label)
         await app.check_rows()
 
+    said: list = []
     asyncio.run(run())
     assert app.state.error == ""
     rect = app.homographies
+    # the homographies' line, its numbers and units kept together as every line on the page
+    assert said == [nowrap_units(rect.describe())] and said[0] != rect.describe()
     assert rect is not None and app.pair[0].shape[:2] == rect.size[::-1]
     assert app.state.rows_label.startswith("rectification ok")
     assert app.view is not None and app.view.result.max_disparity >= rect.max_disparity
@@ -3014,6 +3020,7 @@ def test_the_computations_a_page_asks_and_what_they_are_given(monkeypatch):
     assert app.state.error == "" and len(spawned) == 1
     _run(app, app.recompute)
     assert calls[-1][0] == 40
+    assert app.state.max_disp_hint == "auto: 64 px at full size"  # the automatic one, not 40
     app.apply_max_disparity(text="40")
     assert len(spawned) == 1  # unchanged: nothing to compute
     calls.clear()
