@@ -219,6 +219,8 @@ def test_bad_pairs_are_named(data_dir: Path, tmp_path: Path) -> None:
     sc = load_scene(data_dir / "middlebury2003" / "cones")
     with pytest.raises(ValueError, match="one size"):
         rectify_uncalibrated(sc.left, sc.right[:-10])
+    with pytest.raises(ValueError, match="left is 450x375 px, right is 440x375 px"):
+        rectify_uncalibrated(sc.left, sc.right[:, :-10])
     flat = np.full((200, 300), 128, np.uint8)
     with pytest.raises(ValueError, match=r"only 0 feature matches"):
         rectify_uncalibrated(flat, flat)
@@ -443,10 +445,12 @@ def test_rectify_points_refuses_other_layouts() -> None:
         ("H1", [[float("nan")] * 3] * 3, "H1 has a NaN or infinite entry"),
         ("H2", [[0.0] * 3] * 3, "H2 is singular"),
         ("size", [0, -5], "size 0x-5 px"),
+        ("size", [0, 100], "size 0x100 px"),
         ("input_size", [612, 0], "input_size 612x0 px"),
         ("max_disparity", -3, "max_disparity -3"),
         ("max_disparity", 0, "max_disparity 0"),
         ("model", "banana", "model 'banana'"),
+        ("model", "auto", "model 'auto'"),
     ],
 )
 def test_a_damaged_rectification_file_is_refused(
@@ -560,6 +564,12 @@ def test_check_with_identity_homographies_is_the_plain_check(data_dir: Path) -> 
     got, want = rect.check(sc.left, sc.right), check_rectification(sc.left, sc.right)
     assert want.ok is True and want.matches >= 100
     assert got.matches == want.matches and got.ok == want.ok
+    # its tolerance is the one given: below the rows' median |dy| the verdict turns
+    strict = rect.check(sc.left, sc.right, tolerance=want.median_dy / 2)
+    assert (
+        strict.ok is False
+        and strict.ok == check_rectification(sc.left, sc.right, tolerance=want.median_dy / 2).ok
+    )
     np.testing.assert_array_equal(got.points, want.points)
     assert (got.median_dy, got.offset) == (want.median_dy, want.offset)
     for bad in (0, -0.5, float("nan"), True):
@@ -597,3 +607,98 @@ def test_the_search_range_starts_low_disparity_px_above_zero(
     assert lo == pytest.approx(uc._LOW_DISPARITY, abs=1e-9)
     assert hi > 20
     assert rect.max_disparity == math.ceil(hi - lo + 2 * uc._LOW_DISPARITY)
+
+
+def test_the_search_range_reaches_the_margin_beyond_the_features(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Cones, bumped, with the features' span alone (no coarse probe): the range reaches
+    ``_RANGE_MARGIN`` of the span below its low end, so the 5th percentile lands that far above
+    ``_LOW_DISPARITY``, and as far beyond the high end (measured: 10.48 to 38.76 px, max 50)."""
+    import stereovision.uncalibrated as uc
+
+    monkeypatch.setattr(uc, "_dense_span", lambda *args: None)
+    sc, _, right = perturbed_scene(data_dir, "middlebury2003/cones")
+    rect = rectify_uncalibrated(sc.left, right)
+    lo, hi = rect.disparity_range
+    assert lo == pytest.approx(uc._LOW_DISPARITY + uc._RANGE_MARGIN * (hi - lo), abs=1e-6)
+    width = (1 + 2 * uc._RANGE_MARGIN) * (hi - lo) + 2 * uc._LOW_DISPARITY
+    assert rect.max_disparity == math.ceil(width - 1e-6)
+
+
+def test_hartleys_homographies_keep_the_images_upright(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """OpenCV's homographies may turn both images upside down (a rotation by 180 degrees fits
+    ``F`` as well): they are turned back, to the same rectification; a right image mirrored
+    against the left one is refused."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    want = rectify_uncalibrated(sc.left, sc.right, model="projective")
+    original = cv2.stereoRectifyUncalibrated
+
+    def turned(*args: object) -> tuple:
+        ok, h1, h2 = original(*args)
+        flip = np.diag([-1.0, -1.0, 1.0])
+        return ok, flip @ h1, flip @ h2
+
+    monkeypatch.setattr(cv2, "stereoRectifyUncalibrated", turned)
+    got = rectify_uncalibrated(sc.left, sc.right, model="projective")
+    np.testing.assert_allclose(got.H1, want.H1, rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(got.H2, want.H2, rtol=1e-9, atol=1e-9)
+    assert got.size == want.size
+
+    def mirrored(*args: object) -> tuple:
+        ok, h1, h2 = original(*args)
+        return ok, h1, np.diag([-1.0, 1.0, 1.0]) @ h2
+
+    monkeypatch.setattr(cv2, "stereoRectifyUncalibrated", mirrored)
+    with pytest.raises(ValueError, match="rectified right image would be mirrored"):
+        rectify_uncalibrated(sc.left, sc.right, model="projective")
+
+
+def test_options_of_the_fit_are_used(data_dir: Path) -> None:
+    """``ransac_px`` is the fundamental matrix's threshold (cones: 500 matches fit within 0.3 px,
+    524 within 1, 537 within 3), ``matches`` counts those that fit, not all SIFT matches; and
+    ``model="quasi-euclidean"`` refuses a hand-held pair the turned cameras do not fit (OpenCV's
+    books: median residual 2.62 px), which ``"auto"`` rectifies with Hartley's homographies."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    counts = [rectify_uncalibrated(sc.left, sc.right, ransac_px=p).matches for p in (0.3, 3.0)]
+    assert counts[0] + 20 < counts[1]
+    books = data_dir / "opencv_uncalibrated" / "books"
+    left, right = cv2.imread(str(books / "left.jpg")), cv2.imread(str(books / "right.jpg"))
+    rect = rectify_uncalibrated(left, right)
+    assert rect.model == "projective" and 80 <= rect.matches <= 100  # measured 91 of 107
+    with pytest.raises(ValueError, match=r"two turned cameras do not fit the matches \(median"):
+        rectify_uncalibrated(left, right, model="quasi-euclidean")
+
+
+def test_a_file_without_a_model_or_with_a_short_size(tmp_path: Path) -> None:
+    """A file written before the quasi-Euclidean model existed (no ``model``) holds Hartley's
+    homographies: it reads as ``"projective"``; a one-number size is named, not an IndexError."""
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (100, 80), (100, 80), np.eye(3), 40, 0.1, 0.2, (1.0, 9.0), 16,
+        (0.0, 0.0), (1.0, 1.0), "quasi-euclidean",
+    )  # fmt: skip
+    data = rect.as_dict()
+    del data["model"]
+    (tmp_path / "old.json").write_text(json.dumps(data))
+    assert UncalibratedRectification.load(tmp_path / "old.json").model == "projective"
+    data["size"] = [100]
+    (tmp_path / "short.json").write_text(json.dumps(data))
+    with pytest.raises(ValueError, match=r"short\.json is not an uncalibrated rectification"):
+        UncalibratedRectification.load(tmp_path / "short.json")
+
+
+def test_rectify_uses_the_interpolation_given() -> None:
+    """A half-pixel shift: linear interpolation averages neighbours, nearest keeps the input's
+    own values."""
+    img = np.tile(np.array([0, 100], np.uint8), (8, 6))  # columns 0, 100, 0, 100, ...
+    half = np.array([[1.0, 0, 0.5], [0, 1, 0], [0, 0, 1]])
+    rect = UncalibratedRectification(
+        half, half, (12, 8), (12, 8), np.eye(3), 40, 0.1, 0.2, (1.0, 9.0), 16, (0.0, 0.0),
+        (1.0, 1.0),
+    )  # fmt: skip
+    lin, _ = rect.rectify(img, img)
+    near, _ = rect.rectify(img, img, interpolation=cv2.INTER_NEAREST)
+    assert set(np.unique(lin[:, 1:-1])) == {50}
+    assert set(np.unique(near)) <= {0, 100}
