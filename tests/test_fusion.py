@@ -132,6 +132,7 @@ def test_bits_follow_the_spec() -> None:
     [
         ({"sparse": {}}, "at least one sparse channel"),
         ({"sparse": {"sgbm": None}}, "unknown sparse channel"),
+        ({"sparse": {"gabor": None}}, "unknown sparse channel"),  # the dense one
         ({"mode": "all"}, "mode"),
         ({"tau_dx": 0.0}, "tau_dx"),
         ({"r_spatial": float("nan")}, "r_spatial"),
@@ -219,6 +220,12 @@ def test_fused_dense_veto_replace_and_fill() -> None:
     # Holes within 1.5 px of a member take its value at the fill confidence.
     assert out[0, 24] == 12.0 and conf[0, 24] == pytest.approx(0.25)
     assert np.isnan(out[0, 10])
+    # The fill's confidence is the one given.
+    _, conf2 = fused_dense(d, c, members, radius=5.0, tau=2.0, fill_radius=1.5, fill_confidence=0.4)
+    assert conf2[0, 24] == pytest.approx(0.4) and conf2[1, 24] == 1.0
+    for bad in ({"fill_confidence": 1.5}, {"second_confidence": -0.1}):
+        with pytest.raises(ValueError, match=next(iter(bad))):
+            fused_dense(d, c, members, **bad)
     # Without members the Gabor map is returned unchanged.
     same, _ = fused_dense(d, c, np.full((H, W), np.nan, np.float32))
     np.testing.assert_array_equal(same, d)
@@ -434,6 +441,19 @@ def test_edge_check_drops_members_on_fattened_edges(data_dir: Path) -> None:
     assert 0.97 * p_off.count < p_on.count < p_off.count
     keys = [set(zip(r.matches.xl.tolist(), r.matches.yl.tolist(), strict=True)) for r in (on, off)]
     assert keys[0] < keys[1]
+    # Exactly the members on step 7's pixels of the re-measured Gabor map (_EDGE_MEMBERS: 7 px,
+    # an edge 1.5 x the step, jumps over 2 px) go, with or without the both-sides check.
+    from stereovision import _core
+
+    fat = _core.fattened(off.channel_outputs["gabor_remeasured"], gl, 7, 1.5, 2.0)
+    assert keys[0] == {(x, y) for x, y in keys[1] if not fat[int(y), int(x)]}
+    kw = {"max_disparity": 80, "census_members": False, "check_members": False}
+    alone = [fuse_pair(gl, gr, edge_members=e, **kw) for e in (True, False)]
+    kept, all_ = (
+        {(x, y) for x, y in zip(r.matches.xl.tolist(), r.matches.yl.tolist(), strict=True)}
+        for r in alone
+    )
+    assert kept == {(x, y) for x, y in all_ if not fat[int(y), int(x)]} != all_
 
 
 def test_census_clear_drops_members_near_a_lower_census_region() -> None:
@@ -479,6 +499,21 @@ def test_census_clear_drops_members_near_a_lower_census_region() -> None:
         census_clear(fr, census, radius=-1)
     with pytest.raises(ValueError, match="radius"):
         census_clear(fr, census, radius=2.5)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="radius"):
+        census_clear(fr, census, radius=True)
+    # "More than jump below": a census value exactly jump below keeps the member.
+    exact = census.copy()
+    exact[2, 27] = 18.5
+    kept = census_clear(fr, exact, radius=7, jump=1.5).matches
+    assert (22.0, 2.0) in set(zip(kept.xl.tolist(), kept.yl.tolist(), strict=True))
+    # After fuse_pair's member check the count before it stays what it was.
+    from stereovision.matching.fusion import _members_where
+
+    checked = _members_where(fr, np.arange(len(pts)) != 6)
+    assert checked.matches.stats["members_before_check"] == len(pts)
+    after = census_clear(checked, census, radius=7, jump=1.5)
+    assert after.matches.stats["members_before_check"] == len(pts)
+    assert after.matches.stats["members_before_census"] == len(pts) - 1
     with pytest.raises(ValueError, match="jump"):
         census_clear(fr, census, jump=float("nan"))
 
@@ -624,6 +659,14 @@ def test_enclosed_far_fills_dark_locked_regions_only() -> None:
     assert not fill_enclosed_far(d, g, floor=-1.0)[1].any()
     # A surround less than `jump` above the floor: kept.
     assert not fill_enclosed_far(d, g, jump=9.0)[1].any()
+    # ... above the floor, not above 0: the scene 4 px further, floor 4 (surround 6 above it).
+    assert fill_enclosed_far(d + 4.0, g, floor=4.0, jump=5.0)[1].sum() == 150
+    assert not fill_enclosed_far(d + 4.0, g, floor=4.0, jump=7.0)[1].any()
+    # A surround partly NaN: the median of its measured pixels.
+    dp = d.copy()
+    dp[17:20, 7:28] = np.nan  # the ring's top rows
+    out_p, filled_p = fill_enclosed_far(dp, g)
+    assert filled_p.sum() == 150 and np.all(out_p[20:30, 10:25] == 6.0)
     # NaN pixels belong to no region and to no surround.
     dn = d.copy()
     dn[16:34, 6:29] = np.nan  # wider than the ring
@@ -832,3 +875,27 @@ def test_fused_dense_gives_holes_no_confidence() -> None:
     c = np.full((H, W), 0.5, np.float32)
     out, conf = fused_dense(d, c, np.full((H, W), np.nan, np.float32))
     assert np.isnan(out[4, 4]) and conf[4, 4] == 0.0 and conf[5, 5] == 0.5
+
+
+def test_fused_dense_second_opinion_drops_disagreement_and_fills_holes() -> None:
+    """Step 4: a Gabor value more than ``second_tol`` from the second map becomes a hole (not
+    the second map's value); exactly ``second_tol`` apart it stays; a hole takes the second
+    map's value at ``second_confidence``, also when there is no map of its own at all. Step 5's
+    bound is strict too."""
+    nan = np.float32(np.nan)
+    d = np.array([[10, 10, 10, 10, nan, 10, 10, 10]], np.float32)
+    second = np.array([[10.5, 11, 14, 10, 7, 10, 10, 10]], np.float32)
+    conf = np.full(d.shape, 0.8, np.float32)
+    none = np.full(d.shape, nan, np.float32)
+    out, c = fused_dense(d, conf, none, second=second, second_tol=1.0, second_confidence=0.7)
+    np.testing.assert_array_equal(out, np.array([[10, 10, nan, 10, 7, 10, 10, 10]], np.float32))
+    np.testing.assert_allclose(c, [[0.8, 0.8, 0.0, 0.8, 0.7, 0.8, 0.8, 0.8]])
+    out, c = fused_dense(none, conf, none, second=second, second_confidence=0.7)
+    np.testing.assert_array_equal(out, second)
+    np.testing.assert_allclose(c, np.full(d.shape, 0.7))
+    # Step 5: a lone Gabor value (no second value there) more than occlusion_tau above the row
+    # fill of the others goes; exactly occlusion_tau above it stays.
+    lone = np.array([[5, 5, 7, 5, 5, 7.5, 5, 5]], np.float32)
+    quiet = np.array([[5, 5, nan, 5, 5, nan, 5, 5]], np.float32)
+    out, _ = fused_dense(lone, conf, none, second=quiet, occlusion_tau=2.0)
+    np.testing.assert_array_equal(out, np.array([[5, 5, 7, 5, 5, nan, 5, 5]], np.float32))
