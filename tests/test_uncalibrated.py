@@ -191,6 +191,13 @@ def test_opencv_homographies_are_skewed_and_the_shear_fixes_them(data_dir: Path)
     assert skew1 > 3.0 and aspect2 > 1.5  # measured 4.48 degrees and 2.03
     assert max(rect.skew_deg) < 0.05 and abs(rect.aspect[1] - 1) < 0.005
 
+    # One scale keeps the matched part's area (measured over all the matches, those that do
+    # not fit F too: 70033 -> 70696 px^2; the area ratio itself as the scale gave 78972).
+    def area(pts: np.ndarray) -> float:
+        return float(cv2.contourArea(cv2.convexHull(pts.astype(np.float32))))
+
+    assert area(rect.rectify_points(p1)) == pytest.approx(area(p1), rel=0.03)
+
 
 def _stepped_forward(img: np.ndarray, gt: np.ndarray) -> np.ndarray:
     """The view of a camera moved forward along its axis, from the image and its GT disparity
@@ -244,6 +251,14 @@ def test_bad_pairs_are_named(data_dir: Path, tmp_path: Path) -> None:
     rx = cv2.perspectiveTransform(np.float64([np.c_[xs - d, ys]]), rect.H2)[0][:, 0]
     np.testing.assert_allclose(rect.disparity_range, np.percentile(lx - rx, [5, 95]), atol=5.0)
     assert rect.disparity_range[1] <= rect.max_disparity
+    # the output reaches no further than the images: its top and bottom rows lie in both (to
+    # its size rounded up and the rows' slant: measured -0.95 and 376.1 of 0-374; unclamped,
+    # a margin of a quarter of the matched rows beyond them: black rows)
+    w_out, h_out = rect.size
+    ends = np.float64([[[w_out / 2, 0.0], [w_out / 2, h_out - 1.0]]])
+    for hom in (rect.H1, rect.H2):
+        ys = cv2.perspectiveTransform(ends, np.linalg.inv(hom))[0][:, 1]
+        assert -3.0 <= ys.min() and ys.max() <= sc.left.shape[0] + 2.0, ys
     # the rows' figures: the median and the 95th percentile of the matches' |dy| in order
     assert 0 < rect.median_dy < rect.p95_dy < 1.0
     with pytest.raises(ValueError, match="this rectification is for 450x375"):
@@ -702,3 +717,38 @@ def test_rectify_uses_the_interpolation_given() -> None:
     near, _ = rect.rectify(img, img, interpolation=cv2.INTER_NEAREST)
     assert set(np.unique(lin[:, 1:-1])) == {50}
     assert set(np.unique(near)) <= {0, 100}
+
+
+def test_the_coarse_probe_widens_the_range_unless_it_ran_out(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Cones, bumped, with the coarse match's span given: one that ends before its search does
+    widens the features' range; one that reached the end of its search (``search`` px, the last
+    argument) found no end there and is not used: the features' span alone, as with no probe."""
+    import stereovision.uncalibrated as uc
+
+    sc, _, right = perturbed_scene(data_dir, "middlebury2003/cones")
+    monkeypatch.setattr(uc, "_dense_span", lambda *args: None)
+    alone = rectify_uncalibrated(sc.left, right)
+    monkeypatch.setattr(uc, "_dense_span", lambda *a: (0.45 * a[-1], a[-1] - 8.0))
+    ran_out = rectify_uncalibrated(sc.left, right)
+    assert ran_out.max_disparity == alone.max_disparity
+    np.testing.assert_array_equal(ran_out.H1, alone.H1)
+    monkeypatch.setattr(uc, "_dense_span", lambda *a: (0.45 * a[-1], a[-1] - 12.0))
+    ended = rectify_uncalibrated(sc.left, right)
+    assert ended.max_disparity > alone.max_disparity + 40
+
+
+def test_the_search_range_is_at_least_16_px(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A scene whose matches span no disparities (here: the span taken at the median, from
+    both ends, no probe) still gets a search range of 16 px, not the 4 px of the margins."""
+    import stereovision.uncalibrated as uc
+
+    monkeypatch.setattr(uc, "_dense_span", lambda *args: None)
+    monkeypatch.setattr(uc, "_SPAN_PERCENTILE", 50.0)
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    rect = rectify_uncalibrated(sc.left, sc.right)
+    assert rect.disparity_range[0] == pytest.approx(rect.disparity_range[1])
+    assert rect.max_disparity == 16
