@@ -239,6 +239,8 @@ def test_bad_pairs_are_named(data_dir: Path, tmp_path: Path) -> None:
     assert math.hypot(ex - 224.5, ey - 187) < 40  # measured (218, 208): the image's centre
     with pytest.raises(ValueError, match="ransac_px"):
         rectify_uncalibrated(sc.left, sc.right, ransac_px=0)
+    with pytest.raises(ValueError, match="ransac_px"):
+        rectify_uncalibrated(sc.left, sc.right, ransac_px=True)  # not 1 px
     with pytest.raises(ValueError, match="model: expected one of auto"):
         rectify_uncalibrated(sc.left, sc.right, model="affine")
     assert rectify_uncalibrated(sc.left, sc.right, model="projective").model == "projective"
@@ -461,6 +463,7 @@ def test_rectify_points_refuses_other_layouts() -> None:
         ("H2", [[0.0] * 3] * 3, "H2 is singular"),
         ("size", [0, -5], "size 0x-5 px"),
         ("size", [0, 100], "size 0x100 px"),
+        ("size", [200_000, 100], "size 200000x100 px"),
         ("input_size", [612, 0], "input_size 612x0 px"),
         ("max_disparity", -3, "max_disparity -3"),
         ("max_disparity", 0, "max_disparity 0"),
@@ -752,3 +755,21 @@ def test_the_search_range_is_at_least_16_px(
     rect = rectify_uncalibrated(sc.left, sc.right)
     assert rect.disparity_range[0] == pytest.approx(rect.disparity_range[1])
     assert rect.max_disparity == 16
+
+
+def test_sampson_distance_and_describe_in_closed_form() -> None:
+    """The rectified pair's ``F``: a match ``dy`` px apart in its rows is ``dy / sqrt(2)`` from
+    it in Sampson's first-order distance (both points move). ``describe`` names the larger of
+    the two images' skews."""
+    from stereovision.uncalibrated import _RECTIFIED_F, _sampson
+
+    x1 = np.array([[10.0, 20.0, 1.0], [50.0, 7.0, 1.0]])
+    x2 = np.array([[4.0, 23.0, 1.0], [41.0, 6.0, 1.0]])
+    np.testing.assert_allclose(
+        _sampson(_RECTIFIED_F, x1, x2), [-3 / math.sqrt(2), 1 / math.sqrt(2)]
+    )
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (100, 80), (100, 80), np.eye(3), 40, 0.1, 0.2, (1.0, 9.0), 16,
+        (0.02, 0.5), (1.0, 1.0),
+    )  # fmt: skip
+    assert "skew 0.50 deg" in rect.describe()
