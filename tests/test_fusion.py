@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -899,3 +900,29 @@ def test_fused_dense_second_opinion_drops_disagreement_and_fills_holes() -> None
     quiet = np.array([[5, 5, nan, 5, 5, nan, 5, 5]], np.float32)
     out, _ = fused_dense(lone, conf, none, second=quiet, occlusion_tau=2.0)
     np.testing.assert_array_equal(out, np.array([[5, 5, 7, 5, 5, nan, 5, 5]], np.float32))
+
+
+def test_fuse_pair_passes_its_range_to_the_remeasure_and_the_member_check(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A range that starts above 0 reaches the re-measure and the members' both-sides check
+    too, not 0 to ``max_disparity``."""
+    import stereovision.matching.mcgm as mcgm
+    import stereovision.refine as refine
+
+    seen: dict[str, list[tuple[float, float]]] = {"refine": [], "sides": []}
+
+    def spy(name: str, fn: Any) -> Any:
+        def call(*args: Any, **kw: Any) -> Any:
+            seen[name].append((kw["min_disparity"], kw["max_disparity"]))
+            return fn(*args, **kw)
+
+        return call
+
+    monkeypatch.setattr(refine, "refine_disparity", spy("refine", refine.refine_disparity))
+    monkeypatch.setattr(mcgm, "edge_filters", spy("sides", mcgm.edge_filters))
+    sc = load_scene(data_dir / "middlebury2001" / "tsukuba")
+    gl, gr = as_gray_float(sc.left, "left"), as_gray_float(sc.right, "right")
+    res = fuse_pair(gl, gr, max_disparity=16, min_disparity=3, census_members=False)
+    assert len(res) > 100
+    assert seen == {"refine": [(3, 16)], "sides": [(3, 16)]}
