@@ -600,6 +600,9 @@ def test_fused_dense_drops_speckles() -> None:
     np.testing.assert_array_equal(out[~gone], d[~gone])
     kept, _ = fused_dense(d, conf, none, speckle_area=0.0)
     np.testing.assert_array_equal(kept, d)
+    # "Smaller than": an area of exactly 9 px keeps the 9 px island, 10 px does not.
+    assert np.isfinite(fused_dense(d, conf, none, speckle_area=9 / (h * w))[0]).all()
+    assert np.isnan(fused_dense(d, conf, none, speckle_area=10 / (h * w))[0]).sum() == 9
     # An island 1 px off its surroundings is part of them (speckle_diff = 1).
     d2 = bg.copy()
     d2[100:103, 100:103] += 1.0
