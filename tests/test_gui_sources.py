@@ -1,7 +1,7 @@
 """The GUI's sources without a browser: allowed folders, camera pairs, image folders, scaling.
 
-test_gui_browser.py holds the first tests of these (and needs chromium for the rest); these
-pin down what a mutation audit of ``stereovision.gui.sources`` found unasserted.
+The first tests of path escapes and video files are at the end; the others pin down what a
+mutation audit of ``stereovision.gui.sources`` found unasserted.
 """
 
 from __future__ import annotations
@@ -14,6 +14,9 @@ from typing import Any, ClassVar
 import cv2
 import numpy as np
 import pytest
+import synthetic_scene as syn
+from gui_helpers import VIDEO_FRAMES
+from gui_helpers import write_video as _write_video
 
 from stereovision.gui import sources
 from stereovision.gui.sources import AllowedFolders, FolderPairs, VideoPair, display_path
@@ -668,3 +671,132 @@ def test_a_data_folder_inside_another_is_listed_once(data: Path) -> None:
     ]
     assert folders.folders() == [data / "scene", data.resolve()]
     assert folders.scenes() == [data / "scene"]
+
+
+# ----------------------------------------------------------------------------- allowed folders
+
+
+@pytest.fixture
+def tree(tmp_path):
+    """data/ (allowed) with a file, a sub-folder and a symlink out; secret/ beside it."""
+    data = tmp_path / "data"
+    (data / "sub").mkdir(parents=True)
+    (data / "sub" / "a.ply").write_text("x")
+    (data / "img.png").write_bytes(b"png")
+    secret = tmp_path / "secret"
+    secret.mkdir()
+    (secret / "key.ply").write_text("secret")
+    (data / "link.ply").symlink_to(secret / "key.ply")
+    (data / "linkdir").symlink_to(secret)
+    (tmp_path / "data2").mkdir()
+    (tmp_path / "data2" / "b.ply").write_text("y")
+    return data, secret
+
+
+def test_allowed_folders_accept_inside(tree):
+    data, _ = tree
+    folders = AllowedFolders([data])
+    assert folders.resolve(data / "sub" / "a.ply") == (data / "sub" / "a.ply").resolve()
+    assert folders.resolve("sub/a.ply") == (data / "sub" / "a.ply").resolve()  # relative to root
+    assert folders.resolve(data / "sub" / ".." / "img.png") == (data / "img.png").resolve()
+
+
+@pytest.mark.parametrize(
+    "path",
+    [
+        "../secret/key.ply",
+        "sub/../../secret/key.ply",
+        "link.ply",  # symlink to a file outside
+        "linkdir/key.ply",  # symlinked folder outside
+        "/etc/passwd",
+        "../data2/b.ply",  # a sibling whose name starts like the root
+        "",
+    ],
+)
+def test_allowed_folders_reject_escapes(tree, path):
+    data, _ = tree
+    with pytest.raises(ValueError, match=r"outside the allowed folders|empty"):
+        AllowedFolders([data]).resolve(path)
+
+
+def test_allowed_folders_listing_and_errors(tree):
+    data, _ = tree
+    folders = AllowedFolders([data])
+    listed = folders.files(sources.CLOUD_SUFFIXES)
+    assert listed == [(data / "sub" / "a.ply").resolve()] or listed == [data / "sub" / "a.ply"]
+    with pytest.raises(FileNotFoundError, match="no such file"):
+        folders.resolve("sub/missing.ply")
+    with pytest.raises(FileNotFoundError, match="data folder not found"):
+        AllowedFolders([data / "nope"])
+
+
+def test_two_data_folders_of_one_name_are_told_apart(tmp_path):
+    # the bundled ".../stereovision/data" and "--data .../shared/data" both read "data/..."
+    a, b = tmp_path / "pkg" / "data", tmp_path / "shared" / "data"
+    for d in (a, b):
+        (d / "cones").mkdir(parents=True)
+    both = AllowedFolders([a, b])
+    assert [both.label(d / "cones") for d in (a, b)] == ["pkg/data/cones", "shared/data/cones"]
+    assert AllowedFolders([a]).label(a / "cones") == "data/cones"  # alone: as before
+
+
+def test_scene_list_is_not_cut_short_by_other_images(tmp_path, monkeypatch):
+    """The listing's limit counted PNG files: a folder of calibration pairs before the scenes
+    (in walking order) filled it, and the scenes after it were not offered."""
+    monkeypatch.setattr(sources, "MAX_LISTED", 5)
+    (tmp_path / "a_calib").mkdir()
+    for k in range(6):
+        (tmp_path / "a_calib" / f"left_{k:02d}.png").write_bytes(b"png")
+    for name in ("b_scene", "c_scene"):
+        (tmp_path / name).mkdir()
+        for side in ("left.png", "right.png"):
+            (tmp_path / name / side).write_bytes(b"png")
+    (tmp_path / "d_half").mkdir()
+    (tmp_path / "d_half" / "left.png").write_bytes(b"png")  # no right.png: not a scene
+    folders = AllowedFolders([tmp_path])
+    assert [folders.label(p) for p in folders.scenes()] == [
+        f"{tmp_path.name}/b_scene",
+        f"{tmp_path.name}/c_scene",
+    ]
+
+
+# -------------------------------------------------------------------------------------- video files
+
+
+def test_video_pair_reads_frames_and_rewinds(tmp_path):
+    img = syn.left_image()
+    lv = _write_video(tmp_path / "l.avi", img)
+    rv = _write_video(tmp_path / "r.avi", img[:, ::-1].copy())
+    pair = sources.VideoPair(str(lv), str(rv))
+    try:
+        frames = [pair.read() for _ in range(VIDEO_FRAMES + 1)]
+    finally:
+        pair.close()
+    assert frames[0][0].shape == img.shape
+    # Consecutive frames differ (rolled), and after the last frame the video starts again.
+    assert np.abs(frames[0][0].astype(int) - frames[1][0]).mean() > 10
+    assert np.abs(frames[0][0].astype(int) - frames[VIDEO_FRAMES][0]).mean() < 3
+
+
+def test_missing_cameras_clear_errors(tmp_path):
+    with pytest.raises(FileNotFoundError, match="left camera source not found"):
+        sources.VideoPair(str(tmp_path / "none.avi"), str(tmp_path / "none2.avi"))
+    with pytest.raises(OSError, match="cannot open camera 9"):
+        sources.VideoPair(9, 10)
+    with pytest.raises(ValueError, match="empty camera source"):
+        sources.parse_source(" ")
+
+
+def test_open_stereo_source_loops_video_files(tmp_path):
+    img = syn.left_image()
+    lv = _write_video(tmp_path / "l.avi", img)
+    rv = _write_video(tmp_path / "r.avi", img)
+    src = sources.open_stereo_source(str(lv), str(rv))
+    try:
+        frames = [src.read()[0] for _ in range(2 * VIDEO_FRAMES + 1)]
+    finally:
+        src.close()
+    assert all(f.shape == img.shape for f in frames)
+    assert np.abs(frames[0].astype(int) - frames[VIDEO_FRAMES]).mean() < 3  # started again
+    with pytest.raises(OSError, match="7"):
+        sources.open_stereo_source(7, 8)

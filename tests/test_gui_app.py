@@ -1,0 +1,3184 @@
+"""The GUI without a browser: its command line and server start, and ``StereoApp``'s handlers
+called in process (what each click, field and toggle does to the page's state and texts).
+
+The same page driven in headless chromium is tested in test_gui_browser.py; the sources
+(allowed folders, cameras, image folders) in test_gui_sources.py.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import re
+import socket
+import subprocess
+import sys
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+import pytest
+import synthetic_scene as syn
+from gui_helpers import CONES, STARTUP_TIMEOUT_S
+from gui_helpers import decode_data_url as _decode
+from gui_helpers import write_video as _write_video
+
+from stereovision.gui import sources
+from stereovision.gui.sources import AllowedFolders
+
+# -------------------------------------------------------------------------- command line and server
+
+
+def test_gui_cli_errors_exit_2(tmp_path, capsys):
+    from stereovision.gui import main
+
+    assert main(["--left", "0", "--port", "0"]) == 2
+    assert "give both --left and --right" in capsys.readouterr().err
+    assert main(["--left", str(tmp_path / "x.avi"), "--right", str(tmp_path / "y.avi")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("stereovision: error: ") and "not found" in err
+    assert main(["--data", str(tmp_path / "nope")]) == 2
+    assert "data folder not found" in capsys.readouterr().err
+
+
+def _gui_process(*args: str) -> subprocess.Popen:
+    cmd = [sys.executable, "-m", "stereovision.gui", "--no-browser", *args]
+    return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def test_a_page_closed_mid_message_prints_no_traceback():
+    """Closing the browser tab while the 3-D view streamed a frame printed about 40 lines of
+    wslink and aiohttp tracebacks in the terminal. They are filtered now; any other error of
+    those libraries still prints its name and trace."""
+    import logging
+
+    from stereovision.gui import SERVER_LOGGERS, quiet_closed_pages
+
+    flt = quiet_closed_pages()
+    try:
+        assert quiet_closed_pages() is flt  # once only
+        seen: list[str] = []
+
+        class Keep(logging.Handler):
+            def emit(self, record: logging.LogRecord) -> None:
+                seen.append(record.getMessage())
+
+        keep = Keep()
+        wslink, aiohttp = (logging.getLogger(n) for n in SERVER_LOGGERS)
+        for lg in (wslink, aiohttp):
+            lg.addHandler(keep)
+        try:
+            closed = ConnectionResetError("Cannot write to closing transport")
+            wslink.error("Exception raised")
+            wslink.error("ClientConnectionResetError('Cannot write to closing transport')")
+            wslink.error("Traceback ...\nClientConnectionResetError: Cannot write to closing")
+            aiohttp.error("Error handling request from 127.0.0.1", exc_info=closed)
+            wslink.error("Exception raised")
+            wslink.error("ValueError('bad')")
+            aiohttp.error("Error handling request from 127.0.0.1", exc_info=ValueError("x"))
+        finally:
+            for lg in (wslink, aiohttp):
+                lg.removeHandler(keep)
+        assert seen == ["ValueError('bad')", "Error handling request from 127.0.0.1"]
+    finally:
+        for n in SERVER_LOGGERS:
+            logging.getLogger(n).removeFilter(flt)
+
+
+def test_gui_port_0_announces_the_port_it_got():
+    """``gui --port 0`` printed ``http://127.0.0.1:0/``: the address was printed before the
+    server bound. It is now printed once the server listens, with the port the system chose."""
+    import threading
+    import urllib.request
+
+    pytest.importorskip("trame")
+    proc = _gui_process("--port", "0")
+    watchdog = threading.Timer(STARTUP_TIMEOUT_S, proc.kill)  # a hung start ends the read
+    watchdog.start()
+    try:
+        line = proc.stdout.readline()  # blocks until the server listens (or exits)
+        watchdog.cancel()
+        m = re.fullmatch(
+            r"stereovision gui on http://127\.0\.0\.1:(\d+)/ \(Ctrl\+C to stop\)\n", line
+        )
+        assert m is not None, (line, proc.poll())
+        port = int(m.group(1))
+        assert port > 0
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=30) as reply:
+            assert reply.status == 200 and b"<html" in reply.read().lower()
+    finally:
+        watchdog.cancel()
+        proc.terminate()
+        proc.wait(timeout=30)
+
+
+def test_gui_on_a_busy_port_says_so_in_one_line():
+    """A busy port: the address was announced first, then
+    ``[Errno 98] error while attempting to bind on address ...``. Now nothing is announced and
+    the error says which port is taken and what to do."""
+    pytest.importorskip("trame")
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        proc = _gui_process("--port", str(port))
+        out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 2
+    assert out == ""
+    assert err == (
+        f"stereovision: error: port {port} on 127.0.0.1 is in use (another server?): "
+        "choose another with --port, or --port 0 for a free one\n"
+    )
+
+
+def test_gui_url_brackets_an_ipv6_host():
+    from stereovision.gui import url_for
+
+    assert url_for("127.0.0.1", 8080) == "http://127.0.0.1:8080/"
+    assert url_for("::1", 41000) == "http://[::1]:41000/"
+    assert url_for("localhost", 1) == "http://localhost:1/"
+
+
+def test_add_cli_registers_gui():
+    from stereovision.gui import DEFAULT_HOST, add_cli
+
+    parser = argparse.ArgumentParser()
+    add_cli(parser.add_subparsers())
+    args = parser.parse_args(["gui", "--left", "0", "--right", "1", "--no-browser"])
+    assert (args.left, args.right, args.host, args.no_browser) == ("0", "1", DEFAULT_HOST, True)
+    assert DEFAULT_HOST == "127.0.0.1"
+
+
+def test_scaled_calibration_and_compute_view():
+    from stereovision.gui.app import compute_view, draw_matches
+
+    calib = syn.calibration()
+    half = sources.scaled_calibration(calib, 0.5, (syn.W // 2, syn.H // 2))
+    assert half.K1[0, 0] == pytest.approx(syn.F / 2)
+    assert half.K1[0, 2] == pytest.approx((syn.CX + 0.5) / 2 - 0.5)
+    assert half.image_size == (syn.W // 2, syn.H // 2)
+    res = syn.depth_result()
+    right = np.roll(res.left_rectified, -4, axis=1)
+    view = compute_view(res.left_rectified, right, calib, "opencv-sgbm", max_disparity=16)
+    assert view.left_url.startswith("data:image/jpeg;base64,")
+    assert view.disparity_url.startswith("data:image/jpeg;base64,")
+    assert view.result.method == "opencv-sgbm"
+    with pytest.raises(ValueError, match="unknown method"):
+        compute_view(res.left_rectified, right, calib, "nope")
+    # frames at half the calibration's resolution: the calibration is scaled, with a note
+    small, small_r, _ = sources.scale_pair(res.left_rectified, right, 80)
+    half_view = compute_view(small, small_r, calib, "opencv-sgbm", max_disparity=16)
+    assert half_view.result.calibration.K1[0, 0] == pytest.approx(syn.F / 2)
+    assert "warning: the calibration is for 160x120 and the frames are 80x60" in half_view.stats
+    cropped = np.ascontiguousarray(res.left_rectified[:, :100])
+    with pytest.raises(ValueError, match=r"calibration is for 160x120 .* another aspect"):
+        compute_view(cropped, cropped, calib, "opencv-sgbm")
+    sparse = np.full(res.disparity.shape, np.nan, np.float32)
+    sparse[60, 100] = 10.0
+    canvas = draw_matches(res.left_rectified, right, sparse)
+    assert canvas.shape == (syn.H, 2 * syn.W, 3)
+    assert (canvas[60, 100] != np.hstack([res.left_rectified, right])[60, 100]).any()
+
+
+@pytest.mark.parametrize(
+    ("shape", "method", "said"),
+    [
+        (
+            (300, 2, 3),
+            "opencv-sgbm",
+            # depth_map's words: the width needed and the range that fits (it said neither)
+            "disparity range 16 is not smaller than the image width 2: it needs images at least "
+            "17 px wide, or give a max_disparity below 2",
+        ),
+        ((2, 300, 3), "opencv-bm", "opencv-bm cannot match this 300x2 pair: (-211:"),
+    ],
+)
+def test_opencv_methods_on_a_pair_they_cannot_take_say_why(shape, method, said):
+    """An OpenCV reference method on a pair too small for it: the page showed OpenCV's own
+    message, "OpenCV(5.x) /io/opencv/modules/core/src/alloc.cpp:73: error: (-4:Insufficient
+    memory) Failed to allocate 18446744073709551600 bytes" for a 2 px wide pair."""
+    from stereovision.gui.app import compute_view
+
+    img = np.random.default_rng(0).integers(0, 255, shape, dtype=np.uint8)
+    with pytest.raises(ValueError) as err:
+        compute_view(img, img, None, method)
+    assert str(err.value).startswith(said) and "/opencv/" not in str(err.value)
+
+
+def test_the_depth_picture_says_the_distances_of_its_colours():
+    """The depth picture had no key ("depth (near = warm)"), and its colour scale changes with
+    every pair: its caption now gives the distances at its two ends, those of its colour map
+    (1st and 99th percentile of 1 / depth), so that a colour can be read in metres."""
+    from stereovision.calibration import Calibration
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import DEPTH_CAPTION, compute_view
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    view = compute_view(left, right, Calibration.from_file(cones / "calib.txt"), "fast")
+    got = re.fullmatch(r"depth: red ([0-9.]+)\xa0m … blue ([0-9.]+)\xa0m", view.depth_caption)
+    assert got is not None, view.depth_caption
+    inv = 1.0 / view.result.depth[np.isfinite(view.result.depth)]
+    near, far = 1.0 / np.percentile(inv, 99), 1.0 / np.percentile(inv, 1)
+    assert float(got.group(1)) == pytest.approx(near, abs=0.006) and near < 3.0
+    assert float(got.group(2)) == pytest.approx(far, abs=0.006) and far > 4.0
+    assert compute_view(left, right, None, "fast").depth_caption == DEPTH_CAPTION  # no depth
+
+    app = _scene_app("test-depth-caption", [bundled_data_dir()])
+    app._load_scene(cones)
+    _run(app, app.recompute)
+    assert app.state.depth_caption == view.depth_caption
+
+
+def test_the_disparity_picture_says_the_pixels_of_its_colours():
+    """The disparity picture was captioned "disparity", with no key to its colours (0 px to the
+    99th percentile, which changes with every pair). Its caption now gives both ends; the
+    picture itself is the one it was."""
+    from stereovision.cli import colorize
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import DISPARITY_CAPTION, _data_url, compute_view
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    view = compute_view(left, right, None, "fast")
+    got = re.fullmatch(r"disparity: blue 0\xa0px … red ([0-9.]+)\xa0px", view.disparity_caption)
+    assert got is not None, view.disparity_caption
+    d = view.result.disparity
+    assert float(got.group(1)) == pytest.approx(np.percentile(d[np.isfinite(d)], 99), abs=0.05)
+    assert 40 < float(got.group(1)) < 70  # cones: up to about 55 px
+    assert view.disparity_url == _data_url(colorize(d, lo=0.0))
+    empty = compute_view(np.zeros((60, 80, 3), np.uint8), np.zeros((60, 80, 3), np.uint8),
+                         None, "opencv-bm", max_disparity=16)  # fmt: skip
+    assert empty.disparity_caption == DISPARITY_CAPTION
+
+    app = _scene_app("test-disparity-caption", [bundled_data_dir()])
+    app._load_scene(cones)
+    _run(app, app.recompute)
+    assert app.state.disparity_caption.startswith("disparity: blue 0\xa0px … red ")
+
+
+def test_a_number_and_its_unit_are_never_broken_apart():
+    """On a narrow page the statistics line broke "median depth 3.50 m" as "3.50" at the end
+    of a line and "m" alone on the next. The page's texts hold a non-breaking space between
+    each number and its unit (the captions, the statistics, their warnings, in both units)."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import compute_view, nowrap_units
+    from stereovision.io import load_scene
+
+    scene = load_scene(bundled_data_dir() / "cones")
+    view = compute_view(scene.left, scene.right, scene.calib, "opencv-bm", max_disparity=40)
+    breakable = re.compile(r"[0-9∞] (px|m|ft|s|%)(?![A-Za-z])")
+    for unit in ("m", "ft"):
+        caption, stats = view.texts(unit)
+        for text in (caption, stats, view.disparity_caption):
+            assert not breakable.search(text), text
+    assert f"median depth {view.median_depth:.2f}\xa0m" in view.texts("m")[1]
+    assert "searched as 48\xa0px" in view.stats
+    assert nowrap_units("2 matches in 3 s, 1 m") == "2 matches in 3\xa0s, 1\xa0m"
+    # Find floor's line: its angles too ("pitch -0.40" then "deg" alone on a narrow page)
+    assert nowrap_units("pitch -0.40 deg, roll 2 degrees") == "pitch -0.40\xa0deg, roll 2 degrees"
+
+
+def test_the_unit_toggle_shows_lengths_in_feet():
+    """Depth was shown in metres only. The unit toggle (metres by default) shows the depth
+    caption, the median depth and the 3-D translation sliders in feet; the sliders' values are
+    converted, so the view does not move, and back in metres they read as before."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-units", [bundled_data_dir()])
+    assert app.state.unit == "m"
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    metres = app.state.depth_caption, app.state.stats
+    near_m, far_m = (float(v) for v in re.findall(r"([0-9.]+)\xa0m", metres[0]))
+    median_m = float(re.search(r"median depth ([0-9.]+)\xa0m", metres[1]).group(1))
+    app.state.forward = 1.0
+    app._apply_camera()
+    pose = app.plotter.camera.position
+    app._on_unit(unit="ft")
+    got = re.fullmatch(
+        r"depth: red ([0-9.]+)\xa0ft … blue ([0-9.]+)\xa0ft", app.state.depth_caption
+    )
+    assert got is not None, app.state.depth_caption
+    assert float(got.group(1)) == pytest.approx(near_m / 0.3048, abs=0.02)
+    assert float(got.group(2)) == pytest.approx(far_m / 0.3048, abs=0.02)
+    median_ft = float(re.search(r"median depth ([0-9.]+)\xa0ft", app.state.stats).group(1))
+    assert median_ft == pytest.approx(median_m / 0.3048, abs=0.02)
+    assert not re.search(r"[0-9][ \xa0]m\b", app.state.stats)
+    assert app.state.forward == pytest.approx(3.281) and app.state.translation_range == 16.4
+    np.testing.assert_allclose(app.plotter.camera.position, pose, atol=1e-3)  # did not move
+    _run(app, app.recompute)  # a new result comes in the unit on show
+    assert "\xa0ft … " in app.state.depth_caption
+    app._on_unit(unit="m")
+    assert app.state.depth_caption == metres[0] and app.state.forward == pytest.approx(1.0)
+    app._on_unit(unit="furlong")
+    assert app.state.error == "unit: expected one of ['m', 'ft'], got 'furlong'"
+    assert app.state.unit == "m"
+
+
+def test_the_unit_toggle_keeps_the_translations_inside_the_feet_sliders_range():
+    """The translation sliders' +-5 m are shown as +-16.4 ft, yet the toggle converted 5 m to
+    16.404 ft (4.999 m to 16.401 ft): values past the feet sliders' range, the thumb stuck at
+    its end. They are clamped to the range shown, as :func:`sliders_from_pose` clamps, and the
+    view does not move (the 1.3 mm the clamp takes is no camera move)."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-units-range", [bundled_data_dir()])
+    app.state.forward, app.state.up, app.state.right = 5.0, -4.999, 4.998
+    app._apply_camera()
+    pose = app.plotter.camera.position
+    app._on_unit(unit="ft")
+    assert (app.state.translation_range, app.state.translation_step) == (16.4, 0.1)
+    assert (app.state.forward, app.state.up, app.state.right) == (16.4, -16.4, 16.398)
+    np.testing.assert_allclose(app.plotter.camera.position, pose, atol=1e-9)  # did not move
+    app._on_unit(unit="m")
+    assert (app.state.translation_range, app.state.translation_step) == (5.0, 0.05)
+    assert (app.state.forward, app.state.up, app.state.right) == (4.999, -4.999, 4.998)
+
+
+def test_view_texts_say_no_far_end_as_infinity_and_refuse_an_unknown_unit():
+    """The depth caption's far end is infinite when the colours reach no depth: it reads
+    "∞", not "inf ft"; an unknown unit is a ValueError naming it, with or without depths."""
+    from stereovision.gui.app import ViewData
+
+    view = ViewData(
+        None, "", "", "", "", "", None, None, "0.3 s", "", depth_ends=(0.6096, math.inf)
+    )
+    assert view.texts("ft")[0] == "depth: red 2.00\xa0ft … blue ∞"
+    assert view.texts()[0] == "depth: red 0.61\xa0m … blue ∞"
+    for v in (view, ViewData(None, "", "", "", "", "", None, None, "0.3 s", "")):
+        with pytest.raises(ValueError, match="unit: expected one of \\['m', 'ft'\\], got 'yd'"):
+            v.texts("yd")
+
+
+def test_the_max_disparity_field_is_applied_and_checked():
+    """The disparity range could not be set on the page. Its field is empty for automatic (the
+    pair's own range, shown as its hint); a number is applied on Enter, and a bad one is said
+    on the page without computing anything."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import parse_max_disparity
+
+    app = _scene_app("test-max-disp", [bundled_data_dir()])
+    spawned: list = []
+    app._spawn = spawned.append
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    auto = app.max_disparity
+    assert app.state.max_disp_hint == f"auto: {auto} px at full size"
+    assert f"disparities 0–{auto}\xa0px" in app.state.stats
+    for typed, said in (
+        (
+            "abc",
+            "max disparity: expected a whole number of pixels above 0 (empty: automatic), "
+            "got 'abc'",
+        ),
+        (
+            "-5",
+            "max disparity: expected a whole number of pixels above 0 (empty: automatic), got '-5'",
+        ),
+        (
+            "2.5",
+            "max disparity: expected a whole number of pixels above 0 (empty: automatic), "
+            "got '2.5'",
+        ),
+        ("450", "max disparity 450 px is not smaller than the pair's width 450 px"),
+    ):
+        app.state.max_disp = typed
+        app.apply_max_disparity()
+        assert app.state.error == said and spawned == [], typed
+    app.state.max_disp = " 32 "
+    app.apply_max_disparity(True)  # focused: nothing yet
+    assert spawned == []
+    app.apply_max_disparity(False)  # left the field
+    assert app.state.error == "" and len(spawned) == 1
+    _run(app, spawned.pop)
+    assert "disparities 0–32\xa0px" in app.state.stats and app.state.computations == 2
+    app.apply_max_disparity()  # Enter again: the same value, nothing to compute
+    assert spawned == []
+    app.state.max_disp = "auto"
+    app.apply_max_disparity()
+    _run(app, spawned.pop)
+    assert f"disparities 0–{auto}\xa0px" in app.state.stats
+    assert parse_max_disparity(None, 10) is None
+
+
+def test_the_max_disparity_field_is_searched_as_typed():
+    """The page rounded the field up to a multiple of 16 px (40 searched 48 px) although
+    depth_map searches any range: a rounding from the GUI's first commit that only OpenCV's
+    matchers need. The library's methods now search the value as typed (scaled to a lower
+    resolution, up to a whole pixel, kept below the width and said so); the OpenCV reference
+    methods still round up, said in the statistics. 449 px at width 450 is taken."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import parse_max_disparity
+
+    app = _scene_app("test-max-disp-typed", [bundled_data_dir()])
+    spawned: list = []
+    app._spawn = spawned.append
+    app._load_scene(bundled_data_dir() / "cones")
+    app.state.max_disp = "40"
+    app.apply_max_disparity()
+    _run(app, spawned.pop)
+    assert app.state.error == "" and app.view.result.max_disparity == 40
+    assert " · disparities 0–40\xa0px · " in app.state.stats and "warning" not in app.state.stats
+    app.state.method = "opencv-bm"
+    _run(app, app.recompute)
+    assert app.state.error == "" and " · disparities 0–48\xa0px · " in app.state.stats
+    assert (
+        "warning: max disparity 40\xa0px searched as 48\xa0px (OpenCV's matchers take multiples of "
+        "16\xa0px)" in app.state.stats
+    )
+    assert parse_max_disparity("449", 450) == 449
+    with pytest.raises(ValueError, match=r"^max disparity 450 px is not smaller than the pair"):
+        parse_max_disparity("450", 450)
+    app.state.method = "fast"
+    app.state.max_disp = "449"
+    app.apply_max_disparity()
+    _run(app, spawned.pop)
+    assert app.state.error == "" and "disparities 0–449\xa0px" in app.state.stats
+    app.state.resolution = "320"  # 449 x 320 / 450 = 319.3: up to 320, the width
+    _run(app, app.recompute)
+    assert app.state.error == "" and app.view.result.disparity.shape[1] == 320
+    assert "disparities 0–319\xa0px" in app.state.stats
+    assert "warning: max disparity 320\xa0px at width 320 searched as 319\xa0px" in app.state.stats
+
+
+def test_a_max_disparity_scaled_to_a_whole_pixel_is_not_rounded_up_past_it():
+    """159 px at width 424 is 120 px at width 320 exactly; scaled in floats it was
+    120.00000000000001 px, searched as 121 px (and said as '121 px searched as 128 px' by
+    the OpenCV methods)."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import compute_view
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png"))[:, :424] for s in ("left", "right"))
+    view = compute_view(left, right, None, "fast", width=320, max_disparity=159)
+    assert view.result.max_disparity == 120
+    view = compute_view(left, right, None, "opencv-bm", width=320, max_disparity=159)
+    assert "warning: max disparity 120\xa0px searched as 128\xa0px" in view.stats
+
+
+@pytest.mark.parametrize("method", ["gabor", "fused"])
+def test_progress_goes_forward_and_says_what_runs(method):
+    """The status read "prepare done" during the whole matching (most of the time: it looked
+    stalled), and gabor's refinement, missing from the stages' table, put the bar back from
+    75 % to 50 %."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import compute_view
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    said: list = []
+    compute_view(left, right, None, method, progress=lambda pct, text: said.append((pct, text)))
+    percents = [p for p, _ in said]
+    assert percents == sorted(percents) and percents[-1] == 92, said
+    assert (20, f"{method}: prepare done, matching…") in said
+
+
+def test_compute_view_shows_the_swapped_warning(data_dir):
+    """A swapped pair: the page's statistics line carries the library's warning (once), and the
+    pair given the right way round carries none."""
+    from stereovision.gui.app import compute_view
+    from stereovision.io import load_scene
+
+    s = load_scene(data_dir / "middlebury2003" / "cones")
+    swapped = compute_view(s.right, s.left, None, "gabor")
+    assert swapped.stats.count("warning: the left and right images look swapped") == 1
+    assert "warning" not in compute_view(s.left, s.right, None, "gabor").stats
+
+
+def test_app_controllers_report_errors_and_compute(tmp_path, monkeypatch):
+    """The page's controllers in-process (no browser): errors land in ``state.error``."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import StereoApp
+
+    app = StereoApp(
+        get_server("test-controllers", client_type="vue3"),
+        AllowedFolders([bundled_data_dir()]),
+        bundled_data_dir() / "cones",
+    )
+    app.state.left_file, app.state.right_file = "/etc/passwd", "cones/right.png"
+    app.load_files()
+    assert app.state.error == "path outside the allowed folders: /etc/passwd"
+    app.state.cloud_path = "cones/left.png"
+    app.open_cloud()
+    assert app.state.error.startswith("not a point cloud file")
+    app.capture()
+    assert app.state.error.startswith("no camera open")
+    # an emptied field sends None (a TypeError the page never showed)
+    app.state.left_file, app.state.cloud_path = None, None
+    app.load_files()
+    assert app.state.error == "empty or invalid path"
+    app.state.error = ""
+    app.open_cloud()
+    assert app.state.error == "empty or invalid path"
+    app._on_scene(scene="../../../../etc")
+    assert app.state.error == "path outside the allowed folders: ../../../../etc"
+    assert [s["title"] for s in app.state.scenes] == ["data/cones"]
+
+    # computed by hand below (a spawned computation as well would supersede these)
+    app._spawn = lambda coro: coro.close()
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app.state.method = "opencv-bm"
+        app.state.left_file, app.state.right_file = "cones/left.png", "cones/right.png"
+        app.load_files()  # no --calib: disparity only, the 3-D panel says why it is empty
+        await app.recompute()
+
+    asyncio.run(run())
+    assert app.state.error == ""
+    assert app.state.computations == 1
+    asyncio.run(app.check_rows())
+    assert app.state.rows_label.startswith("rectification ok: median |dy| 0.0")
+
+    async def reload() -> None:
+        app.load_files()  # a new pair: the old verdict goes
+
+    asyncio.run(reload())
+    assert app.state.rows_label == ""
+    assert app.state.stats.startswith("opencv-bm · 450×375")
+    assert "No calibration" in app.state.message_3d
+
+    # A pair that fails to compute: the page keeps the previous one, and so does the app (Check
+    # rows and Find floor used to work on the failed pair the page did not show).
+    tiny = np.zeros((8, 8, 3), np.uint8)
+    app.pair, app.state.source_label = (tiny, tiny), "tiny files"
+
+    async def fails() -> None:
+        await app.recompute()
+
+    asyncio.run(fails())
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.pair[0].shape == (375, 450, 3) and app.state.source_label == "files"
+    assert app.state.computations == 1
+
+    # A pair too large for the machine's memory: the census map's check refuses it, and the page
+    # says so instead of the task dying.
+    from stereovision.matching import sgm
+
+    async def too_big() -> None:
+        app.state.method = "fused"
+        await app.recompute()
+
+    # The buffers the extension keeps from earlier calls count as available: none here.
+    monkeypatch.setattr(sgm, "_available_bytes", lambda: 1000)
+    monkeypatch.setattr(sgm._core, "kept_memory", lambda: ((0, 0), 0))
+    asyncio.run(too_big())
+    assert app.state.error.startswith("the census semi-global map needs about")
+    assert app.state.computations == 1
+
+
+def test_files_at_another_resolution_keep_the_calibration_and_the_view_mode(data_dir, tmp_path):
+    """Files twice the calibration's size are matched with it scaled (it was dropped, and the
+    page asked for --calib); another shape says why there is no depth. A new result is drawn
+    as the points / surface toggle shows (it went back to the surface)."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.calibration import Calibration
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import StereoApp
+
+    cones = bundled_data_dir() / "cones"  # with its calib.txt
+    for side in ("left", "right"):
+        img = cv2.imread(str(cones / f"{side}.png"))
+        cv2.imwrite(str(tmp_path / f"big_{side}.png"), cv2.resize(img, None, fx=2, fy=2))
+        cv2.imwrite(str(tmp_path / f"wide_{side}.png"), cv2.resize(img, (900, 375)))
+    app = StereoApp(
+        get_server("test-files-calib", client_type="vue3"),
+        AllowedFolders([tmp_path]),
+        cones,
+        calib=Calibration.from_file(cones / "calib.txt"),
+    )
+    app._spawn = lambda coro: coro.close()  # computed by hand below
+
+    async def load(prefix: str) -> None:
+        app._lock = asyncio.Lock()
+        app.state.left_file = str(tmp_path / f"{prefix}_left.png")
+        app.state.right_file = str(tmp_path / f"{prefix}_right.png")
+        app.load_files()
+        await app.recompute()
+
+    app.state.method = "fast"
+    app.state.view_mode = "points"
+    asyncio.run(load("big"))
+    assert app.state.error == "" and app.calib is not None
+    assert "No calibration" not in app.state.message_3d and "median depth" in app.state.stats
+    shown = app.plotter.actors["scene"].GetMapper().GetInput()
+    assert shown.GetNumberOfPolys() == 0 and shown.GetNumberOfPoints() > 1000  # points, no faces
+    asyncio.run(load("wide"))
+    assert app.calib is None and "another aspect ratio" in app.state.rows_label
+    # --calib was given: the 3-D panel says it does not fit (it said "give --calib")
+    assert app.state.message_3d == (
+        "No calibration: the --calib calibration does not fit these images (disparity only)."
+    )
+
+
+def test_a_later_success_clears_an_error_and_a_scene_can_be_chosen_again(data_dir):
+    """A failed camera open left the toolbar on "error" while the old results stayed; a later
+    successful Check rows now clears it. Choosing the scene on show again after files were
+    loaded reloaded nothing: trame reports only a changed choice."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import StereoApp
+
+    cones = bundled_data_dir() / "cones"
+    app = StereoApp(
+        get_server("test-error-clears", client_type="vue3"),
+        AllowedFolders([bundled_data_dir()]),
+        cones,
+    )
+    app.state.method = "fast"
+    app._spawn = lambda coro: coro.close()  # no server loop here: computed by hand below
+
+    async def run(action) -> None:
+        app._lock = app._lock or asyncio.Lock()
+        await action()
+
+    app._on_scene(scene=str(cones))
+    asyncio.run(run(app.recompute))
+    assert app.state.status == "ready" and app.state.computations == 1
+    app.state.cam_left, app.state.cam_right = "cones/none.mp4", "cones/none.mp4"
+    app.open_cameras()
+    assert app.state.status == "error" and app.state.error.startswith("no such file")
+    asyncio.run(run(app.check_rows))
+    assert app.state.status == "ready" and app.state.error == ""
+    assert app.state.rows_label.startswith("rectification ok")
+
+    app.state.scene = str(cones)
+    app.state.left_file, app.state.right_file = "cones/right.png", "cones/right.png"
+    app.load_files()
+    assert app.state.source_label == "files" and app.state.scene is None
+    assert app.pair[0] is app.pair[1] or np.array_equal(app.pair[0], app.pair[1])
+    app._on_scene(scene=str(cones))
+    assert app.state.source_label == "scene data/cones"
+    assert not np.array_equal(app.pair[0], app.pair[1])
+
+
+def _scene_app(name: str, folders: list[Path], **kw):
+    """A StereoApp on the bundled cones, its tasks run by hand (no server loop here)."""
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import StereoApp
+
+    app = StereoApp(
+        get_server(name, client_type="vue3"),
+        AllowedFolders(folders),
+        bundled_data_dir() / "cones",
+        **kw,
+    )
+    app.state.method = "fast"
+    app._spawn = lambda coro: coro.close()
+    return app
+
+
+def _tiny_scene(folder: Path) -> None:
+    """An 8x8 black pair in ``folder``: it loads, then fails to compute."""
+    folder.mkdir()
+    for side in ("left", "right"):
+        cv2.imwrite(str(folder / f"{side}.png"), np.zeros((8, 8, 3), np.uint8))
+
+
+def _chooser(app: Any, root: Path) -> Any:
+    """``choose(name)``: the scene ``root/name`` chosen in the page's scene list."""
+
+    def choose(name: str) -> None:
+        app.state.scene = str(root / name)
+        app._on_scene(scene=str(root / name))
+
+    return choose
+
+
+def test_the_demo_scene_is_the_scene_list_choice_at_start_up(tmp_path):
+    """At start-up the page showed "scene data/cones" above a scene list whose choice was an
+    empty entry (the state's "" is a chosen value to the select). The demo's entry is now the
+    choice; a pair from elsewhere clears it to None (no choice, the select's label alone)."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-demo-choice", [bundled_data_dir(), tmp_path])
+    assert app.state.scene is None
+    app._on_ready()
+    demo = str((bundled_data_dir() / "cones").resolve())
+    assert app.state.error == "" and app.state.source_label == "scene data/cones"
+    assert app.state.scene == demo
+    assert {i["value"]: i["title"] for i in app.state.scenes}[demo] == "data/cones"
+    app._other_source()
+    assert app.state.scene is None and app._scene == ""
+
+
+def _run(app, action) -> None:
+    import asyncio
+
+    async def go() -> None:
+        app._lock = app._lock or asyncio.Lock()
+        await action()
+
+    asyncio.run(go())
+
+
+def test_a_computed_pair_hands_its_memory_back():
+    """The server kept what a pair's computation left: after a 3600 x 3000 pair, 11-12 GB
+    resident. Each computation now ends with release_memory (the kept buffers and glibc's free
+    pages go back)."""
+    from stereovision import _core
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-release", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    assert app.state.error == "" and app.state.computations == 1
+    assert _core.kept_memory() == ((0, 0), 0)
+
+
+def test_an_opened_cloud_stays_shown_in_both_view_modes(tmp_path):
+    """After "Open" of a PLY the points / surface toggle swapped in the scene's points while the
+    caption still named the file. The file now stays on show in both modes (it has no surface:
+    the caption says so), until the next computed pair replaces it."""
+    from stereovision.gui import bundled_data_dir
+
+    n = 500
+    pts = np.random.default_rng(0).uniform([-1, -1, 2], [1, 1, 4], (n, 3)).astype("<f4")
+    header = f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\n"
+    header += "property float x\nproperty float y\nproperty float z\nend_header\n"
+    (tmp_path / "blob.ply").write_bytes(header.encode() + pts.tobytes())
+    app = _scene_app("test-cloud-modes", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")  # with its calibration: a 3-D scene
+    _run(app, app.recompute)
+
+    def shown() -> tuple[int, int]:
+        poly = app.plotter.actors["scene"].GetMapper().GetInput()
+        return poly.GetNumberOfPoints(), poly.GetNumberOfPolys()
+
+    assert shown()[0] > 10 * n and shown()[1] > 0  # the scene's surface
+    app.state.cloud_path = str(tmp_path / "blob.ply")
+    app.open_cloud()
+    assert app.state.error == ""
+    label = app.folders.label((tmp_path / "blob.ply").resolve())
+    assert shown() == (n, 0)
+    no_surface = " (a point cloud has no surface: shown as points)"
+    assert app.state.message_3d == f"{label}: {n} points{no_surface}"
+    for mode in ("points", "surface", "points"):
+        app.state.view_mode = mode
+        app._on_view_mode()
+        assert shown() == (n, 0), mode
+        assert app.state.message_3d.startswith(f"{label}: {n} points"), mode
+    assert app.state.message_3d == f"{label}: {n} points"
+    _run(app, app.recompute)  # a new pair: its scene replaces the file, drawn as points
+    assert shown()[0] > 10 * n and shown()[1] == 0
+    assert "blob" not in app.state.message_3d
+
+
+def test_a_big_cloud_is_shown_as_a_capped_subset_and_says_so(tmp_path, monkeypatch):
+    """The 3-D view drew every point: a 10 M point PLY took 12.5 s to its first frame (2.7 GB).
+    A cloud over the cap (an opened file, or a computed pair in points mode) is drawn as an
+    evenly spaced subset, the caption says how many of how many, and the file is only read."""
+    from stereovision.gui import app as gui_app
+    from stereovision.gui import bundled_data_dir
+    from stereovision.io import write_ply
+
+    monkeypatch.setattr(gui_app, "MAX_SHOWN_POINTS", 100, raising=False)  # old: none
+    n = 500
+    pts = np.random.default_rng(1).uniform([-1, -1, 2], [1, 1, 4], (n, 3)).astype(np.float32)
+    write_ply(tmp_path / "big.ply", pts)
+    before = (tmp_path / "big.ply").read_bytes()
+    app = _scene_app("test-cloud-cap", [bundled_data_dir(), tmp_path])
+
+    def shown() -> Any:
+        poly = app.plotter.actors["scene"].GetMapper().GetInput()
+        return np.asarray(poly.GetPoints().GetData())
+
+    app.state.view_mode = "points"
+    app.state.cloud_path = str(tmp_path / "big.ply")
+    app.open_cloud()
+    assert app.state.error == ""
+    label = app.folders.label((tmp_path / "big.ply").resolve())
+    assert app.state.message_3d == f"{label}: 100 of 500 points shown, evenly spaced"
+    np.testing.assert_array_equal(shown(), pts[::5])  # every 5th: deterministic, spread
+    assert (tmp_path / "big.ply").read_bytes() == before
+    # a computed pair in points mode: its cloud capped too, and said after its own caption
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    total = len(app.view.result.points)
+    assert total > 10_000 and len(shown()) == 100
+    assert app.state.message_3d == f"100 of {total:,} points shown, evenly spaced"
+    app.state.view_mode = "surface"  # the surface has its own (smaller) vertex budget
+    app._on_view_mode()
+    assert len(shown()) > 100 and app.state.message_3d == ""
+    app.state.view_mode = "points"
+    app._on_view_mode()
+    assert app.state.message_3d == f"100 of {total:,} points shown, evenly spaced"
+
+
+def test_a_failed_scene_choice_puts_the_list_back(tmp_path):
+    """A scene that failed (to load, or to compute) stayed chosen in the list, so choosing it
+    again did nothing (trame reports only a changed value). The list now goes back to the
+    scene on show, and choosing the failed one again retries (and fails again, saying so)."""
+    import asyncio
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    good = tmp_path / "good"
+    shutil.copytree(bundled_data_dir() / "cones", good)
+    (tmp_path / "tiny").mkdir()  # loads, then fails to compute
+    (tmp_path / "odd").mkdir()  # fails to load: the two images differ in size
+    for side in ("left", "right"):
+        cv2.imwrite(str(tmp_path / "tiny" / f"{side}.png"), np.zeros((8, 8, 3), np.uint8))
+    cv2.imwrite(str(tmp_path / "odd" / "left.png"), np.zeros((40, 50, 3), np.uint8))
+    cv2.imwrite(str(tmp_path / "odd" / "right.png"), np.zeros((40, 60, 3), np.uint8))
+    app = _scene_app("test-scene-back", [tmp_path])
+    app._lock = asyncio.Lock()
+    app._spawn = asyncio.run  # a loaded scene is computed at once
+
+    def choose(path: Path) -> None:
+        app.state.scene = str(path)
+        app._on_scene(scene=str(path))
+
+    choose(good)
+    assert app.state.computations == 1 and app.state.scene == str(good)
+    for bad in ("odd", "tiny", "odd", "tiny"):
+        app.state.error = ""
+        choose(tmp_path / bad)
+        assert app.state.error != "", bad  # it was tried (the first time, and again)
+        assert app.state.scene == str(good), bad
+        assert app.state.source_label == "scene data/good" or app.state.source_label.endswith(
+            "/good"
+        ), bad
+        assert app.state.computations == 1, bad
+    # the good scene is still the one the app works on
+    assert app.pair[0].shape == (375, 450, 3)
+
+
+def test_a_pair_that_fails_takes_its_files_warning_with_it(tmp_path):
+    """Files that load but cannot be matched (8 px wide) put the page back on the previous
+    pair, but the acquisition panel kept the failed files' warning ("... are the same image")
+    above the previous pair's images, and its Check rows verdict was gone. The previous
+    pair's line comes back with it."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-files-fail-rows", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.check_rows)
+    verdict = app.state.rows_label
+    assert verdict.startswith("rectification ok"), verdict
+    tiny = np.random.default_rng(0).integers(0, 255, (8, 8, 3)).astype(np.uint8)
+    cv2.imwrite(str(tmp_path / "tiny.png"), tiny)
+    app.state.left_file = app.state.right_file = str(tmp_path / "tiny.png")
+    app.load_files()
+    assert app.state.rows_label.startswith("warning: ")  # said while it is tried
+    _run(app, app.recompute)
+    assert app.state.error.startswith("image too narrow for stereo matching")
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.source_label == "scene data/cones"
+    assert app.state.rows_label == verdict
+
+
+def test_a_scene_chosen_during_a_computation_is_not_shown_the_previous_result(tmp_path):
+    """A scene chosen while another was computing: the running computation recorded the new
+    scene's pair as the one on show, and put its (previous) result under the new scene's name.
+    When the new scene then failed, the app kept its pair (Check rows worked on it) and the list
+    and label named it, while the page showed the other scene's disparity."""
+    import asyncio
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    for name in ("first", "second"):
+        shutil.copytree(bundled_data_dir() / "cones", tmp_path / name)
+    _tiny_scene(tmp_path / "tiny")
+    app = _scene_app("test-scene-during-compute", [tmp_path])
+    tasks: list = []
+    choose = _chooser(app, tmp_path)
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        choose("first")
+        await asyncio.gather(*tasks)
+        choose("second")
+        await asyncio.sleep(0)  # its computation is running in the worker
+        choose("tiny")
+        await asyncio.gather(*tasks)
+
+    asyncio.run(run())
+    first = app.folders.label((tmp_path / "first").resolve())
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.source_label == f"scene {first}"
+    assert app.state.scene == str(tmp_path / "first")
+    assert app.pair[0].shape == (375, 450, 3) and app._scene == str(tmp_path / "first")
+    assert app.state.computations == 1  # the superseded "second" was not put on the page
+
+
+def test_a_new_pair_does_not_show_the_previous_pairs_results_while_it_computes(tmp_path):
+    """While a newly chosen scene computed (23 s for a 1850 px pair), the page showed the
+    previous scene's images, disparity, depth and floor under the new scene's name. The new
+    pair's images now show at once, the previous results are cleared (the 3-D caption says the
+    view is the previous pair's), and they come back if the new pair fails."""
+    import asyncio
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import PENDING_3D, PENDING_FLOOR, _data_url
+
+    shutil.copytree(bundled_data_dir() / "cones", tmp_path / "cones")
+    shutil.copytree(bundled_data_dir() / "cones", tmp_path / "swapped")
+    for side, other in (("left", "right"), ("right", "left")):  # another pair, same size
+        src = bundled_data_dir() / "cones" / f"{other}.png"
+        (tmp_path / "swapped" / f"{side}.png").write_bytes(src.read_bytes())
+    _tiny_scene(tmp_path / "tiny")
+    app = _scene_app("test-new-pair-pending", [tmp_path])
+    tasks: list = []
+    seen: dict = {}
+    choose = _chooser(app, tmp_path)
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        choose("cones")
+        await asyncio.gather(*tasks)
+        await app.find_floor()
+        seen["page"] = {k: app.state[k] for k in ("img_disparity", "stats", "floor_label")}
+        for name in ("swapped", "tiny"):
+            choose(name)
+            await asyncio.sleep(0)  # its computation is running in the worker
+            seen[name] = {k: app.state[k] for k in ("img_left", "img_disparity", "stats")}
+            seen[name]["message_3d"] = app.state.message_3d
+            await app.find_floor()
+            seen[name]["floor_label"] = app.state.floor_label
+            await asyncio.gather(*tasks)
+
+    asyncio.run(run())
+    swapped = seen["swapped"]
+    assert swapped["img_left"] == _data_url(cv2.imread(str(tmp_path / "swapped" / "left.png")))
+    assert swapped["img_disparity"] == "" and swapped["stats"] == ""
+    assert swapped["message_3d"] == PENDING_3D and swapped["floor_label"] == PENDING_FLOOR
+    assert seen["tiny"]["img_disparity"] == "" and seen["tiny"]["stats"] == ""
+    # "tiny" failed: the page shows the swapped pair's results again, as the error says
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.computations == 2 and app.state.stats.startswith("fast · 450×375")
+    assert app.state.img_disparity not in ("", seen["page"]["img_disparity"])
+    assert app.state.img_left == swapped["img_left"] and app.state.message_3d == ""
+
+
+def test_a_failed_method_puts_the_toggle_back_to_the_result_on_show(monkeypatch):
+    """A method that fails on the pair on show (fused refused for memory, when fast fits):
+    the toggle stayed on the failed method above the previous method's disparity. It goes back
+    to the method on show, without computing it again, and the error says what is shown."""
+    from stereovision import _core
+    from stereovision.gui import bundled_data_dir
+    from stereovision.matching import sgm
+
+    app = _scene_app("test-method-back", [bundled_data_dir()])
+    spawned: list = []
+    app._spawn = lambda coro: (spawned.append(coro), coro.close())
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    assert app.state.stats.startswith("fast · ") and app.state.computations == 1
+    app.state.ready()  # from here the toggles' listeners run at each flush, as on the server
+    monkeypatch.setattr(sgm, "_available_bytes", lambda: 1000)
+    monkeypatch.setattr(_core, "kept_memory", lambda: ((0, 0), 0))
+    app.state.method = "fused"
+    spawned.clear()
+    _run(app, app.recompute)
+    assert app.state.error.startswith("the census semi-global map needs about")
+    assert app.state.error.endswith("(the page still shows fast at full resolution)")
+    assert app.state.method == "fast" and app.state.stats.startswith("fast · ")
+    # one computation asked: the click's (its listener ran at the first flush); the toggle's
+    # return to "fast" asks none
+    assert len(spawned) == 1 and app.state.computations == 1
+
+
+def test_a_scene_without_calibration_is_not_told_to_give_calib(tmp_path):
+    """A scene without calib.txt: the 3-D panel and Find floor said "give --calib", but a
+    scene's calibration is its own calib.txt (--calib is for cameras and files), so a restart
+    with --calib changed nothing. They now name the missing file."""
+    from stereovision.gui import bundled_data_dir
+
+    scene = tmp_path / "nocalib"
+    scene.mkdir()
+    for side in ("left", "right"):
+        (scene / f"{side}.png").write_bytes(
+            (bundled_data_dir() / "cones" / f"{side}.png").read_bytes()
+        )
+    app = _scene_app("test-scene-no-calib", [tmp_path])
+    app._load_scene(scene)
+    _run(app, app.recompute)
+    label = app.folders.label(scene.resolve())
+    assert app.state.error == "" and app.state.computations == 1
+    assert (
+        app.state.message_3d == f"No calibration: scene {label} has no calib.txt (disparity only)."
+    )
+    _run(app, app.find_floor)
+    assert app.state.floor_label == (
+        f"finding the floor needs a calibration (scene {label} has no calib.txt)"
+    )
+    app._load_scene(bundled_data_dir() / "cones")  # with its calib.txt: depth and 3-D
+    _run(app, app.recompute)
+    assert app.state.message_3d == "" and "median depth" in app.state.stats
+
+
+def test_buttons_before_a_pair_say_so():
+    """Check rows, Rectify, Find floor and a method click before any pair: one sentence on the
+    page (they did nothing, silently)."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import NO_PAIR, StereoApp
+
+    app = StereoApp(
+        get_server("test-no-pair", client_type="vue3"),
+        AllowedFolders([bundled_data_dir()]),
+        bundled_data_dir() / "cones",
+    )
+    app.pair = None
+    app.view = None
+    app._lock = asyncio.Lock()
+    for action in (app.check_rows, app.rectify_from_features, app.find_floor):
+        app.state.error = ""
+        asyncio.run(action())
+        assert app.state.error == NO_PAIR, action.__name__
+    app.state.error = ""
+    app._on_method()
+    assert app.state.error == NO_PAIR
+
+
+def test_find_floor_controller_on_kitti(data_dir):
+    """The stereo panel's "Find floor", in-process: on KITTI (scaled to the page's width) the
+    camera's height above the road and a picture of floor and obstacles; without a
+    calibration, a sentence saying so."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui.app import StereoApp
+
+    app = StereoApp(
+        get_server("test-floor", client_type="vue3"),
+        AllowedFolders([data_dir]),
+        data_dir / "kitti2015" / "000005_10",
+    )
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._load_scene(data_dir / "kitti2015" / "000005_10")
+        await app.recompute()
+        await app.find_floor()
+
+    asyncio.run(run())
+    assert app.state.error == ""
+    text = app.state.floor_label
+    height = float(re.search(r"camera ([0-9.]+)\xa0m above it", text).group(1))
+    assert height == pytest.approx(1.62, abs=0.05)
+    assert app.state.img_floor.startswith("data:image/jpeg;base64,")
+    picture = _decode(app.state.img_floor)
+    assert (np.abs(picture[..., 1] - picture[..., 0]) > 60).mean() > 0.05  # green floor shown
+
+    async def no_calib() -> None:
+        app.calib = None
+        await app.recompute()
+        await app.find_floor()
+
+    asyncio.run(no_calib())
+    assert app.state.floor_label == "finding the floor needs a calibration (--calib)"
+    assert app.state.img_floor == ""
+
+
+def test_find_floor_says_its_heights_in_the_unit_on_show(data_dir):
+    """With feet chosen, Find floor still said "camera 1.62 m above it" (the ground module's
+    line) under a picture captioned "obstacles 0.15-2 m". Both follow the unit toggle now: a
+    floor found in metres is said again in feet, one found in feet is said in feet, and back
+    in metres the line is the library's own."""
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui.app import StereoApp, nowrap_units
+
+    scene = data_dir / "kitti2015" / "000005_10"
+    app = StereoApp(
+        get_server("test-floor-ft", client_type="vue3"), AllowedFolders([data_dir]), scene
+    )
+    app._spawn = lambda coro: coro.close()
+    assert app.state.floor_caption == "floor (green), obstacles 0.15-2\xa0m (red)"
+    app._load_scene(scene)
+    _run(app, app.recompute)
+    _run(app, app.find_floor)
+    metres = app.state.floor_label
+    assert metres == nowrap_units(app.view.floor.describe())
+    height_m = float(re.search(r"camera ([0-9.]+)\xa0m above it", metres).group(1))
+    app._on_unit(unit="ft")
+    assert app.state.floor_caption == "floor (green), obstacles 0.49-6.56\xa0ft (red)"
+    height_ft = float(re.search(r"camera ([0-9.]+)\xa0ft above it", app.state.floor_label).group(1))
+    assert height_ft == pytest.approx(height_m / 0.3048, abs=0.002)
+    assert not re.search(r"[0-9][ \xa0]m\b", app.state.floor_label)
+    assert app.state.floor_label.replace(f"{height_ft:.3f}\xa0ft", f"{height_m:.3f}\xa0m") == metres
+    _run(app, app.recompute)  # a new depth map: its floor is found in feet
+    assert app.state.floor_label == ""
+    _run(app, app.find_floor)
+    assert re.search(r"camera [0-9.]+\xa0ft above it", app.state.floor_label)
+    app._on_unit(unit="m")
+    assert app.state.floor_label == metres
+    assert app.state.floor_caption == "floor (green), obstacles 0.15-2\xa0m (red)"
+    from stereovision.gui.app import floor_text
+
+    assert floor_text(None, "ft").startswith("ground plane: none found")
+
+
+def test_save_writes_the_pair_on_show_as_depth_does_and_never_overwrites(tmp_path):
+    """The page had no way to keep a result. "Save" writes the pair on show with the depth
+    command's writer (disparity PNG + PFM, 16-bit depth PNG in mm, cloud.ply) into a folder
+    inside --data; a folder already holding one of those files is refused, naming it, and
+    the file is left as it was; a folder outside --data is refused."""
+    from stereovision.export import read_depth_png
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import NO_PAIR, SAVED_DEPTH_FILES, SAVED_FILES
+    from stereovision.io import read_pfm
+
+    app = _scene_app("test-save", [bundled_data_dir(), tmp_path])
+    assert app.state.save_dir == str(tmp_path.resolve() / "saved")
+    _run(app, app.save)
+    assert app.state.error == NO_PAIR
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    out = tmp_path / "saved"
+    assert app.state.error == ""
+    assert sorted(p.name for p in out.iterdir()) == sorted(SAVED_FILES + SAVED_DEPTH_FILES)
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/saved: ")
+    res = app.view.result
+    np.testing.assert_array_equal(read_pfm(out / "disparity.pfm"), res.disparity)
+    depth = read_depth_png(out / "depth_mm.png")
+    ok = np.isfinite(res.depth) & (res.depth < 60)
+    assert np.nanmax(np.abs(depth[ok] - res.depth[ok])) < 0.001
+    # typed into a folder that holds the files: refused, nothing replaced
+    (out / "cloud.ply").write_text("mine")
+    (out / "disparity.pfm").unlink()
+    app.state.save_label = ""
+    app.state.save_dir = "saved"
+    _run(app, app.save)
+    assert app.state.error == (
+        f"save: {tmp_path.name}/saved already holds disparity.png, depth.png, depth.npy, "
+        "depth_mm.png, cloud.ply, render.png, overview.png; nothing was overwritten: choose "
+        "another folder"
+    )
+    assert (out / "cloud.ply").read_text() == "mine" and not (out / "disparity.pfm").exists()
+    for outside in ("../elsewhere", "/tmp", str(bundled_data_dir() / "x")):
+        app.state.save_dir = outside
+        _run(app, app.save)
+        assert app.state.error == f"folder outside the --data folders: {outside}", outside
+    app.state.save_dir = "second"  # relative: inside the first --data folder
+    _run(app, app.save)
+    assert app.state.error == "" and (tmp_path / "second" / "cloud.ply").stat().st_size > 1000
+    # only the bundled data: nowhere to write, said so
+    bare = _scene_app("test-save-bare", [bundled_data_dir()])
+    bare.view = app.view
+    assert bare.state.save_dir == ""
+    assert bare.state.save_hint == "Save writes into a --data folder: start the GUI with --data DIR"
+    _run(bare, bare.save)
+    assert bare.state.error == "empty or invalid folder"
+    bare.state.save_dir = "x"
+    _run(bare, bare.save)
+    assert bare.state.error == "no folder to write into: start the GUI with --data DIR"
+
+
+def test_save_writes_the_overview_as_depth_does_in_the_pages_unit(tmp_path):
+    """Save said it wrote the pair "as depth -o does", but not overview.png (the pictures with
+    their labelled colour bars), which depth, demo and batch write. It is written by the same
+    writer: its title names the pair as the page does, its depth bar is in the page's unit; a
+    folder that holds a user's overview.png is refused, the file left as it was."""
+    from stereovision.cli import write_overview
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import overview_name
+
+    app = _scene_app("test-save-overview", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app._on_unit(unit="ft")
+    _run(app, app.save)
+    assert app.state.error == "" and "overview.png" in app.state.save_label
+    assert overview_name(app.state.source_label) == "scene data/cones"
+    reference = tmp_path / "reference"
+    reference.mkdir()
+    write_overview(app.view.result, reference, "scene data/cones", "ft")
+    saved = cv2.imread(str(tmp_path / "saved" / "overview.png"))
+    np.testing.assert_array_equal(saved, cv2.imread(str(reference / "overview.png")))
+    # in feet, not the metres of the default: another picture
+    write_overview(app.view.result, reference, "scene data/cones", "m")
+    assert not np.array_equal(saved, cv2.imread(str(reference / "overview.png")))
+    assert overview_name("folder seq: pair 2 · 640×480 …") == "folder seq: pair 2 | 640x480 ..."
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "overview.png").write_bytes(b"my picture")
+    app.state.save_dir = "mine"
+    _run(app, app.save)
+    assert app.state.error == (
+        f"save: {tmp_path.name}/mine already holds overview.png; nothing was overwritten: "
+        "choose another folder"
+    )
+    assert sorted(p.name for p in mine.iterdir()) == ["overview.png"]
+    assert (mine / "overview.png").read_bytes() == b"my picture"
+
+
+def test_save_writes_render_png_of_the_3d_view_from_the_sliders_pose(tmp_path, monkeypatch):
+    """Save wrote depth's files but not render.png, the 3-D view. It is now written too: the
+    view on show seen from the pose the sliders set (translations in the page's unit), at the
+    pair's size. A render that fails, or a pair without calibration, is said at the end of the
+    Save's line; the other files are written all the same; a user's render.png is kept."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SAVED_DEPTH_FILES, SAVED_FILES, shown_cloud
+
+    app = _scene_app("test-save-render", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app._on_unit(unit="ft")
+    app.state.yaw, app.state.right = 15.0, -1.0  # 1 ft to the left
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.endswith(", overview.png, render.png")
+    png = cv2.imread(str(tmp_path / "saved" / "render.png"), cv2.IMREAD_UNCHANGED)
+    assert png.shape == (375, 450, 3) and png.dtype == np.uint8
+    assert png.astype(np.float64).std() > 20.0  # a picture, not a blank window
+    assert not render.is_blank(png[..., ::-1], min_fraction=0.5)
+    view = app.view
+    posed = render.CameraControls(yaw=15.0, right=-0.3048)
+    expected = render.render_view(view.mesh, posed, intrinsics=view.intrinsics)
+    assert np.abs(png[..., ::-1].astype(np.int16) - expected).mean() < 1.0
+    default = render.render_view(view.mesh, intrinsics=view.intrinsics)
+    assert np.abs(png[..., ::-1].astype(np.int16) - default).mean() > 10.0  # the pose counts
+    # the points mode on show: its points, from the same pose
+    app.state.view_mode, app.state.save_dir = "points", "points"
+    _run(app, app.save)
+    assert app.state.error == ""
+    points = cv2.imread(str(tmp_path / "points" / "render.png"))
+    cloud = shown_cloud(view.result.points, view.result.colors)[0]
+    expected = render.render_view(cloud, posed, intrinsics=view.intrinsics)
+    assert np.abs(points[..., ::-1].astype(np.int16) - expected).mean() < 1.0
+    assert np.abs(points.astype(np.int16) - png).mean() > 3.0
+    app.state.view_mode = "surface"
+    # the user's render.png in a typed folder: refused, kept
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "render.png").write_bytes(b"my render")
+    app.state.save_dir = "mine"
+    _run(app, app.save)
+    assert app.state.error == (
+        f"save: {tmp_path.name}/mine already holds render.png; nothing was overwritten: "
+        "choose another folder"
+    )
+    assert (mine / "render.png").read_bytes() == b"my render"
+
+    # a render that fails: said in the line, the other files written
+    def broken(*args: Any, **kw: Any) -> Any:
+        raise RuntimeError("the offscreen render returned no image\nline 2")
+
+    monkeypatch.setattr(render, "render_view", broken)
+    app.state.save_dir = "broken"
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/broken: ")
+    assert app.state.save_label.endswith(
+        ", overview.png (render.png not written: the offscreen render returned no image)"
+    )
+    assert sorted(p.name for p in (tmp_path / "broken").iterdir()) == sorted(
+        n for n in SAVED_FILES + SAVED_DEPTH_FILES if n != "render.png"
+    )
+    # no calibration: no depth, said
+    scene = tmp_path / "nocalib"
+    scene.mkdir()
+    for side in ("left", "right"):
+        (scene / f"{side}.png").write_bytes(
+            (bundled_data_dir() / "cones" / f"{side}.png").read_bytes()
+        )
+    app._load_scene(scene)
+    _run(app, app.recompute)
+    app.state.save_dir = "nocalib-out"
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label == (
+        f"saved 450×375 to {tmp_path.name}/nocalib-out: disparity.png, disparity.pfm, "
+        "overview.png (no calibration: disparity only; no depth, cloud.ply or render.png)"
+    )
+    assert sorted(p.name for p in (tmp_path / "nocalib-out").iterdir()) == sorted(SAVED_FILES)
+
+
+def test_save_renders_the_3d_view_as_the_mouse_left_it(tmp_path):
+    """render.png was the view from the sliders' pose even after the view was dragged with the
+    mouse (the sliders do not follow it): not what the page showed. The page's view is rendered
+    on the server, whose camera the mouse moves: render.png is now that camera's view, said in
+    the Save's line, until a slider puts the view back on the sliders' pose."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-save-mouse", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.yaw = 10.0
+    app._on_controls()
+    view = app.view
+    posed = render.render_view(
+        view.mesh, render.CameraControls(yaw=10.0), intrinsics=view.intrinsics
+    )
+    # what the trackball style does on a drag: turn about the focal point
+    cam = app.plotter.camera
+    cam.Azimuth(-25.0)
+    cam.Elevation(12.0)
+    cam.OrthogonalizeViewUp()
+    dragged = render.CameraState.of(cam)
+    app.state.save_dir = "dragged"
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.endswith(
+        ", overview.png, render.png (render.png: the 3-D view as the mouse left it, not the "
+        "sliders' pose)"
+    )
+    png = cv2.imread(str(tmp_path / "dragged" / "render.png"))[..., ::-1].astype(np.int16)
+    assert png.shape == (375, 450, 3)
+    expected = render.render_view(view.mesh, intrinsics=view.intrinsics, camera=dragged)
+    assert np.abs(png - expected).mean() < 1.0
+    assert np.abs(png - posed).mean() > 10.0
+    # a slider moved after the drag: the view is on the sliders' pose again, and render.png
+    app.state.yaw = 5.0
+    app._on_controls()
+    app.state.save_dir = "slid"
+    _run(app, app.save)
+    assert app.state.save_label.endswith(", overview.png, render.png")
+    png = cv2.imread(str(tmp_path / "slid" / "render.png"))[..., ::-1].astype(np.int16)
+    expected = render.render_view(
+        view.mesh, render.CameraControls(yaw=5.0), intrinsics=view.intrinsics
+    )
+    assert np.abs(png - expected).mean() < 1.0
+
+
+def test_the_unit_toggle_and_the_view_mode_keep_the_view_the_mouse_left(tmp_path):
+    """The unit toggle (which converts the translation sliders so that their pose stays) and the
+    surface/points toggle put the view back on the sliders' pose: a view dragged with the mouse
+    was lost, and render.png was the sliders' pose again. The dragged view now stays."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import MOUSE_RENDER
+
+    app = _scene_app("test-save-mouse-unit", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.right = 0.123
+    app._on_controls()
+    cam = app.plotter.camera
+    cam.Azimuth(-25.0)
+    cam.Elevation(12.0)
+    cam.OrthogonalizeViewUp()
+    dragged = render.CameraState.of(cam)
+    app.state.unit = "ft"
+    app._on_unit("ft")
+    assert app.state.right == pytest.approx(0.404)  # 0.123 m in feet, rounded as the slider
+    assert render.CameraState.of(app.plotter.camera).same_view(dragged)
+    app.state.view_mode = "points"
+    app._on_view_mode()
+    assert render.CameraState.of(app.plotter.camera).same_view(dragged)
+    app.state.save_dir = "ft"
+    _run(app, app.save)
+    assert app.state.save_label.endswith(f", overview.png, render.png ({MOUSE_RENDER})")
+    # not dragged: the toggle leaves the view on the sliders' pose (no mouse view said)
+    app.reset_camera()
+    app.state.right = 0.5
+    app._on_controls()
+    app.state.unit = "m"
+    app._on_unit("m")
+    app.state.save_dir = "m"
+    _run(app, app.save)
+    assert app.state.save_label.endswith(", overview.png, render.png")
+
+
+def _mouse_drag(app: Any, path: list[tuple[float, float]]) -> None:
+    """A left-button drag of the 3-D view along ``path`` (fractions of the view), sent as the
+    page's server-side view sends the browser's mouse events (trame-vtk's mouse handler)."""
+    from vtkmodules.vtkWebCore import vtkWebApplication, vtkWebInteractionEvent
+
+    iren = app.plotter.iren.interactor
+    iren.Initialize()  # the served page's view has it; the app alone does not
+    iren.Enable()
+    web = vtkWebApplication()
+    for i, (x, y) in enumerate(path):
+        event = vtkWebInteractionEvent()
+        down = i < len(path) - 1  # the last point: the button released
+        event.SetButtons(vtkWebInteractionEvent.LEFT_BUTTON if down else 0)
+        event.SetX(x)
+        event.SetY(y)
+        assert web.HandleInteractionEvent(app.plotter.render_window, event)
+
+
+def test_sliders_from_pose_clamps_values_past_the_sliders_range():
+    """The pose the mouse leaves can be past the sliders' range (yaw 150 after orbiting the
+    scene, 7 m forward after zooming): each value is clamped to its slider's range, in the
+    page's unit for the translations, and said so."""
+    from stereovision import render
+    from stereovision.gui.app import sliders_from_pose
+
+    pose = render.camera_pose(roll=10.0, pitch=-20.0, yaw=30.0, forward=1.5, up=0.2, right=-0.3)
+    values, clamped = sliders_from_pose(pose)
+    assert not clamped
+    expected = {"roll": 10.0, "pitch": -20.0, "yaw": 30.0, "forward": 1.5, "up": 0.2}
+    assert values == pytest.approx({**expected, "right": -0.3}, abs=1e-9)
+    values, clamped = sliders_from_pose(pose, "ft")
+    assert not clamped
+    assert values["forward"] == pytest.approx(1.5 / 0.3048) and values["yaw"] == pytest.approx(30)
+    values, clamped = sliders_from_pose(render.camera_pose(yaw=150.0, pitch=5.0, forward=7.0))
+    assert clamped
+    assert values["yaw"] == 90.0 and values["forward"] == 5.0
+    assert values["pitch"] == pytest.approx(5.0) and values["roll"] == pytest.approx(0.0)
+    values, clamped = sliders_from_pose(render.camera_pose(roll=-120.0, right=-7.0), "ft")
+    assert clamped and values["roll"] == -90.0 and values["right"] == -16.4  # the page's range
+    with pytest.raises(ValueError, match="unit"):
+        sliders_from_pose(pose, "yd")
+
+
+def test_the_sliders_follow_the_view_the_mouse_left(tmp_path):
+    """The sliders stayed where they were when the 3-D view was dragged with the mouse, so the
+    next slider move put the view back on their old pose: the drag was undone. The end of a
+    drag now sets the sliders from the view's camera, and a slider moved next continues from
+    the dragged view."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-follow-mouse", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.yaw = 10.0
+    app._on_controls()
+    _mouse_drag(app, [(0.5, 0.5), (0.55, 0.52), (0.6, 0.55), (0.6, 0.55)])
+    dragged = render.controls_from_pose(render.pose_from_camera(app.plotter.camera))
+    assert abs(dragged.yaw - 10.0) > 5.0 and abs(dragged.pitch) > 5.0  # the drag turned it
+    names = ("roll", "pitch", "yaw", "forward", "up", "right")
+    assert {n: app.state[n] for n in names} == pytest.approx(
+        {n: getattr(dragged, n) for n in names}, abs=1e-9
+    )
+    assert app._mouse_camera() is None  # the view is the sliders' pose: Save renders it
+    app.state.yaw = dragged.yaw + 5.0
+    app._on_controls()
+    moved = render.controls_from_pose(render.pose_from_camera(app.plotter.camera))
+    assert moved.yaw == pytest.approx(dragged.yaw + 5.0)
+    assert moved.pitch == pytest.approx(dragged.pitch) and moved.up == pytest.approx(dragged.up)
+    # a click (nothing moved) leaves the sliders alone
+    before = {n: app.state[n] for n in names}
+    _mouse_drag(app, [(0.3, 0.3), (0.3, 0.3)])
+    assert {n: app.state[n] for n in names} == before
+    # the wheel (as the page's view sends it: the interactor's wheel event) moves forward
+    app.plotter.iren.interactor.MouseWheelForwardEvent()
+    zoomed = render.controls_from_pose(render.pose_from_camera(app.plotter.camera))
+    assert zoomed.forward > before["forward"] + 0.1
+    assert app.state.forward == pytest.approx(zoomed.forward, abs=1e-9)
+
+
+def test_a_drag_past_the_sliders_range_clamps_them_and_keeps_the_view(tmp_path):
+    """A drag that turns the view past the sliders' +-90 degrees sets them clamped; the view
+    stays as the mouse left it (Save says so) until a slider moves it from the clamped pose."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-follow-mouse-clamped", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    # the sliders' listeners run at each flush, as on the server: setting the sliders from the
+    # view must not put the view on their (clamped) pose
+    app.state.ready()
+    cam = app.plotter.camera
+    cam.Azimuth(-130.0)  # orbiting the scene: the camera turns right past yaw 90
+    cam.OrthogonalizeViewUp()
+    app.plotter.iren.interactor.InvokeEvent("EndInteractionEvent")
+    dragged = render.CameraState.of(cam)
+    assert app.state.yaw == 90.0
+    assert render.CameraState.of(app.plotter.camera).same_view(dragged)
+    assert app._mouse_camera() is not None  # not the sliders' pose: Save renders this view
+    app.state.pitch = 3.0
+    app._on_controls()
+    moved = render.controls_from_pose(render.pose_from_camera(app.plotter.camera))
+    assert moved.yaw == pytest.approx(90.0) and moved.pitch == pytest.approx(3.0)
+
+
+def test_a_toggle_after_a_followed_drag_keeps_the_view_and_its_pivot(tmp_path):
+    """Once the sliders followed a drag, the unit and surface/points toggles put the view on
+    the sliders' pose again: the focal point (the centre of the next drag, 1.35 m ahead after
+    the wheel) went back to the scene's median depth (3.5 m) and the feet slider's rounding
+    moved the camera. The view the mouse left now stays whole, still the sliders' pose."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-follow-mouse-toggle", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _mouse_drag(app, [(0.5, 0.5), (0.55, 0.52), (0.6, 0.55), (0.6, 0.55)])
+    for _ in range(5):
+        app.plotter.iren.interactor.MouseWheelForwardEvent()
+    dragged = render.CameraState.of(app.plotter.camera)
+    assert app.plotter.camera.GetDistance() < 2.0  # the wheel brought the pivot nearer
+    app.state.unit = "ft"
+    app._on_unit("ft")
+    assert render.CameraState.of(app.plotter.camera).same_view(dragged)
+    app.state.view_mode = "points"
+    app._on_view_mode()
+    assert render.CameraState.of(app.plotter.camera).same_view(dragged)
+    assert app._mouse_camera() is None  # still the sliders' pose: Save says no mouse view
+
+
+def test_save_of_the_pair_ignores_a_drag_of_an_opened_cloud_file(tmp_path):
+    """With a point-cloud file shown in the 3-D view, a drag moves the view of that file (another
+    scene, framed without the pair's intrinsics), yet Save rendered the pair from that camera
+    and said it was the 3-D view as the mouse left it: render.png is the pair's from the
+    sliders' pose, as when nothing was dragged."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import MOUSE_RENDER
+
+    app = _scene_app("test-save-cloud-drag", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.save_dir = "first"
+    _run(app, app.save)
+    app.state.cloud_path = str((tmp_path / "first" / "cloud.ply").resolve())
+    app.open_cloud()
+    assert app.state.error == "" and app._cloud is not None
+    cam = app.plotter.camera
+    cam.Azimuth(-25.0)
+    cam.OrthogonalizeViewUp()
+    app.state.save_dir = "second"
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert MOUSE_RENDER not in app.state.save_label
+    assert app.state.save_label.endswith(", overview.png, render.png")
+    png = cv2.imread(str(tmp_path / "second" / "render.png"))[..., ::-1].astype(np.int16)
+    view = app.view
+    posed = render.render_view(view.mesh, render.CameraControls(), intrinsics=view.intrinsics)
+    assert np.abs(png - posed).mean() < 1.0
+
+
+def test_save_says_a_3d_view_it_cannot_render_and_writes_the_rest(tmp_path):
+    """A view's camera CameraState refuses (its up along the view direction) stopped the Save
+    before any file was written; it is said as a failed render, the other files written."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SAVED_DEPTH_FILES, SAVED_FILES
+
+    app = _scene_app("test-save-bad-camera", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    cam = app.plotter.camera
+    cam.SetViewUp(*cam.GetDirectionOfProjection())
+    app.state.save_dir = "bad"
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/bad: ")
+    assert re.search(
+        r", overview\.png \(render\.png not written: CameraState: up \([^)]+\) is along the "
+        r"view direction \(or zero\): no way is up\)$",
+        app.state.save_label,
+    ), app.state.save_label
+    assert sorted(p.name for p in (tmp_path / "bad").iterdir()) == sorted(
+        n for n in SAVED_FILES + SAVED_DEPTH_FILES if n != "render.png"
+    )
+
+
+def test_the_save_field_shows_the_data_folder_short_and_saves_where_it_says(tmp_path, monkeypatch):
+    """The save field showed the --data folder's absolute path (the README's picture: a
+    temporary /tmp/sv-.../scenes/saved). It shows it relative to the current directory when
+    it is under it, else ~-abbreviated, else absolute, the whole path in its tooltip; a path
+    typed as the field shows them (relative to the current directory) is saved there, a bare
+    name still in the first --data folder."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.sources import display_path
+
+    data = tmp_path / "scenes"
+    data.mkdir()
+    monkeypatch.chdir(tmp_path)
+    app = _scene_app("test-save-shown", [bundled_data_dir(), data])
+    assert app.state.save_dir == "scenes/saved"
+    full = str(data.resolve() / "saved")
+    assert app.state.save_dir_title == f"{full} (or the next new saved-N)"
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.error == "" and (data / "saved" / "cloud.ply").is_file()
+    for typed, where in (("scenes/mine", data / "mine"), ("other", data / "other")):
+        app._on_save_dir(typed)
+        assert app.state.save_dir_title == str(where.resolve()), typed
+        app.state.save_dir = typed
+        _run(app, app.save)
+        assert app.state.error == "" and (where / "cloud.ply").is_file(), typed
+    assert not (data / "scenes").exists()
+    app._on_save_dir("../outside")
+    assert app.state.save_dir_title == ""
+    # under the home folder, not the current directory: ~/...
+    monkeypatch.setenv("HOME", str(tmp_path))
+    monkeypatch.chdir("/")
+    home_app = _scene_app("test-save-home", [bundled_data_dir(), data])
+    assert home_app.state.save_dir == "~/scenes/saved"
+    assert display_path(data, cwd=Path("/nowhere"), home=Path("/nohome")) == str(data)
+
+
+def test_saves_into_the_offered_folder_go_to_a_new_numbered_folder_each(tmp_path):
+    """Each Save after the first was refused ("saved already holds ...") until a new folder was
+    typed: saving several pairs meant typing a folder for each. Left as offered (or emptied),
+    the field now sends each Save to the first of saved, saved-2, saved-3, ... that is new or
+    empty, and the page says which; nothing is overwritten."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SAVED_DEPTH_FILES, SAVED_FILES
+
+    app = _scene_app("test-save-numbered", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    (tmp_path / "saved-2").mkdir()
+    (tmp_path / "saved-2" / "notes.txt").write_text("mine")  # not empty: skipped
+    (tmp_path / "saved-4").mkdir()  # empty: taken in turn
+    said = []
+    for _ in range(3):
+        app.state.save_label = ""
+        _run(app, app.save)
+        assert app.state.error == ""
+        said.append(app.state.save_label.split(":")[0])
+    assert said == [
+        f"saved 450×375 to {tmp_path.name}/{n}" for n in ("saved", "saved-3", "saved-4")
+    ]
+    for name in ("saved", "saved-3", "saved-4"):
+        assert sorted(p.name for p in (tmp_path / name).iterdir()) == sorted(
+            SAVED_FILES + SAVED_DEPTH_FILES
+        )
+    assert [p.name for p in (tmp_path / "saved-2").iterdir()] == ["notes.txt"]
+    app.state.save_dir = "  "  # emptied: as offered
+    _run(app, app.save)
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/saved-5: ")
+    assert app.state.save_dir == "  "  # the field is left as the user left it
+    # a folder typed just before the click, not yet in the server's state: the click's own
+    # copy of the field is the one saved into (the page's test saved into "saved" instead)
+    app.state.save_dir = app._offered_save_dir
+    pending: list = []
+    app._spawn = pending.append
+    app.save_clicked("typed")
+    _run(app, pending.pop)
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/typed: ")
+
+
+def test_the_offered_save_folder_skips_a_link_named_saved(tmp_path):
+    """A ``saved`` in --data that was a symbolic link leading outside it made every Save as
+    offered fail with "folder outside the --data folders: saved", a folder the user never
+    typed. A link is now skipped, whatever it leads to (nothing is written through it), and the
+    page says so; a link the user types is still refused."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SAVED_DEPTH_FILES, SAVED_FILES
+
+    data, outside = tmp_path / "mine", tmp_path / "outside"
+    data.mkdir()
+    outside.mkdir()
+    (data / "saved").symlink_to(outside, target_is_directory=True)
+    app = _scene_app("test-save-link", [bundled_data_dir(), data])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.startswith("saved 450×375 to mine/saved-2: ")
+    assert app.state.save_label.endswith(
+        " (saved: a symbolic link, not a folder of --data: left alone)"
+    )
+    assert sorted(p.name for p in (data / "saved-2").iterdir()) == sorted(
+        SAVED_FILES + SAVED_DEPTH_FILES
+    )
+    assert list(outside.iterdir()) == []
+    app.state.save_dir = "saved"  # typed: refused, nothing written
+    _run(app, app.save)
+    assert app.state.error == "folder outside the --data folders: saved"
+    assert list(outside.iterdir()) == []
+
+
+def test_a_saved_cloud_is_offered_in_the_point_cloud_list(tmp_path):
+    """The file lists were walked once, at start-up: the cloud.ply a Save had just written was
+    not in the 3-D panel's point-cloud list (to be shown, its path had to be typed). Each Save
+    now refreshes the lists, and its cloud opens in the 3-D view."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-save-list", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    assert app.state.clouds == []
+    _run(app, app.save)
+    saved = str((tmp_path / "saved" / "cloud.ply").resolve())
+    assert [c["value"] for c in app.state.clouds] == [saved]
+    assert app.state.clouds[0]["title"] == f"{tmp_path.name}/saved/cloud.ply"
+    app.state.cloud_path = saved
+    app.open_cloud()
+    assert app.state.error == "" and app._cloud is not None
+
+
+def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkeypatch):
+    """Save pressed twice (or again after a new pair came) while the first still wrote: the
+    second found none of the files yet, wrote too, and replaced the first's files without a
+    word. A typed folder being written is now refused like one that holds the files; the
+    offered folder sends the second Save to the next numbered one."""
+    import asyncio
+    import threading
+
+    import stereovision.cli as cli
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-save-twice", [bundled_data_dir(), tmp_path])
+    app.state.save_dir = "saved"  # typed
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    real = cli.write_depth_outputs
+    started, gate = threading.Event(), threading.Event()
+    calls: list = []
+
+    def held(result, folder):
+        calls.append(folder)
+        started.set()
+        gate.wait(60)
+        return real(result, folder)
+
+    monkeypatch.setattr(cli, "write_depth_outputs", held)
+
+    async def twice() -> None:
+        app._lock = asyncio.Lock()
+        first = asyncio.ensure_future(app.save())
+        await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
+        await app.save()  # the first is still writing
+        assert app.state.error == (
+            f"save: {tmp_path.name}/saved is being written by the previous Save; nothing was "
+            "overwritten: choose another folder"
+        )
+        gate.set()
+        await first
+
+    asyncio.run(twice())
+    assert len(calls) == 1
+    assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/saved: ")
+    app._done()
+    app.state.save_label = ""
+    _run(app, app.save)  # and once written, the folder holds the files: refused as before
+    assert app.state.error.startswith(f"save: {tmp_path.name}/saved already holds disparity.png")
+    # the offered folder, pressed twice: the second Save goes to the next numbered folder
+    app._done()
+    app.state.save_dir = app._offered_save_dir
+    calls.clear()
+    started.clear()
+    gate.clear()
+
+    async def twice_offered() -> None:
+        first = asyncio.ensure_future(app.save())
+        await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
+        gate.set()
+        await app.save()
+        await first
+
+    asyncio.run(twice_offered())
+    assert app.state.error == ""
+    # each written in its own staging folder beside it, then moved into place
+    assert [c.name for c in calls] == ["saved-2", "saved-3"]
+    assert all(c.parent.parent == tmp_path.resolve() for c in calls)
+    assert all(c.parent.name.startswith(".stereovision-partial-") for c in calls)
+    assert (tmp_path / "saved-2" / "cloud.ply").is_file()
+    assert (tmp_path / "saved-3" / "cloud.ply").is_file()
+    assert not list(tmp_path.glob(".stereovision-partial-*"))
+
+
+def _disk_full_at(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    """Make ``stereovision.io.atomic_write`` fail as a full disk does (ENOSPC) for the file
+    whose name is the returned list's one item (set it before each Save; "" fails none)."""
+    import contextlib
+    import errno
+
+    import stereovision.io as svio
+
+    real = svio.atomic_write
+    failing = [""]
+
+    @contextlib.contextmanager
+    def full_disk(path, mode="wb"):
+        if Path(path).name == failing[0]:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        with real(path, mode) as fh:
+            yield fh
+
+    monkeypatch.setattr(svio, "atomic_write", full_disk)
+    return failing
+
+
+def test_a_failed_save_of_a_pair_without_depth_names_the_file_that_failed(tmp_path, monkeypatch):
+    """A pair without a calibration: its Save writes disparity.png, disparity.pfm and
+    overview.png. One that failed at disparity.pfm or overview.png said "depth.png could not
+    be written", the first file of the full write order not written, a file that Save never
+    writes; it names the file that failed."""
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    scene = tmp_path / "cones-uncalibrated"
+    scene.mkdir()
+    for side in ("left", "right"):
+        shutil.copy(bundled_data_dir() / "cones" / f"{side}.png", scene / f"{side}.png")
+    app = _scene_app("test-save-without-depth", [tmp_path])
+    app._load_scene(scene)
+    _run(app, app.recompute)
+    assert app.view.result.depth is None
+    failing = _disk_full_at(monkeypatch)
+    for name in ("disparity.png", "disparity.pfm", "overview.png"):
+        failing[0] = name
+        app.state.save_dir = app._offered_save_dir
+        _run(app, app.save)
+        assert app.state.save_label.startswith(
+            f"save: {name} could not be written ([Errno 28] No space left on device); "
+        ), name
+        assert not (tmp_path / "saved").exists()
+
+
+def test_a_save_folder_made_by_someone_else_while_the_save_wrote(tmp_path):
+    """The Save's folder did not exist and another program made it while the files were
+    written: the rename of the staging folder onto it failed with "[Errno 39] Directory not
+    empty: '.../.stereovision-partial-.../saved' -> '.../saved'", naming a hidden folder the
+    user never saw, where a folder that existed at the start gets its files moved in one by
+    one, or "disparity.png appeared in ... while the Save wrote". The folder come meanwhile is
+    treated as one that existed: a file of the Save's there is refused by name, nothing
+    replaced; otherwise the files join the other program's."""
+    pytest.importorskip("trame")
+    from stereovision.gui.app import save_all_or_nothing
+
+    folder = tmp_path / "saved"
+
+    def write(notes: str, into: Path) -> None:
+        (into / "disparity.png").write_bytes(b"png")
+        (into / "overview.png").write_bytes(b"overview")
+        folder.mkdir()
+        (folder / notes).write_text("theirs")
+
+    with pytest.raises(FileExistsError) as info:
+        save_all_or_nothing(lambda into: write("disparity.png", into), folder)
+    assert str(info.value) == (
+        f"save: disparity.png appeared in {folder} while the Save wrote; nothing was "
+        "overwritten: choose another folder"
+    )
+    assert [p.name for p in folder.iterdir()] == ["disparity.png"]
+    assert (folder / "disparity.png").read_text() == "theirs"
+    (folder / "disparity.png").unlink()
+    folder.rmdir()
+    written = save_all_or_nothing(lambda into: write("notes.txt", into), folder)
+    assert written == {
+        "disparity.png": folder / "disparity.png",
+        "overview.png": folder / "overview.png",
+    }
+    assert sorted(p.name for p in folder.iterdir()) == [
+        "disparity.png",
+        "notes.txt",
+        "overview.png",
+    ]
+    assert (folder / "notes.txt").read_text() == "theirs"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["saved"]  # no staging folder left
+
+
+def test_save_all_or_nothing_says_a_failure_in_one_line_with_the_folders_path(tmp_path):
+    """What a failed writer said is told in its first line, its staging path
+    (``.stereovision-partial-...``, a folder the user never saw) written as the folder's; the
+    files written are listed in the write order, not as the writer wrote them."""
+    pytest.importorskip("trame")
+    from stereovision.gui.app import SaveFailed, save_all_or_nothing
+
+    folder = tmp_path / "saved"
+
+    def failing(into: Path) -> None:
+        (into / "disparity.png").write_bytes(b"png")
+        raise OSError(f"cannot write {into / 'depth.png'}\nsecond line of the reason")
+
+    with pytest.raises(SaveFailed) as info:
+        save_all_or_nothing(failing, folder)
+    assert str(info.value) == f"depth.png could not be written (cannot write {folder}/depth.png)"
+    assert not folder.exists() and sorted(p.name for p in tmp_path.iterdir()) == []
+
+    def backwards(into: Path) -> None:
+        for name in ("overview.png", "depth.png", "disparity.png"):
+            (into / name).write_bytes(b"x")
+
+    written = save_all_or_nothing(backwards, folder)
+    assert list(written) == ["disparity.png", "depth.png", "overview.png"]  # SAVE_WRITE_ORDER's
+
+
+def test_a_save_whose_writer_fails_leaves_no_partial_folder_and_names_the_file(
+    tmp_path, monkeypatch
+):
+    """Save wrote its files one by one into the folder: a writer that failed midway (disk full)
+    left a partial set there. A Save is now all or nothing: written into a staging folder and
+    moved into place once every file is; a failure leaves the folder as it was (absent when it
+    was), no staging folder behind, and the Save's line names the file that failed."""
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SAVE_WRITE_ORDER, SAVED_DEPTH_FILES, SAVED_FILES
+
+    assert sorted(SAVE_WRITE_ORDER) == sorted(SAVED_FILES + SAVED_DEPTH_FILES)
+    app = _scene_app("test-save-all-or-nothing", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    failing = _disk_full_at(monkeypatch)
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("mine")
+    for name in SAVE_WRITE_ORDER:
+        failing[0] = name
+        for typed, folder in (("", "saved"), ("mine", "mine"), ("new/deeper", "new/deeper")):
+            app.state.save_dir = typed or app._offered_save_dir
+            app.state.save_label = ""
+            _run(app, app.save)
+            said = (
+                f"save: {name} could not be written ([Errno 28] No space left on device); "
+                f"nothing was saved in {tmp_path.name}/{folder}"
+            )
+            assert app.state.save_label == said, (name, typed)
+            assert app.state.error == said
+            assert not (tmp_path / "saved").exists() and not (tmp_path / "new").exists()
+            assert [p.name for p in (tmp_path / "mine").iterdir()] == ["notes.txt"]
+            assert not list(tmp_path.glob(".*")), (name, typed)
+    # the disk has room again: the same Saves write every file
+    failing[0] = ""
+    for typed in ("", "mine", "new/deeper"):
+        app.state.save_dir = typed or app._offered_save_dir
+        _run(app, app.save)
+        assert app.state.error == ""
+    for folder in ("saved", "new/deeper"):
+        assert sorted(p.name for p in (tmp_path / folder).iterdir()) == sorted(SAVE_WRITE_ORDER)
+    assert sorted(p.name for p in (tmp_path / "mine").iterdir()) == sorted(
+        ("notes.txt", *SAVE_WRITE_ORDER)
+    )
+    assert not list(tmp_path.glob(".*")) and not list((tmp_path / "mine").glob(".*"))
+
+
+def _still_cameras_app(name: str, data_dir: Path, raw: tuple) -> Any:
+    """A :class:`StereoApp` (demo scene cones) whose cameras give ``raw`` on every read."""
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui.app import StereoApp
+
+    class Cameras:
+        def read(self):
+            return raw
+
+        def close(self):
+            pass
+
+    return StereoApp(
+        get_server(name, client_type="vue3"),
+        AllowedFolders([data_dir]),
+        data_dir / "middlebury2003" / "cones",
+        source=Cameras(),
+    )
+
+
+def test_rectify_controller_without_a_calibration(data_dir):
+    """The acquisition panel's "Rectify", in-process, on StereoPi's raw pair (rows 0.59 px
+    apart): rectified from its features, the rows check passes, and the cameras' next pair
+    goes through the same homographies; with a calibration, a sentence saying so."""
+    import asyncio
+
+    sp = data_dir / "stereopi_rig" / "scene_photo"
+    from stereovision.gui.app import nowrap_units
+
+    raw = (cv2.imread(str(sp / "left.png")), cv2.imread(str(sp / "right.png")))
+    app = _still_cameras_app("test-rectify", data_dir, raw)
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._grab()
+        await app.check_rows()
+        assert "NOT rectified" in app.state.rows_label
+        await app.rectify_from_features()
+        said.append(app.state.rows_label)
+        await app.check_rows()
+
+    said: list = []
+    asyncio.run(run())
+    assert app.state.error == ""
+    rect = app.homographies
+    # the homographies' line, its numbers and units kept together as every line on the page
+    assert said == [nowrap_units(rect.describe())] and said[0] != rect.describe()
+    assert rect is not None and app.pair[0].shape[:2] == rect.size[::-1]
+    assert app.state.rows_label.startswith("rectification ok")
+    assert app.view is not None and app.view.result.max_disparity >= rect.max_disparity
+    app._grab()  # the next pair from the cameras: rectified the same way
+    np.testing.assert_array_equal(app.pair[0], rect.rectify(*raw)[0])
+    assert app.state.source_label.endswith("(rectified from features)")
+
+    async def again() -> None:
+        await app.rectify_from_features()  # pressed a second time
+
+    # It starts again from the raw pair: its homographies still fit the cameras' frames (the
+    # second press rectified the rectified pair, and the next capture went unrectified).
+    asyncio.run(again())
+    assert app.homographies.input_size == (raw[0].shape[1], raw[0].shape[0])
+    assert app.state.source_label.count("(rectified from features)") == 1
+    app._grab()
+    np.testing.assert_array_equal(app.pair[0], app.homographies.rectify(*raw)[0])
+    assert app.state.source_label.count("(rectified from features)") == 1
+
+    async def with_calib() -> None:
+        app.calib = object()
+        await app.rectify_from_features()
+
+    asyncio.run(with_calib())
+    assert app.state.rows_label == "this pair has a calibration: it is rectified with it"
+
+
+def test_rectify_uses_a_pair_already_rectified_as_given(data_dir):
+    """ "Rectify" on a pair whose rows already agree (cones, a rectified dataset) warped it by
+    homographies fitted to those rows: resampled, 455x378 px instead of 450x375. As `rectify`
+    without --calib, the rows check now says it is rectified and the pair is used as given."""
+    cones = data_dir / "middlebury2003" / "cones"
+    raw = (cv2.imread(str(cones / "left.png")), cv2.imread(str(cones / "right.png")))
+
+    class Cameras:
+        def read(self):
+            return raw
+
+        def close(self):
+            pass
+
+    app = _scene_app("test-rectify-given", [data_dir], source=Cameras())
+    app._grab()
+    _run(app, app.recompute)
+    assert app.state.computations == 1
+    _run(app, app.rectify_from_features)
+    assert app.state.error == ""
+    got = re.fullmatch(
+        r"already rectified \(rows median \|dy\| (0\.[0-9]+) px over ([0-9]+) matches, "
+        r"tolerance 0\.5\): used as given",
+        app.state.rows_label,
+    )
+    assert got is not None, app.state.rows_label
+    assert float(got.group(1)) < 0.5 and int(got.group(2)) >= 30
+    assert app.homographies is None and app.pair[0] is raw[0] and app.pair[0].shape == (375, 450, 3)
+    assert app.state.computations == 1  # the result on show is this pair's: nothing to compute
+    assert "rectified from features" not in app.state.source_label
+    # a pair warped earlier (its homographies kept) goes back to the pair as it comes
+    from stereovision.uncalibrated import rectify_uncalibrated
+
+    app.homographies = rectify_uncalibrated(*raw)
+    app._grab()
+    assert app.pair[0].shape != raw[0].shape
+    _run(app, app.rectify_from_features)
+    assert app.homographies is None and app.pair[0] is raw[0]
+    assert app.max_disparity is None  # the homographies' range went with them
+    assert app.state.computations == 2 and " · 450×375 · " in app.state.stats
+
+
+def test_an_image_folder_plays_its_pairs_one_per_capture(tmp_path):
+    """The page could open two files or a scene, not a folder of pairs (what `capture` saves,
+    or left/ + right/ camera folders). "Play" takes a folder's pairs as `batch` finds them,
+    one per Capture, starting again after the last; a scene's calib.txt comes with its pair;
+    a folder without pairs, or whose images lead outside --data, says so."""
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    data, outside = tmp_path / "data", tmp_path / "outside"
+    seq, rig = data / "seq", data / "rig"
+    for d in (seq, rig / "left", rig / "right", outside, data / "empty"):
+        d.mkdir(parents=True)
+    for k, scale in ((1, 1.0), (2, 0.5)):
+        for side, img in (("left", left), ("right", right)):
+            cv2.imwrite(str(seq / f"{side}_{k:04d}.png"), cv2.resize(img, None, fx=scale, fy=scale))
+    for side, img in (("left", left), ("right", right)):
+        cv2.imwrite(str(rig / side / "0001.png"), img)
+        cv2.imwrite(str(outside / f"{side}.png"), img)
+    shutil.copytree(cones, data / "scenes" / "cones")
+    (data / "escape").mkdir()
+    (data / "escape" / "left_0001.png").symlink_to(outside / "left.png")
+    (data / "escape" / "right_0001.png").symlink_to(outside / "right.png")
+
+    app = _scene_app("test-pair-folder", [data])
+    assert str(seq.resolve()) in [i["value"] for i in app.state.pair_folders]
+    app.state.pair_folder = str(seq)
+    app.open_pair_folder()
+    assert app.state.error == "" and app.state.live
+    assert app.state.source_label == "folder data/seq: pair 0001 (1 of 2)"
+    np.testing.assert_array_equal(app.pair[0], left)
+    assert app.calib is None
+    app.capture()
+    assert app.state.source_label == "folder data/seq: pair 0002 (2 of 2)"
+    assert app.pair[0].shape == (188, 225, 3)
+    app.capture()  # after the last, the first again
+    assert app.state.source_label == "folder data/seq: pair 0001 (1 of 2)"
+    app.state.pair_folder = str(rig)
+    app.open_pair_folder()
+    assert app.state.source_label.startswith("folder data/rig: pair ")
+    assert app.state.source_label.endswith(" (1 of 1)")
+    np.testing.assert_array_equal(app.pair[1], right)
+    app.state.pair_folder = str(data / "scenes")
+    app.open_pair_folder()
+    assert app.state.error == "" and app.calib is not None  # the scene's calib.txt
+    for bad in ("empty", "escape"):
+        app.state.pair_folder = str(data / bad)
+        app.open_pair_folder()
+        assert app.state.error == (
+            f"no image pairs in data/{bad} (left_0001.png + right_0001.png, left/ + right/ "
+            "folders, or scene folders with left.png + right.png)"
+        ), bad
+    app.state.pair_folder = str(seq / "left_0001.png")
+    app.open_pair_folder()
+    assert app.state.error == "not a folder: data/seq/left_0001.png"
+    assert app.state.source_label.startswith("folder data/scenes: pair ")  # still in use
+
+
+def test_rectify_and_check_rows_of_a_pair_replaced_meanwhile_are_dropped(data_dir, monkeypatch):
+    """A scene chosen while "Rectify" or "Check rows" ran on the cameras' pair: their results
+    were put on the new scene (its label read "(rectified from features)" above the cameras'
+    rectified pair, its rows line was the cameras' verdict). The newer choice wins."""
+    import asyncio
+    import threading
+
+    import stereovision.rectification_check as rc
+
+    sp = data_dir / "stereopi_rig" / "scene_photo"
+    raw = (cv2.imread(str(sp / "left.png")), cv2.imread(str(sp / "right.png")))
+    venus = data_dir / "middlebury2001" / "venus"
+    app = _still_cameras_app("test-superseded-buttons", data_dir, raw)
+    real = rc.check_rectification
+    started, gate = threading.Event(), threading.Event()
+
+    def held(*args: Any, **kwargs: Any) -> Any:
+        started.set()
+        gate.wait(60)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(rc, "check_rectification", held)
+    tasks: list = []
+
+    async def pressed_then_scene(action: Any) -> None:
+        started.clear()
+        gate.clear()
+        tasks.clear()
+        app._lock = asyncio.Lock()  # one per event loop
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        app._grab()
+        running = asyncio.ensure_future(action())
+        await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
+        app._on_scene(scene=str(venus))  # chosen while the button's work runs
+        gate.set()
+        await running
+        await asyncio.gather(*tasks)
+
+    label = f"scene {app.folders.label(app.folders.resolve(str(venus)))}"
+    for action in (app.rectify_from_features, app.check_rows):
+        asyncio.run(pressed_then_scene(action))
+        assert app.state.error == "" and app.homographies is None
+        assert app.pair[0].shape == (383, 434, 3) and app.state.source_label == label
+        assert app.state.rows_label == ""
+        assert app.view is not None and app.view.result.disparity.shape == (383, 434)
+
+
+def test_a_floor_found_for_a_pair_replaced_meanwhile_is_dropped(data_dir, monkeypatch):
+    """Find floor on a scene, then another scene chosen while the fit ran: the first scene's
+    floor picture and height were put on the page under the new scene's name while it computed
+    (its images shown, the previous results cleared), until its own depth map came."""
+    import asyncio
+    import threading
+
+    import stereovision.gui.app as app_mod
+
+    first = data_dir / "tartanair" / "oldtown_easy_p000_001116"
+    venus = data_dir / "middlebury2001" / "venus"
+    app = _scene_app("test-floor-superseded", [data_dir])
+    real = app_mod.floor_view
+    started, gate = threading.Event(), threading.Event()
+
+    def held(res: Any) -> Any:
+        started.set()
+        gate.wait(60)
+        return real(res)
+
+    monkeypatch.setattr(app_mod, "floor_view", held)
+    tasks: list = []
+
+    def choose(scene: Path) -> None:
+        app.state.scene = str(scene)
+        app._on_scene(scene=str(scene))
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        choose(first)
+        await asyncio.gather(*tasks)
+        floor = asyncio.ensure_future(app.find_floor())
+        await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
+        choose(venus)  # chosen while the floor is fitted
+        await asyncio.sleep(0)
+        gate.set()
+        await floor
+        # venus computes: its images are on the page, no result of the previous scene
+        assert app.state.img_floor == "" and app.state.floor_label == ""
+        await asyncio.gather(*tasks)
+
+    asyncio.run(run())
+    assert app.state.error == "" and app.state.source_label.endswith("venus")
+    assert app.view is not None and app.view.result.disparity.shape == (383, 434)
+    assert app.state.img_floor == "" and app.state.floor_label == ""
+
+
+def test_capture_averages_still_frames_when_asked(data_dir):
+    """The acquisition panel's "average 8 still frames", in-process: cameras giving venus with
+    fresh noise of 8 grey levels on every read. Off, a capture is one noisy frame; on, it is
+    the mean of 8 (its noise about a third) and the label says so."""
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui.app import AVERAGE_FRAMES, StereoApp
+    from tests.test_exposure import noisy
+
+    venus = data_dir / "middlebury2001" / "venus"
+    clean = [cv2.imread(str(venus / f"{s}.png")) for s in ("left", "right")]
+    rng = np.random.default_rng(0)
+
+    class Cameras:
+        reads = 0
+
+        def read(self):
+            Cameras.reads += 1
+            return tuple(noisy(c, 8.0, rng) for c in clean)
+
+        def close(self):
+            pass
+
+    app = StereoApp(
+        get_server("test-average", client_type="vue3"),
+        AllowedFolders([data_dir]),
+        data_dir / "middlebury2003" / "cones",
+        source=Cameras(),
+    )
+
+    def noise() -> float:
+        return float(np.std(app.pair[0].astype(np.float32) - clean[0]))
+
+    app._grab()
+    single = noise()
+    assert Cameras.reads == 1 and "averaged" not in app.state.source_label
+    app.state.average = True
+    app._grab()
+    assert Cameras.reads == 1 + AVERAGE_FRAMES
+    assert noise() < 0.45 * single, (noise(), single)
+    assert app.state.source_label.endswith("(8.0 frames averaged)")
+
+
+def test_cameras_that_cannot_be_paired_leave_the_open_ones_in_use(tmp_path):
+    """Two videos of different sizes open, but give no pair: "Open" closed the cameras in use
+    and kept the unusable pair, so every later Capture failed (and a capture was labelled with
+    the names typed in the fields, not those of the cameras it came from). The open cameras
+    now stay until new ones have given a pair."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.sources import open_stereo_source
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    lv = _write_video(tmp_path / "l.avi", left)
+    rv = _write_video(tmp_path / "r.avi", right)
+    small = _write_video(tmp_path / "small.avi", cv2.resize(right, (400, 300)))
+
+    lonely = _scene_app("test-cameras-unpaired-none", [tmp_path])
+    lonely.state.cam_left, lonely.state.cam_right = str(lv), str(small)
+    lonely.open_cameras()
+    assert lonely.state.error.startswith("right source") and "400x300" in lonely.state.error
+    assert lonely.source is None and lonely.state.live is False and lonely.pair is None
+
+    app = _scene_app(
+        "test-cameras-unpaired",
+        [tmp_path],
+        source=open_stereo_source(str(lv), str(rv)),
+        source_names=(str(lv), str(rv)),
+    )
+    app._grab()
+    assert app.state.source_label == "cameras l.avi / r.avi"
+    app.state.cam_right = str(small)
+    app.open_cameras()
+    assert app.state.error.startswith("right source") and "400x300" in app.state.error
+    assert app.state.error.endswith("(the cameras in use are unchanged)")
+    app.state.error = ""
+    app.capture()  # from the cameras still open
+    assert app.state.error == "" and app.state.captures == 1
+    assert app.state.source_label == "cameras l.avi / r.avi"
+    assert app.pair[0].shape == app.pair[1].shape and app.pair[0].shape[1] == 450
+    app.source.close()
+
+
+def test_open_cameras_asks_the_chosen_pixel_format(data_dir, monkeypatch):
+    """The camera row's "format" select, in-process: "MJPG" and "YUYV" reach the cameras as
+    ``StereoCamera(..., fourcc=)`` (what ``capture --fourcc`` asks), "driver" asks nothing, and
+    ``stereovision gui --fourcc`` does the same for the cameras it opens."""
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision import capture
+    from stereovision.gui import add_arguments, build_app
+    from stereovision.gui.app import FOURCCS, StereoApp
+
+    asked: list[str | None] = []
+    frame = cv2.imread(str(data_dir / "middlebury2001" / "venus" / "left.png"))
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None):
+            asked.append(fourcc)
+
+        def read(self):
+            return frame, frame
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    app = StereoApp(
+        get_server("test-fourcc", client_type="vue3"),
+        AllowedFolders([data_dir]),
+        data_dir / "middlebury2003" / "cones",
+    )
+    monkeypatch.setattr(app, "_spawn", lambda coro: coro.close())  # no event loop here
+    assert app.state.fourccs == list(FOURCCS) and app.state.fourcc == "driver"
+    app.state.cam_left, app.state.cam_right = "0", "1"
+    for choice in ("MJPG", "YUYV", "driver"):
+        app.state.fourcc = choice
+        app.open_cameras()
+        assert app.state.error == "" and app.state.live
+    assert asked == ["MJPG", "YUYV", None]
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    built = build_app(parser.parse_args(["--left", "0", "--right", "1", "--fourcc", "MJPG"]))
+    assert asked[-1] == "MJPG" and built.state.live
+    with pytest.raises(ValueError, match="four characters"):
+        build_app(parser.parse_args(["--left", "0", "--right", "1", "--fourcc", "MJPEG"]))
+    with pytest.raises(ValueError, match="--fourcc asks the cameras for a format"):
+        build_app(parser.parse_args(["--fourcc", "MJPG"]))
+
+
+def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
+    data_dir, tmp_path, capsys
+):
+    """OpenCV stereo_calib's intrinsics.yml + extrinsics.yml hold no image size: `gui --calib`
+    refused them ("this command cannot read it from its images, so save the rig once in Python
+    ..."), while depth, batch and stream take the size from their pairs. The first pair the
+    calibration is used with sizes it: the cameras' first frames, an image folder's first
+    pair, files (a scene has its own calib.txt); a pair of another size is refused in depth's
+    words, the pair on show stays. --calib-unit is still asked for in one line."""
+    from test_calibration import _opencv_stereo_calib
+
+    from stereovision.gui import add_arguments, build_app, main
+
+    rig, data = tmp_path / "rig", tmp_path / "data"
+    rig.mkdir()
+    _opencv_stereo_calib(rig)  # 640x480, T (-120, 1.5, 0.8) mm
+    for d in ("big", "small", "seq"):
+        (data / d).mkdir(parents=True)
+    for n in ("01", "02"):
+        for side in ("left", "right"):
+            img = cv2.imread(str(data_dir / "chessboard" / f"{side}{n}.jpg"))
+            assert img.shape == (480, 640, 3)
+            cv2.imwrite(str(data / "big" / f"{side}_00{n}.png"), img)
+            cv2.imwrite(str(data / "small" / f"{side}_00{n}.png"), cv2.resize(img, (320, 240)))
+            cv2.imwrite(str(data / "seq" / f"{side}{n}.png"), img)
+    assert main(["--calib", str(rig), "--data", str(data)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.endswith(
+        "(the board's square size): pass --calib-unit (m, mm, cm, ft or in)\n"
+    )
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    args = ["--calib", str(rig), "--calib-unit", "mm", "--data", str(data)]
+    app = build_app(parser.parse_args(args))
+    app._spawn = lambda coro: coro.close()
+    app._on_ready()  # the demo scene, with its own calibration
+    assert app.state.error == "" and app.calib.image_size == (450, 375)
+    app.state.pair_folder = str(data / "big")
+    app.open_pair_folder()
+    assert app.state.error == ""
+    assert app.calib.image_size == (640, 480) and app.calib.unit == "mm"
+    assert app.calib.baseline_m == pytest.approx(np.linalg.norm([120.0, 1.5, 0.8]) / 1000)
+    said = "calibration is for 640x480 images, got 320x240 (images resized, not cropped: "
+    said += "calib.scaled_to((320, 240)))"
+    app.state.left_file = str(data / "small" / "left_0001.png")
+    app.state.right_file = str(data / "small" / "right_0001.png")
+    app.load_files()
+    assert app.state.error == said
+    assert app.pair[0].shape == (480, 640, 3)  # the pair on show stays
+    app.state.pair_folder = str(data / "small")
+    app.open_pair_folder()
+    assert app.state.error == f"{said} (the cameras in use are unchanged)"
+    assert app.state.source_label.endswith("data/big: pair 0001 (1 of 2)")
+    app.state.left_file = str(data / "big" / "left_0002.png")
+    app.state.right_file = str(data / "big" / "right_0002.png")
+    app.state.error = ""  # (a computation clears it: none runs here)
+    app.load_files()
+    assert app.state.error == "" and app.calib is app.source_calib
+    assert app.state.source_label == "files"
+    assert app.state.rows_label == ""  # no "does not fit" note
+
+    # files first; cameras (an image sequence) sized by their first frames
+    app = build_app(parser.parse_args(args))
+    app._spawn = lambda coro: coro.close()
+    app.state.left_file = str(data / "small" / "left_0002.png")
+    app.state.right_file = str(data / "small" / "right_0002.png")
+    app.load_files()
+    assert app.state.error == "" and app.calib.image_size == (320, 240)
+    seq = ["--left", str(data / "seq" / "left%02d.png"), "--right"]
+    app = build_app(parser.parse_args([*args, *seq, str(data / "seq" / "right%02d.png")]))
+    app._spawn = lambda coro: coro.close()
+    app._on_ready()
+    assert app.state.error == "" and app.calib.image_size == (640, 480)
+
+
+def test_calib_unit_without_calib_is_refused():
+    """`gui --calib-unit mm` without --calib started the page with the option ignored; it is
+    refused in the other commands' words (cli.load_calibration)."""
+    pytest.importorskip("trame")
+    from stereovision.gui import add_arguments, build_app
+
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    with pytest.raises(ValueError) as err:
+        build_app(parser.parse_args(["--calib-unit", "mm"]))
+    assert str(err.value) == "--calib-unit is the unit of --calib's file: give --calib too"
+
+
+def test_a_one_point_cloud_is_captioned_1_point(tmp_path):
+    """A cloud file of one point was captioned "1 points"."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import shown_cloud
+    from stereovision.io import write_ply
+
+    assert shown_cloud(np.ones((1, 3)))[1] == "1 point"
+    assert shown_cloud(np.ones((2, 3)))[1] == "2 points"
+    write_ply(tmp_path / "one.ply", np.array([[0.1, 0.2, 2.0]], np.float32))
+    app = _scene_app("test-one-point", [bundled_data_dir(), tmp_path])
+    app.state.view_mode = "points"
+    app.state.cloud_path = str(tmp_path / "one.ply")
+    app.open_cloud()
+    label = app.folders.label((tmp_path / "one.ply").resolve())
+    assert app.state.error == "" and app.state.message_3d == f"{label}: 1 point"
+
+
+def test_cloud_and_save_errors_show_short_paths(tmp_path, monkeypatch):
+    """A point-cloud file or a Save folder that failed was named by its whole absolute path
+    (/tmp/.../data/bad.ply) where the page shows paths short (the Save field: data/saved);
+    the errors show them as the Save field does (display_path)."""
+    from stereovision.gui import bundled_data_dir
+
+    data = tmp_path / "data"
+    data.mkdir()
+    (data / "bad.ply").write_text("not a cloud at all\n")
+    (data / "afile").write_text("mine")
+    monkeypatch.chdir(tmp_path)
+    app = _scene_app("test-short-paths", [bundled_data_dir(), data])
+    assert app.state.save_dir == "data/saved"
+    app.state.cloud_path = str(data / "bad.ply")
+    app.open_cloud()
+    assert app.state.error == "not a PLY file: data/bad.ply"
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.state.save_dir = "data/afile"
+    _run(app, app.save)
+    assert app.state.error == "save folder data/afile: is a file, not a folder"
+    app.state.save_dir = "data/afile/inside"
+    _run(app, app.save)
+    assert app.state.error == "save folder data/afile/inside: data/afile is a file, not a folder"
+    assert (data / "afile").read_text() == "mine"
+    assert str(tmp_path) not in app.state.error
+
+
+def test_the_max_disparity_hint_says_full_size_and_the_processing_width():
+    """At 320 the max-disparity field's hint gave the full-size range alone (64 px on the
+    450 px cones, 46 px searched). The field is in full-size pixels: the hint says so, and the
+    range searched at the processing width."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-max-disp-hint", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    auto = app.max_disparity
+    app.state.resolution = "320"
+    _run(app, app.recompute)
+    searched = -(-auto * 320 // 450)
+    assert app.state.max_disp_hint == (f"auto: {auto} px at full size ({searched} at 320)")
+    assert f"disparities 0–{searched}\xa0px" in app.state.stats
+    app.state.resolution = "full"
+    _run(app, app.recompute)
+    assert app.state.max_disp_hint == f"auto: {auto} px at full size"
+
+
+def test_the_max_disparity_field_and_the_overview_name_edge_values():
+    """At full processing width the hint says the full-size range once (no "(64 at 450)"),
+    "auto" is read in any case, as the field's hint writes it, and a pair with no label is
+    called "pair" in a saved overview's title."""
+    from stereovision.gui.app import max_disparity_hint, overview_name, parse_max_disparity
+
+    assert max_disparity_hint(64, 450, 450) == "auto: 64 px at full size"
+    assert max_disparity_hint(None, 450, 320) == "auto: estimated from the images"
+    assert [parse_max_disparity(t, 450) for t in ("AUTO", "Auto", " 63 ")] == [None, None, 63]
+    assert overview_name("  ") == "pair"
+
+
+def test_the_progress_plan_names_only_the_stages_depth_map_runs():
+    """The status's stages are those ``depth_map`` runs for the method: gabor re-measures and
+    fills nothing, the dense methods fill (fast does not re-measure), and nothing is
+    triangulated without a calibration."""
+    from stereovision.gui.app import _planned_stages
+
+    base = ["rectify", "prepare", "match"]
+    assert _planned_stages("gabor", False) == [*base, "refine"]
+    assert _planned_stages("gabor", True) == [*base, "refine", "triangulate"]
+    assert _planned_stages("fused", True) == [*base, "fill", "triangulate"]
+    assert _planned_stages("census", False) == [*base, "fill"]
+    assert _planned_stages("fast", False) == [*base, "fill"]
+
+
+@pytest.mark.parametrize("method", ["mcgm", "hopfield"])
+def test_the_sparse_channels_are_offered_and_their_matches_drawn(method):
+    """The page offered fused, gabor, census, fast and the OpenCV references: MCGM and Hopfield,
+    the paper's other channels, were not on it (its list was depth_map's methods; the sparse
+    drawing path named them but was never reached). They are offered: the matches on show are
+    stereovision.match's on the same scaled pair, the statistics give their count and their
+    precision@1 against the scene's GT, and the 3-D view shows their points in either mode."""
+    from stereovision import match
+    from stereovision.evaluate import sparse_metrics
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.sources import scale_pair, scaled_calibration
+    from stereovision.io import load_scene
+
+    app = _scene_app(f"test-sparse-{method}", [bundled_data_dir()])
+    assert method in app.state.methods
+    cones = bundled_data_dir() / "cones"
+    app._load_scene(cones)
+    app.state.method, app.state.resolution = method, "320"
+    _run(app, app.recompute)
+    assert app.state.error == ""
+    view = app.view
+    scene = load_scene(cones)
+    left_s, right_s, s = scale_pair(scene.left, scene.right, 320)
+    calib_s = scaled_calibration(scene.calib, s, (left_s.shape[1], left_s.shape[0]))
+    d_max = -(-scene.max_disparity * 320 // 450)
+    assert view.result.max_disparity == d_max
+    expected = match(left_s, right_s, calib_s, method=method, max_disparity=d_max)
+    assert len(expected) > 500 and len(view.matches) == len(expected)
+    np.testing.assert_array_equal(view.matches.to_array(), expected.to_array())
+    np.testing.assert_array_equal(view.result.disparity, expected.dispx)
+    h_s, w_s = left_s.shape[:2]
+    gt_s = cv2.resize(scene.gt, (w_s, h_s), interpolation=cv2.INTER_NEAREST_EXACT) * (w_s / 450)
+    m = sparse_metrics(expected.xl, expected.yl, expected.xr, gt_s)
+    assert m.precision[1.0] > 90
+    said = (
+        f"{len(expected)} matches, precision@1 {m.precision[1.0]:.1f}\xa0% of the {m.count} on GT"
+    )
+    assert said in app.state.stats and "density" not in app.state.stats
+    n = len(view.result.points)
+    assert n == np.isfinite(expected.dispx).sum()
+    for mode in ("surface", "points"):
+        app.state.view_mode = mode
+        app._on_view_mode()
+        poly = app.plotter.actors["scene"].GetMapper().GetInput()
+        assert (poly.GetNumberOfPoints(), poly.GetNumberOfPolys()) == (n, 0), mode
+        assert app.state.message_3d == (
+            f"{method} is sparse: no dense map, its {n} points shown as points"
+        )
+        assert app.state.view_mode == "points" and app.state.points_only, mode
+    # after Rectify (or for another pair) the scene's GT is not that pair's: no precision said
+    app._scene_gt = (None, scene.gt)
+    _run(app, app.recompute)
+    assert f"{len(expected)} matches ·" in app.state.stats and "precision" not in app.state.stats
+
+
+def test_the_scaled_gt_is_sampled_at_the_scaled_pixels_centres():
+    """scaled_gt took each scaled pixel's GT from the first source pixel it covers
+    (cv2.INTER_NEAREST: floor(x * w / w_s)), not the one at its centre, as the images' INTER_AREA
+    averages them: the GT sat half a scaled pixel left of and above the images, and the cones'
+    fast map at 160 px said bad-2.0 6.4 % where its own GT gives 5.8 %. It takes the pixel at
+    the centre (INTER_NEAREST_EXACT); its values are in the scaled pair's pixels, an unknown
+    (NaN, inf) stays unknown, and at full size the GT is as given."""
+    from stereovision.gui.app import scaled_gt
+
+    ramp = np.tile(np.arange(8, dtype=np.float32), (4, 1))  # disparity = column, 8 x 4 px
+    ramp[:, 5] = np.nan
+    ramp[2, :] = np.inf
+    g = scaled_gt(ramp, np.zeros((4, 8, 3), np.uint8), np.zeros((2, 2, 3), np.uint8))
+    # scaled pixel 0 covers columns 0-3 (centre 1.5): column 2; pixel 1 covers 4-7: column 6;
+    # rows: 0-1 -> row 1, 2-3 -> row 3 (the inf row 2 is not the centre's); x 2/8 the values
+    np.testing.assert_array_equal(g, [[0.5, 1.5], [0.5, 1.5]])
+    g = scaled_gt(ramp, np.zeros((4, 8, 3), np.uint8), np.zeros((4, 4, 3), np.uint8))
+    assert np.isnan(g[0, 2]) and np.isinf(g[2]).all()  # column 5, row 2: unknown, not filled
+    np.testing.assert_array_equal(g[0], [0.5, 1.5, np.nan, 3.5])
+    full = scaled_gt(ramp, np.zeros((4, 8, 3), np.uint8), np.zeros((4, 8, 3), np.uint8))
+    np.testing.assert_array_equal(full, ramp)
+
+
+@pytest.mark.parametrize("method", ["fast", "opencv-bm"])
+def test_a_dense_method_says_its_bad_2_and_density_on_the_scenes_gt(method):
+    """The sparse methods' statistics said their precision@1 against the scene's GT, the dense
+    ones no GT figure at all. They say the map's bad-2.0 (holes counted as errors) and density
+    over the GT pixels (evaluation.md), dense_metrics' on the scaled map and the GT scaled as
+    the images were; after Rectify (or for another pair) they say none."""
+    from stereovision.evaluate import dense_metrics
+    from stereovision.gui import bundled_data_dir
+    from stereovision.io import load_scene
+
+    app = _scene_app(f"test-dense-gt-{method}", [bundled_data_dir()])
+    cones = bundled_data_dir() / "cones"
+    app._load_scene(cones)
+    app.state.method, app.state.resolution = method, "320"
+    _run(app, app.recompute)
+    assert app.state.error == ""
+    scene = load_scene(cones)
+    disparity = app.view.result.disparity
+    h_s, w_s = disparity.shape
+    assert w_s == 320
+    gt_s = cv2.resize(scene.gt, (w_s, h_s), interpolation=cv2.INTER_NEAREST_EXACT) * (w_s / 450)
+    m = dense_metrics(disparity, gt_s)
+    assert 0 < m.bad[2.0] < 60 and 50 < m.density <= 100
+    said = f", on GT bad-2.0 {m.bad[2.0]:.1f}\xa0% (holes count) at density {m.density:.1f}\xa0%"
+    assert said in app.state.stats
+    app._scene_gt = (None, scene.gt)
+    _run(app, app.recompute)
+    assert app.state.error == "" and "bad-2.0" not in app.state.stats
+    assert "density" in app.state.stats
+
+
+def test_the_view_mode_toggle_says_points_for_a_sparse_method():
+    """For mcgm and hopfield the 3-D view shows points in either mode, and the surface / points
+    toggle still said "surface". It says "points" and is disabled while a sparse method's
+    matches are on show; a dense method's result is drawn again as the user had chosen (the
+    toggle enabled, back to it)."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-sparse-toggle", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    app.state.resolution = "320"
+    _run(app, app.recompute)
+    assert (app.state.view_mode, app.state.points_only) == ("surface", False)
+    dense = app.plotter.actors["scene"].GetMapper().GetInput()
+    assert dense.GetNumberOfPolys() > 0  # the surface
+    app.state.method = "mcgm"
+    _run(app, app.recompute)
+    assert app.state.error == ""
+    assert (app.state.view_mode, app.state.points_only) == ("points", True)
+    app.state.view_mode = "surface"  # a change from the page while it is disabled: put back
+    app._on_view_mode()
+    assert app.state.view_mode == "points"
+    poly = app.plotter.actors["scene"].GetMapper().GetInput()
+    assert poly.GetNumberOfPolys() == 0 and poly.GetNumberOfPoints() == len(app.view.result.points)
+    app.state.method = "fast"
+    _run(app, app.recompute)
+    assert (app.state.view_mode, app.state.points_only) == ("surface", False)
+    assert app.plotter.actors["scene"].GetMapper().GetInput().GetNumberOfPolys() > 0
+    app.state.view_mode = "points"  # the user's points, kept through a sparse method and back
+    app._on_view_mode()
+    assert app.plotter.actors["scene"].GetMapper().GetInput().GetNumberOfPolys() == 0
+    app.state.method = "hopfield"
+    _run(app, app.recompute)
+    assert (app.state.view_mode, app.state.points_only) == ("points", True)
+    app.state.method = "fast"
+    _run(app, app.recompute)
+    assert (app.state.view_mode, app.state.points_only) == ("points", False)
+    assert app.plotter.actors["scene"].GetMapper().GetInput().GetNumberOfPolys() == 0
+
+
+def test_the_lines_between_the_images_are_coloured_by_disparity():
+    """The matches' lines between the two images were coloured by their index (a hue ramp over
+    the list: two matches of one disparity in two colours). Each line and its end dots have
+    the colour of its disparity on the disparity picture's scale, as the dots of draw_sparse."""
+    from stereovision.cli import colorize
+    from stereovision.gui.app import draw_matches, draw_sparse
+
+    left = np.zeros((40, 200, 3), np.uint8)
+    right = np.zeros_like(left)
+    disparity = np.full((40, 200), np.nan, np.float32)
+    disparity[5, 150], disparity[20, 60], disparity[35, 180] = 30.0, 30.0, 10.0
+    canvas = draw_matches(left, right, disparity, lo=0.0, hi=32.0)
+    ramp = colorize(np.array([[30.0, 10.0]], np.float32), lo=0.0, hi=32.0)[0]
+    for (y, x), c in zip(((5, 150), (20, 60), (35, 180)), (ramp[0], ramp[0], ramp[1]), strict=True):
+        xr = 200 + x - round(float(disparity[y, x]))
+        np.testing.assert_array_equal(canvas[y, x], c)  # the left end
+        np.testing.assert_array_equal(canvas[y, xr], c)  # the right end
+        # the line between, antialiased: its colour a little darker
+        line = canvas[y, (x + xr) // 2].astype(float)
+        k = line[np.argmax(c)] / c.max()
+        assert 0.8 < k <= 1 and np.allclose(line, k * c, atol=2), (line, c)
+    # the dots of the sparse picture have the same colours
+    dots = draw_sparse(left, disparity, 0.0, 32.0)
+    np.testing.assert_array_equal(dots[20, 60], canvas[20, 60])
+    # by default the ends are the disparity picture's: 0 px and the map's 99th percentile
+    np.testing.assert_array_equal(
+        draw_matches(left, right, disparity)[35, 180], colorize(disparity, lo=0.0)[35, 180]
+    )
+
+
+def test_draw_sparse_colours_each_match_by_its_value():
+    """A sparse method's picture: each matched pixel in the colour colorize gives its value on
+    the dense pictures' scale, the rest the image dimmed in grey."""
+    from stereovision.cli import colorize
+    from stereovision.gui.app import draw_sparse
+
+    image = np.full((40, 60, 3), 200, np.uint8)
+    values = np.full((40, 60), np.nan, np.float32)
+    values[10, 10], values[30, 50] = 2.0, 30.0
+    out = draw_sparse(image, values, 0.0, 32.0)
+    ramp = colorize(np.array([[2.0, 30.0]], np.float32), lo=0.0, hi=32.0)[0]
+    np.testing.assert_array_equal(out[10, 10], ramp[0])
+    np.testing.assert_array_equal(out[30, 50], ramp[1])
+    np.testing.assert_array_equal(out[0, 0], [100, 100, 100])
+    assert not np.array_equal(ramp[0], ramp[1])
+
+
+# ----------------------------------------------------------------------------- page events
+
+
+def test_the_scene_list_after_start_up_cameras_and_a_choice_put_back(tmp_path):
+    """The scene list's choice and what it says: a failed choice after start-up goes back to
+    the demo scene, choosing the scene on show (the list put back) computes nothing, another
+    scene drops the previous pair's Check rows verdict, and a camera pair clears the choice so
+    that choosing the scene again reloads it."""
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    shutil.copytree(bundled_data_dir() / "cones", tmp_path / "other")
+    (tmp_path / "odd").mkdir()  # fails to load: the two images differ in size
+    cv2.imwrite(str(tmp_path / "odd" / "left.png"), np.zeros((40, 50, 3), np.uint8))
+    cv2.imwrite(str(tmp_path / "odd" / "right.png"), np.zeros((40, 60, 3), np.uint8))
+    app = _scene_app("test-scene-list-events", [bundled_data_dir(), tmp_path])
+    spawned: list = []
+    app._spawn = lambda coro: (spawned.append(coro), coro.close())
+    app._on_ready()
+    demo = str((bundled_data_dir() / "cones").resolve())
+    choose = _chooser(app, tmp_path)
+    choose("odd")
+    assert app.state.error != "" and app.state.scene == demo
+    spawned.clear()
+    app._on_scene(scene=demo)  # the list put back on the scene on show
+    assert spawned == [] and app.state.source_label == "scene data/cones"
+    _run(app, app.check_rows)
+    assert app.state.rows_label.startswith("rectification ok")
+    choose("other")
+    assert app.state.rows_label == "" and len(spawned) == 1
+
+    left, right = app.pair
+
+    class Cameras:
+        def read(self):
+            return left.copy(), right.copy()
+
+        def close(self):
+            pass
+
+    app._switch_source(Cameras(), ("0", "1"))
+    assert app.state.scene is None and app.state.source_label == "cameras 0 / 1"
+    app._on_scene(scene=str(tmp_path / "other"))
+    assert app.state.source_label.startswith("scene ") and app.state.source_label.endswith("other")
+
+
+def test_cameras_after_a_scene_count_captures_close_the_old_and_use_their_own_range():
+    """A camera pair after a scene: the scene's disparity range (cones: 64) is not the cameras',
+    the previous cameras are closed, each pair counts as a capture, and homographies the
+    features gave another rig's pair are not put on the cameras' next pairs after a scene or
+    files were shown."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-cameras-after-scene", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    assert app.max_disparity == 64
+    left, right = app.pair
+    closed: list = []
+
+    class Cameras:
+        def __init__(self, name: str) -> None:
+            self.name = name
+
+        def read(self):
+            return left.copy(), right.copy()
+
+        def close(self):
+            closed.append(self.name)
+
+    class Rectified:  # the features' homographies of a 450x375 pair
+        input_size = (450, 375)
+        max_disparity = 50
+
+        def rectify(self, a, b):
+            return a, b
+
+    class NoFrames(Cameras):
+        def read(self):
+            raise OSError("camera 9 gave no frame")
+
+    app._switch_source(NoFrames("none"), ("9", "9"))
+    assert app.state.error == "camera 9 gave no frame" and closed == ["none"]
+    closed.clear()
+    app._switch_source(Cameras("a"), ("0", "1"))
+    assert app.state.error == ""
+    assert app.max_disparity is None and app.state.captures == 1 and closed == []
+    app._switch_source(Cameras("b"), ("2", "3"))
+    assert closed == ["a"] and app.state.captures == 2
+    app.capture()
+    assert app.state.captures == 3
+    for other in ("scene", "files"):
+        app.homographies = Rectified()
+        if other == "scene":
+            app._load_scene(bundled_data_dir() / "cones")
+        else:
+            app.state.left_file, app.state.right_file = "cones/left.png", "cones/right.png"
+            app.load_files()
+        app.capture()
+        assert app.state.error == "", other
+        assert app.state.source_label == "cameras 2 / 3", other
+        assert app.max_disparity is None, other
+
+
+def test_the_computations_a_page_asks_and_what_they_are_given(monkeypatch):
+    """What each computation is given and how many run: the max-disparity field wins over the
+    scene's range, the same value applied again computes nothing, three quick requests compute
+    the first and the newest only, and the first pair's 3-D caption does not speak of a
+    previous pair while it computes."""
+    import asyncio
+
+    from stereovision.gui import app as gui_app
+    from stereovision.gui import bundled_data_dir
+
+    real = gui_app.compute_view
+    calls: list = []
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        calls.append((kwargs["max_disparity"], app.state.message_3d))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(gui_app, "compute_view", spy)
+    app = _scene_app("test-computations-asked", [bundled_data_dir()])
+    spawned: list = []
+    app._spawn = lambda coro: (spawned.append(coro), coro.close())
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    assert calls == [(64, "")]  # the scene's range; no previous pair to speak of
+    app.apply_max_disparity(text="40")
+    assert app.state.error == "" and len(spawned) == 1
+    _run(app, app.recompute)
+    assert calls[-1][0] == 40
+    assert app.state.max_disp_hint == "auto: 64 px at full size"  # the automatic one, not 40
+    app.apply_max_disparity(text="40")
+    assert len(spawned) == 1  # unchanged: nothing to compute
+    calls.clear()
+
+    async def three() -> None:
+        await asyncio.gather(app.recompute(), app.recompute(), app.recompute())
+
+    _run(app, three)
+    assert len(calls) == 2 and app.state.computations == 3
+
+
+def test_toggles_during_a_computation_and_a_failure_keep_the_unit(tmp_path):
+    """The unit and surface/points toggles while a new pair computes leave its cleared results
+    and its 3-D caption alone (they put the previous pair's statistics under the new pair's
+    images); when the pair then fails, the previous pair's statistics and floor come back in
+    the unit chosen meanwhile. An unknown unit is refused and the toggle put back."""
+    import asyncio
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import PENDING_3D
+
+    shutil.copytree(bundled_data_dir() / "cones", tmp_path / "cones")
+    _tiny_scene(tmp_path / "tiny")
+    app = _scene_app("test-toggles-while-computing", [tmp_path])
+    app.state.unit = "yd"  # as the page sends it
+    app._on_unit(unit="yd")
+    assert app.state.error.startswith("unit: expected one of") and app.state.unit == "m"
+    tasks: list = []
+    seen: dict = {}
+    choose = _chooser(app, tmp_path)
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        choose("cones")
+        await asyncio.gather(*tasks)
+        await app.find_floor()
+        seen["floor"] = app.state.floor_label
+        choose("tiny")
+        await asyncio.sleep(0)  # its computation is running in the worker
+        app.state.unit = "ft"
+        app._on_unit(unit="ft")
+        app.state.view_mode = "points"
+        app._on_view_mode()
+        seen["during"] = (app.state.stats, app.state.message_3d)
+        await asyncio.gather(*tasks)
+
+    asyncio.run(run())
+    assert "\xa0m above it" in seen["floor"]
+    assert seen["during"] == ("", PENDING_3D)
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.stats == app.view.texts("ft")[1] and "\xa0ft" in app.state.stats
+    assert "\xa0ft above it" in app.state.floor_label
+
+
+def test_a_new_pair_clears_the_previous_saves_line(tmp_path):
+    """The Save's line ("saved 450×375 to ...") named the previous pair's folder under the next
+    computed pair: it goes with the pair it was said of."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-save-line-cleared", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.save_label.startswith("saved 450×375 to ")
+    _run(app, app.recompute)
+    assert app.state.error == "" and app.state.save_label == ""
+
+
+def test_check_rows_that_fails_on_a_pair_replaced_meanwhile_says_nothing(monkeypatch):
+    """Check rows that failed after another scene was chosen put its error over the new
+    scene's page: the failure was of a pair no longer on show."""
+    import asyncio
+    import threading
+
+    import stereovision.rectification_check as rc
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-rows-fail-replaced", [bundled_data_dir()])
+    started, gate = threading.Event(), threading.Event()
+
+    def fails(*args: Any, **kwargs: Any) -> Any:
+        started.set()
+        gate.wait(60)
+        raise ValueError("no features to check")
+
+    monkeypatch.setattr(rc, "check_rectification", fails)
+
+    async def pressed_then_scene() -> None:
+        app._lock = asyncio.Lock()
+        app._load_scene(bundled_data_dir() / "cones")
+        running = asyncio.ensure_future(app.check_rows())
+        await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
+        app._load_scene(bundled_data_dir() / "cones")  # another pair, chosen meanwhile
+        gate.set()
+        await running
+
+    asyncio.run(pressed_then_scene())
+    assert app.state.error == ""
+    _run(app, app.check_rows)  # on the pair on show it is said
+    assert app.state.error == "no features to check"
+
+
+def test_a_cloud_opened_after_a_failed_start_up_clears_the_error_status(tmp_path):
+    """Cameras that gave no pair at start-up left the toolbar on "error"; a point-cloud file
+    then opened cleared the message but the toolbar still said "error" above a page with no
+    error on it (the status went back to "ready" only once a pair was on show)."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.io import write_ply
+
+    class NoFrames:
+        def read(self):
+            raise OSError("camera 0 gave no frame")
+
+        def close(self):
+            pass
+
+    write_ply(tmp_path / "blob.ply", np.random.default_rng(2).uniform(1, 3, (50, 3)))
+    app = _scene_app(
+        "test-cloud-after-failed-start", [bundled_data_dir(), tmp_path], source=NoFrames()
+    )
+    app._on_ready()
+    assert app.state.status == "error" and app.state.error == "camera 0 gave no frame"
+    app.state.cloud_path = str(tmp_path / "blob.ply")
+    app.open_cloud()
+    assert app.state.error == "" and app.state.status == "ready"
+    assert app.state.message_3d.endswith(
+        ": 50 points (a point cloud has no surface: shown as points)"
+    )
+
+
+def test_reset_puts_all_six_sliders_back_to_zero():
+    """The 3-D view's Reset: every slider at 0 (the left camera's pose), the view with them."""
+    from stereovision import render
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import _CONTROL_NAMES
+
+    app = _scene_app("test-reset-sliders", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    for k, name in enumerate(_CONTROL_NAMES):
+        app.state[name] = 0.5 + k
+    app._on_controls()
+    app.reset_camera()
+    assert {n: app.state[n] for n in _CONTROL_NAMES} == dict.fromkeys(_CONTROL_NAMES, 0.0)
+    pose = render.controls_from_pose(render.pose_from_camera(app.plotter.camera))
+    assert [getattr(pose, n) for n in _CONTROL_NAMES] == pytest.approx([0.0] * 6, abs=1e-6)
+
+
+def test_a_pair_superseded_while_it_fails_leaves_the_newer_choice_and_the_page(tmp_path):
+    """A scene that failed after a newer one was chosen put its failure on the page and the
+    previous pair back in the app, so the newer choice computed the previous pair; a new pair
+    queued behind a superseded one took the blank page as the one to put back on failure."""
+    import asyncio
+    import shutil
+
+    from stereovision.gui import bundled_data_dir
+
+    for name in ("cones", "other"):
+        shutil.copytree(bundled_data_dir() / "cones", tmp_path / name)
+    _tiny_scene(tmp_path / "tiny")
+    app = _scene_app("test-superseded-failure", [tmp_path])
+    tasks: list = []
+    choose = _chooser(app, tmp_path)
+    seen: dict = {}
+
+    async def run() -> None:
+        app._lock = asyncio.Lock()
+        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        choose("cones")
+        await asyncio.gather(*tasks)
+        choose("tiny")  # fails, but "other" is chosen while it runs
+        await asyncio.sleep(0)
+        choose("other")
+        await asyncio.gather(*tasks)
+        seen["other"] = (app.state.error, app.state.source_label, app.state.computations)
+        seen["page"] = (app.state.stats, app.state.img_disparity)
+        choose("cones")  # queued behind "tiny", which is superseded: both then fail
+        choose("tiny")
+        await asyncio.gather(*tasks)
+
+    asyncio.run(run())
+    other = app.folders.label((tmp_path / "other").resolve())
+    assert seen["other"] == ("", f"scene {other}", 2)
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.source_label == f"scene {other}" and app.state.computations == 2
+    assert seen["page"][1] != "" and (app.state.stats, app.state.img_disparity) == seen["page"]
+
+
+def test_an_image_sequence_typed_as_a_camera_is_opened_by_its_folder(tmp_path):
+    """A camera field may hold an image sequence (``seq/left%02d.png``): its folder is checked
+    against --data, the pattern is no file of its own."""
+    from stereovision.gui import bundled_data_dir
+
+    left, right = (cv2.imread(str(CONES / f"{s}.png")) for s in ("left", "right"))
+    (tmp_path / "seq").mkdir()
+    for k in range(2):
+        cv2.imwrite(str(tmp_path / "seq" / f"left{k:02d}.png"), left)
+        cv2.imwrite(str(tmp_path / "seq" / f"right{k:02d}.png"), right)
+    app = _scene_app("test-camera-sequence", [bundled_data_dir(), tmp_path])
+    app.state.cam_left = str(tmp_path / "seq" / "left%02d.png")
+    app.state.cam_right = str(tmp_path / "seq" / "right%02d.png")
+    app.open_cameras()
+    assert app.state.error == ""
+    assert app.state.source_label == "cameras left%02d.png / right%02d.png"
+    assert app.pair[0].shape == (375, 450, 3)
+    app.source.close()
+
+
+def test_loading_files_names_sizes_and_warns_of_one_file_twice(tmp_path):
+    """The files' size mismatch said "left (375, 450, 3) and right (288, 384, 3) differ in
+    size"; the same file as left and right computed a flat 0 disparity without a word."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-files-twice", [bundled_data_dir(), tmp_path])
+    cv2.imwrite(str(tmp_path / "small.png"), np.full((288, 384, 3), 50, np.uint8))
+    app.state.left_file, app.state.right_file = "cones/left.png", str(tmp_path / "small.png")
+    app.load_files()
+    assert app.state.error == (
+        f"data/cones/left.png is 450x375 (colour), {tmp_path.name}/small.png is 384x288 "
+        "(colour): the two images of a pair have one size"
+    )
+    app.state.error = ""
+    app.state.left_file = app.state.right_file = "cones/left.png"
+    app.load_files()
+    assert app.state.error == ""
+    assert app.state.rows_label == (
+        "warning: data/cones/left.png and data/cones/left.png are the same file: every "
+        "disparity comes out 0 (two views of the scene are needed)"
+    )
+    app.state.right_file = "cones/right.png"
+    app.load_files()
+    assert app.state.rows_label == ""
+
+
+@pytest.mark.parametrize(
+    ("method", "calibrated", "steps"),
+    [
+        ("fused", False, ["preparing", "matching", "filling", "drawing"]),
+        ("gabor", False, ["preparing", "matching", "refining", "drawing"]),
+        ("fast", True, ["preparing", "matching", "filling", "triangulating", "drawing"]),
+    ],
+)
+def test_progress_names_the_step_that_really_follows(method, calibrated, steps, data_dir):
+    """The status named a fixed next step: "refining and filling" after fused's match (it only
+    fills), "filling" after gabor's refinement (it does not fill) and "triangulating" without a
+    calibration (nothing is triangulated)."""
+    from stereovision.gui.app import compute_view
+    from stereovision.io import load_scene
+
+    name = "tartanair/oldtown_easy_p000_001116" if calibrated else "middlebury2001/tsukuba"
+    sc = load_scene(data_dir / name)
+    assert (sc.calib is not None) == calibrated
+    said: list = []
+    compute_view(
+        sc.left, sc.right, sc.calib, method, width=320, progress=lambda p, t: said.append(t)
+    )
+    done = [t for t in said if " done, " in t]
+    assert [t.split(", ", 1)[1] for t in done] == [f"{s}…" for s in steps], said
+    assert said.index("drawing") == said.index(done[-1]) + 1
+
+
+def test_a_pair_rectified_by_its_calibration_is_shown_rectified_on_both_sides():
+    """With a calibration of unrectified cameras, the acquisition panel showed the rectified
+    left image (the one the disparity belongs to) beside the right image as the cameras gave
+    it, and the matches were drawn on the raw pair. Both images are the rectified pair now."""
+    import dataclasses
+
+    from stereovision.calibration import Calibration
+    from stereovision.gui.app import _data_url, compute_view
+
+    left, right = (cv2.imread(str(CONES / f"{s}.png")) for s in ("left", "right"))
+    ideal = Calibration.ideal((450, 375), 60, 0.16)
+    turned = cv2.Rodrigues(np.array([0.0, 0.03, 0.02]))[0]
+    calib = dataclasses.replace(ideal, R=turned, rectified=False)
+    rect_left, rect_right = calib.rectify(left, right)
+    view = compute_view(left, right, calib, "fast")
+    np.testing.assert_array_equal(view.result.left_rectified, rect_left)
+    assert view.left_url == _data_url(rect_left)
+    assert view.right_url == _data_url(rect_right) != _data_url(right)
+    # a rectified calibration's pair is shown as it comes
+    plain = compute_view(left, right, ideal, "fast")
+    assert (plain.left_url, plain.right_url) == (_data_url(left), _data_url(right))
+
+
+def test_the_average_switch_is_offered_only_for_sources_it_averages(tmp_path):
+    """With an image folder playing, the "average 8 still frames" switch was enabled and did
+    nothing (a folder's pairs are one view after another, never averaged). It is enabled for
+    cameras (and recordings) only."""
+    left, right = (cv2.imread(str(CONES / f"{s}.png")) for s in ("left", "right"))
+    for side, img in (("left", left), ("right", right)):
+        cv2.imwrite(str(tmp_path / f"{side}_0001.png"), img)
+
+    class Cameras:
+        def read(self):
+            return left.copy(), right.copy()
+
+        def close(self):
+            pass
+
+    app = _scene_app("test-average-offered", [tmp_path])
+    assert not app.state.live and not app.state.can_average  # the demo scene
+    app.state.pair_folder = str(tmp_path)
+    app.open_pair_folder()
+    assert app.state.error == "" and app.state.live and not app.state.can_average
+    app._switch_source(Cameras(), ("0", "1"))
+    assert app.state.error == "" and app.state.can_average
+    app.state.average = True
+    app.capture()
+    assert app.state.source_label.endswith("(8.0 frames averaged)")
