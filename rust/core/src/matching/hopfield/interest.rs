@@ -356,4 +356,161 @@ mod tests {
                 .all(|(a, b)| (a.x, a.y) == (b.x, b.y)));
         }
     }
+
+    /// Deterministic integers in `0..levels`.
+    fn noise(n: usize, seed: u64, levels: u64) -> Vec<u64> {
+        let mut s = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
+        (0..n)
+            .map(|_| {
+                s ^= s << 13;
+                s ^= s >> 7;
+                s ^= s << 17;
+                s % levels
+            })
+            .collect()
+    }
+
+    /// `M` straight from its definition (C.1) at one pixel: per direction the 5x5 window of
+    /// squared differences, each window row summed left to right, the rows top to bottom (the
+    /// module's fixed `f32` order), then the minimum of the four.
+    fn moravec_at(img: &[f32], w: usize, x: usize, y: usize) -> f32 {
+        let px = |x: usize, y: usize| img[y * w + x];
+        let mut best = f32::INFINITY;
+        for (sx, sy) in [(1isize, 0isize), (0, 1), (1, 1), (1, -1)] {
+            let mut rows = [0.0f32; 5];
+            for (k, r) in rows.iter_mut().enumerate() {
+                let v = y + k - 2;
+                let sq = |u: usize| {
+                    let d = px(u, v) - px((u as isize + sx) as usize, (v as isize + sy) as usize);
+                    d * d
+                };
+                *r = (((sq(x - 2) + sq(x - 1)) + sq(x)) + sq(x + 1)) + sq(x + 2);
+            }
+            let s = (((rows[0] + rows[1]) + rows[2]) + rows[3]) + rows[4];
+            best = best.min(s);
+        }
+        best
+    }
+
+    /// Every value of the map, bit for bit, on sizes from the smallest with an interior (7 x 7)
+    /// to one of more than a task's 32 rows, and 0 within 3 px of the edges.
+    #[test]
+    fn moravec_equals_the_definition_at_every_pixel() {
+        for (w, h, seed) in [(7, 7, 1), (8, 9, 2), (6, 12, 3), (23, 41, 4), (40, 75, 5)] {
+            let img: Vec<f32> = noise(w * h, seed, 251)
+                .into_iter()
+                .map(|k| k as f32 / 251.0)
+                .collect();
+            let m = moravec(ImageView::new(w, h, &img).expect("valid")).unwrap();
+            for y in 0..h {
+                for x in 0..w {
+                    let inside = (BORDER..w.saturating_sub(BORDER)).contains(&x)
+                        && (BORDER..h.saturating_sub(BORDER)).contains(&y);
+                    let want = if inside {
+                        moravec_at(&img, w, x, y)
+                    } else {
+                        0.0
+                    };
+                    assert_eq!(
+                        m[y * w + x].to_bits(),
+                        want.to_bits(),
+                        "{w}x{h} at ({x}, {y})"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The selection rule of [`interest_points`] by brute force: threshold from the pixel's
+    /// tile maximum and the floor from the map's maximum, strict against earlier neighbours,
+    /// at least as large as later ones, raster order.
+    fn select_brute(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<(u32, u32, f32)> {
+        let tile = if p.tile == 0 {
+            w.max(h)
+        } else {
+            p.tile.min(w.max(h))
+        };
+        let max = m.iter().copied().fold(0.0f32, f32::max);
+        let r = p.nms_half as isize;
+        let mut out = Vec::new();
+        for y in BORDER..h.saturating_sub(BORDER) {
+            for x in BORDER..w.saturating_sub(BORDER) {
+                let (tx, ty) = (x / tile * tile, y / tile * tile);
+                let mut tmax = 0.0f32;
+                for yy in ty..(ty + tile).min(h) {
+                    for xx in tx..(tx + tile).min(w) {
+                        tmax = tmax.max(m[yy * w + xx]);
+                    }
+                }
+                let v = m[y * w + x];
+                let thr = (tmax * p.rel_threshold).max(max * p.floor_rel);
+                let mut peak = v > 0.0 && v >= thr;
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        let (xx, yy) = (x as isize + dx, y as isize + dy);
+                        if (dx, dy) == (0, 0)
+                            || xx < 0
+                            || yy < 0
+                            || xx >= w as isize
+                            || yy >= h as isize
+                        {
+                            continue;
+                        }
+                        let n = m[yy as usize * w + xx as usize];
+                        let earlier = dy < 0 || (dy == 0 && dx < 0);
+                        if n > v || (earlier && n == v) {
+                            peak = false;
+                        }
+                    }
+                }
+                if peak {
+                    out.push((x as u32, y as u32, v));
+                }
+            }
+        }
+        out
+    }
+
+    /// Coarse random maps (plateaus, ties with the thresholds, zeros) against the brute-force
+    /// rule, for the 3x3 fast path and the general one, whole-image and small tiles.
+    #[test]
+    fn selection_equals_the_brute_force_rule() {
+        for (w, h, seed) in [(9, 8, 1), (30, 21, 2), (47, 37, 3)] {
+            // Values k / 8 (k = 0..=8: plateaus, zeros, exact ties with the thresholds) times
+            // 1/2 on the last 4 columns, 1/4 on the rest of the right half, 1/8 on the left:
+            // tiles with different maxima, and the image's maximum (1/2) in one tile only.
+            let m: Vec<f32> = noise(w * h, seed, 9)
+                .into_iter()
+                .enumerate()
+                .map(|(i, k)| {
+                    let x = i % w;
+                    let scale = if x + 4 >= w {
+                        0.5
+                    } else if 2 * x >= w {
+                        0.25
+                    } else {
+                        0.125
+                    };
+                    k as f32 / 8.0 * scale
+                })
+                .collect();
+            for nms_half in [1, 2] {
+                for tile in [0, 5, 16, 64] {
+                    for (rel_threshold, floor_rel) in [(0.5, 0.0), (0.25, 0.5), (1e-3, 1e-4)] {
+                        let p = InterestParams {
+                            rel_threshold,
+                            nms_half,
+                            tile,
+                            floor_rel,
+                        };
+                        let got: Vec<(u32, u32, f32)> = select_points(&m, w, h, &p)
+                            .iter()
+                            .map(|q| (q.x, q.y, q.value))
+                            .collect();
+                        assert_eq!(got, select_brute(&m, w, h, &p), "{w}x{h} {p:?}");
+                    }
+                }
+            }
+        }
+    }
 }
