@@ -954,4 +954,174 @@ mod tests {
             }
         }
     }
+
+    /// Right image for the scalar checks: hashed noise in [0, 1) with a patch of near-constant
+    /// values (standard deviation 5e-4, below [`MIN_WINDOW_STD`]) at x 10..22, y 4..13; the
+    /// left image is the right one shifted by 3 px, scaled, with noise added (and the same
+    /// patch, so textureless left windows occur too).
+    fn scalar_pair(w: usize, h: usize) -> (Vec<f32>, Vec<f32>) {
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let patch = |x: usize, y: usize| (10..22).contains(&x) && (4..13).contains(&y);
+        let flat = |x: usize, y: usize| 0.5 + ((x + 2 * y) % 3) as f32 * 6e-4;
+        let right: Vec<f32> = (0..w * h)
+            .map(|i| {
+                let v = next();
+                if patch(i % w, i / w) {
+                    flat(i % w, i / w)
+                } else {
+                    v
+                }
+            })
+            .collect();
+        let left: Vec<f32> = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                let v = 0.7 * right[y * w + (x + w - 3) % w] + 0.3 * next();
+                if patch(x, y) {
+                    flat(x, y)
+                } else {
+                    v
+                }
+            })
+            .collect();
+        (left, right)
+    }
+
+    /// Sum, mean-free sum of squares and values of region `k` around `(x, y)` (f64).
+    fn region_stats(img: &[f32], w: usize, k: usize, x: usize, y: usize) -> (f64, f64, Vec<f64>) {
+        let (x0, x1, y0, y1) = REGIONS[k];
+        let mut vals = Vec::new();
+        for dy in y0..=y1 {
+            for dx in x0..=x1 {
+                let (u, v) = ((x as isize + dx) as usize, (y as isize + dy) as usize);
+                vals.push(img[v * w + u] as f64);
+            }
+        }
+        let n = vals.len() as f64;
+        let sum: f64 = vals.iter().sum();
+        let q: f64 = vals.iter().map(|v| (v - sum / n) * (v - sum / n)).sum();
+        (sum, q, vals)
+    }
+
+    /// The right statistics against their definition: every region's window sum and inverse
+    /// zero-mean norm where the window fits (0 for a textureless window), 0 elsewhere and in
+    /// the padding, and the window mean.
+    #[test]
+    fn right_statistics_equal_the_definition() {
+        let (w, h) = (40, 16);
+        let (_, right) = scalar_pair(w, h);
+        let img = ImageView::new(w, h, &right).expect("valid");
+        let stats = RightStats::new(&img);
+        let mut flat_windows = 0;
+        for y in 0..h {
+            for k in 0..N_REGIONS {
+                let (sums, invs) = (stats.sums(k, y), stats.inv_norms(k, y));
+                assert_eq!(sums.len(), w + LANES);
+                for x in 0..w + LANES {
+                    let fits = (SIM_RADIUS..w - SIM_RADIUS).contains(&x)
+                        && (SIM_RADIUS..h - SIM_RADIUS).contains(&y);
+                    if !fits {
+                        assert_eq!((sums[x], invs[x]), (0.0, 0.0), "region {k} at ({x}, {y})");
+                        continue;
+                    }
+                    let (sum, q, vals) = region_stats(&right, w, k, x, y);
+                    let n = vals.len() as f64;
+                    assert!(
+                        (sums[x] as f64 - sum).abs() < 1e-4,
+                        "region {k} at ({x}, {y})"
+                    );
+                    let want = if q >= n * MIN_WINDOW_STD * MIN_WINDOW_STD {
+                        1.0 / q.sqrt()
+                    } else {
+                        flat_windows += 1;
+                        0.0
+                    };
+                    let tol = 1e-5 * want.max(1.0);
+                    assert!(
+                        (invs[x] as f64 - want).abs() < tol,
+                        "region {k} at ({x}, {y})"
+                    );
+                    if k == FULL {
+                        assert!((stats.mean(x, y) as f64 - sum / n).abs() < 1e-6);
+                    }
+                }
+            }
+        }
+        assert!(flat_windows > 0);
+    }
+
+    /// The five curves of both paths against ZNCC computed from its definition in `f64`
+    /// (0 where either window is textureless), and the left window's mean, at every point,
+    /// row offset -1..=1 and disparity of a small image.
+    #[test]
+    fn curves_equal_the_definition() {
+        let (w, h) = (40, 16);
+        let (left, right) = scalar_pair(w, h);
+        let (lv, rv) = (
+            ImageView::new(w, h, &left).expect("valid"),
+            ImageView::new(w, h, &right).expect("valid"),
+        );
+        let stats = RightStats::new(&rv);
+        let mut c = Curves::default();
+        let (mut textureless, mut strong) = (0, 0);
+        for y in SIM_RADIUS..h - SIM_RADIUS {
+            for yr in y.saturating_sub(1).max(SIM_RADIUS)..=(y + 1).min(h - 1 - SIM_RADIUS) {
+                for x in SIM_RADIUS..w - SIM_RADIUS {
+                    let d_hi = x - SIM_RADIUS;
+                    for avx2 in [false, true] {
+                        curves_with(avx2, &lv, &rv, &stats, x, y, yr, d_hi, &mut c);
+                        let (lsum, _, _) = region_stats(&left, w, FULL, x, y);
+                        assert!((c.left_mean as f64 - lsum / 49.0).abs() < 1e-6);
+                        for k in 0..N_REGIONS {
+                            let (ls, lq, lvals) = region_stats(&left, w, k, x, y);
+                            let n = lvals.len() as f64;
+                            for d in 0..=d_hi {
+                                let (rs, rq, rvals) = region_stats(&right, w, k, x - d, yr);
+                                let min = n * MIN_WINDOW_STD * MIN_WINDOW_STD;
+                                let want = if lq < min || rq < min {
+                                    textureless += 1;
+                                    0.0
+                                } else {
+                                    let cross: f64 = lvals
+                                        .iter()
+                                        .zip(&rvals)
+                                        .map(|(a, b)| (a - ls / n) * (b - rs / n))
+                                        .sum();
+                                    cross / (lq * rq).sqrt()
+                                };
+                                strong += usize::from(want > 0.9);
+                                let got = c.curve[k][d] as f64;
+                                assert!(
+                                    (got - want).abs() < 1e-4,
+                                    "avx2 {avx2} ({x}, {y}) yr {yr} region {k} d {d}: {got} vs {want}"
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(textureless > 0 && strong > 0);
+    }
+
+    /// The largest value for every length around the lane width, negative values included;
+    /// `f32::MIN` for none.
+    #[test]
+    fn max_of_is_the_largest_value() {
+        assert_eq!(max_of(&[]), f32::MIN);
+        for n in 1..=20 {
+            let v: Vec<f32> = (0..n).map(|i| -1.0 - ((i * 7) % 5) as f32).collect();
+            for peak in 0..n {
+                let mut v = v.clone();
+                v[peak] = -0.5;
+                assert_eq!(max_of(&v), -0.5, "n {n} peak {peak}");
+            }
+        }
+    }
 }
