@@ -1716,4 +1716,285 @@ mod tests {
         let msg = msg.downcast_ref::<String>().unwrap();
         assert!(msg.contains("`u` holds"), "{msg}");
     }
+
+    /// The rows of `T` from the rule of C.4 as the NumPy reference writes it
+    /// (`tests/reference/hopfield_ref.py::build_weights`), pair by pair: `-B` for the other
+    /// candidates of the same point and for other points' candidates with the same right
+    /// pixel; for the candidates of the other points in the window (any other right pixel)
+    /// `A / max(n_p, n_q, 1) * C(|d_a - d_b|, theta + grad * r)`, `n` the points' window
+    /// neighbour counts and `r` their Chebyshev distance. Each row sorted by neuron.
+    fn reference_rows(neurons: &[Neuron], w: &EnergyWeights) -> Vec<Vec<(u32, f32)>> {
+        let half = w.nbr_half;
+        let near = |a: &Neuron, b: &Neuron| {
+            a.point != b.point && (a.xl - b.xl).abs() <= half && (a.yl - b.yl).abs() <= half
+        };
+        // Window neighbour count per point (other points, counted once each).
+        let mut n_of = std::collections::HashMap::new();
+        for a in neurons {
+            n_of.entry(a.point).or_insert_with(|| {
+                let mut others: Vec<u32> = neurons
+                    .iter()
+                    .filter(|b| near(a, b))
+                    .map(|b| b.point)
+                    .collect();
+                others.dedup();
+                others.len()
+            });
+        }
+        neurons
+            .iter()
+            .map(|na| {
+                let mut row: Vec<(u32, f32)> = Vec::new();
+                for (b, nb) in neurons.iter().enumerate() {
+                    let same_right = (nb.xr, nb.yr) == (na.xr, na.yr);
+                    if std::ptr::eq(na, nb) {
+                        continue;
+                    } else if nb.point == na.point || same_right {
+                        row.push((b as u32, -w.b));
+                    } else if near(na, nb) {
+                        let n = n_of[&na.point].max(n_of[&nb.point]).max(1);
+                        let norm = w.a / n as f32;
+                        let r = (na.xl - nb.xl).abs().max((na.yl - nb.yl).abs());
+                        let theta = w.compat_theta as f64 + w.compat_grad as f64 * r as f64;
+                        let (ex, ey) = ((na.dx() - nb.dx()) as f64, (na.dy() - nb.dy()) as f64);
+                        let c = compat((ex * ex + ey * ey).sqrt(), theta, w.compat_slope as f64);
+                        row.push((b as u32, norm * c as f32));
+                    }
+                }
+                row
+            })
+            .collect()
+    }
+
+    /// Every stored weight, bit for bit, against the pair-by-pair rule: the default weights,
+    /// a negative `A`, a small window without the distance term, a steep sigmoid.
+    #[test]
+    fn weights_equal_the_pairwise_rule() {
+        let variants = [
+            EnergyWeights::default(),
+            EnergyWeights {
+                a: -2.0,
+                b: 0.7,
+                ..EnergyWeights::default()
+            },
+            EnergyWeights {
+                nbr_half: 5,
+                compat_grad: 0.0,
+                compat_theta: 3.5,
+                ..EnergyWeights::default()
+            },
+            EnergyWeights {
+                compat_slope: 9.0,
+                nbr_half: 11,
+                ..EnergyWeights::default()
+            },
+        ];
+        for (seed, w) in variants.iter().enumerate() {
+            // Fewer points than random_neurons' 900 keep the O(n^2) rule fast in debug builds.
+            let mut neurons: Vec<Neuron> = random_neurons(seed as u64)
+                .into_iter()
+                .filter(|n| n.point < 300)
+                .collect();
+            if seed == 2 {
+                // Left points squeezed into 9 columns: a window spans whole strips, so a
+                // block's lanes past a range's end hold the next strip's first neurons.
+                for n in &mut neurons {
+                    let d = n.dx();
+                    n.xl = 40 + n.xl % 9;
+                    n.xr = n.xl - d;
+                }
+            }
+            let csr = build_weights(&neurons, w);
+            let want = reference_rows(&neurons, w);
+            let (mut pos, mut neg) = (0, 0);
+            for (a, want_row) in want.iter().enumerate() {
+                let (idx, val) = csr.row(a);
+                let mut got: Vec<(u32, f32)> =
+                    idx.iter().copied().zip(val.iter().copied()).collect();
+                got.sort_by_key(|e| e.0);
+                let bits =
+                    |r: &[(u32, f32)]| r.iter().map(|e| (e.0, e.1.to_bits())).collect::<Vec<_>>();
+                assert_eq!(bits(&got), bits(want_row), "weights {seed} row {a}");
+                pos += want_row.iter().filter(|e| e.1 > 0.0).count();
+                neg += want_row
+                    .iter()
+                    .filter(|e| e.1 < -0.0 && e.1 != -w.b)
+                    .count();
+            }
+            assert!(
+                pos > 100 && neg > 100,
+                "weights {seed}: {pos} positive, {neg} negative"
+            );
+        }
+    }
+
+    /// The asynchronous dynamics written out plainly (the NumPy reference's loop): net inputs
+    /// from the rows, a seeded shuffle per sweep, `u > 0` on, `u < 0` off, `0` unchanged, the
+    /// energy recomputed after every sweep, stop after a sweep without a flip.
+    fn reference_dynamics(
+        csr: &Csr,
+        input: &[f64],
+        init: &[u8],
+        seed: u64,
+        max_sweeps: usize,
+    ) -> (Vec<u8>, Vec<f64>, usize, bool) {
+        let m = csr.n();
+        let mut v = init.to_vec();
+        let mut u = input.to_vec();
+        for (a, &on) in init.iter().enumerate() {
+            if on == 1 {
+                let (idx, val) = csr.row(a);
+                for (&b, &t) in idx.iter().zip(val) {
+                    u[b as usize] += t as f64;
+                }
+            }
+        }
+        let energy = |v: &[u8], u: &[f64]| -> f64 {
+            (0..m)
+                .filter(|&a| v[a] == 1)
+                .map(|a| -(0.5 * (u[a] - input[a]) + input[a]))
+                .sum()
+        };
+        let mut trace = vec![energy(&v, &u)];
+        let mut order: Vec<u32> = (0..m as u32).collect();
+        let mut rng = SplitMix64::new(seed);
+        let (mut sweeps, mut converged) = (0, m == 0);
+        while !converged && sweeps < max_sweeps {
+            rng.shuffle(&mut order);
+            let mut flips = 0;
+            for &a in &order {
+                let a = a as usize;
+                let new = if u[a] > 0.0 {
+                    1
+                } else if u[a] < 0.0 {
+                    0
+                } else {
+                    v[a]
+                };
+                if new != v[a] {
+                    v[a] = new;
+                    flips += 1;
+                    let s = if new == 1 { 1.0 } else { -1.0 };
+                    let (idx, val) = csr.row(a);
+                    for (&b, &t) in idx.iter().zip(val) {
+                        u[b as usize] += s * t as f64;
+                    }
+                }
+            }
+            sweeps += 1;
+            trace.push(energy(&v, &u));
+            converged = flips == 0;
+        }
+        (v, trace, sweeps, converged)
+    }
+
+    /// Final state, sweeps and energy trace of both weight forms against the plain loop, from
+    /// a few starts (inputs with exact zeros: the "unchanged" case), and a sweep cap.
+    #[test]
+    fn dynamics_equal_the_plain_loop() {
+        let neurons: Vec<Neuron> = random_neurons(9)
+            .into_iter()
+            .filter(|n| n.point < 400)
+            .collect();
+        let w = EnergyWeights::default();
+        let (net, csr) = (Network::new(&neurons, &w), build_weights(&neurons, &w));
+        let m = neurons.len();
+        for (seed, max_sweeps) in [(0u64, 100usize), (3, 100), (8, 1)] {
+            let input: Vec<f64> = (0..m)
+                .map(|a| [0.25, -0.5, 0.0, 1.0, -0.125][(a + seed as usize) % 5])
+                .collect();
+            let init: Vec<u8> = (0..m)
+                .map(|a| u8::from((a * 7 + seed as usize) % 3 == 0))
+                .collect();
+            let (v, trace, sweeps, converged) =
+                reference_dynamics(&csr, &input, &init, seed, max_sweeps);
+            for d in [
+                run_dynamics(&csr, &input, &init, seed, max_sweeps),
+                run_dynamics(&net, &input, &init, seed, max_sweeps),
+            ] {
+                assert_eq!(d.state, v, "seed {seed}");
+                assert_eq!(d.sweeps, sweeps, "seed {seed}");
+                assert_eq!(d.converged, converged, "seed {seed}");
+                assert_eq!(d.energy_trace.len(), trace.len());
+                for (e, f) in d.energy_trace.iter().zip(&trace) {
+                    assert!(
+                        (e - f).abs() <= 1e-9 * (1.0 + f.abs()),
+                        "seed {seed}: {e} vs {f}"
+                    );
+                }
+                assert_eq!(d.nnz, csr.nnz());
+            }
+            assert!(sweeps >= 1 && v != init, "seed {seed}");
+        }
+    }
+
+    /// The compatibility sigmoid of C.4 by value: 0 at the crossing, +-(2 / (1 + e^-4) - 1)
+    /// one crossing-width either side for slope 2, odd about the crossing, towards -1 far out.
+    #[test]
+    fn compatibility_has_its_sign_and_crossing() {
+        assert_eq!(compat(2.0, 2.0, 2.0), 0.0);
+        let near = 2.0 / (1.0 + (-4.0f64).exp()) - 1.0;
+        assert!((compat(0.0, 2.0, 2.0) - near).abs() < 1e-15);
+        assert!((compat(4.0, 2.0, 2.0) + near).abs() < 1e-15);
+        assert!(compat(20.0, 2.0, 2.0) < -0.999_999);
+        assert!((compat(1.0, 3.0, 0.5) + compat(5.0, 3.0, 0.5)).abs() < 1e-15);
+    }
+
+    /// SplitMix64's first outputs for seed 0 (the published sequence the NumPy reference
+    /// mirrors) and the Fisher-Yates shuffle step by step: `j = next % (i + 1)` for
+    /// `i = n - 1 .. 1`, swapping `i` and `j`.
+    #[test]
+    fn generator_and_shuffle_follow_their_definitions() {
+        let mut g = SplitMix64::new(0);
+        assert_eq!(
+            [g.next_u64(), g.next_u64(), g.next_u64()],
+            [
+                0xe220_a839_7b1d_cdaf,
+                0x6e78_9e6a_a1b9_65f4,
+                0x06c4_5d18_8009_454f
+            ]
+        );
+        for (seed, n) in [(1u64, 2usize), (2, 3), (7, 10), (9, 33)] {
+            let mut v: Vec<u32> = (0..n as u32).collect();
+            SplitMix64::new(seed).shuffle(&mut v);
+            let mut want: Vec<u32> = (0..n as u32).collect();
+            let mut g = SplitMix64::new(seed);
+            let mut i = n - 1;
+            while i >= 1 {
+                let j = (g.next_u64() % (i as u64 + 1)) as usize;
+                want.swap(i, j);
+                i -= 1;
+            }
+            assert_eq!(v, want, "seed {seed} n {n}");
+        }
+    }
+
+    /// Neurons without any weight keep their state when their net input is exactly 0, switch
+    /// on for a positive one and off for a negative one; one sweep of flips, one without.
+    #[test]
+    fn a_zero_net_input_leaves_the_state_alone() {
+        let lone = |point: u32, x: i32| Neuron {
+            point,
+            xl: x,
+            yl: 10,
+            xr: x - 3,
+            yr: 10,
+            sim: 0.8,
+            edge_ok: true,
+            halves_fail: 0,
+            centre_ok: true,
+            sub: 0.0,
+        };
+        // 100 px apart: outside each other's 41x41 windows, distinct right pixels.
+        let neurons: Vec<Neuron> = (0..4).map(|p| lone(p, 10 + 100 * p as i32)).collect();
+        let w = EnergyWeights::default();
+        let net = Network::new(&neurons, &w);
+        let input = [0.0, 0.0, 0.5, -0.5];
+        let init = [1u8, 0, 0, 1];
+        let d = run_dynamics(&net, &input, &init, 1, 10);
+        assert_eq!(d.nnz, 0);
+        assert_eq!(d.state, vec![1, 0, 1, 0]);
+        assert_eq!((d.sweeps, d.converged), (2, true));
+        assert_eq!(d.energy_trace, vec![0.5, -0.5, -0.5]);
+    }
 }
