@@ -158,4 +158,92 @@ mod tests {
         assert_eq!(&d[..8], &[3.0, 3.0, 1.0, 1.0, 1.0, 1.0, 1.0, 2.0]);
         assert!(d[8..].iter().all(|v| v.is_nan())); // a row with no valid value stays NaN
     }
+
+    /// Hand-computed rows (tau 2, colours along the first channel unless noted): the left and
+    /// right neighbours' own colours are the references (not the run's end pixels), a tie
+    /// `d_l + tau == d_r` goes right, the distance is Euclidean over all three channels,
+    /// equal sides and a run reaching the row's end are left alone, an infinite value is a hole.
+    #[test]
+    fn the_side_rule_on_hand_computed_rows() {
+        let (n, inf) = (f32::NAN, f32::INFINITY);
+        // (disparities, Lab colours, expected) per row.
+        type Row = ([f32; 5], [[f32; 3]; 5], [f32; 5]);
+        let rows: [Row; 7] = [
+            // d to 0 / 20: 4/16 left; 10/10 and 16/4 right (a reference at pixel 1: 10 left).
+            (
+                [6.0, n, n, n, 1.0],
+                [
+                    [0.0; 3],
+                    [4.0, 0.0, 0.0],
+                    [10.0, 0.0, 0.0],
+                    [16.0, 0.0, 0.0],
+                    [20.0, 0.0, 0.0],
+                ],
+                [6.0, 6.0, 1.0, 1.0, 1.0],
+            ),
+            // 8/12 left (a reference at pixel 3: 8/8, right).
+            (
+                [6.0, n, n, n, 1.0],
+                [
+                    [0.0; 3],
+                    [4.0, 0.0, 0.0],
+                    [8.0, 0.0, 0.0],
+                    [16.0, 0.0, 0.0],
+                    [20.0, 0.0, 0.0],
+                ],
+                [6.0, 6.0, 6.0, 1.0, 1.0],
+            ),
+            // 9 + 2 == 11: a tie goes right.
+            (
+                [6.0, n, 1.0, 1.0, 1.0],
+                [
+                    [0.0; 3],
+                    [9.0, 0.0, 0.0],
+                    [20.0, 0.0, 0.0],
+                    [0.0; 3],
+                    [0.0; 3],
+                ],
+                [6.0, 1.0, 1.0, 1.0, 1.0],
+            ),
+            // Three channels: 3 + 2 == |(0, -4, 3)| = 5, a tie again.
+            (
+                [6.0, n, 1.0, 1.0, 1.0],
+                [
+                    [0.0; 3],
+                    [0.0, 0.0, 3.0],
+                    [0.0, 4.0, 0.0],
+                    [0.0; 3],
+                    [0.0; 3],
+                ],
+                [6.0, 1.0, 1.0, 1.0, 1.0],
+            ),
+            (
+                [3.0, n, 3.0, 1.0, 1.0],
+                [[0.0; 3]; 5],
+                [3.0, n, 3.0, 1.0, 1.0],
+            ),
+            ([1.0, 1.0, 5.0, n, n], [[0.0; 3]; 5], [1.0, 1.0, 5.0, n, n]),
+            (
+                [5.0, inf, 2.0, 2.0, 2.0],
+                [
+                    [0.0; 3],
+                    [0.0; 3],
+                    [20.0, 0.0, 0.0],
+                    [20.0, 0.0, 0.0],
+                    [20.0, 0.0, 0.0],
+                ],
+                [5.0, 5.0, 2.0, 2.0, 2.0],
+            ),
+        ];
+        for (i, (d, lab, want)) in rows.iter().enumerate() {
+            let mut got = d.to_vec();
+            let lab: Vec<f32> = lab.iter().flatten().copied().collect();
+            side_fill(&mut got, &lab, 5, 2.0);
+            let same = got
+                .iter()
+                .zip(want)
+                .all(|(g, w)| g == w || (g.is_nan() && w.is_nan()));
+            assert!(same, "row {i}: {got:?}, want {want:?}");
+        }
+    }
 }
