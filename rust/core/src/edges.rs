@@ -201,4 +201,108 @@ mod tests {
             assert_eq!(fattened(&d, &g, w, 1, &FattenParams { radius, ..P }), want);
         }
     }
+
+    /// The rule along the rows written out plainly (`tests/reference/edges_ref.py`): the row
+    /// filled (nearest finite value each side, the smaller; one side only: that one), a jump
+    /// where neighbours differ by more than `jump`, the first strongest guide step among the
+    /// columns `j - r ..= j + r` clipped to `[1, w - 1]`, and `[j, e)` or `[e, j)` marked.
+    fn rows_brute(d: &[f32], g: &[f32], w: usize, h: usize, p: &FattenParams) -> Vec<bool> {
+        let mut out = vec![false; w * h];
+        if w < 3 {
+            return out;
+        }
+        for y in 0..h {
+            let (d, g) = (&d[y * w..(y + 1) * w], &g[y * w..(y + 1) * w]);
+            let f: Vec<f32> = (0..w)
+                .map(|x| {
+                    if d[x].is_finite() {
+                        return d[x];
+                    }
+                    let l = (0..x).rev().map(|i| d[i]).find(|v| v.is_finite());
+                    let r = (x + 1..w).map(|i| d[i]).find(|v| v.is_finite());
+                    match (l, r) {
+                        (Some(a), Some(b)) => a.min(b),
+                        (Some(a), None) | (None, Some(a)) => a,
+                        (None, None) => f32::NAN,
+                    }
+                })
+                .collect();
+            let step = |x: usize| if x == 0 { 0.0 } else { (g[x] - g[x - 1]).abs() };
+            let r = p.radius.min(w) as isize;
+            for j in 1..w {
+                // NaN (a row without values) is no jump.
+                let is_jump = (f[j] - f[j - 1]).abs() > p.jump;
+                if !is_jump {
+                    continue;
+                }
+                let mut e = None;
+                for t in -r..=r {
+                    let x = (j as isize + t).clamp(1, w as isize - 1) as usize;
+                    if e.is_none_or(|e| step(x) > step(e)) {
+                        e = Some(x);
+                    }
+                }
+                let e = e.expect("r >= 0");
+                if step(e) >= p.ratio * step(j) {
+                    let (lo, hi) = if f[j] > f[j - 1] { (j, e) } else { (e, j) };
+                    for x in lo..hi {
+                        out[y * w + x] = true;
+                    }
+                }
+            }
+        }
+        out
+    }
+
+    /// Random maps (holes, infinite values, plateaus; guide steps in eighths, so equal steps
+    /// occur) of several shapes against the plain rule on the rows and on the columns.
+    #[test]
+    fn marks_equal_the_plain_rule_on_random_maps() {
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move |n: u64| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s % n
+        };
+        let transpose = |a: &[f32], w: usize, h: usize| -> Vec<f32> {
+            (0..w * h).map(|i| a[(i % h) * w + i / h]).collect()
+        };
+        let mut marked = 0;
+        for (w, h) in [(23, 17), (17, 23), (2, 9), (3, 4), (1, 12), (40, 6)] {
+            for _ in 0..6 {
+                // Disparity: blocks of 1-6 equal values, a few holes and infinities.
+                let mut d = Vec::with_capacity(w * h);
+                let mut v = 1.0;
+                for _ in 0..w * h {
+                    if next(4) == 0 {
+                        v = next(12) as f32 * 0.75;
+                    }
+                    d.push(match next(12) {
+                        0 | 1 => f32::NAN,
+                        2 => f32::INFINITY,
+                        _ => v,
+                    });
+                }
+                let g: Vec<f32> = (0..w * h).map(|_| next(9) as f32 / 8.0).collect();
+                for radius in [0, 1, 3, 7, 40] {
+                    for (ratio, jump) in [(1.0, 2.0), (0.5, 0.5), (2.0, 1.5), (1.5, 0.75)] {
+                        let p = FattenParams {
+                            radius,
+                            ratio,
+                            jump,
+                        };
+                        let rows = rows_brute(&d, &g, w, h, &p);
+                        let cols = rows_brute(&transpose(&d, w, h), &transpose(&g, w, h), h, w, &p);
+                        let want: Vec<bool> = (0..w * h)
+                            .map(|i| rows[i] || cols[(i % w) * h + i / w])
+                            .collect();
+                        assert_eq!(fattened(&d, &g, w, h, &p), want, "{w}x{h} {p:?}");
+                        marked += want.iter().filter(|&&m| m).count();
+                    }
+                }
+            }
+        }
+        assert!(marked > 1000, "{marked}");
+    }
 }
