@@ -205,4 +205,13 @@ mod tests {
         assert_eq!(s[0], s[1]);
         assert!((s[0] - 5.0 * 0.74 / 10.0).abs() < 1e-7);
     }
+
+    /// A depth that overflows `f32` (a huge `f B` over a small disparity) is no depth, though
+    /// the disparity itself passes its sigma test.
+    #[test]
+    fn no_depth_where_the_depth_overflows() {
+        let (z, s) = depth_rectified(&[0.5, 4.0], &[1.0, 1.0], 2, 1, f32::MAX, 0.0, M).unwrap();
+        assert!(z[0].is_nan() && s[0].is_nan(), "{} {}", z[0], s[0]);
+        assert_eq!(z[1], f32::MAX / 4.0);
+    }
 }
