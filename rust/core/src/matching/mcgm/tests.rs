@@ -829,3 +829,116 @@ fn edge_filters_check_their_parameters() {
         assert!(matches!(err, CoreError::InvalidParameter { .. }), "{err}");
     }
 }
+
+/// A deterministic generator of `[0, 1)` floats for the scalar-reference tests below.
+fn unit_rng(seed: u64) -> impl FnMut() -> f32 {
+    let mut s = seed;
+    move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((s >> 40) as f32) / (1u64 << 24) as f32
+    }
+}
+
+#[test]
+fn log_kernels_and_reflect_have_the_specified_values() {
+    use super::log::{radius_for, reflect};
+    // Radius ceil(4 sigma), at least 1.
+    assert_eq!(radius_for(1.0), 4);
+    assert_eq!(radius_for(0.6), 3);
+    assert_eq!(radius_for(0.1), 1);
+    // g(t) = exp(-t^2 / 2 sigma^2); a = (t^2 / sigma^2 - 1) g / (2 pi sigma^2), made zero-mean
+    // by subtracting g sum(a) / sum(g).
+    let sigma = 1.5f64;
+    let (g, a) = log_kernels(sigma as f32);
+    let r = 6isize;
+    assert_eq!(g.len(), 13);
+    let gw: Vec<f64> = (-r..=r)
+        .map(|t| (-((t * t) as f64) / (2.0 * sigma * sigma)).exp())
+        .collect();
+    let aw: Vec<f64> = (-r..=r)
+        .zip(&gw)
+        .map(|(t, gv)| {
+            ((t * t) as f64 / (sigma * sigma) - 1.0) * gv
+                / (2.0 * std::f64::consts::PI * sigma * sigma)
+        })
+        .collect();
+    let (sa, sg): (f64, f64) = (aw.iter().sum(), gw.iter().sum());
+    for k in 0..13 {
+        assert!((g[k] as f64 - gw[k]).abs() < 1e-7, "g[{k}]");
+        let want = aw[k] - gw[k] * sa / sg;
+        assert!((a[k] as f64 - want).abs() < 1e-8, "a[{k}] {} {want}", a[k]);
+    }
+    // Reflect-101: the edge pixel is not repeated; folds again past the far end.
+    let want5 = [
+        (-1, 1),
+        (-4, 4),
+        (5, 3),
+        (8, 0),
+        (-5, 3),
+        (9, 1),
+        (13, 3),
+        (2, 2),
+    ];
+    for (i, want) in want5 {
+        assert_eq!(reflect(i, 5), want, "reflect({i}, 5)");
+    }
+    for i in [-3, 0, 4] {
+        assert_eq!(reflect(i, 1), 0);
+    }
+}
+
+#[test]
+fn log_filter_equals_the_direct_2d_convolution() {
+    // K(x, y) = a(x) g(y) + g(x) a(y) over reflect-101 borders, summed in f64 directly: non-square
+    // images, one smaller than the kernel (folded borders).
+    use super::log::reflect;
+    for &(w, h, sigma) in &[(13usize, 7usize, 1.0f32), (5, 9, 2.0), (9, 4, 0.7)] {
+        let mut rnd = unit_rng(w as u64 * 31 + h as u64);
+        let img = Image::new(w, h, (0..w * h).map(|_| rnd()).collect()).unwrap();
+        let (g, a) = log_kernels(sigma);
+        let r = (g.len() / 2) as isize;
+        let got = log_filter(&img, sigma).unwrap();
+        for y in 0..h {
+            for x in 0..w {
+                let mut s = 0.0f64;
+                for j in -r..=r {
+                    for i in -r..=r {
+                        let k = a[(i + r) as usize] as f64 * g[(j + r) as usize] as f64
+                            + g[(i + r) as usize] as f64 * a[(j + r) as usize] as f64;
+                        let v = img.at(reflect(x as isize + i, w), reflect(y as isize + j, h));
+                        s += k * v as f64;
+                    }
+                }
+                let d = (got[y * w + x] as f64 - s).abs();
+                assert!(
+                    d < 1e-6,
+                    "{w}x{h} sigma {sigma} ({x}, {y}): {} vs {s}",
+                    got[y * w + x]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn decimate2_averages_each_2x2_block() {
+    use super::log::decimate2;
+    // v = x + 10 y: block (i, j) averages to (2i + 0.5) + 10 (2j + 0.5).
+    let img = Image::new(
+        5,
+        5,
+        (0..25).map(|k| (k % 5 + 10 * (k / 5)) as f32).collect(),
+    )
+    .unwrap();
+    let d = decimate2(&img).unwrap();
+    assert_eq!((d.width, d.height), (2, 2));
+    assert_eq!(d.data, [5.5, 7.5, 25.5, 27.5]);
+    // One row or column: the missing partner is the last one (clamped), size at least 1.
+    let strip = Image::new(5, 1, vec![1.0, 3.0, 5.0, 7.0, 9.0]).unwrap();
+    let d = decimate2(&strip).unwrap();
+    assert_eq!((d.width, d.height, d.data.clone()), (2, 1, vec![2.0, 6.0]));
+    let d = decimate2(&Image::new(1, 1, vec![0.25]).unwrap()).unwrap();
+    assert_eq!((d.width, d.height, d.data.clone()), (1, 1, vec![0.25]));
+}
