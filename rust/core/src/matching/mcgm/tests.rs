@@ -942,3 +942,145 @@ fn decimate2_averages_each_2x2_block() {
     let d = decimate2(&Image::new(1, 1, vec![0.25]).unwrap()).unwrap();
     assert_eq!((d.width, d.height, d.data.clone()), (1, 1, vec![0.25]));
 }
+
+/// The zero-crossing rule of algorithms.md B.4 written out pixel by pixel (no compaction):
+/// the reference of [`zero_crossings`].
+fn zero_crossings_reference(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
+    use super::zerocross::ZC_V;
+    use std::f32::consts::TAU;
+    let n = w * h;
+    let (mut mark, mut xsub) = (vec![0u8; n], vec![f32::NAN; n]);
+    let inside = |x: usize, y: usize| x >= 1 && y >= 1 && x + 1 < w && y + 1 < h;
+    for y in 0..h {
+        for x in 0..w - 1 {
+            let (a, b) = (l[y * w + x], l[y * w + x + 1]);
+            let (px, pos) = if a * b < 0.0 {
+                let px = if a.abs() <= b.abs() { x } else { x + 1 };
+                (px, x as f32 + a / (a - b))
+            } else if a == 0.0 && x >= 1 && l[y * w + x - 1] * b < 0.0 {
+                (x, x as f32)
+            } else {
+                continue;
+            };
+            if !inside(px, y) {
+                continue;
+            }
+            let i = y * w + px;
+            if mark[i] & ZC_H == 0 || (pos - px as f32).abs() < (xsub[i] - px as f32).abs() {
+                xsub[i] = pos;
+            }
+            mark[i] |= ZC_H;
+        }
+    }
+    for y in 0..h - 1 {
+        for x in 0..w {
+            let (a, b) = (l[y * w + x], l[(y + 1) * w + x]);
+            let py = if a * b < 0.0 {
+                if a.abs() <= b.abs() {
+                    y
+                } else {
+                    y + 1
+                }
+            } else if a == 0.0 && y >= 1 && l[(y - 1) * w + x] * b < 0.0 {
+                y
+            } else {
+                continue;
+            };
+            if inside(x, py) {
+                mark[py * w + x] |= ZC_V;
+            }
+        }
+    }
+    let (mut strength, mut theta) = (vec![0.0f32; n], vec![0.0f32; n]);
+    for i in 0..n {
+        if mark[i] == 0 {
+            continue;
+        }
+        let x = i % w;
+        let gx = 0.5 * (l[i + 1] - l[i - 1]);
+        let gy = 0.5 * (l[i + w] - l[i - w]);
+        let st = (gx * gx + gy * gy).sqrt();
+        // The floor written out: the constant itself is under test.
+        if st < 1e-5 {
+            mark[i] = 0;
+            xsub[i] = f32::NAN;
+            continue;
+        }
+        strength[i] = st;
+        let t = gy.atan2(gx);
+        theta[i] = if t < 0.0 { (t + TAU) % TAU } else { t };
+        if mark[i] & ZC_H == 0 {
+            xsub[i] = if l[i - 1] * l[i] < 0.0 {
+                x as f32 - 1.0 + l[i - 1] / (l[i - 1] - l[i])
+            } else if l[i] * l[i + 1] < 0.0 {
+                x as f32 + l[i] / (l[i] - l[i + 1])
+            } else if gx != 0.0 && (l[i] / gx).abs() <= 1.0 {
+                x as f32 - l[i] / gx
+            } else {
+                x as f32
+            };
+        }
+    }
+    ZeroCrossings {
+        width: w,
+        height: h,
+        mark,
+        xsub,
+        strength,
+        theta,
+    }
+}
+
+#[test]
+fn zero_crossings_equal_the_pixel_by_pixel_rule() {
+    // Values from a few levels (exact zeros, equal magnitudes: the tie rules), a band of tiny
+    // values (crossings on either side of MIN_STRENGTH) and smooth fields (sub-pixel positions, Newton
+    // steps), on non-square images: every plane equal, bit for bit.
+    use std::f32::consts::TAU;
+    let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(u, v)| u.to_bits() == v.to_bits());
+    for (seed, &(w, h)) in [(23usize, 17usize), (17, 23), (40, 30), (3, 9), (9, 3)]
+        .iter()
+        .enumerate()
+    {
+        let mut rnd = unit_rng(seed as u64 + 7);
+        let fields: [Vec<f32>; 3] = [
+            (0..w * h)
+                .map(|_| ((rnd() * 5.0) as i32 - 2) as f32)
+                .collect(),
+            (0..w * h)
+                .map(|i| {
+                    let v = ((rnd() * 5.0) as i32 - 2) as f32;
+                    if (1..=3).contains(&((i / w) % 6)) {
+                        v * 1e-5
+                    } else {
+                        v * (0.5 + rnd())
+                    }
+                })
+                .collect(),
+            (0..w * h)
+                .map(|i| {
+                    let (x, y) = ((i % w) as f32, (i / w) as f32);
+                    (0.7 * x + 0.3 * y).sin()
+                        + 0.4 * (0.5 * y - 0.9 * x).cos()
+                        + 0.05 * (rnd() - 0.5)
+                })
+                .collect(),
+        ];
+        for l in &fields {
+            let got = zero_crossings(l, w, h).unwrap();
+            let want = zero_crossings_reference(l, w, h);
+            assert_eq!(got.mark, want.mark, "{w}x{h}");
+            assert!(same(&got.xsub, &want.xsub), "{w}x{h} xsub");
+            assert!(same(&got.strength, &want.strength), "{w}x{h} strength");
+            assert!(same(&got.theta, &want.theta), "{w}x{h} theta");
+            assert!(got.theta.iter().all(|&t| (0.0..TAU).contains(&t)));
+        }
+    }
+    // A normal just below the +x axis: atan2 is a tiny negative angle, and t + 2 pi rounds to
+    // 2 pi; the direction is 0, not 2 pi (the range is [0, 2 pi)).
+    let (w, h) = (3, 3);
+    let l = [0.0, 1e-7, 0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0];
+    let zc = zero_crossings(&l, w, h).unwrap();
+    assert_eq!(zc.mark[4], ZC_H);
+    assert_eq!(zc.theta[4], 0.0);
+}
