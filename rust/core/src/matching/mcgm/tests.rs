@@ -1084,3 +1084,237 @@ fn zero_crossings_equal_the_pixel_by_pixel_rule() {
     assert_eq!(zc.mark[4], ZC_H);
     assert_eq!(zc.theta[4], 0.0);
 }
+
+/// Hysteresis tracking written out plainly (full sorts, a neighbour loop with branches): the
+/// reference of [`track`].
+fn track_reference(zc: &ZeroCrossings, p: &tracking::TrackParams) -> tracking::Curves {
+    use std::f64::consts::{PI, TAU};
+    let (w, h) = (zc.width, zc.height);
+    let mut marked: Vec<f32> = zc.marked().map(|i| zc.strength[i]).collect();
+    marked.sort_by(f32::total_cmp);
+    let t_high = if marked.is_empty() {
+        0.0
+    } else {
+        marked[((p.high_quantile as f64) * (marked.len() - 1) as f64).floor() as usize]
+    };
+    let t_low = p.low_ratio * t_high;
+    let interior = |i: usize| i % w >= 1 && i / w >= 1 && i % w + 1 < w && i / w + 1 < h;
+    let mut free: Vec<bool> = (0..w * h)
+        .map(|i| interior(i) && zc.mark[i] != 0 && zc.strength[i] >= t_low && zc.strength[i] > 0.0)
+        .collect();
+    let mut seeds: Vec<usize> = (0..w * h)
+        .filter(|&i| free[i] && zc.strength[i] >= t_high)
+        .collect();
+    seeds.sort_by(|&a, &b| zc.strength[b].total_cmp(&zc.strength[a]).then(a.cmp(&b)));
+    let tangent = |i: usize| {
+        let t = zc.theta[i] as f64;
+        (-t.sin(), t.cos())
+    };
+    let turn = |d: f64| {
+        let d = if d > PI {
+            d - TAU
+        } else if d <= -PI {
+            d + TAU
+        } else {
+            d
+        };
+        d.abs()
+    };
+    let max_turn = (p.max_turn_deg as f64).to_radians();
+    let steps = [
+        (-1, -1),
+        (0, -1),
+        (1, -1),
+        (-1, 0),
+        (1, 0),
+        (-1, 1),
+        (0, 1),
+        (1, 1),
+    ];
+    let grow = |start: usize, sign: f64, free: &mut Vec<bool>| {
+        let mut out = Vec::new();
+        let (mut cur, t0) = (start, tangent(start));
+        let mut dir = (sign * t0.0, sign * t0.1);
+        loop {
+            let mut best: Option<(f64, f32, usize, i64, i64)> = None;
+            for &(dx, dy) in &steps {
+                let q = ((cur / w) as i64 + dy) as usize * w + ((cur % w) as i64 + dx) as usize;
+                let dot =
+                    (dx as f64 * dir.0 + dy as f64 * dir.1) / ((dx * dx + dy * dy) as f64).sqrt();
+                if !free[q]
+                    || dot <= 0.0
+                    || turn(zc.theta[q] as f64 - zc.theta[cur] as f64) >= max_turn
+                {
+                    continue;
+                }
+                let s = zc.strength[q];
+                if best.is_none_or(|b| dot > b.0 || (dot == b.0 && s > b.1)) {
+                    best = Some((dot, s, q, dx, dy));
+                }
+            }
+            let Some((_, _, q, dx, dy)) = best else { break };
+            free[q] = false;
+            let t = tangent(q);
+            let sgn = if t.0 * dx as f64 + t.1 * dy as f64 >= 0.0 {
+                1.0
+            } else {
+                -1.0
+            };
+            dir = (sgn * t.0, sgn * t.1);
+            out.push(q);
+            cur = q;
+        }
+        out
+    };
+    let mut labels = vec![-1i32; w * h];
+    let mut segments = Vec::new();
+    for s in seeds {
+        if !free[s] {
+            continue;
+        }
+        free[s] = false;
+        let fwd = grow(s, 1.0, &mut free);
+        let bwd = grow(s, -1.0, &mut free);
+        if 1 + fwd.len() + bwd.len() < p.min_len {
+            continue;
+        }
+        let pixels: Vec<u32> = bwd
+            .iter()
+            .rev()
+            .chain([s].iter())
+            .chain(&fwd)
+            .map(|&i| i as u32)
+            .collect();
+        let (mut sx, mut sy, mut sc, mut ss) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
+        for &i in &pixels {
+            let i = i as usize;
+            labels[i] = segments.len() as i32;
+            sx += (i % w) as f64;
+            sy += (i / w) as f64;
+            sc += (zc.theta[i] as f64).cos();
+            ss += (zc.theta[i] as f64).sin();
+        }
+        let xs = pixels.iter().map(|&i| (i as usize % w) as i32);
+        let ys = pixels.iter().map(|&i| (i as usize / w) as i32);
+        let m = ss.atan2(sc);
+        let k = pixels.len() as f64;
+        segments.push(Segment {
+            centroid: ((sx / k) as f32, (sy / k) as f32),
+            x_min: xs.clone().min().unwrap(),
+            x_max: xs.max().unwrap(),
+            y_min: ys.clone().min().unwrap(),
+            y_max: ys.max().unwrap(),
+            mean_theta: (if m < 0.0 { m + TAU } else { m }) as f32 % std::f32::consts::TAU,
+            pixels,
+        });
+    }
+    tracking::Curves {
+        segments,
+        labels,
+        t_high,
+        t_low,
+    }
+}
+
+#[test]
+fn track_equals_the_plain_hysteresis_tracker() {
+    // Crossings of real-like LoG responses, and synthetic ones (random marks, strengths on a
+    // few levels: ties of the seed order and of the step choice; smooth or random normals),
+    // under several thresholds: the same segments, labels and thresholds.
+    let base = McgmParams::default().track;
+    let params = [
+        base,
+        tracking::TrackParams { min_len: 1, ..base },
+        tracking::TrackParams {
+            high_quantile: 0.9,
+            low_ratio: 1.0,
+            max_turn_deg: 30.0,
+            min_len: 3,
+        },
+        tracking::TrackParams {
+            high_quantile: 0.2,
+            low_ratio: 0.1,
+            max_turn_deg: 90.0,
+            min_len: 2,
+        },
+    ];
+    let mut zcs = Vec::new();
+    for (sigma, shift) in [(1.0f32, 0.0f32), (2.0, 1.3)] {
+        let img = blobs(70, 50, shift);
+        zcs.push(zero_crossings(&log_filter(&img, sigma).unwrap(), 70, 50).unwrap());
+    }
+    for (seed, &(w, h)) in [(31usize, 23usize), (12, 40)].iter().enumerate() {
+        let mut rnd = unit_rng(seed as u64 + 99);
+        for mode in 0..3 {
+            let n = w * h;
+            let mark: Vec<u8> = (0..n).map(|_| u8::from(rnd() < 0.55)).collect();
+            let strength: Vec<f32> = (0..n)
+                .map(|i| {
+                    if mark[i] != 0 {
+                        1e-5 * (1 + (rnd() * 4.0) as i32) as f32
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            let theta: Vec<f32> = (0..n)
+                .map(|i| {
+                    let (x, y) = ((i % w) as f32, (i / w) as f32);
+                    // Smooth, random, or mostly exactly 0 (tangent (-0, 1): exact ties of
+                    // the step projections and a zero tangent-step product).
+                    let t = match mode {
+                        0 => 0.3 * x - 0.2 * y + 0.4 * rnd(),
+                        1 => std::f32::consts::TAU * rnd(),
+                        _ => [0.0, 0.0, 0.0, 0.5, 5.9][(rnd() * 5.0) as usize],
+                    };
+                    t.rem_euclid(std::f32::consts::TAU)
+                })
+                .collect();
+            let xsub = (0..n)
+                .map(|i| {
+                    if mark[i] != 0 {
+                        (i % w) as f32
+                    } else {
+                        f32::NAN
+                    }
+                })
+                .collect();
+            zcs.push(ZeroCrossings {
+                width: w,
+                height: h,
+                mark,
+                xsub,
+                strength,
+                theta,
+            });
+        }
+    }
+    let mut n_segments = 0;
+    for zc in &zcs {
+        for p in &params {
+            let got = track(zc, p).unwrap();
+            let want = track_reference(zc, p);
+            assert_eq!(got.t_high, want.t_high);
+            assert_eq!(got.t_low, want.t_low);
+            assert_eq!(
+                got.segments, want.segments,
+                "{}x{} {p:?}",
+                zc.width, zc.height
+            );
+            assert_eq!(got.labels, want.labels);
+            n_segments += got.segments.len();
+        }
+    }
+    // No crossing: no seed, thresholds 0.
+    let none = ZeroCrossings {
+        width: 5,
+        height: 5,
+        mark: vec![0; 25],
+        xsub: vec![f32::NAN; 25],
+        strength: vec![0.0; 25],
+        theta: vec![0.0; 25],
+    };
+    let got = track(&none, &base).unwrap();
+    assert_eq!((got.t_high, got.t_low, got.segments.len()), (0.0, 0.0, 0));
+    assert!(n_segments > 200, "{n_segments} segments");
+}
