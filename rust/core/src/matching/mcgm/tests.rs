@@ -1318,3 +1318,146 @@ fn track_equals_the_plain_hysteresis_tracker() {
     assert_eq!((got.t_high, got.t_low, got.segments.len()), (0.0, 0.0, 0));
     assert!(n_segments > 200, "{n_segments} segments");
 }
+
+/// The GHT of algorithms.md B.4.8 by brute force: every pixel pair within `tol` orientation bins
+/// (circularly) votes for `t = p - q`; the first maximum (ty, then tx ascending), its 3x3
+/// vote-weighted centroid, the peak over the longer segment.
+#[allow(clippy::too_many_arguments)]
+fn ght_reference(
+    a: &[(i32, i32, usize)],
+    b: &[(i32, i32, usize)],
+    lo: i32,
+    hi: i32,
+    dy: i32,
+    n_bins: usize,
+    tol: usize,
+) -> Option<rtable::Ght> {
+    if hi < lo || a.is_empty() || b.is_empty() {
+        return None;
+    }
+    let (nx, ny) = ((hi - lo + 1) as usize, (2 * dy + 1) as usize);
+    let mut acc = vec![0u32; nx * ny];
+    for &(px, py, pb) in a {
+        for &(qx, qy, qb) in b {
+            let d = pb.abs_diff(qb);
+            let (tx, ty) = (px - qx, py - qy);
+            if d.min(n_bins - d) <= tol && (lo..=hi).contains(&tx) && ty.abs() <= dy {
+                acc[(ty + dy) as usize * nx + (tx - lo) as usize] += 1;
+            }
+        }
+    }
+    let best = *acc.iter().max().unwrap();
+    if best == 0 {
+        return None;
+    }
+    let bi = acc.iter().position(|&v| v == best).unwrap();
+    let (cx, cy) = ((bi % nx) as i32, (bi / nx) as i32);
+    let (mut sw, mut sx, mut sy) = (0.0f64, 0.0f64, 0.0f64);
+    for yy in cy - 1..=cy + 1 {
+        for xx in cx - 1..=cx + 1 {
+            if yy < 0 || xx < 0 || yy >= ny as i32 || xx >= nx as i32 {
+                continue;
+            }
+            let v = acc[yy as usize * nx + xx as usize] as f64;
+            sw += v;
+            sx += v * (xx + lo) as f64;
+            sy += v * (yy - dy) as f64;
+        }
+    }
+    Some(rtable::Ght {
+        score: best as f32 / a.len().max(b.len()) as f32,
+        tx: (sx / sw) as f32,
+        ty: (sy / sw) as f32,
+        peak: best,
+    })
+}
+
+#[test]
+fn ght_and_rtable_equal_the_brute_force_vote() {
+    // Random pixel sets with orientations on few bins (many votes, ties of the peak), windows
+    // cut at either side, bands, tolerances up to half the bins; both kernels.
+    let w = 50usize;
+    let mut rnd = unit_rng(4242);
+    let mut compared = 0;
+    for trial in 0..300 {
+        let n_bins = [5usize, 8, 36][trial % 3];
+        let seg = |n: usize, rnd: &mut dyn FnMut() -> f32| -> (Vec<u32>, Vec<f32>) {
+            let pix: Vec<u32> = (0..n)
+                .map(|_| ((rnd() * 12.0) as usize * w + (rnd() * 30.0) as usize + 10) as u32)
+                .collect();
+            let th: Vec<f32> = (0..n)
+                .map(|_| {
+                    ((rnd() * n_bins as f32).floor() + 0.5) * std::f32::consts::TAU / n_bins as f32
+                })
+                .collect();
+            (pix, th)
+        };
+        let (pa, ta) = seg(1 + (rnd() * 15.0) as usize, &mut rnd);
+        let (pb, tb) = seg((rnd() * 15.0) as usize, &mut rnd);
+        let mut theta = vec![0.0f32; w * 20];
+        let mut theta_b = vec![0.0f32; w * 20];
+        for (&i, &t) in pa.iter().zip(&ta) {
+            theta[i as usize] = t;
+        }
+        for (&i, &t) in pb.iter().zip(&tb) {
+            theta_b[i as usize] = t;
+        }
+        // Distinct pixels (a segment visits each once), theta as stored.
+        let dedup = |p: &[u32]| {
+            let mut seen = std::collections::HashSet::new();
+            p.iter()
+                .copied()
+                .filter(|&i| seen.insert(i))
+                .collect::<Vec<u32>>()
+        };
+        let (pa, pb) = (dedup(&pa), dedup(&pb));
+        let xy = |i: u32| ((i as usize % w) as i32, (i as usize / w) as i32);
+        let cx = pa.iter().map(|&i| xy(i).0 as f32).sum::<f32>() / pa.len() as f32;
+        let cy = pa.iter().map(|&i| xy(i).1 as f32).sum::<f32>() / pa.len() as f32;
+        let sa = Segment {
+            pixels: pa.clone(),
+            centroid: (cx, cy),
+            x_min: 0,
+            x_max: 0,
+            y_min: 0,
+            y_max: 0,
+            mean_theta: 0.0,
+        };
+        let rt = build_rtable(&sa, &theta, w, n_bins);
+        // The R-table: bins in order, each bin's pixels in segment order, r = c - p.
+        let bin = |t: f32| rtable::theta_bin(t, n_bins);
+        let mut k = 0;
+        for b in 0..n_bins {
+            assert_eq!(rt.offsets[b] as usize, k);
+            for &i in pa.iter().filter(|&&i| bin(theta[i as usize]) == b) {
+                let (x, y) = xy(i);
+                assert_eq!(rt.px[k], (x, y));
+                assert_eq!(rt.vecs[k], (cx - x as f32, cy - y as f32));
+                k += 1;
+            }
+        }
+        assert_eq!(rt.offsets[n_bins] as usize, pa.len());
+        let va: Vec<(i32, i32, usize)> = pa
+            .iter()
+            .map(|&i| (xy(i).0, xy(i).1, bin(theta[i as usize])))
+            .collect();
+        let vb: Vec<(i32, i32, usize)> = pb
+            .iter()
+            .map(|&i| (xy(i).0, xy(i).1, bin(theta_b[i as usize])))
+            .collect();
+        let voters_b = voters(&pb, &theta_b, w, n_bins);
+        let ix = RowIndex::new(&rt);
+        let lo = (rnd() * 40.0) as i32 - 25;
+        let hi = lo + (rnd() * 30.0) as i32 - 3;
+        let dy = (rnd() * 3.0) as i32;
+        let tol = (rnd() * ((n_bins - 1) / 2 + 1) as f32) as usize;
+        let want = ght_reference(&va, &vb, lo, hi, dy, n_bins, tol);
+        let mut acc = Vec::new();
+        let got = ght_vote(&rt, pa.len(), &voters_b, lo, hi, dy, n_bins, tol, &mut acc);
+        assert_eq!(got, want, "trial {trial} ght_vote");
+        let got = ght_vote_rows(&ix, pa.len(), &voters_b, lo, hi, dy, n_bins, tol, &mut acc);
+        assert_eq!(got, want, "trial {trial} ght_vote_rows");
+        compared += usize::from(want.is_some());
+    }
+    assert!(compared > 100, "{compared}");
+}
