@@ -1461,3 +1461,282 @@ fn ght_and_rtable_equal_the_brute_force_vote() {
     }
     assert!(compared > 100, "{compared}");
 }
+
+#[test]
+fn candidates_equal_the_gated_brute_force_search() {
+    // Every left-right segment pair of two real-like channels, gated as B.4.7 says (rows within
+    // the band overlapping half the shorter extent, mean normals within the tolerance, centroid
+    // offset within the window widened by half the wider segment, length ratio), scored by the
+    // brute-force GHT; best k_cand per left segment, best first (ties by right id).
+    let (w, h) = (140, 90);
+    let p = McgmParams::default();
+    let cl = channel_curves(&blobs(w, h, 0.0), 1.0, 1, &p).unwrap();
+    let cr = channel_curves(&blobs(w, h, 4.6), 1.0, 1, &p).unwrap();
+    let (ls, rs) = (&cl.curves.segments, &cr.curves.segments);
+    let mut rnd = unit_rng(77);
+    let window: Vec<Option<(i32, i32)>> = (0..ls.len())
+        .map(|i| {
+            (i % 7 != 3).then(|| {
+                let lo = (rnd() * 10.0) as i32 - 2;
+                (lo, lo + 2 + (rnd() * 14.0) as i32)
+            })
+        })
+        .collect();
+    for cp in [
+        p.cand,
+        graph::CandParams {
+            dy_band: 0,
+            vote_bin_tol: 1,
+            ght_min_score: 0.6,
+            k_cand: 2,
+            seg_theta_tol_deg: 20.0,
+            ..p.cand
+        },
+        graph::CandParams {
+            dy_band: 3,
+            ght_min_score: 0.2,
+            k_cand: 100,
+            ..p.cand
+        },
+    ] {
+        let rts: Vec<_> = ls
+            .iter()
+            .map(|s| build_rtable(s, &cl.zc.theta, w, cp.n_bins))
+            .collect();
+        let got = graph::candidates(ls, &rts, rs, &cr.zc.theta, w, h, &window, &cp);
+        let bins = |s: &Segment, theta: &[f32]| -> Vec<(i32, i32, usize)> {
+            s.pixels
+                .iter()
+                .map(|&i| {
+                    (
+                        (i as usize % w) as i32,
+                        (i as usize / w) as i32,
+                        rtable::theta_bin(theta[i as usize], cp.n_bins),
+                    )
+                })
+                .collect()
+        };
+        let mut want = Vec::new();
+        for (ia, a) in ls.iter().enumerate() {
+            let Some((lo, hi)) = window[ia] else { continue };
+            let va = bins(a, &cl.zc.theta);
+            let mut out = Vec::new();
+            for (ib, b) in rs.iter().enumerate() {
+                let (y0, y1) = (
+                    (a.y_min - cp.dy_band).max(0),
+                    (a.y_max + cp.dy_band).min(h as i32 - 1),
+                );
+                let ov = y1.min(b.y_max) - y0.max(b.y_min) + 1;
+                let (ea, eb) = (a.y_max - a.y_min + 1, b.y_max - b.y_min + 1);
+                let dth = tracking::wrap_angle(a.mean_theta as f64 - b.mean_theta as f64).abs();
+                let slack = 0.5 * (a.x_max - a.x_min + 1).max(b.x_max - b.x_min + 1) as f32;
+                let dc = a.centroid.0 - b.centroid.0;
+                let (la, lb) = (a.pixels.len() as f32, b.pixels.len() as f32);
+                if ov < 1
+                    || dth >= (cp.seg_theta_tol_deg as f64).to_radians()
+                    || (ov as f32) < 0.5 * ea.min(eb) as f32
+                    || dc < lo as f32 - slack
+                    || dc > hi as f32 + slack
+                    || la.min(lb) / la.max(lb) < cp.ght_min_score
+                {
+                    continue;
+                }
+                let vb = bins(b, &cr.zc.theta);
+                let Some(g) =
+                    ght_reference(&va, &vb, lo, hi, cp.dy_band, cp.n_bins, cp.vote_bin_tol)
+                else {
+                    continue;
+                };
+                if g.score >= cp.ght_min_score {
+                    out.push(graph::Candidate {
+                        left: ia as u32,
+                        right: ib as u32,
+                        score: g.score,
+                        tx: g.tx,
+                        ty: g.ty,
+                    });
+                }
+            }
+            out.sort_by(|x, y| y.score.total_cmp(&x.score).then(x.right.cmp(&y.right)));
+            out.truncate(cp.k_cand);
+            want.extend(out);
+        }
+        assert_eq!(got, want, "{cp:?}");
+        assert!(got.len() > 8, "{} candidates", got.len());
+    }
+}
+
+#[test]
+fn association_weights_and_the_resolution_follow_the_definitions() {
+    // Weights: -B between candidates sharing a left or a right segment; between candidates of
+    // adjacent left segments (different right ones) A C_ab / sqrt(deg A deg B) with
+    // C_ab = 2 / (1 + exp(slope (g - g0))) - 1, g = |t_a - t_b| / max(1, |c_A - c_B|).
+    let seg = |cx: f32, cy: f32| Segment {
+        pixels: vec![0],
+        centroid: (cx, cy),
+        x_min: 0,
+        x_max: 0,
+        y_min: 0,
+        y_max: 0,
+        mean_theta: 0.0,
+    };
+    let left = [seg(0.0, 0.0), seg(3.0, 4.0), seg(0.5, 0.0), seg(40.0, 0.0)];
+    let adj: Vec<Vec<u32>> = vec![vec![1, 2], vec![0], vec![0], vec![]];
+    let c = |l: u32, r: u32, score: f32, tx: f32, ty: f32| graph::Candidate {
+        left: l,
+        right: r,
+        score,
+        tx,
+        ty,
+    };
+    let cands = [
+        c(0, 0, 0.9, 5.0, 0.0),
+        c(0, 1, 0.8, 2.0, 0.0),
+        c(1, 2, 0.95, 5.5, 0.5),
+        c(1, 1, 0.5, 9.0, 0.0),
+        c(2, 3, 0.7, 5.2, 0.0),
+        c(3, 0, 0.95, 5.0, 0.0),
+    ];
+    let sp = SolverParams {
+        a: 1.3,
+        b: 1.7,
+        dg_0: 0.4,
+        dg_slope: 8.0,
+        ..McgmParams::default().solver
+    };
+    let csr = graph::association_weights(&cands, &left, &adj, 4, &sp);
+    let compat = |ia: usize, ib: usize| {
+        let (a, b) = (&cands[ia], &cands[ib]);
+        let (sa, sb) = (&left[a.left as usize], &left[b.left as usize]);
+        let dist = ((sa.centroid.0 - sb.centroid.0).powi(2)
+            + (sa.centroid.1 - sb.centroid.1).powi(2))
+        .sqrt()
+        .max(1.0);
+        let g = ((a.tx - b.tx).powi(2) + (a.ty - b.ty).powi(2)).sqrt() / dist;
+        let deg = |i: u32| adj[i as usize].len() as f32;
+        sp.a / (deg(a.left) * deg(b.left)).sqrt()
+            * (2.0 / (1.0 + (sp.dg_slope * (g - sp.dg_0)).exp()) - 1.0)
+    };
+    let mut want: Vec<Vec<(u32, f32)>> = vec![Vec::new(); cands.len()];
+    for ia in 0..cands.len() {
+        for ib in 0..cands.len() {
+            let (a, b) = (&cands[ia], &cands[ib]);
+            if ia == ib {
+                continue;
+            }
+            if a.left == b.left || a.right == b.right {
+                want[ia].push((ib as u32, -sp.b));
+            } else if adj[a.left as usize].contains(&b.left) {
+                want[ia].push((ib as u32, compat(ia, ib)));
+            }
+        }
+    }
+    let got: Vec<Vec<(u32, f32)>> = (0..cands.len())
+        .map(|a| {
+            let (idx, val) = csr.row(a);
+            idx.iter().copied().zip(val.iter().copied()).collect()
+        })
+        .collect();
+    assert_eq!(got, want);
+    // The resolution: with no weights every candidate with D score > theta ends on; each left
+    // segment keeps its highest net input (= D score - theta), then each right segment.
+    let empty = crate::matching::hopfield::Csr {
+        indptr: vec![0; cands.len() + 1],
+        indices: vec![],
+        data: vec![],
+    };
+    let sol = graph::solve(&cands, &empty, 4, &sp);
+    assert_eq!(sol.state, [1, 1, 1, 1, 1, 1]);
+    // Left 0: c0 (0.9); left 1: c2 (0.95); left 2: c4; left 3: c5, which takes right 0 from
+    // c0 (0.95 > 0.9).
+    assert_eq!(sol.chosen, [2, 4, 5]);
+    // D score below theta: off, not chosen.
+    let low = [c(0, 0, 0.25, 1.0, 0.0), c(1, 1, 0.9, 1.0, 0.0)];
+    let empty2 = crate::matching::hopfield::Csr {
+        indptr: vec![0; 3],
+        indices: vec![],
+        data: vec![],
+    };
+    let sol = graph::solve(&low, &empty2, 2, &sp);
+    assert_eq!((sol.state, sol.chosen), (vec![0, 1], vec![1]));
+    // Net inputs with weights: a single weight lifts c1 above c0 on left 0.
+    let lift = crate::matching::hopfield::Csr {
+        indptr: vec![0, 0, 1, 1, 1, 1, 2],
+        indices: vec![5, 1],
+        data: vec![0.5, 0.5],
+    };
+    let sol = graph::solve(&cands, &lift, 4, &sp);
+    assert_eq!(sol.state, [1, 1, 1, 1, 1, 1]);
+    assert_eq!(sol.chosen, [1, 2, 4, 5]);
+    // Equal net inputs: the lower index.
+    let tie = [
+        c(0, 0, 0.8, 1.0, 0.0),
+        c(0, 1, 0.8, 1.0, 0.0),
+        c(1, 1, 0.8, 1.0, 0.0),
+    ];
+    let empty3 = crate::matching::hopfield::Csr {
+        indptr: vec![0; 4],
+        indices: vec![],
+        data: vec![],
+    };
+    assert_eq!(graph::solve(&tie, &empty3, 2, &sp).chosen, [0, 2]);
+    // The preset (each left segment's best candidate on) is a stable state of mutually
+    // inhibiting pairs: the network stays there (from all off, the visiting order decides).
+    let pairs: Vec<graph::Candidate> = (0..8u32)
+        .flat_map(|i| [c(i, 2 * i, 0.9, 1.0, 0.0), c(i, 2 * i + 1, 0.85, 1.0, 0.0)])
+        .collect();
+    let segs: Vec<Segment> = (0..8).map(|i| seg(100.0 * i as f32, 0.0)).collect();
+    let w8 = graph::association_weights(&pairs, &segs, &vec![Vec::new(); 8], 16, &sp);
+    let sol = graph::solve(&pairs, &w8, 8, &sp);
+    assert_eq!(sol.state, [1, 0].repeat(8));
+    assert_eq!(sol.chosen, (0..8).map(|i| 2 * i).collect::<Vec<usize>>());
+}
+
+#[test]
+fn candidates_reach_across_the_band_and_the_wider_segment_slack() {
+    // Hand-built segments (normals along +x, theta 0): a horizontal left segment and its copy
+    // two rows higher (dy_band 2) at disparity 3; a slanted 4-column-wide left segment and a
+    // 1-column right one whose centroids differ by 4.2, past the window [0, 3] but within
+    // half the wider segment (2 px).
+    let (w, h) = (60usize, 40usize);
+    let theta = vec![0.0f32; w * h];
+    let mk = |pix: Vec<(usize, usize)>| {
+        let n = pix.len() as f32;
+        let xs = pix.iter().map(|p| p.0 as i32);
+        let ys = pix.iter().map(|p| p.1 as i32);
+        Segment {
+            centroid: (
+                pix.iter().map(|p| p.0 as f32).sum::<f32>() / n,
+                pix.iter().map(|p| p.1 as f32).sum::<f32>() / n,
+            ),
+            x_min: xs.clone().min().unwrap(),
+            x_max: xs.max().unwrap(),
+            y_min: ys.clone().min().unwrap(),
+            y_max: ys.max().unwrap(),
+            mean_theta: 0.0,
+            pixels: pix.iter().map(|&(x, y)| (y * w + x) as u32).collect(),
+        }
+    };
+    let cp = graph::CandParams {
+        dy_band: 2,
+        ght_min_score: 0.2,
+        ..McgmParams::default().cand
+    };
+    let run = |a: Segment, b: Segment, win: (i32, i32)| {
+        let rt = build_rtable(&a, &theta, w, cp.n_bins);
+        graph::candidates(&[a], &[rt], &[b], &theta, w, h, &[Some(win)], &cp)
+    };
+    let a = mk((20..26).map(|x| (x, 10)).collect());
+    let b = mk((17..23).map(|x| (x, 8)).collect());
+    let got = run(a, b, (0, 8));
+    assert_eq!(got.len(), 1);
+    // Peak at t = (3, 2); the 3x3 centroid is pulled toward the rows around it.
+    assert_eq!(got[0].score, 1.0);
+    assert!(got[0].ty > 1.0, "{:?}", got[0]);
+    let a = mk((0..10).map(|k| (20 + k / 3, 10 + k)).collect());
+    let b = mk((10..20).map(|y| (17, y)).collect());
+    assert!((a.centroid.0 - b.centroid.0 - 4.2).abs() < 1e-5);
+    let got = run(a, b, (0, 3));
+    assert_eq!(got.len(), 1);
+    assert_eq!(got[0].score, 0.3);
+}
