@@ -1722,21 +1722,35 @@ fn candidates_reach_across_the_band_and_the_wider_segment_slack() {
         ght_min_score: 0.2,
         ..McgmParams::default().cand
     };
-    let run = |a: Segment, b: Segment, win: (i32, i32)| {
+    let run = |a: Segment, b: &[Segment], win: (i32, i32), cp: &graph::CandParams| {
         let rt = build_rtable(&a, &theta, w, cp.n_bins);
-        graph::candidates(&[a], &[rt], &[b], &theta, w, h, &[Some(win)], &cp)
+        graph::candidates(&[a], &[rt], b, &theta, w, h, &[Some(win)], cp)
     };
     let a = mk((20..26).map(|x| (x, 10)).collect());
-    let b = mk((17..23).map(|x| (x, 8)).collect());
-    let got = run(a, b, (0, 8));
-    assert_eq!(got.len(), 1);
+    // Right 0 two rows higher, right 1 on the same row at disparity 5: both score 1.
+    let b = [
+        mk((17..23).map(|x| (x, 8)).collect()),
+        mk((15..21).map(|x| (x, 10)).collect()),
+    ];
+    let got = run(a.clone(), &b, (0, 8), &cp);
+    assert_eq!(got.len(), 2);
+    assert_eq!((got[0].right, got[1].right), (0, 1));
     // Peak at t = (3, 2); the 3x3 centroid is pulled toward the rows around it.
-    assert_eq!(got[0].score, 1.0);
+    assert_eq!((got[0].score, got[1].score), (1.0, 1.0));
     assert!(got[0].ty > 1.0, "{:?}", got[0]);
+    // Equal scores: the lower right id is kept first.
+    let one = graph::CandParams { k_cand: 1, ..cp };
+    let got = run(a, &b, (0, 8), &one);
+    assert_eq!((got.len(), got[0].right), (1, 0));
     let a = mk((0..10).map(|k| (20 + k / 3, 10 + k)).collect());
-    let b = mk((10..20).map(|y| (17, y)).collect());
-    assert!((a.centroid.0 - b.centroid.0 - 4.2).abs() < 1e-5);
-    let got = run(a, b, (0, 3));
+    let b = [mk((10..20).map(|y| (17, y)).collect())];
+    assert!((a.centroid.0 - b[0].centroid.0 - 4.2).abs() < 1e-5);
+    // Peak 3 of 10 pixels: a score of 0.3 passes a threshold of 0.3 (inclusive).
+    let at = graph::CandParams {
+        ght_min_score: 0.3,
+        ..cp
+    };
+    let got = run(a, &b, (0, 3), &at);
     assert_eq!(got.len(), 1);
     assert_eq!(got[0].score, 0.3);
 }
