@@ -1775,3 +1775,41 @@ def test_depth_failing_before_its_first_move_leaves_no_folder_and_the_old_manife
     capsys.readouterr()
     assert (out / cli.DEPTH_MANIFEST).read_text() == '[ "depth.npy" ]'
     assert sorted(p.name for p in out.iterdir()) == [cli.DEPTH_MANIFEST, "depth.npy"]
+
+
+def test_commit_outputs_interrupted_right_after_the_first_move_keeps_it_listed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A second Ctrl-C during the first rename is raised once it returns, before the file is
+    counted as written: the earlier manifest was put back without the file that did move in,
+    and the rerun refused it as the user's. The manifest keeps listing it."""
+    import os
+
+    from stereovision import cli
+
+    out = tmp_path / "o"
+    stage = tmp_path / "stage"
+    stage.mkdir()
+    out.mkdir()
+    (out / cli.DEPTH_MANIFEST).write_text('["depth.npy"]')
+    (out / "depth.npy").write_bytes(b"earlier")
+    staged = {}
+    for name in ("disparity.png", "disparity.pfm"):
+        (stage / name).write_bytes(b"new")
+        staged[name] = stage / name
+    real_replace = os.replace
+
+    def replace(src: str | os.PathLike[str], dst: str | os.PathLike[str]) -> None:
+        real_replace(src, dst)
+        if Path(src).parent == stage:
+            raise KeyboardInterrupt  # the handler of a second signal, run as the rename returns
+
+    monkeypatch.setattr(os, "replace", replace)
+    with pytest.raises(KeyboardInterrupt):
+        cli.commit_outputs(out, staged, {"depth.npy"})
+    monkeypatch.setattr(os, "replace", real_replace)
+    assert (out / "disparity.png").read_bytes() == b"new"
+    listed = json.loads((out / cli.DEPTH_MANIFEST).read_text())
+    assert "disparity.png" in listed and "depth.npy" in listed
+    # the rerun replaces it, not refuses it as a file of the user's
+    assert cli.refuse_foreign_outputs(out, list(cli.DEPTH_OUTPUTS)) == set(listed)

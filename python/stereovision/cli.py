@@ -664,7 +664,10 @@ def commit_outputs(
                 os.replace(path, out_dir / name)
                 written[name] = out_dir / name
         except BaseException:
-            if not written:
+            # a second Ctrl-C during the first rename is raised once it returns, before the
+            # file counts as written: only a first file still in the staging folder moved nowhere
+            first = next(iter(staged.values()), None)
+            if not written and (first is None or os.path.lexists(first)):
                 # nothing moved in: the earlier manifest back (or none), so that the folder is
                 # as it was, and a folder the run made is empty and removed (staged_outputs)
                 with contextlib.suppress(OSError):
