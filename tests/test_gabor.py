@@ -358,3 +358,27 @@ def test_the_wrappers_own_checks_name_the_argument() -> None:
         gabor_disparity(img, np.zeros((24, 41), np.float32), max_disparity=8)
     with pytest.raises(TypeError, match=r"^lr_check: expected True or False, got 1"):
         gabor_disparity(img, img, max_disparity=8, lr_check=1)
+
+
+def test_direct_call_refuses_an_unreachable_range_as_match_does() -> None:
+    """min_disparity at the width or above (or max_disparity at minus the width or below): no
+    pixel has a match there. match() refused it; gabor_disparity returned an all-NaN map
+    without a word (as hopfield_match and mcgm_match did). It now raises match()'s error."""
+    import re
+
+    import stereovision as sv
+
+    rng = np.random.default_rng(0)
+    left = rng.random((40, 48), dtype=np.float32)
+    right = np.roll(left, -5, axis=1)
+    for lo, hi in ((48, 60), (48.5, 49), (-60, -48)):
+        with pytest.raises(ValueError) as want:
+            sv.match(left, right, method="gabor", max_disparity=hi, min_disparity=lo)
+        assert "image width" in str(want.value)
+        with pytest.raises(ValueError, match=f"^{re.escape(str(want.value))}$"):
+            gabor_disparity(left, right, max_disparity=hi, min_disparity=lo)
+    # one column short of the width is searched: no error
+    assert gabor_disparity(left, right, max_disparity=48, min_disparity=47).disparity.shape == (
+        40,
+        48,
+    )

@@ -3,6 +3,7 @@ accuracy on real scenes beside OpenCV, the fused dense map's use of it, errors."
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
@@ -474,3 +475,22 @@ def test_address_space_room_is_the_limit_less_vmsize_in_bytes(
     with open("/proc/self/status") as f:
         vm = next(int(line.split()[1]) for line in f if line.startswith("VmSize:")) * 1024
     assert room is not None and abs(room - (limit - vm)) < 2**26  # VmSize moves a little
+
+
+def test_direct_call_refuses_an_unreachable_range_as_depth_map_does() -> None:
+    """min_disparity at the width or above (or max_disparity at minus the width or below): no
+    pixel has a match there. depth_map refused it; sgm_disparity returned an all-NaN map
+    without a word (as hopfield_match and mcgm_match did). It now raises depth_map's error."""
+    import stereovision as sv
+
+    rng = np.random.default_rng(0)
+    left = rng.random((30, 40), dtype=np.float32)
+    right = np.roll(left, -5, axis=1)
+    for lo, hi in ((40, 50), (40.5, 41), (-50, -40)):
+        with pytest.raises(ValueError) as want:
+            sv.depth_map(left, right, max_disparity=hi, min_disparity=lo, method="census")
+        assert "image width" in str(want.value)
+        with pytest.raises(ValueError, match=f"^{re.escape(str(want.value))}$"):
+            sgm_disparity(left, right, max_disparity=hi, min_disparity=lo)
+    # one column short of the width is searched: nothing there, and no error
+    assert sgm_disparity(left, right, max_disparity=39, min_disparity=39).shape == (30, 40)

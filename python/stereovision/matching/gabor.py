@@ -139,7 +139,9 @@ def gabor_disparity(
     ------
     ValueError
         If an image is not 2-D, empty, not floating point, non-finite or has values outside
-        ``[0, 1]``, the shapes differ, a parameter is unknown or out of range.
+        ``[0, 1]``, the shapes differ, a parameter is unknown or out of range, or the range is
+        one no pixel can match in (``min_disparity`` not below the image width, or
+        ``max_disparity`` not above minus it; as :func:`stereovision.match`).
     TypeError
         If a switch (``lr_check``, ``research_finest``, ``lr_light``) is not True or False.
     MemoryError
@@ -152,6 +154,13 @@ def gabor_disparity(
     if lft.shape != rgt.shape:
         raise ValueError(f"left {lft.shape} and right {rgt.shape} images differ in shape")
     lo, hi = disparity_range(min_disparity, max_disparity)
+    # match()'s error for a range no pixel can match in (the kernel searched nothing and
+    # returned an all-NaN map without a word); depth imports the matchers, hence here
+    from stereovision.depth import _unreachable_range
+
+    err = _unreachable_range(lo, hi, lft.shape[1])
+    if err is not None:
+        raise err
     # the kernel's limits, in the caller's names (they were its own: "invalid parameter `d_max`:
     # must be finite, got inf" for 1e300, float32's inf)
     if hi - lo > MAX_RANGE:

@@ -152,8 +152,9 @@ def sgm_disparity(
     Raises
     ------
     ValueError
-        Bad images, an unknown option, a range with ``max_disparity < min_disparity`` or a
-        parameter out of its range.
+        Bad images, an unknown option, a range with ``max_disparity < min_disparity``, one no
+        pixel can match in (``min_disparity`` not below the image width, or ``max_disparity``
+        not above minus it; as :func:`stereovision.depth_map`) or a parameter out of its range.
     MemoryError
         When the kernel's peak (3 bytes per pixel and disparity level) exceeds the memory
         available (Linux's MemAvailable, a container's cgroup limit, or the address space left
@@ -193,6 +194,13 @@ def sgm_disparity(
     if isinstance(p["paths"], bool) or p["paths"] not in (3, 8):
         raise ValueError(f"paths: expected 8 or 3, got {p['paths']!r}")
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
+    # depth_map's error for a range no pixel can match in (the kernel searched nothing and
+    # returned an all-NaN map without a word); depth imports the matchers, hence here
+    from stereovision.depth import _unreachable_range
+
+    err = _unreachable_range(min_disparity, max_disparity, gl.shape[1])
+    if err is not None:
+        raise err
     levels = math.ceil(max_disparity) - math.floor(min_disparity) + 1
     if levels > _MAX_LEVELS:
         # the kernel's own message named its `d_max` ("the range holds 8192 levels; at most
