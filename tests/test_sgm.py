@@ -494,3 +494,23 @@ def test_direct_call_refuses_an_unreachable_range_as_depth_map_does() -> None:
             sgm_disparity(left, right, max_disparity=hi, min_disparity=lo)
     # one column short of the width is searched: nothing there, and no error
     assert sgm_disparity(left, right, max_disparity=39, min_disparity=39).shape == (30, 40)
+
+
+def test_uniqueness_and_gamma_are_refused_in_the_callers_names() -> None:
+    """uniqueness 101..2**32-1 passed the Python check ("an integer in [0, 4294967295]") and
+    came back as the kernel's "invalid parameter `uniqueness`: expected a percentage in
+    [0, 100]"; gamma 0, negative, NaN or inf as its "invalid parameter `gamma`", and a string as
+    float()'s "could not convert string to float". Each is named as the other options are."""
+    img = np.random.default_rng(0).random((30, 40)).astype(np.float32)
+    bad = (
+        ({"uniqueness": 101}, r"^uniqueness: expected an integer in \[0, 100\], got 101$"),
+        ({"gamma": 0.0}, r"^gamma: expected a positive number, got 0.0$"),
+        ({"gamma": -1}, r"^gamma: expected a positive number, got -1$"),
+        ({"gamma": float("nan")}, r"^gamma: expected a finite number, got nan$"),
+        ({"gamma": float("inf")}, r"^gamma: expected a finite number, got inf$"),
+        ({"gamma": "16"}, r"^gamma: expected a finite number, got '16'$"),
+    )
+    for kw, msg in bad:
+        with pytest.raises(ValueError, match=msg):
+            sgm_disparity(img, img, max_disparity=8, **kw)
+    assert sgm_disparity(img, img, max_disparity=8, uniqueness=100, gamma=1e-3).shape == img.shape

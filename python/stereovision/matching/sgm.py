@@ -19,7 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import as_gray_float, check_pair, float_sized
+from stereovision._validate import as_gray_float, check_pair, finite_number, float_sized
 
 __all__ = ["DEFAULTS", "sgm_disparity"]
 
@@ -177,12 +177,12 @@ def sgm_disparity(
         raise ValueError(
             f"max_disparity ({max_disparity}) is smaller than min_disparity ({min_disparity})"
         )
-    # P1/P2: the kernel's own limits (named here, not as its "invalid parameter `p2`"); the
-    # rest: the kernel's u32 widths.
+    # P1/P2 and uniqueness: the kernel's own limits (named here, not as its "invalid parameter
+    # `p2`"); the rest: the kernel's u32 widths.
     for name, bottom, top in (
         ("p1", 1, _MAX_P2 - 1),
         ("p2", 2, _MAX_P2),
-        ("uniqueness", 0, 2**32 - 1),
+        ("uniqueness", 0, 100),
         ("lr_tol", 0, 2**32 - 1),
         ("edge_margin", 0, 2**32 - 1),
     ):
@@ -191,6 +191,10 @@ def sgm_disparity(
             raise ValueError(f"{name}: expected an integer in [{bottom}, {top}], got {v!r}")
     if p["p1"] >= p["p2"]:
         raise ValueError(f"p1: expected p1 < p2, got p1 = {p['p1']}, p2 = {p['p2']}")
+    # NaN, inf, 10**400 and strings named as gamma (float() and the kernel named them otherwise)
+    gamma = finite_number(p["gamma"], "gamma")
+    if not gamma > 0:
+        raise ValueError(f"gamma: expected a positive number, got {p['gamma']!r}")
     if isinstance(p["paths"], bool) or p["paths"] not in (3, 8):
         raise ValueError(f"paths: expected 8 or 3, got {p['paths']!r}")
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
@@ -218,7 +222,7 @@ def sgm_disparity(
         math.ceil(max_disparity),
         int(p["p1"]),
         int(p["p2"]),
-        float(float_sized(p["gamma"], "gamma")),
+        gamma,
         int(p["uniqueness"]),
         int(p["lr_tol"]),
         int(p["edge_margin"]),
