@@ -202,14 +202,14 @@ def write_bag(
     encoding: str = "bgr8",
     topics: tuple[str, str] = (LEFT, RIGHT),
     infos: tuple[dict, dict] | None = None,
-    binning: int | tuple[int, int] = 0,
+    binning: int | tuple[int, int] | list[tuple[int, int]] = 0,
     roi: tuple[int, int, int, int] = (0, 0, 0, 0),
 ) -> Path:
     """A bag of ``(stamp_left, left, stamp_right, right)`` frames (a None stamp: not recorded),
     each message recorded 2 ms after its stamp, in recording order; ``infos``: the two cameras'
     parsed camera_info, published beside the image topics once per left frame, with
-    ``binning`` (both axes, or ``(x, y)``) and ``roi`` ``(x_offset, y_offset, width,
-    height)``."""
+    ``binning`` (both axes, or ``(x, y)``; a list: ``[left's, right's]``) and ``roi``
+    ``(x_offset, y_offset, width, height)``."""
     ros1 = flavour == "ros1"
     ts = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
     t = ts.types
@@ -231,11 +231,13 @@ def write_bag(
                 msgs.append((stamp + 2_000_000, topic, "sensor_msgs/msg/Image", msg))
             if infos is not None:
                 cam = infos[0] if topic == topics[0] else infos[1]
+                side = 0 if topic == topics[0] else 1
+                bins = binning[side] if isinstance(binning, list) else binning
                 box = t["sensor_msgs/msg/RegionOfInterest"](
                     x_offset=roi[0], y_offset=roi[1], width=roi[2], height=roi[3],
                     do_rectify=False)  # fmt: skip
                 info = t["sensor_msgs/msg/CameraInfo"](
-                    header=header, roi=box, **_info_fields(cam, ros1, binning))  # fmt: skip
+                    header=header, roi=box, **_info_fields(cam, ros1, bins))  # fmt: skip
                 info_topic = topic.rsplit("/", 1)[0] + "/camera_info"
                 msgs.append((stamp + 2_000_001, info_topic, "sensor_msgs/msg/CameraInfo", info))
     msgs.sort(key=lambda m: m[0])
@@ -1101,3 +1103,21 @@ def test_an_equal_distance_tie_takes_the_earlier_right_frame(cones: Any, tmp_pat
         ((T0 + 4 * ms) / 1e9, (T0 + 2 * ms) / 1e9),
     ]
     assert cam.dropped == {"left": 0, "right": 0}
+
+
+def test_a_rig_whose_cameras_bin_differently_is_refused(cones: Any, tmp_path: Path) -> None:
+    """Left binned 2 x 2, right not: both were scaled by the larger binning (the right camera's
+    calibration at half its size, without a word). It is refused, naming both."""
+    cams = tuple(parse_ros_camera_info(t) for t in _raw_rig().to_ros())
+    frames = [(T0, cones.left, T0, cones.right)]
+    bag = write_bag(tmp_path / "mixed", frames, infos=cams, binning=[(2, 2), (1, 1)])
+    with BagCamera(bag) as cam, pytest.raises(ValueError) as err:
+        cam.calibration()
+    assert str(err.value) == (
+        "/stereo/left/camera_info and /stereo/right/camera_info bin differently (2x2 and 1x1): "
+        "a stereo pair's cameras must run in one mode"
+    )
+    # binning 0 (unset) is 1
+    bag = write_bag(tmp_path / "same", frames, infos=cams, binning=[(0, 0), (1, 1)])
+    with BagCamera(bag) as cam:
+        assert cam.calibration().image_size == (450, 375)

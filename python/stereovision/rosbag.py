@@ -1205,13 +1205,14 @@ class BagCamera(PairSource):
         ------
         ValueError
             If a ``camera_info`` is not a stereo camera's (no baseline), its model is not
-            supported, or it describes a region of interest (named).
+            supported, it describes a region of interest (named), or the two bin differently.
         """
         from stereovision.calibration import Calibration, _ros_yaml
 
         if self._reader is None or None in self.info_topics.values():
             return None
-        texts, binning = [], set()
+        texts: list[str] = []
+        binning: list[tuple[int, int]] = []
         for side in ("left", "right"):
             topic = self.info_topics[side]
             conns = [c for c in self._reader.connections if c.topic == topic]
@@ -1235,11 +1236,19 @@ class BagCamera(PairSource):
             if self.rectified_topics:
                 K, D, R, model = P[:, :3], np.zeros(5), np.eye(3), "plumb_bob"
             texts.append(_ros_yaml(side, size, K, D, R, P, model))
-            binning.add((max(int(msg.binning_x), 1), max(int(msg.binning_y), 1)))
+            binning.append((max(int(msg.binning_x), 1), max(int(msg.binning_y), 1)))
         calib = Calibration._from_ros_texts(
             texts[0], texts[1], str(self.info_topics["left"]), str(self.info_topics["right"])
         )
-        bx, by = max(b[0] for b in binning), max(b[1] for b in binning)
+        if binning[0] != binning[1]:
+            # the larger was taken for both: one camera's calibration at another size than its
+            # images', without a word
+            (lx, ly), (rx, ry) = binning
+            raise ValueError(
+                f"{self.info_topics['left']} and {self.info_topics['right']} bin differently "
+                f"({lx}x{ly} and {rx}x{ry}): a stereo pair's cameras must run in one mode"
+            )
+        bx, by = binning[0]
         if (bx, by) != (1, 1):
             w, h = calib.image_size
             # each axis by exactly 1 / b: scaled_to((w // bx, h // by)) took 187 / 375 for 375
