@@ -611,7 +611,9 @@ def commit_outputs(
     folder holds one run's files, the earlier run's or this one's. A folder where a file goes
     is refused before any file moves. The manifest lists this run's files before the first
     move; a failure before any file moved in puts the earlier manifest back (or none), so that
-    a folder the run made is left empty and removed (:func:`staged_outputs`).
+    a folder the run made is left empty and removed (:func:`staged_outputs`). A rename that
+    fails after others moved in (the folder made read-only meanwhile) leaves files of both
+    runs, all listed in the manifest: a rerun replaces them.
 
     Parameters
     ----------
