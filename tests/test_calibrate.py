@@ -1485,3 +1485,136 @@ def test_without_refinement_the_intrinsics_are_each_cameras_own(cached_corners: 
             covered.mean(), abs=0.01
         )
     assert rep.coverage_right < 0.5 * rep.coverage_left
+
+
+def _solve_with_errors(monkeypatch: pytest.MonkeyPatch, errors: dict[int, np.ndarray]) -> None:
+    """calibrate's solver, its per-pair (left, right) errors replaced by ``errors[n_views]``
+    (the outlier rule and the report's per-pair figures read them; the rest stays real)."""
+    real = calmod._solve
+
+    def solve(obj: Any, *rest: Any) -> Any:
+        sol = real(obj, *rest)
+        sol.per_view = np.array(errors[len(obj)], np.float64)
+        return sol
+
+    monkeypatch.setattr(calmod, "_solve", solve)
+
+
+def test_outlier_rule_and_per_pair_figures_on_given_errors(
+    cached_corners: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A second mutation audit found the outlier rule held by one far-off pair only: a limit of 3
+    x the mean (not the median), a pair's error as its worse camera (not both cameras' RMS), an
+    error equal to the limit counted, and the report's pair RMS as the mean of the two cameras
+    or the right camera's error given the left one's all went unseen. Nine pairs at 0.25 px put
+    the limit at 0.75 px; the pair at 0.75 px is kept, (1.0, 0.1) px is 0.711 px RMS (kept),
+    1.2 and 4.0 px are outliers (3 x their mean, 2.06 px, would keep 1.2)."""
+    left, right = _chessboard_paths()
+    per_view = np.array([[0.25, 0.25]] * 9 + [[0.75, 0.75], [1.0, 0.1], [1.2, 1.2], [4.0, 4.0]])
+    _solve_with_errors(monkeypatch, {13: per_view})
+    _, rep = calibrate(left, right, square_size=1.0, distortion="k1k2p1p2")
+    names = rep.used_pairs
+    assert len(names) == 13 and rep.outlier_pairs == names[11:]
+    for n, (el, er) in zip(names, per_view, strict=True):
+        assert rep.per_pair_errors_left[n] == el and rep.per_pair_errors_right[n] == er
+        assert rep.per_pair_errors[n] == pytest.approx(math.sqrt((el**2 + er**2) / 2), rel=1e-12)
+    assert rep.stereo_rms_right == pytest.approx(math.sqrt(np.mean(per_view[:, 1] ** 2)))
+    page = calmod._render_html(rep)
+    for k, n in enumerate(names):
+        status = "outlier \\(kept\\)" if k >= 11 else "used"
+        assert re.search(
+            rf"<tr><td>{re.escape(n)}</td>(<td>[^<]*</td>){{3}}<td>{status}</td>", page
+        )
+    assert f"  outlier kept: {names[12]} (drop it with drop_outliers=True)" in rep.summary()
+
+
+def test_an_outlier_is_dropped_when_exactly_the_minimum_remains(
+    cached_corners: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """drop_outliers drops a pair while MIN_PAIRS (3) remain, 4 - 1 included (a mutation audit
+    found the boundary unchecked); the pair dropped is not also said to be an outlier kept."""
+    left, right = _chessboard_paths()
+    _solve_with_errors(
+        monkeypatch, {4: np.array([[0.2, 0.2]] * 3 + [[4.0, 4.0]]), 3: np.full((3, 2), 0.2)}
+    )
+    _, rep = calibrate(
+        left[:4], right[:4], square_size=1.0, distortion="k1k2p1p2", drop_outliers=True,
+        names=["a", "b", "c", "d"],
+    )  # fmt: skip
+    assert rep.used_pairs == ["a", "b", "c"] and rep.outlier_pairs == ["d"]
+    assert rep.rejected_pairs["d"].startswith("outlier: error 4.000 px > 0.600 px")
+    assert "outlier kept" not in rep.summary()
+
+
+def test_report_square_sides_yml_and_the_unit_of_t(
+    chessboard: tuple[Calibration, CalibrationReport], tmp_path: Path
+) -> None:
+    """A second mutation audit found unchecked: the triangulated square's median (the mean
+    passed) and spread (the sides along the columns only passed), a report saved as .yml, and
+    the page's T heading and the summary's baseline naming their unit (the board's), report
+    folders made two deep, and empty lists of pairs (an AssertionError). The sides:
+    cv2.stereoRectify (alpha 0), cv2.undistortPoints and cv2.triangulatePoints on the used
+    corners, neighbours both ways."""
+    cal, rep = chessboard
+    R1, R2, P1, P2, *_ = cv2.stereoRectify(
+        cal.K1, cal.D1, cal.K2, cal.D2, cal.image_size, cal.R, cal.T.reshape(3, 1),
+        flags=cv2.CALIB_ZERO_DISPARITY, alpha=0,
+    )  # fmt: skip
+    crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 40, 1e-12)
+    sides = []
+    for name in rep.used_pairs:
+        cl, cr = rep._corners[name]
+        ul = cv2.undistortPoints(cl.reshape(-1, 1, 2), cal.K1, cal.D1, R=R1, P=P1, criteria=crit)
+        ur = cv2.undistortPoints(cr.reshape(-1, 1, 2), cal.K2, cal.D2, R=R2, P=P2, criteria=crit)
+        Xh = cv2.triangulatePoints(P1, P2, ul.reshape(-1, 2).T, ur.reshape(-1, 2).T)
+        X = (Xh[:3] / Xh[3]).T.reshape(6, 9, 3)
+        sides += [np.linalg.norm(np.diff(X, axis=a), axis=2).ravel() for a in (0, 1)]
+    side = np.concatenate(sides)
+    assert rep.square_size_measured == pytest.approx(float(np.median(side)), rel=1e-6)
+    assert rep.square_size_std == pytest.approx(float(side.std()), rel=1e-4)
+    rep.save(tmp_path / "r.yml")
+    assert yaml.safe_load((tmp_path / "r.yml").read_text())["rms"] == rep.rms
+    assert "<h3>T (m)</h3>" in calmod._render_html(rep)
+    assert f"baseline {rep.baseline:.6g} m, fx" in rep.summary()
+    paths = rep.write(tmp_path / "new" / "report")  # folders made as needed
+    assert json.loads(paths["json"].read_text())["unit"] == "m"
+    with pytest.raises(ValueError, match=r"^no image pairs given$"):
+        calibrate([], [], square_size=1.0)
+
+
+def test_cli_refuses_a_ros_file_and_a_bag_beside_right_and_writes_xml(
+    cached_corners: None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A second mutation audit found unchecked: --ros naming a file (said by its own line, before
+    the work), --from-bag given with --right only, and -o rig.xml (OpenCV's FileStorage)."""
+    left, right = _chessboard_paths()
+    base = ["calibrate", "--left", str(left[0].parent / "left*.jpg"), "--right",
+            str(right[0].parent / "right*.jpg"), "--square", "1"]  # fmt: skip
+    (tmp_path / "ros").write_text("x")
+    args = _parser().parse_args(
+        [*base, "-o", str(tmp_path / "a.yaml"), "--ros", str(tmp_path / "ros")]
+    )
+    with pytest.raises(ValueError, match=r"^--ros .*ros: is a file; give a folder for left\.yaml"):
+        args.func(args)
+    args = _parser().parse_args(
+        ["calibrate", "--from-bag", str(tmp_path / "b.bag"), "--right", "r*.png", "--square", "1",
+         "-o", str(tmp_path / "a.yaml")]
+    )  # fmt: skip
+    with pytest.raises(ValueError, match=r"^--from-bag replaces --left and --right"):
+        args.func(args)
+    assert not (tmp_path / "a.yaml").exists()
+    out = tmp_path / "rig.xml"
+    args = _parser().parse_args([*base, "-o", str(out), "--max-pairs", "4"])
+    assert args.func(args) == 0
+    assert Calibration.load(out).K1[0, 0] == pytest.approx(535, abs=15)
+
+
+def test_model_selection_starts_at_its_minimum_of_views(cached_corners: None) -> None:
+    """``distortion="auto"`` compares its models from MODEL_SELECTION_MIN_VIEWS (6) views on; a
+    mutation audit found only 13 views checked (6 skipped the selection unseen)."""
+    left, right = _chessboard_paths()
+    n = calmod.MODEL_SELECTION_MIN_VIEWS
+    _, rep = calibrate(left[:n], right[:n], square_size=1.0)
+    assert sorted(rep.model_selection) == sorted(calmod.AUTO_CANDIDATES)
+    _, rep = calibrate(left[: n - 1], right[: n - 1], square_size=1.0)
+    assert rep.model_selection == {} and rep.distortion_model == calmod.AUTO_CANDIDATES[0]
