@@ -1586,7 +1586,9 @@ def test_cli_refuses_a_ros_file_and_a_bag_beside_right_and_writes_xml(
     cached_corners: None, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A second mutation audit found unchecked: --ros naming a file (said by its own line, before
-    the work), --from-bag given with --right only, and -o rig.xml (OpenCV's FileStorage)."""
+    the work), --from-bag given with --right only, --max-skew-ms without --from-bag, -o in a
+    missing folder (its own FileNotFoundError), -o rep/report.json beside --report rep, and
+    -o rig.xml (OpenCV's FileStorage)."""
     left, right = _chessboard_paths()
     base = ["calibrate", "--left", str(left[0].parent / "left*.jpg"), "--right",
             str(right[0].parent / "right*.jpg"), "--square", "1"]  # fmt: skip
@@ -1603,6 +1605,20 @@ def test_cli_refuses_a_ros_file_and_a_bag_beside_right_and_writes_xml(
     with pytest.raises(ValueError, match=r"^--from-bag replaces --left and --right"):
         args.func(args)
     assert not (tmp_path / "a.yaml").exists()
+    (tmp_path / "rep").mkdir()
+    for extra, error, said in (
+        (["--max-skew-ms", "5", "-o", str(tmp_path / "a.yaml")], ValueError,
+         r"^--left-topic, --right-topic and --max-skew-ms are for --from-bag$"),
+        (["-o", str(tmp_path / "no" / "a.yaml")], FileNotFoundError,
+         r"^-o .*a\.yaml: directory .*no does not exist$"),
+        (["-o", str(tmp_path / "rep" / "report.json"), "--report", str(tmp_path / "rep")],
+         ValueError, r"^-o .*: --report .*rep writes report\.json there too"),
+    ):  # fmt: skip
+        args = _parser().parse_args([*base, *extra])
+        with pytest.raises(error, match=said):
+            args.func(args)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rep", "ros"]
+    assert not any((tmp_path / "rep").iterdir())
     out = tmp_path / "rig.xml"
     args = _parser().parse_args([*base, "-o", str(out), "--max-pairs", "4"])
     assert args.func(args) == 0
