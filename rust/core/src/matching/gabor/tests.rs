@@ -1,5 +1,14 @@
 use super::*;
 
+/// The tests' channels: frequency 1/4, 1.5 octaves of bandwidth, a round envelope; one
+/// per orientation in degrees.
+fn channels(orientations_deg: &[f32]) -> Vec<filter::Channel> {
+    orientations_deg
+        .iter()
+        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
+        .collect()
+}
+
 /// Band-limited random texture (sum of sinusoids) sampled at `x + shift`: an exact sub-pixel shift.
 fn texture(w: usize, h: usize, shift: f32, seed: u64) -> Image {
     let mut s = seed;
@@ -281,10 +290,7 @@ fn fused_search_row_equals_the_generic_one() {
     for &(w, h) in &[(61usize, 9usize), (64, 5), (13, 3)] {
         let (left, right) = (texture(w, h, 0.0, 3), texture(w, h, 4.3, 3));
         for n_or in [1usize, 3] {
-            let chans: Vec<_> = DEFAULT_ORIENTATIONS[..n_or]
-                .iter()
-                .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
-                .collect();
+            let chans = channels(&DEFAULT_ORIENTATIONS[..n_or]);
             let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
             let rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
             let base: Vec<f32> = (0..w * h)
@@ -498,10 +504,7 @@ fn fused_search_reads_only_the_channels_both_levels_have() {
     // (`get_unchecked`) for every left channel. Both now use the channels both levels have.
     let (w, h) = (37usize, 4usize);
     let (left, right) = (texture(w, h, 0.0, 3), texture(w, h, 2.0, 3));
-    let chans: Vec<_> = DEFAULT_ORIENTATIONS[..3]
-        .iter()
-        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
-        .collect();
+    let chans = channels(&DEFAULT_ORIENTATIONS[..3]);
     let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
     let rd = level_data(&right.data, w, h, &chans[..1], 1.25, true).unwrap();
     let base = vec![1.5f32; w * h];
@@ -589,10 +592,7 @@ fn search_equals_its_definition_pooled_or_not() {
     // re-search offsets and a top-level range; both kernels of the unpooled search.
     let (w, h) = (45usize, 37usize);
     let (left, right) = (texture(w, h, 0.0, 5), texture(w, h, 3.4, 5));
-    let chans: Vec<_> = DEFAULT_ORIENTATIONS
-        .iter()
-        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
-        .collect();
+    let chans = channels(&DEFAULT_ORIENTATIONS);
     let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
     let rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
     let base: Vec<f32> = (0..w * h)
@@ -808,10 +808,7 @@ fn level_data_holds_the_responses_demodulated_and_their_frequency_phasors() {
     // every third |y|^2 as the percentile sample.
     let (w, h) = (29usize, 7usize);
     let img = texture(w, h, 0.0, 11);
-    let chans: Vec<_> = [0.0f32, 60.0, -60.0]
-        .iter()
-        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
-        .collect();
+    let chans = channels(&DEFAULT_ORIENTATIONS);
     let fb = filter::filter_bank(&img.data, w, h, &chans).unwrap();
     for right in [false, true] {
         let ld = level_data(&img.data, w, h, &chans, 1.25, right).unwrap();
@@ -877,10 +874,7 @@ fn stability_bits_follow_the_fleet_jepson_test() {
     // Re psi = (ln |y(x+1)|^2 - ln |y(x-1)|^2) / 4; never on the first and last columns.
     let (w, h) = (40usize, 6usize);
     let img = texture(w, h, 0.0, 21);
-    let chans: Vec<_> = [0.0f32, 60.0]
-        .iter()
-        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
-        .collect();
+    let chans = channels(&DEFAULT_ORIENTATIONS[..2]);
     let tau = 0.6;
     let ld = level_data(&img.data, w, h, &chans, tau, false).unwrap();
     let (mut set, mut clear) = (0, 0);
@@ -935,10 +929,7 @@ fn newton_step_equals_its_definition() {
     // libm; pixels within rounding of a threshold are skipped.
     let (w, h) = (31usize, 6usize);
     let (left, right) = (texture(w, h, 0.0, 8), texture(w, h, 2.6, 8));
-    let chans: Vec<_> = [0.0f32, 60.0, -60.0]
-        .iter()
-        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
-        .collect();
+    let chans = channels(&DEFAULT_ORIENTATIONS);
     let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
     let rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
     let cc = level::chan_consts(&chans, &ld, &rd, 0.4);
@@ -1033,10 +1024,7 @@ fn amplitude_thresholds_are_relative_to_the_95th_percentile() {
     // +-60 degrees share a kx slot.
     let (w, h) = (30usize, 8usize);
     let (left, right) = (texture(w, h, 0.0, 4), texture(w, h, 1.0, 4));
-    let chans: Vec<_> = [0.0f32, 60.0, -60.0]
-        .iter()
-        .map(|&t| filter::Channel::new(0.25, t, 1.5, 1.0).unwrap())
-        .collect();
+    let chans = channels(&DEFAULT_ORIENTATIONS);
     let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
     let rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
     let cc = level::chan_consts(&chans, &ld, &rd, 0.3);
