@@ -1166,3 +1166,96 @@ def test_saved_yaml_holds_opencvs_shapes_and_every_field(tmp_path: Path) -> None
         assert fs.getNode("unit").string() == "m" and fs.getNode("rectified").real() == 0
     finally:
         fs.release()
+
+
+# ------------------------------------------------------ rectification geometry (mutation audit)
+
+
+def test_rectify_refuses_a_transposed_image() -> None:
+    """A portrait 240x320 image for a 320x240 calibration holds the same number of pixels; it
+    is refused naming both sizes, not remapped into a landscape picture of the wrong pixels."""
+    c = raw_calib()
+    good = np.zeros((240, 320), np.uint8)
+    with pytest.raises(
+        ValueError, match="right: image is 240x320, calibration image_size is 320x240"
+    ):
+        c.rectify(good, np.zeros((320, 240), np.uint8))
+
+
+def test_rectify_points_lands_where_the_raw_camera_sees_it_far_off_axis() -> None:
+    """A rectified point, turned back by R1^T and projected with K1/D1, is the raw pixel it
+    came from, to 1e-4 px even in a strongly distorted corner (OpenCV's default 5 iterations
+    leave more there)."""
+    c = raw_calib(D1=np.array([-0.45, 0.25, 0.0, 0.0, -0.08]))
+    raw = np.array([[2.0, 2.0], [317.0, 3.0], [5.0, 236.0], [300.0, 230.0], [160.0, 120.0]])
+    rect = c.rectify_points(raw, "left")
+    r1, _, p1, _, _ = c._stereo_rectify(0.0)
+    f, cx, cy = p1[0, 0], p1[0, 2], p1[1, 2]
+    rays = np.column_stack(
+        [(rect[:, 0] - cx) / f, (rect[:, 1] - cy) / p1[1, 1], np.ones(len(rect))]
+    )
+    back = cv2.projectPoints(rays @ r1, np.zeros(3), np.zeros(3), c.K1, c.D1)[0].reshape(-1, 2)
+    np.testing.assert_allclose(back, raw, atol=1e-4)
+
+
+def test_rectified_calibration_keeps_the_unit() -> None:
+    """A raw rig in millimetres rectifies to a millimetre pair: same baseline in metres, and the
+    same depths as the rig given in metres (T read as metres would put them 1000x too far)."""
+    metres = raw_calib()
+    mm = raw_calib(T=metres.T * 1000.0, unit="mm")
+    rc = mm.rectified_calibration()
+    assert rc.unit == "mm"
+    assert rc.baseline_m == pytest.approx(metres.baseline_m, rel=1e-9)
+    disp = np.array([[10.0, 25.0]])
+    np.testing.assert_allclose(
+        mm.depth_from_disparity(disp), metres.depth_from_disparity(disp), rtol=1e-6
+    )
+    np.testing.assert_allclose(
+        mm.depth_from_disparity(disp, unit="mm"),
+        1000.0 * metres.depth_from_disparity(disp),
+        rtol=1e-6,
+    )
+
+
+def test_to_camera_frame_of_a_rectified_rig_returns_a_copy() -> None:
+    """As for a raw rig, the result is a new array: writing to it leaves the caller's points."""
+    pts = np.array([[0.1, 0.2, 1.5]])
+    out = rect_calib().to_camera_frame(pts)
+    out[0, 0] = 99.0
+    assert pts[0, 0] == 0.1
+
+
+def test_from_q_keeps_a_positive_doffs(tmp_path: Path) -> None:
+    """A Q written from a rectified rig with doffs (cx2 - cx1 = 12.5 px) reads back as that rig:
+    K2's cx on the right side of K1's, same Q, same depths."""
+    k1 = np.array([[500.0, 0.0, 150.0], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]])
+    k2 = k1.copy()
+    k2[0, 2] = 162.5
+    rig = rect_calib(K1=k1, K2=k2, T=np.array([-0.1, 0.0, 0.0]), unit="m")
+    (tmp_path / "Q.dat").write_text("\n".join(" ".join(repr(float(v)) for v in r) for r in rig.Q))
+    back = Calibration.from_q(tmp_path / "Q.dat", SIZE)
+    assert back.doffs_px == pytest.approx(12.5, abs=1e-9)
+    np.testing.assert_allclose(back.K2, k2, atol=1e-9)
+    np.testing.assert_allclose(back.Q, rig.Q, atol=1e-9)
+
+
+@pytest.mark.parametrize(("f", "inv_b"), [(0.0, 10.0), (500.0, 0.0)])
+def test_from_q_refuses_a_zero_focal_length_or_inverse_baseline(
+    tmp_path: Path, f: float, inv_b: float
+) -> None:
+    """Q[2,3] = 0 or Q[3,2] = 0 gives no depth: named as such (Q[3,2] = 0 was 1/0 otherwise)."""
+    (tmp_path / "Q.dat").write_text(f"1 0 0 -5\n0 1 0 -4\n0 0 0 {f}\n0 0 {inv_b} 0\n")
+    with pytest.raises(ValueError, match=r"Q\[2,3\] \(focal length .*must be positive"):
+        Calibration.from_q(tmp_path / "Q.dat", (10, 8))
+
+
+def test_fit_to_frames_refuses_a_two_percent_crop() -> None:
+    """Aspect ratios 1 % apart are the limit: 160x117 for 320x240 (2.5 % apart) is a crop,
+    160x119 (0.8 %) a scaling."""
+    from stereovision.calibration import fit_to_frames
+
+    c = raw_calib()
+    with pytest.raises(ValueError, match="another aspect ratio"):
+        fit_to_frames(c, (160, 117))
+    scaled, note = fit_to_frames(c, (160, 119))
+    assert scaled.image_size == (160, 119) and note is not None
