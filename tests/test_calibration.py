@@ -107,8 +107,11 @@ def test_bad_values_name_the_field(field: str, value: object, message: str) -> N
         ({"T": np.array([-100.0, 1.0, 0.0])}, r"T: a rectified calibration needs T = \(-B"),
         ({"T": np.array([100.0, 0.0, 0.0])}, "T: T\\[0\\] must be negative"),
         ({"D1": np.array([0.1, 0, 0, 0, 0])}, "D1: a rectified calibration has no distortion"),
+        ({"T": np.array([-100.0, 0.0, 1.0])}, r"T: a rectified calibration needs T = \(-B"),
         ({"K2": np.array([[510.0, 0, 160], [0, 500, 120], [0, 0, 1]])}, "K2: fx"),
+        ({"K2": np.array([[500.0, 0, 160], [0, 500, 121], [0, 0, 1]])}, "K2: cy = 121 differs"),
         ({"doffs": 4.0}, r"doffs: 4.0 differs from cx2 - cx1 = 0.0"),
+        ({"doffs": 0.01}, r"doffs: 0.01 differs from cx2 - cx1 = 0.0"),
         ({"doffs": float("nan")}, "doffs: expected a finite number"),
         # an OverflowError naming no field ("int too large to convert to float")
         (
@@ -146,6 +149,9 @@ def test_equality() -> None:
     with pytest.warns(UserWarning, match="shorter than any stereo rig"):
         assert raw_calib() != raw_calib(unit="mm")
     assert raw_calib() != raw_calib(T=np.array([-0.13, 0.0, 0.0]))
+    # a given doffs is a field: within its 2e-3 px tolerance of cx2 - cx1, yet another value
+    assert rect_calib(doffs=0.001) == rect_calib(doffs=0.001)
+    assert rect_calib(doffs=0.001) != rect_calib() != rect_calib(doffs=0.0)
 
 
 # ---------------------------------------------------------------------------------- round trips
@@ -1259,3 +1265,20 @@ def test_fit_to_frames_refuses_a_two_percent_crop() -> None:
         fit_to_frames(c, (160, 117))
     scaled, note = fit_to_frames(c, (160, 119))
     assert scaled.image_size == (160, 119) and note is not None
+
+
+def test_an_ideal_rigs_principal_point_is_the_image_centre() -> None:
+    """Pixel centres run 0 .. w - 1, so the centre of a 1280x720 image is (639.5, 359.5); a
+    90 degree field of view over 1280 px is f = 640 px."""
+    paper = Calibration.ideal((1280, 720), 90.0, 0.12)
+    np.testing.assert_allclose(
+        paper.K1, [[640.0, 0.0, 639.5], [0.0, 640.0, 359.5], [0.0, 0.0, 1.0]], rtol=1e-12
+    )
+    assert paper.doffs_px == 0.0 and paper.baseline_m == 0.12
+
+
+def test_rectify_points_of_no_points_on_a_raw_rig() -> None:
+    """An empty (0, 2) list (a tracker that lost every feature) gives an empty (0, 2) list."""
+    for c in (raw_calib(), rect_calib()):
+        out = c.rectify_points(np.zeros((0, 2)), "right")
+        assert out.shape == (0, 2) and out.dtype == np.float64
