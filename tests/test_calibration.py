@@ -1282,3 +1282,23 @@ def test_rectify_points_of_no_points_on_a_raw_rig() -> None:
     for c in (raw_calib(), rect_calib()):
         out = c.rectify_points(np.zeros((0, 2)), "right")
         assert out.shape == (0, 2) and out.dtype == np.float64
+
+
+def test_depth_from_disparity_in_every_unit() -> None:
+    """A rig in inches gives depths in metres by default and in any unit asked: 1 in =
+    0.0254 m, 1 ft = 0.3048 m, 1 cm = 0.01 m exactly."""
+    inches = rect_calib(T=np.array([-5.0, 0.0, 0.0]), unit="in")  # 5 in = 0.127 m
+    assert inches.baseline_m == pytest.approx(0.127, rel=1e-12)
+    disp = np.array([[10.0, 50.0]])
+    z_m = inches.depth_from_disparity(disp)
+    np.testing.assert_allclose(z_m, 500.0 * 0.127 / disp, rtol=1e-6)
+    for unit, metres in (("in", 0.0254), ("ft", 0.3048), ("cm", 0.01), ("mm", 0.001)):
+        np.testing.assert_allclose(
+            inches.depth_from_disparity(disp, unit=unit), z_m / metres, rtol=1e-6
+        )
+
+
+def test_describe_field_of_view_runs_edge_to_edge() -> None:
+    """8 px at f = 4 px about a centred principal point (3.5) span 90 degrees: from the left
+    edge (-0.5) to the right one (7.5), not to the last pixel's far side."""
+    assert "field of view 90.0 x 73.7 degrees" in Calibration.ideal((8, 6), 90.0, 0.1).describe()
