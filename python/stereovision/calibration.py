@@ -299,9 +299,9 @@ def _pixels(value: object, what: str) -> int:
 
 def _check_alpha(alpha: object, *, any_finite: bool = False) -> None:
     """A ``ValueError`` naming ``alpha`` unless it is a real number in ``[0, 1]`` (any finite
-    one with ``any_finite``: :meth:`Calibration.rectified_calibration` passes OpenCV's -1, its
-    default scaling): ``"1"`` and None were a TypeError from the comparison ("'<=' not supported
-    between instances of 'float' and 'str'"), True was read as 1."""
+    one with ``any_finite``: :meth:`Calibration.rectified_calibration` passes OpenCV's -1, a
+    pinhole rig's default scaling): ``"1"`` and None were a TypeError from the comparison
+    ("'<=' not supported between instances of 'float' and 'str'"), True was read as 1."""
     real = isinstance(alpha, (int, float, np.integer, np.floating)) and not isinstance(
         alpha, (bool, np.bool_)
     )
@@ -799,7 +799,9 @@ class Calibration:
         ----------
         alpha : float
             ``cv2.stereoRectify`` free scaling, as given to :meth:`rectify`: 0 keeps only valid
-            pixels, 1 keeps all pixels.
+            pixels, 1 keeps all pixels. Any finite number is passed on, so that OpenCV's -1
+            (its default scaling) works on a pinhole rig; a fisheye rig's balance takes values
+            outside [0, 1] as the nearer end (-1 gives the focal length of 0).
 
         Returns
         -------
