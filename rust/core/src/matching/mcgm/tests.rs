@@ -753,6 +753,14 @@ fn area_check_keeps_the_true_disparity_and_rejects_one_pixel_off() {
     assert!((off_kept as f32) < 0.05 * n as f32, "{off_kept} of {n}");
     // Windows leaving the image, and flat windows, have no ZNCC: rejected.
     assert!(!area_ok(&l, &r, &at(2.0, 50.0, 0.0), 0.5));
+    // The best of the five at either end is no peak: rejected (2 px off either way).
+    for dd in [d - 2.0, d + 2.0] {
+        let n_kept = (20..190)
+            .step_by(5)
+            .filter(|&x| area_ok(&l, &r, &at(x as f32 + 0.3, 70.0, dd), 0.5))
+            .count();
+        assert!(n_kept <= 1, "{dd}: {n_kept}");
+    }
     let flat = Image::filled(200, 150, 0.5);
     assert!(!area_ok(&flat, &flat, &at(100.0, 50.0, 0.0), 0.5));
 }
@@ -1753,4 +1761,242 @@ fn candidates_reach_across_the_band_and_the_wider_segment_slack() {
     let got = run(a, &b, (0, 3), &at);
     assert_eq!(got.len(), 1);
     assert_eq!(got[0].score, 0.3);
+}
+
+/// One match at `(xl, yl)` of disparity `d` on the same row.
+fn match_at(xl: f32, yl: f32, d: f32) -> Match {
+    Match {
+        xl,
+        yl,
+        xr: xl - d,
+        yr: yl,
+        score: 1.0,
+        channel: 0,
+    }
+}
+
+/// The both-sides check's half-windows are columns `xi +- (gap + 1 ..= gap + width)` of the
+/// rounded left x and rows `yl +- height / 2`, inside the image; a MAD equal to `sides_mad`
+/// passes. On flat images a match passes unless one window column is brightened.
+#[test]
+fn both_sides_windows_have_the_specified_columns_rows_and_limit() {
+    let (w, h) = (40, 30);
+    let f = FilterParams {
+        sides_best: false,
+        disc: false,
+        zncc_check: false,
+        ..FilterParams::default()
+    };
+    let kept = |left: &Image, m: Match, f: &FilterParams| {
+        let r = Image::filled(w, h, 0.5);
+        edge_filters(left, &r, &[m], f, (0, 16)).unwrap().0[0]
+    };
+    let flat = Image::filled(w, h, 0.5);
+    // Column `c` of rows 12..=18 brightened by 0.4: a mean-free MAD of 2 * 0.4 * 5 / 36.
+    let bright = |c: usize| {
+        let mut img = Image::filled(w, h, 0.5);
+        for y in 12..=18 {
+            img.data[y * w + c] = 0.9;
+        }
+        img
+    };
+    let m = match_at(20.0, 15.0, 0.0);
+    for (c, expect) in [
+        (19, true), // the skipped gap column
+        (21, true),
+        (18, false), // the first window column
+        (22, false),
+        (13, false), // the last window column
+        (27, false),
+        (12, true), // just outside
+        (28, true),
+    ] {
+        assert_eq!(kept(&bright(c), m, &f), expect, "column {c}");
+    }
+    // xl 20.6 rounds to 21: columns 23..=28 on the right.
+    assert!(!kept(&bright(28), match_at(20.6, 15.0, 0.0), &f));
+    assert!(kept(&bright(22), match_at(20.6, 15.0, 0.0), &f));
+    // A MAD of exactly sides_mad (0 here) passes.
+    let f0 = FilterParams {
+        sides_mad: 0.0,
+        ..f
+    };
+    assert!(kept(&flat, m, &f0));
+    // Rows yl +- 3 and columns xi +- 7 must lie inside the image.
+    for (x, y, expect) in [
+        (20.0, 3.0, true),
+        (20.0, 2.0, false),
+        (20.0, 26.0, true),
+        (20.0, 27.0, false),
+        (7.0, 15.0, true),
+        (6.0, 15.0, false),
+        (32.0, 15.0, true),
+        (33.0, 15.0, false),
+    ] {
+        assert_eq!(kept(&flat, match_at(x, y, 0.0), &f), expect, "({x}, {y})");
+    }
+    // The left rows alone leaving the image.
+    let low = Match {
+        yr: 26.0,
+        ..match_at(20.0, 27.0, 0.0)
+    };
+    assert!(!kept(&flat, low, &f));
+}
+
+#[test]
+fn median_lower_takes_the_lower_middle_value() {
+    assert_eq!(median_lower(&mut [4.0, 1.0, 3.0, 2.0]), Some(2.0));
+    assert_eq!(median_lower(&mut [5.0, 1.0, 3.0]), Some(3.0));
+    assert_eq!(median_lower(&mut []), None);
+}
+
+/// `sides_best` compares only the disparities `d + k` (integer `k`, `|k| > 1`) inside the
+/// searched range: noise shifted by 3 px, a match at 5.5 with range 4..=6 has nothing to
+/// compare (3.5 lies below 4) and is kept; with range 3..=6 it finds 3.5 better.
+#[test]
+fn both_sides_best_compares_only_disparities_inside_the_range() {
+    let (w, h) = (60, 30);
+    let mut next = unit_rng(7);
+    let l: Vec<f32> = (0..w * h).map(|_| next()).collect();
+    let r: Vec<f32> = (0..w * h)
+        .map(|i| {
+            let (x, y) = (i % w, i / w);
+            l[y * w + (x + 3).min(w - 1)]
+        })
+        .collect();
+    let (l, r) = (Image::new(w, h, l).unwrap(), Image::new(w, h, r).unwrap());
+    let f = FilterParams {
+        sides_mad: 1.0,
+        disc: false,
+        zncc_check: false,
+        ..FilterParams::default()
+    };
+    for x in [20.0f32, 25.0, 30.0] {
+        let m = [match_at(x, 15.0, 5.5)];
+        assert!(edge_filters(&l, &r, &m, &f, (4, 6)).unwrap().0[0], "{x}");
+        assert!(!edge_filters(&l, &r, &m, &f, (3, 6)).unwrap().0[0], "{x}");
+    }
+}
+
+/// The discontinuity filter drops both matches of a pair within +- disc_dx columns and
+/// +- disc_dy rows whose disparities differ by more than (not exactly) disc_tol.
+#[test]
+fn discontinuity_filter_neighbourhood_and_tolerance() {
+    let img = Image::filled(40, 30, 0.5);
+    let f = FilterParams {
+        sides: false,
+        zncc_check: false,
+        ..FilterParams::default()
+    };
+    let base = match_at(20.0, 15.0, 5.0);
+    for (x, y, d, expect) in [
+        (26.0, 15.0, 6.0, [true, true]), // a difference of exactly disc_tol
+        (26.0, 15.0, 6.5, [false, false]),
+        (14.0, 15.0, 6.5, [false, false]),
+        (27.0, 15.0, 7.0, [true, true]), // disc_dx + 1 columns away
+        (13.0, 15.0, 7.0, [true, true]),
+        (20.0, 17.0, 6.5, [false, false]),
+        (20.0, 13.0, 6.5, [false, false]),
+        (20.0, 18.0, 6.5, [true, true]), // disc_dy + 1 rows away
+        (20.0, 12.0, 6.5, [true, true]),
+    ] {
+        let ms = [base, match_at(x, y, d)];
+        let (keep, counts) = edge_filters(&img, &img, &ms, &f, (0, 16)).unwrap();
+        assert_eq!(keep, expect, "({x}, {y}) d {d}");
+        assert_eq!(counts.disc, expect.iter().filter(|&&k| k).count());
+    }
+}
+
+/// A segment's disparity window: the lower median of the prior at its pixels' centres in
+/// full-resolution pixels (`2 x + 1` at half resolution), divided by the scale, floor / ceil
+/// of `+- width`, clipped to the channel's range.
+#[test]
+fn windows_equal_the_lower_median_of_the_prior_at_pixel_centres() {
+    let p = McgmParams::default();
+    let half = blobs(60, 45, 0.0);
+    let cc = channel_curves(&half, 2.0, 2, &p).unwrap();
+    assert!(cc.curves.segments.len() > 5);
+    let (fw, fh) = (120, 90);
+    let map: Vec<f32> = (0..fw * fh)
+        .map(|i| 20.0 + ((i % fw * 7 + i / fw * 13) % 23) as f32 * 0.37)
+        .collect();
+    let sp = SpreadPrior::new(&map, fw, fh, 0).unwrap();
+    let width = CHANNEL_WIDTH_SIGMAS * 2.0;
+    let got = windows(&cc, Some(&sp), fw, width, 0, 40);
+    let mut n_even = 0;
+    for (seg, g) in cc.curves.segments.iter().zip(&got) {
+        let mut v: Vec<f32> = seg
+            .pixels
+            .iter()
+            .map(|&i| {
+                let (x, y) = (i as usize % 60, i as usize / 60);
+                map[(2 * y + 1) * fw + 2 * x + 1] / 2.0
+            })
+            .collect();
+        v.sort_by(f32::total_cmp);
+        n_even += usize::from(v.len() % 2 == 0);
+        let med = v[(v.len() - 1) / 2];
+        let want = ((med - width).floor() as i32, (med + width).ceil() as i32);
+        assert_eq!(*g, Some(want));
+    }
+    assert!(n_even > 0);
+}
+
+#[test]
+fn channel_geometry_and_track_lengths_follow_sigma() {
+    let p = McgmParams::default();
+    assert_eq!(channel_geometry(4.0, &p), (2.0, 2));
+    assert_eq!(channel_geometry(3.9, &p), (3.9, 1));
+    // max(min_len 8, ceil(4 sigma)).
+    assert_eq!(p.track_params(2.3).min_len, 10);
+    assert_eq!(p.track_params(1.0).min_len, 8);
+}
+
+/// End to end: the half-resolution channel is a prior only (its full range `0..=ceil(15 / 2)`,
+/// its matches at pixel centres `2 y + 0.5`); the next channel's windows come from that prior
+/// spread by `ceil(4 * 4)` px; matches of different channels on a row are > fill_radius apart.
+#[test]
+fn channel_prior_and_combination_follow_the_definitions() {
+    let (l, r) = (blobs(200, 150, 0.0), blobs(200, 150, 3.3));
+    let p = McgmParams {
+        d_max: 15,
+        ..McgmParams::default()
+    };
+    let out = mcgm_match(&l, &r, &p).unwrap();
+    let c0 = &out.channels[0];
+    assert_eq!(c0.scale, 2);
+    assert!(!c0.windows.is_empty() && c0.windows.iter().all(|w| *w == Some((0, 8))));
+    assert!(!c0.matches.is_empty());
+    assert!(c0.matches.iter().all(|m| m.yl.fract() == 0.5));
+    assert!(out.matches.iter().all(|m| m.channel != 0));
+    // Channel 1's windows from channel 0's matches.
+    let (fw, fh) = (200, 150);
+    let mut map = vec![f32::NAN; fw * fh];
+    for m in &c0.matches {
+        map[m.yl.round() as usize * fw + m.xl.round() as usize] = m.xl - m.xr;
+    }
+    let sp = SpreadPrior::new(&map, fw, fh, 16).unwrap();
+    let cc = &image_curves(&l, &p).unwrap()[1];
+    let want = windows(cc, Some(&sp), fw, p.prior_width_sigmas * cc.sigma, 0, 15);
+    assert_eq!(out.channels[1].windows, want);
+    // Combination: no two channels' matches within fill_radius on a row.
+    let mut by_row: std::collections::HashMap<i32, Vec<(i32, u8)>> = Default::default();
+    for m in &out.matches {
+        by_row
+            .entry(m.yl.round() as i32)
+            .or_default()
+            .push((m.xl.round() as i32, m.channel));
+    }
+    let mut n_mixed = 0;
+    for row in by_row.values() {
+        for a in row {
+            for b in row {
+                if a.1 != b.1 {
+                    n_mixed += 1;
+                    assert!((a.0 - b.0).abs() > p.fill_radius, "{a:?} {b:?}");
+                }
+            }
+        }
+    }
+    assert!(n_mixed > 0);
 }
