@@ -261,3 +261,102 @@ fn median_by_selection_equals_the_sorted_median() {
         );
     }
 }
+
+/// A neuron of point `point` at left `(x, y)` with disparity `d` (same row).
+fn neuron(point: u32, (x, y): (i32, i32), d: i32, sub: f32, edge_ok: bool) -> Neuron {
+    Neuron {
+        point,
+        xl: x,
+        yl: y,
+        xr: x - d,
+        yr: y,
+        sim: 0.9,
+        edge_ok,
+        halves_fail: u8::from(!edge_ok),
+        centre_ok: true,
+        sub,
+    }
+}
+
+#[test]
+fn parabola_vertex_is_the_clamped_offset_and_zero_without_a_peak() {
+    // Vertex of (-1, 0.5), (0, 1), (1, 0.7): 0.5 (0.5 - 0.7) / (0.5 - 2 + 0.7) = 0.125.
+    assert!((parabola(0.5, 1.0, 0.7) - 0.125).abs() < 1e-6);
+    assert!((parabola(0.7, 1.0, 0.5) + 0.125).abs() < 1e-6);
+    assert_eq!(parabola(1.0, 1.0, 0.5), -0.5);
+    // Flat or a valley: no offset.
+    assert_eq!(parabola(1.0, 1.0, 1.0), 0.0);
+    assert_eq!(parabola(1.0, 0.5, 1.0), 0.0);
+}
+
+#[test]
+fn initial_state_switches_on_the_best_candidate_at_or_above_s_init() {
+    let mut ns = vec![
+        neuron(0, (10, 10), 3, 0.0, true),
+        neuron(0, (10, 10), 5, 0.0, true),
+        neuron(1, (20, 10), 3, 0.0, true),
+    ];
+    (ns[0].sim, ns[1].sim, ns[2].sim) = (0.8, 0.8, 0.79);
+    let p = HopfieldParams::default();
+    assert_eq!(initial_state(&ns, &p), [1, 0, 0]);
+    let all = HopfieldParams {
+        init_best: false,
+        ..p
+    };
+    assert_eq!(initial_state(&ns, &all), [1, 1, 0]);
+}
+
+/// Neighbour agreement of [`finish`]: at least `min_agree` agreeing others (the match itself
+/// not counted), or, in sparse areas, `agree_share` of the others; matches at `x - (d + sub)`.
+#[test]
+fn finish_keeps_matches_with_enough_agreeing_neighbours() {
+    let img = Image::filled(400, 200, 0.5);
+    let v = ImageView::from(&img);
+    // Dense: 9 matches, each with exactly min_agree = 8 agreeing others.
+    let dense: Vec<Neuron> = (0..9)
+        .map(|k| neuron(k, (100 + 2 * k as i32, 100), 10, 0.25, true))
+        .collect();
+    let chosen: Vec<usize> = (0..dense.len()).collect();
+    let p = HopfieldParams {
+        agree_share: 0.0,
+        ..HopfieldParams::default()
+    };
+    let out = finish(&v, &v, &dense, &chosen, &p);
+    assert_eq!(out.len(), 9);
+    assert!(out.iter().all(|m| m.xl - m.xr == 10.25 && m.yl == m.yr));
+    // Sparse: 5 agreeing and one outlier; 4 of 5 others agree (exactly the 0.8 share).
+    let mut sparse: Vec<Neuron> = (0..5)
+        .map(|k| neuron(k, (300 + 2 * k as i32, 100), 10, 0.0, true))
+        .collect();
+    sparse.push(neuron(5, (310, 100), 20, 0.0, true));
+    let chosen: Vec<usize> = (0..sparse.len()).collect();
+    let out = finish(&v, &v, &sparse, &chosen, &HopfieldParams::default());
+    let xs: Vec<f32> = out.iter().map(|m| m.xl).collect();
+    assert_eq!(xs, [300.0, 302.0, 304.0, 306.0, 308.0]);
+}
+
+/// Side rescue: a match failing its left half (centre check passed) is kept when at least
+/// `rescue_min` accepted matches lie strictly left of it in the window, all within `agree_tol`
+/// of it, their median sub-pixel disparity within `rescue_med`; a match failing the centre
+/// check is never rescued. All three limits are met exactly here.
+#[test]
+fn rescue_keeps_a_half_failure_backed_by_its_side() {
+    let side = |x0: i32, first: u32| -> Vec<Neuron> {
+        [(x0 - 10, 100), (x0 - 8, 100), (x0 - 6, 104)]
+            .iter()
+            .enumerate()
+            .map(|(k, &xy)| neuron(first + k as u32, xy, 11, -0.25, true))
+            .collect()
+    };
+    let mut ns = vec![neuron(0, (100, 100), 10, 0.0, false)];
+    ns.extend(side(100, 1));
+    // Same column, other surface: on no side of the left half.
+    ns.push(neuron(4, (100, 110), 30, 0.0, true));
+    let mut no_centre = neuron(5, (300, 100), 10, 0.0, false);
+    no_centre.centre_ok = false;
+    ns.push(no_centre);
+    ns.extend(side(300, 6));
+    let chosen: Vec<usize> = (0..ns.len()).collect();
+    let ok = rescue(&ns, &chosen, &HopfieldParams::default());
+    assert_eq!(ok, [true, true, true, true, true, false, true, true, true]);
+}
