@@ -360,3 +360,81 @@ fn rescue_keeps_a_half_failure_backed_by_its_side() {
     let ok = rescue(&ns, &chosen, &HopfieldParams::default());
     assert_eq!(ok, [true, true, true, true, true, false, true, true, true]);
 }
+
+/// C.5 disambiguation: a point's single active neuron is kept (not its inactive ones); of
+/// several, the one whose vertical disparity is closest to the window's singles' median
+/// (here 0), then the higher similarity; none farther than `tau_y` (1 px: kept).
+#[test]
+fn disambiguation_keeps_singles_and_picks_by_vertical_disparity_then_similarity() {
+    let at = |point: u32, x: i32, d: i32, dy: i32, sim: f32| Neuron {
+        yr: 100 - dy,
+        sim,
+        ..neuron(point, (x, 100), d, 0.0, true)
+    };
+    let ns = vec![
+        at(0, 100, 10, 0, 0.9),
+        at(0, 100, 12, 0, 0.85),
+        at(1, 104, 10, 0, 0.9),
+        at(1, 104, 15, 0, 0.8),
+        at(2, 108, 10, 0, 0.9),
+        at(3, 112, 10, 0, 0.9),
+        at(4, 116, 10, 1, 0.9),
+        at(4, 116, 12, -2, 0.95),
+    ];
+    let state = [1, 1, 1, 0, 1, 1, 1, 1];
+    let p = HopfieldParams::default();
+    let net = Network::new(&ns, &p.weights);
+    assert_eq!(disambiguate(&ns, &net, &state, &p), [0, 2, 4, 5, 6]);
+}
+
+/// `right = 0.5 left(x + d) + 0.2` (an exposure offset): the centre check, on window-mean-free
+/// grey levels, passes at the true disparity.
+#[test]
+fn centre_check_ignores_an_exposure_offset() {
+    let (l, r) = shifted_pair(120, 80, 6);
+    let scale = |img: &Image, off: f32| {
+        Image::new(
+            img.width,
+            img.height,
+            img.data.iter().map(|v| 0.5 * v + off).collect(),
+        )
+        .unwrap()
+    };
+    let (l, r) = (scale(&l, 0.1), scale(&r, 0.3));
+    let (_, ns) = candidate_neurons(&l, &r, &params(16)).unwrap();
+    let at_true: Vec<&Neuron> = ns.iter().filter(|n| n.dx() == 6).collect();
+    assert!(at_true.len() > 50, "{}", at_true.len());
+    assert!(at_true.iter().all(|n| n.centre_ok));
+}
+
+/// A fractional shift (3.4, 3.6 px: the full window's peak at one integer, a half's at the
+/// other): the half-window test accepts a half's best within `edge_tol` = 1 px either way.
+#[test]
+fn half_window_test_accepts_a_best_one_pixel_away() {
+    for wt in [0.6f32, 0.4] {
+        let (w, h) = (120, 80);
+        let base = texture(w + 5, h, 11);
+        let l: Vec<f32> = (0..w * h)
+            .map(|i| base[(i / w) * (w + 5) + i % w])
+            .collect();
+        let r: Vec<f32> = (0..w * h)
+            .map(|i| {
+                let o = (i / w) * (w + 5) + i % w;
+                wt * base[o + 3] + (1.0 - wt) * base[o + 4]
+            })
+            .collect();
+        let (l, r) = (Image::new(w, h, l).unwrap(), Image::new(w, h, r).unwrap());
+        let p = params(16);
+        let (_, ns) = candidate_neurons(&l, &r, &p).unwrap();
+        let best: Vec<&Neuron> = ns
+            .iter()
+            .enumerate()
+            .filter(|&(a, n)| a == 0 || ns[a - 1].point != n.point)
+            .map(|(_, n)| n)
+            .collect();
+        let ok = best.iter().filter(|n| n.halves_fail == 0).count();
+        // With edge_tol 0, 14 (wt 0.6) and 25 (wt 0.4) of the 451 fail.
+        assert!(best.len() > 400);
+        assert_eq!(ok, best.len());
+    }
+}
