@@ -438,3 +438,37 @@ fn half_window_test_accepts_a_best_one_pixel_away() {
         assert_eq!(ok, best.len());
     }
 }
+
+/// Fallback of thin surfaces: lone points (one candidate, edge test passed, no support, all
+/// off) come back when more than `min_agree` = 8 of them (each counting itself) agree.
+#[test]
+fn group_fallback_needs_more_than_min_agree_agreeing_lone_points() {
+    let p = HopfieldParams::default();
+    for (n, expect) in [(8u32, 0u8), (9, 1)] {
+        let ns: Vec<Neuron> = (0..n)
+            .map(|k| neuron(k, (100 + 2 * k as i32, 100), 10, 0.0, true))
+            .collect();
+        let net = Network::new(&ns, &p.weights);
+        let out = fallback(&ns, &net, &vec![0; ns.len()], &p);
+        assert!(out.iter().all(|&s| s == expect), "{n}: {out:?}");
+    }
+}
+
+/// The sub-pixel offset is computed up to `d = d_hi - 1` (both neighbours of the peak in the
+/// range): the same with `d_max` one above the true disparity as with a wide range.
+#[test]
+fn subpixel_offset_reaches_the_last_disparity_but_one() {
+    let (l, r) = shifted_pair(120, 80, 6);
+    let (_, narrow) = candidate_neurons(&l, &r, &params(7)).unwrap();
+    let (_, wide) = candidate_neurons(&l, &r, &params(16)).unwrap();
+    let at6 = |ns: &[Neuron]| -> Vec<(i32, i32, f32)> {
+        ns.iter()
+            .filter(|n| n.dx() == 6 && n.xl >= 20)
+            .map(|n| (n.xl, n.yl, n.sub))
+            .collect()
+    };
+    let (a, b) = (at6(&narrow), at6(&wide));
+    assert!(a.len() > 50);
+    assert_eq!(a, b);
+    assert!(a.iter().any(|t| t.2 != 0.0));
+}
