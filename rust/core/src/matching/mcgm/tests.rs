@@ -2000,3 +2000,41 @@ fn channel_prior_and_combination_follow_the_definitions() {
     }
     assert!(n_mixed > 0);
 }
+
+/// B.4.12: a left curve pixel takes the right segment's crossing on its row nearest to
+/// `x - tx`, only within half a channel width (`sqrt 2 sigma`). Right shifted by 2.2 px: with
+/// `tx` = 2.2 most pixels find their crossing, with `tx` = 0 none of those 2.2 px away counts.
+#[test]
+fn decompose_searches_half_a_channel_width_around_the_translation() {
+    let p = McgmParams::default();
+    let lc = channel_curves(&blobs(100, 80, 0.0), 1.0, 1, &p).unwrap();
+    let rc = channel_curves(&blobs(100, 80, 2.2), 1.0, 1, &p).unwrap();
+    let half = 0.5 * CHANNEL_WIDTH_SIGMAS;
+    for tx in [2.2f32, 0.0] {
+        let cands: Vec<Candidate> = (0..lc.curves.segments.len())
+            .flat_map(|i| {
+                (0..rc.curves.segments.len()).map(move |j| Candidate {
+                    left: i as u32,
+                    right: j as u32,
+                    score: 1.0,
+                    tx,
+                    ty: 0.0,
+                })
+            })
+            .collect();
+        let chosen: Vec<usize> = (0..cands.len()).collect();
+        let ms = decompose(&lc, &rc, &cands, &chosen, p.horiz_skip_deg, 2);
+        assert!(ms.iter().all(|m| m.yl == m.yr && m.channel == 2));
+        assert!(
+            ms.iter().all(|m| (m.xr - (m.xl - tx)).abs() <= half),
+            "tx {tx}"
+        );
+        if tx > 0.0 {
+            let near = ms
+                .iter()
+                .filter(|m| (m.xl - m.xr - 2.2).abs() < 0.3)
+                .count();
+            assert!(near > 100, "{near}");
+        }
+    }
+}
