@@ -509,8 +509,11 @@ def test_uniqueness_and_gamma_are_refused_in_the_callers_names() -> None:
         ({"gamma": float("nan")}, r"^gamma: expected a finite number, got nan$"),
         ({"gamma": float("inf")}, r"^gamma: expected a finite number, got inf$"),
         ({"gamma": "16"}, r"^gamma: expected a finite number, got '16'$"),
+        # past float32's range the kernel's own message said "got inf" of a finite 1e300
+        ({"gamma": 1e39}, r"^gamma: 1e\+39 is beyond the kernel's 32-bit float range"),
     )
     for kw, msg in bad:
         with pytest.raises(ValueError, match=msg):
             sgm_disparity(img, img, max_disparity=8, **kw)
     assert sgm_disparity(img, img, max_disparity=8, uniqueness=100, gamma=1e-3).shape == img.shape
+    assert sgm_disparity(img, img, max_disparity=8, gamma=3e38).shape == img.shape

@@ -51,6 +51,7 @@ _MAX_LEVELS = 2048  # the kernel's limit
 # The kernel's P2 limit (`MAX_P2` in sgm.rs: eight path costs of OUTSIDE + p2 fit a u16 sum); it
 # also wants 0 < p1 < p2, so p1 is at most MAX_P2 - 1 and p2 at least 2.
 _MAX_P2 = 4000
+_F32_MAX = float(np.finfo(np.float32).max)  # gamma reaches the kernel as an f32
 _I32_LIMIT = 2**31 - 1  # |min_disparity|, |max_disparity| below it: the kernel's i32 levels
 
 
@@ -195,6 +196,11 @@ def sgm_disparity(
     gamma = finite_number(p["gamma"], "gamma")
     if not gamma > 0:
         raise ValueError(f"gamma: expected a positive number, got {p['gamma']!r}")
+    if gamma > _F32_MAX:  # the kernel's f32 made it inf, and said "got inf"
+        raise ValueError(
+            f"gamma: {p['gamma']!r} is beyond the kernel's 32-bit float range "
+            f"(at most {_F32_MAX:.4g})"
+        )
     if isinstance(p["paths"], bool) or p["paths"] not in (3, 8):
         raise ValueError(f"paths: expected 8 or 3, got {p['paths']!r}")
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
