@@ -60,17 +60,25 @@ def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
 def test_closed_pipe_stops_quietly(tmp_path: Path) -> None:
     """`stereovision demo | head -1`: the reader goes away while the pipeline runs; the CLI
     stops with 141 (128 + SIGPIPE, as a shell reports) and prints no error."""
-    proc = subprocess.Popen(
-        [*SV, "demo", "-o", str(tmp_path / "demo")],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    assert proc.stdout is not None and proc.stderr is not None
-    assert proc.stdout.readline().startswith("demo scene:")
-    proc.stdout.close()  # before the results are printed (the pipeline takes a fraction of a s)
-    err = proc.stderr.read()
-    assert proc.wait(timeout=120) == 141 and err == "", err
+    codes = []
+    # The pipe is closed a fraction of a second before the results are printed; on a loaded
+    # machine the demo can finish first (exit 0, nothing to test), so up to three tries.
+    for attempt in range(3):
+        proc = subprocess.Popen(
+            [*SV, "demo", "-o", str(tmp_path / f"demo{attempt}")],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        assert proc.stdout is not None and proc.stderr is not None
+        assert proc.stdout.readline().startswith("demo scene:")
+        proc.stdout.close()
+        err = proc.stderr.read()
+        codes.append(proc.wait(timeout=120))
+        assert codes[-1] in (0, 141) and err == "", (codes, err)
+        if codes[-1] == 141:
+            break
+    assert codes[-1] == 141, codes
 
 
 def test_warnings_are_one_line(tmp_path: Path, data_dir: Path) -> None:
