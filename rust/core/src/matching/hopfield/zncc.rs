@@ -823,18 +823,22 @@ mod tests {
     use super::*;
     use crate::image::Image;
 
+    /// Xorshift noise in [0, 1), one stream per seed.
+    fn unit_noise(mut s: u64) -> impl FnMut() -> f32 {
+        move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
     #[test]
     fn avx2_and_portable_curves_are_bit_identical() {
         if !has_avx2() {
             return; // nothing to compare on this CPU
         }
-        let mut s = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = unit_noise(0x2545_f491_4f6c_dd1d);
         let (w, h) = (90, 20);
         let left = Image::new(w, h, (0..w * h).map(|_| next()).collect()).expect("valid");
         let left = left.view();
@@ -870,13 +874,7 @@ mod tests {
         if !has_avx2() {
             return; // nothing to compare on this CPU
         }
-        let mut s = 0x5851_f42d_4c95_7f2du64;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = unit_noise(0x5851_f42d_4c95_7f2d);
         let (mut a, mut b) = (Curves::default(), Curves::default());
         for w in (7..=70usize).chain([127, 128, 129, 140]) {
             for h in [7usize, 9] {
@@ -907,13 +905,7 @@ mod tests {
 
     #[test]
     fn row_peaks_match_the_scalar_definition() {
-        let mut s = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = unit_noise(0x9e37_79b9_7f4a_7c15);
         let mut got = Vec::new();
         // Every length 1..=70 (the 8-wide interior tests: 10 = LANES + 2 and up) and a few
         // longer ones.
@@ -960,13 +952,7 @@ mod tests {
     /// left image is the right one shifted by 3 px, scaled, with noise added (and the same
     /// patch, so textureless left windows occur too).
     fn scalar_pair(w: usize, h: usize) -> (Vec<f32>, Vec<f32>) {
-        let mut s = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = unit_noise(0x2545_f491_4f6c_dd1d);
         let patch = |x: usize, y: usize| (10..22).contains(&x) && (4..13).contains(&y);
         let flat = |x: usize, y: usize| 0.5 + ((x + 2 * y) % 3) as f32 * 6e-4;
         let right: Vec<f32> = (0..w * h)
