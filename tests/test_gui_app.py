@@ -626,7 +626,6 @@ def test_a_later_success_clears_an_error_and_a_scene_can_be_chosen_again(data_di
     """A failed camera open left the toolbar on "error" while the old results stayed; a later
     successful Check rows now clears it. Choosing the scene on show again after files were
     loaded reloaded nothing: trame reports only a changed choice."""
-    import asyncio
 
     pytest.importorskip("trame")
     from trame.app import get_server
@@ -643,17 +642,13 @@ def test_a_later_success_clears_an_error_and_a_scene_can_be_chosen_again(data_di
     app.state.method = "fast"
     app._spawn = lambda coro: coro.close()  # no server loop here: computed by hand below
 
-    async def run(action) -> None:
-        app._lock = app._lock or asyncio.Lock()
-        await action()
-
     app._on_scene(scene=str(cones))
-    asyncio.run(run(app.recompute))
+    _run(app, app.recompute)
     assert app.state.status == "ready" and app.state.computations == 1
     app.state.cam_left, app.state.cam_right = "cones/none.mp4", "cones/none.mp4"
     app.open_cameras()
     assert app.state.status == "error" and app.state.error.startswith("no such file")
-    asyncio.run(run(app.check_rows))
+    _run(app, app.check_rows)
     assert app.state.status == "ready" and app.state.error == ""
     assert app.state.rows_label.startswith("rectification ok")
 
@@ -665,6 +660,15 @@ def test_a_later_success_clears_an_error_and_a_scene_can_be_chosen_again(data_di
     app._on_scene(scene=str(cones))
     assert app.state.source_label == "scene data/cones"
     assert not np.array_equal(app.pair[0], app.pair[1])
+
+
+def _queue_spawns(app, tasks: list) -> None:
+    """Inside a running loop: a lock of that loop, and the computations the app spawns queued
+    in ``tasks`` as futures (to be awaited by the test)."""
+    import asyncio
+
+    app._lock = asyncio.Lock()
+    app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
 
 
 def _scene_app(name: str, folders: list[Path], **kw):
@@ -906,8 +910,7 @@ def test_a_scene_chosen_during_a_computation_is_not_shown_the_previous_result(tm
     choose = _chooser(app, tmp_path)
 
     async def run() -> None:
-        app._lock = asyncio.Lock()
-        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        _queue_spawns(app, tasks)
         choose("first")
         await asyncio.gather(*tasks)
         choose("second")
@@ -947,8 +950,7 @@ def test_a_new_pair_does_not_show_the_previous_pairs_results_while_it_computes(t
     choose = _chooser(app, tmp_path)
 
     async def run() -> None:
-        app._lock = asyncio.Lock()
-        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        _queue_spawns(app, tasks)
         choose("cones")
         await asyncio.gather(*tasks)
         await app.find_floor()
@@ -2166,8 +2168,7 @@ def test_rectify_and_check_rows_of_a_pair_replaced_meanwhile_are_dropped(data_di
         started.clear()
         gate.clear()
         tasks.clear()
-        app._lock = asyncio.Lock()  # one per event loop
-        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        _queue_spawns(app, tasks)
         app._grab()
         running = asyncio.ensure_future(action())
         await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
@@ -2213,8 +2214,7 @@ def test_a_floor_found_for_a_pair_replaced_meanwhile_is_dropped(data_dir, monkey
         app._on_scene(scene=str(scene))
 
     async def run() -> None:
-        app._lock = asyncio.Lock()
-        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        _queue_spawns(app, tasks)
         choose(first)
         await asyncio.gather(*tasks)
         floor = asyncio.ensure_future(app.find_floor())
@@ -2904,8 +2904,7 @@ def test_toggles_during_a_computation_and_a_failure_keep_the_unit(tmp_path):
     choose = _chooser(app, tmp_path)
 
     async def run() -> None:
-        app._lock = asyncio.Lock()
-        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        _queue_spawns(app, tasks)
         choose("cones")
         await asyncio.gather(*tasks)
         await app.find_floor()
@@ -3039,8 +3038,7 @@ def test_a_pair_superseded_while_it_fails_leaves_the_newer_choice_and_the_page(t
     seen: dict = {}
 
     async def run() -> None:
-        app._lock = asyncio.Lock()
-        app._spawn = lambda coro: tasks.append(asyncio.ensure_future(coro))
+        _queue_spawns(app, tasks)
         choose("cones")
         await asyncio.gather(*tasks)
         choose("tiny")  # fails, but "other" is chosen while it runs
