@@ -575,6 +575,46 @@ def number_shown(value: object) -> str:
     return too_large_for_float(value) or _shown(value)
 
 
+def pixels_shown(value: float) -> str:
+    """A number of pixels for a message: every digit of a whole number up to 12 digits
+    (``:g`` showed 3e10 + 48 as "3e+10"), a fraction as given (16.5), beyond that 12 digits; an
+    int beyond a float's range (match's min_disparity of 10**400) by its size: ``:g`` of it is an
+    OverflowError."""
+    return too_large_for_float(value, why=False) or f"{value:.12g}"
+
+
+def unreachable_range(min_disparity: float, max_disparity: float, width: int) -> ValueError | None:
+    """The error of a range no pixel of a ``width`` px wide pair can match in, or None.
+
+    A match ``xr = xl - d`` needs both columns in the image, so ``|d| < width``: a
+    ``min_disparity`` at the width or above (or a ``max_disparity`` at minus the width or
+    below) searched nothing and returned an all-NaN map, or a float32 kernel parameter error
+    ("invalid parameter `d_max`") for a range beyond float32's resolution (3e10 to 3e10 + 16).
+    """
+    if min_disparity >= width:
+        return ValueError(
+            f"min_disparity ({pixels_shown(min_disparity)}) is not below the image width "
+            f"{width}: no pixel has a match that far to its left in the right image; give a "
+            f"min_disparity below {width}"
+        )
+    if max_disparity <= -width:
+        return ValueError(
+            f"max_disparity ({pixels_shown(max_disparity)}) is not above minus the image width "
+            f"(-{width}): no pixel has a match that far to its right in the right image; give "
+            f"a max_disparity above -{width}"
+        )
+    return None
+
+
+def refuse_unreachable_range(min_disparity: float, max_disparity: float, width: int) -> None:
+    """Raise :func:`unreachable_range`'s error, if any: the matchers' own entry points refuse
+    such a range as ``match()`` and ``depth_map`` do (their kernels clip the range to the image
+    and return nothing without a word)."""
+    err = unreachable_range(min_disparity, max_disparity, width)
+    if err is not None:
+        raise err
+
+
 def first_line(exc: BaseException) -> str:
     """What a one-line error message says of ``exc``: its message's first line (its type's
     name if empty), as the CLI, the GUI and the stream print errors.

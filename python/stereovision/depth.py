@@ -30,8 +30,9 @@ from stereovision._validate import (
     as_gray_float,
     check_pair,
     finite_number,
-    too_large_for_float,
+    unreachable_range,
 )
+from stereovision._validate import pixels_shown as _px
 from stereovision.calibration import Calibration
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -188,37 +189,6 @@ def _finite(v: float) -> bool:
         return math.isfinite(v)
     except OverflowError:
         return False
-
-
-def _px(value: float) -> str:
-    """A number of pixels for a message: every digit of a whole number up to 12 digits
-    (``:g`` showed 3e10 + 48 as "3e+10"), a fraction as given (16.5), beyond that 12 digits; an
-    int beyond a float's range (match's min_disparity of 10**400) by its size: ``:g`` of it is an
-    OverflowError."""
-    return too_large_for_float(value, why=False) or f"{value:.12g}"
-
-
-def _unreachable_range(min_disparity: float, max_disparity: float, width: int) -> ValueError | None:
-    """The error of a range no pixel of a ``width`` px wide pair can match in, or None.
-
-    A match ``xr = xl - d`` needs both columns in the image, so ``|d| < width``: a
-    ``min_disparity`` at the width or above (or a ``max_disparity`` at minus the width or
-    below) searched nothing and returned an all-NaN map, or a float32 kernel parameter error
-    ("invalid parameter `d_max`") for a range beyond float32's resolution (3e10 to 3e10 + 16).
-    """
-    if min_disparity >= width:
-        return ValueError(
-            f"min_disparity ({_px(min_disparity)}) is not below the image width {width}: no "
-            f"pixel has a match that far to its left in the right image; give a min_disparity "
-            f"below {width}"
-        )
-    if max_disparity <= -width:
-        return ValueError(
-            f"max_disparity ({_px(max_disparity)}) is not above minus the image width "
-            f"(-{width}): no pixel has a match that far to its right in the right image; give "
-            f"a max_disparity above -{width}"
-        )
-    return None
 
 
 def _too_narrow(width: int, automatic_range: float, min_disparity: float = 0) -> ValueError:
@@ -1346,7 +1316,7 @@ def depth_map(
         # "max_disparity (16) must be larger than min_disparity (20)" named a value never given;
         # "give a max_disparity above 100" to a min_disparity no pixel reaches sent the caller
         # to the error below
-        unreachable = _unreachable_range(min_disparity, math.inf, gl.shape[1])
+        unreachable = unreachable_range(min_disparity, math.inf, gl.shape[1])
         if unreachable is not None:
             raise unreachable
         raise ValueError(
@@ -1362,7 +1332,7 @@ def depth_map(
         # a range the caller never gave: the image is the problem (the automatic range is at
         # least 16 px, so 16 px wide images and narrower are refused)
         raise _too_narrow(gl.shape[1], max_disparity - min_disparity, min_disparity)
-    unreachable = _unreachable_range(min_disparity, max_disparity, gl.shape[1])
+    unreachable = unreachable_range(min_disparity, max_disparity, gl.shape[1])
     if unreachable is not None:
         raise unreachable
     if max_disparity - min_disparity >= gl.shape[1]:

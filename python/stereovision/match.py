@@ -7,12 +7,17 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import as_bgr_uint8, check_pair, finite_number, too_large_for_float
+from stereovision._validate import (
+    as_bgr_uint8,
+    check_pair,
+    finite_number,
+    refuse_unreachable_range,
+    too_large_for_float,
+)
 from stereovision.calibration import Calibration
 from stereovision.depth import (
     _rectify_grey,
     _rig_to_warp_by,
-    _unreachable_range,
     estimate_max_disparity,
 )
 from stereovision.matches import Matches
@@ -152,14 +157,12 @@ def _refuse_unreachable(
         return
     if hi < lo and not automatic:
         return
-    err = _unreachable_range(lo, hi, width)
-    if err is not None:
-        raise err
+    refuse_unreachable_range(lo, hi, width)
 
 
 def _bound(value: object, name: str) -> float:
     """``value`` as a finite float (:func:`finite_number`), or an int beyond a float's range as
-    it is (exact comparisons with the width; :func:`_unreachable_range` shows its size)."""
+    it is (exact comparisons with the width; ``_validate.unreachable_range`` shows its size)."""
     if too_large_for_float(value):
         return value  # type: ignore[return-value]
     return finite_number(value, name)

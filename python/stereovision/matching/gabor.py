@@ -23,6 +23,7 @@ from stereovision._validate import (
     disparity_range,
     float_sized,
     refuse_unknown,
+    refuse_unreachable_range,
     renamed_keyword,
 )
 
@@ -154,13 +155,7 @@ def gabor_disparity(
     if lft.shape != rgt.shape:
         raise ValueError(f"left {lft.shape} and right {rgt.shape} images differ in shape")
     lo, hi = disparity_range(min_disparity, max_disparity)
-    # match()'s error for a range no pixel can match in (the kernel searched nothing and
-    # returned an all-NaN map without a word); depth imports the matchers, hence here
-    from stereovision.depth import _unreachable_range
-
-    err = _unreachable_range(lo, hi, lft.shape[1])
-    if err is not None:
-        raise err
+    refuse_unreachable_range(lo, hi, lft.shape[1])
     # the kernel's limits, in the caller's names (they were its own: "invalid parameter `d_max`:
     # must be finite, got inf" for 1e300, float32's inf)
     if hi - lo > MAX_RANGE:

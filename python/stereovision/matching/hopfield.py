@@ -30,6 +30,7 @@ from stereovision._validate import (
     int_in_range,
     luma_weights,
     refuse_unknown,
+    refuse_unreachable_range,
     too_large_for_float,
     u8_pair,
 )
@@ -204,17 +205,6 @@ def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) 
     return {**DEFAULTS, **params, "min_disparity": lo, "max_disparity": hi}
 
 
-def _refuse_unreachable(min_disparity: float, max_disparity: float, width: int) -> None:
-    """match()'s ValueError for a range no pixel of a ``width`` px pair can match in (the
-    kernel clipped it to the image and returned 0 matches without a word)."""
-    # depth imports the matchers (through fusion): imported here, not at the top
-    from stereovision.depth import _unreachable_range
-
-    err = _unreachable_range(min_disparity, max_disparity, width)
-    if err is not None:
-        raise err
-
-
 def _run(
     method: str,
     left: npt.ArrayLike,
@@ -227,7 +217,7 @@ def _run(
     if pair is None:
         gl, gr = check_pair(left, right)
         kw = _params(max_disparity, min_disparity, params)
-        _refuse_unreachable(min_disparity, max_disparity, gl.shape[1])
+        refuse_unreachable_range(min_disparity, max_disparity, gl.shape[1])
         kw["method"] = method
         m, trace, stats = _core.hopfield_match(gl, gr, kw)
         shape = gl.shape
@@ -235,7 +225,7 @@ def _run(
         # 8-bit input (camera frames): the grey conversion runs in the kernel's call, with the
         # same values as check_pair's (no float32 intermediates).
         kw = _params(max_disparity, min_disparity, params)
-        _refuse_unreachable(min_disparity, max_disparity, pair[0].shape[1])
+        refuse_unreachable_range(min_disparity, max_disparity, pair[0].shape[1])
         kw["method"] = method
         m, trace, stats = _core.hopfield_match_u8(pair[0], pair[1], luma_weights(), kw)
         shape = pair[0].shape

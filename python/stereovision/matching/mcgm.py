@@ -31,6 +31,7 @@ from stereovision._validate import (
     check_pair,
     float_sized,
     refuse_unknown,
+    refuse_unreachable_range,
     too_large_for_float,
 )
 from stereovision.matches import Matches
@@ -347,13 +348,7 @@ def mcgm_match(
     """
     gl, gr = check_pair(left, right)
     kw = _params(max_disparity, min_disparity, params)
-    # match()'s ValueError for a range no pixel can match in (the kernel clipped it to the
-    # image and returned 0 matches without a word); depth imports the matchers, hence here
-    from stereovision.depth import _unreachable_range
-
-    err = _unreachable_range(min_disparity, max_disparity, gl.shape[1])
-    if err is not None:
-        raise err
+    refuse_unreachable_range(min_disparity, max_disparity, gl.shape[1])
     m, stats, chans = _core.mcgm_match(gl, gr, kw)
     st: dict[str, Any] = dict(stats)
     st["channel"] = m[:, 5].astype(np.int64)

@@ -19,7 +19,13 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import _core
-from stereovision._validate import as_gray_float, check_pair, finite_number, float_sized
+from stereovision._validate import (
+    as_gray_float,
+    check_pair,
+    finite_number,
+    float_sized,
+    refuse_unreachable_range,
+)
 
 __all__ = ["DEFAULTS", "sgm_disparity"]
 
@@ -204,13 +210,7 @@ def sgm_disparity(
     if isinstance(p["paths"], bool) or p["paths"] not in (3, 8):
         raise ValueError(f"paths: expected 8 or 3, got {p['paths']!r}")
     gl, gr = check_pair(as_gray_float(left, "left"), as_gray_float(right, "right"))
-    # depth_map's error for a range no pixel can match in (the kernel searched nothing and
-    # returned an all-NaN map without a word); depth imports the matchers, hence here
-    from stereovision.depth import _unreachable_range
-
-    err = _unreachable_range(min_disparity, max_disparity, gl.shape[1])
-    if err is not None:
-        raise err
+    refuse_unreachable_range(min_disparity, max_disparity, gl.shape[1])
     levels = math.ceil(max_disparity) - math.floor(min_disparity) + 1
     if levels > _MAX_LEVELS:
         # the kernel's own message named its `d_max` ("the range holds 8192 levels; at most
