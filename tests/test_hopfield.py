@@ -484,3 +484,18 @@ def test_direct_call_refuses_an_unreachable_range_as_match_does(
         run(l8, r8, max_disparity=80, min_disparity=80)
     # one column short of the width is searched: nothing there, 0 matches and no error
     assert len(run(left, right, max_disparity=79, min_disparity=79, min_agree=0)) == 0
+
+
+def test_candidates_refuse_an_unreachable_range_as_match_does() -> None:
+    """hopfield_candidates with min_disparity at the width or above returned an empty (0, 6)
+    array without a word (the kernel clips the range to the image); it now raises match()'s
+    ValueError, and one column short of the width still returns without error."""
+    rng = np.random.default_rng(0)
+    left = rng.random((60, 80), dtype=np.float32)
+    right = np.roll(left, -5, axis=1)
+    for lo in (80, 81.5, 10**400):
+        with pytest.raises(ValueError) as want:
+            sv.match(left, right, method="hopfield", max_disparity=lo, min_disparity=lo)
+        with pytest.raises(ValueError, match=f"^{re.escape(str(want.value))}$"):
+            hp.hopfield_candidates(left, right, max_disparity=lo, min_disparity=lo)
+    assert hp.hopfield_candidates(left, right, max_disparity=79, min_disparity=79).shape[1] == 6

@@ -736,3 +736,24 @@ def test_direct_call_refuses_an_unreachable_range_as_match_does() -> None:
             mcgm.mcgm_match(left, right, max_disparity=lo, min_disparity=lo)
     # one column short of the width is searched: nothing there, 0 matches and no error
     assert len(mcgm.mcgm_match(left, right, max_disparity=79, min_disparity=79)) == 0
+
+
+def test_reference_and_filters_refuse_an_unreachable_range_as_match_does() -> None:
+    """zncc_reference and edge_filters with min_disparity at the width or above: the reference
+    returned 0 matches and the filters kept every match (their ``sides_best`` range was empty),
+    both without a word. Both now raise match()'s ValueError; one column short of the width is
+    still searched."""
+    rng = np.random.default_rng(0)
+    left = rng.random((60, 80), dtype=np.float32)
+    right = np.roll(left, -5, axis=1)
+    one = np.array([[40.0, 30.0, 35.0, 30.0]], np.float32)
+    for lo in (80, 81.5, 10**400):
+        with pytest.raises(ValueError) as want:
+            sv.match(left, right, method="mcgm", max_disparity=lo, min_disparity=lo)
+        says = f"^{re.escape(str(want.value))}$"
+        with pytest.raises(ValueError, match=says):
+            mcgm.zncc_reference(left, right, max_disparity=lo, min_disparity=lo)
+        with pytest.raises(ValueError, match=says):
+            mcgm.edge_filters(left, right, one, max_disparity=lo, min_disparity=lo)
+    assert len(mcgm.zncc_reference(left, right, max_disparity=79, min_disparity=79)) == 0
+    assert mcgm.edge_filters(left, right, one, max_disparity=79, min_disparity=79).shape == (1,)

@@ -364,6 +364,13 @@ def hopfield_candidates(
     -------
     numpy.ndarray
         ``(M, 6)`` float32, one row per candidate: ``[point, xl, yl, xr, yr, zncc]``.
+
+    Raises
+    ------
+    ValueError
+        As :func:`hopfield_match` (a ``min_disparity`` not below the image width included).
     """
     gl, gr = check_pair(left, right)
-    return _core.hopfield_candidates(gl, gr, _params(max_disparity, min_disparity, params))
+    kw = _params(max_disparity, min_disparity, params)
+    refuse_unreachable_range(min_disparity, max_disparity, gl.shape[1])
+    return _core.hopfield_candidates(gl, gr, kw)

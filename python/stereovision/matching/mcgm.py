@@ -403,7 +403,8 @@ def edge_filters(
     Raises
     ------
     ValueError
-        Bad images, a matches array not of shape ``(N, 4)``, an unknown parameter, or a match
+        Bad images, a matches array not of shape ``(N, 4)``, an unknown parameter, a
+        ``min_disparity`` not below the image width (as :func:`stereovision.match`), or a match
         that is no match of this pair: a NaN or infinite coordinate, or a point outside the
         images (beyond the outer pixels' edges, ``-0.5 .. W - 0.5`` and ``-0.5 .. H - 0.5``).
         The filters used to keep such rows when switched off and drop them otherwise.
@@ -428,7 +429,9 @@ def edge_filters(
             f"matches: {int(out.sum())} of {len(arr)} rows lie outside the {w}x{h} images "
             f"(row {i}: {_row(arr[i])})"
         )
-    return _core.mcgm_filter(gl, gr, arr, _params(max_disparity, min_disparity, params))
+    kw = _params(max_disparity, min_disparity, params)
+    refuse_unreachable_range(min_disparity, max_disparity, w)
+    return _core.mcgm_filter(gl, gr, arr, kw)
 
 
 def _row(m: npt.NDArray[np.float32]) -> str:
@@ -483,10 +486,16 @@ def zncc_reference(
     -------
     Matches
         ``score`` = the ZNCC.
+
+    Raises
+    ------
+    ValueError
+        As :func:`mcgm_match` (a ``min_disparity`` not below the image width included).
     """
     gl, gr = check_pair(left, right)
     kw = _params(max_disparity, min_disparity, params)
     h, w = gl.shape
+    refuse_unreachable_range(min_disparity, max_disparity, w)
     if pixels is None:
         mask = np.zeros((h, w), dtype=bool)
         min_cos = np.sin(np.deg2rad(kw["horiz_skip_deg"]))
