@@ -893,8 +893,8 @@ def fused_dense(
     Raises
     ------
     ValueError
-        Maps of different shapes, a negative radius / tolerance, ``fill_confidence`` outside
-        [0, 1] or ``second_confidence`` outside (0, 1] (0 is the filled pixels' mark).
+        Maps of different shapes, a negative radius / tolerance, ``fill_confidence`` or
+        ``second_confidence`` outside (0, 1] (0 is the filled pixels' mark).
     """
     d = _check_map(disparity, "disparity", None)
     shape = (int(d.shape[0]), int(d.shape[1]))
@@ -915,10 +915,11 @@ def fused_dense(
     ):
         if finite_number(v, name) < 0:
             raise ValueError(f"{name}: expected a non-negative number, got {v}")
-    if not 0 <= fill_confidence <= 1:
-        raise ValueError(f"fill_confidence: expected a value in [0, 1], got {fill_confidence}")
     # Confidence 0 marks a filled disparity (DepthResult.depth_counts, point_image(filled=True)):
-    # 0 here would mark every pixel only the census map measured as filled.
+    # 0 here would mark as such the anchor-filled pixels, which get a depth (a member's value),
+    # or every pixel only the census map measured.
+    if not 0 < fill_confidence <= 1:
+        raise ValueError(f"fill_confidence: expected a value in (0, 1], got {fill_confidence}")
     if not 0 < second_confidence <= 1:
         raise ValueError(f"second_confidence: expected a value in (0, 1], got {second_confidence}")
     out = d.copy()
