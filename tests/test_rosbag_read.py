@@ -1066,6 +1066,25 @@ def test_a_camera_info_with_a_region_of_interest_is_refused(cones: Any, tmp_path
             assert cam.calibration().image_size == (450, 375)
 
 
+def test_a_camera_info_with_a_half_zero_region_of_interest_is_refused(
+    cones: Any, tmp_path: Path
+) -> None:
+    """ROS reads a roi of all zeros as the full image; one with a width and no height (or the
+    reverse) is malformed, and was taken for the full image without a word (the check needed
+    both sizes). It is refused naming the topic and the roi."""
+    cams = tuple(parse_ros_camera_info(t) for t in _raw_rig().to_ros())
+    frames = [(T0, cones.left, T0, cones.right)]
+    for name, roi in (("no_height", (0, 0, 450, 0)), ("no_width", (10, 20, 0, 100))):
+        bag = write_bag(tmp_path / name, frames, infos=cams, roi=roi)
+        with BagCamera(bag) as cam, pytest.raises(ValueError) as err:
+            cam.calibration()
+        assert str(err.value) == (
+            f"/stereo/left/camera_info: camera_info has a malformed region of interest "
+            f"({roi[2]}x{roi[3]} at {roi[0]},{roi[1]}): a zero width or height alone describes "
+            "no region (ROS's all-zero roi means the full image)"
+        )
+
+
 def test_the_default_tolerance_is_half_the_faster_topics_period(cones: Any, tmp_path: Path) -> None:
     """Left at 25 fps, right at 16.7 fps: max_skew_ms is half the left's 40 ms period (the
     median of the first PERIOD_SAMPLE steps: a frame 5 ms late and a missing one, an 80 ms

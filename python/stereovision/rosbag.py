@@ -1205,7 +1205,8 @@ class BagCamera(PairSource):
         ------
         ValueError
             If a ``camera_info`` is not a stereo camera's (no baseline), its model is not
-            supported, it describes a region of interest (named), or the two bin differently.
+            supported, it describes a region of interest (named) or a malformed one (a zero
+            width or height alone), or the two bin differently.
         """
         from stereovision.calibration import Calibration, _ros_yaml
 
@@ -1227,6 +1228,13 @@ class BagCamera(PairSource):
             K, R, P = K.reshape(3, 3), R.reshape(3, 3), P.reshape(3, 4)
             roi = msg.roi
             size = (int(msg.width), int(msg.height))
+            # ROS: a roi of all zeros is the full image; a zero width or height alone is none
+            if bool(roi.width) != bool(roi.height):
+                raise ValueError(
+                    f"{topic}: camera_info has a malformed region of interest ({roi.width}x"
+                    f"{roi.height} at {roi.x_offset},{roi.y_offset}): a zero width or height "
+                    "alone describes no region (ROS's all-zero roi means the full image)"
+                )
             if roi.width and roi.height and (roi.width, roi.height) != size:
                 raise ValueError(
                     f"{topic}: camera_info has a region of interest ({roi.width}x{roi.height} at "
