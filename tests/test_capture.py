@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import itertools
 import os
+import re
 import subprocess
 import sys
 import threading
@@ -1336,6 +1337,31 @@ def test_the_same_source_on_both_sides_is_said(
     argv = ["stream", "--left", "/dev/video7", "--right", str(link), "--no-display"]
     assert main([*argv, "--frames", "1"]) == 2
     assert capsys.readouterr().err.startswith("stereovision: error: --left '/dev/video7' and")
+    assert not (tmp_path / "x").exists()
+
+
+def test_a_negative_camera_index_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--left -1` was taken for a file and refused as "left source not found: -1"; the index
+    -1 itself (OpenCV's "any camera", no side of a rig) crashed the process in
+    cv2.VideoCapture(-1) with no camera present (a segmentation fault). Both say what is wrong.
+    `--left ²` (a digit to str.isdigit, no number to int) was "invalid literal for int()"."""
+    from stereovision.cli import main
+
+    says = "camera index {0} is negative: cameras are numbered from 0 (./{0} for a file)"
+    for text in ("-1", " -2 ", -1):
+        n = int(text)
+        with pytest.raises(ValueError, match=f"^{re.escape(says.format(n))}$"):
+            parse_source(text)
+    with pytest.raises(ValueError, match=r"^left source: camera index -1 is negative"):
+        StereoCamera(-1, 0)
+    assert parse_source("²") == "²" and parse_source(" 3 ") == 3 and parse_source("-x") == "-x"
+    argv = ["capture", "--left", "-1", "--right", "0", "-o", str(tmp_path / "x")]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == f"stereovision: error: {says.format(-1)}\n"
+    assert main(["capture", "--left", "²", "--right", "0", "-o", str(tmp_path / "x")]) == 2
+    assert capsys.readouterr().err == "stereovision: error: left source not found: ²\n"
     assert not (tmp_path / "x").exists()
 
 

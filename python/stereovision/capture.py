@@ -202,6 +202,10 @@ def _source_error(message: str, kwargs: dict[str, Any]) -> SourceError:
 # --------------------------------------------------------------------------------- parsing
 
 
+def _negative_index(n: int) -> str:
+    return f"camera index {n} is negative: cameras are numbered from 0 (./{n} for a file)"
+
+
 def parse_source(text: str | int) -> int | str:
     """A device index for an all-digit string (``"0"`` -> ``0``), else the text (file/pattern).
 
@@ -214,10 +218,21 @@ def parse_source(text: str | int) -> int | str:
     -------
     int or str
         The device index, or ``text`` unchanged (a video file, an image pattern, a URL).
+
+    Raises
+    ------
+    ValueError
+        A negative index (``-1`` or ``"-1"``): OpenCV's -1 is "any camera", no side of a rig,
+        and crashes the process where no camera is present; as text it was taken for a file.
     """
     if isinstance(text, int):
+        if text < 0:
+            raise ValueError(_negative_index(text))
         return text
-    return int(text) if text.strip().isdigit() else text
+    # isdecimal, not isdigit: "²" is a digit that int() refuses ("invalid literal for int()")
+    if re.fullmatch(r"-\d+", text.strip(), re.ASCII):
+        raise ValueError(_negative_index(int(text)))
+    return int(text) if text.strip().isdecimal() else text
 
 
 #: Largest frame side accepted for ``--size`` (16K video is 15360 px wide).
@@ -717,6 +732,8 @@ class StereoCamera(PairSource):
                 cap: Any = _open_path(path)
             self._sequence[side] = cap.isOpened() and cap.getBackendName() == "CV_IMAGES"
         elif isinstance(src, (int, np.integer)):
+            if src < 0:  # cv2.VideoCapture(-1) crashes the process when no camera is present
+                raise ValueError(f"{side} source: {_negative_index(int(src))}")
             with _opencv_quiet():
                 cap = cv2.VideoCapture(int(src))
         else:
