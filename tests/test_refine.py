@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import os
 import subprocess
 import sys
@@ -295,3 +296,53 @@ def test_bit_identical_across_thread_counts(data_dir: Path, tmp_path: Path) -> N
         )
         outs.append(np.load(f))
     np.testing.assert_array_equal(outs[0], outs[1])
+
+
+def test_defaults_are_the_references() -> None:
+    """:data:`DEFAULTS` mirror ``RefineParams::default`` and the NumPy reference: a drifted
+    default (``fills`` min_score 0.35, ``base_sigma`` 4.5) moved every refined map while the
+    parity tests, which pass the module's defaults to the kernel, still passed."""
+    sig = inspect.signature(refine_ref.refine_disparity).parameters
+    assert DEFAULTS == {k: sig[k].default for k in DEFAULTS}
+
+
+def test_var_floor_and_fill_confidence_reach_the_kernel(data_dir: Path) -> None:
+    """Overrides of ``var_floor`` and ``fill_confidence`` are the kernel's: parity with the
+    reference at 1e-5 and 0.5, and the default's map is not within its tolerance of it."""
+    left, right, disp, conf, dmax = _crop_inputs(data_dir)
+    kw = {"var_floor": 1e-5, "fill_confidence": 0.5}
+    out = refine_disparity(left, right, disp, conf, max_disparity=dmax, **kw)
+    ref = refine_ref.refine_disparity(left, right, disp, conf, 0.0, dmax, **kw)
+    assert _within(_compare(ref, out)), _compare(ref, out)
+    default = refine_disparity(left, right, disp, conf, max_disparity=dmax)
+    assert not _within(_compare(ref, default))
+    filled = np.isnan(disp) & np.isfinite(out.disparity)
+    assert filled.sum() > 100 and np.all(out.confidence[filled] == np.float32(0.5))
+
+
+def test_confidence_default_one_zero_allowed_and_inf_is_a_hole() -> None:
+    """Without a confidence every refined pixel carries 1 (the documented default); a
+    confidence of 0 is in [0, 1] and is carried over; an infinite disparity is a hole like NaN,
+    so its confidence is not read (NaN allowed there)."""
+    rng = np.random.default_rng(0)
+    left = rng.random((40, 60), dtype=np.float32)
+    right = np.roll(left, -3, axis=1)
+    d = np.full(left.shape, 3.0, np.float32)
+    d[:, ::9] = np.nan
+    d[5, :] = np.inf
+    res = refine_disparity(left, right, d, max_disparity=8)
+    refined = np.isfinite(d) & np.isfinite(res.disparity)
+    assert refined.sum() > 1500
+    assert np.all(res.confidence[refined] == 1.0)
+    conf = np.where(np.isfinite(d), 0.0, np.nan).astype(np.float32)
+    zero = refine_disparity(left, right, d, conf, max_disparity=8)
+    np.testing.assert_array_equal(zero.disparity, res.disparity)
+    assert np.all(zero.confidence[refined] == 0.0)
+
+
+def test_empty_images_and_a_confidence_of_another_shape_are_named() -> None:
+    a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    with pytest.raises(ValueError, match=r"left must be a non-empty 2-D \(H, W\) array"):
+        refine_disparity(a[:0], a[:0], a[:0], max_disparity=8)
+    with pytest.raises(ValueError, match=r"confidence \(20, 5\) and disparity \(20, 30\) differ"):
+        refine_disparity(a, a, a, a[:, :5], max_disparity=8)
