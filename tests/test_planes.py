@@ -432,3 +432,75 @@ def test_side_fill_tau_and_one_channel_image() -> None:
     img[0, :4] = 100
     np.testing.assert_array_equal(side_fill(d, img, blur=0, tau=200)[0], [5, 5, 2, 2, 2, 2])
     np.testing.assert_array_equal(side_fill(d, img[:, :, None], blur=0), side_fill(d, img, blur=0))
+
+
+def test_segments_step_one_empty_image_and_fractional_step() -> None:
+    """A step of 1 is a bin per grey level (the ``>= 1`` bound is inclusive); an empty image is
+    named; a fractional step bins a uint8 image as it bins the same floats (the uint8 kernel
+    takes whole steps: 2.5 would have been 2)."""
+    g = np.tile(np.arange(12, dtype=np.uint8), (3, 1))
+    np.testing.assert_array_equal(segments(g, blur=0, step=1)[0], np.arange(12))
+    want = [0, 0, 0, 1, 1, 2, 2, 2, 3, 3, 4, 4]  # floor(v / 2.5)
+    np.testing.assert_array_equal(segments(g, blur=0, step=2.5)[0], want)
+    np.testing.assert_array_equal(segments(g.astype(np.float32), blur=0, step=2.5)[0], want)
+    with pytest.raises(ValueError, match="image: expected a real"):
+        segments(np.zeros((0, 5), np.uint8))
+
+
+def test_segments_k_merges_a_uint8_image_too() -> None:
+    """``k > 0`` merges regions whatever the image type: two bins 2 apart over 200 px each
+    merge at k = 1000 (an edge of 2 against 1000 / 200), uint8 or float."""
+    im = np.zeros((20, 20), np.uint8)
+    im[:, 10:] = 40
+    assert segments(im, blur=0).max() == 1
+    assert segments(im, blur=0, k=1000.0).max() == 0
+    assert segments(im.astype(np.float32), blur=0, k=1000.0).max() == 0
+
+
+def test_blur_of_64_px_is_accepted() -> None:
+    """The documented range of ``blur`` is [0, 64] px, both ends included."""
+    np.testing.assert_array_equal(segments(np.zeros((6, 6), np.uint8), blur=64), 0)
+
+
+def test_plane_fill_min_pixels_lo_and_defaults() -> None:
+    """A segment with exactly ``min_pixels`` measured pixels gets its plane, one fewer does not;
+    the default is the documented 50; ``min_pixels=0`` is allowed, ``True`` is no count; a
+    plane value below ``lo`` leaves the hole."""
+    yy, xx = np.mgrid[0:10, 0:10]
+    plane = (2 + 0.5 * xx + 0.25 * yy).astype(np.float32)
+    lab = np.zeros((10, 10), np.uint32)
+    fifty = plane.copy()
+    fifty.flat[50:] = np.nan
+    forty_nine = plane.copy()
+    forty_nine.flat[49:] = np.nan
+    assert plane_fill(fifty, lab)[9, 9] == pytest.approx(8.75, abs=1e-4)
+    assert np.isnan(plane_fill(forty_nine, lab)[9, 9])
+    assert plane_fill(forty_nine, lab, min_pixels=49)[9, 9] == pytest.approx(8.75, abs=1e-4)
+    assert np.isnan(plane_fill(fifty, lab, min_pixels=51)[9, 9])
+    assert plane_fill(fifty, lab, min_pixels=0)[9, 9] == pytest.approx(8.75, abs=1e-4)
+    assert plane_fill(fifty, lab, lo=8.0)[9, 9] == pytest.approx(8.75, abs=1e-4)
+    assert np.isnan(plane_fill(fifty, lab, lo=9.0)[9, 9])
+    with pytest.raises(ValueError, match="min_pixels: expected a whole number, got True"):
+        plane_fill(fifty, lab, min_pixels=True)
+
+
+def test_fill_planes_takes_a_zero_residual_and_a_zero_count() -> None:
+    """``max_residual`` 0 and a pass's ``min_pixels`` 0 are in range (non-negative)."""
+    c = np.full((10, 10), 5.0, np.float32)
+    c[4, 4] = np.nan
+    img = np.zeros((10, 10), np.uint8)
+    out = fill_planes(c, img, max_residual=0)
+    np.testing.assert_array_equal(out[np.isfinite(c)], c[np.isfinite(c)])
+    assert fill_planes(c, img, passes=((16, 0),))[4, 4] == 5.0
+
+
+def test_side_fill_blur_and_a_zero_tau_are_the_callers() -> None:
+    """The hole run's pixels 2-4 have the left colour, pixel 5 the right one's: unblurred each
+    takes its side; a 3 px blur greys the two pixels next to the edge, which take the right
+    value. ``tau`` 0 (any closer colour) is in range."""
+    d = np.array([[5, 5, np.nan, np.nan, np.nan, np.nan, 2]] * 9, np.float32)
+    img = np.zeros((9, 7), np.uint8)
+    img[:, :5] = 100
+    np.testing.assert_array_equal(side_fill(d, img, blur=0)[4], [5, 5, 5, 5, 5, 2, 2])
+    np.testing.assert_array_equal(side_fill(d, img, blur=3.0)[4], [5, 5, 5, 2, 2, 2, 2])
+    np.testing.assert_array_equal(side_fill(d, img, blur=0, tau=0)[4], [5, 5, 5, 5, 5, 2, 2])
