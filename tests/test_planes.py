@@ -504,3 +504,29 @@ def test_side_fill_blur_and_a_zero_tau_are_the_callers() -> None:
     np.testing.assert_array_equal(side_fill(d, img, blur=0)[4], [5, 5, 5, 5, 5, 2, 2])
     np.testing.assert_array_equal(side_fill(d, img, blur=3.0)[4], [5, 5, 5, 2, 2, 2, 2])
     np.testing.assert_array_equal(side_fill(d, img, blur=0, tau=0)[4], [5, 5, 5, 5, 5, 2, 2])
+
+
+def test_fill_planes_names_an_image_of_four_dimensions() -> None:
+    """An (H, W, C, 1) image passed the channel test (it looks at ndim 3 only) and reached
+    OpenCV's blur: cv2.error "m->dims <= 2", not a ValueError naming the image."""
+    holed = np.ones((8, 8), np.float32)
+    holed[2, 2:5] = np.nan
+    for d in (holed, np.ones((8, 8), np.float32)):
+        with pytest.raises(ValueError, match=r"image: expected \(H, W\) or \(H, W, C\)"):
+            fill_planes(d, np.zeros((8, 8, 3, 1), np.uint8))
+
+
+@pytest.mark.parametrize("value", ["x", None, [1.0], True])
+@pytest.mark.parametrize("name", ["max_residual", "lo", "hi", "k"])
+def test_a_parameter_that_is_no_number_is_named(name: str, value: object) -> None:
+    """plane_fill's ``max_residual``, ``lo`` and ``hi`` and segments' ``k`` given a string, None
+    or a list came back as float()'s or the binding's "could not convert string to float: 'x'" /
+    "must be real number, not str" (a TypeError), naming no parameter."""
+    d = np.ones((8, 8), np.float32)
+    d[2, 2] = np.nan
+    lab = np.zeros((8, 8), np.uint32)
+    with pytest.raises(ValueError, match=f"^{name}: expected a number"):
+        if name == "k":
+            segments(np.zeros((8, 8), np.uint8), k=value)
+        else:
+            plane_fill(d, lab, **{name: value})

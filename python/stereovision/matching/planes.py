@@ -92,7 +92,8 @@ def segments(
     ------
     ValueError
         A non-2-D/3-D image, a ``step`` below 1 or not finite, a non-finite ``offset``, a
-        ``blur`` outside [0, 64] px, a ``min_size`` outside 0 to 2**31 - 1 or a negative ``k``.
+        ``blur`` outside [0, 64] px, a ``min_size`` outside 0 to 2**31 - 1, a ``k`` that is no
+        number (or a bool) or a negative ``k``.
     """
     from stereovision import _core
 
@@ -103,6 +104,7 @@ def segments(
     if not finite_number(step, "step") >= 1 or finite_number(blur, "blur") < 0:
         raise ValueError(f"step must be >= 1 and blur >= 0, got step={step}, blur={blur}")
     finite_number(offset, "offset")
+    _real(k, "k")
     size = int_in_range(min_size, "min_size", 0, _MAX_COUNT)
     if blur > 0:
         im = _blurred(im, blur)
@@ -121,6 +123,17 @@ def segments(
         key = key[:, :, None]
     k = float(float_sized(k, "k"))
     return _core.graph_segments(np.ascontiguousarray(key, np.float32), k, size)
+
+
+def _real(value: object, name: str) -> object:
+    """``value`` unchanged after a ``ValueError`` naming ``name`` unless it is a real number (not
+    a bool; infinities are the caller's to judge). A string or None reached ``float()`` or the
+    binding and came back as "could not convert string to float" or a TypeError naming nothing."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(
+        value, (int, float, np.integer, np.floating)
+    ):
+        raise ValueError(f"{name}: expected a number, got {value!r}")
+    return float_sized(value, name)
 
 
 def _check_blur(blur: float) -> None:
@@ -181,7 +194,8 @@ def plane_fill(
     ------
     ValueError
         ``disparity`` not 2-D, ``labels`` of another shape, not integers (or booleans) or not in
-        ``0 .. H * W - 1``, a negative ``min_pixels`` or ``max_residual``, ``lo`` above ``hi``.
+        ``0 .. H * W - 1``, a negative ``min_pixels`` or ``max_residual``, ``lo`` above ``hi``, a
+        ``max_residual``, ``lo`` or ``hi`` that is no number (or a bool).
     """
     from stereovision import _core
 
@@ -206,7 +220,7 @@ def plane_fill(
     if not 0 <= min_pixels <= _MAX_COUNT:
         raise ValueError(f"min_pixels: expected a non-negative count, got {min_pixels}")
     for name, v in (("max_residual", max_residual), ("lo", lo), ("hi", hi)):
-        float_sized(v, name)
+        _real(v, name)
     out, _, _ = _core.plane_fill(d, lab, int(min_pixels), float(max_residual), lo, hi)
     return out
 
@@ -250,10 +264,10 @@ def fill_planes(
     Raises
     ------
     ValueError
-        ``disparity`` not 2-D, an image of another size, with more than 3 channels, not real or
-        with NaN/inf, ``passes`` not pairs of a step in 1-255 and a count in 0 to 2**31 - 1, a
-        ``blur`` outside [0, 64] px or a negative or non-finite ``max_residual`` (checked also
-        when ``disparity`` has no hole).
+        ``disparity`` not 2-D, an image not 2-D or 3-D, of another size, with more than 3
+        channels, not real or with NaN/inf, ``passes`` not pairs of a step in 1-255 and a count
+        in 0 to 2**31 - 1, a ``blur`` outside [0, 64] px or a negative or non-finite
+        ``max_residual`` (checked also when ``disparity`` has no hole).
     """
     from stereovision import _core
 
@@ -263,6 +277,9 @@ def fill_planes(
     im = np.asarray(image)
     if im.shape[:2] != d.shape:
         raise ValueError(f"image: expected {d.shape} pixels like disparity, got {im.shape[:2]}")
+    # An (H, W, C, 1) image passed the channel test below and reached OpenCV: cv2.error.
+    if im.ndim not in (2, 3):
+        raise ValueError(f"image: expected (H, W) or (H, W, C), got {im.shape}")
     if im.ndim == 3 and not 1 <= im.shape[2] <= 3:
         raise ValueError(f"image: expected 1-3 channels, got {im.shape[2]}")
     try:
