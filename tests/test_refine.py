@@ -346,3 +346,13 @@ def test_empty_images_and_a_confidence_of_another_shape_are_named() -> None:
         refine_disparity(a[:0], a[:0], a[:0], max_disparity=8)
     with pytest.raises(ValueError, match=r"confidence \(20, 5\) and disparity \(20, 30\) differ"):
         refine_disparity(a, a, a, a[:, :5], max_disparity=8)
+
+
+@pytest.mark.parametrize("value", ["no", None, 0, 0.5])
+def test_fill_plane_is_a_bool(value: object) -> None:
+    """``fill_plane`` went through ``bool()``: "no" and 0.5 started every fill from the plane
+    and None from the local mean, without a word."""
+    a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    with pytest.raises(ValueError, match="fill_plane must be True or False, got"):
+        refine_disparity(a, a, a, max_disparity=8, fill_plane=value)
+    refine_disparity(a, a, a, max_disparity=8, fill_plane=np.bool_(False))

@@ -140,7 +140,7 @@ def refine_disparity(
     ValueError
         Shapes differ, an image is empty, not finite or has values outside ``[0, 1]``, a
         confidence is NaN or outside ``[0, 1]`` where the disparity has a value, a parameter is
-        unknown or out of range.
+        unknown or out of range, ``fill_plane`` not a bool.
     """
     unknown = set(params) - set(DEFAULTS)
     if unknown:
@@ -177,6 +177,9 @@ def refine_disparity(
         ) from exc
     f = {k: _number(kw[k], k) for k in _FLOAT_KEYS}
     i = {k: _number(kw[k], k, whole=True) for k in ("win_radius", "search", "fill_search")}
+    # A switch, not a truth value: "no" or 0.5 went through bool() as True, None as False.
+    if not isinstance(kw["fill_plane"], (bool, np.bool_)):
+        raise ValueError(f"fill_plane must be True or False, got {kw['fill_plane']!r}")
     d, c, n = _core.refine_disparity(
         lft,
         rgt,
