@@ -530,3 +530,29 @@ def test_a_parameter_that_is_no_number_is_named(name: str, value: object) -> Non
             segments(np.zeros((8, 8), np.uint8), k=value)
         else:
             plane_fill(d, lab, **{name: value})
+
+
+def test_an_infinite_disparity_is_a_hole_and_an_empty_map_is_empty() -> None:
+    """side_fill takes any non-finite value as a hole (documented), and fill_planes does as its
+    kernel does: a map whose only holes are inf is filled as the NaN one, not returned as it
+    is. An empty map and labels give an empty map (the label range check has no min)."""
+    nan = np.nan
+    d = np.array([[5, 5, nan, nan, nan, 2]], np.float32)
+    img = np.zeros((1, 6), np.uint8)
+    img[0, :4] = 100
+    inf = np.where(np.isnan(d), np.inf, d).astype(np.float32)
+    np.testing.assert_array_equal(side_fill(inf, img, blur=0), side_fill(d, img, blur=0))
+    np.testing.assert_array_equal(side_fill(inf, img, blur=0)[0], [5, 5, 5, 5, 2, 2])
+    c = np.full((10, 10), 5.0, np.float32)
+    c[4, 4] = np.inf
+    assert fill_planes(c, np.zeros((10, 10), np.uint8))[4, 4] == pytest.approx(5.0)
+    empty = plane_fill(np.zeros((0, 0), np.float32), np.zeros((0, 0), np.uint32))
+    assert empty.shape == (0, 0)
+
+
+@pytest.mark.parametrize("dtype", [np.uint16, np.int32])
+def test_segments_clips_integer_values_to_0_255_before_the_blur(dtype: type) -> None:
+    """The clip holds for integer images too: 300 is 255, not 300 blurred and wrapped to 44."""
+    img = np.full((6, 12), 255, dtype)
+    img[:, 6:] = 300
+    np.testing.assert_array_equal(segments(img, blur=1.0), np.zeros((6, 12), np.uint32))

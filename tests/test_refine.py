@@ -356,3 +356,17 @@ def test_fill_plane_is_a_bool(value: object) -> None:
     with pytest.raises(ValueError, match="fill_plane must be True or False, got"):
         refine_disparity(a, a, a, max_disparity=8, fill_plane=value)
     refine_disparity(a, a, a, max_disparity=8, fill_plane=np.bool_(False))
+
+
+def test_min_disparity_bounds_the_map_and_a_1d_confidence_is_named() -> None:
+    """Values below ``min_disparity`` become NaN like those above ``max_disparity``: a pair
+    shifted 3 px refined over [4, 8] keeps nothing, over [0, 8] most pixels."""
+    rng = np.random.default_rng(0)
+    left = rng.random((40, 60), dtype=np.float32)
+    right = np.roll(left, -3, axis=1)
+    d = np.full(left.shape, 3.0, np.float32)
+    assert np.isfinite(refine_disparity(left, right, d, max_disparity=8).disparity).mean() > 0.8
+    res = refine_disparity(left, right, d, min_disparity=4, max_disparity=8)
+    assert np.isnan(res.disparity).all() and res.n_filled == 0
+    with pytest.raises(ValueError, match=r"^confidence must be a non-empty 2-D"):
+        refine_disparity(left, right, d, np.ones(60, np.float32), max_disparity=8)
