@@ -175,7 +175,7 @@ def plane_fill(
     Parameters
     ----------
     disparity : array_like
-        ``(H, W)`` disparity, NaN = hole.
+        ``(H, W)`` disparity, NaN (or any non-finite value) = hole.
         The keyword ``disp=``, its former name, still works, with a DeprecationWarning.
     labels : array_like
         ``(H, W)`` segment labels (:func:`segments`).
@@ -244,7 +244,7 @@ def fill_planes(
     Parameters
     ----------
     disparity : array_like
-        ``(H, W)`` disparity, NaN = hole.
+        ``(H, W)`` disparity, NaN (or any non-finite value) = hole.
         The keyword ``disp=``, its former name, still works, with a DeprecationWarning.
     image : array_like
         The left image, ``(H, W)`` or ``(H, W, C)`` with 1-3 channels, 0-255 (uint8; other
