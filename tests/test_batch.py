@@ -278,6 +278,48 @@ def test_find_pairs_keeps_the_case_of_left_and_takes_the_last_left(tmp_path: Pat
     ]
 
 
+def _blank(root: Path, *names: str) -> None:
+    """An 8 x 8 black image under each name (``find_pairs`` reads names only)."""
+    for name in names:
+        p = root / name
+        p.parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(p), np.zeros((8, 8, 3), np.uint8))
+
+
+def test_find_pairs_layouts_it_leaves_out_or_names_by_the_root(tmp_path: Path) -> None:
+    """Edge cases of the search: the root's own ``left.jpg`` pair takes the root's name,
+    upper-case extensions count, hidden folders and a second link to one folder do not, and
+    camera folders are not guessed (two spellings of ``left``, images of two sub-folders,
+    a number that two images of one side carry)."""
+    solo = tmp_path / "solo"
+    _blank(solo, "left.jpg", "right.jpg")
+    assert [j.name for j in find_pairs(solo)] == ["solo"]
+    upper = tmp_path / "upper"
+    _blank(upper, "s/left_1.PNG", "s/right_1.PNG", ".hidden/left.png", ".hidden/right.png")
+    assert [(j.name, j.right.name) for j in find_pairs(upper)] == [("s/1", "right_1.PNG")]
+    ext, linked = tmp_path / "ext", tmp_path / "linked"
+    _blank(ext, "left.png", "right.png")
+    linked.mkdir()
+    for link in ("a", "b"):
+        (linked / link).symlink_to(ext, target_is_directory=True)
+    assert [j.name for j in find_pairs(linked)] == ["a"]  # the first link, whatever the listing
+    cams = tmp_path / "cams"
+    _blank(cams, "two/left/0001.png", "two/Left/0001.png", "two/right/0001.png")
+    _blank(cams, "sub/left/a/0001.png", "sub/right/b/0001.png")
+    _blank(cams, "dup/left/0001.png", "dup/left/1.png", "dup/right/01.png")
+    import stereovision.batch as batch
+
+    jobs, unpaired, _ = batch._scan(cams)
+    assert jobs == []
+    assert sorted(u.name for u in unpaired) == [
+        "dup/0001",
+        "dup/01",
+        "dup/1",
+        "sub/a/0001",
+        "sub/b/0001",
+    ]
+
+
 def test_batch_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["batch", str(tmp_path / "missing"), "-o", str(tmp_path / "o")]) == 2
     assert main(["batch", str(tmp_path), "-o", str(tmp_path / "o")]) == 2

@@ -406,7 +406,9 @@ def _walk(top: Path) -> Iterator[tuple[str, list[str], list[str], list[str]]]:
     for d, dirs, files in os.walk(top, followlinks=True):
         listed = list(dirs)
         keep = []
-        for x in dirs:
+        # in name order, so that of two links to one folder the same one names its pairs on
+        # every filesystem (the listing's order took the other one: ``in/b`` for ``in/a``)
+        for x in sorted(dirs):
             p = os.path.join(d, x)
             if os.path.islink(p):
                 real = os.path.realpath(p)
