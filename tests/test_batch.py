@@ -444,6 +444,23 @@ def test_batch_max_disparity_zero_is_refused(tmp_path: Path) -> None:
         run_batch(tmp_path / "missing", tmp_path / "o", max_disparity=0)
 
 
+def test_batch_grid_bounds_are_accepted_and_calib_unit_needs_calib(tmp_path: Path) -> None:
+    """A grid cell of 0.01 m and of 10 m, the bounds, pass the options' check (the missing input
+    is the error); past them, and a calib_unit without calib, are refused by name."""
+    from stereovision.batch import run_batch
+
+    missing = tmp_path / "missing"
+    for cell in (0.01, 10.0):
+        with pytest.raises(FileNotFoundError, match=r"^input folder not found: "):
+            run_batch(missing, tmp_path / "o", ground=True, grid=cell)
+    for cell in (0.0099, 10.5, math.nan):
+        with pytest.raises(ValueError, match=r"^grid: expected a cell side from 0.01 to 10 m"):
+            run_batch(missing, tmp_path / "o", ground=True, grid=cell)
+    with pytest.raises(ValueError, match=r"^calib_unit is the unit of calib's file: give calib"):
+        run_batch(missing, tmp_path / "o", calib_unit="mm")
+    assert not (tmp_path / "o").exists()
+
+
 def test_batch_redoes_the_pairs_when_the_grid_cell_changes(data_dir: Path, tmp_path: Path) -> None:
     """--grid is one of the options a pair was done with: a run with another cell side redoes
     it (it was skipped as done, its map.yaml still of the old cell), said as grid 0.2 -> 0.5."""
