@@ -708,6 +708,7 @@ def test_batch_reports_an_image_without_its_pair(
         assert entry["status"] == "failed" and entry["error"] == error
         assert f"failed {name}: {error}" in said.err
     assert s["pairs"]["c/y"]["left"] == str(root / "c/y_left.png")
+    assert all(s["pairs"][name]["this_run"] == "failed" for name in missing)
     # the missing image comes: that pair is done, the others stay failed
     _tiny(root, data_dir, "b/right.png")
     assert main(args) == 1
@@ -1538,6 +1539,61 @@ def test_a_pair_whose_outputs_were_deleted_between_runs_is_redone(
     s = _summary(out)
     assert s["pairs"]["a"]["this_run"] == "skipped" and s["pairs"]["b"]["this_run"] == "processed"
     assert {p.name for p in (out / "b").iterdir()} == DISPARITY_FILES
+
+
+def test_retry_failed_redoes_the_pairs_that_failed_on_the_same_images(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A pair that failed is skipped on unchanged images, and tried again with --retry-failed
+    (the done pairs stay skipped)."""
+    src, out = tmp_path / "in", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png")
+    (src / "b/right.png").write_bytes((src / "a/right.png").read_bytes()[:200])  # truncated
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 1
+    capsys.readouterr()
+    assert main(args) == 1
+    assert capsys.readouterr().out.startswith(
+        "0 processed, 1 skipped (done before), 1 skipped (failed before; --retry-failed "
+        "redoes them), 0 failed in "
+    )
+    assert main([*args, "--retry-failed"]) == 1
+    assert capsys.readouterr().out.startswith("0 processed, 1 skipped (done before), 1 failed in ")
+    s = _summary(out)
+    assert s["run"]["failed"] == 1 and s["run"]["skipped_failed"] == 0
+    assert s["pairs"]["b"]["this_run"] == "failed" and "cannot decode" in s["pairs"]["b"]["error"]
+    assert s["pairs"]["a"]["this_run"] == "skipped"
+
+
+def test_a_pair_whose_image_went_keeps_its_outputs_and_a_resized_image_is_redone(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A done pair whose right image goes is a failed pair that keeps its outputs listed: when
+    the image comes back the pair is redone over them (not refused as files no run wrote). An
+    image rewritten to another size is redone even with its old modification time."""
+    src, out = tmp_path / "in", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png", "b/left.png", "b/right.png")
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    right = (src / "b/right.png").read_bytes()
+    (src / "b/right.png").unlink()
+    assert main(args) == 1  # no cluster: a is skipped, b has an image missing
+    b = _summary(out)["pairs"]["b"]
+    assert b["status"] == "failed" and b["error"].startswith("unpaired image: no right.png")
+    assert b["outputs"] == sorted(DISPARITY_FILES)
+    (src / "b/right.png").write_bytes(right)
+    capsys.readouterr()
+    assert main(args) == 0
+    assert capsys.readouterr().out.startswith("1 processed, 1 skipped (done before), 0 failed")
+    assert {p.name for p in (out / "b").iterdir()} == DISPARITY_FILES
+    left = src / "b/left.png"
+    st = left.stat()
+    cv2.imwrite(str(left), cv2.flip(cv2.imread(str(left)), 1))
+    assert left.stat().st_size != st.st_size
+    os.utime(left, ns=(st.st_atime_ns, st.st_mtime_ns))  # the time it had: the size differs
+    assert main(args) == 0
+    assert capsys.readouterr().out.startswith("1 processed, 1 skipped (done before), 0 failed")
+    assert _summary(out)["pairs"]["b"]["this_run"] == "processed"
 
 
 def test_a_changed_pair_is_redone_from_another_working_directory(
