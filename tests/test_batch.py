@@ -1841,6 +1841,52 @@ def test_a_copy_without_its_times_is_up_to_date_and_a_changed_byte_is_redone(
     assert "hashes" in s["pairs"]["seq/0000"] and "hashes" not in s["pairs"]["seq/0001"]
 
 
+def test_a_copy_without_its_times_of_a_calibration_is_up_to_date(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The --calib file copied without its time beside the images is checked against its
+    recorded sha256 as they are: the same bytes, the pairs are up to date."""
+    src, copy, out = tmp_path / "drive", tmp_path / "copy", tmp_path / "out"
+    _tiny(src, data_dir, "seq/0000_left.bmp", "seq/0000_right.bmp")
+    Calibration.ideal((96, 64), 60.0, 0.1).save(src / "rig.yaml")
+    args = ["-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(["batch", str(src), *args, "--calib", str(src / "rig.yaml")]) == 0
+    assert "calib" in _summary(out)["pairs"]["seq/0000"]["hashes"]
+    shutil.copytree(src, copy, copy_function=shutil.copyfile)  # times not kept
+    for p in copy.rglob("*.*"):
+        os.utime(p, ns=(10**18, 10**18))
+    capsys.readouterr()
+    assert main(["batch", str(copy), *args, "--calib", str(copy / "rig.yaml")]) == 0
+    assert capsys.readouterr().out.startswith("0 processed, 1 skipped (done before), 0 failed")
+    assert _summary(out)["pairs"]["seq/0000"]["calib"] == str(copy / "rig.yaml")
+
+
+def test_a_run_that_never_starts_keeps_the_summary_of_earlier_runs(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The summary a run removes when its scheduler cannot be reached is only one it wrote
+    into a folder that had none: an earlier run's record (here a pair done) stays."""
+    import stereovision.batch as batch
+
+    monkeypatch.setattr(batch, "CONNECT_TIMEOUT", "1s")
+    scene = tmp_path / "in" / "scene"
+    scene.mkdir(parents=True)
+    img = np.random.default_rng(0).integers(0, 255, (32, 48, 3), np.uint8)
+    for side in ("left", "right"):
+        cv2.imwrite(str(scene / f"{side}.png"), img)
+    out = tmp_path / "out"
+    out.mkdir()
+    earlier = {"version": 3, "pairs": {"old": {"status": "done", "outputs": []}}}
+    (out / SUMMARY_NAME).write_text(json.dumps(earlier))
+    rc = main(["batch", str(tmp_path / "in"), "-o", str(out), "--scheduler", "tcp://127.0.0.1:1"])
+    assert rc == 2 and "cannot reach the Dask scheduler" in capsys.readouterr().err
+    assert _summary(out)["pairs"]["old"] == {
+        "status": "done",
+        "outputs": [],
+        "this_run": "not in input",
+    }
+
+
 def test_one_cameras_ros_file_reaches_the_workers_with_its_partner(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
