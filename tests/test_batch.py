@@ -1563,6 +1563,13 @@ def test_retry_failed_redoes_the_pairs_that_failed_on_the_same_images(
     assert s["run"]["failed"] == 1 and s["run"]["skipped_failed"] == 0
     assert s["pairs"]["b"]["this_run"] == "failed" and "cannot decode" in s["pairs"]["b"]["error"]
     assert s["pairs"]["a"]["this_run"] == "skipped"
+    # a new failure beside it: the line on pairs still without outputs is for runs without one
+    _tiny(src, data_dir, "c/left.png")
+    (src / "c/right.png").write_bytes((src / "a/right.png").read_bytes()[:200])
+    assert main(args) == 1
+    said = capsys.readouterr().out
+    assert "1 skipped (failed before; --retry-failed redoes them), 1 failed in " in said
+    assert "still without outputs" not in said
 
 
 def test_a_pair_whose_image_went_keeps_its_outputs_and_a_resized_image_is_redone(
@@ -1594,6 +1601,25 @@ def test_a_pair_whose_image_went_keeps_its_outputs_and_a_resized_image_is_redone
     assert main(args) == 0
     assert capsys.readouterr().out.startswith("1 processed, 1 skipped (done before), 0 failed")
     assert _summary(out)["pairs"]["b"]["this_run"] == "processed"
+
+
+def test_a_pair_name_taken_by_other_files_of_the_same_input_is_redone(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The scene folder ``a/`` replaced by ``a_left.png`` + ``a_right.png`` (other images, the
+    same pair name) in the same input folder: redone; only another input's pairs are refused
+    as 'made from other images'."""
+    src, out = tmp_path / "in", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png")
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    shutil.rmtree(src / "a")
+    _tiny(src, data_dir, "a_left.png", "a_right.png")
+    _change(src / "a_left.png")
+    capsys.readouterr()
+    assert main(args) == 0, capsys.readouterr().err
+    assert capsys.readouterr().out.startswith("1 processed, 0 skipped (done before), 0 failed")
+    assert _summary(out)["pairs"]["a"]["left"] == str(src / "a_left.png")
 
 
 def test_a_changed_pair_is_redone_from_another_working_directory(
