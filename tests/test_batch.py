@@ -349,6 +349,8 @@ def test_batch_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture
     with pytest.raises(ValueError, match=r"output folder .*taken/x: .*taken is a file, not a"):
         run_batch(tmp_path, tmp_path / "taken" / "x")
     assert (tmp_path / "taken").read_text() == "mine"
+    with pytest.raises(NotADirectoryError, match=r"^input is not a folder: .*taken$"):
+        run_batch(tmp_path / "taken", tmp_path / "o")
 
 
 def test_batch_ctrl_c_keeps_finished_pairs(data_dir: Path, tmp_path: Path) -> None:
@@ -1521,6 +1523,12 @@ def test_a_pair_gone_from_the_input_is_not_recorded_as_processed_this_run(
     _change(src / "b/left.png")  # another image: redone
     assert main(args) == 0
     assert _summary(out)["pairs"]["b"]["this_run"] == "processed"
+    # gone from the input and its outputs deleted: not this run's pair, not said as missing
+    shutil.rmtree(src / "b")
+    shutil.rmtree(out / "b")
+    assert main(args) == 0
+    s = _summary(out)
+    assert s["run"]["missing"] == 0 and s["pairs"]["b"]["status"] == "done"
 
 
 def test_a_pair_whose_outputs_were_deleted_between_runs_is_redone(
