@@ -318,6 +318,15 @@ def test_find_pairs_layouts_it_leaves_out_or_names_by_the_root(tmp_path: Path) -
         "sub/a/0001",
         "sub/b/0001",
     ]
+    # an image without its pair takes the next name free after the pairs' clash
+    clash = tmp_path / "clash"
+    _blank(clash, "x_left.png", "x_right.png", "x/left.png", "x/right.png", "x-left.png")
+    jobs, unpaired, _ = batch._scan(clash)
+    assert [(j.name, j.left.relative_to(clash).as_posix()) for j in jobs] == [
+        ("x", "x_left.png"),
+        ("x~2", "x/left.png"),
+    ]
+    assert [(u.name, u.present.name) for u in unpaired] == [("x~3", "x-left.png")]
 
 
 def test_batch_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
