@@ -1639,6 +1639,28 @@ def test_a_pair_name_taken_by_other_files_of_the_same_input_is_redone(
     assert _summary(out)["pairs"]["a"]["left"] == str(src / "a_left.png")
 
 
+def test_a_run_killed_after_one_with_other_outputs_is_resumed_over_both(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A run with --calib wrote depth files; a run without it was killed before recording the
+    pair (pending, calib None, the first run's outputs still listed). A third run with --calib
+    takes the folder's files as both runs' outputs: it is not refused as another's file."""
+    src, out = tmp_path / "in", tmp_path / "out"
+    _tiny(src, data_dir, "seq/0000_left.bmp", "seq/0000_right.bmp")
+    Calibration.ideal((96, 64), 60.0, 0.1).save(tmp_path / "rig.yaml")
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    args += ["--calib", str(tmp_path / "rig.yaml")]
+    assert main(args) == 0
+    s = _summary(out)
+    assert set(s["pairs"]["seq/0000"]["outputs"]) == DEPTH_FILES
+    s["pairs"]["seq/0000"].update(status="pending", calib=None)  # as the killed run left it
+    (out / SUMMARY_NAME).write_text(json.dumps(s))
+    capsys.readouterr()
+    assert main(args) == 0, capsys.readouterr().err
+    assert capsys.readouterr().out.startswith("1 processed, 0 skipped (done before), 0 failed")
+    assert {p.name for p in (out / "seq/0000").iterdir()} == DEPTH_FILES
+
+
 def test_a_changed_pair_is_redone_from_another_working_directory(
     data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
