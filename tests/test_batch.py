@@ -1661,6 +1661,26 @@ def test_a_run_killed_after_one_with_other_outputs_is_resumed_over_both(
     assert {p.name for p in (out / "seq/0000").iterdir()} == DEPTH_FILES
 
 
+def test_a_redo_without_calib_removes_the_stale_depth_files_but_not_a_link(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """A pair done with --calib, redone without it: its depth files (an earlier run's, not
+    written now) are removed; one the user replaced with a link is left alone."""
+    src, out = tmp_path / "in", tmp_path / "out"
+    _tiny(src, data_dir, "seq/0000_left.bmp", "seq/0000_right.bmp")
+    Calibration.ideal((96, 64), 60.0, 0.1).save(tmp_path / "rig.yaml")
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main([*args, "--calib", str(tmp_path / "rig.yaml")]) == 0
+    pair = out / "seq/0000"
+    mine = tmp_path / "mine.png"
+    mine.write_bytes((pair / "depth.png").read_bytes())
+    (pair / "depth.png").unlink()
+    (pair / "depth.png").symlink_to(mine)
+    assert main(args) == 0
+    assert {p.name for p in pair.iterdir()} == DISPARITY_FILES | {"depth.png"}
+    assert (pair / "depth.png").is_symlink() and mine.is_file()
+
+
 def test_a_changed_pair_is_redone_from_another_working_directory(
     data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
