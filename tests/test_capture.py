@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import math
 import os
 import re
 import subprocess
 import sys
 import threading
+import time
 import warnings
 from pathlib import Path
 from typing import Any
@@ -278,11 +280,18 @@ def test_image_sequence_frames_keep_their_own_size(
     assert len(got) == 6 and got[3].left.shape == (240, 320, 3)
     assert [_read_stamp(f.left) for f in got] == list(range(6))
     assert capfd.readouterr().err == ""  # OpenCV's warning for the file after the last is quiet
-    # A sequence starting at 2 (FFmpeg's image2 looks at 0-4) opens from its first file.
-    for i in range(2, 5):
-        cv2.imwrite(str(tmp_path / f"late_{i:03d}.png"), _numbered(i))
-    with StereoCamera(str(tmp_path / "late_%03d.png"), str(tmp_path / "late_%03d.png")) as cam:
-        assert [_read_stamp(f.left) for f in cam.frames()] == [2, 3, 4]
+    # A sequence starting at 2-4 (FFmpeg's image2 looks at 0-4) opens from its first file.
+    for first in (2, 4):
+        late = tmp_path / f"late{first}"
+        late.mkdir()
+        for i in range(first, 5):
+            cv2.imwrite(str(late / f"f_{i:03d}.png"), _numbered(i))
+        with StereoCamera(str(late / "f_%03d.png"), str(late / "f_%03d.png")) as cam:
+            got = list(cam.frames())
+            # read by OpenCV's image reader, as a sequence from 0 or 1 (no media time, no rate)
+            assert cam.delivered_fps == {"left": 0.0, "right": 0.0}
+        assert [_read_stamp(f.left) for f in got] == list(range(first, 5))
+        assert all(math.isnan(f.pos_left_ms) for f in got)
 
 
 class _FakeCap:
@@ -428,6 +437,7 @@ def test_resolution_request_and_resize_warning(tmp_path: Path) -> None:
         with StereoCamera(left, right, image_size="160x120") as cam:
             assert cam.read().left.shape == (120, 160, 3)
     assert parse_size("1280x720") == (1280, 720)
+    assert parse_size(" 640X480 ") == (640, 480)  # an upper-case X and spaces are taken
     for bad in ("big", "0x5", "12x"):
         with pytest.raises(ValueError, match="WIDTHxHEIGHT"):
             parse_size(bad)
@@ -449,8 +459,9 @@ def test_open_failures_name_the_source(tmp_path: Path) -> None:
     with pytest.raises(SourceError, match="cannot open right source _FakeCap"):
         StereoCamera(good, _FakeCap("R", log, opened=False))
     assert good.released == 1  # the camera opened first is released
-    with pytest.raises(ValueError, match="fps"):
-        StereoCamera(left, left, fps=-1)
+    for fps in (-1, 0, float("nan"), float("inf")):
+        with pytest.raises(ValueError, match=r"^fps: expected a positive number"):
+            StereoCamera(left, left, fps=fps)
     assert issubclass(SourceError, OSError)
 
 
@@ -994,8 +1005,12 @@ def test_cli_capture(
         run("--left", str(left), "--right", str(right), "--count", "9", "-o", str(out))
     with pytest.raises(ValueError, match="four characters"):
         run(*src, "--fourcc", "MJPEG")
-    with pytest.raises(ValueError, match="--temporal: expected 2-255"):
-        run(*src, "--temporal", "1")
+    for frames in ("1", "256"):
+        with pytest.raises(ValueError, match="--temporal: expected 2-255"):
+            run(*src, "--temporal", frames)
+    with pytest.raises(FileNotFoundError, match="left source not found"):  # 255 is taken
+        run("--left", str(tmp_path / "x.avi"), "--right", str(right), "--temporal", "255",
+            "-o", str(out))  # fmt: skip
     with pytest.raises(ValueError, match="--every and --temporal"):
         run(*src, "--temporal", "4", "--every", "3")
     with pytest.raises(ValueError, match="--fourcc asks a camera for a format"):
@@ -1506,3 +1521,140 @@ def test_cli_count_is_checked_before_the_cameras_open(tmp_path: Path) -> None:
     )  # fmt: skip
     with pytest.raises(ValueError, match=r"^--count: expected a positive number, got 0$"):
         args.func(args)
+
+
+SIDES = ("left", "right")
+
+
+class _ModeCam(_FakeCap):
+    """A webcam stand-in with a few fixed modes: it takes the mode nearest the width and height
+    asked (as V4L2 does) and delivers a real image at that size."""
+
+    MODES = ((640, 480), (1280, 720))
+
+    def __init__(self, name: str, image: np.ndarray) -> None:
+        super().__init__(name, [], frames=2)
+        self.image, self.asked = image, [640.0, 480.0]
+
+    def mode(self) -> tuple[int, int]:
+        w, h = self.asked
+        return min(self.MODES, key=lambda m: abs(m[0] - w) + abs(m[1] - h))
+
+    def get(self, prop: int) -> float:
+        axis = {cv2.CAP_PROP_FRAME_WIDTH: 0, cv2.CAP_PROP_FRAME_HEIGHT: 1}.get(prop)
+        return 0.0 if axis is None else float(self.mode()[axis])
+
+    def set(self, prop: int, value: float) -> bool:
+        axis = {cv2.CAP_PROP_FRAME_WIDTH: 0, cv2.CAP_PROP_FRAME_HEIGHT: 1}.get(prop)
+        if axis is not None:
+            self.asked[axis] = value
+        return axis is not None
+
+    def retrieve(self) -> tuple[bool, np.ndarray]:
+        return True, cv2.resize(self.image, self.mode(), interpolation=cv2.INTER_AREA)
+
+
+def test_a_mode_the_camera_has_is_delivered_and_another_is_reported(data_dir: Path) -> None:
+    """Asked 1280x720 of webcams offering it: width and height go to their own properties, the
+    frames come at 1280x720, unresized and without a warning. Asked 800x600, they give their
+    nearest mode 640x480: that is what is reported, and the frames are resized to 800x600
+    with one warning per camera."""
+    img = {s: cv2.imread(str(data_dir / f"middlebury2001/tsukuba/{s}.png")) for s in SIDES}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with StereoCamera(*(_ModeCam(s, img[s]) for s in SIDES), image_size="1280x720") as cam:
+            frame = cam.read()
+            assert cam.delivered_size == {"left": (1280, 720), "right": (1280, 720)}
+    assert frame.left.shape == frame.right.shape == (720, 1280, 3) and frame.delivered is None
+    assert np.array_equal(
+        frame.left, cv2.resize(img["left"], (1280, 720), interpolation=cv2.INTER_AREA)
+    )
+    with pytest.warns(
+        UserWarning, match=r"delivers 640x480, not 800x600: its frames are resized"
+    ) as rec:
+        with StereoCamera(*(_ModeCam(s, img[s]) for s in SIDES), image_size="800x600") as cam:
+            frame = cam.read()
+            assert cam.delivered_size == {"left": (640, 480), "right": (640, 480)}
+            assert cam.describe() == (
+                "asked 800x600; left _ModeCam: 640x480 @ 0 fps; right _ModeCam: 640x480 @ 0 fps"
+            )
+    assert len(rec) == 2 and frame.left.shape == (600, 800, 3)
+    assert frame.delivered is not None and frame.delivered[0].shape == (480, 640, 3)
+
+
+def test_numbering_continues_after_a_lone_right_image(tmp_path: Path) -> None:
+    """A left image deleted by hand (a blurred view) leaves right_0007: the next pair is 8, and
+    a file of another format counts too (its number is taken)."""
+    (tmp_path / "right_0007.png").write_bytes(b"")
+    assert next_pair_index(tmp_path) == 8
+    (tmp_path / "left_0009.jpg").write_bytes(b"")
+    assert next_pair_index(tmp_path) == 10
+    (tmp_path / "right_0012.png.bak").write_bytes(b"")  # not a pair's name
+    assert next_pair_index(tmp_path) == 10
+
+
+def test_sources_that_deliver_nothing_are_an_error(tmp_path: Path) -> None:
+    """Sources that open but end before a first pair: an error, with or without count (it was
+    "0 pairs saved (end of stream)" without, as if the run had done its work)."""
+    for count in (None, 3):
+        with StereoCamera(_FakeCap("L", [], frames=0), _FakeCap("R", [], frames=0)) as cam:
+            with pytest.raises(SourceError) as ei:
+                capture(cam, tmp_path / "pairs", count=count)
+        kept = f"0 of {count} pairs were" if count else "0 pairs were"
+        assert str(ei.value) == (
+            f"both sources ended after 0 frames; {kept} saved in {tmp_path / 'pairs'} and are kept"
+        )
+        assert ei.value.end and ei.value.frames == 0
+    assert list((tmp_path / "pairs").iterdir()) == []
+
+
+def test_temporal_pair_is_taken_at_95_percent_of_the_frames(data_dir: Path, tmp_path: Path) -> None:
+    """A still noiseless view with temporal=20: the pair is taken once the means hold 19
+    frames (95 %), not 20, and it is the view itself."""
+    base = cv2.resize(cv2.imread(str(data_dir / "middlebury2001/venus/left.png")), SMALL)
+    lpat = _write_sequence(tmp_path / "still", "left", [base] * 25)
+    rpat = _write_sequence(tmp_path / "still", "right", [base] * 25)
+    with StereoCamera(lpat, rpat) as cam:
+        result = capture(cam, tmp_path / "pairs", count=1, temporal=20)
+    assert result.frames_read == 19
+    assert np.array_equal(cv2.imread(str(result.saved[0][0])), base)
+
+
+def test_a_pose_equal_to_a_kept_one_is_refused_at_distance_zero() -> None:
+    """ROS's rule keeps a view only when its distance is *above* min_distance: with 0, the
+    very pose kept already is still refused."""
+    img = _board(POSE_A, 0, False)
+    frame = capmod.StereoFrame(img, img, 0.0, 0.0, 0)
+    col = ChessboardCollector((9, 6), min_distance=0.0)
+    assert col.consider(frame).save
+    d = col.consider(frame)
+    assert not d.save and d.reason == "pose too close to a saved one (0.000)"
+    assert len(col.kept) == 1
+
+
+class _SlowGrab(_FakeCap):
+    def grab(self) -> bool:
+        time.sleep(0.05)
+        return super().grab()
+
+
+def test_skew_includes_the_right_grab(tmp_path: Path) -> None:
+    """The skew runs from the end of the left grab to the end of the right one: a right camera
+    that takes 50 ms to grab gives pairs at least 50 ms apart."""
+    with StereoCamera(_FakeCap("L", []), _SlowGrab("R", [])) as cam:
+        frame = cam.read()
+    assert frame.skew_ms >= 50.0 and frame.t_right - frame.t_left >= 0.05
+
+
+class _Undecodable(_FakeCap):
+    def retrieve(self) -> tuple[bool, np.ndarray]:
+        return False, np.zeros((SMALL[1], SMALL[0], 3), np.uint8)  # a buffer, but no frame
+
+
+def test_a_frame_the_source_says_it_could_not_decode_is_refused() -> None:
+    """retrieve() answering False is a failed frame even when it hands back a buffer."""
+    with StereoCamera(_FakeCap("L", []), _Undecodable("R", [])) as cam:
+        with pytest.raises(SourceError) as ei:
+            cam.read()
+    assert str(ei.value) == "right source _Undecodable could not decode a frame after 0 pairs"
+    assert (ei.value.side, ei.value.end) == ("right", False)
