@@ -1005,6 +1005,8 @@ def test_cli_capture(
         run("--left", str(left), "--right", str(right), "--count", "9", "-o", str(out))
     with pytest.raises(ValueError, match="four characters"):
         run(*src, "--fourcc", "MJPEG")
+    with pytest.raises(ValueError, match=r"^--left-topic, --right-topic and --max-skew-ms are for"):
+        run(*src, "--max-skew-ms", "5")
     for frames in ("1", "256"):
         with pytest.raises(ValueError, match="--temporal: expected 2-255"):
             run(*src, "--temporal", frames)
@@ -1091,6 +1093,10 @@ def test_capture_refuses_to_save_into_the_sequence_it_reads(
     ]
     with StereoCamera(lpat, rpat) as cam, pytest.raises(ValueError, match="without end"):
         capture(cam, pairs)
+    other = _write_sequence(tmp_path / "other", "left", [_numbered(i) for i in range(3)])
+    with StereoCamera(other, rpat) as cam:  # the right pattern alone reads them too
+        with pytest.raises(ValueError, match=f"the source {re.escape(rpat)} would read"):
+            capture(cam, pairs)
     assert sorted(p.name for p in pairs.iterdir()) == before
     lcam = _write_sequence(pairs, "cam0", [_numbered(i) for i in range(3)])
     rcam = _write_sequence(pairs, "cam1", [_numbered(i, shade=160) for i in range(3)])
@@ -1336,6 +1342,11 @@ def test_the_same_source_on_both_sides_is_said(
         f"stereovision: warning: --left and --right are the same source {str(left)!r}: every "
         "pair is one view twice and every disparity comes out 0 (two cameras' views are needed)"
     ]
+    # an image-sequence pattern is no file: the two spellings are compared as paths
+    pat = _write_sequence(tmp_path / "seq", "left", [_numbered(i) for i in range(2)])
+    same = ["--left", pat, "--right", f"{tmp_path}/seq/./left_%03d.png"]  # not Path: it drops "."
+    assert main(["capture", *same, "-o", str(tmp_path / "seqpairs"), "--count", "1"]) == 0
+    assert f"are the same source {pat!r}" in capsys.readouterr().err
     assert main(["capture", "--left", "7", "--right", "7", "-o", str(tmp_path / "x")]) == 2
     assert capsys.readouterr().err == (
         "stereovision: error: --left and --right are both camera 7: give the rig's two cameras\n"
@@ -1352,6 +1363,10 @@ def test_the_same_source_on_both_sides_is_said(
     argv = ["stream", "--left", "/dev/video7", "--right", str(link), "--no-display"]
     assert main([*argv, "--frames", "1"]) == 2
     assert capsys.readouterr().err.startswith("stereovision: error: --left '/dev/video7' and")
+    assert (
+        main(["capture", "--left", "12", "--right", "/dev/video12", "-o", str(tmp_path / "x")]) == 2
+    )
+    assert "are both camera /dev/video12" in capsys.readouterr().err  # two digits too
     assert not (tmp_path / "x").exists()
 
 
@@ -1614,8 +1629,10 @@ def test_temporal_pair_is_taken_at_95_percent_of_the_frames(data_dir: Path, tmp_
     base = cv2.resize(cv2.imread(str(data_dir / "middlebury2001/venus/left.png")), SMALL)
     lpat = _write_sequence(tmp_path / "still", "left", [base] * 25)
     rpat = _write_sequence(tmp_path / "still", "right", [base] * 25)
-    with StereoCamera(lpat, rpat) as cam:
-        result = capture(cam, tmp_path / "pairs", count=1, temporal=20)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # frames at their own size: nothing to warn about
+        with StereoCamera(lpat, rpat) as cam:
+            result = capture(cam, tmp_path / "pairs", count=1, temporal=20)
     assert result.frames_read == 19
     assert np.array_equal(cv2.imread(str(result.saved[0][0])), base)
 
@@ -1658,3 +1675,131 @@ def test_a_frame_the_source_says_it_could_not_decode_is_refused() -> None:
             cam.read()
     assert str(ei.value) == "right source _Undecodable could not decode a frame after 0 pairs"
     assert (ei.value.side, ei.value.end) == ("right", False)
+
+
+def test_pairs_are_saved_whole_without_hard_links(
+    data_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """On a filesystem without hard links (FAT) the name is given by a rename after a check:
+    the pair appears, intact, no temporary file stays, and an existing pair is not replaced."""
+    img = {s: cv2.imread(str(data_dir / f"middlebury2001/tsukuba/{s}.png")) for s in SIDES}
+
+    def no_link(src: Any, dst: Any) -> None:
+        raise OSError(1, "Operation not permitted")
+
+    monkeypatch.setattr(os, "link", no_link)
+    out = tmp_path / "fat" / "pairs"  # missing folders are created
+    lp, rp = save_pair(out, 1, img["left"], img["right"])
+    assert (lp.name, rp.name) == ("left_0001.png", "right_0001.png")
+    assert np.array_equal(cv2.imread(str(lp)), img["left"])
+    assert np.array_equal(cv2.imread(str(rp)), img["right"])
+    with pytest.raises(FileExistsError):
+        save_pair(out, 1, img["right"], img["left"])
+    assert np.array_equal(cv2.imread(str(lp)), img["left"])  # not replaced
+    assert sorted(p.name for p in out.iterdir()) == ["left_0001.png", "right_0001.png"]
+
+
+def test_a_pair_number_half_taken_by_another_capture_is_skipped(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Another capture into the folder has written left_0001 but not yet right_0001: this one
+    takes the next number (it stopped with FileExistsError when only one image was there)."""
+    real = capmod.save_pair
+    out = tmp_path / "pairs"
+
+    def raced(directory: Any, index: int, *a: Any, **kw: Any) -> tuple[Path, Path]:
+        if index == 1:
+            (out / "left_0001.png").write_bytes(b"the other capture's")
+        return real(directory, index, *a, **kw)
+
+    monkeypatch.setattr(capmod, "save_pair", raced)
+    left, right = _videos(tmp_path, 2, 2)
+    with StereoCamera(left, right) as cam:
+        result = capture(cam, out, count=1)
+    assert [(a.name, b.name) for a, b in result.saved] == [("left_0002.png", "right_0002.png")]
+    assert (out / "left_0001.png").read_bytes() == b"the other capture's"
+
+
+def test_cli_capture_releases_the_cameras(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The cameras are released when the capture ends normally, and when it fails."""
+    caps: list[_FakeCap] = []
+
+    def cameras(args: Any, fps: float | None = None) -> StereoCamera:
+        caps[:] = [_FakeCap("L", [], frames=3), _FakeCap("R", [], frames=3)]
+        return StereoCamera(*caps)
+
+    monkeypatch.setattr(capmod, "open_source", cameras)
+    for count, code in (("2", 0), ("5", None)):
+        args = _parser().parse_args(
+            [
+                "capture",
+                "--left",
+                "0",
+                "--right",
+                "1",
+                "--count",
+                count,
+                "-o",
+                str(tmp_path / count),
+            ]
+        )
+        if code is None:
+            with pytest.raises(SourceError, match="both sources ended after 3 frames"):
+                args.func(args)
+        else:
+            assert args.func(args) == code
+        assert [c.released for c in caps] == [1, 1]
+    assert "2 pairs saved" in capsys.readouterr().out
+
+
+def test_capture_refuses_a_count_or_every_below_one(tmp_path: Path) -> None:
+    for kw, said in (
+        ({"count": 0}, r"^count: expected a positive number of pairs, got 0$"),
+        ({"every": 0}, r"^every: expected a positive integer, got 0$"),
+    ):
+        with StereoCamera(_FakeCap("L", []), _FakeCap("R", [])) as cam:
+            with pytest.raises(ValueError, match=said):
+                capture(cam, tmp_path / "pairs", **kw)
+            assert cam.count == 0  # nothing read
+    assert not (tmp_path / "pairs").exists()
+
+
+def test_source_errors_keep_their_attributes_when_reworded_or_pickled() -> None:
+    import pickle
+
+    err = SourceError("x", side="left", frames=3, other_had_frames=False, gap="left_003.png")
+    for copy in (err.with_message("y"), pickle.loads(pickle.dumps(err))):
+        assert copy._kwargs() == err._kwargs() and copy.ended_early
+    assert str(err.with_message("y")) == "y" and str(pickle.loads(pickle.dumps(err))) == "x"
+
+
+def test_frames_raise_a_failure_that_is_no_end() -> None:
+    """frames() ends at a source's end, but a frame that does not decode is raised."""
+    with StereoCamera(_FakeCap("L", []), _Undecodable("R", [])) as cam:
+        with pytest.raises(SourceError, match="could not decode a frame"):
+            list(cam.frames())
+    with StereoCamera(_FakeCap("L", [], frames=2), _FakeCap("R", [], frames=2)) as cam:
+        assert len(list(cam.frames())) == 2
+
+
+def test_coverage_is_capped_and_its_bars_rounded() -> None:
+    """Coverage is span / ROS's target span, at most 1; a bar has round(10 * coverage) marks."""
+    col = ChessboardCollector((9, 6))
+    col.kept = [(0.0, 0.0, 0.0, 0.0), (0.5, 3.0, 0.0, 0.0)]
+    ranges = dict(zip(capmod.POSE_PARAM_NAMES, capmod.POSE_PARAM_RANGES, strict=True))
+    prog = col.progress()
+    assert prog["x"] == pytest.approx(min(1.0, 0.5 / ranges["x"])) and prog["y"] == 1.0
+    assert prog["size"] == prog["skew"] == 0.0
+    col.kept = [(0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.07 * ranges["skew"])]
+    assert "skew [#---------]   7%" in col.format_progress()  # 0.7 of a mark rounds to 1
+
+
+def test_live_board_corners_start_at_the_top_left_whichever_way_the_board_turns() -> None:
+    """A board turned half round is found with its corners in the opposite order; they are
+    given back starting at the top left, as calibrate.find_corners orders them."""
+    img = _board(POSE_A, 0, False)
+    for view in (img, np.ascontiguousarray(img[::-1, ::-1])):
+        c = detect_board_live(view, (9, 6))
+        assert c is not None and c[0].sum() < c[-1].sum()
