@@ -1803,3 +1803,18 @@ def test_live_board_corners_start_at_the_top_left_whichever_way_the_board_turns(
     for view in (img, np.ascontiguousarray(img[::-1, ::-1])):
         c = detect_board_live(view, (9, 6))
         assert c is not None and c[0].sum() < c[-1].sum()
+
+
+def test_save_pair_refuses_a_negative_or_fractional_index(tmp_path: Path) -> None:
+    """save_pair(-1) wrote left_-001.png, a name no pair numbering reads (next_pair_index
+    skipped it); 1.0 failed on the format code. Both are refused naming the index, before any
+    folder or file is made."""
+    img = np.zeros((8, 8, 3), np.uint8)
+    for bad in (-1, 1.0, True):
+        with pytest.raises(ValueError, match=rf"^index: expected a pair number >= 0, got {bad!r}$"):
+            save_pair(tmp_path / "pairs", bad, img, img)  # type: ignore[arg-type]
+    assert not (tmp_path / "pairs").exists()
+    assert [p.name for p in save_pair(tmp_path / "pairs", np.int64(0), img, img)] == [
+        "left_0000.png",
+        "right_0000.png",
+    ]

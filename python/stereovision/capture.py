@@ -1360,12 +1360,15 @@ def save_pair(
     Raises
     ------
     ValueError
-        If an image cannot be encoded in that format.
+        If ``index`` is not an integer ``>= 0``, or an image cannot be encoded in that format.
     FileExistsError
         If ``left_NNNN`` or ``right_NNNN`` exists (nothing of this pair is left behind).
     OSError
         If writing fails (no partial file, and no half pair, is left behind).
     """
+    # -1 made left_-001.png, a name next_pair_index does not read; a float failed on the format
+    if isinstance(index, bool) or not isinstance(index, (int, np.integer)) or index < 0:
+        raise ValueError(f"index: expected a pair number >= 0, got {index!r}")
     d = Path(directory)
     d.mkdir(parents=True, exist_ok=True)
     data = []
