@@ -1086,17 +1086,19 @@ def test_capture_refuses_to_save_into_the_sequence_it_reads(
         cv2.imwrite(str(pairs / f"right_{i:04d}.png"), _numbered(i, shade=160))
     lpat, rpat = str(pairs / "left_%04d.png"), str(pairs / "right_%04d.png")
     before = sorted(p.name for p in pairs.iterdir())
-    assert main(["capture", "--left", lpat, "--right", rpat, "-o", str(pairs)]) == 2
+    # count bounds each call: without the refusal they would save pairs for ever, not fail
+    argv = ["capture", "--left", lpat, "--right", rpat, "-o", str(pairs), "--count", "20"]
+    assert main(argv) == 2
     assert capsys.readouterr().err.splitlines() == [
         f"stereovision: error: -o {pairs}: the source {lpat} would read the pairs saved there as "
         "its next frames, without end; save them in another folder"
     ]
     with StereoCamera(lpat, rpat) as cam, pytest.raises(ValueError, match="without end"):
-        capture(cam, pairs)
+        capture(cam, pairs, count=20)
     other = _write_sequence(tmp_path / "other", "left", [_numbered(i) for i in range(3)])
     with StereoCamera(other, rpat) as cam:  # the right pattern alone reads them too
         with pytest.raises(ValueError, match=f"the source {re.escape(rpat)} would read"):
-            capture(cam, pairs)
+            capture(cam, pairs, count=20)
     assert sorted(p.name for p in pairs.iterdir()) == before
     lcam = _write_sequence(pairs, "cam0", [_numbered(i) for i in range(3)])
     rcam = _write_sequence(pairs, "cam1", [_numbered(i, shade=160) for i in range(3)])
