@@ -442,6 +442,10 @@ def test_resolution_request_and_resize_warning(tmp_path: Path) -> None:
         with pytest.raises(ValueError, match="WIDTHxHEIGHT"):
             parse_size(bad)
     assert parse_size("16384x8640") == (16384, 8640)
+    assert parse_size((640, 480)) == parse_size([640.0, np.int64(480)]) == (640, 480)
+    for bad in ((640.7, 480), (True, 480), (640,), (640, 480, 3), 640, (640, float("nan"))):
+        with pytest.raises(ValueError, match="WIDTHxHEIGHT"):  # 640.7 was cut, True taken as 1
+            parse_size(bad)
     with pytest.raises(ValueError, match="at most 16384 px per side, got 100000x100000"):
         parse_size("100000x100000")
     assert parse_source("0") == 0 and parse_source("a.avi") == "a.avi"
@@ -459,7 +463,7 @@ def test_open_failures_name_the_source(tmp_path: Path) -> None:
     with pytest.raises(SourceError, match="cannot open right source _FakeCap"):
         StereoCamera(good, _FakeCap("R", log, opened=False))
     assert good.released == 1  # the camera opened first is released
-    for fps in (-1, 0, float("nan"), float("inf")):
+    for fps in (-1, 0, float("nan"), float("inf"), True, "30"):
         with pytest.raises(ValueError, match=r"^fps: expected a positive number"):
             StereoCamera(left, left, fps=fps)
     assert issubclass(SourceError, OSError)

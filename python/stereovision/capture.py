@@ -245,7 +245,8 @@ def parse_size(text: str | tuple[int, int] | None, name: str = "size") -> tuple[
     Parameters
     ----------
     text : str or tuple of int or None
-        ``"WIDTHxHEIGHT"``, a ``(width, height)`` tuple (checked the same way), or None.
+        ``"WIDTHxHEIGHT"``, a ``(width, height)`` tuple or list of whole numbers (checked the
+        same way), or None.
     name : str
         What the messages call it (the parameter or option it came from).
 
@@ -266,7 +267,16 @@ def parse_size(text: str | tuple[int, int] | None, name: str = "size") -> tuple[
         m = re.fullmatch(r"\s*(\d+)\s*[xX]\s*(\d+)\s*", text)
         vals = (int(m.group(1)), int(m.group(2))) if m else (0, 0)
     else:
-        vals = (int(text[0]), int(text[1])) if len(text) == 2 else (0, 0)
+        # int() cut (640.7, 480) to 640x480 and took (True, 480) as 1x480 without a word
+        items = tuple(text) if isinstance(text, (tuple, list, np.ndarray)) else ()
+        whole = len(items) == 2 and all(
+            not isinstance(v, (bool, np.bool_))
+            and isinstance(v, (int, float, np.integer, np.floating))
+            and math.isfinite(v)
+            and float(v).is_integer()
+            for v in items
+        )
+        vals = (int(items[0]), int(items[1])) if whole else (0, 0)
     if min(vals) <= 0:
         raise ValueError(f"{name}: expected WIDTHxHEIGHT with positive integers, got {text!r}")
     # Frames of another size are resized to this one: 100000x100000 made OpenCV fail to
@@ -696,7 +706,12 @@ class StereoCamera(PairSource):
     ) -> None:
         self.sources = {"left": left, "right": right}
         self.requested_size = parse_size(image_size, "image_size")
-        if fps is not None and not (math.isfinite(fps) and fps > 0):
+        # True was taken as 1 fps, and "30" gave math's TypeError
+        if fps is not None and (
+            isinstance(fps, (bool, np.bool_))
+            or not isinstance(fps, (int, float, np.integer, np.floating))
+            or not (math.isfinite(fps) and fps > 0)
+        ):
             raise ValueError(f"fps: expected a positive number, got {fps!r}")
         self.requested_fourcc = parse_fourcc(fourcc)
         self.delivered_fourcc: dict[str, str] = {}
