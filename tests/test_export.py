@@ -776,3 +776,152 @@ def test_depth_png_refuses_what_it_cannot_read_or_write(tmp_path) -> None:
         export.write_depth_png(tmp_path / "z.PNG", np.zeros((2, 3)))
     assert export.read_depth_png(tmp_path / "z.PNG").shape == (2, 3)
     assert np.isnan(export.read_depth_png(tmp_path / "z.PNG")).all()
+
+
+# -------------------------------------------------------- mutation audit 2 (value tests)
+
+
+def _fake_mesh(points, faces):
+    """What write_mesh_ply reads of a mesh: points, the flat VTK face list, point data."""
+    from types import SimpleNamespace
+
+    return SimpleNamespace(
+        points=np.asarray(points, np.float32), faces=np.asarray(faces), point_data={}
+    )
+
+
+def test_mesh_ply_refuses_quads(tmp_path):
+    """Quads are refused by name, also when the face list's length is a multiple of 4 and
+    every 4th entry (read as a triangle's count) is at least 3."""
+    pts = np.zeros((8, 3))
+    for faces in ([4, 3, 4, 5, 6], [4, 3, 4, 5, 6] * 4):
+        with pytest.raises(ValueError, match="only triangle meshes are supported"):
+            export.write_mesh_ply(tmp_path / "q.ply", _fake_mesh(pts, faces))
+    assert not (tmp_path / "q.ply").exists()
+
+
+def test_unpack_rgb_refuses_values_that_are_not_4_bytes():
+    with pytest.raises(ValueError, match="packed rgb: expected 4-byte values, got float64"):
+        export._unpack_rgb(np.array([1.0, 2.0]))
+
+
+_XYZ_HEAD = (
+    "# .PCD v0.7\nVERSION 0.7\nFIELDS {fields}\nSIZE {sizes}\nTYPE {types}\nCOUNT {counts}\n"
+    "WIDTH {w}\nHEIGHT 1\nPOINTS {w}\nDATA {mode}\n"
+)
+
+
+def _xyz_pcd(path, rows="1 2 3\n4 5 6\n", w=2, mode="ascii", fields="x y z", counts="1 1 1"):
+    n = len(fields.split())
+    head = _XYZ_HEAD.format(
+        fields=fields, sizes=" ".join(["4"] * n), types=" ".join(["F"] * n), counts=counts,
+        w=w, mode=mode,
+    )  # fmt: skip
+    path.write_text(head + rows)
+    return path
+
+
+def test_read_pcd_names_what_is_wrong(tmp_path):
+    """read_pcd called directly (not through load_cloud, which checks the magic first)."""
+    with pytest.raises(FileNotFoundError, match=r"PCD file not found: .*none\.pcd"):
+        export.read_pcd(tmp_path / "none.pcd")
+    (tmp_path / "a.ply").write_text("ply\nformat ascii 1.0\nend_header\n")
+    with pytest.raises(ValueError, match=r"not a PCD file: .*a\.ply"):
+        export.read_pcd(tmp_path / "a.ply")
+    xy = _xyz_pcd(tmp_path / "xy.pcd", "1 2\n3 4\n", fields="x y", counts="1 1")
+    with pytest.raises(ValueError, match=r"fields \['x', 'y'\], expected x y z"):
+        export.read_pcd(xy)
+    neg = _xyz_pcd(tmp_path / "neg.pcd", w=-1)
+    with pytest.raises(ValueError, match=r"negative WIDTH or HEIGHT \(-1 x 1\)"):
+        export.read_pcd(neg)
+    more = _xyz_pcd(tmp_path / "more.pcd", "1 2 3\n4 5 6\n7 8 9\n")
+    with pytest.raises(ValueError, match=r"more\.pcd: expected 2 points, got 3$"):
+        export.read_pcd(more)
+    # PCL's binary_compressed (LZF, fields one after the other) is not read as binary records
+    packed = _xyz_pcd(tmp_path / "lzf.pcd", "", mode="binary_compressed")
+    packed.write_bytes(packed.read_bytes() + b"\0" * 64)
+    with pytest.raises(ValueError, match=r"unsupported DATA 'binary_compressed' \(ascii or b"):
+        export.read_pcd(packed)
+    quad = tmp_path / "u1.pcd"
+    quad.write_text(
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 1\nTYPE F F F U\n"
+        "COUNT 1 1 1 4\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n1 2 3 255 0 0 0\n"
+    )
+    with pytest.raises(ValueError, match=r"field 'rgb' of SIZE 1 COUNT 4, expected a packed"):
+        export.read_pcd(quad)
+
+
+def test_read_pcd_without_count_and_in_lower_case(tmp_path):
+    """COUNT is optional (1 per field) and the header's keywords are read in any case."""
+    path = tmp_path / "c.pcd"
+    path.write_text(
+        "# .PCD v0.7\nversion 0.7\nfields x y z rgb\nsize 4 4 4 4\ntype F F F U\nwidth 2\n"
+        f"height 1\npoints 2\ndata ascii\n1 2 3 {0xFF0000}\n4 5 6 {0x0A141E}\n"
+    )
+    pts, cols = export.read_pcd(path)
+    assert pts.reshape(-1, 3).tolist() == [[1, 2, 3], [4, 5, 6]]
+    assert cols.reshape(-1, 3).tolist() == [[255, 0, 0], [10, 20, 30]]
+
+
+def test_npz_bundle_keeps_the_left_camera_and_the_range(result, tmp_path):
+    """K is the left camera's (the frame of the points), not the right one's; a fractional
+    range stays fractional; without calibration baseline and doffs are NaN, not 0."""
+    c = syn.calibration()
+    K2 = c.K2.copy()
+    K2[0, 2] += 4.5
+    right_moved = replace(result, calibration=replace(c, K2=K2), max_disparity=37.5)
+    data = export.read_npz(export.write_npz(tmp_path / "k.npz", right_moved))
+    np.testing.assert_array_equal(data["K"], c.K1)
+    assert data["max_disparity"] == 37.5
+    data = export.read_npz(export.write_npz(tmp_path / "w.npz", result))
+    assert data["max_disparity"] == 16 and isinstance(data["max_disparity"], int)
+    bare = replace(result, depth=None, depth_sigma=None, calibration=None)
+    data = export.read_npz(export.write_npz(tmp_path / "b.npz", bare))
+    assert math.isnan(data["baseline"]) and math.isnan(data["doffs"])
+
+
+def test_foreign_bundle_without_k_or_with_a_nan_in_k(tmp_path):
+    np.savez(tmp_path / "d.npz", depth=np.ones((2, 2)))
+    with pytest.raises(ValueError, match=r"d\.npz: not a stereovision depth bundle \(needs"):
+        export.read_npz(tmp_path / "d.npz")
+    k = np.array([[100.0, 0, np.nan], [0, 100, 1], [0, 0, 1]])
+    np.savez(tmp_path / "n.npz", depth=np.ones((2, 2)), K=k)
+    with pytest.raises(ValueError, match=r"n\.npz: a depth bundle without calibration"):
+        export.load_cloud(tmp_path / "n.npz")
+
+
+def test_load_cloud_of_a_folder_and_an_upper_case_ply(tmp_path):
+    with pytest.raises(ValueError, match=r"^not a file: "):
+        export.load_cloud(tmp_path)
+    (tmp_path / "SCAN.PLY").write_bytes(b"\x89PNG not a ply")
+    with pytest.raises(ValueError, match=r"not a PLY file: .*SCAN\.PLY"):
+        export.load_cloud(tmp_path / "SCAN.PLY")
+
+
+def test_voxel_downsample_keeps_white_and_drops_partly_nan_points():
+    pts = np.array([[0.01, 0.01, 0.01], [0.02, 0.02, 0.02], [np.nan, 0.01, 0.01]])
+    cols = np.array([[255.0, 255, 255], [255, 253, 0], [0, 0, 0]])
+    down, dc = export.voxel_downsample(pts, cols, voxel=0.1)
+    np.testing.assert_allclose(down, [[0.015, 0.015, 0.015]], rtol=1e-6)
+    assert dc.tolist() == [[255, 254, 128]]  # 127.5 rounds to even
+
+
+def test_depth_png_warning_and_suffix(tmp_path):
+    """The all-0 warning points at the caller's line and only comes when nothing fits; a
+    16-bit image is refused under another suffix than .png."""
+    import warnings
+
+    with pytest.warns(UserWarning, match="millimetres given") as rec:
+        export.write_depth_png(tmp_path / "mm.png", np.full((2, 2), 1500.0))
+    assert rec[0].filename == __file__
+    with pytest.warns(UserWarning, match="none of its 4 values") as rec:
+        export.encode_depth_png(np.full((2, 2), 1500.0))
+    assert rec[0].filename == __file__
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        export.write_depth_png(tmp_path / "far.png", np.array([[1.0, 70.0]]))
+    assert export.read_depth_png(tmp_path / "far.png")[0, 0] == 1.0
+    for name in ("d.tiff", "d.jpg", "d"):
+        with pytest.raises(ValueError, match=r"a 16-bit depth image is written as \.png"):
+            export.write_depth_png(tmp_path / name, np.ones((2, 2)))
+        assert not (tmp_path / name).exists()
