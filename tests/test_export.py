@@ -925,3 +925,14 @@ def test_depth_png_warning_and_suffix(tmp_path):
         with pytest.raises(ValueError, match=r"a 16-bit depth image is written as \.png"):
             export.write_depth_png(tmp_path / name, np.ones((2, 2)))
         assert not (tmp_path / name).exists()
+
+
+def test_export_result_formats_as_one_string_is_named(result, tmp_path):
+    """``formats="ply"`` was split into letters: "unknown export format(s) ['l', 'p', 'y']"
+    (and nothing written); the string is named, with the tuple to give instead."""
+    with pytest.raises(TypeError) as info:
+        export.export_result(result, tmp_path / "out", "ply")
+    assert str(info.value) == (
+        "formats: expected a tuple of format names, got the string 'ply' (give ('ply',))"
+    )
+    assert not (tmp_path / "out").exists()

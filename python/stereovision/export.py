@@ -945,9 +945,17 @@ def export_result(
 
     Raises
     ------
+    TypeError
+        If ``formats`` is one string (``"ply"``), not a tuple of them.
     ValueError
         Unknown format, or PLY / PCD / depth PNG asked for a result without calibration.
     """
+    if isinstance(formats, str):
+        # set("ply") is its letters: "unknown export format(s) ['l', 'p', 'y']"
+        raise TypeError(
+            f"formats: expected a tuple of format names, got the string {formats!r} "
+            f"(give ({formats!r},))"
+        )
     unknown = set(formats) - set(EXPORT_FORMATS)
     if unknown:
         raise ValueError(
