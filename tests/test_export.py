@@ -298,6 +298,7 @@ def test_load_cloud_errors(tmp_path):
         (np.ones((4, 4)), np.ones(3), r"its K has shape \(3,\), expected \(3, 3\)"),
         (np.ones((4, 4)), np.zeros((3, 3)), "its K has focal lengths 0 and 0, expected positive"),
         (np.array(["a", "b"]), np.eye(3), "its depth is not numbers"),
+        (np.ones((4, 4), bool), np.eye(3), r"its depth is not numbers \(bool\)"),
     ],
 )
 def test_a_foreign_npz_bundle_is_named(tmp_path, depth, k, message):
@@ -936,3 +937,98 @@ def test_export_result_formats_as_one_string_is_named(result, tmp_path):
         "formats: expected a tuple of format names, got the string 'ply' (give ('ply',))"
     )
     assert not (tmp_path / "out").exists()
+
+
+def test_pcd_without_the_comment_line_and_with_signed_colours(tmp_path):
+    """A PCD may start at VERSION (the comment line is optional); a ``TYPE I`` colour holds
+    the bits as a signed integer (opaque red 0xFFFF0000 is -65536)."""
+    path = tmp_path / "i.pcd"
+    path.write_text(
+        "VERSION 0.7\nFIELDS x y z rgba\nSIZE 4 4 4 4\nTYPE F F F I\nCOUNT 1 1 1 1\n"
+        "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1 2 3 -65536\n4 5 6 -16116706\n"
+    )
+    pts, cols = export.load_cloud(path)
+    assert pts.tolist() == [[1, 2, 3], [4, 5, 6]]
+    assert cols.tolist() == [[255, 0, 0], [10, 20, 30]]  # -16116706 = 0xFF0A141E
+
+
+def test_binary_pcd_with_bytes_after_its_points(tmp_path):
+    """Bytes after the WIDTH x HEIGHT records (a closing newline) are not points."""
+    path = _xyz_pcd(tmp_path / "b.pcd", "", mode="binary")
+    path.write_bytes(path.read_bytes() + np.arange(6, dtype="<f4").tobytes() + b"\n")
+    pts, cols = export.read_pcd(path)
+    assert pts.tolist() == [[[0, 1, 2], [3, 4, 5]]] and cols is None
+
+
+def test_ascii_pcd_rows_short_of_a_count_field(tmp_path):
+    path = tmp_path / "c.pcd"
+    path.write_text(
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS uv x y z rgb\nSIZE 4 4 4 4 4\nTYPE F F F F U\n"
+        "COUNT 2 1 1 1 1\nWIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n0.5 1 2 3 0\n0.5 4 5 6 0\n"
+    )
+    with pytest.raises(ValueError, match=r"rows of 5 values, FIELDS has 6 \(with its COUNT\)$"):
+        export.read_pcd(path)
+
+
+def test_load_cloud_keeps_the_colours_of_a_cloud_without_nan(tmp_path):
+    from stereovision.io import write_ply
+
+    pts = np.array([[1, 2, 3], [4, 5, 6]], np.float32)
+    cols = np.array([[255, 0, 0], [10, 20, 30]], np.uint8)
+    back, back_cols = export.load_cloud(write_ply(tmp_path / "c.ply", pts, cols))
+    np.testing.assert_array_equal(back, pts)
+    np.testing.assert_array_equal(back_cols, cols)
+
+
+def test_voxel_downsample_colour_shape_and_an_all_nan_cloud():
+    pts = np.zeros((2, 3))
+    with pytest.raises(ValueError, match=r"colors: expected shape \(2, 3\), got \(2, 4\)"):
+        export.voxel_downsample(pts, np.zeros((2, 4), np.uint8))
+    down, dc = export.voxel_downsample(np.full((2, 3), np.nan), np.zeros((2, 3), np.uint8))
+    assert down.shape == (0, 3) and dc is not None and dc.shape == (0, 3)
+    assert dc.dtype == np.uint8
+
+
+def test_empty_png_is_not_a_png(tmp_path):
+    (tmp_path / "e.png").write_bytes(b"")
+    with pytest.raises(ValueError, match=r"e\.png: expected a single-channel 16-bit PNG, got not"):
+        export.read_depth_png(tmp_path / "e.png")
+
+
+def test_writers_make_nested_folders_and_return_paths(result, tmp_path):
+    """export_result creates missing parent folders; every writer returns a Path for a str."""
+    written = export.export_result(result, tmp_path / "a" / "b", ("npz",))
+    assert written["depth.npz"] == tmp_path / "a" / "b" / "depth.npz"
+    for write, name in (
+        (export.write_cloud_ply, "c.ply"),
+        (export.write_pcd, "c.pcd"),
+        (export.write_npz, "d.npz"),
+        (export.write_depth_png, "d.png"),
+        (export.write_disparity_png, "p.png"),
+    ):
+        out = write(str(tmp_path / name), result)
+        assert isinstance(out, type(tmp_path)) and out == tmp_path / name
+
+
+def test_mesh_without_colours(tmp_path):
+    """A mesh without point data ``RGB`` is written with x y z vertices only."""
+    from stereovision.io import read_ply
+
+    mesh = _fake_mesh([[0, 0, 1], [1, 0, 1], [0, 1, 2]], [3, 0, 1, 2])
+    path = export.write_mesh_ply(tmp_path / "m.ply", mesh)
+    assert b"property uchar red" not in path.read_bytes()[:400]
+    pts, cols = read_ply(path)
+    assert pts.tolist() == [[0, 0, 1], [1, 0, 1], [0, 1, 2]] and cols is None
+
+
+def test_npz_bundle_types_and_refuses_pickles(result, tmp_path):
+    """Maps are float32 whatever the result holds; an object array (a pickle, which could run
+    code on load) is refused; a missing bundle is FileNotFoundError."""
+    wide = replace(result, confidence=result.confidence.astype(np.float64))
+    data = export.read_npz(export.write_npz(tmp_path / "w.npz", wide))
+    assert data["confidence"].dtype == np.float32
+    np.savez(tmp_path / "o.npz", depth=np.ones((2, 2)), K=np.eye(3), extra=np.array([{}]))
+    with pytest.raises(ValueError, match=r"not an \.npz bundle \(or a damaged one\): .*o\.npz"):
+        export.read_npz(tmp_path / "o.npz")
+    with pytest.raises(FileNotFoundError, match=r"npz file not found: .*none\.npz"):
+        export.read_npz(tmp_path / "none.npz")
