@@ -1032,3 +1032,24 @@ def test_npz_bundle_types_and_refuses_pickles(result, tmp_path):
         export.read_npz(tmp_path / "o.npz")
     with pytest.raises(FileNotFoundError, match=r"npz file not found: .*none\.npz"):
         export.read_npz(tmp_path / "none.npz")
+
+
+@pytest.mark.parametrize(
+    ("voxel", "shown"),
+    [("0.05", "'0.05'"), (None, "None"), ([0.05], r"\[0.05\]"), (10**400, "an integer of 401 d")],
+    ids=["str", "None", "list", "10**400"],
+)
+def test_voxel_that_is_not_a_number_is_named(voxel, shown):
+    """A string, None or a list failed inside numpy ("ufunc 'isfinite' not supported for the
+    input types", naming no argument), as did an int too large for a float."""
+    with pytest.raises(ValueError, match=rf"^voxel: expected a positive cube side, got {shown}"):
+        export.voxel_downsample(np.zeros((3, 3)), voxel=voxel)
+
+
+def test_voxel_takes_any_real_number():
+    """A Fraction failed in numpy's isfinite; ints and numpy scalars work as floats do."""
+    pts = np.array([[0.01, 0.0, 0.0], [0.04, 0.0, 0.0], [0.06, 0.0, 0.0]])
+    for voxel in (Fraction(1, 20), 0.05, np.float32(0.05)):
+        down, _ = export.voxel_downsample(pts, voxel=voxel)
+        np.testing.assert_allclose(down, [[0.025, 0, 0], [0.06, 0, 0]], rtol=1e-6)
+    assert len(export.voxel_downsample(pts, voxel=1)[0]) == 1

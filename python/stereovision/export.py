@@ -641,8 +641,16 @@ def voxel_downsample(
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ValueError(f"points: expected shape (N, 3), got {pts.shape}")
-    if isinstance(voxel, bool) or not (np.isfinite(voxel) and voxel > 0):
+    # Not a real number (a string, None): numpy's isfinite failed naming no argument.
+    if isinstance(voxel, (bool, np.bool_)) or not isinstance(voxel, numbers.Real):
         raise ValueError(f"voxel: expected a positive cube side, got {voxel!r}")
+    try:  # as a float: a Fraction made numpy's isfinite fail
+        side = float(voxel)
+    except OverflowError:  # an int too large for a float
+        side = math.inf
+    if not (math.isfinite(side) and side > 0):
+        raise ValueError(f"voxel: expected a positive cube side, got {number_shown(voxel)}")
+    voxel = side
     cols = None
     if colors is not None:
         cols = np.asarray(colors)
