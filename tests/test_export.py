@@ -1053,3 +1053,18 @@ def test_voxel_takes_any_real_number():
         down, _ = export.voxel_downsample(pts, voxel=voxel)
         np.testing.assert_allclose(down, [[0.025, 0, 0], [0.06, 0, 0]], rtol=1e-6)
     assert len(export.voxel_downsample(pts, voxel=1)[0]) == 1
+
+
+def test_pcd_of_a_result_with_a_grey_left_image(result, tmp_path):
+    """A grey (H, W) left image: organised_points gave it mirrored (``[..., ::-1]`` reversed
+    its columns) as (H, W) colours and write_pcd failed with NumPy's "could not broadcast";
+    as write_cloud_ply (and the ROS bag writer) do, the cloud's own colours are used."""
+    from stereovision.io import read_ply
+
+    grey = replace(result, left_rectified=result.left_rectified[..., 1].copy())
+    pts, cols = export.read_pcd(export.write_pcd(tmp_path / "g.pcd", grey))
+    x, y = result.pixels[:, 0], result.pixels[:, 1]
+    np.testing.assert_array_equal(pts[y, x], result.points)
+    np.testing.assert_array_equal(cols[y, x], result.colors)
+    _, ply_cols = read_ply(export.write_cloud_ply(tmp_path / "g.ply", grey))
+    np.testing.assert_array_equal(ply_cols, result.colors)
