@@ -1068,3 +1068,36 @@ def test_pcd_of_a_result_with_a_grey_left_image(result, tmp_path):
     np.testing.assert_array_equal(cols[y, x], result.colors)
     _, ply_cols = read_ply(export.write_cloud_ply(tmp_path / "g.ply", grey))
     np.testing.assert_array_equal(ply_cols, result.colors)
+
+
+def test_depth_png_scale_and_its_smallest_value(result, tmp_path):
+    """encode_depth_png writes millimetres by default (the bytes write_depth_png writes); a
+    result is written at the scale given; 1 mm (the value 1) reads back, only 0 is none."""
+    z = np.array([[1.2344, 0.001, np.nan]])
+    png = export.encode_depth_png(z)
+    assert png == export.write_depth_png(tmp_path / "z.png", z).read_bytes()
+    raw = cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_UNCHANGED)
+    assert raw.tolist() == [[1234, 1, 0]]
+    back = export.read_depth_png(tmp_path / "z.png")
+    assert back[0, 1] == np.float32(0.001) and np.isnan(back[0, 2])
+    tum = export.write_depth_png(tmp_path / "tum.png", result, scale=5000)
+    raw = cv2.imread(str(tum), cv2.IMREAD_UNCHANGED)
+    assert raw[60, 80] == round(syn.BOX_Z * 5000) and raw[5, 150] == round(syn.WALL_Z * 5000)
+
+
+def test_disparity_png_warning_does_not_speak_of_millimetres(tmp_path):
+    with pytest.warns(UserWarning) as rec:
+        export.write_disparity_png(tmp_path / "d.png", np.full((2, 2), 300.0))
+    assert str(rec[0].message) == (
+        "disparity: none of its 4 values fits 1..65535 at scale 256: the image is all 0"
+    )
+
+
+def test_pcd_header_incomplete_or_not_terminated(tmp_path):
+    path = _xyz_pcd(tmp_path / "h.pcd")
+    path.write_text(path.read_text().replace("WIDTH 2\n", ""))
+    with pytest.raises(ValueError, match=r"^PCD file .*h\.pcd: incomplete header$"):
+        export.read_pcd(path)
+    path.write_text("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4")
+    with pytest.raises(ValueError, match=r"^not a PCD file \(header not terminated\): "):
+        export.read_pcd(path)
