@@ -1101,3 +1101,11 @@ def test_pcd_header_incomplete_or_not_terminated(tmp_path):
     path.write_text("# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4")
     with pytest.raises(ValueError, match=r"^not a PCD file \(header not terminated\): "):
         export.read_pcd(path)
+
+
+def test_read_npz_of_a_npy_file_is_named(tmp_path):
+    """np.load gives a .npy file's array, not a bundle: read_npz failed with "'numpy.ndarray'
+    object does not support the context manager protocol"."""
+    np.save(tmp_path / "d.npy", np.ones((2, 2)))
+    with pytest.raises(ValueError, match=r"^not an \.npz bundle \(or a damaged one\): .*d\.npy$"):
+        export.read_npz(tmp_path / "d.npy")

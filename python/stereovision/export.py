@@ -491,7 +491,10 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     if not p.is_file():
         raise FileNotFoundError(f"npz file not found: {p}")
     try:
-        with np.load(p, allow_pickle=False) as z:
+        loaded = np.load(p, allow_pickle=False)
+        if not isinstance(loaded, np.lib.npyio.NpzFile):  # a .npy file: one array, no bundle
+            raise ValueError
+        with loaded as z:
             data = {k: z[k] for k in z.files}
     except (zipfile.BadZipFile, zlib.error, EOFError, ValueError, OSError):
         # zlib.error / EOFError: a bundle whose compressed members are damaged or cut.
