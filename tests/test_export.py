@@ -1109,3 +1109,13 @@ def test_read_npz_of_a_npy_file_is_named(tmp_path):
     np.save(tmp_path / "d.npy", np.ones((2, 2)))
     with pytest.raises(ValueError, match=r"^not an \.npz bundle \(or a damaged one\): .*d\.npy$"):
         export.read_npz(tmp_path / "d.npy")
+
+
+def test_encode_depth_png_of_a_whole_result_is_named(result):
+    """write_depth_png takes a result; encode_depth_png (its bytes, for a map) failed with
+    "float() argument must be a string or a real number, not 'DepthResult'"."""
+    with pytest.raises(TypeError, match=r"^depth: got a DepthResult; pass its array, result\.dep"):
+        export.encode_depth_png(result)
+    assert export.encode_depth_png(result.depth) == export.encode_depth_png(
+        np.asarray(result.depth, np.float64)
+    )

@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING, Any, overload
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import number_shown, renamed_keyword
+from stereovision._validate import not_a_result, number_shown, renamed_keyword
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -640,8 +640,6 @@ def voxel_downsample(
         If ``points`` is not ``(N, 3)``, ``colors`` does not match it or holds values outside
         0-255, or ``voxel`` is not a positive number.
     """
-    from stereovision._validate import not_a_result
-
     not_a_result(points, "points", "points")
     pts = np.asarray(points, dtype=np.float64)
     if pts.ndim != 2 or pts.shape[1] != 3:
@@ -750,10 +748,12 @@ def encode_depth_png(depth: npt.ArrayLike, scale: float = DEPTH_PNG_SCALE) -> by
     Raises
     ------
     TypeError
-        If ``scale`` is not a real number (a string, a bool).
+        If ``scale`` is not a real number (a string, a bool), or ``depth`` is a whole
+        :class:`~stereovision.DepthResult` (its ``depth`` is meant).
     ValueError
         If ``scale`` is not positive and finite, or ``depth`` is not a non-empty 2-D map.
     """
+    not_a_result(depth, "depth", "depth")  # else numpy's "float() argument must be ..."
     return _png16_bytes(_scaled_u16(depth, scale, "depth"), "depth")
 
 
