@@ -286,6 +286,23 @@ def test_surface_mesh_errors(result):
         render.surface_mesh(replace(result, depth=None, calibration=None))
 
 
+def test_surface_mesh_texture_of_a_grey_or_bgra_left_image(result):
+    """The texture is the left image in RGB: a grey (H, W) one repeated in the three channels
+    (``[..., ::-1]`` mirrored its columns, and its reshape to RGB rows failed or scrambled
+    them), a BGRA one without its alpha."""
+    from dataclasses import replace
+
+    bgr = result.left_rectified
+    tex = render.texture_of(render.surface_mesh(result)).to_array()
+    np.testing.assert_array_equal(tex.reshape(bgr.shape), bgr[..., ::-1])
+    grey = bgr[..., 1].copy()
+    tex = render.texture_of(render.surface_mesh(replace(result, left_rectified=grey)))
+    np.testing.assert_array_equal(tex.to_array().reshape(bgr.shape), np.dstack([grey] * 3))
+    bgra = np.dstack([bgr, np.full(grey.shape, 7, np.uint8)])
+    tex = render.texture_of(render.surface_mesh(replace(result, left_rectified=bgra)))
+    np.testing.assert_array_equal(tex.to_array().reshape(bgr.shape), bgr[..., ::-1])
+
+
 def test_zero_pose_render_reproduces_left_image(result, mesh):
     img = render.render_view(mesh, intrinsics=render.Intrinsics.from_result(result))
     assert img.shape == (syn.H, syn.W, 3)

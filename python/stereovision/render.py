@@ -713,8 +713,13 @@ def surface_mesh(
     v = 1.0 - (ys[sel] + 0.5) / h
     mesh.active_texture_coordinates = np.stack([u, v], axis=1).astype(np.float32)
     mesh.point_data["RGB"] = result.colors[sel]
-    if result.left_rectified is not None:
-        rgb = np.ascontiguousarray(result.left_rectified[..., ::-1])
+    img = result.left_rectified
+    if img is not None:
+        # a grey (H, W) image has no channels to reverse: [..., ::-1] mirrored its columns
+        # into a texture of the wrong size; BGRA's alpha is no colour
+        rgb = np.ascontiguousarray(
+            np.repeat(img[..., None], 3, axis=2) if img.ndim == 2 else img[..., 2::-1]
+        )
         mesh.field_data["texture_rgb"] = rgb.reshape(-1, 3)
         mesh.field_data["texture_shape"] = np.array(rgb.shape[:2], dtype=np.int64)
     return mesh
