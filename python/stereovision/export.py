@@ -318,11 +318,13 @@ def read_pcd(
     FileNotFoundError
         Missing file.
     ValueError
-        Not a PCD file, unsupported fields / compression, truncated data.
+        Not a PCD file, unsupported fields / compression, truncated data, or a folder.
     """
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise FileNotFoundError(f"PCD file not found: {p}")
+    if not p.is_file():  # a folder was "not found", as if the path were wrong (as load_cloud)
+        raise ValueError(f"not a file: {p}")
     raw = p.read_bytes()
     if not raw.startswith(_PCD_MAGIC):
         raise ValueError(f"not a PCD file: {p}")
@@ -485,11 +487,13 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     FileNotFoundError
         Missing file.
     ValueError
-        If the file is not an ``.npz`` bundle with ``depth`` and ``K``.
+        If the file is not an ``.npz`` bundle with ``depth`` and ``K``, or is a folder.
     """
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise FileNotFoundError(f"npz file not found: {p}")
+    if not p.is_file():  # a folder was "not found", as if the path were wrong (as load_cloud)
+        raise ValueError(f"not a file: {p}")
     try:
         loaded = np.load(p, allow_pickle=False)
         if not isinstance(loaded, np.lib.npyio.NpzFile):  # a .npy file: one array, no bundle
