@@ -845,7 +845,8 @@ def write_depth_png(
 def write_disparity_png(path: PathLike, disparity: DepthResult | npt.ArrayLike) -> Path:
     """Disparity in KITTI's 16-bit PNG format: ``round(d * 256)``, 0 = no disparity.
 
-    Disparities at or below 1/512 px and above 255.996 px are written as 0.
+    Disparities at or below 1/512 px and at or above 65535.5/256 = 255.998 px (which would round
+    past 16 bits) are written as 0.
 
     Parameters
     ----------
