@@ -1170,3 +1170,198 @@ def test_below_share_is_the_documented_rule() -> None:
     res = short[plane.inliers]
     assert plane.rms_px == pytest.approx(math.sqrt(float(np.mean(res**2))), rel=1e-9)
     assert plane.inlier_share == pytest.approx(plane.inliers.sum() / known.sum(), rel=1e-12)
+
+
+def _exact_floor(calib: Calibration, pitch: float = 8.0, roll: float = -5.0) -> np.ndarray:
+    """The exact disparity of a floor 1.3 m under ``calib``'s rectified left camera, pitched and
+    rolled (NaN where no floor is seen)."""
+    rc = calib if calib.rectified else calib.rectified_calibration()
+    f, cx, cy = rc.K1[0, 0], rc.K1[0, 2], rc.K1[1, 2]
+    w, h = rc.image_size
+    n_true = _camera_rotation(pitch, roll) @ np.array([0.0, -1.0, 0.0])
+    v, u = np.mgrid[0:h, 0:w].astype(np.float64)
+    rays = np.stack([(u - cx) / f, (v - cy) / f, np.ones_like(u)], axis=-1)
+    z = -1.3 / (rays @ n_true)
+    out: np.ndarray = np.where(z > 0, f * rc.baseline_m / z - rc.doffs_px, np.nan)
+    return out
+
+
+def test_zero_and_negative_disparities_are_unknown() -> None:
+    """A matcher's 0 or -1 for "no match" is no pixel of the map: the floor holds all of the
+    pixels with a disparity, as when those pixels are NaN (counted, they lowered its share)."""
+    floor = _exact_floor(RIG)
+    marked, unknown = floor.copy(), floor.copy()
+    marked[:100], marked[100:120] = 0.0, -1.0
+    unknown[:120] = np.nan
+    got, want = fit_ground_plane(marked, RIG), fit_ground_plane(unknown, RIG)
+    assert got is not None and want is not None
+    assert got.inlier_share == want.inlier_share == 1.0
+    assert got.height == pytest.approx(1.3, rel=1e-9) and got.below_share == 0.0
+
+
+def test_the_fewest_pixels_a_fit_is_tried_on() -> None:
+    """MIN_PIXELS disparities over the floor give it; one fewer gives None."""
+    from stereovision.ground import MIN_PIXELS
+
+    floor = _exact_floor(RIG)
+    idx = np.argwhere(np.isfinite(floor))
+    pick = idx[np.random.default_rng(1).choice(len(idx), MIN_PIXELS, replace=False)]
+    sparse = np.full_like(floor, np.nan)
+    sparse[pick[:, 0], pick[:, 1]] = floor[pick[:, 0], pick[:, 1]]
+    plane = fit_ground_plane(sparse, RIG)
+    assert plane is not None and plane.height == pytest.approx(1.3, rel=1e-9)
+    sparse[pick[0, 0], pick[0, 1]] = np.nan
+    assert fit_ground_plane(sparse, RIG) is None
+
+
+def test_a_band_of_15_rows_is_a_plane() -> None:
+    """The spread needed is a share of the image's shorter side (360 px: 3.6 px): a band of 15
+    rows (4.3 px) of an 800 x 360 rig gives the floor, where the longer side's 8 px refused it."""
+    k = [[F, 0, 399.5], [0, F, 179.5], [0, 0, 1]]
+    rig = Calibration(
+        K1=k, D1=np.zeros(5), K2=k, D2=np.zeros(5), R=np.eye(3), T=[-0.12, 0, 0],
+        image_size=(800, 360), rectified=True,
+    )  # fmt: skip
+    floor = _exact_floor(rig)
+    band = np.full_like(floor, np.nan)
+    band[300:315] = floor[300:315]
+    plane = fit_ground_plane(band, rig)
+    assert plane is not None and plane.height == pytest.approx(1.3, rel=1e-6)
+
+
+def test_support_of_an_empty_map_and_of_another_sized_plane() -> None:
+    """support() of a map without a disparity is 0 (nothing holds); a plane fitted at another
+    size than the rig's is refused even when the map and the rig agree."""
+    floor = _exact_floor(RIG)
+    plane = fit_ground_plane(floor, RIG)
+    assert plane is not None
+    assert plane.support(np.full_like(floor, np.nan), RIG) == 0.0
+    half = RIG.scaled_to((240, 180))
+    with pytest.raises(ValueError, match="this plane's 480x360"):
+        plane.support(floor[::2, ::2], half)
+
+
+def test_the_floor_stays_inside_the_tilt_cone() -> None:
+    """A floor tilted 38 degrees from the camera's up, max_tilt_deg 35: whatever plane comes
+    out leans at most 35 degrees (measured 34.5; the refit past the cone came out at 38.1)."""
+    n_true = _camera_rotation(10.0, 37.0) @ np.array([0.0, -1.0, 0.0])
+    v, u = np.mgrid[0 : SIZE[1], 0 : SIZE[0]].astype(np.float64)
+    rays = np.stack([(u - 239.5) / F, (v - 179.5) / F, np.ones_like(u)], axis=-1)
+    z = -1.3 / (rays @ n_true)
+    noise = np.random.default_rng(0).normal(0.0, 0.2, z.shape)
+    disp = np.where(z > 0, F * 0.12 / z + noise, np.nan)
+    disp[disp <= 0] = np.nan
+    plane = fit_ground_plane(disp, RIG, max_tilt_deg=35.0)
+    assert plane is not None
+    assert math.degrees(math.acos(-plane.normal[1])) <= 35.0
+
+
+def test_the_same_seed_gives_the_same_floor() -> None:
+    """Determinism: a floor dropping 0.3 m 6 m ahead, fitted twice with the same seed, is the
+    same plane to the bit (an unseeded sample moved below_share in the 4th digit)."""
+    disp = _floor_disparity(12.0, [(0.0, 6.0, 0.0, 0.0), (6.0, math.inf, 0.3, 0.0)], 0.05)
+    a, b = fit_ground_plane(disp, RIG, seed=0), fit_ground_plane(disp, RIG, seed=0)
+    assert a is not None and b is not None
+    assert a.disparity_plane == b.disparity_plane and a.below_share == b.below_share
+
+
+def test_below_share_with_middleburys_doffs() -> None:
+    """The points below the floor are placed with the rig's doffs (Z = f B / (d + doffs)): the
+    same scene, its disparities 15 px smaller under doffs 15, has the same share below (was 0:
+    without doffs every point came out farther and higher)."""
+    doffs = 15.0
+    rc = Calibration(
+        K1=RIG.K1, D1=RIG.D1, K2=[[F, 0, 239.5 + doffs], [0, F, 179.5], [0, 0, 1]], D2=RIG.D2,
+        R=RIG.R, T=RIG.T, image_size=SIZE, rectified=True,
+    )  # fmt: skip
+    disp = _floor_disparity(12.0, [(0.0, 6.0, 0.0, 0.0), (6.0, math.inf, 0.3, 0.0)], 0.05)
+    plain, shifted = fit_ground_plane(disp, RIG), fit_ground_plane(disp - doffs, rc)
+    assert plain is not None and shifted is not None
+    assert 0.06 < shifted.below_share == pytest.approx(plain.below_share, abs=1e-9)
+
+
+def test_a_raw_rig_is_fitted_in_its_rectified_geometry() -> None:
+    """A raw (distorted) calibration fits the disparity of its rectified images with its
+    rectified camera: the same plane as its rectified_calibration() (the raw K1 put the
+    camera's pitch at 8.51 degrees instead of 8)."""
+    raw = Calibration(
+        K1=np.array([[700, 0, 330], [0, 705, 245], [0, 0, 1.0]]),
+        D1=np.array([-0.2, 0.05, 0.001, -0.001, 0.0]),
+        K2=np.array([[710, 0, 320], [0, 708, 238], [0, 0, 1.0]]),
+        D2=np.array([-0.18, 0.04, -0.0005, 0.0008, 0.0]),
+        R=cv2.Rodrigues(np.array([0.01, -0.02, 0.005]))[0],
+        T=np.array([-0.12, 0.0015, -0.002]),
+        image_size=(640, 480),
+    )
+    disp = _exact_floor(raw)
+    got = fit_ground_plane(disp, raw)
+    assert got is not None
+    assert got.height == pytest.approx(1.3, rel=1e-9)
+    assert got.pitch_deg == pytest.approx(8.0, abs=1e-6)
+    assert got.roll_deg == pytest.approx(-5.0, abs=1e-6)
+
+
+def test_a_camera_looking_straight_down() -> None:
+    """Looking straight down, the floor frame's forward is the image's up: the limit of the
+    frames of a camera pitched 89 to 89.99 degrees, a rotation (det 1)."""
+    from stereovision.ground import floor_frame
+
+    def frame(pitch: float) -> np.ndarray:
+        t = math.radians(pitch)
+        plane = GroundPlane(
+            normal=np.array([0.0, -math.cos(t), -math.sin(t)]),
+            height=1.0,
+            disparity_plane=(0.0, 0.0, 0.0),
+            inliers=np.zeros((4, 4), bool),
+            inlier_share=1.0,
+            rms_px=0.0,
+        )
+        return floor_frame(plane)
+
+    down = frame(90.0)
+    np.testing.assert_allclose(down[0], [0.0, -1.0, 0.0], atol=1e-12)  # forward: image's up
+    np.testing.assert_allclose(down, frame(89.99), atol=1e-3)
+    assert np.linalg.det(down) == pytest.approx(1.0)
+
+
+def test_occupancy_grid_extent_height_band_and_size() -> None:
+    """An extent not a whole number of cells is covered (1 m of 0.3 m cells: 4, the last one
+    holding a box 0.95 m ahead); points above max_height leave their cell unknown; a grid over
+    4096 cells across (sideways too) is refused."""
+    from stereovision.ground import occupancy_grid
+
+    plane, _ = _level_floor()
+    box = _camera_points([(0.95, 0.0, 0.5)] * 3)
+    grid = occupancy_grid(box, plane, resolution=0.3, forward=(0, 1), lateral=(-0.3, 0.3))
+    assert grid.data.shape == (2, 4) and grid.data[1, 3] == 100
+    high = _camera_points([(0.95, 0.0, 2.5)] * 3)
+    grid = occupancy_grid(high, plane, resolution=0.3, forward=(0, 1), lateral=(-0.3, 0.3))
+    assert (grid.data == -1).all()
+    with pytest.raises(ValueError, match="over 4096 cells a side"):
+        occupancy_grid(box, plane, resolution=0.1, lateral=(-500, 500))
+
+
+def test_laser_scan_beam_count_and_range_min() -> None:
+    """-0.3 to 0.3 rad by 0.1 rad is 7 beams (0.6 / 0.1 is 5.999999999999999 in floats: 6
+    beams, angle_max 0.2); points nearer than range_min are dropped: the hand-placed beam's
+    third point is then its 4 m one, and the beam whose obstacles all lie nearer sees none."""
+    plane, pts = _level_floor()
+    scan = laser_scan(pts, plane, angle_min=-0.3, angle_max=0.3, angle_increment=0.1)
+    assert len(scan.ranges) == 7 and scan.angle_max == pytest.approx(0.3, abs=1e-12)
+    a4 = 0.5
+    pts = _camera_points(
+        [(r, 0.0, 0.5) for r in (2.0, 2.5, 3.0, 4.0)]
+        + [(r * math.cos(a4), r * math.sin(a4), 0.4) for r in (1.0, 1.5, 2.0)]
+    )
+    scan = laser_scan(
+        pts, plane, angle_min=-0.5, angle_max=0.5, angle_increment=0.25, range_min=2.2
+    )
+    np.testing.assert_array_equal(scan.ranges, np.float32([np.nan, np.nan, 4.0, np.nan, np.nan]))
+
+
+def test_height_limits_out_of_range() -> None:
+    """A negative min_height, or a max_height of -10**400 (a float's -inf, not +inf), is refused."""
+    plane, pts = _level_floor()
+    for kw in ({"min_height": -0.1}, {"max_height": -(10**400)}):
+        with pytest.raises(ValueError, match="0 <= min_height < max_height"):
+            obstacle_mask(pts, plane, **kw)
