@@ -1365,3 +1365,18 @@ def test_height_limits_out_of_range() -> None:
     for kw in ({"min_height": -0.1}, {"max_height": -(10**400)}):
         with pytest.raises(ValueError, match="0 <= min_height < max_height"):
             obstacle_mask(pts, plane, **kw)
+
+
+def test_points_outside_the_band_or_behind_the_grid_are_no_obstacle() -> None:
+    """Obstacle points above max_height (what the robot passes under) return no beam; points
+    just behind a grid's near edge (x -0.2 m, cells from 0) are outside it, not in its first
+    column (truncation toward zero put them there)."""
+    from stereovision.ground import occupancy_grid
+
+    plane, _ = _level_floor()
+    high = _camera_points([(r, 0.0, 2.5) for r in (2.0, 2.5, 3.0)])
+    scan = laser_scan(high, plane, angle_min=-0.5, angle_max=0.5, angle_increment=0.25)
+    assert np.isnan(scan.ranges).all()
+    behind = _camera_points([(-0.2, 0.0, 0.5)] * 3)
+    grid = occupancy_grid(behind, plane, resolution=0.5, forward=(0, 2), lateral=(-1, 1))
+    assert (grid.data == -1).all()
