@@ -1380,3 +1380,33 @@ def test_points_outside_the_band_or_behind_the_grid_are_no_obstacle() -> None:
     behind = _camera_points([(-0.2, 0.0, 0.5)] * 3)
     grid = occupancy_grid(behind, plane, resolution=0.5, forward=(0, 2), lateral=(-1, 1))
     assert (grid.data == -1).all()
+
+
+@pytest.mark.parametrize("seed", [-1, 1.5, True, "0"])
+def test_a_bad_seed_is_named(seed: object) -> None:
+    """fit_ground_plane(seed=-1) was NumPy's 'expected non-negative integer' and 1.5 its
+    TypeError about a SeedSequence, neither naming the argument; True was taken as seed 1."""
+    with pytest.raises(
+        ValueError, match=re.escape(f"seed: expected an integer >= 0, got {seed!r}")
+    ):
+        fit_ground_plane(_floor_disparity(12.0, FLAT), RIG, seed=seed)  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize(
+    ("kw", "msg"),
+    [
+        ({"forward": ("0", "20")}, "forward: expected a number, got '0'"),
+        ({"forward": (0, 1, 2)}, "forward: expected (near, far), got (0, 1, 2)"),
+        ({"lateral": 5}, "lateral: expected (right, left), got 5"),
+        ({"lateral": (True, 2)}, "lateral: expected a number, got True"),
+    ],
+)
+def test_occupancy_grid_extent_must_be_two_numbers(kw: dict, msg: str) -> None:
+    """forward=("0", "20") was read as 0-20 m without a word (the heights refuse strings), three
+    values were 'too many values to unpack' and a lone number 'int object is not iterable'."""
+    from stereovision.ground import occupancy_grid
+
+    plane, pts = _level_floor()
+    assert occupancy_grid(pts, plane).data.shape == (200, 200)
+    with pytest.raises(ValueError, match=re.escape(msg)):
+        occupancy_grid(pts, plane, **kw)

@@ -604,6 +604,9 @@ def fit_ground_plane(
     tilt = positive_finite(max_tilt_deg, "max_tilt_deg")
     if tilt >= 90:
         raise ValueError(f"max_tilt_deg: expected less than 90 degrees, got {max_tilt_deg!r}")
+    # NumPy's own errors named no argument ("expected non-negative integer"), and took True as 1
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ValueError(f"seed: expected an integer >= 0, got {seed!r}")
     rig = _rig(calib)
     known = np.isfinite(disp) & (disp + rig[4] > 0)
     if int(known.sum()) < MIN_PIXELS:
@@ -755,6 +758,17 @@ def obstacle_mask(
         h = plane.height_of(pts)
         out: npt.NDArray[np.bool_] = (h > lo) & (h < hi) & (pts[..., 2] < far)
     return out
+
+
+def _pair(value: Any, name: str, what: str) -> tuple[float, float]:
+    """``value`` as two numbers (:func:`_number`), after a ``ValueError`` naming ``name`` for
+    what is not a pair: unpacking said 'too many values to unpack' or 'object is not
+    iterable', and ``float()`` read ``"0"`` as 0 m."""
+    try:
+        a, b = value
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected {what}, got {value!r}") from None
+    return _number(a, name), _number(b, name)
 
 
 #: nav_msgs/OccupancyGrid cell values.
@@ -1011,8 +1025,8 @@ def occupancy_grid(
     Raises
     ------
     ValueError
-        For points not of shape ``(..., 3)``, a non-positive resolution, an empty extent, a grid
-        over 4096 cells a side, or a bad height band.
+        For points not of shape ``(..., 3)``, a non-positive resolution, an extent not two
+        numbers or empty, a grid over 4096 cells a side, or a bad height band.
     """
     _require_type(plane, "GroundPlane", "plane")
     from stereovision._validate import positive_finite
@@ -1021,7 +1035,8 @@ def occupancy_grid(
     if pts.ndim == 0 or pts.shape[-1] != 3:
         raise ValueError(f"points: expected shape (..., 3), got {pts.shape}")
     res = positive_finite(resolution, "resolution")
-    (x0, x1), (y0, y1) = (float(v) for v in forward), (float(v) for v in lateral)
+    x0, x1 = _pair(forward, "forward", "(near, far)")
+    y0, y1 = _pair(lateral, "lateral", "(right, left)")
     if not (math.isfinite(x0) and math.isfinite(x1) and x1 > x0):
         raise ValueError(f"forward: expected (near, far) with far > near, got {forward!r}")
     if not (math.isfinite(y0) and math.isfinite(y1) and y1 > y0):
