@@ -1410,3 +1410,14 @@ def test_occupancy_grid_extent_must_be_two_numbers(kw: dict, msg: str) -> None:
     assert occupancy_grid(pts, plane).data.shape == (200, 200)
     with pytest.raises(ValueError, match=re.escape(msg)):
         occupancy_grid(pts, plane, **kw)
+
+
+def test_laser_scan_range_max_is_finite() -> None:
+    """range_max=inf was taken, and the scan's as_dict(), promised JSON-ready, held an infinity
+    (json.dumps wrote 'Infinity', which JSON has not); it is refused, and a finite scan's dict
+    is strict JSON."""
+    plane, pts = _level_floor()
+    angles = {"angle_min": -0.5, "angle_max": 0.5}
+    json.dumps(laser_scan(pts, plane, **angles, range_max=1e6).as_dict(), allow_nan=False)
+    with pytest.raises(ValueError, match="range_max: expected a finite distance, got inf"):
+        laser_scan(pts, plane, **angles, range_max=math.inf)

@@ -1224,7 +1224,7 @@ def laser_scan(
     ValueError
         For points not of shape ``(..., 3)``, no angles (no ``calib`` and no ``angle_min`` /
         ``angle_max``), ``angle_max <= angle_min``, a non-positive increment or over 100000
-        beams, a bad height band or range, or ``min_points < 1``.
+        beams, a bad height band or range (``range_max`` infinite too), or ``min_points < 1``.
     """
     _require_type(plane, "GroundPlane", "plane")
     from stereovision._validate import positive_finite
@@ -1242,6 +1242,8 @@ def laser_scan(
         raise ValueError(
             f"range_min, range_max: expected 0 <= range_min < range_max, got {r0!r}, {r1!r}"
         )
+    if not math.isfinite(r1):  # as_dict() is JSON, which has no infinity; +inf ranges mean "free"
+        raise ValueError(f"range_max: expected a finite distance, got {r1!r}")
     # a NumPy integer (a count from an array) was refused as not an integer, and 2**70 was
     # NumPy's OverflowError "Python int too large to convert to C long" further on
     if (
