@@ -1421,3 +1421,28 @@ def test_laser_scan_range_max_is_finite() -> None:
     json.dumps(laser_scan(pts, plane, **angles, range_max=1e6).as_dict(), allow_nan=False)
     with pytest.raises(ValueError, match="range_max: expected a finite distance, got inf"):
         laser_scan(pts, plane, **angles, range_max=math.inf)
+
+
+def test_support_counts_as_the_fit_counts() -> None:
+    """support() of the plane's own map is its inlier_share: at a focal length under
+    GROUND_FOCAL_PX (200 px) with the tolerance scaled as the fit's (0.625 px), and with 0 and
+    -1 marking unmatched pixels, which are no pixels of the map."""
+    half = RIG.scaled_to((240, 180))
+    disp = _exact_floor(half) + np.random.default_rng(0).normal(0.0, 0.4, (180, 240))
+    plane = fit_ground_plane(disp, half)
+    assert plane is not None and plane.inlier_share < 0.95
+    assert plane.support(disp, half) == pytest.approx(plane.inlier_share, abs=1e-9)
+    marked = disp.copy()
+    marked[np.isnan(marked)] = 0.0
+    marked[:10] = -1.0
+    unknown = np.where(marked > 0, marked, np.nan)
+    assert plane.support(marked, half) == plane.support(unknown, half)
+
+
+def test_laser_scan_angles_given_with_calib() -> None:
+    """With calib, a given angle_min, angle_max or angle_increment overrides the image's."""
+    plane, pts = _level_floor()
+    scan = laser_scan(pts, plane, RIG, angle_min=-0.2, angle_increment=0.01)
+    assert scan.angle_min == -0.2 and scan.angle_increment == 0.01
+    full = laser_scan(pts, plane, RIG)
+    assert scan.angle_max == pytest.approx(full.angle_max, abs=0.01)
