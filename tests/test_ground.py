@@ -1446,3 +1446,17 @@ def test_laser_scan_angles_given_with_calib() -> None:
     assert scan.angle_min == -0.2 and scan.angle_increment == 0.01
     full = laser_scan(pts, plane, RIG)
     assert scan.angle_max == pytest.approx(full.angle_max, abs=0.01)
+
+
+def test_occupancy_grid_save_refuses_a_name_with_a_folder(tmp_path: Path) -> None:
+    """``name`` is the files' stem: "../x" wrote x.png and x.yaml beside ``directory``."""
+    from stereovision.ground import OccupancyGrid
+
+    grid = OccupancyGrid(np.array([[0, 100], [-1, -1]], np.int8), 0.05, (0.0, -0.05))
+    inner = tmp_path / "maps"
+    for bad in ("../x", "a/x", "", "..", f"{tmp_path}/y"):
+        with pytest.raises(ValueError, match=r"^name: expected a file stem without a folder"):
+            grid.save(inner, name=bad)
+    assert sorted(p.name for p in tmp_path.rglob("*")) == []  # nothing written, no folder made
+    png, yml = grid.save(inner, name="floor.v2")
+    assert (png.name, yml.name) == ("floor.v2.png", "floor.v2.yaml") and png.parent == inner

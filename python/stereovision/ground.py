@@ -865,6 +865,8 @@ class OccupancyGrid:
 
         Raises
         ------
+        ValueError
+            A ``name`` that is empty or holds a folder (``"../x"``, ``"a/b"``).
         RuntimeError
             If the grid could not be encoded as PNG.
         OSError
@@ -873,6 +875,9 @@ class OccupancyGrid:
         """
         import cv2
 
+        # a stem with a folder in it ("../x") wrote outside ``directory``
+        if not isinstance(name, str) or name in ("", ".", "..") or Path(name).name != name:
+            raise ValueError(f"name: expected a file stem without a folder, got {name!r}")
         d = Path(str(directory))
         d.mkdir(parents=True, exist_ok=True)
         png, yml = d / f"{name}.png", d / f"{name}.yaml"
