@@ -150,6 +150,33 @@ def test_add_cli_registers_gui():
     assert DEFAULT_HOST == "127.0.0.1"
 
 
+def test_gui_main_errors_are_one_line(monkeypatch, capsys, tmp_path):
+    """``python -m stereovision.gui``: Ctrl+C is exit 130; a missing optional package (trame,
+    rosbags for --from-bag) one line and exit 2. Without rosbags, ``--from-bag`` printed
+    ImportError's traceback here, where ``stereovision gui`` says the line."""
+    import stereovision.gui as gui
+
+    def interrupted(_args: argparse.Namespace) -> Any:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(gui, "build_app", interrupted)
+    assert gui.main([]) == 130
+    monkeypatch.undo()
+    for argv in (["--port", "65536"], ["--port", "-1"]):
+        assert gui.main(argv) == 2
+        err = capsys.readouterr().err
+        assert err == f"stereovision: error: --port must be in 0..65535, got {argv[1]}\n"
+    pytest.importorskip("trame")
+    monkeypatch.setitem(sys.modules, "rosbags.highlevel", None)  # rosbags not installed
+    bag = tmp_path / "rig.bag"
+    bag.write_bytes(b"")
+    assert gui.main(["--from-bag", str(bag), "--no-browser"]) == 2
+    assert capsys.readouterr() == (
+        "",
+        "stereovision: error: reading ROS bags needs rosbags: pip install 'stereovision-rs[ros]'\n",
+    )
+
+
 def test_scaled_calibration_and_compute_view():
     from stereovision.gui.app import compute_view, draw_matches
 

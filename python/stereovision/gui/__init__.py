@@ -269,7 +269,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return cmd_gui(args)
     except KeyboardInterrupt:
         return 130
-    except (ValueError, OSError, RuntimeError) as exc:
+    # ImportError: an optional package missing (rosbags for --from-bag), said with its pip line
+    except (ValueError, OSError, RuntimeError, ImportError) as exc:
         from stereovision._validate import first_line
 
         print(f"stereovision: error: {first_line(exc)}", file=sys.stderr)
