@@ -536,3 +536,111 @@ def test_default_tolerance_is_half_a_pixel() -> None:
     r = check_rectification(left, right)
     assert r.tolerance == 0.5 and r.ok is False and r.matches >= 100
     assert r.offset == pytest.approx(0.7, abs=0.05) and r.median_dy == pytest.approx(0.7, abs=0.05)
+
+
+def test_rows_agree_and_a_pair_of_two_sizes_in_words() -> None:
+    """The line ``rectify`` and the GUI print for a pair used as given, and the refusal of a
+    pair of two sizes: width x height of each image."""
+    r = _judge_rows(_quad(*_grid(60), np.full(60, 20.0), np.full(60, 0.25)), 640, 480, 0.5)
+    assert r.rows_agree() == "rows median |dy| 0.25 px over 60 matches, tolerance 0.5"
+    with pytest.raises(ValueError) as err:
+        check_rectification(np.zeros((60, 80), np.uint8), np.zeros((60, 90), np.uint8))
+    assert str(err.value) == (
+        "left is 80x60 px, right is 90x60 px: the two images of a pair have one size"
+    )
+    flat = np.zeros((60, 80), np.uint8)
+    with pytest.raises(ValueError, match="tolerance: expected a positive number of pixels"):
+        check_rectification(flat, flat, tolerance=True)
+
+
+def _grid(n: int) -> tuple[np.ndarray, np.ndarray]:
+    i = np.arange(n, dtype=np.float64)
+    return 20 + 10 * i, 10 + (37 * i) % 460  # not on one line: the model's plane is fixed
+
+
+def test_a_negative_disparity_is_a_wrong_match_beyond_2_percent_of_the_width() -> None:
+    # 1000 px wide: matches down to -20 px (2 % of the width, not of the 480 px height) are
+    # fitted, those below are not
+    dx = np.where(np.arange(60) < 40, 20.0, -15.0)
+    r = _judge_rows(_quad(*_grid(60), dx, np.zeros(60)), 1000, 480, 0.5)
+    assert (r.matches, r.ok, r.swapped) == (60, True, False)
+    dx = np.where(np.arange(60) < 40, 20.0, -21.0)
+    assert _judge_rows(_quad(*_grid(60), dx, np.zeros(60)), 1000, 480, 0.5).matches == 40
+
+
+def test_sift_runs_on_a_copy_at_most_1600_px(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The longer side, wide or tall, is brought to 1600 px; a smaller image is used as is."""
+    import types
+
+    import stereovision.rectification_check as rc
+
+    seen: list[tuple[int, ...]] = []
+
+    class Sift:
+        def __init__(self, **kw: int) -> None:
+            self.sift = cv2.SIFT.create(**kw)
+
+        def detectAndCompute(self, img: np.ndarray, mask: None) -> tuple:
+            seen.append(img.shape)
+            return self.sift.detectAndCompute(img, mask)
+
+    class Cv2:
+        SIFT = types.SimpleNamespace(create=Sift)
+
+        def __getattr__(self, name: str) -> object:
+            return getattr(cv2, name)
+
+    monkeypatch.setattr(rc, "cv2", Cv2())
+    for h, w in ((750, 2484), (2000, 1000), (375, 450)):
+        rc._features(np.zeros((h, w), np.uint8))
+    assert seen == [(483, 1600), (1600, 800), (375, 450)]
+
+
+def test_swapped_needs_most_negative_matches_on_common_rows() -> None:
+    """80 matches at negative disparities, 36 on their rows and 44 scattered 2-8 rows off:
+    30 or more on common rows is not enough, it takes more than half of them."""
+    rng = np.random.default_rng(1)
+    off = rng.uniform(2.0, 8.0, 80) * rng.choice([-1.0, 1.0], 80)
+    dy = np.where(np.arange(80) < 36, 0.0, off)
+    r = _judge_rows(_quad(*_grid(80), np.full(80, -30.0), dy), 1000, 480, 0.5)
+    assert (r.ok, r.swapped, r.matches) == (False, False, 80)
+    # 50 of 80 at negative disparities on common rows: swapped, though the other 30 would fit
+    dx = np.where(np.arange(80) < 50, -30.0, 20.0)
+    r = _judge_rows(_quad(*_grid(80), dx, np.zeros(80)), 1000, 480, 0.5)
+    assert (r.ok, r.swapped, r.matches) == (False, True, 80)
+
+
+def test_matches_off_any_row_model_count_in_the_verdict() -> None:
+    """A pair whose matches fit no row model: ``matches`` and ``median_dy`` are over all of
+    them, those far off their rows too."""
+    rng = np.random.default_rng(2)
+    dy = rng.uniform(3.0, 8.0, 70) * rng.choice([-1.0, 1.0], 70)
+    dy[60:] = 100.0  # beyond 10 % of the height of their rows
+    r = _judge_rows(_quad(*_grid(70), np.full(70, 20.0), dy), 1000, 480, 0.5)
+    assert (r.ok, r.swapped, r.matches) == (False, False, 70)
+    assert r.median_dy == pytest.approx(float(np.median(np.abs(dy))), abs=1e-12)
+
+
+def test_already_rectified_only_for_a_passing_check() -> None:
+    from stereovision.rectification_check import already_rectified
+
+    flat = np.full((120, 160), 128, np.uint8)
+    assert check_rectification(flat, flat).ok is None and already_rectified(flat, flat) is None
+
+
+def test_the_plot_colours_each_match_by_its_row_error() -> None:
+    """Green within the tolerance, yellow up to 3 times it, red beyond; the tick in the left
+    image points to the right image's row, ten times magnified."""
+    from stereovision.rectification_check import RectificationCheck, draw_rectification_check
+
+    black = np.zeros((100, 200), np.uint8)
+    pts = np.float32([[30, 40, 20, 40.25], [90, 40, 80, 41.25], [150, 40, 140, 42]])
+    check = RectificationCheck(3, 1.25, 1.9, 1.2, 0.0, 0.0, False, 0.5, points=pts)
+    img = draw_rectification_check(black, black, check)
+    pair = img[-100:].astype(int)
+    green, yellow, red = (0, 200, 0), (0, 220, 255), (0, 0, 255)
+    for (xl, _, xr, _), colour in zip(pts, (green, yellow, red), strict=True):
+        for x in (int(xl), 200 + int(xr)):
+            assert np.abs(pair[40, x] - colour).max() <= 2, (x, pair[40, x])
+    # the red match's right row is 2 px lower: its tick runs 20 px down, none up
+    assert pair[52, 150, 2] > 200 and pair[52, 150, :2].max() == 0 and pair[28, 150].max() == 0
