@@ -644,3 +644,24 @@ def test_the_plot_colours_each_match_by_its_row_error() -> None:
             assert np.abs(pair[40, x] - colour).max() <= 2, (x, pair[40, x])
     # the red match's right row is 2 px lower: its tick runs 20 px down, none up
     assert pair[52, 150, 2] > 200 and pair[52, 150, :2].max() == 0 and pair[28, 150].max() == 0
+
+
+def test_refine_fits_the_turn_to_the_matches_within_1_px() -> None:
+    """Given the check: 40 matches 1 px above their rows in the right image (a pitch of
+    atan(1 / 700) = 0.082 degrees) and 20 more 3 px off are corrected by the 40 alone; a
+    check whose matches fit no row model is refused in its own words."""
+    from stereovision.rectification_check import RectificationCheck
+
+    w, h = 640, 480
+    rig = dataclasses.replace(_rig(w, h, (0.0, 0.0, 0.0)), rectified=True)
+    xl, yl = _grid(60)
+    yr = yl + np.where(np.arange(60) % 3 == 2, 3.0, 1.0)
+    pts = np.column_stack([xl, yl, xl - 20, yr]).astype(np.float32)
+    check = RectificationCheck(60, 1.0, 3.0, -1.67, 0.0, 0.0, False, 0.5, points=pts)
+    flat = np.full((h, w), 128, np.uint8)
+    fixed, _ = refine_rectification(flat, flat, rig, check=check)
+    assert _deg(fixed.R) == pytest.approx(np.degrees(np.arctan(1 / 700)), abs=0.005)
+    nan = float("nan")
+    lost = RectificationCheck(60, 5.0, 9.0, nan, nan, nan, False, 0.5, points=pts)
+    with pytest.raises(ValueError, match=r"^cannot refine: .* which fit no common row offset$"):
+        refine_rectification(flat, flat, rig, check=lost)
