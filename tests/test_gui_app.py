@@ -138,6 +138,7 @@ def test_gui_url_brackets_an_ipv6_host():
     assert url_for("127.0.0.1", 8080) == "http://127.0.0.1:8080/"
     assert url_for("::1", 41000) == "http://[::1]:41000/"
     assert url_for("localhost", 1) == "http://localhost:1/"
+    assert url_for("2001:db8:0:0:0:0:0:1", 80) == "http://[2001:db8:0:0:0:0:0:1]:80/"
 
 
 def test_add_cli_registers_gui():
@@ -148,6 +149,120 @@ def test_add_cli_registers_gui():
     args = parser.parse_args(["gui", "--left", "0", "--right", "1", "--no-browser"])
     assert (args.left, args.right, args.host, args.no_browser) == ("0", "1", DEFAULT_HOST, True)
     assert DEFAULT_HOST == "127.0.0.1"
+
+
+# ------------------------------------------------------- mutation audit: cmd_gui and main with a
+# stand-in app (its server's start binds, or fails, as told), no trame server started
+
+
+class _Ready(list):
+    def add(self, fn: Any) -> None:
+        self.append(fn)
+
+
+class _Source:
+    closed = 0
+
+    def close(self) -> None:
+        self.closed += 1
+
+
+class _Server:
+    def __init__(self, fail: BaseException | None, after_bind: bool) -> None:
+        self.port, self.fail, self.after_bind = 43210, fail, after_bind
+        self.ready = _Ready()
+        self.started: dict[str, Any] = {}
+
+    def start(self, **kw: Any) -> None:
+        self.started = dict(kw, argv=list(sys.argv))
+        if self.fail is not None and not self.after_bind:
+            raise self.fail
+        for fn in self.ready:
+            fn()
+        if self.fail is not None:
+            raise self.fail
+
+
+class _App:
+    def __init__(self, fail: BaseException | None = None, after_bind: bool = False) -> None:
+        self.server = _Server(fail, after_bind)
+        self.ctrl = argparse.Namespace(on_server_ready=self.server.ready)
+        self.source = _Source()
+
+
+def _gui_args(*argv: str) -> argparse.Namespace:
+    from stereovision.gui import add_arguments
+
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    return parser.parse_args(list(argv))
+
+
+def test_cmd_gui_starts_the_server_as_asked_and_closes_the_cameras(monkeypatch, capsys):
+    """What cmd_gui hands the server (port, host, browser), the address it prints once bound,
+    the note for a non-loopback host, trame's view of sys.argv and the cameras closed after."""
+    import stereovision.gui as gui
+
+    args = _gui_args()
+    assert (args.port, args.host, args.no_browser) == (8080, "127.0.0.1", False)
+    for argv, browser, note in (
+        ([], True, ""),
+        (["--no-browser", "--host", "::1", "--port", "0"], False, ""),
+        (["--host", "0.0.0.0"], True, "note: listening on 0.0.0.0: anyone who can reach this "
+         "address sees the cameras\n"),
+    ):  # fmt: skip
+        app = _App()
+        monkeypatch.setattr(gui, "build_app", lambda _args, app=app: app)
+        args = _gui_args(*argv)
+        monkeypatch.setattr(sys, "argv", ["stereovision", "gui", *argv])
+        assert gui.cmd_gui(args) == 0
+        assert app.server.started == {
+            "port": args.port,
+            "host": args.host,
+            "open_browser": browser,
+            "show_connection_info": False,
+            "timeout": 0,
+            "argv": ["stereovision"],  # trame parses sys.argv: it sees none of ours
+        }
+        assert sys.argv == ["stereovision", "gui", *argv]
+        assert app.source.closed == 1
+        out, err = capsys.readouterr()
+        assert out == f"stereovision gui on {gui.url_for(args.host, 43210)} (Ctrl+C to stop)\n"
+        assert err == note
+
+
+def test_cmd_gui_says_why_the_server_cannot_listen(monkeypatch, capsys):
+    """A bind that fails: one message naming the port and host (errno kept), nothing announced,
+    the cameras closed; a failure after the bind is raised as it came."""
+    import errno
+
+    import stereovision.gui as gui
+
+    cases = (
+        (OSError(errno.EADDRINUSE, "Address already in use"), ["--port", "8181"],
+         "port 8181 on 127.0.0.1 is in use (another server?): choose another with --port, or "
+         "--port 0 for a free one"),
+        (OSError(errno.EACCES, "Permission denied"), ["--port", "80"],
+         "cannot listen on 127.0.0.1 port 80: Permission denied"),
+        (OSError("no such host"), ["--host", "nowhere.invalid"],
+         "cannot listen on nowhere.invalid port 8080: no such host"),
+    )  # fmt: skip
+    for exc, argv, said in cases:
+        app = _App(exc)
+        monkeypatch.setattr(gui, "build_app", lambda _args, app=app: app)
+        with pytest.raises(OSError) as raised:
+            gui.cmd_gui(_gui_args(*argv))
+        assert str(raised.value) == said and raised.value.errno == exc.errno
+        assert raised.value.__cause__ is exc and app.source.closed == 1
+        assert capsys.readouterr() == ("", "")
+        assert gui.main(argv) == 2
+        assert capsys.readouterr() == ("", f"stereovision: error: {said}\n")
+    later = OSError(errno.EADDRINUSE, "Address already in use")
+    app = _App(later, after_bind=True)
+    monkeypatch.setattr(gui, "build_app", lambda _args: app)
+    with pytest.raises(OSError) as raised:
+        gui.cmd_gui(_gui_args())
+    assert raised.value is later and app.source.closed == 1
 
 
 def test_gui_main_errors_are_one_line(monkeypatch, capsys, tmp_path):
@@ -166,6 +281,11 @@ def test_gui_main_errors_are_one_line(monkeypatch, capsys, tmp_path):
         assert gui.main(argv) == 2
         err = capsys.readouterr().err
         assert err == f"stereovision: error: --port must be in 0..65535, got {argv[1]}\n"
+    monkeypatch.setitem(sys.modules, "trame.app", None)  # trame not installed
+    assert gui.main([]) == 2
+    err = capsys.readouterr().err
+    assert err == "stereovision: error: the GUI needs trame: pip install 'stereovision-rs[gui]'\n"
+    monkeypatch.undo()
     pytest.importorskip("trame")
     monkeypatch.setitem(sys.modules, "rosbags.highlevel", None)  # rosbags not installed
     bag = tmp_path / "rig.bag"
