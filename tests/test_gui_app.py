@@ -77,10 +77,15 @@ def test_a_page_closed_mid_message_prints_no_traceback():
             wslink.error("Exception raised")
             wslink.error("ValueError('bad')")
             aiohttp.error("Error handling request from 127.0.0.1", exc_info=ValueError("x"))
+            aiohttp.error("Error handling request from ::1", exc_info=OSError(28, "No space"))
         finally:
             for lg in (wslink, aiohttp):
                 lg.removeHandler(keep)
-        assert seen == ["ValueError('bad')", "Error handling request from 127.0.0.1"]
+        assert seen == [
+            "ValueError('bad')",
+            "Error handling request from 127.0.0.1",
+            "Error handling request from ::1",  # an OSError other than a closed page stays
+        ]
     finally:
         for n in SERVER_LOGGERS:
             logging.getLogger(n).removeFilter(flt)
