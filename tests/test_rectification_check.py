@@ -665,3 +665,13 @@ def test_refine_fits_the_turn_to_the_matches_within_1_px() -> None:
     lost = RectificationCheck(60, 5.0, 9.0, nan, nan, nan, False, 0.5, points=pts)
     with pytest.raises(ValueError, match=r"^cannot refine: .* which fit no common row offset$"):
         refine_rectification(flat, flat, rig, check=lost)
+
+
+def test_align_rows_leaves_a_pair_without_a_row_model_as_it_is() -> None:
+    from stereovision.rectification_check import RectificationCheck, align_rows
+
+    nan = float("nan")
+    lost = RectificationCheck(80, 24.0, 60.0, nan, nan, nan, False, 0.5)
+    right = np.arange(60 * 80, dtype=np.uint16).reshape(60, 80)
+    out, res = align_rows(right, right, check=lost)
+    assert res is lost and out.dtype == np.uint16 and np.array_equal(out, right)
