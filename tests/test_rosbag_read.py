@@ -7,6 +7,7 @@ OpenCV's chessboard pairs), so every frame read back can be compared with its so
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import warnings
 from collections.abc import Callable
@@ -621,6 +622,15 @@ def test_gui_plays_a_bag(cones: Any, tmp_path: Path) -> None:
         app.source.close()
     with pytest.raises(ValueError, match="replaces --left and --right"):
         build_app(p.parse_args(["--from-bag", str(bag), "--left", "0", "--right", "1"]))
+    # --calib wins over the bag's camera_info
+    mine = dataclasses.replace(_raw_rig(), T=np.array([-0.2, 0.0, 0.0]))
+    rig = mine.save(tmp_path / "mine.yaml")
+    app = build_app(p.parse_args(["--from-bag", str(bag), "--calib", str(rig), "--no-browser"]))
+    try:
+        assert app.source_calib == Calibration.load(rig)
+        assert app.source_calib.baseline_m == pytest.approx(0.2)
+    finally:
+        app.source.close()
 
 
 def _raw_rig() -> Calibration:
