@@ -270,6 +270,17 @@ def test_cmd_gui_says_why_the_server_cannot_listen(monkeypatch, capsys):
     assert raised.value is later and app.source.closed == 1
 
 
+def test_the_page_may_open_the_demo_data_and_the_data_folders(tmp_path):
+    """``--data DIR`` adds DIR to the folders the page may open files from; the bundled demo
+    data stays allowed."""
+    pytest.importorskip("trame")
+    from stereovision.gui import build_app, bundled_data_dir
+
+    app = build_app(_gui_args("--data", str(tmp_path), "--no-browser"))
+    assert app.folders.roots == (bundled_data_dir().resolve(), tmp_path.resolve())
+    assert app.folders.resolve(bundled_data_dir() / "cones" / "left.png").is_file()
+
+
 def test_gui_main_errors_are_one_line(monkeypatch, capsys, tmp_path):
     """``python -m stereovision.gui``: Ctrl+C is exit 130; a missing optional package (trame,
     rosbags for --from-bag) one line and exit 2. Without rosbags, ``--from-bag`` printed
