@@ -290,8 +290,17 @@ def test_gui_main_errors_are_one_line(monkeypatch, capsys, tmp_path):
     def interrupted(_args: argparse.Namespace) -> Any:
         raise KeyboardInterrupt
 
+    def too_large(_args: argparse.Namespace) -> Any:
+        raise MemoryError("Unable to allocate 30.0 GiB for an array")
+
     monkeypatch.setattr(gui, "build_app", interrupted)
     assert gui.main([]) == 130
+    assert capsys.readouterr().err == "stereovision: interrupted\n"  # as the CLI; it said nothing
+    monkeypatch.setattr(gui, "build_app", too_large)
+    assert gui.main([]) == 2  # as the CLI; MemoryError's traceback came out
+    assert capsys.readouterr().err == (
+        "stereovision: error: Unable to allocate 30.0 GiB for an array\n"
+    )
     monkeypatch.undo()
     for argv in (["--port", "65536"], ["--port", "-1"]):
         assert gui.main(argv) == 2

@@ -267,10 +267,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = p.parse_args(argv)
     try:
         return cmd_gui(args)
-    except KeyboardInterrupt:
+    except KeyboardInterrupt:  # as the CLI: a word, where this said nothing
+        print("stereovision: interrupted", file=sys.stderr)
         return 130
-    # ImportError: an optional package missing (rosbags for --from-bag), said with its pip line
-    except (ValueError, OSError, RuntimeError, ImportError) as exc:
+    # ImportError: an optional package missing (rosbags for --from-bag), said with its pip line;
+    # MemoryError: as the CLI, one line for a frame size too large to allocate
+    except (ValueError, OSError, RuntimeError, ImportError, MemoryError) as exc:
         from stereovision._validate import first_line
 
         print(f"stereovision: error: {first_line(exc)}", file=sys.stderr)
