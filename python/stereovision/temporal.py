@@ -56,7 +56,8 @@ _HALF_NORMAL_MEDIAN = 0.6745
 #: Every how many pixels (in each direction) the image-wide statistics are taken (medians and
 #: percentiles of a quarter-million values cost milliseconds; every 16th pixel says the same).
 _STRIDE = 4
-#: Fewest sampled pixels a motion test's median is taken over once black ones are left out.
+#: Fewest sampled pixels a motion test's median is taken over once black ones are left out (a
+#: tenth of the sample where that is fewer).
 _MIN_SAMPLES = 64
 
 
@@ -317,11 +318,14 @@ class TemporalFilter:
             # Black pixels (a rectified frame's border, a fisheye's corners) stay black when
             # the rig moves: left out, or their zero differences pull the median down (a rig
             # moving 2 px a frame behind a black border over 46 % of the width was averaged,
-            # 0 restarts of 5). Kept only when too few others remain for a median: a share
-            # rule (kept at 90 % black) smeared a moving strip of 40 px into 3.7 frames.
+            # 0 restarts of 5). Kept only when too few others remain for a median: fewer than
+            # _MIN_SAMPLES, or than a tenth of the sample where that is fewer (under 640
+            # sampled, ~100 x 100 px). The count alone kept them on any image of 32 x 32 px or
+            # less (a half-black one moving was averaged, 0 restarts of 5); a share alone (kept
+            # at 90 % black) smeared a moving strip of 40 px into 3.7 frames.
             keep = np.ones(top.shape, bool)
             black = top == 0
-            if np.count_nonzero(~black) >= _MIN_SAMPLES:
+            if np.count_nonzero(~black) >= min(_MIN_SAMPLES, 0.1 * black.size):
                 keep &= ~black
             # Saturated pixels do not follow a change of light: left out of the test.
             bright = top >= _SATURATED
