@@ -1401,6 +1401,20 @@ def test_a_negative_camera_index_is_refused(
     assert not (tmp_path / "x").exists()
 
 
+def test_a_negative_index_message_names_the_file_as_typed() -> None:
+    """The negative index's hint spelt the file from int(): `--left -01` said "./-1 for a
+    file" (another file) and `--left -0` "camera index 0 is negative" (0 is no negative
+    index, and ./0 another file). -01 is refused pointing at ./-01; -0, no negative number,
+    is a path as before the refusal."""
+    with pytest.raises(
+        ValueError, match=r"^camera index -1 is negative: .* \(\./-01 for a file\)$"
+    ):
+        parse_source(" -01 ")
+    assert parse_source("-0") == "-0" and parse_source("-00") == "-00"
+    with pytest.raises(FileNotFoundError, match=r"^left source not found: -0$"):
+        StereoCamera("-0", 0)
+
+
 def test_every_with_a_board_is_refused(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """`--chessboard 9x6 --every 10` ignored --every (the board's poses choose the pairs) and
     said nothing; it is refused in one line, nothing opened or saved."""

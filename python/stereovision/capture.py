@@ -202,8 +202,12 @@ def _source_error(message: str, kwargs: dict[str, Any]) -> SourceError:
 # --------------------------------------------------------------------------------- parsing
 
 
-def _negative_index(n: int) -> str:
-    return f"camera index {n} is negative: cameras are numbered from 0 (./{n} for a file)"
+def _negative_index(n: int, text: str | None = None) -> str:
+    # the file as typed: "./-1" for "-01" was another file
+    return (
+        f"camera index {n} is negative: cameras are numbered from 0 "
+        f"(./{n if text is None else text} for a file)"
+    )
 
 
 def parse_source(text: str | int) -> int | str:
@@ -229,9 +233,10 @@ def parse_source(text: str | int) -> int | str:
         if text < 0:
             raise ValueError(_negative_index(text))
         return text
+    # "-0" is no negative index: a path, as it was (its message said "camera index 0 is negative")
+    if re.fullmatch(r"-\d+", text.strip(), re.ASCII) and int(text) < 0:
+        raise ValueError(_negative_index(int(text), text.strip()))
     # isdecimal, not isdigit: "²" is a digit that int() refuses ("invalid literal for int()")
-    if re.fullmatch(r"-\d+", text.strip(), re.ASCII):
-        raise ValueError(_negative_index(int(text)))
     return int(text) if text.strip().isdecimal() else text
 
 
