@@ -1121,3 +1121,20 @@ def test_encode_depth_png_of_a_whole_result_is_named(result):
     assert export.encode_depth_png(result.depth) == export.encode_depth_png(
         np.asarray(result.depth, np.float64)
     )
+
+
+@pytest.mark.parametrize("channels", [4, 1])
+def test_pcd_of_a_result_with_a_bgra_or_one_channel_left_image(result, tmp_path, channels):
+    """A BGRA left image (surface_mesh takes one, its alpha dropped) gave organised_points
+    (H, W, 4) colours, alpha first (``[..., ::-1]``), and an (H, W, 1) one (H, W, 1) colours:
+    write_pcd failed with NumPy's "could not broadcast" on both. BGRA's colours are its BGR in
+    RGB; a one-channel image is grey, the cloud's own colours are used (as a (H, W) one)."""
+    bgr = result.left_rectified
+    left = np.dstack([bgr, np.full(bgr.shape[:2], 7, np.uint8)]) if channels == 4 else bgr[..., 1:2]
+    other = replace(result, left_rectified=left.copy())
+    _, cols = export.organised_points(other)
+    assert cols.shape == (*bgr.shape[:2], 3)
+    pts, cols = export.read_pcd(export.write_pcd(tmp_path / "c.pcd", other))
+    x, y = result.pixels[:, 0], result.pixels[:, 1]
+    np.testing.assert_array_equal(pts[y, x], result.points)
+    np.testing.assert_array_equal(cols[y, x], result.colors)

@@ -100,8 +100,8 @@ def organised_points(
     points : ndarray, float32 (H, W, 3)
         Metres, left rectified camera frame; NaN where the pixel has no 3-D point.
     colors : ndarray, uint8 (H, W, 3)
-        RGB of the left rectified image; without a colour one (none, or grey), the cloud's
-        colours at their pixels, zeros elsewhere.
+        RGB of the left rectified image (BGR or BGRA); without a colour one (none, or grey),
+        the cloud's colours at their pixels, zeros elsewhere.
     """
     _require_type(result, "DepthResult", "result")
     _require_metric(result)
@@ -112,9 +112,11 @@ def organised_points(
         pts = np.full((h, w, 3), np.nan, dtype=np.float32)
         pts[result.pixels[:, 1], result.pixels[:, 0]] = result.points
     xs, ys = result.pixels[:, 0], result.pixels[:, 1]
-    # a grey (H, W) left image has no channels to reverse ([..., ::-1] mirrored its columns)
-    if result.left_rectified is not None and result.left_rectified.ndim == 3:
-        cols = np.ascontiguousarray(result.left_rectified[..., ::-1], dtype=np.uint8)
+    # a grey (H, W) left image has no channels to reverse ([..., ::-1] mirrored its columns),
+    # an (H, W, 1) one no colour, and BGRA's alpha is none (as render.surface_mesh's texture)
+    left = result.left_rectified
+    if left is not None and left.ndim == 3 and left.shape[2] >= 3:
+        cols = np.ascontiguousarray(left[..., 2::-1], dtype=np.uint8)
     else:
         cols = np.zeros((h, w, 3), np.uint8)
         cols[ys, xs] = result.colors
