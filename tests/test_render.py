@@ -303,6 +303,19 @@ def test_surface_mesh_texture_of_a_grey_or_bgra_left_image(result):
     np.testing.assert_array_equal(tex.to_array().reshape(bgr.shape), bgr[..., ::-1])
 
 
+def test_surface_mesh_texture_of_a_one_channel_left_image(result):
+    """An (H, W, 1) left image kept its one channel ([..., 2::-1]), and its reshape to RGB rows
+    made a third of the texture's rows, scrambled, under a texture_shape of the whole image;
+    it is grey, repeated in R, G and B as an (H, W) one."""
+    from dataclasses import replace
+
+    grey = result.left_rectified[..., 1:2].copy()
+    mesh = render.surface_mesh(replace(result, left_rectified=grey))
+    assert mesh.field_data["texture_rgb"].shape == (grey.size, 3)
+    tex = render.texture_of(mesh).to_array()
+    np.testing.assert_array_equal(tex.reshape(*grey.shape[:2], 3), np.dstack([grey] * 3))
+
+
 def test_zero_pose_render_reproduces_left_image(result, mesh):
     img = render.render_view(mesh, intrinsics=render.Intrinsics.from_result(result))
     assert img.shape == (syn.H, syn.W, 3)

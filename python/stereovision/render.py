@@ -716,9 +716,11 @@ def surface_mesh(
     img = result.left_rectified
     if img is not None:
         # a grey (H, W) image has no channels to reverse: [..., ::-1] mirrored its columns
-        # into a texture of the wrong size; BGRA's alpha is no colour
+        # into a texture of the wrong size; an (H, W, 1) one is grey too; BGRA's alpha is no
+        # colour
+        grey = img.ndim == 2 or img.shape[2] == 1
         rgb = np.ascontiguousarray(
-            np.repeat(img[..., None], 3, axis=2) if img.ndim == 2 else img[..., 2::-1]
+            np.repeat(img.reshape(img.shape[:2])[..., None], 3, axis=2) if grey else img[..., 2::-1]
         )
         mesh.field_data["texture_rgb"] = rgb.reshape(-1, 3)
         mesh.field_data["texture_shape"] = np.array(rgb.shape[:2], dtype=np.int64)
