@@ -240,6 +240,9 @@ def test_parse_source() -> None:
     assert sources.parse_source("img_%03d.png") == "img_%03d.png"
     with pytest.raises(ValueError, match=r"^empty camera source$"):
         sources.parse_source("")
+    # a digit to str.isdigit but no number to int(): "invalid literal for int()" on the page;
+    # a file name, as stereovision.capture.parse_source takes it
+    assert sources.parse_source(" ² ") == "²"
 
 
 # ----------------------------------------------------------------------------- VideoPair

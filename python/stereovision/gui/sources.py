@@ -282,7 +282,8 @@ def parse_source(text: str | int) -> int | str:
     s = str(text).strip()
     if not s:
         raise ValueError("empty camera source")
-    return int(s) if s.isdigit() else s
+    # isdecimal, not isdigit: "²" is a digit that int() refuses ("invalid literal for int()")
+    return int(s) if s.isdecimal() else s
 
 
 class VideoPair:
