@@ -696,7 +696,8 @@ class StereoCamera(PairSource):
     SourceError
         If a source cannot be opened (the message names it).
     ValueError
-        If ``image_size``, ``fps`` or ``fourcc`` is invalid.
+        If ``image_size``, ``fps`` or ``fourcc`` is invalid, or a source is a negative device
+        index.
     """
 
     @renamed_keyword("size", "image_size")
