@@ -1838,3 +1838,16 @@ def test_save_pair_refuses_a_negative_or_fractional_index(tmp_path: Path) -> Non
         "left_0000.png",
         "right_0000.png",
     ]
+
+
+def test_numpy_and_bool_sources() -> None:
+    """A NumPy integer is a device index (parse_source failed with "'numpy.int64' object has no
+    attribute 'strip'"); a bool is no camera (True opened camera 1)."""
+    assert parse_source(np.int64(2)) == 2 and type(parse_source(np.int64(2))) is int
+    with pytest.raises(ValueError, match=r"^camera index -3 is negative"):
+        parse_source(np.int32(-3))
+    for flag in (True, np.True_):
+        with pytest.raises(ValueError, match=r"^camera source: expected a device index or a path"):
+            parse_source(flag)  # type: ignore[arg-type]
+        with pytest.raises(ValueError, match=r"^left source: expected a device index or a path"):
+            StereoCamera(flag, 0)  # type: ignore[arg-type]

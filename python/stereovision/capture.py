@@ -229,10 +229,13 @@ def parse_source(text: str | int) -> int | str:
         A negative index (``-1`` or ``"-1"``): OpenCV's -1 is "any camera", no side of a rig,
         and crashes the process where no camera is present; as text it was taken for a file.
     """
-    if isinstance(text, int):
+    # a bool is no camera (True opened camera 1); NumPy's integers are (AttributeError: strip)
+    if isinstance(text, (bool, np.bool_)):
+        raise ValueError(f"camera source: expected a device index or a path, got {text!r}")
+    if isinstance(text, (int, np.integer)):
         if text < 0:
-            raise ValueError(_negative_index(text))
-        return text
+            raise ValueError(_negative_index(int(text)))
+        return int(text)
     # "-0" is no negative index: a path, as it was (its message said "camera index 0 is negative")
     if re.fullmatch(r"-\d+", text.strip(), re.ASCII) and int(text) < 0:
         raise ValueError(_negative_index(int(text), text.strip()))
@@ -752,6 +755,8 @@ class StereoCamera(PairSource):
             with _opencv_quiet():
                 cap: Any = _open_path(path)
             self._sequence[side] = cap.isOpened() and cap.getBackendName() == "CV_IMAGES"
+        elif isinstance(src, (bool, np.bool_)):  # True opened camera 1
+            raise ValueError(f"{side} source: expected a device index or a path, got {src!r}")
         elif isinstance(src, (int, np.integer)):
             if src < 0:  # cv2.VideoCapture(-1) crashes the process when no camera is present
                 raise ValueError(f"{side} source: {_negative_index(int(src))}")
