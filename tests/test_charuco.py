@@ -18,7 +18,7 @@ import cv2
 import numpy as np
 import pytest
 
-from stereovision.calibrate import calibrate
+from stereovision.calibrate import calibrate, calibrate_from_video
 from stereovision.charuco import (
     CharucoBoard,
     board_png,
@@ -749,3 +749,27 @@ def test_six_corners_are_enough_and_four_are_not() -> None:
     assert six is not None and six[0].tolist() == [0, 1, 2, 9, 10, 11]
     np.testing.assert_allclose(six[1][4], (120 - 0.5, 120 - 0.5), atol=0.2)
     assert find_charuco_corners(np.ascontiguousarray(img[:160, :160]), BOARD) is None
+
+
+def test_calibrate_from_video_passes_numpy_indexes_as_cameras(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``np.int64(1)`` was made the file name "1" by ``str()`` (FileNotFoundError "left source
+    not found: 1"); it is device 1, and a bool is refused as no source."""
+    import stereovision.capture as capture
+
+    seen: list[tuple[object, object]] = []
+
+    class Opened(Exception):
+        pass
+
+    def fake(left: object, right: object, **_kw: object) -> None:
+        seen.append((left, right))
+        raise Opened
+
+    with pytest.raises(ValueError, match=r"^left source: expected a device index or a path"):
+        calibrate_from_video(np.True_, 0, board=BOARD)  # type: ignore[arg-type]
+    monkeypatch.setattr(capture, "StereoCamera", fake)
+    with pytest.raises(Opened):
+        calibrate_from_video(np.int64(1), np.int32(2), board=BOARD)  # type: ignore[arg-type]
+    assert seen == [(1, 2)] and all(isinstance(v, (int, np.integer)) for v in seen[0])

@@ -1808,10 +1808,12 @@ def calibrate_from_video(
     from stereovision.capture import StereoCamera
 
     _check_max_pairs(max_pairs)
-    cam = StereoCamera(
-        left if isinstance(left, int) else str(left),
-        right if isinstance(right, int) else str(right),
-    )
+
+    # str() made np.int64(1) the file "1", and a bool is left to StereoCamera to refuse
+    def _source(s: object) -> int | str:
+        return s if isinstance(s, (int, np.integer, np.bool_)) else str(s)  # type: ignore[return-value]
+
+    cam = StereoCamera(_source(left), _source(right))
     return _calibrate_from_camera(
         cam,
         pattern=pattern,
