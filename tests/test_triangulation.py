@@ -506,3 +506,55 @@ def test_a_point_behind_the_right_camera_is_invalid() -> None:
     )
     assert res.valid.tolist() == [False, True]
     assert np.isnan(res.XL[0]).all() and np.isnan(res.XR[0]).all()
+
+
+def test_a_point_behind_the_left_camera_is_invalid() -> None:
+    """The mirror of the right camera's case: a wrong match whose left ray's closest point is
+    3.7 mm behind the left camera (Z_L < 0) while the right one's and the midpoint lie in front
+    of both cameras: no point."""
+    c = raw_calib()
+    good_l, good_r = project(c, scene_points(1))
+    res = triangulate(
+        np.vstack([[175.26, 45.64], good_l]), np.vstack([[116.82, 428.44], good_r]), c
+    )
+    assert res.valid.tolist() == [False, True]
+    assert np.isnan(res.XL[0]).all() and np.isnan(res.XR[0]).all()
+
+
+def test_the_parallel_ray_limit_is_an_angle_wherever_the_rays_point() -> None:
+    """Rays 5e-7 rad apart are parallel (below 1e-6 rad) at the image corner of a wide lens as
+    at its centre: the limit is on the squared sine, ``delta / (|u|^2 |xR|^2)``; on ``delta``
+    alone the corner's longer rays (|x|^2 = 4.6) passed as a point 80 km away."""
+    K = np.array([[200.0, 0.0, 320.0], [0.0, 200.0, 240.0], [0.0, 0.0, 1.0]])
+    c = Calibration(
+        K1=K, D1=np.zeros(5), K2=K.copy(), D2=np.zeros(5), R=np.eye(3),
+        T=np.array([-120.0, 0.0, 0.0]), image_size=SIZE, unit="mm", rectified=True,
+    )  # fmt: skip
+    # normalised (1.5, 1.15): rays 1.5e-6 / 4.6 * sqrt(1 + 1.15^2) = 5e-7 rad apart
+    e = 1.5e-6 * 200  # px
+    xl = np.array([[620.0, 470.0], [620.0, 470.0]])
+    xr = np.array([[620.0 - e, 470.0], [600.0, 470.0]])
+    res = triangulate(xl, xr, c)
+    assert res.valid.tolist() == [False, True]
+    assert np.isnan(res.XL[0]).all()
+
+
+def test_triangulate_gives_both_frames_in_the_unit_asked() -> None:
+    """XR as XL: in feet when asked (``XR = R XL + T`` in that unit), not in metres."""
+    pts = scene_points(10, seed=5)
+    c = raw_calib(unit="mm", scale=1000.0)
+    xl, xr = project(c, pts)
+    m = triangulate(xl, xr, c)
+    ft = triangulate(xl, xr, c, unit="ft")
+    want_r = pts @ c.R.T + c.T / 1000.0  # metres
+    np.testing.assert_allclose(m.XR, want_r, rtol=1e-9)
+    np.testing.assert_allclose(ft.XR, want_r / 0.3048, rtol=1e-9)
+    np.testing.assert_allclose(ft.XR, ft.XL @ c.R.T + c.T / 304.8, rtol=1e-9)
+
+
+def test_a_map_resized_with_a_pixel_of_rounding_is_warned_about() -> None:
+    """640x480 shrunk by 0.502 with sizes rounded down is 321x240: its height is 0.75 px off
+    480 * 321 / 640, within the pixel of rounding the check allows, so it warns."""
+    c = rect_calib()
+    with pytest.warns(UserWarning, match="is 321x240 px"):
+        depth_from_disparity(np.full((240, 321), 20.0), c)
