@@ -757,3 +757,60 @@ def test_reference_and_filters_refuse_an_unreachable_range_as_match_does() -> No
             mcgm.edge_filters(left, right, one, max_disparity=lo, min_disparity=lo)
     assert len(mcgm.zncc_reference(left, right, max_disparity=79, min_disparity=79)) == 0
     assert mcgm.edge_filters(left, right, one, max_disparity=79, min_disparity=79).shape == (1,)
+
+
+def test_matches_rasters_keep_row_and_column_0_and_skip_only_the_outside_ones() -> None:
+    """Row 0 and column 0 are in the image; a match outside it is left out of the rasters
+    without moving or dropping the others (its score ranks it between them)."""
+    m = sv.Matches(
+        xl=[0.0, 45.0, 7.2, 3.0], yl=[3.0, 2.0, 0.4, -0.6], xr=[-1.5, 40.0, 4.2, 1.0],
+        yr=[3.0, 2.0, 0.4, -0.1], score=[0.9, 0.5, 0.7, 0.8], image_shape=(12, 40),
+    )  # fmt: skip
+    dx = m.dispx
+    assert (dx[3, 0], dx[0, 7]) == (1.5, 3.0)
+    assert np.count_nonzero(np.isfinite(dx)) == 2  # (45, 2) and (3, -1) are outside
+    assert np.count_nonzero(np.isfinite(m.dispy)) == 2 and m.dispy[3, 0] == 0.0
+
+
+def test_matches_repr_gives_the_median_disparity() -> None:
+    m = sv.Matches(
+        xl=[11.0, 12.0, 19.0], yl=[1.0, 2.0, 3.0], xr=[10.0] * 3, yr=[1.0, 2.0, 3.0],
+        score=[0.5, 0.75, 1.0], image_shape=(8, 30),
+    )  # fmt: skip
+    assert repr(m) == (
+        "Matches(3 matches in 30x8; disparity 1.00-9.00 px (median 2.00); score 0.5-1)"
+    )
+
+
+def test_save_csv_that_fails_leaves_the_old_file_and_no_temporary(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The CSV is replaced only once fully written: a write failing midway (a full disk) keeps
+    the previous file whole and leaves no temporary behind."""
+    from stereovision import matches as matches_mod
+
+    m = _three()
+    path = m.save_csv(tmp_path / "m.csv")
+    before = path.read_text()
+
+    class DiskFull(str):
+        def __add__(self, other: str) -> str:
+            raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(matches_mod, "_CSV_HEADER", DiskFull(matches_mod._CSV_HEADER))
+    with pytest.raises(OSError, match="No space left"):
+        m[:1].save_csv(path)
+    assert path.read_text() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.csv"]
+
+
+def test_from_csv_reads_a_header_without_a_final_newline(tmp_path: Path) -> None:
+    """A file of no matches whose last line has no newline (as an editor may save it) is
+    0 matches, not 'expected the header ..., got ...scor'."""
+    path = tmp_path / "none.csv"
+    path.write_text("x_left,y_left,x_right,y_right,score")
+    assert len(sv.Matches.from_csv(path, image_shape=(10, 10))) == 0
+    path.write_text("x_left,y_left,x_right,y_right,score\n1,2,0.5,2,0.9")
+    assert sv.Matches.from_csv(path, image_shape=(10, 10)).to_array().tolist() == [
+        [1.0, 2.0, 0.5, 2.0]
+    ]
