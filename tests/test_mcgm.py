@@ -814,3 +814,17 @@ def test_from_csv_reads_a_header_without_a_final_newline(tmp_path: Path) -> None
     assert sv.Matches.from_csv(path, image_shape=(10, 10)).to_array().tolist() == [
         [1.0, 2.0, 0.5, 2.0]
     ]
+
+
+def test_matches_integer_index_out_of_range_is_an_index_error() -> None:
+    """``m[k]`` beyond the matches was an empty ``Matches``, not an IndexError, so ``for one in
+    m`` (Python iterates by index until IndexError) never ended."""
+    import itertools
+
+    m = _three()
+    assert m[-1].xl.tolist() == [30.0] and m[1].xr.tolist() == [18.0]
+    for k in (3, -4, np.int64(7)):
+        with pytest.raises(IndexError, match=rf"index {k} is out of range for 3 matches"):
+            m[k]
+    got = list(itertools.islice(iter(m), 5))
+    assert [one.xl.tolist() for one in got] == [[10.0], [20.0], [30.0]]

@@ -117,9 +117,15 @@ class Matches:
 
     def __getitem__(self, index: Any) -> Matches:
         """The matches picked by a slice, an integer array or a boolean mask, as ``Matches``
-        (``m[m.score > 0.9]``); the image shape and stats are kept, the energy trace too."""
+        (``m[m.score > 0.9]``); the image shape and stats are kept, the energy trace too. An
+        integer gives that one match; beyond the matches it is an IndexError."""
         if isinstance(index, (int, np.integer)):
-            index = slice(int(index), int(index) + 1 or None)
+            # As a slice an index beyond the end was an empty Matches, so iterating (by index
+            # until IndexError) never ended.
+            i, n = int(index), len(self)
+            if not -n <= i < n:
+                raise IndexError(f"Matches: index {i} is out of range for {n} matches")
+            index = slice(i, i + 1 or None)
         pick = np.asarray(np.arange(len(self))[index])
         if pick.ndim != 1:
             raise IndexError(f"Matches: expected a 1-D index or mask, got shape {pick.shape}")
