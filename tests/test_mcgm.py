@@ -828,3 +828,19 @@ def test_matches_integer_index_out_of_range_is_an_index_error() -> None:
             m[k]
     got = list(itertools.islice(iter(m), 5))
     assert [one.xl.tolist() for one in got] == [[10.0], [20.0], [30.0]]
+
+
+def test_matches_rasters_leave_out_non_finite_positions_without_a_warning() -> None:
+    """A NaN or infinite left position (a CSV row of ``nan``) is outside the image: left out of
+    the rasters as one beyond the edge is, not cast to an integer with NumPy's 'invalid value
+    encountered in cast' RuntimeWarning."""
+    import warnings
+
+    m = sv.Matches(
+        xl=[np.nan, 2.0, 1e30, 3.0], yl=[1.0, np.inf, 1.0, 2.0], xr=[0.0, 0.0, 0.0, 1.0],
+        yr=[1.0, 1.0, 1.0, 2.0], score=[1.0, 1.0, 1.0, 0.5], image_shape=(4, 4),
+    )  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        dx, dy = m.dispx, m.dispy
+    assert np.count_nonzero(np.isfinite(dx)) == 1 and dx[2, 3] == 2.0 and dy[2, 3] == 0.0

@@ -219,9 +219,12 @@ class Matches:
     def _raster(self, values: F32) -> F32:
         h, w = self.image_shape
         out = np.full((h, w), np.nan, dtype=np.float32)
-        xi = np.rint(self.xl).astype(np.int64)
-        yi = np.rint(self.yl).astype(np.int64)
-        ok = (xi >= 0) & (xi < w) & (yi >= 0) & (yi < h)
+        # Bounds on the rounded floats: NaN compares False (cast first, a NaN, inf or 1e30
+        # position was NumPy's 'invalid value encountered in cast' warning).
+        rx, ry = np.rint(self.xl), np.rint(self.yl)
+        ok = (rx >= 0) & (rx < w) & (ry >= 0) & (ry < h)
+        xi = np.where(ok, rx, 0).astype(np.int64)
+        yi = np.where(ok, ry, 0).astype(np.int64)
         # Two matches can round to one pixel (MCGM: 15 of 5086 on tsukuba): the better-scored
         # one is written last, so it is the one kept.
         order = np.argsort(self.score, kind="stable")
