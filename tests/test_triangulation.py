@@ -558,3 +558,12 @@ def test_a_map_resized_with_a_pixel_of_rounding_is_warned_about() -> None:
     c = rect_calib()
     with pytest.warns(UserWarning, match="is 321x240 px"):
         depth_from_disparity(np.full((240, 321), 20.0), c)
+
+
+@pytest.mark.parametrize("n", [1, 3, 6, 7, 13])
+def test_a_distortion_vector_of_an_opencv_unknown_length_is_refused(n: int) -> None:
+    """OpenCV's models have 4, 5, 8, 12 or 14 coefficients: 6 values were read silently as
+    k1, k2, p1, p2, k3 and the rational k4 (OpenCV refuses them)."""
+    K = np.array([[600.0, 0.0, 320.0], [0.0, 600.0, 240.0], [0.0, 0.0, 1.0]])
+    with pytest.raises(ValueError, match=rf"D: expected 4, 5, 8, 12 or 14 coefficients, got {n}"):
+        undistort_normalized(np.zeros((1, 2)), K, np.full(n, 0.01))
