@@ -491,6 +491,12 @@ def test_save_csv_round_trips_exactly(tmp_path: Path) -> None:
     np.testing.assert_array_equal(back.to_array(), m.to_array())
     np.testing.assert_array_equal(back.score, m.score)
     np.testing.assert_array_equal(back.dispx, m.dispx)
+    # Excel's "CSV UTF-8" starts the file with a BOM: it was "another header"
+    bom = tmp_path / "bom.csv"
+    bom.write_bytes(b"\xef\xbb\xbf" + path.read_bytes().replace(b"\n", b"\r\n"))
+    np.testing.assert_array_equal(
+        sv.Matches.from_csv(bom, image_shape=m.image_shape).to_array(), m.to_array()
+    )
     (tmp_path / "bad.csv").write_text("x,y,x2,y2\n1,2,3,4\n")
     with pytest.raises(ValueError, match="header"):
         sv.Matches.from_csv(tmp_path / "bad.csv", image_shape=(10, 10))

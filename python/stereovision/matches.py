@@ -282,7 +282,7 @@ class Matches:
 
     @classmethod
     def from_csv(cls, path: str | os.PathLike[str], image_shape: tuple[int, int]) -> Matches:
-        """Read a file :meth:`save_csv` wrote.
+        """Read a file :meth:`save_csv` wrote (also after a spreadsheet saved it with a BOM).
 
         Parameters
         ----------
@@ -301,7 +301,9 @@ class Matches:
         ValueError
             Another header, or a row without five numbers.
         """
-        with open(path, encoding="utf-8") as fh:
+        # utf-8-sig: a file saved again by a spreadsheet (Excel) starts with a BOM, which made
+        # the header "another header"
+        with open(path, encoding="utf-8-sig") as fh:
             head = fh.readline().strip()
             if head != _CSV_HEADER:
                 raise ValueError(f"{path}: expected the header {_CSV_HEADER!r}, got {head!r}")
