@@ -927,3 +927,19 @@ def test_read_ply_header_ends_at_the_end_header_line(tmp_path: Path) -> None:
     (tmp_path / "n.ply").write_bytes(b"ply\nformat ascii 1.0\ncomment end_header\n")
     with pytest.raises(ValueError, match="not a PLY file"):
         read_ply(tmp_path / "n.ply")
+
+
+# ------------------------------------------------- mutation audit 2: scenes, images, path helpers
+
+
+def test_load_scene_names_a_relative_folder_by_its_own_names(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``stereovision eval .`` inside a scene's folder listed it as "/", and ``eval tsukuba``
+    beside it as "/tsukuba", ``eval ../tsukuba`` as "../tsukuba": the name is
+    ``<family>/<scene>`` of the folder itself, however it is spelt."""
+    monkeypatch.chdir(data_dir / "middlebury2001" / "tsukuba")
+    for spelt in (".", "../tsukuba", Path("..") / "tsukuba" / "."):
+        assert load_scene(spelt).name == "middlebury2001/tsukuba", spelt
+    monkeypatch.chdir(data_dir / "middlebury2001")
+    assert load_scene("tsukuba").name == "middlebury2001/tsukuba"

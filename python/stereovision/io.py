@@ -1211,8 +1211,11 @@ def load_scene(directory: PathLike) -> Scene:
             )
     elif (d / "Q.dat").exists():
         calib = Calibration.from_q(d / "Q.dat", (left.shape[1], left.shape[0]))
+    # named from the absolute path, '..' folded: '.', 'tsukuba' or '../tsukuba' gave '/',
+    # '/tsukuba' or '../tsukuba' (os.path.abspath keeps a link's own name, as resolve() would not)
+    named = Path(os.path.abspath(d))
     return Scene(
-        name=f"{d.parent.name}/{d.name}",
+        name=f"{named.parent.name}/{named.name}",
         left=left,
         right=right,
         gt=gt,
