@@ -943,3 +943,106 @@ def test_load_scene_names_a_relative_folder_by_its_own_names(
         assert load_scene(spelt).name == "middlebury2001/tsukuba", spelt
     monkeypatch.chdir(data_dir / "middlebury2001")
     assert load_scene("tsukuba").name == "middlebury2001/tsukuba"
+
+
+def _jpeg_with_orientation(image: np.ndarray, orientation: int) -> bytes:
+    """A JPEG of ``image`` with an EXIF APP1 segment holding only the Orientation tag."""
+    ok, jpg = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, 100])
+    assert ok
+    tiff = b"II*\x00" + struct.pack("<I", 8)  # little-endian TIFF header, IFD at offset 8
+    tiff += struct.pack("<H", 1) + struct.pack("<HHIHH", 0x0112, 3, 1, orientation, 0)
+    tiff += struct.pack("<I", 0)  # no next IFD
+    app1 = b"Exif\x00\x00" + tiff
+    data = jpg.tobytes()
+    return data[:2] + b"\xff\xe1" + struct.pack(">H", len(app1) + 2) + app1 + data[2:]
+
+
+def test_images_are_read_upright_as_their_exif_orientation_says(tmp_path: Path) -> None:
+    """A camera's JPEG tagged "rotate 90 clockwise" (EXIF Orientation 6) is read turned, as
+    cv2.imread and image viewers show it, by imread and read_image alike."""
+    img = np.zeros((16, 24, 3), np.uint8)
+    img[:8, :8] = 255  # a white top-left block
+    path = tmp_path / "portrait.jpg"
+    path.write_bytes(_jpeg_with_orientation(img, 6))
+    for got in (imread(path), read_image(path), imread(path, gray=True)):
+        assert got.shape[:2] == (24, 16)
+        assert got[:8, 8:].min() > 200 and got[:8, :8].max() < 50  # now top right
+    np.testing.assert_array_equal(imread(path), cv2.imread(str(path)))
+
+
+def test_a_folder_or_a_float_file_is_no_image(tmp_path: Path) -> None:
+    """A folder given as an image is 'not a regular file' (ValueError, as for any other input),
+    not 'not found' nor NumPy's IsADirectoryError; a float32 TIFF is refused, not read
+    as uint16 by a cast (0.5 -> 0)."""
+    (tmp_path / "left.png").mkdir()
+    for read in (imread, read_image):
+        with pytest.raises(ValueError, match=r"^image file is not a regular file: .*left\.png$"):
+            read(tmp_path / "left.png")
+    colour = np.dstack([np.array([[0.5, 300.0]], np.float32)] * 3)  # decodes as float32 BGR
+    assert cv2.imwrite(str(tmp_path / "f.tiff"), colour)
+    with pytest.raises(ValueError, match=r"^cannot decode .*f\.tiff as an image$"):
+        read_image(tmp_path / "f.tiff")
+
+
+def test_a_video_is_named_whatever_the_case_of_its_suffix(tmp_path: Path) -> None:
+    for name, says in (("CLIP.AVI", "it is a video"), ("run.Bag", "it is a ROS bag")):
+        (tmp_path / name).write_bytes(b"\x00" * 64)
+        with pytest.raises(ValueError, match=rf"as an image: {says}; this command"):
+            imread(tmp_path / name)
+
+
+def _scene(folder: Path, width: int, height: int) -> Path:
+    folder.mkdir(parents=True, exist_ok=True)
+    rng = np.random.default_rng(0)
+    for name in ("left.png", "right.png"):
+        cv2.imwrite(str(folder / name), rng.integers(0, 255, (height, width, 3), np.uint8))
+    return folder
+
+
+def test_load_scene_right_image_gt_width_and_range_without_gt(tmp_path: Path) -> None:
+    """The right image is right.png's pixels; a GT one column narrower than the images is
+    refused as one a row shorter is; without GT or calibration the range is a quarter of the
+    width (200 // 4 = 50 -> 64), not of the height (40 // 4 -> 16)."""
+    d = _scene(tmp_path / "fam" / "wide", 200, 40)
+    s = load_scene(d)
+    np.testing.assert_array_equal(s.right, cv2.imread(str(d / "right.png")))
+    assert not np.array_equal(s.left, s.right)
+    assert s.gt is None and s.calib is None and s.max_disparity == 64
+    write_pfm(d / "gt_disp.pfm", np.full((40, 199), 5.0, np.float32))
+    with pytest.raises(ValueError) as info:
+        load_scene(d)
+    assert str(info.value) == f"scene {d}: gt_disp.pfm is 199x40, left.png 200x40"
+    with pytest.raises(FileNotFoundError, match=r"^scene directory not found: .*left\.png$"):
+        load_scene(d / "left.png")  # a file is no scene folder
+
+
+def test_scene_range_ignores_infinite_gt_and_calib_ndisp_inf_names_the_file(
+    tmp_path: Path,
+) -> None:
+    """+inf (the files' unknown) is no disparity of the range: [inf, 30] gives
+    round_up16(33) = 48, not an overflow; an ndisp=inf in calib.txt is refused naming the
+    file and the key, as NaN, 0 and -5 are."""
+    gt = np.array([[np.inf, 30.0], [-np.inf, np.nan]], np.float32)
+    assert scene_max_disparity(gt, width=100) == 48
+    d = _scene(tmp_path / "fam" / "s", 64, 8)
+    calib = d / "calib.txt"
+    calib.write_text(
+        "cam0=[100 0 32; 0 100 4; 0 0 1]\ncam1=[100 0 32; 0 100 4; 0 0 1]\ndoffs=0\n"
+        "baseline=120\nwidth=64\nheight=8\nndisp=inf\n"
+    )
+    with pytest.raises(ValueError) as info:
+        load_scene(d)
+    assert str(info.value) == (
+        f"{calib}: ndisp=inf: expected the disparity range in pixels, a positive finite number"
+    )
+    calib.write_text(calib.read_text().replace("ndisp=inf", "ndisp=20"))
+    assert load_scene(d).max_disparity == 32  # no GT: the calibration's ndisp, rounded up
+    calib.write_text(calib.read_text().replace("0 0 1]\ncam1", "0 0 1; 1 2 3]\ncam1"))
+    with pytest.raises(ValueError, match=r"calib\.txt:1: cannot parse cam0=.*\(shape \(4, 3\)\)"):
+        load_scene(d)
+
+
+def test_find_scenes_of_a_file_is_not_found(tmp_path: Path) -> None:
+    (tmp_path / "left.png").write_bytes(b"")
+    with pytest.raises(FileNotFoundError, match=r"^scene root not found: .*left\.png$"):
+        find_scenes(tmp_path / "left.png")
