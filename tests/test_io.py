@@ -1046,3 +1046,35 @@ def test_find_scenes_of_a_file_is_not_found(tmp_path: Path) -> None:
     (tmp_path / "left.png").write_bytes(b"")
     with pytest.raises(FileNotFoundError, match=r"^scene root not found: .*left\.png$"):
         find_scenes(tmp_path / "left.png")
+
+
+def test_path_helpers_of_the_cli(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """missing_folders lists absolute folders, skips '..' and stops at a (dangling) link;
+    check_output_folder refuses a folder it cannot write in; refuse_an_input looks past an
+    input not given; lock_folder tells a held lock (busy) from its own."""
+    from stereovision.io import (
+        check_output_folder,
+        lock_folder,
+        missing_folders,
+        refuse_an_input,
+    )
+
+    monkeypatch.chdir(tmp_path)
+    assert missing_folders("new/../out") == [tmp_path / "new/../out", tmp_path / "new"]
+    assert missing_folders("a/b") == [tmp_path / "a/b", tmp_path / "a"]
+    (tmp_path / "link").symlink_to(tmp_path / "gone")
+    assert missing_folders("link/sub") == [tmp_path / "link/sub"]  # not the link itself
+    with pytest.raises(PermissionError, match=r"^-o /proc/x/out: cannot write in /proc \("):
+        check_output_folder("/proc/x/out", "-o")
+    (tmp_path / "l.png").write_bytes(b"x")
+    with pytest.raises(ValueError, match=r"^--plot l\.png: is the left image \(l\.png\)"):
+        refuse_an_input("--plot", Path("l.png"), {"the mask": None, "the left image": "l.png"})
+    fd, busy = lock_folder(tmp_path)
+    assert isinstance(fd, int) and busy is False
+    try:
+        assert lock_folder(tmp_path) == (None, True)  # another descriptor: the lock is held
+    finally:
+        os.close(fd)
+    fd, busy = lock_folder(tmp_path)
+    assert fd is not None and busy is False
+    os.close(fd)
