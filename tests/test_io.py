@@ -1078,3 +1078,16 @@ def test_path_helpers_of_the_cli(tmp_path: Path, monkeypatch: pytest.MonkeyPatch
     fd, busy = lock_folder(tmp_path)
     assert fd is not None and busy is False
     os.close(fd)
+
+
+def test_load_scene_refuses_a_colour_pfm_as_gt_saying_so(tmp_path: Path) -> None:
+    """A colour PFM (PF, 3 channels) of the images' size as gt_disp.pfm was refused as
+    'gt_disp.pfm is 6x4, left.png 6x4', a size mismatch between two equal sizes."""
+    d = _scene(tmp_path / "fam" / "s", 6, 4)
+    write_pfm(d / "gt_disp.pfm", np.ones((4, 6, 3), np.float32))
+    with pytest.raises(ValueError) as info:
+        load_scene(d)
+    assert str(info.value) == (
+        f"scene {d}: gt_disp.pfm holds 3 channels (a colour PF file): a GT disparity map has "
+        "one value per pixel (Pf)"
+    )

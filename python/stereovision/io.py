@@ -1171,9 +1171,9 @@ def load_scene(directory: PathLike) -> Scene:
     FileNotFoundError
         If the directory, ``left.png`` or ``right.png`` is missing.
     ValueError
-        If an image cannot be decoded, the pair sizes differ, the GT size differs from the
-        left image, or the calibration file is invalid (an ``ndisp`` of NaN, 0 or below
-        included).
+        If an image cannot be decoded, the pair sizes differ, the GT is not one channel or
+        its size differs from the left image, or the calibration file is invalid (an
+        ``ndisp`` of NaN, 0 or below included).
     """
     from stereovision.calibration import Calibration, parse_middlebury_calib
 
@@ -1191,6 +1191,11 @@ def load_scene(directory: PathLike) -> Scene:
     gt_path = d / "gt_disp.pfm"
     if gt_path.exists():
         gt = read_pfm(gt_path)
+        if gt.ndim == 3:  # else refused below as 'gt_disp.pfm is 6x4, left.png 6x4'
+            raise ValueError(
+                f"scene {d}: gt_disp.pfm holds {gt.shape[2]} channels (a colour PF file): a GT "
+                "disparity map has one value per pixel (Pf)"
+            )
         if gt.shape != left.shape[:2]:
             raise ValueError(
                 f"scene {d}: gt_disp.pfm is {gt.shape[1]}x{gt.shape[0]}, left.png "
