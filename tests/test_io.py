@@ -1091,3 +1091,26 @@ def test_load_scene_refuses_a_colour_pfm_as_gt_saying_so(tmp_path: Path) -> None
         f"scene {d}: gt_disp.pfm holds 3 channels (a colour PF file): a GT disparity map has "
         "one value per pixel (Pf)"
     )
+
+
+def test_pair_check_keep_previous_and_quiet_decodes_edge_cases(tmp_path: Path) -> None:
+    """Paths that do not exist (the GUI's, a bag's) are not 'the same file'; keep_previous of
+    a folder copies nothing; an empty file is 'cannot decode' for read_image too (not
+    OpenCV's assertion); a decode inside another keeps OpenCV silent until the outer ends."""
+    from stereovision.io import _opencv_quiet, check_pair_files, keep_previous
+
+    a, b = np.zeros((2, 3, 3), np.uint8), np.ones((2, 3, 3), np.uint8)
+    assert check_pair_files(a, b, tmp_path / "l.png", tmp_path / "r.png") is None
+    (tmp_path / "shot.png").mkdir()
+    assert keep_previous(tmp_path / "shot.png") is None
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["shot.png"]
+    (tmp_path / "empty.png").write_bytes(b"")
+    with pytest.raises(ValueError, match=r"^cannot decode .*empty\.png as an image$"):
+        read_image(tmp_path / "empty.png")
+    log = cv2.utils.logging  # type: ignore[attr-defined]
+    before = log.getLogLevel()
+    with _opencv_quiet():
+        with _opencv_quiet():
+            pass
+        assert log.getLogLevel() == log.LOG_LEVEL_SILENT
+    assert log.getLogLevel() == before
