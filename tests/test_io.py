@@ -1114,3 +1114,50 @@ def test_pair_check_keep_previous_and_quiet_decodes_edge_cases(tmp_path: Path) -
             pass
         assert log.getLogLevel() == log.LOG_LEVEL_SILENT
     assert log.getLogLevel() == before
+
+
+def test_scene_calibrations_are_the_calib_txt_values(data_dir: Path, tmp_path: Path) -> None:
+    """Each calib.txt layout read by hand: K of cam0, baseline in mm, the image size, doffs;
+    depth Z = f B / (d + doffs) in metres."""
+    kitti = load_scene(data_dir / "kitti2015/000005_10").calib
+    assert kitti is not None and kitti.unit == "mm" and kitti.image_size == (1242, 375)
+    np.testing.assert_array_equal(
+        kitti.K1, [[721.5377, 0, 609.5593], [0, 721.5377, 172.854], [0, 0, 1]]
+    )
+    assert kitti.baseline_m == pytest.approx(0.532725, rel=1e-12)
+    z = kitti.depth_from_disparity(np.array([[50.0]], np.float32))
+    assert float(z[0, 0]) == pytest.approx(721.5377 * 0.532725 / 50, rel=1e-6)  # 7.688 m
+    tartan = load_scene(data_dir / "tartanair/oldtown_easy_p000_001116").calib
+    assert tartan is not None and tartan.focal_px == 320.0 and tartan.doffs_px == 0.0
+    assert float(tartan.depth_from_disparity(np.array([[8.0]], np.float32))[0, 0]) == 10.0
+    play = load_scene(data_dir / "eth3d/playground").calib
+    assert play is not None and play.image_size == (941, 490)
+    assert (play.K1[0, 2], play.K1[1, 2], play.baseline) == (541.836, 255.198, 59.5549)
+    # Middlebury 2014's layout: cam1's cx is cam0's + doffs
+    d = _scene(tmp_path / "fam" / "mb2014", 64, 8)
+    (d / "calib.txt").write_text(
+        "cam0=[100 0 30; 0 100 4; 0 0 1]\ncam1=[100 0 40; 0 100 4; 0 0 1]\ndoffs=10\n"
+        "baseline=120\nwidth=64\nheight=8\nndisp=20\nisint=0\nvmin=2\nvmax=18\n"
+    )
+    mb = load_scene(d).calib
+    assert mb is not None and mb.doffs_px == 10.0 and mb.K1[0, 2] == 30.0 and mb.K2[0, 2] == 40.0
+    z = mb.depth_from_disparity(np.array([[20.0, -10.0]], np.float32))
+    assert float(z[0, 0]) == pytest.approx(0.4, rel=1e-6)  # 120 mm * 100 / (20 + 10)
+    assert np.isnan(z[0, 1])  # d + doffs = 0: no depth
+
+
+def test_scene_range_fallbacks_and_16_bit_scene_images(tmp_path: Path) -> None:
+    """ndisp is the range as given (16 -> 16; not 1.1 x, which gives 32); the width's quarter
+    rounds down (65 // 4 = 16 -> 16); a scene's 16-bit PNGs are read as evaluation.md says,
+    8-bit as cv2.imread reads them (the top 8 bits), both images alike."""
+    assert scene_max_disparity(None, width=100, ndisp=16) == 16
+    assert scene_max_disparity(None, width=65) == 16
+    d = tmp_path / "fam" / "deep"
+    d.mkdir(parents=True)
+    deep = np.full((4, 6, 3), 0x1234, np.uint16)
+    for name in ("left.png", "right.png"):
+        assert cv2.imwrite(str(d / name), deep)
+        deep = deep + 0x0100
+    s = load_scene(d)
+    assert s.left.dtype == np.uint8 and s.right.dtype == np.uint8
+    assert (int(s.left[0, 0, 0]), int(s.right[0, 0, 0])) == (0x12, 0x13)
