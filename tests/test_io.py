@@ -1161,3 +1161,19 @@ def test_scene_range_fallbacks_and_16_bit_scene_images(tmp_path: Path) -> None:
     s = load_scene(d)
     assert s.left.dtype == np.uint8 and s.right.dtype == np.uint8
     assert (int(s.left[0, 0, 0]), int(s.right[0, 0, 0])) == (0x12, 0x13)
+
+
+def test_find_scenes_follows_linked_folders_once(data_dir: Path, tmp_path: Path) -> None:
+    """Scenes linked into a folder (``ln -s /data/middlebury2001 mine/mb``) were not found:
+    Path.rglob does not enter a link to a folder, so ``eval mine`` said there was no scene.
+    Links are followed, a link back up the tree (a loop) once."""
+    (tmp_path / "fam").mkdir()
+    (tmp_path / "mb").symlink_to(data_dir / "middlebury2001")
+    (tmp_path / "fam" / "terrace").symlink_to(data_dir / "eth3d" / "terrace")
+    (tmp_path / "fam" / "loop").symlink_to(tmp_path)
+    assert find_scenes(tmp_path) == [
+        tmp_path / "fam" / "terrace",
+        tmp_path / "mb" / "tsukuba",
+        tmp_path / "mb" / "venus",
+    ]
+    assert load_scene(tmp_path / "mb" / "venus").name == "mb/venus"  # the link's own name

@@ -1231,7 +1231,8 @@ def load_scene(directory: PathLike) -> Scene:
 
 
 def find_scenes(root: PathLike) -> list[Path]:
-    """Scene directories under ``root`` (any depth) that contain ``left.png`` and ``right.png``.
+    """Scene directories under ``root`` (any depth, through links to folders) that contain
+    ``left.png`` and ``right.png``.
 
     Parameters
     ----------
@@ -1251,5 +1252,17 @@ def find_scenes(root: PathLike) -> list[Path]:
     r = Path(root)
     if not r.is_dir():
         raise FileNotFoundError(f"scene root not found: {r}")
-    found = {p.parent for p in r.rglob("left.png") if (p.parent / "right.png").is_file()}
+    # os.walk following links: Path.rglob does not enter a link to a folder, so scenes linked
+    # into a folder were not found. A link back to a folder on its own path (a loop) is not
+    # entered; one scene linked twice is listed under both names.
+    found = []
+    above: dict[str, frozenset[str]] = {}  # real folders on the way to each folder
+    for folder, subfolders, files in os.walk(r, followlinks=True):
+        on_path = above.pop(folder, frozenset()) | {os.path.realpath(folder)}
+        subfolders[:] = [
+            s for s in subfolders if os.path.realpath(os.path.join(folder, s)) not in on_path
+        ]
+        above.update((os.path.join(folder, s), on_path) for s in subfolders)
+        if "left.png" in files and os.path.isfile(os.path.join(folder, "right.png")):
+            found.append(Path(folder))
     return sorted(found)
