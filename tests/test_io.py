@@ -1177,3 +1177,25 @@ def test_find_scenes_follows_linked_folders_once(data_dir: Path, tmp_path: Path)
         tmp_path / "mb" / "venus",
     ]
     assert load_scene(tmp_path / "mb" / "venus").name == "mb/venus"  # the link's own name
+
+
+def test_load_scene_keeps_gt_zero_and_large_values_as_disparities(tmp_path: Path) -> None:
+    """evaluation.md: only inf or NaN is unknown. A GT of 0 (a point at infinity, TartanAir's
+    sky) is a known disparity, not KITTI's raw 'no LiDAR' 0 (its SOURCE conversion made those
+    +inf); 65504 (float16's largest) is a value too, and then the range says the scene is
+    too narrow for it."""
+    from stereovision.io import scene_too_narrow
+
+    d = _scene(tmp_path / "fam" / "s", 4, 2)
+    gt = np.array([[0.0, 65504.0, np.inf, -np.inf], [np.nan, 1.5, 0.0, 2.0]], np.float32)
+    write_pfm(d / "gt_disp.pfm", gt)
+    s = load_scene(d)
+    assert s.gt is not None
+    np.testing.assert_array_equal(
+        s.gt, np.array([[0.0, 65504.0, np.nan, np.nan], [np.nan, 1.5, 0.0, 2.0]], np.float32)
+    )
+    assert s.max_disparity == 72064  # round_up16(1.1 * 65504 = 72054.4)
+    assert scene_too_narrow(s) == (
+        "images 4 px wide, not wider than the scene's disparity range (72064 px, "
+        "evaluation.md's rule: 16 at least): a scene needs images at least 72065 px wide"
+    )
