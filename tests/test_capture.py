@@ -443,7 +443,17 @@ def test_resolution_request_and_resize_warning(tmp_path: Path) -> None:
             parse_size(bad)
     assert parse_size("16384x8640") == (16384, 8640)
     assert parse_size((640, 480)) == parse_size([640.0, np.int64(480)]) == (640, 480)
-    for bad in ((640.7, 480), (True, 480), (640,), (640, 480, 3), 640, (640, float("nan"))):
+    for bad in (
+        (640.7, 480),
+        (True, 480),
+        (640,),
+        (640, 480, 3),
+        640,
+        (640, float("nan")),
+        np.array(640),
+        np.ones((2, 2)),
+        ((640, 1), 480),
+    ):
         with pytest.raises(ValueError, match="WIDTHxHEIGHT"):  # 640.7 was cut, True taken as 1
             parse_size(bad)
     with pytest.raises(ValueError, match="at most 16384 px per side, got 100000x100000"):

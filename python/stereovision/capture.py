@@ -276,7 +276,8 @@ def parse_size(text: str | tuple[int, int] | None, name: str = "size") -> tuple[
         vals = (int(m.group(1)), int(m.group(2))) if m else (0, 0)
     else:
         # int() cut (640.7, 480) to 640x480 and took (True, 480) as 1x480 without a word
-        items = tuple(text) if isinstance(text, (tuple, list, np.ndarray)) else ()
+        listed = isinstance(text, (tuple, list))
+        items = tuple(text) if listed or (isinstance(text, np.ndarray) and text.ndim == 1) else ()
         whole = len(items) == 2 and all(
             not isinstance(v, (bool, np.bool_))
             and isinstance(v, (int, float, np.integer, np.floating))
