@@ -1160,4 +1160,584 @@ mod tests {
         assert!((cubic_sample(&row, 3.25) - 3.25).abs() < 1e-6); // exact on a line
         assert_eq!(cubic_sample(&row, 4.0), 4.0);
     }
+
+    /// Three box sums of half-width `b` along x, then three along y, zero padding: the
+    /// definition of [`box3_zero`], summed term by term.
+    fn box3_direct(a: &[f64], w: usize, h: usize, b: usize) -> Vec<f64> {
+        let pass = |src: &[f64], len: usize, lines: usize, at: &dyn Fn(usize, usize) -> usize| {
+            let mut out = vec![0f64; w * h];
+            for line in 0..lines {
+                for i in 0..len {
+                    let lo = i.saturating_sub(b);
+                    let hi = (i + b).min(len - 1);
+                    out[at(line, i)] = (lo..=hi).map(|j| src[at(line, j)]).sum();
+                }
+            }
+            out
+        };
+        let mut v = a.to_vec();
+        for _ in 0..3 {
+            v = pass(&v, w, h, &|y, x| y * w + x);
+        }
+        for _ in 0..3 {
+            v = pass(&v, h, w, &|x, y| y * w + x);
+        }
+        v
+    }
+
+    #[test]
+    fn box3_zero_equals_the_direct_triple_box_sum() {
+        // Small integers: every sum is exact in either order. 70 columns: two column strips;
+        // 11 rows: two groups of four rows and a remainder of three.
+        let (w, h) = (70, 11);
+        let a: Vec<f64> = (0..w * h).map(|i| ((i * 7) % 13) as f64).collect();
+        for b in [1, 2, 7] {
+            let want = box3_direct(&a, w, h, b);
+            assert_eq!(box3_zero(a.clone(), w, h, b), want, "f64, b {b}");
+        }
+        let a32: Vec<f32> = a.iter().map(|&v| v as f32).collect();
+        let got: Vec<f64> = box3_zero(a32, w, h, 2).iter().map(|&v| v as f64).collect();
+        assert_eq!(got, box3_direct(&a, w, h, 2), "f32");
+    }
+
+    #[test]
+    fn box_radius_and_gaussian_taps_values() {
+        // (2b + 1)^2 = 4 sigma^2 + 1 rounded: sigma 4 gives b = 3.53 -> 4, sigma 16 15.51 -> 16.
+        assert_eq!(
+            [0.1, 1.0, 2.0, 4.0, 16.0].map(box3_radius),
+            [1, 1, 2, 4, 16]
+        );
+        let g = gaussian_taps(2.0, 2);
+        let want = [
+            (-0.5f32).exp(),
+            (-0.125f32).exp(),
+            1.0,
+            (-0.125f32).exp(),
+            (-0.5f32).exp(),
+        ];
+        assert_eq!(g, want);
+    }
+
+    #[test]
+    fn a_single_value_reaches_the_three_boxes_extent() {
+        // One value at (10, 10), b = 1: three boxes reach 3 px in x and y (the corner with
+        // weight 1 * 1), and both smoothings give the value itself there, NaN beyond.
+        let (w, h) = (25, 25);
+        let mut d = vec![f32::NAN; w * h];
+        d[10 * w + 10] = 3.0;
+        let s = nc_smooth(&d, w, h, 1.0);
+        let (pl, res) = nc_plane(&d, w, h, 1.0, true);
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                let near = x.abs_diff(10) <= 3 && y.abs_diff(10) <= 3;
+                if near {
+                    assert_eq!((s[i], pl[i], res[i]), (3.0, 3.0, 0.0), "({x}, {y})");
+                } else {
+                    assert!(
+                        s[i].is_nan() && pl[i].is_nan() && res[i].is_nan(),
+                        "({x}, {y})"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Weighted least-squares plane at pixel `(x, y)` with the three-box kernel, by direct sums
+    /// (f64): the definition of [`nc_plane`]'s value and RMS residual.
+    fn plane_direct(d: &[f32], w: usize, h: usize, b: usize, x: usize, y: usize) -> (f64, f64) {
+        // The 1-D weight of sample q at p: three boxes of 2b + 1 ones, each pass zero-padded
+        // (a path through a position outside the image counts for nothing), so near a border
+        // it is not the full kernel cut off.
+        let k1 = |n: usize, p: i64, q: i64| -> f64 {
+            let mut v = vec![0f64; n];
+            v[q as usize] = 1.0;
+            for _ in 0..3 {
+                v = (0..n)
+                    .map(|i| {
+                        (i.saturating_sub(b)..=(i + b).min(n - 1))
+                            .map(|j| v[j])
+                            .sum()
+                    })
+                    .collect();
+            }
+            v[p as usize]
+        };
+        let r = 3 * b as i64;
+        let mut m = [[0f64; 3]; 3];
+        let mut v = [0f64; 3];
+        let mut pts = Vec::new();
+        for dy in -r..=r {
+            for dx in -r..=r {
+                let (xx, yy) = (x as i64 + dx, y as i64 + dy);
+                if xx < 0 || yy < 0 || xx >= w as i64 || yy >= h as i64 {
+                    continue;
+                }
+                let val = d[yy as usize * w + xx as usize];
+                if !val.is_finite() {
+                    continue;
+                }
+                let g = k1(w, x as i64, xx) * k1(h, y as i64, yy);
+                let row = [1.0, dx as f64, dy as f64];
+                for i in 0..3 {
+                    for j in 0..3 {
+                        m[i][j] += g * row[i] * row[j];
+                    }
+                    v[i] += g * row[i] * val as f64;
+                }
+                pts.push((g, dx as f64, dy as f64, val as f64));
+            }
+        }
+        // Gaussian elimination (the test maps fix a plane everywhere).
+        for c in 0..3 {
+            for rr in c + 1..3 {
+                let (pivot, f) = (m[c], m[rr][c] / m[c][c]);
+                for (a, p) in m[rr].iter_mut().zip(pivot).skip(c) {
+                    *a -= f * p;
+                }
+                v[rr] -= f * v[c];
+            }
+        }
+        let mut s = [0f64; 3];
+        for c in (0..3).rev() {
+            let t: f64 = (c + 1..3).map(|k| m[c][k] * s[k]).sum();
+            s[c] = (v[c] - t) / m[c][c];
+        }
+        let (mut e2, mut g0) = (0f64, 0f64);
+        for (g, dx, dy, val) in pts {
+            let e = val - (s[0] + s[1] * dx + s[2] * dy);
+            e2 += g * e * e;
+            g0 += g;
+        }
+        (s[0], (e2 / g0).sqrt())
+    }
+
+    #[test]
+    fn plane_fit_and_residual_equal_the_direct_weighted_fit() {
+        let (w, h) = (23, 19);
+        let d: Vec<f32> = (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as f32, (i / w) as f32);
+                if (i * 11) % 7 == 0 {
+                    f32::NAN
+                } else {
+                    4.0 + 0.3 * x - 0.2 * y + (0.9 * x).sin() * (0.5 * y).cos()
+                }
+            })
+            .collect();
+        let b = box3_radius(2.0);
+        let (pl, res) = nc_plane(&d, w, h, 2.0, true);
+        for (x, y) in [(0, 0), (22, 18), (11, 9), (3, 17), (20, 2), (7, 7)] {
+            let (a, rms) = plane_direct(&d, w, h, b, x, y);
+            let i = y * w + x;
+            assert!(
+                (pl[i] as f64 - a).abs() < 1e-4,
+                "({x}, {y}): {} vs {a}",
+                pl[i]
+            );
+            assert!(
+                (res[i] as f64 - rms).abs() < 1e-4,
+                "({x}, {y}): {} vs {rms}",
+                res[i]
+            );
+            assert!(rms > 0.1, "({x}, {y}): the map is not one plane there");
+        }
+        // Positions on one line (a single row) fix no plane: the flat weighted mean (at x = 0,
+        // b = 1: weights 4 5 3 1 on the values 0 1 2 3).
+        let row: Vec<f32> = (0..w).map(|x| x as f32).collect();
+        let (pl, _) = nc_plane(&row, w, 1, 1.0, false);
+        assert!((pl[0] - 14.0 / 13.0).abs() < 1e-6, "{}", pl[0]);
+    }
+
+    #[test]
+    fn cubic_sample_is_catmull_rom_with_clamped_ends() {
+        let row: Vec<f32> = (0..10).map(|i| ((i * i) % 7) as f32).collect();
+        let at = |i: i64| row[i.clamp(0, 9) as usize] as f64;
+        for t in [0.0f32, 0.3, 2.75, 5.5, 7.9, 8.5, 8.99, 9.0] {
+            let i = t.floor() as i64;
+            let f = (t - t.floor()) as f64;
+            let (p0, p1, p2, p3) = (at(i - 1), at(i), at(i + 1), at(i + 2));
+            let want = 0.5
+                * (2.0 * p1
+                    + (p2 - p0) * f
+                    + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * f * f
+                    + (3.0 * p1 - p0 - 3.0 * p2 + p3) * f * f * f);
+            let got = cubic_sample(&row, t) as f64;
+            assert!((got - want).abs() < 1e-5, "t {t}: {got} vs {want}");
+        }
+    }
+
+    /// ZNCC of the left window and the warped right window at `(x, y)`, shift `s`, by direct
+    /// Gaussian-weighted sums (f64): the definition [`zncc_band`] computes. None where the
+    /// kernel's NaN rules apply; Some(None) where `vl` or `vr` is too close to the floor for
+    /// f32 and f64 to agree on the side.
+    #[allow(clippy::too_many_arguments)]
+    fn zncc_direct(
+        l: &[f32],
+        r: &[f32],
+        base: &[f32],
+        taps: &[f32],
+        floor: f32,
+        means: (f64, f64),
+        (w, h): (usize, usize),
+        (x, y): (usize, usize),
+        s: f32,
+    ) -> Option<Option<f64>> {
+        // Both images centred on their means (as the kernel; ZNCC does not see them).
+        let (lm, rm) = means;
+        let rad = (taps.len() / 2) as i64;
+        let (mut m, mut s1, mut s2, mut t1, mut t2, mut st) = (0f64, 0f64, 0f64, 0f64, 0f64, 0f64);
+        for dy in -rad..=rad {
+            for dx in -rad..=rad {
+                let (xx, yy) = (x as i64 + dx, y as i64 + dy);
+                if xx < 0 || yy < 0 || xx >= w as i64 || yy >= h as i64 {
+                    continue;
+                }
+                let (xx, yy) = (xx as usize, yy as usize);
+                let g = taps[(dx + rad) as usize] as f64 * taps[(dy + rad) as usize] as f64;
+                let lv = l[yy * w + xx] as f64 - lm;
+                let b = base[yy * w + xx];
+                let rv = if b.is_finite() {
+                    let row = &r[yy * w..(yy + 1) * w];
+                    cubic_sample(row, xx as f32 - b - s) as f64 - rm
+                } else {
+                    0.0
+                };
+                m += g;
+                s1 += g * lv;
+                s2 += g * lv * lv;
+                t1 += g * rv;
+                t2 += g * rv * rv;
+                st += g * lv * rv;
+            }
+        }
+        let t = x as f32 - base[y * w + x] - s;
+        if !(t >= 0.0 && t <= (w - 1) as f32) {
+            return None;
+        }
+        let (ml, mr) = (s1 / m, t1 / m);
+        let (vl, vr) = (s2 / m - ml * ml, t2 / m - mr * mr);
+        let f = floor as f64;
+        if (vl - f).abs() < 1e-6 || (vr - f).abs() < 1e-6 {
+            return Some(None);
+        }
+        if vl <= f || vr <= f {
+            return None;
+        }
+        Some(Some((st / m - ml * mr) / (vl * vr).sqrt()))
+    }
+
+    #[test]
+    fn band_correlations_equal_the_direct_window_sums() {
+        // 140 rows: two bands (the second's window reaches into the first). Rows of three kinds
+        // of base: a slant, a negative disparity (both borders in reach), holes. A patch of the
+        // right image has almost no contrast (under the variance floor).
+        let (w, h) = (40, 140);
+        let tex = |x: f32, y: f32| {
+            0.3 + 0.4 * x / 40.0
+                + 0.2 * (0.7 * x + 0.2 * y).sin() * (0.3 * y).cos()
+                + 0.1 * (1.9 * x - 0.4 * y).sin()
+        };
+        let mut l = vec![0f32; w * h];
+        let mut r = vec![0f32; w * h];
+        let mut base = vec![0f32; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let i = y * w + x;
+                l[i] = tex(x as f32, y as f32);
+                r[i] = if (20..28).contains(&x) && (60..80).contains(&y) {
+                    0.5 + 0.01 * (0.9 * x as f32).sin()
+                } else {
+                    tex(x as f32 + 5.0, y as f32) + 0.05 * (y as f32).sin()
+                };
+                base[i] = match y % 3 {
+                    0 => 5.2 + 0.01 * y as f32,
+                    1 => -0.6,
+                    _ if x % 7 == 3 => f32::NAN,
+                    _ => 4.7,
+                };
+            }
+        }
+        let taps = gaussian_taps(1.5, 3);
+        let p = RefineParams {
+            var_floor: 1e-3,
+            ..Default::default()
+        };
+        let ls = left_stats(&l, &r, w, h, &taps);
+        let (search, step) = (2usize, 0.5f32);
+        let n_s = 2 * search + 1;
+        let means = (image_mean(&l) as f64, image_mean(&r) as f64);
+        let mut sc = Scratch::default();
+        let (mut checked, mut nan) = (0, 0);
+        for (y0, y1) in [(0, BAND), (BAND, h)] {
+            zncc_band(
+                &mut sc,
+                &ls,
+                &r,
+                &base,
+                &p,
+                (search, step),
+                &taps,
+                w,
+                h,
+                y0,
+                y1,
+            );
+            let band_len = (y1 - y0) * w;
+            for y in y0..y1 {
+                for x in 0..w {
+                    for k in 0..n_s {
+                        let s = (k as f32 - search as f32) * step;
+                        let got = sc.z[k * band_len + (y - y0) * w + x];
+                        match zncc_direct(
+                            &l,
+                            &r,
+                            &base,
+                            &taps,
+                            p.var_floor,
+                            means,
+                            (w, h),
+                            (x, y),
+                            s,
+                        ) {
+                            None => {
+                                assert!(got.is_nan(), "({x}, {y}) s {s}: {got}, want NaN");
+                                nan += 1;
+                            }
+                            Some(None) => {}
+                            Some(Some(want)) => {
+                                assert!(
+                                    (got as f64 - want).abs() < 1e-3,
+                                    "({x}, {y}) s {s}: {got} vs {want}"
+                                );
+                                checked += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            checked > 10_000 && nan > 3_000,
+            "{checked} values, {nan} NaN"
+        );
+    }
+
+    /// A pair whose left image sees the texture at disparity `d(x, y)`: `L(x) = T(x - d)`,
+    /// `R = T` (occlusions ignored), with the slanted pair's texture.
+    fn pair_of(d: &[f32], w: usize, h: usize) -> (Vec<f32>, Vec<f32>) {
+        let tex = |x: f32, y: f32| {
+            0.5 + 0.2 * (0.7 * x).sin() * (0.3 * y).cos() + 0.15 * (0.23 * x + 0.41 * y).sin()
+        };
+        let l = (0..w * h)
+            .map(|i| tex((i % w) as f32 - d[i], (i / w) as f32))
+            .collect();
+        let r = (0..w * h)
+            .map(|i| tex((i % w) as f32, (i / w) as f32))
+            .collect();
+        (l, r)
+    }
+
+    fn run(
+        l: &[f32],
+        r: &[f32],
+        start: &[f32],
+        conf: &[f32],
+        (w, h): (usize, usize),
+        range: (f32, f32),
+        p: &RefineParams,
+    ) -> (Vec<f32>, Vec<f32>, usize) {
+        let lv = ImageView::new(w, h, l).unwrap();
+        let rv = ImageView::new(w, h, r).unwrap();
+        refine_disparity(lv, rv, start, conf, range.0, range.1, p).unwrap()
+    }
+
+    #[test]
+    fn refine_keeps_only_a_central_peak_in_range_with_every_shift_defined() {
+        let (w, h) = (96, 64);
+        let (l, r, d) = slanted_pair(w, h);
+        let ones = vec![1f32; w * h];
+        let p = RefineParams {
+            fills: vec![],
+            ..Default::default()
+        };
+        // A start a whole pixel off puts the peak two half-pixel shifts away: rejected, not
+        // moved half-way.
+        let off: Vec<f32> = d.iter().map(|v| v + 1.0).collect();
+        let (out, _, _) = run(&l, &r, &off, &ones, (w, h), (0.0, 16.0), &p);
+        let kept = out.iter().filter(|v| v.is_finite()).count();
+        assert!(kept < w * h / 50, "kept {kept}");
+        // Values outside [d_min, d_max] become NaN (the truth is 6.3..6.93).
+        let (out, _, _) = run(&l, &r, &d, &ones, (w, h), (0.0, 6.0), &p);
+        assert!(out.iter().all(|v| v.is_nan()));
+        // Column 7: the shift +1 looks left of the right image (t = 7 - 6.3 - 1 < 0), so no
+        // peak is known there; column 9 has every shift.
+        let conf: Vec<f32> = (0..w * h)
+            .map(|i| if i % 2 == 0 { 2.0 } else { -1.0 })
+            .collect();
+        let (out, oc, _) = run(&l, &r, &d, &conf, (w, h), (0.0, 16.0), &p);
+        assert!((0..h).all(|y| out[y * w + 7].is_nan()));
+        assert!((0..h).filter(|y| out[y * w + 9].is_finite()).count() > h / 2);
+        // The confidence is clamped to [0, 1] where a value is kept, 0 elsewhere.
+        for i in 0..w * h {
+            let want = if out[i].is_nan() {
+                0.0
+            } else {
+                conf[i].clamp(0.0, 1.0)
+            };
+            assert_eq!(oc[i], want, "{i}");
+        }
+    }
+
+    #[test]
+    fn a_fill_keeps_the_measured_pixels_and_reaches_by_its_own_sigma() {
+        // A 48 x 48 hole: its centre lies 24 px from any value, beyond the base smoothing's
+        // reach (b = 4, 12 px) and within the fill pass's (sigma 16: b = 16, 48 px).
+        let (w, h) = (96, 64);
+        let (l, r, d) = slanted_pair(w, h);
+        let mut start = d.clone();
+        for y in 8..56 {
+            start[y * w + 24..y * w + 72].fill(f32::NAN);
+        }
+        let ones = vec![1f32; w * h];
+        let bare = RefineParams {
+            fills: vec![],
+            ..Default::default()
+        };
+        let (refined, _, none) = run(&l, &r, &start, &ones, (w, h), (0.0, 16.0), &bare);
+        assert_eq!(none, 0);
+        let centre = 32 * w + 48;
+        for (plane, max_residual) in [(true, f32::INFINITY), (true, 0.5), (false, f32::INFINITY)] {
+            let p = RefineParams {
+                fill_plane: plane,
+                fill_max_residual: max_residual,
+                ..Default::default()
+            };
+            let (out, oc, filled) = run(&l, &r, &start, &ones, (w, h), (0.0, 16.0), &p);
+            let what = format!("plane {plane}, max_residual {max_residual}");
+            assert!(
+                (out[centre] - d[centre]).abs() < 0.05,
+                "{what}: {}",
+                out[centre]
+            );
+            // Measured pixels keep their refined values; every new value is counted.
+            let mut new = 0;
+            for i in 0..w * h {
+                if refined[i].is_finite() {
+                    assert_eq!(out[i].to_bits(), refined[i].to_bits(), "{what}: {i}");
+                } else if out[i].is_finite() {
+                    assert_eq!(oc[i], 0.25);
+                    new += 1;
+                }
+            }
+            assert_eq!(new, filled, "{what}");
+        }
+    }
+
+    #[test]
+    fn a_fill_takes_a_peak_one_shift_away_and_no_farther() {
+        // A block 1 (or 2) px nearer than the surface around it, with no values: the fill
+        // starts from the surface's plane (6.3) and finds the block's peak one shift away (or
+        // two: beyond |k| <= 1 even with fill_search 3).
+        let (w, h) = (96, 64);
+        let inside = |i: usize| (36..68).contains(&(i % w)) && (16..48).contains(&(i / w));
+        let interior = |i: usize| (46..58).contains(&(i % w)) && (26..38).contains(&(i / w));
+        let ones = vec![1f32; w * h];
+        for (gap, fill_search) in [(1.0f32, 2usize), (2.0, 3)] {
+            let d: Vec<f32> = (0..w * h)
+                .map(|i| if inside(i) { 6.3 - gap } else { 6.3 })
+                .collect();
+            let (l, r) = pair_of(&d, w, h);
+            let start: Vec<f32> = (0..w * h)
+                .map(|i| if inside(i) { f32::NAN } else { d[i] })
+                .collect();
+            let p = RefineParams {
+                fill_search,
+                ..Default::default()
+            };
+            let (out, _, _) = run(&l, &r, &start, &ones, (w, h), (0.0, 16.0), &p);
+            let cells: Vec<usize> = (0..w * h).filter(|&i| interior(i)).collect();
+            let got: Vec<f32> = cells.iter().map(|&i| out[i]).collect();
+            if gap == 1.0 {
+                assert!(
+                    got.iter().all(|v| (v - 5.3).abs() < 0.1),
+                    "one shift: {got:?}"
+                );
+            } else {
+                assert!(got.iter().all(|v| v.is_nan()), "two shifts: {got:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_fill_needs_its_correlation_to_reach_min_score() {
+        // The right image's texture is replaced by an unrelated one in a block: the block's
+        // holes have no correlation peak worth min_score, and stay holes.
+        let (w, h) = (96, 64);
+        let (l, mut r, d) = slanted_pair(w, h);
+        let block = |i: usize| (30..70).contains(&(i % w)) && (12..52).contains(&(i / w));
+        let mut state = 7u64;
+        for i in (0..w * h).filter(|&i| block(i)) {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            r[i] = ((state >> 40) % 1000) as f32 / 1000.0;
+        }
+        let start: Vec<f32> = (0..w * h)
+            .map(|i| if block(i) { f32::NAN } else { d[i] })
+            .collect();
+        let ones = vec![1f32; w * h];
+        let (out, _, _) = run(
+            &l,
+            &r,
+            &start,
+            &ones,
+            (w, h),
+            (0.0, 16.0),
+            &RefineParams::default(),
+        );
+        let inner = |i: usize| (42..62).contains(&(i % w)) && (22..42).contains(&(i / w));
+        let n = (0..w * h)
+            .filter(|&i| inner(i) && out[i].is_finite())
+            .count();
+        assert_eq!(n, 0);
+    }
+
+    #[test]
+    fn parameter_bounds_are_inclusive_where_documented() {
+        let ok = |p: RefineParams| p.validate().is_ok();
+        let d = RefineParams::default;
+        assert!(ok(RefineParams {
+            search: 16,
+            fill_search: 1,
+            win_radius: 64,
+            ..d()
+        }));
+        assert!(!ok(RefineParams { search: 0, ..d() }));
+        assert!(!ok(RefineParams {
+            fill_search: 17,
+            ..d()
+        }));
+        assert!(!ok(RefineParams {
+            win_radius: 65,
+            ..d()
+        }));
+        assert!(ok(RefineParams {
+            fill_confidence: 1.0,
+            ..d()
+        }));
+        assert!(!ok(RefineParams {
+            fill_confidence: 1.01,
+            ..d()
+        }));
+        let pass = |min_score: f32| RefineParams {
+            fills: vec![FillPass {
+                sigma: 8.0,
+                min_score,
+            }],
+            ..d()
+        };
+        assert!(ok(pass(-0.99)) && ok(pass(0.99)));
+        assert!(!ok(pass(-1.0)) && !ok(pass(1.0)));
+    }
 }
