@@ -681,4 +681,139 @@ mod tests {
         fill_planes(&mut empty, &img, w, 1, &[(16, 10)], 0.5);
         assert!(empty.iter().all(|v| v.is_nan()));
     }
+
+    #[test]
+    fn merges_follow_the_internal_difference_plus_k_over_size() {
+        let row =
+            |v: &[f32], k: f32, min_size: usize| graph_segments(v, v.len(), 1, 1, k, min_size);
+        // Unit steps, k = 2.5: each merge leaves Int + k / |C| = 1 + 2.5 / |C| >= 1.
+        assert_eq!(row(&[0.0, 1.0, 2.0, 3.0], 2.5, 1), [0, 0, 0, 0]);
+        // Two singletons merge when their distance (2, not its square) is at most k.
+        assert_eq!(row(&[0.0, 2.0], 3.0, 1), [0, 0]);
+        // Runs of equal values have thresholds 0 + 6 / 3, 6 / 2, 6 / 3: the step of 3 from the
+        // first run exceeds its 2, the step of 6 both sides'.
+        let runs = [0.0, 0.0, 0.0, 3.0, 3.0, 9.0, 9.0, 9.0];
+        assert_eq!(row(&runs, 6.0, 1), [0, 0, 0, 1, 1, 2, 2, 2]);
+        // min_size 3: the pair joins a neighbour along its lightest edge (3 before 6).
+        assert_eq!(row(&runs, 6.0, 3), [0, 0, 0, 0, 0, 1, 1, 1]);
+        // Both sides' thresholds count: the edge of 10 is within the singleton's 12 but not
+        // the run 10 10.5 11's 0.5 + 12 / 3.
+        assert_eq!(row(&[0.0, 10.0, 10.5, 11.0], 12.0, 1), [0, 1, 1, 1]);
+        // min_size 3 joins the pair 30 31 (size 2) to its neighbour, not the runs of three.
+        let three = [0.0, 2.0, 4.0, 10.0, 11.0, 12.0, 30.0, 31.0];
+        assert_eq!(row(&three, 4.0, 1), [0, 0, 0, 1, 1, 1, 2, 2]);
+        assert_eq!(row(&three, 4.0, 3), [0, 0, 0, 1, 1, 1, 1, 1]);
+        // min_size 1 joins nothing: the single pixel 5 stays.
+        assert_eq!(
+            row(&[5.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.5, 1.5], 1.0, 1),
+            [0, 1, 1, 1, 1, 1, 2, 2]
+        );
+    }
+
+    #[test]
+    fn plane_fill_refits_without_its_outliers() {
+        // A slanted plane whose measured values have every fifth one 1.5 px off: the first fit
+        // is pulled towards them (by about 0.3), the re-fits on the values within
+        // max(1, 2 median) px of it leave them out (1.2 px off) and are exact.
+        let (w, h) = (12, 10);
+        let truth = |p: usize| 5.0 + 0.5 * (p % w) as f32 + 0.25 * (p / w) as f32;
+        let mut d: Vec<f32> = (0..w * h)
+            .map(|p| truth(p) + if p % 5 == 2 { 1.5 } else { 0.0 })
+            .collect();
+        let holes = [0, 13, 59, 119];
+        for p in holes {
+            d[p] = f32::NAN;
+        }
+        let labels = vec![0u32; w * h];
+        let s = plane_fill(&mut d, &labels, w, 10, 0.5, 0.0, 100.0);
+        assert_eq!(s.filled, 4);
+        for p in holes {
+            assert!(
+                (d[p] - truth(p)).abs() < 1e-4,
+                "{p}: {} vs {}",
+                d[p],
+                truth(p)
+            );
+        }
+    }
+
+    #[test]
+    fn the_median_residual_is_the_upper_one_and_may_equal_max_residual() {
+        // 4 x 4 measured values symmetric about their centre, so the fit is flat and exact; a
+        // fifth row of holes. A checkerboard of 0 and 1: every residual is 0.5, the limit.
+        let (w, h) = (4, 5);
+        let labels = vec![0u32; w * h];
+        let with_holes = |f: &dyn Fn(usize, usize) -> f32| -> Vec<f32> {
+            (0..w * h)
+                .map(|p| {
+                    if p / w == 4 {
+                        f32::NAN
+                    } else {
+                        f(p % w, p / w)
+                    }
+                })
+                .collect()
+        };
+        let checker = with_holes(&|x, y| ((x + y) % 2) as f32);
+        let mut d = checker.clone();
+        assert_eq!(plane_fill(&mut d, &labels, w, 3, 0.5, -9.0, 9.0).filled, 4);
+        assert!(d[4 * w..].iter().all(|&v| v == 0.5), "{:?}", &d[4 * w..]);
+        let mut d = checker;
+        assert_eq!(plane_fill(&mut d, &labels, w, 3, 0.49, -9.0, 9.0).filled, 0);
+        // Centre 1, corners -1, edges 0: residuals eight 0, then eight 1 (the mean is 0). The
+        // median of 16 is the 9th smallest, 1: over a limit of 0.5.
+        let rings = with_holes(&|x, y| {
+            let (ex, ey) = (x == 0 || x == 3, y == 0 || y == 3);
+            match (ex, ey) {
+                (true, true) => -1.0,
+                (false, false) => 1.0,
+                _ => 0.0,
+            }
+        });
+        let mut d = rings.clone();
+        assert_eq!(plane_fill(&mut d, &labels, w, 3, 0.5, -9.0, 9.0).filled, 0);
+        let mut d = rings;
+        assert_eq!(plane_fill(&mut d, &labels, w, 3, 1.0, -9.0, 9.0).filled, 4);
+    }
+
+    #[test]
+    fn fill_planes_means_two_different_cut_values() {
+        // Grey 20 | 30 | 36 in thirds of 4 columns: at step 16 the cut at offset 0 bins them
+        // 1 1 2, the cut at offset 8 bins them 1 2 2. The middle third has no values: one cut
+        // fills it from the left third's plane (4), the other from the right third's (6).
+        let (w, h) = (12, 6);
+        let img: Vec<u8> = (0..w * h).map(|p| [20, 30, 36][(p % w) / 4]).collect();
+        let mut d: Vec<f32> = (0..w * h)
+            .map(|p| [4.0, f32::NAN, 6.0][(p % w) / 4])
+            .collect();
+        fill_planes(&mut d, &img, w, 1, &[(16, 5)], 0.5);
+        assert!(
+            d.iter()
+                .enumerate()
+                .all(|(p, &v)| v == [4.0, 5.0, 6.0][(p % w) / 4]),
+            "{d:?}"
+        );
+    }
+
+    #[test]
+    fn fill_planes_keeps_to_the_measured_range_and_runs_every_pass() {
+        // A ramp d = x + 1 over one colour with a hole at each end: the plane's value there (1
+        // and 10) lies outside the measured range [2, 9], so fill_planes leaves both holes.
+        let (w, h) = (10, 6);
+        let img = vec![50u8; w * h];
+        let mut d: Vec<f32> = (0..w * h).map(|p| (p % w + 1) as f32).collect();
+        for y in 0..h {
+            d[y * w] = f32::NAN;
+            d[y * w + w - 1] = f32::NAN;
+        }
+        let mut one = d.clone();
+        fill_planes(&mut one, &img, w, 1, &[(16, 5)], 1.0);
+        assert_eq!(one.iter().filter(|v| v.is_nan()).count(), 2 * h);
+        // A hole inside the range: the first pass needs 1000 measured pixels and fills
+        // nothing, the second does.
+        let mut two = d.clone();
+        two[2 * w + 4] = f32::NAN;
+        fill_planes(&mut two, &img, w, 1, &[(16, 1000), (16, 5)], 1.0);
+        assert!((two[2 * w + 4] - 5.0).abs() < 1e-4, "{}", two[2 * w + 4]);
+    }
 }
