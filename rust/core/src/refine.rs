@@ -1429,10 +1429,11 @@ mod tests {
 
     #[test]
     fn band_correlations_equal_the_direct_window_sums() {
-        // 140 rows: two bands (the second's window reaches into the first). Rows of three kinds
+        // 140 rows: two bands (the second's window reaches into the first); 43 columns: the
+        // eight-lane sums' tail too. Rows of three kinds
         // of base: a slant, a negative disparity (both borders in reach), holes. A patch of the
         // right image has almost no contrast (under the variance floor).
-        let (w, h) = (40, 140);
+        let (w, h) = (43, 140);
         let tex = |x: f32, y: f32| {
             0.3 + 0.4 * x / 40.0
                 + 0.2 * (0.7 * x + 0.2 * y).sin() * (0.3 * y).cos()
