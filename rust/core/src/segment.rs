@@ -738,6 +738,26 @@ mod tests {
     }
 
     #[test]
+    fn min_pixels_measured_values_are_enough() {
+        // A 2 x 2 segment with three measured values (not on a line) and a hole: exactly
+        // min_pixels = 3 fix the plane d = 1 + x + 2 y, whose value at the hole is 4.
+        let (w, h) = (3, 2);
+        let labels: Vec<u32> = (0..w * h).map(|p| u32::from(p % w == 2)).collect();
+        let mut d = vec![1.0, 2.0, 7.0, 3.0, f32::NAN, 7.0];
+        let s = plane_fill(&mut d, &labels, w, 3, 0.5, 0.0, 10.0);
+        assert_eq!(
+            s,
+            PlaneFillStats {
+                planes: 1,
+                filled: 1
+            }
+        );
+        assert!((d[4] - 4.0).abs() < 1e-5, "{}", d[4]);
+        let mut d = vec![1.0, 2.0, 7.0, 3.0, f32::NAN, 7.0];
+        assert_eq!(plane_fill(&mut d, &labels, w, 4, 0.5, 0.0, 10.0).filled, 0);
+    }
+
+    #[test]
     fn the_median_residual_is_the_upper_one_and_may_equal_max_residual() {
         // 4 x 4 measured values symmetric about their centre, so the fit is flat and exact; a
         // fifth row of holes. A checkerboard of 0 and 1: every residual is 0.5, the limit.
