@@ -201,9 +201,13 @@ def refine_disparity(
     oconf = np.where(keep, cf, 0.0)
     filled = 0
     for sigma, min_score in fills:
+        # A pixel off its plane is no fill target, but its plane value stays in the warp base
+        # its neighbours' windows sample (as the kernel; a NaN base there counted as 0).
+        planar = np.ones(out.shape, bool)
         if fill_plane:
             base, resid = nc_plane(out, sigma)
-            base = np.where(resid < fill_max_residual, base, np.nan)
+            if np.isfinite(fill_max_residual):
+                planar = resid < fill_max_residual
         else:
             base = nc_smooth(out, sigma)
         z = stack(base, fill_search, fill_step)
@@ -214,6 +218,7 @@ def refine_disparity(
         off, curved = _parabola(za, zb, zc)
         v = base + fill_step * (kc - fill_search + off)
         new = ~np.isfinite(out) & ok & (zk >= min_score) & curved & (v >= d_min) & (v <= d_max)
+        new &= planar
         out = np.where(new, v, out)
         oconf = np.where(new, fill_confidence, oconf)
         filled += int(new.sum())
