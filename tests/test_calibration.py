@@ -1302,3 +1302,75 @@ def test_describe_field_of_view_runs_edge_to_edge() -> None:
     """8 px at f = 4 px about a centred principal point (3.5) span 90 degrees: from the left
     edge (-0.5) to the right one (7.5), not to the last pixel's far side."""
     assert "field of view 90.0 x 73.7 degrees" in Calibration.ideal((8, 6), 90.0, 0.1).describe()
+
+
+# ------------------------------------------------- loading, saving and conversion (mutation audit)
+
+
+def test_saved_xml_is_xml_and_saved_yaml_is_yaml(tmp_path: Path) -> None:
+    """The extension picks the format OpenCV readers get: the round trip reads either, so a
+    .xml written as YAML (or a .yml as XML) passed every other test."""
+    c = raw_calib()
+    assert c.save(tmp_path / "c.xml").read_text().startswith("<?xml")
+    for suffix in (".yml", ".yaml", ".YAML"):
+        assert c.save(tmp_path / f"c{suffix}").read_text().startswith("%YAML")
+
+
+def test_opencv_stereo_calib_names_m1_m2_load_as_k1_k2(tmp_path: Path) -> None:
+    """OpenCV's stereo_calib names the camera matrices M1/M2 (in YAML and XML): they load as
+    K1/K2, the same rig."""
+    c = raw_calib()
+    text = c.save(tmp_path / "c.yaml").read_text()
+    (tmp_path / "m.yaml").write_text(text.replace("K1:", "M1:").replace("K2:", "M2:"))
+    assert Calibration.load(tmp_path / "m.yaml") == c
+    xml = c.save(tmp_path / "c.xml").read_text()
+    (tmp_path / "m.xml").write_text(re.sub(r"(</?)K([12])([ >])", r"\1M\2\3", xml))
+    assert "<M1" in (tmp_path / "m.xml").read_text()
+    assert Calibration.load(tmp_path / "m.xml") == c
+
+
+def test_a_saved_file_without_its_unit_is_refused_not_read_in_metres(tmp_path: Path) -> None:
+    """The unit of T is the one number a reader cannot guess (a mm rig read in metres is 1000x
+    off): a file without it is refused naming the field, not given a default."""
+    rec = json.loads(rect_calib().save(tmp_path / "c.json").read_text())
+    del rec["unit"]
+    (tmp_path / "e.json").write_text(json.dumps(rec))
+    with pytest.raises(ValueError, match=r"e\.json lacks field 'unit'"):
+        Calibration.load(tmp_path / "e.json")
+
+
+@pytest.mark.parametrize(("field", "value"), [("rectified", 2), ("doffs", True)])
+def test_a_saved_rectified_rigs_flag_and_doffs_are_checked(
+    tmp_path: Path, field: str, value: object
+) -> None:
+    """rectified=2 is not a flag and doffs=true not a number of pixels (it read as 1 px, the
+    rig's own cx2 - cx1 here, so it passed the constructor's check): each is named."""
+    k2 = np.array([[500.0, 0.0, 161.0], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]])
+    rec = json.loads(rect_calib(K2=k2).save(tmp_path / "c.json").read_text())
+    rec[field] = value
+    (tmp_path / "e.json").write_text(json.dumps(rec))
+    with pytest.raises(ValueError, match=rf"e\.json: {field} must be"):
+        Calibration.load(tmp_path / "e.json")
+
+
+def test_a_camera_matrix_saved_as_a_vector_is_named(tmp_path: Path) -> None:
+    """D1, D2 and T may be 1-D (!!opencv-nd-matrix); K1 written so (its 9 numbers in a row) is
+    not a camera matrix and is refused as the field that is not a matrix."""
+    fs = cv2.FileStorage(str(tmp_path / "c.yaml"), cv2.FILE_STORAGE_WRITE)
+    for key, value in raw_calib()._to_record().items():
+        fs.write(key, value.ravel().copy() if key == "K1" else value)
+    fs.release()
+    with pytest.raises(ValueError, match=r"field 'K1' is not a matrix: a !!opencv-nd-matrix"):
+        Calibration.load(tmp_path / "c.yaml")
+
+
+def test_a_kitti_file_without_a_space_after_its_keys_reads_the_same(tmp_path: Path) -> None:
+    """A key's colon may touch its first number ("P2:7.2e+02 ..."): the values are the same as
+    with the space KITTI's files have, not a key "P2:7.2e+02" that is no key at all."""
+    p2 = "7.2e+02 0 6.1e+02 4.5e+01 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    p3 = "7.2e+02 0 6.1e+02 -3.6e+02 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    (tmp_path / "spaced.txt").write_text(f"P2: {p2}\nP3: {p3}\n")
+    (tmp_path / "tight.txt").write_text(f"P2:{p2}\nP3:{p3}\n")
+    spaced = Calibration.from_file(tmp_path / "spaced.txt", image_size=(1242, 375))
+    assert Calibration.from_file(tmp_path / "tight.txt", image_size=(1242, 375)) == spaced
+    assert parse_kitti_calib(tmp_path / "tight.txt")["P3"][3] == -360.0

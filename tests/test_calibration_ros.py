@@ -196,6 +196,7 @@ def _cam_text(**changes: object) -> str:
         ({"camera_matrix": [1, 0, 0, 0, "x", 0, 0, 0, 1]}, "not a number"),
         ({"camera_matrix": [float("nan")] * 9}, "NaN"),
         ({"image_width": -3}, "image_width must be a positive integer"),
+        ({"image_height": 0}, "image_height must be a positive integer"),
         ({"rectification_matrix": [2, 0, 0, 0, 1, 0, 0, 0, 1]}, "does not hold a rotation"),
         ({"projection_matrix": [0] * 12}, "positive fx"),
     ],
@@ -402,3 +403,16 @@ def test_a_four_coefficient_pinhole_rig_is_written_as_five_plumb_bob_ones() -> N
         assert doc["distortion_model"] == "plumb_bob"
         assert doc["distortion_coefficients"]["cols"] == 5
         assert doc["distortion_coefficients"]["data"] == [*d[:4].tolist(), 0.0]
+
+
+def test_the_old_camera_model_spelling_names_the_distortion_model() -> None:
+    """Older camera_info files say camera_model where ROS now writes distortion_model; its
+    value is the model (dropped, 8 rational_polynomial coefficients were refused as plumb_bob)."""
+    text = _cam_text(
+        distortion_model=None,
+        camera_model="rational_polynomial",
+        distortion_coefficients={"rows": 1, "cols": 8, "data": [0.1, 0.01, 0, 0, 0, 0.2, 0, 0]},
+    )
+    info = parse_ros_camera_info(text, "cam")
+    assert info["distortion_model"] == "rational_polynomial"
+    assert info["D"].tolist() == [0.1, 0.01, 0, 0, 0, 0.2, 0, 0]
