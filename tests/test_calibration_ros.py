@@ -416,3 +416,27 @@ def test_the_old_camera_model_spelling_names_the_distortion_model() -> None:
     info = parse_ros_camera_info(text, "cam")
     assert info["distortion_model"] == "rational_polynomial"
     assert info["D"].tolist() == [0.1, 0.01, 0, 0, 0, 0.2, 0, 0]
+
+
+def test_a_failed_save_ros_keeps_the_earlier_pair(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """left.yaml was replaced before right.yaml was written: a failure at right.yaml (disk
+    full) left the new left camera beside the old right one, a pair that loads as a rig neither
+    calibration is. Both files are written before either replaces the earlier one."""
+    earlier = [p.read_bytes() for p in rect_calib().save_ros(tmp_path)]
+    import stereovision.io as sio
+
+    real_replace = sio.os.replace
+
+    def replace(src: str, dst: object) -> None:
+        if Path(str(dst)).name == "right.yaml":
+            raise OSError(28, "No space left on device")
+        real_replace(src, dst)
+
+    monkeypatch.setattr(sio.os, "replace", replace)
+    with pytest.raises(OSError, match="No space left"):
+        raw_calib().save_ros(tmp_path)
+    monkeypatch.undo()
+    assert [(tmp_path / n).read_bytes() for n in ("left.yaml", "right.yaml")] == earlier
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["left.yaml", "right.yaml"]

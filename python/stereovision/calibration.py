@@ -2076,7 +2076,8 @@ class Calibration:
         Parameters
         ----------
         directory : str or os.PathLike
-            Created if missing; each file is replaced atomically.
+            Created if missing; both files are written before either replaces the one there,
+            so a failure while writing keeps the earlier pair.
         alpha : float
             Free scaling of the rectification, in ``[0, 1]``.
         names : tuple of str
@@ -2102,9 +2103,11 @@ class Calibration:
 
         make_folder(d)
         paths = (d / "left.yaml", d / "right.yaml")
-        for path, text in zip(paths, texts, strict=True):
-            with atomic_write(path, "w") as fh:
-                fh.write(text)
+        # both written before either replaces its file: one by one, a failure at right.yaml
+        # left the new left camera beside the earlier right one, a rig neither calibration is
+        with atomic_write(paths[0], "w") as left, atomic_write(paths[1], "w") as right:
+            left.write(texts[0])
+            right.write(texts[1])
         return paths
 
 
