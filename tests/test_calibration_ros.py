@@ -440,3 +440,18 @@ def test_a_failed_save_ros_keeps_the_earlier_pair(
     monkeypatch.undo()
     assert [(tmp_path / n).read_bytes() for n in ("left.yaml", "right.yaml")] == earlier
     assert sorted(p.name for p in tmp_path.iterdir()) == ["left.yaml", "right.yaml"]
+
+
+def test_an_empty_distortion_list_is_no_distortion(tmp_path: Path) -> None:
+    """ROS's camera_calibration_parsers write an empty D as rows: 1, cols: 0, data: [] (a
+    camera calibrated without distortion): it was refused as "says rows=1, cols=0 but holds 0
+    numbers"; it is five zeros (plumb_bob)."""
+    empty = {"rows": 1, "cols": 0, "data": []}
+    proj = [300, 0, 160, -30.0, 0, 300, 120, 0, 0, 0, 1, 0]
+    (tmp_path / "left.yaml").write_text(
+        _cam_text(distortion_coefficients=empty, projection_matrix=[*proj[:3], 0.0, *proj[4:]])
+    )
+    (tmp_path / "right.yaml").write_text(_cam_text(distortion_coefficients=empty))
+    c = Calibration.from_file(tmp_path)
+    assert c.D1.tolist() == [0.0] * 5 and c.D2.tolist() == [0.0] * 5
+    assert c.rectified and c.baseline_m == pytest.approx(0.1)

@@ -2320,7 +2320,11 @@ def _ros_matrix(value: object, key: str, source: str, size: int | None) -> F64:
     except (TypeError, ValueError):
         raise ValueError(f"{source}: {key} holds a value that is not a number") from None
     if rows is not None and cols is not None:
-        if not all(isinstance(n, int) and n > 0 for n in (rows, cols)) or rows * cols != arr.size:
+        # cols: 0 with no data is what ROS writes for a camera without distortion (1 x 0)
+        counts = all(
+            isinstance(n, int) and not isinstance(n, bool) and n >= 0 for n in (rows, cols)
+        )
+        if not counts or rows * cols != arr.size:
             raise ValueError(
                 f"{source}: {key} says rows={rows!r}, cols={cols!r} but holds {arr.size} numbers"
             )
