@@ -1374,3 +1374,15 @@ def test_a_kitti_file_without_a_space_after_its_keys_reads_the_same(tmp_path: Pa
     spaced = Calibration.from_file(tmp_path / "spaced.txt", image_size=(1242, 375))
     assert Calibration.from_file(tmp_path / "tight.txt", image_size=(1242, 375)) == spaced
     assert parse_kitti_calib(tmp_path / "tight.txt")["P3"][3] == -360.0
+
+
+def test_a_folder_with_a_sizeless_kitti_calib_txt_takes_the_image_size_given(
+    tmp_path: Path,
+) -> None:
+    """A folder's calib.txt is read with the image_size given: an object/odometry KITTI file
+    (no S_rect_02) with no image beside it needs it, and was refused as unsized without it."""
+    p2 = "7.2e+02 0 6.1e+02 4.5e+01 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    p3 = "7.2e+02 0 6.1e+02 -3.6e+02 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    (tmp_path / "calib.txt").write_text(f"P2: {p2}\nP3: {p3}\n")
+    c = Calibration.from_file(tmp_path, image_size=(1242, 375))
+    assert c.image_size == (1242, 375) and c.baseline == pytest.approx(405.0 / 720.0)

@@ -455,3 +455,15 @@ def test_an_empty_distortion_list_is_no_distortion(tmp_path: Path) -> None:
     c = Calibration.from_file(tmp_path)
     assert c.D1.tolist() == [0.0] * 5 and c.D2.tolist() == [0.0] * 5
     assert c.rectified and c.baseline_m == pytest.approx(0.1)
+
+
+@pytest.mark.parametrize(("a", "b"), [("Left", "Right"), ("LEFT", "RIGHT")])
+def test_one_file_names_its_partner_in_any_case(tmp_path: Path, a: str, b: str) -> None:
+    """cam_Left.yaml names cam_Right.yaml (and LEFT names RIGHT): either file gives the rig."""
+    c = raw_calib()
+    left, right = c.save_ros(tmp_path / "ros")
+    (tmp_path / f"cam_{a}.yaml").write_bytes(left.read_bytes())
+    (tmp_path / f"cam_{b}.yaml").write_bytes(right.read_bytes())
+    rig = Calibration.from_file(tmp_path / "ros")
+    assert Calibration.from_file(tmp_path / f"cam_{b}.yaml") == rig
+    assert Calibration.from_file(tmp_path / f"cam_{a}.yaml") == rig
