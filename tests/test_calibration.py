@@ -1386,3 +1386,26 @@ def test_a_folder_with_a_sizeless_kitti_calib_txt_takes_the_image_size_given(
     (tmp_path / "calib.txt").write_text(f"P2: {p2}\nP3: {p3}\n")
     c = Calibration.from_file(tmp_path, image_size=(1242, 375))
     assert c.image_size == (1242, 375) and c.baseline == pytest.approx(405.0 / 720.0)
+
+
+def test_a_dataset_file_the_constructor_refuses_is_named(tmp_path: Path) -> None:
+    """A Middlebury or KITTI file whose numbers are not a rectified pair (doffs off cx2 - cx1,
+    the two focal lengths apart) was refused as "doffs: 31.111 differs from ..." naming no file,
+    where a saved calibration's refusal names it; each names its file now."""
+    (tmp_path / "calib.txt").write_text(
+        "cam0=[3997.684 0 1176.728; 0 3997.684 1011.728; 0 0 1]\n"
+        "cam1=[3997.684 0 1307.839; 0 3997.684 1011.728; 0 0 1]\n"
+        "doffs=31.111\nbaseline=193.001\nwidth=2964\nheight=1988\n"
+    )
+    with pytest.raises(
+        ValueError, match=r"^Middlebury calibration .*calib\.txt: doffs: 31\.111 differs from"
+    ):
+        Calibration.from_file(tmp_path / "calib.txt")
+    (tmp_path / "k.txt").write_text(
+        "P2: 7.2e+02 0 6.1e+02 4.5e+01 0 7.0e+02 1.7e+02 0 0 0 1 0\n"
+        "P3: 7.2e+02 0 6.1e+02 -3.6e+02 0 7.2e+02 1.7e+02 0 0 0 1 0\n"
+    )
+    with pytest.raises(
+        ValueError, match=r"^KITTI calibration .*k\.txt: K2: fy = 720 differs from K1's 700"
+    ):
+        Calibration.from_file(tmp_path / "k.txt", image_size=(1242, 375))

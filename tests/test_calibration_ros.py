@@ -467,3 +467,29 @@ def test_one_file_names_its_partner_in_any_case(tmp_path: Path, a: str, b: str) 
     rig = Calibration.from_file(tmp_path / "ros")
     assert Calibration.from_file(tmp_path / f"cam_{b}.yaml") == rig
     assert Calibration.from_file(tmp_path / f"cam_{a}.yaml") == rig
+
+
+def test_a_ros_pair_or_camchain_the_constructor_refuses_is_named(tmp_path: Path) -> None:
+    """A camera matrix with a negative focal length passes each file's parser and was refused
+    by the constructor as "K1: focal lengths must be positive", naming none of the files."""
+    k = [300, 0, 160, 0, -300, 120, 0, 0, 1]
+    (tmp_path / "left.yaml").write_text(
+        _cam_text(
+            camera_matrix=k,
+            distortion_coefficients=[0.1, 0, 0, 0, 0],
+            projection_matrix=[300, 0, 160, 0, 0, 300, 120, 0, 0, 0, 1, 0],
+        )
+    )
+    (tmp_path / "right.yaml").write_text(_cam_text())
+    with pytest.raises(
+        ValueError, match=r"^ROS camera_info .*left\.yaml and .*right\.yaml: K1: focal lengths"
+    ):
+        Calibration.from_file(tmp_path)
+    c = raw_calib()
+    cams = [
+        {"K": np.diag([300.0, -300.0, 1.0]), "D": c.D1, "size": c.image_size},
+        {"K": c.K2, "D": c.D2, "size": c.image_size, "T": _pose(c.R, c.T)},
+    ]
+    (tmp_path / "camchain.yaml").write_text(_camchain(cams))
+    with pytest.raises(ValueError, match=r"^.*camchain\.yaml: K1: focal lengths must be positive"):
+        Calibration.from_file(tmp_path / "camchain.yaml")

@@ -1193,6 +1193,15 @@ class Calibration:
         return p
 
     @classmethod
+    def _made(cls, where: str, **fields: Any) -> Calibration:
+        """The calibration of a file's numbers, a refusal naming the file: the constructor's
+        "K2: fy = 720 differs from K1's 700" said nothing of which calib.txt among many."""
+        try:
+            return cls(**fields)
+        except ValueError as exc:
+            raise ValueError(f"{where}: {exc}") from None
+
+    @classmethod
     def _from_mapping(cls, get: Any, source: str) -> Calibration:
         def need(key: str, *aliases: str) -> Any:
             for k in (key, *aliases):
@@ -1614,7 +1623,8 @@ class Calibration:
         for key in ("cam0", "cam1", "baseline", "width", "height"):
             if key not in v:
                 raise ValueError(f"Middlebury calibration {p} lacks {key!r}")
-        return cls(
+        return cls._made(
+            f"Middlebury calibration {p}",
             K1=v["cam0"],
             D1=np.zeros(5),
             K2=v["cam1"],
@@ -1805,7 +1815,8 @@ class Calibration:
                 f"image_size: KITTI calibration {p} has no S_rect_02 and no image next to it; "
                 "pass image_size=(width, height)"
             )
-        return cls(
+        return cls._made(
+            f"KITTI calibration {p}",
             K1=p2[:, :3],
             D1=np.zeros(5),
             K2=p3[:, :3],
@@ -1906,7 +1917,8 @@ class Calibration:
                 )
             except ValueError:
                 pass  # e.g. a vertical rig: keep it as a raw rig that stereoRectify handles
-        return cls(
+        return cls._made(
+            f"ROS camera_info {lsrc} and {rsrc}",
             K1=cams[0]["K"],
             D1=cams[0]["D"],
             K2=cams[1]["K"],
@@ -1989,7 +2001,8 @@ class Calibration:
             raise ValueError(
                 f"{p}: {left} and {right} use different distortion models; a rig needs one"
             )
-        return cls(
+        return cls._made(
+            str(p),
             K1=cams[0]["K"],
             D1=cams[0]["D"],
             K2=cams[1]["K"],
