@@ -1409,3 +1409,29 @@ def test_a_dataset_file_the_constructor_refuses_is_named(tmp_path: Path) -> None
         ValueError, match=r"^KITTI calibration .*k\.txt: K2: fy = 720 differs from K1's 700"
     ):
         Calibration.from_file(tmp_path / "k.txt", image_size=(1242, 375))
+
+
+def test_homographies_json_and_damaged_q_and_kitti_files_are_named(tmp_path: Path) -> None:
+    """What a mutation audit found unchecked: `stereovision rectify`'s homographies given as a
+    calibration are named as such (not 'lacks field image_width'), a Q.dat holding inf is not
+    16 finite numbers (it reached the constructor as "K2: contains NaN or inf", no file), and
+    a KITTI P2 of 13 values is counted (numpy's reshape error named neither file nor key)."""
+    (tmp_path / "h.json").write_text(json.dumps({"H1": [[1.0]], "H2": [[1.0]], "F": [[1.0]]}))
+    with pytest.raises(ValueError, match=r"h\.json holds the homographies .* --rectification"):
+        Calibration.from_file(tmp_path / "h.json")
+    (tmp_path / "Q.dat").write_text("1 0 0 -160\n0 1 0 -120\n0 0 0 500\n0 0 10 inf\n")
+    with pytest.raises(ValueError, match=r"Q\.dat: not a Q matrix \(16 finite numbers"):
+        Calibration.from_q(tmp_path / "Q.dat", (320, 240))
+    p2 = "7.2e+02 0 6.1e+02 4.5e+01 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    (tmp_path / "k.txt").write_text(f"P2: {p2} 5\nP3: {p2}\n")
+    with pytest.raises(ValueError, match=r"k\.txt: P2 has 13 values, not 12"):
+        Calibration.from_kitti(tmp_path / "k.txt", image_size=(1242, 375))
+
+
+def test_an_object_kitti_file_is_sized_by_the_image_2_png_beside_it(tmp_path: Path) -> None:
+    """Without S_rect_02 the size comes from a left.png, else from KITTI's own image_2.png."""
+    p2 = "7.2e+02 0 6.1e+02 4.5e+01 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    p3 = "7.2e+02 0 6.1e+02 -3.6e+02 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    (tmp_path / "000000.txt").write_text(f"P2: {p2}\nP3: {p3}\n")
+    cv2.imwrite(str(tmp_path / "image_2.png"), np.zeros((375, 1242), np.uint8))
+    assert Calibration.from_file(tmp_path / "000000.txt").image_size == (1242, 375)

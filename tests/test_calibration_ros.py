@@ -493,3 +493,13 @@ def test_a_ros_pair_or_camchain_the_constructor_refuses_is_named(tmp_path: Path)
     (tmp_path / "camchain.yaml").write_text(_camchain(cams))
     with pytest.raises(ValueError, match=r"^.*camchain\.yaml: K1: focal lengths must be positive"):
         Calibration.from_file(tmp_path / "camchain.yaml")
+
+
+def test_a_thin_prism_term_is_refused_by_to_ros() -> None:
+    """ROS has no model for OpenCV's thin-prism terms s1..s4 (coefficients 9-12) either, not
+    only for the tilt (13-14): a 12-term D with s1 set is refused, not written without it."""
+    d12 = np.zeros(12)
+    d12[:5] = [-0.1, 0.01, 0.0, 0.0, 0.0]
+    d12[8] = 0.002  # s1
+    with pytest.raises(ValueError, match=r"D2: .*thin-prism .*coefficients 9-12 are not zero"):
+        raw_calib(D2=d12).to_ros()
