@@ -199,6 +199,7 @@ def _cam_text(**changes: object) -> str:
         ({"image_height": 0}, "image_height must be a positive integer"),
         ({"rectification_matrix": [2, 0, 0, 0, 1, 0, 0, 0, 1]}, "does not hold a rotation"),
         ({"projection_matrix": [0] * 12}, "positive fx"),
+        ({"projection_matrix": [300, 0, 160, -30, 0, 0, 120, 0, 0, 0, 1, 0]}, "positive fx, fy"),
     ],
 )
 def test_bad_camera_info_names_the_field(
@@ -366,6 +367,7 @@ def test_kalibr_camchain(tmp_path: Path) -> None:
         ({"dist": "double_sphere"}, "expected 'radtan', 'equidistant' or 'none'"),
         ({"model": "omni"}, "only 'pinhole'"),
         ({"size": (640, 480)}, "a rig needs one size"),
+        ({"size": (320.5, 240)}, "resolution must be two positive integers"),
         ({"T": np.zeros((4, 4))}, "last row"),
         ({"T": _pose(2 * np.eye(3), np.zeros(3))}, "does not hold a rotation"),
     ],
@@ -503,3 +505,18 @@ def test_a_thin_prism_term_is_refused_by_to_ros() -> None:
     d12[8] = 0.002  # s1
     with pytest.raises(ValueError, match=r"D2: .*thin-prism .*coefficients 9-12 are not zero"):
         raw_calib(D2=d12).to_ros()
+
+
+def test_a_common_tilt_of_both_cameras_is_not_a_rectified_pair(tmp_path: Path) -> None:
+    """No distortion and K = P[:, :3] but both rectification_matrix a 2 degree tilt: the
+    images are not rectified yet (ROS warps them by R_i), so the rig is not read as rectified
+    even though R = R2^T R1 = I and T is along x."""
+    tilt = cv2.Rodrigues(np.array([np.radians(2.0), 0.0, 0.0]))[0]
+    k = np.array([[300.0, 0.0, 160.0], [0.0, 300.0, 120.0], [0.0, 0.0, 1.0]])
+    p1 = np.hstack([k, np.zeros((3, 1))])
+    p2 = np.hstack([k, (k @ [-0.1, 0.0, 0.0]).reshape(3, 1)])
+    _write_pair(tmp_path, [(k, np.zeros(5), tilt, p1), (k, np.zeros(5), tilt, p2)])
+    c = Calibration.from_file(tmp_path)
+    assert not c.rectified
+    np.testing.assert_allclose(c.R, np.eye(3), atol=1e-15)
+    np.testing.assert_allclose(c.T, [-0.1, 0.0, 0.0], atol=1e-15)
