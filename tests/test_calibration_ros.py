@@ -198,6 +198,7 @@ def _cam_text(**changes: object) -> str:
         ({"image_width": -3}, "image_width must be a positive integer"),
         ({"image_height": 0}, "image_height must be a positive integer"),
         ({"rectification_matrix": [2, 0, 0, 0, 1, 0, 0, 0, 1]}, "does not hold a rotation"),
+        ({"rectification_matrix": [1, 0, 0, 0, 1, 0, 0, 0, -1]}, "does not hold a rotation"),
         ({"projection_matrix": [0] * 12}, "positive fx"),
         ({"projection_matrix": [300, 0, 160, -30, 0, 0, 120, 0, 0, 0, 1, 0]}, "positive fx, fy"),
     ],
@@ -390,6 +391,8 @@ def test_kalibr_camera_choice_errors(tmp_path: Path) -> None:
         Calibration.from_kalibr(path, cameras=("cam0", "cam5"))
     with pytest.raises(ValueError, match="must come after"):
         Calibration.from_kalibr(path, cameras=("cam1", "cam0"))
+    with pytest.raises(ValueError, match="'cam0' must come after 'cam0'"):
+        Calibration.from_kalibr(path, cameras=("cam0", "cam0"))  # not a zero baseline
     path.write_text(_camchain([*cams, {**cams[0]}]))  # cam1 without its pose
     with pytest.raises(ValueError, match="lacks field 'T_cn_cnm1'"):
         Calibration.from_file(path)
