@@ -993,7 +993,9 @@ def test_opencv_stereo_calib_reads_1d_vectors_saved_by_filestorage(
     assert Calibration.from_file(tmp_path, image_size=(320, 240), unit="cm") == calib
     # a vector of the wrong length: refused by its length, as the constructor refuses it
     write({"M1": K1, "D1": np.append(D1, 0.0), "M2": K2, "D2": D2}, {"R": R, "T": T})
-    with pytest.raises(ValueError, match=r"^D1: expected shape \(4,\) or \(5,\).*got \(6,\)$"):
+    with pytest.raises(
+        ValueError, match=r"extrinsics\.yml: D1: expected shape \(4,\) or \(5,\).*got \(6,\)$"
+    ):
         Calibration.from_file(tmp_path, image_size=(320, 240), unit="cm")
     # a matrix saved 1-D is not a matrix
     write({"M1": K1.ravel(), "D1": D1, "M2": K2, "D2": D2}, {"R": R, "T": T})
@@ -1435,3 +1437,25 @@ def test_an_object_kitti_file_is_sized_by_the_image_2_png_beside_it(tmp_path: Pa
     (tmp_path / "000000.txt").write_text(f"P2: {p2}\nP3: {p3}\n")
     cv2.imwrite(str(tmp_path / "image_2.png"), np.zeros((375, 1242), np.uint8))
     assert Calibration.from_file(tmp_path / "000000.txt").image_size == (1242, 375)
+
+
+def test_opencv_stereo_calib_numbers_the_constructor_refuses_name_the_files(
+    tmp_path: Path,
+) -> None:
+    """An R that is not a rotation in extrinsics.yml was "R: not a rotation matrix", naming
+    neither file; the arguments image_size and unit are still refused as themselves."""
+    _opencv_stereo_calib(tmp_path)
+    fs = cv2.FileStorage(str(tmp_path / "extrinsics.yml"), cv2.FILE_STORAGE_WRITE)
+    fs.write("R", 2 * np.eye(3))
+    fs.write("T", np.array([[-60.0], [0.0], [0.0]]))
+    fs.release()
+    files = (tmp_path / "intrinsics.yml", tmp_path / "extrinsics.yml")
+    with pytest.raises(
+        ValueError,
+        match=r"^OpenCV stereo_calib files .*intrinsics\.yml and .*extrinsics\.yml: R: not a rot",
+    ):
+        Calibration.from_opencv_stereo_calib(*files, (640, 480), "mm")
+    with pytest.raises(ValueError, match=r"^unit: expected one of .* got 'yd'$"):
+        Calibration.from_opencv_stereo_calib(*files, (640, 480), "yd")
+    with pytest.raises(ValueError, match=r"^image_size: expected positive integers"):
+        Calibration.from_opencv_stereo_calib(*files, (640, 0), "mm")

@@ -1511,9 +1511,15 @@ class Calibration:
         ValueError
             If a file cannot be parsed, lacks a field (named), or holds invalid values.
         """
+        # the two arguments checked first: a refusal of the files' numbers names the files
+        size = cls._check_size(image_size)
+        if unit not in UNIT_TO_METRES:
+            raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
         fields: dict[str, Any] = {}
+        files: list[Path] = []
         for path, keys in ((intrinsics, ("M1", "D1", "M2", "D2")), (extrinsics, ("R", "T"))):
             p, text = cls._read_text(path)
+            files.append(p)
             fs = _open_filestorage(text, str(p))
             try:
                 for key in keys:
@@ -1524,14 +1530,15 @@ class Calibration:
                     fields[key] = _node_matrix(node, key, str(p), vector=vector)
             finally:
                 fs.release()
-        return cls(
+        return cls._made(
+            f"OpenCV stereo_calib files {files[0]} and {files[1]}",
             K1=fields["M1"],
             D1=fields["D1"],
             K2=fields["M2"],
             D2=fields["D2"],
             R=fields["R"],
             T=fields["T"],
-            image_size=image_size,
+            image_size=size,
             unit=unit,
         )
 
