@@ -1459,3 +1459,13 @@ def test_opencv_stereo_calib_numbers_the_constructor_refuses_name_the_files(
         Calibration.from_opencv_stereo_calib(*files, (640, 480), "yd")
     with pytest.raises(ValueError, match=r"^image_size: expected positive integers"):
         Calibration.from_opencv_stereo_calib(*files, (640, 0), "mm")
+
+
+def test_loading_a_folder_or_a_binary_file_is_named(tmp_path: Path) -> None:
+    """load() of a folder is 'not a file' (a ValueError, not open()'s IsADirectoryError), and
+    of a binary file 'not a text calibration file', each naming the path."""
+    with pytest.raises(ValueError, match=r"^calibration path is not a file: "):
+        Calibration.load(tmp_path)
+    (tmp_path / "c.yaml").write_bytes(b"%YAML:1.0\n\xff\xfe\x00")
+    with pytest.raises(ValueError, match=r"^not a text calibration file: .*c\.yaml$"):
+        Calibration.load(tmp_path / "c.yaml")
