@@ -1469,3 +1469,16 @@ def test_loading_a_folder_or_a_binary_file_is_named(tmp_path: Path) -> None:
     (tmp_path / "c.yaml").write_bytes(b"%YAML:1.0\n\xff\xfe\x00")
     with pytest.raises(ValueError, match=r"^not a text calibration file: .*c\.yaml$"):
         Calibration.load(tmp_path / "c.yaml")
+
+
+def test_a_word_among_a_matrixs_numbers_is_named_not_read_as_zero(tmp_path: Path) -> None:
+    """FileNode.real() of a string is 0: a word where K1's skew is was read as a skew of 0."""
+    text = raw_calib().save(tmp_path / "c.yaml").read_text()
+    k1 = text.index("K1:")
+    start = text.index("data: [", k1) + len("data: [")
+    comma = text.index(",", start)
+    (tmp_path / "w.yaml").write_text(
+        text[: comma + 1] + ' "abc",' + text[text.index(",", comma + 1) + 1 :]
+    )
+    with pytest.raises(ValueError, match=r"field 'K1' is not a matrix: element 1 of data is not"):
+        Calibration.load(tmp_path / "w.yaml")

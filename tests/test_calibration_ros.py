@@ -523,3 +523,11 @@ def test_a_common_tilt_of_both_cameras_is_not_a_rectified_pair(tmp_path: Path) -
     assert not c.rectified
     np.testing.assert_allclose(c.R, np.eye(3), atol=1e-15)
     np.testing.assert_allclose(c.T, [-0.1, 0.0, 0.0], atol=1e-15)
+
+
+def test_save_ros_writes_the_alpha_given(tmp_path: Path) -> None:
+    """save_ros(alpha=1) writes to_ros(alpha=1)'s projections (all pixels kept), not alpha 0's."""
+    c = raw_calib()
+    left, right = c.save_ros(tmp_path, alpha=1.0)
+    assert (left.read_text(), right.read_text()) == c.to_ros(alpha=1.0)
+    assert left.read_text() != c.to_ros(alpha=0.0)[0]
