@@ -531,3 +531,14 @@ def test_save_ros_writes_the_alpha_given(tmp_path: Path) -> None:
     left, right = c.save_ros(tmp_path, alpha=1.0)
     assert (left.read_text(), right.read_text()) == c.to_ros(alpha=1.0)
     assert left.read_text() != c.to_ros(alpha=0.0)[0]
+
+
+@pytest.mark.parametrize("name", ["calib.tgz", "calib.tar", "CALIB.TAR.GZ"])
+def test_a_ros_tarball_is_read_by_any_of_its_names(tmp_path: Path, name: str) -> None:
+    """ROS camera_calibration's tarball renamed .tgz or uncompressed .tar reads the same rig."""
+    c = raw_calib()
+    left, right = c.save_ros(tmp_path / "ros")
+    with tarfile.open(tmp_path / name, "w:gz" if "gz" in name.lower() else "w") as t:
+        t.add(left, arcname="left.yaml")
+        t.add(right, arcname="right.yaml")
+    assert Calibration.from_file(tmp_path / name) == Calibration.from_file(tmp_path / "ros")
