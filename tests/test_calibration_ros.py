@@ -423,19 +423,21 @@ def test_the_old_camera_model_spelling_names_the_distortion_model() -> None:
     assert info["D"].tolist() == [0.1, 0.01, 0, 0, 0, 0.2, 0, 0]
 
 
+@pytest.mark.parametrize("failing", ["left.yaml", "right.yaml"])
 def test_a_failed_save_ros_keeps_the_earlier_pair(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, failing: str
 ) -> None:
     """left.yaml was replaced before right.yaml was written: a failure at right.yaml (disk
     full) left the new left camera beside the old right one, a pair that loads as a rig neither
-    calibration is. Both files are written before either replaces the earlier one."""
+    calibration is. Written both first, a failure at the second replacement (left.yaml there)
+    still did. The pair is written all or nothing."""
     earlier = [p.read_bytes() for p in rect_calib().save_ros(tmp_path)]
     import stereovision.io as sio
 
     real_replace = sio.os.replace
 
     def replace(src: str, dst: object) -> None:
-        if Path(str(dst)).name == "right.yaml":
+        if Path(str(dst)).name == failing:
             raise OSError(28, "No space left on device")
         real_replace(src, dst)
 

@@ -2096,8 +2096,9 @@ class Calibration:
         Parameters
         ----------
         directory : str or os.PathLike
-            Created if missing; both files are written before either replaces the one there,
-            so a failure while writing keeps the earlier pair.
+            Created if missing. The pair is written all or nothing
+            (:func:`stereovision.io.write_together`): a failure at any step keeps the earlier
+            pair.
         alpha : float
             Free scaling of the rectification, in ``[0, 1]``.
         names : tuple of str
@@ -2113,7 +2114,7 @@ class Calibration:
         ValueError
             As :meth:`to_ros`, or if ``directory`` is an existing file.
         """
-        from stereovision.io import atomic_write
+        from stereovision.io import write_together
 
         d = Path(directory)
         if d.exists() and not d.is_dir():
@@ -2123,11 +2124,10 @@ class Calibration:
 
         make_folder(d)
         paths = (d / "left.yaml", d / "right.yaml")
-        # both written before either replaces its file: one by one, a failure at right.yaml
-        # left the new left camera beside the earlier right one, a rig neither calibration is
-        with atomic_write(paths[0], "w") as left, atomic_write(paths[1], "w") as right:
-            left.write(texts[0])
-            right.write(texts[1])
+        # all or nothing: one by one, a failure at right.yaml left the new left camera beside
+        # the earlier right one, a rig neither calibration is (and a failure at the second
+        # replacement did, when both were written first)
+        write_together([(p, t.encode("utf-8")) for p, t in zip(paths, texts, strict=True)])
         return paths
 
 

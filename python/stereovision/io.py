@@ -368,6 +368,79 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
         raise
 
 
+def write_together(files: list[tuple[Path, bytes]]) -> None:
+    """Write files that belong together (a map's picture and YAML, a rig's two camera_info) all or
+    nothing.
+
+    Every file is written and synced to a temporary file next to its destination; then each
+    replaces its destination in order (the last one commits the set), a copy of each previous
+    destination being kept under a temporary name until the last is in place. On any failure the
+    destinations already replaced get their previous contents back (or are removed if they did
+    not exist) and every temporary file is removed, except a copy of previous contents that could
+    not be put back: it is kept, and the exception's notes name it and its destination.
+
+    Parameters
+    ----------
+    files : list of (pathlib.Path, bytes)
+        Destinations and their contents, in the order they are to replace the destinations.
+    """
+    import shutil
+
+    temps: list[Path] = []  # the new contents, not yet in place
+    kept: list[tuple[Path, Path | None]] = []  # (destination, its previous contents or None)
+    replaced = 0  # how many of kept's destinations hold their new contents
+    try:
+        for dest, data in files:
+            fd, name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=dest.parent)
+            temps.append(Path(name))
+            with os.fdopen(fd, "wb") as fh:
+                fh.write(data)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.chmod(name, 0o666 & ~_current_umask())  # mkstemp's 0600 -> a plain open()'s
+        for (dest, _), new in zip(files, temps, strict=True):
+            previous: Path | None = None
+            if dest.is_file():
+                fd, name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".old", dir=dest.parent)
+                os.close(fd)
+                previous = Path(name)
+            # listed before the copy: a copy failing half-way (a full disk) is removed below
+            kept.append((dest, previous))
+            if previous is not None:
+                shutil.copy2(dest, previous)  # dest stays in place meanwhile
+            os.replace(new, dest)
+            replaced += 1
+    except BaseException as exc:
+        stranded: list[tuple[Path, Path]] = []  # (destination, the only copy of its old contents)
+        # (a destination whose own replacement failed still holds its previous contents)
+        for dest, previous in reversed(kept[:replaced]):
+            try:
+                if previous is not None:
+                    os.replace(previous, dest)
+                elif dest.exists():
+                    os.unlink(dest)
+            except OSError:
+                if previous is not None:
+                    # not removed below: it holds the previous contents, the destination the new
+                    stranded.append((dest, previous))
+        for left_over in temps + [p for _, p in kept if p is not None]:
+            if any(left_over == copy for _, copy in stranded):
+                continue
+            try:
+                os.unlink(left_over)
+            except FileNotFoundError:
+                pass
+        for dest, copy in stranded:
+            exc.add_note(f"{dest} could not be restored: its previous contents are in {copy}")
+        raise
+    for _, previous in kept:
+        if previous is not None:
+            try:
+                os.unlink(previous)
+            except FileNotFoundError:
+                pass
+
+
 def _describe(a: np.ndarray) -> str:
     return f"shape {a.shape} dtype {a.dtype}"
 
