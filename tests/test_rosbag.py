@@ -650,3 +650,54 @@ def test_bag_of_a_rig_with_doffs_and_its_own_right_camera(data_dir: Path, tmp_pa
     np.testing.assert_array_equal(right.p.reshape(3, 4)[:, :3], k2)
     np.testing.assert_array_equal(left.k.reshape(3, 3), sc.calib.K1)
     assert right.p[2] - left.p[2] == pytest.approx(20.0)
+
+
+def test_bag_fields_of_a_filled_map_and_its_floor_scan(data_dir: Path, tmp_path: Path) -> None:
+    """Second mutation audit, on the default (filled) map written with a ``ground`` as
+    ``stream --bag`` does: the scan is stamped as the frame (to the ns) and carries the
+    :func:`laser_scan` of the filled point image (its angles and range limits too); the cloud
+    holds the pixels with a depth only, dense and little-endian; the camera_info is the
+    rectified one (5 zero ``d``, identity ``r``); the disparity image is ``32FC1``; a result
+    without its calibration is refused (not rosbags' or numpy's error part-way)."""
+    import dataclasses
+
+    from stereovision.ground import fit_ground_plane, laser_scan
+    from stereovision.rosbag import BagWriter
+
+    sc = load_scene(data_dir / "kitti2015" / "000005_10")
+    res = sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity, cloud=False)
+    plane = fit_ground_plane(res.disparity, res.calibration)
+    assert plane is not None
+    want = laser_scan(res.point_image(filled=True), plane, res.calibration)
+    lean = laser_scan(res.point_image(filled=False), plane, res.calibration)
+    assert not np.array_equal(want.ranges, lean.ranges)  # the filled pixels count
+    stamp = 1_700_000_000_123_456_789
+    with BagWriter(tmp_path / "run") as bag:
+        with pytest.raises(ValueError, match="compute the result with a calibration"):
+            bag.write(dataclasses.replace(res, calibration=None), stamp)
+        bag.write(res, stamp, ground=plane)
+        # a scan given: its own range limits (laser_scan's range_min is 0 by default)
+        bag.write(res, stamp + 1, scan=dataclasses.replace(want, range_min=0.25, range_max=7.5))
+    assert (bag.messages, bag.frames) == (16, 2)
+    topics = _read(tmp_path / "run")
+    scan_stamp, scan = topics["/stereo/scan"][0]
+    assert scan_stamp == stamp
+    assert (scan.header.stamp.sec, scan.header.stamp.nanosec) == (1_700_000_000, 123_456_789)
+    assert scan.header.frame_id == "base_footprint"
+    for name in ("angle_min", "angle_max", "angle_increment", "range_min", "range_max"):
+        assert getattr(scan, name) == pytest.approx(getattr(want, name), rel=1e-6), name
+    assert scan.angle_max > scan.angle_min
+    given = topics["/stereo/scan"][1][1]
+    assert (given.range_min, given.range_max) == (0.25, 7.5)
+    np.testing.assert_array_equal(scan.ranges, want.ranges)
+    cloud = topics["/stereo/points"][0][1]
+    assert cloud.width == np.isfinite(res.depth).sum() and cloud.height == 1
+    assert cloud.is_dense and not cloud.is_bigendian
+    xyz = np.frombuffer(cloud.data.tobytes(), "<f4").reshape(-1, 4)[:, :3]
+    np.testing.assert_array_equal(xyz, res.point_image()[np.isfinite(res.depth)])
+    for topic in ("left/camera_info", "right/camera_info", "camera_info"):
+        info = topics[f"/stereo/{topic}"][0][1]
+        np.testing.assert_array_equal(info.d, np.zeros(5))
+        np.testing.assert_array_equal(info.r, np.eye(3).ravel())
+    disp = topics["/stereo/disparity"][0][1].image
+    assert disp.encoding == "32FC1" and disp.step == 4 * disp.width and not disp.is_bigendian
