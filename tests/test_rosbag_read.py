@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -1150,3 +1151,131 @@ def test_a_rig_whose_cameras_bin_differently_is_refused(cones: Any, tmp_path: Pa
     bag = write_bag(tmp_path / "same", frames, infos=cams, binning=[(0, 0), (1, 1)])
     with BagCamera(bag) as cam:
         assert cam.calibration().image_size == (450, 375)
+
+
+def test_ros_encoding_names_aliases_and_16_bit_bayer(cones: Any) -> None:
+    """Second mutation audit: ROS spells the generic encodings in capitals (``16UC1``,
+    ``8UC3``; read as ``mono16`` and ``bgr8``), ``uyvy`` and ``yuyv`` are ``yuv422`` and
+    ``yuv422_yuy2``, the 16-bit Bayer patterns keep red and blue as the 8-bit ones, and an
+    empty (0 x 0) image is refused as one the message does not hold."""
+    bgr, grey = cones.left, cv2.cvtColor(cones.left, cv2.COLOR_BGR2GRAY)
+    g12 = grey.astype(np.uint16) << 4
+    mono16 = _image_fields(g12, "mono16", pad=2)
+    np.testing.assert_array_equal(decode_image(_Msg(**{**mono16, "encoding": "16UC1"})),
+                                  decode_image(_Msg(**mono16)))  # fmt: skip
+    assert decode_image(_Msg(**{**mono16, "encoding": "16UC1"})).dtype == np.uint16
+    bgr8 = _image_fields(bgr, "bgr8", pad=1)
+    np.testing.assert_array_equal(decode_image(_Msg(**{**bgr8, "encoding": "8UC3"})), bgr)
+    for alias, layout in (("uyvy", "yuv422"), ("yuyv", "yuv422_yuy2")):
+        fields = _image_fields(grey, layout)
+        np.testing.assert_array_equal(decode_image(_Msg(**{**fields, "encoding": alias})),
+                                      decode_image(_Msg(**fields)))  # fmt: skip
+    smooth = cv2.GaussianBlur(bgr, (0, 0), 2.0)
+    for pattern in ("rggb", "bggr", "gbrg", "grbg"):
+        raw = decode_image(_Msg(**_image_fields(smooth.astype(np.uint16) << 8,
+                                                f"bayer_{pattern}16")))  # fmt: skip
+        assert raw.dtype == np.uint16 and raw.shape == bgr.shape
+        eight = decode_image(_Msg(**_image_fields(smooth, f"bayer_{pattern}8")))
+        # OpenCV interpolates the 16-bit data before the shift: rounding, 1 level at most
+        np.testing.assert_allclose(to_8bit(raw)[0], eight, atol=1)
+    empty = {"height": 0, "width": 0, "encoding": "mono8", "is_bigendian": 0, "step": 0,
+             "data": np.zeros(0, np.uint8)}  # fmt: skip
+    with pytest.raises(ValueError, match=r"mono8 image of 0x0 px: .* do not hold it"):
+        decode_image(_Msg(**empty))
+
+
+def test_compressed_bgra_and_16_bit_png(cones: Any) -> None:
+    """Second mutation audit: a PNG with alpha comes out BGR (3 channels), and a 16-bit PNG
+    (12-bit data) stays 16-bit, so :func:`to_8bit` shifts it by 4 (read as 8 bits it was
+    divided by 256: nearly black)."""
+    bgr = cones.left
+    bgra = np.dstack([bgr, np.full(bgr.shape[:2], 200, np.uint8)])
+    _ok, png = cv2.imencode(".png", bgra)
+    np.testing.assert_array_equal(decode_image(_Msg(format="bgra8; png", data=png.reshape(-1))),
+                                  bgr)  # fmt: skip
+    grey = cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)
+    _ok, png16 = cv2.imencode(".png", grey.astype(np.uint16) << 4)
+    out = decode_image(_Msg(format="mono16; png compressed mono16", data=png16.reshape(-1)))
+    assert out.dtype == np.uint16 and out.shape == bgr.shape
+    np.testing.assert_array_equal(to_8bit(out)[0][..., 0], grey)
+
+
+def test_a_nearer_right_frame_drops_the_one_before_and_the_end_says_so(
+    cones: Any, tmp_path: Path
+) -> None:
+    """Second mutation audit: a left frame with two right frames within ``max_skew_ms`` pairs
+    with the nearer, and the one passed over is counted dropped; the end-of-recording error
+    says how many of each side found no partner (the sides in their places)."""
+    left, right = cones.left[:64, :96], cones.right[:64, :96]
+    ms = 1_000_000
+    frames = [(T0, left, T0 - 3 * ms // 2, right), (None, left, T0 + ms // 2, right)]
+    with BagCamera(write_bag(tmp_path / "near", frames), max_skew_ms=2) as cam:
+        got = list(cam.frames())
+        with pytest.raises(SourceError) as err:
+            cam.read()
+    assert [(f.t_left, f.t_right) for f in got] == [(T0 / 1e9, (T0 + ms // 2) / 1e9)]
+    assert cam.dropped == {"left": 0, "right": 1}
+    assert str(err.value).endswith(
+        "end of the recording after 1 pairs (0 left and 1 right frames without a partner)"
+    )
+    # two lefts, one right: the left passed over is counted on its side
+    frames = [(T0, left, T0, right), (T0 + 40 * ms, left, None, right)]
+    with BagCamera(write_bag(tmp_path / "lone", frames), max_skew_ms=2) as cam:
+        list(cam.frames())
+        with pytest.raises(SourceError, match=r"\(1 left and 0 right frames without"):
+            cam.read()
+
+
+def test_the_default_tolerance_waits_for_both_topics_and_skips_repeated_stamps(
+    cones: Any, tmp_path: Path
+) -> None:
+    """Second mutation audit of the default ``max_skew_ms`` (half the faster topic's period):
+    a faster right topic that starts late is waited for (10 ms for 50 fps, not the 25 fps
+    left's 20 ms, decided before the right's first frame); a stamp sent again (a step of 0)
+    is no period (it made the tolerance 0: no pair); a bag of one frame a side has no period
+    and pairs its two frames."""
+    left, right = cones.left[:64, :96], cones.right[:64, :96]
+    ms = 1_000_000
+    frames = [(T0 + k * 40 * ms, left, None, right) for k in range(30)]
+    frames += [(None, left, T0 + 400 * ms + k * 20 * ms, right) for k in range(20)]
+    with BagCamera(write_bag(tmp_path / "late", frames)) as cam:
+        list(cam.frames())
+    assert cam.max_skew_ms == 10.0
+    # left stamps 0, 0, 0, 40, 40, 40, 80, 80, ... ms (each frame sent three times)
+    lefts = [T0 + (k // 3) * 40 * ms for k in range(24)]
+    frames = [(sl, left, None, right) for sl in lefts]
+    frames += [(None, left, T0 + k * 40 * ms + 3 * ms, right) for k in range(8)]
+    with BagCamera(write_bag(tmp_path / "repeated", frames)) as cam:
+        got = list(cam.frames())
+    assert cam.max_skew_ms == 20.0
+    assert [f.skew_ms for f in got] == pytest.approx([3.0] * 8, abs=1e-3)
+    with BagCamera(write_bag(tmp_path / "one", [(T0, left, T0 + 3 * ms, right)])) as cam:
+        got = list(cam.frames())
+    assert len(got) == 1 and cam.max_skew_ms == math.inf and cam.dropped == {"left": 0, "right": 0}
+
+
+def test_camera_info_beside_a_compressed_image_topic(cones: Any, tmp_path: Path) -> None:
+    """Second mutation audit: the camera_info of ``.../image_raw/compressed`` is the one
+    beside ``.../image_raw`` (image_transport's suffix is no part of the camera's name)."""
+    from rosbags.rosbag2 import Reader, Writer
+
+    raw = _raw_rig()
+    cams = tuple(parse_ros_camera_info(t) for t in raw.to_ros())
+    src = write_bag(tmp_path / "src", [(T0, cones.left, T0, cones.right)], encoding="png",
+                    infos=cams)  # fmt: skip
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    with Reader(src) as r, Writer(tmp_path / "rig", version=9) as w:
+        conns: dict[str, Any] = {}
+        for conn, stamp, data in r.messages():
+            topic = conn.topic + "/compressed" if conn.topic in (LEFT, RIGHT) else conn.topic
+            if topic not in conns:
+                conns[topic] = w.add_connection(topic, conn.msgtype, typestore=ts)
+            w.write(conns[topic], stamp, data)
+    with BagCamera(tmp_path / "rig") as cam:
+        assert cam.topics == {"left": LEFT + "/compressed", "right": RIGHT + "/compressed"}
+        assert cam.info_topics == {"left": "/stereo/left/camera_info",
+                                   "right": "/stereo/right/camera_info"}  # fmt: skip
+        got = cam.calibration()
+        np.testing.assert_array_equal(cam.read().left, cones.left)
+    np.testing.assert_allclose(got.K1, raw.K1)
+    np.testing.assert_allclose(got.T, raw.T, atol=1e-9)
