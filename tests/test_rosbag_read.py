@@ -37,6 +37,7 @@ from stereovision.rosbag import (  # noqa: E402
 
 LEFT, RIGHT = "/stereo/left/image_raw", "/stereo/right/image_raw"
 PERIOD_NS = 33_333_333  # 30 fps
+CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
 T0 = 1_700_000_000_000_000_000
 
 
@@ -1279,3 +1280,26 @@ def test_camera_info_beside_a_compressed_image_topic(cones: Any, tmp_path: Path)
         np.testing.assert_array_equal(cam.read().left, cones.left)
     np.testing.assert_allclose(got.K1, raw.K1)
     np.testing.assert_allclose(got.T, raw.T, atol=1e-9)
+
+
+def test_a_camera_info_topic_without_messages_is_no_calibration(cones: Any, tmp_path: Path) -> None:
+    """A bag whose camera_info topics were recorded but never published (ROS 2 keeps a topic
+    subscribed to and never heard, 0 messages): ``calibration()`` raised StopIteration (past
+    ``info``'s and ``stream``'s error handling); the topic is taken as absent, so there is
+    no calibration (None) and the commands ask for one."""
+    from rosbags.rosbag2 import Reader, Writer
+
+    src = write_bag(tmp_path / "src", [(T0, cones.left, T0, cones.right)])
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    with Reader(src) as r, Writer(tmp_path / "rig", version=9) as w:
+        conns: dict[str, Any] = {}
+        for conn, stamp, data in r.messages():
+            if conn.topic not in conns:
+                conns[conn.topic] = w.add_connection(conn.topic, conn.msgtype, typestore=ts)
+            w.write(conns[conn.topic], stamp, data)
+        for side in ("left", "right"):
+            w.add_connection(f"/stereo/{side}/camera_info", CAMERA_INFO, typestore=ts)
+    with BagCamera(tmp_path / "rig") as cam:
+        assert cam.info_topics == {"left": None, "right": None}
+        assert cam.calibration() is None
+        np.testing.assert_array_equal(cam.read().left, cones.left)

@@ -878,7 +878,8 @@ class BagCamera(PairSource):
     topics : dict of str to str
         ``{"left": topic, "right": topic}``.
     info_topics : dict of str to str or None
-        Each side's ``camera_info`` topic, None when the bag has none beside the image topic.
+        Each side's ``camera_info`` topic, None when the bag has none beside the image topic
+        (or only one without messages).
     dropped : dict of str to int
         Frames of each side that found no partner within ``max_skew_ms`` (so far).
     stamps_ns : list of int
@@ -957,7 +958,13 @@ class BagCamera(PairSource):
         self.info_topics: dict[str, str | None] = {}
         for side, topic in self.topics.items():
             info = _base_topic(topic).rsplit("/", 1)[0] + "/camera_info"
-            ok = info in topics and topics[info].msgtype == CAMERA_INFO_TYPE
+            # a topic recorded and never published (0 messages) is none: calibration()'s first
+            # message raised StopIteration
+            ok = (
+                info in topics
+                and topics[info].msgtype == CAMERA_INFO_TYPE
+                and topics[info].msgcount > 0
+            )
             self.info_topics[side] = info if ok else None
         self.rectified_topics = all(
             "rect" in _base_topic(t).rsplit("/", 1)[-1] for t in (left, right)
