@@ -1303,3 +1303,43 @@ def test_a_camera_info_topic_without_messages_is_no_calibration(cones: Any, tmp_
         assert cam.info_topics == {"left": None, "right": None}
         assert cam.calibration() is None
         np.testing.assert_array_equal(cam.read().left, cones.left)
+
+
+def test_small_reader_cases_a_third_mutation_round_found_untested(
+    cones: Any, tmp_path: Path
+) -> None:
+    """Mutation audit: compressed data of 0 bytes is a ValueError (OpenCV raised its own
+    error); names that differ past their number are no camera pair (``camera0`` /
+    ``camera1_depth``); 16-bit images dimmer than 8 bits are not shifted (a negative shift);
+    a camera_info beside one image topic only is no calibration (None); an empty
+    ``distortion_model`` is ROS's default ``plumb_bob``."""
+    with pytest.raises(ValueError, match=r"compressed image \('jpeg', 0 bytes\) does not decode"):
+        decode_image(_Msg(format="jpeg", data=np.zeros(0, np.uint8)))
+    with pytest.raises(ValueError, match="no left/right pair"):
+        find_stereo_topics(["/camera0/image_raw", "/camera1_depth/image_raw"])
+    dim = np.array([[0, 3], [100, 27]], np.uint16)  # 7 bits
+    np.testing.assert_array_equal(to_8bit(dim)[0], dim.astype(np.uint8))
+    raw = _raw_rig()
+    cams = tuple(parse_ros_camera_info(t) for t in raw.to_ros())
+    frames = [(T0, cones.left, T0, cones.right)]
+    bag = write_bag(tmp_path / "one_info", frames, infos=cams)
+    from rosbags.rosbag2 import Reader, Writer
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    with Reader(bag) as r, Writer(tmp_path / "left_info", version=9) as w:
+        conns: dict[str, Any] = {}
+        for conn, stamp, data in r.messages():
+            if conn.topic == "/stereo/right/camera_info":
+                continue
+            if conn.topic not in conns:
+                conns[conn.topic] = w.add_connection(conn.topic, conn.msgtype, typestore=ts)
+            w.write(conns[conn.topic], stamp, data)
+    with BagCamera(tmp_path / "left_info") as cam:
+        assert cam.info_topics == {"left": "/stereo/left/camera_info", "right": None}
+        assert cam.calibration() is None
+    unset = tuple({**c, "distortion_model": ""} for c in cams)
+    with BagCamera(write_bag(tmp_path / "unset", frames, infos=unset)) as cam:
+        got = cam.calibration()
+    with BagCamera(bag) as cam:
+        assert got == cam.calibration()
+    np.testing.assert_allclose(got.D1, raw.D1)
