@@ -701,3 +701,33 @@ def test_bag_fields_of_a_filled_map_and_its_floor_scan(data_dir: Path, tmp_path:
         np.testing.assert_array_equal(info.r, np.eye(3).ravel())
     disp = topics["/stereo/disparity"][0][1].image
     assert disp.encoding == "32FC1" and disp.step == 4 * disp.width and not disp.is_bigendian
+
+
+def test_every_header_carries_the_frames_stamp_and_the_frame_id_given(
+    kitti: tuple, tmp_path: Path
+) -> None:
+    """Mutation audit: ``frame_id`` given is every header's (the default's was not checked
+    against another), each message's header (the disparity's and its image's, the right
+    camera_info's) carries the frame's stamp to the ns (tf and message_filters match on it),
+    and a path that is a file is refused as existing (it was taken for a new folder)."""
+    from stereovision.rosbag import BagWriter
+
+    res, _ = kitti
+    stamp = 1_700_000_005_000_000_007
+    with BagWriter(tmp_path / "run", frame_id="cam_left_optical") as bag:
+        bag.write(res, stamp)
+    headers = []
+    for topic, msgs in _read(tmp_path / "run").items():
+        ((recorded, msg),) = msgs
+        assert recorded == stamp, topic
+        headers.append((topic, msg.header))
+        if topic.endswith("disparity"):
+            headers.append((topic + ".image", msg.image.header))
+    assert len(headers) == 8
+    for topic, header in headers:
+        assert header.frame_id == "cam_left_optical", topic
+        assert (header.stamp.sec, header.stamp.nanosec) == (1_700_000_005, 7), topic
+    (tmp_path / "a_file").write_text("x")
+    with pytest.raises(FileExistsError, match="bag folder already exists"):
+        BagWriter(tmp_path / "a_file")
+    assert (tmp_path / "a_file").read_text() == "x"
