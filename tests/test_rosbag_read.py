@@ -1343,3 +1343,25 @@ def test_small_reader_cases_a_third_mutation_round_found_untested(
     with BagCamera(bag) as cam:
         assert got == cam.calibration()
     np.testing.assert_allclose(got.D1, raw.D1)
+
+
+@pytest.mark.parametrize("flavour", ["ros2", "mcap"])
+def test_the_storage_file_of_a_bag_without_metadata_is_a_bag(
+    cones: Any, tmp_path: Path, flavour: str, run: Callable[..., tuple[int, str, str]]
+) -> None:
+    """BagCamera reads the ``.db3`` / ``.mcap`` file of a bag whose recorder left no
+    metadata.yaml, but ``is_bag`` said no, so ``stereovision info`` took it for a calibration
+    ("not a text calibration file"); such a file is a bag."""
+    from stereovision.rosbag import is_bag
+
+    bag = write_bag(tmp_path / "rig", [(T0, cones.left, T0, cones.right)], flavour=flavour)
+    (bag / "metadata.yaml").unlink()
+    (storage,) = bag.iterdir()
+    assert is_bag(storage)
+    with BagCamera(storage) as cam:
+        np.testing.assert_array_equal(cam.read().left, cones.left)
+    code, out, _ = run("info", str(storage))
+    assert code == 0 and out.startswith(f"bag {storage} (ROS 2")
+    assert "no camera_info beside the image topics" in out
+    (tmp_path / "rig.yaml").write_text("x")
+    assert not is_bag(tmp_path / "rig.yaml")

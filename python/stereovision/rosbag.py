@@ -763,10 +763,12 @@ def to_8bit(*images: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def is_bag(path: str | os.PathLike[str]) -> bool:
     """Does ``path`` name a ROS bag: a ``.bag`` file, a folder of them (a split recording), a
-    ROS 2 bag folder (``metadata.yaml``; or its ``.db3`` / ``.mcap`` files without it) or one of
-    its files?"""
+    ROS 2 bag folder (``metadata.yaml``; or its ``.db3`` / ``.mcap`` files without it), one of
+    its files, or a ``.db3`` / ``.mcap`` file alone (a recorder that left no metadata.yaml)?"""
     p = Path(path)
-    if p.is_file() and p.suffix == ".bag":
+    # a bag's storage file alone is read (its recorder left no metadata.yaml): `info` took
+    # it for a calibration file
+    if p.is_file() and p.suffix in (".bag", ".db3", ".mcap"):
         return True
     folder = p if p.is_dir() else p.parent
     if (folder / "metadata.yaml").is_file():
