@@ -1365,3 +1365,22 @@ def test_the_storage_file_of_a_bag_without_metadata_is_a_bag(
     assert "no camera_info beside the image topics" in out
     (tmp_path / "rig.yaml").write_text("x")
     assert not is_bag(tmp_path / "rig.yaml")
+
+
+def test_a_resized_pair_keeps_the_recorded_frames_and_describe_says_the_tolerance(
+    cones: Any, tmp_path: Path
+) -> None:
+    """Mutation audit: a pair resized to ``image_size`` carries the frames as recorded
+    (``delivered``; None when nothing was resized), and ``describe`` says ``auto`` until the
+    default tolerance is known, then its value."""
+    frames = [(T0 + k * PERIOD_NS, cones.left, T0 + k * PERIOD_NS, cones.right) for k in range(3)]
+    bag = write_bag(tmp_path / "rig", frames)
+    with BagCamera(bag, image_size="225x188") as cam:
+        assert cam.describe().endswith("; max skew: auto")
+        f = cam.read()
+        assert f.left.shape == (188, 225, 3) and f.delivered is not None
+        np.testing.assert_array_equal(f.delivered[0], cones.left)
+        np.testing.assert_array_equal(f.delivered[1], cones.right)
+        assert cam.describe().endswith("; max skew 16.7 ms")
+    with BagCamera(bag) as cam:
+        assert cam.read().delivered is None
