@@ -247,6 +247,111 @@ mod tests {
     }
 
     #[test]
+    fn checks_the_exact_size_every_non_finite_value_and_both_sides() {
+        // A longer buffer is as wrong as a shorter one; infinities count as NaN does.
+        assert!(matches!(
+            ImageView::new(2, 2, &[0.0; 5]),
+            Err(CoreError::BufferSize {
+                got: 5,
+                expected: 4,
+                ..
+            })
+        ));
+        assert_eq!(
+            Image::new(3, 1, vec![f32::INFINITY, 0.0, f32::NEG_INFINITY]),
+            Err(CoreError::NonFinite { count: 2 })
+        );
+        // Sizes that differ in height only.
+        let (a, b) = (Image::filled(3, 2, 0.0), Image::filled(3, 4, 0.0));
+        assert_eq!(
+            check_pair(&a, &b),
+            Err(CoreError::SizeMismatch {
+                left: (3, 2),
+                right: (3, 4)
+            })
+        );
+        assert_eq!(Image::filled(3, 2, 0.5).data, vec![0.5; 6]);
+        // A confidence of the wrong length, with a disparity of the right one.
+        assert!(check_map_pair(&[0.0; 6], &[0.0; 6], 3, 2).is_ok());
+        assert!(check_map_pair(&[0.0; 6], &[0.0; 5], 3, 2).is_err());
+        assert!(check_map_pair(&[0.0; 5], &[0.0; 6], 3, 2).is_err());
+    }
+
+    #[test]
+    fn at_is_row_major_on_a_non_square_image() {
+        let img = Image::new(3, 2, (0..6).map(|v| v as f32).collect()).unwrap();
+        let view = ImageView::from(&img);
+        for y in 0..2 {
+            for x in 0..3 {
+                assert_eq!(img.at(x, y), (y * 3 + x) as f32);
+                assert_eq!(view.at(x, y), (y * 3 + x) as f32);
+            }
+        }
+        assert_eq!(view.size(), (3, 2));
+    }
+
+    /// The documented per-pixel formula, written out without the tables.
+    fn grey_reference(px: &[u8], w: [f32; 3]) -> f32 {
+        if px.len() == 1 {
+            return px[0] as f32 / 255.0;
+        }
+        let (b, g, r) = (
+            px[0] as f32 / 255.0,
+            px[1] as f32 / 255.0,
+            px[2] as f32 / 255.0,
+        );
+        ((w[0] * b + w[1] * g) + w[2] * r).clamp(0.0, 1.0)
+    }
+
+    #[test]
+    fn grey_from_u8_is_the_documented_formula_bit_for_bit() {
+        let (width, height) = (7, 3);
+        let mut seed = 12345u32;
+        let mut bytes = |n: usize| -> Vec<u8> {
+            (0..n)
+                .map(|_| {
+                    seed = seed.wrapping_mul(1_103_515_245).wrapping_add(12345);
+                    (seed >> 16) as u8
+                })
+                .collect()
+        };
+        // BT.601 (BGR order), and weights that leave [0, 1] on both sides (the clamp).
+        for weights in [[0.114, 0.587, 0.299], [0.9, 0.8, -0.6], [-0.2, 0.3, 0.1]] {
+            for channels in [1usize, 3, 4] {
+                let data = bytes(width * height * channels);
+                let got = grey_from_u8(&data, width, height, channels, weights).unwrap();
+                let want: Vec<f32> = data
+                    .chunks(channels)
+                    .map(|px| grey_reference(&px[..channels.min(3)], weights))
+                    .collect();
+                assert_eq!(got.len(), width * height);
+                for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+                    assert_eq!(g.to_bits(), w.to_bits(), "{channels} channels, pixel {i}");
+                }
+            }
+        }
+        // Hand-computed: grey 51 is 0.2; white with weights summing past 1 is 1; alpha ignored.
+        let w = [0.5, 0.5, 0.5];
+        assert_eq!(grey_from_u8(&[51, 0], 2, 1, 1, w).unwrap(), [0.2, 0.0]);
+        assert_eq!(grey_from_u8(&[255; 4], 1, 1, 4, w).unwrap(), [1.0]);
+        assert_eq!(
+            grey_from_u8(&[0, 0, 0, 255, 255, 0, 0, 0], 2, 1, 4, w).unwrap(),
+            [0.0, 0.5]
+        );
+        // Only 1, 3 or 4 channels.
+        assert!(matches!(
+            grey_from_u8(&[0; 4], 1, 2, 2, w),
+            Err(CoreError::InvalidParameter {
+                name: "channels",
+                ..
+            })
+        ));
+        // A pair: each side from its own buffer.
+        let (l, r) = grey_pair_from_u8(&[0, 51], &[255, 102], 2, 1, 1, w).unwrap();
+        assert_eq!((l, r), (vec![0.0, 0.2], vec![1.0, 0.4]));
+    }
+
+    #[test]
     fn an_empty_8_bit_image_is_an_empty_image() {
         // It said "buffer of 0 bytes does not hold 0x5x3".
         let w = [1.0 / 3.0; 3];
