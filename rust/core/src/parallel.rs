@@ -196,4 +196,49 @@ mod tests {
             .enumerate()
             .all(|(y, r)| r.iter().all(|&v| v == 2 * y)));
     }
+
+    #[test]
+    fn rows_of_different_widths_and_empty_rows() {
+        // Two buffers of 37 rows, 2 and 5 wide: row y of each, whatever the band split.
+        let (wa, wb, h) = (2, 5, 37);
+        let mut a = vec![usize::MAX; wa * h];
+        let mut b = vec![usize::MAX; wb * h];
+        super::for_each_row_pair(&mut a, wa, &mut b, wb, |y, ra, rb| {
+            assert_eq!((ra.len(), rb.len()), (wa, wb));
+            ra.iter_mut().for_each(|v| *v = y);
+            rb.iter_mut().for_each(|v| *v = 10 * y);
+        });
+        assert!(a
+            .chunks(wa)
+            .enumerate()
+            .all(|(y, r)| r.iter().all(|&v| v == y)));
+        assert!(b
+            .chunks(wb)
+            .enumerate()
+            .all(|(y, r)| r.iter().all(|&v| v == 10 * y)));
+        // A zero width on either side is no rows: no call (and no zero-sized chunks).
+        let mut none: Vec<usize> = Vec::new();
+        super::for_each_row(&mut none, 0, |_, _| panic!("called"));
+        super::for_each_row_pair(&mut a, wa, &mut none, 0, |_, _, _| panic!("called"));
+        super::for_each_row_pair(&mut none, 0, &mut b, wb, |_, _, _| panic!("called"));
+    }
+
+    #[test]
+    fn run_hot_marks_its_body_and_clears_the_mark() {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let hot = || super::HOT.with(std::cell::Cell::get);
+            assert!(!hot());
+            // Set in the body (so a nested call runs in place), cleared after it, also after a panic.
+            // (Unless STEREOVISION_SPIN_WAIT=0 turned the waiting, and so the mark, off.)
+            assert_eq!(super::run_hot(hot), super::spin_wait_enabled());
+            assert!(!hot());
+            let r = std::panic::catch_unwind(|| super::run_hot(|| panic!("boom")));
+            assert!(r.is_err());
+            assert!(!hot());
+        });
+    }
 }
