@@ -417,4 +417,73 @@ mod tests {
         let (n, bytes) = CACHE.kept();
         assert!(n <= SLOTS && bytes == n * l.size());
     }
+
+    #[test]
+    fn takes_the_newest_of_a_layout_and_keeps_the_rest() {
+        let cache = BlockCache::new();
+        let l1 = Layout::from_size_align(MIN_CACHED, 64).unwrap();
+        let l2 = Layout::from_size_align(MIN_CACHED + 64, 64).unwrap();
+        unsafe {
+            let (a1, b, a2) = (System.alloc(l1), System.alloc(l2), System.alloc(l1));
+            cache.dealloc(a1, l1);
+            cache.dealloc(b, l2);
+            cache.dealloc(a2, l1);
+            assert_eq!(cache.kept(), (3, 3 * MIN_CACHED + 64));
+            // Out of the middle: the blocks either side stay, each once.
+            assert_eq!(cache.alloc(l2), b);
+            assert_eq!(cache.kept(), (2, 2 * MIN_CACHED));
+            // Newest first, by plain `alloc` too (a request of exactly MIN_CACHED is served).
+            assert_eq!(cache.alloc(l1), a2);
+            assert_eq!(cache.alloc(l1), a1);
+            assert_eq!(cache.kept(), (0, 0));
+            for (p, l) in [(a1, l1), (b, l2), (a2, l1)] {
+                System.dealloc(p, l);
+            }
+        }
+    }
+
+    #[test]
+    fn releases_the_oldest_and_fills_the_bounds_exactly() {
+        let cache = BlockCache::new();
+        let l = Layout::from_size_align(MIN_CACHED, 8).unwrap();
+        unsafe {
+            let held: Vec<_> = (0..SLOTS + 1).map(|_| System.alloc(l)).collect();
+            for &p in &held {
+                cache.dealloc(p, l);
+            }
+            // The first one went back to the system; the others come out newest first.
+            assert_eq!(cache.kept(), (SLOTS, SLOTS * MIN_CACHED));
+            let back: Vec<_> = (0..SLOTS).map(|_| cache.alloc(l)).collect();
+            let want: Vec<_> = held[1..].iter().rev().copied().collect();
+            assert_eq!(back, want);
+            for p in back {
+                System.dealloc(p, l);
+            }
+            // Blocks that add up to exactly MAX_CACHED_BYTES are all kept, as is one block of
+            // exactly that size (pages of a fresh block are not touched: cheap to allocate).
+            let rest = Layout::from_size_align(MAX_CACHED_BYTES - MIN_CACHED, 8).unwrap();
+            let (p, q) = (System.alloc(rest), System.alloc(l));
+            cache.dealloc(p, rest);
+            cache.dealloc(q, l);
+            assert_eq!(cache.kept(), (2, MAX_CACHED_BYTES));
+            let all = Layout::from_size_align(MAX_CACHED_BYTES, 8).unwrap();
+            cache.dealloc(System.alloc(all), all);
+            assert_eq!(cache.kept(), (1, MAX_CACHED_BYTES));
+            assert_eq!(cache.clear(), MAX_CACHED_BYTES);
+        }
+    }
+
+    #[test]
+    fn human_bytes_units_and_reserve_to_a_total() {
+        assert_eq!(human_bytes(1 << 30), "1.00 GiB (1073741824 bytes)");
+        assert_eq!(human_bytes((1 << 30) - 1), "1024.00 MiB (1073741823 bytes)");
+        assert_eq!(human_bytes(1 << 20), "1.00 MiB (1048576 bytes)");
+        assert_eq!(human_bytes(3 << 19), "1.50 MiB (1572864 bytes)");
+        assert_eq!(human_bytes((1 << 20) - 1), "1048575 bytes");
+        // Room for 10 in all, not 10 more.
+        let mut v = vec![1u8; 3];
+        try_reserve_len(&mut v, 10, "v").unwrap();
+        assert!(v.capacity() >= 10 && v.capacity() < 13, "{}", v.capacity());
+        assert_eq!(v, [1, 1, 1]);
+    }
 }
