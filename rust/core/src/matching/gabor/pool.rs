@@ -149,4 +149,66 @@ mod tests {
             vec![1.0, 2.0]
         );
     }
+
+    /// A fresh (not pooled) buffer of exactly `n` values.
+    fn fresh(n: usize) -> Buf {
+        Buf {
+            v: crate::alloc::try_zeroed(n, "test").unwrap(),
+            n,
+        }
+    }
+
+    /// The pool is shared with every test of the binary (the Gabor ones take and return planes
+    /// concurrently), so a check of what it hands back is retried: another caller may take the
+    /// buffer in between. A wrong pool fails every try.
+    fn eventually(mut check: impl FnMut() -> bool) -> bool {
+        (0..10).any(|_| check())
+    }
+
+    #[test]
+    fn best_fit_reuse_from_min_pooled_up_and_the_byte_cap() {
+        use super::{held_bytes, release, MIN_POOLED, POOL_MAX_BYTES};
+        // A returned buffer of exactly the size, from MIN_POOLED up, comes back unfilled.
+        for n in [MIN_POOLED, 3_000_000] {
+            let reused = eventually(|| {
+                let mut a = fresh(n);
+                a[0] = 7.0;
+                let p = a.as_ptr();
+                drop(a);
+                let b = Buf::scratch(n).unwrap();
+                b.as_ptr() == p && b[0] == 7.0
+            });
+            assert!(reused, "{n}");
+        }
+        // The smallest that fits (not a larger one, nor the exact ones just returned), cut to
+        // the asked length.
+        let n = 4_000_000;
+        let best = eventually(|| {
+            let (mut a, mut b) = (fresh(n + 1000), fresh(n + 10));
+            (a[0], b[0]) = (1.0, 2.0);
+            drop(a);
+            drop(b);
+            Buf::scratch(n).unwrap()[0] == 2.0
+        });
+        assert!(best);
+        drop(fresh(n + 10));
+        assert_eq!(Buf::scratch(n).unwrap().into_vec().len(), n);
+        // Over the cap the oldest goes, and only as many as needed; sizes are in bytes.
+        let big = POOL_MAX_BYTES / 4 * 3 / 4;
+        let capped = eventually(|| {
+            release();
+            let (mut a, mut b) = (fresh(big), fresh(big));
+            // Marked: a freed block can come back from the system at the same address.
+            (a[0], b[0]) = (1.0, 2.0);
+            drop(a);
+            drop(b);
+            assert!(held_bytes() <= POOL_MAX_BYTES);
+            let kept = held_bytes() >= 4 * big;
+            let c = Buf::scratch(big).unwrap();
+            let newest = c[0] == 2.0;
+            drop(c);
+            kept && newest && release() >= 4 * big
+        });
+        assert!(capped);
+    }
 }
