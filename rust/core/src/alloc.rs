@@ -436,7 +436,14 @@ mod tests {
             assert_eq!(cache.alloc(l1), a2);
             assert_eq!(cache.alloc(l1), a1);
             assert_eq!(cache.kept(), (0, 0));
-            for (p, l) in [(a1, l1), (b, l2), (a2, l1)] {
+            // A larger kept block does not serve a smaller request (it would be freed with the
+            // smaller layout).
+            cache.dealloc(b, l2);
+            let c = cache.alloc(l1);
+            assert_ne!(c, b);
+            assert_eq!(cache.kept(), (1, MIN_CACHED + 64));
+            cache.clear();
+            for (p, l) in [(a1, l1), (c, l1), (a2, l1)] {
                 System.dealloc(p, l);
             }
         }
