@@ -28,6 +28,7 @@ from stereovision.io import (
     scene_max_disparity,
     write_pfm,
     write_ply,
+    write_together,
 )
 
 # evaluation.md "Reference figures": max_disparity per scene.
@@ -1199,3 +1200,47 @@ def test_load_scene_keeps_gt_zero_and_large_values_as_disparities(tmp_path: Path
         "images 4 px wide, not wider than the scene's disparity range (72064 px, "
         "evaluation.md's rule: 16 at least): a scene needs images at least 72065 px wide"
     )
+
+
+def test_find_scenes_lists_a_scene_behind_an_alias_link_once(tmp_path: Path) -> None:
+    """A link inside the root to a folder of it (``latest -> run3``) listed its scenes twice,
+    so ``bench`` counted them twice in its mean; rglob did not enter it. As batch's walk, a link
+    inside the root (or to a folder entered already) is an alias, also when the root is a link."""
+    scene = tmp_path / "data" / "run3" / "s1"
+    scene.mkdir(parents=True)
+    for name in ("left.png", "right.png"):
+        (scene / name).write_bytes(b"")
+    (tmp_path / "data" / "latest").symlink_to(tmp_path / "data" / "run3")
+    (tmp_path / "data" / "x1").symlink_to(tmp_path / "outside")
+    (tmp_path / "data" / "x2").symlink_to(tmp_path / "outside")
+    (tmp_path / "outside" / "s2").mkdir(parents=True)
+    for name in ("left.png", "right.png"):
+        (tmp_path / "outside" / "s2" / name).write_bytes(b"")
+    assert find_scenes(tmp_path / "data") == [
+        tmp_path / "data" / "run3" / "s1",
+        tmp_path / "data" / "x1" / "s2",
+    ]
+    (tmp_path / "root").symlink_to(tmp_path / "data")
+    assert find_scenes(tmp_path / "root") == [
+        tmp_path / "root" / "run3" / "s1",
+        tmp_path / "root" / "x1" / "s2",
+    ]
+
+
+def test_write_together_refuses_a_folder_or_missing_folder_naming_the_destination(
+    tmp_path: Path,
+) -> None:
+    """save_ros's right.yaml being a folder was atomic_write's 'cannot write .../right.yaml: it
+    is a folder'; write_together said '[Errno 21] Is a directory: .../.right.yaml.x1y2.tmp ->
+    ...', naming its temporary file. Each destination is checked first, nothing written."""
+    (tmp_path / "b.yaml").mkdir()
+    with pytest.raises(IsADirectoryError) as info:
+        write_together([(tmp_path / "a.yaml", b"1"), (tmp_path / "b.yaml", b"2")])
+    folder = tmp_path / "b.yaml"
+    assert str(info.value) == f"cannot write {folder}: it is a folder; give a file name"
+    with pytest.raises(FileNotFoundError) as missing:
+        write_together([(tmp_path / "a.yaml", b"1"), (tmp_path / "no" / "c.yaml", b"2")])
+    assert str(missing.value) == (
+        f"cannot write {tmp_path / 'no' / 'c.yaml'}: directory {tmp_path / 'no'} does not exist"
+    )
+    assert sorted(os.listdir(tmp_path)) == ["b.yaml"]

@@ -383,9 +383,24 @@ def write_together(files: list[tuple[Path, bytes]]) -> None:
     ----------
     files : list of (pathlib.Path, bytes)
         Destinations and their contents, in the order they are to replace the destinations.
+
+    Raises
+    ------
+    IsADirectoryError, NotADirectoryError, FileNotFoundError
+        As :func:`atomic_write`, for any destination, before anything is written.
     """
     import shutil
 
+    # checked first, in atomic_write's words: os.replace's error named the temporary file
+    # ('Is a directory: .../.right.yaml.x1y2.tmp -> .../right.yaml')
+    for dest, _ in files:
+        directory = dest.parent
+        if dest.is_dir():
+            raise IsADirectoryError(f"cannot write {dest}: it is a folder; give a file name")
+        if directory.exists() and not directory.is_dir():
+            raise NotADirectoryError(f"cannot write {dest}: {directory} is a file, not a folder")
+        if not directory.is_dir():
+            raise FileNotFoundError(f"cannot write {dest}: directory {directory} does not exist")
     temps: list[Path] = []  # the new contents, not yet in place
     kept: list[tuple[Path, Path | None]] = []  # (destination, its previous contents or None)
     replaced = 0  # how many of kept's destinations hold their new contents
@@ -1304,8 +1319,8 @@ def load_scene(directory: PathLike) -> Scene:
 
 
 def find_scenes(root: PathLike) -> list[Path]:
-    """Scene directories under ``root`` (any depth, through links to folders) that contain
-    ``left.png`` and ``right.png``.
+    """Scene directories under ``root`` (any depth, through links to folders outside it, each
+    once) that contain ``left.png`` and ``right.png``.
 
     Parameters
     ----------
@@ -1325,17 +1340,15 @@ def find_scenes(root: PathLike) -> list[Path]:
     r = Path(root)
     if not r.is_dir():
         raise FileNotFoundError(f"scene root not found: {r}")
-    # os.walk following links: Path.rglob does not enter a link to a folder, so scenes linked
-    # into a folder were not found. A link back to a folder on its own path (a loop) is not
-    # entered; one scene linked twice is listed under both names.
-    found = []
-    above: dict[str, frozenset[str]] = {}  # real folders on the way to each folder
-    for folder, subfolders, files in os.walk(r, followlinks=True):
-        on_path = above.pop(folder, frozenset()) | {os.path.realpath(folder)}
-        subfolders[:] = [
-            s for s in subfolders if os.path.realpath(os.path.join(folder, s)) not in on_path
-        ]
-        above.update((os.path.join(folder, s), on_path) for s in subfolders)
-        if "left.png" in files and os.path.isfile(os.path.join(folder, "right.png")):
-            found.append(Path(folder))
+    # Links followed: Path.rglob does not enter a link to a folder, so scenes linked into a
+    # folder were not found. As batch's walk, a link to a folder inside the root (or holding
+    # it: a loop), or to one entered already, is an alias, not entered: `latest -> run3` listed
+    # run3's scenes twice and `bench` counted them twice in its mean.
+    from stereovision.batch import _walk
+
+    found = [
+        Path(folder)
+        for folder, _, files, _ in _walk(r)
+        if "left.png" in files and os.path.isfile(os.path.join(folder, "right.png"))
+    ]
     return sorted(found)
