@@ -1861,3 +1861,11 @@ def test_numpy_and_bool_sources() -> None:
             parse_source(flag)  # type: ignore[arg-type]
         with pytest.raises(ValueError, match=r"^left source: expected a device index or a path"):
             StereoCamera(flag, 0)  # type: ignore[arg-type]
+
+
+def test_a_numpy_device_index_that_cannot_open_is_named_a_camera() -> None:
+    """A NumPy index now reaches StereoCamera as a device (calibrate_from_video passes it on);
+    one that could not open was 'cannot open left source int64', the type's name for the
+    camera's number."""
+    with pytest.raises(SourceError, match=r"^cannot open left source camera 97 "):
+        StereoCamera(np.int64(97), np.int64(98))

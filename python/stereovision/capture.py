@@ -384,8 +384,9 @@ def _media_ms(cap: Any) -> float:
 
 
 def _describe_source(src: Source) -> str:
-    if isinstance(src, int):
-        return f"camera {src}"
+    # a NumPy index is a device too (StereoCamera opens it): it was described as 'int64'
+    if isinstance(src, (int, np.integer)):
+        return f"camera {int(src)}"
     if isinstance(src, (str, os.PathLike)):
         return repr(os.fspath(src))
     return type(src).__name__
