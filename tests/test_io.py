@@ -1244,3 +1244,13 @@ def test_write_together_refuses_a_folder_or_missing_folder_naming_the_destinatio
         f"cannot write {tmp_path / 'no' / 'c.yaml'}: directory {tmp_path / 'no'} does not exist"
     )
     assert sorted(os.listdir(tmp_path)) == ["b.yaml"]
+
+
+def test_load_scene_of_a_folder_at_the_filesystem_root_has_no_leading_slash(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A scene folder directly under '/' (a container's /tsukuba) was still named '/tsukuba',
+    the name a10afcb called wrong for 'tsukuba': a folder with no family is named alone."""
+    monkeypatch.chdir(data_dir / "middlebury2001")
+    monkeypatch.setattr(os, "getcwd", lambda: "/")  # abspath("tsukuba") is then "/tsukuba"
+    assert load_scene("tsukuba").name == "tsukuba"

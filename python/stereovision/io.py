@@ -1306,9 +1306,10 @@ def load_scene(directory: PathLike) -> Scene:
         calib = Calibration.from_q(d / "Q.dat", (left.shape[1], left.shape[0]))
     # named from the absolute path, '..' folded: '.', 'tsukuba' or '../tsukuba' gave '/',
     # '/tsukuba' or '../tsukuba' (os.path.abspath keeps a link's own name, as resolve() would not)
+    # ('/tsukuba', a folder under the filesystem's root, has no family: named alone)
     named = Path(os.path.abspath(d))
     return Scene(
-        name=f"{named.parent.name}/{named.name}",
+        name=f"{named.parent.name}/{named.name}" if named.parent.name else named.name,
         left=left,
         right=right,
         gt=gt,
