@@ -184,7 +184,12 @@ pub fn grey_from_u8(
     if width == 0 || height == 0 {
         return Err(CoreError::EmptyImage { width, height });
     }
-    if data.len() != width * height * channels {
+    // checked: a shape whose product wraps (a release build) matched a short buffer, then
+    // indexed past it
+    let expected = width
+        .checked_mul(height)
+        .and_then(|n| n.checked_mul(channels));
+    if expected != Some(data.len()) {
         return Err(CoreError::param(
             "image",
             format!(
@@ -301,6 +306,16 @@ mod tests {
             px[2] as f32 / 255.0,
         );
         ((w[0] * b + w[1] * g) + w[2] * r).clamp(0.0, 1.0)
+    }
+
+    #[test]
+    fn grey_from_u8_refuses_a_shape_whose_size_overflows() {
+        // 2^63 x 2 wraps to 0 in a release build, which matched an empty buffer
+        let w = 1usize << (usize::BITS - 1);
+        for (width, height, channels) in [(w, 2, 1), (w, 1, 4), (usize::MAX, usize::MAX, 3)] {
+            let r = grey_from_u8(&[], width, height, channels, [0.114, 0.587, 0.299]);
+            assert!(r.is_err(), "{width}x{height}x{channels}");
+        }
     }
 
     #[test]
