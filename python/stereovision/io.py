@@ -318,6 +318,19 @@ def keep_previous(path: PathLike, new: bytes | None = None) -> Path | None:
     return kept
 
 
+def _writable_destination(dest: Path) -> Path:
+    """``dest``'s folder, after refusing a ``dest`` that is a folder or a folder that is missing
+    or a file (the errors :func:`atomic_write` documents)."""
+    directory = dest.parent if str(dest.parent) else Path(".")
+    if dest.is_dir():
+        raise IsADirectoryError(f"cannot write {dest}: it is a folder; give a file name")
+    if directory.exists() and not directory.is_dir():
+        raise NotADirectoryError(f"cannot write {dest}: {directory} is a file, not a folder")
+    if not directory.is_dir():
+        raise FileNotFoundError(f"cannot write {dest}: directory {directory} does not exist")
+    return directory
+
+
 @contextmanager
 def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
     """Open a temporary file next to ``path``; on success it atomically replaces ``path``.
@@ -343,13 +356,7 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
         If ``path`` is a folder, or its directory is a file.
     """
     dest = Path(path)
-    directory = dest.parent if str(dest.parent) else Path(".")
-    if dest.is_dir():
-        raise IsADirectoryError(f"cannot write {dest}: it is a folder; give a file name")
-    if directory.exists() and not directory.is_dir():
-        raise NotADirectoryError(f"cannot write {dest}: {directory} is a file, not a folder")
-    if not directory.is_dir():
-        raise FileNotFoundError(f"cannot write {dest}: directory {directory} does not exist")
+    directory = _writable_destination(dest)
     fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=directory)
     try:
         encoding = None if "b" in mode else "utf-8"
@@ -394,13 +401,7 @@ def write_together(files: list[tuple[Path, bytes]]) -> None:
     # checked first, in atomic_write's words: os.replace's error named the temporary file
     # ('Is a directory: .../.right.yaml.x1y2.tmp -> .../right.yaml')
     for dest, _ in files:
-        directory = dest.parent
-        if dest.is_dir():
-            raise IsADirectoryError(f"cannot write {dest}: it is a folder; give a file name")
-        if directory.exists() and not directory.is_dir():
-            raise NotADirectoryError(f"cannot write {dest}: {directory} is a file, not a folder")
-        if not directory.is_dir():
-            raise FileNotFoundError(f"cannot write {dest}: directory {directory} does not exist")
+        _writable_destination(dest)
     temps: list[Path] = []  # the new contents, not yet in place
     kept: list[tuple[Path, Path | None]] = []  # (destination, its previous contents or None)
     replaced = 0  # how many of kept's destinations hold their new contents
