@@ -282,3 +282,19 @@ def test_bench_cli_prints_the_table_then_the_json_lines(
     table, objects = lines[1 : 1 + n], [json.loads(ln) for ln in lines[1 + n :]]
     assert len(objects) == n and [o["case"] for o in objects][-1] == "SGBM-3WAY"
     assert [ln.split()[0] for ln in table[1:]] == [o["case"] for o in objects][1:]
+
+
+def test_bench_times_a_scene_given_twice_once(
+    data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`bench middlebury2001 middlebury2001/tsukuba` timed tsukuba twice (eval dropped the
+    second already), and the scene counted twice among the rows; it is benched once, said."""
+    from stereovision.bench import _scene_dirs
+
+    family = data_dir / "middlebury2001"
+    dirs = _scene_dirs([str(family), str(family / "tsukuba"), str(family / "venus")])
+    assert dirs == [family / "tsukuba", family / "venus"]
+    assert capsys.readouterr().err == "".join(
+        f"stereovision: {family / s} given more than once: benched once\n"
+        for s in ("tsukuba", "venus")
+    )

@@ -266,7 +266,7 @@ def format_table(cases: Sequence[BenchCase]) -> str:
 
 
 def _scene_dirs(paths: Sequence[str]) -> list[Path]:
-    from stereovision.io import find_scenes
+    from stereovision.io import distinct_scenes, find_scenes
 
     if not paths:
         return [Path(str(resources.files("stereovision") / "data" / "cones"))]
@@ -276,6 +276,10 @@ def _scene_dirs(paths: Sequence[str]) -> list[Path]:
         if not found:
             raise ValueError(f"no scene (left.png + right.png) under {d}")
         dirs.extend(found)
+    # as eval: a scene named twice (its folder and one holding it) was timed twice
+    dirs, dropped = distinct_scenes(dirs)
+    for s in dropped:
+        print(f"stereovision: {s} given more than once: benched once", file=sys.stderr)
     return dirs
 
 

@@ -1448,7 +1448,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
     """``stereovision eval SCENE_DIR...``: evaluation.md metrics, ours beside OpenCV."""
     from tqdm import tqdm
 
-    from stereovision.io import find_scenes, load_scene, scene_too_narrow
+    from stereovision.io import distinct_scenes, find_scenes, load_scene, scene_too_narrow
 
     dirs: list[Path] = []
     for d in args.scenes:
@@ -1463,15 +1463,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
         dirs.extend(found)
     # a scene named twice (its folder and a folder holding it) is evaluated once: twice, it
     # counted twice in the mean line
-    seen: set[Path] = set()
-    unique = []
-    for s in dirs:
-        if s.resolve() in seen:
-            print(f"stereovision: {s} given more than once: evaluated once", file=sys.stderr)
-            continue
-        seen.add(s.resolve())
-        unique.append(s)
-    dirs = unique
+    dirs, dropped = distinct_scenes(dirs)
+    for s in dropped:
+        print(f"stereovision: {s} given more than once: evaluated once", file=sys.stderr)
     rows = []
     header = (
         f"{'scene':38s} {'D':>4s} | {'ours':^20s} | {'ours+fill':^20s} |"

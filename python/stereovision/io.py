@@ -1320,6 +1320,29 @@ def load_scene(directory: PathLike) -> Scene:
     )
 
 
+def distinct_scenes(dirs: Sequence[Path]) -> tuple[list[Path], list[Path]]:
+    """``dirs`` without the scenes already listed (the same real folder: a scene and a folder
+    holding it, both given), in order, and the dropped ones.
+
+    Parameters
+    ----------
+    dirs : sequence of pathlib.Path
+        Scene folders, as :func:`find_scenes` lists them.
+
+    Returns
+    -------
+    kept, dropped : list of pathlib.Path
+    """
+    seen: set[Path] = set()
+    kept: list[Path] = []
+    dropped: list[Path] = []
+    for s in dirs:
+        real = s.resolve()
+        (dropped if real in seen else kept).append(s)
+        seen.add(real)
+    return kept, dropped
+
+
 def find_scenes(root: PathLike) -> list[Path]:
     """Scene directories under ``root`` (any depth, through links to folders outside it, each
     once) that contain ``left.png`` and ``right.png``.
