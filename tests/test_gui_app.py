@@ -301,6 +301,15 @@ def test_gui_main_errors_are_one_line(monkeypatch, capsys, tmp_path):
     assert capsys.readouterr().err == (
         "stereovision: error: Unable to allocate 30.0 GiB for an array\n"
     )
+
+    def a_bug(_args: argparse.Namespace) -> Any:
+        raise KeyError("view")
+
+    monkeypatch.setattr(gui, "build_app", a_bug)
+    assert gui.main([]) == 2  # as the CLI: one line, where a bug of ours printed a traceback
+    assert capsys.readouterr().err == (
+        "stereovision: error: internal KeyError: 'view' (please report this)\n"
+    )
     monkeypatch.undo()
     for argv in (["--port", "65536"], ["--port", "-1"]):
         assert gui.main(argv) == 2

@@ -639,6 +639,29 @@ def first_line(exc: BaseException) -> str:
     return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
 
 
+def internal_error(exc: BaseException) -> str:
+    """The one line the CLI and ``python -m stereovision.gui`` print for an unexpected error (a
+    bug of ours), instead of a traceback.
+
+    Parameters
+    ----------
+    exc : BaseException
+        The error.
+
+    Returns
+    -------
+    str
+        ``"stereovision: error: internal TYPE: FIRST LINE (please report this)"``.
+
+    Examples
+    --------
+    >>> internal_error(KeyError("k"))
+    "stereovision: error: internal KeyError: 'k' (please report this)"
+    """
+    msg = str(exc).splitlines()[0] if str(exc) else ""
+    return f"stereovision: error: internal {type(exc).__name__}: {msg} (please report this)"
+
+
 def finite_number(value: object, name: str) -> float:
     """``value`` as a finite Python float.
 

@@ -27,7 +27,7 @@ import numpy as np
 
 from stereovision._interrupt import Terminated, raise_terminated
 from stereovision._jsonout import json_line
-from stereovision._validate import first_line
+from stereovision._validate import first_line, internal_error
 
 EXIT_ERROR = 2
 EXIT_CANNOT_TELL = 3  # `check`: too little texture to tell whether the rows agree
@@ -1908,11 +1908,7 @@ def _run(args: argparse.Namespace) -> int:
         print(f"stereovision: error: {first_line(exc)}", file=sys.stderr)
         return EXIT_ERROR
     except Exception as exc:  # a bug of ours: still one line, never a traceback
-        msg = str(exc).splitlines()[0] if str(exc) else ""
-        print(
-            f"stereovision: error: internal {type(exc).__name__}: {msg} (please report this)",
-            file=sys.stderr,
-        )
+        print(internal_error(exc), file=sys.stderr)
         return EXIT_ERROR
     return status
 

@@ -277,3 +277,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
         print(f"stereovision: error: {first_line(exc)}", file=sys.stderr)
         return 2
+    except Exception as exc:  # a bug of ours: one line, as the CLI, not a traceback
+        from stereovision._validate import internal_error
+
+        print(internal_error(exc), file=sys.stderr)
+        return 2
