@@ -108,6 +108,14 @@ def _stereo_calib_input(
     return rig, root, out
 
 
+def _noise_pair(scene: Path) -> None:
+    """``scene/left.png`` and ``right.png``: one 48 x 32 noise image twice."""
+    scene.mkdir(parents=True)
+    img = np.random.default_rng(0).integers(0, 255, (32, 48, 3), np.uint8)
+    for side in ("left", "right"):
+        cv2.imwrite(str(scene / f"{side}.png"), img)
+
+
 def _not_ours(out: Path, pair: str, name: str) -> str:
     """batch's line refusing to replace ``out / pair / name``, which no earlier run listed."""
     return (
@@ -200,11 +208,7 @@ def test_unreachable_scheduler_leaves_no_new_folder(
     import stereovision.batch as batch
 
     monkeypatch.setattr(batch, "CONNECT_TIMEOUT", "1s")
-    scene = tmp_path / "in" / "scene"
-    scene.mkdir(parents=True)
-    img = np.random.default_rng(0).integers(0, 255, (32, 48, 3), np.uint8)
-    for side in ("left", "right"):
-        cv2.imwrite(str(scene / f"{side}.png"), img)
+    _noise_pair(tmp_path / "in" / "scene")
     out = tmp_path / "new" / "out"
     rc = main(["batch", str(tmp_path / "in"), "-o", str(out), "--scheduler", "tcp://127.0.0.1:1"])
     err = capsys.readouterr().err.strip().splitlines()
@@ -1954,11 +1958,7 @@ def test_a_run_that_never_starts_keeps_the_summary_of_earlier_runs(
     import stereovision.batch as batch
 
     monkeypatch.setattr(batch, "CONNECT_TIMEOUT", "1s")
-    scene = tmp_path / "in" / "scene"
-    scene.mkdir(parents=True)
-    img = np.random.default_rng(0).integers(0, 255, (32, 48, 3), np.uint8)
-    for side in ("left", "right"):
-        cv2.imwrite(str(scene / f"{side}.png"), img)
+    _noise_pair(tmp_path / "in" / "scene")
     out = tmp_path / "out"
     out.mkdir()
     earlier = {"version": 3, "pairs": {"old": {"status": "done", "outputs": []}}}

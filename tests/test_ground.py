@@ -722,6 +722,19 @@ def test_scan_on_kitti_against_the_lidar(data_dir: Path) -> None:
     assert np.median(rel) < 0.015 and np.mean(rel < 0.05) > 0.93
 
 
+def _raw_rig() -> Calibration:
+    """A raw (distorted) 640 x 480 rig whose rectified camera differs from its K1."""
+    return Calibration(
+        K1=np.array([[700, 0, 330], [0, 705, 245], [0, 0, 1.0]]),
+        D1=np.array([-0.2, 0.05, 0.001, -0.001, 0.0]),
+        K2=np.array([[710, 0, 320], [0, 708, 238], [0, 0, 1.0]]),
+        D2=np.array([-0.18, 0.04, -0.0005, 0.0008, 0.0]),
+        R=cv2.Rodrigues(np.array([0.01, -0.02, 0.005]))[0],
+        T=np.array([-0.12, 0.0015, -0.002]),
+        image_size=(640, 480),
+    )
+
+
 def test_scan_angles_of_a_raw_rig_are_its_rectified_cameras() -> None:
     """The points are in the left rectified frame: a raw (distorted) rig's scan spans the
     rectified camera's field of view, as its rectified calibration's does (the raw K1, f 700
@@ -730,15 +743,7 @@ def test_scan_angles_of_a_raw_rig_are_its_rectified_cameras() -> None:
     from stereovision.ground import GroundPlane, laser_scan
 
     w, h = 640, 480
-    raw = Calibration(
-        K1=np.array([[700, 0, 330], [0, 705, 245], [0, 0, 1.0]]),
-        D1=np.array([-0.2, 0.05, 0.001, -0.001, 0.0]),
-        K2=np.array([[710, 0, 320], [0, 708, 238], [0, 0, 1.0]]),
-        D2=np.array([-0.18, 0.04, -0.0005, 0.0008, 0.0]),
-        R=cv2.Rodrigues(np.array([0.01, -0.02, 0.005]))[0],
-        T=np.array([-0.12, 0.0015, -0.002]),
-        image_size=(w, h),
-    )
+    raw = _raw_rig()
     rect = raw.rectified_calibration()
     f, cx, cy = rect.K1[0, 0], rect.K1[0, 2], rect.K1[1, 2]
     assert abs(f - raw.K1[0, 0]) > 10 and abs(cx - raw.K1[0, 2]) > 5
@@ -1284,15 +1289,7 @@ def test_a_raw_rig_is_fitted_in_its_rectified_geometry() -> None:
     """A raw (distorted) calibration fits the disparity of its rectified images with its
     rectified camera: the same plane as its rectified_calibration() (the raw K1 put the
     camera's pitch at 8.51 degrees instead of 8)."""
-    raw = Calibration(
-        K1=np.array([[700, 0, 330], [0, 705, 245], [0, 0, 1.0]]),
-        D1=np.array([-0.2, 0.05, 0.001, -0.001, 0.0]),
-        K2=np.array([[710, 0, 320], [0, 708, 238], [0, 0, 1.0]]),
-        D2=np.array([-0.18, 0.04, -0.0005, 0.0008, 0.0]),
-        R=cv2.Rodrigues(np.array([0.01, -0.02, 0.005]))[0],
-        T=np.array([-0.12, 0.0015, -0.002]),
-        image_size=(640, 480),
-    )
+    raw = _raw_rig()
     disp = _exact_floor(raw)
     got = fit_ground_plane(disp, raw)
     assert got is not None
