@@ -658,7 +658,7 @@ def internal_error(exc: BaseException) -> str:
     >>> internal_error(KeyError("k"))
     "stereovision: error: internal KeyError: 'k' (please report this)"
     """
-    msg = str(exc).splitlines()[0] if str(exc) else ""
+    msg = first_line(exc) if str(exc) else ""  # first_line's type name is said already
     return f"stereovision: error: internal {type(exc).__name__}: {msg} (please report this)"
 
 

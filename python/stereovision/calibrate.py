@@ -1809,11 +1809,8 @@ def calibrate_from_video(
 
     _check_max_pairs(max_pairs)
 
-    # str() made np.int64(1) the file "1", and a bool is left to StereoCamera to refuse
-    def _source(s: object) -> int | str:
-        return s if isinstance(s, (int, np.integer, np.bool_)) else str(s)  # type: ignore[return-value]
-
-    cam = StereoCamera(_source(left), _source(right))
+    # as given: StereoCamera takes paths and indexes (a str() made np.int64(1) the file "1")
+    cam = StereoCamera(left, right)
     return _calibrate_from_camera(
         cam,
         pattern=pattern,
