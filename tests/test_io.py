@@ -1254,3 +1254,49 @@ def test_load_scene_of_a_folder_at_the_filesystem_root_has_no_leading_slash(
     monkeypatch.chdir(data_dir / "middlebury2001")
     monkeypatch.setattr(os, "getcwd", lambda: "/")  # abspath("tsukuba") is then "/tsukuba"
     assert load_scene("tsukuba").name == "tsukuba"
+
+
+def test_writers_write_through_a_link_to_a_file_as_open_does(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A destination that is a link to a file (rig.yaml -> rigs/2026.yaml) was replaced by a
+    regular file: the link was lost and its target kept the old contents. Like open(path, "w"),
+    atomic_write and write_together write the target now, still all or nothing; a dangling
+    link's target is created, a link loop is refused naming the link."""
+    elsewhere = tmp_path / "rigs"
+    elsewhere.mkdir()
+    for name in ("a.yaml", "b.yaml", "c.yaml"):
+        (elsewhere / name).write_text("old")
+        (tmp_path / name).symlink_to(Path("rigs") / name)  # relative, as ln -s makes them
+    with atomic_write(tmp_path / "a.yaml", "w") as fh:
+        fh.write("new")
+    write_together([(tmp_path / "b.yaml", b"new"), (tmp_path / "plain.yaml", b"new")])
+    for name in ("a.yaml", "b.yaml"):
+        assert (tmp_path / name).is_symlink() and (elsewhere / name).read_text() == "new"
+    assert sorted(os.listdir(elsewhere)) == ["a.yaml", "b.yaml", "c.yaml"]  # no temporaries
+    # all or nothing through the link: the second replacement fails, the first is undone
+    real_replace = os.replace
+
+    def fail_second(src: str, dst: str) -> None:
+        if str(dst).endswith("d.yaml"):
+            raise OSError(28, "No space left on device")
+        real_replace(src, dst)
+
+    monkeypatch.setattr(os, "replace", fail_second)
+    with pytest.raises(OSError, match="No space left"):
+        write_together([(tmp_path / "c.yaml", b"new"), (tmp_path / "d.yaml", b"new")])
+    monkeypatch.undo()
+    assert (tmp_path / "c.yaml").is_symlink() and (elsewhere / "c.yaml").read_text() == "old"
+    assert sorted(os.listdir(elsewhere)) == ["a.yaml", "b.yaml", "c.yaml"]
+    (tmp_path / "dangling.yaml").symlink_to(elsewhere / "new.yaml")
+    with atomic_write(tmp_path / "dangling.yaml", "w") as fh:
+        fh.write("created")
+    assert (elsewhere / "new.yaml").read_text() == "created"
+    assert (tmp_path / "dangling.yaml").is_symlink()
+    (tmp_path / "loop.yaml").symlink_to(tmp_path / "loop.yaml")
+    with pytest.raises(OSError, match=r"^cannot write .*loop\.yaml: it is a link that loops"):
+        write_together([(tmp_path / "loop.yaml", b"x")])
+    with pytest.raises(OSError, match=r"^cannot write .*loop\.yaml: it is a link that loops"):
+        with atomic_write(tmp_path / "loop.yaml") as fh:
+            fh.write(b"x")
+    assert (tmp_path / "loop.yaml").is_symlink()

@@ -14,6 +14,7 @@ Scene layout (evaluation.md)::
 
 from __future__ import annotations
 
+import errno
 import math
 import os
 import re
@@ -318,6 +319,27 @@ def keep_previous(path: PathLike, new: bytes | None = None) -> Path | None:
     return kept
 
 
+def _through_links(dest: Path) -> Path:
+    """The file a write to ``dest`` lands in: a link's target (created when missing), as
+    ``open(dest, "w")`` writes it, not a regular file replacing the link.
+
+    Raises
+    ------
+    OSError
+        If ``dest`` is a link that loops (ELOOP), naming ``dest``.
+    """
+    if not dest.is_symlink():
+        return dest
+    try:
+        return Path(os.path.realpath(dest, strict=True))
+    except FileNotFoundError:
+        return Path(os.path.realpath(dest))  # dangling: its target is created, as open() does
+    except OSError as exc:
+        loop = OSError(f"cannot write {dest}: it is a link that loops")  # str() without [Errno 40]
+        loop.errno = errno.ELOOP
+        raise loop from exc
+
+
 def _writable_destination(dest: Path) -> Path:
     """``dest``'s folder, after refusing a ``dest`` that is a folder or a folder that is missing
     or a file (the errors :func:`atomic_write` documents)."""
@@ -338,7 +360,8 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
     Parameters
     ----------
     path : str or os.PathLike
-        Destination file. Its directory must exist.
+        Destination file. Its directory must exist. A link is written through: its target
+        is replaced (created when missing) and the link kept, as ``open(path, "w")`` does.
     mode : str
         ``"wb"`` (default) or ``"w"`` (text, UTF-8).
 
@@ -354,8 +377,10 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
         If the destination directory does not exist.
     IsADirectoryError, NotADirectoryError
         If ``path`` is a folder, or its directory is a file.
+    OSError
+        If ``path`` is a link that loops.
     """
-    dest = Path(path)
+    dest = _through_links(Path(path))
     directory = _writable_destination(dest)
     fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=directory)
     try:
@@ -390,16 +415,19 @@ def write_together(files: list[tuple[Path, bytes]]) -> None:
     ----------
     files : list of (pathlib.Path, bytes)
         Destinations and their contents, in the order they are to replace the destinations.
+        A link is written through, as by :func:`atomic_write`.
 
     Raises
     ------
-    IsADirectoryError, NotADirectoryError, FileNotFoundError
+    IsADirectoryError, NotADirectoryError, FileNotFoundError, OSError
         As :func:`atomic_write`, for any destination, before anything is written.
     """
     import shutil
 
     # checked first, in atomic_write's words: os.replace's error named the temporary file
     # ('Is a directory: .../.right.yaml.x1y2.tmp -> .../right.yaml')
+    # a link is written through (its target replaced, the link kept), as open(path, "w") does
+    files = [(_through_links(dest), data) for dest, data in files]
     for dest, _ in files:
         _writable_destination(dest)
     temps: list[Path] = []  # the new contents, not yet in place
