@@ -418,7 +418,8 @@ def read_pcd(
 
 
 def write_npz(path: PathLike, result: DepthResult) -> Path:
-    """Bundle depth, its uncertainty, confidence, disparity and the intrinsics into a ``.npz``.
+    """Bundle depth, its uncertainty, confidence, disparity, the intrinsics and the disparity
+    range searched into a ``.npz``.
 
     Without calibration ``depth`` and ``depth_sigma`` are all NaN and ``K`` / ``baseline`` /
     ``doffs`` are NaN.
@@ -463,6 +464,8 @@ def write_npz(path: PathLike, result: DepthResult) -> Path:
         method=np.array(result.method),
         # int64 for a whole range, float64 for a fractional one (int64 truncated 37.5 to 37)
         max_disparity=np.asarray(result.max_disparity),
+        # the range's lower end: without it a [8, 40] px search read back as [0, 40]
+        min_disparity=np.float64(result.min_disparity),
     )
     with atomic_write(path) as fh:
         fh.write(bio.getvalue())
@@ -481,8 +484,10 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     -------
     dict
         ``depth``, ``confidence``, ``disparity`` (H, W) float32, ``K`` (3, 3), ``baseline``,
-        ``doffs``, ``image_size``, ``method``, ``max_disparity``, and ``depth_sigma`` (H, W)
-        float32, the depth's one-sigma uncertainty in metres (absent from older bundles).
+        ``doffs``, ``image_size``, ``method``, ``max_disparity``, ``min_disparity`` (a float;
+        0.0, the :class:`~stereovision.depth.DepthResult` default, for bundles written before
+        it was stored), and ``depth_sigma`` (H, W) float32, the depth's one-sigma uncertainty
+        in metres (absent from older bundles).
 
     Raises
     ------
@@ -501,7 +506,7 @@ def read_npz(path: PathLike) -> dict[str, Any]:
         if not isinstance(loaded, np.lib.npyio.NpzFile):  # a .npy file: one array, no bundle
             raise ValueError
         with loaded as z:
-            data = {k: z[k] for k in z.files}
+            data: dict[str, Any] = {k: z[k] for k in z.files}
     except (zipfile.BadZipFile, zlib.error, EOFError, ValueError, OSError):
         # zlib.error / EOFError: a bundle whose compressed members are damaged or cut.
         raise ValueError(f"not an .npz bundle (or a damaged one): {p}") from None
@@ -510,6 +515,7 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     for key, value in list(data.items()):
         if value.ndim == 0:
             data[key] = value.item()
+    data.setdefault("min_disparity", 0.0)  # bundles written before it was stored searched from 0
     return data
 
 
