@@ -946,6 +946,23 @@ def test_load_scene_names_a_relative_folder_by_its_own_names(
     assert load_scene("tsukuba").name == "middlebury2001/tsukuba"
 
 
+def test_load_scene_names_the_folder_a_dotdot_after_a_link_reads(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """``home/tsu/../venus`` with ``tsu`` a link to ``/data/middlebury2001/tsukuba``: the OS
+    reads ``/data/middlebury2001/venus`` but the name folded '..' as text, 'home/venus' (a
+    folder that is not there). A '..' after a link goes up from the link's target now; other
+    '..' and the links' own names are kept as spelt."""
+    (tmp_path / "home").mkdir()
+    (tmp_path / "home" / "tsu").symlink_to(data_dir / "middlebury2001" / "tsukuba")
+    s = load_scene(tmp_path / "home" / "tsu" / ".." / "venus")
+    assert s.name == "middlebury2001/venus"
+    np.testing.assert_array_equal(
+        s.left, imread(data_dir / "middlebury2001" / "venus" / "left.png")
+    )
+    assert load_scene(tmp_path / "home" / ".." / "home" / "tsu").name == "home/tsu"
+
+
 def _jpeg_with_orientation(image: np.ndarray, orientation: int) -> bytes:
     """A JPEG of ``image`` with an EXIF APP1 segment holding only the Orientation tag."""
     ok, jpg = cv2.imencode(".jpg", image, [cv2.IMWRITE_JPEG_QUALITY, 100])

@@ -1267,6 +1267,24 @@ def scene_max_disparity(
     return round_up16(width // _WIDTH_FRACTION)
 
 
+def _absolute_as_read(path: Path) -> Path:
+    """``path`` made absolute with each '..' folded as the OS follows it, links' names kept.
+
+    :func:`os.path.abspath` folds '..' as text: ``home/link/../x`` gave ``home/x``, where the OS
+    reads ``x`` beside the link's target. A '..' after a link goes up from its target here; any
+    other '..' drops the name before it, as abspath does.
+    """
+    shown = Path(path.anchor) if path.is_absolute() else Path(os.getcwd())
+    for part in path.parts[1:] if path.is_absolute() else path.parts:
+        if part != "..":
+            shown = shown / part
+        elif shown.is_symlink():
+            shown = Path(os.path.realpath(shown)).parent
+        else:
+            shown = shown.parent
+    return shown
+
+
 def load_scene(directory: PathLike) -> Scene:
     """Load one scene directory (``left.png``, ``right.png``, optional GT and calibration).
 
@@ -1334,9 +1352,9 @@ def load_scene(directory: PathLike) -> Scene:
     elif (d / "Q.dat").exists():
         calib = Calibration.from_q(d / "Q.dat", (left.shape[1], left.shape[0]))
     # named from the absolute path, '..' folded: '.', 'tsukuba' or '../tsukuba' gave '/',
-    # '/tsukuba' or '../tsukuba' (os.path.abspath keeps a link's own name, as resolve() would not)
+    # '/tsukuba' or '../tsukuba' (links keep their own names, as resolve() would not)
     # ('/tsukuba', a folder under the filesystem's root, has no family: named alone)
-    named = Path(os.path.abspath(d))
+    named = _absolute_as_read(d)
     return Scene(
         name=f"{named.parent.name}/{named.name}" if named.parent.name else named.name,
         left=left,
