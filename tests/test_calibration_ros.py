@@ -544,3 +544,15 @@ def test_a_ros_tarball_is_read_by_any_of_its_names(tmp_path: Path, name: str) ->
         t.add(left, arcname="left.yaml")
         t.add(right, arcname="right.yaml")
     assert Calibration.from_file(tmp_path / name) == Calibration.from_file(tmp_path / "ros")
+
+
+def test_an_integral_float_size_is_taken_and_a_fractional_one_refused(tmp_path: Path) -> None:
+    """``image_width: 320.0`` (a camera_info written by a tool that dumps floats) was refused as
+    'must be a positive integer, got 320.0', though the native YAML loader takes it: a whole
+    number of pixels is taken as an int; 320.5, inf and NaN are refused naming the field."""
+    info = parse_ros_camera_info(_cam_text(image_width=320.0, image_height=240.0), "cam")
+    assert info["image_size"] == (320, 240)
+    assert all(type(v) is int for v in info["image_size"])
+    for bad in (320.5, float("inf"), float("nan"), -320.0):
+        with pytest.raises(ValueError, match=r"^cam: image_width must be a positive integer"):
+            parse_ros_camera_info(_cam_text(image_width=bad), "cam")

@@ -2414,9 +2414,11 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
     size = []
     for key in ("image_width", "image_height"):
         v = doc[key]
-        if isinstance(v, bool) or not isinstance(v, int) or v <= 0:
+        # 640.0 (a tool dumping floats) is a whole number of pixels, as the native loader takes
+        whole = isinstance(v, int) or (isinstance(v, float) and math.isfinite(v) and v == int(v))
+        if isinstance(v, bool) or not whole or v <= 0:
             raise ValueError(f"{source}: {key} must be a positive integer, got {v!r}")
-        size.append(v)
+        size.append(int(v))
     model = doc.get("distortion_model", doc.get("camera_model", "plumb_bob"))
     if model not in ROS_DISTORTION_MODELS:
         raise ValueError(
