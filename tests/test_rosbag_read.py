@@ -207,12 +207,14 @@ def write_bag(
     infos: tuple[dict, dict] | None = None,
     binning: int | tuple[int, int] | list[tuple[int, int]] = 0,
     roi: tuple[int, int, int, int] = (0, 0, 0, 0),
+    empty: tuple[str, ...] = (),
 ) -> Path:
     """A bag of ``(stamp_left, left, stamp_right, right)`` frames (a None stamp: not recorded),
     each message recorded 2 ms after its stamp, in recording order; ``infos``: the two cameras'
     parsed camera_info, published beside the image topics once per left frame, with
     ``binning`` (both axes, or ``(x, y)``; a list: ``[left's, right's]``) and ``roi``
-    ``(x_offset, y_offset, width, height)``."""
+    ``(x_offset, y_offset, width, height)``; ``empty``: image topics recorded without a
+    message (a publisher that never published)."""
     ros1 = flavour == "ros1"
     ts = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
     t = ts.types
@@ -255,6 +257,8 @@ def write_bag(
         writer = Writer(path, version=9, storage_plugin=plugin)
     conns: dict[str, Any] = {}
     with writer:
+        for topic in empty:
+            conns[topic] = writer.add_connection(topic, "sensor_msgs/msg/Image", typestore=ts)
         for recorded, topic, msgtype, msg in msgs:
             if topic not in conns:
                 conns[topic] = writer.add_connection(topic, msgtype, typestore=ts)
@@ -768,6 +772,30 @@ def test_topics_of_another_shape_are_refused_not_stretched(
     with BagCamera(bag) as cam, pytest.warns(UserWarning, match=r"is 225x188, not 450x375"):
         frame = cam.read()
     assert frame.right.shape == cones.left.shape
+
+
+def test_a_pair_recorded_without_messages_is_passed_over(cones: Any, tmp_path: Path) -> None:
+    """A ROS 2 bag whose raw topics were recorded but never published, its rectified ones with
+    frames: the raw pair (preferred by name) was taken, a camera of no frames. A pair with
+    messages on both topics comes first now; a bag with none says so, listing the counts."""
+    rect = ("/stereo/left/image_rect", "/stereo/right/image_rect")
+    frames = [(T0 + k * PERIOD_NS, cones.left, T0 + k * PERIOD_NS, cones.right) for k in range(3)]
+    bag = write_bag(tmp_path / "rig", frames, topics=rect, empty=(LEFT, RIGHT))
+    with BagCamera(bag) as cam:
+        assert cam.topics == {"left": rect[0], "right": rect[1]}
+        assert len(list(cam.frames())) == 3
+    counts = {LEFT: 4, RIGHT: 0, rect[0]: 2, rect[1]: 2}  # one side without messages
+    assert find_stereo_topics([LEFT, RIGHT, *rect], counts) == rect
+    with pytest.raises(ValueError, match=r"no stereo pair .*holds messages on both topics: "):
+        find_stereo_topics([LEFT, RIGHT], {LEFT: 5, RIGHT: 0})
+    empty = write_bag(tmp_path / "empty", [], empty=(LEFT, RIGHT))
+    want = (
+        "no stereo pair of the bag holds messages on both topics: "
+        f"{LEFT} + {RIGHT} (0 and 0 messages)"
+    )
+    with pytest.raises(ValueError) as info:
+        BagCamera(empty)
+    assert str(info.value) == want
 
 
 def test_capture_of_a_bag_without_a_pair_is_an_error(

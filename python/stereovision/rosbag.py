@@ -803,17 +803,27 @@ def _base_topic(topic: str) -> str:
     return re.sub(r"/(compressed|theora|ffmpeg|zstd)$", "", topic)
 
 
-def find_stereo_topics(image_topics: list[str]) -> tuple[str, str]:
+def find_stereo_topics(
+    image_topics: list[str], counts: dict[str, int] | None = None
+) -> tuple[str, str]:
     """Pick the left and right image topics among a bag's image topics.
 
     Two topics form a pair when their names differ in one ``/``-separated part, ``left`` against
-    ``right`` or a lower against a higher number (``cam0``/``cam1``). Among several pairs, raw
-    (``image_raw``) and uncompressed ones are preferred.
+    ``right`` or a lower against a higher number (``cam0``/``cam1``). Among several pairs, those
+    whose two topics hold messages are preferred, then raw (``image_raw``) and uncompressed ones.
+
+    Parameters
+    ----------
+    image_topics : list of str
+        The bag's image topics.
+    counts : dict of str to int, optional
+        Each topic's message count. Default: every topic taken to hold messages.
 
     Raises
     ------
     ValueError
-        When no pair, or more than one equally good pair, is found (the topics are listed).
+        When no pair, more than one equally good pair, or only pairs without messages on both
+        topics are found (the topics are listed).
     """
     pairs = []
     for a in image_topics:
@@ -832,10 +842,19 @@ def find_stereo_topics(image_topics: list[str]) -> tuple[str, str]:
             "(--left-topic, --right-topic)"
         )
 
-    def rank(pair: tuple[str, str]) -> tuple[bool, bool]:
-        return ("raw" in pair[0], _base_topic(pair[0]) == pair[0])
+    def held(topic: str) -> int:
+        return 1 if counts is None else counts.get(topic, 0)
+
+    # a topic recorded but never published (0 messages) gave a camera of no frames: a raw pair
+    # without messages was taken over a rectified one with them
+    def rank(pair: tuple[str, str]) -> tuple[bool, bool, bool]:
+        full = held(pair[0]) > 0 and held(pair[1]) > 0
+        return (full, "raw" in pair[0], _base_topic(pair[0]) == pair[0])
 
     best = max(rank(p) for p in pairs)
+    if not best[0]:
+        names = "; ".join(f"{a} + {b} ({held(a)} and {held(b)} messages)" for a, b in pairs)
+        raise ValueError(f"no stereo pair of the bag holds messages on both topics: {names}")
     top = [p for p in pairs if rank(p) == best]
     if len(top) > 1:
         names = "; ".join(f"{a} + {b}" for a, b in top)
@@ -946,7 +965,7 @@ class BagCamera(PairSource):
         topics = self._reader.topics
         images = sorted(t for t, i in topics.items() if i.msgtype in (IMAGE_TYPE, COMPRESSED_TYPE))
         if left is None or right is None:
-            left, right = find_stereo_topics(images)
+            left, right = find_stereo_topics(images, {t: topics[t].msgcount for t in images})
         for side, topic in (("left", left), ("right", right)):
             if topic not in images:
                 raise ValueError(
