@@ -349,6 +349,13 @@ try:
         _core.sgm_disparity(a, a, 0, 2047, 8, 96, 16.0, 5, 1, 4)
     elif case == "broadcast":
         _core.gabor_responses(np.broadcast_to(np.float32(0.5), (100_000, 100_000)))
+    elif case == "lr_check":
+        d = np.broadcast_to(np.float32(1.0), (100_000, 100_000))
+        _core.gabor_lr_check(d, d, 1.0)
+    elif case == "mcgm_filter":
+        a = np.random.default_rng(0).random((40, 64), dtype=np.float32)
+        m = np.broadcast_to(np.array([30, 20, 26, 20], np.float32), (2**27, 4))
+        _core.mcgm_filter(a, a, m, {{"max_disparity": 16}})
     elif case == "available":
         print("available", sgm._available_bytes())
         raise MemoryError("none")
@@ -381,9 +388,14 @@ def _under_address_limit(case: str, limit: int) -> subprocess.CompletedProcess[s
             "out of memory: the census matcher's cost volume needs 5.72 GiB (6144000000 bytes)",
         ),
         ("broadcast", "out of memory: a copy of img needs 37.25 GiB (40000000000 bytes)"),
+        ("lr_check", "out of memory: a copy of disp_left needs 37.25 GiB (40000000000 bytes)"),
+        ("mcgm_filter", "out of memory: a copy of matches needs 3.00 GiB (3221225472 bytes)"),
     ],
 )
 def test_a_failed_allocation_is_a_memory_error(case: str, message: str) -> None:
+    """``gabor_lr_check`` copied its maps and ``mcgm_filter`` its matches with an unchecked
+    ``collect``: a huge (broadcast) array aborted the whole process where the other kernels'
+    copies raise MemoryError."""
     out = _under_address_limit(case, 3_000_000 * 1024)
     assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
     assert f"MemoryError: {message} and the allocation failed" in out.stdout, out.stdout

@@ -275,8 +275,10 @@ pub fn gabor_lr_check<'py>(
         )));
     }
     let (h, w) = a.dim();
-    let dl: Vec<f32> = a.iter().copied().collect();
-    let dr: Vec<f32> = b.iter().copied().collect();
+    // The arrays' own buffers when C-contiguous, else checked copies: an unchecked collect of a
+    // huge (broadcast) map aborted the process where the other kernels raise MemoryError.
+    let dl = crate::convert::row_major(&disp_left, "disp_left")?;
+    let dr = crate::convert::row_major(&disp_right, "disp_right")?;
     let ok = crate::workers::detach(py, || {
         guard("gabor_lr_check", || lr_check(&dl, &dr, w, h, tol))
     })?;

@@ -371,18 +371,18 @@ pub fn mcgm_filter<'py>(
         )));
     }
     check_match_rows(&view, l.width, l.height)?;
-    let ms: Vec<Match> = view
-        .rows()
-        .into_iter()
-        .map(|row| Match {
-            xl: row[0],
-            yl: row[1],
-            xr: row[2],
-            yr: row[3],
-            score: 0.0,
-            channel: 0,
-        })
-        .collect();
+    // Reserved first: an unchecked collect of a huge (broadcast) `matches` aborted the process.
+    let mut ms: Vec<Match> = Vec::new();
+    ms.try_reserve_exact(view.nrows())
+        .map_err(|_| crate::errors::copy_oom::<Match>(view.nrows(), "matches"))?;
+    ms.extend(view.rows().into_iter().map(|row| Match {
+        xl: row[0],
+        yl: row[1],
+        xr: row[2],
+        yr: row[3],
+        score: 0.0,
+        channel: 0,
+    }));
     let (keep, _) = crate::workers::detach(py, || {
         guard("mcgm_filter", || {
             edge_filters(
