@@ -179,6 +179,17 @@ NAMED: list[tuple[Call, str]] = [
     (lambda c, kw: gabor.gabor_disparity(c["gl"], c["gr"], max_disparity=32, freq=10**400), "freq"),
     (lambda c, kw: planes.side_fill(c["disp"], c["bgr"], tau=-(10**400)), "tau"),
     (lambda c, kw: mcgm.mcgm_match(c["gl"], c["gr"], max_disparity=32, sigmas=[10**400]), "sigmas"),
+    # these four were the binding's bare "OverflowError: int too large to convert to float"
+    (lambda c, kw: gabor.gabor_responses(c["gl"], freq=10**400), "freq"),
+    (lambda c, kw: gabor.gabor_responses(c["gl"], theta_deg=-(10**400)), "theta_deg"),
+    (lambda c, kw: gabor.gabor_responses(c["gl"], bandwidth_oct=10**400), "bandwidth_oct"),
+    (lambda c, kw: mcgm.log_filter(c["gl"], 10**400), "sigma"),
+    (
+        lambda c, kw: gabor.gabor_disparity(
+            c["gl"], c["gr"], max_disparity=32, orientations_deg=[0.0, 10**400]
+        ),
+        "orientations_deg",
+    ),
 ]
 
 

@@ -189,7 +189,7 @@ def gabor_disparity(
     orient = kw["orientations_deg"]
     if not isinstance(orient, Sequence) and not isinstance(orient, np.ndarray):
         raise ValueError(f"orientations_deg must be a sequence of degrees, got {orient!r}")
-    kw["orientations_deg"] = [float(t) for t in orient]
+    kw["orientations_deg"] = [float(float_sized(t, "orientations_deg")) for t in orient]
     disp, conf = _core.gabor_disparity(lft, rgt, float(min_disparity), float(max_disparity), **kw)
     return GaborResult(disparity=disp, confidence=conf)
 
@@ -223,5 +223,12 @@ def gabor_responses(
     numpy.ndarray
         ``(H, W)`` complex64 response ``y = h * image`` (true convolution, reflect-101 borders).
     """
+    for name, v in (
+        ("freq", freq),
+        ("theta_deg", theta_deg),
+        ("bandwidth_oct", bandwidth_oct),
+        ("aspect", aspect),
+    ):
+        float_sized(v, name)  # 10**400: the binding's bare OverflowError
     re, im = _core.gabor_responses(_as_grey(image, "image"), freq, theta_deg, bandwidth_oct, aspect)
     return (re + 1j * im).astype(np.complex64)

@@ -259,7 +259,8 @@ def log_filter(image: npt.ArrayLike, sigma: float) -> npt.NDArray[np.float32]:
     ValueError
         Bad image or sigma.
     """
-    return _core.mcgm_log(as_gray_float(image, "image"), float(sigma))
+    # 10**400 was float()'s bare OverflowError
+    return _core.mcgm_log(as_gray_float(image, "image"), float(float_sized(sigma, "sigma")))
 
 
 def curves(image: npt.ArrayLike, **params: Any) -> list[ChannelCurves]:
