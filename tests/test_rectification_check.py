@@ -675,3 +675,83 @@ def test_align_rows_leaves_a_pair_without_a_row_model_as_it_is() -> None:
     right = np.arange(60 * 80, dtype=np.uint16).reshape(60, 80)
     out, res = align_rows(right, right, check=lost)
     assert res is lost and out.dtype == np.uint16 and np.array_equal(out, right)
+
+
+def test_cli_check_fix_refuses_a_bad_destination_before_the_work(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check --fix`` to a file name no calibration is saved as, or into a missing folder, is
+    one line and status 2, before the pair is checked: nothing printed on stdout, nothing
+    written."""
+    from stereovision.cli import main
+
+    cones = data_dir / "middlebury2003" / "cones"
+    bumped = _rig(450, 375, (0.3, 0.0, 0.0)).save(tmp_path / "rig.yaml")
+    pair = [str(cones / "left.png"), str(cones / "right.png")]
+    for dest, says in (
+        (tmp_path / "fixed.txt", f"--fix {tmp_path / 'fixed.txt'}: use a .yaml, .yml, .xml or"),
+        (
+            tmp_path / "gone" / "fixed.yaml",
+            f"--fix {tmp_path / 'gone' / 'fixed.yaml'}: directory {tmp_path / 'gone'} does not",
+        ),
+    ):
+        assert main(["check", *pair, "--calib", str(bumped), "--fix", str(dest)]) == 2
+        out, err = capsys.readouterr()
+        assert out == "" and err.startswith(f"stereovision: error: {says}") and err.count("\n") == 1
+        assert not dest.exists()
+
+
+def test_cli_check_default_tolerance_is_half_a_pixel() -> None:
+    """``check``'s --tolerance is 0.5 px unless given (as check_rectification's)."""
+    from stereovision.cli import build_parser
+
+    assert build_parser().parse_args(["check", "l.png", "r.png"]).tolerance == 0.5
+
+
+def test_cli_check_fix_json_keeps_stdout_one_object(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check --json --fix OUT`` onto an existing file: stdout holds the check and the
+    correction as JSON only; the line naming the earlier file's copy goes to stderr."""
+    from stereovision.cli import main
+
+    cones = data_dir / "middlebury2003" / "cones"
+    bumped = _rig(450, 375, (0.3, 0.0, 0.0)).save(tmp_path / "rig.yaml")
+    earlier = _rig(450, 375, (0.1, 0.0, 0.0)).save(tmp_path / "rig2.yaml")
+    pair = [str(cones / "left.png"), str(cones / "right.png")]
+    assert main(["check", *pair, "--calib", str(bumped), "--fix", str(earlier), "--json"]) == 0
+    out, err = capsys.readouterr()
+    first, second = out.splitlines()
+    assert json.loads(first)["ok"] is False
+    fixed = json.loads(second)
+    assert fixed["fixed"]["ok"] is True and fixed["turn_deg"] == pytest.approx(0.3, abs=0.05)
+    kept = tmp_path / "rig2.previous.yaml"
+    assert err == f"stereovision: {earlier} replaced; the earlier file is {kept}\n"
+
+
+def test_cli_check_fix_that_still_fails_writes_nothing_and_exits_1(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A correction whose own check still fails is not written, and the status is 1 (a
+    verdict on the rig), as a pair that cannot correct it."""
+    from stereovision import rectification_check
+    from stereovision.cli import main
+
+    cones = data_dir / "middlebury2003" / "cones"
+    bumped = _rig(450, 375, (0.3, 0.0, 0.0))
+    rig = bumped.save(tmp_path / "rig.yaml")
+
+    def still_failing(left, right, calib, tolerance, check):  # type: ignore[no-untyped-def]
+        return bumped, check  # the correction judged as the failing check
+
+    monkeypatch.setattr(rectification_check, "refine_rectification", still_failing)
+    pair = [str(cones / "left.png"), str(cones / "right.png")]
+    fixed = tmp_path / "fixed.yaml"
+    assert main(["check", *pair, "--calib", str(rig), "--fix", str(fixed)]) == 1
+    out, err = capsys.readouterr()
+    assert out.splitlines()[1].startswith("corrected (the right camera turned 0.000 degrees)")
+    assert err == "stereovision: the corrected calibration still fails: not written\n"
+    assert not fixed.exists()
