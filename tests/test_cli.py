@@ -1821,3 +1821,141 @@ def test_commit_outputs_interrupted_right_after_the_first_move_keeps_it_listed(
     assert "disparity.png" in listed and "depth.npy" in listed
     # the rerun replaces it, not refuses it as a file of the user's
     assert cli.refuse_foreign_outputs(out, list(cli.DEPTH_OUTPUTS)) == set(listed)
+
+
+def test_depth_says_its_depths_in_metres_unless_unit_is_given(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The summary's depths are in metres by default and in --unit's unit when given (a wall
+    about 8 px apart, 150 px focal, 0.1 m baseline: near 1.9 m); depth.npy stays in metres."""
+    from tests import synthetic_scene as syn
+
+    rng = np.random.default_rng(0)
+    left = (rng.random((syn.H, syn.W + 8)) * 255).astype(np.uint8)
+    left = cv2.GaussianBlur(left, (3, 3), 0)
+    pair = left[:, 8:], left[:, :-8]  # the right view's wall 8 px to the left
+    for name, img in zip(("l.png", "r.png"), pair, strict=True):
+        assert cv2.imwrite(str(tmp_path / name), img)
+    rig = syn.calibration().save(tmp_path / "rig.yaml")
+    argv = ["depth", str(tmp_path / "l.png"), str(tmp_path / "r.png"), "--calib", str(rig)]
+    argv += ["--max-disparity", "16"]
+    medians = {}
+    for unit in ("m", "ft"):
+        extra = [] if unit == "m" else ["--unit", "ft"]
+        assert main([*argv, *extra, "-o", str(tmp_path / unit)]) == 0
+        line = capsys.readouterr().out.splitlines()[0]
+        found = re.search(rf"depth [\d.]+-[\d.]+ {unit} \(median ([\d.]+) {unit}\)", line)
+        assert found, line
+        medians[unit] = float(found.group(1))
+        metres = float(np.nanmedian(np.load(tmp_path / unit / "depth.npy")))
+        assert 1.8 < metres < 2.0  # the wall, in metres whatever --unit says
+    assert medians["m"] == pytest.approx(metres, abs=0.005)
+    assert medians["ft"] == pytest.approx(metres / 0.3048, abs=0.005)
+
+
+def test_depth_of_a_pair_16_px_wide_says_so_before_a_file_in_the_output_folder(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A pair too narrow for the automatic range is refused as such, before (not behind) a
+    file of the user's under an output name in -o, which stays."""
+    rng = np.random.default_rng(0)
+    img = (rng.random((8, 16, 3)) * 255).astype(np.uint8)
+    assert cv2.imwrite(str(tmp_path / "l.png"), img)
+    assert cv2.imwrite(str(tmp_path / "r.png"), img[:, ::-1])
+    (tmp_path / "o").mkdir()
+    (tmp_path / "o" / "disparity.png").write_bytes(b"mine")
+    argv = ["depth", str(tmp_path / "l.png"), str(tmp_path / "r.png"), "-o", str(tmp_path / "o")]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("stereovision: error: image too narrow for stereo matching: 16 px wide")
+    assert (tmp_path / "o" / "disparity.png").read_bytes() == b"mine"
+
+
+def test_positive_rate_refuses_an_infinite_rate() -> None:
+    """``--fps inf`` is no frame rate (a zero frame period): refused in the option's words."""
+    import argparse
+
+    from stereovision.cli import positive_rate
+
+    assert positive_rate("2.5") == 2.5
+    for bad in ("inf", "-inf", "nan", "0", "x"):
+        with pytest.raises(argparse.ArgumentTypeError, match="expected a frame rate above 0"):
+            positive_rate(bad)
+
+
+def test_commit_outputs_keeps_a_link_the_user_put_under_an_earlier_output_name(
+    tmp_path: Path,
+) -> None:
+    """An earlier run's depth.npy that the user replaced by a link (to a file of theirs) is
+    not the tool's file any more: a run that does not write depth.npy leaves the link."""
+    from stereovision.cli import DEPTH_MANIFEST, commit_outputs
+
+    out = tmp_path / "o"
+    out.mkdir()
+    (tmp_path / "mine.npy").write_bytes(b"mine")
+    (out / "depth.npy").symlink_to(tmp_path / "mine.npy")
+    (out / "cloud.ply").write_bytes(b"earlier run's")
+    stage = tmp_path / "stage"
+    stage.mkdir()
+    (stage / "disparity.png").write_bytes(b"new")
+    written, removed = commit_outputs(
+        out, {"disparity.png": stage / "disparity.png"}, {"depth.npy", "cloud.ply"}
+    )
+    assert written == {"disparity.png": out / "disparity.png"}
+    assert removed == [out / "cloud.ply"]
+    assert (out / "depth.npy").is_symlink() and (out / "depth.npy").read_bytes() == b"mine"
+    assert json.loads((out / DEPTH_MANIFEST).read_text()) == ["disparity.png"]
+
+
+@pytest.mark.parametrize(
+    ("argv", "says"),
+    [
+        (["rectify", "L", "R", "-o", "FILE"], "-o FILE: is a file; give a folder"),
+        (
+            ["rectify", "L", "R", "--calib", "RIG", "--model", "projective", "-o", "OUT"],
+            "--model is for rectifying without a calibration (no --calib)",
+        ),
+        (
+            ["info", "--calib-unit", "mm"],
+            "--calib-unit is the unit of a calibration file: give one, or none",
+        ),
+        (
+            ["info", "RIG", "--hfov", "60", "--baseline", "0.1"],
+            "--hfov and --baseline describe a rig on paper: give no calibration",
+        ),
+        (
+            ["info", "BAG", "--size", "640x480"],
+            "--size and --calib-unit are for a calibration file, not a bag",
+        ),
+    ],
+)
+def test_rectify_and_info_refuse_options_that_do_not_fit_in_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], argv: list[str], says: str
+) -> None:
+    """Options the run would drop or trip over are one line and status 2 before any work:
+    nothing on stdout, nothing written (the file given as -o stays as it was)."""
+    from tests import synthetic_scene as syn
+
+    rng = np.random.default_rng(0)
+    img = (rng.random((syn.H, syn.W)) * 255).astype(np.uint8)
+    names = {"L": tmp_path / "l.png", "R": tmp_path / "r.png", "FILE": tmp_path / "notes"}
+    names |= {"RIG": tmp_path / "rig.yaml", "OUT": tmp_path / "out"}
+    assert cv2.imwrite(str(names["L"]), img) and cv2.imwrite(str(names["R"]), img[:, ::-1])
+    names["FILE"].write_text("mine")
+    names["BAG"] = tmp_path / "rec.bag"  # not opened: the option is refused first
+    names["BAG"].write_bytes(b"not read")
+    syn.calibration().save(names["RIG"])
+    capsys.readouterr()
+    assert main([str(names.get(a, a)) for a in argv]) == 2
+    out, err = capsys.readouterr()
+    for key, path in names.items():
+        says = says.replace(f" {key}:", f" {path}:")
+    assert out == "" and err == f"stereovision: error: {says}\n"
+    assert names["FILE"].read_text() == "mine" and not names["OUT"].exists()
+
+
+def test_demo_writes_into_demo_output_unless_told() -> None:
+    """`stereovision demo` writes into ./demo_output (README's Quick start, `make demo`)."""
+    from stereovision.cli import build_parser
+
+    assert build_parser().parse_args(["demo"]).output == "demo_output"
