@@ -1959,3 +1959,23 @@ def test_demo_writes_into_demo_output_unless_told() -> None:
     from stereovision.cli import build_parser
 
     assert build_parser().parse_args(["demo"]).output == "demo_output"
+
+
+def test_a_warning_with_an_empty_message_is_one_line_not_an_error(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A warning with no message (a library's ``warnings.warn(SomeWarning())``) made the
+    one-line printer index an empty list: the IndexError stopped the command as an internal
+    error (status 2). It is said by its category's name, and the command goes on."""
+    import warnings
+
+    from stereovision import cli
+
+    def warns(args: object) -> int:
+        warnings.warn(UserWarning(), stacklevel=1)
+        print("done")
+        return 0
+
+    monkeypatch.setattr(cli, "cmd_info", warns)
+    assert cli.main(["info"]) == 0
+    assert capsys.readouterr() == ("done\n", "stereovision: warning: UserWarning\n")

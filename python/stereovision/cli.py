@@ -1860,8 +1860,10 @@ def _one_line_warning(
     file: Any = None,
     line: str | None = None,
 ) -> None:
-    """Warnings as one line, like the errors (not Python's file:line and source echo)."""
-    print(f"stereovision: warning: {str(message).splitlines()[0]}", file=sys.stderr)
+    """Warnings as one line, like the errors (not Python's file:line and source echo); one
+    with no message (``warnings.warn(SomeWarning())``) is named by its category."""
+    text = str(message).splitlines()
+    print(f"stereovision: warning: {text[0] if text else category.__name__}", file=sys.stderr)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
