@@ -698,15 +698,18 @@ def test_demo_interrupted_midway_leaves_the_earlier_outputs_whole(
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
 
 
-def test_demo_refuses_a_broken_link_under_an_output_name(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+@pytest.mark.parametrize("target", ["on_a_drive_not_mounted.ply", "mine.ply"])
+def test_demo_refuses_a_link_under_an_output_name(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], target: str
 ) -> None:
     """A link under an output name is refused by demo as by depth, but a link whose target is
     gone (exists() False) was neither copied aside nor refused: the run replaced it silently.
-    It is refused up front now, in depth's line."""
+    It is refused up front now, in depth's line; a link to a file of the user's too (not
+    replaced by the run's file, its target copied aside)."""
     out = tmp_path / "d"
     out.mkdir()
-    (out / "cloud.ply").symlink_to(tmp_path / "on_a_drive_not_mounted.ply")
+    (tmp_path / "mine.ply").write_bytes(b"mine")
+    (out / "cloud.ply").symlink_to(tmp_path / target)
     assert main(["demo", "-o", str(out)]) == 2
     captured = capsys.readouterr()
     assert captured.out == ""  # before any work
