@@ -1843,7 +1843,8 @@ def test_a_calibration_is_sized_by_the_size_asked_before_the_size_delivered() ->
 def test_a_temporal_stream_averages_up_to_255_pairs(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """``--temporal 255``, the largest count the filter takes, is accepted."""
+    """``--temporal 255``, the largest count the filter takes, is accepted; 1 (a mean of one
+    pair: nothing averaged) and 256 are refused in one line."""
     import stereovision.stream as stream
 
     monkeypatch.setattr(stream, "open_source", lambda args, fps=None: _SkippingRig([_frame(0)]))
@@ -1851,14 +1852,22 @@ def test_a_temporal_stream_averages_up_to_255_pairs(
     assert main([*argv, "--max-disparity", "8", "--temporal", "255", "--json"]) == 0
     summary = _json_lines(capsys.readouterr().out)[-1]
     assert summary["frames"] == 1 and summary["temporal"]["frames_averaged"] == 1.0
+    for n in (1, 256):
+        assert main([*argv, "--max-disparity", "8", "--temporal", str(n)]) == 2
+        assert capsys.readouterr().err.strip().splitlines() == [
+            f"stereovision: error: --temporal: expected 2-255 pairs to average, got {n}"
+        ]
 
 
 def test_run_stream_refuses_a_bool_ground_every_and_two_ways_to_rectify() -> None:
-    """``ground_every=True`` and homographies with a calibration are usage errors, said as
-    such before any grab."""
+    """``ground_every=True`` or 0, ``ground_every`` without a calibration (a floor in metres)
+    and homographies with a calibration are usage errors, said as such before any grab."""
     rig = _FakeRig([_frame(0)])
-    with pytest.raises(ValueError, match="ground_every: expected a positive number of pairs"):
-        run_stream(rig, max_disparity=8, ground_every=True)  # type: ignore[arg-type]
+    for every in (True, 0):
+        with pytest.raises(ValueError, match="ground_every: expected a positive number of pairs"):
+            run_stream(rig, object(), max_disparity=8, ground_every=every)  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match="ground_every: the floor is found in metres; give a"):
+        run_stream(rig, max_disparity=8, ground_every=2)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="homographies and calib: give one way"):
         run_stream(rig, object(), max_disparity=8, homographies=_Homographies())  # type: ignore[arg-type]
     assert rig.count == 0
@@ -1930,3 +1939,24 @@ def test_the_wait_is_for_the_pair_not_its_matching(monkeypatch: pytest.MonkeyPat
     monkeypatch.setattr(depth, "depth_map", slow)
     rep = run_stream(_FakeRig([_frame(0)]), max_disparity=8, pipelined=False, check=False)  # type: ignore[arg-type]
     assert rep.latency_ms >= 200 and rep.wait_ms < 100
+
+
+def test_a_calibration_that_cannot_be_sized_closes_the_cameras(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A calibration sized by the frames (stereo_calib output) that fails to load after the
+    cameras opened (no unit given) is said in one line, and the cameras are let go of."""
+    from test_calibration import _opencv_stereo_calib
+
+    import stereovision.stream as stream
+
+    _opencv_stereo_calib(tmp_path)
+    closed: list[bool] = []
+    rig = _SkippingRig([_frame(0)])
+    rig.close = lambda: closed.append(True)  # type: ignore[method-assign]
+    monkeypatch.setattr(stream, "open_source", lambda args, fps=None: rig)
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--calib", str(tmp_path)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("stereovision: error: ")
+    assert closed == [True]
