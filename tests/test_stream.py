@@ -1941,6 +1941,97 @@ def test_the_wait_is_for_the_pair_not_its_matching(monkeypatch: pytest.MonkeyPat
     assert rep.latency_ms >= 200 and rep.wait_ms < 100
 
 
+def _fake_clock(monkeypatch: pytest.MonkeyPatch, match_s: float) -> list[float]:
+    """The stream's ``perf_counter`` made a clock that moves only when told (returned: its
+    time, a one-item list); each depth_map advances it by ``match_s``."""
+    from types import SimpleNamespace
+
+    import stereovision.depth as depth
+    import stereovision.stream as stream
+
+    now = [0.0]
+    monkeypatch.setattr(stream, "time", SimpleNamespace(
+        perf_counter=lambda: now[0], monotonic=time.monotonic, time_ns=time.time_ns))  # fmt: skip
+    real = depth.depth_map
+
+    def timed(*args: Any, **kw: Any) -> Any:
+        now[0] += match_s
+        return real(*args, **kw)
+
+    monkeypatch.setattr(depth, "depth_map", timed)
+    return now
+
+
+def test_each_report_covers_its_own_window(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A per-second report counts the pairs done since the previous one, over the time since
+    it: pairs of 0.25 s reported every 0.5 s are 2 pairs at 4 fps each time."""
+    _fake_clock(monkeypatch, 0.25)
+    rep = run_stream(_FakeRig([_frame(i) for i in range(6)]), max_disparity=8,  # type: ignore[arg-type]
+                     pipelined=False, check=False, report_period=0.5)  # fmt: skip
+    assert [(r["t"], r["frames"], r["total_frames"], r["fps"]) for r in rep.reports] == [
+        (0.5, 2, 2, 4.0), (1.0, 2, 4, 4.0), (1.5, 2, 6, 4.0)]  # fmt: skip
+    assert (rep.frames, rep.seconds, rep.fps) == (6, 1.5, 4.0)
+
+
+class _SlowRig(_FakeRig):
+    """A rig whose every grab takes ``grab_s`` on the clock ``now`` (:func:`_fake_clock`)."""
+
+    def __init__(self, pairs: list[Any], now: list[float], grab_s: float) -> None:
+        super().__init__(pairs)
+        self._now, self._grab_s = now, grab_s
+
+    def read(self) -> Any:
+        self._now[0] += self._grab_s
+        return super().read()
+
+
+def test_each_pairs_latency_runs_from_its_own_grab(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A pair's latency is its own grab (0.1 s) and matching (0.25 s): not counted from the
+    matching alone, nor, for pair 1 of a calibrated stream (whose pair 0 was read ahead to
+    fit the calibration), from the grab of pair 0."""
+    calib = Calibration.from_file(data_dir / SCENE / "calib.txt").scaled_to((64, 48))
+    now = _fake_clock(monkeypatch, 0.25)
+    rig = _SlowRig([_frame(i) for i in range(3)], now, 0.1)
+    rep = run_stream(rig, calib, max_disparity=8, pipelined=False, check=False,  # type: ignore[arg-type]
+                     report_period=0.0)  # fmt: skip
+    assert [r["latency_ms"] for r in rep.reports] == pytest.approx([350.0] * 3)
+    assert [r["stage_ms"]["grab"] for r in rep.reports] == pytest.approx([100.0] * 3)
+    # pair 0 was grabbed before the loop waited; the others while it waited
+    assert [r["wait_ms"] for r in rep.reports] == pytest.approx([0.0, 100.0, 100.0])
+    assert rep.latency_ms == pytest.approx(350.0) and rep.seconds == pytest.approx(1.05)
+
+
+@pytest.mark.parametrize("stop", [OSError("disk full"), KeyboardInterrupt()])
+def test_the_grab_thread_runs_one_pair_ahead_and_is_joined_at_the_end(
+    stop: BaseException,
+) -> None:
+    """Pipelined, the grab thread takes one pair ahead of the one being matched, not more (a
+    live camera's pairs would age in a queue); a run that ends early (an output failing,
+    Ctrl-C) stops and joins it, leaving no thread reading the camera it closes next."""
+    import threading
+
+    rig = _FakeRig([_frame(i) for i in range(8)])
+    read: list[int] = []
+
+    def on_result(left: np.ndarray, res: Any) -> None:
+        time.sleep(0.3)  # a slow output: room for the grab thread to run ahead if it could
+        read.append(rig.count)
+        if len(read) == 3:
+            raise stop
+
+    t0 = time.monotonic()
+    rep = run_stream(rig, max_disparity=8, check=False, on_result=on_result)  # type: ignore[arg-type]
+    assert read == [2, 3, 4]
+    assert (rep.frames, rep.ended) == (
+        2,
+        "output failed" if isinstance(stop, OSError) else "interrupted",
+    )
+    assert not [t for t in threading.enumerate() if t.name == "stereovision-grab"]
+    assert time.monotonic() - t0 < 3.0  # stopped, not waited for until the join's timeout
+
+
 def test_a_calibration_that_cannot_be_sized_closes_the_cameras(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
