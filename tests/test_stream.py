@@ -2051,3 +2051,31 @@ def test_a_calibration_that_cannot_be_sized_closes_the_cameras(
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("stereovision: error: ")
     assert closed == [True]
+
+
+def test_a_sizeless_source_interrupted_before_its_first_pair_is_not_asked_for_a_size(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Cameras that state no size, stopped (Ctrl-C) while their first pair was read to size a
+    calibration that holds none: the summary of no pair (exit 130), not the error asking for
+    ``--size`` that sizing the calibration without that pair would give."""
+    from test_calibration import _opencv_stereo_calib
+
+    import stereovision.stream as stream
+
+    class _Sizeless(_ModeCap):
+        def get(self, prop: int) -> float:
+            return 0.0
+
+        def grab(self) -> bool:
+            raise KeyboardInterrupt
+
+    _opencv_stereo_calib(tmp_path)
+    monkeypatch.setattr(
+        stream, "open_source", lambda args, fps=None: StereoCamera(_Sizeless([]), _Sizeless([]))
+    )
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--max-disparity", "16"]
+    assert main([*argv, "--calib", str(tmp_path), "--calib-unit", "mm", "--json"]) == 130
+    cap = capsys.readouterr()
+    summary = json.loads(cap.out)
+    assert (summary["frames"], summary["ended"], cap.err) == (0, "interrupted", "")
