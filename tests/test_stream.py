@@ -2079,3 +2079,43 @@ def test_a_sizeless_source_interrupted_before_its_first_pair_is_not_asked_for_a_
     cap = capsys.readouterr()
     summary = json.loads(cap.out)
     assert (summary["frames"], summary["ended"], cap.err) == (0, "interrupted", "")
+
+
+def test_the_view_listens_on_the_loopback_by_default() -> None:
+    """A FrameServer made without a host serves on 127.0.0.1 only (a robot is often on a
+    shared network): not on every interface."""
+    srv = FrameServer(port=0)
+    try:
+        assert srv.url == f"http://127.0.0.1:{srv.port}/"
+        assert srv._httpd.server_address[0] == "127.0.0.1"
+    finally:
+        srv.close()
+
+
+@pytest.mark.parametrize("json_out", [True, False])
+def test_each_report_line_is_flushed_as_it_is_written(
+    json_out: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Every report line reaches a pipe when it is printed (a process reading ``--json`` live
+    got the lines of a block-buffered stdout only at its end): each is flushed at once."""
+    import io
+    import sys
+
+    import stereovision.stream as stream
+
+    class _Piped(io.StringIO):
+        def __init__(self) -> None:
+            super().__init__()
+            self.flushed: list[str] = []
+
+        def flush(self) -> None:
+            self.flushed.append(self.getvalue())
+
+    out = _Piped()
+    monkeypatch.setattr(sys, "stdout", out)
+    monkeypatch.setattr(stream, "open_source", lambda args, fps=None: _SkippingRig([_frame(0)]))
+    argv = ["stream", "--left", "0", "--right", "1", "--no-display", "--no-check"]
+    assert main([*argv, "--max-disparity", "8", *(["--json"] if json_out else [])]) == 0
+    report = out.getvalue().splitlines()[0]
+    assert ("fps" in json.loads(report)) if json_out else ("fps |" in report)
+    assert report + "\n" in out.flushed  # flushed alone, before the summary was written
