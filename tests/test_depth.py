@@ -1085,3 +1085,35 @@ def test_values_past_the_range_are_holes_beyond_half_a_pixel() -> None:
         assert (valid.mean() > 0.9) if dense else (valid.mean() < 0.3), (method, lo, hi)
         assert lo <= np.nanmin(res.disparity) and np.nanmax(res.disparity) <= top
         assert (res.confidence[~valid] == 0).all()  # no confidence without a disparity
+
+
+def test_filtered_keeps_limits_inclusive_and_its_cloud_and_maps_its_own() -> None:
+    """Second audit: a relative-sigma limit met exactly, the cloud's pixels, copies of the
+    confidence and left image, and a sigma limit on a result without depth_sigma were free."""
+    r = _hand_result()
+    # sigma 0.05 at 1 m and 0.1 at 2 m are exactly 5 % of the depth: kept (as max_sigma is)
+    assert _kept(r.filtered(max_relative_sigma=0.05).require_depth()) == [1, 2]
+    # the cloud loses the same pixels as the depth map: points, colours and pixels alike
+    k = _known_depth_result(_rect_calib(2, 2))
+    k.colors[:] = [[1, 2, 3], [4, 5, 6]]
+    near = k.filtered(max_depth=0.5)
+    np.testing.assert_array_equal(near.points, k.points[1:])
+    np.testing.assert_array_equal(near.pixels, [[1, 1]])
+    np.testing.assert_array_equal(near.colors, [[4, 5, 6]])
+    # a copy: writing into its maps leaves the original's alone
+    k.left_rectified = np.zeros((2, 2, 3), np.uint8)
+    f = k.filtered(max_depth=5)
+    assert f.left_rectified is not None
+    f.confidence[0, 0] = -1.0
+    f.left_rectified[0, 0] = 255
+    assert k.confidence[0, 0] == 1.0 and k.left_rectified[0, 0, 0] == 0
+    with pytest.raises(ValueError, match="max_sigma: this result has no depth_sigma"):
+        dataclasses.replace(r, depth_sigma=None).filtered(max_sigma=1.0)
+
+
+def test_point_image_guesses_exclude_dropped_pixels_and_keep_the_range_inclusive() -> None:
+    r = _hand_result()
+    # the dropped pixel (measured 5 px at confidence 0.2, 10 m) is no guess: left out
+    assert _kept(r.point_image(filled=True)[..., 2]) == [1, 2, 2.5, 5]
+    # the guess at 2.5 m is inside a max_depth of 2.5 m
+    assert _kept(r.filtered(max_depth=2.5).point_image(filled=True)[..., 2]) == [1, 2, 2.5]
