@@ -1117,3 +1117,68 @@ def test_point_image_guesses_exclude_dropped_pixels_and_keep_the_range_inclusive
     assert _kept(r.point_image(filled=True)[..., 2]) == [1, 2, 2.5, 5]
     # the guess at 2.5 m is inside a max_depth of 2.5 m
     assert _kept(r.filtered(max_depth=2.5).point_image(filled=True)[..., 2]) == [1, 2, 2.5]
+
+
+def test_a_raw_rig_gives_depth_and_points_in_its_rectified_calibration() -> None:
+    """A raw (unrectified) calibration: the result's calibration, its depth and its cloud are
+    the rectified rig's (K1 here 499.5 px, not the raw 500), not the raw one's."""
+    h, w, d = 96, 160, 6.5
+    left = _texture(h, w)
+    lens = np.array([-0.1, 0, 0, 0, 0.0])
+    raw = dataclasses.replace(_rect_calib(w, h), rectified=False, D1=lens, D2=lens.copy())
+    rect = raw.rectified_calibration()
+    assert rect.K1[0, 0] != raw.K1[0, 0]
+    res = sv.depth_map(left, _shift(left, d), raw, method="gabor", max_disparity=16)
+    assert res.calibration is not None and res.calibration.rectified
+    np.testing.assert_array_equal(res.calibration.K1, rect.K1)
+    ok = np.isfinite(res.require_depth())
+    assert ok.mean() > 0.5
+    z = rect.depth_from_disparity(res.disparity)
+    np.testing.assert_allclose(res.depth[ok], z[ok], rtol=1e-5)
+    x, y = res.pixels[:, 0], res.pixels[:, 1]
+    k = rect.K1
+    z = res.points[:, 2]
+    np.testing.assert_allclose(res.points[:, 0], (x - k[0, 2]) / k[0, 0] * z, rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(res.points[:, 1], (y - k[1, 2]) / k[1, 1] * z, rtol=1e-5, atol=1e-6)
+
+
+def test_an_enclosed_far_region_the_fill_took_over_is_counted_as_filled(data_dir: Path) -> None:
+    """TartanAir's sky, enclosed and measured at 0 px, takes its surround's disparity in the
+    fill: those pixels are guesses (confidence 0, no depth), counted as filled, not dropped."""
+    s = load_scene(data_dir / "tartanair" / "oldtown_easy_p000_001116")
+    kw = {"max_disparity": 64, "cloud": False}
+    res = sv.depth_map(s.left, s.right, s.calib, **kw)
+    raw = sv.depth_map(s.left, s.right, s.calib, fill=False, **kw)
+    taken = raw.valid & (res.disparity != raw.disparity)
+    assert taken.sum() > 1000  # measured: 1985 pixels
+    assert (res.confidence[taken] == 0).all() and np.isnan(res.require_depth()[taken]).all()
+    c = res.depth_counts()
+    assert c["filled"] == int((res.valid & (res.confidence == 0)).sum())
+    assert c["filled"] >= int((~raw.valid).sum()) + int(taken.sum())
+
+
+def test_depth_map_argument_edges_of_the_second_audit() -> None:
+    """The homographies' range stands in only for a max_disparity not given; a pair of two
+    sizes is refused before a raw rig would warp both to its size; an unknown method is named
+    before the images are looked at; min_disparity is reported as a float."""
+    from stereovision.uncalibrated import UncalibratedRectification
+
+    h, w = 64, 96
+    left = _texture(h, w, seed=3)
+    right = _shift(left, 4.0)
+    ident = np.eye(3)
+    homographies = UncalibratedRectification(
+        ident, ident, (w, h), (w, h), np.zeros((3, 3)), 100, 0.0, 0.0, (0.0, 20.0), 32,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    own = sv.depth_map(left, right, homographies, method="gabor")
+    given = sv.depth_map(left, right, homographies, method="gabor", max_disparity=16)
+    assert own.max_disparity == 32 and given.max_disparity == 16
+    raw = dataclasses.replace(_rect_calib(w, h), rectified=False)
+    wider = np.zeros((h, w + 8), np.float32)
+    with pytest.raises(ValueError, match=r"same shape, got left \(64, 96\) and right \(64, 104\)"):
+        sv.depth_map(left, wider, raw, max_disparity=16)
+    with pytest.raises(ValueError, match="unknown method 'best'"):
+        sv.depth_map(np.zeros((0, 4)), np.zeros((0, 4)), method="best", max_disparity=8)
+    res = sv.depth_map(left, right, method="fast", max_disparity=16, min_disparity=np.int64(2))
+    assert type(res.min_disparity) is float and res.min_disparity == 2.0
