@@ -1182,3 +1182,58 @@ def test_depth_map_argument_edges_of_the_second_audit() -> None:
         sv.depth_map(np.zeros((0, 4)), np.zeros((0, 4)), method="best", max_disparity=8)
     res = sv.depth_map(left, right, method="fast", max_disparity=16, min_disparity=np.int64(2))
     assert type(res.min_disparity) is float and res.min_disparity == 2.0
+
+
+def test_stages_are_timed_apart_and_reported_in_order() -> None:
+    """Each timing is its own stage's (they add up to at most the call), and progress hears the
+    stages in the order they ran."""
+    import time
+
+    h, w = 64, 96
+    left = _texture(h, w, seed=4)
+    said: list[str] = []
+    t0 = time.perf_counter()
+    res = sv.depth_map(
+        left, _shift(left, 4.0), _rect_calib(w, h), max_disparity=16, progress=said.append
+    )
+    wall = time.perf_counter() - t0
+    assert said == list(res.timings) == ["rectify", "prepare", "match", "fill", "triangulate"]
+    assert 0 < sum(res.timings.values()) <= wall
+
+
+def test_gabor_with_fill_only_re_measures_and_census_takes_the_fused_fill() -> None:
+    """``"gabor"`` with ``fill=True``: only the re-measure runs (the refinement's own hole
+    passes would give guesses a depth): the depth stays on the Gabor channel's pixels.
+    ``"census"`` is filled as the fused map is (side rule, enclosed far regions)."""
+    from stereovision.depth import fill_holes
+
+    left = _texture(64, 128, seed=2)
+    right = _shift(left, 4.0)
+    left[:, 60:70] = 0.5  # a textureless stripe: holes there
+    right[:, 56:66] = 0.5
+    calib = _rect_calib(128, 64)
+    kw = {"method": "gabor", "max_disparity": 16}
+    raw = sv.depth_map(left, right, calib, refine=False, fill=False, **kw)
+    done = sv.depth_map(left, right, calib, fill=True, **kw)
+    grown = sv.depth_map(left, right, calib, fill=False, **kw)  # the refinement fills some
+    z = done.require_depth()
+    assert (np.isfinite(z) <= raw.valid).all() and np.isfinite(z).sum() > 0.5 * raw.valid.sum()
+    assert (np.isfinite(grown.require_depth()) & ~raw.valid).any()
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")
+    kw = {"method": "census", "max_disparity": 64, "cloud": False}
+    filled = sv.depth_map(s.left, s.right, **kw)
+    holes = sv.depth_map(s.left, s.right, fill=False, **kw)
+    grey = as_gray_float(s.left, "left")
+    for fused, same in ((True, True), (False, False)):
+        disp, _ = fill_holes(holes.disparity.copy(), s.left, fused=fused, grey=grey)
+        assert np.array_equal(np.clip(disp, 0, 64), filled.disparity) == same, fused
+
+
+def test_a_result_prints_its_limits_and_no_depth_and_refuses_a_switch_as_a_limit() -> None:
+    r = _hand_result()
+    assert "limits max_depth=5" in repr(r.filtered(max_depth=5))
+    assert "limits" not in repr(r)
+    empty = r.filtered(min_depth=100)
+    assert "; no depth; 0 points" in repr(empty)
+    with pytest.raises(ValueError, match="max_depth: expected a positive number, got True"):
+        r.filtered(max_depth=True)
