@@ -1237,3 +1237,24 @@ def test_a_result_prints_its_limits_and_no_depth_and_refuses_a_switch_as_a_limit
     assert "; no depth; 0 points" in repr(empty)
     with pytest.raises(ValueError, match="max_depth: expected a positive number, got True"):
         r.filtered(max_depth=True)
+
+
+def test_a_dark_region_locked_at_a_min_disparity_above_0_is_filled_without_depth() -> None:
+    """The enclosed far region step looks at the range's floor (min_disparity, not 0), and the
+    pixels it fills are guesses: the surround's disparity, confidence 0, no depth."""
+    h, w = 96, 160
+    bright = 0.4 + 0.6 * _texture(h, w, seed=5)
+    dark = 0.15 * _texture(h, w, seed=6)
+    left = bright.copy()
+    left[30:66, 60:110] = dark[30:66, 60:110]  # a dark square at 2 px in a wall at 8 px
+    right = _shift(bright, 8.0)
+    right[30:66, 58:108] = _shift(dark, 2.0)[30:66, 58:108]
+    kw = {"max_disparity": 16, "min_disparity": 2, "cloud": False}
+    res = sv.depth_map(left, right, _rect_calib(w, h), **kw)
+    raw = sv.depth_map(left, right, _rect_calib(w, h), fill=False, **kw)
+    inner = (slice(35, 61), slice(65, 105))
+    assert float(np.nanmedian(raw.disparity[inner])) == pytest.approx(2.0, abs=0.1)
+    assert float(np.median(res.disparity[inner])) == pytest.approx(8.0, abs=0.2)
+    assert (res.confidence[inner] == 0).mean() > 0.9  # measured: 94 %
+    assert np.isnan(res.require_depth()[inner]).mean() > 0.9
+    assert not (np.isfinite(res.depth) & (res.confidence == 0)).any()
