@@ -1052,6 +1052,9 @@ def test_the_automatic_range_is_clamped_to_half_the_width() -> None:
     tex = _texture(128, 128, seed=2)
     # 60 px x 1.15 headroom is 69, rounded up 80: past half the width, so 64
     assert estimate_max_disparity(tex, _shift(tex, 60)) == 64
+    # the half width is rounded up to a multiple of 16 as the range is: 100 -> 112 px
+    wide = _texture(128, 200, seed=2)
+    assert estimate_max_disparity(wide, _shift(wide, 95)) == 112
     flat = np.zeros((128, 96), np.float32)
     assert estimate_max_disparity(flat, flat) == 16  # no features: width / 8, at least 16
 

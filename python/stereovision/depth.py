@@ -236,7 +236,8 @@ def estimate_max_disparity(left: npt.ArrayLike, right: npt.ArrayLike) -> int:
     more than 2 rows apart or with negative disparity discarded), their 99th percentile; and
     OpenCV's SGBM on the pair shrunk 4x (a dense map: it sees the textureless near ground
     sparse features miss), its 99.5th percentile. The range is 1.15 x that, rounded up to a
-    multiple of 16 and clamped to [16, width / 2]. With too few features (fewer than 12
+    multiple of 16 and clamped to [16, width / 2 rounded up to a multiple of 16] (112 px for a
+    200 px wide pair). With too few features (fewer than 12
     matches) the dense estimate alone is used, or, on a pair too small for it, width / 8. A
     dark pair (brightest grey under a quarter of the range: a 12-bit camera's data in 16 bits)
     is first stretched by one gain, so its 8-bit copy keeps its features. Over
