@@ -1009,7 +1009,9 @@ def test_a_hand_made_result_counts_filters_and_converts_by_hand_values(tmp_path:
     no_sigma = dataclasses.replace(r, depth_sigma=None)
     with pytest.raises(ValueError, match="no depth uncertainty"):
         no_sigma.require_depth_sigma()
-    assert read_ply(r.to_ply(tmp_path / "cloud.PLY"))[0].shape == (3, 3)
+    pts, cols = read_ply(r.to_ply(tmp_path / "cloud.PLY"))
+    # no cloud and no left image: the depth map's points, black
+    assert pts.shape == (3, 3) and cols.shape == (3, 3) and not cols.any()
 
 
 def test_depth_uses_doffs_and_points_use_fx_and_fy_and_rgb_colours() -> None:
