@@ -461,6 +461,8 @@ def test_rectify_points_refuses_other_layouts() -> None:
     [
         ("H1", [[float("nan")] * 3] * 3, "H1 has a NaN or infinite entry"),
         ("H2", [[0.0] * 3] * 3, "H2 is singular"),
+        ("H1", [[1.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 1.0]], "H1 is singular"),
+        ("F", [[float("nan")] * 3] * 3, "F has a NaN or infinite entry"),
         ("size", [0, -5], "size 0x-5 px"),
         ("size", [0, 100], "size 0x100 px"),
         ("size", [200_000, 100], "size 200000x100 px"),
@@ -773,3 +775,99 @@ def test_sampson_distance_and_describe_in_closed_form() -> None:
         (0.02, 0.5), (1.0, 1.0),
     )  # fmt: skip
     assert "skew 0.50 deg" in rect.describe()
+
+
+def test_too_few_matches_or_inliers_are_refused_with_their_counts(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Cones: 29 SIFT matches are refused by count (at least 30), not passed on to the fit; and a
+    threshold of 0.003 px leaves 14 of 547 matches fitting ``F`` (measured), refused as too few
+    inliers: a floor of 8 (the eight-point minimum) let such a fit through."""
+    import stereovision.uncalibrated as uc
+
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    with pytest.raises(ValueError, match=r"(\d+) of 547 feature matches fit one fundamental") as e:
+        rectify_uncalibrated(sc.left, sc.right, ransac_px=0.003)
+    assert 8 <= int(re.findall(r"(\d+) of 547", str(e.value))[0]) < 30
+    original = uc._mutual_matches
+    monkeypatch.setattr(uc, "_mutual_matches", lambda dl, dr: original(dl, dr)[:29])
+    with pytest.raises(ValueError, match=r"only 29 feature matches between the two images"):
+        rectify_uncalibrated(sc.left, sc.right)
+
+
+def test_rows_figures_are_those_of_the_matches_that_fit(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Cones, bumped: the matches that fit ``F`` (OpenCV's own inlier mask, recorded), moved by
+    the returned ``H1`` and ``H2``, lie on common rows; ``median_dy`` and ``p95_dy`` are their
+    ``|y_left - y_right|``'s median and 95th percentile exactly, and ``matches`` their count
+    (measured: 470 of 493 fit; mean 0.14 px, median 0.07, 95 % 0.53, against a median of 4.57
+    px before)."""
+    seen: dict[str, np.ndarray] = {}
+    fit = cv2.findFundamentalMat
+
+    def spy_fit(p1: np.ndarray, p2: np.ndarray, *args: object) -> tuple:
+        fm, mask = fit(p1, p2, *args)
+        seen.update(p1=p1, p2=p2, mask=mask.ravel().astype(bool))
+        return fm, mask
+
+    monkeypatch.setattr(cv2, "findFundamentalMat", spy_fit)
+    _, _, right = perturbed_scene(data_dir, "middlebury2003/cones")
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    rect = rectify_uncalibrated(sc.left, right)
+    p1, p2 = seen["p1"][seen["mask"]], seen["p2"][seen["mask"]]
+    assert rect.matches == len(p1) > 300
+    assert np.median(np.abs(p1[:, 1] - p2[:, 1])) > 2.0  # the bump moved the rows
+    ady = np.abs(rect.rectify_points(p1)[:, 1] - rect.rectify_points(p2, "right")[:, 1])
+    assert float(np.mean(ady)) < 0.2
+    assert rect.median_dy == pytest.approx(float(np.median(ady)), abs=1e-9)
+    assert rect.p95_dy == pytest.approx(float(np.percentile(ady, 95)), abs=1e-9)
+
+
+def test_a_forward_step_seen_off_its_epipole_is_told_by_the_epipole_or_the_size(
+    data_dir: Path,
+) -> None:
+    """A camera stepped forward (the epipole at about (218, 208), see ``_stepped_forward``),
+    cut to rows where the epipole is not: its top 150 rows (the epipole 58 rows below them,
+    its x within them) are not refused as an epipole "in the image", and the homographies found
+    put the matches on common rows (measured: median 0.26 px, 478 x 303 px); its bottom 145
+    rows (the epipole 22 rows above) would be stretched to 170 x 651 px, over
+    :data:`MAX_STRETCH` times the 145 rows: refused by their size."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    ahead = _stepped_forward(sc.left, sc.gt)
+    rect = rectify_uncalibrated(sc.left[:150], ahead[:150])
+    assert rect.median_dy < 0.5 and rect.size[1] <= 4 * 150
+    with pytest.raises(ValueError, match=r"would be (\d+)x(\d+) px from 450x145") as e:
+        rectify_uncalibrated(sc.left[230:], ahead[230:])
+    assert int(re.findall(r"(\d+)x(\d+) px from", str(e.value))[0][1]) > 4 * 145
+
+
+def test_check_leaves_out_matches_moved_off_the_rectified_images(data_dir: Path) -> None:
+    """Cones (450 x 375, already rectified) through homographies that move both images 100 px
+    down and the right one 150 px left: the matches moved below the last row (y > 374.5, though
+    within the width) or left of the first column (the right image's x < -0.5) are off the
+    rectified pair, and left out of :meth:`check` (measured: 322 of the plain check's 523)."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    w, h = sc.left.shape[1], sc.left.shape[0]
+    down = np.array([[1.0, 0, 0], [0, 1, 100], [0, 0, 1]])
+    left_down = np.array([[1.0, 0, -150], [0, 1, 100], [0, 0, 1]])
+    rect = UncalibratedRectification(
+        down, left_down, (w, h), (w, h), np.zeros((3, 3)), 100, 0.1, 0.2, (1.0, 60.0), 64,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    got = rect.check(sc.left, sc.right)
+    plain = check_rectification(sc.left, sc.right)
+    assert got.ok and 30 <= got.matches < plain.matches
+    assert got.points[:, [1, 3]].max() <= h - 0.5 and got.points[:, [0, 2]].min() >= -0.5
+
+
+def test_a_bad_image_is_named_left_or_right() -> None:
+    """The image that cannot be read as one is named: a right image of 5 channels or NaN grey
+    levels was reported as the left one's."""
+    ok = np.zeros((20, 30), np.uint8)
+    with pytest.raises(ValueError, match=r"^right: expected 1, 3 \(BGR\) or 4"):
+        rectify_uncalibrated(ok, np.zeros((20, 30, 5), np.uint8))
+    with pytest.raises(ValueError, match=r"^right: float image contains 600 NaN"):
+        rectify_uncalibrated(ok, np.full((20, 30), np.nan, np.float32))
+    with pytest.raises(ValueError, match=r"^left: expected a grey"):
+        rectify_uncalibrated(np.zeros(10), ok)
