@@ -773,3 +773,28 @@ def test_calibrate_from_video_passes_numpy_indexes_as_cameras(
     with pytest.raises(Opened):
         calibrate_from_video(np.int64(1), np.int32(2), board=BOARD)  # type: ignore[arg-type]
     assert seen == [(1, 2)] and all(isinstance(v, (int, np.integer)) for v in seen[0])
+
+
+def test_no_marker_seen_names_no_dictionary() -> None:
+    """An image without a marker: no family decodes any of the board's ids, and none is named
+    (a tie at 0 took the last family tried, DICT_ARUCO_MIP_36H12)."""
+    assert BOARD.markers_seen(np.full((240, 320), 200, np.uint8)) == ("", 0)
+    auto = CharucoBoard("10x7", 0.03, 0.022)
+    assert auto.markers_seen(np.full((240, 320), 200, np.uint8)) == ("", 0)
+
+
+def test_board_png_refuses_over_20000_px_per_square_by_name() -> None:
+    """A 1 m square at 600 dpi is 23622 px: refused by the square and dpi that make it, for a
+    ChArUco board and a chessboard alike (not by the image's pixels_per_square it led to)."""
+    for board in (BOARD, (9, 6)):
+        with pytest.raises(ValueError, match=r"a 1000 mm square at 600 dpi is 23622 px; use a"):
+            board_png(board, 1.0, 600)
+
+
+def test_board_image_margin_is_checked() -> None:
+    """The margin is 0 to 10 squares of pixels: a negative one or one over 10 squares is named."""
+    board = CharucoBoard("7x5", 0.03, 0.02, "DICT_4X4_50")
+    assert board.image(20, margin=200).shape == (5 * 20 + 400, 7 * 20 + 400)
+    for bad in (-1, 201):
+        with pytest.raises(ValueError, match="margin"):
+            board.image(20, margin=bad)
