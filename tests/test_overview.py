@@ -643,3 +643,22 @@ def test_a_caption_over_the_label_column_keeps_3_rows_above_the_top_label(width:
             reaching += 1
             assert tops[name][1] - y1 >= 3, (name, ov.caption_boxes[name], tops[name])
     assert reaching >= 1
+
+
+def test_colour_levels_clip_values_beyond_the_ends() -> None:
+    """A value below the colour range's low end is level 0, one above its high end 255 (as
+    ``colorize`` draws them): unclipped, -5 and 20 of 0-10 wrapped round in uint8."""
+    from stereovision.overview import colour_levels
+
+    got = colour_levels(np.array([-5.0, 0.0, 5.0, 10.0, 20.0]), 0.0, 10.0)
+    np.testing.assert_array_equal(got, [0, 0, 127, 255, 255])
+
+
+def test_depth_ticks_are_even_steps_within_a_decade_and_1_2_5_beyond() -> None:
+    """Depths of 1.5-12.5 m (under a decade) are labelled in even steps (2, 4, 6, 8 m); those
+    of 0.3-60 m in 1-2-5 steps of each decade, the 2s included."""
+    from stereovision.overview import _nice_values
+
+    ov = overview_image(_result_with_depth(288, 384, 1.5, 12.5), "t")
+    assert [t[1] for t in ov.bars["depth"].ticks] == ["1.5 m", "2", "4", "6", "8", "12.5 m"]
+    assert _nice_values(0.3, 60.0) == [0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0]
