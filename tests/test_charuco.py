@@ -798,3 +798,18 @@ def test_board_image_margin_is_checked() -> None:
     for bad in (-1, 201):
         with pytest.raises(ValueError, match="margin"):
             board.image(20, margin=bad)
+
+
+def test_dictionary_names_ignore_surrounding_spaces() -> None:
+    """A name as typed on a command line or read from a file, spaces around it, is the same
+    dictionary."""
+    assert dictionary_name(" 5x5_100 \n") == "DICT_5X5_100"
+
+
+def test_rendered_board_grey_levels_run_from_25_to_230() -> None:
+    """The board's black and white are drawn as 25 and 230 (a camera's, not 0 and 255), the
+    background at its grey level."""
+    rv, tv = np.zeros(3), np.array([-0.15, -0.1, 0.5])
+    img = render_charuco(BOARD, K1, D1, rv, tv, supersample=SS, background=60)
+    assert img.min() == 25 and img.max() == 230
+    assert img[0, 0] == 60
