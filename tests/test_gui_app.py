@@ -3260,6 +3260,20 @@ def test_an_image_sequence_typed_as_a_camera_is_opened_by_its_folder(tmp_path):
     app.source.close()
 
 
+def test_a_negative_camera_index_typed_on_the_page_is_refused_as_capture_refuses_it(tmp_path):
+    """ "-1" in a camera field was looked for as a file ("no such file: -1"); it is the index
+    capture refuses (OpenCV's -1 crashes where no camera is present), said in its words."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-camera-negative", [bundled_data_dir(), tmp_path])
+    app.state.cam_left, app.state.cam_right = "-1", "0"
+    app.open_cameras()
+    assert app.state.error == (
+        "camera index -1 is negative: cameras are numbered from 0 (./-1 for a file)"
+    )
+    assert app.source is None and app.state.live is False
+
+
 def test_loading_files_names_sizes_and_warns_of_one_file_twice(tmp_path):
     """The files' size mismatch said "left (375, 450, 3) and right (288, 384, 3) differ in
     size"; the same file as left and right computed a flat 0 disparity without a word."""

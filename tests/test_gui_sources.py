@@ -6,6 +6,7 @@ mutation audit of ``stereovision.gui.sources`` found unasserted.
 
 from __future__ import annotations
 
+import subprocess
 import sys
 import types
 from pathlib import Path
@@ -234,7 +235,7 @@ def test_label(data: Path, tmp_path: Path) -> None:
 
 def test_parse_source() -> None:
     assert sources.parse_source(3) == 3
-    assert sources.parse_source(-1) == -1  # OpenCV's "any camera": an int stays an int
+    assert sources.parse_source(np.int64(3)) == 3 and type(sources.parse_source(np.int64(3))) is int
     assert sources.parse_source(" 12 ") == 12
     assert sources.parse_source(" cam.avi ") == "cam.avi"
     assert sources.parse_source("img_%03d.png") == "img_%03d.png"
@@ -243,6 +244,39 @@ def test_parse_source() -> None:
     # a digit to str.isdigit but no number to int(): "invalid literal for int()" on the page;
     # a file name, as stereovision.capture.parse_source takes it
     assert sources.parse_source(" ² ") == "²"
+
+
+def test_parse_source_refuses_what_capture_refuses() -> None:
+    # -1 passed on to cv2.VideoCapture (a crash where no camera is present), True opened camera
+    # 1, a NumPy -1 was taken for a file "-1": refused as stereovision.capture refuses them
+    negative = r"^camera index -1 is negative: cameras are numbered from 0 \(\./-1 for a file\)$"
+    for bad in (-1, np.int64(-1), "-1", " -1 "):
+        with pytest.raises(ValueError, match=negative):
+            sources.parse_source(bad)
+    for flag in (True, np.bool_(False)):
+        with pytest.raises(ValueError, match=r"expected a device index or a path"):
+            sources.parse_source(flag)
+    assert sources.parse_source("-0") == "-0"  # no negative index: a file, as capture takes it
+
+
+def test_video_pair_refuses_a_negative_index_before_opencv_sees_it() -> None:
+    # In a subprocess: cv2.VideoCapture(-1) ended the process (SIGSEGV) with no camera present.
+    code = (
+        "from stereovision.gui.sources import VideoPair\n"
+        "for bad in (-1, True):\n"
+        "    try:\n"
+        "        VideoPair(bad, 0)\n"
+        "    except ValueError as e:\n"
+        "        print(e)\n"
+    )
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert done.returncode == 0, done.stderr[-500:]
+    assert done.stdout.splitlines() == [
+        "camera index -1 is negative: cameras are numbered from 0 (./-1 for a file)",
+        "camera source: expected a device index or a path, got True",
+    ]
 
 
 # ----------------------------------------------------------------------------- VideoPair

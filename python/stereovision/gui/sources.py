@@ -19,6 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision.capture import camera_hint
+from stereovision.capture import parse_source as capture_parse_source
 from stereovision.io import _opencv_quiet
 
 __all__ = [
@@ -276,14 +277,21 @@ class StereoSource(Protocol):
 
 
 def parse_source(text: str | int) -> int | str:
-    """A camera source: an integer device index, or a video file / image-sequence pattern."""
-    if isinstance(text, int):
-        return text
+    """A camera source: an integer device index, or a video file / image-sequence pattern.
+
+    Raises
+    ------
+    ValueError
+        Empty, a bool, or a negative index (``-1``, ``"-1"``, a NumPy ``-1``), refused as
+        :func:`stereovision.capture.parse_source` refuses them: :class:`VideoPair` passed -1 on
+        to ``cv2.VideoCapture``, which crashes the process where no camera is present.
+    """
+    if isinstance(text, (bool, np.bool_, int, np.integer)):
+        return capture_parse_source(text)
     s = str(text).strip()
     if not s:
         raise ValueError("empty camera source")
-    # isdecimal, not isdigit: "²" is a digit that int() refuses ("invalid literal for int()")
-    return int(s) if s.isdecimal() else s
+    return capture_parse_source(s)
 
 
 class VideoPair:
