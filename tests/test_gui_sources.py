@@ -127,6 +127,10 @@ def test_resolve_output(data: Path, tmp_path: Path) -> None:
         folders.resolve_output(data / "z", roots=only)
     with pytest.raises(ValueError, match=r"^no folder to write into: start the GUI with --data"):
         folders.resolve_output("x", roots=[])
+    # a sibling whose name begins with a root's ("data2" beside "data") is no folder in it
+    (tmp_path / "outside2").mkdir()
+    with pytest.raises(ValueError, match=r"^folder outside the --data folders: .*outside2/x$"):
+        folders.resolve_output(tmp_path / "outside2" / "x")
     with pytest.raises(ValueError, match=r"^no folder to write into"):
         AllowedFolders([]).resolve_output("x")
 
@@ -551,6 +555,22 @@ def test_folder_pairs_keep_and_no_pairs(tmp_path: Path) -> None:
     (tmp_path / "empty").mkdir()
     with pytest.raises(ValueError, match=r"^no image pairs in e "):
         FolderPairs(tmp_path / "empty", "e")
+
+
+def test_folder_pairs_keep_checks_a_scenes_calibration_too(tmp_path: Path) -> None:
+    # a scene whose calib.txt is a link out of the allowed folders is dropped whole: its
+    # calibration would be read from outside them
+    img = np.full((4, 5, 3), 9, np.uint8)
+    for name in ("a", "b"):
+        d = tmp_path / "scenes" / name
+        d.mkdir(parents=True)
+        cv2.imwrite(str(d / "left.png"), img)
+        cv2.imwrite(str(d / "right.png"), img)
+    (tmp_path / "secret.txt").write_text("cam0=[1 0 2; 0 1 2; 0 0 1]\n")
+    (tmp_path / "scenes" / "b" / "calib.txt").symlink_to(tmp_path / "secret.txt")
+    folders = AllowedFolders([tmp_path / "scenes"])
+    fp = FolderPairs(tmp_path / "scenes", "scenes", keep=folders.contains)
+    assert [j.left.parent.name for j in fp.jobs] == ["a"]
 
 
 # ----------------------------------------------------------------------------- scaling
