@@ -3375,3 +3375,69 @@ def test_the_average_switch_is_offered_only_for_sources_it_averages(tmp_path):
     app.state.average = True
     app.capture()
     assert app.state.source_label.endswith("(8.0 frames averaged)")
+
+
+def test_a_dangling_link_in_a_typed_save_folder_is_a_file_it_holds(tmp_path):
+    """A link named ``overview.png`` whose target is gone is refused as a file the folder
+    holds, before anything is written (not as a file that "appeared while the Save wrote")."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-save-dangling-link", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "overview.png").symlink_to(tmp_path / "gone.png")
+    app.state.save_dir = "mine"
+    _run(app, app.save)
+    assert app.state.error == (
+        f"save: {tmp_path.name}/mine already holds overview.png; nothing was overwritten: "
+        "choose another folder"
+    )
+    assert [p.name for p in mine.iterdir()] == ["overview.png"]
+
+
+def test_a_failed_click_during_a_computation_leaves_its_progress(tmp_path):
+    """A bad max disparity typed while a pair computes is said, and the toolbar still shows
+    the computation running (it said "error" and not busy while the work went on)."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-fail-while-computing", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    app._computing = True
+    app.state.busy, app.state.status = True, "computing (fast)"
+    app.apply_max_disparity(text="-3")
+    assert app.state.error.startswith("max disparity: expected a whole number of pixels")
+    assert (app.state.busy, app.state.status) == (True, "computing (fast)")
+    app._computing = False
+    app.apply_max_disparity(text="x")
+    assert (app.state.busy, app.state.status) == (False, "error")
+
+
+def test_an_emptied_slider_is_said_on_the_page(tmp_path):
+    """A slider's value the page sent as null (an emptied field) is said as an error; the
+    view stays (a TypeError escaped the controller)."""
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-emptied-slider", [bundled_data_dir()])
+    app.state.roll = None
+    app._apply_camera()
+    assert app.state.error == "float() argument must be a string or a real number, not 'NoneType'"
+
+
+def test_an_image_sequence_typed_as_a_camera_outside_the_data_folders_is_refused(tmp_path):
+    """A pattern's folder is checked against --data like a file: one outside is refused."""
+    from stereovision.gui import bundled_data_dir
+
+    left = cv2.imread(str(CONES / "left.png"))
+    out = tmp_path / "out"
+    out.mkdir()
+    for k in range(2):
+        for side in ("left", "right"):
+            cv2.imwrite(str(out / f"{side}{k:02d}.png"), left)
+    (tmp_path / "in").mkdir()
+    app = _scene_app("test-camera-sequence-outside", [bundled_data_dir(), tmp_path / "in"])
+    app.state.cam_left, app.state.cam_right = str(out / "left%02d.png"), str(out / "right%02d.png")
+    app.open_cameras()
+    assert app.state.error == f"path outside the allowed folders: {out}"
+    assert app.source is None and app.pair is None
