@@ -3441,3 +3441,62 @@ def test_an_image_sequence_typed_as_a_camera_outside_the_data_folders_is_refused
     app.open_cameras()
     assert app.state.error == f"path outside the allowed folders: {out}"
     assert app.source is None and app.pair is None
+
+
+def test_homographies_of_another_frame_size_are_not_put_on_the_cameras_next_pair(tmp_path):
+    """The features' homographies fit one frame size: a pair of another size (the cameras'
+    resolution changed) is shown as it comes, not warped by them under "(rectified from
+    features)"."""
+    from stereovision.gui import bundled_data_dir
+
+    small = (np.full((30, 40, 3), 7, np.uint8), np.full((30, 40, 3), 9, np.uint8))
+
+    class Cameras:
+        def read(self):
+            return small
+
+        def close(self):
+            pass
+
+    class Homographies:  # fitted to 450x375 frames
+        input_size = (450, 375)
+        max_disparity = 60
+
+        def rectify(self, left, right):
+            raise AssertionError("homographies of 450x375 frames put on a 40x30 pair")
+
+    app = _scene_app(
+        "test-homographies-size", [bundled_data_dir()], source=Cameras(), source_names=("0", "1")
+    )
+    app.homographies = Homographies()
+    app._grab()
+    assert app.pair[0] is small[0] and app.pair[1] is small[1] and app.max_disparity is None
+    assert app.state.source_label == "cameras 0 / 1"
+
+
+def test_a_scenes_gt_is_given_only_with_a_calibration_that_leaves_the_pair_as_it_is(monkeypatch):
+    """The scene's GT disparity is of the pair as given: a calibration that rectifies the pair
+    (not rectified) moves its pixels, and the GT is then not given (a bad-2.0 of another
+    pair's pixels)."""
+    from types import SimpleNamespace
+
+    from stereovision.gui import app as gui_app
+    from stereovision.gui import bundled_data_dir
+
+    given: list = []
+
+    def spy(*args: Any, **kwargs: Any) -> Any:
+        given.append((args[2], kwargs["gt"] is not None))
+        raise ValueError("not computed here")
+
+    monkeypatch.setattr(gui_app, "compute_view", spy)
+    app = _scene_app("test-gt-given", [bundled_data_dir()])
+    app._load_scene(bundled_data_dir() / "cones")
+    rectified = app.calib
+    _run(app, app.recompute)
+    app.calib = SimpleNamespace(rectified=False)  # one that rectifies the pair
+    _run(app, app.recompute)
+    app.calib = None
+    _run(app, app.recompute)
+    assert [g for _, g in given] == [True, False, True]
+    assert given[0][0] is rectified and rectified.rectified
