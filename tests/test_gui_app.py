@@ -3500,3 +3500,38 @@ def test_a_scenes_gt_is_given_only_with_a_calibration_that_leaves_the_pair_as_it
     _run(app, app.recompute)
     assert [g for _, g in given] == [True, False, True]
     assert given[0][0] is rectified and rectified.rectified
+
+
+def test_files_loaded_after_rectifying_the_cameras_drop_their_homographies(tmp_path):
+    """Files loaded after "Rectify" on the cameras' pair: the homographies of that pair go
+    (the next capture is not warped by them, and "Rectify" on the files starts afresh)."""
+    from stereovision.gui import bundled_data_dir
+
+    raw = (cv2.imread(str(CONES / "left.png")), cv2.imread(str(CONES / "right.png")))
+
+    class Cameras:
+        def read(self):
+            return raw
+
+        def close(self):
+            pass
+
+    class Homographies:  # fitted to the cameras' 450x375 frames
+        input_size = (450, 375)
+        max_disparity = 60
+
+        def rectify(self, left, right):
+            raise AssertionError("the cameras' homographies put on a pair after the files")
+
+    app = _scene_app(
+        "test-files-drop-homographies",
+        [bundled_data_dir()],
+        source=Cameras(),
+        source_names=("0", "1"),
+    )
+    app.homographies = Homographies()
+    app.state.left_file, app.state.right_file = "cones/left.png", "cones/right.png"
+    app.load_files()
+    assert app.state.error == "" and app.homographies is None
+    app._grab()
+    assert app.pair[0] is raw[0] and app.state.source_label == "cameras 0 / 1"
