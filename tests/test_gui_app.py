@@ -3535,3 +3535,26 @@ def test_files_loaded_after_rectifying_the_cameras_drop_their_homographies(tmp_p
     assert app.state.error == "" and app.homographies is None
     app._grab()
     assert app.pair[0] is raw[0] and app.state.source_label == "cameras 0 / 1"
+
+
+def test_check_rows_of_files_at_another_resolution_uses_the_calibration_scaled(tmp_path):
+    """Files at half the --calib size: "Check rows" checks them with the calibration scaled
+    to them, as their view is computed (not refused as of another image size)."""
+    from stereovision.calibration import Calibration
+    from stereovision.gui import bundled_data_dir
+
+    for side in ("left", "right"):
+        img = cv2.imread(str(CONES / f"{side}.png"))
+        cv2.imwrite(str(tmp_path / f"half_{side}.png"), cv2.resize(img, (225, 188)))
+    app = _scene_app(
+        "test-check-rows-scaled",
+        [bundled_data_dir(), tmp_path],
+        calib=Calibration.from_file(CONES / "calib.txt"),
+    )
+    app.state.left_file = str(tmp_path / "half_left.png")
+    app.state.right_file = str(tmp_path / "half_right.png")
+    app.load_files()
+    assert app.calib is not None and app.calib.image_size == (450, 375)
+    _run(app, app.check_rows)
+    assert app.state.error == ""
+    assert app.state.rows_label.startswith("rectification ok")
