@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import os
 import subprocess
 import sys
 import tarfile
@@ -556,3 +557,18 @@ def test_an_integral_float_size_is_taken_and_a_fractional_one_refused(tmp_path: 
     for bad in (320.5, float("inf"), float("nan"), -320.0):
         with pytest.raises(ValueError, match=r"^cam: image_width must be a positive integer"):
             parse_ros_camera_info(_cam_text(image_width=bad), "cam")
+
+
+def test_save_ros_refuses_right_yaml_linked_to_left_yaml(tmp_path: Path) -> None:
+    """right.yaml -> left.yaml: written through the link, the right camera replaced the left
+    one (a rig of one camera, said nowhere). Refused, the earlier file kept."""
+    (tmp_path / "left.yaml").write_text("old")
+    (tmp_path / "right.yaml").symlink_to("left.yaml")
+    with pytest.raises(ValueError) as info:
+        raw_calib().save_ros(tmp_path)
+    assert str(info.value) == (
+        f"cannot write {tmp_path / 'left.yaml'} and {tmp_path / 'right.yaml'} together: they "
+        "are one file (the second would replace the first)"
+    )
+    assert (tmp_path / "left.yaml").read_text() == "old"
+    assert sorted(os.listdir(tmp_path)) == ["left.yaml", "right.yaml"]

@@ -1317,3 +1317,50 @@ def test_writers_write_through_a_link_to_a_file_as_open_does(
         with atomic_write(tmp_path / "loop.yaml") as fh:
             fh.write(b"x")
     assert (tmp_path / "loop.yaml").is_symlink()
+
+
+def test_a_link_that_cannot_be_followed_is_not_called_a_loop(tmp_path: Path) -> None:
+    """A link through a file (out.yaml -> notes.txt/out.yaml) was refused as 'it is a link that
+    loops': every error of the strict resolution was taken for ELOOP. It is refused as open()
+    refuses it, a file where a folder should be; a link to a folder names the link."""
+    (tmp_path / "notes.txt").write_text("mine")
+    (tmp_path / "out.yaml").symlink_to(Path("notes.txt") / "out.yaml")
+    with pytest.raises(NotADirectoryError) as info:
+        with atomic_write(tmp_path / "out.yaml") as fh:
+            fh.write(b"x")
+    assert str(info.value) == (
+        f"cannot write {tmp_path / 'notes.txt' / 'out.yaml'}: {tmp_path / 'notes.txt'} is a "
+        "file, not a folder"
+    )
+    with pytest.raises(NotADirectoryError):
+        write_together([(tmp_path / "out.yaml", b"x")])
+    (tmp_path / "rigs").mkdir()
+    (tmp_path / "dir.yaml").symlink_to("rigs")
+    with pytest.raises(IsADirectoryError) as folder:
+        write_together([(tmp_path / "dir.yaml", b"x")])
+    assert str(folder.value) == (
+        f"cannot write {tmp_path / 'dir.yaml'}: it is a link to the folder "
+        f"{tmp_path / 'rigs'}; give a file name"
+    )
+    assert sorted(os.listdir(tmp_path)) == ["dir.yaml", "notes.txt", "out.yaml", "rigs"]
+    assert (tmp_path / "notes.txt").read_text() == "mine" and not os.listdir(tmp_path / "rigs")
+
+
+def test_write_together_refuses_two_destinations_that_are_one_file(tmp_path: Path) -> None:
+    """Written through links, right.yaml -> left.yaml made save_ros write the right camera over
+    the left one: a rig of one camera, said nowhere. Two destinations that are one file (a
+    link, a linked folder, a hard link, or the same name twice) are refused before anything
+    is written."""
+    (tmp_path / "left.yaml").write_text("old")
+    (tmp_path / "right.yaml").symlink_to("left.yaml")
+    (tmp_path / "same").symlink_to(".")
+    os.link(tmp_path / "left.yaml", tmp_path / "hard.yaml")
+    for other in ("right.yaml", "same/left.yaml", "hard.yaml", "left.yaml"):
+        with pytest.raises(ValueError) as info:
+            write_together([(tmp_path / "left.yaml", b"L"), (tmp_path / other, b"R")])
+        assert str(info.value) == (
+            f"cannot write {tmp_path / 'left.yaml'} and {tmp_path / other} together: they are "
+            "one file (the second would replace the first)"
+        )
+    assert (tmp_path / "left.yaml").read_text() == "old"
+    assert sorted(os.listdir(tmp_path)) == ["hard.yaml", "left.yaml", "right.yaml", "same"]

@@ -327,17 +327,37 @@ def _through_links(dest: Path) -> Path:
     ------
     OSError
         If ``dest`` is a link that loops (ELOOP), naming ``dest``.
+    IsADirectoryError
+        If ``dest`` is a link to a folder, naming ``dest`` and the folder.
     """
     if not dest.is_symlink():
         return dest
     try:
-        return Path(os.path.realpath(dest, strict=True))
-    except FileNotFoundError:
-        return Path(os.path.realpath(dest))  # dangling: its target is created, as open() does
+        target = Path(os.path.realpath(dest, strict=True))
     except OSError as exc:
+        if exc.errno != errno.ELOOP:
+            # dangling: its target is created, as open() does; or a path open() refuses too (a
+            # file where a folder should be), said by _writable_destination, not as a loop
+            return Path(os.path.realpath(dest))
         loop = OSError(f"cannot write {dest}: it is a link that loops")  # str() without [Errno 40]
         loop.errno = errno.ELOOP
         raise loop from exc
+    if target.is_dir():  # said of the folder alone, the name the user gave was not in it
+        raise IsADirectoryError(
+            f"cannot write {dest}: it is a link to the folder {target}; give a file name"
+        )
+    return target
+
+
+def _one_file(a: Path, b: Path) -> bool:
+    """Whether ``a`` and ``b`` name one file: through links (theirs or their folders') or as
+    hard links of one another."""
+    if os.path.realpath(a) == os.path.realpath(b):
+        return True
+    try:
+        return os.path.samefile(a, b)
+    except OSError:  # one of them does not exist yet: not one file
+        return False
 
 
 def _writable_destination(dest: Path) -> Path:
@@ -421,15 +441,27 @@ def write_together(files: list[tuple[Path, bytes]]) -> None:
     ------
     IsADirectoryError, NotADirectoryError, FileNotFoundError, OSError
         As :func:`atomic_write`, for any destination, before anything is written.
+    ValueError
+        If two destinations are one file (a link to the other, a hard link, the same name
+        twice): the second would replace the first. Nothing is written.
     """
     import shutil
 
     # checked first, in atomic_write's words: os.replace's error named the temporary file
     # ('Is a directory: .../.right.yaml.x1y2.tmp -> .../right.yaml')
     # a link is written through (its target replaced, the link kept), as open(path, "w") does
+    given = [dest for dest, _ in files]
     files = [(_through_links(dest), data) for dest, data in files]
     for dest, _ in files:
         _writable_destination(dest)
+    # written through links, right.yaml -> left.yaml put the right camera over the left one
+    for i, (dest, _) in enumerate(files):
+        for j in range(i):
+            if _one_file(files[j][0], dest):
+                raise ValueError(
+                    f"cannot write {given[j]} and {given[i]} together: they are one file (the "
+                    "second would replace the first)"
+                )
     temps: list[Path] = []  # the new contents, not yet in place
     kept: list[tuple[Path, Path | None]] = []  # (destination, its previous contents or None)
     replaced = 0  # how many of kept's destinations hold their new contents
