@@ -1982,3 +1982,25 @@ def test_a_warning_with_an_empty_message_is_one_line_not_an_error(
     monkeypatch.setattr(cli, "cmd_info", warns)
     assert cli.main(["info"]) == 0
     assert capsys.readouterr() == ("done\n", "stereovision: warning: UserWarning\n")
+
+
+def test_a_warning_whose_message_opens_with_a_blank_line_says_its_text(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A message opening with a line break (``"\\nThe array is ..."``, as some libraries write
+    them) was printed as 'stereovision: warning: ' and nothing else: its first line, empty, was
+    taken. Its first line with text is said; one of blanks only is named by its category."""
+    import warnings
+
+    from stereovision import cli
+
+    def warns(args: object) -> int:
+        warnings.warn("\n  \nthe text\nmore", RuntimeWarning, stacklevel=1)
+        warnings.warn(" \n ", UserWarning, stacklevel=1)
+        return 0
+
+    monkeypatch.setattr(cli, "cmd_info", warns)
+    assert cli.main(["info"]) == 0
+    assert capsys.readouterr().err == (
+        "stereovision: warning: the text\nstereovision: warning: UserWarning\n"
+    )

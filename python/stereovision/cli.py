@@ -1860,9 +1860,11 @@ def _one_line_warning(
     file: Any = None,
     line: str | None = None,
 ) -> None:
-    """Warnings as one line, like the errors (not Python's file:line and source echo); one
-    with no message (``warnings.warn(SomeWarning())``) is named by its category."""
-    text = str(message).splitlines()
+    """Warnings as one line, like the errors (not Python's file:line and source echo): the
+    message's first line with text; one with none (``warnings.warn(SomeWarning())``) is named
+    by its category."""
+    # the first line with text: a message opening with a line break said nothing
+    text = [line for line in str(message).splitlines() if line.strip()]
     print(f"stereovision: warning: {text[0] if text else category.__name__}", file=sys.stderr)
 
 
