@@ -236,8 +236,8 @@ def test_npz_bundle(result, tmp_path):
 
 def test_npz_bundle_keeps_the_searched_range_and_older_bundles_load(result, tmp_path):
     """The bundle kept max_disparity but not min_disparity: a result searched over [8, 40] px
-    read back as if searched from 0. It is kept now; a bundle written before has the
-    DepthResult default, 0.0."""
+    read back as if searched from 0. It is kept now; a bundle written before has none (as
+    depth_sigma): given 0.0, an older [8, 40] px bundle still read back as [0, 40]."""
     ranged = replace(result, min_disparity=8.0, max_disparity=40)
     data = export.read_npz(export.write_npz(tmp_path / "r.npz", ranged))
     assert (data["min_disparity"], data["max_disparity"]) == (8.0, 40)
@@ -245,7 +245,7 @@ def test_npz_bundle_keeps_the_searched_range_and_older_bundles_load(result, tmp_
     older = {k: v for k, v in np.load(tmp_path / "r.npz").items() if k != "min_disparity"}
     np.savez_compressed(tmp_path / "old.npz", **older)
     data = export.read_npz(tmp_path / "old.npz")
-    assert (data["min_disparity"], data["max_disparity"]) == (0.0, 40)
+    assert "min_disparity" not in data and data["max_disparity"] == 40
 
 
 def test_export_result_writes_all(result, tmp_path):

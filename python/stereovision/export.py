@@ -10,7 +10,8 @@ Conventions shared with pyvista, Open3D, MeshLab and PCL:
   ``HEIGHT`` = image height, row-major), pixels without depth are NaN points (``is_dense`` false).
 - NPZ: ``depth``, ``confidence``, ``disparity`` (H, W float32, NaN = none), ``K`` (3x3),
   ``baseline`` (metres), ``doffs`` (pixels), ``image_size`` (W, H), ``method``, ``max_disparity``
-  (int64; float64 for a fractional range).
+  (int64; float64 for a fractional range), ``min_disparity`` (float64), ``depth_sigma`` (H, W
+  float32, metres).
 - 16-bit PNG: depth in millimetres (ROS ``16UC1``, TUM RGB-D, Open3D), disparity times 256
   (KITTI); 0 = none.
 
@@ -485,9 +486,9 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     dict
         ``depth``, ``confidence``, ``disparity`` (H, W) float32, ``K`` (3, 3), ``baseline``,
         ``doffs``, ``image_size``, ``method``, ``max_disparity``, ``min_disparity`` (a float;
-        0.0, the :class:`~stereovision.depth.DepthResult` default, for bundles written before
-        it was stored), and ``depth_sigma`` (H, W) float32, the depth's one-sigma uncertainty
-        in metres (absent from older bundles).
+        absent from bundles written before it was stored: their search may have started above
+        0), and ``depth_sigma`` (H, W) float32, the depth's one-sigma uncertainty in metres
+        (absent from older bundles).
 
     Raises
     ------
@@ -515,7 +516,6 @@ def read_npz(path: PathLike) -> dict[str, Any]:
     for key, value in list(data.items()):
         if value.ndim == 0:
             data[key] = value.item()
-    data.setdefault("min_disparity", 0.0)  # bundles written before it was stored searched from 0
     return data
 
 
