@@ -1364,3 +1364,28 @@ def test_write_together_refuses_two_destinations_that_are_one_file(tmp_path: Pat
         )
     assert (tmp_path / "left.yaml").read_text() == "old"
     assert sorted(os.listdir(tmp_path)) == ["hard.yaml", "left.yaml", "right.yaml", "same"]
+
+
+def test_writers_keep_the_permissions_of_the_file_they_replace(tmp_path: Path) -> None:
+    """A private file (0600) replaced by atomic_write or write_together came back 0644 (a new
+    file's mode), readable by every user; through a link, a private target elsewhere was
+    opened up so. open(path, "w") keeps a file's mode: so do they. A new file still gets a
+    plain open()'s (0666 less the umask)."""
+    (tmp_path / "rigs").mkdir()
+    private = tmp_path / "rigs" / "rig.yaml"
+    private.write_text("old")
+    private.chmod(0o600)
+    (tmp_path / "rig.yaml").symlink_to(Path("rigs") / "rig.yaml")
+    shared = tmp_path / "map.yaml"
+    shared.write_text("old")
+    shared.chmod(0o640)
+    with atomic_write(tmp_path / "rig.yaml", "w") as fh:
+        fh.write("new")
+    assert private.read_text() == "new" and private.stat().st_mode & 0o777 == 0o600
+    private.chmod(0o400)  # read-only to its owner: replaced all the same, as before
+    write_together([(tmp_path / "rig.yaml", b"newer"), (shared, b"new"), (tmp_path / "n", b"")])
+    assert private.read_bytes() == b"newer" and private.stat().st_mode & 0o777 == 0o400
+    assert shared.read_bytes() == b"new" and shared.stat().st_mode & 0o777 == 0o640
+    umask = os.umask(0)
+    os.umask(umask)
+    assert (tmp_path / "n").stat().st_mode & 0o777 == 0o666 & ~umask

@@ -18,6 +18,7 @@ import errno
 import math
 import os
 import re
+import stat
 import tempfile
 import threading
 from collections.abc import Iterator, Sequence
@@ -67,6 +68,18 @@ def _current_umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return mask
+
+
+def _mode_for(dest: Path) -> int:
+    """The permissions a new ``dest`` gets: those of the file it replaces, as ``open(dest, "w")``
+    keeps them (a private 0600 file came back 0644), else a plain open()'s (not mkstemp's 0600).
+    """
+    try:
+        st = os.stat(dest)
+    except OSError:  # none yet (or unreadable: replaced all the same)
+        return 0o666 & ~_current_umask()
+    # permission bits only: a set-user-ID bit is not carried to new contents
+    return st.st_mode & 0o777 if stat.S_ISREG(st.st_mode) else 0o666 & ~_current_umask()
 
 
 def make_folder(path: PathLike) -> Path:
@@ -409,8 +422,9 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
-        # mkstemp creates 0600; give the result the permissions a plain open() would.
-        os.chmod(tmp, 0o666 & ~_current_umask())
+        # mkstemp creates 0600; give the result the permissions open() would (the replaced
+        # file's, else a new file's)
+        os.chmod(tmp, _mode_for(dest))
         os.replace(tmp, dest)
     except BaseException:
         try:
@@ -473,7 +487,7 @@ def write_together(files: list[tuple[Path, bytes]]) -> None:
                 fh.write(data)
                 fh.flush()
                 os.fsync(fh.fileno())
-            os.chmod(name, 0o666 & ~_current_umask())  # mkstemp's 0600 -> a plain open()'s
+            os.chmod(name, _mode_for(dest))  # mkstemp's 0600 -> what open() leaves
         for (dest, _), new in zip(files, temps, strict=True):
             previous: Path | None = None
             if dest.is_file():
