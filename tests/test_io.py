@@ -1389,3 +1389,34 @@ def test_writers_keep_the_permissions_of_the_file_they_replace(tmp_path: Path) -
     umask = os.umask(0)
     os.umask(umask)
     assert (tmp_path / "n").stat().st_mode & 0o777 == 0o666 & ~umask
+
+
+def test_a_folder_without_write_permission_is_named_not_the_temporary_file(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The new contents are made beside the file (through a link: beside its target) and put in
+    place; in a folder the user may not write, the error was '[Errno 13] Permission denied:
+    '.../.rig.yaml.k2j3abcd.tmp'', a file the user never named. The file and its folder are
+    named. (mkstemp refusing stands for the folder's mode: the tests may run as root.)"""
+    import tempfile
+
+    (tmp_path / "ro").mkdir()
+    (tmp_path / "ro" / "rig.yaml").write_text("old")
+    (tmp_path / "rig.yaml").symlink_to(Path("ro") / "rig.yaml")
+
+    def refused(prefix: str = "", suffix: str = "", dir: object = None) -> tuple[int, str]:
+        raise PermissionError(13, "Permission denied", f"{dir}/{prefix}k2j3abcd{suffix}")
+
+    monkeypatch.setattr(tempfile, "mkstemp", refused)
+    want = (
+        f"cannot write {tmp_path / 'ro' / 'rig.yaml'}: its folder {tmp_path / 'ro'} is not "
+        "writable (the new contents are made there, then put in place)"
+    )
+    with pytest.raises(PermissionError) as info:
+        with atomic_write(tmp_path / "rig.yaml") as fh:
+            fh.write(b"x")
+    assert str(info.value) == want
+    with pytest.raises(PermissionError) as together:
+        write_together([(tmp_path / "rig.yaml", b"x")])
+    assert str(together.value) == want
+    assert (tmp_path / "ro" / "rig.yaml").read_text() == "old"

@@ -386,6 +386,22 @@ def _writable_destination(dest: Path) -> Path:
     return directory
 
 
+def _temp_beside(dest: Path, suffix: str) -> tuple[int, str]:
+    """A new temporary file in ``dest``'s folder (``os.replace`` is atomic within a filesystem
+    only), open; a folder the user may not write is named, not the temporary file ('[Errno 13]
+    Permission denied: '.../.rig.yaml.k2j3abcd.tmp'')."""
+    directory = dest.parent if str(dest.parent) else Path(".")
+    try:
+        return tempfile.mkstemp(prefix=f".{dest.name}.", suffix=suffix, dir=directory)
+    except PermissionError as exc:
+        refused = PermissionError(
+            f"cannot write {dest}: its folder {directory} is not writable (the new contents "
+            "are made there, then put in place)"
+        )
+        refused.errno = errno.EACCES
+        raise refused from exc
+
+
 @contextmanager
 def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
     """Open a temporary file next to ``path``; on success it atomically replaces ``path``.
@@ -414,8 +430,8 @@ def atomic_write(path: PathLike, mode: str = "wb") -> Iterator[IO[Any]]:
         If ``path`` is a link that loops.
     """
     dest = _through_links(Path(path))
-    directory = _writable_destination(dest)
-    fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=directory)
+    _writable_destination(dest)
+    fd, tmp = _temp_beside(dest, ".tmp")
     try:
         encoding = None if "b" in mode else "utf-8"
         with os.fdopen(fd, mode, encoding=encoding) as fh:
@@ -481,7 +497,7 @@ def write_together(files: list[tuple[Path, bytes]]) -> None:
     replaced = 0  # how many of kept's destinations hold their new contents
     try:
         for dest, data in files:
-            fd, name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=dest.parent)
+            fd, name = _temp_beside(dest, ".tmp")
             temps.append(Path(name))
             with os.fdopen(fd, "wb") as fh:
                 fh.write(data)
@@ -491,7 +507,7 @@ def write_together(files: list[tuple[Path, bytes]]) -> None:
         for (dest, _), new in zip(files, temps, strict=True):
             previous: Path | None = None
             if dest.is_file():
-                fd, name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".old", dir=dest.parent)
+                fd, name = _temp_beside(dest, ".old")
                 os.close(fd)
                 previous = Path(name)
             # listed before the copy: a copy failing half-way (a full disk) is removed below
