@@ -1634,3 +1634,37 @@ def test_model_selection_starts_at_its_minimum_of_views(cached_corners: None) ->
     assert sorted(rep.model_selection) == sorted(calmod.AUTO_CANDIDATES)
     _, rep = calibrate(left[: n - 1], right[: n - 1], square_size=1.0)
     assert rep.model_selection == {} and rep.distortion_model == calmod.AUTO_CANDIDATES[0]
+
+
+def test_cli_an_output_link_is_checked_in_its_targets_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """-o rig.yaml, a link into a folder the user may not write: the file is written through
+    the link (beside its target), but the early check probed the link's folder, so the run
+    calibrated and then failed at the write. The target's folder is checked, before any
+    corner is looked for. (The probe is faked: the tests may run as root.)"""
+    import stereovision.io as iomod
+
+    def no_work(*_: Any, **__: Any) -> Any:
+        raise AssertionError("the corners were looked for before the outputs were checked")
+
+    monkeypatch.setattr(calmod, "find_corners", no_work)
+    left, right = _chessboard_paths()
+    (tmp_path / "ro").mkdir()
+    (tmp_path / "ro" / "rig.yaml").write_text("kept\n")
+    (tmp_path / "rig.yaml").symlink_to(Path("ro") / "rig.yaml")
+    real_probe = iomod.cannot_write_in
+    monkeypatch.setattr(
+        iomod,
+        "cannot_write_in",
+        lambda f: "Permission denied" if Path(f) == tmp_path / "ro" else real_probe(f),
+    )
+    a = _parser().parse_args(["calibrate", "--left", str(left[0].parent / "left0*.jpg"),
+                              "--right", str(right[0].parent / "right0*.jpg"), "--square",
+                              "0.025", "-o", str(tmp_path / "rig.yaml")])  # fmt: skip
+    with pytest.raises(PermissionError) as info:
+        a.func(a)
+    assert str(info.value) == (
+        f"-o {tmp_path / 'rig.yaml'}: cannot write in {tmp_path / 'ro'} (Permission denied)"
+    )
+    assert (tmp_path / "ro" / "rig.yaml").read_text() == "kept\n"

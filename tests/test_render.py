@@ -1319,3 +1319,40 @@ def test_controls_take_numpy_numbers_and_refuse_bools():
     for bad in (True, 2**1100):
         with pytest.raises(ValueError, match=r"^camera control roll must be a finite number"):
             CameraControls(roll=bad)
+
+
+def test_view_checks_a_screenshot_links_target_folder_before_any_work(
+    result, tmp_path, monkeypatch
+):
+    """-o shot.png, a link: the screenshot is written through it, beside its target, but the
+    early checks looked at the link's folder, so a target folder that is missing or not
+    writable was found after the render. Its target's folder is checked first. (The probe is
+    faked: the tests may run as root.)"""
+    import stereovision.io as iomod
+    from stereovision.export import write_cloud_ply
+
+    write_cloud_ply(tmp_path / "cloud.ply", result)
+
+    def no_work(*_args, **_kw):
+        raise AssertionError("the source was loaded before the -o check")
+
+    monkeypatch.setattr(render, "load_view_source", no_work)
+    (tmp_path / "gone.png").symlink_to(Path("missing") / "shot.png")
+    args = _view_args(tmp_path, tmp_path / "gone.png")
+    with pytest.raises(FileNotFoundError) as missing:
+        args.func(args)
+    assert str(missing.value) == f"output folder does not exist: {tmp_path / 'missing'}"
+    (tmp_path / "ro").mkdir()
+    (tmp_path / "shot.png").symlink_to(Path("ro") / "shot.png")
+    real_probe = iomod.cannot_write_in
+    monkeypatch.setattr(
+        iomod,
+        "cannot_write_in",
+        lambda f: "Permission denied" if Path(f) == tmp_path / "ro" else real_probe(f),
+    )
+    args = _view_args(tmp_path, tmp_path / "shot.png")
+    with pytest.raises(PermissionError) as info:
+        args.func(args)
+    assert str(info.value) == (
+        f"-o {tmp_path / 'shot.png'}: cannot write in {tmp_path / 'ro'} (Permission denied)"
+    )

@@ -2539,13 +2539,18 @@ def _check_output_file(
     ValueError
         If ``out`` is a folder, or is one of the files ``--ros`` or ``--report`` write.
     PermissionError
-        If ``out``'s folder (or ``out`` itself, when it exists) is not writable.
+        If ``out``'s folder (a link's: its target's, where the file is written) or ``out``
+        itself, when it exists, is not writable.
+    OSError
+        If ``out`` is a link that loops.
     """
     if out.is_dir():
         raise ValueError(f"-o {given}: is a folder; give a calibration file name")
-    from stereovision.io import cannot_write_in
+    from stereovision.io import _through_links, cannot_write_in
 
-    folder = out.parent if str(out.parent) else Path(".")
+    # a link is written through: the new file is made beside its target, not beside the link
+    dest = _through_links(out)
+    folder = dest.parent if str(dest.parent) else Path(".")
     why = cannot_write_in(folder)
     if why:
         raise PermissionError(f"-o {given}: cannot write in {folder} ({why})")

@@ -1297,14 +1297,16 @@ def _check_screenshot_path(output: str | os.PathLike[str], source: str | os.Path
     PermissionError
         No file can be made in the folder of ``output`` (the system's reason).
     """
-    from stereovision.io import cannot_write_in, refuse_an_input
+    from stereovision.io import _through_links, cannot_write_in, refuse_an_input
 
     out = Path(output)
     if out.suffix.lower() not in SCREENSHOT_SUFFIXES:
         raise ValueError(f"{out}: a screenshot is written as .png, .jpg or .bmp")
     if out.is_dir():
         raise IsADirectoryError(f"-o {out}: is a folder; give the screenshot a file name")
-    parent = out.parent
+    # a link is written through: the new file is made beside its target, not beside the link
+    dest = _through_links(out)
+    parent = dest.parent
     if parent.exists() and not parent.is_dir():
         raise NotADirectoryError(f"-o {out}: {parent} is a file, not a folder")
     if not parent.exists():
