@@ -711,8 +711,9 @@ def test_cli_check_default_tolerance_is_half_a_pixel() -> None:
 def test_cli_check_fix_json_keeps_stdout_one_object(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """``check --json --fix OUT`` onto an existing file: stdout holds the check and the
-    correction as JSON only; the line naming the earlier file's copy goes to stderr."""
+    """``check --json --fix OUT`` onto an existing file: stdout is one JSON object, the check's
+    with the correction under ``"fixed"`` (it was two JSON lines, which one ``json.loads`` of
+    the output refused); the line naming the earlier file's copy goes to stderr."""
     from stereovision.cli import main
 
     cones = data_dir / "middlebury2003" / "cones"
@@ -721,10 +722,13 @@ def test_cli_check_fix_json_keeps_stdout_one_object(
     pair = [str(cones / "left.png"), str(cones / "right.png")]
     assert main(["check", *pair, "--calib", str(bumped), "--fix", str(earlier), "--json"]) == 0
     out, err = capsys.readouterr()
-    first, second = out.splitlines()
-    assert json.loads(first)["ok"] is False
-    fixed = json.loads(second)
-    assert fixed["fixed"]["ok"] is True and fixed["turn_deg"] == pytest.approx(0.3, abs=0.05)
+    assert out.count("\n") == 1
+    said = json.loads(out)
+    assert said["ok"] is False and said["median_dy"] > 0.5
+    fixed = said["fixed"]
+    assert fixed["check"]["ok"] is True and fixed["check"]["median_dy"] < 0.5
+    assert fixed["turn_deg"] == pytest.approx(0.3, abs=0.05)
+    assert fixed["written"] == str(earlier)
     kept = tmp_path / "rig2.previous.yaml"
     assert err == f"stereovision: {earlier} replaced; the earlier file is {kept}\n"
 
@@ -753,5 +757,13 @@ def test_cli_check_fix_that_still_fails_writes_nothing_and_exits_1(
     assert main(["check", *pair, "--calib", str(rig), "--fix", str(fixed)]) == 1
     out, err = capsys.readouterr()
     assert out.splitlines()[1].startswith("corrected (the right camera turned 0.000 degrees)")
+    assert err == "stereovision: the corrected calibration still fails: not written\n"
+    assert not fixed.exists()
+    # with --json: one object, the correction's check failing too, no file written
+    assert main(["check", *pair, "--calib", str(rig), "--fix", str(fixed), "--json"]) == 1
+    out, err = capsys.readouterr()
+    said = json.loads(out)
+    assert said["ok"] is False and said["fixed"]["check"]["ok"] is False
+    assert said["fixed"]["written"] is None and said["fixed"]["turn_deg"] == 0.0
     assert err == "stereovision: the corrected calibration still fails: not written\n"
     assert not fixed.exists()

@@ -925,7 +925,11 @@ def cmd_check(args: argparse.Namespace) -> int:
             print(
                 f"stereovision: {plot} replaced; the earlier file is {kept_plot}", file=sys.stderr
             )
-    print(json.dumps(res.as_dict()) if args.json else res.summary())
+    said = res.as_dict()  # with --json, printed once at the end: stdout is the one JSON object
+    if not args.json:
+        print(res.summary())
+    elif fix is None or res.ok is None:
+        print(json.dumps(said))
     if res.ok is False and not res.swapped and not args.json and fix is None:
         print(
             "  the calibration no longer rectifies this rig: recalibrate, or correct the right "
@@ -964,25 +968,31 @@ def cmd_check(args: argparse.Namespace) -> int:
         except ValueError as exc:
             why = str(exc).removeprefix("cannot refine: ")
     if why is not None:
+        if args.json:
+            print(json.dumps(said))
         print(f"stereovision: not corrected, nothing written to {fix}: {why}", file=sys.stderr)
         return 1
     turn = float(np.degrees(np.linalg.norm(cv2.Rodrigues(fixed.R @ calib.R.T)[0])))
-    if args.json:
-        print(json.dumps({"fixed": after.as_dict(), "turn_deg": turn}))
-    else:
+    said["fixed"] = {"turn_deg": turn, "check": after.as_dict(), "written": None}
+    if not args.json:
         print(f"corrected (the right camera turned {turn:.3f} degrees): {after.summary()}")
     if not after.ok:
+        if args.json:
+            print(json.dumps(said))
         print("stereovision: the corrected calibration still fails: not written", file=sys.stderr)
         return 1
     from stereovision.io import keep_previous
 
     kept = keep_previous(fix)
     fixed.save(fix)
+    said["fixed"]["written"] = str(fix)
     replaced = f" (the one it replaced kept as {kept})" if kept else ""
     if not args.json:
         print(f"corrected calibration written to {fix}{replaced}")
-    elif kept:  # stdout is the one JSON object
-        print(f"stereovision: {fix} replaced; the earlier file is {kept}", file=sys.stderr)
+    else:
+        print(json.dumps(said))
+        if kept:  # on stderr: stdout is the one JSON object
+            print(f"stereovision: {fix} replaced; the earlier file is {kept}", file=sys.stderr)
     return 0
 
 
@@ -1762,7 +1772,12 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("--calib", help="the rig's calibration (omit for a rectified pair)")
     add_calib_unit(d)
     d.add_argument("--tolerance", type=float, default=0.5, help="median |dy| in px (default 0.5)")
-    d.add_argument("--json", action="store_true", help="one JSON object instead of a line")
+    d.add_argument(
+        "--json",
+        action="store_true",
+        help='one JSON object instead of the lines (with --fix, the correction under "fixed": '
+        "turn_deg, its check, the file written or null)",
+    )
     d.add_argument("--plot", metavar="PNG", help="draw the rectified pair and its matches")
     d.add_argument(
         "--fix",
