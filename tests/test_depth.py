@@ -251,7 +251,7 @@ def test_too_narrow_images_are_named_not_a_range_never_given(width: int) -> None
         rf"least 17 px wide; give a max_disparity below {width} to match it$",
     ):
         sv.depth_map(left, right, calib)
-    res = sv.depth_map(left, right, calib, max_disparity=width // 2, method="census")
+    res = sv.depth_map(left, right, calib, max_disparity=width // 2, method="best")
     assert res.disparity.shape == (12, width) and res.max_disparity == width // 2
     with pytest.raises(ValueError, match=rf"disparity range 40 is not smaller .* width {width}"):
         sv.depth_map(left, right, calib, max_disparity=40)
@@ -268,6 +268,27 @@ def test_swapped_pair_is_warned_about(data_dir: Path) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         sv.estimate_max_disparity(s.left, s.right)
+
+
+def test_swapped_warning_points_at_the_callers_line(data_dir: Path) -> None:
+    """The swapped warning names the user's line, through ``depth_map`` and ``match`` as when
+    ``estimate_max_disparity`` is called directly (a fixed stacklevel named a line of depth.py
+    through ``depth_map``)."""
+    import warnings
+
+    s = load_scene(data_dir / "middlebury2003" / "cones")
+    calls = (
+        lambda: sv.estimate_max_disparity(s.right, s.left),
+        lambda: sv.depth_map(s.right, s.left),
+        lambda: sv.match(s.right, s.left, method="best"),
+    )
+    for call in calls:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            call()
+        said = [w for w in caught if "look swapped" in str(w.message)]
+        assert len(said) == 1
+        assert said[0].filename == __file__, said[0].filename
 
 
 def test_auto_max_disparity_on_real_scene(data_dir: Path) -> None:
@@ -875,7 +896,7 @@ def test_min_disparity_above_the_automatic_range_names_the_estimate() -> None:
         "min_disparity (20) is not below the automatic max_disparity (16, estimated from the "
         "pair): give a max_disparity above 20"
     )
-    res = sv.depth_map(left, right, min_disparity=20, max_disparity=24, method="census")
+    res = sv.depth_map(left, right, min_disparity=20, max_disparity=24, method="best")
     assert res.disparity.shape == (32, 64)
 
 

@@ -14,6 +14,8 @@ from __future__ import annotations
 import functools
 import inspect
 import math
+import os
+import sys
 import warnings
 from collections.abc import Callable
 from typing import Any, TypeVar, cast
@@ -835,6 +837,27 @@ def remap_image(img: np.ndarray, *args: Any, **kwargs: Any) -> np.ndarray:
         work = img.astype(np.float64)
     out = np.asarray(cv2.remap(work, *args, **kwargs))
     return out if out.dtype == img.dtype else out.astype(img.dtype)
+
+
+def user_stacklevel() -> int:
+    """The ``stacklevel`` that points a warning at the first frame outside this package.
+
+    For a warning raised by a helper that public functions reach at different depths (the
+    swapped-pair warning: ``estimate_max_disparity`` called directly, or through ``depth_map``
+    or ``match``), where a fixed ``stacklevel`` is right for one path only.
+
+    Returns
+    -------
+    int
+        The level to pass to :func:`warnings.warn` from the function calling this one.
+    """
+    package = os.path.dirname(os.path.abspath(__file__)) + os.sep
+    frame = sys._getframe(1)  # the function that will call warnings.warn: stacklevel 1
+    level = 1
+    while frame.f_back is not None and frame.f_code.co_filename.startswith(package):
+        frame = frame.f_back
+        level += 1
+    return level
 
 
 def renamed_keyword(old: str, new: str) -> Callable[[_F], _F]:

@@ -31,6 +31,7 @@ from stereovision._validate import (
     check_pair,
     finite_number,
     unreachable_range,
+    user_stacklevel,
 )
 from stereovision._validate import pixels_shown as _px
 from stereovision.calibration import Calibration
@@ -321,7 +322,7 @@ def _warn_if_swapped(d: npt.NDArray[np.float64]) -> None:
             "matches have a negative disparity (x_left < x_right); pass the left camera's "
             "image first",
             UserWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),  # the user's line, through depth_map or match too
         )
 
 
