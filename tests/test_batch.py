@@ -1708,6 +1708,33 @@ def test_a_changed_pair_is_redone_from_another_working_directory(
     assert s["run"]["processed"] == 1 and s["pairs"]["a"]["this_run"] == "processed"
 
 
+def test_the_summary_records_the_files_read_through_a_link_and_dotdot(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``batch home/link/../drive`` with ``link`` a link to ``real/sub``: the OS reads
+    ``real/drive``, but the summary recorded ``home/drive`` (os.path.abspath folds '..' as
+    text), a file never read; after a run over another input, the changed pair was then
+    refused as made from other images (exit 2). It records the files read (io.load_scene's
+    rule: a '..' after a link goes up from its target)."""
+    _tiny(tmp_path, data_dir, "real/drive/a/left.png", "real/drive/a/right.png")
+    _tiny(tmp_path, data_dir, "other/b/left.png", "other/b/right.png")
+    (tmp_path / "real/sub").mkdir()
+    (tmp_path / "home").mkdir()
+    (tmp_path / "home/link").symlink_to(tmp_path / "real/sub", target_is_directory=True)
+    given, out = tmp_path / "home/link/../drive", tmp_path / "out"
+    args = ["-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(["batch", str(given), *args]) == 0
+    pair = _summary(out)["pairs"]["a"]
+    assert pair["left"] == str(tmp_path / "real/drive/a/left.png")
+    assert pair["right"] == str(tmp_path / "real/drive/a/right.png")
+    assert main(["batch", str(tmp_path / "other"), *args]) == 0
+    _change(tmp_path / "real/drive/a/left.png")  # changed: to be redone
+    capsys.readouterr()
+    assert main(["batch", str(given), *args]) == 0, capsys.readouterr().err
+    s = _summary(out)
+    assert s["run"]["processed"] == 1 and s["pairs"]["a"]["this_run"] == "processed"
+
+
 def test_the_progress_lines_estimate_the_time_left_from_the_pairs_pace(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:

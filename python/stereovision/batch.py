@@ -739,8 +739,12 @@ def _same_content(entry: dict[str, Any], fp: dict[str, Any], job: PairJob) -> bo
 
 def _recorded(path: Path) -> str:
     """``path`` as the summary records it: absolute (a path relative to one run's working
-    directory named another file, or none, for a run from another one)."""
-    return os.path.abspath(path)
+    directory named another file, or none, for a run from another one), each '..' folded as
+    the OS follows it (``os.path.abspath`` made ``home/link/../x`` ``home/x``, not the ``x``
+    read beside the link's target)."""
+    from stereovision.io import _absolute_as_read
+
+    return str(_absolute_as_read(Path(path)))
 
 
 def _same_file(recorded: Any, path: Path) -> bool:
