@@ -990,6 +990,31 @@ def test_batch_refuses_to_replace_a_file_it_did_not_write(
     assert cv2.imread(str(out / "a" / "disparity.png")) is not None
 
 
+def test_batch_refuses_to_replace_a_link_put_under_an_output_name_it_wrote(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A pair's disparity.png (recorded as written) that the user replaced by a link to a file
+    of theirs: the redo replaced the link with its own file, unsaid (a redo that does not write
+    the name keeps such a link). Refused before any work, one line naming it, exit 2."""
+    src, out = tmp_path / "drive", tmp_path / "out"
+    _tiny(src, data_dir, "a/left.png", "a/right.png")
+    args = ["--workers", "1", "--max-disparity", "16"]
+    assert main(["batch", str(src), "-o", str(out), *args]) == 0
+    mine = tmp_path / "mine.png"
+    mine.write_bytes(b"mine")
+    (out / "a" / "disparity.png").unlink()
+    (out / "a" / "disparity.png").symlink_to(mine)
+    _change(src / "a/left.png")  # changed: to be redone
+    capsys.readouterr()
+    assert main(["batch", str(src), "-o", str(out), *args]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: error: output folder {out}: {out / 'a' / 'disparity.png'} is a link, "
+        "not the file an earlier run wrote there, and would be replaced: give another output "
+        "folder, or move or remove that file"
+    ]
+    assert (out / "a" / "disparity.png").is_symlink() and mine.read_bytes() == b"mine"
+
+
 def test_batch_resumes_a_pair_written_by_a_run_killed_before_recording_it(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

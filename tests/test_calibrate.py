@@ -788,6 +788,20 @@ def test_cli_ros_and_report_files_of_the_users_are_not_replaced(
         "report.json",
         "report.yaml",
     ]
+    # the listed report.html replaced by a link to a page of the user's: it was written through
+    # (io.atomic_write writes through a link, as open() does), the user's page overwritten
+    mine = tmp_path / "mine.html"
+    mine.write_text("mine\n")
+    (rep / "report.html").unlink()
+    (rep / "report.html").symlink_to(mine)
+    monkeypatch.setattr(calmod, "find_corners", no_work)
+    with pytest.raises(FileExistsError) as info:
+        run("--report", str(rep))
+    assert str(info.value) == (
+        f"--report {rep}: {rep / 'report.html'} is a link, not the file an earlier run wrote "
+        "there, and would be replaced: give another --report folder, or move or remove that file"
+    )
+    assert (rep / "report.html").is_symlink() and mine.read_text() == "mine\n"
 
 
 def test_patterns_too_small_or_not_integers_are_refused(tmp_path: Path) -> None:

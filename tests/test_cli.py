@@ -718,6 +718,39 @@ def test_demo_refuses_a_link_under_an_output_name(
     assert sorted(p.name for p in out.iterdir()) == ["cloud.ply"]
 
 
+def test_depth_refuses_a_link_put_under_an_output_name_an_earlier_run_wrote(
+    tmp_path: Path, data_dir: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An earlier run's disparity.png that the user replaced by a link to a file of theirs: a
+    rerun replaced the link with its own file, unsaid (a run that does not write the name keeps
+    such a link: commit_outputs). Refused before any work, as a link the manifest does not list."""
+    src = data_dir / "middlebury2001" / "tsukuba"
+    for side in ("left", "right"):
+        cv2.imwrite(
+            str(tmp_path / f"{side}.png"), cv2.imread(str(src / f"{side}.png"))[100:164, 150:246]
+        )
+    out = tmp_path / "out"
+    argv = ["depth", str(tmp_path / "left.png"), str(tmp_path / "right.png"), "-o", str(out),
+            "--max-disparity", "16", "--method", "fast"]  # fmt: skip
+    assert main(argv) == 0
+    mine = tmp_path / "mine.png"
+    mine.write_bytes(b"mine")
+    (out / "disparity.png").unlink()
+    (out / "disparity.png").symlink_to(mine)
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    capsys.readouterr()
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == (
+        f"stereovision: error: -o {out}: {out / 'disparity.png'} is a link, not the file an "
+        "earlier run wrote there, and would be replaced: give another -o folder, or move or "
+        "remove that file\n"
+    )
+    assert (out / "disparity.png").is_symlink() and mine.read_bytes() == b"mine"
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
+
+
 def test_a_12_bit_pair_gets_one_warning_line_per_image(tmp_path: Path, data_dir: Path) -> None:
     """A 12-bit pair in 16-bit PNGs printed four warning lines, two per image (the 8-bit copy's
     and the grey image's conversions each warned)."""

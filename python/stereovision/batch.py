@@ -760,7 +760,8 @@ def _foreign_output(
     dest: Path, job: PairJob, opts: dict[str, Any], recorded: list[str] | None
 ) -> Path | None:
     """The first file in the pair's folder ``dest`` under a name this run may write for it
-    that no earlier run recorded writing (``recorded``, from the summary), else None."""
+    that no earlier run recorded writing (``recorded``, from the summary), or a link (the
+    user's, recorded or not: :func:`stereovision.cli.foreign_outputs`), else None."""
     from stereovision.cli import foreign_outputs, planned_depth_outputs
 
     if not dest.is_dir():
@@ -1391,6 +1392,7 @@ def run_batch(
         changes: set[str] = set()
         others: list[tuple[str, str]] = []  # done from another input folder's images: (name, image)
         foreign: Path | None = None  # a file under an output name no run recorded writing
+        foreign_listed: list[str] = []  # the outputs recorded in its pair's folder
         unreadable: list[tuple[PairJob, str]] = []  # an image or calibration not there
         for job in jobs:
             try:
@@ -1459,6 +1461,7 @@ def run_batch(
                     # that was not its own before it began, so what is there now is its output
                     recorded += _pending_outputs(entry)
                 foreign = _foreign_output(out / job.name, job, opts, recorded)
+                foreign_listed = recorded
         if others:
             # a second drive under the same pair names replaced the first one's outputs, unsaid
             name, image = others[0]
@@ -1469,9 +1472,11 @@ def run_batch(
                 f"another output folder, or remove those pairs' folders to replace them"
             )
         if foreign is not None:  # the user's own file in a pair's folder: replaced, unsaid
+            from stereovision.cli import not_ours
+
             raise FileExistsError(
-                f"output folder {out}: {foreign} is not listed as an earlier run's output there "
-                "and would be replaced: give another output folder, or move or remove that file"
+                f"output folder {out}: {foreign} {not_ours(foreign, foreign_listed)} and would "
+                "be replaced: give another output folder, or move or remove that file"
             )
         _remove_partials(out, [j.name for j in jobs])
         if redone and log is not None:

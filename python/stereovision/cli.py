@@ -461,10 +461,10 @@ def refuse_foreign_outputs(
 ) -> set[str]:
     """Refuse, before any work, to replace a file of ``out_dir`` that this tool did not write.
 
-    A file (or anything else, a link or a folder) under one of ``names`` in ``out_dir`` is this
-    tool's only when ``manifest`` there lists it: an earlier run of the command into the folder
-    wrote it, and a rerun replaces it. Any other, e.g. the user's own ``cloud.ply`` in a folder
-    given as ``-o``, would be replaced silently.
+    A file (or anything else, a folder) under one of ``names`` in ``out_dir`` is this tool's
+    only when ``manifest`` there lists it: an earlier run of the command into the folder wrote
+    it, and a rerun replaces it. Any other, e.g. the user's own ``cloud.ply`` in a folder given
+    as ``-o``, would be replaced silently; so would a link, listed or not (runs write files).
 
     Parameters
     ----------
@@ -493,8 +493,8 @@ def refuse_foreign_outputs(
     foreign = foreign_outputs(out_dir, names, earlier)
     if foreign:
         raise FileExistsError(
-            f"{flag} {out_dir}: {foreign[0]} is not listed as an earlier run's output there and "
-            f"would be replaced: give another {flag} folder, or move or remove that file"
+            f"{flag} {out_dir}: {foreign[0]} {not_ours(foreign[0], earlier)} and would be "
+            f"replaced: give another {flag} folder, or move or remove that file"
         )
     return earlier
 
@@ -502,12 +502,21 @@ def refuse_foreign_outputs(
 def foreign_outputs(out_dir: Path, names: Sequence[str], listed: Collection[str]) -> list[Path]:
     """What stands in ``out_dir`` under one of ``names`` (a file, a folder, a link, a broken
     one too) that ``listed`` (an earlier run's recorded outputs) does not name, in the order of
-    ``names``: what a run would replace that it did not write."""
+    ``names``: what a run would replace that it did not write. A link is never a run's output
+    (runs write files), so one under a listed name is the user's too: moved over, it was lost
+    unsaid; written through (``io.atomic_write``, ``calibrate --report``), its target was."""
     return [
         out_dir / n
         for n in names
-        if n not in listed and ((out_dir / n).exists() or (out_dir / n).is_symlink())
+        if (n not in listed and (out_dir / n).exists()) or (out_dir / n).is_symlink()
     ]
+
+
+def not_ours(path: Path, listed: Collection[str]) -> str:
+    """Why :func:`foreign_outputs` named ``path``, for the line refusing to replace it."""
+    if path.name in listed:  # only a link
+        return "is a link, not the file an earlier run wrote there,"
+    return "is not listed as an earlier run's output there"
 
 
 def record_outputs(
