@@ -316,6 +316,7 @@ def test_dense_metrics_takes_disparity_and_still_disp() -> None:
         ("n_points", True, "n_points must be an integer >= 1, got True"),
         ("n_points", "3", "n_points must be an integer >= 1, got '3'"),
         ("seed", -5, "seed must be an integer >= 0 or None, got -5"),
+        ("seed", -1, "seed must be an integer >= 0 or None, got -1"),
         ("seed", float("nan"), "seed must be an integer >= 0 or None, got nan"),
         ("seed", "0", "seed must be an integer >= 0 or None, got '0'"),
     ],
@@ -425,7 +426,9 @@ def test_dense_metrics_takes_a_0_255_mask_image() -> None:
     assert got == want
 
 
-@pytest.mark.parametrize(("unit", "metres"), [("cm", 2.5), ("in", 250 * 0.0254), ("mm", 0.25)])
+@pytest.mark.parametrize(
+    ("unit", "metres"), [("cm", 2.5), ("in", 250 * 0.0254), ("mm", 0.25), ("ft", 250 * 0.3048)]
+)
 def test_table1_report_converts_every_unit_to_metres(unit: str, metres: float) -> None:
     est = np.full((2, 2), 250.0)
     gt = np.full((2, 2), 200.0)
@@ -670,3 +673,44 @@ def test_match_coordinates_must_be_1d() -> None:
         sparse_metrics(row, row, row - 1, gt)
     with pytest.raises(ValueError, match=r"^xl, yl, xr, score: expected 1-D arrays of equal len"):
         count_at_precision(row, row, row - 1, row, gt, 50.0)
+
+
+# -------------------------------------------- mutation audit, third round (each failed on a
+# mutant of evaluate.py that survived the tests above)
+
+
+def test_sparse_coverage_reaches_every_cell_of_the_4x4_grid() -> None:
+    # one match per 2x2 block of an 8x8 map: 16 cells, the last row and column among them
+    # (clamping a cell index to 2 merged the bottom row of cells into the one above: 12)
+    ys, xs = np.mgrid[0:8:2, 0:8:2]
+    xl, yl = xs.ravel().astype(float), ys.ravel().astype(float)
+    m = sparse_metrics(xl, yl, xl - 1.0, np.ones((8, 8)))
+    assert (m.count, m.coverage) == (16, 16)
+    # the bottom-right corner alone is cell (3, 3), apart from the cell above it
+    m = sparse_metrics(
+        np.array([7.0, 7.0]), np.array([5.0, 7.0]), np.array([6.0, 6.0]), np.ones((8, 8))
+    )
+    assert m.coverage == 2
+
+
+@pytest.mark.parametrize("point", [[3, 0], [0, 3], [3, 3]])
+def test_table1_report_refuses_a_point_past_the_far_edge(point: list[int]) -> None:
+    # x == width or y == height is one past the last pixel: refused by name, not an IndexError
+    ones = np.ones((3, 3))
+    with pytest.raises(ValueError, match=re.escape(f"points: [{point}] lie outside the 3x3")):
+        table1_report(ones, ones, points=np.array([point]))
+
+
+def test_sparse_matches_on_infinite_gt_are_not_counted() -> None:
+    """evaluation.md: a GT of inf (either sign) is unknown, as NaN; a match on it is neither
+    right nor wrong (taken as known it was a wrong match, its error infinite)."""
+    gt = np.ones((1, 4))
+    gt[0, 0], gt[0, 1] = INF, -INF
+    xl = np.array([0.0, 1.0, 2.0])
+    yl = np.zeros(3)
+    xr = xl - 1.0  # disparity 1: right wherever the GT is known
+    m = sparse_metrics(xl, yl, xr, gt)
+    assert (m.count, m.n_matches, m.coverage) == (1, 3, 1)
+    assert m.precision == {0.5: 100.0, 1.0: 100.0, 2.0: 100.0}
+    # the matches on inf GT scored best: they are not in the ranking, so 100 % keeps the third
+    assert count_at_precision(xl, yl, xr, np.array([3.0, 2.0, 1.0]), gt, 100.0) == 1
