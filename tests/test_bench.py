@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -159,23 +160,38 @@ class _Clock:
         return self.now
 
 
-def _fake(clock: _Clock, base_s: float, out: object, calls: list[int]) -> object:
-    """A matcher taking 1 s on its first call (the warm-up), then ``base_s`` times 1, 3, 2, 50,
-    2, 1 (median 2 ``base_s``, mean 59/6 of it), returning ``out``."""
-    pattern = [1, 3, 2, 50, 2, 1]
+_PATTERN = (1.0, 3.0, 2.0, 50.0, 2.0, 1.0)
+
+
+def _fake(
+    clock: _Clock,
+    base_s: float,
+    out: object,
+    calls: list[float],
+    pattern: tuple[float, ...] = _PATTERN,
+) -> object:
+    """A matcher taking 1 s on its first call (the warm-up), then ``base_s`` times ``pattern``
+    (by default 1, 3, 2, 50, 2, 1: median 2 ``base_s``, mean 59/6 of it), returning ``out``;
+    ``calls`` gets the clock's time at the start of each call."""
 
     def run(*_a: object, **_k: object) -> object:
+        start = clock.now
         clock.now += 1.0 if not calls else base_s * pattern[len(calls) - 1]
-        calls.append(1)
+        calls.append(start)
         return out
 
     return run
 
 
 def _fake_bench(
-    monkeypatch: pytest.MonkeyPatch, gt: np.ndarray | None
-) -> tuple[list[object], dict[str, list[int]], np.ndarray]:
-    """bench_scene(runs=6) on an 8x32 pair with every matcher faked (timed by the fake clock)."""
+    monkeypatch: pytest.MonkeyPatch,
+    gt: np.ndarray | None,
+    pattern: tuple[float, ...] = _PATTERN,
+    calib: object = None,
+    seen: dict[str, Any] | None = None,
+) -> tuple[list[object], dict[str, list[float]], np.ndarray]:
+    """bench_scene(runs=6) on an 8x32 pair with every matcher faked (timed by the fake clock);
+    ``seen`` gets the arguments the matchers were called with."""
     import sys
     import types
 
@@ -188,18 +204,36 @@ def _fake_bench(
     monkeypatch.setattr(bench_mod, "time", types.SimpleNamespace(perf_counter=clock.perf_counter))
     disp = np.full((8, 32), 2.0, np.float32)
     disp[3, 10] = np.nan  # a hole: bad before the row fill, not after
-    calls: dict[str, list[int]] = {k: [] for k in ("pipeline", "bm", "sgbm")}
+    calls: dict[str, list[float]] = {k: [] for k in ("pipeline", "bm", "sgbm")}
+    seen = {} if seen is None else seen
     pipe = types.SimpleNamespace(disparity=disp)
-    sparse = types.SimpleNamespace(xl=np.array([5.0]), yl=np.array([1.0]), xr=np.array([3.0]))
-    monkeypatch.setattr(depth_mod, "_run_matcher", lambda *a, **k: (disp, None))
-    monkeypatch.setattr(depth_mod, "depth_map", _fake(clock, 0.010, pipe, calls["pipeline"]))
-    monkeypatch.setattr(match_mod, "match", lambda *a, **k: sparse)
-    monkeypatch.setattr(baselines, "opencv_bm", _fake(clock, 0.001, disp, calls["bm"]))
-    monkeypatch.setattr(baselines, "opencv_sgbm", _fake(clock, 0.002, disp, calls["sgbm"]))
+    # GT 2 px: errors 0 and 1.5 px (precision@1 50 %, @2 100 %), the third match off the image
+    sparse = types.SimpleNamespace(
+        xl=np.array([5.0, 6.0, 40.0]), yl=np.array([1.0, 1.0, 1.0]), xr=np.array([3.0, 2.5, 38.0])
+    )
+    pipeline = _fake(clock, 0.010, pipe, calls["pipeline"], pattern)
+
+    def depth_map(*a: object, **k: object) -> object:
+        seen["depth_map"] = (a, k)
+        return pipeline(*a, **k)  # type: ignore[operator]
+
+    def run_matcher(*a: object, **k: object) -> object:
+        seen["_run_matcher"] = (a, k)
+        return disp, None
+
+    def match(*a: object, **k: object) -> object:
+        seen["match"] = (a, k)
+        return sparse
+
+    monkeypatch.setattr(depth_mod, "_run_matcher", run_matcher)
+    monkeypatch.setattr(depth_mod, "depth_map", depth_map)
+    monkeypatch.setattr(match_mod, "match", match)
+    monkeypatch.setattr(baselines, "opencv_bm", _fake(clock, 0.001, disp, calls["bm"], pattern))
+    monkeypatch.setattr(baselines, "opencv_sgbm", _fake(clock, 0.002, disp, calls["sgbm"], pattern))
     rng = np.random.default_rng(0)
     img = (rng.random((8, 32, 3)) * 255).astype(np.uint8)
     scene = types.SimpleNamespace(
-        name="fake", left=img, right=img, gt=gt, max_disparity=4, calib=None
+        name="fake", left=img, right=img, gt=gt, max_disparity=4, calib=calib
     )
     return bench_scene(scene, runs=6), calls, disp  # type: ignore[return-value]
 
@@ -226,7 +260,8 @@ def test_bench_reports_the_median_of_the_timed_runs_after_a_warm_up(
     assert out["bad_2.0"] == round(raw.bad[2.0], 3) and raw.bad[2.0] > 0  # rounded to 3
     assert out["bad_2.0_filled"] == 0.0 and out["density"] == round(raw.density, 3)
     sparse = [c for c in cases if c.kind == "sparse"]  # type: ignore[attr-defined]
-    assert sparse and all(c.accuracy == {"precision@1.0": 100.0, "count": 1} for c in sparse)
+    # precision@1 (not @2) over the 2 matches with GT (not the 3 given)
+    assert sparse and all(c.accuracy == {"precision@1.0": 50.0, "count": 2} for c in sparse)
 
 
 def test_bench_without_gt_reports_times_only(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -298,3 +333,49 @@ def test_bench_times_a_scene_given_twice_once(
         f"stereovision: {family / s} given more than once: benched once\n"
         for s in ("tsukuba", "venus")
     )
+
+
+def test_bench_median_of_an_even_count_interleaved_and_milliseconds_to_3_decimals(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """evaluation.md "Speed": the median of 6 runs is the mean of the middle two (neither the
+    lower nor the upper one), the cases run interleaved (A, B, A, B ...) after every warm-up,
+    and the JSON's ms keeps 3 decimals (mutants of bench.py that survived the tests above)."""
+    gt = np.full((8, 32), 2.0, np.float32)
+    # times 1, 3, 2, 50, 2.25, 1 base: sorted 1 1 2 2.25 3 50, median 2.125 (low 2, high 2.25)
+    cases, calls, _ = _fake_bench(monkeypatch, gt, pattern=(1.0, 3.0, 2.0, 50.0, 2.25, 1.0))
+    by = {c.case: c for c in cases}  # type: ignore[attr-defined]
+    assert by["SGBM-3WAY"].ms == pytest.approx(4.25)
+    assert by["pipeline"].ms == pytest.approx(21.25) and by["pipeline"].ratio == pytest.approx(5)
+    assert by["StereoBM"].as_dict()["ms"] == 2.125
+    pipe, sgbm = calls["pipeline"], calls["sgbm"]
+    assert pipe[1] > sgbm[0]  # every warm-up before the first timed run
+    # timed run k of SGBM falls between the pipeline's k-th and (k+1)-th, not after all of them
+    assert all(pipe[k] < sgbm[k] < pipe[k + 1] for k in range(1, 6))
+
+
+@pytest.mark.parametrize("rectified", [False, True])
+def test_bench_searches_the_scene_range_and_uses_only_a_rectified_calibration(
+    monkeypatch: pytest.MonkeyPatch, rectified: bool
+) -> None:
+    """Every case searches the scene's max_disparity (evaluation.md: the same range for all);
+    the pipeline gets the scene's calibration only when it rectifies the pair as given."""
+    import types
+
+    calib = types.SimpleNamespace(rectified=rectified)
+    seen: dict[str, Any] = {}
+    _fake_bench(monkeypatch, None, calib=calib, seen=seen)
+    a, k = seen["depth_map"]
+    assert a[2] is (calib if rectified else None) and k["max_disparity"] == 4
+    a, k = seen["_run_matcher"]
+    assert a[3:5] == (0.0, 4.0)
+    a, k = seen["match"]
+    assert k["max_disparity"] == 4
+
+
+def test_bench_without_a_scene_times_the_bundled_cones() -> None:
+    # the CLI's help promises the bundled Middlebury Cones (no test ran bench without a scene)
+    from stereovision.bench import _scene_dirs
+
+    (d,) = _scene_dirs([])
+    assert d.parts[-2:] == ("data", "cones") and (d / "left.png").is_file()
