@@ -714,3 +714,38 @@ def test_sparse_matches_on_infinite_gt_are_not_counted() -> None:
     assert m.precision == {0.5: 100.0, 1.0: 100.0, 2.0: 100.0}
     # the matches on inf GT scored best: they are not in the ranking, so 100 % keeps the third
     assert count_at_precision(xl, yl, xr, np.array([3.0, 2.0, 1.0]), gt, 100.0) == 1
+
+
+def test_depth_metrics_leaves_out_an_infinite_estimated_depth() -> None:
+    # an inf depth (a disparity of -doffs) is missing, as NaN: taken as valid, the RMSE was inf
+    est = np.array([[2.0, INF, 4.4]])
+    gt = np.array([[2.0, 3.0, 4.0]])
+    m = depth_metrics(est, gt)
+    assert (m.n, m.density) == (2, pytest.approx(200 / 3))
+    assert m.rmse == pytest.approx(math.sqrt(0.08)) and m.share_off_5 == pytest.approx(50.0)
+
+
+def test_dense_metrics_mask_does_not_make_unknown_gt_known() -> None:
+    # a mask restricts the GT pixels, it never adds one: a masked-in NaN GT pixel is not counted
+    est = np.array([[1.0, 1.0, 1.0]])
+    gt = np.array([[1.0, NAN, 5.0]])
+    m = dense_metrics(est, gt, mask=np.array([[True, True, False]]))
+    assert (m.n_gt, m.n_both) == (1, 1)
+    assert m.bad[0.5] == 0.0 and m.density == 100.0 and m.avgerr == 0.0
+
+
+def test_table1_report_refuses_an_empty_list_of_points() -> None:
+    # no point gave NaN figures (mean of nothing) and a table without a row
+    ones = np.ones((3, 3))
+    with pytest.raises(ValueError, match=r"^points: expected a non-empty integer \(N, 2\)"):
+        table1_report(ones, ones, points=np.zeros((0, 2), dtype=np.int64))
+
+
+def test_table1_report_draws_by_its_seed() -> None:
+    est = np.full((20, 30), 2.0)
+    gt = np.full((20, 30), 2.5)
+    a, b, c = (table1_report(est, gt, seed=s) for s in (1, 1, 2))
+    assert np.array_equal(a.x, b.x) and np.array_equal(a.y, b.y)
+    assert not (np.array_equal(a.x, c.x) and np.array_equal(a.y, c.y))
+    pick = np.sort(np.random.default_rng(2).choice(600, size=10, replace=False))
+    assert np.array_equal(c.y * 30 + c.x, pick)  # the documented draw
