@@ -379,3 +379,13 @@ def test_bench_without_a_scene_times_the_bundled_cones() -> None:
 
     (d,) = _scene_dirs([])
     assert d.parts[-2:] == ("data", "cones") and (d / "left.png").is_file()
+
+
+def test_format_table_shows_a_sparse_case_precision_at_1_and_its_count() -> None:
+    from stereovision.bench import BenchCase
+
+    acc = {"precision@1.0": 97.5, "count": 1326}
+    case = BenchCase("a", "hopfield", "sparse", 32, 8, 4, 5, 3.0, 0.75, acc)
+    row = format_table([case]).splitlines()[1].split()
+    # no dense figure; precision@1 (not another key) to 1 decimal, the count as an integer
+    assert row[4:] == ["3.0", "0.75", "-", "-", "-", "97.5", "1326"]
