@@ -1356,3 +1356,100 @@ def test_view_checks_a_screenshot_links_target_folder_before_any_work(
     assert str(info.value) == (
         f"-o {tmp_path / 'shot.png'}: cannot write in {tmp_path / 'ro'} (Permission denied)"
     )
+
+
+def test_points_in_view_turns_the_way_the_camera_turns():
+    """A cluster 30 degrees to the right (and one 20 degrees up) is in view of yaw = 30 (pitch =
+    20), not of -30: the count rotates the points by R^T, the camera's inverse (R turned
+    them the other way, which a cluster straight ahead cannot tell)."""
+    rng = np.random.default_rng(5)
+    right = 5 * np.array([math.sin(math.radians(30)), 0, math.cos(math.radians(30))])
+    up = 5 * np.array([0, -math.sin(math.radians(20)), math.cos(math.radians(20))])
+    for centre, control in ((right, "yaw"), (up, "pitch")):
+        pts = rng.normal(centre, 0.02, (300, 3))
+        for angle, seen in ((30.0 if control == "yaw" else 20.0, 300), (-30.0, 0)):
+            controls = CameraControls(**{control: angle})
+            assert render.points_in_view(pts, controls, (800, 600)) == seen, (control, angle)
+    cloud = render.point_cloud(rng.normal(right, 0.02, (300, 3)), np.full((300, 3), 255, np.uint8))
+    assert not render.is_blank(
+        render.render_view(cloud, CameraControls(yaw=30.0)), min_fraction=1e-4
+    )
+
+
+def _near_then_far(n: int = 30_000) -> np.ndarray:
+    """A cloud written region by region: ``n`` points about 1 m away, then ``n`` 50 m away."""
+    rng = np.random.default_rng(6)
+    near = rng.uniform([-0.1, -0.1, 1.0], [0.1, 0.1, 1.1], (n, 3))
+    return np.concatenate([near, near * [1, 1, 50]])
+
+
+def test_clipping_range_samples_the_whole_cloud():
+    """More than CLIP_SAMPLE points are sampled evenly over the cloud: the first CLIP_SAMPLE
+    of a cloud written near part first put the far clipping plane at 5 m, clipping away the
+    half 50 m away (robust_clipping_range and the window's observer alike)."""
+    pts = _near_then_far()
+    near, far = render.robust_clipping_range(pts, [0, 0, 0])
+    assert far > 100 and near == pytest.approx(0.5, rel=0.01)
+    plotter = render.make_plotter((64, 48))
+    try:
+        render.add_geometry(plotter, render.point_cloud(pts))
+        render.keep_robust_clipping(plotter, pts)
+        render.apply_camera(plotter, CameraControls(), focal_distance=1.0)
+        plotter.screenshot(return_img=True)
+        np.testing.assert_allclose(plotter.camera.clipping_range, (near, far))
+    finally:
+        plotter.close()
+
+
+def test_median_depth_leaves_out_points_at_zero():
+    """Points (0, 0, 0), what many tools write for a pixel without depth, are no depth: a
+    median of 0 put the focal point on the camera."""
+    pts = np.array([[0, 0, 0.0]] * 5 + [[0, 0, 2.0], [0, 0, 3.0]])
+    assert render.median_depth(render.point_cloud(pts)) == 2.5
+
+
+def test_write_render_creates_nested_folders(tmp_path):
+    img = np.zeros((4, 6, 3), np.uint8)
+    img[..., 2] = 200  # blue in RGB
+    path = render.write_render(img, tmp_path / "a" / "b")["render.png"]
+    assert path == tmp_path / "a" / "b" / "render.png"
+    assert cv2.imread(str(path))[0, 0].tolist() == [200, 0, 0]
+
+
+def test_screenshot_in_a_folder_that_is_a_file_is_refused(tmp_path):
+    (tmp_path / "notes.txt").write_text("x")
+    with pytest.raises(NotADirectoryError, match=r"notes\.txt is a file, not a folder"):
+        render._check_screenshot_path(tmp_path / "notes.txt" / "shot.png", tmp_path / "c.ply")
+
+
+def test_view_of_a_scene_matches_the_scene_s_own_disparity_range(monkeypatch, result):
+    """A scene folder is matched over its calib.txt's range (ndisp), not depth_map's default."""
+    from stereovision import depth
+    from stereovision.gui import bundled_data_dir
+    from stereovision.io import load_scene
+
+    seen = []
+
+    def fake_depth_map(left, right, calib, **kwargs):
+        seen.append(kwargs.get("max_disparity"))
+        return result
+
+    monkeypatch.setattr(depth, "depth_map", fake_depth_map)
+    render.load_view_source(bundled_data_dir() / "cones")
+    scene = load_scene(bundled_data_dir() / "cones")
+    assert scene.max_disparity is not None and seen == [scene.max_disparity]
+
+
+def test_a_mesh_without_colours_is_drawn_as_a_surface(mesh):
+    """Only a cloud without colours is coloured by depth as points: a triangle mesh without
+    RGB nor texture stays a surface."""
+    bare = mesh.copy()
+    bare.point_data.clear()
+    bare.field_data.clear()
+    plotter = render.make_plotter((32, 24))
+    try:
+        actor = render.add_geometry(plotter, bare)
+        assert actor.GetProperty().GetRepresentationAsString() == "Surface"
+        assert not plotter.scalar_bars
+    finally:
+        plotter.close()
