@@ -1453,3 +1453,17 @@ def test_a_mesh_without_colours_is_drawn_as_a_surface(mesh):
         assert not plotter.scalar_bars
     finally:
         plotter.close()
+
+
+def test_view_refuses_to_write_over_the_cloud_it_shows(tmp_path):
+    """A cloud is read by its content, so a PLY named ``scan`` (no suffix, a screenshot name)
+    is shown; ``view scan -o scan`` must not replace it with the screenshot."""
+    from stereovision.io import write_ply
+
+    cloud = tmp_path / "scan"
+    write_ply(cloud, np.array([[0, 0, 3.0], [0.1, 0, 3.0]], np.float32))
+    before = cloud.read_bytes()
+    args = _view_args(cloud, cloud)
+    with pytest.raises(ValueError, match=r"-o .*scan: is the cloud shown \("):
+        args.func(args)
+    assert cloud.read_bytes() == before and sorted(os.listdir(tmp_path)) == ["scan"]
