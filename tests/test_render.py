@@ -1467,3 +1467,39 @@ def test_view_refuses_to_write_over_the_cloud_it_shows(tmp_path):
     with pytest.raises(ValueError, match=r"-o .*scan: is the cloud shown \("):
         args.func(args)
     assert cloud.read_bytes() == before and sorted(os.listdir(tmp_path)) == ["scan"]
+
+
+def test_a_camera_state_render_keeps_the_robust_clipping(result):
+    """render_view(camera=...) (the GUI's Save of a dragged view) clips by the scene's robust
+    range, as the controls' render does: VTK's own range from the bounds of a few points
+    kilometres away put the near plane beyond the scene."""
+    pts = result.points.copy()
+    pts[-5:] *= 2000.0
+    cloud = render.point_cloud(pts, result.colors)
+    intr = render.Intrinsics.from_result(result)
+    plotter = render.make_plotter((intr.width, intr.height))
+    try:
+        render.apply_camera(plotter, CameraControls(), intrinsics=intr, focal_distance=1.0)
+        state = render.CameraState.of(plotter.camera)
+    finally:
+        plotter.close()
+    posed = render.render_view(cloud, intrinsics=intr)
+    again = render.render_view(cloud, intrinsics=intr, camera=state)
+    assert not render.is_blank(again, min_fraction=0.5)
+    assert np.abs(again.astype(np.int16) - posed).mean() < 0.5
+
+
+def test_render_png_is_the_documented_orbit(result):
+    """render.png's default view turns RENDER_YAW_DEG (left) and RENDER_PITCH_DEG (down) about
+    the scene's median depth point, not the two angles swapped."""
+    mesh = render.surface_mesh(result)
+    intr = render.Intrinsics.from_result(result)
+    orbit = render.orbit_controls(
+        render.RENDER_YAW_DEG, render.RENDER_PITCH_DEG, render.median_depth(mesh)
+    )
+    expected = render.render_view(mesh, orbit, intrinsics=intr).astype(np.int16)
+    assert np.abs(render.render_result(result) - expected).mean() < 0.5
+    swapped = render.orbit_controls(
+        render.RENDER_PITCH_DEG, render.RENDER_YAW_DEG, render.median_depth(mesh)
+    )
+    assert np.abs(render.render_view(mesh, swapped, intrinsics=intr) - expected).mean() > 2
