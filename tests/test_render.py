@@ -1503,3 +1503,32 @@ def test_render_png_is_the_documented_orbit(result):
         render.RENDER_PITCH_DEG, render.RENDER_YAW_DEG, render.median_depth(mesh)
     )
     assert np.abs(render.render_view(mesh, swapped, intrinsics=intr) - expected).mean() > 2
+
+
+def test_view_of_a_scene_without_calibration_is_refused_before_matching(tmp_path, monkeypatch):
+    """A scene folder without calib.txt is said at once: matched anyway, its depth map came
+    to nothing to show after the whole computation."""
+    import shutil
+
+    from stereovision import depth
+    from stereovision.gui import bundled_data_dir
+
+    for name in ("left.png", "right.png"):
+        shutil.copy(bundled_data_dir() / "cones" / name, tmp_path / name)
+
+    def no_matching(*args, **kwargs):
+        raise AssertionError("matched a scene without calibration")
+
+    monkeypatch.setattr(depth, "depth_map", no_matching)
+    with pytest.raises(ValueError, match=r"has no calib\.txt: no metric 3-D points to show"):
+        render.load_view_source(tmp_path)
+
+
+def test_view_screenshot_of_a_scene_is_through_its_intrinsics(result, mesh, tmp_path, monkeypatch):
+    """``view SCENE -o shot.png`` renders through the scene's rectified camera: the shot is the
+    left image's size, not the 800x600 default view of a bare cloud."""
+    intr = render.Intrinsics.from_result(result)
+    monkeypatch.setattr(render, "load_view_source", lambda source, max_points: (mesh, intr))
+    args = _view_args(tmp_path, tmp_path / "shot.png")
+    assert args.func(args) == 0
+    assert cv2.imread(str(tmp_path / "shot.png")).shape == (intr.height, intr.width, 3)
