@@ -1741,6 +1741,81 @@ mod tests {
     }
 
     #[test]
+    fn each_pass_sums_its_four_paths_by_their_definition() {
+        // The raster pass sums the paths from the left, above and both upper diagonals, the
+        // reverse pass their opposites, each from its first pixel on (the diagonals entering
+        // from the first and last columns too). The levels at both ends of the range cost the
+        // most, so their path costs climb far above the minimum (each level P1 plus its cost
+        // above the next): with P2 = MAX_P2 the pads must exceed every path cost.
+        let (w, h, n) = (15usize, 9usize, 10usize);
+        let img = noise(w, h, 3);
+        let c: Vec<u8> = noise(w * h * n, 1, 11)
+            .iter()
+            .enumerate()
+            .map(|(i, v)| match i % n {
+                0..=3 => OUTSIDE,
+                k if k >= n - 3 => OUTSIDE - 1,
+                _ => (v * 20.0).round() as u8,
+            })
+            .collect();
+        let d = SgmParams::default();
+        let big = SgmParams { p2: MAX_P2, ..d };
+        for (p, u8_costs) in [(d, true), (d, false), (big, false)] {
+            for (forward, dirs) in [
+                (true, [(-1, 0), (0, -1), (-1, -1), (1, -1)]),
+                (false, [(1, 0), (0, 1), (1, 1), (-1, 1)]),
+            ] {
+                let mut want = vec![0i64; w * h * n];
+                for dir in dirs {
+                    for (a, b) in want.iter_mut().zip(direct_path(&c, &img, w, h, n, &p, dir)) {
+                        *a += b;
+                    }
+                }
+                let mut rows = Vec::new();
+                let mut emit = |y: usize, row: &mut Vec<u16>| rows.push((y, row.clone()));
+                let mut row = vec![0u16; w * n];
+                let run = if u8_costs { pass_u8 } else { pass_u16 };
+                run(&c, &img, w, h, n, &p, forward, &mut row, &mut emit);
+                assert_eq!(rows.len(), h);
+                for (y, r) in rows {
+                    let got: Vec<i64> = r.iter().map(|&v| i64::from(v)).collect();
+                    let tag = format!("{p:?} u8 {u8_costs} forward {forward} row {y}");
+                    assert_eq!(got, want[y * w * n..(y + 1) * w * n], "{tag}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn right_winners_equal_their_definition() {
+        // At each right pixel xr: the first level j minimising S(xr + d_min + j, j) over the left
+        // pixels in the image (u16::MAX and level 0 where none is), for ranges reaching past
+        // either edge of the row; the outputs are overwritten whatever they held.
+        let (w, n) = (13usize, 6usize);
+        let s: Vec<u16> = noise(w * n, 1, 7)
+            .iter()
+            .map(|v| (v * 5.0).round() as u16)
+            .collect();
+        for d_min in [-9i64, -4, 0, 3, 20] {
+            let (mut rbest, mut rk) = (vec![7u16; w], vec![7u16; w]);
+            right_winners(&s, w, n, d_min, &mut rbest, &mut rk);
+            for xr in 0..w as i64 {
+                let want = (0..n)
+                    .filter_map(|j| {
+                        let xl = xr + d_min + j as i64;
+                        (0..w as i64)
+                            .contains(&xl)
+                            .then(|| (s[xl as usize * n + j], j as u16))
+                    })
+                    .min()
+                    .unwrap_or((u16::MAX, 0));
+                let i = w - 1 - xr as usize;
+                assert_eq!((rbest[i], rk[i]), want, "d_min {d_min}, xr {xr}");
+            }
+        }
+    }
+
+    #[test]
     fn parameter_limits_are_exact() {
         // 0 < p1 < p2 <= MAX_P2, uniqueness <= 100, at most 2048 levels.
         let img = vec![0.5f32; 64];
@@ -1750,6 +1825,21 @@ mod tests {
         assert!(run(SgmParams { p1: 96, ..d }, 4).is_err());
         assert!(run(SgmParams { p1: 95, ..d }, 4).is_ok());
         assert!(run(SgmParams { p2: MAX_P2, ..d }, 4).is_ok());
+        // gamma > 0: a zero or negative step scale is refused, the smallest positive one taken.
+        for gamma in [0.0, -1.0] {
+            assert!(matches!(
+                run(SgmParams { gamma, ..d }, 4).unwrap_err(),
+                CoreError::InvalidParameter { name: "gamma", .. }
+            ));
+        }
+        assert!(run(
+            SgmParams {
+                gamma: f32::MIN_POSITIVE,
+                ..d
+            },
+            4
+        )
+        .is_ok());
         assert!(run(
             SgmParams {
                 uniqueness: 101,
