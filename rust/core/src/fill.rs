@@ -138,6 +138,23 @@ mod tests {
     }
 
     #[test]
+    fn maps_of_width_zero_are_left_alone() {
+        // An empty map of width 0 (no chunking by 0, which would panic).
+        let mut d: Vec<f32> = Vec::new();
+        row_fill(&mut d, 0);
+        side_fill(&mut d, &[], 0, 1.0);
+        assert!(d.is_empty());
+    }
+
+    #[test]
+    #[should_panic(expected = "lab must hold 3 values per pixel")]
+    fn the_side_rule_refuses_colours_of_another_length() {
+        // One colour short: a silent zip would leave the last pixel's run unfilled.
+        let mut d = vec![5.0, f32::NAN, 2.0];
+        side_fill(&mut d, &[0.0; 6], 3, 1.0);
+    }
+
+    #[test]
     fn fills_with_the_background_side() {
         let nan = f32::NAN;
         let mut d = vec![
