@@ -251,7 +251,7 @@ def test_too_narrow_images_are_named_not_a_range_never_given(width: int) -> None
         rf"least 17 px wide; give a max_disparity below {width} to match it$",
     ):
         sv.depth_map(left, right, calib)
-    res = sv.depth_map(left, right, calib, max_disparity=width // 2, method="best")
+    res = sv.depth_map(left, right, calib, max_disparity=width // 2, method="census")
     assert res.disparity.shape == (12, width) and res.max_disparity == width // 2
     with pytest.raises(ValueError, match=rf"disparity range 40 is not smaller .* width {width}"):
         sv.depth_map(left, right, calib, max_disparity=40)
@@ -896,7 +896,7 @@ def test_min_disparity_above_the_automatic_range_names_the_estimate() -> None:
         "min_disparity (20) is not below the automatic max_disparity (16, estimated from the "
         "pair): give a max_disparity above 20"
     )
-    res = sv.depth_map(left, right, min_disparity=20, max_disparity=24, method="best")
+    res = sv.depth_map(left, right, min_disparity=20, max_disparity=24, method="census")
     assert res.disparity.shape == (32, 64)
 
 
