@@ -948,3 +948,38 @@ def test_fuse_pair_passes_its_range_to_the_remeasure_and_the_member_check(
     res = fuse_pair(gl, gr, max_disparity=16, min_disparity=3, census_members=False)
     assert len(res) > 100
     assert seen == {"refine": [(3, 16)], "sides": [(3, 16)]}
+
+
+def test_min_agree_three_needs_every_channel_to_agree() -> None:
+    """Vote mode with ``min_agree=3``: a pixel where only two of the three channels agree is no
+    member; one where all three agree is."""
+    mcgm = _m([(3, 3, 10.0), (9, 3, 10.0)])
+    hop = _m([(3, 3, 10.4), (9, 3, 14.0)])  # (9, 3): Hopfield disagrees, Gabor and MCGM agree
+    assert len(fuse(_dense(10.2), {"mcgm": mcgm, "hopfield": hop})) == 2
+    res = fuse(_dense(10.2), {"mcgm": mcgm, "hopfield": hop}, min_agree=3)
+    np.testing.assert_array_equal(res.matches.xl, [3])
+    np.testing.assert_array_equal(res.count, [3])
+
+
+def test_channels_are_named_in_bit_order_and_candidates_counted() -> None:
+    """``channels`` (and ``stats["channels"]``) follow the bits whatever the mapping's order;
+    ``stats["candidates"]`` counts every pixel a sparse channel measured, ``"members"`` those
+    kept."""
+    hop = _m([(5, 5, 10.4), (8, 5, 10.6), (12, 7, 14.0)])
+    mcgm = _m([(5, 5, 10.2)])
+    res = fuse(_dense(10.0, 0.5), {"hopfield": hop, "mcgm": mcgm})
+    assert res.channels == ("gabor", "mcgm", "hopfield")
+    assert res.matches.stats["channels"] == ["gabor", "mcgm", "hopfield"]
+    assert res.matches.stats["candidates"] == 3 and res.matches.stats["members"] == 2
+    assert fuse(None, {"hopfield": hop, "mcgm": mcgm}).channels == ("mcgm", "hopfield")
+
+
+def test_members_y_disparity_is_weighted_by_gabor_confidence() -> None:
+    """Gabor's vertical disparity 0 weighs its confidence (0.5) in the mean, as on x:
+    (0.5 * 0 + 1 * 0.6 + 1 * 0) / 2.5 = 0.24, not the plain mean 0.2."""
+    mcgm = _m([(6, 8, 12.0)], dy=0.6)
+    hop = _m([(6, 8, 12.0)], dy=0.0)
+    res = fuse(_dense(12.0, 0.5), {"mcgm": mcgm, "hopfield": hop})
+    assert len(res) == 1 and res.count[0] == 3
+    assert res.dispy[8, 6] == pytest.approx(0.24)
+    assert res.matches.yr[0] == pytest.approx(8.0 - 0.24)
