@@ -371,6 +371,15 @@ def test_match_refuses_a_min_disparity_not_below_the_width(
 
 
 @pytest.mark.parametrize("method", MATCH_METHODS)
+def test_match_names_a_max_disparity_below_min_disparity_first(method: str) -> None:
+    """A max_disparity the caller gave below min_disparity is the mistake named, even when the
+    min_disparity is past the width too (match()'s docstring: left to the matchers' checks)."""
+    left = np.random.default_rng(0).integers(0, 256, (24, 48), dtype=np.uint8)
+    with pytest.raises(ValueError, match=r"max_disparity \(10\) must be .*min_disparity \(60\)"):
+        sv.match(left, left.copy(), method=method, min_disparity=60, max_disparity=10)
+
+
+@pytest.mark.parametrize("method", MATCH_METHODS)
 def test_match_of_a_flat_pair_in_a_reachable_range_is_still_empty(method: str) -> None:
     """The refusal is of the range, not of the pair: a pair with no edges, in a range it can
     match in (up to the width minus one), has zero matches, not an error."""

@@ -511,6 +511,7 @@ def test_census_clear_drops_members_near_a_lower_census_region() -> None:
     np.testing.assert_array_equal(out.sources_map != 0, np.isfinite(out.dispx))
     assert out.sources_map[5, 15] == 6 and out.sources_map[5, 9] == 0 and np.isnan(out.dispy[5, 9])
     assert out.matches.stats["members_before_census"] == len(pts)
+    assert out.matches.stats["members"] == len(out) == 4  # those kept, not those checked
     assert len(census_clear(fr, census, radius=0)) == len(pts)  # its own pixel only
     assert len(census_clear(fr, census, radius=7, jump=20.0)) == len(pts)
     with pytest.raises(ValueError, match="census: shape"):
@@ -983,3 +984,25 @@ def test_members_y_disparity_is_weighted_by_gabor_confidence() -> None:
     assert len(res) == 1 and res.count[0] == 3
     assert res.dispy[8, 6] == pytest.approx(0.24)
     assert res.matches.yr[0] == pytest.approx(8.0 - 0.24)
+
+
+def test_fuse_pair_runs_only_the_channels_asked_for() -> None:
+    """``channels`` without MCGM: MCGM neither runs nor votes, and the per-channel match counts
+    name exactly the sparse channels that ran (with their lengths)."""
+    rng = np.random.default_rng(5)
+    right = rng.random((48, 80)).astype(np.float32)
+    left = np.roll(right, 4, axis=1)  # disparity 4
+    kw: dict[str, Any] = {"max_disparity": 8, "census_members": False}
+    both = fuse_pair(left, right, **kw)
+    outs = both.channel_outputs
+    assert both.matches.stats["channel_matches"] == {
+        "mcgm": len(outs["mcgm"]),
+        "hopfield": len(outs["hopfield"]),
+    }
+    res = fuse_pair(left, right, channels=("gabor", "hopfield"), **kw)
+    assert len(res) > 0 and res.channels == ("gabor", "hopfield")
+    assert "mcgm" not in res.channel_outputs
+    assert res.matches.stats["channel_matches"] == {
+        "hopfield": len(res.channel_outputs["hopfield"])
+    }
+    assert not np.any(res.sources & CHANNEL_BITS["mcgm"])
