@@ -1006,3 +1006,16 @@ def test_fuse_pair_runs_only_the_channels_asked_for() -> None:
         "hopfield": len(res.channel_outputs["hopfield"])
     }
     assert not np.any(res.sources & CHANNEL_BITS["mcgm"])
+
+
+def test_enclosed_far_bounds_jump_inclusive_and_darker_strict() -> None:
+    """A surround exactly ``jump`` above the floor is enough ("jump px or more"); a region as
+    bright as its surround (not darker) is left alone."""
+    d = np.full((60, 80), 3.0, np.float32)  # floor 0 + jump 3, exactly
+    g = np.full((60, 80), 0.6, np.float32)
+    d[20:30, 10:25], g[20:30, 10:25] = 0.2, 0.1
+    out, filled = fill_enclosed_far(d, g, floor=0.0, jump=3.0)
+    assert filled.sum() == 150 and np.all(out[20:30, 10:25] == 3.0)
+    g[20:30, 10:25] = 0.6  # as bright as the surround
+    out, filled = fill_enclosed_far(d, g, floor=0.0, jump=3.0)
+    assert not filled.any() and np.all(out[20:30, 10:25] == np.float32(0.2))
