@@ -1019,3 +1019,15 @@ def test_enclosed_far_bounds_jump_inclusive_and_darker_strict() -> None:
     g[20:30, 10:25] = 0.6  # as bright as the surround
     out, filled = fill_enclosed_far(d, g, floor=0.0, jump=3.0)
     assert not filled.any() and np.all(out[20:30, 10:25] == np.float32(0.2))
+
+
+def test_enclosed_far_region_is_strictly_below_floor_plus_far() -> None:
+    """The region is ``d < floor + far`` strictly (docs/fusion.md): a dark pane at exactly
+    0.5 px is not locked to the floor; ``far`` and ``jump`` 0 are valid (non-negative)."""
+    d = np.full((60, 80), 6.0, np.float32)
+    g = np.full((60, 80), 0.6, np.float32)
+    d[20:30, 10:25], g[20:30, 10:25] = 0.5, 0.1
+    assert not fill_enclosed_far(d, g, floor=0.0, far=0.5)[1].any()
+    assert fill_enclosed_far(d, g, floor=0.0, far=0.75)[1].sum() == 150
+    assert not fill_enclosed_far(d, g, far=0.0)[1].any()
+    assert fill_enclosed_far(d, g, far=0.75, jump=0.0)[1].sum() == 150
