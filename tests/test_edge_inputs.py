@@ -490,3 +490,17 @@ def test_match_drops_the_integer_searchs_matches_above_a_fractional_max(method: 
     cut = sv.match(left, right, method=method, max_disparity=2.5)
     assert (cut.xl - cut.xr <= 2.5).all()
     assert cut.stats["n_out_of_range"] >= np.count_nonzero(whole.xl - whole.xr > 2.5)
+
+
+def test_match_range_cut_drops_and_counts_a_single_match() -> None:
+    """One match out of range is dropped and counted like any number of them."""
+    from stereovision.match import _in_range, _keep
+    from stereovision.matches import Matches
+
+    x = np.array([10.0, 20.0, 30.0], np.float32)
+    m = Matches(
+        x, x * 0, x - np.array([2.0, 5.0, 9.0], np.float32), x * 0, np.ones_like(x), (8, 40)
+    )
+    out = _keep(m, _in_range(m, 0, 8))
+    np.testing.assert_array_equal(out.xl, [10.0, 20.0])
+    assert out.stats["n_out_of_range"] == 1

@@ -1031,3 +1031,23 @@ def test_enclosed_far_region_is_strictly_below_floor_plus_far() -> None:
     assert fill_enclosed_far(d, g, floor=0.0, far=0.75)[1].sum() == 150
     assert not fill_enclosed_far(d, g, far=0.0)[1].any()
     assert fill_enclosed_far(d, g, far=0.75, jump=0.0)[1].sum() == 150
+
+
+def test_fused_dense_marks_the_pixels_only_second_measured() -> None:
+    """``_only_second`` (depth_map's census-only marks) is set where the value came from
+    ``second`` alone, also without a map of its own, and cleared where step 6 drops it."""
+    none = np.full((H, W), np.nan, np.float32)
+    conf = np.ones((H, W), np.float32)
+    second = none.copy()
+    second[2:6, 3:9] = 7.0
+    flag = np.zeros((H, W), bool)
+    fused_dense(none, conf, none, second=second, _only_second=flag)
+    np.testing.assert_array_equal(flag, np.isfinite(second))
+    d = np.full((H, W), 5.0, np.float32)
+    d[10, 10] = np.nan
+    island = none.copy()
+    island[10, 10] = 20.0  # a one-pixel island the speckle step drops
+    flag = np.zeros((H, W), bool)
+    out, c = fused_dense(d, conf, none, second=island, speckle_area=2 / (H * W), _only_second=flag)
+    assert np.isnan(out[10, 10]) and c[10, 10] == 0.0
+    assert not flag.any()
