@@ -1051,3 +1051,22 @@ def test_fused_dense_marks_the_pixels_only_second_measured() -> None:
     out, c = fused_dense(d, conf, none, second=island, speckle_area=2 / (H * W), _only_second=flag)
     assert np.isnan(out[10, 10]) and c[10, 10] == 0.0
     assert not flag.any()
+
+
+def test_fused_dense_clears_census_only_marks_the_edge_step_drops() -> None:
+    """Step 7 on a map ``second`` alone gave: the fattened ring it turns into holes loses its
+    census-only mark (depth_map would count a hole as census-measured)."""
+    h, w = 60, 80
+    guide = np.full((h, w), 0.2, np.float32)
+    guide[20:40, 30:50] = 0.8
+    guide += np.random.default_rng(1).normal(0, 0.01, (h, w)).astype(np.float32)
+    d = np.full((h, w), 10.0, np.float32)
+    d[20:40, 27:53] = 20.0
+    d[17:43, 30:50] = 20.0
+    none = np.full(d.shape, np.nan, np.float32)
+    flag = np.zeros((h, w), bool)
+    out, _ = fused_dense(
+        none, np.ones_like(d), none, second=d, guide=guide, speckle_area=0.0, _only_second=flag
+    )
+    assert np.isnan(out).sum() > 0
+    np.testing.assert_array_equal(flag, np.isfinite(out))
