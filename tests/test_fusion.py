@@ -1070,3 +1070,25 @@ def test_fused_dense_clears_census_only_marks_the_edge_step_drops() -> None:
     )
     assert np.isnan(out).sum() > 0
     np.testing.assert_array_equal(flag, np.isfinite(out))
+
+
+@pytest.mark.parametrize(
+    "name",
+    [
+        "radius",
+        "tau",
+        "fill_radius",
+        "second_tol",
+        "occlusion_tau",
+        "speckle_area",
+        "speckle_diff",
+        "edge_radius",
+        "edge_ratio",
+        "edge_jump",
+    ],
+)
+def test_fused_dense_refuses_each_negative_setting(name: str) -> None:
+    """Every length and tolerance of fused_dense is refused below 0, naming it."""
+    d, c = _dense(5.0)
+    with pytest.raises(ValueError, match=f"^{name}: expected a non-negative number"):
+        fused_dense(d, c, np.full((H, W), np.nan, np.float32), **{name: -1})
