@@ -504,3 +504,14 @@ def test_match_range_cut_drops_and_counts_a_single_match() -> None:
     out = _keep(m, _in_range(m, 0, 8))
     np.testing.assert_array_equal(out.xl, [10.0, 20.0])
     assert out.stats["n_out_of_range"] == 1
+
+
+@pytest.mark.parametrize("method", ["sgm", "census", "fast", "Hopfield", ""])
+def test_match_refuses_a_method_it_does_not_have(method: str) -> None:
+    """match()'s methods are exactly its documented five; depth_map's dense names (or a
+    misspelt one) are refused by name, not run as another matcher."""
+    from stereovision.match import METHODS
+
+    assert METHODS == ("hopfield", "best", "mcgm", "fused", "gabor")
+    with pytest.raises(ValueError, match=f"unknown method '{method}'"):
+        sv.match(LEFT, RIGHT, method=method, max_disparity=8)

@@ -921,8 +921,9 @@ def test_fused_dense_second_opinion_drops_disagreement_and_fills_holes() -> None
     # fill of the others goes; exactly occlusion_tau above it stays.
     lone = np.array([[5, 5, 7, 5, 5, 7.5, 5, 5]], np.float32)
     quiet = np.array([[5, 5, nan, 5, 5, nan, 5, 5]], np.float32)
-    out, _ = fused_dense(lone, conf, none, second=quiet, occlusion_tau=2.0)
+    out, c = fused_dense(lone, conf, none, second=quiet, occlusion_tau=2.0)
     np.testing.assert_array_equal(out, np.array([[5, 5, 7, 5, 5, nan, 5, 5]], np.float32))
+    assert c[0, 5] == 0.0 and c[0, 2] == np.float32(0.8)  # the hole has no confidence left
 
 
 def test_fuse_pair_passes_its_range_to_the_remeasure_and_the_member_check(
