@@ -1682,3 +1682,57 @@ def test_cli_an_output_link_is_checked_in_its_targets_folder(
         f"-o {tmp_path / 'rig.yaml'}: cannot write in {tmp_path / 'ro'} (Permission denied)"
     )
     assert (tmp_path / "ro" / "rig.yaml").read_text() == "kept\n"
+
+
+def test_a_star_pattern_the_square_bounds_and_names_of_another_count(tmp_path: Path) -> None:
+    """A third mutation audit found unasserted: "9*6" read as 9x6, a square of exactly 100 m and
+    1 nm taken (the refusal is outside them), names= of another length than the pairs refused by
+    name (it failed later in a zip), and one file name in two folders naming its pair once."""
+    assert parse_pattern("9*6") == (9, 6)
+    blank = np.full((120, 160), 128, np.uint8)
+    for square in (100.0, 1e-9):  # the bounds: past the size check, to the boards not found
+        with pytest.raises(ValueError, match=r"only 0 of 3 pairs"):
+            calibrate([blank] * 3, [blank] * 3, square_size=square)
+    with pytest.raises(ValueError, match=r"^names: expected 3 names \(one per pair\), got 2$"):
+        calibrate([blank] * 3, [blank] * 3, square_size=1.0, names=["a", "b"])
+    for side in ("l", "r"):
+        (tmp_path / side).mkdir()
+        for i in range(3):
+            cv2.imwrite(str(tmp_path / side / f"{i:02d}.png"), blank)
+    with pytest.raises(ValueError, match=r"\(rejected: 00\.png, 01\.png, 02\.png\)$"):
+        calibrate(
+            sorted((tmp_path / "l").glob("*.png")),
+            sorted((tmp_path / "r").glob("*.png")),
+            square_size=1.0,
+        )
+
+
+def test_cli_takes_an_upper_case_suffix_and_compares_its_outputs_resolved(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """-o RIG.YAML is a .yaml file (Calibration.save takes it); -o .../rep/report.json given
+    absolute beside --report rep, relative, is the report's file all the same, and refused."""
+
+    class Reached(Exception):
+        pass
+
+    def reached(*_: Any, **__: Any) -> Any:
+        raise Reached
+
+    monkeypatch.setattr(calmod, "find_corners", reached)
+    left, right = _chessboard_paths()
+    base = ["calibrate", "--left", str(left[0].parent / "left0*.jpg"), "--right",
+            str(right[0].parent / "right0*.jpg"), "--square", "0.025"]  # fmt: skip
+
+    def run(*argv: str) -> int:
+        a = _parser().parse_args([*base, *argv])
+        return int(a.func(a))
+
+    with pytest.raises(Reached):  # past the output checks, to the corners
+        run("-o", str(tmp_path / "RIG.YAML"))
+    (tmp_path / "rep").mkdir()
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(
+        ValueError, match=r"^-o .*rep/report\.json: --report rep writes report\.json"
+    ):
+        run("-o", str(tmp_path / "rep" / "report.json"), "--report", "rep")
