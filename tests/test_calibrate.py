@@ -344,7 +344,7 @@ def test_synthetic_rejected_and_outlier_dropped(
 
 
 def test_a_pair_with_the_board_in_neither_image_is_not_said_to_miss_it_in_both(
-    cached_corners: None,
+    cached_corners: None, tmp_path: Path
 ) -> None:
     """A pair whose images both lack the board was rejected as "board not found in both
     images", which reads as found in one of them (the pair a board in one image only gives);
@@ -362,6 +362,10 @@ def test_a_pair_with_the_board_in_neither_image_is_not_said_to_miss_it_in_both(
         "right only": "board not found in left",
     }
     assert "  rejected neither: board not found in either image" in rep.summary().splitlines()
+    # the pairs given count the rejected ones (a third mutation audit); .JSON is a .json report
+    assert rep.summary().startswith("3/5 pairs used (162 corners, chessboard 9x6 inner corners)")
+    rep.save(tmp_path / "r.JSON")
+    assert json.loads((tmp_path / "r.JSON").read_text())["rejected_pairs"] == rep.rejected_pairs
 
 
 def test_outlier_reported_but_kept_without_drop(
@@ -1796,3 +1800,40 @@ def test_a_vertical_rig_whose_t_leans_right_is_not_said_to_be_swapped(
     monkeypatch.setattr(calmod, "_solve", solve)
     cal, rep = calibrate(left[:4], right[:4], square_size=1.0, distortion="k1k2p1p2")
     assert list(cal.T) == [0.05, -3.3, 0.0] and rep.baseline == pytest.approx(math.hypot(0.05, 3.3))
+
+
+def test_a_camera_read_for_calibration_is_closed_and_a_frame_failure_is_not_its_end() -> None:
+    """_calibrate_from_camera (calibrate_from_video's, from_bag's reader): a frame that fails
+    to decode (SourceError with end=False) is raised, not taken for the recording's end and
+    calibrated without the rest; the camera is closed after either (a third mutation audit
+    found both unasserted)."""
+    from stereovision.capture import SourceError
+
+    class Cam:
+        def __init__(self, end: bool) -> None:
+            self.end, self.closed = end, 0
+
+        def read(self) -> Any:
+            raise SourceError("left frame 3 does not decode", side="left", end=self.end)
+
+        def close(self) -> None:
+            self.closed += 1
+
+    def run(cam: Cam) -> Any:
+        return calmod._calibrate_from_camera(
+            cam, pattern=(9, 6), square_size=1.0, board=None, max_pairs=60, min_distance=None,
+            log=None,
+        )  # fmt: skip
+
+    cam = Cam(end=False)
+    with pytest.raises(SourceError, match=r"^left frame 3 does not decode$"):
+        run(cam)
+    assert cam.closed == 1
+    cam = Cam(end=True)
+    with pytest.raises(
+        ValueError,
+        match=r"^no frame pair of the 0 read shows the chessboard 9x6 inner corners in both "
+        r"views \(none read: an empty recording\)$",
+    ):
+        run(cam)
+    assert cam.closed == 1
