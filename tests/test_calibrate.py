@@ -1837,3 +1837,48 @@ def test_a_camera_read_for_calibration_is_closed_and_a_frame_failure_is_not_its_
     ):
         run(cam)
     assert cam.closed == 1
+
+
+def test_outlier_floor_both_cameras_in_model_selection_and_a_worse_refinement_refused(
+    cached_corners: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A third mutation audit found unasserted: the outlier limit's 0.5 px floor (a pair at 0.4
+    px beside twelve at 0.1 px is corner noise, kept unflagged), the model selection's held-out
+    RMS pooling both cameras (the right camera's gain chose k3: sqrt((1 + 0.81) / 2) = 0.951 <
+    0.99), and a joint refinement that ends worse than the fixed-intrinsics solve not taken."""
+    left, right = _chessboard_paths()
+    _solve_with_errors(monkeypatch, {13: np.array([[0.1, 0.1]] * 12 + [[0.4, 0.4]])})
+    _, rep = calibrate(left, right, square_size=1.0, distortion="k1k2p1p2")
+    assert rep.outlier_pairs == []
+    monkeypatch.undo()
+    monkeypatch.setattr(calmod, "find_corners", _cached_find_corners)
+    k3 = calmod.DISTORTION_MODELS["k1k2p1p2k3"]
+    K = np.array([[530.0, 0, 320], [0, 530, 240], [0, 0, 1]])
+    calls: list[int] = []
+
+    def loo(obj: Any, pts: Any, size: Any, flags: int) -> Any:
+        calls.append(flags)  # left then right, for each candidate
+        right_k3 = flags == k3 and calls.count(k3) == 2
+        return (0.9 if right_k3 else 1.0), K, np.zeros(5)
+
+    monkeypatch.setattr(calmod, "_loo_rms", loo)
+    n = calmod.MODEL_SELECTION_MIN_VIEWS
+    with warnings.catch_warnings():  # k3's fit of these 6 views folds: said, not asserted
+        warnings.simplefilter("ignore", UserWarning)
+        _, rep = calibrate(left[:n], right[:n], square_size=1.0)
+    assert rep.model_selection["k1k2p1p2k3"] == pytest.approx(math.sqrt((1 + 0.81) / 2))
+    assert rep.distortion_model == "k1k2p1p2k3"
+    monkeypatch.undo()
+    monkeypatch.setattr(calmod, "find_corners", _cached_find_corners)
+    real = cv2.stereoCalibrateExtended
+
+    def worse_refinement(*a: Any, **kw: Any) -> Any:
+        out = list(real(*a, **kw))
+        if kw["flags"] & cv2.CALIB_USE_INTRINSIC_GUESS:
+            out[0] += 1.0
+        return tuple(out)
+
+    _, fixed = calibrate(left[:4], right[:4], square_size=1.0, distortion="k1k2p1p2", refine=False)
+    monkeypatch.setattr(cv2, "stereoCalibrateExtended", worse_refinement)
+    _, rep = calibrate(left[:4], right[:4], square_size=1.0, distortion="k1k2p1p2")
+    assert not rep.refined and rep.rms == fixed.rms
