@@ -1691,7 +1691,8 @@ def test_cli_an_output_link_is_checked_in_its_targets_folder(
 def test_a_star_pattern_the_square_bounds_and_names_of_another_count(tmp_path: Path) -> None:
     """A third mutation audit found unasserted: "9*6" read as 9x6, a square of exactly 100 m and
     1 nm taken (the refusal is outside them), names= of another length than the pairs refused by
-    name (it failed later in a zip), and one file name in two folders naming its pair once."""
+    name (it failed later in a zip), one file name in two folders naming its pair once, and
+    images of one width and another height refused."""
     assert parse_pattern("9*6") == (9, 6)
     blank = np.full((120, 160), 128, np.uint8)
     for square in (100.0, 1e-9):  # the bounds: past the size check, to the boards not found
@@ -1699,6 +1700,11 @@ def test_a_star_pattern_the_square_bounds_and_names_of_another_count(tmp_path: P
             calibrate([blank] * 3, [blank] * 3, square_size=square)
     with pytest.raises(ValueError, match=r"^names: expected 3 names \(one per pair\), got 2$"):
         calibrate([blank] * 3, [blank] * 3, square_size=1.0, names=["a", "b"])
+    wide, low = np.full((480, 640), 128, np.uint8), np.full((240, 640), 128, np.uint8)
+    with pytest.raises(  # the same width, another height: still another size
+        ValueError, match=r"^right_images\[0\]: image is 640x240, but left_images\[0\] is 640x480$"
+    ):
+        calibrate([wide] * 3, [low] * 3, square_size=1.0)
     for side in ("l", "r"):
         (tmp_path / side).mkdir()
         for i in range(3):
