@@ -480,6 +480,16 @@ def _parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _calibrate_cli(*argv: str) -> int:
+    """``stereovision calibrate`` on the chessboard pairs left0*/right0* (``--square 0.025``),
+    ``argv`` added; its exit status."""
+    left, right = _chessboard_paths()
+    base = ["calibrate", "--left", str(left[0].parent / "left0*.jpg"), "--right",
+            str(right[0].parent / "right0*.jpg"), "--square", "0.025"]  # fmt: skip
+    a = _parser().parse_args([*base, *argv])
+    return int(a.func(a))
+
+
 def test_cli_end_to_end(
     synthetic: tuple[list[np.ndarray], list[np.ndarray], list[str]],
     synthetic_dropped: tuple[Calibration, CalibrationReport],
@@ -707,13 +717,7 @@ def test_cli_outputs_that_collide_or_cannot_be_written_are_refused_first(
         raise AssertionError("the corners were looked for before the outputs were checked")
 
     monkeypatch.setattr(calmod, "find_corners", no_work)
-    left, right = _chessboard_paths()
-    base = ["calibrate", "--left", str(left[0].parent / "left0*.jpg"), "--right",
-            str(right[0].parent / "right0*.jpg"), "--square", "0.025"]  # fmt: skip
-
-    def run(*argv: str) -> int:
-        a = _parser().parse_args([*base, *argv])
-        return int(a.func(a))
+    run = _calibrate_cli
 
     (tmp_path / "rp").mkdir()
     kept = tmp_path / "rp" / "report.yaml"
@@ -1667,7 +1671,6 @@ def test_cli_an_output_link_is_checked_in_its_targets_folder(
         raise AssertionError("the corners were looked for before the outputs were checked")
 
     monkeypatch.setattr(calmod, "find_corners", no_work)
-    left, right = _chessboard_paths()
     (tmp_path / "ro").mkdir()
     (tmp_path / "ro" / "rig.yaml").write_text("kept\n")
     (tmp_path / "rig.yaml").symlink_to(Path("ro") / "rig.yaml")
@@ -1677,11 +1680,8 @@ def test_cli_an_output_link_is_checked_in_its_targets_folder(
         "cannot_write_in",
         lambda f: "Permission denied" if Path(f) == tmp_path / "ro" else real_probe(f),
     )
-    a = _parser().parse_args(["calibrate", "--left", str(left[0].parent / "left0*.jpg"),
-                              "--right", str(right[0].parent / "right0*.jpg"), "--square",
-                              "0.025", "-o", str(tmp_path / "rig.yaml")])  # fmt: skip
     with pytest.raises(PermissionError) as info:
-        a.func(a)
+        _calibrate_cli("-o", str(tmp_path / "rig.yaml"))
     assert str(info.value) == (
         f"-o {tmp_path / 'rig.yaml'}: cannot write in {tmp_path / 'ro'} (Permission denied)"
     )
@@ -1730,13 +1730,7 @@ def test_cli_takes_an_upper_case_suffix_and_compares_its_outputs_resolved(
         raise Reached
 
     monkeypatch.setattr(calmod, "find_corners", reached)
-    left, right = _chessboard_paths()
-    base = ["calibrate", "--left", str(left[0].parent / "left0*.jpg"), "--right",
-            str(right[0].parent / "right0*.jpg"), "--square", "0.025"]  # fmt: skip
-
-    def run(*argv: str) -> int:
-        a = _parser().parse_args([*base, *argv])
-        return int(a.func(a))
+    run = _calibrate_cli
 
     with pytest.raises(Reached):  # past the output checks, to the corners
         run("-o", str(tmp_path / "RIG.YAML"))
