@@ -1906,6 +1906,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         # Each run shows its warnings afresh (setting a filter resets the registry that would
         # hide a message already shown by an earlier call in the same process).
         warnings.simplefilter("default")
+        # a file a Ctrl-C or SIGTERM caught between its open() and its `with` is closed by the
+        # collector, which warns "unclosed file": Python's own default hides that (a developer's
+        # warning), and "default" above had made it a line after the interrupt's
+        warnings.simplefilter("ignore", ResourceWarning)
         warnings.showwarning = _one_line_warning
         if threading.current_thread() is not threading.main_thread():
             return _run(args)
