@@ -618,8 +618,8 @@ def refuse_unreachable_range(min_disparity: float, max_disparity: float, width: 
 
 
 def first_line(exc: BaseException) -> str:
-    """What a one-line error message says of ``exc``: its message's first line (its type's
-    name if empty), as the CLI, the GUI and the stream print errors.
+    """What a one-line error message says of ``exc``: its message's first line with text (its
+    type's name if none), as the CLI, the GUI and the stream print errors and warnings.
 
     Parameters
     ----------
@@ -637,8 +637,12 @@ def first_line(exc: BaseException) -> str:
     'the offscreen render returned no image'
     >>> first_line(MemoryError())
     'MemoryError'
+    >>> first_line(ValueError("\\nthe pair differs in size"))
+    'the pair differs in size'
     """
-    return str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+    # the first line with text: a message opening with a line break said nothing
+    text = [line for line in str(exc).splitlines() if line.strip()]
+    return text[0] if text else type(exc).__name__
 
 
 def internal_error(exc: BaseException) -> str:

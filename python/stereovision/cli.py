@@ -1887,9 +1887,8 @@ def _one_line_warning(
     """Warnings as one line, like the errors (not Python's file:line and source echo): the
     message's first line with text; one with none (``warnings.warn(SomeWarning())``) is named
     by its category."""
-    # the first line with text: a message opening with a line break said nothing
-    text = [line for line in str(message).splitlines() if line.strip()]
-    print(f"stereovision: warning: {text[0] if text else category.__name__}", file=sys.stderr)
+    warning = message if isinstance(message, Warning) else category(message)
+    print(f"stereovision: warning: {first_line(warning)}", file=sys.stderr)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
