@@ -656,6 +656,38 @@ def test_keep_previous_never_replaces_an_earlier_copy(tmp_path):
     ]
 
 
+@pytest.mark.parametrize("kind", ["dangling", "to a folder", "to the file", "loop", "same bytes"])
+def test_keep_previous_leaves_a_link_under_its_name_untouched(tmp_path: Path, kind: str) -> None:
+    """``rig.previous.yaml`` already a link of the user's: a dangling one had the copy written
+    through it (a file made elsewhere, at its target); one to ``rig.yaml`` itself passed for
+    the copy, so the rig about to be replaced was kept nowhere; a looping one failed (after
+    calibrate's work). A link is a taken name now, left as it is: the copy goes to
+    ``rig.previous.2.yaml``, as for a folder or a file of other bytes."""
+    from stereovision.io import keep_previous
+
+    rig = tmp_path / "rig.yaml"
+    rig.write_bytes(b"good")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    link = tmp_path / "rig.previous.yaml"
+    target = {
+        "dangling": elsewhere / "victim.yaml",
+        "to a folder": elsewhere,
+        "to the file": rig,
+        "loop": link,
+        "same bytes": elsewhere / "same.yaml",
+    }[kind]
+    if kind == "same bytes":
+        target.write_bytes(b"good")
+    link.symlink_to(target)
+    assert keep_previous(rig) == tmp_path / "rig.previous.2.yaml"
+    assert (tmp_path / "rig.previous.2.yaml").read_bytes() == b"good"
+    assert link.is_symlink() and os.readlink(link) == str(target)
+    assert sorted(p.name for p in elsewhere.iterdir()) == (
+        ["same.yaml"] if kind == "same bytes" else []
+    )
+
+
 def test_keep_previous_copies_a_large_file_in_chunks(tmp_path):
     """``demo`` keeps a cloud.ply that no earlier run listed aside with keep_previous, which
     read the whole file into memory (and each earlier copy again to compare): a 2 GB cloud

@@ -295,7 +295,9 @@ def keep_previous(path: PathLike, new: bytes | None = None) -> Path | None:
     written, the earlier one is still in place. An earlier copy is never replaced (a third run
     with worse pairs would otherwise lose the good rig of the first): when ``NAME.previous.EXT``
     holds other bytes, the copy is ``NAME.previous.2.EXT`` (``.3``, ...: the first free name);
-    a file already kept byte for byte is not copied again, its copy is returned.
+    a file already kept byte for byte is not copied again, its copy is returned. A name taken
+    by a link (to a file, to a folder, dangling or looping) or a folder is left untouched and
+    the next name is tried: the copy is never written through a link the user made.
 
     Parameters
     ----------
@@ -322,6 +324,12 @@ def keep_previous(path: PathLike, new: bytes | None = None) -> Path | None:
     n = 1
     while True:
         kept = p.with_name(f"{p.stem}.previous{'' if n == 1 else f'.{n}'}{p.suffix}")
+        # a link is taken, not followed: a dangling one had the copy made at its target
+        # (elsewhere), one to NAME.EXT itself passed for the copy of the file about to be
+        # replaced, and a looping one failed after the work; none is a copy this made
+        if kept.is_symlink():
+            n += 1
+            continue
         if not kept.exists():
             break
         if kept.is_file() and _same_bytes(kept, p):
