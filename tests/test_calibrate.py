@@ -9,6 +9,7 @@ import json
 import math
 import os
 import re
+import tempfile
 import warnings
 from pathlib import Path
 from typing import Any
@@ -810,6 +811,63 @@ def test_cli_ros_and_report_files_of_the_users_are_not_replaced(
         "there, and would be replaced: give another --report folder, or move or remove that file"
     )
     assert (rep / "report.html").is_symlink() and mine.read_text() == "mine\n"
+
+
+@pytest.mark.parametrize(
+    ("kind", "error", "says"),
+    [
+        ("link to a read-only folder", PermissionError,
+         r"left\.yaml: it is a link to .*cam\.yaml, whose folder .*ro is not writable \(Perm"),
+        ("folder", IsADirectoryError, r"right\.yaml: it is a folder; give a file name$"),
+        ("dangling into no folder", FileNotFoundError,
+         r"left\.yaml is a link to .*nowhere/x\.yaml; cannot write .*directory .*nowhere does"),
+        ("loop", OSError, r"left\.yaml: it is a link that loops$"),
+        ("right to left", ValueError, r"right\.yaml and .*left\.yaml are one file"),
+    ],
+)  # fmt: skip
+def test_cli_ros_files_that_cannot_be_written_are_refused_first(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, kind: str, error: type, says: str
+) -> None:
+    """--ros DIR, itself writable, holding left.yaml as a link to a file in a read-only folder
+    (or a folder, a link dangling into a missing folder, a loop, right.yaml linked to
+    left.yaml): calibrate found out after the calibration, with -o already written. Refused
+    before any corner is looked for, naming the folder and the file; nothing is written."""
+
+    def no_work(*_: Any, **__: Any) -> Any:
+        raise AssertionError("the corners were looked for before the outputs were checked")
+
+    monkeypatch.setattr(calmod, "find_corners", no_work)
+    ro, ros = tmp_path / "ro", tmp_path / "ros"
+    ro.mkdir()
+    ros.mkdir()
+    (ro / "cam.yaml").write_text("mine\n")
+    real = tempfile.mkstemp
+
+    def mkstemp(*args: Any, dir: Any = None, **kwargs: Any) -> Any:  # root writes anywhere
+        if dir is not None and Path(dir).resolve() == ro.resolve():
+            raise PermissionError(13, "Permission denied")
+        return real(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr("stereovision.io.tempfile.mkstemp", mkstemp)
+    left, right = ros / "left.yaml", ros / "right.yaml"
+    if kind == "link to a read-only folder":
+        left.symlink_to(ro / "cam.yaml")
+    elif kind == "folder":
+        right.mkdir()
+    elif kind == "dangling into no folder":
+        left.symlink_to(tmp_path / "nowhere" / "x.yaml")
+    elif kind == "loop":
+        left.symlink_to(left)
+    else:
+        left.write_text("left\n")
+        right.symlink_to(left)
+    with pytest.raises(error, match=rf"^--ros {ros}: .*{says}"):
+        _calibrate_cli("-o", str(tmp_path / "rig.yaml"), "--ros", str(ros))
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ro", "ros"]
+    assert sorted(p.name for p in ros.iterdir()) == sorted(
+        n for n in ("left.yaml", "right.yaml") if (ros / n).is_symlink() or (ros / n).exists()
+    )
+    assert (ro / "cam.yaml").read_text() == "mine\n"
 
 
 def test_patterns_too_small_or_not_integers_are_refused(tmp_path: Path) -> None:

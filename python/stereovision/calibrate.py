@@ -2720,17 +2720,21 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         raise ValueError(f"-o {args.output}: use a .yaml, .yml, .xml or .json file name")
     if not out.parent.exists() and str(out.parent):
         raise FileNotFoundError(f"-o {args.output}: directory {out.parent} does not exist")
-    _check_output_file(out, args.output, ros=args.ros, report=args.report)
     ros_dir = Path(args.ros) if args.ros else None
     if ros_dir is not None and ros_dir.exists() and not ros_dir.is_dir():
         raise ValueError(f"--ros {args.ros}: is a file; give a folder for left.yaml and right.yaml")
     # Every output folder before the work: a report that cannot be written is said now, not
-    # after minutes of corner finding and a calibration already saved.
-    from stereovision.io import check_output_folder
+    # after minutes of corner finding and a calibration already saved. So is what stands
+    # under --ros's names (a link to a file in a read-only folder, a folder): kept aside, not
+    # refused, but written through.
+    from stereovision.io import check_destinations, check_output_folder
 
     for flag, folder in (("--ros", args.ros), ("--report", args.report)):
         if folder:
             check_output_folder(folder, flag)
+    if args.ros:
+        check_destinations(args.ros, CALIBRATE_OUTPUTS[:2], "--ros")
+    _check_output_file(out, args.output, ros=args.ros, report=args.report)
     # A report.html of the user's is not replaced; the files an earlier calibrate wrote there
     # (listed in its manifest) are. --ros's left.yaml / right.yaml (another rig's camera_info)
     # need no refusal: whatever they are, they are kept as left.previous.yaml ... (keep_previous).

@@ -272,6 +272,71 @@ def cannot_write_in(folder: PathLike) -> str | None:
     return None
 
 
+def check_destinations(folder: PathLike, names: Sequence[str], flag: str) -> None:
+    """Refuse, before the work, a file a command will write into ``folder`` that it could not:
+    what stands under one of ``names`` (a link, a folder) is checked as :func:`atomic_write`
+    and :func:`write_together` would check it, at the end of the work.
+
+    A folder itself writable (:func:`check_output_folder`) can still hold ``left.yaml`` as a
+    link to a file in a folder that is not, a link that loops or dangles into a missing
+    folder, or a folder under the name: each failed after minutes of calibration, with the
+    calibration file already written.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The output folder (it need not exist yet: then nothing stands in the way).
+    names : sequence of str
+        The files the command writes there, in the order it writes them together.
+    flag : str
+        How the user gave the folder (``"--ros"``), for the messages.
+
+    Raises
+    ------
+    IsADirectoryError, NotADirectoryError, FileNotFoundError, OSError
+        If a name is a folder (or a link to one), a link into a missing folder or a link that
+        loops, naming ``flag`` and ``folder``.
+    PermissionError
+        If a name is a link to a file whose folder cannot be written.
+    ValueError
+        If two of the names are one file (one a link to the other).
+    """
+    d = Path(folder)
+    if not d.is_dir():
+        return  # made by the command, empty (a file there: check_output_folder's refusal)
+    targets: list[tuple[Path, Path]] = []
+    for name in names:
+        dest = d / name
+        if not (dest.is_symlink() or dest.exists()):
+            continue
+        try:
+            target = _through_links(dest)
+            _writable_destination(target)
+        except OSError as exc:
+            # a dangling link's error names its target only: the link is named too
+            link = (
+                f"{name} is a link to {os.readlink(dest)}; "
+                if dest.is_symlink() and exc.errno != errno.ELOOP
+                else ""
+            )
+            refused = type(exc)(f"{flag} {folder}: {link}{exc}")
+            refused.errno = exc.errno
+            raise refused from None
+        why = cannot_write_in(target.parent)
+        if why:  # a link's target is replaced in its own folder, not in ``folder``
+            raise PermissionError(
+                f"{flag} {folder}: cannot write {dest}: it is a link to {target}, whose folder "
+                f"{target.parent} is not writable ({why})"
+            )
+        for earlier, earlier_target in targets:
+            if _one_file(earlier_target, target):
+                raise ValueError(
+                    f"{flag} {folder}: {dest} and {earlier} are one file (the second written "
+                    "would replace the first); move or remove the link"
+                )
+        targets.append((dest, target))
+
+
 def _same_bytes(a: Path, b: Path, chunk: int = 1 << 20) -> bool:
     """Whether files ``a`` and ``b`` hold the same bytes, read a chunk at a time (no cache, as
     :func:`filecmp.cmp` keeps by size and modification time)."""
