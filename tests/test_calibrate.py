@@ -870,6 +870,27 @@ def test_cli_ros_files_that_cannot_be_written_are_refused_first(
     assert (ro / "cam.yaml").read_text() == "mine\n"
 
 
+def test_cli_report_file_linked_to_itself_is_refused_as_a_link(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """--report DIR holding report.html as a link to itself: the check that -o is not one of
+    the report's files raised "RuntimeError: Symlink loop from ...". It is refused as any file
+    of the user's there is, naming it, before any corner is looked for."""
+
+    def no_work(*_: Any, **__: Any) -> Any:
+        raise AssertionError("the corners were looked for before the outputs were checked")
+
+    monkeypatch.setattr(calmod, "find_corners", no_work)
+    rep = tmp_path / "rep"
+    rep.mkdir()
+    (rep / "report.html").symlink_to(rep / "report.html")
+    with pytest.raises(
+        FileExistsError, match=rf"^--report {rep}: {rep}/report\.html is not listed"
+    ):
+        _calibrate_cli("-o", str(tmp_path / "rig.yaml"), "--report", str(rep))
+    assert (rep / "report.html").is_symlink() and not (tmp_path / "rig.yaml").exists()
+
+
 def test_patterns_too_small_or_not_integers_are_refused(tmp_path: Path) -> None:
     """2x2 and 2x5 reached OpenCV ("internal error" from cv2.error), 9 said "'int' object is not
     iterable", and (9.5, 6) was truncated to (9, 6)."""

@@ -2556,7 +2556,9 @@ def _check_output_file(
         raise PermissionError(f"-o {given}: cannot write in {folder} ({why})")
     if out.exists() and not os.access(out, os.W_OK):
         raise PermissionError(f"-o {given}: the file is not writable")
-    target = out.resolve()
+    # realpath, not resolve(): a --report file linked to itself raised "RuntimeError: Symlink
+    # loop" here, before the link's own refusal (refuse_foreign_outputs) was reached
+    target = os.path.realpath(out)
     for flag, where, files in (
         ("--report", report, ("report.html", "report.yaml", "report.json")),
         ("--ros", ros, ("left.yaml", "right.yaml")),
@@ -2564,7 +2566,7 @@ def _check_output_file(
         if not where:
             continue
         for name in files:
-            if (Path(where) / name).resolve() == target:
+            if os.path.realpath(Path(where) / name) == target:
                 raise ValueError(
                     f"-o {given}: {flag} {where} writes {name} there too and would overwrite the "
                     "calibration; give -o another name or folder"
