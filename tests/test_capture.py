@@ -223,6 +223,49 @@ def test_image_sequence_source_and_capture(tmp_path: Path) -> None:
     assert result.skew["n"] == 5
 
 
+def test_a_camera_whose_grab_hangs_is_given_up(tmp_path: Path) -> None:
+    """The right camera's grab never returning after 2 frames (a hung USB camera): capture
+    waited forever. After ``read_timeout`` s it raises naming both sources, the 2 pairs saved
+    kept and said."""
+    lpat = _write_sequence(tmp_path / "frames", "left", [_numbered(i) for i in range(5)])
+    rpat = _write_sequence(tmp_path / "frames", "right", [_numbered(i) for i in range(5)])
+    unplug = threading.Event()
+
+    class _HangsAfterTwo:
+        def __init__(self, cap: Any) -> None:
+            self._cap, self._grabs = cap, 0
+
+        def grab(self) -> bool:
+            self._grabs += 1
+            if self._grabs > 2:
+                unplug.wait()
+            return bool(self._cap.grab())
+
+        def __getattr__(self, name: str) -> Any:
+            return getattr(self._cap, name)
+
+    t0 = time.perf_counter()
+    with StereoCamera(lpat, rpat) as cam:
+        cam._caps["right"] = _HangsAfterTwo(cam._caps["right"])
+        try:
+            with pytest.raises(SourceError) as err:
+                capture(cam, tmp_path / "pairs", read_timeout=0.3)
+        finally:
+            unplug.set()
+    assert time.perf_counter() - t0 < 4.0
+    assert str(err.value) == (
+        f"{lpat!r} and {rpat!r} delivered no frame in 0.3 s (its read did not return: a hung "
+        "or unplugged USB camera, a stalled stream); unplug and replug it; 2 pairs were saved "
+        f"in {tmp_path / 'pairs'} and are kept"
+    )
+    assert err.value.end is False
+    assert sorted(p.name for p in (tmp_path / "pairs").iterdir()) == [
+        "left_0001.png", "left_0002.png", "right_0001.png", "right_0002.png"
+    ]  # fmt: skip
+    with pytest.raises(ValueError, match=r"read_timeout: expected a positive number of sec"):
+        capture(cam, tmp_path / "p2", read_timeout=-1.0)
+
+
 def test_a_gap_in_an_image_sequence_is_said(tmp_path: Path) -> None:
     """Pair 3 deleted from both numbered sequences (a blurred pair taken out): the capture
     stops there and says the images after the gap were not read (it said "end of stream", the

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import json
+import re
 import shutil
+import threading
 import time
 import urllib.error
 import urllib.request
@@ -1671,6 +1673,46 @@ def test_a_source_failing_on_the_first_pair_is_raised(pipelined: bool) -> None:
     with pytest.raises(SourceError, match="frame 0 is 64x40") as err:
         run_stream(_FakeRig([bad]), max_disparity=8, pipelined=pipelined)  # type: ignore[arg-type]
     assert err.value is bad
+
+
+class _HungRig(_FakeRig):
+    """A rig whose ``read`` never returns once its pairs are out (a hung USB camera), until
+    ``unplug`` is set."""
+
+    def __init__(self, pairs: list[Any]) -> None:
+        super().__init__(pairs)
+        self.unplug = threading.Event()
+
+    def read(self) -> Any:
+        if not self._pairs:
+            self.unplug.wait()
+        return super().read()
+
+
+@pytest.mark.parametrize("pipelined", [False, True])
+@pytest.mark.parametrize("done", [0, 2])
+def test_a_camera_whose_read_hangs_is_given_up(pipelined: bool, done: int) -> None:
+    """A camera whose read never returns (a hung USB camera): the stream waited forever, its
+    summary never said. After ``read_timeout`` s the camera is named as failing: raised on the
+    first pair, the stream's end ("source failed") after pairs were done."""
+    from stereovision.capture import SourceError
+
+    rig = _HungRig([_frame(i) for i in range(done)])
+    says = r"the camera \(_HungRig\) delivered no frame in 0\.3 s \(its read did not return"
+    t0 = time.perf_counter()
+    try:
+        if done == 0:
+            with pytest.raises(SourceError, match=says):
+                run_stream(rig, max_disparity=8, pipelined=pipelined, read_timeout=0.3)  # type: ignore[arg-type]
+        else:
+            rep = run_stream(rig, max_disparity=8, pipelined=pipelined, read_timeout=0.3)  # type: ignore[arg-type]
+            assert (rep.frames, rep.ended) == (done, "source failed")
+            assert re.match(says, rep.error or "")
+    finally:
+        rig.unplug.set()
+    assert time.perf_counter() - t0 < 4.0
+    with pytest.raises(ValueError, match=r"read_timeout: expected a positive number of seconds"):
+        run_stream(_FakeRig([_frame(0)]), max_disparity=8, read_timeout=0)  # type: ignore[arg-type]
 
 
 def test_a_bag_without_a_calibration_is_refused(

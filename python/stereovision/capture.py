@@ -39,6 +39,7 @@ import re
 import secrets
 import statistics
 import sys
+import threading
 import time
 import warnings
 from collections import deque
@@ -105,6 +106,11 @@ LIVE_DETECT_FLAGS = (
 _TEMPORAL_FULL = 0.95
 #: Width of each coverage bar in the progress line (characters).
 PROGRESS_BAR_WIDTH = 10
+#: Seconds a camera's ``read`` may take before :func:`read_within` gives it up as hung. A hung
+#: USB camera (or a network stream that stalls) never returned: the stream waited forever, and a
+#: read in native code, holding off Ctrl-C until it returned, made it unkillable but by SIGKILL.
+#: 10 s is OpenCV's own V4L2 select timeout, and well above a camera's first frame (1-3 s).
+DEFAULT_READ_TIMEOUT = 10.0
 #: File name pattern of saved pairs (index from 1; 4 digits sort well up to 9999 pairs).
 PAIR_NAME = "{side}_{index:04d}{ext}"
 _PAIR_RE = re.compile(r"^(left|right)_(\d+)\.[A-Za-z0-9]+$")
@@ -394,6 +400,69 @@ def _describe_source(src: Source) -> str:
 
 #: A frame number in an image-sequence pattern (``left_%03d.png``).
 _SEQ_RE = re.compile(r"%(0?\d*)d")
+
+
+def _camera_name(camera: Any) -> str:
+    """``camera 0 and camera 1`` (a :class:`StereoCamera`'s sources), for a message."""
+    sources = getattr(camera, "sources", None)
+    if isinstance(sources, dict) and sources:
+        return " and ".join(_describe_source(src) for src in sources.values())
+    return f"the camera ({type(camera).__name__})"
+
+
+def read_within(camera: Any, timeout: float | None = DEFAULT_READ_TIMEOUT) -> StereoFrame:
+    """``camera.read()``, given up after ``timeout`` seconds.
+
+    The read runs in a daemon thread while the caller waits on an event, which Ctrl-C and
+    SIGTERM interrupt at once: a read in native code (OpenCV's grab) holds them off in the
+    main thread until it returns, which a hung camera never does.
+
+    Parameters
+    ----------
+    camera : object
+        Anything with ``read()`` (a :class:`StereoCamera`, a recording).
+    timeout : float or None
+        Seconds to wait (:data:`DEFAULT_READ_TIMEOUT`); None waits as long as the read takes.
+
+    Returns
+    -------
+    StereoFrame
+        What ``read`` returned.
+
+    Raises
+    ------
+    SourceError
+        If ``read`` did not return within ``timeout`` (``end`` False), naming the camera; or
+        as ``read`` raises it (any exception of ``read`` is raised as it is).
+    """
+    if timeout is None:
+        return camera.read()  # type: ignore[no-any-return]
+    if not timeout > 0:
+        raise ValueError(f"read_timeout: expected a positive number of seconds, got {timeout}")
+    done = threading.Event()
+    box: list[Any] = []
+
+    def work() -> None:
+        try:
+            box.append(camera.read())
+        except BaseException as exc:  # raised in the caller's thread below
+            box.append(exc)
+        finally:
+            done.set()
+
+    threading.Thread(target=work, name="stereovision-read", daemon=True).start()
+    if not done.wait(timeout):
+        # the thread stays in the read (nothing stops native code); its frame, if it ever
+        # comes, is dropped
+        raise SourceError(
+            f"{_camera_name(camera)} delivered no frame in {timeout:g} s (its read did not "
+            "return: a hung or unplugged USB camera, a stalled stream); unplug and replug it",
+            side="both",
+            end=False,
+        )
+    if isinstance(box[0], BaseException):
+        raise box[0]
+    return box[0]  # type: ignore[no-any-return]
 
 
 def _sequence_first(path: str) -> tuple[int, str] | None:
@@ -1625,6 +1694,7 @@ def capture(
     ext: str = ".png",
     log: Callable[[str], None] | None = None,
     temporal: int | None = None,
+    read_timeout: float | None = DEFAULT_READ_TIMEOUT,
 ) -> CaptureResult:
     """Save pairs from ``camera`` into ``directory`` until ``count`` are saved.
 
@@ -1659,6 +1729,10 @@ def capture(
         afresh after each saved pair. Low light: on a rendered rig with grey noise of 20 levels,
         8 frames a pair halved the calibration's range error (docs/robotics.md). Not with
         ``every``.
+    read_timeout : float or None
+        Seconds a pair's read may take (:data:`DEFAULT_READ_TIMEOUT`, 10; None: no limit): a
+        camera whose read does not return by then (a hung USB camera) raises a
+        :class:`SourceError` naming it, the pairs saved so far kept (:func:`read_within`).
 
     Returns
     -------
@@ -1682,6 +1756,8 @@ def capture(
         raise ValueError(f"count: expected a positive number of pairs, got {count!r}")
     if every <= 0:
         raise ValueError(f"every: expected a positive integer, got {every!r}")
+    if read_timeout is not None and not read_timeout > 0:
+        raise ValueError(f"read_timeout: expected a positive number of seconds, got {read_timeout}")
     if chessboard and charuco is not None:
         raise ValueError("chessboard and charuco: give one calibration target, not both")
     tf = None
@@ -1726,7 +1802,7 @@ def capture(
 
     while count is None or len(saved) < count:
         try:
-            frame = camera.read()
+            frame = read_within(camera, read_timeout)
         except SourceError as exc:
             # an end before any pair is an error, as in `stream` (a bag whose frames found no
             # partner said "0 pairs saved (end of stream)" and exited 0)

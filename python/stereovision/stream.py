@@ -42,11 +42,13 @@ from stereovision._jsonout import json_line
 from stereovision._validate import first_line
 from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import (
+    DEFAULT_READ_TIMEOUT,
     SourceError,
     StereoCamera,
     StereoFrame,
     add_source_args,
     open_source,
+    read_within,
     temporal_average,
     warn_resampled_for_temporal,
 )
@@ -430,15 +432,17 @@ def _pairs(
     check_every: int | None = None,
     homographies: Any = None,
     temporal: Any = None,
+    read_timeout: float | None = DEFAULT_READ_TIMEOUT,
 ) -> Iterator[_Pair]:
     """Grab (and rectify, for a raw rig calibration) pairs until the end or ``frames`` pairs;
-    check the rows of pair 0 and, when positive, every ``check_every``-th pair (None: none)."""
+    check the rows of pair 0 and, when positive, every ``check_every``-th pair (None: none);
+    a read taking over ``read_timeout`` s raises (:func:`~stereovision.capture.read_within`)."""
     n = 0
     while frames is None or n < frames:
         t0 = time.perf_counter()
         grabbed = getattr(camera, "grabbed", None) if isinstance(camera, _FirstPairRead) else None
         try:
-            fr = camera.read()
+            fr = read_within(camera, read_timeout)
         except SourceError as exc:
             # no first frame, or a failure that is not an end (a frame that does not decode or
             # of another shape): an error; an end is the end of the stream, said plainly when
@@ -637,6 +641,7 @@ def run_stream(
     on_ground: Callable[[Any], None] | None = None,
     homographies: Any = None,
     temporal: Any = None,
+    read_timeout: float | None = DEFAULT_READ_TIMEOUT,
 ) -> StreamReport:
     """Depth maps from a stereo camera until it ends, ``frames`` pairs, or Ctrl-C.
 
@@ -709,6 +714,11 @@ def run_stream(
         when the rig or the scene moves. It averages the frames as grabbed, before
         rectification (whose interpolation blurs the noise it measures). ``on_result`` gets
         the averaged left image.
+    read_timeout : float or None
+        Seconds a pair's read may take (:data:`~stereovision.capture.DEFAULT_READ_TIMEOUT`,
+        10); a camera whose read does not return by then (a hung USB camera) ends the stream
+        with a :class:`~stereovision.capture.SourceError` naming it, as a failing source does.
+        None waits as long as the read takes. Ctrl-C stops the wait at once either way.
 
     Returns
     -------
@@ -730,6 +740,8 @@ def run_stream(
 
     if frames is not None and frames <= 0:
         raise ValueError(f"frames: expected a positive number, got {frames}")
+    if read_timeout is not None and not read_timeout > 0:
+        raise ValueError(f"read_timeout: expected a positive number of seconds, got {read_timeout}")
     if homographies is not None:
         if calib is not None:
             raise ValueError("homographies and calib: give one way to rectify the pairs")
@@ -754,7 +766,7 @@ def run_stream(
         # that reports 640x480 and delivers 320x240 failed every pair), as batch and gui fit
         # a calibration to the images they read
         try:
-            camera = _FirstPairRead(camera)  # type: ignore[assignment]
+            camera = _FirstPairRead(camera, read_timeout)  # type: ignore[assignment]
         except KeyboardInterrupt as exc:
             # as during the stream's own first grab: the summary of no pair, not an error
             stopped = "terminated" if isinstance(exc, Terminated) else "interrupted"
@@ -776,7 +788,13 @@ def run_stream(
         iter(())
         if stopped
         else _pairs(
-            camera, calib, frames, (check_every or 0) if check else None, homographies, temporal
+            camera,
+            calib,
+            frames,
+            (check_every or 0) if check else None,
+            homographies,
+            temporal,
+            read_timeout,
         )
     )
     producer: _Producer | None = None
@@ -1036,14 +1054,15 @@ class _FirstPairRead:
     Raises
     ------
     SourceError, ValueError
-        As the camera's ``read`` of the first pair (no first frame, one that does not decode).
+        As the camera's ``read`` of the first pair (no first frame, one that does not decode),
+        or :func:`~stereovision.capture.read_within` (no pair within ``read_timeout`` s).
     """
 
-    def __init__(self, camera: Any) -> None:
+    def __init__(self, camera: Any, read_timeout: float | None = DEFAULT_READ_TIMEOUT) -> None:
         self._camera = camera
         self.reported: tuple[int, int] | None = getattr(camera, "delivered_size", {}).get("left")
         t0 = time.perf_counter()
-        self._first: StereoFrame | None = camera.read()
+        self._first: StereoFrame | None = read_within(camera, read_timeout)
         self.grabbed: tuple[float, float] | None = (t0, time.perf_counter())
 
     def read(self) -> StereoFrame:
