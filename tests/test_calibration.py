@@ -1482,3 +1482,42 @@ def test_a_word_among_a_matrixs_numbers_is_named_not_read_as_zero(tmp_path: Path
     )
     with pytest.raises(ValueError, match=r"field 'K1' is not a matrix: element 1 of data is not"):
         Calibration.load(tmp_path / "w.yaml")
+
+
+_SKEWED = np.array([[300.0, 5.0, 161.3], [0.0, 302.0, 118.7], [0.0, 0.0, 1.0]])
+
+
+@pytest.mark.parametrize(
+    "fields",
+    [
+        {"K1": _SKEWED},
+        {"T": np.array([0.12, 0.002, 0.003])},
+        {"T": np.array([-0.12, 0.0, 0.0]), "unit": "mm"},
+    ],
+    ids=["skew", "swapped", "tiny"],
+)
+def test_the_warnings_of_a_calibrations_numbers_point_at_the_callers_line(
+    fields: dict[str, object], tmp_path: Path
+) -> None:
+    """The skew, swapped-cameras and baseline-unit warnings had a fixed ``stacklevel``, right for
+    the constructor only: ``load``, ``from_file`` and ``scaled_to`` were attributed to a line of
+    calibration.py, ``dataclasses.replace`` to dataclasses.py; each is the caller's line now."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        calib = raw_calib(**fields)
+    path = calib.save(tmp_path / "rig.yaml")
+    calls = {
+        "load": lambda: Calibration.load(path),
+        "from_file": lambda: Calibration.from_file(path),
+        "replace": lambda: dataclasses.replace(calib, unit=calib.unit),
+        "scaled_to": lambda: calib.scaled_to((160, 120)),
+    }
+    for how, call in calls.items():
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            call()
+        # a derived calibration (scaled_to) does not say its baseline again
+        want = [] if ("unit" in fields and how == "scaled_to") else [__file__]
+        assert [w.filename for w in caught] == want, (how, [str(w.message) for w in caught])

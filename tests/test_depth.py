@@ -1284,3 +1284,22 @@ def test_a_dark_region_locked_at_a_min_disparity_above_0_is_filled_without_depth
     assert (res.confidence[inner] == 0).mean() > 0.9  # measured: 94 %
     assert np.isnan(res.require_depth()[inner]).mean() > 0.9
     assert not (np.isfinite(res.depth) & (res.confidence == 0)).any()
+
+
+def test_the_12_bit_warning_points_at_the_callers_line() -> None:
+    """The low-uint16 warning had ``stacklevel=4``, right for one depth only: through
+    ``depth_map`` it named a line of depth.py, through ``match`` one of _validate.py."""
+    import warnings
+
+    left = np.rint(_texture(48, 96) * 4095).astype(np.uint16)
+    right = np.rint(_shift(_texture(48, 96), 4.0) * 4095).astype(np.uint16)
+    calls = {
+        "depth_map": lambda: sv.depth_map(left, right, method="fast", max_disparity=16),
+        "match": lambda: sv.match(left, right, max_disparity=16),
+    }
+    for how, call in calls.items():
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            call()
+        said = [w for w in seen if "uint16 image whose largest value" in str(w.message)]
+        assert [w.filename for w in said] == [__file__, __file__], how

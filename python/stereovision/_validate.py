@@ -11,6 +11,7 @@ luma weights.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import inspect
 import math
@@ -148,7 +149,7 @@ def _warn_low_uint16(arr: np.ndarray, name: str) -> None:
             "full range first (img << 4 for 12-bit data, or img.astype(np.uint8) for 8-bit "
             "values)",
             UserWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),  # reached at many depths: as_gray_float, depth_map, match
         )
 
 
@@ -855,13 +856,28 @@ def user_stacklevel() -> int:
     int
         The level to pass to :func:`warnings.warn` from the function calling this one.
     """
-    package = os.path.dirname(os.path.abspath(__file__)) + os.sep
     frame = sys._getframe(1)  # the function that will call warnings.warn: stacklevel 1
     level = 1
-    while frame.f_back is not None and frame.f_code.co_filename.startswith(package):
+    while frame.f_back is not None and _inside_package(frame):
         frame = frame.f_back
         level += 1
     return level
+
+
+_PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__)) + os.sep
+
+
+def _inside_package(frame: Any) -> bool:
+    """Whether ``frame`` runs this package's code: its files, and the ``__init__`` that
+    :mod:`dataclasses` generates for its classes (file ``<string>``) with ``dataclasses.replace``
+    calling it: a :class:`~stereovision.calibration.Calibration`'s warning pointed there."""
+    code = frame.f_code
+    if code.co_filename.startswith(_PACKAGE_DIR):
+        return True
+    if code.co_filename == "<string>" or code.co_filename == dataclasses.__file__:
+        made = frame.f_locals.get("self", frame.f_locals.get("obj"))
+        return type(made).__module__.startswith(f"{__package__}.")
+    return False
 
 
 def renamed_keyword(old: str, new: str) -> Callable[[_F], _F]:

@@ -34,6 +34,7 @@ from stereovision._validate import (
     number_shown,
     positive_finite,
     renamed_keyword,
+    user_stacklevel,
     xy_points,
 )
 
@@ -171,7 +172,7 @@ def _check_camera_matrix(K: F64, name: str) -> None:
             "(OpenCV's undistortion maps drop it) and the rectified depths are off by about "
             "skew / fx (0.2 % at 5 px on a synthetic rig); triangulate() uses it",
             UserWarning,
-            stacklevel=4,
+            stacklevel=user_stacklevel(),  # the user's line, also through load() or from_*()
         )
 
 
@@ -430,7 +431,7 @@ class Calibration:
                 f"{float(self.T[0]):+g} {self.unit}; a left-right rig has T[0] < 0): are the two "
                 "cameras (or their files) swapped?",
                 UserWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
         if _DERIVING.get():
             return
@@ -448,7 +449,7 @@ class Calibration:
                 + f": are T (or the board's square size) in another unit than "
                 f"unit={self.unit!r}?{_unit_suggestion(self.baseline, self.unit)}",
                 UserWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
 
     @staticmethod
