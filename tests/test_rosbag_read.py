@@ -1412,3 +1412,41 @@ def test_a_resized_pair_keeps_the_recorded_frames_and_describe_says_the_toleranc
         assert cam.describe().endswith("; max skew 16.7 ms")
     with BagCamera(bag) as cam:
         assert cam.read().delivered is None
+
+
+def test_the_size_warnings_of_a_bag_point_at_the_callers_line(cones: Any, tmp_path: Path) -> None:
+    """The dropped-size and resized-topic warnings had ``stacklevel=4``, right through
+    ``frames()`` only: a ``read()`` of the user's was attributed to the line that called the
+    user's function (pytest's), ``capture()``'s to capture.py. Each is the caller's line now;
+    through ``frames()`` it is the user's ``for`` (the generator's caller)."""
+    from stereovision.capture import capture
+
+    half = cv2.resize(cones.right, (225, 188), interpolation=cv2.INTER_AREA)
+    frames = [(T0 + k * PERIOD_NS, cones.left, T0 + k * PERIOD_NS, half) for k in range(2)]
+    bag = write_bag(tmp_path / "rig", frames, encoding="png")
+    want = ["size 450x200 is another shape", f"{RIGHT} is 225x188, not 450x375"]
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        BagCamera(bag, image_size="450x200") as cam,
+    ):
+        warnings.simplefilter("always")
+        cam.read()
+    said = [(str(w.message), w.filename) for w in caught]
+    assert [(m[: len(t)], f) for (m, f), t in zip(said, want, strict=True)] == [
+        (t, __file__) for t in want
+    ]
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        BagCamera(bag, image_size="450x200") as cam,
+    ):
+        warnings.simplefilter("always")
+        for _ in cam.frames():
+            pass
+    assert [w.filename for w in caught] == [__file__, __file__]
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        BagCamera(bag, image_size="450x200") as cam,
+    ):
+        warnings.simplefilter("always")
+        capture(cam, tmp_path / "pairs")
+    assert [w.filename for w in caught if "450x" in str(w.message)] == [__file__, __file__]

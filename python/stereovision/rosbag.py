@@ -78,7 +78,7 @@ import cv2
 import numpy as np
 
 from stereovision._interrupt import HeldInterrupts
-from stereovision._validate import renamed_keyword
+from stereovision._validate import renamed_keyword, user_stacklevel
 from stereovision.capture import PairSource, SourceError, StereoFrame, resize_frame
 
 __all__ = [
@@ -1097,7 +1097,7 @@ class BagCamera(PairSource):
                     f"size {rw}x{rh} is another shape than the recording's {w}x{h}: its frames "
                     f"are kept at {w}x{h} (a resize would stretch them)",
                     UserWarning,
-                    stacklevel=4,
+                    stacklevel=user_stacklevel(),  # read(), frames(), capture(), run_stream()
                 )
                 self.size = (w, h)
         if self.size is None:
@@ -1121,7 +1121,7 @@ class BagCamera(PairSource):
                 f"{self.topics[side]} is {w}x{h}, not {self.size[0]}x{self.size[1]}: its frames "
                 "are resized",
                 UserWarning,
-                stacklevel=4,
+                stacklevel=user_stacklevel(),
             )
         return resize_frame(img, self.size)
 
