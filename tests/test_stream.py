@@ -359,6 +359,7 @@ def test_stream_watches_the_floor_and_warns_once_when_the_mount_moves(
     assert rep.grounds[2]["pitch_deg"] == pytest.approx(16.0, abs=0.5)
     moved = [str(w.message) for w in caught if "moved on its mount" in str(w.message)]
     assert len(moved) == 1 and moved[0].startswith("pair 4:")
+    assert [w.filename for w in caught if "moved on its mount" in str(w.message)] == [__file__]
     assert rep.as_dict()["grounds"][1]["pair"] == 2
     # the first floor no longer holds once the camera turned (measured: 0.00)
     kept = [g["first_plane_kept"] for g in rep.grounds[1:]]
@@ -2161,3 +2162,48 @@ def test_each_report_line_is_flushed_as_it_is_written(
     report = out.getvalue().splitlines()[0]
     assert ("fps" in json.loads(report)) if json_out else ("fps |" in report)
     assert report + "\n" in out.flushed  # flushed alone, before the summary was written
+
+
+@pytest.mark.parametrize("pipelined", [False, True])
+def test_the_warnings_of_the_grabbing_point_at_the_callers_line(pipelined: bool) -> None:
+    """A source that ended before the other and frames resampled before ``temporal`` were warned
+    about in :func:`_pairs`: unpipelined that named a line of stream.py, pipelined one of
+    threading.py (the grabbing thread's). ``run_stream`` now gives them, at its caller's line."""
+    from stereovision.capture import SourceError
+    from stereovision.temporal import TemporalFilter
+
+    early = SourceError("right source ended after 2 frames", side="right", other_had_frames=True)
+    rig: Any = _FakeRig([_frame(0), _frame(0), early])
+    rig.rectified_topics, rig.topics = True, {"left": "/l/rect", "right": "/r/rect"}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rep = run_stream(rig, max_disparity=8, pipelined=pipelined, check=False,
+                         temporal=TemporalFilter(max_frames=4))  # fmt: skip
+    assert rep.frames == 2
+    said = [(str(w.message)[:35], w.filename) for w in caught]
+    assert said == [
+        ("temporal averaging: the topics /l/r", __file__),
+        ("right source ended after 2 frames", __file__),
+    ]
+
+
+def test_the_warnings_of_a_streams_pairs_point_at_the_callers_line(data_dir: Path) -> None:
+    """The warnings :func:`run_stream` gives itself of its pairs (noisy cameras, rows that do not
+    agree) name the caller's line, pipelined or not."""
+    from stereovision.capture import StereoFrame
+    from tests.test_exposure import noisy
+
+    cones = load_scene(data_dir / "middlebury2003" / "cones")
+    rng = np.random.default_rng(1)
+    for pipelined in (False, True):
+        frames = []
+        for i in range(2):
+            right = np.roll(cones.right, 4, axis=0)  # rows 4 px apart: not rectified
+            frames.append(StereoFrame(noisy(cones.left, 12.0, rng), noisy(right, 12.0, rng),
+                                      time.monotonic(), time.monotonic(), i))  # fmt: skip
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            run_stream(_FakeRig(frames), max_disparity=16, pipelined=pipelined)  # type: ignore[arg-type]
+        said = sorted((str(w.message)[:20], w.filename) for w in caught)
+        assert [s[0][:11] for s in said] == ["first pair:", "the cameras"], said
+        assert [s[1] for s in said] == [__file__, __file__], said

@@ -1919,6 +1919,14 @@ def warn_resampled_for_temporal(
         That first pair: when :func:`temporal_average` averages it as delivered, an
         enlargement is not said (None: it is).
     """
+    note = resampled_for_temporal_note(camera, frame)
+    if note is not None:
+        warnings.warn(note, UserWarning, stacklevel=stacklevel + 1)
+
+
+def resampled_for_temporal_note(camera: Any, frame: StereoFrame | None = None) -> str | None:
+    """The text of :func:`warn_resampled_for_temporal`'s warning, None when there is none: for a
+    caller that warns elsewhere (the stream's grabbing thread hands it to the caller's)."""
     topics = getattr(camera, "topics", None)
     why: tuple[str, str] | None = None
     if getattr(camera, "rectified_topics", False) and topics:
@@ -1935,13 +1943,12 @@ def warn_resampled_for_temporal(
                 f"the {side} frames are enlarged from {w}x{h} to {size[0]}x{size[1]}",
                 "ask for the cameras' own size",
             )
-    if why is not None:
-        warnings.warn(
-            f"temporal averaging: {why[0]}, and interpolation spreads their noise, which the "
-            f"filter takes for motion (it may average nothing); {why[1]}",
-            UserWarning,
-            stacklevel=stacklevel + 1,
-        )
+    if why is None:
+        return None
+    return (
+        f"temporal averaging: {why[0]}, and interpolation spreads their noise, which the "
+        f"filter takes for motion (it may average nothing); {why[1]}"
+    )
 
 
 def _refuse_own_output(sources: Any, out: PathLike, ext: str, flag: str) -> None:

@@ -39,7 +39,7 @@ import numpy as np
 
 from stereovision._interrupt import Terminated
 from stereovision._jsonout import json_line
-from stereovision._validate import first_line
+from stereovision._validate import first_line, user_stacklevel
 from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import (
     DEFAULT_READ_TIMEOUT,
@@ -49,8 +49,8 @@ from stereovision.capture import (
     add_source_args,
     open_source,
     read_within,
+    resampled_for_temporal_note,
     temporal_average,
-    warn_resampled_for_temporal,
 )
 from stereovision.rectification_check import RectificationCheck, check_rectification
 
@@ -111,6 +111,15 @@ class _Pair:
     # the temporal filter's (frames, restarts, sigma) once it took this pair: the summary's
     # figures are those of the last pair counted, not of pairs it took and never counted
     filtered: tuple[int, int, float] | None = None
+
+
+@dataclass
+class _Note:
+    """A warning of the grabbing, given by :func:`run_stream` when it takes it: warned in the
+    producer thread it was attributed to threading.py (unpipelined, to stream.py), not to the
+    caller's line."""
+
+    message: str
 
 
 @dataclass
@@ -433,7 +442,7 @@ def _pairs(
     homographies: Any = None,
     temporal: Any = None,
     read_timeout: float | None = DEFAULT_READ_TIMEOUT,
-) -> Iterator[_Pair]:
+) -> Iterator[_Pair | _Note]:
     """Grab (and rectify, for a raw rig calibration) pairs until the end or ``frames`` pairs;
     check the rows of pair 0 and, when positive, every ``check_every``-th pair (None: none);
     a read taking over ``read_timeout`` s raises (:func:`~stereovision.capture.read_within`)."""
@@ -450,7 +459,7 @@ def _pairs(
             if camera.count == 0 or not getattr(exc, "end", True):
                 raise
             if getattr(exc, "ended_early", False):
-                warnings.warn(str(exc), UserWarning, stacklevel=2)
+                yield _Note(str(exc))
             return
         except ValueError as exc:
             # a recording's frame that does not decode (BagCamera names its topic and stamp):
@@ -476,9 +485,10 @@ def _pairs(
         # and its motion test then took every pair of a still raw rig for a moving one.
         averaged = 1.0
         filtered = None
+        note = None
         if temporal is not None:
             if n == 0:
-                warn_resampled_for_temporal(camera, stacklevel=2, frame=fr)
+                note = resampled_for_temporal_note(camera, fr)
             left, right = temporal_average(temporal, fr)
             averaged = temporal.mean_frames()
             filtered = (temporal.frames, temporal.restarts, float(temporal.sigma))
@@ -492,6 +502,8 @@ def _pairs(
         # In the producer thread when pipelined: the matcher keeps working meanwhile.
         if check_every is not None and (n == 0 or (check_every > 0 and n % check_every == 0)):
             checked = check_rectification(left, right)
+        if note is not None:  # said before the pair, outside its timings
+            yield _Note(note)
         yield _Pair(
             left,
             right,
@@ -531,7 +543,7 @@ class _Producer(threading.Thread):
     aged in a queue.
     """
 
-    def __init__(self, source: Iterator[_Pair], q: queue.Queue[Any]) -> None:
+    def __init__(self, source: Iterator[_Pair | _Note], q: queue.Queue[Any]) -> None:
         super().__init__(name="stereovision-grab", daemon=True)
         self._source = source
         self._q = q
@@ -784,7 +796,7 @@ def run_stream(
     if calib is not None:
         rect_calib = calib if calib.rectified else calib.rectified_calibration()
     kw: dict[str, Any] = {"refine": refine, "method": method, "fill": fill}
-    source: Iterator[_Pair] = (
+    source: Iterator[_Pair | _Note] = (
         iter(())
         if stopped
         else _pairs(
@@ -803,7 +815,7 @@ def run_stream(
         producer = _Producer(source, q)
         producer.start()
 
-    def next_pair() -> _Pair | None:
+    def next_item() -> _Pair | _Note | None:
         if producer is None:
             return next(source, None)
         item = q.get()
@@ -813,6 +825,13 @@ def run_stream(
         if isinstance(item, BaseException):
             raise item
         return item  # type: ignore[no-any-return]
+
+    def next_pair() -> _Pair | None:
+        item = next_item()
+        while isinstance(item, _Note):
+            warnings.warn(item.message, UserWarning, stacklevel=user_stacklevel())
+            item = next_item()
+        return item
 
     tally = _Tally()
     noise = math.nan  # the first left frame's noise
