@@ -1961,3 +1961,23 @@ def test_outlier_floor_both_cameras_in_model_selection_and_a_worse_refinement_re
     monkeypatch.setattr(cv2, "stereoCalibrateExtended", worse_refinement)
     _, rep = calibrate(left[:4], right[:4], square_size=1.0, distortion="k1k2p1p2")
     assert not rep.refined and rep.rms == fixed.rms
+
+
+def test_calibrate_from_videos_warning_points_at_the_callers_line(tmp_path: Path) -> None:
+    """calibrate()'s warnings had ``stacklevel=2``, right for calibrate() only: through
+    calibrate_from_video (or calibrate_from_bag) they named a line of calibrate.py."""
+    import warnings
+
+    from stereovision.calibrate import calibrate_from_video
+
+    left, right = _chessboard_paths()
+    for side, paths in (("left", left), ("right", right)):
+        for i, p in enumerate(paths):
+            cv2.imwrite(str(tmp_path / f"{side}_{i:02d}.png"), cv2.imread(str(p)))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        calibrate_from_video(str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png"),
+                             pattern=(9, 6), square_size=1.0, distortion="fisheye",
+                             min_distance=0.0)  # fmt: skip
+    folds = [w for w in caught if "is not monotonic" in str(w.message)]
+    assert [w.filename for w in folds] == [__file__]

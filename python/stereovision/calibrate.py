@@ -1119,10 +1119,13 @@ def _rectified_checks(
 # ------------------------------------------------------------------------------------ loading
 
 
-def _warn(notes: list[str], message: str, category: type[Warning], stacklevel: int) -> None:
-    """Give a warning of :func:`calibrate`'s caller and keep it for the report."""
+def _warn(notes: list[str], message: str, category: type[Warning]) -> None:
+    """Give a warning of :func:`calibrate`'s caller and keep it for the report: the first line
+    outside the package (a fixed level named calibrate.py through calibrate_from_video)."""
+    from stereovision._validate import user_stacklevel
+
     notes.append(message)
-    warnings.warn(message, category, stacklevel=stacklevel + 1)
+    warnings.warn(message, category, stacklevel=user_stacklevel())
 
 
 def _charuco_hint(board: CharucoBoard, gray: np.ndarray, name: str) -> str:
@@ -1498,7 +1501,6 @@ def calibrate(
             f"the left and right file numbers differ in {shown}{more}: the pairs are taken in "
             "order, so a missing or extra file shifts the pairing",
             UserWarning,
-            stacklevel=2,
         )
 
     rejected: dict[str, str] = {}
@@ -1645,7 +1647,6 @@ def calibrate(
                 "the board near the image corners"
             ),
             UserWarning,
-            stacklevel=2,
         )
     if sol.model != "fisheye" and max(sol.rms_left, sol.rms_right) > FISHEYE_HINT_MIN_RMS_PX:
         fish = _fisheye_mono_rms(
@@ -1664,7 +1665,6 @@ def calibrate(
                 f"{sol.rms_right:.3f} px (left / right), the fisheye model with {fish[0]:.3f} / "
                 f"{fish[1]:.3f} px: a wide-angle lens; calibrate with distortion='fisheye'",
                 UserWarning,
-                stacklevel=2,
             )
 
     t = np.ravel(sol.T)
