@@ -934,6 +934,9 @@ def test_depth_png_warning_and_suffix(tmp_path):
     with pytest.warns(UserWarning, match="none of its 4 values") as rec:
         export.encode_depth_png(np.full((2, 2), 1500.0))
     assert rec[0].filename == __file__
+    with pytest.warns(UserWarning, match="disparity: none of its 4 values") as rec:
+        export.write_disparity_png(tmp_path / "wide.png", np.full((2, 2), 300.0))
+    assert rec[0].filename == __file__
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         export.write_depth_png(tmp_path / "far.png", np.array([[1.0, 70.0]]))
