@@ -1912,3 +1912,39 @@ def test_a_numpy_device_index_that_cannot_open_is_named_a_camera() -> None:
     camera's number."""
     with pytest.raises(SourceError, match=r"^cannot open left source camera 97 "):
         StereoCamera(np.int64(97), np.int64(98))
+
+
+def test_a_resized_sources_warning_points_at_the_callers_line(tmp_path: Path) -> None:
+    """StereoCamera's resized-frames and another-shape warnings had ``stacklevel=3``, right for
+    a ``read()`` of the user's only: through ``frames()`` they named capture.py's loop, through
+    ``capture()`` its line; each is the caller's line now (through ``frames()``, the user's
+    ``for``, the line that advanced the generator)."""
+    frames = [_numbered(i) for i in range(3)]
+    frames[1] = cv2.resize(frames[1], (160, 120), interpolation=cv2.INTER_AREA)  # half size
+    lpat = _write_sequence(tmp_path / "seq", "left", frames)
+    rpat = _write_sequence(tmp_path / "seq", "right", [_numbered(i) for i in range(3)])
+    size = (320, 180)  # another shape than the frames': dropped, with a warning
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        StereoCamera(lpat, rpat, image_size=size) as cam,
+    ):
+        warnings.simplefilter("always")
+        for _ in range(3):
+            cam.read()
+    assert [w.filename for w in caught] == [__file__, __file__], [str(w.message) for w in caught]
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        StereoCamera(lpat, rpat, image_size=size) as cam,
+    ):
+        warnings.simplefilter("always")
+        for _ in cam.frames():
+            pass
+    assert [w.filename for w in caught] == [__file__, __file__]
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        StereoCamera(lpat, rpat, image_size=size) as cam,
+    ):
+        warnings.simplefilter("always")
+        capture(cam, tmp_path / "pairs")
+    said = [w.filename for w in caught if "delivers" in str(w.message)]
+    assert said == [__file__, __file__]

@@ -52,7 +52,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import renamed_keyword
+from stereovision._validate import renamed_keyword, user_stacklevel
 from stereovision.calibrate import (
     POSE_PARAM_NAMES,
     POSE_PARAM_RANGES,
@@ -989,7 +989,7 @@ class StereoCamera(PairSource):
                 f"{self.size[0]}x{self.size[1]}: another shape, so its frames are kept at "
                 f"{w}x{h} (a resize would stretch them)",
                 UserWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),  # read(), frames(), capture()
             )
             # not marked as warned: a later frame resized to this size is said (it was not)
             self.size = (w, h)
@@ -1002,7 +1002,7 @@ class StereoCamera(PairSource):
                 f"{side} source {_describe_source(self.sources[side])} delivers {w}x{h}, not "
                 f"{self.size[0]}x{self.size[1]}: its frames are resized",
                 UserWarning,
-                stacklevel=3,
+                stacklevel=user_stacklevel(),
             )
         return resize_frame(frame, self.size)
 
@@ -1102,7 +1102,7 @@ class StereoCamera(PairSource):
             f"({period:.0f} ms) from the first pair's offset; the pairs are not simultaneous "
             "(the grab skew only says when each frame was read)",
             UserWarning,
-            stacklevel=3,
+            stacklevel=user_stacklevel(),
         )
 
     def describe(self) -> str:
