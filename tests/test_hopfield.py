@@ -355,6 +355,27 @@ def test_unknown_parameter_names_the_valid_ones() -> None:
         sv.match(ok, ok, method="hopfield", max_disparity=8, k_cnd=3)
 
 
+_NON_NEGATIVE = ["A", "B", "D", "theta", "compat_theta", "compat_slope", "compat_grad",
+                 "tau_y", "edge_penalty", "rescue_med", "agree_tol"]  # fmt: skip
+
+
+@pytest.mark.parametrize("name", _NON_NEGATIVE)
+def test_a_negative_weight_or_tolerance_is_refused(name: str) -> None:
+    """A negative energy weight turns its term into its opposite (A=-1: neighbours of another
+    disparity support a match), a negative tolerance passes nothing (agree_tol=-1: no match at
+    all): they ran without a word (MCGM refuses its own so); 0 stays allowed."""
+    ok = np.random.default_rng(0).random((40, 60), dtype=np.float32)
+    right = np.roll(ok, -3, axis=1)
+    bad = -1 if name == "agree_tol" else -0.5
+    with pytest.raises(
+        ValueError, match=rf"^invalid parameter `{name}`: must be finite and >= 0, got {bad}$"
+    ):
+        sv.match(ok, right, method="hopfield", max_disparity=8, **{name: bad})
+    with pytest.raises(ValueError, match=rf"^invalid parameter `{name}`: must be finite and >= 0"):
+        hp.hopfield_candidates(ok, right, max_disparity=8, **{name: bad})
+    sv.match(ok, right, method="hopfield", max_disparity=8, **{name: 0})
+
+
 @pytest.mark.parametrize("method", ["hopfield", "best"])
 @pytest.mark.parametrize(
     ("lo", "shown"), [(32.5, "32.5"), (1e300, "1e+300"), (2**70, "1180591620717411303424")]
