@@ -1521,3 +1521,31 @@ def test_the_warnings_of_a_calibrations_numbers_point_at_the_callers_line(
         # a derived calibration (scaled_to) does not say its baseline again
         want = [] if ("unit" in fields and how == "scaled_to") else [__file__]
         assert [w.filename for w in caught] == want, (how, [str(w.message) for w in caught])
+
+
+@pytest.mark.parametrize("alpha", [5.0, -1, "1"])
+@pytest.mark.parametrize("rectified", [False, True])
+def test_alpha_out_of_range_is_refused_whatever_the_calibration(
+    alpha: object, rectified: bool
+) -> None:
+    """valid_roi, rectify and rectify_points checked alpha after returning early for a rectified
+    calibration (and rectify_points for no points): alpha=5 or "1" passed there without a word,
+    while the same call on a raw rig was refused; rectified_calibration likewise took "1" of a
+    rectified one. Refused now before any early return."""
+    c = rect_calib() if rectified else raw_calib()
+    img = np.zeros((SIZE[1], SIZE[0]), np.uint8)
+    says = re.escape(f"alpha: expected a value in [0, 1], got {alpha!r}")
+    for call in (
+        lambda: c.valid_roi(alpha),  # type: ignore[arg-type]
+        lambda: c.rectify(img, img, alpha=alpha),  # type: ignore[arg-type]
+        lambda: c.rectify_points(np.array([[10.0, 20.0]]), alpha=alpha),  # type: ignore[arg-type]
+        lambda: c.rectify_points(np.zeros((0, 2)), alpha=alpha),  # type: ignore[arg-type]
+        lambda: c.to_ros(alpha=alpha),  # type: ignore[arg-type]
+    ):
+        with pytest.raises(ValueError, match=says):
+            call()
+    if isinstance(alpha, str):
+        with pytest.raises(ValueError, match=r"^alpha: expected a finite number, got '1'$"):
+            c.rectified_calibration(alpha)  # type: ignore[arg-type]
+    else:  # OpenCV's scaling: any finite number
+        assert c.rectified_calibration(alpha).rectified

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -767,3 +768,19 @@ def test_cli_check_fix_that_still_fails_writes_nothing_and_exits_1(
     assert said["fixed"]["written"] is None and said["fixed"]["turn_deg"] == 0.0
     assert err == "stereovision: the corrected calibration still fails: not written\n"
     assert not fixed.exists()
+
+
+@pytest.mark.parametrize("alpha", [5.0, -1, "1"])
+def test_alpha_out_of_range_is_refused_with_or_without_a_calibration(alpha: object) -> None:
+    """check_rectification without a calibration took any alpha without a word, and
+    refine_rectification given its check passed alpha=5 or -1 to OpenCV's rectification
+    (rectified_calibration takes any finite scaling) before its own check refused it."""
+    from tests.test_calibration import raw_calib
+
+    img = np.zeros((240, 320), np.uint8)
+    says = re.escape(f"alpha: expected a value in [0, 1], got {alpha!r}")
+    with pytest.raises(ValueError, match=says):
+        check_rectification(img, img, alpha=alpha)  # type: ignore[arg-type]
+    checked = check_rectification(img, img)
+    with pytest.raises(ValueError, match=says):
+        refine_rectification(img, img, raw_calib(), alpha=alpha, check=checked)  # type: ignore[arg-type]

@@ -667,9 +667,9 @@ class Calibration:
             ``(roi_left, roi_right)``.
         """
         w, h = self.image_size
+        _check_alpha(alpha)  # also of a rectified calibration: alpha=5 passed there unsaid
         if self.rectified:
             return (0, 0, w, h), (0, 0, w, h)
-        _check_alpha(alpha)
         self._stereo_rectify(alpha)
         if ("roi", float(alpha)) not in self._cache:  # fisheye: OpenCV gives none; from the maps
             m1x, m1y, m2x, m2y = self._maps(alpha)
@@ -734,9 +734,9 @@ class Calibration:
                 raise ValueError(
                     f"{name}: image is {a.shape[1]}x{a.shape[0]}, calibration image_size is {w}x{h}"
                 )
+        _check_alpha(alpha)  # also of a rectified calibration: alpha=5 passed there unsaid
         if self.rectified:
             return la, ra
-        _check_alpha(alpha)
         m1x, m1y, m2x, m2y = self._maps(alpha)
         from stereovision._validate import remap_image
 
@@ -776,9 +776,9 @@ class Calibration:
         pts = xy_points(points)
         if side not in ("left", "right"):
             raise ValueError(f"side: expected 'left' or 'right', got {side!r}")
+        _check_alpha(alpha)  # also of a rectified calibration or no points
         if self.rectified or len(pts) == 0:
             return pts.copy()
-        _check_alpha(alpha)
         r1, r2, p1, p2, _ = self._stereo_rectify(alpha)
         K, D, r, p = (self.K1, self.D1, r1, p1) if side == "left" else (self.K2, self.D2, r2, p2)
         src = pts.reshape(-1, 1, 2)
@@ -816,9 +816,9 @@ class Calibration:
             one's views by 90 degrees, neither of which this package handles) or a right camera
             to the left of the left one.
         """
+        _check_alpha(alpha, any_finite=True)  # float() read "1" and True as 1, NaN went to OpenCV
         if self.rectified:
             return self
-        _check_alpha(alpha, any_finite=True)  # float() read "1" and True as 1, NaN went to OpenCV
         key = ("rectified_calibration", float(alpha))
         if key not in self._cache:
             r1, _, p1, p2, _ = self._stereo_rectify(alpha)

@@ -20,7 +20,7 @@ import numpy.typing as npt
 
 from stereovision._validate import as_gray_uint8, as_image_array, remap_image
 from stereovision._validate import require as _require_type
-from stereovision.calibration import Calibration
+from stereovision.calibration import Calibration, _check_alpha
 
 __all__ = [
     "RectificationCheck",
@@ -238,6 +238,7 @@ def check_rectification(
         or not (np.isfinite(tolerance) and tolerance > 0)
     ):
         raise ValueError(f"tolerance: expected a positive number of pixels, got {tolerance!r}")
+    _check_alpha(alpha)  # also without a calibration (it took any alpha without a word)
     if calib is not None:
         _require_type(calib, "Calibration", "calib")
         left, right = calib.rectify(left, right, alpha=alpha)
@@ -462,6 +463,8 @@ def refine_rectification(
         more than :data:`MAX_CORRECTION_DEG` degrees (not a drift: calibrate again).
     """
     _require_type(calib, "Calibration", "calib")
+    # before rectified_calibration(alpha), which takes any finite scaling (OpenCV's -1)
+    _check_alpha(alpha)
     from dataclasses import replace
 
     before = (
