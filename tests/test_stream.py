@@ -2207,3 +2207,22 @@ def test_the_warnings_of_a_streams_pairs_point_at_the_callers_line(data_dir: Pat
         said = sorted((str(w.message)[:20], w.filename) for w in caught)
         assert [s[0][:11] for s in said] == ["first pair:", "the cameras"], said
         assert [s[1] for s in said] == [__file__, __file__], said
+
+
+def test_the_calibration_fitted_to_the_frames_is_said_at_the_callers_line(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """The note of a calibration scaled to the frames delivered names the caller's line."""
+    scene = data_dir / SCENE
+    for side in ("left", "right"):
+        img = cv2.resize(cv2.imread(str(scene / f"{side}.png")), (320, 240))
+        cv2.imwrite(str(tmp_path / f"{side}_00.png"), img)
+    calib = Calibration.from_file(scene / "calib.txt")  # 640x480
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        StereoCamera(str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png")) as cam,
+    ):
+        warnings.simplefilter("always")
+        run_stream(cam, calib, max_disparity=32, check=False)
+    said = [w for w in caught if "calibration is for 640x480" in str(w.message)]
+    assert [w.filename for w in said] == [__file__]
