@@ -266,6 +266,59 @@ def test_a_camera_whose_grab_hangs_is_given_up(tmp_path: Path) -> None:
         capture(cam, tmp_path / "p2", read_timeout=-1.0)
 
 
+def test_a_grab_given_up_as_hung_keeps_its_capture_until_it_returns(tmp_path: Path) -> None:
+    """A grab given up as hung stays inside OpenCV: ``close()`` released its capture under it
+    and a second ``read`` grabbed it again, which crashed the process (SIGSEGV). Now the
+    second read is refused, and the release waits for the grab to return; the grab's frame,
+    when it comes, is dropped."""
+    lpat = _write_sequence(tmp_path / "frames", "left", [_numbered(i) for i in range(3)])
+    rpat = _write_sequence(tmp_path / "frames", "right", [_numbered(i) for i in range(3)])
+    unplug, returned = threading.Event(), threading.Event()
+    released: list[str] = []
+
+    class _Hangs:
+        def __init__(self, cap: Any, name: str) -> None:
+            self._cap, self._name = cap, name
+
+        def grab(self) -> bool:
+            if self._name == "right":
+                unplug.wait()
+            return bool(self._cap.grab())
+
+        def retrieve(self) -> Any:
+            out = self._cap.retrieve()
+            if self._name == "right":
+                returned.set()
+            return out
+
+        def release(self) -> None:
+            released.append(self._name)
+            self._cap.release()
+
+        def __getattr__(self, name: str) -> Any:
+            return getattr(self._cap, name)
+
+    cam = StereoCamera(lpat, rpat)
+    for side in ("left", "right"):
+        cam._caps[side] = _Hangs(cam._caps[side], side)
+    try:
+        with pytest.raises(SourceError, match=r"delivered no frame in 0\.2 s"):
+            capmod.read_within(cam, 0.2)
+        with pytest.raises(SourceError, match=r"an earlier read given up as hung has not returned"):
+            capmod.read_within(cam, 0.2)
+        cam.close()
+        assert released == []  # the grab is still inside the capture
+    finally:
+        unplug.set()
+    assert returned.wait(5.0)
+    deadline = time.monotonic() + 5.0
+    while len(released) < 2 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert sorted(released) == ["left", "right"]
+    with pytest.raises(SourceError, match="the stereo camera is closed"):
+        cam.read()
+
+
 def test_a_gap_in_an_image_sequence_is_said(tmp_path: Path) -> None:
     """Pair 3 deleted from both numbered sequences (a blurred pair taken out): the capture
     stops there and says the images after the gap were not read (it said "end of stream", the

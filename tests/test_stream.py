@@ -1676,42 +1676,51 @@ def test_a_source_failing_on_the_first_pair_is_raised(pipelined: bool) -> None:
     assert err.value is bad
 
 
-class _HungRig(_FakeRig):
-    """A rig whose ``read`` never returns once its pairs are out (a hung USB camera), until
-    ``unplug`` is set."""
+class _HangsAfter:
+    """A capture whose ``grab`` never returns after ``n`` grabs (a hung USB camera), until
+    ``unplug`` is set; everything else is the wrapped capture's."""
 
-    def __init__(self, pairs: list[Any]) -> None:
-        super().__init__(pairs)
-        self.unplug = threading.Event()
+    def __init__(self, cap: Any, n: int, unplug: threading.Event) -> None:
+        self._cap, self._n, self._unplug = cap, n, unplug
 
-    def read(self) -> Any:
-        if not self._pairs:
-            self.unplug.wait()
-        return super().read()
+    def grab(self) -> bool:
+        self._n -= 1
+        if self._n < 0:
+            self._unplug.wait()
+        return bool(self._cap.grab())
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._cap, name)
 
 
 @pytest.mark.parametrize("pipelined", [False, True])
 @pytest.mark.parametrize("done", [0, 2])
-def test_a_camera_whose_read_hangs_is_given_up(pipelined: bool, done: int) -> None:
-    """A camera whose read never returns (a hung USB camera): the stream waited forever, its
+def test_a_camera_whose_read_hangs_is_given_up(
+    videos: dict[str, Path], pipelined: bool, done: int
+) -> None:
+    """A camera whose grab never returns (a hung USB camera): the stream waited forever, its
     summary never said. After ``read_timeout`` s the camera is named as failing: raised on the
     first pair, the stream's end ("source failed") after pairs were done."""
     from stereovision.capture import SourceError
 
-    rig = _HungRig([_frame(i) for i in range(done)])
-    says = r"the camera \(_HungRig\) delivered no frame in 0\.3 s \(its read did not return"
+    unplug = threading.Event()
+    cam = StereoCamera(str(videos["left"]), str(videos["right"]))
+    cam._caps["right"] = _HangsAfter(cam._caps["right"], done, unplug)  # type: ignore[assignment]
+    names = f"{str(videos['left'])!r} and {str(videos['right'])!r}"
+    says = re.escape(f"{names} delivered no frame in 0.3 s (its read did not return")
     t0 = time.perf_counter()
     try:
         if done == 0:
             with pytest.raises(SourceError, match=says):
-                run_stream(rig, max_disparity=8, pipelined=pipelined, read_timeout=0.3)  # type: ignore[arg-type]
+                run_stream(cam, max_disparity=16, pipelined=pipelined, read_timeout=0.3)
         else:
-            rep = run_stream(rig, max_disparity=8, pipelined=pipelined, read_timeout=0.3)  # type: ignore[arg-type]
+            rep = run_stream(cam, max_disparity=16, pipelined=pipelined, read_timeout=0.3)
             assert (rep.frames, rep.ended) == (done, "source failed")
             assert re.match(says, rep.error or "")
     finally:
-        rig.unplug.set()
-    assert time.perf_counter() - t0 < 4.0
+        unplug.set()
+        cam.close()
+    assert time.perf_counter() - t0 < 6.0
     with pytest.raises(ValueError, match=r"read_timeout: expected a positive number of seconds"):
         run_stream(_FakeRig([_frame(0)]), max_disparity=8, read_timeout=0)  # type: ignore[arg-type]
 

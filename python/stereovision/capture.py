@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import contextvars
 import dataclasses
 import errno
 import glob
@@ -43,10 +44,10 @@ import threading
 import time
 import warnings
 from collections import deque
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, overload
+from typing import Any, TypeVar, overload
 
 import cv2
 import numpy as np
@@ -410,19 +411,29 @@ def _camera_name(camera: Any) -> str:
     return f"the camera ({type(camera).__name__})"
 
 
-def read_within(camera: Any, timeout: float | None = DEFAULT_READ_TIMEOUT) -> StereoFrame:
-    """``camera.read()``, given up after ``timeout`` seconds.
+_T = TypeVar("_T")
+#: The bound on a :class:`StereoCamera`'s native grab in this context (:func:`read_within`).
+_READ_TIMEOUT: contextvars.ContextVar[float | None] = contextvars.ContextVar(
+    "stereovision_read_timeout", default=None
+)
 
-    The read runs in a daemon thread while the caller waits on an event, which Ctrl-C and
-    SIGTERM interrupt at once: a read in native code (OpenCV's grab) holds them off in the
-    main thread until it returns, which a hung camera never does.
+
+def read_within(camera: Any, timeout: float | None = DEFAULT_READ_TIMEOUT) -> StereoFrame:
+    """``camera.read()``, its native grab given up after ``timeout`` seconds.
+
+    A :class:`StereoCamera` (also behind a wrapper that calls its ``read``) runs its grab and
+    retrieve, the part in OpenCV that a hung camera never returns from, in a daemon thread
+    while the caller waits on an event, which Ctrl-C and SIGTERM interrupt at once: in the
+    main thread a read in native code holds them off until it returns. The rest of the read,
+    and its warnings, stay in the caller's thread (a warning raised in the worker would point
+    at threading.py). Another source (a recording, an object of the user's) is read as it is.
 
     Parameters
     ----------
     camera : object
         Anything with ``read()`` (a :class:`StereoCamera`, a recording).
     timeout : float or None
-        Seconds to wait (:data:`DEFAULT_READ_TIMEOUT`); None waits as long as the read takes.
+        Seconds to wait (:data:`DEFAULT_READ_TIMEOUT`); None waits as long as the grab takes.
 
     Returns
     -------
@@ -432,31 +443,42 @@ def read_within(camera: Any, timeout: float | None = DEFAULT_READ_TIMEOUT) -> St
     Raises
     ------
     SourceError
-        If ``read`` did not return within ``timeout`` (``end`` False), naming the camera; or
-        as ``read`` raises it (any exception of ``read`` is raised as it is).
+        If a :class:`StereoCamera`'s grab did not return within ``timeout`` (``end`` False),
+        naming its sources; or as ``read`` raises it.
+    ValueError
+        If ``timeout`` is not a positive number of seconds (or None).
     """
-    if timeout is None:
-        return camera.read()  # type: ignore[no-any-return]
-    if not timeout > 0:
+    if timeout is not None and not timeout > 0:
         raise ValueError(f"read_timeout: expected a positive number of seconds, got {timeout}")
+    token = _READ_TIMEOUT.set(timeout)
+    try:
+        return camera.read()  # type: ignore[no-any-return]
+    finally:
+        _READ_TIMEOUT.reset(token)
+
+
+def _within(work: Callable[[], _T], timeout: float | None, name: str) -> _T:
+    """``work()`` in a daemon thread, given up after ``timeout`` s (None: called here)."""
+    if timeout is None:
+        return work()
     done = threading.Event()
     box: list[Any] = []
 
-    def work() -> None:
+    def run() -> None:
         try:
-            box.append(camera.read())
+            box.append(work())
         except BaseException as exc:  # raised in the caller's thread below
             box.append(exc)
         finally:
             done.set()
 
-    threading.Thread(target=work, name="stereovision-read", daemon=True).start()
+    threading.Thread(target=run, name="stereovision-grab", daemon=True).start()
     if not done.wait(timeout):
-        # the thread stays in the read (nothing stops native code); its frame, if it ever
-        # comes, is dropped
+        # the thread stays in OpenCV (nothing stops native code); its frame, if it ever comes,
+        # is dropped
         raise SourceError(
-            f"{_camera_name(camera)} delivered no frame in {timeout:g} s (its read did not "
-            "return: a hung or unplugged USB camera, a stalled stream); unplug and replug it",
+            f"{name} delivered no frame in {timeout:g} s (its read did not return: a hung or "
+            "unplugged USB camera, a stalled stream); unplug and replug it",
             side="both",
             end=False,
         )
@@ -803,6 +825,12 @@ class StereoCamera(PairSource):
         self._warned: set[str] = set()
         self._size_locked = False  # a frame has fixed the output size
         self._caps: dict[str, Any] = {}
+        # A grab given up as hung (read_within) may still be inside OpenCV: releasing its
+        # capture under it, or grabbing it again, crashed the process (SIGSEGV). The grab that
+        # is running, and whether close() left the release to it, under this lock.
+        self._grab_lock = threading.Lock()
+        self._grabbing = False
+        self._release_on_return = False
         #: Sources read by OpenCV's image-sequence reader (it logs a warning at the end).
         self._sequence: dict[str, bool] = {}
         self._media_offset: float | None = None  # left - right media time of the first pair
@@ -1027,17 +1055,23 @@ class StereoCamera(PairSource):
         caps = self._caps
         if len(caps) != 2:
             raise SourceError("the stereo camera is closed", end=False)
-        # OpenCV's image-sequence reader logs a warning for the file after the last.
-        with _opencv_quiet() if any(self._sequence.values()) else contextlib.nullcontext():
-            ok_l = caps["left"].grab()
-            t_l = time.monotonic()
-            ok_r = caps["right"].grab()
-            t_r = time.monotonic()
+        with self._grab_lock:
+            if self._grabbing:
+                raise SourceError(
+                    f"{_camera_name(self)}: an earlier read given up as hung has not returned; "
+                    "unplug and replug the camera, then open it again",
+                    side="both",
+                    end=False,
+                )
+            self._grabbing = True
+        ok_l, t_l, ok_r, t_r, got = _within(
+            lambda: self._grab(caps), _READ_TIMEOUT.get(), _camera_name(self)
+        )
         if not (ok_l and ok_r):
             raise self._ended({"left": ok_l, "right": ok_r})
         frames, delivered = {}, {}
         for side in ("left", "right"):
-            ok, img = caps[side].retrieve()
+            ok, img = got[side]
             if not ok or img is None:
                 raise self._fail(side, "could not decode a frame")
             if img.ndim == 2:
@@ -1059,6 +1093,27 @@ class StereoCamera(PairSource):
         self.skews_ms.append(frame.skew_ms)
         self._check_media_drift(frame)
         return frame
+
+    def _grab(self, caps: dict[str, Any]) -> tuple[bool, float, bool, float, dict[str, Any]]:
+        """Grab both sources, then retrieve both (the native part of :meth:`read`, which
+        :func:`read_within` bounds): each grab's success and time, each retrieve's result."""
+        try:
+            # OpenCV's image-sequence reader logs a warning for the file after the last.
+            with _opencv_quiet() if any(self._sequence.values()) else contextlib.nullcontext():
+                ok_l = caps["left"].grab()
+                t_l = time.monotonic()
+                ok_r = caps["right"].grab()
+                t_r = time.monotonic()
+            if not (ok_l and ok_r):
+                return ok_l, t_l, ok_r, t_r, {}
+            got = {side: caps[side].retrieve() for side in ("left", "right")}
+            return ok_l, t_l, ok_r, t_r, got
+        finally:
+            with self._grab_lock:
+                self._grabbing = False
+                release, self._release_on_return = self._release_on_return, False
+            if release:  # closed while this grab hung: released now that it is out of OpenCV
+                _release(caps.values())
 
     def _video_files(self) -> bool:
         """Both sources are local video files, whose media times are comparable."""
@@ -1123,16 +1178,26 @@ class StereoCamera(PairSource):
         return out + (f"; format {', '.join(formats)}" if formats else "")
 
     def close(self) -> None:
-        """Release both sources (idempotent)."""
-        for cap in self._caps.values():
-            try:
-                cap.release()
-            except Exception:  # releasing is best effort
-                pass
-        self._caps = {}
+        """Release both sources (idempotent). While a read given up as hung is still inside
+        OpenCV, its return releases them instead (a release under it crashed the process)."""
+        with self._grab_lock:
+            caps, self._caps = self._caps, {}
+            if self._grabbing:
+                self._release_on_return = True
+                return
+        _release(caps.values())
 
     def __enter__(self) -> StereoCamera:
         return self
+
+
+def _release(caps: Iterable[Any]) -> None:
+    """Release each capture, best effort."""
+    for cap in caps:
+        try:
+            cap.release()
+        except Exception:  # releasing is best effort
+            pass
 
 
 def resize_frame(frame: np.ndarray, size: tuple[int, int]) -> np.ndarray:
