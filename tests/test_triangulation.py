@@ -567,3 +567,58 @@ def test_a_distortion_vector_of_an_opencv_unknown_length_is_refused(n: int) -> N
     K = np.array([[600.0, 0.0, 320.0], [0.0, 600.0, 240.0], [0.0, 0.0, 1.0]])
     with pytest.raises(ValueError, match=rf"D: expected 4, 5, 8, 12 or 14 coefficients, got {n}"):
         undistort_normalized(np.zeros((1, 2)), K, np.full(n, 0.01))
+
+
+def test_a_fisheye_rig_obeys_max_iter_and_flags_points_not_yet_back() -> None:
+    """The fisheye inversion's iteration cap was untested (a cap fixed at 20 passed): cut
+    short, a point is invalid, and every point still called valid is exact."""
+    om = np.array([0.01, -0.02, 0.005])
+    c = Calibration(
+        K1=np.array([[280.0, 0.0, 640.0], [0.0, 280.0, 400.0], [0.0, 0.0, 1.0]]),
+        D1=np.array([-0.01, 0.05, -0.06, 0.02]),
+        K2=np.array([[285.0, 0.0, 645.0], [0.0, 282.0, 398.0], [0.0, 0.0, 1.0]]),
+        D2=np.array([-0.012, 0.04, -0.05, 0.018]),
+        R=cv2.Rodrigues(om)[0],
+        T=np.array([-64.0, 1.0, 0.5]),
+        image_size=(1280, 800),
+        unit="mm",
+        model="fisheye",
+    )
+    rng = np.random.default_rng(2)
+    theta, phi = rng.uniform(0, np.radians(80), 200), rng.uniform(0, 2 * np.pi, 200)
+    dist = rng.uniform(0.5, 10.0, 200)
+    pts = (
+        np.column_stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)])
+        * dist[:, None]
+    )
+    xl = cv2.fisheye.projectPoints(pts[:, None], np.zeros(3), np.zeros(3), c.K1, c.D1)[0]
+    xr = cv2.fisheye.projectPoints(pts[:, None] * 1000, om, c.T, c.K2, c.D2)[0]
+    xl, xr = xl.reshape(-1, 2), xr.reshape(-1, 2)
+    assert not triangulate(xl, xr, c, max_iter=1).valid.any()  # one round: none back
+    res = triangulate(xl, xr, c, max_iter=2)
+    assert 0 < res.valid.sum() < 100  # measured 17 of 200
+    np.testing.assert_allclose(res.XL[res.valid], pts[res.valid], rtol=1e-9, atol=1e-9)
+    assert triangulate(xl, xr, c, max_iter=5).valid.all()
+
+
+def test_a_map_not_of_one_scale_both_ways_is_not_warned_about() -> None:
+    """The resize check asks both sides to fit one factor within a pixel; the height alone
+    (a mutant) warned about 100x76 against 640x480 (height 1 px off 75, width 1.3 px off 101.3)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        depth_from_disparity(np.full((76, 100), 20.0), rect_calib())
+    with pytest.warns(UserWarning, match="100x75 px"):
+        depth_from_disparity(np.full((75, 100), 20.0), rect_calib())
+
+
+def test_a_map_of_three_dimensions_or_another_calibration_is_refused() -> None:
+    """A (H, W, 1) map and a calib that is not a Calibration passed no test (dropping either
+    check passed): both are named."""
+    c = rect_calib()
+    for call in (depth_from_disparity, reproject):
+        with pytest.raises(
+            ValueError, match=re.escape("expected a real (H, W) array, got shape (4, 5, 1)")
+        ):
+            call(np.zeros((4, 5, 1)), c)
+    with pytest.raises(TypeError, match=r"calib: expected a stereovision\.Calibration, got dict"):
+        triangulate(np.zeros((3, 2)), np.zeros((3, 2)), {})  # type: ignore[arg-type]
