@@ -508,3 +508,39 @@ def test_a_view_three_times_brighter_restarts_too() -> None:
     out = tf(bright, bright)
     assert np.array_equal(out[0], bright) and np.array_equal(out[1], bright)
     assert tf.restarts == 1 and tf.relit == 0 and tf.mean_frames() == 1.0
+
+
+def test_a_second_mutation_audit_of_the_filters_edges() -> None:
+    """A second mutation audit found unasserted: noise_sigma refusing a frame 2 px wide (only
+    one 2 px tall was), a uint16 frame divided by 257 (256 was within the 1 % allowed), max_frames
+    1 taken and k 0 refused, (H, W) and (H, W, 1) frames called a pair, and a restart handing
+    back the caller's own arrays (writing to the output changed the input)."""
+    with pytest.raises(ValueError, match=re.escape("at least 3 x 3, got (5, 2)")):
+        noise_sigma(np.zeros((5, 2), np.uint8))
+    rng = np.random.default_rng(0)
+    img = rng.integers(20, 230, (40, 50), dtype=np.uint8)
+    as16 = noise_sigma(img.astype(np.uint16) * np.uint16(257))
+    assert as16 == pytest.approx(noise_sigma(img.astype(np.float32)), rel=1e-6)
+    assert TemporalFilter(max_frames=1).max_frames == 1
+    with pytest.raises(ValueError, match="k: expected a positive number of sigmas, got 0"):
+        TemporalFilter(k=0)
+    grey = np.full((8, 8), 100, np.uint8)
+    with pytest.raises(ValueError, match="left and right differ in shape"):
+        TemporalFilter()(grey, grey[..., None])
+    tf = TemporalFilter()
+    out = tf(grey, grey)
+    assert not np.shares_memory(out[0], grey) and not np.shares_memory(out[1], grey)
+
+
+def test_mean_frames_counts_both_images() -> None:
+    """mean_frames() averages both cameras' counts (the left one alone passed): a patch that
+    changes in the right image only restarts there, and the mean says so."""
+    left = np.full((80, 80), 100, np.uint8)
+    right = left.copy()
+    tf = TemporalFilter()
+    tf(left, right)
+    moved = right.copy()
+    moved[:10, :10] = 160  # 100 of 6400 px: something moved in the right view
+    tf(left, moved)
+    assert tf.restarts == 0
+    assert tf.mean_frames() == pytest.approx((2.0 + (2.0 - 100 / 6400)) / 2)
