@@ -1155,3 +1155,24 @@ def test_pcd_of_a_result_with_a_bgra_or_one_channel_left_image(result, tmp_path,
     x, y = result.pixels[:, 0], result.pixels[:, 1]
     np.testing.assert_array_equal(pts[y, x], result.points)
     np.testing.assert_array_equal(cols[y, x], result.colors)
+
+
+def test_mutation_audit_3_export_survivors(result, tmp_path):
+    """A further mutation audit found unasserted: depths that all round to 0 mm (a map in
+    kilometres) warned about like ones past 65535 (a 0 counted as fitting passed), an
+    uncalibrated result's disparity PNG and its export (a writer reading the result only with a
+    calibration passed), and voxel_downsample's cube key (y's extent taken as x's, or z's left
+    out of the int64 check, merged distinct cubes)."""
+    with pytest.warns(UserWarning, match="none of its 2 values fits 1..65535 at scale 1000"):
+        export.encode_depth_png(np.array([[0.0001, 0.0004]]))
+    bare = replace(result, depth=None, depth_sigma=None, calibration=None)
+    written = export.export_result(bare, tmp_path / "bare", formats=("disp16", "npz"))
+    disp = export.read_disparity_png(written["disparity_16.png"])
+    expect = np.where((bare.disparity > 1 / 512) & (bare.disparity < 255.99), bare.disparity, 0)
+    np.testing.assert_allclose(np.nan_to_num(disp), np.rint(expect * 256) / 256)
+    # x all in one cube: y's extent 2, z's 2 (x's extent 1 for y merged (0, 1, 0) and (0, 0, 1))
+    pts = np.array([[0.5, 0.5, 0.5], [0.5, 1.5, 0.5], [0.5, 0.5, 1.5]])
+    assert len(export.voxel_downsample(pts, voxel=1.0)[0]) == 3
+    # 2**22 x 2**22 x (2**20 + 1) cubes: a key without z's extent wrapped (0, 0, 2**20) to 0
+    far = np.array([[0.5, 0.5, 0.5], [2**22 - 0.5, 2**22 - 0.5, 0.5], [0.5, 0.5, 2**20 + 0.5]])
+    assert len(export.voxel_downsample(far, voxel=1.0)[0]) == 3
