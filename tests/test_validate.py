@@ -495,3 +495,63 @@ def test_a_number_too_large_for_a_float_is_said_to_be_so(value: int, says: str) 
         with pytest.raises(ValueError) as info:
             call()
         assert str(info.value) == prefix + says
+
+
+def test_a_second_mutation_audit_of_the_image_checks() -> None:
+    """A second mutation audit found unasserted: a void-dtype array named as not numeric, an
+    empty colour image, the low-uint16 warning's bits (its 257), warn=False, the advice's
+    bounds (1.5 still an overshoot; a negative range is not 16-bit data), a float rounding
+    below 0 clipped, an infinity left to the kernel by check_unit_range, and u8_pair taking a
+    uint16 right image or empty ones."""
+    import warnings
+
+    from stereovision import _validate as v
+
+    with pytest.raises(ValueError, match="expected a numeric image array"):
+        v.as_image_array(np.zeros((2, 2), dtype="V4"))
+    with pytest.raises(ValueError, match=r"image: image is empty \(shape \(0, 4, 3\)\)"):
+        v.as_image_array(np.zeros((0, 4, 3), np.uint8))
+    # log2(1450 / 257) = 2.497: 2 bits (by 256 it was 2.502, 3 bits)
+    with pytest.warns(UserWarning, match="largest value is 1450 .* keeps about 2 bits"):
+        v.as_gray_float(np.full((4, 4), 1450, np.uint16))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        v.as_gray_float(np.full((4, 4), 1450, np.uint16), warn=False)
+        v.check_unit_range(np.array([[0.0, np.inf]], np.float32), "left")  # the kernel's word
+        v.check_unit_range(np.array([[np.nan, 0.5]], np.float32), "left")
+    assert "clip an overshoot" in str(v._unit_range_error(-0.5, 1.5, "left"))
+    assert "scale both images" in str(v._unit_range_error(-3.0, 300.0, "left"))
+    assert v.as_gray_float(np.array([[-1e-7, 0.5]])).tolist() == [[0.0, 0.5]]
+    assert v.as_gray_float(np.array([[0.5, 1.0 + 1e-7]])).tolist() == [[0.5, 1.0]]
+    u8 = np.zeros((4, 4), np.uint8)
+    assert v.u8_pair(u8, u8.astype(np.uint16)) is None
+    assert v.u8_pair(u8[:0], u8[:0]) is None
+    assert v.u8_pair(u8, u8) is not None
+
+
+def test_a_second_mutation_audit_of_the_number_checks() -> None:
+    """A second mutation audit found unasserted: a min_disparity of exactly the width (and a
+    max_disparity of minus it) unreachable, a range past float32 without NumPy's overflow
+    warning, a whole number of 1e20 written as 1e+20, a misspelling 0.8 alike suggested, the
+    defaults' dict named, the digits of every power of ten past a float, and a 1-D or 3-D
+    array refused as points."""
+    import warnings
+
+    from stereovision import _validate as v
+
+    assert v.unreachable_range(10, 20, 10) is not None
+    assert v.unreachable_range(9, 20, 10) is None
+    assert v.unreachable_range(-30, -10, 10) is not None
+    assert v.unreachable_range(-30, -9, 10) is None
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert v.disparity_range(0, 1e39) == (0.0, 1e39)
+    with pytest.raises(ValueError, match=r"min_disparity \(1e\+20\) are the same float32"):
+        v.disparity_range(1e20, 1e20 + 2**20)
+    with pytest.raises(ValueError, match=r"did you mean 'k_cand'\?\): .* \(DEFAULTS\)"):
+        v.refuse_unknown("parameter", {"kcan": 1}, ["k_cand", "other"], "DEFAULTS")
+    for k in range(309, 1000):
+        assert v.too_large_for_float(10**k, why=False) == f"an integer of {k + 1} digits"
+    for bad in ([1.0, 2.0], np.zeros((2, 2, 2))):
+        with pytest.raises(ValueError, match="expected shape"):
+            v.xy_points(bad)
