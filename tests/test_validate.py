@@ -555,3 +555,28 @@ def test_a_second_mutation_audit_of_the_number_checks() -> None:
     for bad in ([1.0, 2.0], np.zeros((2, 2, 2))):
         with pytest.raises(ValueError, match="expected shape"):
             v.xy_points(bad)
+
+
+def test_the_low_uint16_warning_names_the_callers_line() -> None:
+    """Its fixed stacklevel 4 was right for as_gray_float called directly only: through
+    depth_map it named a line of depth.py, through match and check_pair one of _validate.py
+    (a mutation audit's stacklevel 3 passed every test); it names the caller's line."""
+    import warnings
+
+    import stereovision as sv
+    from stereovision import _validate as v
+
+    img = np.random.default_rng(0).integers(0, 4000, (64, 96)).astype(np.uint16)
+    calls = {
+        "as_gray_float": lambda: v.as_gray_float(img),
+        "check_pair": lambda: v.check_pair(img, img),
+        "match": lambda: sv.match(img, img, max_disparity=16),
+        "depth_map": lambda: sv.depth_map(img, img, max_disparity=16),
+    }
+    for name, call in calls.items():
+        with warnings.catch_warnings(record=True) as seen:
+            warnings.simplefilter("always")
+            call()
+        low = [w for w in seen if "uint16 image whose largest value" in str(w.message)]
+        assert low, name
+        assert {w.filename for w in low} == {__file__}, name
