@@ -544,3 +544,34 @@ def test_mean_frames_counts_both_images() -> None:
     tf(left, moved)
     assert tf.restarts == 0
     assert tf.mean_frames() == pytest.approx((2.0 + (2.0 - 100 / 6400)) / 2)
+
+
+def test_a_moving_rig_without_blue_behind_a_black_border_starts_again(data_dir: Path) -> None:
+    """Black is all three colour channels at 0: a view without blue (a red-lit scene) behind a
+    black border, moving 2 px a frame, restarts each frame (a mutant reading black off the blue
+    channel alone took the whole view for black, kept the border in: 0 restarts of 5)."""
+    img = load_scene(data_dir / VENUS).left
+    h, w = img.shape[:2]
+    rng = np.random.default_rng(0)
+    tf = TemporalFilter()
+    for i in range(6):
+        shift = np.float32([[1, 0, 2 * i], [0, 1, 0]])
+        frame = noisy(cv2.warpAffine(img, shift, (w, h), borderMode=cv2.BORDER_REFLECT), 8.0, rng)
+        frame[..., 0] = 0
+        frame[:, :200] = 0
+        tf(frame, frame)
+    assert tf.restarts == 5 and tf.mean_frames() == 1.0
+
+
+def test_a_noiseless_view_restarts_a_pixel_changed_by_two_levels() -> None:
+    """With noise 0 the per-pixel limit k * sigma is 0: a pixel changed by 2 grey levels starts
+    again there (a floor of 1 grey level on sigma passed every test and averaged it to 101)."""
+    left = np.full((80, 80), 100, np.uint8)
+    tf = TemporalFilter()
+    tf(left, left)
+    changed = left.copy()
+    changed[:10, :10] = 102
+    out = tf(changed, changed)
+    assert tf.restarts == 0 and tf.relit == 0
+    assert np.array_equal(out[0], changed) and np.array_equal(out[1], changed)
+    assert tf.mean_frames() == pytest.approx(2.0 - 100 / 6400)
