@@ -575,3 +575,33 @@ def test_a_noiseless_view_restarts_a_pixel_changed_by_two_levels() -> None:
     assert tf.restarts == 0 and tf.relit == 0
     assert np.array_equal(out[0], changed) and np.array_equal(out[1], changed)
     assert tf.mean_frames() == pytest.approx(2.0 - 100 / 6400)
+
+
+def test_the_light_range_is_inclusive_and_a_dark_object_is_no_light_change() -> None:
+    """A gain of exactly 0.5 or 2 is a light's change (relit, kept averaging), 0.49
+    is another view; and a black object over 40 % of a still view is something that moved there,
+    not a darker light (a mutant fitting the light on pixels gone black took the pair for
+    another view and restarted both means)."""
+    for before, after, restarts, relit in ((100, 50, 0, 2), (50, 100, 0, 2), (100, 49, 1, 0)):
+        tf = TemporalFilter()
+        a, b = np.full((40, 40), before, np.uint8), np.full((40, 40), after, np.uint8)
+        tf(a, a)
+        out = tf(b, b)
+        assert (tf.restarts, tf.relit) == (restarts, relit), (before, after)
+        assert np.array_equal(out[0], b)
+    view = np.full((40, 40), 100, np.uint8)
+    dark = view.copy()
+    dark[:, :16] = 0
+    tf = TemporalFilter()
+    tf(view, view)
+    out = tf(dark, dark)
+    assert tf.restarts == 0 and np.array_equal(out[0], dark)
+    assert tf.mean_frames() == pytest.approx(1.6)  # restarted under the object only
+
+
+def test_the_noise_is_read_on_the_flattest_30_percent(data_dir: Path) -> None:
+    """Venus' noise measured on its flattest 30 % (a mutant on 50 % stayed inside the bounds
+    of test_noise_sigma_measures_sensor_noise): 0.93 as given, 5.72 with noise 8."""
+    img = load_scene(data_dir / VENUS).left
+    assert noise_sigma(img) == pytest.approx(0.9276, rel=0.01)
+    assert noise_sigma(noisy(img, 8.0, np.random.default_rng(0))) == pytest.approx(5.718, rel=0.01)
