@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 from fractions import Fraction
 
@@ -1176,3 +1177,23 @@ def test_mutation_audit_3_export_survivors(result, tmp_path):
     # 2**22 x 2**22 x (2**20 + 1) cubes: a key without z's extent wrapped (0, 0, 2**20) to 0
     far = np.array([[0.5, 0.5, 0.5], [2**22 - 0.5, 2**22 - 0.5, 0.5], [0.5, 0.5, 2**20 + 0.5]])
     assert len(export.voxel_downsample(far, voxel=1.0)[0]) == 3
+
+
+def test_mutation_audit_3_export_survivors_bis(result, tmp_path):
+    """More unasserted behaviour: a result with depths but no calibration (as replace() makes
+    one) refused as a cloud, points reaching past 2**62 voxels refused (a bound of 2**63 let the
+    int64 cube indices overflow), and a file opening with 'PK' but not a zip's 'PK\\x03\\x04'
+    named as no point cloud (not as a damaged bundle)."""
+    no_calib = replace(result, calibration=None)
+    assert no_calib.depth is not None
+    for write in (export.write_cloud_ply, export.write_pcd):
+        with pytest.raises(ValueError, match="depth_map was called without a calibration"):
+            write(tmp_path / "c.out", no_calib)
+    with pytest.raises(
+        ValueError, match=re.escape("voxel: 1.0 is too small for points reaching 5e+18")
+    ):
+        export.voxel_downsample(np.array([[-5e18, 0.0, 0.0], [5e18, 0.0, 0.0]]), voxel=1.0)
+    pk = tmp_path / "cloud.bin"
+    pk.write_bytes(b"PKnot a zip at all")
+    with pytest.raises(ValueError, match=re.escape("not a point cloud file (PLY, PCD or NPZ)")):
+        export.load_cloud(pk)
