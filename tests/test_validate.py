@@ -580,3 +580,19 @@ def test_the_low_uint16_warning_names_the_callers_line() -> None:
         low = [w for w in seen if "uint16 image whose largest value" in str(w.message)]
         assert low, name
         assert {w.filename for w in low} == {__file__}, name
+
+
+def test_an_internal_error_without_a_message_is_one_clean_line() -> None:
+    """A bare assert's AssertionError (no message) printed 'internal AssertionError:  (please
+    report this)', a colon and two spaces before nothing; the type is said once, alone."""
+    from stereovision._validate import internal_error
+
+    assert internal_error(AssertionError()) == (
+        "stereovision: error: internal AssertionError (please report this)"
+    )
+    assert internal_error(KeyError("k")) == (
+        "stereovision: error: internal KeyError: 'k' (please report this)"
+    )
+    assert internal_error(ValueError("\nsecond line")) == (
+        "stereovision: error: internal ValueError: second line (please report this)"
+    )

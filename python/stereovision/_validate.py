@@ -658,15 +658,17 @@ def internal_error(exc: BaseException) -> str:
     Returns
     -------
     str
-        ``"stereovision: error: internal TYPE: FIRST LINE (please report this)"``.
+        ``"stereovision: error: internal TYPE: FIRST LINE (please report this)"``, or
+        ``"... internal TYPE (please report this)"`` for an error without a message.
 
     Examples
     --------
     >>> internal_error(KeyError("k"))
     "stereovision: error: internal KeyError: 'k' (please report this)"
     """
-    msg = first_line(exc) if str(exc) else ""  # first_line's type name is said already
-    return f"stereovision: error: internal {type(exc).__name__}: {msg} (please report this)"
+    # without a message (a bare assert) the type alone: "AssertionError:  (" said nothing twice
+    what = type(exc).__name__ + (f": {first_line(exc)}" if str(exc).strip() else "")
+    return f"stereovision: error: internal {what} (please report this)"
 
 
 def finite_number(value: object, name: str) -> float:
