@@ -622,3 +622,17 @@ def test_a_map_of_three_dimensions_or_another_calibration_is_refused() -> None:
             call(np.zeros((4, 5, 1)), c)
     with pytest.raises(TypeError, match=r"calib: expected a stereovision\.Calibration, got dict"):
         triangulate(np.zeros((3, 2)), np.zeros((3, 2)), {})  # type: ignore[arg-type]
+
+
+@pytest.mark.parametrize("call", ["triangulate", "depth", "reproject"])
+def test_an_unknown_unit_is_named(call: str) -> None:
+    """'km' (not among the units) was untested on these three: a mutant letting it through
+    failed with a bare KeyError; it is a ValueError listing the units."""
+    c = rect_calib()
+    calls = {
+        "triangulate": lambda: triangulate(np.zeros((1, 2)), np.zeros((1, 2)), c, unit="km"),
+        "depth": lambda: depth_from_disparity(np.ones((2, 2)), c, unit="km"),
+        "reproject": lambda: reproject(np.ones((2, 2)), c, unit="km"),
+    }
+    with pytest.raises(ValueError, match=r"unit: expected one of \[.*'m'.*\], got 'km'"):
+        calls[call]()
