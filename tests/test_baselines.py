@@ -321,3 +321,42 @@ def test_row_fill_refuses_bool_and_returns_float32_when_empty() -> None:
         row_fill(np.zeros((2, 3), bool))
     out = row_fill(np.zeros((0, 3), np.float64))
     assert out.dtype == np.float32 and out.shape == (0, 3)
+
+
+def test_tool_sgbm_speckle_filters_as_documented(data_dir: Path) -> None:
+    # the synthetic colour pair has no speckle for the filters to take; a cones crop has some
+    s = load_scene(data_dir / "middlebury2003" / "cones")
+    left = np.ascontiguousarray(s.left[100:220, 150:330])
+    right = np.ascontiguousarray(s.right[100:220, 150:330])
+    expected = _raw(cv2.StereoSGBM.create(**_SV_SGBM), left, right)
+    unfiltered = _raw(cv2.StereoSGBM.create(**{**_SV_SGBM, "speckleWindowSize": 0}), left, right)
+    assert (np.isnan(expected) != np.isnan(unfiltered)).sum() > 10  # the filter acts here
+    np.testing.assert_array_equal(stereovision_1_0(left, right, 50, algorithm="sgbm"), expected)
+
+
+_SV_SGBM = {
+    "minDisparity": 0,
+    "numDisparities": 64,
+    "blockSize": 3,
+    "P1": 216,
+    "P2": 864,
+    "disp12MaxDiff": 1,
+    "uniquenessRatio": 10,
+    "speckleWindowSize": 100,
+    "speckleRange": 32,
+    "mode": cv2.STEREO_SGBM_MODE_SGBM,
+}
+
+
+@pytest.mark.parametrize("fn", [ros_stereo_image_proc, stereovision_1_0])
+@pytest.mark.parametrize("algorithm", ["bm", "sgbm"])
+def test_tool_ranges_round_up_to_16_and_refuse_a_negative_one(fn, algorithm: str) -> None:
+    left, right = _shifted_pair(3)
+    np.testing.assert_array_equal(
+        fn(left, right, 0, algorithm), fn(left, right, 16, algorithm)
+    )  # 0 -> 16 levels, not OpenCV's error for 0
+    np.testing.assert_array_equal(fn(left, right, 17, algorithm), fn(left, right, 32, algorithm))
+    with pytest.raises(ValueError, match="disparity range must be finite and >= 0, got -3"):
+        fn(left, right, -3, algorithm)
+    with pytest.raises(ValueError, match=f"expected 'bm' or 'sgbm', got '{algorithm.upper()}'"):
+        fn(left, right, 16, algorithm.upper())  # the node's names, not case-folded
