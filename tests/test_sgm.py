@@ -517,3 +517,47 @@ def test_uniqueness_and_gamma_are_refused_in_the_callers_names() -> None:
             sgm_disparity(img, img, max_disparity=8, **kw)
     assert sgm_disparity(img, img, max_disparity=8, uniqueness=100, gamma=1e-3).shape == img.shape
     assert sgm_disparity(img, img, max_disparity=8, gamma=3e38).shape == img.shape
+
+
+def test_memory_limits_at_their_edges(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A larger RLIMIT_AS room leaves the smaller MemAvailable; a VmSize above the limit is no
+    room (0), an unreadable VmSize no figure (None); the three-path map of a pair shorter than
+    its 11 rows in flight needs its own rows only."""
+    import io as _io
+
+    resource = pytest.importorskip("resource")
+    from stereovision.matching import sgm
+
+    gib = 2**30
+    files = {
+        "/proc/meminfo": f"MemAvailable: {2 * gib // 1024} kB\n",
+        "/sys/fs/cgroup/memory.max": "max\n",
+        "/proc/self/status": f"Name: python\nVmSize: {4 * gib // 1024} kB\n",
+    }
+    monkeypatch.setattr(sgm, "open", lambda p, *a, **k: _io.StringIO(files[p]), raising=False)
+    monkeypatch.setattr(resource, "getrlimit", lambda _: (8 * gib, resource.RLIM_INFINITY))
+    assert sgm._address_space_room() == 4 * gib
+    assert sgm._available_bytes() == 2 * gib  # the least of 2 and 4 GiB
+    monkeypatch.setattr(resource, "getrlimit", lambda _: (gib, resource.RLIM_INFINITY))
+    assert sgm._address_space_room() == 0
+    assert sgm._available_bytes() == 0
+    files["/proc/self/status"] = "VmSize: unknown kB\n"
+    assert sgm._address_space_room() is None
+    monkeypatch.undo()
+
+    img = np.random.default_rng(0).random((6, 160)).astype(np.float32)
+    need = 3 * 160 * 6 * 33 + 16 * 160 * 6  # 6 rows, not 11, of 33 levels
+    monkeypatch.setattr(sgm._core, "kept_memory", lambda: ((0, 0), 0))
+    monkeypatch.setattr(sgm, "_available_bytes", lambda: need)
+    assert sgm_disparity(img, img, max_disparity=32, paths=3).shape == img.shape
+    monkeypatch.setattr(sgm, "_available_bytes", lambda: need - 1)
+    with pytest.raises(MemoryError, match="160x6 pair over 33 disparity levels"):
+        sgm_disparity(img, img, max_disparity=32, paths=3)
+
+
+def test_lr_tol_and_edge_margin_take_the_kernels_u32() -> None:
+    img = np.random.default_rng(0).random((30, 40)).astype(np.float32)
+    for name in ("lr_tol", "edge_margin"):
+        assert sgm_disparity(img, img, max_disparity=8, **{name: 2**32 - 1}).shape == img.shape
+        with pytest.raises(ValueError, match=rf"^{name}: expected an integer in \[0, 4294967295\]"):
+            sgm_disparity(img, img, max_disparity=8, **{name: 2**32})
