@@ -850,3 +850,146 @@ def test_matches_rasters_leave_out_non_finite_positions_without_a_warning() -> N
         warnings.simplefilter("error")
         dx, dy = m.dispx, m.dispy
     assert np.count_nonzero(np.isfinite(dx)) == 1 and dx[2, 3] == 2.0 and dy[2, 3] == 0.0
+
+
+def _zncc_pair() -> tuple[np.ndarray, np.ndarray]:
+    """A textured pair, the right view the left shifted 3.4 px, with a noise patch in the right
+    view (pixels whose best match does not come back)."""
+    yy, xx = np.mgrid[0:60, 0:110].astype(np.float64)
+
+    def scene(s: float) -> np.ndarray:
+        x = xx + s
+        return 0.5 + 0.2 * np.sin(x / 3.1) * np.cos(yy / 4.3) + 0.2 * np.sin(x / 7.7 + yy / 5.9)
+
+    right = scene(3.4)
+    right[20:40, 50:62] = np.random.default_rng(3).random((20, 12))
+    return scene(0.0).astype(np.float32), right.astype(np.float32)
+
+
+def _zncc(a: np.ndarray, b: np.ndarray) -> float:
+    """ZNCC of two windows, -inf where one is flatter than the reference's limit."""
+    sa, sb = a.std(), b.std()
+    if sa <= mcgm.ZNCC_MIN_STD or sb <= mcgm.ZNCC_MIN_STD:
+        return -np.inf
+    return float(((a - a.mean()) * (b - b.mean())).mean() / (sa * sb))
+
+
+def test_zncc_reference_equals_its_definition_pixel_by_pixel() -> None:
+    """Each pixel inside the 7x7 border: the winner of the ZNCC over the range with both windows
+    inside the images, the right pixel's own winner back within 1 level, the parabola vertex
+    (clipped to +-0.5, end levels not refined); score = the winning ZNCC."""
+    left, right = _zncc_pair()
+    h, w = left.shape
+    r, lo, hi = mcgm.ZNCC_RADIUS, 0, 8
+    # the back-match's left windows stay inside the image (x + hi < w - r); x >= w - r and
+    # y = h - r are outside the 7x7 border: never reported, not counted
+    ys, xs = np.mgrid[0 : h - r + 1 : 3, 0 : w - r - hi : 2]
+    edge = [(x, y) for x in (w - r, w - r + 1, w) for y in (10, 30)]
+    pixels = np.concatenate([np.stack([xs.ravel(), ys.ravel()], axis=1), edge])
+    off = {"sides": False, "disc": False, "zncc_check": False}
+    m = mcgm.zncc_reference(left, right, max_disparity=hi, pixels=pixels, **off)
+    L, R = left.astype(np.float64), right.astype(np.float64)
+
+    def score(x: int, y: int, xr: int) -> float:
+        if not (r <= x < w - r and r <= xr < w - r):
+            return -np.inf
+        return _zncc(
+            L[y - r : y + r + 1, x - r : x + r + 1], R[y - r : y + r + 1, xr - r : xr + r + 1]
+        )
+
+    want = {}
+    n_inside = 0
+    for x, y in pixels:
+        if not (r <= x < w - r and r <= y < h - r):
+            continue
+        n_inside += 1
+        c = np.array([score(x, y, x - d) for d in range(lo, hi + 1)])
+        b = int(np.argmax(c))
+        if not np.isfinite(c[b]):
+            continue
+        back = np.array([score(x - b + k, y, x - b) for k in range(lo, hi + 1)])
+        if abs(int(np.argmax(back)) - b) > 1:
+            continue
+        sub = 0.0
+        if 0 < b < hi - lo and np.isfinite(c[b - 1]) and np.isfinite(c[b + 1]):
+            den = c[b - 1] - 2 * c[b] + c[b + 1]
+            if den < 0:
+                sub = float(np.clip(0.5 * (c[b - 1] - c[b + 1]) / den, -0.5, 0.5))
+        want[(int(x), int(y))] = (b + lo + sub, c[b])
+    got = {
+        (int(x), int(y)): (float(x - xr), float(s))
+        for x, y, xr, s in zip(m.xl, m.yl, m.xr, m.score, strict=True)
+    }
+    assert sorted(got) == sorted(want)
+    assert 0 < len(want) < n_inside - 10  # the LR check and the flat-free border dropped some
+    for k, (d, s) in want.items():
+        assert got[k][0] == pytest.approx(d, abs=2e-4), k
+        assert got[k][1] == pytest.approx(s, abs=2e-4), k
+    assert m.stats["n_pixels"] == n_inside and m.stats["n_lr"] == len(want)
+    # interior pixels of the clean part find the 3.4 px shift
+    clean = [d for (x, y), (d, _) in want.items() if not 40 <= x < 75 or not 14 <= y < 46]
+    assert np.median(clean) == pytest.approx(3.4, abs=0.1)
+
+
+def test_zncc_reference_default_pixels_are_the_full_resolution_curves() -> None:
+    """Without ``pixels``: every labelled pixel (segment 0 included) of the full-resolution
+    channels whose normal is at least horiz_skip_deg from vertical, with the curve parameters
+    given (here min_len)."""
+    left, right = _zncc_pair()
+    kw = {"min_len": 12, "horiz_skip_deg": 30.0, "sides": False, "disc": False}
+    mask = np.zeros(left.shape, bool)
+    for c in mcgm.curves(left, min_len=12):
+        if c.scale == 1:
+            mask |= (c.labels >= 0) & (np.abs(np.cos(c.theta)) >= np.sin(np.deg2rad(30.0)))
+    assert any((c.labels == 0).any() for c in mcgm.curves(left, min_len=12) if c.scale == 1)
+    ys, xs = np.nonzero(mask)
+    by_hand = mcgm.zncc_reference(
+        left, right, max_disparity=8, pixels=np.stack([xs, ys], axis=1), **kw
+    )
+    default = mcgm.zncc_reference(left, right, max_disparity=8, **kw)
+    assert len(default) > 50
+    for a in ("xl", "yl", "xr", "score"):
+        np.testing.assert_array_equal(getattr(default, a), getattr(by_hand, a))
+    assert default.stats == by_hand.stats
+
+
+def test_edge_filters_refuse_shapes_and_the_last_half_pixel() -> None:
+    g = np.random.default_rng(0).random((30, 50), dtype=np.float32)
+    off = {"sides": False, "disc": False, "zncc_check": False}
+    for bad in (np.zeros((1, 2, 4), np.float32), np.zeros(4, np.float32)):
+        with pytest.raises(ValueError, match=r"matches: expected shape \(N, 4\), got"):
+            mcgm.edge_filters(g, g, bad, max_disparity=8, **off)
+    # past the outer pixel's edge by a quarter pixel: outside, in x and in y (h < w)
+    for row in ([49.75, 15, 45, 15], [25, 15, 22, 29.75], [25, 40, 22, 40]):
+        with pytest.raises(ValueError, match="1 of 1 rows lie outside the 50x30 images"):
+            mcgm.edge_filters(g, g, np.array([row], np.float32), max_disparity=8, **off)
+
+
+@pytest.mark.parametrize("name", ["max_disparity", "min_disparity"])
+def test_an_infinite_range_is_refused_by_name(name: str) -> None:
+    g = np.random.default_rng(0).random((30, 50), dtype=np.float32)
+    kw = {"max_disparity": 8.0, name: np.inf}
+    for fn in (mcgm.mcgm_match, mcgm.zncc_reference):
+        with pytest.raises(
+            ValueError, match=f"{name} must be a non-negative number of pixels, got inf"
+        ):
+            fn(g, g, **kw)
+
+
+def test_zncc_reference_passes_every_filter_parameter_on() -> None:
+    """Its matches are the unfiltered ones that edge_filters keeps with the same parameters
+    (sides_mean_free off here: the right view has another gain and offset)."""
+    left, right = _zncc_pair()
+    right = right * np.float32(0.8) + np.float32(0.15)
+    flt = {"sides_mean_free": False, "sides_mad": 0.08, "disc_tol": 0.5}
+    none = mcgm.zncc_reference(
+        left, right, max_disparity=8, sides=False, disc=False, zncc_check=False
+    )
+    arr = np.stack([none.xl, none.yl, none.xr, none.yr], axis=1)
+    keep = mcgm.edge_filters(left, right, arr, max_disparity=8, **flt)
+    assert 0 < keep.sum() < len(keep)
+    default_keep = mcgm.edge_filters(left, right, arr, max_disparity=8)
+    assert (keep != default_keep).any()  # the parameters matter on this pair
+    m = mcgm.zncc_reference(left, right, max_disparity=8, **flt)
+    np.testing.assert_array_equal(m.xl, none.xl[keep])
+    np.testing.assert_array_equal(m.xr, none.xr[keep])
