@@ -2038,3 +2038,103 @@ fn decompose_searches_half_a_channel_width_around_the_translation() {
         }
     }
 }
+
+/// Crossings of a `w x h` plane: `(x, y, theta)` marked with strength 1, nothing else.
+fn crossings_at(w: usize, h: usize, marks: &[(usize, usize, f32)]) -> ZeroCrossings {
+    let n = w * h;
+    let mut zc = ZeroCrossings {
+        width: w,
+        height: h,
+        mark: vec![0; n],
+        xsub: vec![f32::NAN; n],
+        strength: vec![0.0; n],
+        theta: vec![0.0; n],
+    };
+    for &(x, y, t) in marks {
+        let i = y * w + x;
+        zc.mark[i] = ZC_H;
+        zc.xsub[i] = x as f32;
+        zc.strength[i] = 1.0;
+        zc.theta[i] = t;
+    }
+    zc
+}
+
+/// B.4 step 5: a curve continues only to a neighbour whose normal turned by less than
+/// `max_turn_deg` (strictly); a 3-px-wide image still has its interior column tracked; a
+/// segment's mean normal lies in `[0, 2 pi)` even where `atan2 + 2 pi` rounds up to `2 pi`.
+#[test]
+fn track_turn_bound_is_strict_narrow_images_track_and_mean_theta_stays_below_tau() {
+    use std::f32::consts::TAU;
+    let p = tracking::TrackParams {
+        high_quantile: 0.0,
+        low_ratio: 1.0,
+        max_turn_deg: 30.0,
+        min_len: 1,
+    };
+    // A vertical line (normal along +x) in the only interior column of a 3 x 6 image.
+    let line: Vec<(usize, usize, f32)> = (1..5).map(|y| (1, y, 0.0)).collect();
+    let c = track(&crossings_at(3, 6, &line), &p).unwrap();
+    assert_eq!(c.segments.len(), 1);
+    assert_eq!(c.segments[0].pixels, vec![4, 7, 10, 13]);
+    // The same line with max_turn 0: no turn is below it, every pixel is its own segment.
+    let c0 = track(
+        &crossings_at(3, 6, &line),
+        &tracking::TrackParams {
+            max_turn_deg: 0.0,
+            ..p
+        },
+    )
+    .unwrap();
+    assert_eq!(c0.segments.len(), 4);
+    assert!(c0.segments.iter().all(|s| s.pixels.len() == 1));
+    // Normals just below 2 pi and just above 0: the circular mean is a tiny negative angle,
+    // whose + 2 pi rounds to 2 pi in f32; the direction is 0.
+    let below = f32::from_bits(TAU.to_bits() - 1); // 2 pi - 3.0e-7
+    let c = track(&crossings_at(5, 6, &[(2, 2, below), (2, 3, 2.5e-7)]), &p).unwrap();
+    assert_eq!(c.segments.len(), 1);
+    assert_eq!(c.segments[0].pixels.len(), 2);
+    assert_eq!(c.segments[0].mean_theta, 0.0);
+}
+
+/// A vertical segment of the pixels `(x, y0..y0 + n)` (normals along +x) in a `w`-wide image.
+fn vertical_segment(w: usize, x: usize, y0: usize, n: usize) -> Segment {
+    Segment {
+        pixels: (y0..y0 + n).map(|y| (y * w + x) as u32).collect(),
+        centroid: (x as f32, y0 as f32 + 0.5 * (n - 1) as f32),
+        x_min: x as i32,
+        x_max: x as i32,
+        y_min: y0 as i32,
+        y_max: (y0 + n - 1) as i32,
+        mean_theta: 0.0,
+    }
+}
+
+/// B.4.7 bounds: a pair whose length ratio equals `ght_min_score` is scored (its GHT peak can
+/// still reach the minimum, and here does: 2 of 4 pixels), and the mean normals must differ by
+/// less than `seg_theta_tol_deg` (strictly: with 0 nothing is a candidate).
+#[test]
+fn candidates_length_ratio_bound_is_inclusive_and_normal_bound_strict() {
+    let (w, h) = (20, 8);
+    let theta = vec![0.0f32; w * h];
+    let left = [vertical_segment(w, 12, 3, 2)];
+    let right = [vertical_segment(w, 10, 2, 4)];
+    let cp = graph::CandParams {
+        seg_theta_tol_deg: 30.0,
+        dy_band: 1,
+        n_bins: 8,
+        vote_bin_tol: 0,
+        ght_min_score: 0.5,
+        k_cand: 4,
+    };
+    let rts = [build_rtable(&left[0], &theta, w, cp.n_bins)];
+    let window = [Some((0, 5))];
+    let got = graph::candidates(&left, &rts, &right, &theta, w, h, &window, &cp);
+    assert_eq!(got.len(), 1);
+    assert_eq!((got[0].score, got[0].tx), (0.5, 2.0));
+    let strict = graph::CandParams {
+        seg_theta_tol_deg: 0.0,
+        ..cp
+    };
+    assert!(graph::candidates(&left, &rts, &right, &theta, w, h, &window, &strict).is_empty());
+}
