@@ -472,3 +472,37 @@ fn subpixel_offset_reaches_the_last_disparity_but_one() {
     assert_eq!(a, b);
     assert!(a.iter().any(|t| t.2 != 0.0));
 }
+
+/// A one-disparity range (`d_min = d_max`) is searched, not skipped as empty; and a point keeps
+/// at most `k_cand` candidates, its best ZNCC first.
+#[test]
+fn one_disparity_range_is_searched_and_k_cand_cuts_each_point() {
+    let (l, r) = shifted_pair(100, 60, 5);
+    let one = HopfieldParams {
+        d_min: 5,
+        d_max: 5,
+        ..HopfieldParams::default()
+    };
+    let (_, ns) = candidate_neurons(&l, &r, &one).unwrap();
+    assert!(ns.len() > 50, "{}", ns.len());
+    assert!(ns.iter().all(|n| n.dx() == 5));
+    // A low s_min gives many points several peaks; k_cand 2 keeps the best two of each.
+    let wide = HopfieldParams {
+        s_min: 0.0,
+        ..params(16)
+    };
+    let cut = HopfieldParams { k_cand: 2, ..wide };
+    let (_, all) = candidate_neurons(&l, &r, &wide).unwrap();
+    let (_, kept) = candidate_neurons(&l, &r, &cut).unwrap();
+    let groups = |ns: &[Neuron]| -> Vec<Vec<Neuron>> {
+        ns.chunk_by(|a, b| a.point == b.point)
+            .map(|g| g.to_vec())
+            .collect()
+    };
+    let (ga, gk) = (groups(&all), groups(&kept));
+    assert_eq!(ga.len(), gk.len());
+    assert!(ga.iter().filter(|g| g.len() > 2).count() > 20);
+    for (a, k) in ga.iter().zip(&gk) {
+        assert_eq!(&a[..a.len().min(2)], &k[..]);
+    }
+}
