@@ -506,3 +506,41 @@ fn one_disparity_range_is_searched_and_k_cand_cuts_each_point() {
         assert_eq!(&a[..a.len().min(2)], &k[..]);
     }
 }
+
+/// The sub-pixel offset is computed from `d = 1` on (its lower neighbour, `d = 0`, is in the
+/// range): matches of a 1-px shift get a parabola offset, not 0.
+#[test]
+fn subpixel_offset_starts_at_disparity_one() {
+    let (l, r) = shifted_pair(100, 60, 1);
+    let (_, ns) = candidate_neurons(&l, &r, &params(8)).unwrap();
+    let at1: Vec<f32> = ns.iter().filter(|n| n.dx() == 1).map(|n| n.sub).collect();
+    assert!(at1.len() > 50, "{}", at1.len());
+    assert!(at1.iter().filter(|&&s| s != 0.0).count() * 2 > at1.len());
+}
+
+/// The side rescue iterates to a fixed point: a match whose side holds too few accepted
+/// matches (2 of `rescue_min` 3) is rescued once a neighbour on that side is rescued in an
+/// earlier round (window half-size 5 px: the neighbour's own backers lie outside its window).
+#[test]
+fn rescue_repeats_until_no_match_is_added() {
+    let mut ns = vec![
+        neuron(0, (94, 100), 10, 0.0, false), // needs (90, 100) rescued first
+        neuron(1, (90, 100), 10, 0.0, false),
+    ];
+    for (k, xy) in [(85, 100), (86, 100), (87, 100), (89, 99), (89, 101)]
+        .into_iter()
+        .enumerate()
+    {
+        ns.push(neuron(2 + k as u32, xy, 10, 0.0, true));
+    }
+    let mut p = HopfieldParams::default();
+    p.weights.nbr_half = 5;
+    let chosen: Vec<usize> = (0..ns.len()).collect();
+    assert_eq!(rescue(&ns, &chosen, &p), [true; 7]);
+    // Without its neighbour the first match stays rejected.
+    let alone: Vec<usize> = [0, 2, 3, 4, 5, 6].into();
+    assert_eq!(
+        rescue(&ns, &alone, &p),
+        [false, true, true, true, true, true]
+    );
+}
