@@ -2138,3 +2138,59 @@ fn candidates_length_ratio_bound_is_inclusive_and_normal_bound_strict() {
     };
     assert!(graph::candidates(&left, &rts, &right, &theta, w, h, &window, &strict).is_empty());
 }
+
+/// B.4.12's search of the right crossing on one row, on hand-made curves (sigma 1, full
+/// resolution): the window starts at `floor(x - tx - half)` (a crossing in that pixel can be
+/// within `half`), a crossing exactly `half` away counts, and of two equally near the first
+/// (leftmost) is taken.
+#[test]
+fn decompose_window_bounds_and_ties() {
+    let (w, h) = (20, 5);
+    // Curves whose crossings (x, y, sub-pixel x) all belong to segment 0.
+    let curves_of = |marks: &[(usize, usize, f32)]| -> ChannelCurves {
+        let mut zc = crossings_at(
+            w,
+            h,
+            &marks.iter().map(|m| (m.0, m.1, 0.0)).collect::<Vec<_>>(),
+        );
+        let mut labels = vec![-1; w * h];
+        for &(x, y, xs) in marks {
+            zc.xsub[y * w + x] = xs;
+            labels[y * w + x] = 0;
+        }
+        ChannelCurves {
+            sigma: 1.0,
+            scale: 1,
+            width: w,
+            height: h,
+            log: vec![0.0; w * h],
+            zc,
+            curves: tracking::Curves {
+                segments: vec![vertical_segment(w, marks[0].0, marks[0].1, 1)],
+                labels,
+                t_high: 1.0,
+                t_low: 1.0,
+            },
+            rtables: Vec::new(),
+        }
+    };
+    let left = curves_of(&[(10, 2, 10.0)]);
+    let half = 0.5 * CHANNEL_WIDTH_SIGMAS;
+    let xr = |right: &[(usize, usize, f32)], tx: f32| -> Vec<f32> {
+        let c = Candidate {
+            left: 0,
+            right: 0,
+            score: 1.0,
+            tx,
+            ty: 0.0,
+        };
+        let ms = decompose(&left, &curves_of(right), &[c], &[0], 20.0, 0);
+        ms.iter().map(|m| m.xr).collect()
+    };
+    // Target 8: the window starts at floor(8 - 1.41) = 6, whose crossing 6.6 is 1.4 away.
+    assert_eq!(xr(&[(6, 2, 6.6)], 2.0), [6.6]);
+    // Two crossings 0.5 either side of the target: the left one.
+    assert_eq!(xr(&[(7, 2, 7.5), (8, 2, 8.5)], 2.0), [7.5]);
+    // Target 0, a crossing exactly half a channel width away.
+    assert_eq!(xr(&[(1, 2, half)], 10.0), [half]);
+}
