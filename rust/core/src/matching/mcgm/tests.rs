@@ -2194,3 +2194,42 @@ fn decompose_window_bounds_and_ties() {
     // Target 0, a crossing exactly half a channel width away.
     assert_eq!(xr(&[(1, 2, half)], 10.0), [half]);
 }
+
+/// A half-resolution channel searches `floor(d_min / 2)..=ceil(d_max / 2)` channel pixels: an
+/// odd `d_min` rounds down, not up (the first channel has no prior: every window is that range).
+#[test]
+fn half_resolution_range_rounds_outward() {
+    let img = blobs(60, 40, 0.0);
+    let p = McgmParams {
+        sigmas: vec![4.0],
+        d_min: 3,
+        d_max: 9,
+        ..McgmParams::default()
+    };
+    let out = mcgm_match(&img, &blobs(60, 40, 4.0), &p).unwrap();
+    let ch = &out.channels[0];
+    assert_eq!(ch.scale, 2);
+    assert!(!ch.windows.is_empty());
+    assert!(ch.windows.iter().all(|&w| w == Some((1, 5))));
+}
+
+/// The discontinuity filter drops a match whose rounded left pixel lies outside the image (it
+/// has no neighbourhood to check), after the both-sides step counted it.
+#[test]
+fn discontinuity_filter_drops_matches_outside_the_image() {
+    let img = Image::filled(40, 30, 0.5);
+    let f = FilterParams {
+        sides: false,
+        zncc_check: false,
+        ..FilterParams::default()
+    };
+    let ms = [
+        match_at(-0.6, 15.0, 5.0),
+        match_at(39.6, 15.0, 5.0),
+        match_at(20.0, 29.5, 5.0),
+        match_at(20.0, 15.0, 5.0),
+    ];
+    let (keep, counts) = edge_filters(&img, &img, &ms, &f, (0, 16)).unwrap();
+    assert_eq!(keep, [false, false, false, true]);
+    assert_eq!((counts.sides, counts.disc), (4, 1));
+}
