@@ -30,7 +30,8 @@ pub struct TrackParams {
     pub high_quantile: f32,
     /// Continuation threshold as a fraction of the seed threshold (B.2: 0.4).
     pub low_ratio: f32,
-    /// Largest change of the normal direction between consecutive pixels (degrees; B.8: 60).
+    /// Bound on the change of the normal direction between consecutive pixels, which must be
+    /// strictly below it (degrees; B.4 "differs by less than"; B.8: 60).
     pub max_turn_deg: f32,
     /// Shortest kept segment (pixels).
     pub min_len: usize,
