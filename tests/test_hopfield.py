@@ -520,3 +520,77 @@ def test_candidates_refuse_an_unreachable_range_as_match_does() -> None:
         with pytest.raises(ValueError, match=f"^{re.escape(str(want.value))}$"):
             hp.hopfield_candidates(left, right, max_disparity=lo, min_disparity=lo)
     assert hp.hopfield_candidates(left, right, max_disparity=79, min_disparity=79).shape[1] == 6
+
+
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {"rel_threshold": 0.0, "floor_rel": 0.0},
+        {"rel_threshold": 1.0, "floor_rel": 1.0, "tile": 0},
+        {"tile": 0},
+        {"nms_half": 2, "tile": 16, "rel_threshold": 0.05},
+    ],
+)
+def test_interest_parameters_at_their_bounds_equal_the_reference(kw: dict[str, float]) -> None:
+    """A second mutation audit: rel_threshold/floor_rel of exactly 0 or 1 refused, tile 0 (the
+    whole image) refused and the arrays' documented float32 dtypes survived the tests."""
+    left, _, _ = _grey("middlebury2001/tsukuba")
+    ours = hp.interest_points(left, **kw)
+    xy, vals = ref.interest_points(left, **kw)
+    assert len(ours) == len(xy) > 0
+    assert ours.xy.dtype == ours.values.dtype == ours.response.dtype == np.float32
+    assert ours.xy.shape == (len(xy), 2) and ours.response.shape == left.shape
+    assert np.array_equal(ours.xy.astype(np.int64), xy)
+    assert np.array_equal(ours.values, vals)
+
+
+def test_range_types_taken_and_refused() -> None:
+    """NumPy integers and floats are pixel counts as Python's are; True and inf are refused
+    (a mutation audit found each of the four unasserted)."""
+    left, right = _blurred_pair()
+    want = hp.hopfield_match(left, right, max_disparity=8).to_array()
+    for v in (np.int64(8), np.int32(8), np.float32(8.0), np.float64(8.0)):
+        got = hp.hopfield_match(left, right, max_disparity=v)
+        np.testing.assert_array_equal(got.to_array(), want)
+    for v, shown in ((True, "True"), (float("inf"), "inf")):
+        with pytest.raises(
+            ValueError, match=f"^max_disparity must be a non-negative .*got {shown}$"
+        ):
+            hp.hopfield_match(left, right, max_disparity=v)
+
+
+@pytest.mark.parametrize("mode", ["row", "points"])
+def test_defaults_are_the_kernels(mode: str) -> None:
+    """DEFAULTS mirror HopfieldParams::default: the wrapper's matches equal the kernel's with
+    only the range given (a changed seed, tau_y, dy_window, min_agree_sparse or
+    fallback_min_support survived the tests, golden figures included)."""
+    left, right, sc = _grey("middlebury2003/cones")
+    crop = (slice(60, 260), slice(40, 400))
+    lc, rc = np.ascontiguousarray(left[crop]), np.ascontiguousarray(right[crop])
+    for method, run in (("hopfield", hp.hopfield_match), ("best", hp.best_match)):
+        got = run(lc, rc, max_disparity=sc.max_disparity, candidates=mode)
+        m, trace, stats = sv._core.hopfield_match(
+            lc, rc, {"max_disparity": sc.max_disparity, "method": method, "candidates": mode}
+        )
+        assert len(got) > 300
+        np.testing.assert_array_equal(np.stack([got.xl, got.yl, got.xr, got.yr, got.score], 1), m)
+        np.testing.assert_array_equal(got.energy_trace, trace)
+        assert got.stats == dict(stats)
+        # score is the match's ZNCC (a Matches with yr as score passed); yr its right row
+        assert np.all((got.score >= hp.DEFAULTS["s_min"]) & (got.score <= 1.0 + 1e-6))
+    if mode == "points":
+        assert np.any(got.yr != got.yl)  # off-row candidates: yr is not yl
+
+
+def test_best_match_on_8bit_frames_is_the_reference() -> None:
+    """8-bit input goes through the kernel's own grey conversion: best_match there ran the
+    network (the method was not passed on that path) without a test noticing."""
+    from stereovision._validate import as_gray_float
+
+    sc = _scene("middlebury2003/cones")
+    left, right = sc.left[40:240, 60:360], sc.right[40:240, 60:360]
+    a = hp.best_match(left, right, max_disparity=sc.max_disparity)
+    b = hp.best_match(as_gray_float(left), as_gray_float(right), max_disparity=sc.max_disparity)
+    assert len(a) > 200 and len(a.energy_trace) == 0
+    np.testing.assert_array_equal(a.to_array(), b.to_array())
+    np.testing.assert_array_equal(a.score, b.score)
