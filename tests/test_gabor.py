@@ -382,3 +382,61 @@ def test_direct_call_refuses_an_unreachable_range_as_match_does() -> None:
         40,
         48,
     )
+
+
+def test_defaults_are_the_kernels() -> None:
+    """DEFAULTS mirror GaborParams::default and gabor_responses' defaults the channel the
+    tests compare with: lr_light=True or a freq default of 0.2 survived a mutation audit (the
+    golden figures included)."""
+    left, right = _grey("middlebury2001/tsukuba")
+    got = gabor_disparity(left, right, max_disparity=16)
+    disp, conf = _core.gabor_disparity(left, right, 0.0, 16.0)
+    np.testing.assert_array_equal(got.disparity, disp)
+    np.testing.assert_array_equal(got.confidence, conf)
+    np.testing.assert_array_equal(gabor_responses(left), gabor_responses(left, 0.25, 0.0, 1.5, 1.0))
+
+
+def test_input_types_taken_and_refused() -> None:
+    """A second mutation audit found unasserted: a float64 image taken as float32, NumPy bools
+    and integers taken as switches and counts, True refused as a count, an orientation array
+    taken and a bare number refused, a (0, 5) image refused as empty, and a bad right image
+    named as right."""
+    rng = np.random.default_rng(0)
+    img = rng.random((24, 40)).astype(np.float32)
+    right = np.roll(img, -2, axis=1)
+    want = gabor_disparity(img, right, max_disparity=8, lr_check=False, speckle_size=5)
+    same = [
+        gabor_disparity(
+            img.astype(np.float64), right, max_disparity=8, lr_check=False, speckle_size=5
+        ),
+        gabor_disparity(img, right, max_disparity=8, lr_check=np.False_, speckle_size=np.int64(5)),
+    ]
+    for got in same:
+        np.testing.assert_array_equal(got.disparity, want.disparity)
+    a = gabor_disparity(img, right, max_disparity=8, orientations_deg=np.array([0.0, 60.0]))
+    b = gabor_disparity(img, right, max_disparity=8, orientations_deg=[0.0, 60.0])
+    np.testing.assert_array_equal(a.disparity, b.disparity)
+    cases: list[tuple[object, object, dict[str, object], str]] = [
+        (
+            img,
+            right,
+            {"speckle_size": True},
+            "speckle_size must be a non-negative integer, got True",
+        ),
+        (
+            img,
+            right,
+            {"orientations_deg": 5},
+            "orientations_deg must be a sequence of degrees, got 5",
+        ),
+        (
+            np.zeros((0, 5), np.float32),
+            np.zeros((0, 5), np.float32),
+            {},
+            r"left is empty: shape \(0, 5\)",
+        ),
+        (img, right * 3, {}, r"right: float image values must lie in \[0, 1\]"),
+    ]
+    for lft, rgt, kw, says in cases:
+        with pytest.raises(ValueError, match="^" + says):
+            gabor_disparity(lft, rgt, max_disparity=8, **kw)
