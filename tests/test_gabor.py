@@ -440,3 +440,12 @@ def test_input_types_taken_and_refused() -> None:
     for lft, rgt, kw, says in cases:
         with pytest.raises(ValueError, match="^" + says):
             gabor_disparity(lft, rgt, max_disparity=8, **kw)
+
+
+@pytest.mark.parametrize("value", ["ab", [None], [0.0, "x"]])
+def test_orientations_of_another_type_are_named(value: object) -> None:
+    """orientations_deg="ab" was "could not convert string to float: 'a'" and [None] float()'s
+    bare TypeError, naming no parameter."""
+    img = np.random.default_rng(0).random((24, 40), dtype=np.float32)
+    with pytest.raises(ValueError, match=r"^orientations_deg must be a sequence of degrees, got "):
+        gabor_disparity(img, img, max_disparity=8, orientations_deg=value)

@@ -594,3 +594,13 @@ def test_best_match_on_8bit_frames_is_the_reference() -> None:
     assert len(a) > 200 and len(a.energy_trace) == 0
     np.testing.assert_array_equal(a.to_array(), b.to_array())
     np.testing.assert_array_equal(a.score, b.score)
+
+
+@pytest.mark.parametrize("value", ["x", None, [0.1]])
+def test_interest_thresholds_of_another_type_are_named(value: object) -> None:
+    """rel_threshold="x" was "could not convert string to float: 'x'" and None float()'s bare
+    TypeError, naming no parameter."""
+    img = np.random.default_rng(0).random((30, 40), dtype=np.float32)
+    for name in ("rel_threshold", "floor_rel"):
+        with pytest.raises(ValueError, match=rf"^{name} must lie in \[0, 1\], got "):
+            hp.interest_points(img, **{name: value})

@@ -187,7 +187,12 @@ def gabor_disparity(
             f"search_pool_radius must be at most 16 px, got {kw['search_pool_radius']!r}"
         )
     orient = kw["orientations_deg"]
-    if not isinstance(orient, Sequence) and not isinstance(orient, np.ndarray):
+    # a string or a None in the sequence reached float(): its message named no parameter
+    if (
+        isinstance(orient, str)
+        or not isinstance(orient, (Sequence, np.ndarray))
+        or not all(isinstance(t, (int, float, np.integer, np.floating)) for t in orient)
+    ):
         raise ValueError(f"orientations_deg must be a sequence of degrees, got {orient!r}")
     kw["orientations_deg"] = [float(float_sized(t, "orientations_deg")) for t in orient]
     disp, conf = _core.gabor_disparity(lft, rgt, float(min_disparity), float(max_disparity), **kw)

@@ -150,7 +150,9 @@ def interest_points(
     """
     img = as_gray_float(image, "image")
     for name, v in (("rel_threshold", rel_threshold), ("floor_rel", floor_rel)):
-        if not (0.0 <= float(float_sized(v, name)) <= 1.0):
+        # a string or None reached float(): its message named no parameter
+        number = isinstance(float_sized(v, name), (int, float, np.integer, np.floating))
+        if not (number and 0.0 <= float(v) <= 1.0):  # type: ignore[arg-type]
             raise ValueError(f"{name} must lie in [0, 1], got {v!r}")
     # Sizes beyond the image act as the image: the cap keeps them within the kernel's integers.
     nms = int_in_range(nms_half, "nms_half", 1, 2**31 - 1)
