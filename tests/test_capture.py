@@ -2001,3 +2001,47 @@ def test_a_resized_sources_warning_points_at_the_callers_line(tmp_path: Path) ->
         capture(cam, tmp_path / "pairs")
     said = [w.filename for w in caught if "delivers" in str(w.message)]
     assert said == [__file__, __file__]
+
+
+def test_skew_median_is_exact_up_to_a_full_window() -> None:
+    """With exactly SKEW_WINDOW skews the window still holds every one: the median is exact,
+    not the histogram's estimate (a mutation audit's '<' for '<=' survived)."""
+    import statistics
+
+    values = [float(v) for v in np.random.default_rng(7).gamma(2.0, 0.2, capmod.SKEW_WINDOW)]
+    stats = capmod.SkewStats()
+    for v in values:
+        stats.append(v)
+    assert stats.median_ms() == statistics.median(values)
+
+
+def test_resize_frame_shrinks_by_area_and_enlarges_linearly() -> None:
+    """resize_frame is the sources' resize: INTER_AREA to shrink (no aliasing), INTER_LINEAR to
+    enlarge, the frame itself at its own size (a mutation audit's linear shrink survived)."""
+    img = np.random.default_rng(3).integers(0, 256, (60, 80, 3), dtype=np.uint8)
+    assert capmod.resize_frame(img, (80, 60)) is img
+    small = cv2.resize(img, (30, 20), interpolation=cv2.INTER_AREA)
+    np.testing.assert_array_equal(capmod.resize_frame(img, (30, 20)), small)
+    big = cv2.resize(img, (160, 120), interpolation=cv2.INTER_LINEAR)
+    np.testing.assert_array_equal(capmod.resize_frame(img, (160, 120)), big)
+
+
+def test_stale_temps_are_listed_sorted_and_another_users_are_kept(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """remove_stale_temps returns the names it removed sorted, whatever the folder's order; a
+    process it may not signal (another user's: PermissionError) is taken as alive and its
+    temporary file kept (both survived a mutation audit)."""
+    names = [f".left_{i:04d}.png.{999_999_000 + i}-0a1b2c3d.tmp" for i in range(12)]
+    for name in reversed(names):
+        (tmp_path / name).write_bytes(b"half a png")
+    assert capmod.remove_stale_temps(tmp_path) == sorted(names)
+    assert list(tmp_path.iterdir()) == []
+
+    def denied(pid: int, sig: int) -> None:
+        raise PermissionError(1, "Operation not permitted")
+
+    (tmp_path / names[0]).write_bytes(b"half a png")
+    monkeypatch.setattr(capmod.os, "kill", denied)
+    assert capmod.remove_stale_temps(tmp_path) == []
+    assert [p.name for p in tmp_path.iterdir()] == [names[0]]
