@@ -9,6 +9,7 @@ import math
 import re
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import cv2
@@ -1457,3 +1458,50 @@ def test_occupancy_grid_save_refuses_a_name_with_a_folder(tmp_path: Path) -> Non
     assert sorted(p.name for p in tmp_path.rglob("*")) == []  # nothing written, no folder made
     png, yml = grid.save(inner, name="floor.v2")
     assert (png.name, yml.name) == ("floor.v2.png", "floor.v2.yaml") and png.parent == inner
+
+
+def test_cell_of_points_before_the_origin_heights_of_bad_shapes_and_the_warning_edge() -> None:
+    """A point just before the grid's origin is in row/column -1 (outside), not 0 as int()
+    truncation put it; height_of refuses a point that is not 3 numbers in its own words; a
+    below share exactly at BELOW_WARN_SHARE does not warn (each survived a mutation audit)."""
+    from stereovision.ground import OccupancyGrid
+
+    grid = OccupancyGrid(np.zeros((4, 4), np.int8), 0.1, (0.0, -0.2))
+    assert grid.cell_of(-0.05, -0.25) == (-1, -1)
+    assert grid.cell_of(0.05, -0.15) == (0, 0)
+    plane = GroundPlane(
+        normal=np.array([0.0, -1.0, 0.0]),
+        height=1.5,
+        disparity_plane=(0.0, 0.05, -10.0),
+        inliers=np.zeros((4, 4), bool),
+        inlier_share=0.3,
+        rms_px=0.4,
+        below_share=BELOW_WARN_SHARE,
+    )
+    assert "below it" not in plane.describe()
+    assert "6 % of the points lie below it" in replace(plane, below_share=0.06).describe()
+    for bad in (np.zeros((5, 2)), np.zeros((2, 4)), 1.0):
+        with pytest.raises(ValueError, match=r"points: expected shape \(\.\.\., 3\)"):
+            plane.height_of(bad)
+
+
+def test_a_cell_with_floor_and_obstacle_points_is_occupied() -> None:
+    """The floor seen in a cell does not free it when MIN_OBSTACLE_POINTS stand on it too (the
+    free mark written after the occupied one survived a mutation audit); fewer leave it free."""
+    from stereovision.ground import MIN_OBSTACLE_POINTS, occupancy_grid
+
+    plane = GroundPlane(
+        normal=np.array([0.0, -1.0, 0.0]),
+        height=1.5,
+        disparity_plane=(0.0, 0.05, -10.0),
+        inliers=np.zeros((4, 4), bool),
+        inlier_share=0.3,
+        rms_px=0.4,
+    )
+    floor = [[0.0, 1.5, 3.05]]  # on the floor, 3.05 m ahead
+    post = [[0.0, 1.0, 3.05]] * MIN_OBSTACLE_POINTS  # 0.5 m above it, same cell
+    kw = {"resolution": 0.1, "forward": (0.0, 5.0), "lateral": (-1.0, 1.0)}
+    grid = occupancy_grid(np.array(floor + post), plane, **kw)
+    cell = grid.cell_of(3.05, 0.0)
+    assert grid.data[cell] == 100
+    assert occupancy_grid(np.array(floor + post[1:]), plane, **kw).data[cell] == 0
