@@ -2265,3 +2265,44 @@ def test_a_full_output_disk_that_the_summary_cannot_be_written_to_is_said(
         "finished since it was last written are not recorded in it; run again to continue"
     )
     assert _summary(out)["counts"] == {"done": 0, "failed": 0, "pending": 4}
+
+
+def test_find_pairs_separators_hidden_camera_images_ambiguous_folders_and_dot(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Pair names drop the '.' and ' ' around 'left' as they drop '_' and '-'; a hidden image in
+    a camera folder is no pair; 'left' beside 'Left' is not guessed a camera folder; '.' as the
+    scene, or a folder of Left.jpg and Right.jpg, is named by the folder it is (each survived a
+    mutation audit)."""
+    img = np.zeros((8, 8, 3), np.uint8)
+    files = [
+        "dots/img.left.png",
+        "dots/img.right.png",
+        "dots/shot left 7.png",
+        "dots/shot right 7.png",
+        "rig/left/0001.png",
+        "rig/right/0001.png",
+        "rig/left/.0002.png",
+        "rig/right/.0002.png",
+        "two/left/0001.png",
+        "two/Left/0001.png",
+        "two/right/0001.png",
+        "scene/left.png",
+        "scene/right.png",
+        "cam/Left.jpg",
+        "cam/Right.jpg",
+    ]
+    for f in files:
+        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(tmp_path / f), img)
+    jobs = find_pairs(tmp_path)
+    assert [(j.name, j.left.relative_to(tmp_path).as_posix()) for j in jobs] == [
+        ("cam", "cam/Left.jpg"),
+        ("dots/img", "dots/img.left.png"),
+        ("dots/shot_7", "dots/shot left 7.png"),
+        ("rig/0001", "rig/left/0001.png"),
+        ("scene", "scene/left.png"),
+    ]
+    for scene in ("scene", "cam"):
+        monkeypatch.chdir(tmp_path / scene)
+        assert [j.name for j in find_pairs(".")] == [scene]
