@@ -1505,3 +1505,21 @@ def test_a_cell_with_floor_and_obstacle_points_is_occupied() -> None:
     cell = grid.cell_of(3.05, 0.0)
     assert grid.data[cell] == 100
     assert occupancy_grid(np.array(floor + post[1:]), plane, **kw).data[cell] == 0
+
+
+def test_scan_json_precision_range_min_edge_beam_cap_and_a_far_negative_range() -> None:
+    """as_dict keeps ranges to 0.1 mm (4 decimals); a point at exactly range_min counts; more
+    than 100000 beams are refused; a max_range of -10**400 is a float's -inf, refused, not +inf
+    (each survived a mutation audit)."""
+    from stereovision.ground import LaserScan
+
+    scan = LaserScan(-0.5, 0.5, 0.5, 0.0, 20.0, np.float32([1.23456, np.inf, np.nan]))
+    assert scan.as_dict()["ranges"] == [1.2346, "inf", None]
+    plane, _ = _level_floor()
+    pts = np.array([[0.0, 0.5, 2.0]] * 3)  # 0.5 m above the floor, 2 m ahead
+    kw = {"angle_min": -0.5, "angle_max": 0.5, "angle_increment": 0.25}
+    assert laser_scan(pts, plane, range_min=2.0, **kw).ranges[2] == 2.0
+    with pytest.raises(ValueError, match="100001 beams; at most 100000"):
+        laser_scan(pts, plane, angle_min=0.0, angle_max=1.0, angle_increment=1e-5)
+    with pytest.raises(ValueError, match="max_range: expected a positive distance"):
+        obstacle_mask(pts.reshape(1, 3, 3), plane, max_range=-(10**400))
