@@ -2306,3 +2306,29 @@ def test_find_pairs_separators_hidden_camera_images_ambiguous_folders_and_dot(
     for scene in ("scene", "cam"):
         monkeypatch.chdir(tmp_path / scene)
         assert [j.name for j in find_pairs(".")] == [scene]
+
+
+def test_camera_folders_pair_by_number_only_when_one_image_of_a_subfolder_carries_it(
+    tmp_path: Path,
+) -> None:
+    """Sibling camera folders pair images by number when the names are otherwise the same but
+    for the side and separators ('.' too); two left images of number 1 (left_1, left_01) are not
+    guessed between, nor are images of other sub-folders paired (each survived a mutation
+    audit)."""
+    img = np.zeros((8, 8, 3), np.uint8)
+    files = [
+        "r1/left/a.left.1.png",
+        "r1/right/a_right_01.png",
+        "r2/left/left_1.png",
+        "r2/left/left_01.png",
+        "r2/right/right_1.png",
+        "r3/left/a/left_1.png",
+        "r3/right/b/right_1.png",
+    ]
+    for f in files:
+        (tmp_path / f).parent.mkdir(parents=True, exist_ok=True)
+        cv2.imwrite(str(tmp_path / f), img)
+    jobs = find_pairs(tmp_path)
+    assert [(j.name, j.right.relative_to(tmp_path).as_posix()) for j in jobs] == [
+        ("r1/a_1", "r1/right/a_right_01.png")
+    ]
