@@ -2330,5 +2330,16 @@ def test_camera_folders_pair_by_number_only_when_one_image_of_a_subfolder_carrie
         cv2.imwrite(str(tmp_path / f), img)
     jobs = find_pairs(tmp_path)
     assert [(j.name, j.right.relative_to(tmp_path).as_posix()) for j in jobs] == [
-        ("r1/a_1", "r1/right/a_right_01.png")
+        ("r1/a_1", "r1/right/a_right_01.png"),
     ]
+
+
+def test_a_failed_pairs_error_is_the_first_line_of_its_message() -> None:
+    """OpenCV's errors run over several lines: a pair's error is the first, after the type
+    (the last line survived a mutation audit); a message-less one is its type alone."""
+    from stereovision.batch import _error_line
+
+    assert _error_line(ValueError("cannot decode a.png\n  detail")) == (
+        "ValueError: cannot decode a.png"
+    )
+    assert _error_line(MemoryError()) == "MemoryError"
