@@ -2343,3 +2343,27 @@ def test_a_failed_pairs_error_is_the_first_line_of_its_message() -> None:
         "ValueError: cannot decode a.png"
     )
     assert _error_line(MemoryError()) == "MemoryError"
+
+
+def test_a_run_killed_without_calib_does_not_own_the_depth_names(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A run without --calib killed before recording its pair (pending, calib None) wrote no
+    files: a cloud.ply the user put in the pair's folder is not taken for its output by a
+    rerun with --calib, which refuses to replace it (the pending run's names taken as with a
+    calibration survived a mutation audit)."""
+    src, out = tmp_path / "in", tmp_path / "out"
+    _tiny(src, data_dir, "seq/0000_left.bmp", "seq/0000_right.bmp")
+    Calibration.ideal((96, 64), 60.0, 0.1).save(tmp_path / "rig.yaml")
+    args = ["batch", str(src), "-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(args) == 0
+    data = _summary(out)
+    entry = data["pairs"]["seq/0000"]
+    killed = {k: entry[k] for k in ("left", "right", "calib", "options", "fingerprint")}
+    data["pairs"]["seq/0000"] = {"status": "pending", **killed}
+    (out / SUMMARY_NAME).write_text(json.dumps(data))
+    (out / "seq/0000/cloud.ply").write_bytes(b"mine")
+    capsys.readouterr()
+    assert main([*args, "--calib", str(tmp_path / "rig.yaml")]) == 2
+    assert "cloud.ply is not listed as an earlier run's output" in capsys.readouterr().err
+    assert (out / "seq/0000/cloud.ply").read_bytes() == b"mine"
