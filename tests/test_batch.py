@@ -2349,7 +2349,7 @@ def test_a_run_killed_without_calib_does_not_own_the_depth_names(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     """A run without --calib killed before recording its pair (pending, calib None) wrote no
-    files: a cloud.ply the user put in the pair's folder is not taken for its output by a
+    depth files: a cloud.ply the user put in the pair's folder is not taken for its output by a
     rerun with --calib, which refuses to replace it (the pending run's names taken as with a
     calibration survived a mutation audit)."""
     src, out = tmp_path / "in", tmp_path / "out"
