@@ -2045,3 +2045,21 @@ def test_stale_temps_are_listed_sorted_and_another_users_are_kept(
     monkeypatch.setattr(capmod.os, "kill", denied)
     assert capmod.remove_stale_temps(tmp_path) == []
     assert [p.name for p in tmp_path.iterdir()] == [names[0]]
+
+
+def test_a_sequence_gap_counts_from_the_first_number_and_a_read_only_node_is_said(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A sequence from 1 read to 3 images stopped at its missing 4th file (not the 3rd, as
+    counting from 0 put it); a camera node readable but not writable is said not readable, as
+    the capture needs both (each survived a mutation audit)."""
+    for i in (1, 2, 3, 5):
+        cv2.imwrite(str(tmp_path / f"left_{i:04d}.png"), np.zeros((4, 4), np.uint8))
+    assert capmod._sequence_gap(str(tmp_path / "left_%04d.png"), 3) == ("left_0004.png", 1)
+    monkeypatch.setattr(capmod.os.path, "exists", lambda p: True)
+    monkeypatch.setattr(capmod.os.path, "isdir", lambda p: True)
+    monkeypatch.setattr(capmod.os, "access", lambda p, mode: mode == os.R_OK)
+    assert (
+        capmod.camera_hint(3)
+        == " (/dev/video3 is not readable: is this user in the 'video' group?)"
+    )
