@@ -319,6 +319,46 @@ def test_a_grab_given_up_as_hung_keeps_its_capture_until_it_returns(tmp_path: Pa
         cam.read()
 
 
+def test_a_grab_that_never_began_leaves_the_camera_usable(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The grab's thread failing to start ("can't start new thread": the process out of
+    threads) left the camera marked as grabbing: every later read was refused as "an earlier
+    read given up as hung", and ``close()`` left the release to a grab that never ran, so the
+    camera stayed open. The grab that never began is no grab: the next read reads, close
+    releases."""
+    lpat = _write_sequence(tmp_path / "frames", "left", [_numbered(i) for i in range(3)])
+    rpat = _write_sequence(tmp_path / "frames", "right", [_numbered(i) for i in range(3)])
+    released: list[str] = []
+
+    class _Counted:
+        def __init__(self, cap: Any, name: str) -> None:
+            self._cap, self._name = cap, name
+
+        def release(self) -> None:
+            released.append(self._name)
+            self._cap.release()
+
+        def __getattr__(self, name: str) -> Any:
+            return getattr(self._cap, name)
+
+    class _NoThread(threading.Thread):
+        def start(self) -> None:
+            raise RuntimeError("can't start new thread")
+
+    cam = StereoCamera(lpat, rpat)
+    for side in ("left", "right"):
+        cam._caps[side] = _Counted(cam._caps[side], side)
+    with monkeypatch.context() as m:
+        m.setattr(capmod.threading, "Thread", _NoThread)
+        with pytest.raises(RuntimeError, match="can't start new thread"):
+            capmod.read_within(cam, 1.0)
+    frame = capmod.read_within(cam, 1.0)
+    assert _read_stamp(frame.left) == 0  # the first pair: the grab that never ran took none
+    cam.close()
+    assert sorted(released) == ["left", "right"]
+
+
 def test_a_gap_in_an_image_sequence_is_said(tmp_path: Path) -> None:
     """Pair 3 deleted from both numbered sequences (a blurred pair taken out): the capture
     stops there and says the images after the gap were not read (it said "end of stream", the

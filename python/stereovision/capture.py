@@ -1052,21 +1052,35 @@ class StereoCamera(PairSource):
             ``side``, ``frames``, ``other_had_frames``, ``expected_frames``; ``end`` True). A
             frame that does not decode or of another shape raises it with ``end`` False.
         """
-        caps = self._caps
-        if len(caps) != 2:
-            raise SourceError("the stereo camera is closed", end=False)
-        with self._grab_lock:
+        timeout, name = _READ_TIMEOUT.get(), _camera_name(self)
+        with self._grab_lock:  # with close(): a capture released here is not grabbed
+            caps = self._caps
+            if len(caps) != 2:
+                raise SourceError("the stereo camera is closed", end=False)
             if self._grabbing:
                 raise SourceError(
-                    f"{_camera_name(self)}: an earlier read given up as hung has not returned; "
+                    f"{name}: an earlier read given up as hung has not returned; "
                     "unplug and replug the camera, then open it again",
                     side="both",
                     end=False,
                 )
             self._grabbing = True
-        ok_l, t_l, ok_r, t_r, got = _within(
-            lambda: self._grab(caps), _READ_TIMEOUT.get(), _camera_name(self)
-        )
+        claim = ["pending"]  # "entered" by the grab, or "abandoned" by this thread first
+        try:
+            ok_l, t_l, ok_r, t_r, got = _within(lambda: self._grab(caps, claim), timeout, name)
+        except BaseException:
+            # A grab that never began (its thread not started: "can't start new thread", or
+            # Ctrl-C before it) left the camera grabbing for good: every read refused as hung
+            # and close() leaving the release to it. One that began ends it itself.
+            release = False
+            with self._grab_lock:
+                if claim[0] != "entered":
+                    claim[0] = "abandoned"
+                    self._grabbing = False
+                    release, self._release_on_return = self._release_on_return, False
+            if release:  # closed meanwhile (by another thread)
+                _release(caps.values())
+            raise
         if not (ok_l and ok_r):
             raise self._ended({"left": ok_l, "right": ok_r})
         frames, delivered = {}, {}
@@ -1094,9 +1108,16 @@ class StereoCamera(PairSource):
         self._check_media_drift(frame)
         return frame
 
-    def _grab(self, caps: dict[str, Any]) -> tuple[bool, float, bool, float, dict[str, Any]]:
+    def _grab(
+        self, caps: dict[str, Any], claim: list[str]
+    ) -> tuple[bool, float, bool, float, dict[str, Any]]:
         """Grab both sources, then retrieve both (the native part of :meth:`read`, which
-        :func:`read_within` bounds): each grab's success and time, each retrieve's result."""
+        :func:`read_within` bounds): each grab's success and time, each retrieve's result.
+        Not begun (nothing grabbed) when :meth:`read` gave it up before it started."""
+        with self._grab_lock:
+            if claim[0] == "abandoned":  # read() has ended the grab for it
+                return False, 0.0, False, 0.0, {}
+            claim[0] = "entered"
         try:
             # OpenCV's image-sequence reader logs a warning for the file after the last.
             with _opencv_quiet() if any(self._sequence.values()) else contextlib.nullcontext():
