@@ -2218,6 +2218,27 @@ def test_the_warnings_of_a_streams_pairs_point_at_the_callers_line(data_dir: Pat
         assert [s[1] for s in said] == [__file__, __file__], said
 
 
+@pytest.mark.parametrize("pipelined", [False, True])
+def test_a_cameras_own_warnings_point_at_the_callers_line(tmp_path: Path, pipelined: bool) -> None:
+    """A StereoCamera's warning of its own (a source delivering another size, resized) raised
+    in the grabbing thread of a pipelined stream named threading.py; the stream hands it to
+    its caller's line, as unpipelined, and before the pair's own warnings."""
+    rng = np.random.default_rng(0)
+    for i in range(3):
+        img = (rng.random((60, 80, 3)) * 255).astype(np.uint8)
+        cv2.imwrite(str(tmp_path / f"left_{i:02d}.png"), img)
+        cv2.imwrite(str(tmp_path / f"right_{i:02d}.png"), cv2.resize(img, (160, 120)))
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        StereoCamera(str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png")) as cam,
+    ):
+        warnings.simplefilter("always")
+        rep = run_stream(cam, max_disparity=8, check=False, pipelined=pipelined)
+    assert rep.frames == 3
+    said = [(str(w.message)[:12], w.filename) for w in caught]
+    assert said == [("right source", __file__), ("the cameras ", __file__)], said
+
+
 def test_the_calibration_fitted_to_the_frames_is_said_at_the_callers_line(
     data_dir: Path, tmp_path: Path
 ) -> None:

@@ -11,6 +11,7 @@ luma weights.
 
 from __future__ import annotations
 
+import contextvars
 import dataclasses
 import functools
 import inspect
@@ -864,6 +865,32 @@ def user_stacklevel() -> int:
         frame = frame.f_back
         level += 1
     return level
+
+
+#: A source's warnings held for the caller in this context (:func:`source_warning`): the
+#: stream's grabbing thread sets it, as a warning raised there pointed at threading.py.
+HELD_WARNINGS: contextvars.ContextVar[list[tuple[str, type[Warning]]] | None] = (
+    contextvars.ContextVar("stereovision_held_warnings", default=None)
+)
+
+
+def source_warning(message: str, category: type[Warning] = UserWarning) -> None:
+    """Warn at the first line outside the package (:func:`user_stacklevel`), or, in a thread
+    reading a source for the caller (:data:`HELD_WARNINGS` set), hold the warning for the
+    caller's thread to give at its own line.
+
+    Parameters
+    ----------
+    message : str
+        The warning's text.
+    category : type of Warning
+        Its category.
+    """
+    held = HELD_WARNINGS.get()
+    if held is not None:
+        held.append((message, category))
+        return
+    warnings.warn(message, category, stacklevel=user_stacklevel())
 
 
 _PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__)) + os.sep

@@ -53,7 +53,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import renamed_keyword, user_stacklevel
+from stereovision._validate import renamed_keyword, source_warning
 from stereovision.calibrate import (
     POSE_PARAM_NAMES,
     POSE_PARAM_RANGES,
@@ -1012,12 +1012,10 @@ class StereoCamera(PairSource):
                     end=False,
                     frames=self.count,
                 )
-            warnings.warn(
+            source_warning(
                 f"{side} source {_describe_source(self.sources[side])} delivers {w}x{h}, not "
                 f"{self.size[0]}x{self.size[1]}: another shape, so its frames are kept at "
                 f"{w}x{h} (a resize would stretch them)",
-                UserWarning,
-                stacklevel=user_stacklevel(),  # read(), frames(), capture()
             )
             # not marked as warned: a later frame resized to this size is said (it was not)
             self.size = (w, h)
@@ -1026,11 +1024,9 @@ class StereoCamera(PairSource):
         self._size_locked = True
         if side not in self._warned:
             self._warned.add(side)
-            warnings.warn(
+            source_warning(
                 f"{side} source {_describe_source(self.sources[side])} delivers {w}x{h}, not "
                 f"{self.size[0]}x{self.size[1]}: its frames are resized",
-                UserWarning,
-                stacklevel=user_stacklevel(),
             )
         return resize_frame(frame, self.size)
 
@@ -1171,14 +1167,12 @@ class StereoCamera(PairSource):
         self._warned.add("media drift")
         fps = {side: self.delivered_fps.get(side, 0.0) for side in ("left", "right")}
         name = {side: _describe_source(src) for side, src in self.sources.items()}
-        warnings.warn(
+        source_warning(
             f"left source {name['left']} ({fps['left']:.3g} fps) and right source "
             f"{name['right']} ({fps['right']:.3g} fps) drift apart: pair {frame.index + 1} is at "
             f"{pl:.0f} ms of the left video and {pr:.0f} ms of the right, more than a frame "
             f"({period:.0f} ms) from the first pair's offset; the pairs are not simultaneous "
             "(the grab skew only says when each frame was read)",
-            UserWarning,
-            stacklevel=user_stacklevel(),
         )
 
     def describe(self) -> str:

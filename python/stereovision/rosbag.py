@@ -78,7 +78,7 @@ import cv2
 import numpy as np
 
 from stereovision._interrupt import HeldInterrupts
-from stereovision._validate import renamed_keyword, user_stacklevel
+from stereovision._validate import renamed_keyword, source_warning
 from stereovision.capture import PairSource, SourceError, StereoFrame, resize_frame
 
 __all__ = [
@@ -1093,11 +1093,9 @@ class BagCamera(PairSource):
             if abs((w / h) / (rw / rh) - 1) > 0.01:
                 # as StereoCamera (and `capture --size`'s help) has it: a size of another
                 # shape would stretch the frames, so they keep theirs (they were stretched)
-                warnings.warn(
+                source_warning(
                     f"size {rw}x{rh} is another shape than the recording's {w}x{h}: its frames "
                     f"are kept at {w}x{h} (a resize would stretch them)",
-                    UserWarning,
-                    stacklevel=user_stacklevel(),  # read(), frames(), capture(), run_stream()
                 )
                 self.size = (w, h)
         if self.size is None:
@@ -1117,11 +1115,9 @@ class BagCamera(PairSource):
         # said unless the size is the one asked (not when a size asked was dropped above)
         if self.size != self.requested_size and side not in self._warned:
             self._warned.add(side)
-            warnings.warn(
+            source_warning(
                 f"{self.topics[side]} is {w}x{h}, not {self.size[0]}x{self.size[1]}: its frames "
                 "are resized",
-                UserWarning,
-                stacklevel=user_stacklevel(),
             )
         return resize_frame(img, self.size)
 

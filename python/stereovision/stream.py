@@ -39,7 +39,7 @@ import numpy as np
 
 from stereovision._interrupt import Terminated
 from stereovision._jsonout import json_line
-from stereovision._validate import first_line, user_stacklevel
+from stereovision._validate import HELD_WARNINGS, first_line, user_stacklevel
 from stereovision.calibration import Calibration, fit_to_frames
 from stereovision.capture import (
     DEFAULT_READ_TIMEOUT,
@@ -120,6 +120,10 @@ class _Note:
     caller's line."""
 
     message: str
+    category: type[Warning] = UserWarning
+    #: Took a slot of the producer's (yielded by :func:`_pairs`); a source's warning held in
+    #: the grabbing thread (:data:`~stereovision._validate.HELD_WARNINGS`) rides with its pair.
+    slot: bool = True
 
 
 @dataclass
@@ -557,16 +561,27 @@ class _Producer(threading.Thread):
         return False
 
     def run(self) -> None:
+        # the source's own warnings (a StereoCamera's resized frames), raised in this thread,
+        # pointed at threading.py: held here, each goes to the consumer before its pair
+        held: list[tuple[str, type[Warning]]] = []
+        HELD_WARNINGS.set(held)  # this thread's context only
         try:
             while self._acquire():
                 pair = next(self._source, None)
+                self._hand_over(held)
                 if pair is None:
                     break
                 self._q.put(pair)
         except BaseException as exc:  # handed to the consumer, which re-raises it
+            self._hand_over(held)
             self._q.put(exc)
             return
         self._q.put(_END)
+
+    def _hand_over(self, held: list[tuple[str, type[Warning]]]) -> None:
+        for message, category in held:
+            self._q.put(_Note(message, category, slot=False))
+        held.clear()
 
 
 def _mean(values: list[float]) -> float:
@@ -819,7 +834,8 @@ def run_stream(
         if producer is None:
             return next(source, None)
         item = q.get()
-        producer.slots.release()
+        if not isinstance(item, _Note) or item.slot:
+            producer.slots.release()
         if item is _END:
             return None
         if isinstance(item, BaseException):
@@ -829,7 +845,7 @@ def run_stream(
     def next_pair() -> _Pair | None:
         item = next_item()
         while isinstance(item, _Note):
-            warnings.warn(item.message, UserWarning, stacklevel=user_stacklevel())
+            warnings.warn(item.message, item.category, stacklevel=user_stacklevel())
             item = next_item()
         return item
 
