@@ -359,6 +359,48 @@ def test_a_grab_that_never_began_leaves_the_camera_usable(
     assert sorted(released) == ["left", "right"]
 
 
+def test_ctrl_c_before_the_grab_began_grabs_nothing(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C while waiting for a grab whose thread has not begun yet: the read gives it up
+    (the camera reads again at once) and the thread, when it runs, grabs nothing (the next
+    read gets the first pair, not the second)."""
+    lpat = _write_sequence(tmp_path / "frames", "left", [_numbered(i) for i in range(3)])
+    rpat = _write_sequence(tmp_path / "frames", "right", [_numbered(i) for i in range(3)])
+    gate = threading.Event()
+    late: list[threading.Thread] = []
+
+    class _LateThread(threading.Thread):
+        def run(self) -> None:
+            gate.wait()
+            super().run()
+
+        def start(self) -> None:
+            late.append(self)
+            super().start()
+
+    class _Interrupted(threading.Event):
+        def wait(self, timeout: float | None = None) -> bool:
+            if timeout is None:  # Thread.start's own wait
+                return super().wait()
+            raise KeyboardInterrupt  # the read's wait for the grab
+
+    cam = StereoCamera(lpat, rpat)
+    try:
+        with monkeypatch.context() as m:
+            m.setattr(capmod.threading, "Thread", _LateThread)
+            m.setattr(capmod.threading, "Event", _Interrupted)
+            with pytest.raises(KeyboardInterrupt):
+                capmod.read_within(cam, 1.0)
+        gate.set()
+        late[0].join(5.0)
+        assert not late[0].is_alive()
+        assert _read_stamp(capmod.read_within(cam, 1.0).left) == 0
+    finally:
+        gate.set()
+        cam.close()
+
+
 def test_a_gap_in_an_image_sequence_is_said(tmp_path: Path) -> None:
     """Pair 3 deleted from both numbered sequences (a blurred pair taken out): the capture
     stops there and says the images after the gap were not read (it said "end of stream", the
