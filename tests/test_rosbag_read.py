@@ -1450,3 +1450,12 @@ def test_the_size_warnings_of_a_bag_point_at_the_callers_line(cones: Any, tmp_pa
         warnings.simplefilter("always")
         capture(cam, tmp_path / "pairs")
     assert [w.filename for w in caught if "450x" in str(w.message)] == [__file__, __file__]
+    from stereovision.stream import run_stream
+
+    with (
+        warnings.catch_warnings(record=True) as caught,
+        BagCamera(bag, image_size="450x200") as cam,
+    ):
+        warnings.simplefilter("always")
+        run_stream(cam, max_disparity=16, check=False)  # read in the stream's grabbing thread
+    assert [w.filename for w in caught if "450x" in str(w.message)] == [__file__, __file__]
