@@ -373,3 +373,26 @@ def test_min_disparity_bounds_the_map_and_a_1d_confidence_is_named() -> None:
     assert np.isnan(res.disparity).all() and res.n_filled == 0
     with pytest.raises(ValueError, match=r"^confidence must be a non-empty 2-D"):
         refine_disparity(left, right, d, np.ones(60, np.float32), max_disparity=8)
+
+
+def test_min_disparity_defaults_to_zero_a_confidence_of_one_is_read_and_3d_is_named() -> None:
+    """A second mutation audit found unasserted: the default ``min_disparity`` of 0 (a pair at
+    -0.5 px refined without one keeps nothing, with -1 most pixels), a confidence of exactly 1
+    (the top of [0, 1]: the same map as no confidence) and a (1, H, W) image refused by name
+    before it reaches the kernel."""
+    rng = np.random.default_rng(0)
+    left = rng.random((40, 60), dtype=np.float32)
+    right = (left + np.roll(left, 1, axis=1)) / 2  # the left image shifted half a pixel right
+    d = np.full(left.shape, -0.5, np.float32)
+    assert np.isnan(refine_disparity(left, right, d, max_disparity=8).disparity).all()
+    wide = refine_disparity(left, right, d, min_disparity=-1, max_disparity=8)
+    assert np.isfinite(wide.disparity).mean() > 0.9
+    assert abs(float(np.nanmedian(wide.disparity)) + 0.5) < 0.01
+    shifted = np.roll(left, -3, axis=1)
+    d3 = np.full(left.shape, 3.0, np.float32)
+    one = refine_disparity(left, shifted, d3, np.ones_like(d3), max_disparity=8)
+    default = refine_disparity(left, shifted, d3, max_disparity=8)
+    np.testing.assert_array_equal(one.disparity, default.disparity)
+    np.testing.assert_array_equal(one.confidence, default.confidence)
+    with pytest.raises(ValueError, match=r"^left must be a non-empty 2-D \(H, W\) array"):
+        refine_disparity(left[None], shifted[None], d3[None], max_disparity=8)
