@@ -576,7 +576,19 @@ def test_sigmas_as_numbers_are_read(sigmas: object) -> None:
 
 
 @pytest.mark.parametrize(
-    "shape", [None, (64,), "64x128", (64.5, 128), (True, 128), (0, 5), (64, 128, 3)]
+    "shape",
+    [
+        None,
+        (64,),
+        "64x128",
+        (64.5, 128),
+        (True, 128),
+        (0, 5),
+        (64, 128, 3),
+        (0.0, 5.0),
+        (float("inf"), 128),
+        (float("nan"), 128),
+    ],
 )
 def test_matches_image_shape_must_be_two_positive_integers(tmp_path: Path, shape: object) -> None:
     # int() of each entry read 64.5 as 64 and True as 1; None, (64,) and "64x128" were a
@@ -593,7 +605,9 @@ def test_matches_image_shape_must_be_two_positive_integers(tmp_path: Path, shape
     assert sv.Matches.from_csv(path, (np.int64(64), 128)).image_shape == (64, 128)
 
 
-@pytest.mark.parametrize("shape", [(64.0, 128.0), (np.float64(64), 128), np.array([64.0, 128])])
+@pytest.mark.parametrize(
+    "shape", [(64.0, 128.0), (np.float64(64), 128), np.array([64.0, 128]), [64.0, 128.0]]
+)
 def test_matches_image_shape_of_whole_floats_is_read(tmp_path: Path, shape: object) -> None:
     # int() of each entry read (64.0, 128.0) as (64, 128), and the project takes a whole float
     # as a count (int_in_range, a calibration's image_width 1242.0); 5478200's check refused it
@@ -993,3 +1007,19 @@ def test_zncc_reference_passes_every_filter_parameter_on() -> None:
     m = mcgm.zncc_reference(left, right, max_disparity=8, **flt)
     np.testing.assert_array_equal(m.xl, none.xl[keep])
     np.testing.assert_array_equal(m.xr, none.xr[keep])
+
+
+def test_matches_nested_trace_first_index_empty_repr_and_csv_path(tmp_path: Path) -> None:
+    """A second mutation audit found unasserted: a nested energy trace read flat, ``m[-n]`` the
+    first match (not an IndexError), the empty summary's W x H order and ``save_csv`` giving a
+    Path for a str path."""
+    none: list[float] = []
+    empty = sv.Matches(
+        xl=none, yl=none, xr=none, yr=none, score=none, image_shape=(8, 30),
+        energy_trace=[[3.0, 2.0]],
+    )  # fmt: skip
+    assert empty.energy_trace.shape == (2,) and repr(empty) == "Matches(0 matches in 30x8)"
+    m = _three()
+    assert m[-3].xl.tolist() == [10.0]
+    out = m.save_csv(str(tmp_path / "m.csv"))
+    assert isinstance(out, Path) and out == tmp_path / "m.csv"
