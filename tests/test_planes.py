@@ -282,6 +282,8 @@ def test_plane_fill_refuses_labels_the_uint32_cast_would_change(labels: np.ndarr
         ("side_fill", {"tau": -1.0}),
         ("side_fill", {"tau": float("nan")}),
         ("side_fill", {"blur": 100.0}),
+        ("fill_planes", {"passes": ((0, 50),)}),
+        ("fill_planes", {"passes": ((256, 50),)}),
     ],
 )
 def test_fill_parameters_are_checked_on_a_map_without_holes(
@@ -556,3 +558,25 @@ def test_segments_clips_integer_values_to_0_255_before_the_blur(dtype: type) -> 
     img = np.full((6, 12), 255, dtype)
     img[:, 6:] = 300
     np.testing.assert_array_equal(segments(img, blur=1.0), np.zeros((6, 12), np.uint32))
+
+
+def test_segments_bounds_four_channels_and_a_wide_offset() -> None:
+    """A second mutation audit found unasserted: a step below 1 (0.5) and a negative blur
+    (-0.5, which skipped the blur) refused, ``min_size`` 0 taken, a 4-channel uint8 image and an
+    offset beyond 255 segmented as the same floats (the uint8 kernel takes neither), and a
+    2-channel image refused by side_fill by name."""
+    g = np.tile(np.arange(0, 240, 20, dtype=np.uint8), (3, 1))
+    with pytest.raises(ValueError, match=r"step must be >= 1 and blur >= 0, got step=0\.5"):
+        segments(g, blur=0, step=0.5)
+    with pytest.raises(ValueError, match=r"blur >= 0, got step=16, blur=-0\.5"):
+        segments(g, blur=-0.5)
+    np.testing.assert_array_equal(segments(g, blur=0, k=1.0, min_size=0)[0], np.arange(12))
+    want = segments(g.astype(np.float32), blur=0, offset=300)
+    np.testing.assert_array_equal(segments(g, blur=0, offset=300), want)
+    four = np.random.default_rng(0).integers(0, 256, (20, 30, 4), dtype=np.uint8)
+    got = segments(four, blur=0)
+    assert got.max() > 0
+    np.testing.assert_array_equal(got, segments(four.astype(np.float32), blur=0))
+    d = np.array([[5, np.nan, 2]], np.float32)
+    with pytest.raises(ValueError, match=r"image: expected \(H, W\) or \(H, W, 3\)"):
+        side_fill(d, np.zeros((1, 3, 2), np.uint8), blur=0)
