@@ -396,3 +396,34 @@ def test_min_disparity_defaults_to_zero_a_confidence_of_one_is_read_and_3d_is_na
     np.testing.assert_array_equal(one.confidence, default.confidence)
     with pytest.raises(ValueError, match=r"^left must be a non-empty 2-D \(H, W\) array"):
         refine_disparity(left[None], shifted[None], d3[None], max_disparity=8)
+
+
+@pytest.mark.parametrize(
+    "fills", [((2**1100, 0.3),), ((True, 0.3),), ((16.0, False),), (("16", "0.3"),)]
+)
+def test_fills_entries_are_numbers_as_every_other_parameter(fills: object) -> None:
+    """``fills`` went through ``float()``: an int past a float's range was a bare OverflowError
+    naming nothing, and True and "16" were taken as a sigma of 1 and 16, where every other
+    parameter refuses them by name (``win_sigma=True``: "must be a number")."""
+    a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    with pytest.raises(ValueError, match=r"^fills must be a sequence of \(sigma, min_score\)"):
+        refine_disparity(a, a, a, max_disparity=8, fills=fills)
+    arr = refine_disparity(a, a, a, max_disparity=8, fills=np.array([[16.0, 0.3]]))
+    np.testing.assert_array_equal(
+        arr.disparity, refine_disparity(a, a, a, max_disparity=8).disparity
+    )
+
+
+@pytest.mark.parametrize("name", ["left", "right", "disparity", "confidence"])
+def test_a_complex_array_is_named_not_cast_to_its_real_part(name: str) -> None:
+    """A complex image, map or confidence was cast to float32 with only NumPy's ComplexWarning:
+    its imaginary part dropped and a map refined from what is left."""
+    import warnings
+
+    a = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    args = {"left": a, "right": a, "disparity": a, "confidence": np.ones_like(a)}
+    args[name] = args[name] + 0.5j
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=rf"^{name} must be real numbers, got dtype complex"):
+            refine_disparity(**args, max_disparity=8)  # type: ignore[arg-type]

@@ -95,6 +95,9 @@ def _number(v: object, name: str, whole: bool = False) -> float:
 
 def _grey(a: object, name: str) -> npt.NDArray[np.float32]:
     arr = np.asarray(a)
+    # The float32 cast dropped a complex array's imaginary part with only NumPy's warning.
+    if arr.dtype.kind not in "biuf":
+        raise ValueError(f"{name} must be real numbers, got dtype {arr.dtype}")
     if arr.ndim != 2 or arr.size == 0:
         raise ValueError(f"{name} must be a non-empty 2-D (H, W) array, got shape {arr.shape}")
     return np.ascontiguousarray(arr, dtype=np.float32)
@@ -138,9 +141,10 @@ def refine_disparity(
     Raises
     ------
     ValueError
-        Shapes differ, an image is empty, not finite or has values outside ``[0, 1]``, a
-        confidence is NaN or outside ``[0, 1]`` where the disparity has a value, a parameter is
-        unknown or out of range, ``fill_plane`` not a bool.
+        Shapes differ, an array is not real (complex), an image is empty, not finite or has
+        values outside ``[0, 1]``, a confidence is NaN or outside ``[0, 1]`` where the disparity
+        has a value, a parameter is unknown, no number (a bool, a string) or out of range,
+        ``fill_plane`` not a bool.
     """
     unknown = set(params) - set(DEFAULTS)
     if unknown:
@@ -170,7 +174,9 @@ def refine_disparity(
     kw = {**DEFAULTS, **params}
     fills_raw = kw.pop("fills")
     try:
-        fills = [(float(s), float(m)) for s, m in fills_raw]  # type: ignore[attr-defined]
+        # Numbers as every other parameter: float() took True and "16" and raised a bare
+        # OverflowError for 2**1100.
+        fills = [(_number(s, "sigma"), _number(m, "min_score")) for s, m in fills_raw]  # type: ignore[attr-defined]
     except (TypeError, ValueError) as exc:
         raise ValueError(
             f"fills must be a sequence of (sigma, min_score), got {fills_raw!r}"
