@@ -1023,3 +1023,15 @@ def test_matches_nested_trace_first_index_empty_repr_and_csv_path(tmp_path: Path
     assert m[-3].xl.tolist() == [10.0]
     out = m.save_csv(str(tmp_path / "m.csv"))
     assert isinstance(out, Path) and out == tmp_path / "m.csv"
+
+
+def test_matches_complex_positions_are_named_not_cast_to_their_real_part() -> None:
+    """Complex positions or scores were cast to float32 with only NumPy's ComplexWarning: the
+    imaginary part dropped without a word."""
+    import warnings
+
+    a = np.array([1.0, 2.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"^xr: expected real values, got dtype complex128"):
+            sv.Matches(xl=a, yl=a, xr=a + 1j, yr=a, score=a, image_shape=(4, 4))

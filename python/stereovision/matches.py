@@ -27,7 +27,11 @@ _CSV_HEADER = "x_left,y_left,x_right,y_right,score"
 
 
 def _f32_1d(a: npt.ArrayLike, name: str) -> F32:
-    arr = np.ascontiguousarray(a, dtype=np.float32)
+    raw = np.asarray(a)
+    # The float32 cast dropped a complex array's imaginary part with only NumPy's warning.
+    if raw.dtype.kind not in "biuf":
+        raise ValueError(f"{name}: expected real values, got dtype {raw.dtype}")
+    arr = np.ascontiguousarray(raw, dtype=np.float32)
     if arr.ndim != 1:
         raise ValueError(f"{name}: expected a 1-D array, got shape {arr.shape}")
     return arr
