@@ -580,3 +580,25 @@ def test_segments_bounds_four_channels_and_a_wide_offset() -> None:
     d = np.array([[5, np.nan, 2]], np.float32)
     with pytest.raises(ValueError, match=r"image: expected \(H, W\) or \(H, W, 3\)"):
         side_fill(d, np.zeros((1, 3, 2), np.uint8), blur=0)
+
+
+@pytest.mark.parametrize("fill", ["plane_fill", "fill_planes", "side_fill"])
+def test_a_complex_disparity_is_named_not_cast_to_its_real_part(fill: str) -> None:
+    """A complex disparity map was cast to float32 with only NumPy's ComplexWarning: its
+    imaginary part dropped and the holes filled from what is left."""
+    import warnings
+
+    d = np.ones((8, 8)) + 0.5j
+    d[2, 2] = np.nan
+    img = np.zeros((8, 8), np.uint8)
+    call = {
+        "plane_fill": lambda: plane_fill(d, np.zeros((8, 8), np.int64), min_pixels=5),
+        "fill_planes": lambda: fill_planes(d, img),
+        "side_fill": lambda: side_fill(d, img),
+    }[fill]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(
+            ValueError, match=r"^disparity: expected real values, got dtype complex"
+        ):
+            call()

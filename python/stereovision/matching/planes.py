@@ -136,6 +136,15 @@ def _real(value: object, name: str) -> object:
     return float_sized(value, name)
 
 
+def _real_map(disparity: npt.ArrayLike) -> F32:
+    """``disparity`` as float32 after a ``ValueError`` unless its values are real: the cast
+    dropped a complex map's imaginary part with only NumPy's ComplexWarning."""
+    raw = np.asarray(disparity)
+    if raw.dtype.kind not in "biuf":
+        raise ValueError(f"disparity: expected real values, got dtype {raw.dtype}")
+    return np.ascontiguousarray(raw, dtype=np.float32)
+
+
 def _check_blur(blur: float) -> None:
     """A ``ValueError`` naming ``blur`` unless it is a sigma in ``[0, _MAX_BLUR]`` px."""
     if not 0 <= finite_number(blur, "blur") <= _MAX_BLUR:
@@ -193,13 +202,13 @@ def plane_fill(
     Raises
     ------
     ValueError
-        ``disparity`` not 2-D, ``labels`` of another shape, not integers (or booleans) or not in
-        ``0 .. H * W - 1``, a negative ``min_pixels`` or ``max_residual``, ``lo`` above ``hi``, a
-        ``max_residual``, ``lo`` or ``hi`` that is no number (or a bool).
+        ``disparity`` not 2-D or not real, ``labels`` of another shape, not integers (or booleans)
+        or not in ``0 .. H * W - 1``, a negative ``min_pixels`` or ``max_residual``, ``lo`` above
+        ``hi``, a ``max_residual``, ``lo`` or ``hi`` that is no number (or a bool).
     """
     from stereovision import _core
 
-    d = np.ascontiguousarray(disparity, dtype=np.float32)
+    d = _real_map(disparity)
     raw = np.asarray(labels)
     if d.ndim != 2:
         raise ValueError(f"disparity: expected an (H, W) array, got {d.shape}")
@@ -264,14 +273,14 @@ def fill_planes(
     Raises
     ------
     ValueError
-        ``disparity`` not 2-D, an image not 2-D or 3-D, of another size, with more than 3
-        channels, not real or with NaN/inf, ``passes`` not pairs of a step in 1-255 and a count
-        in 0 to 2**31 - 1, a ``blur`` outside [0, 64] px or a negative or non-finite
-        ``max_residual`` (checked also when ``disparity`` has no hole).
+        ``disparity`` not 2-D or not real, an image not 2-D or 3-D, of another size, with more than
+        3 channels, not real or with NaN/inf, ``passes`` not pairs of a step in 1-255 and a count in
+        0 to 2**31 - 1, a ``blur`` outside [0, 64] px or a negative or non-finite ``max_residual``
+        (checked also when ``disparity`` has no hole).
     """
     from stereovision import _core
 
-    d = np.ascontiguousarray(disparity, dtype=np.float32)
+    d = _real_map(disparity)
     if d.ndim != 2:
         raise ValueError(f"disparity: expected an (H, W) array, got {d.shape}")
     im = np.asarray(image)
@@ -354,15 +363,15 @@ def side_fill(
     Raises
     ------
     ValueError
-        ``disparity`` not 2-D, an image of another size, with a channel count other than 1 or 3,
-        not real or with NaN/inf, a negative or non-finite ``tau`` or a ``blur`` outside
+        ``disparity`` not 2-D or not real, an image of another size, with a channel count other than
+        1 or 3, not real or with NaN/inf, a negative or non-finite ``tau`` or a ``blur`` outside
         [0, 64] px (the parameters checked also when ``disparity`` has no hole).
     """
     import cv2
 
     from stereovision import _core
 
-    d = np.ascontiguousarray(disparity, dtype=np.float32)
+    d = _real_map(disparity)
     if d.ndim != 2:
         raise ValueError(f"disparity: expected an (H, W) array, got {d.shape}")
     im = np.asarray(image)
