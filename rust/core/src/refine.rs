@@ -1453,6 +1453,9 @@ mod tests {
                 };
                 base[i] = match y % 3 {
                     0 => 5.2 + 0.01 * y as f32,
+                    // A whole-pixel base: t = x + 1 - s lands on 0 and on w - 1 exactly
+                    // (s = 1), both inside.
+                    1 if y % 2 == 0 => -1.0,
                     1 => -0.6,
                     _ if x % 7 == 3 => f32::NAN,
                     _ => 4.7,
@@ -1740,5 +1743,107 @@ mod tests {
         };
         assert!(ok(pass(-0.99)) && ok(pass(0.99)));
         assert!(!ok(pass(-1.0)) && !ok(pass(1.0)));
+        // fill_max_residual: > 0, so 0 is refused and the smallest positive is taken.
+        assert!(!ok(RefineParams {
+            fill_max_residual: 0.0,
+            ..d()
+        }));
+        assert!(ok(RefineParams {
+            fill_max_residual: f32::MIN_POSITIVE,
+            ..d()
+        }));
+    }
+
+    #[test]
+    fn peak_parabola_and_mean_edge_values() {
+        // The first of equal maxima; any NaN or infinite shift: no peak.
+        assert_eq!(peak(&[0.5, 1.0, 1.0, 0.2]), Some((1, 1.0)));
+        assert_eq!(peak(&[-0.5, -0.2, -0.2]), Some((1, -0.2)));
+        assert_eq!(peak(&[0.5, f32::NAN, 1.0]), None);
+        assert_eq!(peak(&[0.5, f32::NEG_INFINITY, 1.0]), None);
+        // A weak peak (curvature -0.002) is still a peak; a flat top is not.
+        assert_eq!(parabola_offset(0.0, 0.001, 0.0), Some(0.0));
+        assert_eq!(parabola_offset(0.5, 0.5, 0.5), None);
+        // The offset is the vertex's: peak 0.25 to the right, and clamped to one shift.
+        assert_eq!(parabola_offset(0.0, 1.0, 0.5), Some(0.5 * -0.5 / -1.5));
+        assert_eq!(parabola_offset(0.0, 0.5, 0.999), Some(1.0));
+        assert_eq!(parabola_offset(0.999, 0.5, 0.0), Some(-1.0));
+        // The mean of an image (0 for none).
+        assert_eq!(image_mean(&[1.0, 2.0, 3.0, 6.0]), 3.0);
+        assert_eq!(image_mean(&[]), 0.0);
+    }
+
+    #[test]
+    fn refine_takes_a_peak_one_shift_either_side_of_the_start() {
+        // A fronto-parallel surface at 6.3 started half a pixel off either way: the peak lies
+        // one shift (0.5) from the centre and is taken, moved towards the truth.
+        let (w, h) = (64, 48);
+        let d = vec![6.3f32; w * h];
+        let (l, r) = pair_of(&d, w, h);
+        let ones = vec![1f32; w * h];
+        let p = RefineParams {
+            fills: vec![],
+            ..Default::default()
+        };
+        for off in [0.5f32, -0.5] {
+            let start: Vec<f32> = d.iter().map(|v| v + off).collect();
+            let (out, _, _) = run(&l, &r, &start, &ones, (w, h), (0.0, 16.0), &p);
+            for y in 12..36 {
+                for x in 16..48 {
+                    let v = out[y * w + x];
+                    assert!((v - 6.3).abs() < 0.25, "start {off:+}: ({x}, {y}) {v}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_range_is_inclusive_at_both_ends() {
+        // A range equal to the values' own extent keeps every one of them.
+        let (w, h) = (96, 64);
+        let (l, r, d) = slanted_pair(w, h);
+        let mut start = d.clone();
+        for y in 20..44 {
+            start[y * w + 36..y * w + 60].fill(f32::NAN);
+        }
+        let ones = vec![1f32; w * h];
+        let p = RefineParams::default();
+        let (out, _, filled) = run(&l, &r, &start, &ones, (w, h), (0.0, 16.0), &p);
+        assert!(filled > 100, "filled {filled}");
+        let vals = out.iter().filter(|v| v.is_finite());
+        let lo = vals.clone().fold(f32::INFINITY, |a, &v| a.min(v));
+        let hi = vals.fold(f32::NEG_INFINITY, |a, &v| a.max(v));
+        let (again, _, n) = run(&l, &r, &start, &ones, (w, h), (lo, hi), &p);
+        assert_eq!(n, filled);
+        let bits = |a: &[f32]| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&again), bits(&out));
+    }
+
+    #[test]
+    fn a_fill_search_of_one_takes_no_peak_at_its_ends() {
+        // fill_search 1 has the shifts -1, 0, 1: a block one pixel nearer peaks at the end
+        // (k = 0), where no parabola fits; it stays a hole.
+        let (w, h) = (96, 64);
+        let inside = |i: usize| (36..68).contains(&(i % w)) && (16..48).contains(&(i / w));
+        let interior = |i: usize| (46..58).contains(&(i % w)) && (26..38).contains(&(i / w));
+        let ones = vec![1f32; w * h];
+        for gap in [1.0f32, -1.0] {
+            let d: Vec<f32> = (0..w * h)
+                .map(|i| if inside(i) { 6.3 - gap } else { 6.3 })
+                .collect();
+            let (l, r) = pair_of(&d, w, h);
+            let start: Vec<f32> = (0..w * h)
+                .map(|i| if inside(i) { f32::NAN } else { d[i] })
+                .collect();
+            let p = RefineParams {
+                fill_search: 1,
+                ..Default::default()
+            };
+            let (out, _, _) = run(&l, &r, &start, &ones, (w, h), (0.0, 16.0), &p);
+            assert!(
+                (0..w * h).filter(|&i| interior(i)).all(|i| out[i].is_nan()),
+                "gap {gap}"
+            );
+        }
     }
 }
