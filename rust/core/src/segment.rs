@@ -836,4 +836,154 @@ mod tests {
         fill_planes(&mut two, &img, w, 1, &[(16, 1000), (16, 5)], 1.0);
         assert!((two[2 * w + 4] - 5.0).abs() < 1e-4, "{}", two[2 * w + 4]);
     }
+
+    #[test]
+    fn bins_keep_nine_bits_each() {
+        // Step 1, offset 1: 254 and 255 bin to 255 and 256, two regions (a bin cut at 255 or
+        // 8-bit fields would merge them).
+        assert_eq!(quantised_regions(&[254, 255], 2, 1, 1, 1, 1), [0, 1]);
+        // Offset 2, two channels: bins (256, 2) and (256, 3) overlap in 8-bit fields.
+        assert_eq!(quantised_regions(&[254, 0, 254, 1], 2, 1, 2, 1, 2), [0, 1]);
+        assert_eq!(quantised_regions(&[254, 0, 254, 0], 2, 1, 2, 1, 2), [0, 0]);
+    }
+
+    #[test]
+    fn a_thin_segment_two_pixels_wide_is_a_plane() {
+        // Two columns by 100 rows: the slope across is poorly conditioned (det / scale**3
+        // about 4e-7) but a plane; its holes take it.
+        let (w, h) = (2, 100);
+        let truth = |p: usize| 3.0 + 0.5 * (p % w) as f32 + 0.05 * (p / w) as f32;
+        let mut d: Vec<f32> = (0..w * h).map(truth).collect();
+        let holes = [10 * w, 50 * w + 1, 90 * w];
+        for &p in &holes {
+            d[p] = f32::NAN;
+        }
+        let labels = vec![0u32; w * h];
+        let s = plane_fill(&mut d, &labels, w, 3, 0.5, 0.0, 20.0);
+        assert_eq!(
+            s,
+            PlaneFillStats {
+                planes: 1,
+                filled: 3
+            }
+        );
+        for &p in &holes {
+            assert!(
+                (d[p] - truth(p)).abs() < 1e-3,
+                "{p}: {} vs {}",
+                d[p],
+                truth(p)
+            );
+        }
+    }
+
+    #[test]
+    fn fill_planes_odd_step_offsets_by_half_rounded_down() {
+        // Grey 1 | 2 at step 3: offset 0 bins them 0 0 (one region, a step no plane fits),
+        // offset 1 (3 / 2) bins them 0 1 (two flat regions); offset 2 would bin them 1 1.
+        let (w, h) = (8, 4);
+        let img: Vec<u8> = (0..w * h).map(|p| if p % w < 4 { 1 } else { 2 }).collect();
+        let mut d: Vec<f32> = (0..w * h)
+            .map(|p| if p % w < 4 { 2.0 } else { 8.0 })
+            .collect();
+        d[w + 1] = f32::NAN;
+        d[2 * w + 6] = f32::NAN;
+        fill_planes(&mut d, &img, w, 1, &[(3, 3)], 0.5);
+        assert_eq!((d[w + 1], d[2 * w + 6]), (2.0, 8.0));
+    }
+
+    #[test]
+    fn fill_planes_fills_from_one_measured_value() {
+        // Every measured value equal (lo == hi): the pass runs and the hole takes it.
+        let (w, h) = (5, 4);
+        let img = vec![50u8; w * h];
+        let mut d = vec![3.0f32; w * h];
+        d[2 * w + 2] = f32::NAN;
+        fill_planes(&mut d, &img, w, 1, &[(16, 5)], 1.0);
+        assert_eq!(d[2 * w + 2], 3.0);
+    }
+
+    /// The refit of one segment written out: three fits, each on the pixels whose residual to
+    /// the previous one is below max(1, 2 * upper median); the last median against
+    /// `max_residual`; values in `[lo, hi]`.
+    fn segment_ref(d: &[f32], w: usize, max_residual: f32, lo: f32, hi: f32) -> Vec<f32> {
+        let meas: Vec<usize> = (0..d.len()).filter(|&p| d[p].is_finite()).collect();
+        let pts: Vec<(f32, f32, f32)> = meas
+            .iter()
+            .map(|&p| ((p % w) as f32, (p / w) as f32, d[p]))
+            .collect();
+        let n = pts.len() as f64;
+        let cx = pts.iter().map(|p| p.0 as f64).sum::<f64>() / n;
+        let cy = pts.iter().map(|p| p.1 as f64).sum::<f64>() / n;
+        let mut keep = vec![true; pts.len()];
+        let (mut plane, mut med) = ([0.0f64; 3], 0.0f32);
+        for _ in 0..3 {
+            plane = fit_plane(&pts, &keep, cx, cy).expect("a plane");
+            let res: Vec<f32> = pts
+                .iter()
+                .map(|&(x, y, d)| {
+                    let e = plane[0] * (x as f64 - cx) + plane[1] * (y as f64 - cy) + plane[2];
+                    (e - d as f64).abs() as f32
+                })
+                .collect();
+            let mut sorted = res.clone();
+            sorted.sort_by(f32::total_cmp);
+            med = sorted[sorted.len() / 2];
+            let cut = (2.0 * med).max(1.0);
+            keep = res.iter().map(|&r| r < cut).collect();
+        }
+        let mut out = d.to_vec();
+        if med <= max_residual {
+            for (p, o) in out.iter_mut().enumerate() {
+                let (x, y) = ((p % w) as f64, (p / w) as f64);
+                let v = (plane[0] * (x - cx) + plane[1] * (y - cy) + plane[2]) as f32;
+                if !o.is_finite() && v >= lo && v <= hi {
+                    *o = v;
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn plane_fill_equals_the_three_refits_written_out() {
+        // One segment: a plane with outliers of every size (so later refits still drop some),
+        // and holes; integer-valued residuals hit the cut exactly.
+        let (w, h) = (9, 7);
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move |n: u64| {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s % n
+        };
+        let labels = vec![0u32; w * h];
+        let (mut changed, mut filled) = (0, 0);
+        for round in 0..200 {
+            let (a, b) = (next(5) as f32 - 2.0, next(5) as f32 - 2.0);
+            let d: Vec<f32> = (0..w * h)
+                .map(|p| {
+                    let v = 10.0 + a * (p % w) as f32 + b * (p / w) as f32;
+                    match next(10) {
+                        0 => f32::NAN,
+                        1 | 2 => v + next(25) as f32 - 12.0,
+                        3 => v + (next(9) as f32 - 4.0) * 0.25,
+                        _ => v,
+                    }
+                })
+                .collect();
+            let max_residual = [0.25, 1.0, 3.0][round % 3];
+            let want = segment_ref(&d, w, max_residual, -40.0, 60.0);
+            let mut got = d.clone();
+            let st = plane_fill(&mut got, &labels, w, 3, max_residual, -40.0, 60.0);
+            let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&want), "round {round}");
+            filled += st.filled;
+            changed += (bits(&got) != bits(&d)) as usize;
+        }
+        assert!(
+            changed > 50 && filled > 200,
+            "{changed} segments, {filled} holes"
+        );
+    }
 }
