@@ -232,4 +232,29 @@ mod tests {
         assert_eq!(count, vec![1, 1]);
         assert_eq!(mean, vec![14.0, 50.0]);
     }
+
+    #[test]
+    fn a_negative_difference_restarts_and_ks_must_be_finite() {
+        // The limit is on |diff|: a frame far below the mean restarts as one far above does.
+        let (mut mean, mut count) = (vec![100.0f32, 100.0], vec![2u8, 2]);
+        running_mean(&[60, 140], &mut mean, &mut count, &[-40.0, 40.0], 1, 3.0, 8).unwrap();
+        assert_eq!((count, mean), (vec![1, 1], vec![60.0, 140.0]));
+        let (mut m, mut n) = ([0.0f32; 2], [1u8, 1]);
+        for ks in [f32::INFINITY, -1.0] {
+            let e = running_mean(&[0; 2], &mut m, &mut n, &[0.0; 2], 1, ks, 8).unwrap_err();
+            assert!(e.to_string().contains("`ks`"), "{ks}: {e}");
+        }
+    }
+
+    #[test]
+    fn the_output_is_the_f32_sum_plus_one_half_truncated() {
+        // mean 1 - 2**-24 averaged with a 0 (weight 1/2) is 0.5 - 2**-25; adding 0.5 in f32
+        // rounds to 1.0, so the output is 1 (as the NumPy reference's floor(mean + 0.5)), not
+        // the 0 of rounding the mean itself.
+        let m0 = 1.0f32 - f32::EPSILON / 2.0;
+        let (mut mean, mut count) = (vec![m0], vec![1u8]);
+        let out = running_mean(&[0], &mut mean, &mut count, &[0.0], 1, 3.0, 8).unwrap();
+        assert_eq!(mean[0], 0.5 - f32::EPSILON / 4.0);
+        assert_eq!((count[0], out[0]), (2, 1));
+    }
 }
