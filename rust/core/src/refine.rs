@@ -1846,4 +1846,73 @@ mod tests {
             );
         }
     }
+
+    #[test]
+    fn every_band_row_and_the_last_pixel_are_refined() {
+        // 130 rows: two bands of rows (128 + 2); the only hole is the last pixel, the one
+        // pixel of the fill's work. Its confidence is fill_confidence's.
+        let (w, h) = (40, 130);
+        let (l, r, d) = slanted_pair(w, h);
+        let mut start = d.clone();
+        start[w * h - 1] = f32::NAN;
+        let ones = vec![1f32; w * h];
+        let p = RefineParams {
+            fill_confidence: 0.6,
+            ..Default::default()
+        };
+        let (out, oc, filled) = run(&l, &r, &start, &ones, (w, h), (0.0, 16.0), &p);
+        for y in [0, 126, 127, 128, 129] {
+            let i = y * w + 20;
+            assert!(
+                (out[i] - d[i]).abs() < 0.05,
+                "row {y}: {} vs {}",
+                out[i],
+                d[i]
+            );
+        }
+        let last = w * h - 1;
+        assert_eq!(filled, 1);
+        assert!(
+            (out[last] - d[last]).abs() < 0.1,
+            "{} vs {}",
+            out[last],
+            d[last]
+        );
+        assert_eq!(oc[last], 0.6);
+        // A start with one value, the last pixel: the second band's only work in stage 1.
+        let mut one = vec![f32::NAN; w * h];
+        one[last] = d[last];
+        let bare = RefineParams {
+            fills: vec![],
+            ..Default::default()
+        };
+        let (out, _, _) = run(&l, &r, &one, &ones, (w, h), (0.0, 16.0), &bare);
+        assert!(
+            (out[last] - d[last]).abs() < 0.1,
+            "{} vs {}",
+            out[last],
+            d[last]
+        );
+    }
+
+    #[test]
+    fn an_infinite_start_value_is_a_hole_as_nan_is() {
+        let (w, h) = (96, 64);
+        let (l, r, d) = slanted_pair(w, h);
+        let mut nan = d.clone();
+        let mut inf = d.clone();
+        for y in 20..44 {
+            for x in 30..60 {
+                nan[y * w + x] = f32::NAN;
+                inf[y * w + x] = if x % 2 == 0 { f32::INFINITY } else { f32::NAN };
+            }
+        }
+        let ones = vec![1f32; w * h];
+        let p = RefineParams::default();
+        let (a, ca, na) = run(&l, &r, &nan, &ones, (w, h), (0.0, 16.0), &p);
+        let (b, cb, nb) = run(&l, &r, &inf, &ones, (w, h), (0.0, 16.0), &p);
+        let bits = |a: &[f32]| a.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert!(na > 100, "filled {na}");
+        assert_eq!((bits(&a), bits(&ca), na), (bits(&b), bits(&cb), nb));
+    }
 }
