@@ -1347,6 +1347,18 @@ mod tests {
         let row: Vec<f32> = (0..w).map(|x| x as f32).collect();
         let (pl, _) = nc_plane(&row, w, 1, 1.0, false);
         assert!((pl[0] - 14.0 / 13.0).abs() < 1e-6, "{}", pl[0]);
+        // Nearly one line: a diagonal and one pixel beside it, all on d = x + y, still fix
+        // that plane (poorly conditioned, not degenerate); the far corner gets x + y.
+        let n = 40;
+        let mut diag = vec![f32::NAN; n * n];
+        for x in 0..n {
+            diag[x * n + x] = 2.0 * x as f32;
+        }
+        diag[21 * n + 20] = 41.0;
+        let (pl, res) = nc_plane(&diag, n, n, 16.0, true);
+        let i = (n - 1) * n;
+        assert!((pl[i] - 39.0).abs() < 1e-3, "{}", pl[i]);
+        assert!(res[i] < 1e-2, "{}", res[i]);
     }
 
     #[test]
