@@ -829,6 +829,12 @@ mod tests {
         let mut one = d.clone();
         fill_planes(&mut one, &img, w, 1, &[(16, 5)], 1.0);
         assert_eq!(one.iter().filter(|v| v.is_nan()).count(), 2 * h);
+        // An infinite value is a hole, not the range's top: the ends stay, it is filled.
+        let mut inf = d.clone();
+        inf[2 * w + 5] = f32::INFINITY;
+        fill_planes(&mut inf, &img, w, 1, &[(16, 5)], 1.0);
+        assert_eq!(inf.iter().filter(|v| v.is_nan()).count(), 2 * h);
+        assert!((inf[2 * w + 5] - 6.0).abs() < 1e-4, "{}", inf[2 * w + 5]);
         // A hole inside the range: the first pass needs 1000 measured pixels and fills
         // nothing, the second does.
         let mut two = d.clone();
@@ -985,5 +991,11 @@ mod tests {
             changed > 50 && filled > 200,
             "{changed} segments, {filled} holes"
         );
+    }
+
+    #[test]
+    #[should_panic(expected = "labels must be below the pixel count")]
+    fn a_label_at_the_pixel_count_is_refused() {
+        plane_fill(&mut [1.0, f32::NAN], &[0, 2], 2, 3, 1.0, 0.0, 9.0);
     }
 }
