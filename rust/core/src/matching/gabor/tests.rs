@@ -1051,3 +1051,325 @@ fn amplitude_thresholds_are_relative_to_the_95th_percentile() {
         .iter()
         .all(|c| c.thr2 == floor2));
 }
+
+#[test]
+fn every_parameter_bound_is_checked_and_named() {
+    // Just outside each bound: refused, naming the parameter; the bound itself: accepted.
+    let d = GaborParams::default;
+    let refused = [
+        (
+            GaborParams {
+                orientations_deg: vec![0.0; 9],
+                ..d()
+            },
+            "orientations_deg",
+        ),
+        (
+            GaborParams {
+                n_levels: Some(11),
+                ..d()
+            },
+            "n_levels",
+        ),
+        (
+            GaborParams {
+                iters_per_level: 21,
+                ..d()
+            },
+            "iters_per_level",
+        ),
+        (
+            GaborParams {
+                iters_finest: 21,
+                ..d()
+            },
+            "iters_per_level",
+        ),
+        (
+            GaborParams {
+                orientations_finest: 0,
+                ..d()
+            },
+            "orientations_finest",
+        ),
+        (
+            GaborParams {
+                lr_coarse_levels: 5,
+                ..d()
+            },
+            "lr_coarse_levels",
+        ),
+        (
+            GaborParams {
+                amp_rel_thresh: 1.01,
+                ..d()
+            },
+            "amp_rel_thresh",
+        ),
+        (
+            GaborParams {
+                amp_rel_thresh: -0.01,
+                ..d()
+            },
+            "amp_rel_thresh",
+        ),
+        (
+            GaborParams {
+                conf_min: f32::NAN,
+                ..d()
+            },
+            "conf_min",
+        ),
+        (
+            GaborParams {
+                stability_tau: 0.0,
+                ..d()
+            },
+            "stability_tau",
+        ),
+        (
+            GaborParams {
+                stability_tau: f32::INFINITY,
+                ..d()
+            },
+            "stability_tau",
+        ),
+        (
+            GaborParams {
+                smooth_sigma: Some(16.5),
+                ..d()
+            },
+            "smooth_sigma",
+        ),
+        (
+            GaborParams {
+                smooth_sigma: Some(0.0),
+                ..d()
+            },
+            "smooth_sigma",
+        ),
+        (
+            GaborParams {
+                lr_tol: -0.1,
+                ..d()
+            },
+            "lr_tol",
+        ),
+        (
+            GaborParams {
+                speckle_range: -0.1,
+                ..d()
+            },
+            "speckle_range",
+        ),
+    ];
+    for (p, name) in refused {
+        match p.validate() {
+            Err(CoreError::InvalidParameter { name: got, .. }) => assert_eq!(got, name, "{p:?}"),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+    let accepted = [
+        GaborParams {
+            d_min: -MAX_RANGE / 2.0,
+            d_max: MAX_RANGE / 2.0,
+            ..d()
+        },
+        GaborParams {
+            orientations_deg: vec![0.0; 8],
+            n_levels: Some(10),
+            iters_per_level: 20,
+            iters_finest: 20,
+            orientations_finest: 1,
+            lr_coarse_levels: 4,
+            research_radius: 16,
+            search_pool_radius: 16,
+            ..d()
+        },
+        GaborParams {
+            amp_rel_thresh: 0.0,
+            conf_min: 1.0,
+            smooth_sigma: Some(16.0),
+            lr_tol: 0.0,
+            speckle_range: 0.0,
+            ..d()
+        },
+        GaborParams {
+            amp_rel_thresh: 1.0,
+            conf_min: 0.0,
+            ..d()
+        },
+    ];
+    for p in accepted {
+        assert!(p.validate().is_ok(), "{p:?}");
+    }
+}
+
+#[test]
+fn pyramid_depth_follows_the_capture_range_and_the_top_level_size() {
+    // Defaults (F = 1/4, range 64): the top level's half-wavelength 2^(L-1) / (2 F) reaches half
+    // the range (32 px) at L = 5, if the top level stays >= 32 px wide and >= 16 px high.
+    let p = GaborParams::default();
+    assert_eq!(p.levels_for(1000, 600), 5);
+    assert_eq!(p.levels_for(512, 256), 5);
+    assert_eq!(p.levels_for(511, 600), 4, "511 >> 4 = 31 px wide");
+    assert_eq!(p.levels_for(200, 600), 3, "200 >> 3 = 25 px wide");
+    assert_eq!(p.levels_for(1000, 100), 3, "100 >> 3 = 12 px high");
+    assert_eq!(p.levels_for(40, 20), 1);
+    // F = 0.1: 5 px, 10, 20, then 40 >= 32.
+    let p = GaborParams { freq: 0.1, ..p };
+    assert_eq!(p.levels_for(1000, 600), 4);
+    // A range of 2 px (half 1 <= 2 px): one level; the widest range: capped at 10 levels.
+    let narrow = GaborParams {
+        d_max: 2.0,
+        ..GaborParams::default()
+    };
+    assert_eq!(narrow.levels_for(1000, 600), 1);
+    let wide = GaborParams {
+        d_max: 8000.0,
+        ..GaborParams::default()
+    };
+    assert_eq!(wide.levels_for(40_000, 20_000), 10);
+    // An explicit depth is taken as is.
+    let fixed = GaborParams {
+        n_levels: Some(3),
+        ..GaborParams::default()
+    };
+    assert_eq!(fixed.levels_for(40, 20), 3);
+}
+
+/// A pair with a background at 2.3 px and a 30 x 24 block at 6 px (occlusions at its sides).
+fn two_plane_pair(w: usize, h: usize) -> (Image, Image) {
+    let (bl, br) = (texture(w, h, 0.0, 31), texture(w, h, 2.3, 31));
+    let (fl, fr) = (texture(w, h, 0.0, 32), texture(w, h, 6.0, 32));
+    let (mut left, mut right) = (bl.clone(), br.clone());
+    for y in 20..44 {
+        for x in 30..60 {
+            left.data[y * w + x] = fl.data[y * w + x];
+            right.data[y * w + x - 6] = fr.data[y * w + x - 6];
+        }
+    }
+    (left, right)
+}
+
+#[test]
+fn gabor_disparity_composes_the_two_directions_the_lr_check_and_the_speckle_filter() {
+    // The output equals its definition from the two one-direction runs: the right-reference run
+    // on the mirrored, swapped pair (light parameters with lr_light; stopping lr_coarse_levels
+    // above full resolution), lr_check with lr_tol, conf >= conf_min, x - d inside the row, the
+    // speckle filter with its size and range, and the confidence (clamped) only where a
+    // disparity is left.
+    let (w, h) = (96usize, 64usize);
+    let (left, right) = two_plane_pair(w, h);
+    let chans_of = |p: &GaborParams| p.channels().unwrap();
+    let base = GaborParams {
+        d_max: 16.0,
+        ..GaborParams::default()
+    };
+    let cases = [
+        (
+            GaborParams {
+                lr_tol: 0.5,
+                speckle_size: 150,
+                ..base.clone()
+            },
+            None,
+        ),
+        (
+            GaborParams {
+                orientations_deg: vec![0.0, 30.0, -30.0, 60.0, -60.0],
+                orientations_finest: 5,
+                iters_finest: 2,
+                lr_coarse_levels: 0,
+                lr_light: true,
+                conf_min: 0.3,
+                speckle_range: 0.5,
+                ..base.clone()
+            },
+            Some((3, 1, false)),
+        ),
+        (
+            GaborParams {
+                lr_check: false,
+                speckle_size: 30,
+                ..base.clone()
+            },
+            None,
+        ),
+    ];
+    for (p, light) in cases {
+        let chans = chans_of(&p);
+        let fwd = one_direction(&left.data, &right.data, w, h, &p, &chans, 0).unwrap();
+        let (mut want, conf) = (fwd.disp.to_vec(), fwd.conf.to_vec());
+        let ok = if p.lr_check {
+            let back = match light {
+                Some((of, it, rf)) => GaborParams {
+                    orientations_finest: of,
+                    iters_finest: it,
+                    research_finest: rf,
+                    ..p.clone()
+                },
+                None => p.clone(),
+            };
+            let (fl, fr) = (
+                post::flip_x(&right.data, w, h).unwrap(),
+                post::flip_x(&left.data, w, h).unwrap(),
+            );
+            let bwd = one_direction(&fl, &fr, w, h, &back, &chans, p.lr_coarse_levels).unwrap();
+            let dr = post::flip_x(&bwd.disp, w, h).unwrap();
+            post::lr_check(&want, &dr, w, h, p.lr_tol).unwrap()
+        } else {
+            vec![true; w * h]
+        };
+        let mut lr_dropped = 0;
+        for i in 0..w * h {
+            let s = (i % w) as f32 - want[i];
+            let kept = conf[i] >= p.conf_min && s >= 0.0 && s <= (w - 1) as f32;
+            lr_dropped += usize::from(kept && !ok[i]);
+            if !(kept && ok[i]) {
+                want[i] = f32::NAN;
+            }
+        }
+        let before = want.iter().filter(|v| v.is_finite()).count();
+        post::remove_speckles(&mut want, w, h, p.speckle_size, p.speckle_range).unwrap();
+        let after = want.iter().filter(|v| v.is_finite()).count();
+        let want_conf: Vec<f32> = want
+            .iter()
+            .zip(&conf)
+            .map(|(d, c)| {
+                if d.is_finite() {
+                    c.clamp(0.0, 1.0)
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let out = gabor_disparity(&left, &right, &p).unwrap();
+        let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+        assert!(same(&out.disparity.data, &want), "disparity, {p:?}");
+        assert!(same(&out.confidence.data, &want_conf), "confidence, {p:?}");
+        // Not vacuous: the check and the filter each drop pixels, and most survive.
+        assert!(
+            (lr_dropped > 0) == p.lr_check && after < before && after > w * h / 3,
+            "{lr_dropped} dropped by the LR check, {before} -> {after} by the speckle filter"
+        );
+    }
+}
+
+#[test]
+fn a_one_level_image_still_gets_its_coarse_right_reference_run() {
+    // 40 x 20: one automatic level, yet the right-reference run stops one level above full
+    // resolution (lr_coarse_levels = 1): it builds that level anyway, so pixels survive.
+    let (left, right) = (texture(40, 20, 0.0, 9), texture(40, 20, 2.3, 9));
+    let p = GaborParams {
+        d_max: 8.0,
+        ..GaborParams::default()
+    };
+    assert_eq!(p.levels_for(40, 20), 1);
+    let out = gabor_disparity(&left, &right, &p).unwrap();
+    let (med, n) = median_of_finite(&out.disparity.data);
+    assert!(
+        n > 40 * 20 / 2 && (med - 2.3).abs() < 0.1,
+        "{n} px, median {med}"
+    );
+}
