@@ -1373,3 +1373,101 @@ fn a_one_level_image_still_gets_its_coarse_right_reference_run() {
         "{n} px, median {med}"
     );
 }
+
+#[test]
+fn search_takes_non_consecutive_offsets() {
+    // The fused kernel needs consecutive integer offsets; any other list goes to the generic
+    // kernel, which follows the definition.
+    let (w, h) = (45usize, 9usize);
+    let (left, right) = (texture(w, h, 0.0, 5), texture(w, h, 3.4, 5));
+    let chans = channels(&DEFAULT_ORIENTATIONS);
+    let ld = level_data(&left.data, w, h, &chans, 1.25, false).unwrap();
+    let rd = level_data(&right.data, w, h, &chans, 1.25, true).unwrap();
+    let base: Vec<f32> = (0..w * h)
+        .map(|i| 0.3 + ((i * 13) % 7) as f32 * 0.5)
+        .collect();
+    for offs in [vec![0.0f32, 2.0, 5.0], vec![4.0, 1.0, 3.0, 0.0]] {
+        let (want, lead) = direct_search(&ld, &rd, &base, &offs, 0);
+        let got = search::search(&ld, &rd, &base, &offs, 0).unwrap();
+        let mut compared = 0;
+        for i in (0..w * h).filter(|&i| lead[i] > 1e-5) {
+            assert_eq!(got[i], want[i], "offsets {offs:?} pixel {i}");
+            compared += 1;
+        }
+        assert!(compared > w * h * 9 / 10, "{compared} compared");
+    }
+}
+
+#[test]
+fn full_resolution_without_steps_is_the_upsampled_half_resolution_map() {
+    // With iters_finest = 0 the full-resolution level only up-samples (disparity x 2, confidence
+    // x 1), re-searches +-research_radius when research_finest, and clamps to the scaled range
+    // +-1 px: the run stopping one level above full resolution, then up-sampled, gives the rest.
+    let (w, h) = (96usize, 64usize);
+    let (left, right) = two_plane_pair(w, h);
+    let base = GaborParams {
+        d_max: 16.0,
+        iters_finest: 0,
+        lr_check: false,
+        ..GaborParams::default()
+    };
+    let chans = base.channels().unwrap();
+    let coarse = one_direction(&left.data, &right.data, w, h, &base, &chans, 1).unwrap();
+    let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    let (lo, hi) = (base.d_min - 1.0, base.d_max + 1.0);
+    for research in [false, true] {
+        let p = GaborParams {
+            research_finest: research,
+            ..base.clone()
+        };
+        let fine = one_direction(&left.data, &right.data, w, h, &p, &chans, 0).unwrap();
+        let mut want = coarse.disp.to_vec();
+        if research {
+            let c0 = &chans[..p.orientations_finest];
+            let ld = level_data(&left.data, w, h, c0, p.stability_tau, false).unwrap();
+            let rd = level_data(&right.data, w, h, c0, p.stability_tau, true).unwrap();
+            let offs: Vec<f32> = (-3..=3).map(|k| k as f32).collect();
+            want = search::search(&ld, &rd, &want, &offs, 0).unwrap().to_vec();
+        }
+        want.iter_mut().for_each(|d| *d = d.clamp(lo, hi));
+        assert!(same(&fine.disp, &want), "disparity, research {research}");
+        assert!(
+            same(&fine.conf, &coarse.conf),
+            "confidence, research {research}"
+        );
+        let moved = want
+            .iter()
+            .zip(coarse.disp.iter())
+            .filter(|(a, b)| a != b)
+            .count();
+        assert!((moved > 0) == research, "{moved} moved");
+    }
+}
+
+#[test]
+fn channel_bounds_are_exclusive_or_inclusive_as_documented() {
+    // freq in (0, 0.5), bandwidth in (0.05, 4], aspect in (0.1, 10], |theta| < 90; each refusal
+    // names its parameter.
+    let refused = [
+        (0.5, 0.0, 1.5, 1.0, "freq"),
+        (0.25, 0.0, 4.01, 1.0, "bandwidth_oct"),
+        (0.25, 0.0, 0.05, 1.0, "bandwidth_oct"),
+        (0.25, 0.0, 1.5, 0.1, "aspect"),
+        (0.25, 0.0, 1.5, 10.01, "aspect"),
+        (0.25, -90.0, 1.5, 1.0, "orientations_deg"),
+    ];
+    for (f, t, b, a, name) in refused {
+        match filter::Channel::new(f, t, b, a) {
+            Err(CoreError::InvalidParameter { name: got, .. }) => assert_eq!(got, name),
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+    for (f, t, b, a) in [
+        (0.49, 89.9, 4.0, 1.0),
+        (0.25, -89.9, 0.06, 1.0),
+        (0.25, 0.0, 1.5, 10.0),
+        (0.25, 0.0, 1.5, 0.11),
+    ] {
+        assert!(filter::Channel::new(f, t, b, a).is_ok(), "{f} {t} {b} {a}");
+    }
+}
