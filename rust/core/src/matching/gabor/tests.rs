@@ -1471,3 +1471,68 @@ fn channel_bounds_are_exclusive_or_inclusive_as_documented() {
         assert!(filter::Channel::new(f, t, b, a).is_ok(), "{f} {t} {b} {a}");
     }
 }
+
+#[test]
+fn one_direction_is_the_top_search_then_the_newton_steps_by_their_definition() {
+    // A range of non-integer ends: the top level searches every whole offset from
+    // d_min * scale to ceil((d_max - d_min) * scale) above it, clamps to the scaled range +-1 px;
+    // a Newton step is newton_step, normalised convolution with the envelope's sigma_x, the
+    // update where cbar >= conf_min, the 5 x 5 median, and the confidence max(0, cbar).
+    let (w, h) = (96usize, 64usize);
+    let (left, right) = two_plane_pair(w, h);
+    let base = GaborParams {
+        d_min: -2.5,
+        d_max: 9.7,
+        n_levels: Some(1),
+        iters_per_level: 0,
+        iters_finest: 0,
+        research_finest: false,
+        lr_check: false,
+        ..GaborParams::default()
+    };
+    let chans = base.channels().unwrap();
+    let same = |a: &[f32], b: &[f32]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    let top = |img_l: &[f32], img_r: &[f32], lw, lh, scale: f32, cs: &[filter::Channel]| {
+        let ld = level_data(img_l, lw, lh, cs, base.stability_tau, false).unwrap();
+        let rd = level_data(img_r, lw, lh, cs, base.stability_tau, true).unwrap();
+        let n = ((base.d_max - base.d_min) * scale).ceil() as usize;
+        let offs: Vec<f32> = (0..=n).map(|k| k as f32).collect();
+        let init = vec![base.d_min * scale; lw * lh];
+        let (lo, hi) = (base.d_min * scale - 1.0, base.d_max * scale + 1.0);
+        let mut d = search::search(&ld, &rd, &init, &offs, 0).unwrap().to_vec();
+        d.iter_mut().for_each(|v| *v = v.clamp(lo, hi));
+        (d, ld, rd)
+    };
+    // One level, no step: the search alone (full resolution uses the first orientation).
+    let (d0, ld, rd) = top(&left.data, &right.data, w, h, 1.0, &chans[..1]);
+    let got = one_direction(&left.data, &right.data, w, h, &base, &chans, 0).unwrap();
+    assert!(same(&got.disp, &d0) && got.conf.iter().all(|&c| c == 0.0));
+    // One Newton step.
+    let p = GaborParams {
+        iters_finest: 1,
+        ..base.clone()
+    };
+    let cc = chan_consts(&chans[..1], &ld, &rd, p.amp_rel_thresh);
+    let (delta, c) = newton_step(&ld, &rd, &cc, &d0).unwrap();
+    let (dbar, cbar) = post::normalized_conv(&delta, &c, w, h, chans[0].sigma_x).unwrap();
+    let mut d1 = d0.clone();
+    post::apply_update(&mut d1, &dbar, &cbar, p.conf_min, -3.5, 10.7, w);
+    let d1 = post::median5(&d1, w, h).unwrap();
+    let got = one_direction(&left.data, &right.data, w, h, &p, &chans, 0).unwrap();
+    assert!(same(&got.disp, &d1), "after a Newton step");
+    let conf: Vec<f32> = cbar.iter().map(|&v| v.max(0.0)).collect();
+    assert!(same(&got.conf, &conf));
+    assert!(d1.iter().zip(&d0).filter(|(a, b)| a != b).count() > w * h / 2);
+    // Two levels, no step: the half-resolution search (all orientations) up-sampled.
+    let p = GaborParams {
+        n_levels: Some(2),
+        ..base.clone()
+    };
+    let (l1, w1, h1) = filter::pyr_down(&left.data, w, h).unwrap();
+    let (r1, _, _) = filter::pyr_down(&right.data, w, h).unwrap();
+    let (dh, _, _) = top(&l1, &r1, w1, h1, 0.5, &chans);
+    let mut want = post::upsample(&dh, w1, h1, w, h, 2.0).unwrap().to_vec();
+    want.iter_mut().for_each(|v| *v = v.clamp(-3.5, 10.7));
+    let got = one_direction(&left.data, &right.data, w, h, &p, &chans, 0).unwrap();
+    assert!(same(&got.disp, &want), "two levels");
+}
