@@ -874,7 +874,8 @@ fn stability_bits_follow_the_fleet_jepson_test() {
     // Re psi = (ln |y(x+1)|^2 - ln |y(x-1)|^2) / 4; never on the first and last columns.
     let (w, h) = (40usize, 6usize);
     let img = texture(w, h, 0.0, 21);
-    let chans = channels(&DEFAULT_ORIENTATIONS[..2]);
+    // Three channels: each has its own bit.
+    let chans = channels(&DEFAULT_ORIENTATIONS);
     let tau = 0.6;
     let ld = level_data(&img.data, w, h, &chans, tau, false).unwrap();
     let (mut set, mut clear) = (0, 0);
@@ -1474,7 +1475,7 @@ fn channel_bounds_are_exclusive_or_inclusive_as_documented() {
 
 #[test]
 fn one_direction_is_the_top_search_then_the_newton_steps_by_their_definition() {
-    // A range of non-integer ends: the top level searches every whole offset from
+    // A range of non-integer ends and an elongated envelope: the top level searches every whole offset from
     // d_min * scale to ceil((d_max - d_min) * scale) above it, clamps to the scaled range +-1 px;
     // a Newton step is newton_step, normalised convolution with the envelope's sigma_x, the
     // update where cbar >= conf_min, the 5 x 5 median, and the confidence max(0, cbar).
@@ -1483,6 +1484,8 @@ fn one_direction_is_the_top_search_then_the_newton_steps_by_their_definition() {
     let base = GaborParams {
         d_min: -2.5,
         d_max: 9.7,
+        // sigma_x != sigma_y: the smoothing uses sigma_x.
+        aspect: 1.5,
         n_levels: Some(1),
         iters_per_level: 0,
         iters_finest: 0,
