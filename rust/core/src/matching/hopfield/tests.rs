@@ -544,3 +544,293 @@ fn rescue_repeats_until_no_match_is_added() {
         [false, true, true, true, true, true]
     );
 }
+
+/// [`texture`] quantised to sixteenths: window sums are exact, so equal windows give
+/// bit-identical ZNCC values and means.
+fn quantised(w: usize, h: usize, seed: u64) -> Vec<f32> {
+    texture(w, h, seed)
+        .into_iter()
+        .map(|v| (v * 16.0).round() / 16.0)
+        .collect()
+}
+
+/// The candidates of one left point `(x, y)` by [`point_candidates`], in points mode against
+/// every column of the rows `y - dy_window ..= y + dy_window` (all disparities offered).
+fn one_point(l: &Image, r: &Image, p: &HopfieldParams, (x, y): (u32, u32)) -> Vec<Neuron> {
+    let (lv, rv) = (ImageView::from(l), ImageView::from(r));
+    let stats = RightStats::new(&rv);
+    let rows: HashMap<usize, Vec<usize>> = (y as usize - p.dy_window..=y as usize + p.dy_window)
+        .map(|yr| (yr, (0..x as usize).collect()))
+        .collect();
+    let pt = InterestPoint { x, y, value: 1.0 };
+    let mut out = Vec::new();
+    let mut sc = CandScratch::default();
+    point_candidates(&lv, &rv, &stats, &rows, p, 0, &pt, &mut sc, &mut out);
+    out
+}
+
+/// Points mode keeps a right point whose ZNCC equals `s_min` exactly (`>=`): with `s_min` set
+/// to each candidate's similarity, the candidates are those at or above it.
+#[test]
+fn points_mode_keeps_a_candidate_at_exactly_s_min() {
+    let (l, r) = shifted_pair(80, 40, 5);
+    let all_p = HopfieldParams {
+        candidates: CandidateMode::Points,
+        s_min: -1.0,
+        k_cand: 1000,
+        ..params(30)
+    };
+    let all = one_point(&l, &r, &all_p, (50, 20));
+    assert!(all.len() > 50, "{}", all.len());
+    for v in [all[0].sim, all[3].sim, all[10].sim] {
+        let p = HopfieldParams {
+            s_min: v,
+            ..all_p.clone()
+        };
+        let want: Vec<Neuron> = all.iter().copied().filter(|n| n.sim >= v).collect();
+        assert_eq!(one_point(&l, &r, &p, (50, 20)), want, "s_min {v}");
+    }
+}
+
+/// Candidates of equal similarity (a texture periodic in x, period 8, and in y, period 2) are
+/// ordered by `xr`, then by `yr`, both ascending.
+#[test]
+fn tied_candidates_are_ordered_by_xr_then_yr() {
+    let (w, h) = (90, 30);
+    let tile = quantised(8, 2, 3);
+    let img = |shift: usize| -> Image {
+        let v = (0..w * h)
+            .map(|i| tile[(i / w % 2) * 8 + (i % w + shift) % 8])
+            .collect();
+        Image::new(w, h, v).unwrap()
+    };
+    let (l, r) = (img(0), img(3));
+    for mode in [CandidateMode::Row, CandidateMode::Points] {
+        let p = HopfieldParams {
+            candidates: mode,
+            s_min: 0.5,
+            k_cand: 1000,
+            ..params(40)
+        };
+        let ns = one_point(&l, &r, &p, (60, 15));
+        let key = |n: &Neuron| (-n.sim, n.xr, n.yr);
+        let xr_ties = ns
+            .windows(2)
+            .filter(|w| w[0].sim == w[1].sim && w[0].xr != w[1].xr)
+            .count();
+        assert!(xr_ties >= 3, "{mode:?}: {ns:?}");
+        if mode == CandidateMode::Points {
+            let yr_ties = ns
+                .windows(2)
+                .filter(|w| w[0].sim == w[1].sim && w[0].xr == w[1].xr)
+                .count();
+            assert!(yr_ties >= 3, "{ns:?}");
+        }
+        for w in ns.windows(2) {
+            assert!(
+                key(&w[0]) < key(&w[1]),
+                "{mode:?}: {:?} then {:?}",
+                w[0],
+                w[1]
+            );
+        }
+    }
+}
+
+/// The centre check allows a difference equal to `centre_tol` (`<=`): at the true disparity of
+/// an exact shift the windows are equal, the difference is 0, and `centre_tol` 0 passes.
+#[test]
+fn centre_check_passes_a_difference_equal_to_the_tolerance() {
+    let (w, h, s) = (100, 50, 6);
+    let base = quantised(w + s, h, 7);
+    let crop = |o: usize| -> Image {
+        let v = (0..w * h)
+            .map(|i| base[(i / w) * (w + s) + i % w + o])
+            .collect();
+        Image::new(w, h, v).unwrap()
+    };
+    let (l, r) = (crop(0), crop(s));
+    let p = HopfieldParams {
+        centre_tol: 0.0,
+        s_min: 0.0,
+        ..params(16)
+    };
+    let (_, ns) = candidate_neurons(&l, &r, &p).unwrap();
+    let at_true: Vec<&Neuron> = ns.iter().filter(|n| n.dx() == s as i32).collect();
+    assert!(at_true.len() > 50, "{}", at_true.len());
+    assert!(at_true.iter().all(|n| n.centre_ok));
+    // Elsewhere the centre pixels differ.
+    assert!(ns.iter().any(|n| !n.centre_ok));
+}
+
+/// The half-window verdict, similarity and sub-pixel offset of every candidate equal their
+/// definition on the ZNCC curves: a half fails when its best over `d_min..=d_hi` is not
+/// positive (a textureless half: the left quarter of the image is flat) or when its best within
+/// `edge_tol` of the candidate, clipped to the range, is more than `edge_margin` below it.
+#[test]
+fn half_window_verdicts_equal_the_definition() {
+    let (w, h, s) = (100, 40, 6);
+    let mut base = quantised(w + s, h, 5);
+    for (i, v) in base.iter_mut().enumerate() {
+        if i % (w + s) < 30 {
+            *v = 0.5;
+        }
+    }
+    let crop = |o: usize| -> Image {
+        let v = (0..w * h)
+            .map(|i| base[(i / w) * (w + s) + i % w + o])
+            .collect();
+        Image::new(w, h, v).unwrap()
+    };
+    let (l, r) = (crop(0), crop(s));
+    let (lv, rv) = (ImageView::from(&l), ImageView::from(&r));
+    let stats = RightStats::new(&rv);
+    let pts: Vec<InterestPoint> = (3..h as u32 - 3)
+        .flat_map(|y| (3..w as u32 - 3).map(move |x| InterestPoint { x, y, value: 1.0 }))
+        .collect();
+    let configs = [
+        params(16),
+        HopfieldParams {
+            d_min: s + 1,
+            s_min: 0.0,
+            ..params(16)
+        },
+        HopfieldParams {
+            edge_tol: 0,
+            s_min: 0.3,
+            ..params(16)
+        },
+        HopfieldParams {
+            edge_margin: 0.1,
+            s_min: 0.3,
+            ..params(16)
+        },
+    ];
+    let mut textureless = 0;
+    for p in &configs {
+        let ns = candidates(&lv, &rv, &pts, p).unwrap();
+        assert!(ns.len() > 500, "{}", ns.len());
+        let mut cv = Curves::default();
+        for n in &ns {
+            let (x, y, d) = (n.xl as usize, n.yl as usize, n.dx() as usize);
+            let d_hi = p.d_max.min(x - SIM_RADIUS);
+            zncc_curves(&lv, &rv, &stats, x, y, n.yr as usize, d_hi, &mut cv);
+            let top = |k: usize, a: usize, b: usize| {
+                cv.curve[k][a..=b].iter().copied().fold(f32::MIN, f32::max)
+            };
+            let lo = d.saturating_sub(p.edge_tol).max(p.d_min);
+            let hi = (d + p.edge_tol).min(d_hi);
+            let mut want = 0u8;
+            for k in 0..4 {
+                let best = top(k + 1, p.d_min, d_hi);
+                textureless += usize::from(best == 0.0);
+                if !(best > 0.0 && top(k + 1, lo, hi) >= best - p.edge_margin) {
+                    want |= 1 << k;
+                }
+            }
+            let full = &cv.curve[FULL];
+            let sub = if d >= 1 && d < d_hi {
+                parabola(full[d - 1], full[d], full[d + 1])
+            } else {
+                0.0
+            };
+            assert_eq!(
+                (n.halves_fail, n.sim, n.sub),
+                (want, full[d], sub),
+                "{n:?} {p:?}"
+            );
+            assert_eq!(n.edge_ok, want == 0 && n.centre_ok);
+        }
+    }
+    assert!(textureless > 10, "{textureless}");
+}
+
+/// The rescue compares the side's median with the match's sub-pixel disparity: side at 11.0,
+/// match at 10 + 0.4 (0.6 away: kept; its integer disparity is 1.0 away).
+#[test]
+fn rescue_compares_the_side_median_with_the_subpixel_disparity() {
+    let mut ns = vec![neuron(0, (100, 100), 10, 0.4, false)];
+    for (k, xy) in [(90, 100), (92, 100), (94, 104)].into_iter().enumerate() {
+        ns.push(neuron(1 + k as u32, xy, 11, 0.0, true));
+    }
+    let chosen: Vec<usize> = (0..ns.len()).collect();
+    assert_eq!(rescue(&ns, &chosen, &HopfieldParams::default()), [true; 4]);
+}
+
+/// Sparse areas: exactly `min_agree_sparse` = 2 agreeing neighbours (all of them) suffice.
+#[test]
+fn finish_keeps_sparse_matches_with_exactly_min_agree_sparse_neighbours() {
+    let img = Image::filled(400, 200, 0.5);
+    let v = ImageView::from(&img);
+    let ns: Vec<Neuron> = (0..3)
+        .map(|k| neuron(k, (300 + 2 * k as i32, 100), 10, 0.0, true))
+        .collect();
+    let out = finish(&v, &v, &ns, &[0, 1, 2], &HopfieldParams::default());
+    assert_eq!(out.len(), 3);
+}
+
+/// A conflict far from every single match (none in its window) is resolved against the median
+/// vertical disparity of all singles (2 here), not 0: the lower-similarity candidate at dy 2.
+#[test]
+fn disambiguation_without_local_singles_uses_the_global_median() {
+    let at = |point: u32, x: i32, dy: i32, sim: f32| Neuron {
+        yr: 100 - dy,
+        sim,
+        ..neuron(point, (x, 100), 10, 0.0, true)
+    };
+    let ns = vec![
+        at(0, 300, 2, 0.9),
+        at(1, 304, 2, 0.9),
+        at(2, 308, 1, 0.9),
+        at(3, 100, 0, 0.95),
+        at(3, 100, 2, 0.85),
+    ];
+    let p = HopfieldParams::default();
+    let net = Network::new(&ns, &p.weights);
+    assert_eq!(disambiguate(&ns, &net, &[1, 1, 1, 1, 1], &p), [0, 1, 2, 4]);
+}
+
+/// Fallback thresholds at equality: an active alternative with support equal to
+/// `fallback_alt_support` is not weak (`<`); a best candidate with support equal to
+/// `fallback_min_support` is (`>=`). Both supports are 0 (no other active neuron).
+#[test]
+fn fallback_support_thresholds_at_equality() {
+    let p = HopfieldParams {
+        fallback_alt_support: 0.0,
+        fallback_min_support: 0.0,
+        fallback_group: false,
+        ..HopfieldParams::default()
+    };
+    let ns = vec![
+        neuron(0, (100, 100), 10, 0.0, true),
+        neuron(0, (100, 100), 30, 0.0, true),
+    ];
+    let net = Network::new(&ns, &p.weights);
+    assert_eq!(fallback(&ns, &net, &[0, 1], &p), [0, 1]);
+    let one = vec![neuron(0, (100, 100), 10, 0.0, true)];
+    let net = Network::new(&one, &p.weights);
+    assert_eq!(fallback(&one, &net, &[0], &p), [1]);
+}
+
+/// The group fallback takes lone points only: one candidate that passed the edge test. Ten
+/// agreeing points, all off; the first fails the edge test, or has a second candidate: it stays
+/// off, the other nine (more than `min_agree` = 8) come back.
+#[test]
+fn group_fallback_skips_edge_failures_and_points_with_several_candidates() {
+    let p = HopfieldParams::default();
+    let row = || -> Vec<Neuron> {
+        (0..10)
+            .map(|k| neuron(k, (100 + 2 * k as i32, 100), 10, 0.0, true))
+            .collect()
+    };
+    let mut edge = row();
+    edge[0].edge_ok = false;
+    let net = Network::new(&edge, &p.weights);
+    let out = fallback(&edge, &net, &[0; 10], &p);
+    assert_eq!(out, [0, 1, 1, 1, 1, 1, 1, 1, 1, 1]);
+    let mut two = row();
+    two.insert(1, neuron(0, (100, 100), 30, 0.0, true));
+    let net = Network::new(&two, &p.weights);
+    let out = fallback(&two, &net, &[0; 11], &p);
+    assert_eq!(out, [0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1]);
+}
