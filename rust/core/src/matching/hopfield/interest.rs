@@ -357,6 +357,33 @@ mod tests {
         }
     }
 
+    /// The general neighbourhood (`nms_half` 3) reaches the map's last column and row: a
+    /// larger value there, 3 px from a candidate at `x = w - 4` (or `y = h - 4`), suppresses it;
+    /// a lone value away from the edges stays.
+    #[test]
+    fn neighbourhood_reaches_the_last_column_and_row() {
+        let (w, h) = (20, 20);
+        let mut m = vec![0.0f32; w * h];
+        for (x, y, v) in [
+            (16, 5, 1.0),
+            (19, 5, 2.0),
+            (5, 16, 1.0),
+            (5, 19, 2.0),
+            (8, 8, 1.0),
+        ] {
+            m[y * w + x] = v;
+        }
+        let p = InterestParams {
+            nms_half: 3,
+            ..InterestParams::default()
+        };
+        let got: Vec<(u32, u32)> = select_points(&m, w, h, &p)
+            .iter()
+            .map(|q| (q.x, q.y))
+            .collect();
+        assert_eq!(got, [(8, 8)]);
+    }
+
     /// Deterministic integers in `0..levels`.
     fn noise(n: usize, seed: u64, levels: u64) -> Vec<u64> {
         let mut s = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
