@@ -1098,6 +1098,47 @@ mod tests {
 
     /// The largest value for every length around the lane width, negative values included;
     /// `f32::MIN` for none.
+    /// The textureless limit [`MIN_WINDOW_STD`] on both sides: a checkerboard `0.5 +- a` (every
+    /// region's standard deviation within 0.2 % of `a`) is defined at `a = 1.2e-3` (ZNCC 1
+    /// against itself), undefined (0) at `a = 0.8e-3`, on the left or on the right.
+    #[test]
+    fn textureless_limit_is_the_window_standard_deviation() {
+        let (w, h) = (20, 16);
+        let board = |a: f32| -> Vec<f32> {
+            (0..w * h)
+                .map(|i| {
+                    if (i % w + i / w) % 2 == 0 {
+                        0.5 + a
+                    } else {
+                        0.5 - a
+                    }
+                })
+                .collect()
+        };
+        let (hi, lo) = (board(1.2e-3), board(0.8e-3));
+        let mut c = Curves::default();
+        for (left, right, defined) in [(&hi, &hi, true), (&lo, &hi, false), (&hi, &lo, false)] {
+            let (lv, rv) = (
+                ImageView::new(w, h, left).expect("valid"),
+                ImageView::new(w, h, right).expect("valid"),
+            );
+            let stats = RightStats::new(&rv);
+            for k in 0..N_REGIONS {
+                let inv = stats.inv_norms(k, 8)[10];
+                assert_eq!(inv > 0.0, std::ptr::eq(right, &hi), "region {k}");
+            }
+            zncc_curves(&lv, &rv, &stats, 10, 8, 8, 2, &mut c);
+            for k in 0..N_REGIONS {
+                let v = c.curve[k][0];
+                if defined {
+                    assert!((v - 1.0).abs() < 1e-3, "region {k}: {v}");
+                } else {
+                    assert_eq!(v, 0.0, "region {k}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn max_of_is_the_largest_value() {
         assert_eq!(max_of(&[]), f32::MIN);
