@@ -1997,4 +1997,77 @@ mod tests {
         assert_eq!((d.sweeps, d.converged), (2, true));
         assert_eq!(d.energy_trace, vec![0.5, -0.5, -0.5]);
     }
+
+    /// Support: the positive weights from active neurons only. With a negative `B` (-1) the
+    /// point's other candidate and the candidate sharing the right pixel weigh +1 each, and count
+    /// only when on; the window neighbour (4 px away, same disparity) adds `A C(0)` with the
+    /// crossing at `2 + 0.05 * 4` (one neighbour each: `n` = 1).
+    #[test]
+    fn support_counts_positive_weights_of_active_neurons_only() {
+        let nrn = |point: u32, x: i32, d: i32| Neuron {
+            point,
+            xl: x,
+            yl: 10,
+            xr: x - d,
+            yr: 10,
+            sim: 0.8,
+            edge_ok: true,
+            halves_fail: 0,
+            centre_ok: true,
+            sub: 0.0,
+        };
+        // 0, 1: one point; 2 shares 0's right pixel (100 px away); 3 is 0's window neighbour.
+        let neurons = [
+            nrn(0, 50, 10),
+            nrn(0, 50, 30),
+            nrn(1, 150, 110),
+            nrn(2, 54, 10),
+        ];
+        let w = EnergyWeights {
+            b: -1.0,
+            ..EnergyWeights::default()
+        };
+        let net = Network::new(&neurons, &w);
+        let support = |state: [u8; 4]| net.support(0, &state, &net.lane_state(&state));
+        let c = (3.0 * compat(0.0, 2.0 + 0.05 * 4.0, 2.0) as f32) as f64;
+        assert_eq!(support([1, 0, 0, 0]), 0.0);
+        assert_eq!(support([0, 1, 0, 0]), 1.0);
+        assert_eq!(support([0, 1, 1, 0]), 2.0);
+        assert!(
+            (support([0, 0, 0, 1]) - c).abs() < 1e-6,
+            "{}",
+            support([0, 0, 0, 1])
+        );
+        assert!((support([1, 1, 1, 1]) - (2.0 + c)).abs() < 1e-6);
+    }
+
+    /// The compatibility table reaches the largest squared disparity-vector difference of the
+    /// neurons (here 3^2 = 9: same horizontal disparity, vertical ones 0 and 3), read as
+    /// `C(3)`; a gentle sigmoid (slope 0.5, crossing 10 + 0.05 * 4) keeps it far from -1.
+    #[test]
+    fn compatibility_reads_the_full_disparity_difference() {
+        let nrn = |point: u32, x: i32, dy: i32| Neuron {
+            point,
+            xl: x,
+            yl: 10,
+            xr: x - 5,
+            yr: 10 - dy,
+            sim: 0.8,
+            edge_ok: true,
+            halves_fail: 0,
+            centre_ok: true,
+            sub: 0.0,
+        };
+        let neurons = [nrn(0, 50, 0), nrn(1, 54, 3)];
+        let w = EnergyWeights {
+            compat_theta: 10.0,
+            compat_slope: 0.5,
+            ..EnergyWeights::default()
+        };
+        let net = Network::new(&neurons, &w);
+        let state = [0u8, 1];
+        let got = net.support(0, &state, &net.lane_state(&state));
+        let want = (3.0 * compat(3.0, 10.0 + 0.05 * 4.0, 0.5) as f32) as f64;
+        assert!((got - want).abs() < 1e-6, "{got} vs {want}");
+    }
 }
