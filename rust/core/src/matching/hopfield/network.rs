@@ -2070,4 +2070,24 @@ mod tests {
         let want = (3.0 * compat(3.0, 10.0 + 0.05 * 4.0, 0.5) as f32) as f64;
         assert!((got - want).abs() < 1e-6, "{got} vs {want}");
     }
+
+    /// The window of `for_each_in_window` is closed: points exactly `half` away in x or in y
+    /// are in it, one further are not.
+    #[test]
+    fn window_visits_points_exactly_half_away() {
+        let pxy = [
+            (10, 10),
+            (10, 15),
+            (15, 10),
+            (10, 16),
+            (16, 10),
+            (5, 5),
+            (4, 10),
+        ];
+        let grid = PointGrid::new(&pxy, 5);
+        let mut got = Vec::new();
+        grid.for_each_in_window((10, 10), 5, |k| got.push(k));
+        got.sort_unstable();
+        assert_eq!(got, [0, 1, 2, 5]);
+    }
 }
