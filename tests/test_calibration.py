@@ -340,7 +340,8 @@ def test_from_middlebury_with_doffs(tmp_path: Path) -> None:
     # the image size: a whole number of pixels, named with its file (inf was an OverflowError,
     # nan a bare "cannot convert float NaN to integer", 713.7 read as 713)
     cams = "cam0=[1 0 0; 0 1 0; 0 0 1]\ncam1=[1 0 0; 0 1 0; 0 0 1]\nbaseline=5\n"
-    for width, shown in (("inf", "inf"), ("nan", "nan"), ("713.7", "713.7"), ("-4", "-4")):
+    sizes = (("inf", "inf"), ("nan", "nan"), ("713.7", "713.7"), ("-4", "-4"), ("0", "0"))
+    for width, shown in sizes:
         (tmp_path / "size.txt").write_text(f"{cams}width={width}\nheight=3\n")
         with pytest.raises(ValueError, match=rf"width in .*size\.txt: expected a positive whole "
                            rf"number of pixels, got {shown}$"):  # fmt: skip
@@ -1549,3 +1550,65 @@ def test_alpha_out_of_range_is_refused_whatever_the_calibration(
             c.rectified_calibration(alpha)  # type: ignore[arg-type]
     else:  # OpenCV's scaling: any finite number
         assert c.rectified_calibration(alpha).rectified
+
+
+# ------------------------------------------------------------ second mutation audit (round 2)
+
+
+def test_a_fisheye_rig_scaled_stays_fisheye_and_differs_from_its_pinhole_twin() -> None:
+    """scaled_to dropping ``model`` made a scaled fisheye rig a pinhole one (4 coefficients
+    are a valid pinhole D), and == ignoring ``model`` called the two the same rig."""
+    d = np.array([0.05, -0.01, 0.002, -0.0005])
+    fish = raw_calib(D1=d, D2=d, model="fisheye")
+    half = fish.scaled_to((160, 120))
+    assert half.model == "fisheye" and np.array_equal(half.D1, d)
+    assert fish != raw_calib(D1=d, D2=d) and fish == raw_calib(D1=d, D2=d, model="fisheye")
+
+
+def test_rectify_remaps_both_images_bilinearly() -> None:
+    """rectify's documented cv2.remap interpolation is bilinear, for the right image too."""
+    c = raw_calib()
+    rng = np.random.default_rng(5)
+    left = rng.integers(0, 256, (SIZE[1], SIZE[0]), dtype=np.uint8)
+    right = rng.integers(0, 256, (SIZE[1], SIZE[0]), dtype=np.uint8)
+    m1x, m1y, m2x, m2y = c._maps(0.0)
+    rl, rr = c.rectify(left, right)
+    assert np.array_equal(rl, cv2.remap(left, m1x, m1y, cv2.INTER_LINEAR))
+    assert np.array_equal(rr, cv2.remap(right, m2x, m2y, cv2.INTER_LINEAR))
+
+
+def test_a_rig_mostly_vertical_is_refused_and_not_warned_swapped() -> None:
+    """A baseline 53 degrees from the rows (T = (-6, -8, 0) cm) is rectified by OpenCV to a
+    vertical one: refused as vertical. A vertical rig whose small T[0] is positive is not a
+    left-right pair the other way round: no 'swapped' warning."""
+    import warnings
+
+    with pytest.raises(ValueError, match=r"^R, T: the rig is vertical \(stereoRectify"):
+        raw_calib(T=np.array([-0.06, -0.08, 0.0])).rectified_calibration()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        raw_calib(T=np.array([0.01, -0.12, 0.0]))
+    with pytest.warns(UserWarning, match="the right camera sits to the left"):
+        raw_calib(T=np.array([0.12, 0.0, 0.0]))
+
+
+def test_describe_at_a_doffs_that_puts_a_disparity_at_infinity() -> None:
+    """doffs -64 px: a disparity of 64 px is at infinity, no nearest depth (it divided by
+    zero); doffs -1 px: 1 px is at infinity, the farthest depth is at 2 px."""
+    k1 = np.array([[500.0, 0.0, 160.0], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]])
+    for doffs in (-64.0, -1.0):
+        k2 = k1.copy()
+        k2[0, 2] += doffs
+        text = rect_calib(K2=k2).describe()
+        if doffs == -64.0:
+            assert "nearest depth a disparity range reaches: 128 px 78.1 cm, 256 px 26.0 cm" in text
+        else:
+            assert text.splitlines()[-1] == (
+                "farthest depth, at a disparity of 2.00 px (1 px above infinity's 1.00 px): 50.00 m"
+            )
+
+
+def test_rectify_points_of_a_rectified_rig_are_a_copy() -> None:
+    pts = np.array([[10.0, 20.0], [30.5, 40.25]])
+    out = rect_calib().rectify_points(pts)
+    assert np.array_equal(out, pts) and not np.shares_memory(out, pts)
