@@ -631,6 +631,10 @@ def test_fit_to_frames_scales_or_names_a_crop() -> None:
     assert scaled.image_size == (160, 120) and note is not None and "scaled" in note
     with pytest.raises(ValueError, match="another aspect ratio"):
         fit_to_frames(c, (320, 180))
+    # the limit is 1 % of the larger scale: 160x121 (0.8 % apart) is scaled, 160x122 (1.6 %) not
+    assert fit_to_frames(c, (160, 121))[0].image_size == (160, 121)
+    with pytest.raises(ValueError, match="another aspect ratio"):
+        fit_to_frames(c, (160, 122))
     for size in ((1,), (0, 0), (2.5, 3)):
         with pytest.raises(ValueError, match="image_size"):
             fit_to_frames(c, size)  # type: ignore[arg-type]
@@ -1612,3 +1616,39 @@ def test_rectify_points_of_a_rectified_rig_are_a_copy() -> None:
     pts = np.array([[10.0, 20.0], [30.5, 40.25]])
     out = rect_calib().rectify_points(pts)
     assert np.array_equal(out, pts) and not np.shares_memory(out, pts)
+
+
+def test_ideal_refuses_an_infinite_baseline_by_name() -> None:
+    with pytest.raises(ValueError, match=r"^baseline_m: expected a positive number of metres"):
+        Calibration.ideal((640, 480), 90.0, float("inf"))
+
+
+def test_from_q_reads_a_negative_multiple_and_refuses_a_q31(tmp_path: Path) -> None:
+    """-Q is the same homogeneous matrix as Q (divided by its Q[0,0] = -1); a Q[3,1] other
+    than 0 is not a rectified Q and is named."""
+    k1 = np.array([[500.0, 0.0, 150.0], [0.0, 500.0, 120.0], [0.0, 0.0, 1.0]])
+    k2 = k1.copy()
+    k2[0, 2] = 162.5
+    rig = rect_calib(K1=k1, K2=k2, T=np.array([-0.1, 0.0, 0.0]), unit="m")
+
+    def write(q: np.ndarray) -> Path:
+        (tmp_path / "Q.dat").write_text("\n".join(" ".join(repr(float(v)) for v in r) for r in q))
+        return tmp_path / "Q.dat"
+
+    back = Calibration.from_q(write(-rig.Q), SIZE)
+    np.testing.assert_allclose(back.Q, rig.Q, atol=1e-12)
+    assert back.doffs_px == pytest.approx(12.5, abs=1e-9)
+    q = rig.Q.copy()
+    q[3, 1] = 0.5
+    with pytest.raises(ValueError, match=r"not a rectified Q matrix: Q\[3,1\] = 0\.5, expected 0$"):
+        Calibration.from_q(write(q), SIZE)
+
+
+def test_from_kitti_refuses_cameras_2_and_3_swapped(tmp_path: Path) -> None:
+    """P3's x offset left of P2's (the files' cameras swapped) is a negative baseline: refused
+    by name, not read as its absolute value."""
+    p2 = "7.2e+02 0 6.1e+02 4.5e+01 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    p3 = "7.2e+02 0 6.1e+02 -3.6e+02 0 7.2e+02 1.7e+02 0 0 0 1 0"
+    (tmp_path / "calib.txt").write_text(f"P2: {p3}\nP3: {p2}\n")
+    with pytest.raises(ValueError, match=r"baseline \(P2\[0, 3\] - P3\[0, 3\]\) / f in .*calib"):
+        Calibration.from_kitti(tmp_path / "calib.txt", image_size=(1242, 375))
