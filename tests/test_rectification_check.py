@@ -385,7 +385,7 @@ def test_a_calibration_file_name_and_numpy_tolerances() -> None:
         check_rectification(flat, flat, "pi.yaml")
     for tol in (np.float32(0.5), np.float64(0.5), np.int64(1)):
         assert check_rectification(flat, flat, tolerance=tol).tolerance == float(tol)
-    for bad in (np.float32("nan"), np.float64(-1.0), np.bool_(True), "0.5"):
+    for bad in (np.float32("nan"), np.float64(-1.0), np.bool_(True), "0.5", 0, float("inf")):
         with pytest.raises(ValueError, match="tolerance: expected a positive number of pixels"):
             check_rectification(flat, flat, tolerance=bad)  # type: ignore[arg-type]
 
@@ -616,10 +616,11 @@ def test_matches_off_any_row_model_count_in_the_verdict() -> None:
     them, those far off their rows too."""
     rng = np.random.default_rng(2)
     dy = rng.uniform(3.0, 8.0, 70) * rng.choice([-1.0, 1.0], 70)
-    dy[60:] = 100.0  # beyond 10 % of the height of their rows
+    dy[60:] = 100.0 + 10 * np.arange(10)  # beyond 10 % of the height of their rows
     r = _judge_rows(_quad(*_grid(70), np.full(70, 20.0), dy), 1000, 480, 0.5)
     assert (r.ok, r.swapped, r.matches) == (False, False, 70)
     assert r.median_dy == pytest.approx(float(np.median(np.abs(dy))), abs=1e-12)
+    assert r.p95_dy == pytest.approx(float(np.percentile(np.abs(dy), 95)), abs=1e-12)
 
 
 def test_already_rectified_only_for_a_passing_check() -> None:
@@ -784,3 +785,61 @@ def test_alpha_out_of_range_is_refused_with_or_without_a_calibration(alpha: obje
     checked = check_rectification(img, img)
     with pytest.raises(ValueError, match=says):
         refine_rectification(img, img, raw_calib(), alpha=alpha, check=checked)  # type: ignore[arg-type]
+
+
+def test_row_rule_edges_second_audit() -> None:
+    """The edges of the row rule: a disparity of exactly -2 % of the width is fitted, as is
+    one down to -8 px on a narrow image; a match 10 % of the height off its row is near it;
+    -1 px of disparity is not negative for 'swapped'; exactly 30 negative matches on common
+    rows are swapped; far-off-row negative matches do not count against a swapped verdict."""
+    xl, yl = _grid(60)
+    # -20 px on a 1000 px image (2 %) and -7 px on a 320 px one (the 8 px floor) are fitted
+    dx = np.where(np.arange(60) < 40, 20.0, -20.0)
+    assert _judge_rows(_quad(xl, yl, dx, np.zeros(60)), 1000, 480, 0.5).matches == 60
+    dx = np.where(np.arange(60) < 40, 20.0, -7.0)
+    assert _judge_rows(_quad(xl, yl, dx, np.zeros(60)), 320, 480, 0.5).matches == 60
+    # 31 matches exactly 48 px (10 % of 480) off their rows are near them: the 30 on common
+    # rows at negative disparities are not most of the near ones, so not swapped
+    dx = np.where(np.arange(61) < 31, 20.0, -30.0)
+    dy = np.where(np.arange(61) < 31, 48.0, 0.0)
+    r = _judge_rows(_quad(*_grid(61), dx, dy), 640, 480, 0.5)
+    assert (r.matches, r.ok, r.swapped, r.median_dy) == (31, False, False, 48.0)
+    # 40 of 65 at -0.5 px: a disparity just below zero is no sign of a swapped pair
+    dx = np.where(np.arange(65) < 40, -0.5, 20.0)
+    r = _judge_rows(_quad(*_grid(65), dx, np.zeros(65)), 640, 480, 0.5)
+    assert (r.matches, r.ok, r.swapped) == (65, True, False)
+    # exactly MIN_MATCHES (30) at negative disparities on common rows: swapped
+    r = _judge_rows(_quad(*_grid(30), np.full(30, -30.0), np.zeros(30)), 640, 480, 0.5)
+    assert (r.ok, r.swapped) == (False, True)
+    # 40 on common rows at negative disparities and 45 more 60-300 px off their rows: swapped
+    # (the far ones are wrong matches, not part of the rule)
+    far = np.random.default_rng(4).uniform(60.0, 300.0, 85)
+    dy = np.where(np.arange(85) < 40, 0.0, far)
+    r = _judge_rows(_quad(*_grid(85), np.full(85, -30.0), dy), 1000, 480, 0.5)
+    assert (r.ok, r.swapped) == (False, True)
+
+
+def test_alpha_reaches_the_rectification_and_a_match_at_the_tolerance_is_green(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """check_rectification rectifies with the alpha given (it was dropped for 0 unnoticed by
+    any value test); in the plot a row error of exactly the tolerance is within it (green)."""
+    from stereovision.rectification_check import RectificationCheck, draw_rectification_check
+
+    seen: list[float] = []
+    real = Calibration.rectify
+
+    def spy(self: Calibration, left: object, right: object, alpha: float = 0.0) -> tuple:
+        seen.append(alpha)
+        return real(self, left, right, alpha=alpha)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(Calibration, "rectify", spy)
+    rig = Calibration.ideal((80, 60), 60.0, 0.1)
+    flat = np.zeros((60, 80), np.uint8)
+    check_rectification(flat, flat, rig, alpha=0.75)
+    assert seen == [0.75]
+    black = np.zeros((100, 200), np.uint8)
+    pts = np.float32([[30, 40, 20, 40.5]])
+    check = RectificationCheck(1, 0.5, 0.5, 0.5, 0.0, 0.0, True, 0.5, points=pts)
+    pair = draw_rectification_check(black, black, check)[-100:].astype(int)
+    assert np.abs(pair[40, 30] - (0, 200, 0)).max() <= 2
