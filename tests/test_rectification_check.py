@@ -843,3 +843,59 @@ def test_alpha_reaches_the_rectification_and_a_match_at_the_tolerance_is_green(
     check = RectificationCheck(1, 0.5, 0.5, 0.5, 0.0, 0.0, True, 0.5, points=pts)
     pair = draw_rectification_check(black, black, check)[-100:].astype(int)
     assert np.abs(pair[40, 30] - (0, 200, 0)).max() <= 2
+
+
+def test_refine_takes_the_rectified_geometry_of_its_alpha(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A raw rig refined with alpha=0.5 fits the turn on the rays of the alpha-0.5 rectified
+    pair (its K2), not on those of alpha 0."""
+    from stereovision.rectification_check import RectificationCheck
+
+    seen: list[float] = []
+    real = Calibration.rectified_calibration
+
+    def spy(self: Calibration, alpha: float = 0.0) -> Calibration:
+        seen.append(alpha)
+        return real(self, alpha)
+
+    monkeypatch.setattr(Calibration, "rectified_calibration", spy)
+    w, h = 640, 480
+    rig = _rig(w, h, (0.1, 0.0, 0.0))
+    xl, yl = _grid(60)
+    pts = np.column_stack([xl, yl, xl - 20, yl]).astype(np.float32)
+    check = RectificationCheck(60, 0.0, 0.0, 0.0, 0.0, 0.0, True, 0.5, points=pts)
+    flat = np.full((h, w), 128, np.uint8)
+    refine_rectification(flat, flat, rig, alpha=0.5, check=check)
+    assert 0.5 in seen and 0.0 not in seen
+
+
+def test_refine_a_rectified_rig_with_doffs() -> None:
+    """A rectified calibration that carries doffs (cx2 - cx1 = 5 px) is refined to a raw one
+    without it (the constructor refuses doffs on an unrectified rig)."""
+    from stereovision.rectification_check import RectificationCheck
+
+    w, h = 640, 480
+    raw = _rig(w, h, (0.0, 0.0, 0.0))
+    k2 = raw.K2.copy()
+    k2[0, 2] += 5.0
+    rig = dataclasses.replace(raw, K2=k2, rectified=True, doffs=5.0)
+    xl, yl = _grid(60)
+    pts = np.column_stack([xl, yl, xl - 20, yl + 1.0]).astype(np.float32)
+    check = RectificationCheck(60, 1.0, 1.0, -1.0, 0.0, 0.0, False, 0.5, points=pts)
+    flat = np.full((h, w), 128, np.uint8)
+    fixed, _ = refine_rectification(flat, flat, rig, check=check)
+    assert fixed.doffs is None and fixed.rectified is False
+    assert _deg(fixed.R) == pytest.approx(np.degrees(np.arctan(1 / 700)), abs=0.005)
+
+
+def test_align_rows_takes_the_roll_about_the_image_centre() -> None:
+    """The fitted slope is about the centre pixel (w - 1) / 2: with no offset, the centre
+    column of a vertical ramp is unmoved and a column 20 px right moves by slope * 20 / 1000."""
+    from stereovision.rectification_check import RectificationCheck, align_rows
+
+    h, w = 60, 81
+    ramp = np.repeat(np.arange(h, dtype=np.float32)[:, None], w, axis=1)
+    check = RectificationCheck(60, 1.0, 2.0, 0.0, 200.0, 0.0, False, 0.5)
+    out, _ = align_rows(ramp, ramp, check=check)
+    rows = slice(10, 50)
+    np.testing.assert_allclose(out[rows, 40], ramp[rows, 40], atol=1e-3)
+    np.testing.assert_allclose(out[rows, 60], ramp[rows, 60] - 4.0, atol=1e-3)
