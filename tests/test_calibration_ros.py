@@ -572,3 +572,31 @@ def test_save_ros_refuses_right_yaml_linked_to_left_yaml(tmp_path: Path) -> None
     )
     assert (tmp_path / "left.yaml").read_text() == "old"
     assert sorted(os.listdir(tmp_path)) == ["left.yaml", "right.yaml"]
+
+
+def _ros_pair(t: tuple[float, float, float], p22: float = 1.0) -> tuple[str, str]:
+    k = np.array([[400.0, 0.0, 159.5], [0.0, 400.0, 119.5], [0.0, 0.0, 1.0]])
+    p1 = np.hstack([k, np.zeros((3, 1))])
+    p2 = np.hstack([k, (k @ np.array(t)).reshape(3, 1)])
+    p1[2, 2] = p2[2, 2] = p22
+    d, r = np.zeros(5), np.eye(3)
+    return (
+        _ros_yaml("left", (320, 240), k, d, r, p1, "plumb_bob"),
+        _ros_yaml("right", (320, 240), k, d, r, p2, "plumb_bob"),
+    )
+
+
+def test_a_ros_pair_that_looks_rectified_but_is_vertical_is_a_raw_rig() -> None:
+    """Identity rectification, no distortion, K = P[:, :3], but the baseline vertical: not a
+    rectified pair (T is not (-B, 0, 0)), read as the raw rig that stereoRectify handles."""
+    left, right = _ros_pair((0.0, -0.1, 0.0))
+    c = Calibration._from_ros_texts(left, right, "left.yaml", "right.yaml")
+    assert c.rectified is False
+    np.testing.assert_allclose(c.T, [0.0, -0.1, 0.0], atol=1e-12)
+
+
+def test_a_ros_projection_with_p22_zero_is_refused_by_name() -> None:
+    """P[2, 2] = 0 made P[:, :3] singular: a bare LinAlgError, not the file's refusal."""
+    left, right = _ros_pair((-0.1, 0.0, 0.0), p22=0.0)
+    with pytest.raises(ValueError, match=r"^left\.yaml: projection_matrix needs positive fx"):
+        Calibration._from_ros_texts(left, right, "left.yaml", "right.yaml")
