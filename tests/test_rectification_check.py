@@ -899,3 +899,24 @@ def test_align_rows_takes_the_roll_about_the_image_centre() -> None:
     rows = slice(10, 50)
     np.testing.assert_allclose(out[rows, 40], ramp[rows, 40], atol=1e-3)
     np.testing.assert_allclose(out[rows, 60], ramp[rows, 60] - 4.0, atol=1e-3)
+
+
+def test_refine_turns_the_right_camera_in_its_own_rectified_frame() -> None:
+    """A toed-in rig (right camera turned 4 degrees about y): rows 1 px apart everywhere are a
+    pitch about the rectified right camera's x axis (R2's frame), not about the left one's
+    (R1's, 4 degrees away, which adds a roll of 6 % of the pitch)."""
+    from stereovision.rectification_check import RectificationCheck
+
+    w, h = 640, 480
+    rig = _rig(w, h, (0.0, 4.0, 0.0))
+    xl, yl = _grid(60)
+    xl = xl - xl.mean() + (w - 1) / 2  # centred: a uniform offset is a pitch, no roll
+    yl = yl - yl.mean() + (h - 1) / 2
+    pts = np.column_stack([xl, yl, xl - 20, yl + 1.0]).astype(np.float32)
+    check = RectificationCheck(60, 1.0, 1.0, -1.0, 0.0, 0.0, False, 0.5, points=pts)
+    flat = np.full((h, w), 128, np.uint8)
+    fixed, _ = refine_rectification(flat, flat, rig, check=check)
+    r2 = rig._stereo_rectify(0.0)[1]
+    turn = cv2.Rodrigues(r2 @ fixed.R @ rig.R.T @ r2.T)[0].ravel()
+    # the fit's own roll is 1 % of the pitch; about R1's axis it was 6 %
+    assert abs(turn[1]) < 1e-9 and abs(turn[2]) < 0.03 * abs(turn[0])
