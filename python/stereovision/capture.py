@@ -412,6 +412,8 @@ def _camera_name(camera: Any) -> str:
 
 
 _T = TypeVar("_T")
+#: Seconds an interrupted wait still gives the grab under way to come back (:func:`_within`).
+_INTERRUPT_GRACE_S = 2.0
 #: The bound on a :class:`StereoCamera`'s native grab in this context (:func:`read_within`).
 _READ_TIMEOUT: contextvars.ContextVar[float | None] = contextvars.ContextVar(
     "stereovision_read_timeout", default=None
@@ -472,8 +474,18 @@ def _within(work: Callable[[], _T], timeout: float | None, name: str) -> _T:
         finally:
             done.set()
 
-    threading.Thread(target=run, name="stereovision-grab", daemon=True).start()
-    if not done.wait(timeout):
+    try:
+        threading.Thread(target=run, name="stereovision-grab", daemon=True).start()
+        finished = done.wait(timeout)
+    except Exception:  # no thread started ("can't start new thread"): nothing under way
+        raise
+    except BaseException:
+        # Ctrl-C (SIGTERM) mid-grab, or while the thread started: the grab, not hung, comes back
+        # within milliseconds; let it before the interrupt goes on. A thread coming back out of
+        # OpenCV while the interpreter shut down aborted the process (SIGABRT, exit -6, not 130).
+        done.wait(min(timeout, _INTERRUPT_GRACE_S))
+        raise
+    if not finished:
         # the thread stays in OpenCV (nothing stops native code); its frame, if it ever comes,
         # is dropped
         raise SourceError(
