@@ -945,6 +945,39 @@ def test_zncc_reference_equals_its_definition_pixel_by_pixel() -> None:
     assert np.median(clean) == pytest.approx(3.4, abs=0.1)
 
 
+def test_zncc_reference_back_match_never_takes_a_padded_right_border_window() -> None:
+    """Left pixels near the right border: the left-right check's candidates x + k - d with
+    x + k - d >= w - r have a 7x7 window padded with zeros by the box filter; such a window
+    once won the back-match and dropped (18, 4) and (18, 5) of this random pair, whose
+    right pixels' best in-image match comes back within 1 level."""
+    rng = np.random.default_rng(0)
+    h, w = 9, 24
+    left = rng.random((h, w)).astype(np.float32)
+    right = rng.random((h, w)).astype(np.float32)
+    r, hi = mcgm.ZNCC_RADIUS, 8
+    ys, xs = np.mgrid[r : h - r, w - r - hi - 1 : w - r]
+    pixels = np.stack([xs.ravel(), ys.ravel()], axis=1)
+    off = {"sides": False, "disc": False, "zncc_check": False}
+    m = mcgm.zncc_reference(left, right, max_disparity=hi, pixels=pixels, **off)
+    L, R = left.astype(np.float64), right.astype(np.float64)
+
+    def score(x: int, y: int, xr: int) -> float:
+        if not (r <= x < w - r and r <= xr < w - r):
+            return -np.inf
+        return _zncc(
+            L[y - r : y + r + 1, x - r : x + r + 1], R[y - r : y + r + 1, xr - r : xr + r + 1]
+        )
+
+    for x, y in [(18, 4), (18, 5)]:
+        c = [score(x, y, x - d) for d in range(hi + 1)]
+        b = int(np.argmax(c))
+        back = [score(x - b + k, y, x - b) for k in range(hi + 1)]
+        assert abs(int(np.argmax(back)) - b) <= 1
+        i = np.flatnonzero((m.xl == x) & (m.yl == y))
+        assert len(i) == 1 and m.score[i[0]] == pytest.approx(c[b], abs=2e-4)
+    assert m.stats == {"n_pixels": 27, "n_lr": 26, "n_matches": 26}
+
+
 def test_zncc_reference_default_pixels_are_the_full_resolution_curves() -> None:
     """Without ``pixels``: every labelled pixel (segment 0 included) of the full-resolution
     channels whose normal is at least horiz_skip_deg from vertical, with the curve parameters

@@ -533,6 +533,9 @@ def zncc_reference(
         ok = np.zeros((h, w), dtype=bool)
         ok[:, d:] = (sa[:, d:] > ZNCC_MIN_STD) & (sb[:, : w - d] > ZNCC_MIN_STD)
         ok[:, : d + r] = False
+        # The box filter zero-pads the left window past the right border: those columns are
+        # never matched forward (``inside``) but would be candidates of the left-right check.
+        ok[:, w - r :] = False
         with np.errstate(invalid="ignore", divide="ignore"):
             z = np.where(ok, cov / np.where(ok, den, 1.0), -np.inf)
         vol[k] = z
