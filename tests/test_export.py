@@ -498,6 +498,16 @@ def test_voxel_downsample_against_a_plain_reference(result):
         export.voxel_downsample(pts[:, :2])
 
 
+@pytest.mark.parametrize("side", [1.0, 2, np.float32(0.5), np.int64(3)])
+def test_voxel_downsample_a_positional_cube_side_is_named(side: object) -> None:
+    """voxel_downsample(pts, 1.0): the side lands in ``colors``; the error said
+    "colors: expected shape (3, 3), got ()" and now says a number came and where it goes."""
+    pts = np.zeros((3, 3))
+    want = f"got the number {side}; give the cube side by keyword: .*voxel={side}\\)"
+    with pytest.raises(ValueError, match=want):
+        export.voxel_downsample(pts, side)  # type: ignore[call-overload]
+
+
 def test_voxel_downsample_refuses_colours_it_would_wrap() -> None:
     """Colours are averaged and cast to uint8: 300 came out 44 and NaN 0 (a cast warning),
     silently. Colours 0-255 of any numeric type are averaged as before; others are refused."""

@@ -649,8 +649,9 @@ def voxel_downsample(
     Raises
     ------
     ValueError
-        If ``points`` is not ``(N, 3)``, ``colors`` does not match it or holds values outside
-        0-255, or ``voxel`` is not a positive number.
+        If ``points`` is not ``(N, 3)``, ``colors`` is a bare number (a cube side given
+        positionally), does not match ``points`` or holds values outside 0-255, or ``voxel``
+        is not a positive number.
     """
     not_a_result(points, "points", "points")
     pts = np.asarray(points, dtype=np.float64)
@@ -666,6 +667,13 @@ def voxel_downsample(
     if not (math.isfinite(side) and side > 0):
         raise ValueError(f"voxel: expected a positive cube side, got {number_shown(voxel)}")
     voxel = side
+    # voxel_downsample(pts, 1.0): the cube side landed in colors, reported as a shape mismatch.
+    if isinstance(colors, (numbers.Number, np.number, np.bool_)):
+        shown = number_shown(colors.item() if isinstance(colors, np.generic) else colors)
+        raise ValueError(
+            f"colors: expected (N, 3) colours, got the number {shown}; give the cube side "
+            f"by keyword: voxel_downsample(points, voxel={shown})"
+        )
     cols = None
     if colors is not None:
         cols = np.asarray(colors)
