@@ -463,6 +463,38 @@ def _blurred_pair(shift: int = 2) -> tuple[np.ndarray, np.ndarray]:
     return img, np.ascontiguousarray(np.roll(img, -shift, axis=1))
 
 
+def test_tau_y_default_drops_a_conflict_two_rows_off() -> None:
+    """C.5 disambiguation at tau_y = 1 px: a 16x16 patch of the right view moved 2 rows up
+    (its points' candidates all 2 rows off the singles' median 0, several on at once with the
+    network's inhibition off) loses those points; tau_y 2 kept them (tau_y 1.0 -> 2.0 changed
+    no match on cones, tsukuba or terrace)."""
+    base = cv2.GaussianBlur(
+        np.random.default_rng(1).random((90, 140)).astype(np.float32), (0, 0), 1.5
+    )
+    base = (base - base.min()) / (base.max() - base.min())
+    left = np.ascontiguousarray(base[5:85, 10:130])  # right = left 6 px on ...
+    right = base[5:85, 16:136].copy()
+    right[30:46, 50:66] = base[37:53, 66:82]  # ... but 2 rows up in the patch
+    kw = {"max_disparity": 10, "candidates": "points", "s_min": 0.5, "A": 0.0, "B": 0.0}
+    kw["theta"] = 0.0
+    default = hp.hopfield_match(left, right, **kw)
+    np.testing.assert_array_equal(
+        default.to_array(), hp.hopfield_match(left, right, tau_y=1.0, **kw).to_array()
+    )
+    # the kernel's own default (HopfieldParams::default) too
+    m, _trace, _stats = sv._core.hopfield_match(left, right, {**kw, "method": "hopfield"})
+    np.testing.assert_array_equal(m[:, :4], default.to_array())
+    wide = hp.hopfield_match(left, right, tau_y=2.0, **kw)
+    got = {(x, y): (x - xr, y - yr) for x, y, xr, yr in default.to_array().tolist()}
+    more = {(x, y): (x - xr, y - yr) for x, y, xr, yr in wide.to_array().tolist()}
+    assert len(got) == 261 and len(more) == 265
+    extra = {k: v for k, v in more.items() if k not in got}
+    assert sorted(extra) == [(62.0, 42.0), (64.0, 42.0), (65.0, 38.0), (67.0, 38.0)]
+    for d, dy in extra.values():
+        assert d == pytest.approx(6.0, abs=0.1) and dy == 2.0
+    assert all(more[k] == v for k, v in got.items())
+
+
 def test_the_range_is_rounded_outwards_and_one_level_is_searched() -> None:
     """min_disparity 2.5 searches from level 2 (floor: the same matches as 2), max == min is a
     one-level search, not an error; rel_threshold/floor_rel above 1 and nms_half 0 are refused."""
