@@ -401,6 +401,58 @@ def test_ctrl_c_before_the_grab_began_grabs_nothing(
         cam.close()
 
 
+def test_an_interrupt_before_the_grab_began_does_not_wait_for_it_to_grab(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C while the grab's thread has started but not yet begun the grab: the interrupt's
+    wait for a grab under way (_INTERRUPT_GRACE_S) let that thread begin and grab a pair,
+    which was lost (the next read got the second pair). A grab not begun is given up before
+    the wait, as it was before the wait came in."""
+    lpat = _write_sequence(tmp_path / "frames", "left", [_numbered(i) for i in range(3)])
+    rpat = _write_sequence(tmp_path / "frames", "right", [_numbered(i) for i in range(3)])
+    gate = threading.Event()
+    opens = threading.Timer(0.3, gate.set)  # the late thread goes on within the grace wait
+    late: list[threading.Thread] = []
+
+    class _LateThread(threading.Thread):
+        def run(self) -> None:
+            gate.wait()
+            super().run()
+
+        def start(self) -> None:
+            late.append(self)
+            super().start()
+
+    interrupted: list[bool] = []
+
+    class _InterruptedOnce(threading.Event):
+        def wait(self, timeout: float | None = None) -> bool:
+            if timeout is not None and not interrupted:  # the read's wait for the grab
+                interrupted.append(True)
+                opens.start()
+                raise KeyboardInterrupt
+            return super().wait(timeout)  # Thread.start's, and the grace wait
+
+    cam = StereoCamera(lpat, rpat)
+    try:
+        with monkeypatch.context() as m:
+            m.setattr(capmod.threading, "Thread", _LateThread)
+            m.setattr(capmod.threading, "Event", _InterruptedOnce)
+            t0 = time.monotonic()
+            with pytest.raises(KeyboardInterrupt):
+                capmod.read_within(cam, 5.0)
+            waited = time.monotonic() - t0
+        gate.set()
+        late[0].join(5.0)
+        assert not late[0].is_alive()
+        assert _read_stamp(capmod.read_within(cam, 1.0).left) == 0
+        assert waited < 0.2
+    finally:
+        gate.set()
+        opens.cancel()
+        cam.close()
+
+
 def test_an_interrupt_while_a_grab_starts_lets_the_grab_come_back(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

@@ -459,8 +459,17 @@ def read_within(camera: Any, timeout: float | None = DEFAULT_READ_TIMEOUT) -> St
         _READ_TIMEOUT.reset(token)
 
 
-def _within(work: Callable[[], _T], timeout: float | None, name: str) -> _T:
-    """``work()`` in a daemon thread, given up after ``timeout`` s (None: called here)."""
+def _within(
+    work: Callable[[], _T],
+    timeout: float | None,
+    name: str,
+    cancel: Callable[[], bool] | None = None,
+) -> _T:
+    """``work()`` in a daemon thread, given up after ``timeout`` s (None: called here).
+
+    On an interrupt, ``cancel()`` (when given) is asked first whether it kept ``work`` from
+    beginning (True); only one under way is waited for, up to :data:`_INTERRUPT_GRACE_S`.
+    """
     if timeout is None:
         return work()
     done = threading.Event()
@@ -483,7 +492,9 @@ def _within(work: Callable[[], _T], timeout: float | None, name: str) -> _T:
         # Ctrl-C (SIGTERM) mid-grab, or while the thread started: the grab, not hung, comes back
         # within milliseconds; let it before the interrupt goes on. A thread coming back out of
         # OpenCV while the interpreter shut down aborted the process (SIGABRT, exit -6, not 130).
-        done.wait(min(timeout, _INTERRUPT_GRACE_S))
+        # One not begun yet is given up instead: waiting let it begin and grab a pair then lost.
+        if cancel is None or not cancel():
+            done.wait(min(timeout, _INTERRUPT_GRACE_S))
         raise
     if not finished:
         # the thread stays in OpenCV (nothing stops native code); its frame, if it ever comes,
@@ -1074,20 +1085,29 @@ class StereoCamera(PairSource):
                 )
             self._grabbing = True
         claim = ["pending"]  # "entered" by the grab, or "abandoned" by this thread first
-        try:
-            ok_l, t_l, ok_r, t_r, got = _within(lambda: self._grab(caps, claim), timeout, name)
-        except BaseException:
+
+        def abandon() -> bool:
             # A grab that never began (its thread not started: "can't start new thread", or
             # Ctrl-C before it) left the camera grabbing for good: every read refused as hung
             # and close() leaving the release to it. One that began ends it itself.
             release = False
             with self._grab_lock:
-                if claim[0] != "entered":
+                if claim[0] == "entered":
+                    return False
+                if claim[0] == "pending":
                     claim[0] = "abandoned"
                     self._grabbing = False
                     release, self._release_on_return = self._release_on_return, False
             if release:  # closed meanwhile (by another thread)
                 _release(caps.values())
+            return True
+
+        try:
+            ok_l, t_l, ok_r, t_r, got = _within(
+                lambda: self._grab(caps, claim), timeout, name, cancel=abandon
+            )
+        except BaseException:
+            abandon()  # also when _within did not ask (no thread started, no interrupt)
             raise
         if not (ok_l and ok_r):
             raise self._ended({"left": ok_l, "right": ok_r})
