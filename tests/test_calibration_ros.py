@@ -600,3 +600,80 @@ def test_a_ros_projection_with_p22_zero_is_refused_by_name() -> None:
     left, right = _ros_pair((-0.1, 0.0, 0.0), p22=0.0)
     with pytest.raises(ValueError, match=r"^left\.yaml: projection_matrix needs positive fx"):
         Calibration._from_ros_texts(left, right, "left.yaml", "right.yaml")
+
+
+def _kalibr_pair(tmp_path: Path, cam0: str, cam1: str) -> Path:
+    """A camchain.yaml of two cameras given as YAML bodies (indented by the caller)."""
+    path = tmp_path / "camchain.yaml"
+    path.write_text(f"cam0:\n{cam0}cam1:\n{cam1}")
+    return path
+
+
+_KALIBR_CAM = (
+    "  intrinsics: [500.0, 510.0, 320.0, 240.0]\n"
+    "  distortion_coeffs: [-0.1, 0.02, 0.001, -0.002]\n"
+    "  resolution: [640, 480]\n"
+)
+_KALIBR_POSE = "  T_cn_cnm1: [[1, 0, 0, -0.1], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]\n"
+
+
+def test_kalibr_defaults_pinhole_radtan_and_ignores_other_keys(tmp_path: Path) -> None:
+    """A camera without camera_model or distortion_model is Kalibr's default pinhole-radtan
+    (its four coefficients read as OpenCV's k1 k2 p1 p2); keys other than camN (a mutation
+    audit found a loose ``cam`` prefix match and the defaults unasserted) are ignored."""
+    path = _kalibr_pair(tmp_path, _KALIBR_CAM, _KALIBR_CAM + _KALIBR_POSE)
+    path.write_text(path.read_text() + "cam0_notes: bench rig\ncamera_count: 2\n")
+    rig = Calibration.from_kalibr(path)
+    assert rig.model == "pinhole" and rig.image_size == (640, 480) and rig.unit == "m"
+    np.testing.assert_array_equal(rig.D1, [-0.1, 0.02, 0.001, -0.002, 0.0])
+    np.testing.assert_array_equal(rig.K2, [[500.0, 0, 320.0], [0, 510.0, 240.0], [0, 0, 1]])
+    np.testing.assert_array_equal(rig.T, [-0.1, 0.0, 0.0])
+
+
+def test_kalibr_cameras_are_ordered_by_number_not_text(tmp_path: Path) -> None:
+    """cam10 comes after cam9 in the chain (a text sort put it first and refused the pair)."""
+    path = tmp_path / "camchain.yaml"
+    path.write_text(f"cam9:\n{_KALIBR_CAM}cam10:\n{_KALIBR_CAM}{_KALIBR_POSE}")
+    rig = Calibration.from_kalibr(path, cameras=("cam9", "cam10"))
+    np.testing.assert_array_equal(rig.T, [-0.1, 0.0, 0.0])
+
+
+@pytest.mark.parametrize(
+    ("cam1", "message"),
+    [
+        ("  5\n", "cam1: expected a camera mapping"),
+        (_KALIBR_CAM.replace("  resolution: [640, 480]\n", ""), "lacks field 'resolution'"),
+        (_KALIBR_CAM.replace("[640, 480]", "[0, 480]"), "two positive integers"),
+        (_KALIBR_CAM.replace("500.0, ", ".nan, "), "intrinsics needs 4 finite numbers"),
+        (_KALIBR_CAM.replace("240.0]", "240.0, 1.0]"), "intrinsics needs 4 finite numbers"),
+        (_KALIBR_CAM.replace("500.0", "abc"), "intrinsics is not a list of numbers"),
+        (_KALIBR_CAM + "  distortion_model: fov\n", "expected 'radtan', 'equidistant'"),
+        (
+            _KALIBR_CAM + _KALIBR_POSE.replace("0, 0, 1]]", "0, 0, 1.0001]]"),
+            "last row must be",
+        ),
+    ],
+)
+def test_kalibr_bad_camera_fields_are_named(tmp_path: Path, cam1: str, message: str) -> None:
+    """Each malformed field is a ValueError naming it (a mutation audit found these checks
+    unasserted: non-finite or too many numbers, a zero size, a non-mapping camera, fov)."""
+    path = _kalibr_pair(tmp_path, _KALIBR_CAM, cam1 if "T_cn" in cam1 else cam1 + _KALIBR_POSE)
+    if cam1 == "  5\n":
+        path.write_text(f"cam0:\n{_KALIBR_CAM}cam1: 5\n")
+    with pytest.raises(ValueError, match=message):
+        Calibration.from_kalibr(path)
+
+
+def test_kalibr_unreadable_documents_are_named(tmp_path: Path) -> None:
+    """Broken YAML, a list instead of the mapping, and a skipped-over camera that is not a
+    mapping are ValueErrors naming the problem (they leaked yaml/Type errors on mutants)."""
+    path = tmp_path / "camchain.yaml"
+    path.write_text("cam0: [unclosed\n")
+    with pytest.raises(ValueError, match=r"cannot parse .* as Kalibr YAML"):
+        Calibration.from_kalibr(path)
+    path.write_text("- cam0\n- cam1\n")
+    with pytest.raises(ValueError, match="expected Kalibr's camchain mapping"):
+        Calibration.from_kalibr(path)
+    path.write_text(f"cam0:\n{_KALIBR_CAM}cam1: 5\ncam2:\n{_KALIBR_CAM}{_KALIBR_POSE}")
+    with pytest.raises(ValueError, match="cam1 lacks field 'T_cn_cnm1'"):
+        Calibration.from_kalibr(path, cameras=("cam0", "cam2"))
