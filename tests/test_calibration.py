@@ -11,7 +11,12 @@ import cv2
 import numpy as np
 import pytest
 
-from stereovision.calibration import Calibration, parse_kitti_calib, parse_middlebury_calib
+from stereovision.calibration import (
+    Calibration,
+    _inner_rectangle,
+    parse_kitti_calib,
+    parse_middlebury_calib,
+)
 
 SIZE = (320, 240)
 
@@ -1652,3 +1657,51 @@ def test_from_kitti_refuses_cameras_2_and_3_swapped(tmp_path: Path) -> None:
     (tmp_path / "calib.txt").write_text(f"P2: {p3}\nP3: {p2}\n")
     with pytest.raises(ValueError, match=r"baseline \(P2\[0, 3\] - P3\[0, 3\]\) / f in .*calib"):
         Calibration.from_kitti(tmp_path / "calib.txt", image_size=(1242, 375))
+
+
+def _roi_of(invalid: list[tuple[int, int]], size: tuple[int, int] = (10, 8)) -> tuple:
+    """:func:`_inner_rectangle` of an identity map of ``size`` with ``(y, x)`` pixels sent out."""
+    w, h = size
+    my, mx = np.mgrid[0:h, 0:w].astype(np.float32)
+    for y, x in invalid:
+        mx[y, x] = -5.0
+    return _inner_rectangle(mx, my, size)
+
+
+@pytest.mark.parametrize(
+    ("invalid", "expected"),
+    [
+        ([], (0, 0, 10, 8)),
+        ([(0, x) for x in range(5)], (0, 1, 10, 7)),  # top row worst: dropped
+        ([(7, x) for x in range(5)], (0, 0, 10, 7)),  # bottom row
+        ([(y, 0) for y in range(5)], (1, 0, 9, 8)),  # left column
+        ([(y, 9) for y in range(5)], (0, 0, 9, 8)),  # right column
+        # right column 3 (its bottom pixel counted), bottom row 3: the bottom first (a tie),
+        # then the right column; a 9x7 rectangle, not 10x5
+        ([(5, 9), (6, 9), (7, 9), (7, 0), (7, 1)], (0, 0, 9, 7)),
+        ([(y, x) for y in range(8) for x in range(10) if x != 3], (3, 0, 1, 8)),  # one column
+        ([(y, x) for y in range(8) for x in range(10)], (0, 0, 0, 0)),  # nothing valid
+    ],
+)
+def test_inner_rectangle_drops_the_worst_side_first(invalid: list, expected: tuple) -> None:
+    """The all-valid rectangle shrinks on the side with most invalid pixels (a mutation audit
+    found _inner_rectangle's sides, its width/height and its empty cases unasserted)."""
+    assert _roi_of(invalid) == expected
+
+
+def test_inner_rectangle_takes_the_last_pixel_and_not_beyond() -> None:
+    """A source coordinate of exactly 0 or w - 1 (h - 1) is inside the image; half a pixel
+    beyond either edge is not (remap would read the border there)."""
+    size = (10, 8)
+    my, mx = np.mgrid[0:8, 0:10].astype(np.float32)
+    assert _inner_rectangle(mx, my, size) == (0, 0, 10, 8)
+    for arr, idx, value, expected in (
+        (mx, (slice(None), 9), 9.5, (0, 0, 9, 8)),
+        (mx, (slice(None), 0), -0.5, (1, 0, 9, 8)),
+        (my, (7, slice(None)), 7.5, (0, 0, 10, 7)),
+        (my, (0, slice(None)), -0.5, (0, 1, 10, 7)),
+    ):
+        saved = arr[idx].copy()
+        arr[idx] = value
+        assert _inner_rectangle(mx, my, size) == expected
+        arr[idx] = saved

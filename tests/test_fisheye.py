@@ -340,3 +340,19 @@ def test_fisheye_alpha_is_the_balance_and_the_roi_holds_valid_pixels(alpha: floa
     assert rw > 0 and rh > 0 and valid[y : y + rh, x : x + rw].all()
     cy, cx = y + rh // 2, x + rw // 2
     assert rw >= 0.9 * np.count_nonzero(valid[cy]) and rh >= 0.9 * np.count_nonzero(valid[:, cx])
+
+
+def test_fisheye_right_roi_comes_from_the_right_maps() -> None:
+    """The right ROI is drawn from the right camera's maps (the left's maps for both went
+    unseen by a mutation audit): at alpha 1 it starts 29 px in, where the left's starts at 0,
+    and holds only pixels mapped from inside the right image."""
+    _, r2, _, p2, _ = cv2.fisheye.stereoRectify(
+        K1, D1, K2, D2, SIZE, ROT, T.reshape(3, 1),
+        flags=cv2.fisheye.CALIB_ZERO_DISPARITY, newImageSize=SIZE, balance=1.0, fov_scale=1.0,
+    )  # fmt: skip
+    mx, my = cv2.fisheye.initUndistortRectifyMap(K2, D2, r2, p2, SIZE, cv2.CV_32FC1)
+    w, h = SIZE
+    valid = (mx >= 0) & (mx <= w - 1) & (my >= 0) & (my <= h - 1)
+    roi_l, (x, y, rw, rh) = TRUTH.valid_roi(1.0)
+    assert roi_l[0] == 0 and x == 29 and rw > 0.8 * w
+    assert valid[y : y + rh, x : x + rw].all() and not valid[y : y + rh, x - 1 : x + rw].all()
