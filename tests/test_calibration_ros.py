@@ -15,7 +15,7 @@ import pytest
 import yaml
 
 from stereovision.calibration import Calibration, _ros_yaml, parse_ros_camera_info
-from tests.test_calibration import raw_calib, rect_calib
+from tests.test_calibration import SIZE, raw_calib, rect_calib
 
 STEREOPI = Path("stereopi_rig") / "reference_calib_result"
 
@@ -677,3 +677,42 @@ def test_kalibr_unreadable_documents_are_named(tmp_path: Path) -> None:
     path.write_text(f"cam0:\n{_KALIBR_CAM}cam1: 5\ncam2:\n{_KALIBR_CAM}{_KALIBR_POSE}")
     with pytest.raises(ValueError, match="cam1 lacks field 'T_cn_cnm1'"):
         Calibration.from_kalibr(path, cameras=("cam0", "cam2"))
+
+
+def test_from_file_sends_each_format_to_its_reader(tmp_path: Path) -> None:
+    """Format detection, from a mutation audit: a ROS pair named "intrinsics" is not Kalibr, a
+    YAML of camN device names is no calibration, a .yml ROS pair is a ROS folder, a Q.dat
+    sized by the image_size given needs no left.png, and 17 numbers or a
+    lone camera_matrix are not a known format."""
+    c = raw_calib()
+    rc = c.rectified_calibration()
+    cams = [
+        (c.K1, c.D1, rc.R, rc.K1 @ np.eye(3, 4)),
+        (c.K2, c.D2, rc.R, rc.K1 @ np.hstack([np.eye(3), rc.T.reshape(3, 1)])),
+    ]
+    ros = _write_pair(tmp_path / "ros", cams)
+    for side in ("left", "right"):
+        text = (
+            (ros / f"{side}.yaml")
+            .read_text()
+            .replace(f'camera_name: "{side}"', 'camera_name: "intrinsics"')
+        )
+        (ros / f"{side}.yaml").write_text(text)
+        (tmp_path / "yml").mkdir(exist_ok=True)
+        (tmp_path / "yml" / f"{side}.yml").write_text(text)
+    assert "intrinsics" in (ros / "left.yaml").read_text()
+    expected = Calibration.from_file(ros)
+    assert Calibration.from_file(ros / "left.yaml") == expected
+    assert Calibration.from_file(tmp_path / "yml") == expected
+    q = tmp_path / "q" / "Q.dat"
+    q.parent.mkdir()
+    q.write_text("\n".join(" ".join(repr(float(v)) for v in r) for r in rc.Q))
+    assert Calibration.from_file(q, image_size=SIZE).image_size == SIZE
+    for name, text in (
+        ("devices.yaml", "cam0: /dev/video0\ncam1: /dev/video2\n"),
+        ("q17.dat", " ".join(["1.0"] * 17)),
+        ("lone.yaml", "camera_matrix:\n  rows: 3\n"),
+    ):
+        (tmp_path / name).write_text(text)
+        with pytest.raises(ValueError, match="unrecognised calibration format"):
+            Calibration.from_file(tmp_path / name)
