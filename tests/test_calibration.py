@@ -1705,3 +1705,12 @@ def test_inner_rectangle_takes_the_last_pixel_and_not_beyond() -> None:
         arr[idx] = value
         assert _inner_rectangle(mx, my, size) == expected
         arr[idx] = saved
+
+
+def test_from_file_reads_an_indented_middlebury_calib(data_dir: Path, tmp_path: Path) -> None:
+    """Middlebury lines with leading blanks are still its calib.txt (a mutation audit found the
+    detection's ``^\\s*cam0=`` unasserted: without the blanks they were an unknown format)."""
+    src = data_dir / "eth3d" / "terrace" / "calib.txt"
+    indented = tmp_path / "calib.txt"
+    indented.write_text("".join(f"  {line}\n" for line in src.read_text().splitlines()))
+    assert Calibration.from_file(indented) == Calibration.from_file(src)
