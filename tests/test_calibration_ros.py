@@ -716,3 +716,30 @@ def test_from_file_sends_each_format_to_its_reader(tmp_path: Path) -> None:
         (tmp_path / name).write_text(text)
         with pytest.raises(ValueError, match="unrecognised calibration format"):
             Calibration.from_file(tmp_path / name)
+
+
+def test_from_file_names_a_truncated_tar_and_skips_txt_stereo_calib_names(tmp_path: Path) -> None:
+    """A calibrationdata.tar.gz cut short (an EOFError from gzip) is a ValueError naming the
+    archive; intrinsics.txt beside extrinsics.txt is not OpenCV stereo_calib output (only
+    .yml/.yaml/.xml are). Both survived a mutation audit."""
+    c = raw_calib()
+    rc = c.rectified_calibration()
+    p2 = rc.K1 @ np.hstack([np.eye(3), rc.T.reshape(3, 1)])
+    ros = _write_pair(
+        tmp_path / "ros", [(c.K1, c.D1, rc.R, rc.K1 @ np.eye(3, 4)), (c.K2, c.D2, rc.R, p2)]
+    )
+    for side in ("left", "right"):  # padded so that the cut falls inside the gzip stream
+        with (ros / f"{side}.yaml").open("a") as fh:
+            fh.write("".join(f"# {os.urandom(32).hex()}\n" for _ in range(400)))
+    tar = tmp_path / "calibrationdata.tar.gz"
+    with tarfile.open(tar, "w:gz") as archive:
+        for side in ("left", "right"):
+            archive.add(ros / f"{side}.yaml", f"{side}.yaml")
+    data = tar.read_bytes()
+    tar.write_bytes(data[: len(data) // 2])
+    with pytest.raises(ValueError, match="as a tar archive"):
+        Calibration.from_file(tar)
+    for name in ("intrinsics.txt", "extrinsics.txt"):
+        (tmp_path / name).write_text("M1 and D1 as text\n")
+    with pytest.raises(ValueError, match="unrecognised calibration format"):
+        Calibration.from_file(tmp_path / "intrinsics.txt")
