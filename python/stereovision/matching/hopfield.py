@@ -184,48 +184,10 @@ def _shown(v: object) -> str:
     return too_large_for_float(v, why=False) or repr(v)
 
 
-#: Parameters a negative value of which means nothing, refused as MCGM refuses its own: the
-#: energy's weights and input offset (A=-1 made neighbours of another disparity support a
-#: match), the compatibility's crossing, slope and growth (negative: unlike disparities the
-#: compatible ones), the edge test's input penalty (negative: a bonus) and the pixel tolerances
-#: (negative: nothing passes; agree_tol=-1 gave no match at all). They ran without a word.
-_NON_NEGATIVE = (
-    "A",
-    "B",
-    "D",
-    "theta",
-    "compat_theta",
-    "compat_slope",
-    "compat_grad",
-    "tau_y",
-    "edge_penalty",
-    "rescue_med",
-    "agree_tol",
-)
-
-
-def _refuse_negative(params: dict[str, Any]) -> None:
-    """ValueError naming the first of :data:`_NON_NEGATIVE` given a negative or non-finite
-    number, worded as the kernel's own refusals; other types are left to the kernel's."""
-    for name in _NON_NEGATIVE:
-        v = params.get(name)
-        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.number)):
-            continue
-        if isinstance(v, (int, np.integer)):
-            bad = v < 0
-        else:
-            bad = not (math.isfinite(v) and v >= 0)
-        if bad:
-            raise ValueError(
-                f"invalid parameter `{name}`: must be finite and >= 0, got {_shown(v)}"
-            )
-
-
 def _params(max_disparity: float, min_disparity: float, params: dict[str, Any]) -> dict[str, Any]:
     refuse_unknown(
         "Hopfield parameter", params, DEFAULTS, "stereovision.matching.hopfield.DEFAULTS"
     )
-    _refuse_negative(params)
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
         if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < 0:
             if isinstance(v, (float, np.floating)) and np.isfinite(v) and v >= 0:

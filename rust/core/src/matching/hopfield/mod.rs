@@ -238,6 +238,26 @@ fn validate(left: &ImageView<'_>, right: &ImageView<'_>, p: &HopfieldParams) -> 
         return Err(CoreError::param("max_sweeps", "must be >= 1"));
     }
     let w = &p.weights;
+    // Supports may be negative; a NaN or inf anywhere is refused.
+    for (name, v) in [
+        ("fallback_alt_support", p.fallback_alt_support),
+        ("fallback_min_support", p.fallback_min_support),
+    ] {
+        if !v.is_finite() {
+            return Err(CoreError::param(name, format!("must be finite, got {v}")));
+        }
+    }
+    if p.agree_tol < 0 {
+        return Err(CoreError::param(
+            "agree_tol",
+            format!("must be finite and >= 0, got {}", p.agree_tol),
+        ));
+    }
+    // A negative value of these means nothing, as MCGM refuses its own: the energy's weights
+    // and input offset (A=-1 made neighbours of another disparity support a match), the
+    // compatibility's crossing, slope and growth, the edge test's penalty (negative: a bonus)
+    // and the tolerances (negative: nothing passes; agree_tol=-1 gave no match at all). A NaN
+    // or negative slack / tolerance failed every edge or centre test without a word.
     for (name, v) in [
         ("A", w.a),
         ("B", w.b),
@@ -245,21 +265,13 @@ fn validate(left: &ImageView<'_>, right: &ImageView<'_>, p: &HopfieldParams) -> 
         ("theta", w.theta),
         ("compat_theta", w.compat_theta),
         ("compat_slope", w.compat_slope),
-        ("tau_y", p.tau_y),
-        ("centre_tol", p.centre_tol),
         ("compat_grad", w.compat_grad),
-        ("rescue_med", p.rescue_med),
-        ("fallback_alt_support", p.fallback_alt_support),
-        ("fallback_min_support", p.fallback_min_support),
+        ("tau_y", p.tau_y),
         ("edge_penalty", p.edge_penalty),
+        ("rescue_med", p.rescue_med),
+        ("edge_margin", p.edge_margin),
+        ("centre_tol", p.centre_tol),
     ] {
-        if !v.is_finite() {
-            return Err(CoreError::param(name, format!("must be finite, got {v}")));
-        }
-    }
-    // A NaN or negative slack / tolerance failed every edge or centre test: no matches at all,
-    // without a word; a NaN share silently switched the sparse-area rule off.
-    for (name, v) in [("edge_margin", p.edge_margin), ("centre_tol", p.centre_tol)] {
         if !(v.is_finite() && v >= 0.0) {
             return Err(CoreError::param(
                 name,

@@ -161,6 +161,31 @@ fn bad_parameters_are_errors() {
             Err(CoreError::InvalidParameter { .. })
         ));
     }
+    // A negative weight, offset or tolerance (agree_tol -1 gave no match at all), named.
+    type Set = fn(&mut HopfieldParams);
+    let negatives: [(&str, Set); 4] = [
+        ("A", |p| p.weights.a = -0.5),
+        ("B", |p| p.weights.b = -0.5),
+        ("tau_y", |p| p.tau_y = -0.5),
+        ("agree_tol", |p| p.agree_tol = -1),
+    ];
+    for (name, set) in negatives {
+        let mut p = params(8);
+        set(&mut p);
+        match hopfield_match(&l, &r, &p) {
+            Err(CoreError::InvalidParameter { name: got, reason }) => {
+                assert_eq!(got, name);
+                assert!(
+                    reason.starts_with("must be finite and >= 0, got -"),
+                    "{reason}"
+                );
+            }
+            other => panic!(
+                "{name}: expected InvalidParameter, got {:?}",
+                other.map(|_| ())
+            ),
+        }
+    }
     let small = Image::filled(20, 30, 0.5);
     assert!(matches!(
         hopfield_match(&l, &small, &params(8)),
