@@ -403,14 +403,6 @@ def _describe_source(src: Source) -> str:
 _SEQ_RE = re.compile(r"%(0?\d*)d")
 
 
-def _camera_name(camera: Any) -> str:
-    """``camera 0 and camera 1`` (a :class:`StereoCamera`'s sources), for a message."""
-    sources = getattr(camera, "sources", None)
-    if isinstance(sources, dict) and sources:
-        return " and ".join(_describe_source(src) for src in sources.values())
-    return f"the camera ({type(camera).__name__})"
-
-
 _T = TypeVar("_T")
 #: Seconds an interrupted wait still gives the grab under way to come back (:func:`_within`).
 _INTERRUPT_GRACE_S = 2.0
@@ -1071,7 +1063,8 @@ class StereoCamera(PairSource):
             ``side``, ``frames``, ``other_had_frames``, ``expected_frames``; ``end`` True). A
             frame that does not decode or of another shape raises it with ``end`` False.
         """
-        timeout, name = _READ_TIMEOUT.get(), _camera_name(self)
+        timeout = _READ_TIMEOUT.get()
+        name = " and ".join(_describe_source(src) for src in self.sources.values())
         with self._grab_lock:  # with close(): a capture released here is not grabbed
             caps = self._caps
             if len(caps) != 2:
