@@ -2042,6 +2042,101 @@ def test_cli_capture_releases_the_cameras(
     assert "2 pairs saved" in capsys.readouterr().out
 
 
+class _SlowFirstGrab(_FakeCap):
+    """A camera slow to deliver its first frame (a GigE or USB3 camera on a cold start): its
+    first ``grab`` takes ``delay`` s."""
+
+    def __init__(self, name: str, delay: float) -> None:
+        super().__init__(name, [], frames=3)
+        self.delay = delay
+
+    def grab(self) -> bool:
+        if self.left == 3:
+            time.sleep(self.delay)
+        return super().grab()
+
+
+@pytest.fixture
+def slow_cameras(monkeypatch: pytest.MonkeyPatch) -> list[float | None]:
+    """``--left 0 --right 1`` opens two cameras, the left's first grab taking 0.5 s; returns the
+    ``read_timeout`` of every read, as :func:`~stereovision.capture.read_within` got it."""
+    from stereovision import stream as streammod
+
+    timeouts: list[float | None] = []
+
+    def cameras(*args: Any, **kwargs: Any) -> StereoCamera:
+        return StereoCamera(_SlowFirstGrab("L", 0.5), _FakeCap("R", [], frames=3))
+
+    def spy(camera: Any, timeout: float | None = capmod.DEFAULT_READ_TIMEOUT) -> Any:
+        timeouts.append(timeout)
+        return real(camera, timeout)
+
+    real = capmod.read_within
+    monkeypatch.setattr(capmod, "StereoCamera", cameras)
+    monkeypatch.setattr(capmod, "read_within", spy)
+    monkeypatch.setattr(streammod, "read_within", spy)
+    return timeouts
+
+
+@pytest.mark.parametrize("command", ["capture", "stream"])
+def test_cli_read_timeout_reaches_the_read(
+    command: str,
+    tmp_path: Path,
+    slow_cameras: list[float | None],
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A camera slow to deliver its first frame could not be used from the CLI: the library's
+    ``read_timeout`` had no option. ``--read-timeout`` reaches every read: 0.2 s gives the
+    0.5 s first grab up as hung (the CLI's error, exit 2), 2 s and ``none`` (no limit) wait for
+    it, and without it the default (10 s) is kept."""
+    from stereovision.cli import main
+
+    argv = [command, "--left", "0", "--right", "1"]
+    if command == "capture":
+        argv += ["--count", "1"]
+    else:
+        argv += ["--frames", "1", "--no-display", "--no-check", "--max-disparity", "16"]
+
+    def run(*extra: str) -> tuple[int, str]:
+        slow_cameras.clear()
+        out = ["-o", str(tmp_path / str(len(list(tmp_path.iterdir()))))]
+        code = main([*argv, *(out if command == "capture" else []), *extra])
+        return code, capsys.readouterr().err
+
+    t0 = time.perf_counter()
+    code, err = run("--read-timeout", "0.2")
+    assert code == 2
+    assert re.fullmatch(
+        r"stereovision: error: .* delivered no frame in 0\.2 s \(its read did not return: .*\n",
+        err,
+    ), err
+    assert slow_cameras == [0.2]
+    assert time.perf_counter() - t0 < 1.5  # given up at 0.2 s, the grab waited for by close
+    for extra, timeout in ((["--read-timeout", "2"], 2.0), (["--read-timeout", "none"], None)):
+        code, err = run(*extra)
+        assert (code, err) == (0, ""), err
+        assert slow_cameras and set(slow_cameras) == {timeout}
+    code, _ = run()
+    assert code == 0
+    assert slow_cameras and set(slow_cameras) == {capmod.DEFAULT_READ_TIMEOUT}
+
+
+def test_cli_read_timeout_is_refused_with_a_bag(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A bag's read waits on no camera: ``--read-timeout`` with ``--from-bag`` is refused (as
+    ``--fps`` and ``--fourcc`` are), not ignored."""
+    from stereovision.cli import main
+
+    bag = ["--from-bag", str(tmp_path / "run.bag"), "--read-timeout", "30"]
+    for argv in (["capture", *bag, "-o", str(tmp_path / "p")], ["stream", *bag, "--no-display"]):
+        assert main(argv) == 2
+        assert capsys.readouterr().err == (
+            "stereovision: error: --read-timeout bounds a camera's read: a bag is read from disk\n"
+        )
+    assert not (tmp_path / "p").exists()
+
+
 def test_capture_refuses_a_count_or_every_below_one(tmp_path: Path) -> None:
     for kw, said in (
         ({"count": 0}, r"^count: expected a positive number of pairs, got 0$"),

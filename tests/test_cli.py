@@ -402,6 +402,11 @@ def test_depth_rectification_on_a_pair_too_small_says_only_that(
         (["capture", "-o", "x", "--every", "0"], "argument --every: expected a whole number"),
         (["capture", "-o", "x", "--fps", "0"], "argument --fps: expected a frame rate above 0"),
         (["stream", "--fps", "nan"], "argument --fps: expected a frame rate above 0, got 'nan'"),
+        (
+            ["capture", "-o", "x", "--read-timeout", "0"],
+            "argument --read-timeout: expected seconds above 0 or 'none' (no limit), got '0'",
+        ),
+        (["stream", "--read-timeout", "inf"], "argument --read-timeout: expected seconds above 0"),
     ],
 )
 def test_usage_errors_are_one_line(argv: list[str], says: str) -> None:

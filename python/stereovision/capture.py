@@ -76,6 +76,7 @@ __all__ = [
     "add_cli",
     "add_source_args",
     "capture",
+    "cli_read_timeout",
     "fourcc_text",
     "open_source",
     "parse_fourcc",
@@ -1327,6 +1328,36 @@ def add_source_args(p: argparse.ArgumentParser) -> None:
         "over USB; costs some accuracy)",
     )
     add_bag_args(p, "read the pairs from a recorded ROS 1 bag or ROS 2 bag folder instead")
+    from stereovision.cli import read_timeout_seconds  # cli builds its parser with it
+
+    p.add_argument(
+        "--read-timeout",
+        type=read_timeout_seconds,
+        metavar="SECONDS",
+        help=f"give a camera up as hung when a pair's read takes longer (default "
+        f"{DEFAULT_READ_TIMEOUT:g} s; raise it for a camera slow to deliver its first frame on a "
+        "cold start, some GigE and USB3 ones; 'none': no limit)",
+    )
+
+
+def cli_read_timeout(args: argparse.Namespace) -> float | None:
+    """The ``read_timeout`` that ``capture``'s or ``stream``'s ``--read-timeout`` asks for.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed command line (``--read-timeout``, absent or None when not given).
+
+    Returns
+    -------
+    float or None
+        The seconds given; :data:`DEFAULT_READ_TIMEOUT` when the option is not given; None (no
+        limit) for ``none``, which the parser gives as ``math.inf``.
+    """
+    given = getattr(args, "read_timeout", None)
+    if given is None:
+        return DEFAULT_READ_TIMEOUT
+    return None if math.isinf(given) else float(given)
 
 
 def _same_path(left: object, right: object) -> bool:
@@ -1387,6 +1418,9 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
             raise ValueError("--fps: a bag is read as recorded, it has no frame rate to ask for")
         if getattr(args, "fourcc", None):
             raise ValueError("--fourcc asks a camera for a format: a bag holds what it recorded")
+        if getattr(args, "read_timeout", None) is not None:
+            # ignored before it was refused: a bag's read never waits on a camera
+            raise ValueError("--read-timeout bounds a camera's read: a bag is read from disk")
         from stereovision.rosbag import BagCamera
 
         return BagCamera(
@@ -2138,6 +2172,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
             every=args.every,
             log=log,
             temporal=args.temporal,
+            read_timeout=cli_read_timeout(args),
         )
     except KeyboardInterrupt as exc:
         # what was kept, as `batch` says it (it was "stereovision: interrupted" alone)

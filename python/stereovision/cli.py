@@ -1638,6 +1638,40 @@ def positive_rate(text: str) -> float:
     return value
 
 
+#: ``--read-timeout``'s spelling of "no limit" (a camera's read waits as long as it takes).
+NO_READ_TIMEOUT = "none"
+
+
+def read_timeout_seconds(text: str) -> float:
+    """argparse type of ``--read-timeout``: finite seconds above 0, or ``none`` (no limit).
+
+    Refused in the option's name, as ``--fps`` is. ``0`` is refused, not read as "no limit":
+    the library refuses it too, and a word of its own cannot be mistaken for a short wait.
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+
+    Returns
+    -------
+    float
+        The seconds; ``math.inf`` for ``none``
+        (:func:`stereovision.capture.cli_read_timeout` makes it None).
+    """
+    if text.strip().lower() == NO_READ_TIMEOUT:
+        return math.inf
+    try:
+        value = float(text)
+    except ValueError:
+        value = 0.0
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(
+            f"expected seconds above 0 or {NO_READ_TIMEOUT!r} (no limit), got {text!r}"
+        )
+    return value
+
+
 def port_number(text: str) -> int:
     """argparse type of ``--serve``: a TCP port, 0 (any free one) to 65535."""
     try:

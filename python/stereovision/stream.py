@@ -47,6 +47,7 @@ from stereovision.capture import (
     StereoCamera,
     StereoFrame,
     add_source_args,
+    cli_read_timeout,
     open_source,
     read_within,
     resampled_for_temporal_note,
@@ -1208,6 +1209,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
         if not 2 <= args.temporal <= 255:
             raise ValueError(f"--temporal: expected 2-255 pairs to average, got {args.temporal}")
         temporal = TemporalFilter(max_frames=args.temporal)
+    read_timeout = cli_read_timeout(args)
     cam = open_source(args, fps=args.fps)
     stopped = False  # Ctrl-C or SIGTERM while the first pair was read to size the calibration
     if sizeless:
@@ -1216,7 +1218,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
                 # sized by the first pair delivered, not by the mode the driver reports (one
                 # that reports 640x480 and delivers 320x240 failed every pair); --size wins
                 try:
-                    cam = _FirstPairRead(cam)
+                    cam = _FirstPairRead(cam, read_timeout)
                 except KeyboardInterrupt as exc:
                     # the summary of no pair, as an interrupt anywhere else in the stream
                     # gives (it said 'interrupted' alone): run_stream meets it again at once
@@ -1291,6 +1293,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             on_ground=(lambda plane: floor.__setitem__(0, plane)) if bag is not None else None,
             homographies=homographies,
             temporal=temporal,
+            read_timeout=read_timeout,
         )
     finally:
         try:
