@@ -1328,6 +1328,28 @@ def test_saved_xml_is_xml_and_saved_yaml_is_yaml(tmp_path: Path) -> None:
         assert c.save(tmp_path / f"c{suffix}").read_text().startswith("%YAML")
 
 
+def test_an_xml_file_without_its_declaration_is_read(tmp_path: Path) -> None:
+    """An OpenCV XML calibration without its ``<?xml ...?>`` line (hand-edited, or from a tool
+    that omits it) was taken for OpenCV XML and parsed as YAML: "cannot parse ... line 1:
+    Invalid or unsupported syntax". It reads as the file with the line; a real error in it is
+    said at the file's own line number."""
+    c = raw_calib()
+    xml = c.save(tmp_path / "c.xml").read_text()
+    head, body = xml.split("\n", 1)
+    assert head == '<?xml version="1.0"?>' and body.startswith("<opencv_storage>")
+    for name, text in (("bare.xml", body), ("indented.xml", "\n  " + body)):
+        (tmp_path / name).write_text(text)
+        assert Calibration.load(tmp_path / name) == c
+        assert Calibration.from_file(tmp_path / name) == c
+    lines = body.splitlines()
+    n = next(i for i, line in enumerate(lines) if "<rows>" in line)
+    lines[n] = lines[n].replace("</rows>", "</rowz>")
+    (tmp_path / "broken.xml").write_text("\n".join(lines))
+    says = rf"^cannot parse .*broken\.xml as OpenCV YAML/XML: line {n + 1}: Mismatched closing tag$"
+    with pytest.raises(ValueError, match=says):
+        Calibration.load(tmp_path / "broken.xml")
+
+
 def test_opencv_stereo_calib_names_m1_m2_load_as_k1_k2(tmp_path: Path) -> None:
     """OpenCV's stereo_calib names the camera matrices M1/M2 (in YAML and XML): they load as
     K1/K2, the same rig."""

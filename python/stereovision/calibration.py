@@ -237,7 +237,14 @@ def _node_matrix(node: Any, key: str, source: str, vector: bool = False) -> npt.
 def _open_filestorage(text: str, source: str) -> Any:
     """``cv2.FileStorage`` reading ``text`` (OpenCV YAML/XML), opened, or a ValueError naming
     ``source``. A damaged file makes OpenCV's parser raise cv2.error (or, from the constructor,
-    a SystemError wrapping it): both are the file's fault."""
+    a SystemError wrapping it): both are the file's fault.
+
+    An XML file without its ``<?xml ...?>`` declaration (hand-edited, or from a tool that
+    omits it) is read as XML: OpenCV took it for YAML ("line 1: Invalid or unsupported
+    syntax"). The declaration goes on the first line, so the parser's line numbers stay the
+    file's."""
+    if text.lstrip().startswith("<opencv_storage"):
+        text = '<?xml version="1.0"?>' + text
     try:
         fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
     except (cv2.error, SystemError) as exc:
