@@ -407,6 +407,7 @@ def test_depth_rectification_on_a_pair_too_small_says_only_that(
             "argument --read-timeout: expected seconds above 0 or 'none' (no limit), got '0'",
         ),
         (["stream", "--read-timeout", "inf"], "argument --read-timeout: expected seconds above 0"),
+        (["gui", "--read-timeout", "-1"], "argument --read-timeout: expected seconds above 0"),
     ],
 )
 def test_usage_errors_are_one_line(argv: list[str], says: str) -> None:

@@ -2546,6 +2546,68 @@ def test_open_cameras_asks_the_chosen_pixel_format(data_dir, monkeypatch):
         build_app(parser.parse_args(["--fourcc", "MJPG"]))
 
 
+def test_gui_read_timeout_reaches_every_camera_read(data_dir, monkeypatch):
+    """`gui` had no --read-timeout (capture and stream now have one) and read its cameras
+    without a limit. The option reaches the reads of the cameras it opens and of those opened
+    on the page: 0.2 s, 'none' (no limit), capture's 10 s when not given; a bag is refused."""
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision import capture
+    from stereovision.gui import add_arguments, app, build_app
+
+    frame = cv2.imread(str(data_dir / "middlebury2001" / "venus" / "left.png"))
+    timeouts: list[float | None] = []
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None):
+            pass
+
+        def read(self):
+            return frame, frame
+
+        def close(self):
+            pass
+
+    def spy(camera, timeout=capture.DEFAULT_READ_TIMEOUT):
+        timeouts.append(timeout)
+        return camera.read()
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    monkeypatch.setattr(sources, "read_within", spy)
+    apps: list[dict[str, Any]] = []
+    real_app = app.StereoApp
+    # the app itself (a 3-D plotter, a second or so) is built once, below
+    monkeypatch.setattr(app, "StereoApp", lambda *a, **kw: apps.append(kw) or kw)
+    parser = argparse.ArgumentParser()
+    add_arguments(parser)
+    cams = ["--left", "0", "--right", "1"]
+    for given, timeout in (
+        (["--read-timeout", "0.2"], 0.2),
+        (["--read-timeout", "none"], None),
+        ([], capture.DEFAULT_READ_TIMEOUT),
+    ):
+        built = build_app(parser.parse_args([*cams, *given]))
+        timeouts.clear()
+        built["source"].read()
+        assert timeouts == [timeout] and built["read_timeout"] == timeout
+    # no cameras given: the app opens those typed on the page with it
+    assert build_app(parser.parse_args(["--read-timeout", "0.2"]))["read_timeout"] == 0.2
+    page = real_app(
+        get_server("test-read-timeout", client_type="vue3"),
+        AllowedFolders([data_dir]),
+        data_dir / "middlebury2003" / "cones",
+        read_timeout=0.2,
+    )
+    monkeypatch.setattr(page, "_spawn", lambda coro: coro.close())  # no event loop here
+    page.state.cam_left, page.state.cam_right = "0", "1"
+    timeouts.clear()
+    page.open_cameras()
+    assert page.state.error == "" and page.state.live and timeouts == [0.2]
+    with pytest.raises(ValueError, match=r"^--read-timeout bounds a camera's read: a bag is"):
+        build_app(parser.parse_args(["--from-bag", "x.bag", "--read-timeout", "5"]))
+
+
 def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
     data_dir, tmp_path, capsys
 ):

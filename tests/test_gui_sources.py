@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import time
 import types
 from pathlib import Path
 from typing import Any, ClassVar
@@ -506,6 +507,61 @@ def test_open_stereo_source_hands_size_fourcc_and_file_flag(
     with pytest.raises(ValueError, match=r"^fourcc: expected four characters"):
         sources.open_stereo_source(0, 1, fourcc="MJPEG")  # checked before a camera opens
     assert len(made) == 3
+
+
+class _SlowStart:
+    """A VideoCapture stand-in whose first grab takes ``delay`` s (a camera slow to start)."""
+
+    def __init__(self, delay: float) -> None:
+        self.delay, self.grabs = delay, 0
+
+    def isOpened(self) -> bool:
+        return True
+
+    def grab(self) -> bool:
+        self.grabs += 1
+        if self.grabs == 1:
+            time.sleep(self.delay)
+        return True
+
+    def retrieve(self) -> tuple[bool, np.ndarray]:
+        return True, _frame(self.grabs)
+
+    def get(self, prop: int) -> float:
+        return {cv2.CAP_PROP_FRAME_WIDTH: 3.0, cv2.CAP_PROP_FRAME_HEIGHT: 2.0}.get(prop, 0.0)
+
+    def set(self, prop: int, value: float) -> bool:
+        return False
+
+    def release(self) -> None:
+        pass
+
+
+def test_open_stereo_source_gives_a_hung_read_up(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The GUI read its cameras without a time limit (capture's and stream's reads have one):
+    a hung camera froze the page for good. A read now takes at most ``read_timeout`` s
+    (capture's default): 0.2 s gives a 0.5 s first grab up, as capture says it; 2 s and None
+    (no limit) wait for it."""
+    import stereovision.capture as capture
+
+    real = capture.StereoCamera
+    monkeypatch.setattr(
+        capture, "StereoCamera", lambda *a, **kw: real(_SlowStart(0.5), _SlowStart(0.0))
+    )
+    src = sources.open_stereo_source(0, 1, read_timeout=0.2)
+    t0 = time.perf_counter()
+    with pytest.raises(capture.SourceError, match=r" delivered no frame in 0\.2 s \(its read did"):
+        src.read()
+    assert time.perf_counter() - t0 < 0.45
+    src.close()
+    for timeout in (2.0, None):
+        src = sources.open_stereo_source(0, 1, read_timeout=timeout)
+        left, right = src.read()
+        assert (int(left[0, 0, 0]), int(right[0, 0, 0])) == (1, 1)
+        src.close()
+    src = sources.open_stereo_source(0, 1)
+    assert src._read_timeout == capture.DEFAULT_READ_TIMEOUT == 10.0  # type: ignore[attr-defined]
+    src.close()
 
 
 def test_open_stereo_source_falls_back_to_opencv(

@@ -74,6 +74,7 @@ __all__ = [
     "StereoFrame",
     "add_bag_args",
     "add_cli",
+    "add_read_timeout",
     "add_source_args",
     "capture",
     "cli_read_timeout",
@@ -1328,6 +1329,12 @@ def add_source_args(p: argparse.ArgumentParser) -> None:
         "over USB; costs some accuracy)",
     )
     add_bag_args(p, "read the pairs from a recorded ROS 1 bag or ROS 2 bag folder instead")
+    add_read_timeout(p)
+
+
+def add_read_timeout(p: argparse.ArgumentParser) -> None:
+    """``--read-timeout SECONDS`` of the commands that read cameras (``capture``, ``stream``,
+    ``gui``); :func:`cli_read_timeout` reads it."""
     from stereovision.cli import read_timeout_seconds  # cli builds its parser with it
 
     p.add_argument(
@@ -1341,7 +1348,7 @@ def add_source_args(p: argparse.ArgumentParser) -> None:
 
 
 def cli_read_timeout(args: argparse.Namespace) -> float | None:
-    """The ``read_timeout`` that ``capture``'s or ``stream``'s ``--read-timeout`` asks for.
+    """The ``read_timeout`` that ``--read-timeout`` (:func:`add_read_timeout`) asks for.
 
     Parameters
     ----------

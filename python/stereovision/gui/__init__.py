@@ -77,11 +77,18 @@ def build_app(args: argparse.Namespace) -> Any:
         from stereovision.cli import load_calibration
 
         load_calibration(None, args.calib_unit)
+    if from_bag is not None and getattr(args, "read_timeout", None) is not None:
+        raise ValueError("--read-timeout bounds a camera's read: a bag is read from disk")
+    from stereovision.capture import cli_read_timeout
+
+    read_timeout = cli_read_timeout(args)  # also for the cameras opened on the page
     source = None
     label = None
     names = (str(args.left or ""), str(args.right or ""))
     if args.left is not None:
-        source = open_stereo_source(args.left, args.right, fourcc=getattr(args, "fourcc", None))
+        source = open_stereo_source(
+            args.left, args.right, fourcc=getattr(args, "fourcc", None), read_timeout=read_timeout
+        )
     elif from_bag is not None:
         from stereovision.gui.sources import open_bag_source
 
@@ -105,6 +112,7 @@ def build_app(args: argparse.Namespace) -> Any:
         source_names=names,
         source_label=label,
         sizeless_calib=sizeless,
+        read_timeout=read_timeout,
     )
 
 
@@ -235,6 +243,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "play a rig recorded in a ROS 1 / ROS 2 bag instead (its camera_info as calibration)",
         skew=False,
     )
+    from stereovision.capture import add_read_timeout
+
+    add_read_timeout(p)
     p.add_argument(
         "--calib",
         help="calibration of the camera pair (YAML/JSON, calib.txt, KITTI, Kalibr, ROS folder)",

@@ -41,6 +41,7 @@ import numpy.typing as npt
 from stereovision import release_memory
 from stereovision._validate import first_line
 from stereovision.calibration import fit_to_frames
+from stereovision.capture import DEFAULT_READ_TIMEOUT
 from stereovision.gui.sources import (
     CLOUD_SUFFIXES,
     IMAGE_SUFFIXES,
@@ -1231,6 +1232,9 @@ class StereoApp:
         output, a ``Q.dat`` alone), given instead of ``calib``: the first pair it is used with
         (the cameras' or an image folder's first pair, files) sizes it; a pair of another size
         is then refused as ``depth`` refuses it ("calibration is for WxH images, got ...").
+    read_timeout : float or None
+        Seconds a read of the cameras opened on the page may take (``--read-timeout``;
+        :data:`~stereovision.capture.DEFAULT_READ_TIMEOUT`; None: no limit).
     """
 
     def __init__(
@@ -1243,6 +1247,7 @@ class StereoApp:
         source_names: tuple[str, str] = ("", ""),
         source_label: str | None = None,
         sizeless_calib: tuple[str, str | None] | None = None,
+        read_timeout: float | None = DEFAULT_READ_TIMEOUT,
     ) -> None:
         import pyvista as pv
 
@@ -1257,6 +1262,7 @@ class StereoApp:
         self.demo_scene = demo_scene
         self.source = source
         self.source_calib = calib
+        self.read_timeout = read_timeout
         #: ``--calib`` that holds no image size, until the first pair it is used with sizes it
         #: (:meth:`_calib_for`); then the size it was read at, which every pair must have.
         self._sizeless_calib = sizeless_calib
@@ -1648,7 +1654,7 @@ class StereoApp:
             left = self._camera_source(self.state.cam_left)
             right = self._camera_source(self.state.cam_right)
             fourcc = None if self.state.fourcc == FOURCCS[0] else self.state.fourcc
-            source = open_stereo_source(left, right, fourcc=fourcc)
+            source = open_stereo_source(left, right, fourcc=fourcc, read_timeout=self.read_timeout)
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
             return

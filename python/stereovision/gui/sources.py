@@ -18,7 +18,7 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision.capture import camera_hint
+from stereovision.capture import DEFAULT_READ_TIMEOUT, camera_hint, read_within
 from stereovision.capture import parse_source as capture_parse_source
 from stereovision.io import _opencv_quiet
 
@@ -389,12 +389,14 @@ class _CaptureAdapter:
     """Wraps ``stereovision.capture.StereoCamera`` into :class:`StereoSource`.
 
     When both sources are files (videos, image sequences) and one ends, the pair is opened again
-    from the start, like :class:`VideoPair`.
+    from the start, like :class:`VideoPair`. A read is given up after ``read_timeout`` seconds
+    (:func:`~stereovision.capture.read_within`; None: no limit).
     """
 
-    def __init__(self, factory: Any, files: bool) -> None:
+    def __init__(self, factory: Any, files: bool, read_timeout: float | None = None) -> None:
         self._factory = factory
         self._files = files
+        self._read_timeout = read_timeout
         self._camera = factory()
 
     def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
@@ -408,7 +410,8 @@ class _CaptureAdapter:
             return self._read()
 
     def _read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
-        got = self._camera.read()
+        # bounded as capture's and stream's reads are: a hung camera froze the page for good
+        got = read_within(self._camera, self._read_timeout)
         if isinstance(got, tuple) and len(got) == 2:
             left, right = got
         elif isinstance(got, tuple) and len(got) == 3 and isinstance(got[0], bool):
@@ -496,6 +499,7 @@ def open_stereo_source(
     right: int | str,
     size: tuple[int, int] | None = None,
     fourcc: str | None = None,
+    read_timeout: float | None = DEFAULT_READ_TIMEOUT,
 ) -> StereoSource:
     """Open a camera pair: ``stereovision.capture.StereoCamera`` if available, else OpenCV.
 
@@ -508,6 +512,10 @@ def open_stereo_source(
     fourcc : str, optional
         Pixel format asked of the cameras (``"MJPG"``, ``"YUYV"``; None: the driver's), as
         ``stereovision capture --fourcc``: two webcams on one USB 2 bus often need MJPG.
+    read_timeout : float or None
+        Seconds a pair's read may take before the camera is given up as hung
+        (:data:`~stereovision.capture.DEFAULT_READ_TIMEOUT`; None: no limit), as ``capture``'s
+        and ``stream``'s ``--read-timeout``.
 
     Raises
     ------
@@ -521,7 +529,9 @@ def open_stereo_source(
         return VideoPair(left, right, size)
     code = parse_fourcc(fourcc)
     files = isinstance(left, str) and isinstance(right, str)
-    return _CaptureAdapter(lambda: StereoCamera(left, right, image_size=size, fourcc=code), files)
+    return _CaptureAdapter(
+        lambda: StereoCamera(left, right, image_size=size, fourcc=code), files, read_timeout
+    )
 
 
 def scale_pair(
