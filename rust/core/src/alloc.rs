@@ -244,6 +244,12 @@ unsafe impl ZeroBits for i16 {}
 unsafe impl ZeroBits for i32 {}
 // SAFETY: as above.
 unsafe impl ZeroBits for f32 {}
+// SAFETY: as above.
+unsafe impl ZeroBits for f64 {}
+// SAFETY: as above.
+unsafe impl ZeroBits for usize {}
+// SAFETY: a zero byte is `false`.
+unsafe impl ZeroBits for bool {}
 
 /// `vec![T::zero; n]` that returns [`CoreError::OutOfMemory`] instead of aborting the process
 /// when the allocation fails. The same zeroed allocation as `vec!` (pages the system hands out
@@ -280,6 +286,16 @@ pub fn try_reserve_len<T>(v: &mut Vec<T>, n: usize, what: &'static str) -> Resul
         .map_err(|_| CoreError::oom(n.saturating_mul(std::mem::size_of::<T>()), what))
 }
 
+/// `it.collect()` of an iterator of exactly `n` values into a vector allocated at once, or
+/// [`CoreError::OutOfMemory`] (a `collect` aborts the process when it cannot allocate).
+pub fn try_collect<T>(n: usize, it: impl Iterator<Item = T>, what: &'static str) -> Result<Vec<T>> {
+    let mut v = Vec::new();
+    try_reserve_len(&mut v, n, what)?;
+    v.extend(it);
+    debug_assert_eq!(v.len(), n, "try_collect: the iterator must yield n values");
+    Ok(v)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -308,6 +324,11 @@ mod tests {
         assert_eq!(try_filled(4, f32::NAN, "b").unwrap().len(), 4);
         assert_eq!(human_bytes(3 << 30), "3.00 GiB (3221225472 bytes)");
         assert_eq!(human_bytes(512), "512 bytes");
+        assert!(matches!(
+            try_collect(1usize << 61, std::iter::repeat(0u32), "c"),
+            Err(CoreError::OutOfMemory { what: "c", .. })
+        ));
+        assert_eq!(try_collect(3, 1..4u8, "c").unwrap(), vec![1, 2, 3]);
     }
 
     #[test]
