@@ -36,16 +36,16 @@ fn bench_segment(c: &mut Criterion) {
     g.sample_size(20).measurement_time(Duration::from_secs(3));
     g.throughput(Throughput::Elements((w * h) as u64));
     g.bench_function("equal_regions", |b| {
-        b.iter(|| graph_segments(&img, w, h, 3, 0.0, 1))
+        b.iter(|| graph_segments(&img, w, h, 3, 0.0, 1).unwrap())
     });
     let img_u8: Vec<u8> = img.iter().map(|&v| (v * 16.0) as u8).collect();
     g.bench_function("quantised_regions", |b| {
         b.iter(|| quantised_regions(&img_u8, w, h, 3, 16, 0))
     });
     g.bench_function("felzenszwalb_k300", |b| {
-        b.iter(|| graph_segments(&img, w, h, 3, 300.0, 20))
+        b.iter(|| graph_segments(&img, w, h, 3, 300.0, 20).unwrap())
     });
-    let labels = graph_segments(&img, w, h, 3, 0.0, 1);
+    let labels = graph_segments(&img, w, h, 3, 0.0, 1).unwrap();
     g.bench_function("plane_fill", |b| {
         b.iter(|| {
             let mut d = disp.clone();
@@ -88,7 +88,7 @@ fn bench_segment(c: &mut Criterion) {
         jump: 2.0,
     };
     g.bench_function("fattened", |b| {
-        b.iter(|| fattened(&raised, &grey, w, h, &fp))
+        b.iter(|| fattened(&raised, &grey, w, h, &fp).unwrap())
     });
     // The fill's last two steps on the raised map: the colour side rule (its holes next to the
     // square's left edge have a nearer left side half the time) and the reference row rule.

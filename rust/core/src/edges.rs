@@ -11,6 +11,8 @@
 
 use rayon::prelude::*;
 
+use crate::alloc::{try_zeroed, ZeroBits};
+use crate::error::Result;
 use crate::fill::fill_row;
 
 /// Thresholds of [`fattened`].
@@ -26,30 +28,44 @@ pub struct FattenParams {
 
 /// The fattened pixels of a row-major `(h, w)` disparity map `d` (NaN = hole) with the grey
 /// `guide` image of the same size: marked along the rows or along the columns (module docs).
-/// Rows (and columns) run in parallel, each independent of the others.
-pub fn fattened(d: &[f32], guide: &[f32], w: usize, h: usize, p: &FattenParams) -> Vec<bool> {
+/// Rows (and columns) run in parallel, each independent of the others. A failed allocation of
+/// an image-sized buffer is [`CoreError::OutOfMemory`](crate::CoreError::OutOfMemory) (a `vec!` aborted the process).
+pub fn fattened(
+    d: &[f32],
+    guide: &[f32],
+    w: usize,
+    h: usize,
+    p: &FattenParams,
+) -> Result<Vec<bool>> {
     assert_eq!(d.len(), w * h, "d must hold w * h values");
     assert_eq!(guide.len(), w * h, "guide must hold w * h values");
-    let mut out = vec![false; w * h];
+    let mut out = try_zeroed::<bool>(w * h, "the fattened-edge check's marks")?;
     if w == 0 || h == 0 {
-        return out;
+        return Ok(out);
     }
     mark_rows(d, guide, w, p, &mut out);
     // The columns: the same rule on the transposed map, marks transposed back.
-    let (dt, gt) = (transpose(d, w, h), transpose(guide, w, h));
-    let mut cols = vec![false; w * h];
+    let what = "the fattened-edge check's transposed maps";
+    let (dt, gt) = (transpose(d, w, h, what)?, transpose(guide, w, h, what)?);
+    let mut cols = try_zeroed::<bool>(w * h, what)?;
     mark_rows(&dt, &gt, h, p, &mut cols);
-    for (o, c) in out.iter_mut().zip(transpose(&cols, h, w)) {
+    drop((dt, gt));
+    for (o, c) in out.iter_mut().zip(transpose(&cols, h, w, what)?) {
         *o |= c;
     }
-    out
+    Ok(out)
 }
 
 /// The `(w, h)` transpose of a row-major `(h, w)` map: bands of `TILE` output rows (input
 /// columns) in parallel, each read row by row, so both sides stay in the cache.
-fn transpose<T: Copy + Default + Send + Sync>(a: &[T], w: usize, h: usize) -> Vec<T> {
+fn transpose<T: ZeroBits + Send + Sync>(
+    a: &[T],
+    w: usize,
+    h: usize,
+    what: &'static str,
+) -> Result<Vec<T>> {
     const TILE: usize = 32;
-    let mut t = vec![T::default(); w * h];
+    let mut t = try_zeroed::<T>(w * h, what)?;
     t.par_chunks_mut(TILE * h)
         .enumerate()
         .for_each(|(b, band)| {
@@ -61,7 +77,7 @@ fn transpose<T: Copy + Default + Send + Sync>(a: &[T], w: usize, h: usize) -> Ve
                 }
             }
         });
-    t
+    Ok(t)
 }
 
 /// Marks the fattened pixels along the rows of width `w` into `out` (same layout).
@@ -161,7 +177,7 @@ mod tests {
         let w = 10;
         let d: Vec<f32> = (0..w).map(|x| if x < 3 { 1.0 } else { 9.0 }).collect();
         let g: Vec<f32> = (0..w).map(|x| if x < 6 { 0.2 } else { 0.8 }).collect();
-        let m = fattened(&d, &g, w, 1, &P);
+        let m = fattened(&d, &g, w, 1, &P).unwrap();
         let marked: Vec<usize> = (0..w).filter(|&x| m[x]).collect();
         assert_eq!(marked, vec![3, 4, 5]);
     }
@@ -171,7 +187,7 @@ mod tests {
         let w = 10;
         let d: Vec<f32> = (0..w).map(|x| if x < 6 { 1.0 } else { 9.0 }).collect();
         let g: Vec<f32> = (0..w).map(|x| if x < 6 { 0.2 } else { 0.8 }).collect();
-        assert!(fattened(&d, &g, w, 1, &P).iter().all(|&m| !m));
+        assert!(fattened(&d, &g, w, 1, &P).unwrap().iter().all(|&m| !m));
     }
 
     #[test]
@@ -180,7 +196,7 @@ mod tests {
         let h = 10;
         let d: Vec<f32> = (0..h).map(|y| if y < 3 { 1.0 } else { 9.0 }).collect();
         let g: Vec<f32> = (0..h).map(|y| if y < 6 { 0.2 } else { 0.8 }).collect();
-        let m = fattened(&d, &g, 1, h, &P);
+        let m = fattened(&d, &g, 1, h, &P).unwrap();
         assert_eq!((0..h).filter(|&y| m[y]).collect::<Vec<_>>(), vec![3, 4, 5]);
     }
 
@@ -192,14 +208,30 @@ mod tests {
         let d: Vec<f32> = (0..w).map(|x| if x < 3 { 1.0 } else { 9.0 }).collect();
         let g: Vec<f32> = (0..w).map(|x| if x < 6 { 0.2 } else { 0.8 }).collect();
         let whole = FattenParams { radius: w, ..P };
-        let want = fattened(&d, &g, w, 1, &whole);
+        let want = fattened(&d, &g, w, 1, &whole).unwrap();
         assert_eq!(
             (0..w).filter(|&x| want[x]).collect::<Vec<_>>(),
             vec![3, 4, 5]
         );
         for radius in [w + 1, 1 << 40, usize::MAX] {
-            assert_eq!(fattened(&d, &g, w, 1, &FattenParams { radius, ..P }), want);
+            assert_eq!(
+                fattened(&d, &g, w, 1, &FattenParams { radius, ..P }).unwrap(),
+                want
+            );
         }
+    }
+
+    #[test]
+    fn a_transpose_too_large_to_allocate_is_an_error() {
+        // It was a `vec!`: a failed allocation aborted the process.
+        let e = transpose::<f32>(&[], 1 << 62, 2, "the test's transpose").unwrap_err();
+        assert!(matches!(
+            e,
+            crate::CoreError::OutOfMemory {
+                what: "the test's transpose",
+                ..
+            }
+        ));
     }
 
     /// The rule along the rows written out plainly (`tests/reference/edges_ref.py`): the row
@@ -297,7 +329,7 @@ mod tests {
                         let want: Vec<bool> = (0..w * h)
                             .map(|i| rows[i] || cols[(i % w) * h + i / w])
                             .collect();
-                        assert_eq!(fattened(&d, &g, w, h, &p), want, "{w}x{h} {p:?}");
+                        assert_eq!(fattened(&d, &g, w, h, &p).unwrap(), want, "{w}x{h} {p:?}");
                         marked += want.iter().filter(|&&m| m).count();
                     }
                 }

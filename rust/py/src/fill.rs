@@ -84,9 +84,8 @@ pub fn fattened<'py>(
         ratio,
         jump,
     };
-    let mask = crate::workers::detach(py, || {
-        guard("fattened", || Ok(core_fattened(&d, &g, w, h, &p)))
-    })?;
+    let mask =
+        crate::workers::detach(py, || guard("fattened", || core_fattened(&d, &g, w, h, &p)))?;
     vec_to_numpy(py, (h, w), mask)
 }
 
