@@ -10,6 +10,7 @@
 //! operations in the same order) allocates and walks half a dozen full-size temporaries, a tenth
 //! of a live frame at VGA.
 
+use crate::alloc::try_zeroed;
 use crate::error::{CoreError, Result};
 use crate::image::check_map_pair;
 use crate::parallel::for_each_row2;
@@ -56,8 +57,9 @@ pub fn depth_rectified(
             return Err(CoreError::param(name, format!("must be > 0, got {v}")));
         }
     }
-    let mut depth = vec![0f32; n];
-    let mut sig = vec![0f32; n];
+    // Checked: a failed `vec!` aborted the process.
+    let mut depth = try_zeroed::<f32>(n, "the depth map")?;
+    let mut sig = try_zeroed::<f32>(n, "the depth sigma map")?;
     if n == 0 {
         return Ok((depth, sig));
     }
