@@ -21,6 +21,7 @@
 //! Everything is row-band parallel with per-row arithmetic in a fixed order, so the output does
 //! not depend on the thread count. `tests/reference/refine_ref.py` is the same maths in NumPy.
 
+use crate::alloc::{try_collect, try_filled, try_zeroed, ZeroBits};
 use crate::error::{CoreError, Result};
 use crate::image::check_map_pair;
 use crate::parallel::for_each_row;
@@ -160,7 +161,7 @@ pub fn box3_radius(sigma: f32) -> usize {
 }
 
 /// A sample type of the box sums: `f32` maps, `f64` moments (running sums are always f64).
-pub trait BoxSample: Copy + Default + Send + Sync {
+pub trait BoxSample: Copy + Default + Send + Sync + ZeroBits {
     fn to64(self) -> f64;
     fn from64(v: f64) -> Self;
 }
@@ -260,8 +261,15 @@ fn box_cols<T: BoxSample>(src: &[T], dst: &mut [T], w: usize, h: usize, b: usize
 }
 
 /// Three box passes of half-width `b` along x, then three along y (zero padding): a
-/// Gaussian-like smoothing whose cost does not grow with its width.
-pub fn box3_zero<T: BoxSample>(a: Vec<T>, w: usize, h: usize, b: usize) -> Vec<T> {
+/// Gaussian-like smoothing whose cost does not grow with its width. The column strips (an
+/// image's worth in all) are allocated checked: [`CoreError::OutOfMemory`] naming `what`.
+pub fn box3_zero<T: BoxSample>(
+    a: Vec<T>,
+    w: usize,
+    h: usize,
+    b: usize,
+    what: &'static str,
+) -> Result<Vec<T>> {
     let mut rows = a;
     // Rows in groups of ROWS_AT_ONCE: their running sums interleaved, so the adds of one row do
     // not wait on each other (each row's sums in its own order, as box_row).
@@ -295,17 +303,19 @@ pub fn box3_zero<T: BoxSample>(a: Vec<T>, w: usize, h: usize, b: usize) -> Vec<T
             .par_iter()
             .map(|&x0| {
                 let sw = STRIP.min(w - x0);
-                let mut cur: Vec<T> = (0..h)
-                    .flat_map(|y| rows[y * w + x0..y * w + x0 + sw].iter().copied())
-                    .collect();
-                let mut tmp = vec![T::default(); sw * h];
+                let mut cur = try_collect(
+                    sw * h,
+                    (0..h).flat_map(|y| rows[y * w + x0..y * w + x0 + sw].iter().copied()),
+                    what,
+                )?;
+                let mut tmp = try_zeroed::<T>(sw * h, what)?;
                 for _ in 0..3 {
                     box_cols(&cur, &mut tmp, sw, h, b);
                     std::mem::swap(&mut cur, &mut tmp);
                 }
-                (x0, cur)
+                Ok((x0, cur))
             })
-            .collect()
+            .collect::<Result<_>>()?
     };
     // Back into rows (the row-pass buffer, no longer read), in parallel over the rows.
     let mut out = rows;
@@ -315,7 +325,7 @@ pub fn box3_zero<T: BoxSample>(a: Vec<T>, w: usize, h: usize, b: usize) -> Vec<T
             row[*x0..x0 + sw].copy_from_slice(&strip[y * sw..(y + 1) * sw]);
         }
     });
-    out
+    Ok(out)
 }
 
 /// Local plane fit of a map with holes (first-order normalised convolution with the three-box
@@ -326,8 +336,15 @@ pub fn box3_zero<T: BoxSample>(a: Vec<T>, w: usize, h: usize, b: usize) -> Vec<T
 /// foliage does not). Where the
 /// neighbourhood's positions do not fix a plane (fewer than three, or all on a line) the plane
 /// is flat (the mean). NaN where no value lies within reach. Moments in f64, about the image
-/// centre.
-pub fn nc_plane(d: &[f32], w: usize, h: usize, sigma: f32, residual: bool) -> (Vec<f32>, Vec<f32>) {
+/// centre. A failed allocation of a map is [`CoreError::OutOfMemory`].
+pub fn nc_plane(
+    d: &[f32],
+    w: usize,
+    h: usize,
+    sigma: f32,
+    residual: bool,
+) -> Result<(Vec<f32>, Vec<f32>)> {
+    let what = "the refinement's local plane fit";
     use rayon::prelude::*;
     let b = box3_radius(sigma);
     let (cx, cy) = ((w as f64 - 1.0) / 2.0, (h as f64 - 1.0) / 2.0);
@@ -358,17 +375,17 @@ pub fn nc_plane(d: &[f32], w: usize, h: usize, sigma: f32, residual: bool) -> (V
     let s: Vec<Vec<f64>> = (0..n_maps)
         .into_par_iter()
         .map(|k| {
-            let mut m = vec![0f64; n];
+            let mut m = try_zeroed::<f64>(n, what)?;
             for_each_row(&mut m, w, |y, row| {
                 for (x, v) in row.iter_mut().enumerate() {
                     *v = moment(k, x, y);
                 }
             });
-            box3_zero(m, w, h, b)
+            box3_zero(m, w, h, b, what)
         })
-        .collect();
-    let mut plane = vec![f32::NAN; n];
-    let mut resid = vec![f32::NAN; n];
+        .collect::<Result<_>>()?;
+    let mut plane = try_filled(n, f32::NAN, what)?;
+    let mut resid = try_filled(n, f32::NAN, what)?;
     plane
         .par_chunks_mut(w)
         .zip(resid.par_chunks_mut(w))
@@ -382,7 +399,7 @@ pub fn nc_plane(d: &[f32], w: usize, h: usize, sigma: f32, residual: bool) -> (V
                 }
             }
         });
-    (plane, resid)
+    Ok((plane, resid))
 }
 
 /// The plane's value and RMS residual at pixel `i` (at `(up, vp)` about the image centre) from
@@ -429,19 +446,25 @@ fn plane_at(s: &[Vec<f64>], i: usize, up: f64, vp: f64) -> Option<(f64, f64)> {
 
 /// Normalised-convolution smoothing of a map with holes (NaN): `K*(v m) / K*m` with the
 /// three-box kernel of [`box3_radius`]; NaN where no value lies within the kernel's reach.
-pub fn nc_smooth(d: &[f32], w: usize, h: usize, sigma: f32) -> Vec<f32> {
+/// A failed allocation of a map is [`CoreError::OutOfMemory`].
+pub fn nc_smooth(d: &[f32], w: usize, h: usize, sigma: f32) -> Result<Vec<f32>> {
+    let what = "the refinement's smoothed map";
     let b = box3_radius(sigma);
-    let m: Vec<f32> = d.iter().map(|v| v.is_finite() as u8 as f32).collect();
-    let vm: Vec<f32> = d
-        .iter()
-        .map(|&v| if v.is_finite() { v } else { 0.0 })
-        .collect();
-    let num = box3_zero(vm, w, h, b);
-    let den = box3_zero(m, w, h, b);
-    num.iter()
-        .zip(&den)
-        .map(|(&n, &dd)| if dd > 0.5 { n / dd } else { f32::NAN })
-        .collect()
+    let m = try_collect(d.len(), d.iter().map(|v| v.is_finite() as u8 as f32), what)?;
+    let vm = try_collect(
+        d.len(),
+        d.iter().map(|&v| if v.is_finite() { v } else { 0.0 }),
+        what,
+    )?;
+    let num = box3_zero(vm, w, h, b, what)?;
+    let den = box3_zero(m, w, h, b, what)?;
+    try_collect(
+        num.len(),
+        num.iter()
+            .zip(&den)
+            .map(|(&n, &dd)| if dd > 0.5 { n / dd } else { f32::NAN }),
+        what,
+    )
 }
 
 /// Catmull-Rom weights of the samples at `i - 1, i, i + 1, i + 2` for a position `i + f`.
@@ -613,17 +636,20 @@ struct LeftStats {
     right_mean: f32,
 }
 
+/// The name of the left image's window statistics in an out-of-memory error.
+const STATS: &str = "the refinement's window statistics";
+
 /// Separable Gaussian-window sums (zero padding, rows then columns) of a full image.
-fn window_sum(a: &[f32], w: usize, h: usize, taps: &[f32]) -> Vec<f32> {
-    let mut tmp = vec![0f32; w * h];
+fn window_sum(a: &[f32], w: usize, h: usize, taps: &[f32]) -> Result<Vec<f32>> {
+    let mut tmp = try_zeroed::<f32>(w * h, STATS)?;
     for_each_row(&mut tmp, w, |y, out| {
         hconv(&a[y * w..(y + 1) * w], out, taps)
     });
-    let mut out = vec![0f32; w * h];
+    let mut out = try_zeroed::<f32>(w * h, STATS)?;
     for_each_row(&mut out, w, |y, o| {
         vsum1(o, &taps_inside(taps, y, h, |yy| yy * w), &tmp);
     });
-    out
+    Ok(out)
 }
 
 /// Mean of an image, summed in f64 in a fixed order.
@@ -652,7 +678,7 @@ fn taps_inside(
 /// [`window_sum`] of an image of ones, without the passes: every row of the row pass is the
 /// same, so every row whose column window lies inside the image sums the same terms in the same
 /// order; those rows are one copied row, the others (the top and bottom `r`) are summed.
-fn window_mass(w: usize, h: usize, taps: &[f32]) -> Vec<f32> {
+fn window_mass(w: usize, h: usize, taps: &[f32]) -> Result<Vec<f32>> {
     let r = taps.len() / 2;
     let ones = vec![1f32; w];
     let mut row = vec![0f32; w];
@@ -663,7 +689,7 @@ fn window_mass(w: usize, h: usize, taps: &[f32]) -> Vec<f32> {
     if h > 2 * r {
         column(r, &mut inner);
     }
-    let mut out = vec![0f32; w * h];
+    let mut out = try_zeroed::<f32>(w * h, STATS)?;
     for_each_row(&mut out, w, |y, o| {
         if y >= r && y + r < h {
             o.copy_from_slice(&inner);
@@ -671,30 +697,33 @@ fn window_mass(w: usize, h: usize, taps: &[f32]) -> Vec<f32> {
             column(y, o);
         }
     });
-    out
+    Ok(out)
 }
 
-fn left_stats(l: &[f32], r: &[f32], w: usize, h: usize, taps: &[f32]) -> LeftStats {
+fn left_stats(l: &[f32], r: &[f32], w: usize, h: usize, taps: &[f32]) -> Result<LeftStats> {
     let lm = image_mean(l);
-    let lc: Vec<f32> = l.iter().map(|v| v - lm).collect();
-    let mass = window_mass(w, h, taps);
-    let s1 = window_sum(&lc, w, h, taps);
-    let sq: Vec<f32> = lc.iter().map(|v| v * v).collect();
-    let s2 = window_sum(&sq, w, h, taps);
-    let mean: Vec<f32> = s1.iter().zip(&mass).map(|(a, m)| a / m).collect();
-    let var: Vec<f32> = s2
-        .iter()
-        .zip(&mass)
-        .zip(&mean)
-        .map(|((a, m), mu)| a / m - mu * mu)
-        .collect();
-    LeftStats {
+    let lc = try_collect(l.len(), l.iter().map(|v| v - lm), STATS)?;
+    let mass = window_mass(w, h, taps)?;
+    let s1 = window_sum(&lc, w, h, taps)?;
+    let sq = try_collect(lc.len(), lc.iter().map(|v| v * v), STATS)?;
+    let s2 = window_sum(&sq, w, h, taps)?;
+    drop(sq);
+    let mean = try_collect(s1.len(), s1.iter().zip(&mass).map(|(a, m)| a / m), STATS)?;
+    let var = try_collect(
+        s2.len(),
+        s2.iter()
+            .zip(&mass)
+            .zip(&mean)
+            .map(|((a, m), mu)| a / m - mu * mu),
+        STATS,
+    )?;
+    Ok(LeftStats {
         mass,
         mean,
         var,
         lc,
         right_mean: image_mean(r),
-    }
+    })
 }
 
 /// Rows per band of the fused correlation pass (the window's rows above and below are
@@ -921,14 +950,14 @@ fn refine_disparity_hot(
         ));
     }
     let taps = gaussian_taps(p.win_sigma, p.win_radius);
-    let ls = left_stats(left.data, right.data, w, h, &taps);
+    let ls = left_stats(left.data, right.data, w, h, &taps)?;
     let c0 = p.search;
     let fc = p.fill_search;
     let in_range = |v: f32| v >= d_min && v <= d_max;
 
     // Stage 1: re-measure every pixel with a value; NaN where the correlation disagrees.
-    let base = nc_smooth(disp, w, h, p.base_sigma);
-    let mut out = vec![f32::NAN; w * h];
+    let base = nc_smooth(disp, w, h, p.base_sigma)?;
+    let mut out = try_filled(w * h, f32::NAN, "the refinement's refined map")?;
     stage(
         &ls,
         right.data,
@@ -949,30 +978,34 @@ fn refine_disparity_hot(
             in_range(v).then_some(v)
         },
     );
-    let mut oconf: Vec<f32> = out
-        .iter()
-        .zip(conf)
-        .map(|(v, c)| {
+    let mut oconf = try_collect(
+        out.len(),
+        out.iter().zip(conf).map(|(v, c)| {
             if v.is_finite() {
                 c.clamp(0.0, 1.0)
             } else {
                 0.0
             }
-        })
-        .collect();
+        }),
+        "the refinement's confidence map",
+    )?;
 
     // Fill passes: holes near measured pixels, accepted on a clear correlation peak.
     let mut filled = 0usize;
     for f in &p.fills {
         let (base, resid) = if p.fill_plane {
-            nc_plane(&out, w, h, f.sigma, p.fill_max_residual.is_finite())
+            nc_plane(&out, w, h, f.sigma, p.fill_max_residual.is_finite())?
         } else {
-            (nc_smooth(&out, w, h, f.sigma), Vec::new())
+            (nc_smooth(&out, w, h, f.sigma)?, Vec::new())
         };
         let planar = |i: usize| {
             !(p.fill_plane && p.fill_max_residual.is_finite()) || resid[i] < p.fill_max_residual
         };
-        let before = out.clone();
+        let before = try_collect(
+            out.len(),
+            out.iter().copied(),
+            "the refinement's refined map",
+        )?;
         stage(
             &ls,
             right.data,
@@ -1011,11 +1044,24 @@ mod tests {
     use super::*;
 
     #[test]
+    fn column_strips_too_large_to_allocate_are_an_error() {
+        // The strips were a `collect` and a `vec!`: a failed allocation aborted the process.
+        let e = box3_zero(Vec::<f32>::new(), 64, 1 << 56, 1, "the test's strips").unwrap_err();
+        assert!(matches!(
+            e,
+            CoreError::OutOfMemory {
+                what: "the test's strips",
+                ..
+            }
+        ));
+    }
+
+    #[test]
     fn window_mass_equals_the_window_sum_of_ones() {
         let taps = gaussian_taps(4.5, 9);
         for (w, h) in [(30, 40), (7, 5), (50, 19), (12, 18), (3, 1)] {
-            let want = window_sum(&vec![1f32; w * h], w, h, &taps);
-            let got = window_mass(w, h, &taps);
+            let want = window_sum(&vec![1f32; w * h], w, h, &taps).unwrap();
+            let got = window_mass(w, h, &taps).unwrap();
             assert!(
                 want.iter()
                     .zip(&got)
@@ -1132,7 +1178,7 @@ mod tests {
         for i in (0..w * h).filter(|i| (i * 7) % 5 == 0) {
             d[i] = f32::NAN;
         }
-        let (plane, resid) = nc_plane(&d, w, h, 4.0, true);
+        let (plane, resid) = nc_plane(&d, w, h, 4.0, true).unwrap();
         for i in 0..w * h {
             let exact = 3.0 + 0.25 * (i % w) as f32 - 0.4 * (i / w) as f32;
             assert!(
@@ -1146,7 +1192,7 @@ mod tests {
         let step: Vec<f32> = (0..w * h)
             .map(|i| if i % w < 20 { 5.0 } else { 15.0 })
             .collect();
-        let (_, r) = nc_plane(&step, w, h, 4.0, true);
+        let (_, r) = nc_plane(&step, w, h, 4.0, true).unwrap();
         assert!(r[15 * w + 20] > 2.0 && r[15 * w + 2] < 1e-3);
     }
 
@@ -1193,10 +1239,18 @@ mod tests {
         let a: Vec<f64> = (0..w * h).map(|i| ((i * 7) % 13) as f64).collect();
         for b in [1, 2, 7] {
             let want = box3_direct(&a, w, h, b);
-            assert_eq!(box3_zero(a.clone(), w, h, b), want, "f64, b {b}");
+            assert_eq!(
+                box3_zero(a.clone(), w, h, b, "t").unwrap(),
+                want,
+                "f64, b {b}"
+            );
         }
         let a32: Vec<f32> = a.iter().map(|&v| v as f32).collect();
-        let got: Vec<f64> = box3_zero(a32, w, h, 2).iter().map(|&v| v as f64).collect();
+        let got: Vec<f64> = box3_zero(a32, w, h, 2, "t")
+            .unwrap()
+            .iter()
+            .map(|&v| v as f64)
+            .collect();
         assert_eq!(got, box3_direct(&a, w, h, 2), "f32");
     }
 
@@ -1225,8 +1279,8 @@ mod tests {
         let (w, h) = (25, 25);
         let mut d = vec![f32::NAN; w * h];
         d[10 * w + 10] = 3.0;
-        let s = nc_smooth(&d, w, h, 1.0);
-        let (pl, res) = nc_plane(&d, w, h, 1.0, true);
+        let s = nc_smooth(&d, w, h, 1.0).unwrap();
+        let (pl, res) = nc_plane(&d, w, h, 1.0, true).unwrap();
         for y in 0..h {
             for x in 0..w {
                 let i = y * w + x;
@@ -1326,7 +1380,7 @@ mod tests {
             })
             .collect();
         let b = box3_radius(2.0);
-        let (pl, res) = nc_plane(&d, w, h, 2.0, true);
+        let (pl, res) = nc_plane(&d, w, h, 2.0, true).unwrap();
         for (x, y) in [(0, 0), (22, 18), (11, 9), (3, 17), (20, 2), (7, 7)] {
             let (a, rms) = plane_direct(&d, w, h, b, x, y);
             let i = y * w + x;
@@ -1345,7 +1399,7 @@ mod tests {
         // Positions on one line (a single row) fix no plane: the flat weighted mean (at x = 0,
         // b = 1: weights 4 5 3 1 on the values 0 1 2 3).
         let row: Vec<f32> = (0..w).map(|x| x as f32).collect();
-        let (pl, _) = nc_plane(&row, w, 1, 1.0, false);
+        let (pl, _) = nc_plane(&row, w, 1, 1.0, false).unwrap();
         assert!((pl[0] - 14.0 / 13.0).abs() < 1e-6, "{}", pl[0]);
         // Nearly one line: a diagonal and one pixel beside it, all on d = x + y, still fix
         // that plane (poorly conditioned, not degenerate); the far corner gets x + y.
@@ -1355,7 +1409,7 @@ mod tests {
             diag[x * n + x] = 2.0 * x as f32;
         }
         diag[21 * n + 20] = 41.0;
-        let (pl, res) = nc_plane(&diag, n, n, 16.0, true);
+        let (pl, res) = nc_plane(&diag, n, n, 16.0, true).unwrap();
         let i = (n - 1) * n;
         assert!((pl[i] - 39.0).abs() < 1e-3, "{}", pl[i]);
         assert!(res[i] < 1e-2, "{}", res[i]);
@@ -1479,7 +1533,7 @@ mod tests {
             var_floor: 1e-3,
             ..Default::default()
         };
-        let ls = left_stats(&l, &r, w, h, &taps);
+        let ls = left_stats(&l, &r, w, h, &taps).unwrap();
         let (search, step) = (2usize, 0.5f32);
         let n_s = 2 * search + 1;
         let means = (image_mean(&l) as f64, image_mean(&r) as f64);
