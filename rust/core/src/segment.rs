@@ -14,6 +14,9 @@
 
 use rayon::prelude::*;
 
+use crate::alloc::{try_filled, try_reserve_len, try_zeroed};
+use crate::error::Result;
+
 /// Union-find with the component size and internal difference `Int(C)` of the paper.
 struct Forest {
     parent: Vec<u32>,
@@ -22,12 +25,18 @@ struct Forest {
 }
 
 impl Forest {
-    fn new(n: usize, k: f32) -> Self {
-        Self {
-            parent: (0..n as u32).collect(),
-            size: vec![1; n],
-            thresh: vec![k; n],
-        }
+    /// `n` single-pixel components, or [`OutOfMemory`](crate::CoreError::OutOfMemory) when a
+    /// table cannot be allocated.
+    fn new(n: usize, k: f32) -> Result<Self> {
+        let what = "the graph segmentation's union-find forest";
+        let mut parent = Vec::new();
+        try_reserve_len(&mut parent, n, what)?;
+        parent.extend(0..n as u32);
+        Ok(Self {
+            parent,
+            size: try_filled(n, 1, what)?,
+            thresh: try_filled(n, k, what)?,
+        })
     }
 
     fn find(&mut self, mut a: u32) -> u32 {
@@ -57,6 +66,9 @@ impl Forest {
 /// `0..n`, numbered in raster order of each segment's first pixel. See the module docs; `k` is
 /// in the image's units (255-scale images: a few hundred).
 ///
+/// A buffer that cannot be allocated is [`OutOfMemory`](crate::CoreError::OutOfMemory)
+/// (unchecked, it aborted the process).
+///
 /// # Panics
 /// If `img.len() != w * h * c` or `c == 0`.
 pub fn graph_segments(
@@ -66,12 +78,15 @@ pub fn graph_segments(
     c: usize,
     k: f32,
     min_size: usize,
-) -> Vec<u32> {
+) -> Result<Vec<u32>> {
     assert!(
         c > 0 && img.len() == w * h * c,
         "image size does not match w * h * c"
     );
     let n = w * h;
+    if n == 0 {
+        return Ok(Vec::new());
+    }
     let dist = |p: usize, q: usize| -> f32 {
         let mut s = 0.0f32;
         for i in 0..c {
@@ -82,18 +97,30 @@ pub fn graph_segments(
     };
     // Edge e: 2 * pixel (to the right), 2 * pixel + 1 (downwards). The key sorts by weight
     // (a non-negative f32's bits order like the value), then by edge index: a total order, so
-    // the unstable parallel sort is deterministic.
-    let mut keys: Vec<u64> = (0..n)
-        .into_par_iter()
-        .flat_map_iter(|p| {
-            let (x, y) = (p % w, p / w);
-            let right =
-                (x + 1 < w).then(|| ((dist(p, p + 1).to_bits() as u64) << 32) | (2 * p) as u64);
-            let down =
-                (y + 1 < h).then(|| ((dist(p, p + w).to_bits() as u64) << 32) | (2 * p + 1) as u64);
-            right.into_iter().chain(down)
-        })
-        .collect();
+    // the unstable parallel sort is deterministic, and the order they are written in does not
+    // matter: all edges to the right (row by row), then all edges downwards, into one checked
+    // buffer (a `collect` aborted the process when it could not allocate).
+    let n_right = (w - 1) * h;
+    let mut keys = try_zeroed::<u64>(n_right + w * (h - 1), "the graph segmentation's edges")?;
+    let (right, down) = keys.split_at_mut(n_right);
+    let key = |p: usize, q: usize, e: usize| ((dist(p, q).to_bits() as u64) << 32) | e as u64;
+    if w > 1 {
+        right
+            .par_chunks_mut(w - 1)
+            .enumerate()
+            .for_each(|(y, row)| {
+                for (x, k) in row.iter_mut().enumerate() {
+                    let p = y * w + x;
+                    *k = key(p, p + 1, 2 * p);
+                }
+            });
+    }
+    down.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
+        for (x, k) in row.iter_mut().enumerate() {
+            let p = y * w + x;
+            *k = key(p, p + w, 2 * p + 1);
+        }
+    });
     keys.par_sort_unstable();
     let ends = |key: u64| -> (u32, u32) {
         let e = (key & 0xffff_ffff) as usize;
@@ -101,7 +128,7 @@ pub fn graph_segments(
         let q = if e % 2 == 0 { p + 1 } else { p + w };
         (p as u32, q as u32)
     };
-    let mut f = Forest::new(n, k);
+    let mut f = Forest::new(n, k)?;
     for &key in &keys {
         let wgt = f32::from_bits((key >> 32) as u32);
         let (p, q) = ends(key);
@@ -121,14 +148,15 @@ pub fn graph_segments(
             f.join(a, b);
         }
     }
+    drop(keys);
     raster_labels(&mut f, n)
 }
 
 /// Labels `0..` of the forest's components, in raster order of their first pixel.
-fn raster_labels(f: &mut Forest, n: usize) -> Vec<u32> {
-    let mut id = vec![u32::MAX; n];
+fn raster_labels(f: &mut Forest, n: usize) -> Result<Vec<u32>> {
+    let mut id = try_filled(n, u32::MAX, "the graph segmentation's labels")?;
     let mut next = 0u32;
-    let mut labels = vec![0u32; n];
+    let mut labels = try_zeroed::<u32>(n, "the graph segmentation's labels")?;
     for (p, l) in labels.iter_mut().enumerate() {
         let r = f.find(p as u32) as usize;
         if id[r] == u32::MAX {
@@ -137,7 +165,7 @@ fn raster_labels(f: &mut Forest, n: usize) -> Vec<u32> {
         }
         *l = id[r];
     }
-    labels
+    Ok(labels)
 }
 
 /// Connected regions (4-neighbours) of equal quantised colour of a row-major `(H, W, C)` u8
@@ -509,12 +537,33 @@ mod tests {
     use super::*;
 
     #[test]
+    fn tables_too_large_to_allocate_are_an_error() {
+        // The forest was three `vec!`s and `collect`s: a failed allocation aborted the process.
+        assert!(matches!(
+            Forest::new(1 << 62, 1.0),
+            Err(crate::CoreError::OutOfMemory {
+                what: "the graph segmentation's union-find forest",
+                ..
+            })
+        ));
+        // An empty image (the checked edge count would wrap) has no labels.
+        assert_eq!(
+            graph_segments(&[], 0, 5, 1, 1.0, 1).unwrap(),
+            Vec::<u32>::new()
+        );
+        assert_eq!(
+            graph_segments(&[], 5, 0, 3, 1.0, 1).unwrap(),
+            Vec::<u32>::new()
+        );
+    }
+
+    #[test]
     fn two_flat_regions_are_two_segments() {
         let (w, h) = (8, 4);
         let img: Vec<f32> = (0..w * h)
             .map(|p| if p % w < 4 { 10.0 } else { 200.0 })
             .collect();
-        let l = graph_segments(&img, w, h, 1, 300.0, 1);
+        let l = graph_segments(&img, w, h, 1, 300.0, 1).unwrap();
         assert!((0..w * h).all(|p| l[p] == if p % w < 4 { 0 } else { 1 }));
     }
 
@@ -526,8 +575,8 @@ mod tests {
         let img: Vec<f32> = (0..w * h)
             .map(|p| ((p % w) / 3 + 3 * ((p / w) / 2)) as f32)
             .collect();
-        let one = graph_segments(&img, w, h, 1, 0.0, 1);
-        assert_eq!(one, graph_segments(&img, w, h, 1, 0.0, 2));
+        let one = graph_segments(&img, w, h, 1, 0.0, 1).unwrap();
+        assert_eq!(one, graph_segments(&img, w, h, 1, 0.0, 2).unwrap());
         assert_eq!(*one.iter().max().unwrap(), 11); // 3 columns x 4 row bands
     }
 
@@ -549,7 +598,7 @@ mod tests {
                 .collect();
             assert_eq!(
                 quantised_regions(&img, w, h, c, step, offset),
-                graph_segments(&bins, w, h, c, 0.0, 1),
+                graph_segments(&bins, w, h, c, 0.0, 1).unwrap(),
                 "step {step} offset {offset}"
             );
         }
@@ -573,7 +622,7 @@ mod tests {
             let bins: Vec<f32> = img.iter().map(|&v| (v as u32 / 16) as f32).collect();
             assert_eq!(
                 quantised_regions(&img, w, h, 1, 16, 0),
-                graph_segments(&bins, w, h, 1, 0.0, 1),
+                graph_segments(&bins, w, h, 1, 0.0, 1).unwrap(),
                 "{levels} levels"
             );
         }
@@ -585,10 +634,15 @@ mod tests {
         let mut img = vec![0.0f32; w * h];
         img[2 * w + 2] = 255.0; // a one-pixel island
         assert_eq!(
-            *graph_segments(&img, w, h, 1, 1.0, 1).iter().max().unwrap(),
+            *graph_segments(&img, w, h, 1, 1.0, 1)
+                .unwrap()
+                .iter()
+                .max()
+                .unwrap(),
             1
         );
         assert!(graph_segments(&img, w, h, 1, 1.0, 2)
+            .unwrap()
             .iter()
             .all(|&l| l == 0));
     }
@@ -684,8 +738,9 @@ mod tests {
 
     #[test]
     fn merges_follow_the_internal_difference_plus_k_over_size() {
-        let row =
-            |v: &[f32], k: f32, min_size: usize| graph_segments(v, v.len(), 1, 1, k, min_size);
+        let row = |v: &[f32], k: f32, min_size: usize| {
+            graph_segments(v, v.len(), 1, 1, k, min_size).unwrap()
+        };
         // Unit steps, k = 2.5: each merge leaves Int + k / |C| = 1 + 2.5 / |C| >= 1.
         assert_eq!(row(&[0.0, 1.0, 2.0, 3.0], 2.5, 1), [0, 0, 0, 0]);
         // Two singletons merge when their distance (2, not its square) is at most k.

@@ -37,7 +37,7 @@ pub fn graph_segments<'py>(
     let img = row_major(&image, "image")?;
     let labels = crate::workers::detach(py, || {
         guard("graph_segments", || {
-            Ok(core_segments(&img, w, h, c, k, min_size))
+            core_segments(&img, w, h, c, k, min_size)
         })
     })?;
     vec_to_numpy(py, (h, w), labels)
