@@ -11,6 +11,7 @@
 //! cores' rayon workers busy, where parallel blocks would wait behind the matcher's (measured
 //! in the stream at 640x480: 32 ms a pair on the shared pool against 9.6 ms alone).
 
+use crate::alloc::try_zeroed;
 use crate::error::{CoreError, Result};
 
 /// Grey weights of the channels (B, G, R; BT.601, as OpenCV's `BGR2GRAY`); alpha counts 0.
@@ -57,7 +58,8 @@ pub fn grey_difference(
 ) -> Result<Vec<f32>> {
     let w = weights(channels)?;
     check(frame, mean, pixels, channels)?;
-    let mut out = vec![0f32; pixels];
+    // Checked: a failed `vec!` aborted the process.
+    let mut out = try_zeroed::<f32>(pixels, "the temporal filter's grey difference")?;
     const ROW: usize = 4096;
     out.chunks_mut(ROW).enumerate().for_each(|(block, chunk)| {
         let p0 = block * ROW;
@@ -114,7 +116,7 @@ pub fn running_mean(
         .map(|n| ks * (1.0 + 1.0 / n.max(1) as f32).sqrt())
         .collect();
     let weight: Vec<f32> = (0..=255u32).map(|n| 1.0 / n.max(1) as f32).collect();
-    let mut out = vec![0u8; mean.len()];
+    let mut out = try_zeroed::<u8>(mean.len(), "the temporal filter's mean image")?;
     let ch = channels;
     let pixels = count
         .iter_mut()
