@@ -433,6 +433,20 @@ def run(a):
         _core.gabor_disparity(a, a, 0.0, 8.0, lr_check=False)
     elif case == "mcgm":
         _core.mcgm_match(a, a, {})
+    elif case == "fattened":
+        _core.fattened(a, a, 7, 1.5, 2.0)
+    elif case == "depth":
+        _core.depth_rectified(a, a, 50.0, 2.0, 0.74, -0.52, 0.2, 0.9)
+    elif case == "refine":
+        fills = [(16.0, 0.3)]
+        args = (4.0, 4.5, 9, 2, 0.5, 2, 1.0, 1e-6, fills, 0.25, True, float("inf"))
+        _core.refine_disparity(a, a, a, a, 0.0, 8.0, *args)
+    elif case == "segments":
+        _core.graph_segments(a[:, :, None], 300.0, 20)
+    elif case == "temporal":
+        # A uint8 frame viewing the first bytes of ``a``: no new memory.
+        frame = a.reshape(-1).view(np.uint8)[: a.size].reshape(a.shape)
+        _core.temporal_grey_difference(frame, a)
     else:
         _core.hopfield_match(a, a, {})
 
@@ -459,14 +473,20 @@ except MemoryError as e:
         ("gabor-one-way", 16384, 0, "Gabor matcher"),
         ("mcgm", 8192, 2, "MCGM matcher"),
         ("hopfield", 16384, 0, "Hopfield matcher"),
+        ("fattened", 16384, 0, "fattened-edge check's"),
+        ("depth", 16384, 0, "depth map"),
+        ("refine", 16384, 0, "refinement's window statistics"),
+        ("segments", 16384, 0, "graph segmentation's edges"),
+        ("temporal", 16384, 0, "temporal filter's grey difference"),
     ],
 )
 def test_a_matcher_that_runs_out_of_memory_raises_memory_error(
     case: str, side: int, copies: int, matcher: str
 ) -> None:
-    """The Gabor, MCGM and Hopfield kernels allocated their image-sized planes with ``vec!``:
-    a failed allocation aborted the whole process (SIGABRT, exit -6). The kernel's own buffer
-    is named, with its size."""
+    """The Gabor, MCGM and Hopfield kernels, the fattened-edge check, depth from disparity,
+    the refinement, the graph segmentation and the temporal filter allocated their image-sized
+    buffers with ``vec!`` or ``collect``: a failed allocation aborted the whole process
+    (SIGABRT, exit -6). The kernel's own buffer is named, with its size."""
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     out = subprocess.run(
         [sys.executable, "-c", _KERNEL_OOM_SCRIPT, case, str(side), str(copies)],
