@@ -202,7 +202,8 @@ pub fn grey_from_u8(
     // per-pixel arithmetic would give (a division per channel and pixel is the slow part).
     let unit: [f32; 256] = std::array::from_fn(|v| v as f32 / 255.0);
     let [tb, tg, tr] = weights.map(|w| unit.map(|u| w * u));
-    let mut out = vec![0.0f32; width * height];
+    // Checked: a failed `vec!` aborted the process.
+    let mut out = crate::alloc::try_zeroed::<f32>(width * height, "the grey image")?;
     out.par_chunks_mut(width)
         .zip(data.par_chunks(width * channels))
         .for_each(|(o, px)| {
