@@ -161,10 +161,11 @@ simd_fn! {
 }
 
 /// 9x7 census codes, row-major: bit `k` (window row-major, centre skipped) set where that
-/// neighbour is darker than the centre.
-pub fn census(img: ImageView<'_>) -> Vec<u64> {
+/// neighbour is darker than the centre. [`CoreError::OutOfMemory`] when the codes (8 bytes a
+/// pixel) cannot be allocated (a `vec!` aborted the process).
+pub fn census(img: ImageView<'_>) -> Result<Vec<u64>> {
     let (w, h) = (img.width, img.height);
-    let mut out = vec![0u64; w * h];
+    let mut out = try_zeroed::<u64>(w * h, "the census matcher's census codes")?;
     out.par_chunks_mut(w).enumerate().for_each(|(y, row)| {
         let rows: Vec<&[f32]> = (-(RY as isize)..=RY as isize)
             .map(|dy| {
@@ -174,7 +175,7 @@ pub fn census(img: ImageView<'_>) -> Vec<u64> {
             .collect();
         census_row(&rows, row);
     });
-    out
+    Ok(out)
 }
 
 simd_fn! {
@@ -732,6 +733,7 @@ pub fn sgm_disparity(
     }
     let mut out = try_filled(w * h, f32::NAN, "the census matcher's disparity map")?;
     let (cl, cr) = rayon::join(|| census(left), || census(right));
+    let (cl, cr) = (cl?, cr?);
     let (mut c, rows) = kept::take(w * n);
     // The cost volume (w h n bytes) is the largest buffer: a failed allocation is an error,
     // not an abort of the process.
@@ -1077,6 +1079,7 @@ fn three_paths_as<T: PathCost + Send>(
     }
     let (w, h) = (left.width, left.height);
     let (cl, cr) = rayon::join(|| census(left), || census(right));
+    let (cl, cr) = (cl?, cr?);
     let img = left.data;
     let mut out = try_filled(w * h, f32::NAN, "the census matcher's disparity map")?;
     // The rows kept from the last call of this size first (a video's next frame).
@@ -1255,7 +1258,7 @@ mod tests {
             .map(|i| if i % w < 6 { 0.2 } else { 0.8 })
             .collect();
         let v = ImageView::new(w, h, &img).unwrap();
-        let c = census(v);
+        let c = census(v).unwrap();
         assert_eq!(
             c[4 * w + 2],
             0,
@@ -1320,8 +1323,8 @@ mod tests {
             .enumerate()
             .map(|(i, v)| if i % 13 < 2 { 1.0 } else { *v })
             .collect();
-        let cl = census(ImageView::new(w, h, &l).unwrap());
-        let cr = census(ImageView::new(w, h, &r).unwrap());
+        let cl = census(ImageView::new(w, h, &l).unwrap()).unwrap();
+        let cr = census(ImageView::new(w, h, &r).unwrap()).unwrap();
         let c = cost_volume(&cl, &cr, w, -3, n);
         let mut rows = Vec::new();
         let mut emit = |y: usize, row: &mut Vec<u16>| rows.push((y, row.clone()));
@@ -1475,7 +1478,7 @@ mod tests {
         // coordinates, is darker than the centre; widths below and above the window.
         for (w, h) in [(23usize, 9usize), (6, 4)] {
             let img = noise(w, h, 5);
-            let c = census(ImageView::new(w, h, &img).unwrap());
+            let c = census(ImageView::new(w, h, &img).unwrap()).unwrap();
             for y in 0..h as isize {
                 for x in 0..w as isize {
                     let at = |xx: isize, yy: isize| {
@@ -1696,7 +1699,13 @@ mod tests {
         };
         for (d_min, d_max) in [(0i32, 8i32), (-3, 17)] {
             let n = (d_max - d_min + 1) as usize;
-            let c = cost_volume(&census(lv), &census(rv), w, i64::from(d_min), n);
+            let c = cost_volume(
+                &census(lv).unwrap(),
+                &census(rv).unwrap(),
+                w,
+                i64::from(d_min),
+                n,
+            );
             for base in [SgmParams::default(), loose] {
                 for paths in [8u8, 3] {
                     let p = SgmParams { paths, ..base };
