@@ -40,7 +40,7 @@ fn bench_segment(c: &mut Criterion) {
     });
     let img_u8: Vec<u8> = img.iter().map(|&v| (v * 16.0) as u8).collect();
     g.bench_function("quantised_regions", |b| {
-        b.iter(|| quantised_regions(&img_u8, w, h, 3, 16, 0))
+        b.iter(|| quantised_regions(&img_u8, w, h, 3, 16, 0).unwrap())
     });
     g.bench_function("felzenszwalb_k300", |b| {
         b.iter(|| graph_segments(&img, w, h, 3, 300.0, 20).unwrap())
@@ -49,13 +49,13 @@ fn bench_segment(c: &mut Criterion) {
     g.bench_function("plane_fill", |b| {
         b.iter(|| {
             let mut d = disp.clone();
-            plane_fill(&mut d, &labels, w, 50, 1.0, 0.0, 100.0)
+            plane_fill(&mut d, &labels, w, 50, 1.0, 0.0, 100.0).unwrap()
         })
     });
     g.bench_function("fill_planes", |b| {
         b.iter(|| {
             let mut d = disp.clone();
-            fill_planes(&mut d, &img_u8, w, 3, &[(16, 50), (24, 200)], 0.7);
+            fill_planes(&mut d, &img_u8, w, 3, &[(16, 50), (24, 200)], 0.7).unwrap();
             d
         })
     });

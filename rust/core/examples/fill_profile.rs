@@ -42,7 +42,7 @@ fn main() {
     for _ in 0..runs {
         let mut d = disp.clone();
         let t = Instant::now();
-        fill_planes(&mut d, &img, w, 3, &[(16, 50), (24, 200)], 0.7);
+        fill_planes(&mut d, &img, w, 3, &[(16, 50), (24, 200)], 0.7).unwrap();
         best = best.min(t.elapsed().as_secs_f64() * 1e3);
         out = d;
     }

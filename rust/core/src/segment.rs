@@ -14,7 +14,7 @@
 
 use rayon::prelude::*;
 
-use crate::alloc::{try_filled, try_reserve_len, try_zeroed};
+use crate::alloc::{try_collect, try_filled, try_reserve_len, try_zeroed};
 use crate::error::Result;
 
 /// Union-find with the component size and internal difference `Int(C)` of the paper.
@@ -173,6 +173,9 @@ fn raster_labels(f: &mut Forest, n: usize) -> Result<Vec<u32>> {
 /// [`graph_segments`] numbers them (it gives the same labels with `k = 0` on the bins), in one
 /// union-find scan whose roots are each region's first pixel.
 ///
+/// A table that cannot be allocated is [`OutOfMemory`](crate::CoreError::OutOfMemory)
+/// (unchecked, it aborted the process).
+///
 /// # Panics
 /// If `img.len() != w * h * c`, `c` is not 1..=3, or `step` is 0.
 pub fn quantised_regions(
@@ -182,7 +185,8 @@ pub fn quantised_regions(
     c: usize,
     step: u32,
     offset: u32,
-) -> Vec<u32> {
+) -> Result<Vec<u32>> {
+    let what = "the colour regions' tables";
     assert!(
         (1..=3).contains(&c) && img.len() == w * h * c,
         "image size does not match w * h * c"
@@ -194,7 +198,7 @@ pub fn quantised_regions(
     let bin: Vec<u32> = (0..256u32)
         .map(|v| ((v + offset) / step).min(511))
         .collect();
-    let mut keys = vec![0u32; n];
+    let mut keys = try_zeroed::<u32>(n, what)?;
     keys.par_chunks_mut(w.max(1))
         .zip(img.par_chunks(w.max(1) * c))
         .for_each(|(k, row)| {
@@ -207,7 +211,7 @@ pub fn quantised_regions(
             }
         });
     // parent[p] <= p always: a region's root is its first pixel in raster order.
-    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut parent = try_collect(n, 0..n as u32, what)?;
     let find = |parent: &mut [u32], mut a: usize| -> usize {
         while parent[a] as usize != a {
             let p = parent[a] as usize;
@@ -254,8 +258,9 @@ pub fn quantised_regions(
             }
         }
     }
+    drop(keys);
     // parent[p] < p unless p is a root, and its label is final by then: no search needed.
-    let mut labels = vec![0u32; n];
+    let mut labels = try_zeroed::<u32>(n, what)?;
     let mut next = 0u32;
     for p in 0..n {
         let q = parent[p] as usize;
@@ -266,7 +271,7 @@ pub fn quantised_regions(
             labels[p] = labels[q];
         }
     }
-    labels
+    Ok(labels)
 }
 
 /// Outcome of [`plane_fill`].
@@ -316,6 +321,9 @@ fn median(v: &mut [f32]) -> f32 {
 /// outside `[lo, hi]` leaves the hole. Segments run in parallel and write disjoint pixels, so
 /// the result does not depend on the thread count.
 ///
+/// A table that cannot be allocated is [`OutOfMemory`](crate::CoreError::OutOfMemory)
+/// (unchecked, it aborted the process).
+///
 /// # Panics
 /// If `labels.len() != disp.len()` or a label is not below it (labels as the segment functions
 /// number them).
@@ -327,14 +335,15 @@ pub fn plane_fill(
     max_residual: f32,
     lo: f32,
     hi: f32,
-) -> PlaneFillStats {
+) -> Result<PlaneFillStats> {
+    let what = "the plane fill's segment tables";
     assert_eq!(
         labels.len(),
         disp.len(),
         "labels and disparity differ in size"
     );
     if disp.is_empty() || w == 0 {
-        return PlaneFillStats::default();
+        return Ok(PlaneFillStats::default());
     }
     let n_seg = labels.iter().max().map_or(0, |&m| m as usize + 1);
     assert!(
@@ -343,8 +352,8 @@ pub fn plane_fill(
     );
     // Measured pixels and holes per segment: only a segment with a hole and enough measured
     // pixels can fill anything (`segment_fill` would return at once for the others).
-    let mut meas = vec![0u32; n_seg];
-    let mut holes = vec![0u32; n_seg];
+    let mut meas = try_zeroed::<u32>(n_seg, what)?;
+    let mut holes = try_zeroed::<u32>(n_seg, what)?;
     for (&l, &d) in labels.iter().zip(disp.iter()) {
         if d.is_finite() {
             meas[l as usize] += 1;
@@ -353,19 +362,19 @@ pub fn plane_fill(
         }
     }
     let min_meas = min_pixels.max(3);
-    let active: Vec<usize> = (0..n_seg)
-        .filter(|&s| holes[s] > 0 && meas[s] as usize >= min_meas)
-        .collect();
+    let is_active = |s: &usize| holes[*s] > 0 && meas[*s] as usize >= min_meas;
+    let n_active = (0..n_seg).filter(is_active).count();
+    let active = try_collect(n_active, (0..n_seg).filter(is_active), what)?;
     // Their pixels grouped by segment (counting sort), raster order inside each.
-    let mut start = vec![0usize; n_seg + 1];
+    let mut start = try_zeroed::<usize>(n_seg + 1, what)?;
     for &s in &active {
         start[s + 1] = (meas[s] + holes[s]) as usize;
     }
     for i in 0..n_seg {
         start[i + 1] += start[i];
     }
-    let mut order = vec![0u32; start[n_seg]];
-    let mut at = start.clone();
+    let mut order = try_zeroed::<u32>(start[n_seg], what)?;
+    let mut at = try_collect(start.len(), start.iter().copied(), what)?;
     for (p, &l) in labels.iter().enumerate() {
         let l = l as usize;
         if at[l] < start[l + 1] {
@@ -404,10 +413,10 @@ pub fn plane_fill(
         }
         disp[p as usize] = v;
     }
-    PlaneFillStats {
+    Ok(PlaneFillStats {
         planes,
         filled: fills.len(),
-    }
+    })
 }
 
 /// The holes of one segment (`pix`, raster order) and their plane values, appended to `out`.
@@ -491,6 +500,9 @@ pub type PlanePass = (u32, usize);
 /// as measured. A pass on a map with no hole or no measured value leaves it. The two cuts run
 /// side by side; each is computed as alone, so the result does not depend on the thread count.
 ///
+/// A buffer that cannot be allocated is [`OutOfMemory`](crate::CoreError::OutOfMemory)
+/// (unchecked, it aborted the process).
+///
 /// # Panics
 /// As [`quantised_regions`] (image size, `c`, `step`) and [`plane_fill`].
 pub fn fill_planes(
@@ -500,7 +512,7 @@ pub fn fill_planes(
     c: usize,
     passes: &[PlanePass],
     max_residual: f32,
-) {
+) -> Result<()> {
     let h = disp.len().checked_div(w).unwrap_or(0);
     for &(step, min_pixels) in passes {
         let (mut lo, mut hi, mut holes) = (f32::INFINITY, f32::NEG_INFINITY, false);
@@ -515,13 +527,15 @@ pub fn fill_planes(
         if !holes || lo > hi {
             continue; // nothing to fill, or nothing to fit
         }
-        let cut = |offset: u32| {
-            let labels = quantised_regions(img, w, h, c, step, offset);
-            let mut out = disp.to_vec();
-            plane_fill(&mut out, &labels, w, min_pixels, max_residual, lo, hi);
-            out
+        let cut = |offset: u32| -> Result<Vec<f32>> {
+            let labels = quantised_regions(img, w, h, c, step, offset)?;
+            let copy = "the plane fill's copy of the map";
+            let mut out = try_collect(disp.len(), disp.iter().copied(), copy)?;
+            plane_fill(&mut out, &labels, w, min_pixels, max_residual, lo, hi)?;
+            Ok(out)
         };
         let (a, b) = rayon::join(|| cut(0), || cut(step / 2));
+        let (a, b) = (a?, b?);
         for ((d, &a), &b) in disp.iter_mut().zip(&a).zip(&b) {
             let hole = !d.is_finite();
             *d = if a.is_finite() { a } else { b };
@@ -530,6 +544,7 @@ pub fn fill_planes(
             }
         }
     }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -597,7 +612,7 @@ mod tests {
                 .map(|&v| ((v as u32 + offset) / step) as f32)
                 .collect();
             assert_eq!(
-                quantised_regions(&img, w, h, c, step, offset),
+                quantised_regions(&img, w, h, c, step, offset).unwrap(),
                 graph_segments(&bins, w, h, c, 0.0, 1).unwrap(),
                 "step {step} offset {offset}"
             );
@@ -621,7 +636,7 @@ mod tests {
                 .collect();
             let bins: Vec<f32> = img.iter().map(|&v| (v as u32 / 16) as f32).collect();
             assert_eq!(
-                quantised_regions(&img, w, h, 1, 16, 0),
+                quantised_regions(&img, w, h, 1, 16, 0).unwrap(),
                 graph_segments(&bins, w, h, 1, 0.0, 1).unwrap(),
                 "{levels} levels"
             );
@@ -658,7 +673,7 @@ mod tests {
             d[p] = f32::NAN;
         }
         let labels = vec![0u32; w * h];
-        let s = plane_fill(&mut d, &labels, w, 10, 0.5, 0.0, 100.0);
+        let s = plane_fill(&mut d, &labels, w, 10, 0.5, 0.0, 100.0).unwrap();
         assert_eq!(
             s,
             PlaneFillStats {
@@ -681,22 +696,30 @@ mod tests {
         d[0] = f32::NAN;
         let labels = vec![0u32; w * h];
         assert_eq!(
-            plane_fill(&mut d, &labels, w, 10, 1.0, -100.0, 100.0).filled,
+            plane_fill(&mut d, &labels, w, 10, 1.0, -100.0, 100.0)
+                .unwrap()
+                .filled,
             0
         );
         let mut flat = vec![3.0f32; w * h];
         flat[0] = f32::NAN;
         assert_eq!(
-            plane_fill(&mut flat, &labels, w, 200, 1.0, 0.0, 100.0).filled,
+            plane_fill(&mut flat, &labels, w, 200, 1.0, 0.0, 100.0)
+                .unwrap()
+                .filled,
             0
         );
         // ... and a plane value out of [lo, hi] too.
         assert_eq!(
-            plane_fill(&mut flat, &labels, w, 10, 1.0, 0.0, 2.0).filled,
+            plane_fill(&mut flat, &labels, w, 10, 1.0, 0.0, 2.0)
+                .unwrap()
+                .filled,
             0
         );
         assert_eq!(
-            plane_fill(&mut flat, &labels, w, 10, 1.0, 0.0, 5.0).filled,
+            plane_fill(&mut flat, &labels, w, 10, 1.0, 0.0, 5.0)
+                .unwrap()
+                .filled,
             1
         );
         assert_eq!(flat[0], 3.0);
@@ -719,20 +742,20 @@ mod tests {
             d[p] = f32::NAN;
         }
         let mut one = d.clone();
-        fill_planes(&mut one, &img, w, 1, &[(16, 10)], 0.5);
+        fill_planes(&mut one, &img, w, 1, &[(16, 10)], 0.5).unwrap();
         assert_eq!((one[22], one[77]), (4.0, 8.0));
         // Where both cuts fill, the mean: one colour, one plane each way.
         let flat = vec![20u8; w * h];
         let mut e: Vec<f32> = (0..w * h).map(|p| 2.0 + 0.5 * (p % w) as f32).collect();
         e[44] = f32::NAN;
-        fill_planes(&mut e, &flat, w, 1, &[(16, 10)], 0.5);
+        fill_planes(&mut e, &flat, w, 1, &[(16, 10)], 0.5).unwrap();
         assert!((e[44] - 4.0).abs() < 1e-5, "{}", e[44]);
         // No hole, or nothing measured: unchanged.
         let mut full = vec![1.0f32; w * h];
-        fill_planes(&mut full, &img, w, 1, &[(16, 10)], 0.5);
+        fill_planes(&mut full, &img, w, 1, &[(16, 10)], 0.5).unwrap();
         assert!(full.iter().all(|&v| v == 1.0));
         let mut empty = vec![f32::NAN; w * h];
-        fill_planes(&mut empty, &img, w, 1, &[(16, 10)], 0.5);
+        fill_planes(&mut empty, &img, w, 1, &[(16, 10)], 0.5).unwrap();
         assert!(empty.iter().all(|v| v.is_nan()));
     }
 
@@ -780,7 +803,7 @@ mod tests {
             d[p] = f32::NAN;
         }
         let labels = vec![0u32; w * h];
-        let s = plane_fill(&mut d, &labels, w, 10, 0.5, 0.0, 100.0);
+        let s = plane_fill(&mut d, &labels, w, 10, 0.5, 0.0, 100.0).unwrap();
         assert_eq!(s.filled, 4);
         for p in holes {
             assert!(
@@ -799,7 +822,7 @@ mod tests {
         let (w, h) = (3, 2);
         let labels: Vec<u32> = (0..w * h).map(|p| u32::from(p % w == 2)).collect();
         let mut d = vec![1.0, 2.0, 7.0, 3.0, f32::NAN, 7.0];
-        let s = plane_fill(&mut d, &labels, w, 3, 0.5, 0.0, 10.0);
+        let s = plane_fill(&mut d, &labels, w, 3, 0.5, 0.0, 10.0).unwrap();
         assert_eq!(
             s,
             PlaneFillStats {
@@ -809,7 +832,12 @@ mod tests {
         );
         assert!((d[4] - 4.0).abs() < 1e-5, "{}", d[4]);
         let mut d = vec![1.0, 2.0, 7.0, 3.0, f32::NAN, 7.0];
-        assert_eq!(plane_fill(&mut d, &labels, w, 4, 0.5, 0.0, 10.0).filled, 0);
+        assert_eq!(
+            plane_fill(&mut d, &labels, w, 4, 0.5, 0.0, 10.0)
+                .unwrap()
+                .filled,
+            0
+        );
     }
 
     #[test]
@@ -831,10 +859,20 @@ mod tests {
         };
         let checker = with_holes(&|x, y| ((x + y) % 2) as f32);
         let mut d = checker.clone();
-        assert_eq!(plane_fill(&mut d, &labels, w, 3, 0.5, -9.0, 9.0).filled, 4);
+        assert_eq!(
+            plane_fill(&mut d, &labels, w, 3, 0.5, -9.0, 9.0)
+                .unwrap()
+                .filled,
+            4
+        );
         assert!(d[4 * w..].iter().all(|&v| v == 0.5), "{:?}", &d[4 * w..]);
         let mut d = checker;
-        assert_eq!(plane_fill(&mut d, &labels, w, 3, 0.49, -9.0, 9.0).filled, 0);
+        assert_eq!(
+            plane_fill(&mut d, &labels, w, 3, 0.49, -9.0, 9.0)
+                .unwrap()
+                .filled,
+            0
+        );
         // Centre 1, corners -1, edges 0: residuals eight 0, then eight 1 (the mean is 0). The
         // median of 16 is the 9th smallest, 1: over a limit of 0.5.
         let rings = with_holes(&|x, y| {
@@ -846,9 +884,19 @@ mod tests {
             }
         });
         let mut d = rings.clone();
-        assert_eq!(plane_fill(&mut d, &labels, w, 3, 0.5, -9.0, 9.0).filled, 0);
+        assert_eq!(
+            plane_fill(&mut d, &labels, w, 3, 0.5, -9.0, 9.0)
+                .unwrap()
+                .filled,
+            0
+        );
         let mut d = rings;
-        assert_eq!(plane_fill(&mut d, &labels, w, 3, 1.0, -9.0, 9.0).filled, 4);
+        assert_eq!(
+            plane_fill(&mut d, &labels, w, 3, 1.0, -9.0, 9.0)
+                .unwrap()
+                .filled,
+            4
+        );
     }
 
     #[test]
@@ -861,7 +909,7 @@ mod tests {
         let mut d: Vec<f32> = (0..w * h)
             .map(|p| [4.0, f32::NAN, 6.0][(p % w) / 4])
             .collect();
-        fill_planes(&mut d, &img, w, 1, &[(16, 5)], 0.5);
+        fill_planes(&mut d, &img, w, 1, &[(16, 5)], 0.5).unwrap();
         assert!(
             d.iter()
                 .enumerate()
@@ -882,19 +930,19 @@ mod tests {
             d[y * w + w - 1] = f32::NAN;
         }
         let mut one = d.clone();
-        fill_planes(&mut one, &img, w, 1, &[(16, 5)], 1.0);
+        fill_planes(&mut one, &img, w, 1, &[(16, 5)], 1.0).unwrap();
         assert_eq!(one.iter().filter(|v| v.is_nan()).count(), 2 * h);
         // An infinite value is a hole, not the range's top: the ends stay, it is filled.
         let mut inf = d.clone();
         inf[2 * w + 5] = f32::INFINITY;
-        fill_planes(&mut inf, &img, w, 1, &[(16, 5)], 1.0);
+        fill_planes(&mut inf, &img, w, 1, &[(16, 5)], 1.0).unwrap();
         assert_eq!(inf.iter().filter(|v| v.is_nan()).count(), 2 * h);
         assert!((inf[2 * w + 5] - 6.0).abs() < 1e-4, "{}", inf[2 * w + 5]);
         // A hole inside the range: the first pass needs 1000 measured pixels and fills
         // nothing, the second does.
         let mut two = d.clone();
         two[2 * w + 4] = f32::NAN;
-        fill_planes(&mut two, &img, w, 1, &[(16, 1000), (16, 5)], 1.0);
+        fill_planes(&mut two, &img, w, 1, &[(16, 1000), (16, 5)], 1.0).unwrap();
         assert!((two[2 * w + 4] - 5.0).abs() < 1e-4, "{}", two[2 * w + 4]);
     }
 
@@ -902,10 +950,19 @@ mod tests {
     fn bins_keep_nine_bits_each() {
         // Step 1, offset 1: 254 and 255 bin to 255 and 256, two regions (a bin cut at 255 or
         // 8-bit fields would merge them).
-        assert_eq!(quantised_regions(&[254, 255], 2, 1, 1, 1, 1), [0, 1]);
+        assert_eq!(
+            quantised_regions(&[254, 255], 2, 1, 1, 1, 1).unwrap(),
+            [0, 1]
+        );
         // Offset 2, two channels: bins (256, 2) and (256, 3) overlap in 8-bit fields.
-        assert_eq!(quantised_regions(&[254, 0, 254, 1], 2, 1, 2, 1, 2), [0, 1]);
-        assert_eq!(quantised_regions(&[254, 0, 254, 0], 2, 1, 2, 1, 2), [0, 0]);
+        assert_eq!(
+            quantised_regions(&[254, 0, 254, 1], 2, 1, 2, 1, 2).unwrap(),
+            [0, 1]
+        );
+        assert_eq!(
+            quantised_regions(&[254, 0, 254, 0], 2, 1, 2, 1, 2).unwrap(),
+            [0, 0]
+        );
     }
 
     #[test]
@@ -920,7 +977,7 @@ mod tests {
             d[p] = f32::NAN;
         }
         let labels = vec![0u32; w * h];
-        let s = plane_fill(&mut d, &labels, w, 3, 0.5, 0.0, 20.0);
+        let s = plane_fill(&mut d, &labels, w, 3, 0.5, 0.0, 20.0).unwrap();
         assert_eq!(
             s,
             PlaneFillStats {
@@ -949,7 +1006,7 @@ mod tests {
             .collect();
         d[w + 1] = f32::NAN;
         d[2 * w + 6] = f32::NAN;
-        fill_planes(&mut d, &img, w, 1, &[(3, 3)], 0.5);
+        fill_planes(&mut d, &img, w, 1, &[(3, 3)], 0.5).unwrap();
         assert_eq!((d[w + 1], d[2 * w + 6]), (2.0, 8.0));
     }
 
@@ -960,7 +1017,7 @@ mod tests {
         let img = vec![50u8; w * h];
         let mut d = vec![3.0f32; w * h];
         d[2 * w + 2] = f32::NAN;
-        fill_planes(&mut d, &img, w, 1, &[(16, 5)], 1.0);
+        fill_planes(&mut d, &img, w, 1, &[(16, 5)], 1.0).unwrap();
         assert_eq!(d[2 * w + 2], 3.0);
     }
 
@@ -1036,7 +1093,7 @@ mod tests {
             let max_residual = [0.25, 1.0, 3.0][round % 3];
             let want = segment_ref(&d, w, max_residual, -40.0, 60.0);
             let mut got = d.clone();
-            let st = plane_fill(&mut got, &labels, w, 3, max_residual, -40.0, 60.0);
+            let st = plane_fill(&mut got, &labels, w, 3, max_residual, -40.0, 60.0).unwrap();
             let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
             assert_eq!(bits(&got), bits(&want), "round {round}");
             filled += st.filled;
@@ -1051,6 +1108,6 @@ mod tests {
     #[test]
     #[should_panic(expected = "labels must be below the pixel count")]
     fn a_label_at_the_pixel_count_is_refused() {
-        plane_fill(&mut [1.0, f32::NAN], &[0, 2], 2, 3, 1.0, 0.0, 9.0);
+        plane_fill(&mut [1.0, f32::NAN], &[0, 2], 2, 3, 1.0, 0.0, 9.0).unwrap();
     }
 }

@@ -89,7 +89,7 @@ pub fn plane_fill<'py>(
     }
     let (out, s) = map_copy_in_place(py, &disp, "disp", |d, w, _| {
         guard("plane_fill", || {
-            Ok(core_plane_fill(d, &l, w, min_pixels, max_residual, lo, hi))
+            core_plane_fill(d, &l, w, min_pixels, max_residual, lo, hi)
         })
     })?;
     let s = s?;
@@ -121,7 +121,7 @@ pub fn quantised_regions<'py>(
     let img = row_major(&image, "image")?;
     let labels = crate::workers::detach(py, || {
         guard("quantised_regions", || {
-            Ok(core_regions(&img, w, h, c, step, offset))
+            core_regions(&img, w, h, c, step, offset)
         })
     })?;
     vec_to_numpy(py, (h, w), labels)
@@ -152,8 +152,7 @@ pub fn fill_planes<'py>(
     let img = row_major(&image, "image")?;
     let (out, done) = map_copy_in_place(py, &disp, "disp", |d, w, _| {
         guard("fill_planes", || {
-            core_fill_planes(d, &img, w, c, &passes, max_residual);
-            Ok(())
+            core_fill_planes(d, &img, w, c, &passes, max_residual)
         })
     })?;
     done?;
