@@ -443,6 +443,14 @@ def run(a):
         _core.refine_disparity(a, a, a, a, 0.0, 8.0, *args)
     elif case == "segments":
         _core.graph_segments(a[:, :, None], 300.0, 20)
+    elif case == "census":
+        _core.sgm_disparity(a, a, 0, 15, 8, 96, 16.0, 5, 1, 4)
+    elif case == "grey":
+        _core.gray_u8(a.reshape(-1).view(np.uint8)[: a.size].reshape(a.shape), (0.1, 0.6, 0.3))
+    elif case == "planes":
+        a[0, 0] = np.nan  # a hole to fill
+        img = a.reshape(-1).view(np.uint8)[: a.size].reshape(*a.shape, 1)
+        _core.fill_planes(a, img, [(16, 50)], 0.7)
     elif case == "temporal":
         # A uint8 frame viewing the first bytes of ``a``: no new memory.
         frame = a.reshape(-1).view(np.uint8)[: a.size].reshape(a.shape)
@@ -478,15 +486,21 @@ except MemoryError as e:
         ("refine", 16384, 0, "refinement's window statistics"),
         ("segments", 16384, 0, "graph segmentation's edges"),
         ("temporal", 16384, 0, "temporal filter's grey difference"),
+        # Small enough for the output map to fit: the census codes come next.
+        ("census", 6144, 0, "census matcher's census codes"),
+        ("grey", 16384, 0, "grey image"),
+        # The binding's copy of the map fits; the kernel's regions do not.
+        ("planes", 16384, 1, "colour regions' tables"),
     ],
 )
 def test_a_matcher_that_runs_out_of_memory_raises_memory_error(
     case: str, side: int, copies: int, matcher: str
 ) -> None:
     """The Gabor, MCGM and Hopfield kernels, the fattened-edge check, depth from disparity,
-    the refinement, the graph segmentation and the temporal filter allocated their image-sized
-    buffers with ``vec!`` or ``collect``: a failed allocation aborted the whole process
-    (SIGABRT, exit -6). The kernel's own buffer is named, with its size."""
+    the refinement, the graph segmentation, the plane fill, the temporal filter, the census
+    codes and the 8-bit grey conversion allocated their image-sized buffers with ``vec!`` or
+    ``collect``: a failed allocation aborted the whole process (SIGABRT, exit -6). The
+    kernel's own buffer is named, with its size."""
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     out = subprocess.run(
         [sys.executable, "-c", _KERNEL_OOM_SCRIPT, case, str(side), str(copies)],
