@@ -21,7 +21,7 @@
 //! Everything is row-band parallel with per-row arithmetic in a fixed order, so the output does
 //! not depend on the thread count. `tests/reference/refine_ref.py` is the same maths in NumPy.
 
-use crate::alloc::{try_collect, try_filled, try_zeroed, ZeroBits};
+use crate::alloc::{try_collect, try_filled, try_reserve_len, try_zeroed, ZeroBits};
 use crate::error::{CoreError, Result};
 use crate::image::check_map_pair;
 use crate::parallel::for_each_row;
@@ -756,6 +756,33 @@ fn sized(v: &mut Vec<f32>, n: usize) -> &mut [f32] {
     &mut v[..n]
 }
 
+impl Scratch {
+    /// Room for a band of `band_len` pixels, `n_s` shifts and `rows` rows of width `w` (the
+    /// band's with the window's margins): [`sized`] then grows nothing. `z` holds up to 33
+    /// values a pixel of the band and the row sums up to 256 rows, per worker: a failed
+    /// `resize` aborted the process, a failed reservation is [`CoreError::OutOfMemory`].
+    fn reserve(&mut self, band_len: usize, n_s: usize, rows: usize, w: usize) -> Result<()> {
+        let what = "the refinement's band buffers";
+        try_reserve_len(&mut self.z, band_len.saturating_mul(n_s), what)?;
+        let win = rows.saturating_mul(w);
+        for v in [&mut self.h1, &mut self.h2, &mut self.h12] {
+            try_reserve_len(v, win, what)?;
+        }
+        let rows = [
+            &mut self.rw,
+            &mut self.sq,
+            &mut self.lr,
+            &mut self.a1,
+            &mut self.a2,
+            &mut self.a12,
+        ];
+        for v in rows.into_iter().chain(self.q.iter_mut()) {
+            try_reserve_len(v, w, what)?;
+        }
+        try_reserve_len(&mut self.idx, w, what)
+    }
+}
+
 /// Correlations of every shift `k step`, `k = -search..=search`, around `base` for the rows
 /// `y0..y1`, into `sc.z` (shift-major): per shift, warp, products, row sums and column sums in
 /// one streaming pass over the band. NaN where undefined: no base, no counterpart in the right
@@ -773,13 +800,14 @@ fn zncc_band(
     h: usize,
     y0: usize,
     y1: usize,
-) {
+) -> Result<()> {
     let rad = taps.len() / 2;
     let ya = y0.saturating_sub(rad);
     let yb = (y1 + rad).min(h);
     let nr = yb - ya;
     let n_s = 2 * search + 1;
     let band_len = (y1 - y0) * w;
+    sc.reserve(band_len, n_s, nr, w)?;
     sized(&mut sc.z, n_s * band_len);
     for k in 0..n_s {
         let s = (k as f32 - search as f32) * step;
@@ -828,6 +856,7 @@ fn zncc_band(
             );
         }
     }
+    Ok(())
 }
 
 /// The peak of a pixel's correlations `z[0..n]` (shift `k - search`): `(k, z_k)` of the first
@@ -874,21 +903,22 @@ fn stage<T, D>(
     out: &mut [f32],
     todo: T,
     decide: D,
-) where
+) -> Result<()>
+where
     T: Fn(usize) -> bool + Sync,
     D: Fn(usize, &[f32]) -> Option<f32> + Sync,
 {
     use rayon::prelude::*;
     let n_s = 2 * shifts.0 + 1;
-    out.par_chunks_mut(w * BAND).enumerate().for_each_init(
+    out.par_chunks_mut(w * BAND).enumerate().try_for_each_init(
         || (Scratch::default(), vec![0f32; n_s]),
         |(sc, zb), (bi, chunk)| {
             let y0 = bi * BAND;
             let y1 = (y0 + BAND).min(h);
             if !(y0 * w..y1 * w).any(&todo) {
-                return;
+                return Ok(());
             }
-            zncc_band(sc, ls, r, base, p, shifts, taps, w, h, y0, y1);
+            zncc_band(sc, ls, r, base, p, shifts, taps, w, h, y0, y1)?;
             let band_len = (y1 - y0) * w;
             for (j, o) in chunk.iter_mut().enumerate().take(band_len) {
                 let i = y0 * w + j;
@@ -902,8 +932,9 @@ fn stage<T, D>(
                     *o = v;
                 }
             }
+            Ok(())
         },
-    );
+    )
 }
 
 /// Refines and completes a disparity map of a rectified grey pair (module docs).
@@ -977,7 +1008,7 @@ fn refine_disparity_hot(
             let v = base[i] + p.step * parabola_offset(z[c0 - 1], z[c0], z[c0 + 1])?;
             in_range(v).then_some(v)
         },
-    );
+    )?;
     let mut oconf = try_collect(
         out.len(),
         out.iter().zip(conf).map(|(v, c)| {
@@ -1028,7 +1059,7 @@ fn refine_disparity_hot(
                 let v = base[i] + p.fill_step * (k as f32 - fc as f32 + off);
                 in_range(v).then_some(v)
             },
-        );
+        )?;
         for i in 0..w * h {
             if out[i].is_finite() && !before[i].is_finite() {
                 oconf[i] = p.fill_confidence;
@@ -1054,6 +1085,24 @@ mod tests {
                 ..
             }
         ));
+    }
+
+    #[test]
+    fn band_buffers_too_large_to_allocate_are_an_error() {
+        // They grew by `resize`: a failed allocation aborted the process.
+        let mut sc = Scratch::default();
+        assert!(matches!(
+            sc.reserve(1 << 60, 33, 256, 1 << 20),
+            Err(CoreError::OutOfMemory {
+                what: "the refinement's band buffers",
+                ..
+            })
+        ));
+        sc.reserve(64, 5, 20, 8).unwrap();
+        let cap = sc.z.capacity();
+        assert!(cap >= 320);
+        sized(&mut sc.z, 320);
+        assert_eq!(sc.z.capacity(), cap);
     }
 
     #[test]
@@ -1552,7 +1601,8 @@ mod tests {
                 h,
                 y0,
                 y1,
-            );
+            )
+            .unwrap();
             let band_len = (y1 - y0) * w;
             for y in y0..y1 {
                 for x in 0..w {
