@@ -29,7 +29,8 @@ pub struct FattenParams {
 /// The fattened pixels of a row-major `(h, w)` disparity map `d` (NaN = hole) with the grey
 /// `guide` image of the same size: marked along the rows or along the columns (module docs).
 /// Rows (and columns) run in parallel, each independent of the others. A failed allocation of
-/// an image-sized buffer is [`CoreError::OutOfMemory`](crate::CoreError::OutOfMemory) (a `vec!` aborted the process).
+/// an image-sized buffer is [`OutOfMemory`](crate::CoreError::OutOfMemory) (a `vec!` aborted
+/// the process).
 pub fn fattened(
     d: &[f32],
     guide: &[f32],
