@@ -605,3 +605,84 @@ def test_the_noise_is_read_on_the_flattest_30_percent(data_dir: Path) -> None:
     img = load_scene(data_dir / VENUS).left
     assert noise_sigma(img) == pytest.approx(0.9276, rel=0.01)
     assert noise_sigma(noisy(img, 8.0, np.random.default_rng(0))) == pytest.approx(5.718, rel=0.01)
+
+
+def test_the_light_fit_band_ends() -> None:
+    """``_brightness_change`` fits on grey levels strictly inside 5-250 in both the mean and the
+    frame (a third mutation audit left each end, its constant and its comparison, unasserted): a
+    pixel at 5 or 250 is left out, one at 6 or 249 is fitted. Each case is 224 pixels lit by a
+    clear gain and 16 + 16 on either side of one end, on the fit's every-4th-pixel grid."""
+    from stereovision.temporal import _brightness_change
+
+    def fit(groups: list[tuple[int, float, float]], sigma: float = 2.0) -> float | None:
+        pairs = [(m, f) for count, m, f in groups for _ in range(count)]
+        mean = np.zeros((64, 64), np.float32)
+        frame = np.zeros((64, 64), np.float32)
+        mean[::4, ::4] = np.array([m for m, _ in pairs], np.float32).reshape(16, 16)
+        frame[::4, ::4] = np.array([f for _, f in pairs], np.float32).reshape(16, 16)
+        return _brightness_change(frame - mean, mean, sigma)
+
+    # (count, mean, frame); the expected gain sums the groups inside the band by hand
+    cases = [
+        ([(224, 100, 110), (16, 5, 8), (16, 6, 9)], (224 * 110 + 16 * 9) / (224 * 100 + 16 * 6)),
+        ([(224, 100, 110), (16, 8, 5), (16, 9, 6)], (224 * 110 + 16 * 6) / (224 * 100 + 16 * 9)),
+        (
+            [(224, 100, 101), (16, 250, 249), (16, 249, 248)],
+            (224 * 101 + 16 * 248) / (224 * 100 + 16 * 249),
+        ),
+        (
+            [(224, 100, 101), (16, 249, 250), (16, 248, 249)],
+            (224 * 101 + 16 * 249) / (224 * 100 + 16 * 248),
+        ),
+    ]
+    for groups, gain in cases:
+        assert fit(groups) == pytest.approx(gain, rel=1e-12), groups
+    # 16 usable pixels are enough to fit (gain 1.2, not the "nothing to fit" 1.0)
+    assert fit([(16, 100, 120), (240, 0, 0)]) == pytest.approx(1.2, rel=1e-12)
+    # the fit holding exactly half of the pixels is a light's change, under half another view:
+    # the 64 + 64 pixels 30 levels off the gain 1.1 cancel in the sums and fall out of the refit
+    assert fit([(128, 100, 110), (64, 50, 85), (64, 50, 25)], 1.0) == pytest.approx(1.1)
+    assert fit([(127, 100, 110), (1, 100, 200), (64, 50, 85), (64, 50, 25)], 1.0) is None
+
+
+@pytest.mark.parametrize(
+    ("kind", "share", "restarts"),
+    [
+        ("grey", 0.4, [0, 0, 0, 0, 0]),
+        ("grey", 0.5, [0, 0, 0, 0, 1]),
+        ("bgr", 0.4, [0, 0, 0, 0, 0]),
+        ("bgra", 0.4, [0, 0, 0, 0, 0]),
+    ],
+)
+def test_the_motion_tests_saturation_rule(kind: str, share: float, restarts: list[int]) -> None:
+    """A window clipped at 250 or above stays out of the motion test when the light dims 10 %
+    (its relit mean reads ~25 below it), under half of the view; at exactly half it counts, and
+    the pair restarts. Synthetic: a ramp with noise 4, the window 255 with its sampled pixels
+    (every 4th) at 250 in grey, or blue 220 in colour (saturated is the brightest of B, G and R,
+    not their mean, and not the alpha); the 255s keep the window out of the noise estimate. A
+    third mutation audit left ``>= 250``, the constant, the channels and ``< 0.5`` unasserted."""
+    rng = np.random.default_rng(0)
+    h, w = 96, 160
+    y, x = np.mgrid[0:h, 0:w].astype(np.float32)
+    ramp = 60 + 0.6 * x + 0.5 * y
+    cut = round(w * (1 - share))
+    tf = TemporalFilter()
+    seen = []
+    for gain in (1.0, 1.0, 1.0, 1.0, 0.9):
+        shape = ramp.shape if kind == "grey" else (h, w, 3)
+        lit = ramp if kind == "grey" else ramp[..., None]
+        f = np.clip(np.round(gain * lit + rng.normal(0, 4, shape)), 0, 255)
+        f[:, cut:] = 255
+        if kind == "grey":
+            f[::4, cut::4] = 250
+        else:
+            f[::4, cut::4, 0] = 220  # grey 251: out of the light's fit too
+        if kind == "bgra":
+            f = np.concatenate([f, np.full((h, w, 1), 255.0)], axis=2)
+        frame = f.astype(np.uint8)
+        tf(frame, frame)
+        seen.append(tf.restarts)
+    assert seen == restarts
+    # not restarted: the view averaged 5 frames, the window's pixels restarted alone
+    expected = 1.0 if restarts[-1] else (1 - share) * 5 + share * 1
+    assert tf.mean_frames() == pytest.approx(expected, abs=0.03)
