@@ -765,6 +765,17 @@ fn area_check_keeps_the_true_disparity_and_rejects_one_pixel_off() {
     assert!(!area_ok(&flat, &flat, &at(100.0, 50.0, 0.0), 0.5));
 }
 
+/// Equal ZNCCs: the area check's best is the first of them. Columns alternating 0, 1 (period
+/// 2) at d = 4.6: disparities 4 and 6 both fit exactly (ZNCC 1, 3, 5 and 7 -1); the first, 4,
+/// is 0.6 px off (kept at tol 1), the last, 6, 1.4 px off (rejected).
+#[test]
+fn area_check_takes_the_first_of_equal_peaks() {
+    let stripes = Image::new(40, 20, (0..40 * 20).map(|i| (i % 2) as f32).collect()).unwrap();
+    let m = match_at(20.0, 10.0, 4.6);
+    assert!(area_ok(&stripes, &stripes, &m, 1.0));
+    assert!(!area_ok(&stripes, &stripes, &m, 0.5));
+}
+
 #[test]
 fn repeated_correspondences_are_dropped_keeping_the_first() {
     let m = |xl: f32, xr: f32, score: f32| Match {
@@ -1688,6 +1699,11 @@ fn association_weights_and_the_resolution_follow_the_definitions() {
         data: vec![],
     };
     assert_eq!(graph::solve(&tie, &empty3, 2, &sp).chosen, [0, 2]);
+    // ... whatever order the left segments' groups come in: left 1's group first, its
+    // candidate 0 ties left 0's candidate 1 on right 0 and is kept (the first one the
+    // right-segment pass meets, left 0's, was kept with the index rule dropped).
+    let swapped = [c(1, 0, 0.8, 1.0, 0.0), c(0, 0, 0.8, 1.0, 0.0)];
+    assert_eq!(graph::solve(&swapped, &empty2, 2, &sp).chosen, [0]);
     // The preset (each left segment's best candidate on) is a stable state of mutually
     // inhibiting pairs: the network stays there (from all off, the visiting order decides).
     let pairs: Vec<graph::Candidate> = (0..8u32)
@@ -1748,6 +1764,13 @@ fn candidates_reach_across_the_band_and_the_wider_segment_slack() {
     assert!(got[0].ty > 1.0, "{:?}", got[0]);
     // Equal scores: the lower right id is kept first.
     let one = graph::CandParams { k_cand: 1, ..cp };
+    let got = run(a.clone(), &b, (0, 8), &one);
+    assert_eq!((got.len(), got[0].right), (1, 0));
+    // ... also when the right segments are met out of id order (the one spanning the band's
+    // first row before the ones starting below it): right 1 two rows higher, right 0 on the row.
+    let b = [b[1].clone(), b[0].clone()];
+    let got = run(a.clone(), &b, (0, 8), &cp);
+    assert_eq!((got[0].right, got[1].right), (0, 1));
     let got = run(a, &b, (0, 8), &one);
     assert_eq!((got.len(), got[0].right), (1, 0));
     let a = mk((0..10).map(|k| (20 + k / 3, 10 + k)).collect());
