@@ -412,6 +412,42 @@ fn disambiguation_keeps_singles_and_picks_by_vertical_disparity_then_similarity(
     assert_eq!(disambiguate(&ns, &net, &state, &p), [0, 2, 4, 5, 6]);
 }
 
+/// C.5 at a half-pixel reference: two singles of vertical disparity 0 and 1 (median 0.5); a
+/// conflict of dy 2 and -1, both 1.5 px off, keeps the more similar (dy 2) only where `tau_y`
+/// reaches 1.5 (inclusive): not at the default 1 px (a default of 1.5, or `<` for `<=`,
+/// survived the tests), nor just under 1.5; of two equally similar, the lower index.
+#[test]
+fn disambiguation_tolerance_is_inclusive_at_a_half_pixel_reference() {
+    let at = |point: u32, x: i32, d: i32, dy: i32, sim: f32| Neuron {
+        yr: 100 - dy,
+        sim,
+        ..neuron(point, (x, 100), d, 0.0, true)
+    };
+    let ns = vec![
+        at(0, 100, 10, 0, 0.9),
+        at(1, 104, 10, 1, 0.9),
+        at(2, 108, 10, -1, 0.8),
+        at(2, 108, 12, 2, 0.9),
+    ];
+    let state = [1, 1, 1, 1];
+    let p = HopfieldParams::default();
+    assert_eq!(p.tau_y, 1.0);
+    let net = Network::new(&ns, &p.weights);
+    assert_eq!(disambiguate(&ns, &net, &state, &p), [0, 1]);
+    let mut p = HopfieldParams {
+        tau_y: 1.5,
+        ..HopfieldParams::default()
+    };
+    assert_eq!(disambiguate(&ns, &net, &state, &p), [0, 1, 3]);
+    p.tau_y = 1.499;
+    assert_eq!(disambiguate(&ns, &net, &state, &p), [0, 1]);
+    // Equal distance and similarity: the lower index.
+    let mut tie = ns.clone();
+    tie[2].sim = 0.9;
+    p.tau_y = 1.5;
+    assert_eq!(disambiguate(&tie, &net, &state, &p), [0, 1, 2]);
+}
+
 /// `right = 0.5 left(x + d) + 0.2` (an exposure offset): the centre check, on window-mean-free
 /// grey levels, passes at the true disparity.
 #[test]
