@@ -495,6 +495,45 @@ def test_tau_y_default_drops_a_conflict_two_rows_off() -> None:
     assert all(more[k] == v for k, v in got.items())
 
 
+def test_tau_y_default_drops_a_conflict_one_and_a_half_rows_off() -> None:
+    """C.5 at a half-pixel reference: one textured patch three times on a flat view, A on its
+    row, B one row up and C both two rows up and one down in the right view. A's and B's 7
+    single matches each put the vertical reference at 0.5, so C's conflict is 1.5 px off either
+    way: dropped at the default tau_y = 1 px, kept from 1.5 (a default of 1.5 survived the
+    tests: no scene has such a conflict; 1.0 -> 1.5 changed no match on the 17 GT scenes)."""
+    size = 10
+    patch = cv2.GaussianBlur(
+        np.random.default_rng(0).random((size, size)).astype(np.float32), (0, 0), 1.0
+    )
+    patch = (patch - patch.mean()) / patch.std() * 0.15
+    left = np.full((80, 110), 0.5, np.float32)
+    right = left.copy()
+    placed = [
+        (left, 30, 20),  # A, disparity 6 ...
+        (right, 24, 20),  # ... on its row
+        (left, 60, 20),  # B ...
+        (right, 54, 19),  # ... one row up
+        (left, 45, 45),  # C ...
+        (right, 39, 43),  # ... two rows up
+        (right, 39, 46),  # ... and one down
+    ]
+    for img, x, y in placed:
+        img[y : y + size, x : x + size] += patch
+    kw = {"max_disparity": 10, "candidates": "points", "s_min": 0.5, "A": 0.0, "B": 0.0}
+    kw["theta"] = 0.0
+    default = hp.hopfield_match(left, right, **kw).to_array()
+    np.testing.assert_array_equal(
+        default, hp.hopfield_match(left, right, tau_y=1.0, **kw).to_array()
+    )
+    dy = default[:, 1] - default[:, 3]
+    assert len(default) == 14 and (dy == 0).sum() == 7 and (dy == 1).sum() == 7
+    assert len(hp.hopfield_match(left, right, tau_y=1.49, **kw)) == 14
+    wide = hp.hopfield_match(left, right, tau_y=1.5, **kw).to_array()
+    extra = [r for r in wide.tolist() if r[1] >= 40]
+    assert len(wide) == 15 and len(extra) == 1
+    assert extra[0][:2] == [48.0, 46.0] and extra[0][3] == 44.0
+
+
 def test_the_range_is_rounded_outwards_and_one_level_is_searched() -> None:
     """min_disparity 2.5 searches from level 2 (floor: the same matches as 2), max == min is a
     one-level search, not an error; rel_threshold/floor_rel above 1 and nms_half 0 are refused."""
