@@ -706,6 +706,18 @@ fn knn_graph_equals_the_brute_force_neighbours() {
     }
 }
 
+/// `wrap_angle` maps a difference of two angles in `[0, 2 pi)` to `(-pi, pi]`: -pi becomes pi
+/// (a `<` for the lower end's `<=` survived the tests: every caller takes the absolute value).
+#[test]
+fn wrap_angle_range_is_open_below_and_closed_above() {
+    use std::f64::consts::{PI, TAU};
+    assert_eq!(tracking::wrap_angle(-PI), PI);
+    assert_eq!(tracking::wrap_angle(PI), PI);
+    assert_eq!(tracking::wrap_angle(0.0), 0.0);
+    assert_eq!(tracking::wrap_angle(1.5 * PI), 1.5 * PI - TAU);
+    assert_eq!(tracking::wrap_angle(-1.5 * PI), TAU - 1.5 * PI);
+}
+
 #[test]
 fn orientation_bin_equals_the_floor_of_the_quotient() {
     // Every f32 in [0, 2 pi) 997 ulps apart, and every f32 within 64 ulps of each bin edge:
