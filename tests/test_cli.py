@@ -1270,7 +1270,7 @@ def test_demo_checks_its_output_folder_first(
         # a range as wide as the image is refused too (terrace: 713 px)
         (["--max-disparity", "713"], "disparity range 713 is not smaller than the image width 713"),
         (["--max-disparity", "5000"], "disparity range 5000 is not smaller than the image width"),
-        (["--right", "tsukuba"], "left and right images must have the same shape"),
+        (["--right", "tsukuba"], "left is 713x434 px, right is 384x288 px: the two images of"),
         (["--calib", "tsukuba"], "calibration is for 713x434 images, got 384x288"),
         (["--no-calib", "--max-sigma", "0.1"], "--max-depth and --max-sigma need --calib"),
         # accepted with no effect (no depth, no cloud) before

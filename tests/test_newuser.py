@@ -177,3 +177,30 @@ def test_check_names_two_sizes_as_the_other_commands_do(
         "stereovision: error: left is 450x375 px, right is 300x250 px: the two images of a pair "
         "have one size"
     )
+
+
+def test_depth_and_batch_name_two_sizes_as_check_does(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stereovision depth` (and `batch`) on a pair of two sizes said "got left (375, 450, 3)
+    and right (250, 300, 3)": NumPy's (height, width, channels), which reads as 375 wide; they
+    say "450x375 px" as `check` and `rectify` do."""
+    import json
+
+    import cv2
+
+    pair = tmp_path / "scenes" / "p1"
+    pair.mkdir(parents=True)
+    (pair / "left.png").write_bytes((CONES / "left.png").read_bytes())
+    cv2.imwrite(
+        str(pair / "right.png"), cv2.resize(cv2.imread(str(CONES / "right.png")), (300, 250))
+    )
+    says = "left is 450x375 px, right is 300x250 px: the two images of a pair have one size"
+    argv = ["depth", str(pair / "left.png"), str(pair / "right.png"), "-o", str(tmp_path / "o")]
+    for calib in ([], ["--calib", str(CONES / "calib.txt")]):
+        assert main([*argv, *calib]) == 2
+        assert capsys.readouterr().err.strip() == f"stereovision: error: {says}"
+    assert not (tmp_path / "o").exists()
+    assert main(["batch", str(tmp_path / "scenes"), "-o", str(tmp_path / "b")]) == 1
+    summary = json.loads((tmp_path / "b" / "summary.json").read_text())
+    assert summary["pairs"]["p1"]["error"] == f"ValueError: {says}"

@@ -260,12 +260,12 @@ def _check_pair(left: np.ndarray, right: np.ndarray, calib: Any, max_disparity: 
         _too_narrow,
     )
 
-    if np.shape(left)[:2] != np.shape(right)[:2]:
+    (h, w), (hr, wr) = np.shape(left)[:2], np.shape(right)[:2]
+    if (h, w) != (hr, wr):
+        # width x height, as check and rectify say it: NumPy's (375, 450, 3) read as 375 wide
         raise ValueError(
-            f"left and right images must have the same shape, got left {np.shape(left)} and "
-            f"right {np.shape(right)}"
+            f"left is {w}x{h} px, right is {wr}x{hr} px: the two images of a pair have one size"
         )
-    h, w = np.shape(left)[:2]
     _rig_to_warp_by(calib, w, h, max_disparity)  # a calibration for another image size
     if max_disparity is not None and max_disparity >= w:
         raise _range_too_wide(max_disparity, w)
