@@ -6,6 +6,7 @@ from __future__ import annotations
 from importlib import resources
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import stereovision
@@ -204,3 +205,48 @@ def test_depth_and_batch_name_two_sizes_as_check_does(
     assert main(["batch", str(tmp_path / "scenes"), "-o", str(tmp_path / "b")]) == 1
     summary = json.loads((tmp_path / "b" / "summary.json").read_text())
     assert summary["pairs"]["p1"]["error"] == f"ValueError: {says}"
+
+
+def test_a_foreign_calibration_is_named_not_asked_for_image_width(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A JSON file of another tool's (MATLAB's stereoParameters through jsonencode) said
+    "lacks field 'image_width'", and a user who added it was asked for K1 next; a YAML one
+    already said it has none of the fields. A JSON file says so too, MATLAB's export (JSON or
+    a MAT-file, which was "not a text calibration file") is named, with the way to convert it."""
+    import json
+
+    other = tmp_path / "other.json"
+    other.write_text(json.dumps({"frame_count": 3, "fps": 30.0}))
+    assert main(["info", str(other)]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: {other} is not a calibration: it has none of the fields "
+        "image_width, K1, K2, R, T (it holds: frame_count, fps)\n"
+    )
+    matlab = (
+        "is MATLAB's stereoParameters, which is not read here: MATLAB's "
+        "stereoParametersToOpenCV gives its K1, D1, K2, D2, R and T in OpenCV's convention; "
+        "save them with image_width, image_height and unit (T's unit: MATLAB's default is mm) "
+        "as a YAML or JSON file\n"
+    )
+    params = {"IntrinsicMatrix": np.eye(3).tolist(), "RadialDistortion": [0.0, 0.0]}
+    exported = {
+        "CameraParameters1": params,
+        "CameraParameters2": params,
+        "RotationOfCamera2": np.eye(3).tolist(),
+        "TranslationOfCamera2": [-120.0, 0.0, 0.0],
+    }
+    for name, text in [
+        ("stereoParams.json", json.dumps(exported)),
+        ("stereoParams.yaml", "%YAML:1.0\n---\nRotationOfCamera2: 1\n"),
+        ("plain.yaml", "RotationOfCamera2: [1, 0, 0]\n"),  # no OpenCV header
+    ]:
+        path = tmp_path / name
+        path.write_text(text)
+        assert main(["info", str(path)]) == 2
+        assert capsys.readouterr().err == f"stereovision: error: {path} {matlab}"
+    mat = tmp_path / "stereoParams.mat"  # a MAT-file's 128-byte header, then binary data
+    mat.write_bytes(b"MATLAB 5.0 MAT-file, Platform: GLNXA64".ljust(124) + b"\x00\x01IM\xff\xfe")
+    assert main(["info", str(mat)]) == 2
+    a_mat_file = matlab.replace("MATLAB's stereoParameters", "a MATLAB MAT-file", 1)
+    assert capsys.readouterr().err == f"stereovision: error: {mat} {a_mat_file}"

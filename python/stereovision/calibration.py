@@ -272,6 +272,33 @@ def _first_line(exc: BaseException) -> str:
 _CALIBRATION_FIELDS = ("image_width", "image_height", "K1", "M1", "K2", "M2", "R", "T")
 
 
+#: Fields of MATLAB's ``stereoParameters`` (its ``toStruct``, saved or ``jsonencode``-d).
+_MATLAB_FIELDS = ("CameraParameters1", "CameraParameters2", "RotationOfCamera2")
+
+
+def _matlab_export(source: str, what: str = "MATLAB's stereoParameters") -> str:
+    """How to bring MATLAB's stereo calibration here: its own convention (a transposed
+    ``IntrinsicMatrix``, the second camera's pose) is not read, OpenCV's is."""
+    return (
+        f"{source} is {what}, which is not read here: MATLAB's "
+        "stereoParametersToOpenCV gives its K1, D1, K2, D2, R and T in OpenCV's convention; "
+        "save them with image_width, image_height and unit (T's unit: MATLAB's default is mm) "
+        "as a YAML or JSON file"
+    )
+
+
+def _not_a_calibration_keys(keys: list[str], source: str) -> str:
+    """Why a YAML/XML/JSON mapping without any calibration field is not one: MATLAB's export
+    (named), or which fields it has."""
+    if any(k in _MATLAB_FIELDS for k in keys):
+        return _matlab_export(source)
+    held = ", ".join(keys) if keys else "nothing"
+    return (
+        f"{source} is not a calibration: it has none of the fields image_width, K1, K2, R, T "
+        f"(it holds: {held})"
+    )
+
+
 def _not_a_calibration(fs: Any, source: str) -> str:
     """Why an OpenCV YAML/XML file without any calibration field is not one: an image list
     (OpenCV's ``stereo_calib.xml`` sample names its chessboard pairs) or which fields it has."""
@@ -289,11 +316,7 @@ def _not_a_calibration(fs: Any, source: str) -> str:
                 f"under {key!r}): calibrate the rig from those images with `stereovision "
                 "calibrate --left ... --right ... --square SIZE -o calib.yaml`"
             )
-    held = ", ".join(keys) if keys else "nothing"
-    return (
-        f"{source} is not a calibration: it has none of the fields image_width, K1, K2, R, T "
-        f"(it holds: {held})"
-    )
+    return _not_a_calibration_keys(keys, source)
 
 
 def _pixels(value: object, what: str) -> int:
@@ -1296,6 +1319,8 @@ class Calibration:
                 f"{source} holds the homographies `stereovision rectify` found for a rig without "
                 "a calibration (disparity only): give it as --rectification"
             )
+        if not any(k in obj for k in _CALIBRATION_FIELDS):  # as a YAML file says it
+            raise ValueError(_not_a_calibration_keys([str(k) for k in obj], source))
         return cls._from_mapping(obj.get, source)
 
     @staticmethod
@@ -1308,6 +1333,9 @@ class Calibration:
         try:
             return p, p.read_text(encoding="utf-8")
         except UnicodeDecodeError:
+            with p.open("rb") as fh:
+                if fh.read(6) == b"MATLAB":  # a MAT-file's header (v5, v7, v7.3)
+                    raise ValueError(_matlab_export(str(p), "a MATLAB MAT-file")) from None
             raise ValueError(f"not a text calibration file: {p}") from None
 
     @classmethod
@@ -1474,6 +1502,8 @@ class Calibration:
             return cls.from_kitti(p, image_size=image_size)
         if _q_numbers(text):  # a Q.dat: OpenCV's Q, sized like load_scene sizes it
             return cls.from_q(p, image_size or _scene_image_size(p), unit=unit or "m")
+        if any(re.search(rf"^{k}\s*:", text, re.MULTILINE) for k in _MATLAB_FIELDS):
+            raise ValueError(_matlab_export(str(p)))  # a YAML written without OpenCV's header
         raise ValueError(
             f"unrecognised calibration format in {p}: expected OpenCV YAML/XML, JSON, "
             "Middlebury calib.txt, KITTI calibration, ROS camera_info, Kalibr camchain or "
