@@ -92,6 +92,11 @@ _AUTO_COARSE_MIN_SIZE = (16, 64)  # (rows, columns) of the shrunk pair, else no 
 _AUTO_ORB_MIN_SIDE = 63
 # Share of the feature matches with a negative disparity above which the pair looks swapped.
 _SWAPPED_SHARE = 0.5
+# Share of the feature matches within _AUTO_DY_TOL rows below which the pair looks unrectified:
+# 0.45-0.95 on the 18 rectified scenes of ../shared/data (art the lowest: ORB's mismatches),
+# 0.02 on OpenCV's uncalibrated books pair; cones and terrace with the right image 3 / 6 rows
+# lower: 0.24 and 0.22 / 0.04 and 0.01.
+_UNRECTIFIED_SHARE = 0.2
 _DISPARITY_STEP = 16  # ranges are multiples of 16, like the evaluation protocol's
 
 # Disparity uncertainty from the matcher's confidence: sigma_d = max(s0 + slope * conf, s_min)
@@ -244,7 +249,8 @@ def estimate_max_disparity(left: npt.ArrayLike, right: npt.ArrayLike) -> int:
     is first stretched by one gain, so its 8-bit copy keeps its features. Over
     the 17 GT scenes of ``../shared/data`` the range covers the GT's 99.5th percentile on all of
     them, in 8-41 ms (ORB alone, as before: 15 of them, KITTI 80 px for a GT that reaches 101
-    px, in 50-200 ms).
+    px, in 50-200 ms). The feature matches also warn of a pair that looks swapped (most of
+    them with a negative disparity) or unrectified (fewer than 20 % of them within 2 rows).
 
     Parameters
     ----------
@@ -299,12 +305,33 @@ def _orb_top(gl: npt.NDArray[np.uint8], gr: npt.NDArray[np.uint8]) -> float | No
     pl = np.array([kl[m.queryIdx].pt for m in matches], dtype=np.float64).reshape(-1, 2)
     pr = np.array([kr[m.trainIdx].pt for m in matches], dtype=np.float64).reshape(-1, 2)
     d = pl[:, 0] - pr[:, 0]
-    same_row = np.abs(pl[:, 1] - pr[:, 1]) <= _AUTO_DY_TOL / s
+    dy = np.abs(pl[:, 1] - pr[:, 1])
+    same_row = dy <= _AUTO_DY_TOL / s
+    _warn_if_unrectified(same_row, dy * s)
     _warn_if_swapped(d[same_row] * s)
     keep = same_row & (d >= 0)
     if int(keep.sum()) < _AUTO_MIN_MATCHES:
         return None
     return float(np.percentile(d[keep], _AUTO_PERCENTILE)) * s
+
+
+def _warn_if_unrectified(same_row: npt.NDArray[np.bool_], dy: npt.NDArray[np.float64]) -> None:
+    """Warn when the pair looks unrectified: few of the feature matches lie within
+    ``_AUTO_DY_TOL`` rows of each other (two raw camera images, matched along rows they do not
+    share, gave a map of noise without a word). ``dy`` in full-resolution pixels."""
+    if same_row.size < _AUTO_MIN_MATCHES:
+        return
+    share = float(np.mean(same_row))
+    if share < _UNRECTIFIED_SHARE:
+        warnings.warn(
+            f"the left and right images look unrectified: {share:.0%} of the feature matches "
+            f"lie within {_AUTO_DY_TOL:g} rows of each other ({same_row.size} matches, median "
+            f"{float(np.median(dy)):.0f} px apart; a rectified pair keeps most on one row); "
+            "give the rig's calibration (calib=, --calib), or rectify the pair from its "
+            "features (stereovision rectify LEFT RIGHT -o DIR)",
+            UserWarning,
+            stacklevel=user_stacklevel(),
+        )
 
 
 def _warn_if_swapped(d: npt.NDArray[np.float64]) -> None:
