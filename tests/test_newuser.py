@@ -280,3 +280,23 @@ def test_an_unrectified_pair_is_said_to_be_one(
     lower = cv2.warpAffine(right, np.float32([[1, 0, 0], [0, 1, 8]]), right.shape[1::-1])
     with pytest.warns(UserWarning, match=r"look unrectified: \d+% of the feature matches"):
         sv.estimate_max_disparity(left, lower)
+
+
+def test_a_pair_halved_with_rounding_is_named_resized(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The sample halved (450x375 -> 225x188, the odd height rounded) was "another aspect
+    ratio: another camera mode or camera, or cropped images" under its calibration: only an
+    exact ratio counted as a resize, where `stream` and `gui` scale a calibration to frames
+    within 1 % (fit_to_frames). The hint takes the same 1 %."""
+    import cv2
+
+    for name in ("left", "right"):
+        image = cv2.imread(str(CONES / f"{name}.png"))
+        cv2.imwrite(str(tmp_path / f"{name}.png"), cv2.resize(image, (225, 188)))
+    argv = ["depth", str(tmp_path / "left.png"), str(tmp_path / "right.png")]
+    assert main([*argv, "--calib", str(CONES / "calib.txt"), "-o", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "stereovision: error: calibration is for 450x375 images, got 225x188 (images resized, "
+        "not cropped: calib.scaled_to((225, 188)))"
+    )

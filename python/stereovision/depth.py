@@ -161,7 +161,8 @@ def _rig_to_warp_by(
         w, h = width, height
         if (cw, ch) == (h, w):
             hint = "width and height swapped? image_size is (width, height)"
-        elif cw * h == ch * w:
+        elif abs(w / cw - h / ch) <= 0.01 * max(w / cw, h / ch):
+            # fit_to_frames' 1 % (stream and gui scale such frames): a halved odd side rounds
             hint = f"images resized, not cropped: calib.scaled_to(({w}, {h}))"
         else:
             hint = "another aspect ratio: another camera mode or camera, or cropped images"
