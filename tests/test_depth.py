@@ -462,8 +462,10 @@ def test_pair_and_calibration_mistakes_are_named() -> None:
     with pytest.raises(ValueError, match=r"450x375 \(width and height swapped\? image_size is"):
         sv.match(s.left, s.right, swapped, method="best")
     with pytest.raises(
-        ValueError, match=r"Calibration \(or an UncalibratedRectification\), got str"
+        ValueError, match=r"Calibration \(or an UncalibratedRectification\), got dict"
     ):
+        sv.match(s.left, s.right, {"K1": 1}, method="best")  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^calib: got the path 'calib.yaml', not a calib"):
         sv.match(s.left, s.right, "calib.yaml", method="best")  # type: ignore[arg-type]
 
 

@@ -300,3 +300,29 @@ def test_a_pair_halved_with_rounding_is_named_resized(
         "stereovision: error: calibration is for 450x375 images, got 225x188 (images resized, "
         "not cropped: calib.scaled_to((225, 188)))"
     )
+
+
+def test_paths_given_for_images_or_calibration_say_read_them_first() -> None:
+    """`sv.depth_map("left.png", "right.png", calib)`, the README's call with file names, said
+    "expected a numeric image array, got str converting to dtype <U8"; a calib.txt path said
+    only "got str". Each says it got a path and how to read it."""
+    import cv2
+
+    import stereovision as sv
+
+    calib = sv.Calibration.from_file(CONES / "calib.txt")
+    left = str(CONES / "left.png")
+    image = cv2.imread(left)
+    for call in (sv.depth_map, sv.match):
+        with pytest.raises(ValueError) as exc:
+            call(left, image, calib)
+        assert str(exc.value) == (
+            f"left: got the path {left!r}, not an image: read it first (cv2.imread(path) or "
+            "stereovision.io.imread(path))"
+        )
+        with pytest.raises(ValueError) as exc:
+            call(image, image, CONES / "calib.txt")
+        assert str(exc.value) == (
+            f"calib: got the path '{CONES / 'calib.txt'}', not a calibration: read it first "
+            "(stereovision.Calibration.from_file(path))"
+        )

@@ -94,6 +94,12 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
             f"{name}: got None, not an image (cv2.imread returns None for a file it cannot "
             "read: check the path)"
         )
+    if isinstance(img, (str, os.PathLike)):
+        # a file name where the README's cv2.imread(...) goes: "got str converting to <U8"
+        raise ValueError(
+            f"{name}: got the path {os.fspath(img)!r}, not an image: read it first "
+            "(cv2.imread(path) or stereovision.io.imread(path))"
+        )
     try:
         arr = np.asarray(img)
     except (ValueError, TypeError) as exc:  # ragged nested sequences and the like

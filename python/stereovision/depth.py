@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import os
 import time
 import warnings
 from collections.abc import Callable
@@ -151,6 +152,11 @@ def _rig_to_warp_by(
         return calib, None, calib.max_disparity if max_disparity is None else max_disparity
     if calib is None:
         return None, None, max_disparity
+    if isinstance(calib, (str, os.PathLike)):  # a calib.txt's name: said, not just "got str"
+        raise ValueError(
+            f"calib: got the path {os.fspath(calib)!r}, not a calibration: read it first "
+            "(stereovision.Calibration.from_file(path))"
+        )
     if not isinstance(calib, Calibration):
         raise ValueError(
             "calib must be a stereovision.Calibration (or an UncalibratedRectification), "
