@@ -326,3 +326,26 @@ def test_paths_given_for_images_or_calibration_say_read_them_first() -> None:
             f"calib: got the path '{CONES / 'calib.txt'}', not a calibration: read it first "
             "(stereovision.Calibration.from_file(path))"
         )
+
+
+def test_a_grey_and_a_colour_image_are_named_as_such() -> None:
+    """`cv2.imread(left, 0)` beside `cv2.imread(right)`: depth_map and match said "must have
+    the same shape, got left (375, 450) and right (375, 450, 3)", the same size; they say
+    which is grey and how to read them alike."""
+    import cv2
+
+    import stereovision as sv
+
+    grey = cv2.imread(str(CONES / "left.png"), cv2.IMREAD_GRAYSCALE)
+    colour = cv2.imread(str(CONES / "right.png"))
+    said = (
+        "left and right images must have the same shape, got left (375, 450) and right "
+        "(375, 450, 3): left is grey, right is colour; read both alike (cv2.imread(path) "
+        "reads both in colour)"
+    )
+    for call in (sv.depth_map, sv.match):
+        with pytest.raises(ValueError) as exc:
+            call(grey, colour)
+        assert str(exc.value) == said
+    with pytest.raises(ValueError, match=r"left is colour, right is colour with alpha; read"):
+        sv.match(colour, cv2.cvtColor(colour, cv2.COLOR_BGR2BGRA))

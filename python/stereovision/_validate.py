@@ -355,6 +355,35 @@ def as_gray_uint8(img: object, name: str = "image") -> npt.NDArray[np.uint8]:
     return np.asarray(cv2.cvtColor(as_bgr_uint8(arr, name), cv2.COLOR_BGR2GRAY), dtype=np.uint8)
 
 
+def _channels_text(shape: tuple[int, ...]) -> str:
+    """``grey``, ``colour``, ``colour with alpha`` or ``N channels`` for an image's shape."""
+    c = shape[2] if len(shape) == 3 else 1
+    return {1: "grey", 3: "colour", 4: "colour with alpha"}.get(c, f"{c} channels")
+
+
+def pair_shape_error(left: tuple[int, ...], right: tuple[int, ...]) -> ValueError:
+    """The refusal of a pair of two shapes; one size read two ways (``cv2.imread(path, 0)``
+    beside ``cv2.imread(path)``) says which is grey and how to read them alike.
+
+    Parameters
+    ----------
+    left, right : tuple of int
+        The two images' shapes.
+
+    Returns
+    -------
+    ValueError
+        The error to raise.
+    """
+    text = f"left and right images must have the same shape, got left {left} and right {right}"
+    if left[:2] == right[:2]:
+        text += (
+            f": left is {_channels_text(left)}, right is {_channels_text(right)}; read both "
+            "alike (cv2.imread(path) reads both in colour)"
+        )
+    return ValueError(text)
+
+
 def check_pair(
     left: object, right: object
 ) -> tuple[npt.NDArray[np.float32], npt.NDArray[np.float32]]:
@@ -380,10 +409,7 @@ def check_pair(
     larr = as_image_array(left, "left")
     rarr = as_image_array(right, "right")
     if larr.shape != rarr.shape:
-        raise ValueError(
-            f"left and right images must have the same shape, got left {larr.shape} and "
-            f"right {rarr.shape}"
-        )
+        raise pair_shape_error(larr.shape, rarr.shape)
     return as_gray_float(larr, "left"), as_gray_float(rarr, "right")
 
 

@@ -31,6 +31,7 @@ from stereovision._validate import (
     as_gray_float,
     check_pair,
     finite_number,
+    pair_shape_error,
     unreachable_range,
     user_stacklevel,
 )
@@ -1311,10 +1312,7 @@ def depth_map(
     # and a colour image are not a pair (match() refuses them too).
     shapes = [np.shape(left), np.shape(right)]
     if left_bgr.shape != right_bgr.shape or len(shapes[0]) != len(shapes[1]):
-        raise ValueError(
-            f"left and right images must have the same shape, got left {shapes[0]} and "
-            f"right {shapes[1]}"
-        )
+        raise pair_shape_error(shapes[0], shapes[1])
     if np.may_share_memory(left_bgr, left):
         # the result keeps the left image (its cloud's colours, exports): not the caller's
         # buffer, which a camera loop refills (cap.read(frame)) before the cloud is written
