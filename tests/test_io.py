@@ -1452,3 +1452,213 @@ def test_a_folder_without_write_permission_is_named_not_the_temporary_file(
         write_together([(tmp_path / "rig.yaml", b"x")])
     assert str(together.value) == want
     assert (tmp_path / "ro" / "rig.yaml").read_text() == "old"
+
+
+# ------------------------------------------------------- third mutation audit of the safe writes
+
+
+def test_a_replaced_files_set_user_id_bit_is_not_carried(tmp_path: Path) -> None:
+    """A third mutation audit: the replaced file's permission bits are kept, but not its
+    set-user-ID, set-group-ID or sticky bits (new contents are not the program it held)."""
+    rig = tmp_path / "tool"
+    rig.write_bytes(b"old")
+    rig.chmod(0o6755)
+    with atomic_write(rig) as fh:
+        fh.write(b"new")
+    assert rig.stat().st_mode & 0o7777 == 0o755
+    rig.chmod(0o4711)
+    write_together([(rig, b"newer")])
+    assert rig.stat().st_mode & 0o7777 == 0o711
+
+
+def test_lock_folder_where_nothing_can_be_locked_is_not_busy(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A filesystem that cannot lock (flock: EOPNOTSUPP, ENOLCK) is no lock held by another
+    run: (None, False); only a held lock (BlockingIOError) is busy. A mutation audit made every
+    failure 'busy' unseen."""
+    import errno
+    import fcntl
+
+    from stereovision.io import lock_folder
+
+    def cannot(fd: int, op: int) -> None:
+        raise OSError(errno.EOPNOTSUPP, "Operation not supported")
+
+    monkeypatch.setattr(fcntl, "flock", cannot)
+    assert lock_folder(tmp_path) == (None, False)
+
+    def held(fd: int, op: int) -> None:
+        raise BlockingIOError(errno.EWOULDBLOCK, "Resource temporarily unavailable")
+
+    monkeypatch.setattr(fcntl, "flock", held)
+    assert lock_folder(tmp_path) == (None, True)
+
+
+def test_refuse_an_input_through_a_folder_not_made_yet(tmp_path: Path) -> None:
+    """``--plot new/../left.png`` names the left image through a folder that does not exist
+    yet (os.path.samefile fails): the spelled-out paths are compared, and it is refused;
+    ``make_folder`` would have made ``new`` and the plot replaced the image."""
+    from stereovision.io import refuse_an_input
+
+    left = tmp_path / "left.png"
+    left.write_bytes(b"img")
+    inputs = {"the left image": str(left), "the calibration": None}
+    with pytest.raises(ValueError, match=r"--plot .*: is the left image \(.*left\.png\); give"):
+        refuse_an_input("--plot", tmp_path / "new" / ".." / "left.png", inputs)
+    refuse_an_input("--plot", tmp_path / "new" / "left.png", inputs)  # another file: accepted
+
+
+def test_check_output_folder_error_classes(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A file above the folder is a ValueError naming that file ('is a file, not a folder');
+    a folder above it that cannot be written is a PermissionError naming it."""
+    import tempfile
+
+    from stereovision.io import check_output_folder
+
+    (tmp_path / "notes").write_text("mine")
+    with pytest.raises(ValueError) as info:
+        check_output_folder(tmp_path / "notes" / "out", "-o")
+    assert str(info.value) == (
+        f"-o {tmp_path / 'notes' / 'out'}: {tmp_path / 'notes'} is a file, not a folder"
+    )
+
+    def refused(*args: object, **kwargs: object) -> tuple[int, str]:
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tempfile, "mkstemp", refused)
+    with pytest.raises(PermissionError) as denied:
+        check_output_folder(tmp_path / "new" / "out", "-o")
+    assert str(denied.value) == (
+        f"-o {tmp_path / 'new' / 'out'}: cannot write in {tmp_path} (Permission denied)"
+    )
+
+
+def test_check_destinations_a_loop_and_a_hard_link(tmp_path: Path) -> None:
+    """A looping link is said as a loop alone (not 'is a link to itself; ...'), its errno
+    kept (ELOOP); right.yaml a hard link of left.yaml is one file, as a symbolic one is."""
+    import errno
+
+    from stereovision.io import check_destinations
+
+    ros = tmp_path / "ros"
+    ros.mkdir()
+    (ros / "left.yaml").symlink_to(ros / "left.yaml")
+    with pytest.raises(OSError) as info:
+        check_destinations(ros, ["left.yaml", "right.yaml"], "--ros")
+    assert (
+        str(info.value) == f"--ros {ros}: cannot write {ros / 'left.yaml'}: it is a link that loops"
+    )
+    assert info.value.errno == errno.ELOOP
+    (ros / "left.yaml").unlink()
+    (ros / "left.yaml").write_text("left\n")
+    os.link(ros / "left.yaml", ros / "right.yaml")
+    with pytest.raises(ValueError, match=r"right\.yaml and .*left\.yaml are one file"):
+        check_destinations(ros, ["left.yaml", "right.yaml"], "--ros")
+    (ros / "right.yaml").unlink()
+    (ros / "right.yaml").write_text("right\n")
+    check_destinations(ros, ["left.yaml", "right.yaml"], "--ros")  # two files: accepted
+
+
+def test_keep_previous_with_the_new_bytes(tmp_path: Path) -> None:
+    """keep_previous(path, new): the same bytes again replace nothing (no copy, None); other
+    bytes of the same length do, so the file is copied aside."""
+    from stereovision.io import keep_previous
+
+    plot = tmp_path / "plot.png"
+    plot.write_bytes(b"abcd")
+    assert keep_previous(plot, b"abcd") is None
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plot.png"]
+    assert keep_previous(plot, b"abce") == tmp_path / "plot.previous.png"
+    assert (tmp_path / "plot.previous.png").read_bytes() == b"abcd"
+
+
+def test_write_together_failing_removes_a_new_file_it_put_in_place(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The second file failing to go in place: the first, which did not exist before, is
+    removed again (all or nothing), the second's earlier contents untouched, no temporary
+    file left."""
+    real = os.replace
+    calls = []
+
+    def second_fails(src: object, dst: object) -> None:
+        calls.append(dst)
+        if len(calls) == 2:
+            raise OSError(28, "No space left on device")
+        real(src, dst)
+
+    (tmp_path / "b.yaml").write_bytes(b"old")
+    monkeypatch.setattr(os, "replace", second_fails)
+    with pytest.raises(OSError, match="No space left"):
+        write_together([(tmp_path / "a.yaml", b"new"), (tmp_path / "b.yaml", b"new")])
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["b.yaml"]
+    assert (tmp_path / "b.yaml").read_bytes() == b"old"
+
+
+def test_write_together_names_previous_contents_it_could_not_put_back(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The second file failing, and the first's previous contents failing to be put back: the
+    copy holding them is kept and the error's note names it and its destination."""
+    real = os.replace
+    calls = []
+
+    def fails_after_the_first(src: object, dst: object) -> None:
+        calls.append(dst)
+        if len(calls) >= 2:
+            raise OSError(5, "Input/output error")
+        real(src, dst)
+
+    (tmp_path / "a.yaml").write_bytes(b"old a")
+    monkeypatch.setattr(os, "replace", fails_after_the_first)
+    with pytest.raises(OSError) as info:
+        write_together([(tmp_path / "a.yaml", b"new a"), (tmp_path / "b.yaml", b"new b")])
+    (copy,) = [p for p in tmp_path.iterdir() if p.name.endswith(".old")]
+    assert copy.read_bytes() == b"old a"
+    assert info.value.__notes__ == [
+        f"{tmp_path / 'a.yaml'} could not be restored: its previous contents are in {copy}"
+    ]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["a.yaml", copy.name])
+
+
+def test_read_pfm_one_value_short_is_truncated(tmp_path: Path) -> None:
+    """A PFM four bytes (one value) short is said to be truncated, with the counts."""
+    path = write_pfm(tmp_path / "d.pfm", np.ones((2, 3), np.float32))
+    path.write_bytes(path.read_bytes()[:-4])
+    with pytest.raises(ValueError) as info:
+        read_pfm(path)
+    assert str(info.value) == (
+        f"truncated PFM file {path}: expected 24 data bytes for 3x2x1, got 20"
+    )
+
+
+def test_scene_too_narrow_at_a_range_as_wide_as_the_images(tmp_path: Path) -> None:
+    """Images exactly as wide as the scene's range cannot be matched over it (the range must be
+    below the width); one pixel wider can."""
+    from stereovision.io import Scene, scene_too_narrow
+
+    def scene(width: int) -> Scene:
+        img = np.zeros((4, width, 3), np.uint8)
+        return Scene("f/s", img, img, None, None, 32, tmp_path)
+
+    assert scene_too_narrow(scene(32)) == (
+        "images 32 px wide, not wider than the scene's disparity range (32 px, evaluation.md's "
+        "rule: 16 at least): a scene needs images at least 33 px wide"
+    )
+    assert scene_too_narrow(scene(33)) is None
+
+
+def test_distinct_scenes_through_a_link(tmp_path: Path) -> None:
+    """A scene given by its folder and through a link to it (or a '..' spelling) is one scene:
+    kept once, the later spellings dropped, in order."""
+    from stereovision.io import distinct_scenes
+
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    (tmp_path / "link").symlink_to(tmp_path / "a")
+    given = [tmp_path / "a", tmp_path / "b", tmp_path / "link", tmp_path / "b" / ".." / "a"]
+    assert distinct_scenes(given) == (
+        [tmp_path / "a", tmp_path / "b"],
+        [tmp_path / "link", tmp_path / "b" / ".." / "a"],
+    )
