@@ -2064,3 +2064,93 @@ def test_a_resource_warning_is_not_said(
     monkeypatch.setattr(cli, "cmd_info", warns)
     assert cli.main(["info"]) == 0
     assert capsys.readouterr().err == "stereovision: warning: a real one\n"
+
+
+# ------------------------------------------------------------- third mutation audit of the CLI
+
+
+@pytest.mark.parametrize(
+    ("grid", "reached"),
+    [("0.01", True), ("10", True), ("0.005", False), ("10.5", False), ("nan", False)],
+)
+def test_depth_grid_takes_0_01_to_10_m_ends_included(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    grid: str,
+    reached: bool,
+) -> None:
+    """--grid's range, as its message says it, 0.01 to 10 m with both ends taken: an end refused
+    or a cell side beyond them taken survived a mutation audit. (The matching stands in for
+    the work: reached, it stops the run.)"""
+    import stereovision.depth
+
+    def matched(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("matched")
+
+    monkeypatch.setattr(stereovision.depth, "depth_map", matched)
+    terrace = data_dir / "eth3d" / "terrace"
+    pair = [str(terrace / "left.png"), str(terrace / "right.png")]
+    argv = ["depth", *pair, "--calib", str(terrace / "calib.txt"), "--ground", "--grid", grid]
+    argv += ["-o", str(tmp_path / "o")]
+    assert main(argv) == 2
+    said = (
+        "matched"
+        if reached
+        else f"--grid: expected a cell side from 0.01 to 10 m, got {float(grid)}"
+    )
+    assert capsys.readouterr().err == f"stereovision: error: {said}\n"
+    assert not (tmp_path / "o").exists()
+
+
+def test_running_out_of_memory_is_the_users_one_line_not_a_bug(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A MemoryError (a pair too large for the machine) is said as the error it is, exit 2,
+    not as 'internal MemoryError ... (please report this)'."""
+    import stereovision.cli as cli
+
+    def too_big(args: object) -> int:
+        raise MemoryError("Unable to allocate 12.0 GiB for an array")
+
+    monkeypatch.setattr(cli, "cmd_info", too_big)
+    assert main(["info", "--size", "640x480", "--hfov", "60", "--baseline", "0.1"]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == "stereovision: error: Unable to allocate 12.0 GiB for an array\n"
+
+
+def test_eval_json_leaves_out_the_text_only_keys(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """eval --json writes a row's figures, not its keys for the text output ('_table1_text',
+    pre-formatted tables): a mutation audit wrote them into the JSON unseen."""
+    import stereovision.cli as cli
+    from stereovision.io import write_pfm
+
+    scene = tmp_path / "fam" / "s"
+    scene.mkdir(parents=True)
+    rng = np.random.default_rng(0)
+    img = (rng.random((24, 64, 3)) * 255).astype(np.uint8)
+    assert cv2.imwrite(str(scene / "left.png"), img)
+    assert cv2.imwrite(str(scene / "right.png"), img[:, ::-1])
+    write_pfm(scene / "gt_disp.pfm", np.full((24, 64), 3.0, np.float32))
+    row = {"scene": "fam/s", "max_disparity": 16, "table1": {"n": 1}, "_table1_text": "T"}
+    monkeypatch.setattr(cli, "_eval_scene", lambda *args, **kwargs: dict(row))
+    assert main(["eval", str(scene), "--json"]) == 0
+    (line,) = capsys.readouterr().out.splitlines()
+    assert json.loads(line) == {"scene": "fam/s", "max_disparity": 16, "table1": {"n": 1}}
+
+
+@pytest.mark.parametrize(
+    ("left", "name"),
+    [("data/terrace/left.png", "terrace/left.png"), ("left.png", "left.png"),
+     ("/tmp/l.png", "tmp/l.png")],
+)  # fmt: skip
+def test_pair_name_is_the_left_images_folder_and_file(left: str, name: str) -> None:
+    """overview.png's title names the pair by its left image's folder and file name (the
+    file alone when it has no folder)."""
+    from stereovision.cli import _pair_name
+
+    assert _pair_name(left) == name
