@@ -1662,3 +1662,28 @@ def test_distinct_scenes_through_a_link(tmp_path: Path) -> None:
         [tmp_path / "a", tmp_path / "b"],
         [tmp_path / "link", tmp_path / "b" / ".." / "a"],
     )
+
+
+def test_keep_previous_steps_over_a_folder_under_its_name(tmp_path: Path) -> None:
+    """A folder named plot.previous.png is not a copy (nor compared as one): the copy is
+    plot.previous.2.png, the folder untouched."""
+    from stereovision.io import keep_previous
+
+    (tmp_path / "plot.previous.png").mkdir()
+    # as many bytes as the folder's size: compared by size alone, it was opened as a file
+    mine = b"m" * (tmp_path / "plot.previous.png").stat().st_size
+    plot = tmp_path / "plot.png"
+    plot.write_bytes(mine)
+    assert keep_previous(plot) == tmp_path / "plot.previous.2.png"
+    assert (tmp_path / "plot.previous.2.png").read_bytes() == mine
+    assert (tmp_path / "plot.previous.png").is_dir()
+
+
+def test_load_scene_refuses_a_folder_named_gt_disp_pfm(tmp_path: Path) -> None:
+    """A folder under gt_disp.pfm is no scene without ground truth: refused, naming it."""
+    img = np.zeros((8, 32, 3), np.uint8)
+    assert cv2.imwrite(str(tmp_path / "left.png"), img)
+    assert cv2.imwrite(str(tmp_path / "right.png"), img)
+    (tmp_path / "gt_disp.pfm").mkdir()
+    with pytest.raises(ValueError, match=r"^PFM file is not a regular file: .*gt_disp\.pfm$"):
+        load_scene(tmp_path)
