@@ -2154,3 +2154,92 @@ def test_pair_name_is_the_left_images_folder_and_file(left: str, name: str) -> N
     from stereovision.cli import _pair_name
 
     assert _pair_name(left) == name
+
+
+def test_depth_pictures_colour_near_warm_and_the_disparity_from_0(tmp_path: Path) -> None:
+    """disparity.png is coloured from 0 px (a disparity of 10..20 does not start at the
+    colour map's end), depth.png by inverse depth (near warm, far cold, as the disparity):
+    neither was asserted by value before a mutation audit."""
+    from types import SimpleNamespace
+
+    from stereovision.cli import colorize, write_depth_outputs
+
+    disparity = np.tile(np.linspace(10.0, 20.0, 8, dtype=np.float32), (4, 1))
+    depth = (40.0 / disparity).astype(np.float32)  # near where the disparity is large
+    res = SimpleNamespace(
+        disparity=disparity,
+        depth=depth,
+        points=np.ones((3, 3), np.float32),
+        colors=np.zeros((3, 3), np.uint8),
+    )
+    written = write_depth_outputs(res, tmp_path / "o")
+    disp_png = cv2.imread(str(written["disparity.png"]))
+    assert np.array_equal(disp_png, colorize(disparity, lo=0.0))
+    assert not np.array_equal(disp_png, colorize(disparity))
+    depth_png = cv2.imread(str(written["depth.png"])).astype(int)
+    near, far = depth_png[0, -1], depth_png[0, 0]  # BGR
+    assert near[2] > near[0] and far[0] > far[2]  # near red, far blue
+    assert np.array_equal(depth_png, colorize(1.0 / depth))
+
+
+def test_a_manifest_that_is_no_list_names_no_earlier_output(tmp_path: Path) -> None:
+    """A manifest holding a JSON object (or a string) is no list of an earlier run's files:
+    the user's cloud.ply beside it is refused, not taken for the run's (its keys, or the
+    string's letters, were never outputs)."""
+    from stereovision.cli import DEPTH_MANIFEST, refuse_foreign_outputs
+
+    (tmp_path / "cloud.ply").write_bytes(b"mine")
+    for text in ('{"cloud.ply": true}', '"cloud.ply"'):
+        (tmp_path / DEPTH_MANIFEST).write_text(text)
+        with pytest.raises(FileExistsError, match=r"cloud\.ply is not listed"):
+            refuse_foreign_outputs(tmp_path, ["disparity.png", "cloud.ply"])
+    (tmp_path / DEPTH_MANIFEST).write_text('["cloud.ply"]')
+    assert refuse_foreign_outputs(tmp_path, ["cloud.ply"]) == {"cloud.ply"}
+
+
+def test_commit_outputs_keeps_an_earlier_file_stale_says_to_keep(tmp_path: Path) -> None:
+    """commit_outputs' ``stale``: an earlier run's file this run did not write goes only when
+    stale(path) says so (rectify keeps a rectification.json that holds no homographies)."""
+    from stereovision.cli import RECTIFY_MANIFEST, RECTIFY_OUTPUTS, commit_outputs
+
+    out, stage = tmp_path / "o", tmp_path / "stage"
+    out.mkdir()
+    stage.mkdir()
+    for name in ("check.png", "rectification.json"):
+        (out / name).write_text("earlier")
+    (stage / "left_rect.png").write_bytes(b"new")
+    earlier = {"check.png", "rectification.json"}
+    written, removed = commit_outputs(
+        out, {"left_rect.png": stage / "left_rect.png"}, earlier, RECTIFY_MANIFEST,
+        RECTIFY_OUTPUTS, stale=lambda p: p.name == "check.png",
+    )  # fmt: skip
+    assert written == {"left_rect.png": out / "left_rect.png"}
+    assert removed == [out / "check.png"]
+    assert (out / "rectification.json").read_text() == "earlier"
+    assert json.loads((out / RECTIFY_MANIFEST).read_text()) == ["left_rect.png"]
+
+
+def test_lengths_are_said_in_the_unit_asked_for() -> None:
+    """_length (the scan's and the floor's lines with --unit): metres said in the unit."""
+    from stereovision.cli import _length
+
+    assert _length(0.3048, "ft", 2) == "1.00 ft"
+    assert _length(1.5, "mm", 0) == "1500 mm"
+    assert _length(1.5, "m", 1) == "1.5 m"
+
+
+def test_check_plot_of_the_same_plot_again_keeps_no_copy(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--plot written again with the same picture (the same pair checked twice) replaces
+    nothing: no plot.previous.png, no line about it."""
+    scene = data_dir / "middlebury2001" / "tsukuba"
+    plot = tmp_path / "plot.png"
+    argv = ["check", str(scene / "left.png"), str(scene / "right.png"), "--plot", str(plot)]
+    assert main(argv) == 0
+    first = plot.read_bytes()
+    capsys.readouterr()
+    assert main(argv) == 0
+    assert capsys.readouterr().err == ""
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plot.png"]
+    assert plot.read_bytes() == first

@@ -920,3 +920,26 @@ def test_refine_turns_the_right_camera_in_its_own_rectified_frame() -> None:
     turn = cv2.Rodrigues(r2 @ fixed.R @ rig.R.T @ r2.T)[0].ravel()
     # the fit's own roll is 1 % of the pitch; about R1's axis it was 6 %
     assert abs(turn[1]) < 1e-9 and abs(turn[2]) < 0.03 * abs(turn[0])
+
+
+def test_cli_check_fix_json_of_a_pair_it_cannot_correct_is_one_object(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check --json --fix OUT`` of a swapped pair: exit 1, stdout the check's one JSON object
+    (no "fixed"), the reason on stderr, nothing written. A mutation audit dropped the object."""
+    from stereovision.cli import main
+
+    cones = data_dir / "middlebury2003" / "cones"
+    rig = _rig(450, 375, (0.3, 0.0, 0.0), f=700.0).save(tmp_path / "rig.yaml")
+    fixed = tmp_path / "fixed.yaml"
+    pair = [str(cones / "right.png"), str(cones / "left.png")]
+    assert main(["check", *pair, "--calib", str(rig), "--fix", str(fixed), "--json"]) == 1
+    out, err = capsys.readouterr()
+    assert out.count("\n") == 1
+    said = json.loads(out)
+    assert said["swapped"] is True and said["ok"] is False and "fixed" not in said
+    assert err == (
+        f"stereovision: not corrected, nothing written to {fixed}: the left and right images "
+        "look swapped: give them the other way round\n"
+    )
+    assert not fixed.exists()
