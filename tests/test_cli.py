@@ -2243,3 +2243,47 @@ def test_check_plot_of_the_same_plot_again_keeps_no_copy(
     assert capsys.readouterr().err == ""
     assert sorted(p.name for p in tmp_path.iterdir()) == ["plot.png"]
     assert plot.read_bytes() == first
+
+
+@pytest.mark.parametrize("blocked", ["file above", "read-only above"])
+def test_rectify_checks_its_output_folder_before_the_work(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    blocked: str,
+) -> None:
+    """rectify -o notes/rect (notes a file), or into a folder that cannot be written, found out
+    after the pair's features were matched and its homographies fitted (depth and demo check
+    their -o first); now one line first, no work done."""
+    import tempfile
+
+    import stereovision.rectification_check
+
+    def worked(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("the pair was matched first")
+
+    monkeypatch.setattr(stereovision.rectification_check, "already_rectified", worked)
+    scene = data_dir / "middlebury2001" / "tsukuba"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    if blocked == "file above":
+        (tmp_path / "notes").write_text("mine")
+        out = tmp_path / "notes" / "rect"
+        says = f"-o {out}: {tmp_path / 'notes'} is a file, not a folder"
+    else:
+        (tmp_path / "ro").mkdir()
+        out = tmp_path / "ro" / "rect"
+        real = tempfile.mkstemp
+
+        def mkstemp(*args: object, dir: object = None, **kwargs: object) -> object:
+            if dir is not None and Path(str(dir)) == tmp_path / "ro":  # root writes anywhere
+                raise PermissionError(13, "Permission denied")
+            return real(*args, dir=dir, **kwargs)  # type: ignore[call-overload]
+
+        monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+        says = f"-o {out}: cannot write in {tmp_path / 'ro'} (Permission denied)"
+    assert main(["rectify", *pair, "-o", str(out)]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == f"stereovision: error: {says}\n"
+    assert not out.exists()

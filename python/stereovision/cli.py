@@ -1035,6 +1035,11 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     out = Path(args.output)
     if out.exists() and not out.is_dir():
         raise CliError(f"-o {args.output}: is a file; give a folder")
+    from stereovision.io import check_output_folder
+
+    # a file above it, or a folder that cannot be written, said before the pair is matched
+    # (as depth and demo say it), not once the homographies were fitted
+    check_output_folder(out, "-o")
     inputs = {"the left image": args.left, "the right image": args.right,
               "the calibration": args.calib}  # fmt: skip
     for name in RECTIFY_OUTPUTS:
