@@ -2287,3 +2287,37 @@ def test_rectify_checks_its_output_folder_before_the_work(
     assert cap.out == ""
     assert cap.err == f"stereovision: error: {says}\n"
     assert not out.exists()
+
+
+@pytest.mark.parametrize("blocked", ["file above", "folder"])
+def test_check_plot_that_cannot_be_written_is_said_before_the_check(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    blocked: str,
+) -> None:
+    """check --plot notes/plot.png (notes a file), or --plot naming a folder, was found out
+    after the pair's features were matched and the verdict printed; now one line first, exit
+    2, nothing checked."""
+    import stereovision.rectification_check
+
+    def worked(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("the pair was checked first")
+
+    monkeypatch.setattr(stereovision.rectification_check, "check_rectification", worked)
+    scene = data_dir / "middlebury2001" / "tsukuba"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    if blocked == "file above":
+        (tmp_path / "notes").write_text("mine")
+        plot = tmp_path / "notes" / "plot.png"
+        says = f"--plot {plot}: its folder {tmp_path / 'notes'}: is a file, not a folder"
+    else:
+        plot = tmp_path / "plot.png"
+        plot.mkdir()
+        says = f"--plot {plot}: is a folder; give a file name"
+    assert main(["check", *pair, "--plot", str(plot)]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == f"stereovision: error: {says}\n"
+    assert (tmp_path / "notes").is_file() if blocked == "file above" else plot.is_dir()

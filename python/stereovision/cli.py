@@ -915,6 +915,13 @@ def cmd_check(args: argparse.Namespace) -> int:
               "the calibration": args.calib}  # fmt: skip
     if args.plot:
         _refuse_an_input("--plot", Path(args.plot), inputs)
+        # said before the check, not after its matching and verdict (as --fix's folder is)
+        from stereovision.io import check_output_folder
+
+        if Path(args.plot).is_dir():
+            raise CliError(f"--plot {args.plot}: is a folder; give a file name")
+        plot_dir = Path(args.plot).parent
+        check_output_folder(plot_dir, f"--plot {args.plot}: its folder")
     if fix is not None:  # the corrected calibration in place of the original lost it
         _refuse_an_input("--fix", fix, inputs)
     raw_left, raw_right = left, right
