@@ -2321,3 +2321,29 @@ def test_check_plot_that_cannot_be_written_is_said_before_the_check(
     assert cap.out == ""
     assert cap.err == f"stereovision: error: {says}\n"
     assert (tmp_path / "notes").is_file() if blocked == "file above" else plot.is_dir()
+
+
+def test_check_fix_naming_a_folder_is_said_before_the_check(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """check --fix rig.yaml where rig.yaml is a folder failed only when the corrected rig was
+    saved, after the check and the correction; now one line first, exit 2."""
+    import stereovision.rectification_check
+
+    def worked(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("the pair was checked first")
+
+    monkeypatch.setattr(stereovision.rectification_check, "check_rectification", worked)
+    scene = data_dir / "eth3d" / "terrace"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    rig = Path(tmp_path / "fixed.yaml")
+    rig.mkdir()
+    calib = scene / "calib.txt"
+    assert main(["check", *pair, "--calib", str(calib), "--fix", str(rig)]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == f"stereovision: error: --fix {rig}: is a folder; give a file name\n"
+    assert rig.is_dir() and not any(rig.iterdir())

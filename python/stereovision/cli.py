@@ -911,6 +911,8 @@ def cmd_check(args: argparse.Namespace) -> int:
             raise CliError(f"--fix {args.fix}: use a .yaml, .yml, .xml or .json file name")
         if str(fix.parent) and not fix.parent.is_dir():
             raise FileNotFoundError(f"--fix {args.fix}: directory {fix.parent} does not exist")
+        if fix.is_dir():  # else found when the corrected rig is saved, after the work
+            raise CliError(f"--fix {args.fix}: is a folder; give a file name")
     inputs = {"the left image": args.left, "the right image": args.right,
               "the calibration": args.calib}  # fmt: skip
     if args.plot:
