@@ -1940,7 +1940,12 @@ def _one_line_warning(
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; returns the exit status (0 ok, 2 error, 130 interrupted)."""
+    """Run the CLI; returns the exit status.
+
+    0 ok; 1 a verdict or partial result (``check`` finds the rows disagree, ``batch`` had pairs
+    fail); 2 an error (one line on stderr); 3 ``check`` cannot tell; 130 interrupted (Ctrl-C);
+    141 a closed pipe (``| head``); 143 terminated (SIGTERM).
+    """
     try:
         # the commands' modules are imported here (0.2 s): a Ctrl-C right after the command
         # was typed printed a traceback of the import it stopped
