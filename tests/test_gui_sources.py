@@ -564,6 +564,32 @@ def test_open_stereo_source_gives_a_hung_read_up(monkeypatch: pytest.MonkeyPatch
     src.close()
 
 
+def test_a_stream_given_by_name_is_not_reopened_when_its_read_hangs(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Sources given by name (``rtsp://...``, ``/dev/video0``: "files", opened again at their
+    end) were opened again when their read was given up as hung (a SourceError is an OSError):
+    a second open of the hung device and a second full wait, the page frozen twice as long. The
+    read says the time-out after one wait; a file's end still starts it again."""
+    import stereovision.capture as capture
+
+    real = capture.StereoCamera
+    opened: list[int] = []
+
+    def slow(*a: Any, **kw: Any) -> Any:
+        opened.append(1)
+        return real(_SlowStart(0.5), _SlowStart(0.0))
+
+    monkeypatch.setattr(capture, "StereoCamera", slow)
+    src = sources.open_stereo_source("rtsp://a/1", "rtsp://a/2", read_timeout=0.2)
+    assert src._files is True  # type: ignore[attr-defined]
+    t0 = time.perf_counter()
+    with pytest.raises(capture.SourceError, match=r" delivered no frame in 0\.2 s"):
+        src.read()
+    assert time.perf_counter() - t0 < 0.35 and len(opened) == 1
+    src.close()
+
+
 def test_open_stereo_source_falls_back_to_opencv(
     fake_cap: type[FakeCap], monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -402,8 +402,10 @@ class _CaptureAdapter:
     def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
         try:
             return self._read()
-        except OSError:
-            if not self._files:
+        except OSError as exc:
+            # a file's end starts it again; a read given up as hung (or refused after one) is
+            # no end: opening the device again doubled the wait on it
+            if not self._files or getattr(exc, "end", True) is False:
                 raise
             self.close()
             self._camera = self._factory()
