@@ -1350,6 +1350,35 @@ def test_an_xml_file_without_its_declaration_is_read(tmp_path: Path) -> None:
         Calibration.load(tmp_path / "broken.xml")
 
 
+def test_an_xml_or_yaml_file_after_blank_lines_or_a_bom_is_read(tmp_path: Path) -> None:
+    """Blank lines before the ``<?xml ...?>`` declaration made OpenCV read the file as YAML
+    ("line 2: Invalid or unsupported syntax"; the file was taken for OpenCV XML), and a UTF-8
+    byte-order mark (Windows editors write one) hid the ``<?xml``/``%YAML`` start: "not a
+    stereovision calibration file". Each reads as the file without them; an error in the
+    indented file is said at the file's own line number."""
+    c = raw_calib()
+    xml = c.save(tmp_path / "c.xml").read_text()
+    yml = c.save(tmp_path / "c.yaml").read_text()
+    body = xml.split("\n", 1)[1]
+    for name, text in (
+        ("blank.xml", "\n\n" + xml),
+        ("crlf.xml", ("\n" + xml).replace("\n", "\r\n")),
+        ("bom.xml", "\ufeff" + xml),
+        ("bom_bare.xml", "\ufeff" + body),
+        ("bom.yaml", "\ufeff" + yml),
+    ):
+        (tmp_path / name).write_bytes(text.encode("utf-8"))
+        assert Calibration.load(tmp_path / name) == c, name
+        assert Calibration.from_file(tmp_path / name) == c, name
+    lines = ("\n\n" + xml).splitlines()
+    n = next(i for i, line in enumerate(lines) if "<rows>" in line)
+    lines[n] = lines[n].replace("</rows>", "</rowz>")
+    (tmp_path / "broken.xml").write_text("\n".join(lines))
+    says = rf"^cannot parse .*broken\.xml as OpenCV YAML/XML: line {n + 1}: Mismatched closing tag$"
+    with pytest.raises(ValueError, match=says):
+        Calibration.load(tmp_path / "broken.xml")
+
+
 def test_opencv_stereo_calib_names_m1_m2_load_as_k1_k2(tmp_path: Path) -> None:
     """OpenCV's stereo_calib names the camera matrices M1/M2 (in YAML and XML): they load as
     K1/K2, the same rig."""

@@ -242,9 +242,15 @@ def _open_filestorage(text: str, source: str) -> Any:
     An XML file without its ``<?xml ...?>`` declaration (hand-edited, or from a tool that
     omits it) is read as XML: OpenCV took it for YAML ("line 1: Invalid or unsupported
     syntax"). The declaration goes on the first line, so the parser's line numbers stay the
-    file's."""
-    if text.lstrip().startswith("<opencv_storage"):
-        text = '<?xml version="1.0"?>' + text
+    file's. OpenCV tells XML by ``<?xml`` at the very start: blank lines before it made it YAML
+    too; they go after the declaration (the line numbers stay)."""
+    body = text.lstrip()
+    lead = "\n" * text[: len(text) - len(body)].count("\n")
+    if body.startswith("<?xml"):
+        declaration, end, rest = body.partition("?>")
+        text = declaration + end + lead + rest
+    elif body.startswith("<opencv_storage"):
+        text = '<?xml version="1.0"?>' + lead + body
     try:
         fs = cv2.FileStorage(text, cv2.FILE_STORAGE_READ | cv2.FILE_STORAGE_MEMORY)
     except (cv2.error, SystemError) as exc:
@@ -1331,7 +1337,8 @@ class Calibration:
         if not p.is_file():
             raise ValueError(f"calibration path is not a file: {p}")
         try:
-            return p, p.read_text(encoding="utf-8")
+            # "-sig": a byte-order mark (Windows editors write one) hid the file's start
+            return p, p.read_text(encoding="utf-8-sig")
         except UnicodeDecodeError:
             with p.open("rb") as fh:
                 if fh.read(6) == b"MATLAB":  # a MAT-file's header (v5, v7, v7.3)
