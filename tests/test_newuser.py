@@ -349,3 +349,24 @@ def test_a_grey_and_a_colour_image_are_named_as_such() -> None:
         assert str(exc.value) == said
     with pytest.raises(ValueError, match=r"left is colour, right is colour with alpha; read"):
         sv.match(colour, cv2.cvtColor(colour, cv2.COLOR_BGR2BGRA))
+
+
+def test_a_grey_image_with_a_channel_axis_is_not_called_grey_and_grey() -> None:
+    """A grey image beside the same one with a channel axis of 1 (``img[..., None]``) was
+    refused with "left is grey, right is grey; read both alike": both are grey. The refusal
+    says which has the axis and how to drop it."""
+    import cv2
+
+    import stereovision as sv
+
+    grey = cv2.imread(str(CONES / "left.png"), cv2.IMREAD_GRAYSCALE)
+    for call in (sv.depth_map, sv.match):
+        with pytest.raises(ValueError) as exc:
+            call(grey, grey[..., None])
+        assert str(exc.value) == (
+            "left and right images must have the same shape, got left (375, 450) and right "
+            "(375, 450, 1): both are grey, right with a channel axis of 1; drop it "
+            "(right[..., 0])"
+        )
+        with pytest.raises(ValueError, match=r": both are grey, left with a channel axis of 1;"):
+            call(grey[..., None], grey)

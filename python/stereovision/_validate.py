@@ -377,10 +377,15 @@ def pair_shape_error(left: tuple[int, ...], right: tuple[int, ...]) -> ValueErro
     """
     text = f"left and right images must have the same shape, got left {left} and right {right}"
     if left[:2] == right[:2]:
-        text += (
-            f": left is {_channels_text(left)}, right is {_channels_text(right)}; read both "
-            "alike (cv2.imread(path) reads both in colour)"
-        )
+        said = _channels_text(left), _channels_text(right)
+        if said[0] == said[1]:  # (H, W) beside (H, W, 1): "left is grey, right is grey"
+            side = "left" if len(left) == 3 else "right"
+            text += f": both are grey, {side} with a channel axis of 1; drop it ({side}[..., 0])"
+        else:
+            text += (
+                f": left is {said[0]}, right is {said[1]}; read both alike (cv2.imread(path) "
+                "reads both in colour)"
+            )
     return ValueError(text)
 
 
