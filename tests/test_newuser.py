@@ -3,6 +3,7 @@ mistakes (a video for an image, a range of 0) named in the command line's words.
 
 from __future__ import annotations
 
+import os
 from importlib import resources
 from pathlib import Path
 
@@ -370,3 +371,23 @@ def test_a_grey_image_with_a_channel_axis_is_not_called_grey_and_grey() -> None:
         )
         with pytest.raises(ValueError, match=r": both are grey, left with a channel axis of 1;"):
             call(grey[..., None], grey)
+
+
+def test_a_path_as_a_numpy_string_or_bytes_is_said_as_a_path() -> None:
+    """A file name taken from a NumPy table (``np.str_``, a 0-d string array) or given as bytes
+    was said as "got the path np.str_('...')" or "got ndarray converting to dtype <U..": each
+    is said as the path it is, for the images and the calibration."""
+    import cv2
+
+    import stereovision as sv
+
+    left = str(CONES / "left.png")
+    image = cv2.imread(left)
+    for given in (np.str_(left), np.array(left), os.fsencode(left)):
+        for call in (sv.depth_map, sv.match):
+            with pytest.raises(ValueError) as exc:
+                call(given, image)
+            assert str(exc.value).startswith(f"left: got the path {left!r}, not an image: ")
+            with pytest.raises(ValueError) as exc:
+                call(image, image, given)
+            assert str(exc.value).startswith(f"calib: got the path {left!r}, not a calibrat")

@@ -64,6 +64,28 @@ def _describe(arr: np.ndarray) -> str:
     return f"shape {arr.shape} dtype {arr.dtype}"
 
 
+def path_given(obj: object) -> str | None:
+    """The file name ``obj`` is (a str, bytes, os.PathLike, a NumPy string or 0-d string
+    array: a name taken from a table), as plain text for a message; None for anything else.
+
+    Parameters
+    ----------
+    obj : object
+        What was given where an image or a calibration goes.
+
+    Returns
+    -------
+    str or None
+        The path (``np.str_('left.png')`` said as ``'left.png'``), or None.
+    """
+    if isinstance(obj, np.ndarray) and obj.ndim == 0 and obj.dtype.kind in "US":
+        obj = obj.item()
+    if isinstance(obj, (str, bytes, os.PathLike)):
+        path = os.fspath(obj)
+        return os.fsdecode(path) if isinstance(path, bytes) else str(path)
+    return None
+
+
 def as_image_array(img: object, name: str = "image") -> np.ndarray:
     """Convert ``img`` to a NumPy image array and check its shape and dtype (no value checks).
 
@@ -94,10 +116,11 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
             f"{name}: got None, not an image (cv2.imread returns None for a file it cannot "
             "read: check the path)"
         )
-    if isinstance(img, (str, os.PathLike)):
+    path = path_given(img)
+    if path is not None:
         # a file name where the README's cv2.imread(...) goes: "got str converting to <U8"
         raise ValueError(
-            f"{name}: got the path {os.fspath(img)!r}, not an image: read it first "
+            f"{name}: got the path {path!r}, not an image: read it first "
             "(cv2.imread(path) or stereovision.io.imread(path))"
         )
     try:

@@ -14,7 +14,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import os
 import time
 import warnings
 from collections.abc import Callable
@@ -32,6 +31,7 @@ from stereovision._validate import (
     check_pair,
     finite_number,
     pair_shape_error,
+    path_given,
     unreachable_range,
     user_stacklevel,
 )
@@ -153,9 +153,10 @@ def _rig_to_warp_by(
         return calib, None, calib.max_disparity if max_disparity is None else max_disparity
     if calib is None:
         return None, None, max_disparity
-    if isinstance(calib, (str, os.PathLike)):  # a calib.txt's name: said, not just "got str"
+    path = path_given(calib)
+    if path is not None:  # a calib.txt's name: said, not just "got str"
         raise ValueError(
-            f"calib: got the path {os.fspath(calib)!r}, not a calibration: read it first "
+            f"calib: got the path {path!r}, not a calibration: read it first "
             "(stereovision.Calibration.from_file(path))"
         )
     if not isinstance(calib, Calibration):
