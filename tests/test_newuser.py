@@ -272,9 +272,16 @@ def test_an_unrectified_pair_is_said_to_be_one(
     assert err[0].startswith("stereovision: warning: the left and right images look unrectified: ")
     assert "of the feature matches lie within 2 rows" in err[0]
     assert err[0].endswith(
-        "give the rig's calibration (calib=, --calib), or rectify the pair from its features "
+        "give the calibration of the rig that took them (calib=, --calib; one marked "
+        "rectified is used as it is), or rectify the pair from its features "
         "(stereovision rectify LEFT RIGHT -o DIR)"
     )
+    # with a calibration marked rectified (another rig's): it said "give the rig's calibration"
+    rectified = sv.Calibration.from_file(data_dir / "eth3d" / "terrace" / "calib.txt")
+    raw = cv2.imread(str(books / "left.jpg")), cv2.imread(str(books / "right.jpg"))
+    size = raw[0].shape[1::-1]
+    with pytest.warns(UserWarning, match=r"--calib; one marked rectified is used as it is\)"):
+        sv.depth_map(*raw, rectified.scaled_to(size), method="fast")
     # the rectified sample: no warning; the same with its right image 8 rows lower: one
     left, right = cv2.imread(str(CONES / "left.png")), cv2.imread(str(CONES / "right.png"))
     assert sv.estimate_max_disparity(left, right) == 64

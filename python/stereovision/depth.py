@@ -336,8 +336,10 @@ def _warn_if_unrectified(same_row: npt.NDArray[np.bool_], dy: npt.NDArray[np.flo
             f"the left and right images look unrectified: {share:.0%} of the feature matches "
             f"lie within {_AUTO_DY_TOL:g} rows of each other ({same_row.size} matches, median "
             f"{float(np.median(dy)):.0f} px apart; a rectified pair keeps most on one row); "
-            "give the rig's calibration (calib=, --calib), or rectify the pair from its "
-            "features (stereovision rectify LEFT RIGHT -o DIR)",
+            # also said with a calibration given: one marked rectified is not applied
+            "give the calibration of the rig that took them (calib=, --calib; one marked "
+            "rectified is used as it is), or rectify the pair from its features "
+            "(stereovision rectify LEFT RIGHT -o DIR)",
             UserWarning,
             stacklevel=user_stacklevel(),
         )
