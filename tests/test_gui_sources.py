@@ -788,6 +788,21 @@ def test_video_pair_of_a_file_without_frames_names_it(
     pair.close()
 
 
+def test_video_pair_names_the_left_file_when_it_has_no_frame(
+    fake_cap: type[FakeCap], tmp_path: Path
+) -> None:
+    """The left file's own name, not the right camera's (the check after both files started
+    again names each side: naming sources[1] for the left passed the other tests)."""
+    f = tmp_path / "empty.avi"
+    f.write_bytes(b"")
+    pair = VideoPair(str(f), 1)
+    fake_cap.made[0].own = []
+    with pytest.raises(OSError, match=r"^camera '.*empty\.avi' gave no frame$"):
+        pair.read()
+    assert fake_cap.made[0].props == {cv2.CAP_PROP_POS_FRAMES: 0}  # it was started again first
+    pair.close()
+
+
 def test_video_pair_grabs_both_before_it_decodes_either(fake_cap: type[FakeCap]) -> None:
     """read() said "grab both, then decode both" and read (grabbed and decoded) one camera
     after the other: the right camera's frame was taken a whole decode later than the left's.
