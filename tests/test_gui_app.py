@@ -639,6 +639,21 @@ def test_a_max_disparity_scaled_to_a_whole_pixel_is_not_rounded_up_past_it():
     assert "warning: max disparity 120\xa0px searched as 128\xa0px" in view.stats
 
 
+def test_a_range_too_wide_for_a_pair_16_px_wide_is_refused_not_narrowed():
+    """A range reaching the width is narrowed below it (with a note) only on a pair wider than
+    16 px; on a narrower one it is depth_map's to refuse, in its words (narrowing there too
+    survived a mutation audit)."""
+    from stereovision.gui.app import compute_view
+
+    img = np.random.default_rng(0).integers(0, 255, (20, 12, 3), dtype=np.uint8)
+    with pytest.raises(ValueError, match=r"^disparity range 12 is not smaller than the image"):
+        compute_view(img, img, None, "gabor", max_disparity=12)
+    wide = np.random.default_rng(0).integers(0, 255, (20, 17, 3), dtype=np.uint8)
+    view = compute_view(wide, wide, None, "gabor", max_disparity=17)
+    assert view.result.max_disparity == 16
+    assert "warning: max disparity 17\xa0px at width 17 searched as 16\xa0px" in view.stats
+
+
 @pytest.mark.parametrize("method", ["gabor", "fused"])
 def test_progress_goes_forward_and_says_what_runs(method):
     """The status read "prepare done" during the whole matching (most of the time: it looked
@@ -1233,6 +1248,9 @@ def test_buttons_before_a_pair_say_so():
     )
     app.pair = None
     app.view = None
+    # the start-up state (the page not up yet, no lock): a method set then is no click
+    app._on_method()
+    assert app.state.error == ""
     app._lock = asyncio.Lock()
     for action in (app.check_rows, app.rectify_from_features, app.find_floor):
         app.state.error = ""
