@@ -2339,6 +2339,32 @@ def test_an_image_folder_plays_its_pairs_one_per_capture(tmp_path):
     assert app.state.source_label.startswith("folder data/scenes: pair ")  # still in use
 
 
+def test_a_capture_of_a_folder_pair_of_two_sizes_is_said_and_keeps_the_pair(tmp_path):
+    """Capture's pair whose two images differ in size (a ValueError of _grab) is said on the
+    page and the pair on show stays (capture caught OSError and RuntimeError alone in a
+    mutation audit, and no test failed)."""
+    from stereovision.gui import bundled_data_dir
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    seq = tmp_path / "data" / "seq"
+    seq.mkdir(parents=True)
+    for k in (1, 2):
+        cv2.imwrite(str(seq / f"left_{k:04d}.png"), left)
+        cv2.imwrite(str(seq / f"right_{k:04d}.png"), right if k == 1 else right[:, :200])
+    app = _scene_app("test-folder-two-sizes", [tmp_path / "data"])
+    spawned: list = []
+    app._spawn = spawned.append
+    app.state.pair_folder = str(seq)
+    app.open_pair_folder()
+    assert app.state.error == "" and len(spawned) == 1
+    shown = app.pair
+    app.capture()
+    assert app.state.error.startswith("folder data/seq: pair 0002 (2 of 2): left 450")
+    assert app.state.status == "error" and app.state.captures == 1 and len(spawned) == 1
+    assert app.pair is shown and app.state.source_label == "folder data/seq: pair 0001 (1 of 2)"
+
+
 def test_rectify_and_check_rows_of_a_pair_replaced_meanwhile_are_dropped(data_dir, monkeypatch):
     """A scene chosen while "Rectify" or "Check rows" ran on the cameras' pair: their results
     were put on the new scene (its label read "(rectified from features)" above the cameras'
@@ -2857,6 +2883,24 @@ def test_the_sparse_channels_are_offered_and_their_matches_drawn(method):
     app._scene_gt = (None, scene.gt)
     _run(app, app.recompute)
     assert f"{len(expected)} matches ·" in app.state.stats and "precision" not in app.state.stats
+
+
+def test_statistics_without_a_gt_pixel_say_so_not_nan():
+    """GT of the pair's size with no known pixel (all NaN), or none where the matches are:
+    the statistics say so, not "bad-2.0 nan %" or "precision@1 nan %" (both lines survived a
+    mutation audit)."""
+    import types
+
+    from stereovision.gui.app import _dense_gt_text, _sparse_precision
+
+    left = np.zeros((10, 20, 3), np.uint8)
+    gt = np.full((10, 20), np.nan, np.float32)
+    assert _dense_gt_text(np.ones((10, 20), np.float32), gt, left, left) == ", no GT pixel"
+    gt[0, 0] = 1.0  # known only where no match is
+    matches = types.SimpleNamespace(xl=np.array([5.0]), yl=np.array([5.0]), xr=np.array([4.0]))
+    assert _sparse_precision(matches, gt, left, left) == ", none on GT"
+    matches.xl, matches.yl, matches.xr = np.array([0.0]), np.array([0.0]), np.array([-1.0])
+    assert _sparse_precision(matches, gt, left, left) == ", precision@1 100.0 % of the 1 on GT"
 
 
 def test_the_scaled_gt_is_sampled_at_the_scaled_pixels_centres():
@@ -3615,6 +3659,49 @@ def test_files_loaded_after_rectifying_the_cameras_drop_their_homographies(tmp_p
     assert app.state.error == "" and app.homographies is None
     app._grab()
     assert app.pair[0] is raw[0] and app.state.source_label == "cameras 0 / 1"
+
+
+def test_other_cameras_drop_the_homographies_a_failed_switch_keeps_them():
+    """Cameras opened after "Rectify" on the cameras' pair: that rig's homographies go with it
+    (the new cameras' pairs were warped by them in a mutation audit, no test failing); cameras
+    that fail to open leave the ones in use with their homographies."""
+    from stereovision.gui import bundled_data_dir
+
+    raw = (cv2.imread(str(CONES / "left.png")), cv2.imread(str(CONES / "right.png")))
+
+    class Cameras:
+        def __init__(self, pair):
+            self.pair = pair
+
+        def read(self):
+            if self.pair is None:
+                raise OSError("camera 3 gave no frame")
+            return self.pair
+
+        def close(self):
+            pass
+
+    class Homographies:  # fitted to the first cameras' 450x375 frames
+        input_size = (450, 375)
+        max_disparity = 60
+
+        def rectify(self, left, right):
+            return left[:, ::-1].copy(), right[:, ::-1].copy()
+
+    app = _scene_app(
+        "test-switch-drops-homographies",
+        [bundled_data_dir()],
+        source=Cameras(raw),
+        source_names=("0", "1"),
+    )
+    app._spawn = lambda coro: coro.close()
+    rect = app.homographies = Homographies()
+    app._switch_source(Cameras(None), ("2", "3"))
+    assert app.state.error == "camera 3 gave no frame (the cameras in use are unchanged)"
+    assert app.homographies is rect
+    app._switch_source(Cameras(raw), ("2", "3"))
+    assert app.state.error == "" and app.homographies is None
+    assert app.pair[0] is raw[0] and app.state.source_label == "cameras 2 / 3"
 
 
 def test_check_rows_of_files_at_another_resolution_uses_the_calibration_scaled(tmp_path):
