@@ -1199,6 +1199,39 @@ def test_a_failed_method_puts_the_toggle_back_to_the_result_on_show(monkeypatch)
     # one computation asked: the click's (its listener ran at the first flush); the toggle's
     # return to "fast" asks none
     assert len(spawned) == 1 and app.state.computations == 1
+    # the method and resolution on show failing again: nothing to put back, nothing added
+    from stereovision.gui import app as gui_app
+
+    monkeypatch.setattr(gui_app, "compute_view", _fails)
+    _run(app, app.recompute)
+    assert app.state.error == "boom" and app.state.method == "fast"
+
+
+def _fails(*args: Any, **kwargs: Any) -> Any:
+    raise ValueError("boom")
+
+
+def test_a_failed_pair_puts_back_the_calibration_and_gt_stays_with_its_scene(monkeypatch):
+    """Files after a scene: the scene's GT is not said of them (its pair only), and a scene
+    that then fails to compute puts back the files' inputs, their calibration (none) with them
+    (both survived a mutation audit: the GT given for any pair, the calibration not put back)."""
+    from stereovision.gui import app as gui_app
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-fail-puts-back-calib", [bundled_data_dir()])
+    app._spawn = lambda coro: coro.close()
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    assert ", on GT bad-2.0" in app.state.stats and app.calib is not None
+    app.state.left_file, app.state.right_file = "cones/left.png", "cones/right.png"
+    app.load_files()
+    _run(app, app.recompute)
+    assert app.state.error == "" and "GT" not in app.state.stats and app.calib is None
+    monkeypatch.setattr(gui_app, "compute_view", _fails)
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    assert app.state.error == "boom (the page still shows the previous pair)"
+    assert app.calib is None and app.state.source_label == "files"
 
 
 def test_a_scene_without_calibration_is_not_told_to_give_calib(tmp_path):
@@ -3277,6 +3310,42 @@ def test_check_rows_that_fails_on_a_pair_replaced_meanwhile_says_nothing(monkeyp
     assert app.state.error == ""
     _run(app, app.check_rows)  # on the pair on show it is said
     assert app.state.error == "no features to check"
+
+
+def test_rectify_that_fails_on_a_pair_replaced_meanwhile_says_nothing(monkeypatch):
+    """As Check rows: Rectify that failed after another pair was chosen is not said over the
+    new pair's page (saying it survived a mutation audit)."""
+    import asyncio
+    import threading
+
+    import stereovision.rectification_check as rc
+    from stereovision.gui import bundled_data_dir
+
+    app = _scene_app("test-rectify-fail-replaced", [bundled_data_dir()])
+    started, gate = threading.Event(), threading.Event()
+
+    def fails(*args: Any, **kwargs: Any) -> Any:
+        started.set()
+        gate.wait(60)
+        raise ValueError("no features to match")
+
+    monkeypatch.setattr(rc, "already_rectified", fails)
+
+    async def pressed_then_scene() -> None:
+        app._lock = asyncio.Lock()
+        app._load_scene(bundled_data_dir() / "cones")
+        app.calib = None  # Rectify works on a pair without a calibration
+        running = asyncio.ensure_future(app.rectify_from_features())
+        await asyncio.get_running_loop().run_in_executor(None, started.wait, 60)
+        app._load_scene(bundled_data_dir() / "cones")  # another pair, chosen meanwhile
+        app.calib = None
+        gate.set()
+        await running
+
+    asyncio.run(pressed_then_scene())
+    assert app.state.error == ""
+    _run(app, app.rectify_from_features)  # on the pair on show it is said
+    assert app.state.error == "no features to match"
 
 
 def test_a_cloud_opened_after_a_failed_start_up_clears_the_error_status(tmp_path):
