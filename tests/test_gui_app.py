@@ -654,6 +654,26 @@ def test_a_range_too_wide_for_a_pair_16_px_wide_is_refused_not_narrowed():
     assert "warning: max disparity 17\xa0px at width 17 searched as 16\xa0px" in view.stats
 
 
+def test_a_dense_map_with_few_matches_draws_them_and_the_median_depth_is_the_median():
+    """A dense method's map below SPARSE_DENSITY has its matches drawn between the images; the
+    statistics' median depth is the points' median, not their mean (both survived a mutation
+    audit)."""
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import compute_view
+    from stereovision.io import load_scene
+
+    flat = np.full((60, 80, 3), 128, np.uint8)
+    view = compute_view(flat, flat, None, "fast", max_disparity=16)
+    assert view.result.density == 0.0 and view.matches_url.startswith("data:image/jpeg")
+    scene = load_scene(bundled_data_dir() / "cones")
+    view = compute_view(scene.left, scene.right, scene.calib, "fast", width=320)
+    assert view.matches_url == ""
+    z = view.result.points[:, 2]
+    assert abs(np.median(z) - np.mean(z)) > 0.01  # the two differ on this scene
+    assert view.median_depth == pytest.approx(float(np.median(z)))
+    assert f"median depth {np.median(z):.2f}\xa0m" in view.stats
+
+
 @pytest.mark.parametrize("method", ["gabor", "fused"])
 def test_progress_goes_forward_and_says_what_runs(method):
     """The status read "prepare done" during the whole matching (most of the time: it looked
@@ -1936,6 +1956,16 @@ def test_the_offered_save_folder_skips_a_link_named_saved(tmp_path):
     _run(app, app.save)
     assert app.state.error == "folder outside the --data folders: saved"
     assert list(outside.iterdir()) == []
+    # two links skipped: both named (only the first was, in a mutation audit)
+    (data / "saved-3").symlink_to(outside, target_is_directory=True)
+    app.state.save_dir = app._offered_save_dir
+    _run(app, app.save)
+    assert app.state.save_label.startswith("saved 450×375 to mine/saved-4: ")
+    assert app.state.save_label.endswith(
+        " (saved, saved-3: a symbolic link, not a folder of --data: left alone)"
+    )
+    with pytest.raises(ValueError, match=r"^empty or invalid folder$"):  # not "embedded null byte"
+        app._typed_save_folder("mine\x00x")
 
 
 def test_a_saved_cloud_is_offered_in_the_point_cloud_list(tmp_path):
