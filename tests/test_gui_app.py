@@ -1848,6 +1848,32 @@ def test_save_says_a_3d_view_it_cannot_render_and_writes_the_rest(tmp_path):
     )
 
 
+def test_a_failed_render_of_a_dragged_view_is_not_said_as_written(tmp_path, monkeypatch):
+    """A render of the view the mouse left that fails: the Save's line says render.png was not
+    written, not also that render.png is the mouse's view (both were said in a mutation
+    audit)."""
+    import stereovision.render as render
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import MOUSE_RENDER
+
+    def fails(*args: Any, **kwargs: Any) -> Any:
+        raise RuntimeError("the offscreen render failed")
+
+    app = _scene_app("test-save-mouse-render-fails", [bundled_data_dir(), tmp_path])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    app.plotter.camera.Azimuth(10)  # the mouse's view, no slider's
+    assert app._mouse_camera() is not None
+    monkeypatch.setattr(render, "render_view", fails)
+    app.state.save_dir = "dragged"
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.endswith(
+        ", overview.png (render.png not written: the offscreen render failed)"
+    ), app.state.save_label
+    assert MOUSE_RENDER not in app.state.save_label
+
+
 def test_the_save_field_shows_the_data_folder_short_and_saves_where_it_says(tmp_path, monkeypatch):
     """The save field showed the --data folder's absolute path (the README's picture: a
     temporary /tmp/sv-.../scenes/saved). It shows it relative to the current directory when
@@ -2474,10 +2500,12 @@ def test_rectify_and_check_rows_of_a_pair_replaced_meanwhile_are_dropped(data_di
         assert app.view is not None and app.view.result.disparity.shape == (383, 434)
 
 
-def test_a_floor_found_for_a_pair_replaced_meanwhile_is_dropped(data_dir, monkeypatch):
+@pytest.mark.parametrize("fails", [False, True])
+def test_a_floor_found_for_a_pair_replaced_meanwhile_is_dropped(data_dir, monkeypatch, fails):
     """Find floor on a scene, then another scene chosen while the fit ran: the first scene's
     floor picture and height were put on the page under the new scene's name while it computed
-    (its images shown, the previous results cleared), until its own depth map came."""
+    (its images shown, the previous results cleared), until its own depth map came. A fit that
+    fails then is not said over the new scene either (saying it survived a mutation audit)."""
     import asyncio
     import threading
 
@@ -2492,6 +2520,8 @@ def test_a_floor_found_for_a_pair_replaced_meanwhile_is_dropped(data_dir, monkey
     def held(res: Any) -> Any:
         started.set()
         gate.wait(60)
+        if fails:
+            raise ValueError("no floor here")
         return real(res)
 
     monkeypatch.setattr(app_mod, "floor_view", held)
@@ -2511,8 +2541,9 @@ def test_a_floor_found_for_a_pair_replaced_meanwhile_is_dropped(data_dir, monkey
         await asyncio.sleep(0)
         gate.set()
         await floor
-        # venus computes: its images are on the page, no result of the previous scene
+        # venus computes: its images are on the page, no result (or error) of the previous scene
         assert app.state.img_floor == "" and app.state.floor_label == ""
+        assert app.state.error == ""
         await asyncio.gather(*tasks)
 
     asyncio.run(run())
