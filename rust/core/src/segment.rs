@@ -386,7 +386,7 @@ pub fn plane_fill(
     // Most segments fill nothing: one vector per task, not one per segment.
     let fills: Vec<(u32, f32)> = active
         .into_par_iter()
-        .fold(Vec::new, |mut acc, s| {
+        .try_fold(Vec::new, |mut acc, s| {
             segment_fill(
                 src,
                 &order[start[s]..start[s + 1]],
@@ -396,13 +396,14 @@ pub fn plane_fill(
                 lo,
                 hi,
                 &mut acc,
-            );
-            acc
+            )?;
+            Ok(acc)
         })
-        .reduce(Vec::new, |mut a, mut b| {
+        .try_reduce(Vec::new, |mut a, mut b| {
+            reserve_fills(&mut a, b.len())?;
             a.append(&mut b);
-            a
-        });
+            Ok(a)
+        })?;
     let mut planes = 0;
     let mut last = u32::MAX;
     for &(p, v) in &fills {
@@ -419,7 +420,18 @@ pub fn plane_fill(
     })
 }
 
+/// Room for `more` fills in `v`, grown as `extend` or `append` would (amortised: one vector
+/// takes many segments' fills), but checked: [`OutOfMemory`](crate::CoreError::OutOfMemory).
+fn reserve_fills(v: &mut Vec<(u32, f32)>, more: usize) -> Result<()> {
+    v.try_reserve(more).map_err(|_| {
+        let n = v.len().saturating_add(more);
+        crate::CoreError::oom(n.saturating_mul(8), "the plane fill's fills")
+    })
+}
+
 /// The holes of one segment (`pix`, raster order) and their plane values, appended to `out`.
+/// One large segment (a flat image is one) needs 21 bytes a measured pixel: allocated checked,
+/// [`OutOfMemory`](crate::CoreError::OutOfMemory) (a `collect` or `vec!` aborted the process).
 #[allow(clippy::too_many_arguments)]
 fn segment_fill(
     disp: &[f32],
@@ -430,41 +442,46 @@ fn segment_fill(
     lo: f32,
     hi: f32,
     out: &mut Vec<(u32, f32)>,
-) {
+) -> Result<()> {
+    let what = "the plane fill's segment fit";
     // Most segments are small: count before collecting anything.
     let n_meas = pix
         .iter()
         .filter(|&&p| disp[p as usize].is_finite())
         .count();
     if n_meas == pix.len() || n_meas < min_pixels.max(3) {
-        return;
+        return Ok(());
     }
-    let holes: Vec<u32> = pix
-        .iter()
-        .copied()
-        .filter(|&p| !disp[p as usize].is_finite())
-        .collect();
-    let pts: Vec<(f32, f32, f32)> = pix
-        .iter()
-        .filter(|&&p| disp[p as usize].is_finite())
-        .map(|&p| {
-            (
-                (p as usize % w) as f32,
-                (p as usize / w) as f32,
-                disp[p as usize],
-            )
-        })
-        .collect();
+    let holes = try_collect(
+        pix.len() - n_meas,
+        pix.iter()
+            .copied()
+            .filter(|&p| !disp[p as usize].is_finite()),
+        what,
+    )?;
+    let pts: Vec<(f32, f32, f32)> = try_collect(
+        n_meas,
+        pix.iter()
+            .filter(|&&p| disp[p as usize].is_finite())
+            .map(|&p| {
+                (
+                    (p as usize % w) as f32,
+                    (p as usize / w) as f32,
+                    disp[p as usize],
+                )
+            }),
+        what,
+    )?;
     let cx = pts.iter().map(|p| p.0 as f64).sum::<f64>() / pts.len() as f64;
     let cy = pts.iter().map(|p| p.1 as f64).sum::<f64>() / pts.len() as f64;
-    let mut keep = vec![true; pts.len()];
-    let mut res = vec![0.0f32; pts.len()];
+    let mut keep = try_filled(pts.len(), true, what)?;
+    let mut res = try_zeroed::<f32>(pts.len(), what)?;
     let mut plane = [0.0f64; 3];
     let mut med = 0.0f32;
-    let mut scratch = vec![0.0f32; pts.len()];
+    let mut scratch = try_zeroed::<f32>(pts.len(), what)?;
     for _ in 0..3 {
         let Some(c) = fit_plane(&pts, &keep, cx, cy) else {
-            return;
+            return Ok(());
         };
         plane = c;
         for (r, &(x, y, d)) in res.iter_mut().zip(&pts) {
@@ -480,13 +497,15 @@ fn segment_fill(
     }
     // The last fit's median residual (the cut above used it too).
     if med > max_residual {
-        return;
+        return Ok(());
     }
+    reserve_fills(out, holes.len())?;
     out.extend(holes.into_iter().filter_map(|p| {
         let (x, y) = ((p as usize % w) as f64, (p as usize / w) as f64);
         let v = (plane[0] * (x - cx) + plane[1] * (y - cy) + plane[2]) as f32;
         (v >= lo && v <= hi).then_some((p, v))
     }));
+    Ok(())
 }
 
 /// One pass of [`fill_planes`]: `(step, min_pixels)`.
@@ -569,6 +588,91 @@ mod tests {
         assert_eq!(
             graph_segments(&[], 5, 0, 3, 1.0, 1).unwrap(),
             Vec::<u32>::new()
+        );
+    }
+
+    /// `setrlimit(RLIMIT_AS, limit)` through the C library std links anyway (no `libc` crate).
+    #[cfg(target_os = "linux")]
+    fn limit_address_space(limit: usize) {
+        #[repr(C)]
+        struct Rlimit {
+            cur: u64,
+            max: u64,
+        }
+        extern "C" {
+            fn setrlimit(resource: i32, rlim: *const Rlimit) -> i32;
+        }
+        const RLIMIT_AS: i32 = 9;
+        let l = Rlimit {
+            cur: limit as u64,
+            max: limit as u64,
+        };
+        // SAFETY: a valid pointer to a `struct rlimit` (two 64-bit `rlim_t`) for the call.
+        assert_eq!(unsafe { setrlimit(RLIMIT_AS, &l) }, 0, "setrlimit failed");
+    }
+
+    /// This process's mapped address space (`VmSize`), in bytes.
+    #[cfg(target_os = "linux")]
+    fn vm_size() -> usize {
+        let status = std::fs::read_to_string("/proc/self/status").unwrap();
+        let line = status.lines().find(|l| l.starts_with("VmSize:")).unwrap();
+        let kb: usize = line.split_whitespace().nth(1).unwrap().parse().unwrap();
+        kb * 1024
+    }
+
+    /// Run by [`a_plane_fit_too_large_to_allocate_is_an_error`] in a child process: a flat
+    /// 4096x4096 image (one region) with one hole, under an address-space limit of 18 bytes a
+    /// pixel more than is mapped. The cut's labels, its copy of the map and the pixel order
+    /// (12 bytes a pixel) fit; the segment's fit points (12 more) do not.
+    #[cfg(target_os = "linux")]
+    #[test]
+    #[ignore = "a child of a_plane_fit_too_large_to_allocate_is_an_error"]
+    fn plane_fit_under_a_memory_limit() {
+        if std::env::var_os("SV_OOM_CHILD").is_none() {
+            return;
+        }
+        let (w, h) = (4096usize, 4096usize);
+        let n = w * h;
+        let img = vec![0u8; n];
+        let mut d = vec![1.0f32; n];
+        d[0] = f32::NAN;
+        rayon::join(|| (), || ()); // the pool's thread started before the limit
+        limit_address_space(vm_size() + 18 * n);
+        match fill_planes(&mut d, &img, w, 1, &[(16, 50)], 0.7) {
+            Ok(()) => println!("child: filled {}", d[0]),
+            Err(e) => println!("child: error: {e}"),
+        }
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_plane_fit_too_large_to_allocate_is_an_error() {
+        // segment_fill collected a segment's points, holes and residuals with collect/vec!
+        // (up to 21 bytes a pixel for one large segment, more than the checked tables): a
+        // failed allocation aborted the process (SIGABRT) instead of returning OutOfMemory.
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "segment::tests::plane_fit_under_a_memory_limit",
+                "--exact",
+                "--ignored",
+                "--nocapture",
+                "--test-threads=1",
+            ])
+            .env("SV_OOM_CHILD", "1")
+            .env("RAYON_NUM_THREADS", "1")
+            .env("MALLOC_ARENA_MAX", "1")
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "the child failed ({}): {stdout}{}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            stdout.contains("child: error: out of memory: the plane fill's segment fit needs "),
+            "{stdout}"
         );
     }
 
