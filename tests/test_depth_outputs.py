@@ -209,6 +209,36 @@ def test_a_folder_under_a_listed_output_name_is_refused_before_any_file_moves(
     assert _files(out) == before
 
 
+def test_a_folder_under_a_listed_output_name_is_refused_before_the_matching(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """An earlier run's depth.png replaced by a folder of that name (listed in the manifest, so
+    not the user's file): the pair was matched and every file written into the hidden folder
+    before the folder was found. Refused first, in the same line, with no matching done."""
+    import stereovision.depth
+
+    out = tmp_path / "o"
+    assert main(_terrace_argv(data_dir, out)) == 0
+    (out / "depth.png").unlink()
+    (out / "depth.png").mkdir()
+    before = _files(out)
+    capsys.readouterr()
+
+    def matched(*args: object, **kwargs: object) -> None:
+        raise AssertionError("the pair was matched before the outputs were checked")
+
+    monkeypatch.setattr(stereovision.depth, "depth_map", matched)
+    assert main(_terrace_argv(data_dir, out, max_disparity=48)) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: {out / 'depth.png'} is a folder, where the run's depth.png goes: "
+        "move it away (the earlier outputs are kept as they were)\n"
+    )
+    assert _files(out) == before
+
+
 @pytest.mark.skipif(sys.platform == "win32", reason="no flock: the folders are left there")
 def test_a_killed_runs_hidden_folder_is_removed_by_the_next_run(
     data_dir: Path, tmp_path: Path

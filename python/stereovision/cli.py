@@ -17,7 +17,7 @@ import sys
 import threading
 import time
 import warnings
-from collections.abc import Callable, Collection, Iterator, Sequence
+from collections.abc import Callable, Collection, Iterable, Iterator, Sequence
 from importlib import resources
 from pathlib import Path
 from typing import Any, NoReturn
@@ -375,6 +375,8 @@ def depth_outputs(
     _check_pair(left, right, calib, max_disparity)
     names = planned_depth_outputs(calib is not None, ground, grid is not None)
     earlier = refuse_foreign_outputs(out_dir, names)  # before the matching, too
+    # an earlier run's file, listed, replaced by a folder: found only once all was written
+    refuse_folders_under(out_dir, names)
     kw: dict[str, Any] = {} if method is None else {"method": method}
     res = depth_map(left, right, calib, max_disparity=max_disparity, fill=fill, refine=refine, **kw)
     if max_depth is not None or max_sigma is not None:
@@ -604,6 +606,32 @@ def _remove_orphan_stages(out_dir: Path, own: Path) -> None:
             os.close(fd)
 
 
+def refuse_folders_under(out_dir: Path, names: Iterable[str]) -> None:
+    """Refuse a folder standing in ``out_dir`` under one of ``names``: an earlier run's file,
+    listed in its manifest (so :func:`refuse_foreign_outputs` lets it be), since replaced by a
+    folder. Checked before the work, and by :func:`commit_outputs` before any file moves.
+
+    Parameters
+    ----------
+    out_dir : pathlib.Path
+        The ``-o`` folder (it need not exist).
+    names : iterable of str
+        The files the run writes there.
+
+    Raises
+    ------
+    IsADirectoryError
+        Naming the first such folder.
+    """
+    for name in names:
+        target = out_dir / name
+        if target.is_dir() and not target.is_symlink():
+            raise IsADirectoryError(
+                f"{target} is a folder, where the run's {name} goes: move it away (the earlier "
+                "outputs are kept as they were)"
+            )
+
+
 def commit_outputs(
     out_dir: Path,
     staged: dict[str, Path],
@@ -653,13 +681,7 @@ def commit_outputs(
     """
     from stereovision._interrupt import HeldInterrupts
 
-    for name in staged:
-        target = out_dir / name
-        if target.is_dir() and not target.is_symlink():
-            raise IsADirectoryError(
-                f"{target} is a folder, where the run's {name} goes: move it away (the earlier "
-                "outputs are kept as they were)"
-            )
+    refuse_folders_under(out_dir, staged)  # again: one may have been made during the work
     written: dict[str, Path] = {}
     removed: list[Path] = []
     listed = out_dir / manifest
