@@ -2347,3 +2347,37 @@ def test_check_fix_naming_a_folder_is_said_before_the_check(
     assert cap.out == ""
     assert cap.err == f"stereovision: error: --fix {rig}: is a folder; give a file name\n"
     assert rig.is_dir() and not any(rig.iterdir())
+
+
+def test_rectify_refuses_a_folder_under_a_listed_output_before_the_work(
+    data_dir: Path,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """An earlier rectify's right_rect.png (listed in its manifest) replaced by a folder: the
+    rerun matched the pair and staged its images before finding it. Refused first, in the
+    line commit_outputs gives, with the pair not matched and the folder as it was."""
+    import stereovision.rectification_check
+
+    scene = data_dir / "middlebury2001" / "tsukuba"
+    pair = [str(scene / "left.png"), str(scene / "right.png")]
+    out = tmp_path / "rect"
+    assert main(["rectify", *pair, "-o", str(out)]) == 0
+    (out / "right_rect.png").unlink()
+    (out / "right_rect.png").mkdir()
+    before = sorted(p.name for p in out.iterdir())
+    capsys.readouterr()
+
+    def worked(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("the pair was matched first")
+
+    monkeypatch.setattr(stereovision.rectification_check, "already_rectified", worked)
+    assert main(["rectify", *pair, "-o", str(out)]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == (
+        f"stereovision: error: {out / 'right_rect.png'} is a folder, where the run's "
+        "right_rect.png goes: move it away (the earlier outputs are kept as they were)\n"
+    )
+    assert sorted(p.name for p in out.iterdir()) == before

@@ -1078,6 +1078,7 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     # a left_rect.png of the user's is not replaced; this command's own (its manifest's) are
     names = RECTIFY_OUTPUTS if calib is None else RECTIFY_OUTPUTS[:3]
     earlier = refuse_foreign_outputs(out, names, RECTIFY_MANIFEST)
+    refuse_folders_under(out, names)  # a listed one made a folder: not once the pair is warped
     given = None  # the pair's own check, when it is already rectified: written as given
     if calib is not None:
         if args.model != "auto":
