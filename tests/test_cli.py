@@ -2381,3 +2381,32 @@ def test_rectify_refuses_a_folder_under_a_listed_output_before_the_work(
         "right_rect.png goes: move it away (the earlier outputs are kept as they were)\n"
     )
     assert sorted(p.name for p in out.iterdir()) == before
+
+
+def test_demo_refuses_a_folder_under_a_listed_output_before_the_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An earlier demo's cloud.ply (listed in its manifest) replaced by a folder: the rerun
+    checked the scene's rows and matched it before finding it. Refused first, in the line
+    commit_outputs gives, with no work done and the folder as it was."""
+    import stereovision.rectification_check
+
+    out = tmp_path / "demo"
+    assert main(["demo", "--method", "fast", "-o", str(out)]) == 0
+    (out / "cloud.ply").unlink()
+    (out / "cloud.ply").mkdir()
+    before = sorted(p.name for p in out.iterdir())
+    capsys.readouterr()
+
+    def worked(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("the scene was checked first")
+
+    monkeypatch.setattr(stereovision.rectification_check, "check_rectification", worked)
+    assert main(["demo", "--method", "fast", "-o", str(out)]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == (
+        f"stereovision: error: {out / 'cloud.ply'} is a folder, where the run's cloud.ply goes: "
+        "move it away (the earlier outputs are kept as they were)\n"
+    )
+    assert sorted(p.name for p in out.iterdir()) == before

@@ -1298,6 +1298,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
     foreign = foreign_outputs(out_dir, names, earlier)
     if any(not p.is_file() or p.is_symlink() for p in foreign):
         refuse_foreign_outputs(out_dir, names)  # a folder or link under an output name
+    refuse_folders_under(out_dir, names)  # a listed one made a folder: not once all is staged
     from stereovision.io import keep_previous
 
     kept_aside = [(p.name, keep_previous(p)) for p in foreign]
