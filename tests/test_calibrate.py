@@ -1981,3 +1981,38 @@ def test_calibrate_from_videos_warning_points_at_the_callers_line(tmp_path: Path
                              min_distance=0.0)  # fmt: skip
     folds = [w for w in caught if "is not monotonic" in str(w.message)]
     assert [w.filename for w in folds] == [__file__]
+
+
+def test_cli_report_file_listed_but_made_a_folder_is_refused_first(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """--report DIR whose report.yaml, listed by an earlier calibrate's manifest, is now a
+    folder: it passed the check of the user's files (listed), and calibrate found out after the
+    corners and the calibration, with -o already written (a half set). Refused before any
+    corner is looked for, in one line naming the folder; nothing is written."""
+    from stereovision.cli import main
+
+    _chessboard_paths()  # skipped without the data
+
+    def no_work(*_: Any, **__: Any) -> Any:
+        raise AssertionError("the corners were looked for before the outputs were checked")
+
+    monkeypatch.setattr(calmod, "find_corners", no_work)
+    rep = tmp_path / "rep"
+    rep.mkdir()
+    (rep / "report.yaml").mkdir()
+    listed = ["report.html", "report.json", "report.yaml"]
+    (rep / ".stereovision-calibrate.json").write_text(json.dumps(listed))
+    left = str(DATA_DIR / "chessboard" / "left0*.jpg")
+    right = str(DATA_DIR / "chessboard" / "right0*.jpg")
+    argv = ["calibrate", "--left", left, "--right", right, "--square", "0.025",
+            "-o", str(tmp_path / "rig.yaml"), "--report", str(rep)]  # fmt: skip
+    assert main(argv) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == (
+        f"stereovision: error: --report {rep}: cannot write {rep / 'report.yaml'}: it is a "
+        "folder; give a file name\n"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rep"]
+    assert sorted(p.name for p in rep.iterdir()) == [".stereovision-calibrate.json", "report.yaml"]

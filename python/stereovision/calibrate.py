@@ -2747,6 +2747,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         if folder:
             earlier = refuse_foreign_outputs(Path(folder), names, CALIBRATE_MANIFEST, flag)
             claims.setdefault(Path(folder).resolve(), set(earlier)).update(names)
+            # a listed one made a folder passes the refusal above: said now, not after the
+            # calibration with -o already written
+            check_destinations(folder, names, flag)
     board = _cli_board(args, printing=False)
     common: dict[str, Any] = {
         "pattern": parse_pattern(args.pattern or "9x6", "--pattern"),
