@@ -1532,3 +1532,37 @@ def test_view_screenshot_of_a_scene_is_through_its_intrinsics(result, mesh, tmp_
     args = _view_args(tmp_path, tmp_path / "shot.png")
     assert args.func(args) == 0
     assert cv2.imread(str(tmp_path / "shot.png")).shape == (intr.height, intr.width, 3)
+
+
+def test_view_without_display_checks_its_folder_before_the_work(tmp_path, monkeypatch, capsys):
+    """Without -o and without a display the screenshot goes to ./view.png: a current folder
+    that cannot be written was found out only after the source was loaded (a scene folder:
+    its depth map computed) and rendered. Now one line first, nothing loaded."""
+    import tempfile
+
+    from stereovision.cli import main
+
+    (tmp_path / "cloud.ply").write_bytes(b"not read")
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(render, "_has_display", lambda: False)
+
+    def loaded(*args, **kwargs):
+        raise RuntimeError("the source was loaded first")
+
+    monkeypatch.setattr(render, "load_view_source", loaded)
+    real = tempfile.mkstemp
+
+    def mkstemp(*args, dir=None, **kwargs):
+        if dir is not None and Path(dir).resolve() == tmp_path.resolve():  # root writes anywhere
+            raise PermissionError(13, "Permission denied")
+        return real(*args, dir=dir, **kwargs)
+
+    monkeypatch.setattr(tempfile, "mkstemp", mkstemp)
+    assert main(["view", str(tmp_path / "cloud.ply")]) == 2
+    cap = capsys.readouterr()
+    assert cap.out == ""
+    assert cap.err == (
+        f"stereovision: error: no display, so the screenshot goes to view.png here: cannot "
+        f"write in {Path.cwd()} (Permission denied); -o names another file\n"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cloud.ply"]

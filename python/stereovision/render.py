@@ -1340,6 +1340,18 @@ def cmd_view(args: argparse.Namespace) -> int:
     max_points = getattr(args, "max_points", VIEW_MAX_POINTS)
     if max_points is not None and max_points < 0:
         raise ValueError(f"--max-points: expected 0 (all) or more, got {max_points}")
+    window = out is None and _has_display()
+    if out is None and not window:
+        from stereovision.io import cannot_write_in
+
+        # the screenshot goes to ./view.png: a folder that cannot be written is said now, not
+        # after the source was loaded (a scene's depth map computed) and rendered
+        why = cannot_write_in(".")
+        if why:
+            raise PermissionError(
+                f"no display, so the screenshot goes to {DEFAULT_SCREENSHOT} here: cannot write "
+                f"in {Path.cwd()} ({why}); -o names another file"
+            )
     geometry, intr = load_view_source(args.source, max_points)
     if POINTS_IN_SOURCE in geometry.field_data:
         total = int(geometry.field_data[POINTS_IN_SOURCE][0])
@@ -1348,7 +1360,7 @@ def cmd_view(args: argparse.Namespace) -> int:
             "display only; --max-points 0 shows all)",
             file=sys.stderr,
         )
-    if out is None and _has_display():
+    if window:
         plotter = make_plotter((1024, 768), off_screen=False)
         add_geometry(plotter, geometry)
         # a mouse drag resets the clipping range from the bounds, which far outliers ruin
