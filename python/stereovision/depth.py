@@ -1261,7 +1261,9 @@ def depth_map(
     MemoryError
         With ``method="fused"`` or ``"census"``, before the census semi-global map allocates
         more than the memory available (3 bytes per pixel and disparity level: about 14 GiB for
-        a 3840 x 2160 pair over 576 px, 2 GiB at 1920 x 1080 over 288 px).
+        a 3840 x 2160 pair over 576 px, 2 GiB at 1920 x 1080 over 288 px). With any method,
+        when a kernel's image-sized buffer cannot be allocated: the message names the buffer
+        and its size, and the process goes on.
 
     Examples
     --------
