@@ -515,3 +515,84 @@ def test_a_matcher_that_runs_out_of_memory_raises_memory_error(
         r"\(\d+ bytes\) and the allocation failed"
     )
     assert re.search(pattern, out.stdout), out.stdout
+
+
+#: Each ``_core`` function that takes a parameter dict, called with one extra key.
+PARAM_DICT_CALLS: dict[str, Callable[[np.ndarray, dict[str, object]], object]] = {
+    "hopfield_match": lambda g, p: _core.hopfield_match(g, g, p),
+    "hopfield_match_u8": lambda g, p: _core.hopfield_match_u8(
+        (g * 255).astype(np.uint8), (g * 255).astype(np.uint8), LUMA_WEIGHTS_BGR, p
+    ),
+    "hopfield_candidates": lambda g, p: _core.hopfield_candidates(g, g, p),
+    "mcgm_match": lambda g, p: _core.mcgm_match(g, g, p),
+    "mcgm_curves": lambda g, p: _core.mcgm_curves(g, p),
+    "mcgm_filter": lambda g, p: _core.mcgm_filter(g, g, np.zeros((0, 4), np.float32), p),
+}
+
+
+@pytest.mark.parametrize("call", list(PARAM_DICT_CALLS))
+def test_an_unknown_key_of_a_parameter_dict_is_refused(call: str) -> None:
+    """The Python wrappers refuse a misspelt keyword first (with "did you mean"); the bindings'
+    own refusal of a key they do not know, for a caller of ``_core``, was unasserted: a
+    mutation audit dropping it left every test passing, the key ignored without a word."""
+    g = np.random.default_rng(0).random((24, 40), dtype=np.float32)
+    channel = "Hopfield" if call.startswith("hopfield") else "MCGM"
+    run = PARAM_DICT_CALLS[call]
+    run(g, {"max_disparity": 8})
+    with pytest.raises(ValueError, match=rf"^unknown {channel} parameter `max_disparit`$"):
+        run(g, {"max_disparity": 8, "max_disparit": 4})
+
+
+@pytest.mark.parametrize(("cl", "cr"), [(3, 4), (4, 3), (1, 3)])
+def test_hopfield_match_u8_refuses_pairs_of_other_channel_counts(cl: int, cr: int) -> None:
+    """Only the height and width of the pair were asserted: a mutation audit comparing those
+    alone left every test passing; the kernel then refused the right image as "invalid
+    parameter `image`: buffer of 3840 bytes does not hold 24x40x3", naming neither image."""
+    rng = np.random.default_rng(0)
+    left = rng.integers(0, 256, (24, 40, cl), dtype=np.uint8)
+    right = rng.integers(0, 256, (24, 40, cr), dtype=np.uint8)
+    _core.hopfield_match_u8(left, left, LUMA_WEIGHTS_BGR, {"max_disparity": 8})
+    says = (
+        "left and right images must have the same shape, got left "
+        f"[24, 40, {cl}] and right [24, 40, {cr}]"
+    )
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.hopfield_match_u8(left, right, LUMA_WEIGHTS_BGR, {"max_disparity": 8})
+
+
+def test_mcgm_filter_refuses_a_range_one_short() -> None:
+    """``max_disparity`` one below ``min_disparity`` is refused and an equal one taken: a
+    mutation audit letting the range be one short left every test passing."""
+    g = np.random.default_rng(0).random((30, 50), dtype=np.float32)
+    ms = np.array([[25, 15, 17, 15]], np.float32)
+    keep = _core.mcgm_filter(g, g, ms, {"min_disparity": 8, "max_disparity": 8})
+    assert keep.shape == (1,) and keep.dtype == np.bool_
+    says = "invalid parameter `max_disparity`: must be >= min_disparity (8), got 7"
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.mcgm_filter(g, g, ms, {"min_disparity": 8, "max_disparity": 7})
+
+
+def test_plane_fill_labels_must_lie_below_the_pixel_count() -> None:
+    """A label of H * W (one past the largest ``segments()`` gives) is refused, H * W - 1
+    taken: a mutation audit letting H * W through left every test passing (the kernel then
+    panicked: "RuntimeError: internal error in plane_fill: labels must be below ...")."""
+    disp = np.tile(np.arange(12, dtype=np.float32), (8, 1))
+    disp[3, 4:7] = np.nan
+    labels = np.zeros(disp.shape, np.uint32)
+    labels[0, 0] = disp.size - 1
+    _core.plane_fill(disp, labels, 5, 1.0, 0.0, 20.0)
+    labels[0, 0] = disp.size
+    says = "labels: expected values below H * W = 96, as segments() numbers them"
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.plane_fill(disp, labels, 5, 1.0, 0.0, 20.0)
+
+
+@pytest.mark.parametrize("shape", [(4, 5, 0), (0, 5, 3), (4, 0, 3)])
+def test_graph_segments_refuses_an_image_with_a_zero_size(shape: tuple[int, int, int]) -> None:
+    """An image of no channels was unasserted: a mutation audit letting it through to the
+    kernel left every test passing (it panicked: "RuntimeError: internal error in
+    graph_segments: image size does not match w * h * c")."""
+    _core.graph_segments(np.zeros((4, 5, 3), np.float32), 1.0, 2)
+    says = f"image: expected (H, W, C) with no zero size, got {shape}"
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.graph_segments(np.zeros(shape, np.float32), 1.0, 2)
