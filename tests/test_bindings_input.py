@@ -596,3 +596,14 @@ def test_graph_segments_refuses_an_image_with_a_zero_size(shape: tuple[int, int,
     says = f"image: expected (H, W, C) with no zero size, got {shape}"
     with pytest.raises(ValueError, match=re.escape(says)):
         _core.graph_segments(np.zeros(shape, np.float32), 1.0, 2)
+
+
+@pytest.mark.parametrize("right_shape", [(6, 8), (6, 10), (5, 9)])
+def test_lr_check_maps_must_have_one_shape(right_shape: tuple[int, int]) -> None:
+    """A right map of another width was unasserted: a mutation audit comparing the heights
+    alone left every test passing (a narrower map then panicked, "index out of bounds", and
+    a wider one was read with the left's width without a word)."""
+    d = np.full((6, 9), 2.0, np.float32)
+    says = f"disp_left (6, 9) and disp_right {right_shape} differ in shape"
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.gabor_lr_check(d, np.full(right_shape, 2.0, np.float32), 1.0)
