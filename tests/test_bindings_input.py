@@ -607,3 +607,14 @@ def test_lr_check_maps_must_have_one_shape(right_shape: tuple[int, int]) -> None
     says = f"disp_left (6, 9) and disp_right {right_shape} differ in shape"
     with pytest.raises(ValueError, match=re.escape(says)):
         _core.gabor_lr_check(d, np.full(right_shape, 2.0, np.float32), 1.0)
+
+
+def test_hopfield_interest_refuses_a_zero_suppression_radius() -> None:
+    """The Python wrapper refuses ``nms_half=0`` before the extension sees it; the extension's
+    own refusal was unasserted: a mutation audit dropping it left every test passing (no
+    suppression at all: 336 points on this image instead of 20, without a word)."""
+    g = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    assert len(_core.hopfield_interest(g, nms_half=1)[1]) > 0
+    says = "rel_threshold and floor_rel must lie in [0, 1] and nms_half be >= 1"
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.hopfield_interest(g, nms_half=0)
