@@ -232,3 +232,43 @@ def test_an_in_place_array_that_cannot_be_written_is_named(
     with pytest.raises(ValueError, match=re.escape(says)):
         _core.temporal_running_mean(u8, mean, count, mean[..., 0], 16.0, 8)
     np.testing.assert_array_equal(mean, arrays["mean"])
+
+
+def _misaligned(a: np.ndarray) -> np.ndarray:
+    """A C-contiguous copy of ``a`` one byte into a buffer: strides whole items, items not
+    aligned."""
+    buf = np.zeros(a.nbytes + 1, np.uint8)
+    out = buf[1:].view(a.dtype).reshape(a.shape)
+    out[...] = a
+    assert out.flags.c_contiguous and not out.flags.aligned
+    return out
+
+
+def test_a_misaligned_array_updated_in_place_is_refused(arrays: dict[str, np.ndarray]) -> None:
+    """Only strides that are no whole items (the packed field) were asserted: a mutation audit
+    letting an array whose items are not aligned through as ``mean`` left every test passing
+    (it was then refused as "mean and count must be C-contiguous", which it is). It is
+    refused as not aligned, and left as it was."""
+    u8, diff = arrays["u8"], arrays["diff"]
+    count = np.full(diff.shape, 3, np.uint8)
+    mean = _misaligned(arrays["mean"])
+    _, w, c = mean.shape
+    says = (
+        "mean must be an aligned array whose strides are whole items (it is updated in place), "
+        f"got strides [{w * c * 4}, {c * 4}, 4] for items of 4 bytes"
+    )
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.temporal_running_mean(u8, mean, count, diff, 16.0, 8)
+    np.testing.assert_array_equal(mean, arrays["mean"])
+
+
+@pytest.mark.parametrize("kernel", ["sgm_disparity", "gabor_responses", "row_fill", "side_fill"])
+def test_a_misaligned_array_read_gives_the_aligned_result(
+    kernel: str, arrays: dict[str, np.ndarray]
+) -> None:
+    """An array read (not written) whose items are not aligned goes through NumPy's aligned
+    copy: the result is the aligned array's."""
+    want = KERNELS[kernel](arrays)
+    # Bytes are always aligned.
+    viewed = {k: _misaligned(a) if a.itemsize > 1 else a for k, a in arrays.items()}
+    _same(KERNELS[kernel](viewed), want)
