@@ -618,3 +618,15 @@ def test_hopfield_interest_refuses_a_zero_suppression_radius() -> None:
     says = "rel_threshold and floor_rel must lie in [0, 1] and nms_half be >= 1"
     with pytest.raises(ValueError, match=re.escape(says)):
         _core.hopfield_interest(g, nms_half=0)
+
+
+@pytest.mark.parametrize(("step", "offset"), [(256, 0), (0, 0), (16, 256)])
+def test_quantised_regions_bounds_are_the_bytes(step: int, offset: int) -> None:
+    """Step 1-255 and offset 0-255: their ends were unasserted, and a mutation audit letting a
+    step of 256 through left every test passing (one region, without a word)."""
+    img = np.random.default_rng(0).integers(0, 256, (6, 8, 3), dtype=np.uint8)
+    assert _core.quantised_regions(img, 255, 255).shape == (6, 8)
+    assert _core.quantised_regions(img, 1, 0).max() > 0
+    says = f"step must be in 1-255 and offset in 0-255, got step={step}, offset={offset}"
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.quantised_regions(img, step, offset)
