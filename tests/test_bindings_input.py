@@ -630,3 +630,36 @@ def test_quantised_regions_bounds_are_the_bytes(step: int, offset: int) -> None:
     says = f"step must be in 1-255 and offset in 0-255, got step={step}, offset={offset}"
     with pytest.raises(ValueError, match=re.escape(says)):
         _core.quantised_regions(img, step, offset)
+
+
+@pytest.mark.parametrize(("step", "ok"), [(0, False), (1, True), (255, True), (256, False)])
+def test_fill_planes_pass_steps_are_1_to_255(step: int, ok: bool) -> None:
+    """The Python wrapper refuses a step of 0 first; the extension's own refusal was
+    unasserted: a mutation audit letting 0 through left every test passing (the kernel then
+    panicked: "RuntimeError: internal error in fill_planes: step must be positive")."""
+    disp = np.tile(np.arange(12, dtype=np.float32), (8, 1))
+    disp[3, 4:7] = np.nan
+    img = np.zeros((8, 12, 3), np.uint8)
+    if ok:
+        assert np.isfinite(_core.fill_planes(disp, img, [(step, 5)], 1.0)).all()
+        return
+    says = f"invalid parameter `passes`: element 0 (({step}, 5)): step must be an integer in 1-255"
+    with pytest.raises(ValueError, match=re.escape(says)):
+        _core.fill_planes(disp, img, [(step, 5)], 1.0)
+
+
+def test_gabor_iters_per_level_reaches_the_kernel(crop: tuple[np.ndarray, np.ndarray]) -> None:
+    """``iters_per_level`` and ``iters_finest`` both default to 1: a mutation audit passing
+    ``iters_finest`` for ``iters_per_level`` left every test passing (3 iterations per
+    level gave the map of 1)."""
+    gl, gr = (as_gray_float(a) for a in crop)
+
+    def run(per_level: int, finest: int) -> np.ndarray:
+        d, _ = _core.gabor_disparity(
+            gl, gr, 0.0, 32.0, iters_per_level=per_level, iters_finest=finest
+        )
+        return d
+
+    one = run(1, 1)
+    assert not np.array_equal(run(3, 1), one, equal_nan=True)
+    assert not np.array_equal(run(3, 1), run(1, 3), equal_nan=True)
