@@ -663,3 +663,17 @@ def test_gabor_iters_per_level_reaches_the_kernel(crop: tuple[np.ndarray, np.nda
     one = run(1, 1)
     assert not np.array_equal(run(3, 1), one, equal_nan=True)
     assert not np.array_equal(run(3, 1), run(1, 3), equal_nan=True)
+
+
+def test_mcgm_disc_dy_reaches_the_discontinuity_filter(crop: tuple[np.ndarray, np.ndarray]) -> None:
+    """``disc_dy`` was unasserted at the binding: a mutation audit writing it into ``disc_dx``
+    left every test passing. More rows in the window drop more matches; -1 is named."""
+    gl, gr = (as_gray_float(a) for a in crop)
+    off = {"max_disparity": 32, "disc": False, "sides": False}
+    ms = np.ascontiguousarray(_core.mcgm_match(gl, gr, off)[0][:, :4])
+    assert len(ms) > 300
+    on = {**off, "disc": True}
+    kept = [int(_core.mcgm_filter(gl, gr, ms, {**on, "disc_dy": dy}).sum()) for dy in (0, 1, 3, 8)]
+    assert kept == sorted(set(kept), reverse=True), kept
+    with pytest.raises(ValueError, match=re.escape("disc_dx = 6, disc_dy = -1")):
+        _core.mcgm_filter(gl, gr, ms, {**on, "disc_dy": -1})
