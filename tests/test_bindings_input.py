@@ -677,3 +677,50 @@ def test_mcgm_disc_dy_reaches_the_discontinuity_filter(crop: tuple[np.ndarray, n
     assert kept == sorted(set(kept), reverse=True), kept
     with pytest.raises(ValueError, match=re.escape("disc_dx = 6, disc_dy = -1")):
         _core.mcgm_filter(gl, gr, ms, {**on, "disc_dy": -1})
+
+
+@pytest.mark.parametrize(
+    ("call", "key", "value"),
+    [
+        (_core.hopfield_match, "min_disparity", -1),
+        (_core.hopfield_match, "seed", 2**64),
+        (_core.mcgm_match, "max_disparity", 2**70),
+    ],
+)
+def test_a_dict_integer_out_of_range_names_its_range(
+    call: Callable[..., object], key: str, value: int
+) -> None:
+    """The Python wrappers refuse these first; through ``_core`` the message naming the range
+    was unasserted: a mutation audit giving back "parameter `min_disparity`: OverflowError:
+    can't convert negative int to unsigned" left every test passing."""
+    g = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    says = f"invalid parameter `{key}`: expected an integer from 0 to {2**64 - 1}, got {value}"
+    with pytest.raises(ValueError, match=f"^{re.escape(says)}$"):
+        call(g, g, {key: value})
+
+
+@pytest.mark.parametrize(
+    ("name", "call"),
+    [
+        ("tau", lambda d, g, v: _core.side_fill(d, np.zeros((*d.shape, 3), np.float32), v)),
+        ("ratio", lambda d, g, v: _core.fattened(d, g, 3, v, 2.0)),
+        ("jump", lambda d, g, v: _core.fattened(d, g, 3, 2.0, v)),
+        ("max_diff", lambda d, g, v: _core.gabor_remove_speckles(d, 10, v)),
+        ("k", lambda d, g, v: _core.graph_segments(np.zeros((*d.shape, 3), np.float32), v, 2)),
+        (
+            "max_residual",
+            lambda d, g, v: _core.plane_fill(d, np.zeros(d.shape, np.uint32), 5, v, 0.0, 9.0),
+        ),
+    ],
+)
+def test_non_negative_arguments_must_be_finite(
+    name: str, call: Callable[[np.ndarray, np.ndarray, float], object]
+) -> None:
+    """0 is taken, infinity refused: a mutation audit letting infinity through (NaN and
+    negative numbers still refused) left every test passing."""
+    d = np.tile(np.arange(12, dtype=np.float32), (8, 1))
+    g = np.ones_like(d)
+    call(d, g, 0.0)
+    says = f"{name}: expected a non-negative number, got inf"
+    with pytest.raises(ValueError, match=f"^{re.escape(says)}$"):
+        call(d, g, float("inf"))
