@@ -567,7 +567,7 @@ pub fn fill_planes(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     #[test]
@@ -593,7 +593,7 @@ mod tests {
 
     /// `setrlimit(RLIMIT_AS, limit)` through the C library std links anyway (no `libc` crate).
     #[cfg(target_os = "linux")]
-    fn limit_address_space(limit: usize) {
+    pub(crate) fn limit_address_space(limit: usize) {
         #[repr(C)]
         struct Rlimit {
             cur: u64,
@@ -613,7 +613,7 @@ mod tests {
 
     /// This process's mapped address space (`VmSize`), in bytes.
     #[cfg(target_os = "linux")]
-    fn vm_size() -> usize {
+    pub(crate) fn vm_size() -> usize {
         let status = std::fs::read_to_string("/proc/self/status").unwrap();
         let line = status.lines().find(|l| l.starts_with("VmSize:")).unwrap();
         let kb: usize = line.split_whitespace().nth(1).unwrap().parse().unwrap();

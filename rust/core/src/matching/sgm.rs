@@ -359,8 +359,44 @@ fn step4<T: PathCost>(
     mn
 }
 
+/// The path buffers of one [`pass_impl`] (see there).
+struct PassPaths<T> {
+    prev: [Vec<T>; 3],
+    cur: [Vec<T>; 3],
+    prev_min: [Vec<T>; 3],
+    cur_min: [Vec<T>; 3],
+    hl: Vec<T>,
+    hl_next: Vec<T>,
+    /// A path's first pixel steps from zeros (its output is then its cost).
+    zero: Vec<T>,
+}
+
+impl<T: PathCost> PassPaths<T> {
+    /// [`CoreError::OutOfMemory`] when they cannot be allocated. Not inlined: with its error
+    /// paths inside [`pass_impl`], the AVX2 pass no longer inlined [`step4`]'s closures and ran
+    /// 15 times slower.
+    #[inline(never)]
+    fn new(w: usize, n: usize) -> Result<Self> {
+        const WHAT: &str = "the census matcher's path costs";
+        let stride = n + 2;
+        let path = || try_filled(w * stride, T::PAD, WHAT);
+        let minima = || try_filled(w, T::of(0), WHAT);
+        Ok(PassPaths {
+            prev: [path()?, path()?, path()?],
+            cur: [path()?, path()?, path()?],
+            prev_min: [minima()?, minima()?, minima()?],
+            cur_min: [minima()?, minima()?, minima()?],
+            hl: try_filled(stride, T::PAD, WHAT)?,
+            hl_next: try_filled(stride, T::PAD, WHAT)?,
+            zero: zero_path(n)?,
+        })
+    }
+}
+
 /// Four paths in one raster (`forward`) or reverse raster pass; hands each row's summed costs
-/// to `emit`. Path costs are kept as `T` ([`PathCost`]).
+/// to `emit`. Path costs are kept as `T` ([`PathCost`]). [`CoreError::OutOfMemory`] when the
+/// path buffers (six rows of `w (n + 2)` path costs) cannot be allocated (a `vec!` aborted the
+/// process).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn pass_impl<T: PathCost>(
@@ -373,23 +409,22 @@ fn pass_impl<T: PathCost>(
     forward: bool,
     row: &mut Vec<u16>,
     emit: &mut dyn FnMut(usize, &mut Vec<u16>),
-) {
+) -> Result<()> {
     let stride = n + 2;
     let lut = p2_table(p);
     // `row`: the four paths' sum for one row (`w * n` values); `emit` may swap in another
     // buffer. Every entry is written before it is read, so its contents do not matter.
     // Path costs of the previous row for the vertical path and the diagonals whose
     // predecessor is at x - sgn and x + sgn; index x * stride.
-    let mut prev: [Vec<T>; 3] = std::array::from_fn(|_| vec![T::PAD; w * stride]);
-    let mut cur: [Vec<T>; 3] = std::array::from_fn(|_| vec![T::PAD; w * stride]);
-    let mut prev_min = [vec![T::of(0); w], vec![T::of(0); w], vec![T::of(0); w]];
-    let mut cur_min = [vec![T::of(0); w], vec![T::of(0); w], vec![T::of(0); w]];
-    let mut hl = vec![T::PAD; stride];
-    let mut hl_next = vec![T::PAD; stride];
-    // A path's first pixel steps from zeros (its output is then its cost).
-    let mut zero = vec![T::of(0); stride];
-    zero[0] = T::PAD;
-    zero[n + 1] = T::PAD;
+    let PassPaths {
+        mut prev,
+        mut cur,
+        mut prev_min,
+        mut cur_min,
+        mut hl,
+        mut hl_next,
+        zero,
+    } = PassPaths::new(w, n)?;
     let sgn: isize = if forward { 1 } else { -1 };
     for i in 0..h {
         let y = if forward { i } else { h - 1 - i };
@@ -443,6 +478,7 @@ fn pass_impl<T: PathCost>(
         std::mem::swap(&mut prev_min, &mut cur_min);
         emit(y, row);
     }
+    Ok(())
 }
 
 /// `fn $name`: [`pass_impl`] with `$t` path costs, compiled for the baseline and AVX2 (the
@@ -460,7 +496,7 @@ macro_rules! pass_with {
                 forward: bool,
                 row: &mut Vec<u16>,
                 emit: &mut dyn FnMut(usize, &mut Vec<u16>),
-            ) {
+            ) -> Result<()> {
                 pass_impl::<$t>(c, img, w, h, n, p, forward, row, emit)
             }
         }
@@ -770,7 +806,10 @@ pub fn sgm_disparity(
     } else {
         pass_u16
     };
-    let meet = |forward: bool| -> Vec<(usize, Vec<f32>)> {
+    // Set when a pass could not allocate its path buffers: the other then parks no more sums
+    // for it (they would never be met).
+    let alone = std::sync::atomic::AtomicBool::new(false);
+    let meet = |forward: bool| -> Result<Vec<(usize, Vec<f32>)>> {
         let mut done = Vec::new();
         let mut emit = |y: usize, row: &mut Vec<u16>| {
             let other = {
@@ -778,6 +817,9 @@ pub fn sgm_disparity(
                 match slot.take() {
                     Some(other) => other,
                     None => {
+                        if alone.load(std::sync::atomic::Ordering::Relaxed) {
+                            return;
+                        }
                         if let Some(next) = fresh() {
                             *slot = Some(std::mem::replace(row, next));
                         }
@@ -792,14 +834,19 @@ pub fn sgm_disparity(
             done.push((y, o));
         };
         let Some(mut row) = fresh() else {
-            return done;
+            return Ok(done);
         };
-        pass(&c, left.data, w, h, n, p, forward, &mut row, &mut emit);
+        let ran = pass(&c, left.data, w, h, n, p, forward, &mut row, &mut emit);
+        if ran.is_err() {
+            alone.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
         free.lock().unwrap_or_else(|e| e.into_inner()).push(row);
-        done
+        ran.map(|()| done)
     };
     let (a, b) = rayon::join(|| meet(true), || meet(false));
     kept::put(c, free.into_inner().unwrap_or_else(|e| e.into_inner()));
+    // A pass without path buffers first: the row sums it starved the other of follow from it.
+    let (a, b) = (a?, b?);
     if starved.into_inner() {
         return Err(CoreError::oom(
             h.saturating_mul(w * n * 2),
@@ -848,12 +895,13 @@ struct Horizontal<T> {
 }
 
 impl<T: PathCost> Horizontal<T> {
-    fn new(n: usize) -> Self {
-        Horizontal {
-            zero: zero_path(n),
-            last: vec![T::PAD; n + 2],
-            next: vec![T::PAD; n + 2],
-        }
+    fn new(n: usize) -> Result<Self> {
+        const WHAT: &str = "the census matcher's horizontal path costs";
+        Ok(Horizontal {
+            zero: zero_path(n)?,
+            last: try_filled(n + 2, T::PAD, WHAT)?,
+            next: try_filled(n + 2, T::PAD, WHAT)?,
+        })
     }
 }
 
@@ -868,14 +916,17 @@ struct VerticalPath<T> {
 }
 
 impl<T: PathCost> VerticalPath<T> {
-    fn new(w: usize, n: usize) -> Self {
-        VerticalPath {
-            zero: zero_path(n),
-            prev: vec![T::PAD; w * (n + 2)],
-            prev_min: vec![T::of(0); w],
-            cur: vec![T::PAD; w * (n + 2)],
-            cur_min: vec![T::of(0); w],
-        }
+    /// [`CoreError::OutOfMemory`] when the two rows of path costs (`2 w (n + 2)` values)
+    /// cannot be allocated.
+    fn new(w: usize, n: usize) -> Result<Self> {
+        const WHAT: &str = "the census matcher's vertical path costs";
+        Ok(VerticalPath {
+            zero: zero_path(n)?,
+            prev: try_filled(w * (n + 2), T::PAD, WHAT)?,
+            prev_min: try_filled(w, T::of(0), WHAT)?,
+            cur: try_filled(w * (n + 2), T::PAD, WHAT)?,
+            cur_min: try_filled(w, T::of(0), WHAT)?,
+        })
     }
 }
 
@@ -997,11 +1048,11 @@ three_paths_for!(u8, horizontal_u8, vertical_u8);
 three_paths_for!(u16, horizontal_u16, vertical_u16);
 
 /// A path-cost vector of `n + 2` entries: zeros inside the two pads.
-fn zero_path<T: PathCost>(n: usize) -> Vec<T> {
-    let mut z = vec![T::of(0); n + 2];
+fn zero_path<T: PathCost>(n: usize) -> Result<Vec<T>> {
+    let mut z = try_filled(n + 2, T::of(0), "the census matcher's path costs")?;
     z[0] = T::PAD;
     z[n + 1] = T::PAD;
-    z
+    Ok(z)
 }
 
 /// The matcher with `paths` 3: left to right, right to left and top to bottom (OpenCV
@@ -1090,7 +1141,7 @@ fn three_paths_as<T: PathCost + Send>(
     });
     let queued = Condvar::new();
     let state = Mutex::new(Vertical {
-        path: VerticalPath::<T>::new(w, n),
+        path: VerticalPath::<T>::new(w, n)?,
         out: &mut out,
     });
     // The vertical path and the selection of the next queued row, by whichever worker calls it;
@@ -1109,17 +1160,31 @@ fn three_paths_as<T: PathCost + Send>(
         lock(&flight).free.push((c, acc));
         true
     };
-    let first = || {
-        // Set when this worker ends, by a panic too: the second would otherwise wait forever
-        // and `join` could not hand the panic on.
+    // The first worker's buffers, allocated here where a failure is simply returned.
+    let mut rev = Vec::new();
+    try_reserve_len(&mut rev, w, "the census matcher's reversed census row")?;
+    let mut hp = Horizontal::<T>::new(n)?;
+    // A row in flight: its costs (`w n` bytes) and path sums (`2 w n`); zeroed, as `vec!`.
+    let new_row = || -> Result<Row> {
+        Ok((
+            try_zeroed(w * n, "the census matcher's row costs")?,
+            try_zeroed(w * n, "the census matcher's row path sums")?,
+        ))
+    };
+    // Ends with an error when a row cannot be allocated: the rows queued are still taken by
+    // the vertical path, and the call returns the error.
+    let first = || -> Result<()> {
+        // Set when this worker ends, by a panic or an error too: the second would otherwise
+        // wait forever and `join` could not hand the panic on.
         let _end = AllQueued(&flight, &queued);
-        let mut rev = Vec::with_capacity(w);
-        let mut hp = Horizontal::<T>::new(n);
         for y in 0..h {
             #[cfg(test)]
             assert!((w, h, y) != tests::PANIC_AT, "a fault injected by a test");
             let reused = lock(&flight).free.pop();
-            let (mut c, mut acc) = reused.unwrap_or_else(|| (vec![0u8; w * n], vec![0u16; w * n]));
+            let (mut c, mut acc) = match reused {
+                Some(r) => r,
+                None => new_row()?,
+            };
             rev.clear();
             rev.extend(cr[y * w..(y + 1) * w].iter().rev());
             cost_row(&cl[y * w..(y + 1) * w], &rev, d_min, n, &mut c);
@@ -1136,6 +1201,7 @@ fn three_paths_as<T: PathCost + Send>(
         }
         drop(_end);
         while vertical_step() {}
+        Ok(())
     };
     let second = || loop {
         {
@@ -1152,9 +1218,10 @@ fn three_paths_as<T: PathCost + Send>(
     // The first worker on this thread: on one thread `join` runs it to the end (it takes every
     // row's vertical path itself once it is `THREE_PATHS_LEAD` ahead), then the second, which
     // finds nothing left.
-    rayon::join(first, second);
+    let (ran, ()) = rayon::join(first, second);
     drop(state);
     kept::put_pairs(flight.into_inner().unwrap_or_else(|e| e.into_inner()).free);
+    ran?;
     Ok(out)
 }
 
@@ -1330,7 +1397,7 @@ mod tests {
         let mut emit = |y: usize, row: &mut Vec<u16>| rows.push((y, row.clone()));
         let mut row = vec![0u16; w * n];
         let run = if u8_costs { pass_u8 } else { pass_u16 };
-        run(&c, &l, w, h, n, p, forward, &mut row, &mut emit);
+        run(&c, &l, w, h, n, p, forward, &mut row, &mut emit).unwrap();
         rows
     }
 
@@ -1424,6 +1491,76 @@ mod tests {
             .recv_timeout(std::time::Duration::from_secs(20))
             .expect("the call hung");
         assert!(panicked);
+    }
+
+    /// Run by [`path_buffers_too_large_to_allocate_are_an_error`] in a child process: under an
+    /// address-space limit of 90 MiB more than is mapped, pairs of 2 rows and 2048 levels whose
+    /// first buffer that does not fit is a path buffer. Three paths, 32768 px wide: the vertical
+    /// path's two rows of path costs (134 MB); 16384 px wide: they fit (67 MB), a row in flight
+    /// (34 MB of costs, then 67 MB of sums) does not. Eight paths (one pass after the other on
+    /// one thread), 8192 px wide: the cost volume and the first pass's row sums fit (67 MB), its
+    /// six rows of path costs (101 MB) do not.
+    #[cfg(target_os = "linux")]
+    #[test]
+    #[ignore = "a child of path_buffers_too_large_to_allocate_are_an_error"]
+    fn path_buffers_under_a_memory_limit() {
+        if std::env::var_os("SV_OOM_CHILD").is_none() {
+            return;
+        }
+        let cases = [(32768usize, 3u8), (16384, 3), (8192, 8)];
+        let imgs: Vec<Vec<f32>> = cases.iter().map(|&(w, _)| ramp(w, 2, 0.0)).collect();
+        rayon::join(|| (), || ()); // the pool's thread started before the limit
+        crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (90 << 20));
+        for (&(w, paths), img) in cases.iter().zip(&imgs) {
+            let v = ImageView::new(w, 2, img).unwrap();
+            let p = SgmParams {
+                paths,
+                ..SgmParams::default()
+            };
+            match sgm_disparity(v, v, 0, 2047, &p) {
+                Ok(d) => println!("child: {w} {paths}: matched {}", d.len()),
+                Err(e) => println!("child: {w} {paths}: error: {e}"),
+            }
+            release_kept();
+        }
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn path_buffers_too_large_to_allocate_are_an_error() {
+        // The path buffers (the 8-path passes' six rows of w (n + 2) path costs, the 3-path
+        // vertical path's two and its rows in flight) were allocated with vec!: a failed
+        // allocation aborted the process (SIGABRT) instead of returning OutOfMemory.
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                "matching::sgm::tests::path_buffers_under_a_memory_limit",
+                "--exact",
+                "--ignored",
+                "--nocapture",
+                "--test-threads=1",
+            ])
+            .env("SV_OOM_CHILD", "1")
+            .env("RAYON_NUM_THREADS", "1")
+            .env("MALLOC_ARENA_MAX", "1")
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "the child failed ({}): {stdout}{}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for want in [
+            "child: 32768 3: error: out of memory: the census matcher's vertical path costs \
+             needs 64.06 MiB (67174400 bytes)",
+            "child: 16384 3: error: out of memory: the census matcher's row costs needs 32.00 \
+             MiB (33554432 bytes)",
+            "child: 8192 8: error: out of memory: the census matcher's path costs needs 16.02 \
+             MiB (16793600 bytes)",
+        ] {
+            assert!(stdout.contains(want), "{want} not in {stdout}");
+        }
     }
 
     #[test]
@@ -1784,7 +1921,7 @@ mod tests {
                 let mut emit = |y: usize, row: &mut Vec<u16>| rows.push((y, row.clone()));
                 let mut row = vec![0u16; w * n];
                 let run = if u8_costs { pass_u8 } else { pass_u16 };
-                run(&c, &img, w, h, n, &p, forward, &mut row, &mut emit);
+                run(&c, &img, w, h, n, &p, forward, &mut row, &mut emit).unwrap();
                 assert_eq!(rows.len(), h);
                 for (y, r) in rows {
                     let got: Vec<i64> = r.iter().map(|&v| i64::from(v)).collect();
