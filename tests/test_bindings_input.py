@@ -517,6 +517,63 @@ def test_a_matcher_that_runs_out_of_memory_raises_memory_error(
     assert re.search(pattern, out.stdout), out.stdout
 
 
+#: Runs the census matcher on a pair of two wide rows with 2048 levels under ``ulimit -v`` set
+#: 256 MiB above what the process holds, after a small pair in both modes (its worker threads
+#: and their heaps exist before the limit). The path buffers are then the first that do not fit.
+_SGM_PATHS_OOM_SCRIPT = """
+import resource
+import sys
+
+import numpy as np
+from stereovision import _core
+
+width, paths = int(sys.argv[1]), int(sys.argv[2])
+small = np.random.default_rng(0).random((64, 96), dtype=np.float32)
+for p in (3, 8):
+    _core.sgm_disparity(small, small, 0, 15, 8, 96, 16.0, 5, 1, 4, p)
+a = np.random.default_rng(1).random((2, width), dtype=np.float32)
+with open("/proc/self/status") as f:
+    held = next(int(line.split()[1]) * 1024 for line in f if line.startswith("VmSize:"))
+limit = held + (256 << 20)
+resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+try:
+    _core.sgm_disparity(a, a, 0, 2047, 8, 96, 16.0, 5, 1, 4, paths)
+    print("matched")
+except MemoryError as e:
+    print("MemoryError:", e)
+"""
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+@pytest.mark.parametrize(
+    ("width", "paths", "message"),
+    [
+        # Two rows of 65536 x 2050 path costs: the second does not fit.
+        (65536, 3, "vertical path costs needs 128.12 MiB (134348800 bytes)"),
+        # The vertical path (2 x 67 MB) and a row's costs fit, its path sums do not.
+        (32768, 3, "row path sums needs 128.00 MiB (134217728 bytes)"),
+        # The cost volume and the passes' row sums fit, their six rows of path costs do not.
+        (16384, 8, "path costs needs 32.03 MiB (33587200 bytes)"),
+    ],
+)
+def test_sgm_path_buffers_that_do_not_fit_raise_memory_error(
+    width: int, paths: int, message: str
+) -> None:
+    """The 8-path passes' path costs and the 3-path vertical path and rows in flight were
+    allocated with ``vec!``: a failed allocation aborted the whole process (SIGABRT, exit -6)."""
+    env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    out = subprocess.run(
+        [sys.executable, "-c", _SGM_PATHS_OOM_SCRIPT, str(width), str(paths)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=env,
+    )
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    want = f"MemoryError: out of memory: the census matcher's {message} and the allocation failed"
+    assert want in out.stdout, out.stdout
+
+
 #: Each ``_core`` function that takes a parameter dict, called with one extra key.
 PARAM_DICT_CALLS: dict[str, Callable[[np.ndarray, dict[str, object]], object]] = {
     "hopfield_match": lambda g, p: _core.hopfield_match(g, g, p),
