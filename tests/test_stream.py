@@ -27,6 +27,13 @@ from stereovision.stream import STAGES, FrameServer, StreamReport, run_stream
 SCENE = "tartanair/oldtown_easy_p000_001116"  # 640x480, metric rectified calibration
 N_FRAMES = 6
 FPS = 30.0
+#: Tests that run the pipelined stream (its grab thread; a ``stream`` command without
+#: --no-pipeline). A deadlock of the grab thread and the matcher (a slot not given back, an
+#: end or error never put) hung them until the suite's 600 s timeout: they now fail within
+#: these seconds, with every thread's stack (pytest-timeout). Each takes at most 3 s alone, the
+#: slow ones 7-12 s; the margin is for a loaded two-core machine.
+PIPELINED = pytest.mark.timeout(30)
+SLOW_PIPELINED = pytest.mark.timeout(45)
 
 
 @pytest.fixture(scope="module")
@@ -54,6 +61,7 @@ def _json_lines(text: str) -> list[dict]:
     return [json.loads(ln) for ln in lines]
 
 
+@PIPELINED
 def test_stream_json_reports(videos: dict[str, Path], capsys: pytest.CaptureFixture[str]) -> None:
     argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
     argv += ["--calib", str(videos["calib"]), "--max-disparity", "64", "--no-display", "--json"]
@@ -91,6 +99,7 @@ def test_stream_json_reports(videos: dict[str, Path], capsys: pytest.CaptureFixt
 
 
 @pytest.mark.parametrize("fill", [None, False])
+@PIPELINED
 def test_stream_census_fills_unless_told(
     videos: dict[str, Path], capsys: pytest.CaptureFixture[str], fill: bool | None
 ) -> None:
@@ -111,6 +120,7 @@ def test_stream_census_fills_unless_told(
         assert all(0.6 < r["density"] < 1.0 for r in reports)  # measured: 0.83
 
 
+@PIPELINED
 def test_stream_results_are_the_frames_depth(videos: dict[str, Path]) -> None:
     """Pipelined, each result is depth_map of its own pair (no mix-up between frames).
 
@@ -171,6 +181,7 @@ def test_stream_unpipelined_with_raw_rig(
     assert sum(r["frames"] for r in objs[:-1]) == 3
 
 
+@PIPELINED
 def test_stream_estimates_range_and_prints_text(
     videos: dict[str, Path], capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -239,6 +250,7 @@ def test_frame_server_serves_left_and_disparity() -> None:
         srv.close()
 
 
+@PIPELINED
 def test_stream_warns_when_the_rig_is_not_rectified(
     videos: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -270,6 +282,7 @@ def test_stream_warns_when_the_rig_is_not_rectified(
     assert _json_lines(cap.out)[-1]["rectification"] is None and "NOT" not in cap.err
 
 
+@PIPELINED
 def test_stream_scales_a_calibration_made_at_another_resolution(
     videos: dict[str, Path], capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -295,6 +308,7 @@ def test_stream_scales_a_calibration_made_at_another_resolution(
     assert "frames are kept at 640x480" in cap.err and "calibration is for" not in cap.err
 
 
+@SLOW_PIPELINED
 def test_stream_checks_every_nth_pair_and_warns_once_when_the_rows_drift(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -332,6 +346,7 @@ def test_stream_checks_every_nth_pair_and_warns_once_when_the_rows_drift(
     assert "argument --check-every: expected a whole number above 0" in capsys.readouterr().err
 
 
+@PIPELINED
 def test_stream_watches_the_floor_and_warns_once_when_the_mount_moves(
     data_dir: Path, tmp_path: Path
 ) -> None:
@@ -369,6 +384,7 @@ def test_stream_watches_the_floor_and_warns_once_when_the_mount_moves(
                    None, ground_every=2)  # fmt: skip
 
 
+@PIPELINED
 def test_a_still_rig_on_uneven_ground_is_not_a_moved_mount(data_dir: Path, tmp_path: Path) -> None:
     """TartanAir's street from 9 m up, the same pair at four JPEG qualities (a webcam's MJPG
     frames differ that way): the fresh floor fits differ by more than the 2 degrees that flag a
@@ -392,6 +408,7 @@ def test_a_still_rig_on_uneven_ground_is_not_a_moved_mount(data_dir: Path, tmp_p
     assert not [w for w in caught if "moved on its mount" in str(w.message)]
 
 
+@PIPELINED
 def test_stream_records_a_ros2_bag(data_dir: Path, tmp_path: Path) -> None:
     """`stream --bag DIR` writes every frame's four topics into a new ROS 2 bag that rosbags'
     reader reads back; without --calib it is a one-line error."""
@@ -420,6 +437,7 @@ def test_stream_records_a_ros2_bag(data_dir: Path, tmp_path: Path) -> None:
     assert main(["stream", *src, "--no-display", "--bag", str(tmp_path / "b2")]) == 2
 
 
+@SLOW_PIPELINED
 def test_stream_averages_a_still_noisy_rig(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -476,6 +494,7 @@ def test_stream_averages_a_still_noisy_rig(
     assert err == ["stereovision: error: --temporal: expected 2-255 pairs to average, got 256"]
 
 
+@PIPELINED
 def test_stream_averages_a_raw_rig_before_rectifying(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -508,6 +527,7 @@ def test_stream_averages_a_raw_rig_before_rectifying(
     assert "the cameras are noisy" in cap.err
 
 
+@PIPELINED
 def test_stream_temporal_restarts_on_a_moving_view(
     videos: dict[str, Path], capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -572,6 +592,7 @@ def test_stream_results_are_stamped_at_their_grab(videos: dict[str, Path]) -> No
         assert t0 <= stamp <= called - 0.9e9 * compute_s  # the matching came after the stamp
 
 
+@SLOW_PIPELINED
 def test_sigterm_finishes_the_bag_of_a_stream(data_dir: Path, tmp_path: Path) -> None:
     """SIGTERM (kill, systemd) to `stream --bag` left a .db3 without metadata.yaml that no
     reader opens: the bag was one transaction, finished only by a normal end or Ctrl-C. Now
@@ -597,16 +618,21 @@ def test_sigterm_finishes_the_bag_of_a_stream(data_dir: Path, tmp_path: Path) ->
            "--calib", str(scene / "calib.txt"), "--no-display", "--max-disparity", "64",
            "--no-check", "--bag", str(bag)]  # fmt: skip
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and proc.poll() is None:
-        db = bag / "bag.db3"
-        if db.exists() and db.stat().st_size > 4e6:  # a few frames in (about 1.5 MB each)
-            break
-        time.sleep(0.2)
-    time.sleep(0.5)
-    assert proc.poll() is None, proc.communicate()
-    proc.send_signal(signal.SIGTERM)
-    out, err = proc.communicate(timeout=60)
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None:
+            db = bag / "bag.db3"
+            if db.exists() and db.stat().st_size > 4e6:  # a few frames in (about 1.5 MB each)
+                break
+            time.sleep(0.2)
+        time.sleep(0.5)
+        assert proc.poll() is None, proc.communicate()
+        proc.send_signal(signal.SIGTERM)
+        out, err = proc.communicate(timeout=60)
+    finally:  # a stream that deadlocked (the test's timeout) is not left running
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
     assert proc.returncode == 143, err  # 128 + SIGTERM, after the summary and the bag
     assert " s (terminated): " in out and "Traceback" not in err
     assert err.strip().splitlines()[-1].startswith(f"ROS 2 bag written to {bag} (")
@@ -656,6 +682,7 @@ def test_a_port_in_use_is_said_with_its_number() -> None:
         FrameServer("no.such.host.invalid", 0)
 
 
+@PIPELINED
 def test_a_stream_stopped_before_its_first_frame_leaves_no_empty_bag(
     videos: dict[str, Path], data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -677,6 +704,7 @@ def test_a_stream_stopped_before_its_first_frame_leaves_no_empty_bag(
         assert {c.topic: c.msgcount for c in reader.connections}["/stereo/depth"] == 2
 
 
+@PIPELINED
 def test_a_source_failing_mid_stream_keeps_the_summary(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -761,6 +789,7 @@ def test_size_help_says_what_another_shape_does(
     ) in text
 
 
+@PIPELINED
 def test_stream_asks_the_cameras_for_a_frame_rate(
     videos: dict[str, Path], monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -793,6 +822,7 @@ def test_stream_asks_the_cameras_for_a_frame_rate(
     assert "a bag has no rate to ask)" in text and "a file or a bag" not in text
 
 
+@PIPELINED
 def test_the_noise_hint_reads_the_frames_matched_when_the_source_shrinks_them(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -826,6 +856,7 @@ def test_the_noise_hint_reads_the_frames_matched_when_the_source_shrinks_them(
     assert sigma > 4.5 and len(hints) == 1
 
 
+@PIPELINED
 def test_stream_sizes_opencv_stereo_calib_output_by_the_frames(
     data_dir: Path,
     tmp_path: Path,
@@ -928,6 +959,7 @@ def _interrupted_cameras(args: Any, fps: float | None = None) -> StereoCamera:
     return StereoCamera(_Interrupted([]), _Interrupted([]))
 
 
+@PIPELINED
 def test_stream_sizes_stereo_calib_output_by_the_frames_delivered_not_the_mode_reported(
     data_dir: Path,
     tmp_path: Path,
@@ -977,6 +1009,7 @@ def test_stream_sizes_stereo_calib_output_by_the_frames_delivered_not_the_mode_r
     assert got[-1].image_size == (160, 120)
 
 
+@PIPELINED
 def test_stream_fits_a_calibration_to_the_frames_delivered_not_the_mode_reported(
     data_dir: Path,
 ) -> None:
@@ -1026,6 +1059,7 @@ def test_stream_fits_a_calibration_to_the_frames_delivered_not_the_mode_reported
             np.testing.assert_array_equal(disp, ref)
 
 
+@PIPELINED
 def test_a_stream_interrupted_before_its_first_pair_writes_strict_json(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1076,6 +1110,7 @@ def test_a_calibrated_streams_seconds_count_from_its_first_grab(data_dir: Path) 
         assert rep.fps == pytest.approx(1 / rep.seconds)
 
 
+@PIPELINED
 def test_a_calibrated_stream_interrupted_before_its_first_pair_writes_its_summary(
     data_dir: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1140,6 +1175,7 @@ def test_an_unknown_method_is_refused_before_the_first_grab(data_dir: Path) -> N
         ), rig
 
 
+@PIPELINED
 def test_a_stream_sized_by_its_first_pair_interrupted_before_it_writes_its_summary(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1181,6 +1217,7 @@ def test_a_stream_sized_by_its_first_pair_interrupted_before_it_writes_its_summa
         assert capsys.readouterr().out.startswith(f"0 pairs in 0.00 s ({ended}): 0.0 fps;")
 
 
+@PIPELINED
 def test_a_temporal_stream_stopped_before_its_first_pair_measured_no_noise(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1205,6 +1242,7 @@ def test_a_temporal_stream_stopped_before_its_first_pair_measured_no_noise(
     }
 
 
+@PIPELINED
 def test_a_bag_that_cannot_be_written_mid_stream_keeps_the_summary(
     videos: dict[str, Path], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1240,6 +1278,7 @@ def test_a_bag_that_cannot_be_written_mid_stream_keeps_the_summary(
     assert "ROS 2 bag written to b (2 of the 2 pairs processed, 14 messages)" in cap.err
 
 
+@PIPELINED
 def test_the_text_summary_of_no_pair_says_so_not_nan(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1266,6 +1305,7 @@ def test_the_text_summary_of_no_pair_says_so_not_nan(
     assert summary["stage_ms"]["match"] is None and summary["latency_ms"] is None
 
 
+@PIPELINED
 def test_a_bag_of_no_frame_is_not_said_written(
     videos: dict[str, Path],
     tmp_path: Path,
@@ -1334,6 +1374,7 @@ def test_the_frames_a_full_disk_undid_are_said(
 
 
 @pytest.mark.parametrize("pipelined", [False, True])
+@PIPELINED
 def test_the_temporal_figures_are_those_of_the_pairs_counted(
     videos: dict[str, Path], pipelined: bool
 ) -> None:
@@ -1397,6 +1438,7 @@ CLOSE_ERROR = (
 )
 
 
+@PIPELINED
 def test_a_bag_that_cannot_be_finished_keeps_the_summary(
     videos: dict[str, Path], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1428,6 +1470,7 @@ def test_a_bag_that_cannot_be_finished_keeps_the_summary(
     assert cap.err.strip().splitlines()[-1] == CLOSE_ERROR
 
 
+@PIPELINED
 def test_a_bag_that_cannot_be_finished_does_not_replace_an_earlier_error(
     videos: dict[str, Path], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1478,6 +1521,7 @@ def test_a_bag_that_cannot_be_finished_does_not_replace_an_earlier_error(
         assert cap.err.strip().splitlines() == [CLOSE_ERROR, last]
 
 
+@PIPELINED
 def test_a_camera_that_fails_to_close_still_lets_the_bag_be_finished(
     videos: dict[str, Path],
     tmp_path: Path,
@@ -1665,6 +1709,7 @@ def test_an_explicit_disparity_range_wins_over_the_homographies() -> None:
 
 
 @pytest.mark.parametrize("pipelined", [False, True])
+@PIPELINED
 def test_a_source_failing_on_the_first_pair_is_raised(pipelined: bool) -> None:
     """A source that fails on pair 0 (a frame of another shape) raises its SourceError: no
     pair done, no summary of a "source failed" run of nothing."""
@@ -1695,6 +1740,7 @@ class _HangsAfter:
 
 @pytest.mark.parametrize("pipelined", [False, True])
 @pytest.mark.parametrize("done", [0, 2])
+@PIPELINED
 def test_a_camera_whose_read_hangs_is_given_up(
     videos: dict[str, Path], pipelined: bool, done: int
 ) -> None:
@@ -1795,6 +1841,7 @@ class _SkippingRig(_FakeRig):
         pass
 
 
+@PIPELINED
 def test_the_pairs_a_realtime_stream_skipped_are_said(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1812,6 +1859,7 @@ def test_the_pairs_a_realtime_stream_skipped_are_said(
     )
 
 
+@PIPELINED
 def test_the_live_view_is_given_every_pair(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1892,6 +1940,7 @@ def test_a_calibration_is_sized_by_the_size_asked_before_the_size_delivered() ->
     assert _frame_size(cam) == (320, 240)
 
 
+@PIPELINED
 def test_a_temporal_stream_averages_up_to_255_pairs(
     capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -1936,6 +1985,7 @@ def test_each_floor_fit_reaches_on_ground(data_dir: Path) -> None:
     assert [p is not None for p in seen] == [g["found"] for g in rep.grounds]
 
 
+@PIPELINED
 def test_the_stream_command_passes_its_options_on(
     videos: dict[str, Path], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -2056,6 +2106,7 @@ def test_each_pairs_latency_runs_from_its_own_grab(
 
 
 @pytest.mark.parametrize("stop", [OSError("disk full"), KeyboardInterrupt()])
+@PIPELINED
 def test_the_grab_thread_runs_one_pair_ahead_and_is_joined_at_the_end(
     stop: BaseException,
 ) -> None:
@@ -2105,6 +2156,7 @@ def test_a_calibration_that_cannot_be_sized_closes_the_cameras(
     assert closed == [True]
 
 
+@PIPELINED
 def test_a_sizeless_source_interrupted_before_its_first_pair_is_not_asked_for_a_size(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -2145,6 +2197,7 @@ def test_the_view_listens_on_the_loopback_by_default() -> None:
 
 
 @pytest.mark.parametrize("json_out", [True, False])
+@PIPELINED
 def test_each_report_line_is_flushed_as_it_is_written(
     json_out: bool, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -2174,6 +2227,7 @@ def test_each_report_line_is_flushed_as_it_is_written(
 
 
 @pytest.mark.parametrize("pipelined", [False, True])
+@PIPELINED
 def test_the_warnings_of_the_grabbing_point_at_the_callers_line(pipelined: bool) -> None:
     """A source that ended before the other and frames resampled before ``temporal`` were warned
     about in :func:`_pairs`: unpipelined that named a line of stream.py, pipelined one of
@@ -2196,6 +2250,7 @@ def test_the_warnings_of_the_grabbing_point_at_the_callers_line(pipelined: bool)
     ]
 
 
+@PIPELINED
 def test_the_warnings_of_a_streams_pairs_point_at_the_callers_line(data_dir: Path) -> None:
     """The warnings :func:`run_stream` gives itself of its pairs (noisy cameras, rows that do not
     agree) name the caller's line, pipelined or not."""
@@ -2219,6 +2274,7 @@ def test_the_warnings_of_a_streams_pairs_point_at_the_callers_line(data_dir: Pat
 
 
 @pytest.mark.parametrize("pipelined", [False, True])
+@PIPELINED
 def test_a_cameras_own_warnings_point_at_the_callers_line(tmp_path: Path, pipelined: bool) -> None:
     """A StereoCamera's warning of its own (a source delivering another size, resized) raised
     in the grabbing thread of a pipelined stream named threading.py; the stream hands it to
@@ -2239,6 +2295,7 @@ def test_a_cameras_own_warnings_point_at_the_callers_line(tmp_path: Path, pipeli
     assert said == [("right source", __file__), ("the cameras ", __file__)], said
 
 
+@PIPELINED
 def test_the_calibration_fitted_to_the_frames_is_said_at_the_callers_line(
     data_dir: Path, tmp_path: Path
 ) -> None:
