@@ -2135,6 +2135,56 @@ def test_the_grab_thread_runs_one_pair_ahead_and_is_joined_at_the_end(
     assert time.monotonic() - t0 < 3.0  # stopped, not waited for until the join's timeout
 
 
+class _WarningRig(_FakeRig):
+    """A rig whose every read warns (a source's own warning, held by the grab thread when
+    pipelined), the read that finds its end too."""
+
+    def read(self) -> Any:
+        from stereovision._validate import source_warning
+
+        source_warning(f"read {self.count}")
+        return super().read()
+
+
+@PIPELINED
+def test_a_sources_own_warnings_take_no_slot_and_the_last_one_is_given() -> None:
+    """A source's warnings ride with its pairs without taking a grab slot: a mutation audit
+    giving a slot back for each (the grab thread ran two pairs ahead, aging a live camera's
+    frames) and one handing over the held warnings only after the end was met (the last
+    read's warning lost) both survived the stream tests."""
+    rig = _WarningRig([_frame(i) for i in range(4)])
+    read: list[int] = []
+
+    def on_result(left: np.ndarray, res: Any) -> None:
+        time.sleep(0.3)  # a slow output: room for the grab thread to run ahead if it could
+        read.append(rig.count)
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rep = run_stream(rig, max_disparity=8, check=False, on_result=on_result)  # type: ignore[arg-type]
+    assert (rep.frames, rep.ended) == (4, "end of stream")
+    assert read == [2, 3, 4, 4]  # one pair ahead of the one matched, not more
+    said = [(str(w.message), w.filename) for w in caught]
+    assert said == [(f"read {i}", __file__) for i in range(5)], said
+
+
+@PIPELINED
+def test_the_warning_of_a_read_that_fails_is_given() -> None:
+    """A source's warning held by the grab thread on the read that then fails reaches the
+    caller before the failure ends the stream, as unpipelined: a mutation audit dropping the
+    hand-over on the grab thread's error path survived."""
+    from stereovision.capture import SourceError
+
+    for pipelined in (False, True):
+        rig = _WarningRig([_frame(0), _frame(1), SourceError("broken frame", end=False)])
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            rep = run_stream(rig, max_disparity=8, check=False, pipelined=pipelined)  # type: ignore[arg-type]
+        assert (rep.frames, rep.ended, rep.error) == (2, "source failed", "broken frame")
+        said = [(str(w.message), w.filename) for w in caught]
+        assert said == [(f"read {i}", __file__) for i in range(3)], (pipelined, said)
+
+
 def test_a_calibration_that_cannot_be_sized_closes_the_cameras(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
