@@ -781,3 +781,20 @@ def test_non_negative_arguments_must_be_finite(
     says = f"{name}: expected a non-negative number, got inf"
     with pytest.raises(ValueError, match=f"^{re.escape(says)}$"):
         call(d, g, float("inf"))
+
+
+def test_gabor_lr_coarse_levels_reaches_the_kernel(crop: tuple[np.ndarray, np.ndarray]) -> None:
+    """``lr_coarse_levels`` and ``iters_finest`` both default to 1: a mutation audit passing
+    each for the other left every test passing. Without the left-right check the coarse levels
+    of the backward pass do nothing; iterations at full resolution do; 5 is named."""
+    gl, gr = (as_gray_float(a) for a in crop)
+
+    def run(**kw: object) -> np.ndarray:
+        return _core.gabor_disparity(gl, gr, 0.0, 32.0, lr_check=False, **kw)[0]
+
+    one = run()
+    for levels in (0, 3):
+        np.testing.assert_array_equal(run(lr_coarse_levels=levels), one)
+    assert not np.array_equal(run(iters_finest=3), one, equal_nan=True)
+    with pytest.raises(ValueError, match=re.escape("`lr_coarse_levels`: must be <= 4")):
+        _core.gabor_disparity(gl, gr, 0.0, 32.0, lr_coarse_levels=5)
