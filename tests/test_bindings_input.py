@@ -798,3 +798,24 @@ def test_gabor_lr_coarse_levels_reaches_the_kernel(crop: tuple[np.ndarray, np.nd
     assert not np.array_equal(run(iters_finest=3), one, equal_nan=True)
     with pytest.raises(ValueError, match=re.escape("`lr_coarse_levels`: must be <= 4")):
         _core.gabor_disparity(gl, gr, 0.0, 32.0, lr_coarse_levels=5)
+
+
+def test_hopfield_compat_theta_and_slope_reach_their_slots(
+    crop: tuple[np.ndarray, np.ndarray],
+) -> None:
+    """``compat_theta`` and ``compat_slope`` are both float and both 2.0 by default: a
+    mutation audit writing each into the other's slot was caught only by the names in the
+    negative-value messages. A slope of 0 makes the compatibility 0 at every distance, so the
+    crossing no longer matters; with a slope it does."""
+    gl, gr = (as_gray_float(a) for a in crop)
+
+    def run(theta: float, slope: float) -> tuple[np.ndarray, np.ndarray]:
+        params = {"max_disparity": 32, "compat_theta": theta, "compat_slope": slope}
+        m, trace, _ = _core.hopfield_match(gl, gr, params)
+        return m, trace
+
+    flat = run(0.5, 0.0)
+    assert len(flat[0]) > 50
+    for got, want in zip(run(8.0, 0.0), flat, strict=True):
+        np.testing.assert_array_equal(got, want)
+    assert not np.array_equal(run(0.5, 2.0)[1], run(8.0, 2.0)[1])
