@@ -819,3 +819,14 @@ def test_hopfield_compat_theta_and_slope_reach_their_slots(
     for got, want in zip(run(8.0, 0.0), flat, strict=True):
         np.testing.assert_array_equal(got, want)
     assert not np.array_equal(run(0.5, 2.0)[1], run(8.0, 2.0)[1])
+
+
+@pytest.mark.parametrize("name", ["prior_radius_sigmas", "prior_width_sigmas"])
+def test_mcgm_prior_slots_are_their_own(name: str, crop: tuple[np.ndarray, np.ndarray]) -> None:
+    """``prior_radius_sigmas`` and ``prior_width_sigmas`` are neighbouring float slots: a
+    mutation audit writing each into the other left every test passing (test_mcgm's reference
+    figures included: a radius of 2.8 and a width of 4 changed no asserted figure). The kernel
+    names the slot a negative value reached."""
+    gl, gr = (as_gray_float(a) for a in crop)
+    with pytest.raises(ValueError, match=f"^invalid parameter `{name}`"):
+        _core.mcgm_match(gl, gr, {"max_disparity": 32, name: -1.0})
