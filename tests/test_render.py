@@ -1566,3 +1566,73 @@ def test_view_without_display_checks_its_folder_before_the_work(tmp_path, monkey
         f"write in {Path.cwd()} (Permission denied); -o names another file\n"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["cloud.ply"]
+
+
+def test_clipping_far_plane_keeps_the_farthest_few_percent():
+    """Far: FAR_FACTOR x the 99.5th percentile distance, so a background of 4 % of the points
+    (a far wall) stays inside the range; the 95th percentile put it 2.5 m beyond the far plane."""
+    pts = np.zeros((1000, 3))
+    pts[:, 2] = 1.0
+    pts[-40:, 2] = 10.0
+    near, far = render.robust_clipping_range(pts, [0, 0, 0])
+    assert near == pytest.approx(render.NEAR_FACTOR * 1.0)
+    assert far == pytest.approx(render.FAR_FACTOR * 10.0)
+
+
+def test_render_view_size_with_intrinsics_counts_only_its_width():
+    """With intrinsics only size's width counts: a 100 px wide render of a 4:3 camera is
+    75 px tall whatever height was asked (scaling by the height gave a 200 x 150 picture)."""
+    pts = np.array([[0.0, 0.0, 2.0], [0.1, 0.1, 2.0]])
+    intr = render.Intrinsics(f=400.0, cx=199.5, cy=149.5, width=400, height=300)
+    img = render.render_view(render.point_cloud(pts), intrinsics=intr, size=(100, 150))
+    assert img.shape == (75, 100, 3)
+
+
+def test_points_in_view_edges_are_the_outer_pixels_edges():
+    """A point projecting onto the right (bottom) edge of the last pixel, x = w - 0.5, is out
+    of the picture; one on the left (top) edge of the first pixel, x = -0.5, is in."""
+    intr = render.Intrinsics(f=100.0, cx=49.5, cy=49.5, width=100, height=100)
+    view = CameraControls()
+
+    def count(p: list[float]) -> int:
+        return render.points_in_view(np.array([p]), view, (100, 100), intr)
+
+    assert count([-0.5, 0.0, 1.0]) == 1 and count([0.0, -0.5, 1.0]) == 1
+    assert count([0.5, 0.0, 1.0]) == 0 and count([0.0, 0.5, 1.0]) == 0
+
+
+def test_is_blank_below_the_fraction_only():
+    """Blank means fewer than min_fraction of the pixels differ from the background: exactly
+    1 % of them drawn is not blank."""
+    img = np.empty((100, 100, 3), np.uint8)
+    img[:] = render.BACKGROUND
+    img[0, :] = 255  # 100 of 10000 pixels
+    assert not render.is_blank(img, min_fraction=0.01)
+    img[0, 0] = render.BACKGROUND
+    assert render.is_blank(img, min_fraction=0.01)
+
+
+def test_view_source_records_the_count_when_a_single_point_is_left_out(tmp_path):
+    """A cloud shown without one of its points records its full count (POINTS_IN_SOURCE)."""
+    from stereovision.io import write_ply
+
+    pts = np.random.default_rng(3).uniform([-1, -1, 2], [1, 1, 4], (50, 3)).astype(np.float32)
+    path = tmp_path / "c.ply"
+    write_ply(path, pts, np.full((50, 3), 200, np.uint8))
+    cloud, _ = render.load_view_source(path, max_points=49)
+    assert cloud.n_points == 49
+    assert cloud.field_data[render.POINTS_IN_SOURCE].tolist() == [50]
+
+
+def test_surface_mesh_is_drawn_with_its_texture(result, mesh):
+    """add_geometry draws a surface mesh with the left image as its texture (the per-vertex
+    RGB colours only without one): the actor carries the texture of texture_of."""
+    plotter = render.make_plotter((64, 48))
+    try:
+        actor = render.add_geometry(plotter, mesh)
+        tex = actor.GetTexture()
+        assert tex is not None
+        h, w = result.left_rectified.shape[:2]
+        assert tex.GetInput().GetDimensions()[:2] == (w, h)
+    finally:
+        plotter.close()
