@@ -428,6 +428,13 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     (tw, _), _ = cv2.getTextSize(title, _FONT, font_scale, 1)
     if tw > width - 2 * _MARGIN:
         font_scale *= (width - 2 * _MARGIN) / tw
+        # cv2 rounds each glyph's advance to whole pixels: at a small scale the text is wider
+        # than the ratio says (200 x's 401 px in 308) and ran out of the picture
+        while (
+            font_scale > 1e-3
+            and cv2.getTextSize(title, _FONT, font_scale, 1)[0][0] > width - 2 * _MARGIN
+        ):
+            font_scale *= 0.95
     cv2.putText(img, title, (_MARGIN, 23), _FONT, font_scale, _WHITE, 1, cv2.LINE_AA)
     return Overview(
         image=img,
