@@ -665,3 +665,21 @@ def test_depth_ticks_are_even_steps_within_a_decade_and_1_2_5_beyond() -> None:
     ov = overview_image(_result_with_depth(288, 384, 1.5, 12.5), "t")
     assert [t[1] for t in ov.bars["depth"].ticks] == ["1.5 m", "2", "4", "6", "8", "12.5 m"]
     assert _nice_values(0.3, 60.0) == [0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 50.0]
+
+
+def test_tick_values_include_ends_that_are_round_values() -> None:
+    """A range's end that is itself a round value is one of its ticks: 1-2-5 steps of 1 to
+    10 m are 1, 2, 5 and 10 (the 1 was left out), even steps of 0-10 run up to 10 (the 10
+    was left out)."""
+    from stereovision.overview import _linear_ticks, _nice_values
+
+    assert _nice_values(1.0, 10.0) == [1.0, 2.0, 5.0, 10.0]
+    assert _linear_ticks(0.0, 10.0) == [0.0, 2.0, 4.0, 6.0, 8.0, 10.0]
+
+
+def test_a_tall_image_narrower_than_a_panel_is_not_downscaled() -> None:
+    """PANEL_WIDTH bounds the panels' width: a portrait image 400 px wide and 700 tall is
+    shown at full size (scaling its height to 640 shrank it to 366 x 640)."""
+    ov = overview_image(_small_result(700, 400), "t")
+    assert ov.scale == 1.0
+    assert ov.panels["left"][2:] == (400, 700)
