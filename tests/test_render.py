@@ -825,9 +825,9 @@ def test_view_shows_a_big_cloud_decimated_and_leaves_the_file(tmp_path, capsys):
     kept = tmp_path / "shot.previous.png"
     assert io.out == f"1000 points -> {shot} (the one it replaced kept as {kept})\n"
     assert "note" not in io.err
-    assert cli.main(["view", str(ply), "-o", str(shot), "--max-points", "-5"]) == 2
+    assert cli.main(["view", str(ply), "-o", str(shot), "--max-points", "-1"]) == 2
     assert capsys.readouterr().err == (
-        "stereovision: error: --max-points: expected 0 (all) or more, got -5\n"
+        "stereovision: error: --max-points: expected 0 (all) or more, got -1\n"
     )
 
 
@@ -1636,3 +1636,14 @@ def test_surface_mesh_is_drawn_with_its_texture(result, mesh):
         assert tex.GetInput().GetDimensions()[:2] == (w, h)
     finally:
         plotter.close()
+
+
+def test_view_of_a_surface_says_its_triangles(result, mesh, tmp_path, capsys, monkeypatch):
+    """A textured surface (a scene folder's) is said as its points and triangles."""
+    monkeypatch.setattr(render, "load_view_source", lambda source, max_points: (mesh, None))
+    shot = tmp_path / "shot.png"
+    args = _view_args(tmp_path, shot)
+    assert args.func(args) == 0
+    out = capsys.readouterr().out
+    assert out == f"{mesh.n_points} points, {mesh.n_faces} triangles -> {shot}\n"
+    assert mesh.n_faces > 0
