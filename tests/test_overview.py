@@ -683,3 +683,31 @@ def test_a_tall_image_narrower_than_a_panel_is_not_downscaled() -> None:
     ov = overview_image(_small_result(700, 400), "t")
     assert ov.scale == 1.0
     assert ov.panels["left"][2:] == (400, 700)
+
+
+def test_a_map_without_any_value_has_no_colour_bar() -> None:
+    """A pair matched nowhere: its maps are black and carry no colour bar (there is no range
+    to label; a 0-1 bar was drawn beside the empty disparity map)."""
+    res = _small_result(40, 60)
+    res.disparity[:] = np.nan
+    res.depth[:] = np.nan
+    ov = overview_image(res, "t")
+    assert ov.bars == {}
+    for name in ("disparity", "depth", "confidence"):
+        x, y, w, h = ov.panels[name]
+        assert not ov.image[y : y + h, x : x + w].any()
+
+
+def test_the_depth_caption_drops_its_reason_only_where_it_would_reach_the_labels() -> None:
+    """The reasons for the depth holes are left out of the caption exactly when the whole
+    caption would reach over the bar's label column (left of it, they stay)."""
+    full = "depth (m) on 97.5 %, none where filled"
+    text_w = cv2.getTextSize(full, cv2.FONT_HERSHEY_SIMPLEX, 0.5, 1)[0][0]
+    reach = 8 + 16 + 7  # bar gap, bar, label offset right of the panel
+    for width, caption in ((text_w - reach, full), (text_w - reach - 20, full.split(",")[0])):
+        res = _small_result(40, width)
+        res.disparity[np.isnan(res.disparity)] = 5.0  # no hole but the filled row
+        res.depth[:] = 40.0 / res.disparity
+        res.depth[0] = np.nan  # one row of 40 filled: a disparity, confidence 0, no depth
+        res.confidence[0] = 0.0
+        assert overview_image(res, "t").captions["depth"] == caption
