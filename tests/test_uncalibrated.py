@@ -907,3 +907,18 @@ def test_the_same_pair_gives_the_same_rectification(data_dir: Path) -> None:
     np.testing.assert_array_equal(again.H2, first.H2)
     np.testing.assert_array_equal(again.F, first.F)
     assert again.matches == first.matches and again.size == first.size
+
+
+def test_matches_no_fundamental_matrix_fits_are_refused_by_name(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Cones' first 30 mutual matches (from one corner of the scene) give MAGSAC++ no model, and
+    OpenCV 5 then fails an assertion: ``cv2.error`` reached the caller (and the CLI) instead of
+    the refusal of too few matches fitting one fundamental matrix."""
+    import stereovision.uncalibrated as uc
+
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    original = uc._mutual_matches
+    monkeypatch.setattr(uc, "_mutual_matches", lambda dl, dr: original(dl, dr)[:30])
+    with pytest.raises(ValueError, match=r"^0 of 30 feature matches fit one fundamental matrix"):
+        rectify_uncalibrated(sc.left, sc.right)

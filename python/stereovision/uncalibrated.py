@@ -653,7 +653,12 @@ def rectify_uncalibrated(
     p1, p2 = pl[pairs[:, 0]], pr[pairs[:, 1]]
     if float(np.median(np.linalg.norm(p1 - p2, axis=1))) < 0.5:
         raise ValueError("the two images show the same view (no parallax): nothing to rectify")
-    found, mask = cv2.findFundamentalMat(p1, p2, cv2.USAC_MAGSAC, float(ransac_px), 0.9999, 10000)
+    try:
+        found, mask = cv2.findFundamentalMat(
+            p1, p2, cv2.USAC_MAGSAC, float(ransac_px), 0.9999, 10000
+        )
+    except cv2.error:  # MAGSAC++ found no model: OpenCV 5 asserts instead of returning None
+        found, mask = None, None
     inl = np.zeros(len(p1), bool) if mask is None else mask.ravel().astype(bool)
     if found is None or found.shape != (3, 3) or inl.sum() < MIN_MATCHES:
         raise ValueError(
