@@ -909,6 +909,51 @@ def test_the_same_pair_gives_the_same_rectification(data_dir: Path) -> None:
     assert again.matches == first.matches and again.size == first.size
 
 
+def _refusal(*args: object, **kwargs: object) -> str:
+    """:func:`rectify_uncalibrated`'s refusal of a pair ("" when it rectifies it)."""
+    try:
+        rectify_uncalibrated(*args, **kwargs)  # type: ignore[arg-type]
+    except ValueError as exc:
+        return str(exc)
+    return ""
+
+
+def test_a_view_moved_under_half_a_pixel_has_no_parallax(data_dir: Path) -> None:
+    """A mutation audit found the no-parallax floor unasserted beyond an identical pair: a view
+    moved 0.3 px (its matches' median movement, under the 0.5 px floor) is the same view; one
+    moved 0.8 px is not refused as such."""
+    left = load_scene(data_dir / "middlebury2003" / "cones").left
+    h, w = left.shape[:2]
+    for dx, same in ((0.3, True), (0.8, False)):
+        moved = cv2.warpAffine(left, np.float64([[1, 0, -dx], [0, 1, 0]]), (w, h))
+        assert ("no parallax" in _refusal(left, moved)) is same, dx
+
+
+def test_thirty_matches_and_thirty_that_fit_are_enough(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A mutation audit found both floors of :data:`MIN_MATCHES` (30) unasserted at their edge:
+    30 SIFT matches are not refused by count, and 30 matches that fit ``F`` are not refused as
+    too few inliers (cones' first 30 mutual matches; its inliers cut to the first 30)."""
+    import stereovision.uncalibrated as uc
+
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    original = uc._mutual_matches
+    with monkeypatch.context() as m:
+        m.setattr(uc, "_mutual_matches", lambda dl, dr: original(dl, dr)[:30])
+        assert "feature matches between" not in _refusal(sc.left, sc.right)
+    fundamental = cv2.findFundamentalMat
+
+    def thirty_fit(*args: object) -> tuple[np.ndarray, np.ndarray]:
+        fm, mask = fundamental(*args)
+        mask[np.flatnonzero(mask.ravel())[30:]] = 0
+        return fm, mask
+
+    monkeypatch.setattr(uc.cv2, "findFundamentalMat", thirty_fit)
+    rect = rectify_uncalibrated(sc.left, sc.right)
+    assert rect.matches == 30
+
+
 def test_matches_no_fundamental_matrix_fits_are_refused_by_name(
     data_dir: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
