@@ -20,6 +20,7 @@ import pytest
 
 from stereovision.calibrate import calibrate, calibrate_from_video
 from stereovision.charuco import (
+    MIN_CORNERS,
     CharucoBoard,
     board_png,
     dictionary_name,
@@ -813,3 +814,13 @@ def test_rendered_board_grey_levels_run_from_25_to_230() -> None:
     img = render_charuco(BOARD, K1, D1, rv, tv, supersample=SS, background=60)
     assert img.min() == 25 and img.max() == 230
     assert img[0, 0] == 60
+
+
+def test_three_squares_a_side_is_a_board_and_two_are_not() -> None:
+    """A mutation audit found the floor of 3 squares a side unasserted at its edge (``<= 3``
+    refused a 3x4 board): 3x4 squares make 2x3 = 6 inner corners (:data:`MIN_CORNERS`)."""
+    board = CharucoBoard("3x4", 0.03, 0.02, "DICT_4X4_50")
+    assert board.inner == (2, 3) and board.n_corners == MIN_CORNERS and board.n_markers == 6
+    for squares in ("2x4", "4x2"):
+        with pytest.raises(ValueError, match="each at least 3"):
+            CharucoBoard(squares, 0.03, 0.02)
