@@ -967,3 +967,17 @@ def test_matches_no_fundamental_matrix_fits_are_refused_by_name(
     monkeypatch.setattr(uc, "_mutual_matches", lambda dl, dr: original(dl, dr)[:30])
     with pytest.raises(ValueError, match=r"^0 of 30 feature matches fit one fundamental matrix"):
         rectify_uncalibrated(sc.left, sc.right)
+
+
+def test_a_swapped_share_at_the_threshold_is_refused(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A mutation audit found the swapped-share threshold unasserted at its edge (``<`` for
+    ``<=``): cones swapped has none of its matches further right in the left image (its
+    disparities are 5 px and more), so a threshold of exactly 0 still refuses it."""
+    import stereovision.uncalibrated as uc
+
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    monkeypatch.setattr(uc, "_SWAPPED_SHARE", 0.0)
+    with pytest.raises(ValueError, match=r"left and right look swapped: 0 % of the \d+"):
+        rectify_uncalibrated(sc.right, sc.left)
