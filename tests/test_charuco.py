@@ -824,3 +824,26 @@ def test_three_squares_a_side_is_a_board_and_two_are_not() -> None:
     for squares in ("2x4", "4x2"):
         with pytest.raises(ValueError, match="each at least 3"):
             CharucoBoard(squares, 0.03, 0.02)
+
+
+def test_an_image_of_exactly_max_image_pixels_is_made(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The pixel limit is on the image as drawn, margins included, and inclusive: a ChArUco
+    board's 360x280 image and a 9x6 chessboard's 1200x900 one are made at a limit of their
+    own size and refused one pixel under it."""
+    import stereovision.charuco as ch
+
+    board = CharucoBoard("7x5", 0.03, 0.02, "DICT_4X4_50")
+    for limit, made in ((360 * 280, True), (360 * 280 - 1, False)):
+        monkeypatch.setattr(ch, "MAX_IMAGE_PIXELS", limit)
+        if made:
+            assert board.image(40).shape == (280, 360)
+        else:
+            with pytest.raises(ValueError, match="a 360x280 image is over"):
+                board.image(40)
+    for limit, made in ((1200 * 900, True), (1200 * 900 - 1, False)):
+        monkeypatch.setattr(ch, "MAX_IMAGE_PIXELS", limit)
+        if made:
+            assert board_png((9, 6), 0.01, dpi=254)[1] == (1200, 900)
+        else:
+            with pytest.raises(ValueError, match="a 9x6 chessboard at 100 px per square is too"):
+                board_png((9, 6), 0.01, dpi=254)
