@@ -981,3 +981,10 @@ def test_a_swapped_share_at_the_threshold_is_refused(
     monkeypatch.setattr(uc, "_SWAPPED_SHARE", 0.0)
     with pytest.raises(ValueError, match=r"left and right look swapped: 0 % of the \d+"):
         rectify_uncalibrated(sc.right, sc.left)
+
+
+def test_loading_a_directory_is_file_not_found(tmp_path: Path) -> None:
+    """A mutation audit found ``is_file`` unasserted (``exists`` let a directory through, to an
+    IsADirectoryError from reading it): a directory given as the file is named as not found."""
+    with pytest.raises(FileNotFoundError, match="rectification file not found: "):
+        UncalibratedRectification.load(tmp_path)
