@@ -847,3 +847,26 @@ def test_an_image_of_exactly_max_image_pixels_is_made(monkeypatch: pytest.Monkey
         else:
             with pytest.raises(ValueError, match="a 9x6 chessboard at 100 px per square is too"):
                 board_png((9, 6), 0.01, dpi=254)
+
+
+def test_a_layout_tie_keeps_the_current_layout(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A mutation audit found the layout's tie unasserted (``>=`` chose the legacy one): when
+    both layouts give as many corners, the board keeps OpenCV's current layout, legacy only
+    for more corners."""
+    import stereovision.charuco as ch
+
+    board = CharucoBoard("10x8", 0.03, 0.022, "DICT_5X5_100")
+    img = CharucoBoard("10x8", 0.03, 0.022, "DICT_5X5_100", legacy=False).image(40)
+    found = {False: 12, True: 12}
+    fake = (np.arange(20), np.zeros((20, 2)))
+
+    def corners(image: Any, b: CharucoBoard) -> Any:
+        n = found[bool(b.legacy)]
+        return (fake[0][:n], fake[1][:n])
+
+    monkeypatch.setattr(ch, "find_charuco_corners", corners)
+    resolved = board.resolve(img)
+    assert resolved is not None and resolved.legacy is False
+    found[True] = 13
+    resolved = board.resolve(img)
+    assert resolved is not None and resolved.legacy is True
