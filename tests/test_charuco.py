@@ -870,3 +870,11 @@ def test_a_layout_tie_keeps_the_current_layout(monkeypatch: pytest.MonkeyPatch) 
     found[True] = 13
     resolved = board.resolve(img)
     assert resolved is not None and resolved.legacy is True
+
+
+def test_render_refuses_over_2000_px_per_square() -> None:
+    """A mutation audit found render_charuco's bound unasserted (20000 let a small board through
+    to a 10000x12000 lookup image): 2001 px per square is refused by name."""
+    board = CharucoBoard("3x4", 0.03, 0.02, "DICT_4X4_50")
+    with pytest.raises(ValueError, match="pixels_per_square"):
+        render_charuco(board, K1, D1, np.zeros(3), np.array([0, 0, 0.5]), pixels_per_square=2001)
