@@ -611,6 +611,34 @@ pub(crate) mod tests {
         assert_eq!(unsafe { setrlimit(RLIMIT_AS, &l) }, 0, "setrlimit failed");
     }
 
+    /// Runs this test binary's ignored test `name` as a child (one rayon thread, one malloc
+    /// arena, `SV_OOM_CHILD` set, so that it may cap its own address space) and returns its
+    /// stdout; fails the test when the child fails (an abort on a failed allocation).
+    #[cfg(target_os = "linux")]
+    pub(crate) fn run_oom_child(name: &str) -> String {
+        let out = std::process::Command::new(std::env::current_exe().unwrap())
+            .args([
+                name,
+                "--exact",
+                "--ignored",
+                "--nocapture",
+                "--test-threads=1",
+            ])
+            .env("SV_OOM_CHILD", "1")
+            .env("RAYON_NUM_THREADS", "1")
+            .env("MALLOC_ARENA_MAX", "1")
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(
+            out.status.success(),
+            "the child failed ({}): {stdout}{}",
+            out.status,
+            String::from_utf8_lossy(&out.stderr)
+        );
+        stdout
+    }
+
     /// This process's mapped address space (`VmSize`), in bytes.
     #[cfg(target_os = "linux")]
     pub(crate) fn vm_size() -> usize {
@@ -650,26 +678,7 @@ pub(crate) mod tests {
         // segment_fill collected a segment's points, holes and residuals with collect/vec!
         // (up to 21 bytes a pixel for one large segment, more than the checked tables): a
         // failed allocation aborted the process (SIGABRT) instead of returning OutOfMemory.
-        let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args([
-                "segment::tests::plane_fit_under_a_memory_limit",
-                "--exact",
-                "--ignored",
-                "--nocapture",
-                "--test-threads=1",
-            ])
-            .env("SV_OOM_CHILD", "1")
-            .env("RAYON_NUM_THREADS", "1")
-            .env("MALLOC_ARENA_MAX", "1")
-            .output()
-            .unwrap();
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(
-            out.status.success(),
-            "the child failed ({}): {stdout}{}",
-            out.status,
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let stdout = run_oom_child("segment::tests::plane_fit_under_a_memory_limit");
         assert!(
             stdout.contains("child: error: out of memory: the plane fill's segment fit needs "),
             "{stdout}"

@@ -1531,25 +1531,8 @@ mod tests {
         // The path buffers (the 8-path passes' six rows of w (n + 2) path costs, the 3-path
         // vertical path's two and its rows in flight) were allocated with vec!: a failed
         // allocation aborted the process (SIGABRT) instead of returning OutOfMemory.
-        let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args([
-                "matching::sgm::tests::path_buffers_under_a_memory_limit",
-                "--exact",
-                "--ignored",
-                "--nocapture",
-                "--test-threads=1",
-            ])
-            .env("SV_OOM_CHILD", "1")
-            .env("RAYON_NUM_THREADS", "1")
-            .env("MALLOC_ARENA_MAX", "1")
-            .output()
-            .unwrap();
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        assert!(
-            out.status.success(),
-            "the child failed ({}): {stdout}{}",
-            out.status,
-            String::from_utf8_lossy(&out.stderr)
+        let stdout = crate::segment::tests::run_oom_child(
+            "matching::sgm::tests::path_buffers_under_a_memory_limit",
         );
         for want in [
             "child: 32768 3: error: out of memory: the census matcher's vertical path costs \
