@@ -291,13 +291,8 @@ mod tests {
     /// occur) of several shapes against the plain rule on the rows and on the columns.
     #[test]
     fn marks_equal_the_plain_rule_on_random_maps() {
-        let mut s = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = move |n: u64| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s % n
-        };
+        let mut rng = crate::testing::xorshift(0x9e37_79b9_7f4a_7c15);
+        let mut next = move |n: u64| rng() % n;
         let transpose = |a: &[f32], w: usize, h: usize| -> Vec<f32> {
             (0..w * h).map(|i| a[(i % h) * w + i / h]).collect()
         };

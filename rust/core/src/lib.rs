@@ -26,6 +26,8 @@ pub mod refine;
 pub mod segment;
 pub(crate) mod simd;
 pub mod temporal;
+#[cfg(test)]
+pub(crate) mod testing;
 pub mod triangulation;
 
 pub use error::{CoreError, Result};

@@ -1181,13 +1181,8 @@ pub(crate) mod tests {
         // One segment: a plane with outliers of every size (so later refits still drop some),
         // and holes; integer-valued residuals hit the cut exactly.
         let (w, h) = (9, 7);
-        let mut s = 0x2545_f491_4f6c_dd1du64;
-        let mut next = move |n: u64| {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            s % n
-        };
+        let mut rng = crate::testing::xorshift(0x2545_f491_4f6c_dd1d);
+        let mut next = move |n: u64| rng() % n;
         let labels = vec![0u32; w * h];
         let (mut changed, mut filled) = (0, 0);
         for round in 0..200 {

@@ -386,15 +386,8 @@ mod tests {
 
     /// Deterministic integers in `0..levels`.
     fn noise(n: usize, seed: u64, levels: u64) -> Vec<u64> {
-        let mut s = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
-        (0..n)
-            .map(|_| {
-                s ^= s << 13;
-                s ^= s >> 7;
-                s ^= s << 17;
-                s % levels
-            })
-            .collect()
+        let mut rng = crate::testing::xorshift(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1);
+        (0..n).map(|_| rng() % levels).collect()
     }
 
     /// `M` straight from its definition (C.1) at one pixel: per direction the 5x5 window of

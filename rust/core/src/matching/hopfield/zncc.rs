@@ -824,13 +824,9 @@ mod tests {
     use crate::image::Image;
 
     /// Xorshift noise in [0, 1), one stream per seed.
-    fn unit_noise(mut s: u64) -> impl FnMut() -> f32 {
-        move || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        }
+    fn unit_noise(s: u64) -> impl FnMut() -> f32 {
+        let mut rng = crate::testing::xorshift(s);
+        move || (rng() >> 40) as f32 / (1u64 << 24) as f32
     }
 
     #[test]
