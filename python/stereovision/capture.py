@@ -414,6 +414,14 @@ _READ_TIMEOUT: contextvars.ContextVar[float | None] = contextvars.ContextVar(
 )
 
 
+def check_read_timeout(timeout: float | None) -> None:
+    """Refuse a ``read_timeout`` that is not a positive number of seconds or None (checked by
+    :func:`read_within`, and by :func:`capture` and :func:`~stereovision.stream.run_stream`
+    before they open anything)."""
+    if timeout is not None and not timeout > 0:
+        raise ValueError(f"read_timeout: expected a positive number of seconds, got {timeout}")
+
+
 def read_within(camera: Any, timeout: float | None = DEFAULT_READ_TIMEOUT) -> StereoFrame:
     """``camera.read()``, its native grab given up after ``timeout`` seconds.
 
@@ -444,8 +452,7 @@ def read_within(camera: Any, timeout: float | None = DEFAULT_READ_TIMEOUT) -> St
     ValueError
         If ``timeout`` is not a positive number of seconds (or None).
     """
-    if timeout is not None and not timeout > 0:
-        raise ValueError(f"read_timeout: expected a positive number of seconds, got {timeout}")
+    check_read_timeout(timeout)
     token = _READ_TIMEOUT.set(timeout)
     try:
         return camera.read()  # type: ignore[no-any-return]
@@ -1902,8 +1909,7 @@ def capture(
         raise ValueError(f"count: expected a positive number of pairs, got {count!r}")
     if every <= 0:
         raise ValueError(f"every: expected a positive integer, got {every!r}")
-    if read_timeout is not None and not read_timeout > 0:
-        raise ValueError(f"read_timeout: expected a positive number of seconds, got {read_timeout}")
+    check_read_timeout(read_timeout)
     if chessboard and charuco is not None:
         raise ValueError("chessboard and charuco: give one calibration target, not both")
     tf = None

@@ -47,6 +47,7 @@ from stereovision.capture import (
     StereoCamera,
     StereoFrame,
     add_source_args,
+    check_read_timeout,
     cli_read_timeout,
     open_source,
     read_within,
@@ -768,8 +769,7 @@ def run_stream(
 
     if frames is not None and frames <= 0:
         raise ValueError(f"frames: expected a positive number, got {frames}")
-    if read_timeout is not None and not read_timeout > 0:
-        raise ValueError(f"read_timeout: expected a positive number of seconds, got {read_timeout}")
+    check_read_timeout(read_timeout)
     if homographies is not None:
         if calib is not None:
             raise ValueError("homographies and calib: give one way to rectify the pairs")
