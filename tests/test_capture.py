@@ -12,8 +12,9 @@ import sys
 import threading
 import time
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import cv2
 import numpy as np
@@ -2119,6 +2120,114 @@ def test_cli_read_timeout_reaches_the_read(
     code, _ = run()
     assert code == 0
     assert slow_cameras and set(slow_cameras) == {capmod.DEFAULT_READ_TIMEOUT}
+
+
+class _WedgedDevice:
+    """A ``cv2.VideoCapture`` stand-in whose constructor never returns for the device indices
+    in ``wedged`` (a wedged V4L2 device) until ``unplug`` is set (3 s at most, so that the old
+    code's test ends); the others open at once, and every one made records its release."""
+
+    wedged: ClassVar[set[int]] = set()
+    unplug = threading.Event()
+    made: ClassVar[list[_WedgedDevice]] = []
+
+    def __init__(self, src: Any, *args: Any) -> None:
+        if src in type(self).wedged:
+            type(self).unplug.wait(3.0)
+        self.src, self.released = src, 0
+        type(self).made.append(self)
+
+    def isOpened(self) -> bool:
+        return True
+
+    def get(self, prop: int) -> float:
+        return 0.0
+
+    def set(self, prop: int, value: float) -> bool:
+        return True
+
+    def release(self) -> None:
+        self.released += 1
+
+
+@pytest.fixture
+def wedged(monkeypatch: pytest.MonkeyPatch) -> Iterator[type[_WedgedDevice]]:
+    """Device indices whose open hangs (``wedged.wedged``); unplugged at teardown."""
+    _WedgedDevice.wedged, _WedgedDevice.made = set(), []
+    _WedgedDevice.unplug = threading.Event()
+    monkeypatch.setattr(cv2, "VideoCapture", _WedgedDevice)
+    yield _WedgedDevice
+    _WedgedDevice.unplug.set()
+
+
+def _released_soon(cap: _WedgedDevice) -> bool:
+    deadline = time.monotonic() + 2.0
+    while not cap.released and time.monotonic() < deadline:
+        time.sleep(0.01)
+    return cap.released == 1
+
+
+@pytest.mark.parametrize("side", ["left", "right"])
+def test_a_camera_whose_open_hangs_is_given_up(wedged: type[_WedgedDevice], side: str) -> None:
+    """A wedged V4L2 device can keep OpenCV's open from ever returning: StereoCamera waited
+    forever (reads were bounded, opens not). After ``open_timeout`` s it raises naming the
+    source and the seconds; the other camera, opened, is released, and the wedged one's
+    capture too once its open returns (it holds the device)."""
+    index = 0 if side == "left" else 1
+    wedged.wedged = {index}
+    t0 = time.perf_counter()
+    with pytest.raises(SourceError) as err:
+        StereoCamera(0, 1, open_timeout=0.2)
+    assert time.perf_counter() - t0 < 1.0
+    assert str(err.value) == (
+        f"{side} source camera {index} did not open within 0.2 s (its open did not return: a "
+        "wedged camera or driver, a stalled stream); unplug and replug it"
+    )
+    assert (err.value.side, err.value.end) == (side, False)
+    assert [c.released for c in wedged.made] == ([1] if side == "right" else [])
+    wedged.unplug.set()  # the open returns at last: its capture is released, not kept
+    deadline = time.monotonic() + 2.0
+    while len(wedged.made) < (2 if side == "right" else 1) and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert [c.src for c in wedged.made] == ([0, 1] if side == "right" else [0])
+    assert all(_released_soon(c) for c in wedged.made)
+    with pytest.raises(ValueError, match=r"^open_timeout: expected a positive number of sec"):
+        StereoCamera(0, 1, open_timeout=0)
+
+
+def test_a_camera_opened_in_time_is_kept(wedged: type[_WedgedDevice]) -> None:
+    """Bounded opens keep what opens in time, unreleased; None opens without a thread."""
+    for timeout in (0.5, None):
+        cam = StereoCamera(0, 1, open_timeout=timeout)
+        assert [c.released for c in wedged.made] == [0, 0]
+        cam.close()
+        assert [c.released for c in wedged.made] == [1, 1]
+        wedged.made.clear()
+
+
+@pytest.mark.parametrize("command", ["capture", "stream"])
+def test_cli_read_timeout_bounds_the_open(
+    command: str, tmp_path: Path, wedged: type[_WedgedDevice], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--read-timeout`` bounds a camera's open as its reads: a wedged device hung the CLI
+    before its first read, Ctrl-C held off by the open in native code."""
+    from stereovision.cli import main
+
+    wedged.wedged = {0}
+    argv = [command, "--left", "0", "--right", "1", "--read-timeout", "0.2"]
+    argv += ["-o", str(tmp_path / "p")] if command == "capture" else ["--no-display"]
+    t0 = time.perf_counter()
+    assert main(argv) == 2
+    assert time.perf_counter() - t0 < 1.0
+    assert capsys.readouterr().err == (
+        "stereovision: error: left source camera 0 did not open within 0.2 s (its open did not "
+        "return: a wedged camera or driver, a stalled stream); unplug and replug it\n"
+    )
+    wedged.unplug.set()  # its open returns: released, not kept (nor left to the next test)
+    deadline = time.monotonic() + 2.0
+    while not wedged.made and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert [c.src for c in wedged.made] == [0] and _released_soon(wedged.made[0])
 
 
 def test_cli_read_timeout_is_refused_with_a_bag(

@@ -2651,7 +2651,7 @@ def test_open_cameras_asks_the_chosen_pixel_format(data_dir, monkeypatch):
     frame = cv2.imread(str(data_dir / "middlebury2001" / "venus" / "left.png"))
 
     class Cameras:
-        def __init__(self, left, right, *, image_size=None, fourcc=None):
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
             asked.append(fourcc)
 
         def read(self):
@@ -2686,8 +2686,9 @@ def test_open_cameras_asks_the_chosen_pixel_format(data_dir, monkeypatch):
 
 def test_gui_read_timeout_reaches_every_camera_read(data_dir, monkeypatch):
     """`gui` had no --read-timeout (capture and stream now have one) and read its cameras
-    without a limit. The option reaches the reads of the cameras it opens and of those opened
-    on the page: 0.2 s, 'none' (no limit), capture's 10 s when not given; a bag is refused."""
+    without a limit. The option reaches the opens and reads of the cameras it opens and of
+    those opened on the page: 0.2 s, 'none' (no limit), capture's 10 s when not given; a bag
+    is refused."""
     pytest.importorskip("trame")
     from trame.app import get_server
 
@@ -2696,10 +2697,11 @@ def test_gui_read_timeout_reaches_every_camera_read(data_dir, monkeypatch):
 
     frame = cv2.imread(str(data_dir / "middlebury2001" / "venus" / "left.png"))
     timeouts: list[float | None] = []
+    opens: list[float | None] = []
 
     class Cameras:
-        def __init__(self, left, right, *, image_size=None, fourcc=None):
-            pass
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            opens.append(open_timeout)
 
         def read(self):
             return frame, frame
@@ -2725,10 +2727,12 @@ def test_gui_read_timeout_reaches_every_camera_read(data_dir, monkeypatch):
         (["--read-timeout", "none"], None),
         ([], capture.DEFAULT_READ_TIMEOUT),
     ):
+        opens.clear()
         built = build_app(parser.parse_args([*cams, *given]))
         timeouts.clear()
         built["source"].read()
         assert timeouts == [timeout] and built["read_timeout"] == timeout
+        assert opens == [timeout]  # the cameras' open is bounded as their reads
     # no cameras given: the app opens those typed on the page with it
     assert build_app(parser.parse_args(["--read-timeout", "0.2"]))["read_timeout"] == 0.2
     page = real_app(
@@ -2740,8 +2744,9 @@ def test_gui_read_timeout_reaches_every_camera_read(data_dir, monkeypatch):
     monkeypatch.setattr(page, "_spawn", lambda coro: coro.close())  # no event loop here
     page.state.cam_left, page.state.cam_right = "0", "1"
     timeouts.clear()
+    opens.clear()
     page.open_cameras()
-    assert page.state.error == "" and page.state.live and timeouts == [0.2]
+    assert page.state.error == "" and page.state.live and timeouts == [0.2] and opens == [0.2]
     with pytest.raises(ValueError, match=r"^--read-timeout bounds a camera's read: a bag is"):
         build_app(parser.parse_args(["--from-bag", "x.bag", "--read-timeout", "5"]))
 

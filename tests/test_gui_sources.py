@@ -493,16 +493,18 @@ def test_open_stereo_source_hands_size_fourcc_and_file_flag(
 
     made: list[tuple[Any, ...]] = []
 
-    def fake_camera(left: Any, right: Any, *, image_size: Any, fourcc: Any) -> FakeCamera:
-        made.append((left, right, image_size, fourcc))
+    def fake_camera(
+        left: Any, right: Any, *, image_size: Any, fourcc: Any, open_timeout: Any
+    ) -> FakeCamera:
+        made.append((left, right, image_size, fourcc, open_timeout))
         return FakeCamera([], [])
 
     monkeypatch.setattr(capture, "StereoCamera", fake_camera)
-    src = sources.open_stereo_source(" 1", "2 ", size=(320, 240), fourcc="YUYV")
-    assert made == [(1, 2, (320, 240), "YUYV")]
+    src = sources.open_stereo_source(" 1", "2 ", size=(320, 240), fourcc="YUYV", read_timeout=3)
+    assert made == [(1, 2, (320, 240), "YUYV", 3)]  # the read's bound bounds the open too
     assert isinstance(src, sources._CaptureAdapter) and src._files is False
     assert sources.open_stereo_source("a.avi", "b.avi")._files is True  # type: ignore[attr-defined]
-    assert made[-1] == ("a.avi", "b.avi", None, None)
+    assert made[-1] == ("a.avi", "b.avi", None, None, capture.DEFAULT_READ_TIMEOUT)
     assert sources.open_stereo_source("a.avi", 0)._files is False  # type: ignore[attr-defined]
     with pytest.raises(ValueError, match=r"^fourcc: expected four characters"):
         sources.open_stereo_source(0, 1, fourcc="MJPEG")  # checked before a camera opens
@@ -562,6 +564,47 @@ def test_open_stereo_source_gives_a_hung_read_up(monkeypatch: pytest.MonkeyPatch
     src = sources.open_stereo_source(0, 1)
     assert src._read_timeout == capture.DEFAULT_READ_TIMEOUT == 10.0  # type: ignore[attr-defined]
     src.close()
+
+
+@pytest.mark.parametrize("fallback", [False, True])
+def test_a_camera_whose_open_hangs_is_given_up(
+    fake_cap: type[FakeCap], monkeypatch: pytest.MonkeyPatch, fallback: bool
+) -> None:
+    """The page's cameras were opened with no time limit (their reads had one): a wedged
+    device froze the page for good in ``cv2.VideoCapture``. The open is now given up after
+    ``read_timeout`` s, with capture's error naming the camera (OpenCV's fallback too)."""
+    import threading
+
+    unplug = threading.Event()
+
+    class Wedged(FakeCap):
+        def __init__(self, src: Any) -> None:
+            if src == 1:
+                unplug.wait(3.0)  # at most: the old code's test ends
+            super().__init__(src)
+
+        def get(self, prop: int) -> float:
+            return 0.0
+
+    monkeypatch.setattr(cv2, "VideoCapture", Wedged)
+    if fallback:
+        monkeypatch.setitem(sys.modules, "stereovision.capture", None)  # import fails
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(OSError) as err:
+            sources.open_stereo_source(0, 1, read_timeout=0.2)
+        assert time.perf_counter() - t0 < 1.0
+    finally:
+        unplug.set()
+    assert str(err.value) == (
+        "right source camera 1 did not open within 0.2 s (its open did not return: a wedged "
+        "camera or driver, a stalled stream); unplug and replug it"
+    )
+    assert fake_cap.made[0].src == 0 and fake_cap.made[0].released  # the left one, opened
+    deadline = time.monotonic() + 2.0  # the wedged open returns: its capture is released
+    while not (len(fake_cap.made) == 2 and fake_cap.made[1].released):
+        assert time.monotonic() < deadline, "the late capture was kept"
+        time.sleep(0.01)
 
 
 def test_a_stream_given_by_name_is_not_reopened_when_its_read_hangs(

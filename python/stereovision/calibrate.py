@@ -204,6 +204,13 @@ VIDEO_SUFFIXES: tuple[str, ...] = (".avi", ".mp4", ".mkv", ".mov", ".webm")
 #: Most pairs :func:`calibrate_from_video` keeps: the first distinct board poses (a calibration
 #: gains little past a few dozen views, and each view costs solver time).
 MAX_VIDEO_PAIRS = 60
+#: Seconds a camera's open or ``read`` may take before it is given up as hung
+#: (:func:`stereovision.capture.read_within`; re-exported as ``capture.DEFAULT_READ_TIMEOUT``,
+#: defined here as capture imports this module). A hung USB camera (or a network stream that
+#: stalls) never returned: the stream waited forever, and a read in native code, holding off
+#: Ctrl-C until it returned, made it unkillable but by SIGKILL. 10 s is OpenCV's own V4L2 select
+#: timeout, and well above a camera's first frame (1-3 s).
+DEFAULT_READ_TIMEOUT = 10.0
 
 
 # ------------------------------------------------------------------------------------- helpers

@@ -55,6 +55,7 @@ import numpy.typing as npt
 
 from stereovision._validate import renamed_keyword, source_warning
 from stereovision.calibrate import (
+    DEFAULT_READ_TIMEOUT,
     POSE_PARAM_NAMES,
     POSE_PARAM_RANGES,
     board_pose_params,
@@ -109,11 +110,6 @@ LIVE_DETECT_FLAGS = (
 _TEMPORAL_FULL = 0.95
 #: Width of each coverage bar in the progress line (characters).
 PROGRESS_BAR_WIDTH = 10
-#: Seconds a camera's ``read`` may take before :func:`read_within` gives it up as hung. A hung
-#: USB camera (or a network stream that stalls) never returned: the stream waited forever, and a
-#: read in native code, holding off Ctrl-C until it returned, made it unkillable but by SIGKILL.
-#: 10 s is OpenCV's own V4L2 select timeout, and well above a camera's first frame (1-3 s).
-DEFAULT_READ_TIMEOUT = 10.0
 #: File name pattern of saved pairs (index from 1; 4 digits sort well up to 9999 pairs).
 PAIR_NAME = "{side}_{index:04d}{ext}"
 _PAIR_RE = re.compile(r"^(left|right)_(\d+)\.[A-Za-z0-9]+$")
@@ -414,12 +410,13 @@ _READ_TIMEOUT: contextvars.ContextVar[float | None] = contextvars.ContextVar(
 )
 
 
-def check_read_timeout(timeout: float | None) -> None:
+def check_read_timeout(timeout: float | None, name: str = "read_timeout") -> None:
     """Refuse a ``read_timeout`` that is not a positive number of seconds or None (checked by
-    :func:`read_within`, and by :func:`capture` and :func:`~stereovision.stream.run_stream`
-    before they open anything)."""
+    :func:`read_within`, and by :func:`capture`, :func:`~stereovision.stream.run_stream` and
+    :func:`~stereovision.calibrate.calibrate_from_video` before they open anything);
+    ``name`` is the keyword said (:class:`StereoCamera`'s ``open_timeout``)."""
     if timeout is not None and not timeout > 0:
-        raise ValueError(f"read_timeout: expected a positive number of seconds, got {timeout}")
+        raise ValueError(f"{name}: expected a positive number of seconds, got {timeout}")
 
 
 def read_within(camera: Any, timeout: float | None = DEFAULT_READ_TIMEOUT) -> StereoFrame:
@@ -465,11 +462,15 @@ def _within(
     timeout: float | None,
     name: str,
     cancel: Callable[[], bool] | None = None,
+    hung: str | None = None,
+    side: str = "both",
 ) -> _T:
     """``work()`` in a daemon thread, given up after ``timeout`` s (None: called here).
 
     On an interrupt, ``cancel()`` (when given) is asked first whether it kept ``work`` from
     beginning (True); only one under way is waited for, up to :data:`_INTERRUPT_GRACE_S`.
+    Given up, it raises :class:`SourceError` saying ``hung`` (default: a read's words, with
+    ``name``, the sources) about ``side``.
     """
     if timeout is None:
         return work()
@@ -501,14 +502,54 @@ def _within(
         # the thread stays in OpenCV (nothing stops native code); its frame, if it ever comes,
         # is dropped
         raise SourceError(
-            f"{name} delivered no frame in {timeout:g} s (its read did not return: a hung or "
+            hung
+            or f"{name} delivered no frame in {timeout:g} s (its read did not return: a hung or "
             "unplugged USB camera, a stalled stream); unplug and replug it",
-            side="both",
+            side=side,
             end=False,
         )
     if isinstance(box[0], BaseException):
         raise box[0]
     return box[0]  # type: ignore[no-any-return]
+
+
+def _open_within(make: Callable[[], Any], timeout: float | None, side: str, src: Source) -> Any:
+    """``make()``, the ``cv2.VideoCapture`` of ``side``'s source ``src``, given up after
+    ``timeout`` s as a read is (:func:`_within`; None: no limit): a wedged V4L2 device, or a
+    stream that stalls, can keep OpenCV's open from ever returning. A capture that opens after
+    it was given up is released then (it held the device)."""
+    if timeout is None:
+        return make()
+    lock = threading.Lock()
+    given_up = [False]
+    made: list[Any] = []  # the capture, once made in time; the one that gives up releases it
+
+    def opened() -> Any:
+        cap = make()
+        with lock:
+            late = given_up[0]
+            if not late:
+                made.append(cap)
+        if late:  # nobody will have it
+            _release([cap])
+        return cap
+
+    what = f"{side} source {_describe_source(src)}"
+    try:
+        return _within(
+            opened,
+            timeout,
+            what,
+            hung=f"{what} did not open within {timeout:g} s (its open did not return: a wedged "
+            "camera or driver, a stalled stream); unplug and replug it",
+            side=side,
+        )
+    except BaseException:  # given up, interrupted, or the open failed
+        with lock:
+            given_up[0] = True
+            gone, made[:] = made[:], []
+        _release(gone)
+        raise
 
 
 def _sequence_first(path: str) -> tuple[int, str] | None:
@@ -791,6 +832,11 @@ class StereoCamera(PairSource):
         one USB bus at a higher size or rate. JPEG costs the matchers some accuracy
         (docs/robotics.md, "Webcams: compressed or raw"). A source that delivers another
         format gets one :class:`UserWarning`; what each delivers is in :attr:`delivered_fourcc`.
+    open_timeout : float or None
+        Seconds each source's open may take (:data:`DEFAULT_READ_TIMEOUT`, 10; None: no
+        limit): a wedged V4L2 device can keep OpenCV's open from ever returning. Given up, it
+        raises :class:`SourceError` naming the source and the seconds (``left source camera 0
+        did not open within 10 s ...``); a capture that opens later is released then.
 
     Attributes
     ----------
@@ -814,10 +860,11 @@ class StereoCamera(PairSource):
     FileNotFoundError
         If a source is a file path (not a pattern) that does not exist.
     SourceError
-        If a source cannot be opened (the message names it).
+        If a source cannot be opened, or does not open within ``open_timeout`` (the message
+        names it).
     ValueError
-        If ``image_size``, ``fps`` or ``fourcc`` is invalid, or a source is a negative device
-        index.
+        If ``image_size``, ``fps``, ``fourcc`` or ``open_timeout`` is invalid, or a source is a
+        negative device index.
     """
 
     @renamed_keyword("size", "image_size")
@@ -829,7 +876,9 @@ class StereoCamera(PairSource):
         image_size: tuple[int, int] | str | None = None,
         fps: float | None = None,
         fourcc: str | None = None,
+        open_timeout: float | None = DEFAULT_READ_TIMEOUT,
     ) -> None:
+        check_read_timeout(open_timeout, "open_timeout")
         self.sources = {"left": left, "right": right}
         self.requested_size = parse_size(image_size, "image_size")
         # True was taken as 1 fps, and "30" gave math's TypeError
@@ -860,12 +909,12 @@ class StereoCamera(PairSource):
         self._media_offset: float | None = None  # left - right media time of the first pair
         try:
             for side, src in self.sources.items():
-                self._caps[side] = self._open(side, src, fps)
+                self._caps[side] = self._open(side, src, fps, open_timeout)
         except BaseException:
             self.close()
             raise
 
-    def _open(self, side: str, src: Source, fps: float | None) -> Any:
+    def _open(self, side: str, src: Source, fps: float | None, timeout: float | None) -> Any:
         if isinstance(src, (str, os.PathLike)):
             path = os.fspath(src)
             if "%" not in path and "://" not in path and not os.path.exists(path):
@@ -876,7 +925,7 @@ class StereoCamera(PairSource):
                 raise FileNotFoundError(f"{side} source: no file matches {path}")
             # OpenCV logs its backends' attempts to stderr; the error below says what failed.
             with _opencv_quiet():
-                cap: Any = _open_path(path)
+                cap: Any = _open_within(lambda: _open_path(path), timeout, side, src)
             self._sequence[side] = cap.isOpened() and cap.getBackendName() == "CV_IMAGES"
         elif isinstance(src, (bool, np.bool_)):  # True opened camera 1
             raise ValueError(f"{side} source: expected a device index or a path, got {src!r}")
@@ -884,7 +933,7 @@ class StereoCamera(PairSource):
             if src < 0:  # cv2.VideoCapture(-1) crashes the process when no camera is present
                 raise ValueError(f"{side} source: {_negative_index(int(src))}")
             with _opencv_quiet():
-                cap = cv2.VideoCapture(int(src))
+                cap = _open_within(lambda: cv2.VideoCapture(int(src)), timeout, side, src)
         else:
             cap = src
         if not cap.isOpened():
@@ -1348,7 +1397,7 @@ def add_read_timeout(p: argparse.ArgumentParser) -> None:
         "--read-timeout",
         type=read_timeout_seconds,
         metavar="SECONDS",
-        help=f"give a camera up as hung when a pair's read takes longer (default "
+        help=f"give a camera up as hung when its open or a pair's read takes longer (default "
         f"{DEFAULT_READ_TIMEOUT:g} s; raise it for a camera slow to deliver its first frame on a "
         "cold start, some GigE and USB3 ones; 'none': no limit)",
     )
@@ -1409,7 +1458,7 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
     ----------
     args : argparse.Namespace
         The parsed command line (``--left``/``--right``, or ``--from-bag`` and its options;
-        ``--size``, ``--fourcc``).
+        ``--size``, ``--fourcc``; ``--read-timeout``, which bounds each camera's open too).
     fps : float, optional
         Frame rate to request of the cameras.
 
@@ -1463,7 +1512,14 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
             f"--left {str(left)!r} and --right {str(right)!r} are both camera {device}: give "
             "the rig's two cameras"
         )
-    cam = StereoCamera(left, right, image_size=size, fps=fps, fourcc=getattr(args, "fourcc", None))
+    cam = StereoCamera(
+        left,
+        right,
+        image_size=size,
+        fps=fps,
+        fourcc=getattr(args, "fourcc", None),
+        open_timeout=cli_read_timeout(args),  # a wedged device hung its open as its reads
+    )
     if _same_path(left, right):
         # a typo: every pair is one view twice, every disparity 0, and nothing said it (said
         # once the source opens: a missing one is said as such)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Iterable, Sequence
+from functools import partial
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -18,7 +19,13 @@ import cv2
 import numpy as np
 import numpy.typing as npt
 
-from stereovision.capture import DEFAULT_READ_TIMEOUT, camera_hint, read_within
+from stereovision.capture import (
+    DEFAULT_READ_TIMEOUT,
+    _open_within,
+    camera_hint,
+    check_read_timeout,
+    read_within,
+)
 from stereovision.capture import parse_source as capture_parse_source
 from stereovision.io import _opencv_quiet
 
@@ -308,18 +315,27 @@ class VideoPair:
         Device index, video file, or image-sequence pattern (``"img_%03d.png"``).
     size : (int, int), optional
         Requested ``(width, height)`` for devices.
+    open_timeout : float or None
+        Seconds each open may take (None: no limit), as
+        :class:`~stereovision.capture.StereoCamera`'s.
 
     Raises
     ------
     FileNotFoundError
         A file source that does not exist.
     OSError
-        A source OpenCV cannot open (``"cannot open camera ..."``) or that gives no frame.
+        A source OpenCV cannot open (``"cannot open camera ..."``), that does not open within
+        ``open_timeout`` (:class:`~stereovision.capture.SourceError`) or that gives no frame.
     """
 
     def __init__(
-        self, left: int | str, right: int | str, size: tuple[int, int] | None = None
+        self,
+        left: int | str,
+        right: int | str,
+        size: tuple[int, int] | None = None,
+        open_timeout: float | None = DEFAULT_READ_TIMEOUT,
     ) -> None:
+        check_read_timeout(open_timeout, "open_timeout")
         self._caps: list[cv2.VideoCapture] = []
         self._files = []
         try:
@@ -329,7 +345,8 @@ class VideoPair:
                 if is_file and "%" not in str(src) and not Path(str(src)).exists():
                     raise FileNotFoundError(f"{side} camera source not found: {src}")
                 with _opencv_quiet():  # the error below says what failed
-                    cap = cv2.VideoCapture(src)
+                    # bounded: a wedged device hung its open forever
+                    cap = _open_within(partial(cv2.VideoCapture, src), open_timeout, side, src)
                 if not cap.isOpened():
                     cap.release()
                     raise OSError(f"cannot open camera {src!r} ({side}){camera_hint(src)}")
@@ -515,9 +532,9 @@ def open_stereo_source(
         Pixel format asked of the cameras (``"MJPG"``, ``"YUYV"``; None: the driver's), as
         ``stereovision capture --fourcc``: two webcams on one USB 2 bus often need MJPG.
     read_timeout : float or None
-        Seconds a pair's read may take before the camera is given up as hung
-        (:data:`~stereovision.capture.DEFAULT_READ_TIMEOUT`; None: no limit), as ``capture``'s
-        and ``stream``'s ``--read-timeout``.
+        Seconds a camera's open or a pair's read may take before the camera is given up as
+        hung (:data:`~stereovision.capture.DEFAULT_READ_TIMEOUT`; None: no limit), as
+        ``capture``'s and ``stream``'s ``--read-timeout``.
 
     Raises
     ------
@@ -528,11 +545,13 @@ def open_stereo_source(
     try:
         from stereovision.capture import StereoCamera, parse_fourcc
     except ImportError:
-        return VideoPair(left, right, size)
+        return VideoPair(left, right, size, read_timeout)
     code = parse_fourcc(fourcc)
     files = isinstance(left, str) and isinstance(right, str)
     return _CaptureAdapter(
-        lambda: StereoCamera(left, right, image_size=size, fourcc=code), files, read_timeout
+        lambda: StereoCamera(left, right, image_size=size, fourcc=code, open_timeout=read_timeout),
+        files,
+        read_timeout,
     )
 
 
