@@ -5,11 +5,14 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import inspect
 import json
 import math
 import os
 import re
 import tempfile
+import threading
+import time
 import warnings
 from pathlib import Path
 from typing import Any
@@ -27,6 +30,7 @@ from stereovision.calibrate import (
     board_object_points,
     board_pose_params,
     calibrate,
+    calibrate_from_video,
     find_corners,
     parse_pattern,
     render_chessboard,
@@ -1916,6 +1920,63 @@ def test_a_camera_read_for_calibration_is_closed_and_a_frame_failure_is_not_its_
     ):
         run(cam)
     assert cam.closed == 1
+
+
+class _HungDevice:
+    """A ``cv2.VideoCapture`` stand-in of a hung camera: its open (``opens`` False) or its grab
+    never returns until ``unplug`` is set (3 s at most, so that the old code's test ends)."""
+
+    unplug = threading.Event()
+    opens = True
+
+    def __init__(self, src: Any, *args: Any) -> None:
+        if not type(self).opens:
+            type(self).unplug.wait(3.0)
+
+    def isOpened(self) -> bool:
+        return True
+
+    def get(self, prop: int) -> float:
+        return 0.0
+
+    def set(self, prop: int, value: float) -> bool:
+        return True
+
+    def grab(self) -> bool:
+        type(self).unplug.wait(3.0)
+        return False
+
+    def release(self) -> None:
+        pass
+
+
+@pytest.mark.parametrize("hangs", ["open", "read"])
+def test_calibrate_from_video_gives_a_hung_camera_up(
+    monkeypatch: pytest.MonkeyPatch, hangs: str
+) -> None:
+    """calibrate_from_video reads live cameras too, with no time limit (capture's and stream's
+    have one): a wedged device hung it for good in its open or its first read. ``read_timeout``
+    (capture's default, 10 s) now bounds both, with capture's error naming the camera."""
+    from stereovision.capture import DEFAULT_READ_TIMEOUT, SourceError
+
+    monkeypatch.setattr(_HungDevice, "unplug", threading.Event())
+    monkeypatch.setattr(_HungDevice, "opens", hangs == "read")
+    monkeypatch.setattr(cv2, "VideoCapture", _HungDevice)
+    says = {
+        "open": "left source camera 0 did not open within 0.2 s (its open did not return",
+        "read": "camera 0 and camera 1 delivered no frame in 0.2 s (its read did not return",
+    }[hangs]
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(SourceError, match="^" + re.escape(says)):
+            calibrate_from_video(0, 1, square_size=1.0, read_timeout=0.2)
+        assert time.perf_counter() - t0 < 1.0
+    finally:
+        _HungDevice.unplug.set()
+    with pytest.raises(ValueError, match=r"^read_timeout: expected a positive number of sec"):
+        calibrate_from_video(0, 1, read_timeout=0)
+    default = inspect.signature(calibrate_from_video).parameters["read_timeout"].default
+    assert default == DEFAULT_READ_TIMEOUT == 10.0
 
 
 def test_outlier_floor_both_cameras_in_model_selection_and_a_worse_refinement_refused(

@@ -1775,6 +1775,7 @@ def calibrate_from_video(
     max_pairs: int = MAX_VIDEO_PAIRS,
     min_distance: float | None = None,
     log: Any = None,
+    read_timeout: float | None = DEFAULT_READ_TIMEOUT,
     **kwargs: Any,
 ) -> tuple[Calibration, CalibrationReport]:
     """Calibrate from two recordings of the board waved about (or two live cameras).
@@ -1796,6 +1797,11 @@ def calibrate_from_video(
         The collector's pose distance (default :data:`stereovision.capture.MIN_POSE_DISTANCE`).
     log : callable, optional
         Receives one line when the reading is done.
+    read_timeout : float or None
+        Seconds a camera's open or a pair's read may take (:data:`DEFAULT_READ_TIMEOUT`, 10;
+        None: no limit), as :func:`stereovision.capture.capture`'s: a hung camera (a wedged
+        USB device, a stalled stream) is given up with a
+        :class:`~stereovision.capture.SourceError` naming it.
     **kwargs
         Passed to :func:`calibrate` (``unit``, ``distortion``, ``drop_outliers``, ...).
 
@@ -1808,16 +1814,21 @@ def calibrate_from_video(
     ------
     FileNotFoundError
         If a video file does not exist (the message names the side).
+    SourceError
+        If a source cannot be opened, or does not open or deliver a pair within
+        ``read_timeout`` s (:class:`stereovision.capture.SourceError`, an OSError).
     ValueError
         As :func:`calibrate` (too few distinct poses with the board in both views, ...), or for
-        a ``max_pairs`` below :data:`MIN_PAIRS`.
+        a ``max_pairs`` below :data:`MIN_PAIRS` or a ``read_timeout`` that is not a positive
+        number of seconds (or None).
     """
-    from stereovision.capture import StereoCamera
+    from stereovision.capture import StereoCamera, check_read_timeout
 
     _check_max_pairs(max_pairs)
+    check_read_timeout(read_timeout)
 
     # as given: StereoCamera takes paths and indexes (a str() made np.int64(1) the file "1")
-    cam = StereoCamera(left, right)
+    cam = StereoCamera(left, right, open_timeout=read_timeout)
     return _calibrate_from_camera(
         cam,
         pattern=pattern,
@@ -1826,6 +1837,7 @@ def calibrate_from_video(
         max_pairs=max_pairs,
         min_distance=min_distance,
         log=log,
+        read_timeout=read_timeout,
         **kwargs,
     )
 
@@ -1902,11 +1914,18 @@ def _calibrate_from_camera(
     max_pairs: int,
     min_distance: float | None,
     log: Any,
+    read_timeout: float | None = None,
     **kwargs: Any,
 ) -> tuple[Calibration, CalibrationReport]:
     """Keep the distinct board poses a camera (or recording) shows, then :func:`calibrate`;
-    the camera is closed."""
-    from stereovision.capture import MIN_POSE_DISTANCE, ChessboardCollector, SourceError
+    the camera is closed. A read taking over ``read_timeout`` s raises
+    (:func:`~stereovision.capture.read_within`; None: no limit, a bag's)."""
+    from stereovision.capture import (
+        MIN_POSE_DISTANCE,
+        ChessboardCollector,
+        SourceError,
+        read_within,
+    )
 
     lefts: list[np.ndarray] = []
     rights: list[np.ndarray] = []
@@ -1920,7 +1939,7 @@ def _calibrate_from_camera(
         )
         while len(lefts) < max_pairs:
             try:
-                frame = cam.read()
+                frame = read_within(cam, read_timeout)
             except SourceError as exc:
                 if not getattr(exc, "end", True):
                     raise  # a frame that does not decode or of another shape: not an end
