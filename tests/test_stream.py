@@ -1771,6 +1771,53 @@ def test_a_camera_whose_read_hangs_is_given_up(
         run_stream(_FakeRig([_frame(0)]), max_disparity=8, read_timeout=0)  # type: ignore[arg-type]
 
 
+@PIPELINED
+def test_a_grab_thread_hung_past_the_join_is_said(
+    videos: dict[str, Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With no read limit, a camera that hangs in the read the grab thread took ahead kept that
+    thread past the end's join (here an output failing on pair 1 ends the run while pair 2 is
+    read): the stream returned as if it had stopped, nothing said a thread was still inside the
+    camera's read. A warning now names the camera and the seconds waited;
+    the thread, a daemon, is left behind (no wait at exit) and ends once the read returns."""
+    import stereovision.stream as streammod
+
+    monkeypatch.setattr(streammod, "GRAB_JOIN_TIMEOUT", 0.2, raising=False)
+    unplug = threading.Event()
+    cam = StereoCamera(str(videos["left"]), str(videos["right"]))
+    # pairs 0 and 1 are read; the thread's read of pair 2 (one ahead) hangs
+    cam._caps["right"] = _HangsAfter(cam._caps["right"], 2, unplug)  # type: ignore[assignment]
+    names = f"{str(videos['left'])!r} and {str(videos['right'])!r}"
+
+    done: list[int] = []
+
+    def on_result(left: np.ndarray, res: Any) -> None:
+        done.append(1)
+        if len(done) == 2:
+            raise OSError("disk full")
+
+    try:
+        t0 = time.perf_counter()
+        with pytest.warns(UserWarning) as said:
+            rep = run_stream(
+                cam, max_disparity=16, check=False, on_result=on_result, read_timeout=None
+            )
+        waited = time.perf_counter() - t0
+        assert (rep.frames, rep.ended) == (1, "output failed")
+        left = [t for t in threading.enumerate() if isinstance(t, streammod._Producer)]
+        assert len(left) == 1 and left[0].daemon  # left behind: no wait at the interpreter's exit
+        assert [str(w.message) for w in said] == [
+            f"the grab thread is still inside a read of {names}, 0.2 s after the stream ended "
+            "(a hung camera): it is left behind; the pair it reads, if any, is dropped"
+        ]
+        assert waited < 3.0
+    finally:
+        unplug.set()
+        cam.close()
+    left[0].join(5.0)
+    assert not left[0].is_alive()
+
+
 def test_a_bag_without_a_calibration_is_refused(
     videos: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -46,6 +46,7 @@ from stereovision.capture import (
     SourceError,
     StereoCamera,
     StereoFrame,
+    _describe_source,
     add_source_args,
     check_read_timeout,
     cli_read_timeout,
@@ -70,6 +71,10 @@ STAGES = ("grab", "rectify", "temporal", "prepare", "match", "fill", "triangulat
 #: Pairs grabbed ahead of the one being matched. One is enough to hide the grab and rectify
 #: behind the matching; more would only age a live camera's frames.
 QUEUE_SIZE = 1
+#: Seconds the end of a pipelined stream waits for its grab thread to stop. A camera hung in
+#: the read under way (``read_timeout=None``, or a longer one) keeps it longer: it is then left
+#: behind, a daemon thread that does not hold up the interpreter's exit, with a warning.
+GRAB_JOIN_TIMEOUT = 5.0
 #: Seconds between two reports.
 REPORT_PERIOD = 1.0
 #: JPEG quality of the served frames.
@@ -586,6 +591,14 @@ class _Producer(threading.Thread):
         held.clear()
 
 
+def _camera_name(camera: Any) -> str:
+    """A camera as its errors name it: its sources (``camera 0 and camera 1``), else its type."""
+    sources = getattr(camera, "sources", None)
+    if isinstance(sources, dict) and sources:
+        return " and ".join(_describe_source(src) for src in sources.values())
+    return type(camera).__name__
+
+
 def _mean(values: list[float]) -> float:
     return float(statistics.fmean(values)) if values else math.nan
 
@@ -946,7 +959,17 @@ def run_stream(
     finally:
         if producer is not None:
             producer.stop.set()
-            producer.join(timeout=5.0)
+            producer.join(timeout=GRAB_JOIN_TIMEOUT)
+            if producer.is_alive():
+                # it returned silently: the stream seemed stopped while a thread was still
+                # inside the camera (which a close then leaves to that read to release)
+                warnings.warn(
+                    f"the grab thread is still inside a read of {_camera_name(camera)}, "
+                    f"{GRAB_JOIN_TIMEOUT:g} s after the stream ended (a hung camera): it is left "
+                    "behind; the pair it reads, if any, is dropped",
+                    UserWarning,
+                    stacklevel=2,
+                )
     if window:  # the last, partial second
         rep = _window_report(
             window, t_last - t_window, tally.n, t_last - t_begin, md or 0, pipelined
