@@ -1831,6 +1831,25 @@ def test_a_bag_without_a_calibration_is_refused(
     assert not bag.exists()
 
 
+def test_a_bag_folder_in_the_way_is_said_of_the_option(
+    videos: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--bag DIR`` where DIR exists said "bag folder already exists: DIR" without the option
+    (BagWriter's own words), unlike the other refusals of --bag; the user's folder is kept."""
+    bag = tmp_path / "b"
+    bag.mkdir()
+    (bag / "mine.txt").write_text("mine")
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--calib", str(videos["calib"]), "--no-display", "--no-check", "--frames", "1"]
+    assert main([*argv, "--max-disparity", "16", "--bag", str(bag)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        f"stereovision: error: --bag: bag folder already exists: {bag} (choose a new one)"
+    ]
+    assert (bag / "mine.txt").read_text() == "mine"
+    assert [p.name for p in bag.iterdir()] == ["mine.txt"]
+
+
 def test_the_prepare_stage_counts_depth_maps_input_conversion(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

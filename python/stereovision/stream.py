@@ -1270,7 +1270,14 @@ def cmd_stream(args: argparse.Namespace) -> int:
         if args.bag and not stopped:
             from stereovision.rosbag import BagWriter
 
-            bag = BagWriter(args.bag)
+            try:
+                bag = BagWriter(args.bag)
+            except OSError as exc:
+                # BagWriter (a library class) names the folder, not the option that gave it,
+                # as every other refusal of --bag does; type and errno kept
+                said = type(exc)(f"--bag: {exc}")
+                said.errno = exc.errno
+                raise said from None
         sinks: list[Callable[[np.ndarray, Any], None]] = []
         if not args.no_display and not stopped:
             server = FrameServer(args.host, args.serve)
