@@ -224,6 +224,45 @@ def test_pfm_errors(tmp_path: Path) -> None:
         write_pfm(tmp_path / "w.pfm", np.zeros((2, 2, 2), np.float32))
 
 
+@pytest.mark.parametrize(
+    "eol", [b"\r\n", b" \n", b"  \t\r\n"], ids=["crlf", "space", "spaces-crlf"]
+)
+@pytest.mark.parametrize("little", [True, False])
+def test_read_pfm_header_lines_of_windows_tools(tmp_path: Path, eol: bytes, little: bool) -> None:
+    """A header written with CRLF line endings (Windows tools) or trailing spaces: its scale
+    line's \\r or space was taken as the whole line ending, so the data began one byte early
+    (every value shifted by a byte, silently) or the file was said to be truncated."""
+    arr = np.array([[1.5, -2.0, 3.25], [0.0, 7.0, -0.5]], np.float32)
+    body = _pfm_bytes(arr, little)
+    magic, sizes, scale, data = body.split(b"\n", 3)
+    p = tmp_path / "w.pfm"
+    p.write_bytes(magic + eol + sizes + eol + scale + eol + data)
+    got = read_pfm(p)
+    assert got.dtype == np.float32
+    np.testing.assert_array_equal(got, arr)
+    # one line, ended by one space (no line feed): the data right after it, as before
+    p.write_bytes(b"Pf 3 2 " + scale + b" " + data)
+    np.testing.assert_array_equal(read_pfm(p), arr)
+
+
+def test_read_pfm_bad_scale_and_truncation_name_the_file(tmp_path: Path) -> None:
+    """A scale that is no number ("1.0.0", "."), zero (no byte order) or a file cut short is a
+    ValueError naming the file (a malformed scale raised float()'s own message, no file)."""
+    data = np.zeros(6, "<f4").tobytes()
+    for scale in (b"1.0.0", b".", b"-."):
+        p = tmp_path / "s.pfm"
+        p.write_bytes(b"Pf\n3 2\n" + scale + b"\n" + data)
+        with pytest.raises(ValueError, match=rf"PFM.*{re.escape(str(p))}"):
+            read_pfm(p)
+    for scale in (b"0", b"-0.0", b"+0e5"):
+        p.write_bytes(b"Pf\n3 2\n" + scale + b"\n" + data)
+        with pytest.raises(ValueError, match=rf"bad PFM header in {re.escape(str(p))}.*scale"):
+            read_pfm(p)
+    p.write_bytes(b"Pf\r\n3 2\r\n-1.0\r\n" + data[:-1])
+    with pytest.raises(ValueError, match=rf"truncated PFM file {re.escape(str(p))}: .*got 23"):
+        read_pfm(p)
+
+
 def test_read_shared_gt(data_dir: Path) -> None:
     gt = read_pfm(data_dir / "middlebury2001" / "tsukuba" / "gt_disp.pfm")
     assert gt.shape == (288, 384)

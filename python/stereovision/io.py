@@ -882,14 +882,18 @@ def _decode_16bit(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint16]
 
 # ------------------------------------------------------------------------------------------ PFM
 
-_PFM_HEADER = re.compile(rb"^(P[Ff])\s+(\d+)\s+(\d+)\s+([-+]?[0-9.]+(?:[eE][-+]?\d+)?)\s")
+# the three header fields, up to the scale and the whitespace character after it
+_PFM_HEADER = re.compile(rb"^(P[Ff])\s+(\d+)\s+(\d+)\s+([-+]?[0-9.]+(?:[eE][-+]?\d+)?)(?=\s)")
+# the scale line's end as Windows tools (CRLF) and others (trailing spaces) write it
+_PFM_LINE_END = re.compile(rb"[ \t]*\r?\n")
 
 
 def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     """Read a PFM file (Middlebury convention) into a top-down ``float32`` array.
 
     PFM stores rows bottom-up; a negative scale means little-endian data, a positive one
-    big-endian. Both endiannesses, grey (``Pf``) and colour (``PF``) files are read. Values are
+    big-endian. Both endiannesses, grey (``Pf``) and colour (``PF``) files are read, their
+    header lines ended by LF or CRLF (Windows tools), trailing spaces allowed. Values are
     returned as stored (``inf`` stays ``inf``; see :func:`load_scene` for the GT convention).
 
     Parameters
@@ -907,7 +911,8 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     FileNotFoundError
         If ``path`` does not exist.
     ValueError
-        If the header is not a PFM header or the data is truncated.
+        If the header is not a PFM header (a scale that is no number or zero) or the data is
+        truncated, naming the file.
     """
     p = _existing_file(path, "PFM file")
     raw = p.read_bytes()
@@ -916,7 +921,12 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
         raise ValueError(f"not a PFM file (bad header): {p}")
     channels = 3 if m.group(1) == b"PF" else 1
     width, height = int(m.group(2)), int(m.group(3))
-    scale = float(m.group(4))
+    try:
+        scale = float(m.group(4))
+    except ValueError:  # "1.0.0", ".": float()'s own message named no file
+        raise ValueError(
+            f"bad PFM header in {p}: scale {m.group(4).decode()!r} is not a number"
+        ) from None
     if width <= 0 or height <= 0 or scale == 0.0 or not math.isfinite(scale):
         raise ValueError(
             f"bad PFM header in {p}: width {width}, height {height}, scale {scale} "
@@ -924,7 +934,12 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
         )
     dtype = np.dtype("<f4") if scale < 0 else np.dtype(">f4")
     count = width * height * channels
-    start = m.end()
+    # the scale line ends in a line feed (the format), after Windows tools' \r or trailing
+    # spaces: that \r or space taken as the whole line ending began the data a byte or more
+    # early, every value misread. Only a header ended by one other whitespace character and no
+    # line feed (PNM's rule) starts its data right after that character.
+    line_end = _PFM_LINE_END.match(raw, m.end())
+    start = m.end() + 1 if line_end is None else line_end.end()
     nbytes = len(raw) - start
     if nbytes < count * 4:
         raise ValueError(
