@@ -838,6 +838,51 @@ def test_files_at_another_resolution_keep_the_calibration_and_the_view_mode(data
     )
 
 
+def test_a_pair_exactly_twice_as_wide_as_high_stays_side_by_side(tmp_path):
+    """``WIDE_ASPECT``'s boundary (a ``>=`` for its ``>`` survived a mutation audit): images
+    of exactly 2:1 (one camera's picture, e.g. 320x160) are shown side by side, 2:1 and a pixel
+    wider (a KITTI-like strip) one above the other, when loaded and when their result is shown."""
+    import asyncio
+
+    pytest.importorskip("trame")
+    from trame.app import get_server
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import WIDE_ASPECT, StereoApp
+
+    assert WIDE_ASPECT == 2.0
+    cones = bundled_data_dir() / "cones"
+    for name, size in (("two", (320, 160)), ("wider", (321, 160))):
+        for side in ("left", "right"):
+            img = cv2.imread(str(cones / f"{side}.png"))
+            cv2.imwrite(str(tmp_path / f"{name}_{side}.png"), cv2.resize(img, size))
+    app = StereoApp(
+        get_server("test-wide-pair", client_type="vue3"), AllowedFolders([tmp_path]), cones
+    )
+    app._spawn = lambda coro: coro.close()  # computed by hand below
+    app.state.method = "fast"
+    seen: list[bool] = []
+    real = app._publish
+
+    def publish(view: Any) -> None:
+        seen.append(bool(app.state.wide_pair))  # as loaded, before the result is shown
+        real(view)
+
+    app._publish = publish  # type: ignore[method-assign]
+
+    async def load(prefix: str) -> None:
+        app._lock = asyncio.Lock()
+        app.state.left_file = str(tmp_path / f"{prefix}_left.png")
+        app.state.right_file = str(tmp_path / f"{prefix}_right.png")
+        app.load_files()
+        await app.recompute()
+
+    asyncio.run(load("two"))
+    assert app.state.error == "" and app.state.wide_pair is False and seen == [False]
+    asyncio.run(load("wider"))
+    assert app.state.error == "" and app.state.wide_pair is True and seen == [False, True]
+
+
 def test_a_later_success_clears_an_error_and_a_scene_can_be_chosen_again(data_dir):
     """A failed camera open left the toolbar on "error" while the old results stayed; a later
     successful Check rows now clears it. Choosing the scene on show again after files were

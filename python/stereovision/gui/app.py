@@ -115,7 +115,10 @@ VIEW_ASPECT = 4 / 3
 #: The 3-D view is at most this high (px); a portrait image's view is then wider than the image.
 VIEW_MAX_HEIGHT_PX = 480
 #: A pair wider than this (width / height) shows its two images one above the other: side by
-#: side, a KITTI pair (1242 x 375) was two pictures 60 px high.
+#: side, a KITTI pair (1242 x 375) was two pictures 60 px high. Strictly wider: a camera's own
+#: picture at exactly 2:1 (the widest common modes, 4:3 and 16:9, are well below) keeps the
+#: side-by-side layout, each half as high as its column is wide; the rule is for strips (KITTI
+#: 3.3:1, a side-by-side USB camera's whole frame, 2 x 4:3 = 8:3 or 2 x 16:9, shown unsplit).
 WIDE_ASPECT = 2.0
 
 #: Most points the 3-D view draws of a cloud (an opened file, a computed pair in "points"
