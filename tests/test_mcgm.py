@@ -850,6 +850,20 @@ def test_matches_integer_index_out_of_range_is_an_index_error() -> None:
     assert [one.xl.tolist() for one in got] == [[10.0], [20.0], [30.0]]
 
 
+def test_matches_refuse_a_boolean_scalar_index() -> None:
+    """``m[True]`` gave match 1 (a Python bool is an int) and ``m[np.True_]`` said "expected a
+    1-D index, got shape (1, 3)" (NumPy's new axis): a boolean scalar is mostly a mask reduced
+    by mistake (``m[m.score.max() > 0.5]``), refused naming it; a mask of one match still picks."""
+    m = _three()
+    for flag in (True, False, np.True_, np.False_, np.array(True)):
+        with pytest.raises(
+            IndexError, match=r"Matches: a boolean scalar \((True|False)\) is not an index"
+        ):
+            m[flag]
+    assert m[np.array([False, True, False])].xl.tolist() == [20.0]
+    assert m[1].xl.tolist() == [20.0] and m[np.int64(1)].xl.tolist() == [20.0]
+
+
 def test_matches_rasters_leave_out_non_finite_positions_without_a_warning() -> None:
     """A NaN or infinite left position (a CSV row of ``nan``) is outside the image: left out of
     the rasters as one beyond the edge is, not cast to an integer with NumPy's 'invalid value

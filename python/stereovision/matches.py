@@ -122,7 +122,18 @@ class Matches:
     def __getitem__(self, index: Any) -> Matches:
         """The matches picked by a slice, an integer array or a boolean mask, as ``Matches``
         (``m[m.score > 0.9]``); the image shape and stats are kept, the energy trace too. An
-        integer gives that one match; beyond the matches it is an IndexError."""
+        integer gives that one match; beyond the matches it is an IndexError, as is a boolean
+        scalar."""
+        if isinstance(index, (bool, np.bool_)) or (
+            isinstance(index, np.ndarray) and index.ndim == 0 and index.dtype == bool
+        ):
+            # a Python bool is an int (m[True] gave match 1) and NumPy reads a scalar bool as a
+            # new axis (a 2-D pick): neither is a selection of matches; it is mostly a mask
+            # reduced by mistake (m[m.score.max() > 0.5]), so it is refused
+            raise IndexError(
+                f"Matches: a boolean scalar ({bool(index)}) is not an index; give an integer, "
+                "a slice, an integer array or a boolean mask with one value per match"
+            )
         if isinstance(index, (int, np.integer)):
             # As a slice an index beyond the end was an empty Matches, so iterating (by index
             # until IndexError) never ended.
