@@ -327,6 +327,9 @@ def test_cli_rectify(data_dir: Path, tmp_path: Path) -> None:
     assert run.returncode == 2 and "--model is for rectifying without" in run.stderr
 
 
+# the pipelined stream (its grab thread), as test_stream marks its own: a deadlock fails it
+# within 30 s, with every thread's stack, not at the suite's 600 s (it takes 2 s)
+@pytest.mark.timeout(30)
 def test_stream_through_the_homographies(data_dir: Path, tmp_path: Path) -> None:
     """``stream --rectification``: a rig without a calibration streams disparity on rows that
     agree (the first pair's row check passes; as taken its rows are 0.59 px apart)."""
