@@ -730,7 +730,11 @@ def test_baseline_implausible_for_its_unit_is_warned_once_and_printed_readably()
         text = tiny.describe()
         tiny.scaled_to((160, 120)).rectified_calibration()
     assert "baseline 0.12 mm (0.12 mm)" in text and "0.0 cm" not in text
-    with pytest.warns(UserWarning, match=r"longer than a robot's rig \(5 m\): .* unit='m'\? With "):
+    # in metres already, the baseline is said once ("120 m = 120 m" said nothing)
+    with pytest.warns(
+        UserWarning,
+        match=r"^baseline 120 m, longer than a robot's rig \(5 m\): .* unit='m'\? With ",
+    ):
         raw_calib(T=np.array([-120.0, 0.0, 0.0]))
     with warnings.catch_warnings():
         warnings.simplefilter("error")

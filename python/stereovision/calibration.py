@@ -476,7 +476,10 @@ class Calibration:
 
             long = self.baseline_m > LONG_BASELINE_M
             warnings.warn(
-                f"baseline {self.baseline:g} {self.unit} = {self.baseline_m:g} m, "
+                f"baseline {self.baseline:g} {self.unit}"
+                # Converted only when the unit is not metres already ("5 m = 5 m" said nothing).
+                + ("" if self.unit == "m" else f" = {self.baseline_m:g} m")
+                + ", "
                 + (
                     f"longer than a robot's rig ({LONG_BASELINE_M:g} m)"
                     if long
