@@ -848,6 +848,10 @@ def test_matches_integer_index_out_of_range_is_an_index_error() -> None:
             m[k]
     got = list(itertools.islice(iter(m), 5))
     assert [one.xl.tolist() for one in got] == [[10.0], [20.0], [30.0]]
+    # a 0-d integer array is that integer (it said "expected a 1-D index, got shape ()")
+    assert m[np.array(2)].xl.tolist() == [30.0] and m[np.array(-3, np.int32)].xl.tolist() == [10.0]
+    with pytest.raises(IndexError, match=r"index 3 is out of range for 3 matches"):
+        m[np.array(3)]
 
 
 def test_matches_refuse_a_boolean_scalar_index() -> None:

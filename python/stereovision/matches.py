@@ -134,6 +134,8 @@ class Matches:
                 f"Matches: a boolean scalar ({bool(index)}) is not an index; give an integer, "
                 "a slice, an integer array or a boolean mask with one value per match"
             )
+        if isinstance(index, np.ndarray) and index.ndim == 0 and index.dtype.kind in "iu":
+            index = int(index)  # a 0-d integer array (an argmax kept as an array) is an integer
         if isinstance(index, (int, np.integer)):
             # As a slice an index beyond the end was an empty Matches, so iterating (by index
             # until IndexError) never ended.
