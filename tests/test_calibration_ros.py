@@ -743,3 +743,62 @@ def test_from_file_names_a_truncated_tar_and_skips_txt_stereo_calib_names(tmp_pa
         (tmp_path / name).write_text("M1 and D1 as text\n")
     with pytest.raises(ValueError, match="unrecognised calibration format"):
         Calibration.from_file(tmp_path / "intrinsics.txt")
+
+
+def _echoed(text: str, ros2: bool = True, **changes: object) -> str:
+    """A camera_info file's content as the message `ros2 topic echo --once` (or ROS 1's
+    `rostopic echo -n 1`) prints it: k d r p (K D R P), width and height, a header, binning and
+    roi, and the `---` after it."""
+    info = parse_ros_camera_info(text)
+    w, h = info["image_size"]
+    fields: dict[str, object] = {
+        "header": {"stamp": {"sec": 1, "nanosec": 0}, "frame_id": "cam_optical"},
+        "height": h,
+        "width": w,
+        "distortion_model": info["distortion_model"],
+        **{(k.lower() if ros2 else k): info[k].ravel().tolist() for k in "DKRP"},
+        "binning_x": 0,
+        "binning_y": 0,
+        "roi": {"x_offset": 0, "y_offset": 0, "height": 0, "width": 0, "do_rectify": False},
+    }
+    fields.update(changes)
+    # ROS 1 prints the arrays inline ([..]), ROS 2 one item a line
+    flow = False if ros2 else None
+    return yaml.safe_dump(fields, default_flow_style=flow, sort_keys=False) + "---\n"
+
+
+@pytest.mark.parametrize("ros2", [True, False], ids=["ros2", "ros1"])
+def test_camera_info_messages_echoed_to_files_are_read(tmp_path: Path, ros2: bool) -> None:
+    """`ros2 topic echo --once /left/camera_info > left.yaml` (the message, not
+    camera_calibration's file: k, d, r, p, width, height, a trailing ---) was refused as an
+    unrecognised format, a folder of two as a YAML parse error; they give the rig of the files."""
+    c = raw_calib()
+    texts = c.to_ros()
+    for side, text in zip(("left", "right"), texts, strict=True):
+        (tmp_path / f"{side}.yaml").write_text(_echoed(text, ros2))
+    want = Calibration._from_ros_texts(*texts, "left", "right")
+    for path in (tmp_path, tmp_path / "left.yaml"):
+        got = Calibration.from_file(path)
+        assert got == want
+    info = parse_ros_camera_info(_echoed(texts[1], ros2), "right")
+    assert info["image_size"] == c.image_size and info["distortion_model"] == "plumb_bob"
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"binning_x": 2, "binning_y": 2}, "binning_x 2"),
+        (
+            {"roi": {"x_offset": 8, "y_offset": 0, "height": 240, "width": 300}},
+            "region of interest",
+        ),
+        ({"p": None}, "lacks field 'p'"),
+    ],
+)
+def test_an_echoed_camera_info_this_cannot_read_is_named(changes: dict, message: str) -> None:
+    """A binned or cropped camera's message (its K is not the image's), or one without P."""
+    text = _echoed(raw_calib().to_ros()[0], **changes)
+    if changes.get("p", 0) is None:
+        text = "\n".join(line for line in text.splitlines() if not line.startswith("p:"))
+    with pytest.raises(ValueError, match=message):
+        parse_ros_camera_info(text, "left")

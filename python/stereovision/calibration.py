@@ -1395,7 +1395,9 @@ class Calibration:
         (:meth:`from_kitti`; ``image_size`` is passed on), and ROS ``camera_info``
         (:meth:`from_ros`): a folder holding ``left.yaml`` and ``right.yaml``, ROS
         ``camera_calibration``'s ``calibrationdata.tar.gz``, or one of the two files when the
-        other lies beside it (``left`` and ``right`` swapped in its name), and Kalibr's
+        other lies beside it (``left`` and ``right`` swapped in its name), each file as
+        ``camera_calibration`` writes it or a ``sensor_msgs/CameraInfo`` message as
+        ``ros2 topic echo`` / ``rostopic echo`` prints it, and Kalibr's
         ``camchain.yaml`` (:meth:`from_kalibr`, ``cam0`` and ``cam1``). A scene folder
         (:func:`stereovision.io.load_scene`) gives its ``calib.txt``, else its ``Q.dat``
         (:meth:`from_q`, sized by ``image_size`` or the folder's ``left.png``); so does a
@@ -1494,7 +1496,9 @@ class Calibration:
         p, text = cls._read_text(path)
         if re.search(r"^cam\d+\s*:", text, re.MULTILINE) and "intrinsics" in text:
             return cls.from_kalibr(p)
-        if _ROS_HEAD.search(text) and "projection_matrix" in text:
+        if (_ROS_HEAD.search(text) and "projection_matrix" in text) or all(
+            r.search(text) for r in _ROS_MESSAGE
+        ):
             pair = _ros_sibling(p)
             if pair is None:
                 raise ValueError(
@@ -2374,6 +2378,12 @@ _ROS_MATRIX_SHAPES = {
 #: How far from identity a ROS ``rectification_matrix`` may be for the pair to count as rectified.
 _ROS_IDENTITY_TOL = 1e-12
 _ROS_HEAD = re.compile(r"^\s*camera_matrix\s*:", re.MULTILINE)
+#: A ``sensor_msgs/CameraInfo`` message as a topic echo prints it (``P:`` in ROS 1).
+_ROS_MESSAGE = (
+    re.compile(r"^distortion_model\s*:", re.M),
+    re.compile(r"^[pP]\s*:", re.M),
+    re.compile(r"^width\s*:", re.M),
+)
 
 
 def _ros_matrix(value: object, key: str, source: str, size: int | None) -> F64:
@@ -2416,8 +2426,9 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
     """Parse one camera's ROS ``camera_info`` YAML (as written by ROS ``camera_calibration``).
 
     Accepts ``{rows, cols, data}`` matrices or flat lists, OpenCV's ``%YAML:1.0`` header and
-    ``!!opencv-matrix`` tags, and the old spellings ``distortion_coefficents`` and
-    ``camera_model``.
+    ``!!opencv-matrix`` tags, the old spellings ``distortion_coefficents`` and
+    ``camera_model``, and a ``sensor_msgs/CameraInfo`` message as a topic echo prints it
+    (``width``, ``height``, ``k d r p`` or ROS 1's ``K D R P``; the first of several).
 
     Parameters
     ----------
@@ -2435,8 +2446,9 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
     Raises
     ------
     ValueError
-        If the YAML does not parse, a field is missing or malformed (named), or the distortion
-        model is not one of :data:`ROS_DISTORTION_MODELS` (``equidistant`` is the fisheye model).
+        If the YAML does not parse, a field is missing or malformed (named), the distortion
+        model is not one of :data:`ROS_DISTORTION_MODELS` (``equidistant`` is the fisheye model),
+        or a message is a binned or cropped camera's.
     """
     import yaml
 
@@ -2444,7 +2456,8 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
     clean = re.sub(r"^%YAML:1\.0[^\n]*\n", "", text.lstrip("\ufeff"))
     clean = re.sub(r"!!opencv-matrix\b", "", clean)
     try:
-        doc = yaml.safe_load(clean)
+        # a topic echo ends its message with "---" (and may print several): the first one
+        docs = [d for d in yaml.safe_load_all(clean) if d is not None]
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"line {mark.line + 1}: " if mark is not None else ""
@@ -2452,8 +2465,11 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
             f"cannot parse {source} as ROS camera_info YAML: {where}"
             f"{getattr(exc, 'problem', None) or exc}"
         ) from None
+    doc = docs[0] if docs else None
     if not isinstance(doc, dict):
         raise ValueError(f"{source}: expected a ROS camera_info mapping")
+    if _is_camera_info_message(doc):
+        doc = _message_as_file(doc, source)
     if "distortion_coefficients" not in doc and "distortion_coefficents" in doc:
         doc["distortion_coefficients"] = doc["distortion_coefficents"]
     for key in (*_ROS_FIELDS, "image_width", "image_height"):
@@ -2491,6 +2507,51 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
         )
     if d.size == 4 and model != "equidistant":
         out["D"] = np.append(d, 0.0)
+    return out
+
+
+def _is_camera_info_message(doc: dict[Any, Any]) -> bool:
+    """Whether ``doc`` is a ``sensor_msgs/CameraInfo`` message (``width``, ``k`` or ``K``, ...),
+    not ``camera_calibration``'s file (``image_width``, ``camera_matrix``, ...)."""
+    return "camera_matrix" not in doc and "width" in doc and ("k" in doc or "K" in doc)
+
+
+def _message_as_file(doc: dict[Any, Any], source: str) -> dict[str, Any]:
+    """A ``sensor_msgs/CameraInfo`` message as ``ros2 topic echo --once`` (``k d r p``) or
+    ROS 1's ``rostopic echo -n 1`` (``K D R P``) prints it, in ``camera_calibration``'s fields.
+
+    Raises
+    ------
+    ValueError
+        A field missing (named), or a binned or cropped camera: its ``K`` and ``P`` are the
+        full sensor's, not the image's (the bag reader scales a binned one, a file is refused).
+    """
+    out: dict[str, Any] = {
+        "image_width": doc["width"],
+        "image_height": doc.get("height"),
+        "distortion_model": doc.get("distortion_model") or "plumb_bob",
+    }
+    for short, key in zip("KDRP", _ROS_FIELDS, strict=True):
+        name = next((n for n in (short.lower(), short) if doc.get(n) is not None), None)
+        if name is None:
+            raise ValueError(
+                f"ROS camera_info message {source} lacks field {short.lower()!r} ({short!r})"
+            )
+        out[key] = doc[name]
+    for axis in ("binning_x", "binning_y"):
+        if doc.get(axis) not in (None, 0, 1):
+            raise ValueError(
+                f"{source}: {axis} {doc[axis]!r}: a binned camera's camera_info describes the "
+                "full sensor, not these images; calibrate at the binned size"
+            )
+    roi = doc.get("roi")
+    if isinstance(roi, dict) and (roi.get("width") or roi.get("height")):
+        if (roi.get("width"), roi.get("height")) != (doc["width"], doc.get("height")):
+            raise ValueError(
+                f"{source}: camera_info has a region of interest ({roi.get('width')}x"
+                f"{roi.get('height')} at {roi.get('x_offset')},{roi.get('y_offset')}); "
+                "cropped cameras are not supported"
+            )
     return out
 
 
