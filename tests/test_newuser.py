@@ -398,3 +398,17 @@ def test_a_path_as_a_numpy_string_or_bytes_is_said_as_a_path() -> None:
             with pytest.raises(ValueError) as exc:
                 call(image, image, given)
             assert str(exc.value).startswith(f"calib: got the path {left!r}, not a calibrat")
+
+
+def test_matches_score_says_what_each_method_scores() -> None:
+    """Matches' score was documented as a 7x7 ZNCC in [-1, 1] whatever the method: MCGM's is
+    its GHT score, Gabor's its confidence and the fused members' the share of channels that
+    agree, so `m[m.score > 0.9]` read differently per method without a word."""
+    import re
+
+    from stereovision.match import METHODS
+
+    doc = stereovision.Matches.__doc__ or ""
+    score = doc.split("score :", 1)[1].split("image_shape :", 1)[0]
+    unsaid = [m for m in METHODS if not re.search(rf'"{m}"', score)]
+    assert not unsaid, f"Matches.score does not say what these methods score: {unsaid}"

@@ -60,7 +60,11 @@ class Matches:
     xr, yr : numpy.ndarray
         ``(N,)`` float32 matched right-image positions (px; ``xr`` sub-pixel).
     score : numpy.ndarray
-        ``(N,)`` float32 match similarity (7x7 ZNCC, in ``[-1, 1]``).
+        ``(N,)`` float32, higher is better; what it measures depends on the matcher
+        (:func:`stereovision.match`'s ``method``): ``"hopfield"`` and ``"best"`` the 7x7 ZNCC
+        (in ``[-1, 1]``; from ``s_min``, 0.8, up), ``"mcgm"`` the GHT score of the matched segment
+        pair (in ``[0, 1]``), ``"gabor"`` the channel's confidence (in ``[0, 1]``), ``"fused"``
+        the share of the available channels that agree (2/3 or 1 with all three).
     image_shape : tuple of int
         ``(H, W)`` of the left image (size of :attr:`dispx` / :attr:`dispy`).
     energy_trace : numpy.ndarray
