@@ -802,3 +802,18 @@ def test_an_echoed_camera_info_this_cannot_read_is_named(changes: dict, message:
         text = "\n".join(line for line in text.splitlines() if not line.startswith("p:"))
     with pytest.raises(ValueError, match=message):
         parse_ros_camera_info(text, "left")
+
+
+def test_one_camera_info_alone_names_the_partner_it_looked_for(tmp_path: Path) -> None:
+    """A lone file was told 'its partner (left/right swapped in the name) is not beside it',
+    also when its name holds neither (ROS's monocular head_camera.yaml): the partner looked for
+    is named, and a name without a side is said to be one."""
+    left = raw_calib().save_ros(tmp_path / "ros")[0]
+    (tmp_path / "ros" / "right.yaml").unlink()
+    with pytest.raises(ValueError, match=r"its partner .*right\.yaml is not beside it"):
+        Calibration.from_file(left)
+    head = tmp_path / "head_camera.yaml"
+    head.write_bytes(left.read_bytes())
+    with pytest.raises(ValueError, match="its name says neither left nor right") as err:
+        Calibration.from_file(head)
+    assert "swapped" not in str(err.value)

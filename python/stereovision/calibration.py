@@ -1499,12 +1499,18 @@ class Calibration:
         if (_ROS_HEAD.search(text) and "projection_matrix" in text) or all(
             r.search(text) for r in _ROS_MESSAGE
         ):
-            pair = _ros_sibling(p)
+            pair = _ros_partner(p)
             if pair is None:
                 raise ValueError(
-                    f"{p} is one camera's ROS camera_info and its partner (left/right swapped "
-                    "in the name) is not beside it; pass the folder holding left.yaml and "
-                    "right.yaml"
+                    f"{p} is one camera's ROS camera_info, and its name says neither left nor "
+                    "right: a rig needs both cameras' files; pass the folder holding left.yaml "
+                    "and right.yaml"
+                )
+            other = pair[1] if pair[0] == p else pair[0]
+            if not other.is_file():
+                raise ValueError(
+                    f"{p} is one camera's ROS camera_info and its partner {other} is not "
+                    "beside it; pass the folder holding left.yaml and right.yaml"
                 )
             return cls.from_ros(*pair)
         head = text.lstrip()
@@ -2711,17 +2717,23 @@ def _ros_pair_from_folder(folder: Path) -> tuple[Path, Path] | None:
     return None
 
 
-def _ros_sibling(path: Path) -> tuple[Path, Path] | None:
+def _ros_partner(path: Path) -> tuple[Path, Path] | None:
+    """``(left, right)`` with ``path`` one of them and the other named by swapping ``left``
+    and ``right`` in its name (any case), whether or not it exists; None for a name with
+    neither."""
     # "left.yaml" names "right.yaml" (and cam_left_x.yml names cam_right_x.yml), and back.
     name = path.name
     for a, b in (("left", "right"), ("Left", "Right"), ("LEFT", "RIGHT")):
         if a in name:
-            other = path.with_name(name.replace(a, b))
-            return (path, other) if other.is_file() else None
+            return path, path.with_name(name.replace(a, b))
         if b in name:
-            other = path.with_name(name.replace(b, a))
-            return (other, path) if other.is_file() else None
+            return path.with_name(name.replace(b, a)), path
     return None
+
+
+def _ros_sibling(path: Path) -> tuple[Path, Path] | None:
+    pair = _ros_partner(path)
+    return pair if pair is not None and all(p.is_file() for p in pair) else None
 
 
 def _read_ros_tar(path: Path) -> tuple[str, str]:
