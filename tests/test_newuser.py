@@ -412,3 +412,31 @@ def test_matches_score_says_what_each_method_scores() -> None:
     score = doc.split("score :", 1)[1].split("image_shape :", 1)[0]
     unsaid = [m for m in METHODS if not re.search(rf'"{m}"', score)]
     assert not unsaid, f"Matches.score does not say what these methods score: {unsaid}"
+
+
+def test_a_stereo_calibrate_dump_is_told_which_fields_to_add(tmp_path: Path) -> None:
+    """cv2.stereoCalibrate's K1 D1 K2 D2 R T written as they are (OpenCV's tutorials do) were
+    told "lacks field 'image_width'", then "lacks field 'unit'", with no word of what either is:
+    each missing field says what to write, the unit that it is T's (the square size's)."""
+    import cv2
+
+    from stereovision.calibration import Calibration
+
+    calib = Calibration.from_file(CONES / "calib.txt")
+    path = tmp_path / "stereo.yaml"
+    fs = cv2.FileStorage(str(path), cv2.FILE_STORAGE_WRITE)
+    for key in ("K1", "D1", "K2", "D2", "R", "T"):
+        fs.write(key, getattr(calib, key))
+    fs.release()
+    with pytest.raises(ValueError, match="lacks field 'image_width'") as err:
+        Calibration.from_file(path)
+    assert "image_width and image_height" in str(err.value)
+    assert "size in pixels of the images it was calibrated on" in str(err.value)
+    text = path.read_text() + "image_width: 450\nimage_height: 375\n"
+    path.write_text(text)
+    with pytest.raises(ValueError, match="lacks field 'unit'") as err:
+        Calibration.from_file(path)
+    assert "length unit of T" in str(err.value) and "square" in str(err.value)
+    path.write_text(text + "unit: mm\n")
+    read = Calibration.from_file(path)
+    assert read.baseline_m == calib.baseline_m and np.array_equal(read.K1, calib.K1)

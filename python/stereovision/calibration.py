@@ -325,6 +325,22 @@ def _not_a_calibration(fs: Any, source: str) -> str:
     return _not_a_calibration_keys(keys, source)
 
 
+# What a file holding cv2.stereoCalibrate's K1 D1 K2 D2 R T alone is told to add.
+_SIZE_MISSING = (
+    ": add image_width and image_height, the size in pixels of the images it was calibrated "
+    "on (cv2.stereoCalibrate's K1, D1, K2, D2, R and T do not hold it)"
+)
+_UNIT_MISSING = (
+    "unit, the length unit of T (that of the board's square size it was calibrated with): "
+    "m, mm, cm, ft or in"
+)
+_MISSING = {
+    "image_width": _SIZE_MISSING,
+    "image_height": _SIZE_MISSING,
+    "unit": ": add " + _UNIT_MISSING,
+}
+
+
 def _pixels(value: object, what: str) -> int:
     """A file's image width or height: a positive whole number of pixels (``1242.0`` is read as
     1242; ``inf``, ``nan``, ``-5`` and ``713.7`` are refused, naming the field and the file)."""
@@ -1248,7 +1264,10 @@ class Calibration:
                 v = get(k)
                 if v is not None:
                     return v
-            raise ValueError(f"calibration file {source} lacks field {key!r}")
+            hint = _MISSING.get(key, "")
+            if key.startswith("image_") and get("unit") is None:
+                hint += ", and " + _UNIT_MISSING  # both missing: both said at once
+            raise ValueError(f"calibration file {source} lacks field {key!r}{hint}")
 
         def integer(key: str) -> int:
             v = need(key)
