@@ -440,3 +440,16 @@ def test_a_stereo_calibrate_dump_is_told_which_fields_to_add(tmp_path: Path) -> 
     path.write_text(text + "unit: mm\n")
     read = Calibration.from_file(path)
     assert read.baseline_m == calib.baseline_m and np.array_equal(read.K1, calib.K1)
+
+
+def test_stream_help_says_a_recording_brings_its_own_calibration() -> None:
+    """stream's --bag and --ground-every said "needs --calib", though with --from-bag the
+    recording's camera_info is the calibration (README: `stream --from-bag run/ --bag out/`)."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    commands = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    helps = {a.dest: a.help or "" for a in commands.choices["stream"]._actions}
+    for dest in ("bag", "ground_every"):
+        assert "--from-bag" in helps[dest] and "camera_info" in helps[dest], helps[dest]

@@ -1543,14 +1543,16 @@ def add_cli(subparsers: Any) -> None:
         "--bag",
         metavar="DIR",
         help="also record every frame into a new ROS 2 bag (rectified left image, camera_info, "
-        "depth, points); needs --calib and the rosbags package",
+        "depth, points); needs a calibration (--calib, or with --from-bag the recording's "
+        "camera_info) and the rosbags package",
     )
     p.add_argument(
         "--ground-every",
         type=positive_count,
         metavar="N",
         help="fit the floor on every N-th pair and warn when the camera's height, pitch or roll "
-        "moves (a mount that slipped); needs --calib",
+        "moves (a mount that slipped); needs a calibration (--calib, or with --from-bag the "
+        "recording's camera_info)",
     )
     p.add_argument(
         "--temporal",
