@@ -1769,3 +1769,34 @@ def test_from_file_reads_an_indented_middlebury_calib(data_dir: Path, tmp_path: 
     indented = tmp_path / "calib.txt"
     indented.write_text("".join(f"  {line}\n" for line in src.read_text().splitlines()))
     assert Calibration.from_file(indented) == Calibration.from_file(src)
+
+
+def test_from_kitti_reads_the_grey_pair_when_asked(tmp_path: Path) -> None:
+    """KITTI's files hold four cameras; from_kitti read the colour pair (2, 3) alone, so the
+    grey sequences (image_0/ + image_1/, the odometry benchmark's) got the colour pair's
+    baseline: 0.5323 against 0.5372 m on odometry sequence 00, depth 0.9 % off without a word.
+    cameras=(0, 1) reads theirs, from the odometry file (P0, P1) and the raw one (P_rect_00,
+    P_rect_01, S_rect_00)."""
+    f = 7.188560e02
+
+    def p(tx: float, ty: float = 0.0, tz: float = 0.0) -> str:
+        return f"{f} 0 607.1928 {tx} 0 {f} 185.2157 {ty} 0 0 1 {tz}"
+
+    odo = tmp_path / "calib.txt"
+    odo.write_text(
+        f"P0: {p(0.0)}\nP1: {p(-386.1448)}\nP2: {p(45.38225, -0.1130887, 0.003779761)}\n"
+        f"P3: {p(-337.2877, 2.369057, 0.004915215)}\n"
+    )
+    colour = Calibration.from_kitti(odo, image_size=(1241, 376))
+    grey = Calibration.from_kitti(odo, image_size=(1241, 376), cameras=(0, 1))
+    assert colour.baseline_m == pytest.approx((45.38225 + 337.2877) / f, rel=1e-12)
+    assert grey.baseline_m == pytest.approx(386.1448 / f, rel=1e-12)
+    raw = tmp_path / "calib_cam_to_cam.txt"
+    raw.write_text(
+        f"S_rect_00: 1.241e+03 3.76e+02\nP_rect_00: {p(0.0)}\nP_rect_01: {p(-386.1448)}\n"
+    )
+    assert Calibration.from_kitti(raw, cameras=(0, 1)) == grey
+    with pytest.raises(ValueError, match=r"lacks P_rect_02/P_rect_03 \(or P2/P3\)"):
+        Calibration.from_kitti(raw)
+    with pytest.raises(ValueError, match=r"cameras: expected two of KITTI's cameras 0-3"):
+        Calibration.from_kitti(odo, image_size=(1241, 376), cameras=(1, 1))
