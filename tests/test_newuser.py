@@ -453,3 +453,19 @@ def test_stream_help_says_a_recording_brings_its_own_calibration() -> None:
     helps = {a.dest: a.help or "" for a in commands.choices["stream"]._actions}
     for dest in ("bag", "ground_every"):
         assert "--from-bag" in helps[dest] and "camera_info" in helps[dest], helps[dest]
+
+
+def test_homographies_given_as_a_calibration_in_python_say_how_to_load_them(
+    tmp_path: Path,
+) -> None:
+    """Calibration.from_file('rect/rectification.json') told a Python user only to "give it as
+    --rectification", a command-line option; it names the loader too."""
+    import json
+
+    from stereovision.calibration import Calibration
+
+    path = tmp_path / "rectification.json"
+    path.write_text(json.dumps({"H1": [[1.0]], "H2": [[1.0]], "F": [[1.0]]}))
+    with pytest.raises(ValueError, match="--rectification") as err:
+        Calibration.from_file(path)
+    assert "UncalibratedRectification.load(" in str(err.value)

@@ -1345,7 +1345,8 @@ class Calibration:
         if "H1" in obj and "H2" in obj and "F" in obj:
             raise ValueError(
                 f"{source} holds the homographies `stereovision rectify` found for a rig without "
-                "a calibration (disparity only): give it as --rectification"
+                "a calibration (disparity only): give it as --rectification (in Python: "
+                "stereovision.uncalibrated.UncalibratedRectification.load(path), passed as calib)"
             )
         if not any(k in obj for k in _CALIBRATION_FIELDS):  # as a YAML file says it
             raise ValueError(_not_a_calibration_keys([str(k) for k in obj], source))
