@@ -469,3 +469,16 @@ def test_homographies_given_as_a_calibration_in_python_say_how_to_load_them(
     with pytest.raises(ValueError, match="--rectification") as err:
         Calibration.from_file(path)
     assert "UncalibratedRectification.load(" in str(err.value)
+
+
+def test_a_board_square_given_in_mm_with_the_unit_left_at_metres_is_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`board --square 30` (30 mm meant, --unit left at m) was refused as "a 30000 mm square at
+    300 dpi is 354331 px", and --square 1.5 printed a 1.5 m square: a square over 1 m is said
+    to be one, with the unit to give (calibrate says it of the baseline it finds)."""
+    assert main(["board", "-o", str(tmp_path / "b.png"), "--square", "30"]) == 2
+    err = capsys.readouterr().err
+    assert "--square 30 m is a 30 m board square" in err and "--unit mm" in err
+    assert main(["board", "-o", str(tmp_path / "b.png"), "--square", "30", "--unit", "mm"]) == 0
+    assert "warning" not in capsys.readouterr().err

@@ -2885,6 +2885,16 @@ def cmd_board(args: argparse.Namespace) -> int:
     from stereovision._validate import positive_finite
 
     square = positive_finite(args.square, "--square")
+    metres = square * UNIT_TO_METRES[args.unit]
+    if metres > 1.0:
+        # 30 meant as mm with --unit left at m was refused as "a 30000 mm square at 300 dpi is
+        # 354331 px", or, up to 1.69 m, printed at that size
+        warnings.warn(
+            f"--square {square:g} {args.unit} is a {metres:g} m board square: measured in mm or "
+            "cm? give its unit (--unit mm)",
+            UserWarning,
+            stacklevel=2,
+        )
     dpi = positive_finite(args.dpi, "--dpi")
     if board is not None:
         data, (w, h) = board_png(board, square * UNIT_TO_METRES[args.unit], dpi)
