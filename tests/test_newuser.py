@@ -482,3 +482,18 @@ def test_a_board_square_given_in_mm_with_the_unit_left_at_metres_is_said(
     assert "--square 30 m is a 30 m board square" in err and "--unit mm" in err
     assert main(["board", "-o", str(tmp_path / "b.png"), "--square", "30", "--unit", "mm"]) == 0
     assert "warning" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("call", ["depth_map", "match"])
+def test_a_method_given_in_the_calibrations_place_is_named_a_method(call: str) -> None:
+    """`sv.match(left, right, "mcgm")` (method is keyword-only, the third argument the
+    calibration) was told "got the path 'mcgm', not a calibration: read it first"."""
+    image = np.zeros((32, 48), np.uint8)
+    with pytest.raises(ValueError, match=r"calib: got 'mcgm', a method's name.*method='mcgm'"):
+        getattr(stereovision, call)(image, image, "mcgm")
+    with pytest.raises(ValueError, match=r"got the path 'rig\.yaml'"):
+        getattr(stereovision, call)(image, image, "rig.yaml")
+    from stereovision.depth import _ALL_METHODS
+    from stereovision.match import METHODS
+
+    assert set(METHODS) <= _ALL_METHODS  # a method match gains is known here too

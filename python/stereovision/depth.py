@@ -57,6 +57,9 @@ _D = TypeVar("_D", int, float)  # a max_disparity (match and depth_map take a fl
 METHODS = ("fused", "gabor", "census", "fast")
 #: Methods whose output is dense by default (holes filled, ``fill=None``).
 _DENSE_METHODS = ("fused", "census", "fast")
+#: Every method name of :func:`depth_map` and :func:`stereovision.match`, to tell one given in
+#: the calibration's place from a file's name.
+_ALL_METHODS = frozenset((*METHODS, "hopfield", "best", "mcgm"))
 #: Methods that re-measure (``refine=None``) unless told not to; ``"fast"`` does not.
 _REFINED_BY_DEFAULT = ("fused", "gabor", "census")
 #: ``fused_dense`` options that apply to ``method="census"`` (the speckle and edge checks, and
@@ -154,6 +157,11 @@ def _rig_to_warp_by(
     if calib is None:
         return None, None, max_disparity
     path = path_given(calib)
+    if path in _ALL_METHODS:  # match(left, right, "mcgm"): method is keyword-only
+        raise ValueError(
+            f"calib: got {path!r}, a method's name, not a calibration: give it as "
+            f"method={path!r} (the third argument is the calibration)"
+        )
     if path is not None:  # a calib.txt's name: said, not just "got str"
         raise ValueError(
             f"calib: got the path {path!r}, not a calibration: read it first "
