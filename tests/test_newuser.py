@@ -497,3 +497,35 @@ def test_a_method_given_in_the_calibrations_place_is_named_a_method(call: str) -
     from stereovision.match import METHODS
 
     assert set(METHODS) <= _ALL_METHODS  # a method match gains is known here too
+
+
+def test_the_result_helpers_name_what_to_pass_instead() -> None:
+    """First mistakes past depth_map: a calibration's path to check_rectification (and the
+    other functions taking a Calibration) was "expected a stereovision.Calibration, got str";
+    obstacle_mask given res.points was "expected shape (H, W, 3), got (N, 3)"; reproject given
+    the whole result was "expected a real (H, W) array, got shape () dtype object"."""
+    import stereovision as sv
+
+    calib = sv.Calibration.from_file(CONES / "calib.txt")
+    image = np.zeros((375, 450), np.uint8)
+    with pytest.raises(TypeError, match=r"calib: got the path 'calib\.txt'.*from_file"):
+        sv.check_rectification(image, image, "calib.txt")
+    disparity = np.full((375, 450), 20.0, np.float32)
+    disparity[200:] += np.linspace(0, 30, 175, dtype=np.float32)[:, None]  # a floor
+    res = sv.DepthResult(
+        disparity=disparity,
+        confidence=np.ones_like(disparity),
+        depth=calib.depth_from_disparity(disparity),
+        points=calib.reproject(disparity).reshape(-1, 3),
+        colors=np.zeros((375 * 450, 3), np.uint8),
+        pixels=np.zeros((375 * 450, 2), np.int32),
+        method="gabor",
+        max_disparity=64,
+        calibration=calib,
+    )
+    plane = sv.fit_ground_plane(disparity, calib)
+    assert plane is not None
+    with pytest.raises(ValueError, match=r"got \(168750, 3\).*point_image\(filled=True\)"):
+        sv.obstacle_mask(res.points, plane)
+    with pytest.raises(TypeError, match=r"disparity: got a DepthResult; .*result\.disparity"):
+        calib.reproject(res)

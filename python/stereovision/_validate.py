@@ -881,6 +881,12 @@ def require(value: object, kind: str, name: str) -> None:
 
     cls = getattr(importlib.import_module(_CLASSES[kind]), kind)
     if not isinstance(value, cls):
+        path = path_given(value) if kind == "Calibration" else None
+        if path is not None:  # a calib.txt's name, as depth_map says it
+            raise TypeError(
+                f"{name}: got the path {path!r}, not a calibration: read it first "
+                "(stereovision.Calibration.from_file(path))"
+            )
         raise TypeError(f"{name}: expected a stereovision.{kind}, got {type(value).__name__}")
 
 

@@ -745,7 +745,10 @@ def obstacle_mask(
     not_a_result(points, "points", "point_image()")
     pts = np.asarray(points, np.float64)
     if pts.ndim != 3 or pts.shape[2] != 3:
-        raise ValueError(f"points: expected shape (H, W, 3), got {pts.shape}")
+        # res.points is the cloud, one row per pixel with a depth: no image to mark
+        cloud = pts.ndim == 2 and pts.shape[1:] == (3,)
+        hint = ": the image-shaped points, result.point_image(filled=True)" if cloud else ""
+        raise ValueError(f"points: expected shape (H, W, 3), got {pts.shape}{hint}")
     lo, hi = _number(min_height, "min_height"), _number(max_height, "max_height")
     if not (math.isfinite(lo) and lo >= 0 and hi > lo):
         raise ValueError(

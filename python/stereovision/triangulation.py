@@ -296,6 +296,9 @@ def triangulate(
 
 
 def _disparity(disparity: npt.ArrayLike) -> F64:
+    from stereovision._validate import not_a_result
+
+    not_a_result(disparity, "disparity", "disparity")
     d = np.asarray(disparity)
     if d.ndim != 2 or d.dtype.kind not in "iuf":
         raise ValueError(
