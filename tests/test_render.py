@@ -1029,6 +1029,36 @@ def test_render_projects_with_an_off_centre_principal_point():
     np.testing.assert_allclose(_lit_centroids(img, expected), expected, atol=1.0)
 
 
+def test_a_result_with_non_square_pixels_renders_each_axis_at_its_focal_length(result):
+    """``Intrinsics.from_result`` took ``fx`` for the only focal length, and the vertical view
+    angle came from it: with ``fx != fy`` (binned or anamorphic pixels; the points' ``Y`` is
+    ``(v - cy) Z / fy``) rows were rendered ``fx / fy`` too far from ``cy``. Points back-projected
+    from known pixels land on them, and the bottom row's point is in view."""
+    fx, fy = 150.0, 120.0
+    k = np.array([[fx, 0.0, syn.CX], [0.0, fy, syn.CY], [0.0, 0.0, 1.0]])
+    calib = dataclasses.replace(syn.calibration(), K1=k, K2=k.copy())
+    intr = render.Intrinsics.from_result(dataclasses.replace(result, calibration=calib))
+    assert intr is not None and (intr.f, intr.fy) == (fx, fy)
+    pixels = np.array([[20.0, 10.0], [140.0, 110.0], [79.5, 100.0], [120.0, 25.0]])
+    z = np.array([4.0, 4.0, 3.0, 5.0])
+    pts = np.stack([(pixels[:, 0] - syn.CX) * z / fx, (pixels[:, 1] - syn.CY) * z / fy, z], 1)
+    plotter = render.make_plotter((intr.width, intr.height))
+    try:
+        for p in pts:
+            plotter.add_mesh(pv.PolyData(p[None].astype(np.float32)), color="white",
+                             point_size=3, style="points", lighting=False)  # fmt: skip
+        render.apply_camera(plotter, CameraControls(), intrinsics=intr, focal_distance=4.0)
+        img = plotter.screenshot(return_img=True)
+    finally:
+        plotter.close()
+    np.testing.assert_allclose(_lit_centroids(img, pixels), pixels, atol=1.0)
+    # the last row's centre (119 px, 59.5 px below cy) is in view; at fx it was 74 px below
+    bottom = np.array([[0.0, (syn.H - 1 - syn.CY) * 4.0 / fy, 4.0]])
+    assert render.points_in_view(bottom, CameraControls(), (syn.W, syn.H), intr) == 1
+    half = intr.scaled(0.5)
+    assert (half.f, half.fy) == (75.0, 60.0)
+
+
 def test_apply_camera_without_intrinsics_resets_the_window_centre():
     """The GUI's plotter shows a calibrated scene (window centre shifted to its principal
     point), then a bare PLY: the shift of the scene before must not stay."""

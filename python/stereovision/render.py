@@ -315,13 +315,23 @@ def orbit_controls(yaw: float, pitch: float, center_depth: float) -> CameraContr
 
 @dataclass(frozen=True)
 class Intrinsics:
-    """Pinhole intrinsics of the rendered view (pixels), origin at the top-left pixel's centre."""
+    """Pinhole intrinsics of the rendered view (pixels), origin at the top-left pixel's centre.
+
+    ``f`` is the horizontal focal length (``fx``); ``fy`` the vertical one, None for square
+    pixels (``fy = f``).
+    """
 
     f: float
     cx: float
     cy: float
     width: int
     height: int
+    fy: float | None = None
+
+    @property
+    def focal_y(self) -> float:
+        """The vertical focal length (pixels): ``fy``, or ``f`` for square pixels."""
+        return self.f if self.fy is None else self.fy
 
     @classmethod
     def from_result(cls, result: DepthResult) -> Intrinsics | None:
@@ -331,7 +341,8 @@ class Intrinsics:
             return None
         k = np.asarray(calib.K1, dtype=np.float64)
         h, w = result.disparity.shape[:2]
-        return cls(float(k[0, 0]), float(k[0, 2]), float(k[1, 2]), int(w), int(h))
+        # the points' Y is (v - cy) Z / fy: fx here rendered non-square pixels' rows off
+        return cls(float(k[0, 0]), float(k[0, 2]), float(k[1, 2]), int(w), int(h), float(k[1, 1]))
 
     def scaled(self, factor: float) -> Intrinsics:
         """The same camera for an image scaled by ``factor`` (pixel centres kept consistent)."""
@@ -341,6 +352,7 @@ class Intrinsics:
             (self.cy + 0.5) * factor - 0.5,
             max(1, round(self.width * factor)),
             max(1, round(self.height * factor)),
+            None if self.fy is None else self.fy * factor,
         )
 
 
@@ -359,9 +371,10 @@ def apply_camera(
     plotter : pyvista.Plotter
     controls : CameraControls
     intrinsics : Intrinsics, optional
-        With intrinsics the view angle is ``2 atan(H / 2f)`` and the window centre is shifted to the
-        principal point, so a zero-control render lines up with the left image pixel for pixel
-        (when the window is ``width x height``). Without, a :data:`DEFAULT_FOV_DEG` view.
+        With intrinsics the view angle is ``2 atan(H / 2 fy)`` (``fx != fy``: an explicit aspect
+        ratio) and the window centre is shifted to the principal point, so a zero-control render
+        lines up with the left image pixel for pixel (when the window is ``width x height``).
+        Without, a :data:`DEFAULT_FOV_DEG` view.
     focal_distance : float
         Distance of the focal point ahead of the camera (metres): the centre of mouse rotations.
     points : array_like (N, 3), optional
@@ -376,7 +389,14 @@ def apply_camera(
     cam.focal_point = tuple(pos + focal_distance * rot[:, 2])
     cam.up = tuple(-rot[:, 1])
     if intrinsics is not None:
-        cam.view_angle = math.degrees(2 * math.atan(intrinsics.height / (2 * intrinsics.f)))
+        fy = intrinsics.focal_y
+        cam.view_angle = math.degrees(2 * math.atan(intrinsics.height / (2 * fy)))
+        # VTK's pixels are square (fx = fy from the vertical view angle): for fx != fy the
+        # horizontal scale comes from an explicit aspect ratio, width / height x fy / fx
+        anamorphic = fy != intrinsics.f
+        cam.SetUseExplicitAspectRatio(anamorphic)
+        if anamorphic:
+            cam.SetExplicitAspectRatio(intrinsics.width / intrinsics.height * fy / intrinsics.f)
         # VTK shifts the image by the window centre: a principal point right of / below the
         # image centre needs the opposite shift (measured: tests/test_render.py projection test).
         wx = 1 - 2 * (intrinsics.cx + 0.5) / intrinsics.width
@@ -385,6 +405,7 @@ def apply_camera(
     else:
         cam.view_angle = DEFAULT_FOV_DEG
         cam.SetWindowCenter(0.0, 0.0)
+        cam.SetUseExplicitAspectRatio(False)
     if points is not None:
         cam.clipping_range = robust_clipping_range(points, pos)
     else:
@@ -1010,16 +1031,16 @@ def points_in_view(
     w, h = size
     if intrinsics is not None:
         k = intrinsics.scaled(w / intrinsics.width)
-        f, cx, cy = k.f, k.cx, k.cy
+        f, fy, cx, cy = k.f, k.focal_y, k.cx, k.cy
     else:
-        f = (h / 2) / math.tan(math.radians(DEFAULT_FOV_DEG / 2))
+        f = fy = (h / 2) / math.tan(math.radians(DEFAULT_FOV_DEG / 2))
         cx, cy = w / 2 - 0.5, h / 2 - 0.5
     pose = controls.pose()
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     cam = (pts - pose[:3, 3]) @ pose[:3, :3]  # R^T (p - t)
     with np.errstate(divide="ignore", invalid="ignore"):
         x = f * cam[:, 0] / cam[:, 2] + cx
-        y = f * cam[:, 1] / cam[:, 2] + cy
+        y = fy * cam[:, 1] / cam[:, 2] + cy
     inside = (cam[:, 2] > 0) & (x >= -0.5) & (x < w - 0.5) & (y >= -0.5) & (y < h - 0.5)
     return int(np.count_nonzero(inside))
 
