@@ -11,6 +11,7 @@ import struct
 import subprocess
 import sys
 import zlib
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -878,3 +879,99 @@ def test_render_refuses_over_2000_px_per_square() -> None:
     board = CharucoBoard("3x4", 0.03, 0.02, "DICT_4X4_50")
     with pytest.raises(ValueError, match="pixels_per_square"):
         render_charuco(board, K1, D1, np.zeros(3), np.array([0, 0, 0.5]), pixels_per_square=2001)
+
+
+def test_a_boards_fields_are_stored_as_plain_python_values() -> None:
+    """A mutation audit found the stored fields unasserted: sizes given as NumPy numbers (a
+    size-1 array among them) are kept as floats (an array left the board unhashable for its
+    OpenCV cache), a short dictionary name as OpenCV's (``getattr(cv2.aruco, "5x5_100")``
+    failed), a NumPy bool layout as a bool (``json.dumps`` refused ``np.True_``)."""
+    board = CharucoBoard("7x5", np.array([0.03]), np.float32(0.02), " 5x5_100", legacy=np.True_)
+    assert type(board.square_size) is float and board.square_size == 0.03
+    assert type(board.marker_size) is float and board.marker_size == float(np.float32(0.02))
+    assert board.dictionary == "DICT_5X5_100" and board.legacy is True
+    assert CharucoBoard("7x6", 0.03, 0.02, legacy=0).legacy is False
+    assert json.loads(json.dumps([board.square_size, board.legacy])) == [0.03, True]
+    assert board.image(40).shape == (280, 360)
+
+
+def test_board_image_refuses_under_10_px_per_square() -> None:
+    """10 px per square is the least :meth:`CharucoBoard.image` draws (a mutant taking 9 drew a
+    4x4 marker of 6.3 px): 9 is refused by name."""
+    board = CharucoBoard("5x5", 1.0, 0.7, "DICT_4X4_50")
+    assert board.image(10).shape == (70, 70)
+    with pytest.raises(ValueError, match="pixels_per_square"):
+        board.image(9)
+
+
+def test_a_row_of_corners_and_one_more_spans_the_board() -> None:
+    """The collinearity test is relative to the spread of the corners, not a loose ratio: a
+    whole row (9 corners) and the first corner of the next one span the board (their smaller
+    singular value is 0.099 of the larger)."""
+    from stereovision.charuco import corners_span_plane
+
+    assert corners_span_plane(BOARD, np.arange(10))
+    assert not corners_span_plane(BOARD, np.arange(9))
+
+
+def test_found_ids_are_ascending_with_their_corners(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The ids are sorted, each corner kept with its id, whatever order the detector gave."""
+    import stereovision.charuco as ch
+
+    ids = np.array([10, 1, 2, 9, 0, 11])
+    corners = np.stack([ids * 10.0, ids + 0.5], 1).astype(np.float32).reshape(-1, 1, 2)
+
+    class Detector:
+        def detectBoard(self, _gray: Any) -> tuple[Any, Any, None, None]:
+            return corners, ids.reshape(-1, 1), None, None
+
+    monkeypatch.setattr(ch, "_detector", lambda _board: Detector())
+    found = find_charuco_corners(np.zeros((40, 40), np.uint8), BOARD)
+    assert found is not None and found[0].tolist() == [0, 1, 2, 9, 10, 11]
+    np.testing.assert_array_equal(found[1], np.stack([found[0] * 10.0, found[0] + 0.5], 1))
+
+
+def test_each_board_gets_a_detector_of_its_own_marker_size() -> None:
+    """The detector cache is keyed by the whole board: two boards differing only in their
+    markers' size do not share OpenCV's detector (and its board)."""
+    from stereovision.charuco import _detector
+
+    big = CharucoBoard("5x4", 0.03, 0.022, "DICT_4X4_50", legacy=False)
+    small = replace(big, marker_size=0.012)
+    assert _detector(big).getBoard().getMarkerLength() == pytest.approx(0.022)
+    assert _detector(small).getBoard().getMarkerLength() == pytest.approx(0.012)
+
+
+def test_render_supersample_antialiases_the_edges() -> None:
+    """One ray a pixel gives the board's few grey levels (25, 230, the background, and the
+    lookup's own blend at its pixel edges); four a side blend the edges into many."""
+    K = np.array([[200.0, 0, 79.5], [0, 200, 59.5], [0, 0, 1]])
+    board = CharucoBoard("3x4", 0.03, 0.02, "DICT_4X4_50")
+    pose = (np.zeros(3), np.array([-0.045, -0.06, 0.3]))
+    kw: dict[str, Any] = {"image_size": (160, 120)}
+    images = [render_charuco(board, K, np.zeros(5), *pose, supersample=s, **kw) for s in (1, 4)]
+    levels = [len(np.unique(img)) for img in images]
+    assert levels[0] <= 6 and levels[1] >= 15
+
+
+def test_object_points_are_float32_at_the_corners() -> None:
+    """OpenCV's calibration takes ``float32`` board points: corner 10 of a 9-wide grid is the
+    second column of the second row, two squares in from the top-left outer corner."""
+    pts = BOARD.object_points([0, 10])
+    assert pts.dtype == np.float32
+    np.testing.assert_allclose(pts, [[0.03, 0.03, 0], [0.06, 0.06, 0]], rtol=1e-6)
+
+
+def test_board_png_rounds_its_resolution_to_the_nearest_pixel_per_metre() -> None:
+    """A 30 mm square at 200 dpi is 236 px: 7866.67 px/m is stored as 7867, printing it 1.3 um
+    short (truncated to 7866 it was 2.5 um long)."""
+    data, _ = board_png((3, 3), 0.03, dpi=200)
+    assert struct.unpack(">IIB", _png_chunks(data)[b"pHYs"]) == (7867, 7867, 1)
+
+
+def test_an_even_rowed_board_in_the_current_layout_is_not_called_legacy() -> None:
+    """``legacy=False`` (OpenCV's current layout, as decided) is not described as the legacy
+    one, and an undecided layout (None) is not either."""
+    for legacy in (False, None):
+        board = CharucoBoard("9x8", 0.03, 0.02, "DICT_4X4_50", legacy=legacy)
+        assert board.describe().endswith("marker 0.02, DICT_4X4_50")
