@@ -975,3 +975,23 @@ def test_an_even_rowed_board_in_the_current_layout_is_not_called_legacy() -> Non
     for legacy in (False, None):
         board = CharucoBoard("9x8", 0.03, 0.02, "DICT_4X4_50", legacy=legacy)
         assert board.describe().endswith("marker 0.02, DICT_4X4_50")
+
+
+def test_board_png_refuses_a_huge_charuco_board_by_its_square_and_dpi(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A 200 mm square at 600 dpi (4724 px) makes a ChArUco image over MAX_IMAGE_PIXELS: it was
+    refused as "pixels_per_square: ... use fewer pixels per square", an argument board_png
+    has not; it is named as the chessboard's is, by the board and its pixels per square (the
+    limit inclusive, margins counted)."""
+    import stereovision.charuco as ch
+
+    with pytest.raises(ValueError, match=r"^a 10x7 ChArUco board at 4724 px per square is too"):
+        board_png(BOARD, 0.2, 600)
+    with pytest.raises(ValueError, match=r"^a 9x6 chessboard at 4724 px per square is too large"):
+        board_png((9, 6), 0.2, 600)
+    monkeypatch.setattr(ch, "MAX_IMAGE_PIXELS", 1200 * 900)  # 10x7 squares and margins, 100 px
+    assert board_png(BOARD, 0.01, dpi=254)[1] == (1200, 900)
+    monkeypatch.setattr(ch, "MAX_IMAGE_PIXELS", 1200 * 900 - 1)
+    with pytest.raises(ValueError, match=r"^a 10x7 ChArUco board at 100 px per square is too"):
+        board_png(BOARD, 0.01, dpi=254)

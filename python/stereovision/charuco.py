@@ -585,6 +585,11 @@ def board_png(
     """
     pix, ppm = _board_scale(square_metres, dpi)
     if isinstance(board, CharucoBoard):
+        cols, rows = board.squares
+        # checked here too: image() names its pixels_per_square, which board_png's caller
+        # did not give (they gave the square and dpi)
+        if (cols + 2) * (rows + 2) * pix * pix > MAX_IMAGE_PIXELS:
+            raise ValueError(f"a {cols}x{rows} ChArUco board at {pix} px per square is too large")
         img = board.image(pix, margin=pix)
     else:
         from stereovision.calibrate import parse_pattern
