@@ -1059,6 +1059,39 @@ def test_a_result_with_non_square_pixels_renders_each_axis_at_its_focal_length(r
     assert (half.f, half.fy) == (75.0, 60.0)
 
 
+def test_a_camera_state_keeps_the_aspect_of_non_square_pixels(result):
+    """A view of a result with ``fx != fy`` (an explicit aspect ratio, :func:`apply_camera`)
+    read into a :class:`render.CameraState` (the GUI's render.png of the mouse's view) was
+    rendered again with square pixels: columns at ``fy / fx`` of their distance from ``cx``."""
+    fx, fy = 150.0, 120.0
+    intr = render.Intrinsics(fx, syn.CX, syn.CY, syn.W, syn.H, fy)
+    pixels = np.array([[20.0, 10.0], [140.0, 110.0], [120.0, 25.0]])
+    z = np.array([4.0, 4.0, 5.0])
+    pts = np.stack([(pixels[:, 0] - syn.CX) * z / fx, (pixels[:, 1] - syn.CY) * z / fy, z], 1)
+    plotter = render.make_plotter((intr.width, intr.height))
+    try:
+        render.apply_camera(plotter, CameraControls(), intrinsics=intr, focal_distance=4.0)
+        state = render.CameraState.of(plotter.camera)
+    finally:
+        plotter.close()
+    assert state.aspect_ratio == pytest.approx(syn.W / syn.H * fy / fx)
+    plotter = render.make_plotter((intr.width, intr.height))
+    try:
+        for p in pts:
+            plotter.add_mesh(pv.PolyData(p[None].astype(np.float32)), color="white",
+                             point_size=3, style="points", lighting=False)  # fmt: skip
+        render.apply_camera(plotter, CameraControls(right=1.0), focal_distance=4.0)
+        state.apply(plotter, points=pts)
+        img = plotter.screenshot(return_img=True)
+    finally:
+        plotter.close()
+    np.testing.assert_allclose(_lit_centroids(img, pixels), pixels, atol=1.0)
+    square = dataclasses.replace(state, aspect_ratio=None)
+    assert not square.same_view(state) and square.same_view(square)
+    with pytest.raises(ValueError, match="aspect_ratio"):
+        dataclasses.replace(state, aspect_ratio=0.0)
+
+
 def test_apply_camera_without_intrinsics_resets_the_window_centre():
     """The GUI's plotter shows a calibrated scene (window centre shifted to its principal
     point), then a bare PLY: the shift of the scene before must not stay."""

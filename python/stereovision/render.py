@@ -503,13 +503,16 @@ class CameraState:
         An orthographic view (VTK's parallel projection) instead of a perspective one.
     parallel_scale : float
         Half the height of an orthographic view, metres (its zoom; VTK's parallel scale).
+    aspect_ratio : float or None
+        VTK's explicit aspect ratio, set by :func:`apply_camera` for non-square pixels
+        (``fx != fy``); None: the window's own (square pixels).
 
     Raises
     ------
     ValueError
         A number that is not finite, a vector of another length, a view angle outside
-        0-180 degrees, a parallel scale <= 0, a focal point at the position, or an ``up``
-        along the view direction (or zero).
+        0-180 degrees, a parallel scale or aspect ratio <= 0, a focal point at the position,
+        or an ``up`` along the view direction (or zero).
     """
 
     position: tuple[float, float, float]
@@ -519,6 +522,7 @@ class CameraState:
     window_center: tuple[float, float] = (0.0, 0.0)
     parallel_projection: bool = False
     parallel_scale: float = 1.0
+    aspect_ratio: float | None = None
 
     def __post_init__(self) -> None:
         # a NaN, a zero view angle or a camera on its focal point rendered an empty or
@@ -549,6 +553,11 @@ class CameraState:
         object.__setattr__(self, "view_angle", angle)
         object.__setattr__(self, "parallel_scale", scale)
         object.__setattr__(self, "parallel_projection", bool(self.parallel_projection))
+        if self.aspect_ratio is not None:
+            aspect = finite_number(self.aspect_ratio, "CameraState: aspect_ratio")
+            if aspect <= 0:
+                raise ValueError(f"CameraState: aspect_ratio: expected > 0, got {aspect:g}")
+            object.__setattr__(self, "aspect_ratio", aspect)
         ahead = np.subtract(focal_point, position)
         distance = float(np.linalg.norm(ahead))
         if not distance > 0:
@@ -584,6 +593,7 @@ class CameraState:
             floats(camera.GetWindowCenter()),  # type: ignore[arg-type]
             bool(camera.GetParallelProjection()),
             float(camera.GetParallelScale()),
+            float(camera.GetExplicitAspectRatio()) if camera.GetUseExplicitAspectRatio() else None,
         )
 
     def same_view(self, other: CameraState, tolerance: float = 1e-9) -> bool:
@@ -623,6 +633,7 @@ class CameraState:
                 *self.window_center,
                 float(self.parallel_projection),
                 self.parallel_scale,
+                0.0 if self.aspect_ratio is None else self.aspect_ratio,
             ]
         )
 
@@ -643,6 +654,9 @@ class CameraState:
         cam.SetWindowCenter(*self.window_center)
         cam.SetParallelProjection(bool(self.parallel_projection))
         cam.SetParallelScale(self.parallel_scale)
+        cam.SetUseExplicitAspectRatio(self.aspect_ratio is not None)
+        if self.aspect_ratio is not None:
+            cam.SetExplicitAspectRatio(self.aspect_ratio)
         if points is not None:
             cam.clipping_range = robust_clipping_range(points, self.position)
         else:
