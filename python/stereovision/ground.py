@@ -384,7 +384,9 @@ def _quaternion(rot: F64) -> tuple[float, float, float, float]:
     return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
 
 
-def _rig(calib: Calibration) -> tuple[float, float, float, float, float]:
+def _rig(calib: Calibration) -> tuple[float, float, float, float, float, float]:
+    """``(fx, cx, cy, B, doffs, fy)`` of the rig's rectified left camera (fy last: a camera
+    with non-square pixels, e.g. binned 2x1, has fy != fx, and Y divides by fy)."""
     rc = calib if calib.rectified else calib.rectified_calibration()
     return (
         float(rc.K1[0, 0]),
@@ -392,6 +394,7 @@ def _rig(calib: Calibration) -> tuple[float, float, float, float, float]:
         float(rc.K1[1, 2]),
         calib.baseline_m,
         rc.doffs_px,
+        float(rc.K1[1, 1]),
     )
 
 
@@ -421,16 +424,23 @@ def _below_weight(calib: Calibration) -> float:
 
 
 def _plane_3d(
-    coef: npt.ArrayLike, rig: tuple[float, float, float, float, float]
+    coef: npt.ArrayLike, rig: tuple[float, float, float, float, float, float]
 ) -> tuple[F64, float]:
     """The 3-D plane ``n . X + h = 0`` (n unit, h > 0) of the disparity plane ``coef``.
 
-    With ``X = (u - cx) Z / f``, ``Y = (v - cy) Z / f`` and ``Z = f B / (d + doffs)``, the plane
-    divided by ``Z`` reads ``d + doffs = -(B / h) (n_x (u - cx) + n_y (v - cy) + f n_z)``.
+    With ``X = (u - cx) Z / f``, ``Y = (v - cy) Z / fy`` and ``Z = f B / (d + doffs)``, the
+    plane divided by ``Z`` reads
+    ``d + doffs = -(B / h) (n_x (u - cx) + n_y (f / fy) (v - cy) + f n_z)``.
     """
-    f, cx, cy, b, doffs = rig
+    f, cx, cy, b, doffs, fy = rig
     a, bb, c = (float(v) for v in np.asarray(coef, np.float64).ravel())
-    m = np.array([-a / b, -bb / b, -(c + doffs) / (f * b) - a * cx / (f * b) - bb * cy / (f * b)])
+    m = np.array(
+        [
+            -a / b,
+            -bb / b * (fy / f),  # times 1.0 exactly for square pixels
+            -(c + doffs) / (f * b) - a * cx / (f * b) - bb * cy / (f * b),
+        ]
+    )
     norm = float(np.linalg.norm(m))
     if not norm > 0:
         return np.array([0.0, -1.0, 0.0]), math.inf
@@ -618,9 +628,9 @@ def fit_ground_plane(
     sample = rng.choice(len(d), min(len(d), RANSAC_SAMPLE), replace=False)
     a_s, d_s = design[sample], d[sample]
     cos_max = math.cos(math.radians(tilt))
-    f, cx, cy, b, doffs = rig
+    f, cx, cy, b, doffs, fy = rig
     z_s = f * b / (d_s + doffs)
-    pts_s = np.column_stack([(a_s[:, 0] - cx) * z_s / f, (a_s[:, 1] - cy) * z_s / f, z_s])
+    pts_s = np.column_stack([(a_s[:, 0] - cx) * z_s / f, (a_s[:, 1] - cy) * z_s / fy, z_s])
     # (sample pixels on it less below_weight per sample point below it, coefficients)
     below_weight = _below_weight(calib)
     hypotheses: list[tuple[float, F64]] = []
@@ -677,7 +687,7 @@ def fit_ground_plane(
     resid = design[inl] @ coef - d[inl]
     rms = float(np.sqrt(np.mean(resid**2)))
     z = f * b / (d + doffs)
-    pts = np.column_stack([(u - cx) * z / f, (v - cy) * z / f, z])
+    pts = np.column_stack([(u - cx) * z / f, (v - cy) * z / fy, z])
     # below by more than BELOW_M and by more than BELOW_SIGMAS height sigmas (see BELOW_SIGMAS)
     short = design @ coef - d  # > 0: farther along its ray than the floor
     band = min(tol, BELOW_SIGMAS * rms)
