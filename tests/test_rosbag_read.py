@@ -726,7 +726,7 @@ def test_one_camera_stops(cones: Any, tmp_path: Path) -> None:
         cam._match = spy  # type: ignore[method-assign]
         assert len(list(cam.frames())) == 10
     assert cam.dropped == {"left": 0, "right": 90}
-    assert max(held) <= rosbag.MAX_WAITING
+    assert max(held) == rosbag.MAX_WAITING  # the newest 64 kept, not fewer
 
 
 def test_realtime_playback_skips_what_a_slow_reader_misses(cones: Any, tmp_path: Path) -> None:
@@ -1470,3 +1470,89 @@ def test_the_size_warnings_of_a_bag_point_at_the_callers_line(cones: Any, tmp_pa
         warnings.simplefilter("always")
         run_stream(cam, max_disparity=16, check=False)  # read in the stream's grabbing thread
     assert [w.filename for w in caught if "450x" in str(w.message)] == [__file__, __file__]
+
+
+def test_generic_encodings_and_rgba16_read_as_their_named_layouts(cones: Any) -> None:
+    """Fourth mutation audit: the generic names ``8UC1``, ``8UC4``, ``16UC3`` and ``16UC4``
+    were read in no test (one taken as 16-bit, or as RGB(A), went unseen), nor ``rgba16``'s
+    channel order: each decodes as its layout's source image."""
+    bgr = cones.left[:40, :60]
+    h, w = bgr.shape[:2]
+    grey = cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)
+    c16 = (bgr.astype(np.uint16) << 8) | 5
+
+    def msg(arr: np.ndarray, encoding: str) -> _Msg:
+        arr = np.ascontiguousarray(arr)
+        arr = arr.astype("<u2") if arr.dtype == np.uint16 else arr
+        rows = arr.view(np.uint8).reshape(h, -1)
+        return _Msg(height=h, width=w, encoding=encoding, is_bigendian=0, step=rows.shape[1],
+                    data=rows.reshape(-1))  # fmt: skip
+
+    alpha8, alpha16 = np.full((h, w), 255, np.uint8), np.full((h, w), 65535, np.uint16)
+    out = decode_image(msg(grey, "8UC1"))
+    assert out.dtype == np.uint8
+    np.testing.assert_array_equal(out, np.dstack([grey] * 3))
+    np.testing.assert_array_equal(decode_image(msg(np.dstack([bgr, alpha8]), "8UC4")), bgr)
+    np.testing.assert_array_equal(decode_image(msg(c16, "16UC3")), c16)
+    np.testing.assert_array_equal(decode_image(msg(np.dstack([c16, alpha16]), "16UC4")), c16)
+    rgba = np.dstack([c16[..., ::-1], alpha16])
+    np.testing.assert_array_equal(decode_image(msg(rgba, "rgba16")), c16)
+
+
+def test_raw_compressed_topics_are_preferred_to_rectified_uncompressed_ones() -> None:
+    """Fourth mutation audit: raw before uncompressed, as documented (a rectified pair was
+    never weighed against a compressed raw one): ``image_raw/compressed`` is taken over
+    ``image_rect``, whose calibration is another rig's."""
+    rect = ["/stereo/left/image_rect", "/stereo/right/image_rect"]
+    raw = [LEFT + "/compressed", RIGHT + "/compressed"]
+    assert find_stereo_topics(rect + raw) == tuple(raw)
+
+
+def test_compressed_rectified_topics_give_the_rectified_rig(cones: Any, tmp_path: Path) -> None:
+    """Fourth mutation audit: ``image_rect/compressed`` topics are rectified ones (the
+    transport suffix is no part of the name): their calibration is the rectified rig of the
+    two ``P`` matrices, not the raw rig of ``K`` and ``D``."""
+    from rosbags.rosbag2 import Reader, Writer
+
+    cams = tuple(parse_ros_camera_info(t) for t in _raw_rig().to_ros())
+    rect = ("/stereo/left/image_rect", "/stereo/right/image_rect")
+    src = write_bag(tmp_path / "src", [(T0, cones.left, T0, cones.right)], topics=rect,
+                    encoding="png", infos=cams)  # fmt: skip
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    with Reader(src) as r, Writer(tmp_path / "rig", version=9) as w:
+        conns: dict[str, Any] = {}
+        for conn, stamp, data in r.messages():
+            topic = conn.topic + "/compressed" if conn.topic in rect else conn.topic
+            if topic not in conns:
+                conns[topic] = w.add_connection(topic, conn.msgtype, typestore=ts)
+            w.write(conns[topic], stamp, data)
+    with BagCamera(tmp_path / "rig") as cam:
+        assert cam.topics == {"left": rect[0] + "/compressed", "right": rect[1] + "/compressed"}
+        got = cam.calibration()
+    assert got.rectified
+    np.testing.assert_allclose(got.K1, cams[0]["P"][:, :3])
+    np.testing.assert_array_equal(got.D1, np.zeros(5))
+
+
+def test_a_shape_a_few_percent_off_is_refused_and_a_size_asked_is_not_warned(
+    cones: Any, tmp_path: Path
+) -> None:
+    """Fourth mutation audit: the shape checks allow 1 % (rounding of a half size), not more:
+    a right topic 450x360 beside a 450x375 left one (4 % off) is refused as another shape,
+    and a size 450x360 asked for a 450x375 recording is dropped with a warning; a size of the
+    recording's shape that was asked resizes without a warning (it was only checked for a
+    size that was not asked)."""
+    left = cones.left
+    squat = cv2.resize(cones.right, (450, 360), interpolation=cv2.INTER_AREA)
+    bag = write_bag(tmp_path / "off", [(T0, left, T0, squat)], encoding="png")
+    with BagCamera(bag) as cam, pytest.raises(SourceError, match=r"is 450x360, the .* 450x375"):
+        cam.read()
+    bag = write_bag(tmp_path / "rig", [(T0, left, T0, cones.right)], encoding="png")
+    with (
+        BagCamera(bag, image_size="450x360") as cam,
+        pytest.warns(UserWarning, match="size 450x360 is another shape"),
+    ):
+        assert cam.read().left.shape == left.shape
+    with BagCamera(bag, image_size="225x188") as cam, warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert cam.read().right.shape == (188, 225, 3)
