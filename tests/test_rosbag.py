@@ -731,3 +731,14 @@ def test_every_header_carries_the_frames_stamp_and_the_frame_id_given(
     with pytest.raises(FileExistsError, match="bag folder already exists"):
         BagWriter(tmp_path / "a_file")
     assert (tmp_path / "a_file").read_text() == "x"
+
+
+def test_a_stamp_of_zero_is_written(kitti: tuple, tmp_path: Path) -> None:
+    """Fourth mutation audit: the stamps accepted start at 0 ns (a recording stamped by frame
+    index times period starts there), as documented; only the upper end was checked."""
+    from stereovision.rosbag import BagWriter
+
+    with BagWriter(tmp_path / "run", points=False) as bag:
+        bag.write(kitti[0], 0)
+    ((recorded, depth),) = _read(tmp_path / "run")["/stereo/depth"]
+    assert recorded == 0 and (depth.header.stamp.sec, depth.header.stamp.nanosec) == (0, 0)
