@@ -1556,3 +1556,31 @@ def test_a_shape_a_few_percent_off_is_refused_and_a_size_asked_is_not_warned(
     with BagCamera(bag, image_size="225x188") as cam, warnings.catch_warnings():
         warnings.simplefilter("error")
         assert cam.read().right.shape == (188, 225, 3)
+
+
+def test_a_left_camera_that_stops_within_its_first_frames_holds_no_more_right_ones(
+    cones: Any, tmp_path: Path
+) -> None:
+    """The left camera stops after 5 frames (fewer than PERIOD_SAMPLE), the right one goes on
+    for 100: the default tolerance waited for 8 left stamps, and until then every right frame
+    was held (a whole bag's right topic in memory, decoded messages); it is decided once 64
+    right frames wait, as it is for 64 left ones, so at most 64 are held."""
+    from stereovision import rosbag
+
+    small_l, small_r = cones.left[:32, :48], cones.right[:32, :48]
+    frames = [(T0 + k * PERIOD_NS if k < 5 else None, small_l, T0 + k * PERIOD_NS, small_r)
+              for k in range(100)]  # fmt: skip
+    bag = write_bag(tmp_path / "rig", frames, encoding="png")
+    held: list[int] = []
+    with BagCamera(bag) as cam:
+        real = cam._match
+
+        def spy(lefts: Any, rights: Any, final: bool) -> Any:
+            yield from real(lefts, rights, final)
+            held.append(len(rights))
+
+        cam._match = spy  # type: ignore[method-assign]
+        assert len(list(cam.frames())) == 5
+    assert cam.stamps_ns == [T0 + k * PERIOD_NS for k in range(5)]
+    assert cam.dropped == {"left": 0, "right": 95}
+    assert max(held) <= rosbag.MAX_WAITING

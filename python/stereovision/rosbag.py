@@ -615,7 +615,8 @@ CAMERA_INFO_TYPE = "sensor_msgs/msg/CameraInfo"
 PERIOD_SAMPLE = 8
 #: Left frames held back while waiting for a right one; beyond, the oldest is decided as if the
 #: recording had ended (a right topic that stopped must not make the reader hold the whole bag).
-#: Right frames beyond this many without a left one are dropped, oldest first.
+#: Right frames beyond this many without a left one are dropped, oldest first (and the default
+#: tolerance is decided then, for a left topic that stopped before its PERIOD_SAMPLE frames).
 MAX_WAITING = 64
 
 # ROS encoding -> (channels, bytes per channel, OpenCV conversion to BGR or None). ROS names a
@@ -1026,7 +1027,10 @@ class BagCamera(PairSource):
     ) -> Iterator[tuple[int, Any, int, Any]]:
         if self._tol_ns is None:
             sampled = all(len(s) >= PERIOD_SAMPLE for s in self._first.values())
-            if not (final or sampled or len(lefts) > MAX_WAITING):
+            # a side that stopped before PERIOD_SAMPLE frames: decided once either side has
+            # MAX_WAITING waiting (it held the other's every frame, decoded, to the end)
+            crowded = max(len(lefts), len(rights)) > MAX_WAITING
+            if not (final or sampled or crowded):
                 return
             self._tol_ns = self._default_tolerance()
             self.max_skew_ms = self._tol_ns / 1e6
