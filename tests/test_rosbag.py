@@ -354,24 +354,27 @@ def test_a_database_that_fills_mid_frame_keeps_the_metadata_true(
     assert meta == {t: 1 for t, _ in got}
 
 
+@pytest.mark.parametrize("points", [True, False])
 def test_the_frames_a_full_disk_rolled_back_are_counted_out(
-    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+    kitti: tuple, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, points: bool
 ) -> None:
     """A full disk lets sqlite undo its whole open transaction: every frame since the last
     commit. The writer counted messages only, so no one could say how many frames the bag
-    still held; :attr:`BagWriter.frames` is the whole frames in its database."""
+    still held; :attr:`BagWriter.frames` is the whole frames in its database (its depth
+    images: a frame is 6 messages without the cloud, 7 with it)."""
     import sqlite3
 
     from stereovision import rosbag
 
     res, _ = kitti
     monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 0.0)
-    bag = rosbag.BagWriter(tmp_path / "run")
+    per_frame = 7 if points else 6
+    bag = rosbag.BagWriter(tmp_path / "run", points=points)
     bag.write(res, 1)  # committed
     monkeypatch.setattr(rosbag, "COMMIT_PERIOD_S", 3600.0)
     bag.write(res, 2)
     bag.write(res, 3)  # both in the open transaction
-    assert (bag.frames, bag.messages) == (3, 21)
+    assert (bag.frames, bag.messages) == (3, 3 * per_frame)
     conn = bag._writer.storage.conn
     conn.execute(f"PRAGMA max_page_count = {conn.execute('PRAGMA page_count').fetchone()[0]}")
     with pytest.raises(OSError, match=r"^bag .*run: database or disk is full$"):
@@ -379,10 +382,10 @@ def test_the_frames_a_full_disk_rolled_back_are_counted_out(
     # sqlite undid frames 2 and 3 with frame 4: the committed frame 1 is the bag's one frame
     stamps = conn.execute("SELECT DISTINCT timestamp FROM messages").fetchall()
     assert stamps == [(1,)]
-    assert (bag.frames, bag.messages) == (1, 7)
+    assert (bag.frames, bag.messages) == (1, per_frame)
     bag.close()
     with sqlite3.connect(tmp_path / "run" / "run.db3") as db:
-        assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == 7
+        assert db.execute("SELECT COUNT(*) FROM messages").fetchone()[0] == per_frame
 
 
 def _frame_cut_while_undone(

@@ -1584,3 +1584,13 @@ def test_a_left_camera_that_stops_within_its_first_frames_holds_no_more_right_on
     assert cam.stamps_ns == [T0 + k * PERIOD_NS for k in range(5)]
     assert cam.dropped == {"left": 0, "right": 95}
     assert max(held) <= rosbag.MAX_WAITING
+
+
+def test_to_8bit_takes_an_empty_image_beside_a_16_bit_one() -> None:
+    """Fourth mutation audit: an empty 16-bit image (a 0-pixel crop) sets no shift and is
+    returned as an empty ``uint8`` one (numpy's max of nothing raised), the other shifted as
+    alone."""
+    img = np.array([[0, 1000], [4095, 16]], np.uint16)  # 12 bits: a shift of 4
+    empty, out = to_8bit(np.zeros((0, 5), np.uint16), img)
+    assert empty.shape == (0, 5) and empty.dtype == np.uint8
+    np.testing.assert_array_equal(out, (img >> 4).astype(np.uint8))
