@@ -745,3 +745,29 @@ def test_a_stamp_of_zero_is_written(kitti: tuple, tmp_path: Path) -> None:
         bag.write(kitti[0], 0)
     ((recorded, depth),) = _read(tmp_path / "run")["/stereo/depth"]
     assert recorded == 0 and (depth.header.stamp.sec, depth.header.stamp.nanosec) == (0, 0)
+
+
+def test_the_disparity_focal_length_is_fx_for_non_square_pixels(
+    kitti: tuple, tmp_path: Path
+) -> None:
+    """Mutation audit: ``DisparityImage.f`` is the rectified ``fx`` (``Z = fx B / d``, as
+    ``stereo_image_proc`` fills it), and the camera_infos' ``K`` keep ``fy``: a rig whose
+    pixels are not square (fy 10 % above fx) tells the two apart (every rig of the tests had
+    fx = fy, so ``f = fy`` survived)."""
+    import dataclasses
+
+    from stereovision.rosbag import BagWriter
+
+    res, _ = kitti
+    cal = res.calibration
+    assert cal.rectified
+    k1, k2 = cal.K1.copy(), cal.K2.copy()
+    k1[1, 1] *= 1.1
+    k2[1, 1] *= 1.1
+    tall = dataclasses.replace(res, calibration=dataclasses.replace(cal, K1=k1, K2=k2))
+    with BagWriter(tmp_path / "run", points=False) as bag:
+        bag.write(tall, 1)
+    topics = _read(tmp_path / "run")
+    assert topics["/stereo/disparity"][0][1].f == pytest.approx(cal.K1[0, 0], rel=1e-7)  # f32
+    info = topics["/stereo/left/camera_info"][0][1]
+    np.testing.assert_allclose(info.k.reshape(3, 3), k1, rtol=1e-12)
