@@ -484,19 +484,41 @@ def test_a_board_square_given_in_mm_with_the_unit_left_at_metres_is_said(
     assert "warning" not in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("call", ["depth_map", "match"])
-def test_a_method_given_in_the_calibrations_place_is_named_a_method(call: str) -> None:
+@pytest.mark.parametrize(("call", "method"), [("depth_map", "census"), ("match", "mcgm")])
+def test_a_method_given_in_the_calibrations_place_is_named_a_method(call: str, method: str) -> None:
     """`sv.match(left, right, "mcgm")` (method is keyword-only, the third argument the
     calibration) was told "got the path 'mcgm', not a calibration: read it first"."""
     image = np.zeros((32, 48), np.uint8)
-    with pytest.raises(ValueError, match=r"calib: got 'mcgm', a method's name.*method='mcgm'"):
-        getattr(stereovision, call)(image, image, "mcgm")
+    said = rf"calib: got '{method}', a method's name.*method='{method}'"
+    with pytest.raises(ValueError, match=said):
+        getattr(stereovision, call)(image, image, method)
     with pytest.raises(ValueError, match=r"got the path 'rig\.yaml'"):
         getattr(stereovision, call)(image, image, "rig.yaml")
     from stereovision.depth import _ALL_METHODS
     from stereovision.match import METHODS
 
     assert set(METHODS) <= _ALL_METHODS  # a method match gains is known here too
+
+
+@pytest.mark.parametrize(
+    ("call", "method", "other"),
+    [
+        ("depth_map", "mcgm", "match"),
+        ("depth_map", "hopfield", "match"),
+        ("match", "census", "depth_map"),
+    ],
+)
+def test_the_other_functions_method_in_the_calibrations_place_is_not_sent_to_method(
+    call: str, method: str, other: str
+) -> None:
+    """`sv.depth_map(left, right, "mcgm")` was told to give it as method='mcgm', which
+    depth_map then refused as an unknown method: the function the method belongs to is said."""
+    image = np.zeros((32, 48), np.uint8)
+    with pytest.raises(
+        ValueError, match=rf"got '{method}'.*it is a method of stereovision\.{other}, not of {call}"
+    ) as err:
+        getattr(stereovision, call)(image, image, method)
+    assert "method=" not in str(err.value)
 
 
 def test_the_result_helpers_name_what_to_pass_instead() -> None:

@@ -139,12 +139,15 @@ def _rig_to_warp_by(
     width: int,
     height: int,
     max_disparity: _D | None,
+    caller: str = "depth_map",
+    methods: tuple[str, ...] = METHODS,
 ) -> tuple[Calibration | UncalibratedRectification | None, Calibration | None, _D | int | None]:
     """What ``calib`` asks of a ``width`` x ``height`` pair (:func:`depth_map`'s and
     ``match``'s): ``(rig, calibration, max_disparity)``, ``rig`` the rectification to warp the
     pair by (None: matched as given), ``calibration`` the rig's calibration (None for an
     :class:`UncalibratedRectification`, whose search range then stands in for a
-    ``max_disparity`` of None).
+    ``max_disparity`` of None). ``caller`` and its ``methods`` name a method given in
+    ``calib``'s place.
 
     Raises
     ------
@@ -158,9 +161,17 @@ def _rig_to_warp_by(
         return None, None, max_disparity
     path = path_given(calib)
     if path in _ALL_METHODS:  # match(left, right, "mcgm"): method is keyword-only
+        # the other function's method (depth_map(l, r, "mcgm")) was told to go as method=,
+        # which then refused it as unknown
+        other = "stereovision.match" if caller == "depth_map" else "stereovision.depth_map"
+        how = (
+            f"give it as method={path!r}"
+            if path in methods
+            else f"it is a method of {other}, not of {caller} ({', '.join(methods)})"
+        )
         raise ValueError(
-            f"calib: got {path!r}, a method's name, not a calibration: give it as "
-            f"method={path!r} (the third argument is the calibration)"
+            f"calib: got {path!r}, a method's name, not a calibration: {how} "
+            "(the third argument is the calibration)"
         )
     if path is not None:  # a calib.txt's name: said, not just "got str"
         raise ValueError(

@@ -106,7 +106,7 @@ def match(
     uint8 = np.asarray(left).dtype == np.uint8 and np.asarray(right).dtype == np.uint8
     h, w = gl.shape
     # a calibrated rig not yet rectified, or an uncalibrated one: as depth_map does
-    rig, _, max_disparity = _rig_to_warp_by(calib, w, h, max_disparity)
+    rig, _, max_disparity = _rig_to_warp_by(calib, w, h, max_disparity, "match", METHODS)
     if rig is not None:
         if uint8:
             lb, rb = rig.rectify(as_bgr_uint8(left, "left"), as_bgr_uint8(right, "right"))
