@@ -784,6 +784,22 @@ def test_camera_info_messages_echoed_to_files_are_read(tmp_path: Path, ros2: boo
     assert info["image_size"] == c.image_size and info["distortion_model"] == "plumb_bob"
 
 
+@pytest.mark.parametrize("ros2", [True, False], ids=["ros2", "ros1"])
+def test_an_echo_stopped_mid_message_reads_its_first_message(tmp_path: Path, ros2: bool) -> None:
+    """`rostopic echo /left/camera_info > left.yaml` stopped by Ctrl-C holds whole messages and
+    a last one cut (ROS 1 mid-array): every message was parsed, the cut one refused the file as
+    a YAML parse error although the first one, the one read, is whole."""
+    c = raw_calib()
+    texts = c.to_ros()
+    for side, text in zip(("left", "right"), texts, strict=True):
+        one = _echoed(text, ros2)
+        cut = one[: one.index("K:" if not ros2 else "k:") + 12]
+        (tmp_path / f"{side}.yaml").write_text(one + one + cut)
+    want = Calibration._from_ros_texts(*texts, "left", "right")
+    assert Calibration.from_file(tmp_path) == want
+    assert Calibration.from_file(tmp_path / "left.yaml") == want
+
+
 @pytest.mark.parametrize(
     ("changes", "message"),
     [

@@ -2506,8 +2506,9 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
     clean = re.sub(r"^%YAML:1\.0[^\n]*\n", "", text.lstrip("\ufeff"))
     clean = re.sub(r"!!opencv-matrix\b", "", clean)
     try:
-        # a topic echo ends its message with "---" (and may print several): the first one
-        docs = [d for d in yaml.safe_load_all(clean) if d is not None]
+        # a topic echo ends its message with "---" (and may print several): the first one,
+        # the rest left unparsed (an echo stopped by Ctrl-C cut its last message mid-array)
+        doc = next((d for d in yaml.safe_load_all(clean) if d is not None), None)
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f"line {mark.line + 1}: " if mark is not None else ""
@@ -2515,7 +2516,6 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
             f"cannot parse {source} as ROS camera_info YAML: {where}"
             f"{getattr(exc, 'problem', None) or exc}"
         ) from None
-    doc = docs[0] if docs else None
     if not isinstance(doc, dict):
         raise ValueError(f"{source}: expected a ROS camera_info mapping")
     if _is_camera_info_message(doc):
