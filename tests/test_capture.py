@@ -2185,7 +2185,7 @@ def test_a_camera_whose_open_hangs_is_given_up(wedged: type[_WedgedDevice], side
     assert time.perf_counter() - t0 < 1.0
     assert str(err.value) == (
         f"{side} source camera {index} did not open within 0.2 s (its open did not return: a "
-        "wedged camera or driver, a stalled stream); unplug and replug it"
+        "wedged camera or driver); unplug and replug it, or give it a longer timeout"
     )
     assert (err.value.side, err.value.end) == (side, False)
     assert [c.released for c in wedged.made] == ([1] if side == "right" else [])
@@ -2197,6 +2197,26 @@ def test_a_camera_whose_open_hangs_is_given_up(wedged: type[_WedgedDevice], side
     assert all(_released_soon(c) for c in wedged.made)
     with pytest.raises(ValueError, match=r"^open_timeout: expected a positive number of sec"):
         StereoCamera(0, 1, open_timeout=0)
+
+
+def test_a_stream_whose_open_hangs_is_not_told_to_be_unplugged(
+    wedged: type[_WedgedDevice],
+) -> None:
+    """A network stream's open given up was told "unplug and replug it" (a device's advice), and
+    nothing of a longer limit, though FFmpeg's own open waits 30 s to the 10 s default's."""
+    url = "rtsp://192.0.2.1/stream"
+    wedged.wedged = {url}  # type: ignore[assignment]
+    with pytest.raises(SourceError) as err:
+        StereoCamera(url, 1, open_timeout=0.2)
+    assert str(err.value) == (
+        f"left source {url!r} did not open within 0.2 s (its open did not return: a stalled "
+        "stream or network share); give it a longer timeout"
+    )
+    wedged.unplug.set()  # its open returns: released (and not left to the next test)
+    deadline = time.monotonic() + 2.0
+    while not wedged.made and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert [c.src for c in wedged.made] == [url] and _released_soon(wedged.made[0])
 
 
 def test_a_camera_opened_in_time_is_kept(wedged: type[_WedgedDevice]) -> None:
@@ -2225,7 +2245,7 @@ def test_cli_read_timeout_bounds_the_open(
     assert time.perf_counter() - t0 < 1.0
     assert capsys.readouterr().err == (
         "stereovision: error: left source camera 0 did not open within 0.2 s (its open did not "
-        "return: a wedged camera or driver, a stalled stream); unplug and replug it\n"
+        "return: a wedged camera or driver); unplug and replug it, or give it a longer timeout\n"
     )
     wedged.unplug.set()  # its open returns: released, not kept (nor left to the next test)
     deadline = time.monotonic() + 2.0

@@ -535,13 +535,22 @@ def _open_within(make: Callable[[], Any], timeout: float | None, side: str, src:
         return cap
 
     what = f"{side} source {_describe_source(src)}"
+    # a URL or file has no plug, and a network stream may just be slow (FFmpeg's own open
+    # waits 30 s): "unplug and replug it" is a device's advice alone, a longer limit either's
+    device = isinstance(src, (int, np.integer))
+    why = "a wedged camera or driver" if device else "a stalled stream or network share"
+    todo = (
+        "unplug and replug it, or give it a longer timeout"
+        if device
+        else "give it a longer timeout"
+    )
     try:
         return _within(
             opened,
             timeout,
             what,
-            hung=f"{what} did not open within {timeout:g} s (its open did not return: a wedged "
-            "camera or driver, a stalled stream); unplug and replug it",
+            hung=f"{what} did not open within {timeout:g} s (its open did not return: {why}); "
+            f"{todo}",
             side=side,
         )
     except BaseException:  # given up, interrupted, or the open failed
