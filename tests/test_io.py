@@ -245,6 +245,23 @@ def test_read_pfm_header_lines_of_windows_tools(tmp_path: Path, eol: bytes, litt
     np.testing.assert_array_equal(read_pfm(p), arr)
 
 
+@pytest.mark.parametrize("first", [b"\n", b" \n", b"\r\n", b"\t\t\n"])
+def test_read_pfm_one_space_header_keeps_data_that_begins_like_a_line_end(
+    tmp_path: Path, first: bytes
+) -> None:
+    """A header ended by one space and no line feed, its data's first bytes 0x0A (or spaces,
+    \r, then 0x0A): those bytes were taken as the scale line's end, the data read from a byte
+    or more late (said truncated). The data is the file's last bytes when they fit there."""
+    raw = first + bytes(range(24 - len(first)))
+    arr = np.frombuffer(raw, "<f4").reshape(2, 3)[::-1]
+    p = tmp_path / "w.pfm"
+    p.write_bytes(b"Pf\n3 2\n-1.0 " + raw)
+    np.testing.assert_array_equal(read_pfm(p), arr)
+    p.write_bytes(b"Pf\n3 2\n-1.0\r\n" + raw[:-1])  # the line's own end still ends it
+    with pytest.raises(ValueError, match=r"truncated PFM file .*got 23"):
+        read_pfm(p)
+
+
 def test_read_pfm_bad_scale_and_truncation_name_the_file(tmp_path: Path) -> None:
     """A scale that is no number ("1.0.0", "."), zero (no byte order) or a file cut short is a
     ValueError naming the file (a malformed scale raised float()'s own message, no file)."""

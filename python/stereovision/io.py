@@ -940,6 +940,11 @@ def read_pfm(path: PathLike) -> npt.NDArray[np.float32]:
     # line feed (PNM's rule) starts its data right after that character.
     line_end = _PFM_LINE_END.match(raw, m.end())
     start = m.end() + 1 if line_end is None else line_end.end()
+    # ... also when its data begins with bytes that read as such a line end (a float whose
+    # first byte is 0x0A after "-1.0 " lost that byte): one space or tab, then exactly the data
+    # to the file's end (a CR is taken as CRLF's: a CRLF file one byte short is truncated)
+    if line_end is not None and len(raw) - count * 4 == m.end() + 1 and raw[m.end()] in b" \t":
+        start = m.end() + 1
     nbytes = len(raw) - start
     if nbytes < count * 4:
         raise ValueError(
