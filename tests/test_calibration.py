@@ -1796,6 +1796,10 @@ def test_from_kitti_reads_the_grey_pair_when_asked(tmp_path: Path) -> None:
         f"S_rect_00: 1.241e+03 3.76e+02\nP_rect_00: {p(0.0)}\nP_rect_01: {p(-386.1448)}\n"
     )
     assert Calibration.from_kitti(raw, cameras=(0, 1)) == grey
+    # a pair taken from an array (np.int64) was refused as not two of cameras 0-3
+    assert Calibration.from_kitti(raw, cameras=tuple(np.array([0, 1]))) == grey
+    with pytest.raises(ValueError, match=r"cameras: expected two of KITTI's cameras 0-3"):
+        Calibration.from_kitti(raw, cameras=(np.True_, np.int64(1)))
     with pytest.raises(ValueError, match=r"lacks P_rect_02/P_rect_03 \(or P2/P3\)"):
         Calibration.from_kitti(raw)
     with pytest.raises(ValueError, match=r"cameras: expected two of KITTI's cameras 0-3"):

@@ -1862,8 +1862,12 @@ class Calibration:
         ok = (
             isinstance(cameras, (tuple, list))
             and len(cameras) == 2
-            and all(isinstance(c, int) and not isinstance(c, bool) for c in cameras)
-            and set(cameras) <= {0, 1, 2, 3}
+            # a NumPy integer too (a pair taken from a table or an array) was refused
+            and all(
+                isinstance(c, (int, np.integer)) and not isinstance(c, (bool, np.bool_))
+                for c in cameras
+            )
+            and {int(c) for c in cameras} <= {0, 1, 2, 3}
             and cameras[0] != cameras[1]
         )
         if not ok:
@@ -1871,7 +1875,7 @@ class Calibration:
                 f"cameras: expected two of KITTI's cameras 0-3 ((2, 3) colour, (0, 1) grey), "
                 f"got {cameras!r}"
             )
-        a, b = cameras
+        a, b = (int(c) for c in cameras)
         p, _ = cls._read_text(path)
         v = parse_kitti_calib(p)
         for k2, k3 in ((f"P_rect_0{a}", f"P_rect_0{b}"), (f"P{a}", f"P{b}")):
