@@ -2199,6 +2199,19 @@ def test_a_camera_whose_open_hangs_is_given_up(wedged: type[_WedgedDevice], side
         StereoCamera(0, 1, open_timeout=0)
 
 
+@pytest.mark.parametrize("timeout", [math.inf, True])
+def test_an_infinite_or_boolean_timeout_is_refused_by_name(timeout: object) -> None:
+    """``open_timeout=math.inf`` (no limit meant; None is) passed the check and then overflowed
+    the wait with "timestamp out of range for platform time_t", naming nothing; True passed as
+    one second. Both are refused naming the keyword, before anything opens."""
+    for call in (
+        lambda: StereoCamera(0, 1, open_timeout=timeout),  # type: ignore[arg-type]
+        lambda: capmod.read_within(object(), timeout),  # type: ignore[arg-type]
+    ):
+        with pytest.raises(ValueError, match=r"_timeout: expected a positive number of sec.*None"):
+            call()
+
+
 def test_a_stream_whose_open_hangs_is_not_told_to_be_unplugged(
     wedged: type[_WedgedDevice],
 ) -> None:

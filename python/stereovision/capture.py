@@ -411,12 +411,19 @@ _READ_TIMEOUT: contextvars.ContextVar[float | None] = contextvars.ContextVar(
 
 
 def check_read_timeout(timeout: float | None, name: str = "read_timeout") -> None:
-    """Refuse a ``read_timeout`` that is not a positive number of seconds or None (checked by
-    :func:`read_within`, and by :func:`capture`, :func:`~stereovision.stream.run_stream` and
+    """Refuse a ``read_timeout`` that is not a positive, finite number of seconds or None
+    (checked by :func:`read_within`, and by :func:`capture`,
+    :func:`~stereovision.stream.run_stream` and
     :func:`~stereovision.calibrate.calibrate_from_video` before they open anything);
     ``name`` is the keyword said (:class:`StereoCamera`'s ``open_timeout``)."""
-    if timeout is not None and not timeout > 0:
-        raise ValueError(f"{name}: expected a positive number of seconds, got {timeout}")
+    # inf (meant as no limit) passed, then overflowed the wait ("timestamp out of range for
+    # platform time_t"); True passed as 1 s
+    if timeout is not None and (
+        isinstance(timeout, (bool, np.bool_)) or not (timeout > 0 and math.isfinite(timeout))
+    ):
+        raise ValueError(
+            f"{name}: expected a positive number of seconds (None: no limit), got {timeout!r}"
+        )
 
 
 def read_within(camera: Any, timeout: float | None = DEFAULT_READ_TIMEOUT) -> StereoFrame:
