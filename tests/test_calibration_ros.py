@@ -809,6 +809,12 @@ def test_an_echo_stopped_mid_message_reads_its_first_message(tmp_path: Path, ros
             "region of interest",
         ),
         ({"p": None}, "lacks field 'p'"),
+        # an uncalibrated camera's driver publishes zeros: was "image_width must be a positive
+        # integer, got 0", a field the message does not have
+        (
+            {"width": 0, "height": 0, "k": [0.0] * 9, "p": [0.0] * 12},
+            "k is all zeros: the camera_info of a camera not calibrated yet",
+        ),
     ],
 )
 def test_an_echoed_camera_info_this_cannot_read_is_named(changes: dict, message: str) -> None:

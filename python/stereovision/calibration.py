@@ -2592,6 +2592,17 @@ def _message_as_file(doc: dict[Any, Any], source: str) -> dict[str, Any]:
                 f"ROS camera_info message {source} lacks field {short.lower()!r} ({short!r})"
             )
         out[key] = doc[name]
+    try:
+        blank = not np.any(np.asarray(out["camera_matrix"], dtype=np.float64))
+    except (TypeError, ValueError):  # malformed: said by the checks that follow
+        blank = False
+    if blank:
+        # a driver with no calibration publishes zeros (width and height too, often): this was
+        # told "image_width must be a positive integer, got 0", a field the message lacks
+        raise ValueError(
+            f"{source}: k is all zeros: the camera_info of a camera not calibrated yet (its "
+            "driver found no calibration); calibrate the rig (stereovision calibrate)"
+        )
     for axis in ("binning_x", "binning_y"):
         if doc.get(axis) not in (None, 0, 1):
             raise ValueError(
