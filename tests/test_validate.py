@@ -14,6 +14,7 @@ from hypothesis.extra import numpy as hnp
 
 from stereovision._validate import (
     LUMA_WEIGHTS_BGR,
+    UNIT_RANGE_TOL,
     as_bgr_uint8,
     as_gray_float,
     as_gray_uint8,
@@ -596,3 +597,41 @@ def test_an_internal_error_without_a_message_is_one_clean_line() -> None:
     assert internal_error(ValueError("\nsecond line")) == (
         "stereovision: error: internal ValueError: second line (please report this)"
     )
+
+
+def test_a_path_in_a_0d_bytes_array_is_said_as_a_path() -> None:
+    # a file name read from a table as bytes (dtype S) was said as "converting to dtype |S8"
+    with pytest.raises(ValueError, match=r"^left: got the path 'left\.png', not an image: "):
+        as_gray_float(np.array(b"left.png"), "left")
+
+
+def test_float_range_limits_are_inclusive() -> None:
+    # UNIT_RANGE_TOL is the largest excursion read (and clipped), not the first one refused
+    out = as_gray_float(np.array([[0.0, 1.0 + UNIT_RANGE_TOL]]), "left")
+    np.testing.assert_array_equal(out, np.array([[0.0, 1.0]], np.float32))
+    # 65535 itself is 16-bit data; just beyond it, no known scale
+    with pytest.raises(ValueError, match=r"range \[0, 65535\] \(divide 16-bit data by 65535"):
+        as_gray_float(np.array([[0.0, 65535.0]]), "left")
+    with pytest.raises(ValueError, match=r"range \[0, 65535\.5\] \(scale both images"):
+        as_gray_float(np.array([[0.0, 65535.5]]), "left")
+
+
+def test_uint16_is_divided_by_full_scale_exactly() -> None:
+    # a division, not a product with float32(1 / 65535): that differs by 1 ulp at 512 levels
+    levels = np.arange(65536, dtype=np.uint16).reshape(256, 256)
+    expected = levels.astype(np.float32) / np.float32(65535)
+    np.testing.assert_array_equal(as_gray_float(levels, "left"), expected)
+    assert as_gray_float(levels, "left")[-1, -1] == 1.0
+
+
+def test_bgr_uint8_is_c_contiguous_from_bgra_and_strided_views() -> None:
+    rng = np.random.default_rng(1)
+    bgra = rng.integers(0, 256, (5, 8, 4), dtype=np.uint8)
+    for img, expected in (
+        (bgra, bgra[:, :, :3]),
+        (bgra[:, ::2, :3], bgra[:, ::2, :3]),
+        (bgra[:, :, 3][:, ::-1], np.repeat(bgra[:, ::-1, 3:], 3, axis=2)),
+    ):
+        out = as_bgr_uint8(img, "left")
+        assert out.flags.c_contiguous, img.strides
+        np.testing.assert_array_equal(out, expected)
