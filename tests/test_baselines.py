@@ -360,3 +360,22 @@ def test_tool_ranges_round_up_to_16_and_refuse_a_negative_one(fn, algorithm: str
         fn(left, right, -3, algorithm)
     with pytest.raises(ValueError, match=f"expected 'bm' or 'sgbm', got '{algorithm.upper()}'"):
         fn(left, right, 16, algorithm.upper())  # the node's names, not case-folded
+
+
+def test_bm_reads_a_grey_image_beside_a_colour_one_as_the_grey_pair() -> None:
+    # the BM reference matches grey images: a pair of one size but read grey and in colour
+    # is the same pair to it (only the sizes must agree)
+    left, right = _colour_pair(4)
+    grey_right = cv2.cvtColor(right, cv2.COLOR_BGR2GRAY)
+    grey_left = cv2.cvtColor(left, cv2.COLOR_BGR2GRAY)
+    np.testing.assert_array_equal(
+        opencv_bm(left, grey_right, 16), opencv_bm(grey_left, grey_right, 16)
+    )
+
+
+def test_row_fill_takes_integer_maps_and_refuses_3d_ones() -> None:
+    got = row_fill(np.array([[0, 3, 7]], dtype=np.int32))
+    assert got.dtype == np.float32
+    np.testing.assert_array_equal(got, np.array([[0, 3, 7]], np.float32))
+    with pytest.raises(ValueError, match=r"disparity: expected a real \(H, W\) array, got shape"):
+        row_fill(np.zeros((2, 3, 1), np.float32))
