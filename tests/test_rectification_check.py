@@ -943,3 +943,57 @@ def test_cli_check_fix_json_of_a_pair_it_cannot_correct_is_one_object(
         "look swapped: give them the other way round\n"
     )
     assert not fixed.exists()
+
+
+def test_refine_turns_in_the_right_cameras_rectified_frame_when_that_is_not_its_own() -> None:
+    """Toed in with the baseline along the left camera's x axis, the right camera's rectified
+    frame (R2) is 4 degrees from its own: the turn is made in R2's frame (about its axis the
+    fit's roll stays 1 % of the pitch; made in the camera's own frame it was 6 %)."""
+    from stereovision.rectification_check import RectificationCheck
+
+    w, h = 640, 480
+    raw = _rig(w, h, (0.0, 4.0, 0.0))
+    rig = dataclasses.replace(raw, T=raw.R @ np.array([-0.1, 0.0, 0.0]))
+    r2 = rig._stereo_rectify(0.0)[1]
+    assert _deg(r2) == pytest.approx(4.0, abs=0.01)
+    xl, yl = _grid(60)
+    xl = xl - xl.mean() + (w - 1) / 2
+    yl = yl - yl.mean() + (h - 1) / 2
+    pts = np.column_stack([xl, yl, xl - 20, yl + 1.0]).astype(np.float32)
+    check = RectificationCheck(60, 1.0, 1.0, -1.0, 0.0, 0.0, False, 0.5, points=pts)
+    flat = np.full((h, w), 128, np.uint8)
+    fixed, _ = refine_rectification(flat, flat, rig, check=check)
+    turn = cv2.Rodrigues(r2 @ fixed.R @ rig.R.T @ r2.T)[0].ravel()
+    assert abs(turn[1]) < 1e-9 and abs(turn[2]) < 0.03 * abs(turn[0])
+
+
+def test_align_rows_repeats_the_edge_rows_into_the_border() -> None:
+    """The rows moved in from outside the image repeat its edge, not black (0) ones."""
+    from stereovision.rectification_check import RectificationCheck, align_rows
+
+    img = np.full((20, 30), 100, np.uint8)
+    for offset in (2.5, -2.5):
+        check = RectificationCheck(60, 2.5, 2.5, offset, 0.0, 0.0, False, 0.5)
+        out, _ = align_rows(img, img, check=check)
+        np.testing.assert_array_equal(out, img)
+
+
+def test_rows_agree_shows_the_tolerance_as_given() -> None:
+    from stereovision.rectification_check import RectificationCheck
+
+    check = RectificationCheck(412, 0.08, 0.2, 0.0, 0.0, 0.0, True, 0.25)
+    assert check.rows_agree() == "rows median |dy| 0.08 px over 412 matches, tolerance 0.25"
+
+
+def test_features_of_a_large_image_are_at_its_pixel_centres() -> None:
+    """SIFT on the half-size copy of an image of 2 x 2 blocks: a feature at x' of the copy is
+    at 2 (x' + 0.5) - 0.5 of the image (pixel centres), not at 2 x'."""
+    from stereovision.rectification_check import _features
+
+    rng = np.random.default_rng(4)
+    small = cv2.GaussianBlur(rng.integers(0, 256, (300, 1600), dtype=np.uint8), (5, 5), 0)
+    large = np.repeat(np.repeat(small, 2, axis=0), 2, axis=1)
+    ps, _ = _features(small)
+    pl, _ = _features(large)
+    assert len(ps) > 100
+    np.testing.assert_allclose(pl, (ps + 0.5) * 2 - 0.5, atol=1e-9)
