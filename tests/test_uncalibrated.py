@@ -1007,3 +1007,26 @@ def test_lenses_differing_by_more_than_30_percent_are_not_two_turned_cameras(
         hz = np.array([[zoom, 0, c * (w - 1) / 2], [0, zoom, c * (h - 1) / 2], [0, 0, 1]])
         right = cv2.warpPerspective(sc.right, hz, (w, h))
         assert rectify_uncalibrated(sc.left, right).model == model, zoom
+
+
+def test_an_epipole_in_the_right_image_is_refused_by_name(data_dir: Path) -> None:
+    """A mutation audit found the right image's epipole check unasserted (the left one's ``F``
+    checked twice): a left camera turned 20 degrees about its y axis (its epipole about 330 px
+    off the centre, outside the 450 px wide image) and a right camera stepped forward (its
+    epipole the centre of its image, see ``_stepped_forward``). Refused, the right image named,
+    its epipole near the centre (measured (250, 176)); the left one's check alone let the pair
+    on to the fold check, which blamed the horizon instead."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    h, w = sc.left.shape[:2]
+    f = 1.1 * (w + h)
+    k = np.array([[f, 0, (w - 1) / 2], [0, f, (h - 1) / 2], [0, 0, 1.0]])
+    turn = k @ cv2.Rodrigues(np.radians([0.0, 20.0, 0.0]))[0] @ np.linalg.inv(k)
+    turned = cv2.warpPerspective(sc.left, turn, (w, h))
+    ahead = _stepped_forward(sc.left, sc.gt)
+    said = _refusal(turned, ahead)
+    found = re.findall(r"^the right image's epipole lies at \((\d+), (\d+)\), in the image", said)
+    assert found, said
+    ex, ey = (float(v) for v in found[0])
+    assert math.hypot(ex - (w - 1) / 2, ey - (h - 1) / 2) < 40
+    # the left epipole is the turned camera's: off its image, not refused as in it
+    assert "left image's epipole" not in said
