@@ -1030,3 +1030,24 @@ def test_an_epipole_in_the_right_image_is_refused_by_name(data_dir: Path) -> Non
     assert math.hypot(ex - (w - 1) / 2, ey - (h - 1) / 2) < 40
     # the left epipole is the turned camera's: off its image, not refused as in it
     assert "left image's epipole" not in said
+
+
+def test_homographies_collapsing_the_left_image_are_refused(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A mutation audit found the collapse guard unasserted: homographies that put every match of
+    the left image on one row (no area; here forced by a shear step of rank 2) are refused by
+    name; without the guard the scale divided by that area raised ZeroDivisionError. Squeezed to
+    a millionth of their height instead, the scale that keeps their area stretches the rows a
+    thousandfold: refused by their size."""
+    import stereovision.uncalibrated as uc
+
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    monkeypatch.setattr(uc, "_shear", lambda *a: np.diag([1.0, 0.0, 1.0]))
+    with pytest.raises(ValueError, match=r"^the rectifying homographies collapse the left image$"):
+        rectify_uncalibrated(sc.left, sc.right)
+    monkeypatch.setattr(uc, "_shear", lambda *a: np.diag([1.0, 1e-6, 1.0]))
+    with pytest.raises(
+        ValueError, match=r"^the rectified images would be (\d+)x\d+ px from 450x375"
+    ):
+        rectify_uncalibrated(sc.left, sc.right)
