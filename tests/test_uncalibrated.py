@@ -1051,3 +1051,35 @@ def test_homographies_collapsing_the_left_image_are_refused(
         ValueError, match=r"^the rectified images would be (\d+)x\d+ px from 450x375"
     ):
         rectify_uncalibrated(sc.left, sc.right)
+
+
+def test_the_coarse_probe_needs_16_rows_16_columns_and_100_disparities(data_dir: Path) -> None:
+    """A mutation audit found the coarse probe's guards unasserted. Shrunk 4 times, the probe needs
+    16 rows and, beyond the search range it moves the images by, 16 columns: cones rectified
+    (identity homographies) 63 rows or 60 columns high / wide is too small (None), 64 is not
+    (SGBM ran on the smaller ones and gave a span too). A pair flat but for a 12 x 24 px patch
+    moved 40 px gives SGBM 82 disparities, too few to tell the scene's span (None); a 12 x 30 px
+    patch 110 (measured): the span is the patch's 40 px."""
+    from stereovision._validate import as_gray_uint8
+    from stereovision.uncalibrated import _dense_span
+
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    gl, gr = as_gray_uint8(sc.left), as_gray_uint8(sc.right)
+    h, w = gl.shape
+    one = np.eye(3)
+
+    def span(a: np.ndarray, b: np.ndarray, size: tuple[int, int]) -> tuple[float, float] | None:
+        return _dense_span(a, b, one, one, 1.0, (0.0, 0.0), 0.0, size, 96)
+
+    assert span(gl, gr, (w, 63)) is None and span(gl, gr, (60, h)) is None
+    assert span(gl, gr, (w, 64)) is not None and span(gl, gr, (64, h)) is not None
+    for cols, has in ((24, False), (30, True)):
+        a, b = np.full_like(gl, 128), np.full_like(gr, 128)
+        a[180:192, 200 : 200 + cols] = gl[180:192, 200 : 200 + cols]
+        b[180:192, 160 : 160 + cols] = gl[180:192, 200 : 200 + cols]
+        got = span(a, b, (w, h))
+        assert (got is not None) is has, (cols, got)
+        if got is not None:
+            assert abs(got[0] - 40) <= 1 and abs(got[1] - 40) <= 1, got
+    flat = np.full_like(gl, 128)
+    assert span(flat, flat, (w, h)) is None  # no disparity at all: no percentile to take
