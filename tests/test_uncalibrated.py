@@ -1083,3 +1083,62 @@ def test_the_coarse_probe_needs_16_rows_16_columns_and_100_disparities(data_dir:
             assert abs(got[0] - 40) <= 1 and abs(got[1] - 40) <= 1, got
     flat = np.full_like(gl, 128)
     assert span(flat, flat, (w, h)) is None  # no disparity at all: no percentile to take
+
+
+def test_check_keeps_a_match_only_when_both_its_points_lie_in_the_rectified_pair(
+    data_dir: Path,
+) -> None:
+    """A mutation audit found :meth:`check`'s match filter unasserted side by side: the bound on
+    the left points' right edge, on the left points' left edge, on the right points' right edge
+    and on either image's last row could each go (the cases before moved both images so that
+    the other image's bound did the work). Cones (already rectified, 450 x 375) through
+    homographies that move one image or both by a shift that puts one match 0.2 px inside, or
+    0.2 px outside, that bound of a rectified pair of 390 x 325 (pixel centres at integers: an
+    image spans -0.5 to its size - 0.5): the check is the rule on exactly the matches whose
+    two points both lie within the rectified pair."""
+    from stereovision.rectification_check import (
+        DEFAULT_TOLERANCE_PX,
+        _features,
+        _judge_rows,
+        _mutual_matches,
+    )
+
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    w, h = sc.left.shape[1] - 60, sc.left.shape[0] - 50  # the rectified size, not the input's
+    gl, gr = (cv2.cvtColor(i, cv2.COLOR_BGR2GRAY) for i in (sc.left, sc.right))
+    (pl, dl), (pr, dr) = _features(gl), _features(gr)
+    pairs = _mutual_matches(dl, dr)
+    p1, p2 = pl[pairs[:, 0]], pr[pairs[:, 1]]
+
+    def move(dx: float, dy: float) -> np.ndarray:
+        return np.array([[1.0, 0, dx], [0, 1, dy], [0, 0, 1]])
+
+    def kth(v: np.ndarray) -> float:
+        return float(np.sort(v)[len(v) // 3])  # a third of the matches beyond the bound
+
+    for inset in (0.2, -0.2):
+        lo, hi_x, hi_y = -0.5 + inset, w - 0.5 - inset, h - 0.5 - inset
+        cases = {  # the bound that binds: the other image's points are well inside it
+            "left x past the right edge": (move(hi_x + kth(-p1[:, 0]), 0), None),
+            "left x before the left edge": (move(lo - kth(p1[:, 0]), 0), np.eye(3)),
+            "right x past the right edge": (np.eye(3), move(hi_x + kth(-p2[:, 0]), 0)),
+            "right x before the left edge": (move(lo - kth(p2[:, 0]), 0), None),
+            "left rows below the last": (move(0, hi_y + kth(-p1[:, 1])), np.eye(3)),
+            "right rows below the last": (np.eye(3), move(0, hi_y + kth(-p2[:, 1]))),
+            "rows above the first": (move(0, lo - kth(p1[:, 1])), None),
+        }
+        for name, (h1, h2) in cases.items():
+            h2 = h1 if h2 is None else h2  # both moved: the right points lie left of the left's
+            q1, q2 = p1 @ h1[:2, :2].T + h1[:2, 2], p2 @ h2[:2, :2].T + h2[:2, 2]
+            q = np.column_stack([q1, q2])
+            on = np.all(q >= -0.5, axis=1) & np.all(q[:, [0, 2]] <= w - 0.5, axis=1)
+            on &= np.all(q[:, [1, 3]] <= h - 0.5, axis=1)
+            assert 30 < on.sum() < len(p1) - 30, name
+            rect = UncalibratedRectification(
+                h1, h2, (w, h), sc.left.shape[1::-1], np.zeros((3, 3)), 100, 0.1, 0.2,
+                (1.0, 60.0), 64, (0.0, 0.0), (1.0, 1.0),
+            )  # fmt: skip
+            got = rect.check(sc.left, sc.right)
+            want = _judge_rows(q[on], w, h, DEFAULT_TOLERANCE_PX)
+            assert (got.matches, got.ok) == (want.matches, want.ok), (name, inset)
+            np.testing.assert_array_equal(got.points, want.points, err_msg=f"{name} {inset}")
