@@ -1142,3 +1142,17 @@ def test_check_keeps_a_match_only_when_both_its_points_lie_in_the_rectified_pair
             want = _judge_rows(q[on], w, h, DEFAULT_TOLERANCE_PX)
             assert (got.matches, got.ok) == (want.matches, want.ok), (name, inset)
             np.testing.assert_array_equal(got.points, want.points, err_msg=f"{name} {inset}")
+
+
+def test_the_output_holds_no_columns_beyond_the_images(data_dir: Path) -> None:
+    """A mutation audit found the columns' clamp unasserted (the rows' is): cones' matches reach
+    both sides of its images, and a margin of a quarter of their span beyond them gave black
+    columns (measured: the right image's first output column 102 px left of its image, the left
+    image's last 62 px right of it; clamped: -0.6 and 449.1 of 0-449)."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    w = sc.left.shape[1]
+    rect = rectify_uncalibrated(sc.left, sc.right)
+    w_out, h_out = rect.size
+    first, last = np.float64([[[0.0, h_out / 2]]]), np.float64([[[w_out - 1.0, h_out / 2]]])
+    assert cv2.perspectiveTransform(first, np.linalg.inv(rect.H2))[0, 0, 0] >= -3.0
+    assert cv2.perspectiveTransform(last, np.linalg.inv(rect.H1))[0, 0, 0] <= w + 2.0
