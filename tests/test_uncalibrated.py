@@ -1169,3 +1169,21 @@ def test_a_camera_rolled_over_30_degrees_is_not_two_turned_cameras(data_dir: Pat
         roll = cv2.getRotationMatrix2D(((w - 1) / 2, (h - 1) / 2), degrees, 1.0)
         rect = rectify_uncalibrated(sc.left, cv2.warpAffine(sc.right, roll, (w, h)))
         assert rect.model == model and rect.median_dy < 0.15, degrees
+
+
+def test_the_right_focal_length_share_is_clamped_to_a_half() -> None:
+    """A mutation audit found the clamp of the right camera's focal-length share unasserted:
+    unturned cameras give the right image ``H = K Kr^-1``, a zoom about the centre by ``f /
+    fr``. A share of -1 (a step of the fit running wild) is taken as -0.5 (the focal length
+    halved: zoom 2), not as a focal length of 0 (a singular ``Kr``: LinAlgError); a share of
+    2 as 0.5 (zoom 2/3)."""
+    from stereovision.uncalibrated import _qe_homographies
+
+    w, h = 640, 480
+    c = np.array([(w - 1) / 2, (h - 1) / 2])
+    pts = c + np.array([[0.0, 0.0], [100.0, -40.0]])
+    for share, zoom in ((-1.0, 2.0), (2.0, 2 / 3), (0.1, 1 / 1.1)):
+        hl, hr = _qe_homographies(np.array([0, 0, 0, 0, 0, 0, share]), w, h)
+        np.testing.assert_allclose(hl, np.eye(3), atol=1e-12)
+        moved = cv2.perspectiveTransform(pts[None], hr)[0]
+        np.testing.assert_allclose(moved, c + zoom * (pts - c), atol=1e-9)
