@@ -1187,3 +1187,19 @@ def test_the_right_focal_length_share_is_clamped_to_a_half() -> None:
         np.testing.assert_allclose(hl, np.eye(3), atol=1e-12)
         moved = cv2.perspectiveTransform(pts[None], hr)[0]
         np.testing.assert_allclose(moved, c + zoom * (pts - c), atol=1e-9)
+
+
+def test_a_file_of_100000_px_a_side_is_read(tmp_path: Path) -> None:
+    """A mutation audit found the size bound of a read file unasserted at its edge: 100000 px a
+    side is within it (a file of 100001 is refused)."""
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (100_000, 100_000), (100_000, 100_000), np.eye(3), 40, 0.1, 0.2,
+        (1.0, 9.0), 16, (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    back = UncalibratedRectification.load(rect.save(tmp_path / "big.json"))
+    assert back.size == back.input_size == (100_000, 100_000)
+    data = rect.as_dict()
+    data["input_size"] = [100_001, 100_000]
+    (tmp_path / "over.json").write_text(json.dumps(data))
+    with pytest.raises(ValueError, match=r"input_size 100001x100000 px: expected positive"):
+        UncalibratedRectification.load(tmp_path / "over.json")
