@@ -1203,3 +1203,20 @@ def test_a_file_of_100000_px_a_side_is_read(tmp_path: Path) -> None:
     (tmp_path / "over.json").write_text(json.dumps(data))
     with pytest.raises(ValueError, match=r"input_size 100001x100000 px: expected positive"):
         UncalibratedRectification.load(tmp_path / "over.json")
+
+
+def test_the_coarse_probe_searches_three_spans_below_the_features(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A mutation audit found how far below the features the coarse probe searches unasserted
+    (one span for three): cones, bumped, with a probe that matched down to the start of its
+    search (a textureless wall far behind the features): the range then starts three spans of
+    the features' disparities and 8 px below their 5th percentile, so that percentile lands
+    there plus ``_LOW_DISPARITY`` (measured: 94.84 px for a span of 28.28)."""
+    import stereovision.uncalibrated as uc
+
+    monkeypatch.setattr(uc, "_dense_span", lambda *a: (0.0, 40.0))
+    sc, _, right = perturbed_scene(data_dir, "middlebury2003/cones")
+    lo, hi = rectify_uncalibrated(sc.left, right).disparity_range
+    assert hi - lo > 20
+    assert lo == pytest.approx(3 * (hi - lo) + 8 + uc._LOW_DISPARITY, abs=1e-6)
