@@ -1220,3 +1220,41 @@ def test_the_coarse_probe_searches_three_spans_below_the_features(
     lo, hi = rectify_uncalibrated(sc.left, right).disparity_range
     assert hi - lo > 20
     assert lo == pytest.approx(3 * (hi - lo) + 8 + uc._LOW_DISPARITY, abs=1e-6)
+
+
+@pytest.mark.parametrize("side", ["left", "right"])
+def test_an_epipole_on_the_image_border_is_in_the_image(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch, side: str
+) -> None:
+    """A mutation audit found the in-image test of an epipole unasserted at its edges (``<= h``
+    for ``<= h - 1``): cones' matches with their F replaced by one of rank 2 whose epipole lies
+    0.01 px inside the image's first or last pixel centres (exactly on them the SVD's rounding
+    decides) are refused as seeing it in the image; half a pixel beyond those centres, not as
+    such (the other image's epipole at infinity)."""
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    h, w = sc.left.shape[:2]
+    fundamental = cv2.findFundamentalMat
+
+    def across(v: np.ndarray) -> np.ndarray:
+        """Two orthonormal rows across ``v``."""
+        out: np.ndarray = np.linalg.svd(v[None])[2][1:]
+        return out
+
+    for x, y, inside in (
+        (0.01, 200.0, True), (w - 1.01, 200.0, True), (200.0, 0.01, True),
+        (200.0, h - 1.01, True), (-0.5, 200.0, False), (w - 0.5, 200.0, False),
+        (200.0, -0.5, False), (200.0, h - 0.5, False),
+    ):  # fmt: skip
+        e = np.array([x, y, 1.0])
+        far = np.array([1.0, 0.0, 0.0])
+        e1, e2 = (e, far) if side == "left" else (far, e)
+
+        def with_epipoles(*args: object, e1: np.ndarray = e1, e2: np.ndarray = e2) -> tuple:
+            _, mask = fundamental(*args)
+            return across(e2).T @ across(e1), mask  # rank 2: F e1 = 0, F^T e2 = 0
+
+        monkeypatch.setattr(cv2, "findFundamentalMat", with_epipoles)
+        said = _refusal(sc.left, sc.right)
+        want = f"the {side} image's epipole lies at ({x:.0f}, {y:.0f}), in the image"
+        assert (want in said) is inside, (x, y, said)
+        assert inside or "epipole" not in said
