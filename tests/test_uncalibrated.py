@@ -1294,3 +1294,25 @@ def test_the_coarse_probe_is_placed_below_the_features(data_dir: Path) -> None:
     want = expected_disparity(rect, hp, sc.gt)
     far_end = float(np.percentile(want[np.isfinite(want)], 99.5))
     assert far_end <= rect.max_disparity <= 1.2 * far_end, (far_end, rect.max_disparity)
+
+
+def test_a_file_missing_a_field_or_with_a_null_is_named(tmp_path: Path) -> None:
+    """A mutation audit found two of load's caught errors unasserted: a file without ``F``
+    (KeyError) and one whose size is null (TypeError) are named as not such a file (the field
+    missing named), not a traceback."""
+    rect = UncalibratedRectification(
+        np.eye(3), np.eye(3), (100, 80), (100, 80), np.eye(3), 40, 0.1, 0.2, (1.0, 9.0), 16,
+        (0.0, 0.0), (1.0, 1.0),
+    )  # fmt: skip
+    missing = rect.as_dict()
+    del missing["F"]
+    (tmp_path / "missing.json").write_text(json.dumps(missing))
+    with pytest.raises(
+        ValueError, match=r"missing\.json is not an uncalibrated rectification: field 'F'$"
+    ):
+        UncalibratedRectification.load(tmp_path / "missing.json")
+    null = rect.as_dict()
+    null["size"] = None
+    (tmp_path / "null.json").write_text(json.dumps(null))
+    with pytest.raises(ValueError, match=r"null\.json is not an uncalibrated rectification: "):
+        UncalibratedRectification.load(tmp_path / "null.json")
