@@ -1316,3 +1316,15 @@ def test_a_file_missing_a_field_or_with_a_null_is_named(tmp_path: Path) -> None:
     (tmp_path / "null.json").write_text(json.dumps(null))
     with pytest.raises(ValueError, match=r"null\.json is not an uncalibrated rectification: "):
         UncalibratedRectification.load(tmp_path / "null.json")
+
+
+def test_opencv_finding_no_homographies_is_refused(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A mutation audit found OpenCV's failure flag unasserted: ``stereoRectifyUncalibrated``
+    saying it found nothing (here forced, with the homographies it leaves) is refused by name,
+    not rectified with whatever matrices came back."""
+    monkeypatch.setattr(cv2, "stereoRectifyUncalibrated", lambda *a: (False, np.eye(3), np.eye(3)))
+    sc = load_scene(data_dir / "middlebury2003" / "cones")
+    with pytest.raises(ValueError, match=r"^OpenCV found no rectifying homographies"):
+        rectify_uncalibrated(sc.left, sc.right, model="projective")
