@@ -31,7 +31,7 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
-use crate::alloc::{try_filled, try_reserve_len, try_zeroed};
+use crate::alloc::{try_collect, try_filled, try_reserve_len, try_zeroed};
 use crate::error::{CoreError, Result};
 use crate::image::ImageView;
 use crate::simd::simd_fn;
@@ -569,12 +569,38 @@ simd_fn! {
     }
 }
 
+/// [`select_row`]'s buffers: the right view's winners of a row (see [`right_winners`]), one
+/// per worker, allocated once per call instead of once a row.
+struct Winners {
+    rbest: Vec<u16>,
+    rk: Vec<u16>,
+}
+
+impl Winners {
+    /// Checked, outside the row loop (kept out of line: see [`pass_impl`]'s buffers).
+    #[inline(never)]
+    fn new(w: usize) -> Result<Self> {
+        const WHAT: &str = "the census matcher's right winners";
+        Ok(Winners {
+            rbest: try_zeroed(w, WHAT)?,
+            rk: try_zeroed(w, WHAT)?,
+        })
+    }
+}
+
 /// Winner, uniqueness, left-right check and sub-pixel vertex for one row of the summed volume.
-fn select_row(s: &[u16], w: usize, n_all: usize, d_min: i64, p: &SgmParams, out: &mut [f32]) {
+fn select_row(
+    s: &[u16],
+    w: usize,
+    n_all: usize,
+    d_min: i64,
+    p: &SgmParams,
+    win: &mut Winners,
+    out: &mut [f32],
+) {
     let d_max = d_min + n_all as i64 - 1;
-    let mut rbest = vec![0u16; w];
-    let mut rk = vec![0u16; w];
-    right_winners(s, w, n_all, d_min, &mut rbest, &mut rk);
+    let Winners { rbest, rk } = win;
+    right_winners(s, w, n_all, d_min, rbest, rk);
     for (x, o) in out.iter_mut().enumerate() {
         // Levels 0..inside land in the right image. The right band (d_min < 0) is not reported.
         let inside = (x as i64 - d_min + 1).min(n_all as i64);
@@ -799,7 +825,13 @@ pub fn sgm_disparity(
     // second adds its own and selects the row. One volume of sums is held at most (the rows
     // each pass reached first), not one per pass; the addition commutes, so the output does
     // not depend on which came first.
-    let slots: Vec<Mutex<Option<Vec<u16>>>> = (0..h).map(|_| Mutex::new(None)).collect();
+    // Each slot also holds its row of the output, which the second pass to reach the row
+    // selects into (no row-sized buffer a row, and no list of them).
+    let slots: Vec<RowSlot<'_>> = try_collect(
+        h,
+        out.chunks_mut(w).map(|o| Mutex::new((None, o))),
+        "the census matcher's row slots",
+    )?;
     // Path costs as u8 where they fit, else u16: the same integers.
     let pass = if u8_fits(&p2_table(p)) {
         pass_u8
@@ -809,55 +841,52 @@ pub fn sgm_disparity(
     // Set when a pass could not allocate its path buffers: the other then parks no more sums
     // for it (they would never be met).
     let alone = std::sync::atomic::AtomicBool::new(false);
-    let meet = |forward: bool| -> Result<Vec<(usize, Vec<f32>)>> {
-        let mut done = Vec::new();
+    let (mut win_a, mut win_b) = (Winners::new(w)?, Winners::new(w)?);
+    let meet = |forward: bool, win: &mut Winners| -> Result<()> {
         let mut emit = |y: usize, row: &mut Vec<u16>| {
-            let other = {
-                let mut slot = slots[y].lock().unwrap_or_else(|e| e.into_inner());
-                match slot.take() {
-                    Some(other) => other,
-                    None => {
-                        if alone.load(std::sync::atomic::Ordering::Relaxed) {
-                            return;
-                        }
-                        if let Some(next) = fresh() {
-                            *slot = Some(std::mem::replace(row, next));
-                        }
-                        return;
-                    }
+            let mut slot = slots[y].lock().unwrap_or_else(|e| e.into_inner());
+            let (parked, o) = &mut *slot;
+            let Some(other) = parked.take() else {
+                if alone.load(std::sync::atomic::Ordering::Relaxed) {
+                    return;
                 }
+                if let Some(next) = fresh() {
+                    *parked = Some(std::mem::replace(row, next));
+                }
+                return;
             };
             add_into(row, &other);
             free.lock().unwrap_or_else(|e| e.into_inner()).push(other);
-            let mut o = vec![f32::NAN; w];
-            select_row(row, w, n, i64::from(d_min), p, &mut o);
-            done.push((y, o));
+            select_row(row, w, n, i64::from(d_min), p, win, o);
         };
         let Some(mut row) = fresh() else {
-            return Ok(done);
+            return Ok(());
         };
         let ran = pass(&c, left.data, w, h, n, p, forward, &mut row, &mut emit);
         if ran.is_err() {
             alone.store(true, std::sync::atomic::Ordering::Relaxed);
         }
         free.lock().unwrap_or_else(|e| e.into_inner()).push(row);
-        ran.map(|()| done)
+        ran
     };
-    let (a, b) = rayon::join(|| meet(true), || meet(false));
+    let (a, b) = rayon::join(|| meet(true, &mut win_a), || meet(false, &mut win_b));
+    drop(slots);
     kept::put(c, free.into_inner().unwrap_or_else(|e| e.into_inner()));
     // A pass without path buffers first: the row sums it starved the other of follow from it.
-    let (a, b) = (a?, b?);
+    a?;
+    b?;
     if starved.into_inner() {
         return Err(CoreError::oom(
             h.saturating_mul(w * n * 2),
             "the census matcher's row sums",
         ));
     }
-    for (y, o) in a.into_iter().chain(b) {
-        out[y * w..(y + 1) * w].copy_from_slice(&o);
-    }
     Ok(out)
 }
+
+/// A row of the 8-path matcher: the sums of the pass that reached it first, parked until the
+/// other pass arrives, and the row of the output it is then selected into.
+type RowSlot<'a> = Mutex<(Option<Vec<u16>>, &'a mut [f32])>;
 
 /// One path's step at one pixel (see [`step4`]): `out[1..n + 1]` gets the new path costs, which
 /// are stored into `acc` (`ADD` false) or added to it; returns their minimum.
@@ -1099,6 +1128,7 @@ struct Flight {
 /// take turns at.
 struct Vertical<'a, T> {
     path: VerticalPath<T>,
+    win: Winners,
     out: &'a mut [f32],
 }
 
@@ -1142,6 +1172,7 @@ fn three_paths_as<T: PathCost + Send>(
     let queued = Condvar::new();
     let state = Mutex::new(Vertical {
         path: VerticalPath::<T>::new(w, n)?,
+        win: Winners::new(w)?,
         out: &mut out,
     });
     // The vertical path and the selection of the next queued row, by whichever worker calls it;
@@ -1156,7 +1187,15 @@ fn three_paths_as<T: PathCost + Send>(
         let prow = (y > 0).then(|| &img[(y - 1) * w..y * w]);
         let irow = &img[y * w..(y + 1) * w];
         vertical(&c, irow, prow, n, p, lut, &mut acc, &mut v.path);
-        select_row(&acc, w, n, d_min, p, &mut v.out[y * w..(y + 1) * w]);
+        select_row(
+            &acc,
+            w,
+            n,
+            d_min,
+            p,
+            &mut v.win,
+            &mut v.out[y * w..(y + 1) * w],
+        );
         lock(&flight).free.push((c, acc));
         true
     };
@@ -1544,6 +1583,42 @@ mod tests {
         ] {
             assert!(stdout.contains(want), "{want} not in {stdout}");
         }
+    }
+
+    /// Run by [`row_slots_too_large_to_allocate_are_an_error`] in a child process: a 1 px
+    /// wide, 4 Mi-row pair with one level under an address-space limit of 120 MiB more than is
+    /// mapped. The map (4 bytes a row), census codes (16) and cost volume (1) fit; the 8-path
+    /// passes' row slots (48 bytes a row) do not.
+    #[cfg(target_os = "linux")]
+    #[test]
+    #[ignore = "a child of row_slots_too_large_to_allocate_are_an_error"]
+    fn row_slots_under_a_memory_limit() {
+        if std::env::var_os("SV_OOM_CHILD").is_none() {
+            return;
+        }
+        let h = 1usize << 22;
+        let img = ramp(1, h, 0.0);
+        rayon::join(|| (), || ()); // the pool's thread started before the limit
+        crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (120 << 20));
+        let v = ImageView::new(1, h, &img).unwrap();
+        match sgm_disparity(v, v, 0, 0, &SgmParams::default()) {
+            Ok(d) => println!("child: matched {}", d.len()),
+            Err(e) => println!("child: error: {e}"),
+        }
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn row_slots_too_large_to_allocate_are_an_error() {
+        // The 8-path passes' per-row slots were collected, and each selected row allocated and
+        // listed (vec!, push) before being copied into the map: h-sized, unchecked, a failed
+        // allocation aborted the process (SIGABRT) instead of returning OutOfMemory.
+        let stdout = crate::segment::tests::run_oom_child(
+            "matching::sgm::tests::row_slots_under_a_memory_limit",
+        );
+        let want = "child: error: out of memory: the census matcher's row slots needs 192.00 MiB \
+                    (201326592 bytes)";
+        assert!(stdout.contains(want), "{want} not in {stdout}");
     }
 
     #[test]
