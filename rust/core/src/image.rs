@@ -21,13 +21,16 @@ impl Image {
         })
     }
 
-    /// An image filled with one value.
-    pub fn filled(width: usize, height: usize, value: f32) -> Self {
-        Image {
+    /// An image filled with one value, or [`CoreError::OutOfMemory`] when it cannot be
+    /// allocated (`vec!` aborted the process).
+    pub fn filled(width: usize, height: usize, value: f32) -> Result<Self> {
+        // Saturated: a size past `usize` is a failed allocation, not a wrapped small image.
+        let n = width.saturating_mul(height);
+        Ok(Image {
             width,
             height,
-            data: vec![value; width * height],
-        }
+            data: crate::alloc::try_filled(n, value, "the filled image")?,
+        })
     }
 
     /// Value at `(x, y)`; the caller guarantees bounds.
@@ -243,8 +246,8 @@ mod tests {
             Image::new(2, 1, vec![0.0, f32::NAN]),
             Err(CoreError::NonFinite { count: 1 })
         ));
-        let a = Image::filled(2, 2, 0.5);
-        let b = Image::filled(3, 2, 0.5);
+        let a = Image::filled(2, 2, 0.5).unwrap();
+        let b = Image::filled(3, 2, 0.5).unwrap();
         assert!(matches!(
             check_pair(&a, &b),
             Err(CoreError::SizeMismatch { .. })
@@ -268,7 +271,10 @@ mod tests {
             Err(CoreError::NonFinite { count: 2 })
         );
         // Sizes that differ in height only.
-        let (a, b) = (Image::filled(3, 2, 0.0), Image::filled(3, 4, 0.0));
+        let (a, b) = (
+            Image::filled(3, 2, 0.0).unwrap(),
+            Image::filled(3, 4, 0.0).unwrap(),
+        );
         assert_eq!(
             check_pair(&a, &b),
             Err(CoreError::SizeMismatch {
@@ -276,7 +282,17 @@ mod tests {
                 right: (3, 4)
             })
         );
-        assert_eq!(Image::filled(3, 2, 0.5).data, vec![0.5; 6]);
+        assert_eq!(Image::filled(3, 2, 0.5).unwrap().data, vec![0.5; 6]);
+        // Too large for any address space (or past `usize`): an error naming it, not an abort.
+        for (w, h) in [(1usize << 31, 1usize << 31), (usize::MAX, 3)] {
+            assert!(matches!(
+                Image::filled(w, h, 0.5),
+                Err(CoreError::OutOfMemory {
+                    what: "the filled image",
+                    ..
+                })
+            ));
+        }
         // A confidence of the wrong length, with a disparity of the right one.
         assert!(check_map_pair(&[0.0; 6], &[0.0; 6], 3, 2).is_ok());
         assert!(check_map_pair(&[0.0; 6], &[0.0; 5], 3, 2).is_err());

@@ -85,7 +85,7 @@ fn negative_range_is_supported() {
 
 #[test]
 fn textureless_pair_gives_all_nan() {
-    let a = Image::filled(64, 48, 0.5);
+    let a = Image::filled(64, 48, 0.5).unwrap();
     let out = gabor_disparity(&a, &a, &GaborParams::default()).unwrap();
     assert!(out.disparity.data.iter().all(|v| v.is_nan()));
     assert!(out.confidence.data.iter().all(|&v| v == 0.0));
@@ -93,7 +93,7 @@ fn textureless_pair_gives_all_nan() {
 
 #[test]
 fn bad_parameters_are_errors() {
-    let a = Image::filled(16, 16, 0.5);
+    let a = Image::filled(16, 16, 0.5).unwrap();
     let bad = [
         GaborParams {
             d_max: 0.0,
@@ -176,7 +176,7 @@ fn bad_parameters_are_errors() {
             other => panic!("{name}: {other:?}"),
         }
     }
-    let b = Image::filled(17, 16, 0.5);
+    let b = Image::filled(17, 16, 0.5).unwrap();
     assert!(matches!(
         gabor_disparity(&a, &b, &GaborParams::default()),
         Err(CoreError::SizeMismatch { .. })

@@ -106,7 +106,7 @@ fn seeded_order_is_reproducible() {
 
 #[test]
 fn textureless_and_tiny_images_give_no_matches() {
-    let flat = Image::filled(60, 40, 0.5);
+    let flat = Image::filled(60, 40, 0.5).unwrap();
     let out = hopfield_match(&flat, &flat, &params(8)).expect("valid input");
     assert!(out.matches.is_empty());
     assert_eq!(out.energy_trace, vec![0.0]);
@@ -186,7 +186,7 @@ fn bad_parameters_are_errors() {
             ),
         }
     }
-    let small = Image::filled(20, 30, 0.5);
+    let small = Image::filled(20, 30, 0.5).unwrap();
     assert!(matches!(
         hopfield_match(&l, &small, &params(8)),
         Err(CoreError::SizeMismatch { .. })
@@ -335,7 +335,7 @@ fn initial_state_switches_on_the_best_candidate_at_or_above_s_init() {
 /// not counted), or, in sparse areas, `agree_share` of the others; matches at `x - (d + sub)`.
 #[test]
 fn finish_keeps_matches_with_enough_agreeing_neighbours() {
-    let img = Image::filled(400, 200, 0.5);
+    let img = Image::filled(400, 200, 0.5).unwrap();
     let v = ImageView::from(&img);
     // Dense: 9 matches, each with exactly min_agree = 8 agreeing others.
     let dense: Vec<Neuron> = (0..9)
@@ -821,7 +821,7 @@ fn rescue_compares_the_side_median_with_the_subpixel_disparity() {
 /// Sparse areas: exactly `min_agree_sparse` = 2 agreeing neighbours (all of them) suffice.
 #[test]
 fn finish_keeps_sparse_matches_with_exactly_min_agree_sparse_neighbours() {
-    let img = Image::filled(400, 200, 0.5);
+    let img = Image::filled(400, 200, 0.5).unwrap();
     let v = ImageView::from(&img);
     let ns: Vec<Neuron> = (0..3)
         .map(|k| neuron(k, (300 + 2 * k as i32, 100), 10, 0.0, true))

@@ -60,7 +60,7 @@ fn log_kernel_sums_to_zero_and_flat_images_give_nothing() {
         );
         assert_eq!(g.len(), 2 * (4.0 * sigma).ceil() as usize + 1);
     }
-    let flat = Image::filled(40, 30, 0.8);
+    let flat = Image::filled(40, 30, 0.8).unwrap();
     let l = log_filter(&flat, 2.0).unwrap();
     assert!(l.iter().all(|v| v.abs() < 1e-5));
     let out = mcgm_match(&flat, &flat, &McgmParams::default()).expect("valid input");
@@ -278,7 +278,7 @@ fn bad_parameters_are_errors_not_panics() {
             3
         );
     }
-    let tiny = Image::filled(2, 2, 0.3);
+    let tiny = Image::filled(2, 2, 0.3).unwrap();
     assert!(mcgm_match(&tiny, &tiny, &McgmParams::default())
         .expect("valid")
         .matches
@@ -773,7 +773,7 @@ fn area_check_keeps_the_true_disparity_and_rejects_one_pixel_off() {
             .count();
         assert!(n_kept <= 1, "{dd}: {n_kept}");
     }
-    let flat = Image::filled(200, 150, 0.5);
+    let flat = Image::filled(200, 150, 0.5).unwrap();
     assert!(!area_ok(&flat, &flat, &at(100.0, 50.0, 0.0), 0.5));
 }
 
@@ -1823,13 +1823,13 @@ fn both_sides_windows_have_the_specified_columns_rows_and_limit() {
         ..FilterParams::default()
     };
     let kept = |left: &Image, m: Match, f: &FilterParams| {
-        let r = Image::filled(w, h, 0.5);
+        let r = Image::filled(w, h, 0.5).unwrap();
         edge_filters(left, &r, &[m], f, (0, 16)).unwrap().0[0]
     };
-    let flat = Image::filled(w, h, 0.5);
+    let flat = Image::filled(w, h, 0.5).unwrap();
     // Column `c` of rows 12..=18 brightened by 0.4: a mean-free MAD of 2 * 0.4 * 5 / 36.
     let bright = |c: usize| {
-        let mut img = Image::filled(w, h, 0.5);
+        let mut img = Image::filled(w, h, 0.5).unwrap();
         for y in 12..=18 {
             img.data[y * w + c] = 0.9;
         }
@@ -1917,7 +1917,7 @@ fn both_sides_best_compares_only_disparities_inside_the_range() {
 /// +- disc_dy rows whose disparities differ by more than (not exactly) disc_tol.
 #[test]
 fn discontinuity_filter_neighbourhood_and_tolerance() {
-    let img = Image::filled(40, 30, 0.5);
+    let img = Image::filled(40, 30, 0.5).unwrap();
     let f = FilterParams {
         sides: false,
         zncc_check: false,
@@ -2252,7 +2252,7 @@ fn half_resolution_range_rounds_outward() {
 /// has no neighbourhood to check), after the both-sides step counted it.
 #[test]
 fn discontinuity_filter_drops_matches_outside_the_image() {
-    let img = Image::filled(40, 30, 0.5);
+    let img = Image::filled(40, 30, 0.5).unwrap();
     let f = FilterParams {
         sides: false,
         zncc_check: false,
