@@ -356,6 +356,14 @@ try:
         a = np.random.default_rng(0).random((40, 64), dtype=np.float32)
         m = np.broadcast_to(np.array([30, 20, 26, 20], np.float32), (2**27, 4))
         _core.mcgm_filter(a, a, m, {{"max_disparity": 16}})
+    elif case in ("mcgm_filter_nan", "mcgm_filter_outside"):
+        a = np.random.default_rng(0).random((40, 64), dtype=np.float32)
+        row = [np.nan, 20, 26, 20] if case.endswith("nan") else [100, 20, 96, 20]
+        m = np.broadcast_to(np.array(row, np.float32), (2**29, 4))
+        try:
+            _core.mcgm_filter(a, a, m, {{"max_disparity": 16}})
+        except ValueError as e:
+            print("ValueError:", e)
     elif case == "available":
         print("available", sgm._available_bytes())
         raise MemoryError("none")
@@ -399,6 +407,24 @@ def test_a_failed_allocation_is_a_memory_error(case: str, message: str) -> None:
     out = _under_address_limit(case, 3_000_000 * 1024)
     assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
     assert f"MemoryError: {message} and the allocation failed" in out.stdout, out.stdout
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+@pytest.mark.parametrize(
+    ("case", "message"),
+    [
+        ("mcgm_filter_nan", "rows have a NaN or infinite coordinate (row 0: "),
+        ("mcgm_filter_outside", "rows lie outside the 64x40 images (row 0: "),
+    ],
+)
+def test_mcgm_filter_counts_bad_rows_without_listing_them(case: str, message: str) -> None:
+    """``mcgm_filter``'s row check collected the indices of every bad row (8 bytes a row) with
+    an unchecked ``collect``: 2**29 broadcast bad rows aborted the process (SIGABRT) under
+    ``ulimit -v`` instead of refusing them with the count."""
+    out = _under_address_limit(case, 3_000_000 * 1024)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    n = 2**29
+    assert f"ValueError: matches: {n} of {n} {message}" in out.stdout, out.stdout
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")

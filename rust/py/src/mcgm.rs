@@ -408,13 +408,13 @@ fn check_match_rows(view: &ArrayView2<'_, f32>, w: usize, h: usize) -> PyResult<
         format!("(xl, yl, xr, yr) = ({})", v.join(", "))
     };
     let n = view.nrows();
-    let bad: Vec<usize> = (0..n)
-        .filter(|&i| view.row(i).iter().any(|v| !v.is_finite()))
-        .collect();
-    if let Some(&i) = bad.first() {
+    // The first bad row and a count, not a list of them: a huge (broadcast) `matches` of NaN
+    // rows made that list N-sized, and its unchecked growth aborted the process.
+    let non_finite = |i: &usize| view.row(*i).iter().any(|v| !v.is_finite());
+    if let Some(i) = (0..n).find(non_finite) {
         return Err(PyValueError::new_err(format!(
             "matches: {} of {n} rows have a NaN or infinite coordinate (row {i}: {})",
-            bad.len(),
+            (i..n).filter(non_finite).count(),
             row(i)
         )));
     }
@@ -425,11 +425,10 @@ fn check_match_rows(view: &ArrayView2<'_, f32>, w: usize, h: usize) -> PyResult<
         let y_out = |y: f32| (y as f64) < -0.5 || (y as f64) > hf;
         x_out(r[0]) || x_out(r[2]) || y_out(r[1]) || y_out(r[3])
     };
-    let out: Vec<usize> = (0..n).filter(|&i| outside(i)).collect();
-    if let Some(&i) = out.first() {
+    if let Some(i) = (0..n).find(|&i| outside(i)) {
         return Err(PyValueError::new_err(format!(
             "matches: {} of {n} rows lie outside the {w}x{h} images (row {i}: {})",
-            out.len(),
+            (i..n).filter(|&i| outside(i)).count(),
             row(i)
         )));
     }
