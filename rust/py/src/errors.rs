@@ -1,7 +1,7 @@
 //! One place that maps core errors (and stray panics) to Python exceptions.
 
 use pyo3::exceptions::{PyMemoryError, PyRuntimeError, PyValueError};
-use pyo3::PyErr;
+use pyo3::{PyErr, PyResult};
 use stereovision_core::CoreError;
 
 /// Maps each core error to the Python exception class users already catch.
@@ -42,4 +42,22 @@ pub fn guard<T>(name: &str, f: impl FnOnce() -> Result<T, CoreError>) -> Result<
             )))
         }
     }
+}
+
+/// `n` rows of `K` values flattened into one vector allocated at once, for an output array:
+/// `MemoryError` naming `what` where an unchecked `collect` aborted the process.
+pub fn flat_rows<T, const K: usize>(
+    n: usize,
+    rows: impl Iterator<Item = [T; K]>,
+    what: &'static str,
+) -> PyResult<Vec<T>> {
+    let mut v = Vec::new();
+    reserve(&mut v, n.saturating_mul(K), what)?;
+    v.extend(rows.flatten());
+    Ok(v)
+}
+
+/// Room for `n` values in all in `v`, or `MemoryError` naming `what` (see [`flat_rows`]).
+pub fn reserve<T>(v: &mut Vec<T>, n: usize, what: &'static str) -> PyResult<()> {
+    stereovision_core::alloc::try_reserve_len(v, n, what).map_err(to_pyerr)
 }

@@ -16,7 +16,7 @@ use stereovision_core::matching::hopfield::{
 use stereovision_core::parallel::run_hot;
 
 use crate::convert::{grey_from_numpy, image_to_numpy, u8_layout};
-use crate::errors::guard;
+use crate::errors::{flat_rows, guard};
 use crate::params::{check_keys, get};
 
 const KEYS: [&str; 41] = [
@@ -158,8 +158,13 @@ pub fn hopfield_interest<'py>(
             Ok((m, pts))
         })
     })?;
-    let xy: Vec<i32> = pts.iter().flat_map(|q| [q.x as i32, q.y as i32]).collect();
-    let vals: Vec<f32> = pts.iter().map(|q| q.value).collect();
+    let n = pts.len();
+    let xy = flat_rows(
+        n,
+        pts.iter().map(|q| [q.x as i32, q.y as i32]),
+        "the points",
+    )?;
+    let vals = flat_rows(n, pts.iter().map(|q| [q.value]), "the points' values")?;
     let xy = Array2::from_shape_vec((pts.len(), 2), xy)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     let mimg = stereovision_core::Image {
@@ -182,11 +187,13 @@ type MatchOut<'py> = (
 
 fn output<'py>(py: Python<'py>, out: HopfieldOutput) -> PyResult<MatchOut<'py>> {
     let n = out.matches.len();
-    let flat: Vec<f32> = out
-        .matches
-        .iter()
-        .flat_map(|m| [m.xl, m.yl, m.xr, m.yr, m.score])
-        .collect();
+    let flat = flat_rows(
+        n,
+        out.matches
+            .iter()
+            .map(|m| [m.xl, m.yl, m.xr, m.yr, m.score]),
+        "the matches array",
+    )?;
     let arr =
         Array2::from_shape_vec((n, 5), flat).map_err(|e| PyValueError::new_err(e.to_string()))?;
     let stats = PyDict::new(py);
@@ -338,9 +345,9 @@ pub fn hopfield_candidates<'py>(
     let (_, neurons) = crate::workers::detach(py, || {
         guard("hopfield_candidates", || candidate_neurons(l, r, &p))
     })?;
-    let flat: Vec<f32> = neurons
-        .iter()
-        .flat_map(|n| {
+    let flat = flat_rows(
+        neurons.len(),
+        neurons.iter().map(|n| {
             [
                 n.point as f32,
                 n.xl as f32,
@@ -349,8 +356,9 @@ pub fn hopfield_candidates<'py>(
                 n.yr as f32,
                 n.sim,
             ]
-        })
-        .collect();
+        }),
+        "the candidates array",
+    )?;
     let arr = Array2::from_shape_vec((neurons.len(), 6), flat)
         .map_err(|e| PyValueError::new_err(e.to_string()))?;
     Ok(arr.into_pyarray(py))

@@ -15,7 +15,7 @@ use stereovision_core::matching::mcgm::{
 use stereovision_core::Image;
 
 use crate::convert::{image_from_numpy, image_to_numpy};
-use crate::errors::guard;
+use crate::errors::{flat_rows, guard, reserve};
 use crate::params::{check_keys, get};
 
 const KEYS: [&str; 43] = [
@@ -119,10 +119,12 @@ fn shape_err(e: impl std::fmt::Display) -> PyErr {
 }
 
 fn matches_array<'py>(py: Python<'py>, ms: &[Match]) -> PyResult<Bound<'py, PyArray2<f32>>> {
-    let flat: Vec<f32> = ms
-        .iter()
-        .flat_map(|m| [m.xl, m.yl, m.xr, m.yr, m.score, m.channel as f32])
-        .collect();
+    let flat = flat_rows(
+        ms.len(),
+        ms.iter()
+            .map(|m| [m.xl, m.yl, m.xr, m.yr, m.score, m.channel as f32]),
+        "the matches array",
+    )?;
     Ok(Array2::from_shape_vec((ms.len(), 6), flat)
         .map_err(shape_err)?
         .into_pyarray(py))
@@ -181,10 +183,17 @@ fn curves_dict<'py>(py: Python<'py>, c: ChannelCurves) -> PyResult<Bound<'py, Py
     let labels = Array2::from_shape_vec((h, w), c.curves.labels).map_err(shape_err)?;
     d.set_item("labels", labels.into_pyarray(py))?;
     let segs = &c.curves.segments;
+    // Reserved first (the curves' pixels are up to one a pixel of the image): the pushes below
+    // do not grow them, so a failed allocation is a MemoryError, not an abort.
+    let n_pix: usize = segs.iter().map(|s| s.pixels.len()).sum();
     let mut offsets = vec![0i64];
     let mut pix: Vec<i32> = Vec::new();
     let mut cen: Vec<f32> = Vec::new();
     let mut mt: Vec<f32> = Vec::new();
+    reserve(&mut offsets, segs.len() + 1, "the curves' offsets")?;
+    reserve(&mut pix, n_pix.saturating_mul(2), "the curves' pixels")?;
+    reserve(&mut cen, segs.len() * 2, "the curves' centroids")?;
+    reserve(&mut mt, segs.len(), "the curves' mean orientations")?;
     for s in segs {
         for &i in &s.pixels {
             pix.push((i as usize % w) as i32);
@@ -211,8 +220,14 @@ fn curves_dict<'py>(py: Python<'py>, c: ChannelCurves) -> PyResult<Bound<'py, Py
     )?;
     d.set_item("mean_theta", Array1::from_vec(mt).into_pyarray(py))?;
     let k = c.rtables.first().map_or(0, |r| r.offsets.len());
-    let mut rt_off: Vec<i32> = Vec::with_capacity(n * k);
-    let mut rt_vec: Vec<f32> = Vec::with_capacity(2 * npix);
+    let (mut rt_off, mut rt_vec): (Vec<i32>, Vec<f32>) = (Vec::new(), Vec::new());
+    reserve(&mut rt_off, n.saturating_mul(k), "the R-tables' offsets")?;
+    let n_vec: usize = c.rtables.iter().map(|r| r.vecs.len()).sum();
+    reserve(
+        &mut rt_vec,
+        n_vec.saturating_mul(2),
+        "the R-tables' vectors",
+    )?;
     for r in &c.rtables {
         rt_off.extend(r.offsets.iter().map(|&o| o as i32));
         for &(vx, vy) in &r.vecs {
@@ -291,36 +306,43 @@ pub fn mcgm_match<'py>(
         d.set_item("scale", c.scale)?;
         d.set_item("n_left", c.n_left)?;
         d.set_item("n_right", c.n_right)?;
-        let flat: Vec<f32> = c
-            .candidates
-            .iter()
-            .flat_map(|k| [k.left as f32, k.right as f32, k.score, k.tx, k.ty])
-            .collect();
+        let flat = flat_rows(
+            c.candidates.len(),
+            c.candidates
+                .iter()
+                .map(|k| [k.left as f32, k.right as f32, k.score, k.tx, k.ty]),
+            "the candidates array",
+        )?;
         d.set_item(
             "candidates",
             Array2::from_shape_vec((c.candidates.len(), 5), flat)
                 .map_err(shape_err)?
                 .into_pyarray(py),
         )?;
-        d.set_item("state", Array1::from_vec(c.state.clone()).into_pyarray(py))?;
-        let chosen: Vec<i64> = c.chosen.iter().map(|&i| i as i64).collect();
+        let state = flat_rows(c.state.len(), c.state.iter().map(|&s| [s]), "the states")?;
+        d.set_item("state", Array1::from_vec(state).into_pyarray(py))?;
+        let chosen = flat_rows(
+            c.chosen.len(),
+            c.chosen.iter().map(|&i| [i as i64]),
+            "the chosen candidates",
+        )?;
         d.set_item("chosen", Array1::from_vec(chosen).into_pyarray(py))?;
-        let edges: Vec<i32> = c
-            .edges
-            .iter()
-            .flat_map(|&(a, b)| [a as i32, b as i32])
-            .collect();
+        let edges = flat_rows(
+            c.edges.len(),
+            c.edges.iter().map(|&(a, b)| [a as i32, b as i32]),
+            "the edges array",
+        )?;
         d.set_item(
             "edges",
             Array2::from_shape_vec((c.edges.len(), 2), edges)
                 .map_err(shape_err)?
                 .into_pyarray(py),
         )?;
-        let win: Vec<i32> = c
-            .windows
-            .iter()
-            .flat_map(|w| w.map_or([1, 0], |(a, b)| [a, b]))
-            .collect();
+        let win = flat_rows(
+            c.windows.len(),
+            c.windows.iter().map(|w| w.map_or([1, 0], |(a, b)| [a, b])),
+            "the windows array",
+        )?;
         d.set_item(
             "windows",
             Array2::from_shape_vec((c.windows.len(), 2), win)
