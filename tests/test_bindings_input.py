@@ -477,6 +477,11 @@ def run(a):
         a[0, 0] = np.nan  # a hole to fill
         img = a.reshape(-1).view(np.uint8)[: a.size].reshape(*a.shape, 1)
         _core.fill_planes(a, img, [(16, 50)], 0.7)
+    elif case == "speckles":
+        # No two neighbours within max_diff (in place, no new memory): one label a pixel.
+        a[:, 1::2] = 10.0
+        a[1::2, :] += 20.0
+        _core.gabor_remove_speckles(a, 2, 1.0)
     elif case == "temporal":
         # A uint8 frame viewing the first bytes of ``a``: no new memory.
         frame = a.reshape(-1).view(np.uint8)[: a.size].reshape(a.shape)
@@ -517,6 +522,8 @@ except MemoryError as e:
         ("grey", 16384, 0, "grey image"),
         # The binding's copy of the map fits; the kernel's regions do not.
         ("planes", 16384, 1, "colour regions' tables"),
+        # The binding's copy, the labels and the bands' tables fit; the merged tables do not.
+        ("speckles", 4096, 1, "speckle filter's label tables"),
     ],
 )
 def test_a_matcher_that_runs_out_of_memory_raises_memory_error(

@@ -6,7 +6,7 @@
 
 use super::filter::{blur_real, gaussian_taps, radius_for};
 use super::pool::Buf;
-use crate::alloc::{try_filled, try_zeroed};
+use crate::alloc::{try_collect, try_filled, try_reserve_len, try_zeroed};
 use crate::error::Result;
 use crate::parallel::for_each_row;
 use crate::simd::simd_fn;
@@ -243,8 +243,8 @@ const NO_LABEL: u32 = u32::MAX;
 /// a fixed graph, so the result does not depend on the band split or the thread count (it
 /// equals the sequential flood fill, which left the other core idle for 5 % of the matcher).
 ///
-/// A failed allocation of the label image is [`crate::CoreError::OutOfMemory`] (`disp`
-/// unchanged).
+/// A failed allocation of the label image or of the tables of its labels (up to one label a
+/// pixel, 4 bytes each per table) is [`crate::CoreError::OutOfMemory`] (`disp` unchanged).
 pub fn remove_speckles(
     disp: &mut [f32],
     w: usize,
@@ -259,6 +259,7 @@ pub fn remove_speckles(
     let joins = |a: f32, b: f32| a.is_finite() && b.is_finite() && (a - b).abs() <= max_diff;
     let mut labels = try_filled(w * h, NO_LABEL, "the speckle filter's labels")?;
     // Per band: local labels 0..n, their union-find parents and pixel counts.
+    const WHAT: &str = "the speckle filter's label tables";
     let bands: Vec<(Vec<u32>, Vec<u32>)> = labels
         .par_chunks_mut(w * SPECKLE_BAND)
         .enumerate()
@@ -289,16 +290,20 @@ pub fn remove_speckles(
                     };
                 }
             }
-            let mut count = vec![0u32; parent.len()];
+            let mut count = try_zeroed::<u32>(parent.len(), WHAT)?;
             for &l in lab.iter().filter(|&&l| l != NO_LABEL) {
                 count[l as usize] += 1;
             }
-            (parent, count)
+            Ok((parent, count))
         })
-        .collect();
-    // Global labels: band-local ones shifted by the labels of the bands above.
+        .collect::<Result<_>>()?;
+    // Global labels: band-local ones shifted by the labels of the bands above. The tables are
+    // allocated at once, checked (they grew by extend and vec!, aborting on a failure).
+    let n_labels: usize = bands.iter().map(|(bp, _)| bp.len()).sum();
     let mut offset = Vec::with_capacity(bands.len());
     let (mut parent, mut count) = (Vec::new(), Vec::new());
+    try_reserve_len(&mut parent, n_labels, WHAT)?;
+    try_reserve_len(&mut count, n_labels, WHAT)?;
     for (bp, bc) in &bands {
         let off = parent.len() as u32;
         offset.push(off);
@@ -315,10 +320,12 @@ pub fn remove_speckles(
             }
         }
     }
-    let mut size = vec![0u32; parent.len()];
-    let root: Vec<u32> = (0..parent.len() as u32)
-        .map(|l| find(&mut parent, l))
-        .collect();
+    let mut size = try_zeroed::<u32>(parent.len(), WHAT)?;
+    let root = try_collect(
+        parent.len(),
+        (0..parent.len() as u32).map(|l| find(&mut parent, l)),
+        WHAT,
+    )?;
     for (l, &c) in count.iter().enumerate() {
         size[root[l] as usize] += c;
     }

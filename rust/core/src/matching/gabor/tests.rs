@@ -234,6 +234,43 @@ fn speckle_removal_drops_only_small_regions() {
     assert!(d[6 * w..7 * w].iter().all(|v| v.is_nan()));
 }
 
+/// Run by [`speckle_tables_too_large_to_allocate_are_an_error`] in a child process: a
+/// 4096x2048 map where no two neighbours join (one label a pixel) under an address-space limit
+/// of 14 bytes a pixel more than is mapped. The label image and the bands' parents and counts
+/// (12 bytes a pixel) fit; the merged parents (4 more) do not.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of speckle_tables_too_large_to_allocate_are_an_error"]
+fn speckle_tables_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let (w, h) = (4096usize, 2048usize);
+    let mut d: Vec<f32> = (0..w * h)
+        .map(|i| ((i % w + 2 * (i / w)) % 5) as f32 * 10.0)
+        .collect();
+    rayon::join(|| (), || ()); // the pool's thread started before the limit
+    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + 14 * w * h);
+    match post::remove_speckles(&mut d, w, h, 2, 1.0) {
+        Ok(()) => println!("child: filtered {}", d[0]),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn speckle_tables_too_large_to_allocate_are_an_error() {
+    // The merged union-find tables (parents, counts, sizes, roots: up to 4 bytes a pixel each)
+    // grew by extend and were allocated with vec!/collect: a failed allocation aborted the
+    // process (SIGABRT) instead of returning OutOfMemory.
+    let stdout = crate::segment::tests::run_oom_child(
+        "matching::gabor::tests::speckle_tables_under_a_memory_limit",
+    );
+    let want = "child: error: out of memory: the speckle filter's label tables needs 32.00 MiB \
+                (33554432 bytes)";
+    assert!(stdout.contains(want), "{want} not in {stdout}");
+}
+
 #[test]
 fn parallel_speckle_labelling_equals_the_flood_fill() {
     // Random maps (values 0.8 px apart, so only neighbouring levels join; NaN holes) of several sizes: regions of all
