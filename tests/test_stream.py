@@ -1818,6 +1818,54 @@ def test_a_grab_thread_hung_past_the_join_is_said(
     assert not left[0].is_alive()
 
 
+@PIPELINED
+def test_a_grab_thread_left_behind_leaves_the_callers_temporal_filter_alone(
+    videos: dict[str, Path], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The grab thread left behind (a read hung past the end's join) went on with the pair it
+    read once the read returned: averaged into the caller's TemporalFilter, after run_stream
+    had returned, so a filter reused for the next stream held a frame of the old one. The
+    thread now drops that pair at once: the filter is as run_stream left it."""
+    import stereovision.stream as streammod
+    from stereovision.temporal import TemporalFilter
+
+    monkeypatch.setattr(streammod, "GRAB_JOIN_TIMEOUT", 0.2, raising=False)
+    unplug = threading.Event()
+    cam = StereoCamera(str(videos["left"]), str(videos["right"]))
+    # pairs 0 and 1 are read; the thread's read of pair 2 (one ahead) hangs until released
+    cam._caps["right"] = _HangsAfter(cam._caps["right"], 2, unplug)  # type: ignore[assignment]
+    tf = TemporalFilter(max_frames=4)
+    done: list[int] = []
+
+    def on_result(left: np.ndarray, res: Any) -> None:
+        done.append(1)
+        if len(done) == 2:
+            raise OSError("disk full")
+
+    try:
+        with pytest.warns(UserWarning, match="the grab thread is still inside a read"):
+            rep = run_stream(
+                cam,
+                max_disparity=16,
+                check=False,
+                on_result=on_result,
+                read_timeout=None,
+                temporal=tf,
+            )
+        assert (rep.frames, rep.ended) == (1, "output failed")
+        behind = [t for t in threading.enumerate() if isinstance(t, streammod._Producer)]
+        assert len(behind) == 1
+        before = (tf.frames, tf.restarts, tf.sigma, tf.mean_frames())
+        assert before[0] == 2  # pairs 0 and 1
+        unplug.set()  # the hung read returns now, after run_stream did
+        behind[0].join(5.0)
+        assert not behind[0].is_alive()
+        assert (tf.frames, tf.restarts, tf.sigma, tf.mean_frames()) == before
+    finally:
+        unplug.set()
+        cam.close()
+
+
 def test_a_bag_without_a_calibration_is_refused(
     videos: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -453,10 +453,12 @@ def _pairs(
     homographies: Any = None,
     temporal: Any = None,
     read_timeout: float | None = DEFAULT_READ_TIMEOUT,
+    stop: threading.Event | None = None,
 ) -> Iterator[_Pair | _Note]:
     """Grab (and rectify, for a raw rig calibration) pairs until the end or ``frames`` pairs;
     check the rows of pair 0 and, when positive, every ``check_every``-th pair (None: none);
-    a read taking over ``read_timeout`` s raises (:func:`~stereovision.capture.read_within`)."""
+    a read taking over ``read_timeout`` s raises (:func:`~stereovision.capture.read_within`).
+    Once ``stop`` is set, a read that returns ends it, its pair dropped untouched."""
     n = 0
     while frames is None or n < frames:
         t0 = time.perf_counter()
@@ -479,6 +481,11 @@ def _pairs(
             if camera.count == 0:
                 raise
             raise SourceError(str(exc), end=False, frames=camera.count) from exc
+        if stop is not None and stop.is_set():
+            # the stream ended during this read (the grab thread left behind on a hung camera):
+            # averaging it into the caller's TemporalFilter, after run_stream returned, mixed a
+            # stale frame into the caller's next stream
+            return
         t1 = time.perf_counter()
         grab_s = t1 - t0
         if n == 0 and grabbed is not None:  # read ahead to size the calibration: its own grab
@@ -554,12 +561,15 @@ class _Producer(threading.Thread):
     aged in a queue.
     """
 
-    def __init__(self, source: Iterator[_Pair | _Note], q: queue.Queue[Any]) -> None:
+    def __init__(
+        self, source: Iterator[_Pair | _Note], q: queue.Queue[Any], stop: threading.Event
+    ) -> None:
         super().__init__(name="stereovision-grab", daemon=True)
         self._source = source
         self._q = q
         self.slots = threading.Semaphore(QUEUE_SIZE)
-        self.stop = threading.Event()
+        #: set when the stream ends; the source checks it too, after each read
+        self.stop = stop
 
     def _acquire(self) -> bool:
         while not self.stop.is_set():
@@ -825,6 +835,7 @@ def run_stream(
     if calib is not None:
         rect_calib = calib if calib.rectified else calib.rectified_calibration()
     kw: dict[str, Any] = {"refine": refine, "method": method, "fill": fill}
+    stop = threading.Event()  # the end of the stream, for a grab thread left behind
     source: Iterator[_Pair | _Note] = (
         iter(())
         if stopped
@@ -836,12 +847,13 @@ def run_stream(
             homographies,
             temporal,
             read_timeout,
+            stop,
         )
     )
     producer: _Producer | None = None
     q: queue.Queue[Any] = queue.Queue()
     if pipelined:
-        producer = _Producer(source, q)
+        producer = _Producer(source, q, stop)
         producer.start()
 
     def next_item() -> _Pair | _Note | None:
