@@ -923,6 +923,22 @@ def test_a_later_success_clears_an_error_and_a_scene_can_be_chosen_again(data_di
     assert not np.array_equal(app.pair[0], app.pair[1])
 
 
+def _open_cameras(app) -> None:
+    """The page's "Open", and the open it spawns run to its end (no server loop here); the
+    computation that follows is spawned as the test's ``_spawn`` has it."""
+    import asyncio
+
+    spawned: list[Any] = []
+    keep = app._spawn
+    app._spawn = spawned.append
+    try:
+        app.open_cameras()
+    finally:
+        app._spawn = keep
+    for coro in spawned:
+        asyncio.run(coro)
+
+
 def _queue_spawns(app, tasks: list) -> None:
     """Inside a running loop: a lock of that loop, and the computations the app spawns queued
     in ``tasks`` as futures (to be awaited by the test)."""
@@ -2657,7 +2673,7 @@ def test_cameras_that_cannot_be_paired_leave_the_open_ones_in_use(tmp_path):
 
     lonely = _scene_app("test-cameras-unpaired-none", [tmp_path])
     lonely.state.cam_left, lonely.state.cam_right = str(lv), str(small)
-    lonely.open_cameras()
+    _open_cameras(lonely)
     assert lonely.state.error.startswith("right source") and "400x300" in lonely.state.error
     assert lonely.source is None and lonely.state.live is False and lonely.pair is None
 
@@ -2670,7 +2686,7 @@ def test_cameras_that_cannot_be_paired_leave_the_open_ones_in_use(tmp_path):
     app._grab()
     assert app.state.source_label == "cameras l.avi / r.avi"
     app.state.cam_right = str(small)
-    app.open_cameras()
+    _open_cameras(app)
     assert app.state.error.startswith("right source") and "400x300" in app.state.error
     assert app.state.error.endswith("(the cameras in use are unchanged)")
     app.state.error = ""
@@ -2716,7 +2732,7 @@ def test_open_cameras_asks_the_chosen_pixel_format(data_dir, monkeypatch):
     app.state.cam_left, app.state.cam_right = "0", "1"
     for choice in ("MJPG", "YUYV", "driver"):
         app.state.fourcc = choice
-        app.open_cameras()
+        _open_cameras(app)
         assert app.state.error == "" and app.state.live
     assert asked == ["MJPG", "YUYV", None]
     parser = argparse.ArgumentParser()
@@ -2790,10 +2806,86 @@ def test_gui_read_timeout_reaches_every_camera_read(data_dir, monkeypatch):
     page.state.cam_left, page.state.cam_right = "0", "1"
     timeouts.clear()
     opens.clear()
-    page.open_cameras()
-    assert page.state.error == "" and page.state.live and timeouts == [0.2] and opens == [0.2]
+    _open_cameras(page)
+    assert page.state.error == "" and page.state.live and timeouts == [0.2]
+    # the page's open runs in a thread of its own, bounded by the page's wait for it (0.2 s,
+    # test_a_wedged_camera_open_leaves_the_page_free), not inside the cameras' open
+    assert opens == [None]
     with pytest.raises(ValueError, match=r"^--read-timeout bounds a camera's read: a bag is"):
         build_app(parser.parse_args(["--from-bag", "x.bag", "--read-timeout", "5"]))
+
+
+def test_a_wedged_camera_open_leaves_the_page_free(monkeypatch):
+    """ "Open" ran the cameras' open in the page's handler: a wedged camera froze the page for
+    the whole --read-timeout, and each retry left one more thread blocked in it. The handler
+    now returns at once, the page saying "opening ..."; the open is given up after the
+    timeout, said on the page; another Open of those cameras is refused, in words, until the
+    given-up open returns (its late cameras are closed then); a camera that opens is used."""
+    import asyncio
+    import threading
+    import time
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    release = threading.Event()
+    made: list[Any] = []
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            self.closed = False
+            made.append(self)
+            release.wait(1.0)  # a wedged device (bounded: a broken app cannot hang the test)
+
+        def read(self):
+            return frame, frame
+
+        def close(self):
+            self.closed = True
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    app = _scene_app("test-wedged-open", [bundled_data_dir()], read_timeout=0.2)
+    app.state.cam_left, app.state.cam_right = "0", "1"
+    opens: list[Any] = []
+    # the opens are run here; the computation of an opened pair is not
+    app._spawn = lambda coro: (
+        opens.append(asyncio.ensure_future(coro)) if "_open" in coro.__qualname__ else coro.close()
+    )
+
+    async def clicks() -> None:
+        t0 = time.perf_counter()
+        app.open_cameras()
+        assert time.perf_counter() - t0 < 0.1  # the handler returned at once
+        assert app.state.status == "opening camera 0 and camera 1..." and app.state.error == ""
+        app.open_cameras()  # clicked again while it opens
+        refused = (
+            "camera 0 is still opening (an earlier Open has not returned): wait for it, or "
+            "unplug and replug the camera"
+        )
+        assert app.state.error == refused and len(opens) == 1
+        await opens[0]
+        assert app.state.status == "error" and app.state.error == (
+            "camera 0 and camera 1 did not open within 0.2 s (the open did not return: a wedged "
+            "camera or driver, or a stalled stream); unplug and replug it, or give gui a "
+            "longer --read-timeout"
+        )
+        app.open_cameras()  # a retry while the given-up open is still inside the camera
+        assert app.state.error == refused and len(opens) == 1 and len(made) == 1
+        assert app.source is None and app.state.live is False
+        release.set()  # the wedged open returns now
+        for _ in range(100):
+            if not app._opening:
+                break
+            await asyncio.sleep(0.01)
+        assert made[0].closed  # nobody took it: closed (it held the devices)
+        app.open_cameras()
+        await opens[1]
+        assert len(made) == 2 and not made[1].closed and app.source is not None
+        assert app.state.error == "" and app.state.live
+        assert app.state.source_label == "cameras 0 / 1" and app.state.captures == 1
+
+    asyncio.run(clicks())
 
 
 def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
@@ -3557,7 +3649,7 @@ def test_an_image_sequence_typed_as_a_camera_is_opened_by_its_folder(tmp_path):
     app = _scene_app("test-camera-sequence", [bundled_data_dir(), tmp_path])
     app.state.cam_left = str(tmp_path / "seq" / "left%02d.png")
     app.state.cam_right = str(tmp_path / "seq" / "right%02d.png")
-    app.open_cameras()
+    _open_cameras(app)
     assert app.state.error == ""
     assert app.state.source_label == "cameras left%02d.png / right%02d.png"
     assert app.pair[0].shape == (375, 450, 3)

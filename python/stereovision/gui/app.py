@@ -27,6 +27,7 @@ import logging
 import math
 import os
 import re
+import threading
 import time
 import warnings
 from collections.abc import Callable, Sequence
@@ -1139,6 +1140,11 @@ def parse_max_disparity(text: str | None, width: int) -> int | None:
     return value
 
 
+def _source_name(src: int | str) -> str:
+    """A camera source as the page names it: ``camera 0``, or the file's name."""
+    return f"camera {src}" if isinstance(src, int) else Path(src).name or src
+
+
 def _button_and_answer(
     v3: Any, html: Any, text: str, button_id: str, click: Any, answer: str, answer_id: str
 ) -> None:
@@ -1309,6 +1315,9 @@ class StereoApp:
         #: the list goes back to when another choice fails.
         self._scene = ""
         self._computing = False
+        #: Camera sources whose open (on the page's "Open") has not returned yet, given up or
+        #: not: another Open of them is refused (each left one more thread blocked in them).
+        self._opening: set[int | str] = set()
         self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1)
         self._generation = 0
         self._lock: asyncio.Lock | None = None
@@ -1650,6 +1659,12 @@ class StereoApp:
     def open_cameras(self) -> None:
         """Open the camera sources typed on the page (device index or allowed file).
 
+        The sources are checked here; the open runs in a thread of its own (:meth:`_open`),
+        the page saying "opening ..." meanwhile: run in the handler, a wedged camera froze the
+        page for the whole ``read_timeout``. A source whose earlier open has not returned yet
+        (given up or not) is refused, said on the page: each retry on a wedged device left one
+        more thread blocked in it.
+
         The new cameras replace the open ones only once they gave a pair: sources that open
         but cannot be paired (frames of two sizes) leave the open cameras in use, and say so.
         """
@@ -1657,11 +1672,85 @@ class StereoApp:
             left = self._camera_source(self.state.cam_left)
             right = self._camera_source(self.state.cam_right)
             fourcc = None if self.state.fourcc == FOURCCS[0] else self.state.fourcc
-            source = open_stereo_source(left, right, fourcc=fourcc, read_timeout=self.read_timeout)
+            pending = [s for s in (left, right) if s in self._opening]
+            if pending:
+                raise OSError(
+                    f"{_source_name(pending[0])} is still opening (an earlier Open has not "
+                    "returned): wait for it, or unplug and replug the camera"
+                )
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
             return
-        self._switch_source(source, (str(self.state.cam_left), str(self.state.cam_right)))
+        names = (str(self.state.cam_left), str(self.state.cam_right))
+        self._opening.update((left, right))
+        what = " and ".join(dict.fromkeys(_source_name(s) for s in (left, right)))
+        with self.state:
+            self.state.error = ""
+            self.state.status = f"opening {what}..."
+        self._spawn(self._open(left, right, fourcc, names, what))
+
+    async def _open(
+        self,
+        left: int | str,
+        right: int | str,
+        fourcc: str | None,
+        names: tuple[str, str],
+        what: str,
+    ) -> None:
+        """Open ``left`` and ``right`` in a daemon thread, wait for it up to ``read_timeout``
+        s, then use the pair (:meth:`_switch_source`) or say why not.
+
+        A given-up open goes on in its thread: its sources stay in ``_opening`` (refused by
+        :meth:`open_cameras`) until it returns; the cameras it opened late are closed then.
+        """
+        loop = asyncio.get_running_loop()
+        opened: asyncio.Future[StereoSource] = loop.create_future()
+        keys = (left, right)
+
+        def settle(source: StereoSource | None, exc: BaseException | None) -> None:
+            # on the page's loop: the sources may be opened again from now
+            self._opening.difference_update(keys)
+            if opened.done():  # given up: nobody takes these cameras
+                if source is not None:
+                    source.close()
+            elif exc is not None:
+                opened.set_exception(exc)
+            else:
+                opened.set_result(source)  # type: ignore[arg-type]
+
+        def run() -> None:
+            source: StereoSource | None = None
+            error: BaseException | None = None
+            try:
+                source = open_stereo_source(
+                    left, right, fourcc=fourcc, read_timeout=self.read_timeout, bound_open=False
+                )
+            except BaseException as exc:  # said on the page, in settle
+                error = exc
+            try:
+                loop.call_soon_threadsafe(settle, source, error)
+            except RuntimeError:  # the page's loop is closed (the server stopped)
+                if source is not None:
+                    source.close()
+
+        threading.Thread(target=run, name="stereovision-gui-open", daemon=True).start()
+        try:
+            # reads are bounded inside the source; its open by this wait (it cancels `opened`)
+            source = await asyncio.wait_for(opened, self.read_timeout)
+        except asyncio.TimeoutError:
+            self._fail(
+                OSError(
+                    f"{what} did not open within {self.read_timeout:g} s (the open did not "
+                    "return: a wedged camera or driver, or a stalled stream); unplug and replug "
+                    "it, or give gui a longer --read-timeout"
+                )
+            )
+            return
+        except (ValueError, OSError, RuntimeError) as exc:
+            self._fail(exc)
+            return
+        with self.state:
+            self._switch_source(source, names)
 
     def open_pair_folder(self) -> None:
         """Play the pairs of the chosen image folder (as ``batch`` pairs them), one per

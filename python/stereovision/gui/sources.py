@@ -519,6 +519,7 @@ def open_stereo_source(
     size: tuple[int, int] | None = None,
     fourcc: str | None = None,
     read_timeout: float | None = DEFAULT_READ_TIMEOUT,
+    bound_open: bool = True,
 ) -> StereoSource:
     """Open a camera pair: ``stereovision.capture.StereoCamera`` if available, else OpenCV.
 
@@ -535,6 +536,9 @@ def open_stereo_source(
         Seconds a camera's open or a pair's read may take before the camera is given up as
         hung (:data:`~stereovision.capture.DEFAULT_READ_TIMEOUT`; None: no limit), as
         ``capture``'s and ``stream``'s ``--read-timeout``.
+    bound_open : bool
+        False: the open is not bounded here, the caller bounds it (the page waits for an open
+        running in a thread of its own, and knows when a given-up open returns).
 
     Raises
     ------
@@ -542,17 +546,23 @@ def open_stereo_source(
         A source that does not exist or cannot be opened.
     """
     left, right = parse_source(left), parse_source(right)
+    open_timeout = read_timeout if bound_open else None
     try:
         from stereovision.capture import StereoCamera, parse_fourcc
     except ImportError:
-        return VideoPair(left, right, size, read_timeout)
+        return VideoPair(left, right, size, open_timeout)
     code = parse_fourcc(fourcc)
     files = isinstance(left, str) and isinstance(right, str)
-    return _CaptureAdapter(
-        lambda: StereoCamera(left, right, image_size=size, fourcc=code, open_timeout=read_timeout),
-        files,
-        read_timeout,
-    )
+    first = [True]
+
+    def make() -> StereoCamera:
+        # only the first open is the caller's to bound: a file opened again at its end, in a
+        # read, is bounded as the read is
+        timeout = open_timeout if first[0] else read_timeout
+        first[0] = False
+        return StereoCamera(left, right, image_size=size, fourcc=code, open_timeout=timeout)
+
+    return _CaptureAdapter(make, files, read_timeout)
 
 
 def scale_pair(
