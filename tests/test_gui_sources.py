@@ -509,6 +509,12 @@ def test_open_stereo_source_hands_size_fourcc_and_file_flag(
     with pytest.raises(ValueError, match=r"^fourcc: expected four characters"):
         sources.open_stereo_source(0, 1, fourcc="MJPEG")  # checked before a camera opens
     assert len(made) == 3
+    # bound_open=False: the caller bounds the first open (the page, which waits for it in a
+    # thread); a file opened again at its end, in a read, is bounded as the read is
+    files = sources.open_stereo_source("a.avi", "b.avi", read_timeout=3, bound_open=False)
+    assert made[-1][-1] is None
+    files._factory()  # type: ignore[attr-defined]
+    assert made[-1][-1] == 3 and len(made) == 5
 
 
 class _SlowStart:
