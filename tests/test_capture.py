@@ -2199,6 +2199,25 @@ def test_a_camera_whose_open_hangs_is_given_up(wedged: type[_WedgedDevice], side
         StereoCamera(0, 1, open_timeout=0)
 
 
+def test_opencv_stays_quiet_until_a_given_up_open_returns(wedged: type[_WedgedDevice]) -> None:
+    """The open's quiet OpenCV log ended when the open was given up, while the open went on in
+    its thread: a late open (and its capture's release) could print OpenCV's lines to stderr.
+    The log stays silent until that open returns, then is as it was."""
+    log = cv2.utils.logging  # type: ignore[attr-defined]
+    before = log.getLogLevel()
+    assert before != log.LOG_LEVEL_SILENT
+    wedged.wedged = {0}
+    with pytest.raises(SourceError, match=r"did not open within 0\.2 s"):
+        StereoCamera(0, 1, open_timeout=0.2)
+    assert log.getLogLevel() == log.LOG_LEVEL_SILENT  # the open is still under way
+    wedged.unplug.set()
+    deadline = time.monotonic() + 2.0
+    while log.getLogLevel() != before and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert log.getLogLevel() == before
+    assert [c.src for c in wedged.made] == [0] and _released_soon(wedged.made[0])
+
+
 @pytest.mark.parametrize("timeout", [math.inf, True])
 def test_an_infinite_or_boolean_timeout_is_refused_by_name(timeout: object) -> None:
     """``open_timeout=math.inf`` (no limit meant; None is) passed the check and then overflowed

@@ -524,7 +524,12 @@ def _open_within(make: Callable[[], Any], timeout: float | None, side: str, src:
     """``make()``, the ``cv2.VideoCapture`` of ``side``'s source ``src``, given up after
     ``timeout`` s as a read is (:func:`_within`; None: no limit): a wedged V4L2 device, or a
     stream that stalls, can keep OpenCV's open from ever returning. A capture that opens after
-    it was given up is released then (it held the device)."""
+    it was given up is released then (it held the device).
+
+    OpenCV's log stays silent (:func:`~stereovision.io._opencv_quiet`) until the open returns,
+    given up or not: the caller's quiet ended when it was given up, and a late open printed
+    its backends' lines. An open that never returns keeps it silent for the process's life.
+    """
     if timeout is None:
         return make()
     lock = threading.Lock()
@@ -532,13 +537,14 @@ def _open_within(make: Callable[[], Any], timeout: float | None, side: str, src:
     made: list[Any] = []  # the capture, once made in time; the one that gives up releases it
 
     def opened() -> Any:
-        cap = make()
-        with lock:
-            late = given_up[0]
-            if not late:
-                made.append(cap)
-        if late:  # nobody will have it
-            _release([cap])
+        with _opencv_quiet():
+            cap = make()
+            with lock:
+                late = given_up[0]
+                if not late:
+                    made.append(cap)
+            if late:  # nobody will have it
+                _release([cap])
         return cap
 
     what = f"{side} source {_describe_source(src)}"
