@@ -1594,3 +1594,21 @@ def test_to_8bit_takes_an_empty_image_beside_a_16_bit_one() -> None:
     empty, out = to_8bit(np.zeros((0, 5), np.uint16), img)
     assert empty.shape == (0, 5) and empty.dtype == np.uint8
     np.testing.assert_array_equal(out, (img >> 4).astype(np.uint8))
+
+
+def test_a_late_starting_faster_left_camera_keeps_the_default_tolerance(tmp_path: Path) -> None:
+    """The right camera (15 fps) records 100 frames before the left one (30 fps) starts: the
+    64 right frames waiting decided the default tolerance before any left stamp came, half the
+    right period (33 ms) instead of half the shorter, left one (16.7 ms), and a left frame was
+    paired with a right one 33 ms away. Right frames older than the first left one's nearest
+    can pair with no left frame: they are dropped while the tolerance waits for its stamps."""
+    img = np.zeros((16, 24, 3), np.uint8)
+    start = T0 + 200 * PERIOD_NS
+    frames = [(None, img, T0 + 2 * k * PERIOD_NS, img) for k in range(160)]
+    frames += [(start + k * PERIOD_NS, img, None, img) for k in range(60)]
+    bag = write_bag(tmp_path / "rig", frames)
+    with BagCamera(bag) as cam:
+        assert len(list(cam.frames())) == 30
+    assert cam.max_skew_ms == pytest.approx(PERIOD_NS / 2e6)
+    assert max(cam.skews_ms) == 0.0
+    assert cam.dropped == {"left": 30, "right": 130}

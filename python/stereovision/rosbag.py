@@ -1026,10 +1026,22 @@ class BagCamera(PairSource):
         self, lefts: deque[tuple[int, Any]], rights: deque[tuple[int, Any]], final: bool
     ) -> Iterator[tuple[int, Any, int, Any]]:
         if self._tol_ns is None:
+            # right frames no left frame can take (left stamps rise): those before the first
+            # waiting left's nearest at or before it, or beyond the newest MAX_WAITING with no
+            # left yet; counted as crowding, they decided the tolerance before a late left
+            # camera's stamps came (half the right period, not the shorter left one's)
+            if lefts:
+                while len(rights) > 1 and rights[1][0] <= lefts[0][0]:
+                    rights.popleft()
+                    self.dropped["right"] += 1
+            else:
+                while len(rights) > MAX_WAITING:
+                    rights.popleft()
+                    self.dropped["right"] += 1
             sampled = all(len(s) >= PERIOD_SAMPLE for s in self._first.values())
-            # a side that stopped before PERIOD_SAMPLE frames: decided once either side has
-            # MAX_WAITING waiting (it held the other's every frame, decoded, to the end)
-            crowded = max(len(lefts), len(rights)) > MAX_WAITING
+            # a left side that stopped before PERIOD_SAMPLE frames: decided once either side
+            # has MAX_WAITING waiting (it held the other's every frame, decoded, to the end)
+            crowded = len(lefts) > MAX_WAITING or (bool(lefts) and len(rights) > MAX_WAITING)
             if not (final or sampled or crowded):
                 return
             self._tol_ns = self._default_tolerance()
