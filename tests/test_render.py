@@ -1059,8 +1059,35 @@ def test_a_result_with_non_square_pixels_renders_each_axis_at_its_focal_length(r
     assert (half.f, half.fy) == (75.0, 60.0)
 
 
+def test_non_square_pixels_keep_their_scale_in_a_window_of_another_shape():
+    """The GUI's 3-D view is the image's shape only up to 480 px high (a wide column gives a
+    wider view, a portrait image too): VTK's explicit aspect ratio for ``fx != fy`` was the
+    image's, so a view twice as wide as the image stretched its columns twice (square pixels
+    showed more of the scene at the same scale). Each axis keeps its focal length, in a wide
+    window as in an image-sized one, and with a principal point off centre."""
+    fx, fy = 150.0, 120.0
+    pixels = np.array([[20.0, 10.0], [140.0, 110.0], [79.5, 100.0], [120.0, 25.0]])
+    z = np.array([4.0, 4.0, 3.0, 5.0])
+    cases = [((syn.CX, syn.CY), (2 * syn.W, syn.H), (syn.W / 2, 0.0)),
+             ((100.0, 40.0), (syn.W, syn.H), (0.0, 0.0))]  # fmt: skip
+    for (cx, cy), window, offset in cases:
+        intr = render.Intrinsics(fx, cx, cy, syn.W, syn.H, fy)
+        pts = np.stack([(pixels[:, 0] - cx) * z / fx, (pixels[:, 1] - cy) * z / fy, z], 1)
+        plotter = render.make_plotter(window)
+        try:
+            for p in pts:
+                plotter.add_mesh(pv.PolyData(p[None].astype(np.float32)), color="white",
+                                 point_size=3, style="points", lighting=False)  # fmt: skip
+            render.apply_camera(plotter, CameraControls(), intrinsics=intr, focal_distance=4.0)
+            img = plotter.screenshot(return_img=True)
+        finally:
+            plotter.close()
+        expected = pixels + np.array(offset)
+        np.testing.assert_allclose(_lit_centroids(img, expected), expected, atol=1.0)
+
+
 def test_a_camera_state_keeps_the_aspect_of_non_square_pixels(result):
-    """A view of a result with ``fx != fy`` (an explicit aspect ratio, :func:`apply_camera`)
+    """A view of a result with ``fx != fy`` (its columns scaled by fx / fy, :func:`apply_camera`)
     read into a :class:`render.CameraState` (the GUI's render.png of the mouse's view) was
     rendered again with square pixels: columns at ``fy / fx`` of their distance from ``cx``."""
     fx, fy = 150.0, 120.0
@@ -1074,7 +1101,7 @@ def test_a_camera_state_keeps_the_aspect_of_non_square_pixels(result):
         state = render.CameraState.of(plotter.camera)
     finally:
         plotter.close()
-    assert state.aspect_ratio == pytest.approx(syn.W / syn.H * fy / fx)
+    assert state.pixel_aspect == pytest.approx(fx / fy)
     plotter = render.make_plotter((intr.width, intr.height))
     try:
         for p in pts:
@@ -1086,10 +1113,10 @@ def test_a_camera_state_keeps_the_aspect_of_non_square_pixels(result):
     finally:
         plotter.close()
     np.testing.assert_allclose(_lit_centroids(img, pixels), pixels, atol=1.0)
-    square = dataclasses.replace(state, aspect_ratio=None)
+    square = dataclasses.replace(state, pixel_aspect=None)
     assert not square.same_view(state) and square.same_view(square)
-    with pytest.raises(ValueError, match="aspect_ratio"):
-        dataclasses.replace(state, aspect_ratio=0.0)
+    with pytest.raises(ValueError, match="pixel_aspect"):
+        dataclasses.replace(state, pixel_aspect=0.0)
 
 
 def test_apply_camera_without_intrinsics_resets_the_window_centre():

@@ -371,9 +371,10 @@ def apply_camera(
     plotter : pyvista.Plotter
     controls : CameraControls
     intrinsics : Intrinsics, optional
-        With intrinsics the view angle is ``2 atan(H / 2 fy)`` (``fx != fy``: an explicit aspect
-        ratio) and the window centre is shifted to the principal point, so a zero-control render
-        lines up with the left image pixel for pixel (when the window is ``width x height``).
+        With intrinsics the view angle is ``2 atan(H / 2 fy)`` (``fx != fy``: the columns
+        scaled by ``fx / fy``) and the window centre is shifted to the principal point, so a
+        zero-control render lines up with the left image pixel for pixel (when the window is
+        ``width x height``).
         Without, a :data:`DEFAULT_FOV_DEG` view.
     focal_distance : float
         Distance of the focal point ahead of the camera (metres): the centre of mouse rotations.
@@ -392,25 +393,45 @@ def apply_camera(
         fy = intrinsics.focal_y
         cam.view_angle = math.degrees(2 * math.atan(intrinsics.height / (2 * fy)))
         # VTK's pixels are square (fx = fy from the vertical view angle): for fx != fy the
-        # horizontal scale comes from an explicit aspect ratio, width / height x fy / fx
-        anamorphic = fy != intrinsics.f
-        cam.SetUseExplicitAspectRatio(anamorphic)
-        if anamorphic:
-            cam.SetExplicitAspectRatio(intrinsics.width / intrinsics.height * fy / intrinsics.f)
+        # columns are scaled by fx / fy after the projection. An explicit aspect ratio (the
+        # image's width / height x fy / fx) stretched them in a window of another shape
+        # (the GUI's view, at most 480 px high, is wider than the image in a wide column).
+        pixel_aspect = None if fy == intrinsics.f else intrinsics.f / fy
+        _set_pixel_aspect(cam, pixel_aspect)
         # VTK shifts the image by the window centre: a principal point right of / below the
         # image centre needs the opposite shift (measured: tests/test_render.py projection test).
+        # The shift is scaled with the columns: given over fx / fy.
         wx = 1 - 2 * (intrinsics.cx + 0.5) / intrinsics.width
         wy = 2 * (intrinsics.cy + 0.5) / intrinsics.height - 1
-        cam.SetWindowCenter(wx, wy)
+        cam.SetWindowCenter(wx if pixel_aspect is None else wx / pixel_aspect, wy)
     else:
         cam.view_angle = DEFAULT_FOV_DEG
         cam.SetWindowCenter(0.0, 0.0)
-        cam.SetUseExplicitAspectRatio(False)
+        _set_pixel_aspect(cam, None)
     if points is not None:
         cam.clipping_range = robust_clipping_range(points, pos)
     else:
         plotter.reset_camera_clipping_range()
     plotter.camera_set = True  # keep this camera: the first render must not reset it to the bounds
+
+
+def _set_pixel_aspect(cam: Any, pixel_aspect: float | None) -> None:
+    """Scale ``cam``'s columns by ``pixel_aspect`` (``fx / fy``) after its projection (VTK's
+    user transform), whatever the window's shape; None: square pixels (no transform)."""
+    if pixel_aspect is None:
+        cam.SetUserTransform(None)
+        return
+    import vtk
+
+    scale = vtk.vtkTransform()
+    scale.Scale(pixel_aspect, 1.0, 1.0)
+    cam.SetUserTransform(scale)
+
+
+def _pixel_aspect(cam: Any) -> float | None:
+    """The ``fx / fy`` :func:`_set_pixel_aspect` gave ``cam``, or None (square pixels)."""
+    user = cam.GetUserTransform()
+    return None if user is None else float(user.GetMatrix().GetElement(0, 0))
 
 
 def robust_clipping_range(points: npt.ArrayLike, position: npt.ArrayLike) -> tuple[float, float]:
@@ -503,15 +524,15 @@ class CameraState:
         An orthographic view (VTK's parallel projection) instead of a perspective one.
     parallel_scale : float
         Half the height of an orthographic view, metres (its zoom; VTK's parallel scale).
-    aspect_ratio : float or None
-        VTK's explicit aspect ratio, set by :func:`apply_camera` for non-square pixels
-        (``fx != fy``); None: the window's own (square pixels).
+    pixel_aspect : float or None
+        ``fx / fy`` of non-square pixels, the columns' scale :func:`apply_camera` sets (in a
+        window of any shape); None: square pixels.
 
     Raises
     ------
     ValueError
         A number that is not finite, a vector of another length, a view angle outside
-        0-180 degrees, a parallel scale or aspect ratio <= 0, a focal point at the position,
+        0-180 degrees, a parallel scale or pixel aspect <= 0, a focal point at the position,
         or an ``up`` along the view direction (or zero).
     """
 
@@ -522,7 +543,7 @@ class CameraState:
     window_center: tuple[float, float] = (0.0, 0.0)
     parallel_projection: bool = False
     parallel_scale: float = 1.0
-    aspect_ratio: float | None = None
+    pixel_aspect: float | None = None
 
     def __post_init__(self) -> None:
         # a NaN, a zero view angle or a camera on its focal point rendered an empty or
@@ -553,11 +574,11 @@ class CameraState:
         object.__setattr__(self, "view_angle", angle)
         object.__setattr__(self, "parallel_scale", scale)
         object.__setattr__(self, "parallel_projection", bool(self.parallel_projection))
-        if self.aspect_ratio is not None:
-            aspect = finite_number(self.aspect_ratio, "CameraState: aspect_ratio")
+        if self.pixel_aspect is not None:
+            aspect = finite_number(self.pixel_aspect, "CameraState: pixel_aspect")
             if aspect <= 0:
-                raise ValueError(f"CameraState: aspect_ratio: expected > 0, got {aspect:g}")
-            object.__setattr__(self, "aspect_ratio", aspect)
+                raise ValueError(f"CameraState: pixel_aspect: expected > 0, got {aspect:g}")
+            object.__setattr__(self, "pixel_aspect", aspect)
         ahead = np.subtract(focal_point, position)
         distance = float(np.linalg.norm(ahead))
         if not distance > 0:
@@ -593,7 +614,7 @@ class CameraState:
             floats(camera.GetWindowCenter()),  # type: ignore[arg-type]
             bool(camera.GetParallelProjection()),
             float(camera.GetParallelScale()),
-            float(camera.GetExplicitAspectRatio()) if camera.GetUseExplicitAspectRatio() else None,
+            _pixel_aspect(camera),
         )
 
     def same_view(self, other: CameraState, tolerance: float = 1e-9) -> bool:
@@ -633,7 +654,7 @@ class CameraState:
                 *self.window_center,
                 float(self.parallel_projection),
                 self.parallel_scale,
-                0.0 if self.aspect_ratio is None else self.aspect_ratio,
+                0.0 if self.pixel_aspect is None else self.pixel_aspect,
             ]
         )
 
@@ -654,9 +675,7 @@ class CameraState:
         cam.SetWindowCenter(*self.window_center)
         cam.SetParallelProjection(bool(self.parallel_projection))
         cam.SetParallelScale(self.parallel_scale)
-        cam.SetUseExplicitAspectRatio(self.aspect_ratio is not None)
-        if self.aspect_ratio is not None:
-            cam.SetExplicitAspectRatio(self.aspect_ratio)
+        _set_pixel_aspect(cam, self.pixel_aspect)
         if points is not None:
             cam.clipping_range = robust_clipping_range(points, self.position)
         else:
