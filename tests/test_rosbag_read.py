@@ -1612,3 +1612,21 @@ def test_a_late_starting_faster_left_camera_keeps_the_default_tolerance(tmp_path
     assert cam.max_skew_ms == pytest.approx(PERIOD_NS / 2e6)
     assert max(cam.skews_ms) == 0.0
     assert cam.dropped == {"left": 30, "right": 130}
+
+
+def test_a_late_starting_faster_right_camera_keeps_the_default_tolerance(tmp_path: Path) -> None:
+    """The mirror case: the left camera (15 fps) records 100 frames before the right one
+    (30 fps) starts. The 64 left frames waiting decided the tolerance from the left period
+    alone (33 ms), and a pair 33 ms apart came out; the oldest left frames are dropped while
+    no right frame waits (as they were once the tolerance was decided), which waits for the
+    right camera's stamps."""
+    img = np.zeros((16, 24, 3), np.uint8)
+    start = T0 + 200 * PERIOD_NS
+    frames = [(T0 + 2 * k * PERIOD_NS, img, None, img) for k in range(160)]
+    frames += [(None, img, start + k * PERIOD_NS, img) for k in range(60)]
+    bag = write_bag(tmp_path / "rig", frames)
+    with BagCamera(bag) as cam:
+        assert len(list(cam.frames())) == 30
+    assert cam.max_skew_ms == pytest.approx(PERIOD_NS / 2e6)
+    assert max(cam.skews_ms) == 0.0
+    assert cam.dropped == {"left": 130, "right": 30}

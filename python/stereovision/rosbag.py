@@ -1029,7 +1029,9 @@ class BagCamera(PairSource):
             # right frames no left frame can take (left stamps rise): those before the first
             # waiting left's nearest at or before it, or beyond the newest MAX_WAITING with no
             # left yet; counted as crowding, they decided the tolerance before a late left
-            # camera's stamps came (half the right period, not the shorter left one's)
+            # camera's stamps came (half the right period, not the shorter left one's). Left
+            # frames beyond MAX_WAITING with no right yet are dropped (as once decided), so a
+            # late right camera's stamps are waited for too.
             if lefts:
                 while len(rights) > 1 and rights[1][0] <= lefts[0][0]:
                     rights.popleft()
@@ -1038,6 +1040,9 @@ class BagCamera(PairSource):
                 while len(rights) > MAX_WAITING:
                     rights.popleft()
                     self.dropped["right"] += 1
+            while not rights and len(lefts) > MAX_WAITING:
+                lefts.popleft()
+                self.dropped["left"] += 1
             sampled = all(len(s) >= PERIOD_SAMPLE for s in self._first.values())
             # a left side that stopped before PERIOD_SAMPLE frames: decided once either side
             # has MAX_WAITING waiting (it held the other's every frame, decoded, to the end)
