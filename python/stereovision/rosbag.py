@@ -1033,7 +1033,8 @@ class BagCamera(PairSource):
             # frames beyond MAX_WAITING with no right yet are dropped (as once decided), so a
             # late right camera's stamps are waited for too.
             if lefts:
-                while len(rights) > 1 and rights[1][0] <= lefts[0][0]:
+                # (strictly older: of equal stamps the pairing takes the first)
+                while len(rights) > 1 and rights[0][0] < rights[1][0] <= lefts[0][0]:
                     rights.popleft()
                     self.dropped["right"] += 1
             else:
