@@ -1630,3 +1630,17 @@ def test_a_late_starting_faster_right_camera_keeps_the_default_tolerance(tmp_pat
     assert cam.max_skew_ms == pytest.approx(PERIOD_NS / 2e6)
     assert max(cam.skews_ms) == 0.0
     assert cam.dropped == {"left": 130, "right": 30}
+
+
+def test_of_two_right_frames_with_one_stamp_the_first_is_paired(tmp_path: Path) -> None:
+    """Two right frames of one stamp (a driver that published a frame twice) before the first
+    left one: the pairing takes the first, as it did before right frames older than the first
+    left one were dropped while the tolerance waits for its stamps."""
+    first, second = np.zeros((16, 24, 3), np.uint8), np.full((16, 24, 3), 200, np.uint8)
+    frames = [(None, first, T0, first), (None, second, T0, second)]
+    frames += [(T0 + 1_000_000 + k * PERIOD_NS, first, T0 + (k + 1) * PERIOD_NS, first)
+               for k in range(20)]  # fmt: skip
+    bag = write_bag(tmp_path / "rig", frames)
+    with BagCamera(bag) as cam:
+        pair = cam.read()
+    assert pair.right.max() == 0
