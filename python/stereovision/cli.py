@@ -1197,7 +1197,8 @@ def _paper_baseline_words(text: str, baseline: float) -> str:
     warning asks about (``--baseline 120`` for 120 mm: "With unit='mm' it would be 12.0 cm")."""
     from stereovision.calibration import PLAUSIBLE_BASELINE_M, UNIT_TO_METRES
 
-    found = re.match(r"baseline \S+ m = \S+ m, (.*?): are T ", text)
+    # "baseline 120 m, ..." (a rig on paper is in metres: the library says no "= 120 m")
+    found = re.match(r"baseline \S+ m(?: = \S+ m)?, (.*?): are T ", text)
     if found is None:
         return text
     lo, hi = PLAUSIBLE_BASELINE_M
