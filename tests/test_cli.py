@@ -770,6 +770,10 @@ def test_a_12_bit_pair_gets_one_warning_line_per_image(tmp_path: Path, data_dir:
     assert proc.returncode == 0, proc.stderr
     lines = proc.stderr.strip().splitlines()
     assert [line.split(":")[2] for line in lines] == [" left", " right"], proc.stderr
+    # the advice fits the command line: it gave Python's (img << 4, img.astype(np.uint8))
+    cli = "save it scaled to the full 16-bit range first (12-bit data shifted left by 4 bits)"
+    assert all(cli in line for line in lines), lines
+    assert "<<" not in proc.stderr and "astype" not in proc.stderr, proc.stderr
 
 
 def test_eval_treats_a_gt_without_known_pixels_as_no_gt(data_dir: Path, tmp_path: Path) -> None:

@@ -162,6 +162,17 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
 #: read the float grey image, all of its bits.
 LOW_UINT16_MAX = 4096
 
+#: The low-uint16 warning's advice, said to a caller of the Python API (an array to scale) ...
+LOW_UINT16_ADVICE = (
+    "scale it to the full range first (img << 4 for 12-bit data, or img.astype(np.uint8) for "
+    "8-bit values)"
+)
+#: ... and on the command line, where the image is a file (cli.py's warning hook swaps them)
+LOW_UINT16_ADVICE_CLI = (
+    "save it scaled to the full 16-bit range first (12-bit data shifted left by 4 bits), or as "
+    "an 8-bit image for 8-bit values"
+)
+
 
 def _warn_low_uint16(arr: np.ndarray, name: str) -> None:
     """Warn when a uint16 image uses only its lowest 12 bits: it is scaled by 65535 (by 257 to
@@ -175,9 +186,8 @@ def _warn_low_uint16(arr: np.ndarray, name: str) -> None:
             f"{name}: uint16 image whose largest value is {top} (12-bit or 8-bit data in a "
             "16-bit container?): it is scaled as 16-bit; the matchers read all its bits, but its "
             f"8-bit copy (colours, the fill's colour segments) "
-            f"keeps about {max(0.0, np.log2(max(top, 1) / 257)):.0f} bits of it; scale it to the "
-            "full range first (img << 4 for 12-bit data, or img.astype(np.uint8) for 8-bit "
-            "values)",
+            f"keeps about {max(0.0, np.log2(max(top, 1) / 257)):.0f} bits of it; "
+            f"{LOW_UINT16_ADVICE}",
             UserWarning,
             stacklevel=user_stacklevel(),  # reached at many depths: as_gray_float, depth_map, match
         )

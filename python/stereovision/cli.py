@@ -1961,7 +1961,17 @@ def _one_line_warning(
     message's first line with text; one with none (``warnings.warn(SomeWarning())``) is named
     by its category."""
     warning = message if isinstance(message, Warning) else category(message)
-    print(f"stereovision: warning: {first_line(warning)}", file=sys.stderr)
+    print(f"stereovision: warning: {_cli_warning_words(first_line(warning))}", file=sys.stderr)
+
+
+def _cli_warning_words(text: str) -> str:
+    """A library warning's advice in the CLI's words: the Python call's (``img << 4``,
+    ``calib=``) is no help to a user who gave files and options."""
+    from stereovision._validate import LOW_UINT16_ADVICE, LOW_UINT16_ADVICE_CLI
+    from stereovision.depth import UNRECTIFIED_ADVICE, UNRECTIFIED_ADVICE_CLI
+
+    text = text.replace(LOW_UINT16_ADVICE, LOW_UINT16_ADVICE_CLI)
+    return text.replace(UNRECTIFIED_ADVICE, UNRECTIFIED_ADVICE_CLI)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
