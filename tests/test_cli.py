@@ -2414,3 +2414,25 @@ def test_demo_refuses_a_folder_under_a_listed_output_before_the_work(
         "move it away (the earlier outputs are kept as they were)\n"
     )
     assert sorted(p.name for p in out.iterdir()) == before
+
+
+def test_calib_help_lists_the_same_formats_for_every_command() -> None:
+    """``--calib`` of stream, batch and gui listed fewer formats than depth's (no stereo_calib
+    output, no Q.dat, no XML) though all read it with Calibration.from_file; ``calibrate -o``
+    said .yaml/.json where .yml and .xml are written too."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    commands = sub.choices
+
+    def option_help(command: str, option: str) -> str:
+        return str(commands[command]._option_string_actions[option].help)
+
+    formats = ("YAML/XML", "JSON", "calib.txt", "KITTI", "Kalibr", "camera_info", "stereo_calib")
+    for command in ("depth", "stream", "batch", "gui"):
+        said = option_help(command, "--calib")
+        assert all(f in said for f in (*formats, "Q.dat", "calibrationdata.tar.gz")), said
+    assert ".yaml, .yml, .xml or .json" in option_help("calibrate", "-o")

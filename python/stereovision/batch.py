@@ -1919,7 +1919,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision batch`` on the CLI's sub-parsers."""
-    from stereovision.cli import add_calib_unit, positive_pixels  # cli builds its parser
+    # cli builds its parser
+    from stereovision.cli import CALIB_FILES_HELP, add_calib_unit, positive_pixels
     from stereovision.depth import METHODS
 
     p = subparsers.add_parser(
@@ -1954,8 +1955,8 @@ def add_cli(subparsers: Any) -> None:
     )
     p.add_argument(
         "--calib",
-        help="calibration for every pair, a file or a ROS camera_info folder (default: each "
-        "scene's calib.txt or Q.dat)",
+        help=f"calibration for every pair: {CALIB_FILES_HELP} (default: each scene's calib.txt "
+        "or Q.dat)",
     )
     add_calib_unit(p)
     p.add_argument(

@@ -2992,7 +2992,9 @@ def add_cli(subparsers: Any) -> None:
         "cv2.fisheye's equidistant model for wide-angle lenses)",
     )
     p.add_argument("--drop-outliers", action="store_true", help="drop outlier pairs and re-solve")
-    p.add_argument("-o", "--output", required=True, help="calibration file (.yaml/.json)")
+    p.add_argument(
+        "-o", "--output", required=True, help="calibration file (.yaml, .yml, .xml or .json)"
+    )
     p.add_argument("--report", metavar="DIR", help="write report.html/.yaml/.json into DIR")
     p.add_argument(
         "--ros",

@@ -174,6 +174,16 @@ CALIB_UNIT_HELP = (
 )
 
 
+#: What ``--calib`` reads (:meth:`Calibration.from_file` for every command: depth, stream,
+#: batch, gui), one text so that no command's help lists fewer formats than another's.
+CALIB_FILES_HELP = (
+    "OpenCV YAML/XML or JSON calibration, Middlebury calib.txt, KITTI calib, Kalibr camchain, "
+    "a ROS camera_info folder (left.yaml, right.yaml) or calibrationdata.tar.gz, OpenCV "
+    "stereo_calib output (intrinsics.yml + extrinsics.yml, with --calib-unit), a Q.dat or a "
+    "scene folder (its calib.txt or Q.dat)"
+)
+
+
 def add_calib_unit(parser: argparse.ArgumentParser) -> None:
     """Add ``--calib-unit`` (the unit of a ``--calib`` file that does not state it) to a
     command that loads a calibration; :func:`load_calibration` reads it."""
@@ -1768,9 +1778,7 @@ def build_parser() -> argparse.ArgumentParser:
     d.add_argument("right", help="right image, the same size")
     d.add_argument(
         "--calib",
-        help="YAML/JSON calibration, Middlebury calib.txt, KITTI calib, Kalibr camchain, a "
-        "ROS camera_info folder (left.yaml, right.yaml), OpenCV stereo_calib output "
-        "(intrinsics.yml + extrinsics.yml, with --calib-unit) or a Q.dat",
+        help=CALIB_FILES_HELP,
     )
     add_calib_unit(d)
     d.add_argument(

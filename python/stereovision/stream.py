@@ -1462,6 +1462,7 @@ def add_cli(subparsers: Any) -> None:
     """Register ``stereovision stream`` on the CLI's sub-parsers."""
     # cli builds its parser with these
     from stereovision.cli import (
+        CALIB_FILES_HELP,
         add_calib_unit,
         port_number,
         positive_count,
@@ -1479,7 +1480,7 @@ def add_cli(subparsers: Any) -> None:
     add_source_args(p)
     p.add_argument(
         "--calib",
-        help="calibration of the rig (YAML/JSON, Middlebury, KITTI, Kalibr, ROS folder); "
+        help=f"calibration of the rig: {CALIB_FILES_HELP}; "
         "--from-bag: default the bag's camera_info",
     )
     add_calib_unit(p)

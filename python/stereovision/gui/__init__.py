@@ -246,12 +246,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     from stereovision.capture import add_read_timeout
 
     add_read_timeout(p)
-    p.add_argument(
-        "--calib",
-        help="calibration of the camera pair (YAML/JSON, calib.txt, KITTI, Kalibr, ROS folder)",
-    )
-    from stereovision.cli import add_calib_unit
+    from stereovision.cli import CALIB_FILES_HELP, add_calib_unit
 
+    p.add_argument("--calib", help=f"calibration of the camera pair: {CALIB_FILES_HELP}")
     add_calib_unit(p)
     p.add_argument(
         "--data",
