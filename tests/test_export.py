@@ -1207,3 +1207,29 @@ def test_mutation_audit_3_export_survivors_bis(result, tmp_path):
     pk.write_bytes(b"PKnot a zip at all")
     with pytest.raises(ValueError, match=re.escape("not a point cloud file (PLY, PCD or NPZ)")):
         export.load_cloud(pk)
+
+
+def test_voxel_downsample_warns_of_a_side_larger_than_the_cloud(result):
+    """A cube side in mm (50 for 5 cm) against points in metres left the cloud a few points
+    without a word; now it warns naming the side, the cloud's extent and the unit. A coarse
+    but plausible grid (50 cm: under 1 % of the points) and a small cloud stay quiet."""
+    import warnings
+
+    pts = result.points[np.isfinite(result.points).all(axis=1)]
+    with pytest.warns(UserWarning) as seen:
+        down, _ = export.voxel_downsample(pts, voxel=50)
+    said = str(seen[0].message)
+    assert said.startswith("voxel: a cube side of 50 is larger than the cloud's extent, "), said
+    assert "(in the points' unit: metres for depth_map's points)" in said
+    assert said.endswith(
+        f"it leaves {len(down)} of {len(pts)} points; give the side in the "
+        "points' unit; 0.05 if 50 was in mm"
+    ), said
+    extent = float(said.split("extent, ")[1].split(" ")[0])
+    assert 3 < extent < 5, said  # the scene is about 4 m across
+    assert seen[0].filename == __file__
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert len(export.voxel_downsample(pts, voxel=0.5)[0]) < 0.01 * len(pts)
+        export.voxel_downsample(pts[:99], voxel=50)
+        export.voxel_downsample(np.zeros((5, 3)), voxel=1.0)  # only duplicates merged
