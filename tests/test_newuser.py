@@ -489,6 +489,13 @@ def test_a_board_square_given_in_mm_with_the_unit_left_at_metres_is_said(
     assert "--square 30 m is a 30 m board square" in err and "--unit mm" in err
     assert main(["board", "-o", str(tmp_path / "b.png"), "--square", "30", "--unit", "mm"]) == 0
     assert "warning" not in capsys.readouterr().err
+    # --unit ft: 4 (1.22 m) was said "measured in mm or cm?", where 4 in is the likely square
+    assert main(["board", "-o", str(tmp_path / "f.png"), "--square", "4", "--unit", "ft"]) == 2
+    err = capsys.readouterr().err  # then refused: too large to print at 300 dpi
+    assert err.splitlines()[0] == (
+        "stereovision: warning: --square 4 ft is a 1.2192 m board square: measured in in, mm or "
+        "cm? give its unit (--unit in: a 10.2 cm square)"
+    ), err
 
 
 @pytest.mark.parametrize(("call", "method"), [("depth_map", "census"), ("match", "mcgm")])

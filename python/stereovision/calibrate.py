@@ -2867,6 +2867,30 @@ def _cli_board(args: argparse.Namespace, *, printing: bool) -> CharucoBoard | No
     return board
 
 
+#: A printed board's plausible square side (metres): a few millimetres (a board for a close
+#: microscope or endoscope rig) to a poster's 30 cm (a far-reaching rig's board).
+PLAUSIBLE_SQUARE_M = (2e-3, 0.3)
+
+
+def _square_unit_hint(square: float, unit: str) -> str:
+    """What ``board`` says of a square too large in ``unit``: the units that make it a
+    plausible one (:data:`PLAUSIBLE_SQUARE_M`; ``unit``'s own system first: 4 meant as inches
+    with --unit ft), the likeliest given as the option (it said "mm or cm" for feet)."""
+    from stereovision.calibration import _format_length, _plausible_units
+
+    imperial = ("ft", "in")  # a slip within one system first: 4 ft for 4 in, not 4 mm
+    found = sorted(
+        _plausible_units(square, unit, PLAUSIBLE_SQUARE_M),
+        key=lambda u: (u[0] in imperial) != (unit in imperial),
+    )
+    if not found:
+        return "give its unit (--unit m, mm, cm, ft or in)"
+    names = [u for u, _ in found]
+    listed = names[0] if len(names) == 1 else f"{', '.join(names[:-1])} or {names[-1]}"
+    best, m = found[0]
+    return f"measured in {listed}? give its unit (--unit {best}: a {_format_length(m)} square)"
+
+
 def cmd_board(args: argparse.Namespace) -> int:
     """``stereovision board -o board.png --pattern 9x6 --square 0.03`` (or ``--board charuco``):
     a printable board at its true size."""
@@ -2890,8 +2914,8 @@ def cmd_board(args: argparse.Namespace) -> int:
         # 30 meant as mm with --unit left at m was refused as "a 30000 mm square at 300 dpi is
         # 354331 px", or, up to 1.69 m, printed at that size
         warnings.warn(
-            f"--square {square:g} {args.unit} is a {metres:g} m board square: measured in mm or "
-            "cm? give its unit (--unit mm)",
+            f"--square {square:g} {args.unit} is a {metres:g} m board square: "
+            f"{_square_unit_hint(square, args.unit)}",
             UserWarning,
             stacklevel=2,
         )

@@ -121,15 +121,27 @@ SKEW_IGNORED_PX = 1e-6
 _DERIVING: ContextVar[bool] = ContextVar("_DERIVING", default=False)
 
 
+def _plausible_units(
+    value: float, unit: str, plausible: tuple[float, float] = PLAUSIBLE_BASELINE_M
+) -> list[tuple[str, float]]:
+    """The other units in which ``value`` (a number given in ``unit``) lies within
+    ``plausible`` (metres), as ``(unit, metres)`` in :data:`UNIT_TO_METRES`' order."""
+    lo, hi = plausible
+    return [
+        (other, value * factor)
+        for other, factor in UNIT_TO_METRES.items()
+        if other != unit and lo <= value * factor <= hi
+    ]
+
+
 def _unit_suggestion(baseline: float, unit: str) -> str:
-    """The units in which ``baseline`` (a number given in ``unit``) would be a plausible rig's,
+    """The unit in which ``baseline`` (a number given in ``unit``) would be a plausible rig's,
     as ``" With unit='m' it would be 8.3 cm."``, or ``""``."""
-    lo, hi = PLAUSIBLE_BASELINE_M
-    for other, factor in UNIT_TO_METRES.items():
-        m = baseline * factor
-        if other != unit and lo <= m <= hi:
-            return f" With unit={other!r} it would be {_format_length(m)}."
-    return ""
+    found = _plausible_units(baseline, unit)
+    if not found:
+        return ""
+    other, m = found[0]
+    return f" With unit={other!r} it would be {_format_length(m)}."
 
 
 def _format_length(metres: float) -> str:
