@@ -635,3 +635,22 @@ def test_bgr_uint8_is_c_contiguous_from_bgra_and_strided_views() -> None:
         out = as_bgr_uint8(img, "left")
         assert out.flags.c_contiguous, img.strides
         np.testing.assert_array_equal(out, expected)
+
+
+def test_scalar_checks_take_the_same_numbers() -> None:
+    """finite_number refused np.array(3.0) (a value read from an array) where positive_finite
+    took a size-1 array, and positive_finite refused 2**70 (an object array to NumPy) where
+    finite_number took it: one rule for both (a list, as CameraControls' slider [1.0], is no
+    number to either), one message each for what neither takes."""
+    from stereovision._validate import finite_number
+
+    for value, want in ((np.array(3.0), 3.0), (np.array([2]), 2.0), (2**70, 2.0**70)):
+        assert finite_number(value, "blur") == want
+        assert positive_finite(value, "f") == want
+    for bad in (np.array([1.0, 2.0]), np.array(True), np.array("3"), [1.0], "3"):
+        with pytest.raises(ValueError, match=r"^blur: expected a finite number, got "):
+            finite_number(bad, "blur")
+        with pytest.raises(ValueError, match=r"^f: expected a positive finite number, got "):
+            positive_finite(bad, "f")
+    with pytest.raises(ValueError, match=r"^blur: expected a finite number, got array\(nan\)$"):
+        finite_number(np.array(np.nan), "blur")

@@ -523,13 +523,26 @@ def luma_weights() -> tuple[float, float, float]:
     return b, g, r
 
 
+def _real_scalar(value: object) -> float:
+    """``value`` as a float when it is one real number: a Python or NumPy int or float, or a
+    size-1 NumPy array of them (``np.array(3.0)``, ``np.array([3.0])``: a value read from an
+    array); a TypeError otherwise (a bool, a string, a list: a slider's ``[1.0]`` is no
+    number). One rule for :func:`positive_finite` and :func:`finite_number` (the second refused
+    ``np.array(3.0)`` and the first ``2**70``, each taken by the other)."""
+    if isinstance(value, (int, float, np.integer, np.floating)):  # 2**70: an object array
+        return float(value)
+    if not isinstance(value, np.ndarray) or value.size != 1 or value.dtype.kind not in "iuf":
+        raise TypeError(type(value).__name__)
+    return float(value.reshape(()))
+
+
 def positive_finite(value: object, name: str) -> float:
     """Return ``value`` as a Python float, checking that it is finite and strictly positive.
 
     Parameters
     ----------
     value : float-like
-        A real scalar (Python or NumPy number, or a size-1 array).
+        A real scalar (Python or NumPy number, or a size-1 array, as :func:`finite_number`).
     name : str
         Field or argument name used in the error message.
 
@@ -547,11 +560,8 @@ def positive_finite(value: object, name: str) -> float:
     if too_large_for_float(value):  # np.asarray made it an object array: its 400 digits shown
         raise ValueError(f"{name}: expected a positive finite number, got {number_shown(value)}")
     try:
-        arr = np.asarray(value)
-        if arr.size != 1 or arr.dtype.kind not in "iuf":
-            raise TypeError
-        out = float(arr.reshape(()))
-    except (TypeError, ValueError):
+        out = _real_scalar(value)
+    except TypeError:
         raise ValueError(
             f"{name}: expected a positive finite number, got {type(value).__name__} {value!r}"
         ) from None
@@ -745,27 +755,30 @@ def internal_error(exc: BaseException) -> str:
 def finite_number(value: object, name: str) -> float:
     """``value`` as a finite Python float.
 
-    An integer too large for a float (``2**1100``: its number of digits is shown), NaN, an
-    infinity or a non-number is a ``ValueError`` naming ``name``, not an OverflowError or
-    NumPy's "ufunc 'isfinite' not supported" (which a Python int beyond 64 bits gave).
+    A size-1 array is its value (as :func:`positive_finite`). An integer too large for a
+    float (``2**1100``: its number of digits is shown), NaN, an infinity or a non-number is a
+    ``ValueError`` naming ``name``, not an OverflowError or NumPy's "ufunc 'isfinite' not
+    supported" (which a Python int beyond 64 bits gave).
 
     Examples
     --------
     >>> finite_number(2**70, "max_disparity")
     1.1805916207174113e+21
+    >>> finite_number(np.array(3.0), "blur")
+    3.0
     >>> finite_number(float("nan"), "blur")
     Traceback (most recent call last):
     ...
     ValueError: blur: expected a finite number, got nan
     """
-    if isinstance(value, (bool, np.bool_)) or not isinstance(
-        value, (int, float, np.integer, np.floating)
-    ):
+    if isinstance(value, (bool, np.bool_)):
         raise ValueError(f"{name}: expected a finite number, got {_shown(value)}")
+    if too_large_for_float(value):  # finite, only too large for a float: say so, not its digits
+        raise ValueError(f"{name}: expected a finite number, got {number_shown(value)}")
     try:
-        out = float(value)
-    except OverflowError:  # finite, only too large for a float: say so, not its digits
-        raise ValueError(f"{name}: expected a finite number, got {number_shown(value)}") from None
+        out = _real_scalar(value)
+    except TypeError:
+        raise ValueError(f"{name}: expected a finite number, got {_shown(value)}") from None
     if not math.isfinite(out):
         raise ValueError(f"{name}: expected a finite number, got {_shown(value)}")
     return out
