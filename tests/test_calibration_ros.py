@@ -745,10 +745,11 @@ def test_from_file_names_a_truncated_tar_and_skips_txt_stereo_calib_names(tmp_pa
         Calibration.from_file(tmp_path / "intrinsics.txt")
 
 
-def _echoed(text: str, ros2: bool = True, **changes: object) -> str:
+def _echoed(text: str, ros2: bool | str = True, **changes: object) -> str:
     """A camera_info file's content as the message `ros2 topic echo --once` (or ROS 1's
     `rostopic echo -n 1`) prints it: k d r p (K D R P), width and height, a header, binning and
-    roi, and the `---` after it."""
+    roi, and the `---` after it; ``ros2="flow"``: `ros2 topic echo --flow-style`, the message
+    on one line (``{header: {...}, height: 480, ...}``)."""
     info = parse_ros_camera_info(text)
     w, h = info["image_size"]
     fields: dict[str, object] = {
@@ -762,16 +763,19 @@ def _echoed(text: str, ros2: bool = True, **changes: object) -> str:
         "roi": {"x_offset": 0, "y_offset": 0, "height": 0, "width": 0, "do_rectify": False},
     }
     fields.update(changes)
-    # ROS 1 prints the arrays inline ([..]), ROS 2 one item a line
-    flow = False if ros2 else None
-    return yaml.safe_dump(fields, default_flow_style=flow, sort_keys=False) + "---\n"
+    # ROS 1 prints the arrays inline ([..]), ROS 2 one item a line, --flow-style all inline
+    flow = True if ros2 == "flow" else False if ros2 else None
+    out = yaml.safe_dump(fields, default_flow_style=flow, sort_keys=False, width=2**31)
+    return out + "---\n"
 
 
-@pytest.mark.parametrize("ros2", [True, False], ids=["ros2", "ros1"])
-def test_camera_info_messages_echoed_to_files_are_read(tmp_path: Path, ros2: bool) -> None:
+@pytest.mark.parametrize("ros2", [True, False, "flow"], ids=["ros2", "ros1", "ros2-flow"])
+def test_camera_info_messages_echoed_to_files_are_read(tmp_path: Path, ros2: bool | str) -> None:
     """`ros2 topic echo --once /left/camera_info > left.yaml` (the message, not
     camera_calibration's file: k, d, r, p, width, height, a trailing ---) was refused as an
-    unrecognised format, a folder of two as a YAML parse error; they give the rig of the files."""
+    unrecognised format, a folder of two as a YAML parse error; they give the rig of the files.
+    With --flow-style (the message on one line, its keys after "{" and ", ") a file was read
+    as an OpenCV JSON calibration and refused."""
     c = raw_calib()
     texts = c.to_ros()
     for side, text in zip(("left", "right"), texts, strict=True):

@@ -2444,11 +2444,13 @@ _ROS_MATRIX_SHAPES = {
 #: How far from identity a ROS ``rectification_matrix`` may be for the pair to count as rectified.
 _ROS_IDENTITY_TOL = 1e-12
 _ROS_HEAD = re.compile(r"^\s*camera_matrix\s*:", re.MULTILINE)
-#: A ``sensor_msgs/CameraInfo`` message as a topic echo prints it (``P:`` in ROS 1).
+#: A ``sensor_msgs/CameraInfo`` message as a topic echo prints it (``P:`` in ROS 1): each key
+#: at the start of a line, or after ``{`` or ``,`` (``ros2 topic echo --flow-style`` prints the
+#: message on one line, ``{header: {...}, height: 480, width: 640, ...}``).
 _ROS_MESSAGE = (
-    re.compile(r"^distortion_model\s*:", re.M),
-    re.compile(r"^[pP]\s*:", re.M),
-    re.compile(r"^width\s*:", re.M),
+    re.compile(r"(?:^|[{,]\s*)distortion_model\s*:", re.M),
+    re.compile(r"(?:^|[{,]\s*)[pP]\s*:", re.M),
+    re.compile(r"(?:^|[{,]\s*)width\s*:", re.M),
 )
 
 
@@ -2494,7 +2496,8 @@ def parse_ros_camera_info(text: str, source: str = "<text>") -> dict[str, Any]:
     Accepts ``{rows, cols, data}`` matrices or flat lists, OpenCV's ``%YAML:1.0`` header and
     ``!!opencv-matrix`` tags, the old spellings ``distortion_coefficents`` and
     ``camera_model``, and a ``sensor_msgs/CameraInfo`` message as a topic echo prints it
-    (``width``, ``height``, ``k d r p`` or ROS 1's ``K D R P``; the first of several).
+    (``width``, ``height``, ``k d r p`` or ROS 1's ``K D R P``; the first of several; on one
+    line with ``ros2 topic echo --flow-style``).
 
     Parameters
     ----------
