@@ -749,3 +749,17 @@ def test_table1_report_draws_by_its_seed() -> None:
     assert not (np.array_equal(a.x, c.x) and np.array_equal(a.y, c.y))
     pick = np.sort(np.random.default_rng(2).choice(600, size=10, replace=False))
     assert np.array_equal(c.y * 30 + c.x, pick)  # the documented draw
+
+
+def test_dense_metrics_bad_keys_are_floats_for_integer_thresholds() -> None:
+    """``bad`` is a dict of float: integer thresholds (``(1, 2)``, ``np.arange``) are keyed as
+    ``1.0`` and ``2.0``, so that its JSON keys are ``"1.0"``, not ``"1"`` or a NumPy type's text
+    (a mutant keying by the threshold as given survived every test)."""
+    from stereovision._jsonout import json_line
+
+    d, g = np.array([[1.0, 2.5, NAN, 9.0]]), np.array([[1.0, 1.0, 1.0, 1.0]])
+    for ts in ((1, 2), np.arange(1, 3)):
+        m = dense_metrics(d, g, thresholds=ts)  # errors 0, 1.5, hole, 8
+        assert [(type(k), k) for k in m.bad] == [(float, 1.0), (float, 2.0)]
+        assert (m.bad[1.0], m.bad[2.0]) == (75.0, 50.0)
+        assert json.loads(json_line({"bad": m.bad})) == {"bad": {"1.0": 75.0, "2.0": 50.0}}
