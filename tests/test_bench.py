@@ -389,3 +389,14 @@ def test_format_table_shows_a_sparse_case_precision_at_1_and_its_count() -> None
     row = format_table([case]).splitlines()[1].split()
     # no dense figure; precision@1 (not another key) to 1 decimal, the count as an integer
     assert row[4:] == ["3.0", "0.75", "-", "-", "-", "97.5", "1326"]
+
+
+def test_bench_json_keeps_the_ratio_to_4_decimals() -> None:
+    """The JSON's ``ratio_sgbm`` is rounded to 4 decimals (a ratio of 0.12346 is not 0.12),
+    ``ms`` and the accuracy figures to 3 (a mutant rounding the ratio to 2 survived)."""
+    from stereovision.bench import BenchCase
+
+    acc = {"bad_2.0": 12.34567, "density": 87.65432}
+    out = BenchCase("a", "census", "method", 32, 8, 4, 5, 1.234567, 0.1234567, acc).as_dict()
+    assert (out["ms"], out["ratio_sgbm"]) == (1.235, 0.1235)
+    assert (out["bad_2.0"], out["density"]) == (12.346, 87.654)
