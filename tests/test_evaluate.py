@@ -763,3 +763,12 @@ def test_dense_metrics_bad_keys_are_floats_for_integer_thresholds() -> None:
         assert [(type(k), k) for k in m.bad] == [(float, 1.0), (float, 2.0)]
         assert (m.bad[1.0], m.bad[2.0]) == (75.0, 50.0)
         assert json.loads(json_line({"bad": m.bad})) == {"bad": {"1.0": 75.0, "2.0": 50.0}}
+
+
+@pytest.mark.parametrize("unit", [["m"], {"m": 1.0}, {"mm"}])
+def test_table1_report_names_a_unit_that_is_no_name(unit: object) -> None:
+    """A list, dict or set for ``unit`` raised ``TypeError: unhashable type: 'list'`` from the
+    unit table, naming neither ``unit`` nor the units it takes."""
+    ones = np.ones((2, 2))
+    with pytest.raises(ValueError, match=r"unit: expected one of \['cm', 'ft', 'in', 'm', 'mm'\]"):
+        table1_report(ones, ones, unit=unit)  # type: ignore[arg-type]

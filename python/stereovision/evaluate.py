@@ -75,7 +75,7 @@ def _same_shape(a: np.ndarray, b: np.ndarray, na: str, nb: str) -> None:
 def _unit_factor(unit: str) -> float:
     try:
         return _TO_METRES[unit]
-    except KeyError:
+    except (KeyError, TypeError):  # TypeError: a list or dict, unhashable
         raise ValueError(f"unit: expected one of {sorted(_TO_METRES)}, got {unit!r}") from None
 
 
@@ -490,8 +490,8 @@ def table1_report(
     Raises
     ------
     ValueError
-        On mismatched shapes, ``n_points < 1``, no pixel with both distances, or a given point
-        outside the image or without both distances.
+        On mismatched shapes, an unknown ``unit``, ``n_points < 1``, no pixel with both
+        distances, or a given point outside the image or without both distances.
     """
     e = _real_2d(depth, "depth", "depth")
     g = _real_2d(gt, "gt", "depth")
