@@ -400,3 +400,14 @@ def test_bench_json_keeps_the_ratio_to_4_decimals() -> None:
     out = BenchCase("a", "census", "method", 32, 8, 4, 5, 1.234567, 0.1234567, acc).as_dict()
     assert (out["ms"], out["ratio_sgbm"]) == (1.235, 0.1235)
     assert (out["bad_2.0"], out["density"]) == (12.346, 87.654)
+
+
+@pytest.mark.parametrize("runs", [5.5, 6.0, float("nan"), "6", None, True])
+def test_bench_scene_refuses_runs_that_are_no_integer_before_any_work(runs: object) -> None:
+    """``runs=5.5`` or NaN passed the ``runs < 5`` check, every case ran its warm-up, and only
+    then ``range(runs)`` raised a TypeError naming no argument ("6" and None: a TypeError from
+    the comparison); a ValueError names ``runs`` before the scene is touched."""
+    import types
+
+    with pytest.raises(ValueError, match=r"^runs: expected an integer, at least 5 .*got "):
+        bench_scene(types.SimpleNamespace(), runs=runs)  # type: ignore[arg-type]

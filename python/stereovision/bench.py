@@ -131,8 +131,17 @@ def sparse_name(method: str) -> str:
     return f"{method}-sparse" if method in METHODS else method
 
 
-def _runs_rule(runs: int) -> str:
-    return f"at least {MIN_RUNS} (evaluation.md: the median of >= {MIN_RUNS} runs), got {runs}"
+def _runs_rule(runs: object) -> str:
+    return f"at least {MIN_RUNS} (evaluation.md: the median of >= {MIN_RUNS} runs), got {runs!r}"
+
+
+def _check_runs(runs: object, name: str) -> None:
+    """Refuse a ``runs`` that is no integer (5.5 and NaN passed ``runs < 5`` and failed in
+    ``range`` after every warm-up) or below :data:`MIN_RUNS`, naming ``name``."""
+    if isinstance(runs, (bool, np.bool_)) or not isinstance(runs, (int, np.integer)):
+        raise ValueError(f"{name}: expected an integer, {_runs_rule(runs)}")
+    if runs < MIN_RUNS:
+        raise ValueError(f"{name}: {_runs_rule(runs)}")
 
 
 def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
@@ -154,7 +163,8 @@ def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
     Raises
     ------
     ValueError
-        If ``runs`` < :data:`MIN_RUNS` (the median of fewer runs is not a figure to report).
+        If ``runs`` is not an integer or is < :data:`MIN_RUNS` (the median of fewer runs is not
+        a figure to report).
     """
     from stereovision import baselines
     from stereovision._validate import as_gray_float
@@ -163,8 +173,7 @@ def bench_scene(scene: Any, runs: int = DEFAULT_RUNS) -> list[BenchCase]:
     from stereovision.match import METHODS as SPARSE_METHODS
     from stereovision.match import match
 
-    if runs < MIN_RUNS:
-        raise ValueError(f"runs: {_runs_rule(runs)}")
+    _check_runs(runs, "runs")
     left, right, gt, md = scene.left, scene.right, scene.gt, int(scene.max_disparity)
     calib = scene.calib if scene.calib is not None and scene.calib.rectified else None
     gl, gr = as_gray_float(left, "left"), as_gray_float(right, "right")
@@ -307,8 +316,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
 
     from stereovision.io import load_scene, scene_too_narrow
 
-    if args.runs < MIN_RUNS:
-        raise ValueError(f"--runs: {_runs_rule(args.runs)}")
+    _check_runs(args.runs, "--runs")
     dirs = _scene_dirs(args.scenes)
     all_cases: list[BenchCase] = []
     quiet = args.json or len(dirs) < 2 or not sys.stderr.isatty()
