@@ -236,3 +236,60 @@ def test_eval_of_a_scene_narrower_than_its_range_names_the_width_needed(
         "disparity range (16 px, evaluation.md's rule: 16 at least): a scene needs images at "
         "least 17 px wide"
     ]
+
+
+def test_eval_scene_figures_are_the_metrics_of_each_output(data_dir: Path) -> None:
+    """Each block of an ``eval`` row is evaluation.md's metric of its own output, reproducible
+    from the public functions: ``ours+fill`` of the row-filled map, ``members_depth`` of the
+    validated matches' depth against the GT depth (not the reverse), Table-1 drawn with seed 0,
+    and every dense block with all four bad-t figures (mutants of _eval_scene that evaluated the
+    raw map as filled, swapped the depth maps or dropped a threshold survived every test)."""
+    from stereovision._jsonout import json_ready
+    from stereovision._validate import as_gray_float
+    from stereovision.baselines import row_fill
+    from stereovision.cli import _eval_scene
+    from stereovision.depth import depth_map
+    from stereovision.evaluate import dense_metrics, depth_metrics, gt_depth, table1_report
+    from stereovision.io import load_scene
+    from stereovision.matching.fusion import fuse_pair
+
+    scene = load_scene(data_dir / "eth3d" / "terrace")
+    calib, md = scene.calib, scene.max_disparity
+    row = json_ready(_eval_scene(scene, "gabor", with_opencv=True))  # gabor leaves holes
+    keys = ["bad_0.5", "bad_1.0", "bad_2.0", "bad_4.0", "density", "avgerr", "rms"]
+    for block in ("ours", "ours+fill", "bm", "sgbm", "sgbm+fill"):
+        assert list(row[block])[:7] == keys, block
+    res = depth_map(scene.left, scene.right, calib, method="gabor", max_disparity=md)
+    filled = dense_metrics(row_fill(res.disparity), scene.gt)
+    assert row["ours+fill"] == json_ready(filled.as_dict())
+    assert row["ours+fill"]["density"] > row["ours"]["density"]  # the fill filled holes
+    zgt = gt_depth(scene.gt, calib)
+    assert row["table1"] == json_ready(table1_report(res.depth, zgt, n_points=10, seed=0).as_dict())
+    gl, gr = as_gray_float(scene.left, "left"), as_gray_float(scene.right, "right")
+    z_members = calib.depth_from_disparity(fuse_pair(gl, gr, max_disparity=md).dispx)
+    assert row["members_depth"] == json_ready(depth_metrics(z_members, zgt).as_dict())
+
+
+def test_eval_scene_uses_only_a_rectified_calibration(
+    data_dir: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A scene whose calibration does not rectify the pair as given is matched without it (no
+    depth figures), as bench does; its dense figures stand."""
+    from types import SimpleNamespace
+
+    from stereovision import depth
+    from stereovision.cli import _eval_scene
+    from stereovision.io import load_scene
+
+    seen: list[object] = []
+    real = depth.depth_map
+
+    def spy(left: Any, right: Any, calib: Any, **k: Any) -> Any:
+        seen.append(calib)
+        return real(left, right, calib, **k)
+
+    monkeypatch.setattr(depth, "depth_map", spy)
+    scene = load_scene(data_dir / "eth3d" / "terrace")
+    fake = SimpleNamespace(**{**vars(scene), "calib": SimpleNamespace(rectified=False)})
+    row = _eval_scene(fake, "fast", with_opencv=False)
+    assert seen == [None] and "depth" not in row and row["ours"]["n_gt"] == 164541
