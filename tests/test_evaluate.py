@@ -772,3 +772,19 @@ def test_table1_report_names_a_unit_that_is_no_name(unit: object) -> None:
     ones = np.ones((2, 2))
     with pytest.raises(ValueError, match=r"unit: expected one of \['cm', 'ft', 'in', 'm', 'mm'\]"):
         table1_report(ones, ones, unit=unit)  # type: ignore[arg-type]
+
+
+def test_depth_metrics_refuses_a_bool_gt_map() -> None:
+    # the GT side too: a validity mask for the GT depth was read as depths of 1 and 0 (a mutant
+    # checking the estimate's dtype only survived)
+    with pytest.raises(ValueError, match=r"^depth maps must be real arrays, got float64 and bool"):
+        depth_metrics(np.ones((2, 2)), np.ones((2, 2), bool))
+
+
+def test_table1_report_seed_none_draws_other_points_each_call() -> None:
+    """``seed=None`` is fresh entropy (``default_rng(None)``): two draws of 10 of 600 pixels
+    differ (a mutant drawing with seed 0 for None survived the test above)."""
+    est = np.full((20, 30), 2.0, np.float32)
+    gt = np.full((20, 30), 2.5, np.float32)
+    draws = [table1_report(est, gt, n_points=10, seed=None) for _ in range(2)]
+    assert (draws[0].x.tolist(), draws[0].y.tolist()) != (draws[1].x.tolist(), draws[1].y.tolist())
