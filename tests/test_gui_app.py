@@ -2888,6 +2888,66 @@ def test_a_wedged_camera_open_leaves_the_page_free(monkeypatch):
     asyncio.run(clicks())
 
 
+def test_a_late_camera_open_does_not_replace_a_newer_choice_nor_hide_its_error(monkeypatch):
+    """The page's Open runs in a thread and is waited for: cameras 0/1 still opening (slow, not
+    yet given up) when cameras 2/3 were opened and used replaced them once they came, the
+    older click winning over the newer; and an open failing with an error of another type
+    than OSError/ValueError/RuntimeError (cv2.error from a backend) left the page saying
+    "opening camera 4 and camera 5..." for good, the error lost in the server's log. The
+    late cameras are closed, the newer ones stay; the error is said on the page."""
+    import asyncio
+    import threading
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    release = threading.Event()
+    made: dict[Any, Any] = {}
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            if left == 4:
+                raise cv2.error("backend failed")
+            self.closed = False
+            made[left] = self
+            if left == 0:
+                release.wait(1.0)  # slow, within the page's 2 s
+
+        def read(self):
+            return frame, frame
+
+        def close(self):
+            self.closed = True
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    app = _scene_app("test-late-open", [bundled_data_dir()], read_timeout=2.0)
+    opens: list[Any] = []
+    app._spawn = lambda coro: (
+        opens.append(asyncio.ensure_future(coro)) if "_open" in coro.__qualname__ else coro.close()
+    )
+
+    async def clicks() -> None:
+        app.state.cam_left, app.state.cam_right = "0", "1"
+        app.open_cameras()
+        app.state.cam_left, app.state.cam_right = "2", "3"
+        app.open_cameras()
+        await opens[1]
+        assert app.source._camera is made[2] and app.state.source_label == "cameras 2 / 3"
+        release.set()
+        await opens[0]
+        assert made[0].closed and not made[2].closed
+        assert app.source._camera is made[2] and app.state.source_label == "cameras 2 / 3"
+        assert not app._opening
+        app.state.cam_left, app.state.cam_right = "4", "5"
+        app.open_cameras()
+        await opens[2]
+        assert app.state.error == "backend failed" and app.state.status == "error"
+        assert app.source._camera is made[2] and not app._opening
+
+    asyncio.run(clicks())
+
+
 def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
     data_dir, tmp_path, capsys
 ):

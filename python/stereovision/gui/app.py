@@ -1318,6 +1318,9 @@ class StereoApp:
         #: Camera sources whose open (on the page's "Open") has not returned yet, given up or
         #: not: another Open of them is refused (each left one more thread blocked in them).
         self._opening: set[int | str] = set()
+        #: Counts the page's source choices (Open, an image folder): an open that returns after
+        #: a newer choice closes its cameras instead of replacing that choice's.
+        self._choice = 0
         self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1)
         self._generation = 0
         self._lock: asyncio.Lock | None = None
@@ -1682,12 +1685,13 @@ class StereoApp:
             self._fail(exc)
             return
         names = (str(self.state.cam_left), str(self.state.cam_right))
+        self._choice += 1
         self._opening.update((left, right))
         what = " and ".join(dict.fromkeys(_source_name(s) for s in (left, right)))
         with self.state:
             self.state.error = ""
             self.state.status = f"opening {what}..."
-        self._spawn(self._open(left, right, fourcc, names, what))
+        self._spawn(self._open(left, right, fourcc, names, what, self._choice))
 
     async def _open(
         self,
@@ -1696,12 +1700,15 @@ class StereoApp:
         fourcc: str | None,
         names: tuple[str, str],
         what: str,
+        choice: int,
     ) -> None:
         """Open ``left`` and ``right`` in a daemon thread, wait for it up to ``read_timeout``
         s, then use the pair (:meth:`_switch_source`) or say why not.
 
         A given-up open goes on in its thread: its sources stay in ``_opening`` (refused by
         :meth:`open_cameras`) until it returns; the cameras it opened late are closed then.
+        ``choice`` is the page's source choice this Open made (``_choice``): cameras that come
+        after a newer choice are closed, and its error is not said over that choice's page.
         """
         loop = asyncio.get_running_loop()
         opened: asyncio.Future[StereoSource] = loop.create_future()
@@ -1733,11 +1740,13 @@ class StereoApp:
                 if source is not None:
                     source.close()
 
-        threading.Thread(target=run, name="stereovision-gui-open", daemon=True).start()
         try:
+            threading.Thread(target=run, name="stereovision-gui-open", daemon=True).start()
             # reads are bounded inside the source; its open by this wait (it cancels `opened`)
             source = await asyncio.wait_for(opened, self.read_timeout)
         except asyncio.TimeoutError:
+            if choice != self._choice:  # another source was chosen meanwhile: it is on show
+                return
             self._fail(
                 OSError(
                     f"{what} did not open within {self.read_timeout:g} s (the open did not "
@@ -1746,8 +1755,17 @@ class StereoApp:
                 )
             )
             return
-        except (ValueError, OSError, RuntimeError) as exc:
+        except Exception as exc:  # any open error is said on the page (cv2.error too)
+            if not opened.done():  # the thread did not start: nothing will settle the keys
+                self._opening.difference_update(keys)
+            if choice != self._choice:
+                return
+            if not isinstance(exc, (ValueError, OSError, RuntimeError)):
+                log.exception("gui: opening %s failed", what)
             self._fail(exc)
+            return
+        if choice != self._choice:  # a newer Open or folder is on show: nobody takes these
+            source.close()
             return
         with self.state:
             self._switch_source(source, names)
@@ -1764,6 +1782,7 @@ class StereoApp:
         except (ValueError, OSError) as exc:
             self._fail(exc)
             return
+        self._choice += 1  # an open still under way must not replace these pairs
         self._switch_source(source, ("", ""))
 
     def _switch_source(self, source: StereoSource, names: tuple[str, str]) -> None:
