@@ -2948,6 +2948,53 @@ def test_a_late_camera_open_does_not_replace_a_newer_choice_nor_hide_its_error(m
     asyncio.run(clicks())
 
 
+def test_a_scene_chosen_while_cameras_open_stays_on_show(monkeypatch):
+    """A scene chosen from the list while an Open was still under way was replaced by the
+    cameras' pair once they came (the list emptied), the older click winning. The scene
+    stays; the late cameras are closed."""
+    import asyncio
+    import threading
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    release = threading.Event()
+    made: list[Any] = []
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            self.closed = False
+            made.append(self)
+            release.wait(1.0)
+
+        def read(self):
+            return frame, frame
+
+        def close(self):
+            self.closed = True
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    app = _scene_app("test-scene-while-open", [bundled_data_dir()], read_timeout=2.0)
+    app.state.cam_left, app.state.cam_right = "0", "1"
+    opens: list[Any] = []
+    app._spawn = lambda coro: (
+        opens.append(asyncio.ensure_future(coro)) if "_open" in coro.__qualname__ else coro.close()
+    )
+    cones = str((bundled_data_dir() / "cones").resolve())
+
+    async def clicks() -> None:
+        app.open_cameras()
+        await asyncio.sleep(0)  # the open's thread is inside the cameras
+        app._on_scene(scene=cones)
+        release.set()
+        await opens[0]
+        assert made[0].closed and app.source is None
+        assert app.state.source_label.startswith("scene ") and app._scene == cones
+
+    asyncio.run(clicks())
+
+
 def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
     data_dir, tmp_path, capsys
 ):

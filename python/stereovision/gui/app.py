@@ -1318,8 +1318,8 @@ class StereoApp:
         #: Camera sources whose open (on the page's "Open") has not returned yet, given up or
         #: not: another Open of them is refused (each left one more thread blocked in them).
         self._opening: set[int | str] = set()
-        #: Counts the page's source choices (Open, an image folder): an open that returns after
-        #: a newer choice closes its cameras instead of replacing that choice's.
+        #: Counts the page's choices of what to show (Open, an image folder, a scene, files): an
+        #: open that returns after a newer choice closes its cameras instead of replacing it.
         self._choice = 0
         self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1)
         self._generation = 0
@@ -1647,6 +1647,7 @@ class StereoApp:
             self.state.scene = self._scene or None
             return
         self._scene = scene
+        self._choice += 1  # an open still under way must not replace this scene
         self._spawn(self.recompute())
 
     def capture(self) -> None:
@@ -1826,6 +1827,7 @@ class StereoApp:
         except (ValueError, OSError) as exc:
             self._fail(exc)
             return
+        self._choice += 1  # an open still under way must not replace these files
         self.pair = self.raw_pair = (left, right)
         self._other_source()
         self.homographies = None
