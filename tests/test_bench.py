@@ -82,10 +82,12 @@ def test_bench_cli_errors_one_line(
     assert err.count("\n") == 0 and needle in err and err.startswith("stereovision: error:")
 
 
-def test_bench_scene_refuses_fewer_than_five_runs(data_dir: Path) -> None:
+@pytest.mark.parametrize("runs", [4, np.int64(4)])
+def test_bench_scene_refuses_fewer_than_five_runs(data_dir: Path, runs: int) -> None:
+    """A NumPy integer is said as the number it is ("got 4", not "got np.int64(4)")."""
     scene = load_scene(data_dir / SCENE)
     with pytest.raises(ValueError, match=r"^runs: at least 5 .*, got 4$"):
-        bench_scene(scene, runs=4)
+        bench_scene(scene, runs=runs)
 
 
 def test_bench_cli_folder_without_scenes(

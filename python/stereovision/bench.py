@@ -132,7 +132,10 @@ def sparse_name(method: str) -> str:
 
 
 def _runs_rule(runs: object) -> str:
-    return f"at least {MIN_RUNS} (evaluation.md: the median of >= {MIN_RUNS} runs), got {runs!r}"
+    # an integer as its number (NumPy 2's repr said np.int64(4)); anything else as Python shows it
+    exact = isinstance(runs, (int, np.integer)) and not isinstance(runs, bool)
+    shown = str(runs) if exact else repr(runs)
+    return f"at least {MIN_RUNS} (evaluation.md: the median of >= {MIN_RUNS} runs), got {shown}"
 
 
 def _check_runs(runs: object, name: str) -> None:
