@@ -94,32 +94,28 @@ def round_up16(n: float) -> int:
 
 def _check_pair_shapes(left: np.ndarray, right: np.ndarray, colour: bool = False) -> None:
     """Refuse a pair of two sizes (:func:`pair_shape_error`, the API's words). ``colour``: the
-    matcher reads the BGR pair (SGBM), so a grey image beside a colour one is refused too, also
-    one read in colour from a grey file (three equal channels): grey replicated against colour
-    matched other costs without a word (cones: bad-2 31.4 % for 21.6 %). The grey matchers (BM)
+    matcher reads the BGR pair (SGBM), so a one-channel image beside a colour one is refused
+    too: grey replicated against colour matched other costs without a word (cones: bad-2
+    31.4 % for 21.6 %); beside a grey file read in colour (three equal channels) it is the
+    same pair. Two three-channel images are never judged by their content: a dark or
+    saturated colour frame (a covered lens) has equal channels too. The grey matchers (BM)
     convert both, so to them it is the grey pair."""
     if left.shape[:2] != right.shape[:2]:
         raise pair_shape_error(left.shape, right.shape)
     if not colour:
         return
-    grey = _is_grey(left), _is_grey(right)
-    if grey[0] == grey[1]:
+    one = _one_channel(left), _one_channel(right)
+    if one[0] == one[1] or _equal_channels(right if one[0] else left):
         return
-    shown = left if grey[0] else right
-    if shown.ndim == 2 or shown.shape[2] == 1:  # (H, W) beside colour: the API's message
-        raise pair_shape_error(left.shape, right.shape)
-    side = "left" if grey[0] else "right"
-    raise ValueError(
-        f"left and right images must both be grey or both colour: {side} is grey (its colour "
-        "channels are equal, a grey file read in colour), the other colour; convert both to "
-        "grey (cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)) or give both cameras' colour images"
-    )
+    raise pair_shape_error(left.shape, right.shape)
 
 
-def _is_grey(img: np.ndarray) -> bool:
-    """Whether ``img`` holds grey levels only: one channel, or colour channels all equal."""
-    if img.ndim == 2 or img.shape[2] == 1:
-        return True
+def _one_channel(img: np.ndarray) -> bool:
+    return img.ndim == 2 or img.shape[2] == 1
+
+
+def _equal_channels(img: np.ndarray) -> bool:
+    """Whether a colour image holds grey levels only (a grey file read in colour)."""
     return bool(
         np.array_equal(img[..., 0], img[..., 1]) and np.array_equal(img[..., 0], img[..., 2])
     )
@@ -183,7 +179,7 @@ def opencv_sgbm(left: object, right: object, max_disparity: float) -> npt.NDArra
     ------
     ValueError
         On invalid images, mismatched sizes, a grey image beside a colour one (SGBM matches
-        colour; a grey image read in colour, three equal channels, counts as grey) or a
+        colour; beside a grey file read in colour, three equal channels, it is the grey pair) or a
         negative/non-finite ``max_disparity``.
     """
     la, ra = as_image_array(left, "left"), as_image_array(right, "right")
