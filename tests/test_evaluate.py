@@ -788,3 +788,30 @@ def test_table1_report_seed_none_draws_other_points_each_call() -> None:
     gt = np.full((20, 30), 2.5, np.float32)
     draws = [table1_report(est, gt, n_points=10, seed=None) for _ in range(2)]
     assert (draws[0].x.tolist(), draws[0].y.tolist()) != (draws[1].x.tolist(), draws[1].y.tolist())
+
+
+@pytest.mark.parametrize(
+    ("mask", "dtype"),
+    [
+        (np.array([[1.0, NAN, 1.0]]), "float64"),  # astype(bool) took the NaN as inside
+        (np.array([[0.5, 0.0, 1.0]]), "float64"),
+        (np.array([["y", "", "y"]]), "<U1"),
+        (np.array([[1, None, 1]], dtype=object), "object"),
+    ],
+)
+def test_dense_metrics_refuses_a_mask_that_is_not_bool_or_integer(
+    mask: np.ndarray, dtype: str
+) -> None:
+    """``astype(bool)`` took any dtype: a NaN in a float mask counted as inside, a string
+    mask was read by emptiness. Only bool, integer and 0/1 float masks are masks."""
+    gt = np.full((1, 3), 4.0)
+    with pytest.raises(ValueError, match=rf"^mask: expected .*bool.*, got dtype {dtype}"):
+        dense_metrics(gt, gt, mask=mask)
+
+
+def test_dense_metrics_takes_int_and_0_1_float_masks_as_bool() -> None:
+    gt = np.array([[4.0, 4.0, 4.0]])
+    disp = np.array([[4.5, 10.0, NAN]])
+    want = dense_metrics(disp, gt, mask=np.array([[True, False, True]]))
+    for mask in (np.array([[1, 0, 1]]), np.array([[1.0, 0.0, 1.0]], np.float32), [[1, 0, 1]]):
+        assert dense_metrics(disp, gt, mask=mask) == want

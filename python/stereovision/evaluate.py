@@ -72,6 +72,20 @@ def _same_shape(a: np.ndarray, b: np.ndarray, na: str, nb: str) -> None:
         raise ValueError(f"{na} and {nb} must have the same shape, got {a.shape} and {b.shape}")
 
 
+def _bool_mask(mask: npt.ArrayLike) -> np.ndarray:
+    """``mask`` as bool: bool, integers (non-zero inside, e.g. a 0/255 PNG) or floats of 0 and 1.
+
+    ``astype(bool)`` took anything: a NaN counted as inside and strings by their emptiness.
+    """
+    m = np.asarray(mask)
+    if m.dtype.kind in "biu" or (m.dtype.kind == "f" and np.isin(m, (0.0, 1.0)).all()):
+        return m.astype(bool)
+    raise ValueError(
+        f"mask: expected a bool or integer array (or floats of only 0 and 1), "
+        f"got dtype {m.dtype}" + (" holding other values" if m.dtype.kind == "f" else "")
+    )
+
+
 def _unit_factor(unit: str) -> float:
     try:
         return _TO_METRES[unit]
@@ -175,7 +189,8 @@ def dense_metrics(
     thresholds : iterable of float
         bad-t thresholds in px (a tuple, list, array, range, set, ...).
     mask : array_like of bool, optional
-        ``(H, W)``; restrict the evaluation to these pixels (e.g. non-occluded).
+        ``(H, W)``; restrict the evaluation to these pixels (e.g. non-occluded). Integers
+        count non-zero as inside (a 0/255 mask image); floats must hold only 0 and 1.
 
     Returns
     -------
@@ -184,7 +199,8 @@ def dense_metrics(
     Raises
     ------
     ValueError
-        On non-2-D input, mismatched shapes or non-positive thresholds.
+        On non-2-D input, mismatched shapes, non-positive thresholds or a mask that is
+        not bool, integer or 0/1 floats.
 
     Examples
     --------
@@ -206,7 +222,7 @@ def dense_metrics(
         raise ValueError(f"thresholds must be positive and finite, got {shown}")
     known = np.isfinite(g)
     if mask is not None:
-        m = np.asarray(mask, dtype=bool)
+        m = _bool_mask(mask)
         _same_shape(m, g, "mask", "gt")
         known &= m
     n_gt = int(known.sum())
