@@ -815,3 +815,10 @@ def test_dense_metrics_takes_int_and_0_1_float_masks_as_bool() -> None:
     want = dense_metrics(disp, gt, mask=np.array([[True, False, True]]))
     for mask in (np.array([[1, 0, 1]]), np.array([[1.0, 0.0, 1.0]], np.float32), [[1, 0, 1]]):
         assert dense_metrics(disp, gt, mask=mask) == want
+
+
+def test_table1_report_shows_a_numpy_string_unit_as_its_text() -> None:
+    # a unit read from an array (np.str_) was shown by repr: "got np.str_('parsec')"
+    ones = np.ones((2, 2))
+    with pytest.raises(ValueError, match=r"got 'parsec'$"):
+        table1_report(ones, ones, unit=np.str_("parsec"))  # type: ignore[arg-type]

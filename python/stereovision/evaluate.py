@@ -90,7 +90,9 @@ def _unit_factor(unit: str) -> float:
     try:
         return _TO_METRES[unit]
     except (KeyError, TypeError):  # TypeError: a list or dict, unhashable
-        raise ValueError(f"unit: expected one of {sorted(_TO_METRES)}, got {unit!r}") from None
+        # a str subclass (np.str_) as its text, not as "np.str_('x')"
+        shown = repr(str(unit)) if isinstance(unit, str) else repr(unit)
+        raise ValueError(f"unit: expected one of {sorted(_TO_METRES)}, got {shown}") from None
 
 
 def _threshold_text(t: float) -> str:
