@@ -375,6 +375,16 @@ def test_from_kitti_shared_file(data_dir: Path) -> None:
     assert parse_kitti_calib(path)["T_03"][0] == -4.731050e-01
 
 
+def test_from_kitti_says_cameras_given_right_first(data_dir: Path) -> None:
+    # (3, 2) was refused as a baseline of -0.533 without the likely cause: the order swapped
+    path = data_dir / "kitti2015" / "000005_10" / "calib_kitti.txt"
+    with pytest.raises(
+        ValueError,
+        match=r"got -0\.5327\d* m; cameras=\(3, 2\) .*right camera first: pass cameras=\(2, 3\)$",
+    ):
+        Calibration.from_kitti(path, cameras=(3, 2))
+
+
 def test_from_kitti_raw_and_object_formats(tmp_path: Path) -> None:
     p2 = "7.2e+02 0 6.1e+02 4.5e+01 0 7.2e+02 1.7e+02 0 0 0 1 0"
     p3 = "7.2e+02 0 6.1e+02 -3.6e+02 0 7.2e+02 1.7e+02 0 0 0 1 0"

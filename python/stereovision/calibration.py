@@ -1905,6 +1905,12 @@ class Calibration:
         if not f > 0:
             raise ValueError(f"KITTI calibration {p}: {k2} focal length {f:g} is not positive")
         baseline = (p2[0, 3] - p3[0, 3]) / f
+        if baseline < 0:  # the left camera has the higher P[0, 3]: most likely a swapped pair
+            raise ValueError(
+                f"baseline ({k2}[0, 3] - {k3}[0, 3]) / f in {p}: expected a positive finite "
+                f"number, got {float(baseline)!r} m; cameras={(a, b)} looks like the right "
+                f"camera first: pass cameras=({b}, {a})"
+            )
         size: tuple[int, int] | None = None
         given = None if image_size is None else cls._check_size(image_size)
         s_rect = f"S_rect_0{a}"
