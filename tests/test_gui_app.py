@@ -2888,6 +2888,56 @@ def test_a_wedged_camera_open_leaves_the_page_free(monkeypatch):
     asyncio.run(clicks())
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="V4L2 device paths")
+def test_a_camera_still_opening_is_refused_by_its_dev_video_path_too(monkeypatch):
+    """The pending-open check compared the sources as typed: camera 0 still opening, its
+    ``/dev/video0`` (accepted where a data folder holds /dev) was opened again beside it."""
+    import asyncio
+    import threading
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    release = threading.Event()
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            release.wait(1.0)  # wedged (bounded: a broken app cannot hang the test)
+
+        def read(self):
+            return frame, frame
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    app = _scene_app("test-dev-video-pending", [bundled_data_dir()], read_timeout=0.2)
+    # as if /dev were an allowed folder holding the device (no camera on the test machine)
+    monkeypatch.setattr(app.folders, "resolve", lambda p: Path(p))
+    opens: list[Any] = []
+    app._spawn = lambda coro: (
+        opens.append(asyncio.ensure_future(coro)) if "_open" in coro.__qualname__ else coro.close()
+    )
+
+    async def clicks() -> None:
+        app.state.cam_left, app.state.cam_right = "0", "1"
+        app.open_cameras()
+        app.state.cam_left, app.state.cam_right = "/dev/video0", "2"
+        app.open_cameras()
+        assert len(opens) == 1
+        assert app.state.error.startswith("video0 is still opening (an earlier Open")
+        release.set()
+        await opens[0]
+        for _ in range(100):
+            if not app._opening:
+                break
+            await asyncio.sleep(0.01)
+        assert not app._opening  # the keys settled under the same names
+
+    asyncio.run(clicks())
+
+
 def test_a_late_camera_open_does_not_replace_a_newer_choice_nor_hide_its_error(monkeypatch):
     """The page's Open runs in a thread and is waited for: cameras 0/1 still opening (slow, not
     yet given up) when cameras 2/3 were opened and used replaced them once they came, the

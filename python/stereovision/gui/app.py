@@ -27,6 +27,7 @@ import logging
 import math
 import os
 import re
+import sys
 import threading
 import time
 import warnings
@@ -1140,6 +1141,20 @@ def parse_max_disparity(text: str | None, width: int) -> int | None:
     return value
 
 
+def _pending_key(src: int | str) -> int | str:
+    """``src`` as the pending-open check knows it: a Linux ``/dev/videoN`` is camera ``N``.
+
+    Typed as ``0`` and as ``/dev/video0`` (a by-id link is resolved to it before this), one
+    device was not recognised as still opening. Only that exact form is an index: other
+    paths are files or streams.
+    """
+    if isinstance(src, str) and sys.platform.startswith("linux"):
+        node = re.fullmatch(r"/dev/video(\d+)", src, re.ASCII)
+        if node:
+            return int(node.group(1))
+    return src
+
+
 def _source_name(src: int | str) -> str:
     """A camera source as the page names it: ``camera 0``, or the file's name."""
     return f"camera {src}" if isinstance(src, int) else Path(src).name or src
@@ -1676,7 +1691,7 @@ class StereoApp:
             left = self._camera_source(self.state.cam_left)
             right = self._camera_source(self.state.cam_right)
             fourcc = None if self.state.fourcc == FOURCCS[0] else self.state.fourcc
-            pending = [s for s in (left, right) if s in self._opening]
+            pending = [s for s in (left, right) if _pending_key(s) in self._opening]
             if pending:
                 raise OSError(
                     f"{_source_name(pending[0])} is still opening (an earlier Open has not "
@@ -1687,7 +1702,7 @@ class StereoApp:
             return
         names = (str(self.state.cam_left), str(self.state.cam_right))
         self._choice += 1
-        self._opening.update((left, right))
+        self._opening.update((_pending_key(left), _pending_key(right)))
         what = " and ".join(dict.fromkeys(_source_name(s) for s in (left, right)))
         with self.state:
             self.state.error = ""
@@ -1713,7 +1728,7 @@ class StereoApp:
         """
         loop = asyncio.get_running_loop()
         opened: asyncio.Future[StereoSource] = loop.create_future()
-        keys = (left, right)
+        keys = (_pending_key(left), _pending_key(right))
 
         def settle(source: StereoSource | None, exc: BaseException | None) -> None:
             # on the page's loop: the sources may be opened again from now
