@@ -765,7 +765,10 @@ def run_stream(
         grab thread when pipelined) before matching: less noise in low light, the same pairs
         when the rig or the scene moves. It averages the frames as grabbed, before
         rectification (whose interpolation blurs the noise it measures). ``on_result`` gets
-        the averaged left image.
+        the averaged left image. Pipelined, a stream ended by Ctrl-C or a failing output
+        leaves the filter holding up to :data:`QUEUE_SIZE` pairs grabbed ahead and never
+        matched (the report counts only the pairs matched): call its ``reset()`` before
+        reusing it if the next stream's first pairs must hold none of them.
     read_timeout : float or None
         Seconds a pair's read may take (:data:`~stereovision.capture.DEFAULT_READ_TIMEOUT`,
         10); a camera whose read does not return by then (a hung USB camera) ends the stream
