@@ -681,7 +681,7 @@ def test_bag_fields_of_a_filled_map_and_its_floor_scan(data_dir: Path, tmp_path:
         bag.write(res, stamp, ground=plane)
         # a scan given: its own range limits (laser_scan's range_min is 0 by default)
         bag.write(res, stamp + 1, scan=dataclasses.replace(want, range_min=0.25, range_max=7.5))
-    assert (bag.messages, bag.frames) == (16, 2)
+    assert (bag.messages, bag.frames) == (17, 2)  # the first with its /tf
     topics = _read(tmp_path / "run")
     scan_stamp, scan = topics["/stereo/scan"][0]
     assert scan_stamp == stamp
@@ -771,3 +771,55 @@ def test_the_disparity_focal_length_is_fx_for_non_square_pixels(
     assert topics["/stereo/disparity"][0][1].f == pytest.approx(cal.K1[0, 0], rel=1e-7)  # f32
     info = topics["/stereo/left/camera_info"][0][1]
     np.testing.assert_allclose(info.k.reshape(3, 3), k1, rtol=1e-12)
+
+
+def test_a_bag_with_a_floor_carries_the_camera_to_floor_transform(
+    data_dir: Path, tmp_path: Path
+) -> None:
+    """REP 105: the scan is in the floor frame (``base_footprint``), the images and cloud in the
+    camera's optical frame; without a transform between the two (the bag had none), RViz and a
+    Nav2 costmap cannot place the scan beside the cloud. With a ``ground``, each frame carries
+    ``/tf``: the optical frame under the floor frame, stamped as the frame, whose rotation and
+    translation take a camera point to REP 103's floor axes (x forward, y left, z up: a point
+    on the optical axis is ahead, the cloud's heights are the plane's) and put each scan hit on
+    an obstacle point at its beam's angle and range. A scan given without a floor has none."""
+    from scipy.spatial.transform import Rotation
+
+    from stereovision.ground import fit_ground_plane, laser_scan
+    from stereovision.rosbag import BagWriter
+
+    sc = load_scene(data_dir / "kitti2015" / "000005_10")
+    res = sv.depth_map(sc.left, sc.right, sc.calib, max_disparity=sc.max_disparity, cloud=False)
+    plane = fit_ground_plane(res.disparity, res.calibration)
+    assert plane is not None
+    stamp = 1_700_000_000_123_456_789
+    with BagWriter(tmp_path / "run", points=False) as bag:
+        bag.write(res, stamp, ground=plane)
+        scan = laser_scan(res.point_image(filled=True), plane, res.calibration)
+        bag.write(res, stamp + 1, scan=scan)
+    topics = _read(tmp_path / "run")
+    ((recorded, tf),) = topics["/tf"]  # absolute (tf's topic), once: the frame with a floor
+    assert recorded == stamp
+    (tr,) = tf.transforms
+    assert (tr.header.frame_id, tr.child_frame_id) == ("base_footprint", "stereo_left_optical")
+    assert (tr.header.stamp.sec, tr.header.stamp.nanosec) == (1_700_000_000, 123_456_789)
+    q = tr.transform.rotation
+    rot = Rotation.from_quat([q.x, q.y, q.z, q.w]).as_matrix()
+    v = tr.transform.translation
+    shift = np.array([v.x, v.y, v.z])
+    np.testing.assert_allclose(shift, [0.0, 0.0, plane.height], atol=1e-12)
+    ahead = rot @ [0.0, 0.0, 1.0] + shift  # 1 m along the optical axis: forward, not sideways
+    assert ahead[0] > 0.9 and abs(ahead[1]) < 0.1
+    assert (rot @ [-1.0, 0.0, 0.0])[1] > 0.9  # the camera's left (-x) is the floor's +y
+    pts = res.point_image(filled=True)
+    ok = np.all(np.isfinite(pts), axis=-1)
+    floor_pts = pts[ok] @ rot.T + shift
+    np.testing.assert_allclose(floor_pts[:, 2], plane.height_of(pts[ok]), atol=1e-9)
+    stood = floor_pts[(floor_pts[:, 2] > 0.15) & (floor_pts[:, 2] < 2.0)]
+    dist = np.hypot(stood[:, 0], stood[:, 1])
+    ang = np.arctan2(stood[:, 1], stood[:, 0])
+    hits = np.nonzero(np.isfinite(scan.ranges))[0]
+    assert hits.size > 10
+    for i in hits[:: max(1, hits.size // 40)]:
+        near = np.abs(ang - scan.angles[i]) <= scan.angle_increment / 2 + 1e-9
+        assert np.min(np.abs(dist[near] - scan.ranges[i])) < 1e-4, i

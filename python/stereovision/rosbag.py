@@ -28,6 +28,8 @@ topic (``prefix`` = ``/stereo``)  type                              content
                                                                     in a float32)
 ``scan`` (when given)             ``sensor_msgs/LaserScan``         the obstacles on the floor,
                                                                     in ``scan_frame_id``
+``/tf`` (with a ``ground``)       ``tf2_msgs/TFMessage``            the optical frame under
+                                                                    ``scan_frame_id`` (REP 105)
 ================================  ================================  ===============================
 
 The bag is written with the pure-Python ``rosbags`` library (the ``ros`` extra:
@@ -232,17 +234,19 @@ ros2_static_transform>`.
 
     def _conn(self, topic: str, msgtype: str) -> Any:
         if topic not in self._conns:
-            self._conns[topic] = self._writer.add_connection(
-                f"{self.prefix}/{topic}", msgtype, typestore=self._types
-            )
+            # an absolute topic ("/tf") stays out of the namespace: tf listens there only
+            name = topic if topic.startswith("/") else f"{self.prefix}/{topic}"
+            self._conns[topic] = self._writer.add_connection(name, msgtype, typestore=self._types)
         return self._conns[topic]
 
-    def _header(self, stamp_ns: int) -> Any:
+    def _header(self, stamp_ns: int, frame_id: str | None = None) -> Any:
         t = self._types.types
         stamp = t["builtin_interfaces/msg/Time"](
             sec=int(stamp_ns // 1_000_000_000), nanosec=int(stamp_ns % 1_000_000_000)
         )
-        return t["std_msgs/msg/Header"](stamp=stamp, frame_id=self.frame_id)
+        return t["std_msgs/msg/Header"](
+            stamp=stamp, frame_id=self.frame_id if frame_id is None else frame_id
+        )
 
     def _put(self, topic: str, msgtype: str, msg: Any, stamp_ns: int) -> None:
         """Serialise one message of the frame being made; :meth:`_flush` writes them."""
@@ -441,13 +445,31 @@ ros2_static_transform>`.
             delta_d=1.0 / 16,  # the floating map is finer; stereo_image_proc's SGBM step
         )
 
+    def _transform(self, stamp_ns: int, ground: Any) -> Any:
+        """``/tf``'s message: the optical frame under :attr:`scan_frame_id`, the pose of
+        :meth:`GroundPlane.camera_in_floor <stereovision.ground.GroundPlane.camera_in_floor>`
+        (REP 105: without it the scan, in the floor frame, and the images and cloud, in the
+        optical frame, could not be shown or used together). Stamped as the frame, on ``/tf``
+        rather than ``/tf_static``: a floor fitted again moves it."""
+        from stereovision.ground import _quaternion, floor_frame
+
+        t = self._types.types
+        qx, qy, qz, qw = _quaternion(floor_frame(ground))
+        moved = t["geometry_msgs/msg/Transform"](
+            translation=t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=float(ground.height)),
+            rotation=t["geometry_msgs/msg/Quaternion"](x=qx, y=qy, z=qz, w=qw),
+        )
+        pose = t["geometry_msgs/msg/TransformStamped"](
+            header=self._header(stamp_ns, self.scan_frame_id),
+            child_frame_id=self.frame_id,
+            transform=moved,
+        )
+        return t["tf2_msgs/msg/TFMessage"](transforms=[pose])
+
     def _scan(self, stamp_ns: int, scan: Any) -> Any:
         t = self._types.types
-        stamp = t["builtin_interfaces/msg/Time"](
-            sec=int(stamp_ns // 1_000_000_000), nanosec=int(stamp_ns % 1_000_000_000)
-        )
         return t["sensor_msgs/msg/LaserScan"](
-            header=t["std_msgs/msg/Header"](stamp=stamp, frame_id=self.scan_frame_id),
+            header=self._header(stamp_ns, self.scan_frame_id),
             angle_min=float(scan.angle_min),
             angle_max=float(scan.angle_max),
             angle_increment=float(scan.angle_increment),
@@ -466,7 +488,9 @@ ros2_static_transform>`.
         stamped ``stamp_ns`` nanoseconds (the frame's time), and its
         :class:`~stereovision.ground.LaserScan`: ``scan`` when given, else the scan of the
         obstacles on ``ground`` (a :class:`~stereovision.ground.GroundPlane`), from the same
-        reprojection of the depth map as the cloud.
+        reprojection of the depth map as the cloud. With ``ground``, also ``/tf``: the optical
+        frame ``frame_id`` under the floor frame ``scan_frame_id``, the camera's pose on the
+        floor (:meth:`~stereovision.ground.GroundPlane.camera_in_floor`).
 
         Raises
         ------
@@ -554,6 +578,8 @@ ros2_static_transform>`.
             scan = laser_scan(grid(), ground, result.calibration)
         if scan is not None:
             self._put("scan", "sensor_msgs/msg/LaserScan", self._scan(stamp, scan), stamp)
+        if ground is not None:
+            self._put("/tf", "tf2_msgs/msg/TFMessage", self._transform(stamp, ground), stamp)
 
     def close(self) -> None:
         """Finish the bag (its metadata.yaml); the writer cannot be used afterwards.
