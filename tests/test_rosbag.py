@@ -823,3 +823,7 @@ def test_a_bag_with_a_floor_carries_the_camera_to_floor_transform(
     for i in hits[:: max(1, hits.size // 40)]:
         near = np.abs(ang - scan.angles[i]) <= scan.angle_increment / 2 + 1e-9
         assert np.min(np.abs(dist[near] - scan.ranges[i])) < 1e-4, i
+    # a robot whose own tree places the camera: no second parent for the optical frame
+    with BagWriter(tmp_path / "own_tree", points=False, tf=False) as bag:
+        bag.write(res, stamp, ground=plane)
+    assert "/tf" not in _read(tmp_path / "own_tree")

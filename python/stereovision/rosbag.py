@@ -171,6 +171,10 @@ class BagWriter:
         ``header.frame_id`` of the scans: the floor frame under the camera, the parent frame of
         :meth:`GroundPlane.ros2_static_transform <stereovision.ground.GroundPlane.\
 ros2_static_transform>`.
+    tf : bool
+        With a ``ground`` given to :meth:`write`, also write ``/tf``: ``frame_id`` under
+        ``scan_frame_id``. False for a robot whose own transforms (``robot_state_publisher``)
+        already place the camera: a frame has one parent in tf.
 
     Raises
     ------
@@ -197,6 +201,7 @@ ros2_static_transform>`.
         frame_id: str = DEFAULT_FRAME_ID,
         points: bool = True,
         scan_frame_id: str = "base_footprint",
+        tf: bool = True,
     ) -> None:
         self.path = Path(path)
         if self.path.exists():
@@ -213,6 +218,7 @@ ros2_static_transform>`.
         self.frame_id = str(frame_id)
         self.points = bool(points)
         self.scan_frame_id = str(scan_frame_id)
+        self.tf = bool(tf)
         self.messages = 0
         #: Whole frames the bag holds (as :attr:`messages`, read back after a rollback).
         self.frames = 0
@@ -488,9 +494,9 @@ ros2_static_transform>`.
         stamped ``stamp_ns`` nanoseconds (the frame's time), and its
         :class:`~stereovision.ground.LaserScan`: ``scan`` when given, else the scan of the
         obstacles on ``ground`` (a :class:`~stereovision.ground.GroundPlane`), from the same
-        reprojection of the depth map as the cloud. With ``ground``, also ``/tf``: the optical
-        frame ``frame_id`` under the floor frame ``scan_frame_id``, the camera's pose on the
-        floor (:meth:`~stereovision.ground.GroundPlane.camera_in_floor`).
+        reprojection of the depth map as the cloud. With ``ground`` (and ``tf``), also
+        ``/tf``: the optical frame ``frame_id`` under the floor frame ``scan_frame_id``, the
+        camera's pose on the floor (:meth:`~stereovision.ground.GroundPlane.camera_in_floor`).
 
         Raises
         ------
@@ -578,7 +584,7 @@ ros2_static_transform>`.
             scan = laser_scan(grid(), ground, result.calibration)
         if scan is not None:
             self._put("scan", "sensor_msgs/msg/LaserScan", self._scan(stamp, scan), stamp)
-        if ground is not None:
+        if ground is not None and self.tf:
             self._put("/tf", "tf2_msgs/msg/TFMessage", self._transform(stamp, ground), stamp)
 
     def close(self) -> None:
