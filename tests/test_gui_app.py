@@ -461,6 +461,21 @@ def test_a_number_and_its_unit_are_never_broken_apart():
     assert nowrap_units("pitch -0.40 deg, roll 2 degrees") == "pitch -0.40\xa0deg, roll 2 degrees"
 
 
+def test_an_unrectified_pair_is_advised_in_the_page_s_words():
+    """An unrectified pair (an image folder of raw camera pairs) put the library's advice on the
+    page: "calib=Calibration.from_file(...)" and "stereovision.uncalibrated.rectify_uncalibrated",
+    Python calls a user of the page cannot make. The page names its own ways: a calibration
+    (the scene's calib.txt or --calib) and its Rectify button."""
+    from stereovision.gui.app import compute_view
+
+    left = cv2.imread(str(CONES / "left.png"))
+    right = np.roll(cv2.imread(str(CONES / "right.png")), 30, axis=0)  # rows 30 px apart
+    stats = compute_view(left, right, None, "fast").stats
+    assert "look unrectified" in stats, stats
+    assert "Calibration.from_file" not in stats and "stereovision.uncalibrated" not in stats
+    assert "--calib" in stats and "the Rectify button" in stats, stats
+
+
 def test_the_unit_toggle_shows_lengths_in_feet():
     """Depth was shown in metres only. The unit toggle (metres by default) shows the depth
     caption, the median depth and the 3-D translation sliders in feet; the sliders' values are
