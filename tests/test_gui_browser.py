@@ -729,3 +729,17 @@ def test_the_max_disparity_hint_fits_its_field(page):
         assert text_px <= room_px, (hint, text_px, room_px)
         assert re.fullmatch(r"auto: \d+ px at full size", hint.split(" (")[0]), hint
         assert hint.endswith(" at 320)") == (res == "320"), hint
+
+
+def test_a_dismissed_error_leaves_no_error_status(page):
+    """Closing the error box (its X) took the message away, but the toolbar went on saying
+    "error" above a page with no error on it, until the next computed pair."""
+    _wait_computations(page, 1)
+    page.fill("#max-disparity", "lots")
+    page.press("#max-disparity", "Enter")
+    _wait_error(page, "max disparity")
+    assert page.inner_text("#status").strip() == "error"
+    page.click("#error-alert button")
+    page.wait_for_selector("#error-alert", state="detached")
+    page.wait_for_function("document.querySelector('#status')?.textContent.trim() === 'ready'")
+    page.fill("#max-disparity", "")  # automatic again

@@ -2735,7 +2735,9 @@ class StereoApp:
                         density="compact",
                         classes="mb-2",
                         id="error-alert",
-                        click_close="error = ''",
+                        # the toolbar's "error" goes with the message (it stayed until the
+                        # next computed pair); a computation's progress is not "error"
+                        click_close="error = ''; if (status === 'error') status = 'ready'",
                     )
                     with v3.VRow(dense=True):
                         with v3.VCol(cols=12, md=4):
