@@ -393,7 +393,7 @@ def test_the_depth_picture_says_the_distances_of_its_colours():
     (1st and 99th percentile of 1 / depth), so that a colour can be read in metres."""
     from stereovision.calibration import Calibration
     from stereovision.gui import bundled_data_dir
-    from stereovision.gui.app import DEPTH_CAPTION, compute_view
+    from stereovision.gui.app import NO_DEPTH_CAPTION, compute_view
 
     cones = bundled_data_dir() / "cones"
     left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
@@ -404,12 +404,25 @@ def test_the_depth_picture_says_the_distances_of_its_colours():
     near, far = 1.0 / np.percentile(inv, 99), 1.0 / np.percentile(inv, 1)
     assert float(got.group(1)) == pytest.approx(near, abs=0.006) and near < 3.0
     assert float(got.group(2)) == pytest.approx(far, abs=0.006) and far > 4.0
-    assert compute_view(left, right, None, "fast").depth_caption == DEPTH_CAPTION  # no depth
+    assert compute_view(left, right, None, "fast").depth_caption == NO_DEPTH_CAPTION  # no depth
 
     app = _scene_app("test-depth-caption", [bundled_data_dir()])
     app._load_scene(cones)
     _run(app, app.recompute)
     assert app.state.depth_caption == view.depth_caption
+
+
+def test_the_depth_picture_of_a_pair_without_calibration_says_why_it_is_black():
+    """Without a calibration (a Middlebury scene, an image folder) the depth picture was black
+    under the caption "depth (near = warm)", which promises colours: it now says there is no
+    depth without a calibration, in both units."""
+    from stereovision.gui.app import compute_view
+
+    left, right = (cv2.imread(str(CONES / f"{s}.png")) for s in ("left", "right"))
+    view = compute_view(left, right, None, "fast")
+    assert view.result.depth is None
+    for unit in ("m", "ft"):
+        assert view.texts(unit)[0] == "depth: none without a calibration", view.texts(unit)
 
 
 def test_the_disparity_picture_says_the_pixels_of_its_colours():

@@ -187,6 +187,8 @@ def _planned_stages(method: str, calibrated: bool) -> list[str]:
 
 #: The depth picture's caption when it has no depth to scale (no calibration, no match).
 DEPTH_CAPTION = "depth (near = warm)"
+#: ... and over the black picture of a pair without a calibration (it promised colours)
+NO_DEPTH_CAPTION = "depth: none without a calibration"
 
 #: What "Save" writes (``stereovision depth``'s own files, by its writers): always, and with depth.
 SAVED_FILES = ("disparity.png", "disparity.pfm", "overview.png")
@@ -929,7 +931,7 @@ def compute_view(
     else:
         disparity_url = _data_url(colorize(result.disparity, lo=0.0, hi=disp_hi))
     depth_img = np.zeros_like(shown_left)
-    depth_caption = DEPTH_CAPTION
+    depth_caption = DEPTH_CAPTION if result.depth is not None else NO_DEPTH_CAPTION
     depth_ends = None
     if result.depth is not None:
         with np.errstate(divide="ignore", invalid="ignore"):
