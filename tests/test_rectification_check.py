@@ -245,7 +245,7 @@ def test_cli_check_fix(data_dir: Path, tmp_path: Path) -> None:
     )
     assert run.returncode == 0, run.stderr
     lines = run.stdout.splitlines()
-    assert lines[0].startswith("rectification NOT rectified")
+    assert lines[0].startswith("pair NOT rectified")
     assert lines[1].startswith("corrected (the right camera turned 0.29")
     assert "rectification ok" in lines[1] and lines[2].endswith(str(fixed))
     run = subprocess.run(
@@ -278,7 +278,7 @@ def test_cli_check_fix(data_dir: Path, tmp_path: Path) -> None:
     cv2.imwrite(str(tmp_path / "low.png"), right)
     run = subprocess.run([*SV, "check", pair[0], str(tmp_path / "low.png")], capture_output=True,
                          text=True, timeout=120)  # fmt: skip
-    assert run.returncode == 1 and run.stdout.startswith("rectification NOT rectified:")
+    assert run.returncode == 1 and run.stdout.startswith("pair NOT rectified:")
     assert "give the rig's calibration (--calib), or rectify them" in run.stdout
     assert "recalibrate" not in run.stdout
 
@@ -321,7 +321,7 @@ def test_cli_check_fix_says_once_what_it_cannot_correct(data_dir: Path, tmp_path
     cases = (
         (pair[::-1], (0.3, 0.0, 0.0), 700.0, "rectification: the left and right images look "
          "swapped", "the left and right images look swapped: give them the other way round"),
-        (pair, (4.0, 0.0, 0.0), 300.0, "rectification NOT rectified: median |dy| 23.",
+        (pair, (4.0, 0.0, 0.0), 300.0, "pair NOT rectified: median |dy| 23.",
          "the rows need the right camera turned by 4.0 degrees, more than a drift (at most 3): "
          "calibrate the rig again"),
     )  # fmt: skip
@@ -400,7 +400,7 @@ def test_an_unrectified_pair_is_not_called_swapped(data_dir: Path) -> None:
     res = check_rectification(left, right)
     assert res.ok is False and not res.swapped
     assert res.median_dy == pytest.approx(36.0, abs=1.0)
-    assert res.summary().startswith("rectification NOT rectified: median |dy| 36.0 px")
+    assert res.summary().startswith("pair NOT rectified: median |dy| 36.0 px")
     # a rectified pair given the other way round still is
     cones_l, cones_r = _pair(data_dir, "middlebury2003/cones")
     assert check_rectification(cones_r, cones_l).swapped

@@ -133,14 +133,15 @@ class RectificationCheck:
                 f"rectification: the left and right images look swapped (most of "
                 f"{self.matches} feature matches have a negative disparity)"
             )
-        verdict = "ok" if self.ok else "NOT rectified"
+        # "rectification NOT rectified" said it twice: the pair is what is not rectified
+        verdict = "rectification ok" if self.ok else "pair NOT rectified"
         if not np.isfinite(self.offset):
             return (
-                f"rectification {verdict}: median |dy| {self.median_dy:.1f} px over "
+                f"{verdict}: median |dy| {self.median_dy:.1f} px over "
                 f"{self.matches} matches, which fit no common row offset"
             )
         return (
-            f"rectification {verdict}: median |dy| {self.median_dy:.2f} px (95 % "
+            f"{verdict}: median |dy| {self.median_dy:.2f} px (95 % "
             f"{self.p95_dy:.2f}, tolerance {self.tolerance:g}) over {self.matches} matches; "
             f"offset {self.offset:+.2f} px, roll {self.slope_x:+.2f} px per 1000 px"
         )
