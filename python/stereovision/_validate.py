@@ -162,16 +162,36 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
 #: read the float grey image, all of its bits.
 LOW_UINT16_MAX = 4096
 
-#: The low-uint16 warning's advice, said to a caller of the Python API (an array to scale) ...
-LOW_UINT16_ADVICE = (
-    "scale it to the full range first (img << 4 for 12-bit data, or img.astype(np.uint8) for "
-    "8-bit values)"
-)
-#: ... and on the command line, where the image is a file (cli.py's warning hook swaps them)
-LOW_UINT16_ADVICE_CLI = (
-    "save it scaled to the full 16-bit range first (12-bit data shifted left by 4 bits), or as "
-    "an 8-bit image for 8-bit values"
-)
+#: Library warnings' advice in the words of where they are shown: the Python API's, as raised
+#: (an array to scale, ``calib=``), the command line's (files and options; cli.py's warning
+#: hook) and the GUI page's (its fields and buttons). :func:`advice_for` swaps them.
+ADVICE: dict[str, dict[str, str]] = {
+    "low_uint16": {
+        "api": "scale it to the full range first (img << 4 for 12-bit data, or "
+        "img.astype(np.uint8) for 8-bit values)",
+        "cli": "save it scaled to the full 16-bit range first (12-bit data shifted left by 4 "
+        "bits), or as an 8-bit image for 8-bit values",
+    },
+    "unrectified": {
+        "api": "(calib=Calibration.from_file(...); one marked rectified is used as it is), or "
+        "rectify the pair from its features (stereovision.uncalibrated.rectify_uncalibrated)",
+        "cli": "(--calib; one marked rectified is used as it is), or rectify the pair from its "
+        "features (stereovision rectify LEFT RIGHT -o DIR)",
+        "page": "(the scene's calib.txt or --calib; one marked rectified is used as it is), or "
+        "rectify the pair from its features (the Rectify button)",
+    },
+}
+ADVICE["low_uint16"]["page"] = ADVICE["low_uint16"]["cli"]  # on the page too, a file
+LOW_UINT16_ADVICE = ADVICE["low_uint16"]["api"]
+
+
+def advice_for(text: str, where: str) -> str:
+    """``text``, a library warning, with its Python advice in the words of ``where``
+    (``"cli"`` or ``"page"``): ``img << 4`` or ``calib=`` is no help to a user who gave files
+    and options, or who clicks."""
+    for said in ADVICE.values():
+        text = text.replace(said["api"], said[where])
+    return text
 
 
 def _warn_low_uint16(arr: np.ndarray, name: str) -> None:

@@ -27,7 +27,7 @@ import numpy as np
 
 from stereovision._interrupt import Terminated, raise_terminated
 from stereovision._jsonout import json_line
-from stereovision._validate import first_line, internal_error
+from stereovision._validate import advice_for, first_line, internal_error
 
 EXIT_ERROR = 2
 EXIT_CANNOT_TELL = 3  # `check`: too little texture to tell whether the rows agree
@@ -1969,17 +1969,7 @@ def _one_line_warning(
     message's first line with text; one with none (``warnings.warn(SomeWarning())``) is named
     by its category."""
     warning = message if isinstance(message, Warning) else category(message)
-    print(f"stereovision: warning: {_cli_warning_words(first_line(warning))}", file=sys.stderr)
-
-
-def _cli_warning_words(text: str) -> str:
-    """A library warning's advice in the CLI's words: the Python call's (``img << 4``,
-    ``calib=``) is no help to a user who gave files and options."""
-    from stereovision._validate import LOW_UINT16_ADVICE, LOW_UINT16_ADVICE_CLI
-    from stereovision.depth import UNRECTIFIED_ADVICE, UNRECTIFIED_ADVICE_CLI
-
-    text = text.replace(LOW_UINT16_ADVICE, LOW_UINT16_ADVICE_CLI)
-    return text.replace(UNRECTIFIED_ADVICE, UNRECTIFIED_ADVICE_CLI)
+    print(f"stereovision: warning: {advice_for(first_line(warning), 'cli')}", file=sys.stderr)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

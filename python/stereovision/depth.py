@@ -26,6 +26,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision._validate import (
+    ADVICE,
     as_bgr_uint8,
     as_gray_float,
     check_pair,
@@ -343,18 +344,6 @@ def _orb_top(gl: npt.NDArray[np.uint8], gr: npt.NDArray[np.uint8]) -> float | No
     return float(np.percentile(d[keep], _AUTO_PERCENTILE)) * s
 
 
-#: The unrectified pair's advice, said to a caller of the Python API ...
-UNRECTIFIED_ADVICE = (
-    "(calib=Calibration.from_file(...); one marked rectified is used as it is), or rectify the "
-    "pair from its features (stereovision.uncalibrated.rectify_uncalibrated)"
-)
-#: ... and on the command line (cli.py's warning hook swaps them)
-UNRECTIFIED_ADVICE_CLI = (
-    "(--calib; one marked rectified is used as it is), or rectify the pair from its features "
-    "(stereovision rectify LEFT RIGHT -o DIR)"
-)
-
-
 def _warn_if_unrectified(same_row: npt.NDArray[np.bool_], dy: npt.NDArray[np.float64]) -> None:
     """Warn when the pair looks unrectified: few of the feature matches lie within
     ``_AUTO_DY_TOL`` rows of each other (two raw camera images, matched along rows they do not
@@ -368,7 +357,7 @@ def _warn_if_unrectified(same_row: npt.NDArray[np.bool_], dy: npt.NDArray[np.flo
             f"lie within {_AUTO_DY_TOL:g} rows of each other ({same_row.size} matches, median "
             f"{float(np.median(dy)):.0f} px apart; a rectified pair keeps most on one row); "
             # also said with a calibration given: one marked rectified is not applied
-            f"give the calibration of the rig that took them {UNRECTIFIED_ADVICE}",
+            f"give the calibration of the rig that took them {ADVICE['unrectified']['api']}",
             UserWarning,
             stacklevel=user_stacklevel(),
         )

@@ -41,7 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import release_memory
-from stereovision._validate import first_line
+from stereovision._validate import advice_for, first_line
 from stereovision.calibration import fit_to_frames
 from stereovision.capture import DEFAULT_READ_TIMEOUT
 from stereovision.gui.sources import (
@@ -789,23 +789,6 @@ def _result_from_disparity(
     )
 
 
-#: The unrectified pair's advice on the page: the library's names Python calls
-#: (``calib=Calibration.from_file``, ``rectify_uncalibrated``) a user of the page cannot make.
-UNRECTIFIED_ADVICE_PAGE = (
-    "(the scene's calib.txt or --calib; one marked rectified is used as it is), or rectify the "
-    "pair from its features (the Rectify button)"
-)
-
-
-def _page_advice(text: str) -> str:
-    """A library warning's advice in the page's words (the CLI's for a 16-bit image: a file)."""
-    from stereovision._validate import LOW_UINT16_ADVICE, LOW_UINT16_ADVICE_CLI
-    from stereovision.depth import UNRECTIFIED_ADVICE
-
-    text = text.replace(LOW_UINT16_ADVICE, LOW_UINT16_ADVICE_CLI)
-    return text.replace(UNRECTIFIED_ADVICE, UNRECTIFIED_ADVICE_PAGE)
-
-
 def compute_view(
     left: npt.NDArray[np.uint8],
     right: npt.NDArray[np.uint8],
@@ -984,7 +967,7 @@ def compute_view(
     if result.depth is not None and len(result.points):
         median_depth = float(np.median(result.points[:, 2]))
     said = notes + [
-        _page_advice(str(c.message)) for c in caught if issubclass(c.category, UserWarning)
+        advice_for(str(c.message), "page") for c in caught if issubclass(c.category, UserWarning)
     ]
     tail = "".join(f" · warning: {msg}" for msg in dict.fromkeys(said))  # once each, in order
     median = "" if median_depth is None else f" · median depth {_length(median_depth, 'm')}"
