@@ -2843,6 +2843,18 @@ def test_gui_read_timeout_reaches_every_camera_read(data_dir, monkeypatch):
         build_app(parser.parse_args(["--from-bag", "x.bag", "--read-timeout", "5"]))
 
 
+def _collect_opens(app: Any) -> list[Any]:
+    """Run the page's spawned camera opens as tasks of the test's loop (returned, to await);
+    other spawned work (an opened pair's computation) is closed unrun."""
+    import asyncio
+
+    opens: list[Any] = []
+    app._spawn = lambda coro: (
+        opens.append(asyncio.ensure_future(coro)) if "_open" in coro.__qualname__ else coro.close()
+    )
+    return opens
+
+
 def test_a_wedged_camera_open_leaves_the_page_free(monkeypatch):
     """ "Open" ran the cameras' open in the page's handler: a wedged camera froze the page for
     the whole --read-timeout, and each retry left one more thread blocked in it. The handler
@@ -2875,11 +2887,8 @@ def test_a_wedged_camera_open_leaves_the_page_free(monkeypatch):
     monkeypatch.setattr(capture, "StereoCamera", Cameras)
     app = _scene_app("test-wedged-open", [bundled_data_dir()], read_timeout=0.2)
     app.state.cam_left, app.state.cam_right = "0", "1"
-    opens: list[Any] = []
     # the opens are run here; the computation of an opened pair is not
-    app._spawn = lambda coro: (
-        opens.append(asyncio.ensure_future(coro)) if "_open" in coro.__qualname__ else coro.close()
-    )
+    opens = _collect_opens(app)
 
     async def clicks() -> None:
         t0 = time.perf_counter()
@@ -2943,10 +2952,7 @@ def test_a_camera_still_opening_is_refused_by_its_dev_video_path_too(monkeypatch
     app = _scene_app("test-dev-video-pending", [bundled_data_dir()], read_timeout=0.2)
     # as if /dev were an allowed folder holding the device (no camera on the test machine)
     monkeypatch.setattr(app.folders, "resolve", lambda p: Path(p))
-    opens: list[Any] = []
-    app._spawn = lambda coro: (
-        opens.append(asyncio.ensure_future(coro)) if "_open" in coro.__qualname__ else coro.close()
-    )
+    opens = _collect_opens(app)
 
     async def clicks() -> None:
         app.state.cam_left, app.state.cam_right = "0", "1"
@@ -3000,10 +3006,7 @@ def test_a_late_camera_open_does_not_replace_a_newer_choice_nor_hide_its_error(m
 
     monkeypatch.setattr(capture, "StereoCamera", Cameras)
     app = _scene_app("test-late-open", [bundled_data_dir()], read_timeout=2.0)
-    opens: list[Any] = []
-    app._spawn = lambda coro: (
-        opens.append(asyncio.ensure_future(coro)) if "_open" in coro.__qualname__ else coro.close()
-    )
+    opens = _collect_opens(app)
 
     async def clicks() -> None:
         app.state.cam_left, app.state.cam_right = "0", "1"
@@ -3055,10 +3058,7 @@ def test_a_scene_chosen_while_cameras_open_stays_on_show(monkeypatch):
     monkeypatch.setattr(capture, "StereoCamera", Cameras)
     app = _scene_app("test-scene-while-open", [bundled_data_dir()], read_timeout=2.0)
     app.state.cam_left, app.state.cam_right = "0", "1"
-    opens: list[Any] = []
-    app._spawn = lambda coro: (
-        opens.append(asyncio.ensure_future(coro)) if "_open" in coro.__qualname__ else coro.close()
-    )
+    opens = _collect_opens(app)
     cones = str((bundled_data_dir() / "cones").resolve())
 
     async def clicks() -> None:
