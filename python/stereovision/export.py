@@ -725,7 +725,7 @@ def voxel_downsample(
         out: npt.NDArray[np.float64] = np.column_stack(sums) / counts[:, None]
         return out
 
-    if _VOXEL_WARN_MIN_POINTS <= len(pts) > len(counts):
+    if len(pts) >= _VOXEL_WARN_MIN_POINTS and len(counts) < len(pts):  # a cloud, merged
         _warn_if_voxel_too_large(pts, voxel, len(counts))
     out_c = None if cols is None else np.rint(mean(cols.astype(np.float64))).astype(np.uint8)
     return mean(pts).astype(np.float32), out_c
