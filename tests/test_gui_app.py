@@ -13,6 +13,7 @@ import re
 import socket
 import subprocess
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -752,7 +753,7 @@ def test_app_controllers_report_errors_and_compute(tmp_path, monkeypatch):
     app.state.cloud_path = "cones/left.png"
     app.open_cloud()
     assert app.state.error.startswith("not a point cloud file")
-    app.capture()
+    _capture(app)
     assert app.state.error.startswith("no camera open")
     # an emptied field sends None (a TypeError the page never showed)
     app.state.left_file, app.state.cloud_path = None, None
@@ -951,20 +952,31 @@ def test_a_later_success_clears_an_error_and_a_scene_can_be_chosen_again(data_di
     assert not np.array_equal(app.pair[0], app.pair[1])
 
 
-def _open_cameras(app) -> None:
-    """The page's "Open", and the open it spawns run to its end (no server loop here); the
-    computation that follows is spawned as the test's ``_spawn`` has it."""
+def _run_clicked(app, click: Callable[[], None]) -> None:
+    """The page's ``click`` ("Open", "Capture"), and the open or read it spawns run to its end
+    (no server loop here); the computation that follows is spawned as the test's ``_spawn``
+    has it."""
     import asyncio
 
     spawned: list[Any] = []
     keep = app._spawn
     app._spawn = spawned.append
     try:
-        app.open_cameras()
+        click()
     finally:
         app._spawn = keep
     for coro in spawned:
         asyncio.run(coro)
+
+
+def _open_cameras(app) -> None:
+    """The page's "Open", run to its end (:func:`_run_clicked`)."""
+    _run_clicked(app, app.open_cameras)
+
+
+def _capture(app) -> None:
+    """The page's "Capture", run to its end (:func:`_run_clicked`)."""
+    _run_clicked(app, app.capture)
 
 
 def _queue_spawns(app, tasks: list) -> None:
@@ -2491,10 +2503,10 @@ def test_an_image_folder_plays_its_pairs_one_per_capture(tmp_path):
     assert app.state.source_label == "folder data/seq: pair 0001 (1 of 2)"
     np.testing.assert_array_equal(app.pair[0], left)
     assert app.calib is None
-    app.capture()
+    _capture(app)
     assert app.state.source_label == "folder data/seq: pair 0002 (2 of 2)"
     assert app.pair[0].shape == (188, 225, 3)
-    app.capture()  # after the last, the first again
+    _capture(app)  # after the last, the first again
     assert app.state.source_label == "folder data/seq: pair 0001 (1 of 2)"
     app.state.pair_folder = str(rig)
     app.open_pair_folder()
@@ -2537,7 +2549,7 @@ def test_a_capture_of_a_folder_pair_of_two_sizes_is_said_and_keeps_the_pair(tmp_
     app.open_pair_folder()
     assert app.state.error == "" and len(spawned) == 1
     shown = app.pair
-    app.capture()
+    _capture(app)
     assert app.state.error.startswith("folder data/seq: pair 0002 (2 of 2): left 450")
     assert app.state.status == "error" and app.state.captures == 1 and len(spawned) == 1
     assert app.pair is shown and app.state.source_label == "folder data/seq: pair 0001 (1 of 2)"
@@ -2718,7 +2730,7 @@ def test_cameras_that_cannot_be_paired_leave_the_open_ones_in_use(tmp_path):
     assert app.state.error.startswith("right source") and "400x300" in app.state.error
     assert app.state.error.endswith("(the cameras in use are unchanged)")
     app.state.error = ""
-    app.capture()  # from the cameras still open
+    _capture(app)  # from the cameras still open
     assert app.state.error == "" and app.state.captures == 1
     assert app.state.source_label == "cameras l.avi / r.avi"
     assert app.pair[0].shape == app.pair[1].shape and app.pair[0].shape[1] == 450
@@ -3069,6 +3081,170 @@ def test_a_scene_chosen_while_cameras_open_stays_on_show(monkeypatch):
         await opens[0]
         assert made[0].closed and app.source is None
         assert app.state.source_label.startswith("scene ") and app._scene == cones
+
+    asyncio.run(clicks())
+
+
+def _collect_reads(app: Any) -> list[Any]:
+    """Run the page's spawned camera opens and Capture reads as tasks of the test's loop
+    (returned, to await); other spawned work (a pair's computation) is closed unrun."""
+    import asyncio
+
+    tasks: list[Any] = []
+
+    def spawn(coro: Any) -> None:
+        if coro.__qualname__.endswith(("._open", "._capture")):
+            tasks.append(asyncio.ensure_future(coro))
+        else:
+            coro.close()
+
+    app._spawn = spawn
+    return tasks
+
+
+async def _until(done: Callable[[], bool]) -> None:
+    """Let the loop run until ``done()`` (at most a second)."""
+    import asyncio
+
+    for _ in range(100):
+        if done():
+            return
+        await asyncio.sleep(0.01)
+    raise AssertionError("not done within a second")
+
+
+def test_a_wedged_camera_read_leaves_the_page_free(monkeypatch):
+    """After an Open, the cameras' first read, and every Capture's, ran in the page's handler:
+    a wedged camera froze the page up to --read-timeout. They run in a thread now, the page
+    saying "reading ..."; the pair or the read's error comes after; a second Capture while one
+    reads is refused, in words; a read that returns after a newer choice (a scene) leaves it
+    on show."""
+    import asyncio
+    import threading
+    import time
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    gate = threading.Event()
+    reads: list[Any] = []
+    fail: list[str] = []
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            pass
+
+        def read(self):
+            reads.append(self)
+            gate.wait(1.0)  # a wedged read (bounded: a broken app cannot hang the test)
+            if fail:
+                raise OSError(fail[0])
+            return frame, frame
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    app = _scene_app("test-wedged-read", [bundled_data_dir()], read_timeout=0.5)
+    app.state.cam_left, app.state.cam_right = "0", "1"
+    tasks = _collect_reads(app)
+    cones = str((bundled_data_dir() / "cones").resolve())
+    reading = "reading camera 0 and camera 1..."
+
+    async def clicks() -> None:
+        app.open_cameras()
+        await _until(lambda: len(reads) == 1)  # opened; its first read is inside the camera
+        assert app.state.status == reading and app.state.error == "" and app.source is None
+        gate.set()
+        await tasks[0]
+        assert app.source is not None and app.state.source_label == "cameras 0 / 1"
+        assert app.state.captures == 1 and app.state.error == ""
+        shown = app.pair
+
+        gate.clear()
+        fail.append("camera 0 delivered no frame in 0.5 s")
+        t0 = time.perf_counter()
+        app.capture()
+        assert time.perf_counter() - t0 < 0.1  # the handler returned at once
+        assert app.state.status == reading and len(tasks) == 2
+        app.capture()  # clicked again while it reads
+        assert app.state.error == (
+            "still reading camera 0 and camera 1 (an earlier Capture has not returned): wait "
+            "for it, or unplug and replug it"
+        )
+        assert len(tasks) == 2 and len(reads) == 1
+        await _until(lambda: len(reads) == 2)
+        gate.set()
+        await tasks[1]
+        assert app.state.error == "camera 0 delivered no frame in 0.5 s"
+        assert app.state.status == "error" and app.pair is shown and app.state.captures == 1
+
+        gate.clear()
+        fail.clear()
+        app.capture()
+        await _until(lambda: len(reads) == 3)
+        app._on_scene(scene=cones)  # chosen while the cameras are read
+        gate.set()
+        await tasks[2]
+        assert app.state.source_label.startswith("scene ") and app._scene == cones
+        assert app.state.captures == 1 and app.state.error == ""
+
+    asyncio.run(clicks())
+
+
+def test_cameras_replaced_while_a_capture_reads_them_are_closed_once_the_read_returns(
+    monkeypatch,
+):
+    """Other cameras opened while a Capture still reads the cameras in use: those are closed
+    only once their read returns (not under a grab in another thread), and the late pair does
+    not replace the new cameras' pair."""
+    import asyncio
+    import threading
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    gate, inside = threading.Event(), threading.Event()
+    made: dict[Any, Any] = {}
+    closed_under_read: list[bool] = []
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            self.left, self.closed, self.hold = left, False, False
+            made[left] = self
+
+        def read(self):
+            if self.hold:
+                inside.set()
+                gate.wait(1.0)
+                closed_under_read.append(self.closed)
+            return frame, frame
+
+        def close(self):
+            self.closed = True
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    app = _scene_app("test-replaced-while-read", [bundled_data_dir()], read_timeout=2.0)
+    tasks = _collect_reads(app)
+
+    async def clicks() -> None:
+        app.state.cam_left, app.state.cam_right = "0", "1"
+        app.open_cameras()
+        await tasks[0]
+        made[0].hold = True
+        app.capture()
+        await _until(inside.is_set)
+        app.state.cam_left, app.state.cam_right = "2", "3"
+        app.open_cameras()
+        await tasks[2]
+        assert app.source._camera is made[2] and not made[0].closed  # still read
+        gate.set()
+        await tasks[1]
+        assert closed_under_read == [False] and made[0].closed
+        assert app.source._camera is made[2] and app.state.source_label == "cameras 2 / 3"
+        assert app.state.captures == 2 and app.state.error == ""
 
     asyncio.run(clicks())
 
@@ -3553,7 +3729,7 @@ def test_cameras_after_a_scene_count_captures_close_the_old_and_use_their_own_ra
     assert app.max_disparity is None and app.state.captures == 1 and closed == []
     app._switch_source(Cameras("b"), ("2", "3"))
     assert closed == ["a"] and app.state.captures == 2
-    app.capture()
+    _capture(app)
     assert app.state.captures == 3
     for other in ("scene", "files"):
         app.homographies = Rectified()
@@ -3562,7 +3738,7 @@ def test_cameras_after_a_scene_count_captures_close_the_old_and_use_their_own_ra
         else:
             app.state.left_file, app.state.right_file = "cones/left.png", "cones/right.png"
             app.load_files()
-        app.capture()
+        _capture(app)
         assert app.state.error == "", other
         assert app.state.source_label == "cameras 2 / 3", other
         assert app.max_disparity is None, other
@@ -3954,7 +4130,7 @@ def test_the_average_switch_is_offered_only_for_sources_it_averages(tmp_path):
     app._switch_source(Cameras(), ("0", "1"))
     assert app.state.error == "" and app.state.can_average
     app.state.average = True
-    app.capture()
+    _capture(app)
     assert app.state.source_label.endswith("(8.0 frames averaged)")
 
 

@@ -1164,6 +1164,59 @@ def _source_name(src: int | str) -> str:
     return f"camera {src}" if isinstance(src, int) else Path(src).name or src
 
 
+@dataclass
+class _Frames:
+    """A pair read from a source (:func:`_read_pair`), not yet on show."""
+
+    left: npt.NDArray[np.uint8]
+    right: npt.NDArray[np.uint8]
+    #: A folder pair's scene calib.txt, read (None: the page's ``--calib`` applies).
+    calib: Any = None
+    #: The folder pair's label (``folder data/seq: pair 0002 (2 of 20)``; "" for cameras).
+    folder: str = ""
+    #: `` (8.0 frames averaged)`` when averaged, else "".
+    averaged: str = ""
+
+
+def _read_pair(source: StereoSource, average: bool) -> _Frames:
+    """The next pair of ``source``, averaged over :data:`AVERAGE_FRAMES` reads when ``average``
+    (not an image folder's: one pair after another). It touches nothing but ``source``: the
+    page reads in a thread of its own (a wedged camera froze the page).
+
+    Raises
+    ------
+    ValueError
+        The two frames differ in size.
+    OSError, RuntimeError
+        As the source's read raises them (a read given up after ``read_timeout``).
+    """
+    left, right = source.read()
+    folder = source if isinstance(source, FolderPairs) else None
+    if left.shape != right.shape:
+        from stereovision.io import image_size_text
+
+        what = folder.describe() if folder else "the cameras give different sizes"
+        raise ValueError(f"{what}: left {image_size_text(left)}, right {image_size_text(right)}")
+    got = _Frames(left, right)
+    if folder:  # one pair after another, not frames of one view: nothing to average
+        got.folder = folder.describe()
+        job = folder.current
+        if job.calib is not None:  # a scene's calib.txt
+            from stereovision.calibration import Calibration
+
+            got.calib = Calibration.from_file(job.calib)
+    elif average:
+        from stereovision.temporal import TemporalFilter
+
+        tf = TemporalFilter(max_frames=AVERAGE_FRAMES)
+        got.left, got.right = tf(left, right)
+        for _ in range(AVERAGE_FRAMES - 1):
+            got.left, got.right = tf(*source.read())
+        moved = f", {tf.restarts} restarts: the view moved" if tf.restarts else ""
+        got.averaged = f" ({tf.mean_frames():.1f} frames averaged{moved})"
+    return got
+
+
 def _button_and_answer(
     v3: Any, html: Any, text: str, button_id: str, click: Any, answer: str, answer_id: str
 ) -> None:
@@ -1340,6 +1393,11 @@ class StereoApp:
         #: Counts the page's choices of what to show (Open, an image folder, a scene, files): an
         #: open that returns after a newer choice closes its cameras instead of replacing it.
         self._choice = 0
+        #: Sources a read of the page's runs in now (:meth:`_read_in_thread`): a second Capture
+        #: of one is refused; one replaced meanwhile is closed when its read returns (closing a
+        #: camera under a grab in another thread is not safe).
+        self._reading: list[StereoSource] = []
+        self._close_after_read: list[StereoSource] = []
         self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1)
         self._generation = 0
         self._lock: asyncio.Lock | None = None
@@ -1549,36 +1607,23 @@ class StereoApp:
         self.state.rows_label = ""
 
     def _grab(self) -> None:
+        """Read a pair from the open source here and show it (start-up; the page's reads run
+        in a thread: :meth:`_read_in_thread`)."""
         if self.source is None:
             raise OSError("no camera open: give --left/--right or open cameras below")
-        left, right = self.source.read()
-        folder = self.source if isinstance(self.source, FolderPairs) else None
-        if left.shape != right.shape:
-            from stereovision.io import image_size_text
+        self._use_pair(_read_pair(self.source, bool(self.state.average)))
 
-            what = folder.describe() if folder else "the cameras give different sizes"
-            raise ValueError(
-                f"{what}: left {image_size_text(left)}, right {image_size_text(right)}"
-            )
-        averaged = ""
-        calib = None
-        own = False  # the pair comes with its own calibration (a scene's calib.txt)
-        if folder:  # one pair after another, not frames of one view: nothing to average
-            job = folder.current
-            if job.calib is not None:  # a scene's calib.txt
-                from stereovision.calibration import Calibration
+    def _use_pair(self, got: _Frames) -> None:
+        """Make ``got``, a pair read from :attr:`source`, the pair on show (on the page's loop).
 
-                calib, own = Calibration.from_file(job.calib), True
-        elif self.state.average:
-            from stereovision.temporal import TemporalFilter
-
-            tf = TemporalFilter(max_frames=AVERAGE_FRAMES)
-            left, right = tf(left, right)
-            for _ in range(AVERAGE_FRAMES - 1):
-                left, right = tf(*self.source.read())
-            moved = f", {tf.restarts} restarts: the view moved" if tf.restarts else ""
-            averaged = f" ({tf.mean_frames():.1f} frames averaged{moved})"
-        if not own:  # --calib (one without an image size: sized by this pair, or refusing it)
+        Raises
+        ------
+        ValueError
+            A ``--calib`` sized by another pair (:meth:`_calib_for`).
+        """
+        left, right = got.left, got.right
+        calib = got.calib
+        if calib is None:  # --calib (one without an image size: sized by this pair, or refusing it)
             calib = self._calib_for(left)
         self.pair = self.raw_pair = (left, right)
         self._other_source()
@@ -1587,7 +1632,7 @@ class StereoApp:
         self.max_disparity = None
         names = (Path(str(n)).name or str(n) for n in self._source_names)
         label = self._source_label or "cameras " + " / ".join(names)
-        self.state.source_label = (folder.describe() if folder else label) + averaged
+        self.state.source_label = (got.folder or label) + got.averaged
         self.state.rows_label = ""
         rect = self.homographies
         if rect is not None and rect.input_size == (left.shape[1], left.shape[0]):
@@ -1670,14 +1715,127 @@ class StereoApp:
         self._spawn(self.recompute())
 
     def capture(self) -> None:
-        """Grab a new pair from the cameras and recompute."""
+        """Read a new pair from the open source (cameras, an image folder) and recompute.
+
+        The read runs in a thread of its own (:meth:`_capture`), the page saying "reading ..."
+        meanwhile: run in the handler, a wedged camera froze the page up to ``read_timeout``.
+        A second Capture while one reads is refused, said on the page.
+        """
+        source = self.source
         try:
-            self._grab()
-            self.state.captures += 1
+            if source is None:
+                raise OSError("no camera open: give --left/--right or open cameras below")
+            what = self._source_what(source)
+            if any(r is source for r in self._reading):
+                replug = "" if isinstance(source, FolderPairs) else ", or unplug and replug it"
+                raise OSError(
+                    f"still reading {what} (an earlier Capture has not returned): wait for "
+                    f"it{replug}"
+                )
+        except (ValueError, OSError, RuntimeError) as exc:
+            self._fail(exc)
+            return
+        average = bool(self.state.average)
+        self._begin_read(source, what)
+        self._spawn(self._capture(source, what, average, self._choice))
+
+    async def _capture(self, source: StereoSource, what: str, average: bool, choice: int) -> None:
+        """Read ``source`` (:meth:`_read_in_thread`) and show its pair, or say why not; a pair
+        (or an error) that comes after a newer choice (``_choice``: a scene, files, other
+        cameras) is dropped: that choice stays on show."""
+        try:
+            got = await self._read_in_thread(source, average)
+        except Exception as exc:  # any read error is said on the page (cv2.error too)
+            if choice != self._choice or source is not self.source:
+                return
+            if not isinstance(exc, (ValueError, OSError, RuntimeError)):
+                log.exception("gui: reading %s failed", what)
+            self._fail(exc)
+            return
+        if choice != self._choice or source is not self.source:
+            return
+        try:
+            with self.state:
+                self._use_pair(got)
+                self.state.captures += 1
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
             return
         self._spawn(self.recompute())
+
+    def _source_what(self, source: StereoSource) -> str:
+        """``source`` as the page's "reading ..." names it: ``camera 0 and camera 1``, the
+        files' names, ``folder data/seq``, or the start-up source's label (a bag)."""
+        if isinstance(source, FolderPairs):
+            return f"folder {source.name}"
+        if self._source_label:
+            return self._source_label
+        typed: list[int | str] = []
+        for name in self._source_names:
+            try:
+                typed.append(parse_source(name))
+            except ValueError:
+                typed.append(str(name))
+        return " and ".join(dict.fromkeys(_source_name(t) for t in typed))
+
+    def _begin_read(self, source: StereoSource, what: str) -> None:
+        """A read of ``source`` is under way from now (before its task runs: a click that
+        comes meanwhile sees it); the page says so."""
+        self._reading.append(source)
+        with self.state:
+            self.state.error = ""
+            self.state.status = f"reading {what}..."
+
+    async def _read_in_thread(self, source: StereoSource, average: bool) -> _Frames:
+        """:func:`_read_pair` of ``source`` in a daemon thread, waited for here (the page's loop
+        stays free). The read is bounded inside the source (``read_timeout``).
+
+        The thread touches only ``source``; its outcome comes back through the loop
+        (``call_soon_threadsafe``), as the Open's does. ``source`` must be registered by
+        :meth:`_begin_read`; it is no longer read once this returns or raises. A source
+        replaced meanwhile (:meth:`_close_source`) is closed when its read returns.
+        """
+        loop = asyncio.get_running_loop()
+        done: asyncio.Future[_Frames] = loop.create_future()
+
+        def settle(got: _Frames | None, exc: BaseException | None) -> None:
+            # on the page's loop
+            self._reading = [r for r in self._reading if r is not source]
+            if any(c is source for c in self._close_after_read):
+                self._close_after_read = [c for c in self._close_after_read if c is not source]
+                source.close()
+            if done.done():  # the waiting task was cancelled (the server stops)
+                return
+            if exc is not None:
+                done.set_exception(exc)
+            else:
+                done.set_result(got)  # type: ignore[arg-type]
+
+        def run() -> None:
+            got: _Frames | None = None
+            error: BaseException | None = None
+            try:
+                got = _read_pair(source, average)
+            except BaseException as exc:  # said on the page by the caller
+                error = exc
+            try:
+                loop.call_soon_threadsafe(settle, got, error)
+            except RuntimeError:  # the page's loop is closed (the server stopped)
+                pass
+
+        try:
+            threading.Thread(target=run, name="stereovision-gui-read", daemon=True).start()
+        except BaseException:  # no thread: nothing reads the source
+            self._reading = [r for r in self._reading if r is not source]
+            raise
+        return await done
+
+    def _close_source(self, source: StereoSource) -> None:
+        """Close ``source`` now, or when the read under way in it returns."""
+        if any(r is source for r in self._reading):
+            self._close_after_read.append(source)
+        else:
+            source.close()
 
     def open_cameras(self) -> None:
         """Open the camera sources typed on the page (device index or allowed file).
@@ -1723,10 +1881,12 @@ class StereoApp:
         choice: int,
     ) -> None:
         """Open ``left`` and ``right`` in a daemon thread, wait for it up to ``read_timeout``
-        s, then use the pair (:meth:`_switch_source`) or say why not.
+        s, then read their first pair in another (:meth:`_read_in_thread`, the page saying
+        "reading ..."), then use it (:meth:`_switch_source`) or say why not.
 
         A given-up open goes on in its thread: its sources stay in ``_opening`` (refused by
         :meth:`open_cameras`) until it returns; the cameras it opened late are closed then.
+        Cameras that opened stay in ``_opening`` until their first read returns.
         ``choice`` is the page's source choice this Open made (``_choice``): cameras that come
         after a newer choice are closed, and its error is not said over that choice's page.
         """
@@ -1735,12 +1895,14 @@ class StereoApp:
         keys = (_pending_key(left), _pending_key(right))
 
         def settle(source: StereoSource | None, exc: BaseException | None) -> None:
-            # on the page's loop: the sources may be opened again from now
-            self._opening.difference_update(keys)
+            # on the page's loop: the sources may be opened again from now, unless they
+            # opened (then once their first pair is read, below)
             if opened.done():  # given up: nobody takes these cameras
+                self._opening.difference_update(keys)
                 if source is not None:
                     source.close()
             elif exc is not None:
+                self._opening.difference_update(keys)
                 opened.set_exception(exc)
             else:
                 opened.set_result(source)  # type: ignore[arg-type]
@@ -1784,11 +1946,32 @@ class StereoApp:
                 log.exception("gui: opening %s failed", what)
             self._fail(exc)
             return
-        if choice != self._choice:  # a newer Open or folder is on show: nobody takes these
-            source.close()
-            return
-        with self.state:
-            self._switch_source(source, names)
+        try:
+            if choice != self._choice:  # a newer Open or folder is on show: nobody takes these
+                source.close()
+                return
+            # the first pair read in a thread too: a camera that opens may still not deliver
+            average = bool(self.state.average)
+            self._begin_read(source, what)
+            try:
+                got = await self._read_in_thread(source, average)
+            except Exception as exc:
+                source.close()
+                if choice != self._choice:
+                    return
+                if not isinstance(exc, (ValueError, OSError, RuntimeError)):
+                    log.exception("gui: reading %s failed", what)
+                if self.source is not None:
+                    exc = OSError(f"{first_line(exc)} (the cameras in use are unchanged)")
+                self._fail(exc)
+                return
+            if choice != self._choice:
+                source.close()
+                return
+            with self.state:
+                self._switch_source(source, names, got)
+        finally:
+            self._opening.difference_update(keys)
 
     def open_pair_folder(self) -> None:
         """Play the pairs of the chosen image folder (as ``batch`` pairs them), one per
@@ -1805,15 +1988,20 @@ class StereoApp:
         self._choice += 1  # an open still under way must not replace these pairs
         self._switch_source(source, ("", ""))
 
-    def _switch_source(self, source: StereoSource, names: tuple[str, str]) -> None:
-        """Use ``source`` once it gave a pair (else the source in use stays, and says so)."""
+    def _switch_source(
+        self, source: StereoSource, names: tuple[str, str], got: _Frames | None = None
+    ) -> None:
+        """Use ``source`` once it gave a pair, ``got`` (None: read here; an image folder's
+        files): else the source in use stays, and says so."""
         before = (self.source, self.homographies, self._source_label, self._source_names)
         self.source = source
         self.homographies = None
         self._source_label = None  # the cameras typed on the page, named by their fields
         self._source_names = names
         try:
-            self._grab()  # sets the pair only once both frames came and fit together
+            if got is None:
+                got = _read_pair(source, bool(self.state.average))
+            self._use_pair(got)  # sets the pair only once both frames came and fit together
         except (ValueError, OSError, RuntimeError) as exc:
             source.close()
             self.source, self.homographies, self._source_label, self._source_names = before
@@ -1823,7 +2011,7 @@ class StereoApp:
             self._fail(exc)
             return
         if before[0] is not None:
-            before[0].close()
+            self._close_source(before[0])  # a Capture may still be reading it
         self.state.live = True
         self.state.can_average = not isinstance(source, FolderPairs)
         self.state.error = ""
