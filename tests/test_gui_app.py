@@ -3738,10 +3738,73 @@ def test_cameras_after_a_scene_count_captures_close_the_old_and_use_their_own_ra
         else:
             app.state.left_file, app.state.right_file = "cones/left.png", "cones/right.png"
             app.load_files()
+        _capture(app)  # says what is on show (test_a_capture_after_a_scene_says_so_first)
+        assert "on show, not camera 2 and camera 3" in app.state.error, other
         _capture(app)
         assert app.state.error == "", other
         assert app.state.source_label == "cameras 2 / 3", other
         assert app.max_disparity is None, other
+
+
+def test_a_capture_after_a_scene_says_so_first(tmp_path):
+    """Capture with a scene (or files) chosen after an image folder or cameras opened went back
+    to that source without a word: the scene left, the list emptied, the folder's next pair on
+    show. The first Capture now says why it does not capture the scene; another, with no choice
+    since, goes back to the source (the folder's next pair, the cameras' pair)."""
+    from stereovision.gui import bundled_data_dir
+
+    cones = bundled_data_dir() / "cones"
+    left, right = (cv2.imread(str(cones / f"{s}.png")) for s in ("left", "right"))
+    seq = tmp_path / "seq"
+    seq.mkdir()
+    for k in (1, 2):
+        cv2.imwrite(str(seq / f"left_{k:04d}.png"), left)
+        cv2.imwrite(str(seq / f"right_{k:04d}.png"), right)
+    app = _scene_app("test-capture-after-scene", [bundled_data_dir(), tmp_path])
+    app.state.pair_folder = str(seq)
+    app.open_pair_folder()
+    seq_name = app.folders.label(seq.resolve())
+    assert app.state.source_label == f"folder {seq_name}: pair 0001 (1 of 2)"
+    demo = str(cones.resolve())
+    app.state.scene = demo
+    app._on_scene(scene=demo)
+    _capture(app)
+    assert app.state.error == (
+        f"scene data/cones is on show, not folder {seq_name}: a scene or files cannot be "
+        "captured; Capture again to go on with its next pair"
+    )
+    assert app.state.source_label == "scene data/cones" and app.state.scene == demo
+    _capture(app)
+    assert (
+        app.state.error == "" and app.state.source_label == f"folder {seq_name}: pair 0002 (2 of 2)"
+    )
+    assert app.state.scene is None
+    _capture(app)  # the folder's pairs on show: no word
+    assert (
+        app.state.error == "" and app.state.source_label == f"folder {seq_name}: pair 0001 (1 of 2)"
+    )
+
+    class Cameras:
+        def read(self):
+            return left.copy(), right.copy()
+
+        def close(self):
+            pass
+
+    app._switch_source(Cameras(), ("0", "1"))
+    app.state.left_file, app.state.right_file = "cones/left.png", "cones/right.png"
+    app.load_files()
+    _capture(app)
+    assert app.state.error == (
+        "the loaded files are on show, not camera 0 and camera 1: a scene or files cannot be "
+        "captured; Capture again to read a pair from them"
+    )
+    assert app.state.source_label == "files"
+    app._on_scene(scene=demo)  # another choice: the next Capture says it again
+    _capture(app)
+    assert app.state.error.startswith("scene data/cones is on show, not camera 0 and camera 1")
+    _capture(app)
+    assert app.state.error == "" and app.state.source_label == "cameras 0 / 1"
 
 
 def test_the_computations_a_page_asks_and_what_they_are_given(monkeypatch):

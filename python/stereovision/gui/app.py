@@ -1398,6 +1398,11 @@ class StereoApp:
         #: camera under a grab in another thread is not safe).
         self._reading: list[StereoSource] = []
         self._close_after_read: list[StereoSource] = []
+        #: The pair on show came from :attr:`source` (False: a scene or files chosen since).
+        self._pair_from_source = False
+        #: ``_choice`` when a Capture was refused for a scene or files on show: another
+        #: Capture with no choice since goes back to the source.
+        self._capture_back: int | None = None
         self._executor = concurrent.futures.ThreadPoolExecutor(max_workers=1)
         self._generation = 0
         self._lock: asyncio.Lock | None = None
@@ -1605,6 +1610,7 @@ class StereoApp:
         self._no_calib = None if scene.calib is not None else f"scene {label} has no calib.txt"
         self.state.source_label = f"scene {label}"
         self.state.rows_label = ""
+        self._pair_from_source = False
 
     def _grab(self) -> None:
         """Read a pair from the open source here and show it (start-up; the page's reads run
@@ -1627,6 +1633,7 @@ class StereoApp:
             calib = self._calib_for(left)
         self.pair = self.raw_pair = (left, right)
         self._other_source()
+        self._pair_from_source = True
         self.calib = calib
         self._no_calib = None
         self.max_disparity = None
@@ -1720,12 +1727,29 @@ class StereoApp:
         The read runs in a thread of its own (:meth:`_capture`), the page saying "reading ..."
         meanwhile: run in the handler, a wedged camera froze the page up to ``read_timeout``.
         A second Capture while one reads is refused, said on the page.
+
+        A scene or files chosen after the source opened are on show: the first Capture says
+        so (it went back to the source without a word, the scene list emptied); another,
+        with no choice since, goes back to the source.
         """
         source = self.source
         try:
             if source is None:
                 raise OSError("no camera open: give --left/--right or open cameras below")
             what = self._source_what(source)
+            if not self._pair_from_source and self._capture_back != self._choice:
+                self._capture_back = self._choice
+                shown = self.state.source_label
+                shown = "the loaded files are" if shown == "files" else f"{shown} is"
+                back = (
+                    "go on with its next pair"
+                    if isinstance(source, FolderPairs)
+                    else "read a pair from them"
+                )
+                raise ValueError(
+                    f"{shown} on show, not {what}: a scene or files cannot be captured; "
+                    f"Capture again to {back}"
+                )
             if any(r is source for r in self._reading):
                 replug = "" if isinstance(source, FolderPairs) else ", or unplug and replug it"
                 raise OSError(
@@ -2049,6 +2073,7 @@ class StereoApp:
         self._no_calib = "the --calib calibration does not fit these images" if note else None
         self.max_disparity = None
         self.state.source_label = "files"
+        self._pair_from_source = False
         self.state.rows_label = "; ".join(
             n for n in (f"warning: {same}" if same else "", note) if n
         )
