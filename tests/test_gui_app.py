@@ -2012,6 +2012,60 @@ def test_the_save_field_shows_the_data_folder_short_and_saves_where_it_says(tmp_
     assert display_path(data, cwd=Path("/nowhere"), home=Path("/nohome")) == str(data)
 
 
+def test_a_save_as_offered_into_a_read_only_data_folder_goes_to_the_home_folder(
+    tmp_path, monkeypatch
+):
+    """The offered save folder is <first --data>/saved; with a read-only data set there (as
+    /work/shared/data), every Save as offered failed ("cannot write in ..."). It goes to
+    ~/stereovision-saved (then -2, ...) instead, the Save's line saying where and why; a folder
+    typed in the read-only --data is refused, naming it (no other folder written); with the
+    home folder read-only too, both are named."""
+    import stereovision.io as svio
+    from stereovision.gui import bundled_data_dir
+
+    data, home = tmp_path / "data", tmp_path / "home"
+    data.mkdir()
+    home.mkdir()
+    real = svio.cannot_write_in
+    read_only = [data.resolve()]
+
+    def cannot_write_in(folder):
+        return "Read-only file system" if Path(folder).resolve() in read_only else real(folder)
+
+    monkeypatch.setattr(svio, "cannot_write_in", cannot_write_in)
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.chdir("/")
+    app = _scene_app("test-save-read-only", [bundled_data_dir(), data])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    why = f"({data.resolve() / 'saved'} cannot be written (Read-only file system))"
+    for name in ("stereovision-saved", "stereovision-saved-2"):
+        _run(app, app.save)
+        assert app.state.error == "", name
+        assert app.state.save_label.startswith(f"saved 450×375 to ~/{name}: disparity.png, ")
+        assert app.state.save_label.endswith(why), name
+        assert (home / name / "cloud.ply").is_file(), name
+    assert list(data.iterdir()) == []
+
+    app.state.save_dir = "mine"  # typed: refused, naming it
+    _run(app, app.save)
+    assert app.state.error == (
+        f"save folder {data.resolve() / 'mine'}: cannot write in {data.resolve()} "
+        "(Read-only file system)"
+    )
+    saved = sorted(p.name for p in home.glob("stereovision-saved*"))  # (~/.cache aside)
+    assert saved == ["stereovision-saved", "stereovision-saved-2"]
+
+    read_only.append(home.resolve())
+    app.state.save_dir = app._offered_save_dir
+    _run(app, app.save)
+    assert app.state.error == (
+        f"save: {data.resolve() / 'saved'} cannot be written (Read-only file system), nor "
+        "~/stereovision-saved-3 (Read-only file system)"
+    )
+    assert list(data.iterdir()) == [] and len(list(home.glob("stereovision-saved*"))) == 2
+
+
 def test_saves_into_the_offered_folder_go_to_a_new_numbered_folder_each(tmp_path):
     """Each Save after the first was refused ("saved already holds ...") until a new folder was
     typed: saving several pairs meant typing a folder for each. Left as offered (or emptied),

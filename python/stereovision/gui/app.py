@@ -208,6 +208,9 @@ SAVE_WRITE_ORDER = (
 )
 #: The save folder offered at start-up, inside the first ``--data`` folder.
 SAVE_FOLDER = "saved"
+#: Where a Save as offered goes, in the user's home folder, when the first ``--data`` folder
+#: cannot be written (a read-only data set): ``~/stereovision-saved``, ``-2``, ...
+FALLBACK_SAVE_FOLDER = "stereovision-saved"
 #: Height of a button of a toggle row (Vuetify's compact button group).
 TOGGLE_HEIGHT_PX = 36
 #: What the page says under the Save folder field (with and without a --data folder).
@@ -410,6 +413,17 @@ def save_all_or_nothing(
             for name in names:
                 os.replace(inner / name, folder / name)
     return {n: folder / n for n in names}
+
+
+def _cannot_make(folder: Path) -> str | None:
+    """Why ``folder`` cannot be made or written in (the nearest existing folder at or above it
+    refuses a file: :func:`~stereovision.io.cannot_write_in`), or None if it can."""
+    from stereovision.io import cannot_write_in
+
+    above = folder
+    while not above.exists() and above.parent != above:
+        above = above.parent
+    return cannot_write_in(above) if above.is_dir() else None
 
 
 def _data_url(image: npt.NDArray[np.uint8], width: int = DISPLAY_WIDTH) -> str:
@@ -2458,9 +2472,12 @@ class StereoApp:
 
         The folder as offered (or an empty field) is a new one each time: the first of
         ``saved``, ``saved-2``, ``saved-3``, ... that does not exist or is empty, so several
-        pairs can be saved one after the other; the page says which. A folder the user typed
-        that already holds one of those files is refused, naming them: nothing the user wrote
-        is replaced (``depth`` replaces its own earlier outputs, the GUI cannot ask).
+        pairs can be saved one after the other; the page says which. When that folder cannot
+        be made or written (a read-only data set as ``--data``), the Save goes to the next new
+        ``~/stereovision-saved`` (``-2``, ...), its line saying where and why. A folder the user
+        typed that already holds one of those files is refused, naming them: nothing the user
+        wrote is replaced (``depth`` replaces its own earlier outputs, the GUI cannot ask); one
+        that cannot be written is refused, naming it (no other folder is written instead).
         """
         from stereovision.cli import DEPTH_OUTPUTS, CliError, write_depth_outputs, write_overview
         from stereovision.io import check_output_folder
@@ -2477,12 +2494,17 @@ class StereoApp:
         typed = str(self.state.save_dir or "").strip()
         skipped: list[str] = []
         folder: Path | None = None
+        elsewhere = ""  # why a Save as offered went to the home folder
         try:
             if self._save_roots and typed in ("", self._offered_save_dir):
                 folder = self._next_save_folder(skipped)
+                why = _cannot_make(folder)
+                if why:  # a read-only --data folder: the home folder's, said in the Save's line
+                    elsewhere = f"{display_path(folder)} cannot be written ({why})"
+                    folder = self._fallback_save_folder(folder, why)
             else:
                 folder = self._typed_save_folder(typed)
-            label = self.folders.label(folder)
+            label = self.folders.label(folder) if not elsewhere else display_path(folder)
             if folder in self._saving_into:  # its files are not there yet: not "taken" below
                 raise FileExistsError(
                     f"save: {label} is being written by the previous Save; nothing was "
@@ -2543,6 +2565,8 @@ class StereoApp:
             without = f" ({no_render})" if no_render else ""
             if mouse_camera is not None and not no_render:
                 without += f" ({MOUSE_RENDER})"
+        if elsewhere:
+            without += f" ({elsewhere})"
         if skipped:
             links = ", ".join(skipped)
             without += f" ({links}: a symbolic link, not a folder of --data: left alone)"
@@ -2592,26 +2616,51 @@ class StereoApp:
             return render_view(geometry, intrinsics=intr.scaled(scale), camera=camera)
         return render_view(geometry, self._controls(), intrinsics=intr.scaled(scale))
 
-    def _next_save_folder(self, skipped: list[str] | None = None) -> Path:
+    def _next_save_folder(self, skipped: list[str] | None = None, home: Path | None = None) -> Path:
         """The first of ``saved``, ``saved-2``, ``saved-3``, ... in the first ``--data``
-        folder that does not exist or is an empty folder, and no Save is writing into.
+        folder that does not exist or is an empty folder, and no Save is writing into; with
+        ``home``, the first such of ``stereovision-saved``, ``stereovision-saved-2``, ... in it.
 
         A name that is a symbolic link is skipped (its name appended to ``skipped``): it may
         lead outside ``--data`` (the Save was refused as "outside the --data folders", naming
         a folder the user never typed) or into a folder the user made for something else.
         """
+        base = SAVE_FOLDER if home is None else FALLBACK_SAVE_FOLDER
         for n in itertools.count(1):
-            name = SAVE_FOLDER if n == 1 else f"{SAVE_FOLDER}-{n}"
-            if os.path.islink(self._save_roots[0] / name):
+            name = base if n == 1 else f"{base}-{n}"
+            if os.path.islink((self._save_roots[0] if home is None else home) / name):
                 if skipped is not None:
                     skipped.append(name)
                 continue
-            folder = self.folders.resolve_output(name, self._save_roots)
+            if home is None:
+                folder = self.folders.resolve_output(name, self._save_roots)
+            else:
+                folder = (home / name).resolve()
             if folder in self._saving_into:
                 continue
             if not os.path.lexists(folder) or (folder.is_dir() and not any(folder.iterdir())):
                 return folder
         raise AssertionError("unreachable")  # pragma: no cover
+
+    def _fallback_save_folder(self, offered: Path, why: str) -> Path:
+        """The folder a Save as offered goes to when ``offered`` (in the first ``--data``
+        folder) cannot be made or written, ``why``: the next new ``~/stereovision-saved``.
+
+        Raises
+        ------
+        PermissionError
+            No home folder, or one that cannot be written either: both named.
+        """
+        said = f"{display_path(offered)} cannot be written ({why})"
+        try:
+            home = Path.home()
+        except RuntimeError:  # no home folder known
+            raise PermissionError(f"save: {said}, and no home folder is known") from None
+        folder = self._next_save_folder(home=home)
+        also = _cannot_make(folder)
+        if also:
+            raise PermissionError(f"save: {said}, nor {display_path(folder)} ({also})")
+        return folder
 
     def _set_progress(self, pct: int, text: str) -> None:
         with self.state:
