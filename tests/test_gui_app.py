@@ -3861,6 +3861,43 @@ def test_a_capture_after_a_scene_says_so_first(tmp_path):
     assert app.state.error == "" and app.state.source_label == "cameras 0 / 1"
 
 
+def test_a_capture_after_a_failed_first_read_reads_the_cameras(tmp_path):
+    """Cameras given at start-up (--left/--right) whose first read failed: the page shows no
+    pair, and the Capture that retries was refused as if a scene were on show (" is on show,
+    not camera 0 and camera 1: a scene or files cannot be captured"). It reads the cameras; a
+    scene chosen after them still makes the first Capture say so."""
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    reads: list[int] = []
+
+    class Cameras:
+        def read(self):
+            reads.append(1)
+            if len(reads) == 1:
+                raise OSError("camera 0 delivered no frame in 5 s")
+            return frame.copy(), frame.copy()
+
+        def close(self):
+            pass
+
+    app = _scene_app(
+        "test-capture-after-failed-start",
+        [bundled_data_dir()],
+        source=Cameras(),
+        source_names=("0", "1"),
+    )
+    app._on_ready()
+    assert app.state.error == "camera 0 delivered no frame in 5 s" and app.pair is None
+    _capture(app)
+    assert app.state.error == "" and len(reads) == 2 and app.state.captures == 1
+    assert app.state.source_label == "cameras 0 / 1" and app.pair is not None
+    app._on_scene(scene=str((bundled_data_dir() / "cones").resolve()))
+    _capture(app)
+    assert app.state.error.startswith("scene data/cones is on show, not camera 0 and camera 1")
+    assert len(reads) == 2
+
+
 def test_the_computations_a_page_asks_and_what_they_are_given(monkeypatch):
     """What each computation is given and how many run: the max-disparity field wins over the
     scene's range, the same value applied again computes nothing, three quick requests compute

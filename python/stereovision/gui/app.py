@@ -1412,8 +1412,9 @@ class StereoApp:
         #: camera under a grab in another thread is not safe).
         self._reading: list[StereoSource] = []
         self._close_after_read: list[StereoSource] = []
-        #: The pair on show came from :attr:`source` (False: a scene or files chosen since).
-        self._pair_from_source = False
+        #: A scene or files are on show, chosen after :attr:`source` opened (False: its pair,
+        #: or none: cameras given at start-up whose first read failed are read by a Capture).
+        self._other_on_show = False
         #: ``_choice`` when a Capture was refused for a scene or files on show: another
         #: Capture with no choice since goes back to the source.
         self._capture_back: int | None = None
@@ -1624,7 +1625,7 @@ class StereoApp:
         self._no_calib = None if scene.calib is not None else f"scene {label} has no calib.txt"
         self.state.source_label = f"scene {label}"
         self.state.rows_label = ""
-        self._pair_from_source = False
+        self._other_on_show = True
 
     def _grab(self) -> None:
         """Read a pair from the open source here and show it (start-up; the page's reads run
@@ -1647,7 +1648,7 @@ class StereoApp:
             calib = self._calib_for(left)
         self.pair = self.raw_pair = (left, right)
         self._other_source()
-        self._pair_from_source = True
+        self._other_on_show = False
         self.calib = calib
         self._no_calib = None
         self.max_disparity = None
@@ -1751,7 +1752,7 @@ class StereoApp:
             if source is None:
                 raise OSError("no camera open: give --left/--right or open cameras below")
             what = self._source_what(source)
-            if not self._pair_from_source and self._capture_back != self._choice:
+            if self._other_on_show and self._capture_back != self._choice:
                 self._capture_back = self._choice
                 shown = self.state.source_label
                 shown = "the loaded files are" if shown == "files" else f"{shown} is"
@@ -2087,7 +2088,7 @@ class StereoApp:
         self._no_calib = "the --calib calibration does not fit these images" if note else None
         self.max_disparity = None
         self.state.source_label = "files"
-        self._pair_from_source = False
+        self._other_on_show = True
         self.state.rows_label = "; ".join(
             n for n in (f"warning: {same}" if same else "", note) if n
         )
