@@ -3898,6 +3898,48 @@ def test_a_capture_after_a_failed_first_read_reads_the_cameras(tmp_path):
     assert len(reads) == 2
 
 
+def test_a_capture_after_a_scene_that_failed_to_compute_reads_the_cameras(tmp_path):
+    """A scene chosen over the cameras' pair that fails to compute puts the cameras' pair back
+    on the page, but the next Capture was refused as if the scene were on show ("cameras 0 / 1
+    is on show, not camera 0 and camera 1: a scene or files cannot be captured"). It reads the
+    cameras, as from their pair; other cameras whose pair fails to compute put the scene back,
+    and with it the first Capture's word."""
+    from stereovision.gui import bundled_data_dir
+
+    _tiny_scene(tmp_path / "tiny")
+    frame = cv2.imread(str(CONES / "left.png"))
+    tiny = np.zeros((8, 8, 3), np.uint8)
+    give = [frame]
+
+    class Cameras:
+        def read(self):
+            return give[0].copy(), give[0].copy()
+
+        def close(self):
+            pass
+
+    app = _scene_app("test-capture-after-failed-scene", [bundled_data_dir(), tmp_path])
+    app._switch_source(Cameras(), ("0", "1"))
+    _run(app, app.recompute)
+    assert app.state.error == "" and app.state.source_label == "cameras 0 / 1"
+    app._on_scene(scene=str(tmp_path / "tiny"))
+    _run(app, app.recompute)
+    assert app.state.error.endswith("(the page still shows the previous pair)")
+    assert app.state.source_label == "cameras 0 / 1"
+    _capture(app)
+    assert app.state.error == "" and app.state.captures == 2
+
+    app._on_scene(scene=str((bundled_data_dir() / "cones").resolve()))
+    _run(app, app.recompute)
+    assert app.state.error == "" and app.state.source_label == "scene data/cones"
+    give[0] = tiny
+    app._switch_source(Cameras(), ("2", "3"))  # a pair too small to compute: the scene back
+    _run(app, app.recompute)
+    assert app.state.source_label == "scene data/cones"
+    _capture(app)
+    assert app.state.error.startswith("scene data/cones is on show, not camera 2 and camera 3")
+
+
 def test_the_computations_a_page_asks_and_what_they_are_given(monkeypatch):
     """What each computation is given and how many run: the max-disparity field wins over the
     scene's range, the same value applied again computes nothing, three quick requests compute

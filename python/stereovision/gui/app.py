@@ -2260,6 +2260,8 @@ class StereoApp:
             "source_label": self.state.source_label,
             "rows_label": self.state.rows_label,
             "_scene": self._scene,
+            # put back with the pair: a Capture says so over a scene or files, not over cameras
+            "_other_on_show": self._other_on_show,
         }
 
     def check_rows_clicked(self) -> None:
