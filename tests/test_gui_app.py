@@ -3303,6 +3303,67 @@ def test_cameras_replaced_while_a_capture_reads_them_are_closed_once_the_read_re
     asyncio.run(clicks())
 
 
+def test_a_capture_is_not_dropped_for_an_open_that_failed_meanwhile(monkeypatch):
+    """A Capture's pair was dropped, without a word, when an Open of other cameras was clicked
+    while it read, even when that Open failed (the cameras read stayed in use, nothing else
+    came on show). It is shown; a scene chosen meanwhile still drops it."""
+    import asyncio
+    import threading
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    gate, inside = threading.Event(), threading.Event()
+    hold: list[bool] = []
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            if left == 5:
+                raise OSError("cannot open camera 5 (left)")
+
+        def read(self):
+            if hold:
+                inside.set()
+                gate.wait(1.0)
+            return frame.copy(), frame.copy()
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    app = _scene_app("test-capture-then-failed-open", [bundled_data_dir()], read_timeout=2.0)
+    tasks = _collect_reads(app)
+
+    async def clicks() -> None:
+        app.state.cam_left, app.state.cam_right = "0", "1"
+        app.open_cameras()
+        await tasks[0]
+        shown, source = app.pair, app.source
+        hold.append(True)
+        app.capture()
+        await _until(inside.is_set)
+        app.state.cam_left, app.state.cam_right = "5", "6"
+        app.open_cameras()
+        await tasks[2]
+        assert app.state.error == "cannot open camera 5 (left)" and app.source is source
+        gate.set()
+        await tasks[1]
+        assert app.pair is not shown and app.state.captures == 2
+
+        inside.clear()
+        gate.clear()
+        shown = app.pair
+        app.capture()
+        await _until(inside.is_set)
+        app._on_scene(scene=str((bundled_data_dir() / "cones").resolve()))
+        gate.set()
+        await tasks[3]
+        assert app.state.source_label == "scene data/cones" and app.state.captures == 2
+
+    asyncio.run(clicks())
+
+
 def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
     data_dir, tmp_path, capsys
 ):

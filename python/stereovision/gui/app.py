@@ -1415,6 +1415,9 @@ class StereoApp:
         #: A scene or files are on show, chosen after :attr:`source` opened (False: its pair,
         #: or none: cameras given at start-up whose first read failed are read by a Capture).
         self._other_on_show = False
+        #: Counts the pairs a choice put on show (a scene, files, an image folder, cameras): a
+        #: Capture's pair that comes after one is dropped (not after an Open that failed).
+        self._shows = 0
         #: ``_choice`` when a Capture was refused for a scene or files on show: another
         #: Capture with no choice since goes back to the source.
         self._capture_back: int | None = None
@@ -1626,6 +1629,7 @@ class StereoApp:
         self.state.source_label = f"scene {label}"
         self.state.rows_label = ""
         self._other_on_show = True
+        self._shows += 1
 
     def _grab(self) -> None:
         """Read a pair from the open source here and show it (start-up; the page's reads run
@@ -1776,22 +1780,23 @@ class StereoApp:
             return
         average = bool(self.state.average)
         self._begin_read(source, what)
-        self._spawn(self._capture(source, what, average, self._choice))
+        self._spawn(self._capture(source, what, average, self._shows))
 
-    async def _capture(self, source: StereoSource, what: str, average: bool, choice: int) -> None:
+    async def _capture(self, source: StereoSource, what: str, average: bool, shows: int) -> None:
         """Read ``source`` (:meth:`_read_in_thread`) and show its pair, or say why not; a pair
-        (or an error) that comes after a newer choice (``_choice``: a scene, files, other
-        cameras) is dropped: that choice stays on show."""
+        (or an error) that comes after another was put on show (``_shows``: a scene, files,
+        other cameras) is dropped: that one stays on show. An Open clicked meanwhile that
+        fails drops nothing (the pair was lost without a word)."""
         try:
             got = await self._read_in_thread(source, average)
         except Exception as exc:  # any read error is said on the page (cv2.error too)
-            if choice != self._choice or source is not self.source:
+            if shows != self._shows or source is not self.source:
                 return
             if not isinstance(exc, (ValueError, OSError, RuntimeError)):
                 log.exception("gui: reading %s failed", what)
             self._fail(exc)
             return
-        if choice != self._choice or source is not self.source:
+        if shows != self._shows or source is not self.source:
             return
         try:
             with self.state:
@@ -2049,6 +2054,7 @@ class StereoApp:
                 exc = OSError(f"{said} (the cameras in use are unchanged)")
             self._fail(exc)
             return
+        self._shows += 1
         if before[0] is not None:
             self._close_source(before[0])  # a Capture may still be reading it
         self.state.live = True
@@ -2089,6 +2095,7 @@ class StereoApp:
         self.max_disparity = None
         self.state.source_label = "files"
         self._other_on_show = True
+        self._shows += 1
         self.state.rows_label = "; ".join(
             n for n in (f"warning: {same}" if same else "", note) if n
         )
