@@ -3364,6 +3364,61 @@ def test_a_capture_is_not_dropped_for_an_open_that_failed_meanwhile(monkeypatch)
     asyncio.run(clicks())
 
 
+@pytest.mark.parametrize("raised", [StopIteration, SystemExit])
+def test_a_read_that_raises_oddly_is_said_and_frees_the_cameras(monkeypatch, raised):
+    """A read (or open) that raised StopIteration could not be handed to the page's loop (a
+    Future refuses it): the page said "reading ..." for good and the cameras stayed "still
+    opening", never to be opened again; SystemExit (KeyboardInterrupt alike) raised into the
+    loop stopped the server. Either is said on the page, the cameras free again."""
+    import asyncio
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    fail = {"open": False, "read": True}
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            if fail["open"]:
+                raise raised("odd")
+
+        def read(self):
+            if fail["read"]:
+                raise raised("odd")
+            return frame, frame
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    app = _scene_app("test-odd-read-" + raised.__name__, [bundled_data_dir()], read_timeout=2.0)
+    app.state.cam_left, app.state.cam_right = "0", "1"
+    tasks = _collect_reads(app)
+    said = f"the camera read ended with {raised.__name__}: odd"
+
+    async def clicks() -> None:
+        app.open_cameras()  # its first read raises
+        await asyncio.wait_for(tasks[0], 1.5)
+        assert app.state.error == said and app.state.status == "error"
+        assert app._opening == set() and app.source is None
+        fail["read"] = False
+        app.open_cameras()  # not "still opening"
+        await asyncio.wait_for(tasks[1], 1.5)
+        assert app.state.error == "" and app.source is not None
+        fail["read"] = True
+        app.capture()
+        await asyncio.wait_for(tasks[2], 1.5)
+        assert app.state.error == said and app.state.status == "error"
+        assert app._reading == []
+        fail["open"] = True
+        app.open_cameras()
+        await asyncio.wait_for(tasks[3], 1.5)
+        assert app.state.error == said.replace("read", "open") and app._opening == set()
+
+    asyncio.run(clicks())
+
+
 def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
     data_dir, tmp_path, capsys
 ):

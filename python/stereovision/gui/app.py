@@ -1231,6 +1231,20 @@ def _read_pair(source: StereoSource, average: bool) -> _Frames:
     return got
 
 
+def _for_the_loop(exc: BaseException, what: str) -> BaseException:
+    """``exc``, raised in a camera ``what`` ("open", "read") in a thread of the page's, as it
+    can be handed to the page's loop: StopIteration cannot be set on a Future (the page said
+    "reading ..." for good, the cameras "still opening"), and SystemExit or KeyboardInterrupt
+    raised into the loop stopped the server; those become a RuntimeError naming them."""
+    if isinstance(exc, Exception) and not isinstance(exc, StopIteration):
+        return exc
+    log.error("gui: a camera %s raised %s", what, type(exc).__name__, exc_info=exc)
+    said = f": {exc}" if str(exc) else ""
+    out = RuntimeError(f"the camera {what} ended with {type(exc).__name__}{said}")
+    out.__cause__ = exc
+    return out
+
+
 def _button_and_answer(
     v3: Any, html: Any, text: str, button_id: str, click: Any, answer: str, answer_id: str
 ) -> None:
@@ -1861,7 +1875,7 @@ class StereoApp:
             try:
                 got = _read_pair(source, average)
             except BaseException as exc:  # said on the page by the caller
-                error = exc
+                error = _for_the_loop(exc, "read")
             try:
                 loop.call_soon_threadsafe(settle, got, error)
             except RuntimeError:  # the page's loop is closed (the server stopped)
@@ -1959,7 +1973,7 @@ class StereoApp:
                     left, right, fourcc=fourcc, read_timeout=self.read_timeout, bound_open=False
                 )
             except BaseException as exc:  # said on the page, in settle
-                error = exc
+                error = _for_the_loop(exc, "open")
             try:
                 loop.call_soon_threadsafe(settle, source, error)
             except RuntimeError:  # the page's loop is closed (the server stopped)
