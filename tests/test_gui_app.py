@@ -2019,7 +2019,7 @@ def test_a_save_as_offered_into_a_read_only_data_folder_goes_to_the_home_folder(
     /work/shared/data), every Save as offered failed ("cannot write in ..."). It goes to
     ~/stereovision-saved (then -2, ...) instead, the Save's line saying where and why; a folder
     typed in the read-only --data is refused, naming it (no other folder written); with the
-    home folder read-only too, both are named."""
+    home folder read-only too, both are named. The field's tooltip says where it goes."""
     import stereovision.io as svio
     from stereovision.gui import bundled_data_dir
 
@@ -2036,6 +2036,11 @@ def test_a_save_as_offered_into_a_read_only_data_folder_goes_to_the_home_folder(
     monkeypatch.setenv("HOME", str(home))
     monkeypatch.chdir("/")
     app = _scene_app("test-save-read-only", [bundled_data_dir(), data])
+    # the field's tooltip named data/saved, where no Save as offered goes
+    assert app.state.save_dir_title == (
+        f"{home.resolve() / 'stereovision-saved'} (or the next new -N: "
+        f"{data.resolve() / 'saved'} cannot be written: Read-only file system)"
+    )
     app._load_scene(bundled_data_dir() / "cones")
     _run(app, app.recompute)
     why = f"({data.resolve() / 'saved'} cannot be written (Read-only file system))"

@@ -1571,7 +1571,15 @@ class StereoApp:
         """The save field's tooltip: the whole path a Save would write into ("" for none)."""
         text = str(typed or "").strip()
         if self._save_roots and text in ("", self._offered_save_dir):
-            return str(self._save_roots[0] / SAVE_FOLDER) + " (or the next new saved-N)"
+            offered = self._save_roots[0] / SAVE_FOLDER
+            why = _cannot_make(offered)
+            if why:  # a read-only --data folder: such a Save goes home (save)
+                try:
+                    home = Path.home() / FALLBACK_SAVE_FOLDER
+                except RuntimeError:  # no home folder known: the Save says so
+                    return f"{offered} cannot be written: {why}"
+                return f"{home} (or the next new -N: {offered} cannot be written: {why})"
+            return f"{offered} (or the next new saved-N)"
         try:
             return str(self._typed_save_folder(text))
         except (ValueError, OSError):
