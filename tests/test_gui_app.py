@@ -2036,7 +2036,11 @@ def test_a_save_as_offered_into_a_read_only_data_folder_goes_to_the_home_folder(
     monkeypatch.setenv("HOME", str(home))
     monkeypatch.chdir("/")
     app = _scene_app("test-save-read-only", [bundled_data_dir(), data])
-    # the field's tooltip named data/saved, where no Save as offered goes
+    # the hint and the field's tooltip named data/saved, where no Save as offered goes
+    assert app.state.save_hint == (
+        "the --data folder cannot be written: as offered, a new one each Save in the home "
+        "folder (stereovision-saved, stereovision-saved-2, ...)"
+    )
     assert app.state.save_dir_title == (
         f"{home.resolve() / 'stereovision-saved'} (or the next new -N: "
         f"{data.resolve() / 'saved'} cannot be written: Read-only file system)"

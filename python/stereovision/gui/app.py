@@ -216,6 +216,10 @@ TOGGLE_HEIGHT_PX = 36
 #: What the page says under the Save folder field (with and without a --data folder).
 SAVE_HINT = "in a --data folder; as offered, a new one each Save (saved, saved-2, ...)"
 NO_SAVE_HINT = "Save writes into a --data folder: start the GUI with --data DIR"
+READ_ONLY_SAVE_HINT = (
+    "the --data folder cannot be written: as offered, a new one each Save in the home folder "
+    f"({FALLBACK_SAVE_FOLDER}, {FALLBACK_SAVE_FOLDER}-2, ...)"
+)
 
 #: Length units the page can show (the unit toggle; metres by default), as
 #: :data:`stereovision.calibration.UNIT_TO_METRES` names them.
@@ -1521,6 +1525,8 @@ class StereoApp:
         st.save_dir = self._offered_save_dir
         st.save_dir_title = self._save_title(self._offered_save_dir)
         st.save_hint = SAVE_HINT if self._save_roots else NO_SAVE_HINT
+        if self._save_roots and _cannot_make(self._save_roots[0] / SAVE_FOLDER):
+            st.save_hint = READ_ONLY_SAVE_HINT  # a read-only data set: save goes home
         st.save_label = ""
         for name in _CONTROL_NAMES:
             st[name] = 0.0
