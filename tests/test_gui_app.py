@@ -2047,7 +2047,8 @@ def test_a_save_as_offered_into_a_read_only_data_folder_goes_to_the_home_folder(
     )
     app._load_scene(bundled_data_dir() / "cones")
     _run(app, app.recompute)
-    why = f"({data.resolve() / 'saved'} cannot be written (Read-only file system))"
+    # one pair of brackets (it read '(... cannot be written (Read-only file system))')
+    why = f"({data.resolve() / 'saved'} cannot be written: Read-only file system)"
     for name in ("stereovision-saved", "stereovision-saved-2"):
         _run(app, app.save)
         assert app.state.error == "", name

@@ -2538,7 +2538,7 @@ class StereoApp:
                 folder = self._next_save_folder(skipped)
                 why = _cannot_make(folder)
                 if why:  # a read-only --data folder: the home folder's, said in the Save's line
-                    elsewhere = f"{display_path(folder)} cannot be written ({why})"
+                    elsewhere = f"{display_path(folder)} cannot be written: {why}"
                     folder = self._fallback_save_folder(folder, why)
             else:
                 folder = self._typed_save_folder(typed)
