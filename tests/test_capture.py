@@ -2132,6 +2132,8 @@ class _WedgedDevice:
     code's test ends); the others open at once, and every one made records its release."""
 
     wedged: ClassVar[set[int]] = set()
+    #: ``(src, prop)``: that source's ``set`` (``get``) of ``prop`` hangs until ``unplug``.
+    wedged_props: ClassVar[set[tuple[Any, int]]] = set()
     unplug = threading.Event()
     made: ClassVar[list[_WedgedDevice]] = []
 
@@ -2139,18 +2141,31 @@ class _WedgedDevice:
         if src in type(self).wedged:
             type(self).unplug.wait(3.0)
         self.src, self.released = src, 0
+        self.threads = {threading.get_ident()}  # the threads that opened and configured it
+        self.busy = False  # inside a set or get
+        self.released_busy = False  # released under a set or get (crashed OpenCV)
         type(self).made.append(self)
+
+    def _call(self, prop: int) -> None:
+        self.threads.add(threading.get_ident())
+        if (self.src, prop) in type(self).wedged_props:
+            self.busy = True
+            type(self).unplug.wait(3.0)
+            self.busy = False
 
     def isOpened(self) -> bool:
         return True
 
     def get(self, prop: int) -> float:
+        self._call(prop)
         return 0.0
 
     def set(self, prop: int, value: float) -> bool:
+        self._call(prop)
         return True
 
     def release(self) -> None:
+        self.released_busy |= self.busy
         self.released += 1
 
 
@@ -2158,6 +2173,7 @@ class _WedgedDevice:
 def wedged(monkeypatch: pytest.MonkeyPatch) -> Iterator[type[_WedgedDevice]]:
     """Device indices whose open hangs (``wedged.wedged``); unplugged at teardown."""
     _WedgedDevice.wedged, _WedgedDevice.made = set(), []
+    _WedgedDevice.wedged_props = set()
     _WedgedDevice.unplug = threading.Event()
     monkeypatch.setattr(cv2, "VideoCapture", _WedgedDevice)
     yield _WedgedDevice
@@ -2197,6 +2213,122 @@ def test_a_camera_whose_open_hangs_is_given_up(wedged: type[_WedgedDevice], side
     assert all(_released_soon(c) for c in wedged.made)
     with pytest.raises(ValueError, match=r"^open_timeout: expected a positive number of sec"):
         StereoCamera(0, 1, open_timeout=0)
+
+
+_SET_HANGS = {
+    "fourcc": (cv2.CAP_PROP_FOURCC, "setting its pixel format to 'MJPG'"),
+    "width": (cv2.CAP_PROP_FRAME_WIDTH, "setting its frame width to 640"),
+    "height": (cv2.CAP_PROP_FRAME_HEIGHT, "setting its frame height to 480"),
+    "fps": (cv2.CAP_PROP_FPS, "setting its frame rate to 30 fps"),
+}
+
+
+@pytest.mark.filterwarnings("ignore:.* delivers no reported format:UserWarning")
+@pytest.mark.parametrize("side", ["left", "right"])
+@pytest.mark.parametrize("what", sorted(_SET_HANGS))
+def test_a_camera_whose_set_hangs_is_given_up(
+    wedged: type[_WedgedDevice], side: str, what: str
+) -> None:
+    """The open was bounded, but the size, rate and format asked of the camera after it
+    (``cap.set``) ran on the caller's thread unbounded: a wedged V4L2 device hung there as in
+    its open. Open and settings together are given up after ``open_timeout`` s, naming the
+    source, the seconds and the setting; the capture is released once its set returns, never
+    under it."""
+    index = 0 if side == "left" else 1
+    prop, doing = _SET_HANGS[what]
+    wedged.wedged_props = {(index, prop)}
+    t0 = time.perf_counter()
+    with pytest.raises(SourceError) as err:
+        StereoCamera(0, 1, image_size=(640, 480), fps=30, fourcc="MJPG", open_timeout=0.2)
+    assert time.perf_counter() - t0 < 1.0
+    assert str(err.value) == (
+        f"{side} source camera {index} did not open within 0.2 s ({doing} did not return: a "
+        "wedged camera or driver); unplug and replug it, or give it a longer timeout"
+    )
+    assert (err.value.side, err.value.end) == (side, False)
+    wedged.unplug.set()  # the set returns at last: its capture is released then, not under it
+    assert [c.src for c in wedged.made] == ([0, 1] if side == "right" else [0])
+    assert all(_released_soon(c) for c in wedged.made)
+    assert not any(c.released_busy for c in wedged.made)
+
+
+def test_a_camera_whose_settings_read_hangs_is_given_up(wedged: type[_WedgedDevice]) -> None:
+    """Reading back what the camera delivers (``cap.get``) hung as a set does."""
+    wedged.wedged_props = {(1, cv2.CAP_PROP_FPS)}
+    with pytest.raises(SourceError) as err:
+        StereoCamera(0, 1, open_timeout=0.2)
+    assert str(err.value) == (
+        "right source camera 1 did not open within 0.2 s (reading back its settings did not "
+        "return: a wedged camera or driver); unplug and replug it, or give it a longer timeout"
+    )
+    wedged.unplug.set()
+    assert all(_released_soon(c) for c in wedged.made)
+    assert not any(c.released_busy for c in wedged.made)
+
+
+def test_a_given_capture_whose_set_hangs_is_given_up(wedged: type[_WedgedDevice]) -> None:
+    """A capture object handed to StereoCamera is set up with the same bound."""
+    left, right = _WedgedDevice("L"), _WedgedDevice("R")
+    wedged.wedged_props = {("R", cv2.CAP_PROP_FRAME_WIDTH)}
+    with pytest.raises(SourceError) as err:
+        StereoCamera(left, right, image_size=(640, 480), open_timeout=0.2)
+    assert str(err.value) == (
+        "right source _WedgedDevice did not open within 0.2 s (setting its frame width to 640 "
+        "did not return: a stalled stream or network share); give it a longer timeout"
+    )
+    wedged.unplug.set()
+    assert _released_soon(left) and _released_soon(right) and not right.released_busy
+
+
+def test_a_camera_is_opened_and_set_up_by_one_thread(wedged: type[_WedgedDevice]) -> None:
+    """Bounding the settings costs no thread of their own: each source's open and settings run
+    in one worker (None: in the caller's thread), and what it delivers is read as before."""
+    main = threading.get_ident()
+    for timeout in (0.5, None):
+        cam = StereoCamera(0, 1, image_size=(640, 480), fps=30, open_timeout=timeout)
+        for c in wedged.made:
+            assert len(c.threads) == 1
+            assert (next(iter(c.threads)) == main) == (timeout is None)
+        assert cam.delivered_fps == {"left": 0.0, "right": 0.0}
+        cam.close()
+        assert [c.released for c in wedged.made] == [1, 1]
+        wedged.made.clear()
+
+
+@pytest.mark.parametrize("command", ["capture", "stream"])
+def test_cli_read_timeout_bounds_the_settings(
+    command: str, tmp_path: Path, wedged: type[_WedgedDevice], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--read-timeout`` bounds what ``--size`` asks of a camera as it bounds the open."""
+    from stereovision.cli import main
+
+    wedged.wedged_props = {(0, cv2.CAP_PROP_FRAME_WIDTH)}
+    argv = [command, "--left", "0", "--right", "1", "--read-timeout", "0.2", "--size", "640x480"]
+    argv += ["-o", str(tmp_path / "p")] if command == "capture" else ["--no-display"]
+    t0 = time.perf_counter()
+    assert main(argv) == 2
+    assert time.perf_counter() - t0 < 1.0
+    assert capsys.readouterr().err == (
+        "stereovision: error: left source camera 0 did not open within 0.2 s (setting its frame "
+        "width to 640 did not return: a wedged camera or driver); unplug and replug it, or give "
+        "it a longer timeout\n"
+    )
+    wedged.unplug.set()
+    assert all(_released_soon(c) for c in wedged.made)
+
+
+def test_calibrate_from_video_bounds_the_settings_read(wedged: type[_WedgedDevice]) -> None:
+    """calibrate_from_video's cameras read back their settings after the open, bounded by
+    ``read_timeout`` with it."""
+    from stereovision.calibrate import calibrate_from_video
+
+    wedged.wedged_props = {(0, cv2.CAP_PROP_FRAME_WIDTH)}
+    t0 = time.perf_counter()
+    with pytest.raises(SourceError, match=r"^left source camera 0 did not open within 0\.2 s \(re"):
+        calibrate_from_video(0, 1, square_size=1.0, read_timeout=0.2)
+    assert time.perf_counter() - t0 < 1.0
+    wedged.unplug.set()
+    assert all(_released_soon(c) for c in wedged.made)
 
 
 def test_opencv_stays_quiet_until_a_given_up_open_returns(wedged: type[_WedgedDevice]) -> None:

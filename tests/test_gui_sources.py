@@ -613,6 +613,48 @@ def test_a_camera_whose_open_hangs_is_given_up(
         time.sleep(0.01)
 
 
+@pytest.mark.parametrize("fallback", [False, True])
+def test_a_camera_whose_size_setting_hangs_is_given_up(
+    fake_cap: type[FakeCap], monkeypatch: pytest.MonkeyPatch, fallback: bool
+) -> None:
+    """The open was bounded, but the size asked of a camera after it (``cap.set``) was not: a
+    wedged device froze the page there. Open and size together are given up after
+    ``read_timeout`` s, naming the camera and the setting (OpenCV's fallback too); the capture
+    is released once its set returns."""
+    import threading
+
+    unplug = threading.Event()
+
+    class Wedged(FakeCap):
+        def set(self, prop: int, value: float) -> bool:
+            if self.src == 1 and prop == cv2.CAP_PROP_FRAME_WIDTH:
+                unplug.wait(3.0)  # at most: the old code's test ends
+            return super().set(prop, value)
+
+        def get(self, prop: int) -> float:
+            return 0.0
+
+    monkeypatch.setattr(cv2, "VideoCapture", Wedged)
+    if fallback:
+        monkeypatch.setitem(sys.modules, "stereovision.capture", None)  # import fails
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(OSError) as err:
+            sources.open_stereo_source(0, 1, size=(640, 480), read_timeout=0.2)
+        assert time.perf_counter() - t0 < 1.0
+    finally:
+        unplug.set()
+    assert str(err.value) == (
+        "right source camera 1 did not open within 0.2 s (setting its frame width to 640 did "
+        "not return: a wedged camera or driver); unplug and replug it, or give it a longer "
+        "timeout"
+    )
+    deadline = time.monotonic() + 2.0  # its set returns: both captures are released
+    while not (len(fake_cap.made) == 2 and all(c.released for c in fake_cap.made)):
+        assert time.monotonic() < deadline, "a capture was kept"
+        time.sleep(0.01)
+
+
 def test_a_stream_given_by_name_is_not_reopened_when_its_read_hangs(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:

@@ -33,6 +33,7 @@ import contextlib
 import contextvars
 import dataclasses
 import errno
+import functools
 import glob
 import math
 import os
@@ -469,15 +470,15 @@ def _within(
     timeout: float | None,
     name: str,
     cancel: Callable[[], bool] | None = None,
-    hung: str | None = None,
+    hung: str | Callable[[], str] | None = None,
     side: str = "both",
 ) -> _T:
     """``work()`` in a daemon thread, given up after ``timeout`` s (None: called here).
 
     On an interrupt, ``cancel()`` (when given) is asked first whether it kept ``work`` from
     beginning (True); only one under way is waited for, up to :data:`_INTERRUPT_GRACE_S`.
-    Given up, it raises :class:`SourceError` saying ``hung`` (default: a read's words, with
-    ``name``, the sources) about ``side``.
+    Given up, it raises :class:`SourceError` saying ``hung`` (called then, when callable;
+    default: a read's words, with ``name``, the sources) about ``side``.
     """
     if timeout is None:
         return work()
@@ -509,7 +510,7 @@ def _within(
         # the thread stays in OpenCV (nothing stops native code); its frame, if it ever comes,
         # is dropped
         raise SourceError(
-            hung
+            (hung() if callable(hung) else hung)
             or f"{name} delivered no frame in {timeout:g} s (its read did not return: a hung or "
             "unplugged USB camera, a stalled stream); unplug and replug it",
             side=side,
@@ -520,18 +521,46 @@ def _within(
     return box[0]  # type: ignore[no-any-return]
 
 
-def _open_within(make: Callable[[], Any], timeout: float | None, side: str, src: Source) -> Any:
-    """``make()``, the ``cv2.VideoCapture`` of ``side``'s source ``src``, given up after
-    ``timeout`` s as a read is (:func:`_within`; None: no limit): a wedged V4L2 device, or a
-    stream that stalls, can keep OpenCV's open from ever returning. A capture that opens after
-    it was given up is released then (it held the device).
+def _open_within(
+    make: Callable[[], Any],
+    timeout: float | None,
+    side: str,
+    src: Source,
+    configure: Callable[[Any, Callable[[str], None]], None] | None = None,
+) -> Any:
+    """``make()``, the ``cv2.VideoCapture`` of ``side``'s source ``src``, then
+    ``configure(cap, doing)``, given up together after ``timeout`` s as a read is
+    (:func:`_within`; None: no limit): a wedged V4L2 device, or a stream that stalls, can keep
+    OpenCV's open, or a ``set``/``get`` after it, from ever returning. Both run in one worker
+    (no thread per call). ``configure`` says what it is about to do (``doing("setting its
+    frame width to 640")``) for the message, should that hang. A capture that opens, or ends
+    its settings, after it was given up is released then (it held the device), never while a
+    ``set`` is under way in it (a release under OpenCV crashed the process); one whose
+    ``configure`` raised is released.
 
     OpenCV's log stays silent (:func:`~stereovision.io._opencv_quiet`) until the open returns,
     given up or not: the caller's quiet ended when it was given up, and a late open printed
     its backends' lines. An open that never returns keeps it silent for the process's life.
+    The settings are not silenced (OpenCV's word on a setting a driver refused is kept).
     """
+    doing = ["its open"]
+
+    def note(what: str) -> None:
+        doing[0] = what
+
+    def configured(cap: Any) -> Any:
+        if configure is not None:
+            try:
+                configure(cap, note)
+            except BaseException:  # nobody will have it
+                _release([cap])
+                raise
+        return cap
+
     if timeout is None:
-        return make()
+        with _opencv_quiet():
+            cap = make()
+        return configured(cap)
     lock = threading.Lock()
     given_up = [False]
     made: list[Any] = []  # the capture, once made in time; the one that gives up releases it
@@ -541,9 +570,16 @@ def _open_within(make: Callable[[], Any], timeout: float | None, side: str, src:
             cap = make()
             with lock:
                 late = given_up[0]
-                if not late:
-                    made.append(cap)
             if late:  # nobody will have it
+                _release([cap])
+                return cap
+        configured(cap)
+        with lock:
+            late = given_up[0]
+            if not late:
+                made.append(cap)
+        if late:  # given up during its settings: released now that none is under way
+            with _opencv_quiet():
                 _release([cap])
         return cap
 
@@ -562,8 +598,10 @@ def _open_within(make: Callable[[], Any], timeout: float | None, side: str, src:
             opened,
             timeout,
             what,
-            hung=f"{what} did not open within {timeout:g} s (its open did not return: {why}); "
-            f"{todo}",
+            hung=lambda: (
+                f"{what} did not open within {timeout:g} s ({doing[0]} did not "
+                f"return: {why}); {todo}"
+            ),
             side=side,
         )
     except BaseException:  # given up, interrupted, or the open failed
@@ -855,10 +893,12 @@ class StereoCamera(PairSource):
         (docs/robotics.md, "Webcams: compressed or raw"). A source that delivers another
         format gets one :class:`UserWarning`; what each delivers is in :attr:`delivered_fourcc`.
     open_timeout : float or None
-        Seconds each source's open may take (:data:`DEFAULT_READ_TIMEOUT`, 10; None: no
-        limit): a wedged V4L2 device can keep OpenCV's open from ever returning. Given up, it
-        raises :class:`SourceError` naming the source and the seconds (``left source camera 0
-        did not open within 10 s ...``); a capture that opens later is released then.
+        Seconds each source's open, with the format, size and rate asked of it and read back
+        (``set``/``get``), may take (:data:`DEFAULT_READ_TIMEOUT`, 10; None: no limit): a
+        wedged V4L2 device can keep OpenCV's open, or a setting, from ever returning. Given
+        up, it raises :class:`SourceError` naming the source, the seconds and the step
+        (``left source camera 0 did not open within 10 s (setting its frame width to 640 did
+        not return ...``); a capture that opens or ends its settings later is released then.
 
     Attributes
     ----------
@@ -937,6 +977,7 @@ class StereoCamera(PairSource):
             raise
 
     def _open(self, side: str, src: Source, fps: float | None, timeout: float | None) -> Any:
+        configure = functools.partial(self._configure, side, fps)
         if isinstance(src, (str, os.PathLike)):
             path = os.fspath(src)
             if "%" not in path and "://" not in path and not os.path.exists(path):
@@ -945,38 +986,23 @@ class StereoCamera(PairSource):
             if "%" in path and "://" not in path and pattern != path and not glob.glob(pattern):
                 # said here: FFmpeg would print its own line first
                 raise FileNotFoundError(f"{side} source: no file matches {path}")
-            # OpenCV logs its backends' attempts to stderr; the error below says what failed.
-            with _opencv_quiet():
-                cap: Any = _open_within(lambda: _open_path(path), timeout, side, src)
+            # OpenCV's log of its backends' attempts stays quiet (_open_within): the error
+            # below says what failed
+            cap: Any = _open_within(lambda: _open_path(path), timeout, side, src, configure)
             self._sequence[side] = cap.isOpened() and cap.getBackendName() == "CV_IMAGES"
         elif isinstance(src, (bool, np.bool_)):  # True opened camera 1
             raise ValueError(f"{side} source: expected a device index or a path, got {src!r}")
         elif isinstance(src, (int, np.integer)):
             if src < 0:  # cv2.VideoCapture(-1) crashes the process when no camera is present
                 raise ValueError(f"{side} source: {_negative_index(int(src))}")
-            with _opencv_quiet():
-                cap = _open_within(lambda: cv2.VideoCapture(int(src)), timeout, side, src)
-        else:
-            cap = src
+            cap = _open_within(lambda: cv2.VideoCapture(int(src)), timeout, side, src, configure)
+        else:  # a capture of the caller's: its settings bounded as a device's
+            cap = _open_within(lambda: src, timeout, side, src, configure)
         if not cap.isOpened():
             cap.release()
             what = f"{_describe_source(src)}{camera_hint(src)}"
             raise SourceError(f"cannot open {side} source {what}")
-        # The format first: V4L2 offers sizes and rates per format.
-        if self.requested_fourcc is not None:
-            cap.set(cv2.CAP_PROP_FOURCC, cv2.VideoWriter.fourcc(*self.requested_fourcc))
-        if self.requested_size is not None:
-            cap.set(cv2.CAP_PROP_FRAME_WIDTH, self.requested_size[0])
-            cap.set(cv2.CAP_PROP_FRAME_HEIGHT, self.requested_size[1])
-        if fps is not None:
-            cap.set(cv2.CAP_PROP_FPS, float(fps))
-        # CAP_IMAGES says -1 (no rate): 0 for unknown, as other sources say it.
-        self.delivered_fps[side] = max(0.0, float(cap.get(cv2.CAP_PROP_FPS) or 0.0))
-        w, h = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
-        if w > 0 and h > 0:
-            self.delivered_size[side] = (w, h)
-        got = fourcc_text(cap.get(cv2.CAP_PROP_FOURCC))
-        self.delivered_fourcc[side] = got
+        got = self.delivered_fourcc[side]
         if self.requested_fourcc is not None and got != self.requested_fourcc:
             warnings.warn(
                 f"{side} source {_describe_source(src)} delivers "
@@ -985,6 +1011,35 @@ class StereoCamera(PairSource):
                 stacklevel=4,  # _open, __init__, renamed_keyword's wrapper, the caller
             )
         return cap
+
+    def _configure(
+        self, side: str, fps: float | None, cap: Any, doing: Callable[[str], None]
+    ) -> None:
+        """Ask ``side``'s just opened ``cap`` for the requested format, size and rate, then
+        read back what it delivers: in :func:`_open_within`'s worker, as a wedged device can
+        hang a ``set`` or ``get`` as it hangs its open (``doing`` says which, for the
+        message). The warnings are the caller's (:meth:`_open`)."""
+        if not cap.isOpened():  # said by the caller
+            return
+        # The format first: V4L2 offers sizes and rates per format.
+        if self.requested_fourcc is not None:
+            doing(f"setting its pixel format to {self.requested_fourcc!r}")
+            cap.set(cv2.CAP_PROP_FOURCC, cv2.VideoWriter.fourcc(*self.requested_fourcc))
+        if self.requested_size is not None:
+            doing(f"setting its frame width to {self.requested_size[0]}")
+            cap.set(cv2.CAP_PROP_FRAME_WIDTH, self.requested_size[0])
+            doing(f"setting its frame height to {self.requested_size[1]}")
+            cap.set(cv2.CAP_PROP_FRAME_HEIGHT, self.requested_size[1])
+        if fps is not None:
+            doing(f"setting its frame rate to {fps:g} fps")
+            cap.set(cv2.CAP_PROP_FPS, float(fps))
+        doing("reading back its settings")
+        # CAP_IMAGES says -1 (no rate): 0 for unknown, as other sources say it.
+        self.delivered_fps[side] = max(0.0, float(cap.get(cv2.CAP_PROP_FPS) or 0.0))
+        w, h = int(cap.get(cv2.CAP_PROP_FRAME_WIDTH)), int(cap.get(cv2.CAP_PROP_FRAME_HEIGHT))
+        if w > 0 and h > 0:
+            self.delivered_size[side] = (w, h)
+        self.delivered_fourcc[side] = fourcc_text(cap.get(cv2.CAP_PROP_FOURCC))
 
     # -- reading
 

@@ -10,7 +10,7 @@ Two safety rules of the GUI live here:
 from __future__ import annotations
 
 import os
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from functools import partial
 from pathlib import Path
 from typing import Any, Protocol
@@ -27,7 +27,6 @@ from stereovision.capture import (
     read_within,
 )
 from stereovision.capture import parse_source as capture_parse_source
-from stereovision.io import _opencv_quiet
 
 __all__ = [
     "CLOUD_SUFFIXES",
@@ -301,6 +300,15 @@ def parse_source(text: str | int) -> int | str:
     return capture_parse_source(s)
 
 
+def _ask_size(size: tuple[int, int], cap: Any, doing: Callable[[str], None]) -> None:
+    """Ask an opened device ``cap`` for ``size`` (a :func:`_open_within` ``configure``)."""
+    if cap.isOpened():
+        doing(f"setting its frame width to {size[0]}")
+        cap.set(cv2.CAP_PROP_FRAME_WIDTH, size[0])
+        doing(f"setting its frame height to {size[1]}")
+        cap.set(cv2.CAP_PROP_FRAME_HEIGHT, size[1])
+
+
 class VideoPair:
     """Two :class:`cv2.VideoCapture` sources read together (fallback when ``stereovision.capture``
     is not available).
@@ -316,7 +324,7 @@ class VideoPair:
     size : (int, int), optional
         Requested ``(width, height)`` for devices.
     open_timeout : float or None
-        Seconds each open may take (None: no limit), as
+        Seconds each open, with the size asked of a device, may take (None: no limit), as
         :class:`~stereovision.capture.StereoCamera`'s.
 
     Raises
@@ -344,15 +352,15 @@ class VideoPair:
                 is_file = isinstance(src, str)
                 if is_file and "%" not in str(src) and not Path(str(src)).exists():
                     raise FileNotFoundError(f"{side} camera source not found: {src}")
-                with _opencv_quiet():  # the error below says what failed
-                    # bounded: a wedged device hung its open forever
-                    cap = _open_within(partial(cv2.VideoCapture, src), open_timeout, side, src)
+                # bounded, the size asked with it: a wedged device hung its open, or a set,
+                # forever (OpenCV's log of the open stays quiet: the error below says what failed)
+                configure = None if size is None or is_file else partial(_ask_size, size)
+                cap = _open_within(
+                    partial(cv2.VideoCapture, src), open_timeout, side, src, configure
+                )
                 if not cap.isOpened():
                     cap.release()
                     raise OSError(f"cannot open camera {src!r} ({side}){camera_hint(src)}")
-                if size is not None and not is_file:
-                    cap.set(cv2.CAP_PROP_FRAME_WIDTH, size[0])
-                    cap.set(cv2.CAP_PROP_FRAME_HEIGHT, size[1])
                 self._caps.append(cap)
                 self._files.append(is_file)
         except BaseException:
