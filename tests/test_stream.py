@@ -438,6 +438,49 @@ def test_stream_records_a_ros2_bag(data_dir: Path, tmp_path: Path) -> None:
 
 
 @SLOW_PIPELINED
+def test_stream_no_tf_leaves_the_floor_transform_out_of_the_bag(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stream --bag DIR --ground-every N` puts /tf in every frame with a floor; a robot whose
+    own tree (robot_state_publisher) already places the camera needs it out (BagWriter's
+    tf=False), which the CLI could not ask for. `--no-tf` leaves it out, the floor's scan kept;
+    without --bag (or --ground-every, the only /tf) it is a one-line error before any open."""
+    pytest.importorskip("rosbags")
+    from rosbags.rosbag2 import Reader
+
+    from tests.test_ground import RIG, composite, floor_scene
+
+    tex = cv2.imread(str(data_dir / "middlebury2003" / "cones" / "left.png"), cv2.IMREAD_GRAYSCALE)
+    left, right = composite(*floor_scene(tex))
+    for n in range(2):
+        cv2.imwrite(str(tmp_path / f"left_{n:03d}.png"), left)
+        cv2.imwrite(str(tmp_path / f"right_{n:03d}.png"), right)
+    RIG.save(tmp_path / "rig.yaml")
+    src = ["--left", str(tmp_path / "left_%03d.png"), "--right", str(tmp_path / "right_%03d.png")]
+    common = ["stream", *src, "--calib", str(tmp_path / "rig.yaml"), "--no-display",
+              "--max-disparity", "64", "--no-check", "--ground-every", "1"]  # fmt: skip
+    counts = {}
+    for name, flag in (("with_tf", []), ("own_tree", ["--no-tf"])):
+        assert main([*common, "--bag", str(tmp_path / name), *flag]) == 0
+        with Reader(tmp_path / name) as reader:
+            counts[name] = {c.topic: c.msgcount for c in reader.connections}
+    assert counts["with_tf"]["/tf"] == 2 and counts["with_tf"]["/stereo/scan"] == 2
+    assert "/tf" not in counts["own_tree"]
+    assert counts["own_tree"] == {k: v for k, v in counts["with_tf"].items() if k != "/tf"}
+    capsys.readouterr()
+    for argv, said in (
+        ([*common, "--no-tf"], "--no-tf leaves /tf out of a --bag: give --bag DIR"),
+        (
+            [*common[:-2], "--bag", str(tmp_path / "b3"), "--no-tf"],
+            "--no-tf: a bag has /tf only with --ground-every (the floor places the camera)",
+        ),
+    ):
+        assert main(argv) == 2
+        assert capsys.readouterr().err == f"stereovision: error: {said}\n"
+    assert not (tmp_path / "b3").exists()
+
+
+@SLOW_PIPELINED
 def test_stream_averages_a_still_noisy_rig(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -1253,7 +1296,7 @@ def test_a_bag_that_cannot_be_written_mid_stream_keeps_the_summary(
     import stereovision.rosbag as rosbag
 
     class _FullDisk:
-        def __init__(self, path: Any) -> None:
+        def __init__(self, path: Any, **kw: Any) -> None:
             self.path, self.messages, self.frames = Path(path), 0, 0
 
         def write(self, res: Any, stamp_ns: int, **kw: Any) -> None:
@@ -1413,7 +1456,7 @@ def _unclosable_bag(fail_write_at: int | None = None) -> type:
     write fails at frame ``fail_write_at``)."""
 
     class _Unclosable:
-        def __init__(self, path: Any) -> None:
+        def __init__(self, path: Any, **kw: Any) -> None:
             self.path, self.messages, self.frames = Path(path), 0, 0
 
         def write(self, res: Any, stamp_ns: int, **kw: Any) -> None:

@@ -1226,6 +1226,13 @@ def cmd_stream(args: argparse.Namespace) -> int:
     from stereovision.calibration import _sizeless
     from stereovision.cli import load_calibration
 
+    if args.no_tf and not args.bag:  # refused before any open, not ignored
+        raise ValueError("--no-tf leaves /tf out of a --bag: give --bag DIR")
+    if args.no_tf and args.ground_every is None:
+        # nothing to leave out: only a frame written with its floor carries /tf
+        raise ValueError(
+            "--no-tf: a bag has /tf only with --ground-every (the floor places the camera)"
+        )
     # one that holds no image size (OpenCV stereo_calib output, a Q.dat alone) is read at the
     # size of the frames, once the sources are open
     sizeless = bool(args.calib) and not args.rectification and _sizeless(args.calib)
@@ -1286,7 +1293,7 @@ def cmd_stream(args: argparse.Namespace) -> int:
             from stereovision.rosbag import BagWriter
 
             try:
-                bag = BagWriter(args.bag)
+                bag = BagWriter(args.bag, tf=not args.no_tf)
             except OSError as exc:
                 # BagWriter (a library class) names the folder, not the option that gave it,
                 # as every other refusal of --bag does; type and errno kept
@@ -1569,6 +1576,14 @@ def add_cli(subparsers: Any) -> None:
         help="fit the floor on every N-th pair and warn when the camera's height, pitch or roll "
         "moves (a mount that slipped); needs a calibration (--calib, or with --from-bag the "
         "recording's camera_info)",
+    )
+    p.add_argument(
+        "--no-tf",
+        action="store_true",
+        help="with --bag and --ground-every: leave /tf (the camera's optical frame under "
+        "base_footprint, at its pose on the fitted floor) out of the bag, for a robot whose own "
+        "transforms (robot_state_publisher, its URDF) already place the camera: a frame has one "
+        "parent in tf",
     )
     p.add_argument(
         "--temporal",
