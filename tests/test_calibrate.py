@@ -2077,3 +2077,10 @@ def test_cli_report_file_listed_but_made_a_folder_is_refused_first(
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["rep"]
     assert sorted(p.name for p in rep.iterdir()) == [".stereovision-calibrate.json", "report.yaml"]
+
+
+def test_a_numpy_string_unit_is_said_as_its_text() -> None:
+    # a unit read from an array (np.str_) was said by repr: "got np.str_('parsec')"
+    left, right = _chessboard_paths()
+    with pytest.raises(ValueError, match=r"^unit: expected one of .*, got 'parsec'$"):
+        calibrate(left[:2], right[:2], square_size=1.0, unit=np.str_("parsec"))

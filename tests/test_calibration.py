@@ -1814,3 +1814,25 @@ def test_from_kitti_reads_the_grey_pair_when_asked(tmp_path: Path) -> None:
         Calibration.from_kitti(raw)
     with pytest.raises(ValueError, match=r"cameras: expected two of KITTI's cameras 0-3"):
         Calibration.from_kitti(odo, image_size=(1241, 376), cameras=(1, 1))
+
+
+def test_a_numpy_string_unit_is_said_as_its_text(tmp_path: Path) -> None:
+    """A unit read from an array (``np.str_``) was said by repr: "got np.str_('yd')", and a valid
+    one stayed an np.str_, so the baseline warning read "unit=np.str_('cm')"."""
+    with pytest.raises(ValueError, match=r"got 'yd'$"):
+        raw_calib(unit=np.str_("yd"))
+    with pytest.raises(ValueError, match=r"got \['m'\]$"):  # was "unhashable type: 'list'"
+        raw_calib(unit=["m"])
+    with pytest.warns(UserWarning, match=r"unit='cm'\?"):
+        calib = raw_calib(unit=np.str_("cm"), T=np.array([-5000.0, 0.0, 0.0]))
+    assert type(calib.unit) is str
+    saved = tmp_path / "rig.json"
+    rect_calib().save(saved)
+    with pytest.raises(ValueError, match=r"got 'yd'$"):
+        Calibration.from_file(saved, unit=np.str_("yd"))  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"not in the unit 'cm' given"):
+        Calibration.from_file(saved, unit=np.str_("cm"))  # type: ignore[arg-type]
+    with pytest.raises(ValueError, match=r"^unit: expected one of .* got 'yd'$"):
+        Calibration.from_opencv_stereo_calib(
+            tmp_path / "i.yml", tmp_path / "e.yml", (640, 480), np.str_("yd")
+        )

@@ -19,7 +19,7 @@ import math
 import os
 import sys
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any, TypeVar, cast
 
 import numpy as np
@@ -677,6 +677,56 @@ def number_shown(value: object) -> str:
     """``repr(value)`` for a message, or :func:`too_large_for_float`'s words for an int beyond a
     float's range."""
     return too_large_for_float(value) or _shown(value)
+
+
+def text_shown(value: object) -> str:
+    """``repr(value)`` for a message, a str subclass (``np.str_`` read from an array or a table)
+    as its text: ``'cm'``, not ``np.str_('cm')``.
+
+    Examples
+    --------
+    >>> text_shown(np.str_("cm"))
+    "'cm'"
+    >>> text_shown(["m"])
+    "['m']"
+    """
+    return repr(str(value)) if isinstance(value, str) else repr(value)
+
+
+def known_unit(unit: object, units: Iterable[str], name: str = "unit") -> str:
+    """``unit`` as a plain str when it is one of ``units``, else a ValueError naming them.
+
+    Parameters
+    ----------
+    unit : object
+        What was given (a str, ``np.str_``, or anything else: refused by name, not by the
+        TypeError ``in`` raises for an unhashable list).
+    units : iterable of str
+        The known units, in the order the message lists them.
+    name : str
+        Argument name used in the message.
+
+    Returns
+    -------
+    str
+        ``unit`` as a built-in str (an ``np.str_`` would otherwise reach later messages).
+
+    Raises
+    ------
+    ValueError
+        If ``unit`` is not one of ``units``.
+
+    Examples
+    --------
+    >>> known_unit(np.str_("furlong"), ["m", "mm"])
+    Traceback (most recent call last):
+    ...
+    ValueError: unit: expected one of ['m', 'mm'], got 'furlong'
+    """
+    known = list(units)
+    if not isinstance(unit, str) or unit not in known:
+        raise ValueError(f"{name}: expected one of {known}, got {text_shown(unit)}")
+    return str(unit)
 
 
 def pixels_shown(value: float) -> str:

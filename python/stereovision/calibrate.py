@@ -1355,7 +1355,7 @@ def calibrate(
     >>> len(rep.used_pairs), rep.rms < 0.3
     (4, True)
     """
-    from stereovision._validate import positive_finite
+    from stereovision._validate import known_unit, positive_finite
     from stereovision.calibration import UNIT_TO_METRES, Calibration
     from stereovision.charuco import CharucoBoard, corners_span_plane, find_charuco_corners
 
@@ -1378,8 +1378,7 @@ def calibrate(
         if square_size is None:
             raise ValueError("square_size: required for a chessboard (the side of one square)")
         square = positive_finite(square_size, "square_size")
-    if unit not in UNIT_TO_METRES:
-        raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+    unit = known_unit(unit, UNIT_TO_METRES)
     # The board's corners are float32 for OpenCV: 1e308 overflowed them into inf and the solver
     # failed an assertion. No printed or built board has squares outside these bounds.
     metres = square * UNIT_TO_METRES[unit]

@@ -31,6 +31,7 @@ import numpy.typing as npt
 
 from stereovision._validate import (
     as_image_array,
+    known_unit,
     number_shown,
     positive_finite,
     renamed_keyword,
@@ -456,8 +457,8 @@ class Calibration:
         if not float(np.linalg.norm(self.T)) > 0:
             raise ValueError(f"T: zero baseline (T = {self.T.tolist()})")
         object.__setattr__(self, "image_size", self._check_size(self.image_size))
-        if self.unit not in UNIT_TO_METRES:
-            raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {self.unit!r}")
+        # a plain str: an np.str_ kept would be said "np.str_('cm')" by later messages
+        object.__setattr__(self, "unit", known_unit(self.unit, UNIT_TO_METRES))
         if not isinstance(self.rectified, (bool, np.bool_)):
             raise ValueError(f"rectified: expected a bool, got {self.rectified!r}")
         object.__setattr__(self, "rectified", bool(self.rectified))
@@ -1468,8 +1469,8 @@ class Calibration:
             ``unit`` is missing where the format needs it, if ``unit`` is not a known unit, or
             if ``image_size`` or ``unit`` is given and the file states another.
         """
-        if unit is not None and unit not in UNIT_TO_METRES:
-            raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+        if unit is not None:
+            unit = known_unit(unit, UNIT_TO_METRES)
         calib = cls._read_any(path, image_size, unit)
         if unit is not None and calib.unit != unit:
             # a unit the file states (calib.txt's mm, KITTI's and ROS's m, a saved file's own)
@@ -1603,8 +1604,7 @@ class Calibration:
         """
         # the two arguments checked first: a refusal of the files' numbers names the files
         size = cls._check_size(image_size)
-        if unit not in UNIT_TO_METRES:
-            raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+        unit = known_unit(unit, UNIT_TO_METRES)
         fields: dict[str, Any] = {}
         files: list[Path] = []
         for path, keys in ((intrinsics, ("M1", "D1", "M2", "D2")), (extrinsics, ("R", "T"))):

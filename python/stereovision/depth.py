@@ -31,6 +31,7 @@ from stereovision._validate import (
     as_gray_float,
     check_pair,
     finite_number,
+    known_unit,
     pair_shape_error,
     path_given,
     unreachable_range,
@@ -449,8 +450,7 @@ def _in_unit(metres: npt.NDArray[np.float32], unit: str) -> npt.NDArray[np.float
     :func:`~stereovision.triangulation.triangulate` takes)."""
     from stereovision.calibration import UNIT_TO_METRES
 
-    if not isinstance(unit, str) or unit not in UNIT_TO_METRES:
-        raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+    unit = known_unit(unit, UNIT_TO_METRES)
     if unit == "m":
         return np.array(metres, dtype=np.float32)
     return (np.asarray(metres, np.float64) / UNIT_TO_METRES[unit]).astype(np.float32)

@@ -22,7 +22,12 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import number_shown, renamed_keyword, too_large_for_float
+from stereovision._validate import (
+    known_unit,
+    number_shown,
+    renamed_keyword,
+    too_large_for_float,
+)
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -87,12 +92,7 @@ def _bool_mask(mask: npt.ArrayLike) -> np.ndarray:
 
 
 def _unit_factor(unit: str) -> float:
-    try:
-        return _TO_METRES[unit]
-    except (KeyError, TypeError):  # TypeError: a list or dict, unhashable
-        # a str subclass (np.str_) as its text, not as "np.str_('x')"
-        shown = repr(str(unit)) if isinstance(unit, str) else repr(unit)
-        raise ValueError(f"unit: expected one of {sorted(_TO_METRES)}, got {shown}") from None
+    return _TO_METRES[known_unit(unit, sorted(_TO_METRES))]
 
 
 def _threshold_text(t: float) -> str:

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from stereovision._validate import known_unit
 from stereovision._validate import require as _require_type
 
 # at run time too, so that typing.get_type_hints resolves the public signatures
@@ -347,8 +348,7 @@ class GroundPlane:
         ValueError
             If ``unit`` is not a known unit.
         """
-        if unit not in UNIT_TO_METRES:
-            raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+        unit = known_unit(unit, UNIT_TO_METRES)
         height = self.height / UNIT_TO_METRES[unit]
         text = (
             f"ground plane: camera {height:.3f} {unit} above it, pitch {self.pitch_deg:+.2f} deg, "

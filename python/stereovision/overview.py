@@ -297,10 +297,10 @@ def overview_image(result: Any, title: str, unit: str = "m") -> Overview:
     ValueError
         An unknown ``unit`` (the message names the allowed ones).
     """
+    from stereovision._validate import known_unit
     from stereovision.calibration import UNIT_TO_METRES
 
-    if not isinstance(unit, str) or unit not in UNIT_TO_METRES:
-        raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+    unit = known_unit(unit, UNIT_TO_METRES)
     size = UNIT_TO_METRES[unit]  # metres in one unit
     disparity = np.asarray(result.disparity, np.float32)
     h, w = disparity.shape[:2]

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import int_in_range, positive_finite
+from stereovision._validate import int_in_range, known_unit, positive_finite
 from stereovision._validate import require as _require_type
 from stereovision.calibration import UNIT_TO_METRES, Calibration
 
@@ -72,8 +72,7 @@ class TriangulationResult:
 
 
 def _unit_scale(calib: Calibration, unit: str) -> float:
-    if unit not in UNIT_TO_METRES:
-        raise ValueError(f"unit: expected one of {list(UNIT_TO_METRES)}, got {unit!r}")
+    unit = known_unit(unit, UNIT_TO_METRES)
     return calib.to_metres_factor / UNIT_TO_METRES[unit]
 
 
