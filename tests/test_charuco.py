@@ -995,3 +995,36 @@ def test_board_png_refuses_a_huge_charuco_board_by_its_square_and_dpi(
     monkeypatch.setattr(ch, "MAX_IMAGE_PIXELS", 1200 * 900 - 1)
     with pytest.raises(ValueError, match=r"^a 10x7 ChArUco board at 100 px per square is too"):
         board_png(BOARD, 0.01, dpi=254)
+
+
+def test_a_board_too_large_to_print_says_the_largest_square_in_pixels_and_dpi(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """ "a 9x6 chessboard at 4724 px per square is too large" gave no limit: it says the most
+    pixels per square the board may have (its image with margins within MAX_IMAGE_PIXELS) and
+    the dpi giving them at the square asked for."""
+    import stereovision.charuco as ch
+
+    # 9x6 inner corners: 10x7 squares and a one-square margin, 12x9 squares of 1521 px at most
+    assert 12 * 9 * 1521**2 <= ch.MAX_IMAGE_PIXELS < 12 * 9 * 1522**2
+    with pytest.raises(
+        ValueError,
+        match=r"^a 9x6 chessboard at 4724 px per square is too large \(over 2\.5e\+08 pixels "
+        r"with its margins\): at most 1521 px per square, 200 mm squares at up to 193\.167 dpi$",
+    ):
+        board_png((9, 6), 0.2, 600)
+    with pytest.raises(ValueError, match=r"at most 1521 px per square, 200 mm squares at up to"):
+        board_png(BOARD, 0.2, 600)  # 10x7 squares, as the 9x6 chessboard's
+    # the limit said is one that passes: 100 px squares of 10 mm are 254 dpi
+    monkeypatch.setattr(ch, "MAX_IMAGE_PIXELS", 12 * 9 * 100**2 + 99)
+    with pytest.raises(
+        ValueError, match=r"at most 100 px per square, 10 mm squares at up to 254 dpi"
+    ):
+        board_png((9, 6), 0.01, 260)
+    assert board_png((9, 6), 0.01, 254)[1] == (1200, 900)
+    # no square small enough: a board whose 10 px squares are already too many pixels
+    monkeypatch.setattr(ch, "MAX_IMAGE_PIXELS", 12 * 9 * 10**2 - 1)
+    with pytest.raises(
+        ValueError, match=r"margins\), even at 10 px per square \(the least\): use fewer squares$"
+    ):
+        board_png((9, 6), 0.01, 254)

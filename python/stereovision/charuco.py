@@ -21,6 +21,7 @@ Conventions (OpenCV's ``cv2.aruco.CharucoBoard``):
 
 from __future__ import annotations
 
+import math
 import struct
 import zlib
 from dataclasses import dataclass, replace
@@ -557,6 +558,27 @@ def _png_with_ppm(img: np.ndarray, ppm: int) -> bytes:
     return data[:ihdr_end] + chunk + data[ihdr_end:]
 
 
+def _too_large(what: str, squares: tuple[int, int], pix: int, square_metres: float) -> ValueError:
+    """The error of a board whose image (``squares`` and a one-square margin of ``pix`` px)
+    is over MAX_IMAGE_PIXELS, with the most pixels per square it may have and the dpi giving
+    them at ``square_metres``: "too large" alone left the user guessing what to ask for."""
+    cols, rows = squares
+    # whole pixels: most**2 <= MAX // area exactly when most**2 * area <= MAX
+    most = math.isqrt(MAX_IMAGE_PIXELS // ((cols + 2) * (rows + 2)))
+    head = (
+        f"{what} at {pix} px per square is too large (over {MAX_IMAGE_PIXELS:.2g} pixels with "
+        "its margins)"
+    )
+    if most < 10:  # _board_scale's least square: no square and dpi would do
+        return ValueError(f"{head}, even at 10 px per square (the least): use fewer squares")
+    # the dpi whose rounded square is `most` px (a print of `square_metres` squares)
+    dpi = most * 0.0254 / square_metres
+    return ValueError(
+        f"{head}: at most {most} px per square, "
+        f"{square_metres * 1000:g} mm squares at up to {dpi:g} dpi"
+    )
+
+
 def board_png(
     board: CharucoBoard | tuple[int, int],
     square_metres: float,
@@ -589,7 +611,7 @@ def board_png(
         # checked here too: image() names its pixels_per_square, which board_png's caller
         # did not give (they gave the square and dpi)
         if (cols + 2) * (rows + 2) * pix * pix > MAX_IMAGE_PIXELS:
-            raise ValueError(f"a {cols}x{rows} ChArUco board at {pix} px per square is too large")
+            raise _too_large(f"a {cols}x{rows} ChArUco board", (cols, rows), pix, square_metres)
         img = board.image(pix, margin=pix)
     else:
         from stereovision.calibrate import parse_pattern
@@ -597,7 +619,7 @@ def board_png(
         cols, rows = parse_pattern(board)
         sq_c, sq_r = cols + 1, rows + 1
         if (sq_c + 2) * (sq_r + 2) * pix * pix > MAX_IMAGE_PIXELS:
-            raise ValueError(f"a {cols}x{rows} chessboard at {pix} px per square is too large")
+            raise _too_large(f"a {cols}x{rows} chessboard", (sq_c, sq_r), pix, square_metres)
         img = np.full((sq_r * pix + 2 * pix, sq_c * pix + 2 * pix), 255, np.uint8)
         for r in range(sq_r):
             for c in range(sq_c):
