@@ -1814,6 +1814,24 @@ def test_from_kitti_reads_the_grey_pair_when_asked(tmp_path: Path) -> None:
         Calibration.from_kitti(raw)
     with pytest.raises(ValueError, match=r"cameras: expected two of KITTI's cameras 0-3"):
         Calibration.from_kitti(odo, image_size=(1241, 376), cameras=(1, 1))
+    # a NumPy array (cameras=np.array([0, 1])) was refused as not two of cameras 0-3; any
+    # sequence of two integers is the pair, anything else is refused naming it by its values
+    for given in (np.array([0, 1]), np.array([0, 1], np.uint8), range(2), [np.int64(0), 1]):
+        assert Calibration.from_kitti(raw, cameras=given) == grey  # type: ignore[arg-type]
+    for bad, shown in (
+        (np.array([0, 5]), r"\[0, 5\]"),
+        ((np.int64(0), np.int64(5)), r"\(0, 5\)"),  # not "(np.int64(0), np.int64(5))"
+        (np.array([[0, 1]]), r"\[\[0, 1\]\]"),
+        (np.array([0.0, 1.0]), r"\[0\.0, 1\.0\]"),
+        ("01", "'01'"),
+        (np.array([0, 1, 2]), r"\[0, 1, 2\]"),
+    ):
+        with pytest.raises(
+            ValueError, match=r"^cameras: expected two of KITTI's cameras 0-3 .*got "
+        ):
+            Calibration.from_kitti(raw, cameras=bad)  # type: ignore[arg-type]
+        with pytest.raises(ValueError, match=shown + "$"):
+            Calibration.from_kitti(raw, cameras=bad)  # type: ignore[arg-type]
 
 
 def test_a_numpy_string_unit_is_said_as_its_text(tmp_path: Path) -> None:

@@ -20,6 +20,7 @@ import math
 import os
 import re
 import reprlib
+from collections.abc import Sequence
 from contextvars import ContextVar
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -35,6 +36,7 @@ from stereovision._validate import (
     number_shown,
     positive_finite,
     renamed_keyword,
+    text_shown,
     user_stacklevel,
     xy_points,
 )
@@ -1831,7 +1833,7 @@ class Calibration:
         cls,
         path: PathLike,
         image_size: tuple[int, int] | None = None,
-        cameras: tuple[int, int] = (2, 3),
+        cameras: Sequence[int] | npt.NDArray[np.integer] = (2, 3),
     ) -> Calibration:
         """Rectified calibration of KITTI's colour pair (cameras 2 and 3), metres.
 
@@ -1854,9 +1856,9 @@ class Calibration:
         image_size : tuple of int, optional
             ``(width, height)``, used when the file has no ``S_rect_02``; else a check: a
             file of another size is refused.
-        cameras : tuple of int
+        cameras : sequence of int
             The left and right camera's numbers: ``(2, 3)`` the colour pair (default),
-            ``(0, 1)`` the grey one.
+            ``(0, 1)`` the grey one (a tuple, list or 1-D integer array of two).
 
         Returns
         -------
@@ -1871,23 +1873,36 @@ class Calibration:
             If the projection matrices or the image size are missing, ``image_size``
             contradicts ``S_rect_02``, or ``cameras`` is not two of 0-3.
         """
+        # any sequence of two integers: a tuple, a list, a range, a NumPy array (a pair taken
+        # from a table; np.array([0, 1]) was refused as not two of cameras 0-3)
+        given: object = cameras
+        if isinstance(given, np.ndarray):
+            given = given.tolist() if given.ndim == 1 else None
+        elif isinstance(given, Sequence) and not isinstance(given, (str, bytes)):
+            given = [c.item() if isinstance(c, np.generic) else c for c in given]
+        else:
+            given = None
         ok = (
-            isinstance(cameras, (tuple, list))
-            and len(cameras) == 2
-            # a NumPy integer too (a pair taken from a table or an array) was refused
-            and all(
-                isinstance(c, (int, np.integer)) and not isinstance(c, (bool, np.bool_))
-                for c in cameras
-            )
-            and {int(c) for c in cameras} <= {0, 1, 2, 3}
-            and cameras[0] != cameras[1]
+            isinstance(given, list)
+            and len(given) == 2
+            and all(isinstance(c, int) and not isinstance(c, bool) for c in given)
+            and set(given) <= {0, 1, 2, 3}
+            and given[0] != given[1]
         )
         if not ok:
+            # by its values: "[0, 5]", "(0, 5)", not "array([0, 5])", "(np.int64(0), ...)"
+            if isinstance(cameras, np.ndarray):
+                shown = repr(cameras.tolist())
+            elif isinstance(cameras, tuple) and isinstance(given, list):
+                shown = repr(tuple(given))
+            else:
+                shown = text_shown(cameras)
             raise ValueError(
                 f"cameras: expected two of KITTI's cameras 0-3 ((2, 3) colour, (0, 1) grey), "
-                f"got {cameras!r}"
+                f"got {shown}"
             )
-        a, b = (int(c) for c in cameras)
+        assert isinstance(given, list)
+        a, b = given
         p, _ = cls._read_text(path)
         v = parse_kitti_calib(p)
         for k2, k3 in ((f"P_rect_0{a}", f"P_rect_0{b}"), (f"P{a}", f"P{b}")):
