@@ -469,6 +469,30 @@ def test_pair_and_calibration_mistakes_are_named() -> None:
         sv.match(s.left, s.right, "calib.yaml", method="best")  # type: ignore[arg-type]
 
 
+@pytest.mark.parametrize(
+    ("size", "said"),
+    [
+        ((450, 374), "1 row more"),  # a KITTI frame of 1242x376 against 1242x375
+        ((450, 377), "2 rows fewer"),
+        ((449, 376), "1 column more and 1 row fewer"),
+    ],
+)
+def test_a_frame_padded_or_cropped_by_a_few_rows_is_not_said_resized(
+    size: tuple[int, int], said: str
+) -> None:
+    """A frame a row or two off the calibration's size (KITTI's 1242x375 and 1242x376) was
+    said "images resized, not cropped: calib.scaled_to(...)", a 0.3 % stretch of one axis:
+    with one side unchanged (or one larger, one smaller) no resize made it."""
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")
+    calib = dataclasses.replace(s.calib, image_size=size)
+    with pytest.raises(
+        ValueError,
+        match=rf"^calibration is for {size[0]}x{size[1]} images, got 450x375 \(images cropped "
+        rf"or padded, not resized \({said}\): crop or pad them to {size[0]}x{size[1]}",
+    ):
+        sv.depth_map(s.left, s.right, calib)
+
+
 def test_a_whole_result_or_a_wrong_unit_is_named(tmp_path: Path) -> None:
     """A DepthResult passed where one of its arrays is meant failed deep inside ("float()
     argument must be ... not 'DepthResult'"); to_ply('x.pcd') wrote PLY bytes, a depth PNG named
