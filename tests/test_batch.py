@@ -333,6 +333,21 @@ def test_find_pairs_layouts_it_leaves_out_or_names_by_the_root(tmp_path: Path) -
     assert [(u.name, u.present.name) for u in unpaired] == [("x~3", "x-left.png")]
 
 
+def test_a_clash_suffix_does_not_take_a_pair_s_own_name(tmp_path: Path) -> None:
+    """Two pairs named ``x`` were told apart as ``x`` and ``x~2`` though a folder ``x~2`` held a
+    pair of its own: two pairs named ``x~2``, one output folder and one summary entry for both.
+    The suffix skips the names pairs have; names without a clash are unchanged."""
+    _blank(tmp_path, "x/left.png", "x/right.png", "x/left.jpg", "x/right.jpg")
+    _blank(tmp_path, "x~2/left.png", "x~2/right.png", "y/left_1.png", "y/right_1.png")
+    jobs = find_pairs(tmp_path)
+    assert [(j.name, j.left.relative_to(tmp_path).as_posix()) for j in jobs] == [
+        ("x", "x/left.png"),
+        ("x~2", "x~2/left.png"),
+        ("x~3", "x/left.jpg"),
+        ("y/1", "y/left_1.png"),
+    ]
+
+
 def test_batch_errors_are_one_line(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["batch", str(tmp_path / "missing"), "-o", str(tmp_path / "o")]) == 2
     assert main(["batch", str(tmp_path), "-o", str(tmp_path / "o")]) == 2

@@ -303,12 +303,19 @@ def _scan(
     # stable): camera folders' images were not pairs before
     found += cam_found
     found.sort(key=lambda j: j.name)
-    seen: dict[str, int] = {}
+    # a clash takes the next suffix no pair has: x~2 beside a folder x~2 of its own made two
+    # pairs x~2, one output folder and one summary entry
+    own = {j.name for j in found}
     unique: list[PairJob] = []
+    used: set[str] = set()
     for j in found:
-        n = seen.get(j.name, 0)
-        seen[j.name] = n + 1
-        unique.append(j if n == 0 else PairJob(f"{j.name}~{n + 1}", j.left, j.right, j.calib))
+        name, n = j.name, 1
+        while name in used or (n > 1 and name in own):
+            n += 1
+            name = f"{j.name}~{n}"
+        used.add(name)
+        unique.append(j if n == 1 else PairJob(name, j.left, j.right, j.calib))
+    unique.sort(key=lambda j: j.name)
     # the pairs keep the names they had before these were reported; these take the next ones
     taken = {j.name for j in unique}
     named: list[_Unpaired] = []
