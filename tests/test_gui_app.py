@@ -3647,13 +3647,22 @@ def test_the_sparse_channels_are_offered_and_their_matches_drawn(method):
     assert said in app.state.stats and "density" not in app.state.stats
     n = len(view.result.points)
     assert n == np.isfinite(expected.dispx).sum()
+    # matches rounding to one pixel are one point (dispx keeps the better): the note said
+    # "its N points" under statistics of more matches, the difference unexplained
+    k = len(expected)
+    assert k > n if method == "mcgm" else k == n  # 21 of 3468 MCGM matches share a pixel
+    dropped = (
+        f" ({k - n} of {k} matches not drawn: another match on the same pixel, or no valid depth)"
+        if k > n
+        else ""
+    )
     for mode in ("surface", "points"):
         app.state.view_mode = mode
         app._on_view_mode()
         poly = app.plotter.actors["scene"].GetMapper().GetInput()
         assert (poly.GetNumberOfPoints(), poly.GetNumberOfPolys()) == (n, 0), mode
         assert app.state.message_3d == (
-            f"{method} is sparse: no dense map, its {n} points shown as points"
+            f"{method} is sparse: no dense map, its {n} points shown as points{dropped}"
         )
         assert app.state.view_mode == "points" and app.state.points_only, mode
     # after Rectify (or for another pair) the scene's GT is not that pair's: no precision said

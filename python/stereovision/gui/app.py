@@ -962,11 +962,16 @@ def compute_view(
         message_3d = "No calibration: give --calib to see the scene in 3-D."
     elif len(result.points) == 0:
         message_3d = "Empty point cloud: the matcher found no depth in this pair."
-    elif sparse:
+    elif matches is not None:  # sparse
         # no dense map to draw a surface of: the matched points, in either mode
         mesh, count = shown_cloud(result.points, result.colors)
         intr = Intrinsics.from_result(result)
-        message_3d = f"{method} is sparse: no dense map, its {count} shown as points"
+        message_3d = f"{method} is sparse: no dense map, its {count} shown as points" + (
+            f" ({len(matches) - len(result.points)} of {len(matches)} matches not drawn: another "
+            "match on the same pixel, or no valid depth)"
+            if len(matches) > len(result.points)
+            else ""
+        )
     else:
         report(95, "building the 3-D surface")
         step = max(1, math.ceil(math.sqrt(len(result.points) / MAX_MESH_VERTICES)))
