@@ -291,7 +291,8 @@ def estimate_max_disparity(left: npt.ArrayLike, right: npt.ArrayLike) -> int:
     the 17 GT scenes of ``../shared/data`` the range covers the GT's 99.5th percentile on all of
     them, in 8-41 ms (ORB alone, as before: 15 of them, KITTI 80 px for a GT that reaches 101
     px, in 50-200 ms). The feature matches also warn of a pair that looks swapped (most of
-    them with a negative disparity) or unrectified (fewer than 20 % of them within 2 rows).
+    them with a negative disparity) or unrectified (fewer than 20 % of them within 2 rows, and
+    :func:`~stereovision.rectification_check.check_rectification` does not pass the pair).
 
     Parameters
     ----------
@@ -332,6 +333,7 @@ def _orb_top(gl: npt.NDArray[np.uint8], gr: npt.NDArray[np.uint8]) -> float | No
     if min(gl.shape) < _AUTO_ORB_MIN_SIDE:
         return None
     s = 2 if min(gl.shape) >= _AUTO_ORB_HALF_FROM else 1
+    full = (gl, gr)  # for the rows check that confirms an unrectified verdict
     if s > 1:
         size = (gl.shape[1] // s, gl.shape[0] // s)
         gl = np.asarray(cv2.resize(gl, size, interpolation=cv2.INTER_AREA), np.uint8)
@@ -348,7 +350,7 @@ def _orb_top(gl: npt.NDArray[np.uint8], gr: npt.NDArray[np.uint8]) -> float | No
     d = pl[:, 0] - pr[:, 0]
     dy = np.abs(pl[:, 1] - pr[:, 1])
     same_row = dy <= _AUTO_DY_TOL / s
-    _warn_if_unrectified(same_row, dy * s)
+    _warn_if_unrectified(same_row, dy * s, *full)
     _warn_if_swapped(d[same_row] * s)
     keep = same_row & (d >= 0)
     if int(keep.sum()) < _AUTO_MIN_MATCHES:
@@ -356,14 +358,31 @@ def _orb_top(gl: npt.NDArray[np.uint8], gr: npt.NDArray[np.uint8]) -> float | No
     return float(np.percentile(d[keep], _AUTO_PERCENTILE)) * s
 
 
-def _warn_if_unrectified(same_row: npt.NDArray[np.bool_], dy: npt.NDArray[np.float64]) -> None:
+def _warn_if_unrectified(
+    same_row: npt.NDArray[np.bool_],
+    dy: npt.NDArray[np.float64],
+    gl: npt.NDArray[np.uint8],
+    gr: npt.NDArray[np.uint8],
+) -> None:
     """Warn when the pair looks unrectified: few of the feature matches lie within
     ``_AUTO_DY_TOL`` rows of each other (two raw camera images, matched along rows they do not
-    share, gave a map of noise without a word). ``dy`` in full-resolution pixels."""
+    share, gave a map of noise without a word). ``dy`` in full-resolution pixels, ``gl``/``gr``
+    the full-resolution grey pair.
+
+    ORB's matches are cross-checked only, so on a repeated texture (a chessboard: 9 of OpenCV's
+    13 sample pairs, rectified by their own calibration, had 8-20 % within 2 rows) most pair a
+    corner with the wrong copy of it. The verdict is then confirmed by the rows check's SIFT
+    matches (ratio-tested, :func:`~stereovision.rectification_check.check_rectification`): a
+    pair they find on common rows is not warned about.
+    """
     if same_row.size < _AUTO_MIN_MATCHES:
         return
     share = float(np.mean(same_row))
     if share < _UNRECTIFIED_SHARE:
+        from stereovision.rectification_check import check_rectification
+
+        if check_rectification(gl, gr).ok is True:
+            return
         warnings.warn(
             f"the left and right images look unrectified: {share:.0%} of the feature matches "
             f"lie within {_AUTO_DY_TOL:g} rows of each other ({same_row.size} matches, median "
