@@ -1217,13 +1217,16 @@ def test_depth_takes_a_q_dat_apart_from_its_scene_sized_by_the_pair(
     ref = depth_map(scene.left, scene.right, scene.calib, method="fast", max_disparity=64)
     assert ref.depth is not None
     np.testing.assert_array_equal(np.load(out / "depth.npy"), ref.depth)
-    # info has no pair: still refused, in one line
+    # info has no pair: still refused, in one line, which names its --size (it named none,
+    # where the same refusal of stereo_calib output and of a KITTI file did); Python's call
+    # names image_size=
     assert main(["info", str(q)]) == 2
-    assert (
-        capsys.readouterr()
-        .err.strip()
-        .endswith("Q.dat does not give the image size and there is no left.png beside it")
-    )
+    refused = "Q.dat does not give the image size and there is no left.png beside it"
+    assert capsys.readouterr().err.strip().endswith(f"{refused}: pass --size WxH")
+    with pytest.raises(ValueError, match=r"beside it: pass image_size=\(width, height\)$"):
+        Calibration.from_file(q)
+    assert main(["info", str(q), "--size", "900x750"]) == 0
+    assert "900x750 px, rectified pair" in capsys.readouterr().out
     # a left.png beside the Q.dat still sizes it (a half-size pair is refused with the hint)
     half = cv2.resize(cv2.imread(pair[0]), None, fx=0.5, fy=0.5)
     cv2.imwrite(str(q.parent / "left.png"), cv2.imread(pair[0]))

@@ -2734,7 +2734,10 @@ def _scene_image_size(q_file: Path) -> tuple[int, int]:
 
             h, w = imread(folder / name).shape[:2]
             return w, h
-    raise ValueError(f"{q_file} does not give the image size and there is no left.png beside it")
+    raise ValueError(
+        f"{q_file} does not give the image size and there is no left.png beside it: "
+        "pass image_size=(width, height)"
+    )
 
 
 _OPENCV_EXTS = (".yml", ".yaml", ".xml")
