@@ -63,3 +63,35 @@ def test_a_rectified_chessboard_is_not_said_unrectified(
     lower = cv2.warpAffine(right, np.float32([[1, 0, 0], [0, 1, 6]]), right.shape[1::-1])
     with pytest.warns(UserWarning, match=r"look unrectified: \d+% of the feature matches"):
         sv.estimate_max_disparity(left, lower)
+
+
+def test_info_lists_the_topics_of_a_bag_without_a_pair(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stereovision info depth_run/` on the bag `stream --bag depth_run/` had written printed
+    one error line ("no left/right pair among the bag's image topics ...") and nothing of what
+    the bag holds, where `info BAG` is documented as "its topics, the stereo pair found". The
+    topics are listed, then the reason (exit 2 as before)."""
+    pytest.importorskip("rosbags")
+    from importlib import resources
+
+    import stereovision as sv
+    from stereovision.io import load_scene
+    from stereovision.rosbag import BagWriter
+
+    sc = load_scene(Path(str(resources.files("stereovision") / "data" / "cones")))
+    res = sv.depth_map(sc.left, sc.right, sc.calib, method="gabor", max_disparity=64)
+    with BagWriter(tmp_path / "depth_run") as bag:
+        bag.write(res, 1_700_000_000_000_000_000)
+    assert main(["info", str(tmp_path / "depth_run")]) == 2
+    out, err = capsys.readouterr()
+    assert out.startswith(f"bag {tmp_path / 'depth_run'} (ROS 2, ")
+    listed = [ln.split()[:2] for ln in out.splitlines()[1:]]
+    assert ["/stereo/depth", "sensor_msgs/msg/Image"] in listed
+    assert ["/stereo/points", "sensor_msgs/msg/PointCloud2"] in listed
+    assert err.count("\n") == 1 and "no left/right pair among the bag's image topics" in err
+    # a path that is no bag is still one line, nothing listed
+    (tmp_path / "empty").mkdir()
+    assert main(["info", str(tmp_path / "empty")]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1

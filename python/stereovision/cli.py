@@ -1272,9 +1272,18 @@ def cmd_info(args: argparse.Namespace) -> int:
         return 0
     if args.size is not None or args.calib_unit is not None:
         raise CliError("--size and --calib-unit are for a calibration file, not a bag")
-    from stereovision.rosbag import BagCamera
+    from stereovision.rosbag import BagCamera, bag_topics
 
-    with BagCamera(args.calib, left_topic=topics[0], right_topic=topics[1]) as cam:
+    try:
+        cam = BagCamera(args.calib, left_topic=topics[0], right_topic=topics[1])
+    except ValueError:
+        # no stereo pair found (or the topics given are not image topics): the topics are
+        # still what `info BAG` shows, the reason below them (a depth bag of `stream --bag`
+        # holds one camera's images: listing nothing hid what it holds)
+        with contextlib.suppress(ValueError):
+            print(bag_topics(args.calib))
+        raise
+    with cam:
         print(cam.summary())
         calib = cam.calibration()
     if calib is None:

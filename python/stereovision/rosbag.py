@@ -719,6 +719,58 @@ def _open_reader(path: Path) -> Any:
     return reader
 
 
+def _topic_lines(path: Path, reader: Any, roles: dict[str, str]) -> str:
+    """``BagCamera.summary``'s lines: the bag, then each topic's type, messages and rate,
+    with its role (``roles``: topic -> suffix)."""
+    span_s = max(reader.duration, 1) / 1e9
+    kind = "ROS 2" if getattr(reader, "is2", True) else "ROS 1"
+    lines = [f"bag {path} ({kind}, {span_s:.1f} s, {len(reader.topics)} topics)"]
+    width = max((len(t) for t in reader.topics), default=0)
+    for topic, info in sorted(reader.topics.items()):
+        lines.append(
+            f"  {topic:<{width}}  {info.msgtype:<31} {info.msgcount:7d} msgs "
+            f"{_rate(info.msgcount, reader):7.2f} Hz{roles.get(topic, '')}"
+        )
+    return "\n".join(lines)
+
+
+def bag_topics(path: str | os.PathLike[str]) -> str:
+    """The topics of any bag, as :meth:`BagCamera.summary` lists them, without looking for a
+    stereo pair: for a bag in which none is found (the depth bag ``stream --bag`` writes holds
+    one image topic and the depth image), so that ``info`` still shows what it holds.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        A ROS 1 ``.bag`` file or a folder of them, or a ROS 2 bag folder (or one of its files).
+
+    Returns
+    -------
+    str
+        A few lines for a terminal.
+
+    Raises
+    ------
+    ValueError
+        If ``path`` is not a readable bag.
+    ImportError
+        Without the ``rosbags`` package.
+    """
+    p = Path(path)
+    if p.is_file() and (p.parent / "metadata.yaml").is_file():
+        p = p.parent  # a file of a ROS 2 bag, as BagCamera takes it
+    try:
+        reader = _open_reader(p)
+    except ImportError:
+        raise
+    except Exception as exc:  # rosbags' errors name no common base class
+        raise ValueError(f"{p} is not a readable ROS 1 or ROS 2 bag: {exc}") from None
+    try:
+        return _topic_lines(p, reader, {})
+    finally:
+        reader.close()
+
+
 def decode_image(msg: Any) -> np.ndarray:
     """A ``sensor_msgs/Image`` or ``CompressedImage`` message as a BGR image.
 
@@ -1254,18 +1306,9 @@ class BagCamera(PairSource):
         reader = self._reader
         if reader is None:
             return f"bag {self.path} (closed)"
-        span_s = max(reader.duration, 1) / 1e9
-        kind = "ROS 2" if getattr(reader, "is2", True) else "ROS 1"
-        lines = [f"bag {self.path} ({kind}, {span_s:.1f} s, {len(reader.topics)} topics)"]
         roles = {t: f"  <- {side}" for side, t in self.topics.items()}
         roles |= {t: f"  <- {side} camera_info" for side, t in self.info_topics.items() if t}
-        width = max(len(t) for t in reader.topics)
-        for topic, info in sorted(reader.topics.items()):
-            lines.append(
-                f"  {topic:<{width}}  {info.msgtype:<31} {info.msgcount:7d} msgs "
-                f"{_rate(info.msgcount, reader):7.2f} Hz{roles.get(topic, '')}"
-            )
-        return "\n".join(lines)
+        return _topic_lines(self.path, reader, roles)
 
     # ---------------------------------------------------------------------------- calibration
 
