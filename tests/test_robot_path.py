@@ -95,3 +95,36 @@ def test_info_lists_the_topics_of_a_bag_without_a_pair(
     assert main(["info", str(tmp_path / "empty")]) == 2
     out, err = capsys.readouterr()
     assert out == "" and err.count("\n") == 1
+
+
+def test_rectify_with_a_calibration_writes_the_rectified_pair_s(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`rectify raw_left raw_right --calib rig.yaml -o rect/` wrote the rectified pair and no
+    calibration for it: `depth rect/left_rect.png rect/right_rect.png --calib rig.yaml`
+    rectified it a second time (rows 11.5 px apart, a warning, wrong depths), and the rectified
+    rig was only to be had in Python (`calib.rectified_calibration()`). It writes
+    `calib_rect.yaml`, with which depth on the rectified pair is the raw pair's, bit for bit;
+    a later run without --calib removes it with the rest of its run's files."""
+    rig = _chessboard_rig()
+    rig.save(tmp_path / "rig.yaml")  # type: ignore[attr-defined]
+    board = data_dir / "chessboard"
+    raw = [str(board / "left01.jpg"), str(board / "right01.jpg")]
+    rect = tmp_path / "rect"
+    assert main(["rectify", *raw, "--calib", str(tmp_path / "rig.yaml"), "-o", str(rect)]) == 0
+    out = capsys.readouterr().out
+    assert f"  calib_rect.yaml     {rect / 'calib_rect.yaml'}" in out
+    assert f"--calib {rect / 'calib_rect.yaml'}" in out  # the next command, said
+    opts = ["--method", "gabor", "--max-disparity", "96"]
+    pair = [str(rect / "left_rect.png"), str(rect / "right_rect.png")]
+    on_rect = [*pair, "--calib", str(rect / "calib_rect.yaml"), *opts, "-o", str(tmp_path / "a")]
+    assert main(["depth", *on_rect]) == 0
+    on_raw = [*raw, "--calib", str(tmp_path / "rig.yaml"), *opts, "-o", str(tmp_path / "b")]
+    assert main(["depth", *on_raw]) == 0
+    assert "warning" not in capsys.readouterr().err
+    np.testing.assert_array_equal(np.load(tmp_path / "a" / "depth.npy"),
+                                  np.load(tmp_path / "b" / "depth.npy"))  # fmt: skip
+    # the pair rectified from its features instead: the calibration of the earlier run goes
+    assert main(["rectify", *raw, "-o", str(rect)]) == 0
+    assert "removed calib_rect.yaml of an earlier run" in capsys.readouterr().out
+    assert not (rect / "calib_rect.yaml").exists() and (rect / "rectification.json").is_file()

@@ -1047,7 +1047,13 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 #: Every file ``stereovision rectify`` may write into its ``-o`` folder.
-RECTIFY_OUTPUTS = ("left_rect.png", "right_rect.png", "check.png", "rectification.json")
+RECTIFY_OUTPUTS = (
+    "left_rect.png",
+    "right_rect.png",
+    "check.png",
+    "rectification.json",
+    "calib_rect.yaml",
+)
 
 #: What ``stereovision rectify`` wrote into its ``-o`` folder (JSON list of file names, as
 #: :data:`DEPTH_MANIFEST`): the files a later run may replace.
@@ -1086,7 +1092,9 @@ def cmd_rectify(args: argparse.Namespace) -> int:
     for name in RECTIFY_OUTPUTS:
         _refuse_an_input("-o", out / name, inputs)  # rectifying rect/*.png again into rect/
     # a left_rect.png of the user's is not replaced; this command's own (its manifest's) are
-    names = RECTIFY_OUTPUTS if calib is None else RECTIFY_OUTPUTS[:3]
+    # with --calib: the rectified pair's own calibration, where without one its homographies
+    own = "rectification.json" if calib is None else "calib_rect.yaml"
+    names = (*RECTIFY_OUTPUTS[:3], own)
     earlier = refuse_foreign_outputs(out, names, RECTIFY_MANIFEST)
     refuse_folders_under(out, names)  # a listed one made a folder: not once the pair is warped
     given = None  # the pair's own check, when it is already rectified: written as given
@@ -1142,8 +1150,14 @@ def cmd_rectify(args: argparse.Namespace) -> int:
             _atomic_write_bytes(staged[name], _png_bytes(img))
         if summary is not None:
             staged["rectification.json"] = summary.save(stage / "rectification.json")
+        if calib is not None:
+            # without it `depth rect/*.png --calib rig.yaml` rectified the pair a second time:
+            # depth on the rectified pair needs the rectified rig (R = I, no distortion)
+            staged["calib_rect.yaml"] = calib.rectified_calibration().save(
+                stage / "calib_rect.yaml"
+            )
         written, removed = commit_outputs(
-            out, staged, earlier, RECTIFY_MANIFEST, RECTIFY_OUTPUTS, stale=_homographies
+            out, staged, earlier, RECTIFY_MANIFEST, RECTIFY_OUTPUTS, stale=_stale_rectify_output
         )
     if summary is not None:
         print(summary.describe())
@@ -1168,11 +1182,26 @@ def cmd_rectify(args: argparse.Namespace) -> int:
             )
     for name, path in written.items():
         print(f"  {name:19s} {path}")
-    now = "the pair as given" if given is not None else "rectified by --calib"
-    for path in removed:
+    if "calib_rect.yaml" in written:
         print(
-            f"  removed {path.name} of an earlier run (its homographies do not fit the "
-            f"images written now: {now})"
+            f"  depth on the rectified pair: stereovision depth {written['left_rect.png']} "
+            f"{written['right_rect.png']} --calib {written['calib_rect.yaml']} -o OUT (the raw "
+            "rig's calibration would rectify it again)"
+        )
+    now = (
+        "the pair as given"
+        if given is not None
+        else "rectified by --calib"
+        if calib is not None
+        else "rectified from its features"
+    )
+    for path in removed:
+        what = (
+            "homographies do" if path.name == "rectification.json" else "rectified calibration does"
+        )
+        print(
+            f"  removed {path.name} of an earlier run (its {what} not fit the images "
+            f"written now: {now})"
         )
     mine = out / "rectification.json"
     if (
@@ -1188,6 +1217,13 @@ def cmd_rectify(args: argparse.Namespace) -> int:
             "to depth --rectification with them"
         )
     return 0
+
+
+def _stale_rectify_output(path: Path) -> bool:
+    """Whether an earlier ``rectify`` run's file this run did not write goes: its
+    ``calib_rect.yaml`` always (it is the calibration of the images it wrote), its
+    ``rectification.json`` when it holds homographies (:func:`_homographies`)."""
+    return path.name != "rectification.json" or _homographies(path)
 
 
 def _homographies(path: Path) -> bool:
@@ -1889,8 +1925,10 @@ def build_parser() -> argparse.ArgumentParser:
         "rectify",
         help="rectify a pair: with --calib, or without a calibration from its own features",
         description="Write the rectified pair (left_rect.png, right_rect.png) and how its rows "
-        "agree. Without --calib the homographies are found from the pair's feature matches "
-        "(disparity, not metric depth) and saved as rectification.json, with the disparity "
+        "agree. With --calib also calib_rect.yaml, the rectified pair's calibration (for "
+        "depth --calib on left_rect.png and right_rect.png). Without --calib the homographies "
+        "are found from the pair's feature matches (disparity, not metric depth) and saved as "
+        "rectification.json, with the disparity "
         "range to search; a pair whose rows already agree (as `check` measures them) is "
         "written as given, not warped, unless --force.",
     )
