@@ -686,3 +686,34 @@ def test_the_motion_tests_saturation_rule(kind: str, share: float, restarts: lis
     # not restarted: the view averaged 5 frames, the window's pixels restarted alone
     expected = 1.0 if restarts[-1] else (1 - share) * 5 + share * 1
     assert tf.mean_frames() == pytest.approx(expected, abs=0.03)
+
+
+@pytest.mark.parametrize("level", [1, 254])
+def test_noise_beside_clipped_pixels_is_left_out(level: int) -> None:
+    """Noise 8 on a flat grey 128, beside a region at ``level`` whose noise clips at 0 or 255
+    over most of the view (a dark corner, a saturated sky): the clipped pixels' unclipped
+    neighbours, whose Laplacian sees a clipped value, are left out with them. A mutation audit
+    of a stream left that erosion unasserted: without it the estimate read 5.9-6.0, not ~8."""
+    rng = np.random.default_rng(0)
+    img = np.full((240, 320), 128.0)
+    img[:, :256] = level
+    img = np.clip(np.round(img + rng.normal(0, 8, img.shape)), 0, 255).astype(np.uint8)
+    assert noise_sigma(img) == pytest.approx(8.0, abs=0.5)
+
+
+def test_a_light_that_saturates_part_of_the_view_keeps_averaging_there() -> None:
+    """A ramp with noise 4 and a strip at 235 lit 15 % brighter: the strip clips at 255 and
+    its relit mean (235 * 1.15 = 270) is clipped to the frame's range, so the strip agrees with
+    the frame and keeps averaging with the rest (5 frames of 5 nearly everywhere, output 255 bar
+    a few). A mutation audit of a stream left that clip unasserted: unclipped, the strip's pixels
+    restarted (4.59 frames on average)."""
+    rng = np.random.default_rng(1)
+    base = np.tile(np.linspace(40, 200, 320), (240, 1))
+    base[:, 280:] = 235
+    tf = TemporalFilter()
+    for gain in (1.0, 1.0, 1.0, 1.0, 1.15):
+        frame = np.clip(np.round(base * gain + rng.normal(0, 4, base.shape)), 0, 255)
+        out, _ = tf(frame.astype(np.uint8), frame.astype(np.uint8))
+    assert tf.restarts == 0 and tf.relit == 2
+    assert np.mean(out[:, 280:] == 255) > 0.99  # a few means relit to 253-254
+    assert tf.mean_frames() > 4.9, tf.mean_frames()
