@@ -1660,6 +1660,19 @@ def test_a_first_pair_that_does_not_decode_is_a_value_error() -> None:
     assert (rep.frames, rep.ended, rep.error) == (1, "source failed", "frame 1 does not decode")
 
 
+def test_a_later_frame_that_does_not_decode_is_no_end_of_the_source() -> None:
+    """A camera whose first pair was read before the stream (a preview) and whose next frame
+    does not decode: no pair was done, so the error is raised, a SourceError that is not an end
+    (``end`` False, as capture's failing sources say; a mutation audit left it unasserted)."""
+    from stereovision.capture import SourceError
+
+    rig = _FakeRig([_frame(0), ValueError("frame 1 does not decode")])
+    rig.read()
+    with pytest.raises(SourceError, match="frame 1 does not decode") as err:
+        run_stream(rig, max_disparity=8, pipelined=False, check=False)  # type: ignore[arg-type]
+    assert (err.value.end, err.value.frames) == (False, 1)
+
+
 def test_a_recordings_results_carry_each_pairs_own_stamp() -> None:
     """A recording's pair is stamped with its own stamp (the latest read), not its first's."""
     stamps = [1_000_000_000, 1_033_000_000, 1_066_000_000]
