@@ -1729,6 +1729,15 @@ def test_a_window_reports_its_own_pairs_per_second() -> None:
     assert (rep["frames"], rep["total_frames"], rep["fps"]) == (2, 10, 4.0)
 
 
+def test_a_window_reports_the_mean_of_its_pairs_averaged_frames() -> None:
+    """A per-second report's ``frames_averaged`` is the mean over its pairs (1 and 3: 2), not
+    the last pair's (a mutation audit's survivor)."""
+    from stereovision.stream import _Done, _window_report
+
+    done = [_Done(dict.fromkeys(STAGES, 0.001), 0.01, 0.0, 0.1, 0.5, averaged=a) for a in (1, 3)]
+    assert _window_report(done, 0.5, 2, 0.5, 8, False)["frames_averaged"] == 2.0
+
+
 def test_a_temporal_stream_warns_once_of_frames_resampled_before_it() -> None:
     """With ``temporal``, a source whose frames come resampled (a bag's rectified topics) is
     said once, on the first pair: the filter takes the spread noise for motion."""
@@ -1762,6 +1771,31 @@ def test_an_explicit_disparity_range_wins_over_the_homographies() -> None:
         rep = run_stream(_FakeRig([_frame(0)]), max_disparity=given,  # type: ignore[arg-type]
                          pipelined=False, check=False, homographies=_Homographies())  # fmt: skip
         assert (rep.frames, rep.max_disparity) == (1, used)
+
+
+def test_the_homographies_rectify_every_pair() -> None:
+    """Each pair is rectified through the homographies before matching: ``on_result`` gets the
+    rectified left image (a mutation audit dropped the call and no test failed)."""
+
+    class Flips(_Homographies):
+        def rectify(self, left: np.ndarray, right: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return left[::-1].copy(), right[::-1].copy()
+
+    pairs = [_frame(i) for i in range(2)]
+    seen: list[np.ndarray] = []
+    rep = run_stream(_FakeRig(pairs), pipelined=False, check=False, homographies=Flips(),  # type: ignore[arg-type]
+                     on_result=lambda left, res: seen.append(left))  # fmt: skip
+    assert rep.frames == 2
+    for got, fr in zip(seen, pairs, strict=True):
+        assert np.array_equal(got, fr.left[::-1])
+
+
+def test_check_every_one_checks_every_pair() -> None:
+    """``check_every=1`` checks the rows of every pair, not only the first (a mutation audit
+    took the 1 for "none after the first" and no test failed)."""
+    rep = run_stream(_FakeRig([_frame(i) for i in range(3)]), max_disparity=8,  # type: ignore[arg-type]
+                     pipelined=False, check_every=1)  # fmt: skip
+    assert [c["pair"] for c in rep.checks] == [0, 1, 2]
 
 
 @pytest.mark.parametrize("pipelined", [False, True])
@@ -1825,6 +1859,32 @@ def test_a_camera_whose_read_hangs_is_given_up(
     assert time.perf_counter() - t0 < 6.0
     with pytest.raises(ValueError, match=r"read_timeout: expected a positive number of seconds"):
         run_stream(_FakeRig([_frame(0)]), max_disparity=8, read_timeout=0)  # type: ignore[arg-type]
+
+
+@PIPELINED
+def test_a_calibrated_streams_first_pair_read_ahead_is_given_up_on_a_hung_camera(
+    videos: dict[str, Path],
+) -> None:
+    """With a calibration the first pair is read ahead (to fit the calibration to the frames
+    delivered): that read too gives up after ``read_timeout`` s, not when the camera comes back
+    (a mutation audit read it without the timeout and no test failed)."""
+    from stereovision.capture import SourceError
+
+    unplug = threading.Event()
+    back = threading.Timer(4.0, unplug.set)  # the camera "comes back": the mutant returned then
+    back.start()
+    cam = StereoCamera(str(videos["left"]), str(videos["right"]))
+    cam._caps["right"] = _HangsAfter(cam._caps["right"], 0, unplug)  # type: ignore[assignment]
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(SourceError, match=r"delivered no frame in 0\.3 s"):
+            run_stream(cam, Calibration.from_file(videos["calib"]), max_disparity=16,
+                       read_timeout=0.3)  # fmt: skip
+        assert time.perf_counter() - t0 < 3.0
+    finally:
+        unplug.set()
+        back.cancel()
+        cam.close()
 
 
 @PIPELINED
