@@ -1754,6 +1754,12 @@ def test_a_temporal_stream_warns_once_of_frames_resampled_before_it() -> None:
     assert len(said) == 1 and said[0].startswith(
         "temporal averaging: the topics /l/rect and /r/rect are rectified"
     )
+    # said on the first pair: a one-pair stream says it too (a mutation audit's survivor)
+    rig = _FakeRig([_frame(0), _frame(0)])
+    rig.rectified_topics, rig.topics = True, {"left": "/l/rect", "right": "/r/rect"}
+    with pytest.warns(UserWarning, match="temporal averaging: the topics"):
+        run_stream(rig, max_disparity=8, pipelined=False, check=False, frames=1,
+                   temporal=TemporalFilter(max_frames=4))  # fmt: skip
 
 
 class _Homographies:
@@ -2131,6 +2137,9 @@ def test_the_view_colours_the_whole_range_and_waits_for_a_new_frame() -> None:
     img = _compose(left, disp, 64.0)
     top = cv2.applyColorMap(np.array([[255]], np.uint8), cv2.COLORMAP_TURBO)[0, 0]
     assert img.shape == (4, 8, 3) and (img[:, 4:] == top).all() and top.any()
+    # the middle of a range of 16 is the colour map's middle (8 * 255 / 16 = 127.5: 127)
+    mid = cv2.applyColorMap(np.array([[127]], np.uint8), cv2.COLORMAP_TURBO)[0, 0]
+    assert (_compose(left, np.full((4, 4), 8.0, np.float32), 16.0)[:, 4:] == mid).all()
     srv = FrameServer("127.0.0.1", 0)
     try:
         srv.update(left, np.zeros((4, 4), np.float32), 8.0)
@@ -2396,6 +2405,28 @@ def test_a_sources_own_warnings_take_no_slot_and_the_last_one_is_given() -> None
     assert read == [2, 3, 4, 4]  # one pair ahead of the one matched, not more
     said = [(str(w.message), w.filename) for w in caught]
     assert said == [(f"read {i}", __file__) for i in range(5)], said
+
+
+@pytest.mark.parametrize("pipelined", [False, True])
+@PIPELINED
+def test_a_sources_own_warning_keeps_its_category(pipelined: bool) -> None:
+    """A source's warning of another category than UserWarning (a RuntimeWarning) is given as
+    that category from the grab thread too (a mutation audit gave every held warning as a
+    UserWarning and no test failed)."""
+    from stereovision._validate import source_warning
+
+    class Rig(_FakeRig):
+        def read(self) -> Any:
+            source_warning(f"read {self.count}", RuntimeWarning)
+            return super().read()
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        run_stream(Rig([_frame(0)]), max_disparity=8, check=False, pipelined=pipelined)  # type: ignore[arg-type]
+    assert [(str(w.message), w.category) for w in caught] == [
+        ("read 0", RuntimeWarning),
+        ("read 1", RuntimeWarning),
+    ]
 
 
 @PIPELINED
