@@ -112,9 +112,11 @@ pub fn log_filter(img: &Image, sigma: f32) -> Result<Vec<f32>> {
     let mut ha = try_zeroed::<f32>(w * h, "a LoG plane of the MCGM matcher")?;
     crate::parallel::for_each_row2(&mut hg, &mut ha, w, |y, og, oa| {
         let src = &img.data[y * w..(y + 1) * w];
-        let p: Vec<f32> = (-(r as isize)..(w + r) as isize)
-            .map(|i| src[reflect(i, w)])
-            .collect();
+        // The padded row: reflected borders around a copy of the row (no reflect per pixel).
+        let mut p: Vec<f32> = Vec::with_capacity(w + 2 * r);
+        p.extend((-(r as isize)..0).map(|i| src[reflect(i, w)]));
+        p.extend_from_slice(src);
+        p.extend((w as isize..(w + r) as isize).map(|i| src[reflect(i, w)]));
         row_pass(&p, &g, &a, og, oa);
     });
     // Column pass: L = ha *_y g + hg *_y a.
