@@ -901,7 +901,13 @@ fn half_better(
     // order); the scan stops at the first lane that fits better.
     for j0 in (0..nk).step_by(8) {
         let lanes = (nk - j0).min(8);
-        let open = bound.open_lanes(&scratch.v_top, &scratch.v_bot, j0, mean_free, open_below)
+        let open = bound.open_lanes(
+            (&scratch.v_top, &scratch.v_bot),
+            &mut scratch.tb,
+            j0,
+            mean_free,
+            open_below,
+        )
             & ((1u32 << lanes) - 1)
             & !near(j0);
         if open == 0 {
@@ -1010,10 +1016,11 @@ impl SidesBound {
 
     /// Bit `t` set when lane `j0 + t` is not ruled out: its bound / n is below `open_below`.
     #[inline(always)]
+    #[allow(clippy::type_complexity)]
     fn open_lanes(
         &self,
-        v_top: &[f32],
-        v_bot: &[f32],
+        (v_top, v_bot): (&[f32], &[f32]),
+        tb: &mut [([f32; 8], [f32; 8]); MAX_SIDES_WIDTH],
         j0: usize,
         mean_free: bool,
         open_below: f32,
@@ -1023,10 +1030,15 @@ impl SidesBound {
             std::array::from_fn(|t| v[t] + f * (v[t + 1] - v[t]))
         };
         let cols = &self.cols[..self.nc];
+        // Each column's interpolated right sums, once for both passes (the mean pass and the
+        // bound read the same values), in the caller's buffer (no per-block array to zero).
+        for (s, &(o, f, _, _)) in tb.iter_mut().zip(cols) {
+            *s = (interp(v_top, o, f), interp(v_bot, o, f));
+        }
+        let tb = &tb[..self.nc];
         let mut m = [0.0f32; 8];
         if mean_free {
-            for &(o, f, _, _) in cols {
-                let (t, b) = (interp(v_top, o, f), interp(v_bot, o, f));
+            for (t, b) in tb {
                 for q in 0..8 {
                     m[q] += t[q] + b[q];
                 }
@@ -1037,15 +1049,17 @@ impl SidesBound {
         }
         let (wt, wb) = self.rows;
         let mut acc = [0.0f32; 8];
-        for &(o, f, lt, lb) in cols {
-            let (t, b) = (interp(v_top, o, f), interp(v_bot, o, f));
+        for (&(_, _, lt, lb), (t, b)) in cols.iter().zip(tb) {
             for q in 0..8 {
                 acc[q] += (lt - t[q] - wt * m[q]).abs() + (lb - b[q] - wb * m[q]).abs();
             }
         }
-        acc.iter().enumerate().fold(0u32, |bits, (t, &a)| {
-            bits | (u32::from(a / self.n < open_below) << t)
-        })
+        // Compares first, then the bits (a vector compare and a mask, not eight branches).
+        let below: [bool; 8] = std::array::from_fn(|t| acc[t] / self.n < open_below);
+        below
+            .iter()
+            .enumerate()
+            .fold(0u32, |bits, (t, &b)| bits | (u32::from(b) << t))
     }
 }
 
@@ -1186,6 +1200,8 @@ struct SidesScratch {
     /// [`SidesBound`]'s column-wise sums of the right rows' upper and lower halves.
     v_top: Vec<f32>,
     v_bot: Vec<f32>,
+    /// [`SidesBound::open_lanes`]' interpolated column sums (upper, lower half) of a block.
+    tb: [([f32; 8], [f32; 8]); MAX_SIDES_WIDTH],
     /// The largest absolute grey value of the pair (the bound's rounding slack).
     scale: f32,
 }

@@ -525,8 +525,8 @@ fn bound_keeps_every_lane(
     for &(k, v) in &values {
         let j = (k_hi - k) as usize;
         let bits = bound.open_lanes(
-            &scratch.v_top,
-            &scratch.v_bot,
+            (&scratch.v_top, &scratch.v_bot),
+            &mut scratch.tb,
             j / 8 * 8,
             mean_free,
             v + slack,
