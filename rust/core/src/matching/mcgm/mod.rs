@@ -759,6 +759,7 @@ fn half_mad(
     side: i32,
     (inner, outer, hh): (i32, i32, i32),
     mean_free: bool,
+    diffs: &mut Vec<f32>,
 ) -> f32 {
     let n = ((outer - inner + 1) * (2 * hh + 1)) as f32;
     // Per column: the left x, the two right columns of the linear interpolation and its weight
@@ -777,22 +778,24 @@ fn half_mad(
         let row = &right.data[ry * right.width..(ry + 1) * right.width];
         left.at(x, ly) - (row[x0] + f * (row[x1] - row[x0]))
     };
+    // The differences once, in raster order, for both passes (`diffs`: the caller's buffer).
+    diffs.clear();
+    for dy in -hh..=hh {
+        let (ly, ry) = ((yl + dy) as usize, (yr + dy) as usize);
+        for c in 0..nc {
+            diffs.push(diff(ly, ry, c));
+        }
+    }
     let mut offset = 0.0f32;
     if mean_free {
-        for dy in -hh..=hh {
-            let (ly, ry) = ((yl + dy) as usize, (yr + dy) as usize);
-            for c in 0..nc {
-                offset += diff(ly, ry, c);
-            }
+        for &e in diffs.iter() {
+            offset += e;
         }
         offset /= n;
     }
     let mut sad = 0.0f32;
-    for dy in -hh..=hh {
-        let (ly, ry) = ((yl + dy) as usize, (yr + dy) as usize);
-        for c in 0..nc {
-            sad += (diff(ly, ry, c) - offset).abs();
-        }
+    for &e in diffs.iter() {
+        sad += (e - offset).abs();
     }
     sad / n
 }
@@ -1202,6 +1205,8 @@ struct SidesScratch {
     v_bot: Vec<f32>,
     /// [`SidesBound::open_lanes`]' interpolated column sums (upper, lower half) of a block.
     tb: [([f32; 8], [f32; 8]); MAX_SIDES_WIDTH],
+    /// [`half_mad`]'s differences of one half-window.
+    diffs: Vec<f32>,
     /// The largest absolute grey value of the pair (the bound's rounding slack).
     scale: f32,
 }
@@ -1246,7 +1251,18 @@ fn sides_ok(
     // Both half-windows' own fit first (cheap), then the other disparities.
     let mut here = [0.0f32; 2];
     for (h, side) in here.iter_mut().zip([-1i32, 1]) {
-        *h = half_mad(left, right, xi, yl, yr, d, side, geom, f.sides_mean_free);
+        *h = half_mad(
+            left,
+            right,
+            xi,
+            yl,
+            yr,
+            d,
+            side,
+            geom,
+            f.sides_mean_free,
+            &mut scratch.diffs,
+        );
         if *h > f.sides_mad {
             return false;
         }
