@@ -271,6 +271,43 @@ fn speckle_tables_too_large_to_allocate_are_an_error() {
     assert!(stdout.contains(want), "{want} not in {stdout}");
 }
 
+/// Run by [`speckle_band_labels_too_large_to_allocate_are_an_error`] in a child process: the
+/// map of [`speckle_tables_under_a_memory_limit`] under a limit of the label image (4 bytes a
+/// pixel) and 256 KiB more than is mapped: the first band's labels (one a pixel, 512 KiB) do
+/// not fit.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of speckle_band_labels_too_large_to_allocate_are_an_error"]
+fn speckle_band_labels_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let (w, h) = (4096usize, 2048usize);
+    let mut d: Vec<f32> = (0..w * h)
+        .map(|i| ((i % w + 2 * (i / w)) % 5) as f32 * 10.0)
+        .collect();
+    rayon::join(|| (), || ()); // the pool's thread started before the limit
+    crate::segment::tests::limit_address_space(
+        crate::segment::tests::vm_size() + 4 * w * h + (256 << 10),
+    );
+    match post::remove_speckles(&mut d, w, h, 2, 1.0) {
+        Ok(()) => println!("child: filtered {}", d[0]),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn speckle_band_labels_too_large_to_allocate_are_an_error() {
+    // Each band's union-find parents grew by push in the labelling loop: a failed allocation
+    // aborted the process (SIGABRT) instead of returning OutOfMemory.
+    let stdout = crate::segment::tests::run_oom_child(
+        "matching::gabor::tests::speckle_band_labels_under_a_memory_limit",
+    );
+    let want = "child: error: out of memory: the speckle filter's band labels needs 524288 bytes";
+    assert!(stdout.contains(want), "{want} not in {stdout}");
+}
+
 #[test]
 fn parallel_speckle_labelling_equals_the_flood_fill() {
     // Random maps (values 0.8 px apart, so only neighbouring levels join; NaN holes) of several sizes: regions of all
