@@ -296,6 +296,19 @@ pub fn try_collect<T>(n: usize, it: impl Iterator<Item = T>, what: &'static str)
     Ok(v)
 }
 
+/// `parts.concat()` (or a flattening `collect`) into a vector allocated at once, or
+/// [`CoreError::OutOfMemory`] (those abort the process when they cannot allocate). The parts
+/// are moved, not cloned.
+pub fn try_concat<T>(parts: Vec<Vec<T>>, what: &'static str) -> Result<Vec<T>> {
+    let n = parts.iter().map(Vec::len).fold(0, usize::saturating_add);
+    let mut v = Vec::new();
+    try_reserve_len(&mut v, n, what)?;
+    for p in parts {
+        v.extend(p);
+    }
+    Ok(v)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -329,6 +342,38 @@ mod tests {
             Err(CoreError::OutOfMemory { what: "c", .. })
         ));
         assert_eq!(try_collect(3, 1..4u8, "c").unwrap(), vec![1, 2, 3]);
+        let parts = vec![vec![1u16, 2], Vec::new(), vec![3]];
+        assert_eq!(try_concat(parts.clone(), "d").unwrap(), parts.concat());
+        assert_eq!(
+            try_concat(Vec::<Vec<u8>>::new(), "d").unwrap(),
+            Vec::<u8>::new()
+        );
+    }
+
+    /// Run by [`a_concat_too_large_to_allocate_is_an_error`] in a child process: four 8 MiB
+    /// parts under an address-space limit of 16 MiB more than is mapped.
+    #[cfg(target_os = "linux")]
+    #[test]
+    #[ignore = "a child of a_concat_too_large_to_allocate_is_an_error"]
+    fn concat_under_a_memory_limit() {
+        if std::env::var_os("SV_OOM_CHILD").is_none() {
+            return;
+        }
+        let parts: Vec<Vec<u8>> = (0..4u8).map(|i| vec![i + 1; 8 << 20]).collect();
+        crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (16 << 20));
+        match try_concat(parts, "the parts") {
+            Ok(v) => println!("child: concatenated {}", v.len()),
+            Err(e) => println!("child: error: {e}"),
+        }
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_concat_too_large_to_allocate_is_an_error() {
+        let stdout =
+            crate::segment::tests::run_oom_child("alloc::tests::concat_under_a_memory_limit");
+        let want = "child: error: out of memory: the parts needs 32.00 MiB (33554432 bytes)";
+        assert!(stdout.contains(want), "{want} not in {stdout}");
     }
 
     #[test]
