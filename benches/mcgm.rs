@@ -123,6 +123,7 @@ fn bench(c: &mut Criterion) {
                     &window,
                     &p.cand,
                 )
+                .expect("valid input")
             })
         });
         g.bench_function(BenchmarkId::new("image_curves", &id), |b| {

@@ -15,6 +15,8 @@ use rayon::prelude::*;
 
 use super::rtable::{ght_vote_rows, voters, RTable, RowIndex};
 use super::tracking::{wrap_angle, Segment};
+use crate::alloc::{try_concat, try_reserve_len};
+use crate::error::Result;
 use crate::matching::hopfield::{run_dynamics, Csr};
 
 /// One candidate segment pair with its GHT evidence.
@@ -45,7 +47,8 @@ pub struct CandParams {
 }
 
 /// Candidates of every left segment (grouped by left id, best score first). `window[A]` is the
-/// integer disparity window `[lo, hi]` of segment `A` (None: no candidates).
+/// integer disparity window `[lo, hi]` of segment `A` (None: no candidates). A failed
+/// allocation of the list is [`crate::CoreError::OutOfMemory`].
 #[allow(clippy::too_many_arguments)]
 pub fn candidates(
     left: &[Segment],
@@ -56,7 +59,7 @@ pub fn candidates(
     h: usize,
     window: &[Option<(i32, i32)>],
     p: &CandParams,
-) -> Vec<Candidate> {
+) -> Result<Vec<Candidate>> {
     // The right segments overlapping rows `y0..=y1` are those spanning row `y0` plus those
     // starting in `y0 + 1..=y1`: per row, the segments spanning it and the segments starting
     // on it (each segment met once, without scanning every row of a long left segment).
@@ -149,7 +152,7 @@ pub fn candidates(
             out
         })
         .collect();
-    per.into_iter().flatten().collect()
+    try_concat(per, "the MCGM matcher's candidate pairs")
 }
 
 /// Symmetrised k-nearest-neighbour adjacency of segment centroids within `r_max` px (sorted
@@ -289,14 +292,15 @@ pub struct Solution {
     pub converged: bool,
 }
 
-/// Builds the association graph's weights (CSR, symmetric, zero diagonal).
+/// Builds the association graph's weights (CSR, symmetric, zero diagonal). A failed allocation
+/// of the matrix (8 bytes a weight) is [`crate::CoreError::OutOfMemory`].
 pub fn association_weights(
     cands: &[Candidate],
     left: &[Segment],
     adj: &[Vec<u32>],
     n_right: usize,
     p: &SolverParams,
-) -> Csr {
+) -> Result<Csr> {
     let n_left = left.len();
     // Candidates per left segment (contiguous) and per right segment.
     let mut by_left: Vec<Vec<u32>> = vec![Vec::new(); n_left];
@@ -345,7 +349,13 @@ pub fn association_weights(
             row
         })
         .collect();
+    // Allocated at once, checked (they grew by push, aborting on a failure).
+    const WHAT: &str = "the MCGM matcher's association weights";
+    let nnz = rows.iter().map(Vec::len).sum();
     let mut csr = Csr::default();
+    try_reserve_len(&mut csr.indptr, rows.len() + 1, WHAT)?;
+    try_reserve_len(&mut csr.indices, nnz, WHAT)?;
+    try_reserve_len(&mut csr.data, nnz, WHAT)?;
     csr.indptr.push(0);
     for r in rows {
         for (j, v) in r {
@@ -354,7 +364,7 @@ pub fn association_weights(
         }
         csr.indptr.push(csr.indices.len());
     }
-    csr
+    Ok(csr)
 }
 
 /// Runs the network and resolves double activations by the highest net input.

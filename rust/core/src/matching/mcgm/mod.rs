@@ -689,7 +689,7 @@ fn decompose(
     chosen: &[usize],
     horiz_skip_deg: f32,
     channel: u8,
-) -> Vec<Match> {
+) -> Result<Vec<Match>> {
     let (w, h) = (l.width, l.height);
     let min_cos = (horiz_skip_deg as f64).to_radians().sin();
     let half = 0.5 * CHANNEL_WIDTH_SIGMAS * l.sigma;
@@ -741,7 +741,7 @@ fn decompose(
             out
         })
         .collect();
-    per.into_iter().flatten().collect()
+    crate::alloc::try_concat(per, "the MCGM matcher's curve matches")
 }
 
 /// Mean absolute difference of one half-window (columns `xi + side * (inner..=outer)`, rows
@@ -1602,7 +1602,7 @@ fn match_channel(
         l.height,
         &win,
         &p.cand,
-    );
+    )?;
     let adj = knn_graph(&l.curves.segments, p.knn, p.r_graph / s);
     let csr = association_weights(
         &cands,
@@ -1610,9 +1610,9 @@ fn match_channel(
         &adj,
         r.curves.segments.len(),
         &p.solver,
-    );
+    )?;
     let sol = solve(&cands, &csr, l.curves.segments.len(), &p.solver);
-    let matches = decompose(l, r, &cands, &sol.chosen, p.horiz_skip_deg, ci as u8);
+    let matches = decompose(l, r, &cands, &sol.chosen, p.horiz_skip_deg, ci as u8)?;
     // Prior for the finer channels: this channel's disparities over the coarser ones'.
     if prior.is_none() {
         *prior = Some(crate::alloc::try_filled(
@@ -1628,15 +1628,21 @@ fn match_channel(
             map[y as usize * fw + x as usize] = m.xl - m.xr;
         }
     }
-    let edges = adj
+    // Each graph edge once (i < j), allocated at once, checked.
+    let n_edges = adj
         .iter()
         .enumerate()
-        .flat_map(|(i, nb)| {
+        .map(|(i, nb)| nb.iter().filter(|&&j| (j as usize) > i).count())
+        .sum();
+    let edges = crate::alloc::try_collect(
+        n_edges,
+        adj.iter().enumerate().flat_map(|(i, nb)| {
             nb.iter()
                 .filter(move |&&j| (j as usize) > i)
                 .map(move |&j| (i as u32, j))
-        })
-        .collect();
+        }),
+        "the MCGM matcher's graph edges",
+    )?;
     Ok(ChannelResult {
         sigma: l.sigma,
         scale: l.scale,
@@ -1738,9 +1744,24 @@ fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
     )?);
     // Combination: finest full-resolution channel first; coarser ones fill empty places.
     let mut taken = crate::alloc::try_filled(fw * fh, false, "the MCGM matcher's taken mask")?;
+    // Every channel's matches at most, reserved checked (the pushes below never reallocate).
     let mut combined: Vec<Match> = Vec::new();
+    crate::alloc::try_reserve_len(
+        &mut combined,
+        channels
+            .iter()
+            .filter(|c| c.scale == 1)
+            .map(|c| c.matches.len())
+            .sum(),
+        "the MCGM matcher's combined matches",
+    )?;
     for ch in channels.iter().rev().filter(|c| c.scale == 1) {
         let mut mine: Vec<(usize, usize)> = Vec::new();
+        crate::alloc::try_reserve_len(
+            &mut mine,
+            ch.matches.len(),
+            "the MCGM matcher's combined matches",
+        )?;
         for m in &ch.matches {
             let (x, y) = (m.xl.round() as i32, m.yl.round() as i32);
             if x < 0 || y < 0 || x >= fw as i32 || y >= fh as i32 {
@@ -1768,11 +1789,14 @@ fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
         (p.d_min.min(fw) as i32, p.d_max.min(fw) as i32),
     )?;
     let n_combined = combined.len();
-    let matches = combined
-        .into_iter()
-        .zip(keep)
-        .filter_map(|(m, k)| k.then_some(m))
-        .collect();
+    let matches = crate::alloc::try_collect(
+        keep.iter().filter(|&&k| k).count(),
+        combined
+            .into_iter()
+            .zip(keep)
+            .filter_map(|(m, k)| k.then_some(m)),
+        "the MCGM matcher's matches",
+    )?;
     Ok(McgmOutput {
         matches,
         channels,

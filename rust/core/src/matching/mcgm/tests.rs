@@ -1534,7 +1534,7 @@ fn candidates_equal_the_gated_brute_force_search() {
             .iter()
             .map(|s| build_rtable(s, &cl.zc.theta, w, cp.n_bins))
             .collect();
-        let got = graph::candidates(ls, &rts, rs, &cr.zc.theta, w, h, &window, &cp);
+        let got = graph::candidates(ls, &rts, rs, &cr.zc.theta, w, h, &window, &cp).unwrap();
         let bins = |s: &Segment, theta: &[f32]| -> Vec<(i32, i32, usize)> {
             s.pixels
                 .iter()
@@ -1635,7 +1635,7 @@ fn association_weights_and_the_resolution_follow_the_definitions() {
         dg_slope: 8.0,
         ..McgmParams::default().solver
     };
-    let csr = graph::association_weights(&cands, &left, &adj, 4, &sp);
+    let csr = graph::association_weights(&cands, &left, &adj, 4, &sp).unwrap();
     let compat = |ia: usize, ib: usize| {
         let (a, b) = (&cands[ia], &cands[ib]);
         let (sa, sb) = (&left[a.left as usize], &left[b.left as usize]);
@@ -1722,7 +1722,7 @@ fn association_weights_and_the_resolution_follow_the_definitions() {
         .flat_map(|i| [c(i, 2 * i, 0.9, 1.0, 0.0), c(i, 2 * i + 1, 0.85, 1.0, 0.0)])
         .collect();
     let segs: Vec<Segment> = (0..8).map(|i| seg(100.0 * i as f32, 0.0)).collect();
-    let w8 = graph::association_weights(&pairs, &segs, &vec![Vec::new(); 8], 16, &sp);
+    let w8 = graph::association_weights(&pairs, &segs, &vec![Vec::new(); 8], 16, &sp).unwrap();
     let sol = graph::solve(&pairs, &w8, 8, &sp);
     assert_eq!(sol.state, [1, 0].repeat(8));
     assert_eq!(sol.chosen, (0..8).map(|i| 2 * i).collect::<Vec<usize>>());
@@ -1760,7 +1760,7 @@ fn candidates_reach_across_the_band_and_the_wider_segment_slack() {
     };
     let run = |a: Segment, b: &[Segment], win: (i32, i32), cp: &graph::CandParams| {
         let rt = build_rtable(&a, &theta, w, cp.n_bins);
-        graph::candidates(&[a], &[rt], b, &theta, w, h, &[Some(win)], cp)
+        graph::candidates(&[a], &[rt], b, &theta, w, h, &[Some(win)], cp).unwrap()
     };
     let a = mk((20..26).map(|x| (x, 10)).collect());
     // Right 0 two rows higher, right 1 on the same row at disparity 5: both score 1.
@@ -2058,7 +2058,7 @@ fn decompose_searches_half_a_channel_width_around_the_translation() {
             })
             .collect();
         let chosen: Vec<usize> = (0..cands.len()).collect();
-        let ms = decompose(&lc, &rc, &cands, &chosen, p.horiz_skip_deg, 2);
+        let ms = decompose(&lc, &rc, &cands, &chosen, p.horiz_skip_deg, 2).unwrap();
         assert!(ms.iter().all(|m| m.yl == m.yr && m.channel == 2));
         assert!(
             ms.iter().all(|m| (m.xr - (m.xl - tx)).abs() <= half),
@@ -2164,14 +2164,18 @@ fn candidates_length_ratio_bound_is_inclusive_and_normal_bound_strict() {
     };
     let rts = [build_rtable(&left[0], &theta, w, cp.n_bins)];
     let window = [Some((0, 5))];
-    let got = graph::candidates(&left, &rts, &right, &theta, w, h, &window, &cp);
+    let got = graph::candidates(&left, &rts, &right, &theta, w, h, &window, &cp).unwrap();
     assert_eq!(got.len(), 1);
     assert_eq!((got[0].score, got[0].tx), (0.5, 2.0));
     let strict = graph::CandParams {
         seg_theta_tol_deg: 0.0,
         ..cp
     };
-    assert!(graph::candidates(&left, &rts, &right, &theta, w, h, &window, &strict).is_empty());
+    assert!(
+        graph::candidates(&left, &rts, &right, &theta, w, h, &window, &strict)
+            .unwrap()
+            .is_empty()
+    );
 }
 
 /// B.4.12's search of the right crossing on one row, on hand-made curves (sigma 1, full
@@ -2219,7 +2223,7 @@ fn decompose_window_bounds_and_ties() {
             tx,
             ty: 0.0,
         };
-        let ms = decompose(&left, &curves_of(right), &[c], &[0], 20.0, 0);
+        let ms = decompose(&left, &curves_of(right), &[c], &[0], 20.0, 0).unwrap();
         ms.iter().map(|m| m.xr).collect()
     };
     // Target 8: the window starts at floor(8 - 1.41) = 6, whose crossing 6.6 is 1.4 away.
@@ -2267,4 +2271,59 @@ fn discontinuity_filter_drops_matches_outside_the_image() {
     let (keep, counts) = edge_filters(&img, &img, &ms, &f, (0, 16)).unwrap();
     assert_eq!(keep, [false, false, false, true]);
     assert_eq!((counts.sides, counts.disc), (4, 1));
+}
+
+/// Run by [`association_weights_too_large_to_allocate_are_an_error`] in a child process: 3000
+/// candidates of one left segment (each inhibits the 2999 others: 9 M weights, 8 bytes each
+/// in the rows, whose capacities take 32 KiB a row) under an address-space limit of the rows
+/// and 54 MiB more than is mapped. The matrix's indices (36 MB) fit; its data does not.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of association_weights_too_large_to_allocate_are_an_error"]
+fn association_weights_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let n = 3000u32;
+    let cands: Vec<graph::Candidate> = (0..n)
+        .map(|r| graph::Candidate {
+            left: 0,
+            right: r,
+            score: 1.0,
+            tx: 0.0,
+            ty: 0.0,
+        })
+        .collect();
+    let left = [Segment {
+        pixels: vec![0],
+        centroid: (0.0, 0.0),
+        x_min: 0,
+        x_max: 0,
+        y_min: 0,
+        y_max: 0,
+        mean_theta: 0.0,
+    }];
+    let sp = McgmParams::default().solver;
+    rayon::join(|| (), || ()); // the pool's thread started before the limit
+    crate::segment::tests::limit_address_space(
+        crate::segment::tests::vm_size() + n as usize * (32 << 10) + (54 << 20),
+    );
+    match graph::association_weights(&cands, &left, &[Vec::new()], n as usize, &sp) {
+        Ok(csr) => println!("child: weights {}", csr.nnz()),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn association_weights_too_large_to_allocate_are_an_error() {
+    // The matrix's indices and data grew by push (8 bytes a weight, the largest N-sized
+    // tables of the channel): a failed allocation aborted the process (SIGABRT) instead of
+    // returning OutOfMemory.
+    let stdout = crate::segment::tests::run_oom_child(
+        "matching::mcgm::tests::association_weights_under_a_memory_limit",
+    );
+    let want = "child: error: out of memory: the MCGM matcher's association weights needs \
+                34.32 MiB (35988000 bytes)";
+    assert!(stdout.contains(want), "{want} not in {stdout}");
 }
