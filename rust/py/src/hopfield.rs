@@ -154,7 +154,7 @@ pub fn hopfield_interest<'py>(
     let (m, pts) = crate::workers::detach(py, || {
         guard("hopfield_interest", || {
             let m = moravec(im)?;
-            let pts = select_points(&m, w, h, &p);
+            let pts = select_points(&m, w, h, &p)?;
             Ok((m, pts))
         })
     })?;

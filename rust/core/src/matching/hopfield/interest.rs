@@ -7,7 +7,7 @@
 
 use rayon::prelude::*;
 
-use crate::alloc::try_zeroed;
+use crate::alloc::{try_concat, try_zeroed};
 use crate::error::Result;
 use crate::image::ImageView;
 use crate::simd::simd_fn;
@@ -167,7 +167,7 @@ pub fn interest_points<'a>(
     let img = img.into();
     let m = moravec(img)?;
     let (w, h) = img.size();
-    Ok(select_points(&m, w, h, p))
+    select_points(&m, w, h, p)
 }
 
 /// Image rows per parallel task of [`select_points`].
@@ -217,10 +217,15 @@ fn seg_max(seg: &[f32]) -> f32 {
 }
 
 /// Selection step of [`interest_points`] on a precomputed map (row bands in parallel, raster
-/// order).
-pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<InterestPoint> {
+/// order). A failed allocation of the list is [`crate::CoreError::OutOfMemory`].
+pub fn select_points(
+    m: &[f32],
+    w: usize,
+    h: usize,
+    p: &InterestParams,
+) -> Result<Vec<InterestPoint>> {
     if w == 0 {
-        return Vec::new();
+        return Ok(Vec::new());
     }
     // Largest M per tile (a single tile covering the image when `tile == 0`). A tile larger
     // than the image is that single tile too: `tile * w` of a huge tile wrapped to 0 and
@@ -246,7 +251,7 @@ pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<I
     // The image's largest M is the largest tile maximum (max is exact: same value).
     let max = tile_max.iter().copied().fold(0.0f32, f32::max);
     if max <= 0.0 {
-        return Vec::new();
+        return Ok(Vec::new());
     }
     let floor = max * p.floor_rel;
     let r = p.nms_half;
@@ -325,7 +330,7 @@ pub fn select_points(m: &[f32], w: usize, h: usize, p: &InterestParams) -> Vec<I
             out
         })
         .collect();
-    per_task.concat()
+    try_concat(per_task, "the Hopfield matcher's interest points")
 }
 
 #[cfg(test)]
@@ -343,7 +348,7 @@ mod tests {
                 tile,
                 ..InterestParams::default()
             };
-            select_points(&m, w, h, &p)
+            select_points(&m, w, h, &p).unwrap()
         };
         let whole = at(0);
         assert!(!whole.is_empty());
@@ -378,6 +383,7 @@ mod tests {
             ..InterestParams::default()
         };
         let got: Vec<(u32, u32)> = select_points(&m, w, h, &p)
+            .unwrap()
             .iter()
             .map(|q| (q.x, q.y))
             .collect();
@@ -524,6 +530,7 @@ mod tests {
                             floor_rel,
                         };
                         let got: Vec<(u32, u32, f32)> = select_points(&m, w, h, &p)
+                            .unwrap()
                             .iter()
                             .map(|q| (q.x, q.y, q.value))
                             .collect();

@@ -33,6 +33,7 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
+use crate::alloc::try_concat;
 use crate::error::{CoreError, Result};
 use crate::image::ImageView;
 use crate::simd::simd_fn;
@@ -473,7 +474,7 @@ fn candidates(
             },
         )
         .collect();
-    Ok(per_task.concat())
+    try_concat(per_task, "the Hopfield matcher's candidate neurons")
 }
 
 /// Median (mean of the two middle values for an even count; 0 if empty), by selection: the
