@@ -85,7 +85,7 @@ fn bench(c: &mut Criterion) {
             |b, (l, r)| b.iter(|| candidate_neurons(*l, *r, &p).expect("valid input")),
         );
         let (_, neurons) = candidate_neurons(&l, &r, &p).expect("valid input");
-        let net = Network::new(&neurons, &p.weights);
+        let net = Network::new(&neurons, &p.weights).expect("valid input");
         let input: Vec<f64> = neurons
             .iter()
             .map(|n| (p.weights.d * n.sim - p.weights.theta) as f64)
@@ -94,7 +94,7 @@ fn bench(c: &mut Criterion) {
         // The implicit network: its set-up, then the dynamics (the initial net inputs from
         // every row, then the sweeps, each flip re-reading its row).
         g.bench_function(BenchmarkId::new("network", &id), |b| {
-            b.iter(|| Network::new(&neurons, &p.weights))
+            b.iter(|| Network::new(&neurons, &p.weights).expect("valid input"))
         });
         g.bench_function(BenchmarkId::new("network_dynamics", &id), |b| {
             b.iter(|| run_dynamics(&net, &input, &init, 0, p.max_sweeps))

@@ -79,7 +79,7 @@ fn main() {
         let (_, neurons) = candidate_neurons(&l, &r, &p).expect("valid input");
         t[1].push(ms(s));
         let s = Instant::now();
-        let net = Network::new(&neurons, &p.weights);
+        let net = Network::new(&neurons, &p.weights).expect("valid input");
         t[2].push(ms(s));
         let input: Vec<f64> = neurons
             .iter()

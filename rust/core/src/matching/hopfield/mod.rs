@@ -903,7 +903,7 @@ fn match_hot(
     p: &HopfieldParams,
 ) -> Result<HopfieldOutput> {
     let (pts, neurons) = candidate_neurons(left, right, p)?;
-    let net = Network::new(&neurons, &p.weights);
+    let net = Network::new(&neurons, &p.weights)?;
     let input: Vec<f64> = neurons
         .iter()
         .map(|n| {

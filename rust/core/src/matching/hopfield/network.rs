@@ -12,6 +12,8 @@
 
 use rayon::prelude::*;
 
+use crate::alloc::{try_collect, try_reserve_len, try_zeroed};
+use crate::error::Result;
 use crate::simd::has_avx2;
 
 /// One neuron: left point index, right position and disparity vector `(x_l - x_r, y_l - y_r)`.
@@ -982,10 +984,13 @@ const SYM_STRIPS: usize = 4;
 
 impl Network {
     /// The network of `neurons`, which must be grouped by `point` in increasing order and
-    /// have non-negative coordinates.
-    pub fn new(neurons: &[Neuron], w: &EnergyWeights) -> Self {
+    /// have non-negative coordinates. A failed allocation of its per-neuron and per-point
+    /// tables is [`crate::CoreError::OutOfMemory`].
+    pub fn new(neurons: &[Neuron], w: &EnergyWeights) -> Result<Self> {
+        const WHAT: &str = "the Hopfield network's tables";
         let m = neurons.len();
         let mut starts: Vec<usize> = Vec::new();
+        try_reserve_len(&mut starts, m + 1, WHAT)?; // at most one point a neuron
         for (a, nr) in neurons.iter().enumerate() {
             if a == 0 || nr.point != neurons[a - 1].point {
                 starts.push(a);
@@ -993,62 +998,71 @@ impl Network {
         }
         let n_pts = starts.len();
         starts.push(m);
-        let pxy: Vec<(i32, i32)> = (0..n_pts)
-            .map(|p| (neurons[starts[p]].xl.max(0), neurons[starts[p]].yl.max(0)))
-            .collect();
+        let pxy = try_collect(
+            n_pts,
+            (0..n_pts).map(|p| (neurons[starts[p]].xl.max(0), neurons[starts[p]].yl.max(0))),
+            WHAT,
+        )?;
         let half = w.nbr_half.max(1);
-        let p_of: Vec<u32> = (0..n_pts)
-            .flat_map(|p| std::iter::repeat_n(p as u32, starts[p + 1] - starts[p]))
-            .collect();
-        let dxs: Vec<i32> = neurons.iter().map(Neuron::dx).collect();
-        let dys: Vec<i32> = neurons.iter().map(Neuron::dy).collect();
+        let p_of = try_collect(
+            m,
+            (0..n_pts).flat_map(|p| std::iter::repeat_n(p as u32, starts[p + 1] - starts[p])),
+            WHAT,
+        )?;
+        let dxs = try_collect(m, neurons.iter().map(Neuron::dx), WHAT)?;
+        let dys = try_collect(m, neurons.iter().map(Neuron::dy), WHAT)?;
         // The strip order and windows, and the right-pixel groups, are independent: built side
         // by side.
         let ((strip_start, sorder, wins), (by_right, group, rank, n_groups)) =
             rayon::join(|| strip_order(&pxy, half), || right_groups(neurons));
         // A / max(n_p, n_q, 1) = min(A / max(n_p, 1), A / max(n_q, 1)) exactly: division rounds
         // monotonically (max for a negative A). One division per point instead of per pair.
-        let a_over_n: Vec<f32> = wins
-            .iter()
-            .map(|&(_, n)| w.a / (n as f32).max(1.0))
-            .collect();
+        let a_over_n = try_collect(
+            wins.len(),
+            wins.iter().map(|&(_, n)| w.a / (n as f32).max(1.0)),
+            WHAT,
+        )?;
         // Strip-ordered neuron arrays: the neuron order first, then each array by an
         // exact-size map over it (padded with LANES entries).
-        let mut gstart = Vec::with_capacity(n_pts + 1);
+        let mut gstart = Vec::new();
+        try_reserve_len(&mut gstart, n_pts + 1, WHAT)?;
         gstart.push(0u32);
-        let mut idx: Vec<u32> = Vec::with_capacity(m + LANES);
+        let mut idx: Vec<u32> = Vec::new();
+        try_reserve_len(&mut idx, m + LANES, WHAT)?;
         for &q in &sorder {
             let q = q as usize;
             idx.extend(starts[q] as u32..starts[q + 1] as u32);
             gstart.push(idx.len() as u32);
         }
-        fn padded<T: Copy + Default>(idx: &[u32], f: impl Fn(usize) -> T) -> Vec<T> {
-            let mut v: Vec<T> = Vec::with_capacity(idx.len() + LANES);
+        fn padded<T: Copy + Default>(idx: &[u32], f: impl Fn(usize) -> T) -> Result<Vec<T>> {
+            let mut v: Vec<T> = Vec::new();
+            try_reserve_len(&mut v, idx.len() + LANES, WHAT)?;
             v.extend(idx.iter().map(|&b| f(b as usize)));
             v.resize(idx.len() + LANES, T::default());
-            v
+            Ok(v)
         }
         let cells = Cells {
-            x: padded(&idx, |b| pxy[p_of[b] as usize].0),
-            y: padded(&idx, |b| pxy[p_of[b] as usize].1),
-            dx: padded(&idx, |b| dxs[b]),
-            dy: padded(&idx, |b| dys[b]),
-            point: padded(&idx, |b| p_of[b]),
-            rank: padded(&idx, |b| rank[b]),
-            norm: padded(&idx, |b| a_over_n[p_of[b] as usize]),
-            idx: padded(&idx, |b| b as u32),
+            x: padded(&idx, |b| pxy[p_of[b] as usize].0)?,
+            y: padded(&idx, |b| pxy[p_of[b] as usize].1)?,
+            dx: padded(&idx, |b| dxs[b])?,
+            dy: padded(&idx, |b| dys[b])?,
+            point: padded(&idx, |b| p_of[b])?,
+            rank: padded(&idx, |b| rank[b])?,
+            norm: padded(&idx, |b| a_over_n[p_of[b] as usize])?,
+            idx: padded(&idx, |b| b as u32)?,
         };
         let padded = cells.idx.len();
-        let mut slot_of = vec![0u32; m];
+        let mut slot_of = try_zeroed::<u32>(m, WHAT)?;
         for (j, &b) in cells.idx[..padded - LANES].iter().enumerate() {
             slot_of[b as usize] = j as u32;
         }
         let cell_strip: Vec<u32> = strip_start.iter().map(|&q| gstart[q]).collect();
         // Per point, the `cells` range of its window in each strip the window's rows touch.
-        let wranges: Vec<[(u32, u32); MAX_STRIPS]> = wins
-            .par_iter()
+        let mut wranges: Vec<[(u32, u32); MAX_STRIPS]> = Vec::new();
+        try_reserve_len(&mut wranges, wins.len(), WHAT)?;
+        wins.par_iter()
             .map(|(r, _)| r.map(|(lo, hi)| (gstart[lo as usize], gstart[hi as usize])))
-            .collect();
+            .collect_into_vec(&mut wranges);
         // Compatibility lookup per Chebyshev distance r of the two points (0..=half) over the
         // integer squared disparity-vector difference q. A row ends where the f32 value has
         // saturated at -1 (slope > 0, q past the crossing): larger q read the last entry, which
@@ -1087,7 +1101,7 @@ impl Network {
             let last = row[row.len() - 1];
             lut.resize(lut.len() + lut_stride - row.len(), last);
         }
-        Network {
+        Ok(Network {
             b: w.b,
             half,
             starts,
@@ -1107,7 +1121,7 @@ impl Network {
             dys,
             lut,
             lut_stride,
-        }
+        })
     }
 
     /// The rank of neuron `a`'s right pixel among the distinct right pixels (`0..`
@@ -1292,9 +1306,10 @@ impl Weights for Network {
 }
 
 /// Builds the CSR weights (the [`Network`]'s rows, stored). `neurons` must be grouped by
-/// `point` in increasing order and have non-negative coordinates.
-pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
-    let net = Network::new(neurons, w);
+/// `point` in increasing order and have non-negative coordinates. A failed allocation of the
+/// network's tables is [`crate::CoreError::OutOfMemory`].
+pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Result<Csr> {
+    let net = Network::new(neurons, w)?;
     let rows: Vec<(Vec<u32>, Vec<f32>)> = (0..net.n())
         .into_par_iter()
         .map(|a| {
@@ -1315,7 +1330,7 @@ pub fn build_weights(neurons: &[Neuron], w: &EnergyWeights) -> Csr {
         csr.data.extend(val);
         csr.indptr.push(csr.indices.len());
     }
-    csr
+    Ok(csr)
 }
 
 /// SplitMix64: a tiny, well-mixed generator (mirrored exactly by the NumPy reference).
@@ -1537,7 +1552,7 @@ mod tests {
     fn avx2_and_portable_row_scans_are_bit_identical() {
         for seed in 0..3 {
             let neurons = random_neurons(seed);
-            let net = Network::new(&neurons, &EnergyWeights::default());
+            let net = Network::new(&neurons, &EnergyWeights::default()).unwrap();
             let on: Vec<f32> = (0..net.cells.idx.len())
                 .map(|j| {
                     if j % 3 == 0 || j >= net.cells.idx.len() - LANES {
@@ -1603,8 +1618,8 @@ mod tests {
     fn implicit_rows_give_the_stored_matrix_dynamics() {
         let neurons = random_neurons(7);
         let w = EnergyWeights::default();
-        let net = Network::new(&neurons, &w);
-        let csr = build_weights(&neurons, &w);
+        let net = Network::new(&neurons, &w).unwrap();
+        let csr = build_weights(&neurons, &w).unwrap();
         let m = neurons.len();
         let input: Vec<f64> = (0..m).map(|a| 0.2 - 0.01 * (a % 7) as f64).collect();
         let init: Vec<u8> = (0..m).map(|a| u8::from(a % 4 != 0)).collect();
@@ -1697,7 +1712,7 @@ mod tests {
         // kernels (they only checked it in debug builds, or not at all). Now a panic naming
         // the buffer, on every CPU.
         let neurons = random_neurons(2);
-        let net = Network::new(&neurons, &EnergyWeights::default());
+        let net = Network::new(&neurons, &EnergyWeights::default()).unwrap();
         let state = vec![1u8; neurons.len()];
         let on = net.lane_state(&state);
         let a = (0..neurons.len())
@@ -1804,7 +1819,7 @@ mod tests {
                     n.xr = n.xl - d;
                 }
             }
-            let csr = build_weights(&neurons, w);
+            let csr = build_weights(&neurons, w).unwrap();
             let want = reference_rows(&neurons, w);
             let (mut pos, mut neg) = (0, 0);
             for (a, want_row) in want.iter().enumerate() {
@@ -1897,7 +1912,10 @@ mod tests {
             .filter(|n| n.point < 400)
             .collect();
         let w = EnergyWeights::default();
-        let (net, csr) = (Network::new(&neurons, &w), build_weights(&neurons, &w));
+        let (net, csr) = (
+            Network::new(&neurons, &w).unwrap(),
+            build_weights(&neurons, &w).unwrap(),
+        );
         let m = neurons.len();
         for (seed, max_sweeps) in [(0u64, 100usize), (3, 100), (8, 1)] {
             let input: Vec<f64> = (0..m)
@@ -1988,7 +2006,7 @@ mod tests {
         // 100 px apart: outside each other's 41x41 windows, distinct right pixels.
         let neurons: Vec<Neuron> = (0..4).map(|p| lone(p, 10 + 100 * p as i32)).collect();
         let w = EnergyWeights::default();
-        let net = Network::new(&neurons, &w);
+        let net = Network::new(&neurons, &w).unwrap();
         let input = [0.0, 0.0, 0.5, -0.5];
         let init = [1u8, 0, 0, 1];
         let d = run_dynamics(&net, &input, &init, 1, 10);
@@ -2027,7 +2045,7 @@ mod tests {
             b: -1.0,
             ..EnergyWeights::default()
         };
-        let net = Network::new(&neurons, &w);
+        let net = Network::new(&neurons, &w).unwrap();
         let support = |state: [u8; 4]| net.support(0, &state, &net.lane_state(&state));
         let c = (3.0 * compat(0.0, 2.0 + 0.05 * 4.0, 2.0) as f32) as f64;
         assert_eq!(support([1, 0, 0, 0]), 0.0);
@@ -2064,7 +2082,7 @@ mod tests {
             compat_slope: 0.5,
             ..EnergyWeights::default()
         };
-        let net = Network::new(&neurons, &w);
+        let net = Network::new(&neurons, &w).unwrap();
         let state = [0u8, 1];
         let got = net.support(0, &state, &net.lane_state(&state));
         let want = (3.0 * compat(3.0, 10.0 + 0.05 * 4.0, 0.5) as f32) as f64;

@@ -68,7 +68,7 @@ fn energy_is_monotone_and_weights_symmetric() {
     let (l, r) = shifted_pair(100, 80, 4);
     let p = params(16);
     let (_, neurons) = candidate_neurons(&l, &r, &p).expect("valid input");
-    let csr = build_weights(&neurons, &p.weights);
+    let csr = build_weights(&neurons, &p.weights).unwrap();
     // Symmetry: T_ab == T_ba for every stored entry.
     for a in 0..csr.n() {
         let (idx, val) = csr.row(a);
@@ -223,7 +223,7 @@ fn results_do_not_depend_on_the_thread_count() {
             .install(|| {
                 let out = hopfield_match(&l, &r, &p).expect("valid input");
                 let (_, neurons) = candidate_neurons(&l, &r, &p).expect("valid input");
-                let csr = build_weights(&neurons, &p.weights);
+                let csr = build_weights(&neurons, &p.weights).unwrap();
                 (
                     out,
                     csr.indptr,
@@ -246,7 +246,7 @@ fn csr_rows_hold_every_pair_of_the_window_once() {
     let (l, r) = shifted_pair(120, 90, 5);
     let p = params(16);
     let (_, neurons) = candidate_neurons(&l, &r, &p).expect("valid input");
-    let csr = build_weights(&neurons, &p.weights);
+    let csr = build_weights(&neurons, &p.weights).unwrap();
     let half = p.weights.nbr_half;
     for (a, na) in neurons.iter().enumerate() {
         let (idx, _) = csr.row(a);
@@ -408,7 +408,7 @@ fn disambiguation_keeps_singles_and_picks_by_vertical_disparity_then_similarity(
     ];
     let state = [1, 1, 1, 0, 1, 1, 1, 1];
     let p = HopfieldParams::default();
-    let net = Network::new(&ns, &p.weights);
+    let net = Network::new(&ns, &p.weights).unwrap();
     assert_eq!(disambiguate(&ns, &net, &state, &p), [0, 2, 4, 5, 6]);
 }
 
@@ -432,7 +432,7 @@ fn disambiguation_tolerance_is_inclusive_at_a_half_pixel_reference() {
     let state = [1, 1, 1, 1];
     let p = HopfieldParams::default();
     assert_eq!(p.tau_y, 1.0);
-    let net = Network::new(&ns, &p.weights);
+    let net = Network::new(&ns, &p.weights).unwrap();
     assert_eq!(disambiguate(&ns, &net, &state, &p), [0, 1]);
     let mut p = HopfieldParams {
         tau_y: 1.5,
@@ -509,7 +509,7 @@ fn group_fallback_needs_more_than_min_agree_agreeing_lone_points() {
         let ns: Vec<Neuron> = (0..n)
             .map(|k| neuron(k, (100 + 2 * k as i32, 100), 10, 0.0, true))
             .collect();
-        let net = Network::new(&ns, &p.weights);
+        let net = Network::new(&ns, &p.weights).unwrap();
         let out = fallback(&ns, &net, &vec![0; ns.len()], &p);
         assert!(out.iter().all(|&s| s == expect), "{n}: {out:?}");
     }
@@ -847,7 +847,7 @@ fn disambiguation_without_local_singles_uses_the_global_median() {
         at(3, 100, 2, 0.85),
     ];
     let p = HopfieldParams::default();
-    let net = Network::new(&ns, &p.weights);
+    let net = Network::new(&ns, &p.weights).unwrap();
     assert_eq!(disambiguate(&ns, &net, &[1, 1, 1, 1, 1], &p), [0, 1, 2, 4]);
 }
 
@@ -866,10 +866,10 @@ fn fallback_support_thresholds_at_equality() {
         neuron(0, (100, 100), 10, 0.0, true),
         neuron(0, (100, 100), 30, 0.0, true),
     ];
-    let net = Network::new(&ns, &p.weights);
+    let net = Network::new(&ns, &p.weights).unwrap();
     assert_eq!(fallback(&ns, &net, &[0, 1], &p), [0, 1]);
     let one = vec![neuron(0, (100, 100), 10, 0.0, true)];
-    let net = Network::new(&one, &p.weights);
+    let net = Network::new(&one, &p.weights).unwrap();
     assert_eq!(fallback(&one, &net, &[0], &p), [1]);
 }
 
@@ -886,12 +886,61 @@ fn group_fallback_skips_edge_failures_and_points_with_several_candidates() {
     };
     let mut edge = row();
     edge[0].edge_ok = false;
-    let net = Network::new(&edge, &p.weights);
+    let net = Network::new(&edge, &p.weights).unwrap();
     let out = fallback(&edge, &net, &[0; 10], &p);
     assert_eq!(out, [0, 1, 1, 1, 1, 1, 1, 1, 1, 1]);
     let mut two = row();
     two.insert(1, neuron(0, (100, 100), 30, 0.0, true));
-    let net = Network::new(&two, &p.weights);
+    let net = Network::new(&two, &p.weights).unwrap();
     let out = fallback(&two, &net, &[0; 11], &p);
     assert_eq!(out, [0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1]);
+}
+
+/// Run by [`network_tables_too_large_to_allocate_are_an_error`] in a child process: 2^20
+/// neurons, each its own point, under an address-space limit of 4 MiB more than is mapped: the
+/// network's point starts (8 bytes a point) do not fit.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of network_tables_too_large_to_allocate_are_an_error"]
+fn network_tables_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let neurons: Vec<Neuron> = (0..1u32 << 20)
+        .map(|a| {
+            let (x, y) = ((a % 1024) as i32, (a / 1024) as i32);
+            Neuron {
+                point: a,
+                xl: x,
+                yl: y,
+                xr: x,
+                yr: y,
+                sim: 0.8,
+                edge_ok: true,
+                halves_fail: 0,
+                centre_ok: true,
+                sub: 0.0,
+            }
+        })
+        .collect();
+    rayon::join(|| (), || ()); // the pool's thread started before the limit
+    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (4 << 20));
+    match Network::new(&neurons, &HopfieldParams::default().weights) {
+        Ok(net) => println!("child: network of {}", net.n()),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn network_tables_too_large_to_allocate_are_an_error() {
+    // Network::new built its per-point and per-neuron tables (starts, coordinates, the padded
+    // cell arrays, slots) with push/collect/vec!: a failed allocation aborted the process
+    // (SIGABRT) instead of returning OutOfMemory.
+    let stdout = crate::segment::tests::run_oom_child(
+        "matching::hopfield::tests::network_tables_under_a_memory_limit",
+    );
+    let want = "child: error: out of memory: the Hopfield network's tables needs 8.00 MiB \
+                (8388616 bytes)";
+    assert!(stdout.contains(want), "{want} not in {stdout}");
 }
