@@ -97,7 +97,7 @@ fn bench(c: &mut Criterion) {
             b.iter(|| Network::new(&neurons, &p.weights).expect("valid input"))
         });
         g.bench_function(BenchmarkId::new("network_dynamics", &id), |b| {
-            b.iter(|| run_dynamics(&net, &input, &init, 0, p.max_sweeps))
+            b.iter(|| run_dynamics(&net, &input, &init, 0, p.max_sweeps).expect("valid input"))
         });
         g.bench_function(BenchmarkId::new("hopfield_match", &id), |b| {
             b.iter(|| hopfield_match(&l, &r, &p).expect("valid input"))

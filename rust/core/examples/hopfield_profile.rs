@@ -90,7 +90,7 @@ fn main() {
         net.initial_input(&init, &input);
         t[5].push(ms(s));
         let s = Instant::now();
-        run_dynamics(&net, &input, &init, p.seed, p.max_sweeps);
+        run_dynamics(&net, &input, &init, p.seed, p.max_sweeps).expect("valid input");
         t[3].push(ms(s));
         let s = Instant::now();
         hopfield_match(&l, &r, &p).expect("valid input");

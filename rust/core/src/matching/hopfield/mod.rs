@@ -916,7 +916,7 @@ fn match_hot(
         })
         .collect();
     let init = initial_state(&neurons, p);
-    let dynamics = run_dynamics(&net, &input, &init, p.seed, p.max_sweeps);
+    let dynamics = run_dynamics(&net, &input, &init, p.seed, p.max_sweeps)?;
     let selected = fallback(&neurons, &net, &dynamics.state, p);
     let chosen = disambiguate(&neurons, &net, &selected, p);
     let matches = finish(left, right, &neurons, &chosen, p);

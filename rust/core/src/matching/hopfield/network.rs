@@ -1381,34 +1381,51 @@ fn energy(state: &[u8], u: &[f64], input: &[f64]) -> f64 {
         .sum()
 }
 
+/// The slot-ordered arrays of [`run_dynamics`] (slot of each neuron, net inputs, states, the
+/// neuron in each slot, the visiting order), allocated checked out of line (no error path near
+/// the sweeps).
+#[allow(clippy::type_complexity)]
+#[inline(never)]
+fn slot_arrays<W: Weights>(net: &W) -> Result<(Vec<u32>, Vec<f64>, Vec<u8>, Vec<u32>, Vec<u32>)> {
+    const WHAT: &str = "the Hopfield dynamics' slot arrays";
+    let m = net.n();
+    let slot = try_collect(m, (0..m).map(|a| net.slot(a) as u32), WHAT)?;
+    let u = try_zeroed::<f64>(net.slots(), WHAT)?;
+    let st = try_zeroed::<u8>(net.slots(), WHAT)?;
+    let neuron_at = try_zeroed::<u32>(net.slots(), WHAT)?;
+    let order = try_collect(m, slot.iter().copied(), WHAT)?;
+    Ok((slot, u, st, neuron_at, order))
+}
+
 /// Runs the asynchronous dynamics from `init` until a sweep without a flip (or `max_sweeps`).
+/// A failed allocation of its per-neuron arrays is [`crate::CoreError::OutOfMemory`].
 pub fn run_dynamics<W: Weights>(
     net: &W,
     input: &[f64],
     init: &[u8],
     seed: u64,
     max_sweeps: usize,
-) -> Dynamics {
+) -> Result<Dynamics> {
     let m = net.n();
-    let mut state = init.to_vec();
+    let mut state = try_collect(
+        init.len(),
+        init.iter().copied(),
+        "the Hopfield dynamics' state",
+    )?;
     // Initial net inputs u_a = I_a + sum_b T_ab V_b, each from its own row (T is symmetric):
     // in parallel, every sum in row order, so independent of the thread count.
     let (u0, nnz) = net.initial_input(init, input);
     let mut trace = vec![energy(&state, &u0, input)];
     // The sweeps work in the weights' slot order (see `Weights::slot`): net inputs, states and
     // the visiting order are indexed by slot, so a visit reads two arrays at one index.
-    let slot: Vec<u32> = (0..m).map(|a| net.slot(a) as u32).collect();
-    let mut u = vec![0.0f64; net.slots()];
-    let mut st = vec![0u8; net.slots()];
-    let mut neuron_at = vec![0u32; net.slots()];
+    let (slot, mut u, mut st, mut neuron_at, mut order) = slot_arrays(net)?;
     for (a, &j) in slot.iter().enumerate() {
         u[j as usize] = u0[a];
         st[j as usize] = state[a];
         neuron_at[j as usize] = a as u32;
     }
     // The shuffle moves entries by position only, so shuffling the slots of 0..m visits the
-    // same neurons in the same sequence as shuffling 0..m.
-    let mut order = slot.clone();
+    // same neurons in the same sequence as shuffling 0..m (`order` starts as a copy of `slot`).
     let mut rng = SplitMix64::new(seed);
     // Energy tracked per flip: switching `a` on changes E by -u_a, off by +u_a (T_aa = 0), and
     // a flip happens only against the sign of u_a, so every step lowers E.
@@ -1443,13 +1460,13 @@ pub fn run_dynamics<W: Weights>(
     for (a, &j) in slot.iter().enumerate() {
         state[a] = st[j as usize];
     }
-    Dynamics {
+    Ok(Dynamics {
         state,
         energy_trace: trace,
         sweeps,
         converged,
         nnz,
-    }
+    })
 }
 
 #[cfg(test)]
@@ -1632,8 +1649,8 @@ mod tests {
             assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()), "{a} vs {b}");
         }
         let (dn, dc) = (
-            run_dynamics(&net, &input, &init, 5, 100),
-            run_dynamics(&csr, &input, &init, 5, 100),
+            run_dynamics(&net, &input, &init, 5, 100).unwrap(),
+            run_dynamics(&csr, &input, &init, 5, 100).unwrap(),
         );
         assert!(dn.converged && dn.sweeps >= 2);
         assert_eq!(dn.state, dc.state);
@@ -1927,8 +1944,8 @@ mod tests {
             let (v, trace, sweeps, converged) =
                 reference_dynamics(&csr, &input, &init, seed, max_sweeps);
             for d in [
-                run_dynamics(&csr, &input, &init, seed, max_sweeps),
-                run_dynamics(&net, &input, &init, seed, max_sweeps),
+                run_dynamics(&csr, &input, &init, seed, max_sweeps).unwrap(),
+                run_dynamics(&net, &input, &init, seed, max_sweeps).unwrap(),
             ] {
                 assert_eq!(d.state, v, "seed {seed}");
                 assert_eq!(d.sweeps, sweeps, "seed {seed}");
@@ -2009,7 +2026,7 @@ mod tests {
         let net = Network::new(&neurons, &w).unwrap();
         let input = [0.0, 0.0, 0.5, -0.5];
         let init = [1u8, 0, 0, 1];
-        let d = run_dynamics(&net, &input, &init, 1, 10);
+        let d = run_dynamics(&net, &input, &init, 1, 10).unwrap();
         assert_eq!(d.nnz, 0);
         assert_eq!(d.state, vec![1, 0, 1, 0]);
         assert_eq!((d.sweeps, d.converged), (2, true));

@@ -81,7 +81,7 @@ fn energy_is_monotone_and_weights_symmetric() {
     // Start from everything off: the dynamics must switch neurons on, never raising E.
     let input: Vec<f64> = neurons.iter().map(|n| (n.sim - 0.6) as f64).collect();
     let init = vec![0u8; neurons.len()];
-    let d = run_dynamics(&csr, &input, &init, 3, 100);
+    let d = run_dynamics(&csr, &input, &init, 3, 100).unwrap();
     assert!(d.converged && d.sweeps >= 2, "{d:?}");
     assert!(d.energy_trace[1] < d.energy_trace[0]);
     for w in d.energy_trace.windows(2) {
@@ -942,5 +942,43 @@ fn network_tables_too_large_to_allocate_are_an_error() {
     );
     let want = "child: error: out of memory: the Hopfield network's tables needs 8.00 MiB \
                 (8388616 bytes)";
+    assert!(stdout.contains(want), "{want} not in {stdout}");
+}
+
+/// Run by [`dynamics_arrays_too_large_to_allocate_are_an_error`] in a child process: 2^20
+/// neurons without weights under an address-space limit of 19 MiB more than is mapped. The
+/// state and the initial net inputs (17 MiB at the peak) fit; the slot-ordered net inputs
+/// (8 MiB) after the slots (4 MiB) do not.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of dynamics_arrays_too_large_to_allocate_are_an_error"]
+fn dynamics_arrays_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let m = 1usize << 20;
+    let csr = Csr {
+        indptr: vec![0; m + 1],
+        ..Csr::default()
+    };
+    let (input, init) = (vec![0.5f64; m], vec![0u8; m]);
+    rayon::join(|| (), || ()); // the pool's thread started before the limit
+    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (19 << 20));
+    match run_dynamics(&csr, &input, &init, 1, 10) {
+        Ok(d) => println!("child: {} sweeps", d.sweeps),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn dynamics_arrays_too_large_to_allocate_are_an_error() {
+    // run_dynamics allocated its slot-ordered arrays with vec!/collect/clone: a failed
+    // allocation aborted the process (SIGABRT) instead of returning OutOfMemory.
+    let stdout = crate::segment::tests::run_oom_child(
+        "matching::hopfield::tests::dynamics_arrays_under_a_memory_limit",
+    );
+    let want = "child: error: out of memory: the Hopfield dynamics' slot arrays needs 8.00 MiB \
+                (8388608 bytes)";
     assert!(stdout.contains(want), "{want} not in {stdout}");
 }

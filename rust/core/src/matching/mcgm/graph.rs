@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use super::rtable::{ght_vote_rows, voters, RTable, RowIndex};
 use super::tracking::{wrap_angle, Segment};
-use crate::alloc::{try_concat, try_reserve_len};
+use crate::alloc::{try_collect, try_concat, try_filled, try_reserve_len};
 use crate::error::Result;
 use crate::matching::hopfield::{run_dynamics, Csr};
 
@@ -367,20 +367,25 @@ pub fn association_weights(
     Ok(csr)
 }
 
-/// Runs the network and resolves double activations by the highest net input.
-pub fn solve(cands: &[Candidate], csr: &Csr, n_left: usize, p: &SolverParams) -> Solution {
+/// Runs the network and resolves double activations by the highest net input. A failed
+/// allocation of its per-candidate and per-segment arrays is [`crate::CoreError::OutOfMemory`].
+pub fn solve(cands: &[Candidate], csr: &Csr, n_left: usize, p: &SolverParams) -> Result<Solution> {
+    const WHAT: &str = "the MCGM network's arrays";
     let m = cands.len();
-    let input: Vec<f64> = cands
-        .iter()
-        .map(|c| (p.d * c.score - p.theta) as f64)
-        .collect();
+    let input = try_collect(
+        m,
+        cands.iter().map(|c| (p.d * c.score - p.theta) as f64),
+        WHAT,
+    )?;
     // Preset: the best candidate of every left segment on (candidates are best first).
-    let init: Vec<u8> = (0..m)
-        .map(|i| u8::from(i == 0 || cands[i - 1].left != cands[i].left))
-        .collect();
-    let dynamics = run_dynamics(csr, &input, &init, p.seed, p.max_sweeps);
+    let init = try_collect(
+        m,
+        (0..m).map(|i| u8::from(i == 0 || cands[i - 1].left != cands[i].left)),
+        WHAT,
+    )?;
+    let dynamics = run_dynamics(csr, &input, &init, p.seed, p.max_sweeps)?;
     let state = dynamics.state;
-    let mut net = input.clone();
+    let mut net = try_collect(m, input.iter().copied(), WHAT)?;
     for (a, &on) in state.iter().enumerate() {
         if on == 1 {
             let (idx, val) = csr.row(a);
@@ -390,7 +395,7 @@ pub fn solve(cands: &[Candidate], csr: &Csr, n_left: usize, p: &SolverParams) ->
         }
     }
     let better = |a: usize, b: usize| net[a] > net[b] || (net[a] == net[b] && a < b);
-    let mut best_left: Vec<Option<usize>> = vec![None; n_left];
+    let mut best_left: Vec<Option<usize>> = try_filled(n_left, None, WHAT)?;
     for a in (0..m).filter(|&a| state[a] == 1) {
         let slot = &mut best_left[cands[a].left as usize];
         if slot.is_none_or(|b| better(a, b)) {
@@ -402,20 +407,21 @@ pub fn solve(cands: &[Candidate], csr: &Csr, n_left: usize, p: &SolverParams) ->
         .map(|c| c.right as usize + 1)
         .max()
         .unwrap_or(0);
-    let mut best_right: Vec<Option<usize>> = vec![None; n_right];
+    let mut best_right: Vec<Option<usize>> = try_filled(n_right, None, WHAT)?;
     for a in best_left.iter().flatten().copied() {
         let slot = &mut best_right[cands[a].right as usize];
         if slot.is_none_or(|b| better(a, b)) {
             *slot = Some(a);
         }
     }
-    let mut chosen: Vec<usize> = best_right.into_iter().flatten().collect();
+    let n_chosen = best_right.iter().flatten().count();
+    let mut chosen = try_collect(n_chosen, best_right.into_iter().flatten(), WHAT)?;
     chosen.sort_unstable();
-    Solution {
+    Ok(Solution {
         chosen,
         state,
         n_weights: csr.nnz(),
         sweeps: dynamics.sweeps,
         converged: dynamics.converged,
-    }
+    })
 }

@@ -1611,7 +1611,7 @@ fn match_channel(
         r.curves.segments.len(),
         &p.solver,
     )?;
-    let sol = solve(&cands, &csr, l.curves.segments.len(), &p.solver);
+    let sol = solve(&cands, &csr, l.curves.segments.len(), &p.solver)?;
     let matches = decompose(l, r, &cands, &sol.chosen, p.horiz_skip_deg, ci as u8)?;
     // Prior for the finer channels: this channel's disparities over the coarser ones'.
     if prior.is_none() {

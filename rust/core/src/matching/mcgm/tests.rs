@@ -1676,7 +1676,7 @@ fn association_weights_and_the_resolution_follow_the_definitions() {
         indices: vec![],
         data: vec![],
     };
-    let sol = graph::solve(&cands, &empty, 4, &sp);
+    let sol = graph::solve(&cands, &empty, 4, &sp).unwrap();
     assert_eq!(sol.state, [1, 1, 1, 1, 1, 1]);
     // Left 0: c0 (0.9); left 1: c2 (0.95); left 2: c4; left 3: c5, which takes right 0 from
     // c0 (0.95 > 0.9).
@@ -1688,7 +1688,7 @@ fn association_weights_and_the_resolution_follow_the_definitions() {
         indices: vec![],
         data: vec![],
     };
-    let sol = graph::solve(&low, &empty2, 2, &sp);
+    let sol = graph::solve(&low, &empty2, 2, &sp).unwrap();
     assert_eq!((sol.state, sol.chosen), (vec![0, 1], vec![1]));
     // Net inputs with weights: a single weight lifts c1 above c0 on left 0.
     let lift = crate::matching::hopfield::Csr {
@@ -1696,7 +1696,7 @@ fn association_weights_and_the_resolution_follow_the_definitions() {
         indices: vec![5, 1],
         data: vec![0.5, 0.5],
     };
-    let sol = graph::solve(&cands, &lift, 4, &sp);
+    let sol = graph::solve(&cands, &lift, 4, &sp).unwrap();
     assert_eq!(sol.state, [1, 1, 1, 1, 1, 1]);
     assert_eq!(sol.chosen, [1, 2, 4, 5]);
     // Equal net inputs: the lower index.
@@ -1710,12 +1710,12 @@ fn association_weights_and_the_resolution_follow_the_definitions() {
         indices: vec![],
         data: vec![],
     };
-    assert_eq!(graph::solve(&tie, &empty3, 2, &sp).chosen, [0, 2]);
+    assert_eq!(graph::solve(&tie, &empty3, 2, &sp).unwrap().chosen, [0, 2]);
     // ... whatever order the left segments' groups come in: left 1's group first, its
     // candidate 0 ties left 0's candidate 1 on right 0 and is kept (the first one the
     // right-segment pass meets, left 0's, was kept with the index rule dropped).
     let swapped = [c(1, 0, 0.8, 1.0, 0.0), c(0, 0, 0.8, 1.0, 0.0)];
-    assert_eq!(graph::solve(&swapped, &empty2, 2, &sp).chosen, [0]);
+    assert_eq!(graph::solve(&swapped, &empty2, 2, &sp).unwrap().chosen, [0]);
     // The preset (each left segment's best candidate on) is a stable state of mutually
     // inhibiting pairs: the network stays there (from all off, the visiting order decides).
     let pairs: Vec<graph::Candidate> = (0..8u32)
@@ -1723,7 +1723,7 @@ fn association_weights_and_the_resolution_follow_the_definitions() {
         .collect();
     let segs: Vec<Segment> = (0..8).map(|i| seg(100.0 * i as f32, 0.0)).collect();
     let w8 = graph::association_weights(&pairs, &segs, &vec![Vec::new(); 8], 16, &sp).unwrap();
-    let sol = graph::solve(&pairs, &w8, 8, &sp);
+    let sol = graph::solve(&pairs, &w8, 8, &sp).unwrap();
     assert_eq!(sol.state, [1, 0].repeat(8));
     assert_eq!(sol.chosen, (0..8).map(|i| 2 * i).collect::<Vec<usize>>());
 }
