@@ -1821,6 +1821,7 @@ def test_from_kitti_reads_the_grey_pair_when_asked(tmp_path: Path) -> None:
     for bad, shown in (
         (np.array([0, 5]), r"\[0, 5\]"),
         ((np.int64(0), np.int64(5)), r"\(0, 5\)"),  # not "(np.int64(0), np.int64(5))"
+        ([np.int64(0), np.int64(5)], r"\[0, 5\]"),  # a list too, not "[np.int64(0), ...]"
         (np.array([[0, 1]]), r"\[\[0, 1\]\]"),
         (np.array([0.0, 1.0]), r"\[0\.0, 1\.0\]"),
         ("01", "'01'"),

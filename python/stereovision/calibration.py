@@ -1893,8 +1893,8 @@ class Calibration:
             # by its values: "[0, 5]", "(0, 5)", not "array([0, 5])", "(np.int64(0), ...)"
             if isinstance(cameras, np.ndarray):
                 shown = repr(cameras.tolist())
-            elif isinstance(cameras, tuple) and isinstance(given, list):
-                shown = repr(tuple(given))
+            elif isinstance(cameras, (tuple, list)) and isinstance(given, list):
+                shown = repr(tuple(given) if isinstance(cameras, tuple) else given)
             else:
                 shown = text_shown(cameras)
             raise ValueError(
