@@ -2272,9 +2272,12 @@ def test_a_given_capture_whose_set_hangs_is_given_up(wedged: type[_WedgedDevice]
     wedged.wedged_props = {("R", cv2.CAP_PROP_FRAME_WIDTH)}
     with pytest.raises(SourceError) as err:
         StereoCamera(left, right, image_size=(640, 480), open_timeout=0.2)
+    # it was open already, and may be a camera: "did not open ... a stalled stream or network
+    # share" said neither
     assert str(err.value) == (
-        "right source _WedgedDevice did not open within 0.2 s (setting its frame width to 640 "
-        "did not return: a stalled stream or network share); give it a longer timeout"
+        "right source _WedgedDevice was not set up within 0.2 s (setting its frame width to "
+        "640 did not return: a wedged camera or driver, or a stalled stream); give it a longer "
+        "timeout, or unplug and replug the camera"
     )
     wedged.unplug.set()
     assert _released_soon(left) and _released_soon(right) and not right.released_busy

@@ -587,20 +587,30 @@ def _open_within(
     # a URL or file has no plug, and a network stream may just be slow (FFmpeg's own open
     # waits 30 s): "unplug and replug it" is a device's advice alone, a longer limit either's
     device = isinstance(src, (int, np.integer))
-    why = "a wedged camera or driver" if device else "a stalled stream or network share"
+    # a capture of the caller's was open already, and may be a camera's or a stream's
+    given = not device and not isinstance(src, (str, os.PathLike))
+    why = (
+        "a wedged camera or driver, or a stalled stream"
+        if given
+        else "a wedged camera or driver"
+        if device
+        else "a stalled stream or network share"
+    )
     todo = (
-        "unplug and replug it, or give it a longer timeout"
+        "give it a longer timeout, or unplug and replug the camera"
+        if given
+        else "unplug and replug it, or give it a longer timeout"
         if device
         else "give it a longer timeout"
     )
+    verb = "was not set up" if given else "did not open"
     try:
         return _within(
             opened,
             timeout,
             what,
             hung=lambda: (
-                f"{what} did not open within {timeout:g} s ({doing[0]} did not "
-                f"return: {why}); {todo}"
+                f"{what} {verb} within {timeout:g} s ({doing[0]} did not return: {why}); {todo}"
             ),
             side=side,
         )
