@@ -2386,6 +2386,31 @@ def test_a_stream_whose_open_hangs_is_not_told_to_be_unplugged(
     assert [c.src for c in wedged.made] == [url] and _released_soon(wedged.made[0])
 
 
+def test_a_device_node_whose_setting_hangs_is_told_to_be_unplugged(
+    wedged: type[_WedgedDevice], monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """A camera named by its V4L2 node (``/dev/video7``, or a ``/dev/v4l/by-id`` link to it) is
+    a device as its index is: its hung setting was said "a stalled stream or network share",
+    with no word of unplugging it."""
+    node = "/dev/video7"
+    link = tmp_path / "usb-cam-video-index0"
+    link.symlink_to(node)
+    exists = os.path.exists
+    monkeypatch.setattr(os.path, "exists", lambda p: os.fspath(p) in (node, str(link)) or exists(p))
+    for src in (node, link):
+        wedged.wedged_props = {(os.fspath(src), cv2.CAP_PROP_FRAME_WIDTH)}
+        with pytest.raises(SourceError) as err:
+            StereoCamera(src, 1, image_size=(640, 480), open_timeout=0.2)
+        assert str(err.value) == (
+            f"left source {capmod._describe_source(src)} did not open within 0.2 s (setting its "
+            "frame width to 640 did not return: a wedged camera or driver); unplug and replug "
+            "it, or give it a longer timeout"
+        )
+        wedged.unplug.set()
+        assert _released_soon(wedged.made[-1])
+        wedged.unplug.clear()
+
+
 def test_a_camera_opened_in_time_is_kept(wedged: type[_WedgedDevice]) -> None:
     """Bounded opens keep what opens in time, unreleased; None opens without a thread."""
     for timeout in (0.5, None):

@@ -586,9 +586,11 @@ def _open_within(
     what = f"{side} source {_describe_source(src)}"
     # a URL or file has no plug, and a network stream may just be slow (FFmpeg's own open
     # waits 30 s): "unplug and replug it" is a device's advice alone, a longer limit either's
-    device = isinstance(src, (int, np.integer))
+    # a camera by its index or by its V4L2 node (/dev/video0, a /dev/v4l/by-id link): a device
+    path = isinstance(src, (str, os.PathLike))
+    device = _camera_device(os.fspath(src) if isinstance(src, os.PathLike) else src) is not None
     # a capture of the caller's was open already, and may be a camera's or a stream's
-    given = not device and not isinstance(src, (str, os.PathLike))
+    given = not device and not path
     why = (
         "a wedged camera or driver, or a stalled stream"
         if given
