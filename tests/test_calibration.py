@@ -655,6 +655,50 @@ def test_fit_to_frames_scales_or_names_a_crop() -> None:
             fit_to_frames(c, size)  # type: ignore[arg-type]
 
 
+@pytest.mark.parametrize(
+    ("size", "said"),
+    [
+        ((320, 241), "1 row more"),  # KITTI's 1242x376 frames against a 1242x375 calibration
+        ((320, 238), "2 rows fewer"),
+        ((321, 239), "1 column more and 1 row fewer"),
+    ],
+)
+def test_fit_to_frames_refuses_a_crop_or_pad_of_a_few_rows(
+    size: tuple[int, int], said: str
+) -> None:
+    """Frames a row or two off the calibration (one side kept, or one larger and one smaller)
+    were scaled to, a 0.4 % stretch of one axis moving the principal point ~0.5 px with only a
+    note: no resize makes them. They are refused with depth's advice."""
+    from stereovision.calibration import fit_to_frames
+
+    with pytest.raises(
+        ValueError,
+        match=rf"^calibration is for 320x240 images, the frames are {size[0]}x{size[1]}: images "
+        rf"cropped or padded, not resized \({said}\): crop or pad them to 320x240$",
+    ):
+        fit_to_frames(raw_calib(), size)
+
+
+def test_fit_to_frames_still_scales_a_true_resize() -> None:
+    """Both sides by one factor (320x240 -> 640x480, or 160x121 within the 1 %): scaled, the
+    pixel centres kept (c' = (c + 0.5) s - 0.5)."""
+    from stereovision.calibration import fit_to_frames
+
+    c = raw_calib()
+    big, note = fit_to_frames(c, (640, 480))
+    assert note is not None and note.startswith(
+        "the calibration is for 320x240 and the frames are 640x480: scaled to them"
+    )
+    np.testing.assert_allclose(big.K1, [[600.0, 0, 323.1], [0, 604.0, 237.9], [0, 0, 1]])
+    np.testing.assert_allclose(big.K2, [[610.0, 0, 316.9], [0, 613.0, 243.3], [0, 0, 1]])
+    np.testing.assert_array_equal(big.D1, c.D1)
+    np.testing.assert_array_equal(big.T, c.T)
+    near, _ = fit_to_frames(c, (160, 121))
+    assert near.image_size == (160, 121)
+    assert near.K1[1, 1] == pytest.approx(302.0 * 121 / 240)
+    assert near.K1[1, 2] == pytest.approx((118.7 + 0.5) * 121 / 240 - 0.5)
+
+
 def test_depth_step_and_describe() -> None:
     """f 500 px, B 0.1 m: fB = 50 m px, so one pixel of disparity is Z^2 / 50 of depth."""
     c = rect_calib()

@@ -729,6 +729,49 @@ def known_unit(unit: object, units: Iterable[str], name: str = "unit") -> str:
     return str(unit)
 
 
+def same_aspect(calib_size: tuple[int, int], size: tuple[int, int]) -> bool:
+    """Whether ``size`` scales ``calib_size`` by one factor on both sides, within 1 % of the
+    larger (a halved odd side rounds: 450x375 -> 225x188)."""
+    sx, sy = size[0] / calib_size[0], size[1] / calib_size[1]
+    return abs(sx - sy) <= 0.01 * max(sx, sy)
+
+
+def crop_or_pad_hint(calib_size: tuple[int, int], size: tuple[int, int]) -> str | None:
+    """Advice for frames a few rows or columns off a calibration's size, else None.
+
+    A resize moves both sides one way; one side kept (KITTI's 1242x376 frames against
+    1242x375) or one larger and one smaller, within :func:`same_aspect`, is a crop or pad,
+    which a scaled calibration would take for a stretch of one axis (0.27 % there, the
+    principal point moved ~0.5 px).
+
+    Parameters
+    ----------
+    calib_size, size : tuple of int
+        ``(width, height)`` of the calibration and of the frames.
+
+    Returns
+    -------
+    str or None
+        "images cropped or padded, not resized (1 row more): crop or pad them to WxH", or None
+        when the sizes are equal, a resize, or another aspect ratio.
+
+    Examples
+    --------
+    >>> crop_or_pad_hint((1242, 375), (1242, 376))
+    'images cropped or padded, not resized (1 row more): crop or pad them to 1242x375'
+    """
+    (cw, ch), (w, h) = calib_size, size
+    dw, dh = w - cw, h - ch
+    if (dw, dh) == (0, 0) or dw * dh > 0 or not same_aspect(calib_size, size):
+        return None
+    off = " and ".join(
+        f"{abs(d)} {what}{'s' if abs(d) > 1 else ''} {'more' if d > 0 else 'fewer'}"
+        for d, what in ((dw, "column"), (dh, "row"))
+        if d
+    )
+    return f"images cropped or padded, not resized ({off}): crop or pad them to {cw}x{ch}"
+
+
 def pixels_shown(value: float) -> str:
     """A number of pixels for a message: every digit of a whole number up to 12 digits
     (``:g`` showed 3e10 + 48 as "3e+10"), a fraction as given (16.5), beyond that 12 digits; an

@@ -32,10 +32,12 @@ import numpy.typing as npt
 
 from stereovision._validate import (
     as_image_array,
+    crop_or_pad_hint,
     known_unit,
     number_shown,
     positive_finite,
     renamed_keyword,
+    same_aspect,
     text_shown,
     user_stacklevel,
     xy_points,
@@ -2321,14 +2323,21 @@ def fit_to_frames(calib: Calibration, size: tuple[int, int]) -> tuple[Calibratio
     Raises
     ------
     ValueError
-        If ``size`` is not two positive integers, or the aspect ratios differ by more than 1 %
-        (a camera mode that crops: it needs its own calibration).
+        If ``size`` is not two positive integers, the aspect ratios differ by more than 1 %
+        (a camera mode that crops: it needs its own calibration), or one side is kept (or one
+        larger, one smaller): frames cropped or padded by a few rows, which scaling would
+        stretch along one axis.
     """
     (w0, h0), (w, h) = calib.image_size, Calibration._check_size(size)
     if (w0, h0) == (w, h):
         return calib, None
-    sx, sy = w / w0, h / h0
-    if abs(sx - sy) > 0.01 * max(sx, sy):
+    # refused, not cropped or padded here: where the rows were added or cut is unknown (the
+    # principal point moves with a crop at the top), and a camera mode delivers the size
+    # it was calibrated at; frames a row off (KITTI's 1242x376) have their own calibration
+    crop = crop_or_pad_hint((w0, h0), (w, h))
+    if crop is not None:
+        raise ValueError(f"calibration is for {w0}x{h0} images, the frames are {w}x{h}: {crop}")
+    if not same_aspect((w0, h0), (w, h)):
         raise ValueError(
             f"calibration is for {w0}x{h0} images, the frames are {w}x{h}: another aspect "
             "ratio (a camera mode that crops), which needs its own calibration"

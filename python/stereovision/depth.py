@@ -30,10 +30,12 @@ from stereovision._validate import (
     as_bgr_uint8,
     as_gray_float,
     check_pair,
+    crop_or_pad_hint,
     finite_number,
     known_unit,
     pair_shape_error,
     path_given,
+    same_aspect,
     unreachable_range,
     user_stacklevel,
 )
@@ -188,20 +190,11 @@ def _rig_to_warp_by(
     if tuple(calib.image_size) != (width, height):
         cw, ch = calib.image_size
         w, h = width, height
-        dw, dh = w - cw, h - ch
         if (cw, ch) == (h, w):
             hint = "width and height swapped? image_size is (width, height)"
-        elif dw * dh <= 0 and abs(w / cw - h / ch) <= 0.01 * max(w / cw, h / ch):
-            # a resize moves both sides one way: one side kept (KITTI's 1242x376 frames
-            # against 1242x375) or one larger, one smaller is a crop or pad of a few rows,
-            # which scaled_to would take for a 0.3 % stretch of one axis
-            off = " and ".join(
-                f"{abs(d)} {what}{'s' if abs(d) > 1 else ''} {'more' if d > 0 else 'fewer'}"
-                for d, what in ((dw, "column"), (dh, "row"))
-                if d
-            )
-            hint = f"images cropped or padded, not resized ({off}): crop or pad them to {cw}x{ch}"
-        elif abs(w / cw - h / ch) <= 0.01 * max(w / cw, h / ch):
+        elif (crop := crop_or_pad_hint((cw, ch), (w, h))) is not None:
+            hint = crop
+        elif same_aspect((cw, ch), (w, h)):
             # fit_to_frames' 1 % (stream and gui scale such frames): a halved odd side rounds
             hint = f"images resized, not cropped: calib.scaled_to(({w}, {h}))"
         else:
