@@ -560,6 +560,9 @@ def test_view_texts_say_no_far_end_as_infinity_and_refuse_an_unknown_unit():
     for v in (view, ViewData(None, "", "", "", "", "", None, None, "0.3 s", "")):
         with pytest.raises(ValueError, match="unit: expected one of \\['m', 'ft'\\], got 'yd'"):
             v.texts("yd")
+        # a NumPy string by its text, not "got np.str_('yd')" (known_unit's message)
+        with pytest.raises(ValueError, match=r"^unit: expected one of \['m', 'ft'\], got 'yd'$"):
+            v.texts(np.str_("yd"))
 
 
 def test_the_max_disparity_field_is_applied_and_checked():

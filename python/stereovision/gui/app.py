@@ -41,7 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from stereovision import release_memory
-from stereovision._validate import advice_for, first_line
+from stereovision._validate import advice_for, first_line, known_unit
 from stereovision.calibration import fit_to_frames
 from stereovision.capture import DEFAULT_READ_TIMEOUT
 from stereovision.gui.sources import (
@@ -326,8 +326,7 @@ def sliders_from_pose(pose: npt.ArrayLike, unit: str = "m") -> tuple[dict[str, f
     from stereovision.calibration import UNIT_TO_METRES
     from stereovision.render import controls_from_pose
 
-    if unit not in UNITS:
-        raise ValueError(f"unit: expected one of {list(UNITS)}, got {unit!r}")
+    unit = known_unit(unit, UNITS)
     controls = controls_from_pose(pose)
     metres = UNIT_TO_METRES[unit]
     values, clamped = {}, False
@@ -615,8 +614,7 @@ class ViewData:
         ValueError
             An unknown unit.
         """
-        if unit not in UNITS:
-            raise ValueError(f"unit: expected one of {list(UNITS)}, got {unit!r}")
+        unit = known_unit(unit, UNITS)
         caption, stats = self.depth_caption, self.stats
         if self.depth_ends is not None:
             near, far = (_length(v, unit) for v in self.depth_ends)
@@ -2936,8 +2934,10 @@ class StereoApp:
         where it was) in metres or feet."""
         from stereovision.calibration import UNIT_TO_METRES
 
-        if unit not in UNITS:
-            self._fail(ValueError(f"unit: expected one of {list(UNITS)}, got {unit!r}"))
+        try:
+            unit = known_unit(unit, UNITS)  # a plain str: an np.str_ was shown by its repr
+        except ValueError as exc:
+            self._fail(exc)
             with self.state:
                 self.state.unit = self._unit
             return
