@@ -3180,6 +3180,101 @@ async def _until(done: Callable[[], bool]) -> None:
     raise AssertionError("not done within a second")
 
 
+def test_the_end_of_a_computation_leaves_a_pending_reads_status(monkeypatch):
+    """A Capture clicked while a pair computes said "reading ...", and the computation's end
+    then said "ready" (or "error") while the read went on, as it did over an Open's "opening
+    ...". The end, and its progress meanwhile, say the read or open; with neither under way
+    the end says "ready" as before."""
+    import asyncio
+    import threading
+
+    from stereovision import capture
+    from stereovision.gui import app as gui_app
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    read_gate, compute_gate, open_gate = threading.Event(), threading.Event(), threading.Event()
+    reads: list[Any] = []
+    opens: list[Any] = []
+    outcome: list[BaseException] = []
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            opens.append(self)
+            open_gate.wait(1.0)
+
+        def read(self):
+            reads.append(self)
+            read_gate.wait(1.0)  # bounded: a broken app cannot hang the test
+            return frame, frame
+
+        def close(self):
+            pass
+
+    real = gui_app.compute_view
+
+    def gated(*args: Any, **kwargs: Any) -> Any:
+        compute_gate.wait(1.0)
+        if outcome:
+            raise outcome[0]
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    monkeypatch.setattr(gui_app, "compute_view", gated)
+    app = _scene_app("test-compute-end-reading", [bundled_data_dir()], read_timeout=2.0)
+    app.state.cam_left, app.state.cam_right = "0", "1"
+    tasks = _collect_reads(app)
+    reading = "reading camera 0 and camera 1..."
+
+    async def computed_during_a_capture(n: int) -> None:
+        read_gate.clear()
+        compute_gate.clear()
+        computing = asyncio.ensure_future(app.recompute())
+        await _until(lambda: app._computing)
+        app.capture()
+        await _until(lambda: len(reads) == n)
+        assert app.state.status == reading
+        app._set_progress(50, "census")  # a progress step meanwhile: both said
+        assert app.state.status == f"census; {reading}"
+        compute_gate.set()
+        await computing
+        assert app.state.status == reading and not app.state.busy
+        read_gate.set()
+        await tasks[-1]
+
+    async def clicks() -> None:
+        app._lock = asyncio.Lock()
+        read_gate.set()
+        open_gate.set()
+        app.open_cameras()
+        await tasks[0]  # open, their pair taken (its computation closed unrun)
+        await computed_during_a_capture(2)
+        assert app.state.computations == 1 and app.state.error == ""
+        assert app.state.captures == 2
+        outcome.append(ValueError("bad pair"))  # a computation that fails meanwhile
+        await computed_during_a_capture(3)
+        assert app.state.error.startswith("bad pair") and app.state.computations == 1
+        outcome.clear()
+        compute_gate.set()
+        await app.recompute()  # no read under way
+        assert app.state.status == "ready" and app.state.computations == 2
+        compute_gate.clear()
+        open_gate.clear()
+        computing = asyncio.ensure_future(app.recompute())
+        await _until(lambda: app._computing)
+        app.open_cameras()
+        await _until(lambda: len(opens) == 2)
+        compute_gate.set()
+        await computing
+        assert app.state.status == "opening camera 0 and camera 1..."
+        assert app.state.computations == 3
+        open_gate.set()
+        await tasks[-1]
+        assert app.state.error == "" and app.state.captures == 4
+
+    asyncio.run(clicks())
+
+
 def test_a_wedged_camera_read_leaves_the_page_free(monkeypatch):
     """After an Open, the cameras' first read, and every Capture's, ran in the page's handler:
     a wedged camera froze the page up to --read-timeout. They run in a thread now, the page

@@ -1432,6 +1432,10 @@ class StereoApp:
         #: of one is refused; one replaced meanwhile is closed when its read returns (closing a
         #: camera under a grab in another thread is not safe).
         self._reading: list[StereoSource] = []
+        #: The opens and reads under way (a token each) with their "opening ..." or "reading
+        #: ..." status, which a computation's end and progress keep saying
+        #: (:meth:`_status_with_reads`).
+        self._under_way: list[tuple[object, str]] = []
         self._close_after_read: list[StereoSource] = []
         #: A scene or files are on show, chosen after :attr:`source` opened (False: its pair,
         #: or none: cameras given at start-up whose first read failed are read by a Capture).
@@ -1608,7 +1612,7 @@ class StereoApp:
             self.state.error = msg
             if not self._computing:  # a failed click during a computation leaves its progress
                 self.state.busy = False
-                self.state.status = "error"
+                self.state.status = self._status_with_reads(None) or "error"
 
     def _done(self) -> None:
         """A button's action succeeded: an earlier failure's message and "error" status go (they
@@ -1617,7 +1621,11 @@ class StereoApp:
             self.state.error = ""
             # without a pair on show too: the toolbar said "error" above a page with no error
             # on it (cameras that failed at start-up, then a point-cloud file opened)
-            if not self._computing and (self.view is not None or self.state.status == "error"):
+            if self._computing:
+                return
+            if self._under_way:
+                self.state.status = self._status_with_reads(None)
+            elif self.view is not None or self.state.status == "error":
                 self.state.status = "ready"
 
     def _other_source(self) -> None:
@@ -1856,10 +1864,25 @@ class StereoApp:
     def _begin_read(self, source: StereoSource, what: str) -> None:
         """A read of ``source`` is under way from now (before its task runs: a click that
         comes meanwhile sees it); the page says so."""
+        said = f"reading {what}..."
         self._reading.append(source)
+        self._under_way.append((source, said))
         with self.state:
             self.state.error = ""
-            self.state.status = f"reading {what}..."
+            self.state.status = said
+
+    def _end_under_way(self, token: object) -> None:
+        """The open or read of ``token`` (:attr:`_under_way`) has returned."""
+        self._under_way = [u for u in self._under_way if u[0] is not token]
+
+    def _status_with_reads(self, text: str | None) -> str:
+        """The status ``text`` followed by the newest open or read under way's "opening ..." or
+        "reading ..." ("census; reading camera 0..."), that alone for None, "" with neither:
+        a computation's end and progress said "ready" or their step while a Capture read."""
+        said = self._under_way[-1][1] if self._under_way else None
+        if said is None or text is None:
+            return said or text or ""
+        return f"{text}; {said}"
 
     async def _read_in_thread(self, source: StereoSource, average: bool) -> _Frames:
         """:func:`_read_pair` of ``source`` in a daemon thread, waited for here (the page's loop
@@ -1876,6 +1899,7 @@ class StereoApp:
         def settle(got: _Frames | None, exc: BaseException | None) -> None:
             # on the page's loop
             self._reading = [r for r in self._reading if r is not source]
+            self._end_under_way(source)
             if any(c is source for c in self._close_after_read):
                 self._close_after_read = [c for c in self._close_after_read if c is not source]
                 source.close()
@@ -1902,6 +1926,7 @@ class StereoApp:
             threading.Thread(target=run, name="stereovision-gui-read", daemon=True).start()
         except BaseException:  # no thread: nothing reads the source
             self._reading = [r for r in self._reading if r is not source]
+            self._end_under_way(source)
             raise
         return await done
 
@@ -1968,6 +1993,10 @@ class StereoApp:
         loop = asyncio.get_running_loop()
         opened: asyncio.Future[StereoSource] = loop.create_future()
         keys = (_pending_key(left), _pending_key(right))
+        # said until the open returns or is given up (registered here, not by the click: a
+        # task closed unrun would leave it said for good)
+        token = object()
+        self._under_way.append((token, f"opening {what}..."))
 
         def settle(source: StereoSource | None, exc: BaseException | None) -> None:
             # on the page's loop: the sources may be opened again from now, unless they
@@ -1998,9 +2027,12 @@ class StereoApp:
                     source.close()
 
         try:
-            threading.Thread(target=run, name="stereovision-gui-open", daemon=True).start()
-            # reads are bounded inside the source; its open by this wait (it cancels `opened`)
-            source = await asyncio.wait_for(opened, self.read_timeout)
+            try:
+                threading.Thread(target=run, name="stereovision-gui-open", daemon=True).start()
+                # reads are bounded inside the source; its open by this wait (it cancels `opened`)
+                source = await asyncio.wait_for(opened, self.read_timeout)
+            finally:  # before an error is said: the status says no open then
+                self._end_under_way(token)
         except asyncio.TimeoutError:
             if choice != self._choice:  # another source was chosen meanwhile: it is on show
                 return
@@ -2196,7 +2228,7 @@ class StereoApp:
                 st = self.state
                 st.busy = True
                 st.progress = 1
-                st.status = f"computing ({method})"
+                st.status = self._status_with_reads(f"computing ({method})")
                 st.max_disp_hint = max_disparity_hint(self.max_disparity, left.shape[1], width)
                 if fresh:  # another pair: its images now, no result of the previous pair
                     if self._page_before is None:
@@ -2706,7 +2738,7 @@ class StereoApp:
     def _set_progress(self, pct: int, text: str) -> None:
         with self.state:
             self.state.progress = pct
-            self.state.status = text
+            self.state.status = self._status_with_reads(text)
 
     def _publish(self, view: ViewData) -> None:
         self.view = view
@@ -2739,7 +2771,7 @@ class StereoApp:
             st.message_3d = self._scene_message()
             st.progress = 100
             st.busy = False
-            st.status = "ready"
+            st.status = self._status_with_reads(None) or "ready"
             st.error = ""
             st.floor_label = st.img_floor = ""  # a new depth map: its floor is not found yet
             st.save_label = ""
