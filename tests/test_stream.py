@@ -2001,6 +2001,20 @@ def test_a_bag_without_a_calibration_is_refused(
     assert not bag.exists()
 
 
+def test_ground_every_without_a_calibration_is_said_in_the_cli_words(
+    videos: dict[str, Path], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--ground-every`` without ``--calib`` was refused as "ground_every: ... give a
+    calibration", run_stream's keyword: said with the option and the option to give."""
+    argv = ["stream", "--left", str(videos["left"]), "--right", str(videos["right"])]
+    argv += ["--no-display", "--no-check", "--frames", "1", "--max-disparity", "16"]
+    assert main([*argv, "--ground-every", "2"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        "stereovision: error: --ground-every: the floor is found in metres; give --calib"
+    ]
+
+
 def test_a_bag_folder_in_the_way_is_said_of_the_option(
     videos: dict[str, Path], tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

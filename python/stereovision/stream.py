@@ -1289,6 +1289,10 @@ def cmd_stream(args: argparse.Namespace) -> int:
     try:
         if args.bag and calib is None and not stopped:
             raise ValueError("--bag: a bag holds depth; give --calib")
+        if args.ground_every is not None and calib is None and not stopped:
+            # refused here, as --bag is, in the CLI's words: run_stream's refusal names its
+            # keyword (ground_every) and "a calibration"
+            raise ValueError("--ground-every: the floor is found in metres; give --calib")
         if args.bag and not stopped:
             from stereovision.rosbag import BagWriter
 
