@@ -588,6 +588,45 @@ def test_cli_keeps_the_calibration_it_replaces(
     assert Calibration.load(out).baseline != pytest.approx(chessboard[0].baseline, rel=0.1)
 
 
+def test_cli_keeps_no_copy_of_a_calibration_written_again_unchanged(
+    synthetic: tuple[list[np.ndarray], list[np.ndarray], list[str]],
+    cached_corners: None,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``calibrate -o rig.yaml --ros ros`` run twice on the same pairs kept the first run's
+    identical files as ``rig.previous.yaml`` and ``ros/*.previous.yaml``: a result that equals
+    the file is said unchanged and no copy is made; a changed result is still kept aside."""
+    left, right, _ = synthetic
+    for i, (a, b) in enumerate(zip(left[:SYN_GOOD_PAIRS], right[:SYN_GOOD_PAIRS], strict=True)):
+        cv2.imwrite(str(tmp_path / f"L{i:02d}.png"), a)
+        cv2.imwrite(str(tmp_path / f"R{i:02d}.png"), b)
+    out, ros = tmp_path / "rig.yaml", tmp_path / "ros"
+    argv = ["calibrate", "--left", str(tmp_path / "L*.png"), "--right", str(tmp_path / "R*.png"),
+            "--pattern", "9x6", "-o", str(out), "--ros", str(ros)]  # fmt: skip
+
+    def run(square: float) -> list[str]:
+        args = _parser().parse_args([*argv, "--square", str(square)])
+        assert args.func(args) == 0
+        return capsys.readouterr().out.splitlines()
+
+    run(SYN_SQUARE)
+    first = out.read_bytes()
+    lines = run(SYN_SQUARE)
+    assert out.read_bytes() == first
+    assert sorted(p.name for p in tmp_path.rglob("*.previous*")) == []
+    assert f"calibration written to {out} (unchanged: it held this calibration)" in lines
+    assert lines[-1] == (
+        f"ROS camera_info written to {ros / 'left.yaml'} and {ros / 'right.yaml'} (unchanged: "
+        "they held this calibration)"
+    )
+    lines = run(2 * SYN_SQUARE)  # another baseline: the earlier files kept aside
+    kept = tmp_path / "rig.previous.yaml"
+    assert f"calibration written to {out} (the one it replaced kept as {kept})" in lines
+    assert kept.read_bytes() == first
+    assert (ros / "left.previous.yaml").is_file() and (ros / "right.previous.yaml").is_file()
+
+
 def test_squares_counted_for_the_inner_corners_are_named(
     synthetic: tuple[list[np.ndarray], list[np.ndarray], list[str]], cached_corners: None
 ) -> None:
@@ -757,8 +796,8 @@ def test_cli_ros_and_report_files_of_the_users_are_not_replaced(
 ) -> None:
     """--report DIR holding a report.html of the user's: calibrate replaced it silently. Refused
     before any corner is looked for, naming the file; the files an earlier calibrate wrote there
-    (its manifest's) are replaced by a rerun. (--ros's files are kept as left.previous.yaml ...:
-    test_cli_keeps_the_calibration_it_replaces.)"""
+    (its manifest's) are replaced by a rerun. (--ros's files are kept as left.previous.yaml ...
+    when they change: test_cli_keeps_the_calibration_it_replaces.)"""
     left, right = _chessboard_paths()
     base = ["calibrate", "--left", str(left[0].parent / "left*.jpg"), "--right",
             str(right[0].parent / "right*.jpg"), "--square", "0.025",
@@ -794,7 +833,8 @@ def test_cli_ros_and_report_files_of_the_users_are_not_replaced(
             assert run("--ros", str(ros), "--report", str(rep)) == 0
     assert Calibration.load(tmp_path / "rig.yaml") is not None
     assert "camera_name" in (ros / "right.yaml").read_text()
-    assert "camera_name" in (ros / "right.previous.yaml").read_text()  # the first run's
+    # the rerun's files equal the first run's: nothing replaced, so no copy kept
+    assert not (ros / "right.previous.yaml").exists()
     manifest = ".stereovision-calibrate.json"
     assert json.loads((rep / manifest).read_text()) == [
         "report.html",

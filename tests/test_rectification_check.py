@@ -433,6 +433,36 @@ def test_cli_check_fix_keeps_the_calibration_it_replaces(
     assert not (tmp_path / "rig3.previous.yaml").exists()
 
 
+def test_cli_check_fix_keeps_no_copy_of_a_calibration_written_again_unchanged(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``check --fix OUT`` run twice with the same result kept the first run's identical file
+    as OUT's ``.previous`` copy: it is said unchanged and no copy is made; a changed one still
+    is kept aside."""
+    from stereovision.cli import main
+
+    cones = data_dir / "middlebury2003" / "cones"
+    img = cv2.imread(str(cones / "left.png"))
+    bumped = _rig(img.shape[1], img.shape[0], (0.3, 0.0, 0.0)).save(tmp_path / "rig.yaml")
+    other = _rig(img.shape[1], img.shape[0], (-0.3, 0.0, 0.0)).save(tmp_path / "other.yaml")
+    fix = tmp_path / "rig2.yaml"
+    pair = [str(cones / "left.png"), str(cones / "right.png")]
+    assert main(["check", *pair, "--calib", str(bumped), "--fix", str(fix)]) == 0
+    first = fix.read_bytes()
+    capsys.readouterr()
+    assert main(["check", *pair, "--calib", str(bumped), "--fix", str(fix)]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == (
+        f"corrected calibration written to {fix} (unchanged: it held this calibration)"
+    )
+    assert fix.read_bytes() == first and not list(tmp_path.glob("*.previous*"))
+    assert main(["check", *pair, "--calib", str(other), "--fix", str(fix)]) == 0
+    kept = tmp_path / "rig2.previous.yaml"
+    assert capsys.readouterr().out.splitlines()[-1] == (
+        f"corrected calibration written to {fix} (the one it replaced kept as {kept})"
+    )
+    assert kept.read_bytes() == first and fix.read_bytes() != first
+
+
 def test_cli_check_names_a_bad_tolerance_before_the_work(
     data_dir: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -2802,21 +2802,28 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     for key in ("option", "rule"):
         if key in rep.pair_selection:
             rep.pair_selection[key] = _cli_words(rep.pair_selection[key])
-    from stereovision.io import keep_previous
+    from stereovision.io import keep_previous, replaced_words
 
-    kept = keep_previous(out)
+    # the same result again (a rerun on the same pairs) replaces nothing: no copy is kept
+    existed = Path(out).is_file()
+    kept = keep_previous(out, cal._file_text(out).encode("utf-8"))
     for folder, claimed in claims.items():  # before the files: a run stopped keeps them its own
         record_outputs(folder, claimed, CALIBRATE_MANIFEST, CALIBRATE_OUTPUTS)
     cal.save(out)
     print(rep.summary(drop_option=DROP_OUTLIERS_CLI))
     print(cal.describe())
-    print(
-        f"calibration written to {out}" + (f" (the one it replaced kept as {kept})" if kept else "")
-    )
+    print(f"calibration written to {out}{replaced_words(kept, existed)}")
     if ros_dir is not None:
         try:
-            cal.to_ros()  # refused (a rig ROS cannot hold) before the earlier files are copied
-            ros_kept = [k for n in ("left", "right") if (k := keep_previous(ros_dir / f"{n}.yaml"))]
+            # refused (a rig ROS cannot hold) before the earlier files are copied
+            texts = cal.to_ros()
+            ros_files = [ros_dir / f"{n}.yaml" for n in ("left", "right")]
+            existed = all(p.is_file() for p in ros_files)
+            ros_kept = [
+                k
+                for p, t in zip(ros_files, texts, strict=True)
+                if (k := keep_previous(p, t.encode("utf-8")))
+            ]
             left_yaml, right_yaml = cal.save_ros(ros_dir)
         except ValueError as exc:
             raise ValueError(
@@ -2824,11 +2831,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
             ) from None
         print(
             f"ROS camera_info written to {left_yaml} and {right_yaml}"
-            + (
-                f" (the ones they replaced kept as {' and '.join(map(str, ros_kept))})"
-                if ros_kept
-                else ""
-            )
+            + replaced_words(" and ".join(map(str, ros_kept)), existed, "the ones they", "they")
         )
     if args.report:
         paths = rep.write(args.report)

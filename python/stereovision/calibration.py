@@ -1234,6 +1234,16 @@ class Calibration:
         from stereovision.io import atomic_write
 
         p = Path(path)
+        text = self._file_text(p)
+        with atomic_write(p, "w") as fh:
+            fh.write(text)
+        return p
+
+    def _file_text(self, path: PathLike) -> str:
+        """The text :meth:`save` writes to ``path`` (its format from the extension): what a
+        command compares with the file there before replacing it
+        (:func:`stereovision.io.keep_previous`). ValueError for another extension."""
+        p = Path(path)
         suffix = p.suffix.lower()
         rec = self._to_record()
         if suffix in (".yaml", ".yml", ".xml"):
@@ -1261,9 +1271,7 @@ class Calibration:
             raise ValueError(
                 f"cannot save a calibration as {p.name!r}: use .yaml, .yml, .xml or .json"
             )
-        with atomic_write(p, "w") as fh:
-            fh.write(text)
-        return p
+        return str(text)
 
     @classmethod
     def _made(cls, where: str, **fields: Any) -> Calibration:

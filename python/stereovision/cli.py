@@ -1031,12 +1031,14 @@ def cmd_check(args: argparse.Namespace) -> int:
             print(json.dumps(said))
         print("stereovision: the corrected calibration still fails: not written", file=sys.stderr)
         return 1
-    from stereovision.io import keep_previous
+    from stereovision.io import keep_previous, replaced_words
 
-    kept = keep_previous(fix)
+    # the same correction again (a rerun) replaces nothing: no copy is kept
+    existed = Path(fix).is_file()
+    kept = keep_previous(fix, fixed._file_text(fix).encode("utf-8"))
     fixed.save(fix)
     said["fixed"]["written"] = str(fix)
-    replaced = f" (the one it replaced kept as {kept})" if kept else ""
+    replaced = replaced_words(kept, existed)
     if not args.json:
         print(f"corrected calibration written to {fix}{replaced}")
     else:

@@ -351,6 +351,31 @@ def _same_bytes(a: Path, b: Path, chunk: int = 1 << 20) -> bool:
                 return True
 
 
+def replaced_words(
+    kept: object, existed: bool, replaced: str = "the one it", held: str = "it"
+) -> str:
+    """What the line of a calibration written says of the file it replaced.
+
+    Parameters
+    ----------
+    kept : object
+        The copy :func:`keep_previous` made (a path, or the paths' text), or None / ``""``.
+    existed : bool
+        Whether the file(s) existed before the write.
+    replaced, held : str
+        The subject of the two phrases (``"the ones they"`` and ``"they"`` for two files).
+
+    Returns
+    -------
+    str
+        `` (the one it replaced kept as X)``, `` (unchanged: it held this calibration)`` when
+        the file held the new bytes already (no copy made), or ``""`` for a new file.
+    """
+    if kept:
+        return f" ({replaced} replaced kept as {kept})"
+    return f" (unchanged: {held} held this calibration)" if existed else ""
+
+
 def keep_previous(path: PathLike, new: bytes | None = None) -> Path | None:
     """Copy an existing file aside as ``NAME.previous.EXT`` before a command replaces it.
 
