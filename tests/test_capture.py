@@ -1292,6 +1292,98 @@ def test_cli_capture(
         run("--from-bag", str(tmp_path), "--fourcc", "MJPG", "-o", str(out))
 
 
+def test_a_folder_a_glob_or_a_misnumbered_pattern_names_the_source_that_would_work(
+    tmp_path: Path,
+) -> None:
+    """``--left pairs/`` was "cannot open left source 'pairs/'", ``--left 'pairs/left*.png'``
+    "left source not found" and ``left_%03d.png`` for ``left_0001.png ...`` FFmpeg's line and
+    "cannot open": none named what works. The one line names the pattern of the files there
+    (or a video file, or a bag's --from-bag)."""
+    pairs = tmp_path / "pairs"
+    pairs.mkdir()
+    img = np.zeros((8, 8, 3), np.uint8)
+    for i in (1, 2, 3):
+        for side in ("left", "right"):
+            cv2.imwrite(str(pairs / f"{side}_{i:04d}.png"), img)
+    right = str(pairs / "right_%04d.png")
+    seq = f"a pattern such as {pairs}/left_%04d.png (its files are named left_0001.png, "
+    seq += "left_0002.png ...)"
+    for given, error, said in (
+        (f"{pairs}/", SourceError, f"left source {pairs}/ is a folder: give {seq}"),
+        (str(pairs), SourceError, f"left source {pairs} is a folder: give {seq}"),
+        (
+            f"{pairs}/left*.png",
+            FileNotFoundError,
+            f"left source {pairs}/left*.png is a glob, which OpenCV does not expand: give {seq}",
+        ),
+        (
+            f"{pairs}/left_%03d.png",
+            FileNotFoundError,
+            f"left source: no file numbered 0-4 fits {pairs}/left_%03d.png; give {seq}",
+        ),
+        (
+            f"{pairs}/left_*1.png",
+            FileNotFoundError,
+            f"left source {pairs}/left_*1.png is a glob, which OpenCV does not expand: give the "
+            f"file it matches, {pairs}/left_0001.png",
+        ),
+    ):
+        with pytest.raises(error) as err:
+            StereoCamera(given, right)
+        assert str(err.value) == said
+    # the right side is told its own files; an unpadded run is %d
+    for i in (1, 2, 10):
+        cv2.imwrite(str(pairs / f"R{i}.jpg"), img)
+    (pairs / "right_0001.png").unlink()
+    with pytest.raises(SourceError) as err:
+        StereoCamera(f"{pairs}/left_%04d.png", pairs)
+    assert str(err.value) == (
+        f"right source {pairs} is a folder: give a pattern such as {pairs}/right_%04d.png (its "
+        "files are named right_0002.png, right_0003.png)"
+    )
+    videos = tmp_path / "videos"
+    videos.mkdir()
+    _videos(videos, 1, 1)
+    with pytest.raises(SourceError) as err:
+        StereoCamera(videos / "left.avi", videos)
+    assert str(err.value) == (
+        f"right source {videos} is a folder: give a video file such as {videos}/right.avi"
+    )
+    bag = tmp_path / "bag"
+    bag.mkdir()
+    (bag / "metadata.yaml").write_text("")
+    with pytest.raises(SourceError, match="is a folder holding a ROS 2 bag: read it with --from"):
+        StereoCamera(bag, right)
+    with pytest.raises(FileNotFoundError) as nothing:
+        StereoCamera(f"{tmp_path}/empty/*.png", right)
+    assert str(nothing.value).endswith(
+        "(it matches no file): give a video file, an image-sequence pattern such as "
+        f"{tmp_path}/empty/left_%04d.png or a camera index"
+    )
+
+
+def test_cli_folder_source_is_one_line_naming_its_pattern(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``stream`` and ``capture`` share the source parsing: a folder is one line naming the
+    pattern of its files, exit 2."""
+    from stereovision.cli import main
+
+    pairs = tmp_path / "pairs"
+    pairs.mkdir()
+    for side in ("left", "right"):
+        cv2.imwrite(str(pairs / f"{side}_0001.png"), np.zeros((8, 8, 3), np.uint8))
+    src = ["--left", str(pairs), "--right", str(pairs / "right_%04d.png")]
+    said = (
+        f"stereovision: error: left source {pairs} is a folder: give a pattern such as "
+        f"{pairs}/left_%04d.png (its files are named left_0001.png)\n"
+    )
+    assert main(["stream", *src, "--no-display", "--frames", "1"]) == 2
+    assert capsys.readouterr().err == said
+    assert main(["capture", *src, "--count", "1", "-o", str(tmp_path / "out")]) == 2
+    assert capsys.readouterr().err == said
+
+
 def test_cli_missing_camera_is_one_line_naming_its_device(tmp_path: Path) -> None:
     # OpenCV's backends log each failed attempt to stderr; the CLI's one line says it instead.
     if os.path.exists("/dev/video97") or not os.path.isdir("/dev"):

@@ -656,6 +656,108 @@ def _sequence_gap(path: str, read: int) -> tuple[str, int] | None:
     return (os.path.basename(missing), later) if later else None
 
 
+#: A numbered file: its name before the number, the number, the extension (``left_``,
+#: ``0001``, ``.png``).
+_NUMBERED_RE = re.compile(r"^(.*?)(\d+)(\.[A-Za-z0-9]+)$")
+#: Files :func:`_forms_that_work` looks at in a folder at most (a listing stays cheap).
+_HINT_MAX_FILES = 20000
+
+
+def _forms_that_work(side: str, folder: str, names: Iterable[str]) -> tuple[str, str] | None:
+    """What ``--left``/``--right`` could name among ``names``, files of ``folder`` as typed:
+    the image-sequence pattern of the largest numbered run (one named after ``side`` first)
+    and the words for it (``"pattern such as DIR/left_%04d.png (its files are named
+    left_0001.png ...)"``), else a video file (one named after ``side`` first); None when
+    neither is there."""
+    from stereovision.batch import IMAGE_EXTS
+    from stereovision.io import _VIDEO_SUFFIXES
+
+    runs: dict[tuple[str, str], list[str]] = {}
+    videos: list[str] = []
+    for name in names:
+        if name.startswith("."):
+            continue
+        ext = os.path.splitext(name)[1].lower()
+        m = _NUMBERED_RE.match(name)
+        if m is not None and ext in IMAGE_EXTS:
+            runs.setdefault((m.group(1), m.group(3)), []).append(m.group(2))
+        elif ext in _VIDEO_SUFFIXES:
+            videos.append(name)
+
+    def ours(name: str) -> bool:  # named after this side ("left_", "Left", "cam_left")
+        return side in name.lower()
+
+    if runs:
+        (head, ext), digits = max(runs.items(), key=lambda r: (ours(r[0][0]), len(r[1])))
+        digits.sort(key=int)
+        widths = {len(d) for d in digits}
+        width = widths.pop() if len(widths) == 1 else 0
+        pattern = os.path.join(folder, f"{head}{f'%0{width}d' if width > 1 else '%d'}{ext}")
+        shown = ", ".join(f"{head}{d}{ext}" for d in digits[:2])
+        more = " ..." if len(digits) > 2 else ""
+        return pattern, f"pattern such as {pattern} (its files are named {shown}{more})"
+    if videos:
+        videos.sort(key=lambda v: (not ours(v), v))
+        video = os.path.join(folder, videos[0])
+        return video, f"video file such as {video}"
+    return None
+
+
+def _listing(folder: str) -> list[str]:
+    """The names in ``folder`` (at most :data:`_HINT_MAX_FILES`; none when unreadable)."""
+    try:
+        with os.scandir(folder or ".") as it:
+            return [e.name for _, e in zip(range(_HINT_MAX_FILES), it, strict=False)]
+    except OSError:
+        return []
+
+
+def _anything_hint(side: str, folder: str) -> str:
+    return (
+        "a video file, an image-sequence pattern such as "
+        f"{os.path.join(folder, side + '_%04d.png')} or a camera index"
+    )
+
+
+def _folder_hint(side: str, path: str) -> str:
+    """The one line for a folder given as a source, naming what would work in it."""
+    names = _listing(path)
+    if "metadata.yaml" in names or any(n.endswith((".db3", ".mcap")) for n in names):
+        return f"{side} source {path} is a folder holding a ROS 2 bag: read it with --from-bag"
+    form = _forms_that_work(side, path, names)
+    return f"{side} source {path} is a folder: give " + (
+        f"a {form[1]}" if form else _anything_hint(side, path)
+    )
+
+
+def _glob_hint(side: str, path: str) -> str:
+    """The one line for a shell glob given as a source (OpenCV expands none), naming the
+    pattern of the files it matches."""
+    folder = os.path.dirname(path)
+    matched = glob.glob(path)[:_HINT_MAX_FILES]
+    said = f"{side} source {path} is a glob, which OpenCV does not expand"
+    if len(matched) == 1 and os.path.isfile(matched[0]):  # one file: it is the source
+        return f"{said}: give the file it matches, {matched[0]}"
+    names = [os.path.basename(m) for m in matched if os.path.dirname(m) == folder]
+    form = _forms_that_work(side, folder, names)
+    if form is not None:
+        return f"{said}: give a {form[1]}"
+    none = "" if matched else " (it matches no file)"
+    return f"{said}{none}: give {_anything_hint(side, folder)}"
+
+
+def _pattern_hint(side: str, path: str) -> str | None:
+    """For an image-sequence pattern whose first file (numbered 0-4) is missing while files of
+    another numbering are there (``left_%03d.png`` for ``left_0001.png ...``): the one line
+    naming the pattern they need; None when they need this one (or none is there)."""
+    folder = os.path.dirname(path)
+    names = [os.path.basename(m) for m in glob.glob(re.sub(r"%0?\d*d", "*", path))]
+    form = _forms_that_work(side, folder, names[:_HINT_MAX_FILES])
+    if form is None or form[0] == path:
+        return None
+    return f"{side} source: no file numbered 0-4 fits {path}; give a {form[1]}"
+
+
 def _open_path(path: str) -> Any:
     """``cv2.VideoCapture`` of a file, a URL or an image-sequence pattern.
 
@@ -993,11 +1095,20 @@ class StereoCamera(PairSource):
         if isinstance(src, (str, os.PathLike)):
             path = os.fspath(src)
             if "%" not in path and "://" not in path and not os.path.exists(path):
+                if re.search(r"[*?[]", path):  # "not found" said nothing of the pattern
+                    raise FileNotFoundError(_glob_hint(side, path))
                 raise FileNotFoundError(f"{side} source not found: {path}")
+            if os.path.isdir(path):  # "cannot open" said nothing of what to give instead
+                raise SourceError(_folder_hint(side, path), side=side, end=False)
             pattern = re.sub(r"%0?\d*d", "*", path)
             if "%" in path and "://" not in path and pattern != path and not glob.glob(pattern):
                 # said here: FFmpeg would print its own line first
                 raise FileNotFoundError(f"{side} source: no file matches {path}")
+            if "%" in path and "://" not in path and _sequence_first(path) is None:
+                # files of another numbering: FFmpeg's line, then "cannot open", said neither
+                hint = _pattern_hint(side, path)
+                if hint is not None:
+                    raise FileNotFoundError(hint)
             # OpenCV's log of its backends' attempts stays quiet (_open_within): the error
             # below says what failed
             cap: Any = _open_within(lambda: _open_path(path), timeout, side, src, configure)
