@@ -617,10 +617,19 @@ def test_the_summary_keeps_bounded_figures(monkeypatch: pytest.MonkeyPatch) -> N
     assert tally.mean("density") == 5.0 and tally.skew_max == 4.0
 
 
-def test_stream_results_are_stamped_at_their_grab(videos: dict[str, Path]) -> None:
+def test_stream_results_are_stamped_at_their_grab(videos: dict[str, Path], tmp_path: Path) -> None:
     """A live pair's stamp is its grab time, not the time its depth was done (the bag's
-    messages were stamped a frame's latency late, against TF and odometry)."""
-    cam = StereoCamera(str(videos["left"]), str(videos["right"]))
+    messages were stamped a frame's latency late, against TF and odometry). Read from image
+    sequences, which have no time of their own as cameras (a video file's pairs carry its)."""
+    for side in ("left", "right"):
+        cap = cv2.VideoCapture(str(videos[side]))
+        for i in range(3):
+            ok, img = cap.read()
+            assert ok
+            cv2.imwrite(str(tmp_path / f"{side}_{i:03d}.png"), img)
+        cap.release()
+    cam = StereoCamera(str(tmp_path / "left_%03d.png"), str(tmp_path / "right_%03d.png"))
+    assert not cam.media_clock
     seen: list[tuple[int, int, float]] = []
 
     def on_stamped(left: np.ndarray, res: object, stamp_ns: int) -> None:
@@ -633,6 +642,48 @@ def test_stream_results_are_stamped_at_their_grab(videos: dict[str, Path]) -> No
     assert len(seen) == 3
     for stamp, called, compute_s in seen:
         assert t0 <= stamp <= called - 0.9e9 * compute_s  # the matching came after the stamp
+
+
+@PIPELINED
+def test_a_bag_written_from_video_files_steps_by_their_frame_period(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``stream --left L.avi --right R.avi --bag`` stamped each frame with the wall clock of its
+    read, so the bag's stamps followed the processing speed; a video file's pairs carry its
+    own time (the first pair's grab time plus the left video's CAP_PROP_POS_MSEC), and the
+    stamps step by 1/fps. An image sequence (no media time) keeps the grab's wall clock."""
+    pytest.importorskip("rosbags")
+    from rosbags.rosbag2 import Reader
+
+    fps, n, size = 7.0, 4, (160, 120)
+    scene = data_dir / SCENE
+    Calibration.from_file(scene / "calib.txt").scaled_to(size).save(tmp_path / "rig.yaml")
+    for side in ("left", "right"):
+        img = cv2.resize(cv2.imread(str(scene / f"{side}.png")), size)
+        vw = cv2.VideoWriter(str(tmp_path / f"{side}.avi"), cv2.VideoWriter_fourcc(*"MJPG"),
+                             fps, size)  # fmt: skip
+        for i in range(n):
+            vw.write(img)
+            cv2.imwrite(str(tmp_path / f"{side}_{i:03d}.png"), img)
+        vw.release()
+    common = ["--calib", str(tmp_path / "rig.yaml"), "--no-display", "--no-check",
+              "--max-disparity", "16", "--no-pipeline"]  # fmt: skip
+
+    def stamps(name: str, left: str, right: str) -> tuple[list[int], int]:
+        t0 = time.time_ns()
+        argv = ["stream", "--left", str(tmp_path / left), "--right", str(tmp_path / right)]
+        assert main([*argv, *common, "--bag", str(tmp_path / name)]) == 0
+        end = time.time_ns()
+        with Reader(tmp_path / name) as reader:
+            got = [t for c, t, _ in reader.messages() if c.topic == "/stereo/depth"]
+        assert len(got) == n and t0 <= got[0] <= end  # the first: its grab
+        capsys.readouterr()
+        return got, end
+
+    got, _ = stamps("video", "left.avi", "right.avi")
+    assert np.diff(got).tolist() == [round(1e9 / fps)] * (n - 1)
+    got, end = stamps("sequence", "left_%03d.png", "right_%03d.png")
+    assert got == sorted(got) and got[-1] <= end  # each read's wall clock
 
 
 @SLOW_PIPELINED

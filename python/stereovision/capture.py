@@ -1424,6 +1424,16 @@ class StereoCamera(PairSource):
             for side, src in self.sources.items()
         )
 
+    @property
+    def media_clock(self) -> bool:
+        """Whether the pairs carry their own time: both sources are local video files (no
+        camera, URL or image sequence), each frame's ``pos_left_ms`` / ``pos_right_ms`` its time
+        in the video (``CAP_PROP_POS_MSEC``). :func:`~stereovision.stream.run_stream` stamps
+        such pairs by it, not by the wall clock of their read."""
+        return self._video_files() and all(
+            _camera_device(src) is None for src in self.sources.values()
+        )
+
     def _check_media_drift(self, frame: StereoFrame) -> None:
         """Warn once when two video files' media times drift apart by more than a frame.
 

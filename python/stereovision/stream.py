@@ -460,6 +460,9 @@ def _pairs(
     a read taking over ``read_timeout`` s raises (:func:`~stereovision.capture.read_within`).
     Once ``stop`` is set, a read that returns ends it, its pair dropped untouched."""
     n = 0
+    # video files: their own time, from the first pair's wall clock (None until it is read)
+    media = getattr(camera, "media_clock", False) is True
+    media_origin_ns: int | None = None
     while frames is None or n < frames:
         t0 = time.perf_counter()
         grabbed = getattr(camera, "grabbed", None) if isinstance(camera, _FirstPairRead) else None
@@ -496,6 +499,12 @@ def _pairs(
         else:  # the wall clock at the middle of the two grabs (host monotonic times)
             ago = time.monotonic() - 0.5 * (fr.t_left + fr.t_right)
             stamp_ns = time.time_ns() - round(1e9 * ago)
+            if media and math.isfinite(fr.pos_left_ms):
+                # a video file's pair at its place in the video: the read's wall clock made
+                # the stamps (a --bag's) follow the processing speed, not the video's 1/fps
+                if media_origin_ns is None:
+                    media_origin_ns = stamp_ns - round(1e6 * fr.pos_left_ms)
+                stamp_ns = media_origin_ns + round(1e6 * fr.pos_left_ms)
         left, right = fr.left, fr.right
         # The mean of the frames as the cameras give them, then rectified: the filter measures
         # the noise of each pixel (temporal.noise_sigma), which rectification's interpolation
@@ -736,8 +745,10 @@ def run_stream(
     on_stamped_result : callable, optional
         Called like ``on_result`` with a third argument: the pair's time in nanoseconds since
         the epoch, taken at its grab (the middle of the two cameras' grabs; a recording's own
-        stamp), not when its depth was done (a live frame's latency later): the time to stamp
-        messages for TF and odometry with.
+        stamp; for two video files, :attr:`~stereovision.capture.StereoCamera.media_clock`,
+        the first pair's grab time plus the left video's ``CAP_PROP_POS_MSEC``, so that the
+        stamps step by its frame period), not when its depth was done (a live frame's latency
+        later): the time to stamp messages for TF and odometry with.
     report_period : float
         Seconds between reports.
     check : bool
