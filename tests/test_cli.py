@@ -352,6 +352,36 @@ def test_depth_same_image_with_a_calibration_for_another_size_says_only_that(
     assert not (tmp_path / "o").exists()
 
 
+def test_resized_pair_size_error_gives_cli_advice(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A pair resized from the calibration's images was refused by depth and batch with
+    "calib.scaled_to((450, 375))", a Python call no one at the command line can make: said in
+    the CLI's words (the ADVICE swap its warnings get); Python's message keeps the call."""
+    from stereovision.depth import depth_map
+    from stereovision.io import load_scene
+
+    teddy = load_scene(data_dir / "middeval3" / "teddyH")
+    half = [cv2.resize(img, None, fx=0.5, fy=0.5) for img in (teddy.left, teddy.right)]
+    pairs = tmp_path / "pairs"
+    pairs.mkdir()
+    pair = [str(pairs / "left.png"), str(pairs / "right.png")]
+    for path, img in zip(pair, half, strict=True):
+        cv2.imwrite(path, img)
+    rig = str(teddy.calib.save(tmp_path / "rig.yaml"))
+    said = (
+        "calibration is for 900x750 images, got 450x375 (images resized, not cropped: resize "
+        "them back to the calibration's size, or save it scaled to them once in Python with "
+        "Calibration.from_file(path).scaled_to((450, 375)).save('rig.yaml') and give rig.yaml)"
+    )
+    assert main(["depth", *pair, "--calib", rig, "-o", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err == f"stereovision: error: {said}\n"
+    assert main(["batch", str(pairs), "--calib", rig, "-o", str(tmp_path / "b")]) == 1
+    assert f"failed pairs: ValueError: {said}\n" in capsys.readouterr().err
+    with pytest.raises(ValueError, match=r"not cropped: calib\.scaled_to\(\(450, 375\)\)\)$"):
+        depth_map(*half, teddy.calib)
+
+
 def test_depth_rectification_on_a_pair_too_small_says_only_that(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -17,6 +17,7 @@ import functools
 import inspect
 import math
 import os
+import re
 import sys
 import warnings
 from collections.abc import Callable, Iterable
@@ -162,9 +163,10 @@ def as_image_array(img: object, name: str = "image") -> np.ndarray:
 #: read the float grey image, all of its bits.
 LOW_UINT16_MAX = 4096
 
-#: Library warnings' advice in the words of where they are shown: the Python API's, as raised
-#: (an array to scale, ``calib=``), the command line's (files and options; cli.py's warning
-#: hook) and the GUI page's (its fields and buttons). :func:`advice_for` swaps them.
+#: Library warnings' and errors' advice in the words of where they are shown: the Python API's,
+#: as raised (an array to scale, ``calib=``), the command line's (files and options; cli.py's
+#: warning hook and error line) and the GUI page's (its fields and buttons). :func:`advice_for`
+#: swaps them. A ``{name}`` field stands for a number the message holds, kept in the swap.
 ADVICE: dict[str, dict[str, str]] = {
     "low_uint16": {
         "api": "scale it to the full range first (img << 4 for 12-bit data, or "
@@ -180,18 +182,36 @@ ADVICE: dict[str, dict[str, str]] = {
         "page": "(the scene's calib.txt or --calib; one marked rectified is used as it is), or "
         "rectify the pair from its features (the Rectify button)",
     },
+    # a pair resized from the calibration's images (depth_map's size error; its whole phrase,
+    # not triangulation's "use calib.scaled_to" of a map); no command scales a calibration,
+    # so the CLI's remedy is the images or a file saved once in Python
+    "resized": {
+        "api": "images resized, not cropped: calib.scaled_to(({w}, {h}))",
+        "cli": "images resized, not cropped: resize them back to the calibration's size, or "
+        "save it scaled to them once in Python with "
+        "Calibration.from_file(path).scaled_to(({w}, {h})).save('rig.yaml') and give rig.yaml",
+    },
 }
 ADVICE["low_uint16"]["page"] = ADVICE["low_uint16"]["cli"]  # on the page too, a file
+# the page scales a calibration to frames resized by it (fit_to_frames): never said there
+ADVICE["resized"]["page"] = ADVICE["resized"]["cli"]
 LOW_UINT16_ADVICE = ADVICE["low_uint16"]["api"]
 
 
 def advice_for(text: str, where: str) -> str:
-    """``text``, a library warning, with its Python advice in the words of ``where``
+    """``text``, a library warning or error, with its Python advice in the words of ``where``
     (``"cli"`` or ``"page"``): ``img << 4`` or ``calib=`` is no help to a user who gave files
     and options, or who clicks."""
     for said in ADVICE.values():
-        text = text.replace(said["api"], said[where])
+        # the API's words as a pattern, each {field} a number carried into the other words
+        api = re.sub(r"\\\{(\w+)\\\}", r"(?P<\1>\\d+)", re.escape(said["api"]))
+        text = re.sub(api, functools.partial(_said_with, said[where]), text)
     return text
+
+
+def _said_with(words: str, found: re.Match[str]) -> str:
+    """``words`` with the numbers of their ``{fields}`` that ``found`` read."""
+    return words.format(**found.groupdict())
 
 
 def _warn_low_uint16(arr: np.ndarray, name: str) -> None:

@@ -1842,7 +1842,11 @@ def cmd_batch(args: argparse.Namespace) -> int:
     def log(line: str) -> None:
         from tqdm import tqdm
 
-        tqdm.write(line, file=sys.stderr)
+        from stereovision._validate import advice_for
+
+        # a pair's error in the CLI's words, as the CLI's own error line (summary.json keeps
+        # run_batch's, the Python API's)
+        tqdm.write(advice_for(line, "cli"), file=sys.stderr)
 
     # SIGTERM (a service manager, `kill`) stops the run as Ctrl-C does, unless the caller
     # already handles it (the CLI may turn it into a KeyboardInterrupt itself).

@@ -2071,7 +2071,7 @@ def _run(args: argparse.Namespace) -> int:
         return EXIT_BROKEN_PIPE
     # ImportError: an optional package missing (trame, rosbags, dask), said with its pip line
     except (CliError, ValueError, OSError, RuntimeError, MemoryError, ImportError) as exc:
-        print(f"stereovision: error: {first_line(exc)}", file=sys.stderr)
+        print(f"stereovision: error: {advice_for(first_line(exc), 'cli')}", file=sys.stderr)
         return EXIT_ERROR
     except Exception as exc:  # a bug of ours: still one line, never a traceback
         print(internal_error(exc), file=sys.stderr)

@@ -196,7 +196,7 @@ def _rig_to_warp_by(
             hint = crop
         elif same_aspect((cw, ch), (w, h)):
             # fit_to_frames' 1 % (stream and gui scale such frames): a halved odd side rounds
-            hint = f"images resized, not cropped: calib.scaled_to(({w}, {h}))"
+            hint = ADVICE["resized"]["api"].format(w=w, h=h)
         else:
             hint = "another aspect ratio: another camera mode or camera, or cropped images"
         raise ValueError(f"calibration is for {cw}x{ch} images, got {w}x{h} ({hint})")
