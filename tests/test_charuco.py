@@ -1028,3 +1028,35 @@ def test_a_board_too_large_to_print_says_the_largest_square_in_pixels_and_dpi(
         ValueError, match=r"margins\), even at 10 px per square \(the least\): use fewer squares$"
     ):
         board_png((9, 6), 0.01, 254)
+
+
+@pytest.mark.parametrize("most", [10, 11])
+def test_the_dpi_a_too_large_board_suggests_is_accepted_typed_back(
+    monkeypatch: pytest.MonkeyPatch,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    most: int,
+) -> None:
+    """The dpi said for the largest square was rounded to 6 digits to the nearest: at the
+    10 px floor, "70 mm squares at up to 3.62857 dpi" typed back is 9.99999 px, refused as
+    under 10 px per square. It is rounded toward the side that is accepted: typed back (in
+    metres, or in mm as the CLI's --square) it gives exactly the largest square said."""
+    import stereovision.charuco as ch
+    from stereovision.cli import main
+
+    monkeypatch.setattr(ch, "MAX_IMAGE_PIXELS", 12 * 9 * most**2 + 99)
+    said = re.compile(rf"at most {most} px per square, ([\d.]+) mm squares at up to ([\d.]+) dpi$")
+    for tenth_mm in range(5, 3000, 7):  # 0.5 to 300 mm: at 10 px, 211 of 428 refused before
+        with pytest.raises(ValueError, match=said) as refused:
+            board_png((9, 6), tenth_mm / 10000, 1000 * 0.0254 / (tenth_mm / 10000))
+        m = said.search(str(refused.value))
+        assert m is not None and float(m[1]) == tenth_mm / 10
+        for metres in (float(f"{m[1]}e-3"), float(m[1]) / 1000, float(m[1]) * 1e-3):
+            assert board_png((9, 6), metres, float(m[2]))[1] == (12 * most, 9 * most)
+    out = str(tmp_path / "b.png")
+    argv = ["board", "-o", out, "--pattern", "9x6", "--square", "70", "--unit", "mm"]
+    assert main([*argv, "--dpi", "300"]) == 2
+    m = said.search(capsys.readouterr().err.strip())
+    assert m is not None and m[1] == "70"
+    assert main([*argv, "--dpi", m[2]]) == 0
+    assert cv2.imread(out, cv2.IMREAD_GRAYSCALE).shape == (9 * most, 12 * most)

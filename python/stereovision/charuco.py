@@ -571,12 +571,30 @@ def _too_large(what: str, squares: tuple[int, int], pix: int, square_metres: flo
     )
     if most < 10:  # _board_scale's least square: no square and dpi would do
         return ValueError(f"{head}, even at 10 px per square (the least): use fewer squares")
-    # the dpi whose rounded square is `most` px (a print of `square_metres` squares)
-    dpi = most * 0.0254 / square_metres
+    mm = f"{square_metres * 1000:g}"
     return ValueError(
-        f"{head}: at most {most} px per square, "
-        f"{square_metres * 1000:g} mm squares at up to {dpi:g} dpi"
+        f"{head}: at most {most} px per square, {mm} mm squares at up to "
+        f"{_dpi_for(most, square_metres, mm):g} dpi"
     )
+
+
+def _dpi_for(pix: int, square_metres: float, mm: str) -> float:
+    """The dpi, to 6 significant digits, at which squares of ``square_metres``, or of ``mm``
+    millimetres as said and typed back (metres in Python, the CLI's ``--square`` in mm), are
+    ``pix`` pixels each (:func:`_board_scale`).
+
+    Rounded to the nearest it could fall under ``pix`` and, at the 10 px floor, be refused
+    (70 mm at 3.62857 dpi is 9.99999 px): raised by a last digit until all give ``pix``."""
+    from stereovision.calibration import UNIT_TO_METRES
+
+    squares = (square_metres, float(f"{mm}e-3"), float(mm) / 1000, float(mm) * UNIT_TO_METRES["mm"])
+    dpi = float(f"{pix * 0.0254 / square_metres:.6g}")
+    step = 10.0 ** (math.floor(math.log10(dpi)) - 5)  # one in the 6th digit
+    for _ in range(10):  # a step or two: the 6-digit rounding is 1e-5 of it at most
+        if all(10 <= (p := s / 0.0254 * dpi) and round(p) == pix for s in squares):
+            break
+        dpi = float(f"{dpi + step:.6g}")
+    return dpi
 
 
 def board_png(
