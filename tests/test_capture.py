@@ -2737,3 +2737,84 @@ def test_a_sequence_gap_counts_from_the_first_number_and_a_read_only_node_is_sai
         capmod.camera_hint(3)
         == " (/dev/video3 is not readable: is this user in the 'video' group?)"
     )
+
+
+_SET_REFUSED = (
+    "OpenCV(5.1.0) /io/opencv/modules/videoio/src/cap.cpp:606: error: (-2:Unspecified error) "
+    "could not set prop 3 = 640.000000 in function 'set'\n"
+)
+
+
+@pytest.mark.parametrize("timeout", [0.5, None])
+def test_a_setting_opencv_raises_on_names_the_source_and_the_step(
+    tmp_path: Path, timeout: float | None
+) -> None:
+    """A capture in OpenCV's exception mode raises cv2.error on a setting it refuses (a video
+    file asked for 640 px): it came out raw, naming neither the side nor the setting. It is a
+    SourceError as a hung setting's, with OpenCV's words, chaining the cv2.error; the capture
+    is released as a hung one is."""
+    video = str(_write_video(tmp_path / "v.avi", [_numbered(i) for i in range(3)]))
+    caps = [cv2.VideoCapture(video), cv2.VideoCapture(video)]
+    for cap in caps:
+        cap.setExceptionMode(True)
+    with pytest.raises(SourceError) as err:
+        StereoCamera(*caps, image_size=(640, 480), open_timeout=timeout)
+    assert str(err.value) == (
+        "left source VideoCapture was not set up: setting its frame width to 640 failed in "
+        "OpenCV (could not set prop 3 = 640.000000)"
+    )
+    assert (err.value.side, err.value.end) == ("left", False)
+    assert isinstance(err.value.__cause__, cv2.error)
+    assert not caps[0].isOpened()
+    caps[1].release()  # not reached: the left source failed first
+
+
+@pytest.mark.parametrize("command", ["capture", "stream"])
+def test_cli_says_a_setting_opencv_raised_on_in_one_line(
+    command: str,
+    tmp_path: Path,
+    wedged: type[_WedgedDevice],
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The CLI printed OpenCV's cv2.error as an internal error ("please report this"): it is
+    the camera's, said in one line naming the source and the setting, exit 2."""
+    from stereovision.cli import main
+
+    def refused(self: _WedgedDevice, prop: int, value: float) -> bool:
+        if self.src == 1 and prop == cv2.CAP_PROP_FRAME_WIDTH:
+            raise cv2.error(_SET_REFUSED)
+        return True
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(_WedgedDevice, "set", refused)
+        argv = [command, "--left", "0", "--right", "1", "--size", "640x480"]
+        argv += ["-o", str(tmp_path / "p")] if command == "capture" else ["--no-display"]
+        assert main(argv) == 2
+    assert capsys.readouterr().err == (
+        "stereovision: error: right source camera 1 was not set up: setting its frame width to "
+        "640 failed in OpenCV (could not set prop 3 = 640.000000)\n"
+    )
+    assert [c.released for c in wedged.made] == [1, 1]
+
+
+@pytest.mark.parametrize("timeout", [0.5, None])
+def test_an_open_opencv_raises_on_names_the_source(
+    monkeypatch: pytest.MonkeyPatch, timeout: float | None
+) -> None:
+    """cv2.error out of the open itself (a backend in exception mode) came out raw as well: a
+    SourceError naming the source, chaining it."""
+
+    def refused(src: Any, *args: Any) -> Any:
+        raise cv2.error(
+            "OpenCV(5.1.0) cap.cpp:1: error: (-2:Unspecified error) could not open camera 0 in "
+            "function 'open'\n"
+        )
+
+    monkeypatch.setattr(cv2, "VideoCapture", refused)
+    with pytest.raises(SourceError) as err:
+        StereoCamera(0, 1, open_timeout=timeout)
+    assert str(err.value) == (
+        "left source camera 0 did not open: OpenCV failed (could not open camera 0)"
+    )
+    assert (err.value.side, err.value.end) == ("left", False)
+    assert isinstance(err.value.__cause__, cv2.error)

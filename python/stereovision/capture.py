@@ -542,24 +542,47 @@ def _open_within(
     given up or not: the caller's quiet ended when it was given up, and a late open printed
     its backends' lines. An open that never returns keeps it silent for the process's life.
     The settings are not silenced (OpenCV's word on a setting a driver refused is kept).
+    A ``cv2.error`` of the open or of a setting is a :class:`SourceError` naming the source
+    and the step, as a hang is.
     """
     doing = ["its open"]
+    what = f"{side} source {_describe_source(src)}"
 
-    def note(what: str) -> None:
-        doing[0] = what
+    def note(step: str) -> None:
+        doing[0] = step
+
+    def failed(exc: cv2.error) -> SourceError:
+        # OpenCV's words on what it refused (a setting a backend cannot take, in its exception
+        # mode): a source's failure as a hung setting's, not a bug's raw cv2.error
+        from stereovision.calibration import _first_line
+
+        said = (
+            f"did not open: OpenCV failed ({_first_line(exc)})"
+            if doing[0] == "its open"
+            else f"was not set up: {doing[0]} failed in OpenCV ({_first_line(exc)})"
+        )
+        return SourceError(f"{what} {said}", side=side, end=False)
+
+    def made_now() -> Any:
+        try:
+            return make()
+        except cv2.error as exc:
+            raise failed(exc) from exc
 
     def configured(cap: Any) -> Any:
         if configure is not None:
             try:
                 configure(cap, note)
-            except BaseException:  # nobody will have it
+            except BaseException as exc:  # nobody will have it
                 _release([cap])
+                if isinstance(exc, cv2.error):
+                    raise failed(exc) from exc
                 raise
         return cap
 
     if timeout is None:
         with _opencv_quiet():
-            cap = make()
+            cap = made_now()
         return configured(cap)
     lock = threading.Lock()
     given_up = [False]
@@ -567,7 +590,7 @@ def _open_within(
 
     def opened() -> Any:
         with _opencv_quiet():
-            cap = make()
+            cap = made_now()
             with lock:
                 late = given_up[0]
             if late:  # nobody will have it
@@ -583,7 +606,6 @@ def _open_within(
                 _release([cap])
         return cap
 
-    what = f"{side} source {_describe_source(src)}"
     # a URL or file has no plug, and a network stream may just be slow (FFmpeg's own open
     # waits 30 s): "unplug and replug it" is a device's advice alone, a longer limit either's
     # a camera by its index or by its V4L2 node (/dev/video0, a /dev/v4l/by-id link): a device
@@ -1036,8 +1058,9 @@ class StereoCamera(PairSource):
     FileNotFoundError
         If a source is a file path (not a pattern) that does not exist.
     SourceError
-        If a source cannot be opened, or does not open within ``open_timeout`` (the message
-        names it).
+        If a source cannot be opened, OpenCV raises on its open or on a setting asked of it
+        (``cv2.error``, chained), or it does not open within ``open_timeout`` (the message
+        names it, and the step).
     ValueError
         If ``image_size``, ``fps``, ``fourcc`` or ``open_timeout`` is invalid, or a source is a
         negative device index.
