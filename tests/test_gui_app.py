@@ -3472,6 +3472,70 @@ def test_a_capture_is_not_dropped_for_an_open_that_failed_meanwhile(monkeypatch)
     asyncio.run(clicks())
 
 
+@pytest.mark.parametrize("step", ["read", "read fails", "open", "open fails"])
+def test_a_dropped_read_or_open_does_not_leave_its_status(monkeypatch, step):
+    """A Capture (or Open) under way when a scene was chosen: the scene's computation ended on
+    "reading ..." ("opening ..."), as the read went on, and the read's pair (or error), dropped
+    for the scene, said nothing: "reading camera 0 and camera 1..." stayed on for good. Its
+    end puts the status the page would have without it back ("ready")."""
+    import asyncio
+    import threading
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    gate, inside = threading.Event(), threading.Event()
+    hold: list[str] = []
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            if "open" in hold:
+                inside.set()
+                gate.wait(1.0)
+                if step == "open fails":
+                    raise OSError("cannot open camera 2 (left)")
+
+        def read(self):
+            if "read" in hold:
+                inside.set()
+                gate.wait(1.0)
+                if step == "read fails":
+                    raise OSError("camera 0 gave no frame")
+            return frame.copy(), frame.copy()
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    app = _scene_app("test-dropped-read-status", [bundled_data_dir()], read_timeout=2.0)
+    tasks = _collect_reads(app)
+
+    async def clicks() -> None:
+        app._lock = asyncio.Lock()
+        app.state.cam_left, app.state.cam_right = "0", "1"
+        app.open_cameras()
+        await tasks[0]
+        hold.append(step.split()[0])
+        if step.startswith("read"):
+            app.capture()
+            said = "reading camera 0 and camera 1..."
+        else:
+            app.state.cam_left, app.state.cam_right = "2", "3"
+            app.open_cameras()
+            said = "opening camera 2 and camera 3..."
+        await _until(inside.is_set)
+        app._on_scene(scene=str((bundled_data_dir() / "cones").resolve()))
+        await app.recompute()  # the scene computes while the read or open goes on
+        assert app.state.status == said
+        gate.set()
+        await tasks[-1]
+        assert app.state.source_label == "scene data/cones" and app.state.error == ""
+        assert app.state.status == "ready"
+
+    asyncio.run(clicks())
+
+
 @pytest.mark.parametrize("raised", [StopIteration, SystemExit])
 def test_a_read_that_raises_oddly_is_said_and_frees_the_cameras(monkeypatch, raised):
     """A read (or open) that raised StopIteration could not be handed to the page's loop (a

@@ -1872,8 +1872,17 @@ class StereoApp:
             self.state.status = said
 
     def _end_under_way(self, token: object) -> None:
-        """The open or read of ``token`` (:attr:`_under_way`) has returned."""
+        """The open or read of ``token`` (:attr:`_under_way`) has returned: a status saying it
+        goes (its caller says more after this, but one dropped for a newer choice says
+        nothing: "reading ..." stayed on for good over the scene computed meanwhile)."""
+        said = [u[1] for u in self._under_way if u[0] is token]
         self._under_way = [u for u in self._under_way if u[0] is not token]
+        if said and not self._computing and self.state.status in said:
+            # a computation says its own on its next step and end (_status_with_reads)
+            with self.state:
+                self.state.status = self._status_with_reads(None) or (
+                    "ready" if self.view is not None else ""
+                )
 
     def _status_with_reads(self, text: str | None) -> str:
         """The status ``text`` followed by the newest open or read under way's "opening ..." or
