@@ -1362,6 +1362,48 @@ def test_a_folder_a_glob_or_a_misnumbered_pattern_names_the_source_that_would_wo
     )
 
 
+def test_sources_that_opened_before_the_folder_and_pattern_hints_still_open(
+    tmp_path: Path,
+) -> None:
+    """The hints for a folder, a glob or a misnumbered pattern refused sources that open: a
+    video file whose name holds ``%d`` ("no file numbered 0-4 fits take_%d.avi; give a video
+    file such as take_left.avi", the file beside it) and a pattern in a folder whose name
+    holds brackets ("no file matches run[1]/left_%04d.png", the brackets taken for a glob's)."""
+    videos = tmp_path / "videos"
+    videos.mkdir()
+    _videos(videos, 2, 2)
+    (videos / "left.avi").rename(videos / "take_%d.avi")
+    (videos / "right.avi").rename(videos / "take_left.avi")
+    _videos(videos, 2, 2)
+    with StereoCamera(videos / "take_%d.avi", videos / "right.avi") as cam:
+        assert cam.read().left.shape[:2] == (240, 320)
+    run = tmp_path / "run[1]"
+    run.mkdir()
+    img = np.zeros((8, 8, 3), np.uint8)
+    for i in (0, 1):
+        for side in ("left", "right"):
+            cv2.imwrite(str(run / f"{side}_{i:04d}.png"), img)
+    with StereoCamera(f"{run}/left_%04d.png", f"{run}/right_%04d.png") as cam:
+        assert cam.read().left.shape[:2] == (8, 8)
+
+
+def test_a_misnumbered_pattern_is_told_a_pattern_that_opens(tmp_path: Path) -> None:
+    """Files left_0001.png ... left_10000.png (the last one digit wider) were told the
+    pattern left_%d.png, which names left_1.png and opens nothing; %04d prints 10000 too."""
+    pairs = tmp_path / "pairs"
+    pairs.mkdir()
+    img = np.zeros((8, 8, 3), np.uint8)
+    for i in (1, 2, 10000):
+        cv2.imwrite(str(pairs / f"left_{i:04d}.png"), img)
+    cv2.imwrite(str(pairs / "right_0001.png"), img)
+    with pytest.raises(FileNotFoundError) as err:
+        StereoCamera(f"{pairs}/left_%03d.png", f"{pairs}/right_%04d.png")
+    assert str(err.value) == (
+        f"left source: no file numbered 0-4 fits {pairs}/left_%03d.png; give a pattern such as "
+        f"{pairs}/left_%04d.png (its files are named left_0001.png, left_0002.png ...)"
+    )
+
+
 def test_cli_folder_source_is_one_line_naming_its_pattern(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -712,8 +712,11 @@ def _forms_that_work(side: str, folder: str, names: Iterable[str]) -> tuple[str,
     if runs:
         (head, ext), digits = max(runs.items(), key=lambda r: (ours(r[0][0]), len(r[1])))
         digits.sort(key=int)
-        widths = {len(d) for d in digits}
-        width = widths.pop() if len(widths) == 1 else 0
+        # the narrowest number's width, when every wider one prints alike at it (%04d prints
+        # 10000 as is; %d would name left_1.png for left_0001.png ...): else unpadded, %d
+        width = min(len(d) for d in digits)
+        if any(len(d) > width and d.startswith("0") for d in digits):
+            width = 0
         pattern = os.path.join(folder, f"{head}{f'%0{width}d' if width > 1 else '%d'}{ext}")
         shown = ", ".join(f"{head}{d}{ext}" for d in digits[:2])
         more = " ..." if len(digits) > 2 else ""
@@ -773,7 +776,8 @@ def _pattern_hint(side: str, path: str) -> str | None:
     another numbering are there (``left_%03d.png`` for ``left_0001.png ...``): the one line
     naming the pattern they need; None when they need this one (or none is there)."""
     folder = os.path.dirname(path)
-    names = [os.path.basename(m) for m in glob.glob(re.sub(r"%0?\d*d", "*", path))]
+    pattern = "*".join(glob.escape(part) for part in re.split(r"%0?\d*d", path))
+    names = [os.path.basename(m) for m in glob.glob(pattern)]
     form = _forms_that_work(side, folder, names[:_HINT_MAX_FILES])
     if form is None or form[0] == path:
         return None
@@ -1123,11 +1127,14 @@ class StereoCamera(PairSource):
                 raise FileNotFoundError(f"{side} source not found: {path}")
             if os.path.isdir(path):  # "cannot open" said nothing of what to give instead
                 raise SourceError(_folder_hint(side, path), side=side, end=False)
-            pattern = re.sub(r"%0?\d*d", "*", path)
-            if "%" in path and "://" not in path and pattern != path and not glob.glob(pattern):
-                # said here: FFmpeg would print its own line first
-                raise FileNotFoundError(f"{side} source: no file matches {path}")
-            if "%" in path and "://" not in path and _sequence_first(path) is None:
+            # the text around the number matched as written (a folder "run[1]" is no glob)
+            pattern = "*".join(glob.escape(part) for part in re.split(r"%0?\d*d", path))
+            if "%" in path and "://" not in path and pattern != glob.escape(path):
+                if not glob.glob(pattern):
+                    # said here: FFmpeg would print its own line first
+                    raise FileNotFoundError(f"{side} source: no file matches {path}")
+            exists = os.path.exists(path)  # a file whose name holds "%d" is no pattern
+            if "%" in path and "://" not in path and not exists and _sequence_first(path) is None:
                 # files of another numbering: FFmpeg's line, then "cannot open", said neither
                 hint = _pattern_hint(side, path)
                 if hint is not None:
