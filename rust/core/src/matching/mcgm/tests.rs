@@ -2327,3 +2327,248 @@ fn association_weights_too_large_to_allocate_are_an_error() {
                 34.32 MiB (35988000 bytes)";
     assert!(stdout.contains(want), "{want} not in {stdout}");
 }
+
+/// The LoG as computed before the row pass copied the row (every padded pixel by `reflect`)
+/// and the column pass read row slices: the same operations in the same order, scalar.
+fn log_filter_per_pixel_reflect(img: &Image, sigma: f32) -> Vec<f32> {
+    use super::log::reflect;
+    let (w, h) = img.size();
+    let (g, a) = log_kernels(sigma);
+    let r = g.len() / 2;
+    let (mut hg, mut ha) = (vec![0.0f32; w * h], vec![0.0f32; w * h]);
+    for y in 0..h {
+        let src = &img.data[y * w..(y + 1) * w];
+        let p: Vec<f32> = (-(r as isize)..(w + r) as isize)
+            .map(|i| src[reflect(i, w)])
+            .collect();
+        for x in 0..w {
+            let (mut og, mut oa) = (g[r] * p[r + x], a[r] * p[r + x]);
+            for j in 1..=r {
+                let s = p[r - j + x] + p[r + j + x];
+                og += g[r + j] * s;
+                oa += a[r + j] * s;
+            }
+            hg[y * w + x] = og;
+            ha[y * w + x] = oa;
+        }
+    }
+    let mut out = vec![0.0f32; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let mut o = g[r] * ha[y * w + x] + a[r] * hg[y * w + x];
+            for j in 1..=r as isize {
+                let lo = reflect(y as isize - j, h) * w + x;
+                let hi = reflect(y as isize + j, h) * w + x;
+                o += g[r + j as usize] * (ha[lo] + ha[hi]);
+                o += a[r + j as usize] * (hg[lo] + hg[hi]);
+            }
+            out[y * w + x] = o;
+        }
+    }
+    out
+}
+
+#[test]
+fn log_filter_is_bit_identical_to_per_pixel_reflect_padding_on_tiny_and_odd_images() {
+    // The scenes never reach these: 1-pixel images, rows and columns shorter than the kernel
+    // radius (borders folded several times), odd widths, widths not a multiple of the vector.
+    for &(w, h) in &[
+        (1usize, 1usize),
+        (1, 6),
+        (6, 1),
+        (2, 2),
+        (2, 9),
+        (3, 5),
+        (5, 3),
+        (7, 1),
+        (13, 2),
+        (17, 11),
+        (33, 7),
+    ] {
+        let mut rnd = unit_rng(w as u64 * 131 + h as u64);
+        let img = Image::new(w, h, (0..w * h).map(|_| 255.0 * rnd()).collect()).unwrap();
+        for sigma in [0.1f32, 0.7, 1.0, 2.0, 3.3] {
+            let got = log_filter(&img, sigma).unwrap();
+            let want = log_filter_per_pixel_reflect(&img, sigma);
+            for (i, (g, v)) in got.iter().zip(&want).enumerate() {
+                assert_eq!(g.to_bits(), v.to_bits(), "{w}x{h} sigma {sigma} pixel {i}");
+            }
+        }
+    }
+}
+
+/// [`half_mad`] as before its differences were stored: each difference computed in both
+/// passes.
+#[allow(clippy::too_many_arguments)]
+fn half_mad_twice(
+    left: &Image,
+    right: &Image,
+    (xi, yl, yr, d): (i32, i32, i32, f32),
+    side: i32,
+    (inner, outer, hh): (i32, i32, i32),
+    mean_free: bool,
+) -> f32 {
+    let n = ((outer - inner + 1) * (2 * hh + 1)) as f32;
+    let diff = |ly: usize, ry: usize, k: i32| {
+        let x = xi + side * k;
+        let pos = x as f32 - d;
+        let x0 = (pos.floor() as usize).min(right.width - 1);
+        let x1 = (x0 + 1).min(right.width - 1);
+        let f = pos - x0 as f32;
+        let row = &right.data[ry * right.width..(ry + 1) * right.width];
+        left.at(x as usize, ly) - (row[x0] + f * (row[x1] - row[x0]))
+    };
+    let mut offset = 0.0f32;
+    if mean_free {
+        for dy in -hh..=hh {
+            for k in inner..=outer {
+                offset += diff((yl + dy) as usize, (yr + dy) as usize, k);
+            }
+        }
+        offset /= n;
+    }
+    let mut sad = 0.0f32;
+    for dy in -hh..=hh {
+        for k in inner..=outer {
+            sad += (diff((yl + dy) as usize, (yr + dy) as usize, k) - offset).abs();
+        }
+    }
+    sad / n
+}
+
+#[test]
+fn half_mad_with_stored_differences_is_bit_identical_and_keeps_nothing_stale() {
+    // One scratch buffer through windows of every width and height, largest first then small
+    // (a stale difference of the previous window would change the sums), windows touching the
+    // image's edges, disparities putting the right samples on the last column (clamped).
+    let (w, h) = (40usize, 12usize);
+    let mut rnd = unit_rng(11);
+    let l = Image::new(w, h, (0..w * h).map(|_| 255.0 * rnd()).collect()).unwrap();
+    let r = Image::new(w, h, (0..w * h).map(|_| 255.0 * rnd()).collect()).unwrap();
+    let mut diffs = vec![f32::NAN; 3];
+    let mut checked = 0;
+    for hh in [5, 0, 2, 1] {
+        for width in [16, 1, 7, 2] {
+            for gap in [0, 2] {
+                let (inner, outer) = (gap + 1, gap + width);
+                for side in [-1, 1] {
+                    for (xi, d) in [
+                        (outer, 0.0f32),
+                        (outer, 0.25),
+                        (w as i32 - 1 - outer, 0.0),
+                        (w as i32 - 1 - outer, -0.75),
+                        (20, 3.6),
+                        (outer + 2, 1.999),
+                    ] {
+                        let (yl, yr) = (hh, h as i32 - 1 - hh);
+                        for mean_free in [false, true] {
+                            let at = (xi, yl, yr, d);
+                            let geom = (inner, outer, hh);
+                            let got =
+                                half_mad(&l, &r, xi, yl, yr, d, side, geom, mean_free, &mut diffs);
+                            let want = half_mad_twice(&l, &r, at, side, geom, mean_free);
+                            assert_eq!(got.to_bits(), want.to_bits(), "{at:?} {geom:?} {side}");
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(checked, 4 * 4 * 2 * 2 * 6 * 2);
+}
+
+/// [`SidesBound::open_lanes`] as before its sums were stored: each column's interpolated sums
+/// computed in both passes, the bits set one compare at a time.
+fn open_lanes_twice(
+    b: &SidesBound,
+    (v_top, v_bot): (&[f32], &[f32]),
+    j0: usize,
+    mean_free: bool,
+    open_below: f32,
+) -> u32 {
+    let interp = |v: &[f32], o: usize, f: f32| -> [f32; 8] {
+        let v = &v[o + j0..o + j0 + 9];
+        std::array::from_fn(|t| v[t] + f * (v[t + 1] - v[t]))
+    };
+    let cols = &b.cols[..b.nc];
+    let mut m = [0.0f32; 8];
+    if mean_free {
+        for &(o, f, _, _) in cols {
+            let (t, bt) = (interp(v_top, o, f), interp(v_bot, o, f));
+            for q in 0..8 {
+                m[q] += t[q] + bt[q];
+            }
+        }
+        for q in &mut m {
+            *q = (b.ltot - *q) / b.n;
+        }
+    }
+    let (wt, wb) = b.rows;
+    let mut acc = [0.0f32; 8];
+    for &(o, f, lt, lb) in cols {
+        let (t, bt) = (interp(v_top, o, f), interp(v_bot, o, f));
+        for q in 0..8 {
+            acc[q] += (lt - t[q] - wt * m[q]).abs() + (lb - bt[q] - wb * m[q]).abs();
+        }
+    }
+    acc.iter().enumerate().fold(0u32, |bits, (t, &a)| {
+        bits | (u32::from(a / b.n < open_below) << t)
+    })
+}
+
+#[test]
+fn open_lanes_with_stored_sums_is_bit_identical_and_keeps_nothing_stale() {
+    // Every block of lanes (the last one partial: lane counts not a multiple of 8), windows of
+    // 16 columns then 1 (a stale column sum of the wider window would enter the narrow one's),
+    // thresholds around each lane's bound so that both bit values occur.
+    let (w, h) = (96usize, 16usize);
+    let (l, r) = (blobs(w, h, 0.0), blobs(w, h, 5.3));
+    let mut scratch = SidesScratch {
+        scale: 1.0,
+        ..SidesScratch::default()
+    };
+    for e in scratch.tb.iter_mut() {
+        *e = ([f32::NAN; 8], [f32::NAN; 8]);
+    }
+    let (mut ones, mut zeros) = (0u32, 0u32);
+    for geom in [(1, 16, 3), (1, 1, 0), (3, 9, 2), (1, 2, 1)] {
+        for side in [-1, 1] {
+            for ks in [(-7, 40), (-3, 13), (-2, 6)] {
+                let at = (45, 8, 8, 5.3f32);
+                let (base, b_range, (k_lo, k_hi)) = window_bases(at, side, geom, ks, w);
+                assert!(k_hi >= k_lo, "{geom:?} {side} {ks:?}");
+                let nk = (k_hi - k_lo + 1) as usize;
+                let bound = SidesBound::new(
+                    &l,
+                    &r,
+                    at,
+                    side,
+                    geom,
+                    (k_hi, nk),
+                    (&base, b_range),
+                    &mut scratch,
+                );
+                for mean_free in [false, true] {
+                    for j0 in (0..nk).step_by(8) {
+                        for open_below in [0.0f32, 0.02, 0.05, 0.1, 0.2, f32::INFINITY] {
+                            let vs = (&scratch.v_top[..], &scratch.v_bot[..]);
+                            let want = open_lanes_twice(&bound, vs, j0, mean_free, open_below);
+                            let got = bound.open_lanes(
+                                (&scratch.v_top, &scratch.v_bot),
+                                &mut scratch.tb,
+                                j0,
+                                mean_free,
+                                open_below,
+                            );
+                            assert_eq!(got, want, "{geom:?} {side} {ks:?} {j0} {mean_free}");
+                            ones += got.count_ones();
+                            zeros += got.count_zeros();
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(ones > 100 && zeros > 100, "{ones} {zeros}");
+}
