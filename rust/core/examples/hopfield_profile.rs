@@ -87,7 +87,7 @@ fn main() {
             .collect();
         let init = initial_state(&neurons, &p);
         let s = Instant::now();
-        net.initial_input(&init, &input);
+        net.initial_input(&init, &input).expect("valid input");
         t[5].push(ms(s));
         let s = Instant::now();
         run_dynamics(&net, &input, &init, p.seed, p.max_sweeps).expect("valid input");

@@ -616,19 +616,27 @@ pub(crate) mod tests {
     /// stdout; fails the test when the child fails (an abort on a failed allocation).
     #[cfg(target_os = "linux")]
     pub(crate) fn run_oom_child(name: &str) -> String {
-        let out = std::process::Command::new(std::env::current_exe().unwrap())
-            .args([
-                name,
-                "--exact",
-                "--ignored",
-                "--nocapture",
-                "--test-threads=1",
-            ])
-            .env("SV_OOM_CHILD", "1")
-            .env("RAYON_NUM_THREADS", "1")
-            .env("MALLOC_ARENA_MAX", "1")
-            .output()
-            .unwrap();
+        run_oom_child_with(name, None)
+    }
+
+    /// [`run_oom_child`] with one more environment variable (a variant of the child test).
+    #[cfg(target_os = "linux")]
+    pub(crate) fn run_oom_child_with(name: &str, var: Option<(&str, &str)>) -> String {
+        let mut cmd = std::process::Command::new(std::env::current_exe().unwrap());
+        cmd.args([
+            name,
+            "--exact",
+            "--ignored",
+            "--nocapture",
+            "--test-threads=1",
+        ])
+        .env("SV_OOM_CHILD", "1")
+        .env("RAYON_NUM_THREADS", "1")
+        .env("MALLOC_ARENA_MAX", "1");
+        if let Some((k, v)) = var {
+            cmd.env(k, v);
+        }
+        let out = cmd.output().unwrap();
         let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
         assert!(
             out.status.success(),

@@ -387,11 +387,28 @@ pub(crate) fn right_pixel_order(neurons: &[Neuron], mut idx: Vec<usize>) -> Vec<
 }
 
 /// `f(a)` = (row sum, entry count) for every row, in parallel; the sums in row order and the
-/// total count (each row's sum in its own fixed order: independent of the thread count).
-fn row_sums(n: usize, f: impl Fn(usize) -> (f64, usize) + Sync + Send) -> (Vec<f64>, usize) {
-    let (u, counts): (Vec<f64>, Vec<usize>) = (0..n).into_par_iter().map(f).unzip();
-    (u, counts.iter().sum())
+/// total count (each row's sum in its own fixed order: independent of the thread count). A
+/// failed allocation of the sums is [`crate::CoreError::OutOfMemory`].
+fn row_sums(
+    n: usize,
+    f: impl Fn(usize) -> (f64, usize) + Sync + Send,
+) -> Result<(Vec<f64>, usize)> {
+    // Written in place (an unzip into sums and counts allocated 16 bytes a row unchecked).
+    let mut u = try_zeroed::<f64>(n, INITIAL_INPUT)?;
+    let nnz = u
+        .par_iter_mut()
+        .enumerate()
+        .map(|(a, ua)| {
+            let (s, c) = f(a);
+            *ua = s;
+            c
+        })
+        .sum();
+    Ok((u, nnz))
 }
+
+/// What [`Weights::initial_input`]'s allocations are named in an out-of-memory error.
+const INITIAL_INPUT: &str = "the Hopfield dynamics' initial net inputs";
 
 /// A net-input sum over row entries: every entry counted, those of active neurons added.
 struct ActiveSum<'a> {
@@ -426,7 +443,8 @@ pub trait Weights: Sync {
     fn for_each_in_row(&self, a: usize, f: impl FnMut(u32, f32));
     /// The net inputs `u_a = input_a + sum_b T_ab [state_b == 1]` of every neuron (each summed
     /// in a fixed order in `f64`, independent of the thread count) and the number of entries.
-    fn initial_input(&self, state: &[u8], input: &[f64]) -> (Vec<f64>, usize) {
+    /// A failed allocation is [`crate::CoreError::OutOfMemory`].
+    fn initial_input(&self, state: &[u8], input: &[f64]) -> Result<(Vec<f64>, usize)> {
         row_sums(self.n(), |a| {
             let mut acc = ActiveSum::new(input[a], state);
             self.for_each_in_row(a, |b, t| acc.add(b, t));
@@ -1225,8 +1243,13 @@ impl Weights for Network {
     /// sums `T_ab V_b` there and pushes `T_ab V_a` to the later rows; in fixed tasks of
     /// `SYM_STRIPS` strips, each with its own push buffer, then added up in task order. Half
     /// the lane work of one full scan per row; independent of the thread count.
-    fn initial_input(&self, state: &[u8], input: &[f64]) -> (Vec<f64>, usize) {
-        let on = self.lane_state(state);
+    fn initial_input(&self, state: &[u8], input: &[f64]) -> Result<(Vec<f64>, usize)> {
+        // As `lane_state`, allocated checked.
+        let n_on = self.cells.idx.len() - LANES;
+        let mut on = try_zeroed::<f32>(n_on + LANES, INITIAL_INPUT)?;
+        for (o, &b) in on.iter_mut().zip(&self.cells.idx[..n_on]) {
+            *o = f32::from(state[b as usize]);
+        }
         let slots = self.cells.idx.len();
         let n_strips = self.cell_strip.len() - 1;
         let tasks: Vec<(usize, usize)> = (0..n_strips)
@@ -1249,8 +1272,9 @@ impl Weights for Network {
                     .max()
                     .unwrap_or(j1)
                     .max(j1);
-                let mut buf = vec![0.0f64; reach - j0 + LANES];
-                let mut own = Vec::with_capacity(j1 - j0);
+                let mut buf = try_zeroed::<f64>(reach - j0 + LANES, INITIAL_INPUT)?;
+                let mut own = Vec::new();
+                try_reserve_len(&mut own, j1 - j0, INITIAL_INPUT)?;
                 let mut n = 0usize;
                 for j in j0..j1 {
                     let a = self.cells.idx[j] as usize;
@@ -1266,10 +1290,10 @@ impl Weights for Network {
                     own.push(acc.s + w);
                     n += acc.n + 2 * nw;
                 }
-                (own, buf, n)
+                Ok((own, buf, n))
             })
-            .collect();
-        let mut u_slot = vec![0.0f64; slots];
+            .collect::<Result<_>>()?;
+        let mut u_slot = try_zeroed::<f64>(slots, INITIAL_INPUT)?;
         let mut nnz = 0usize;
         for (&(j0, j1), (own, _, n)) in tasks.iter().zip(&parts) {
             u_slot[j0..j1].copy_from_slice(own);
@@ -1281,10 +1305,12 @@ impl Weights for Network {
                 *u += b;
             }
         }
-        let u = (0..self.n())
-            .map(|a| u_slot[self.slot_of[a] as usize])
-            .collect();
-        (u, nnz)
+        let u = try_collect(
+            self.n(),
+            (0..self.n()).map(|a| u_slot[self.slot_of[a] as usize]),
+            INITIAL_INPUT,
+        )?;
+        Ok((u, nnz))
     }
 
     fn slots(&self) -> usize {
@@ -1414,7 +1440,7 @@ pub fn run_dynamics<W: Weights>(
     )?;
     // Initial net inputs u_a = I_a + sum_b T_ab V_b, each from its own row (T is symmetric):
     // in parallel, every sum in row order, so independent of the thread count.
-    let (u0, nnz) = net.initial_input(init, input);
+    let (u0, nnz) = net.initial_input(init, input)?;
     let mut trace = vec![energy(&state, &u0, input)];
     // The sweeps work in the weights' slot order (see `Weights::slot`): net inputs, states and
     // the visiting order are indexed by slot, so a visit reads two arrays at one index.
@@ -1641,8 +1667,8 @@ mod tests {
         let input: Vec<f64> = (0..m).map(|a| 0.2 - 0.01 * (a % 7) as f64).collect();
         let init: Vec<u8> = (0..m).map(|a| u8::from(a % 4 != 0)).collect();
         // The initial net inputs differ only by the order of the f64 sums.
-        let (u_net, nnz) = net.initial_input(&init, &input);
-        let (u_csr, nnz_csr) = csr.initial_input(&init, &input);
+        let (u_net, nnz) = net.initial_input(&init, &input).unwrap();
+        let (u_csr, nnz_csr) = csr.initial_input(&init, &input).unwrap();
         assert_eq!((nnz, nnz_csr), (csr.nnz(), csr.nnz()));
         assert!(nnz > 10_000, "{nnz}");
         for (a, b) in u_net.iter().zip(&u_csr) {

@@ -982,3 +982,82 @@ fn dynamics_arrays_too_large_to_allocate_are_an_error() {
                 (8388608 bytes)";
     assert!(stdout.contains(want), "{want} not in {stdout}");
 }
+
+/// 2^20 neurons, each its own point 1 px from the next (no weights between them; see
+/// [`network_tables_under_a_memory_limit`]).
+#[cfg(target_os = "linux")]
+fn lone_neurons() -> Vec<Neuron> {
+    (0..1u32 << 20)
+        .map(|a| {
+            let (x, y) = ((a % 1024) as i32, (a / 1024) as i32);
+            Neuron {
+                point: a,
+                xl: x,
+                yl: y,
+                xr: x,
+                yr: y,
+                sim: 0.8,
+                edge_ok: true,
+                halves_fail: 0,
+                centre_ok: true,
+                sub: 0.0,
+            }
+        })
+        .collect()
+}
+
+/// Run by [`initial_net_inputs_too_large_to_allocate_are_an_error`] in a child process:
+/// 2^20 neurons (stored weights, then the channel's implicit ones) under an address-space
+/// limit of 3 MiB more than is mapped. The state (1 MiB) fits; the initial net inputs (8 MiB,
+/// the implicit weights' lane states 4 MiB first) do not.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of initial_net_inputs_too_large_to_allocate_are_an_error"]
+fn initial_net_inputs_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let m = 1usize << 20;
+    let (input, init) = (vec![0.5f64; m], vec![0u8; m]);
+    let implicit = std::env::var_os("SV_OOM_IMPLICIT").is_some();
+    let net = implicit.then(|| Network::new(&lone_neurons(), &HopfieldParams::default().weights));
+    let csr = Csr {
+        indptr: vec![0; m + 1],
+        ..Csr::default()
+    };
+    rayon::join(|| (), || ()); // the pool's thread started before the limit
+    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (3 << 20));
+    let got = match net {
+        Some(net) => run_dynamics(&net.unwrap(), &input, &init, 1, 10),
+        None => run_dynamics(&csr, &input, &init, 1, 10),
+    };
+    match got {
+        Ok(d) => println!("child: {} sweeps", d.sweeps),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn initial_net_inputs_too_large_to_allocate_are_an_error() {
+    // run_dynamics checked its slot-ordered arrays, but the initial net inputs before them
+    // (Weights::initial_input: the sums and entry counts, 16 bytes a neuron stored; lane
+    // states, slot-ordered sums and push buffers implicit) were still allocated unchecked: a
+    // failed allocation aborted the process (SIGABRT) instead of returning OutOfMemory.
+    for (implicit, size) in [
+        (false, "8.00 MiB (8388608 bytes)"),
+        (true, "4.00 MiB (4194336 bytes)"),
+    ] {
+        let stdout = crate::segment::tests::run_oom_child_with(
+            "matching::hopfield::tests::initial_net_inputs_under_a_memory_limit",
+            implicit.then_some(("SV_OOM_IMPLICIT", "1")),
+        );
+        let want = format!(
+            "child: error: out of memory: the Hopfield dynamics' initial net inputs needs {size}"
+        );
+        assert!(
+            stdout.contains(&want),
+            "implicit {implicit}: {want} not in {stdout}"
+        );
+    }
+}
