@@ -433,7 +433,7 @@ pub fn channel_curves(
     let curves = track(&zc, &tp)?;
     let rtables = curves
         .segments
-        .iter()
+        .par_iter()
         .map(|s| build_rtable(s, &zc.theta, w, p.cand.n_bins))
         .collect();
     Ok(ChannelCurves {

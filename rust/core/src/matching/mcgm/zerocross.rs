@@ -3,8 +3,11 @@
 
 use std::f32::consts::TAU;
 
+use rayon::prelude::*;
+
 use crate::alloc::{try_filled, try_zeroed};
 use crate::error::Result;
+use crate::parallel::ROWS_PER_TASK;
 
 /// Names the crossing planes in an out-of-memory error.
 const WHAT: &str = "a zero-crossing plane of the MCGM matcher";
@@ -50,123 +53,40 @@ impl ZeroCrossings {
 
 /// Finds the crossings of `l` (`w x h`). Only interior pixels (1 px from the border) are marked,
 /// so the central differences are always defined.
+///
+/// Rows in parallel bands: every value of row `y` is a function of the LoG rows `y - 1..=y + 1`
+/// alone (the vertical scan's marks on row `y` come from the pairs `(y - 1, y)` and `(y, y + 1)`),
+/// so the maps are the same whatever the split.
 pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> Result<ZeroCrossings> {
     let n = w * h;
     let mut mark = try_zeroed::<u8>(n, WHAT)?;
     let mut xsub = try_filled(n, f32::NAN, WHAT)?;
-    let inside = |x: usize, y: usize| x >= 1 && y >= 1 && x + 1 < w && y + 1 < h;
-    // Horizontal scan: the crossing between p and p + (1, 0) is marked on the pixel with the
-    // smaller |L| (ties: p); a pixel with L = 0 exactly is marked if its neighbours differ in sign.
-    // Candidate positions first (sign change or an exact zero), then the rule at those
-    // positions only, in the same order. The positions are listed by a branch-free compaction:
-    // about a third of the pixels are crossings, so a test per pixel is often mispredicted.
-    let mut cand: Vec<u32> = vec![0; w + 1];
-    let flags = |cand: &mut Vec<u32>, a: &[f32], b: &[f32], from: usize| -> usize {
-        let mut c = 0;
-        for (x, (&a, &b)) in a.iter().zip(b).enumerate().skip(from) {
-            cand[c] = x as u32;
-            c += usize::from((a * b < 0.0) | (a == 0.0));
-        }
-        c
-    };
-    for y in 1..h.saturating_sub(1) {
-        let row = &l[y * w..(y + 1) * w];
-        let nc = flags(&mut cand, &row[..w.saturating_sub(1)], &row[1.min(w)..], 0);
-        for &x in &cand[..nc] {
-            let x = x as usize;
-            let (a, b) = (row[x], row[x + 1]);
-            let (px, pos) = if a * b < 0.0 {
-                let px = if a.abs() <= b.abs() { x } else { x + 1 };
-                (px, x as f32 + a / (a - b))
-            } else if a == 0.0 && x >= 1 && row[x - 1] * b < 0.0 {
-                (x, x as f32)
-            } else {
-                continue;
-            };
-            if !inside(px, y) {
-                continue;
-            }
-            let i = y * w + px;
-            // Two crossings on one pixel (both neighbours): keep the nearer one.
-            if mark[i] & ZC_H == 0 || (pos - px as f32).abs() < (xsub[i] - px as f32).abs() {
-                xsub[i] = pos;
-            }
-            mark[i] |= ZC_H;
-        }
-    }
-    // Vertical scan: the same rule along y.
-    for y in 0..h.saturating_sub(1) {
-        let (ra, rb) = (&l[y * w..(y + 1) * w], &l[(y + 1) * w..(y + 2) * w]);
-        let m = w.saturating_sub(1);
-        let nc = flags(&mut cand, &ra[..m], &rb[..m], 1);
-        for &x in &cand[..nc] {
-            let x = x as usize;
-            let (a, b) = (ra[x], rb[x]);
-            let py = if a * b < 0.0 {
-                if a.abs() <= b.abs() {
-                    y
-                } else {
-                    y + 1
-                }
-            } else if a == 0.0 && y >= 1 && l[(y - 1) * w + x] * b < 0.0 {
-                y
-            } else {
-                continue;
-            };
-            if inside(x, py) {
-                mark[py * w + x] |= ZC_V;
-            }
-        }
-    }
     let mut strength = try_zeroed::<f32>(n, WHAT)?;
     let mut theta = try_zeroed::<f32>(n, WHAT)?;
-    let mut on: Vec<u32> = vec![0; w + 1];
-    for y in 0..h {
-        let mut c = 0;
-        for (x, &m) in mark[y * w..(y + 1) * w].iter().enumerate() {
-            on[c] = x as u32;
-            c += usize::from(m != 0);
-        }
-        for &x in &on[..c] {
-            let x = x as usize;
-            let i = y * w + x;
-            let gx = 0.5 * (l[i + 1] - l[i - 1]);
-            let gy = 0.5 * (l[i + w] - l[i - w]);
-            let st = (gx * gx + gy * gy).sqrt();
-            if st < MIN_STRENGTH {
-                mark[i] = 0;
-                xsub[i] = f32::NAN;
-                continue;
-            }
-            strength[i] = st;
-            let t = gy.atan2(gx);
-            // `(t + TAU) % TAU` without the fmod call: u = t + TAU lies in [pi, TAU], and
-            // u - TAU is exact there (Sterbenz).
-            theta[i] = if t < 0.0 {
-                let u = t + TAU;
-                if u >= TAU {
-                    u - TAU
-                } else {
-                    u
+    // (Images narrower or lower than 3 pixels have no interior: nothing is marked.)
+    if w >= 3 && h >= 3 {
+        let band = w * ROWS_PER_TASK;
+        mark.par_chunks_mut(band)
+            .zip(xsub.par_chunks_mut(band))
+            .zip(
+                strength
+                    .par_chunks_mut(band)
+                    .zip(theta.par_chunks_mut(band)),
+            )
+            .enumerate()
+            .for_each(|(b, ((mk, xs), (st, th)))| {
+                let mut cand: Vec<u32> = vec![0; w + 1];
+                let rows = mk
+                    .chunks_mut(w)
+                    .zip(xs.chunks_mut(w))
+                    .zip(st.chunks_mut(w).zip(th.chunks_mut(w)));
+                for (k, ((mk, xs), (st, th))) in rows.enumerate() {
+                    let y = b * ROWS_PER_TASK + k;
+                    if y >= 1 && y + 1 < h {
+                        crossings_row(l, w, y, &mut cand, mk, xs, st, th);
+                    }
                 }
-            } else {
-                t
-            };
-            if mark[i] & ZC_H == 0 {
-                // Vertical-only mark: x from the horizontal crossing next to it, else a Newton step.
-                let left = x as f32 - 1.0 + l[i - 1] / (l[i - 1] - l[i]);
-                let right = x as f32 + l[i] / (l[i] - l[i + 1]);
-                xsub[i] = if l[i - 1] * l[i] < 0.0 {
-                    left
-                } else if l[i] * l[i + 1] < 0.0 {
-                    right
-                } else if gx != 0.0 && (l[i] / gx).abs() <= MAX_NEWTON_STEP {
-                    x as f32 - l[i] / gx
-                } else {
-                    x as f32
-                };
-            }
-        }
+            });
     }
     Ok(ZeroCrossings {
         width: w,
@@ -176,4 +96,114 @@ pub fn zero_crossings(l: &[f32], w: usize, h: usize) -> Result<ZeroCrossings> {
         strength,
         theta,
     })
+}
+
+/// Row `y` (interior: `1 <= y < h - 1`, `w >= 3`) of [`zero_crossings`]' maps, written into the
+/// row slices (`cand`: scratch of `w + 1`).
+#[allow(clippy::too_many_arguments)]
+fn crossings_row(
+    l: &[f32],
+    w: usize,
+    y: usize,
+    cand: &mut [u32],
+    mark: &mut [u8],
+    xsub: &mut [f32],
+    strength: &mut [f32],
+    theta: &mut [f32],
+) {
+    // Horizontal scan: the crossing between p and p + (1, 0) is marked on the pixel with the
+    // smaller |L| (ties: p); a pixel with L = 0 exactly is marked if its neighbours differ in sign.
+    // Candidate positions first (sign change or an exact zero), then the rule at those
+    // positions only, in the same order. The positions are listed by a branch-free compaction:
+    // about a third of the pixels are crossings, so a test per pixel is often mispredicted.
+    let flags = |cand: &mut [u32], a: &[f32], b: &[f32], from: usize| -> usize {
+        let mut c = 0;
+        for (x, (&a, &b)) in a.iter().zip(b).enumerate().skip(from) {
+            cand[c] = x as u32;
+            c += usize::from((a * b < 0.0) | (a == 0.0));
+        }
+        c
+    };
+    let row = &l[y * w..(y + 1) * w];
+    let nc = flags(cand, &row[..w - 1], &row[1..], 0);
+    for &x in &cand[..nc] {
+        let x = x as usize;
+        let (a, b) = (row[x], row[x + 1]);
+        let (px, pos) = if a * b < 0.0 {
+            let px = if a.abs() <= b.abs() { x } else { x + 1 };
+            (px, x as f32 + a / (a - b))
+        } else if a == 0.0 && x >= 1 && row[x - 1] * b < 0.0 {
+            (x, x as f32)
+        } else {
+            continue;
+        };
+        if px < 1 || px + 1 >= w {
+            continue;
+        }
+        // Two crossings on one pixel (both neighbours): keep the nearer one.
+        if mark[px] & ZC_H == 0 || (pos - px as f32).abs() < (xsub[px] - px as f32).abs() {
+            xsub[px] = pos;
+        }
+        mark[px] |= ZC_H;
+    }
+    // Vertical scan, the same rule along y: the pair (y - 1, y) marks this row when its
+    // crossing is nearer here; the pair (y, y + 1) when nearer here (ties: here), or when this
+    // pixel is an exact zero between opposite signs.
+    let (up, down) = (&l[(y - 1) * w..y * w], &l[(y + 1) * w..(y + 2) * w]);
+    for x in 1..w - 1 {
+        let (u, c, d) = (up[x], row[x], down[x]);
+        // (`u * c < 0` holds for no NaN: there `>` is the negation of the scan's `<=`.)
+        let from_above = u * c < 0.0 && u.abs() > c.abs();
+        let from_below = if c * d < 0.0 {
+            c.abs() <= d.abs()
+        } else {
+            c == 0.0 && u * d < 0.0
+        };
+        mark[x] |= ZC_V * u8::from(from_above | from_below);
+    }
+    let mut c = 0;
+    for (x, &m) in mark.iter().enumerate() {
+        cand[c] = x as u32;
+        c += usize::from(m != 0);
+    }
+    for &x in &cand[..c] {
+        let x = x as usize;
+        let i = y * w + x;
+        let gx = 0.5 * (l[i + 1] - l[i - 1]);
+        let gy = 0.5 * (l[i + w] - l[i - w]);
+        let st = (gx * gx + gy * gy).sqrt();
+        if st < MIN_STRENGTH {
+            mark[x] = 0;
+            xsub[x] = f32::NAN;
+            continue;
+        }
+        strength[x] = st;
+        let t = gy.atan2(gx);
+        // `(t + TAU) % TAU` without the fmod call: u = t + TAU lies in [pi, TAU], and
+        // u - TAU is exact there (Sterbenz).
+        theta[x] = if t < 0.0 {
+            let u = t + TAU;
+            if u >= TAU {
+                u - TAU
+            } else {
+                u
+            }
+        } else {
+            t
+        };
+        if mark[x] & ZC_H == 0 {
+            // Vertical-only mark: x from the horizontal crossing next to it, else a Newton step.
+            let left = x as f32 - 1.0 + l[i - 1] / (l[i - 1] - l[i]);
+            let right = x as f32 + l[i] / (l[i] - l[i + 1]);
+            xsub[x] = if l[i - 1] * l[i] < 0.0 {
+                left
+            } else if l[i] * l[i + 1] < 0.0 {
+                right
+            } else if gx != 0.0 && (l[i] / gx).abs() <= MAX_NEWTON_STEP {
+                x as f32 - l[i] / gx
+            } else {
+                x as f32
+            };
+        }
+    }
 }
