@@ -1581,29 +1581,37 @@ fn match_channel(
     } else {
         0
     };
-    let spread = prior
-        .as_deref()
-        .map(|m| SpreadPrior::new(m, fw, fh, radius))
-        .transpose()?;
-    let win = windows(
-        l,
-        spread.as_ref(),
-        fw,
-        p.prior_width_sigmas * l.sigma,
-        lo_c,
-        hi_c,
+    // The segment graph needs no prior: built beside the windows and candidates (whose
+    // distance transform and row index are sequential).
+    let prior_map = prior.as_deref();
+    let (pairs, adj) = rayon::join(
+        || -> Result<_> {
+            let spread = prior_map
+                .map(|m| SpreadPrior::new(m, fw, fh, radius))
+                .transpose()?;
+            let win = windows(
+                l,
+                spread.as_ref(),
+                fw,
+                p.prior_width_sigmas * l.sigma,
+                lo_c,
+                hi_c,
+            );
+            let cands = candidates(
+                &l.curves.segments,
+                &l.rtables,
+                &r.curves.segments,
+                &r.zc.theta,
+                l.width,
+                l.height,
+                &win,
+                &p.cand,
+            )?;
+            Ok((win, cands))
+        },
+        || knn_graph(&l.curves.segments, p.knn, p.r_graph / s),
     );
-    let cands = candidates(
-        &l.curves.segments,
-        &l.rtables,
-        &r.curves.segments,
-        &r.zc.theta,
-        l.width,
-        l.height,
-        &win,
-        &p.cand,
-    )?;
-    let adj = knn_graph(&l.curves.segments, p.knn, p.r_graph / s);
+    let (win, cands) = pairs?;
     let csr = association_weights(
         &cands,
         &l.curves.segments,
