@@ -12,7 +12,7 @@
 
 use rayon::prelude::*;
 
-use crate::alloc::{try_collect, try_reserve_len, try_zeroed};
+use crate::alloc::{try_collect, try_filled, try_reserve_len, try_zeroed};
 use crate::error::Result;
 use crate::simd::has_avx2;
 
@@ -141,27 +141,29 @@ impl DivBy {
 }
 
 /// Stable counting sort of `items` by `key(item) < n_keys`: each key's start in the result
-/// (`n_keys + 1` values) and the items by key, in their given order within a key.
+/// (`n_keys + 1` values) and the items by key, in their given order within a key. A failed
+/// allocation is [`crate::CoreError::OutOfMemory`] naming `what`.
 fn counting_sort(
     items: impl Iterator<Item = u32> + Clone,
     key: impl Fn(u32) -> usize,
     n_keys: usize,
-) -> (Vec<usize>, Vec<u32>) {
-    let mut start = vec![0usize; n_keys + 1];
+    what: &'static str,
+) -> Result<(Vec<usize>, Vec<u32>)> {
+    let mut start = try_zeroed::<usize>(n_keys + 1, what)?;
     for it in items.clone() {
         start[key(it) + 1] += 1;
     }
     for i in 1..start.len() {
         start[i] += start[i - 1];
     }
-    let mut fill = start.clone();
-    let mut out = vec![0u32; start[n_keys]];
+    let mut fill = try_collect(start.len(), start.iter().copied(), what)?;
+    let mut out = try_zeroed::<u32>(start[n_keys], what)?;
     for it in items {
         let k = key(it);
         out[fill[k]] = it;
         fill[k] += 1;
     }
-    (start, out)
+    Ok((start, out))
 }
 
 /// Uniform grid over the left points, counting-sorted: `items` lists the point indices cell by
@@ -192,8 +194,22 @@ impl PointGrid {
             .map(|p| (cell.of(p.1) * gw + cell.of(p.0)) as u32)
             .collect();
         let n_cells = (gw * gh) as usize;
-        let (start, items) =
-            counting_sort(0..pxy.len() as u32, |k| cells[k as usize] as usize, n_cells);
+        // The grid's other tables are allocated unchecked: a failed allocation of the sort
+        // aborts the process as theirs does (the default handler, with the size).
+        let (start, items) = counting_sort(
+            0..pxy.len() as u32,
+            |k| cells[k as usize] as usize,
+            n_cells,
+            "the point grid",
+        )
+        .unwrap_or_else(|e| {
+            let bytes = match e {
+                crate::CoreError::OutOfMemory { bytes, .. } => bytes,
+                _ => 0,
+            };
+            let l = std::alloc::Layout::from_size_align(bytes.min(isize::MAX as usize / 2), 8);
+            std::alloc::handle_alloc_error(l.expect("a valid layout"))
+        });
         // Coordinates padded with LANES far-away entries: a block of lanes may read past the
         // last point (its lanes beyond a range are masked, these are never inside a window).
         let far = i32::MIN / 4;
@@ -361,19 +377,24 @@ unsafe fn count_avx2(
 /// `idx` (neuron indices) sorted by right pixel `(yr, xr)`, then index: one `u64` key per
 /// neuron (coordinates non-negative; below 2^21, else a tuple sort), sorted per right row when
 /// the rows already come in order, else in parallel.
-pub(crate) fn right_pixel_order(neurons: &[Neuron], mut idx: Vec<usize>) -> Vec<u32> {
+pub(crate) fn right_pixel_order(
+    neurons: &[Neuron],
+    mut idx: Vec<usize>,
+    what: &'static str,
+) -> Result<Vec<u32>> {
     let fits = neurons.len() < 1 << 22 && neurons.iter().all(|n| n.xr < 1 << 21 && n.yr < 1 << 21);
     if !fits {
         idx.sort_unstable_by_key(|&a| (neurons[a].yr, neurons[a].xr, a));
-        return idx.into_iter().map(|a| a as u32).collect();
+        return try_collect(idx.len(), idx.into_iter().map(|a| a as u32), what);
     }
-    let mut keys: Vec<u64> = idx
-        .iter()
-        .map(|&a| {
+    let mut keys: Vec<u64> = try_collect(
+        idx.len(),
+        idx.iter().map(|&a| {
             let n = &neurons[a];
             ((n.yr as u64) << 43) | ((n.xr as u64) << 22) | a as u64
-        })
-        .collect();
+        }),
+        what,
+    )?;
     if keys.windows(2).all(|w| w[0] >> 43 <= w[1] >> 43) {
         // Right rows already in order (row candidates of raster-ordered points: yr = yl): the
         // order is each row's run sorted on its own, a few dozen keys each.
@@ -383,7 +404,11 @@ pub(crate) fn right_pixel_order(neurons: &[Neuron], mut idx: Vec<usize>) -> Vec<
     } else {
         keys.par_sort_unstable();
     }
-    keys.iter().map(|&k| (k & ((1 << 22) - 1)) as u32).collect()
+    try_collect(
+        keys.len(),
+        keys.iter().map(|&k| (k & ((1 << 22) - 1)) as u32),
+        what,
+    )
 }
 
 /// `f(a)` = (row sum, entry count) for every row, in parallel; the sums in row order and the
@@ -887,6 +912,10 @@ unsafe fn window_add_avx2(
     }
 }
 
+/// A point's window: its ranges of strip-order positions, one per strip (see
+/// [`strip_windows`]), and its neighbour count.
+type PointWindow = ([(u32, u32); MAX_STRIPS], usize);
+
 /// For every query point (`queries`, one of the points, in any order) of the points in strip
 /// order (strips of `strip_h` rows, by x within a strip; `sx`, `sy` their coordinates,
 /// `strip_start` the strips' starts): the ranges of strip-order positions within `half` of it
@@ -902,12 +931,13 @@ fn strip_windows(
     strip_h: i32,
     half: i32,
     queries: &[(i32, i32)],
-) -> Vec<([(u32, u32); MAX_STRIPS], usize)> {
+) -> Result<Vec<PointWindow>> {
+    const WHAT: &str = "the Hopfield network's point windows";
     let n_strips = strip_start.len() - 1;
     let w = sx.iter().copied().max().unwrap_or(0) as usize + 1;
     let stride = w + 1;
     // xp[t][x]: points of strip t with sx < x.
-    let mut xp = vec![0u32; n_strips * stride];
+    let mut xp = try_zeroed::<u32>(n_strips.saturating_mul(stride), WHAT)?;
     xp.par_chunks_mut(stride).enumerate().for_each(|(t, row)| {
         for &x in &sx[strip_start[t]..strip_start[t + 1]] {
             row[x as usize + 1] += 1;
@@ -917,6 +947,8 @@ fn strip_windows(
         }
     });
     let last = n_strips as i32 - 1;
+    let mut wins = Vec::new();
+    try_reserve_len(&mut wins, queries.len(), WHAT)?;
     queries
         .par_iter()
         .map(|&(x, y)| {
@@ -943,17 +975,17 @@ fn strip_windows(
             }
             (r, count - 1) // the point itself
         })
-        .collect()
+        .collect_into_vec(&mut wins); // into the reserved room: no reallocation
+    Ok(wins)
 }
 
 /// Strip order of the points `pxy` (strips of `(half + 1) / 2` rows, by x within a strip, so
 /// that a window's points in one strip are ONE contiguous range cut exactly in x): the strips'
 /// starts, the points in strip order and each point's window ([`strip_windows`], point order).
+/// A failed allocation is [`crate::CoreError::OutOfMemory`].
 #[allow(clippy::type_complexity)]
-fn strip_order(
-    pxy: &[(i32, i32)],
-    half: i32,
-) -> (Vec<usize>, Vec<u32>, Vec<([(u32, u32); MAX_STRIPS], usize)>) {
+fn strip_order(pxy: &[(i32, i32)], half: i32) -> Result<(Vec<usize>, Vec<u32>, Vec<PointWindow>)> {
+    const WHAT: &str = "the Hopfield network's strip order";
     let strip_h = (half + 1) / 2;
     let n_strips = pxy.iter().map(|p| p.1 / strip_h).max().unwrap_or(0) as usize + 1;
     let w_max = pxy.iter().map(|p| p.0).max().unwrap_or(0) as usize;
@@ -962,26 +994,38 @@ fn strip_order(
         0..pxy.len() as u32,
         |q| pxy[q as usize].0 as usize,
         w_max + 1,
-    );
+        WHAT,
+    )?;
     let strip_of = |q: u32| (pxy[q as usize].1 / strip_h) as usize;
-    let (strip_start, sorder) = counting_sort(by_x.iter().copied(), strip_of, n_strips);
-    let sx: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].0).collect();
-    let sy: Vec<i32> = sorder.iter().map(|&q| pxy[q as usize].1).collect();
+    let (strip_start, sorder) = counting_sort(by_x.iter().copied(), strip_of, n_strips, WHAT)?;
+    drop(by_x);
+    let sx = try_collect(
+        sorder.len(),
+        sorder.iter().map(|&q| pxy[q as usize].0),
+        WHAT,
+    )?;
+    let sy = try_collect(
+        sorder.len(),
+        sorder.iter().map(|&q| pxy[q as usize].1),
+        WHAT,
+    )?;
     // Per point (point order): its window's point ranges per strip and neighbour count n_p.
-    let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half, pxy);
-    (strip_start, sorder, wins)
+    let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half, pxy)?;
+    Ok((strip_start, sorder, wins))
 }
 
 /// Column groups: neurons sharing a right pixel, wherever their left points are. The neurons
 /// in right-pixel order, each neuron's group (its range in that order) and its right pixel's
-/// rank, and the number of right pixels.
+/// rank, and the number of right pixels. A failed allocation is
+/// [`crate::CoreError::OutOfMemory`].
 #[allow(clippy::type_complexity)]
-fn right_groups(neurons: &[Neuron]) -> (Vec<u32>, Vec<(u32, u32)>, Vec<u32>, u32) {
+fn right_groups(neurons: &[Neuron]) -> Result<(Vec<u32>, Vec<(u32, u32)>, Vec<u32>, u32)> {
+    const WHAT: &str = "the Hopfield network's right-pixel groups";
     let m = neurons.len();
     let key = |a: u32| (neurons[a as usize].yr, neurons[a as usize].xr);
-    let by_right: Vec<u32> = right_pixel_order(neurons, (0..m).collect::<Vec<_>>());
-    let mut group = vec![(0u32, 0u32); m];
-    let mut rank = vec![0u32; m];
+    let by_right = right_pixel_order(neurons, try_collect(m, 0..m, WHAT)?, WHAT)?;
+    let mut group = try_filled(m, (0u32, 0u32), WHAT)?;
+    let mut rank = try_zeroed::<u32>(m, WHAT)?;
     let (mut g0, mut n_groups) = (0, 0u32);
     for k in 1..=m {
         if k == m || key(by_right[k]) != key(by_right[g0]) {
@@ -993,7 +1037,7 @@ fn right_groups(neurons: &[Neuron]) -> (Vec<u32>, Vec<(u32, u32)>, Vec<u32>, u32
             n_groups += 1;
         }
     }
-    (by_right, group, rank, n_groups)
+    Ok((by_right, group, rank, n_groups))
 }
 
 /// Strips per task of the symmetric initial pass: a fixed split of the rows, so the sums do
@@ -1031,8 +1075,8 @@ impl Network {
         let dys = try_collect(m, neurons.iter().map(Neuron::dy), WHAT)?;
         // The strip order and windows, and the right-pixel groups, are independent: built side
         // by side.
-        let ((strip_start, sorder, wins), (by_right, group, rank, n_groups)) =
-            rayon::join(|| strip_order(&pxy, half), || right_groups(neurons));
+        let (strips, groups) = rayon::join(|| strip_order(&pxy, half), || right_groups(neurons));
+        let ((strip_start, sorder, wins), (by_right, group, rank, n_groups)) = (strips?, groups?);
         // A / max(n_p, n_q, 1) = min(A / max(n_p, 1), A / max(n_q, 1)) exactly: division rounds
         // monotonically (max for a negative A). One division per point instead of per pair.
         let a_over_n = try_collect(
@@ -1074,7 +1118,11 @@ impl Network {
         for (j, &b) in cells.idx[..padded - LANES].iter().enumerate() {
             slot_of[b as usize] = j as u32;
         }
-        let cell_strip: Vec<u32> = strip_start.iter().map(|&q| gstart[q]).collect();
+        let cell_strip = try_collect(
+            strip_start.len(),
+            strip_start.iter().map(|&q| gstart[q]),
+            WHAT,
+        )?;
         // Per point, the `cells` range of its window in each strip the window's rows touch.
         let mut wranges: Vec<[(u32, u32); MAX_STRIPS]> = Vec::new();
         try_reserve_len(&mut wranges, wins.len(), WHAT)?;
@@ -1563,7 +1611,7 @@ mod tests {
         }
         let sx: Vec<i32> = pts.iter().map(|p| p.0).collect();
         let sy: Vec<i32> = pts.iter().map(|p| p.1).collect();
-        let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half, &pts);
+        let wins = strip_windows(&sx, &sy, &strip_start, strip_h, half, &pts).unwrap();
         for (i, &(x, y)) in pts.iter().enumerate() {
             let brute = pts
                 .iter()
@@ -1586,7 +1634,7 @@ mod tests {
         }
         // The queries in any order: the same answer per point.
         let rev: Vec<(i32, i32)> = pts.iter().rev().copied().collect();
-        let mut wins_rev = strip_windows(&sx, &sy, &strip_start, strip_h, half, &rev);
+        let mut wins_rev = strip_windows(&sx, &sy, &strip_start, strip_h, half, &rev).unwrap();
         wins_rev.reverse();
         assert_eq!(wins_rev, wins);
     }

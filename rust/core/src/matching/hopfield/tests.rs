@@ -1061,3 +1061,55 @@ fn initial_net_inputs_too_large_to_allocate_are_an_error() {
         );
     }
 }
+
+/// Run by [`network_orders_too_large_to_allocate_are_an_error`] in a child process: 2^20
+/// lone neurons under an address-space limit of `SV_OOM_MIB` MiB more than is mapped. The
+/// checked per-point and per-neuron tables before the orders take 28 MiB; then (one rayon
+/// thread) the strip order (4 MiB sorts, 4 MiB coordinates), the point windows (56 MiB) and
+/// the right-pixel groups (8 MiB indices and keys, 4 MiB order, 8 + 4 MiB groups and ranks).
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of network_orders_too_large_to_allocate_are_an_error"]
+fn network_orders_under_a_memory_limit() {
+    let Some(mib) = std::env::var_os("SV_OOM_MIB") else {
+        return;
+    };
+    let mib: usize = mib.to_str().unwrap().parse().unwrap();
+    let neurons = lone_neurons();
+    rayon::join(|| (), || ()); // the pool's thread started before the limit
+    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (mib << 20));
+    match Network::new(&neurons, &HopfieldParams::default().weights) {
+        Ok(net) => println!("child: network of {}", net.n()),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn network_orders_too_large_to_allocate_are_an_error() {
+    // Network::new checked its cell arrays, slots and window ranges, but the strip order
+    // (counting sorts, strip coordinates), the point windows and the right-pixel groups before
+    // them (about 90 bytes a neuron) were still allocated unchecked: a failed allocation
+    // aborted the process (SIGABRT) instead of returning OutOfMemory.
+    for (mib, want) in [
+        (
+            "34",
+            "the Hopfield network's strip order needs 4.00 MiB (4194304 bytes)",
+        ),
+        (
+            "70",
+            "the Hopfield network's point windows needs 56.00 MiB (58720256 bytes)",
+        ),
+        (
+            "101",
+            "the Hopfield network's right-pixel groups needs 8.00 MiB (8388608 bytes)",
+        ),
+    ] {
+        let stdout = crate::segment::tests::run_oom_child_with(
+            "matching::hopfield::tests::network_orders_under_a_memory_limit",
+            Some(("SV_OOM_MIB", mib)),
+        );
+        let want = format!("child: error: out of memory: {want}");
+        assert!(stdout.contains(&want), "{mib} MiB: {want} not in {stdout}");
+    }
+}
