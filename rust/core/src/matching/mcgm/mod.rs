@@ -1764,11 +1764,13 @@ fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
         "the MCGM matcher's combined matches",
     )?;
     for ch in channels.iter().rev().filter(|c| c.scale == 1) {
+        // The places this channel takes, marked after its pass (its own matches do not block
+        // each other).
         let mut mine: Vec<(usize, usize)> = Vec::new();
         crate::alloc::try_reserve_len(
             &mut mine,
             ch.matches.len(),
-            "the MCGM matcher's combined matches",
+            "the MCGM matcher's channel places",
         )?;
         for m in &ch.matches {
             let (x, y) = (m.xl.round() as i32, m.yl.round() as i32);
