@@ -303,7 +303,7 @@ def test_a_pair_halved_with_rounding_is_named_resized(
     """The sample halved (450x375 -> 225x188, the odd height rounded) was "another aspect
     ratio: another camera mode or camera, or cropped images" under its calibration: only an
     exact ratio counted as a resize, where `stream` and `gui` scale a calibration to frames
-    within 1 % (fit_to_frames). The hint takes the same 1 %."""
+    within 1 % (fit_to_frames). The hint takes the same 1 %, in the CLI's words (cf572b2)."""
     import cv2
 
     for name in ("left", "right"):
@@ -313,7 +313,9 @@ def test_a_pair_halved_with_rounding_is_named_resized(
     assert main([*argv, "--calib", str(CONES / "calib.txt"), "-o", str(tmp_path / "o")]) == 2
     assert capsys.readouterr().err.strip() == (
         "stereovision: error: calibration is for 450x375 images, got 225x188 (images resized, "
-        "not cropped: calib.scaled_to((225, 188)))"
+        "not cropped: resize them back to the calibration's size, or save it scaled to them once "
+        "in Python with Calibration.from_file(path).scaled_to((225, 188)).save('rig.yaml') and "
+        "give rig.yaml)"
     )
 
 
