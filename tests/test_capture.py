@@ -1319,7 +1319,7 @@ def test_a_folder_a_glob_or_a_misnumbered_pattern_names_the_source_that_would_wo
         (
             f"{pairs}/left_%03d.png",
             FileNotFoundError,
-            f"left source: no file numbered 0-4 fits {pairs}/left_%03d.png; give {seq}",
+            f"left source: no file fits {pairs}/left_%03d.png; give {seq}",
         ),
         (
             f"{pairs}/left_*1.png",
@@ -1399,7 +1399,7 @@ def test_a_misnumbered_pattern_is_told_a_pattern_that_opens(tmp_path: Path) -> N
     with pytest.raises(FileNotFoundError) as err:
         StereoCamera(f"{pairs}/left_%03d.png", f"{pairs}/right_%04d.png")
     assert str(err.value) == (
-        f"left source: no file numbered 0-4 fits {pairs}/left_%03d.png; give a pattern such as "
+        f"left source: no file fits {pairs}/left_%03d.png; give a pattern such as "
         f"{pairs}/left_%04d.png (its files are named left_0001.png, left_0002.png ...)"
     )
 
@@ -2860,3 +2860,70 @@ def test_an_open_opencv_raises_on_names_the_source(
     )
     assert (err.value.side, err.value.end) == ("left", False)
     assert isinstance(err.value.__cause__, cv2.error)
+
+
+@pytest.mark.parametrize(
+    ("name", "first"),
+    [
+        ("f_%03d.png", 5),
+        ("f_%04d.png", 1007),
+        ("f_%d.png", 12),
+        ("cam2_%03d.png", 3),
+        ("cam2_%03d.png", 9),
+    ],
+)
+def test_an_image_sequence_opens_from_its_first_number_however_late(
+    tmp_path: Path, name: str, first: int
+) -> None:
+    """OpenCV's image reader and FFmpeg's look for a sequence's first file among numbers 0-4:
+    one starting at 5 or later did not open ("cannot open left source"), and one at 2-4 opened
+    by its first file had OpenCV take the other digits in its name for the number (cam2_003.png
+    read as "cam%01d_003.png" from 2: one frame). Each opens from its first number, reads
+    every image in turn and tells a gap as a sequence from 0 does."""
+    folder = tmp_path / "seq"
+    folder.mkdir()
+    for i in range(first, first + 4):
+        cv2.imwrite(str(folder / (name % i)), _numbered(i))
+    pattern = str(folder / name)
+    with StereoCamera(pattern, pattern) as cam:
+        got = list(cam.frames())
+        assert cam.delivered_fps == {"left": 0.0, "right": 0.0}  # no rate, as CAP_IMAGES
+        assert cam.delivered_size == {"left": SMALL, "right": SMALL}
+    assert [_read_stamp(f.left) for f in got] == list(range(first, first + 4))
+    assert all(math.isnan(f.pos_left_ms) for f in got)
+    (folder / (name % (first + 1))).unlink()
+    with StereoCamera(pattern, pattern) as cam:
+        result = capture(cam, tmp_path / "pairs")
+    assert len(result.saved) == 1
+    assert result.ended.startswith(
+        f"left source {pattern!r} ended after 1 images: {name % (first + 1)} is missing, so the "
+        "2 images numbered after it were not read"
+    )
+
+
+def test_a_pattern_with_a_literal_percent_sign_opens(tmp_path: Path) -> None:
+    """``%%`` is printf's (and OpenCV's) literal percent sign: ``take_50%%_%03d.png`` names
+    take_50%_000.png ... Our pattern code matched it as two percent signs ("no file matches
+    take_50%%_%03d.png"); it opens, and a misnumbered one is told a pattern, escaped, that
+    opens."""
+    folder = tmp_path / "seq"
+    folder.mkdir()
+    for i in range(3):
+        cv2.imwrite(str(folder / f"take_50%_{i:03d}.png"), _numbered(i))
+        cv2.imwrite(str(folder / f"right_{i:03d}.png"), _numbered(i))
+    right = str(folder / "right_%03d.png")
+    with StereoCamera(str(folder / "take_50%%_%03d.png"), right) as cam:
+        assert [_read_stamp(f.left) for f in cam.frames()] == [0, 1, 2]
+    with pytest.raises(FileNotFoundError) as err:
+        StereoCamera(str(folder / "take_50%%_%04d.png"), right)
+    told = str(folder / "take_50%%_%03d.png")
+    assert str(err.value) == (
+        f"left source: no file fits {folder}/take_50%%_%04d.png; give a pattern such as {told} "
+        "(its files are named take_50%_000.png, take_50%_001.png ...)"
+    )
+    with StereoCamera(told, right) as cam:  # what it was told opens
+        assert cam.read().left.shape == (240, 320, 3)
+    # a file whose name holds a single percent sign is that file, as before
+    cv2.imwrite(str(folder / "50%.png"), _numbered(7))
+    with StereoCamera(str(folder / "50%.png"), str(folder / "right_000.png")) as cam:
+        assert _read_stamp(cam.read().left) == 7

@@ -35,6 +35,7 @@ import dataclasses
 import errno
 import functools
 import glob
+import itertools
 import math
 import os
 import re
@@ -398,8 +399,9 @@ def _describe_source(src: Source) -> str:
     return type(src).__name__
 
 
-#: A frame number in an image-sequence pattern (``left_%03d.png``).
-_SEQ_RE = re.compile(r"%(0?\d*)d")
+#: What a ``%`` of an image-sequence pattern starts: a literal percent sign (``%%``) or the
+#: frame number (``left_%03d.png``).
+_SEQ_TOKEN_RE = re.compile(r"%%|%(0?\d*)d")
 
 
 _T = TypeVar("_T")
@@ -646,36 +648,71 @@ def _open_within(
         raise
 
 
+def _sequence_parts(path: str) -> tuple[str, str, str] | None:
+    """An image-sequence pattern's text before its number, the number's printf format and the
+    text after it, each ``%%`` read as the ``%`` it stands for (``take_50%%_%03d.png`` ->
+    ``("take_50%_", "%03d", ".png")``); None when ``path`` holds no number format."""
+    for m in _SEQ_TOKEN_RE.finditer(path):
+        if m.group(0) != "%%":  # "%%" is a literal percent sign, never a frame number
+            head, tail = path[: m.start()], path[m.end() :]
+            return head.replace("%%", "%"), m.group(0), tail.replace("%%", "%")
+    return None
+
+
+def _sequence_name(path: str, number: int) -> str:
+    """The file of image-sequence pattern ``path`` numbered ``number`` (``path`` holds a
+    number format: :func:`_sequence_parts`)."""
+    parts = _sequence_parts(path)
+    assert parts is not None
+    return parts[0] + parts[1] % number + parts[2]
+
+
+def _sequence_numbers(path: str) -> list[int]:
+    """The numbers of the files that image-sequence pattern ``path`` names, sorted (at most
+    :data:`_HINT_MAX_FILES` files of its folder looked at)."""
+    parts = _sequence_parts(path)
+    if parts is None:
+        return []
+    head, fmt, tail = parts
+    numbers = []
+    for name in itertools.islice(
+        glob.iglob(glob.escape(head) + "*" + glob.escape(tail)), _HINT_MAX_FILES
+    ):
+        digits = name[len(head) : len(name) - len(tail)]
+        # as the pattern prints it: left_%03d.png names left_007.png, not left_0007.png
+        if digits.isdecimal() and fmt % int(digits) == digits:
+            numbers.append(int(digits))
+    return sorted(numbers)
+
+
 def _sequence_first(path: str) -> tuple[int, str] | None:
-    """The first file of an image-sequence pattern and its number, looked for as FFmpeg's
-    image2 does (numbers 0-4); None when ``path`` is no pattern or none of those exists."""
-    m = _SEQ_RE.search(path)
-    if m is None or "://" in path or os.path.exists(path):
+    """The first file of an image-sequence pattern and its number: the lowest number of the
+    files it names (FFmpeg's image2 and OpenCV's own reader look at 0-4 alone, so a sequence
+    starting at 5 or later did not open); None when ``path`` is no pattern or names no file."""
+    parts = _sequence_parts(path)
+    if "://" in path or parts is None or os.path.exists(path):
         return None
-    for i in range(5):
-        name = path[: m.start()] + ("%" + m.group(1) + "d") % i + path[m.end() :]
+    for i in range(5):  # the usual starts, without a listing of the folder
+        name = _sequence_name(path, i)
         if os.path.exists(name):
             return i, name
-    return None
+    # a first number wider than the pattern pads to is no start (left_%03d.png for left_0001.png
+    # ... left_10000.png: its files are a %04d run, and left_10000.png alone is no sequence)
+    width = int(parts[1][1:-1] or 0)
+    numbers = [n for n in _sequence_numbers(path) if not width or len(parts[1] % n) == width]
+    return (numbers[0], _sequence_name(path, numbers[0])) if numbers else None
 
 
 def _sequence_gap(path: str, read: int) -> tuple[str, int] | None:
     """For an image-sequence pattern read to its end after ``read`` images: the file that
     stopped it (the next number, missing) and how many files numbered after it exist; None
     when no file is numbered after it (the sequence's real end) or ``path`` is no pattern."""
-    m = _SEQ_RE.search(path)
     first = _sequence_first(path)
-    if m is None or first is None:
+    if first is None:
         return None
     number = first[0] + read
-    missing = path[: m.start()] + ("%" + m.group(1) + "d") % number + path[m.end() :]
-    head, tail = path[: m.start()], path[m.end() :]
-    later = 0
-    for name in glob.glob(glob.escape(head) + "*" + glob.escape(tail)):
-        digits = name[len(head) : len(name) - len(tail)]
-        if digits.isdigit() and int(digits) > number:
-            later += 1
-    return (os.path.basename(missing), later) if later else None
+    later = sum(1 for n in _sequence_numbers(path) if n > number)
+    return (os.path.basename(_sequence_name(path, number)), later) if later else None
 
 
 #: A numbered file: its name before the number, the number, the extension (``left_``,
@@ -717,7 +754,9 @@ def _forms_that_work(side: str, folder: str, names: Iterable[str]) -> tuple[str,
         width = min(len(d) for d in digits)
         if any(len(d) > width and d.startswith("0") for d in digits):
             width = 0
-        pattern = os.path.join(folder, f"{head}{f'%0{width}d' if width > 1 else '%d'}{ext}")
+        # a percent sign in a name is "%%" in its pattern (printf's, OpenCV's)
+        number = f"%0{width}d" if width > 1 else "%d"
+        pattern = os.path.join(folder, head.replace("%", "%%") + number + ext)
         shown = ", ".join(f"{head}{d}{ext}" for d in digits[:2])
         more = " ..." if len(digits) > 2 else ""
         return pattern, f"pattern such as {pattern} (its files are named {shown}{more})"
@@ -772,16 +811,87 @@ def _glob_hint(side: str, path: str) -> str:
 
 
 def _pattern_hint(side: str, path: str) -> str | None:
-    """For an image-sequence pattern whose first file (numbered 0-4) is missing while files of
-    another numbering are there (``left_%03d.png`` for ``left_0001.png ...``): the one line
-    naming the pattern they need; None when they need this one (or none is there)."""
+    """For an image-sequence pattern that names no file while files of another numbering are
+    there (``left_%03d.png`` for ``left_0001.png ...``): the one line naming the pattern they
+    need; None when they need this one (or none is there)."""
     folder = os.path.dirname(path)
-    pattern = "*".join(glob.escape(part) for part in re.split(r"%0?\d*d", path))
-    names = [os.path.basename(m) for m in glob.glob(pattern)]
-    form = _forms_that_work(side, folder, names[:_HINT_MAX_FILES])
+    matching = _sequence_glob(path)
+    if matching is None:
+        return None
+    names = [os.path.basename(m) for m in itertools.islice(glob.iglob(matching), _HINT_MAX_FILES)]
+    form = _forms_that_work(side, folder, names)
     if form is None or form[0] == path:
         return None
-    return f"{side} source: no file numbered 0-4 fits {path}; give a {form[1]}"
+    return f"{side} source: no file fits {path}; give a {form[1]}"
+
+
+def _sequence_glob(path: str) -> str | None:
+    """The glob of the files image-sequence pattern ``path`` may name, whatever their number's
+    width (``left_*.png`` for ``left_%03d.png``); None when ``path`` is no pattern."""
+    parts = _sequence_parts(path)
+    return None if parts is None else glob.escape(parts[0]) + "*" + glob.escape(parts[2])
+
+
+class _ImageSequence:
+    """The numbered images of a pattern read in turn from the first one there, a
+    ``cv2.VideoCapture`` stand-in for the sequences OpenCV's reader cannot open: one that
+    starts at 5 or later (``CAP_IMAGES`` and FFmpeg look at 0-4), one at 2-4 whose name holds
+    other digits before the number (``CAP_IMAGES`` opened by its first file took those for
+    it), or a pattern with a literal percent sign (``%%``, refused by ``CAP_IMAGES``). Frames
+    are read as ``CAP_IMAGES`` reads them (``cv2.IMREAD_UNCHANGED``, each at its own size);
+    the sequence is the run of consecutive numbers from the first, and ends at a missing one
+    (its backend is said as ``CV_IMAGES``: the end and a gap are told as for OpenCV's)."""
+
+    def __init__(self, path: str, first: int) -> None:
+        self._path, self._first, self._next = path, first, 0
+        self._frame: np.ndarray | None = None
+        self._count = 0
+        while os.path.exists(_sequence_name(path, first + self._count)):
+            self._count += 1
+        probe = cv2.imread(_sequence_name(path, first), cv2.IMREAD_UNCHANGED)
+        self._size = (0, 0) if probe is None else (probe.shape[1], probe.shape[0])
+        self._open = probe is not None
+
+    def isOpened(self) -> bool:
+        return self._open
+
+    def getBackendName(self) -> str:
+        return "CV_IMAGES"
+
+    def grab(self) -> bool:
+        self._frame = None
+        if not self._open:
+            return False
+        name = _sequence_name(self._path, self._first + self._next)
+        frame = cv2.imread(name, cv2.IMREAD_UNCHANGED)
+        if frame is None:
+            return False
+        self._frame = frame
+        self._next += 1
+        return True
+
+    def retrieve(self) -> tuple[bool, np.ndarray | None]:
+        return self._frame is not None, self._frame
+
+    def read(self) -> tuple[bool, np.ndarray | None]:
+        return self.retrieve() if self.grab() else (False, None)
+
+    def get(self, prop: int) -> float:
+        values = {
+            cv2.CAP_PROP_FRAME_WIDTH: self._size[0],
+            cv2.CAP_PROP_FRAME_HEIGHT: self._size[1],
+            cv2.CAP_PROP_FRAME_COUNT: self._count,
+            cv2.CAP_PROP_POS_FRAMES: self._next,
+            cv2.CAP_PROP_POS_MSEC: -1,  # no media time, as CAP_IMAGES says
+            cv2.CAP_PROP_FPS: -1,
+        }
+        return float(values.get(prop, 0))
+
+    def set(self, prop: int, value: float) -> bool:
+        return False  # a file cannot be asked (CAP_IMAGES refuses them too)
+
+    def release(self) -> None:
+        self._open, self._frame = False, None
 
 
 def _open_path(path: str) -> Any:
@@ -791,13 +901,15 @@ def _open_path(path: str) -> Any:
     rescales a frame of another size to the first frame's before anyone sees it (a 300x300
     frame in a 384x288 sequence came out stretched to 384x288), while ``CAP_IMAGES`` gives
     every frame at its own size, so that :class:`StereoCamera`'s size and shape rules apply.
-    ``CAP_IMAGES`` starts a pattern at number 0 or 1; a sequence starting at 2-4 (FFmpeg's range)
-    is opened by its first file, whose number it reads. The default backend remains for what
-    ``CAP_IMAGES`` cannot open.
+    ``CAP_IMAGES`` starts a pattern at number 0 or 1 and refuses a literal ``%%``: a sequence
+    that starts later, or names a percent sign, is read by :class:`_ImageSequence` the same way.
+    The default backend remains for what ``CAP_IMAGES`` cannot open.
     """
     first = _sequence_first(path)
+    if first is not None and (first[0] > 1 or "%%" in path):
+        return _ImageSequence(path, first[0])
     if first is not None:
-        cap = cv2.VideoCapture(path if first[0] <= 1 else first[1], cv2.CAP_IMAGES)
+        cap = cv2.VideoCapture(path, cv2.CAP_IMAGES)
         if cap.isOpened():
             return cap
         cap.release()
@@ -1128,8 +1240,8 @@ class StereoCamera(PairSource):
             if os.path.isdir(path):  # "cannot open" said nothing of what to give instead
                 raise SourceError(_folder_hint(side, path), side=side, end=False)
             # the text around the number matched as written (a folder "run[1]" is no glob)
-            pattern = "*".join(glob.escape(part) for part in re.split(r"%0?\d*d", path))
-            if "%" in path and "://" not in path and pattern != glob.escape(path):
+            pattern = _sequence_glob(path) if "://" not in path else None
+            if pattern is not None:
                 if not glob.glob(pattern):
                     # said here: FFmpeg would print its own line first
                     raise FileNotFoundError(f"{side} source: no file matches {path}")
@@ -2330,13 +2442,11 @@ def _reads_own_output(sources: Any, out: PathLike, ext: str = ".png") -> str | N
         if not isinstance(src, (str, os.PathLike)):
             continue
         path = os.fspath(src)
-        if "://" in path or _SEQ_RE.search(path) is None:
-            continue
         folder, base = os.path.split(path)
-        regex = "".join(
-            r"\d+" if _SEQ_RE.fullmatch(part) else re.escape(part)
-            for part in re.split(r"(%0?\d*d)", base)
-        )
+        parts = _sequence_parts(base)
+        if "://" in path or parts is None:
+            continue
+        regex = re.escape(parts[0]) + r"\d+" + re.escape(parts[2])
         try:
             same = os.path.samefile(folder or ".", out)
         except OSError:
