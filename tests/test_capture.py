@@ -2927,3 +2927,87 @@ def test_a_pattern_with_a_literal_percent_sign_opens(tmp_path: Path) -> None:
     cv2.imwrite(str(folder / "50%.png"), _numbered(7))
     with StereoCamera(str(folder / "50%.png"), str(folder / "right_000.png")) as cam:
         assert _read_stamp(cam.read().left) == 7
+
+
+class _FailsToRead(_FakeCap):
+    """A backend in OpenCV's exception mode failing mid-stream: ``step`` raises cv2.error on
+    its ``at``-th call."""
+
+    def __init__(self, name: str, log: list[str], step: str, at: int) -> None:
+        super().__init__(name, log, frames=10)
+        self.step, self.at, self.calls = step, at, 0
+
+    def _maybe_fail(self, step: str) -> None:
+        if step == self.step:
+            self.calls += 1
+            if self.calls == self.at:
+                raise cv2.error(
+                    "OpenCV(5.1.0) cap_ffmpeg.cpp:1: error: (-2:Unspecified error) packet read "
+                    "failed in function 'grabFrame'\n"
+                )
+
+    def getBackendName(self) -> str:
+        return "FFMPEG"
+
+    def grab(self) -> bool:
+        self._maybe_fail("grab")
+        return super().grab()
+
+    def retrieve(self) -> tuple[bool, np.ndarray]:
+        self._maybe_fail("retrieve")
+        return super().retrieve()
+
+
+@pytest.mark.parametrize("step", ["grab", "retrieve"])
+@pytest.mark.parametrize("timeout", [0.5, None])
+def test_a_read_opencv_raises_on_is_a_source_error_naming_the_side(
+    tmp_path: Path, step: str, timeout: float | None
+) -> None:
+    """A cv2.error out of a grab or retrieve after the open came out raw (the CLI called it an
+    internal error): a SourceError naming the side, the step and the pair, not an end, chaining
+    it; the pairs saved before it are kept and said."""
+    log: list[str] = []
+    cam = StereoCamera(_FakeCap("L", log, frames=10), _FailsToRead("R", log, step, at=2))
+    with pytest.raises(SourceError) as err:
+        capture(cam, tmp_path / "pairs", read_timeout=timeout)
+    assert str(err.value) == (
+        f"right source _FailsToRead failed in OpenCV's {step} of pair 2 (packet read failed); "
+        f"1 pair was saved in {tmp_path / 'pairs'} and is kept"
+    )
+    assert (err.value.side, err.value.end, err.value.frames) == ("right", False, 1)
+    assert isinstance(err.value.__cause__, SourceError)  # the read's, said with what was kept
+    assert isinstance(err.value.__cause__.__cause__, cv2.error)
+    assert sorted(p.name for p in (tmp_path / "pairs").iterdir()) == [
+        "left_0001.png",
+        "right_0001.png",
+    ]
+    cam.close()
+
+
+@pytest.mark.parametrize("command", ["capture", "stream"])
+def test_cli_says_a_read_opencv_raised_on_in_one_line(
+    command: str,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The CLI printed a cv2.error of a read as an internal error: one line naming the side,
+    exit 2."""
+    from stereovision.cli import main
+
+    left, right = _videos(tmp_path, 3, 3)
+    log: list[str] = []
+    made = {
+        str(left): _FailsToRead("L", log, "none", at=1),
+        str(right): _FailsToRead("R", log, "grab", at=1),
+    }
+    monkeypatch.setattr(capmod, "_open_path", lambda path: made[path])
+    argv = [command, "--left", str(left), "--right", str(right)]
+    argv += ["-o", str(tmp_path / "p")] if command == "capture" else ["--no-display"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(
+        f"stereovision: error: right source {str(right)!r} failed in OpenCV's grab of pair 1 "
+        "(packet read failed)"
+    )
+    assert err.count("\n") == 1 and "internal" not in err

@@ -1542,13 +1542,13 @@ class StereoCamera(PairSource):
         try:
             # OpenCV's image-sequence reader logs a warning for the file after the last.
             with _opencv_quiet() if any(self._sequence.values()) else contextlib.nullcontext():
-                ok_l = caps["left"].grab()
+                ok_l = self._native(caps, "left", "grab")
                 t_l = time.monotonic()
-                ok_r = caps["right"].grab()
+                ok_r = self._native(caps, "right", "grab")
                 t_r = time.monotonic()
             if not (ok_l and ok_r):
                 return ok_l, t_l, ok_r, t_r, {}
-            got = {side: caps[side].retrieve() for side in ("left", "right")}
+            got = {side: self._native(caps, side, "retrieve") for side in ("left", "right")}
             return ok_l, t_l, ok_r, t_r, got
         finally:
             with self._grab_lock:
@@ -1556,6 +1556,25 @@ class StereoCamera(PairSource):
                 release, self._release_on_return = self._release_on_return, False
             if release:  # closed while this grab hung: released now that it is out of OpenCV
                 _release(caps.values())
+
+    def _native(self, caps: dict[str, Any], side: str, step: str) -> Any:
+        """``caps[side].grab()`` or ``.retrieve()`` (``step``); a ``cv2.error`` it raises (a
+        backend failing mid-stream, in its exception mode) is a :class:`SourceError` naming
+        the side and the step, with ``end`` False: it came out raw, which the CLI called an
+        internal error."""
+        try:
+            return getattr(caps[side], step)()
+        except cv2.error as exc:
+            from stereovision.calibration import _first_line
+
+            name = _describe_source(self.sources[side])
+            raise SourceError(
+                f"{side} source {name} failed in OpenCV's {step} of pair {self.count + 1} "
+                f"({_first_line(exc)})",
+                side=side,
+                end=False,
+                frames=self.count,
+            ) from exc
 
     def _video_files(self) -> bool:
         """Both sources are local video files, whose media times are comparable."""
