@@ -2689,3 +2689,54 @@ def test_the_calibration_fitted_to_the_frames_is_said_at_the_callers_line(
         run_stream(cam, calib, max_disparity=32, check=False)
     said = [w for w in caught if "calibration is for 640x480" in str(w.message)]
     assert [w.filename for w in said] == [__file__]
+
+
+@pytest.mark.parametrize(
+    ("positions", "fps"),
+    [([0.0] * 5, 10.0), ([0.0, 100.0, 200.0, 100.0, 400.0], 10.0), ([0.0] * 5, 0.0)],
+    ids=["stalled", "backwards", "no rate"],
+)
+@pytest.mark.parametrize("pipelined", [False, True])
+def test_video_stamps_increase_when_the_media_time_stalls_or_goes_back(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    positions: list[float],
+    fps: float,
+    pipelined: bool,
+) -> None:
+    """Two video files are stamped by the left one's media time (CAP_PROP_POS_MSEC); a
+    container or backend that reports 0 throughout, or a position that goes back, gave pairs
+    one stamp, or a stamp before the last. From there the frame period steps them (the wall
+    clock without a rate), strictly increasing, said once."""
+    from stereovision import capture as capmod
+
+    size = (64, 48)
+    for side in ("left", "right"):
+        vw = cv2.VideoWriter(str(tmp_path / f"{side}.avi"), cv2.VideoWriter_fourcc(*"MJPG"),
+                             10.0, size)  # fmt: skip
+        for i in range(len(positions)):
+            vw.write(np.full((size[1], size[0], 3), 40 * i, np.uint8))
+        vw.release()
+    told = iter([p for p in positions for _ in ("left", "right")])
+    monkeypatch.setattr(capmod, "_media_ms", lambda cap: next(told))
+    seen: list[int] = []
+    with StereoCamera(tmp_path / "left.avi", tmp_path / "right.avi") as cam:
+        assert cam.media_clock
+        cam.delivered_fps["left"] = fps
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            run_stream(cam, max_disparity=8, pipelined=pipelined, check=False,
+                       on_stamped_result=lambda left, res, ns: seen.append(ns))  # fmt: skip
+    assert len(seen) == len(positions)
+    assert (np.diff(seen) > 0).all()
+    if fps:
+        assert np.diff(seen).tolist() == [100_000_000] * (len(positions) - 1)
+    stalled = [str(w.message) for w in caught if "media time" in str(w.message)]
+    at = 4 if positions[3] < positions[2] else 2
+    step = "the frame index and the video's frame rate" if fps else "the wall clock of their read"
+    assert stalled == [
+        f"left source {str(tmp_path / 'left.avi')!r}: its media time did not move on at pair "
+        f"{at} (position {positions[at - 1]:.0f} ms; the container or backend reports a stalled "
+        f"or repeated one): this pair and the next are stamped by {step}"
+        + (" (the video reports no frame rate)" if not fps else "")
+    ]

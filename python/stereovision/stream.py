@@ -463,6 +463,9 @@ def _pairs(
     # video files: their own time, from the first pair's wall clock (None until it is read)
     media = getattr(camera, "media_clock", False) is True
     media_origin_ns: int | None = None
+    last_stamp_ns: int | None = None  # of the pair before, for a media time that stalls
+    media_fallback: tuple[int, int] | None = None  # (stamp, frame index) it steps on from
+    stall: str | None = None  # the warning of a media time that stalled, not said yet
     while frames is None or n < frames:
         t0 = time.perf_counter()
         grabbed = getattr(camera, "grabbed", None) if isinstance(camera, _FirstPairRead) else None
@@ -499,12 +502,28 @@ def _pairs(
         else:  # the wall clock at the middle of the two grabs (host monotonic times)
             ago = time.monotonic() - 0.5 * (fr.t_left + fr.t_right)
             stamp_ns = time.time_ns() - round(1e9 * ago)
-            if media and math.isfinite(fr.pos_left_ms):
+            at = None  # the pair's place in the video, as a stamp
+            if media and media_fallback is None and math.isfinite(fr.pos_left_ms):
                 # a video file's pair at its place in the video: the read's wall clock made
                 # the stamps (a --bag's) follow the processing speed, not the video's 1/fps
                 if media_origin_ns is None:
                     media_origin_ns = stamp_ns - round(1e6 * fr.pos_left_ms)
-                stamp_ns = media_origin_ns + round(1e6 * fr.pos_left_ms)
+                at = media_origin_ns + round(1e6 * fr.pos_left_ms)
+            if media and at is not None and (last_stamp_ns is None or at > last_stamp_ns):
+                stamp_ns = at
+            elif media:
+                # a container or backend whose position stalls (0, a repeated value) or goes
+                # back gave two pairs one stamp, or a stamp before the last: from here on the
+                # frame period steps the stamps (the wall clock without one), said once
+                if media_fallback is None:
+                    media_fallback = (
+                        (stamp_ns, fr.index)
+                        if last_stamp_ns is None
+                        else (last_stamp_ns, fr.index - 1)
+                    )
+                    stall = _media_stall_note(camera, fr)
+                stamp_ns = _stepped_stamp(camera, fr, media_fallback, last_stamp_ns, stamp_ns)
+            last_stamp_ns = stamp_ns
         left, right = fr.left, fr.right
         # The mean of the frames as the cameras give them, then rectified: the filter measures
         # the noise of each pixel (temporal.noise_sigma), which rectification's interpolation
@@ -529,7 +548,10 @@ def _pairs(
         # In the producer thread when pipelined: the matcher keeps working meanwhile.
         if check_every is not None and (n == 0 or (check_every > 0 and n % check_every == 0)):
             checked = check_rectification(left, right)
-        if note is not None:  # said before the pair, outside its timings
+        if stall is not None:  # said before the pair, outside its timings
+            yield _Note(stall)
+            stall = None
+        if note is not None:
             yield _Note(note)
         yield _Pair(
             left,
@@ -548,6 +570,39 @@ def _pairs(
             filtered=filtered,
         )
         n += 1
+
+
+def _media_period_ns(camera: Any) -> int | None:
+    """The left video's frame period in ns (its ``CAP_PROP_FPS``), None when unknown."""
+    fps = float(getattr(camera, "delivered_fps", {}).get("left", 0.0) or 0.0)
+    return round(1e9 / fps) if math.isfinite(fps) and fps > 0 else None
+
+
+def _media_stall_note(camera: Any, fr: StereoFrame) -> str:
+    """The warning, once, of a video whose media time (``CAP_PROP_POS_MSEC``) did not move on."""
+    name = _describe_source(getattr(camera, "sources", {}).get("left", "?"))
+    step = (
+        "stamped by the frame index and the video's frame rate"
+        if _media_period_ns(camera) is not None
+        else "stamped by the wall clock of their read (the video reports no frame rate)"
+    )
+    pos = f"{fr.pos_left_ms:.0f} ms" if math.isfinite(fr.pos_left_ms) else "none"
+    return (
+        f"left source {name}: its media time did not move on at pair {fr.index + 1} "
+        f"(position {pos}; the container or backend reports a stalled or repeated one): this "
+        f"pair and the next are {step}"
+    )
+
+
+def _stepped_stamp(
+    camera: Any, fr: StereoFrame, since: tuple[int, int], last_ns: int | None, wall_ns: int
+) -> int:
+    """The stamp of pair ``fr`` of a video whose media time stalled: ``since``'s stamp plus a
+    frame period for each frame read after its index, or without a known rate the wall clock
+    ``wall_ns``; after ``last_ns`` in either case (the stamps strictly increase)."""
+    period = _media_period_ns(camera)
+    stamp = wall_ns if period is None else since[0] + (fr.index - since[1]) * period
+    return stamp if last_ns is None or stamp > last_ns else last_ns + 1
 
 
 def _noise_frame(fr: StereoFrame) -> np.ndarray:
