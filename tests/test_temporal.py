@@ -734,3 +734,45 @@ def test_a_one_percent_change_of_light_is_relit() -> None:
         out, _ = tf(frame.astype(np.uint8), frame.astype(np.uint8))
     assert (tf.restarts, tf.relit) == (0, 2)
     assert np.abs(out.astype(float) - base * 1.01).mean() < 2.0
+
+
+def test_a_reset_filter_behaves_as_a_new_one(data_dir: Path) -> None:
+    """reset() forgot the means only: the noise median of the frames before, `frames`,
+    `restarts`, `relit` and `sigma` carried over, so a reset filter fed a quiet scene after a
+    noisy one restarted, relit and averaged otherwise than a new filter. After a reset every
+    output and counter equals a new filter's on the same frames."""
+    sc = load_scene(data_dir / VENUS)
+    rng = np.random.default_rng(11)
+    h, w = sc.left.shape[:2]
+
+    def frames(sigma: float) -> list[tuple[np.ndarray, np.ndarray]]:
+        out = []
+        for k in range(6):  # a flickering light, then a drift of 1 px a frame
+            gain = 1.0 + 0.04 * np.sin(2.1 * k)
+            shift = np.float32([[1, 0, -max(0, k - 3)], [0, 1, 0]])
+            pair = []
+            for img in (sc.left, sc.right):
+                lit = np.clip(img * gain, 0, 255).astype(np.uint8)
+                moved = cv2.warpAffine(lit, shift, (w, h), borderMode=cv2.BORDER_REPLICATE)
+                pair.append(noisy(moved, sigma, rng) if sigma else moved)
+            out.append((pair[0], pair[1]))
+        return out
+
+    used = TemporalFilter(max_frames=4, k=2.5)
+    for pair in frames(12.0):
+        used(*pair)
+    assert used.frames == 6 and used.restarts > 0 and used.relit > 0 and used.sigma > 5
+    used.reset()
+    fresh = TemporalFilter(max_frames=4, k=2.5)
+    counters = ("frames", "restarts", "relit", "sigma")
+    assert [getattr(used, c) for c in counters] == [getattr(fresh, c) for c in counters]
+    assert used.mean_frames() == 0.0
+    for pair in frames(2.0):
+        a, b = used(*pair), fresh(*pair)
+        assert all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
+        assert [getattr(used, c) for c in counters] == [getattr(fresh, c) for c in counters]
+        assert used.mean_frames() == fresh.mean_frames()
+    # the noise estimates and the means themselves too
+    assert list(used._sigmas) == list(fresh._sigmas)
+    for m, n in zip(used._means, fresh._means, strict=True):
+        assert np.array_equal(m.mean, n.mean) and np.array_equal(m.count, n.count)

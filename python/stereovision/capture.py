@@ -2433,7 +2433,7 @@ def capture(
         last_index = frame.index
         index += 1
         if tf is not None:
-            tf.reset()  # the next pair from frames of its own
+            tf._forget_means()  # the next pair from frames of its own, the same rig's noise
         if log is not None:
             line = f"saved {paths[0].name} {paths[1].name} (skew {frame.skew_ms:.2f} ms)"
             if averaged is not None:

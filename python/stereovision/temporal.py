@@ -239,7 +239,18 @@ class TemporalFilter:
             raise ValueError(f"k: expected a positive number of sigmas, got {self.k!r}")
 
     def reset(self) -> None:
-        """Forget the means (the next pair starts them again)."""
+        """Start afresh: the filter behaves as a new one of the same ``max_frames`` and ``k``
+        (means, noise estimates and counters all forgotten)."""
+        # it forgot the means only: the noise median of the frames before (another scene,
+        # another gain) and the counters carried over into what followed
+        self._forget_means()
+        self._sigmas = deque(maxlen=self._sigmas.maxlen)
+        self.frames = self.restarts = self.relit = 0
+        self.sigma = 0.0
+
+    def _forget_means(self) -> None:
+        """Forget the means only (capture's next pair of the same still rig: its noise
+        estimate and counters go on)."""
         self._means = []
 
     def mean_frames(self) -> float:
