@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -709,6 +710,34 @@ def test_demo_keeps_a_file_it_did_not_write(
     captured = capsys.readouterr()
     assert captured.out == ""  # before any work
     assert captured.err == _not_ours(other, "cloud.ply")
+
+
+def test_demo_keeps_no_copy_of_a_file_holding_the_bytes_it_writes(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A file demo did not list but that holds the very bytes it writes (the outputs of a demo
+    before the manifest) was still copied aside as NAME.previous.EXT and said so: the rule is a
+    copy unless the bytes are equal. One that differs in its line endings alone (LF -> CRLF) is
+    another file: kept byte for byte, said."""
+    first = tmp_path / "first"
+    assert main(["demo", "--method", "fast", "-o", str(first)]) == 0
+    out = tmp_path / "d"
+    out.mkdir()
+    shutil.copy(first / "disparity.png", out / "disparity.png")
+    crlf = (first / "disparity.pfm").read_bytes().replace(b"\n", b"\r\n")
+    (out / "disparity.pfm").write_bytes(crlf)
+    capsys.readouterr()
+    assert main(["demo", "--method", "fast", "-o", str(out)]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    kept = out / "disparity.previous.pfm"
+    assert lines[-1] == (
+        f"  the disparity.pfm that was there (no earlier run's output) is kept as {kept}"
+    )
+    assert not any("disparity.png that was there" in line for line in lines)
+    assert sorted(p.name for p in out.glob("*.previous*")) == ["disparity.previous.pfm"]
+    assert kept.read_bytes() == crlf
+    for name in ("disparity.png", "disparity.pfm"):
+        assert (out / name).read_bytes() == (first / name).read_bytes()
 
 
 def test_demo_interrupted_midway_leaves_the_earlier_outputs_whole(

@@ -1357,9 +1357,6 @@ def cmd_demo(args: argparse.Namespace) -> int:
     if any(not p.is_file() or p.is_symlink() for p in foreign):
         refuse_foreign_outputs(out_dir, names)  # a folder or link under an output name
     refuse_folders_under(out_dir, names)  # a listed one made a folder: not once all is staged
-    from stereovision.io import keep_previous
-
-    kept_aside = [(p.name, keep_previous(p)) for p in foreign]
     scene_dir = _demo_scene_dir()
     scene = load_scene(scene_dir)
     if scene.gt is None:
@@ -1378,6 +1375,7 @@ def cmd_demo(args: argparse.Namespace) -> int:
         staged = write_depth_outputs(res, stage)
         staged.update(render_outputs(res, stage))
         staged.update(write_overview(res, stage, "cones (Middlebury 2003, the demo scene)"))
+        kept_aside = _keep_foreign_aside(foreign, staged)
         written, removed = commit_outputs(out_dir, staged, earlier)
     raw = dense_metrics(res.disparity, scene.gt)
     from stereovision.baselines import opencv_sgbm, row_fill
@@ -1422,6 +1420,30 @@ def cmd_demo(args: argparse.Namespace) -> int:
     for name, kept in kept_aside:
         print(f"  the {name} that was there (no earlier run's output) is kept as {kept}")
     return 0
+
+
+def _keep_foreign_aside(foreign: Sequence[Path], staged: dict[str, Path]) -> list[tuple[str, Path]]:
+    """Copy aside (``NAME.previous.EXT``) each file of ``foreign`` that its staged output
+    (``staged``, name -> new file) would replace with other bytes: a file holding the very
+    bytes this run writes (the outputs of a demo before the manifest) loses nothing. Only the
+    bytes count: one that differs in line endings alone (CRLF) is another file, kept.
+
+    Returns
+    -------
+    list of (str, pathlib.Path)
+        Each copied file's name and its copy.
+    """
+    from stereovision.io import _same_bytes, keep_previous
+
+    kept = []
+    for p in foreign:
+        new = staged.get(p.name)
+        if new is not None and _same_bytes(p, new):
+            continue
+        copy = keep_previous(p)
+        if copy is not None:
+            kept.append((p.name, copy))
+    return kept
 
 
 def _eval_scene(scene: Any, method: str, with_opencv: bool, runs: int = 1) -> dict[str, Any]:
