@@ -383,6 +383,34 @@ def test_resized_pair_size_error_gives_cli_advice(
         depth_map(*half, teddy.calib)
 
 
+def test_a_resized_maps_depth_warning_gives_cli_advice(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Triangulation's warning for a map of a resized pair read with the full-size calibration
+    ended "use calib.scaled_to((225, 188))" on the CLI's warning line too, a Python call: the
+    line (cli's warning hook, also the error line's and batch's swap) says it with --calib and
+    files; Python's warning keeps the call."""
+    from stereovision import cli
+    from stereovision.calibration import Calibration
+    from stereovision.triangulation import depth_from_disparity
+
+    calib = Calibration.from_file(cli._demo_scene_dir() / "calib.txt")  # 450x375
+    with pytest.warns(UserWarning, match=r"225x188 px, the calibration's images 450x375") as w:
+        depth_from_disparity(np.full((188, 225), 20.0), calib)
+    (seen,) = w
+    assert "x the true depths; use calib.scaled_to((225, 188)) (a map" in str(seen.message)
+    cli._one_line_warning(seen.message, seen.category, seen.filename, seen.lineno)
+    err = capsys.readouterr().err
+    assert err == (
+        "stereovision: warning: disparity map is 225x188 px, the calibration's images 450x375: "
+        "read with it, a map of the pair resized by 0.5 gives about 2 x the true depths; give "
+        "--calib a calibration scaled to 225x188 images (save it once in Python with "
+        "Calibration.from_file(path).scaled_to((225, 188)).save('rig.yaml')), or resize the "
+        "images back to the calibration's size (a map of the images' top-left 225x188 px is "
+        "read right)\n"
+    )
+
+
 def test_depth_rectification_on_a_pair_too_small_says_only_that(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

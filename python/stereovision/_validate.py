@@ -191,10 +191,20 @@ ADVICE: dict[str, dict[str, str]] = {
         "save it scaled to them once in Python with "
         "Calibration.from_file(path).scaled_to(({w}, {h})).save('rig.yaml') and give rig.yaml",
     },
+    # a disparity map of a resized pair read with the calibration of the full-size images
+    # (triangulation's warning, and the same in Matches.to_points): the depths are off by the
+    # factor; at the command line the calibration is a file and the map a depth run's output
+    "resized_map": {
+        "api": "use calib.scaled_to(({w}, {h}))",
+        "cli": "give --calib a calibration scaled to {w}x{h} images (save it once in Python with "
+        "Calibration.from_file(path).scaled_to(({w}, {h})).save('rig.yaml')), or resize the "
+        "images back to the calibration's size",
+    },
 }
 ADVICE["low_uint16"]["page"] = ADVICE["low_uint16"]["cli"]  # on the page too, a file
 # the page scales a calibration to frames resized by it (fit_to_frames): never said there
 ADVICE["resized"]["page"] = ADVICE["resized"]["cli"]
+ADVICE["resized_map"]["page"] = ADVICE["resized_map"]["cli"]
 LOW_UINT16_ADVICE = ADVICE["low_uint16"]["api"]
 
 

@@ -325,11 +325,14 @@ def _warn_if_resized(shape: tuple[int, ...], calib: Calibration, stacklevel: int
         return
     import warnings
 
+    from stereovision._validate import ADVICE
+
+    # ADVICE's Python words: the CLI's warning line swaps them for its own (advice_for)
     warnings.warn(
         f"disparity map is {w}x{h} px, the calibration's images {cw}x{ch}: read with it, a map "
-        f"of the pair resized by {w / cw:.3g} gives about {cw / w:.3g} x the true depths; use "
-        f"calib.scaled_to(({w}, {h})) (a map of the images' top-left {w}x{h} px is read "
-        "right)",
+        f"of the pair resized by {w / cw:.3g} gives about {cw / w:.3g} x the true depths; "
+        f"{ADVICE['resized_map']['api'].format(w=w, h=h)} (a map of the images' top-left "
+        f"{w}x{h} px is read right)",
         UserWarning,
         stacklevel=stacklevel + 1,
     )
