@@ -2382,3 +2382,51 @@ def test_a_run_killed_without_calib_does_not_own_the_depth_names(
     assert main([*args, "--calib", str(tmp_path / "rig.yaml")]) == 2
     assert "cloud.ply is not listed as an earlier run's output" in capsys.readouterr().err
     assert (out / "seq/0000/cloud.ply").read_bytes() == b"mine"
+
+
+def test_the_summary_of_a_cli_run_says_its_errors_in_the_clis_words(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stereovision batch` logged a pair's error in the CLI's words but recorded it in
+    summary.json in Python's: "calib.scaled_to((225, 188))" for a resized pair, "give a
+    max_disparity below 96" for a pair too narrow for --max-disparity. A CLI run records the
+    flags and files (as depth's error line says them); run_batch keeps Python's words."""
+    from stereovision.batch import _error_line
+    from stereovision.cli import _demo_scene_dir
+
+    cones, root, out = _demo_scene_dir(), tmp_path / "in", tmp_path / "out"
+    (root / "half").mkdir(parents=True)
+    for side in ("left", "right"):
+        img = cv2.imread(str(cones / f"{side}.png"))
+        cv2.imwrite(str(root / "half" / f"{side}.png"), cv2.resize(img, (225, 188)))
+    shutil.copy(cones / "calib.txt", root / "half" / "calib.txt")
+    _tiny(root, data_dir, "narrow/left.png", "narrow/right.png")  # 96 px wide
+    argv = ["batch", str(root), "-o", str(out), "--max-disparity", "200", "--workers", "1"]
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    resized = (
+        "ValueError: calibration is for 450x375 images, got 225x188 (images resized, not "
+        "cropped: resize them back to the calibration's size, or save it scaled to them once "
+        "in Python with Calibration.from_file(path).scaled_to((225, 188)).save('rig.yaml') and "
+        "give rig.yaml)"
+    )
+    narrow = (
+        "ValueError: disparity range 200 is not smaller than the image width 96: it needs "
+        "images at least 201 px wide, or give a --max-disparity below 96"
+    )
+    pairs = _summary(out)["pairs"]
+    assert pairs["half"]["error"] == resized
+    assert pairs["narrow"]["error"] == narrow
+    assert f"failed half: {resized}\n" in err and f"failed narrow: {narrow}\n" in err
+    # the Python API's words where they are raised
+    api = ValueError("... got 225x188 (images resized, not cropped: calib.scaled_to((225, 188)))")
+    assert _error_line(api) == f"ValueError: {api}"
+    assert _error_line(api, "cli").endswith(resized[-40:])
+    with pytest.raises(ValueError, match=r"or give a max_disparity below 96$"):
+        depth_map(
+            *(cv2.imread(str(root / "narrow" / f"{s}.png")) for s in ("left", "right")),
+            max_disparity=200,
+        )
+    left, right = (str(root / "narrow" / f"{s}.png") for s in ("left", "right"))
+    assert main(["depth", left, right, "--max-disparity", "200", "-o", str(tmp_path / "d")]) == 2
+    assert capsys.readouterr().err == f"stereovision: error: {narrow[12:]}\n"

@@ -324,8 +324,8 @@ def test_depth_on_a_pair_too_small_says_only_that(
     assert main(argv) == 2
     assert capsys.readouterr().err == (
         "stereovision: error: image too narrow for stereo matching: 1 px wide, and the automatic "
-        "disparity range (at least 16 px) needs images at least 17 px wide; a max_disparity of "
-        "your own needs images at least 2 px wide\n"
+        "disparity range (at least 16 px) needs images at least 17 px wide; a --max-disparity "
+        "of your own needs images at least 2 px wide\n"  # the option, not Python's keyword
     )
     assert main([*argv, "--max-disparity", "16"]) == 2
     assert capsys.readouterr().err == (

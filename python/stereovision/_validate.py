@@ -200,6 +200,19 @@ ADVICE: dict[str, dict[str, str]] = {
         "Calibration.from_file(path).scaled_to(({w}, {h})).save('rig.yaml')), or resize the "
         "images back to the calibration's size",
     },
+    # depth_map's refusal of a range not below the pair's width (or of a pair too narrow for
+    # the automatic one): the keyword is an option at the command line; the page keeps the
+    # words (its field is no keyword, but no flag either)
+    "range": {
+        "api": "give a max_disparity below {n}",
+        "cli": "give a --max-disparity below {n}",
+        "page": "give a max_disparity below {n}",
+    },
+    "own_range": {
+        "api": "a max_disparity of your own",
+        "cli": "a --max-disparity of your own",
+        "page": "a max_disparity of your own",
+    },
 }
 ADVICE["low_uint16"]["page"] = ADVICE["low_uint16"]["cli"]  # on the page too, a file
 # the page scales a calibration to frames resized by it (fit_to_frames): never said there

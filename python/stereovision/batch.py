@@ -876,8 +876,14 @@ def _remove_partials(out: Path, names: list[str]) -> None:
                 shutil.rmtree(e.path, ignore_errors=True)
 
 
-def _error_line(exc: BaseException) -> str:
+def _error_line(exc: BaseException, words: str = "api") -> str:
+    """``exc`` as a summary line, ``Type: first line``, its advice in ``words`` ("api" as
+    raised, or "cli": :func:`stereovision._validate.advice_for`)."""
     msg = str(exc).splitlines()[0] if str(exc) else ""
+    if words != "api":
+        from stereovision._validate import advice_for
+
+        msg = advice_for(msg, words)
     return f"{type(exc).__name__}: {msg}" if msg else type(exc).__name__
 
 
@@ -1271,6 +1277,7 @@ def run_batch(
     grid: float | None = None,
     log: Callable[[str], None] | None = None,
     progress: bool = True,
+    words: str = "api",
 ) -> BatchResult:
     """Process every pair under ``input_dir`` into ``output_dir`` on Dask (see the module doc).
 
@@ -1311,6 +1318,11 @@ def run_batch(
     progress : bool
         Show a progress bar on a terminal (stderr), else a plain line on stderr every tenth of
         the pairs or every :data:`PROGRESS_SECONDS`.
+    words : {"api", "cli"}
+        Whose words the errors recorded in ``summary.json`` (and given to ``log``) advise in:
+        the Python API's, as raised (``calib.scaled_to((w, h))``, ``max_disparity``), or the
+        command line's (``--calib``, ``--max-disparity``), as ``stereovision batch`` records
+        them.
 
     Returns
     -------
@@ -1337,6 +1349,8 @@ def run_batch(
     """
     if workers is not None and workers <= 0:
         raise ValueError(f"workers: expected a positive number, got {workers}")
+    if words not in ("api", "cli"):
+        raise ValueError(f"words: expected 'api' or 'cli', got {words!r}")
     if grid is not None and not ground:
         raise ValueError("grid: the occupancy grid lies on the floor; it needs ground=True")
     if grid is not None and not (math.isfinite(grid) and 0.01 <= grid <= 10):
@@ -1405,7 +1419,7 @@ def run_batch(
             try:
                 fp = _fingerprint(job)
             except OSError as exc:  # a broken link, an unmounted drive: this pair alone fails
-                unreadable.append((job, _error_line(exc)))
+                unreadable.append((job, _error_line(exc, words)))
                 continue
             entry = summary.pairs.get(job.name)
             if (
@@ -1558,6 +1572,7 @@ def run_batch(
                     processed,
                     failed,
                     previous,
+                    words,
                 )
         except KeyboardInterrupt as exc:
             interrupted = True
@@ -1575,7 +1590,7 @@ def run_batch(
                 run.update(
                     finished=_now(),
                     seconds=round(time.perf_counter() - t0, 3),
-                    error=_error_line(exc),
+                    error=_error_line(exc, words),
                 )
                 unsaved = ""
                 try:
@@ -1717,9 +1732,11 @@ def _run_jobs(
     processed: list[str],
     failed: list[str],
     previous: dict[str, list[str]] | None = None,
+    words: str = "api",
 ) -> None:
     """Run ``todo`` on Dask, recording each pair as it finishes into ``processed`` / ``failed``
-    and the summary; a KeyboardInterrupt is raised on after Dask is stopped."""
+    and the summary (errors in ``words``, :func:`_error_line`); a KeyboardInterrupt is raised
+    on after Dask is stopped."""
     bar = _Progress(len(todo), progress)
     futures: dict[Any, PairJob] = {}
     dask = _Dask()
@@ -1756,7 +1773,10 @@ def _run_jobs(
         def record_failure(job: PairJob, exc: BaseException) -> None:
             entry = summary.pairs[job.name]
             entry.update(
-                status="failed", error=_error_line(exc), finished=_now(), this_run="failed"
+                status="failed",
+                error=_error_line(exc, words),
+                finished=_now(),
+                this_run="failed",
             )
             failed.append(job.name)
             run["failed"] = len(failed)
@@ -1844,8 +1864,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
         from stereovision._validate import advice_for
 
-        # a pair's error in the CLI's words, as the CLI's own error line (summary.json keeps
-        # run_batch's, the Python API's)
+        # the CLI's words, as its own error line (a pair's error already is: words="cli")
         tqdm.write(advice_for(line, "cli"), file=sys.stderr)
 
     # SIGTERM (a service manager, `kill`) stops the run as Ctrl-C does, unless the caller
@@ -1884,6 +1903,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
             ground=args.ground,
             grid=args.grid,
             log=log,
+            words="cli",  # summary.json's errors as the command line's user gives things
         )
     except KeyboardInterrupt as exc:
         terminated = isinstance(exc, Terminated) or isinstance(exc.__cause__, Terminated)

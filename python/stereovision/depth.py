@@ -249,11 +249,12 @@ def _too_narrow(width: int, automatic_range: float, min_disparity: float = 0) ->
         f"image too narrow for stereo matching: {width} px wide, and the automatic "
         f"disparity range {what} needs images at least {need} px wide"
     )
+    # ADVICE's words: the CLI's error line and batch's summary name --max-disparity instead
     if width < 2:
-        return ValueError(f"{text}; a max_disparity of your own needs images at least 2 px wide")
-    return ValueError(
-        f"{text}; give a max_disparity below {_px(width + min_disparity)} to match it"
-    )
+        own = ADVICE["own_range"]["api"]
+        return ValueError(f"{text}; {own} needs images at least 2 px wide")
+    below = ADVICE["range"]["api"].format(n=_px(width + min_disparity))
+    return ValueError(f"{text}; {below} to match it")
 
 
 def _range_too_wide(span: float, width: int, min_disparity: float = 0) -> ValueError:
@@ -265,7 +266,8 @@ def _range_too_wide(span: float, width: int, min_disparity: float = 0) -> ValueE
     )
     if width < 2:
         return ValueError(f"{text} (a range of a pixel or more needs 2 px)")
-    return ValueError(f"{text}, or give a max_disparity below {_px(width + min_disparity)}")
+    below = ADVICE["range"]["api"].format(n=_px(width + min_disparity))  # as _too_narrow's
+    return ValueError(f"{text}, or {below}")
 
 
 def estimate_max_disparity(left: npt.ArrayLike, right: npt.ArrayLike) -> int:
