@@ -3275,6 +3275,81 @@ def test_the_end_of_a_computation_leaves_a_pending_reads_status(monkeypatch):
     asyncio.run(clicks())
 
 
+def test_a_read_that_fails_during_a_computation_is_said_after_it(monkeypatch):
+    """A Capture's read that failed while a pair computed left "census; reading camera 0 and
+    camera 1..." in the status until the computation's end, which then said "ready" and
+    cleared the read's error: the failure was never seen. The reading part goes when the read
+    returns; the read's error stays on the page after the computation ("error")."""
+    import asyncio
+    import threading
+
+    from stereovision import capture
+    from stereovision.gui import app as gui_app
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    read_gate, compute_gate = threading.Event(), threading.Event()
+    reads: list[Any] = []
+    fail: list[str] = []
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            pass
+
+        def read(self):
+            reads.append(self)
+            read_gate.wait(1.0)  # bounded: a broken app cannot hang the test
+            if fail:
+                raise OSError(fail[0])
+            return frame, frame
+
+        def close(self):
+            pass
+
+    real = gui_app.compute_view
+
+    def gated(*args: Any, **kwargs: Any) -> Any:
+        compute_gate.wait(1.0)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    monkeypatch.setattr(gui_app, "compute_view", gated)
+    app = _scene_app("test-read-fails-computing", [bundled_data_dir()], read_timeout=2.0)
+    app.state.cam_left, app.state.cam_right = "0", "1"
+    tasks = _collect_reads(app)
+
+    async def clicks() -> None:
+        app._lock = asyncio.Lock()
+        read_gate.set()
+        app.open_cameras()
+        await tasks[0]
+        read_gate.clear()
+        compute_gate.clear()
+        computing = asyncio.ensure_future(app.recompute())
+        await _until(lambda: app._computing)
+        fail.append("camera 0 delivered no frame in 2 s")
+        app.capture()
+        await _until(lambda: len(reads) == 2)
+        app._set_progress(50, "census")
+        assert app.state.status == "census; reading camera 0 and camera 1..."
+        read_gate.set()
+        await tasks[-1]
+        # the computation goes on: its step alone, the read's error beside it
+        assert app.state.status == "census" and app.state.busy
+        assert app.state.error == "camera 0 delivered no frame in 2 s"
+        compute_gate.set()
+        await computing
+        assert app.state.computations == 1 and not app.state.busy
+        assert app.state.status == "error"
+        assert app.state.error == "camera 0 delivered no frame in 2 s"
+        # the next computation, with nothing failed meanwhile, clears it as before
+        await app.recompute()
+        assert (app.state.status, app.state.error) == ("ready", "")
+        assert app.state.computations == 2
+
+    asyncio.run(clicks())
+
+
 def test_a_wedged_camera_read_leaves_the_page_free(monkeypatch):
     """After an Open, the cameras' first read, and every Capture's, ran in the page's handler:
     a wedged camera froze the page up to --read-timeout. They run in a thread now, the page

@@ -1422,6 +1422,12 @@ class StereoApp:
         #: the list goes back to when another choice fails.
         self._scene = ""
         self._computing = False
+        #: The running computation's step as its status says it ("computing (census)"), without
+        #: the reads under way (:meth:`_status_with_reads`).
+        self._step: str | None = None
+        #: The error of a camera read or open that failed while a pair computed: the
+        #: computation's end keeps it on the page (it said "ready" and cleared it).
+        self._failed_meanwhile: str | None = None
         #: Camera sources whose open (on the page's "Open") has not returned yet, given up or
         #: not: another Open of them is refused (each left one more thread blocked in them).
         self._opening: set[int | str] = set()
@@ -1601,9 +1607,10 @@ class StereoApp:
     def _on_save_dir(self, save_dir: str | None = None, **_: Any) -> None:
         self.state.save_dir_title = self._save_title(save_dir)
 
-    def _fail(self, exc: BaseException, path: Path | None = None) -> None:
+    def _fail(self, exc: BaseException, path: Path | None = None, outlasts: bool = False) -> None:
         """Say ``exc`` on the page (its first line), ``path`` in it as the page shows paths
-        (:func:`short_paths`) when given."""
+        (:func:`short_paths`) when given. With ``outlasts`` (a camera's read or open), an error
+        said while a pair computes stays on the page after the computation's end."""
         msg = first_line(exc)
         if path is not None:
             msg = short_paths(msg, path)
@@ -1613,6 +1620,8 @@ class StereoApp:
             if not self._computing:  # a failed click during a computation leaves its progress
                 self.state.busy = False
                 self.state.status = self._status_with_reads(None) or "error"
+            elif outlasts:
+                self._failed_meanwhile = msg
 
     def _done(self) -> None:
         """A button's action succeeded: an earlier failure's message and "error" status go (they
@@ -1833,7 +1842,7 @@ class StereoApp:
                 return
             if not isinstance(exc, (ValueError, OSError, RuntimeError)):
                 log.exception("gui: reading %s failed", what)
-            self._fail(exc)
+            self._fail(exc, outlasts=True)
             return
         if shows != self._shows or source is not self.source:
             return
@@ -1842,7 +1851,7 @@ class StereoApp:
                 self._use_pair(got)
                 self.state.captures += 1
         except (ValueError, OSError, RuntimeError) as exc:
-            self._fail(exc)
+            self._fail(exc, outlasts=True)
             return
         self._spawn(self.recompute())
 
@@ -1877,8 +1886,12 @@ class StereoApp:
         nothing: "reading ..." stayed on for good over the scene computed meanwhile)."""
         said = [u[1] for u in self._under_way if u[0] is token]
         self._under_way = [u for u in self._under_way if u[0] is not token]
-        if said and not self._computing and self.state.status in said:
-            # a computation says its own on its next step and end (_status_with_reads)
+        if said and self._computing:
+            # its step now, not on its next one: a read that failed on the last step left
+            # "census; reading camera 0..." said until the computation's end
+            with self.state:
+                self.state.status = self._status_with_reads(self._step)
+        elif said and self.state.status in said:
             with self.state:
                 self.state.status = self._status_with_reads(None) or (
                     "ready" if self.view is not None else ""
@@ -2050,7 +2063,8 @@ class StereoApp:
                     f"{what} did not open within {self.read_timeout:g} s (the open did not "
                     "return: a wedged camera or driver, or a stalled stream); unplug and replug "
                     "it, or give gui a longer --read-timeout"
-                )
+                ),
+                outlasts=True,
             )
             return
         except Exception as exc:  # any open error is said on the page (cv2.error too)
@@ -2060,7 +2074,7 @@ class StereoApp:
                 return
             if not isinstance(exc, (ValueError, OSError, RuntimeError)):
                 log.exception("gui: opening %s failed", what)
-            self._fail(exc)
+            self._fail(exc, outlasts=True)
             return
         try:
             if choice != self._choice:  # a newer Open or folder is on show: nobody takes these
@@ -2079,7 +2093,7 @@ class StereoApp:
                     log.exception("gui: reading %s failed", what)
                 if self.source is not None:
                     exc = OSError(f"{first_line(exc)} (the cameras in use are unchanged)")
-                self._fail(exc)
+                self._fail(exc, outlasts=True)
                 return
             if choice != self._choice:
                 source.close()
@@ -2124,7 +2138,7 @@ class StereoApp:
             if self.source is not None:
                 said = first_line(exc)
                 exc = OSError(f"{said} (the cameras in use are unchanged)")
-            self._fail(exc)
+            self._fail(exc, outlasts=True)
             return
         self._shows += 1
         if before[0] is not None:
@@ -2237,7 +2251,8 @@ class StereoApp:
                 st = self.state
                 st.busy = True
                 st.progress = 1
-                st.status = self._status_with_reads(f"computing ({method})")
+                self._step = f"computing ({method})"
+                st.status = self._status_with_reads(self._step)
                 st.max_disp_hint = max_disparity_hint(self.max_disparity, left.shape[1], width)
                 if fresh:  # another pair: its images now, no result of the previous pair
                     if self._page_before is None:
@@ -2279,6 +2294,7 @@ class StereoApp:
                 self._computing = False
                 if gen != self._generation:
                     return  # superseded: the newer request computes (and reports) its own pair
+                self._failed_meanwhile = None  # the computation's error replaces it
                 self._fail(exc)
                 page, self._page_before = self._page_before, None
                 if page is not None:
@@ -2745,6 +2761,7 @@ class StereoApp:
         return folder
 
     def _set_progress(self, pct: int, text: str) -> None:
+        self._step = text
         with self.state:
             self.state.progress = pct
             self.state.status = self._status_with_reads(text)
@@ -2780,8 +2797,12 @@ class StereoApp:
             st.message_3d = self._scene_message()
             st.progress = 100
             st.busy = False
-            st.status = self._status_with_reads(None) or "ready"
-            st.error = ""
+            # a camera's read or open that failed meanwhile is still the page's news, unless
+            # something said since replaced it
+            kept = self._failed_meanwhile if st.error == self._failed_meanwhile else None
+            self._failed_meanwhile = None
+            st.status = self._status_with_reads(None) or ("error" if kept else "ready")
+            st.error = kept or ""
             st.floor_label = st.img_floor = ""  # a new depth map: its floor is not found yet
             st.save_label = ""
             st.computations += 1
