@@ -2181,6 +2181,55 @@ def test_a_saved_cloud_is_offered_in_the_point_cloud_list(tmp_path):
     assert app.state.error == "" and app._cloud is not None
 
 
+def test_clouds_saved_in_the_home_folder_are_offered_to_show_again(tmp_path, monkeypatch):
+    """With a read-only --data folder a Save goes to ~/stereovision-saved (-2, ...), but the
+    3-D panel's point-cloud list offered only the --data folders' files, and "Show" refused
+    the saved cloud ("path outside the allowed folders"): what was just saved could not be
+    looked at again. Those home folders' clouds are offered (an earlier session's too), named
+    as the Save's line names them, and open; a link named like them that leads elsewhere, and
+    other home folders, are not offered nor opened."""
+    import stereovision.io as svio
+    from stereovision.export import write_ply
+    from stereovision.gui import bundled_data_dir
+
+    data, home, outside = tmp_path / "data", tmp_path / "home", tmp_path / "outside"
+    for d in (data, home / "stereovision-saved-3", home / "other", outside):
+        d.mkdir(parents=True)
+    points = np.array([[0.0, 0.0, 1.0], [0.1, 0.0, 1.0], [0.0, 0.1, 1.2]], np.float32)
+    for where in (home / "stereovision-saved-3", home / "other", outside):
+        write_ply(where / "cloud.ply", points)  # an earlier session's, and two elsewhere
+    (home / "stereovision-saved-4").symlink_to(outside, target_is_directory=True)
+    real = svio.cannot_write_in
+    read_only = data.resolve()
+    monkeypatch.setattr(
+        svio,
+        "cannot_write_in",
+        lambda f: "Read-only file system" if Path(f).resolve() == read_only else real(f),
+    )
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.chdir("/")
+    app = _scene_app("test-home-clouds", [bundled_data_dir(), data])
+    earlier = str((home / "stereovision-saved-3" / "cloud.ply").resolve())
+    assert app.state.clouds == [{"title": "~/stereovision-saved-3/cloud.ply", "value": earlier}]
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.save_label.startswith("saved 450×375 to ~/stereovision-saved: ")
+    saved = str((home / "stereovision-saved" / "cloud.ply").resolve())
+    assert app.state.clouds == [
+        {"title": "~/stereovision-saved/cloud.ply", "value": saved},
+        {"title": "~/stereovision-saved-3/cloud.ply", "value": earlier},
+    ]
+    app.state.cloud_path = saved
+    app.open_cloud()
+    assert app.state.error == "" and app._cloud is not None
+    assert app.state.message_3d.startswith("~/stereovision-saved/cloud.ply: ")
+    for elsewhere in (home / "other", home / "stereovision-saved-4", outside):
+        app.state.cloud_path = str(elsewhere / "cloud.ply")
+        app.open_cloud()
+        assert app.state.error.startswith("path outside the allowed folders: "), elsewhere
+
+
 def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkeypatch):
     """Save pressed twice (or again after a new pair came) while the first still wrote: the
     second found none of the files yet, wrote too, and replaced the first's files without a

@@ -1558,13 +1558,61 @@ class StereoApp:
     def _refresh_file_lists(self) -> None:
         f = self.folders
         self.state.scenes = [{"title": f.label(p), "value": str(p)} for p in f.scenes()]
+        home = self._home_saves()
         self.state.clouds = [
             {"title": f.label(p), "value": str(p)} for p in f.files(CLOUD_SUFFIXES)
+        ] + [
+            {"title": display_path(p), "value": str(p)}
+            for p in (home.files(CLOUD_SUFFIXES) if home is not None else [])
         ]
         self.state.images = [
             {"title": f.label(p), "value": str(p)} for p in f.files(IMAGE_SUFFIXES)
         ]
         self.state.pair_folders = [{"title": f.label(p), "value": str(p)} for p in f.folders()]
+
+    def _home_saves(self) -> AllowedFolders | None:
+        """The home folder's ``stereovision-saved``, ``-2``, ... a Save as offered writes into
+        when the first ``--data`` folder cannot be written (:meth:`_fallback_save_folder`), as
+        folders the page may read (their clouds: the point-cloud list offered only the
+        ``--data`` folders', and "Show" refused what was just saved). None when Saves do not
+        go there. A link named so is left out: it may lead anywhere."""
+        if not self._save_roots or not _cannot_make(self._save_roots[0] / SAVE_FOLDER):
+            return None
+        try:
+            home = Path.home()
+            names = os.listdir(home)
+        except (RuntimeError, OSError):  # no home folder known, or none to read
+            return None
+        saves: list[tuple[int, Path]] = []
+        for name in names:
+            m = re.fullmatch(re.escape(FALLBACK_SAVE_FOLDER) + r"(?:-(\d+))?", name, re.ASCII)
+            p = home / name
+            if m and not p.is_symlink() and p.is_dir():
+                saves.append((int(m.group(1) or 1), p))
+        try:
+            return AllowedFolders(p for _, p in sorted(saves)) if saves else None
+        except OSError:  # one removed meanwhile: listed at the next refresh
+            return None
+
+    def _cloud_file(self, typed: str) -> tuple[Path, str]:
+        """The point-cloud file ``typed`` on the page and its name as the page says it: in the
+        ``--data`` folders, or (an absolute path) in the home folder's saves
+        (:meth:`_home_saves`).
+
+        Raises
+        ------
+        ValueError, FileNotFoundError
+            As :meth:`AllowedFolders.resolve` raises them for the ``--data`` folders.
+        """
+        try:
+            path = self.folders.resolve(typed)
+            return path, self.folders.label(path)
+        except ValueError:
+            home = self._home_saves() if Path(typed).expanduser().is_absolute() else None
+            if home is None or not home.contains(typed):
+                raise
+        path = home.resolve(typed)
+        return path, display_path(path)
 
     def _typed_save_folder(self, typed: str) -> Path:
         """The folder a Save goes to for the save field's text (not the offered one).
@@ -2193,7 +2241,7 @@ class StereoApp:
 
         path: Path | None = None
         try:
-            path = self.folders.resolve(self.state.cloud_path or "")
+            path, label = self._cloud_file(self.state.cloud_path or "")
             pts, cols = load_cloud(path)
             cloud, count = shown_cloud(pts, cols)
             del pts, cols  # the drawn subset is a copy: the file's arrays can go
@@ -2202,7 +2250,7 @@ class StereoApp:
             self._fail(exc, path)
             return
         self._cloud = cloud
-        self._cloud_caption = f"{self.folders.label(path)}: {count}"
+        self._cloud_caption = f"{label}: {count}"
         self._show_geometry(cloud, None)
         self._done()
         with self.state:
