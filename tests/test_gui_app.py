@@ -982,6 +982,17 @@ def _capture(app) -> None:
     _run_clicked(app, app.capture)
 
 
+def _play(app) -> None:
+    """The page's image-folder "Play", its first pair read to its end (:func:`_run_clicked`)."""
+    _run_clicked(app, app.open_pair_folder)
+
+
+def _start(app) -> None:
+    """The page's start-up with cameras given (``--left``/``--right``), their first read run to
+    its end (:func:`_run_clicked`)."""
+    _run_clicked(app, app._on_ready)
+
+
 def _queue_spawns(app, tasks: list) -> None:
     """Inside a running loop: a lock of that loop, and the computations the app spawns queued
     in ``tasks`` as futures (to be awaited by the test)."""
@@ -2614,7 +2625,7 @@ def test_an_image_folder_plays_its_pairs_one_per_capture(tmp_path):
     app = _scene_app("test-pair-folder", [data])
     assert str(seq.resolve()) in [i["value"] for i in app.state.pair_folders]
     app.state.pair_folder = str(seq)
-    app.open_pair_folder()
+    _play(app)
     assert app.state.error == "" and app.state.live
     assert app.state.source_label == "folder data/seq: pair 0001 (1 of 2)"
     np.testing.assert_array_equal(app.pair[0], left)
@@ -2625,22 +2636,22 @@ def test_an_image_folder_plays_its_pairs_one_per_capture(tmp_path):
     _capture(app)  # after the last, the first again
     assert app.state.source_label == "folder data/seq: pair 0001 (1 of 2)"
     app.state.pair_folder = str(rig)
-    app.open_pair_folder()
+    _play(app)
     assert app.state.source_label.startswith("folder data/rig: pair ")
     assert app.state.source_label.endswith(" (1 of 1)")
     np.testing.assert_array_equal(app.pair[1], right)
     app.state.pair_folder = str(data / "scenes")
-    app.open_pair_folder()
+    _play(app)
     assert app.state.error == "" and app.calib is not None  # the scene's calib.txt
     for bad in ("empty", "escape"):
         app.state.pair_folder = str(data / bad)
-        app.open_pair_folder()
+        _play(app)
         assert app.state.error == (
             f"no image pairs in data/{bad} (left_0001.png + right_0001.png, left/ + right/ "
             "folders, or scene folders with left.png + right.png)"
         ), bad
     app.state.pair_folder = str(seq / "left_0001.png")
-    app.open_pair_folder()
+    _play(app)
     assert app.state.error == "not a folder: data/seq/left_0001.png"
     assert app.state.source_label.startswith("folder data/scenes: pair ")  # still in use
 
@@ -2662,7 +2673,7 @@ def test_a_capture_of_a_folder_pair_of_two_sizes_is_said_and_keeps_the_pair(tmp_
     spawned: list = []
     app._spawn = spawned.append
     app.state.pair_folder = str(seq)
-    app.open_pair_folder()
+    _play(app)
     assert app.state.error == "" and len(spawned) == 1
     shown = app.pair
     _capture(app)
@@ -3202,14 +3213,15 @@ def test_a_scene_chosen_while_cameras_open_stays_on_show(monkeypatch):
 
 
 def _collect_reads(app: Any) -> list[Any]:
-    """Run the page's spawned camera opens and Capture reads as tasks of the test's loop
-    (returned, to await); other spawned work (a pair's computation) is closed unrun."""
+    """Run the page's spawned camera opens and reads (Capture, start-up, Play) as tasks of the
+    test's loop (returned, to await); other spawned work (a pair's computation) is closed
+    unrun."""
     import asyncio
 
     tasks: list[Any] = []
 
     def spawn(coro: Any) -> None:
-        if coro.__qualname__.endswith(("._open", "._capture")):
+        if coro.__qualname__.endswith(("._open", "._capture", "._first_pair")):
             tasks.append(asyncio.ensure_future(coro))
         else:
             coro.close()
@@ -3395,6 +3407,86 @@ def test_a_read_that_fails_during_a_computation_is_said_after_it(monkeypatch):
         await app.recompute()
         assert (app.state.status, app.state.error) == ("ready", "")
         assert app.state.computations == 2
+
+    asyncio.run(clicks())
+
+
+def test_start_up_cameras_and_play_read_their_first_pair_off_the_page(tmp_path, monkeypatch):
+    """The first pair of cameras given at start-up (--left/--right), and of an image folder's
+    "Play", were read in the page's handler: a camera that hung (or a folder on a stalled
+    share) froze the page. They are read in a thread as a Capture's, the page saying
+    "reading ..." meanwhile; the pair, or the read's error, comes after."""
+    import asyncio
+    import threading
+    import time
+
+    import stereovision.io as svio
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    gate, inside = threading.Event(), threading.Event()
+    fail: list[str] = []
+
+    class Cameras:
+        def read(self):
+            inside.set()
+            gate.wait(1.0)  # a wedged read (bounded: a broken app cannot hang the test)
+            if fail:
+                raise OSError(fail[0])
+            return frame.copy(), frame.copy()
+
+        def close(self):
+            pass
+
+    seq = tmp_path / "seq"
+    seq.mkdir()
+    for side in ("left", "right"):
+        cv2.imwrite(str(seq / f"{side}_0001.png"), frame)
+    real = svio.imread
+
+    def held(*args: Any, **kwargs: Any) -> Any:
+        inside.set()
+        gate.wait(1.0)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(svio, "imread", held)
+
+    def started(name: str) -> Any:
+        app = _scene_app(
+            name, [bundled_data_dir(), tmp_path], source=Cameras(), source_names=("0", "1")
+        )
+        return app, _collect_reads(app)
+
+    async def clicks() -> None:
+        app, tasks = started("test-start-up-read")
+        for step in ("start-up", "play"):
+            gate.clear()
+            inside.clear()
+            t0 = time.perf_counter()
+            if step == "start-up":
+                app._on_ready()
+                said = "reading camera 0 and camera 1..."
+            else:
+                app.state.pair_folder = str(seq)
+                app.open_pair_folder()
+                said = f"reading folder {tmp_path.name}/seq..."
+            assert time.perf_counter() - t0 < 0.2, step  # the handler returned at once
+            assert app.state.status == said and app.state.error == "", step
+            await _until(inside.is_set)
+            gate.set()
+            await tasks[-1]
+            assert app.state.error == "" and app.pair is not None, step
+        assert app.state.source_label == f"folder {tmp_path.name}/seq: pair 0001 (1 of 1)"
+
+        fail.append("camera 0 delivered no frame in 5 s")
+        app, tasks = started("test-start-up-read-fails")
+        gate.clear()
+        app._on_ready()
+        assert app.state.status == "reading camera 0 and camera 1..."
+        gate.set()
+        await tasks[0]
+        assert app.state.error == "camera 0 delivered no frame in 5 s"
+        assert app.state.status == "error" and app.pair is None and app._reading == []
 
     asyncio.run(clicks())
 
@@ -3753,7 +3845,7 @@ def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
     app._on_ready()  # the demo scene, with its own calibration
     assert app.state.error == "" and app.calib.image_size == (450, 375)
     app.state.pair_folder = str(data / "big")
-    app.open_pair_folder()
+    _play(app)
     assert app.state.error == ""
     assert app.calib.image_size == (640, 480) and app.calib.unit == "mm"
     assert app.calib.baseline_m == pytest.approx(np.linalg.norm([120.0, 1.5, 0.8]) / 1000)
@@ -3765,7 +3857,7 @@ def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
     assert app.state.error == said
     assert app.pair[0].shape == (480, 640, 3)  # the pair on show stays
     app.state.pair_folder = str(data / "small")
-    app.open_pair_folder()
+    _play(app)
     assert app.state.error == f"{said} (the cameras in use are unchanged)"
     assert app.state.source_label.endswith("data/big: pair 0001 (1 of 2)")
     app.state.left_file = str(data / "big" / "left_0002.png")
@@ -3786,7 +3878,7 @@ def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
     seq = ["--left", str(data / "seq" / "left%02d.png"), "--right"]
     app = build_app(parser.parse_args([*args, *seq, str(data / "seq" / "right%02d.png")]))
     app._spawn = lambda coro: coro.close()
-    app._on_ready()
+    _start(app)
     assert app.state.error == "" and app.calib.image_size == (640, 480)
 
 
@@ -4237,7 +4329,7 @@ def test_a_capture_after_a_scene_says_so_first(tmp_path):
         cv2.imwrite(str(seq / f"right_{k:04d}.png"), right)
     app = _scene_app("test-capture-after-scene", [bundled_data_dir(), tmp_path])
     app.state.pair_folder = str(seq)
-    app.open_pair_folder()
+    _play(app)
     seq_name = app.folders.label(seq.resolve())
     assert app.state.source_label == f"folder {seq_name}: pair 0001 (1 of 2)"
     demo = str(cones.resolve())
@@ -4308,7 +4400,7 @@ def test_a_capture_after_a_failed_first_read_reads_the_cameras(tmp_path):
         source=Cameras(),
         source_names=("0", "1"),
     )
-    app._on_ready()
+    _start(app)
     assert app.state.error == "camera 0 delivered no frame in 5 s" and app.pair is None
     _capture(app)
     assert app.state.error == "" and len(reads) == 2 and app.state.captures == 1
@@ -4547,7 +4639,7 @@ def test_a_cloud_opened_after_a_failed_start_up_clears_the_error_status(tmp_path
     app = _scene_app(
         "test-cloud-after-failed-start", [bundled_data_dir(), tmp_path], source=NoFrames()
     )
-    app._on_ready()
+    _start(app)
     assert app.state.status == "error" and app.state.error == "camera 0 gave no frame"
     app.state.cloud_path = str(tmp_path / "blob.ply")
     app.open_cloud()
@@ -4742,7 +4834,7 @@ def test_the_average_switch_is_offered_only_for_sources_it_averages(tmp_path):
     app = _scene_app("test-average-offered", [tmp_path])
     assert not app.state.live and not app.state.can_average  # the demo scene
     app.state.pair_folder = str(tmp_path)
-    app.open_pair_folder()
+    _play(app)
     assert app.state.error == "" and app.state.live and not app.state.can_average
     app._switch_source(Cameras(), ("0", "1"))
     assert app.state.error == "" and app.state.can_average

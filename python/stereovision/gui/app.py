@@ -1728,8 +1728,8 @@ class StereoApp:
         self._shows += 1
 
     def _grab(self) -> None:
-        """Read a pair from the open source here and show it (start-up; the page's reads run
-        in a thread: :meth:`_read_in_thread`)."""
+        """Read a pair from the open source here and show it (the page's reads run in a thread:
+        :meth:`_read_in_thread`)."""
         if self.source is None:
             raise OSError("no camera open: give --left/--right or open cameras below")
         self._use_pair(_read_pair(self.source, bool(self.state.average)))
@@ -1802,12 +1802,17 @@ class StereoApp:
 
     def _on_ready(self, **_: Any) -> None:
         self._lock = asyncio.Lock()
+        source = self.source
+        if source is not None:
+            # the first pair read as a Capture's, in a thread (:meth:`_capture`): read here, in
+            # the page's handler, a camera that hung froze the page up to --read-timeout
+            what = self._source_what(source)
+            self._begin_read(source, what)
+            self._spawn(self._capture(source, what, bool(self.state.average), self._shows))
+            return
         try:
-            if self.source is not None:
-                self._grab()
-            else:
-                self._load_scene(self.demo_scene)
-                self._show_demo_in_list()
+            self._load_scene(self.demo_scene)
+            self._show_demo_in_list()
         except (ValueError, OSError, RuntimeError) as exc:
             self._fail(exc)
             return
@@ -2129,31 +2134,44 @@ class StereoApp:
                 source.close()
                 return
             # the first pair read in a thread too: a camera that opens may still not deliver
-            average = bool(self.state.average)
             self._begin_read(source, what)
-            try:
-                got = await self._read_in_thread(source, average)
-            except Exception as exc:
-                source.close()
-                if choice != self._choice:
-                    return
-                if not isinstance(exc, (ValueError, OSError, RuntimeError)):
-                    log.exception("gui: reading %s failed", what)
-                if self.source is not None:
-                    exc = OSError(f"{first_line(exc)} (the cameras in use are unchanged)")
-                self._fail(exc, outlasts=True)
-                return
-            if choice != self._choice:
-                source.close()
-                return
-            with self.state:
-                self._switch_source(source, names, got)
+            await self._first_pair(source, names, what, choice)
         finally:
             self._opening.difference_update(keys)
 
+    async def _first_pair(
+        self, source: StereoSource, names: tuple[str, str], what: str, choice: int
+    ) -> None:
+        """Read the first pair of ``source``, newly opened (cameras, an image folder), in a
+        thread (:meth:`_read_in_thread`; registered by :meth:`_begin_read`), then use it
+        (:meth:`_switch_source`) or say why not. ``source`` is closed unless used; after a
+        newer choice than ``choice`` (``_choice``), nothing is said."""
+        try:
+            got = await self._read_in_thread(source, bool(self.state.average))
+        except Exception as exc:
+            source.close()
+            if choice != self._choice:
+                return
+            if not isinstance(exc, (ValueError, OSError, RuntimeError)):
+                log.exception("gui: reading %s failed", what)
+            if self.source is not None:
+                exc = OSError(f"{first_line(exc)} (the cameras in use are unchanged)")
+            self._fail(exc, outlasts=True)
+            return
+        if choice != self._choice:
+            source.close()
+            return
+        with self.state:
+            self._switch_source(source, names, got)
+
     def open_pair_folder(self) -> None:
         """Play the pairs of the chosen image folder (as ``batch`` pairs them), one per
-        Capture, starting again after the last."""
+        Capture, starting again after the last.
+
+        The first pair is read in a thread (:meth:`_first_pair`), the page saying "reading
+        folder ..." meanwhile, as a Capture's: read in the handler, a folder on a stalled
+        disk or network share froze the page.
+        """
         try:
             folder = self.folders.resolve(self.state.pair_folder or "")
             label = self.folders.label(folder)
@@ -2164,13 +2182,15 @@ class StereoApp:
             self._fail(exc)
             return
         self._choice += 1  # an open still under way must not replace these pairs
-        self._switch_source(source, ("", ""))
+        what = self._source_what(source)
+        self._begin_read(source, what)
+        self._spawn(self._first_pair(source, ("", ""), what, self._choice))
 
     def _switch_source(
         self, source: StereoSource, names: tuple[str, str], got: _Frames | None = None
     ) -> None:
-        """Use ``source`` once it gave a pair, ``got`` (None: read here; an image folder's
-        files): else the source in use stays, and says so."""
+        """Use ``source`` once it gave a pair, ``got`` (None: read here; the page reads it in a
+        thread first, :meth:`_first_pair`): else the source in use stays, and says so."""
         before = (self.source, self.homographies, self._source_label, self._source_names)
         self.source = source
         self.homographies = None
