@@ -3407,6 +3407,22 @@ def test_a_read_that_fails_during_a_computation_is_said_after_it(monkeypatch):
         await app.recompute()
         assert (app.state.status, app.state.error) == ("ready", "")
         assert app.state.computations == 2
+        # an Open whose first read fails while a pair computes: the same
+        read_gate.clear()
+        compute_gate.clear()
+        computing = asyncio.ensure_future(app.recompute())
+        await _until(lambda: app._computing)
+        app.state.cam_left, app.state.cam_right = "2", "3"
+        app.open_cameras()
+        await _until(lambda: len(reads) == 3)
+        read_gate.set()
+        await tasks[-1]
+        said = "camera 0 delivered no frame in 2 s (the cameras in use are unchanged)"
+        assert (app.state.status, app.state.error) == ("computing (fast)", said)
+        compute_gate.set()
+        await computing
+        assert (app.state.status, app.state.error) == ("error", said)
+        assert app.state.source_label == "cameras 0 / 1"
 
     asyncio.run(clicks())
 
