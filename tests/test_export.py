@@ -1233,3 +1233,30 @@ def test_voxel_downsample_warns_of_a_side_larger_than_the_cloud(result):
         assert len(export.voxel_downsample(pts, voxel=0.5)[0]) < 0.01 * len(pts)
         export.voxel_downsample(pts[:99], voxel=50)
         export.voxel_downsample(np.zeros((5, 3)), voxel=1.0)  # only duplicates merged
+
+
+def test_mutation_audit_4_pcd_edges_and_the_16_bit_limit(tmp_path):
+    """A mutation audit of the exporters found unasserted: a binary PCD one byte short of its
+    records (read by numpy's "buffer is smaller than requested size" when the length check was
+    off by one), an ASCII ``TYPE F`` colour written as the float itself whose value is an
+    integer of 2**32 or more (taken as the integer's bits, it wrapped to black), and a depth
+    that rounds to 65536 mm (kept as fitting 16 bits, it wrapped to 0 without the warning)."""
+    head = "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\n"
+    short = tmp_path / "short.pcd"
+    short.write_bytes(
+        (head + "POINTS 2\nDATA binary\n").encode() + np.arange(6, dtype="<f4").tobytes()[:-1]
+    )
+    with pytest.raises(ValueError, match=r"truncated PCD file .*: expected 2 points$"):
+        export.read_pcd(short)
+    # 0x4F800000 (alpha 0x4F, red 0x80) is the float 2**32: an integer, but not the bits
+    big = tmp_path / "big.pcd"
+    big.write_text(
+        "VERSION 0.7\nFIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\n"
+        "WIDTH 2\nHEIGHT 1\nPOINTS 2\nDATA ascii\n1 2 3 4294967296\n4 5 6 4.2949673e+09\n"
+    )
+    pts, cols = export.read_pcd(big)
+    assert pts.tolist() == [[[1, 2, 3], [4, 5, 6]]]
+    assert cols.tolist() == [[[128, 0, 0], [128, 0, 0]]]
+    with pytest.warns(UserWarning, match="none of its 1 values fits 1..65535 at scale 1000"):
+        png = export.encode_depth_png(np.array([[65.5355]]))  # 65535.5 mm rounds to 65536
+    assert cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_UNCHANGED).tolist() == [[0]]
