@@ -1526,3 +1526,39 @@ def test_scan_json_precision_range_min_edge_beam_cap_and_a_far_negative_range() 
         laser_scan(pts, plane, angle_min=0.0, angle_max=1.0, angle_increment=1e-5)
     with pytest.raises(ValueError, match="max_range: expected a positive distance"):
         obstacle_mask(pts.reshape(1, 3, 3), plane, max_range=-(10**400))
+
+
+def test_mutation_audit_boundaries_of_the_band_the_range_and_the_tolerance() -> None:
+    """A mutation audit of ground.py found its boundaries unasserted: a point exactly
+    ``min_height`` above the floor is floor in obstacle_mask, occupancy_grid and laser_scan
+    alike (``h >= min_height`` in one of them made it an obstacle there only), one exactly
+    ``max_height`` up is no obstacle, an obstacle exactly ``range_max`` away is in the scan
+    (``dist < range_max`` dropped it), and support() counts a pixel exactly ``inlier_px`` off
+    the plane as off it, as the fit does (``<=`` counted it on)."""
+    from stereovision.ground import occupancy_grid
+
+    plane, _ = _level_floor()
+    # heights 0.25 and 2.0 are exact: the camera frame's Y is 0.75 and -1.0
+    at_lo = _camera_points([(2.2, 0.2, 0.25)] * 3)
+    at_hi = _camera_points([(3.2, 0.2, 2.0)] * 3)
+    image = np.concatenate([at_lo, at_hi]).reshape(2, 3, 3)
+    band = {"min_height": 0.25, "max_height": 2.0}
+    assert obstacle_mask(image, plane, **band).tolist() == [[False] * 3] * 2
+    grid = occupancy_grid(
+        image, plane, resolution=0.5, forward=(0.0, 4.0), lateral=(-1.0, 1.0), **band
+    )
+    assert grid.data[grid.cell_of(2.2, 0.2)] == 0  # free: floor points, no obstacle
+    assert grid.data[grid.cell_of(3.2, 0.2)] == -1  # above the band: neither
+    assert (grid.data == 100).sum() == 0
+    scan_kw = {"angle_min": -0.5, "angle_max": 0.5, "angle_increment": 0.5}
+    scan = laser_scan(at_lo, plane, **scan_kw, **band)
+    np.testing.assert_array_equal(scan.ranges, np.float32([np.nan, np.inf, np.nan]))
+    far = _camera_points([(5.0, 0.0, 0.5)])  # exactly 5 m out along beam 0 rad
+    scan = laser_scan(far, plane, **scan_kw, range_max=5.0, min_points=1)
+    np.testing.assert_array_equal(scan.ranges, np.float32([np.nan, 5.0, np.nan]))
+    small = RIG.scaled_to((48, 36))
+    flat = replace(plane, disparity_plane=(0.0, 0.0, 10.0), inliers=np.zeros((36, 48), bool))
+    disp = np.full((36, 48), 10.0)
+    disp[:12] = 11.0  # exactly 1 px off: off the plane
+    disp[12:18] = 9.5
+    assert flat.support(disp, small, inlier_px=1.0) == pytest.approx(2 / 3)
