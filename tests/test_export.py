@@ -1260,3 +1260,58 @@ def test_mutation_audit_4_pcd_edges_and_the_16_bit_limit(tmp_path):
     with pytest.warns(UserWarning, match="none of its 1 values fits 1..65535 at scale 1000"):
         png = export.encode_depth_png(np.array([[65.5355]]))  # 65535.5 mm rounds to 65536
     assert cv2.imdecode(np.frombuffer(png, np.uint8), cv2.IMREAD_UNCHANGED).tolist() == [[0]]
+
+
+@pytest.mark.parametrize("writer", ["ply", "mesh", "pcd", "npz", "depth16", "disp16"])
+def test_a_disk_full_half_way_keeps_the_previous_file(result, tmp_path, writer):
+    """Every writer replaces its file atomically: when the disk fills half-way (here a file
+    size limit of half the file, so the write itself fails with EFBIG), the previous file is
+    left byte for byte and no temporary file stays. A mutation audit found write_npz and the
+    16-bit PNG writers' atomicity unasserted (opening the file itself, they emptied the
+    previous one)."""
+    import signal
+
+    resource = pytest.importorskip("resource")  # POSIX: file size limits
+    mesh = _grid_mesh(400) if writer == "mesh" else None
+    writers = {
+        "ply": lambda p: export.write_cloud_ply(p, result),
+        "mesh": lambda p: export.write_mesh_ply(p, mesh),
+        "pcd": lambda p: export.write_pcd(p, result),
+        "npz": lambda p: export.write_npz(p, result),
+        "depth16": lambda p: export.write_depth_png(p, result),
+        "disp16": lambda p: export.write_disparity_png(p, result),
+    }
+    path = tmp_path / ("out.png" if writer.endswith("16") else "out.bin")
+    writers[writer](path)
+    before = path.read_bytes()
+    path.write_bytes(before[::-1])  # a previous file that the new one would differ from
+    previous = path.read_bytes()
+    old_limit = resource.getrlimit(resource.RLIMIT_FSIZE)
+    old_handler = signal.signal(signal.SIGXFSZ, signal.SIG_IGN)  # EFBIG, not a killed process
+    try:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (len(before) // 2, old_limit[1]))
+        with pytest.raises(OSError, match="File too large"):
+            writers[writer](path)
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, old_limit)
+        signal.signal(signal.SIGXFSZ, old_handler)
+    assert path.read_bytes() == previous
+    assert [p.name for p in tmp_path.iterdir()] == [path.name]
+    writers[writer](path)  # and a write that fits replaces it
+    assert path.read_bytes() == before
+
+
+def test_the_voxel_warning_starts_at_the_clouds_extent():
+    """The warning is for a cube side past the cloud's 1-99 % extent (0.98 for points spread
+    over a unit cube), not only for one past twice it (a mutation audit found the threshold
+    unasserted between the two): 1.5 warns, 0.9 does not."""
+    import warnings
+
+    pts = np.random.default_rng(0).random((1000, 3))
+    with pytest.warns(UserWarning, match=r"a cube side of 1\.5 is larger than the cloud's extent"):
+        out, _ = export.voxel_downsample(pts, voxel=1.5)
+    assert len(out) == 1
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out, _ = export.voxel_downsample(pts, voxel=0.9)
+    assert len(out) == len(np.unique(np.floor(pts / 0.9), axis=0))  # 7 of 2 x 2 x 2 cubes
