@@ -1885,7 +1885,9 @@ def test_outlier_error_is_both_cameras_rms_and_model_gain_and_pairing_use_their_
     n = calmod.MODEL_SELECTION_MIN_VIEWS
     for k3_loo, chosen in ((0.995, "k1k2p1p2"), (0.985, "k1k2p1p2k3")):
         monkeypatch.setattr(
-            calmod, "_loo_rms", lambda o, p, s, f, v=k3_loo: (v if f == k3 else 1.0, K, np.zeros(5))
+            calmod,
+            "_loo_rms",
+            lambda o, p, s, f, v=k3_loo, **_: (v if f == k3 else 1.0, K, np.zeros(5)),
         )
         with warnings.catch_warnings():  # k3's fit of these 6 views folds: said, not asserted
             warnings.simplefilter("ignore", UserWarning)
@@ -2036,7 +2038,7 @@ def test_outlier_floor_both_cameras_in_model_selection_and_a_worse_refinement_re
     K = np.array([[530.0, 0, 320], [0, 530, 240], [0, 0, 1]])
     calls: list[int] = []
 
-    def loo(obj: Any, pts: Any, size: Any, flags: int) -> Any:
+    def loo(obj: Any, pts: Any, size: Any, flags: int, **_: Any) -> Any:
         calls.append(flags)  # left then right, for each candidate
         right_k3 = flags == k3 and calls.count(k3) == 2
         return (0.9 if right_k3 else 1.0), K, np.zeros(5)

@@ -567,3 +567,71 @@ def test_the_result_helpers_name_what_to_pass_instead() -> None:
         sv.obstacle_mask(res.points, plane)
     with pytest.raises(TypeError, match=r"disparity: got a DepthResult; .*result\.disparity"):
         calib.reproject(res)
+
+
+def _chessboard_pairs(n: int) -> tuple[list[Path], list[Path]]:
+    from tests.conftest import DATA_DIR
+
+    folder = DATA_DIR / "chessboard"
+    if not folder.is_dir():
+        pytest.skip(f"chessboard data not found at {folder}")
+    ids = ("01", "02", "03", "04", "05", "06", "07", "08", "09", "11", "12", "13", "14")[:n]
+    return [folder / f"left{i}.jpg" for i in ids], [folder / f"right{i}.jpg" for i in ids]
+
+
+def test_calibrate_reports_its_progress() -> None:
+    """calibrate said nothing until it was done (30 StereoPi pairs: 22 s, 14 s of them finding
+    the boards and 8 s choosing the distortion model); its ``progress`` callback now hears each
+    pair's board search, then each leave-one-out fit, and the result is the same."""
+    from stereovision.calibrate import PROGRESS_BOARDS, PROGRESS_MODELS, calibrate
+
+    lefts, rights = _chessboard_pairs(6)  # 6: the fewest views the model is chosen over
+    calls: list[tuple[str, int, int]] = []
+    cal, _ = calibrate(lefts, rights, square_size=1.0, progress=lambda *a: calls.append(a))
+    boards = [(PROGRESS_BOARDS, i, 6) for i in range(1, 7)]
+    # two candidate models, each left out view by view, for each camera
+    fits = [(PROGRESS_MODELS, i, 24) for i in range(1, 25)]
+    assert calls == boards + fits
+    plain, _ = calibrate(lefts, rights, square_size=1.0)
+    np.testing.assert_array_equal(cal.K1, plain.K1)
+    np.testing.assert_array_equal(cal.T, plain.T)
+
+
+class _Terminal:
+    """A stderr that says it is a terminal, keeping what is written to it."""
+
+    def __init__(self) -> None:
+        self.text = ""
+
+    def write(self, s: str) -> int:
+        self.text += s
+        return len(s)
+
+    def flush(self) -> None:
+        pass
+
+    def isatty(self) -> bool:
+        return True
+
+
+def test_calibrate_draws_progress_bars_on_a_terminal_only(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stereovision calibrate` on a terminal shows a bar while it finds the boards and one
+    while it chooses the distortion model, and leaves neither on screen; in a log (stderr not a
+    terminal) it writes no bar, only its summary lines."""
+    lefts, rights = _chessboard_pairs(6)
+    args = ["calibrate", "--left", *map(str, lefts), "--right", *map(str, rights)]
+    args += ["--square", "1", "-o", str(tmp_path / "rig.yaml")]
+    terminal = _Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    assert main(args) == 0
+    assert "boards:   0%" in terminal.text and "/6 [" in terminal.text
+    assert "distortion models:   0%" in terminal.text and "/24 [" in terminal.text
+    assert terminal.text.rsplit("\r", 2)[-2].strip() == ""  # the bars cleared from the screen
+    assert "6/6 pairs used" in capsys.readouterr().out
+    monkeypatch.undo()
+    assert main([*args[:-1], str(tmp_path / "rig2.yaml")]) == 0
+    logged = capsys.readouterr()
+    assert "boards" not in logged.err and "%" not in logged.err
+    assert "6/6 pairs used" in logged.out

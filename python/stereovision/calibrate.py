@@ -46,8 +46,9 @@ import json
 import math
 import os
 import re
+import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -165,6 +166,12 @@ OUTLIER_FACTOR = 3.0
 OUTLIER_MIN_PX = 0.5
 #: The fewest pairs a stereo calibration is attempted with (intrinsics need several views).
 MIN_PAIRS = 3
+
+#: The stages :func:`calibrate` reports to its ``progress`` callback: the board search in each
+#: pair, then the leave-one-out fits that choose the distortion model.
+PROGRESS_BOARDS = "boards"
+PROGRESS_MODELS = "distortion models"
+
 #: Fewest ChArUco corners seen by both cameras for a pair to be used (see charuco.MIN_CORNERS).
 CHARUCO_MIN_COMMON = 6
 #: Outlier rejection rounds at most (each round re-solves once).
@@ -814,9 +821,15 @@ class _Solution:
 
 
 def _loo_rms(
-    obj: Sequence[np.ndarray], pts: Sequence[np.ndarray], size: tuple[int, int], flags: int
+    obj: Sequence[np.ndarray],
+    pts: Sequence[np.ndarray],
+    size: tuple[int, int],
+    flags: int,
+    *,
+    step: Callable[[], None] | None = None,
 ) -> tuple[float, F64, F64]:
-    """Leave-one-view-out RMS of a camera model; also the fit on all views (K, D)."""
+    """Leave-one-view-out RMS of a camera model; also the fit on all views (K, D). ``step`` is
+    called after each view left out (a progress bar's tick)."""
     fit: Any = cv2.calibrateCamera(
         obj, pts, size, None, None, flags=flags, criteria=SOLVER_CRITERIA
     )
@@ -834,6 +847,8 @@ def _loo_rms(
             flags=flags | cv2.CALIB_USE_INTRINSIC_GUESS,
             criteria=SOLVER_CRITERIA,
         )
+        if step is not None:
+            step()
         ok, rvec, tvec = cv2.solvePnP(obj[i], pts[i], Ki, Di, flags=cv2.SOLVEPNP_IPPE)
         if not ok:
             return math.inf, K, D
@@ -1027,6 +1042,7 @@ def _solve(
     size: tuple[int, int],
     distortion: str,
     refine: bool,
+    progress: Callable[[str, int, int], None] | None = None,
 ) -> _Solution:
     if distortion == "fisheye":
         return _solve_fisheye(obj, left, right, size, refine)
@@ -1041,10 +1057,19 @@ def _solve(
         model = candidates[0]
     else:
         best_model, best_loo = "", math.inf
+        # each candidate is fitted once per view left out, per camera: n^2 solver work that
+        # took 8 of the 22 s of 30 pairs, said on a progress bar as the corner search is
+        fits = [0, 2 * len(candidates) * len(obj)]
+
+        def step() -> None:
+            fits[0] += 1
+            if progress is not None:
+                progress(PROGRESS_MODELS, fits[0], fits[1])
+
         for name in candidates:
             flags = DISTORTION_MODELS[name]
-            loo_l, K1, D1 = _loo_rms(obj, left, size, flags)
-            loo_r, K2, D2 = _loo_rms(obj, right, size, flags)
+            loo_l, K1, D1 = _loo_rms(obj, left, size, flags, step=step)
+            loo_r, K2, D2 = _loo_rms(obj, right, size, flags, step=step)
             loo = math.sqrt((loo_l**2 + loo_r**2) / 2)
             selection[name] = loo
             sane = _radial_is_monotonic(K1, D1, size) and _radial_is_monotonic(K2, D2, size)
@@ -1286,6 +1311,7 @@ def calibrate(
     refine: bool = True,
     drop_outliers: bool = False,
     names: Sequence[str] | None = None,
+    progress: Callable[[str, int, int], None] | None = None,
 ) -> tuple[Calibration, CalibrationReport]:
     """Calibrate a stereo rig from chessboard or ChArUco pairs.
 
@@ -1317,6 +1343,12 @@ def calibrate(
         :data:`OUTLIER_MIN_PX`) and solve again; otherwise they are only reported.
     names : sequence of str, optional
         Pair names for the report (default: the file names, or ``pair_NN`` for arrays).
+    progress : callable, optional
+        Called as ``progress(stage, done, total)`` while the work goes on (``stereovision
+        calibrate`` draws its progress bars with it): stage :data:`PROGRESS_BOARDS` after each
+        pair's board search (``total`` pairs), :data:`PROGRESS_MODELS` after each leave-one-out
+        fit while ``distortion="auto"`` chooses the model (``total`` fits; a second round when
+        ``drop_outliers`` solves again).
 
     Returns
     -------
@@ -1481,6 +1513,8 @@ def calibrate(
         corners_l.append(cl)
         corners_r.append(cr)
         corner_ids.append(ids)
+        if progress is not None:
+            progress(PROGRESS_BOARDS, i + 1, len(lefts))
     assert size is not None
     n_more = max(n_more_cols, n_more_rows)
     if n_more and 2 * n_more >= n_boards:
@@ -1602,7 +1636,7 @@ def calibrate(
         obj = [obj_pts[corner_ids[i]] for i in used]  # type: ignore[index]
         pl = [corners_l[i].astype(np.float32) for i in used]  # type: ignore[union-attr]
         pr = [corners_r[i].astype(np.float32) for i in used]  # type: ignore[union-attr]
-        sol = _solve(obj, pl, pr, size, distortion, refine)
+        sol = _solve(obj, pl, pr, size, distortion, refine, progress)
         pair_err = np.sqrt(np.mean(sol.per_view**2, axis=1))
         limit = max(OUTLIER_FACTOR * float(np.median(pair_err)), OUTLIER_MIN_PX)
         bad = [k for k, e in enumerate(pair_err) if e > limit]
@@ -2610,6 +2644,35 @@ def _cli_words(text: str) -> str:
     return re.sub(r"\bunit='(\w+)'", r"--unit \1", text)
 
 
+class _ProgressBars:
+    """``stereovision calibrate``'s progress bars on a terminal (a tqdm bar per stage of
+    :func:`calibrate`'s ``progress``: the board search, the distortion model's choice); nothing
+    elsewhere, where the summary lines are the log. Thirty 320x240 pairs took 22 s without a
+    word: 14 s finding boards, 8 s choosing the model."""
+
+    def __init__(self) -> None:
+        self.enabled = sys.stderr.isatty()
+        self.bar: Any = None
+        self.stage = ""
+
+    def __call__(self, stage: str, done: int, total: int) -> None:
+        if not self.enabled:
+            return
+        if self.bar is None or stage != self.stage or done < self.bar.n:  # a new stage or round
+            from tqdm import tqdm
+
+            self.close()
+            self.stage = stage
+            unit = "pair" if stage == PROGRESS_BOARDS else "fit"
+            self.bar = tqdm(total=total, desc=stage, unit=unit, file=sys.stderr, leave=False)
+        self.bar.update(done - self.bar.n)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+
+
 def _calibrate_source(
     args: argparse.Namespace,
     video: bool,
@@ -2783,6 +2846,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         "unit": args.unit,
         "distortion": args.distortion,
         "drop_outliers": args.drop_outliers,
+        "progress": (bars := _ProgressBars()),
     }
     caught: list[warnings.WarningMessage] = []
     try:
@@ -2792,6 +2856,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     except ValueError as exc:
         raise ValueError(_cli_words(str(exc))) from None
     finally:  # said in the CLI's words, once each (and also when the calibration failed)
+        bars.close()  # before any line: a bar left on screen would share it
         seen: set[str] = set()
         for w in caught:
             text = _cli_words(str(w.message))
