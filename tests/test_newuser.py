@@ -635,3 +635,30 @@ def test_calibrate_draws_progress_bars_on_a_terminal_only(
     logged = capsys.readouterr()
     assert "boards" not in logged.err and "%" not in logged.err
     assert "6/6 pairs used" in logged.out
+
+
+def test_a_scene_folder_given_as_the_images_names_its_pair(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stereovision depth cones cones -o out` (a scene folder, as eval and batch take it) said
+    only "image file is not a regular file: cones"; it now names the folder's two images, as
+    the Python reader does (left.png + right.png, or Middlebury's im0.png + im1.png), and a
+    folder without one pair keeps the plain words."""
+    from stereovision.io import imread
+
+    assert main(["depth", str(CONES), str(CONES), "-o", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        f"stereovision: error: image file is not a regular file: {CONES} (a folder holding a "
+        f"pair: give its two images, {CONES / 'left.png'} and {CONES / 'right.png'})"
+    )
+    assert not (tmp_path / "out").exists()
+    scene = tmp_path / "scene"
+    scene.mkdir()
+    for name in ("im0.png", "im1.png", "disp0.pfm"):
+        (scene / name).write_bytes(b"")
+    with pytest.raises(ValueError, match=r"give its two images, .*im0\.png and .*im1\.png\)$"):
+        imread(scene)
+    (scene / "im1.png").unlink()
+    with pytest.raises(ValueError, match=r"^image file is not a regular file: .*scene$"):
+        imread(scene)

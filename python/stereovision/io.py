@@ -728,8 +728,30 @@ def _existing_file(path: PathLike, what: str) -> Path:
     if not p.exists():
         raise FileNotFoundError(f"{what} not found: {p}")
     if not p.is_file():
-        raise ValueError(f"{what} is not a regular file: {p}")
+        hint = _pair_in_folder(p) if what == "image file" else ""
+        raise ValueError(f"{what} is not a regular file: {p}{hint}")
     return p
+
+
+def _pair_in_folder(folder: Path) -> str:
+    """What to give instead of a scene folder given as an image (``stereovision depth cones``,
+    as ``eval`` and ``batch`` take it): the folder's left and right images, when it holds one of
+    each (``left.png`` + ``right.png``, Middlebury's ``im0.png`` + ``im1.png``), else ""."""
+    from stereovision.batch import IMAGE_EXTS
+
+    try:
+        images = [f for f in os.listdir(folder) if Path(f).suffix.lower() in IMAGE_EXTS]
+    except OSError:  # not a folder, or not readable: nothing to suggest
+        return ""
+    for left, right in (("left", "right"), ("im0", "im1")):
+        ls = sorted(f for f in images if Path(f).stem.lower() == left)
+        rs = sorted(f for f in images if Path(f).stem.lower() == right)
+        if len(ls) == 1 and len(rs) == 1:
+            return (
+                f" (a folder holding a pair: give its two images, {folder / ls[0]} and "
+                f"{folder / rs[0]})"
+            )
+    return ""
 
 
 # --------------------------------------------------------------------------------------- images
