@@ -662,3 +662,26 @@ def test_a_scene_folder_given_as_the_images_names_its_pair(
     (scene / "im1.png").unlink()
     with pytest.raises(ValueError, match=r"^image file is not a regular file: .*scene$"):
         imread(scene)
+
+
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["capture", "--left", "0", "--right", "1", "-o", "{tmp}/pairs"],
+        ["stream", "--left", "0", "--right", "1", "--no-display"],
+        ["info", "--hfov", "90", "--baseline", "0.1"],
+        ["info", str(CONES / "calib.txt")],
+    ],
+    ids=["capture", "stream", "info-paper", "info-calib"],
+)
+def test_a_bad_size_is_named_by_its_option(
+    command: list[str], tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`--size 640*480` was refused as "size: expected WIDTHxHEIGHT ...", the parameter's
+    name where every other option's message names the option (--hfov, --baseline)."""
+    args = [a.replace("{tmp}", str(tmp_path)) for a in command]
+    assert main([*args, "--size", "640*480"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "stereovision: error: --size: expected WIDTHxHEIGHT with positive integers, got '640*480'"
+    )
+    assert list(tmp_path.iterdir()) == []

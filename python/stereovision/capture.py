@@ -1844,7 +1844,7 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
         If both or neither source kind is given, a bag option comes without ``--from-bag``,
         or ``--left`` and ``--right`` name one camera (``0`` and ``/dev/video0``).
     """
-    size = parse_size(args.size)
+    size = parse_size(args.size, "--size")
     if args.from_bag:
         if args.left is not None or args.right is not None:
             raise ValueError("--from-bag replaces --left and --right: give one source")

@@ -1279,7 +1279,7 @@ def cmd_info(args: argparse.Namespace) -> int:
         from stereovision.calibration import Calibration
         from stereovision.capture import parse_size
 
-        size = parse_size(args.size)
+        size = parse_size(args.size, "--size")
         assert size is not None
         try:  # the rig before its heading: a bad value is the one line said, in the CLI's words
             with warnings.catch_warnings(record=True) as caught:
@@ -1304,7 +1304,10 @@ def cmd_info(args: argparse.Namespace) -> int:
         # --size with a calibration: the image size of one that holds none (stereo_calib
         # output, a Q.dat alone), a check of the size of one that does
         calib = load_calibration(
-            args.calib, args.calib_unit, size=parse_size(args.size), size_words="--size WxH"
+            args.calib,
+            args.calib_unit,
+            size=parse_size(args.size, "--size"),
+            size_words="--size WxH",
         )
         print(calib.describe())
         return 0
