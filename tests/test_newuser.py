@@ -685,3 +685,28 @@ def test_a_bad_size_is_named_by_its_option(
         "stereovision: error: --size: expected WIDTHxHEIGHT with positive integers, got '640*480'"
     )
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("command", "says"),
+    [
+        (["depth", "l.png", "r.png", "-o", "out", "--max-depth", "5m"], "--max-depth: expected a "
+         "number, got '5m' (see stereovision depth --help)"),
+        (["calibrate", "--left", "l", "--right", "r", "-o", "rig.yaml", "--square", "1/4"],
+         "--square: expected a number, got '1/4' (see stereovision calibrate --help)"),
+        (["batch", "in", "-o", "out", "--workers", "two"], "--workers: expected a whole number, "
+         "got 'two' (see stereovision batch --help)"),
+    ],
+    ids=["depth", "calibrate", "batch"],
+)  # fmt: skip
+def test_a_value_that_is_no_number_is_said_without_python_types(
+    command: list[str], says: str, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """argparse refused `--max-depth 5m` as "invalid float value: '5m'" (`--workers two`:
+    "invalid int value"), Python's type names; the line says what to type instead."""
+    with pytest.raises(SystemExit) as exit_:
+        main(command)
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"stereovision {command[0]}: error: argument ") and err.endswith(says)
+    assert "float" not in err and "int value" not in err

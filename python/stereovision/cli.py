@@ -1810,6 +1810,12 @@ class _Parser(argparse.ArgumentParser):
     """argparse with its errors in one line, as the command's own (not the usage block)."""
 
     def error(self, message: str) -> NoReturn:
+        # argparse names the Python type ("invalid float value: 'abc'"): said as what to type
+        message = re.sub(
+            r"invalid (float|int) value: ('.*')$",
+            lambda m: f"expected a {'number' if m[1] == 'float' else 'whole number'}, got {m[2]}",
+            message,
+        )
         sys.stderr.write(f"{self.prog}: error: {message} (see {self.prog} --help)\n")
         sys.exit(EXIT_ERROR)
 
