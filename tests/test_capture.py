@@ -2014,7 +2014,8 @@ def test_a_mode_the_camera_has_is_delivered_and_another_is_reported(data_dir: Pa
             frame = cam.read()
             assert cam.delivered_size == {"left": (640, 480), "right": (640, 480)}
             assert cam.describe() == (
-                "asked 800x600; left _ModeCam: 640x480 @ 0 fps; right _ModeCam: 640x480 @ 0 fps"
+                "asked 800x600; left _ModeCam: 640x480 (no frame rate given); right _ModeCam: "
+                "640x480 (no frame rate given)"
             )
     assert len(rec) == 2 and frame.left.shape == (600, 800, 3)
     assert frame.delivered is not None and frame.delivered[0].shape == (480, 640, 3)

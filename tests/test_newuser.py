@@ -710,3 +710,24 @@ def test_a_value_that_is_no_number_is_said_without_python_types(
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"stereovision {command[0]}: error: argument ") and err.endswith(says)
     assert "float" not in err and "int value" not in err
+
+
+def test_an_image_sequence_is_not_said_to_run_at_0_fps(tmp_path: Path) -> None:
+    """`capture --left 'pairs/left_%02d.png' ...` ended with "left ...: 320x240 @ 0 fps", OpenCV's
+    0 for a frame rate it does not know read as a source delivering nothing; a known rate is
+    still given."""
+    import cv2
+
+    from stereovision.capture import StereoCamera
+
+    image = np.random.default_rng(0).integers(0, 255, (48, 64, 3), np.uint8)
+    for i in (1, 2):
+        for side in ("left", "right"):
+            assert cv2.imwrite(str(tmp_path / f"{side}_{i:02d}.png"), image)
+    with StereoCamera(str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png")) as cam:
+        cam.read()
+        said = cam.describe()
+        assert "left_%02d.png': 64x48 (no frame rate given); right" in said
+        assert "0 fps" not in said
+        cam.delivered_fps["left"] = 30.0
+        assert "64x48 @ 30 fps; right" in cam.describe()

@@ -1042,9 +1042,11 @@ class PairSource:
         for side in ("left", "right"):
             d = self.delivered_size.get(side)
             got = f"{d[0]}x{d[1]}" if d else "?"
-            parts.append(
-                f"{side} {names[side]}: {got} @ {self.delivered_fps.get(side, 0.0):.3g} fps"
-            )
+            fps = self.delivered_fps.get(side, 0.0)
+            # OpenCV gives 0 for a rate it does not know (an image sequence, some webcams):
+            # "@ 0 fps" read as a source delivering nothing
+            rate = f"@ {fps:.3g} fps" if fps > 0 else "(no frame rate given)"
+            parts.append(f"{side} {names[side]}: {got} {rate}")
         return "; ".join(parts)
 
     def read(self) -> StereoFrame:
