@@ -286,6 +286,16 @@ pub fn try_reserve_len<T>(v: &mut Vec<T>, n: usize, what: &'static str) -> Resul
         .map_err(|_| CoreError::oom(n.saturating_mul(std::mem::size_of::<T>()), what))
 }
 
+/// Room for `more` values after those in `v`, grown as `push` or `extend` would (amortised:
+/// for a vector whose final length is not known in advance), or [`CoreError::OutOfMemory`]
+/// (the smallest size that would hold them); the values are not changed.
+pub fn try_grow<T>(v: &mut Vec<T>, more: usize, what: &'static str) -> Result<()> {
+    v.try_reserve(more).map_err(|_| {
+        let n = v.len().saturating_add(more);
+        CoreError::oom(n.saturating_mul(std::mem::size_of::<T>()), what)
+    })
+}
+
 /// `it.collect()` of an iterator of exactly `n` values into a vector allocated at once, or
 /// [`CoreError::OutOfMemory`] (a `collect` aborts the process when it cannot allocate).
 pub fn try_collect<T>(n: usize, it: impl Iterator<Item = T>, what: &'static str) -> Result<Vec<T>> {
@@ -331,6 +341,12 @@ mod tests {
         let mut v = vec![1u8; 3];
         assert!(try_reserve_len(&mut v, usize::MAX, "z").is_err());
         assert_eq!(v, [1, 1, 1]);
+        assert_eq!(
+            try_grow(&mut v, usize::MAX / 2, "g"),
+            Err(CoreError::oom(usize::MAX / 2 + 3, "g"))
+        );
+        try_grow(&mut v, 5, "g").unwrap();
+        assert!(v.capacity() >= 8 && v == [1, 1, 1]);
         // Success: the same values as `vec!`.
         assert_eq!(try_zeroed::<f32>(5, "a").unwrap(), vec![0.0f32; 5]);
         assert_eq!(try_zeroed::<u8>(0, "a").unwrap(), Vec::<u8>::new());

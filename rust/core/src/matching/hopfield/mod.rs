@@ -33,7 +33,7 @@ use std::collections::HashMap;
 
 use rayon::prelude::*;
 
-use crate::alloc::try_concat;
+use crate::alloc::{try_collect, try_concat, try_filled, try_grow, try_reserve_len, try_zeroed};
 use crate::error::{CoreError, Result};
 use crate::image::ImageView;
 use crate::simd::simd_fn;
@@ -297,6 +297,9 @@ fn validate(left: &ImageView<'_>, right: &ImageView<'_>, p: &HopfieldParams) -> 
     Ok(())
 }
 
+/// What the candidate search's allocations are named in an out-of-memory error.
+const CANDIDATES: &str = "the Hopfield matcher's candidate neurons";
+
 /// Rows of the right image holding right interest points (points mode).
 fn right_rows(right: &ImageView<'_>, p: &HopfieldParams) -> Result<HashMap<usize, Vec<usize>>> {
     let mut rows: HashMap<usize, Vec<usize>> = HashMap::new();
@@ -330,8 +333,8 @@ struct CandScratch {
 }
 
 simd_fn! {
-/// The candidate neurons of left point `i` appended to `out` (best ZNCC first, at most
-/// `k_cand`), with their depth-edge verdict and sub-pixel offset. Compiled for AVX2 too: the
+/// The candidate neurons of left point `i` in `sc.found` (best ZNCC first, at most `k_cand`),
+/// with their depth-edge verdict and sub-pixel offset. Compiled for AVX2 too: the
 /// curves' maxima then run eight lanes wide.
 fn point_candidates(
     left: &ImageView<'_>,
@@ -342,8 +345,8 @@ fn point_candidates(
     i: usize,
     pt: &InterestPoint,
     sc: &mut CandScratch,
-    out: &mut Vec<Neuron>,
 ) {
+    sc.found.clear();
     let (w, h) = right.size();
     let (x, y) = (pt.x as usize, pt.y as usize);
     let d_hi = p.d_max.min(x.saturating_sub(SIM_RADIUS));
@@ -357,7 +360,6 @@ fn point_candidates(
             (y + p.dy_window).min(h.saturating_sub(SIM_RADIUS + 1)),
         ),
     };
-    sc.found.clear();
     for yr in lo_row..=hi_row {
         let right_xs = rows.get(&yr).map(|v| v.as_slice()).unwrap_or(&[]);
         if p.candidates == CandidateMode::Points && right_xs.is_empty() {
@@ -429,7 +431,7 @@ fn point_candidates(
             .then(a.xr.cmp(&b.xr))
             .then(a.yr.cmp(&b.yr))
     });
-    out.extend(sc.found.iter().take(p.k_cand));
+    sc.found.truncate(p.k_cand);
 }
 }
 
@@ -450,6 +452,7 @@ fn candidates(
     let mut s0 = 0;
     for i in 1..=pts.len() {
         if i == pts.len() || band_of(&pts[i]) != band_of(&pts[s0]) {
+            try_grow(&mut tasks, 1, CANDIDATES)?;
             tasks.push((s0, i));
             s0 = i;
         }
@@ -458,7 +461,9 @@ fn candidates(
         CandidateMode::Row => 0,
         CandidateMode::Points => p.dy_window,
     };
-    let per_task: Vec<Vec<Neuron>> = tasks
+    let mut per_task: Vec<Result<Vec<Neuron>>> = Vec::new();
+    try_reserve_len(&mut per_task, tasks.len(), CANDIDATES)?;
+    tasks
         .par_iter()
         .map_init(
             || (CandScratch::default(), RightStats::default()),
@@ -466,15 +471,19 @@ fn candidates(
                 let y_lo = pts[i0].y as usize;
                 let y_hi = pts[i1 - 1].y as usize + 1;
                 stats.fill_band(right, y_lo.saturating_sub(reach), y_hi + reach);
-                let mut out = Vec::with_capacity(2 * (i1 - i0));
+                let mut out = Vec::new();
+                try_reserve_len(&mut out, 2 * (i1 - i0), CANDIDATES)?;
                 for (i, pt) in pts.iter().enumerate().take(i1).skip(i0) {
-                    point_candidates(left, right, stats, &rows, p, i, pt, sc, &mut out);
+                    point_candidates(left, right, stats, &rows, p, i, pt, sc);
+                    // The point's best `k_cand`, appended as `extend` grows, checked.
+                    try_grow(&mut out, sc.found.len(), CANDIDATES)?;
+                    out.extend_from_slice(&sc.found);
                 }
-                out
+                Ok(out)
             },
         )
-        .collect();
-    try_concat(per_task, "the Hopfield matcher's candidate neurons")
+        .collect_into_vec(&mut per_task);
+    try_concat(per_task.into_iter().collect::<Result<_>>()?, CANDIDATES)
 }
 
 /// Median (mean of the two middle values for an even count; 0 if empty), by selection: the
@@ -497,9 +506,34 @@ fn median(v: &mut [f32]) -> f32 {
     }
 }
 
+/// What the allocations of the final selection ([`fallback`], [`disambiguate`]) are named in an
+/// out-of-memory error.
+const SELECTION: &str = "the Hopfield matcher's final selection";
+
+/// What the allocations of the depth-edge filters ([`rescue`], [`finish`]) are named in an
+/// out-of-memory error.
+const FILTERS: &str = "the Hopfield matcher's depth-edge filters";
+
+/// The values of `it` that pass `keep`, collected checked (counted first: a `filter` then
+/// `collect` grows its vector unchecked). [`CoreError::OutOfMemory`] names `what`.
+fn try_filtered<T>(
+    it: impl Iterator<Item = T> + Clone,
+    keep: impl Fn(&T) -> bool,
+    what: &'static str,
+) -> Result<Vec<T>> {
+    let n = it.clone().filter(&keep).count();
+    try_collect(n, it.filter(keep), what)
+}
+
 /// C.5 disambiguation: indices of the kept active neurons (at most one per left point and one
-/// per right pixel).
-fn disambiguate(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams) -> Vec<usize> {
+/// per right pixel). A failed allocation of its lists (per active neuron, per conflict, per
+/// right pixel) is [`CoreError::OutOfMemory`].
+fn disambiguate(
+    neurons: &[Neuron],
+    net: &Network,
+    state: &[u8],
+    p: &HopfieldParams,
+) -> Result<Vec<usize>> {
     // Active neurons per left point (neurons are grouped by point): singles kept as they are.
     let m = neurons.len();
     let mut singles: Vec<usize> = Vec::new();
@@ -512,51 +546,61 @@ fn disambiguate(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldPar
         }
         let n_on = (a..e).filter(|&b| state[b] == 1).count();
         if n_on == 1 {
+            try_grow(&mut singles, 1, SELECTION)?;
             singles.extend((a..e).filter(|&b| state[b] == 1));
         } else if n_on > 1 {
-            ambiguous.push((a..e).filter(|&b| state[b] == 1).collect());
+            try_grow(&mut ambiguous, 1, SELECTION)?;
+            ambiguous.push(try_collect(
+                n_on,
+                (a..e).filter(|&b| state[b] == 1),
+                SELECTION,
+            )?);
         }
         a = e;
     }
     // Fallback reference of a window without single matches, computed when first needed.
     let global = std::sync::OnceLock::new();
-    let global = || {
-        *global.get_or_init(|| {
-            let mut all_dy: Vec<f32> = singles.iter().map(|&s| neurons[s].dy() as f32).collect();
-            median(&mut all_dy)
-        })
+    let global = || -> Result<f32> {
+        global
+            .get_or_init(|| {
+                let dy = singles.iter().map(|&s| neurons[s].dy() as f32);
+                let mut all_dy = try_collect(singles.len(), dy, SELECTION)?;
+                Ok(median(&mut all_dy))
+            })
+            .clone()
     };
     let half = p.weights.nbr_half.max(1);
     // The singles' grid, built when a conflict first needs it (most scenes have few).
     let grid = std::sync::OnceLock::new();
-    let grid = || {
+    let grid = || -> Result<&network::PointGrid> {
         grid.get_or_init(|| {
-            let sxy: Vec<(i32, i32)> = singles
+            let xy = singles
                 .iter()
-                .map(|&s| (neurons[s].xl.max(0), neurons[s].yl.max(0)))
-                .collect();
-            network::PointGrid::new(&sxy, half)
+                .map(|&s| (neurons[s].xl.max(0), neurons[s].yl.max(0)));
+            network::PointGrid::new(&try_collect(singles.len(), xy, SELECTION)?, half)
         })
+        .as_ref()
+        .map_err(Clone::clone)
     };
     // Reference vertical disparity: median over the single matches in the 40x40 window.
-    let local_ref = |a: usize| -> f32 {
+    let local_ref = |a: usize| -> Result<f32> {
         let n = &neurons[a];
         let mut v: Vec<f32> = Vec::new();
-        grid().for_each_in_window((n.xl.max(0), n.yl.max(0)), half, |k| {
+        grid()?.for_each_in_window((n.xl.max(0), n.yl.max(0)), half, |k| {
             v.push(neurons[singles[k]].dy() as f32)
         });
         if v.is_empty() {
             global()
         } else {
-            median(&mut v)
+            Ok(median(&mut v))
         }
     };
     // Closest to the reference, then higher similarity, then lower index; None if too far.
-    let pick = |group: &[usize]| -> Option<usize> {
+    let pick = |group: &[usize]| -> Result<Option<usize>> {
         let mut best: Option<(f32, f32, usize)> = None;
         for &a in group {
             let key = (
-                (neurons[a].dy() as f32 - local_ref(a)).abs(),
+                (neurons[a].dy() as f32 - local_ref(a)?).abs(),
                 -neurons[a].sim,
                 a,
             );
@@ -564,80 +608,115 @@ fn disambiguate(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldPar
                 best = Some(key);
             }
         }
-        best.filter(|b| b.0 <= p.tau_y).map(|b| b.2)
+        Ok(best.filter(|b| b.0 <= p.tau_y).map(|b| b.2))
     };
-    let mut kept = singles.clone();
-    // Few conflicts (the usual case) are picked on this thread: no dispatch to the pool.
-    let picked: Vec<usize> = if ambiguous.len() < 256 {
-        ambiguous.iter().filter_map(|g| pick(g)).collect()
+    // Every pick of a point's conflict, in point order (few conflicts, the usual case, on
+    // this thread: no dispatch to the pool).
+    let mut picks: Vec<Result<Option<usize>>> = Vec::new();
+    try_reserve_len(&mut picks, ambiguous.len(), SELECTION)?;
+    if ambiguous.len() < 256 {
+        picks.extend(ambiguous.iter().map(|g| pick(g)));
     } else {
-        ambiguous.par_iter().filter_map(|g| pick(g)).collect()
-    };
-    kept.extend(picked);
+        ambiguous
+            .par_iter()
+            .map(|g| pick(g))
+            .collect_into_vec(&mut picks);
+    }
+    let n_picked = picks.iter().filter(|r| !matches!(r, Ok(None))).count();
+    let mut kept = Vec::new();
+    try_reserve_len(&mut kept, singles.len() + n_picked, SELECTION)?;
+    kept.extend_from_slice(&singles);
+    for r in picks {
+        kept.extend(r?);
+    }
     // The same rule on the right side (neurons sharing a right pixel, by the network's
     // right-pixel rank): a pixel held once keeps its match, a conflict is picked as above
     // (`pick` depends on the group's members only, not on their order).
-    let mut held = vec![0u32; net.n_right_pixels()];
+    let mut held = try_zeroed::<u32>(net.n_right_pixels(), SELECTION)?;
     for &a in &kept {
         held[net.right_pixel(a)] += 1;
     }
-    let (mut out, mut conflicts): (Vec<usize>, Vec<usize>) =
-        kept.iter().partition(|&&a| held[net.right_pixel(a)] == 1);
+    // `out` takes the unique ones, then at most one pick per conflict.
+    let mut out = try_filtered(
+        kept.iter().copied(),
+        |&a| held[net.right_pixel(a)] == 1,
+        SELECTION,
+    )?;
+    let mut conflicts = try_filtered(
+        kept.iter().copied(),
+        |&a| held[net.right_pixel(a)] != 1,
+        SELECTION,
+    )?;
+    try_reserve_len(&mut out, kept.len(), SELECTION)?;
     conflicts.sort_unstable_by_key(|&a| (net.right_pixel(a), a));
     for group in conflicts.chunk_by(|&a, &b| net.right_pixel(a) == net.right_pixel(b)) {
-        out.extend(pick(group));
+        out.extend(pick(group)?);
     }
     out.sort_unstable();
-    out
+    Ok(out)
 }
 
 /// Stage 1 of [`finish`]: which of `chosen` pass the depth-edge test, with the side rescue of
 /// [`HopfieldParams::rescue_min`] iterated to a fixed point (every round tests the remaining
 /// candidates against the matches accepted before it, so the order of the points is irrelevant).
-fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool> {
+/// A failed allocation of its per-match lists or grids is [`CoreError::OutOfMemory`].
+fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Result<Vec<bool>> {
     if !p.edge_test {
-        return vec![true; chosen.len()];
+        return try_filled(chosen.len(), true, FILTERS);
     }
-    let mut ok: Vec<bool> = chosen.iter().map(|&a| neurons[a].edge_ok).collect();
+    let mut ok = try_collect(
+        chosen.len(),
+        chosen.iter().map(|&a| neurons[a].edge_ok),
+        FILTERS,
+    )?;
     if p.rescue_min == 0 {
-        return ok;
+        return Ok(ok);
     }
     // Candidates of the rescue: failed half-window tests only.
-    let cands: Vec<usize> = (0..chosen.len())
-        .filter(|&c| {
+    let cands = try_filtered(
+        0..chosen.len(),
+        |&c| {
             let n = &neurons[chosen[c]];
             !n.edge_ok && n.centre_ok && n.halves_fail != 0
-        })
-        .collect();
+        },
+        FILTERS,
+    )?;
     let half = p.weights.nbr_half.max(1);
     // One grid over every chosen match (filtered by `ok` when read) and one over the
     // candidates: no grid is rebuilt per round.
-    let cxy: Vec<(i32, i32)> = chosen
-        .iter()
-        .map(|&a| (neurons[a].xl.max(0), neurons[a].yl.max(0)))
-        .collect();
-    let grid = network::PointGrid::new(&cxy, half);
+    let cxy = try_collect(
+        chosen.len(),
+        chosen
+            .iter()
+            .map(|&a| (neurons[a].xl.max(0), neurons[a].yl.max(0))),
+        FILTERS,
+    )?;
+    let grid = network::PointGrid::new(&cxy, half)?;
     // The chosen matches' disparity, sub-pixel disparity and verdict in grid order: a window
     // scan reads them in place (same positions, same order as `for_each_in_window`).
-    let g_dx = grid.values_in_grid_order(|t| neurons[chosen[t]].dx());
-    let g_v: Vec<f32> = grid
-        .items
-        .iter()
-        .map(|&t| {
+    let g_dx = grid.values_in_grid_order(|t| neurons[chosen[t]].dx())?;
+    let g_v = try_collect(
+        grid.items.len(),
+        grid.items.iter().map(|&t| {
             let b = &neurons[chosen[t as usize]];
             b.dx() as f32 + b.sub
-        })
-        .collect();
-    let mut g_of = vec![0usize; chosen.len()];
+        }),
+        FILTERS,
+    )?;
+    let mut g_of = try_zeroed::<usize>(chosen.len(), FILTERS)?;
     for (g, &t) in grid.items.iter().enumerate() {
         g_of[t as usize] = g;
     }
-    let mut ok_g: Vec<bool> = grid.items.iter().map(|&t| ok[t as usize]).collect();
-    let kxy: Vec<(i32, i32)> = cands.iter().map(|&c| cxy[c]).collect();
-    let cand_grid = network::PointGrid::new(&kxy, half);
+    let mut ok_g = try_collect(
+        grid.items.len(),
+        grid.items.iter().map(|&t| ok[t as usize]),
+        FILTERS,
+    )?;
+    let kxy = try_collect(cands.len(), cands.iter().map(|&c| cxy[c]), FILTERS)?;
+    let cand_grid = network::PointGrid::new(&kxy, half)?;
     // Round 1 tests every candidate; a later round only those with a point accepted in the
     // round before in their window (the others see the same side sets and keep their verdict).
-    let mut to_test: Vec<usize> = (0..cands.len()).collect();
+    let mut to_test = try_collect(cands.len(), 0..cands.len(), FILTERS)?;
     loop {
         // Candidates are tested independently within a round (in parallel, kept in order),
         // against the matches accepted before the round.
@@ -670,47 +749,48 @@ fn rescue(neurons: &[Neuron], chosen: &[usize], p: &HopfieldParams) -> Vec<bool>
                     && (median(&mut sides[h]) - dsub).abs() <= p.rescue_med
             })
         };
-        // Small rounds (the later ones) run on this thread: no dispatch to the pool.
-        let added: Vec<usize> = if to_test.len() < 256 {
+        // The round's verdicts (in `to_test` order); small rounds (the later ones) run on this
+        // thread: no dispatch to the pool.
+        let mut pass = try_zeroed::<bool>(to_test.len(), FILTERS)?;
+        if to_test.len() < 256 {
             let mut sides = std::array::from_fn(|_| Vec::new());
-            to_test
-                .iter()
-                .copied()
-                .filter(|&k| test(&mut sides, k))
-                .collect()
+            for (v, &k) in pass.iter_mut().zip(&to_test) {
+                *v = test(&mut sides, k);
+            }
         } else {
-            to_test
-                .par_iter()
-                .map_init(
-                    || std::array::from_fn::<Vec<f32>, 4, _>(|_| Vec::new()),
-                    |sides, &k| test(sides, k).then_some(k),
-                )
-                .flatten()
-                .collect()
-        };
-        if added.is_empty() {
-            return ok;
+            pass.par_iter_mut().zip(&to_test).for_each_init(
+                || std::array::from_fn::<Vec<f32>, 4, _>(|_| Vec::new()),
+                |sides, (v, &k)| *v = test(sides, k),
+            );
         }
-        for &k in &added {
+        let added = try_filtered(to_test.iter().zip(&pass), |&(_, &v)| v, FILTERS)?;
+        if added.is_empty() {
+            return Ok(ok);
+        }
+        for &(&k, _) in &added {
             ok[cands[k]] = true;
             ok_g[g_of[cands[k]]] = true;
         }
-        let mut near = vec![false; cands.len()];
-        for &k in &added {
+        let mut near = try_zeroed::<bool>(cands.len(), FILTERS)?;
+        for &(&k, _) in &added {
             cand_grid.for_each_in_window(kxy[k], half, |j| near[j] = true);
         }
-        to_test = (0..cands.len())
-            .filter(|&j| near[j] && !ok[cands[j]])
-            .collect();
+        to_test = try_filtered(0..cands.len(), |&j| near[j] && !ok[cands[j]], FILTERS)?;
     }
 }
 
 /// The final selection's fallback to the best candidate (see [`HopfieldParams::fallback`]):
-/// the network's state with the best candidate of some points switched on.
-fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams) -> Vec<u8> {
-    let mut out = state.to_vec();
+/// the network's state with the best candidate of some points switched on. A failed allocation
+/// of its per-neuron, per-point or per-right-pixel lists is [`CoreError::OutOfMemory`].
+fn fallback(
+    neurons: &[Neuron],
+    net: &Network,
+    state: &[u8],
+    p: &HopfieldParams,
+) -> Result<Vec<u8>> {
+    let mut out = try_collect(state.len(), state.iter().copied(), SELECTION)?;
     if !p.fallback {
-        return out;
+        return Ok(out);
     }
     // Groups of neurons per point (best ZNCC first) whose best candidate is off.
     let mut groups: Vec<(usize, usize)> = Vec::new();
@@ -721,15 +801,18 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
             e += 1;
         }
         if state[a] == 0 {
+            try_grow(&mut groups, 1, SELECTION)?;
             groups.push((a, e));
         }
         a = e;
     }
     // Support (positive weights from active neurons, summed in row order in f64) of the
     // neurons the rule reads: the active alternatives, else the best candidate.
-    let on = net.lane_state(state);
+    let on = net.lane_state(state, SELECTION)?;
     let support_of = |a: usize| net.support(a, state, &on);
-    let mut weak: Vec<bool> = groups
+    let mut weak = Vec::new();
+    try_reserve_len(&mut weak, groups.len(), SELECTION)?;
+    groups
         .par_iter()
         .map(|&(a, e)| {
             let alt = (a + 1..e)
@@ -741,39 +824,43 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
                 None => support_of(a) >= p.fallback_min_support as f64,
             }
         })
-        .collect();
+        .collect_into_vec(&mut weak); // into the reserved room: no reallocation
     if p.fallback_group {
         // Thin surfaces: points the network left with nothing (one candidate, edge test passed,
         // no support) because the window's dominant surface inhibits them. Where at least
         // `min_agree` other such points in the window agree with one (within `agree_tol`),
         // they are a surface of their own, the evidence the final agreement filter asks for.
-        let lone: Vec<usize> = (0..groups.len())
-            .filter(|&g| {
+        let lone = try_filtered(
+            0..groups.len(),
+            |&g| {
                 let (a, e) = groups[g];
                 !weak[g] && e - a == 1 && neurons[a].edge_ok
-            })
-            .collect();
+            },
+            SELECTION,
+        )?;
         let half = p.weights.nbr_half.max(1);
-        let lxy: Vec<(i32, i32)> = lone
-            .iter()
-            .map(|&g| {
+        let lxy = try_collect(
+            lone.len(),
+            lone.iter().map(|&g| {
                 (
                     neurons[groups[g].0].xl.max(0),
                     neurons[groups[g].0].yl.max(0),
                 )
-            })
-            .collect();
-        let grid = network::PointGrid::new(&lxy, half);
-        let ld = grid.values_in_grid_order(|t| neurons[groups[lone[t]].0].dx());
-        let coherent: Vec<bool> = lone
-            .par_iter()
+            }),
+            SELECTION,
+        )?;
+        let grid = network::PointGrid::new(&lxy, half)?;
+        let ld = grid.values_in_grid_order(|t| neurons[groups[lone[t]].0].dx())?;
+        let mut coherent = Vec::new();
+        try_reserve_len(&mut coherent, lone.len(), SELECTION)?;
+        lone.par_iter()
             .zip(&lxy)
             .map(|(&g, &xy)| {
                 let d = neurons[groups[g].0].dx();
                 // The count includes the point itself.
                 grid.count_in_window(xy, half, &ld, d, p.agree_tol).1 > p.min_agree
             })
-            .collect();
+            .collect_into_vec(&mut coherent);
         for (&g, &c) in lone.iter().zip(&coherent) {
             weak[g] |= c;
         }
@@ -781,7 +868,7 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
     // Right pixels held by an active neuron: its left point (FREE: none, SEVERAL: several).
     const FREE: u32 = u32::MAX;
     const SEVERAL: u32 = u32::MAX - 1;
-    let mut held = vec![FREE; net.n_right_pixels()];
+    let mut held = try_filled(net.n_right_pixels(), FREE, SELECTION)?;
     for (a, n) in neurons.iter().enumerate().filter(|&(a, _)| state[a] == 1) {
         let h = &mut held[net.right_pixel(a)];
         if *h == FREE {
@@ -798,56 +885,69 @@ fn fallback(neurons: &[Neuron], net: &Network, state: &[u8], p: &HopfieldParams)
             out[a] = 1;
         }
     }
-    out
+    Ok(out)
 }
 
-/// Depth-edge filters and sub-pixel refinement of the selected neurons.
+/// Depth-edge filters and sub-pixel refinement of the selected neurons. A failed allocation of
+/// their per-match lists or grids is [`CoreError::OutOfMemory`].
 fn finish(
     left: &ImageView<'_>,
     right: &ImageView<'_>,
     neurons: &[Neuron],
     chosen: &[usize],
     p: &HopfieldParams,
-) -> Vec<Match> {
+) -> Result<Vec<Match>> {
     let _ = (left, right);
     // Stage 1: the per-candidate depth-edge verdict (computed with the ZNCC curves), then the
     // side rescue of half-window failures.
-    let accepted = rescue(neurons, chosen, p);
-    let survivors: Vec<(usize, f32)> = chosen
-        .iter()
-        .zip(&accepted)
-        .filter(|&(_, &ok)| ok)
-        .map(|(&a, _)| (a, neurons[a].dx() as f32 + neurons[a].sub))
-        .collect();
+    let accepted = rescue(neurons, chosen, p)?;
+    let survivors = try_filtered(
+        chosen
+            .iter()
+            .zip(&accepted)
+            .map(|(&a, &ok)| (a, neurons[a].dx() as f32 + neurons[a].sub, ok)),
+        |&(_, _, ok)| ok,
+        FILTERS,
+    )?;
     // Stage 2: neighbour agreement among the survivors (uniform grid, cell = window half-size).
     let half = p.weights.nbr_half.max(1);
-    let sxy: Vec<(i32, i32)> = survivors
-        .iter()
-        .map(|&(a, _)| (neurons[a].xl.max(0), neurons[a].yl.max(0)))
-        .collect();
-    let grid = network::PointGrid::new(&sxy, half);
+    let sxy = try_collect(
+        survivors.len(),
+        survivors
+            .iter()
+            .map(|&(a, _, _)| (neurons[a].xl.max(0), neurons[a].yl.max(0))),
+        FILTERS,
+    )?;
+    let grid = network::PointGrid::new(&sxy, half)?;
     // Survivor disparities in grid order.
-    let sd = grid.values_in_grid_order(|t| neurons[survivors[t].0].dx());
-    survivors
-        .par_iter()
+    let sd = grid.values_in_grid_order(|t| neurons[survivors[t].0].dx())?;
+    // Each survivor's verdict, then the matches of those that pass (counted first: a parallel
+    // filter's collect grows its vector unchecked).
+    let mut pass = try_zeroed::<bool>(survivors.len(), FILTERS)?;
+    pass.par_iter_mut()
+        .zip(&survivors)
         .enumerate()
-        .filter(|&(s, &(a, _))| {
-            if !p.edge_test {
-                return true;
-            }
-            let d = neurons[a].dx();
-            let (x, y) = sxy[s];
-            let (mut near, mut agree) = grid.count_in_window((x, y), half, &sd, d, p.agree_tol);
-            near -= 1;
-            agree -= usize::from(p.agree_tol >= 0); // the survivor itself
-                                                    // Dense areas: at least min_agree agreeing neighbours (C.10). Sparse areas (weak
-                                                    // texture) optionally: a large share of the few neighbours, at least min_agree_sparse.
-            agree >= p.min_agree
-                || (p.agree_share > 0.0
-                    && agree >= p.min_agree_sparse
-                    && agree as f32 >= p.agree_share * near as f32)
-        })
-        .map(|(_, &(a, dsub))| {
+        .for_each(|(s, (v, &(a, _, _)))| {
+            *v = !p.edge_test || {
+                let d = neurons[a].dx();
+                let (x, y) = sxy[s];
+                let (mut near, mut agree) = grid.count_in_window((x, y), half, &sd, d, p.agree_tol);
+                near -= 1;
+                agree -= usize::from(p.agree_tol >= 0); // the survivor itself
+                                                        // Dense areas: at least min_agree agreeing neighbours (C.10). Sparse areas
+                                                        // (weak texture) optionally: a large share of the few neighbours, at least
+                                                        // min_agree_sparse.
+                agree >= p.min_agree
+                    || (p.agree_share > 0.0
+                        && agree >= p.min_agree_sparse
+                        && agree as f32 >= p.agree_share * near as f32)
+            };
+        });
+    let matches = survivors
+        .iter()
+        .zip(&pass)
+        .filter(|&(_, &v)| v)
+        .map(|(&(a, dsub, _), _)| {
             let n = &neurons[a];
             Match {
                 xl: n.xl as f32,
@@ -856,8 +956,8 @@ fn finish(
                 yr: n.yr as f32,
                 score: n.sim,
             }
-        })
-        .collect()
+        });
+    try_collect(pass.iter().filter(|&&v| v).count(), matches, FILTERS)
 }
 
 /// Interest points and candidate neurons (exposed for tests and the reference comparison).
@@ -876,14 +976,18 @@ pub fn candidate_neurons<'a>(
 /// The preset state (C.4): neurons with `S >= s_init` on, with [`HopfieldParams::init_best`]
 /// only the first (best) candidate of each point.
 pub fn initial_state(neurons: &[Neuron], p: &HopfieldParams) -> Vec<u8> {
-    neurons
-        .iter()
-        .enumerate()
-        .map(|(a, n)| {
-            let first = a == 0 || neurons[a - 1].point != n.point;
-            u8::from(n.sim >= p.s_init && (first || !p.init_best))
-        })
-        .collect()
+    initial_states(neurons, p).collect()
+}
+
+/// The values of [`initial_state`], one per neuron.
+fn initial_states<'a>(
+    neurons: &'a [Neuron],
+    p: &'a HopfieldParams,
+) -> impl Iterator<Item = u8> + 'a {
+    neurons.iter().enumerate().map(|(a, n)| {
+        let first = a == 0 || neurons[a - 1].point != n.point;
+        u8::from(n.sim >= p.s_init && (first || !p.init_best))
+    })
 }
 
 /// The Hopfield channel: interest points matched by energy minimisation (see the module docs).
@@ -904,22 +1008,24 @@ fn match_hot(
 ) -> Result<HopfieldOutput> {
     let (pts, neurons) = candidate_neurons(left, right, p)?;
     let net = Network::new(&neurons, &p.weights)?;
-    let input: Vec<f64> = neurons
-        .iter()
-        .map(|n| {
+    const WHAT: &str = "the Hopfield dynamics' inputs";
+    let input = try_collect(
+        neurons.len(),
+        neurons.iter().map(|n| {
             let penalty = if p.edge_test && !n.edge_ok {
                 p.edge_penalty
             } else {
                 0.0
             };
             (p.weights.d * n.sim - p.weights.theta - penalty) as f64
-        })
-        .collect();
-    let init = initial_state(&neurons, p);
+        }),
+        WHAT,
+    )?;
+    let init = try_collect(neurons.len(), initial_states(&neurons, p), WHAT)?;
     let dynamics = run_dynamics(&net, &input, &init, p.seed, p.max_sweeps)?;
-    let selected = fallback(&neurons, &net, &dynamics.state, p);
-    let chosen = disambiguate(&neurons, &net, &selected, p);
-    let matches = finish(left, right, &neurons, &chosen, p);
+    let selected = fallback(&neurons, &net, &dynamics.state, p)?;
+    let chosen = disambiguate(&neurons, &net, &selected, p)?;
+    let matches = finish(left, right, &neurons, &chosen, p)?;
     Ok(HopfieldOutput {
         matches,
         energy_trace: dynamics.energy_trace,
@@ -950,13 +1056,13 @@ fn best_hot(
     p: &HopfieldParams,
 ) -> Result<HopfieldOutput> {
     let (pts, neurons) = candidate_neurons(left, right, p)?;
-    let mut chosen = Vec::new();
-    for (a, n) in neurons.iter().enumerate() {
-        if a == 0 || neurons[a - 1].point != n.point {
-            chosen.push(a); // candidates are sorted best first within a point
-        }
-    }
-    let matches = finish(left, right, &neurons, &chosen, p);
+    // Each point's first candidate (candidates are sorted best first within a point).
+    let chosen = try_filtered(
+        0..neurons.len(),
+        |&a| a == 0 || neurons[a - 1].point != neurons[a].point,
+        SELECTION,
+    )?;
+    let matches = finish(left, right, &neurons, &chosen, p)?;
     Ok(HopfieldOutput {
         matches,
         energy_trace: Vec::new(),

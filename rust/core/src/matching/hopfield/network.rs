@@ -12,7 +12,7 @@
 
 use rayon::prelude::*;
 
-use crate::alloc::{try_collect, try_filled, try_reserve_len, try_zeroed};
+use crate::alloc::{try_collect, try_filled, try_grow, try_reserve_len, try_zeroed};
 use crate::error::Result;
 use crate::simd::has_avx2;
 
@@ -166,6 +166,9 @@ fn counting_sort(
     Ok((start, out))
 }
 
+/// What [`PointGrid`]'s allocations are named in an out-of-memory error.
+const POINT_GRID: &str = "the Hopfield matcher's point grid";
+
 /// Uniform grid over the left points, counting-sorted: `items` lists the point indices cell by
 /// cell (raster order of the cells, point order within a cell) with their coordinates beside
 /// them, so the cells of one grid row around a point form ONE contiguous range.
@@ -181,50 +184,45 @@ pub(crate) struct PointGrid {
 
 impl PointGrid {
     /// Grid over points with non-negative coordinates, for window queries of half-size `half`
-    /// (>= 1).
-    pub(crate) fn new(pxy: &[(i32, i32)], half: i32) -> Self {
+    /// (>= 1). A failed allocation of its tables (about 20 bytes a point) is
+    /// [`crate::CoreError::OutOfMemory`].
+    pub(crate) fn new(pxy: &[(i32, i32)], half: i32) -> Result<Self> {
         let cell = (half.max(1) + GRID_SUB - 1) / GRID_SUB;
         // Coordinates are >= 0: the largest cell index is the largest coordinate's. Each
         // point's cell computed once, by a multiply (divisions were most of the build).
         let cell = DivBy::new(cell as u32);
         let gw = cell.of(pxy.iter().map(|p| p.0).max().unwrap_or(0)) + 1;
         let gh = cell.of(pxy.iter().map(|p| p.1).max().unwrap_or(0)) + 1;
-        let cells: Vec<u32> = pxy
-            .iter()
-            .map(|p| (cell.of(p.1) * gw + cell.of(p.0)) as u32)
-            .collect();
+        let cells = try_collect(
+            pxy.len(),
+            pxy.iter()
+                .map(|p| (cell.of(p.1) * gw + cell.of(p.0)) as u32),
+            POINT_GRID,
+        )?;
         let n_cells = (gw * gh) as usize;
-        // The grid's other tables are allocated unchecked: a failed allocation of the sort
-        // aborts the process as theirs does (the default handler, with the size).
         let (start, items) = counting_sort(
             0..pxy.len() as u32,
             |k| cells[k as usize] as usize,
             n_cells,
-            "the point grid",
-        )
-        .unwrap_or_else(|e| {
-            let bytes = match e {
-                crate::CoreError::OutOfMemory { bytes, .. } => bytes,
-                _ => 0,
-            };
-            let l = std::alloc::Layout::from_size_align(bytes.min(isize::MAX as usize / 2), 8);
-            std::alloc::handle_alloc_error(l.expect("a valid layout"))
-        });
+            POINT_GRID,
+        )?;
+        drop(cells);
         // Coordinates padded with LANES far-away entries: a block of lanes may read past the
         // last point (its lanes beyond a range are masked, these are never inside a window).
         let far = i32::MIN / 4;
         let pad = std::iter::repeat_n(far, LANES);
-        let xs = items
-            .iter()
-            .map(|&k| pxy[k as usize].0)
-            .chain(pad.clone())
-            .collect();
-        let ys = items
-            .iter()
-            .map(|&k| pxy[k as usize].1)
-            .chain(pad)
-            .collect();
-        PointGrid {
+        let n = items.len() + LANES;
+        let xs = try_collect(
+            n,
+            items.iter().map(|&k| pxy[k as usize].0).chain(pad.clone()),
+            POINT_GRID,
+        )?;
+        let ys = try_collect(
+            n,
+            items.iter().map(|&k| pxy[k as usize].1).chain(pad),
+            POINT_GRID,
+        )?;
+        Ok(PointGrid {
             cell,
             gw,
             gh,
@@ -232,7 +230,7 @@ impl PointGrid {
             items,
             xs,
             ys,
-        }
+        })
     }
 
     /// The (possibly empty) ranges of `items` positions covering the cells within
@@ -286,11 +284,12 @@ impl PointGrid {
     }
 
     /// `f(t)` of every point `t` in grid order, padded like `xs` (the `vals` of
-    /// [`PointGrid::count_in_window`]).
-    pub(crate) fn values_in_grid_order(&self, f: impl Fn(usize) -> i32) -> Vec<i32> {
-        let mut v: Vec<i32> = self.items.iter().map(|&t| f(t as usize)).collect();
-        v.resize(self.xs.len(), 0);
-        v
+    /// [`PointGrid::count_in_window`]). A failed allocation is
+    /// [`crate::CoreError::OutOfMemory`].
+    pub(crate) fn values_in_grid_order(&self, f: impl Fn(usize) -> i32) -> Result<Vec<i32>> {
+        let pad = std::iter::repeat_n(0, self.xs.len() - self.items.len());
+        let vals = self.items.iter().map(|&t| f(t as usize)).chain(pad);
+        try_collect(self.xs.len(), vals, POINT_GRID)
     }
 
     /// Calls `f(k)` with the grid position `k` (index into `items`, `xs`, `ys`) of every point
@@ -1138,22 +1137,26 @@ impl Network {
             let hi = v.iter().copied().max().unwrap_or(0);
             (hi - lo) as usize
         };
+        // Checked: a row is as long as the squared disparity span when the values never
+        // saturate (compat_slope = 0: 2^22 entries a row for a span of 2048 px).
+        const LUT: &str = "the Hopfield network's compatibility table";
         let (max_dx, max_dy) = (span(&dxs), span(&dys));
         let max_q = max_dx * max_dx + max_dy * max_dy;
-        let rows: Vec<Vec<f32>> = (0..=half)
-            .map(|r| {
-                let theta = w.compat_theta as f64 + w.compat_grad as f64 * r as f64;
-                let mut row = Vec::new();
-                for q in 0..=max_q {
-                    let v = compat((q as f64).sqrt(), theta, w.compat_slope as f64) as f32;
-                    row.push(v);
-                    if v == -1.0 && w.compat_slope > 0.0 && (q as f64).sqrt() > theta {
-                        break;
-                    }
+        let mut rows: Vec<Vec<f32>> = Vec::new();
+        try_reserve_len(&mut rows, half as usize + 1, LUT)?;
+        for r in 0..=half {
+            let theta = w.compat_theta as f64 + w.compat_grad as f64 * r as f64;
+            let mut row = Vec::new();
+            for q in 0..=max_q {
+                let v = compat((q as f64).sqrt(), theta, w.compat_slope as f64) as f32;
+                try_grow(&mut row, 1, LUT)?; // as `push` grows, checked
+                row.push(v);
+                if v == -1.0 && w.compat_slope > 0.0 && (q as f64).sqrt() > theta {
+                    break;
                 }
-                row
-            })
-            .collect();
+            }
+            rows.push(row);
+        }
         // A power-of-two stride: the lanes index the table with a shift, not a multiply.
         let lut_stride = rows
             .iter()
@@ -1161,7 +1164,8 @@ impl Network {
             .max()
             .unwrap_or(1)
             .next_power_of_two();
-        let mut lut = Vec::with_capacity(rows.len() * lut_stride);
+        let mut lut = Vec::new();
+        try_reserve_len(&mut lut, rows.len().saturating_mul(lut_stride), LUT)?;
         for row in &rows {
             lut.extend_from_slice(row);
             let last = row[row.len() - 1];
@@ -1202,14 +1206,14 @@ impl Network {
     }
 
     /// `state` (0/1 per neuron) in strip order, as `f32` factors of the lanes (padding 0).
-    pub fn lane_state(&self, state: &[u8]) -> Vec<f32> {
+    /// A failed allocation is [`crate::CoreError::OutOfMemory`] naming `what`.
+    pub fn lane_state(&self, state: &[u8], what: &'static str) -> Result<Vec<f32>> {
         let n = self.cells.idx.len() - LANES;
-        let mut on: Vec<f32> = self.cells.idx[..n]
-            .iter()
-            .map(|&b| f32::from(state[b as usize]))
-            .collect();
-        on.resize(n + LANES, 0.0);
-        on
+        let mut on = try_zeroed::<f32>(n + LANES, what)?;
+        for (o, &b) in on.iter_mut().zip(&self.cells.idx[..n]) {
+            *o = f32::from(state[b as usize]);
+        }
+        Ok(on)
     }
 
     /// Support of neuron `a`: the sum of its positive weights from active neurons (`on` from
@@ -1292,12 +1296,7 @@ impl Weights for Network {
     /// `SYM_STRIPS` strips, each with its own push buffer, then added up in task order. Half
     /// the lane work of one full scan per row; independent of the thread count.
     fn initial_input(&self, state: &[u8], input: &[f64]) -> Result<(Vec<f64>, usize)> {
-        // As `lane_state`, allocated checked.
-        let n_on = self.cells.idx.len() - LANES;
-        let mut on = try_zeroed::<f32>(n_on + LANES, INITIAL_INPUT)?;
-        for (o, &b) in on.iter_mut().zip(&self.cells.idx[..n_on]) {
-            *o = f32::from(state[b as usize]);
-        }
+        let on = self.lane_state(state, INITIAL_INPUT)?;
         let slots = self.cells.idx.len();
         let n_strips = self.cell_strip.len() - 1;
         let tasks: Vec<(usize, usize)> = (0..n_strips)
@@ -1738,7 +1737,7 @@ mod tests {
         let mut pxy_u = pxy.clone();
         pxy_u.dedup();
         for half in [1, 7, 20] {
-            let grid = PointGrid::new(&pxy_u, half);
+            let grid = PointGrid::new(&pxy_u, half).unwrap();
             let mut vals: Vec<i32> = grid.items.iter().map(|&k| (k % 5) as i32).collect();
             vals.resize(grid.xs.len(), 0);
             for &(x, y) in &pxy_u {
@@ -1782,8 +1781,8 @@ mod tests {
                     })
                     .collect();
                 for half in [1, 4, 9] {
-                    let grid = PointGrid::new(&pxy, half);
-                    let vals = grid.values_in_grid_order(|t| (t % 5) as i32);
+                    let grid = PointGrid::new(&pxy, half).unwrap();
+                    let vals = grid.values_in_grid_order(|t| (t % 5) as i32).unwrap();
                     for &(x, y) in pxy.iter().chain(&[(0, 0), (spread as i32, spread as i32)]) {
                         let want = count_portable(&grid, &vals, (x, y, half, 2, 1));
                         // SAFETY: AVX2 is present; `PointGrid::new` pads xs and ys, and `vals`
@@ -1805,7 +1804,7 @@ mod tests {
         let neurons = random_neurons(2);
         let net = Network::new(&neurons, &EnergyWeights::default()).unwrap();
         let state = vec![1u8; neurons.len()];
-        let on = net.lane_state(&state);
+        let on = net.lane_state(&state, "t").unwrap();
         let a = (0..neurons.len())
             .max_by_key(|&a| net.window_ranges(a).iter().map(|r| r.1).max())
             .unwrap();
@@ -2137,7 +2136,8 @@ mod tests {
             ..EnergyWeights::default()
         };
         let net = Network::new(&neurons, &w).unwrap();
-        let support = |state: [u8; 4]| net.support(0, &state, &net.lane_state(&state));
+        let support =
+            |state: [u8; 4]| net.support(0, &state, &net.lane_state(&state, "t").unwrap());
         let c = (3.0 * compat(0.0, 2.0 + 0.05 * 4.0, 2.0) as f32) as f64;
         assert_eq!(support([1, 0, 0, 0]), 0.0);
         assert_eq!(support([0, 1, 0, 0]), 1.0);
@@ -2175,7 +2175,7 @@ mod tests {
         };
         let net = Network::new(&neurons, &w).unwrap();
         let state = [0u8, 1];
-        let got = net.support(0, &state, &net.lane_state(&state));
+        let got = net.support(0, &state, &net.lane_state(&state, "t").unwrap());
         let want = (3.0 * compat(3.0, 10.0 + 0.05 * 4.0, 0.5) as f32) as f64;
         assert!((got - want).abs() < 1e-6, "{got} vs {want}");
     }
@@ -2193,7 +2193,7 @@ mod tests {
             (5, 5),
             (4, 10),
         ];
-        let grid = PointGrid::new(&pxy, 5);
+        let grid = PointGrid::new(&pxy, 5).unwrap();
         let mut got = Vec::new();
         grid.for_each_in_window((10, 10), 5, |k| got.push(k));
         got.sort_unstable();

@@ -346,7 +346,7 @@ fn finish_keeps_matches_with_enough_agreeing_neighbours() {
         agree_share: 0.0,
         ..HopfieldParams::default()
     };
-    let out = finish(&v, &v, &dense, &chosen, &p);
+    let out = finish(&v, &v, &dense, &chosen, &p).unwrap();
     assert_eq!(out.len(), 9);
     assert!(out.iter().all(|m| m.xl - m.xr == 10.25 && m.yl == m.yr));
     // Sparse: 5 agreeing and one outlier; 4 of 5 others agree (exactly the 0.8 share).
@@ -355,7 +355,7 @@ fn finish_keeps_matches_with_enough_agreeing_neighbours() {
         .collect();
     sparse.push(neuron(5, (310, 100), 20, 0.0, true));
     let chosen: Vec<usize> = (0..sparse.len()).collect();
-    let out = finish(&v, &v, &sparse, &chosen, &HopfieldParams::default());
+    let out = finish(&v, &v, &sparse, &chosen, &HopfieldParams::default()).unwrap();
     let xs: Vec<f32> = out.iter().map(|m| m.xl).collect();
     assert_eq!(xs, [300.0, 302.0, 304.0, 306.0, 308.0]);
 }
@@ -382,7 +382,7 @@ fn rescue_keeps_a_half_failure_backed_by_its_side() {
     ns.push(no_centre);
     ns.extend(side(300, 6));
     let chosen: Vec<usize> = (0..ns.len()).collect();
-    let ok = rescue(&ns, &chosen, &HopfieldParams::default());
+    let ok = rescue(&ns, &chosen, &HopfieldParams::default()).unwrap();
     assert_eq!(ok, [true, true, true, true, true, false, true, true, true]);
 }
 
@@ -409,7 +409,10 @@ fn disambiguation_keeps_singles_and_picks_by_vertical_disparity_then_similarity(
     let state = [1, 1, 1, 0, 1, 1, 1, 1];
     let p = HopfieldParams::default();
     let net = Network::new(&ns, &p.weights).unwrap();
-    assert_eq!(disambiguate(&ns, &net, &state, &p), [0, 2, 4, 5, 6]);
+    assert_eq!(
+        disambiguate(&ns, &net, &state, &p).unwrap(),
+        [0, 2, 4, 5, 6]
+    );
 }
 
 /// C.5 at a half-pixel reference: two singles of vertical disparity 0 and 1 (median 0.5); a
@@ -433,19 +436,19 @@ fn disambiguation_tolerance_is_inclusive_at_a_half_pixel_reference() {
     let p = HopfieldParams::default();
     assert_eq!(p.tau_y, 1.0);
     let net = Network::new(&ns, &p.weights).unwrap();
-    assert_eq!(disambiguate(&ns, &net, &state, &p), [0, 1]);
+    assert_eq!(disambiguate(&ns, &net, &state, &p).unwrap(), [0, 1]);
     let mut p = HopfieldParams {
         tau_y: 1.5,
         ..HopfieldParams::default()
     };
-    assert_eq!(disambiguate(&ns, &net, &state, &p), [0, 1, 3]);
+    assert_eq!(disambiguate(&ns, &net, &state, &p).unwrap(), [0, 1, 3]);
     p.tau_y = 1.499;
-    assert_eq!(disambiguate(&ns, &net, &state, &p), [0, 1]);
+    assert_eq!(disambiguate(&ns, &net, &state, &p).unwrap(), [0, 1]);
     // Equal distance and similarity: the lower index.
     let mut tie = ns.clone();
     tie[2].sim = 0.9;
     p.tau_y = 1.5;
-    assert_eq!(disambiguate(&tie, &net, &state, &p), [0, 1, 2]);
+    assert_eq!(disambiguate(&tie, &net, &state, &p).unwrap(), [0, 1, 2]);
 }
 
 /// `right = 0.5 left(x + d) + 0.2` (an exposure offset): the centre check, on window-mean-free
@@ -510,7 +513,7 @@ fn group_fallback_needs_more_than_min_agree_agreeing_lone_points() {
             .map(|k| neuron(k, (100 + 2 * k as i32, 100), 10, 0.0, true))
             .collect();
         let net = Network::new(&ns, &p.weights).unwrap();
-        let out = fallback(&ns, &net, &vec![0; ns.len()], &p);
+        let out = fallback(&ns, &net, &vec![0; ns.len()], &p).unwrap();
         assert!(out.iter().all(|&s| s == expect), "{n}: {out:?}");
     }
 }
@@ -597,11 +600,11 @@ fn rescue_repeats_until_no_match_is_added() {
     let mut p = HopfieldParams::default();
     p.weights.nbr_half = 5;
     let chosen: Vec<usize> = (0..ns.len()).collect();
-    assert_eq!(rescue(&ns, &chosen, &p), [true; 7]);
+    assert_eq!(rescue(&ns, &chosen, &p).unwrap(), [true; 7]);
     // Without its neighbour the first match stays rejected.
     let alone: Vec<usize> = [0, 2, 3, 4, 5, 6].into();
     assert_eq!(
-        rescue(&ns, &alone, &p),
+        rescue(&ns, &alone, &p).unwrap(),
         [false, true, true, true, true, true]
     );
 }
@@ -624,10 +627,9 @@ fn one_point(l: &Image, r: &Image, p: &HopfieldParams, (x, y): (u32, u32)) -> Ve
         .map(|yr| (yr, (0..x as usize).collect()))
         .collect();
     let pt = InterestPoint { x, y, value: 1.0 };
-    let mut out = Vec::new();
     let mut sc = CandScratch::default();
-    point_candidates(&lv, &rv, &stats, &rows, p, 0, &pt, &mut sc, &mut out);
-    out
+    point_candidates(&lv, &rv, &stats, &rows, p, 0, &pt, &mut sc);
+    sc.found
 }
 
 /// Points mode keeps a right point whose ZNCC equals `s_min` exactly (`>=`): with `s_min` set
@@ -815,7 +817,10 @@ fn rescue_compares_the_side_median_with_the_subpixel_disparity() {
         ns.push(neuron(1 + k as u32, xy, 11, 0.0, true));
     }
     let chosen: Vec<usize> = (0..ns.len()).collect();
-    assert_eq!(rescue(&ns, &chosen, &HopfieldParams::default()), [true; 4]);
+    assert_eq!(
+        rescue(&ns, &chosen, &HopfieldParams::default()).unwrap(),
+        [true; 4]
+    );
 }
 
 /// Sparse areas: exactly `min_agree_sparse` = 2 agreeing neighbours (all of them) suffice.
@@ -826,7 +831,7 @@ fn finish_keeps_sparse_matches_with_exactly_min_agree_sparse_neighbours() {
     let ns: Vec<Neuron> = (0..3)
         .map(|k| neuron(k, (300 + 2 * k as i32, 100), 10, 0.0, true))
         .collect();
-    let out = finish(&v, &v, &ns, &[0, 1, 2], &HopfieldParams::default());
+    let out = finish(&v, &v, &ns, &[0, 1, 2], &HopfieldParams::default()).unwrap();
     assert_eq!(out.len(), 3);
 }
 
@@ -848,7 +853,10 @@ fn disambiguation_without_local_singles_uses_the_global_median() {
     ];
     let p = HopfieldParams::default();
     let net = Network::new(&ns, &p.weights).unwrap();
-    assert_eq!(disambiguate(&ns, &net, &[1, 1, 1, 1, 1], &p), [0, 1, 2, 4]);
+    assert_eq!(
+        disambiguate(&ns, &net, &[1, 1, 1, 1, 1], &p).unwrap(),
+        [0, 1, 2, 4]
+    );
 }
 
 /// Fallback thresholds at equality: an active alternative with support equal to
@@ -867,10 +875,10 @@ fn fallback_support_thresholds_at_equality() {
         neuron(0, (100, 100), 30, 0.0, true),
     ];
     let net = Network::new(&ns, &p.weights).unwrap();
-    assert_eq!(fallback(&ns, &net, &[0, 1], &p), [0, 1]);
+    assert_eq!(fallback(&ns, &net, &[0, 1], &p).unwrap(), [0, 1]);
     let one = vec![neuron(0, (100, 100), 10, 0.0, true)];
     let net = Network::new(&one, &p.weights).unwrap();
-    assert_eq!(fallback(&one, &net, &[0], &p), [1]);
+    assert_eq!(fallback(&one, &net, &[0], &p).unwrap(), [1]);
 }
 
 /// The group fallback takes lone points only: one candidate that passed the edge test. Ten
@@ -887,12 +895,12 @@ fn group_fallback_skips_edge_failures_and_points_with_several_candidates() {
     let mut edge = row();
     edge[0].edge_ok = false;
     let net = Network::new(&edge, &p.weights).unwrap();
-    let out = fallback(&edge, &net, &[0; 10], &p);
+    let out = fallback(&edge, &net, &[0; 10], &p).unwrap();
     assert_eq!(out, [0, 1, 1, 1, 1, 1, 1, 1, 1, 1]);
     let mut two = row();
     two.insert(1, neuron(0, (100, 100), 30, 0.0, true));
     let net = Network::new(&two, &p.weights).unwrap();
-    let out = fallback(&two, &net, &[0; 11], &p);
+    let out = fallback(&two, &net, &[0; 11], &p).unwrap();
     assert_eq!(out, [0, 0, 1, 1, 1, 1, 1, 1, 1, 1, 1]);
 }
 
@@ -1112,4 +1120,94 @@ fn network_orders_too_large_to_allocate_are_an_error() {
         let want = format!("child: error: out of memory: {want}");
         assert!(stdout.contains(&want), "{mib} MiB: {want} not in {stdout}");
     }
+}
+
+/// Run by [`final_stages_too_large_to_allocate_are_an_error`] in a child process: the final
+/// selection and the depth-edge filters of 2^20 lone neurons, all on (the network built
+/// before), under an address-space limit of `SV_OOM_MIB` MiB more than is mapped.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of final_stages_too_large_to_allocate_are_an_error"]
+fn final_stages_under_a_memory_limit() {
+    let Some(mib) = std::env::var_os("SV_OOM_MIB") else {
+        return;
+    };
+    let mib: usize = mib.to_str().unwrap().parse().unwrap();
+    let neurons = lone_neurons();
+    let p = HopfieldParams::default();
+    let net = Network::new(&neurons, &p.weights).unwrap();
+    let state = vec![1u8; neurons.len()];
+    let img = vec![0.0f32; 4];
+    let v = ImageView::new(2, 2, &img).unwrap();
+    rayon::join(|| (), || ()); // the pool's thread started before the limit
+    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (mib << 20));
+    let run = || -> Result<usize> {
+        let selected = fallback(&neurons, &net, &state, &p)?;
+        let chosen = disambiguate(&neurons, &net, &selected, &p)?;
+        Ok(finish(&v, &v, &neurons, &chosen, &p)?.len())
+    };
+    match run() {
+        Ok(n) => println!("child: {n} matches"),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn final_stages_too_large_to_allocate_are_an_error() {
+    // The stages after the dynamics (fallback, disambiguation, the rescue and the neighbour
+    // agreement) built their per-neuron, per-point and per-match lists and their point grids
+    // (PointGrid::new) with collect/vec!/push: a failed allocation aborted the process
+    // (SIGABRT) instead of returning OutOfMemory.
+    for (mib, want) in [
+        ("1", "the Hopfield matcher's final selection needs "),
+        ("24", "the Hopfield matcher's point grid needs "),
+        ("40", "the Hopfield matcher's depth-edge filters needs "),
+    ] {
+        let stdout = crate::segment::tests::run_oom_child_with(
+            "matching::hopfield::tests::final_stages_under_a_memory_limit",
+            Some(("SV_OOM_MIB", mib)),
+        );
+        let want = format!("child: error: out of memory: {want}");
+        assert!(stdout.contains(&want), "{mib} MiB: {want} not in {stdout}");
+    }
+}
+
+/// Run by [`a_compatibility_table_too_large_to_allocate_is_an_error`] in a child process: two
+/// points with a disparity span of 2048 px and a compatibility that never saturates
+/// (`compat_slope` 0: 21 rows of 2^22 + 1 entries, 352 MiB) under an address-space limit of
+/// 64 MiB more than is mapped.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of a_compatibility_table_too_large_to_allocate_is_an_error"]
+fn compatibility_table_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let mut neurons = lone_neurons();
+    neurons.truncate(2);
+    neurons[0].xl = 2048;
+    let w = EnergyWeights {
+        compat_slope: 0.0,
+        ..HopfieldParams::default().weights
+    };
+    rayon::join(|| (), || ()); // the pool's thread started before the limit
+    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (64 << 20));
+    match Network::new(&neurons, &w) {
+        Ok(net) => println!("child: network of {}", net.n()),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn a_compatibility_table_too_large_to_allocate_is_an_error() {
+    // Network::new built the compatibility table (one row per window distance, as long as the
+    // squared disparity span where the values do not saturate) with push/collect: a failed
+    // allocation aborted the process (SIGABRT) instead of returning OutOfMemory.
+    let stdout = crate::segment::tests::run_oom_child(
+        "matching::hopfield::tests::compatibility_table_under_a_memory_limit",
+    );
+    let want = "child: error: out of memory: the Hopfield network's compatibility table needs ";
+    assert!(stdout.contains(want), "{want} not in {stdout}");
 }
