@@ -435,7 +435,7 @@ pub fn channel_curves(
         .segments
         .par_iter()
         .map(|s| build_rtable(s, &zc.theta, w, p.cand.n_bins))
-        .collect();
+        .collect::<Result<_>>()?;
     Ok(ChannelCurves {
         sigma,
         scale,

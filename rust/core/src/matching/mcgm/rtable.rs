@@ -11,6 +11,8 @@
 use std::f64::consts::TAU;
 
 use super::tracking::Segment;
+use crate::alloc::{try_collect, try_filled, try_zeroed};
+use crate::error::Result;
 
 /// R-table of one segment in CSR form over `n_bins` orientation bins.
 #[derive(Debug, Clone, PartialEq)]
@@ -48,24 +50,29 @@ pub fn theta_bin(theta: f32, n_bins: usize) -> usize {
     }
 }
 
-/// Builds the R-table of `seg` (`theta`: normal directions of the image, `w`: its width).
-pub fn build_rtable(seg: &Segment, theta: &[f32], w: usize, n_bins: usize) -> RTable {
-    let mut counts = vec![0u32; n_bins + 1];
-    let bins: Vec<usize> = seg
-        .pixels
-        .iter()
-        .map(|&i| theta_bin(theta[i as usize], n_bins))
-        .collect();
+/// Builds the R-table of `seg` (`theta`: normal directions of the image, `w`: its width). A
+/// failed allocation of its tables (24 bytes a pixel at the peak) is
+/// [`crate::CoreError::OutOfMemory`].
+pub fn build_rtable(seg: &Segment, theta: &[f32], w: usize, n_bins: usize) -> Result<RTable> {
+    const WHAT: &str = "an R-table of the MCGM matcher";
+    let mut counts = try_zeroed::<u32>(n_bins + 1, WHAT)?;
+    let bins = try_collect(
+        seg.pixels.len(),
+        seg.pixels
+            .iter()
+            .map(|&i| theta_bin(theta[i as usize], n_bins)),
+        WHAT,
+    )?;
     for &b in &bins {
         counts[b + 1] += 1;
     }
     for b in 1..=n_bins {
         counts[b] += counts[b - 1];
     }
-    let mut fill = counts.clone();
+    let mut fill = try_collect(counts.len(), counts.iter().copied(), WHAT)?;
     let n = seg.pixels.len();
-    let mut vecs = vec![(0.0f32, 0.0f32); n];
-    let mut px = vec![(0i32, 0i32); n];
+    let mut vecs = try_filled(n, (0.0f32, 0.0f32), WHAT)?;
+    let mut px = try_filled(n, (0i32, 0i32), WHAT)?;
     for (k, &i) in seg.pixels.iter().enumerate() {
         let (x, y) = ((i as usize % w) as i32, (i as usize / w) as i32);
         let slot = fill[bins[k]] as usize;
@@ -73,11 +80,11 @@ pub fn build_rtable(seg: &Segment, theta: &[f32], w: usize, n_bins: usize) -> RT
         vecs[slot] = (seg.centroid.0 - x as f32, seg.centroid.1 - y as f32);
         px[slot] = (x, y);
     }
-    RTable {
+    Ok(RTable {
         offsets: counts,
         vecs,
         px,
-    }
+    })
 }
 
 /// GHT comparison result: normalised peak and the vote-weighted translation `t = p - q`.

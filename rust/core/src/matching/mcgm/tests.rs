@@ -121,7 +121,7 @@ fn ght_of_a_translated_contour_scores_one_at_the_translation() {
         .iter()
         .find(|s| s.pixels.len() >= 20 && s.x_min > 10)
         .expect("a long segment");
-    let rt = build_rtable(seg, &cl.zc.theta, w, p.cand.n_bins);
+    let rt = build_rtable(seg, &cl.zc.theta, w, p.cand.n_bins).unwrap();
     let moved: Vec<u32> = seg.pixels.iter().map(|&i| i - 7).collect();
     let mut theta = cl.zc.theta.clone();
     for (&i, &j) in seg.pixels.iter().zip(&moved) {
@@ -1454,7 +1454,7 @@ fn ght_and_rtable_equal_the_brute_force_vote() {
             y_max: 0,
             mean_theta: 0.0,
         };
-        let rt = build_rtable(&sa, &theta, w, n_bins);
+        let rt = build_rtable(&sa, &theta, w, n_bins).unwrap();
         // The R-table: bins in order, each bin's pixels in segment order, r = c - p.
         let bin = |t: f32| rtable::theta_bin(t, n_bins);
         let mut k = 0;
@@ -1532,7 +1532,7 @@ fn candidates_equal_the_gated_brute_force_search() {
     ] {
         let rts: Vec<_> = ls
             .iter()
-            .map(|s| build_rtable(s, &cl.zc.theta, w, cp.n_bins))
+            .map(|s| build_rtable(s, &cl.zc.theta, w, cp.n_bins).unwrap())
             .collect();
         let got = graph::candidates(ls, &rts, rs, &cr.zc.theta, w, h, &window, &cp).unwrap();
         let bins = |s: &Segment, theta: &[f32]| -> Vec<(i32, i32, usize)> {
@@ -1759,7 +1759,7 @@ fn candidates_reach_across_the_band_and_the_wider_segment_slack() {
         ..McgmParams::default().cand
     };
     let run = |a: Segment, b: &[Segment], win: (i32, i32), cp: &graph::CandParams| {
-        let rt = build_rtable(&a, &theta, w, cp.n_bins);
+        let rt = build_rtable(&a, &theta, w, cp.n_bins).unwrap();
         graph::candidates(&[a], &[rt], b, &theta, w, h, &[Some(win)], cp).unwrap()
     };
     let a = mk((20..26).map(|x| (x, 10)).collect());
@@ -2162,7 +2162,7 @@ fn candidates_length_ratio_bound_is_inclusive_and_normal_bound_strict() {
         ght_min_score: 0.5,
         k_cand: 4,
     };
-    let rts = [build_rtable(&left[0], &theta, w, cp.n_bins)];
+    let rts = [build_rtable(&left[0], &theta, w, cp.n_bins).unwrap()];
     let window = [Some((0, 5))];
     let got = graph::candidates(&left, &rts, &right, &theta, w, h, &window, &cp).unwrap();
     assert_eq!(got.len(), 1);
@@ -2571,4 +2571,45 @@ fn open_lanes_with_stored_sums_is_bit_identical_and_keeps_nothing_stale() {
         }
     }
     assert!(ones > 100 && zeros > 100, "{ones} {zeros}");
+}
+
+/// Run by [`an_rtable_too_large_to_allocate_is_an_error`] in a child process: one segment of
+/// 2^21 pixels under an address-space limit of 24 MiB more than is mapped: its orientation
+/// bins (16 MiB) fit, its vectors (16 MiB more) do not.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of an_rtable_too_large_to_allocate_is_an_error"]
+fn rtable_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let n = 1u32 << 21;
+    let seg = Segment {
+        pixels: (0..n).collect(),
+        centroid: (1024.0, 512.0),
+        x_min: 0,
+        x_max: 2047,
+        y_min: 0,
+        y_max: 1023,
+        mean_theta: 0.0,
+    };
+    let theta = vec![1.0f32; n as usize];
+    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (24 << 20));
+    match build_rtable(&seg, &theta, 2048, 16) {
+        Ok(rt) => println!("child: {} entries", rt.px.len()),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn an_rtable_too_large_to_allocate_is_an_error() {
+    // build_rtable allocated its bins, vectors and pixels (24 bytes a segment pixel) with
+    // collect/vec!: a failed allocation aborted the process (SIGABRT) instead of returning
+    // OutOfMemory.
+    let stdout =
+        crate::segment::tests::run_oom_child("matching::mcgm::tests::rtable_under_a_memory_limit");
+    let want = "child: error: out of memory: an R-table of the MCGM matcher needs 16.00 MiB \
+                (16777216 bytes)";
+    assert!(stdout.contains(want), "{want} not in {stdout}");
 }
