@@ -3866,7 +3866,8 @@ def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
     assert app.calib.image_size == (640, 480) and app.calib.unit == "mm"
     assert app.calib.baseline_m == pytest.approx(np.linalg.norm([120.0, 1.5, 0.8]) / 1000)
     said = "calibration is for 640x480 images, got 320x240 (images resized, not cropped: "
-    said += "calib.scaled_to((320, 240)))"
+    said += "choose images, an image folder or cameras of the calibration's size, or start gui "
+    said += "again with a --calib for 320x240 images)"
     app.state.left_file = str(data / "small" / "left_0001.png")
     app.state.right_file = str(data / "small" / "right_0001.png")
     app.load_files()

@@ -215,8 +215,12 @@ ADVICE: dict[str, dict[str, str]] = {
     },
 }
 ADVICE["low_uint16"]["page"] = ADVICE["low_uint16"]["cli"]  # on the page too, a file
-# the page scales a calibration to frames resized by it (fit_to_frames): never said there
-ADVICE["resized"]["page"] = ADVICE["resized"]["cli"]
+# the page refuses a pair of another size than the one a size-less --calib was read at
+# (StereoApp._calib_for; one with a size is fitted to the frames): no calibration is scaled there
+ADVICE["resized"]["page"] = (
+    "images resized, not cropped: choose images, an image folder or cameras of the "
+    "calibration's size, or start gui again with a --calib for {w}x{h} images"
+)
 ADVICE["resized_map"]["page"] = ADVICE["resized_map"]["cli"]
 LOW_UINT16_ADVICE = ADVICE["low_uint16"]["api"]
 

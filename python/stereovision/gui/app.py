@@ -1784,8 +1784,12 @@ class StereoApp:
             self._sizeless_calib = None
             self._calib_sized_by = (left.shape[1], left.shape[0])
         if self._calib_sized_by is not None:
-            # "calibration is for 640x480 images, got 320x240 (...)", as depth and batch say
-            _rig_to_warp_by(self.source_calib, left.shape[1], left.shape[0], None)
+            # "calibration is for 640x480 images, got 320x240 (...)", as depth and batch say,
+            # its remedy in the page's words (it said "calib.scaled_to((320, 240))")
+            try:
+                _rig_to_warp_by(self.source_calib, left.shape[1], left.shape[0], None)
+            except ValueError as exc:
+                raise ValueError(advice_for(str(exc), "page")) from None
         return self.source_calib
 
     def _camera_source(self, text: str) -> int | str:
