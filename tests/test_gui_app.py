@@ -2241,6 +2241,40 @@ def test_clouds_saved_in_the_home_folder_are_offered_to_show_again(tmp_path, mon
         assert app.state.error.startswith("path outside the allowed folders: "), elsewhere
 
 
+def test_home_clouds_are_offered_when_saves_go_home_past_a_writable_saved(tmp_path, monkeypatch):
+    """A read-only --data folder holding a writable, full ``saved`` (made before it was made
+    read-only): a Save as offered goes to ``saved-2``, which cannot be made, so home; but the
+    point-cloud list decided on ``saved`` alone (writable: "Saves do not go home"), so the cloud
+    just saved to ~/stereovision-saved was not offered and "Show" refused it. The list now asks
+    what the Save asks: the folder the next Save as offered would write into."""
+    import stereovision.io as svio
+    from stereovision.gui import bundled_data_dir
+
+    data, home = tmp_path / "data", tmp_path / "home"
+    (data / "saved").mkdir(parents=True)
+    (data / "saved" / "notes.txt").write_text("an earlier Save's")
+    home.mkdir()
+    real = svio.cannot_write_in
+    read_only = data.resolve()
+    monkeypatch.setattr(
+        svio,
+        "cannot_write_in",
+        lambda f: "Read-only file system" if Path(f).resolve() == read_only else real(f),
+    )
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.chdir("/")
+    app = _scene_app("test-home-clouds-saved-2", [bundled_data_dir(), data])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.save_label.startswith("saved 450×375 to ~/stereovision-saved: ")
+    saved = str((home / "stereovision-saved" / "cloud.ply").resolve())
+    assert {"title": "~/stereovision-saved/cloud.ply", "value": saved} in app.state.clouds
+    app.state.cloud_path = saved
+    app.open_cloud()
+    assert app.state.error == "" and app._cloud is not None
+
+
 def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkeypatch):
     """Save pressed twice (or again after a new pair came) while the first still wrote: the
     second found none of the files yet, wrote too, and replaced the first's files without a

@@ -1576,7 +1576,14 @@ class StereoApp:
         folders the page may read (their clouds: the point-cloud list offered only the
         ``--data`` folders', and "Show" refused what was just saved). None when Saves do not
         go there. A link named so is left out: it may lead anywhere."""
-        if not self._save_roots or not _cannot_make(self._save_roots[0] / SAVE_FOLDER):
+        if not self._save_roots:
+            return None
+        try:
+            # the folder a Save as offered takes, as save() decides: ``saved`` alone was asked
+            # of, and a writable full one in a read-only --data hid the home folder's clouds
+            if not _cannot_make(self._next_save_folder()):
+                return None
+        except (ValueError, OSError):  # no such folder in --data: save() says why
             return None
         try:
             home = Path.home()
