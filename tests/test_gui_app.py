@@ -2241,6 +2241,30 @@ def test_clouds_saved_in_the_home_folder_are_offered_to_show_again(tmp_path, mon
         assert app.state.error.startswith("path outside the allowed folders: "), elsewhere
 
 
+def test_a_home_relative_path_without_a_home_folder_is_said_on_the_page(tmp_path, monkeypatch):
+    """No home folder known (HOME unset, no password entry): "~/stereovision-saved/cloud.ply"
+    typed in the point-cloud field, or "~/out" in the save field, raised Path.expanduser's
+    RuntimeError out of the page's handler (Show said nothing, the field's tooltip broke).
+    Show says why on the page; the field's tooltip is empty, as for any unusable folder."""
+    import pwd
+
+    from stereovision.gui import bundled_data_dir
+
+    def no_entry(uid: int) -> Any:
+        raise KeyError(uid)
+
+    app = _scene_app("test-no-home-tilde", [bundled_data_dir(), tmp_path])
+    monkeypatch.delenv("HOME", raising=False)
+    monkeypatch.setattr(pwd, "getpwuid", no_entry)
+    app.state.cloud_path = "~/stereovision-saved/cloud.ply"
+    app.open_cloud()
+    assert app.state.error == (
+        "no home folder is known for ~/stereovision-saved/cloud.ply (HOME is not set): "
+        "give the whole path"
+    )
+    assert app._save_title("~/out") == ""
+
+
 def test_home_clouds_are_offered_when_saves_go_home_past_a_writable_saved(tmp_path, monkeypatch):
     """A read-only --data folder holding a writable, full ``saved`` (made before it was made
     read-only): a Save as offered goes to ``saved-2``, which cannot be made, so home; but the

@@ -6,6 +6,7 @@ mutation audit of ``stereovision.gui.sources`` found unasserted.
 
 from __future__ import annotations
 
+import re
 import subprocess
 import sys
 import time
@@ -177,6 +178,34 @@ def test_home_relative_paths_are_expanded(
     assert folders.roots == (data.resolve(),)
     assert folders.resolve("~/data/a.ply") == (data / "a.ply").resolve()
     assert folders.resolve_output(" ~/data/new") == data.resolve() / "new"
+
+
+def _no_home(monkeypatch: pytest.MonkeyPatch) -> None:
+    """No home folder known: HOME unset and no password entry (a service's user)."""
+    import pwd
+
+    def no_entry(uid: int) -> Any:
+        raise KeyError(uid)
+
+    monkeypatch.delenv("HOME", raising=False)
+    monkeypatch.setattr(pwd, "getpwuid", no_entry)
+
+
+def test_a_home_relative_path_without_a_home_folder_is_refused_in_words(
+    data: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With no home folder known, a typed ``~/...`` raised Path.expanduser's RuntimeError
+    ("Could not determine home directory."), which the page's handlers (ValueError, OSError)
+    let through: the page said nothing. It is a ValueError naming the path and the cause."""
+    _no_home(monkeypatch)
+    folders = AllowedFolders([data])
+    said = "no home folder is known for ~/data/a.ply (HOME is not set): give the whole path"
+    with pytest.raises(ValueError, match=re.escape(said)):
+        folders.resolve("~/data/a.ply")
+    with pytest.raises(ValueError, match="no home folder is known for ~/new "):
+        folders.resolve_output("~/new")
+    assert not folders.contains("~/data/a.ply")
+    assert folders.resolve(data / "a.ply") == (data / "a.ply").resolve()  # the rest as before
 
 
 def test_files_and_scenes_of_two_roots(tmp_path: Path) -> None:

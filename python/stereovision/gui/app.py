@@ -51,6 +51,7 @@ from stereovision.gui.sources import (
     FolderPairs,
     StereoSource,
     display_path,
+    expand_home,
     open_stereo_source,
     parse_source,
     scale_pair,
@@ -1615,7 +1616,7 @@ class StereoApp:
             path = self.folders.resolve(typed)
             return path, self.folders.label(path)
         except ValueError:
-            home = self._home_saves() if Path(typed).expanduser().is_absolute() else None
+            home = self._home_saves() if expand_home(typed).is_absolute() else None
             if home is None or not home.contains(typed):
                 raise
         path = home.resolve(typed)
@@ -1634,7 +1635,7 @@ class StereoApp:
             Empty, or outside the ``--data`` folders.
         """
         text = typed.strip()
-        p = Path(text).expanduser() if text else None
+        p = expand_home(text) if text else None
         if p is not None and "\x00" not in text and not p.is_absolute():
             here = (Path.cwd() / p).resolve()
             if any(here == r or here.is_relative_to(r) for r in self._save_roots):

@@ -94,6 +94,24 @@ def display_path(
     return str(p)
 
 
+def expand_home(text: str) -> Path:
+    """``text`` as a path, a leading ``~`` expanded to the home folder.
+
+    Raises
+    ------
+    ValueError
+        ``text`` starts with ``~`` and no home folder is known (HOME unset, no password
+        entry): Path.expanduser's RuntimeError went past the page's handlers, which said
+        nothing.
+    """
+    try:
+        return Path(text).expanduser()
+    except RuntimeError:
+        raise ValueError(
+            f"no home folder is known for {text} (HOME is not set): give the whole path"
+        ) from None
+
+
 class AllowedFolders:
     """The folders the page may read files from, and the check that keeps it inside them.
 
@@ -147,7 +165,7 @@ class AllowedFolders:
         text = os.fspath(path)
         if not text or "\x00" in text:
             raise ValueError("empty or invalid path")
-        p = Path(text).expanduser()
+        p = expand_home(text)
         if not p.is_absolute():
             if not self.roots:
                 raise ValueError(f"path outside the allowed folders: {text}")
@@ -183,7 +201,7 @@ class AllowedFolders:
             raise ValueError("empty or invalid folder")
         if not allowed:
             raise ValueError("no folder to write into: start the GUI with --data DIR")
-        p = Path(text.strip()).expanduser()
+        p = expand_home(text.strip())
         if not p.is_absolute():
             p = allowed[0] / p
         real = p.resolve()  # the existing part's links resolved, the rest as written
