@@ -3565,6 +3565,77 @@ def test_start_up_cameras_and_play_read_their_first_pair_off_the_page(tmp_path, 
     asyncio.run(clicks())
 
 
+def test_capture_waits_for_the_first_pair_of_a_folder_being_played(tmp_path, monkeypatch):
+    """Play's first pair now comes from a thread; a Capture clicked before it came said "no
+    camera open: give --left/--right or open cameras below" (none yet: the folder was chosen),
+    or read the start-up cameras the folder replaces, their pair shown and computed before the
+    folder's. It is refused in words until that pair comes; then Capture plays the folder."""
+    import asyncio
+    import threading
+
+    import stereovision.io as svio
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    gate = threading.Event()
+    camera_reads: list[int] = []
+
+    class Cameras:
+        def read(self):
+            camera_reads.append(1)
+            return frame.copy(), frame.copy()
+
+        def close(self):
+            pass
+
+    seq = tmp_path / "seq"
+    seq.mkdir()
+    for n in ("0001", "0002"):
+        for side in ("left", "right"):
+            cv2.imwrite(str(seq / f"{side}_{n}.png"), frame)
+    real = svio.imread
+
+    def held(*args: Any, **kwargs: Any) -> Any:
+        gate.wait(1.0)  # a stalled share (bounded: a broken app cannot hang the test)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(svio, "imread", held)
+    said = f"still reading folder {tmp_path.name}/seq (its first pair has not come): wait for it"
+
+    async def clicks(source: Any) -> None:
+        app = _scene_app(
+            f"test-capture-first-pair-{source is None}",
+            [bundled_data_dir(), tmp_path],
+            source=source,
+            source_names=("0", "1"),
+        )
+        tasks = _collect_reads(app)
+        app._lock = asyncio.Lock()
+        if source is not None:
+            app._on_ready()
+            await tasks[-1]
+        reads_before = len(camera_reads)
+        gate.clear()
+        app.state.pair_folder = str(seq)
+        app.open_pair_folder()
+        app.capture()
+        assert app.state.error == said
+        assert app.state.status == f"reading folder {tmp_path.name}/seq..."
+        assert len(tasks) == (2 if source is not None else 1)  # no read of the cameras
+        gate.set()
+        await tasks[-1]
+        assert len(camera_reads) == reads_before
+        assert app.state.error == ""
+        assert app.state.source_label.endswith("seq: pair 0001 (1 of 2)")
+        app.capture()  # the folder's next pair
+        await tasks[-1]
+        assert app.state.error == ""
+        assert app.state.source_label.endswith("seq: pair 0002 (2 of 2)")
+
+    asyncio.run(clicks(None))
+    asyncio.run(clicks(Cameras()))
+
+
 def test_a_wedged_camera_read_leaves_the_page_free(monkeypatch):
     """After an Open, the cameras' first read, and every Capture's, ran in the page's handler:
     a wedged camera froze the page up to --read-timeout. They run in a thread now, the page

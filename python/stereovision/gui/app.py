@@ -1432,6 +1432,10 @@ class StereoApp:
         #: Camera sources whose open (on the page's "Open") has not returned yet, given up or
         #: not: another Open of them is refused (each left one more thread blocked in them).
         self._opening: set[int | str] = set()
+        #: The source choice (``_choice``) whose first pair is being read, an Open's cameras
+        #: or a folder's Play (:meth:`_first_pair`), and how "reading ..." names it: a Capture
+        #: meanwhile read the cameras that choice replaces, or said "no camera open".
+        self._first_read: tuple[int, str] | None = None
         #: Counts the page's choices of what to show (Open, an image folder, a scene, files): an
         #: open that returns after a newer choice closes its cameras instead of replacing it.
         self._choice = 0
@@ -1866,6 +1870,12 @@ class StereoApp:
         """
         source = self.source
         try:
+            first = self._first_read
+            if first is not None and first[0] == self._choice:
+                # the chosen source's first pair comes: not the source it replaces
+                raise OSError(
+                    f"still reading {first[1]} (its first pair has not come): wait for it"
+                )
             if source is None:
                 raise OSError("no camera open: give --left/--right or open cameras below")
             what = self._source_what(source)
@@ -2147,6 +2157,7 @@ class StereoApp:
                 return
             # the first pair read in a thread too: a camera that opens may still not deliver
             self._begin_read(source, what)
+            self._first_read = (choice, what)
             await self._first_pair(source, names, what, choice)
         finally:
             self._opening.difference_update(keys)
@@ -2157,10 +2168,12 @@ class StereoApp:
         """Read the first pair of ``source``, newly opened (cameras, an image folder), in a
         thread (:meth:`_read_in_thread`; registered by :meth:`_begin_read`), then use it
         (:meth:`_switch_source`) or say why not. ``source`` is closed unless used; after a
-        newer choice than ``choice`` (``_choice``), nothing is said."""
+        newer choice than ``choice`` (``_choice``), nothing is said. The caller set
+        ``_first_read`` (a Capture is refused until this returns)."""
         try:
             got = await self._read_in_thread(source, bool(self.state.average))
         except Exception as exc:
+            self._end_first_read(choice)
             source.close()
             if choice != self._choice:
                 return
@@ -2170,11 +2183,17 @@ class StereoApp:
                 exc = OSError(f"{first_line(exc)} (the cameras in use are unchanged)")
             self._fail(exc, outlasts=True)
             return
+        self._end_first_read(choice)
         if choice != self._choice:
             source.close()
             return
         with self.state:
             self._switch_source(source, names, got)
+
+    def _end_first_read(self, choice: int) -> None:
+        """The first read of ``choice``'s source returned: Capture is no longer refused for it."""
+        if self._first_read is not None and self._first_read[0] == choice:
+            self._first_read = None
 
     def open_pair_folder(self) -> None:
         """Play the pairs of the chosen image folder (as ``batch`` pairs them), one per
@@ -2196,6 +2215,7 @@ class StereoApp:
         self._choice += 1  # an open still under way must not replace these pairs
         what = self._source_what(source)
         self._begin_read(source, what)
+        self._first_read = (self._choice, what)
         self._spawn(self._first_pair(source, ("", ""), what, self._choice))
 
     def _switch_source(
