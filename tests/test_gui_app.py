@@ -3413,7 +3413,8 @@ def test_a_read_that_fails_during_a_computation_is_said_after_it(monkeypatch):
 
     class Cameras:
         def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
-            pass
+            if left == 7:
+                raise OSError("camera 7 did not open")
 
         def read(self):
             reads.append(self)
@@ -3481,6 +3482,17 @@ def test_a_read_that_fails_during_a_computation_is_said_after_it(monkeypatch):
         await computing
         assert (app.state.status, app.state.error) == ("error", said)
         assert app.state.source_label == "cameras 0 / 1"
+        # an Open that fails (the cameras do not open) while a pair computes: the same
+        compute_gate.clear()
+        computing = asyncio.ensure_future(app.recompute())
+        await _until(lambda: app._computing)
+        app.state.cam_left, app.state.cam_right = "7", "8"
+        app.open_cameras()
+        await tasks[-1]
+        assert (app.state.status, app.state.error) == ("computing (fast)", "camera 7 did not open")
+        compute_gate.set()
+        await computing
+        assert (app.state.status, app.state.error) == ("error", "camera 7 did not open")
 
     asyncio.run(clicks())
 
