@@ -1060,3 +1060,37 @@ def test_the_dpi_a_too_large_board_suggests_is_accepted_typed_back(
     assert m is not None and m[1] == "70"
     assert main([*argv, "--dpi", m[2]]) == 0
     assert cv2.imread(out, cv2.IMREAD_GRAYSCALE).shape == (9 * most, 12 * most)
+
+
+def test_the_triangulated_square_sides_pair_partial_boards_corners_by_their_ids(
+    rig: dict[str, Any],
+) -> None:
+    """The report's square sides are measured between grid neighbours, which a cut board's
+    corners must be placed by their ids to find. A fourth mutation audit found them placed in
+    the order seen unasserted: the median side passed (30.05 mm for 30.00: most consecutive
+    corners are still neighbours) while the spread went from 0.45 % of the square to 152 %.
+    Independently: cv2.stereoRectify (alpha 0), cv2.undistortPoints and cv2.triangulatePoints,
+    each corner at its id in the 9x6 grid."""
+    cal, rep = calibrate(rig["left"][:6], rig["right"][:6], board=BOARD)
+    assert any(len(rep._ids[n]) < BOARD.n_corners for n in rep.used_pairs)  # cut boards
+    R1, R2, P1, P2, *_ = cv2.stereoRectify(
+        cal.K1, cal.D1, cal.K2, cal.D2, cal.image_size, cal.R, cal.T.reshape(3, 1),
+        flags=cv2.CALIB_ZERO_DISPARITY, alpha=0,
+    )  # fmt: skip
+    crit = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 40, 1e-12)
+    cols, rows = BOARD.inner
+    sides = []
+    for name in rep.used_pairs:
+        cl, cr = rep._corners[name]
+        ul = cv2.undistortPoints(cl.reshape(-1, 1, 2), cal.K1, cal.D1, R=R1, P=P1, criteria=crit)
+        ur = cv2.undistortPoints(cr.reshape(-1, 1, 2), cal.K2, cal.D2, R=R2, P=P2, criteria=crit)
+        Xh = cv2.triangulatePoints(P1, P2, ul.reshape(-1, 2).T, ur.reshape(-1, 2).T)
+        grid = np.full((rows * cols, 3), np.nan)
+        grid[rep._ids[name]] = (Xh[:3] / Xh[3]).T
+        X = grid.reshape(rows, cols, 3)
+        sides += [np.linalg.norm(np.diff(X, axis=a), axis=2).ravel() for a in (0, 1)]
+    side = np.concatenate(sides)
+    side = side[np.isfinite(side)]
+    assert rep.square_size_measured == pytest.approx(float(np.median(side)), rel=1e-6)
+    assert rep.square_size_std == pytest.approx(float(side.std()), rel=1e-4)
+    assert rep.square_size_std < 0.01 * BOARD.square_size
