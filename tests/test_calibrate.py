@@ -685,14 +685,19 @@ def test_outliers_of_the_last_round_are_kept_not_dropped_unsolved(
 ) -> None:
     """With no re-solve left, a round's outliers were dropped from the used pairs after the
     solve: the solution's per-pair errors (12 pairs) and the names (11) fell out of step, and
-    the pairing check failed with an IndexError. Now they are kept, and named."""
+    the pairing check failed with an IndexError. Now they are kept, and named; the message
+    does not advise dropping the outliers, asked for already (a fourth mutation audit found
+    its words unasserted)."""
     monkeypatch.setattr("stereovision.calibrate.MAX_OUTLIER_ROUNDS", 0)
     left, right = _mispaired_paths()
     with (
         pytest.warns(UserWarning, match="file numbers differ"),
-        pytest.raises(ValueError, match=r"Worst pairs: left06\.jpg / right05\.jpg \(26\."),
+        pytest.raises(ValueError, match=r"Worst pairs: left06\.jpg / right05\.jpg \(26\.") as err,
     ):
         calibrate(left, right, pattern=(9, 6), square_size=1.0, drop_outliers=True)
+    assert str(err.value).endswith(
+        ". Dropping the outliers left too many such pairs: check the pairing of the files"
+    )
 
 
 def test_a_swapped_pair_is_refused(cached_corners: None) -> None:
@@ -2126,3 +2131,92 @@ def test_a_numpy_string_unit_is_said_as_its_text() -> None:
     left, right = _chessboard_paths()
     with pytest.raises(ValueError, match=r"^unit: expected one of .*, got 'parsec'$"):
         calibrate(left[:2], right[:2], square_size=1.0, unit=np.str_("parsec"))
+
+
+def test_a_square_boards_right_corners_read_turned_are_put_in_the_left_order() -> None:
+    """A square pattern (7x7) has four readings of one board, the grid turned by quarter turns
+    (a detector may start it at any of the board's corners); the right corners are put in the
+    left camera's order whichever the right detector read. A fourth mutation audit found the
+    quarter turns unasserted (OpenCV's 9x6 sample boards have only the half turn)."""
+    left = np.mgrid[0:7, 0:7].T.reshape(-1, 2) * 20.0 + np.array([100.0, 50.0])
+    right = left + np.array([-30.0, 0.5])  # the other camera: the board shifted along the rows
+    grid = np.arange(49).reshape(7, 7)
+    for turns in (0, 1, 2, 3):
+        read = right[np.rot90(grid, turns).ravel()]
+        np.testing.assert_array_equal(calmod._match_order(left, read, (7, 7)), right)
+    wide = np.mgrid[0:9, 0:6].T.reshape(-1, 2) * 20.0
+    np.testing.assert_array_equal(calmod._match_order(wide, wide[::-1] + 3.0, (9, 6)), wide + 3.0)
+
+
+def test_the_classic_detector_is_tried_when_the_sector_based_one_finds_nothing(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """find_corners tries each of SB_FLAG_SETS with findChessboardCornersSB (only the first
+    when checkChessboard sees no board), then the classic findChessboardCorners. A fourth
+    mutation audit found the classic fallback unasserted: every board of the tests is found by
+    the sector-based detector. With that one failing, the rendered board is still found, its
+    corners within 0.15 px RMS of their projection."""
+    rv, tv = np.array([0.3, -0.2, 0.1]), np.array([-0.12, -0.07, 0.5])
+    img = render_chessboard(
+        SYN_K1, SYN_D1, rv, tv, pattern=SYN_PATTERN, square_size=SYN_SQUARE, image_size=SYN_SIZE
+    )
+    calls: list[int] = []
+
+    def sb_finds_nothing(gray: Any, pattern: Any, flags: int = 0) -> Any:
+        calls.append(flags)
+        return False, None
+
+    monkeypatch.setattr(cv2, "findChessboardCornersSB", sb_finds_nothing)
+    corners = find_corners(img, SYN_PATTERN)
+    assert calls == list(calmod.SB_FLAG_SETS)
+    truth = cv2.projectPoints(
+        board_object_points(SYN_PATTERN, SYN_SQUARE).astype(np.float64), rv, tv, SYN_K1, SYN_D1
+    )[0].reshape(-1, 2)
+    assert corners is not None and corners.shape == (54, 2)
+    if np.linalg.norm(corners[0] - truth[0]) > np.linalg.norm(corners[0] - truth[-1]):
+        truth = truth[::-1]
+    assert np.sqrt(np.mean(np.sum((corners - truth) ** 2, axis=1))) < 0.15
+    calls.clear()
+    assert find_corners(np.full((240, 320), 100, np.uint8), SYN_PATTERN) is None
+    assert calls == [calmod.SB_FLAG_SETS[0]]
+
+
+def test_the_fisheye_hint_needs_both_cameras_to_fit_far_better(
+    cached_corners: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The hint to calibrate with distortion='fisheye' is given when the fisheye model's RMS is
+    below the pinhole one's / FISHEYE_HINT_GAIN (2) in both cameras, and is looked for only when
+    a camera's pinhole RMS exceeds FISHEYE_HINT_MIN_RMS_PX (0.4). A fourth mutation audit found
+    "both" unasserted (one camera sufficed) and the bounds unchecked; on given solver figures."""
+    left, right = _chessboard_paths()
+    real = calmod._solve
+    mono = [(0.8, 0.8)]
+
+    def solve(*a: Any) -> Any:
+        sol = real(*a)
+        sol.rms_left, sol.rms_right = mono[0]
+        return sol
+
+    monkeypatch.setattr(calmod, "_solve", solve)
+    for pinhole, fisheye, hinted in (
+        ((0.8, 0.8), (0.39, 0.39), True),
+        ((0.8, 0.8), (0.1, 0.5), False),  # the right camera gains 1.6x only
+        ((0.8, 0.8), (0.5, 0.1), False),
+        ((0.8, 0.8), (0.4, 0.4), False),  # exactly 2x is not "below"
+        ((0.4, 0.4), (0.1, 0.1), False),  # a pinhole fit of 0.4 px is not compared
+    ):
+        mono[0] = pinhole
+        monkeypatch.setattr(calmod, "_fisheye_mono_rms", lambda *a, f=fisheye: f)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            _, rep = calibrate(left[:4], right[:4], square_size=1.0, distortion="k1k2p1p2")
+        hints = [w for w in rep.warnings if "distortion='fisheye'" in w]
+        assert hints == (
+            [
+                f"the k1k2p1p2 model fits these views with {pinhole[0]:.3f} / {pinhole[1]:.3f} "
+                f"px (left / right), the fisheye model with {fisheye[0]:.3f} / {fisheye[1]:.3f} "
+                "px: a wide-angle lens; calibrate with distortion='fisheye'"
+            ]
+            if hinted
+            else []
+        ), (pinhole, fisheye)
