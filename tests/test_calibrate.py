@@ -2220,3 +2220,46 @@ def test_the_fisheye_hint_needs_both_cameras_to_fit_far_better(
             if hinted
             else []
         ), (pinhole, fisheye)
+
+
+def test_a_names_last_number_is_its_frame_number() -> None:
+    """Files named by camera and frame (cam1_0005.png with cam2_0005.png, as many capture tools
+    save them) are pairs of the same number: the frame, the name's last number, not the camera's.
+    A fourth mutation audit found the first number taken unasserted: every pair was then said to
+    have different file numbers, and the CLI paired the images on each side of a deleted one
+    by position (cam1_0004 with cam2_0003), without a word."""
+    assert calmod._file_number("cam1_0005.png") == 5
+    assert calmod._file_number("2024-05-01/left.png") is None
+    lefts = [f"cam1_{i:04d}.png" for i in (1, 2, 4, 5, 6)]
+    rights = [f"cam2_{i:04d}.png" for i in (1, 2, 4, 5, 6)]
+    assert calmod._numbers_differ(lefts, rights, lefts) == []
+    rights = [f"cam2_{i:04d}.png" for i in (1, 2, 3, 4, 6)]  # cam2_0005 and cam1_0003 deleted
+    assert calmod._numbers_differ(lefts, rights, lefts) == ["cam1_0004.png", "cam1_0005.png"]
+    with pytest.raises(
+        ValueError, match=r": cam1_0005\.png \(no right\), cam2_0003\.png \(no left\);"
+    ):
+        calmod._pair_by_number(lefts, rights)
+
+
+def test_outliers_are_dropped_for_three_rounds_then_kept(
+    cached_corners: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """drop_outliers re-solves after each drop, for MAX_OUTLIER_ROUNDS (3) rounds: an outlier
+    that only shows once a worse one is gone is dropped too, and one left after the last round
+    is kept and named. A fourth mutation audit found one round passing every test. Given
+    errors: one outlier (4 px beside 0.2 px) among 13, 12, 11 and 10 pairs."""
+    left, right = _chessboard_paths()
+    errors = {}
+    for n in (13, 12, 11, 10):
+        errors[n] = np.full((n, 2), 0.2)
+        errors[n][-1] = 4.0  # the last pair still used: dropped pairs are the last ones
+    errors[9] = np.full((9, 2), 0.2)  # (a fourth round would solve once more)
+    _solve_with_errors(monkeypatch, errors)
+    names = [f"p{i:02d}" for i in range(13)]
+    _, rep = calibrate(
+        left, right, square_size=1.0, distortion="k1k2p1p2", drop_outliers=True, names=names
+    )
+    assert list(rep.rejected_pairs) == ["p12", "p11", "p10"]
+    assert rep.used_pairs == names[:10]
+    assert rep.outlier_pairs == ["p12", "p11", "p10", "p09"]
+    assert rep.summary().endswith("  outlier kept: p09 (drop it with drop_outliers=True)")
