@@ -2263,3 +2263,23 @@ def test_outliers_are_dropped_for_three_rounds_then_kept(
     assert rep.used_pairs == names[:10]
     assert rep.outlier_pairs == ["p12", "p11", "p10", "p09"]
     assert rep.summary().endswith("  outlier kept: p09 (drop it with drop_outliers=True)")
+
+
+def test_a_mispairing_refusal_names_no_rejected_pair_among_the_numbers_that_differ(
+    cached_corners: None, tmp_path: Path
+) -> None:
+    """The refusal of mis-paired images lists the pairs whose file numbers differ among the
+    pairs it solved: a pair rejected before (no board) is in the warning, not the refusal. A
+    fourth mutation audit found the rejected pairs' exclusion unasserted."""
+    left, right = _mispaired_paths()
+    blank = np.full((480, 640), 128, np.uint8)
+    for name in ("left20.png", "right21.png"):
+        cv2.imwrite(str(tmp_path / name), blank)
+    with (
+        pytest.warns(UserWarning, match=r"differ in left06\.jpg / right05\.jpg, left20\.png / r"),
+        pytest.raises(ValueError) as err,
+    ):
+        calibrate(
+            [*left, tmp_path / "left20.png"], [*right, tmp_path / "right21.png"], square_size=1.0
+        )
+    assert "; the file numbers differ in left06.jpg / right05.jpg. Check" in str(err.value)
