@@ -3012,3 +3012,28 @@ def test_cli_says_a_read_opencv_raised_on_in_one_line(
         "(packet read failed)"
     )
     assert err.count("\n") == 1 and "internal" not in err
+
+
+@pytest.mark.parametrize("first", [0, 7])
+def test_a_gap_counts_every_image_after_it_in_a_folder_of_more_files_than_a_hint_lists(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, first: int
+) -> None:
+    """The start of a late sequence and the images after a gap were looked for among the
+    first _HINT_MAX_FILES files the folder lists (in the file system's order, 20000): a
+    longer sequence was told fewer images after its gap than there are (and a late one could
+    start at a later number). Every file counts; the cap is made 3 here to stand for a folder
+    of more files than it."""
+    monkeypatch.setattr(capmod, "_HINT_MAX_FILES", 3)
+    folder = tmp_path / "seq"
+    folder.mkdir()
+    for i in range(first, first + 10):
+        if i != first + 2:
+            cv2.imwrite(str(folder / f"f_{i:03d}.png"), _numbered(i))
+    pattern = str(folder / "f_%03d.png")
+    with StereoCamera(pattern, pattern) as cam:
+        result = capture(cam, tmp_path / "pairs")
+    assert len(result.saved) == 2
+    assert result.ended.startswith(
+        f"left source {pattern!r} ended after 2 images: f_{first + 2:03d}.png is missing, so the "
+        "7 images numbered after it were not read"
+    )

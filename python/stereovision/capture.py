@@ -667,22 +667,28 @@ def _sequence_name(path: str, number: int) -> str:
     return parts[0] + parts[1] % number + parts[2]
 
 
-def _sequence_numbers(path: str) -> list[int]:
-    """The numbers of the files that image-sequence pattern ``path`` names, sorted (at most
-    :data:`_HINT_MAX_FILES` files of its folder looked at)."""
+def _sequence_digits(path: str) -> list[str]:
+    """The digits in the number's place of every file named as image-sequence pattern ``path``
+    around its number (``007``, ``0012`` for ``left_%03d.png``), whatever their width. Every
+    file of its folder is looked at: a sequence's start and the images after a gap may be
+    anywhere in the file system's listing order."""
     parts = _sequence_parts(path)
     if parts is None:
         return []
-    head, fmt, tail = parts
-    numbers = []
-    for name in itertools.islice(
-        glob.iglob(glob.escape(head) + "*" + glob.escape(tail)), _HINT_MAX_FILES
-    ):
-        digits = name[len(head) : len(name) - len(tail)]
-        # as the pattern prints it: left_%03d.png names left_007.png, not left_0007.png
-        if digits.isdecimal() and fmt % int(digits) == digits:
-            numbers.append(int(digits))
-    return sorted(numbers)
+    head, _, tail = parts
+    found = (
+        name[len(head) : len(name) - len(tail)] for name in glob.iglob(_sequence_glob(path) or "")
+    )
+    return [digits for digits in found if digits.isdecimal()]
+
+
+def _sequence_numbers(path: str) -> list[int]:
+    """The numbers of the files that image-sequence pattern ``path`` names, sorted."""
+    parts = _sequence_parts(path)
+    if parts is None:
+        return []
+    # as the pattern prints it: left_%03d.png names left_007.png, not left_0007.png
+    return sorted(int(d) for d in _sequence_digits(path) if parts[1] % int(d) == d)
 
 
 def _sequence_first(path: str) -> tuple[int, str] | None:
@@ -698,8 +704,9 @@ def _sequence_first(path: str) -> tuple[int, str] | None:
             return i, name
     # a first number wider than the pattern pads to is no start (left_%03d.png for left_0001.png
     # ... left_10000.png: its files are a %04d run, and left_10000.png alone is no sequence)
-    width = int(parts[1][1:-1] or 0)
-    numbers = [n for n in _sequence_numbers(path) if not width or len(parts[1] % n) == width]
+    fmt = parts[1]
+    width = int(fmt[1:-1] or 0)
+    numbers = [n for n in _sequence_numbers(path) if not width or len(fmt % n) == width]
     return (numbers[0], _sequence_name(path, numbers[0])) if numbers else None
 
 
