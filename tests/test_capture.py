@@ -3014,6 +3014,34 @@ def test_cli_says_a_read_opencv_raised_on_in_one_line(
     assert err.count("\n") == 1 and "internal" not in err
 
 
+@pytest.mark.parametrize(
+    ("name", "files", "told"),
+    [
+        ("left_%d.png", [f"left_{i:02d}.png" for i in range(1, 151)], "left_%02d.png"),
+        ("left_%03d.png", [f"left_{i:02d}.png" for i in range(1, 151)], "left_%02d.png"),
+        ("left_%d.png", [f"left_{i:04d}.png" for i in range(1, 1101)], "left_%04d.png"),
+    ],
+)
+def test_a_misnumbered_pattern_over_a_long_run_is_told_not_opened_part_way(
+    tmp_path: Path, name: str, files: list[str], told: str
+) -> None:
+    """A pattern that prints the numbers of a run's later files alone (left_%d.png over
+    left_01.png ... left_150.png prints 10-150 as they are named) opened the run from the
+    lowest of those, the images before it silently left out (left_%d.png read from left_10.png,
+    left_%03d.png from left_100.png); it was, and is again, told the pattern of the files."""
+    folder = tmp_path / "seq"
+    folder.mkdir()
+    img = np.zeros((8, 8, 3), np.uint8)
+    for f in files:
+        cv2.imwrite(str(folder / f), img)
+    with pytest.raises(FileNotFoundError) as err:
+        StereoCamera(str(folder / name), str(folder / name))
+    assert str(err.value) == (
+        f"left source: no file fits {folder / name}; give a pattern such as {folder / told} "
+        f"(its files are named {files[0]}, {files[1]} ...)"
+    )
+
+
 @pytest.mark.parametrize("first", [0, 7])
 def test_a_gap_counts_every_image_after_it_in_a_folder_of_more_files_than_a_hint_lists(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, first: int

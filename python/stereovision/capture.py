@@ -706,8 +706,16 @@ def _sequence_first(path: str) -> tuple[int, str] | None:
     # ... left_10000.png: its files are a %04d run, and left_10000.png alone is no sequence)
     fmt = parts[1]
     width = int(fmt[1:-1] or 0)
-    numbers = [n for n in _sequence_numbers(path) if not width or len(fmt % n) == width]
-    return (numbers[0], _sequence_name(path, numbers[0])) if numbers else None
+    digits = _sequence_digits(path)
+    numbers = sorted(int(d) for d in digits if fmt % int(d) == d and (not width or len(d) == width))
+    if not numbers:
+        return None
+    # nor is a number after a file of the run the pattern does not print: left_%d.png over
+    # left_01.png ... left_150.png prints 10-150 as named, and opened there (left_01-09 left
+    # out); such a pattern is told the files' own (_pattern_hint)
+    if any(int(d) < numbers[0] and fmt % int(d) != d for d in digits):
+        return None
+    return numbers[0], _sequence_name(path, numbers[0])
 
 
 def _sequence_gap(path: str, read: int) -> tuple[str, int] | None:
