@@ -3065,3 +3065,34 @@ def test_a_gap_counts_every_image_after_it_in_a_folder_of_more_files_than_a_hint
         f"left source {pattern!r} ended after 2 images: f_{first + 2:03d}.png is missing, so the "
         "7 images numbered after it were not read"
     )
+
+
+def test_capture_refuses_to_save_into_the_sequence_it_reads_through_a_folder_with_a_percent(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A folder named with a percent sign is written ``%%`` in a pattern (printf's, OpenCV's):
+    ``50%% done/left_%04d.png`` reads ``50% done/``. The guard against saving into the
+    sequence read compared the folder as written (``50%% done``, which is no folder), so
+    ``-o '50% done'`` was let through: each pair saved became the next frame, the source's
+    own images overwritten (left_0001.png) and the capture without end. It is refused, one
+    line, nothing written."""
+    from stereovision.cli import main
+
+    pairs = tmp_path / "50% done"
+    pairs.mkdir()
+    for i in range(1, 4):
+        cv2.imwrite(str(pairs / f"left_{i:04d}.png"), _numbered(i))
+        cv2.imwrite(str(pairs / f"right_{i:04d}.png"), _numbered(i, shade=160))
+    written = tmp_path / "50%% done"
+    lpat, rpat = str(written / "left_%04d.png"), str(written / "right_%04d.png")
+    before = {p.name: p.read_bytes() for p in pairs.iterdir()}
+    # count bounds each call: without the refusal they would save pairs for ever, not fail
+    argv = ["capture", "--left", lpat, "--right", rpat, "-o", str(pairs), "--count", "5"]
+    assert main(argv) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"stereovision: error: -o {pairs}: the source {lpat} would read the pairs saved there as "
+        "its next frames, without end; save them in another folder"
+    ]
+    with StereoCamera(lpat, rpat) as cam, pytest.raises(ValueError, match="without end"):
+        capture(cam, pairs, count=5)
+    assert {p.name: p.read_bytes() for p in pairs.iterdir()} == before

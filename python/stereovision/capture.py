@@ -2482,6 +2482,8 @@ def _reads_own_output(sources: Any, out: PathLike, ext: str = ".png") -> str | N
         parts = _sequence_parts(base)
         if "://" in path or parts is None:
             continue
+        # the folder as read: "%%" is a percent sign there too ("50%% done" reads "50% done")
+        folder = folder.replace("%%", "%")
         regex = re.escape(parts[0]) + r"\d+" + re.escape(parts[2])
         try:
             same = os.path.samefile(folder or ".", out)
