@@ -3096,3 +3096,23 @@ def test_capture_refuses_to_save_into_the_sequence_it_reads_through_a_folder_wit
     with StereoCamera(lpat, rpat) as cam, pytest.raises(ValueError, match="without end"):
         capture(cam, pairs, count=5)
     assert {p.name: p.read_bytes() for p in pairs.iterdir()} == before
+
+
+@pytest.mark.parametrize("first", [0, 7])
+def test_an_image_that_does_not_read_is_not_told_missing(tmp_path: Path, first: int) -> None:
+    """A sequence stopped by an image that is there but does not read (damaged) was told
+    "f_003.png is missing, so the 1 image numbered after it was not read (renumber them without
+    the gap)": it is told it does not read, the images after it still counted."""
+    folder = tmp_path / "seq"
+    folder.mkdir()
+    for i in range(first, first + 5):
+        cv2.imwrite(str(folder / f"f_{i:03d}.png"), _numbered(i))
+    (folder / f"f_{first + 3:03d}.png").write_bytes(b"not a png")
+    pattern = str(folder / "f_%03d.png")
+    with StereoCamera(pattern, pattern) as cam:
+        result = capture(cam, tmp_path / "pairs")
+    assert len(result.saved) == 3
+    assert result.ended.startswith(
+        f"left source {pattern!r} ended after 3 images: f_{first + 3:03d}.png does not read "
+        "(damaged?), so the 1 image numbered after it was not read (replace or remove it)"
+    )

@@ -1369,10 +1369,17 @@ class StereoCamera(PairSource):
         if gap is not None:
             # a numbered image taken out of a sequence (a blurred frame deleted) ended it there:
             # the images after it were never read, which "ended after 4 frames" did not say
+            # one that is there but does not read (damaged) was told "missing" too
+            there = os.path.exists(os.path.join(os.path.dirname(os.fspath(src)), gap[0]))
+            why, fix = (
+                ("does not read (damaged?)", "replace or remove it")
+                if there
+                else ("is missing", "renumber them without the gap")
+            )
             return (
-                f"{side} source {name} ended after {n} images: {gap[0]} is missing, so the "
+                f"{side} source {name} ended after {n} images: {gap[0]} {why}, so the "
                 f"{gap[1]} image{'s' if gap[1] > 1 else ''} numbered after it "
-                f"{'were' if gap[1] > 1 else 'was'} not read (renumber them without the gap)"
+                f"{'were' if gap[1] > 1 else 'was'} not read ({fix})"
             )
         if total is None:
             return f"{side} source {name} ended after {n} frames"
