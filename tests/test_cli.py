@@ -768,6 +768,33 @@ def test_demo_keeps_no_copy_of_a_file_holding_the_bytes_it_writes(
         assert (out / name).read_bytes() == (first / name).read_bytes()
 
 
+def test_demo_runs_on_when_a_file_it_would_keep_aside_went_meanwhile(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """demo compares a file under an output name that no run listed with its staged output
+    after the matching: one removed meanwhile (moved away by its owner while the scene was
+    matched) failed the whole run there, "[Errno 2] No such file or directory", every output
+    lost. Nothing is left to keep: the run writes its outputs and keeps no copy."""
+    import stereovision.depth as depth_mod
+
+    out = tmp_path / "d"
+    out.mkdir()
+    (out / "disparity.pfm").write_bytes(b"mine")
+    real = depth_mod.depth_map
+
+    def moved_away_meanwhile(*args: object, **kwargs: object) -> object:
+        (out / "disparity.pfm").rename(tmp_path / "moved.pfm")
+        return real(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(depth_mod, "depth_map", moved_away_meanwhile)
+    assert main(["demo", "--method", "fast", "-o", str(out)]) == 0
+    said = capsys.readouterr()
+    assert said.err == "" and "that was there" not in said.out
+    assert (tmp_path / "moved.pfm").read_bytes() == b"mine"
+    assert not list(out.glob("*.previous*"))
+    assert read_pfm(out / "disparity.pfm").shape == (375, 450)
+
+
 def test_demo_interrupted_midway_leaves_the_earlier_outputs_whole(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:

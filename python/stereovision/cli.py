@@ -1429,7 +1429,8 @@ def _keep_foreign_aside(foreign: Sequence[Path], staged: dict[str, Path]) -> lis
     """Copy aside (``NAME.previous.EXT``) each file of ``foreign`` that its staged output
     (``staged``, name -> new file) would replace with other bytes: a file holding the very
     bytes this run writes (the outputs of a demo before the manifest) loses nothing. Only the
-    bytes count: one that differs in line endings alone (CRLF) is another file, kept.
+    bytes count: one that differs in line endings alone (CRLF) is another file, kept. One gone
+    since it was listed (the comparison comes after the matching) has nothing to keep.
 
     Returns
     -------
@@ -1441,7 +1442,10 @@ def _keep_foreign_aside(foreign: Sequence[Path], staged: dict[str, Path]) -> lis
     kept = []
     for p in foreign:
         new = staged.get(p.name)
-        if new is not None and _same_bytes(p, new):
+        try:
+            if new is not None and _same_bytes(p, new):
+                continue
+        except FileNotFoundError:  # moved away while the scene was matched: nothing to keep
             continue
         copy = keep_previous(p)
         if copy is not None:
