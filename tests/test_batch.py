@@ -460,7 +460,8 @@ def test_batch_ground_outputs(data_dir: Path, tmp_path: Path) -> None:
         run_batch(kitti, tmp_path / "o", grid=0.2)
     tsukuba = data_dir / "middlebury2001" / "tsukuba"  # no metric calibration: a failed pair
     (job,) = find_pairs(tsukuba)
-    with pytest.raises(Exception, match="--ground needs --calib"):
+    # Python's words, not the CLI's (a CLI run's summary swaps them: _error_line)
+    with pytest.raises(ValueError, match=r"^ground=True needs calib=\.\.\. or a calib\.txt"):
         process_pair(_task(job, {"method": "gabor", "max_disparity": 16, "fill": None,
                                  "ground": True}))  # fmt: skip
 
@@ -2430,3 +2431,31 @@ def test_the_summary_of_a_cli_run_says_its_errors_in_the_clis_words(
     left, right = (str(root / "narrow" / f"{s}.png") for s in ("left", "right"))
     assert main(["depth", left, right, "--max-disparity", "200", "-o", str(tmp_path / "d")]) == 2
     assert capsys.readouterr().err == f"stereovision: error: {narrow[12:]}\n"
+
+
+def test_ground_without_a_calibration_is_said_in_the_callers_words(
+    data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """run_batch(ground=True) on a pair with no calibration recorded "CliError: --ground needs
+    --calib": the command line's option and an internal class of the CLI's in the Python API
+    (the workers share the CLI's depth_outputs). run_batch says it in Python's words, a CLI run
+    (words="cli") in the command line's, as `stereovision depth --ground` says it."""
+    from stereovision.batch import run_batch
+
+    root = tmp_path / "in"
+    _tiny(root, data_dir, "a/left.png", "a/right.png")  # no calib.txt, no calib=
+    api = (
+        "ValueError: ground=True needs calib=... or a calib.txt beside the pair (the floor is "
+        "found in metres)"
+    )
+    cli = "ValueError: --ground needs --calib (the floor is found in metres)"
+    res = run_batch(root, tmp_path / "o1", workers=1, ground=True, progress=False)
+    assert res.failed == ["a"]
+    assert _summary(tmp_path / "o1")["pairs"]["a"]["error"] == api
+    res = run_batch(root, tmp_path / "o2", workers=1, ground=True, progress=False, words="cli")
+    assert _summary(tmp_path / "o2")["pairs"]["a"]["error"] == cli
+    capsys.readouterr()
+    argv = ["batch", str(root), "-o", str(tmp_path / "o3"), "--ground", "--workers", "1"]
+    assert main(argv) == 1
+    assert f"failed a: {cli}\n" in capsys.readouterr().err
+    assert _summary(tmp_path / "o3")["pairs"]["a"]["error"] == cli

@@ -213,6 +213,13 @@ ADVICE: dict[str, dict[str, str]] = {
         "cli": "a --max-disparity of your own",
         "page": "a max_disparity of your own",
     },
+    # batch's pair with no calibration asked for its floor: the workers said the CLI's words
+    # (depth_outputs') to run_batch's caller too; no page asks for a floor
+    "ground_calib": {
+        "api": "ground=True needs calib=... or a calib.txt beside the pair",
+        "cli": "--ground needs --calib",
+        "page": "ground=True needs calib=... or a calib.txt beside the pair",
+    },
 }
 ADVICE["low_uint16"]["page"] = ADVICE["low_uint16"]["cli"]  # on the page too, a file
 # the page refuses a pair of another size than the one a size-less --calib was read at

@@ -588,7 +588,7 @@ def process_pair(task: dict[str, Any]) -> dict[str, Any]:
     task : dict
         ``name``; ``left`` and ``right``: ``(file name, bytes)``; ``calib``: ``(file name,
         bytes)`` or None; ``method`` (None = default), ``max_disparity`` (None = estimated),
-        ``fill``.
+        ``fill``; ``ground`` and ``grid`` (:func:`run_batch`'s).
 
     Returns
     -------
@@ -600,11 +600,16 @@ def process_pair(task: dict[str, Any]) -> dict[str, Any]:
     ------
     ValueError
         An image that cannot be decoded, a pair of different sizes, a calibration for another
-        size, ... (as ``stereovision depth`` reports them).
+        size, ... (as ``stereovision depth`` reports them); ``ground`` without ``calib``.
     """
+    from stereovision._validate import ADVICE
     from stereovision.calibration import Calibration
     from stereovision.cli import depth_outputs
 
+    if task.get("ground") and task.get("calib") is None:
+        # before depth_outputs, whose refusal is the CLI's ("CliError: --ground needs
+        # --calib"); a CLI run's summary swaps these words back (_error_line)
+        raise ValueError(f"{ADVICE['ground_calib']['api']} (the floor is found in metres)")
     t0 = time.perf_counter()
     left = _decode(task["left"][0], task["left"][1])
     right = _decode(task["right"][0], task["right"][1])
