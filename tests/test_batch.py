@@ -2459,3 +2459,30 @@ def test_ground_without_a_calibration_is_said_in_the_callers_words(
     assert main(argv) == 1
     assert f"failed a: {cli}\n" in capsys.readouterr().err
     assert _summary(tmp_path / "o3")["pairs"]["a"]["error"] == cli
+
+
+@pytest.mark.parametrize("words", ["page", "CLI", ""])
+def test_run_batch_refuses_words_it_has_no_summary_for(tmp_path: Path, words: str) -> None:
+    """words is "api" or "cli": another (the GUI's "page", a capital) is refused by name before
+    anything is read or written, not met by advice_for after a pair's work."""
+    from stereovision.batch import run_batch
+
+    with pytest.raises(ValueError, match=rf"^words: expected 'api' or 'cli', got '{words}'$"):
+        run_batch(tmp_path / "missing", tmp_path / "o", words=words)
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_cli_runs_words_said_again_are_the_same() -> None:
+    """stereovision batch logs a pair's error through advice_for again, after run_batch(words=
+    "cli") has worded it: every entry's command-line words, and the range errors' numbers
+    (a fraction too), come through a second swap unchanged."""
+    from stereovision._validate import ADVICE, advice_for
+
+    for key, said in ADVICE.items():
+        cli = said["cli"].format(w=225, h=188, n=96)
+        assert advice_for(cli, "cli") == cli, key
+        assert advice_for(said["api"].format(w=225, h=188, n=96), "cli") == cli, key
+    line = "disparity range 199.5 is not smaller than the image width 96: ... or give a "
+    assert (
+        advice_for(line + "max_disparity below 96.5", "cli") == line + "--max-disparity below 96.5"
+    )
