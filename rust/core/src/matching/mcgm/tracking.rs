@@ -78,26 +78,24 @@ pub fn wrap_angle(d: f64) -> f64 {
 /// Seed threshold: the `q` quantile ("lower": sorted value at `floor(q (n - 1))`) of the
 /// strengths of marked pixels; 0 when nothing is marked.
 pub fn high_threshold(zc: &ZeroCrossings, q: f32) -> f32 {
+    let marked: Vec<u32> = zc.marked().map(|i| i as u32).collect();
+    marked_quantile(&marked, &zc.strength, q)
+}
+
+/// [`high_threshold`] over the marked pixels' indices `marked` (ascending).
+fn marked_quantile(marked: &[u32], strength: &[f32], q: f32) -> f32 {
     // Marked strengths are >= MIN_STRENGTH > 0, so their bit patterns order as the values
     // do: the k-th is found in the bucket of its upper 12 bits (one histogram pass), then by
     // selection among that bucket's values only.
     const SHIFT: u32 = 20;
     const BUCKETS: usize = 1 << (32 - SHIFT);
-    // Unmarked pixels count into 16 spare slots by column (not all into one slot: each add
-    // would wait for the previous one's store).
-    let mut hist = vec![0usize; BUCKETS + 16];
-    for (i, (&m, &s)) in zc.mark.iter().zip(&zc.strength).enumerate() {
-        let b = if m != 0 {
-            (s.to_bits() >> SHIFT) as usize
-        } else {
-            BUCKETS + (i & 15)
-        };
-        hist[b] += 1;
-    }
-    hist.truncate(BUCKETS);
-    let count: usize = hist.iter().sum();
+    let count = marked.len();
     if count == 0 {
         return 0.0;
+    }
+    let mut hist = vec![0usize; BUCKETS];
+    for &i in marked {
+        hist[(strength[i as usize].to_bits() >> SHIFT) as usize] += 1;
     }
     let k = (((q as f64) * (count - 1) as f64).floor() as usize).min(count - 1);
     let (mut below, mut bucket) = (0usize, 0usize);
@@ -108,12 +106,13 @@ pub fn high_threshold(zc: &ZeroCrossings, q: f32) -> f32 {
         }
         below += c;
     }
-    // The bucket's values (branch-free compaction: its size is known).
+    // The bucket's values in raster order (branch-free compaction: its size is known).
     let mut vals = vec![0.0f32; hist[bucket] + 1];
     let mut c = 0;
-    for (&m, &s) in zc.mark.iter().zip(&zc.strength) {
+    for &i in marked {
+        let s = strength[i as usize];
         vals[c] = s;
-        c += usize::from((m != 0) & ((s.to_bits() >> SHIFT) as usize == bucket));
+        c += usize::from((s.to_bits() >> SHIFT) as usize == bucket);
     }
     vals.truncate(c);
     *vals.select_nth_unstable_by(k - below, f32::total_cmp).1
@@ -170,30 +169,45 @@ fn radix_sort_upper(keys: &mut Vec<u64>) -> Result<()> {
 pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
     let (w, h) = (zc.width, zc.height);
     let n = w * h;
-    let t_high = high_threshold(zc, p.high_quantile);
+    // The marked pixels (a third or less of the image) listed once: the threshold, the
+    // candidates and the seeds are found among them instead of in three passes over every
+    // pixel (branch-free compaction: the i-th write lands at or before i).
+    let mut marked = try_zeroed::<u32>(n, WHAT)?;
+    let mut n_marked = 0;
+    for (i, &m) in zc.mark.iter().enumerate() {
+        marked[n_marked] = i as u32;
+        n_marked += usize::from(m != 0);
+    }
+    marked.truncate(n_marked);
+    let t_high = marked_quantile(&marked, &zc.strength, p.high_quantile);
     let t_low = p.low_ratio * t_high;
-    // Per pixel: FREE = unvisited candidate (marked, s >= t_low), TAKEN = on a curve (or a seed
-    // already used), 0 = not a candidate. One byte array instead of three passes over the image.
+    // Per pixel: FREE = unvisited candidate (marked interior pixel, s >= t_low), TAKEN = on a
+    // curve (or a seed already used), 0 = not a candidate.
     const FREE: u8 = 1;
     const TAKEN: u8 = 2;
     let mut state = try_zeroed::<u8>(n, WHAT)?;
-    // (Images narrower than 3 pixels have no interior.)
-    for y in (1..h.saturating_sub(1)).filter(|_| w >= 3) {
-        let r = y * w + 1..(y + 1) * w - 1;
-        let (st, mk, sr) = (&mut state[r.clone()], &zc.mark[r.clone()], &zc.strength[r]);
-        for x in 0..st.len() {
-            let s = sr[x];
-            st[x] = u8::from((mk[x] != 0) & (s >= t_low) & (s > 0.0));
-        }
-    }
-    // Seeds by decreasing strength, then index: one key each, `!bits(s) << 32 | i` (strengths
-    // are > 0, so their bit patterns order as the values do), listed by index (branch-free)
-    // and radix-sorted on the upper half.
-    let mut keys = try_zeroed::<u64>(n, WHAT)?;
+    // Seeds (candidates with s >= t_high) by decreasing strength, then index: one key each,
+    // `!bits(s) << 32 | i` (strengths are > 0, so their bit patterns order as the values do),
+    // listed by index (branch-free) and radix-sorted on the upper half.
+    let mut keys = try_zeroed::<u64>(marked.len(), WHAT)?;
     let mut n_seeds = 0;
-    for (i, (&st, &s)) in state.iter().zip(&zc.strength).enumerate() {
-        keys[n_seeds] = (u64::from(!s.to_bits()) << 32) | i as u64;
-        n_seeds += usize::from((st == FREE) & (s >= t_high));
+    // (Images narrower or lower than 3 pixels have no interior.)
+    if w >= 3 && h >= 3 {
+        // The row of each index follows the ascending list (no division per pixel).
+        let (mut y, mut row_end) = (0usize, w);
+        for &i in &marked {
+            let i = i as usize;
+            while i >= row_end {
+                y += 1;
+                row_end += w;
+            }
+            let x = i + w - row_end;
+            let s = zc.strength[i];
+            let free = (y >= 1) & (y + 1 < h) & (x >= 1) & (x + 1 < w) & (s >= t_low) & (s > 0.0);
+            state[i] = u8::from(free);
+            keys[n_seeds] = (u64::from(!s.to_bits()) << 32) | i as u64;
+            n_seeds += usize::from(free & (s >= t_high));
+        }
     }
     keys.truncate(n_seeds);
     radix_sort_upper(&mut keys)?;
