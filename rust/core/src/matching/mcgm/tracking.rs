@@ -285,7 +285,9 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
             prefetch(state, ahead);
         }
     };
-    let (mut fwd, mut bwd) = (Vec::new(), Vec::new());
+    // Growth buffers and the kept curve's pixels, reused by every seed (a kept segment cost
+    // three allocations: the collect, the push past its exact capacity, the extend).
+    let (mut fwd, mut bwd, mut pixels) = (Vec::new(), Vec::new(), Vec::new());
     // Seeds lie anywhere in the image (strength order): ask for a later seed's cache lines
     // now, so its state and neighbourhood are there when its turn comes (a hint only).
     const AHEAD: usize = 8;
@@ -311,7 +313,8 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
         if 1 + fwd.len() + bwd.len() < p.min_len {
             continue;
         }
-        let mut pixels: Vec<(u32, (f64, f64))> = bwd.iter().rev().copied().collect();
+        pixels.clear();
+        pixels.extend(bwd.iter().rev().copied());
         pixels.push((s as u32, t0));
         pixels.extend_from_slice(&fwd);
         let id = segments.len() as i32;
