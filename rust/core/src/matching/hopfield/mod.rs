@@ -470,7 +470,7 @@ fn candidates(
             |(sc, stats), &(i0, i1)| {
                 let y_lo = pts[i0].y as usize;
                 let y_hi = pts[i1 - 1].y as usize + 1;
-                stats.fill_band(right, y_lo.saturating_sub(reach), y_hi + reach);
+                stats.fill_band(right, y_lo.saturating_sub(reach), y_hi + reach)?;
                 let mut out = Vec::new();
                 try_reserve_len(&mut out, 2 * (i1 - i0), CANDIDATES)?;
                 for (i, pt) in pts.iter().enumerate().take(i1).skip(i0) {

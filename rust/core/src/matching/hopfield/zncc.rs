@@ -12,6 +12,8 @@
 
 use rayon::prelude::*;
 
+use crate::alloc::try_reserve_len;
+use crate::error::Result;
 use crate::image::ImageView;
 use crate::simd::{has_avx2, simd_fn};
 
@@ -120,6 +122,19 @@ struct StatsScratch {
     ring: [BandSums; RING],
     all: BandSums,
     n2: Vec<f32>,
+}
+
+impl StatsScratch {
+    /// Room (checked) for rows `w` wide: [`BandSums::resize`] and `stats_row`'s `n2` then
+    /// do not reallocate.
+    fn reserve(&mut self, w: usize, what: &'static str) -> Result<()> {
+        for b in self.ring.iter_mut().chain(std::iter::once(&mut self.all)) {
+            for a in b.v.iter_mut().chain(b.h.iter_mut()) {
+                try_reserve_len(a, w, what)?;
+            }
+        }
+        try_reserve_len(&mut self.n2, w, what)
+    }
 }
 
 impl BandSums {
@@ -283,21 +298,32 @@ impl RightStats {
         }
     }
 
-    /// Recomputes `self` for the rows `y_lo..y_hi` of `img` only (reusing its buffers).
-    pub fn fill_band(&mut self, img: &ImageView<'_>, y_lo: usize, y_hi: usize) {
+    /// Recomputes `self` for the rows `y_lo..y_hi` of `img` only (reusing its buffers). A
+    /// failed allocation of the band or its scratch (about 40 bytes a pixel of the band, 196 a
+    /// pixel of one row) is [`crate::CoreError::OutOfMemory`] and leaves `self` as it was
+    /// (nothing is written before every buffer is in place).
+    pub fn fill_band(&mut self, img: &ImageView<'_>, y_lo: usize, y_hi: usize) -> Result<()> {
+        const WHAT: &str = "the Hopfield matcher's right-image statistics";
         let (w, h) = img.size();
         let y_hi = y_hi.min(h);
         let y_lo = y_lo.min(y_hi);
-        self.stride = w + LANES;
-        self.y0 = y_lo;
-        self.rows = y_hi - y_lo;
-        let row_len = 2 * N_REGIONS * self.stride;
-        // Only grows, not cleared: fill_rows writes every value of the band.
-        if self.buf.len() < row_len * self.rows {
-            self.buf.resize(row_len * self.rows, 0.0);
+        let stride = w + LANES;
+        let rows = y_hi - y_lo;
+        let row_len = 2 * N_REGIONS * stride;
+        let n = row_len.saturating_mul(rows); // a saturated size fails to reserve
+                                              // Every buffer grown (checked) before the band is recorded: a failure leaves the
+                                              // previous band's description, never one the buffer is too short for.
+                                              // Only grows, not cleared: fill_rows writes every value of the band.
+        if self.buf.len() < n {
+            try_reserve_len(&mut self.buf, n, WHAT)?;
+            self.buf.resize(n, 0.0);
         }
-        let chunk = &mut self.buf[..row_len * self.rows];
-        fill_rows(img, y_lo, y_hi, &mut self.scratch, chunk);
+        self.scratch.reserve(w, WHAT)?;
+        self.stride = stride;
+        self.y0 = y_lo;
+        self.rows = rows;
+        fill_rows(img, y_lo, y_hi, &mut self.scratch, &mut self.buf[..n]);
+        Ok(())
     }
     /// Window sums of region `k` along row `y` (`W + LANES` values, zero past the image).
     #[inline]
@@ -934,12 +960,67 @@ mod tests {
         let img = img.view();
         let full = RightStats::new(&img);
         let mut band = RightStats::default();
-        band.fill_band(&img, 9, 17);
+        band.fill_band(&img, 9, 17).unwrap();
         for y in 9..17 {
             for k in 0..N_REGIONS {
                 assert_eq!(full.sums(k, y), band.sums(k, y));
                 assert_eq!(full.inv_norms(k, y), band.inv_norms(k, y));
             }
+        }
+    }
+
+    /// Run by [`a_band_too_large_to_allocate_is_an_error_and_the_next_band_is_right`] in a
+    /// child process: a 4096x512 image whose whole-image band (80 MiB) does not fit under an
+    /// address-space limit of 32 MiB more than is mapped, then a 16-row band that does.
+    #[cfg(target_os = "linux")]
+    #[test]
+    #[ignore = "a child of a_band_too_large_to_allocate_is_an_error_and_the_next_band_is_right"]
+    fn band_statistics_under_a_memory_limit() {
+        if std::env::var_os("SV_OOM_CHILD").is_none() {
+            return;
+        }
+        let (w, h) = (4096, 512);
+        let data: Vec<f32> = (0..w * h)
+            .map(|i| ((i * 7919) % 251) as f32 / 250.0)
+            .collect();
+        let img = Image::new(w, h, data).expect("valid");
+        let img = img.view();
+        let full = RightStats::new(&img);
+        let mut band = RightStats::default();
+        band.fill_band(&img, 0, 8).unwrap();
+        crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (32 << 20));
+        match band.fill_band(&img, 0, h) {
+            Ok(()) => println!("child: filled {} rows", band.rows),
+            Err(e) => println!("child: error: {e}"),
+        }
+        // The failed call left the previous band as it was; the next one is right.
+        let same = |b: &RightStats, ys: std::ops::Range<usize>| {
+            ys.clone().all(|y| {
+                (0..N_REGIONS).all(|k| {
+                    full.sums(k, y) == b.sums(k, y) && full.inv_norms(k, y) == b.inv_norms(k, y)
+                })
+            }) && (b.y0, b.rows) == (ys.start, ys.len())
+        };
+        println!("child: kept {}", same(&band, 0..8));
+        band.fill_band(&img, 200, 216).unwrap();
+        println!("child: next {}", same(&band, 200..216));
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_band_too_large_to_allocate_is_an_error_and_the_next_band_is_right() {
+        // fill_band grew its band and scratch with resize: a failed allocation aborted the
+        // process (SIGABRT) instead of returning OutOfMemory.
+        let stdout = crate::segment::tests::run_oom_child(
+            "matching::hopfield::zncc::tests::band_statistics_under_a_memory_limit",
+        );
+        for want in [
+            "child: error: out of memory: the Hopfield matcher's right-image statistics needs \
+             80.16 MiB (84049920 bytes)",
+            "child: kept true",
+            "child: next true",
+        ] {
+            assert!(stdout.contains(want), "{want} not in {stdout}");
         }
     }
 
