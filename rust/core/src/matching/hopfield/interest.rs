@@ -7,8 +7,8 @@
 
 use rayon::prelude::*;
 
-use crate::alloc::{try_concat, try_zeroed};
-use crate::error::Result;
+use crate::alloc::{try_concat, try_grow, try_reserve_len, try_zeroed};
+use crate::error::{CoreError, Result};
 use crate::image::ImageView;
 use crate::simd::simd_fn;
 
@@ -110,7 +110,8 @@ fn min_row(hs: &[[&[f32]; RING]; 4], out: &mut [f32]) {
 /// Row bands in parallel; every value is computed in the fixed order of the module docs, so the
 /// map does not depend on the thread count.
 ///
-/// A failed allocation of the map is [`crate::CoreError::OutOfMemory`].
+/// A failed allocation of the map or of a thread's scratch (84 bytes a column) is
+/// [`crate::CoreError::OutOfMemory`].
 pub fn moravec<'a>(img: impl Into<ImageView<'a>>) -> Result<Vec<f32>> {
     let img = &img.into();
     let (w, h) = img.size();
@@ -121,12 +122,27 @@ pub fn moravec<'a>(img: impl Into<ImageView<'a>>) -> Result<Vec<f32>> {
     let r = MORAVEC_HALF;
     let row = |y: usize| &img.data[y * w..(y + 1) * w];
     let inner = &mut out[BORDER * w..(h - BORDER) * w];
+    // A thread's scratch is allocated checked in rayon's init; a failure is recorded here (the
+    // first one) and that thread's bands are skipped: the map is then not returned.
+    const SCRATCH: &str = "the Hopfield matcher's interest-map scratch";
+    let failed: std::sync::Mutex<Option<CoreError>> = std::sync::Mutex::new(None);
     inner
         .par_chunks_mut(ROWS_PER_TASK * w)
         .enumerate()
         .for_each_init(
-            || (vec![0.0f32; 4 * RING * w], vec![0.0f32; w]),
-            |(ring, sq), (t, band)| {
+            || -> Result<(Vec<f32>, Vec<f32>)> {
+                let ring = try_zeroed::<f32>(4 * RING * w, SCRATCH)?;
+                Ok((ring, try_zeroed::<f32>(w, SCRATCH)?))
+            },
+            |bufs, (t, band)| {
+                let (ring, sq) = match bufs {
+                    Ok((ring, sq)) => (ring, sq),
+                    Err(e) => {
+                        let mut f = failed.lock().unwrap_or_else(|p| p.into_inner());
+                        f.get_or_insert_with(|| e.clone());
+                        return;
+                    }
+                };
                 let y0 = BORDER + t * ROWS_PER_TASK;
                 // Horizontal sums of image row y (y - 1 and y + 1 stay inside the image: rows
                 // y0 - 2 ..= y_last + 2 with BORDER = 3), every direction, into its ring slot.
@@ -153,7 +169,10 @@ pub fn moravec<'a>(img: impl Into<ImageView<'a>>) -> Result<Vec<f32>> {
                 }
             },
         );
-    Ok(out)
+    match failed.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        Some(e) => Err(e),
+        None => Ok(out),
+    }
 }
 
 /// Interest points of `img`: local maxima of [`moravec`] over a `(2 nms_half + 1)^2`
@@ -270,12 +289,15 @@ pub fn select_points(
         true
     };
     let y_end = h.saturating_sub(BORDER);
+    const POINTS: &str = "the Hopfield matcher's interest points";
     let rows: Vec<usize> = (BORDER..y_end).step_by(SELECT_ROWS).collect();
-    let per_task: Vec<Vec<InterestPoint>> = rows
-        .par_iter()
+    // Each task's points, grown checked (as `push` grows) into room reserved for every task.
+    let mut per_task: Vec<Result<Vec<InterestPoint>>> = Vec::new();
+    try_reserve_len(&mut per_task, rows.len(), POINTS)?;
+    rows.par_iter()
         .map(|&ya| {
             let mut out = Vec::new();
-            let mut mask = vec![0u8; w];
+            let mut mask = try_zeroed::<u8>(w, POINTS)?;
             for y in ya..(ya + SELECT_ROWS).min(y_end) {
                 let row = &m[y * w..(y + 1) * w];
                 let tiles = &tile_max[(y / tile) * tiles_x..(y / tile + 1) * tiles_x];
@@ -294,6 +316,7 @@ pub fn select_points(
                             // least as large as the later ones (deterministic ties); the centre
                             // compares equal to itself and is neither.
                             if v > 0.0 && v >= thr && is_peak(x, y, v) {
+                                try_grow(&mut out, 1, POINTS)?;
                                 out.push(InterestPoint {
                                     x: x as u32,
                                     y: y as u32,
@@ -317,6 +340,7 @@ pub fn select_points(
                         while bits != 0 {
                             let x = base + bits.trailing_zeros() as usize / 8;
                             bits &= bits - 1;
+                            try_grow(&mut out, 1, POINTS)?;
                             out.push(InterestPoint {
                                 x: x as u32,
                                 y: y as u32,
@@ -327,15 +351,85 @@ pub fn select_points(
                     }
                 }
             }
-            out
+            Ok(out)
         })
-        .collect();
-    try_concat(per_task, "the Hopfield matcher's interest points")
+        .collect_into_vec(&mut per_task);
+    try_concat(per_task.into_iter().collect::<Result<_>>()?, POINTS)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Run by [`interest_scratch_and_points_too_large_to_allocate_are_an_error`] in a child
+    /// process, under an address-space limit of `SV_OOM_MIB` MiB more than is mapped: "map",
+    /// the Moravec map of a 2^18 x 7 image (7 MiB) fits in 10 MiB, its thread's scratch
+    /// (20 MiB) does not; "points", the ~2^20 peaks of a 2^18 x 22 map (12 MiB) do not fit in 4.
+    #[cfg(target_os = "linux")]
+    #[test]
+    #[ignore = "a child of interest_scratch_and_points_too_large_to_allocate_are_an_error"]
+    fn interest_under_a_memory_limit() {
+        let Some(which) = std::env::var_os("SV_OOM_WHICH") else {
+            return;
+        };
+        let w = 1usize << 18;
+        rayon::join(|| (), || ()); // the pool's thread started before the limit
+        let limit = |mib: usize| {
+            let vm = crate::segment::tests::vm_size();
+            crate::segment::tests::limit_address_space(vm + (mib << 20));
+        };
+        let out = if which == "map" {
+            let data = vec![0.5f32; w * 7];
+            let img = ImageView::new(w, 7, &data).unwrap();
+            limit(10);
+            moravec(img).map(|m| m.len())
+        } else {
+            // 2 at even x and y, 1 elsewhere: every even pair inside the border is a peak.
+            let h = 22;
+            let m: Vec<f32> = (0..w * h)
+                .map(|i| {
+                    if (i % w) % 2 == 0 && (i / w) % 2 == 0 {
+                        2.0
+                    } else {
+                        1.0
+                    }
+                })
+                .collect();
+            let p = InterestParams {
+                tile: 0,
+                rel_threshold: 0.0,
+                floor_rel: 0.0,
+                nms_half: 1,
+            };
+            limit(4);
+            select_points(&m, w, h, &p).map(|v| v.len())
+        };
+        match out {
+            Ok(n) => println!("child: {n} values"),
+            Err(e) => println!("child: error: {e}"),
+        }
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn interest_scratch_and_points_too_large_to_allocate_are_an_error() {
+        // moravec's per-thread scratch (vec! in rayon's init) and select_points' per-task point
+        // lists (push) were allocated unchecked: a failed allocation aborted the process.
+        for (which, want) in [
+            (
+                "map",
+                "the Hopfield matcher's interest-map scratch needs 20.00 MiB (20971520 bytes)",
+            ),
+            ("points", "the Hopfield matcher's interest points needs "),
+        ] {
+            let stdout = crate::segment::tests::run_oom_child_with(
+                "matching::hopfield::interest::tests::interest_under_a_memory_limit",
+                Some(("SV_OOM_WHICH", which)),
+            );
+            let want = format!("child: error: out of memory: {want}");
+            assert!(stdout.contains(&want), "{which}: {want} not in {stdout}");
+        }
+    }
 
     /// A tile of any size beyond the image's is the whole image (`tile == 0`), never a
     /// wrapped `tile * w` (a zero chunk size: a panic).
