@@ -302,11 +302,33 @@ const CANDIDATES: &str = "the Hopfield matcher's candidate neurons";
 
 /// Rows of the right image holding right interest points (points mode).
 fn right_rows(right: &ImageView<'_>, p: &HopfieldParams) -> Result<HashMap<usize, Vec<usize>>> {
-    let mut rows: HashMap<usize, Vec<usize>> = HashMap::new();
     if p.candidates == CandidateMode::Points {
-        for rp in interest_points(right, &p.interest)? {
-            rows.entry(rp.y as usize).or_default().push(rp.x as usize);
+        rows_of(&interest_points(right, &p.interest)?)
+    } else {
+        Ok(HashMap::new())
+    }
+}
+
+/// What [`rows_of`]'s allocations are named in an out-of-memory error.
+const RIGHT_ROWS: &str = "the Hopfield matcher's right points by row";
+
+/// The x of `pts` per row (in the order of `pts`). A failed allocation of the map or a row's
+/// list is [`CoreError::OutOfMemory`] (`entry().or_default().push()` aborted the process); the
+/// size named for the map is its entries' (the table adds control bytes and free slots).
+fn rows_of(pts: &[InterestPoint]) -> Result<HashMap<usize, Vec<usize>>> {
+    let mut rows: HashMap<usize, Vec<usize>> = HashMap::new();
+    let entry = std::mem::size_of::<(usize, Vec<usize>)>();
+    let oom = |n: usize| CoreError::oom(n.saturating_mul(entry), RIGHT_ROWS);
+    // Points come in raster order: room for one entry per run of a row (grown below if not).
+    let n_rows = pts.chunk_by(|a, b| a.y == b.y).count();
+    rows.try_reserve(n_rows).map_err(|_| oom(n_rows))?;
+    for run in pts.chunk_by(|a, b| a.y == b.y) {
+        if !rows.contains_key(&(run[0].y as usize)) {
+            rows.try_reserve(1).map_err(|_| oom(rows.len() + 1))?;
         }
+        let xs = rows.entry(run[0].y as usize).or_default();
+        try_grow(xs, run.len(), RIGHT_ROWS)?;
+        xs.extend(run.iter().map(|rp| rp.x as usize));
     }
     Ok(rows)
 }

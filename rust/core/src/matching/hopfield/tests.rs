@@ -1211,3 +1211,56 @@ fn a_compatibility_table_too_large_to_allocate_is_an_error() {
     let want = "child: error: out of memory: the Hopfield network's compatibility table needs ";
     assert!(stdout.contains(want), "{want} not in {stdout}");
 }
+
+/// `rows_of` holds the same lists as the `entry().or_default().push()` it replaced, in point
+/// order, also for points not in raster order (a row met twice).
+#[test]
+fn rows_of_lists_each_rows_points_in_order() {
+    let pt = |x: u32, y: u32| InterestPoint { x, y, value: 1.0 };
+    let pts = [pt(5, 2), pt(9, 2), pt(1, 7), pt(3, 2), pt(4, 7), pt(0, 0)];
+    let got = rows_of(&pts).unwrap();
+    let mut want: HashMap<usize, Vec<usize>> = HashMap::new();
+    for p in &pts {
+        want.entry(p.y as usize).or_default().push(p.x as usize);
+    }
+    assert_eq!(got, want);
+    assert_eq!(got[&2], [5, 9, 3]);
+    assert!(rows_of(&[]).unwrap().is_empty());
+}
+
+/// Run by [`right_rows_too_large_to_allocate_are_an_error`] in a child process: 2^20 right
+/// points, one a row (their map: 32 MiB of entries), under an address-space limit of 8 MiB
+/// more than is mapped.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of right_rows_too_large_to_allocate_are_an_error"]
+fn right_rows_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let pts: Vec<InterestPoint> = (0..1u32 << 20)
+        .map(|y| InterestPoint {
+            x: 1,
+            y,
+            value: 1.0,
+        })
+        .collect();
+    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (8 << 20));
+    match rows_of(&pts) {
+        Ok(rows) => println!("child: {} rows", rows.len()),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn right_rows_too_large_to_allocate_are_an_error() {
+    // Points mode built its rows map with entry().or_default().push(): a failed allocation
+    // aborted the process (SIGABRT) instead of returning OutOfMemory.
+    let stdout = crate::segment::tests::run_oom_child(
+        "matching::hopfield::tests::right_rows_under_a_memory_limit",
+    );
+    let want = "child: error: out of memory: the Hopfield matcher's right points by row needs \
+                32.00 MiB (33554432 bytes)";
+    assert!(stdout.contains(want), "{want} not in {stdout}");
+}
