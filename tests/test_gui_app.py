@@ -3497,6 +3497,128 @@ def test_a_read_that_fails_during_a_computation_is_said_after_it(monkeypatch):
     asyncio.run(clicks())
 
 
+#: A pair refused by the page (:meth:`StereoApp._calib_for`), in the tests below.
+_REFUSED = "calibration is for 640x480 images, got 450x375"
+
+
+def _refuse_pairs(app: Any) -> None:
+    """From now, every pair read is refused by ``app`` (as a --calib of another size)."""
+
+    def refuse(left: Any) -> Any:
+        raise ValueError(_REFUSED)
+
+    app._calib_for = refuse
+
+
+def _cameras_computing(monkeypatch: Any, name: str) -> tuple[Any, Any, Any]:
+    """``(app, during, open_gate)``: an app on fake cameras (camera 5's open wedged until
+    ``open_gate`` is set; ``--read-timeout`` 0.3 s), and ``during(click, said, first)``, a
+    coroutine: cameras 0 / 1 opened, then ``first()``, then ``click`` while a pair computes
+    says ``said``, which outlasts the computation's end ("error") until the next one."""
+    import asyncio
+    import threading
+
+    from stereovision import capture
+    from stereovision.gui import app as gui_app
+    from stereovision.gui import bundled_data_dir
+
+    frame = cv2.imread(str(CONES / "left.png"))
+    compute_gate, open_gate = threading.Event(), threading.Event()
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            if left == 5:
+                open_gate.wait(2.0)  # bounded: a broken app cannot hang the test
+
+        def read(self):
+            return frame, frame
+
+        def close(self):
+            pass
+
+    real = gui_app.compute_view
+
+    def gated(*args: Any, **kwargs: Any) -> Any:
+        compute_gate.wait(1.0)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+    monkeypatch.setattr(gui_app, "compute_view", gated)
+    app = _scene_app(name, [bundled_data_dir()], read_timeout=0.3)
+    app.state.cam_left, app.state.cam_right = "0", "1"
+    tasks = _collect_reads(app)
+
+    async def during(click: Callable[[], None], said: str, first: Callable[[], None]) -> None:
+        app._lock = asyncio.Lock()
+        app.open_cameras()  # their first pair on show
+        await tasks[-1]
+        assert app.state.error == "" and app.state.source_label == "cameras 0 / 1"
+        first()
+        compute_gate.clear()
+        computing = asyncio.ensure_future(app.recompute())
+        await _until(lambda: app._computing)
+        click()
+        await tasks[-1]
+        assert (app.state.status, app.state.error) == ("computing (fast)", said)
+        compute_gate.set()
+        await computing
+        assert (app.state.status, app.state.error) == ("error", said)
+        assert app.state.source_label == "cameras 0 / 1"
+        await app.recompute()  # nothing failed meanwhile: cleared as before
+        assert (app.state.status, app.state.error) == ("ready", "")
+
+    compute_gate.set()
+    return app, during, open_gate
+
+
+def test_a_captured_pair_refused_during_a_computation_is_said_after_it(monkeypatch):
+    """A Capture's pair refused (``_capture`` -> ``_use_pair``) while a pair computed: the
+    keep-the-error flag off there passed every test. It is still said after the computation."""
+    import asyncio
+
+    app, during, _ = _cameras_computing(monkeypatch, "test-capture-refused-computing")
+
+    asyncio.run(during(app.capture, _REFUSED, lambda: _refuse_pairs(app)))
+
+
+def test_an_opened_pair_refused_during_a_computation_is_said_after_it(monkeypatch):
+    """An Open's first pair refused (``_switch_source``'s failure path) while a pair computed:
+    the keep-the-error flag off there passed every test. It is still said after the
+    computation, the cameras in use kept."""
+    import asyncio
+
+    app, during, _ = _cameras_computing(monkeypatch, "test-open-refused-computing")
+
+    def first() -> None:
+        _refuse_pairs(app)
+        app.state.cam_left, app.state.cam_right = "2", "3"
+
+    said = f"{_REFUSED} (the cameras in use are unchanged)"
+    asyncio.run(during(app.open_cameras, said, first))
+
+
+def test_an_open_given_up_during_a_computation_is_said_after_it(monkeypatch):
+    """An Open that did not return within --read-timeout while a pair computed: the
+    keep-the-error flag off there passed every test. It is still said after the
+    computation."""
+    import asyncio
+
+    app, during, open_gate = _cameras_computing(monkeypatch, "test-open-timeout-computing")
+    said = (
+        "camera 5 and camera 6 did not open within 0.3 s (the open did not return: a wedged "
+        "camera or driver, or a stalled stream); unplug and replug it, or give gui a longer "
+        "--read-timeout"
+    )
+
+    def first() -> None:
+        app.state.cam_left, app.state.cam_right = "5", "6"
+
+    try:
+        asyncio.run(during(app.open_cameras, said, first))
+    finally:
+        open_gate.set()  # the wedged open returns: its cameras are closed
+
+
 def test_start_up_cameras_and_play_read_their_first_pair_off_the_page(tmp_path, monkeypatch):
     """The first pair of cameras given at start-up (--left/--right), and of an image folder's
     "Play", were read in the page's handler: a camera that hung (or a folder on a stalled
