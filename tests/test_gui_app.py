@@ -2913,7 +2913,8 @@ def test_cameras_that_cannot_be_paired_leave_the_open_ones_in_use(tmp_path):
     app.state.cam_right = str(small)
     _open_cameras(app)
     assert app.state.error.startswith("right source") and "400x300" in app.state.error
-    assert app.state.error.endswith("(the cameras in use are unchanged)")
+    # video files in use: not said to be "the cameras"
+    assert app.state.error.endswith("(the source in use is unchanged)")
     app.state.error = ""
     _capture(app)  # from the cameras still open
     assert app.state.error == "" and app.state.captures == 1
@@ -4138,7 +4139,8 @@ def test_opencv_stereo_calib_output_is_sized_by_the_first_pair_it_is_used_with(
     assert app.pair[0].shape == (480, 640, 3)  # the pair on show stays
     app.state.pair_folder = str(data / "small")
     _play(app)
-    assert app.state.error == f"{said} (the cameras in use are unchanged)"
+    assert app.source.name.endswith("data/big")  # the folder in use, named: not "cameras"
+    assert app.state.error == f"{said} (the folder {app.source.name} in use is unchanged)"
     assert app.state.source_label.endswith("data/big: pair 0001 (1 of 2)")
     app.state.left_file = str(data / "big" / "left_0002.png")
     app.state.right_file = str(data / "big" / "right_0002.png")
@@ -5324,6 +5326,64 @@ def test_other_cameras_drop_the_homographies_a_failed_switch_keeps_them():
     app._switch_source(Cameras(raw), ("2", "3"))
     assert app.state.error == "" and app.homographies is None
     assert app.pair[0] is raw[0] and app.state.source_label == "cameras 2 / 3"
+
+
+def test_a_failed_open_names_the_source_it_leaves_in_use(tmp_path, monkeypatch):
+    """An Open or Play that failed said "(the cameras in use are unchanged)" whatever was in
+    use: an image folder being played, video files, a bag. It names what stays: the cameras,
+    the folder, or (files, a bag) the source."""
+    from stereovision.gui import app as gui_app
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.sources import FolderPairs
+
+    raw = (cv2.imread(str(CONES / "left.png")), cv2.imread(str(CONES / "right.png")))
+
+    class Cameras:
+        def __init__(self, pair):
+            self.pair = pair
+
+        def read(self):
+            if self.pair is None:
+                raise OSError("camera 3 gave no frame")
+            return self.pair
+
+        def close(self):
+            pass
+
+    def refused(**kw: Any) -> str:
+        app = _scene_app("test-failed-open-names", [bundled_data_dir(), tmp_path / "scenes"], **kw)
+        app._spawn = lambda coro: coro.close()
+        app._switch_source(Cameras(None), ("2", "3"))
+        assert app.source is kw.get("source"), kw
+        return str(app.state.error)
+
+    seq = tmp_path / "scenes" / "seq"
+    seq.mkdir(parents=True)
+    cv2.imwrite(str(seq / "left_0001.png"), raw[0])
+    cv2.imwrite(str(seq / "right_0001.png"), raw[1])
+    said = "camera 3 gave no frame"
+    cameras = refused(source=Cameras(raw), source_names=("0", "1"))
+    assert cameras == f"{said} (the cameras in use are unchanged)"
+    videos = refused(source=Cameras(raw), source_names=("left.mp4", "right.mp4"))
+    assert videos == f"{said} (the source in use is unchanged)"
+    bag = refused(source=Cameras(raw), source_names=("", ""), source_label="bag rig.bag: /l / /r")
+    assert bag == f"{said} (the source in use is unchanged)"
+    assert refused() == said  # nothing in use: nothing said of it
+    # a folder being played; then an Open whose first read fails (_first_pair)
+    app = _scene_app("test-failed-open-folder", [bundled_data_dir(), tmp_path / "scenes"])
+    app._spawn = lambda coro: coro.close()
+    app.state.pair_folder = str(seq)
+    _play(app)
+    assert app.state.error == "" and isinstance(app.source, FolderPairs)
+    playing = app.source
+    app._switch_source(Cameras(None), ("2", "3"))
+    assert app.state.error == f"{said} (the folder scenes/seq in use is unchanged)"
+    assert app.source is playing
+    app.state.cam_left, app.state.cam_right = "2", "3"
+    monkeypatch.setattr(gui_app, "open_stereo_source", lambda *a, **k: Cameras(None))
+    _open_cameras(app)
+    assert app.state.error == f"{said} (the folder scenes/seq in use is unchanged)"
+    assert app.source is playing
 
 
 def test_check_rows_of_files_at_another_resolution_uses_the_calibration_scaled(tmp_path):

@@ -1945,6 +1945,21 @@ class StereoApp:
                 typed.append(str(name))
         return " and ".join(dict.fromkeys(_source_name(t) for t in typed))
 
+    def _in_use_unchanged(self) -> str:
+        """What a failed Open or Play leaves in use, as the page says it: ``the cameras in use
+        are unchanged``, ``the folder data/seq in use is unchanged``, or (video files, a bag)
+        ``the source in use is unchanged`` ("the cameras" was said of a folder's pairs too)."""
+        source = self.source
+        if isinstance(source, FolderPairs):
+            return f"the folder {source.name} in use is unchanged"
+        if self._source_label is None:
+            try:
+                if all(isinstance(parse_source(n), int) for n in self._source_names):
+                    return "the cameras in use are unchanged"
+            except ValueError:  # a name no camera has: not said to be cameras
+                pass
+        return "the source in use is unchanged"
+
     def _begin_read(self, source: StereoSource, what: str) -> None:
         """A read of ``source`` is under way from now (before its task runs: a click that
         comes meanwhile sees it); the page says so."""
@@ -2180,7 +2195,7 @@ class StereoApp:
             if not isinstance(exc, (ValueError, OSError, RuntimeError)):
                 log.exception("gui: reading %s failed", what)
             if self.source is not None:
-                exc = OSError(f"{first_line(exc)} (the cameras in use are unchanged)")
+                exc = OSError(f"{first_line(exc)} ({self._in_use_unchanged()})")
             self._fail(exc, outlasts=True)
             return
         self._end_first_read(choice)
@@ -2236,8 +2251,7 @@ class StereoApp:
             source.close()
             self.source, self.homographies, self._source_label, self._source_names = before
             if self.source is not None:
-                said = first_line(exc)
-                exc = OSError(f"{said} (the cameras in use are unchanged)")
+                exc = OSError(f"{first_line(exc)} ({self._in_use_unchanged()})")
             self._fail(exc, outlasts=True)
             return
         self._shows += 1
