@@ -2299,6 +2299,45 @@ def test_home_clouds_are_offered_when_saves_go_home_past_a_writable_saved(tmp_pa
     assert app.state.error == "" and app._cloud is not None
 
 
+def test_the_save_hint_and_tooltip_name_the_home_folder_past_a_writable_saved(
+    tmp_path, monkeypatch
+):
+    """A read-only --data folder holding a writable, full ``saved``: a Save as offered goes to
+    ``saved-2``, cannot make it and goes home, but the start-up hint said "in a --data
+    folder" and the field's tooltip named data/saved: both asked of ``saved`` alone. They ask
+    what the Save asks (the folder the next Save as offered takes), and name the home
+    folder, and saved-2 as the folder that cannot be written, as the Save's line does."""
+    import stereovision.io as svio
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import READ_ONLY_SAVE_HINT
+
+    data, home = tmp_path / "data", tmp_path / "home"
+    (data / "saved").mkdir(parents=True)
+    (data / "saved" / "notes.txt").write_text("an earlier Save's")
+    home.mkdir()
+    real = svio.cannot_write_in
+    read_only = data.resolve()
+    monkeypatch.setattr(
+        svio,
+        "cannot_write_in",
+        lambda f: "Read-only file system" if Path(f).resolve() == read_only else real(f),
+    )
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.chdir("/")
+    app = _scene_app("test-save-hint-saved-2", [bundled_data_dir(), data])
+    assert app.state.save_hint == READ_ONLY_SAVE_HINT
+    refused = f"{data.resolve() / 'saved-2'} cannot be written: Read-only file system"
+    title = f"{Path.home() / 'stereovision-saved'} (or the next new -N: {refused})"
+    assert app.state.save_dir_title == title
+    app._on_save_dir("")  # an emptied field: as offered
+    assert app.state.save_dir_title == title
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.save_label.startswith("saved 450×375 to ~/stereovision-saved: ")
+    assert app.state.save_label.endswith(f"({refused})")  # as the tooltip said
+
+
 def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkeypatch):
     """Save pressed twice (or again after a new pair came) while the first still wrote: the
     second found none of the files yet, wrote too, and replaced the first's files without a

@@ -1543,7 +1543,7 @@ class StereoApp:
         st.save_dir = self._offered_save_dir
         st.save_dir_title = self._save_title(self._offered_save_dir)
         st.save_hint = SAVE_HINT if self._save_roots else NO_SAVE_HINT
-        if self._save_roots and _cannot_make(self._save_roots[0] / SAVE_FOLDER):
+        if self._offered_save_folder_refused():
             st.save_hint = READ_ONLY_SAVE_HINT  # a read-only data set: save goes home
         st.save_label = ""
         for name in _CONTROL_NAMES:
@@ -1581,14 +1581,7 @@ class StereoApp:
         folders the page may read (their clouds: the point-cloud list offered only the
         ``--data`` folders', and "Show" refused what was just saved). None when Saves do not
         go there. A link named so is left out: it may lead anywhere."""
-        if not self._save_roots:
-            return None
-        try:
-            # the folder a Save as offered takes, as save() decides: ``saved`` alone was asked
-            # of, and a writable full one in a read-only --data hid the home folder's clouds
-            if not _cannot_make(self._next_save_folder()):
-                return None
-        except (ValueError, OSError):  # no such folder in --data: save() says why
+        if not self._offered_save_folder_refused():
             return None
         try:
             home = Path.home()
@@ -1650,15 +1643,19 @@ class StereoApp:
         """The save field's tooltip: the whole path a Save would write into ("" for none)."""
         text = str(typed or "").strip()
         if self._save_roots and text in ("", self._offered_save_dir):
-            offered = self._save_roots[0] / SAVE_FOLDER
-            why = _cannot_make(offered)
-            if why:  # a read-only --data folder: such a Save goes home (save)
-                try:
-                    home = Path.home() / FALLBACK_SAVE_FOLDER
-                except RuntimeError:  # no home folder known: the Save says so
-                    return f"{offered} cannot be written: {why}"
-                return f"{home} (or the next new -N: {offered} cannot be written: {why})"
-            return f"{offered} (or the next new saved-N)"
+            try:
+                folder, why = self._offered_save_folder()
+            except (ValueError, OSError):  # no such folder in --data: the Save says why
+                return ""
+            if not why:
+                return f"{self._save_roots[0] / SAVE_FOLDER} (or the next new saved-N)"
+            # a read-only --data folder: such a Save goes home (save), ``folder`` refused (not
+            # ``saved``: saved-2 past a writable, full one)
+            try:
+                home = Path.home() / FALLBACK_SAVE_FOLDER
+            except RuntimeError:  # no home folder known: the Save says so
+                return f"{folder} cannot be written: {why}"
+            return f"{home} (or the next new -N: {folder} cannot be written: {why})"
         try:
             return str(self._typed_save_folder(text))
         except (ValueError, OSError):
@@ -2709,8 +2706,7 @@ class StereoApp:
         elsewhere = ""  # why a Save as offered went to the home folder
         try:
             if self._save_roots and typed in ("", self._offered_save_dir):
-                folder = self._next_save_folder(skipped)
-                why = _cannot_make(folder)
+                folder, why = self._offered_save_folder(skipped)
                 if why:  # a read-only --data folder: the home folder's, said in the Save's line
                     elsewhere = f"{display_path(folder)} cannot be written: {why}"
                     folder = self._fallback_save_folder(folder, why)
@@ -2853,6 +2849,30 @@ class StereoApp:
             if not os.path.lexists(folder) or (folder.is_dir() and not any(folder.iterdir())):
                 return folder
         raise AssertionError("unreachable")  # pragma: no cover
+
+    def _offered_save_folder(self, skipped: list[str] | None = None) -> tuple[Path, str | None]:
+        """The folder in the first ``--data`` folder a Save as offered takes next
+        (:meth:`_next_save_folder`) and why it cannot be made or written (None if it can: else
+        the Save goes home, :meth:`_fallback_save_folder`). The one rule of :meth:`save`, the
+        field's hint and tooltip and the point-cloud list (they asked of ``saved`` alone: a
+        writable, full one in a read-only ``--data`` named it where Saves went home).
+
+        Raises
+        ------
+        ValueError, OSError
+            As :meth:`_next_save_folder` raises them.
+        """
+        folder = self._next_save_folder(skipped)
+        return folder, _cannot_make(folder)
+
+    def _offered_save_folder_refused(self) -> bool:
+        """True if a Save as offered goes to the home folder (:meth:`_offered_save_folder`)."""
+        if not self._save_roots:
+            return False
+        try:
+            return bool(self._offered_save_folder()[1])
+        except (ValueError, OSError):  # no such folder in --data: save() says why
+            return False
 
     def _fallback_save_folder(self, offered: Path, why: str) -> Path:
         """The folder a Save as offered goes to when ``offered`` (in the first ``--data``
