@@ -2338,6 +2338,39 @@ def test_the_save_hint_and_tooltip_name_the_home_folder_past_a_writable_saved(
     assert app.state.save_label.endswith(f"({refused})")  # as the tooltip said
 
 
+def test_a_home_folder_that_is_a_link_is_shown_as_tilde(tmp_path, monkeypatch):
+    """HOME a symbolic link (/home/me -> /data/me): the Save's line and the point-cloud list
+    showed the home folder's saves by their resolved, absolute paths, since they were asked
+    of HOME as given alone. They show ``~/...`` for a path under HOME as given or resolved,
+    and agree."""
+    import stereovision.io as svio
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.sources import display_path
+
+    data, home, link = tmp_path / "data", tmp_path / "real-home", tmp_path / "home"
+    data.mkdir()
+    home.mkdir()
+    link.symlink_to(home, target_is_directory=True)
+    real = svio.cannot_write_in
+    read_only = data.resolve()
+    monkeypatch.setattr(
+        svio,
+        "cannot_write_in",
+        lambda f: "Read-only file system" if Path(f).resolve() == read_only else real(f),
+    )
+    monkeypatch.setenv("HOME", str(link))
+    monkeypatch.chdir("/")
+    assert display_path(home / "x.ply") == display_path(link / "x.ply") == "~/x.ply"
+    assert display_path(home) == "~" and display_path(tmp_path) == str(tmp_path)
+    app = _scene_app("test-home-link", [bundled_data_dir(), data])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.save_label.startswith("saved 450×375 to ~/stereovision-saved: ")
+    saved = str((home / "stereovision-saved" / "cloud.ply").resolve())
+    assert {"title": "~/stereovision-saved/cloud.ply", "value": saved} in app.state.clouds
+
+
 def test_a_second_save_into_the_folder_being_written_is_refused(tmp_path, monkeypatch):
     """Save pressed twice (or again after a new pair came) while the first still wrote: the
     second found none of the files yet, wrote too, and replaced the first's files without a

@@ -88,9 +88,12 @@ def display_path(
         home = Path.home() if home is None else home
     except RuntimeError:  # no home folder known
         return str(p)
-    if p.is_relative_to(home) and home != Path(home.anchor):
-        rel = p.relative_to(home).as_posix()
-        return "~" if rel == "." else f"~/{rel}"
+    # as given and resolved: a HOME that is a symbolic link showed the resolved paths of the
+    # home folder's saves whole
+    for h in dict.fromkeys((home, Path(os.path.realpath(home)))):
+        if p.is_relative_to(h) and h != Path(h.anchor):
+            rel = p.relative_to(h).as_posix()
+            return "~" if rel == "." else f"~/{rel}"
     return str(p)
 
 
