@@ -696,8 +696,13 @@ def test_a_bad_size_is_named_by_its_option(
          "--square: expected a number, got '1/4' (see stereovision calibrate --help)"),
         (["batch", "in", "-o", "out", "--workers", "two"], "--workers: expected a whole number, "
          "got 'two' (see stereovision batch --help)"),
+        # a value holding a ' is in double quotes in argparse's words: it kept them all
+        (["depth", "l.png", "r.png", "-o", "out", "--max-depth=5'"], "--max-depth: expected a "
+         "number, got \"5'\" (see stereovision depth --help)"),
+        (["batch", "in", "-o", "out", "--workers", "2'"], "--workers: expected a whole number, "
+         "got \"2'\" (see stereovision batch --help)"),
     ],
-    ids=["depth", "calibrate", "batch"],
+    ids=["depth", "calibrate", "batch", "depth-quote", "batch-quote"],
 )  # fmt: skip
 def test_a_value_that_is_no_number_is_said_without_python_types(
     command: list[str], says: str, capsys: pytest.CaptureFixture[str]

@@ -1814,9 +1814,10 @@ class _Parser(argparse.ArgumentParser):
     """argparse with its errors in one line, as the command's own (not the usage block)."""
 
     def error(self, message: str) -> NoReturn:
-        # argparse names the Python type ("invalid float value: 'abc'"): said as what to type
+        # argparse names the Python type ("invalid float value: 'abc'"): said as what to type.
+        # The value is in repr's quotes: double ones when it holds a ' ("5'", feet)
         message = re.sub(
-            r"invalid (float|int) value: ('.*')$",
+            r"invalid (float|int) value: ('.*'|\".*\")$",
             lambda m: f"expected a {'number' if m[1] == 'float' else 'whole number'}, got {m[2]}",
             message,
         )
