@@ -736,3 +736,45 @@ def test_an_image_sequence_is_not_said_to_run_at_0_fps(tmp_path: Path) -> None:
         assert "0 fps" not in said
         cam.delivered_fps["left"] = 30.0
         assert "64x48 @ 30 fps; right" in cam.describe()
+
+
+@pytest.mark.parametrize("command", ["depth", "check", "rectify"])
+def test_one_scene_folder_for_both_images_says_what_to_type(
+    command: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stereovision depth cones -o out` (one positional: the scene folder, as eval and batch
+    take it) said argparse's "the following arguments are required: right"; it now names the
+    folder's two images, as `depth cones cones` does. A folder without one pair, or a file,
+    keeps the plain one line."""
+    out = str(tmp_path / "out")
+    pair = f"give its two images, {CONES / 'left.png'} and {CONES / 'right.png'}"
+    options = {"depth": ["-o", out, "--max-disparity", "64"], "check": ["--tolerance", "1"]}
+    options["rectify"] = ["-o", out]
+    for args in ([str(CONES), *options[command]], [*options[command], str(CONES)]):
+        with pytest.raises(SystemExit) as exit_:
+            main([command, *args])
+        assert exit_.value.code == 2
+        err = capsys.readouterr().err
+        assert err == (
+            f"stereovision {command}: error: the right image is missing; {CONES} is a folder "
+            f"holding a pair: {pair} (see stereovision {command} --help)\n"
+        )
+    if command == "depth":  # -o missing too: both said
+        with pytest.raises(SystemExit):
+            main([command, str(CONES)])
+        assert capsys.readouterr().err.endswith(
+            f"{pair} (also required: -o/--output) (see stereovision depth --help)\n"
+        )
+    calib_set = tmp_path / "boards"  # left01/left02...: no single pair
+    calib_set.mkdir()
+    for name in ("left01.png", "left02.png", "right01.png", "right02.png"):
+        (calib_set / name).write_bytes(b"")
+    for given in (calib_set, CONES / "left.png"):
+        with pytest.raises(SystemExit):
+            main([command, str(given)])
+        err = capsys.readouterr().err
+        assert err.startswith(
+            f"stereovision {command}: error: the following arguments are required: right"
+        )
+        assert err.count("\n") == 1
+    assert not (tmp_path / "out").exists()

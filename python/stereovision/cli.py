@@ -1813,6 +1813,15 @@ def port_number(text: str) -> int:
 class _Parser(argparse.ArgumentParser):
     """argparse with its errors in one line, as the command's own (not the usage block)."""
 
+    #: The words this parser (a subcommand's: those after its name) was given, for error().
+    typed: tuple[str, ...] = ()
+
+    def parse_known_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: Any = None
+    ) -> tuple[Any, list[str]]:
+        self.typed = tuple(sys.argv[1:] if args is None else args)
+        return super().parse_known_args(args, namespace)
+
     def error(self, message: str) -> NoReturn:
         # argparse names the Python type ("invalid float value: 'abc'"): said as what to type.
         # The value is in repr's quotes: double ones when it holds a ' ("5'", feet)
@@ -1821,8 +1830,39 @@ class _Parser(argparse.ArgumentParser):
             lambda m: f"expected a {'number' if m[1] == 'float' else 'whole number'}, got {m[2]}",
             message,
         )
+        missing = "the following arguments are required: right"
+        if message == missing or message.startswith(f"{missing}, "):
+            message = self._folder_for_a_pair(message, message[len(missing) + 2 :])
         sys.stderr.write(f"{self.prog}: error: {message} (see {self.prog} --help)\n")
         sys.exit(EXIT_ERROR)
+
+    def _words_given(self) -> list[str]:
+        """The words typed that are no option nor an option's value."""
+        words, i = [], 0
+        while i < len(self.typed):
+            action = self._option_string_actions.get(self.typed[i])
+            if action is not None:  # an option: its value (if it takes one) follows
+                i += 1 if action.nargs == 0 else 2
+                continue
+            if not self.typed[i].startswith("-"):  # (--opt=value is one word)
+                words.append(self.typed[i])
+            i += 1
+        return words
+
+    def _folder_for_a_pair(self, message: str, also: str) -> str:
+        """``stereovision depth cones -o out``: one positional, a scene folder (as eval and
+        batch take it). argparse said only that ``right`` is required; the folder's two images
+        are what to type (as imread says of a folder given as an image)."""
+        from stereovision.io import _folder_pair
+
+        given = self._words_given()
+        pair = _folder_pair(given[0]) if len(given) == 1 else None
+        if pair is None:
+            return message
+        return (
+            f"the right image is missing; {given[0]} is a folder holding a pair: give its two "
+            f"images, {pair[0]} and {pair[1]}" + (f" (also required: {also})" if also else "")
+        )
 
 
 _METHOD_HELP = (

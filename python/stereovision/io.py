@@ -736,22 +736,42 @@ def _existing_file(path: PathLike, what: str) -> Path:
 def _pair_in_folder(folder: Path) -> str:
     """What to give instead of a scene folder given as an image (``stereovision depth cones``,
     as ``eval`` and ``batch`` take it): the folder's left and right images, when it holds one of
-    each (``left.png`` + ``right.png``, Middlebury's ``im0.png`` + ``im1.png``), else ""."""
+    each, else ""."""
+    pair = _folder_pair(folder)
+    if pair is None:
+        return ""
+    return f" (a folder holding a pair: give its two images, {pair[0]} and {pair[1]})"
+
+
+def _folder_pair(folder: PathLike) -> tuple[Path, Path] | None:
+    """The left and right image of a scene folder holding one pair (``left.png`` +
+    ``right.png``, Middlebury's ``im0.png`` + ``im1.png``), for a message saying what to give
+    instead of the folder.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        The folder given where images were expected.
+
+    Returns
+    -------
+    (Path, Path) or None
+        The two images under ``folder``; None when it is no readable folder or holds no single
+        pair (``left01.png``, ``left02.png``, ... is a calibration set, not a pair).
+    """
     from stereovision.batch import IMAGE_EXTS
 
+    folder = Path(folder)
     try:
         images = [f for f in os.listdir(folder) if Path(f).suffix.lower() in IMAGE_EXTS]
     except OSError:  # not a folder, or not readable: nothing to suggest
-        return ""
+        return None
     for left, right in (("left", "right"), ("im0", "im1")):
         ls = sorted(f for f in images if Path(f).stem.lower() == left)
         rs = sorted(f for f in images if Path(f).stem.lower() == right)
         if len(ls) == 1 and len(rs) == 1:
-            return (
-                f" (a folder holding a pair: give its two images, {folder / ls[0]} and "
-                f"{folder / rs[0]})"
-            )
-    return ""
+            return folder / ls[0], folder / rs[0]
+    return None
 
 
 # --------------------------------------------------------------------------------------- images
