@@ -778,3 +778,40 @@ def test_one_scene_folder_for_both_images_says_what_to_type(
         )
         assert err.count("\n") == 1
     assert not (tmp_path / "out").exists()
+
+
+def test_reading_a_calibration_recording_reports_its_progress(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`stereovision calibrate --left left.mp4 --right right.mp4` read the recording's frames
+    without a word before the boards' bar; calibrate_from_video's ``progress`` now hears each
+    pair read (of the pairs the recording announces), and the CLI draws a bar for it on a
+    terminal only, gone before the "frame pairs kept" line; nothing of it in a log."""
+    import cv2
+
+    from stereovision.calibrate import PROGRESS_BOARDS, PROGRESS_FRAMES, calibrate_from_video
+
+    lefts, rights = _chessboard_pairs(6)
+    for side, paths in (("left", lefts), ("right", rights)):
+        for i, path in enumerate(paths):
+            assert cv2.imwrite(str(tmp_path / f"{side}_{i:02d}.png"), cv2.imread(str(path)))
+    left, right = str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png")
+    calls: list[tuple[str, int, int]] = []
+    calibrate_from_video(
+        left, right, square_size=1.0, min_distance=0.0, progress=lambda *a: calls.append(a)
+    )
+    assert calls[:7] == [(PROGRESS_FRAMES, i, 6) for i in range(1, 7)] + [(PROGRESS_BOARDS, 1, 6)]
+
+    args = ["calibrate", "--left", left, "--right", right, "--square", "1"]
+    terminal = _Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    assert main([*args, "-o", str(tmp_path / "rig.yaml")]) == 0
+    assert "frames:   0%" in terminal.text and "/6 [" in terminal.text
+    assert terminal.text.rsplit("\r", 2)[-2].strip() == ""  # the bars cleared from the screen
+    out = capsys.readouterr().out
+    assert "frames" not in out.replace("frame pairs kept", "")  # no bar on stdout
+    monkeypatch.undo()
+    assert main([*args, "-o", str(tmp_path / "rig2.yaml")]) == 0
+    logged = capsys.readouterr()
+    assert "frames:" not in logged.err and "%" not in logged.err
+    assert "of 6 frame pairs kept" in logged.out

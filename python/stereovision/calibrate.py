@@ -168,9 +168,11 @@ OUTLIER_MIN_PX = 0.5
 MIN_PAIRS = 3
 
 #: The stages :func:`calibrate` reports to its ``progress`` callback: the board search in each
-#: pair, then the leave-one-out fits that choose the distortion model.
+#: pair, then the leave-one-out fits that choose the distortion model; before them
+#: :func:`calibrate_from_video` and :func:`calibrate_from_bag` report each frame pair read.
 PROGRESS_BOARDS = "boards"
 PROGRESS_MODELS = "distortion models"
+PROGRESS_FRAMES = "frames"
 
 #: Fewest ChArUco corners seen by both cameras for a pair to be used (see charuco.MIN_CORNERS).
 CHARUCO_MIN_COMMON = 6
@@ -1836,7 +1838,9 @@ def calibrate_from_video(
         USB device, a stalled stream) is given up with a
         :class:`~stereovision.capture.SourceError` naming it.
     **kwargs
-        Passed to :func:`calibrate` (``unit``, ``distortion``, ``drop_outliers``, ...).
+        Passed to :func:`calibrate` (``unit``, ``distortion``, ``drop_outliers``, ...); its
+        ``progress`` also hears the reading, stage :data:`PROGRESS_FRAMES` after each frame pair
+        read (``total`` the pairs the recording announces, 0 when it announces none: a camera).
 
     Returns
     -------
@@ -1965,6 +1969,9 @@ def _calibrate_from_camera(
     names: list[str] = []
     read = 0
     last = ""  # the last frame read
+    progress = kwargs.get("progress")
+    # a few hundred frames of a recording are read before calibrate's own stages: said too
+    total = _frames_announced(cam) if progress is not None else 0
     try:
         pat = board.inner if board is not None else parse_pattern(pattern)
         collector = ChessboardCollector(
@@ -1983,6 +1990,8 @@ def _calibrate_from_camera(
                 lefts.append(frame.left)
                 rights.append(frame.right)
                 names.append(last)
+            if progress is not None:
+                progress(PROGRESS_FRAMES, read, total)
     finally:
         cam.close()
     what = board.describe() if board is not None else f"chessboard {pat[0]}x{pat[1]} inner corners"
@@ -2015,6 +2024,16 @@ def _calibrate_from_camera(
     )
     rep.pair_selection = selection
     return cal, rep
+
+
+def _frames_announced(cam: Any) -> int:
+    """The frame pairs a recording announces (the fewer of its two videos'), 0 when unknown (a
+    camera, a bag: its bar counts without an end)."""
+    announced = getattr(cam, "_announced", None)  # StereoCamera's (CAP_PROP_FRAME_COUNT)
+    if announced is None:
+        return 0
+    counts = [announced(side) for side in ("left", "right")]
+    return min(counts) if None not in counts else 0
 
 
 # ---------------------------------------------------------------------------------- pictures
@@ -2646,9 +2665,9 @@ def _cli_words(text: str) -> str:
 
 class _ProgressBars:
     """``stereovision calibrate``'s progress bars on a terminal (a tqdm bar per stage of
-    :func:`calibrate`'s ``progress``: the board search, the distortion model's choice); nothing
-    elsewhere, where the summary lines are the log. Thirty 320x240 pairs took 22 s without a
-    word: 14 s finding boards, 8 s choosing the model."""
+    :func:`calibrate`'s ``progress``: a recording's frames read, the board search, the
+    distortion model's choice); nothing elsewhere, where the summary lines are the log. Thirty
+    320x240 pairs took 22 s without a word: 14 s finding boards, 8 s choosing the model."""
 
     def __init__(self) -> None:
         self.enabled = sys.stderr.isatty()
@@ -2663,8 +2682,10 @@ class _ProgressBars:
 
             self.close()
             self.stage = stage
-            unit = "pair" if stage == PROGRESS_BOARDS else "fit"
-            self.bar = tqdm(total=total, desc=stage, unit=unit, file=sys.stderr, leave=False)
+            unit = {PROGRESS_BOARDS: "pair", PROGRESS_FRAMES: "frame"}.get(stage, "fit")
+            self.bar = tqdm(
+                total=total or None, desc=stage, unit=unit, file=sys.stderr, leave=False
+            )
         self.bar.update(done - self.bar.n)
 
     def close(self) -> None:
@@ -2681,6 +2702,13 @@ def _calibrate_source(
     common: dict[str, Any],
 ) -> tuple[Calibration, CalibrationReport]:
     """Calibrate from the source the options give: a bag, two videos or two sets of images."""
+    bars = common.get("progress")
+
+    def log(line: str) -> None:
+        if isinstance(bars, _ProgressBars):
+            bars.close()  # the frames' bar off the screen first: it would share the line
+        print(_cli_words(line))
+
     if args.from_bag:
         return calibrate_from_bag(
             args.from_bag,
@@ -2688,7 +2716,7 @@ def _calibrate_source(
             right_topic=args.right_topic,
             max_skew_ms=args.max_skew_ms,
             max_pairs=MAX_VIDEO_PAIRS if args.max_pairs is None else args.max_pairs,
-            log=lambda line: print(_cli_words(line)),
+            log=log,
             **common,
         )
     if video:
@@ -2696,7 +2724,7 @@ def _calibrate_source(
             args.left[0],
             args.right[0],
             max_pairs=MAX_VIDEO_PAIRS if args.max_pairs is None else args.max_pairs,
-            log=lambda line: print(_cli_words(line)),
+            log=log,
             **common,
         )
     selection: dict[str, Any] = {}
