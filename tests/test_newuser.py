@@ -597,6 +597,35 @@ def test_calibrate_reports_its_progress() -> None:
     np.testing.assert_array_equal(cal.T, plain.T)
 
 
+def test_calibrate_progress_reaches_its_total_when_a_fit_ends_early(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A view whose pose is not found (solvePnP failing) ends that camera's leave-one-out
+    early, its RMS inf: the fits it skipped were never counted, and the "distortion models"
+    count stopped short of the total it announced (20 of 24 here). They are now counted: the
+    count rises to its total."""
+    import cv2
+
+    from stereovision.calibrate import PROGRESS_MODELS, calibrate
+
+    lefts, rights = _chessboard_pairs(6)
+    real = cv2.solvePnP
+    n = [0]
+
+    def fails_once(*a: object, **kw: object) -> object:
+        n[0] += 1
+        return (False, None, None) if n[0] == 2 else real(*a, **kw)  # k1k2p1p2's left, view 2
+
+    monkeypatch.setattr(cv2, "solvePnP", fails_once)
+    calls: list[tuple[str, int, int]] = []
+    _, rep = calibrate(lefts, rights, square_size=1.0, progress=lambda *a: calls.append(a))
+    fits = [done for stage, done, total in calls if stage == PROGRESS_MODELS and total == 24]
+    assert len(fits) == len([c for c in calls if c[0] == PROGRESS_MODELS])
+    assert fits[-1] == 24 and fits == sorted(set(fits))
+    assert fits[:3] == [1, 2, 6]  # the left camera's 4 fits skipped, counted at once
+    assert rep.model_selection["k1k2p1p2"] == float("inf")
+
+
 class _Terminal:
     """A stderr that says it is a terminal, keeping what is written to it."""
 

@@ -1068,10 +1068,20 @@ def _solve(
             if progress is not None:
                 progress(PROGRESS_MODELS, fits[0], fits[1])
 
-        for name in candidates:
+        def reach(done: int) -> None:
+            # a view whose pose is not found ends a camera's leave-one-out early (its RMS inf):
+            # the fits it skipped are counted, or the count stopped short of the total given
+            if fits[0] < done:
+                fits[0] = done
+                if progress is not None:
+                    progress(PROGRESS_MODELS, done, fits[1])
+
+        for k, name in enumerate(candidates):
             flags = DISTORTION_MODELS[name]
             loo_l, K1, D1 = _loo_rms(obj, left, size, flags, step=step)
+            reach((2 * k + 1) * len(obj))
             loo_r, K2, D2 = _loo_rms(obj, right, size, flags, step=step)
+            reach((2 * k + 2) * len(obj))
             loo = math.sqrt((loo_l**2 + loo_r**2) / 2)
             selection[name] = loo
             sane = _radial_is_monotonic(K1, D1, size) and _radial_is_monotonic(K2, D2, size)
