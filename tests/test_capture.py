@@ -167,6 +167,18 @@ def test_videos_of_different_rates_drift_apart_once(tmp_path: Path) -> None:
         warnings.simplefilter("error")
         with StereoCamera(left, left) as cam:
             assert len(list(cam.frames())) == 8
+    # a video that gives no rate (OpenCV's 0): the warning said "(0 fps)", a source delivering
+    # nothing; it says so as the description does
+    with pytest.warns(UserWarning) as rec:
+        with StereoCamera(left, right) as cam:
+            cam.delivered_fps["right"] = 0.0
+            assert len(list(cam.frames())) == 8
+    assert len(rec) == 1
+    assert str(rec[0].message).startswith(
+        f"left source {str(left)!r} (10 fps) and right source {str(right)!r} (no frame rate "
+        "given) drift apart: pair 3 is at 200 ms of the left video and 400 ms of the right, "
+        "more than a frame (100 ms) "
+    )
 
 
 def test_skews_are_kept_in_bounded_memory() -> None:

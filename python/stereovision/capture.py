@@ -1041,6 +1041,13 @@ class SkewStats(Sequence[float]):
         return f"SkewStats(n={self.n}, latest {len(self.recent)})"
 
 
+def _rate_words(fps: float) -> str:
+    """A source's frame rate in words: ``30 fps``, or ``no frame rate given`` for OpenCV's 0,
+    a rate it does not know (an image sequence, some webcams and containers): "0 fps" read as
+    a source delivering nothing."""
+    return f"{fps:.3g} fps" if fps > 0 else "no frame rate given"
+
+
 class PairSource:
     """What every pair source shares (:class:`StereoCamera`,
     :class:`~stereovision.rosbag.BagCamera`): iteration until the end, the skew report, ``with``.
@@ -1058,9 +1065,7 @@ class PairSource:
             d = self.delivered_size.get(side)
             got = f"{d[0]}x{d[1]}" if d else "?"
             fps = self.delivered_fps.get(side, 0.0)
-            # OpenCV gives 0 for a rate it does not know (an image sequence, some webcams):
-            # "@ 0 fps" read as a source delivering nothing
-            rate = f"@ {fps:.3g} fps" if fps > 0 else "(no frame rate given)"
+            rate = f"@ {fps:.3g} fps" if fps > 0 else f"({_rate_words(fps)})"
             parts.append(f"{side} {names[side]}: {got} {rate}")
         return "; ".join(parts)
 
@@ -1646,11 +1651,11 @@ class StereoCamera(PairSource):
         fps = {side: self.delivered_fps.get(side, 0.0) for side in ("left", "right")}
         name = {side: _describe_source(src) for side, src in self.sources.items()}
         source_warning(
-            f"left source {name['left']} ({fps['left']:.3g} fps) and right source "
-            f"{name['right']} ({fps['right']:.3g} fps) drift apart: pair {frame.index + 1} is at "
-            f"{pl:.0f} ms of the left video and {pr:.0f} ms of the right, more than a frame "
-            f"({period:.0f} ms) from the first pair's offset; the pairs are not simultaneous "
-            "(the grab skew only says when each frame was read)",
+            f"left source {name['left']} ({_rate_words(fps['left'])}) and right source "
+            f"{name['right']} ({_rate_words(fps['right'])}) drift apart: pair "
+            f"{frame.index + 1} is at {pl:.0f} ms of the left video and {pr:.0f} ms of the "
+            f"right, more than a frame ({period:.0f} ms) from the first pair's offset; the pairs "
+            "are not simultaneous (the grab skew only says when each frame was read)",
         )
 
     def describe(self) -> str:
