@@ -844,3 +844,18 @@ def test_reading_a_calibration_recording_reports_its_progress(
     logged = capsys.readouterr()
     assert "frames:" not in logged.err and "%" not in logged.err
     assert "of 6 frame pairs kept" in logged.out
+
+
+@pytest.mark.parametrize("workers", ["0", "-1"])
+def test_batch_refuses_no_workers_in_the_options_words(
+    workers: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`batch in -o out --workers -1` (or 0) was refused as "workers: expected a positive
+    number", run_batch's parameter, where --count, --max-pairs and a --workers that is no
+    number name the option; nothing is written."""
+    out = tmp_path / "out"
+    assert main(["batch", str(CONES.parent), "-o", str(out), "--workers", workers]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: --workers: expected a whole number above 0, got {workers}\n"
+    )
+    assert not out.exists()

@@ -1864,6 +1864,10 @@ def cmd_batch(args: argparse.Namespace) -> int:
     from stereovision._interrupt import Terminated
     from stereovision.cli import EXIT_INTERRUPTED, EXIT_TERMINATED
 
+    # in the option's name, as --count and --max-pairs are (run_batch names its parameter)
+    if args.workers is not None and args.workers < 1:
+        raise ValueError(f"--workers: expected a whole number above 0, got {args.workers}")
+
     def log(line: str) -> None:
         from tqdm import tqdm
 
