@@ -1061,6 +1061,22 @@ def test_a_hand_made_result_counts_filters_and_converts_by_hand_values(tmp_path:
     assert pts.shape == (3, 3) and cols.shape == (3, 3) and not cols.any()
 
 
+def test_a_min_depth_of_0_is_a_limit_and_the_filled_guess_obeys_max_depth() -> None:
+    """min_depth 0 (the only limit that may be 0) keeps every depth and is recorded; the filled
+    pixel's guess (2.5 m) is left out of point_image(filled=True) beyond max_depth 2 m as a
+    measured depth (5 m) is."""
+    r = _hand_result()
+    zero = r.filtered(min_depth=0)
+    assert zero.limits == {"min_depth": 0.0}
+    assert _kept(zero.require_depth()) == [1, 2, 5]
+    with pytest.raises(ValueError, match="max_sigma: expected a positive number, got 0"):
+        r.filtered(max_sigma=0)
+    near = r.filtered(max_depth=2)
+    assert _kept(near.require_depth()) == [1, 2]
+    assert _kept(near.point_image(filled=True)[..., 2]) == [1, 2]
+    assert _kept(r.filtered(max_depth=2.5).point_image(filled=True)[..., 2]) == [1, 2, 2.5]
+
+
 def test_depth_uses_doffs_and_points_use_fx_and_fy_and_rgb_colours() -> None:
     h, w, d = 96, 160, 6.5
     tex = _texture(h, w)

@@ -636,3 +636,35 @@ def test_an_unknown_unit_is_named(call: str) -> None:
     }
     with pytest.raises(ValueError, match=r"unit: expected one of \[.*'m'.*\], got 'km'"):
         calls[call]()
+
+
+def test_a_midpoint_behind_the_right_camera_is_invalid() -> None:
+    """Both rays' closest points in front of their cameras (Z_L 5.0 mm, Z_R 4.2 mm) and the
+    midpoint in front of the left camera (6.6 mm), but 0.39 mm behind the right one: no point
+    (the rig is raw_calib's with the cameras' roles swapped, where a wrong match of two
+    rays crossing just ahead of the cameras puts the midpoint there)."""
+    c0 = raw_calib()
+    with pytest.warns(UserWarning, match="swapped"):
+        c = Calibration(
+            K1=c0.K2, D1=c0.D2, K2=c0.K1, D2=c0.D1, R=c0.R.T, T=-c0.R.T @ c0.T,
+            image_size=SIZE, unit="m",
+        )  # fmt: skip
+    good_l, good_r = project(c, scene_points(1))
+    xl = np.vstack([[329.44, 323.18], good_l])
+    xr = np.vstack([[354.86, 11.47], good_r])
+    res = triangulate(xl, xr, c)
+    assert res.valid.tolist() == [False, True]
+    assert np.isnan(res.XL[0]).all() and np.isnan(res.XR[0]).all()
+
+
+def test_rays_just_wider_than_the_parallel_limit_give_a_far_point() -> None:
+    """The limit is 1e-6 rad: rays 3e-6 rad apart (a disparity of 2.1e-3 px at f = 700 px)
+    still give their point, Z = f B / d = 700 * 0.12 m / 2.1e-3 = 40 km; 5e-7 rad do not."""
+    c = rect_calib()
+    d = np.array([3e-6, 5e-7]) * 700.0
+    xl = np.array([[400.0, 250.0], [400.0, 250.0]])
+    xr = xl - np.column_stack([d, np.zeros(2)])
+    res = triangulate(xl, xr, c)
+    assert res.valid.tolist() == [True, False]
+    np.testing.assert_allclose(res.XL[0, 2], 700.0 * 0.12 / d[0], rtol=1e-4)
+    assert res.XL[0, 2] == pytest.approx(40_000.0, rel=1e-4)
