@@ -648,6 +648,18 @@ def test_the_map_stays_in_the_range_searched(method: str, max_disparity: float) 
     assert float(np.nanmax(d)) > max_disparity - 0.5  # cones reaches 55 px: the top is hit
 
 
+def test_a_fractional_range_reaches_the_next_whole_pixel_in_the_census_map() -> None:
+    """max_disparity 37.5: the census semi-global map searches up to 38 (as DepthResult's
+    max_disparity says), so the fast and fused maps reach 38 on cones (55 px at most), not
+    37.5, while the result still reports the range given."""
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")
+    for method in ("fast", "fused"):
+        res = sv.depth_map(s.left, s.right, s.calib, method=method, max_disparity=37.5)
+        assert res.max_disparity == 37.5
+        assert float(np.nanmax(res.disparity)) == 38.0, method
+        assert np.count_nonzero(res.disparity > 37.5) > 5000, method
+
+
 def test_census_depth_sigma_is_one_value_as_documented() -> None:
     """The docs of ``depth_sigma`` did not say that ``"fast"`` and ``"census"`` without the
     re-measure give every pixel sigma_d 0.63 px (and 0.29 px with it): one confidence, 0.5."""
@@ -1075,6 +1087,18 @@ def test_a_min_depth_of_0_is_a_limit_and_the_filled_guess_obeys_max_depth() -> N
     assert _kept(near.require_depth()) == [1, 2]
     assert _kept(near.point_image(filled=True)[..., 2]) == [1, 2]
     assert _kept(r.filtered(max_depth=2.5).point_image(filled=True)[..., 2]) == [1, 2, 2.5]
+
+
+def test_a_hand_made_result_prints_its_depth_range_and_counts_a_zero_confidence_depth() -> None:
+    """The summary gives the depth range lowest first (1-5 m, median 2 m, on 3 of 6 pixels);
+    a measured pixel with confidence 0 that has a depth is not "filled": the counts still add
+    up, disparity == depth + filled + dropped."""
+    r = _hand_result()
+    assert "; depth 1-5 m (median 2 m) on 50.0 %; 0 points" in repr(r)
+    conf = r.confidence.copy()
+    conf[0, 0] = 0  # the 5 m pixel: measured, a depth, confidence 0
+    counts = dataclasses.replace(r, confidence=conf).depth_counts()
+    assert counts == {"pixels": 6, "disparity": 5, "depth": 3, "filled": 1, "dropped": 1}
 
 
 def test_depth_uses_doffs_and_points_use_fx_and_fy_and_rgb_colours() -> None:
