@@ -668,3 +668,46 @@ def test_rays_just_wider_than_the_parallel_limit_give_a_far_point() -> None:
     assert res.valid.tolist() == [True, False]
     np.testing.assert_allclose(res.XL[0, 2], 700.0 * 0.12 / d[0], rtol=1e-4)
     assert res.XL[0, 2] == pytest.approx(40_000.0, rel=1e-4)
+
+
+#: A Middlebury-2014-style calib.txt with a principal point offset (doffs = cx1 - cx0), mm.
+_MB2014_CALIB = """cam0=[3979.911 0 1244.772; 0 3979.911 1019.507; 0 0 1]
+cam1=[3979.911 0 1369.115; 0 3979.911 1019.507; 0 0 1]
+doffs=124.343
+baseline=193.001
+width=2964
+height=1988
+ndisp=270
+"""
+
+
+def test_a_middlebury_calib_txt_gives_depth_and_points_by_its_own_numbers(
+    tmp_path: Path,
+) -> None:
+    """Z = f B / (d + doffs) in metres (baseline in mm), feet by 0.3048 m, X = (x - cx) Z / f,
+    Y = (y - cy) Z / f, from the file's numbers read here by hand; d + doffs <= 0, NaN and inf
+    give no depth; cv2.reprojectImageTo3D with Q gives the same points in mm."""
+    path = tmp_path / "calib.txt"
+    path.write_text(_MB2014_CALIB)
+    c = Calibration.from_file(path)
+    f, cx, cy, cx1, doffs, b_mm = 3979.911, 1244.772, 1019.507, 1369.115, 124.343, 193.001
+    assert c.doffs_px == pytest.approx(cx1 - cx, abs=1e-9) == pytest.approx(doffs, abs=1e-9)
+    d = np.array([[100.0, 270.0, 0.0], [-doffs, -doffs - 1.0, np.nan], [np.inf, -50.0, 1.5]])
+    z = depth_from_disparity(d, c)
+    with np.errstate(divide="ignore"):
+        want = f * b_mm / 1000.0 / (d + doffs)
+    want[~(np.isfinite(d + doffs) & (d + doffs > 0))] = np.nan
+    np.testing.assert_allclose(z, want, rtol=1e-6)
+    assert np.isnan(z).tolist() == [[False] * 3, [True, True, True], [True, False, False]]
+    # 3979.911 px * 0.193001 m / 224.343 px = 3.424 m; in feet / 0.3048, in mm * 1000
+    assert float(z[0, 0]) == pytest.approx(3.4239, abs=1e-4)
+    np.testing.assert_allclose(depth_from_disparity(d, c, unit="ft"), want / 0.3048, rtol=1e-6)
+    np.testing.assert_allclose(depth_from_disparity(d, c, unit="mm"), want * 1000, rtol=1e-6)
+    pts = reproject(d, c)
+    ys, xs = np.mgrid[0:3, 0:3].astype(np.float64)
+    np.testing.assert_allclose(pts[..., 0], (xs - cx) * want / f, rtol=1e-6)
+    np.testing.assert_allclose(pts[..., 1], (ys - cy) * want / f, rtol=1e-6)
+    np.testing.assert_allclose(pts[..., 2], want, rtol=1e-6)
+    ok = np.isfinite(want)
+    ref = cv2.reprojectImageTo3D(np.nan_to_num(d, nan=-1e3, posinf=-1e3).astype(np.float32), c.Q)
+    np.testing.assert_allclose(pts[ok], ref[ok] / 1000.0, rtol=1e-5)
