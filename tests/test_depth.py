@@ -660,6 +660,17 @@ def test_a_fractional_range_reaches_the_next_whole_pixel_in_the_census_map() -> 
         assert np.count_nonzero(res.disparity > 37.5) > 5000, method
 
 
+def test_the_gabor_map_keeps_its_holes_by_default() -> None:
+    """fill defaults to True for the dense methods only: the Gabor map as depth_map gives it
+    keeps its holes (82 % of cones' pixels measured, none filled), as fill=False does."""
+    s = load_scene(Path(sv.__file__).parent / "data" / "cones")
+    res = sv.depth_map(s.left, s.right, s.calib, method="gabor", max_disparity=64)
+    assert 0.75 < res.density < 0.9
+    assert res.depth_counts()["filled"] == 0
+    unfilled = sv.depth_map(s.left, s.right, s.calib, method="gabor", max_disparity=64, fill=False)
+    np.testing.assert_array_equal(res.disparity, unfilled.disparity)
+
+
 def test_census_depth_sigma_is_one_value_as_documented() -> None:
     """The docs of ``depth_sigma`` did not say that ``"fast"`` and ``"census"`` without the
     re-measure give every pixel sigma_d 0.63 px (and 0.29 px with it): one confidence, 0.5."""
