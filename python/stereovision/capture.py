@@ -691,10 +691,12 @@ def _sequence_numbers(path: str) -> list[int]:
     return sorted(int(d) for d in _sequence_digits(path) if parts[1] % int(d) == d)
 
 
-def _sequence_first(path: str) -> tuple[int, str] | None:
+def _sequence_first(path: str, digits: list[str] | None = None) -> tuple[int, str] | None:
     """The first file of an image-sequence pattern and its number: the lowest number of the
     files it names (FFmpeg's image2 and OpenCV's own reader look at 0-4 alone, so a sequence
-    starting at 5 or later did not open); None when ``path`` is no pattern or names no file."""
+    starting at 5 or later did not open); None when ``path`` is no pattern or names no file.
+    ``digits`` is :func:`_sequence_digits` of ``path`` when the caller has listed the folder
+    already (a listing of 200,000 files takes a fifth of a second)."""
     parts = _sequence_parts(path)
     if "://" in path or parts is None or os.path.exists(path):
         return None
@@ -706,7 +708,7 @@ def _sequence_first(path: str) -> tuple[int, str] | None:
     # ... left_10000.png: its files are a %04d run, and left_10000.png alone is no sequence)
     fmt = parts[1]
     width = int(fmt[1:-1] or 0)
-    digits = _sequence_digits(path)
+    digits = _sequence_digits(path) if digits is None else digits
     numbers = sorted(int(d) for d in digits if fmt % int(d) == d and (not width or len(d) == width))
     if not numbers:
         return None
@@ -722,11 +724,14 @@ def _sequence_gap(path: str, read: int) -> tuple[str, int] | None:
     """For an image-sequence pattern read to its end after ``read`` images: the file that
     stopped it (the next number, missing) and how many files numbered after it exist; None
     when no file is numbered after it (the sequence's real end) or ``path`` is no pattern."""
-    first = _sequence_first(path)
-    if first is None:
+    parts = _sequence_parts(path)
+    digits = _sequence_digits(path)  # one listing of the folder for the start and the rest
+    first = _sequence_first(path, digits)
+    if parts is None or first is None:
         return None
     number = first[0] + read
-    later = sum(1 for n in _sequence_numbers(path) if n > number)
+    # as the pattern prints them (_sequence_numbers)
+    later = sum(1 for d in digits if parts[1] % int(d) == d and int(d) > number)
     return (os.path.basename(_sequence_name(path, number)), later) if later else None
 
 
@@ -909,8 +914,9 @@ class _ImageSequence:
         self._open, self._frame = False, None
 
 
-def _open_path(path: str) -> Any:
-    """``cv2.VideoCapture`` of a file, a URL or an image-sequence pattern.
+def _open_path(path: str, first: tuple[int, str] | None) -> Any:
+    """``cv2.VideoCapture`` of a file, a URL or an image-sequence pattern (``first``: its
+    :func:`_sequence_first`).
 
     A pattern is opened with OpenCV's own image reader (``CAP_IMAGES``): FFmpeg's, the default,
     rescales a frame of another size to the first frame's before anyone sees it (a 300x300
@@ -920,7 +926,6 @@ def _open_path(path: str) -> Any:
     that starts later, or names a percent sign, is read by :class:`_ImageSequence` the same way.
     The default backend remains for what ``CAP_IMAGES`` cannot open.
     """
-    first = _sequence_first(path)
     if first is not None and (first[0] > 1 or "%%" in path):
         return _ImageSequence(path, first[0])
     if first is not None:
@@ -1261,21 +1266,24 @@ class StereoCamera(PairSource):
                 raise FileNotFoundError(f"{side} source not found: {path}")
             if os.path.isdir(path):  # "cannot open" said nothing of what to give instead
                 raise SourceError(_folder_hint(side, path), side=side, end=False)
+            # looked for once: each look at a late start lists the whole folder (0.2 s for
+            # 200,000 files), and a sequence found needs no listing to know it has files
+            first = _sequence_first(path)
             # the text around the number matched as written (a folder "run[1]" is no glob)
-            pattern = _sequence_glob(path) if "://" not in path else None
+            pattern = _sequence_glob(path) if "://" not in path and first is None else None
             if pattern is not None:
-                if not glob.glob(pattern):
+                if next(glob.iglob(pattern), None) is None:
                     # said here: FFmpeg would print its own line first
                     raise FileNotFoundError(f"{side} source: no file matches {path}")
             exists = os.path.exists(path)  # a file whose name holds "%d" is no pattern
-            if "%" in path and "://" not in path and not exists and _sequence_first(path) is None:
+            if "%" in path and "://" not in path and not exists and first is None:
                 # files of another numbering: FFmpeg's line, then "cannot open", said neither
                 hint = _pattern_hint(side, path)
                 if hint is not None:
                     raise FileNotFoundError(hint)
             # OpenCV's log of its backends' attempts stays quiet (_open_within): the error
             # below says what failed
-            cap: Any = _open_within(lambda: _open_path(path), timeout, side, src, configure)
+            cap: Any = _open_within(lambda: _open_path(path, first), timeout, side, src, configure)
             self._sequence[side] = cap.isOpened() and cap.getBackendName() == "CV_IMAGES"
         elif isinstance(src, (bool, np.bool_)):  # True opened camera 1
             raise ValueError(f"{side} source: expected a device index or a path, got {src!r}")
