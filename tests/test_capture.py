@@ -3160,3 +3160,24 @@ def test_a_sequence_lists_its_folder_once_a_side_to_open_and_once_at_its_end(
     assert len(result.saved) == 3
     assert result.ended == "end of stream"
     assert len(listed) == at_open + 2
+
+
+def test_an_image_that_does_not_read_in_a_folder_with_a_percent_is_not_told_missing(
+    tmp_path: Path,
+) -> None:
+    """The damaged image was looked for in the folder as written ("50%% done"), where it is
+    not: in "50% done" a sequence stopped by an image that does not read was still told "is
+    missing ... (renumber them without the gap)"."""
+    folder = tmp_path / "50% done"
+    folder.mkdir()
+    for i in range(5):
+        cv2.imwrite(str(folder / f"f_{i:03d}.png"), _numbered(i))
+    (folder / "f_003.png").write_bytes(b"not a png")
+    pattern = str(tmp_path / "50%% done" / "f_%03d.png")
+    with StereoCamera(pattern, pattern) as cam:
+        result = capture(cam, tmp_path / "pairs")
+    assert len(result.saved) == 3
+    assert result.ended.startswith(
+        f"left source {pattern!r} ended after 3 images: f_003.png does not read "
+        "(damaged?), so the 1 image numbered after it was not read (replace or remove it)"
+    )

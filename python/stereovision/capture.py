@@ -1383,7 +1383,10 @@ class StereoCamera(PairSource):
             # a numbered image taken out of a sequence (a blurred frame deleted) ended it there:
             # the images after it were never read, which "ended after 4 frames" did not say
             # one that is there but does not read (damaged) was told "missing" too
-            there = os.path.exists(os.path.join(os.path.dirname(os.fspath(src)), gap[0]))
+            # in the folder as read ("50%% done/f_%03d.png" reads from "50% done")
+            parts = _sequence_parts(os.fspath(src))
+            folder = os.path.dirname(parts[0]) if parts is not None else ""
+            there = os.path.exists(os.path.join(folder, gap[0]))
             why, fix = (
                 ("does not read (damaged?)", "replace or remove it")
                 if there
