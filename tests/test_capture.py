@@ -3181,3 +3181,23 @@ def test_an_image_that_does_not_read_in_a_folder_with_a_percent_is_not_told_miss
         f"left source {pattern!r} ended after 3 images: f_003.png does not read "
         "(damaged?), so the 1 image numbered after it was not read (replace or remove it)"
     )
+
+
+@pytest.mark.parametrize("folder_name", ["100%", "50%%"])
+def test_a_sequence_in_a_folder_named_with_a_percent_sign_opens(
+    tmp_path: Path, folder_name: str
+) -> None:
+    """CAP_IMAGES takes a path's first "%" for the number and FFmpeg refuses a lone one, so
+    "100%/l_%03d.png" (read by our pattern code as the folder 100%) was "cannot open left
+    source"; it is read by _ImageSequence as a "%%" is. A folder "50%%" is written "50%%%%"."""
+    folder = tmp_path / folder_name
+    folder.mkdir()
+    for i in range(3):
+        cv2.imwrite(str(folder / f"l_{i:03d}.png"), _numbered(i))
+    pattern = str(tmp_path / folder_name.replace("%", "%%") / "l_%03d.png")
+    with StereoCamera(pattern, pattern) as cam:
+        assert [_read_stamp(f.left) for f in cam.frames()] == [0, 1, 2]
+    if folder_name == "100%":  # the folder as written, its lone "%" read as itself
+        lone = str(folder / "l_%03d.png")
+        with StereoCamera(lone, lone) as cam:
+            assert [_read_stamp(f.right) for f in cam.frames()] == [0, 1, 2]

@@ -922,11 +922,14 @@ def _open_path(path: str, first: tuple[int, str] | None) -> Any:
     rescales a frame of another size to the first frame's before anyone sees it (a 300x300
     frame in a 384x288 sequence came out stretched to 384x288), while ``CAP_IMAGES`` gives
     every frame at its own size, so that :class:`StereoCamera`'s size and shape rules apply.
-    ``CAP_IMAGES`` starts a pattern at number 0 or 1 and refuses a literal ``%%``: a sequence
-    that starts later, or names a percent sign, is read by :class:`_ImageSequence` the same way.
+    ``CAP_IMAGES`` starts a pattern at number 0 or 1 and refuses any ``%`` besides the number's
+    (a literal ``%%``, a folder ``100%``): a sequence that starts later, or names a percent
+    sign, is read by :class:`_ImageSequence` the same way.
     The default backend remains for what ``CAP_IMAGES`` cannot open.
     """
-    if first is not None and (first[0] > 1 or "%%" in path):
+    # any other "%" (a literal "%%", or a lone one as in a folder "100%") CAP_IMAGES refuses:
+    # it takes the path's first "%" for the number and allows no second
+    if first is not None and (first[0] > 1 or path.count("%") > 1):
         return _ImageSequence(path, first[0])
     if first is not None:
         cap = cv2.VideoCapture(path, cv2.CAP_IMAGES)
