@@ -3201,3 +3201,30 @@ def test_a_sequence_in_a_folder_named_with_a_percent_sign_opens(
         lone = str(folder / "l_%03d.png")
         with StereoCamera(lone, lone) as cam:
             assert [_read_stamp(f.right) for f in cam.frames()] == [0, 1, 2]
+
+
+def test_the_image_sequence_reader_seeks_and_counts_as_opencvs(tmp_path: Path) -> None:
+    """_ImageSequence stands in for CAP_IMAGES, but its set() refused every property, "as
+    CAP_IMAGES refuses them too": CAP_IMAGES seeks on CAP_PROP_POS_FRAMES (kept within its
+    count). Both readers now give the same frames, positions and answers for the same calls."""
+    for i in range(6):
+        cv2.imwrite(str(tmp_path / f"s_{i:03d}.png"), _numbered(i))
+    pattern = str(tmp_path / "s_%03d.png")
+
+    def session(cap: Any) -> list[object]:
+        said: list[object] = [cap.get(cv2.CAP_PROP_FRAME_COUNT), cap.get(cv2.CAP_PROP_POS_FRAMES)]
+        for seek in (None, None, 0, 99, -3, 2.6, None):
+            if seek is not None:
+                said.append(cap.set(cv2.CAP_PROP_POS_FRAMES, seek))
+            ok, frame = cap.read()
+            said += [ok, _read_stamp(frame) if ok else None, cap.get(cv2.CAP_PROP_POS_FRAMES)]
+        said.append(cap.set(cv2.CAP_PROP_FPS, 5.0))
+        cap.release()
+        cap.release()  # twice, as OpenCV allows
+        said += [cap.isOpened(), cap.read()[0]]
+        return said
+
+    opencv = session(cv2.VideoCapture(pattern, cv2.CAP_IMAGES))
+    assert opencv[:2] == [6.0, 0.0]
+    assert opencv[2:5] == [True, 0, 1.0]  # the first image, then position 1
+    assert session(capmod._ImageSequence(pattern, 0)) == opencv

@@ -908,7 +908,12 @@ class _ImageSequence:
         return float(values.get(prop, 0))
 
     def set(self, prop: int, value: float) -> bool:
-        return False  # a file cannot be asked (CAP_IMAGES refuses them too)
+        # CAP_IMAGES seeks (the position kept within the images counted at the open, as its
+        # own) and refuses every other setting: a file cannot be asked a size or a rate
+        if prop != cv2.CAP_PROP_POS_FRAMES or not self._count:
+            return False
+        self._next = round(min(max(value, 0), self._count - 1))
+        return True
 
     def release(self) -> None:
         self._open, self._frame = False, None
