@@ -3228,3 +3228,25 @@ def test_the_image_sequence_reader_seeks_and_counts_as_opencvs(tmp_path: Path) -
     assert opencv[:2] == [6.0, 0.0]
     assert opencv[2:5] == [True, 0, 1.0]  # the first image, then position 1
     assert session(capmod._ImageSequence(pattern, 0)) == opencv
+
+
+def test_a_space_padded_sequence_opens_from_its_first_number_however_late(
+    tmp_path: Path,
+) -> None:
+    """printf's (and CAP_IMAGES's) "%3d" pads with spaces: sp_  7.png ... sp_ 12.png. From 0-4
+    it opened; from 7 our listing took only digits for numbers and told "no file fits
+    sp_%3d.png; give a pattern such as sp_  %d.png", which reads 7-9 alone. It opens, all six
+    read, and a gap in it is told."""
+    for i in range(7, 13):
+        cv2.imwrite(str(tmp_path / f"sp_{i:3d}.png"), _numbered(i))
+    pattern = str(tmp_path / "sp_%3d.png")
+    with StereoCamera(pattern, pattern) as cam:
+        assert [_read_stamp(f.left) for f in cam.frames()] == list(range(7, 13))
+    (tmp_path / "sp_ 10.png").unlink()
+    with StereoCamera(pattern, pattern) as cam:
+        result = capture(cam, tmp_path / "pairs")
+    assert len(result.saved) == 3
+    assert result.ended.startswith(
+        f"left source {pattern!r} ended after 3 images: sp_ 10.png is missing, so the 2 images "
+        "numbered after it were not read"
+    )

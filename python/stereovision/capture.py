@@ -669,9 +669,9 @@ def _sequence_name(path: str, number: int) -> str:
 
 def _sequence_digits(path: str) -> list[str]:
     """The digits in the number's place of every file named as image-sequence pattern ``path``
-    around its number (``007``, ``0012`` for ``left_%03d.png``), whatever their width. Every
-    file of its folder is looked at: a sequence's start and the images after a gap may be
-    anywhere in the file system's listing order."""
+    around its number (``007``, ``0012`` for ``left_%03d.png``; ``  7`` for ``left_%3d.png``),
+    whatever their width. Every file of its folder is looked at: a sequence's start and the
+    images after a gap may be anywhere in the file system's listing order."""
     parts = _sequence_parts(path)
     if parts is None:
         return []
@@ -679,7 +679,8 @@ def _sequence_digits(path: str) -> list[str]:
     found = (
         name[len(head) : len(name) - len(tail)] for name in glob.iglob(_sequence_glob(path) or "")
     )
-    return [digits for digits in found if digits.isdecimal()]
+    # printf's "%3d" pads with spaces (left_  7.png), as CAP_IMAGES names them
+    return [digits for digits in found if digits.lstrip(" ").isdecimal()]
 
 
 def _sequence_numbers(path: str) -> list[int]:
