@@ -3250,3 +3250,30 @@ def test_a_space_padded_sequence_opens_from_its_first_number_however_late(
         f"left source {pattern!r} ended after 3 images: sp_ 10.png is missing, so the 2 images "
         "numbered after it were not read"
     )
+
+
+def test_a_misnumbered_pattern_lists_its_folder_twice_to_be_told(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A pattern misnumbered for its files (l_%02d.png over l_000.png ...) listed its folder
+    three times before its hint (the start looked for, the files-match glob, the hint's own
+    glob): 0.5 s among 200,000 files, twice the 0.24 s before af641c1. The hint takes the
+    files the check listed: two listings, the hint unchanged."""
+    for i in range(3):
+        cv2.imwrite(str(tmp_path / f"l_{i:03d}.png"), _numbered(i))
+    listed: list[str] = []
+    scandir = os.scandir
+
+    def counting(path: Any = ".") -> Any:
+        if os.fspath(path) == str(tmp_path):
+            listed.append(os.fspath(path))
+        return scandir(path)
+
+    monkeypatch.setattr(os, "scandir", counting)
+    with pytest.raises(FileNotFoundError) as err:
+        StereoCamera(str(tmp_path / "l_%02d.png"), str(tmp_path / "l_%03d.png"))
+    assert str(err.value) == (
+        f"left source: no file fits {tmp_path}/l_%02d.png; give a pattern such as "
+        f"{tmp_path}/l_%03d.png (its files are named l_000.png, l_001.png ...)"
+    )
+    assert len(listed) == 2

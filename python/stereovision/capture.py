@@ -831,15 +831,18 @@ def _glob_hint(side: str, path: str) -> str:
     return f"{said}{none}: give {_anything_hint(side, folder)}"
 
 
-def _pattern_hint(side: str, path: str) -> str | None:
+def _pattern_hint(side: str, path: str, matched: list[str] | None = None) -> str | None:
     """For an image-sequence pattern that names no file while files of another numbering are
     there (``left_%03d.png`` for ``left_0001.png ...``): the one line naming the pattern they
-    need; None when they need this one (or none is there)."""
+    need; None when they need this one (or none is there). ``matched``: the files of
+    :func:`_sequence_glob` when the caller has listed them already."""
     folder = os.path.dirname(path)
     matching = _sequence_glob(path)
     if matching is None:
         return None
-    names = [os.path.basename(m) for m in itertools.islice(glob.iglob(matching), _HINT_MAX_FILES)]
+    if matched is None:
+        matched = list(itertools.islice(glob.iglob(matching), _HINT_MAX_FILES))
+    names = [os.path.basename(m) for m in matched[:_HINT_MAX_FILES]]
     form = _forms_that_work(side, folder, names)
     if form is None or form[0] == path:
         return None
@@ -1280,14 +1283,15 @@ class StereoCamera(PairSource):
             first = _sequence_first(path)
             # the text around the number matched as written (a folder "run[1]" is no glob)
             pattern = _sequence_glob(path) if "://" not in path and first is None else None
-            if pattern is not None:
-                if next(glob.iglob(pattern), None) is None:
+            matched = None if pattern is None else glob.glob(pattern)  # for the hint too
+            if matched is not None:
+                if not matched:
                     # said here: FFmpeg would print its own line first
                     raise FileNotFoundError(f"{side} source: no file matches {path}")
             exists = os.path.exists(path)  # a file whose name holds "%d" is no pattern
             if "%" in path and "://" not in path and not exists and first is None:
                 # files of another numbering: FFmpeg's line, then "cannot open", said neither
-                hint = _pattern_hint(side, path)
+                hint = _pattern_hint(side, path, matched)
                 if hint is not None:
                     raise FileNotFoundError(hint)
             # OpenCV's log of its backends' attempts stays quiet (_open_within): the error
