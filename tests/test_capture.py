@@ -3277,3 +3277,15 @@ def test_a_misnumbered_pattern_lists_its_folder_twice_to_be_told(
         f"{tmp_path}/l_%03d.png (its files are named l_000.png, l_001.png ...)"
     )
     assert len(listed) == 2
+
+
+def test_a_sequence_numbered_with_u_opens_from_its_first_number_however_late(
+    tmp_path: Path,
+) -> None:
+    """CAP_IMAGES takes "%03u" as "%03d" (printf's unsigned): u_%03u.png from 0 opened, but our
+    pattern code knew only "d", so from 7 it was "cannot open left source"; it opens."""
+    for i in range(7, 10):
+        cv2.imwrite(str(tmp_path / f"u_{i:03d}.png"), _numbered(i))
+    pattern = str(tmp_path / "u_%03u.png")
+    with StereoCamera(pattern, pattern) as cam:
+        assert [_read_stamp(f.left) for f in cam.frames()] == [7, 8, 9]

@@ -400,8 +400,8 @@ def _describe_source(src: Source) -> str:
 
 
 #: What a ``%`` of an image-sequence pattern starts: a literal percent sign (``%%``) or the
-#: frame number (``left_%03d.png``).
-_SEQ_TOKEN_RE = re.compile(r"%%|%(0?\d*)d")
+#: frame number (``left_%03d.png``; ``%03u``, printf's unsigned, as ``CAP_IMAGES`` allows).
+_SEQ_TOKEN_RE = re.compile(r"%%|%(0?\d*)[du]")
 
 
 _T = TypeVar("_T")
