@@ -859,3 +859,32 @@ def test_batch_refuses_no_workers_in_the_options_words(
         f"stereovision: error: --workers: expected a whole number above 0, got {workers}\n"
     )
     assert not out.exists()
+
+
+def test_a_scene_folder_beside_an_abbreviated_option_still_says_what_to_type(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """argparse takes an option by a prefix (`--meth census` for --method): 5e96852's scan of
+    the words typed did not, so `depth cones --meth census -o out` counted `census` as a second
+    positional and said argparse's plain "required: right" instead of the folder's two images.
+    After `--` every word is a positional, even one starting with -."""
+    out = str(tmp_path / "out")
+    hint = f"give its two images, {CONES / 'left.png'} and {CONES / 'right.png'}"
+    for args in (
+        [str(CONES), "--meth", "census", "-o", out],
+        ["--meth", "census", "--max-disp", "64", str(CONES), "--out", out],
+        ["-o", out, "--", str(CONES)],
+    ):
+        with pytest.raises(SystemExit) as exit_:
+            main(["depth", *args])
+        assert exit_.value.code == 2
+        err = capsys.readouterr().err
+        assert err == (
+            f"stereovision depth: error: the right image is missing; {CONES} is a folder "
+            f"holding a pair: {hint} (see stereovision depth --help)\n"
+        )
+    with pytest.raises(SystemExit):  # two words, one a prefix of no option: no hint
+        main(["depth", str(CONES), "--zzz", "census", "-o", out])
+    assert "folder holding a pair" not in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()
+

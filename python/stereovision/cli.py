@@ -1838,14 +1838,23 @@ class _Parser(argparse.ArgumentParser):
 
     def _words_given(self) -> list[str]:
         """The words typed that are no option nor an option's value."""
-        words, i = [], 0
+        words: list[str] = []
+        i = 0
         while i < len(self.typed):
-            action = self._option_string_actions.get(self.typed[i])
+            word = self.typed[i]
+            if word == "--":  # argparse: every word after it is a positional
+                words.extend(self.typed[i + 1 :])
+                break
+            action = self._option_string_actions.get(word)
+            if action is None and self.allow_abbrev and word.startswith("--") and "=" not in word:
+                # argparse takes an option by a unique prefix (--meth census): its value too
+                hits = {a for s, a in self._option_string_actions.items() if s.startswith(word)}
+                action = hits.pop() if len(hits) == 1 else None
             if action is not None:  # an option: its value (if it takes one) follows
                 i += 1 if action.nargs == 0 else 2
                 continue
-            if not self.typed[i].startswith("-"):  # (--opt=value is one word)
-                words.append(self.typed[i])
+            if not word.startswith("-"):  # (--opt=value is one word)
+                words.append(word)
             i += 1
         return words
 
