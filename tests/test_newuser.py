@@ -888,3 +888,29 @@ def test_a_scene_folder_beside_an_abbreviated_option_still_says_what_to_type(
     assert "folder holding a pair" not in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
 
+
+def test_a_recording_announcing_fewer_frames_than_it_holds_never_reports_past_its_total(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """CAP_PROP_FRAME_COUNT is a container's guess: a recording holding more frames than it
+    announces had progress hear ('frames', 5, 3), done past total (a callback's 167 %); once
+    the reading passes the count announced, the total is said unknown (0), as a camera's."""
+    import cv2
+
+    from stereovision.calibrate import PROGRESS_FRAMES, calibrate_from_video
+    from stereovision.capture import StereoCamera
+
+    lefts, rights = _chessboard_pairs(6)
+    for side, paths in (("left", lefts), ("right", rights)):
+        for i, path in enumerate(paths):
+            assert cv2.imwrite(str(tmp_path / f"{side}_{i:02d}.png"), cv2.imread(str(path)))
+    left, right = str(tmp_path / "left_%02d.png"), str(tmp_path / "right_%02d.png")
+    monkeypatch.setattr(StereoCamera, "_announced", lambda self, side: 3)
+    calls: list[tuple[str, int, int]] = []
+    calibrate_from_video(
+        left, right, square_size=1.0, min_distance=0.0, progress=lambda *a: calls.append(a)
+    )
+    frames = [c for c in calls if c[0] == PROGRESS_FRAMES]
+    assert frames == [(PROGRESS_FRAMES, i, 3) for i in (1, 2, 3)] + [
+        (PROGRESS_FRAMES, i, 0) for i in (4, 5, 6)
+    ]

@@ -1850,7 +1850,8 @@ def calibrate_from_video(
     **kwargs
         Passed to :func:`calibrate` (``unit``, ``distortion``, ``drop_outliers``, ...); its
         ``progress`` also hears the reading, stage :data:`PROGRESS_FRAMES` after each frame pair
-        read (``total`` the pairs the recording announces, 0 when it announces none: a camera).
+        read (``total`` the pairs the recording announces, 0 when it announces none, a camera,
+        or once more were read than it announced: ``done`` never passes a nonzero ``total``).
 
     Returns
     -------
@@ -2001,7 +2002,8 @@ def _calibrate_from_camera(
                 rights.append(frame.right)
                 names.append(last)
             if progress is not None:
-                progress(PROGRESS_FRAMES, read, total)
+                # CAP_PROP_FRAME_COUNT is the container's guess: past it, the total is unknown
+                progress(PROGRESS_FRAMES, read, total if read <= total else 0)
     finally:
         cam.close()
     what = board.describe() if board is not None else f"chessboard {pat[0]}x{pat[1]} inner corners"
