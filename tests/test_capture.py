@@ -3289,3 +3289,21 @@ def test_a_sequence_numbered_with_u_opens_from_its_first_number_however_late(
     pattern = str(tmp_path / "u_%03u.png")
     with StereoCamera(pattern, pattern) as cam:
         assert [_read_stamp(f.left) for f in cam.frames()] == [7, 8, 9]
+
+
+def test_the_image_sequence_reader_refuses_a_nan_position_without_raising(
+    tmp_path: Path,
+) -> None:
+    """_ImageSequence.set(CAP_PROP_POS_FRAMES, nan) raised ValueError from round(), where a
+    cv2.VideoCapture's set() never raises: a NaN position is refused (False), the position
+    and the frames read after it unchanged."""
+    for i in range(7, 10):
+        cv2.imwrite(str(tmp_path / f"s_{i:03d}.png"), _numbered(i))
+    seq = capmod._ImageSequence(str(tmp_path / "s_%03d.png"), 7)
+    assert seq.read()[0]
+    assert seq.set(cv2.CAP_PROP_POS_FRAMES, float("nan")) is False
+    assert seq.get(cv2.CAP_PROP_POS_FRAMES) == 1.0
+    ok, frame = seq.read()
+    assert ok and _read_stamp(frame) == 8
+    assert seq.set(cv2.CAP_PROP_POS_FRAMES, float("inf")) is True  # clamped to the last
+    assert _read_stamp(seq.read()[1]) == 9

@@ -913,8 +913,9 @@ class _ImageSequence:
 
     def set(self, prop: int, value: float) -> bool:
         # CAP_IMAGES seeks (the position kept within the images counted at the open, as its
-        # own) and refuses every other setting: a file cannot be asked a size or a rate
-        if prop != cv2.CAP_PROP_POS_FRAMES or not self._count:
+        # own) and refuses every other setting: a file cannot be asked a size or a rate. A NaN
+        # position is refused: round() raised ValueError where cv2's set() never raises
+        if prop != cv2.CAP_PROP_POS_FRAMES or not self._count or math.isnan(value):
             return False
         self._next = round(min(max(value, 0), self._count - 1))
         return True
