@@ -3307,3 +3307,33 @@ def test_the_image_sequence_reader_refuses_a_nan_position_without_raising(
     assert ok and _read_stamp(frame) == 8
     assert seq.set(cv2.CAP_PROP_POS_FRAMES, float("inf")) is True  # clamped to the last
     assert _read_stamp(seq.read()[1]) == 9
+
+
+@pytest.mark.parametrize(
+    ("start", "change"),
+    [(7, "l_005.png copied in"), (7, "l_007.png moved away"), (0, "l_000.png moved away")],
+)
+def test_a_gap_is_told_from_the_start_the_sequence_opened_at(
+    tmp_path: Path, start: int, change: str
+) -> None:
+    """The image that stopped a sequence was found from its first number looked up again at
+    the end: a folder changed since the open (an earlier image copied in, the images read moved
+    away as they are done) named another file ("l_003.png is missing, so the 4 images ...") or
+    no gap at all ("ended after 3 frames"). It is counted from the number the sequence opened
+    at (CAP_IMAGES's 0, ours 7)."""
+    for i in (start, start + 1, start + 2, start + 4):
+        cv2.imwrite(str(tmp_path / f"l_{i:03d}.png"), _numbered(i))
+    pattern = str(tmp_path / "l_%03d.png")
+    with StereoCamera(pattern, pattern) as cam:
+        assert [_read_stamp(cam.read().left) for _ in range(3)] == [start, start + 1, start + 2]
+        name = change.split()[0]
+        if change.endswith("copied in"):
+            cv2.imwrite(str(tmp_path / name), _numbered(5))
+        else:
+            (tmp_path / name).unlink()
+        with pytest.raises(SourceError) as err:
+            cam.read()
+    assert (
+        f"left source {pattern!r} ended after 3 images: l_{start + 3:03d}.png is missing, so "
+        "the 1 image numbered after it was not read (renumber them without the gap)"
+    ) in str(err.value)

@@ -721,16 +721,22 @@ def _sequence_first(path: str, digits: list[str] | None = None) -> tuple[int, st
     return numbers[0], _sequence_name(path, numbers[0])
 
 
-def _sequence_gap(path: str, read: int) -> tuple[str, int] | None:
+def _sequence_gap(path: str, read: int, first: int | None = None) -> tuple[str, int] | None:
     """For an image-sequence pattern read to its end after ``read`` images: the file that
     stopped it (the next number, missing) and how many files numbered after it exist; None
-    when no file is numbered after it (the sequence's real end) or ``path`` is no pattern."""
+    when no file is numbered after it (the sequence's real end) or ``path`` is no pattern.
+    ``first``: the number the sequence opened at (else looked up now, as
+    :func:`_sequence_first`), which an image copied in or moved away since would change."""
     parts = _sequence_parts(path)
-    digits = _sequence_digits(path)  # one listing of the folder for the start and the rest
-    first = _sequence_first(path, digits)
-    if parts is None or first is None:
+    if parts is None:
         return None
-    number = first[0] + read
+    digits = _sequence_digits(path)  # one listing of the folder for the start and the rest
+    if first is None:
+        found = _sequence_first(path, digits)
+        if found is None:
+            return None
+        first = found[0]
+    number = first + read
     # as the pattern prints them (_sequence_numbers)
     later = sum(1 for d in digits if parts[1] % int(d) == d and int(d) > number)
     return (os.path.basename(_sequence_name(path, number)), later) if later else None
@@ -1261,6 +1267,9 @@ class StereoCamera(PairSource):
         self._release_on_return = False
         #: Sources read by OpenCV's image-sequence reader (it logs a warning at the end).
         self._sequence: dict[str, bool] = {}
+        # the number each image sequence opened at: its gap is counted from it at the end,
+        # whatever was copied into or moved out of its folder while it was read
+        self._sequence_start: dict[str, int] = {}
         self._media_offset: float | None = None  # left - right media time of the first pair
         try:
             for side, src in self.sources.items():
@@ -1299,6 +1308,8 @@ class StereoCamera(PairSource):
             # below says what failed
             cap: Any = _open_within(lambda: _open_path(path, first), timeout, side, src, configure)
             self._sequence[side] = cap.isOpened() and cap.getBackendName() == "CV_IMAGES"
+            if self._sequence[side] and first is not None:
+                self._sequence_start[side] = first[0]
         elif isinstance(src, (bool, np.bool_)):  # True opened camera 1
             raise ValueError(f"{side} source: expected a device index or a path, got {src!r}")
         elif isinstance(src, (int, np.integer)):
@@ -1384,7 +1395,7 @@ class StereoCamera(PairSource):
         src = self.sources[side]
         if not self._sequence.get(side) or not isinstance(src, (str, os.PathLike)):
             return None
-        return _sequence_gap(os.fspath(src), self.count)
+        return _sequence_gap(os.fspath(src), self.count, self._sequence_start.get(side))
 
     def _end_phrase(self, side: str) -> str:
         src, n = self.sources[side], self.count
