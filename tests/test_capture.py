@@ -3337,3 +3337,32 @@ def test_a_gap_is_told_from_the_start_the_sequence_opened_at(
         f"left source {pattern!r} ended after 3 images: l_{start + 3:03d}.png is missing, so "
         "the 1 image numbered after it was not read (renumber them without the gap)"
     ) in str(err.value)
+
+
+def test_a_misnumbered_pattern_over_space_padded_files_is_told_the_padding(
+    tmp_path: Path,
+) -> None:
+    """Over sp_  7.png ... sp_ 12.png (printf's "%3d", which opens since 274d300) the hint for
+    a misnumbered pattern took the two-digit names for the run and told "give a pattern such as
+    sp_ %02d.png", which opens nothing (the "%02d" run starts after files it does not print).
+    It names "%3d", the pattern that reads all six; one-space names of every width (frame 1.png
+    ... frame 12.png) are still "frame %d.png"."""
+    for i in range(7, 13):
+        cv2.imwrite(str(tmp_path / f"sp_{i:3d}.png"), _numbered(i))
+    for given in ("sp_%03d.png", "sp_%d.png"):
+        with pytest.raises(FileNotFoundError) as err:
+            StereoCamera(str(tmp_path / given), str(tmp_path / given))
+        assert str(err.value) == (
+            f"left source: no file fits {tmp_path}/{given}; give a pattern such as "
+            f"{tmp_path}/sp_%3d.png (its files are named sp_  7.png, sp_  8.png ...)"
+        )
+    told = str(tmp_path / "sp_%3d.png")
+    with StereoCamera(told, told) as cam:
+        assert [_read_stamp(f.left) for f in cam.frames()] == list(range(7, 13))
+    frames = tmp_path / "frames"
+    frames.mkdir()
+    for i in range(1, 13):
+        cv2.imwrite(str(frames / f"frame {i}.png"), _numbered(i))
+    with pytest.raises(FileNotFoundError) as err:
+        StereoCamera(str(frames / "frame %02d.png"), str(frames / "frame %02d.png"))
+    assert f"give a pattern such as {frames}/frame %d.png (its files" in str(err.value)

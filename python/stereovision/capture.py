@@ -749,6 +749,30 @@ _NUMBERED_RE = re.compile(r"^(.*?)(\d+)(\.[A-Za-z0-9]+)$")
 _HINT_MAX_FILES = 20000
 
 
+def _merge_space_padded(runs: dict[tuple[str, str], list[str]]) -> set[tuple[str, str]]:
+    """Merge, in place, the runs of ``runs`` (``(head, ext)``: numbers) that are one
+    space-padded numbering, as printf's and ``CAP_IMAGES``'s ``%3d`` names them (``sp_  7.png``,
+    ``sp_ 10.png``, ``sp_100.png``: heads ``"sp_  "``, ``"sp_ "``, ``"sp_"``); each merged run's
+    numbers keep their spaces (``"  7"``). The keys of the runs merged."""
+    groups: dict[tuple[str, str], list[tuple[str, str]]] = {}
+    for head, ext in runs:
+        groups.setdefault((head.rstrip(" "), ext), []).append((head, ext))
+    spaced: set[tuple[str, str]] = set()
+    for key, heads in groups.items():
+        # one head alone is no padding: "frame 1.png ... frame 12.png" is "frame %d.png"
+        if len(heads) < 2 or not any(head.endswith(" ") for head, _ in heads):
+            continue
+        padded = [head[len(key[0]) :] + d for head, ext in heads for d in runs[(head, ext)]]
+        width = len(padded[0])
+        if any(len(p) != width or f"{int(p):{width}d}" != p for p in padded):
+            continue
+        for run in heads:
+            del runs[run]
+        runs[key] = padded
+        spaced.add(key)
+    return spaced
+
+
 def _forms_that_work(side: str, folder: str, names: Iterable[str]) -> tuple[str, str] | None:
     """What ``--left``/``--right`` could name among ``names``, files of ``folder`` as typed:
     the image-sequence pattern of the largest numbered run (one named after ``side`` first)
@@ -773,6 +797,9 @@ def _forms_that_work(side: str, folder: str, names: Iterable[str]) -> tuple[str,
     def ours(name: str) -> bool:  # named after this side ("left_", "Left", "cam_left")
         return side in name.lower()
 
+    # a space-padded run was taken for one run a width (sp_ 10.png ...: "sp_ %02d.png", which
+    # opens nothing) and the rest left out
+    spaced = _merge_space_padded(runs)
     if runs:
         (head, ext), digits = max(runs.items(), key=lambda r: (ours(r[0][0]), len(r[1])))
         digits.sort(key=int)
@@ -782,7 +809,7 @@ def _forms_that_work(side: str, folder: str, names: Iterable[str]) -> tuple[str,
         if any(len(d) > width and d.startswith("0") for d in digits):
             width = 0
         # a percent sign in a name is "%%" in its pattern (printf's, OpenCV's)
-        number = f"%0{width}d" if width > 1 else "%d"
+        number = f"%{width}d" if (head, ext) in spaced else f"%0{width}d" if width > 1 else "%d"
         pattern = os.path.join(folder, head.replace("%", "%%") + number + ext)
         shown = ", ".join(f"{head}{d}{ext}" for d in digits[:2])
         more = " ..." if len(digits) > 2 else ""
