@@ -3366,3 +3366,28 @@ def test_a_misnumbered_pattern_over_space_padded_files_is_told_the_padding(
     with pytest.raises(FileNotFoundError) as err:
         StereoCamera(str(frames / "frame %02d.png"), str(frames / "frame %02d.png"))
     assert f"give a pattern such as {frames}/frame %d.png (its files" in str(err.value)
+
+
+def test_a_pattern_with_a_doubled_slash_opens_late_and_tells_its_gap(tmp_path: Path) -> None:
+    """glob gives "dir//l_*.png" as "dir/l_007.png": the number, sliced at the pattern's
+    length, lost its first digit ("07", which %03d does not print), so "dir//l_%03d.png" (a
+    folder joined with a trailing slash) from 7 was "no file fits ... give a pattern such as
+    dir/l_%03d.png" and a gap in one from 0 went untold. Both read as with one slash."""
+    late, early = tmp_path / "late", tmp_path / "early"
+    late.mkdir()
+    early.mkdir()
+    for i in (7, 8, 9):
+        cv2.imwrite(str(late / f"l_{i:03d}.png"), _numbered(i))
+    pattern = f"{late}//l_%03d.png"
+    with StereoCamera(pattern, pattern) as cam:
+        assert [_read_stamp(f.left) for f in cam.frames()] == [7, 8, 9]
+    for i in (0, 1, 2, 4):
+        cv2.imwrite(str(early / f"l_{i:03d}.png"), _numbered(i))
+    pattern = f"{early}//l_%03d.png"
+    with StereoCamera(pattern, pattern) as cam:
+        result = capture(cam, tmp_path / "pairs")
+    assert len(result.saved) == 3
+    assert result.ended.startswith(
+        f"left source {pattern!r} ended after 3 images: l_003.png is missing, so the 1 image "
+        "numbered after it was not read"
+    )

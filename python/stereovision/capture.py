@@ -676,9 +676,12 @@ def _sequence_digits(path: str) -> list[str]:
     if parts is None:
         return []
     head, _, tail = parts
-    found = (
-        name[len(head) : len(name) - len(tail)] for name in glob.iglob(_sequence_glob(path) or "")
-    )
+    names: Iterable[str] = glob.iglob(_sequence_glob(path) or "")
+    if os.sep not in tail and (os.altsep is None or os.altsep not in tail):
+        # the number in the file's name: sliced from it alone, glob giving "dir//l_007.png"
+        # as "dir/l_007.png" (a number a character short, "07": a start from 7 did not open)
+        head, names = os.path.basename(head), (os.path.basename(name) for name in names)
+    found = (name[len(head) : len(name) - len(tail)] for name in names)
     # printf's "%3d" pads with spaces (left_  7.png), as CAP_IMAGES names them
     return [digits for digits in found if digits.lstrip(" ").isdecimal()]
 
