@@ -3391,3 +3391,20 @@ def test_a_pattern_with_a_doubled_slash_opens_late_and_tells_its_gap(tmp_path: P
         f"left source {pattern!r} ended after 3 images: l_003.png is missing, so the 1 image "
         "numbered after it was not read"
     )
+
+
+def test_a_pattern_ten_digits_wide_is_read_as_an_image_sequence(tmp_path: Path) -> None:
+    """CAP_IMAGES refuses a width of 10 or more (l_%010d.png: its pattern is 0?[1-9][du]), so a
+    sequence of them from 0 went to FFmpeg, which rescales a frame of another size to the
+    first's, and its end was told as a video's ("ended after 3 of the 5 frames ... truncated or
+    damaged"). It is read by our reader, as one from 7 was: the gap is told."""
+    for i in (0, 1, 2, 4):
+        cv2.imwrite(str(tmp_path / f"l_{i:010d}.png"), _numbered(i))
+    pattern = str(tmp_path / "l_%010d.png")
+    with StereoCamera(pattern, pattern) as cam:
+        result = capture(cam, tmp_path / "pairs")
+    assert [_read_stamp(cv2.imread(str(left))) for left, _ in result.saved] == [0, 1, 2]
+    assert result.ended.startswith(
+        f"left source {pattern!r} ended after 3 images: l_0000000003.png is missing, so the 1 "
+        "image numbered after it was not read"
+    )

@@ -971,7 +971,7 @@ def _open_path(path: str, first: tuple[int, str] | None) -> Any:
     ``CAP_IMAGES`` starts a pattern at number 0 or 1 and refuses any ``%`` besides the number's
     (a literal ``%%``, a folder ``100%``): a sequence that starts later, or names a percent
     sign, is read by :class:`_ImageSequence` the same way.
-    The default backend remains for what ``CAP_IMAGES`` cannot open.
+    The default backend remains for what neither reader opens.
     """
     # any other "%" (a literal "%%", or a lone one as in a folder "100%") CAP_IMAGES refuses:
     # it takes the path's first "%" for the number and allows no second
@@ -982,6 +982,11 @@ def _open_path(path: str, first: tuple[int, str] | None) -> Any:
         if cap.isOpened():
             return cap
         cap.release()
+        # CAP_IMAGES refuses a width of 10 or more (its pattern is 0?[1-9][du]): FFmpeg's
+        # opened l_%010d.png, rescaling a frame of another size, its gaps untold
+        sequence = _ImageSequence(path, first[0])
+        if sequence.isOpened():
+            return sequence
     return cv2.VideoCapture(path)
 
 
