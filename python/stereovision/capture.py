@@ -897,7 +897,8 @@ class _ImageSequence:
     ``cv2.VideoCapture`` stand-in for the sequences OpenCV's reader cannot open: one that
     starts at 5 or later (``CAP_IMAGES`` and FFmpeg look at 0-4), one at 2-4 whose name holds
     other digits before the number (``CAP_IMAGES`` opened by its first file took those for
-    it), or a pattern with a literal percent sign (``%%``, refused by ``CAP_IMAGES``). Frames
+    it), or a pattern ``CAP_IMAGES`` refuses: a literal percent sign (``%%``, a folder
+    ``100%``) or a number 10 or more digits wide (``%010d``). Frames
     are read as ``CAP_IMAGES`` reads them (``cv2.IMREAD_UNCHANGED``, each at its own size);
     the sequence is the run of consecutive numbers from the first, and ends at a missing one
     (its backend is said as ``CV_IMAGES``: the end and a gap are told as for OpenCV's)."""
