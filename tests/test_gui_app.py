@@ -5458,6 +5458,44 @@ def test_a_failed_open_names_the_source_it_leaves_in_use(tmp_path, monkeypatch):
     assert app.source is playing
 
 
+def test_a_failed_open_calls_cameras_typed_by_their_device_node_cameras(tmp_path):
+    """Cameras in use typed as ``/dev/video0`` and ``/dev/video1`` (or one of each form): a
+    failed Open said "the source in use is unchanged" of them, as of video files; the
+    capture code takes such a node for a camera, and so does the page now."""
+    from stereovision.gui import bundled_data_dir
+
+    raw = (cv2.imread(str(CONES / "left.png")), cv2.imread(str(CONES / "right.png")))
+
+    class Cameras:
+        def __init__(self, pair):
+            self.pair = pair
+
+        def read(self):
+            if self.pair is None:
+                raise OSError("camera 3 gave no frame")
+            return self.pair
+
+        def close(self):
+            pass
+
+    def refused(names: tuple[str, str]) -> str:
+        app = _scene_app(
+            "test-failed-open-node", [bundled_data_dir()], source=Cameras(raw), source_names=names
+        )
+        app._spawn = lambda coro: coro.close()
+        app._switch_source(Cameras(None), ("2", "3"))
+        return str(app.state.error)
+
+    cameras = "camera 3 gave no frame (the cameras in use are unchanged)"
+    assert refused(("/dev/video0", "/dev/video1")) == cameras
+    assert refused(("0", "/dev/video1")) == cameras
+    # a file, a stream or a path that only looks like a node is no camera
+    source = "camera 3 gave no frame (the source in use is unchanged)"
+    assert refused(("/dev/video0", "right.mp4")) == source
+    assert refused(("rtsp://rig/0", "rtsp://rig/1")) == source
+    assert refused(("/dev/video0x", "/dev/video1")) == source
+
+
 def test_check_rows_of_files_at_another_resolution_uses_the_calibration_scaled(tmp_path):
     """Files at half the --calib size: "Check rows" checks them with the calibration scaled
     to them, as their view is computed (not refused as of another image size)."""

@@ -43,7 +43,7 @@ import numpy.typing as npt
 from stereovision import release_memory
 from stereovision._validate import advice_for, first_line, known_unit
 from stereovision.calibration import fit_to_frames
-from stereovision.capture import DEFAULT_READ_TIMEOUT
+from stereovision.capture import DEFAULT_READ_TIMEOUT, _camera_device
 from stereovision.gui.sources import (
     CLOUD_SUFFIXES,
     IMAGE_SUFFIXES,
@@ -1945,13 +1945,15 @@ class StereoApp:
     def _in_use_unchanged(self) -> str:
         """What a failed Open or Play leaves in use, as the page says it: ``the cameras in use
         are unchanged``, ``the folder data/seq in use is unchanged``, or (video files, a bag)
-        ``the source in use is unchanged`` ("the cameras" was said of a folder's pairs too)."""
+        ``the source in use is unchanged`` ("the cameras" was said of a folder's pairs too).
+        A camera typed by its device node (``/dev/video0``, a ``/dev/v4l/by-id`` link) is a
+        camera, as the capture code knows it: it was said to be "the source"."""
         source = self.source
         if isinstance(source, FolderPairs):
             return f"the folder {source.name} in use is unchanged"
         if self._source_label is None:
             try:
-                if all(isinstance(parse_source(n), int) for n in self._source_names):
+                if all(_camera_device(parse_source(n)) for n in self._source_names):
                     return "the cameras in use are unchanged"
             except ValueError:  # a name no camera has: not said to be cameras
                 pass
