@@ -2338,6 +2338,45 @@ def test_the_save_hint_and_tooltip_name_the_home_folder_past_a_writable_saved(
     assert app.state.save_label.endswith(f"({refused})")  # as the tooltip said
 
 
+def test_the_save_hint_and_tooltip_follow_a_save_that_fills_the_last_writable_saved(
+    tmp_path, monkeypatch
+):
+    """A read-only --data folder holding a writable, empty ``saved``: the first Save as
+    offered fills it, the next goes home, and the point-cloud list says so after the Save;
+    but the save field's hint and tooltip, set at start-up alone, still said "in a --data
+    folder" and named data/saved. They follow each Save as the list does."""
+    import stereovision.io as svio
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import READ_ONLY_SAVE_HINT, SAVE_HINT
+
+    data, home = tmp_path / "data", tmp_path / "home"
+    (data / "saved").mkdir(parents=True)
+    home.mkdir()
+    real = svio.cannot_write_in
+    read_only = data.resolve()
+    monkeypatch.setattr(
+        svio,
+        "cannot_write_in",
+        lambda f: "Read-only file system" if Path(f).resolve() == read_only else real(f),
+    )
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.chdir("/")
+    app = _scene_app("test-save-hint-follows", [bundled_data_dir(), data])
+    assert app.state.save_hint == SAVE_HINT
+    assert app.state.save_dir_title == f"{data.resolve() / 'saved'} (or the next new saved-N)"
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.save_label.startswith(f"saved 450×375 to {app.folders.label(data / 'saved')}")
+    assert app.state.save_hint == READ_ONLY_SAVE_HINT
+    refused = f"{data.resolve() / 'saved-2'} cannot be written: Read-only file system"
+    title = f"{Path.home() / 'stereovision-saved'} (or the next new -N: {refused})"
+    assert app.state.save_dir_title == title
+    _run(app, app.save)  # as the hint and tooltip now say
+    assert app.state.save_label.startswith("saved 450×375 to ~/stereovision-saved: ")
+    assert app.state.save_label.endswith(f"({refused})")
+
+
 def test_a_home_folder_that_is_a_link_is_shown_as_tilde(tmp_path, monkeypatch):
     """HOME a symbolic link (/home/me -> /data/me): the Save's line and the point-cloud list
     showed the home folder's saves by their resolved, absolute paths, since they were asked

@@ -1541,11 +1541,7 @@ class StereoApp:
             display_path(self._save_roots[0] / SAVE_FOLDER) if self._save_roots else ""
         )
         st.save_dir = self._offered_save_dir
-        st.save_dir_title = self._save_title(self._offered_save_dir)
-        st.save_hint = SAVE_HINT if self._save_roots else NO_SAVE_HINT
-        if self._offered_save_folder_refused():
-            st.save_hint = READ_ONLY_SAVE_HINT  # a read-only data set: save goes home
-        st.save_label = ""
+        st.save_label = ""  # the save field's hint and tooltip: _refresh_file_lists, below
         for name in _CONTROL_NAMES:
             st[name] = 0.0
         self._refresh_file_lists()
@@ -1561,6 +1557,16 @@ class StereoApp:
     # ------------------------------------------------------------------------- helpers
 
     def _refresh_file_lists(self) -> None:
+        """The lists of what the ``--data`` folders (and the home folder's saves) hold, and the
+        save field's hint and tooltip, which follow the same rule as the point-cloud list
+        (:meth:`_offered_save_folder`): set at start-up alone, they named the ``--data``
+        folder after a Save filled the last writable ``saved-N`` of a read-only one, while
+        the list and the next Save went home."""
+        st = self.state
+        st.save_dir_title = self._save_title(st.save_dir)
+        st.save_hint = SAVE_HINT if self._save_roots else NO_SAVE_HINT
+        if self._offered_save_folder_refused():
+            st.save_hint = READ_ONLY_SAVE_HINT  # a read-only data set: save goes home
         f = self.folders
         self.state.scenes = [{"title": f.label(p), "value": str(p)} for p in f.scenes()]
         home = self._home_saves()
