@@ -208,6 +208,28 @@ def test_a_home_relative_path_without_a_home_folder_is_refused_in_words(
     assert folders.resolve(data / "a.ply") == (data / "a.ply").resolve()  # the rest as before
 
 
+def test_a_path_under_an_unknown_users_home_is_not_said_to_lack_home(
+    data: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """HOME set, a typed ``~bob/...`` of a user the system does not know: Path.expanduser's
+    RuntimeError was said "(HOME is not set)", the cure offered the wrong one. It names the
+    user; ``~/...`` with HOME set still expands."""
+    import pwd
+
+    def no_user(name: str) -> Any:
+        raise KeyError(name)
+
+    monkeypatch.setenv("HOME", str(data))
+    monkeypatch.setattr(pwd, "getpwnam", no_user)
+    folders = AllowedFolders([data])
+    said = "no home folder is known for ~bob/a.ply (no user bob is known): give the whole path"
+    with pytest.raises(ValueError, match=re.escape(said)):
+        folders.resolve("~bob/a.ply")
+    with pytest.raises(ValueError, match=re.escape("~bob (no user bob is known)")):
+        folders.resolve_output("~bob")
+    assert folders.resolve("~/a.ply") == (data / "a.ply").resolve()
+
+
 def test_files_and_scenes_of_two_roots(tmp_path: Path) -> None:
     a, b = tmp_path / "a", tmp_path / "b"
     for d in (a, b):

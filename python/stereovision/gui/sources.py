@@ -105,13 +105,16 @@ def expand_home(text: str) -> Path:
     ValueError
         ``text`` starts with ``~`` and no home folder is known (HOME unset, no password
         entry): Path.expanduser's RuntimeError went past the page's handlers, which said
-        nothing.
+        nothing. Or ``text`` starts with ``~user`` and no such user is known (it was said
+        to be "HOME is not set", HOME set).
     """
     try:
         return Path(text).expanduser()
     except RuntimeError:
+        user = Path(text).parts[0][1:]  # "~bob/x": "bob"; "~/x": ""
+        why = f"no user {user} is known" if user else "HOME is not set"
         raise ValueError(
-            f"no home folder is known for {text} (HOME is not set): give the whole path"
+            f"no home folder is known for {text} ({why}): give the whole path"
         ) from None
 
 
