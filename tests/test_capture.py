@@ -3408,3 +3408,28 @@ def test_a_pattern_ten_digits_wide_is_read_as_an_image_sequence(tmp_path: Path) 
         f"left source {pattern!r} ended after 3 images: l_0000000003.png is missing, so the 1 "
         "image numbered after it was not read"
     )
+
+
+def test_a_numbered_folder_after_a_doubled_slash_opens_late_and_tells_its_gap(
+    tmp_path: Path,
+) -> None:
+    """glob gives "dir//run*/x.png" (and "run*//x.png") with one slash: the number of a
+    numbered folder, sliced at the pattern's lengths, was lost (978a6ab mended a number in the
+    file's name alone), so "dir//run%d/x.png" from 7 was "cannot open" and a gap in one from 0
+    went untold. Both read as with one slash."""
+    late, early = tmp_path / "late", tmp_path / "early"
+    for i in (7, 8, 9):
+        (late / f"run{i}").mkdir(parents=True)
+        cv2.imwrite(str(late / f"run{i}" / "x.png"), _numbered(i))
+    for i in (0, 1, 2, 4):
+        (early / f"run{i}").mkdir(parents=True)
+        cv2.imwrite(str(early / f"run{i}" / "x.png"), _numbered(i))
+    for pattern in (f"{late}//run%d/x.png", f"{late}/run%d//x.png"):
+        with StereoCamera(pattern, pattern) as cam:
+            assert [_read_stamp(f.left) for f in cam.frames()] == [7, 8, 9]
+    pattern = f"{early}//run%d/x.png"
+    with StereoCamera(pattern, pattern) as cam:
+        result = capture(cam, tmp_path / "pairs")
+    assert len(result.saved) == 3
+    assert result.ended.startswith(f"left source {pattern!r} ended after 3 images: ")
+    assert "so the 1 image numbered after it was not read" in result.ended

@@ -681,9 +681,20 @@ def _sequence_digits(path: str) -> list[str]:
         # the number in the file's name: sliced from it alone, glob giving "dir//l_007.png"
         # as "dir/l_007.png" (a number a character short, "07": a start from 7 did not open)
         head, names = os.path.basename(head), (os.path.basename(name) for name in names)
+    else:
+        # the number in a folder's name: glob gives "dir//run*/x.png" as "dir/run7/x.png"
+        # too, a folder from 7 did not open; each run of separators read as one, both sides
+        head, tail = _one_separator(head), _one_separator(tail)
+        names = (_one_separator(name) for name in names)
     found = (name[len(head) : len(name) - len(tail)] for name in names)
     # printf's "%3d" pads with spaces (left_  7.png), as CAP_IMAGES names them
     return [digits for digits in found if digits.lstrip(" ").isdecimal()]
+
+
+def _one_separator(path: str) -> str:
+    """``path`` with each run of path separators as one (``dir//run7`` -> ``dir/run7``)."""
+    seps = re.escape(os.sep + (os.altsep or ""))
+    return re.sub(f"[{seps}]+", lambda _: os.sep, path)
 
 
 def _sequence_numbers(path: str) -> list[int]:
