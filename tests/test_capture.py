@@ -3433,3 +3433,27 @@ def test_a_numbered_folder_after_a_doubled_slash_opens_late_and_tells_its_gap(
     assert len(result.saved) == 3
     assert result.ended.startswith(f"left source {pattern!r} ended after 3 images: ")
     assert "so the 1 image numbered after it was not read" in result.ended
+
+
+def test_a_gap_in_numbered_folders_names_the_folder(tmp_path: Path) -> None:
+    """Of run%d/x.png the gap was told by its basename, "x.png is missing", every image's name,
+    and an image there that does not read was "missing" too (looked for as x.png in the
+    pattern's folder). It names run3/x.png, missing or damaged as it is."""
+    for i in (0, 1, 2, 4):
+        (tmp_path / f"run{i}").mkdir()
+        cv2.imwrite(str(tmp_path / f"run{i}" / "x.png"), _numbered(i))
+    pattern = str(tmp_path / "run%d" / "x.png")
+    with StereoCamera(pattern, pattern) as cam:
+        result = capture(cam, tmp_path / "pairs")
+    assert result.ended.startswith(
+        f"left source {pattern!r} ended after 3 images: run3/x.png is missing, so the 1 image "
+        "numbered after it was not read (renumber them without the gap)"
+    )
+    (tmp_path / "run3").mkdir()
+    (tmp_path / "run3" / "x.png").write_bytes(b"not a png")
+    with StereoCamera(pattern, pattern) as cam:
+        result = capture(cam, tmp_path / "pairs2")
+    assert result.ended.startswith(
+        f"left source {pattern!r} ended after 3 images: run3/x.png does not read (damaged?), "
+        "so the 1 image numbered after it was not read (replace or remove it)"
+    )

@@ -737,7 +737,8 @@ def _sequence_first(path: str, digits: list[str] | None = None) -> tuple[int, st
 
 def _sequence_gap(path: str, read: int, first: int | None = None) -> tuple[str, int] | None:
     """For an image-sequence pattern read to its end after ``read`` images: the file that
-    stopped it (the next number, missing) and how many files numbered after it exist; None
+    stopped it (the next number, missing; from its pattern's folder, ``run3/x.png`` for
+    ``run%d/x.png``) and how many files numbered after it exist; None
     when no file is numbered after it (the sequence's real end) or ``path`` is no pattern.
     ``first``: the number the sequence opened at (else looked up now, as
     :func:`_sequence_first`), which an image copied in or moved away since would change."""
@@ -753,7 +754,10 @@ def _sequence_gap(path: str, read: int, first: int | None = None) -> tuple[str, 
     number = first + read
     # as the pattern prints them (_sequence_numbers)
     later = sum(1 for d in digits if parts[1] % int(d) == d and int(d) > number)
-    return (os.path.basename(_sequence_name(path, number)), later) if later else None
+    # named from the number's folder or file on: of "run%d/x.png" the basename was "x.png",
+    # every image's name, and its "does not read" looked for it in the pattern's folder
+    name = os.path.basename(parts[0]) + parts[1] % number + parts[2]
+    return (name, later) if later else None
 
 
 #: A numbered file: its name before the number, the number, the extension (``left_``,
