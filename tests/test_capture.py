@@ -3457,3 +3457,33 @@ def test_a_gap_in_numbered_folders_names_the_folder(tmp_path: Path) -> None:
         f"left source {pattern!r} ended after 3 images: run3/x.png does not read (damaged?), "
         "so the 1 image numbered after it was not read (replace or remove it)"
     )
+
+
+def test_a_stray_name_beside_a_space_padded_sequence_keeps_its_hint(tmp_path: Path) -> None:
+    """One stray name beside sp_  7.png ... sp_ 12.png (printf's "%3d"), sp_007.png, left the
+    whole space-padded group unmerged: the hint named a part of it ("sp_  %d.png", which reads
+    3 of the 6, or "sp_ %02d.png", which opens nothing). It names sp_%3d.png, which reads all
+    six; a stray number before the run (q 5.png) leaves it unmerged, the hint one that opens."""
+    sp, q = tmp_path / "sp", tmp_path / "q"
+    sp.mkdir()
+    q.mkdir()
+    for i in range(7, 13):
+        cv2.imwrite(str(sp / f"sp_{i:3d}.png"), _numbered(i))
+        cv2.imwrite(str(q / f"q{i:3d}.png"), _numbered(i))
+    cv2.imwrite(str(sp / "sp_007.png"), _numbered(7))
+    cv2.imwrite(str(q / "q 5.png"), _numbered(5))
+    with pytest.raises(SourceError) as err:
+        StereoCamera(str(sp), str(sp))
+    told = f"{sp}/sp_%3d.png"
+    assert str(err.value) == (
+        f"left source {sp} is a folder: give a pattern such as {told} (its files are named "
+        "sp_  7.png, sp_  8.png ...)"
+    )
+    with StereoCamera(told, told) as cam:
+        assert [_read_stamp(f.left) for f in cam.frames()] == list(range(7, 13))
+    with pytest.raises(SourceError) as err:
+        StereoCamera(str(q), str(q))
+    told = str(err.value).split("such as ")[1].split(" (its files")[0]
+    assert told == f"{q}/q %d.png"
+    with StereoCamera(told, told) as cam:
+        assert _read_stamp(cam.read().left) == 5

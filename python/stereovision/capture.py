@@ -771,7 +771,8 @@ def _merge_space_padded(runs: dict[tuple[str, str], list[str]]) -> set[tuple[str
     """Merge, in place, the runs of ``runs`` (``(head, ext)``: numbers) that are one
     space-padded numbering, as printf's and ``CAP_IMAGES``'s ``%3d`` names them (``sp_  7.png``,
     ``sp_ 10.png``, ``sp_100.png``: heads ``"sp_  "``, ``"sp_ "``, ``"sp_"``); each merged run's
-    numbers keep their spaces (``"  7"``). The keys of the runs merged."""
+    numbers keep their spaces (``"  7"``), a number padded otherwise (``sp_007.png``) left in
+    its own run. The keys of the runs merged."""
     groups: dict[tuple[str, str], list[tuple[str, str]]] = {}
     for head, ext in runs:
         groups.setdefault((head.rstrip(" "), ext), []).append((head, ext))
@@ -780,13 +781,34 @@ def _merge_space_padded(runs: dict[tuple[str, str], list[str]]) -> set[tuple[str
         # one head alone is no padding: "frame 1.png ... frame 12.png" is "frame %d.png"
         if len(heads) < 2 or not any(head.endswith(" ") for head, _ in heads):
             continue
-        padded = [head[len(key[0]) :] + d for head, ext in heads for d in runs[(head, ext)]]
-        width = len(padded[0])
-        if any(len(p) != width or f"{int(p):{width}d}" != p for p in padded):
+        # each number as padded, by its width: one stray name (sp_007.png beside sp_  7.png
+        # ... sp_ 12.png, a12.png beside a 10.png) left the whole group out, and the hint named
+        # a part of it ("sp_ %02d.png", which opens nothing)
+        widths: dict[int, list[tuple[tuple[str, str], str]]] = {}
+        for run in heads:
+            for d in runs[run]:
+                p = run[0][len(key[0]) :] + d
+                if f"{int(p):{len(p)}d}" == p:
+                    widths.setdefault(len(p), []).append((run, d))
+        taken = max(widths.values(), key=len, default=[])
+        if len({run for run, _ in taken}) < 2:
+            continue
+        chosen = set(taken)
+        left = {run: [d for d in runs[run] if (run, d) not in chosen] for run in heads}
+        # the unpadded run's other numbers keep its key when more (the hint names the largest
+        # run alone); nor is a run merged after a number left out, as its pattern would not
+        # open (_sequence_first: q 5.png before q  7.png ... is no start of "q%3d.png")
+        lowest = min(int(d) for _, d in taken)
+        if len(left.get(key, [])) >= len(taken) or any(
+            int(d) < lowest for numbers in left.values() for d in numbers
+        ):
             continue
         for run in heads:
-            del runs[run]
-        runs[key] = padded
+            if left[run]:
+                runs[run] = left[run]
+            else:
+                del runs[run]
+        runs[key] = [run[0][len(key[0]) :] + d for run, d in taken]
         spaced.add(key)
     return spaced
 
