@@ -103,7 +103,8 @@ fn count(l: &Image, p: &McgmParams) {
     for sig in [1.0f32, 2.0] {
         let zc = zerocross::zero_crossings(&log::log_filter(l, sig).expect("memory"), w, h)
             .expect("memory");
-        let t_low = p.track.low_ratio * tracking::high_threshold(&zc, p.track.high_quantile);
+        let t_low = p.track.low_ratio
+            * tracking::high_threshold(&zc, p.track.high_quantile).expect("memory");
         let marked = zc.mark.iter().filter(|&&m| m != 0).count();
         let free = zc
             .strength

@@ -5,11 +5,13 @@
 use std::f64::consts::{PI, TAU};
 
 use super::zerocross::ZeroCrossings;
-use crate::alloc::{try_filled, try_zeroed};
+use crate::alloc::{try_collect, try_filled, try_grow, try_reserve_len, try_zeroed};
 use crate::error::Result;
 
 /// Names the tracker's per-pixel buffers in an out-of-memory error.
 const WHAT: &str = "a tracking plane of the MCGM matcher";
+/// Names a segment's pixel lists (growth buffers, the kept curve, the segments) likewise.
+const SEG: &str = "a tracked segment of the MCGM matcher";
 
 /// 8-neighbour offsets in the fixed scan order that breaks exact ties.
 const NEIGHBOURS: [(i32, i32); 8] = [
@@ -76,14 +78,16 @@ pub fn wrap_angle(d: f64) -> f64 {
 }
 
 /// Seed threshold: the `q` quantile ("lower": sorted value at `floor(q (n - 1))`) of the
-/// strengths of marked pixels; 0 when nothing is marked.
-pub fn high_threshold(zc: &ZeroCrossings, q: f32) -> f32 {
-    let marked: Vec<u32> = zc.marked().map(|i| i as u32).collect();
+/// strengths of marked pixels; 0 when nothing is marked. A failed allocation of the list of
+/// marked pixels (4 bytes each) is [`crate::CoreError::OutOfMemory`].
+pub fn high_threshold(zc: &ZeroCrossings, q: f32) -> Result<f32> {
+    let n = zc.marked().count();
+    let marked = try_collect(n, zc.marked().map(|i| i as u32), WHAT)?;
     marked_quantile(&marked, &zc.strength, q)
 }
 
 /// [`high_threshold`] over the marked pixels' indices `marked` (ascending).
-fn marked_quantile(marked: &[u32], strength: &[f32], q: f32) -> f32 {
+fn marked_quantile(marked: &[u32], strength: &[f32], q: f32) -> Result<f32> {
     // Marked strengths are >= MIN_STRENGTH > 0, so their bit patterns order as the values
     // do: the k-th is found in the bucket of its upper 12 bits (one histogram pass), then by
     // selection among that bucket's values only.
@@ -91,7 +95,7 @@ fn marked_quantile(marked: &[u32], strength: &[f32], q: f32) -> f32 {
     const BUCKETS: usize = 1 << (32 - SHIFT);
     let count = marked.len();
     if count == 0 {
-        return 0.0;
+        return Ok(0.0);
     }
     let mut hist = vec![0usize; BUCKETS];
     for &i in marked {
@@ -107,7 +111,7 @@ fn marked_quantile(marked: &[u32], strength: &[f32], q: f32) -> f32 {
         below += c;
     }
     // The bucket's values in raster order (branch-free compaction: its size is known).
-    let mut vals = vec![0.0f32; hist[bucket] + 1];
+    let mut vals = try_zeroed::<f32>(hist[bucket] + 1, WHAT)?;
     let mut c = 0;
     for &i in marked {
         let s = strength[i as usize];
@@ -115,7 +119,7 @@ fn marked_quantile(marked: &[u32], strength: &[f32], q: f32) -> f32 {
         c += usize::from((s.to_bits() >> SHIFT) as usize == bucket);
     }
     vals.truncate(c);
-    *vals.select_nth_unstable_by(k - below, f32::total_cmp).1
+    Ok(*vals.select_nth_unstable_by(k - below, f32::total_cmp).1)
 }
 
 /// Hints the CPU to fetch the cache line of `v[i]` (no effect on any value; `i` in range).
@@ -179,7 +183,7 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
         n_marked += usize::from(m != 0);
     }
     marked.truncate(n_marked);
-    let t_high = marked_quantile(&marked, &zc.strength, p.high_quantile);
+    let t_high = marked_quantile(&marked, &zc.strength, p.high_quantile)?;
     let t_low = p.low_ratio * t_high;
     // Per pixel: FREE = unvisited candidate (marked interior pixel, s >= t_low), TAKEN = on a
     // curve (or a seed already used), 0 = not a candidate.
@@ -218,12 +222,13 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
     let mut labels = try_filled(n, -1i32, WHAT)?;
     let mut segments = Vec::new();
     // Grows from `start` (tangent `t0`) along `sign * t0`, appending the pixels taken and their
-    // tangents to `out`.
+    // tangents to `out` (a curve can run through the whole image: its growth is checked).
     let grow = |start: usize,
                 t0: (f64, f64),
                 sign: f64,
                 state: &mut Vec<u8>,
-                out: &mut Vec<(u32, (f64, f64))>| {
+                out: &mut Vec<(u32, (f64, f64))>|
+     -> Result<()> {
         let mut cur = start;
         let mut dir = (sign * t0.0, sign * t0.1);
         // The position follows the steps (no division per step).
@@ -270,6 +275,7 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
             };
             state[q] = TAKEN;
             let (tx, ty) = tangent(zc.theta[q]);
+            try_grow(out, 1, SEG)?;
             out.push((q as u32, (tx, ty)));
             let sgn = if tx * dx as f64 + ty * dy as f64 >= 0.0 {
                 1.0
@@ -287,6 +293,7 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
             prefetch(&zc.strength, ahead);
             prefetch(state, ahead);
         }
+        Ok(())
     };
     // Growth buffers and the kept curve's pixels, reused by every seed (a kept segment cost
     // three allocations: the collect, the push past its exact capacity, the extend).
@@ -311,17 +318,20 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
         let t0 = tangent(zc.theta[s]);
         fwd.clear();
         bwd.clear();
-        grow(s, t0, 1.0, &mut state, &mut fwd);
-        grow(s, t0, -1.0, &mut state, &mut bwd);
+        grow(s, t0, 1.0, &mut state, &mut fwd)?;
+        grow(s, t0, -1.0, &mut state, &mut bwd)?;
         if 1 + fwd.len() + bwd.len() < p.min_len {
             continue;
         }
         pixels.clear();
+        try_reserve_len(&mut pixels, 1 + fwd.len() + bwd.len(), SEG)?;
         pixels.extend(bwd.iter().rev().copied());
         pixels.push((s as u32, t0));
         pixels.extend_from_slice(&fwd);
         let id = segments.len() as i32;
-        segments.push(make_segment(w, &pixels, &mut labels, id));
+        let seg = make_segment(w, &pixels, &mut labels, id)?;
+        try_grow(&mut segments, 1, SEG)?;
+        segments.push(seg);
     }
     Ok(Curves {
         segments,
@@ -332,7 +342,12 @@ pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
 }
 
 /// The segment of `pixels` (with their tangents `(-sin theta, cos theta)`), labelled `id`.
-fn make_segment(w: usize, pixels: &[(u32, (f64, f64))], labels: &mut [i32], id: i32) -> Segment {
+fn make_segment(
+    w: usize,
+    pixels: &[(u32, (f64, f64))],
+    labels: &mut [i32],
+    id: i32,
+) -> Result<Segment> {
     let (mut sx, mut sy, mut sc, mut ss) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let (mut x_min, mut x_max, mut y_min, mut y_max) = (i32::MAX, i32::MIN, i32::MAX, i32::MIN);
     for &(i, (tx, ty)) in pixels {
@@ -350,15 +365,15 @@ fn make_segment(w: usize, pixels: &[(u32, (f64, f64))], labels: &mut [i32], id: 
     }
     let k = pixels.len() as f64;
     let m = ss.atan2(sc);
-    Segment {
+    Ok(Segment {
         centroid: ((sx / k) as f32, (sy / k) as f32),
         x_min,
         x_max,
         y_min,
         y_max,
         mean_theta: (if m < 0.0 { m + TAU } else { m }) as f32 % std::f32::consts::TAU,
-        pixels: pixels.iter().map(|&(i, _)| i).collect(),
-    }
+        pixels: try_collect(pixels.len(), pixels.iter().map(|&(i, _)| i), SEG)?,
+    })
 }
 
 #[cfg(test)]
@@ -549,7 +564,7 @@ mod tests {
             pixels.push((s as u32, t0));
             pixels.extend_from_slice(&fwd);
             let id = segments.len() as i32;
-            segments.push(make_segment(w, &pixels, &mut labels, id));
+            segments.push(make_segment(w, &pixels, &mut labels, id).unwrap());
         }
         Ok(Curves {
             segments,
@@ -700,7 +715,8 @@ mod tests {
                 for kind in 0..4 {
                     let zc = crossings(w, h, density, kind, (s * 16 + kind) as u64 + 1);
                     for q in [0.0, 0.3, 0.5, 0.99, 1.0] {
-                        let (new, old) = (high_threshold(&zc, q), high_threshold_old(&zc, q));
+                        let (new, old) =
+                            (high_threshold(&zc, q).unwrap(), high_threshold_old(&zc, q));
                         assert_eq!(new.to_bits(), old.to_bits(), "{w}x{h} {density} {kind} {q}");
                     }
                     for p in &params {
@@ -758,6 +774,56 @@ mod tests {
             Ok(c) => println!("child: {} segments", c.segments.len()),
             Err(e) => println!("child: error: {e}"),
         }
+    }
+
+    /// Run by [`a_segment_too_long_to_allocate_is_an_error`] in a child process: a 2^20 x 3
+    /// image, every pixel marked, tangents along the rows: one segment along the middle row
+    /// (2^20 - 2 pixels, 24 bytes each while it grows). The planes (39 bytes a column) fit
+    /// under the limit, the growing curve (24 MiB at the end) does not.
+    #[cfg(target_os = "linux")]
+    #[test]
+    #[ignore = "a child of a_segment_too_long_to_allocate_is_an_error"]
+    fn track_a_long_segment_under_a_memory_limit() {
+        if std::env::var_os("SV_OOM_CHILD").is_none() {
+            return;
+        }
+        let (w, h) = (1 << 20, 3);
+        let n = w * h;
+        let zc = ZeroCrossings {
+            width: w,
+            height: h,
+            mark: vec![ZC_V; n],
+            xsub: vec![0.0; n],
+            strength: vec![1.0; n],
+            // Normal straight down the columns: tangent (-sin, cos) = (1, 0).
+            theta: vec![3.0 * std::f32::consts::FRAC_PI_2; n],
+        };
+        let p = TrackParams {
+            high_quantile: 0.5,
+            low_ratio: 0.4,
+            max_turn_deg: 60.0,
+            min_len: 5,
+        };
+        crate::segment::tests::limit_address_space(
+            crate::segment::tests::vm_size() + 39 * w + (16 << 20),
+        );
+        match track(&zc, &p) {
+            Ok(c) => println!("child: {} segments", c.segments.len()),
+            Err(e) => println!("child: error: {e}"),
+        }
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn a_segment_too_long_to_allocate_is_an_error() {
+        // A curve's growth buffers, its pixel list and the segment list grew by push/collect:
+        // a curve through a large image that did not fit aborted the process (SIGABRT)
+        // instead of returning OutOfMemory.
+        let stdout = crate::segment::tests::run_oom_child(
+            "matching::mcgm::tracking::tests::track_a_long_segment_under_a_memory_limit",
+        );
+        let want = "child: error: out of memory: a tracked segment of the MCGM matcher needs ";
+        assert!(stdout.contains(want), "{want} not in {stdout}");
     }
 
     #[cfg(target_os = "linux")]
