@@ -90,7 +90,11 @@ fn filters(l: &Image, r: &Image, p: &McgmParams, d: usize) {
 fn graph(l: &Image, p: &McgmParams) {
     let cc = channel_curves(l, 1.0, 1, p).expect("memory");
     let segs = &cc.curves.segments;
-    let edges: usize = knn_graph(segs, p.knn, p.r_graph).iter().map(Vec::len).sum();
+    let edges: usize = knn_graph(segs, p.knn, p.r_graph)
+        .expect("memory")
+        .iter()
+        .map(Vec::len)
+        .sum();
     let t = best_ms(9, || drop(knn_graph(segs, p.knn, p.r_graph)));
     println!(
         "k-NN graph of {} segments: {t:.2} ms ({edges} directed edges)",

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 
 use super::rtable::{ght_vote_rows, voters, RTable, RowIndex};
 use super::tracking::{wrap_angle, Segment};
-use crate::alloc::{try_collect, try_concat, try_filled, try_reserve_len};
+use crate::alloc::{try_collect, try_concat, try_filled, try_grow, try_reserve_len, try_zeroed};
 use crate::error::Result;
 use crate::matching::hopfield::{run_dynamics, Csr};
 
@@ -48,7 +48,8 @@ pub struct CandParams {
 
 /// Candidates of every left segment (grouped by left id, best score first). `window[A]` is the
 /// integer disparity window `[lo, hi]` of segment `A` (None: no candidates). A failed
-/// allocation of the list is [`crate::CoreError::OutOfMemory`].
+/// allocation of the list, of the right segments' row lists and voters or of a left segment's
+/// row index is [`crate::CoreError::OutOfMemory`].
 #[allow(clippy::too_many_arguments)]
 pub fn candidates(
     left: &[Segment],
@@ -63,14 +64,17 @@ pub fn candidates(
     // The right segments overlapping rows `y0..=y1` are those spanning row `y0` plus those
     // starting in `y0 + 1..=y1`: per row, the segments spanning it and the segments starting
     // on it (each segment met once, without scanning every row of a long left segment).
-    let mut rows: Vec<Vec<u32>> = vec![Vec::new(); h];
-    let mut starts: Vec<Vec<u32>> = vec![Vec::new(); h];
+    const ROWS: &str = "the MCGM matcher's right segments by row";
+    let mut rows: Vec<Vec<u32>> = try_filled(h, Vec::new(), ROWS)?;
+    let mut starts: Vec<Vec<u32>> = try_filled(h, Vec::new(), ROWS)?;
     for (id, s) in right.iter().enumerate() {
         let (a, b) = (s.y_min.max(0), s.y_max.min(h as i32 - 1));
         if a <= b {
+            try_grow(&mut starts[a as usize], 1, ROWS)?;
             starts[a as usize].push(id as u32);
         }
         for y in a..=b {
+            try_grow(&mut rows[y as usize], 1, ROWS)?;
             rows[y as usize].push(id as u32);
         }
     }
@@ -78,13 +82,13 @@ pub fn candidates(
     let right_voters: Vec<Vec<(i32, i32, u32)>> = right
         .par_iter()
         .map(|s| voters(&s.pixels, theta_r, w, p.n_bins))
-        .collect();
+        .collect::<Result<_>>()?;
     let per: Vec<Vec<Candidate>> = left
         .par_iter()
         .enumerate()
-        .map_init(Vec::<u32>::new, |acc, (ia, a)| {
+        .map_init(Vec::<u32>::new, |acc, (ia, a)| -> Result<Vec<Candidate>> {
             let Some((lo, hi)) = window[ia] else {
-                return Vec::new();
+                return Ok(Vec::new());
             };
             // Right segments on the rows of A (the order does not matter: the candidates
             // are sorted below).
@@ -123,7 +127,10 @@ pub fn candidates(
                 if (la.min(lb) as f32 / la.max(lb).max(1) as f32) < p.ght_min_score {
                     continue;
                 }
-                let ix = index.get_or_insert_with(|| RowIndex::new(&rtables[ia]));
+                let ix = match index {
+                    Some(ref ix) => ix,
+                    None => index.insert(RowIndex::new(&rtables[ia])?),
+                };
                 let Some(g) = ght_vote_rows(
                     ix,
                     a.pixels.len(),
@@ -138,6 +145,7 @@ pub fn candidates(
                     continue;
                 };
                 if g.score >= p.ght_min_score {
+                    try_grow(&mut out, 1, "the MCGM matcher's candidate pairs")?;
                     out.push(Candidate {
                         left: ia as u32,
                         right: ib,
@@ -149,9 +157,9 @@ pub fn candidates(
             }
             out.sort_by(|x, y| y.score.total_cmp(&x.score).then(x.right.cmp(&y.right)));
             out.truncate(p.k_cand);
-            out
+            Ok(out)
         })
-        .collect();
+        .collect::<Result<_>>()?;
     try_concat(per, "the MCGM matcher's candidate pairs")
 }
 
@@ -159,15 +167,19 @@ pub fn candidates(
 /// lists; ties by id). Uniform grid of cell `r_max / 4`, searched ring by ring around each
 /// centroid's cell until the `k` nearest are known: a point in a further ring is at least the
 /// ring's inner distance away, so the search stops once the `k`-th nearest is closer than
-/// that (with a margin for rounding) or the rings pass `r_max`.
-pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Vec<Vec<u32>> {
+/// that (with a margin for rounding) or the rings pass `r_max`. A failed allocation of the
+/// lists or of the grid (which grows with the spread of the centroids) is
+/// [`crate::CoreError::OutOfMemory`].
+pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Result<Vec<Vec<u32>>> {
+    const WHAT: &str = "the MCGM matcher's segment adjacency";
+    const GRID: &str = "the MCGM matcher's centroid grid";
     let n = segs.len();
-    let mut adj: Vec<Vec<u32>> = vec![Vec::new(); n];
+    let mut adj: Vec<Vec<u32>> = try_filled(n, Vec::new(), WHAT)?;
     if n == 0 || k == 0 {
-        return adj;
+        return Ok(adj);
     }
     // Centroids apart from the segments (their pixel lists made the scan miss the cache).
-    let cs: Vec<(f32, f32)> = segs.iter().map(|s| s.centroid).collect();
+    let cs: Vec<(f32, f32)> = try_collect(n, segs.iter().map(|s| s.centroid), WHAT)?;
     let cell = (r_max / 4.0).max(1.0);
     let (x0, y0) = cs.iter().fold((f32::INFINITY, f32::INFINITY), |a, c| {
         (a.0.min(c.0), a.1.min(c.1))
@@ -183,7 +195,8 @@ pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Vec<Vec<u32>> {
         (a.0.max(x + 1), a.1.max(y + 1))
     });
     // Cells in CSR form, each listing its points by id.
-    let mut start = vec![0u32; gw * gh + 1];
+    let cells = gw.checked_mul(gh).and_then(|c| c.checked_add(1));
+    let mut start = try_zeroed::<u32>(cells.unwrap_or(usize::MAX), GRID)?;
     for &c in &cs {
         let (x, y) = key(c);
         start[y * gw + x + 1] += 1;
@@ -191,8 +204,8 @@ pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Vec<Vec<u32>> {
     for i in 1..start.len() {
         start[i] += start[i - 1];
     }
-    let mut fill = start.clone();
-    let mut items = vec![0u32; n];
+    let mut fill = try_collect(start.len(), start.iter().copied(), GRID)?;
+    let mut items = try_zeroed::<u32>(n, GRID)?;
     for (i, &c) in cs.iter().enumerate() {
         let (x, y) = key(c);
         items[fill[y * gw + x] as usize] = i as u32;
@@ -256,7 +269,9 @@ pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Vec<Vec<u32>> {
         .collect();
     for (i, nb) in nearest.iter().enumerate() {
         for &j in nb {
+            try_grow(&mut adj[i], 1, WHAT)?;
             adj[i].push(j);
+            try_grow(&mut adj[j as usize], 1, WHAT)?;
             adj[j as usize].push(i as u32);
         }
     }
@@ -264,7 +279,7 @@ pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Vec<Vec<u32>> {
         a.sort_unstable();
         a.dedup();
     }
-    adj
+    Ok(adj)
 }
 
 /// Solver weights (B.2: the module C defaults `A = 1, B = 1.5, D = 1, theta = 0.3`).
@@ -293,7 +308,8 @@ pub struct Solution {
 }
 
 /// Builds the association graph's weights (CSR, symmetric, zero diagonal). A failed allocation
-/// of the matrix (8 bytes a weight) is [`crate::CoreError::OutOfMemory`].
+/// of the matrix (8 bytes a weight) or of the candidate lists per segment is
+/// [`crate::CoreError::OutOfMemory`].
 pub fn association_weights(
     cands: &[Candidate],
     left: &[Segment],
@@ -303,10 +319,13 @@ pub fn association_weights(
 ) -> Result<Csr> {
     let n_left = left.len();
     // Candidates per left segment (contiguous) and per right segment.
-    let mut by_left: Vec<Vec<u32>> = vec![Vec::new(); n_left];
-    let mut by_right: Vec<Vec<u32>> = vec![Vec::new(); n_right];
+    const BY: &str = "the MCGM matcher's candidates per segment";
+    let mut by_left: Vec<Vec<u32>> = try_filled(n_left, Vec::new(), BY)?;
+    let mut by_right: Vec<Vec<u32>> = try_filled(n_right, Vec::new(), BY)?;
     for (i, c) in cands.iter().enumerate() {
+        try_grow(&mut by_left[c.left as usize], 1, BY)?;
         by_left[c.left as usize].push(i as u32);
+        try_grow(&mut by_right[c.right as usize], 1, BY)?;
         by_right[c.right as usize].push(i as u32);
     }
     let rows: Vec<Vec<(u32, f32)>> = cands

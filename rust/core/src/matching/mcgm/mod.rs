@@ -1612,6 +1612,7 @@ fn match_channel(
         || knn_graph(&l.curves.segments, p.knn, p.r_graph / s),
     );
     let (win, cands) = pairs?;
+    let adj = adj?;
     let csr = association_weights(
         &cands,
         &l.curves.segments,

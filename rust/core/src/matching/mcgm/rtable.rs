@@ -99,15 +99,19 @@ pub struct Ght {
 
 /// A segment's pixels as voters of [`ght_vote`]: integer position and orientation bin of each
 /// (computed once per segment instead of once per comparison). `theta`: the image's normal
-/// directions, `w` its width.
-pub fn voters(pixels: &[u32], theta: &[f32], w: usize, n_bins: usize) -> Vec<(i32, i32, u32)> {
-    pixels
-        .iter()
-        .map(|&q| {
-            let (x, y) = ((q as usize % w) as i32, (q as usize / w) as i32);
-            (x, y, theta_bin(theta[q as usize], n_bins) as u32)
-        })
-        .collect()
+/// directions, `w` its width. A failed allocation (12 bytes a pixel) is
+/// [`crate::CoreError::OutOfMemory`].
+pub fn voters(
+    pixels: &[u32],
+    theta: &[f32],
+    w: usize,
+    n_bins: usize,
+) -> Result<Vec<(i32, i32, u32)>> {
+    let it = pixels.iter().map(|&q| {
+        let (x, y) = ((q as usize % w) as i32, (q as usize / w) as i32);
+        (x, y, theta_bin(theta[q as usize], n_bins) as u32)
+    });
+    try_collect(pixels.len(), it, "the MCGM matcher's GHT voters")
 }
 
 /// Votes `A'` (its [`voters`]: pixel positions and orientation bins) against the R-table of `A`
@@ -205,20 +209,22 @@ pub struct RowIndex {
 }
 
 impl RowIndex {
-    /// Indexes `rt`'s entries by row.
-    pub fn new(rt: &RTable) -> Self {
+    /// Indexes `rt`'s entries by row. A failed allocation (8 bytes an entry, 4 a row) is
+    /// [`crate::CoreError::OutOfMemory`].
+    pub fn new(rt: &RTable) -> Result<Self> {
+        const WHAT: &str = "an R-table's row index of the MCGM matcher";
         let y_min = rt.px.iter().map(|p| p.1).min().unwrap_or(0);
         let y_max = rt.px.iter().map(|p| p.1).max().unwrap_or(-1);
         let rows = (y_max - y_min + 1).max(0) as usize;
-        let mut offsets = vec![0u32; rows + 1];
+        let mut offsets = try_zeroed::<u32>(rows + 1, WHAT)?;
         for &(_, y) in &rt.px {
             offsets[(y - y_min) as usize + 1] += 1;
         }
         for r in 1..=rows {
             offsets[r] += offsets[r - 1];
         }
-        let mut fill = offsets.clone();
-        let mut ents = vec![(0i32, 0u32); rt.px.len()];
+        let mut fill = try_collect(offsets.len(), offsets.iter().copied(), WHAT)?;
+        let mut ents = try_filled(rt.px.len(), (0i32, 0u32), WHAT)?;
         for b in 0..rt.offsets.len().saturating_sub(1) {
             for &(x, y) in &rt.px[rt.offsets[b] as usize..rt.offsets[b + 1] as usize] {
                 let r = (y - y_min) as usize;
@@ -226,11 +232,11 @@ impl RowIndex {
                 fill[r] += 1;
             }
         }
-        RowIndex {
+        Ok(RowIndex {
             y_min,
             offsets,
             ents,
-        }
+        })
     }
 }
 

@@ -3,7 +3,7 @@
 //! sub-pixel shift end to end.
 
 use super::log::{log_filter, log_kernels};
-use super::rtable::{build_rtable, ght_vote, ght_vote_rows, voters, RowIndex};
+use super::rtable::{build_rtable, ght_vote, ght_vote_rows, voters, RTable, RowIndex};
 use super::tracking::{track, Segment};
 use super::zerocross::{zero_crossings, ZC_H};
 use super::*;
@@ -131,7 +131,7 @@ fn ght_of_a_translated_contour_scores_one_at_the_translation() {
     let g = ght_vote(
         &rt,
         seg.pixels.len(),
-        &voters(&moved, &theta, w, 36),
+        &voters(&moved, &theta, w, 36).unwrap(),
         0,
         20,
         1,
@@ -159,9 +159,9 @@ fn ght_by_rows_equals_ght_by_bins() {
     let (mut acc, mut acc2) = (Vec::new(), Vec::new());
     let mut compared = 0;
     for (a, rt) in cl.curves.segments.iter().zip(&cl.rtables).take(40) {
-        let ix = RowIndex::new(rt);
+        let ix = RowIndex::new(rt).unwrap();
         for b in cr.curves.segments.iter().take(60) {
-            let vb = voters(&b.pixels, &cr.zc.theta, w, 36);
+            let vb = voters(&b.pixels, &cr.zc.theta, w, 36).unwrap();
             for (lo, hi, dy, tol) in [(0, 16, 1, 1), (-5, 40, 0, 0), (2, 9, 2, 3)] {
                 let want = ght_vote(rt, a.pixels.len(), &vb, lo, hi, dy, 36, tol, &mut acc);
                 let got = ght_vote_rows(&ix, a.pixels.len(), &vb, lo, hi, dy, 36, tol, &mut acc2);
@@ -682,7 +682,7 @@ fn knn_graph_equals_the_brute_force_neighbours() {
                 mean_theta: 0.0,
             })
             .collect();
-        let got = graph::knn_graph(&segs, k, r_max);
+        let got = graph::knn_graph(&segs, k, r_max).unwrap();
         let mut want: Vec<Vec<u32>> = vec![Vec::new(); n];
         for (i, &(x, y)) in cs.iter().enumerate() {
             let mut d: Vec<(f32, u32)> = cs
@@ -1476,8 +1476,8 @@ fn ght_and_rtable_equal_the_brute_force_vote() {
             .iter()
             .map(|&i| (xy(i).0, xy(i).1, bin(theta_b[i as usize])))
             .collect();
-        let voters_b = voters(&pb, &theta_b, w, n_bins);
-        let ix = RowIndex::new(&rt);
+        let voters_b = voters(&pb, &theta_b, w, n_bins).unwrap();
+        let ix = RowIndex::new(&rt).unwrap();
         let lo = (rnd() * 40.0) as i32 - 25;
         let hi = lo + (rnd() * 30.0) as i32 - 3;
         let dy = (rnd() * 3.0) as i32;
@@ -2612,4 +2612,102 @@ fn an_rtable_too_large_to_allocate_is_an_error() {
     let want = "child: error: out of memory: an R-table of the MCGM matcher needs 16.00 MiB \
                 (16777216 bytes)";
     assert!(stdout.contains(want), "{want} not in {stdout}");
+}
+
+/// Run by [`graph_buffers_too_large_to_allocate_are_an_error`] in a child process, one case
+/// (`SV_MCGM_OOM_CASE`) under an address-space limit of 64 MiB more than is mapped: a buffer
+/// of the candidate search or the graphs that grows with the image or the segments, 256-384
+/// MiB each.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of graph_buffers_too_large_to_allocate_are_an_error"]
+fn graph_buffers_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let seg = |pixels: Vec<u32>, c: (f32, f32)| Segment {
+        pixels,
+        centroid: c,
+        x_min: 0,
+        x_max: 0,
+        y_min: 0,
+        y_max: 0,
+        mean_theta: 0.0,
+    };
+    let case = std::env::var("SV_MCGM_OOM_CASE").unwrap();
+    let cp = McgmParams::default().cand;
+    let sp = McgmParams::default().solver;
+    // Inputs built before the limit: 2^23 pixels of one segment (32 MiB), two far centroids.
+    let long = [seg(vec![0; 1 << 23], (0.0, 0.0))];
+    let far = [seg(vec![0], (0.0, 0.0)), seg(vec![0], (8191.0, 8191.0))];
+    let rt = RTable {
+        offsets: vec![0, 2],
+        vecs: vec![(0.0, 0.0); 2],
+        px: vec![(0, 0), (0, 1 << 26)],
+    };
+    let cand = [graph::Candidate {
+        left: 0,
+        right: 0,
+        score: 1.0,
+        tx: 0.0,
+        ty: 0.0,
+    }];
+    rayon::join(|| (), || ()); // the pool's thread started before the limit
+    crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + (64 << 20));
+    let r = match case.as_str() {
+        // Per row of the image (24 bytes a row: 2^24 rows).
+        "rows" => graph::candidates(&[], &[], &[], &[0.0], 1, 1 << 24, &[], &cp).map(|c| c.len()),
+        // 12 bytes a pixel of a right segment.
+        "voters" => voters(&long[0].pixels, &[0.0], 1, 36).map(|v| v.len()),
+        // 4 bytes a row the R-table spans.
+        "row_index" => RowIndex::new(&rt).map(|_| 1),
+        // 4 bytes a grid cell: 8192 x 8192 cells of 1 px (r_max 4).
+        "grid" => graph::knn_graph(&far, 1, 4.0).map(|a| a.len()),
+        // 24 bytes a right segment (2^24).
+        "by_right" => {
+            graph::association_weights(&cand, &long, &[Vec::new()], 1 << 24, &sp).map(|c| c.nnz())
+        }
+        other => panic!("no case {other}"),
+    };
+    match r {
+        Ok(n) => println!("child: {case} {n}"),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn graph_buffers_too_large_to_allocate_are_an_error() {
+    // The right segments' row lists, their voters, a left segment's row index, the k-NN grid
+    // and the candidates per segment were allocated with vec!/collect/push: a failed
+    // allocation aborted the process (SIGABRT) instead of returning OutOfMemory.
+    for (case, want) in [
+        (
+            "rows",
+            "the MCGM matcher's right segments by row needs 384.00 MiB (402653184 bytes)",
+        ),
+        (
+            "voters",
+            "the MCGM matcher's GHT voters needs 96.00 MiB (100663296 bytes)",
+        ),
+        (
+            "row_index",
+            "an R-table's row index of the MCGM matcher needs 256.00 MiB (268435464 bytes)",
+        ),
+        (
+            "grid",
+            "the MCGM matcher's centroid grid needs 256.00 MiB (268435460 bytes)",
+        ),
+        (
+            "by_right",
+            "the MCGM matcher's candidates per segment needs 384.00 MiB (402653184 bytes)",
+        ),
+    ] {
+        let stdout = crate::segment::tests::run_oom_child_with(
+            "matching::mcgm::tests::graph_buffers_under_a_memory_limit",
+            Some(("SV_MCGM_OOM_CASE", case)),
+        );
+        let want = format!("child: error: out of memory: {want}");
+        assert!(stdout.contains(&want), "{case}: {want} not in {stdout}");
+    }
 }
