@@ -976,7 +976,7 @@ fn decimate2_averages_each_2x2_block() {
 
 /// The zero-crossing rule of algorithms.md B.4 written out pixel by pixel (no compaction):
 /// the reference of [`zero_crossings`].
-fn zero_crossings_reference(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
+pub(super) fn zero_crossings_reference(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
     use super::zerocross::ZC_V;
     use std::f32::consts::TAU;
     let n = w * h;

@@ -214,148 +214,11 @@ fn crossings_row(
 
 #[cfg(test)]
 mod tests {
-    //! `crossings_row` as dispatched (its AVX2 build on a CPU that has AVX2) against its body
-    //! as it was before `simd_fn` (compiled for baseline x86-64 only), on values real scenes do
-    //! not hold: NaN of either sign, infinities, signed zeros, denormals, exact ties.
+    //! `crossings_row` as dispatched (its AVX2 build on a CPU that has AVX2) against the
+    //! pixel-by-pixel rule of the channel's tests (plain scalar code, baseline x86-64), on values
+    //! real scenes do not hold: NaN of either sign, infinities, signed zeros, denormals, exact ties.
     use super::*;
-
-    /// `crossings_row` before it was a `simd_fn` (the baseline build only).
-    #[allow(clippy::too_many_arguments)]
-    fn crossings_row_old(
-        l: &[f32],
-        w: usize,
-        y: usize,
-        cand: &mut [u32],
-        mark: &mut [u8],
-        xsub: &mut [f32],
-        strength: &mut [f32],
-        theta: &mut [f32],
-    ) {
-        // Horizontal scan: the crossing between p and p + (1, 0) is marked on the pixel with the
-        // smaller |L| (ties: p); a pixel with L = 0 exactly is marked if its neighbours differ in sign.
-        // Candidate positions first (sign change or an exact zero), then the rule at those
-        // positions only, in the same order. The positions are listed by a branch-free compaction:
-        // about a third of the pixels are crossings, so a test per pixel is often mispredicted.
-        let flags = |cand: &mut [u32], a: &[f32], b: &[f32], from: usize| -> usize {
-            let mut c = 0;
-            for (x, (&a, &b)) in a.iter().zip(b).enumerate().skip(from) {
-                cand[c] = x as u32;
-                c += usize::from((a * b < 0.0) | (a == 0.0));
-            }
-            c
-        };
-        let row = &l[y * w..(y + 1) * w];
-        let nc = flags(cand, &row[..w - 1], &row[1..], 0);
-        for &x in &cand[..nc] {
-            let x = x as usize;
-            let (a, b) = (row[x], row[x + 1]);
-            let (px, pos) = if a * b < 0.0 {
-                let px = if a.abs() <= b.abs() { x } else { x + 1 };
-                (px, x as f32 + a / (a - b))
-            } else if a == 0.0 && x >= 1 && row[x - 1] * b < 0.0 {
-                (x, x as f32)
-            } else {
-                continue;
-            };
-            if px < 1 || px + 1 >= w {
-                continue;
-            }
-            // Two crossings on one pixel (both neighbours): keep the nearer one.
-            if mark[px] & ZC_H == 0 || (pos - px as f32).abs() < (xsub[px] - px as f32).abs() {
-                xsub[px] = pos;
-            }
-            mark[px] |= ZC_H;
-        }
-        // Vertical scan, the same rule along y: the pair (y - 1, y) marks this row when its
-        // crossing is nearer here; the pair (y, y + 1) when nearer here (ties: here), or when this
-        // pixel is an exact zero between opposite signs.
-        let (up, down) = (&l[(y - 1) * w..y * w], &l[(y + 1) * w..(y + 2) * w]);
-        for x in 1..w - 1 {
-            let (u, c, d) = (up[x], row[x], down[x]);
-            // (`u * c < 0` holds for no NaN: there `>` is the negation of the scan's `<=`.)
-            let from_above = u * c < 0.0 && u.abs() > c.abs();
-            let from_below = if c * d < 0.0 {
-                c.abs() <= d.abs()
-            } else {
-                c == 0.0 && u * d < 0.0
-            };
-            mark[x] |= ZC_V * u8::from(from_above | from_below);
-        }
-        let mut c = 0;
-        for (x, &m) in mark.iter().enumerate() {
-            cand[c] = x as u32;
-            c += usize::from(m != 0);
-        }
-        for &x in &cand[..c] {
-            let x = x as usize;
-            let i = y * w + x;
-            let gx = 0.5 * (l[i + 1] - l[i - 1]);
-            let gy = 0.5 * (l[i + w] - l[i - w]);
-            let st = (gx * gx + gy * gy).sqrt();
-            if st < MIN_STRENGTH {
-                mark[x] = 0;
-                xsub[x] = f32::NAN;
-                continue;
-            }
-            strength[x] = st;
-            let t = gy.atan2(gx);
-            // `(t + TAU) % TAU` without the fmod call: u = t + TAU lies in [pi, TAU], and
-            // u - TAU is exact there (Sterbenz).
-            theta[x] = if t < 0.0 {
-                let u = t + TAU;
-                if u >= TAU {
-                    u - TAU
-                } else {
-                    u
-                }
-            } else {
-                t
-            };
-            if mark[x] & ZC_H == 0 {
-                // Vertical-only mark: x from the horizontal crossing next to it, else a Newton step.
-                let left = x as f32 - 1.0 + l[i - 1] / (l[i - 1] - l[i]);
-                let right = x as f32 + l[i] / (l[i] - l[i + 1]);
-                xsub[x] = if l[i - 1] * l[i] < 0.0 {
-                    left
-                } else if l[i] * l[i + 1] < 0.0 {
-                    right
-                } else if gx != 0.0 && (l[i] / gx).abs() <= MAX_NEWTON_STEP {
-                    x as f32 - l[i] / gx
-                } else {
-                    x as f32
-                };
-            }
-        }
-    }
-
-    /// [`zero_crossings`] row by row with [`crossings_row_old`].
-    fn zero_crossings_old(l: &[f32], w: usize, h: usize) -> ZeroCrossings {
-        let n = w * h;
-        let (mut mark, mut xsub) = (vec![0u8; n], vec![f32::NAN; n]);
-        let (mut strength, mut theta) = (vec![0.0f32; n], vec![0.0f32; n]);
-        let mut cand = vec![0u32; w + 1];
-        for y in (1..h.saturating_sub(1)).filter(|_| w >= 3) {
-            let r = y * w..(y + 1) * w;
-            crossings_row_old(
-                l,
-                w,
-                y,
-                &mut cand,
-                &mut mark[r.clone()],
-                &mut xsub[r.clone()],
-                &mut strength[r.clone()],
-                &mut theta[r],
-            );
-        }
-        ZeroCrossings {
-            width: w,
-            height: h,
-            mark,
-            xsub,
-            strength,
-            theta,
-        }
-    }
+    use crate::matching::mcgm::tests::zero_crossings_reference;
 
     #[test]
     fn dispatched_crossings_equal_the_baseline_build_bit_for_bit() {
@@ -416,7 +279,7 @@ mod tests {
                     })
                     .collect();
                 let new = zero_crossings(&l, w, h).unwrap();
-                let old = zero_crossings_old(&l, w, h);
+                let old = zero_crossings_reference(&l, w, h);
                 let what = format!("{w}x{h} mode {mode} case {k}");
                 assert_eq!(new.mark, old.mark, "{what}");
                 assert_eq!(bits(&new.xsub), bits(&old.xsub), "{what} xsub");
