@@ -21,6 +21,7 @@ import re
 import stat
 import tempfile
 import threading
+import warnings
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -635,7 +636,11 @@ def write_together(files: list[tuple[Path, bytes]]) -> None:
             except FileNotFoundError:
                 pass
         for dest, copy in stranded:
-            exc.add_note(f"{dest} could not be restored: its previous contents are in {copy}")
+            note = f"{dest} could not be restored: its previous contents are in {copy}"
+            if hasattr(exc, "add_note"):
+                exc.add_note(note)
+            else:  # Python 3.10: no notes; a warning still says where the contents are
+                warnings.warn(note, RuntimeWarning, stacklevel=3)
         raise
     for _, previous in kept:
         if previous is not None:
