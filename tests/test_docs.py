@@ -552,3 +552,232 @@ def test_robotics_quotes_kittis_floor_as_the_fit_finds_it(data_dir: Path) -> Non
     assert metres is not None and feet is not None
     assert f"# KITTI: {metres.group(0)}, pitch" in page
     assert f"`{feet.group(0)}` on KITTI" in page
+
+
+def _python_blocks(page: Path) -> list[str]:
+    return re.findall(r"```python\n(.*?)```", page.read_text(), re.S)
+
+
+def test_readme_python_example_runs_as_written(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The README's "Using it" block, pasted as it stands into a script beside the bundled cones
+    (its ``calib.txt``, ``left.png`` and ``right.png``), runs; what its comments name is what the
+    calls return (``depth_counts()``'s keys, the channels and their types) and every file it
+    writes is there. typed_user_script.py is a copy of it, which the README can drift from."""
+    import shutil
+
+    import numpy as np
+
+    import stereovision as sv
+
+    (block,) = _python_blocks(ROOT / "README.md")
+    cones = Path(sv.__file__).parent / "data" / "cones"
+    given = ("calib.txt", "left.png", "right.png")
+    for name in given:
+        shutil.copy(cones / name, tmp_path)
+    monkeypatch.chdir(tmp_path)
+    scope: dict[str, object] = {}
+    exec(compile(block, "README.md", "exec"), scope)  # the README's own code
+
+    res, fused, m = scope["res"], scope["fused"], scope["m"]
+    assert isinstance(res, sv.DepthResult) and isinstance(fused, sv.DepthResult)
+    assert isinstance(m, sv.Matches)
+    assert res.disparity.shape == (375, 450) and res.disparity.dtype == np.float32
+    counts = re.search(r"res\.depth_counts\(\)\s+# \{([^}]*)\}", block)
+    assert counts is not None
+    assert set(re.findall(r'"(\w+)"', counts.group(1))) == set(res.depth_counts())
+    channels = re.search(r"fused\.channels\s+# \{(.*)\}", block)
+    assert channels is not None and fused.channels is not None
+    said = dict(re.findall(r'"(\w+)": (\w+)', channels.group(1)))
+    assert {k: type(v).__name__ for k, v in fused.channels.items()} == said
+    assert m.to_array().shape == (len(m), 4)
+    written = set(re.findall(r'"(\w+\.(?:ply|png|csv))"', block)) - set(given)
+    assert written == {"cloud.ply", "depth_mm.png", "disp.png", "matches.csv"}
+    assert all((tmp_path / name).stat().st_size > 0 for name in written)
+
+
+def test_robotics_pipeline_runs_as_written(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, data_dir: Path
+) -> None:
+    """docs/robotics.md's two Python blocks (the pipeline from the calibration to a robot's
+    inputs, and the fisheye field's ``alpha=1``) run as written on KITTI 000005, its calibration
+    saved as the ROS ``camera_info`` folder ``ros/`` the pipeline reads; the obstacles are the
+    ``(H, W) bool`` its comment says, within the 8 m the depth is filtered to."""
+    import cv2
+    import numpy as np
+
+    import stereovision as sv
+
+    kitti = data_dir / "kitti2015" / "000005_10"
+    left, right = cv2.imread(str(kitti / "left.png")), cv2.imread(str(kitti / "right.png"))
+    monkeypatch.chdir(tmp_path)
+    calib = sv.Calibration.from_file(kitti / "calib.txt")
+    calib.save_ros("ros/")
+    pipeline, fisheye = _python_blocks(ROOT / "docs" / "robotics.md")
+    scope: dict[str, object] = {"left": left, "right": right}
+    exec(compile(pipeline, "robotics.md", "exec"), scope)  # the page's own code
+
+    res, obstacles = scope["res"], scope["obstacles"]
+    assert isinstance(res, sv.DepthResult) and isinstance(obstacles, np.ndarray)
+    assert obstacles.shape == left.shape[:2] and obstacles.dtype == np.bool_
+    assert 0 < obstacles.sum() and np.nanmax(res.point_image(filled=True)[obstacles][:, 2]) <= 8
+    assert (tmp_path / "depth_mm.png").stat().st_size > 0
+    pts = scope["pts"]
+    assert isinstance(pts, np.ndarray) and pts.shape[1] == 3
+
+    scope = {"sv": sv, "left": left, "right": right, "calib": calib}
+    exec(compile(fisheye, "robotics.md", "exec"), scope)
+    res = scope["res"]
+    assert isinstance(res, sv.DepthResult) and res.disparity.shape == left.shape[:2]
+
+
+def _commands() -> dict[str, set[str]]:
+    """Each command of the command line and the option strings it takes."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return {
+        name: {o for a in sub._actions for o in a.option_strings}
+        for name, sub in commands.choices.items()
+    }
+
+
+def test_commands_named_in_the_prose_take_their_options() -> None:
+    """A ``cmd ... --option`` quoted in the prose (`capture --fourcc`, `depth --unit ft`, `board
+    -o`) names an option that command takes: the code-block test sees whole lines only."""
+    commands = _commands()
+    wrong, checked = [], 0
+    for page in PAGES:
+        prose = re.sub(r"```.*?```", "", page.read_text(), flags=re.S)
+        for span in " ".join(prose.split()).split("`")[1::2]:
+            m = re.match(r"(?:stereovision )?(\w+) (.*)", span)
+            if not m or m.group(1) not in commands:
+                continue
+            for option in re.findall(r"(?<![\w-])(--?[a-z][\w-]*)", m.group(2)):
+                checked += 1
+                if option not in commands[m.group(1)]:
+                    wrong.append(f"{page.name}: `{span}`: {option}")
+    assert not wrong, f"options the command does not take: {wrong}"
+    assert checked >= 60, checked  # 81 on 2026-12-06
+
+
+def test_synopsis_choices_are_the_parsers() -> None:
+    """An option shown with its values (`--method fused|gabor|census|fast`, `--unit m|ft|...`)
+    in a code block lists exactly the values the parser accepts."""
+    import argparse
+
+    from stereovision.cli import build_parser
+
+    parser = build_parser()
+    commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    wrong, checked = [], 0
+    for page in PAGES:
+        for block in re.findall(r"```[a-z]*\n(.*?)```", page.read_text(), re.S):
+            command = ""
+            for line in block.splitlines():
+                start = re.match(r"\s*(?:\w+\$ )?stereovision (\w+)", line)
+                command = start.group(1) if start else command
+                sub = commands.choices.get(command)
+                for option, values in re.findall(r"(--[\w-]+) (\w+(?:\|\w+)+)", line):
+                    action = next(a for a in sub._actions if option in a.option_strings)
+                    checked += 1
+                    if set(values.split("|")) != set(action.choices or ()):
+                        wrong.append(f"{page.name}: {command} {option} {values}")
+    assert not wrong, f"values that are not the parser's: {wrong}"
+    assert checked >= 2, checked
+
+
+def _api_names() -> dict[str, list[object]]:
+    """Every public function, class and method of the package, by name."""
+    import stereovision
+
+    names: dict[str, list[object]] = {}
+    for info in pkgutil.walk_packages(stereovision.__path__, "stereovision."):
+        if info.name.endswith("__main__"):
+            continue
+        try:
+            module = importlib.import_module(info.name)
+        except ImportError:  # an optional extra not installed
+            continue
+        for name, obj in vars(module).items():
+            if name.startswith("_"):
+                continue
+            if inspect.isclass(obj):
+                names.setdefault(name, []).append(obj)
+                for attr, value in vars(obj).items():
+                    if isinstance(value, (classmethod, staticmethod)):
+                        value = value.__func__
+                    if not attr.startswith("_") and inspect.isfunction(value):
+                        names.setdefault(attr, []).append(value)
+            elif inspect.isfunction(obj):
+                names.setdefault(name, []).append(obj)
+    return names
+
+
+def test_names_the_docs_give_exist() -> None:
+    """Every ``sv.name`` / ``stereovision.module.name`` and every ``Class.attribute`` of the
+    package's classes (``Calibration.scaled_to``, ``GroundPlane.below_share``) that the README
+    and docs/ name exists: a renamed function leaves no stale name in the prose."""
+    names = _api_names()
+    classes = {n: objs for n, objs in names.items() if any(inspect.isclass(o) for o in objs)}
+    broken, checked = [], 0
+    for page in PAGES:
+        text = page.read_text()
+        for dotted in re.findall(r"(?<![\w.])((?:sv|stereovision)(?:\.\w+)+)", text):
+            full = "stereovision" + dotted[2:] if dotted.startswith("sv.") else dotted
+            checked += 1
+            if not _resolves(full):
+                broken.append(f"{page.name}: {dotted}")
+        for cls, attr in re.findall(r"(?<![\w.])([A-Z]\w+)\.([a-z_]\w*)\b(?!\.\w)", text):
+            if cls not in classes:
+                continue
+            owners = [o for o in classes[cls] if inspect.isclass(o)]
+            checked += 1
+            fields = {
+                f
+                for o in owners
+                for f in (
+                    *getattr(o, "__dataclass_fields__", {}),
+                    *getattr(o, "__annotations__", {}),
+                )
+            }
+            if any(hasattr(o, attr) for o in owners) or attr in fields:
+                continue
+            if not any(f"self.{attr} =" in inspect.getsource(o) for o in owners):  # set in __init__
+                broken.append(f"{page.name}: {cls}.{attr}")
+    assert not broken, f"the docs name what does not exist: {broken}"
+    assert checked >= 60, checked  # 76 on 2026-12-06
+
+
+def test_keyword_arguments_in_the_docs_are_taken() -> None:
+    """A call the README or docs/ write with keywords (``filtered(max_depth=...,
+    max_relative_sigma=...)``, ``BagWriter(path, tf=False)``, ``run_stream(check_every=N)``)
+    passes names the package's function of that name takes."""
+    names = _api_names()
+    call = re.compile(r"(?<![\w])(\w+)\(([^()]*(?:\([^()]*\)[^()]*)*)\)")
+    wrong, checked = [], 0
+    for page in PAGES:
+        for name, args in call.findall(page.read_text()):
+            if name not in names:
+                continue
+            own = re.sub(r"\([^()]*\)", "", args)  # a nested call's keywords are its own
+            for keyword in re.findall(r"(?:^|[,\s])([a-z_]\w*)=(?!=)", own):
+                checked += 1
+                takes = False
+                for func in names[name]:
+                    try:
+                        params = inspect.signature(func).parameters  # type: ignore[arg-type]
+                    except (TypeError, ValueError):
+                        takes = True
+                        continue
+                    takes |= keyword in params or any(
+                        p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values()
+                    )
+                if not takes:
+                    wrong.append(f"{page.name}: {name}({keyword}=)")
+    assert not wrong, f"keywords no function of that name takes: {wrong}"
+    assert checked >= 50, checked  # 72 on 2026-12-06
