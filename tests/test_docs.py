@@ -781,3 +781,32 @@ def test_keyword_arguments_in_the_docs_are_taken() -> None:
                     wrong.append(f"{page.name}: {name}({keyword}=)")
     assert not wrong, f"keywords no function of that name takes: {wrong}"
     assert checked >= 50, checked  # 72 on 2026-12-06
+
+
+def test_readme_set_up_is_the_build_files() -> None:
+    """What the README and docs/ say about setting up (the Python and Rust floors, the
+    `.[extra]` installs, `make` targets, the distribution name) is what pyproject.toml,
+    Cargo.toml and the Makefile hold (read as text: tomllib is Python 3.11's)."""
+    pyproject = (ROOT / "pyproject.toml").read_text()
+    cargo = (ROOT / "Cargo.toml").read_text()
+    makefile = (ROOT / "Makefile").read_text()
+    readme = " ".join((ROOT / "README.md").read_text().split())
+    python = re.search(r'^requires-python = ">=([\d.]+)"', pyproject, re.M)
+    rust = re.search(r'^rust-version = "([\d.]+)"', cargo, re.M)
+    name = re.search(r'^name = "([\w-]+)"', pyproject, re.M)
+    assert python is not None and rust is not None and name is not None
+    assert f"Python {python.group(1)} or newer" in readme
+    assert f"Rust toolchain {rust.group(1)} or newer" in readme
+    assert f"Distribution name `{name.group(1)}`" in readme
+    section = pyproject.split("[project.optional-dependencies]", 1)[1].split("\n[", 1)[0]
+    extras = set(re.findall(r"^(\w+) = \[", section, re.M))
+    wrong = []
+    for page in PAGES:
+        text = page.read_text()
+        said = re.findall(r"`\.\[(\w+)\]`", text)
+        said += re.findall(rf"{re.escape(name.group(1))}\[(\w+)\]", text)
+        wrong += [f"{page.name}: [{extra}]" for extra in said if extra not in extras]
+        for target in re.findall(r"`make (\w[\w-]*)`", text):
+            if not re.search(rf"^{re.escape(target)}:", makefile, re.M):
+                wrong.append(f"{page.name}: make {target}")
+    assert not wrong, f"set-up steps the build files do not have: {wrong}"
