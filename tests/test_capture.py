@@ -3230,6 +3230,71 @@ def test_the_image_sequence_reader_seeks_and_counts_as_opencvs(tmp_path: Path) -
     assert session(capmod._ImageSequence(pattern, 0)) == opencv
 
 
+def test_the_image_sequence_reader_answers_ratio_count_and_size_as_opencvs(
+    tmp_path: Path,
+) -> None:
+    """Beside CAP_IMAGES on the same sequences (from 0, where both open), _ImageSequence
+    refused a seek by CAP_PROP_POS_AVI_RATIO and said 0 for it, counted a stray file that is
+    no image in the numbering among its frames (FRAME_COUNT 6 where CAP_IMAGES says 3, and 3
+    are read), and said the first frame's size after a frame of another size was read. Both
+    now give the same answers, frames and positions; where they differ (a seek by
+    milliseconds, the ratio past the last frame) ours is the documented answer."""
+    sizes = {2: (200, 150)}  # frame 2 at another size: each frame is read at its own
+    for i in range(6):
+        cv2.imwrite(str(tmp_path / f"s_{i:03d}.png"), _numbered(i, sizes.get(i, SMALL)))
+    pattern = str(tmp_path / "s_%03d.png")
+
+    def session(cap: Any) -> list[object]:
+        said: list[object] = [cap.get(cv2.CAP_PROP_FRAME_COUNT)]
+        for seek in (None, 0.5, None, 1.0, -0.5, 0.3, 7.0, 0.0, 0.1):
+            if seek is not None:
+                said.append(cap.set(cv2.CAP_PROP_POS_AVI_RATIO, seek))
+            said.append(cap.get(cv2.CAP_PROP_POS_AVI_RATIO))
+            ok, frame = cap.read()
+            said += [ok, _read_stamp(frame) if ok else None, cap.get(cv2.CAP_PROP_POS_FRAMES)]
+            said += [cap.get(cv2.CAP_PROP_FRAME_WIDTH), cap.get(cv2.CAP_PROP_FRAME_HEIGHT)]
+            if cap.get(cv2.CAP_PROP_POS_FRAMES) < 6:  # past the last frame: below
+                said.append(cap.get(cv2.CAP_PROP_POS_AVI_RATIO))
+        return said
+
+    opencv = session(cv2.VideoCapture(pattern, cv2.CAP_IMAGES))
+    # ratio 0.5 of 5 frames' span is frame 2.5, rounded half to even: the 200x150 frame 2
+    assert opencv[:10] == [6.0, 0.0, True, 0, 1.0, *SMALL, 0.2, True, 0.4]
+    assert opencv[10:16] == [True, 2, 3.0, 200.0, 150.0, 0.6]
+    assert session(capmod._ImageSequence(pattern, 0)) == opencv
+
+    # a gap (s_003.png missing), then a stray file that is no image in its place: both count
+    # and read the 3 images before it
+    (tmp_path / "s_003.png").unlink()
+    for stray in (False, True):
+        if stray:
+            (tmp_path / "s_003.png").write_text("not an image")
+        caps = (cv2.VideoCapture(pattern, cv2.CAP_IMAGES), capmod._ImageSequence(pattern, 0))
+        for cap in caps:
+            assert cap.get(cv2.CAP_PROP_FRAME_COUNT) == 3.0
+            assert [cap.read()[0] for _ in range(5)] == [True] * 3 + [False] * 2
+            assert cap.set(cv2.CAP_PROP_POS_AVI_RATIO, 1.0) is True
+            assert _read_stamp(cap.read()[1]) == 2  # the last of the 3
+
+    # where ours differs, as documented: a seek by milliseconds (an image has no media time)
+    # CAP_IMAGES takes for a frame number; the ratio past the last frame it says above 1
+    cv_cap, ours = cv2.VideoCapture(pattern, cv2.CAP_IMAGES), capmod._ImageSequence(pattern, 0)
+    assert cv_cap.set(cv2.CAP_PROP_POS_MSEC, 2.0) is True
+    assert cv_cap.get(cv2.CAP_PROP_POS_FRAMES) == 2.0 and cv_cap.get(cv2.CAP_PROP_POS_MSEC) == -1
+    assert ours.set(cv2.CAP_PROP_POS_MSEC, 2.0) is False
+    assert ours.get(cv2.CAP_PROP_POS_FRAMES) == 0.0 and ours.get(cv2.CAP_PROP_POS_MSEC) == -1
+    for cap in (cv_cap, ours):
+        cap.set(cv2.CAP_PROP_POS_FRAMES, 2)
+        assert cap.read()[0] and not cap.read()[0]
+    assert cv_cap.get(cv2.CAP_PROP_POS_AVI_RATIO) == 1.5  # 3 read of 3, over the span 2
+    assert ours.get(cv2.CAP_PROP_POS_AVI_RATIO) == 1.0
+    one = tmp_path / "one_%d.png"
+    cv2.imwrite(str(tmp_path / "one_0.png"), _numbered(0))
+    single = capmod._ImageSequence(str(one), 0)
+    assert single.get(cv2.CAP_PROP_POS_AVI_RATIO) == 0.0  # CAP_IMAGES: NaN (0 / 0)
+    assert single.read()[0] and single.get(cv2.CAP_PROP_POS_AVI_RATIO) == 1.0  # inf
+
+
 def test_a_space_padded_sequence_opens_from_its_first_number_however_late(
     tmp_path: Path,
 ) -> None:

@@ -938,13 +938,29 @@ class _ImageSequence:
     ``100%``) or a number 10 or more digits wide (``%010d``). Frames
     are read as ``CAP_IMAGES`` reads them (``cv2.IMREAD_UNCHANGED``, each at its own size);
     the sequence is the run of consecutive numbers from the first, and ends at a missing one
-    (its backend is said as ``CV_IMAGES``: the end and a gap are told as for OpenCV's)."""
+    (its backend is said as ``CV_IMAGES``: the end and a gap are told as for OpenCV's).
+
+    ``get`` and ``set`` answer as ``CAP_IMAGES``'s do (OpenCV 5.1, side by side in
+    tests/test_capture.py): ``CAP_PROP_FRAME_COUNT`` is the run of files from the first that
+    OpenCV has a reader for (``cv2.haveImageReader``: a gap, or a file that is no image, ends
+    it, as the reading ends there); ``CAP_PROP_POS_AVI_RATIO`` is the position over the last
+    frame's (``POS_FRAMES / (FRAME_COUNT - 1)``), and a seek to a ratio goes to that frame;
+    the width and height are the last frame read's (the first's before any). Where OpenCV's
+    answer is no answer, ours differs: a seek by ``CAP_PROP_POS_MSEC`` is refused (False),
+    as an image has no media time (``get`` says -1), where ``CAP_IMAGES`` took the
+    milliseconds for a frame number (2 ms went to frame 2, 2000 ms to the last); a NaN seek
+    is refused where ``CAP_IMAGES`` took it for frame 2**31 - 1 and read nothing more; the
+    ratio stays within 0-1 where ``CAP_IMAGES`` said 1.2 once the last of 6 frames was read
+    (and NaN or inf for one image); after the end the size stays the last frame's, where
+    ``CAP_IMAGES`` says 0x0."""
 
     def __init__(self, path: str, first: int) -> None:
         self._path, self._first, self._next = path, first, 0
         self._frame: np.ndarray | None = None
         self._count = 0
-        while os.path.exists(_sequence_name(path, first + self._count)):
+        # as CAP_IMAGES counts: a file present that no codec reads (a stray text file in the
+        # numbering) was counted, so the count promised frames the reading never gave
+        while cv2.haveImageReader(_sequence_name(path, first + self._count)):
             self._count += 1
         probe = cv2.imread(_sequence_name(path, first), cv2.IMREAD_UNCHANGED)
         self._size = (0, 0) if probe is None else (probe.shape[1], probe.shape[0])
@@ -965,6 +981,7 @@ class _ImageSequence:
         if frame is None:
             return False
         self._frame = frame
+        self._size = (frame.shape[1], frame.shape[0])  # each frame at its own size
         self._next += 1
         return True
 
@@ -982,15 +999,22 @@ class _ImageSequence:
             cv2.CAP_PROP_POS_FRAMES: self._next,
             cv2.CAP_PROP_POS_MSEC: -1,  # no media time, as CAP_IMAGES says
             cv2.CAP_PROP_FPS: -1,
+            # CAP_IMAGES's ratio (the inverse of its seek), kept within 0-1 (see the class)
+            cv2.CAP_PROP_POS_AVI_RATIO: min(self._next / max(self._count - 1, 1), 1.0),
         }
         return float(values.get(prop, 0))
 
     def set(self, prop: int, value: float) -> bool:
-        # CAP_IMAGES seeks (the position kept within the images counted at the open, as its
-        # own) and refuses every other setting: a file cannot be asked a size or a rate. A NaN
-        # position is refused: round() raised ValueError where cv2's set() never raises
-        if prop != cv2.CAP_PROP_POS_FRAMES or not self._count or math.isnan(value):
+        # CAP_IMAGES seeks by frame or by ratio (the position kept within the images counted
+        # at the open, as its own) and refuses every other setting: a file cannot be asked a
+        # size or a rate. A NaN position is refused: round() raised ValueError where cv2's
+        # set() never raises. POS_MSEC is refused: see the class
+        seeks = (cv2.CAP_PROP_POS_FRAMES, cv2.CAP_PROP_POS_AVI_RATIO)
+        if prop not in seeks or not self._count or math.isnan(value):
             return False
+        if prop == cv2.CAP_PROP_POS_AVI_RATIO:
+            value = min(max(value, 0.0), 1.0) * (self._count - 1)
+        # round() as OpenCV's cvRound: half to even (2.5 goes to frame 2 in both)
         self._next = round(min(max(value, 0), self._count - 1))
         return True
 
