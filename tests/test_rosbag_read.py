@@ -8,6 +8,7 @@ OpenCV's chessboard pairs), so every frame read back can be compared with its so
 from __future__ import annotations
 
 import dataclasses
+import io
 import json
 import math
 import warnings
@@ -578,6 +579,54 @@ def test_cli_capture_and_calibrate_from_bag(
     ]:  # fmt: skip
         code, out, err = run("calibrate", *argv, "--square", "1", "-o", str(tmp_path / "x.yaml"))
         assert code != 0 and msg in err and "Traceback" not in err, err
+
+
+class _Terminal(io.StringIO):
+    """A stderr that says it is a terminal (the calibrate CLI draws its bars on one only)."""
+
+    def isatty(self) -> bool:
+        return True
+
+
+@pytest.mark.parametrize("count_known", [True, False])
+def test_calibrating_from_a_bag_gives_the_frames_bar_its_total(
+    cones: Any, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, count_known: bool
+) -> None:
+    """`calibrate --from-bag`'s bar over the frames read had no total (tqdm's total None: a
+    count without an end) though the bag's index holds each topic's messages; its total is
+    now the fewer of the two topics' messages (6 left, 5 right: at most 5 pairs). A bag whose
+    index says no count (metadata.yaml's message_count 0) is still read, its bar without a
+    total as before."""
+    import re
+
+    from stereovision.calibrate import PROGRESS_FRAMES, _ProgressBars, calibrate_from_bag
+
+    frames = [
+        (T0 + k * PERIOD_NS, np.roll(cones.left, k, axis=1),
+         None if k == 3 else T0 + k * PERIOD_NS, np.roll(cones.right, k, axis=1))
+        for k in range(6)
+    ]  # fmt: skip
+    bag = write_bag(tmp_path / "rig", frames)
+    if not count_known:
+        meta = bag / "metadata.yaml"
+        meta.write_text(re.sub(r"message_count: \d+", "message_count: 0", meta.read_text()))
+    monkeypatch.setattr("sys.stderr", _Terminal())
+    bars = _ProgressBars()
+    seen: list[tuple[int, float | None]] = []
+
+    def progress(stage: str, done: int, total: int) -> None:
+        bars(stage, done, total)
+        if stage == PROGRESS_FRAMES:
+            seen.append((bars.bar.n, bars.bar.total))
+
+    # no board in the cones: every pair is read, then the calibration is refused
+    with pytest.raises(ValueError, match="no frame pair of the 5 read shows the chessboard"):
+        calibrate_from_bag(
+            bag, left_topic=LEFT, right_topic=RIGHT, pattern=(9, 6), square_size=1.0,
+            progress=progress,
+        )  # fmt: skip
+    bars.close()
+    assert seen == [(n, 5 if count_known else None) for n in range(1, 6)]
 
 
 def test_cli_source_errors(

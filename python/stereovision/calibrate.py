@@ -2039,9 +2039,11 @@ def _calibrate_from_camera(
 
 
 def _frames_announced(cam: Any) -> int:
-    """The frame pairs a recording announces (the fewer of its two videos'), 0 when unknown (a
-    camera, a bag: its bar counts without an end)."""
-    announced = getattr(cam, "_announced", None)  # StereoCamera's (CAP_PROP_FRAME_COUNT)
+    """The frame pairs a recording announces (the fewer of its two videos' frames, or of its
+    bag's two topics' messages), 0 when unknown (a camera: its bar counts without an end)."""
+    # StereoCamera's (CAP_PROP_FRAME_COUNT); BagCamera's (the bag's index): a bag's bar had
+    # no total though the index knows each topic's messages
+    announced = getattr(cam, "_announced", None)
     if announced is None:
         return 0
     counts = [announced(side) for side in ("left", "right")]

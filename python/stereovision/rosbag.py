@@ -1294,6 +1294,17 @@ class BagCamera(PairSource):
             self._sleep((nxt[0] - due) / 1e9)
         return nxt
 
+    def _announced(self, side: str) -> int | None:
+        """The messages the bag's index holds on ``side``'s topic, as
+        :class:`~stereovision.capture.StereoCamera`'s ``_announced`` gives a video's frame count
+        (a progress bar's total: each frame pairs at most once); None when the bag says none,
+        or it is closed."""
+        if self._reader is None:
+            return None
+        info = self._reader.topics.get(self.topics[side])
+        count = int(getattr(info, "msgcount", 0) or 0)
+        return count if count > 0 else None
+
     def describe(self) -> str:
         """One line: the bag, its two topics with their size and rate, the pairing tolerance."""
         tol = self.max_skew_ms
