@@ -1565,6 +1565,59 @@ def test_two_captures_into_one_folder_never_overwrite_a_pair(
     assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == []
 
 
+class _Terminal:
+    """A stderr that says it is a terminal, keeping what is written to it."""
+
+    def __init__(self) -> None:
+        self.text = ""
+
+    def write(self, s: str) -> int:
+        self.text += s
+        return len(s)
+
+    def flush(self) -> None:
+        pass
+
+    def isatty(self) -> bool:
+        return True
+
+
+def test_cli_capture_from_a_recording_shows_its_frames_bar_on_a_terminal(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`capture` from a recording read its frames without a word between two "saved" lines (a
+    board search through hundreds of pairs): on a terminal a bar now counts the frames read
+    of those the recording announces (6), gone before the last line; the "saved" lines are
+    on stdout as before, and off a terminal (a log) nothing is added."""
+    from stereovision.cli import main
+
+    frames = [_numbered(i) for i in range(6)]
+    left = _write_sequence(tmp_path / "seq", "left", frames)
+    right = _write_sequence(tmp_path / "seq", "right", frames)
+    args = ["capture", "--left", left, "--right", right, "--every", "2"]
+    terminal = _Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    assert main([*args, "-o", str(tmp_path / "a")]) == 0
+    assert "frames:   0%" in terminal.text and "| 0/6 [" in terminal.text
+    assert terminal.text.rsplit("\r", 2)[-2].strip() == ""  # cleared from the screen
+    saved = [f"saved left_{i:04d}.png right_{i:04d}.png" for i in (1, 2, 3)]
+    out = capsys.readouterr().out.splitlines()
+    assert [line.split(" (")[0] for line in out[1:4]] == saved
+    assert out[4].startswith("3 pairs saved in") and "6 pairs read" in out[4]
+    monkeypatch.undo()
+    assert main([*args, "-o", str(tmp_path / "b")]) == 0
+    logged = capsys.readouterr()
+    assert "frames" not in logged.err and "%" not in logged.err
+    assert [line.split(" (")[0] for line in logged.out.splitlines()[1:4]] == saved
+    # a recording holding more frames than it announces (a container's guess): past the
+    # count, the bar counts on without a total, not "6/3 200%"
+    monkeypatch.setattr(StereoCamera, "_announced", lambda self, side: 3)
+    monkeypatch.setattr("sys.stderr", terminal := _Terminal())
+    assert main([*args, "-o", str(tmp_path / "c")]) == 0
+    assert "| 0/3 [" in terminal.text and re.search(r"frames: [4-6]frame \[", terminal.text)
+    assert not re.search(r"[4-6]/3 ", terminal.text)
+
+
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 @pytest.mark.parametrize(
     ("sig", "status", "what"), [(2, 130, "interrupted"), (15, 143, "terminated (SIGTERM)")]

@@ -1972,6 +1972,7 @@ def _calibrate_from_camera(
         MIN_POSE_DISTANCE,
         ChessboardCollector,
         SourceError,
+        _frames_announced,
         read_within,
     )
 
@@ -2036,18 +2037,6 @@ def _calibrate_from_camera(
     )
     rep.pair_selection = selection
     return cal, rep
-
-
-def _frames_announced(cam: Any) -> int:
-    """The frame pairs a recording announces (the fewer of its two videos' frames, or of its
-    bag's two topics' messages), 0 when unknown (a camera: its bar counts without an end)."""
-    # StereoCamera's (CAP_PROP_FRAME_COUNT); BagCamera's (the bag's index): a bag's bar had
-    # no total though the index knows each topic's messages
-    announced = getattr(cam, "_announced", None)
-    if announced is None:
-        return 0
-    counts = [announced(side) for side in ("left", "right")]
-    return min(counts) if None not in counts else 0
 
 
 # ---------------------------------------------------------------------------------- pictures

@@ -2424,6 +2424,19 @@ class CaptureResult:
     removed_temps: list[str] = field(default_factory=list)
 
 
+def _frames_announced(cam: Any) -> int:
+    """The frame pairs a recording announces (the fewer of its two videos' frames, or of its
+    bag's two topics' messages), 0 when unknown (a camera: a bar of its frames has no end):
+    the total of the frames bar of ``capture`` and ``calibrate`` from a recording."""
+    # StereoCamera's (CAP_PROP_FRAME_COUNT); BagCamera's (the bag's index): a bag's bar had
+    # no total though the index knows each topic's messages
+    announced = getattr(cam, "_announced", None)
+    if announced is None:
+        return 0
+    counts = [announced(side) for side in ("left", "right")]
+    return min(counts) if None not in counts else 0
+
+
 def capture(
     camera: StereoCamera,
     directory: PathLike,
@@ -2437,6 +2450,7 @@ def capture(
     log: Callable[[str], None] | None = None,
     temporal: int | None = None,
     read_timeout: float | None = DEFAULT_READ_TIMEOUT,
+    progress: Callable[[int], None] | None = None,
 ) -> CaptureResult:
     """Save pairs from ``camera`` into ``directory`` until ``count`` are saved.
 
@@ -2475,6 +2489,9 @@ def capture(
         Seconds a pair's read may take (:data:`DEFAULT_READ_TIMEOUT`, 10; None: no limit): a
         camera whose read does not return by then (a hung USB camera) raises a
         :class:`SourceError` naming it, the pairs saved so far kept (:func:`read_within`).
+    progress : callable, optional
+        Called with the number of pairs read so far after each pair read (a progress bar's
+        tick: ``stereovision capture`` draws one for a recording on a terminal).
 
     Returns
     -------
@@ -2533,6 +2550,7 @@ def capture(
     saved: list[tuple[Path, Path]] = []
     ended = "count reached"
     last_index = -1  # the frame index of the pair saved last
+    read = 0  # pairs read by this capture
 
     def kept_note() -> str:
         if count is not None:
@@ -2557,6 +2575,9 @@ def capture(
             if not saved:
                 raise
             raise ValueError(f"{exc}; {kept_note()}") from exc
+        read += 1
+        if progress is not None:
+            progress(read)
         averaged = None
         if tf is not None:
             if tf.frames == 0:
@@ -2721,6 +2742,41 @@ def _end_reason(exc: SourceError, saved: list[tuple[Path, Path]], last_index: in
 # -------------------------------------------------------------------------------------- CLI
 
 
+class _FramesBar:
+    """``stereovision capture``'s bar over a recording's frames on a terminal: a board search
+    through a recording (``--chessboard``, ``--from-bag``) read hundreds of pairs between two
+    "saved" lines without a word, where the recording says its frames (``total``). Nothing for
+    a camera (no total: its "saved" lines are its progress) nor off a terminal (a log); the
+    lines said go above the bar."""
+
+    def __init__(self) -> None:
+        self.bar: Any = None
+
+    def start(self, total: int) -> None:
+        """Draw the bar of ``total`` frames, on a terminal only (none for a total of 0)."""
+        if total > 0 and sys.stderr.isatty():
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, desc="frames", unit="frame", file=sys.stderr, leave=False)
+
+    def update(self, read: int) -> None:
+        if self.bar is not None:
+            # past the total (CAP_PROP_FRAME_COUNT is a container's guess) tqdm counts on
+            # without one
+            self.bar.update(read - self.bar.n)
+
+    def write(self, line: str) -> None:
+        if self.bar is None:
+            print(line)
+        else:
+            self.bar.write(line, file=sys.stdout)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+
+
 def cmd_capture(args: argparse.Namespace) -> int:
     """``stereovision capture --left 0 --right 1 --size 1280x720 -o pairs/``."""
     pattern = parse_pattern(args.chessboard, "--chessboard") if args.chessboard else None
@@ -2757,14 +2813,16 @@ def cmd_capture(args: argparse.Namespace) -> int:
         _refuse_own_output({"left": args.left, "right": args.right}, args.output, ".png", "-o")
     cam = open_source(args, fps=args.fps)
     saved = [0]  # the pairs this run saved, as capture says them (not another capture's)
+    bar = _FramesBar()
 
     def log(line: str) -> None:
         if line.startswith("saved "):
             saved[0] += 1
-        print(line)
+        bar.write(line)
 
     try:
         print(cam.describe())
+        bar.start(_frames_announced(cam))  # below the source's line
         result = capture(
             cam,
             args.output,
@@ -2775,12 +2833,14 @@ def cmd_capture(args: argparse.Namespace) -> int:
             log=log,
             temporal=args.temporal,
             read_timeout=cli_read_timeout(args),
+            progress=bar.update,
         )
     except KeyboardInterrupt as exc:
         # what was kept, as `batch` says it (it was "stereovision: interrupted" alone)
         from stereovision._interrupt import Terminated
         from stereovision.cli import EXIT_INTERRUPTED, EXIT_TERMINATED
 
+        bar.close()  # off the screen before the interrupt's words
         what = "terminated (SIGTERM)" if isinstance(exc, Terminated) else "interrupted"
         n = saved[0]  # the pair being saved is saved whole, and said
         print(
@@ -2791,6 +2851,7 @@ def cmd_capture(args: argparse.Namespace) -> int:
         )
         return EXIT_TERMINATED if isinstance(exc, Terminated) else EXIT_INTERRUPTED
     finally:
+        bar.close()  # off the screen before the last words (or the error)
         cam.close()
     sk = result.skew
     print(
