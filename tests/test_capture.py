@@ -3348,6 +3348,21 @@ def test_the_image_sequence_reader_answers_ratio_count_and_size_as_opencvs(
     assert single.read()[0] and single.get(cv2.CAP_PROP_POS_AVI_RATIO) == 1.0  # inf
 
 
+def test_the_image_sequence_reader_opens_without_opencvs_missing_file_warning(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str]
+) -> None:
+    """_ImageSequence counted its frames with cv2.haveImageReader (f6c5c37), which on the
+    missing file ending the run logs OpenCV's "can't open/read file" warning: a line on
+    stderr at every open of a sequence from 5 on. The count asks the file's presence first:
+    the open says nothing, the count is the same."""
+    for i in range(7, 10):
+        cv2.imwrite(str(tmp_path / f"s_{i:03d}.png"), _numbered(i))
+    capfd.readouterr()
+    seq = capmod._ImageSequence(str(tmp_path / "s_%03d.png"), 7)
+    assert seq.get(cv2.CAP_PROP_FRAME_COUNT) == 3.0
+    assert "s_010.png" not in capfd.readouterr().err
+
+
 def test_a_space_padded_sequence_opens_from_its_first_number_however_late(
     tmp_path: Path,
 ) -> None:

@@ -959,8 +959,12 @@ class _ImageSequence:
         self._frame: np.ndarray | None = None
         self._count = 0
         # as CAP_IMAGES counts: a file present that no codec reads (a stray text file in the
-        # numbering) was counted, so the count promised frames the reading never gave
-        while cv2.haveImageReader(_sequence_name(path, first + self._count)):
+        # numbering) was counted, so the count promised frames the reading never gave. The
+        # file's presence first: haveImageReader of a missing one logs OpenCV's "can't
+        # open/read file" warning, on stderr at every open
+        while os.path.exists(name := _sequence_name(path, first + self._count)) and (
+            cv2.haveImageReader(name)
+        ):
             self._count += 1
         probe = cv2.imread(_sequence_name(path, first), cv2.IMREAD_UNCHANGED)
         self._size = (0, 0) if probe is None else (probe.shape[1], probe.shape[0])
