@@ -3025,7 +3025,7 @@ def test_cameras_that_cannot_be_paired_leave_the_open_ones_in_use(tmp_path):
     _open_cameras(app)
     assert app.state.error.startswith("right source") and "400x300" in app.state.error
     # video files in use: not said to be "the cameras"
-    assert app.state.error.endswith("(the source in use is unchanged)")
+    assert app.state.error.endswith("(the source in use, l.avi and r.avi, is unchanged)")
     app.state.error = ""
     _capture(app)  # from the cameras still open
     assert app.state.error == "" and app.state.captures == 1
@@ -3332,7 +3332,9 @@ def test_a_late_camera_open_does_not_replace_a_newer_choice_nor_hide_its_error(m
         app.state.cam_left, app.state.cam_right = "4", "5"
         app.open_cameras()
         await opens[2]
-        assert app.state.error == "backend failed" and app.state.status == "error"
+        assert app.state.status == "error" and app.state.error == (
+            "backend failed (the cameras in use, camera 2 and camera 3, are unchanged)"
+        )
         assert app.source._camera is made[2] and not app._opening
 
     asyncio.run(clicks())
@@ -3588,7 +3590,10 @@ def test_a_read_that_fails_during_a_computation_is_said_after_it(monkeypatch):
         await _until(lambda: len(reads) == 3)
         read_gate.set()
         await tasks[-1]
-        said = "camera 0 delivered no frame in 2 s (the cameras in use are unchanged)"
+        said = (
+            "camera 0 delivered no frame in 2 s "
+            "(the cameras in use, camera 0 and camera 1, are unchanged)"
+        )
         assert (app.state.status, app.state.error) == ("computing (fast)", said)
         compute_gate.set()
         await computing
@@ -3601,10 +3606,11 @@ def test_a_read_that_fails_during_a_computation_is_said_after_it(monkeypatch):
         app.state.cam_left, app.state.cam_right = "7", "8"
         app.open_cameras()
         await tasks[-1]
-        assert (app.state.status, app.state.error) == ("computing (fast)", "camera 7 did not open")
+        said = "camera 7 did not open (the cameras in use, camera 0 and camera 1, are unchanged)"
+        assert (app.state.status, app.state.error) == ("computing (fast)", said)
         compute_gate.set()
         await computing
-        assert (app.state.status, app.state.error) == ("error", "camera 7 did not open")
+        assert (app.state.status, app.state.error) == ("error", said)
 
     asyncio.run(clicks())
 
@@ -3705,7 +3711,7 @@ def test_an_opened_pair_refused_during_a_computation_is_said_after_it(monkeypatc
         _refuse_pairs(app)
         app.state.cam_left, app.state.cam_right = "2", "3"
 
-    said = f"{_REFUSED} (the cameras in use are unchanged)"
+    said = f"{_REFUSED} (the cameras in use, camera 0 and camera 1, are unchanged)"
     asyncio.run(during(app.open_cameras, said, first))
 
 
@@ -3719,7 +3725,7 @@ def test_an_open_given_up_during_a_computation_is_said_after_it(monkeypatch):
     said = (
         "camera 5 and camera 6 did not open within 0.3 s (the open did not return: a wedged "
         "camera or driver, or a stalled stream); unplug and replug it, or give gui a longer "
-        "--read-timeout"
+        "--read-timeout (the cameras in use, camera 0 and camera 1, are unchanged)"
     )
 
     def first() -> None:
@@ -4061,7 +4067,9 @@ def test_a_capture_is_not_dropped_for_an_open_that_failed_meanwhile(monkeypatch)
         app.state.cam_left, app.state.cam_right = "5", "6"
         app.open_cameras()
         await tasks[2]
-        assert app.state.error == "cannot open camera 5 (left)" and app.source is source
+        assert app.source is source and app.state.error == (
+            "cannot open camera 5 (left) (the cameras in use, camera 0 and camera 1, are unchanged)"
+        )
         gate.set()
         await tasks[1]
         assert app.pair is not shown and app.state.captures == 2
@@ -4193,7 +4201,9 @@ def test_a_read_that_raises_oddly_is_said_and_frees_the_cameras(monkeypatch, rai
         fail["open"] = True
         app.open_cameras()
         await asyncio.wait_for(tasks[3], 1.5)
-        assert app.state.error == said.replace("read", "open") and app._opening == set()
+        in_use = "(the cameras in use, camera 0 and camera 1, are unchanged)"
+        assert app.state.error == f"{said.replace('read', 'open')} {in_use}"
+        assert app._opening == set()
 
     asyncio.run(clicks())
 
@@ -5432,7 +5442,9 @@ def test_other_cameras_drop_the_homographies_a_failed_switch_keeps_them():
     app._spawn = lambda coro: coro.close()
     rect = app.homographies = Homographies()
     app._switch_source(Cameras(None), ("2", "3"))
-    assert app.state.error == "camera 3 gave no frame (the cameras in use are unchanged)"
+    assert app.state.error == (
+        "camera 3 gave no frame (the cameras in use, camera 0 and camera 1, are unchanged)"
+    )
     assert app.homographies is rect
     app._switch_source(Cameras(raw), ("2", "3"))
     assert app.state.error == "" and app.homographies is None
@@ -5474,11 +5486,11 @@ def test_a_failed_open_names_the_source_it_leaves_in_use(tmp_path, monkeypatch):
     cv2.imwrite(str(seq / "right_0001.png"), raw[1])
     said = "camera 3 gave no frame"
     cameras = refused(source=Cameras(raw), source_names=("0", "1"))
-    assert cameras == f"{said} (the cameras in use are unchanged)"
+    assert cameras == f"{said} (the cameras in use, camera 0 and camera 1, are unchanged)"
     videos = refused(source=Cameras(raw), source_names=("left.mp4", "right.mp4"))
-    assert videos == f"{said} (the source in use is unchanged)"
+    assert videos == f"{said} (the source in use, left.mp4 and right.mp4, is unchanged)"
     bag = refused(source=Cameras(raw), source_names=("", ""), source_label="bag rig.bag: /l / /r")
-    assert bag == f"{said} (the source in use is unchanged)"
+    assert bag == f"{said} (the source in use, bag rig.bag: /l / /r, is unchanged)"
     assert refused() == said  # nothing in use: nothing said of it
     # a folder being played; then an Open whose first read fails (_first_pair)
     app = _scene_app("test-failed-open-folder", [bundled_data_dir(), tmp_path / "scenes"])
@@ -5495,6 +5507,63 @@ def test_a_failed_open_names_the_source_it_leaves_in_use(tmp_path, monkeypatch):
     _open_cameras(app)
     assert app.state.error == f"{said} (the folder scenes/seq in use is unchanged)"
     assert app.source is playing
+
+
+def test_an_open_that_cannot_open_names_the_source_that_stays_in_use(tmp_path, monkeypatch):
+    """An Open whose cameras did not open (the open raised, or was given up, or a typed file
+    was missing) said only what failed ("cannot open camera 5 (left)"): nothing told that the
+    source on show kept running, as a failed first read tells it. Each now says what failed,
+    then the source that stays in use, named; with nothing in use, only what failed."""
+    import threading
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    raw = (cv2.imread(str(CONES / "left.png")), cv2.imread(str(CONES / "right.png")))
+    wedged = threading.Event()
+
+    class Cameras:
+        def __init__(self, left, right, *, image_size=None, fourcc=None, open_timeout=None):
+            if left == 7:
+                wedged.wait(2.0)  # an open that does not return in time (bounded)
+            if left in (5, 7):
+                raise OSError(f"cannot open camera {left} (left)")
+
+        def read(self):
+            return raw
+
+        def close(self):
+            pass
+
+    monkeypatch.setattr(capture, "StereoCamera", Cameras)
+
+    def failed(left: str, **kw: Any) -> str:
+        app = _scene_app(
+            "test-open-fails-names", [bundled_data_dir(), tmp_path], read_timeout=0.2, **kw
+        )
+        kept = app.source
+        app.state.cam_left, app.state.cam_right = left, "6"
+        _open_cameras(app)
+        assert app.source is kw.get("source") is kept and app.state.status == "error"
+        return str(app.state.error)
+
+    cams = {"source": Cameras(0, 1), "source_names": ("0", "1")}
+    in_use = "(the cameras in use, camera 0 and camera 1, are unchanged)"
+    assert failed("5", **cams) == f"cannot open camera 5 (left) {in_use}"
+    assert failed("5") == "cannot open camera 5 (left)"  # nothing in use: nothing said of it
+    videos = {"source": Cameras(0, 1), "source_names": ("l.avi", "r.avi")}
+    assert failed("5", **videos) == (
+        "cannot open camera 5 (left) (the source in use, l.avi and r.avi, is unchanged)"
+    )
+    assert failed("none.avi", **cams) == f"no such file: none.avi {in_use}"
+    try:
+        assert failed("7", **cams) == (
+            "camera 7 and camera 6 did not open within 0.2 s (the open did not return: a "
+            "wedged camera or driver, or a stalled stream); unplug and replug it, or give gui "
+            f"a longer --read-timeout {in_use}"
+        )
+    finally:
+        wedged.set()
 
 
 def test_a_failed_open_calls_cameras_typed_by_their_device_node_cameras(tmp_path):
@@ -5525,13 +5594,18 @@ def test_a_failed_open_calls_cameras_typed_by_their_device_node_cameras(tmp_path
         app._switch_source(Cameras(None), ("2", "3"))
         return str(app.state.error)
 
-    cameras = "camera 3 gave no frame (the cameras in use are unchanged)"
+    said = "camera 3 gave no frame"
+    cameras = f"{said} (the cameras in use, video0 and video1, are unchanged)"
     assert refused(("/dev/video0", "/dev/video1")) == cameras
+    cameras = f"{said} (the cameras in use, camera 0 and video1, are unchanged)"
     assert refused(("0", "/dev/video1")) == cameras
-    # a file, a stream or a path that only looks like a node is no camera
-    source = "camera 3 gave no frame (the source in use is unchanged)"
+    # a file, a stream or a path that only looks like a node is no camera; a stream is named
+    # by its whole URL (its last part, "0", read as a camera's number)
+    source = f"{said} (the source in use, video0 and right.mp4, is unchanged)"
     assert refused(("/dev/video0", "right.mp4")) == source
+    source = f"{said} (the source in use, rtsp://rig/0 and rtsp://rig/1, is unchanged)"
     assert refused(("rtsp://rig/0", "rtsp://rig/1")) == source
+    source = f"{said} (the source in use, video0x and video1, is unchanged)"
     assert refused(("/dev/video0x", "/dev/video1")) == source
 
 

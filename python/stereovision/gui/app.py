@@ -1182,8 +1182,11 @@ def _pending_key(src: int | str) -> int | str:
 
 
 def _source_name(src: int | str) -> str:
-    """A camera source as the page names it: ``camera 0``, or the file's name."""
-    return f"camera {src}" if isinstance(src, int) else Path(src).name or src
+    """A camera source as the page names it: ``camera 0``, the file's name, or a stream's
+    whole URL (``rtsp://rig/0`` was named ``0``, as camera 0 might be)."""
+    if isinstance(src, int):
+        return f"camera {src}"
+    return src if "://" in src else Path(src).name or src
 
 
 @dataclass
@@ -1949,21 +1952,34 @@ class StereoApp:
         return " and ".join(dict.fromkeys(_source_name(t) for t in typed))
 
     def _in_use_unchanged(self) -> str:
-        """What a failed Open or Play leaves in use, as the page says it: ``the cameras in use
-        are unchanged``, ``the folder data/seq in use is unchanged``, or (video files, a bag)
-        ``the source in use is unchanged`` ("the cameras" was said of a folder's pairs too).
+        """What a failed Open or Play leaves in use, as the page says it, named as its
+        "reading ..." names it (:meth:`_source_what`): ``the cameras in use, camera 0 and
+        camera 1, are unchanged``, ``the folder data/seq in use is unchanged``, or (video
+        files, a bag) ``the source in use, l.avi and r.avi, is unchanged`` ("the cameras" was
+        said of a folder's pairs too; the cameras and files were not named).
         A camera typed by its device node (``/dev/video0``, a ``/dev/v4l/by-id`` link) is a
         camera, as the capture code knows it: it was said to be "the source"."""
         source = self.source
         if isinstance(source, FolderPairs):
             return f"the folder {source.name} in use is unchanged"
+        named = self._source_what(source) if source is not None else ""
+        named = f", {named}," if named else ""  # a source given no name: none said
         if self._source_label is None:
             try:
                 if all(_camera_device(parse_source(n)) for n in self._source_names):
-                    return "the cameras in use are unchanged"
+                    return f"the cameras in use{named} are unchanged"
             except ValueError:  # a name no camera has: not said to be cameras
                 pass
-        return "the source in use is unchanged"
+        return f"the source in use{named} is unchanged"
+
+    def _fail_open(self, exc: BaseException, outlasts: bool = True) -> None:
+        """Say an Open that failed (refused, given up, or the open raised): with the source
+        still in use named (:meth:`_in_use_unchanged`), as a failed first read says it. An
+        open that raised said only its error ("cannot open camera 5 (left)"): nothing told
+        that the cameras on show kept running."""
+        if self.source is not None:
+            exc = OSError(f"{first_line(exc)} ({self._in_use_unchanged()})")
+        self._fail(exc, outlasts=outlasts)
 
     def _begin_read(self, source: StereoSource, what: str) -> None:
         """A read of ``source`` is under way from now (before its task runs: a click that
@@ -2077,7 +2093,7 @@ class StereoApp:
                     "returned): wait for it, or unplug and replug the camera"
                 )
         except (ValueError, OSError, RuntimeError) as exc:
-            self._fail(exc)
+            self._fail_open(exc, outlasts=False)
             return
         names = (str(self.state.cam_left), str(self.state.cam_right))
         self._choice += 1
@@ -2153,13 +2169,12 @@ class StereoApp:
         except asyncio.TimeoutError:
             if choice != self._choice:  # another source was chosen meanwhile: it is on show
                 return
-            self._fail(
+            self._fail_open(
                 OSError(
                     f"{what} did not open within {self.read_timeout:g} s (the open did not "
                     "return: a wedged camera or driver, or a stalled stream); unplug and replug "
                     "it, or give gui a longer --read-timeout"
-                ),
-                outlasts=True,
+                )
             )
             return
         except Exception as exc:  # any open error is said on the page (cv2.error too)
@@ -2169,7 +2184,7 @@ class StereoApp:
                 return
             if not isinstance(exc, (ValueError, OSError, RuntimeError)):
                 log.exception("gui: opening %s failed", what)
-            self._fail(exc, outlasts=True)
+            self._fail_open(exc)
             return
         try:
             if choice != self._choice:  # a newer Open or folder is on show: nobody takes these
