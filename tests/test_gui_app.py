@@ -2132,6 +2132,64 @@ def test_saves_into_the_offered_folder_go_to_a_new_numbered_folder_each(tmp_path
     assert app.state.save_label.startswith(f"saved 450×375 to {tmp_path.name}/typed: ")
 
 
+@pytest.mark.parametrize("how", ["unlistable", "unwritable", "a file"])
+def test_the_offered_save_folder_skips_a_saved_that_cannot_be_used(tmp_path, monkeypatch, how):
+    """A ``saved`` in a writable --data folder that could not be listed failed every Save as
+    offered with the bare "[Errno 13] Permission denied: '.../saved'"; an empty one that could
+    not be written sent the Saves home, said as "the --data folder cannot be written". Either
+    is now skipped as a full one is (a file named ``saved`` already was): the Save goes to
+    ``saved-2``, its line saying why ``saved`` was left alone; nothing is written into it.
+    (Permissions are faked: root lists and writes every folder.)"""
+    import stereovision.io as svio
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import SAVE_HINT, SAVED_DEPTH_FILES, SAVED_FILES
+
+    data, home = tmp_path / "mine", tmp_path / "home"
+    data.mkdir()
+    home.mkdir()
+    monkeypatch.setenv("HOME", str(home))
+    bad = data / "saved"
+    if how == "a file":
+        bad.write_text("not a folder")
+    else:
+        bad.mkdir()
+    real_iterdir, real_cannot = Path.iterdir, svio.cannot_write_in
+
+    def iterdir(self: Path) -> Any:
+        if how == "unlistable" and self.resolve() == bad.resolve():
+            raise PermissionError(13, "Permission denied", str(self))
+        return real_iterdir(self)
+
+    def cannot_write_in(folder: Any) -> str | None:
+        if how == "unwritable" and Path(folder).resolve() == bad.resolve():
+            return "Permission denied"
+        return real_cannot(folder)
+
+    monkeypatch.setattr(Path, "iterdir", iterdir)
+    monkeypatch.setattr(svio, "cannot_write_in", cannot_write_in)
+    app = _scene_app(f"test-save-unusable-{how.replace(' ', '-')}", [bundled_data_dir(), data])
+    assert app.state.save_hint == SAVE_HINT  # Saves do not go home
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    _run(app, app.save)
+    assert app.state.error == ""
+    assert app.state.save_label.startswith("saved 450×375 to mine/saved-2: ")
+    why = {
+        "unlistable": " (saved cannot be listed: Permission denied: left alone)",
+        "unwritable": " (saved cannot be written: Permission denied: left alone)",
+        "a file": "",
+    }[how]
+    assert app.state.save_label.endswith(f".png{why}")
+    assert sorted(p.name for p in (data / "saved-2").iterdir()) == sorted(
+        SAVED_FILES + SAVED_DEPTH_FILES
+    )
+    if how == "a file":
+        assert bad.read_text() == "not a folder"
+    else:
+        assert list(real_iterdir(bad)) == []
+    assert list(home.glob("stereovision-saved*")) == []  # nothing went home
+
+
 def test_the_offered_save_folder_skips_a_link_named_saved(tmp_path):
     """A ``saved`` in --data that was a symbolic link leading outside it made every Save as
     offered fail with "folder outside the --data folders: saved", a folder the user never

@@ -2704,7 +2704,8 @@ class StereoApp:
 
         The folder as offered (or an empty field) is a new one each time: the first of
         ``saved``, ``saved-2``, ``saved-3``, ... that does not exist or is empty, so several
-        pairs can be saved one after the other; the page says which. When that folder cannot
+        pairs can be saved one after the other; the page says which (and why it skipped one
+        that cannot be listed or written: :meth:`_next_save_folder`). When that folder cannot
         be made or written (a read-only data set as ``--data``), the Save goes to the next new
         ``~/stereovision-saved`` (``-2``, ...), its line saying where and why. A folder the user
         typed that already holds one of those files is refused, naming them: nothing the user
@@ -2725,11 +2726,12 @@ class StereoApp:
         title, unit = overview_name(shown), self._unit
         typed = str(self.state.save_dir or "").strip()
         skipped: list[str] = []
+        unusable: list[str] = []  # saved-N folders that cannot be listed or written
         folder: Path | None = None
         elsewhere = ""  # why a Save as offered went to the home folder
         try:
             if self._save_roots and typed in ("", self._offered_save_dir):
-                folder, why = self._offered_save_folder(skipped)
+                folder, why = self._offered_save_folder(skipped, unusable)
                 if why:  # a read-only --data folder: the home folder's, said in the Save's line
                     elsewhere = f"{display_path(folder)} cannot be written: {why}"
                     folder = self._fallback_save_folder(folder, why)
@@ -2801,6 +2803,8 @@ class StereoApp:
         if skipped:
             links = ", ".join(skipped)
             without += f" ({links}: a symbolic link, not a folder of --data: left alone)"
+        if unusable:
+            without += f" ({'; '.join(unusable)}: left alone)"
         with self.state:
             self.state.save_label = f"saved {w}×{h} to {label}: {', '.join(written)}{without}"
             # the lists offer what was just written: its cloud.ply to Show in the 3-D view
@@ -2847,15 +2851,28 @@ class StereoApp:
             return render_view(geometry, intrinsics=intr.scaled(scale), camera=camera)
         return render_view(geometry, self._controls(), intrinsics=intr.scaled(scale))
 
-    def _next_save_folder(self, skipped: list[str] | None = None, home: Path | None = None) -> Path:
+    def _next_save_folder(
+        self,
+        skipped: list[str] | None = None,
+        home: Path | None = None,
+        unusable: list[str] | None = None,
+    ) -> Path:
         """The first of ``saved``, ``saved-2``, ``saved-3``, ... in the first ``--data``
-        folder that does not exist or is an empty folder, and no Save is writing into; with
-        ``home``, the first such of ``stereovision-saved``, ``stereovision-saved-2``, ... in it.
+        folder that does not exist or is an empty folder a file can be made in, and no Save is
+        writing into; with ``home``, the first such of ``stereovision-saved``,
+        ``stereovision-saved-2``, ... in it.
 
         A name that is a symbolic link is skipped (its name appended to ``skipped``): it may
         lead outside ``--data`` (the Save was refused as "outside the --data folders", naming
         a folder the user never typed) or into a folder the user made for something else.
+        A folder that cannot be listed or written in is skipped as a full one is (why, with
+        its name, appended to ``unusable``): one that could not be listed failed every Save
+        as offered with the system's bare "[Errno 13] Permission denied: '.../saved'", and
+        an empty one that could not be written sent the Saves home, said as "the --data
+        folder cannot be written" of a folder that could.
         """
+        from stereovision.io import cannot_write_in
+
         base = SAVE_FOLDER if home is None else FALLBACK_SAVE_FOLDER
         for n in itertools.count(1):
             name = base if n == 1 else f"{base}-{n}"
@@ -2869,11 +2886,26 @@ class StereoApp:
                 folder = (home / name).resolve()
             if folder in self._saving_into:
                 continue
-            if not os.path.lexists(folder) or (folder.is_dir() and not any(folder.iterdir())):
+            if not os.path.lexists(folder):
                 return folder
+            if not folder.is_dir():  # a file named so
+                continue
+            try:
+                if any(folder.iterdir()):  # full
+                    continue
+                why = cannot_write_in(folder)
+                why = why and f"cannot be written: {why}"
+            except OSError as exc:  # it may hold files: not written into
+                why = f"cannot be listed: {exc.strerror or exc}"
+            if not why:
+                return folder
+            if unusable is not None:
+                unusable.append(f"{name} {why}")
         raise AssertionError("unreachable")  # pragma: no cover
 
-    def _offered_save_folder(self, skipped: list[str] | None = None) -> tuple[Path, str | None]:
+    def _offered_save_folder(
+        self, skipped: list[str] | None = None, unusable: list[str] | None = None
+    ) -> tuple[Path, str | None]:
         """The folder in the first ``--data`` folder a Save as offered takes next
         (:meth:`_next_save_folder`) and why it cannot be made or written (None if it can: else
         the Save goes home, :meth:`_fallback_save_folder`). The one rule of :meth:`save`, the
@@ -2885,7 +2917,7 @@ class StereoApp:
         ValueError, OSError
             As :meth:`_next_save_folder` raises them.
         """
-        folder = self._next_save_folder(skipped)
+        folder = self._next_save_folder(skipped, unusable=unusable)
         return folder, _cannot_make(folder)
 
     def _offered_save_folder_refused(self) -> bool:
