@@ -5187,6 +5187,39 @@ def test_an_image_sequence_typed_as_a_camera_is_opened_by_its_folder(tmp_path):
     app.source.close()
 
 
+@pytest.mark.parametrize("opener", ["capture", "fallback"])
+def test_a_sequence_starting_at_5_typed_as_a_camera_opens(tmp_path, monkeypatch, opener):
+    """An image sequence whose first number is 5 or more opens with ``stereovision capture``
+    and ``stream``; the page's fallback (VideoPair, when ``StereoCamera`` cannot be imported)
+    said "cannot open camera" of it (cv2.VideoCapture alone looks at numbers 0-4). The page
+    opens it either way, its pairs in order and again after the last."""
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+
+    if opener == "fallback":  # `from stereovision.capture import StereoCamera` fails
+        monkeypatch.delattr(capture, "StereoCamera")
+    left, right = (cv2.imread(str(CONES / f"{s}.png")) for s in ("left", "right"))
+    (tmp_path / "seq").mkdir()
+    for k in (7, 8):
+        cv2.imwrite(str(tmp_path / "seq" / f"left{k:02d}.png"), left // (k - 5))
+        cv2.imwrite(str(tmp_path / "seq" / f"right{k:02d}.png"), right // (k - 5))
+    app = _scene_app(f"test-camera-sequence-at-7-{opener}", [bundled_data_dir(), tmp_path])
+    app.state.cam_left = str(tmp_path / "seq" / "left%02d.png")
+    app.state.cam_right = str(tmp_path / "seq" / "right%02d.png")
+    _open_cameras(app)
+    assert app.state.error == ""
+    assert app.state.source_label == "cameras left%02d.png / right%02d.png"
+    try:
+        for k in (7, 8, 7):
+            if k != 7 or app.state.captures > 1:
+                _capture(app)
+            assert app.state.error == ""
+            np.testing.assert_array_equal(app.raw_pair[0], left // (k - 5))
+            np.testing.assert_array_equal(app.raw_pair[1], right // (k - 5))
+    finally:
+        app.source.close()
+
+
 def test_a_negative_camera_index_typed_on_the_page_is_refused_as_capture_refuses_it(tmp_path):
     """ "-1" in a camera field was looked for as a file ("no such file: -1"); it is the index
     capture refuses (OpenCV's -1 crashes where no camera is present), said in its words."""

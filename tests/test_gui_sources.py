@@ -465,6 +465,41 @@ def test_video_pair_plays_an_image_sequence_again_after_the_last(tmp_path: Path)
     assert got == [50, 150, 50]
 
 
+@pytest.mark.parametrize(
+    ("folder", "fmt", "first"),
+    [("seq", "%03d", 5), ("seq", "%010d", 0), ("run 100%", "%03d", 0)],
+    ids=["starts-at-5", "10-wide", "percent-folder"],
+)
+def test_video_pair_opens_the_sequences_capture_opens(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str], folder: str, fmt: str, first: int
+) -> None:
+    """VideoPair opened an image sequence with cv2.VideoCapture alone: one whose first
+    number is 5 or more (FFmpeg's image2 looks at 0-4), one 10 digits wide or in a folder
+    whose name holds a ``%`` did not open ("cannot open camera"), while ``stereovision
+    capture`` and ``stream`` open them (:class:`stereovision.capture._ImageSequence`). It
+    opens them as they do, plays them again after the last pair, and OpenCV's warning of the
+    file after the last is not printed."""
+    seq = tmp_path / folder
+    seq.mkdir()
+    for k in range(first, first + 3):
+        cv2.imwrite(str(seq / f"l_{fmt % k}.png"), np.full((6, 8), 10 + k, np.uint8))
+        cv2.imwrite(str(seq / f"r_{fmt % k}.png"), np.full((6, 8), 100 + k, np.uint8))
+    capfd.readouterr()
+    left, right = str(seq / f"l_{fmt}.png"), str(seq / f"r_{fmt}.png")
+    pair = VideoPair(left, right)
+    try:
+        got = [tuple(int(x[0, 0, 0]) for x in pair.read()) for _ in range(5)]
+    finally:
+        pair.close()
+    assert got == [(10 + first + k, 100 + first + k) for k in (0, 1, 2, 0, 1)]
+    source = sources.open_stereo_source(left, right)  # what the page opens, as capture does
+    try:
+        assert [tuple(int(x[0, 0, 0]) for x in source.read()) for _ in range(5)] == got
+    finally:
+        source.close()
+    assert "WARN" not in capfd.readouterr().err
+
+
 # ----------------------------------------------------------------------------- _CaptureAdapter
 
 

@@ -9,6 +9,7 @@ Two safety rules of the GUI live here:
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Callable, Iterable, Sequence
 from functools import partial
@@ -21,12 +22,15 @@ import numpy.typing as npt
 
 from stereovision.capture import (
     DEFAULT_READ_TIMEOUT,
+    _open_path,
     _open_within,
+    _sequence_first,
     camera_hint,
     check_read_timeout,
     read_within,
 )
 from stereovision.capture import parse_source as capture_parse_source
+from stereovision.io import _opencv_quiet
 
 __all__ = [
     "CLOUD_SUFFIXES",
@@ -333,6 +337,18 @@ def _ask_size(size: tuple[int, int], cap: Any, doing: Callable[[str], None]) -> 
         cap.set(cv2.CAP_PROP_FRAME_HEIGHT, size[1])
 
 
+def _open_capture(src: int | str, first: tuple[int, str] | None) -> Any:
+    """A device, a video file or an image-sequence pattern (``first``: its first file,
+    :func:`~stereovision.capture._sequence_first`) opened as ``stereovision capture`` and
+    ``stream`` open them (:func:`stereovision.capture._open_path`): a sequence whose first
+    number is 5 or more, or that OpenCV's image reader refuses, is read by
+    :class:`~stereovision.capture._ImageSequence`. ``cv2.VideoCapture`` alone did not open
+    such a sequence (FFmpeg's image2 looks at numbers 0-4 for its first file)."""
+    if isinstance(src, str):
+        return _open_path(src, first)
+    return cv2.VideoCapture(src)
+
+
 class VideoPair:
     """Two :class:`cv2.VideoCapture` sources read together (fallback when ``stereovision.capture``
     is not available).
@@ -344,7 +360,8 @@ class VideoPair:
     Parameters
     ----------
     left, right : int or str
-        Device index, video file, or image-sequence pattern (``"img_%03d.png"``).
+        Device index, video file, or image-sequence pattern (``"img_%03d.png"``), opened as
+        ``stereovision capture`` opens it (a sequence may start at any number).
     size : (int, int), optional
         Requested ``(width, height)`` for devices.
     open_timeout : float or None
@@ -370,6 +387,8 @@ class VideoPair:
         check_read_timeout(open_timeout, "open_timeout")
         self._caps: list[cv2.VideoCapture] = []
         self._files = []
+        #: An image sequence is read: its reader logs a warning for the file after the last.
+        self._sequence = False
         try:
             for side, src in (("left", left), ("right", right)):
                 src = parse_source(src)
@@ -379,14 +398,16 @@ class VideoPair:
                 # bounded, the size asked with it: a wedged device hung its open, or a set,
                 # forever (OpenCV's log of the open stays quiet: the error below says what failed)
                 configure = None if size is None or is_file else partial(_ask_size, size)
+                first = _sequence_first(src) if isinstance(src, str) else None
                 cap = _open_within(
-                    partial(cv2.VideoCapture, src), open_timeout, side, src, configure
+                    partial(_open_capture, src, first), open_timeout, side, src, configure
                 )
                 if not cap.isOpened():
                     cap.release()
                     raise OSError(f"cannot open camera {src!r} ({side}){camera_hint(src)}")
                 self._caps.append(cap)
                 self._files.append(is_file)
+                self._sequence |= first is not None
         except BaseException:
             self.close()
             raise
@@ -406,7 +427,8 @@ class VideoPair:
     def _pair(self) -> tuple[npt.NDArray[np.uint8] | None, npt.NDArray[np.uint8] | None]:
         # Both grabbed before either is decoded: read() one after the other took the right
         # frame a whole decode later than the left.
-        grabbed = [cap.grab() for cap in self._caps]
+        with _opencv_quiet() if self._sequence else contextlib.nullcontext():
+            grabbed = [cap.grab() for cap in self._caps]
         return self._decode(0, grabbed[0]), self._decode(1, grabbed[1])
 
     def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
