@@ -48,6 +48,24 @@ def test_noise_of_a_16_bit_image_and_images_it_cannot_read(data_dir: Path) -> No
             noise_sigma(np.ones((8, 8), dtype))
 
 
+@pytest.mark.parametrize("dtype", [np.float64, np.float16, np.int32, np.int64])
+@pytest.mark.parametrize("channels", [3, 4])
+def test_noise_of_a_colour_image_of_any_number_type(
+    data_dir: Path, dtype: type, channels: int
+) -> None:
+    """A colour image of float64 (an image scaled in NumPy), float16 or int (a nested list's
+    int64) raised OpenCV's cv2.error from the grey conversion, which takes uint8, uint16 and
+    float32 only; it is measured as the same image in float32."""
+    img = noisy(load_scene(data_dir / VENUS).left, 8.0, np.random.default_rng(0))
+    if channels == 4:
+        img = cv2.cvtColor(img, cv2.COLOR_BGR2BGRA)
+    expected = noise_sigma(img.astype(np.float32))
+    assert 4.8 < expected < 6.5, expected
+    assert noise_sigma(img.astype(dtype)) == pytest.approx(expected, rel=1e-3)
+    if dtype is np.int64:  # a list of lists of ints, as from JSON
+        assert noise_sigma(img[:40, :40].tolist()) == noise_sigma(img[:40, :40].astype(np.float32))
+
+
 def test_a_black_border_is_no_noiseless_image(data_dir: Path) -> None:
     """Venus with noise 8 and a black border over its left 46 % (a fisheye's corners, a
     rectified frame's border): the noise reads as without the border. The border's pixels were
