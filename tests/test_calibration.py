@@ -1325,6 +1325,27 @@ def test_from_q_refuses_a_zero_focal_length_or_inverse_baseline(
         Calibration.from_q(tmp_path / "Q.dat", (10, 8))
 
 
+def test_from_q_names_a_non_finite_entry_and_a_missing_image_size(tmp_path: Path) -> None:
+    """A Q holding NaN or inf was refused as "16 finite numbers expected, got 16", which read as
+    if the file held what was expected; the entry is named. ``image_size=None`` (or a size of
+    three numbers) raised TypeError "'NoneType' object is not iterable" (ValueError "too many
+    values to unpack"), naming neither the argument nor the file."""
+    (tmp_path / "Q.dat").write_text("1 0 0 -5\n0 1 0 -4\n0 0 0 nan\n0 0 10 inf\n")
+    with pytest.raises(
+        ValueError,
+        match=r"Q\.dat: not a Q matrix \(16 finite numbers expected, got Q\[2,3\] = nan\)$",
+    ):
+        Calibration.from_q(tmp_path / "Q.dat", (10, 8))
+    (tmp_path / "Q.dat").write_text("1 0 0 -5\n0 1 0 -4\n0 0 0 100\n0 0 10 0\n")
+    for size in (None, (10, 8, 3), 10):
+        said = re.escape(repr(size))
+        with pytest.raises(
+            ValueError, match=rf"image_size for .*Q\.dat: expected \(width, height\), got {said}$"
+        ):
+            Calibration.from_q(tmp_path / "Q.dat", size)  # type: ignore[arg-type]
+    assert Calibration.from_q(tmp_path / "Q.dat", np.array([10, 8])).image_size == (10, 8)
+
+
 def test_fit_to_frames_refuses_a_two_percent_crop() -> None:
     """Aspect ratios 1 % apart are the limit: 160x117 for 320x240 (2.5 % apart) is a crop,
     160x119 (0.8 %) a scaling."""

@@ -1798,8 +1798,15 @@ class Calibration:
             q = np.array([float(t) for t in text.split()], dtype=np.float64)
         except ValueError:
             raise ValueError(f"{p}: not a Q matrix (16 numbers expected)") from None
-        if q.size != 16 or not np.isfinite(q).all():
+        if q.size != 16:
             raise ValueError(f"{p}: not a Q matrix (16 finite numbers expected, got {q.size})")
+        if not np.isfinite(q).all():
+            # 'got 16' alone read as if the file held what was expected
+            i = int(np.flatnonzero(~np.isfinite(q))[0])
+            raise ValueError(
+                f"{p}: not a Q matrix (16 finite numbers expected, got Q[{i // 4},{i % 4}] = "
+                f"{q[i]:g})"
+            )
         q = q.reshape(4, 4)
         scaled = ""
         if q[0, 0] not in (0.0, 1.0):  # a multiple of Q is the same Q (homogeneous coordinates)
@@ -1824,6 +1831,9 @@ class Calibration:
             )
         cx, cy = -float(q[0, 3]), -float(q[1, 3])
         cx_right = cx + float(q[3, 3]) / inv_b
+        if not isinstance(image_size, (tuple, list, np.ndarray)) or len(image_size) != 2:
+            # None raised "'NoneType' object is not iterable", naming neither argument nor file
+            raise ValueError(f"image_size for {p}: expected (width, height), got {image_size!r}")
         w, h = (_pixels(v, f"image size for {p}") for v in image_size)
         return cls(
             K1=np.array([[f, 0.0, cx], [0.0, f, cy], [0.0, 0.0, 1.0]]),
