@@ -105,6 +105,28 @@ def test_depth_sigma_formula_on_a_plane() -> None:
     )
 
 
+def test_disparity_sigma_refuses_what_is_no_confidence_map() -> None:
+    """None gave a NaN sigma and a complex map lost its imaginary part with NumPy's warning
+    only; a ``filled`` mask of one row was spread over every row of the map (and another shape
+    refused in NumPy's broadcasting words). Each is a ValueError naming the argument."""
+    conf = np.array([[0.0, 1.0], [0.5, 0.25]], np.float32)
+    for bad in (None, conf.astype(np.complex64), "0.5"):
+        with pytest.raises(ValueError, match="confidence: expected real numbers in"):
+            sv.depth.disparity_sigma(bad)  # type: ignore[arg-type]
+    for mask in ([[True, False]], np.ones((3, 2), bool)):
+        said = re.escape(str(np.shape(mask)))
+        with pytest.raises(ValueError, match=rf"filled: expected .* \(2, 2\), got {said}$"):
+            sv.depth.disparity_sigma(conf, filled=mask)
+    # a whole mask, a bool or integer confidence, a scalar: as before
+    np.testing.assert_allclose(
+        sv.depth.disparity_sigma(conf, filled=[[True, False], [False, False]]),
+        [[0.63, 0.184], [0.2945, 0.34975]],
+        rtol=1e-5,
+    )
+    assert sv.depth.disparity_sigma(np.array([True]))[0] == pytest.approx(0.184)
+    assert float(sv.depth.disparity_sigma(0)) == pytest.approx(0.405)
+
+
 @pytest.mark.parametrize("refine", [True, False])
 def test_depth_sigma_predicts_the_error(data_dir: Path, refine: bool) -> None:
     """The error in units of the predicted sigma is about standard normal in its core.

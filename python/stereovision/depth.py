@@ -956,12 +956,26 @@ def disparity_sigma(
     -------
     numpy.ndarray
         float32 array of the same shape, pixels.
+
+    Raises
+    ------
+    ValueError
+        If ``confidence`` is not real numbers (None, complex, text), or ``filled`` is not of
+        its shape.
     """
     s0, slope, s_min = _SIGMA_REFINED if refined else _SIGMA_RAW
-    c = np.clip(np.asarray(confidence, dtype=np.float32), 0.0, 1.0)
+    raw = np.asarray(confidence)
+    # None became a NaN sigma, a complex map lost its imaginary part with NumPy's warning only
+    if raw.dtype.kind not in "biuf":
+        raise ValueError(f"confidence: expected real numbers in [0, 1], got dtype {raw.dtype}")
+    c = np.clip(raw.astype(np.float32), 0.0, 1.0)
     out = np.maximum(np.float32(s0) + np.float32(slope) * c, np.float32(s_min))
     if filled is not None:
-        out = np.where(np.asarray(filled, bool), np.float32(_SIGMA_FILLED), out)
+        mask = np.asarray(filled, bool)
+        if mask.shape != c.shape:
+            # NumPy broadcast a (1, W) mask over every row, and refused others in its own words
+            raise ValueError(f"filled: expected the confidence's shape {c.shape}, got {mask.shape}")
+        out = np.where(mask, np.float32(_SIGMA_FILLED), out)
     return np.asarray(out, np.float32)
 
 
