@@ -40,6 +40,10 @@ def test_noise_of_a_16_bit_image_and_images_it_cannot_read(data_dir: Path) -> No
     sixteen = noise_sigma(img.astype(np.uint16) * np.uint16(257))  # 8 bits spread over 16
     # 5.700 and 5.718: the 8-bit grey image is rounded to whole levels, the 16-bit one is not
     assert sixteen == pytest.approx(eight, rel=0.01) and 4.8 < sixteen < 6.5
+    # a big-endian frame (raw sensor data read as '>u2') is the same frame: it read 0
+    for frame in (img, cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)):
+        native = frame.astype(np.uint16) * np.uint16(257)
+        assert noise_sigma(native.astype(">u2")) == noise_sigma(native) > 4.8
     for channels in (2, 5):
         with pytest.raises(ValueError, match=f"expected 1, 3 or 4 channels, got {channels}"):
             noise_sigma(np.zeros((8, 8, channels), np.uint8))

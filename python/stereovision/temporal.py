@@ -152,8 +152,9 @@ def noise_sigma(image: npt.ArrayLike) -> float:
         np.issubdtype(img.dtype, np.integer) or np.issubdtype(img.dtype, np.floating)
     ):
         raise ValueError(f"image: expected grey levels (uint8, uint16 or float), got {img.dtype}")
-    if img.dtype == np.uint16:
-        # 0-65535: every pixel over 255 counted as clipped, and the noise came out 0
+    if img.dtype.kind == "u" and img.dtype.itemsize == 2:  # of either byte order
+        # 0-65535: every pixel over 255 counted as clipped, and the noise came out 0 (so it
+        # still did for a big-endian '>u2' frame, which is not np.uint16)
         img = img.astype(np.float32) / np.float32(257.0)
     g = _grey(img)
     lap = np.array([[1, -2, 1], [-2, 4, -2], [1, -2, 1]], np.float32)
