@@ -146,6 +146,26 @@ def test_bad_arguments(kwargs: dict, needle: str) -> None:
         fuse(args.pop("gabor"), args.pop("sparse"), **args)
 
 
+def test_a_map_that_is_not_real_numbers_is_named() -> None:
+    """A complex disparity map lost its imaginary part with NumPy's ComplexWarning only, and a
+    map of text raised NumPy's "could not convert string to float"; both name the map."""
+    conf = np.ones((H, W), np.float32)
+    members = np.full((H, W), 3, np.uint8)
+    for bad in (np.ones((H, W), np.complex64), np.full((H, W), "1")):
+        with pytest.raises(
+            ValueError, match=r"^disparity: expected a real \(H, W\) map, got dtype"
+        ):
+            fused_dense(bad, conf, members)
+        with pytest.raises(ValueError, match=r"^guide: expected a real \(H, W\) map, got dtype"):
+            fill_enclosed_far(np.ones((H, W), np.float32), bad)
+    # bool, integer and float maps are numbers: read as before
+    d = np.full((H, W), 4.0, np.float32)
+    np.testing.assert_array_equal(
+        fused_dense(d.astype(np.int16), conf.astype(bool), members)[0],
+        fused_dense(d, conf, members)[0],
+    )
+
+
 def test_mismatched_sizes() -> None:
     small = Matches(*(np.zeros(1, np.float32),) * 5, (H - 1, W))
     with pytest.raises(ValueError, match="differs"):

@@ -373,6 +373,22 @@ def test_a_huge_finite_range_is_named_outside_the_kernels_int32(name: str, value
         sgm_disparity(ok, ok, **{**kw, name: float("-inf")})
 
 
+@pytest.mark.parametrize("name", ["max_disparity", "min_disparity"])
+@pytest.mark.parametrize("value", [True, np.bool_(False), "16", [16], None])
+def test_a_range_bound_that_is_no_number_is_named(name: str, value: object) -> None:
+    """True was searched as one level (gabor_disparity and depth_map refuse a bool); a string,
+    a list or None raised TypeError "must be real number, not str", naming no argument."""
+    ok = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    kw = {"max_disparity": 8.0, "min_disparity": 0.0, name: value}
+    said = re.escape(repr(value))
+    with pytest.raises(ValueError, match=f"^{name}: expected a number of pixels, got {said}$"):
+        sgm_disparity(ok, ok, **kw)  # type: ignore[arg-type]
+    # NumPy numbers and a 0-d array are numbers: the range they say
+    want = sgm_disparity(ok, ok, max_disparity=8, min_disparity=0)
+    for a, b in ((np.int64(8), np.float32(0)), (np.array(8), np.array(0.0))):
+        np.testing.assert_array_equal(sgm_disparity(ok, ok, max_disparity=a, min_disparity=b), want)
+
+
 def test_a_one_level_range_and_the_p2_width() -> None:
     """max_disparity == min_disparity is a one-level search, not an error; p2 past the kernel's
     u16 (65536) is refused naming the kernel's real limit (4000), not an OverflowError from the

@@ -177,7 +177,12 @@ def _nearest_within_at(
 
 
 def _check_map(a: npt.ArrayLike, name: str, shape: tuple[int, int] | None) -> F32:
-    arr = np.asarray(a, dtype=np.float32)
+    raw = np.asarray(a)
+    # a complex map lost its imaginary part with NumPy's warning only; text raised NumPy's
+    # "could not convert string to float", naming no argument
+    if raw.dtype.kind not in "biuf":
+        raise ValueError(f"{name}: expected a real (H, W) map, got dtype {raw.dtype}")
+    arr = np.asarray(raw, dtype=np.float32)
     if arr.ndim != 2:
         raise ValueError(f"{name}: expected an (H, W) map, got shape {arr.shape}")
     if shape is not None and arr.shape != shape:

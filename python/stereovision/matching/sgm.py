@@ -20,6 +20,7 @@ import numpy.typing as npt
 
 from stereovision import _core
 from stereovision._validate import (
+    _real_scalar,
     as_gray_float,
     check_pair,
     finite_number,
@@ -172,6 +173,13 @@ def sgm_disparity(
         raise ValueError(f"unknown SGM option(s) {unknown}: expected {sorted(DEFAULTS)}")
     p = {**DEFAULTS, **params}
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
+        # True searched one level, a string or a list raised "must be real number, not str"
+        if isinstance(v, (bool, np.bool_)):
+            raise ValueError(f"{name}: expected a number of pixels, got {v!r}")
+        try:
+            _real_scalar(float_sized(v, name))
+        except TypeError:
+            raise ValueError(f"{name}: expected a number of pixels, got {v!r}") from None
         # The kernel takes i32 levels (and at most 2048 of them); 1e300 is finite, only too big.
         if not math.isfinite(float_sized(v, name)):
             raise ValueError(f"{name}: expected a finite number of pixels, got {v}")
