@@ -65,9 +65,25 @@ def test_noise_of_a_colour_image_of_any_number_type(
         img = cv2.cvtColor(img, cv2.COLOR_BGR2BGRA)
     expected = noise_sigma(img.astype(np.float32))
     assert 4.8 < expected < 6.5, expected
+    if np.issubdtype(dtype, np.integer):  # 8-bit levels: read as the uint8 image, bit for bit
+        expected = noise_sigma(img)
     assert noise_sigma(img.astype(dtype)) == pytest.approx(expected, rel=1e-3)
-    if dtype is np.int64:  # a list of lists of ints, as from JSON
-        assert noise_sigma(img[:40, :40].tolist()) == noise_sigma(img[:40, :40].astype(np.float32))
+
+
+def test_noise_of_int_levels_as_from_a_nested_list(data_dir: Path) -> None:
+    """A nested list of ints (an image sent as JSON) is int64: its colour image was measured as
+    float grey levels, not rounded as its uint8 image's (5.718 for 5.700), and a list of 16-bit
+    levels read 0 (every pixel over 255 clipped). 8-bit levels read as the uint8 image; levels
+    outside 0-255 are refused, naming uint16."""
+    img = noisy(load_scene(data_dir / VENUS).left, 8.0, np.random.default_rng(0))
+    for frame in (img, cv2.cvtColor(img, cv2.COLOR_BGR2BGRA), img[..., 1]):
+        assert noise_sigma(frame.tolist()) == noise_sigma(frame) > 4.8
+    with pytest.raises(
+        ValueError, match=r"int64 grey levels must lie in 0-255, got \d+-\d+ .*uint16"
+    ):
+        noise_sigma((img.astype(np.int64) * 257).tolist())
+    with pytest.raises(ValueError, match=r"int16 grey levels must lie in 0-255, got -1-0"):
+        noise_sigma(-np.eye(5, dtype=np.int16))
 
 
 def test_a_black_border_is_no_noiseless_image(data_dir: Path) -> None:

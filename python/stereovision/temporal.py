@@ -138,7 +138,8 @@ def noise_sigma(image: npt.ArrayLike) -> float:
     ------
     ValueError
         If the image is not 2-D grey or 3-D colour of 1, 3 or 4 channels, is smaller than
-        3 x 3, or is not of numbers (bool, complex).
+        3 x 3, is not of numbers (bool, complex), or is of integers other than uint16 outside
+        0-255 (an int image's levels in 0-255 read as its uint8 image).
     """
     img = np.asarray(image)
     if img.ndim not in (2, 3) or img.shape[0] < 3 or img.shape[1] < 3:
@@ -156,6 +157,16 @@ def noise_sigma(image: npt.ArrayLike) -> float:
         # 0-65535: every pixel over 255 counted as clipped, and the noise came out 0 (so it
         # still did for a big-endian '>u2' frame, which is not np.uint16)
         img = img.astype(np.float32) / np.float32(257.0)
+    elif img.dtype.kind in "iu" and img.dtype != np.uint8:
+        # int levels (a nested list's int64): a colour image was measured as float, unrounded
+        # grey (5.718 where its uint8 image reads 5.700), 16-bit levels all as clipped (0)
+        lo, hi = int(img.min()), int(img.max())
+        if lo < 0 or hi > 255:
+            raise ValueError(
+                f"image: {img.dtype} grey levels must lie in 0-255, got {lo}-{hi} (a 16-bit "
+                "image: pass it as uint16)"
+            )
+        img = img.astype(np.uint8)
     g = _grey(img)
     lap = np.array([[1, -2, 1], [-2, 4, -2], [1, -2, 1]], np.float32)
     resp = np.abs(cv2.filter2D(g, -1, lap))[1:-1, 1:-1]
