@@ -807,6 +807,47 @@ def test_decode_image_takes_a_column_or_row_of_bytes() -> None:
         assert img is not None and img.shape == (4, 6, 3) and int(img.max()) == 7
 
 
+def _png_of_size(width: int, height: int) -> bytes:
+    """A 4 x 4 PNG whose header (its CRC made right) says ``width`` x ``height``."""
+    import zlib
+
+    png = cv2.imencode(".png", np.zeros((4, 4, 3), np.uint8))[1].tobytes()
+    body = b"IHDR" + struct.pack(">II", width, height) + png[24:29]
+    return png[:8] + struct.pack(">I", 13) + body + struct.pack(">I", zlib.crc32(body)) + png[33:]
+
+
+@pytest.mark.parametrize(
+    "data",
+    [_png_of_size(100_000, 100_000), b"Pf\n-3 2\n-1\n" + bytes(24)],
+    ids=["png-over-the-pixel-limit", "pfm-of-width-minus-3"],
+)
+def test_an_image_header_of_an_impossible_size_is_unreadable(tmp_path: Path, data: bytes) -> None:
+    """A header saying 10^10 pixels (a corrupt or hostile PNG) or a negative width raised
+    OpenCV's cv2.error from its size check, where other bytes it cannot decode are None: from
+    decode_image, read_image, imread, read_depth_png and a bag's compressed image alike. They
+    are unreadable now, each caller's own error naming the file."""
+    from stereovision.export import read_depth_png, read_disparity_png
+    from stereovision.io import decode_image, imread, read_image
+    from stereovision.rosbag import decode_image as decode_message
+
+    path = tmp_path / "frame.png"
+    path.write_bytes(data)
+    assert decode_image(data) is None
+    for read in (read_image, imread):
+        with pytest.raises(ValueError, match=r"cannot decode .*frame\.png as an image"):
+            read(path)
+    for read_png in (read_depth_png, read_disparity_png):
+        with pytest.raises(ValueError, match=r"frame\.png: expected a single-channel 16-bit PNG"):
+            read_png(path)
+
+    class Msg:
+        format = "png"
+
+    Msg.data = np.frombuffer(data, np.uint8)  # type: ignore[attr-defined]
+    with pytest.raises(ValueError, match=r"compressed image \('png', \d+ bytes\) does not decode"):
+        decode_message(Msg())
+
+
 def test_write_pfm_refuses_what_it_would_change(tmp_path: Path) -> None:
     # a finite 1e300 was written as inf, and little_endian="no" (true) a little-endian file
     arr = np.array([[1.0, np.nan], [np.inf, -3.5e38]])  # -3.5e38 is beyond float32 too

@@ -927,11 +927,11 @@ def write_disparity_png(path: PathLike, disparity: DepthResult | npt.ArrayLike) 
 def _read_png16(path: PathLike, scale: float, what: str) -> npt.NDArray[np.float32]:
     import cv2
 
-    from stereovision.io import _existing_file
+    from stereovision.io import _existing_file, _imdecode
 
     p = _existing_file(path, what)
     raw = np.fromfile(p, dtype=np.uint8)
-    img = cv2.imdecode(raw, cv2.IMREAD_UNCHANGED) if raw.size else None
+    img = _imdecode(raw, cv2.IMREAD_UNCHANGED) if raw.size else None
     if img is None or img.ndim != 2 or img.dtype != np.uint16:
         got = "not a PNG" if img is None else f"{img.dtype} with shape {img.shape}"
         raise ValueError(f"{p}: expected a single-channel 16-bit PNG, got {got}")

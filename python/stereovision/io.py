@@ -822,9 +822,19 @@ def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] |
         raise TypeError(f"data: expected the file's bytes or a 1-D uint8 array, got {what}")
     if buf.size == 0:
         return None
-    with _opencv_quiet():
-        img = cv2.imdecode(buf, cv2.IMREAD_COLOR)
+    img = _imdecode(buf, cv2.IMREAD_COLOR)
     return None if img is None else np.asarray(img, dtype=np.uint8)
+
+
+def _imdecode(buf: npt.NDArray[np.uint8], flags: int) -> npt.NDArray[Any] | None:
+    """``cv2.imdecode``, quiet, None for bytes it cannot decode: a header whose size is 0,
+    negative or over OpenCV's pixel limit (a corrupt or hostile PNG, a PFM of width -3) raised
+    cv2.error from its size check where other unreadable bytes give None."""
+    with _opencv_quiet():
+        try:
+            return cv2.imdecode(buf, flags)  # type: ignore[no-any-return]
+        except cv2.error:
+            return None
 
 
 # OpenCV's log level is process-wide: the first of concurrent decodes silences it and the last
@@ -945,8 +955,7 @@ def _decode_16bit(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint16]
     buf = np.frombuffer(data, np.uint8) if isinstance(data, bytes) else data
     if buf.size == 0:
         return None
-    with _opencv_quiet():
-        deep = cv2.imdecode(buf, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
+    deep = _imdecode(buf, cv2.IMREAD_COLOR | cv2.IMREAD_ANYDEPTH)
     if deep is not None and deep.dtype == np.uint16:
         return np.asarray(deep, dtype=np.uint16)
     return None

@@ -795,8 +795,10 @@ def decode_image(msg: Any) -> np.ndarray:
         fmt = str(msg.format)
         if "compresseddepth" in fmt.lower():
             raise ValueError(f"compressed image format {fmt!r} is a depth image, not a camera's")
+        from stereovision.io import _imdecode  # cv2.error for a header of an impossible size
+
         buf = np.asarray(msg.data, np.uint8).reshape(-1)
-        img = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED) if buf.size else None
+        img = _imdecode(buf, cv2.IMREAD_UNCHANGED) if buf.size else None
         if img is None:
             raise ValueError(f"compressed image ({fmt!r}, {buf.size} bytes) does not decode")
         if img.ndim == 2:
