@@ -105,12 +105,27 @@ def test_declared_minimums_are_versions_the_package_runs_on() -> None:
     OpenCV 4.8 (the old minimum) to 4.14 have no ``criteria`` in ``cv2.undistortPoints``
     (calibrate) and 4.8-4.12 no ``cv2.utils.logging`` (every image decode); with OpenCV 5.0
     ``import stereovision`` fails (no ``cv2.fisheye.CALIB_RECOMPUTE_EXTRINSIC``). OpenCV 5.1,
-    numpy 2.0, pyvista 0.48 and VTK 9.4 run them."""
+    numpy 2.0, pyvista 0.48 and VTK 9.4 run them. The floor said VTK 9.4, but pyvista (0.48
+    on) excludes 9.4.0 and 9.4.1: pip found no vtk==9.4.0 beside pyvista==0.48.0, and 9.4.2
+    is the oldest VTK the package was tested on."""
     dist = _distribution()
     assert _minimum(dist, "pyvista") >= (0, 48)
-    assert _minimum(dist, "vtk") >= (9, 4)
+    assert _minimum(dist, "vtk") >= (9, 4, 2)
     assert _minimum(dist, "opencv-python-headless") >= (5, 1)
     assert _minimum(dist, "numpy") >= (2, 0)  # OpenCV 5 needs it
+
+
+def test_gui_extra_floors_install_beside_its_trame_pyvista() -> None:
+    """The ``gui`` extra asked for trame>=3, trame-vtk>=2.8 and trame-vuetify>=2.7 beside
+    trame-pyvista>=0.2, but trame-pyvista 0.2.0 requires trame>=3.9.1, trame-vtk>=2.11.16 and
+    trame-vuetify>=3.2.5: pip found no install of the floors together. tests/test_gui_app.py
+    passes with exactly those (trame 3.9.1, trame-vtk 2.11.16, trame-vuetify 3.2.5,
+    trame-pyvista 0.2.0)."""
+    dist = _distribution()
+    assert _minimum(dist, "trame-pyvista") >= (0, 2)
+    assert _minimum(dist, "trame") >= (3, 9, 1)
+    assert _minimum(dist, "trame-vtk") >= (2, 11, 16)
+    assert _minimum(dist, "trame-vuetify") >= (3, 2, 5)
 
 
 def test_ros_extra_asks_for_a_rosbags_that_reads_bags_in_a_thread() -> None:
