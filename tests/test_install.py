@@ -115,6 +115,15 @@ def test_declared_minimums_are_versions_the_package_runs_on() -> None:
     assert _minimum(dist, "numpy") >= (2, 0)  # OpenCV 5 needs it
 
 
+def test_pyyaml_floor_installs_on_every_python_it_claims() -> None:
+    """The floor was pyyaml>=6: PyYAML 6.0 has no wheel for Python 3.12 or 3.13 (classifiers
+    here) and its sdist fails to build with Cython 3 ("'build_ext' object has no attribute
+    'cython_sources'"). 6.0.1 has a 3.12 wheel and an sdist that builds (it pins Cython < 3);
+    tests/test_calibration.py, test_calibrate.py, test_calibration_ros.py and test_io.py pass
+    with it."""
+    assert _minimum(_distribution(), "pyyaml") >= (6, 0, 1)
+
+
 def test_gui_extra_floors_install_beside_its_trame_pyvista() -> None:
     """The ``gui`` extra asked for trame>=3, trame-vtk>=2.8 and trame-vuetify>=2.7 beside
     trame-pyvista>=0.2, but trame-pyvista 0.2.0 requires trame>=3.9.1, trame-vtk>=2.11.16 and
