@@ -1116,18 +1116,28 @@ fn zero_crossings_equal_the_pixel_by_pixel_rule() {
     assert_eq!(zc.theta[4], 0.0);
 }
 
+/// The seed threshold written out plainly (a full sort): the reference of
+/// [`tracking::high_threshold`]. The marked strengths sorted by their bit patterns, the value
+/// at `floor(q (n - 1))` clamped to the list; 0 when nothing is marked. `zero_crossings` marks
+/// strengths >= MIN_STRENGTH > 0 only, where the bit patterns order as the values do; strengths
+/// it never gives (negative ones, -0, NaN of either sign) order by their bits as the kernel's
+/// buckets do (-NaN last, not first as in `total_cmp`).
+pub(super) fn high_threshold_reference(zc: &ZeroCrossings, q: f32) -> f32 {
+    let mut marked: Vec<f32> = zc.marked().map(|i| zc.strength[i]).collect();
+    marked.sort_by_key(|s| s.to_bits());
+    if marked.is_empty() {
+        return 0.0;
+    }
+    let k = ((q as f64) * (marked.len() - 1) as f64).floor() as usize;
+    marked[k.min(marked.len() - 1)]
+}
+
 /// Hysteresis tracking written out plainly (full sorts, a neighbour loop with branches): the
 /// reference of [`track`].
-fn track_reference(zc: &ZeroCrossings, p: &tracking::TrackParams) -> tracking::Curves {
+pub(super) fn track_reference(zc: &ZeroCrossings, p: &tracking::TrackParams) -> tracking::Curves {
     use std::f64::consts::{PI, TAU};
     let (w, h) = (zc.width, zc.height);
-    let mut marked: Vec<f32> = zc.marked().map(|i| zc.strength[i]).collect();
-    marked.sort_by(f32::total_cmp);
-    let t_high = if marked.is_empty() {
-        0.0
-    } else {
-        marked[((p.high_quantile as f64) * (marked.len() - 1) as f64).floor() as usize]
-    };
+    let t_high = high_threshold_reference(zc, p.high_quantile);
     let t_low = p.low_ratio * t_high;
     let interior = |i: usize| i % w >= 1 && i / w >= 1 && i % w + 1 < w && i / w + 1 < h;
     let mut free: Vec<bool> = (0..w * h)
@@ -1172,8 +1182,11 @@ fn track_reference(zc: &ZeroCrossings, p: &tracking::TrackParams) -> tracking::C
                 let q = ((cur / w) as i64 + dy) as usize * w + ((cur % w) as i64 + dx) as usize;
                 let dot =
                     (dx as f64 * dir.0 + dy as f64 * dir.1) / ((dx * dx + dy * dy) as f64).sqrt();
+                // Forward half-plane only: a NaN projection (a NaN normal of either sign) is
+                // not in it.
+                let forward = dot > 0.0;
                 if !free[q]
-                    || dot <= 0.0
+                    || !forward
                     || turn(zc.theta[q] as f64 - zc.theta[cur] as f64) >= max_turn
                 {
                     continue;

@@ -379,220 +379,40 @@ fn make_segment(
 #[cfg(test)]
 mod tests {
     //! The one-pass threshold, candidate and seed lists and the reused segment buffer against
-    //! the code they replaced (copied as it was before them), on the inputs real scenes do not
-    //! hold: nothing or everything marked, images 1 or 2 pixels wide or high, equal strengths
-    //! (ties of the quantile and of the seed order), NaN and infinite strengths, segments
-    //! rejected after partial growth.
+    //! the plain hysteresis tracker of the channel's tests (full sorts, a neighbour loop with
+    //! branches), on the inputs real scenes do not hold: nothing or everything marked, images 1
+    //! or 2 pixels wide or high, equal strengths (ties of the quantile and of the seed order),
+    //! NaN of either sign, infinite, zero and negative strengths, segments rejected after
+    //! partial growth.
     use super::*;
+    use crate::matching::mcgm::tests::{high_threshold_reference, track_reference};
     use crate::matching::mcgm::zerocross::{ZC_H, ZC_V};
-
-    /// [`high_threshold`] before the marked pixels were listed (a histogram over every pixel).
-    fn high_threshold_old(zc: &ZeroCrossings, q: f32) -> f32 {
-        // Marked strengths are >= MIN_STRENGTH > 0, so their bit patterns order as the values
-        // do: the k-th is found in the bucket of its upper 12 bits (one histogram pass), then by
-        // selection among that bucket's values only.
-        const SHIFT: u32 = 20;
-        const BUCKETS: usize = 1 << (32 - SHIFT);
-        // Unmarked pixels count into 16 spare slots by column (not all into one slot: each add
-        // would wait for the previous one's store).
-        let mut hist = vec![0usize; BUCKETS + 16];
-        for (i, (&m, &s)) in zc.mark.iter().zip(&zc.strength).enumerate() {
-            let b = if m != 0 {
-                (s.to_bits() >> SHIFT) as usize
-            } else {
-                BUCKETS + (i & 15)
-            };
-            hist[b] += 1;
-        }
-        hist.truncate(BUCKETS);
-        let count: usize = hist.iter().sum();
-        if count == 0 {
-            return 0.0;
-        }
-        let k = (((q as f64) * (count - 1) as f64).floor() as usize).min(count - 1);
-        let (mut below, mut bucket) = (0usize, 0usize);
-        for (b, &c) in hist.iter().enumerate() {
-            if below + c > k {
-                bucket = b;
-                break;
-            }
-            below += c;
-        }
-        // The bucket's values (branch-free compaction: its size is known).
-        let mut vals = vec![0.0f32; hist[bucket] + 1];
-        let mut c = 0;
-        for (&m, &s) in zc.mark.iter().zip(&zc.strength) {
-            vals[c] = s;
-            c += usize::from((m != 0) & ((s.to_bits() >> SHIFT) as usize == bucket));
-        }
-        vals.truncate(c);
-        *vals.select_nth_unstable_by(k - below, f32::total_cmp).1
-    }
-
-    /// [`track`] before the marked pixels were listed and the segment buffer was reused.
-    fn track_old(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
-        let (w, h) = (zc.width, zc.height);
-        let n = w * h;
-        let t_high = high_threshold_old(zc, p.high_quantile);
-        let t_low = p.low_ratio * t_high;
-        // Per pixel: FREE = unvisited candidate (marked, s >= t_low), TAKEN = on a curve (or a seed
-        // already used), 0 = not a candidate. One byte array instead of three passes over the image.
-        const FREE: u8 = 1;
-        const TAKEN: u8 = 2;
-        let mut state = try_zeroed::<u8>(n, WHAT)?;
-        // (Images narrower than 3 pixels have no interior.)
-        for y in (1..h.saturating_sub(1)).filter(|_| w >= 3) {
-            let r = y * w + 1..(y + 1) * w - 1;
-            let (st, mk, sr) = (&mut state[r.clone()], &zc.mark[r.clone()], &zc.strength[r]);
-            for x in 0..st.len() {
-                let s = sr[x];
-                st[x] = u8::from((mk[x] != 0) & (s >= t_low) & (s > 0.0));
-            }
-        }
-        // Seeds by decreasing strength, then index: one key each, `!bits(s) << 32 | i` (strengths
-        // are > 0, so their bit patterns order as the values do), listed by index (branch-free)
-        // and radix-sorted on the upper half.
-        let mut keys = try_zeroed::<u64>(n, WHAT)?;
-        let mut n_seeds = 0;
-        for (i, (&st, &s)) in state.iter().zip(&zc.strength).enumerate() {
-            keys[n_seeds] = (u64::from(!s.to_bits()) << 32) | i as u64;
-            n_seeds += usize::from((st == FREE) & (s >= t_high));
-        }
-        keys.truncate(n_seeds);
-        radix_sort_upper(&mut keys)?;
-        let max_turn = (p.max_turn_deg as f64).to_radians();
-        let mut labels = try_filled(n, -1i32, WHAT)?;
-        let mut segments = Vec::new();
-        // Grows from `start` (tangent `t0`) along `sign * t0`, appending the pixels taken and their
-        // tangents to `out`.
-        let grow = |start: usize,
-                    t0: (f64, f64),
-                    sign: f64,
-                    state: &mut Vec<u8>,
-                    out: &mut Vec<(u32, (f64, f64))>| {
-            let mut cur = start;
-            let mut dir = (sign * t0.0, sign * t0.1);
-            // The position follows the steps (no division per step).
-            let (mut cx, mut cy) = ((start % w) as i32, (start / w) as i32);
-            loop {
-                let tc = zc.theta[cur] as f64;
-                let mut best: Option<(f64, f32, usize, (i32, i32))> = None;
-                // `cur` is an interior pixel (see `state`): its neighbours are inside the image.
-                debug_assert!(cx >= 1 && cy >= 1 && cx + 1 < w as i32 && cy + 1 < h as i32);
-                // The free neighbours in the forward half-plane (`dx dir.0 + dy dir.1 > 0`; the
-                // diagonals' `/ sqrt 2` keeps the sign), found without a branch per neighbour; then
-                // those, in NEIGHBOURS order.
-                let mut cand = 0u32;
-                for (k, &(dx, dy)) in NEIGHBOURS.iter().enumerate() {
-                    let q = (cur as isize + dy as isize * w as isize + dx as isize) as usize;
-                    let proj = dx as f64 * dir.0 + dy as f64 * dir.1;
-                    cand |= u32::from((state[q] == FREE) & (proj > 0.0)) << k;
-                }
-                while cand != 0 {
-                    let k = cand.trailing_zeros() as usize;
-                    cand &= cand - 1;
-                    let (dx, dy) = NEIGHBOURS[k];
-                    let q = (cy + dy) as usize * w + (cx + dx) as usize;
-                    if wrap_angle(zc.theta[q] as f64 - tc).abs() >= max_turn {
-                        continue;
-                    }
-                    let proj = dx as f64 * dir.0 + dy as f64 * dir.1;
-                    // An axis step's length is 1: no division (x / 1.0 == x).
-                    let dot = if dx != 0 && dy != 0 {
-                        proj / std::f64::consts::SQRT_2
-                    } else {
-                        proj
-                    };
-                    if dot <= 0.0 {
-                        continue; // forward half-plane only
-                    }
-                    let s = zc.strength[q];
-                    if best.is_none_or(|b| dot > b.0 || (dot == b.0 && s > b.1)) {
-                        best = Some((dot, s, q, (dx, dy)));
-                    }
-                }
-                let Some((_, _, q, (dx, dy))) = best else {
-                    break;
-                };
-                state[q] = TAKEN;
-                let (tx, ty) = tangent(zc.theta[q]);
-                out.push((q as u32, (tx, ty)));
-                let sgn = if tx * dx as f64 + ty * dy as f64 >= 0.0 {
-                    1.0
-                } else {
-                    -1.0
-                };
-                dir = (sgn * tx, sgn * ty);
-                cur = q;
-                (cx, cy) = (cx + dx, cy + dy);
-                // Curves are smooth: the step after next most likely reads the pixels one more
-                // step ahead. Ask for their cache lines now (a hint only; no effect on the result).
-                let ahead = (cy + 2 * dy).clamp(0, h as i32 - 1) as usize * w
-                    + (cx + 2 * dx).clamp(0, w as i32 - 1) as usize;
-                prefetch(&zc.theta, ahead);
-                prefetch(&zc.strength, ahead);
-                prefetch(state, ahead);
-            }
-        };
-        let (mut fwd, mut bwd) = (Vec::new(), Vec::new());
-        // Seeds lie anywhere in the image (strength order): ask for a later seed's cache lines
-        // now, so its state and neighbourhood are there when its turn comes (a hint only).
-        const AHEAD: usize = 8;
-        for (i, &key) in keys.iter().enumerate() {
-            if let Some(&next) = keys.get(i + AHEAD) {
-                let q = next as u32 as usize;
-                prefetch(&state, q);
-                prefetch(&zc.theta, q.saturating_sub(w));
-                prefetch(&zc.theta, q);
-                prefetch(&zc.theta, (q + w).min(n - 1));
-                prefetch(&zc.strength, q);
-            }
-            let s = key as u32 as usize;
-            if state[s] != FREE {
-                continue;
-            }
-            state[s] = TAKEN;
-            let t0 = tangent(zc.theta[s]);
-            fwd.clear();
-            bwd.clear();
-            grow(s, t0, 1.0, &mut state, &mut fwd);
-            grow(s, t0, -1.0, &mut state, &mut bwd);
-            if 1 + fwd.len() + bwd.len() < p.min_len {
-                continue;
-            }
-            let mut pixels: Vec<(u32, (f64, f64))> = bwd.iter().rev().copied().collect();
-            pixels.push((s as u32, t0));
-            pixels.extend_from_slice(&fwd);
-            let id = segments.len() as i32;
-            segments.push(make_segment(w, &pixels, &mut labels, id).unwrap());
-        }
-        Ok(Curves {
-            segments,
-            labels,
-            t_high,
-            t_low,
-        })
-    }
 
     /// A segment's pixels, float fields by their bits, and bounds.
     type SegmentBits = (Vec<u32>, [u32; 3], [i32; 4]);
 
-    /// Every field of `c`, floats by their bits (NaN centroids and directions compare).
+    /// Every field of `c`, floats by their bits (NaN centroids and directions compare). A NaN
+    /// computed by arithmetic is one NaN: Rust leaves its sign unspecified (the kernel's
+    /// `ss += -tx` and the reference's `ss += sin` gave opposite signs on a NaN normal).
+    /// `t_high` is picked from the strengths, not computed: its bits are compared as they are,
+    /// NaN sign included.
     fn bits(c: &Curves) -> (Vec<SegmentBits>, &[i32], [u32; 2]) {
+        let any_nan = |v: f32| if v.is_nan() { f32::NAN } else { v }.to_bits();
         let segs = c
             .segments
             .iter()
             .map(|s| {
-                let f = [s.centroid.0, s.centroid.1, s.mean_theta].map(f32::to_bits);
+                let f = [s.centroid.0, s.centroid.1, s.mean_theta].map(any_nan);
                 (s.pixels.clone(), f, [s.x_min, s.x_max, s.y_min, s.y_max])
             })
             .collect();
-        (segs, &c.labels, [c.t_high.to_bits(), c.t_low.to_bits()])
+        (segs, &c.labels, [c.t_high.to_bits(), any_nan(c.t_low)])
     }
 
     /// Crossings of a `w x h` image: marks with probability `density`, strengths by `kind`
     /// (0: all equal, 1: three levels, 2: continuous, 3: with 0, NaN of either sign, inf,
-    /// denormal and negative values among them), normals by `kind` too (smooth, random, NaN).
+    /// denormal and negative values among them), normals by `kind` too (smooth, random, NaN
+    /// of either sign).
     fn crossings(w: usize, h: usize, density: f32, kind: usize, seed: u64) -> ZeroCrossings {
         let mut state = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1;
         let mut rnd = move || {
@@ -623,7 +443,7 @@ mod tests {
             theta[i] = match (kind + i) % 3 {
                 0 => (0.3 * x - 0.2 * y + 0.4 * rnd()).rem_euclid(std::f32::consts::TAU),
                 1 => [0.0, 0.0, 0.5, 5.9][(rnd() * 4.0) as usize],
-                _ if kind == 3 && rnd() < 0.05 => f32::NAN,
+                _ if kind == 3 && rnd() < 0.05 => [f32::NAN, -f32::NAN][i & 1],
                 _ => std::f32::consts::TAU * rnd(),
             };
             if mark[i] != 0 {
@@ -656,7 +476,7 @@ mod tests {
     }
 
     #[test]
-    fn one_pass_lists_and_reused_buffer_equal_the_old_tracker_on_edge_cases() {
+    fn one_pass_lists_and_reused_buffer_equal_the_plain_tracker_on_edge_cases() {
         let base = TrackParams {
             high_quantile: 0.5,
             low_ratio: 0.4,
@@ -715,14 +535,20 @@ mod tests {
                 for kind in 0..4 {
                     let zc = crossings(w, h, density, kind, (s * 16 + kind) as u64 + 1);
                     for q in [0.0, 0.3, 0.5, 0.99, 1.0] {
-                        let (new, old) =
-                            (high_threshold(&zc, q).unwrap(), high_threshold_old(&zc, q));
-                        assert_eq!(new.to_bits(), old.to_bits(), "{w}x{h} {density} {kind} {q}");
+                        let (new, want) = (
+                            high_threshold(&zc, q).unwrap(),
+                            high_threshold_reference(&zc, q),
+                        );
+                        assert_eq!(
+                            new.to_bits(),
+                            want.to_bits(),
+                            "{w}x{h} {density} {kind} {q}"
+                        );
                     }
                     for p in &params {
                         let new = track(&zc, p).unwrap();
-                        let old = track_old(&zc, p).unwrap();
-                        assert_eq!(bits(&new), bits(&old), "{w}x{h} {density} {kind} {p:?}");
+                        let want = track_reference(&zc, p);
+                        assert_eq!(bits(&new), bits(&want), "{w}x{h} {density} {kind} {p:?}");
                         segments += new.segments.len();
                         // Segments a longer min_len rejects after they grew.
                         short += new
