@@ -213,9 +213,13 @@ pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Result<Vec<Vec<u32>>
     }
     let by_dist = |a: &(f32, u32), b: &(f32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
     let max_ring = (r_max / cell).ceil() as i64 + 1;
-    let nearest: Vec<Vec<u32>> = (0..n)
-        .into_par_iter()
-        .map_init(Vec::new, |d: &mut Vec<(f32, u32)>, i| {
+    // The k nearest of every segment, and the points within r_max of one (`d`, up to every
+    // other centroid): checked, they grew by collect and push.
+    const NEAR: &str = "the MCGM matcher's nearest segments";
+    let mut nearest: Vec<Vec<u32>> = try_filled(n, Vec::new(), NEAR)?;
+    nearest.par_iter_mut().enumerate().try_for_each_init(
+        Vec::new,
+        |d: &mut Vec<(f32, u32)>, (i, out)| -> Result<()> {
             let (cx, cy) = key(cs[i]);
             let (cx, cy) = (cx as i64, cy as i64);
             let (x, y) = cs[i];
@@ -250,6 +254,7 @@ pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Result<Vec<Vec<u32>>
                                 let (u, v) = cs[j as usize];
                                 let dd = ((u - x) * (u - x) + (v - y) * (v - y)).sqrt();
                                 if dd <= r_max {
+                                    try_grow(d, 1, NEAR)?;
                                     d.push((dd, j));
                                 }
                             }
@@ -264,9 +269,10 @@ pub fn knn_graph(segs: &[Segment], k: usize, r_max: f32) -> Result<Vec<Vec<u32>>
                 d.truncate(k);
             }
             d.sort_by(by_dist);
-            d.iter().map(|&(_, j)| j).collect()
-        })
-        .collect();
+            *out = try_collect(d.len(), d.iter().map(|&(_, j)| j), NEAR)?;
+            Ok(())
+        },
+    )?;
     for (i, nb) in nearest.iter().enumerate() {
         for &j in nb {
             try_grow(&mut adj[i], 1, WHAT)?;
@@ -328,16 +334,20 @@ pub fn association_weights(
         try_grow(&mut by_right[c.right as usize], 1, BY)?;
         by_right[c.right as usize].push(i as u32);
     }
-    let rows: Vec<Vec<(u32, f32)>> = cands
-        .par_iter()
+    // A row per candidate, as long as its segments' candidates and its neighbours' together:
+    // checked (the rows grew by push, their list by collect).
+    const WHAT: &str = "the MCGM matcher's association weights";
+    let mut rows: Vec<Vec<(u32, f32)>> = try_filled(cands.len(), Vec::new(), WHAT)?;
+    rows.par_iter_mut()
+        .zip(cands)
         .enumerate()
-        .map(|(ia, ca)| {
-            let mut row: Vec<(u32, f32)> = Vec::new();
+        .try_for_each(|(ia, (row, ca))| -> Result<()> {
             for &ib in by_left[ca.left as usize]
                 .iter()
                 .chain(&by_right[ca.right as usize])
             {
                 if ib as usize != ia {
+                    try_grow(row, 1, WHAT)?;
                     row.push((ib, -p.b));
                 }
             }
@@ -358,6 +368,7 @@ pub fn association_weights(
                     }
                     let g = ((ca.tx - cb.tx).powi(2) + (ca.ty - cb.ty).powi(2)).sqrt() / dist;
                     let c = 2.0 / (1.0 + (p.dg_slope * (g - p.dg_0)).exp()) - 1.0;
+                    try_grow(row, 1, WHAT)?;
                     row.push((ib, norm * c));
                 }
             }
@@ -365,11 +376,9 @@ pub fn association_weights(
             // A and A' twice (same left and same right) would be the same candidate.
             row.sort_by_key(|e| e.0);
             row.dedup_by_key(|e| e.0);
-            row
-        })
-        .collect();
+            Ok(())
+        })?;
     // Allocated at once, checked (they grew by push, aborting on a failure).
-    const WHAT: &str = "the MCGM matcher's association weights";
     let nnz = rows.iter().map(Vec::len).sum();
     let mut csr = Csr::default();
     try_reserve_len(&mut csr.indptr, rows.len() + 1, WHAT)?;

@@ -645,19 +645,23 @@ fn windows(
     width: f32,
     lo_c: i32,
     hi_c: i32,
-) -> Vec<Option<(i32, i32)>> {
+) -> Result<Vec<Option<(i32, i32)>>> {
+    // One window per segment, and a segment's prior values (as long as the segment): checked,
+    // they were allocated by vec!/collect/with_capacity.
+    const WHAT: &str = "the MCGM matcher's disparity windows";
     let full = Some((lo_c, hi_c)).filter(|w| w.0 <= w.1);
+    let mut out = crate::alloc::try_filled(cc.curves.segments.len(), full, WHAT)?;
     let Some(prior) = prior else {
-        return vec![full; cc.curves.segments.len()];
+        return Ok(out);
     };
     let s = cc.scale as f32;
     let (w, sc) = (cc.width, cc.scale);
     let fh = prior.h;
-    cc.curves
-        .segments
-        .par_iter()
-        .map(|seg| {
-            let mut vals: Vec<f32> = Vec::with_capacity(seg.pixels.len());
+    out.par_iter_mut()
+        .zip(&cc.curves.segments)
+        .try_for_each(|(win, seg)| -> Result<()> {
+            let mut vals: Vec<f32> = Vec::new();
+            crate::alloc::try_reserve_len(&mut vals, seg.pixels.len(), WHAT)?;
             for &i in &seg.pixels {
                 let (x, y) = (i as usize % w, i as usize / w);
                 // Channel pixel centre in full-resolution coordinates, rounded (half away
@@ -669,16 +673,17 @@ fn windows(
                     vals.push(v / s);
                 }
             }
-            match median_lower(&mut vals) {
+            *win = match median_lower(&mut vals) {
                 None => full,
                 Some(d) => {
                     let lo = ((d - width).floor() as i32).max(lo_c);
                     let hi = ((d + width).ceil() as i32).min(hi_c);
                     (lo <= hi).then_some((lo, hi))
                 }
-            }
-        })
-        .collect()
+            };
+            Ok(())
+        })?;
+    Ok(out)
 }
 
 /// Per-pixel correspondences along the chosen pairs (B.4.12), in full-resolution coordinates.
@@ -695,12 +700,15 @@ fn decompose(
     let half = 0.5 * CHANNEL_WIDTH_SIGMAS * l.sigma;
     let s = l.scale as f32;
     let to_full = |v: f32| s * v + 0.5 * (s - 1.0);
-    let per: Vec<Vec<Match>> = chosen
-        .par_iter()
-        .map(|&ci| {
+    // The matches of each chosen pair (up to one a pixel of its left segment), and their list:
+    // checked, they grew by push and collect.
+    const WHAT: &str = "the MCGM matcher's curve matches";
+    let mut per: Vec<Vec<Match>> = crate::alloc::try_filled(chosen.len(), Vec::new(), WHAT)?;
+    per.par_iter_mut()
+        .zip(chosen)
+        .try_for_each(|(out, &ci)| -> Result<()> {
             let c = &cands[ci];
             let seg = &l.curves.segments[c.left as usize];
-            let mut out = Vec::new();
             for &i in &seg.pixels {
                 let i = i as usize;
                 if (l.zc.theta[i] as f64).cos().abs() < min_cos {
@@ -728,6 +736,7 @@ fn decompose(
                 }
                 let _ = x;
                 if let Some((_, q)) = best {
+                    crate::alloc::try_grow(out, 1, WHAT)?;
                     out.push(Match {
                         xl: to_full(xp),
                         yl: to_full(y as f32),
@@ -738,10 +747,9 @@ fn decompose(
                     });
                 }
             }
-            out
-        })
-        .collect();
-    crate::alloc::try_concat(per, "the MCGM matcher's curve matches")
+            Ok(())
+        })?;
+    crate::alloc::try_concat(per, WHAT)
 }
 
 /// Mean absolute difference of one half-window (columns `xi + side * (inner..=outer)`, rows
@@ -1596,7 +1604,7 @@ fn match_channel(
                 p.prior_width_sigmas * l.sigma,
                 lo_c,
                 hi_c,
-            );
+            )?;
             let cands = candidates(
                 &l.curves.segments,
                 &l.rtables,

@@ -1970,7 +1970,7 @@ fn windows_equal_the_lower_median_of_the_prior_at_pixel_centres() {
         .collect();
     let sp = SpreadPrior::new(&map, fw, fh, 0).unwrap();
     let width = CHANNEL_WIDTH_SIGMAS * 2.0;
-    let got = windows(&cc, Some(&sp), fw, width, 0, 40);
+    let got = windows(&cc, Some(&sp), fw, width, 0, 40).unwrap();
     let mut n_even = 0;
     for (seg, g) in cc.curves.segments.iter().zip(&got) {
         let mut v: Vec<f32> = seg
@@ -2025,7 +2025,7 @@ fn channel_prior_and_combination_follow_the_definitions() {
     }
     let sp = SpreadPrior::new(&map, fw, fh, 16).unwrap();
     let cc = &image_curves(&l, &p).unwrap()[1];
-    let want = windows(cc, Some(&sp), fw, p.prior_width_sigmas * cc.sigma, 0, 15);
+    let want = windows(cc, Some(&sp), fw, p.prior_width_sigmas * cc.sigma, 0, 15).unwrap();
     assert_eq!(out.channels[1].windows, want);
     // Combination: no two channels' matches within fill_radius on a row.
     let mut by_row: std::collections::HashMap<i32, Vec<(i32, u8)>> = Default::default();
@@ -2718,6 +2718,122 @@ fn graph_buffers_too_large_to_allocate_are_an_error() {
     ] {
         let stdout = crate::segment::tests::run_oom_child_with(
             "matching::mcgm::tests::graph_buffers_under_a_memory_limit",
+            Some(("SV_MCGM_OOM_CASE", case)),
+        );
+        let want = format!("child: error: out of memory: {want}");
+        assert!(stdout.contains(&want), "{case}: {want} not in {stdout}");
+    }
+}
+
+/// Run by [`segment_lists_too_large_to_allocate_are_an_error`] in a child process, one case
+/// (`SV_MCGM_OOM_CASE`) under an address-space limit a little above what is mapped: a list kept
+/// per segment, per candidate or per chosen pair whose length grows with a curve or with the
+/// segments, larger than the room left.
+#[cfg(target_os = "linux")]
+#[test]
+#[ignore = "a child of segment_lists_too_large_to_allocate_are_an_error"]
+fn segment_lists_under_a_memory_limit() {
+    if std::env::var_os("SV_OOM_CHILD").is_none() {
+        return;
+    }
+    let seg = |pixels: Vec<u32>| Segment {
+        pixels,
+        centroid: (0.0, 0.0),
+        x_min: 0,
+        x_max: 0,
+        y_min: 0,
+        y_max: 0,
+        mean_theta: 0.0,
+    };
+    let case = std::env::var("SV_MCGM_OOM_CASE").unwrap();
+    let p = McgmParams::default();
+    let limit = |extra: usize| {
+        rayon::join(|| (), || ()); // the pool's thread started before the limit
+        crate::segment::tests::limit_address_space(crate::segment::tests::vm_size() + extra);
+    };
+    let r = match case.as_str() {
+        // 2^20 candidates of one segment pair: each one's row lists the others twice (16 MiB);
+        // the rows' list (24 MiB) and the candidates per segment (8 MiB) fit, a few rows do not.
+        "weights_row" => {
+            let cand = graph::Candidate {
+                left: 0,
+                right: 0,
+                score: 1.0,
+                tx: 0.0,
+                ty: 0.0,
+            };
+            let cands = vec![cand; 1 << 20];
+            let left = [seg(vec![0])];
+            limit(64 << 20);
+            graph::association_weights(&cands, &left, &[Vec::new()], 1, &p.solver).map(|c| c.nnz())
+        }
+        // 2^20 segments at one centroid: the adjacency, centroids, nearest lists and grid
+        // (60 bytes a segment) fit, the points within r_max of one (8 bytes each) do not.
+        "nearest" => {
+            let segs: Vec<Segment> = (0..1 << 20).map(|_| seg(vec![0])).collect();
+            limit((60 << 20) + (2 << 20));
+            graph::knn_graph(&segs, 1, 4.0).map(|a| a.len())
+        }
+        // A segment of 2^23 pixels: its prior values (32 MiB) do not fit in 16 MiB.
+        "windows" => {
+            let mut cc = channel_curves(&blobs(60, 45, 0.0), 2.0, 1, &p).unwrap();
+            cc.curves.segments.push(seg(vec![0; 1 << 23]));
+            let map = vec![20.0f32; 60 * 45];
+            let sp = SpreadPrior::new(&map, 60, 45, 0).unwrap();
+            limit(16 << 20);
+            windows(&cc, Some(&sp), 60, 4.0, 0, 40).map(|w| w.len())
+        }
+        // A chosen pair whose left segment lists one matching pixel 2^20 times: its matches
+        // (24 MiB) do not fit in 16 MiB.
+        "decompose" => {
+            let mut l = channel_curves(&blobs(60, 45, 0.0), 2.0, 1, &p).unwrap();
+            let mut r = l.clone();
+            l.curves.segments = vec![seg(vec![0; 1 << 20])];
+            (l.zc.theta[0], l.zc.xsub[0]) = (0.0, 0.0);
+            (r.curves.labels[0], r.zc.xsub[0]) = (0, 0.0);
+            let cand = graph::Candidate {
+                left: 0,
+                right: 0,
+                score: 1.0,
+                tx: 0.0,
+                ty: 0.0,
+            };
+            limit(16 << 20);
+            decompose(&l, &r, &[cand], &[0], p.horiz_skip_deg, 0).map(|m| m.len())
+        }
+        other => panic!("no case {other}"),
+    };
+    match r {
+        Ok(n) => println!("child: {case} {n}"),
+        Err(e) => println!("child: error: {e}"),
+    }
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn segment_lists_too_large_to_allocate_are_an_error() {
+    // An association-weight row per candidate, the points near a segment's centroid in the
+    // k-NN search, a segment's prior values for its window and a chosen pair's matches were
+    // allocated with push/collect/with_capacity: a failed allocation aborted the process
+    // (SIGABRT) instead of returning OutOfMemory.
+    for (case, want) in [
+        (
+            "weights_row",
+            "the MCGM matcher's association weights needs 8.00 MiB (8388616 bytes)",
+        ),
+        // (Where `d` fails depends on the room the heap left: its size is not asserted.)
+        ("nearest", "the MCGM matcher's nearest segments needs "),
+        (
+            "windows",
+            "the MCGM matcher's disparity windows needs 32.00 MiB (33554432 bytes)",
+        ),
+        (
+            "decompose",
+            "the MCGM matcher's curve matches needs 12.00 MiB (12582936 bytes)",
+        ),
+    ] {
+        let stdout = crate::segment::tests::run_oom_child_with(
+            "matching::mcgm::tests::segment_lists_under_a_memory_limit",
             Some(("SV_MCGM_OOM_CASE", case)),
         );
         let want = format!("child: error: out of memory: {want}");
