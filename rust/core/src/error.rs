@@ -30,6 +30,15 @@ pub enum CoreError {
     /// A parameter is out of its valid range.
     #[error("invalid parameter `{name}`: {reason}")]
     InvalidParameter { name: &'static str, reason: String },
+    /// An image has more pixels, or a longer side, than the kernels' 32-bit pixel indices and
+    /// coordinates reach ([`crate::image::check_index_range`]); they would wrap silently.
+    #[error(
+        "image of {width}x{height} pixels is too large: the kernels index pixels with 32-bit \
+         integers (at most {} pixels, {} per side)",
+        crate::image::MAX_PIXELS,
+        crate::image::MAX_SIDE
+    )]
+    TooLarge { width: usize, height: usize },
     /// A buffer could not be allocated (the binding raises `MemoryError` instead of the
     /// process aborting).
     #[error("out of memory: {what} needs {} and the allocation failed", crate::alloc::human_bytes(*.bytes))]

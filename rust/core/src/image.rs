@@ -120,6 +120,28 @@ impl Image {
     }
 }
 
+/// Most pixels of an image the kernels take: pixel indices `y * w + x` and pixel counts are
+/// held in `u32` (MCGM's segments and seeds, the graph and colour segmentations, Gabor's
+/// component labels, Hopfield's interest points).
+pub const MAX_PIXELS: usize = u32::MAX as usize;
+/// Longest side: columns and rows are held in `i32` (MCGM's tracking, Hopfield's matches, the
+/// refinement's warp).
+pub const MAX_SIDE: usize = i32::MAX as usize;
+
+/// Refuses a `width x height` image whose pixel indices or coordinates would not fit the
+/// kernels' 32-bit integers ([`MAX_PIXELS`], [`MAX_SIDE`]): [`CoreError::TooLarge`] instead of
+/// indices that wrap silently. Reads the dimensions only (a kernel calls it once, first).
+pub fn check_index_range(width: usize, height: usize) -> Result<()> {
+    let fits = width <= MAX_SIDE
+        && height <= MAX_SIDE
+        && width.checked_mul(height).is_some_and(|n| n <= MAX_PIXELS);
+    if fits {
+        Ok(())
+    } else {
+        Err(CoreError::TooLarge { width, height })
+    }
+}
+
 /// Checks that a stereo pair has the same, non-empty size.
 pub fn check_pair(left: &Image, right: &Image) -> Result<()> {
     if left.size() != right.size() {
@@ -405,5 +427,83 @@ mod tests {
             grey_from_u8(&[0; 5], 2, 2, 1, w),
             Err(CoreError::InvalidParameter { name: "image", .. })
         ));
+    }
+
+    /// Shapes at and past the 32-bit limits of [`check_index_range`].
+    const TOO_LARGE: [(usize, usize); 4] = [
+        (1 << 16, 1 << 16), // 2^32 pixels: one more than u32 holds
+        (MAX_SIDE + 1, 1),  // a row past i32
+        (1, MAX_SIDE + 1),  // a column past i32
+        (usize::MAX, 2),    // a product past usize
+    ];
+
+    #[test]
+    fn check_index_range_refuses_indices_past_32_bits() {
+        for (w, h) in [(1, 1), (3, MAX_PIXELS / 3), (MAX_SIDE, 2), (65535, 65537)] {
+            assert_eq!(check_index_range(w, h), Ok(()), "{w}x{h}");
+        }
+        for (w, h) in TOO_LARGE {
+            assert_eq!(
+                check_index_range(w, h),
+                Err(CoreError::TooLarge {
+                    width: w,
+                    height: h
+                })
+            );
+        }
+        assert_eq!(
+            CoreError::TooLarge {
+                width: 65536,
+                height: 65536
+            }
+            .to_string(),
+            "image of 65536x65536 pixels is too large: the kernels index pixels with 32-bit \
+             integers (at most 4294967295 pixels, 2147483647 per side)"
+        );
+    }
+
+    #[test]
+    fn kernels_refuse_images_past_32_bit_indices_before_reading_them() {
+        // Their pixel indices (u32) or coordinates (i32) wrapped silently past the limits
+        // (or the kernel indexed past its buffers). The shape alone is checked first: the
+        // buffers here are empty, an image that size cannot be allocated in a test.
+        use crate::matching::{gabor, hopfield, mcgm};
+        let too_large = |w, h| {
+            Err::<(), _>(CoreError::TooLarge {
+                width: w,
+                height: h,
+            })
+        };
+        for (w, h) in TOO_LARGE {
+            let img = Image {
+                width: w,
+                height: h,
+                data: Vec::new(),
+            };
+            let ok = |r: Result<()>| assert_eq!(r, too_large(w, h), "{w}x{h}");
+            let mp = mcgm::McgmParams::default();
+            ok(mcgm::mcgm_match(&img, &img, &mp).map(|_| ()));
+            ok(mcgm::image_curves(&img, &mp).map(|_| ()));
+            let zc = mcgm::zerocross::ZeroCrossings {
+                width: w,
+                height: h,
+                mark: Vec::new(),
+                xsub: Vec::new(),
+                strength: Vec::new(),
+                theta: Vec::new(),
+            };
+            ok(mcgm::tracking::track(&zc, &mp.track).map(|_| ()));
+            let hp = hopfield::HopfieldParams::default();
+            ok(hopfield::hopfield_match(&img, &img, &hp).map(|_| ()));
+            ok(hopfield::best_match(&img, &img, &hp).map(|_| ()));
+            let gp = gabor::GaborParams::default();
+            ok(gabor::gabor_disparity(&img, &img, &gp).map(|_| ()));
+            let rp = crate::refine::RefineParams::default();
+            let r =
+                crate::refine::refine_disparity(img.view(), img.view(), &[], &[], 0.0, 1.0, &rp);
+            ok(r.map(|_| ()));
+            ok(crate::segment::graph_segments(&[], w, h, 1, 1.0, 1).map(|_| ()));
+            ok(crate::segment::quantised_regions(&[], w, h, 1, 8, 0).map(|_| ()));
+        }
     }
 }

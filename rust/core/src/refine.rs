@@ -973,6 +973,8 @@ fn refine_disparity_hot(
             right: (right.width, right.height),
         });
     }
+    // The warp holds columns in i32.
+    crate::image::check_index_range(w, h)?;
     check_map_pair(disp, conf, w, h)?;
     if !(d_min.is_finite() && d_max.is_finite() && d_max > d_min) {
         return Err(CoreError::param(

@@ -79,6 +79,8 @@ pub fn graph_segments(
     k: f32,
     min_size: usize,
 ) -> Result<Vec<u32>> {
+    // The forest and the edges hold pixel indices in u32.
+    crate::image::check_index_range(w, h)?;
     assert!(
         c > 0 && img.len() == w * h * c,
         "image size does not match w * h * c"
@@ -187,6 +189,8 @@ pub fn quantised_regions(
     offset: u32,
 ) -> Result<Vec<u32>> {
     let what = "the colour regions' tables";
+    // The region forest holds pixel indices in u32.
+    crate::image::check_index_range(w, h)?;
     assert!(
         (1..=3).contains(&c) && img.len() == w * h * c,
         "image size does not match w * h * c"

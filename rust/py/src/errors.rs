@@ -11,7 +11,8 @@ pub fn to_pyerr(err: CoreError) -> PyErr {
         | CoreError::BufferSize { .. }
         | CoreError::SizeMismatch { .. }
         | CoreError::NonFinite { .. }
-        | CoreError::InvalidParameter { .. } => PyValueError::new_err(err.to_string()),
+        | CoreError::InvalidParameter { .. }
+        | CoreError::TooLarge { .. } => PyValueError::new_err(err.to_string()),
         CoreError::OutOfMemory { .. } => PyMemoryError::new_err(err.to_string()),
     }
 }

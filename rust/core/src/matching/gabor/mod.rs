@@ -326,6 +326,8 @@ fn gabor_disparity_hot(
             right: right.size(),
         });
     }
+    // The post-processing labels its components in u32.
+    crate::image::check_index_range(left.width, left.height)?;
     params.validate()?;
     let chans = params.channels()?;
     let (w, h) = left.size();

@@ -209,6 +209,8 @@ fn validate(left: &ImageView<'_>, right: &ImageView<'_>, p: &HopfieldParams) -> 
             right: right.size(),
         });
     }
+    // Interest points are numbered in u32, matched positions held in i32.
+    crate::image::check_index_range(left.width, left.height)?;
     if p.d_max < p.d_min {
         return Err(CoreError::param(
             "max_disparity",

@@ -451,6 +451,7 @@ pub fn channel_curves(
 /// Curves of every channel of one image (the debugging / GUI view of `curves(image)`).
 pub fn image_curves(img: &Image, p: &McgmParams) -> Result<Vec<ChannelCurves>> {
     validate_params(p)?;
+    crate::image::check_index_range(img.width, img.height)?;
     let half = needs_half(p).then(|| log::decimate2(img)).transpose()?;
     p.sigmas
         .par_iter()
@@ -1710,6 +1711,8 @@ pub fn mcgm_match(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOut
 /// The body of [`mcgm_match`], run inside the pool ([`crate::parallel::run_hot`]).
 fn mcgm_match_hot(left: &Image, right: &Image, p: &McgmParams) -> Result<McgmOutput> {
     check_pair(left, right)?;
+    // Segments and seeds index pixels in u32: refused before any plane is computed.
+    crate::image::check_index_range(left.width, left.height)?;
     validate_params(p)?;
     let (fw, fh) = left.size();
     // Curves of every channel; the finest (the most pixels) computed beside the coarser

@@ -172,6 +172,9 @@ fn radix_sort_upper(keys: &mut Vec<u64>) -> Result<()> {
 /// Tracks the crossings into segments.
 pub fn track(zc: &ZeroCrossings, p: &TrackParams) -> Result<Curves> {
     let (w, h) = (zc.width, zc.height);
+    // Pixel indices are u32 here (the marked list, the seeds' keys, the segments), positions
+    // i32: a larger image is refused, not wrapped.
+    crate::image::check_index_range(w, h)?;
     let n = w * h;
     // The marked pixels (a third or less of the image) listed once: the threshold, the
     // candidates and the seeds are found among them instead of in three passes over every
