@@ -500,6 +500,50 @@ def test_video_pair_opens_the_sequences_capture_opens(
     assert "WARN" not in capfd.readouterr().err
 
 
+def test_video_pair_quiets_only_the_sequences_grab(tmp_path: Path) -> None:
+    """A video paired with an image sequence: both grabs ran with OpenCV's process-wide log
+    silenced, so the video's (or a camera's) own warnings were lost, and every other
+    thread's meanwhile. Only the sequence's grab is quiet now; the level is put back."""
+    log = cv2.utils.logging
+    video = tmp_path / "l.avi"
+    writer = cv2.VideoWriter(str(video), cv2.VideoWriter_fourcc(*"MJPG"), 5, (8, 6))
+    for k in range(3):
+        writer.write(np.full((6, 8, 3), 10 * k, np.uint8))
+    writer.release()
+    for k in range(5, 8):  # from 5: read by _ImageSequence
+        cv2.imwrite(str(tmp_path / f"r_{k:03d}.png"), np.full((6, 8), 100 + k, np.uint8))
+
+    class Recorder:
+        """A capture that records OpenCV's log level at each grab."""
+
+        def __init__(self, cap: Any, levels: list[int]) -> None:
+            self.cap, self.levels = cap, levels
+
+        def grab(self) -> bool:
+            self.levels.append(log.getLogLevel())
+            return bool(self.cap.grab())
+
+        def __getattr__(self, name: str) -> Any:
+            return getattr(self.cap, name)
+
+    before = log.getLogLevel()
+    log.setLogLevel(log.LOG_LEVEL_WARNING)
+    try:
+        pair = VideoPair(str(video), str(tmp_path / "r_%03d.png"))
+        seen: tuple[list[int], list[int]] = ([], [])
+        pair._caps = [Recorder(c, s) for c, s in zip(pair._caps, seen, strict=True)]
+        try:
+            got = [int(pair.read()[1][0, 0, 0]) for _ in range(4)]
+        finally:
+            pair.close()
+        assert got == [105, 106, 107, 105]  # played again after the last
+        assert set(seen[0]) == {log.LOG_LEVEL_WARNING}  # the video's warnings are said
+        assert set(seen[1]) == {log.LOG_LEVEL_SILENT}
+        assert log.getLogLevel() == log.LOG_LEVEL_WARNING
+    finally:
+        log.setLogLevel(before)
+
+
 # ----------------------------------------------------------------------------- _CaptureAdapter
 
 

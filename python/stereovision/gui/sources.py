@@ -387,8 +387,9 @@ class VideoPair:
         check_read_timeout(open_timeout, "open_timeout")
         self._caps: list[cv2.VideoCapture] = []
         self._files = []
-        #: An image sequence is read: its reader logs a warning for the file after the last.
-        self._sequence = False
+        #: Which sources are image sequences: their reader logs a warning for the file after
+        #: the last, kept quiet; a camera's or video's warnings are not.
+        self._sequence: list[bool] = []
         try:
             for side, src in (("left", left), ("right", right)):
                 src = parse_source(src)
@@ -407,7 +408,7 @@ class VideoPair:
                     raise OSError(f"cannot open camera {src!r} ({side}){camera_hint(src)}")
                 self._caps.append(cap)
                 self._files.append(is_file)
-                self._sequence |= first is not None
+                self._sequence.append(first is not None)
         except BaseException:
             self.close()
             raise
@@ -427,8 +428,12 @@ class VideoPair:
     def _pair(self) -> tuple[npt.NDArray[np.uint8] | None, npt.NDArray[np.uint8] | None]:
         # Both grabbed before either is decoded: read() one after the other took the right
         # frame a whole decode later than the left.
-        with _opencv_quiet() if self._sequence else contextlib.nullcontext():
-            grabbed = [cap.grab() for cap in self._caps]
+        # Only a sequence's grab is quiet: OpenCV's log level is process-wide, and both grabs
+        # quiet silenced a camera's or video's own warnings (and every thread's meanwhile).
+        grabbed = []
+        for cap, sequence in zip(self._caps, self._sequence, strict=True):
+            with _opencv_quiet() if sequence else contextlib.nullcontext():
+                grabbed.append(cap.grab())
         return self._decode(0, grabbed[0]), self._decode(1, grabbed[1])
 
     def read(self) -> tuple[npt.NDArray[np.uint8], npt.NDArray[np.uint8]]:
