@@ -5700,6 +5700,47 @@ def test_a_failed_open_calls_cameras_typed_by_their_device_node_cameras(tmp_path
     assert refused(("/dev/video0x", "/dev/video1")) == source
 
 
+def test_a_streams_password_is_not_said_on_the_page_nor_logged(caplog):
+    """A stream is named by its whole URL since f723ecb (it was named by its last part):
+    one typed with a password (``rtsp://admin:s3cret@cam/0``) had it said in the page's
+    messages ("reading ...", a failed Open's "the source in use, ...") and in the server's
+    log. The password is said as ``***``; the user and the rest are kept."""
+    import logging
+
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.app import _source_name
+
+    raw = (cv2.imread(str(CONES / "left.png")), cv2.imread(str(CONES / "right.png")))
+
+    class Cameras:
+        def __init__(self, pair):
+            self.pair = pair
+
+        def read(self):
+            if self.pair is None:
+                raise OSError("camera 3 gave no frame")
+            return self.pair
+
+        def close(self):
+            pass
+
+    names = ("rtsp://admin:s3cret@cam/0", "rtsp://admin:p@ss:w@cam:554/1?x=a:b@c")
+    app = _scene_app("test-stream-password", [bundled_data_dir()], source=Cameras(raw))
+    app._source_names = names
+    app._spawn = lambda coro: coro.close()
+    caplog.set_level(logging.INFO, logger="stereovision")
+    app._switch_source(Cameras(None), ("2", "3"))
+    assert app.state.error == (
+        "camera 3 gave no frame (the source in use, rtsp://admin:***@cam/0 and "
+        "rtsp://admin:***@cam:554/1?x=a:b@c, is unchanged)"
+    )
+    assert "s3cret" not in caplog.text and "p@ss" not in caplog.text
+    assert app.state.error in caplog.text  # logged, as said
+    # no password: the URL as typed (a port, an "@" after the host's "/" is no password)
+    for url in ("rtsp://cam:554/0", "rtsp://admin@cam/0", "http://cam:80/a:b@c"):
+        assert _source_name(url) == url
+
+
 def test_check_rows_of_files_at_another_resolution_uses_the_calibration_scaled(tmp_path):
     """Files at half the --calib size: "Check rows" checks them with the calibration scaled
     to them, as their view is computed (not refused as of another image size)."""

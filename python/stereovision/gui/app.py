@@ -1181,12 +1181,19 @@ def _pending_key(src: int | str) -> int | str:
     return src
 
 
+# A URL's password: its user and the scheme kept, the authority's last "@" its end.
+_URL_PASSWORD = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*://[^/@:]*):[^/]*@")
+
+
 def _source_name(src: int | str) -> str:
     """A camera source as the page names it: ``camera 0``, the file's name, or a stream's
-    whole URL (``rtsp://rig/0`` was named ``0``, as camera 0 might be)."""
+    whole URL (``rtsp://rig/0`` was named ``0``, as camera 0 might be), its password, if
+    any, said as ``***``: the name goes into the page's messages and the server's log."""
     if isinstance(src, int):
         return f"camera {src}"
-    return src if "://" in src else Path(src).name or src
+    if "://" in src:
+        return _URL_PASSWORD.sub(r"\1:***@", src, count=1)
+    return Path(src).name or src
 
 
 @dataclass
