@@ -5704,7 +5704,8 @@ def test_a_streams_password_is_not_said_on_the_page_nor_logged(caplog):
     """A stream is named by its whole URL since f723ecb (it was named by its last part):
     one typed with a password (``rtsp://admin:s3cret@cam/0``) had it said in the page's
     messages ("reading ...", a failed Open's "the source in use, ...") and in the server's
-    log. The password is said as ``***``; the user and the rest are kept."""
+    log. The password is said as ``***``; the user and the rest are kept. The pair's label
+    named streams by their last part still ("cameras 0 / 1"): by their URLs now."""
     import logging
 
     from stereovision.gui import bundled_data_dir
@@ -5736,6 +5737,11 @@ def test_a_streams_password_is_not_said_on_the_page_nor_logged(caplog):
     )
     assert "s3cret" not in caplog.text and "p@ss" not in caplog.text
     assert app.state.error in caplog.text  # logged, as said
+    # the pair's label names the streams so too: "cameras 0 / 1" was said of them, as of
+    # cameras 0 and 1
+    app._switch_source(Cameras(raw), ("rtsp://rig/0", names[0]))
+    assert app.state.error == ""
+    assert app.state.source_label == "cameras rtsp://rig/0 / rtsp://admin:***@cam/0"
     # no password: the URL as typed (a port, an "@" after the host's "/" is no password)
     for url in ("rtsp://cam:554/0", "rtsp://admin@cam/0", "http://cam:80/a:b@c"):
         assert _source_name(url) == url

@@ -1777,7 +1777,12 @@ class StereoApp:
         self.calib = calib
         self._no_calib = None
         self.max_disparity = None
-        names = (Path(str(n)).name or str(n) for n in self._source_names)
+        # a stream by its URL, as the page's messages name it (_source_name): by its last part,
+        # rtsp://rig/0 and rtsp://rig/1 were labelled "cameras 0 / 1", as cameras 0 and 1 are
+        names = (
+            _source_name(str(n)) if "://" in str(n) else Path(str(n)).name or str(n)
+            for n in self._source_names
+        )
         label = self._source_label or "cameras " + " / ".join(names)
         self.state.source_label = (got.folder or label) + got.averaged
         self.state.rows_label = ""
