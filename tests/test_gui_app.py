@@ -2190,6 +2190,41 @@ def test_the_offered_save_folder_skips_a_saved_that_cannot_be_used(tmp_path, mon
     assert list(home.glob("stereovision-saved*")) == []  # nothing went home
 
 
+@pytest.mark.parametrize("becomes", ["removed", "a file"])
+def test_a_saved_changed_while_looked_at_is_not_said_unusable(tmp_path, monkeypatch, becomes):
+    """A ``saved`` removed (or replaced by a file) between its look and its listing was said
+    "saved cannot be listed: No such file or directory" ("Not a directory"): left alone as
+    unusable, the Save sent to ``saved-2``. A removed one is made by the Save, as one that
+    never was; a file put in its place is skipped as a file named ``saved`` is, unsaid."""
+    from stereovision.gui import bundled_data_dir
+
+    data = tmp_path / "mine"
+    bad = data / "saved"
+    bad.mkdir(parents=True)
+    real_iterdir = Path.iterdir
+
+    def iterdir(self: Path) -> Any:
+        if self.resolve() == bad.resolve() and bad.is_dir():  # the race, made certain
+            bad.rmdir()
+            if becomes == "a file":
+                bad.write_text("not a folder")
+        return real_iterdir(self)
+
+    monkeypatch.setattr(Path, "iterdir", iterdir)
+    app = _scene_app(f"test-save-race-{becomes.replace(' ', '-')}", [bundled_data_dir(), data])
+    app._load_scene(bundled_data_dir() / "cones")
+    _run(app, app.recompute)
+    if not bad.is_dir():  # the page's hints looked at it too: the race again at the Save
+        bad.unlink(missing_ok=True)
+        bad.mkdir()
+    _run(app, app.save)
+    assert app.state.error == ""
+    into = "saved" if becomes == "removed" else "saved-2"
+    assert app.state.save_label.startswith(f"saved 450×375 to mine/{into}: ")
+    assert app.state.save_label.endswith(".png")  # nothing said left alone
+    assert (data / into / "disparity.png").is_file()
+
+
 def test_the_offered_save_folder_skips_a_link_named_saved(tmp_path):
     """A ``saved`` in --data that was a symbolic link leading outside it made every Save as
     offered fail with "folder outside the --data folders: saved", a folder the user never

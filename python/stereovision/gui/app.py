@@ -2909,8 +2909,12 @@ class StereoApp:
                 why = why and f"cannot be written: {why}"
             except OSError as exc:  # it may hold files: not written into
                 why = f"cannot be listed: {exc.strerror or exc}"
-            if not why:
+            # removed, or made a file, since it was looked at: not said to be unusable ("saved
+            # cannot be listed: No such file or directory" of a folder the Save could make)
+            if not why or not os.path.lexists(folder):
                 return folder
+            if not folder.is_dir():
+                continue
             if unusable is not None:
                 unusable.append(f"{name} {why}")
         raise AssertionError("unreachable")  # pragma: no cover
