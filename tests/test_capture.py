@@ -1618,6 +1618,30 @@ def test_cli_capture_from_a_recording_shows_its_frames_bar_on_a_terminal(
     assert not re.search(r"[4-6]/3 ", terminal.text)
 
 
+def test_cli_capture_warning_while_reading_goes_above_the_frames_bar(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A warning while the bar was drawn (the right frames resized at the first read) was
+    printed onto the bar's line, "| 0/6 [00:00<?, ?frame/s]stereovision: warning: ...": the
+    bar is now cleared first, the warning a line of its own, and the bar drawn again below."""
+    from stereovision.cli import main
+
+    left = _write_sequence(tmp_path / "seq", "left", [_numbered(i, (64, 48)) for i in range(6)])
+    right = _write_sequence(tmp_path / "seq", "right", [_numbered(i, (32, 24)) for i in range(6)])
+    terminal = _Terminal()
+    monkeypatch.setattr("sys.stderr", terminal)
+    args = ["capture", "--left", left, "--right", right, "--every", "2"]
+    assert main([*args, "-o", str(tmp_path / "a")]) == 0
+    warning = "stereovision: warning: right source "
+    assert terminal.text.count(warning) == 1
+    before, after = terminal.text.split(warning)
+    assert before.endswith("\r") and before.rsplit("\r", 2)[-2].strip() == ""  # cleared
+    assert after.split("\n")[0].endswith("delivers 32x24, not 64x48: its frames are resized")
+    assert "| 0/6 [" in after.split("\n", 1)[1]  # drawn again below it
+    assert terminal.text.rsplit("\r", 2)[-2].strip() == ""  # and gone at the end
+    assert capsys.readouterr().out.splitlines()[-1].startswith("3 pairs saved in")
+
+
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 @pytest.mark.parametrize(
     ("sig", "status", "what"), [(2, 130, "interrupted"), (15, 143, "terminated (SIGTERM)")]

@@ -2751,10 +2751,11 @@ class _FramesBar:
     through a recording (``--chessboard``, ``--from-bag``) read hundreds of pairs between two
     "saved" lines without a word, where the recording says its frames (``total``). Nothing for
     a camera (no total: its "saved" lines are its progress) nor off a terminal (a log); the
-    lines said go above the bar."""
+    lines said go above the bar, the warnings too."""
 
     def __init__(self) -> None:
         self.bar: Any = None
+        self._shown: Any = None  # warnings.showwarning before the bar's
 
     def start(self, total: int) -> None:
         """Draw the bar of ``total`` frames, on a terminal only (none for a total of 0)."""
@@ -2762,6 +2763,15 @@ class _FramesBar:
             from tqdm import tqdm
 
             self.bar = tqdm(total=total, desc="frames", unit="frame", file=sys.stderr, leave=False)
+            # a warning while reading (a source's frames resized) was printed onto the bar's
+            # line ("| 0/6 [...]stereovision: warning: ..."): it now goes above the bar
+            shown = self._shown = warnings.showwarning
+
+            def above(*args: Any, **kwargs: Any) -> None:
+                with tqdm.external_write_mode(file=sys.stderr):
+                    shown(*args, **kwargs)
+
+            warnings.showwarning = above
 
     def update(self, read: int) -> None:
         if self.bar is not None:
@@ -2779,6 +2789,7 @@ class _FramesBar:
         if self.bar is not None:
             self.bar.close()
             self.bar = None
+            warnings.showwarning = self._shown
 
 
 def cmd_capture(args: argparse.Namespace) -> int:
