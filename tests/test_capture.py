@@ -3644,3 +3644,27 @@ def test_a_stray_name_beside_a_space_padded_sequence_keeps_its_hint(tmp_path: Pa
     assert told == f"{q}/q %d.png"
     with StereoCamera(told, told) as cam:
         assert _read_stamp(cam.read().left) == 5
+
+
+@pytest.mark.parametrize(("start", "junk"), [(0, b"truncated"), (5, b"text")])
+def test_a_sequence_whose_first_image_does_not_read_names_it(
+    tmp_path: Path, start: int, junk: bytes
+) -> None:
+    """A sequence whose first image is there but does not read: from 0 with a truncated PNG,
+    neither CAP_IMAGES nor _ImageSequence opened it and FFmpeg's did, then "ended after 0 of
+    the 4 frames its header announces: the file ended early", as of a video; from 5 with a
+    text file in its place, "cannot open" without a word of the file. Both now name it."""
+    frames = [_numbered(i) for i in range(start + 4)]
+    left = _write_sequence(tmp_path, "left", frames)
+    right = _write_sequence(tmp_path, "right", frames)
+    for i in range(start):
+        (tmp_path / f"left_{i:03d}.png").unlink()
+        (tmp_path / f"right_{i:03d}.png").unlink()
+    first = tmp_path / f"left_{start:03d}.png"
+    first.write_bytes(first.read_bytes()[:60] if junk == b"truncated" else junk)
+    with pytest.raises(SourceError) as info:
+        StereoCamera(left, right)
+    assert str(info.value) == (
+        f"cannot open left source {left!r}: its first image, left_{start:03d}.png, does not "
+        "read (damaged?)"
+    )

@@ -1056,6 +1056,23 @@ def _open_path(path: str, first: tuple[int, str] | None) -> Any:
     return cv2.VideoCapture(path)
 
 
+def _damaged_first(path: str, first: int, opened: bool) -> str | None:
+    """What is wrong with the first image of sequence ``path`` (numbered ``first``) that neither
+    ``CAP_IMAGES`` nor :class:`_ImageSequence` opened; None when it reads.
+
+    FFmpeg's reader, the last resort, opened a sequence whose first PNG was truncated and said
+    "ended after 0 of the 4 frames its header announces: the file ended early", of a video;
+    one from 5 on was "cannot open" without a word of the file. A first image OpenCV has no
+    reader for is said only when nothing opened it: FFmpeg may read a format OpenCV does not
+    (TGA)."""
+    name = _sequence_name(path, first)
+    with _opencv_quiet():
+        known = cv2.haveImageReader(name)
+        if (opened and not known) or cv2.imread(name, cv2.IMREAD_UNCHANGED) is not None:
+            return None
+    return f"its first image, {os.path.basename(name)}, does not read (damaged?)"
+
+
 def camera_hint(src: object) -> str:
     """Why a camera index may not open, where Linux can tell (V4L2 device nodes)."""
     if not isinstance(src, (int, np.integer)) or not os.path.isdir("/dev"):
@@ -1411,6 +1428,15 @@ class StereoCamera(PairSource):
             self._sequence[side] = cap.isOpened() and cap.getBackendName() == "CV_IMAGES"
             if self._sequence[side] and first is not None:
                 self._sequence_start[side] = first[0]
+            if first is not None and not self._sequence[side]:
+                damaged = _damaged_first(path, first[0], cap.isOpened())
+                if damaged is not None:
+                    cap.release()
+                    raise SourceError(
+                        f"cannot open {side} source {_describe_source(src)}: {damaged}",
+                        side=side,
+                        end=False,
+                    )
         elif isinstance(src, (bool, np.bool_)):  # True opened camera 1
             raise ValueError(f"{side} source: expected a device index or a path, got {src!r}")
         elif isinstance(src, (int, np.integer)):
