@@ -848,6 +848,30 @@ def test_an_image_header_of_an_impossible_size_is_unreadable(tmp_path: Path, dat
         decode_message(Msg())
 
 
+def test_an_image_out_of_memory_is_a_memory_error_not_unreadable(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """OpenCV's cv2.error of a failed allocation (a valid 16000 x 16000 PNG under ulimit -v)
+    was swallowed with the impossible headers' errors: a good file read as "cannot decode
+    frame.png as an image". It is a MemoryError saying so."""
+    from stereovision.export import read_depth_png
+    from stereovision.io import decode_image, read_image
+
+    def no_memory(buf: object, flags: int) -> None:
+        exc = cv2.error("Failed to allocate 768000000 bytes")
+        exc.code, exc.err = cv2.Error.StsNoMem, "Failed to allocate 768000000 bytes"
+        raise exc
+
+    path = tmp_path / "frame.png"
+    path.write_bytes(cv2.imencode(".png", np.zeros((4, 4), np.uint16))[1].tobytes())
+    monkeypatch.setattr(cv2, "imdecode", no_memory)
+    for read in (lambda: decode_image(path.read_bytes()), lambda: read_image(path)):
+        with pytest.raises(MemoryError, match="not enough memory to decode the image: Failed"):
+            read()
+    with pytest.raises(MemoryError, match="768000000 bytes"):
+        read_depth_png(path)
+
+
 def test_write_pfm_refuses_what_it_would_change(tmp_path: Path) -> None:
     # a finite 1e300 was written as inf, and little_endian="no" (true) a little-endian file
     arr = np.array([[1.0, np.nan], [np.inf, -3.5e38]])  # -3.5e38 is beyond float32 too

@@ -829,11 +829,14 @@ def decode_image(data: npt.NDArray[np.uint8] | bytes) -> npt.NDArray[np.uint8] |
 def _imdecode(buf: npt.NDArray[np.uint8], flags: int) -> npt.NDArray[Any] | None:
     """``cv2.imdecode``, quiet, None for bytes it cannot decode: a header whose size is 0,
     negative or over OpenCV's pixel limit (a corrupt or hostile PNG, a PFM of width -3) raised
-    cv2.error from its size check where other unreadable bytes give None."""
+    cv2.error from its size check where other unreadable bytes give None. A MemoryError when
+    the pixels of a readable image cannot be allocated: not "cannot decode" of a good file."""
     with _opencv_quiet():
         try:
             return cv2.imdecode(buf, flags)  # type: ignore[no-any-return]
-        except cv2.error:
+        except cv2.error as exc:
+            if exc.code == cv2.Error.StsNoMem:
+                raise MemoryError(f"not enough memory to decode the image: {exc.err}") from None
             return None
 
 
