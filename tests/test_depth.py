@@ -105,6 +105,19 @@ def test_depth_sigma_formula_on_a_plane() -> None:
     )
 
 
+def test_disparity_sigma_takes_a_single_bool_for_every_pixel() -> None:
+    """``filled=True`` (every pixel filled) and ``filled=False`` gave the whole map's sigmas
+    until the shape check of the mask refused them as of shape ``()``."""
+    conf = np.array([[0.0, 1.0], [0.5, 0.25]], np.float32)
+    for every in (True, np.True_, np.array(True)):
+        np.testing.assert_array_equal(
+            sv.depth.disparity_sigma(conf, filled=every), np.full((2, 2), 0.63, np.float32)
+        )
+    np.testing.assert_allclose(
+        sv.depth.disparity_sigma(conf, filled=False), [[0.405, 0.184], [0.2945, 0.34975]]
+    )
+
+
 def test_disparity_sigma_refuses_what_is_no_confidence_map() -> None:
     """None gave a NaN sigma and a complex map lost its imaginary part with NumPy's warning
     only; a ``filled`` mask of one row was spread over every row of the map (and another shape

@@ -950,7 +950,8 @@ def disparity_sigma(
     refined : bool
         Whether the map was refined (:mod:`stereovision.refine`).
     filled : array_like of bool, optional
-        Pixels the refinement filled (same shape as ``confidence``).
+        Pixels the refinement filled (same shape as ``confidence``; a single bool for every
+        pixel).
 
     Returns
     -------
@@ -972,7 +973,8 @@ def disparity_sigma(
     out = np.maximum(np.float32(s0) + np.float32(slope) * c, np.float32(s_min))
     if filled is not None:
         mask = np.asarray(filled, bool)
-        if mask.shape != c.shape:
+        # a single True or False says it of every pixel, as it did before shapes were checked
+        if mask.ndim and mask.shape != c.shape:
             # NumPy broadcast a (1, W) mask over every row, and refused others in its own words
             raise ValueError(f"filled: expected the confidence's shape {c.shape}, got {mask.shape}")
         out = np.where(mask, np.float32(_SIGMA_FILLED), out)
