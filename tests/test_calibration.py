@@ -1346,6 +1346,24 @@ def test_from_q_names_a_non_finite_entry_and_a_missing_image_size(tmp_path: Path
     assert Calibration.from_q(tmp_path / "Q.dat", np.array([10, 8])).image_size == (10, 8)
 
 
+def test_from_q_takes_any_two_numbers_and_names_image_size_otherwise(tmp_path: Path) -> None:
+    """Today's check of image_size took only a tuple, a list or an array: a map or generator
+    (``map(int, "10 8".split())``) and an ``array.array``, read before, were refused; a 0-d
+    array raised TypeError "len() of unsized object" and ``(10, None)`` float()'s TypeError,
+    ``("a", 8)`` its ValueError, naming neither argument nor file; ``(True, 8)`` was 1 px."""
+    import array
+
+    (tmp_path / "Q.dat").write_text("1 0 0 -5\n0 1 0 -4\n0 0 0 100\n0 0 10 0\n")
+    for size in (map(int, "10 8".split()), (v for v in (10, 8)), array.array("i", [10, 8])):
+        assert Calibration.from_q(tmp_path / "Q.dat", size).image_size == (10, 8)  # type: ignore[arg-type]
+    for size in (np.array(10), (10, None), ("a", 8), (True, 8), (10 + 0j, 8), "10", {10: 8}):
+        said = re.escape(repr(size))
+        with pytest.raises(
+            ValueError, match=rf"image_size for .*Q\.dat: expected \(width, height\), got {said}$"
+        ):
+            Calibration.from_q(tmp_path / "Q.dat", size)  # type: ignore[arg-type]
+
+
 def test_fit_to_frames_refuses_a_two_percent_crop() -> None:
     """Aspect ratios 1 % apart are the limit: 160x117 for 320x240 (2.5 % apart) is a crop,
     160x119 (0.8 %) a scaling."""

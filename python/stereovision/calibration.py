@@ -1791,7 +1791,8 @@ class Calibration:
         FileNotFoundError
             If the file does not exist.
         ValueError
-            If it does not hold 16 finite numbers of that form (the offending entry named).
+            If it does not hold 16 finite numbers of that form (the offending entry named), or
+            ``image_size`` is not two positive whole numbers.
         """
         p, text = cls._read_text(path)
         try:
@@ -1831,10 +1832,21 @@ class Calibration:
             )
         cx, cy = -float(q[0, 3]), -float(q[1, 3])
         cx_right = cx + float(q[3, 3]) / inv_b
-        if not isinstance(image_size, (tuple, list, np.ndarray)) or len(image_size) != 2:
-            # None raised "'NoneType' object is not iterable", naming neither argument nor file
-            raise ValueError(f"image_size for {p}: expected (width, height), got {image_size!r}")
-        w, h = (_pixels(v, f"image size for {p}") for v in image_size)
+        bad = ValueError(f"image_size for {p}: expected (width, height), got {image_size!r}")
+        if isinstance(image_size, (str, bytes, dict)):
+            raise bad
+        try:
+            # any two numbers, as before: a tuple, an array, map(int, "640 480".split())
+            size = tuple(image_size)
+        except TypeError:  # None raised "'NoneType' object is not iterable", naming neither
+            raise bad from None
+        if len(size) != 2 or any(isinstance(v, (bool, np.bool_)) for v in size):
+            raise bad
+        try:
+            [float(v) for v in size]  # (640, None), ("a", 480): float()'s words, naming nothing
+        except (TypeError, ValueError):
+            raise bad from None
+        w, h = (_pixels(v, f"image size for {p}") for v in size)
         return cls(
             K1=np.array([[f, 0.0, cx], [0.0, f, cy], [0.0, 0.0, 1.0]]),
             D1=np.zeros(5),
