@@ -389,6 +389,18 @@ def test_a_range_bound_that_is_no_number_is_named(name: str, value: object) -> N
         np.testing.assert_array_equal(sgm_disparity(ok, ok, max_disparity=a, min_disparity=b), want)
 
 
+def test_a_range_bound_of_a_size_1_array_or_a_fraction_is_its_number() -> None:
+    """np.array([8]) passed today's check (_real_scalar takes a size-1 array) and then raised
+    NumPy's TypeError "only 0-dimensional arrays can be converted", naming no argument; a
+    Fraction, searched before, was refused as no number. Each is the range it says."""
+    from fractions import Fraction
+
+    ok = np.random.default_rng(0).random((20, 30), dtype=np.float32)
+    want = sgm_disparity(ok, ok, max_disparity=8, min_disparity=0)
+    for a, b in ((np.array([8]), np.array([0.0])), (Fraction(15, 2), Fraction(0))):
+        np.testing.assert_array_equal(sgm_disparity(ok, ok, max_disparity=a, min_disparity=b), want)  # type: ignore[arg-type]
+
+
 def test_a_one_level_range_and_the_p2_width() -> None:
     """max_disparity == min_disparity is a one-level search, not an error; p2 past the kernel's
     u16 (65536) is refused naming the kernel's real limit (4000), not an OverflowError from the

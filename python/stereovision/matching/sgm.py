@@ -13,6 +13,7 @@ NumPy reference: ``tests/reference/sgm_ref.py``.
 from __future__ import annotations
 
 import math
+import numbers
 from typing import Any
 
 import numpy as np
@@ -20,7 +21,6 @@ import numpy.typing as npt
 
 from stereovision import _core
 from stereovision._validate import (
-    _real_scalar,
     as_gray_float,
     check_pair,
     finite_number,
@@ -172,14 +172,17 @@ def sgm_disparity(
     if unknown:
         raise ValueError(f"unknown SGM option(s) {unknown}: expected {sorted(DEFAULTS)}")
     p = {**DEFAULTS, **params}
+    bounds: list[float] = []
     for name, v in (("max_disparity", max_disparity), ("min_disparity", min_disparity)):
-        # True searched one level, a string or a list raised "must be real number, not str"
-        if isinstance(v, (bool, np.bool_)):
+        if isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "iuf":
+            # its number, as _real_scalar reads it: np.array([16]) passed a check by it, then
+            # raised NumPy's "only 0-dimensional arrays can be converted", naming no argument
+            v = v.reshape(())[()]
+        # True searched one level, a string or a list raised "must be real number, not str";
+        # any other real number (a Fraction) is read as it was
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, numbers.Real):
             raise ValueError(f"{name}: expected a number of pixels, got {v!r}")
-        try:
-            _real_scalar(float_sized(v, name))
-        except TypeError:
-            raise ValueError(f"{name}: expected a number of pixels, got {v!r}") from None
+        bounds.append(v)
         # The kernel takes i32 levels (and at most 2048 of them); 1e300 is finite, only too big.
         if not math.isfinite(float_sized(v, name)):
             raise ValueError(f"{name}: expected a finite number of pixels, got {v}")
@@ -188,6 +191,7 @@ def sgm_disparity(
                 f"{name}: {v} is outside the census kernel's 32-bit integer levels "
                 f"(|{name}| must be below {_I32_LIMIT})"
             )
+    max_disparity, min_disparity = bounds
     if max_disparity < min_disparity:
         raise ValueError(
             f"max_disparity ({max_disparity}) is smaller than min_disparity ({min_disparity})"
