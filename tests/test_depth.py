@@ -118,6 +118,17 @@ def test_disparity_sigma_takes_a_single_bool_for_every_pixel() -> None:
     )
 
 
+def test_disparity_sigma_reads_an_object_array_of_numbers() -> None:
+    """``np.array(values, dtype=object)`` of numbers gave their sigmas until today's dtype
+    check refused it; one holding None is still refused, as None is."""
+    conf = np.array([[0.0, 1.0], [0.5, 0.25]], np.float32)
+    np.testing.assert_array_equal(
+        sv.depth.disparity_sigma(conf.astype(object)), sv.depth.disparity_sigma(conf)
+    )
+    with pytest.raises(ValueError, match=r"confidence: expected real numbers in .* object$"):
+        sv.depth.disparity_sigma(np.array([0.5, None]))
+
+
 def test_disparity_sigma_refuses_what_is_no_confidence_map() -> None:
     """None gave a NaN sigma and a complex map lost its imaginary part with NumPy's warning
     only; a ``filled`` mask of one row was spread over every row of the map (and another shape

@@ -16,6 +16,7 @@ import dataclasses
 import functools
 import inspect
 import math
+import numbers
 import os
 import re
 import sys
@@ -595,6 +596,21 @@ def luma_weights() -> tuple[float, float, float]:
     """:data:`LUMA_WEIGHTS_BGR` as the ``float32`` values the grey conversion uses."""
     b, g, r = (float(np.float32(w)) for w in LUMA_WEIGHTS_BGR)
     return b, g, r
+
+
+def _real_array(a: object) -> np.ndarray | None:
+    """``a`` as an array of real numbers (bool, int, float), or None when it holds something
+    else (complex, text, None). An object array of real numbers only (``np.array(values,
+    dtype=object)``, a pandas object column) is their float64 array: a dtype check alone
+    refused it, where ``np.asarray(a, np.float32)`` had read it."""
+    raw = np.asarray(a)
+    if raw.dtype.kind in "biuf":
+        return raw
+    if raw.dtype == object and all(
+        isinstance(v, numbers.Real) and not isinstance(v, np.bool_) for v in raw.flat
+    ):
+        return raw.astype(np.float64)
+    return None
 
 
 def _real_scalar(value: object) -> float:

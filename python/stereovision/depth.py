@@ -27,6 +27,7 @@ import numpy.typing as npt
 
 from stereovision._validate import (
     ADVICE,
+    _real_array,
     as_bgr_uint8,
     as_gray_float,
     check_pair,
@@ -965,10 +966,11 @@ def disparity_sigma(
         its shape.
     """
     s0, slope, s_min = _SIGMA_REFINED if refined else _SIGMA_RAW
-    raw = np.asarray(confidence)
+    raw = _real_array(confidence)
     # None became a NaN sigma, a complex map lost its imaginary part with NumPy's warning only
-    if raw.dtype.kind not in "biuf":
-        raise ValueError(f"confidence: expected real numbers in [0, 1], got dtype {raw.dtype}")
+    if raw is None:
+        got = np.asarray(confidence).dtype
+        raise ValueError(f"confidence: expected real numbers in [0, 1], got dtype {got}")
     c = np.clip(raw.astype(np.float32), 0.0, 1.0)
     out = np.maximum(np.float32(s0) + np.float32(slope) * c, np.float32(s_min))
     if filled is not None:

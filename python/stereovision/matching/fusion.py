@@ -28,7 +28,7 @@ from typing import Any, TypedDict
 import numpy as np
 import numpy.typing as npt
 
-from stereovision._validate import finite_number, refuse_unknown
+from stereovision._validate import _real_array, finite_number, refuse_unknown
 from stereovision.matches import Matches
 
 # at run time too, so that typing.get_type_hints resolves ChannelOutputs (and DepthChannels)
@@ -177,11 +177,11 @@ def _nearest_within_at(
 
 
 def _check_map(a: npt.ArrayLike, name: str, shape: tuple[int, int] | None) -> F32:
-    raw = np.asarray(a)
+    raw = _real_array(a)
     # a complex map lost its imaginary part with NumPy's warning only; text raised NumPy's
     # "could not convert string to float", naming no argument
-    if raw.dtype.kind not in "biuf":
-        raise ValueError(f"{name}: expected a real (H, W) map, got dtype {raw.dtype}")
+    if raw is None:
+        raise ValueError(f"{name}: expected a real (H, W) map, got dtype {np.asarray(a).dtype}")
     arr = np.asarray(raw, dtype=np.float32)
     if arr.ndim != 2:
         raise ValueError(f"{name}: expected an (H, W) map, got shape {arr.shape}")
