@@ -86,6 +86,18 @@ def test_noise_of_int_levels_as_from_a_nested_list(data_dir: Path) -> None:
         noise_sigma(-np.eye(5, dtype=np.int16))
 
 
+def test_a_negative_int_level_is_not_told_to_be_uint16() -> None:
+    """An int image with a negative level was told "(a 16-bit image: pass it as uint16)",
+    which cannot hold it; the advice is kept for levels over 255 only."""
+    with pytest.raises(ValueError) as exc:
+        noise_sigma(np.arange(-128, 128, dtype=np.int16).reshape(16, 16))
+    assert str(exc.value) == (
+        "image: int16 grey levels must lie in 0-255, got -128-127 (a grey level cannot be negative)"
+    )
+    with pytest.raises(ValueError, match=r"got 0-300 \(a 16-bit image: pass it as uint16\)$"):
+        noise_sigma(np.linspace(0, 300, 16, dtype=np.int32)[None].repeat(4, axis=0))
+
+
 def test_a_black_border_is_no_noiseless_image(data_dir: Path) -> None:
     """Venus with noise 8 and a black border over its left 46 % (a fisheye's corners, a
     rectified frame's border): the noise reads as without the border. The border's pixels were

@@ -162,9 +162,12 @@ def noise_sigma(image: npt.ArrayLike) -> float:
         # grey (5.718 where its uint8 image reads 5.700), 16-bit levels all as clipped (0)
         lo, hi = int(img.min()), int(img.max())
         if lo < 0 or hi > 255:
+            # uint16 cannot hold a negative level: no advice to pass -5 as one
+            why = (
+                "a grey level cannot be negative" if lo < 0 else "a 16-bit image: pass it as uint16"
+            )
             raise ValueError(
-                f"image: {img.dtype} grey levels must lie in 0-255, got {lo}-{hi} (a 16-bit "
-                "image: pass it as uint16)"
+                f"image: {img.dtype} grey levels must lie in 0-255, got {lo}-{hi} ({why})"
             )
         img = img.astype(np.uint8)
     g = _grey(img)
