@@ -1374,6 +1374,47 @@ def test_a_folder_a_glob_or_a_misnumbered_pattern_names_the_source_that_would_wo
     )
 
 
+def test_a_glob_with_a_wildcard_in_a_folder_part_names_a_source_that_opens(
+    tmp_path: Path,
+) -> None:
+    """``--left 'runs/run*/left_*.png'`` was told "give a video file, an image-sequence pattern
+    such as runs/run*/left_%04d.png or a camera index": a pattern with the star still in it,
+    which opens nothing. The hint names one matched folder's pattern, or says plainly that a
+    sequence is one folder's."""
+    img = np.zeros((8, 8, 3), np.uint8)
+    for run, count in (("run1", 3), ("run2", 2)):
+        (tmp_path / run).mkdir()
+        for i in range(1, count + 1):
+            cv2.imwrite(str(tmp_path / run / f"left_{i:04d}.png"), img)
+    right = str(tmp_path / "right_%04d.png")
+    said = "is a glob, which OpenCV does not expand"
+    for given, hint in (
+        (
+            f"{tmp_path}/run*/left_*.png",
+            f"it matches files in 2 folders ({tmp_path}/run1, {tmp_path}/run2) and a source is "
+            f"one folder's: give e.g. a pattern such as {tmp_path}/run1/left_%04d.png (its "
+            "files are named left_0001.png, left_0002.png ...)",
+        ),
+        (  # one folder matched: its own pattern
+            f"{tmp_path}/run[1]/*.png",
+            f"give a pattern such as {tmp_path}/run1/left_%04d.png (its files are named "
+            "left_0001.png, left_0002.png ...)",
+        ),
+    ):
+        with pytest.raises(FileNotFoundError) as err:
+            StereoCamera(given, right)
+        assert str(err.value) == f"left source {given} {said}: {hint}"
+        assert "*" not in hint and "[" not in hint
+    given = f"{tmp_path}/run*/nothing_*.png"
+    with pytest.raises(FileNotFoundError) as err:
+        StereoCamera(given, right)
+    assert str(err.value) == (
+        f"left source {given} {said} (it matches no file): give a video file, an image-sequence "
+        "pattern in one folder (no wildcard in it; the number as %04d: left_%04d.png) or a "
+        "camera index"
+    )
+
+
 def test_sources_that_opened_before_the_folder_and_pattern_hints_still_open(
     tmp_path: Path,
 ) -> None:

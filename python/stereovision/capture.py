@@ -896,6 +896,27 @@ def _glob_hint(side: str, path: str) -> str:
     said = f"{side} source {path} is a glob, which OpenCV does not expand"
     if len(matched) == 1 and os.path.isfile(matched[0]):  # one file: it is the source
         return f"{said}: give the file it matches, {matched[0]}"
+    if re.search(r"[*?[]", folder):
+        # a wildcard in a folder part ('runs/run*/x.png'): the hint named a pattern in the
+        # folder as typed ('runs/run*/left_%04d.png', which opens nothing); a sequence's
+        # pattern is one folder's, so the folders matched are what to choose from
+        folders = sorted({os.path.dirname(m) for m in matched if os.path.isfile(m)})
+        if not folders:
+            return (
+                f"{said} (it matches no file): give a video file, an image-sequence pattern in "
+                f"one folder (no wildcard in it; the number as %04d: {side}_%04d.png) or a "
+                "camera index"
+            )
+        if len(folders) > 1:
+            shown = ", ".join(folders[:2]) + (" ..." if len(folders) > 2 else "")
+            inside = [os.path.basename(m) for m in matched if os.path.dirname(m) == folders[0]]
+            form = _forms_that_work(side, folders[0], inside)
+            one = f"a {form[1]}" if form else _anything_hint(side, folders[0])
+            return (
+                f"{said}: it matches files in {len(folders)} folders ({shown}) and a source is "
+                f"one folder's: give e.g. {one}"
+            )
+        folder = folders[0]
     names = [os.path.basename(m) for m in matched if os.path.dirname(m) == folder]
     form = _forms_that_work(side, folder, names)
     if form is not None:
