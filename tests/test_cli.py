@@ -7,6 +7,7 @@ import re
 import shutil
 import subprocess
 import sys
+from importlib import resources
 from pathlib import Path
 
 import cv2
@@ -17,6 +18,7 @@ from stereovision.cli import main
 from stereovision.io import read_pfm, read_ply
 
 SV = [sys.executable, "-m", "stereovision.cli"]
+CONES = Path(str(resources.files("stereovision") / "data" / "cones"))  # the bundled scene
 
 
 def test_demo_writes_outputs_and_prints_figures(tmp_path: Path) -> None:
@@ -2553,3 +2555,29 @@ def test_calib_help_lists_the_same_formats_for_every_command() -> None:
         said = option_help(command, "--calib")
         assert all(f in said for f in (*formats, "Q.dat", "calibrationdata.tar.gz")), said
     assert ".yaml, .yml, .xml or .json" in option_help("calibrate", "-o")
+
+
+def test_a_folder_without_a_pair_given_as_the_images_says_what_was_looked_for(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`depth somefolder` said only "the following arguments are required: right", and
+    `depth somefolder somefolder` "image file is not a regular file": neither said what was
+    expected of the folder. Both name the files looked for."""
+    folder = tmp_path / "shots"
+    folder.mkdir()
+    cv2.imwrite(str(folder / "a.png"), np.zeros((4, 4, 3), np.uint8))
+    out = tmp_path / "out"
+    looked = "looked for left.png + right.png or im0.png + im1.png, any image suffix"
+    with pytest.raises(SystemExit):
+        main(["depth", str(folder), "-o", str(out)])
+    assert capsys.readouterr().err == (
+        f"stereovision depth: error: the right image is missing; {folder} is a folder with no "
+        f"pair in it ({looked}): give two image files, left and right (see stereovision depth "
+        "--help)\n"
+    )
+    assert main(["depth", str(folder), str(folder), "-o", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: image file is not a regular file: {folder} (a folder with no pair "
+        f"in it: {looked}; give two image files)\n"
+    )
+    assert not out.exists()

@@ -672,7 +672,7 @@ def test_a_scene_folder_given_as_the_images_names_its_pair(
     """`stereovision depth cones cones -o out` (a scene folder, as eval and batch take it) said
     only "image file is not a regular file: cones"; it now names the folder's two images, as
     the Python reader does (left.png + right.png, or Middlebury's im0.png + im1.png), and a
-    folder without one pair keeps the plain words."""
+    folder without one pair says the names looked for."""
     from stereovision.io import imread
 
     assert main(["depth", str(CONES), str(CONES), "-o", str(tmp_path / "out")]) == 2
@@ -689,7 +689,7 @@ def test_a_scene_folder_given_as_the_images_names_its_pair(
     with pytest.raises(ValueError, match=r"give its two images, .*im0\.png and .*im1\.png\)$"):
         imread(scene)
     (scene / "im1.png").unlink()
-    with pytest.raises(ValueError, match=r"^image file is not a regular file: .*scene$"):
+    with pytest.raises(ValueError, match=r"^image file is not a regular file: .*scene \(a folder "):
         imread(scene)
 
 
@@ -773,8 +773,8 @@ def test_one_scene_folder_for_both_images_says_what_to_type(
 ) -> None:
     """`stereovision depth cones -o out` (one positional: the scene folder, as eval and batch
     take it) said argparse's "the following arguments are required: right"; it now names the
-    folder's two images, as `depth cones cones` does. A folder without one pair, or a file,
-    keeps the plain one line."""
+    folder's two images, as `depth cones cones` does. A folder without one pair names the files
+    looked for; a file keeps the plain one line."""
     out = str(tmp_path / "out")
     pair = f"give its two images, {CONES / 'left.png'} and {CONES / 'right.png'}"
     options = {"depth": ["-o", out, "--max-disparity", "64"], "check": ["--tolerance", "1"]}
@@ -798,13 +798,14 @@ def test_one_scene_folder_for_both_images_says_what_to_type(
     calib_set.mkdir()
     for name in ("left01.png", "left02.png", "right01.png", "right02.png"):
         (calib_set / name).write_bytes(b"")
-    for given in (calib_set, CONES / "left.png"):
+    for given, said in (
+        (calib_set, f"the right image is missing; {calib_set} is a folder with no pair in it"),
+        (CONES / "left.png", "the following arguments are required: right"),
+    ):
         with pytest.raises(SystemExit):
             main([command, str(given)])
         err = capsys.readouterr().err
-        assert err.startswith(
-            f"stereovision {command}: error: the following arguments are required: right"
-        )
+        assert err.startswith(f"stereovision {command}: error: {said}")
         assert err.count("\n") == 1
     assert not (tmp_path / "out").exists()
 

@@ -1862,15 +1862,21 @@ class _Parser(argparse.ArgumentParser):
         """``stereovision depth cones -o out``: one positional, a scene folder (as eval and
         batch take it). argparse said only that ``right`` is required; the folder's two images
         are what to type (as imread says of a folder given as an image)."""
-        from stereovision.io import _folder_pair
+        from stereovision.io import FOLDER_PAIR_NAMES, _folder_pair
 
         given = self._words_given()
-        pair = _folder_pair(given[0]) if len(given) == 1 else None
-        if pair is None:
+        if len(given) != 1 or not os.path.isdir(given[0]):
             return message
+        pair = _folder_pair(given[0])
+        also = f" (also required: {also})" if also else ""
+        if pair is None:  # argparse's "required: right" did not say the folder was the problem
+            return (
+                f"the right image is missing; {given[0]} is a folder with no pair in it "
+                f"({FOLDER_PAIR_NAMES}): give two image files, left and right{also}"
+            )
         return (
             f"the right image is missing; {given[0]} is a folder holding a pair: give its two "
-            f"images, {pair[0]} and {pair[1]}" + (f" (also required: {also})" if also else "")
+            f"images, {pair[0]} and {pair[1]}{also}"
         )
 
 

@@ -738,13 +738,20 @@ def _existing_file(path: PathLike, what: str) -> Path:
     return p
 
 
+#: The names :func:`_folder_pair` looks for, as the messages about a folder without them say.
+FOLDER_PAIR_NAMES = "looked for left.png + right.png or im0.png + im1.png, any image suffix"
+
+
 def _pair_in_folder(folder: Path) -> str:
     """What to give instead of a scene folder given as an image (``stereovision depth cones``,
     as ``eval`` and ``batch`` take it): the folder's left and right images, when it holds one of
     each, else ""."""
     pair = _folder_pair(folder)
     if pair is None:
-        return ""
+        if not folder.is_dir():  # a FIFO or a device: no folder to speak of
+            return ""
+        # "not a regular file" alone did not say what was expected of it
+        return f" (a folder with no pair in it: {FOLDER_PAIR_NAMES}; give two image files)"
     return f" (a folder holding a pair: give its two images, {pair[0]} and {pair[1]})"
 
 
