@@ -720,14 +720,16 @@ def test_a_bad_size_is_named_by_its_option(
     ("command", "says"),
     [
         (["depth", "l.png", "r.png", "-o", "out", "--max-depth", "5m"], "--max-depth: expected a "
-         "number, got '5m' (see stereovision depth --help)"),
+         "number of metres above 0 without a unit (5 for 5 m), got '5m' (see stereovision "
+         "depth --help)"),
         (["calibrate", "--left", "l", "--right", "r", "-o", "rig.yaml", "--square", "1/4"],
          "--square: expected a number, got '1/4' (see stereovision calibrate --help)"),
         (["batch", "in", "-o", "out", "--workers", "two"], "--workers: expected a whole number, "
          "got 'two' (see stereovision batch --help)"),
         # a value holding a ' is in double quotes in argparse's words: it kept them all
         (["depth", "l.png", "r.png", "-o", "out", "--max-depth=5'"], "--max-depth: expected a "
-         "number, got \"5'\" (see stereovision depth --help)"),
+         "number of metres above 0 without a unit (5 for 5 m), got \"5'\" (see stereovision "
+         "depth --help)"),
         (["batch", "in", "-o", "out", "--workers", "2'"], "--workers: expected a whole number, "
          "got \"2'\" (see stereovision batch --help)"),
     ],

@@ -1960,7 +1960,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
 def add_cli(subparsers: Any) -> None:
     """Register ``stereovision batch`` on the CLI's sub-parsers."""
     # cli builds its parser
-    from stereovision.cli import CALIB_FILES_HELP, add_calib_unit, positive_pixels
+    from stereovision.cli import CALIB_FILES_HELP, add_calib_unit, metres, positive_pixels
     from stereovision.depth import METHODS
 
     p = subparsers.add_parser(
@@ -2014,6 +2014,9 @@ def add_cli(subparsers: Any) -> None:
         help="also each pair's floor and obstacles (ground.json, obstacles.png, scan.json)",
     )
     p.add_argument(
-        "--grid", type=float, metavar="M", help="with --ground: an occupancy grid of M-metre cells"
+        "--grid",
+        type=metres,
+        metavar="M",
+        help="with --ground: an occupancy grid of M-metre cells",
     )
     p.set_defaults(func=cmd_batch)

@@ -1751,6 +1751,43 @@ def _whole_above_zero(text: str, what: str) -> int:
     return value
 
 
+#: A number with a unit after it (``5m``, ``-50 cm``, ``2ft``, ``5'``): the metre options take
+#: none.
+_UNIT_SUFFIXED = re.compile(
+    r"^\s*[-+]?(\d+\.?\d*|\.\d+)(e[-+]?\d+)?\s*([a-z]+|'|\")\s*$", re.IGNORECASE
+)
+
+
+def positive_metres(text: str) -> float:
+    """argparse type of ``--max-depth``, ``--max-sigma`` and ``--voxel``: a finite
+    number of metres above 0, as a plain number.
+
+    Refused by argparse in the option's name: ``5m`` was "expected a number", ``-5`` "expected
+    a positive finite number" only after the images were read, and neither said the unit.
+    """
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and value > 0):
+        # "5m": the value is metres already; a unit word is what to leave out
+        unit = " without a unit (5 for 5 m)" if _UNIT_SUFFIXED.match(text) else ""
+        raise argparse.ArgumentTypeError(f"expected a number of metres above 0{unit}, got {text!r}")
+    return value
+
+
+def metres(text: str) -> float:
+    """argparse type of ``--grid``: a number of metres, as a plain number (its range is checked
+    with the other options, in :func:`run_depth`); ``5m`` said only "expected a number"."""
+    try:
+        return float(text)
+    except ValueError:
+        unit = " without a unit (5 for 5 m)" if _UNIT_SUFFIXED.match(text) else ""
+        raise argparse.ArgumentTypeError(
+            f"expected a number of metres{unit}, got {text!r}"
+        ) from None
+
+
 def positive_rate(text: str) -> float:
     """argparse type of ``--fps``: a finite number above 0, refused in the option's name (it
     was the library's ``fps: expected a positive number``, after the parsing)."""
@@ -1830,11 +1867,47 @@ class _Parser(argparse.ArgumentParser):
             lambda m: f"expected a {'number' if m[1] == 'float' else 'whole number'}, got {m[2]}",
             message,
         )
+        one = re.fullmatch(r"argument (\S+): expected one argument", message)
+        if one is not None:
+            message = self._dash_value(one[1]) or message
         missing = "the following arguments are required: right"
         if message == missing or message.startswith(f"{missing}, "):
             message = self._folder_for_a_pair(message, message[len(missing) + 2 :])
         sys.stderr.write(f"{self.prog}: error: {message} (see {self.prog} --help)\n")
         sys.exit(EXIT_ERROR)
+
+    def _dash_value(self, names: str) -> str | None:
+        """``--max-depth -5m``: argparse takes a value starting with ``-`` (other than a plain
+        negative number) for an option, and says only "expected one argument". The line for the
+        value typed after option ``names`` (argparse's ``-o/--output``): the option's own
+        refusal of it, else how to give it; None when no such value was typed."""
+        action = next(
+            (a for a in self._actions if "/".join(a.option_strings) == names and a.nargs is None),
+            None,
+        )
+        if action is None:
+            return None
+        for word, value in zip(self.typed, self.typed[1:], strict=False):
+            # the option as typed, or by a unique prefix (--max-d), as argparse takes it
+            hits = [s for s in self._option_string_actions if s.startswith(word)]
+            named = word in action.option_strings or (
+                word.startswith("--")
+                and self.allow_abbrev
+                and hits
+                and all(self._option_string_actions[s] is action for s in hits)
+            )
+            if not (named and value.startswith("-") and len(value) > 1):
+                continue
+            if callable(action.type) and action.type not in (int, float, str):
+                try:
+                    action.type(value)
+                except (argparse.ArgumentTypeError, ValueError) as exc:
+                    return f"argument {names}: {exc}"
+            return (
+                f"argument {names}: {value!r} starts with '-' and was taken for an option; "
+                f"give it as {max(action.option_strings, key=len)}={value}"
+            )
+        return None
 
     def _words_given(self) -> list[str]:
         """The words typed that are no option nor an option's value."""
@@ -1941,17 +2014,20 @@ def build_parser() -> argparse.ArgumentParser:
         help="skip the sub-pixel refinement (default: the method's)",
     )
     d.add_argument(
-        "--max-depth", type=float, metavar="M", help="keep depths up to M metres (and points)"
+        "--max-depth",
+        type=positive_metres,
+        metavar="M",
+        help="keep depths up to M metres (and points)",
     )
     d.add_argument(
         "--max-sigma",
-        type=float,
+        type=positive_metres,
         metavar="M",
         help="keep depths whose one-sigma uncertainty is at most M metres",
     )
     d.add_argument(
         "--voxel",
-        type=float,
+        type=positive_metres,
         metavar="M",
         help="with --calib: cloud.ply with one point per M-metre cube",
     )
@@ -1963,7 +2039,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     d.add_argument(
         "--grid",
-        type=float,
+        type=metres,
         metavar="M",
         help="with --ground: a bird's-eye occupancy grid of M-metre cells, 20 m ahead and 10 m "
         "to each side, as ROS map_server's map.png and map.yaml",
