@@ -2636,3 +2636,74 @@ def test_a_folder_without_a_pair_given_as_the_images_says_what_was_looked_for(
         f"in it: {looked}; give two image files)\n"
     )
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        # calibrate said its parameters' names (square_size:, unit:)
+        (
+            ["calibrate", "--left", "l*.png", "--right", "r*.png", "--square", "0", "-o", "c.yaml"],
+            "stereovision: error: --square: expected a positive finite number, got 0.0",
+        ),
+        (
+            ["calibrate", "--left", "l*.png", "--right", "r*.png", "--square", "1", "--unit",
+             "parsec", "-o", "c.yaml"],
+            "stereovision: error: --unit: expected one of ['m', 'mm', 'cm', 'ft', 'in'], got "
+            "'parsec'",
+        ),
+        # "expected a number" did not say where the unit goes
+        (
+            ["board", "-o", "b.png", "--square", "25mm"],
+            "stereovision board: error: argument --square: expected a number, its unit given by "
+            "--unit (25 --unit mm), got '25mm' (see stereovision board --help)",
+        ),
+        (
+            ["info", "--size", "640x480", "--hfov", "60", "--baseline", "10cm"],
+            "stereovision info: error: argument --baseline: expected a number of metres without "
+            "a unit (5 for 5 m), got '10cm' (see stereovision info --help)",
+        ),
+        # told to write --tolerance=-1px, which is no number either
+        (
+            ["check", "l.png", "r.png", "--tolerance", "-1px"],
+            "stereovision check: error: argument --tolerance: expected a number, got '-1px' (see "
+            "stereovision check --help)",
+        ),
+        # "scene root not found" of a file that is there
+        (
+            ["bench", "{tmp}/notes.txt"],
+            "stereovision: error: {tmp}/notes.txt: is a file; give a scene folder (holding "
+            "left.png, right.png)",
+        ),
+        # run_batch's words: "grid: the occupancy grid lies on the floor; it needs ground=True"
+        (
+            ["batch", "{tmp}", "-o", "{tmp}/out", "--grid", "0.1"],
+            "stereovision: error: --grid needs --ground (the grid lies on the floor)",
+        ),
+        (
+            ["batch", "{tmp}", "-o", "{tmp}/out", "--ground", "--grid", "nan"],
+            "stereovision: error: --grid: expected a cell side from 0.01 to 10 m, got nan",
+        ),
+    ],
+    ids=["calibrate-square", "calibrate-unit", "board-square", "info-baseline", "check-tolerance",
+         "bench-file", "batch-grid-ground", "batch-grid-range"],
+)  # fmt: skip
+def test_a_bad_option_value_is_said_in_the_option_s_name(
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+    argv: list[str],
+    said: str,
+) -> None:
+    """The sweep of bad values at every command: each is one line naming the option as typed
+    (not a library parameter) and what it takes, exit 2, nothing written."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "notes.txt").write_text("mine")
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    try:
+        status = main(argv)
+    except SystemExit as exit_:  # refused by argparse
+        status = exit_.code
+    assert status == 2
+    assert capsys.readouterr().err == said.replace("{tmp}", str(tmp_path)) + "\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]

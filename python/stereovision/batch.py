@@ -1867,6 +1867,11 @@ def cmd_batch(args: argparse.Namespace) -> int:
     # in the option's name, as --count and --max-pairs are (run_batch names its parameter)
     if args.workers is not None and args.workers < 1:
         raise ValueError(f"--workers: expected a whole number above 0, got {args.workers}")
+    # as depth says them: run_batch's words were its parameters' ("it needs ground=True")
+    if args.grid is not None and not args.ground:
+        raise ValueError("--grid needs --ground (the grid lies on the floor)")
+    if args.grid is not None and not (math.isfinite(args.grid) and 0.01 <= args.grid <= 10):
+        raise ValueError(f"--grid: expected a cell side from 0.01 to 10 m, got {args.grid}")
 
     def log(line: str) -> None:
         from tqdm import tqdm

@@ -284,6 +284,8 @@ def _scene_dirs(paths: Sequence[str]) -> list[Path]:
         return [Path(str(resources.files("stereovision") / "data" / "cones"))]
     dirs: list[Path] = []
     for d in paths:
+        if Path(d).exists() and not Path(d).is_dir():  # find_scenes: "scene root not found"
+            raise ValueError(f"{d}: is a file; give a scene folder (holding left.png, right.png)")
         found = find_scenes(d)  # FileNotFoundError for a missing folder
         if not found:
             raise ValueError(f"no scene (left.png + right.png) under {d}")

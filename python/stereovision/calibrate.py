@@ -2818,6 +2818,14 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         raise ValueError(
             f"--max-pairs: expected an integer of at least {MIN_PAIRS}, got {args.max_pairs}"
         )
+    # in the options' names, before the images are searched (calibrate said square_size: and
+    # unit:, its parameters)
+    from stereovision._validate import positive_finite
+    from stereovision.calibration import UNIT_TO_METRES
+
+    positive_finite(args.square, "--square")
+    if args.unit not in UNIT_TO_METRES:
+        raise ValueError(f"--unit: expected one of {list(UNIT_TO_METRES)}, got {args.unit!r}")
     if args.from_bag:
         if args.left or args.right:
             raise ValueError("--from-bag replaces --left and --right: give one source")
@@ -3057,11 +3065,26 @@ def _add_board_options(p: argparse.ArgumentParser) -> None:
         default=None,
         help="chessboard: inner corners COLSxROWS (default 9x6); charuco: squares COLSxROWS",
     )
-    p.add_argument("--square", required=True, type=float, help="square side in --unit")
+    p.add_argument("--square", required=True, type=length, help="square side in --unit")
     p.add_argument(
         "--unit", default="m", help="length unit of --square: m (default), mm, cm, ft or in"
     )
-    p.add_argument("--marker", type=float, help="charuco: marker side in --unit")
+    p.add_argument("--marker", type=length, help="charuco: marker side in --unit")
+
+
+def length(text: str) -> float:
+    """argparse type of ``--square`` and ``--marker``: a number in ``--unit``'s unit; ``25mm``
+    said only "expected a number", not where the unit goes."""
+    from stereovision.cli import _UNIT_SUFFIXED
+
+    try:
+        return float(text)
+    except ValueError:
+        if _UNIT_SUFFIXED.match(text):
+            raise argparse.ArgumentTypeError(
+                f"expected a number, its unit given by --unit (25 --unit mm), got {text!r}"
+            ) from None
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
 
 
 def add_cli(subparsers: Any) -> None:

@@ -1898,7 +1898,13 @@ class _Parser(argparse.ArgumentParser):
             )
             if not (named and value.startswith("-") and len(value) > 1):
                 continue
-            if callable(action.type) and action.type not in (int, float, str):
+            if action.type in (int, float):  # a plain number type: said as _Parser.error does
+                try:
+                    action.type(value)
+                except ValueError:
+                    kind = "number" if action.type is float else "whole number"
+                    return f"argument {names}: expected a {kind}, got {value!r}"
+            elif callable(action.type) and action.type is not str:
                 try:
                     action.type(value)
                 except (argparse.ArgumentTypeError, ValueError) as exc:
@@ -2139,7 +2145,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_calib_unit(d)
     d.add_argument("--hfov", type=float, metavar="DEG", help="a rig on paper: horizontal FOV")
-    d.add_argument("--baseline", type=float, metavar="M", help="a rig on paper: baseline (m)")
+    d.add_argument("--baseline", type=metres, metavar="M", help="a rig on paper: baseline (m)")
     d.add_argument("--left-topic", help="a bag: its left image topic (default: found)")
     d.add_argument("--right-topic", help="a bag: its right image topic (default: found)")
     d.set_defaults(func=cmd_info)
