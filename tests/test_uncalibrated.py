@@ -1328,3 +1328,32 @@ def test_opencv_finding_no_homographies_is_refused(
     sc = load_scene(data_dir / "middlebury2003" / "cones")
     with pytest.raises(ValueError, match=r"^OpenCV found no rectifying homographies"):
         rectify_uncalibrated(sc.left, sc.right, model="projective")
+
+
+def test_an_image_an_empty_file_or_a_folder_given_as_the_rectification_says_what_was_expected(
+    tmp_path: Path,
+) -> None:
+    """`depth L R --rectification left.png` said "'utf-8' codec can't decode byte 0x89 in
+    position 0", an empty file "Expecting value: line 1 column 1 (char 0)" and a folder
+    "rectification file not found" of a folder that is there."""
+    assert cv2.imwrite(str(tmp_path / "left.png"), np.zeros((4, 4, 3), np.uint8))
+    (tmp_path / "empty.json").write_bytes(b"")
+    for name in ("left.png", "empty.json"):
+        with pytest.raises(ValueError) as err:
+            UncalibratedRectification.load(tmp_path / name)
+        assert str(err.value) == (
+            f"{tmp_path / name} is not an uncalibrated rectification: not JSON text (expected "
+            "the rectification.json that `stereovision rectify` writes)"
+        )
+    with pytest.raises(FileNotFoundError) as missing:
+        UncalibratedRectification.load(tmp_path)
+    assert str(missing.value) == (
+        f"rectification file not found: {tmp_path} is a folder; give the rectification.json in it"
+    )
+    (tmp_path / "rectification.json").write_text("{}")
+    with pytest.raises(FileNotFoundError) as missing:
+        UncalibratedRectification.load(tmp_path)
+    assert str(missing.value) == (
+        f"rectification file not found: {tmp_path} is a folder; give its "
+        f"{tmp_path / 'rectification.json'}"
+    )

@@ -513,10 +513,24 @@ class UncalibratedRectification:
             (NaN or singular homographies, sizes of 0 or less, an unknown model).
         """
         p = Path(path)
+        if p.is_dir():  # "not found" alone, of a folder that is there (the type kept: API)
+            inside = p / "rectification.json"
+            raise FileNotFoundError(
+                f"rectification file not found: {p} is a folder; give "
+                + (f"its {inside}" if inside.is_file() else "the rectification.json in it")
+            )
         if not p.is_file():
             raise FileNotFoundError(f"rectification file not found: {p}")
         try:
             d = json.loads(p.read_text())
+        except (UnicodeDecodeError, json.JSONDecodeError):
+            # json's "Expecting value: line 1 column 1 (char 0)", or utf-8's "can't decode byte
+            # 0x89", of an image given for it: neither said what was expected
+            raise ValueError(
+                f"{p} is not an uncalibrated rectification: not JSON text (expected the "
+                "rectification.json that `stereovision rectify` writes)"
+            ) from None
+        try:
             mats = {k: np.asarray(d[k], np.float64).reshape(3, 3) for k in ("H1", "H2", "F")}
             out = cls(
                 mats["H1"],
