@@ -85,8 +85,10 @@ def test_roots_are_resolved_deduplicated_and_checked(data: Path, tmp_path: Path)
     (tmp_path / "alias").symlink_to(data)
     folders = AllowedFolders([data, tmp_path / "alias", data / "scene" / ".."])
     assert folders.roots == (data.resolve(),)
-    with pytest.raises(FileNotFoundError, match=r"^data folder not found: .*a\.ply$"):
-        AllowedFolders([data / "a.ply"])  # a file, not a folder
+    with pytest.raises(FileNotFoundError, match=r"^data folder not found: .*a\.ply is a file, "):
+        AllowedFolders([data / "a.ply"])  # a file, not a folder: said so (it was "not found")
+    with pytest.raises(FileNotFoundError, match=r"^data folder not found: .*nothing$"):
+        AllowedFolders([data / "nothing"])
 
 
 def test_resolve_accepts_the_root_and_refuses_nul_and_rootless(data: Path) -> None:

@@ -140,8 +140,9 @@ class AllowedFolders:
         resolved: list[Path] = []
         for r in roots:
             p = Path(r).expanduser()
-            if not p.is_dir():
-                raise FileNotFoundError(f"data folder not found: {r}")
+            if not p.is_dir():  # a file that is there was said only as "not found"
+                there = " is a file, not a folder" if p.exists() else ""
+                raise FileNotFoundError(f"data folder not found: {r}{there}")
             rp = p.resolve()
             if rp not in resolved:
                 resolved.append(rp)
