@@ -1938,3 +1938,17 @@ def test_a_numpy_string_unit_is_said_as_its_text(tmp_path: Path) -> None:
         Calibration.from_opencv_stereo_calib(
             tmp_path / "i.yml", tmp_path / "e.yml", (640, 480), np.str_("yd")
         )
+
+
+def test_from_file_takes_a_numpy_image_size_for_a_q_dat(data_dir: Path) -> None:
+    """A Q.dat's ``image_size`` given as a NumPy array (a frame's ``shape[1::-1]``) raised NumPy's
+    "truth value of an array ... is ambiguous" (``image_size or`` the scene's size); it is read as
+    the same size given as a tuple, for the file and for its folder."""
+    import numpy as np
+
+    q = next(p for p in sorted(data_dir.rglob("Q.dat")) if (p.parent / "left.png").is_file())
+    for where in (q, q.parent):
+        as_tuple = Calibration.from_file(where, image_size=(320, 240))
+        as_array = Calibration.from_file(where, image_size=np.array([320, 240]))
+        assert as_array == as_tuple
+        assert as_array.image_size == (320, 240)

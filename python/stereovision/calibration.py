@@ -1530,7 +1530,11 @@ class Calibration:
                 return cls.from_file(p / "calib.txt", image_size=image_size)
             if (p / "Q.dat").is_file():
                 q = p / "Q.dat"
-                return cls.from_q(q, image_size or _scene_image_size(q), unit=unit or "m")
+                return cls.from_q(
+                    q,
+                    _scene_image_size(q) if image_size is None else image_size,
+                    unit=unit or "m",
+                )
             raise ValueError(
                 f"calibration path {p} is a folder without left.yaml and right.yaml "
                 "(ROS camera_info), calib.txt or Q.dat; pass a calibration file"
@@ -1566,7 +1570,9 @@ class Calibration:
         if re.search(r"^\s*(P_rect_02|P2)\s*:", text, re.MULTILINE):
             return cls.from_kitti(p, image_size=image_size)
         if _q_numbers(text):  # a Q.dat: OpenCV's Q, sized like load_scene sizes it
-            return cls.from_q(p, image_size or _scene_image_size(p), unit=unit or "m")
+            return cls.from_q(
+                p, _scene_image_size(p) if image_size is None else image_size, unit=unit or "m"
+            )
         if any(re.search(rf"^{k}\s*:", text, re.MULTILINE) for k in _MATLAB_FIELDS):
             raise ValueError(_matlab_export(str(p)))  # a YAML written without OpenCV's header
         raise ValueError(
