@@ -1737,3 +1737,14 @@ def test_view_of_a_surface_says_its_triangles(result, mesh, tmp_path, capsys, mo
     out = capsys.readouterr().out
     assert out == f"{mesh.n_points} points, {mesh.n_faces} triangles -> {shot}\n"
     assert mesh.n_faces > 0
+
+
+def test_render_view_takes_a_numpy_size():
+    """``size`` as a NumPy array (a frame's ``shape[1::-1]``) raised NumPy's "truth value of an
+    array ... is ambiguous" (``size or (800, 600)``); it renders at that size as a tuple does."""
+    rng = np.random.default_rng(1)
+    pts = rng.uniform([-1, -1, 3], [1, 1, 5], (500, 3)).astype(np.float32)
+    cloud = render.point_cloud(pts)
+    as_array = render.render_view(cloud, size=np.array([160, 120]))
+    assert as_array.shape == (120, 160, 3)
+    assert np.array_equal(as_array, render.render_view(cloud, size=(160, 120)))

@@ -1015,7 +1015,7 @@ def render_view(
         if size is not None:
             intrinsics = intrinsics.scaled(size[0] / intrinsics.width)
         size = (intrinsics.width, intrinsics.height)
-    size = size or (800, 600)
+    size = (800, 600) if size is None else size  # not `or`: a NumPy size has no truth value
     plotter = make_plotter(size)
     try:
         add_geometry(plotter, geometry)
