@@ -855,6 +855,74 @@ def test_a_pair_recorded_without_messages_is_passed_over(cones: Any, tmp_path: P
     assert str(info.value) == want
 
 
+def _zero_ros1_index_counts(bag: Path) -> None:
+    """Zero every count of a ROS 1 bag's chunk infos (the index's per-topic message counts),
+    keeping the messages and each chunk's own index of them."""
+    import struct
+
+    buf = bytearray(bag.read_bytes())
+
+    def record(pos: int) -> tuple[dict[bytes, bytes], int, int]:
+        (hlen,) = struct.unpack_from("<I", buf, pos)
+        fields, i = {}, pos + 4
+        while i < pos + 4 + hlen:
+            (flen,) = struct.unpack_from("<I", buf, i)
+            name, _, value = bytes(buf[i + 4 : i + 4 + flen]).partition(b"=")
+            fields[name] = value
+            i += 4 + flen
+        (dlen,) = struct.unpack_from("<I", buf, i)
+        return fields, i + 4, dlen
+
+    header, _, _ = record(len(b"#ROSBAG V2.0\n"))
+    (pos,) = struct.unpack("<Q", header[b"index_pos"])
+    while pos < len(buf):
+        fields, data, dlen = record(pos)
+        if fields[b"op"] == b"\x06":  # a chunk info: (connection id, count) pairs
+            for k in range(data + 4, data + dlen, 8):
+                struct.pack_into("<I", buf, k, 0)
+        pos = data + dlen
+    bag.write_bytes(bytes(buf))
+
+
+@pytest.mark.parametrize("flavour", ["ros2", "mcap", "ros1"])
+def test_a_bag_whose_index_counts_no_messages_is_read_with_its_topics_found(
+    cones: Any, tmp_path: Path, flavour: str
+) -> None:
+    """A bag whose index says 0 messages on its image topics, but holds them (metadata.yaml's
+    message_count left 0 by some recorders, a ROS 1 index of zero counts): its topics found
+    by name were refused ("no stereo pair of the bag holds messages on both topics: ... (0 and
+    0 messages)") though it read fine with the topics given. A zero count is now checked on
+    the messages themselves; a pair truly without any is still passed over (the test above)."""
+    import re
+
+    from stereovision.rosbag import _open_reader
+
+    frames = [
+        (T0 + k * PERIOD_NS, np.roll(cones.left, k, axis=1),
+         T0 + k * PERIOD_NS, np.roll(cones.right, k, axis=1))
+        for k in range(3)
+    ]  # fmt: skip
+    bag = write_bag(tmp_path / ("rig.bag" if flavour == "ros1" else "rig"), frames,
+                    flavour=flavour)  # fmt: skip
+    if flavour == "ros1":
+        _zero_ros1_index_counts(bag)
+    else:
+        meta = bag / "metadata.yaml"
+        meta.write_text(re.sub(r"message_count: \d+", "message_count: 0", meta.read_text()))
+    reader = _open_reader(bag)
+    try:  # the bag is what the test says: its index counts nothing
+        assert {t: i.msgcount for t, i in reader.topics.items()} == {LEFT: 0, RIGHT: 0}
+    finally:
+        reader.close()
+    with BagCamera(bag) as cam:
+        assert cam.topics == {"left": LEFT, "right": RIGHT}
+        got = list(cam.frames())
+    assert cam.stamps_ns == [T0 + k * PERIOD_NS for k in range(3)]
+    for f, (_, left, _, right) in zip(got, frames, strict=True):
+        np.testing.assert_array_equal(f.left, left)
+        np.testing.assert_array_equal(f.right, right)
+
+
 @PIPELINED
 def test_capture_of_a_bag_without_a_pair_is_an_error(
     cones: Any, tmp_path: Path, run: Callable[..., tuple[int, str, str]]
