@@ -1998,6 +1998,59 @@ def test_a_copy_without_its_times_is_up_to_date_and_a_changed_byte_is_redone(
     assert "hashes" in s["pairs"]["seq/0000"] and "hashes" not in s["pairs"]["seq/0001"]
 
 
+class _Terminal(io.StringIO):
+    """A stderr that says it is a terminal (batch draws its bars on one only)."""
+
+    def isatty(self) -> bool:
+        return True
+
+
+def test_the_check_of_a_copy_without_its_times_shows_its_progress(
+    data_dir: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Files copied without their times are read again (their sha256 against the summary's)
+    before the pairs' bar starts, which took long on a large dataset with nothing shown. That
+    check now has its bar on a terminal once it runs CHECK_BAR_DELAY seconds (a quick one draws
+    none), its total the pairs; elsewhere a plain line every PROGRESS_SECONDS while files are
+    read. stdout and every output file stay as they were."""
+    import stereovision.batch as batch
+
+    src, copy, out = tmp_path / "drive", tmp_path / "copy", tmp_path / "out"
+    _tiny(src, data_dir, *(f"seq/{i:04d}_{s}.bmp" for i in range(3) for s in ("left", "right")))
+    args = ["-o", str(out), "--workers", "1", "--max-disparity", "16"]
+    assert main(["batch", str(src), *args]) == 0
+    shutil.copytree(src, copy, copy_function=shutil.copyfile)  # times not kept
+    before = _tree(out)
+    capsys.readouterr()
+
+    def rerun(err: io.StringIO, stamp: int) -> str:
+        for p in copy.rglob("*.bmp"):  # new times again: every pair's files are read again
+            os.utime(p, ns=(stamp, stamp))
+        monkeypatch.setattr("sys.stderr", err)
+        assert main(["batch", str(copy), *args]) == 0
+        assert capsys.readouterr().out.startswith("0 processed, 3 skipped (done before), 0 ")
+        assert _tree(out) == before
+        return err.getvalue()
+
+    # raising=False: the code before this bar fails on its output, not on the name
+    monkeypatch.setattr(batch, "CHECK_BAR_DELAY", 0.0, raising=False)  # a long check, to the bar
+    shown = re.findall(r"checking files: +(\d+)%\|[^|]*\| (\d+)/(\d+) ", rerun(_Terminal(), 10**18))
+    assert shown and shown[-1] == ("100", "3", "3"), shown
+    monkeypatch.setattr(batch, "CHECK_BAR_DELAY", 60.0)  # a quick check: no bar
+    assert "checking" not in rerun(_Terminal(), 2 * 10**18)
+    monkeypatch.setattr(batch, "PROGRESS_SECONDS", 0.0)  # not a terminal: plain lines
+    lines = rerun(io.StringIO(), 3 * 10**18).splitlines()
+    line = re.compile(
+        r"batch: checking the pairs' files \(their times changed\): (\d)/3 pairs, \d+ s"
+    )
+    assert [m[1] if (m := line.fullmatch(x)) else x for x in lines] == ["1", "2"]
+    monkeypatch.setattr(batch, "PROGRESS_SECONDS", math.inf)  # a quick check: no line
+    assert rerun(io.StringIO(), 4 * 10**18) == ""
+
+
 def test_a_copy_without_its_times_of_a_calibration_is_up_to_date(
     data_dir: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -67,6 +67,9 @@ IN_FLIGHT_PER_WORKER = 2
 #: Seconds between the plain progress lines written when stderr is not a terminal (there is
 #: also one every tenth of the pairs).
 PROGRESS_SECONDS = 10.0
+#: Seconds the check of the pairs' files against the summary (their sha256 read again for files
+#: copied without their times) runs before its bar shows on a terminal: a quick one draws none.
+CHECK_BAR_DELAY = 2.0
 #: The summary is rewritten after a finished pair once this many times the duration of its last
 #: write has passed since (after every pair for a small one; at most a tenth of the time goes to
 #: rewriting a large one).
@@ -1322,7 +1325,9 @@ def run_batch(
         (redone), an output folder that went away during the run.
     progress : bool
         Show a progress bar on a terminal (stderr), else a plain line on stderr every tenth of
-        the pairs or every :data:`PROGRESS_SECONDS`.
+        the pairs or every :data:`PROGRESS_SECONDS`; before it, when the check of the pairs'
+        files against the summary runs long (files copied without their times are read
+        again), a bar over that check (a plain line every :data:`PROGRESS_SECONDS`).
     words : {"api", "cli"}
         Whose words the errors recorded in ``summary.json`` (and given to ``log``) advise in:
         the Python API's, as raised (``calib.scaled_to((w, h))``, ``max_disparity``), or the
@@ -1420,13 +1425,17 @@ def run_batch(
         foreign: Path | None = None  # a file under an output name no run recorded writing
         foreign_listed: list[str] = []  # the outputs recorded in its pair's folder
         unreadable: list[tuple[PairJob, str]] = []  # an image or calibration not there
-        for job in jobs:
+        checking = _Checking(len(jobs), progress)
+        for job in checking.over(jobs):
             try:
                 fp = _fingerprint(job)
             except OSError as exc:  # a broken link, an unmounted drive: this pair alone fails
                 unreadable.append((job, _error_line(exc, words)))
                 continue
             entry = summary.pairs.get(job.name)
+            # new times: the files are read again (a copy of a large dataset took minutes with
+            # nothing shown before the pairs' bar)
+            checking.reading |= entry is not None and entry.get("fingerprint") != fp
             if (
                 entry is not None
                 and entry.get("fingerprint") != fp
@@ -1722,6 +1731,58 @@ class _Progress:
 
     def close(self) -> None:
         self.bar.close()
+
+
+class _Checking:
+    """Progress of the check of every pair's files against the summary, which reads the files
+    again whose times changed (:func:`_same_content`): on a terminal a bar over the pairs, shown
+    once the check has run :data:`CHECK_BAR_DELAY` seconds; elsewhere, once files are being
+    read, a plain line every :data:`PROGRESS_SECONDS`: ``batch: checking the pairs' files
+    (their times changed): 120/400 pairs, 31 s``."""
+
+    def __init__(self, total: int, enabled: bool) -> None:
+        from tqdm import tqdm
+
+        tty = sys.stderr.isatty()
+        self.bar = tqdm(
+            total=total,
+            desc="checking files",
+            unit="pair",
+            file=sys.stderr,
+            delay=CHECK_BAR_DELAY,
+            disable=not enabled or not tty,
+        )
+        self.plain = enabled and not tty
+        self.total, self.n = total, 0
+        #: set by the caller once a pair's files are read again (their times changed)
+        self.reading = False
+        self.t0 = self.last = time.monotonic()
+
+    def over(self, jobs: list[PairJob]) -> Iterator[PairJob]:
+        """``jobs``, each counted once the caller is done with it; the bar closed at the end
+        (or when the caller stops)."""
+        try:
+            for job in jobs:
+                yield job
+                self._update()
+        finally:
+            self.bar.close()
+
+    def _update(self) -> None:
+        self.bar.update(1)
+        self.n += 1
+        now = time.monotonic()
+        if not (self.plain and self.reading) or self.n >= self.total:
+            return
+        if now - self.last < PROGRESS_SECONDS:
+            return
+        self.last = now
+        print(
+            f"batch: checking the pairs' files (their times changed): {self.n}/{self.total} "
+            f"pairs, {now - self.t0:.0f} s",
+            file=sys.stderr,
+            flush=True,
+        )
 
 
 def _run_jobs(
