@@ -891,8 +891,10 @@ def test_a_bag_whose_index_counts_no_messages_is_read_with_its_topics_found(
     """A bag whose index says 0 messages on its image topics, but holds them (metadata.yaml's
     message_count left 0 by some recorders, a ROS 1 index of zero counts): its topics found
     by name were refused ("no stereo pair of the bag holds messages on both topics: ... (0 and
-    0 messages)") though it read fine with the topics given. A zero count is now checked on
-    the messages themselves; a pair truly without any is still passed over (the test above)."""
+    0 messages)") though it read fine with the topics given; given them, it was read without
+    its calibration (its camera_info topics taken for empty ones). A zero count is now checked
+    on the messages themselves; a pair or camera_info truly without any is still passed over
+    (the test above, test_a_camera_info_topic_without_messages_is_no_calibration)."""
     import re
 
     from stereovision.rosbag import _open_reader
@@ -902,8 +904,12 @@ def test_a_bag_whose_index_counts_no_messages_is_read_with_its_topics_found(
          T0 + k * PERIOD_NS, np.roll(cones.right, k, axis=1))
         for k in range(3)
     ]  # fmt: skip
+    cams = tuple(parse_ros_camera_info(t) for t in _raw_rig().to_ros())
     bag = write_bag(tmp_path / ("rig.bag" if flavour == "ros1" else "rig"), frames,
-                    flavour=flavour)  # fmt: skip
+                    flavour=flavour, infos=cams)  # fmt: skip
+    with BagCamera(bag) as cam:
+        want = cam.calibration()
+    assert want is not None
     if flavour == "ros1":
         _zero_ros1_index_counts(bag)
     else:
@@ -911,11 +917,14 @@ def test_a_bag_whose_index_counts_no_messages_is_read_with_its_topics_found(
         meta.write_text(re.sub(r"message_count: \d+", "message_count: 0", meta.read_text()))
     reader = _open_reader(bag)
     try:  # the bag is what the test says: its index counts nothing
-        assert {t: i.msgcount for t, i in reader.topics.items()} == {LEFT: 0, RIGHT: 0}
+        assert {i.msgcount for i in reader.topics.values()} == {0} and len(reader.topics) == 4
     finally:
         reader.close()
     with BagCamera(bag) as cam:
         assert cam.topics == {"left": LEFT, "right": RIGHT}
+        assert cam.info_topics == {"left": "/stereo/left/camera_info",
+                                   "right": "/stereo/right/camera_info"}  # fmt: skip
+        assert cam.calibration() == want
         got = list(cam.frames())
     assert cam.stamps_ns == [T0 + k * PERIOD_NS for k in range(3)]
     for f, (_, left, _, right) in zip(got, frames, strict=True):

@@ -1100,17 +1100,21 @@ class BagCamera(PairSource):
             raise ValueError(f"the left and right topics are the same: {left!r}")
         self.topics = {"left": left, "right": right}
         self.sources = {"left": f"{self.path}:{left}", "right": f"{self.path}:{right}"}
-        self.info_topics: dict[str, str | None] = {}
-        for side, topic in self.topics.items():
-            info = _base_topic(topic).rsplit("/", 1)[0] + "/camera_info"
-            # a topic recorded and never published (0 messages) is none: calibration()'s first
-            # message raised StopIteration
-            ok = (
-                info in topics
-                and topics[info].msgtype == CAMERA_INFO_TYPE
-                and topics[info].msgcount > 0
-            )
-            self.info_topics[side] = info if ok else None
+        infos = {
+            side: info
+            for side, topic in self.topics.items()
+            if (info := _base_topic(topic).rsplit("/", 1)[0] + "/camera_info") in topics
+            and topics[info].msgtype == CAMERA_INFO_TYPE
+        }
+        # a topic recorded and never published (0 messages) is none: calibration()'s first
+        # message raised StopIteration. An index's 0 is checked on the messages, as the image
+        # topics' are (a bag whose index counts none read without its calibration)
+        unsure = {info for info in infos.values() if topics[info].msgcount <= 0}
+        held = _holding(self._reader, unsure) if unsure else set()
+        empty = unsure - held
+        self.info_topics: dict[str, str | None] = {
+            side: None if infos.get(side) in empty else infos.get(side) for side in self.topics
+        }
         self.rectified_topics = all(
             "rect" in _base_topic(t).rsplit("/", 1)[-1] for t in (left, right)
         )
