@@ -2612,6 +2612,32 @@ def test_a_negative_number_for_a_plain_float_option_says_how_to_give_it(
     )
 
 
+@pytest.mark.parametrize(
+    ("given", "names"),
+    [
+        (["-o", "--calib", "rig.yaml"], "-o/--output"),
+        (["--max-depth", "--voxel", "0.05"], "--max-depth"),
+        (["--max-depth", "--calib=rig.yaml"], "--max-depth"),
+        (["--max-depth", "--vox", "0.05"], "--max-depth"),
+        (["--voxel", "-oout"], "--voxel"),
+    ],
+)
+def test_an_option_whose_value_was_left_out_before_another_option_says_so(
+    capsys: pytest.CaptureFixture[str], given: list[str], names: str
+) -> None:
+    """`depth L R -o --calib rig.yaml` (the folder left out) was told "'--calib' starts with '-'
+    and was taken for an option; give it as --output=--calib", and `--max-depth --voxel 0.05`
+    "expected a number of metres above 0, got '--voxel'": the next option was taken for a value
+    typed with a '-'. The value is missing, as argparse says."""
+    with pytest.raises(SystemExit) as exit_:
+        main(["depth", str(CONES / "left.png"), str(CONES / "right.png"), *given])
+    assert exit_.value.code == 2
+    assert capsys.readouterr().err == (
+        f"stereovision depth: error: argument {names}: expected one argument "
+        "(see stereovision depth --help)\n"
+    )
+
+
 def test_a_folder_without_a_pair_given_as_the_images_says_what_was_looked_for(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

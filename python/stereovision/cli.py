@@ -1898,6 +1898,10 @@ class _Parser(argparse.ArgumentParser):
             )
             if not (named and value.startswith("-") and len(value) > 1):
                 continue
+            if self._names_an_option(value):
+                # `-o --calib rig.yaml`: the value was left out, not typed with a '-'; argparse's
+                # "expected one argument" says so (not "give it as --output=--calib")
+                return None
             if action.type in (int, float):  # a plain number type: said as _Parser.error does
                 try:
                     action.type(value)
@@ -1914,6 +1918,18 @@ class _Parser(argparse.ArgumentParser):
                 f"give it as {max(action.option_strings, key=len)}={value}"
             )
         return None
+
+    def _names_an_option(self, word: str) -> bool:
+        """Whether argparse reads ``word`` as one of this parser's options: by its name, its
+        ``--name=value`` form, a unique prefix of a long one (``--cal``) or a short one with its
+        value attached (``-oout``)."""
+        name = word.split("=", 1)[0] if word.startswith("--") else word
+        if name in self._option_string_actions:
+            return True
+        if word.startswith("--"):
+            known = self._option_string_actions
+            return self.allow_abbrev and any(s.startswith(name) for s in known)
+        return word[:2] in self._option_string_actions
 
     def _words_given(self) -> list[str]:
         """The words typed that are no option nor an option's value."""
