@@ -2664,6 +2664,50 @@ def test_a_folder_without_a_pair_given_as_the_images_says_what_was_looked_for(
     assert not out.exists()
 
 
+def test_a_folder_of_pairs_named_otherwise_given_as_the_images_is_no_folder_without_a_pair(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A folder holding one pair as capture saves it (left_0001.jpg + right_0001.jpg), or a
+    calibration set (left01.jpg + right01.jpg, ...), was said to be "a folder with no pair in
+    it": the pair is named as left.png + right.png are; the set is said to be pairs, for batch."""
+    one, many = tmp_path / "one", tmp_path / "many"
+    for folder, names in ((one, ["left_0001", "right_0001"]), (many, ["l01", "r01"])):
+        folder.mkdir()
+        for name in names:
+            cv2.imwrite(str(folder / f"{name}.jpg"), np.zeros((4, 4, 3), np.uint8))
+    for i in (1, 2, 3):  # right04 missing: 3 pairs, left04 alone
+        for side in ("left", "right"):
+            cv2.imwrite(str(many / f"{side}{i:02}.jpg"), np.zeros((4, 4, 3), np.uint8))
+    cv2.imwrite(str(many / "left04.jpg"), np.zeros((4, 4, 3), np.uint8))
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit):
+        main(["depth", str(one), "-o", str(out)])
+    assert capsys.readouterr().err == (
+        f"stereovision depth: error: the right image is missing; {one} is a folder holding a "
+        f"pair: give its two images, {one / 'left_0001.jpg'} and {one / 'right_0001.jpg'} (see "
+        "stereovision depth --help)\n"
+    )
+    assert main(["depth", str(one), str(one), "-o", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: image file is not a regular file: {one} (a folder holding a pair: "
+        f"give its two images, {one / 'left_0001.jpg'} and {one / 'right_0001.jpg'})\n"
+    )
+    many_said = "3 pairs: left01.jpg + right01.jpg, ...; stereovision batch takes such a folder"
+    with pytest.raises(SystemExit):
+        main(["depth", str(many), "-o", str(out)])
+    assert capsys.readouterr().err == (
+        f"stereovision depth: error: the right image is missing; {many} is a folder of "
+        f"{many_said.replace(': ', ' (', 1)}): give two image files, left and right (see "
+        "stereovision depth --help)\n"
+    )
+    assert main(["depth", str(many), str(many), "-o", str(out)]) == 2
+    assert capsys.readouterr().err == (
+        f"stereovision: error: image file is not a regular file: {many} (a folder of "
+        f"{many_said}; give two image files)\n"
+    )
+    assert not out.exists()
+
+
 @pytest.mark.parametrize(
     ("argv", "said"),
     [

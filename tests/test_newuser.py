@@ -796,12 +796,16 @@ def test_one_scene_folder_for_both_images_says_what_to_type(
         assert capsys.readouterr().err.endswith(
             f"{pair} (also required: -o/--output) (see stereovision depth --help)\n"
         )
-    calib_set = tmp_path / "boards"  # left01/left02...: no single pair
+    calib_set = tmp_path / "boards"  # left01/left02...: no single pair, but pairs (batch's)
     calib_set.mkdir()
     for name in ("left01.png", "left02.png", "right01.png", "right02.png"):
         (calib_set / name).write_bytes(b"")
     for given, said in (
-        (calib_set, f"the right image is missing; {calib_set} is a folder with no pair in it"),
+        (
+            calib_set,
+            f"the right image is missing; {calib_set} is a folder of 2 pairs (left01.png + "
+            "right01.png, ...; stereovision batch takes such a folder)",
+        ),
         (CONES / "left.png", "the following arguments are required: right"),
     ):
         with pytest.raises(SystemExit):

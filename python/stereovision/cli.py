@@ -1957,7 +1957,7 @@ class _Parser(argparse.ArgumentParser):
         """``stereovision depth cones -o out``: one positional, a scene folder (as eval and
         batch take it). argparse said only that ``right`` is required; the folder's two images
         are what to type (as imread says of a folder given as an image)."""
-        from stereovision.io import FOLDER_PAIR_NAMES, _folder_pair
+        from stereovision.io import _folder_pair, _no_single_pair
 
         given = self._words_given()
         if len(given) != 1 or not os.path.isdir(given[0]):
@@ -1965,9 +1965,10 @@ class _Parser(argparse.ArgumentParser):
         pair = _folder_pair(given[0])
         also = f" (also required: {also})" if also else ""
         if pair is None:  # argparse's "required: right" did not say the folder was the problem
+            what, detail = _no_single_pair(given[0])
             return (
-                f"the right image is missing; {given[0]} is a folder with no pair in it "
-                f"({FOLDER_PAIR_NAMES}): give two image files, left and right{also}"
+                f"the right image is missing; {given[0]} is a folder {what} ({detail}): "
+                f"give two image files, left and right{also}"
             )
         return (
             f"the right image is missing; {given[0]} is a folder holding a pair: give its two "

@@ -751,14 +751,49 @@ def _pair_in_folder(folder: Path) -> str:
         if not folder.is_dir():  # a FIFO or a device: no folder to speak of
             return ""
         # "not a regular file" alone did not say what was expected of it
-        return f" (a folder with no pair in it: {FOLDER_PAIR_NAMES}; give two image files)"
+        what, detail = _no_single_pair(folder)
+        return f" (a folder {what}: {detail}; give two image files)"
     return f" (a folder holding a pair: give its two images, {pair[0]} and {pair[1]})"
+
+
+def _no_single_pair(folder: PathLike) -> tuple[str, str]:
+    """What a folder without a single pair (:func:`_folder_pair` None) holds, and the detail,
+    for the messages about it given as the images: its pairs by name (``left01.jpg`` +
+    ``right01.jpg``, ..., which ``stereovision batch`` takes) are not "no pair"."""
+    pairs = _named_pairs(folder)
+    if len(pairs) > 1:
+        first, second = pairs[0]
+        return (
+            f"of {len(pairs)} pairs",
+            f"{first.name} + {second.name}, ...; stereovision batch takes such a folder",
+        )
+    return "with no pair in it", FOLDER_PAIR_NAMES
+
+
+def _named_pairs(folder: PathLike) -> list[tuple[Path, Path]]:
+    """The images directly in ``folder`` named with ``left`` whose name with ``right`` in its
+    place is there too (``left_0001.png`` + ``right_0001.png``), as
+    :func:`stereovision.batch.find_pairs` pairs them; [] when it is no readable folder."""
+    from stereovision.batch import IMAGE_EXTS, _last_left, _swap
+
+    folder = Path(folder)
+    try:
+        names = {f for f in os.listdir(folder) if Path(f).suffix.lower() in IMAGE_EXTS}
+    except OSError:
+        return []
+    pairs = []
+    for name in sorted(names):
+        m = _last_left(Path(name).stem)
+        if m is not None and (right := _swap(Path(name), m, "right").name) in names:
+            pairs.append((folder / name, folder / right))
+    return pairs
 
 
 def _folder_pair(folder: PathLike) -> tuple[Path, Path] | None:
     """The left and right image of a scene folder holding one pair (``left.png`` +
-    ``right.png``, Middlebury's ``im0.png`` + ``im1.png``), for a message saying what to give
-    instead of the folder.
+    ``right.png``, Middlebury's ``im0.png`` + ``im1.png``, else one pair named as
+    :func:`_named_pairs` finds them: ``left_0001.png`` + ``right_0001.png``), for a message
+    saying what to give instead of the folder.
 
     Parameters
     ----------
@@ -783,7 +818,9 @@ def _folder_pair(folder: PathLike) -> tuple[Path, Path] | None:
         rs = sorted(f for f in images if Path(f).stem.lower() == right)
         if len(ls) == 1 and len(rs) == 1:
             return folder / ls[0], folder / rs[0]
-    return None
+    # one pair named as capture saves it (left_0001.png + right_0001.png), cam_left.jpg + ...
+    named = _named_pairs(folder)
+    return named[0] if len(named) == 1 else None
 
 
 # --------------------------------------------------------------------------------------- images
