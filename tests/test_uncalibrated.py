@@ -1330,6 +1330,21 @@ def test_opencv_finding_no_homographies_is_refused(
         rectify_uncalibrated(sc.left, sc.right, model="projective")
 
 
+@pytest.mark.parametrize(("text", "kind"), [("[1, 2]", "array"), ("null", "null"), ("5", "number")])
+def test_json_that_is_no_object_given_as_the_rectification_says_what_was_expected(
+    tmp_path: Path, text: str, kind: str
+) -> None:
+    """A JSON list, null or number said Python's words of the lookup ("list indices must be
+    integers or slices, not str", "'NoneType' object is not subscriptable")."""
+    (tmp_path / "r.json").write_text(text)
+    with pytest.raises(ValueError) as err:
+        UncalibratedRectification.load(tmp_path / "r.json")
+    assert str(err.value) == (
+        f"{tmp_path / 'r.json'} is not an uncalibrated rectification: a JSON {kind}, not an object "
+        "(expected the rectification.json that `stereovision rectify` writes)"
+    )
+
+
 def test_an_image_an_empty_file_or_a_folder_given_as_the_rectification_says_what_was_expected(
     tmp_path: Path,
 ) -> None:

@@ -530,6 +530,15 @@ class UncalibratedRectification:
                 f"{p} is not an uncalibrated rectification: not JSON text (expected the "
                 "rectification.json that `stereovision rectify` writes)"
             ) from None
+        if not isinstance(d, dict):
+            # a JSON list or number (another tool's file) said "list indices must be integers
+            # or slices, not str", Python's words of the lookup, not what was expected
+            kind = {list: "array", str: "string", bool: "true/false"}.get(type(d), "number")
+            raise ValueError(
+                f"{p} is not an uncalibrated rectification: a JSON "
+                f"{'null' if d is None else kind}, not an object (expected the "
+                "rectification.json that `stereovision rectify` writes)"
+            )
         try:
             mats = {k: np.asarray(d[k], np.float64).reshape(3, 3) for k in ("H1", "H2", "F")}
             out = cls(
