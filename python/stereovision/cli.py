@@ -2216,7 +2216,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     0 ok; 1 a verdict or partial result (``check`` finds the rows disagree, ``batch`` had pairs
     fail); 2 an error (one line on stderr); 3 ``check`` cannot tell; 130 interrupted (Ctrl-C);
-    141 a closed pipe (``| head``); 143 terminated (SIGTERM).
+    141 a closed pipe (``| head``); 143 terminated (SIGTERM). A refusal of the command line
+    itself (an unknown option, a value an option does not take: ``--voxel 0``, ``--square 25mm``),
+    ``--help`` and ``--version`` exit as argparse's do, by ``SystemExit`` (2, or 0), before any
+    work.
     """
     try:
         # the commands' modules are imported here (0.2 s): a Ctrl-C right after the command
