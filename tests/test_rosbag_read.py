@@ -909,7 +909,8 @@ def test_a_bag_whose_index_counts_no_messages_is_read_with_its_topics_found(
                     flavour=flavour, infos=cams)  # fmt: skip
     with BagCamera(bag) as cam:
         want = cam.calibration()
-    assert want is not None
+        positions = [(f.pos_left_ms, f.pos_right_ms) for f in cam.frames()]
+    assert want is not None and positions[0] == (-2.0, -2.0)  # recorded 2 ms after its stamp
     if flavour == "ros1":
         _zero_ros1_index_counts(bag)
     else:
@@ -927,6 +928,8 @@ def test_a_bag_whose_index_counts_no_messages_is_read_with_its_topics_found(
         assert cam.calibration() == want
         got = list(cam.frames())
     assert cam.stamps_ns == [T0 + k * PERIOD_NS for k in range(3)]
+    # the time since the bag's start, as indexed (a ROS 2 bag's start was rosbags' 2**63 - 1)
+    assert [(f.pos_left_ms, f.pos_right_ms) for f in got] == positions
     for f, (_, left, _, right) in zip(got, frames, strict=True):
         np.testing.assert_array_equal(f.left, left)
         np.testing.assert_array_equal(f.right, right)

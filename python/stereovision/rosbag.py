@@ -1070,6 +1070,7 @@ class BagCamera(PairSource):
         self._sleep: Any = time.sleep
         self._start: tuple[float, int] | None = None  # (wall time, stamp) of the first pair
         self._peeked: deque[tuple[int, Any, int, Any]] = deque()
+        self._origin: int | None = None  # the bag's start (_start_ns)
         try:
             self._setup(left_topic, right_topic, max_skew_ms)
         except BaseException:
@@ -1298,7 +1299,7 @@ class BagCamera(PairSource):
             except ValueError as exc:
                 raise ValueError(f"{self.topics[side]} at stamp {stamp} ns: {exc}") from None
         left, right = to_8bit(*imgs)
-        start = self._reader.start_time
+        start = self._start_ns()
         fitted = (self._fit("left", left, sl), self._fit("right", right, sr))
         frame = StereoFrame(
             left=fitted[0],
@@ -1314,6 +1315,24 @@ class BagCamera(PairSource):
         self.skews_ms.append(frame.skew_ms)
         self.stamps_ns.append(sl)
         return frame
+
+    def _start_ns(self) -> int:
+        """The bag's start (its first message's recording time), the origin of the frames'
+        ``pos_*_ms``. rosbags takes it from the index: a ROS 2 bag whose metadata.yaml counts
+        no message (read since its topics are checked on the messages) gave 2**63 - 1, and
+        every position near -7.5e12 ms; its first message is read for it then (once)."""
+        if self._origin is None:
+            reader = self._reader
+            start = int(reader.start_time)
+            if start > reader.end_time:  # no message counted: no span known
+                messages = reader.messages()
+                try:
+                    first = next(messages, None)
+                finally:
+                    messages.close()
+                start = int(first[1]) if first is not None else 0
+            self._origin = start
+        return self._origin
 
     def _next_pair(self) -> tuple[int, Any, int, Any] | None:
         """The next pair; with ``realtime``, the newest whose time has come (waiting for it)."""
