@@ -853,6 +853,21 @@ def test_a_pair_recorded_without_messages_is_passed_over(cones: Any, tmp_path: P
     with pytest.raises(ValueError) as info:
         BagCamera(empty)
     assert str(info.value) == want
+    # an index counting none (metadata.yaml's message_count 0), the right topic truly empty:
+    # the left one's messages were said as 1 (the check's mark), not a count
+    import re
+
+    lone = [(T0 + k * PERIOD_NS, cones.left, None, cones.right) for k in range(2)]
+    one = write_bag(tmp_path / "one", lone, empty=(RIGHT,))
+    meta = one / "metadata.yaml"
+    meta.write_text(re.sub(r"message_count: \d+", "message_count: 0", meta.read_text()))
+    with pytest.raises(ValueError) as info:
+        BagCamera(one)
+    assert str(info.value) == (
+        "no stereo pair of the bag holds messages on both topics: "
+        f"{LEFT} + {RIGHT} (some and 0 messages)"
+    )
+    assert find_stereo_topics([LEFT, RIGHT], {LEFT: -1, RIGHT: -1}) == (LEFT, RIGHT)
 
 
 def _zero_ros1_index_counts(bag: Path) -> None:

@@ -941,7 +941,8 @@ def find_stereo_topics(
     image_topics : list of str
         The bag's image topics.
     counts : dict of str to int, optional
-        Each topic's message count. Default: every topic taken to hold messages.
+        Each topic's message count (-1: holds messages, how many unknown). Default: every
+        topic taken to hold messages.
 
     Raises
     ------
@@ -963,12 +964,14 @@ def find_stereo_topics(
     # a topic recorded but never published (0 messages) gave a camera of no frames: a raw pair
     # without messages was taken over a rectified one with them
     def rank(pair: tuple[str, str]) -> tuple[bool, bool, bool]:
-        full = held(pair[0]) > 0 and held(pair[1]) > 0
+        full = held(pair[0]) != 0 and held(pair[1]) != 0
         return (full, "raw" in pair[0], _base_topic(pair[0]) == pair[0])
 
     best = max(rank(p) for p in pairs)
     if not best[0]:
-        names = "; ".join(f"{a} + {b} ({held(a)} and {held(b)} messages)" for a, b in pairs)
+        # a count unknown is not said as a number (a zero-count index's topic held 4, said 1)
+        said = {t: "some" if held(t) < 0 else str(held(t)) for p in pairs for t in p}
+        names = "; ".join(f"{a} + {b} ({said[a]} and {said[b]} messages)" for a, b in pairs)
         raise ValueError(f"no stereo pair of the bag holds messages on both topics: {names}")
     top = [p for p in pairs if rank(p) == best]
     if len(top) > 1:
@@ -1089,7 +1092,7 @@ class BagCamera(PairSource):
             # costs nothing more.
             unsure = {t for pair in _stereo_pairs(images) for t in pair if counts[t] <= 0}
             if unsure:
-                counts |= dict.fromkeys(_holding(self._reader, unsure), 1)
+                counts |= dict.fromkeys(_holding(self._reader, unsure), -1)  # how many unknown
             left, right = find_stereo_topics(images, counts)
         for side, topic in (("left", left), ("right", right)):
             if topic not in images:
