@@ -840,6 +840,8 @@ def test_a_pair_recorded_without_messages_is_passed_over(cones: Any, tmp_path: P
     bag = write_bag(tmp_path / "rig", frames, topics=rect, empty=(LEFT, RIGHT))
     with BagCamera(bag) as cam:
         assert cam.topics == {"left": rect[0], "right": rect[1]}
+        listed = {ln.split()[0]: ln.split()[2:] for ln in cam.summary().splitlines()[1:]}
+        assert listed[LEFT] == ["0", "msgs", "0.00", "Hz"]  # truly none: not "?"
         assert len(list(cam.frames())) == 3
     counts = {LEFT: 4, RIGHT: 0, rect[0]: 2, rect[1]: 2}  # one side without messages
     assert find_stereo_topics([LEFT, RIGHT, *rect], counts) == rect
@@ -941,6 +943,13 @@ def test_a_bag_whose_index_counts_no_messages_is_read_with_its_topics_found(
         assert cam.info_topics == {"left": "/stereo/left/camera_info",
                                    "right": "/stereo/right/camera_info"}  # fmt: skip
         assert cam.calibration() == want
+        # info's lines: the counts and rates unknown, not 0 (a ROS 2 index gives no span)
+        lines = cam.summary().splitlines()
+        span = "0.1 s" if flavour == "ros1" else "? s"
+        assert (
+            lines[0] == f"bag {bag} ({'ROS 1' if flavour == 'ros1' else 'ROS 2'}, {span}, 4 topics)"
+        )
+        assert len(lines) == 5 and all(" ? msgs       ? Hz" in line for line in lines[1:]), lines
         got = list(cam.frames())
     assert cam.stamps_ns == [T0 + k * PERIOD_NS for k in range(3)]
     # the time since the bag's start, as indexed (a ROS 2 bag's start was rosbags' 2**63 - 1)

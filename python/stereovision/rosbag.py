@@ -722,14 +722,23 @@ def _open_reader(path: Path) -> Any:
 def _topic_lines(path: Path, reader: Any, roles: dict[str, str]) -> str:
     """``BagCamera.summary``'s lines: the bag, then each topic's type, messages and rate,
     with its role (``roles``: topic -> suffix)."""
-    span_s = max(reader.duration, 1) / 1e9
+    # an index's count of 0 is checked on the messages, as BagCamera's topics are: a bag whose
+    # metadata.yaml counts none listed the topics it reads as "0 msgs 0.00 Hz" (and a ROS 2
+    # one's span as 0.0 s); their count and rate are unknown ("?"), a topic without any is 0
+    zero = {t for t, i in reader.topics.items() if i.msgcount <= 0}
+    unknown = _holding(reader, zero) if zero else set()
+    span = "?" if reader.start_time > reader.end_time else f"{max(reader.duration, 1) / 1e9:.1f}"
     kind = "ROS 2" if getattr(reader, "is2", True) else "ROS 1"
-    lines = [f"bag {path} ({kind}, {span_s:.1f} s, {len(reader.topics)} topics)"]
+    lines = [f"bag {path} ({kind}, {span} s, {len(reader.topics)} topics)"]
     width = max((len(t) for t in reader.topics), default=0)
     for topic, info in sorted(reader.topics.items()):
+        count, rate = (
+            (f"{'?':>7}", f"{'?':>7}")
+            if topic in unknown
+            else (f"{info.msgcount:7d}", f"{_rate(info.msgcount, reader):7.2f}")
+        )
         lines.append(
-            f"  {topic:<{width}}  {info.msgtype:<31} {info.msgcount:7d} msgs "
-            f"{_rate(info.msgcount, reader):7.2f} Hz{roles.get(topic, '')}"
+            f"  {topic:<{width}}  {info.msgtype:<31} {count} msgs {rate} Hz{roles.get(topic, '')}"
         )
     return "\n".join(lines)
 
