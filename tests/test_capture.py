@@ -3709,3 +3709,39 @@ def test_a_sequence_whose_first_image_does_not_read_names_it(
         f"cannot open left source {left!r}: its first image, left_{start:03d}.png, does not "
         "read (damaged?)"
     )
+
+
+def test_stereo_camera_quiets_only_the_sequences_grab(tmp_path: Path) -> None:
+    """A video paired with an image sequence: both grabs ran with OpenCV's process-wide log
+    silenced, so the video's (or a camera's) own warnings were lost, and every other
+    thread's meanwhile. Only the sequence's grab is quiet now; the level is put back."""
+    log = cv2.utils.logging
+    video = _write_video(tmp_path / "left.avi", [_numbered(i) for i in range(3)])
+    seq = _write_sequence(tmp_path / "frames", "right", [_numbered(i, shade=160) for i in range(3)])
+
+    class Recorder:
+        """A capture that records OpenCV's log level at each grab."""
+
+        def __init__(self, cap: Any, levels: list[int]) -> None:
+            self.cap, self.levels = cap, levels
+
+        def grab(self) -> bool:
+            self.levels.append(log.getLogLevel())
+            return bool(self.cap.grab())
+
+        def __getattr__(self, name: str) -> Any:
+            return getattr(self.cap, name)
+
+    before = log.getLogLevel()
+    log.setLogLevel(log.LOG_LEVEL_WARNING)
+    try:
+        seen: dict[str, list[int]] = {"left": [], "right": []}
+        with StereoCamera(str(video), seq) as cam:
+            cam._caps = {side: Recorder(c, seen[side]) for side, c in cam._caps.items()}
+            got = [_read_stamp(cam.read().right) for _ in range(3)]
+        assert got == [0, 1, 2]
+        assert seen["left"] == [log.LOG_LEVEL_WARNING] * 3  # the video's warnings are said
+        assert seen["right"] == [log.LOG_LEVEL_SILENT] * 3
+        assert log.getLogLevel() == log.LOG_LEVEL_WARNING
+    finally:
+        log.setLogLevel(before)

@@ -1753,12 +1753,10 @@ class StereoCamera(PairSource):
                 return False, 0.0, False, 0.0, {}
             claim[0] = "entered"
         try:
-            # OpenCV's image-sequence reader logs a warning for the file after the last.
-            with _opencv_quiet() if any(self._sequence.values()) else contextlib.nullcontext():
-                ok_l = self._native(caps, "left", "grab")
-                t_l = time.monotonic()
-                ok_r = self._native(caps, "right", "grab")
-                t_r = time.monotonic()
+            ok_l = self._grab_one(caps, "left")
+            t_l = time.monotonic()
+            ok_r = self._grab_one(caps, "right")
+            t_r = time.monotonic()
             if not (ok_l and ok_r):
                 return ok_l, t_l, ok_r, t_r, {}
             got = {side: self._native(caps, side, "retrieve") for side in ("left", "right")}
@@ -1769,6 +1767,13 @@ class StereoCamera(PairSource):
                 release, self._release_on_return = self._release_on_return, False
             if release:  # closed while this grab hung: released now that it is out of OpenCV
                 _release(caps.values())
+
+    def _grab_one(self, caps: dict[str, Any], side: str) -> Any:
+        """``side``'s grab (:meth:`_native`), OpenCV's log quiet for an image sequence's alone:
+        its reader logs a warning for the file after the last. The level is process-wide: both
+        grabs quiet lost the other side's warnings, and every thread's while a camera hung."""
+        with _opencv_quiet() if self._sequence.get(side) else contextlib.nullcontext():
+            return self._native(caps, side, "grab")
 
     def _native(self, caps: dict[str, Any], side: str, step: str) -> Any:
         """``caps[side].grab()`` or ``.retrieve()`` (``step``); a ``cv2.error`` it raises (a
