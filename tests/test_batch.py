@@ -228,6 +228,24 @@ def test_unreachable_scheduler_leaves_no_new_folder(
     assert list(kept.iterdir()) == []
 
 
+def test_a_password_in_an_address_is_not_said(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A scheduler address, or an input given as a URL, with a password: the one line said
+    it (Dask's "invalid address 'admin:s3cret@127.0.0.1:1'", "input folder not found:
+    rtsp:/admin:s3cret@cam/0"). It is said as ***; nothing is left written."""
+    _noise_pair(tmp_path / "in" / "scene")
+    out = tmp_path / "out"
+    argv = ["batch", str(tmp_path / "in"), "-o", str(out)]
+    assert main([*argv, "--scheduler", "tcp://admin:s3cret@127.0.0.1:1"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "'admin:***@127.0.0.1:1'" in err[0] and "s3cret" not in err[0]
+    assert main(["batch", "rtsp://admin:s3cret@cam/0?token=tok77", "-o", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["stereovision: error: input folder not found: rtsp://admin:***@cam/0?token=***"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in"]
+
+
 def test_find_pairs_names(tmp_path: Path) -> None:
     img = np.zeros((8, 8, 3), np.uint8)
     files = [

@@ -31,6 +31,7 @@ from stereovision.capture import (
     charuco_pose_params,
     detect_board_live,
     fourcc_text,
+    mask_url_secrets,
     next_pair_index,
     parse_fourcc,
     parse_size,
@@ -3745,3 +3746,119 @@ def test_stereo_camera_quiets_only_the_sequences_grab(tmp_path: Path) -> None:
         assert log.getLogLevel() == log.LOG_LEVEL_WARNING
     finally:
         log.setLogLevel(before)
+
+
+@pytest.mark.parametrize(
+    ("url", "said"),
+    [
+        ("rtsp://admin:s3cret@cam/0", "rtsp://admin:***@cam/0"),
+        ("http://user:pw@host/x", "http://user:***@host/x"),
+        # FFmpeg's split: the authority ends at "/", "?" or "#", the user part at its last "@"
+        ("rtsp://admin:p@ss:w@cam:554/1?x=a:b@c", "rtsp://admin:***@cam:554/1?x=a:b@c"),
+        ("http://u:pw@host?key=1", "http://u:***@host?key=***"),
+        (
+            "http://cam/x?size=2&TOKEN=abc;access_token=d#f&pwd=e",
+            "http://cam/x?size=2&TOKEN=***;access_token=***#f&pwd=e",
+        ),
+        (
+            "http://cam/x?passwd=a&password=b&api_key=c",
+            "http://cam/x?passwd=***&password=***&api_key=***",
+        ),
+        # a path's "&key=" is no parameter
+        ("http://h/a&key=1/x?q=1&key=1", "http://h/a&key=1/x?q=1&key=***"),
+        # no secret: as given (a port, a user alone, an "@" in the path, empty or longer keys)
+        ("rtsp://cam:554/0", "rtsp://cam:554/0"),
+        ("rtsp://admin@cam/0", "rtsp://admin@cam/0"),
+        ("http://cam:80/a:b@c", "http://cam:80/a:b@c"),
+        ("http://cam/x?token=&tokens=1&monkey=2", "http://cam/x?token=&tokens=1&monkey=2"),
+        # a path is no URL, whatever its name holds
+        ("/data/a:b@c/x?token=1.avi", "/data/a:b@c/x?token=1.avi"),
+    ],
+)
+def test_a_urls_secrets_are_masked(url: str, said: str) -> None:
+    assert mask_url_secrets(url) == said
+    if "://" in url:  # another library's words for a URL lose them too (Dask's own)
+        text = f"a: bad address {url.split('://')[1]!r} (a=a, user u, key c)"
+        assert capmod._mask_secrets_of(text, url) == (
+            f"a: bad address {said.split('://')[1]!r} (a=a, user u, key c)"
+        )
+
+
+#: Streams with a password and a token: what the capture code says must not hold these.
+_LEFT_URL, _RIGHT_URL = "rtsp://admin:s3cret@cam/0?token=tok77", "http://u:pw99@cam/1.avi"
+_SECRETS = ("s3cret", "tok77", "pw99")
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["capture", "--count", "1", "-o", "pairs"],
+        ["stream", "--no-display", "--json"],
+        ["calibrate", "--square", "0.025", "-o", "calib.yaml"],
+    ],
+    ids=["capture", "stream", "calibrate"],
+)
+def test_a_stream_that_does_not_open_is_said_without_its_password(
+    argv: list[str],
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """A stream URL with a password that does not open: "cannot open left source
+    'rtsp://admin:s3cret@cam/0'", the one line of capture, stream and calibrate, said it. It
+    is said as ***; the URL opened is the one given."""
+    from stereovision.cli import main
+
+    opened: list[str] = []
+
+    def down(path: str, first: Any) -> Any:
+        opened.append(path)
+        return cv2.VideoCapture()  # not open
+
+    monkeypatch.setattr(capmod, "_open_path", down)
+    monkeypatch.chdir(tmp_path)
+    # calibrate takes a video by its suffix: a query after it is no video
+    video = argv[0] == "calibrate"
+    left = "rtsp://admin:s3cret@cam/0.avi" if video else _LEFT_URL
+    assert main([*argv, "--left", left, "--right", _RIGHT_URL]) == 2
+    out, err = capsys.readouterr()
+    name = "rtsp://admin:***@cam/0" + (".avi" if video else "?token=***")
+    assert err.splitlines() == [f"stereovision: error: cannot open left source '{name}'"]
+    assert opened == [left]
+    assert not any(s in out + err for s in _SECRETS)
+    assert not list(tmp_path.iterdir())  # nothing written
+
+
+def test_a_streams_password_is_not_said_in_captures_lines(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Streams given by URLs with a password: capture's description of its sources, its
+    end (a stream ending early) and the warning of one source given twice named them with it.
+    They are said as ***; nothing written holds them."""
+    from stereovision.cli import main
+
+    left, right = _videos(tmp_path, 4, 2)
+    real = capmod._open_path
+    files = {_LEFT_URL: str(left), _RIGHT_URL: str(right)}
+    monkeypatch.setattr(capmod, "_open_path", lambda path, first: real(files[path], first))
+    out = tmp_path / "pairs"
+    argv = ["capture", "--count", "3", "-o", str(out), "--left", _LEFT_URL, "--right", _RIGHT_URL]
+    assert main(argv) == 2
+    said, err = capsys.readouterr()
+    left_name, right_name = "'rtsp://admin:***@cam/0?token=***'", "'http://u:***@cam/1.avi'"
+    assert said.splitlines()[0].startswith(f"native size; left {left_name}: ")
+    assert f"; right {right_name}: " in said.splitlines()[0]
+    assert err.splitlines()[-1].startswith(
+        f"stereovision: error: right source {right_name} ended after 2 frames"
+    )
+    assert len(list(out.iterdir())) == 4  # the 2 pairs saved, kept
+    argv = ["capture", "--count", "1", "-o", str(out), "--left", _LEFT_URL, "--right", _LEFT_URL]
+    assert main(argv) == 0
+    said2, err2 = capsys.readouterr()
+    assert err2.splitlines()[0] == (
+        f"stereovision: warning: --left and --right are the same source {left_name}: every "
+        "pair is one view twice and every disparity comes out 0 (two cameras' views are needed)"
+    )
+    assert not any(s in said + err + said2 + err2 for s in _SECRETS)
+    for path in out.iterdir():
+        assert not any(s.encode() in path.read_bytes() for s in _SECRETS)

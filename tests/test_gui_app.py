@@ -5803,3 +5803,52 @@ def test_check_rows_of_files_at_another_resolution_uses_the_calibration_scaled(t
     _run(app, app.check_rows)
     assert app.state.error == ""
     assert app.state.rows_label.startswith("rectification ok")
+
+
+def test_a_streams_password_is_not_said_when_it_does_not_open(monkeypatch, caplog):
+    """A stream URL with a password: the page said it typed in the camera fields ("no such
+    file: rtsp://admin:s3cret@cam/0", logged too), showed it in those fields to every browser
+    when given as ``gui --left``, and a stream that does not open was refused as "cannot open
+    left source 'rtsp://admin:s3cret@cam/0'" (VideoPair: "left camera source not found: ...").
+    The password and a token parameter are said as ``***``; the URL opened is the one given."""
+    import logging
+
+    from stereovision import capture
+    from stereovision.gui import bundled_data_dir
+    from stereovision.gui.sources import VideoPair, open_stereo_source
+
+    url = "rtsp://admin:s3cret@cam/0?token=tok77"
+    caplog.set_level(logging.INFO, logger="stereovision")
+    app = _scene_app("test-stream-password-typed", [bundled_data_dir()])
+    app.state.cam_left, app.state.cam_right = url, "rtsp://cam/1"
+    _open_cameras(app)
+    assert app.state.error == "no such file: rtsp://admin:***@cam/0?token=***"
+    assert app.state.error in caplog.text  # logged, as said
+    # given as gui --left: shown in the page's field without it
+    app = _scene_app(
+        "test-stream-password-given", [bundled_data_dir()], source_names=(url, "rtsp://cam/1")
+    )
+    assert (app.state.cam_left, app.state.cam_right) == (
+        "rtsp://admin:***@cam/0?token=***",
+        "rtsp://cam/1",
+    )
+    opened: list[str] = []
+
+    def down(path: str, first: Any) -> Any:
+        opened.append(path)
+        return cv2.VideoCapture()  # not open: the stream is down
+
+    monkeypatch.setattr(capture, "_open_path", down)
+    with pytest.raises(OSError) as err:
+        open_stereo_source(url, "rtsp://cam/1")
+    assert str(err.value) == "cannot open left source 'rtsp://admin:***@cam/0?token=***'"
+    assert opened == [url]  # opened as given
+    # OpenCV's own pair (no capture module) takes no URL: refused without its password
+    with pytest.raises(OSError) as err:
+        VideoPair(url, "rtsp://cam/1")
+    assert str(err.value) == "left camera source not found: rtsp://admin:***@cam/0?token=***"
+    monkeypatch.setattr("stereovision.gui.sources._open_capture", down)
+    with pytest.raises(OSError) as err:  # a pattern is not looked for: opened, and refused
+        VideoPair("http://admin:s3cret@cam/f_%03d.jpg", "rtsp://cam/1")
+    assert str(err.value) == "cannot open camera 'http://admin:***@cam/f_%03d.jpg' (left)"
+    assert "s3cret" not in caplog.text and "tok77" not in caplog.text

@@ -2740,3 +2740,50 @@ def test_video_stamps_increase_when_the_media_time_stalls_or_goes_back(
         f"or repeated one): this pair and the next are stamped by {step}"
         + (" (the video reports no frame rate)" if not fps else "")
     ]
+
+
+@PIPELINED
+def test_a_streams_password_is_not_said_in_its_reports(
+    videos: dict[str, Path], monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Streams given by URLs with a password (and a token parameter): the failing source
+    was named with them in the error line and the JSON summary's ``error``. They are said as
+    ``***``; the URLs opened are the ones given."""
+    from stereovision import capture as capmod
+
+    left_url, right_url = "rtsp://admin:s3cret@cam/0?token=tok77", "http://u:pw99@cam/1"
+    real = capmod._open_path
+    opened: list[str] = []
+
+    class FailsAtThird:
+        """The right stream: a backend error in its third grab."""
+
+        def __init__(self, cap: Any) -> None:
+            self.cap, self.grabs = cap, 0
+
+        def grab(self) -> bool:
+            self.grabs += 1
+            if self.grabs == 3:
+                raise cv2.error("connection reset")
+            return bool(self.cap.grab())
+
+        def __getattr__(self, name: str) -> Any:
+            return getattr(self.cap, name)
+
+    def open_path(path: str, first: Any) -> Any:
+        opened.append(path)
+        if path == right_url:
+            return FailsAtThird(real(str(videos["right"]), first))
+        return real(str(videos["left"]) if path == left_url else path, first)
+
+    monkeypatch.setattr(capmod, "_open_path", open_path)
+    argv = ["stream", "--left", left_url, "--right", right_url, "--no-pipeline"]
+    argv += ["--calib", str(videos["calib"]), "--max-disparity", "64", "--no-display", "--json"]
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    said = "right source 'http://u:***@cam/1' failed in OpenCV's grab of pair 3 ("
+    assert _json_lines(out)[-1]["error"].startswith(said)
+    assert err.splitlines()[-1].startswith(f"stereovision: error: {said}")
+    assert opened == [left_url, right_url]
+    for secret in ("s3cret", "tok77", "pw99"):
+        assert secret not in out + err

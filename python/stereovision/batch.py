@@ -240,7 +240,13 @@ def _scan(
     ``calib`` is read at when it holds none (:func:`_calib_size`), else None."""
     r = Path(root)
     if not r.exists():
-        raise FileNotFoundError(f"input folder not found: {r}")
+        from stereovision.capture import mask_url_secrets
+
+        # a URL given (Path made rtsp:// rtsp:/): its password is not said
+        given = os.fspath(root)
+        raise FileNotFoundError(
+            f"input folder not found: {mask_url_secrets(given) if '://' in given else r}"
+        )
     if not r.is_dir():
         raise NotADirectoryError(f"input is not a folder: {r}")
     cal = Path(calib) if calib is not None else None
@@ -1132,13 +1138,24 @@ class _Dask:
             ) from None
 
         def connect() -> None:
+            from stereovision.capture import _mask_secrets_of, mask_url_secrets
+
+            # an address's password (tcp://user:pw@host) is not said, nor written in the run
+            address = str(scheduler)
+            said = mask_url_secrets(address)
             try:
                 self.client = Client(scheduler, timeout=CONNECT_TIMEOUT)
             except (OSError, TimeoutError) as exc:
                 raise OSError(
-                    f"cannot reach the Dask scheduler at {scheduler}: {_error_line(exc)}"
+                    f"cannot reach the Dask scheduler at {said}: "
+                    f"{_mask_secrets_of(_error_line(exc), address)}"
                 ) from None
-            self.desc = str(scheduler)
+            except ValueError as exc:  # Dask's "invalid address 'user:pw@host'"
+                message = _mask_secrets_of(str(exc), address)
+                if message == str(exc):
+                    raise
+                raise ValueError(message) from None
+            self.desc = said
 
         def local() -> None:
             # One worker process per core by default, each kernel with its share of the cores,

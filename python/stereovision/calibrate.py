@@ -2501,14 +2501,16 @@ def _is_video(path: str) -> bool:
 
 def _expand(pattern: str, option: str) -> list[str]:
     """Sorted files matching a glob pattern (or the file itself)."""
-    if glob.has_magic(pattern):
+    from stereovision.capture import mask_url_secrets  # capture imports this module
+
+    if glob.has_magic(pattern):  # a URL's "?" too
         files = sorted(glob.glob(os.path.expanduser(pattern)))
         if not files:
-            raise FileNotFoundError(f"{option} {pattern!r}: no file matches")
+            raise FileNotFoundError(f"{option} {mask_url_secrets(pattern)!r}: no file matches")
         return files
     p = os.path.expanduser(pattern)
-    if not os.path.exists(p):
-        raise FileNotFoundError(f"{option}: file not found: {pattern}")
+    if not os.path.exists(p):  # a stream's password is not said
+        raise FileNotFoundError(f"{option}: file not found: {mask_url_secrets(pattern)}")
     if os.path.isdir(p):
         example = os.path.join(pattern, "*.png")
         raise ValueError(

@@ -68,6 +68,7 @@ from stereovision.io import _opencv_quiet, check_output_folder
 
 __all__ = [
     "MIN_POSE_DISTANCE",
+    "SECRET_QUERY_KEYS",
     "CaptureResult",
     "ChessboardCollector",
     "PairSource",
@@ -82,6 +83,7 @@ __all__ = [
     "capture",
     "cli_read_timeout",
     "fourcc_text",
+    "mask_url_secrets",
     "open_source",
     "parse_fourcc",
     "parse_size",
@@ -390,12 +392,100 @@ def _media_ms(cap: Any) -> float:
     return ms if ms >= 0 else math.nan
 
 
+#: A URL's password: the scheme and user kept. The authority ends at the first "/", "?" or
+#: "#" and its user part at its last "@", as FFmpeg splits a URL (a raw "@" in a password).
+_URL_PASSWORD = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*://[^/?#@:]*):[^/?#]*@")
+#: Query parameters whose value is a secret (case-insensitive): what IP cameras and stream
+#: servers take a token or password as.
+SECRET_QUERY_KEYS = (
+    "access_token",
+    "api_key",
+    "apikey",
+    "auth",
+    "key",
+    "passwd",
+    "password",
+    "pwd",
+    "secret",
+    "token",
+)
+_URL_SECRET_PARAM = re.compile(
+    r"([?&;](?:" + "|".join(SECRET_QUERY_KEYS) + r")=)[^&;#]+", re.IGNORECASE
+)
+
+
+def mask_url_secrets(source: str) -> str:
+    """``source`` as it may be said (in a message, a log, a written file): a URL's password and
+    the values of its :data:`SECRET_QUERY_KEYS` query parameters as ``***``.
+
+    Only what is said is masked: the source is opened as given.
+
+    Parameters
+    ----------
+    source : str
+        A camera source as given: a stream URL, a path or a device index's text.
+
+    Returns
+    -------
+    str
+        ``source`` unchanged unless it is a URL (``scheme://``) holding a password or a secret
+        parameter: ``rtsp://admin:s3cret@cam/0?token=abc`` is ``rtsp://admin:***@cam/0?token=***``.
+
+    Examples
+    --------
+    >>> mask_url_secrets("http://user:pw@host:8080/x?size=2&access_token=abc")
+    'http://user:***@host:8080/x?size=2&access_token=***'
+    >>> mask_url_secrets("rtsp://cam:554/0")
+    'rtsp://cam:554/0'
+    """
+    said, at = [], 0
+    for start, end, masked in _url_secrets(source):
+        said += [source[at:start], masked]
+        at = end
+    return "".join(said) + source[at:]
+
+
+def _url_secrets(source: str) -> list[tuple[int, int, str]]:
+    """Where ``source`` (a URL; none for a path, whose name may hold ``user:pw@`` or
+    ``?key=``) holds a secret: ``(start, end, masked)`` of each part, ``admin:s3cret@`` to be
+    said ``admin:***@``, ``?token=abc`` ``?token=***``; in their order in ``source``."""
+    if "://" not in source:
+        return []
+    parts = []
+    password = _URL_PASSWORD.match(source)
+    if password:
+        parts.append((0, password.end(), f"{password.group(1)}:***@"))
+    # the query alone: from the first "?" after the authority to the fragment ("#")
+    start = source.find("?", password.end() if password else 0)
+    if start >= 0:
+        end = source.find("#", start)
+        query = _URL_SECRET_PARAM.finditer(source, start, end if end >= 0 else len(source))
+        parts += [(m.start(), m.end(), f"{m.group(1)}***") for m in query]
+    return parts
+
+
+def _mask_secrets_of(text: str, source: str) -> str:
+    """``text`` (another library's message, that names ``source`` in its own way: Dask's
+    ``invalid address 'admin:pw@host:1'``) with the parts of ``source`` that hold a secret
+    (``admin:pw@``, ``?token=abc``) masked as :func:`mask_url_secrets` masks them."""
+    # the whole URL first, with or without its scheme (as Dask says an address): a part
+    # alone may be in it twice ("&key=1" in a path too)
+    said = mask_url_secrets(source)
+    for raw, masked in ((source, said), (source.split("://", 1)[-1], said.split("://", 1)[-1])):
+        if raw in text:
+            return text.replace(raw, masked)
+    for start, end, masked in _url_secrets(source):  # a part said alone
+        text = text.replace(source[start:end].split("://", 1)[-1], masked.split("://", 1)[-1])
+    return text
+
+
 def _describe_source(src: Source) -> str:
     # a NumPy index is a device too (StereoCamera opens it): it was described as 'int64'
     if isinstance(src, (int, np.integer)):
         return f"camera {int(src)}"
     if isinstance(src, (str, os.PathLike)):
-        return repr(os.fspath(src))
+        # a stream's password is not said (in an error, a log line, a report)
+        return repr(mask_url_secrets(os.fspath(src)))
     return type(src).__name__
 
 
@@ -2113,8 +2203,9 @@ def open_source(args: argparse.Namespace, *, fps: float | None = None) -> Any:
         # a typo: every pair is one view twice, every disparity 0, and nothing said it (said
         # once the source opens: a missing one is said as such)
         warnings.warn(
-            f"--left and --right are the same source {str(left)!r}: every pair is one "
-            "view twice and every disparity comes out 0 (two cameras' views are needed)",
+            f"--left and --right are the same source {mask_url_secrets(str(left))!r}: every "
+            "pair is one view twice and every disparity comes out 0 (two cameras' views are "
+            "needed)",
             UserWarning,
             stacklevel=2,
         )

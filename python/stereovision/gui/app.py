@@ -43,7 +43,7 @@ import numpy.typing as npt
 from stereovision import release_memory
 from stereovision._validate import advice_for, first_line, known_unit
 from stereovision.calibration import fit_to_frames
-from stereovision.capture import DEFAULT_READ_TIMEOUT, _camera_device
+from stereovision.capture import DEFAULT_READ_TIMEOUT, _camera_device, mask_url_secrets
 from stereovision.gui.sources import (
     CLOUD_SUFFIXES,
     IMAGE_SUFFIXES,
@@ -1181,18 +1181,15 @@ def _pending_key(src: int | str) -> int | str:
     return src
 
 
-# A URL's password: its user and the scheme kept, the authority's last "@" its end.
-_URL_PASSWORD = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*://[^/@:]*):[^/]*@")
-
-
 def _source_name(src: int | str) -> str:
     """A camera source as the page names it: ``camera 0``, the file's name, or a stream's
-    whole URL (``rtsp://rig/0`` was named ``0``, as camera 0 might be), its password, if
-    any, said as ``***``: the name goes into the page's messages and the server's log."""
+    whole URL (``rtsp://rig/0`` was named ``0``, as camera 0 might be), its password and
+    secret parameters, if any, said as ``***`` (:func:`~stereovision.capture.mask_url_secrets`):
+    the name goes into the page's messages and the server's log."""
     if isinstance(src, int):
         return f"camera {src}"
     if "://" in src:
-        return _URL_PASSWORD.sub(r"\1:***@", src, count=1)
+        return mask_url_secrets(src)
     return Path(src).name or src
 
 
@@ -1513,7 +1510,9 @@ class StereoApp:
         st.floor_label = ""
         st.img_floor = ""
         st.floor_caption = floor_caption()
-        st.cam_left, st.cam_right = source_names
+        # the page's fields, sent to every browser on it: a stream's password is not shown
+        # (a URL is no file the page's Open takes: nothing typed there is lost)
+        st.cam_left, st.cam_right = (mask_url_secrets(str(n)) for n in source_names)
         st.live = source is not None
         #: The average switch works on cameras (and recordings), not on a folder's pairs: one
         #: pair after another, never averaged (the switch was on and did nothing).

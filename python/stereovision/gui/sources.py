@@ -27,6 +27,7 @@ from stereovision.capture import (
     _sequence_first,
     camera_hint,
     check_read_timeout,
+    mask_url_secrets,
     read_within,
 )
 from stereovision.capture import parse_source as capture_parse_source
@@ -177,15 +178,16 @@ class AllowedFolders:
         if not text or "\x00" in text:
             raise ValueError("empty or invalid path")
         p = expand_home(text)
+        said = mask_url_secrets(text)  # a stream URL typed: its password is not said
         if not p.is_absolute():
             if not self.roots:
-                raise ValueError(f"path outside the allowed folders: {text}")
+                raise ValueError(f"path outside the allowed folders: {said}")
             p = self.roots[0] / p
         real = p.resolve()
         if not any(real == r or real.is_relative_to(r) for r in self.roots):
-            raise ValueError(f"path outside the allowed folders: {text}")
+            raise ValueError(f"path outside the allowed folders: {said}")
         if not real.exists():
-            raise FileNotFoundError(f"no such file: {text}")
+            raise FileNotFoundError(f"no such file: {said}")
         return real
 
     def resolve_output(
@@ -396,7 +398,9 @@ class VideoPair:
                 src = parse_source(src)
                 is_file = isinstance(src, str)
                 if is_file and "%" not in str(src) and not Path(str(src)).exists():
-                    raise FileNotFoundError(f"{side} camera source not found: {src}")
+                    raise FileNotFoundError(
+                        f"{side} camera source not found: {mask_url_secrets(str(src))}"
+                    )
                 # bounded, the size asked with it: a wedged device hung its open, or a set,
                 # forever (OpenCV's log of the open stays quiet: the error below says what failed)
                 configure = None if size is None or is_file else partial(_ask_size, size)
@@ -406,7 +410,9 @@ class VideoPair:
                 )
                 if not cap.isOpened():
                     cap.release()
-                    raise OSError(f"cannot open camera {src!r} ({side}){camera_hint(src)}")
+                    # a stream's password is not said (the page shows it, the server logs it)
+                    name = mask_url_secrets(src) if isinstance(src, str) else src
+                    raise OSError(f"cannot open camera {name!r} ({side}){camera_hint(src)}")
                 self._caps.append(cap)
                 self._files.append(is_file)
                 self._sequence.append(first is not None)
