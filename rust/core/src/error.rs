@@ -32,13 +32,17 @@ pub enum CoreError {
     InvalidParameter { name: &'static str, reason: String },
     /// An image has more pixels, or a longer side, than the kernels' 32-bit pixel indices and
     /// coordinates reach ([`crate::image::check_index_range`]); they would wrap silently.
+    /// `max_pixels` is the kernel's own limit ([`crate::image::MAX_PIXELS`] for most).
     #[error(
         "image of {width}x{height} pixels is too large: the kernels index pixels with 32-bit \
-         integers (at most {} pixels, {} per side)",
-        crate::image::MAX_PIXELS,
+         integers (at most {max_pixels} pixels, {} per side)",
         crate::image::MAX_SIDE
     )]
-    TooLarge { width: usize, height: usize },
+    TooLarge {
+        width: usize,
+        height: usize,
+        max_pixels: usize,
+    },
     /// A buffer could not be allocated (the binding raises `MemoryError` instead of the
     /// process aborting).
     #[error("out of memory: {what} needs {} and the allocation failed", crate::alloc::human_bytes(*.bytes))]

@@ -132,13 +132,23 @@ pub const MAX_SIDE: usize = i32::MAX as usize;
 /// kernels' 32-bit integers ([`MAX_PIXELS`], [`MAX_SIDE`]): [`CoreError::TooLarge`] instead of
 /// indices that wrap silently. Reads the dimensions only (a kernel calls it once, first).
 pub fn check_index_range(width: usize, height: usize) -> Result<()> {
+    check_index_range_within(width, height, MAX_PIXELS)
+}
+
+/// [`check_index_range`] for a kernel whose 32-bit numbers reach fewer pixels than
+/// [`MAX_PIXELS`] (the graph segmentation numbers two edges a pixel): at most `max_pixels`.
+pub fn check_index_range_within(width: usize, height: usize, max_pixels: usize) -> Result<()> {
     let fits = width <= MAX_SIDE
         && height <= MAX_SIDE
-        && width.checked_mul(height).is_some_and(|n| n <= MAX_PIXELS);
+        && width.checked_mul(height).is_some_and(|n| n <= max_pixels);
     if fits {
         Ok(())
     } else {
-        Err(CoreError::TooLarge { width, height })
+        Err(CoreError::TooLarge {
+            width,
+            height,
+            max_pixels,
+        })
     }
 }
 
@@ -447,14 +457,16 @@ mod tests {
                 check_index_range(w, h),
                 Err(CoreError::TooLarge {
                     width: w,
-                    height: h
+                    height: h,
+                    max_pixels: MAX_PIXELS
                 })
             );
         }
         assert_eq!(
             CoreError::TooLarge {
                 width: 65536,
-                height: 65536
+                height: 65536,
+                max_pixels: MAX_PIXELS
             }
             .to_string(),
             "image of 65536x65536 pixels is too large: the kernels index pixels with 32-bit \
@@ -472,6 +484,7 @@ mod tests {
             Err::<(), _>(CoreError::TooLarge {
                 width: w,
                 height: h,
+                max_pixels: MAX_PIXELS,
             })
         };
         for (w, h) in TOO_LARGE {
@@ -502,7 +515,16 @@ mod tests {
             let r =
                 crate::refine::refine_disparity(img.view(), img.view(), &[], &[], 0.0, 1.0, &rp);
             ok(r.map(|_| ()));
-            ok(crate::segment::graph_segments(&[], w, h, 1, 1.0, 1).map(|_| ()));
+            // Its own, lower limit (two edge numbers a pixel).
+            assert_eq!(
+                crate::segment::graph_segments(&[], w, h, 1, 1.0, 1).map(|_| ()),
+                Err(CoreError::TooLarge {
+                    width: w,
+                    height: h,
+                    max_pixels: crate::segment::GRAPH_MAX_PIXELS,
+                }),
+                "{w}x{h}"
+            );
             ok(crate::segment::quantised_regions(&[], w, h, 1, 8, 0).map(|_| ()));
         }
     }

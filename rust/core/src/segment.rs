@@ -62,12 +62,17 @@ impl Forest {
     }
 }
 
+/// Most pixels of [`graph_segments`]'s image: its sort keys hold the edge numbers (2 p to the
+/// right, 2 p + 1 downwards) in their low 32 bits, so the last, 2 n - 1, must fit a `u32`.
+pub const GRAPH_MAX_PIXELS: usize = 1 << 31;
+
 /// Segments a row-major `(H, W, C)` image (`C` interleaved channels, any scale) into labels
 /// `0..n`, numbered in raster order of each segment's first pixel. See the module docs; `k` is
 /// in the image's units (255-scale images: a few hundred).
 ///
 /// A buffer that cannot be allocated is [`OutOfMemory`](crate::CoreError::OutOfMemory)
-/// (unchecked, it aborted the process).
+/// (unchecked, it aborted the process); more than [`GRAPH_MAX_PIXELS`] pixels is
+/// [`TooLarge`](crate::CoreError::TooLarge).
 ///
 /// # Panics
 /// If `img.len() != w * h * c` or `c == 0`.
@@ -79,8 +84,8 @@ pub fn graph_segments(
     k: f32,
     min_size: usize,
 ) -> Result<Vec<u32>> {
-    // The forest and the edges hold pixel indices in u32.
-    crate::image::check_index_range(w, h)?;
+    // The forest holds pixel indices in u32, the sort keys edge numbers (two a pixel).
+    crate::image::check_index_range_within(w, h, GRAPH_MAX_PIXELS)?;
     assert!(
         c > 0 && img.len() == w * h * c,
         "image size does not match w * h * c"
@@ -573,6 +578,36 @@ pub fn fill_planes(
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+
+    #[test]
+    fn graph_segments_refuses_images_past_its_32_bit_edge_numbers() {
+        // Edge numbers (two a pixel: 2 p, 2 p + 1) sit in the low 32 bits of the sort keys:
+        // past 2^31 pixels they spilled into the weight bits (wrong order, wrong ends), yet
+        // check_index_range let up to u32::MAX pixels through. The shape alone is checked
+        // first (empty buffers: an image that size cannot be allocated in a test).
+        let too_large = |w, h| {
+            Err(crate::CoreError::TooLarge {
+                width: w,
+                height: h,
+                max_pixels: GRAPH_MAX_PIXELS,
+            })
+        };
+        for (w, h) in [(1 << 16, (1 << 15) + 1), ((1 << 31) + 1, 1), (3, 1 << 30)] {
+            assert_eq!(
+                graph_segments(&[], w, h, 1, 1.0, 1),
+                too_large(w, h),
+                "{w}x{h}"
+            );
+        }
+        assert_eq!(GRAPH_MAX_PIXELS, 1 << 31);
+        // At the limit the last edge number, 2 (n - 1) + 1, is u32::MAX: it fits.
+        assert_eq!(2 * (GRAPH_MAX_PIXELS - 1) + 1, u32::MAX as usize);
+        assert_eq!(
+            too_large(1 << 16, 1 << 16).unwrap_err().to_string(),
+            "image of 65536x65536 pixels is too large: the kernels index pixels with 32-bit \
+             integers (at most 2147483648 pixels, 2147483647 per side)"
+        );
+    }
 
     #[test]
     fn tables_too_large_to_allocate_are_an_error() {
