@@ -497,6 +497,9 @@ mod tests {
             let mp = mcgm::McgmParams::default();
             ok(mcgm::mcgm_match(&img, &img, &mp).map(|_| ()));
             ok(mcgm::image_curves(&img, &mp).map(|_| ()));
+            // Reached alone through the binding (mcgm_filter).
+            let r = mcgm::edge_filters(&img, &img, &[], &mp.filters, (0, 16));
+            ok(r.map(|_| ()));
             let zc = mcgm::zerocross::ZeroCrossings {
                 width: w,
                 height: h,
@@ -511,6 +514,8 @@ mod tests {
             ok(hopfield::best_match(&img, &img, &hp).map(|_| ()));
             let gp = gabor::GaborParams::default();
             ok(gabor::gabor_disparity(&img, &img, &gp).map(|_| ()));
+            // Reached alone through the binding (gabor_remove_speckles).
+            ok(gabor::post::remove_speckles(&mut [], w, h, 1, 1.0));
             let rp = crate::refine::RefineParams::default();
             let r =
                 crate::refine::refine_disparity(img.view(), img.view(), &[], &[], 0.0, 1.0, &rp);

@@ -245,7 +245,8 @@ const NO_LABEL: u32 = u32::MAX;
 ///
 /// A failed allocation of the label image, of a band's labels (reserved for one label a pixel)
 /// or of the tables of its labels (up to one label a pixel, 4 bytes each per table) is
-/// [`crate::CoreError::OutOfMemory`] (`disp` unchanged).
+/// [`crate::CoreError::OutOfMemory`] (`disp` unchanged); an image past
+/// [`crate::image::check_index_range`] is [`crate::CoreError::TooLarge`].
 pub fn remove_speckles(
     disp: &mut [f32],
     w: usize,
@@ -254,6 +255,9 @@ pub fn remove_speckles(
     max_diff: f32,
 ) -> Result<()> {
     use rayon::prelude::*;
+    // Labels are u32 (NO_LABEL = u32::MAX): the binding's gabor_remove_speckles reaches this
+    // without gabor_disparity's check.
+    crate::image::check_index_range(w, h)?;
     if min_size == 0 || w == 0 || h == 0 {
         return Ok(());
     }

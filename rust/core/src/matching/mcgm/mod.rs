@@ -1455,6 +1455,9 @@ pub fn edge_filters(
 ) -> Result<(Vec<bool>, FilterCounts)> {
     f.validate()?;
     check_pair(left, right)?;
+    // Positions are compared with `w as i32`, rows and match numbers counted in u32: the
+    // binding's mcgm_filter reaches this without mcgm_match's check.
+    crate::image::check_index_range(left.width, left.height)?;
     let (w, h) = left.size();
     // Both per-match checks run in raster order of the left pixel: neighbouring checks read
     // the same image rows (in match order, the windows' rows were mostly cache misses).
