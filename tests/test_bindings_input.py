@@ -364,6 +364,11 @@ try:
             _core.mcgm_filter(a, a, m, {{"max_disparity": 16}})
         except ValueError as e:
             print("ValueError:", e)
+    elif case == "interest_too_wide":
+        try:
+            _core.hopfield_interest(np.broadcast_to(np.float32(0.5), (1, 2**31 + 1)))
+        except ValueError as e:
+            print("ValueError:", e)
     elif case == "available":
         print("available", sgm._available_bytes())
         raise MemoryError("none")
@@ -407,6 +412,20 @@ def test_a_failed_allocation_is_a_memory_error(case: str, message: str) -> None:
     out = _under_address_limit(case, 3_000_000 * 1024)
     assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
     assert f"MemoryError: {message} and the allocation failed" in out.stdout, out.stdout
+
+
+@pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")
+def test_hopfield_interest_refuses_a_row_past_int32_before_copying_it() -> None:
+    """``hopfield_interest`` returns its points as int32 but checked no size: a column of
+    2**31 or more wrapped negative. It copied the (broadcast) image first, too: under
+    ``ulimit -v`` that was a MemoryError for the 8 GiB copy instead of the size's ValueError."""
+    out = _under_address_limit("interest_too_wide", 3_000_000 * 1024)
+    assert out.returncode == 0, (out.returncode, out.stderr[-2000:])
+    want = (
+        "ValueError: image of 2147483649x1 pixels is too large: the kernels index pixels "
+        "with 32-bit integers (at most 4294967295 pixels, 2147483647 per side)"
+    )
+    assert want in out.stdout, out.stdout
 
 
 @pytest.mark.skipif(sys.platform != "linux", reason="RLIMIT_AS and /proc are Linux's")

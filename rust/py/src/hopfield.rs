@@ -136,6 +136,10 @@ pub fn hopfield_interest<'py>(
     Bound<'py, PyArray1<f32>>,
 )> {
     let img: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(img, "img")?;
+    // The points go out as int32 (a column past i32 wrapped): refused from the shape, before
+    // the image is copied.
+    let (h, w) = img.as_array().dim();
+    stereovision_core::image::check_index_range(w, h).map_err(crate::errors::to_pyerr)?;
     let im = grey_from_numpy(&img, "image")?;
     let im = im.view();
     let unit = |v: f32| v.is_finite() && (0.0..=1.0).contains(&v);
@@ -144,7 +148,6 @@ pub fn hopfield_interest<'py>(
             "rel_threshold and floor_rel must lie in [0, 1] and nms_half be >= 1",
         ));
     }
-    let (w, h) = im.size();
     let p = stereovision_core::matching::hopfield::InterestParams {
         rel_threshold,
         nms_half,
