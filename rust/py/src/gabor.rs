@@ -298,6 +298,9 @@ pub fn gabor_remove_speckles<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let disp: PyReadonlyArray2<'py, f32> = crate::convert::array_arg(disp, "disp")?;
     crate::params::non_negative("max_diff", max_diff)?;
+    // The kernel's own check comes after the copy below: refused from the shape first.
+    let (h, w) = disp.as_array().dim();
+    stereovision_core::image::check_index_range(w, h).map_err(crate::errors::to_pyerr)?;
     let kernel = |d: &mut [f32], w, h| {
         guard("gabor_remove_speckles", || {
             remove_speckles(d, w, h, min_size, max_diff)

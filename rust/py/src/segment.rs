@@ -61,6 +61,9 @@ pub fn plane_fill<'py>(
     let labels: PyReadonlyArray2<'py, u32> = crate::convert::array_arg(labels, "labels")?;
     let a = disp.as_array();
     let (h, w) = a.dim();
+    // The kernel lists pixels and counts them in u32, and has no check of its own: refused
+    // from the shape, before the arrays are copied.
+    stereovision_core::image::check_index_range(w, h).map_err(crate::errors::to_pyerr)?;
     if labels.as_array().dim() != (h, w) {
         return Err(PyValueError::new_err(format!(
             "labels: expected shape ({h}, {w}) like disp, got {:?}",
