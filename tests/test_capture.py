@@ -3773,6 +3773,26 @@ def test_stereo_camera_quiets_only_the_sequences_grab(tmp_path: Path) -> None:
         ("http://cam/x?token=&tokens=1&monkey=2", "http://cam/x?token=&tokens=1&monkey=2"),
         # a path is no URL, whatever its name holds
         ("/data/a:b@c/x?token=1.avi", "/data/a:b@c/x?token=1.avi"),
+        ("/data/run@2/left_%03d.png", "/data/run@2/left_%03d.png"),
+        ("frames:left/%d.png", "frames:left/%d.png"),
+        ("a?key=1.png", "a?key=1.png"),
+        ("user@host:path", "user@host:path"),
+        ("C:\\data\\left_%03d.png", "C:\\data\\left_%03d.png"),
+        ("/data/rtsp://u:pw@h/0", "/data/rtsp://u:pw@h/0"),
+        ("v4l2src device=/dev/video0 ! videoconvert ! appsink",) * 2,
+        ("rtsp://[::1]:554/0?keyframe=3", "rtsp://[::1]:554/0?keyframe=3"),
+        ("rtsp://u:pw@[::1]:554/0", "rtsp://u:***@[::1]:554/0"),
+        # a URL in a GStreamer pipeline: its password was said, and a masked parameter's
+        # value ran on over the rest of the pipeline ('?token=***' ate '" ! appsink')
+        (
+            "rtspsrc location=rtsp://u:pw@cam/0 latency=0 ! decodebin ! appsink",
+            "rtspsrc location=rtsp://u:***@cam/0 latency=0 ! decodebin ! appsink",
+        ),
+        (
+            'souphttpsrc location="http://u:pw@cam/x?token=abc" ! jpegdec ! appsink',
+            'souphttpsrc location="http://u:***@cam/x?token=***" ! jpegdec ! appsink',
+        ),
+        (" rtsp://admin:s3cret@cam/0", " rtsp://admin:***@cam/0"),
     ],
 )
 def test_a_urls_secrets_are_masked(url: str, said: str) -> None:

@@ -392,9 +392,13 @@ def _media_ms(cap: Any) -> float:
     return ms if ms >= 0 else math.nan
 
 
+_SCHEME = r"[A-Za-z][A-Za-z0-9+.-]*://"
 #: A URL's password: the scheme and user kept. The authority ends at the first "/", "?" or
 #: "#" and its user part at its last "@", as FFmpeg splits a URL (a raw "@" in a password).
-_URL_PASSWORD = re.compile(r"^([A-Za-z][A-Za-z0-9+.-]*://[^/?#@:]*):[^/?#]*@")
+_URL_PASSWORD = re.compile(r"(" + _SCHEME + r"[^/?#@:]*):[^/?#]*@")
+#: A URL inside other text (a GStreamer pipeline's ``location=rtsp://...``): its scheme at
+#: the start or after a space, "=" or a quote; it ends at a space or a quote.
+_URL_IN_TEXT = re.compile(r"(?:^|(?<=[\s=\"']))" + _SCHEME + r"[^\s\"']*")
 #: Query parameters whose value is a secret (case-insensitive): what IP cameras and stream
 #: servers take a token or password as.
 SECRET_QUERY_KEYS = (
@@ -446,21 +450,28 @@ def mask_url_secrets(source: str) -> str:
 
 
 def _url_secrets(source: str) -> list[tuple[int, int, str]]:
-    """Where ``source`` (a URL; none for a path, whose name may hold ``user:pw@`` or
-    ``?key=``) holds a secret: ``(start, end, masked)`` of each part, ``admin:s3cret@`` to be
-    said ``admin:***@``, ``?token=abc`` ``?token=***``; in their order in ``source``."""
+    """Where ``source`` (a URL, or text holding URLs such as a GStreamer pipeline; none for a
+    path, whose name may hold ``user:pw@`` or ``?key=``) holds a secret: ``(start, end,
+    masked)`` of each part, ``admin:s3cret@`` to be said ``admin:***@``, ``?token=abc``
+    ``?token=***``; in their order in ``source``."""
     if "://" not in source:
         return []
+    body = source.lstrip()
+    if re.match(_SCHEME, body):  # one URL (a space in it is the URL's, as it is opened)
+        spans = [(len(source) - len(body), len(source))]
+    else:  # URLs in a pipeline: the password in "location=rtsp://u:pw@h/" was said
+        spans = [m.span() for m in _URL_IN_TEXT.finditer(source)]
     parts = []
-    password = _URL_PASSWORD.match(source)
-    if password:
-        parts.append((0, password.end(), f"{password.group(1)}:***@"))
-    # the query alone: from the first "?" after the authority to the fragment ("#")
-    start = source.find("?", password.end() if password else 0)
-    if start >= 0:
-        end = source.find("#", start)
-        query = _URL_SECRET_PARAM.finditer(source, start, end if end >= 0 else len(source))
-        parts += [(m.start(), m.end(), f"{m.group(1)}***") for m in query]
+    for first, last in spans:
+        password = _URL_PASSWORD.match(source, first, last)
+        if password:
+            parts.append((first, password.end(), f"{password.group(1)}:***@"))
+        # the query alone: from the first "?" after the authority to the fragment ("#")
+        start = source.find("?", password.end() if password else first, last)
+        if start >= 0:
+            end = source.find("#", start, last)
+            query = _URL_SECRET_PARAM.finditer(source, start, end if end >= 0 else last)
+            parts += [(m.start(), m.end(), f"{m.group(1)}***") for m in query]
     return parts
 
 
