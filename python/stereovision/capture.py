@@ -394,8 +394,10 @@ def _media_ms(cap: Any) -> float:
 
 _SCHEME = r"[A-Za-z][A-Za-z0-9+.-]*://"
 #: A URL's password: the scheme and user kept. The authority ends at the first "/", "?" or
-#: "#" and its user part at its last "@", as FFmpeg splits a URL (a raw "@" in a password).
-_URL_PASSWORD = re.compile(r"(" + _SCHEME + r"[^/?#@:]*):[^/?#]*@")
+#: "#" and its user part at its last "@", as FFmpeg splits a URL (a raw "@" in a password);
+#: failing that, at the first "/": a password typed with a raw "#" or "?" (which FFmpeg
+#: cannot open, so it is said in the error) is a password still.
+_URL_PASSWORD = re.compile(r"(" + _SCHEME + r"[^/?#@:]*):(?:[^/?#]*|[^/]*)@")
 #: A URL inside other text (a GStreamer pipeline's ``location=rtsp://...``): its scheme at
 #: the start or after a space, "=" or a quote; it ends at a space or a quote.
 _URL_IN_TEXT = re.compile(r"(?:^|(?<=[\s=\"']))" + _SCHEME + r"[^\s\"']*")
