@@ -1177,3 +1177,17 @@ def test_open_stereo_source_loops_video_files(tmp_path):
     assert np.abs(frames[0].astype(int) - frames[VIDEO_FRAMES]).mean() < 3  # started again
     with pytest.raises(OSError, match="7"):
         sources.open_stereo_source(7, 8)
+
+
+def test_video_pair_says_a_stream_that_gives_no_frame_without_its_password(
+    fake_cap: type[FakeCap],
+) -> None:
+    """A URL with a percent-encoded password ("%" in it: not looked for as a file) that opens
+    and gives no frame was said whole, 'camera 'rtsp://admin:p%40ss@cam/0' gave no frame',
+    where its "cannot open" is masked."""
+    fake_cap.frames = []
+    url = "rtsp://admin:p%40ss@cam/0"
+    pair = VideoPair(url, url)
+    with pytest.raises(OSError, match=r"^camera 'rtsp://admin:\*\*\*@cam/0' gave no frame$"):
+        pair.read()
+    pair.close()

@@ -421,13 +421,18 @@ class VideoPair:
             raise
         self.sources = (left, right)
 
+    def _name(self, i: int) -> int | str:
+        """Source ``i`` as said in an error: a stream's password masked."""
+        src = self.sources[i]
+        return mask_url_secrets(src) if isinstance(src, str) else src
+
     def _decode(self, i: int, grabbed: bool) -> npt.NDArray[np.uint8] | None:
         """Source ``i``'s grabbed frame; None when it is a file that ended."""
         ok, frame = self._caps[i].retrieve() if grabbed else (False, None)
         if not ok or frame is None:
             if self._files[i]:
                 return None
-            raise OSError(f"camera {self.sources[i]!r} gave no frame")
+            raise OSError(f"camera {self._name(i)!r} gave no frame")
         if frame.ndim == 2:
             frame = cv2.cvtColor(frame, cv2.COLOR_GRAY2BGR)
         return np.ascontiguousarray(frame, dtype=np.uint8)
@@ -456,9 +461,9 @@ class VideoPair:
                     cap.set(cv2.CAP_PROP_POS_FRAMES, 0)
             left, right = self._pair()
         if left is None:
-            raise OSError(f"camera {self.sources[0]!r} gave no frame")
+            raise OSError(f"camera {self._name(0)!r} gave no frame")
         if right is None:
-            raise OSError(f"camera {self.sources[1]!r} gave no frame")
+            raise OSError(f"camera {self._name(1)!r} gave no frame")
         return left, right
 
     def close(self) -> None:
