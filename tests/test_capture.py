@@ -3798,6 +3798,17 @@ def test_stereo_camera_quiets_only_the_sequences_grab(tmp_path: Path) -> None:
         ("rtsp://admin:pa?ss@cam/0?token=t", "rtsp://admin:***@cam/0?token=***"),
         # FFmpeg's split first: an "@" in the query is not the password's end
         ("http://u:pw@host?mail=a@b", "http://u:***@host?mail=a@b"),
+        # a presigned URL's signature and token (S3's, a CDN's sig=), an OAuth client secret
+        (
+            "https://b.s3.amazonaws.com/v.mp4?X-Amz-Credential=AK%2F1&X-Amz-Signature=ab12"
+            "&X-Amz-Security-Token=tk&X-Amz-Expires=60",
+            "https://b.s3.amazonaws.com/v.mp4?X-Amz-Credential=***&X-Amz-Signature=***"
+            "&X-Amz-Security-Token=***&X-Amz-Expires=60",
+        ),
+        (
+            "https://cdn/v.m3u8?sig=ab&signature=cd&client_secret=ef&signed=1",
+            "https://cdn/v.m3u8?sig=***&signature=***&client_secret=***&signed=1",
+        ),
     ],
 )
 def test_a_urls_secrets_are_masked(url: str, said: str) -> None:

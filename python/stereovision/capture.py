@@ -402,18 +402,24 @@ _URL_PASSWORD = re.compile(r"(" + _SCHEME + r"[^/?#@:]*):(?:[^/?#]*|[^/]*)@")
 #: the start or after a space, "=" or a quote; it ends at a space or a quote.
 _URL_IN_TEXT = re.compile(r"(?:^|(?<=[\s=\"']))" + _SCHEME + r"[^\s\"']*")
 #: Query parameters whose value is a secret (case-insensitive): what IP cameras and stream
-#: servers take a token or password as.
+#: servers take a token or password as, and a presigned URL's signature (S3's, a CDN's).
 SECRET_QUERY_KEYS = (
     "access_token",
     "api_key",
     "apikey",
     "auth",
+    "client_secret",
     "key",
     "passwd",
     "password",
     "pwd",
     "secret",
+    "sig",
+    "signature",
     "token",
+    "x-amz-credential",
+    "x-amz-security-token",
+    "x-amz-signature",
 )
 _URL_SECRET_PARAM = re.compile(
     r"([?&;](?:" + "|".join(SECRET_QUERY_KEYS) + r")=)[^&;#]+", re.IGNORECASE
