@@ -3809,6 +3809,17 @@ def test_stereo_camera_quiets_only_the_sequences_grab(tmp_path: Path) -> None:
             "https://cdn/v.m3u8?sig=ab&signature=cd&client_secret=ef&signed=1",
             "https://cdn/v.m3u8?sig=***&signature=***&client_secret=***&signed=1",
         ),
+        # a user named by an e-mail address: FFmpeg's user ends at the last "@"'s first ":"
+        # (its password was said in full); an "@" before a port is no password's end
+        ("rtsp://me@mail.com:pw@cam/0", "rtsp://me@mail.com:***@cam/0"),
+        ("rtsp://me@mail.com:p@ss@cam/0?token=t", "rtsp://me@mail.com:***@cam/0?token=***"),
+        ("http://u@host:8080?mail=a@b", "http://u@host:8080?mail=a@b"),
+        # the query is looked for after the password: a "?key=" in a password is the password's
+        ("rtsp://u:a?key=b@cam/0", "rtsp://u:***@cam/0"),
+        # one URL is the whole source, spaces and all (a leading space too)
+        ("http://cam/my video.avi?token=x", "http://cam/my video.avi?token=***"),
+        (" http://cam/a b?token=x", " http://cam/a b?token=***"),
+        ("http://cam/x?auth=a&secret=b&apikey=c", "http://cam/x?auth=***&secret=***&apikey=***"),
     ],
 )
 def test_a_urls_secrets_are_masked(url: str, said: str) -> None:

@@ -393,11 +393,14 @@ def _media_ms(cap: Any) -> float:
 
 
 _SCHEME = r"[A-Za-z][A-Za-z0-9+.-]*://"
-#: A URL's password: the scheme and user kept. The authority ends at the first "/", "?" or
-#: "#" and its user part at its last "@", as FFmpeg splits a URL (a raw "@" in a password);
+#: A URL's password: the scheme and user kept (group 1 or 2). The authority ends at the first
+#: "/", "?" or "#", its user part at its last "@" and the user at its first ":", as FFmpeg
+#: splits a URL (a raw "@" in a password, or in a user named by an e-mail address);
 #: failing that, at the first "/": a password typed with a raw "#" or "?" (which FFmpeg
 #: cannot open, so it is said in the error) is a password still.
-_URL_PASSWORD = re.compile(r"(" + _SCHEME + r"[^/?#@:]*):(?:[^/?#]*|[^/]*)@")
+_URL_PASSWORD = re.compile(
+    r"(" + _SCHEME + r"[^/?#:]*):[^/?#]*@|(" + _SCHEME + r"[^/?#@:]*):[^/]*@"
+)
 #: A URL inside other text (a GStreamer pipeline's ``location=rtsp://...``): its scheme at
 #: the start or after a space, "=" or a quote; it ends at a space or a quote.
 _URL_IN_TEXT = re.compile(r"(?:^|(?<=[\s=\"']))" + _SCHEME + r"[^\s\"']*")
@@ -473,7 +476,7 @@ def _url_secrets(source: str) -> list[tuple[int, int, str]]:
     for first, last in spans:
         password = _URL_PASSWORD.match(source, first, last)
         if password:
-            parts.append((first, password.end(), f"{password.group(1)}:***@"))
+            parts.append((first, password.end(), f"{password[1] or password[2]}:***@"))
         # the query alone: from the first "?" after the authority to the fragment ("#")
         start = source.find("?", password.end() if password else first, last)
         if start >= 0:
