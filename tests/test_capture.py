@@ -1660,6 +1660,50 @@ def test_cli_capture_from_a_recording_shows_its_frames_bar_on_a_terminal(
     assert not re.search(r"[4-6]/3 ", terminal.text)
 
 
+def test_the_frames_bars_total_is_the_fewer_announced_and_zero_when_one_is_unknown(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The frames bar's total (``_frames_announced``) is the fewer of the two sources' frame
+    counts (the pairs a recording can give), 0 (no total) when either says none: a source
+    given as an object (its count may mean anything) or a count that is no count (0, NaN,
+    inf: ``int(nan)`` raised). A bar of total 0 is not drawn, and the warnings' routing ends
+    with the bar."""
+
+    class _Counted(_FakeCap):
+        def get(self, prop: int) -> float:
+            return 6.0 if prop == cv2.CAP_PROP_FRAME_COUNT else super().get(prop)
+
+    left, right = _videos(tmp_path, 6, 4)
+    with StereoCamera(str(left), str(right)) as cam:
+        assert [cam._announced(side) for side in ("left", "right")] == [6, 4]
+        assert capmod._frames_announced(cam) == 4
+        real = cam._caps["left"]
+        for said in (0.0, -1.0, math.nan, math.inf):
+
+            class _Says:
+                def get(self, prop: int, said: float = said) -> float:
+                    return said if prop == cv2.CAP_PROP_FRAME_COUNT else real.get(prop)
+
+            cam._caps["left"] = _Says()
+            assert cam._announced("left") is None, said
+            assert capmod._frames_announced(cam) == 0
+        cam._caps["left"] = real
+    with StereoCamera(_Counted("L", []), str(right)) as cam:
+        assert cam._announced("left") is None and cam._announced("right") == 4
+        assert capmod._frames_announced(cam) == 0
+    assert capmod._frames_announced(object()) == 0
+
+    monkeypatch.setattr("sys.stderr", terminal := _Terminal())
+    shown = warnings.showwarning
+    bar = capmod._FramesBar()
+    bar.start(0)  # a camera's: no bar, warnings as they were
+    assert bar.bar is None and terminal.text == "" and warnings.showwarning is shown
+    bar.start(6)
+    assert bar.bar is not None and warnings.showwarning is not shown
+    bar.close()
+    assert bar.bar is None and warnings.showwarning is shown
+
+
 def test_cli_capture_warning_while_reading_goes_above_the_frames_bar(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -3506,6 +3550,10 @@ def test_the_image_sequence_reader_refuses_a_nan_position_without_raising(
     assert ok and _read_stamp(frame) == 8
     assert seq.set(cv2.CAP_PROP_POS_FRAMES, float("inf")) is True  # clamped to the last
     assert _read_stamp(seq.read()[1]) == 9
+    # none there: no seek (CAP_IMAGES unopened refuses too), where the position went to -1
+    empty = capmod._ImageSequence(str(tmp_path / "none_%03d.png"), 7)
+    for prop in (cv2.CAP_PROP_POS_FRAMES, cv2.CAP_PROP_POS_AVI_RATIO):
+        assert empty.set(prop, 0.0) is False and empty.get(cv2.CAP_PROP_POS_FRAMES) == 0.0
 
 
 @pytest.mark.parametrize(
