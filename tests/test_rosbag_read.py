@@ -188,6 +188,61 @@ def test_topic_discovery() -> None:
         find_stereo_topics(["/cam0/image_raw", "/cam1/image_raw", "/cam2/image_raw"])
     with pytest.raises(ValueError, match="none"):
         find_stereo_topics([])
+    # names of another depth are no pair, whatever their one differing part
+    with pytest.raises(ValueError, match="no left/right pair"):
+        find_stereo_topics(["/stereo/left/image", "/stereo/right/image/theora"])
+
+
+def test_holding_reads_only_the_topics_asked_until_each_shows_a_message() -> None:
+    """``_holding`` (the check of an index's zero count on the messages) asks the reader for
+    the topics asked alone, stops at the first message of the last of them (a topic with
+    messages costs a few, not a pass over the bag) and closes the messages it opened."""
+    from types import SimpleNamespace
+
+    from stereovision.rosbag import _holding
+
+    conns = [SimpleNamespace(topic=t) for t in ("/a", "/b", "/c")]
+
+    class _Reader:
+        connections = conns
+
+        def __init__(self) -> None:
+            self.asked: list[str] = []
+            self.read = 0
+            self.closed = False
+
+        def messages(self, connections: list[Any]) -> Any:
+            self.asked = [c.topic for c in connections]
+            order = ["/a", "/a", "/b", "/c", "/a", "/b"]  # in time order, as the bag holds them
+            reader = self
+
+            class _Messages:  # rosbags' generator, whose close() ends its read of the bag
+                def __init__(self) -> None:
+                    self.left = [
+                        c for t in order if t in reader.asked for c in conns if c.topic == t
+                    ]
+
+                def __iter__(self) -> Any:
+                    return self
+
+                def __next__(self) -> tuple[Any, int, bytes]:
+                    if not self.left:
+                        raise StopIteration
+                    reader.read += 1
+                    return self.left.pop(0), 0, b""
+
+                def close(self) -> None:
+                    reader.closed = True
+
+            return _Messages()
+
+    reader = _Reader()
+    assert _holding(reader, {"/a", "/b"}) == {"/a", "/b"}
+    assert reader.asked == ["/a", "/b"] and reader.read == 3 and reader.closed
+    reader = _Reader()
+    assert _holding(reader, {"/c", "/x"}) == {"/c"}  # /x: no connection, no message
+    assert reader.asked == ["/c"] and reader.closed
+    assert _holding(_Reader(), {"/x"}) == set()
 
 
 # ------------------------------------------------------------------------------- the bags
@@ -872,6 +927,21 @@ def test_a_pair_recorded_without_messages_is_passed_over(cones: Any, tmp_path: P
     assert find_stereo_topics([LEFT, RIGHT], {LEFT: -1, RIGHT: -1}) == (LEFT, RIGHT)
 
 
+@pytest.mark.parametrize("flavour", ["ros2", "ros1"])
+def test_a_bag_of_one_instant_has_a_span_and_its_counts_announced(
+    cones: Any, tmp_path: Path, flavour: str
+) -> None:
+    """A bag whose messages were all recorded at one instant (one pair) spans 0.0 s, not "?"
+    (kept for an index that counts none); its topics announce their messages to the frames
+    bar, none once the bag is closed (an index counting none: the test below)."""
+    bag = write_bag(tmp_path / ("one.bag" if flavour == "ros1" else "one"),
+                    [(T0, cones.left, T0, cones.right)], flavour=flavour)  # fmt: skip
+    with BagCamera(bag) as cam:
+        assert cam.summary().splitlines()[0].endswith(", 0.0 s, 2 topics)")
+        assert [cam._announced(side) for side in ("left", "right")] == [1, 1]
+    assert cam._announced("left") is None  # closed
+
+
 def _zero_ros1_index_counts(bag: Path) -> None:
     """Zero every count of a ROS 1 bag's chunk infos (the index's per-topic message counts),
     keeping the messages and each chunk's own index of them."""
@@ -940,6 +1010,7 @@ def test_a_bag_whose_index_counts_no_messages_is_read_with_its_topics_found(
         reader.close()
     with BagCamera(bag) as cam:
         assert cam.topics == {"left": LEFT, "right": RIGHT}
+        assert cam._announced("left") is None  # the frames bar has no total, not 0
         assert cam.info_topics == {"left": "/stereo/left/camera_info",
                                    "right": "/stereo/right/camera_info"}  # fmt: skip
         assert cam.calibration() == want
