@@ -3543,6 +3543,8 @@ def test_the_image_sequence_reader_refuses_a_nan_position_without_raising(
     for i in range(7, 10):
         cv2.imwrite(str(tmp_path / f"s_{i:03d}.png"), _numbered(i))
     seq = capmod._ImageSequence(str(tmp_path / "s_%03d.png"), 7)
+    # the first image's size before any read (width, height)
+    assert (seq.get(cv2.CAP_PROP_FRAME_WIDTH), seq.get(cv2.CAP_PROP_FRAME_HEIGHT)) == SMALL
     assert seq.read()[0]
     assert seq.set(cv2.CAP_PROP_POS_FRAMES, float("nan")) is False
     assert seq.get(cv2.CAP_PROP_POS_FRAMES) == 1.0
@@ -3550,6 +3552,7 @@ def test_the_image_sequence_reader_refuses_a_nan_position_without_raising(
     assert ok and _read_stamp(frame) == 8
     assert seq.set(cv2.CAP_PROP_POS_FRAMES, float("inf")) is True  # clamped to the last
     assert _read_stamp(seq.read()[1]) == 9
+    assert seq.grab() is False and seq.retrieve() == (False, None)  # not the last again
     # none there: no seek (CAP_IMAGES unopened refuses too), where the position went to -1
     empty = capmod._ImageSequence(str(tmp_path / "none_%03d.png"), 7)
     for prop in (cv2.CAP_PROP_POS_FRAMES, cv2.CAP_PROP_POS_AVI_RATIO):
@@ -3877,6 +3880,23 @@ def test_a_urls_secrets_are_masked(url: str, said: str) -> None:
         assert capmod._mask_secrets_of(text, url) == (
             f"a: bad address {said.split('://')[1]!r} (a=a, user u, key c)"
         )
+
+
+def test_another_librarys_words_for_a_urls_parts_lose_their_secrets() -> None:
+    """A message naming a URL's parts alone, not the URL (the user part without its scheme,
+    the query), says them masked as the URL is."""
+    url = "rtsp://admin:s3cret@cam/0?token=abc"
+    text = "refused admin:s3cret@ (query ?token=abc)"
+    assert capmod._mask_secrets_of(text, url) == "refused admin:***@ (query ?token=***)"
+
+
+def test_capture_calls_progress_with_the_pairs_read_so_far(tmp_path: Path) -> None:
+    """``capture(progress=)`` (the frames bar's update) is told the pairs read after each."""
+    left, right = _videos(tmp_path, 3, 3)
+    seen: list[int] = []
+    with StereoCamera(str(left), str(right)) as cam:
+        result = capture(cam, tmp_path / "pairs", every=2, progress=seen.append)
+    assert seen == [1, 2, 3] and result.frames_read == 3 and len(result.saved) == 2
 
 
 #: Streams with a password and a token: what the capture code says must not hold these.
